@@ -1,0 +1,1 @@
+"""Analysis on top of the models: hybrid integration, Poincaré map, fixed points, metrics."""

@@ -1,0 +1,94 @@
+"""Gait metrics and named samples of a rigid hybrid trajectory."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from walkerlab.analysis.hybrid import HybridTrajectory
+from walkerlab.io.trajectory import NamedTrajectory
+
+
+def _leg_point_name(name: str, roles_to_legs: dict[str, str]) -> str:
+    for role, leg in roles_to_legs.items():
+        if name.startswith(role + "_"):
+            return leg + name[len(role):]
+    return name
+
+
+def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory:
+    """Dense samples at ``rate_hz`` plus each step's end (pre-impact) state.
+
+    Potential energy is measured from the first stance foot's height, so the total
+    mechanical energy is constant in swing and drops at each heel strike.
+    """
+    w = traj.walker
+    n = w.n_coordinates
+    legs = list(w.legs)
+    chunks = {k: [] for k in ("t", "stance", "step", "ke", "pe")}
+    ang = {leg: [] for leg in legs}
+    rat = {leg: [] for leg in legs}
+    pts: dict[str, list] = {}
+    g = w.params.get("gravity_m_per_s2", 9.81)
+    for seg in traj.segments:
+        dt = 1.0 / rate_hz
+        times = np.arange(seg.t_start, seg.t_end, dt)
+        times = np.append(times, seg.t_end)
+        X = seg.sample(times)
+        r2l = w.role_to_leg(seg.stance_leg)
+        for i, role in enumerate(w.roles):
+            ang[r2l[role]].append(X[i])
+            rat[r2l[role]].append(X[n + i])
+        ke, pe = w.energies(X)
+        pe = pe + w.total_mass_kg * g * seg.stance_foot_world[1]
+        chunks["t"].append(times)
+        chunks["ke"].append(np.broadcast_to(ke, times.shape))
+        chunks["pe"].append(np.broadcast_to(pe, times.shape))
+        chunks["stance"].append(np.full(times.size, legs.index(seg.stance_leg)))
+        chunks["step"].append(np.full(times.size, seg.index))
+        for name, xy in w.points(X).items():
+            key = _leg_point_name(name, r2l)
+            pts.setdefault(key, []).append(np.asarray(xy) + seg.stance_foot_world[:, None])
+    cat = np.concatenate
+    return NamedTrajectory(
+        time=cat(chunks["t"]), legs=legs,
+        angle={k: cat(v) for k, v in ang.items()}, rate={k: cat(v) for k, v in rat.items()},
+        stance_leg=cat(chunks["stance"]), step_index=cat(chunks["step"]),
+        kinetic=cat(chunks["ke"]), potential=cat(chunks["pe"]),
+        points={k: np.hstack(v) for k, v in pts.items()},
+    )
+
+
+def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
+    """Per-step metrics: period [s], step length [m], hip speed [m/s], impact loss [J], ...
+
+    Step length is the distance between the stance foot and the swing foot at heel strike;
+    hip speed is the horizontal hip displacement over the step divided by its period.
+    """
+    w = traj.walker
+    rows = {k: [] for k in ("index", "stance_leg", "swing_leg", "t_start", "t_end", "period",
+                            "termination", "event", "step_length", "hip_speed",
+                            "impact_energy_loss", "nfev", "midstance_time")}
+    for seg in traj.segments:
+        r2l = w.role_to_leg(seg.stance_leg)
+        rows["index"].append(seg.index)
+        rows["stance_leg"].append(seg.stance_leg)
+        rows["swing_leg"].append(r2l.get("swing", ""))
+        rows["t_start"].append(seg.t_start)
+        rows["t_end"].append(seg.t_end)
+        rows["period"].append(seg.period)
+        rows["termination"].append(seg.termination)
+        rows["event"].append(seg.event)
+        rows["nfev"].append(seg.nfev)
+        rows["midstance_time"].append(seg.phase_times.get("midstance", np.nan))
+        p0, p1 = w.points(seg.x_start), w.points(seg.x_end)
+        if seg.termination == "heel_strike":
+            rows["step_length"].append(float(np.linalg.norm(p1["swing_foot"])))
+            rows["hip_speed"].append(float((p1["hip"][0] - p0["hip"][0]) / seg.period))
+            ke_m, _ = w.energies(seg.x_end)
+            ke_p, _ = w.energies(seg.x_next)
+            rows["impact_energy_loss"].append(float(ke_m - ke_p))
+        else:
+            rows["step_length"].append(np.nan)
+            rows["hip_speed"].append(np.nan)
+            rows["impact_energy_loss"].append(np.nan)
+    return {k: np.asarray(v) for k, v in rows.items()}

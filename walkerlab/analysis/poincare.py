@@ -1,0 +1,183 @@
+"""Poincaré map, period-1 fixed point and Floquet multipliers (paper Sec. 3.3, Eq. 10).
+
+The Poincaré section is the state just after heel strike.  The map ``P`` integrates one
+step and applies the impact; its fixed point is found with ``scipy.optimize.root`` on the
+map reduced to the guard surface (``walker.section`` coordinates).  Floquet multipliers are
+the eigenvalues of ``DP`` at the fixed point, computed (a) by central finite differences of
+``P`` and (b) from the variational equations with saltation matrices at the guards; one
+multiplier is zero by construction because ``P`` lands on the guard surface.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import root
+
+from walkerlab.analysis.hybrid import Solver, integrate_step
+from walkerlab.models.base import HybridWalker
+
+
+class StepFailed(RuntimeError):
+    """One step did not end in heel strike (``termination`` says how it ended)."""
+
+    def __init__(self, termination: str, t: float, x: np.ndarray, message: str = ""):
+        super().__init__(f"step ended by {termination} at t = {t:.4g} s {message}".strip())
+        self.termination, self.t, self.x = termination, t, x
+
+
+class FixedPointNotFound(RuntimeError):
+    """The root finder stopped without a fixed point; ``residual`` is the best reached."""
+
+    def __init__(self, message: str, residual: float):
+        super().__init__(f"no fixed point found: {message} (residual {residual:.3g})")
+        self.residual = residual
+
+
+def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
+                 max_step_time: float = 5.0, jacobian: bool = False):
+    """One step of the Poincaré map ``x_{n+1} = P(x_n)`` (Eq. 10).
+
+    Parameters
+    ----------
+    x : ndarray, shape (2n,)
+        State just after heel strike (role-ordered).
+    jacobian : bool
+        Also return ``DP`` (2n x 2n) from the variational equations.
+
+    Returns
+    -------
+    x_next : ndarray, shape (2n,)
+    period : float
+        Step period [s].
+    DP : ndarray (2n, 2n), only if ``jacobian``.
+    nfev : int
+
+    Raises
+    ------
+    StepFailed
+        The step ended in a fall, a solver failure or ran past ``max_step_time``.
+    """
+    seg = integrate_step(walker, x, solver, max_step_time=max_step_time, variational=jacobian)
+    if seg.termination != "heel_strike":
+        raise StepFailed(seg.termination, seg.t_end, seg.x_end, seg.message)
+    if jacobian:
+        return seg.x_next, seg.period, seg.monodromy, seg.nfev
+    return seg.x_next, seg.period, seg.nfev
+
+
+def fd_jacobian(walker: HybridWalker, x: np.ndarray, solver: Solver, h: float = 1e-7,
+                max_step_time: float = 5.0) -> tuple[np.ndarray, int]:
+    """Central finite-difference Jacobian of the Poincaré map (2n x 2n) and RHS count."""
+    n = x.size
+    J = np.empty((n, n))
+    nfev = 0
+    for k in range(n):
+        e = np.zeros(n)
+        e[k] = h
+        xp, _, f1 = poincare_map(walker, x + e, solver, max_step_time)
+        xm, _, f2 = poincare_map(walker, x - e, solver, max_step_time)
+        J[:, k] = (xp - xm) / (2 * h)
+        nfev += f1 + f2
+    return J, nfev
+
+
+def sort_multipliers(ev: np.ndarray) -> np.ndarray:
+    """Floquet multipliers sorted by decreasing modulus (ties by real part)."""
+    ev = np.asarray(ev, dtype=complex)
+    return ev[np.lexsort((-ev.real, -np.abs(ev)))]
+
+
+@dataclass
+class FixedPointResult:
+    """Period-1 gait: fixed point, period, multipliers and bookkeeping.
+
+    Attributes
+    ----------
+    x : ndarray (2n,)  fixed point just after heel strike (role-ordered)
+    period_s : float   step period [s]
+    residual : float   ``max |P(x) - x|``
+    multipliers_variational, multipliers_fd : ndarray (2n,) complex
+        Eigenvalues of ``DP`` (variational equations / finite differences), sorted.
+    jacobian_variational, jacobian_fd : ndarray (2n, 2n)
+    nfev : int         RHS evaluations in total (search + Jacobians)
+    iterations : int   map evaluations by the root finder
+    wall_time_s : float
+    stable : bool      all multipliers (variational) strictly inside the unit circle
+    """
+
+    x: np.ndarray
+    period_s: float
+    residual: float
+    multipliers_variational: np.ndarray
+    multipliers_fd: np.ndarray
+    jacobian_variational: np.ndarray
+    jacobian_fd: np.ndarray
+    nfev: int
+    iterations: int
+    wall_time_s: float
+
+    @property
+    def stable(self) -> bool:
+        return bool(np.max(np.abs(self.multipliers_variational)) < 1.0)
+
+    @property
+    def multiplier_difference(self) -> float:
+        return float(np.max(np.abs(self.multipliers_variational - self.multipliers_fd)))
+
+
+def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xtol: float = 1e-12,
+                     fd_step: float = 1e-7, max_step_time: float = 5.0) -> FixedPointResult:
+    """Find the period-1 fixed point of the Poincaré map and its Floquet multipliers.
+
+    Parameters
+    ----------
+    guess : ndarray, shape (2n,)
+        Initial guess (projected on the guard surface through ``walker.section``).
+    xtol : float
+        ``scipy.optimize.root`` (MINPACK hybrd) relative tolerance.
+
+    Returns
+    -------
+    FixedPointResult
+
+    Raises
+    ------
+    FixedPointNotFound
+        The root finder did not converge, or the map failed (fall) near the guess.
+    """
+    t0 = time.perf_counter()
+    counter = {"nfev": 0, "calls": 0}
+
+    def residual(z):
+        x = walker.from_section(z)
+        try:
+            xn, _, nf = poincare_map(walker, x, solver, max_step_time)
+        except StepFailed as exc:
+            counter["calls"] += 1
+            return np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
+        counter["nfev"] += nf
+        counter["calls"] += 1
+        return walker.section(xn) - z
+
+    sol = root(residual, walker.section(np.asarray(guess, float)), method="hybr",
+               options={"xtol": xtol})
+    x = walker.from_section(sol.x)
+    try:
+        xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True)
+    except StepFailed as exc:
+        raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate ({exc})",
+                                 float("nan")) from None
+    res = float(np.max(np.abs(xn - x)))
+    if not sol.success or res > 1e-6:
+        raise FixedPointNotFound(sol.message, res)
+    Jfd, nf2 = fd_jacobian(walker, x, solver, fd_step, max_step_time)
+    return FixedPointResult(
+        x=x, period_s=period, residual=res,
+        multipliers_variational=sort_multipliers(np.linalg.eigvals(DP)),
+        multipliers_fd=sort_multipliers(np.linalg.eigvals(Jfd)),
+        jacobian_variational=DP, jacobian_fd=Jfd, nfev=counter["nfev"] + nf + nf2,
+        iterations=counter["calls"], wall_time_s=time.perf_counter() - t0,
+    )

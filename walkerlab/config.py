@@ -1,0 +1,217 @@
+"""Typed scene configuration (YAML -> pydantic v2).
+
+A *scene* declares only the sections it uses; every section is optional except the walker
+and the slope.  Every numeric field carries its unit in its name (``leg_length_m``) and a
+description; validation always runs and unknown keys are rejected (``extra="forbid"``).
+
+Raises
+------
+SceneError
+    One line naming the file and the offending field, for every bad input.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from walkerlab.contact.config import ContactSettings, ContactSimSettings, TerrainSettings
+
+
+class SceneError(ValueError):
+    """A scene file cannot be read or does not validate (message is one line)."""
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+# --------------------------------------------------------------------------- walker
+class CompassGaitParams(_Strict):
+    """Rigid-legged compass-gait walker (paper Table 1; Goswami et al. 1996, Fig. 1).
+
+    Point masses: hip ``hip_mass_kg`` and one ``leg_mass_kg`` per leg at distance
+    ``leg_mass_from_foot_m`` (a) from the foot, b = L - a from the hip.
+    """
+
+    model: Literal["compass_gait"] = Field("compass_gait", description="walker model name")
+    leg_length_m: float = Field(gt=0, le=100, description="leg length L [m]")
+    leg_mass_kg: float = Field(gt=0, le=1e4, description="point mass m of each leg [kg]")
+    hip_mass_kg: float = Field(ge=0, le=1e4, description="hip point mass M_H [kg]")
+    gravity_m_per_s2: float = Field(9.81, gt=0, le=100, description="gravity g [m/s^2]")
+    leg_mass_from_foot_m: float = Field(
+        gt=0, description="distance a of the leg mass from the foot [m]; b = L - a"
+    )
+
+    @model_validator(mode="after")
+    def _a_inside_leg(self) -> "CompassGaitParams":
+        if not self.leg_mass_from_foot_m < self.leg_length_m:
+            raise ValueError(
+                "walker.leg_mass_from_foot_m must be smaller than walker.leg_length_m"
+            )
+        return self
+
+    @property
+    def b_m(self) -> float:
+        """Distance b of the leg mass from the hip [m]."""
+        return self.leg_length_m - self.leg_mass_from_foot_m
+
+
+WalkerParams = Annotated[CompassGaitParams, Field(discriminator="model")]
+
+
+class SlopeSettings(_Strict):
+    """Ramp angle phi (the walker walks downhill in +x). Give exactly one of the two fields."""
+
+    angle_rad: float | None = Field(None, gt=-math.pi / 2, lt=math.pi / 2, description="slope [rad]")
+    angle_deg: float | None = Field(None, gt=-90, lt=90, description="slope [deg]")
+
+    @model_validator(mode="after")
+    def _exactly_one(self) -> "SlopeSettings":
+        if (self.angle_rad is None) == (self.angle_deg is None):
+            raise ValueError("slope: give exactly one of angle_rad or angle_deg")
+        return self
+
+    @property
+    def phi_rad(self) -> float:
+        """Slope angle [rad]."""
+        return self.angle_rad if self.angle_rad is not None else math.radians(self.angle_deg)
+
+
+class IdealModelSettings(_Strict):
+    """Which equations the rigid hybrid model uses."""
+
+    variant: Literal["derived", "appendix_a"] = Field(
+        "derived",
+        description="'derived': equations derived with sympy (default, energy-consistent); "
+        "'appendix_a': the paper's printed Appendix A, signs included (reproduces Eq. 11)",
+    )
+
+
+class SolverSettings(_Strict):
+    """One integrator setting fed to ``scipy.integrate.solve_ivp``."""
+
+    method: Literal["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"] = Field(
+        "DOP853", description="scipy solve_ivp method"
+    )
+    rtol: float = Field(1e-10, gt=0, lt=1, description="relative tolerance [-]")
+    atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
+    max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
+
+
+class StateSpec(_Strict):
+    """A compass-gait state right after heel strike, by role (Eq. 1: swing, stance)."""
+
+    swing_angle_rad: float = Field(description="theta_1, swing-leg angle from vertical [rad]")
+    stance_angle_rad: float = Field(description="theta_2, stance-leg angle from vertical [rad]")
+    swing_rate_rad_per_s: float = Field(description="dtheta_1 [rad/s]")
+    stance_rate_rad_per_s: float = Field(description="dtheta_2 [rad/s]")
+
+    def as_array(self):
+        import numpy as np
+
+        return np.array(
+            [self.swing_angle_rad, self.stance_angle_rad,
+             self.swing_rate_rad_per_s, self.stance_rate_rad_per_s]
+        )
+
+
+class FixedPointSettings(_Strict):
+    """Search for the period-1 fixed point of the Poincaré map (paper Sec. 3.3)."""
+
+    initial_guess: StateSpec = Field(description="starting point of the root finder")
+    tolerance: float = Field(1e-12, gt=0, lt=1e-3, description="root-finder xtol [-]")
+    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this is a failure [s]")
+    fd_step: float = Field(1e-7, gt=0, lt=1e-2, description="finite-difference step for the Jacobian")
+
+
+class SimulateSettings(_Strict):
+    """Forward simulation of the rigid hybrid model."""
+
+    strides: int = Field(5, ge=1, le=10_000, description="number of strides (2 steps each)")
+    sample_rate_hz: float = Field(500.0, gt=0, le=1e6, description="dense output rate [Hz]")
+    initial_state: Literal["fixed_point"] | StateSpec = Field(
+        "fixed_point", description="'fixed_point' (from fixedpoint.h5) or an explicit state"
+    )
+    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this ends the run [s]")
+
+
+class Scene(_Strict):
+    """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
+
+    name: str | None = Field(None, description="run folder name; default: YAML file stem")
+    source: str | None = Field(None, description="citation of the parameter set")
+    walker: WalkerParams
+    slope: SlopeSettings
+    ideal: IdealModelSettings = IdealModelSettings()
+    solver: SolverSettings = SolverSettings()
+    fixedpoint: FixedPointSettings | None = None
+    simulate: SimulateSettings | None = None
+    contact: ContactSettings | None = None
+    terrain: TerrainSettings | None = None
+    contact_sim: ContactSimSettings | None = None
+    contact_solver: SolverSettings | None = None
+
+    def section_json(self, *names: str) -> str:
+        """Canonical JSON of the named sections (for content hashes)."""
+        d = self.model_dump(mode="json")
+        return json.dumps({n: d.get(n) for n in names}, sort_keys=True)
+
+    def section_hash(self, *names: str) -> str:
+        return hashlib.sha256(self.section_json(*names).encode()).hexdigest()
+
+
+def _format_error(path: Path, err: ValidationError) -> str:
+    e = err.errors()[0]
+    loc = ".".join(str(p) for p in e["loc"] if not str(p).startswith("function-after"))
+    msg = e["msg"].removeprefix("Value error, ")
+    extra = f" (+{len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
+    return f"{path}: {loc or '<scene>'}: {msg}{extra}"
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene YAML file.
+
+    Parameters
+    ----------
+    path : str or Path
+        YAML scene file.
+
+    Returns
+    -------
+    Scene
+        Validated, frozen scene; ``name`` defaults to the file stem.
+
+    Raises
+    ------
+    SceneError
+        File missing, malformed YAML, or a field that fails validation (one line, naming
+        the file and the field).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(f"{path}: scene file not found")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" line {mark.line + 1}" if mark is not None else ""
+        raise SceneError(f"{path}:{where} malformed YAML ({getattr(exc, 'problem', exc)})") from None
+    if not isinstance(data, dict):
+        raise SceneError(f"{path}: a scene must be a YAML mapping")
+    data.setdefault("name", path.stem)
+    return scene_from_dict(data, path)
+
+
+def scene_from_dict(data: dict[str, Any], origin: str | Path = "<scene>") -> Scene:
+    """Validate a scene given as a plain mapping (used by sweeps). Raises SceneError."""
+    try:
+        return Scene.model_validate(data)
+    except ValidationError as err:
+        raise SceneError(_format_error(Path(str(origin)), err)) from None

@@ -1,0 +1,359 @@
+"""Numba-compiled kernels of the floating compass walker with compliant feet.
+
+Internal module.  Everything is SI.  The packed parameter vector ``P`` (float64, (16,)) is:
+
+====  ======================  =====
+idx   meaning                 unit
+====  ======================  =====
+0     L leg length            m
+1     m leg mass              kg
+2     MH hip mass             kg
+3     b hip-to-leg-mass       m
+4     g gravity               m/s^2
+5     phi slope               rad
+6     k stiffness             N/m^e
+7     e exponent              -
+8     cmax max damping        N s/m
+9     dmax                    m
+10    mu_s                    -
+11    mu_d                    -
+12    v_s                     m/s
+13    v_d                     m/s
+14    patch half width        m
+15    continuous ground (1/0) -
+====  ======================  =====
+
+``c1``/``c2`` are the along-slope patch centres [m] of the lanes of leg1/leg2.
+State ``x = [hip_x, hip_y, theta1, theta2, vhip_x, vhip_y, dtheta1, dtheta2]``.
+The pure-numpy reference of the same equations is :mod:`walkerlab.contact.reference`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+NPAR = 16
+
+
+@njit(cache=True)
+def step(x, x0, h0, x1, h1):
+    """Scalar ADAMS STEP and its derivative d/dx (see laws.adams_step)."""
+    if x <= x0:
+        return h0, 0.0
+    if x >= x1:
+        return h1, 0.0
+    w = x1 - x0
+    s = (x - x0) / w
+    return h0 + (h1 - h0) * s * s * (3.0 - 2.0 * s), 6.0 * (h1 - h0) * s * (1.0 - s) / w
+
+
+@njit(cache=True)
+def normal_force(delta, ddot, k, e, cmax, dmax):
+    """IMPACT force and its partials (F [N], dF/ddelta [N/m], dF/dddot [N s/m])."""
+    if delta <= 0.0:
+        return 0.0, 0.0, 0.0
+    c, dc = step(delta, 0.0, 0.0, dmax, cmax)
+    ke = k * delta ** e
+    f = ke + c * ddot
+    if f <= 0.0:
+        return 0.0, 0.0, 0.0
+    return f, e * ke / delta + dc * ddot, c
+
+
+@njit(cache=True)
+def friction_mu(v, mus, mud, vs, vd):
+    """Signed ADAMS Coulomb coefficient and d(mu)/dv [s/m] (see laws)."""
+    av = abs(v)
+    if av < vs:
+        return step(v, -vs, mus, vs, -mus)
+    sg = 1.0 if v > 0.0 else -1.0
+    mu, dmu = step(av, vs, mus, vd, mud)
+    return -sg * mu, -dmu  # d/dv(-sg*h(|v|)) = -sg*h'*sg = -h'
+
+
+@njit(cache=True)
+def in_patch(s, centres, hw, continuous):
+    """True when along-slope coordinate ``s`` [m] lies on ground of the lane."""
+    if continuous:
+        return True
+    for j in range(centres.shape[0]):
+        if abs(s - centres[j]) <= hw:
+            return True
+    return False
+
+
+@njit(cache=True)
+def foot_state(x, i, P):
+    """Foot i (0/1) position and velocity: (px, py, vx, vy)."""
+    L = P[0]
+    th = x[2 + i]
+    w = x[6 + i]
+    st, ct = np.sin(th), np.cos(th)
+    return x[0] + L * st, x[1] - L * ct, x[4] + L * ct * w, x[5] + L * st * w
+
+
+@njit(cache=True)
+def foot_contact(x, i, P, centres):
+    """Contact of foot i: (delta, ddot, v_t, s, Fn, Ff, dFn_dd, dFn_dddot, mu, dmu).
+
+    delta [m] penetration (may be negative = height), ddot [m/s] penetration rate,
+    v_t [m/s] down-slope slip velocity, s [m] along-slope position, Fn [N] normal force,
+    Ff [N] friction force along t = (cos phi, -sin phi).
+    """
+    sp, cp = np.sin(P[5]), np.cos(P[5])
+    px, py, vx, vy = foot_state(x, i, P)
+    delta = -(px * sp + py * cp)
+    ddot = -(vx * sp + vy * cp)
+    vt = vx * cp - vy * sp
+    s = px * cp - py * sp
+    fn, dfd, dfdd, mu, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
+    if delta > 0.0 and in_patch(s, centres, P[14], P[15] > 0.5):
+        fn, dfd, dfdd = normal_force(delta, ddot, P[6], P[7], P[8], P[9])
+        if fn > 0.0:
+            mu, dmu = friction_mu(vt, P[10], P[11], P[12], P[13])
+    return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu
+
+
+@njit(cache=True)
+def msolve(th1, th2, P, r):
+    """Solve M(q) a = r for the 4x4 mass matrix by its 2x2 block structure.
+
+    M = [[A I, B], [B^T, D I]], A = MH + 2m, D = m b^2, B = m b [[c1, c2], [s1, s2]].
+    ``r`` is (4,) or (4, n).
+    """
+    m, MH, b = P[1], P[2], P[3]
+    c1, s1, c2, s2 = np.cos(th1), np.sin(th1), np.cos(th2), np.sin(th2)
+    A = MH + 2.0 * m
+    D = m * b * b
+    B00, B01, B10, B11 = m * b * c1, m * b * c2, m * b * s1, m * b * s2
+    # Schur complement S = A I - B B^T / D
+    S00 = A - m * (c1 * c1 + c2 * c2)
+    S01 = -m * (c1 * s1 + c2 * s2)
+    S11 = A - m * (s1 * s1 + s2 * s2)
+    det = S00 * S11 - S01 * S01
+    out = np.empty_like(r)
+    r0 = r[0] - (B00 * r[2] + B01 * r[3]) / D
+    r1 = r[1] - (B10 * r[2] + B11 * r[3]) / D
+    a0 = (S11 * r0 - S01 * r1) / det
+    a1 = (S00 * r1 - S01 * r0) / det
+    out[0] = a0
+    out[1] = a1
+    out[2] = (r[2] - B00 * a0 - B10 * a1) / D
+    out[3] = (r[3] - B01 * a0 - B11 * a1) / D
+    return out
+
+
+@njit(cache=True)
+def gen_force(x, P, c1, c2, use1, use2):
+    """Generalized force Q - c (4,): gravity, centripetal terms, contact of feet used."""
+    L, m, MH, b, g, phi = P[0], P[1], P[2], P[3], P[4], P[5]
+    sp, cp = np.sin(phi), np.cos(phi)
+    Q = np.zeros(4)
+    Q[1] = -(MH + 2.0 * m) * g
+    for i in range(2):
+        th = x[2 + i]
+        w = x[6 + i]
+        st, ct = np.sin(th), np.cos(th)
+        Q[2 + i] = -m * g * b * st
+        # minus centripetal term c(q, qd)
+        Q[0] += m * b * st * w * w
+        Q[1] -= m * b * ct * w * w
+        if (i == 0 and use1) or (i == 1 and use2):
+            cen = c1 if i == 0 else c2
+            res = foot_contact(x, i, P, cen)
+            fn, ff = res[4], res[5]
+            if fn > 0.0:
+                Fx = fn * sp + ff * cp
+                Fy = fn * cp - ff * sp
+                Q[0] += Fx
+                Q[1] += Fy
+                Q[2 + i] += L * (ct * Fx + st * Fy)
+    return Q
+
+
+@njit(cache=True)
+def rhs(x, P, c1, c2):
+    """Free-floating walker: dx/dt (8,)."""
+    Q = gen_force(x, P, c1, c2, True, True)
+    qdd = msolve(x[2], x[3], P, Q)
+    out = np.empty(8)
+    out[:4] = x[4:]
+    out[4:] = qdd
+    return out
+
+
+@njit(cache=True)
+def jac(x, P, c1, c2):
+    """Analytic Jacobian d(rhs)/dx (8, 8) of the free-floating walker.
+
+    Patch membership is treated as locally constant (the patch edge is a discontinuity).
+    """
+    L, m, MH, b, g, phi = P[0], P[1], P[2], P[3], P[4], P[5]
+    sp, cp = np.sin(phi), np.cos(phi)
+    Q = gen_force(x, P, c1, c2, True, True)
+    qdd = msolve(x[2], x[3], P, Q)
+    dQq = np.zeros((4, 4))
+    dQv = np.zeros((4, 4))
+    for i in range(2):
+        j = 2 + i
+        th = x[j]
+        w = x[6 + i]
+        st, ct = np.sin(th), np.cos(th)
+        # gravity
+        dQq[j, j] += -m * g * b * ct
+        # -c(q, qd): Q0 += m b st w^2, Q1 -= m b ct w^2
+        dQq[0, j] += m * b * ct * w * w
+        dQq[1, j] += m * b * st * w * w
+        dQv[0, j] += 2.0 * m * b * st * w
+        dQv[1, j] += -2.0 * m * b * ct * w
+        # - dM/dth_j * qdd  (dM/dth_j: (0,j),(j,0) = -m b st ; (1,j),(j,1) = m b ct)
+        dQq[0, j] -= -m * b * st * qdd[j]
+        dQq[1, j] -= m * b * ct * qdd[j]
+        dQq[j, j] -= -m * b * st * qdd[0] + m * b * ct * qdd[1]
+        # contact
+        cen = c1 if i == 0 else c2
+        delta, ddot, vt, s, fn, ff, dfd, dfdd, mu, dmu = foot_contact(x, i, P, cen)
+        if fn <= 0.0:
+            continue
+        # foot Jacobian columns: d p/d(hx,hy,th) = (1,0,L ct), (0,1,L st)
+        # dv/dth = (-L st w, L ct w); dv/dqd same as dp/dq
+        # derivatives of delta, ddot, vt w.r.t. (q, qd) -- only hx, hy, th_j, vx, vy, w_j
+        # n = (sp, cp), t = (cp, -sp)
+        Jx = np.zeros(4)
+        Jy = np.zeros(4)
+        Jx[0] = 1.0
+        Jy[1] = 1.0
+        Jx[j] = L * ct
+        Jy[j] = L * st
+        Vx = np.zeros(4)
+        Vy = np.zeros(4)
+        Vx[j] = -L * st * w
+        Vy[j] = L * ct * w
+        d_delta_q = -(sp * Jx + cp * Jy)
+        d_ddot_q = -(sp * Vx + cp * Vy)
+        d_ddot_v = d_delta_q
+        d_vt_q = cp * Vx - sp * Vy
+        d_vt_v = cp * Jx - sp * Jy
+        dfn_q = dfd * d_delta_q + dfdd * d_ddot_q
+        dfn_v = dfdd * d_ddot_v
+        dff_q = mu * dfn_q + fn * dmu * d_vt_q
+        dff_v = mu * dfn_v + fn * dmu * d_vt_v
+        dFx_q = sp * dfn_q + cp * dff_q
+        dFy_q = cp * dfn_q - sp * dff_q
+        dFx_v = sp * dfn_v + cp * dff_v
+        dFy_v = cp * dfn_v - sp * dff_v
+        Fx = fn * sp + ff * cp
+        Fy = fn * cp - ff * sp
+        for k in range(4):
+            dQq[0, k] += dFx_q[k]
+            dQq[1, k] += dFy_q[k]
+            dQq[j, k] += L * (ct * dFx_q[k] + st * dFy_q[k])
+            dQv[0, k] += dFx_v[k]
+            dQv[1, k] += dFy_v[k]
+            dQv[j, k] += L * (ct * dFx_v[k] + st * dFy_v[k])
+        dQq[j, j] += L * (-st * Fx + ct * Fy)
+    out = np.zeros((8, 8))
+    for k in range(4):
+        out[k, 4 + k] = 1.0
+    out[4:, :4] = msolve(x[2], x[3], P, dQq)
+    out[4:, 4:] = msolve(x[2], x[3], P, dQv)
+    return out
+
+
+@njit(cache=True)
+def rhs_pinned(z, P, c1, c2, pfx, pfy):
+    """Reduced dynamics with foot 2 pinned at (pfx, pfy): z = [th1, th2, w1, w2] -> dz/dt."""
+    L = P[0]
+    th1, th2, w1, w2 = z[0], z[1], z[2], z[3]
+    s2, c2_ = np.sin(th2), np.cos(th2)
+    x = np.empty(8)
+    x[0] = pfx - L * s2
+    x[1] = pfy + L * c2_
+    x[2] = th1
+    x[3] = th2
+    x[4] = -L * c2_ * w2
+    x[5] = -L * s2 * w2
+    x[6] = w1
+    x[7] = w2
+    Q = gen_force(x, P, c1, c2, True, False)
+    # q = Phi(th), qd = Jp thd, qdd = Jp thdd + gam, gam = (L s2 w2^2, -L c2 w2^2, 0, 0)
+    gam = np.zeros(4)
+    gam[0] = L * s2 * w2 * w2
+    gam[1] = -L * c2_ * w2 * w2
+    Jp = np.zeros((4, 2))
+    Jp[0, 1] = -L * c2_
+    Jp[1, 1] = -L * s2
+    Jp[2, 0] = 1.0
+    Jp[3, 1] = 1.0
+    M = mass_matrix(x[2], x[3], P)
+    r = Jp.T @ (Q - M @ gam)
+    Mr = Jp.T @ M @ Jp
+    det = Mr[0, 0] * Mr[1, 1] - Mr[0, 1] * Mr[1, 0]
+    out = np.empty(4)
+    out[0] = w1
+    out[1] = w2
+    out[2] = (Mr[1, 1] * r[0] - Mr[0, 1] * r[1]) / det
+    out[3] = (Mr[0, 0] * r[1] - Mr[1, 0] * r[0]) / det
+    return out
+
+
+@njit(cache=True)
+def mass_matrix(th1, th2, P):
+    """4x4 mass matrix M(q) [kg, kg m, kg m^2]."""
+    m, MH, b = P[1], P[2], P[3]
+    M = np.zeros((4, 4))
+    M[0, 0] = MH + 2.0 * m
+    M[1, 1] = MH + 2.0 * m
+    for i in range(2):
+        th = th1 if i == 0 else th2
+        M[0, 2 + i] = M[2 + i, 0] = m * b * np.cos(th)
+        M[1, 2 + i] = M[2 + i, 1] = m * b * np.sin(th)
+        M[2 + i, 2 + i] = m * b * b
+    return M
+
+
+@njit(cache=True)
+def contact_table(X, P, c1, c2):
+    """Per-sample contact quantities of both feet.
+
+    X: (n, 8) states.  Returns (n, 2, 8): [delta, ddot, vt, s, Fn, Ff, power, on_ground] per
+    foot; power = F . v_foot [W]; on_ground = 1 where the lane has ground under the foot.
+    """
+    n = X.shape[0]
+    out = np.zeros((n, 2, 8))
+    sp, cp = np.sin(P[5]), np.cos(P[5])
+    for r in range(n):
+        x = X[r]
+        for i in range(2):
+            cen = c1 if i == 0 else c2
+            res = foot_contact(x, i, P, cen)
+            px, py, vx, vy = foot_state(x, i, P)
+            fn, ff = res[4], res[5]
+            Fx = fn * sp + ff * cp
+            Fy = fn * cp - ff * sp
+            for k in range(6):
+                out[r, i, k] = res[k]
+            out[r, i, 6] = Fx * vx + Fy * vy
+            out[r, i, 7] = 1.0 if in_patch(res[3], cen, P[14], P[15] > 0.5) else 0.0
+    return out
+
+
+@njit(cache=True)
+def rhs_guarded(x, P, c1, c2, hmin):
+    """:func:`rhs`, but frozen (zero derivative) once the hip height x.n < hmin [m].
+
+    Used by drivers without event support (odeint) so that a fallen walker (feet sinking
+    through lane gaps, then re-entering patches deep below their surface) costs nothing.
+    """
+    if x[0] * np.sin(P[5]) + x[1] * np.cos(P[5]) < hmin:
+        return np.zeros(8)
+    return rhs(x, P, c1, c2)
+
+
+@njit(cache=True)
+def jac_guarded(x, P, c1, c2, hmin):
+    """Jacobian of :func:`rhs_guarded`."""
+    if x[0] * np.sin(P[5]) + x[1] * np.cos(P[5]) < hmin:
+        return np.zeros((8, 8))
+    return jac(x, P, c1, c2)

@@ -1,0 +1,169 @@
+"""Validated settings of the compliant-contact simulation (pydantic v2).
+
+Numbers in :class:`ContactSettings` are written in the unit system named by
+``unit_system`` (ADAMS's default is mm-kg-s); :meth:`ContactSettings.to_si` converts them
+explicitly to SI (NOTES.md: "a wrong unit here changes the answer by 10^6").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, Optional
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+__all__ = ["ContactParamsSI", "ContactSettings", "TerrainSettings", "ContactSimSettings"]
+
+
+@dataclass(frozen=True)
+class ContactParamsSI:
+    """Contact parameters in SI units (what the model kernels use).
+
+    Attributes
+    ----------
+    k : float
+        Stiffness ``[N/m**e]``.
+    e : float
+        Force exponent ``[-]``.
+    cmax : float
+        Maximum damping ``[N s/m]``.
+    dmax : float
+        Penetration at full damping ``[m]``.
+    mu_s, mu_d : float
+        Static / dynamic friction coefficients ``[-]``.
+    v_s, v_d : float
+        Stiction / friction transition velocities ``[m/s]``.
+    """
+
+    k: float
+    e: float
+    cmax: float
+    dmax: float
+    mu_s: float
+    mu_d: float
+    v_s: float
+    v_d: float
+
+
+def _len_factor(unit_system: str) -> float:
+    """Metres per length unit of ``unit_system``."""
+    return {"mm-kg-s": 1e-3, "SI": 1.0}[unit_system]
+
+
+class ContactSettings(BaseModel):
+    """IMPACT normal force + Coulomb friction, numbers in ``unit_system``.
+
+    Defaults are the paper's values (k = 1e5, damping 90, mu_s = 0.9, mu_d = 0.7) read in
+    ADAMS's default mm-kg-s units, with the ADAMS View defaults for the rest (NOTES.md).
+    """
+
+    model_config = ConfigDict(extra="forbid")
+
+    unit_system: Literal["mm-kg-s", "SI"] = Field(
+        "mm-kg-s", description="Unit system of the numbers below: 'mm-kg-s' (ADAMS default) or 'SI'."
+    )
+    stiffness: float = Field(
+        1e5, gt=0, description="IMPACT stiffness k.",
+        json_schema_extra={"unit": "N/<len>^e"},
+    )
+    exponent: float = Field(
+        2.2, ge=1.0, le=10.0, description="IMPACT force exponent e (ADAMS default 2.2).",
+        json_schema_extra={"unit": "-"},
+    )
+    max_damping: float = Field(
+        90.0, ge=0, description="IMPACT maximum damping cmax (paper: 'damping 90').",
+        json_schema_extra={"unit": "N s/<len>"},
+    )
+    penetration_at_max_damping: float = Field(
+        0.1, gt=0, description="IMPACT penetration dmax at which full damping is reached.",
+        json_schema_extra={"unit": "<len>"},
+    )
+    mu_static: float = Field(0.9, ge=0, description="Static friction coefficient.",
+                             json_schema_extra={"unit": "-"})
+    mu_dynamic: float = Field(0.7, ge=0, description="Dynamic friction coefficient.",
+                              json_schema_extra={"unit": "-"})
+    stiction_velocity: float = Field(
+        100.0, gt=0, description="Stiction transition velocity vs.",
+        json_schema_extra={"unit": "<len>/s"},
+    )
+    friction_velocity: float = Field(
+        1000.0, gt=0, description="Friction transition velocity vd (> vs).",
+        json_schema_extra={"unit": "<len>/s"},
+    )
+
+    @model_validator(mode="after")
+    def _check_relations(self) -> "ContactSettings":
+        if self.mu_dynamic > self.mu_static:
+            raise ValueError(
+                f"mu_dynamic ({self.mu_dynamic}) must be <= mu_static ({self.mu_static})"
+            )
+        if not self.stiction_velocity < self.friction_velocity:
+            raise ValueError(
+                f"stiction_velocity ({self.stiction_velocity}) must be < "
+                f"friction_velocity ({self.friction_velocity})"
+            )
+        return self
+
+    def to_si(self) -> ContactParamsSI:
+        """Convert to SI: ``k_SI = k * f**-e``, ``c_SI = c / f``, lengths and velocities ``* f``.
+
+        ``f`` = metres per length unit (1e-3 for mm-kg-s).  E.g. ``k = 1e5 N/mm^2.2`` becomes
+        ``1e5 * 1000**2.2 N/m^2.2``.
+
+        Returns
+        -------
+        ContactParamsSI
+        """
+        f = _len_factor(self.unit_system)
+        e = self.exponent
+        return ContactParamsSI(
+            k=self.stiffness * f ** (-e),
+            e=e,
+            cmax=self.max_damping / f,
+            dmax=self.penetration_at_max_damping * f,
+            mu_s=self.mu_static,
+            mu_d=self.mu_dynamic,
+            v_s=self.stiction_velocity * f,
+            v_d=self.friction_velocity * f,
+        )
+
+
+class TerrainSettings(BaseModel):
+    """Ground geometry: continuous slope or the paper's 'checkerboard' lanes.
+
+    For ``checkerboard`` each leg has its own lane with ground patches of width
+    ``patch_width_m`` centred on that leg's ideal footfalls: leg2 at ``s = 0, 2l, 4l, ...``,
+    leg1 at ``s = l, 3l, ...`` (``l`` = ideal step length, given at run time).  Elsewhere in
+    the lane there is no ground (a gap), so the swing foot is not scuffed at mid-stance.
+    """
+
+    model_config = ConfigDict(extra="forbid")
+
+    kind: Literal["checkerboard", "continuous"] = Field(
+        "checkerboard", description="'checkerboard' (per-leg patches at footfalls) or 'continuous'."
+    )
+    patch_width_m: float = Field(
+        0.10, gt=0, description="Width of each checkerboard patch along the slope [m]."
+    )
+
+
+class ContactSimSettings(BaseModel):
+    """Run settings of a contact simulation."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    n_strides: int = Field(5, ge=1, description="Strides (2 steps each) to simulate [-].")
+    t_final_s: Optional[float] = Field(
+        None, gt=0, description="Simulated time [s]; default n_strides * 2 * ideal step period."
+    )
+    pin_stance_until: Literal["none", "first_touchdown", "time"] = Field(
+        "none", description="Hold the first stance foot fixed until this moment."
+    )
+    pin_time_s: float = Field(0.0, ge=0, description="Pin duration when pin_stance_until='time' [s].")
+    fall_hip_height_m: Optional[float] = Field(
+        None, gt=0, description="Fall when hip height above ground < this [m]; default 0.5*L."
+    )
+    sample_rate_hz: float = Field(1000.0, gt=0, description="Output sample rate [Hz].")
+    initial_rate_scale: tuple[float, float] = Field(
+        (1.0, 1.0), description="Multipliers [-] on dtheta1, dtheta2 of the initial state."
+    )

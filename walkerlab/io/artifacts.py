@@ -1,0 +1,171 @@
+"""One HDF5 file per stage.
+
+Layout conventions
+------------------
+- Root attributes: ``stage``, ``walkerlab_version``, ``scene_name``, ``scene_json`` (the
+  resolved scene), ``input_hash`` (content hash of config sections, upstream artifacts and
+  code), ``created_utc``, ``wall_time_s`` (compute part of the stage).
+- Every dataset has ``unit`` and ``description`` attributes; time series are 1-D along
+  ``time``; state is addressed by *name* (``samples/angle/leg1``), never by row number.
+- Files are written to a temporary name in the same folder and renamed, so a crash never
+  leaves a half-written artifact and never overwrites a good one.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import json
+import os
+import tempfile
+from contextlib import contextmanager
+from functools import lru_cache
+from pathlib import Path
+from typing import Callable, Iterator
+
+import h5py
+import numpy as np
+
+import walkerlab
+
+
+class ArtifactError(RuntimeError):
+    """An artifact is missing, unreadable, of another stage or of another walkerlab version."""
+
+
+@lru_cache(maxsize=1)
+def code_hash() -> str:
+    """SHA-256 over the package's Python sources (a code change invalidates cached stages)."""
+    root = Path(walkerlab.__file__).parent
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "",
+        **attrs) -> h5py.Dataset:
+    """Create dataset ``name`` (intermediate groups allowed) with unit and description.
+
+    Strings and lists of strings are stored as UTF-8 variable-length strings.
+    """
+    if isinstance(data, str) or (isinstance(data, (list, tuple)) and data
+                                 and isinstance(data[0], str)):
+        data = np.asarray(data, dtype=h5py.string_dtype())
+    ds = group.create_dataset(name, data=data)
+    ds.attrs["unit"] = unit
+    ds.attrs["description"] = description
+    for k, v in attrs.items():
+        ds.attrs[k] = v
+    return ds
+
+
+def read_named(group: h5py.Group, name: str):
+    """Read a dataset as numpy (or str for string scalars/arrays)."""
+    ds = group[name]
+    val = ds[()]
+    if isinstance(val, bytes):
+        return val.decode()
+    if isinstance(val, np.ndarray) and val.dtype.kind == "O":
+        return [v.decode() if isinstance(v, bytes) else v for v in val.tolist()]
+    return val
+
+
+def write_artifact(path: Path, stage: str, scene, input_hash: str,
+                   writer: Callable[[h5py.File], None], wall_time_s: float,
+                   extra_attrs: dict | None = None) -> Path:
+    """Write an artifact atomically.
+
+    Parameters
+    ----------
+    path : Path
+        Final file name (e.g. ``runs/paper/fixedpoint.h5``).
+    stage : str
+        Stage name stored in the file.
+    scene : walkerlab.config.Scene
+        Resolved scene, stored as JSON.
+    input_hash : str
+        Content hash deciding whether the stage can be skipped next time.
+    writer : callable(h5py.File)
+        Fills the file's contents.
+    wall_time_s : float
+        Compute wall time of the stage [s].
+
+    Raises
+    ------
+    ArtifactError
+        The folder cannot be created or written.
+    """
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ArtifactError(f"{path.parent}: cannot create run folder ({exc.strerror})") from None
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".h5.tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        with h5py.File(tmp, "w") as f:
+            f.attrs["stage"] = stage
+            f.attrs["walkerlab_version"] = walkerlab.__version__
+            f.attrs["scene_name"] = scene.name or ""
+            f.attrs["scene_json"] = scene.model_dump_json()
+            f.attrs["input_hash"] = input_hash
+            f.attrs["created_utc"] = _dt.datetime.now(_dt.timezone.utc).isoformat()
+            f.attrs["wall_time_s"] = float(wall_time_s)
+            for k, v in (extra_attrs or {}).items():
+                f.attrs[k] = v
+            writer(f)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+@contextmanager
+def open_artifact(path: Path, stage: str | None = None,
+                  check_version: bool = True) -> Iterator[h5py.File]:
+    """Open an artifact read-only after checking it is complete and of the expected kind.
+
+    Raises
+    ------
+    ArtifactError
+        Missing file, not a readable HDF5 file (e.g. truncated), another stage's file, or a
+        file written by another walkerlab version (one line naming the file).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ArtifactError(f"{path}: artifact not found (run its stage first)")
+    try:
+        f = h5py.File(path, "r")
+    except OSError:
+        raise ArtifactError(f"{path}: not a readable HDF5 artifact (truncated or damaged); "
+                            "delete it and rerun its stage") from None
+    try:
+        got = f.attrs.get("stage")
+        if stage is not None and got != stage:
+            raise ArtifactError(f"{path}: expected a '{stage}' artifact, found '{got}'")
+        ver = f.attrs.get("walkerlab_version")
+        if check_version and ver != walkerlab.__version__:
+            raise ArtifactError(f"{path}: written by walkerlab {ver}, this is "
+                                f"{walkerlab.__version__}; rerun the stage to refresh it")
+        yield f
+    finally:
+        f.close()
+
+
+def stored_hash(path: Path) -> str | None:
+    """``input_hash`` of an artifact, or None when it is absent or unreadable."""
+    try:
+        with h5py.File(path, "r") as f:
+            if f.attrs.get("walkerlab_version") != walkerlab.__version__:
+                return None
+            return str(f.attrs.get("input_hash"))
+    except (OSError, KeyError):
+        return None
+
+
+def scene_json_of(path: Path) -> dict:
+    with open_artifact(path) as f:
+        return json.loads(f.attrs["scene_json"])

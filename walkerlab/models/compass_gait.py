@@ -1,0 +1,286 @@
+"""Rigid-legged compass-gait walker as a hybrid system (paper Sec. 3.1-3.2, Appendix A).
+
+State (paper Eq. 1), role-ordered: ``x = [theta1, theta2, dtheta1, dtheta2]`` with
+``theta1`` the swing leg and ``theta2`` the stance leg, absolute angles from the vertical
+[rad], positive when the foot is ahead of the hip... for the swing leg, i.e. the swing foot
+is at ``hip + L (sin theta1, -cos theta1)`` and the hip at ``stance_foot + L (-sin theta2,
+cos theta2)`` (A.1-A.3).  The walker walks in +x down a slope of angle ``phi``.
+
+Three pure pieces (as in Drake's ``examples/compass_gait``):
+
+- flow   :func:`flow`        ``M(q) qdd + C(q, dq) dq + G(q) = 0`` (Eq. 3-4)
+- guard  :func:`heel_strike_guard`, :func:`swing_foot_ahead`, :func:`swing_foot_height`
+- reset  :func:`impact`       plastic impact and role swap (Eq. 6-8, A.41-A.57)
+
+Equation variants
+-----------------
+``derived``      sympy derivation (:mod:`walkerlab.models.derivation`) - the default.
+``appendix_a``   the printed Appendix A flow (A.4-A.6, including the wrong sign of
+                 ``C[1, 0]`` in A.5) with the impact of A.57; reproduces the paper's Eq. 11.
+``appendix_a_literal``  as ``appendix_a`` but also with the printed y-component of the
+                 swing-foot position (A.55, ``cos(theta1) - cos(-theta2)``); its fixed point
+                 does *not* match Eq. 11, which shows the MATLAB code did not use that sign.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+
+from walkerlab.models.base import Guard, HybridWalker, Phase
+from walkerlab.models.derivation import compass_gait_functions
+
+VARIANTS = ("derived", "appendix_a", "appendix_a_literal")
+
+
+# ----------------------------------------------------------------- equations of motion
+def matrices(q, dq, p, variant: str = "derived"):
+    """Inertia ``M`` (2x2), Coriolis ``C`` (2x2) and gravity ``G`` (2,) of the swing phase.
+
+    Parameters
+    ----------
+    q, dq : array_like, shape (2,)
+        ``[theta1, theta2]`` [rad] and rates [rad/s] (complex allowed, for complex-step
+        derivatives).
+    p : tuple
+        ``(m, M_H, L, a, g)`` in SI units.
+    variant : str
+        One of :data:`VARIANTS`.
+
+    Returns
+    -------
+    M, C : ndarray, shape (2, 2)
+    G : ndarray, shape (2,)
+    """
+    if variant == "derived":
+        f = compass_gait_functions()
+        return (np.asarray(f["M"](q, p)), np.asarray(f["C"](q, dq, p)),
+                np.asarray(f["G"](q, p)).reshape(-1))
+    m, mh, L, a, g = p
+    b = L - a
+    t1, t2 = q
+    w1, w2 = dq
+    c, s = np.cos(t2 - t1), np.sin(t2 - t1)
+    M = np.array([[m * b**2, -m * L * b * c],
+                  [-m * L * b * c, mh * L**2 + m * (L**2 + a**2)]])  # A.4
+    C = np.array([[0 * w2, m * L * b * w2 * s],
+                  [m * L * b * w1 * s, 0 * w1]])  # A.5 as printed (C[1,0] sign is wrong)
+    G = np.array([m * g * b * np.sin(t1), -(mh * L + m * (a + L)) * g * np.sin(t2)])  # A.6
+    return M, C, G
+
+
+def flow(t: float, x: np.ndarray, p: tuple, variant: str = "derived") -> np.ndarray:
+    """Swing-phase vector field ``dx/dt = [dq, M^-1 (-C dq - G)]`` (paper Eq. 4, A.58).
+
+    Parameters
+    ----------
+    t : float
+        Time [s] (unused: the system is autonomous).
+    x : ndarray, shape (4,)
+        Role-ordered state ``[theta1, theta2, dtheta1, dtheta2]``.
+    p : tuple
+        ``(m, M_H, L, a, g)`` [kg, kg, m, m, m/s^2].
+
+    Returns
+    -------
+    ndarray, shape (4,)
+    """
+    q, dq = x[:2], x[2:]
+    M, C, G = matrices(q, dq, p, variant)
+    qdd = np.linalg.solve(M, -C @ dq - G)
+    return np.concatenate([dq, qdd])
+
+
+def complex_step_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
+    """Jacobian of an analytic function by the complex-step method (exact to round-off).
+
+    Squire & Trapp (1998), SIAM Review 40(1): ``df/dx_k = Im f(x + i h e_k) / h``.
+    """
+    x = np.asarray(x, dtype=float)
+    cols = []
+    for k in range(x.size):
+        xc = x.astype(complex)
+        xc[k] += 1j * h
+        cols.append(np.imag(fun(xc)) / h)
+    return np.stack(cols, axis=1)
+
+
+# ----------------------------------------------------------------------------- guard
+def swing_foot_height(x: np.ndarray, phi: float, L: float) -> np.ndarray:
+    """Height of the swing foot above the slope, normal to it [m].
+
+    ``h = L (cos(theta2 + phi) - cos(theta1 + phi)) = 2 L sin(sigma/2) sin((theta1-theta2)/2)``
+    with ``sigma = theta1 + theta2 + 2 phi``.  It vanishes on two surfaces: heel strike
+    (``sigma = 0``, the set S of Eq. 9-2 shifted by the slope) and mid-stance
+    (``theta1 = theta2``, legs aligned: the swing foot scuffs through the ground).
+    """
+    return L * (np.cos(x[1] + phi) - np.cos(x[0] + phi))
+
+
+def heel_strike_guard(t: float, x: np.ndarray, phi: float) -> float:
+    """Heel-strike guard ``sigma = theta1 + theta2 + 2 phi`` (Eq. 9-2 on a slope).
+
+    The swing foot touches the ground on ``sigma = 0`` *with the swing foot ahead*
+    (``theta1 > theta2``) and ``sigma`` decreasing.  This factor of the swing-foot height
+    excludes the other factor, ``theta1 - theta2``, which vanishes at mid-stance when the
+    legs are aligned and the point foot would scuff the ground; the ideal model ignores
+    scuffing (paper Sec. 3.2, "we do not consider the scuffing with the ground").  Because
+    ``sigma`` is also zero right *after* heel strike, the integrator only arms this guard
+    in the late-swing phase, after :func:`swing_foot_ahead` has crossed zero upward.
+    """
+    return x[0] + x[1] + 2.0 * phi
+
+
+def swing_foot_ahead(t: float, x: np.ndarray) -> float:
+    """``theta1 - theta2`` [rad]: positive when the swing foot is ahead of the stance foot."""
+    return x[0] - x[1]
+
+
+def hip_height(t: float, x: np.ndarray, phi: float, L: float) -> float:
+    """Hip height above the slope [m]; zero means the walker has fallen (fall guard)."""
+    return L * np.cos(x[1] + phi)
+
+
+def is_heel_strike(x: np.ndarray, phi: float, tol: float = 1e-9) -> bool:
+    """True if ``x`` is a heel-strike state: ``sigma = 0``, swing foot ahead, foot descending.
+
+    Returns False on the mid-stance scuffing surface (``theta1 = theta2``) and right after
+    an impact (swing foot behind).
+    """
+    sigma = heel_strike_guard(0.0, x, phi)
+    sigma_dot = x[2] + x[3]
+    return bool(abs(sigma) <= tol and swing_foot_ahead(0.0, x) > tol and sigma_dot < 0)
+
+
+# ----------------------------------------------------------------------------- reset
+def impact_matrices(q, p, variant: str = "derived"):
+    """Extended inertia ``De`` (4x4, coordinates ``[theta1, theta2, x_f, y_f]``, A.7-A.24)
+    and swing-foot Jacobian ``E`` (2x4, A.56)."""
+    f = compass_gait_functions()
+    De = np.asarray(f["De"](q, p))
+    E = np.asarray(f["E"](q, p))
+    if variant == "appendix_a_literal":
+        m, mh, L, a, g = p
+        t1, t2 = q
+        # A.55 as printed: y + L (cos(theta1) - cos(-theta2))
+        E = E.copy()
+        E[1] = [-L * np.sin(t1), L * np.sin(t2), 0.0, 1.0]
+    return De, E
+
+
+def impact(x_minus: np.ndarray, p: tuple, variant: str = "derived",
+           return_impulse: bool = False):
+    """Plastic heel-strike impact and leg-role swap (paper Eq. 6-8, A.41-A.57).
+
+    Solves ``[[De, -E^T], [E, 0]] [dqe+, F] = [De dqe-, 0]`` with the stance foot at rest
+    before impact (``dqe- = [dq-, 0, 0]``), so the new stance foot (old swing foot) has zero
+    velocity afterwards, then swaps the roles: ``theta1+ = theta2-``, ``theta2+ = theta1-``.
+
+    Parameters
+    ----------
+    x_minus : ndarray, shape (4,)
+        State just before heel strike.
+    return_impulse : bool
+        Also return the impulse ``F`` [N s] (2,) at the new stance foot and the velocity
+        [m/s] (2,) of the old stance foot just after impact (``y`` > 0: it lifts off).
+
+    Returns
+    -------
+    x_plus : ndarray, shape (4,)
+    """
+    q, dq = x_minus[:2], x_minus[2:]
+    De, E = impact_matrices(q, p, variant)
+    dtype = np.result_type(De, x_minus)
+    A = np.zeros((6, 6), dtype=dtype)
+    A[:4, :4] = De
+    A[:4, 4:] = -E.T
+    A[4:, :4] = E
+    rhs = np.zeros(6, dtype=dtype)
+    rhs[:4] = De @ np.concatenate([dq, np.zeros(2, dtype=dq.dtype)])
+    sol = np.linalg.solve(A, rhs)
+    x_plus = np.array([q[1], q[0], sol[1], sol[0]])
+    if return_impulse:
+        return x_plus, sol[4:], sol[2:4]
+    return x_plus
+
+
+# ---------------------------------------------------------------------------- energy
+def energies(x: np.ndarray, p: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic and potential energy [J]; ``x`` of shape (4,) or (4, k).
+
+    Potential energy is measured from the stance foot's height (world vertical).
+    """
+    m, mh, L, a, g = p
+    b = L - a
+    t1, t2, w1, w2 = x
+    kin = 0.5 * (m * b**2 * w1**2 + (mh * L**2 + m * (L**2 + a**2)) * w2**2) \
+        - m * L * b * np.cos(t2 - t1) * w1 * w2
+    pot = g * ((m * a + mh * L + m * L) * np.cos(t2) - m * b * np.cos(t1))
+    return kin, pot
+
+
+def points(x: np.ndarray, p: tuple) -> dict[str, np.ndarray]:
+    """Positions [m] relative to the stance foot (A.1-A.3); each value (2,) or (2, k)."""
+    m, mh, L, a, g = p
+    b = L - a
+    t1, t2 = x[0], x[1]
+    hip = np.array([-L * np.sin(t2), L * np.cos(t2)])
+    return {
+        "stance_foot": np.zeros_like(hip),
+        "stance_mass": np.array([-a * np.sin(t2), a * np.cos(t2)]),
+        "hip": hip,
+        "swing_mass": hip + np.array([b * np.sin(t1), -b * np.cos(t1)]),
+        "swing_foot": hip + np.array([L * np.sin(t1), -L * np.cos(t1)]),
+    }
+
+
+# --------------------------------------------------------------------------- builder
+def _role_to_leg(stance_leg: str) -> dict[str, str]:
+    other = {"leg1": "leg2", "leg2": "leg1"}[stance_leg]
+    return {"stance": stance_leg, "swing": other}
+
+
+def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: float,
+                      gravity_m_per_s2: float, leg_mass_from_foot_m: float, slope_rad: float,
+                      variant: str = "derived") -> HybridWalker:
+    """Build the compass-gait :class:`HybridWalker` (all arguments SI).
+
+    Raises
+    ------
+    ValueError
+        Unknown ``variant``.
+    """
+    if variant not in VARIANTS:
+        raise ValueError(f"ideal.variant: unknown variant {variant!r}; choose from {VARIANTS}")
+    p = (leg_mass_kg, hip_mass_kg, leg_length_m, leg_mass_from_foot_m, gravity_m_per_s2)
+    L, phi = leg_length_m, slope_rad
+    f = partial(flow, p=p, variant=variant)
+    fall = Guard("fall", partial(hip_height, phi=phi, L=L), -1, "fall")
+    early = Phase("early_swing", f, (
+        Guard("midstance", swing_foot_ahead, +1, "next_phase"), fall))
+    late = Phase("late_swing", f, (
+        Guard("heel_strike", partial(heel_strike_guard, phi=phi), -1, "heel_strike"),
+        Guard("swing_leg_falls_back", swing_foot_ahead, -1, "fall"), fall))
+    reset = partial(impact, p=p, variant=variant)
+
+    def section(x):
+        return np.asarray(x)[1:]
+
+    def from_section(z):
+        z = np.asarray(z)
+        return np.concatenate([[-2.0 * phi - z[0]], z])
+
+    return HybridWalker(
+        name="compass_gait", variant=variant, roles=("swing", "stance"), legs=("leg1", "leg2"),
+        phases=(early, late), reset=reset, energies=partial(energies, p=p),
+        points=partial(points, p=p), section=section, from_section=from_section,
+        role_to_leg=_role_to_leg, total_mass_kg=hip_mass_kg + 2 * leg_mass_kg,
+        slope_rad=phi,
+        params={"leg_length_m": L, "leg_mass_kg": leg_mass_kg, "hip_mass_kg": hip_mass_kg,
+                "gravity_m_per_s2": gravity_m_per_s2,
+                "leg_mass_from_foot_m": leg_mass_from_foot_m, "slope_rad": phi},
+        variational=lambda t, x: complex_step_jacobian(lambda z: f(t, z), x),
+        reset_jacobian=lambda x: complex_step_jacobian(reset, x),
+        heel_strike_guard=partial(heel_strike_guard, phi=phi),
+    )

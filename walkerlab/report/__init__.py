@@ -1,0 +1,1 @@
+"""Human-readable summaries and the HTML/Markdown report, built from artifacts only."""

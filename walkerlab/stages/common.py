@@ -1,0 +1,73 @@
+"""Shared stage plumbing: artifact paths, input hashes, skip-if-up-to-date."""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import walkerlab
+from walkerlab.config import Scene
+from walkerlab.io.artifacts import code_hash, stored_hash, write_artifact
+
+
+class StageError(RuntimeError):
+    """A stage cannot run (missing section, failed upstream); the message is one line."""
+
+
+@dataclass
+class StageOutcome:
+    """What a stage did: its artifact, whether it was reused, and a printable summary."""
+
+    stage: str
+    path: Path
+    reused: bool
+    wall_time_s: float
+    summary: dict = field(default_factory=dict)
+
+
+def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
+    """``runs/<scene name>/<stage>.h5``."""
+    return Path(runs_root) / (scene.name or "scene") / f"{stage.replace('-', '_')}.h5"
+
+
+def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
+               upstream: tuple[Path, ...] = ()) -> str:
+    """Content hash of everything a stage's output depends on."""
+    h = hashlib.sha256()
+    h.update(stage.encode())
+    h.update(scene.section_json(*sections).encode())
+    h.update(walkerlab.__version__.encode())
+    h.update(code_hash().encode())
+    for p in upstream:
+        h.update(str(stored_hash(p)).encode())
+    return h.hexdigest()
+
+
+def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
+               upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
+               force: bool = False, extra_attrs: dict | None = None) -> StageOutcome:
+    """Run ``compute`` unless the artifact is up to date, then write it atomically.
+
+    ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
+    """
+    path = artifact_path(scene, runs_root, stage)
+    key = input_hash(stage, scene, sections, upstream)
+    if not force and path.is_file() and stored_hash(path) == key:
+        return StageOutcome(stage, path, True, 0.0, {})
+    t0 = time.perf_counter()
+    writer, summary = compute()
+    wall = time.perf_counter() - t0
+    write_artifact(path, stage, scene, key, writer, wall, extra_attrs)
+    return StageOutcome(stage, path, False, wall, summary)
+
+
+def require(scene: Scene, section: str, stage: str):
+    """Return the scene section a stage needs, or raise a one-line StageError."""
+    val = getattr(scene, section)
+    if val is None:
+        raise StageError(f"scene '{scene.name}' has no '{section}' section, which stage "
+                         f"'{stage}' needs")
+    return val

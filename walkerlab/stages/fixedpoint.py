@@ -1,0 +1,118 @@
+"""Stage ``fixedpoint``: period-1 gait of the rigid hybrid walker -> ``fixedpoint.h5``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.analysis.hybrid import Solver
+from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
+from walkerlab.config import Scene
+from walkerlab.io.artifacts import put
+from walkerlab.models.registry import build_walker
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+
+SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
+
+# The paper's Eq. (11), printed to these digits (rad, rad/s); role-ordered.
+PAPER_EQ11 = np.array([-0.2022, 0.1674, -0.60, -0.84])
+
+
+def _variants_for(scene: Scene) -> tuple[str, ...]:
+    if scene.walker.model == "compass_gait":
+        from walkerlab.models.compass_gait import VARIANTS
+
+        return VARIANTS
+    return (scene.ideal.variant,)
+
+
+def solve_variant(scene: Scene, variant: str):
+    """Fixed point of one equation variant of the scene's walker (raises FixedPointNotFound)."""
+    sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
+    walker = build_walker(sc)
+    fp = require(scene, "fixedpoint", "fixedpoint")
+    res = find_fixed_point(walker, fp.initial_guess.as_array(), Solver.from_settings(scene.solver),
+                           xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
+    return walker, res
+
+
+def _write_result(g, walker, res, guess) -> None:
+    names = walker.state_names()
+    units = ["rad"] * walker.n_coordinates + ["rad/s"] * walker.n_coordinates
+    g.attrs["variant"] = walker.variant
+    g.attrs["roles"] = list(walker.roles)
+    g.attrs["legs_by_role"] = json.dumps(walker.role_to_leg("leg2"))
+    for name, val, u in zip(names, res.x, units):
+        put(g, f"fixed_point/{name}", float(val), u, f"{name} just after heel strike")
+    for name, val, u in zip(names, guess, units):
+        put(g, f"initial_guess/{name}", float(val), u, "root-finder starting point")
+    put(g, "step_period", res.period_s, "s", "step period of the period-1 gait")
+    put(g, "residual", res.residual, "rad or rad/s", "max |P(x*) - x*| over the state")
+    for kind, ev, J in (("variational", res.multipliers_variational, res.jacobian_variational),
+                        ("finite_difference", res.multipliers_fd, res.jacobian_fd)):
+        put(g, f"floquet/{kind}/real", ev.real, "-", f"Floquet multipliers ({kind}), real part")
+        put(g, f"floquet/{kind}/imag", ev.imag, "-", f"Floquet multipliers ({kind}), imag part")
+        put(g, f"floquet/{kind}/jacobian", J, "-", "DP, rows/cols in state_names order",
+            state_names=names)
+    put(g, "floquet/max_difference", res.multiplier_difference, "-",
+        "max |multiplier(variational) - multiplier(finite difference)|")
+    put(g, "floquet/stable", res.stable, "-", "all |multipliers| < 1")
+    put(g, "stats/nfev", res.nfev, "-", "right-hand-side evaluations")
+    put(g, "stats/map_evaluations", res.iterations, "-", "Poincare-map calls by the root finder")
+    put(g, "stats/wall_time", res.wall_time_s, "s", "fixed-point search + Jacobians")
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
+    """Find the fixed point (scene's variant, plus the other equation variants for comparison).
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section, or no fixed point for the scene's own variant.
+    """
+    fp_cfg = require(scene, "fixedpoint", "fixedpoint")
+
+    def compute():
+        results = {}
+        for variant in _variants_for(scene):
+            try:
+                results[variant] = solve_variant(scene, variant)
+            except FixedPointNotFound as exc:
+                if variant == scene.ideal.variant:
+                    raise StageError(f"fixedpoint: {exc}") from None
+                results[variant] = exc
+        walker, main = results[scene.ideal.variant]
+        guess = fp_cfg.initial_guess.as_array()
+
+        def writer(f):
+            f.attrs["model"] = walker.name
+            f.attrs["variant"] = walker.variant
+            f.attrs["state_names"] = walker.state_names()
+            _write_result(f, walker, main, guess)
+            put(f, "paper/eq11", PAPER_EQ11, "rad, rad/s", "paper Eq. (11) as printed",
+                state_names=walker.state_names())
+            for v, r in results.items():
+                if isinstance(r, Exception):
+                    f.create_group(f"variants/{v}").attrs["error"] = str(r)
+                else:
+                    _write_result(f.create_group(f"variants/{v}"), r[0], r[1], guess)
+
+        summary = {"walker": walker, "result": main,
+                   "variants": {k: v for k, v in results.items()}}
+        return writer, summary
+
+    return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force)
+
+
+def load_fixed_point(path: Path) -> tuple[np.ndarray, dict]:
+    """Fixed point (role-ordered state) and metadata from ``fixedpoint.h5``."""
+    from walkerlab.io.artifacts import open_artifact
+
+    with open_artifact(path, "fixedpoint") as f:
+        names = [str(n) for n in f.attrs["state_names"]]
+        x = np.array([f[f"fixed_point/{n}"][()] for n in names])
+        meta = {"step_period_s": float(f["step_period"][()]), "state_names": names,
+                "stable": bool(f["floquet/stable"][()])}
+    return x, meta

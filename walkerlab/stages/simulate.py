@@ -1,0 +1,102 @@
+"""Stage ``simulate``: N strides of the rigid hybrid walker -> ``simulate.h5``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.analysis.hybrid import Solver, simulate_steps
+from walkerlab.analysis.metrics import sample_trajectory, step_table
+from walkerlab.config import Scene, SimulateSettings
+from walkerlab.io.artifacts import put
+from walkerlab.io.trajectory import write_samples
+from walkerlab.models.registry import build_walker
+from walkerlab.stages import fixedpoint as fixedpoint_stage
+from walkerlab.stages.common import StageError, StageOutcome, artifact_path, run_cached
+
+SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
+
+STEP_UNITS = {"t_start": "s", "t_end": "s", "period": "s", "step_length": "m",
+              "hip_speed": "m/s", "impact_energy_loss": "J", "midstance_time": "s"}
+
+
+def with_strides(scene: Scene, strides: int | None) -> Scene:
+    """Scene with ``simulate.strides`` overridden (section created with defaults if absent)."""
+    sim = scene.simulate or SimulateSettings()
+    if strides is not None:
+        sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+    return scene.model_copy(update={"simulate": sim})
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
+        strides: int | None = None) -> StageOutcome:
+    """Simulate ``simulate.strides`` strides (2 steps each) and write ``simulate.h5``.
+
+    The initial state is the fixed point from ``fixedpoint.h5`` (the fixedpoint stage is run
+    first if its artifact is missing or stale) or the scene's explicit state.
+
+    Raises
+    ------
+    StageError
+        Upstream failure; a run that falls is *not* an error: it is recorded.
+    """
+    scene = with_strides(scene, strides)
+    sim = scene.simulate
+    upstream: tuple[Path, ...] = ()
+    if sim.initial_state == "fixed_point":
+        fixedpoint_stage.run(scene, runs_root)
+        upstream = (artifact_path(scene, runs_root, "fixedpoint"),)
+
+    def compute():
+        walker = build_walker(scene)
+        if sim.initial_state == "fixed_point":
+            x0, _ = fixedpoint_stage.load_fixed_point(upstream[0])
+        else:
+            x0 = sim.initial_state.as_array()
+        traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
+                              max_step_time=sim.max_step_time_s)
+        samples = sample_trajectory(traj, sim.sample_rate_hz)
+        steps = step_table(traj)
+        ok = steps["termination"] == "heel_strike"
+        summary = {
+            "termination": traj.termination,
+            "steps_completed": int(ok.sum()),
+            "wall_time_s": traj.wall_time_s,
+            "nfev": traj.nfev,
+            "mean_period_s": float(np.mean(steps["period"][ok])) if ok.any() else np.nan,
+            "mean_step_length_m": float(np.mean(steps["step_length"][ok])) if ok.any() else np.nan,
+            "mean_hip_speed_m_per_s": float(np.mean(steps["hip_speed"][ok])) if ok.any() else np.nan,
+            "mean_total_energy_J": float(np.mean(samples.total)),
+        }
+
+        def writer(f):
+            f.attrs["model"] = walker.name
+            f.attrs["variant"] = walker.variant
+            f.attrs["legs"] = list(walker.legs)
+            f.attrs["termination"] = traj.termination
+            f.attrs["strides_requested"] = sim.strides
+            write_samples(f, samples)
+            g = f.create_group("steps")
+            for k, v in steps.items():
+                if v.dtype.kind in "US":
+                    put(g, k, [str(s) for s in v], "-", k)
+                else:
+                    put(g, k, v, STEP_UNITS.get(k, "-"), k)
+            names = walker.state_names()
+            for i, seg in enumerate(traj.segments):
+                sg = g.create_group(f"states/{i:04d}")
+                for nm, a, b in zip(names, seg.x_start, seg.x_end):
+                    sg.attrs[f"start_{nm}"] = a
+                    sg.attrs[f"end_{nm}"] = b
+            put(f, "initial_state", x0, "rad, rad/s", "role-ordered initial state",
+                state_names=names)
+            for k, v in summary.items():
+                if k != "termination":
+                    put(f, f"summary/{k}", v, {"wall_time_s": "s", "mean_period_s": "s",
+                                               "mean_step_length_m": "m",
+                                               "mean_hip_speed_m_per_s": "m/s",
+                                               "mean_total_energy_J": "J"}.get(k, "-"), k)
+        return writer, summary
+
+    return run_cached("simulate", scene, runs_root, SECTIONS, upstream, compute, force)
