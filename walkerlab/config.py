@@ -169,7 +169,9 @@ class Scene(_Strict):
 
 def _format_error(path: Path, err: ValidationError) -> str:
     e = err.errors()[0]
-    loc = ".".join(str(p) for p in e["loc"] if not str(p).startswith("function-after"))
+    tags = {"compass_gait"}  # discriminator tags of walker models: not part of the field path
+    loc = ".".join(str(p) for p in e["loc"]
+                   if not str(p).startswith("function-after") and str(p) not in tags)
     msg = e["msg"].removeprefix("Value error, ")
     extra = f" (+{len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
     return f"{path}: {loc or '<scene>'}: {msg}{extra}"

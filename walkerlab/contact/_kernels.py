@@ -340,20 +340,37 @@ def contact_table(X, P, c1, c2):
 
 
 @njit(cache=True)
-def rhs_guarded(x, P, c1, c2, hmin):
-    """:func:`rhs`, but frozen (zero derivative) once the hip height x.n < hmin [m].
-
-    Used by drivers without event support (odeint) so that a fallen walker (feet sinking
-    through lane gaps, then re-entering patches deep below their surface) costs nothing.
-    """
+def dead(x, P, c1, c2, hmin, dtrip):
+    """True once the walker has fallen (hip height x.n < hmin [m]) or tripped (a foot is
+    more than dtrip [m] below the surface of a patch, i.e. it came in through a patch side)."""
     if x[0] * np.sin(P[5]) + x[1] * np.cos(P[5]) < hmin:
+        return True
+    for i in range(2):
+        cen = c1 if i == 0 else c2
+        px, py, vx, vy = foot_state(x, i, P)
+        delta = -(px * np.sin(P[5]) + py * np.cos(P[5]))
+        if delta > dtrip and in_patch(px * np.cos(P[5]) - py * np.sin(P[5]), cen, P[14],
+                                      P[15] > 0.5):
+            return True
+    return False
+
+
+@njit(cache=True)
+def rhs_guarded(x, P, c1, c2, hmin, dtrip):
+    """:func:`rhs`, but frozen (zero derivative) once :func:`dead`.
+
+    A fallen walker (feet sinking through lane gaps, then re-entering patches far below their
+    surface, where the IMPACT law would give absurd forces) then costs nothing to integrate;
+    needed by drivers without event support (odeint).
+    """
+    if dead(x, P, c1, c2, hmin, dtrip):
         return np.zeros(8)
     return rhs(x, P, c1, c2)
 
 
 @njit(cache=True)
-def jac_guarded(x, P, c1, c2, hmin):
+def jac_guarded(x, P, c1, c2, hmin, dtrip):
     """Jacobian of :func:`rhs_guarded`."""
-    if x[0] * np.sin(P[5]) + x[1] * np.cos(P[5]) < hmin:
+    if dead(x, P, c1, c2, hmin, dtrip):
         return np.zeros((8, 8))
     return jac(x, P, c1, c2)

@@ -1,0 +1,29 @@
+"""Shared fixtures: the paper walker and its fixed point (computed once per session)."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from walkerlab.analysis.hybrid import Solver
+from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.config import load_scene
+from walkerlab.models.registry import build_walker
+
+ROOT = Path(__file__).resolve().parents[1]
+TIGHT = Solver("DOP853", 1e-12, 1e-12)
+
+
+@pytest.fixture(scope="session")
+def paper_scene():
+    return load_scene(ROOT / "configs" / "paper.yaml")
+
+
+@pytest.fixture(scope="session")
+def paper_walker(paper_scene):
+    return build_walker(paper_scene)
+
+
+@pytest.fixture(scope="session")
+def paper_fixed_point(paper_walker):
+    return find_fixed_point(paper_walker, np.array([-0.2022, 0.1674, -0.60, -0.84]), TIGHT)
