@@ -11,7 +11,7 @@ from typing import Optional
 
 import typer
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="walkerlab: passive-dynamic biped walkers, from fixed point to report.")
 
 SceneArg = typer.Argument(None, help="scene YAML file [default: configs/paper.yaml]",

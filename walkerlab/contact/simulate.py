@@ -68,8 +68,8 @@ class StepSummary:
     period : float
         ``t_end - t_start`` [s] (nan if incomplete).
     stance_slip_mm : float
-        Along-slope displacement of the stance foot between its touchdown and its lift-off
-        (or the run's end) [mm]; positive = downhill.
+        Along-slope displacement of the stance foot between its touchdown and its last
+        lift-off before its next heel strike (or the run's end) [mm]; positive = downhill.
     bounce_count : int
         Touchdowns within the step other than the heel strike that starts it.
     peak_penetration_m : float
@@ -116,6 +116,8 @@ class ContactResult:
     method : str
     pin_end_time : float
         End of the pinned phase [s] (= t0 if none).
+    fall_reason : str or None
+        "hip_height" (hip below the threshold) or "trip" (foot entered a patch from the side).
     """
 
     t: np.ndarray
@@ -133,6 +135,7 @@ class ContactResult:
     wall_time_s: float
     method: str
     pin_end_time: float = 0.0
+    fall_reason: str | None = None
     extra: dict = field(default_factory=dict)
 
     @property
@@ -221,22 +224,23 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, rate, rtol, atol, max_st
         sol.message
 
 
-def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_jac, chunk_s):
+def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, dtrip, use_jac,
+              chunk_s):
     """Integrate the free walker.  Returns (t, X, nfev, njev, status, message)."""
-    jac = walker.jac if use_jac else None
+    # frozen once fallen / tripped (see _kernels.dead): odeint has no events, and the solve_ivp
+    # fall event cannot see a trip
+    P, c1, c2 = walker._P, walker.lane1, walker.lane2
+    hfreeze = hth * (1.0 - 1e-9)
+
+    def frhs(t, x):
+        return K.rhs_guarded(x, P, c1, c2, hfreeze, dtrip)
+
+    def fjac(t, x):
+        return K.jac_guarded(x, P, c1, c2, hfreeze, dtrip)
+
+    if not use_jac:
+        fjac = None
     if method == "odeint":
-        # frozen below the fall height (odeint has no events); see _kernels.rhs_guarded
-        P, c1, c2 = walker._P, walker.lane1, walker.lane2
-        hfreeze = hth * (1.0 - 1e-9)
-
-        def frhs(t, x):
-            return K.rhs_guarded(x, P, c1, c2, hfreeze)
-
-        def fjac(t, x):
-            return K.jac_guarded(x, P, c1, c2, hfreeze)
-
-        if not use_jac:
-            fjac = None
         ts, Xs, nfev, njev = [np.array([t0])], [x0[None]], 0, 0
         ta, xa = t0, x0
         status, msg = "ok", "Integration successful."
@@ -245,20 +249,18 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
             tg = _grid(ta, tb, rate)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", ODEintWarning)
-                X, info = odeint(frhs, xa, tg, Dfun=fjac, tfirst=True, rtol=rtol,
-                                 atol=atol, hmax=0.0 if not np.isfinite(max_step) else max_step,
+                X, info = odeint(frhs, xa, tg, Dfun=fjac, tfirst=True, rtol=rtol, atol=atol,
+                                 hmax=0.0 if not np.isfinite(max_step) else max_step,
                                  full_output=True, mxstep=200000)
             nfev += int(info["nfe"][-1])
             njev += int(info["nje"][-1])
-            ok = info["message"] == "Integration successful."
-            if not ok:
-                good = np.flatnonzero(info["tcur"] >= tg[1:] - 1e-14)
-                nk = good.size + 1
+            if info["message"] != "Integration successful.":
+                nk = int(np.count_nonzero(info["tcur"] >= tg[1:] - 1e-14)) + 1
                 ts.append(tg[1:nk]); Xs.append(X[1:nk])
                 return np.concatenate(ts), np.vstack(Xs), nfev, njev, "fail", info["message"]
             ts.append(tg[1:]); Xs.append(X[1:])
-            if np.any(walker.hip_height(X) < hth):
-                status = "fall"
+            if np.all(X[-1] == X[-2]) or np.any(walker.hip_height(X) < hth):
+                status = "fall"  # frozen or fallen; the caller finds the time and the cause
                 break
             ta, xa = tb, X[-1]
         return np.concatenate(ts), np.vstack(Xs), nfev, njev, status, msg
@@ -268,8 +270,8 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
 
     fall.terminal = True
     fall.direction = -1
-    kw = {"jac": jac} if use_jac else {}
-    sol = solve_ivp(walker.rhs, (t0, t1), x0, method=method, rtol=rtol, atol=atol,
+    kw = {"jac": fjac} if use_jac else {}
+    sol = solve_ivp(frhs, (t0, t1), x0, method=method, rtol=rtol, atol=atol,
                     max_step=max_step, t_eval=_grid(t0, t1, rate), events=[fall], **kw)
     status = {0: "ok", 1: "fall", -1: "fail"}[sol.status]
     return sol.t, sol.y.T, sol.nfev, sol.njev, status, sol.message
@@ -280,7 +282,8 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
                      max_step: float = np.inf, sample_rate_hz: float = 1000.0, *,
                      t0: float = 0.0, pin_stance_until: str = "none", pin_time_s: float = 0.0,
                      fall_hip_height_m: float | None = None, use_jacobian: bool = True,
-                     chunk_s: float = 1.0, min_step_m: float = 0.05,
+                     trip_depth_m: float = 0.01, chunk_s: float = 1.0,
+                     min_step_m: float = 0.05,
                      initial_stance: str = "leg2") -> ContactResult:
     """Simulate the floating walker with compliant feet.
 
@@ -305,6 +308,9 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         ground, or until ``t0 + pin_time_s``.
     fall_hip_height_m : float, optional
         Fall threshold of the hip height above ground [m] (default 0.5 L).
+    trip_depth_m : float
+        A foot found more than this [m] below the surface of a patch (it entered through the
+        patch's side after sinking in a gap) ends the run as a fall ("trip").
     use_jacobian : bool
         Pass the analytic Jacobian to the integrator.
     chunk_s : float
@@ -334,8 +340,8 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         t_pin, x0 = tp[-1], Xp[-1]
     if status == "ok" and t_pin < t_final - 1e-12:
         tf, Xf, nf, nj, status, msg = _run_free(walker, x0, t_pin, t_final, method, rtol, atol,
-                                                max_step, sample_rate_hz, hth, use_jacobian,
-                                                chunk_s)
+                                                max_step, sample_rate_hz, hth, trip_depth_m,
+                                                use_jacobian, chunk_s)
         if ts:
             tf, Xf = tf[1:], Xf[1:]
         ts.append(tf); Xs.append(Xf); nfev += nf; njev += nj
@@ -344,20 +350,31 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
     X = np.vstack(Xs)
     fall_time = None
     termination = {"ok": "t_final", "fall": "fall", "fail": "solver_failure"}[status]
+    fall_reason = None
     hh = walker.hip_height(X)
     below = np.flatnonzero(hh < hth)
-    if below.size:
-        k = below[0]
-        fall_time = float(t[k]) if k == 0 else float(
-            np.interp(hth, [hh[k], hh[k - 1]], [t[k], t[k - 1]]))
+    cq = walker.contact_quantities(X)
+    deep = np.flatnonzero(np.any([(cq[f]["penetration"] > trip_depth_m) & (cq[f]["on_ground"] > 0)
+                                  for f in FOOT_NAMES], axis=0))
+    k_fall = below[0] if below.size else len(t)
+    k_trip = deep[0] if deep.size else len(t)
+    if k_fall < len(t) or k_trip < len(t):
         termination = "fall"
+        k = min(k_fall, k_trip)
+        if k_trip < k_fall:
+            fall_reason, fall_time = "trip", float(t[k])
+            msg = f"trip: a foot entered a patch > {trip_depth_m} m below its surface"
+        else:
+            fall_reason = "hip_height"
+            fall_time = float(t[k]) if k == 0 else float(
+                np.interp(hth, [hh[k], hh[k - 1]], [t[k], t[k - 1]]))
         t, X = t[:k + 1], X[:k + 1]
     res = _postprocess(walker, t, X, min_step_m, initial_stance)
     return ContactResult(t=t, q=X[:, :4], qdot=X[:, 4:], feet=res["feet"],
                          heel_strike_times=res["hs_t"], heel_strike_legs=res["hs_leg"],
                          steps=res["steps"], termination=termination, fall_time=fall_time,
                          message=str(msg), nfev=int(nfev), njev=int(njev), wall_time_s=wall,
-                         method=method, pin_end_time=float(t_pin))
+                         method=method, pin_end_time=float(t_pin), fall_reason=fall_reason)
 
 
 # ---------------------------------------------------------------------------- events
@@ -404,9 +421,11 @@ def _postprocess(walker, t, X, min_step_m, initial_stance):
     steps = []
     for j, (ta, leg) in enumerate(zip(starts, legs)):
         tb = starts[j + 1] if j + 1 < len(starts) else np.nan
+        # stance ends at this foot's last lift-off before its next heel strike
+        t_next = starts[j + 2] if j + 2 < len(starts) else t[-1]
         lo = feet[leg].liftoff_times
-        later = lo[lo > (tb if np.isfinite(tb) else ta)]
-        t_lo = later[0] if later.size else t[-1]
+        mine = lo[(lo > ta) & (lo <= t_next)]
+        t_lo = mine[-1] if mine.size else t[-1]
         slip = np.interp(t_lo, t, feet[leg].s) - np.interp(ta, t, feet[leg].s)
         sel = (t >= ta) & (t <= (tb if np.isfinite(tb) else t[-1]))
         peak = max(float(np.max(feet[f].penetration[sel] * feet[f].on_ground[sel]))

@@ -1,0 +1,106 @@
+"""Paper Tables 2 and 3, recomputed from artifacts (never typed in), beside the published values."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.io.artifacts import open_artifact
+from walkerlab.io.trajectory import NamedTrajectory, read_samples
+
+# Published values, paper Table 3 (MATLAB, MSC ADAMS) and Table 2.
+PAPER_TABLE3 = {
+    "t_left_s": (0.60, 0.59),
+    "t_right_s": (0.79, 0.77),
+    "t_cycle_s": (1.39, 1.38),
+    "v_com_m_per_s": (0.0246, 0.0248),
+    "E_avg_J": (150.13, 150.14),
+}
+PAPER_DELTA_X_M = 0.0342  # "the length of the robot's step is constant and equal to 0.0342 m"
+PAPER_TABLE2 = {  # MATLAB, MSC ADAMS
+    "theta1_rad": (-0.2022, -0.2021),
+    "theta2_rad": (0.1674, 0.1670),
+    "dtheta1_rad_per_s": (-0.60, -1.02),
+    "dtheta2_rad_per_s": (-0.84, -3.20),
+}
+TABLE3_ROWS = {
+    "t_left_s": ("Left step period", "t_left", "s"),
+    "t_right_s": ("Right step period", "t_right", "s"),
+    "t_cycle_s": ("One cycle period", "t_cycle = t_left + t_right", "s"),
+    "v_com_m_per_s": ("Average velocity of robot", "v_com", "m/s"),
+    "E_avg_J": ("Average mechanical energy (5 steps)", "E_avg = KE + PE", "J"),
+}
+
+
+def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_steps: int = 5,
+                 mass_kg: float | None = None, g: float = 9.81) -> dict[str, float]:
+    """Table 3 quantities of a named trajectory.
+
+    Steps are delimited by changes of ``stance_leg`` (the last sample closes the last step); a *left step* is a step in which the
+    left leg (``legs[0]`` unless given) swings.  Only complete steps (followed by another
+    step) count.  ``v_com`` is the hip's horizontal displacement over whole cycles divided by
+    their duration (over a periodic cycle the centre of mass and the hip advance alike).
+    ``E_avg`` is the time average of KE + PE over the first ``n_energy_steps`` steps with PE
+    from the first stance foot; ``E_avg_stance_frame`` measures PE from the current stance
+    foot instead (needs ``mass_kg``).
+
+    Returns
+    -------
+    dict
+        ``t_left_s``, ``t_right_s``, ``t_cycle_s``, ``v_com_m_per_s``, ``E_avg_J``,
+        ``E_avg_stance_frame_J``, ``step_length_m``, ``n_steps``.
+    """
+    left = left_leg or tr.legs[0]
+    li = tr.legs.index(left)
+    change = np.flatnonzero(np.diff(tr.stance_leg) != 0) + 1
+    bounds = np.concatenate([[0], change, [tr.time.size - 1]])
+    t_b = tr.time[bounds]
+    periods = np.diff(t_b)
+    stance = tr.stance_leg[bounds[:-1]]
+    left_steps = periods[stance != li]  # left leg swings when it is not in stance
+    right_steps = periods[stance == li]
+    hip = tr.points.get("hip")
+    out = {"n_steps": int(periods.size)}
+    out["t_left_s"] = float(np.mean(left_steps)) if left_steps.size else np.nan
+    out["t_right_s"] = float(np.mean(right_steps)) if right_steps.size else np.nan
+    out["t_cycle_s"] = out["t_left_s"] + out["t_right_s"]
+    n_cyc = periods.size // 2
+    if hip is not None and n_cyc >= 1:
+        i0, i1 = bounds[0], bounds[2 * n_cyc]
+        out["v_com_m_per_s"] = float((hip[0, i1] - hip[0, i0]) / (tr.time[i1] - tr.time[i0]))
+        feet = [tr.points.get(f"{leg}_foot") for leg in tr.legs]
+        if all(f is not None for f in feet):
+            lengths = []
+            for k in range(1, periods.size + 1):
+                i = bounds[k] - 1 if k < len(bounds) - 1 else bounds[k]
+                d = feet[0][:, i] - feet[1][:, i]
+                lengths.append(np.hypot(*d))
+            out["step_length_m"] = float(np.mean(lengths)) if lengths else np.nan
+    else:
+        out["v_com_m_per_s"] = np.nan
+    out.setdefault("step_length_m", np.nan)
+    iE = bounds[min(n_energy_steps, periods.size)]
+    sl = slice(0, max(iE, 2))
+    tt = tr.time[sl]
+    out["E_avg_J"] = float(np.trapezoid(tr.total[sl], tt) / (tt[-1] - tt[0]))
+    if mass_kg is not None:
+        y_st = np.empty(tt.size)
+        for k, leg in enumerate(tr.legs):
+            foot = tr.points.get(f"{leg}_foot")
+            if foot is not None:
+                m = tr.stance_leg[sl] == k
+                y_st[m] = foot[1, sl][m]
+        e_st = tr.total[sl] - mass_kg * g * y_st
+        out["E_avg_stance_frame_J"] = float(np.trapezoid(e_st, tt) / (tt[-1] - tt[0]))
+    return out
+
+
+def table3(paths: dict[str, Path], mass_kg: float, g: float) -> dict[str, dict[str, float]]:
+    """Table 3 columns recomputed from trajectory artifacts ``{label: path}``."""
+    cols = {}
+    for label, (stage, p) in paths.items():
+        with open_artifact(p, stage) as f:
+            tr = read_samples(f)
+        cols[label] = gait_metrics(tr, mass_kg=mass_kg, g=g)
+    return cols

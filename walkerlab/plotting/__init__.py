@@ -1,0 +1,1 @@
+"""Figures drawn from loaded artifacts only (never from live simulation objects)."""

@@ -1,0 +1,165 @@
+"""The paper's figures 7-10, stick diagrams (Figs. 2, 6) and the work-precision diagram.
+
+Every function takes data loaded from artifacts (:class:`NamedTrajectory`, dicts of arrays)
+keyed by a *model label* (``"ideal (rigid)"``, ``"contact"``) and returns a matplotlib
+Figure; :func:`save` writes it as PNG and SVG.  Legs are addressed by name.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from walkerlab.io.trajectory import NamedTrajectory  # noqa: E402
+
+LEG_COLORS = ["tab:blue", "tab:red", "tab:green", "tab:purple"]
+MODEL_STYLES = ["-", "--", ":", "-."]
+
+
+def save(fig, folder: Path, stem: str) -> list[Path]:
+    """Write ``stem.png`` (150 dpi) and ``stem.svg``; close the figure."""
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for ext in ("png", "svg"):
+        p = folder / f"{stem}.{ext}"
+        fig.savefig(p, dpi=150, bbox_inches="tight")
+        out.append(p)
+    plt.close(fig)
+    return out
+
+
+def _legend(ax, **kw):
+    h, lab = ax.get_legend_handles_labels()
+    if h:
+        ax.legend(fontsize=8, **kw)
+
+
+def fig7_angles_rates(trajs: dict[str, NamedTrajectory]):
+    """Fig. 7: leg angles [rad] (a) and angular rates [rad/s] (b) over time, every model."""
+    fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    for mi, (label, tr) in enumerate(trajs.items()):
+        for li, leg in enumerate(tr.legs):
+            kw = dict(color=LEG_COLORS[li % 4], ls=MODEL_STYLES[mi % 4], lw=1.2)
+            axes[0].plot(tr.time, tr.angle[leg], label=f"{leg} - {label}", **kw)
+            axes[1].plot(tr.time, tr.rate[leg], label=f"{leg} - {label}", **kw)
+    axes[0].set_ylabel("leg angle from vertical [rad]")
+    axes[1].set_ylabel("leg angular rate [rad/s]")
+    axes[1].set_xlabel("time [s]")
+    axes[0].set_title("(a) leg angles")
+    axes[1].set_title("(b) leg angular rates")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    h, lab = axes[0].get_legend_handles_labels()
+    fig.legend(h, lab, loc="lower center", ncol=min(4, len(h)), fontsize=8)
+    fig.subplots_adjust(bottom=0.16, hspace=0.3)
+    fig.suptitle("Fig. 7 - compass-gait walking, leg angles and rates")
+    return fig
+
+
+def fig8_errors(time: np.ndarray, angle_err: dict[str, np.ndarray],
+                rate_err: dict[str, np.ndarray], label: str):
+    """Fig. 8: error between two models (contact - ideal) of angles [rad] and rates [rad/s]."""
+    fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    for li, leg in enumerate(angle_err):
+        axes[0].plot(time, angle_err[leg], color=LEG_COLORS[li % 4], label=leg, lw=1)
+        axes[1].plot(time, rate_err[leg], color=LEG_COLORS[li % 4], label=leg, lw=1)
+    axes[0].set_ylabel("angle error [rad]")
+    axes[1].set_ylabel("rate error [rad/s]")
+    axes[1].set_xlabel("time [s]")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        _legend(ax)
+    fig.suptitle(f"Fig. 8 - error {label}")
+    return fig
+
+
+def fig9_limit_cycle(trajs: dict[str, NamedTrajectory]):
+    """Fig. 9: limit cycles in the phase plane, rate [rad/s] vs angle [rad], per leg."""
+    legs = next(iter(trajs.values())).legs
+    fig, axes = plt.subplots(1, len(legs), figsize=(5 * len(legs), 4.5), squeeze=False)
+    for mi, (label, tr) in enumerate(trajs.items()):
+        for li, leg in enumerate(tr.legs):
+            ax = axes[0, li]
+            ax.plot(tr.angle[leg], tr.rate[leg], ls=MODEL_STYLES[mi % 4],
+                    color=LEG_COLORS[mi % 4], lw=1, label=label)
+    for li, leg in enumerate(legs):
+        ax = axes[0, li]
+        ax.set_xlabel(f"{leg} angle [rad]")
+        ax.set_ylabel(f"{leg} rate [rad/s]")
+        ax.set_title(f"{leg}")
+        ax.grid(alpha=0.3)
+        _legend(ax)
+    fig.suptitle("Fig. 9 - limit cycles in the phase plane")
+    return fig
+
+
+def fig10_energy(trajs: dict[str, NamedTrajectory]):
+    """Fig. 10: kinetic, potential and total mechanical energy [J] over time."""
+    fig, axes = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True)
+    for mi, (label, tr) in enumerate(trajs.items()):
+        kw = dict(ls=MODEL_STYLES[mi % 4], color=LEG_COLORS[mi % 4], lw=1.2, label=label)
+        axes[0].plot(tr.time, tr.kinetic, **kw)
+        axes[1].plot(tr.time, tr.potential, **kw)
+        axes[2].plot(tr.time, tr.total, **kw)
+    for ax, name in zip(axes, ("kinetic", "potential", "total mechanical")):
+        ax.set_ylabel(f"{name} energy [J]")
+        ax.grid(alpha=0.3)
+        _legend(ax)
+    axes[2].set_xlabel("time [s]")
+    fig.suptitle("Fig. 10 - energies (potential from the first stance foot's height)")
+    return fig
+
+
+def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
+                  slope_rad: float | None = None):
+    """Stick diagram of the first gait cycle (two steps), as the paper's Figs. 2 and 6."""
+    steps = np.unique(tr.step_index)
+    sel = np.isin(tr.step_index, steps[:2])
+    idx = np.flatnonzero(sel)
+    picks = idx[np.linspace(0, idx.size - 1, n_snapshots).astype(int)]
+    fig, ax = plt.subplots(figsize=(10, 3.8))
+    cmap = plt.get_cmap("viridis")
+    hip = tr.points["hip"]
+    for j, i in enumerate(picks):
+        c = cmap(j / max(1, len(picks) - 1))
+        for li, leg in enumerate(tr.legs):
+            foot = tr.points.get(f"{leg}_foot")
+            if foot is None:
+                continue
+            ax.plot([hip[0, i], foot[0, i]], [hip[1, i], foot[1, i]], color=c,
+                    lw=2.2 if li == 0 else 1.2)
+        ax.plot(hip[0, i], hip[1, i], "o", color=c, ms=6)
+    xs = np.array([hip[0, idx].min() - 0.4, hip[0, idx].max() + 0.4])
+    if slope_rad is not None:
+        ax.plot(xs, -np.tan(slope_rad) * xs, color="k", lw=1)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m] (downhill)")
+    ax.set_ylabel("y [m]")
+    ax.set_title(f"stick diagram, one gait cycle - {label} (thick: {tr.legs[0]}; "
+                 "colour: time)")
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None):
+    """Work-precision diagram: error vs wall time (log-log), one line per method."""
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for mi, (method, d) in enumerate(rows.items()):
+        ok = np.isfinite(d["error"]) & (d["error"] > 0)
+        ax.loglog(d["time"][ok], d["error"][ok], "o-", label=method, ms=4)
+        for t, e, tol in zip(d["time"][ok], d["error"][ok], d["rtol"][ok]):
+            ax.annotate(f"{tol:.0e}", (t, e), fontsize=6, alpha=0.6)
+    if pareto:
+        pt = np.array([(p["time"], p["error"]) for p in pareto])
+        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front")
+    ax.set_xlabel("wall time (median of repeats) [s]")
+    ax.set_ylabel("max state error vs reference [rad, rad/s]")
+    ax.set_title(title)
+    ax.grid(alpha=0.3, which="both")
+    _legend(ax)
+    return fig

@@ -1,0 +1,82 @@
+"""Stage ``plot``: figures (PNG + SVG) from the scene's artifacts; omits what is absent."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.config import Scene
+from walkerlab.io.artifacts import open_artifact
+from walkerlab.io.trajectory import read_samples
+from walkerlab.plotting import figures as F
+from walkerlab.stages.common import StageError, artifact_path
+
+IDEAL_LABEL = "ideal (rigid, plastic impact)"
+CONTACT_LABEL = "contact (IMPACT + Coulomb)"
+
+
+def figures_dir(scene: Scene, runs_root: Path | str) -> Path:
+    return Path(runs_root) / (scene.name or "scene") / "report" / "figures"
+
+
+def load_trajectories(scene: Scene, runs_root: Path | str) -> dict:
+    """Named trajectories of every trajectory artifact present, keyed by model label."""
+    out = {}
+    for stage, label in (("simulate", IDEAL_LABEL), ("contact-sim", CONTACT_LABEL)):
+        p = artifact_path(scene, runs_root, stage)
+        if p.is_file():
+            with open_artifact(p, stage) as f:
+                out[label] = read_samples(f)
+    return out
+
+
+def run(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
+    """Draw every figure the scene's artifacts support.
+
+    Returns
+    -------
+    list of Path
+        Written files (PNG and SVG).
+
+    Raises
+    ------
+    StageError
+        No trajectory artifact exists yet.
+    """
+    out_dir = figures_dir(scene, runs_root)
+    trajs = load_trajectories(scene, runs_root)
+    if not trajs:
+        raise StageError(f"plot: no simulate.h5 or contact_sim.h5 under "
+                         f"{Path(runs_root) / (scene.name or '')}; run 'walkerlab simulate' first")
+    written: list[Path] = []
+    written += F.save(F.fig7_angles_rates(trajs), out_dir, "fig7_angles_rates")
+    written += F.save(F.fig9_limit_cycle(trajs), out_dir, "fig9_limit_cycles")
+    written += F.save(F.fig10_energy(trajs), out_dir, "fig10_energy")
+    for label, tr in trajs.items():
+        stem = "fig2_stick_ideal" if label == IDEAL_LABEL else "fig6_stick_contact"
+        written += F.save(F.stick_diagram(tr, label, slope_rad=scene.slope.phi_rad), out_dir, stem)
+    cmp_path = artifact_path(scene, runs_root, "compare")
+    if cmp_path.is_file():
+        with open_artifact(cmp_path, "compare") as f:
+            g = f["errors"]
+            legs = [str(x) for x in g.attrs["legs"]]
+            t = g["time"][()]
+            ae = {leg: g[f"angle/{leg}"][()] for leg in legs}
+            re = {leg: g[f"rate/{leg}"][()] for leg in legs}
+        written += F.save(F.fig8_errors(t, ae, re, "contact - ideal"), out_dir, "fig8_errors")
+    wp_path = artifact_path(scene, runs_root, "workprecision")
+    if wp_path.is_file():
+        with open_artifact(wp_path, "workprecision") as f:
+            for model in f:
+                g = f[model]
+                rows = {m: {k: g[m][k][()] for k in ("time", "error", "rtol", "nfev")}
+                        for m in g if isinstance(g[m], type(g))}
+                pareto = [dict(zip(("method", "rtol", "time", "error"), r))
+                          for r in zip([str(s) for s in g.attrs.get("pareto_methods", [])],
+                                       np.asarray(g.attrs.get("pareto_rtol", [])),
+                                       np.asarray(g.attrs.get("pareto_time", [])),
+                                       np.asarray(g.attrs.get("pareto_error", [])))]
+                written += F.save(F.work_precision(rows, f"work-precision, {model} model",
+                                                   pareto), out_dir, f"work_precision_{model}")
+    return written

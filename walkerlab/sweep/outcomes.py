@@ -1,0 +1,96 @@
+"""Typed outcomes of a sweep point and the result columns of each swept stage.
+
+Every point of a sweep ends in exactly one outcome (never an unhandled exception):
+
+==================  =======================================================================
+``ok``              the stage succeeded (fixed point found / all steps walked)
+``no_fixed_point``  the root finder stopped without a fixed point (``residual`` column)
+``fall``            the walker fell (``fall_time_s``, ``fall_leg`` = stance leg, ``message``
+                    = guard that fired)
+``scuffing``        the swing foot hit the ground before heel strike (contact model: a
+                    touchdown of the swing foot that is not a heel strike; rigid model: only
+                    when ``options["scuff_limit_m"]`` is set, since the ideal model ignores it)
+``slip``            contact model: the stance foot slid more than ``slip_limit_mm``
+``bounce``          contact model: the stance foot left the ground and touched down again
+``solver_failure``  the integrator stopped (``message`` = scipy's message)
+``max_steps``       a budget ran out before a verdict: a step lasted longer than
+                    ``max_step_time_s`` (rigid), or the contact walker stalled (too few steps)
+``invalid_config``  the point's scene does not validate (``message`` = pydantic's, one line)
+``error``           any other exception (type and message recorded; should not happen)
+==================  =======================================================================
+"""
+
+from __future__ import annotations
+
+OUTCOMES = ("ok", "no_fixed_point", "fall", "scuffing", "slip", "bounce", "solver_failure",
+            "max_steps", "invalid_config", "error")
+
+STATE_COLS = ("swing_angle_rad", "stance_angle_rad", "swing_rate_rad_per_s",
+              "stance_rate_rad_per_s")
+
+# column name -> (unit, description); all stored as float64 (NaN = not applicable)
+_FP = {
+    **{c: ("rad" if "angle" in c else "rad/s", f"fixed point, {c} just after heel strike")
+       for c in STATE_COLS},
+    "step_period_s": ("s", "step period of the period-1 gait"),
+    "residual": ("rad or rad/s", "max |P(x) - x| at the last iterate"),
+    **{f"multiplier_{k}_{p}": ("-", f"Floquet multiplier {k} (variational, sorted by modulus), "
+                               f"{'real' if p == 're' else 'imaginary'} part")
+       for k in range(4) for p in ("re", "im")},
+    "max_abs_multiplier": ("-", "largest |Floquet multiplier|"),
+    "stable": ("-", "1 if all |multipliers| < 1, else 0"),
+    "map_evaluations": ("-", "Poincare-map calls of the root finder"),
+    "nfev": ("-", "right-hand-side evaluations"),
+}
+
+_SIM = {
+    "steps_completed": ("-", "heel strikes before the run ended"),
+    "t_end_s": ("s", "time at which the run ended"),
+    "fall_time_s": ("s", "time of the fall (NaN if none)"),
+    "mean_step_period_s": ("s", "mean period of the completed steps"),
+    "mean_step_length_m": ("m", "mean step length (foot to foot at heel strike)"),
+    "mean_hip_speed_m_per_s": ("m/s", "mean step length / mean step period"),
+    "interleg_angle_last_rad": ("rad", "inter-leg angle at the last heel strike"),
+    "scuff_depth_m": ("m", "largest depth of the swing foot below the slope before heel "
+                           "strike (the ideal model ignores it)"),
+    **{f"x0_{c}": ("rad" if "angle" in c else "rad/s", f"initial state, {c}") for c in STATE_COLS},
+    "nfev": ("-", "right-hand-side evaluations"),
+}
+
+_CONTACT = {
+    "heel_strikes": ("-", "heel strikes detected"),
+    "steps_expected": ("-", "2 * contact_sim.n_strides"),
+    "t_end_s": ("s", "time at which the run ended"),
+    "fall_time_s": ("s", "time of the fall (NaN if none)"),
+    "mean_step_period_s": ("s", "mean period of the complete steps"),
+    "max_slip_mm": ("mm", "largest along-slope slide of a stance foot while in contact"),
+    "bounces": ("-", "touchdowns of a stance foot after it lifted off within its step"),
+    "scuffs": ("-", "touchdowns of the swing foot that are not heel strikes"),
+    "peak_penetration_mm": ("mm", "largest penetration of either foot"),
+    "ideal_step_length_m": ("m", "step length of the ideal gait (checkerboard spacing)"),
+    "ideal_step_period_s": ("s", "step period of the ideal gait"),
+    "integration_wall_time_s": ("s", "wall time of the contact integration alone"),
+    "nfev": ("-", "right-hand-side evaluations"),
+}
+
+COLUMNS: dict[str, dict[str, tuple[str, str]]] = {
+    "fixedpoint": _FP, "simulate": _SIM, "contact-sim": _CONTACT,
+}
+
+# string columns shared by every stage
+STRING_COLUMNS = {
+    "outcome": "typed outcome (see walkerlab.sweep.outcomes)",
+    "message": "human-readable detail (exception text, solver message, guard name)",
+    "fall_leg": "physical leg in stance when the walker fell ('' if none)",
+    "guess_source": "fixed-point guess used: 'neighbour' (continuation), 'scene', or ''",
+}
+
+STAGES = tuple(COLUMNS)
+
+
+def empty_row(stage: str, index: int) -> dict:
+    """A row with every column of ``stage`` at its 'not applicable' value."""
+    row = {c: float("nan") for c in COLUMNS[stage]}
+    row.update({c: "" for c in STRING_COLUMNS})
+    row.update(index=int(index), wall_time_s=float("nan"))
+    return row

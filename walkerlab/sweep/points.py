@@ -1,0 +1,434 @@
+"""Evaluate sweep points: one function per swept stage, and the chunk runner workers call.
+
+Each point function takes a validated :class:`~walkerlab.config.Scene`, the fixed point of
+the previous point of the same chunk (continuation guess, or ``None``) and the sweep
+options, and returns ``(columns, next_guess)``.  :func:`run_chunk` wraps them so that every
+point ends in a typed outcome (:mod:`walkerlab.sweep.outcomes`), whatever happens.
+
+The contact-sim point goes through :func:`contact_adapter`, the only place that knows the
+calling convention of :func:`walkerlab.contact.simulate.simulate_contact` (that model is being
+written in parallel; adjust the adapter, nothing else, when its interface changes).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import traceback
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from walkerlab.config import Scene, SceneError
+from walkerlab.sweep.outcomes import COLUMNS, STATE_COLS, empty_row
+from walkerlab.sweep.params import apply_point
+
+__all__ = ["Task", "run_chunk", "fixedpoint_point", "simulate_point", "contact_point",
+           "contact_adapter", "ideal_fixed_point", "DEFAULT_OPTIONS", "POINT_FUNCTIONS"]
+
+DEFAULT_OPTIONS: dict[str, Any] = {
+    "scuff_limit_m": None,   # rigid model: report 'scuffing' if the swing foot dips deeper [m]
+    "slip_limit_mm": 5.0,    # contact model: 'slip' if a stance foot slides farther [mm]
+    "min_interleg_angle_rad": 1e-3,  # smaller fixed-point inter-leg angle = degenerate gait
+}
+
+
+class _Outcome(Exception):
+    """Internal: end a point with a typed outcome and extra columns."""
+
+    def __init__(self, outcome: str, message: str = "", **cols):
+        super().__init__(message)
+        self.outcome, self.message, self.cols = outcome, message, cols
+
+
+@dataclass(frozen=True)
+class Task:
+    """A chunk of sweep points evaluated in order by one worker (picklable).
+
+    Attributes
+    ----------
+    stage : str
+        ``"fixedpoint"``, ``"simulate"`` or ``"contact-sim"``.
+    base : dict
+        Base scene as a plain mapping (``Scene.model_dump(mode="json")``).
+    paths : tuple of str
+        Dotted parameter paths, one per axis.
+    points : tuple of (int, tuple)
+        ``(row index, parameter values)`` in evaluation (continuation) order.
+    options : dict
+        Sweep options (see :data:`DEFAULT_OPTIONS`).
+    origin : str
+        Scene origin for error messages.
+    """
+
+    stage: str
+    base: dict
+    paths: tuple
+    points: tuple
+    options: dict = field(default_factory=dict)
+    origin: str = "<sweep>"
+
+
+# ----------------------------------------------------------------------------- helpers
+def _solver(scene: Scene):
+    from walkerlab.analysis.hybrid import Solver
+
+    return Solver.from_settings(scene.solver)
+
+
+_FP_CACHE: dict[tuple, Any] = {}
+
+
+def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | None = None):
+    """Period-1 fixed point of the scene's rigid walker, trying the continuation guess first.
+
+    Parameters
+    ----------
+    scene : Scene
+        Needs a ``fixedpoint`` section (its ``initial_guess`` is the fallback guess).
+    guess : ndarray (4,) or None
+        Neighbour's fixed point (role-ordered state just after heel strike).
+
+    Returns
+    -------
+    walker : HybridWalker
+    result : FixedPointResult
+    source : str
+        ``"neighbour"`` or ``"scene"``.
+
+    Raises
+    ------
+    _Outcome
+        ``no_fixed_point`` (with the best residual) or ``invalid_config`` (no section).
+    """
+    from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
+    from walkerlab.models.registry import build_walker
+
+    opts = {**DEFAULT_OPTIONS, **(options or {})}
+    fp = scene.fixedpoint
+    if fp is None:
+        raise _Outcome("invalid_config", "scene has no 'fixedpoint' section (needed for the "
+                       "initial guess of the fixed point)")
+    walker = build_walker(scene)
+    solver = _solver(scene)
+    tries = ([("neighbour", np.asarray(guess, float))] if guess is not None else []) \
+        + [("scene", fp.initial_guess.as_array())]
+    best, msg = math.inf, ""
+    for source, g in tries:
+        try:
+            res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
+                                   max_step_time=fp.max_step_time_s)
+        except FixedPointNotFound as exc:
+            if not (exc.residual >= best):  # keeps NaN out unless nothing better
+                best = exc.residual if math.isfinite(exc.residual) else best
+            msg = str(exc)
+            continue
+        if abs(res.x[1] - res.x[0]) < opts["min_interleg_angle_rad"]:
+            msg = (f"degenerate fixed point (inter-leg angle {abs(res.x[1] - res.x[0]):.2e} rad "
+                   f"< {opts['min_interleg_angle_rad']:g}): no step")
+            best = min(best, res.residual)
+            continue
+        return walker, res, source
+    raise _Outcome("no_fixed_point", msg, residual=best if math.isfinite(best) else math.nan)
+
+
+def _fp_columns(res) -> dict:
+    cols = {c: float(v) for c, v in zip(STATE_COLS, res.x)}
+    mult = np.asarray(res.multipliers_variational, complex)
+    for k in range(4):
+        z = mult[k] if k < mult.size else complex(math.nan, math.nan)
+        cols[f"multiplier_{k}_re"], cols[f"multiplier_{k}_im"] = float(z.real), float(z.imag)
+    cols.update(step_period_s=float(res.period_s), residual=float(res.residual),
+                max_abs_multiplier=float(np.max(np.abs(mult))), stable=float(res.stable),
+                map_evaluations=float(res.iterations), nfev=float(res.nfev))
+    return cols
+
+
+# ----------------------------------------------------------------------------- stages
+def fixedpoint_point(scene: Scene, guess, options: dict):
+    """Fixed point and Floquet multipliers at one point (stage ``fixedpoint``).
+
+    Returns
+    -------
+    cols : dict
+        Columns of :data:`walkerlab.sweep.outcomes.COLUMNS` ``["fixedpoint"]``, ``outcome``
+        ``ok`` and ``guess_source``.
+    next_guess : ndarray (4,)
+        The fixed point, for the next point of the chunk.
+    """
+    _walker, res, source = ideal_fixed_point(scene, guess, options)
+    cols = _fp_columns(res)
+    cols.update(outcome="ok", guess_source=source,
+                message="" if res.stable else "unstable period-1 gait (|multiplier| >= 1)")
+    return cols, res.x
+
+
+def _scuff_depth(walker, seg, n: int = 64) -> float:
+    """Largest depth [m] of the swing foot below the slope strictly inside a step."""
+    if seg.t_end <= seg.t_start:
+        return 0.0
+    ts = np.linspace(seg.t_start, seg.t_end, n + 2)[1:-1]
+    X = seg.sample(ts)
+    foot = walker.points(X)["swing_foot"]
+    phi = walker.slope_rad
+    h = foot[1] * math.cos(phi) + foot[0] * math.sin(phi)
+    return float(max(0.0, -np.min(h)))
+
+
+def simulate_point(scene: Scene, guess, options: dict):
+    """Forward simulation of ``2 * simulate.strides`` steps (stage ``simulate``).
+
+    The initial state is the scene's explicit state, or (``initial_state: fixed_point``)
+    the fixed point found at this point (continuation from ``guess``).
+    """
+    from walkerlab.analysis.hybrid import simulate_steps
+    from walkerlab.config import SimulateSettings
+    from walkerlab.models.registry import build_walker
+
+    opts = {**DEFAULT_OPTIONS, **options}
+    sim = scene.simulate or SimulateSettings()
+    cols: dict = {}
+    next_guess = None
+    if sim.initial_state == "fixed_point":
+        walker, res, source = ideal_fixed_point(scene, guess, options)
+        x0, next_guess = res.x, res.x
+        cols["guess_source"] = source
+    else:
+        walker = build_walker(scene)
+        x0 = sim.initial_state.as_array()
+    cols.update({f"x0_{c}": float(v) for c, v in zip(STATE_COLS, x0)})
+    traj = simulate_steps(walker, x0, 2 * sim.strides, _solver(scene),
+                          max_step_time=sim.max_step_time_s)
+    segs = traj.segments
+    done = [s for s in segs if s.termination == "heel_strike"]
+    last = segs[-1]
+    cols.update(steps_completed=float(len(done)), t_end_s=float(last.t_end), nfev=float(traj.nfev))
+    if done:
+        per = np.array([s.period for s in done])
+        lengths = np.array([float(np.hypot(*walker.points(s.x_end)["swing_foot"])) for s in done])
+        cols.update(mean_step_period_s=float(per.mean()), mean_step_length_m=float(lengths.mean()),
+                    mean_hip_speed_m_per_s=float(lengths.mean() / per.mean()),
+                    interleg_angle_last_rad=float(abs(done[-1].x_end[1] - done[-1].x_end[0])))
+        depth = max(_scuff_depth(walker, s) for s in done)
+        cols["scuff_depth_m"] = depth
+    if last.termination == "fall":
+        raise _Outcome("fall", f"guard '{last.event}' at t = {last.t_end:.4g} s in step "
+                       f"{last.index}", fall_time_s=float(last.t_end), fall_leg=last.stance_leg,
+                       **cols)
+    if last.termination == "solver_failure":
+        raise _Outcome("solver_failure", last.message, **cols)
+    if last.termination == "t_final":
+        raise _Outcome("max_steps", f"step {last.index} lasted longer than max_step_time_s = "
+                       f"{sim.max_step_time_s:g} s (walker stalled)", **cols)
+    lim = opts.get("scuff_limit_m")
+    if lim is not None and cols.get("scuff_depth_m", 0.0) > lim:
+        raise _Outcome("scuffing", f"swing foot {1e3 * cols['scuff_depth_m']:.3g} mm below the "
+                       f"slope before heel strike (limit {1e3 * lim:g} mm)", **cols)
+    cols["outcome"] = "ok"
+    return cols, next_guess
+
+
+def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
+                    step_length_m: float):
+    """Run the compliant-contact simulation of ``scene`` from an ideal-model state.
+
+    The only place that calls :mod:`walkerlab.contact`; keep it in step with that module.
+
+    Parameters
+    ----------
+    scene : Scene
+        Uses ``walker``, ``slope``, ``contact``, ``terrain``, ``contact_sim``,
+        ``contact_solver`` (defaults when absent).
+    x_ideal : ndarray (4,)
+        Ideal-model state just after heel strike (role-ordered: swing, stance).
+    ideal_period_s : float
+        Step period of the ideal gait [s] (sets the default simulated time).
+    step_length_m : float
+        Step length of the ideal gait [m] (checkerboard patch spacing).
+
+    Returns
+    -------
+    walker : ContactWalker
+    result : ContactResult
+    n_steps : int
+        Steps requested (2 * ``contact_sim.n_strides``).
+    """
+    from walkerlab.contact import (ContactSettings, ContactSimSettings, ContactWalker,
+                                   TerrainSettings, initial_state_from_ideal, simulate_contact)
+
+    cs = scene.contact_sim or ContactSimSettings()
+    contact = scene.contact or ContactSettings()
+    terrain = scene.terrain or TerrainSettings()
+    w = scene.walker
+    n_steps = 2 * cs.n_strides
+    cw = ContactWalker.from_settings(contact, terrain, step_length=step_length_m,
+                                     n_steps=n_steps, L=w.leg_length_m, m=w.leg_mass_kg,
+                                     MH=w.hip_mass_kg, a=w.leg_mass_from_foot_m,
+                                     g=w.gravity_m_per_s2, phi=scene.slope.phi_rad)
+    x0 = initial_state_from_ideal(cw, *x_ideal, rate_scale=tuple(cs.initial_rate_scale))
+    t_final = cs.t_final_s if cs.t_final_s is not None else n_steps * ideal_period_s
+    kw: dict = {"method": "odeint", "rtol": 1e-8, "atol": 1e-10}
+    if scene.contact_solver is not None:
+        s = scene.contact_solver
+        kw = {"method": s.method if s.method in ("LSODA", "Radau", "BDF") else "odeint",
+              "rtol": s.rtol, "atol": s.atol}
+        if s.max_step_s is not None:
+            kw["max_step"] = s.max_step_s
+    res = simulate_contact(cw, x0, t_final, sample_rate_hz=cs.sample_rate_hz,
+                           pin_stance_until=cs.pin_stance_until, pin_time_s=cs.pin_time_s,
+                           fall_hip_height_m=cs.fall_hip_height_m, **kw)
+    return cw, res, n_steps
+
+
+def _contact_events(res) -> tuple[float, int, int, str]:
+    """Largest stance slip [mm], bounces, scuffs, and the stance leg at the run's end."""
+    t = res.t
+    starts = [float(t[0])] + [float(x) for x in res.heel_strike_times]
+    legs = [res.steps[0].stance_leg if res.steps else "leg2"] + list(res.heel_strike_legs)
+    ends = starts[1:] + [float(t[-1])]
+    max_slip = 0.0
+    for ta, tb, leg in zip(starts, ends, legs):
+        ft = res.feet[leg]
+        m = (t >= ta) & (t <= tb) & (ft.penetration > 0) & ft.on_ground
+        if m.sum() >= 2:
+            s = ft.s[m]
+            max_slip = max(max_slip, 1e3 * abs(float(s[-1] - s[0])))
+    hs = set(zip([round(x, 12) for x in starts[1:]], legs[1:]))
+    bounces = scuffs = 0
+    for leg, ft in res.feet.items():
+        for tt in ft.touchdown_times:
+            if tt <= t[0] or (round(float(tt), 12), leg) in hs:
+                continue
+            j = int(np.searchsorted(starts, tt, side="right")) - 1
+            if legs[j] == leg:
+                bounces += 1
+            else:
+                scuffs += 1
+    return max_slip, bounces, scuffs, legs[-1]
+
+
+def contact_point(scene: Scene, guess, options: dict):
+    """Compliant-contact simulation started from the ideal gait at this point (``contact-sim``).
+
+    The ideal fixed point (continuation from ``guess``) gives the initial state, the step
+    period and the checkerboard spacing; see :func:`contact_adapter`.
+    """
+    from walkerlab.analysis.hybrid import integrate_step
+
+    opts = {**DEFAULT_OPTIONS, **options}
+    walker, fp, source = ideal_fixed_point(scene, guess, options)
+    seg = integrate_step(walker, fp.x, _solver(scene), max_step_time=scene.fixedpoint.max_step_time_s)
+    step_length = float(np.hypot(*walker.points(seg.x_end)["swing_foot"]))
+    cols = {"guess_source": source, "ideal_step_length_m": step_length,
+            "ideal_step_period_s": float(fp.period_s)}
+    _cw, res, n_steps = contact_adapter(scene, fp.x, fp.period_s, step_length)
+    slip, bounces, scuffs, last_leg = _contact_events(res)
+    periods = [s.period for s in res.steps if math.isfinite(s.period)]
+    peak = max((float(np.max(np.where(ft.on_ground, ft.penetration, 0.0))) for ft in
+                res.feet.values()), default=0.0)
+    cols.update(heel_strikes=float(res.walked_steps), steps_expected=float(n_steps),
+                t_end_s=float(res.t[-1]), max_slip_mm=slip, bounces=float(bounces),
+                scuffs=float(scuffs), peak_penetration_mm=1e3 * max(peak, 0.0),
+                mean_step_period_s=float(np.mean(periods)) if periods else math.nan,
+                integration_wall_time_s=float(res.wall_time_s), nfev=float(res.nfev))
+    if res.termination == "solver_failure":
+        raise _Outcome("solver_failure", res.message, **cols)
+    if res.termination == "fall":
+        raise _Outcome("fall", f"hip below the fall height at t = {res.fall_time:.4g} s after "
+                       f"{res.walked_steps} heel strikes", fall_time_s=float(res.fall_time),
+                       fall_leg=last_leg, **cols)
+    if slip > opts["slip_limit_mm"]:
+        raise _Outcome("slip", f"stance foot slid {slip:.3g} mm (limit "
+                       f"{opts['slip_limit_mm']:g} mm)", **cols)
+    if bounces:
+        raise _Outcome("bounce", f"{bounces} stance-foot bounce(s)", **cols)
+    if scuffs:
+        raise _Outcome("scuffing", f"{scuffs} swing-foot touchdown(s) before heel strike", **cols)
+    if res.walked_steps < n_steps - 1:
+        raise _Outcome("max_steps", f"stalled: {res.walked_steps} of {n_steps} heel strikes by "
+                       f"t = {res.t[-1]:.4g} s", **cols)
+    cols["outcome"] = "ok"
+    return cols, fp.x
+
+
+POINT_FUNCTIONS: dict[str, Callable] = {
+    "fixedpoint": fixedpoint_point, "simulate": simulate_point, "contact-sim": contact_point,
+}
+
+
+# ----------------------------------------------------------------------------- chunk runner
+def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: dict,
+             origin: str = "<sweep>") -> tuple[dict, Any]:
+    """Evaluate one point; never raises (except KeyboardInterrupt / SystemExit).
+
+    Returns
+    -------
+    row : dict
+        All columns of the stage (NaN / ``""`` where not applicable), ``index``,
+        ``outcome``, ``message``, ``wall_time_s``.
+    next_guess : ndarray (4,) or None
+        Continuation guess for the next point (``None`` after a failure).
+    """
+    row = empty_row(stage, index)
+    t0 = time.perf_counter()
+    next_guess = None
+    with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
+        warnings.simplefilter("always")
+        try:
+            scene = apply_point(base, list(paths), tuple(values), origin)
+            cols, next_guess = POINT_FUNCTIONS[stage](scene, guess, options)
+            row.update(cols)
+        except SceneError as exc:
+            row.update(outcome="invalid_config", message=str(exc))
+        except _Outcome as exc:
+            row.update({k: v for k, v in exc.cols.items() if k in row})
+            row.update(outcome=exc.outcome, message=exc.message)
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except Exception as exc:  # noqa: BLE001 - a sweep point must never crash the sweep
+            tb = traceback.extract_tb(exc.__traceback__)
+            where = f" ({tb[-1].filename.rsplit('/', 1)[-1]}:{tb[-1].lineno})" if tb else ""
+            kind = "solver_failure" if _from_solver(exc) else "error"
+            row.update(outcome=kind, message=f"{type(exc).__name__}: {exc}{where}")
+    if caught and row["outcome"] != "ok":
+        uniq = list(dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught))[:3]
+        row["message"] = (row["message"] + " [warnings: " + "; ".join(uniq) + "]")[:2000]
+    row["wall_time_s"] = time.perf_counter() - t0
+    row["message"] = str(row["message"]).replace("\n", " ")
+    return row, next_guess
+
+
+def _from_solver(exc: BaseException) -> bool:
+    tb = traceback.extract_tb(exc.__traceback__)
+    return any("scipy/integrate" in f.filename for f in tb)
+
+
+def run_chunk(task: Task) -> list[dict]:
+    """Evaluate a chunk of points in order, passing each fixed point to the next as its guess.
+
+    Top-level and picklable, so it runs the same in a process pool and on Dask workers.
+
+    Returns
+    -------
+    list of dict
+        One row per point, in the chunk's order.
+    """
+    rows, guess = [], None
+    for index, values in task.points:
+        row, nxt = evaluate(task.stage, task.base, task.paths, values, index, guess,
+                            task.options, task.origin)
+        rows.append(row)
+        guess = nxt if nxt is not None else guess
+    return rows
+
+
+def warm_up() -> None:
+    """Build the lambdified model functions once (called in fresh worker processes)."""
+    try:
+        from walkerlab.models.derivation import compass_gait_functions
+
+        compass_gait_functions()
+    except Exception:  # noqa: BLE001 - warming is an optimisation only
+        pass

@@ -1,0 +1,235 @@
+"""Incremental HDF5 store of a sweep: rows appended as points finish, finalized at the end.
+
+Layout (``stage`` attribute ``"sweep"``; every dataset has ``unit`` and ``description``)::
+
+    /                      attrs: stage, walkerlab_version, scene_name, scene_json, input_hash,
+                           created_utc, wall_time_s, sweep_stage, params_json, options_json,
+                           grid_shape, n_points, complete
+    /grid/axis_<i>         values of axis i (float64 or string); attrs path, spec
+    /points/index          (n,) int64 flat grid index, C order (first axis slowest):
+                           grid position = numpy.unravel_index(index, grid_shape)
+    /points/param/<path>   (n,) value of each swept field at the row
+    /points/outcome        (n,) str, see walkerlab.sweep.outcomes
+    /points/message, fall_leg, guess_source  (n,) str
+    /points/wall_time_s    (n,) float64 [s], wall time of the point (worker side)
+    /points/<column>       (n,) float64, the stage's result columns (NaN = not applicable)
+    /summary/outcome_counts  (k,) int64 with attrs outcomes (after finalize)
+
+While running, the file is ``<name>.h5.partial`` next to the final name; rows are appended
+in completion order and flushed after every chunk.  :meth:`SweepStore.finalize` sorts the
+rows by ``index`` and renames the file to ``<name>.h5``.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import os
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+import walkerlab
+from walkerlab.sweep.outcomes import COLUMNS, OUTCOMES, STRING_COLUMNS
+from walkerlab.sweep.params import ParamAxis, SweepError
+
+__all__ = ["SweepStore", "partial_path", "load_sweep"]
+
+STR = h5py.string_dtype()
+
+
+def partial_path(final: Path) -> Path:
+    """Name of the in-progress file of a sweep artifact."""
+    final = Path(final)
+    return final.with_name(final.name + ".partial")
+
+
+def _param_key(path: str) -> str:
+    return path.replace("/", "_")
+
+
+class SweepStore:
+    """An open in-progress sweep file (use :meth:`create` or :meth:`resume`)."""
+
+    def __init__(self, final: Path, f: h5py.File, stage: str, axes: list[ParamAxis]):
+        self.final = Path(final)
+        self.f = f
+        self.stage = stage
+        self.axes = axes
+
+    # ------------------------------------------------------------------ open
+    @classmethod
+    def create(cls, final: Path, scene, stage: str, axes: list[ParamAxis], options: dict,
+               input_hash: str) -> "SweepStore":
+        """Start a new partial file (an old one is overwritten)."""
+        final = Path(final)
+        final.parent.mkdir(parents=True, exist_ok=True)
+        part = partial_path(final)
+        part.unlink(missing_ok=True)
+        f = h5py.File(part, "w")
+        f.attrs.update({
+            "stage": "sweep", "walkerlab_version": walkerlab.__version__,
+            "scene_name": scene.name or "", "scene_json": scene.model_dump_json(),
+            "input_hash": input_hash,
+            "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(),
+            "wall_time_s": 0.0, "sweep_stage": stage,
+            "params_json": json.dumps([[a.path, list(a.values), a.spec] for a in axes]),
+            "options_json": json.dumps(options, sort_keys=True, default=str),
+            "grid_shape": np.array([len(a) for a in axes], dtype=np.int64),
+            "n_points": int(np.prod([len(a) for a in axes])), "complete": False,
+        })
+        for i, a in enumerate(axes):
+            data = np.asarray(a.values, float) if a.numeric else \
+                np.asarray([str(v) for v in a.values], dtype=STR)
+            ds = f.create_dataset(f"grid/axis_{i}", data=data)
+            ds.attrs.update(path=a.path, spec=a.spec, unit="", description=f"values of {a.path}")
+        g = f.create_group("points")
+
+        def mk(name, dtype, unit, desc):
+            ds = g.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(256,))
+            ds.attrs.update(unit=unit, description=desc)
+
+        mk("index", np.int64, "-", "flat grid index (C order, first axis slowest)")
+        for a in axes:
+            mk(f"param/{_param_key(a.path)}", np.float64 if a.numeric else STR, "",
+               f"value of {a.path}")
+            g[f"param/{_param_key(a.path)}"].attrs["path"] = a.path
+        for name, desc in STRING_COLUMNS.items():
+            mk(name, STR, "-", desc)
+        mk("wall_time_s", np.float64, "s", "wall time of the point on its worker")
+        for name, (unit, desc) in COLUMNS[stage].items():
+            mk(name, np.float64, unit, desc)
+        f.flush()
+        return cls(final, f, stage, axes)
+
+    @classmethod
+    def resume(cls, final: Path, stage: str, axes: list[ParamAxis],
+               input_hash: str) -> tuple["SweepStore", set[int]]:
+        """Reopen a partial file; returns the store and the indices already done.
+
+        Raises
+        ------
+        SweepError
+            Unreadable partial file, or one written for another sweep (other scene,
+            parameters, stage, options or code).
+        """
+        part = partial_path(final)
+        try:
+            f = h5py.File(part, "a")
+        except OSError:
+            raise SweepError(f"{part}: damaged partial sweep file; rerun without --resume") \
+                from None
+        if f.attrs.get("input_hash") != input_hash:
+            f.close()
+            raise SweepError(f"{part}: partial file of a different sweep (scene, parameters, "
+                             "stage, options or code changed); rerun without --resume")
+        done = set(int(i) for i in f["points/index"][()])
+        return cls(final, f, stage, axes), done
+
+    # ------------------------------------------------------------------ write
+    def append(self, rows: list[dict], values_of: dict[int, tuple]) -> None:
+        """Append rows (dicts from :func:`walkerlab.sweep.points.evaluate`) and flush."""
+        if not rows:
+            return
+        g = self.f["points"]
+        n0 = g["index"].shape[0]
+        n1 = n0 + len(rows)
+
+        def put(name, vals):
+            ds = g[name]
+            ds.resize((n1,))
+            ds[n0:n1] = vals
+
+        put("index", np.array([r["index"] for r in rows], np.int64))
+        for k, a in enumerate(self.axes):
+            vals = [values_of[r["index"]][k] for r in rows]
+            put(f"param/{_param_key(a.path)}", np.asarray(vals, float) if a.numeric
+                else np.asarray([str(v) for v in vals], dtype=object))
+        for name in STRING_COLUMNS:
+            put(name, np.asarray([str(r.get(name, "")) for r in rows], dtype=object))
+        put("wall_time_s", np.array([r["wall_time_s"] for r in rows], float))
+        for name in COLUMNS[self.stage]:
+            put(name, np.array([r.get(name, np.nan) for r in rows], float))
+        self.f.attrs["wall_time_s"] = float(self.f.attrs["wall_time_s"]) + 0.0
+        self.f.flush()
+
+    def add_wall_time(self, seconds: float) -> None:
+        """Add elapsed sweep wall time [s] (accumulates over resumed sessions)."""
+        self.f.attrs["wall_time_s"] = float(self.f.attrs["wall_time_s"]) + float(seconds)
+        self.f.flush()
+
+    def close(self) -> None:
+        """Close without finalizing (the partial file stays for ``resume``)."""
+        if self.f.id.valid:
+            self.f.close()
+
+    def finalize(self) -> Path:
+        """Sort rows by index, write the outcome summary, rename to the final name."""
+        f = self.f
+        g = f["points"]
+        order = np.argsort(g["index"][()], kind="stable")
+
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                obj[...] = obj[()][order]
+
+        g.visititems(visit)
+        outc = [o.decode() if isinstance(o, bytes) else str(o) for o in g["outcome"][()]]
+        counts = np.array([outc.count(o) for o in OUTCOMES], np.int64)
+        if "summary" in f:
+            del f["summary"]
+        ds = f.create_dataset("summary/outcome_counts", data=counts)
+        ds.attrs.update(outcomes=list(OUTCOMES), unit="-", description="points per outcome")
+        f.attrs["complete"] = True
+        f.close()
+        os.replace(partial_path(self.final), self.final)
+        return self.final
+
+
+def load_sweep(path: Path) -> dict:
+    """Read a sweep artifact (complete or partial) into plain numpy arrays.
+
+    Returns
+    -------
+    dict
+        ``attrs`` (dict of root attributes, ``params`` parsed), ``axes`` (list of
+        ``(path, values ndarray)``), ``grid_shape`` (tuple), and ``points``: column name ->
+        (n,) array (strings as ``str`` object arrays; params under ``param/<path>``).
+    """
+    from walkerlab.io.artifacts import ArtifactError
+
+    path = Path(path)
+    try:
+        f = h5py.File(path, "r")
+    except OSError:
+        raise ArtifactError(f"{path}: not a readable sweep artifact") from None
+    with f:
+        if f.attrs.get("stage") != "sweep":
+            raise ArtifactError(f"{path}: expected a 'sweep' artifact, found "
+                                f"'{f.attrs.get('stage')}'")
+        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+        attrs["params"] = json.loads(attrs["params_json"])
+        axes = []
+        for i in range(len(attrs["params"])):
+            ds = f[f"grid/axis_{i}"]
+            v = ds[()]
+            if v.dtype.kind == "O":
+                v = np.array([x.decode() if isinstance(x, bytes) else x for x in v], object)
+            axes.append((str(ds.attrs["path"]), v))
+        pts = {}
+
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                v = obj[()]
+                if v.dtype.kind == "O":
+                    v = np.array([x.decode() if isinstance(x, bytes) else x for x in v], object)
+                key = name
+                if name.startswith("param/"):
+                    key = "param/" + str(obj.attrs.get("path", name[6:]))
+                pts[key] = v
+
+        f["points"].visititems(visit)
+        return {"attrs": attrs, "axes": axes, "grid_shape": tuple(int(n) for n in
+                                                                   attrs["grid_shape"]),
+                "points": pts}
