@@ -130,6 +130,22 @@ def compare(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
 
 @app.command()
 @_guard
+def workprecision(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
+                  force: bool = ForceOpt) -> None:
+    """Work-precision study: error vs wall time for every solver and tolerance."""
+    from walkerlab.stages import workprecision as stage
+
+    out = stage.run(_load(scene), runs_dir, force)
+    for model, s in out.summary.items():
+        if s.get("best"):
+            m, rtol, t, e = s["best"]
+            typer.echo(f"{model}: Pareto-best setting reaching the target error: {m} "
+                       f"rtol={rtol:g} ({t * 1e3:.1f} ms, error {e:.1e})")
+    typer.echo(_status(out))
+
+
+@app.command()
+@_guard
 def plot(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt) -> None:
     """Draw the figures (PNG + SVG) from the scene's existing artifacts."""
     from walkerlab.stages import plot as stage

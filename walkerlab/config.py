@@ -142,6 +142,23 @@ class SimulateSettings(_Strict):
     max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this ends the run [s]")
 
 
+class WorkPrecisionSettings(_Strict):
+    """Error against run time for every scipy method over a range of tolerances."""
+
+    methods: list[Literal["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"]] = Field(
+        ["RK45", "DOP853", "Radau", "BDF", "LSODA"], description="scipy solve_ivp methods")
+    rtols: list[Annotated[float, Field(gt=0, lt=1)]] = Field(
+        [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12],
+        description="relative tolerances [-]; atol = atol_factor * rtol")
+    atol_factor: float = Field(1.0, gt=0, description="atol = atol_factor * rtol [state units]")
+    repeats: int = Field(3, ge=1, le=50, description="timing repeats (median is kept)")
+    strides: int = Field(5, ge=1, le=100, description="strides per run")
+    reference_rtol: float = Field(1e-13, gt=0, lt=1e-8, description="reference run rtol [-]")
+    target_error: float = Field(1e-8, gt=0, description="error the Pareto-best setting must "
+                                "reach [rad, rad/s]")
+    models: list[Literal["ideal", "contact"]] = Field(["ideal"], description="models to study")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
@@ -157,6 +174,7 @@ class Scene(_Strict):
     terrain: TerrainSettings | None = None
     contact_sim: ContactSimSettings | None = None
     contact_solver: SolverSettings | None = None
+    workprecision: WorkPrecisionSettings | None = None
 
     def section_json(self, *names: str) -> str:
         """Canonical JSON of the named sections (for content hashes)."""

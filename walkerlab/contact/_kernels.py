@@ -189,9 +189,25 @@ def jac(x, P, c1, c2):
 
     Patch membership is treated as locally constant (the patch edge is a discontinuity).
     """
+    return jac_flag(x, P, c1, c2, True)
+
+
+@njit(cache=True)
+def rhs_flag(x, P, c1, c2, use_contact):
+    """:func:`rhs` with the contact forces switched on/off."""
+    Q = gen_force(x, P, c1, c2, use_contact, use_contact)
+    out = np.empty(8)
+    out[:4] = x[4:]
+    out[4:] = msolve(x[2], x[3], P, Q)
+    return out
+
+
+@njit(cache=True)
+def jac_flag(x, P, c1, c2, use_contact):
+    """:func:`jac` with the contact forces switched on/off."""
     L, m, MH, b, g, phi = P[0], P[1], P[2], P[3], P[4], P[5]
     sp, cp = np.sin(phi), np.cos(phi)
-    Q = gen_force(x, P, c1, c2, True, True)
+    Q = gen_force(x, P, c1, c2, use_contact, use_contact)
     qdd = msolve(x[2], x[3], P, Q)
     dQq = np.zeros((4, 4))
     dQv = np.zeros((4, 4))
@@ -212,6 +228,8 @@ def jac(x, P, c1, c2):
         dQq[1, j] -= m * b * ct * qdd[j]
         dQq[j, j] -= -m * b * st * qdd[0] + m * b * ct * qdd[1]
         # contact
+        if not use_contact:
+            continue
         cen = c1 if i == 0 else c2
         delta, ddot, vt, s, fn, ff, dfd, dfdd, mu, dmu = foot_contact(x, i, P, cen)
         if fn <= 0.0:
@@ -357,20 +375,18 @@ def dead(x, P, c1, c2, hmin, dtrip):
 
 @njit(cache=True)
 def rhs_guarded(x, P, c1, c2, hmin, dtrip):
-    """:func:`rhs`, but frozen (zero derivative) once :func:`dead`.
+    """:func:`rhs`, but without any contact force once :func:`dead` (free fall).
 
     A fallen walker (feet sinking through lane gaps, then re-entering patches far below their
-    surface, where the IMPACT law would give absurd forces) then costs nothing to integrate;
-    needed by drivers without event support (odeint).
+    surface, where the IMPACT law would give absurd forces) then costs almost nothing to
+    integrate; needed by drivers without event support (odeint).  Both sides of the switch
+    are smooth, so the integrator simply passes it (a zero-derivative freeze instead makes
+    LSODA creep towards the switching surface).
     """
-    if dead(x, P, c1, c2, hmin, dtrip):
-        return np.zeros(8)
-    return rhs(x, P, c1, c2)
+    return rhs_flag(x, P, c1, c2, not dead(x, P, c1, c2, hmin, dtrip))
 
 
 @njit(cache=True)
 def jac_guarded(x, P, c1, c2, hmin, dtrip):
     """Jacobian of :func:`rhs_guarded`."""
-    if dead(x, P, c1, c2, hmin, dtrip):
-        return np.zeros((8, 8))
-    return jac(x, P, c1, c2)
+    return jac_flag(x, P, c1, c2, not dead(x, P, c1, c2, hmin, dtrip))

@@ -227,10 +227,10 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, rate, rtol, atol, max_st
 def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, dtrip, use_jac,
               chunk_s):
     """Integrate the free walker.  Returns (t, X, nfev, njev, status, message)."""
-    # frozen once fallen / tripped (see _kernels.dead): odeint has no events, and the solve_ivp
-    # fall event cannot see a trip
+    # contact switched off once fallen / tripped (see _kernels.dead): odeint has no events, and
+    # the solve_ivp fall event cannot see a trip.  The samples are cut at the first dead one.
     P, c1, c2 = walker._P, walker.lane1, walker.lane2
-    hfreeze = hth * (1.0 - 1e-9)
+    hfreeze = 0.98 * hth
 
     def frhs(t, x):
         return K.rhs_guarded(x, P, c1, c2, hfreeze, dtrip)
@@ -259,8 +259,8 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, dtrip
                 ts.append(tg[1:nk]); Xs.append(X[1:nk])
                 return np.concatenate(ts), np.vstack(Xs), nfev, njev, "fail", info["message"]
             ts.append(tg[1:]); Xs.append(X[1:])
-            if np.all(X[-1] == X[-2]) or np.any(walker.hip_height(X) < hth):
-                status = "fall"  # frozen or fallen; the caller finds the time and the cause
+            if K.dead(X[-1], P, c1, c2, hfreeze, dtrip) or np.any(walker.hip_height(X) < hth):
+                status = "fall"  # the caller finds the time and the cause
                 break
             ta, xa = tb, X[-1]
         return np.concatenate(ts), np.vstack(Xs), nfev, njev, status, msg

@@ -151,7 +151,6 @@ class SweepStore:
         put("wall_time_s", np.array([r["wall_time_s"] for r in rows], float))
         for name in COLUMNS[self.stage]:
             put(name, np.array([r.get(name, np.nan) for r in rows], float))
-        self.f.attrs["wall_time_s"] = float(self.f.attrs["wall_time_s"]) + 0.0
         self.f.flush()
 
     def add_wall_time(self, seconds: float) -> None:

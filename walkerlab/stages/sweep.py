@@ -1,0 +1,84 @@
+"""Stage ``sweep``: run a stage over a grid of scene fields -> ``sweep_<stage>_<hash>.h5``.
+
+``walkerlab sweep SCENE --param slope.angle_deg=0.5:5:0.05 [--param ...] --stage fixedpoint``
+calls :func:`run`.  One row per grid point: the parameters, the typed outcome
+(:mod:`walkerlab.sweep.outcomes`), the stage's key results and the point's wall time.
+Rows are appended to ``<name>.h5.partial`` as chunks finish; an interrupted sweep keeps them
+and ``resume=True`` computes only the rest.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from walkerlab.config import Scene, load_scene
+from walkerlab.sweep.params import ParamAxis, SweepError, params_hash, parse_param
+from walkerlab.sweep.runner import run_sweep
+
+__all__ = ["run", "parse_param", "sweep_path", "SweepError", "STAGE_NAMES"]
+
+STAGE_NAMES = ("fixedpoint", "simulate", "contact-sim")
+
+
+def sweep_path(scene: Scene, axes: list[ParamAxis], stage: str, runs_root: Path | str = "runs",
+               name: str | None = None) -> Path:
+    """``runs/<scene>/sweep_<stage>_<short hash of params>.h5`` (or ``<name>.h5``)."""
+    stem = name.removesuffix(".h5") if name else \
+        f"sweep_{stage.replace('-', '_')}_{params_hash(axes, stage)}"
+    return Path(runs_root) / (scene.name or "scene") / f"{stem}.h5"
+
+
+def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str = "fixedpoint",
+        workers: int = 2, scheduler: str | None = None, resume: bool = False,
+        runs_root: str | Path = "runs", name: str | None = None, *,
+        options: dict | None = None, chunk_size: int | None = None, progress: bool = True,
+        on_chunk=None) -> Path:
+    """Sweep ``stage`` over the grid of ``params`` and write one HDF5 artifact.
+
+    Parameters
+    ----------
+    scene_path_or_scene : str, Path or Scene
+        Scene YAML file or a validated scene.
+    params : list of str
+        ``--param`` strings, e.g. ``["slope.angle_deg=0.5:5:0.05", "walker.hip_mass_kg=5,10"]``;
+        continuation runs along the first one.
+    stage : {"fixedpoint", "simulate", "contact-sim"}
+    workers : int
+        Local processes (1 = in this process).
+    scheduler : str, optional
+        Dask distributed scheduler address; the chunks run on that cluster.
+    resume : bool
+        Continue from ``<artifact>.h5.partial`` (rows already there are not recomputed).
+    runs_root : str or Path
+    name : str, optional
+        Artifact file name (without folder); default ``sweep_<stage>_<hash>.h5``.
+    options : dict, optional
+        Point options, see :data:`walkerlab.sweep.points.DEFAULT_OPTIONS`.
+    chunk_size : int, optional
+        Longest chunk of consecutive points given to one worker.
+    progress : bool
+        Show the rich progress bar.
+    on_chunk : callable(done, total), optional
+        Hook after each chunk is written.
+
+    Returns
+    -------
+    Path
+        The artifact (``runs/<scene>/sweep_<stage>_<hash>.h5``).
+
+    Raises
+    ------
+    SceneError
+        The base scene does not validate.
+    SweepError
+        A malformed ``--param``, an unknown stage, or a resume file of another sweep.
+    """
+    scene = scene_path_or_scene if isinstance(scene_path_or_scene, Scene) \
+        else load_scene(scene_path_or_scene)
+    if stage not in STAGE_NAMES:
+        raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(STAGE_NAMES)}")
+    axes = [parse_param(p) if isinstance(p, str) else p for p in params]
+    out = sweep_path(scene, axes, stage, runs_root, name)
+    return run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
+                     resume=resume, options=options, chunk_size=chunk_size, progress=progress,
+                     on_chunk=on_chunk)

@@ -1,0 +1,277 @@
+"""Run a sweep: plan chunks, evaluate them locally or on Dask, append rows as they finish.
+
+Chunks are *runs along the first axis*: for every combination of the other axes the points
+of the first axis are evaluated in order by one worker, so each point can start its
+fixed-point search from its neighbour's fixed point (continuation).  When the base scene's
+own value of the first parameter lies inside the axis, a line is split there into an
+upward run and a downward run, both starting next to the scene's initial guess.
+
+Executors
+---------
+- ``workers == 1`` and no scheduler: in this process (no start-up cost).
+- ``workers >= 2`` and no scheduler: ``concurrent.futures.ProcessPoolExecutor`` (forkserver
+  processes on Linux, with the model functions built once in the server).
+- ``scheduler`` given: a Dask ``distributed`` cluster at that address (or a ``Client``);
+  the same :func:`walkerlab.sweep.points.run_chunk` runs on its workers.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import multiprocessing as mp
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+from typing import Any, Callable, Iterator
+
+import numpy as np
+
+import walkerlab
+from walkerlab.config import Scene
+from walkerlab.io.artifacts import code_hash
+from walkerlab.sweep.outcomes import OUTCOMES, STAGES
+from walkerlab.sweep.params import ParamAxis, SweepError, grid_points
+from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, run_chunk, warm_up
+from walkerlab.sweep.store import SweepStore, partial_path
+
+__all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "sweep_input_hash"]
+
+
+def _dotted_get(d: dict, path: str):
+    node: Any = d
+    for k in path.split("."):
+        if not isinstance(node, dict) or k not in node:
+            return None
+        node = node[k]
+    return node
+
+
+def _base_value(base: dict, path: str):
+    v = _dotted_get(base, path)
+    if v is None and path == "slope.angle_deg" and _dotted_get(base, "slope.angle_rad") is not None:
+        v = math.degrees(_dotted_get(base, "slope.angle_rad"))
+    if v is None and path == "slope.angle_rad" and _dotted_get(base, "slope.angle_deg") is not None:
+        v = math.radians(_dotted_get(base, "slope.angle_deg"))
+    return v
+
+
+def plan_chunks(axes: list[ParamAxis], base: dict, done: set[int] | frozenset = frozenset(),
+                chunk_size: int | None = None, workers: int = 1) -> list[list[tuple[int, tuple]]]:
+    """Split the grid into ordered chunks of ``(index, values)``.
+
+    Parameters
+    ----------
+    axes : list of ParamAxis
+    base : dict
+        Base scene mapping (its value of the first parameter anchors the runs).
+    done : set of int
+        Indices already computed (resume); they are left out.
+    chunk_size : int, optional
+        Longest chunk; default: whole runs, halved until there are at least ``workers``.
+    workers : int
+
+    Returns
+    -------
+    list of list of (int, tuple)
+        Chunks in submission order (longest first, for load balance).
+    """
+    shape = tuple(len(a) for a in axes)
+    pts = grid_points(axes)
+    a0 = axes[0]
+    anchor = None
+    bv = _base_value(base, a0.path)
+    if a0.numeric and isinstance(bv, (int, float)) and not isinstance(bv, bool) and len(a0) > 1:
+        vals = np.asarray(a0.values, float)
+        anchor = int(np.argmin(np.abs(vals - float(bv))))
+    runs: list[list[int]] = []
+    for rest in np.ndindex(*shape[1:]) if len(shape) > 1 else [()]:
+        line = [int(np.ravel_multi_index((i0, *rest), shape)) for i0 in range(shape[0])]
+        if anchor is None or anchor == 0:
+            cand = [line]
+        else:
+            cand = [line[anchor:], line[:anchor][::-1]]
+        for r in cand:
+            r = [i for i in r if i not in done]
+            if r:
+                runs.append(r)
+    if chunk_size is not None:
+        runs = [r[k:k + chunk_size] for r in runs for k in range(0, len(r), max(1, chunk_size))]
+    else:
+        while 0 < len(runs) < workers and max(len(r) for r in runs) > 1:
+            runs.sort(key=len)
+            r = runs.pop()
+            h = (len(r) + 1) // 2
+            runs += [r[:h], r[h:]]
+    runs.sort(key=len, reverse=True)
+    return [[(i, pts[i]) for i in r] for r in runs]
+
+
+def sweep_input_hash(scene: Scene, stage: str, axes: list[ParamAxis], options: dict) -> str:
+    """Content hash of a sweep (scene, stage, axes, options, walkerlab version and code)."""
+    h = hashlib.sha256()
+    h.update(json.dumps([scene.model_dump(mode="json"), stage,
+                         [[a.path, list(a.values)] for a in axes], options],
+                        sort_keys=True, default=str).encode())
+    h.update(walkerlab.__version__.encode())
+    h.update(code_hash().encode())
+    return h.hexdigest()
+
+
+def _mp_context():
+    if sys.platform.startswith("linux"):
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(["walkerlab.sweep._preload"])
+        return ctx
+    return mp.get_context("spawn")
+
+
+def iter_chunk_results(tasks: list[Task], workers: int = 2, scheduler=None,
+                       fn: Callable = run_chunk, pool: bool | None = None) -> Iterator[Any]:
+    """Evaluate ``fn(task)`` for every task and yield results as they complete.
+
+    Parameters
+    ----------
+    tasks : list
+        Picklable task objects.
+    workers : int
+        Local processes (ignored with a scheduler).
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address (``"tcp://..."``) or an existing client.
+    fn : callable
+        Top-level (picklable) function of one task.
+    pool : bool, optional
+        Force (True) or forbid (False) a process pool; default: pool when ``workers > 1``.
+    """
+    if not tasks:
+        return
+    if scheduler is not None:
+        from distributed import Client
+        from distributed import as_completed as dask_completed
+
+        own = isinstance(scheduler, str)
+        client = Client(scheduler, set_as_default=False) if own else scheduler
+        futs = client.map(fn, tasks, pure=False)
+        try:
+            for fut in dask_completed(futs):
+                yield fut.result()
+        finally:
+            client.cancel([f for f in futs if not f.done()])
+            if own:
+                client.close()
+        return
+    if not (pool if pool is not None else workers > 1):
+        warm_up()
+        for t in tasks:
+            yield fn(t)
+        return
+    ex = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=_mp_context(),
+                             initializer=warm_up)
+    try:
+        futs = [ex.submit(fn, t) for t in tasks]
+        for fut in as_completed(futs):
+            yield fut.result()
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
+
+
+def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
+              workers: int = 2, scheduler=None, resume: bool = False,
+              options: dict | None = None, chunk_size: int | None = None,
+              progress: bool = True,
+              on_chunk: Callable[[int, int], None] | None = None) -> Path:
+    """Run a sweep and write its artifact (see :mod:`walkerlab.sweep.store`).
+
+    Parameters
+    ----------
+    scene : Scene
+        Base scene.
+    axes : list of ParamAxis
+        Sweep axes (at least one).
+    stage : {"fixedpoint", "simulate", "contact-sim"}
+    out_path : Path
+        Final artifact path (``.h5``); ``<out_path>.partial`` while running.
+    workers : int
+        Local worker processes (1 = in this process).
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address: run the chunks there instead.
+    resume : bool
+        Continue an interrupted sweep from its partial file (finished rows are kept).
+    options : dict, optional
+        Point options (:data:`walkerlab.sweep.points.DEFAULT_OPTIONS`).
+    chunk_size : int, optional
+        Longest chunk (continuation restarts from the scene's guess at each chunk start).
+    progress : bool
+        Show a rich progress bar.
+    on_chunk : callable(done_points, total_points), optional
+        Called after each chunk is written (raising ``KeyboardInterrupt`` there simulates
+        an interruption).
+
+    Returns
+    -------
+    Path
+        The finished artifact.
+
+    Raises
+    ------
+    SweepError
+        Unknown stage, no axes, or a partial file of another sweep with ``resume``.
+    KeyboardInterrupt
+        Propagated after the finished rows are flushed to the partial file.
+    """
+    if stage not in STAGES:
+        raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(STAGES)}")
+    if not axes:
+        raise SweepError("sweep: give at least one --param")
+    paths = [a.path for a in axes]
+    if len(set(paths)) != len(paths):
+        raise SweepError("sweep: a parameter is given twice")
+    opts = {**DEFAULT_OPTIONS, **(options or {})}
+    out_path = Path(out_path)
+    key = sweep_input_hash(scene, stage, axes, opts)
+    base = scene.model_dump(mode="json")
+    n_total = int(np.prod([len(a) for a in axes]))
+    done: set[int] = set()
+    if resume and out_path.is_file() and not partial_path(out_path).is_file():
+        from walkerlab.io.artifacts import stored_hash
+
+        if stored_hash(out_path) == key:
+            return out_path
+    if resume and partial_path(out_path).is_file():
+        store, done = SweepStore.resume(out_path, stage, axes, key)
+    else:
+        store = SweepStore.create(out_path, scene, stage, axes, opts, key)
+    chunks = plan_chunks(axes, base, done, chunk_size, 1 if scheduler is None and workers <= 1
+                         else max(2, workers))
+    origin = scene.name or "<scene>"
+    tasks = [Task(stage, base, tuple(paths), tuple(c), opts, origin) for c in chunks]
+    values_of = dict(enumerate(grid_points(axes)))
+    t0 = time.perf_counter()
+    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
+                               TimeElapsedColumn, TimeRemainingColumn)
+
+    counts = {o: 0 for o in OUTCOMES}
+    bar = Progress(TextColumn(f"sweep {stage}"), BarColumn(), MofNCompleteColumn(),
+                   TimeElapsedColumn(), TimeRemainingColumn(), TextColumn("{task.fields[stats]}"),
+                   disable=not progress, transient=False)
+    n_done = len(done)
+    try:
+        with bar:
+            tid = bar.add_task("points", total=n_total, completed=n_done, stats="")
+            for rows in iter_chunk_results(tasks, workers, scheduler):
+                store.append(rows, values_of)
+                n_done += len(rows)
+                for r in rows:
+                    counts[r["outcome"]] = counts.get(r["outcome"], 0) + 1
+                bar.update(tid, completed=n_done,
+                           stats=" ".join(f"{k}:{v}" for k, v in counts.items() if v))
+                if on_chunk is not None:
+                    on_chunk(n_done, n_total)
+    except BaseException:
+        store.add_wall_time(time.perf_counter() - t0)
+        store.close()
+        raise
+    store.add_wall_time(time.perf_counter() - t0)
+    return store.finalize()
