@@ -274,7 +274,11 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, dtrip
     sol = solve_ivp(frhs, (t0, t1), x0, method=method, rtol=rtol, atol=atol,
                     max_step=max_step, t_eval=_grid(t0, t1, rate), events=[fall], **kw)
     status = {0: "ok", 1: "fall", -1: "fail"}[sol.status]
-    return sol.t, sol.y.T, sol.nfev, sol.njev, status, sol.message
+    t, X = sol.t, sol.y.T
+    if sol.status == 1:  # append the fall-event state
+        t = np.append(t, sol.t_events[0][0])
+        X = np.vstack([X, sol.y_events[0][0]])
+    return t, X, sol.nfev, sol.njev, status, sol.message
 
 
 def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
@@ -352,7 +356,7 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
     termination = {"ok": "t_final", "fall": "fall", "fail": "solver_failure"}[status]
     fall_reason = None
     hh = walker.hip_height(X)
-    below = np.flatnonzero(hh < hth)
+    below = np.flatnonzero(hh < hth + 1e-12)
     cq = walker.contact_quantities(X)
     deep = np.flatnonzero(np.any([(cq[f]["penetration"] > trip_depth_m) & (cq[f]["on_ground"] > 0)
                                   for f in FOOT_NAMES], axis=0))
