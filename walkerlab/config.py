@@ -105,6 +105,16 @@ class SolverSettings(_Strict):
     max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
 
 
+class ContactSolverSettings(_Strict):
+    """Integrator of the stiff contact model: ``odeint`` (LSODA, low overhead) or solve_ivp."""
+
+    method: Literal["odeint", "LSODA", "Radau", "BDF", "RK45", "DOP853"] = Field(
+        "odeint", description="scipy.integrate.odeint or a solve_ivp method")
+    rtol: float = Field(1e-8, gt=0, lt=1, description="relative tolerance [-]")
+    atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
+    max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
+
+
 class StateSpec(_Strict):
     """A compass-gait state right after heel strike, by role (Eq. 1: swing, stance)."""
 
@@ -173,7 +183,7 @@ class Scene(_Strict):
     contact: ContactSettings | None = None
     terrain: TerrainSettings | None = None
     contact_sim: ContactSimSettings | None = None
-    contact_solver: SolverSettings | None = None
+    contact_solver: ContactSolverSettings | None = None
     workprecision: WorkPrecisionSettings | None = None
 
     def section_json(self, *names: str) -> str:

@@ -46,18 +46,21 @@ def test_slope_steeper_than_friction_angle_slides():
     assert r.feet["leg2"].s[-1] > 0.1  # slid more than 10 cm in 0.6 s
 
 
-@pytest.mark.parametrize("phi_deg", [10.0, 40.0])
+@pytest.mark.parametrize("phi_deg", [10.0, 30.0, 40.0])
 def test_slope_shallower_than_friction_angle_sticks(phi_deg):
     phi = np.radians(phi_deg)  # atan(0.9) = 42 deg
-    w, r = _standing(phi, t_final=0.4)
+    w, r = _standing(phi, t_final=0.1)
     c = w.contact
     # ADAMS "stiction" is regularized: the foot creeps at the v* where mu(v*) = -tan(phi)
     vstar = brentq(lambda v: coulomb_friction_coefficient(v, c.mu_s, c.mu_d, c.v_s, c.v_d)
                    + np.tan(phi), 0.0, c.v_s)
-    v = r.feet["leg2"].slip_velocity[r.t > 0.2]
-    assert np.all(np.abs(v) < c.v_s)
-    # 2%: the upright leg is an inverted pendulum, slowly tipping from the settling transient
-    np.testing.assert_allclose(v, vstar, rtol=0.02)
+    v = r.feet["leg2"].slip_velocity
+    assert np.all(np.abs(v[r.t > 0.01]) < c.v_s)  # below the stiction velocity: "sticks"
+    # The creep settles within ~10 ms (tangential time constant M / (1.5 mu_s Fn / v_s)
+    # = 7.5 ms); the upright stance leg is an inverted pendulum that slowly tips after the
+    # settling transient (~0.1 rad/s), which changes the friction demand by < 1% before 30 ms.
+    win = (r.t >= 0.015) & (r.t <= 0.03)
+    np.testing.assert_allclose(v[win], vstar, rtol=0.01)
 
 
 def test_energy_balance_equals_contact_work():

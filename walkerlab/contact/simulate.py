@@ -286,7 +286,7 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
                      max_step: float = np.inf, sample_rate_hz: float = 1000.0, *,
                      t0: float = 0.0, pin_stance_until: str = "none", pin_time_s: float = 0.0,
                      fall_hip_height_m: float | None = None, use_jacobian: bool = True,
-                     trip_depth_m: float = 0.01, chunk_s: float = 1.0,
+                     trip_depth_m: float | None = None, chunk_s: float = 1.0,
                      min_step_m: float = 0.05,
                      initial_stance: str = "leg2") -> ContactResult:
     """Simulate the floating walker with compliant feet.
@@ -312,9 +312,11 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         ground, or until ``t0 + pin_time_s``.
     fall_hip_height_m : float, optional
         Fall threshold of the hip height above ground [m] (default 0.5 L).
-    trip_depth_m : float
+    trip_depth_m : float, optional
         A foot found more than this [m] below the surface of a patch (it entered through the
-        patch's side after sinking in a gap) ends the run as a fall ("trip").
+        patch's side after sinking in a gap) ends the run as a fall ("trip").  Default: 20 x
+        the static penetration under the full weight (1.2 mm for the paper's contact; heel
+        strikes reach ~2 x static).
     use_jacobian : bool
         Pass the analytic Jacobian to the integrator.
     chunk_s : float
@@ -332,6 +334,8 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         raise ValueError(f"method must be odeint, LSODA, Radau or BDF, not {method!r}")
     x0 = np.asarray(x0, dtype=float)
     hth = 0.5 * walker.L if fall_hip_height_m is None else fall_hip_height_m
+    if trip_depth_m is None:
+        trip_depth_m = 20.0 * walker.static_penetration()
     wall = time.perf_counter()
     ts, Xs, nfev, njev, status, msg = [], [], 0, 0, "ok", ""
     t_pin = t0
@@ -366,13 +370,15 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         termination = "fall"
         k = min(k_fall, k_trip)
         if k_trip < k_fall:
+            # the deep sample itself (absurd IMPACT force) is dropped
             fall_reason, fall_time = "trip", float(t[k])
             msg = f"trip: a foot entered a patch > {trip_depth_m} m below its surface"
+            t, X = t[:max(k, 1)], X[:max(k, 1)]
         else:
             fall_reason = "hip_height"
             fall_time = float(t[k]) if k == 0 else float(
                 np.interp(hth, [hh[k], hh[k - 1]], [t[k], t[k - 1]]))
-        t, X = t[:k + 1], X[:k + 1]
+            t, X = t[:k + 1], X[:k + 1]
     res = _postprocess(walker, t, X, min_step_m, initial_stance)
     return ContactResult(t=t, q=X[:, :4], qdot=X[:, 4:], feet=res["feet"],
                          heel_strike_times=res["hs_t"], heel_strike_legs=res["hs_leg"],

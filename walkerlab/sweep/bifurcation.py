@@ -328,3 +328,29 @@ def load_bifurcation(path: Path) -> dict:
 
         f.visititems(visit)
     return out
+
+
+def run_bifurcation(scene: Scene, slopes_deg, runs_root: Path | str = "runs",
+                    n_transient: int = 100, n_keep: int = 30, workers: int = 2,
+                    scheduler=None, name: str = "bifurcation") -> dict:
+    """Compute, write ``runs/<scene>/<name>.h5`` and draw ``<name>.png/.svg`` from it.
+
+    Returns
+    -------
+    dict
+        ``artifact`` (Path), ``figures`` (list of Path), ``onset_deg`` (float),
+        ``wall_time_s`` (float).
+    """
+    from walkerlab.plotting.sweep_figures import bifurcation_figure, save
+
+    t0 = time.perf_counter()
+    res = bifurcation_diagram(scene, slopes_deg, n_transient, n_keep, workers, scheduler)
+    wall = time.perf_counter() - t0
+    folder = Path(runs_root) / (scene.name or "scene")
+    path = write_bifurcation(folder / f"{name}.h5", scene, res, wall)
+    w = scene.walker
+    title = (f"compass gait m={w.leg_mass_kg:g} kg, M_H={w.hip_mass_kg:g} kg, "
+             f"L={w.leg_length_m:g} m, a={w.leg_mass_from_foot_m:g} m")
+    figs = save(bifurcation_figure(load_bifurcation(path), title), folder, name)
+    return {"artifact": path, "figures": figs, "onset_deg": res.onset["onset_deg"],
+            "wall_time_s": wall}

@@ -12,7 +12,9 @@ written in parallel; adjust the adapter, nothing else, when its interface change
 
 from __future__ import annotations
 
+import contextlib
 import math
+import threading
 import time
 import traceback
 import warnings
@@ -374,8 +376,13 @@ def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: 
     row = empty_row(stage, index)
     t0 = time.perf_counter()
     next_guess = None
-    with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
-        warnings.simplefilter("always")
+    # warnings.catch_warnings is process-global: only capture in the main thread (Dask
+    # workers with processes=False run points in threads; np.errstate is thread-local).
+    main = threading.current_thread() is threading.main_thread()
+    with (warnings.catch_warnings(record=True) if main else contextlib.nullcontext([])) \
+            as caught, np.errstate(all="ignore"):
+        if main:
+            warnings.simplefilter("always")
         try:
             scene = apply_point(base, list(paths), tuple(values), origin)
             cols, next_guess = POINT_FUNCTIONS[stage](scene, guess, options)

@@ -1,0 +1,160 @@
+"""Figures of sweeps, drawn from loaded artifacts only.
+
+- :func:`bifurcation_figure`: steady-state inter-leg angle at heel strike vs slope (the
+  period-doubling cascade), the period-1 branch, and its Floquet multipliers with the -1 line.
+- :func:`stability_map_figure`: outcome per grid point of a 2-D sweep (categorical map) and
+  the run time per point.
+- :func:`save`: PNG (150 dpi) + SVG.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.colors import BoundaryNorm, ListedColormap  # noqa: E402
+
+from walkerlab.sweep.outcomes import OUTCOMES  # noqa: E402
+
+OUTCOME_COLORS = {
+    "ok": "#2ca02c", "no_fixed_point": "#7f7f7f", "fall": "#d62728", "scuffing": "#9467bd",
+    "slip": "#ff7f0e", "bounce": "#e7ba52", "solver_failure": "#000000", "max_steps": "#17becf",
+    "invalid_config": "#c7c7c7", "error": "#8c564b",
+}
+OUTCOME_LABELS = {"ok": "walks (ok)", "fall": "falls", "slip": "slips", "bounce": "bounces"}
+
+
+def save(fig, folder: Path, stem: str) -> list[Path]:
+    """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for ext in ("png", "svg"):
+        p = folder / f"{stem}.{ext}"
+        fig.savefig(p, dpi=150, bbox_inches="tight")
+        out.append(p)
+    plt.close(fig)
+    return out
+
+
+def bifurcation_figure(data: dict, title: str = ""):
+    """Bifurcation diagram from :func:`walkerlab.sweep.bifurcation.load_bifurcation` data.
+
+    Parameters
+    ----------
+    data : dict
+        Keys ``slope`` (n,) [deg], ``steady_state/interleg_angle`` (n, k) [deg],
+        ``fixed_point/swing_angle``, ``fixed_point/stance_angle`` (n,) [rad],
+        ``floquet/real``, ``floquet/imag`` (n, 4), ``onset/slope`` [deg].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    s = np.asarray(data["slope"], float)
+    il = np.asarray(data["steady_state/interleg_angle"], float)
+    fp_il = np.degrees(np.abs(np.asarray(data["fixed_point/stance_angle"])
+                              - np.asarray(data["fixed_point/swing_angle"])))
+    mult = np.asarray(data["floquet/real"]) + 1j * np.asarray(data["floquet/imag"])
+    stable = np.max(np.abs(mult), axis=1) < 1
+    onset = float(data.get("onset/slope", np.nan))
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True,
+                                   gridspec_kw={"height_ratios": [3, 2]})
+    ss, yy = np.repeat(s, il.shape[1]), il.ravel()
+    m = np.isfinite(yy)
+    ax1.plot(ss[m], yy[m], ".", ms=2.0, color="k", label="steady state (last heel strikes)")
+    ax1.plot(np.where(stable, s, np.nan), np.where(stable, fp_il, np.nan), "-", color="tab:blue",
+             lw=1.2, label="period-1 fixed point, stable")
+    ax1.plot(np.where(~stable, s, np.nan), np.where(~stable, fp_il, np.nan), "--",
+             color="tab:blue", lw=1.0, label="period-1 fixed point, unstable")
+    ax1.set_ylabel("inter-leg angle at heel strike [deg]")
+    for ax in (ax1, ax2):
+        if np.isfinite(onset):
+            ax.axvline(onset, color="tab:red", lw=0.8, ls=":")
+    if np.isfinite(onset):
+        ax1.text(onset, ax1.get_ylim()[1], f" period doubling {onset:.3f}°", color="tab:red",
+                 va="top", fontsize=8)
+    ax1.legend(fontsize=8, loc="upper left")
+    if title:
+        ax1.set_title(title)
+    for k in range(mult.shape[1]):
+        ax2.plot(s, mult[:, k].real, ".", ms=3, label=f"Re multiplier {k}")
+    ax2.plot(s, np.max(np.abs(mult), axis=1), "-", color="0.4", lw=1, label="max |multiplier|")
+    ax2.axhline(-1.0, color="tab:red", lw=0.8)
+    ax2.axhline(1.0, color="0.6", lw=0.6)
+    ax2.set_xlabel("slope φ [deg]")
+    ax2.set_ylabel("Floquet multiplier [-]")
+    ax2.legend(fontsize=7, ncol=3, loc="lower left")
+    fig.tight_layout()
+    return fig
+
+
+def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | None = None,
+                         title: str = "", log_y: bool | None = None):
+    """Outcome map and run time per point of a 2-D sweep (from :func:`load_sweep`).
+
+    Parameters
+    ----------
+    sweep : dict
+        :func:`walkerlab.sweep.store.load_sweep` output; 2 axes.
+    x_path, y_path : str, optional
+        Which axis is drawn along x / y (default: second axis on x, first on y).
+    log_y : bool, optional
+        Logarithmic y axis (default: when the y values span more than a factor 100).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    axes = dict(sweep["axes"])
+    paths = [p for p, _ in sweep["axes"]]
+    if len(paths) != 2:
+        raise ValueError("stability map needs a 2-D sweep")
+    x_path = x_path or paths[1]
+    y_path = y_path or [p for p in paths if p != x_path][0]
+    xv, yv = np.asarray(axes[x_path], float), np.asarray(axes[y_path], float)
+    pts = sweep["points"]
+    code = np.full((yv.size, xv.size), np.nan)
+    wall = np.full((yv.size, xv.size), np.nan)
+    for k in range(pts["index"].size):
+        i = int(np.argmin(np.abs(yv - pts[f"param/{y_path}"][k])))
+        j = int(np.argmin(np.abs(xv - pts[f"param/{x_path}"][k])))
+        code[i, j] = OUTCOMES.index(pts["outcome"][k])
+        wall[i, j] = pts["wall_time_s"][k]
+    if log_y is None:
+        log_y = yv.min() > 0 and yv.max() / yv.min() > 100
+    cmap = ListedColormap([OUTCOME_COLORS[o] for o in OUTCOMES])
+    norm = BoundaryNorm(np.arange(len(OUTCOMES) + 1) - 0.5, cmap.N)
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    xi, yi = np.arange(xv.size), np.arange(yv.size)
+    a1.pcolormesh(xi, yi, code, cmap=cmap, norm=norm, shading="nearest")
+    present = [o for o in OUTCOMES if np.any(code == OUTCOMES.index(o))]
+    for o in present:
+        a1.plot([], [], "s", color=OUTCOME_COLORS[o], label=OUTCOME_LABELS.get(o, o))
+    a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    im = a2.pcolormesh(xi, yi, wall, shading="nearest", cmap="viridis")
+    fig.colorbar(im, ax=a2, label="wall time per point [s]")
+    ylab = _label(y_path)
+    for ax in (a1, a2):
+        ax.set_xticks(xi, [f"{v:g}" for v in xv], fontsize=7)
+        ax.set_yticks(yi, [f"{v:.3g}" for v in yv], fontsize=7)
+        ax.set_xlabel(_label(x_path))
+        ax.set_ylabel(ylab + (" (log grid)" if log_y else ""))
+    a1.set_title(title or "outcome per point", fontsize=9)
+    a2.set_title("run time per point", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+_UNITS = {"slope.angle_deg": "slope φ [deg]", "slope.angle_rad": "slope φ [rad]",
+          "contact.stiffness": "contact stiffness k [N/len^e, contact.unit_system]",
+          "contact.mu_static": "static friction μs [-]",
+          "contact.mu_dynamic": "dynamic friction μd [-]"}
+
+
+def _label(path: str) -> str:
+    return _UNITS.get(path, path)
