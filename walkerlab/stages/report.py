@@ -141,7 +141,8 @@ def _table3_section(scene: Scene, runs_root) -> str:
                  *(c["step_length_m"] for c in cols.values())])
     ideal = cols.get("ours, ideal")
     out = ["## Table 3 — gait characteristics", "",
-           "Recomputed from the trajectory artifacts (`simulate.h5`, `contact_sim.h5`).", "",
+           "Recomputed from the trajectory artifacts ("
+           + ", ".join(f"`{p.name}`" for _, p in paths.values()) + ").", "",
            _table(header, rows)]
     if ideal:
         from walkerlab.stages.fixedpoint import PAPER_EQ11

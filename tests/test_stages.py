@@ -1,0 +1,190 @@
+"""Stages, caching, artifacts and the report (behaviour, not timing)."""
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+from walkerlab.config import load_scene
+from walkerlab.io.artifacts import ArtifactError, open_artifact
+from walkerlab.io.trajectory import NamedTrajectory, write_samples
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture()
+def ideal_scene(tmp_path):
+    """The paper's walker, ideal model only (no contact / work-precision sections)."""
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    for k in ("contact", "terrain", "contact_sim", "contact_solver", "workprecision"):
+        d.pop(k, None)
+    d["simulate"]["strides"] = 1
+    p = tmp_path / "ideal_only.yaml"
+    p.write_text(yaml.safe_dump(d))
+    return load_scene(p)
+
+
+def test_stage_reuse_and_invalidation(ideal_scene, tmp_path):
+    from walkerlab.stages import fixedpoint, simulate
+
+    runs = tmp_path / "runs"
+    a = simulate.run(ideal_scene, runs)
+    assert not a.reused
+    assert simulate.run(ideal_scene, runs).reused
+    assert fixedpoint.run(ideal_scene, runs).reused
+    # change the slope: both stages that depend on it rerun
+    d = ideal_scene.model_dump(mode="json", exclude_none=True)
+    d["slope"] = {"angle_rad": 0.02}
+    from walkerlab.config import scene_from_dict
+
+    steeper = scene_from_dict(d)
+    assert not fixedpoint.run(steeper, runs).reused
+    assert not simulate.run(steeper, runs).reused
+    # a change of simulate-only settings leaves the fixed point alone
+    d["simulate"]["sample_rate_hz"] = 100
+    s2 = scene_from_dict(d)
+    assert fixedpoint.run(s2, runs).reused
+    assert not simulate.run(s2, runs).reused
+
+
+def test_simulate_artifact_is_named_and_physical(ideal_scene, tmp_path):
+    from walkerlab.stages import simulate
+
+    out = simulate.run(ideal_scene, tmp_path)
+    with open_artifact(out.path, "simulate") as f:
+        assert f["samples/angle/leg1"].attrs["unit"] == "rad"
+        assert f["samples/rate/leg2"].attrs["unit"] == "rad/s"
+        assert "scene_json" in f.attrs and f.attrs["wall_time_s"] > 0
+        assert list(f["steps/termination"].asstr()[()]) == ["heel_strike"] * 2
+        # total energy is constant within each step (PE from a fixed datum)
+        tot, step = f["samples/energy/total"][()], f["samples/step_index"][()]
+        for k in np.unique(step):
+            e = tot[step == k]
+            assert np.ptp(e) < 1e-8 * abs(e[0])
+        # and drops at heel strike (plastic impact)
+        assert tot[step == 1][0] < tot[step == 0][-1]
+
+
+def test_report_of_ideal_only_scene_has_no_contact_sections(ideal_scene, tmp_path):
+    from walkerlab.stages import report
+
+    html = report.run(ideal_scene, tmp_path, echo=lambda s: None)
+    md = (html.parent / "report.md").read_text()
+    assert "Fixed point" in md and "Table 3" in md
+    for word in ("contact", "Fig. 8", "Table 2", "work-precision"):
+        assert word not in md.replace("ours, ideal", "")
+    figs = sorted(p.name for p in (html.parent / "figures").glob("*.png"))
+    assert figs == ["fig10_energy.png", "fig2_stick_ideal.png", "fig7_angles_rates.png",
+                    "fig9_limit_cycles.png"]
+    assert "data:image/png;base64" in html.read_text()
+
+
+def _fake_trajectory(n=200):
+    t = np.linspace(0, 2, n)
+    step = (t >= 1).astype(int)
+    th = 0.2 * np.sin(np.pi * t)
+    return NamedTrajectory(
+        time=t, legs=["leg1", "leg2"], angle={"leg1": th, "leg2": -th},
+        rate={"leg1": np.gradient(th, t), "leg2": -np.gradient(th, t)},
+        stance_leg=step.copy(), step_index=step, kinetic=1 + 0 * t, potential=100 + 0 * t,
+        points={"hip": np.vstack([0.5 * t, 1 + 0 * t]),
+                "leg1_foot": np.vstack([0.5 * t + np.sin(th), 1 - np.cos(th)]),
+                "leg2_foot": np.vstack([0.5 * t - np.sin(th), 1 - np.cos(th)])})
+
+
+def test_figures_are_drawn_from_a_hand_built_artifact(tmp_path, ideal_scene):
+    """Plot from a small artifact written by hand (no simulation involved)."""
+    import walkerlab.io.artifacts as A
+    from walkerlab.stages import plot
+
+    path = tmp_path / "ideal_only" / "simulate.h5"
+    A.write_artifact(path, "simulate", ideal_scene, "x", lambda f: write_samples(f, _fake_trajectory()),
+                     0.0)
+    written = plot.run(ideal_scene, tmp_path)
+    assert {p.name for p in written} >= {"fig7_angles_rates.png", "fig9_limit_cycles.png",
+                                         "fig10_energy.png", "fig2_stick_ideal.png"}
+    assert all(p.stat().st_size > 5000 for p in written)
+
+
+def test_compare_of_a_trajectory_with_itself_is_zero():
+    from walkerlab.analysis.compare import aligned_errors, limit_cycle_distance
+
+    tr = _fake_trajectory()
+    t, ae, re = aligned_errors(tr, tr)
+    assert all(np.max(np.abs(v)) == 0 for v in ae.values())
+    assert all(np.max(np.abs(v)) == 0 for v in re.values())
+    assert limit_cycle_distance(tr, tr, "leg1") == 0
+
+
+def test_table3_is_recomputed_from_the_artifact(tmp_path, ideal_scene):
+    from walkerlab.analysis.tables import gait_metrics
+
+    tr = _fake_trajectory()
+    m = gait_metrics(tr)
+    assert m["t_left_s"] == pytest.approx(1.0, abs=0.02)  # step boundary at t = 1 s
+    assert m["v_com_m_per_s"] == pytest.approx(0.5, rel=1e-9)  # hip x = 0.5 t
+    assert m["E_avg_J"] == pytest.approx(101.0)
+
+
+def test_truncated_artifact_is_a_clear_error(tmp_path):
+    p = tmp_path / "simulate.h5"
+    with h5py.File(p, "w") as f:
+        f.attrs["stage"] = "simulate"
+    data = p.read_bytes()
+    p.write_bytes(data[: len(data) // 3])
+    with pytest.raises(ArtifactError, match="simulate.h5.*truncated or damaged"):
+        with open_artifact(p, "simulate"):
+            pass
+
+
+def test_artifact_of_another_version_is_refused(tmp_path):
+    p = tmp_path / "fixedpoint.h5"
+    with h5py.File(p, "w") as f:
+        f.attrs["stage"] = "fixedpoint"
+        f.attrs["walkerlab_version"] = "0.0.1"
+    with pytest.raises(ArtifactError, match="written by walkerlab 0.0.1"):
+        with open_artifact(p, "fixedpoint"):
+            pass
+
+
+def test_failed_write_leaves_the_good_artifact(tmp_path, ideal_scene):
+    import walkerlab.io.artifacts as A
+
+    path = tmp_path / "x.h5"
+    A.write_artifact(path, "simulate", ideal_scene, "good", lambda f: f.create_dataset("a", data=1), 0)
+
+    def boom(f):
+        f.create_dataset("a", data=2)
+        raise RuntimeError("crash mid-write")
+
+    with pytest.raises(RuntimeError):
+        A.write_artifact(path, "simulate", ideal_scene, "bad", boom, 0)
+    with h5py.File(path) as f:
+        assert f["a"][()] == 1 and f.attrs["input_hash"] == "good"
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_cli_fixedpoint_prints_named_state(tmp_path):
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, ["fixedpoint", str(ROOT / "configs" / "paper.yaml"),
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert "stance_angle   (leg2, stance leg)" in r.output
+    assert "rad/s" in r.output and "verdict: STABLE" in r.output
+
+
+def test_cli_bad_scene_is_one_line(tmp_path):
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    p = tmp_path / "bad.yaml"
+    p.write_text("walker: {leg_length_m: -1}\nslope: {angle_deg: 1}\n")
+    r = CliRunner().invoke(app, ["fixedpoint", str(p), "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 1
+    assert r.output.strip().count("\n") == 0 and "bad.yaml" in r.output
