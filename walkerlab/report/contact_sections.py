@@ -52,6 +52,70 @@ def workprecision_section(scene, runs_root) -> list[str]:
     return out
 
 
+def contact_section(scene, runs_root) -> list[str]:
+    from walkerlab.analysis.tables import PAPER_TABLE2
+
+    p = artifact_path(scene, runs_root, "contact-sim")
+    if not p.is_file():
+        return []
+    with open_artifact(p, "contact-sim") as f:
+        x_id = f["initial_state_ideal"][()]
+        scale = f["initial_rate_scale"][()]
+        x0 = f["initial_state"][()]
+        summ = {k: f["summary"][k][()] for k in f["summary"]}
+        cp = {k: (f["contact_params_si"][k][()], f["contact_params_si"][k].attrs["unit"])
+              for k in f["contact_params_si"]}
+        term = str(f.attrs["termination"])
+        slips = f["steps/stance_slip_mm"][()]
+        periods = f["steps/period"][()]
+        adj = {k: f["adjust"][k][()] for k in f["adjust"]} if "adjust" in f else None
+    ours_c = np.array([x0[2], x0[3], x0[6], x0[7]])
+    rows = []
+    for i, (key, (pm, pa)) in enumerate(PAPER_TABLE2.items()):
+        rows.append([key, pm, pa, f"{100 * (abs(pa) - abs(pm)) / abs(pm):+.1f}%", float(x_id[i]),
+                     float(ours_c[i]),
+                     f"{100 * (abs(ours_c[i]) - abs(x_id[i])) / abs(x_id[i]):+.1f}%"])
+    out = ["## Table 2 — initial states (ideal vs contact model)", "",
+           _table(["state", "paper MATLAB", "paper ADAMS", "paper diff.", "ours ideal",
+                   "ours contact", "ours diff."], rows), "",
+           f"Our contact walker starts from our ideal fixed point with the initial rates scaled "
+           f"by {np.array2string(scale, precision=3)}"
+           + (f" (found by `--adjust`: objective {float(adj['objective']):.2e} after "
+              f"{int(adj['evaluations'])} simulations)" if adj else "")
+           + ". Note that the paper's ADAMS column is not the stated +41 % / +74 %: "
+             "−0.60 → −1.02 is +70 % and −0.84 → −3.20 is +281 %.", "",
+           "## Contact walker (MSC ADAMS-style model)", "",
+           _table(["quantity", "value"], [[k, float(v) if np.ndim(v) == 0 else str(v)]
+                                          for k, v in summ.items()] + [["termination", term]]),
+           "", "Contact parameters in SI (converted from the scene's unit system): "
+           + ", ".join(f"{k} = {float(v):.4g} {u}" for k, (v, u) in cp.items()) + ".", "",
+           "Per-step stance slip [mm]: " + ", ".join(f"{v:.3f}" for v in slips)
+           + "; step periods [s]: " + ", ".join(f"{v:.4f}" for v in periods) + ".",
+           "(% columns: change of magnitude relative to the ideal/MATLAB value.)", ""]
+    return out
+
+
+def compare_section(scene, runs_root) -> list[str]:
+    p = artifact_path(scene, runs_root, "compare")
+    if not p.is_file():
+        return []
+    with open_artifact(p, "compare") as f:
+        g = f["errors"]
+        legs = [str(x) for x in g.attrs["legs"]]
+        rows = [[leg, float(np.max(np.abs(g[f"angle/{leg}"][()]))),
+                 float(np.max(np.abs(g[f"rate/{leg}"][()]))),
+                 float(g[f"limit_cycle_distance/{leg}"][()])] for leg in legs]
+        t_end = float(g["time"][-1])
+    return ["## Comparison ideal vs contact (Fig. 8)", "",
+            f"Errors contact − ideal over the common span 0–{t_end:.2f} s:", "",
+            _table(["leg", "max abs angle error [rad]", "max abs rate error [rad/s]",
+                    "mean limit-cycle distance"], rows), "",
+            "The paper reports a maximum error 'around 1e-4'. Ours is larger because the "
+            "contact gait settles to a slightly different period (the regularised ADAMS "
+            "friction lets the stance foot creep, ~0.5 mm per step), so the two trajectories "
+            "drift apart in phase; the limit cycles themselves stay close (last column).", ""]
+
+
 def sections(scene, runs_root) -> list[str]:
     """All optional sections, in report order."""
     out: list[str] = []
@@ -60,4 +124,4 @@ def sections(scene, runs_root) -> list[str]:
     return out
 
 
-_SECTION_FUNCS = [workprecision_section]
+_SECTION_FUNCS = [contact_section, compare_section, workprecision_section]
