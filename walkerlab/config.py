@@ -167,6 +167,15 @@ class WorkPrecisionSettings(_Strict):
     target_error: float = Field(1e-8, gt=0, description="error the Pareto-best setting must "
                                 "reach [rad, rad/s]")
     models: list[Literal["ideal", "contact"]] = Field(["ideal"], description="models to study")
+    contact_methods: list[Literal["odeint", "LSODA", "Radau", "BDF"]] = Field(
+        ["odeint", "LSODA", "Radau", "BDF"],
+        description="methods for the stiff contact model (explicit methods are hopeless there)")
+    contact_rtols: list[Annotated[float, Field(gt=0, lt=1)]] = Field(
+        [1e-5, 1e-6, 1e-7, 1e-8, 1e-9], description="contact-model tolerances [-]")
+    contact_target_error: float = Field(1e-6, gt=0, description="contact-model error the "
+                                        "Pareto-best setting must reach [rad, rad/s]")
+    contact_reference_rtol: float = Field(1e-12, gt=0, lt=1e-6,
+                                          description="contact reference (odeint) rtol [-]")
 
 
 class Scene(_Strict):

@@ -39,7 +39,10 @@ def workprecision_section(scene, runs_root) -> list[str]:
                            f"{g.attrs['target_error']:.0e}: **{g.attrs['best_method']} rtol "
                            f"{g.attrs['best_rtol']:.0e}** ({g.attrs['best_time'] * 1e3:.1f} ms, "
                            f"error {g.attrs['best_error']:.1e}). Scene default: "
-                           f"{scene.solver.method} rtol {scene.solver.rtol:.0e}.")
+                           + (f"{scene.solver.method} rtol {scene.solver.rtol:.0e}."
+                              if model == "ideal" else
+                              f"{(scene.contact_solver.method if scene.contact_solver else 'odeint')}"
+                              f" rtol {(scene.contact_solver.rtol if scene.contact_solver else 1e-8):.0e}."))
             pm = [str(s) for s in g.attrs.get("pareto_methods", [])]
             pr = list(g.attrs.get("pareto_rtol", []))
             out.append("")

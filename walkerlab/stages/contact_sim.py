@@ -190,8 +190,7 @@ def workprecision_runner(scene: Scene, runs_root, x_fp: np.ndarray, strides: int
     _, meta = fixedpoint_stage.load_fixed_point(artifact_path(scene, runs_root, "fixedpoint"))
 
     def run(method, rtol, atol):
-        sv = ContactSolverSettings(method=method if method != "DOP853" else "DOP853",
-                                   rtol=rtol, atol=atol)
+        sv = ContactSolverSettings(method=method, rtol=rtol, atol=atol)
         _, res, _, _ = simulate_from(scene, x_fp, meta["step_period_s"], solver=sv,
                                      strides=strides)
         if res.termination != "t_final":

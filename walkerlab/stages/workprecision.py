@@ -2,7 +2,9 @@
 
 For each model and each scipy method and tolerance, the run is repeated ``repeats`` times
 (the median wall time is kept) and its error is measured against a tightly converged
-reference (DOP853 at ``reference_rtol``).  The ideal model's error is the max-norm of the
+reference (DOP853 at ``reference_rtol`` for the ideal model; odeint/LSODA at
+``contact_reference_rtol`` for the contact model, whose atol is 1e-2 * rtol because its
+positions are sub-millimetre penetrations).  The ideal model's error is the max-norm of the
 difference of the state and time at the last heel strike; the contact model's error is the
 max-norm of the leg angles [rad] and rates [rad/s] at the final time.  The artifact stores
 every point, the Pareto front (no other setting is both faster and more accurate) and the
@@ -106,9 +108,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
             from walkerlab.stages.contact_sim import workprecision_runner
 
             runner = workprecision_runner(scene, runs_root, x0, wp.strides)
-            ref, _ = runner("Radau", wp.reference_rtol * 100, wp.reference_rtol * 100)
-            rows = study(runner, wp.methods, wp.rtols, wp.atol_factor, wp.repeats, ref)
-            results["contact"] = (rows, summarize(rows, wp.target_error))
+            ref, _ = runner("odeint", wp.contact_reference_rtol,
+                            wp.contact_reference_rtol * 1e-2)
+            rows = study(runner, wp.contact_methods, wp.contact_rtols, 1e-2, wp.repeats, ref)
+            results["contact"] = (rows, summarize(rows, wp.contact_target_error))
 
         def writer(f):
             for model, (rows, summ) in results.items():
@@ -126,7 +129,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                 if summ["best"]:
                     g.attrs["best_method"], g.attrs["best_rtol"] = summ["best"][:2]
                     g.attrs["best_time"], g.attrs["best_error"] = summ["best"][2:]
-                g.attrs["target_error"] = wp.target_error
+                g.attrs["target_error"] = (wp.target_error if model == "ideal"
+                                           else wp.contact_target_error)
         return writer, {k: v[1] for k, v in results.items()}
 
     return run_cached("workprecision", scene, runs_root, SECTIONS, up, compute, force)

@@ -222,7 +222,7 @@ class BifurcationResult:
     n_keep: int
 
 
-def _distinct(v: np.ndarray, tol: float = 1e-5) -> int:
+def _distinct(v: np.ndarray, tol: float = 1e-4) -> int:
     v = np.sort(v[np.isfinite(v)])
     if v.size == 0:
         return 0

@@ -155,7 +155,7 @@ def iter_chunk_results(tasks: list[Task], workers: int = 2, scheduler=None,
         client = Client(scheduler, set_as_default=False) if own else scheduler
         futs = client.map(fn, tasks, pure=False)
         try:
-            for fut in dask_completed(futs):
+            for fut in dask_completed(futs, loop=client.loop):
                 yield fut.result()
         finally:
             client.cancel([f for f in futs if not f.done()])
