@@ -11,7 +11,6 @@ from walkerlab.models.compass_gait import (
     impact,
     is_heel_strike,
     make_compass_gait,
-    points,
     swing_foot_height,
 )
 from walkerlab.models.derivation import compass_gait_symbolic, derive
@@ -102,8 +101,8 @@ def test_appendix_a_literal_impact_breaks_momentum():
 def test_guard_fires_at_heel_strike_not_at_midstance_scuffing(paper_walker, paper_fixed_point):
     """One step from the fixed point: the swing foot height vanishes twice after the start -
     at mid-stance (legs aligned, scuffing: ignored) and at heel strike (the event)."""
-    from walkerlab.analysis.hybrid import integrate_step
     from tests.conftest import TIGHT
+    from walkerlab.analysis.hybrid import integrate_step
 
     seg = integrate_step(paper_walker, paper_fixed_point.x, TIGHT)
     assert seg.termination == "heel_strike"

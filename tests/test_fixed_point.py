@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
+from tests.conftest import TIGHT
 from walkerlab.analysis.poincare import find_fixed_point, poincare_map
 from walkerlab.models.compass_gait import make_compass_gait
-from tests.conftest import TIGHT
 
 EQ11 = np.array([-0.2022, 0.1674, -0.60, -0.84])
 
@@ -23,7 +23,7 @@ def test_fixed_point_residual_and_stability(paper_fixed_point):
 def test_fixed_point_is_a_fixed_point(paper_walker, paper_fixed_point):
     x1, T, _ = poincare_map(paper_walker, paper_fixed_point.x, TIGHT)
     assert np.max(np.abs(x1 - paper_fixed_point.x)) < 1e-10
-    assert T == pytest.approx(paper_fixed_point.period_s, abs=1e-10)
+    assert pytest.approx(paper_fixed_point.period_s, abs=1e-10) == T
 
 
 def test_appendix_a_reproduces_eq11():

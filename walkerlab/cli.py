@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Optional
 
 import typer
 
@@ -29,7 +28,7 @@ def default_scene() -> Path:
     return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
 
 
-def _load(scene: Optional[Path]):
+def _load(scene: Path | None):
     from walkerlab.config import load_scene
 
     return load_scene(scene or default_scene())
@@ -65,11 +64,11 @@ def _status(o) -> str:
 
 @app.command()
 @_guard
-def fixedpoint(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
+def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                force: bool = ForceOpt) -> None:
     """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
-    from walkerlab.stages import fixedpoint as stage
     from walkerlab.report.text import fixedpoint_text
+    from walkerlab.stages import fixedpoint as stage
 
     sc = _load(scene)
     out = stage.run(sc, runs_dir, force)
@@ -79,8 +78,8 @@ def fixedpoint(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
 
 @app.command()
 @_guard
-def simulate(scene: Optional[Path] = SceneArg,
-             strides: Optional[int] = typer.Option(
+def simulate(scene: Path | None = SceneArg,
+             strides: int | None = typer.Option(
                  None, "--strides", min=1, help="strides to simulate (1 stride = 2 steps) "
                  "[default: simulate.strides of the scene]"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
@@ -102,7 +101,7 @@ def simulate(scene: Optional[Path] = SceneArg,
 
 @app.command("contact-sim")
 @_guard
-def contact_sim(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
+def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                 force: bool = ForceOpt,
                 adjust: bool = typer.Option(False, "--adjust", help="search the initial rates "
                                             "that make the contact walker match the ideal gait")
@@ -119,7 +118,7 @@ def contact_sim(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
 
 @app.command()
 @_guard
-def compare(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
+def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
             force: bool = ForceOpt) -> None:
     """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
     from walkerlab.stages import compare as stage
@@ -130,7 +129,7 @@ def compare(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
 
 @app.command()
 @_guard
-def workprecision(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
+def workprecision(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                   force: bool = ForceOpt) -> None:
     """Work-precision study: error vs wall time for every solver and tolerance."""
     from walkerlab.stages import workprecision as stage
@@ -146,7 +145,7 @@ def workprecision(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
 
 @app.command()
 @_guard
-def plot(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt) -> None:
+def plot(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
     """Draw the figures (PNG + SVG) from the scene's existing artifacts."""
     from walkerlab.stages import plot as stage
 
@@ -156,7 +155,7 @@ def plot(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt) -> None:
 
 @app.command()
 @_guard
-def report(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
+def report(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
            force: bool = ForceOpt) -> None:
     """Run every stage the scene needs (skipping up-to-date ones) and write the report."""
     from walkerlab.stages import report as stage
@@ -167,16 +166,16 @@ def report(scene: Optional[Path] = SceneArg, runs_dir: Path = RunsOpt,
 
 @app.command()
 @_guard
-def sweep(scene: Optional[Path] = SceneArg,
+def sweep(scene: Path | None = SceneArg,
           param: list[str] = typer.Option(..., "--param", help="dotted scene field and values, "
                                           "e.g. slope.angle_deg=0.5:5:0.05 or a,b,c"),
           stage: str = typer.Option("fixedpoint", "--stage",
                                     help="fixedpoint | simulate | contact-sim"),
           workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
-          scheduler: Optional[str] = typer.Option(None, "--scheduler",
+          scheduler: str | None = typer.Option(None, "--scheduler",
                                                   help="Dask scheduler address (tcp://host:port)"),
           resume: bool = typer.Option(False, "--resume", help="continue an interrupted sweep"),
-          name: Optional[str] = typer.Option(None, "--name", help="artifact name"),
+          name: str | None = typer.Option(None, "--name", help="artifact name"),
           runs_dir: Path = RunsOpt) -> None:
     """Run a stage over a grid of scene fields; one row per point, failures recorded."""
     from walkerlab.stages import sweep as stage_mod

@@ -50,7 +50,7 @@ class CompassGaitParams(_Strict):
     )
 
     @model_validator(mode="after")
-    def _a_inside_leg(self) -> "CompassGaitParams":
+    def _a_inside_leg(self) -> CompassGaitParams:
         if not self.leg_mass_from_foot_m < self.leg_length_m:
             raise ValueError(
                 "walker.leg_mass_from_foot_m must be smaller than walker.leg_length_m"
@@ -73,7 +73,7 @@ class SlopeSettings(_Strict):
     angle_deg: float | None = Field(None, gt=-90, lt=90, description="slope [deg]")
 
     @model_validator(mode="after")
-    def _exactly_one(self) -> "SlopeSettings":
+    def _exactly_one(self) -> SlopeSettings:
         if (self.angle_rad is None) == (self.angle_deg is None):
             raise ValueError("slope: give exactly one of angle_rad or angle_deg")
         return self

@@ -5,9 +5,13 @@ import pytest
 from pydantic import ValidationError
 
 from walkerlab.contact import _kernels as K
-from walkerlab.contact.config import ContactSettings, TerrainSettings, ContactSimSettings
-from walkerlab.contact.laws import (adams_step, adams_step_derivative,
-                                    coulomb_friction_coefficient, impact_normal_force)
+from walkerlab.contact.config import ContactSettings, ContactSimSettings, TerrainSettings
+from walkerlab.contact.laws import (
+    adams_step,
+    adams_step_derivative,
+    coulomb_friction_coefficient,
+    impact_normal_force,
+)
 
 
 def test_step_values_and_derivative():

@@ -5,8 +5,13 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from walkerlab.contact import (ContactSettings, ContactWalker, TerrainSettings,
-                               initial_state_from_ideal, simulate_contact)
+from walkerlab.contact import (
+    ContactSettings,
+    ContactWalker,
+    TerrainSettings,
+    initial_state_from_ideal,
+    simulate_contact,
+)
 from walkerlab.contact.laws import coulomb_friction_coefficient
 
 PAPER_FP = (-0.2042, 0.1694, -0.6058, -0.8610)  # ideal fixed point after heel strike

@@ -3,8 +3,13 @@
 import numpy as np
 import pytest
 
-from walkerlab.contact import (ContactSettings, ContactWalker, TerrainSettings,
-                               initial_state_from_ideal, simulate_contact)
+from walkerlab.contact import (
+    ContactSettings,
+    ContactWalker,
+    TerrainSettings,
+    initial_state_from_ideal,
+    simulate_contact,
+)
 from walkerlab.contact.bench import run_benchmark
 
 FP = (-0.2042, 0.1694, -0.6058, -0.8610)  # approx. ideal fixed point (leg1 swing)

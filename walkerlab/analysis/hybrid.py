@@ -31,7 +31,7 @@ class Solver:
     max_step_s: float | None = None
 
     @classmethod
-    def from_settings(cls, s) -> "Solver":
+    def from_settings(cls, s) -> Solver:
         return cls(s.method, s.rtol, s.atol, s.max_step_s)
 
     def kwargs(self) -> dict:

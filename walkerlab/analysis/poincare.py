@@ -155,7 +155,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         x = walker.from_section(z)
         try:
             xn, _, nf = poincare_map(walker, x, solver, max_step_time)
-        except StepFailed as exc:
+        except StepFailed:
             counter["calls"] += 1
             return np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
         counter["nfev"] += nf

@@ -8,11 +8,11 @@ explicitly to SI (NOTES.md: "a wrong unit here changes the answer by 10^6").
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal, Optional
+from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-__all__ = ["ContactParamsSI", "ContactSettings", "TerrainSettings", "ContactSimSettings"]
+__all__ = ["ContactParamsSI", "ContactSettings", "ContactSimSettings", "TerrainSettings"]
 
 
 @dataclass(frozen=True)
@@ -92,7 +92,7 @@ class ContactSettings(BaseModel):
     )
 
     @model_validator(mode="after")
-    def _check_relations(self) -> "ContactSettings":
+    def _check_relations(self) -> ContactSettings:
         if self.mu_dynamic > self.mu_static:
             raise ValueError(
                 f"mu_dynamic ({self.mu_dynamic}) must be <= mu_static ({self.mu_static})"
@@ -153,14 +153,14 @@ class ContactSimSettings(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     n_strides: int = Field(5, ge=1, description="Strides (2 steps each) to simulate [-].")
-    t_final_s: Optional[float] = Field(
+    t_final_s: float | None = Field(
         None, gt=0, description="Simulated time [s]; default n_strides * 2 * ideal step period."
     )
     pin_stance_until: Literal["none", "first_touchdown", "time"] = Field(
         "none", description="Hold the first stance foot fixed until this moment."
     )
     pin_time_s: float = Field(0.0, ge=0, description="Pin duration when pin_stance_until='time' [s].")
-    fall_hip_height_m: Optional[float] = Field(
+    fall_hip_height_m: float | None = Field(
         None, gt=0, description="Fall when hip height above ground < this [m]; default 0.5*L."
     )
     sample_rate_hz: float = Field(1000.0, gt=0, description="Output sample rate [Hz].")

@@ -22,8 +22,8 @@ import numpy as np
 __all__ = [
     "adams_step",
     "adams_step_derivative",
-    "impact_normal_force",
     "coulomb_friction_coefficient",
+    "impact_normal_force",
 ]
 
 

@@ -16,7 +16,7 @@ from . import _kernels as K
 from .config import ContactParamsSI, ContactSettings, TerrainSettings
 from .reference import rhs_ref
 
-__all__ = ["ContactWalker", "checkerboard_lanes", "FOOT_NAMES"]
+__all__ = ["FOOT_NAMES", "ContactWalker", "checkerboard_lanes"]
 
 FOOT_NAMES = ("leg1", "leg2")
 
@@ -84,7 +84,7 @@ class ContactWalker:
     @classmethod
     def from_settings(cls, contact: ContactSettings, terrain: TerrainSettings, *,
                       step_length: float, n_steps: int, L=1.0, m=5.0, MH=10.0, a=0.5,
-                      g=9.81, phi=0.0174) -> "ContactWalker":
+                      g=9.81, phi=0.0174) -> ContactWalker:
         """Build from validated settings; ``step_length`` [m] is the ideal gait's step length."""
         c1, c2 = checkerboard_lanes(step_length, n_steps)
         return cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=contact.to_si(), lane1=c1,

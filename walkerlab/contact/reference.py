@@ -16,7 +16,7 @@ import numpy as np
 
 from .laws import coulomb_friction_coefficient, impact_normal_force
 
-__all__ = ["mass_matrix_ref", "contact_forces_ref", "rhs_ref"]
+__all__ = ["contact_forces_ref", "mass_matrix_ref", "rhs_ref"]
 
 
 def mass_matrix_ref(q, L, m, MH, a):

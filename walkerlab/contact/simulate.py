@@ -20,8 +20,13 @@ from scipy.integrate import ODEintWarning, odeint, solve_ivp
 from . import _kernels as K
 from .model import FOOT_NAMES, ContactWalker
 
-__all__ = ["FootTrace", "StepSummary", "ContactResult", "simulate_contact",
-           "initial_state_from_ideal"]
+__all__ = [
+    "ContactResult",
+    "FootTrace",
+    "StepSummary",
+    "initial_state_from_ideal",
+    "simulate_contact",
+]
 
 
 @dataclass

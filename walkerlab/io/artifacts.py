@@ -18,10 +18,10 @@ import hashlib
 import json
 import os
 import tempfile
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
-from typing import Callable, Iterator
 
 import h5py
 import numpy as np
@@ -111,7 +111,7 @@ def write_artifact(path: Path, stage: str, scene, input_hash: str,
             f.attrs["scene_name"] = scene.name or ""
             f.attrs["scene_json"] = scene.model_dump_json()
             f.attrs["input_hash"] = input_hash
-            f.attrs["created_utc"] = _dt.datetime.now(_dt.timezone.utc).isoformat()
+            f.attrs["created_utc"] = _dt.datetime.now(_dt.UTC).isoformat()
             f.attrs["wall_time_s"] = float(wall_time_s)
             for k, v in (extra_attrs or {}).items():
                 f.attrs[k] = v

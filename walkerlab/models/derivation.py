@@ -13,7 +13,7 @@ torso is derived by the same code from its mass positions.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 import sympy as sp
 
@@ -111,7 +111,7 @@ def derive(model: PointMassModel) -> Derived:
     return Derived(M=M, C=C, G=G, kinetic=sp.simplify(T), potential=sp.simplify(V), De=De, E=E)
 
 
-@lru_cache(maxsize=None)
+@cache
 def compass_gait_functions():
     """Lambdified numpy functions of the derived compass gait (cached per process).
 

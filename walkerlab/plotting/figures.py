@@ -12,10 +12,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from walkerlab.io.trajectory import NamedTrajectory  # noqa: E402
+from walkerlab.io.trajectory import NamedTrajectory
 
 LEG_COLORS = ["tab:blue", "tab:red", "tab:green", "tab:purple"]
 MODEL_STYLES = ["-", "--", ":", "-."]

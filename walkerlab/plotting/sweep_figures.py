@@ -14,11 +14,11 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.colors import BoundaryNorm, ListedColormap  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.colors import BoundaryNorm, ListedColormap
 
-from walkerlab.sweep.outcomes import OUTCOMES  # noqa: E402
+from walkerlab.sweep.outcomes import OUTCOMES
 
 OUTCOME_COLORS = {
     "ok": "#2ca02c", "no_fixed_point": "#7f7f7f", "fall": "#d62728", "scuffing": "#9467bd",
@@ -94,7 +94,8 @@ def bifurcation_figure(data: dict, title: str = ""):
 
 
 def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | None = None,
-                         title: str = "", log_y: bool | None = None):
+                         title: str = "", log_y: bool | None = None,
+                         annotate: str | None = "heel_strikes"):
     """Outcome map and run time per point of a 2-D sweep (from :func:`load_sweep`).
 
     Parameters
@@ -105,6 +106,9 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
         Which axis is drawn along x / y (default: second axis on x, first on y).
     log_y : bool, optional
         Logarithmic y axis (default: when the y values span more than a factor 100).
+    annotate : str, optional
+        Numeric column written into each cell of the outcome map (default: heel strikes
+        before the run ended), if the sweep has it.
 
     Returns
     -------
@@ -120,11 +124,14 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
     pts = sweep["points"]
     code = np.full((yv.size, xv.size), np.nan)
     wall = np.full((yv.size, xv.size), np.nan)
+    note = np.full((yv.size, xv.size), np.nan)
     for k in range(pts["index"].size):
         i = int(np.argmin(np.abs(yv - pts[f"param/{y_path}"][k])))
         j = int(np.argmin(np.abs(xv - pts[f"param/{x_path}"][k])))
         code[i, j] = OUTCOMES.index(pts["outcome"][k])
         wall[i, j] = pts["wall_time_s"][k]
+        if annotate and annotate in pts:
+            note[i, j] = pts[annotate][k]
     if log_y is None:
         log_y = yv.min() > 0 and yv.max() / yv.min() > 100
     cmap = ListedColormap([OUTCOME_COLORS[o] for o in OUTCOMES])
@@ -135,6 +142,11 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
     present = [o for o in OUTCOMES if np.any(code == OUTCOMES.index(o))]
     for o in present:
         a1.plot([], [], "s", color=OUTCOME_COLORS[o], label=OUTCOME_LABELS.get(o, o))
+    for (i, j), v in np.ndenumerate(note):
+        if np.isfinite(v):
+            a1.text(j, i, f"{v:g}", ha="center", va="center", fontsize=6, color="w")
+    if annotate and np.isfinite(note).any():
+        a1.plot([], [], " ", label=f"cell text: {annotate}")
     a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     im = a2.pcolormesh(xi, yi, wall, shading="nearest", cmap="viridis")
     fig.colorbar(im, ax=a2, label="wall time per point [s]")

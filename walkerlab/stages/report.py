@@ -12,8 +12,8 @@ import datetime as _dt
 import html
 import json
 import platform
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -220,7 +220,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
           f"- walkerlab {walkerlab.__version__}, Python {platform.python_version()}, "
           f"numpy {np.__version__}, scipy {scipy.__version__}, machine {platform.machine()} "
           f"({platform.processor() or platform.system()})",
-          f"- generated {_dt.datetime.now(_dt.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')}",
+          f"- generated {_dt.datetime.now(_dt.UTC).strftime('%Y-%m-%d %H:%M UTC')}",
           f"- slope φ = {scene.slope.phi_rad:.6f} rad ({np.degrees(scene.slope.phi_rad):.4f}°); "
           f"ideal equations: `{scene.ideal.variant}`; solver {scene.solver.method} "
           f"rtol {scene.solver.rtol:g} atol {scene.solver.atol:g}",

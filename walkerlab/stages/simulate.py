@@ -13,7 +13,7 @@ from walkerlab.io.artifacts import put
 from walkerlab.io.trajectory import write_samples
 from walkerlab.models.registry import build_walker
 from walkerlab.stages import fixedpoint as fixedpoint_stage
-from walkerlab.stages.common import StageError, StageOutcome, artifact_path, run_cached
+from walkerlab.stages.common import StageOutcome, artifact_path, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
 
