@@ -63,7 +63,9 @@ class CompassGaitParams(_Strict):
         return self.leg_length_m - self.leg_mass_from_foot_m
 
 
-WalkerParams = Annotated[CompassGaitParams, Field(discriminator="model")]
+# One walker model today; a kneed walker or a walker with a torso joins this union with a
+# discriminator on ``model`` (defaulting to "compass_gait" so existing scenes stay valid).
+WalkerParams = CompassGaitParams
 
 
 class SlopeSettings(_Strict):

@@ -171,8 +171,15 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate ({exc})",
                                  float("nan")) from None
     res = float(np.max(np.abs(xn - x)))
+    message = " ".join(str(sol.message).split())
+    step = walker.points(x).get("swing_foot")
+    L = walker.params.get("leg_length_m", 1.0)
+    if step is not None and float(np.linalg.norm(step)) < 1e-3 * L:
+        raise FixedPointNotFound("the root finder went to the trivial standing solution "
+                                 f"(step length {1e3 * float(np.linalg.norm(step)):.2f} mm), "
+                                 "not to a walking gait", res)
     if not sol.success or res > 1e-6:
-        raise FixedPointNotFound(sol.message, res)
+        raise FixedPointNotFound(message, res)
     Jfd, nf2 = fd_jacobian(walker, x, solver, fd_step, max_step_time)
     return FixedPointResult(
         x=x, period_s=period, residual=res,

@@ -81,7 +81,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                 results[variant] = solve_variant(scene, variant)
             except FixedPointNotFound as exc:
                 if variant == scene.ideal.variant:
-                    raise StageError(f"fixedpoint: {exc}") from None
+                    hint = ("; a passive walker needs a downhill slope (slope > 0), level or "
+                            "uphill ground has no passive gait") if scene.slope.phi_rad <= 0 else ""
+                    raise StageError(f"fixedpoint: {exc}{hint}") from None
                 results[variant] = exc
         walker, main = results[scene.ideal.variant]
         guess = fp_cfg.initial_guess.as_array()
