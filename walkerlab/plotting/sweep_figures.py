@@ -150,7 +150,14 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
     a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     im = a2.pcolormesh(xi, yi, wall, shading="nearest", cmap="viridis")
     fig.colorbar(im, ax=a2, label="wall time per point [s]")
-    ylab = _label(y_path)
+    import json
+
+    try:
+        unit_sys = (json.loads(sweep["attrs"]["scene_json"]).get("contact") or {}).get(
+            "unit_system", "mm-kg-s")
+    except (KeyError, ValueError, AttributeError):
+        unit_sys = "mm-kg-s"
+    ylab = _label(y_path).replace("len", "mm" if unit_sys == "mm-kg-s" else "m")
     for ax in (a1, a2):
         ax.set_xticks(xi, [f"{v:g}" for v in xv], fontsize=7)
         ax.set_yticks(yi, [f"{v:.3g}" for v in yv], fontsize=7)
@@ -163,7 +170,7 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
 
 
 _UNITS = {"slope.angle_deg": "slope φ [deg]", "slope.angle_rad": "slope φ [rad]",
-          "contact.stiffness": "contact stiffness k [N/len^e, contact.unit_system]",
+          "contact.stiffness": "contact stiffness k [N/len^e]",
           "contact.mu_static": "static friction μs [-]",
           "contact.mu_dynamic": "dynamic friction μd [-]"}
 

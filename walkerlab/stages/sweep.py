@@ -32,7 +32,7 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
         workers: int = 2, scheduler: str | None = None, resume: bool = False,
         runs_root: str | Path = "runs", name: str | None = None, *,
         options: dict | None = None, chunk_size: int | None = None, progress: bool = True,
-        on_chunk=None) -> Path:
+        on_chunk=None, pool: bool | None = None) -> Path:
     """Sweep ``stage`` over the grid of ``params`` and write one HDF5 artifact.
 
     Parameters
@@ -60,6 +60,8 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
         Show the rich progress bar.
     on_chunk : callable(done, total), optional
         Hook after each chunk is written.
+    pool : bool, optional
+        Force a process pool even with one worker (benchmarks) or forbid it.
 
     Returns
     -------
@@ -81,4 +83,4 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     out = sweep_path(scene, axes, stage, runs_root, name)
     return run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
                      resume=resume, options=options, chunk_size=chunk_size, progress=progress,
-                     on_chunk=on_chunk)
+                     on_chunk=on_chunk, pool=pool)

@@ -181,7 +181,8 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
               workers: int = 2, scheduler=None, resume: bool = False,
               options: dict | None = None, chunk_size: int | None = None,
               progress: bool = True,
-              on_chunk: Callable[[int, int], None] | None = None) -> Path:
+              on_chunk: Callable[[int, int], None] | None = None,
+              pool: bool | None = None) -> Path:
     """Run a sweep and write its artifact (see :mod:`walkerlab.sweep.store`).
 
     Parameters
@@ -208,6 +209,9 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     on_chunk : callable(done_points, total_points), optional
         Called after each chunk is written (raising ``KeyboardInterrupt`` there simulates
         an interruption).
+    pool : bool, optional
+        Force a process pool even for one worker (True) or run in this process (False);
+        default: a pool when ``workers > 1``.
 
     Returns
     -------
@@ -260,7 +264,7 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     try:
         with bar:
             tid = bar.add_task("points", total=n_total, completed=n_done, stats="")
-            for rows in iter_chunk_results(tasks, workers, scheduler):
+            for rows in iter_chunk_results(tasks, workers, scheduler, pool=pool):
                 store.append(rows, values_of)
                 n_done += len(rows)
                 for r in rows:

@@ -1,0 +1,221 @@
+"""Parameter sweeps: parsing, typed outcomes, resume, Dask parity, bifurcation onset."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from walkerlab.config import load_scene
+from walkerlab.stages import sweep as sweep_stage
+from walkerlab.sweep import points as points_mod
+from walkerlab.sweep.outcomes import COLUMNS, OUTCOMES
+from walkerlab.sweep.params import SweepError, apply_point, parse_param
+from walkerlab.sweep.points import evaluate
+from walkerlab.sweep.runner import plan_chunks
+from walkerlab.sweep.store import load_sweep, partial_path
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "configs" / "goswami1996.yaml"
+FAR_STATE = {"swing_angle_rad": -0.33, "stance_angle_rad": 0.22,
+             "swing_rate_rad_per_s": -0.38, "stance_rate_rad_per_s": -0.3}
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_scene(SCENE)
+
+
+@pytest.fixture(scope="module")
+def base(scene):
+    return scene.model_dump(mode="json")
+
+
+def _rows(path):
+    return load_sweep(path)["points"]
+
+
+# ----------------------------------------------------------------------------- parsing
+def test_parse_param_range_inclusive_and_rounded():
+    ax = parse_param("slope.angle_deg=0.5:5:0.05")
+    assert ax.path == "slope.angle_deg" and len(ax) == 91
+    assert ax.values[0] == 0.5 and ax.values[-1] == 5.0 and ax.values[2] == 0.6
+    assert parse_param("x.y=1:0:-0.25").values == (1.0, 0.75, 0.5, 0.25, 0.0)
+    assert parse_param("x.y=0:1:0.3").values == (0.0, 0.3, 0.6, 0.9)  # stop not reached
+    assert parse_param("x.y=0:0.3:0.1").values[-1] == 0.3               # float noise kept
+
+
+def test_parse_param_lists_and_errors():
+    assert parse_param("solver.rtol=1e-3,1e-6").values == (1e-3, 1e-6)
+    assert parse_param("solver.method=RK45, DOP853").values == ("RK45", "DOP853")
+    assert parse_param("simulate.strides=1,2").values == (1, 2)
+    assert parse_param("a.b=true,null").values == (True, None)
+    for bad in ("slope.angle_deg", "=1,2", "a.b=", "a.b=1:2", "a.b=0:1:0", "a.b=1:0:0.1",
+                "a.b=x:1:0.1", "a b=1", "a.b=0:1e9:1e-3"):
+        with pytest.raises(SweepError):
+            parse_param(bad)
+
+
+def test_apply_point_swaps_exclusive_slope_fields(base):
+    b = dict(base, slope={"angle_rad": 0.05, "angle_deg": None})
+    sc = apply_point(b, ["slope.angle_deg"], (2.0,))
+    assert sc.slope.angle_rad is None and math.isclose(sc.slope.phi_rad, math.radians(2.0))
+
+
+def test_plan_chunks_runs_from_scene_value_and_skips_done(base):
+    ax = [parse_param("slope.angle_deg=2:4:0.5"), parse_param("walker.hip_mass_kg=5,10")]
+    chunks = plan_chunks(ax, base)  # scene slope 3 deg -> runs up from 3 and down from 2.5
+    vals = sorted([[v[0] for _, v in c] for c in chunks])
+    assert vals == [[2.5, 2.0], [2.5, 2.0], [3.0, 3.5, 4.0], [3.0, 3.5, 4.0]]
+    idx = {i for c in chunks for i, _ in c}
+    assert idx == set(range(10))
+    left = plan_chunks(ax, base, done={0, 1, 2, 3})
+    assert {i for c in left for i, _ in c} == set(range(4, 10))
+
+
+# ----------------------------------------------------------------------------- outcomes
+def test_bad_value_is_an_invalid_config_row(scene, tmp_path):
+    p = sweep_stage.run(scene, ["walker.leg_mass_from_foot_m=0.5,1.5", "fixedpoint.tolerance=1e-10,1e-3"],
+                        "fixedpoint", workers=1, runs_root=tmp_path, progress=False)
+    rows = _rows(p)
+    assert p.name.startswith("sweep_fixedpoint_") and p.is_file()
+    assert not partial_path(p).exists()
+    out = dict(zip(zip(rows["param/walker.leg_mass_from_foot_m"],
+                       rows["param/fixedpoint.tolerance"]), rows["outcome"]))
+    assert out[(0.5, 1e-10)] == "ok"
+    assert out[(1.5, 1e-10)] == out[(1.5, 1e-3)] == out[(0.5, 1e-3)] == "invalid_config"
+    msg = rows["message"][list(rows["outcome"]).index("invalid_config")]
+    assert "\n" not in msg and ("leg_mass_from_foot_m" in msg or "tolerance" in msg)
+
+
+def test_slope_zero_no_fixed_point_and_past_period_doubling(base):
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (0.0,), 0, None, {})
+    assert row["outcome"] == "no_fixed_point" and np.isfinite(row["residual"])
+    assert row["residual"] > 1e-6
+    row, x = evaluate("fixedpoint", base, ["slope.angle_deg"], (5.0,), 1, None, {})
+    assert row["outcome"] == "ok" and row["stable"] == 0.0
+    assert row["multiplier_0_re"] < -1.0 and abs(row["multiplier_0_im"]) < 1e-12
+    assert x.shape == (4,)
+
+
+def test_far_initial_state_falls(base):
+    b = dict(base, simulate={**base["simulate"], "initial_state": FAR_STATE})
+    row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None, {})
+    assert row["outcome"] == "fall"
+    assert row["fall_leg"] in ("leg1", "leg2") and 0 < row["fall_time_s"] < 5
+    assert row["steps_completed"] == 0
+
+
+def test_max_steps_scuffing_solver_failure_error(base, monkeypatch):
+    row, _ = evaluate("simulate", base, ["simulate.max_step_time_s"], (0.05,), 0, None, {})
+    assert row["outcome"] == "max_steps"
+    b = dict(base, simulate={**base["simulate"], "strides": 1})
+    row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None,
+                      {"scuff_limit_m": 1e-4})
+    assert row["outcome"] == "scuffing" and row["scuff_depth_m"] > 1e-3  # ideal gait dips ~3.6 mm
+    row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None, {})
+    assert row["outcome"] == "ok" and row["steps_completed"] == 2
+    bad = dict(base, simulate={**base["simulate"],
+                               "initial_state": {**FAR_STATE, "swing_rate_rad_per_s": float("nan")}})
+    row, _ = evaluate("simulate", bad, ["slope.angle_deg"], (3.0,), 0, None, {})
+    assert row["outcome"] == "solver_failure" and "finite" in row["message"]
+
+    def boom(*a, **k):
+        raise RuntimeError("kaboom")
+
+    monkeypatch.setitem(points_mod.POINT_FUNCTIONS, "fixedpoint", boom)
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.0,), 0, None, {})
+    assert row["outcome"] == "error" and "kaboom" in row["message"]
+
+
+def test_tolerances_from_1e_3_to_1e_12(base):
+    xs = {}
+    for tol in (1e-3, 1e-6, 1e-9, 1e-12):
+        row, x = evaluate("fixedpoint", base, ["solver.rtol", "solver.atol"], (tol, tol), 0,
+                          None, {})
+        assert row["outcome"] in ("ok", "no_fixed_point"), row["message"]
+        xs[tol] = x if row["outcome"] == "ok" else None
+    assert xs[1e-12] is not None and xs[1e-9] is not None
+    assert np.max(np.abs(xs[1e-9] - xs[1e-12])) < 1e-6
+    if xs[1e-3] is not None:
+        assert np.max(np.abs(xs[1e-3] - xs[1e-12])) < 0.05
+
+
+def test_outcome_columns_declared():
+    assert set(OUTCOMES) >= {"ok", "no_fixed_point", "fall", "scuffing", "solver_failure",
+                             "max_steps", "invalid_config"}
+    assert set(COLUMNS) == {"fixedpoint", "simulate", "contact-sim"}
+
+
+# ----------------------------------------------------------------------------- resume
+def test_resume_after_interruption_keeps_finished_rows(scene, tmp_path):
+    params = ["slope.angle_deg=2.5:3.5:0.5", "walker.hip_mass_kg=8,10"]
+
+    def stop(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sweep_stage.run(scene, params, "fixedpoint", workers=1, runs_root=tmp_path,
+                        name="resume_me", progress=False, on_chunk=stop)
+    final = tmp_path / scene.name / "resume_me.h5"
+    part = partial_path(final)
+    assert part.is_file() and not final.exists()
+    first = _rows(part)
+    n_first = first["index"].size
+    assert 0 < n_first < 6
+    p = sweep_stage.run(scene, params, "fixedpoint", workers=1, runs_root=tmp_path,
+                        name="resume_me", progress=False, resume=True)
+    rows = _rows(p)
+    assert list(rows["index"]) == list(range(6)) and not part.exists()
+    for k, i in enumerate(first["index"]):  # finished rows kept untouched (same wall time)
+        assert rows["wall_time_s"][i] == first["wall_time_s"][k]
+    assert set(rows["outcome"]) == {"ok"}
+    with pytest.raises(KeyboardInterrupt):  # interrupt again, then resume another sweep
+        sweep_stage.run(scene, params, "fixedpoint", workers=1, runs_root=tmp_path,
+                        name="resume_me", progress=False, on_chunk=stop)
+    with pytest.raises(SweepError, match="different sweep"):
+        sweep_stage.run(scene, ["slope.angle_deg=1,2"], "fixedpoint", workers=1,
+                        runs_root=tmp_path, name="resume_me", resume=True, progress=False)
+
+
+# ----------------------------------------------------------------------------- dask
+def test_dask_local_cluster_matches_local_runner(scene, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    params = ["slope.angle_deg=2.5,3,3.5"]
+    p_local = sweep_stage.run(scene, params, "fixedpoint", workers=1, runs_root=tmp_path,
+                              name="local", progress=False)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        p_dask = sweep_stage.run(scene, params, "fixedpoint", scheduler=cluster.scheduler_address,
+                                 runs_root=tmp_path, name="dask", progress=False)
+    a, b = _rows(p_local), _rows(p_dask)
+    assert list(a["outcome"]) == list(b["outcome"]) == ["ok"] * 3
+    for col in COLUMNS["fixedpoint"]:
+        np.testing.assert_array_equal(a[col], b[col], err_msg=col)
+
+
+# ----------------------------------------------------------------------------- bifurcation
+def test_bifurcation_onset_where_multiplier_crosses_minus_one(scene):
+    from walkerlab.sweep.bifurcation import bifurcation_diagram, min_real_multiplier
+
+    res = bifurcation_diagram(scene, [3.5, 4.0, 4.5, 5.0], workers=1, steady_state=False,
+                              xtol_deg=1e-3)
+    m = np.array([min_real_multiplier(z) for z in res.multipliers])
+    lo, hi = res.onset["bracket_deg"]
+    k = int(np.flatnonzero(res.slopes_deg == lo)[0])
+    assert m[k] > -1.0 >= m[k + 1]
+    assert lo < res.onset["onset_deg"] < hi
+    assert abs(res.onset["multiplier_at_onset"] + 1.0) < 1e-2
+    assert all(o == "ok" for o in res.fp_outcome)
+
+
+def test_process_pool_matches_in_process_runner(scene, tmp_path):
+    params = ["slope.angle_deg=2.5,3,3.5"]
+    a = _rows(sweep_stage.run(scene, params, "fixedpoint", workers=1, runs_root=tmp_path,
+                              name="inproc", progress=False))
+    b = _rows(sweep_stage.run(scene, params, "fixedpoint", workers=2, runs_root=tmp_path,
+                              name="pool", progress=False))
+    for col in COLUMNS["fixedpoint"]:
+        np.testing.assert_array_equal(a[col], b[col], err_msg=col)
