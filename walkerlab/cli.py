@@ -186,6 +186,45 @@ def sweep(scene: Path | None = SceneArg,
 
 
 @app.command()
+@_guard
+def bifurcation(scene: Path | None = SceneArg,
+                slopes: str = typer.Option("1:5.5:0.05", "--slopes",
+                                           help="slope grid [deg], start:stop:step or a,b,c"),
+                transient: int = typer.Option(100, "--transient", min=1,
+                                              help="steps discarded before sampling"),
+                keep: int = typer.Option(30, "--keep", min=1, help="heel strikes kept per slope"),
+                workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
+                runs_dir: Path = RunsOpt) -> None:
+    """Bifurcation diagram over the slope: fixed points, multipliers, period-doubling onset."""
+    from walkerlab.sweep.bifurcation import run_bifurcation
+    from walkerlab.sweep.params import parse_param
+
+    axis = parse_param(f"slope.angle_deg={slopes}")
+    out = run_bifurcation(_load(scene), axis.values, runs_dir, transient, keep, workers)
+    typer.echo(f"period-doubling onset: {out['onset_deg']:.4f} deg")
+    typer.echo(f"wrote {out['artifact']} and {', '.join(str(p) for p in out['figures'])}")
+
+
+@app.command("stability-map")
+@_guard
+def stability_map(scene: Path | None = SceneArg,
+                  y: str = typer.Option("contact.stiffness=1e3,1e4,1e5,1e6,1e7,1e8", "--y",
+                                        help="y axis, e.g. contact.stiffness=... (scene units) "
+                                        "or contact.mu_static=..."),
+                  x: str = typer.Option("slope.angle_deg=0.5:3:0.5", "--x",
+                                        help="x axis (slope) [deg]"),
+                  name: str = typer.Option("stability_stiffness", "--name", help="artifact name"),
+                  workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
+                  runs_dir: Path = RunsOpt) -> None:
+    """Stability map of the contact walker: walks / falls / slips / bounces / solver failure."""
+    from walkerlab.sweep.stability import stability_map as smap
+
+    out = smap(_load(scene), y, x, runs_root=runs_dir, name=name, workers=workers)
+    typer.echo(", ".join(f"{k}: {v}" for k, v in out["counts"].items()))
+    typer.echo(f"wrote {out['artifact']}")
+
+
+@app.command()
 def bench(what: str = typer.Argument("all", help="ideal | contact | all"),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""

@@ -257,31 +257,13 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
     n_steps : int
         Steps requested (2 * ``contact_sim.n_strides``).
     """
-    from walkerlab.contact import (ContactSettings, ContactSimSettings, ContactWalker,
-                                   TerrainSettings, initial_state_from_ideal, simulate_contact)
+    from walkerlab.contact import ContactSimSettings
+    from walkerlab.stages.contact_sim import simulate_from
 
+    # one code path with the contact-sim stage (terrain, initial state, solver, end time)
     cs = scene.contact_sim or ContactSimSettings()
-    contact = scene.contact or ContactSettings()
-    terrain = scene.terrain or TerrainSettings()
-    w = scene.walker
-    n_steps = 2 * cs.n_strides
-    cw = ContactWalker.from_settings(contact, terrain, step_length=step_length_m,
-                                     n_steps=n_steps, L=w.leg_length_m, m=w.leg_mass_kg,
-                                     MH=w.hip_mass_kg, a=w.leg_mass_from_foot_m,
-                                     g=w.gravity_m_per_s2, phi=scene.slope.phi_rad)
-    x0 = initial_state_from_ideal(cw, *x_ideal, rate_scale=tuple(cs.initial_rate_scale))
-    t_final = cs.t_final_s if cs.t_final_s is not None else n_steps * ideal_period_s
-    kw: dict = {"method": "odeint", "rtol": 1e-8, "atol": 1e-10}
-    if scene.contact_solver is not None:
-        s = scene.contact_solver
-        kw = {"method": s.method if s.method in ("LSODA", "Radau", "BDF") else "odeint",
-              "rtol": s.rtol, "atol": s.atol}
-        if s.max_step_s is not None:
-            kw["max_step"] = s.max_step_s
-    res = simulate_contact(cw, x0, t_final, sample_rate_hz=cs.sample_rate_hz,
-                           pin_stance_until=cs.pin_stance_until, pin_time_s=cs.pin_time_s,
-                           fall_hip_height_m=cs.fall_hip_height_m, **kw)
-    return cw, res, n_steps
+    cw, res, _, _ = simulate_from(scene, np.asarray(x_ideal, float), ideal_period_s)
+    return cw, res, 2 * cs.n_strides
 
 
 def _contact_events(res) -> tuple[float, int, int, str]:
