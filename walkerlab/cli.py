@@ -208,7 +208,7 @@ def bifurcation(scene: Path | None = SceneArg,
 @app.command("stability-map")
 @_guard
 def stability_map(scene: Path | None = SceneArg,
-                  y: str = typer.Option("contact.stiffness=1e3,1e4,1e5,1e6,1e7,1e8", "--y",
+                  y: str = typer.Option("contact.stiffness=1e3,1e4,1e5,1e6,1e7,1e8,1e9", "--y",
                                         help="y axis, e.g. contact.stiffness=... (scene units) "
                                         "or contact.mu_static=..."),
                   x: str = typer.Option("slope.angle_deg=0.5:3:0.5", "--x",
