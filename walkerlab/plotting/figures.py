@@ -22,7 +22,8 @@ MODEL_STYLES = ["-", "--", ":", "-."]
 
 
 def save(fig, folder: Path, stem: str) -> list[Path]:
-    """Write ``stem.png`` (150 dpi) and ``stem.svg``; close the figure."""
+    """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure."""
+    folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     out = []
     for ext in ("png", "svg"):
@@ -149,7 +150,7 @@ def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
 def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None):
     """Work-precision diagram: error vs wall time (log-log), one line per method."""
     fig, ax = plt.subplots(figsize=(7, 5))
-    for mi, (method, d) in enumerate(rows.items()):
+    for method, d in rows.items():
         ok = np.isfinite(d["error"]) & (d["error"] > 0)
         ax.loglog(d["time"][ok], d["error"][ok], "o-", label=method, ms=4)
         for t, e, tol in zip(d["time"][ok], d["error"][ok], d["rtol"][ok]):

@@ -9,8 +9,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import matplotlib
 
 matplotlib.use("Agg")
@@ -18,6 +16,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
+from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
 from walkerlab.sweep.outcomes import OUTCOMES
 
 OUTCOME_COLORS = {
@@ -26,19 +25,6 @@ OUTCOME_COLORS = {
     "invalid_config": "#c7c7c7", "error": "#8c564b",
 }
 OUTCOME_LABELS = {"ok": "walks (ok)", "fall": "falls", "slip": "slips", "bounce": "bounces"}
-
-
-def save(fig, folder: Path, stem: str) -> list[Path]:
-    """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure."""
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    out = []
-    for ext in ("png", "svg"):
-        p = folder / f"{stem}.{ext}"
-        fig.savefig(p, dpi=150, bbox_inches="tight")
-        out.append(p)
-    plt.close(fig)
-    return out
 
 
 def bifurcation_figure(data: dict, title: str = ""):
