@@ -13,7 +13,7 @@ import typer
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="walkerlab: passive-dynamic biped walkers, from fixed point to report.")
 
-SceneArg = typer.Argument(None, help="scene YAML file [default: configs/paper.yaml]",
+SceneArg = typer.Argument(None, help="scene YAML file (default: configs/paper.yaml, the paper's walker)",
                           show_default=False)
 RunsOpt = typer.Option(Path("runs"), "--runs-dir", help="folder for artifacts (runs/<scene>/)")
 ForceOpt = typer.Option(False, "--force", help="recompute even if the artifact is up to date")
@@ -81,7 +81,7 @@ def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def simulate(scene: Path | None = SceneArg,
              strides: int | None = typer.Option(
                  None, "--strides", min=1, help="strides to simulate (1 stride = 2 steps) "
-                 "[default: simulate.strides of the scene]"),
+                 "(default: simulate.strides of the scene)"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Simulate N strides of the rigid walker from its fixed point (or a given state)."""
     from walkerlab.report.text import simulate_text
