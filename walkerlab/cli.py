@@ -104,14 +104,17 @@ def simulate(scene: Path | None = SceneArg,
 def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                 force: bool = ForceOpt,
                 adjust: bool = typer.Option(False, "--adjust", help="search the initial rates "
-                                            "that make the contact walker match the ideal gait")
+                                            "that make the contact walker match the ideal gait"),
+                periodic: bool = typer.Option(False, "--periodic", help="also find the contact "
+                                              "walker's own periodic gait and its Floquet "
+                                              "multipliers (about 10 s)")
                 ) -> None:
     """Simulate the compliant-contact (MSC ADAMS style) walker on the scene's terrain."""
     from walkerlab.report.text import contact_text
     from walkerlab.stages import contact_sim as stage
 
     sc = _load(scene)
-    out = stage.run(sc, runs_dir, force, adjust=adjust)
+    out = stage.run(sc, runs_dir, force, adjust=adjust, periodic=periodic)
     typer.echo(contact_text(out.path))
     typer.echo(_status(out))
 

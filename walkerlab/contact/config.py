@@ -164,6 +164,10 @@ class ContactSimSettings(BaseModel):
         None, gt=0, description="Fall when hip height above ground < this [m]; default 0.5*L."
     )
     sample_rate_hz: float = Field(1000.0, gt=0, description="Output sample rate [Hz].")
+    periodic_gait: bool = Field(
+        False, description="Also find the contact walker's own periodic gait and its Floquet "
+        "multipliers (walkerlab.contact.periodic; about 5-10 s)."
+    )
     initial_rate_scale: tuple[float, float] = Field(
         (1.0, 1.0), description="Multipliers [-] on dtheta1, dtheta2 of the initial state."
     )

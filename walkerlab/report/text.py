@@ -65,4 +65,12 @@ def contact_text(path: Path) -> str:
             for k in f["summary"]:
                 ds = f["summary"][k]
                 lines.append(f"  {k:<28s} {ds[()]} {ds.attrs.get('unit', '')}")
+        if "periodic_gait" in f:
+            g = f["periodic_gait"]
+            mult = g["multipliers/real"][()] + 1j * g["multipliers/imag"][()]
+            lines.append(f"periodic contact gait: step period {g['step_period'][()]:.6f} s, "
+                         f"step length {g['step_length'][()]:.6f} m, "
+                         f"{'stable' if g['stable'][()] else 'unstable'}")
+            lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
+                         + f" (+{len(mult) - 3} fast contact modes ~0)")
     return "\n".join(lines)

@@ -90,7 +90,7 @@ def named_trajectory(walker, res) -> NamedTrajectory:
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        adjust: bool = False) -> StageOutcome:
+        adjust: bool = False, periodic: bool = False) -> StageOutcome:
     """Simulate the contact walker (optionally after ``--adjust``) and write the artifact.
 
     Raises
@@ -98,10 +98,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         The scene has no ``contact`` section.
     """
-    settings(scene)
+    periodic = periodic or settings(scene)[2].periodic_gait
     fixedpoint_stage.run(scene, runs_root)
     up = (artifact_path(scene, runs_root, "fixedpoint"),)
-    sections = SECTIONS + (("adjust",) if adjust else ())
+    sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())
 
     def compute():
         x_fp, meta = fixedpoint_stage.load_fixed_point(up[0])
@@ -114,6 +114,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             scale = adj["scale"]
         walker, res, x0, step_length = simulate_from(scene, x_fp, meta["step_period_s"], scale)
         tr = named_trajectory(walker, res)
+        gait = None
+        if periodic:
+            from walkerlab.contact.periodic import find_contact_periodic_gait
+
+            gait = find_contact_periodic_gait(walker, x_fp)
         c = walker.contact
         steps = res.steps
         slips = np.array([s.stance_slip_mm for s in steps])
@@ -176,6 +181,20 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             for k, v in summary.items():
                 if k != "termination":
                     put(f, f"summary/{k}", v, units.get(k, "-"), k)
+            if gait is not None:
+                g = f.create_group("periodic_gait")
+                g.attrs["section"] = "mid-stance (legs aligned), stance foot loaded only"
+                for k, v in gait.fixed_point.items():
+                    g.attrs[f"fixed_point_{k}"] = float(v)
+                put(g, "step_period", gait.period_s, "s", "period of the contact gait")
+                put(g, "step_length", gait.step_length_m, "m", "")
+                put(g, "residual", gait.residual, "-", "scaled map residual")
+                put(g, "multipliers/real", gait.multipliers.real, "-", "Floquet multipliers")
+                put(g, "multipliers/imag", gait.multipliers.imag, "-", "")
+                put(g, "multiplier_fd_spread", gait.multiplier_fd_spread, "-",
+                    "change of the multipliers for FD steps x3 and /3")
+                put(g, "stable", bool(gait.stable), "-", "all |multipliers| < 1")
+                put(g, "converged", bool(gait.converged), "-", "residual below tolerance")
             if adj is not None:
                 for k, v in adj.items():
                     if isinstance(v, (int, float, np.ndarray, list, tuple)):

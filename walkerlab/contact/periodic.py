@@ -1,0 +1,439 @@
+"""The compliant-contact walker's own periodic gait: fixed point of a mid-stance step map.
+
+Poincaré section
+----------------
+Mid-stance single support: the legs are aligned, ``theta_swing - theta_stance`` crosses zero
+upward.  In the compliant model a heel strike is not an instant but a double-support phase
+(both feet loaded for ~10 ms), so a touchdown section would cut through an impact transient;
+at mid-stance only the stance foot is loaded and the state is smooth.
+
+Section coordinates (6 = 8 states - section constraint - translation along the slope)::
+
+    z = [theta_stance, dtheta_swing, dtheta_stance,
+         delta_stance, v_t_stance, ddelta_stance]
+
+``theta_swing = theta_stance`` on the section [rad]; rates [rad/s]; ``delta_stance`` is the
+stance foot's penetration [m] (along -n), ``v_t_stance`` its down-slope slip velocity [m/s],
+``ddelta_stance`` its penetration rate [m/s].  The along-slope position of the stance foot is
+dropped (the dynamics are invariant under translation along the slope, see *Terrain*).
+
+Step map
+--------
+``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 =
+stance, leg1 = swing: the legs are identical, so one orientation suffices), integrate with
+``solve_ivp`` (LSODA or Radau with the analytic numba Jacobian) until the next upward zero
+of ``theta2 - theta1`` (mid-stance of the other leg), located by ``solve_ivp``'s event
+root-finding on the dense output; swap the leg roles and express the state relative to the
+new stance foot (leg1).  Outputs besides ``P(z)``: the step period ``T`` [s] and the step
+length (along-slope displacement of the stance foot from one mid-stance to the next) [m].
+
+Terrain (the choice made here, and why)
+---------------------------------------
+*Continuous ground* is not usable at this section: with rigid legs of equal length the swing
+foot is exactly at stance-foot depth when the legs are aligned, i.e. it penetrates the ground
+(foot scuffing) precisely on the section.  *Checkerboard at fixed positions* breaks the
+translation invariance (the gait's steps are ~12 mm shorter than the ideal ones, so footfalls
+drift across the patches).  We therefore use **checkerboard lanes placed relative to the
+current footfall**: during each step the stance lane has one patch centred on the stance
+foot's section position (s = 0) and the swing lane one patch centred one *ideal* step length
+``l`` ahead (the paper's rule: patches around the footfalls of the ideal gait).  The swing
+foot passes over a gap at mid-stance exactly as in the ADAMS model.  The re-centring is
+physically invisible as long as each foot stays inside its patch during its stance (the
+IMPACT force only depends on the patch membership, not on the distance to the centre):
+:func:`find_contact_periodic_gait` reports the worst margin to a patch edge
+(``patch_margin_m``), and the fixed point is then a true periodic gait of a checkerboard
+whose patches are spaced by the gait's own step length.
+
+Floquet multipliers
+-------------------
+Eigenvalues of the 6x6 Jacobian of ``P`` at the fixed point, by central finite differences
+in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the coordinate scale
+(:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1 mm/s, 1 mm/s), with
+the map integrated at rtol 1e-12 / atol 1e-14.  Measured on the paper's contact: the map's
+noise (adaptive-step jitter) is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD
+noise is ~1e-10 / h ~ 1e-6, and the truncation error O(h^2) is ~1e-8; the multipliers
+agree to ~1e-5 between h = 1e-3, 1e-4 and 1e-5 (``multiplier_fd_spread`` reports the
+change for h*3 and h/3).  The three "fast" multipliers (normal contact mode, tangential
+creep of the stance foot, both damped within milliseconds) are ~1e-5..1e-8, i.e. zero
+within the FD noise; the three slow ones belong to the swing dynamics and correspond to the
+ideal model's nonzero multipliers (section-independent for a periodic orbit).
+
+Rigid limit
+-----------
+:func:`rigid_limit_contact` scales the contact towards the ideal model's assumptions
+(stiff, plastic, no slip): ``k -> kappa k``, ``dmax -> kappa^(-1/e) dmax`` (follows the
+penetration), ``cmax -> kappa^(1/(2e)) cmax`` (constant damping ratio of the stance
+contact), ``v_s, v_d -> kappa^(-1/2) v_s, v_d`` (less friction creep) and high friction.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import root
+
+from . import _kernels as K
+from .model import ContactWalker
+
+__all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait",
+           "find_contact_periodic_gait", "section_guess_from_ideal", "rigid_limit_contact"]
+
+SECTION_NAMES = ("theta_stance", "dtheta_swing", "dtheta_stance", "delta_stance",
+                 "v_t_stance", "ddelta_stance")
+SECTION_UNITS = ("rad", "rad/s", "rad/s", "m", "m/s", "m/s")
+
+
+@dataclass
+class ContactPeriodicGait:
+    """Periodic gait of the contact walker (fixed point of the mid-stance step map).
+
+    Attributes
+    ----------
+    z : ndarray (6,)
+        Fixed point in :data:`SECTION_NAMES` order (units :data:`SECTION_UNITS`).
+    fixed_point : dict[str, float]
+        The same, named.
+    period_s : float
+        Step period [s] (mid-stance to mid-stance; equals the heel-strike-to-heel-strike
+        period on a periodic orbit).
+    step_length_m : float
+        Along-slope advance of the stance foot per step [m].
+    residual : float
+        max |(P(z) - z) / scale| (scaled, see :data:`SCALES`) [-].
+    residual_si : ndarray (6,)
+        P(z) - z in SI units.
+    jacobian : ndarray (6, 6)
+        dP/dz in SI (rows/cols in :data:`SECTION_NAMES` order).
+    multipliers : ndarray (6,) complex
+        Floquet multipliers, sorted by decreasing modulus.
+    multiplier_fd_spread : float
+        max change of the slow (|lambda| > 1e-3) sorted multipliers when the FD step is
+        multiplied or divided by 3.
+    stable : bool
+        All |multipliers| < 1.
+    converged : bool
+    message : str
+    nfev : int
+        Step-map evaluations (root finding + Jacobian).
+    patch_margin_m : float
+        Smallest distance [m] of a loaded foot to the edge of its patch on the orbit.
+    full_state : ndarray (8,)
+        Full state at the section (leg2 stance at s = 0).
+    wall_time_s : float
+    info : dict
+        Extra diagnostics (warm-up history, solver settings).
+    """
+
+    z: np.ndarray
+    fixed_point: dict
+    period_s: float
+    step_length_m: float
+    residual: float
+    residual_si: np.ndarray
+    jacobian: np.ndarray
+    multipliers: np.ndarray
+    multiplier_fd_spread: float
+    stable: bool
+    converged: bool
+    message: str
+    nfev: int
+    patch_margin_m: float
+    full_state: np.ndarray
+    wall_time_s: float
+    info: dict = field(default_factory=dict)
+
+    @property
+    def max_multiplier(self) -> float:
+        """Largest |multiplier| [-]."""
+        return float(np.max(np.abs(self.multipliers)))
+
+
+class StepMap:
+    """Mid-stance-to-mid-stance step map of a :class:`ContactWalker`.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        Parameters and contact law; its lanes are replaced by footfall-relative lanes.
+    patch_spacing : float, optional
+        Distance [m] ahead of the stance foot of the swing lane's patch (default: the
+        walker's lane spacing ``lane1[0] - lane2[0]`` if it has lanes, else 0.372 m).
+    method : {"LSODA", "Radau", "BDF"}
+    rtol, atol : float
+        Integrator tolerances (``atol`` well below the penetration ~6e-5 m).
+    t_max : float
+        Give up a step after this time [s].
+    """
+
+    def __init__(self, walker: ContactWalker, patch_spacing: float | None = None,
+                 method: str = "LSODA", rtol: float = 1e-11, atol: float = 1e-13,
+                 t_max: float = 3.0):
+        if patch_spacing is None:
+            if walker.lane1.size and walker.lane2.size:
+                patch_spacing = float(walker.lane1[0] - walker.lane2[0])
+            else:
+                patch_spacing = 0.372
+        self.spacing = float(patch_spacing)
+        self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing]),
+                                          lane2=np.array([0.0]), continuous=False)
+        self.method, self.rtol, self.atol, self.t_max = method, rtol, atol, t_max
+        self.nfev = 0
+        w = self.walker
+        self._P, self._c1, self._c2 = w._P, w.lane1, w.lane2
+        self.n, self.t = w.normal, w.tangent
+
+    # ------------------------------------------------------------------ coordinates
+    def to_state(self, z) -> np.ndarray:
+        """Full state (8,) from section coordinates (leg2 stance, stance foot at s = 0)."""
+        th, wsw, wst, d, vt, dd = np.asarray(z, float)
+        L = self.walker.L
+        p = -d * self.n
+        v = vt * self.t - dd * self.n
+        hip = p - L * np.array([np.sin(th), -np.cos(th)])
+        vh = v - L * np.array([np.cos(th), np.sin(th)]) * wst
+        return np.array([hip[0], hip[1], th, th, vh[0], vh[1], wsw, wst])
+
+    def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
+        """Section coordinates (6,) and along-slope position s [m] of foot ``stance`` (0/1)."""
+        px, py, vx, vy = K.foot_state(np.asarray(x, float), stance, self._P)
+        p, v = np.array([px, py]), np.array([vx, vy])
+        sw = 1 - stance
+        z = np.array([x[2 + stance], x[6 + sw], x[6 + stance], -p @ self.n, v @ self.t,
+                      -v @ self.n])
+        return z, float(p @ self.t)
+
+    # ------------------------------------------------------------------ the map
+    def _rhs(self, t, x):
+        return K.rhs(x, self._P, self._c1, self._c2)
+
+    def _jac(self, t, x):
+        return K.jac(x, self._P, self._c1, self._c2)
+
+    def integrate(self, x0, stance_to_come: int = 0, dense: bool = False):
+        """Integrate from ``x0`` to the next upward zero of theta_sw - theta_st where the
+        new stance leg is ``stance_to_come`` (0 = leg1).  Returns the solve_ivp solution."""
+        ist, isw = 2 + stance_to_come, 3 - stance_to_come
+
+        def mid(t, x):
+            return x[isw] - x[ist]
+
+        mid.terminal = True
+        mid.direction = 1.0
+
+        def fall(t, x):
+            return x[0] * np.sin(self.walker.phi) + x[1] * np.cos(self.walker.phi) - 0.5
+
+        fall.terminal = True
+        fall.direction = -1.0
+        sol = solve_ivp(self._rhs, (0.0, self.t_max), np.asarray(x0, float),
+                        method=self.method, jac=self._jac, rtol=self.rtol, atol=self.atol,
+                        events=[mid, fall], dense_output=dense)
+        self.nfev += 1
+        return sol
+
+    def __call__(self, z):
+        """One step: returns (P(z) (6,), period [s], step length [m]).
+
+        Raises
+        ------
+        RuntimeError
+            The walker fell, or did not reach the next mid-stance within ``t_max``.
+        """
+        sol = self.integrate(self.to_state(z))
+        if sol.status != 1 or sol.t_events[0].size == 0:
+            why = "fell" if sol.t_events[1].size else f"no mid-stance ({sol.message})"
+            raise RuntimeError(f"step map failed: {why}")
+        xe = sol.y_events[0][0]
+        z1, s1 = self.to_section(xe, 0)
+        return z1, float(sol.t_events[0][0]), s1
+
+    def patch_margin(self, z) -> float:
+        """Smallest distance [m] of a loaded foot to its patch edge over one step."""
+        sol = self.integrate(self.to_state(z), dense=True)
+        te = sol.t_events[0][0] if sol.t_events[0].size else sol.t[-1]
+        tt = np.linspace(0.0, te, 2001)
+        X = sol.sol(tt).T
+        cq = self.walker.contact_quantities(X)
+        hw = self.walker.patch_half_width
+        margin = np.inf
+        for leg, c in (("leg1", self.spacing), ("leg2", 0.0)):
+            q = cq[leg]
+            loaded = q["penetration"] > 0
+            near = np.abs(q["s"] - c) <= 2 * hw  # in or next to this leg's patch
+            sel = loaded & near
+            if sel.any():
+                margin = min(margin, float(np.min(hw - np.abs(q["s"][sel] - c))))
+        return margin
+
+
+#: coordinate scales (SI) used for the root finder, the residual and the FD steps; the
+#: penetration scale is replaced by the walker's static penetration at run time.
+SCALES = np.array([1.0, 1.0, 1.0, 6e-5, 1e-3, 1e-3])
+
+
+def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
+    """Section state from an ideal-model post-impact state ``[th_sw, th_st, w_sw, w_st]``.
+
+    The ideal state is placed as :func:`initial_state_from_ideal` does (stance foot leg2 at
+    its static penetration, ``rate_scale`` on the rates) and integrated to the first
+    mid-stance of leg2, where the section coordinates are read.
+    """
+    from .simulate import initial_state_from_ideal
+
+    w = step_map.walker
+    x0 = initial_state_from_ideal(w, *x_ideal, rate_scale=rate_scale)
+    sol = step_map.integrate(x0, stance_to_come=1)
+    if sol.status != 1 or sol.t_events[0].size == 0:
+        raise RuntimeError("the ideal state does not reach mid-stance on the contact model")
+    return step_map.to_section(sol.y_events[0][0], 1)[0]
+
+
+def rigid_limit_contact(walker: ContactWalker, kappa: float, mu_s: float = 2.0,
+                        mu_d: float | None = None) -> ContactWalker:
+    """Copy of ``walker`` with a contact ``kappa`` times stiffer (family in the module doc).
+
+    Parameters
+    ----------
+    kappa : float
+        Stiffness factor [-] (1 keeps k, dmax, cmax, v_s, v_d).
+    mu_s, mu_d : float
+        Friction coefficients [-] (``mu_d`` default ``0.8 mu_s``).
+    """
+    c = walker.contact
+    e = c.e
+    new = dataclasses.replace(
+        c, k=c.k * kappa, dmax=c.dmax * kappa ** (-1.0 / e),
+        cmax=c.cmax * kappa ** (0.5 / e), v_s=c.v_s / np.sqrt(kappa),
+        v_d=c.v_d / np.sqrt(kappa), mu_s=mu_s, mu_d=0.8 * mu_s if mu_d is None else mu_d)
+    return dataclasses.replace(walker, contact=new)
+
+
+def _walker_and_guess(walker_or_scene, guess):
+    if isinstance(walker_or_scene, ContactWalker):
+        return walker_or_scene, guess, None
+    from walkerlab.stages.contact_sim import build
+    from walkerlab.stages.fixedpoint import solve_variant
+
+    scene = walker_or_scene
+    ideal = solve_variant(scene, "derived")[1]
+    walker, _ = build(scene, ideal.x, 2)
+    return walker, (ideal.x if guess is None else guess), ideal
+
+
+def fd_jacobian(F, z, scale, h):
+    """Central-difference Jacobian dF/dz (SI) with steps ``h * scale``."""
+    n = len(z)
+    J = np.empty((n, n))
+    for j in range(n):
+        dz = np.zeros(n)
+        dz[j] = h * scale[j]
+        J[:, j] = (F(z + dz) - F(z - dz)) / (2 * dz[j])
+    return J
+
+
+def _sorted_eig(J):
+    ev = np.linalg.eigvals(J)
+    return ev[np.argsort(-np.abs(ev), kind="stable")]
+
+
+def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 1.0),
+                               warmup_steps: int = 8, xtol: float = 1e-11,
+                               residual_tol: float = 1e-8, fd_step: float = 1e-4,
+                               check_fd: bool = True, method: str = "LSODA",
+                               rtol: float = 1e-11, atol: float = 1e-13,
+                               jac_rtol: float = 1e-12, jac_atol: float = 1e-14,
+                               patch_spacing: float | None = None) -> ContactPeriodicGait:
+    """Periodic gait of the compliant-contact walker and its Floquet multipliers.
+
+    Parameters
+    ----------
+    walker_or_scene : ContactWalker or walkerlab.config.Scene
+        A scene is built into a walker with :func:`walkerlab.stages.contact_sim.build`; then
+        the default guess is its ideal (derived) fixed point.
+    guess : array_like, optional
+        Either a section state (6,) (:data:`SECTION_NAMES`) or an ideal post-impact state (4,)
+        ``[th_swing, th_stance, w_swing, w_stance]`` (role order, as ``solve_variant``).
+    rate_scale : (float, float)
+        Multipliers on the rates of a (4,) guess.
+    warmup_steps : int
+        Steps of the map iterated from the guess before root finding (the gait is stable,
+        so this brings the guess into the Newton basin).
+    xtol : float
+        Relative tolerance of ``scipy.optimize.root`` (hybr) in scaled coordinates.
+    residual_tol : float
+        ``converged`` means the scaled residual is below this [-] (hybr may stop with "not
+        making good progress" once it reaches the map's noise floor, ~1e-9 at rtol 1e-11).
+    fd_step : float
+        Relative central-difference step (times :data:`SCALES`) of the final Jacobian [-]
+        (the root finder's own Jacobians use ``10 * fd_step`` on the cheaper map).
+    check_fd : bool
+        Also compute the multipliers with ``fd_step * 3`` and ``/ 3`` (``multiplier_fd_spread``).
+    method, rtol, atol : integrator settings of the map (``solve_ivp``) while root finding.
+    jac_rtol, jac_atol : tighter tolerances of the map for the final FD Jacobian.
+    patch_spacing : float, optional
+        Swing-patch distance ahead of the stance foot [m]; default the walker's lane spacing.
+
+    Returns
+    -------
+    ContactPeriodicGait
+    """
+    wall = time.perf_counter()
+    walker, guess, ideal = _walker_and_guess(walker_or_scene, guess)
+    P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol)
+    scale = SCALES.copy()
+    scale[3] = walker.static_penetration()
+    guess = np.asarray(guess, float)
+    if guess.size == 4:
+        z = section_guess_from_ideal(P, guess, rate_scale)
+    elif guess.size == 6:
+        z = guess.copy()
+    else:
+        raise ValueError("guess must be a section state (6,) or an ideal state (4,)")
+    hist = []
+    for _ in range(warmup_steps):
+        z1 = P(z)[0]
+        hist.append(float(np.max(np.abs((z1 - z) / scale))))
+        z = z1
+
+    def G(u):
+        return (P(u * scale)[0] - u * scale) / scale
+
+    def dG(u):
+        return fd_jacobian(lambda v: P(v)[0], u * scale, scale, 10 * fd_step) \
+            * scale[None, :] / scale[:, None] - np.eye(6)
+
+    sol = root(G, z / scale, jac=dG, method="hybr", options={"xtol": xtol})
+    zs = sol.x * scale
+    z1, T, ell = P(zs)
+    res_si = z1 - zs
+    PJ = StepMap(walker, patch_spacing, method=method, rtol=jac_rtol, atol=jac_atol)
+    FJ = lambda v: PJ(v)[0]  # noqa: E731
+    J = fd_jacobian(FJ, zs, scale, fd_step)
+    ev = _sorted_eig(J)
+    spread = np.nan
+    if check_fd:
+        ev_lo = _sorted_eig(fd_jacobian(FJ, zs, scale, fd_step / 3))
+        ev_hi = _sorted_eig(fd_jacobian(FJ, zs, scale, fd_step * 3))
+        # compare the slow (|lambda| > 1e-3) multipliers; the fast ones are FD noise
+        slow = np.abs(ev) > 1e-3
+        spread = float(max(np.max(np.abs(ev_lo - ev)[slow], initial=0.0),
+                           np.max(np.abs(ev_hi - ev)[slow], initial=0.0)))
+    margin = P.patch_margin(zs)
+    info = {"warmup_history": hist, "root_message": sol.message, "root_nfev": sol.nfev,
+            "fd_step": fd_step, "scales": scale, "method": method, "rtol": rtol, "atol": atol,
+            "patch_spacing_m": P.spacing}
+    if ideal is not None:
+        info["ideal_period_s"] = ideal.period_s
+        info["ideal_multipliers"] = ideal.multipliers_variational
+    resid = float(np.max(np.abs(res_si / scale)))
+    return ContactPeriodicGait(
+        z=zs, fixed_point=dict(zip(SECTION_NAMES, map(float, zs))), period_s=T,
+        step_length_m=ell, residual=resid, residual_si=res_si, jacobian=J, multipliers=ev,
+        multiplier_fd_spread=spread, stable=bool(np.all(np.abs(ev) < 1)),
+        converged=bool(resid < residual_tol), message=sol.message, nfev=P.nfev + PJ.nfev,
+        patch_margin_m=margin, full_state=P.to_state(zs),
+        wall_time_s=time.perf_counter() - wall, info=info)
