@@ -205,7 +205,7 @@ def rhs_flag(x, P, c1, c2, use_contact):
 @njit(cache=True)
 def jac_flag(x, P, c1, c2, use_contact):
     """:func:`jac` with the contact forces switched on/off."""
-    L, m, MH, b, g, phi = P[0], P[1], P[2], P[3], P[4], P[5]
+    L, m, b, g, phi = P[0], P[1], P[3], P[4], P[5]
     sp, cp = np.sin(phi), np.cos(phi)
     Q = gen_force(x, P, c1, c2, use_contact, use_contact)
     qdd = msolve(x[2], x[3], P, Q)

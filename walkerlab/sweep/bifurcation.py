@@ -160,7 +160,7 @@ def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
             lo, hi = float(slopes_deg[k]), float(slopes_deg[k + 1])
             state = {"guess": x[k], "n": 0}
 
-            def f(s):
+            def f(s, state=state):
                 val, xs = _g(base, s, state["guess"])
                 state["n"] += 1
                 state["guess"] = xs

@@ -18,13 +18,14 @@ import threading
 import time
 import traceback
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from walkerlab.config import Scene, SceneError
-from walkerlab.sweep.outcomes import COLUMNS, STATE_COLS, empty_row
+from walkerlab.sweep.outcomes import STATE_COLS, empty_row
 from walkerlab.sweep.params import apply_point
 
 __all__ = ["Task", "run_chunk", "fixedpoint_point", "simulate_point", "contact_point",

@@ -23,9 +23,10 @@ import math
 import multiprocessing as mp
 import sys
 import time
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -253,8 +254,14 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     tasks = [Task(stage, base, tuple(paths), tuple(c), opts, origin) for c in chunks]
     values_of = dict(enumerate(grid_points(axes)))
     t0 = time.perf_counter()
-    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
-                               TimeElapsedColumn, TimeRemainingColumn)
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     counts = {o: 0 for o in OUTCOMES}
     bar = Progress(TextColumn(f"sweep {stage}"), BarColumn(), MofNCompleteColumn(),

@@ -61,7 +61,7 @@ class SweepStore:
     # ------------------------------------------------------------------ open
     @classmethod
     def create(cls, final: Path, scene, stage: str, axes: list[ParamAxis], options: dict,
-               input_hash: str) -> "SweepStore":
+               input_hash: str) -> SweepStore:
         """Start a new partial file (an old one is overwritten)."""
         final = Path(final)
         final.parent.mkdir(parents=True, exist_ok=True)
@@ -72,7 +72,7 @@ class SweepStore:
             "stage": "sweep", "walkerlab_version": walkerlab.__version__,
             "scene_name": scene.name or "", "scene_json": scene.model_dump_json(),
             "input_hash": input_hash,
-            "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(),
+            "created_utc": _dt.datetime.now(_dt.UTC).isoformat(),
             "wall_time_s": 0.0, "sweep_stage": stage,
             "params_json": json.dumps([[a.path, list(a.values), a.spec] for a in axes]),
             "options_json": json.dumps(options, sort_keys=True, default=str),
@@ -105,7 +105,7 @@ class SweepStore:
 
     @classmethod
     def resume(cls, final: Path, stage: str, axes: list[ParamAxis],
-               input_hash: str) -> tuple["SweepStore", set[int]]:
+               input_hash: str) -> tuple[SweepStore, set[int]]:
         """Reopen a partial file; returns the store and the indices already done.
 
         Raises
