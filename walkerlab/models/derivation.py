@@ -118,17 +118,15 @@ def compass_gait_functions():
     Returns
     -------
     dict
-        ``M(q, p)``, ``C(q, dq, p)``, ``G(q, p)``, ``dM(q, p)`` (n x n x n, dM[i, j, k] =
-        dM_ij/dq_k), ``dCdq`` and ``dCddq`` (derivatives of ``C dq``), ``dG(q, p)``,
-        ``De(q, p)``, ``E(q, p)``, ``kinetic``, ``potential``; ``p = (m, M_H, L, a, g)``.
+        ``M(q, p)``, ``C(q, dq, p)``, ``G(q, p)``, ``De(q, p)``, ``E(q, p)`` and the
+        ``symbolic`` results; ``p = (m, M_H, L, a, g)``.  Derivatives for the variational
+        equations are taken by complex step on these functions, not derived here.
     """
     model = compass_gait_symbolic()
     d = derive(model)
     q, dq = sp.Matrix(model.q), sp.Matrix(model.dq)
     m, mh, L, a, g = sp.symbols("m M_H L a g", positive=True)
     p = (m, mh, L, a, g)
-    h = d.C * dq
-    dM = [[[sp.diff(d.M[i, j], qk) for qk in q] for j in range(len(q))] for i in range(len(q))]
     args_q = (tuple(q), p)
     args_x = (tuple(q), tuple(dq), p)
     lam = lambda args, expr: sp.lambdify(args, expr, modules="numpy", cse=True)  # noqa: E731
@@ -136,14 +134,8 @@ def compass_gait_functions():
         "M": lam(args_q, d.M),
         "C": lam(args_x, d.C),
         "G": lam(args_q, d.G),
-        "dM": lam(args_q, dM),
-        "dh_dq": lam(args_x, h.jacobian(q)),
-        "dh_ddq": lam(args_x, h.jacobian(dq)),
-        "dG": lam(args_q, d.G.jacobian(q)),
         "De": lam(args_q, d.De),
         "E": lam(args_q, d.E),
-        "kinetic": lam(args_x, d.kinetic),
-        "potential": lam(args_q, d.potential),
         "symbolic": d,
     }
 

@@ -9,13 +9,19 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.io.artifacts import open_artifact
+from walkerlab.report.markdown import table as _table
 from walkerlab.stages.common import artifact_path
 
 
-def _table(header, rows):
-    from walkerlab.stages.report import _table as t
+def _default_solver(scene, model: str) -> str:
+    """The scene's solver for ``model`` (contact defaults come from the contact-sim stage)."""
+    if model == "ideal":
+        sv = scene.solver
+    else:
+        from walkerlab.stages.contact_sim import settings
 
-    return t(header, rows)
+        sv = settings(scene)[3]
+    return f"{sv.method} rtol {sv.rtol:.0e}."
 
 
 def workprecision_section(scene, runs_root) -> list[str]:
@@ -39,10 +45,7 @@ def workprecision_section(scene, runs_root) -> list[str]:
                            f"{g.attrs['target_error']:.0e}: **{g.attrs['best_method']} rtol "
                            f"{g.attrs['best_rtol']:.0e}** ({g.attrs['best_time'] * 1e3:.1f} ms, "
                            f"error {g.attrs['best_error']:.1e}). Scene default: "
-                           + (f"{scene.solver.method} rtol {scene.solver.rtol:.0e}."
-                              if model == "ideal" else
-                              f"{(scene.contact_solver.method if scene.contact_solver else 'odeint')}"
-                              f" rtol {(scene.contact_solver.rtol if scene.contact_solver else 1e-8):.0e}."))
+                           + _default_solver(scene, model))
             pm = [str(s) for s in g.attrs.get("pareto_methods", [])]
             pr = list(g.attrs.get("pareto_rtol", []))
             out.append("")

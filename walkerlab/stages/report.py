@@ -7,9 +7,7 @@ ideal-only report, with no empty contact panels.
 
 from __future__ import annotations
 
-import base64
 import datetime as _dt
-import html
 import json
 import platform
 from collections.abc import Callable
@@ -20,6 +18,8 @@ import numpy as np
 import walkerlab
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import open_artifact
+from walkerlab.report.markdown import table as _table
+from walkerlab.report.markdown import to_html as _to_html
 from walkerlab.stages.common import StageOutcome, artifact_path
 from walkerlab.stages.plot import figures_dir
 
@@ -48,17 +48,6 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
         echo(f"{o.stage:>13s}: " + ("reused (inputs unchanged)" if o.reused
                                     else f"computed in {o.wall_time_s:.2f} s") + f" -> {o.path}")
     return done
-
-
-# ------------------------------------------------------------------ markdown helpers
-def _table(header: list[str], rows: list[list]) -> str:
-    def cell(v):
-        if isinstance(v, float):
-            return "—" if not np.isfinite(v) else f"{v:.6g}"
-        return str(v)
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
-    return "\n".join(lines)
 
 
 def _fixedpoint_section(path: Path) -> str:
@@ -102,16 +91,15 @@ def _fixedpoint_section(path: Path) -> str:
                 f"{np.max(np.abs(d[2:])):.4f} rad/s in the rates. Taking the printed y-component "
                 "of A.55 literally (`appendix_a_literal`) does not reproduce Eq. (11) at all, so "
                 "that sign is a typesetting error only.")
-        g = f
-        re, im = g["floquet/variational/real"][()], g["floquet/variational/imag"][()]
-        re2, im2 = g["floquet/finite_difference/real"][()], g["floquet/finite_difference/imag"][()]
+        re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
+        re2, im2 = f["floquet/finite_difference/real"][()], f["floquet/finite_difference/imag"][()]
         out += ["", f"### Floquet multipliers (`{main}`)", "",
                 _table(["#", "variational equations", "finite differences", "abs value"],
                        [[i + 1, f"{a:+.10f}{b:+.10f}j", f"{c:+.10f}{d:+.10f}j",
                          float(np.hypot(a, b))]
                         for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
-                "", f"Max difference between the two: {g['floquet/max_difference'][()]:.2e}. "
-                f"Verdict: **{'stable' if g['floquet/stable'][()] else 'unstable'}** "
+                "", f"Max difference between the two: {f['floquet/max_difference'][()]:.2e}. "
+                f"Verdict: **{'stable' if f['floquet/stable'][()] else 'unstable'}** "
                 "(one multiplier is 0 by construction: the map lands on the heel-strike "
                 "surface)."]
     return "\n".join(out)
@@ -247,61 +235,3 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     html_path = rep_dir / "report.html"
     html_path.write_text(_to_html(text, rep_dir))
     return html_path
-
-
-def _to_html(md: str, base: Path) -> str:
-    """Minimal Markdown -> self-contained HTML (tables, headings, lists, images embedded)."""
-    body = []
-    in_table = in_code = False
-    for line in md.splitlines():
-        if line.startswith("```"):
-            body.append("</pre>" if in_code else "<pre>")
-            in_code = not in_code
-            continue
-        if in_code:
-            body.append(html.escape(line))
-            continue
-        if line.startswith("|"):
-            cells = [c.strip() for c in line.strip("|").split("|")]
-            if set(line.replace("|", "").strip()) <= {"-"}:
-                continue
-            if not in_table:
-                body.append("<table>")
-                in_table = True
-                body.append("<tr>" + "".join(f"<th>{_inline(c)}</th>" for c in cells) + "</tr>")
-            else:
-                body.append("<tr>" + "".join(f"<td>{_inline(c)}</td>" for c in cells) + "</tr>")
-            continue
-        if in_table:
-            body.append("</table>")
-            in_table = False
-        if line.startswith("!["):
-            cap = line[2:line.rindex("](")]
-            src = line[line.rindex("](") + 2:-1]
-            data = base64.b64encode((base / src).read_bytes()).decode()
-            body.append(f'<img alt="{html.escape(cap)}" src="data:image/png;base64,{data}" '
-                        'style="max-width:100%">')
-        elif line.startswith("#"):
-            lvl = len(line) - len(line.lstrip("#"))
-            body.append(f"<h{lvl}>{_inline(line[lvl:].strip())}</h{lvl}>")
-        elif line.startswith("- "):
-            body.append(f"<li>{_inline(line[2:])}</li>")
-        elif line.strip():
-            body.append(f"<p>{_inline(line)}</p>")
-    if in_table:
-        body.append("</table>")
-    style = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}"
-             "table{border-collapse:collapse;font-size:90%}td,th{border:1px solid #ccc;"
-             "padding:3px 6px}pre{background:#f6f6f6;padding:.5em;font-size:80%}")
-    return ("<!doctype html><html><head><meta charset='utf-8'><title>walkerlab report</title>"
-            f"<style>{style}</style></head><body>" + "\n".join(body) + "</body></html>")
-
-
-def _inline(s: str) -> str:
-    import re
-
-    s = html.escape(s)
-    s = re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", s)
-    s = re.sub(r"`(.+?)`", r"<code>\1</code>", s)
-    s = re.sub(r"\*(.+?)\*", r"<i>\1</i>", s)
-    return s

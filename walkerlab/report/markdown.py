@@ -1,0 +1,77 @@
+"""Markdown tables and a minimal Markdown -> self-contained HTML converter for the report."""
+
+from __future__ import annotations
+
+import base64
+import html
+import re
+from pathlib import Path
+
+import numpy as np
+
+
+def table(header: list[str], rows: list[list]) -> str:
+    """A Markdown table; floats shown with 6 significant digits, non-finite as a dash."""
+    def cell(v):
+        if isinstance(v, float):
+            return "—" if not np.isfinite(v) else f"{v:.6g}"
+        return str(v)
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def to_html(md: str, base: Path) -> str:
+    """Minimal Markdown -> self-contained HTML (tables, headings, lists, images embedded)."""
+    body = []
+    in_table = in_code = False
+    for line in md.splitlines():
+        if line.startswith("```"):
+            body.append("</pre>" if in_code else "<pre>")
+            in_code = not in_code
+            continue
+        if in_code:
+            body.append(html.escape(line))
+            continue
+        if line.startswith("|"):
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            if set(line.replace("|", "").strip()) <= {"-"}:
+                continue
+            if not in_table:
+                body.append("<table>")
+                in_table = True
+                body.append("<tr>" + "".join(f"<th>{inline(c)}</th>" for c in cells) + "</tr>")
+            else:
+                body.append("<tr>" + "".join(f"<td>{inline(c)}</td>" for c in cells) + "</tr>")
+            continue
+        if in_table:
+            body.append("</table>")
+            in_table = False
+        if line.startswith("!["):
+            cap = line[2:line.rindex("](")]
+            src = line[line.rindex("](") + 2:-1]
+            data = base64.b64encode((base / src).read_bytes()).decode()
+            body.append(f'<img alt="{html.escape(cap)}" src="data:image/png;base64,{data}" '
+                        'style="max-width:100%">')
+        elif line.startswith("#"):
+            lvl = len(line) - len(line.lstrip("#"))
+            body.append(f"<h{lvl}>{inline(line[lvl:].strip())}</h{lvl}>")
+        elif line.startswith("- "):
+            body.append(f"<li>{inline(line[2:])}</li>")
+        elif line.strip():
+            body.append(f"<p>{inline(line)}</p>")
+    if in_table:
+        body.append("</table>")
+    style = ("body{font-family:sans-serif;max-width:1100px;margin:auto;padding:1em}"
+             "table{border-collapse:collapse;font-size:90%}td,th{border:1px solid #ccc;"
+             "padding:3px 6px}pre{background:#f6f6f6;padding:.5em;font-size:80%}")
+    return ("<!doctype html><html><head><meta charset='utf-8'><title>walkerlab report</title>"
+            f"<style>{style}</style></head><body>" + "\n".join(body) + "</body></html>")
+
+
+def inline(s: str) -> str:
+    s = html.escape(s)
+    s = re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", s)
+    s = re.sub(r"`(.+?)`", r"<code>\1</code>", s)
+    s = re.sub(r"\*(.+?)\*", r"<i>\1</i>", s)
+    return s
