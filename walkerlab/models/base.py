@@ -116,3 +116,45 @@ class HybridWalker:
     def state_names(self) -> list[str]:
         """Role-ordered state names, e.g. ``['swing_angle', 'stance_angle', 'swing_rate', ...]``."""
         return [f"{r}_angle" for r in self.roles] + [f"{r}_rate" for r in self.roles]
+
+    def state_units(self) -> list[str]:
+        """Units of :meth:`state_names` (angles [rad], then rates [rad/s])."""
+        n = self.n_coordinates
+        return ["rad"] * n + ["rad/s"] * n
+
+    def _physical_name(self, role: str, stance_leg: str) -> str:
+        for prefix, leg in self.role_to_leg(stance_leg).items():
+            if role == prefix or role.startswith(prefix + "_"):
+                return leg + role[len(prefix):]
+        return role
+
+    def leg_coordinates(self, X: np.ndarray, stance_leg: str) -> dict[str, np.ndarray]:
+        """Physical named series of a role-ordered state while ``stance_leg`` is in stance.
+
+        Parameters
+        ----------
+        X : ndarray, shape (2n,) or (2n, k)
+        stance_leg : str
+            One of :attr:`legs`.
+
+        Returns
+        -------
+        dict
+            ``<leg>[_<part>]_angle`` [rad] and ``..._rate`` [rad/s] (compass gait:
+            ``leg1_angle``, ``leg2_angle``, ``leg1_rate``, ``leg2_rate``); the keys do not
+            depend on ``stance_leg``; coordinates not on a leg keep their role name.
+        """
+        X = np.asarray(X)
+        n = self.n_coordinates
+        out = {}
+        for i, role in enumerate(self.roles):
+            out[self._physical_name(role, stance_leg) + "_angle"] = X[i]
+        for i, role in enumerate(self.roles):
+            out[self._physical_name(role, stance_leg) + "_rate"] = X[n + i]
+        return out
+
+    @property
+    def coordinate_units(self) -> dict[str, str]:
+        """Unit of each key of :meth:`leg_coordinates`."""
+        names = self.leg_coordinates(np.zeros(2 * self.n_coordinates), self.legs[-1])
+        return {k: ("rad" if k.endswith("_angle") else "rad/s") for k in names}
