@@ -18,6 +18,7 @@ import numpy as np
 import walkerlab
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import open_artifact
+from walkerlab.io.runpaths import atomic_text, report_dir
 from walkerlab.report.markdown import table as _table
 from walkerlab.report.markdown import to_html as _to_html
 from walkerlab.stages.common import StageOutcome, artifact_path
@@ -199,8 +200,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     figs = plot.run(scene, runs_root) if any(
         o.stage in ("simulate", "contact-sim") for o in done) else []
     echo(f"         plot: {len([p for p in figs if p.suffix == '.png'])} figures")
-    rep_dir = Path(runs_root) / (scene.name or "scene") / "report"
-    rep_dir.mkdir(parents=True, exist_ok=True)
+    rep_dir = report_dir(scene, runs_root, claim=True)
     import scipy
 
     md = [f"# walkerlab report — scene `{scene.name}`", "",
@@ -231,7 +231,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     md += ["## Scene", "", "```json", json.dumps(scene.model_dump(mode="json", exclude_none=True),
                                                   indent=1), "```", ""]
     text = "\n".join(md)
-    (rep_dir / "report.md").write_text(text)
+    atomic_text(rep_dir / "report.md", text)
     html_path = rep_dir / "report.html"
-    html_path.write_text(_to_html(text, rep_dir))
+    atomic_text(html_path, _to_html(text, rep_dir))
     return html_path

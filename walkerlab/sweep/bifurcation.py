@@ -341,13 +341,16 @@ def run_bifurcation(scene: Scene, slopes_deg, runs_root: Path | str = "runs",
         ``artifact`` (Path), ``figures`` (list of Path), ``onset_deg`` (float),
         ``wall_time_s`` (float).
     """
+    from walkerlab.io.runpaths import named_artifact
     from walkerlab.plotting.sweep_figures import bifurcation_figure, save
 
+    target = named_artifact(scene, runs_root, name, "--name", claim=True,
+                            allow_stage="bifurcation")
     t0 = time.perf_counter()
     res = bifurcation_diagram(scene, slopes_deg, n_transient, n_keep, workers, scheduler)
     wall = time.perf_counter() - t0
-    folder = Path(runs_root) / (scene.name or "scene")
-    path = write_bifurcation(folder / f"{name}.h5", scene, res, wall)
+    folder = target.parent
+    path = write_bifurcation(target, scene, res, wall)
     w = scene.walker
     title = (f"compass gait m={w.leg_mass_kg:g} kg, M_H={w.hip_mass_kg:g} kg, "
              f"L={w.leg_length_m:g} m, a={w.leg_mass_from_foot_m:g} m")
