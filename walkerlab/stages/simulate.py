@@ -15,7 +15,7 @@ from walkerlab.io.readers import load_fixed_point
 from walkerlab.io.trajectory import write_samples
 from walkerlab.models.registry import build_walker
 from walkerlab.stages import fixedpoint as fixedpoint_stage
-from walkerlab.stages.common import StageOutcome, artifact_path, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, artifact_path, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
 
@@ -27,7 +27,13 @@ def with_strides(scene: Scene, strides: int | None) -> Scene:
     """Scene with ``simulate.strides`` overridden (section created with defaults if absent)."""
     sim = scene.simulate or SimulateSettings()
     if strides is not None:
-        sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+        from pydantic import ValidationError
+
+        try:
+            sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+        except ValidationError as err:
+            raise StageError(f"--strides {strides}: {err.errors()[0]['msg'].lower()} "
+                             "(simulate.strides)") from None
     return scene.model_copy(update={"simulate": sim})
 
 
