@@ -22,7 +22,6 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
     mechanical energy is constant in swing and drops at each heel strike.
     """
     w = traj.walker
-    n = w.n_coordinates
     legs = list(w.legs)
     chunks = {k: [] for k in ("t", "stance", "step", "ke", "pe")}
     ang = {leg: [] for leg in legs}
@@ -35,9 +34,10 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         times = np.append(times, seg.t_end)
         X = seg.sample(times)
         r2l = w.role_to_leg(seg.stance_leg)
-        for i, role in enumerate(w.roles):
-            ang[r2l[role]].append(X[i])
-            rat[r2l[role]].append(X[n + i])
+        lc = w.leg_coordinates(X, seg.stance_leg)  # absolute leg angles, whatever the state
+        for leg in legs:
+            ang[leg].append(lc[f"{leg}_angle"])
+            rat[leg].append(lc[f"{leg}_rate"])
         ke, pe = w.energies(X)
         pe = pe + w.total_mass_kg * g * seg.stance_foot_world[1]
         chunks["t"].append(times)
