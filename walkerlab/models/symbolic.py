@@ -178,14 +178,15 @@ def derive(structure: Structure) -> Equations:
 
     foot = points["swing_foot"]
     V = sp.Integer(0)
-    Mi = sp.zeros(2, 2)
-    Bm = sp.zeros(2, 2)
-    Mp = sp.zeros(2, 2)
+    k = len(psv)  # links (absolute link angles)
+    Mi = sp.zeros(k, k)
+    Bm = sp.zeros(k, k)
+    Mp = sp.zeros(k, k)
     for mass, lin, inertia, psi in bodies:
         # d(position)/d(psi_k) = lin[psi_k] e'(psi_k), and e'(a) . e'(b) = cos(a - b): the
         # inertia matrices come out simplified without a trigonometric simplifier
-        new = {k: lin.get(k, 0) - foot_lin.get(k, 0) for k in psv}  # swing foot at rest
-        a = sp.Matrix([[1 if psi == k else 0 for k in psv]])
+        new = {p_: lin.get(p_, 0) - foot_lin.get(p_, 0) for p_ in psv}  # swing foot at rest
+        a = sp.Matrix([[1 if psi == p_ else 0 for p_ in psv]])
         for i, pi_ in enumerate(psv):
             for j, pj in enumerate(psv):
                 c = sp.cos(pi_ - pj)
@@ -199,12 +200,12 @@ def derive(structure: Structure) -> Equations:
     Mp, Mi, Bm = (X.applyfunc(sp.factor_terms) for X in (Mp, Mi, Bm))
     T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
     G = sp.Matrix([sp.diff(V, s) for s in psv])
-    C = sp.zeros(2, 2)
-    for i in range(2):
-        for j in range(2):
-            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[k]) + sp.diff(Mp[i, k], psv[j])
-                                               - sp.diff(Mp[j, k], psv[i])) * dps[k]
-                          for k in range(2))
+    C = sp.zeros(k, k)
+    for i in range(k):
+        for j in range(k):
+            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[r]) + sp.diff(Mp[i, r], psv[j])
+                                               - sp.diff(Mp[j, r], psv[i])) * dps[r]
+                          for r in range(k))  # Christoffel symbols of the first kind
     if structure.variant == "appendix_a":  # the paper's printed A.5: C[1, 0] sign flipped
         if structure.coordinates != "absolute" or len(structure.bodies) != 1:
             raise ValueError("ideal.variant: appendix_a exists only for the compass gait")
@@ -213,19 +214,19 @@ def derive(structure: Structure) -> Equations:
     M = Mp
     if lim:
         flow, _ = _row_limit(Mp.row_join(C).row_join(G), beta)
-        M, C, G = flow[:, :2], flow[:, 2:4], flow[:, 4]
+        M, C, G = flow[:, :k], flow[:, k:2 * k], flow[:, 2 * k]
         imp, _ = _row_limit(Mi.row_join(Bm), beta)
-        Mi, Bm = imp[:, :2], imp[:, 2:]
+        Mi, Bm = imp[:, :k], imp[:, k:]
         T, V = T.subs(beta, 0), V.subs(beta, 0)
     # to the scene's coordinates: psi = A q + c, dpsi = A dq
     psi_q = sp.Matrix([psi_sw, psi_st])
     A = psi_q.jacobian(qv)
-    sub = {ps_sw: psi_sw, ps_st: psi_st, dps[0]: (A * dqv)[0], dps[1]: (A * dqv)[1]}
-    W = sp.eye(2) if lim else A.T  # keep psi rows in the limit; else Lagrange's rows in q
+    sub = {ps_sw: psi_sw, ps_st: psi_st, **{d: e for d, e in zip(dps, A * dqv)}}
+    W = sp.eye(k) if lim else A.T  # keep psi rows in the limit; else Lagrange's rows in q
     M, C, G = (W * M * A).subs(sub), (W * C * A).subs(sub), (W * G).subs(sub)
     Mi, Bm = (W * Mi * A).subs(sub), (W * Bm * A).subs(sub)
     T, V = T.subs(sub), V.subs(sub)
-    points = {k: v.subs(sub) for k, v in points.items()}
+    points = {name: v.subs(sub) for name, v in points.items()}
     hip, foot = points["hip"], points["swing_foot"]
     bodies = [(m_, _pos(lin).subs(sub), i_, psi.subs(sub)) for m_, lin, i_, psi in bodies]
 
