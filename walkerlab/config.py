@@ -232,20 +232,48 @@ class ContactSolverSettings(_Strict):
 
 
 class StateSpec(_Strict):
-    """A compass-gait state right after heel strike, by role (Eq. 1: swing, stance)."""
+    """A walker state right after heel strike, by state name with its unit:
+    ``<role>_angle_rad`` and ``<role>_rate_rad_per_s`` for each role of the walker (compass
+    gait, Eq. 1: ``swing_angle_rad, stance_angle_rad, swing_rate_rad_per_s,
+    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``)."""
 
-    swing_angle_rad: float = Field(description="theta_1, swing-leg angle from vertical [rad]")
-    stance_angle_rad: float = Field(description="theta_2, stance-leg angle from vertical [rad]")
-    swing_rate_rad_per_s: float = Field(description="dtheta_1 [rad/s]")
-    stance_rate_rad_per_s: float = Field(description="dtheta_2 [rad/s]")
+    model_config = ConfigDict(extra="allow", frozen=True)
 
-    def as_array(self):
+    @model_validator(mode="after")
+    def _named_finite(self) -> StateSpec:
+        import re
+
+        for k, v in (self.model_extra or {}).items():
+            if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
+                raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
+                                 "<role>_rate_rad_per_s)")
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ValueError(f"{k}: must be a finite number")
+        if not self.model_extra:
+            raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
+        return self
+
+    def as_array(self, state_names: list[str] | None = None):
+        """State (2n,) in the order of ``state_names`` (a walker's ``state_names()``; default:
+        the compass gait's ``swing_angle, stance_angle, swing_rate, stance_rate``).
+
+        Raises
+        ------
+        ValueError
+            A state of the walker is missing, or a given name is not one of its states.
+        """
         import numpy as np
 
-        return np.array(
-            [self.swing_angle_rad, self.stance_angle_rad,
-             self.swing_rate_rad_per_s, self.stance_rate_rad_per_s]
-        )
+        names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
+        keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
+        given = dict(self.model_extra or {})
+        missing = [k for k in keys if k not in given]
+        extra = [k for k in given if k not in keys]
+        if missing or extra:
+            raise ValueError(f"state must give exactly {keys}" +
+                             (f"; missing {missing}" if missing else "") +
+                             (f"; unknown {extra}" if extra else ""))
+        return np.array([float(given[k]) for k in keys])
 
 
 class FixedPointSettings(_Strict):

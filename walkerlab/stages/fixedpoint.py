@@ -32,7 +32,11 @@ def solve_variant(scene: Scene, variant: str):
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
     walker = build_walker(sc)
     fp = require(scene, "fixedpoint", "fixedpoint")
-    res = find_fixed_point(walker, fp.initial_guess.as_array(), Solver.from_settings(scene.solver),
+    try:
+        guess = fp.initial_guess.as_array(walker.state_names())
+    except ValueError as exc:
+        raise StageError(f"fixedpoint.initial_guess: {exc}") from None
+    res = find_fixed_point(walker, guess, Solver.from_settings(scene.solver),
                            xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
     return walker, res
 
@@ -87,7 +91,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                     raise StageError(f"fixedpoint: {exc}{hint}") from None
                 results[variant] = exc
         walker, main = results[scene.ideal.variant]
-        guess = fp_cfg.initial_guess.as_array()
+        guess = fp_cfg.initial_guess.as_array(walker.state_names())
 
         def writer(f):
             f.attrs["model"] = walker.name

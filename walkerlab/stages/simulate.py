@@ -61,7 +61,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         if sim.initial_state == "fixed_point":
             x0, _ = load_fixed_point(upstream[0])
         else:
-            x0 = sim.initial_state.as_array()
+            try:
+                x0 = sim.initial_state.as_array(walker.state_names())
+            except ValueError as exc:
+                raise StageError(f"simulate.initial_state: {exc}") from None
         traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
                               max_step_time=sim.max_step_time_s)
         samples = sample_trajectory(traj, sim.sample_rate_hz)

@@ -117,7 +117,7 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
     walker = build_walker(scene)
     solver = _solver(scene)
     tries = ([("neighbour", np.asarray(guess, float))] if guess is not None else []) \
-        + [("scene", fp.initial_guess.as_array())]
+        + [("scene", fp.initial_guess.as_array(walker.state_names()))]
     best, msg = math.inf, ""
     for source, g in tries:
         try:
@@ -217,7 +217,7 @@ def simulate_point(scene: Scene, guess, options: dict):
         cols["guess_source"] = source
     else:
         walker = build_walker(scene)
-        x0 = sim.initial_state.as_array()
+        x0 = sim.initial_state.as_array(walker.state_names())
     cols.update(_state_columns(walker, x0, "x0_"))
     traj = simulate_steps(walker, x0, 2 * sim.strides, _solver(scene),
                           max_step_time=sim.max_step_time_s)
