@@ -337,7 +337,7 @@ def bifurcation_section(paths: dict[str, Path]) -> list[str]:
     if p is None:
         return []
     with open_artifact(p, "bifurcation") as f:
-        onset = float(f["onset/slope"][()])
+        onset = float(f["onset/onset_slope"][()])
         slopes = f["slope"][()]
         per = f["steady_state/attractor_period"][()]
     text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
