@@ -122,9 +122,9 @@ def test_samples_artifact_and_figures_name_the_torso(walker, fixed_point, scene,
     traj = simulate_steps(walker, walker.from_section(walker.section(x0)), 4,
                           Solver("DOP853", 1e-10, 1e-10))
     tr = sample_trajectory(traj, 200)
-    assert list(tr.coordinates) == ["leg1_angle", "leg2_angle", "torso_angle", "leg1_rate",
-                                    "leg2_rate", "torso_rate"]
-    assert tr.phase_pairs()[2] == ("torso_angle", "torso_rate")
+    assert set(tr.coordinates) == {"leg1_angle", "leg2_angle", "torso_angle", "leg1_rate",
+                                   "leg2_rate", "torso_rate"}
+    assert ("torso_angle", "torso_rate") in tr.phase_pairs() and len(tr.phase_pairs()) == 3
     assert "torso_top" in tr.points and {"leg1_foot", "leg2_foot"} <= set(tr.points)
     # leg names swap roles at heel strike: leg1's angle is continuous through the impact
     # (the angle does not jump), while the role-ordered swing angle would
