@@ -21,16 +21,22 @@ ROOT = Path(__file__).resolve().parents[1]
 K, C, TORSO_M = 40.0, 8.0, 0.3  # spring [1/s^2], damping [1/s], drawn torso length [m]
 
 
-def _csj(fun, x, h=1e-30):
-    x = np.asarray(x, float)
-    return np.stack([np.imag(fun(x + 1j * h * e)) / h for e in np.eye(x.size)], axis=1)
+IDX = [0, 1, 3, 4]  # compass-gait rows of the test state [swing, stance, torso, rates...]
+
+
+def _embed(J4: np.ndarray, torso: np.ndarray) -> np.ndarray:
+    """6x6 Jacobian from the compass-gait 4x4 one and the torso's own 2x2 block."""
+    J = np.zeros((6, 6))
+    J[np.ix_(IDX, IDX)] = J4
+    J[np.ix_([2, 5], [2, 5])] = torso
+    return J
 
 
 def torso_walker(cg: HybridWalker) -> HybridWalker:
     """Compass gait ``cg`` with a passive, damped, massless torso coordinate (test model)."""
     def sub(x):  # the compass-gait part of [swing, stance, torso, rates...]
         x = np.asarray(x)
-        return x[[0, 1, 3, 4]]
+        return x[IDX]
 
     def flow_of(f4):
         def flow(t, x):
@@ -62,7 +68,7 @@ def torso_walker(cg: HybridWalker) -> HybridWalker:
         return np.array([x4[0], x4[1], z[3], x4[2], x4[3], z[4]])
 
     def variational(t, x):
-        return _csj(lambda z: phases[0].flow(t, z), x)
+        return _embed(cg.variational(t, sub(x)), np.array([[0.0, 1.0], [-K, -C]]))
 
     return HybridWalker(
         name="compass_with_torso", variant="test", roles=("swing", "stance", "torso"),
@@ -70,7 +76,8 @@ def torso_walker(cg: HybridWalker) -> HybridWalker:
         energies=lambda X: cg.energies(sub(X)), points=points, section=section,
         from_section=from_section, role_to_leg=cg.role_to_leg,
         total_mass_kg=cg.total_mass_kg, slope_rad=cg.slope_rad, params=dict(cg.params),
-        variational=variational, reset_jacobian=lambda x: _csj(reset, x),
+        variational=variational,
+        reset_jacobian=lambda x: _embed(cg.reset_jacobian(sub(x)), np.eye(2)),
         heel_strike_guard=lambda t, x: cg.heel_strike_guard(t, sub(x)))
 
 
