@@ -16,7 +16,7 @@ import numpy as np
 from walkerlab.analysis.tables import TABLE3_ROWS, table3
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.readers import load_fixed_point
-from walkerlab.report.markdown import details, num, table
+from walkerlab.report.markdown import details, num, printed, table
 
 
 # --------------------------------------------------------------------------- data
@@ -71,7 +71,7 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
                        f"|Floquet multiplier| {num(meta['max_abs_multiplier'])}).")
         eq = dict(zip(getattr(pub, "EQ11_NAMES", ()), getattr(pub, "EQ11_STATE", ())))
         for n, v, u in zip(meta["state_names"], x, meta["state_units"]):
-            rows.append([f"fixed point {n}", u, num(v), num(eq[n]) if n in eq else "—"])
+            rows.append([f"fixed point {n}", u, num(v), printed(eq[n]) if n in eq else "—"])
         rows.append(["step period", "s", num(meta["step_period_s"]), "—"])
         rows.append(["max abs(multiplier)", "-", num(meta["max_abs_multiplier"]), "—"])
     elif "fixedpoint" not in paths and scene.fixedpoint is not None:
@@ -101,13 +101,13 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
         t3 = getattr(pub, "TABLE3", {})
         for key in ("t_cycle_s", "v_com_m_per_s"):
             name, _sym, unit = TABLE3_ROWS[key]
-            rows.append([name, unit, num(ideal[key]), num(t3[key][0]) if key in t3 else "—"])
+            rows.append([name, unit, num(ideal[key]), printed(t3[key][0]) if key in t3 else "—"])
         if "E_avg_J" in t3:
             rows.append(["average mechanical energy, PE from the stance foot", "J",
-                         num(ideal.get("E_avg_stance_frame_J", np.nan)), num(t3["E_avg_J"][0])])
+                         num(ideal.get("E_avg_stance_frame_J", np.nan)), printed(t3["E_avg_J"][0])])
         step_pub = getattr(pub, "STEP_LENGTH_M", None)
         rows.append(["step length", "m", num(ideal["step_length_m"]),
-                     num(step_pub) if step_pub is not None else "—"])
+                     printed(step_pub) if step_pub is not None else "—"])
     out += bullets
     if rows:
         header = ["quantity", "unit", "ours"]
@@ -134,7 +134,7 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
         main = str(f.attrs["variant"])
         rows = []
         if eq is not None and eq.size == len(names):
-            rows.append([f"{pub.SHORT} Eq. (11) (printed)", *[num(v) for v in eq], "—", "—",
+            rows.append([f"{pub.SHORT} Eq. (11) (printed)", *[printed(v) for v in eq], "—", "—",
                          "—"])
         fps = {}
         for v in f["variants"]:
@@ -199,13 +199,13 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
     header += list(cols)
     rows = []
     for key, (name, sym, unit) in TABLE3_ROWS.items():
-        pubv = [num(v) for v in t3[key]] if t3 else []
+        pubv = [printed(v) for v in t3[key]] if t3 else []
         rows.append([name, sym, unit, *pubv, *(num(c[key]) for c in cols.values())])
     blank = ["", ""] if t3 else []
     rows.append(["Average mechanical energy, PE from the current stance foot", "E_avg'", "J",
                  *blank, *(num(c.get("E_avg_stance_frame_J", np.nan)) for c in cols.values())])
     step_pub = getattr(pub, "STEP_LENGTH_M", None)
-    rows.append(["Step length", "Δx", "m", *([num(step_pub)] * 2 if t3 else []),
+    rows.append(["Step length", "Δx", "m", *([printed(step_pub)] * 2 if t3 else []),
                  *(num(c["step_length_m"]) for c in cols.values())])
     title = "## Table 3 — gait characteristics" if t3 else "## Gait characteristics"
     out = [title, "", "Recomputed from the trajectory artifacts ("
@@ -222,20 +222,20 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
         out += ["", "**Differences from the published Table 3, measured:**", "",
                 f"- *Left/right step periods.* A period-1 gait has identical steps: ours are "
                 f"{num(ideal['t_left_s'])} s and {num(ideal['t_right_s'])} s. The published "
-                f"{num(t3['t_left_s'][0])} s and {num(t3['t_right_s'][0])} s cannot both belong "
-                f"to the period-1 fixed point of Eq. (11); their sum {num(t3['t_cycle_s'][0])} s "
+                f"{printed(t3['t_left_s'][0])} s and {printed(t3['t_right_s'][0])} s cannot both belong "
+                f"to the period-1 fixed point of Eq. (11); their sum {printed(t3['t_cycle_s'][0])} s "
                 f"is within {num(abs(t3['t_cycle_s'][0] - ideal['t_cycle_s']), 2)} s of our "
                 f"cycle period {num(ideal['t_cycle_s'])} s.",
                 f"- *Step length Δx.* Eq. (11) itself implies Δx = 2 L sin((θ2 − θ1)/2) = "
                 f"{num(dx_eq11)} m (ours: {num(ideal['step_length_m'])} m), about "
-                f"{dx_eq11 / step_pub:.0f}× the printed {num(step_pub)} m. With the printed Δx "
-                f"the speed formula gives {num(step_pub)}/{num(t3['t_cycle_s'][0])} = "
+                f"{dx_eq11 / step_pub:.0f}× the printed {printed(step_pub)} m. With the printed Δx "
+                f"the speed formula gives {printed(step_pub)}/{printed(t3['t_cycle_s'][0])} = "
                 f"{num(step_pub / t3['t_cycle_s'][0])} m/s, the printed v_com; the walker "
                 f"actually advances at {num(ideal['v_com_m_per_s'])} m/s (hip displacement over "
                 "whole cycles / time).",
                 f"- *Energy.* With the potential energy measured from the current stance foot "
                 f"we get E_avg' = {num(e_st)} J, within {num(abs(e_pub - e_st), 2)} J of the "
-                f"printed {num(e_pub)} J; measured from a fixed datum (first stance foot) the "
+                f"printed {printed(e_pub)} J; measured from a fixed datum (first stance foot) the "
                 f"average over 5 steps is {num(ideal['E_avg_J'])} J because the walker descends "
                 f"the {num(scene.slope.phi_rad)} rad slope by Δx sin φ per step."]
     out.append("")
