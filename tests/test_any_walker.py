@@ -100,9 +100,9 @@ def fixed_point(walker, scene):
     from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import find_fixed_point
 
-    g = scene.fixedpoint.initial_guess
-    guess = [g.swing_angle_rad, g.stance_angle_rad, 0.05, g.swing_rate_rad_per_s,
-             g.stance_rate_rad_per_s, 0.0]
+    g = dict(zip(["swing_angle", "stance_angle", "swing_rate", "stance_rate"],
+                 scene.fixedpoint.initial_guess.as_array()))
+    guess = [g["swing_angle"], g["stance_angle"], 0.05, g["swing_rate"], g["stance_rate"], 0.0]
     return find_fixed_point(walker, guess, Solver("DOP853", 1e-10, 1e-10), xtol=1e-11)
 
 
