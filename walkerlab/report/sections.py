@@ -35,6 +35,35 @@ def energy_drift_in_swing(path: Path) -> tuple[float, float]:
     return drift, drift / float(np.max(np.abs(tot)))
 
 
+def swing_foot_clearance(path: Path, slope_rad: float, margin: float = 0.1) -> float:
+    """Lowest height [m] of the swing foot above the slope inside the steps of ``simulate.h5``.
+
+    Heights are normal to the slope through the first stance foot; the first and last
+    ``margin`` of each step (lift-off, heel strike, where the height is ~0) are left out.
+    A negative value means the foot passes through the ground (scuffing, which the rigid
+    model ignores).  Round feet use the ``<leg>_contact`` point when the walker has one.
+    """
+    from walkerlab.io.trajectory import read_samples
+
+    with open_artifact(path, "simulate") as f:
+        tr = read_samples(f)
+    lowest = np.inf
+    for k in np.unique(tr.step_index):
+        m = tr.step_index == k
+        t = tr.time[m]
+        inner = (t > t[0] + margin * (t[-1] - t[0])) & (t < t[-1] - margin * (t[-1] - t[0]))
+        swing = tr.legs[1 - int(tr.stance_leg[m][0])] if len(tr.legs) == 2 else None
+        if swing is None or not inner.any():
+            continue
+        foot = tr.points.get(f"{swing}_contact", tr.points.get(f"{swing}_foot"))
+        if foot is None:
+            continue
+        xy = foot[:, m][:, inner]
+        h = xy[1] * np.cos(slope_rad) + xy[0] * np.sin(slope_rad)
+        lowest = min(lowest, float(np.min(h)))
+    return lowest
+
+
 def _contact_summary(path: Path) -> dict:
     with open_artifact(path, "contact-sim") as f:
         out = {"termination": str(f.attrs["termination"]),
@@ -89,6 +118,13 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
                        f"({n_hs} heel strikes, ended by {term}); energy drift in swing "
                        f"{num(drift, 2)} J ({num(rel, 2)} relative).")
         rows.append(["energy drift in swing", "J", num(drift, 2), "—"])
+        clear = swing_foot_clearance(sim, scene.slope.phi_rad)
+        if np.isfinite(clear):
+            verdict = ("no scuffing" if clear > 0 else "the swing foot passes through the "
+                       "ground (scuffing), which the rigid model ignores")
+            bullets.append(f"- **Swing-foot clearance**: lowest {num(1e3 * clear, 3)} mm above "
+                           f"the slope inside the steps: {verdict}.")
+            rows.append(["lowest swing-foot clearance", "mm", num(1e3 * clear, 3), "—"])
     if "contact-sim" in paths:
         c = _contact_summary(paths["contact-sim"])
         walks = c["termination"] != "fall" and c["heel_strikes"] > 0
