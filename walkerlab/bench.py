@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.published import paper
+
 
 def _machine() -> dict:
     return {"machine": platform.machine(), "processor": platform.processor(),
@@ -36,7 +38,7 @@ def bench_ideal(repeats: int = 5) -> dict:
     fp_t, sim_t = [], []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        fp = find_fixed_point(w, np.array([-0.2022, 0.1674, -0.60, -0.84]), sv)
+        fp = find_fixed_point(w, np.array(paper.EQ11_STATE), sv)
         fp_t.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
         tr = simulate_steps(w, fp.x, 10, sv)

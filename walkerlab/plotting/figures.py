@@ -109,7 +109,8 @@ def fig9_limit_cycle(trajs: dict[str, NamedTrajectory]):
     pairs = next(iter(trajs.values())).phase_pairs()
     ncol = min(3, len(pairs))
     nrow = -(-len(pairs) // ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(5 * ncol, 4.5 * nrow), squeeze=False)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5 * ncol, 4.5 * nrow), squeeze=False,
+                             layout="constrained")
     for mi, (label, tr) in enumerate(trajs.items()):
         for k, (a, r) in enumerate(pairs):
             if a in tr.coordinates and r in tr.coordinates:

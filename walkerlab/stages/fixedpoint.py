@@ -16,11 +16,13 @@ from walkerlab.io.readers import load_fixed_point  # noqa: F401  (re-exported fo
 from walkerlab.models.registry import build_walker
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
-SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
+SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
 
 
 def _variants_for(scene: Scene) -> tuple[str, ...]:
-    if scene.walker.model == "compass_gait":
+    """The scene's equation variant, plus the compass gait's other variants when the scene
+    is compared with published numbers (they explain the difference from Eq. 11)."""
+    if scene.walker.model == "compass_gait" and scene.published is not None:
         from walkerlab.models.compass_gait import VARIANTS
 
         return VARIANTS

@@ -31,6 +31,7 @@ import h5py
 import numpy as np
 
 import walkerlab
+from walkerlab.io import netcdf
 from walkerlab.sweep.outcomes import OUTCOMES, STRING_COLUMNS, walker_columns
 from walkerlab.sweep.params import ParamAxis, SweepError
 
@@ -203,6 +204,7 @@ class SweepStore:
         ds = f.create_dataset("summary/outcome_counts", data=counts)
         ds.attrs.update(outcomes=list(OUTCOMES), unit="-", description="points per outcome")
         f.attrs["complete"] = True
+        netcdf.finish_sweep(f)
         f.close()
         os.replace(partial_path(self.final), self.final)
         return self.final
