@@ -14,9 +14,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import root
-
-from walkerlab.analysis.hybrid import Solver, integrate_step
+from walkerlab.analysis.hybrid import Solver, integrate_step, numeric_jacobian
 from walkerlab.models.base import HybridWalker
 
 
@@ -129,15 +127,29 @@ class FixedPointResult:
 
 
 def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xtol: float = 1e-12,
-                     fd_step: float = 1e-7, max_step_time: float = 5.0) -> FixedPointResult:
+                     fd_step: float = 1e-7, max_step_time: float = 5.0,
+                     fd_check: bool = True) -> FixedPointResult:
     """Find the period-1 fixed point of the Poincaré map and its Floquet multipliers.
+
+    The root finder is MINPACK's ``hybrj`` (``scipy.optimize.root``, method ``hybr``) on the
+    map reduced to the section, ``F(z) = section(P(from_section(z))) - z``, with the
+    Jacobian ``DF = D section . DP . D from_section - I`` from the variational equations
+    (asked for only when hybrj needs a fresh one; rank-1 updates in between).  The map and
+    its Jacobian at the last iterate are reused for the result when the root finder ended
+    there.
 
     Parameters
     ----------
     guess : ndarray, shape (2n,)
         Initial guess (projected on the guard surface through ``walker.section``).
     xtol : float
-        ``scipy.optimize.root`` (MINPACK hybrd) relative tolerance.
+        ``scipy.optimize.root`` (MINPACK hybrj) relative tolerance.
+    fd_step : float
+        Step of the central finite-difference check of ``DP``.
+    fd_check : bool
+        Also compute ``DP`` by finite differences (``2 * 2n`` more map evaluations) and
+        its multipliers, as an independent check of the variational equations.  Without it
+        ``multipliers_fd``/``jacobian_fd`` are NaN.
 
     Returns
     -------
@@ -148,28 +160,48 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     FixedPointNotFound
         The root finder did not converge, or the map failed (fall) near the guess.
     """
+    from scipy.optimize import root
+
     t0 = time.perf_counter()
     counter = {"nfev": 0, "calls": 0}
+    memo: dict = {}
 
     def residual(z):
         x = walker.from_section(z)
+        counter["calls"] += 1
         try:
-            xn, _, nf = poincare_map(walker, x, solver, max_step_time)
+            xn, period, nf = poincare_map(walker, x, solver, max_step_time)
         except StepFailed:
-            counter["calls"] += 1
             return np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
         counter["nfev"] += nf
-        counter["calls"] += 1
         return walker.section(xn) - z
 
-    sol = root(residual, walker.section(np.asarray(guess, float)), method="hybr",
+    def jacobian(z):
+        x = walker.from_section(z)
+        counter["calls"] += 1
+        try:
+            xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True)
+        except StepFailed:
+            return -np.eye(z.size)
+        counter["nfev"] += nf
+        memo["last"] = (np.array(z, float), xn, period, DP)
+        Ds = numeric_jacobian(walker.section, xn)
+        Dfs = numeric_jacobian(walker.from_section, np.asarray(z, float))
+        return Ds @ DP @ Dfs - np.eye(z.size)
+
+    sol = root(residual, walker.section(np.asarray(guess, float)), jac=jacobian, method="hybr",
                options={"xtol": xtol})
     x = walker.from_section(sol.x)
-    try:
-        xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True)
-    except StepFailed as exc:
-        raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate ({exc})",
-                                 float("nan")) from None
+    last = memo.get("last")
+    if last is not None and np.array_equal(last[0], sol.x):
+        xn, period, DP = last[1:]
+    else:
+        try:
+            xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True)
+        except StepFailed as exc:
+            raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate ({exc})",
+                                     float("nan")) from None
+        counter["nfev"] += nf
     res = float(np.max(np.abs(xn - x)))
     message = " ".join(str(sol.message).split())
     step = walker.points(x).get("swing_foot")
@@ -180,11 +212,16 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
                                  "not to a walking gait", res)
     if not sol.success or res > 1e-6:
         raise FixedPointNotFound(message, res)
-    Jfd, nf2 = fd_jacobian(walker, x, solver, fd_step, max_step_time)
+    if fd_check:
+        Jfd, nf2 = fd_jacobian(walker, x, solver, fd_step, max_step_time)
+        mult_fd = sort_multipliers(np.linalg.eigvals(Jfd))
+    else:
+        Jfd, nf2 = np.full_like(DP, np.nan), 0
+        mult_fd = np.full(DP.shape[0], np.nan + 0j)
     return FixedPointResult(
         x=x, period_s=period, residual=res,
         multipliers_variational=sort_multipliers(np.linalg.eigvals(DP)),
-        multipliers_fd=sort_multipliers(np.linalg.eigvals(Jfd)),
-        jacobian_variational=DP, jacobian_fd=Jfd, nfev=counter["nfev"] + nf + nf2,
-        iterations=counter["calls"], wall_time_s=time.perf_counter() - t0,
+        multipliers_fd=mult_fd, jacobian_variational=DP, jacobian_fd=Jfd,
+        nfev=counter["nfev"] + nf2, iterations=counter["calls"],
+        wall_time_s=time.perf_counter() - t0,
     )
