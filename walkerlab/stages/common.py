@@ -34,10 +34,13 @@ def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
 
 
 def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
-               upstream: tuple[Path, ...] = ()) -> str:
-    """Content hash of everything a stage's output depends on."""
+               upstream: tuple[Path, ...] = (), salt: str = "") -> str:
+    """Content hash of everything a stage's output depends on (``salt``: stage options
+    that are not scene sections, e.g. which extra results were asked for)."""
     h = hashlib.sha256()
     h.update(stage.encode())
+    if salt:
+        h.update(salt.encode())
     h.update(scene.section_json(*sections).encode())
     h.update(walkerlab.__version__.encode())
     h.update(code_hash().encode())
@@ -48,15 +51,21 @@ def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
 
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
-               force: bool = False, extra_attrs: dict | None = None) -> StageOutcome:
+               force: bool = False, extra_attrs: dict | None = None, salt: str = "",
+               also_accept: tuple[str, ...] = ()) -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
+    ``salt`` enters the input hash; an artifact written with one of the ``also_accept``
+    salts (a superset of what is asked for) counts as up to date too.
     """
     path = artifact_path(scene, runs_root, stage)
-    key = input_hash(stage, scene, sections, upstream)
-    if not force and path.is_file() and stored_hash(path) == key:
-        return StageOutcome(stage, path, True, 0.0, {})
+    key = input_hash(stage, scene, sections, upstream, salt)
+    if not force and path.is_file():
+        have = stored_hash(path)
+        if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
+                              for a in also_accept):
+            return StageOutcome(stage, path, True, 0.0, {})
     t0 = time.perf_counter()
     writer, summary = compute()
     wall = time.perf_counter() - t0
