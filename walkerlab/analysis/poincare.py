@@ -14,6 +14,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+
 from walkerlab.analysis.hybrid import Solver, integrate_step
 from walkerlab.models.base import HybridWalker
 
