@@ -260,7 +260,7 @@ def stability_map(scene: Path | None = SceneArg,
 
 
 @app.command()
-def bench(what: str = typer.Argument("all", help="ideal | contact | all"),
+def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact | all (all but basin)"),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
     from walkerlab.bench import run_bench
