@@ -73,7 +73,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     fixedpoint_stage.run(scene, runs_root)
     up = artifact_path(scene, runs_root, "fixedpoint")
     path = artifact_path(scene, runs_root, "basin")
-    key = input_hash("basin", scene, SECTIONS, (up,), salt=f"grid={grid[0]}x{grid[1]}")
+    key = input_hash("basin", scene, SECTIONS, (up,), extra=f"grid={grid[0]}x{grid[1]}")
     from walkerlab.io.artifacts import stored_hash
 
     if not force and path.is_file() and stored_hash(path) == key:

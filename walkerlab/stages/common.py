@@ -34,13 +34,12 @@ def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
 
 
 def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
-               upstream: tuple[Path, ...] = (), salt: str = "") -> str:
-    """Content hash of everything a stage's output depends on (``salt``: stage options
-    that are not scene sections, e.g. which extra results were asked for)."""
+               upstream: tuple[Path, ...] = (), extra: str = "") -> str:
+    """Content hash of everything a stage's output depends on (``extra``: stage options
+    that are not scene sections, e.g. a bifurcation grid)."""
     h = hashlib.sha256()
     h.update(stage.encode())
-    if salt:
-        h.update(salt.encode())
+    h.update(extra.encode())
     h.update(scene.section_json(*sections).encode())
     h.update(walkerlab.__version__.encode())
     h.update(code_hash().encode())
@@ -51,16 +50,19 @@ def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
 
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
-               force: bool = False, extra_attrs: dict | None = None, salt: str = "",
-               also_accept: tuple[str, ...] = ()) -> StageOutcome:
+               force: bool = False, extra_attrs: dict | None = None,
+               extra_key: str = "", also_accept: tuple[str, ...] = ()) -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
-    ``salt`` enters the input hash; an artifact written with one of the ``also_accept``
-    salts (a superset of what is asked for) counts as up to date too.
+    ``extra_key`` enters the input hash; an artifact written with one of the ``also_accept``
+    keys (a superset of what is asked for) counts as up to date too.
     """
+    from walkerlab.models.cache import set_cache_dir
+
+    set_cache_dir(Path(runs_root) / ".cache" / "models")  # generated model code lives in runs/
     path = artifact_path(scene, runs_root, stage)
-    key = input_hash(stage, scene, sections, upstream, salt)
+    key = input_hash(stage, scene, sections, upstream, extra_key)
     if not force and path.is_file():
         have = stored_hash(path)
         if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
