@@ -15,6 +15,7 @@ import numpy as np
 
 from walkerlab.config import BasinSettings, Scene
 from walkerlab.io.artifacts import put, write_artifact
+from walkerlab.io.netcdf import coordinate
 from walkerlab.stages import fixedpoint as fixedpoint_stage
 from walkerlab.stages.common import (
     StageError,
@@ -100,14 +101,14 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         f.attrs["x_axis"], f.attrs["y_axis"] = st.x_axis, st.y_axis
         f.attrs["outcomes"] = list(OUTCOMES)
         f.attrs["axis_order"] = "outcome[j, i]: j along y_axis, i along x_axis"
-        put(f, "x", res["x"], unit[st.x_axis], f"cell centres, {st.x_axis}")
-        put(f, "y", res["y"], unit[st.y_axis], f"cell centres, {st.y_axis}")
+        coordinate(f, "x", res["x"], unit[st.x_axis], f"cell centres, {st.x_axis}")
+        coordinate(f, "y", res["y"], unit[st.y_axis], f"cell centres, {st.y_axis}")
         put(f, "outcome", res["outcome"], "-",
-            "index into attrs['outcomes'] (converged = period-1 gait)", dims="y, x")
+            "index into attrs['outcomes'] (converged = period-1 gait)", dims=("y", "x"))
         put(f, "steps", res["steps"], "steps", "steps until the outcome was decided",
-            dims="y, x")
+            dims=("y", "x"))
         put(f, "period", res["period"], "steps", "period of the attractor reached "
-            "(1 = fixed point, 0 = none)", dims="y, x")
+            "(1 = fixed point, 0 = none)", dims=("y", "x"))
         for n, v in zip(names, x_star):
             put(f, f"fixed_point/{n}", float(v), unit[n], f"{n} of the period-1 gait")
         for o, c in counts.items():
