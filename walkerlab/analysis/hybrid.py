@@ -168,9 +168,14 @@ class _CyDense:
         return np.asarray(self._res.call_vectorize(np.ascontiguousarray(t))).reshape(-1, t.size)
 
 
+IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+
+
 def _solve_phase(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
-                 solver: Solver, backend: str) -> _PhaseRun:
-    """Integrate ``rhs`` from ``t0`` until the first guard (state rows ``:n``) fires or ``t1``."""
+                 solver: Solver, backend: str, jac=None) -> _PhaseRun:
+    """Integrate ``rhs`` from ``t0`` until the first guard (state rows ``:n``) fires or ``t1``.
+
+    ``jac`` (``(t, y) -> (m, m)``) is handed to scipy's implicit methods."""
     evs = []
     for gd in guards:
         def ev(t, y, _g=gd.function):
@@ -201,8 +206,10 @@ def _solve_phase(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
     else:
         from scipy.integrate import solve_ivp
 
-        sol = solve_ivp(rhs, (t0, t1), y0, events=evs or None, dense_output=True,
-                        **solver.kwargs())
+        kw = solver.kwargs()
+        if jac is not None and solver.method in IMPLICIT_METHODS:
+            kw["jac"] = jac
+        sol = solve_ivp(rhs, (t0, t1), y0, events=evs or None, dense_output=True, **kw)
         t_events, y_events = (sol.t_events, sol.y_events) if evs else ([], [])
         failed = sol.status == -1
         t_last, y_last, msg = float(sol.t[-1]), sol.y[:, -1], sol.message
@@ -372,7 +379,11 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
             y0 = x
         if t >= t_stop:
             break
-        run = _solve_phase(rhs, t, t_stop, y0, phase.guards, n, solver, backend)
+        # the model's analytic Jacobian for scipy's implicit methods (not a numerical one:
+        # those methods approximate it themselves)
+        jac = (None if variational else phase.jacobian if phase.jacobian is not None
+               else walker.variational)
+        run = _solve_phase(rhs, t, t_stop, y0, phase.guards, n, solver, backend, jac)
         nfev += run.nfev
         message = run.message
         pieces.append((phase, run.dense, (t, run.t_last)))
