@@ -294,6 +294,38 @@ def bifurcation(scene: Path | None = SceneArg,
     typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
 
 
+@app.command()
+@_guard
+def basin(scene: Path | None = SceneArg,
+          grid: str | None = typer.Option(None, "--grid", help="cells NXxNY, e.g. 200x200 "
+                                          "(default: basin.grid of the scene, 200x200)"),
+          workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+          scheduler: str | None = typer.Option(None, "--scheduler",
+                                                help="Dask scheduler address (tcp://host:port)"),
+          resume: bool = typer.Option(True, "--resume/--no-resume",
+                                      help="continue an interrupted map with the same inputs"),
+          runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section."""
+    from walkerlab.stages import basin as stage
+
+    g = None
+    if grid is not None:
+        try:
+            nx, ny = (int(v) for v in grid.lower().split("x"))
+            if nx < 2 or ny < 2:
+                raise ValueError
+        except ValueError:
+            _fail(ValueError(f"--grid: expected NXxNY with NX, NY >= 2 (e.g. 200x200), "
+                             f"got {grid!r}"))
+        g = (nx, ny)
+    out = stage.run(_load(scene), runs_dir, force, grid=g, workers=workers,
+                    scheduler=scheduler, resume=resume)
+    if out.summary:
+        typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
+    typer.echo(_status(out))
+    typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir)}")
+
+
 @app.command("stability-map")
 @_guard
 def stability_map(scene: Path | None = SceneArg,
@@ -315,7 +347,8 @@ def stability_map(scene: Path | None = SceneArg,
 
 @app.command()
 @_guard
-def bench(what: str = typer.Argument("all", help="ideal | contact | all"),
+def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
+                                     " | all (all but basin)"),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
     from walkerlab.bench import run_bench

@@ -324,6 +324,36 @@ class WorkPrecisionSettings(_Strict):
                                           description="contact reference (odeint) rtol [-]")
 
 
+class BasinSettings(_Strict):
+    """Basin of attraction over a 2-D slice of the Poincaré section (Schwab & Wisse 2001).
+
+    Each cell is a state just after heel strike: the two axis coordinates come from the grid,
+    the coordinate fixed by the heel-strike surface from that constraint, the others from
+    the period-1 fixed point.  Axes are named by ``walker.state_names()``.
+    """
+
+    x_axis: str = Field("stance_angle", description="state name on the x axis")
+    y_axis: str = Field("stance_rate", description="state name on the y axis")
+    x_range: tuple[float, float] | None = Field(
+        None, description="x axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
+        "1.2 rad/s (rates)")
+    y_range: tuple[float, float] | None = Field(
+        None, description="y axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
+        "1.2 rad/s (rates)")
+    grid: tuple[Annotated[int, Field(ge=2, le=4000)], Annotated[int, Field(ge=2, le=4000)]] = \
+        Field((200, 200), description="cells along x and y")
+    max_steps: int = Field(50, ge=1, le=10_000, description="steps simulated per cell at most")
+    converge_tol: float = Field(1e-4, gt=0, lt=1, description="a cell has converged to the "
+                                "period-1 gait once max|x - x*| < this [rad, rad/s]")
+    period_tol: float = Field(1e-6, gt=0, lt=1, description="x_k and x_{k-p} closer than this "
+                              "(p >= 2) = another periodic attractor [rad, rad/s]")
+    max_period: int = Field(8, ge=2, le=64, description="longest period looked for [steps]")
+    rtol: float = Field(1e-8, gt=0, lt=1, description="integrator relative tolerance [-]")
+    atol: float = Field(1e-8, gt=0, lt=1, description="integrator absolute tolerance")
+    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this ends the "
+                                   "cell as 'stalled' [s]")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
@@ -354,6 +384,7 @@ class Scene(_Strict):
     def origin(self) -> Path | None:
         """Resolved path of the scene file, or None for a scene built in code."""
         return self._origin
+    basin: BasinSettings | None = None
 
     @model_validator(mode="after")
     def _published_exists(self) -> Scene:

@@ -73,10 +73,12 @@ def _tell(msg: str) -> None:
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
                force: bool = False, extra_attrs: dict | None = None,
-               extra_key: str = "") -> StageOutcome:
+               extra_key: str = "", also_accept: tuple[str, ...] = ()) -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
+    ``extra_key`` enters the input hash; an artifact written with one of the ``also_accept``
+    keys (a superset of what is asked for) counts as up to date too.
     """
     from walkerlab.models.cache import set_cache_dir
 
@@ -85,8 +87,11 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
     # one writer per artifact: a second identical run waits, then finds the result up to date
     with artifact_lock(path, wait=True, on_wait=_tell):
         key = input_hash(stage, scene, sections, upstream, extra_key)
-        if not force and path.is_file() and verified_hash(path) == key:
-            return StageOutcome(stage, path, True, 0.0, {})
+        if not force and path.is_file():
+            have = verified_hash(path)
+            if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
+                                  for a in also_accept):
+                return StageOutcome(stage, path, True, 0.0, {})
         t0 = time.perf_counter()
         writer, summary = compute()
         wall = time.perf_counter() - t0

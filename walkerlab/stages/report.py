@@ -27,7 +27,7 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
 
     done: list[StageOutcome] = []
     if scene.fixedpoint is not None:
-        done.append(fixedpoint.run(scene, runs_root, force))
+        done.append(fixedpoint.run(scene, runs_root, force, compare_variants=True))
     if scene.simulate is not None:
         done.append(simulate.run(scene, runs_root, force))
     if scene.contact is not None:
