@@ -48,13 +48,17 @@ def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
 
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
-               force: bool = False, extra_attrs: dict | None = None) -> StageOutcome:
+               force: bool = False, extra_attrs: dict | None = None,
+               extra_key: str = "") -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
+    ``extra_key``: text of inputs that are not scene sections (e.g. a map's grid), hashed too.
     """
     path = artifact_path(scene, runs_root, stage)
     key = input_hash(stage, scene, sections, upstream)
+    if extra_key:
+        key = hashlib.sha256((key + extra_key).encode()).hexdigest()
     if not force and path.is_file() and stored_hash(path) == key:
         return StageOutcome(stage, path, True, 0.0, {})
     t0 = time.perf_counter()
