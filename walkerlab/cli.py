@@ -329,20 +329,29 @@ def basin(scene: Path | None = SceneArg,
 @app.command("stability-map")
 @_guard
 def stability_map(scene: Path | None = SceneArg,
-                  y: str = typer.Option("contact.stiffness=1e3,1e4,1e5,1e6,1e7,1e8,1e9", "--y",
-                                        help="y axis, e.g. contact.stiffness=... (scene units) "
-                                        "or contact.mu_static=..."),
-                  x: str = typer.Option("slope.angle_deg=0.5:3:0.5", "--x",
-                                        help="x axis (slope) [deg]"),
-                  name: str = typer.Option("stability_stiffness", "--name", help="artifact name"),
+                  kind: str = typer.Option("all", "--kind", help="stiffness | friction | "
+                                           "patch_width | all (each against the slope)"),
+                  n: int = typer.Option(8, "--n", min=2, help="grid size n x n"),
+                  time_limit: float = typer.Option(60.0, "--time-limit", min=1.0,
+                                                   help="wall-time limit per cell [s]"),
                   workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
-                  runs_dir: Path = RunsOpt) -> None:
-    """Stability map of the contact walker: walks / falls / slips / bounces / solver failure."""
-    from walkerlab.sweep.stability import stability_map as smap
+                  runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Stability maps of the contact gait: does a periodic gait exist, is it stable, max
+    |Floquet multiplier|, or why not (cached stage)."""
+    from walkerlab.stages import stability_map as stage
+    from walkerlab.sweep.stability import MAP_KINDS
 
-    out = smap(_load(scene), y, x, runs_root=runs_dir, name=name, workers=workers)
-    typer.echo(", ".join(f"{k}: {v}" for k, v in out["counts"].items()))
-    typer.echo(f"wrote {out['artifact']}")
+    sc = _load(scene)
+    kinds = list(MAP_KINDS) if kind == "all" else [kind]
+    for k in kinds:
+        if k not in MAP_KINDS:
+            _fail(ValueError(f"--kind: unknown map {k!r} (stiffness, friction, patch_width, all)"))
+        out = stage.run(sc, runs_dir, force, kind=k, n=n, workers=workers,
+                        time_limit_s=time_limit)
+        s = out.summary
+        typer.echo(f"{k}: " + (", ".join(f"{a}: {b:.3g}" if isinstance(b, float) else
+                                         f"{a}: {b}" for a, b in s.items()) or "cached"))
+        typer.echo(f"wrote {out.path}")
 
 
 @app.command()

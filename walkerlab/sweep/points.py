@@ -277,7 +277,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
         Steps requested (2 * ``contact_sim.n_strides``).
     """
     from walkerlab.contact import ContactSimSettings
-    from walkerlab.stages.contact_sim import simulate_from
+    from walkerlab.contact.scene import simulate_from
 
     # one code path with the contact-sim stage (terrain, initial state, solver, end time)
     cs = scene.contact_sim or ContactSimSettings()
