@@ -282,39 +282,82 @@ def bifurcation(scene: Path | None = SceneArg,
                                               help="steps discarded before sampling"),
                 keep: int = typer.Option(30, "--keep", min=1, help="heel strikes kept per slope"),
                 workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
-                runs_dir: Path = RunsOpt) -> None:
+                runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Bifurcation diagram over the slope: fixed points, multipliers, period-doubling onset."""
-    from walkerlab.sweep.bifurcation import run_bifurcation
+    from walkerlab.stages import bifurcation as stage
     from walkerlab.sweep.params import parse_param
 
     axis = parse_param(f"slope.angle_deg={slopes}")
-    out = run_bifurcation(_load(scene), axis.values, runs_dir, transient, keep, workers)
-    typer.echo(f"period-doubling onset: {out['onset_deg']:.4f} deg")
-    typer.echo(f"wrote {out['artifact']} and {', '.join(str(p) for p in out['figures'])}")
+    out = stage.run(_load(scene), axis.values, runs_dir, transient, keep, workers, force=force)
+    typer.echo(f"period-doubling onset: {out.summary['onset_deg']:.4f} deg")
+    typer.echo(_status(out))
+    typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
+
+
+@app.command()
+@_guard
+def basin(scene: Path | None = SceneArg,
+          grid: str | None = typer.Option(None, "--grid", help="cells NXxNY, e.g. 200x200 "
+                                          "(default: basin.grid of the scene, 200x200)"),
+          workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+          scheduler: str | None = typer.Option(None, "--scheduler",
+                                                help="Dask scheduler address (tcp://host:port)"),
+          resume: bool = typer.Option(True, "--resume/--no-resume",
+                                      help="continue an interrupted map with the same inputs"),
+          runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section."""
+    from walkerlab.stages import basin as stage
+
+    g = None
+    if grid is not None:
+        try:
+            nx, ny = (int(v) for v in grid.lower().split("x"))
+            if nx < 2 or ny < 2:
+                raise ValueError
+        except ValueError:
+            _fail(ValueError(f"--grid: expected NXxNY with NX, NY >= 2 (e.g. 200x200), "
+                             f"got {grid!r}"))
+        g = (nx, ny)
+    out = stage.run(_load(scene), runs_dir, force, grid=g, workers=workers,
+                    scheduler=scheduler, resume=resume)
+    if out.summary:
+        typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
+    typer.echo(_status(out))
+    typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir)}")
 
 
 @app.command("stability-map")
 @_guard
 def stability_map(scene: Path | None = SceneArg,
-                  y: str = typer.Option("contact.stiffness=1e3,1e4,1e5,1e6,1e7,1e8,1e9", "--y",
-                                        help="y axis, e.g. contact.stiffness=... (scene units) "
-                                        "or contact.mu_static=..."),
-                  x: str = typer.Option("slope.angle_deg=0.5:3:0.5", "--x",
-                                        help="x axis (slope) [deg]"),
-                  name: str = typer.Option("stability_stiffness", "--name", help="artifact name"),
+                  kind: str = typer.Option("all", "--kind", help="stiffness | friction | "
+                                           "patch_width | all (each against the slope)"),
+                  n: int = typer.Option(8, "--n", min=2, help="grid size n x n"),
+                  time_limit: float = typer.Option(60.0, "--time-limit", min=1.0,
+                                                   help="wall-time limit per cell [s]"),
                   workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
-                  runs_dir: Path = RunsOpt) -> None:
-    """Stability map of the contact walker: walks / falls / slips / bounces / solver failure."""
-    from walkerlab.sweep.stability import stability_map as smap
+                  runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Stability maps of the contact gait: does a periodic gait exist, is it stable, max
+    |Floquet multiplier|, or why not (cached stage)."""
+    from walkerlab.stages import stability_map as stage
+    from walkerlab.sweep.stability import MAP_KINDS
 
-    out = smap(_load(scene), y, x, runs_root=runs_dir, name=name, workers=workers)
-    typer.echo(", ".join(f"{k}: {v}" for k, v in out["counts"].items()))
-    typer.echo(f"wrote {out['artifact']}")
+    sc = _load(scene)
+    kinds = list(MAP_KINDS) if kind == "all" else [kind]
+    for k in kinds:
+        if k not in MAP_KINDS:
+            _fail(ValueError(f"--kind: unknown map {k!r} (stiffness, friction, patch_width, all)"))
+        out = stage.run(sc, runs_dir, force, kind=k, n=n, workers=workers,
+                        time_limit_s=time_limit)
+        s = out.summary
+        typer.echo(f"{k}: " + (", ".join(f"{a}: {b:.3g}" if isinstance(b, float) else
+                                         f"{a}: {b}" for a, b in s.items()) or "cached"))
+        typer.echo(f"wrote {out.path}")
 
 
 @app.command()
 @_guard
-def bench(what: str = typer.Argument("all", help="ideal | contact | all"),
+def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
+                                     " | all (all but basin)"),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
     from walkerlab.bench import run_bench

@@ -24,8 +24,10 @@ from pydantic import (
     BaseModel,
     BeforeValidator,
     ConfigDict,
+    Discriminator,
     Field,
     PrivateAttr,
+    Tag,
     ValidationError,
     model_validator,
 )
@@ -91,9 +93,91 @@ class CompassGaitParams(_Strict):
         return self.leg_length_m - self.leg_mass_from_foot_m
 
 
-# One walker model today; a kneed walker or a walker with a torso joins this union with a
-# discriminator on ``model`` (defaulting to "compass_gait" so existing scenes stay valid).
-WalkerParams = CompassGaitParams
+# ---- generic walker description (``model: biped``): bodies, joints, feet as data.
+# A kneed leg (``knee``) and round feet (``foot.kind: arc``) extend these classes.
+class PointMassBody(_Strict):
+    """A point mass on a leg link, at ``from_hip_m`` along the link from the hip."""
+
+    kind: Literal["point_mass"] = Field(description="body type")
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (points: swing_<name>)")
+    link: Literal["leg"] = Field("leg", description="leg link carrying the body")
+    mass_kg: float = Field(ge=0, le=1e4, description="mass [kg]; 0 = the limit m/M -> 0, "
+                           "taken symbolically (Garcia et al. 1998), not a small number")
+    from_hip_m: float = Field(ge=0, le=100, description="distance from the hip along the link [m]")
+
+
+class RodBody(_Strict):
+    """A rigid rod on a leg link: mass, centre of mass along the link, inertia about the COM."""
+
+    kind: Literal["rod"] = Field(description="body type")
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (points: swing_<name>)")
+    link: Literal["leg"] = Field("leg", description="leg link carrying the body")
+    mass_kg: float = Field(gt=0, le=1e4, description="mass [kg]")
+    com_from_hip_m: float = Field(ge=0, le=100, description="centre of mass from the hip [m]")
+    inertia_about_com_kg_m2: float = Field(ge=0, le=1e6, description="moment of inertia about "
+                                           "the centre of mass [kg m^2] (uniform rod: m l^2/12)")
+
+
+Body = Annotated[PointMassBody | RodBody, Field(discriminator="kind")]
+
+
+class PointFoot(_Strict):
+    """A point foot at the end of the leg (the contact point is fixed during stance)."""
+
+    kind: Literal["point"] = Field("point", description="foot shape")
+
+
+class LegSpec(_Strict):
+    """One leg (both legs are identical): a straight link from the hip to the foot."""
+
+    length_m: float = Field(gt=0, le=100, description="leg length l, hip to foot [m]")
+    bodies: list[Body] = Field(default_factory=list, description="bodies on the leg")
+    foot: PointFoot = Field(PointFoot(), description="foot shape")
+
+    @model_validator(mode="after")
+    def _bodies_on_leg(self) -> LegSpec:
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names):
+            raise ValueError(f"walker.leg.bodies: duplicate body names {names}")
+        if "foot" in names or "hip" in names:
+            raise ValueError("walker.leg.bodies: 'foot' and 'hip' are reserved point names")
+        for b in self.bodies:
+            d = b.from_hip_m if b.kind == "point_mass" else b.com_from_hip_m
+            if d > self.length_m:
+                raise ValueError(f"walker.leg.bodies.{b.name}: lies beyond the foot "
+                                 f"({d} m > leg length {self.length_m} m)")
+        return self
+
+
+class BipedParams(_Strict):
+    """A planar passive biped described as data (``model: biped``); its equations of motion,
+    guards and impact are derived symbolically (:mod:`walkerlab.models.symbolic`)."""
+
+    model: Literal["biped"] = Field(description="generic biped description")
+    coordinates: Literal["absolute", "slope_relative"] = Field(
+        "absolute", description="'absolute': leg angles from the vertical (swing, stance; paper "
+        "Eq. 1); 'slope_relative': stance angle from the slope normal and hip angle between "
+        "the legs (Garcia et al. 1998)")
+    gravity_m_per_s2: float = Field(9.81, gt=0, le=100, description="gravity g [m/s^2]")
+    hip_mass_kg: float = Field(ge=0, le=1e4, description="hip point mass [kg]")
+    leg: LegSpec = Field(description="each leg (both are identical)")
+
+    @model_validator(mode="after")
+    def _has_mass(self) -> BipedParams:
+        if self.hip_mass_kg + sum(b.mass_kg for b in self.leg.bodies) <= 0:
+            raise ValueError("walker: the walker has no mass (hip_mass_kg and all bodies are 0)")
+        return self
+
+
+# ``model`` is the discriminator; "compass_gait" is the paper's shorthand for a biped with a
+# hip mass and one point mass per leg (expanded by walkerlab.models.description).
+def _walker_tag(v: Any) -> str:
+    return (v.get("model", "compass_gait") if isinstance(v, dict)
+            else getattr(v, "model", "compass_gait"))
+
+
+WalkerParams = Annotated[Annotated[CompassGaitParams, Tag("compass_gait")]
+                         | Annotated[BipedParams, Tag("biped")], Discriminator(_walker_tag)]
 
 
 class SlopeSettings(_Strict):
@@ -148,20 +232,48 @@ class ContactSolverSettings(_Strict):
 
 
 class StateSpec(_Strict):
-    """A compass-gait state right after heel strike, by role (Eq. 1: swing, stance)."""
+    """A walker state right after heel strike, by state name with its unit:
+    ``<role>_angle_rad`` and ``<role>_rate_rad_per_s`` for each role of the walker (compass
+    gait, Eq. 1: ``swing_angle_rad, stance_angle_rad, swing_rate_rad_per_s,
+    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``)."""
 
-    swing_angle_rad: float = Field(description="theta_1, swing-leg angle from vertical [rad]")
-    stance_angle_rad: float = Field(description="theta_2, stance-leg angle from vertical [rad]")
-    swing_rate_rad_per_s: float = Field(description="dtheta_1 [rad/s]")
-    stance_rate_rad_per_s: float = Field(description="dtheta_2 [rad/s]")
+    model_config = ConfigDict(extra="allow", frozen=True)
 
-    def as_array(self):
+    @model_validator(mode="after")
+    def _named_finite(self) -> StateSpec:
+        import re
+
+        for k, v in (self.model_extra or {}).items():
+            if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
+                raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
+                                 "<role>_rate_rad_per_s)")
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ValueError(f"{k}: must be a finite number")
+        if not self.model_extra:
+            raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
+        return self
+
+    def as_array(self, state_names: list[str] | None = None):
+        """State (2n,) in the order of ``state_names`` (a walker's ``state_names()``; default:
+        the compass gait's ``swing_angle, stance_angle, swing_rate, stance_rate``).
+
+        Raises
+        ------
+        ValueError
+            A state of the walker is missing, or a given name is not one of its states.
+        """
         import numpy as np
 
-        return np.array(
-            [self.swing_angle_rad, self.stance_angle_rad,
-             self.swing_rate_rad_per_s, self.stance_rate_rad_per_s]
-        )
+        names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
+        keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
+        given = dict(self.model_extra or {})
+        missing = [k for k in keys if k not in given]
+        extra = [k for k in given if k not in keys]
+        if missing or extra:
+            raise ValueError(f"state must give exactly {keys}" +
+                             (f"; missing {missing}" if missing else "") +
+                             (f"; unknown {extra}" if extra else ""))
+        return np.array([float(given[k]) for k in keys])
 
 
 class FixedPointSettings(_Strict):
@@ -212,6 +324,36 @@ class WorkPrecisionSettings(_Strict):
                                           description="contact reference (odeint) rtol [-]")
 
 
+class BasinSettings(_Strict):
+    """Basin of attraction over a 2-D slice of the Poincaré section (Schwab & Wisse 2001).
+
+    Each cell is a state just after heel strike: the two axis coordinates come from the grid,
+    the coordinate fixed by the heel-strike surface from that constraint, the others from
+    the period-1 fixed point.  Axes are named by ``walker.state_names()``.
+    """
+
+    x_axis: str = Field("stance_angle", description="state name on the x axis")
+    y_axis: str = Field("stance_rate", description="state name on the y axis")
+    x_range: tuple[float, float] | None = Field(
+        None, description="x axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
+        "1.2 rad/s (rates)")
+    y_range: tuple[float, float] | None = Field(
+        None, description="y axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
+        "1.2 rad/s (rates)")
+    grid: tuple[Annotated[int, Field(ge=2, le=4000)], Annotated[int, Field(ge=2, le=4000)]] = \
+        Field((200, 200), description="cells along x and y")
+    max_steps: int = Field(50, ge=1, le=10_000, description="steps simulated per cell at most")
+    converge_tol: float = Field(1e-4, gt=0, lt=1, description="a cell has converged to the "
+                                "period-1 gait once max|x - x*| < this [rad, rad/s]")
+    period_tol: float = Field(1e-6, gt=0, lt=1, description="x_k and x_{k-p} closer than this "
+                              "(p >= 2) = another periodic attractor [rad, rad/s]")
+    max_period: int = Field(8, ge=2, le=64, description="longest period looked for [steps]")
+    rtol: float = Field(1e-8, gt=0, lt=1, description="integrator relative tolerance [-]")
+    atol: float = Field(1e-8, gt=0, lt=1, description="integrator absolute tolerance")
+    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this ends the "
+                                   "cell as 'stalled' [s]")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
@@ -220,6 +362,9 @@ class Scene(_Strict):
                              "separators, not starting with a dot", max_length=100,
                              pattern=r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
     source: str | None = Field(None, description="citation of the parameter set")
+    published: str | None = Field(
+        None, description="walkerlab.published module whose printed numbers the report sets "
+        "next to ours (e.g. 'paper'); null: no published comparison")
     walker: WalkerParams
     slope: SlopeSettings
     ideal: IdealModelSettings = IdealModelSettings()
@@ -239,6 +384,17 @@ class Scene(_Strict):
     def origin(self) -> Path | None:
         """Resolved path of the scene file, or None for a scene built in code."""
         return self._origin
+    basin: BasinSettings | None = None
+
+    @model_validator(mode="after")
+    def _published_exists(self) -> Scene:
+        if self.published is not None:
+            from walkerlab.published import available
+
+            if self.published not in available():
+                raise ValueError(f"published: no module walkerlab.published.{self.published} "
+                                 f"(available: {', '.join(available())})")
+        return self
 
     def section_json(self, *names: str) -> str:
         """Canonical JSON of the named sections (for content hashes)."""
@@ -252,13 +408,17 @@ class Scene(_Strict):
 _NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
 
 
+# discriminator tags of walker models and bodies: not part of a field's path
+_TAGS = {"compass_gait", "biped", "point_mass", "rod", "point"}
+
+
 def _loc_part(p) -> bool:
     """Keep a location element that is a field name or index (not a union/type tag)."""
     s = str(p)
     if s.startswith(("function-after", "function-before", "literal[", "tuple[", "list[")):
         return False
     # union members appear as their class name (``StateSpec``) or a discriminator tag
-    return not (s[:1].isupper() and s.isidentifier()) and s != "compass_gait"
+    return not (s[:1].isupper() and s.isidentifier()) and s not in _TAGS
 
 
 def _format_error(path: Path, err: ValidationError) -> str:

@@ -12,7 +12,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
-__all__ = ["ContactParamsSI", "ContactSettings", "ContactSimSettings", "TerrainSettings"]
+__all__ = ["ContactParamsSI", "ContactSettings", "ContactSimSettings", "TerrainSettings",
+           "family_scaling"]
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,26 @@ MAX_CONTACT_STRIDES = 100
 
 def _list_to_tuple(v):
     return tuple(v) if isinstance(v, list) else v
+
+
+def family_scaling(cmax: float, dmax: float, e: float, kappa: float) -> tuple[float, float]:
+    """Damping and damping-ramp depth of the 'rigid_limit' stiffness family.
+
+    A point mass m dropping at speed v on ``F = k d^e + c(d) d'`` reaches the depth
+    ``d* ~ (m v^2 / k)^(1/(e+1))`` in the time ``d* / v``; in the scaled variables
+    ``d / d*``, ``t v / d*`` the equation is unchanged when ``c ~ k^(1/(e+1))`` and
+    ``dmax ~ d* ~ k^(-1/(e+1))``.  So with ``kappa = k / k_ref`` the family
+    ``cmax kappa^(1/(e+1))``, ``dmax kappa^(-1/(e+1))`` keeps the coefficient of restitution
+    of the reference contact for every k (gravity during the impact aside), and the contact
+    tends to the rigid plastic impact only through its duration ``~ k^(-1/(e+1))``.
+
+    Returns
+    -------
+    (cmax, dmax) : tuple of float
+        In the units of the inputs.
+    """
+    p = 1.0 / (e + 1.0)
+    return cmax * kappa ** p, dmax * kappa ** (-p)
 
 
 def _len_factor(unit_system: str) -> float:
@@ -103,6 +124,17 @@ class ContactSettings(BaseModel):
         json_schema_extra={"unit": "<len>/s"},
     )
 
+    stiffness_family: Literal["paper", "rigid_limit"] = Field(
+        "paper", description="How damping and dmax follow the stiffness: 'paper' keeps "
+        "max_damping and penetration_at_max_damping as given (a stiffer contact is then more "
+        "elastic); 'rigid_limit' scales them with kappa = stiffness / reference_stiffness as "
+        "cmax * kappa^(1/(e+1)), dmax * kappa^(-1/(e+1)), so a drop impact keeps the "
+        "restitution it has at the reference stiffness (near-plastic) as k grows.")
+    reference_stiffness: float = Field(
+        1e5, gt=0, description="Stiffness at which max_damping and penetration_at_max_damping "
+        "hold in the 'rigid_limit' family (paper: 1e5 N/mm^2.2).",
+        json_schema_extra={"unit": "N/<len>^e"})
+
     @model_validator(mode="after")
     def _check_relations(self) -> ContactSettings:
         if self.mu_dynamic > self.mu_static:
@@ -128,11 +160,15 @@ class ContactSettings(BaseModel):
         """
         f = _len_factor(self.unit_system)
         e = self.exponent
+        cmax, dmax = self.max_damping, self.penetration_at_max_damping
+        if self.stiffness_family == "rigid_limit":
+            kappa = self.stiffness / self.reference_stiffness
+            cmax, dmax = family_scaling(cmax, dmax, e, kappa)
         return ContactParamsSI(
             k=self.stiffness * f ** (-e),
             e=e,
-            cmax=self.max_damping / f,
-            dmax=self.penetration_at_max_damping * f,
+            cmax=cmax / f,
+            dmax=dmax * f,
             mu_s=self.mu_static,
             mu_d=self.mu_dynamic,
             v_s=self.stiction_velocity * f,
@@ -185,3 +221,14 @@ class ContactSimSettings(BaseModel):
     initial_rate_scale: Annotated[tuple[float, float], BeforeValidator(_list_to_tuple)] = Field(
         (1.0, 1.0), description="Multipliers [-] on dtheta1, dtheta2 of the initial state."
     )
+    wall_time_limit_s: float | None = Field(
+        120.0, gt=0, description="Wall-time limit of one contact run [s]; when it runs out "
+        "the run ends with outcome 'time_limit' (null = none).",
+        json_schema_extra={"unit": "s"})
+    stop_after_strides: bool = Field(
+        True, description="Strides cap: stop once 2 * n_strides + 1 heel strikes have "
+        "happened, even if t_final_s is longer.")
+    periodic_time_limit_s: float | None = Field(
+        120.0, gt=0, description="Wall-time limit of the periodic-gait search [s]; when it "
+        "runs out the gait is reported as 'time_limit' (null = none).",
+        json_schema_extra={"unit": "s"})

@@ -33,6 +33,7 @@ import h5py
 import numpy as np
 
 import walkerlab
+from walkerlab.io import netcdf
 
 
 class ArtifactError(RuntimeError):
@@ -73,6 +74,11 @@ def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
     return path
 
 
+# HDF5 dimension-scale bookkeeping (netCDF-4 conventions): object references whose printed
+# form depends on the open file handle, not on the content; the scales themselves are hashed.
+_REFERENCE_ATTRS = frozenset({"DIMENSION_LIST", "REFERENCE_LIST"})
+
+
 def _hash_value(h, v) -> None:
     if isinstance(v, h5py.Empty):
         h.update(b"<empty>")
@@ -102,6 +108,8 @@ def content_hash_of(f: h5py.File) -> str:
         if isinstance(obj, h5py.Dataset):
             _hash_value(h, obj[()])
         for key in sorted(obj.attrs):
+            if key in _REFERENCE_ATTRS:
+                continue
             h.update(f"@{key}".encode())
             _hash_value(h, obj.attrs[key])
     return h.hexdigest()
@@ -146,10 +154,12 @@ def code_hash() -> str:
 
 
 def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "",
-        **attrs) -> h5py.Dataset:
+        dims: tuple[str | None, ...] | None = None, **attrs) -> h5py.Dataset:
     """Create dataset ``name`` (intermediate groups allowed) with unit and description.
 
-    Strings and lists of strings are stored as UTF-8 variable-length strings.
+    Strings and lists of strings are stored as UTF-8 variable-length strings.  ``dims``
+    names the dimension of each axis (netCDF-4 dimension scales, see
+    :mod:`walkerlab.io.netcdf`); ``units`` and ``long_name`` are added for netCDF readers.
     """
     if isinstance(data, str) or (isinstance(data, (list, tuple)) and data
                                  and isinstance(data[0], str)):
@@ -157,8 +167,12 @@ def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "
     ds = group.create_dataset(name, data=data)
     ds.attrs["unit"] = unit
     ds.attrs["description"] = description
+    ds.attrs["units"] = netcdf.cf_units(unit)
+    ds.attrs["long_name"] = description or name.rsplit("/", 1)[-1]
     for k, v in attrs.items():
         ds.attrs[k] = v
+    if dims is not None:
+        netcdf.attach(ds, dims)
     return ds
 
 
@@ -218,6 +232,7 @@ def write_artifact(path: Path, stage: str, scene, input_hash: str,
             for k, v in (extra_attrs or {}).items():
                 f.attrs[k] = v
             writer(f)
+            netcdf.finish(f)
             f.attrs["content_hash"] = content_hash_of(f)
         os.chmod(tmp, FILE_MODE)
         os.replace(tmp, path)

@@ -47,15 +47,17 @@ def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
 
 
 def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
-               upstream: tuple[Path, ...] = ()) -> str:
+               upstream: tuple[Path, ...] = (), extra: str = "") -> str:
     """Content hash of everything a stage's output depends on.
 
+    ``extra``: stage options that are not scene sections (e.g. a bifurcation grid).
     Includes the upstream artifacts' *recomputed* content hashes
     (:func:`walkerlab.io.artifacts.content_hash`), not the hashes they store: an upstream
     artifact edited by hand changes the key.
     """
     h = hashlib.sha256()
     h.update(stage.encode())
+    h.update(extra.encode())
     h.update(scene.section_json(*sections).encode())
     h.update(walkerlab.__version__.encode())
     h.update(code_hash().encode())
@@ -70,17 +72,26 @@ def _tell(msg: str) -> None:
 
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
-               force: bool = False, extra_attrs: dict | None = None) -> StageOutcome:
+               force: bool = False, extra_attrs: dict | None = None,
+               extra_key: str = "", also_accept: tuple[str, ...] = ()) -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
+    ``extra_key`` enters the input hash; an artifact written with one of the ``also_accept``
+    keys (a superset of what is asked for) counts as up to date too.
     """
+    from walkerlab.models.cache import set_cache_dir
+
+    set_cache_dir(Path(runs_root) / ".cache" / "models")  # generated model code lives in runs/
     path = stage_artifact(scene, runs_root, stage, claim=True)
     # one writer per artifact: a second identical run waits, then finds the result up to date
     with artifact_lock(path, wait=True, on_wait=_tell):
-        key = input_hash(stage, scene, sections, upstream)
-        if not force and path.is_file() and verified_hash(path) == key:
-            return StageOutcome(stage, path, True, 0.0, {})
+        key = input_hash(stage, scene, sections, upstream, extra_key)
+        if not force and path.is_file():
+            have = verified_hash(path)
+            if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
+                                  for a in also_accept):
+                return StageOutcome(stage, path, True, 0.0, {})
         t0 = time.perf_counter()
         writer, summary = compute()
         wall = time.perf_counter() - t0
