@@ -147,6 +147,19 @@ def d3_readonly_runs(d):
     return rc, msg, "run as uid 65534 (root ignores modes)"
 
 
+@case
+def d3_readonly_runs_sweep(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    (d / "cfg" / "runs").mkdir(parents=True)
+    os.chmod(d / "cfg" / "runs", 0o555)
+    os.chmod(d, 0o777)
+    os.chmod(d / "cfg", 0o777)
+    os.chmod(s, 0o644)
+    rc, msg, _ = cli(d / "cfg", "sweep", str(s), "--param", "slope.angle_deg=1", "--workers",
+                     "1", "--runs-dir", "runs", user="65534", env={"HOME": str(d)})
+    return rc, msg, "run as uid 65534 (root ignores modes)"
+
+
 def _contact(d, **kw):
     return scene(d / "cfg", with_(PAPER, **{"contact_sim__periodic_gait": False,
                                             "contact_sim__n_strides": 2, **kw}), "paper.yaml")
@@ -282,7 +295,8 @@ def d7_sigkill_sweep_orphans(d):
     main = subprocess.Popen([PY, "-m", "walkerlab.cli", "sweep", str(s), "--param",
                              "slope.angle_deg=1:4:0.05", "--workers", "2", "--runs-dir", "runs"],
                             cwd=d / "cfg", stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(10)
+    kids = _wait_workers(main.pid)
+    time.sleep(3)
     kids = _children(main.pid)
     os.kill(main.pid, signal.SIGKILL)
     main.wait()
@@ -291,6 +305,17 @@ def d7_sigkill_sweep_orphans(d):
     for k in alive:
         os.kill(k, signal.SIGKILL)
     return -9, "", f"{len(kids)} descendants, {len(alive)} still alive 5 s after SIGKILL"
+
+
+def _wait_workers(pid, n=3, timeout=180):
+    t0 = time.time()
+    kids = []
+    while time.time() - t0 < timeout:
+        kids = _children(pid)
+        if len(kids) >= n:
+            break
+        time.sleep(0.2)
+    return kids
 
 
 def _children(pid):
@@ -415,9 +440,10 @@ def d12_sweep_rows_saved_early(d):
                              "slope.angle_deg=1:4:0.05", "--workers", "2", "--runs-dir", "runs",
                              "--name", "prog"], cwd=d / "cfg", stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, start_new_session=True)
-    time.sleep(20)
+    _wait_workers(main.pid)
+    time.sleep(15)
     os.killpg(main.pid, signal.SIGINT)
-    main.wait(timeout=60)
+    main.wait(timeout=300)
     import h5py
 
     p = d / "cfg/runs/paper/prog.h5.partial"
@@ -425,7 +451,8 @@ def d12_sweep_rows_saved_early(d):
     if p.is_file():
         with h5py.File(p) as f:
             rows = f["points/index"].shape[0]
-    return main.returncode, "", f"SIGINT after 20 s of a 61-point sweep: {rows} rows saved"
+    return main.returncode, "", (f"SIGINT 15 s after the workers started (61 points): "
+                                 f"{rows} rows saved")
 
 
 @case
