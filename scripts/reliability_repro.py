@@ -283,10 +283,10 @@ def d6_edited_artifact_reused(d):
 
     with h5py.File(d / "cfg/runs/paper/fixedpoint.h5", "a") as f:
         f["fixed_point/stance_rate"][()] = -3.0
-    rc, msg, _ = cli(d / "cfg", "simulate", str(s), "--runs-dir", "runs")
     p = subprocess.run([PY, "-m", "walkerlab.cli", "fixedpoint", str(s), "--runs-dir", "runs"],
                        cwd=d / "cfg", capture_output=True, text=True)
-    return rc, msg, "fixedpoint then says: " + p.stdout.strip().splitlines()[-1][:70]
+    rc, msg, _ = cli(d / "cfg", "simulate", str(s), "--runs-dir", "runs")
+    return rc, msg, "after the edit, fixedpoint says: " + p.stdout.strip().splitlines()[-1][:50]
 
 
 @case
@@ -437,7 +437,7 @@ def d11_simulate_fall_exit_code(d):
 def d12_sweep_rows_saved_early(d):
     s = scene(d / "cfg", IDEAL, "paper.yaml")
     main = subprocess.Popen([PY, "-m", "walkerlab.cli", "sweep", str(s), "--param",
-                             "slope.angle_deg=1:4:0.05", "--workers", "2", "--runs-dir", "runs",
+                             "slope.angle_deg=1:4:0.01", "--workers", "2", "--runs-dir", "runs",
                              "--name", "prog"], cwd=d / "cfg", stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, start_new_session=True)
     _wait_workers(main.pid)
@@ -451,7 +451,7 @@ def d12_sweep_rows_saved_early(d):
     if p.is_file():
         with h5py.File(p) as f:
             rows = f["points/index"].shape[0]
-    return main.returncode, "", (f"SIGINT 15 s after the workers started (61 points): "
+    return main.returncode, "", (f"SIGINT 15 s after the workers started (301 points): "
                                  f"{rows} rows saved")
 
 

@@ -92,7 +92,8 @@ def test_d1_symlinked_run_folder_leaving_runs_rejected(tmp_path):
 
 
 @pytest.mark.parametrize("name", ["fixedpoint", "simulate.h5", "contact_sim", "compare",
-                                  "bifurcation", "workprecision"])
+                                  "bifurcation", "workprecision", "basin",
+                                  "stability_map_stiffness"])
 def test_d2_sweep_cannot_take_a_stage_artifact_name(tmp_path, name):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     from walkerlab.stages.sweep import sweep_path
