@@ -474,3 +474,26 @@ def test_d7_sigkill_of_the_main_process_leaves_no_workers(tmp_path):
             names[k] = "?"
         os.kill(k, 9)
     assert not alive, f"still running after SIGKILL of the main process: {names}"
+
+
+def test_d4_a_second_stage_run_waits_for_the_first_writer(tmp_path, capfd):
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    target = common.artifact_path(sc, tmp_path, "fixedpoint")
+    target.parent.mkdir(parents=True)
+    holder = subprocess.Popen([sys.executable, "-c", textwrap.dedent(f"""
+        import time
+        from pathlib import Path
+        from walkerlab.io.runpaths import artifact_lock
+        with artifact_lock(Path({str(target)!r})):
+            print('locked', flush=True); time.sleep(1.5)
+            Path({str(tmp_path / "released")!r}).touch()
+        """)], stdout=subprocess.PIPE, text=True, env={**os.environ,
+                                                        "PYTHONPATH": str(ROOT)})
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        out = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(1.0))
+        assert (tmp_path / "released").exists()  # it ran only after the first one let go
+    finally:
+        holder.wait()
+        holder.stdout.close()
+    assert not out.reused and f"pid {holder.pid}" in capfd.readouterr().err
