@@ -168,42 +168,42 @@ def _contact(d, **kw):
 @case
 def d3_contact_inf_stiffness(d):
     s = _contact(d, contact__stiffness=float("inf"))
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_inf_rate_scale(d):
     s = _contact(d, contact_sim__initial_rate_scale=[float("inf"), 1.0])
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_inf_damping(d):
     s = _contact(d, contact__max_damping=float("inf"))
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_rtol_1e14(d):
     s = _contact(d, contact_solver__rtol=1e-14)
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_mu_005(d):
     s = _contact(d, contact__mu_static=0.05, contact__mu_dynamic=0.05)
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_slope_6deg(d):
     s = _contact(d, slope={"angle_deg": 6.0})
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
@@ -413,14 +413,14 @@ def d10_nan_initial_guess(d):
 @case
 def d10_inf_patch_width(d):
     s = _contact(d, terrain__patch_width_m=float("inf"))
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d11_contact_fall_exit_code(d):
     s = _contact(d, contact_sim__initial_rate_scale=[1.0, 0.5])
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
