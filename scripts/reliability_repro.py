@@ -201,6 +201,14 @@ def d3_contact_mu_005(d):
 
 
 @case
+def d3_contact_mu_005_periodic(d):
+    s = _contact(d, contact__mu_static=0.05, contact__mu_dynamic=0.05,
+                 contact_sim__periodic_gait=True)
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
+    return rc, msg, ""
+
+
+@case
 def d3_contact_slope_6deg(d):
     s = _contact(d, slope={"angle_deg": 6.0})
     rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
