@@ -23,7 +23,9 @@ from pathlib import Path
 
 import yaml
 
-ROOT = Path(__file__).resolve().parents[1]
+import walkerlab  # noqa: E402  (the checkout under test, from PYTHONPATH)
+
+ROOT = Path(walkerlab.__file__).resolve().parents[1]  # its own configs/paper.yaml
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
 IDEAL = {k: v for k, v in PAPER.items() if k in ("source", "walker", "slope", "solver",
                                                   "fixedpoint", "simulate")}
