@@ -221,7 +221,7 @@ def test_d3_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
     write_artifact(path, "simulate", sc, "k", lambda f: None, 0.0)  # no samples/ inside
     from walkerlab.stages import plot
 
-    with pytest.raises(ArtifactError, match="damaged artifact, missing"):
+    with pytest.raises(ArtifactError, match="doesn't exist .the artifact is damaged"):
         plot.run(sc, tmp_path)
 
 

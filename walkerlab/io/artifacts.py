@@ -280,8 +280,8 @@ def open_artifact(path: Path, stage: str | None = None,
             what = str(exc.args[0]) if exc.args else "?"
             if "(" in what and what.endswith(")"):  # h5py: "Unable to ... (object 'x' ...)"
                 what = what[what.rindex("(") + 1:-1]
-            raise ArtifactError(f"{path}: damaged artifact, missing {what}; delete it and "
-                                "rerun its stage (or rerun with --force)") from None
+            raise ArtifactError(f"{path}: {what} (the artifact is damaged or lacks what "
+                                "this reader needs); rerun its stage with --force") from None
     finally:
         f.close()
 
