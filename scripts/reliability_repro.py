@@ -23,7 +23,9 @@ from pathlib import Path
 
 import yaml
 
-ROOT = Path(__file__).resolve().parents[1]
+import walkerlab  # noqa: E402  (the checkout under test, from PYTHONPATH)
+
+ROOT = Path(walkerlab.__file__).resolve().parents[1]  # its own configs/paper.yaml
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
 IDEAL = {k: v for k, v in PAPER.items() if k in ("source", "walker", "slope", "solver",
                                                   "fixedpoint", "simulate")}
@@ -147,6 +149,19 @@ def d3_readonly_runs(d):
     return rc, msg, "run as uid 65534 (root ignores modes)"
 
 
+@case
+def d3_readonly_runs_sweep(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    (d / "cfg" / "runs").mkdir(parents=True)
+    os.chmod(d / "cfg" / "runs", 0o555)
+    os.chmod(d, 0o777)
+    os.chmod(d / "cfg", 0o777)
+    os.chmod(s, 0o644)
+    rc, msg, _ = cli(d / "cfg", "sweep", str(s), "--param", "slope.angle_deg=1", "--workers",
+                     "1", "--runs-dir", "runs", user="65534", env={"HOME": str(d)})
+    return rc, msg, "run as uid 65534 (root ignores modes)"
+
+
 def _contact(d, **kw):
     return scene(d / "cfg", with_(PAPER, **{"contact_sim__periodic_gait": False,
                                             "contact_sim__n_strides": 2, **kw}), "paper.yaml")
@@ -155,42 +170,50 @@ def _contact(d, **kw):
 @case
 def d3_contact_inf_stiffness(d):
     s = _contact(d, contact__stiffness=float("inf"))
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_inf_rate_scale(d):
     s = _contact(d, contact_sim__initial_rate_scale=[float("inf"), 1.0])
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_inf_damping(d):
     s = _contact(d, contact__max_damping=float("inf"))
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_rtol_1e14(d):
     s = _contact(d, contact_solver__rtol=1e-14)
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_mu_005(d):
     s = _contact(d, contact__mu_static=0.05, contact__mu_dynamic=0.05)
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
+    return rc, msg, ""
+
+
+@case
+def d3_contact_mu_005_periodic(d):
+    s = _contact(d, contact__mu_static=0.05, contact__mu_dynamic=0.05,
+                 contact_sim__periodic_gait=True)
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d3_contact_slope_6deg(d):
     s = _contact(d, slope={"angle_deg": 6.0})
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
@@ -270,10 +293,10 @@ def d6_edited_artifact_reused(d):
 
     with h5py.File(d / "cfg/runs/paper/fixedpoint.h5", "a") as f:
         f["fixed_point/stance_rate"][()] = -3.0
-    rc, msg, _ = cli(d / "cfg", "simulate", str(s), "--runs-dir", "runs")
     p = subprocess.run([PY, "-m", "walkerlab.cli", "fixedpoint", str(s), "--runs-dir", "runs"],
                        cwd=d / "cfg", capture_output=True, text=True)
-    return rc, msg, "fixedpoint then says: " + p.stdout.strip().splitlines()[-1][:70]
+    rc, msg, _ = cli(d / "cfg", "simulate", str(s), "--runs-dir", "runs")
+    return rc, msg, "after the edit, fixedpoint says: " + p.stdout.strip().splitlines()[-1][:50]
 
 
 @case
@@ -282,7 +305,8 @@ def d7_sigkill_sweep_orphans(d):
     main = subprocess.Popen([PY, "-m", "walkerlab.cli", "sweep", str(s), "--param",
                              "slope.angle_deg=1:4:0.05", "--workers", "2", "--runs-dir", "runs"],
                             cwd=d / "cfg", stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(10)
+    kids = _wait_workers(main.pid)
+    time.sleep(3)
     kids = _children(main.pid)
     os.kill(main.pid, signal.SIGKILL)
     main.wait()
@@ -291,6 +315,17 @@ def d7_sigkill_sweep_orphans(d):
     for k in alive:
         os.kill(k, signal.SIGKILL)
     return -9, "", f"{len(kids)} descendants, {len(alive)} still alive 5 s after SIGKILL"
+
+
+def _wait_workers(pid, n=3, timeout=180):
+    t0 = time.time()
+    kids = []
+    while time.time() - t0 < timeout:
+        kids = _children(pid)
+        if len(kids) >= n:
+            break
+        time.sleep(0.2)
+    return kids
 
 
 def _children(pid):
@@ -388,14 +423,14 @@ def d10_nan_initial_guess(d):
 @case
 def d10_inf_patch_width(d):
     s = _contact(d, terrain__patch_width_m=float("inf"))
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
 @case
 def d11_contact_fall_exit_code(d):
     s = _contact(d, contact_sim__initial_rate_scale=[1.0, 0.5])
-    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs")
+    rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
 
@@ -412,12 +447,13 @@ def d11_simulate_fall_exit_code(d):
 def d12_sweep_rows_saved_early(d):
     s = scene(d / "cfg", IDEAL, "paper.yaml")
     main = subprocess.Popen([PY, "-m", "walkerlab.cli", "sweep", str(s), "--param",
-                             "slope.angle_deg=1:4:0.05", "--workers", "2", "--runs-dir", "runs",
+                             "slope.angle_deg=1:4:0.01", "--workers", "2", "--runs-dir", "runs",
                              "--name", "prog"], cwd=d / "cfg", stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, start_new_session=True)
-    time.sleep(20)
+    _wait_workers(main.pid)
+    time.sleep(15)
     os.killpg(main.pid, signal.SIGINT)
-    main.wait(timeout=60)
+    main.wait(timeout=300)
     import h5py
 
     p = d / "cfg/runs/paper/prog.h5.partial"
@@ -425,7 +461,8 @@ def d12_sweep_rows_saved_early(d):
     if p.is_file():
         with h5py.File(p) as f:
             rows = f["points/index"].shape[0]
-    return main.returncode, "", f"SIGINT after 20 s of a 61-point sweep: {rows} rows saved"
+    return main.returncode, "", (f"SIGINT 15 s after the workers started (301 points): "
+                                 f"{rows} rows saved")
 
 
 @case

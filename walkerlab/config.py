@@ -29,6 +29,7 @@ from pydantic import (
     PrivateAttr,
     Tag,
     ValidationError,
+    field_validator,
     model_validator,
 )
 
@@ -360,8 +361,7 @@ class Scene(_Strict):
 
     name: str | None = Field(None, description="run folder name (runs/<name>/); default: "
                              "YAML file stem. Letters, digits and . _ + - only, no path "
-                             "separators, not starting with a dot", max_length=100,
-                             pattern=r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
+                             "separators, not starting with a dot", max_length=100)
     source: str | None = Field(None, description="citation of the parameter set")
     published: str | None = Field(
         None, description="walkerlab.published module whose printed numbers the report sets "
@@ -397,6 +397,14 @@ class Scene(_Strict):
                                  f"(available: {', '.join(available())})")
         return self
 
+    @field_validator("name")
+    @classmethod
+    def _plain_name(cls, v: str | None) -> str | None:
+        if v is not None and not _NAME_RE.match(v):
+            raise ValueError(f"{v!r} is not a plain folder name: use letters, digits and "
+                             ". _ + - only (no path separators, not starting with a dot)")
+        return v
+
     def section_json(self, *names: str) -> str:
         """Canonical JSON of the named sections (for content hashes)."""
         d = self.model_dump(mode="json")
@@ -426,14 +434,20 @@ def _format_error(path: Path, err: ValidationError) -> str:
     errs = err.errors()
     # a union (``'fixed_point' | StateSpec``) reports one error per member: prefer the one
     # that went deepest into a mapping, it names the offending field
-    e = max(errs, key=lambda x: len([p for p in x["loc"] if _loc_part(p)]))
+    e = max(errs, key=lambda x: (len([p for p in x["loc"] if _loc_part(p)]),
+                                 x["type"] not in ("literal_error", "none_required")))
     loc = ".".join(str(p) for p in e["loc"] if _loc_part(p))
     msg = e["msg"].removeprefix("Value error, ")
     if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
             and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
                               "string_type", "float_parsing", "int_parsing"):
         msg += f" (got {e['input']!r})"
-    extra = f" (+{len(errs) - 1} more)" if len(errs) > 1 else ""
+    # other members of the same union are alternatives, not further errors
+    others = [x for x in errs if x is not e and
+              tuple(p for p in x["loc"] if _loc_part(p)) != tuple(p for p in e["loc"]
+                                                                  if _loc_part(p))[:len(
+                  [p for p in x["loc"] if _loc_part(p)])]]
+    extra = f" (+{len(others)} more)" if others else ""
     return f"{path}: {loc or '<scene>'}: {msg}{extra}"
 
 

@@ -278,8 +278,10 @@ def open_artifact(path: Path, stage: str | None = None,
             yield f
         except KeyError as exc:  # a dataset or attribute the reader needs is missing
             what = str(exc.args[0]) if exc.args else "?"
-            raise ArtifactError(f"{path}: damaged artifact, missing {what}; delete it and "
-                                "rerun its stage (or rerun with --force)") from None
+            if "(" in what and what.endswith(")"):  # h5py: "Unable to ... (object 'x' ...)"
+                what = what[what.rindex("(") + 1:-1]
+            raise ArtifactError(f"{path}: {what} (the artifact is damaged or lacks what "
+                                "this reader needs); rerun its stage with --force") from None
     finally:
         f.close()
 

@@ -44,7 +44,8 @@ MAX_NAME = 100
 
 # File stems that belong to stages (a sweep or any free --name may not take them).
 STAGE_FILES = frozenset({"fixedpoint", "simulate", "contact_sim", "compare", "workprecision",
-                         "bifurcation", "report", "plot", "sweep"})
+                         "bifurcation", "basin", "report", "plot", "sweep"})
+STAGE_PREFIXES = ("stability_map", "stability-map")  # stability_map_<kind>.h5
 
 ORIGIN_FILE = ".scene"
 
@@ -147,7 +148,7 @@ def named_artifact(scene, runs_root: Path | str, name: str, what: str = "--name"
         than ``allow_stage``.
     """
     stem = check_name(name.removesuffix(".h5"), what)
-    if stem in STAGE_FILES and stem != allow_stage:
+    if (stem in STAGE_FILES or stem.startswith(STAGE_PREFIXES)) and stem != allow_stage:
         raise RunPathError(f"{what} {name!r}: that is the name of the {stem!r} stage's "
                            "artifact; choose another name")
     d = scene_dir(scene, runs_root, claim)
