@@ -45,12 +45,16 @@ class Structure:
         True if there is a hip point mass.
     foot : str
         ``"point"``.
+    variant : str
+        ``"derived"``; ``"appendix_a"`` only for the paper's compass gait: the flow with the
+        Coriolis matrix as printed in the paper (A.5, sign of ``C[1, 0]`` flipped).
     """
 
     coordinates: str
     bodies: tuple[BodySpec, ...]
     hip_mass: bool = True
     foot: str = "point"
+    variant: str = "derived"
 
     @property
     def roles(self) -> tuple[str, ...]:
@@ -71,7 +75,7 @@ class Structure:
     def key(self) -> str:
         """Canonical JSON of the structure (part of the generated-code cache key)."""
         return json.dumps({"coordinates": self.coordinates, "foot": self.foot,
-                           "hip_mass": self.hip_mass,
+                           "hip_mass": self.hip_mass, "variant": self.variant,
                            "bodies": [[b.name, b.kind, b.massless] for b in self.bodies]})
 
 

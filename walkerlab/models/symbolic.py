@@ -27,6 +27,7 @@ Eq. 2-4), not a small-mass approximation.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 
 import sympy as sp
 
@@ -104,9 +105,12 @@ def _leg_angles(structure: Structure, q, gamma):
     return theta - gamma, theta - phi - gamma
 
 
-def _trig(e):
-    """Cheap trigonometric tidy-up: products of sines/cosines of two angles to cos(a - b)."""
-    return sp.trigsimp(sp.expand(e), method="fu") if e.has(sp.sin, sp.cos) else e
+def _pos(lin: dict) -> sp.Matrix:
+    """Position ``sum(length * e(angle))`` of a ``{angle: length}`` leg-vector sum."""
+    out = sp.zeros(2, 1)
+    for psi, length in lin.items():
+        out += length * _e(psi)
+    return out
 
 
 def _row_limit(rows: sp.Matrix, beta) -> tuple[sp.Matrix, bool]:
@@ -124,8 +128,9 @@ def _row_limit(rows: sp.Matrix, beta) -> tuple[sp.Matrix, bool]:
     return out, scaled
 
 
+@cache
 def derive(structure: Structure) -> Equations:
-    """Derive flow, impact, guards, energies and points of ``structure``.
+    """Derive flow, impact, guards, energies and points of ``structure`` (memoised per process).
 
     Returns
     -------
@@ -153,66 +158,77 @@ def derive(structure: Structure) -> Equations:
     ps_sw, ps_st = sp.symbols("psi_swing psi_stance", real=True)
     dps = sp.Matrix(sp.symbols("dpsi_swing dpsi_stance", real=True))
     psv = sp.Matrix([ps_sw, ps_st])
-    hip = -L * _e(ps_st)  # stance foot at the origin (A.2)
-    points = {"stance_foot": sp.zeros(2, 1), "hip": hip, "swing_foot": hip + L * _e(ps_sw)}
-    bodies = []  # (mass, position, inertia, link angle)
+    # every position is a sum of leg vectors: {leg angle: length along it} times e(angle)
+    hip_lin = {ps_st: -L}  # stance foot at the origin (A.2)
+    foot_lin = {ps_st: -L, ps_sw: L}
+    points = {"stance_foot": sp.zeros(2, 1), "hip": _pos(hip_lin), "swing_foot": _pos(foot_lin)}
+    bodies = []  # (mass, {angle: length}, inertia, link angle)
     if structure.hip_mass:
-        bodies.append((P["M_hip"], hip, 0, ps_st))
+        bodies.append((P["M_hip"], hip_lin, 0, ps_st))
     for b in structure.bodies:
         mass = beta if b.massless else P[f"m_{b.name}"]
         inertia = P[f"I_{b.name}"] if b.kind == "rod" else 0
         for role, psi in (("stance", ps_st), ("swing", ps_sw)):
-            pos = hip + P[f"d_{b.name}"] * _e(psi)
+            lin = dict(hip_lin)
+            lin[psi] = lin.get(psi, 0) + P[f"d_{b.name}"]
             if f"{role}_{b.name}" in points:
                 raise ValueError(f"walker.leg.bodies: body name {b.name!r} is reserved")
-            points[f"{role}_{b.name}"] = pos
-            bodies.append((mass, pos, inertia, psi))
+            points[f"{role}_{b.name}"] = _pos(lin)
+            bodies.append((mass, lin, inertia, psi))
 
     foot = points["swing_foot"]
-    Jf = foot.jacobian(psv)
-    T = sp.Integer(0)
     V = sp.Integer(0)
-    Mi = sp.zeros(2, 2)
-    Bm = sp.zeros(2, 2)
-    Mp = sp.zeros(2, 2)
-    for mass, pos, inertia, psi in bodies:
-        J = pos.jacobian(psv)
-        a = sp.Matrix([[sp.diff(psi, s) for s in psv]])
-        Mp += mass * J.T * J + inertia * a.T * a
-        V += mass * g * pos[1]
-        Jn = J - Jf  # velocity Jacobian with the swing foot at rest (new pivot)
-        Mi += mass * Jn.T * Jn + inertia * a.T * a
-        Bm += mass * Jn.T * J + inertia * a.T * a
-    Mp = Mp.applyfunc(_trig)
-    Mi = Mi.applyfunc(_trig)
-    Bm = Bm.applyfunc(_trig)
+    k = len(psv)  # links (absolute link angles)
+    Mi = sp.zeros(k, k)
+    Bm = sp.zeros(k, k)
+    Mp = sp.zeros(k, k)
+    for mass, lin, inertia, psi in bodies:
+        # d(position)/d(psi_k) = lin[psi_k] e'(psi_k), and e'(a) . e'(b) = cos(a - b): the
+        # inertia matrices come out simplified without a trigonometric simplifier
+        new = {p_: lin.get(p_, 0) - foot_lin.get(p_, 0) for p_ in psv}  # swing foot at rest
+        a = sp.Matrix([[1 if psi == p_ else 0 for p_ in psv]])
+        for i, pi_ in enumerate(psv):
+            for j, pj in enumerate(psv):
+                c = sp.cos(pi_ - pj)
+                Mp[i, j] += mass * lin.get(pi_, 0) * lin.get(pj, 0) * c
+                Mi[i, j] += mass * new[pi_] * new[pj] * c
+                Bm[i, j] += mass * new[pi_] * lin.get(pj, 0) * c
+        Mp += inertia * a.T * a
+        Mi += inertia * a.T * a
+        Bm += inertia * a.T * a
+        V += mass * g * _pos(lin)[1]
+    Mp, Mi, Bm = (X.applyfunc(sp.factor_terms) for X in (Mp, Mi, Bm))
     T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
     G = sp.Matrix([sp.diff(V, s) for s in psv])
-    C = sp.zeros(2, 2)
-    for i in range(2):
-        for j in range(2):
-            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[k]) + sp.diff(Mp[i, k], psv[j])
-                                               - sp.diff(Mp[j, k], psv[i])) * dps[k]
-                          for k in range(2))
+    C = sp.zeros(k, k)
+    for i in range(k):
+        for j in range(k):
+            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[r]) + sp.diff(Mp[i, r], psv[j])
+                                               - sp.diff(Mp[j, r], psv[i])) * dps[r]
+                          for r in range(k))  # Christoffel symbols of the first kind
+    if structure.variant == "appendix_a":  # the paper's printed A.5: C[1, 0] sign flipped
+        if structure.coordinates != "absolute" or len(structure.bodies) != 1:
+            raise ValueError("ideal.variant: appendix_a exists only for the compass gait")
+        C[1, 0] = -C[1, 0]
     lim = any(b.massless for b in structure.bodies)
     M = Mp
     if lim:
         flow, _ = _row_limit(Mp.row_join(C).row_join(G), beta)
-        M, C, G = flow[:, :2], flow[:, 2:4], flow[:, 4]
+        M, C, G = flow[:, :k], flow[:, k:2 * k], flow[:, 2 * k]
         imp, _ = _row_limit(Mi.row_join(Bm), beta)
-        Mi, Bm = imp[:, :2], imp[:, 2:]
+        Mi, Bm = imp[:, :k], imp[:, k:]
         T, V = T.subs(beta, 0), V.subs(beta, 0)
     # to the scene's coordinates: psi = A q + c, dpsi = A dq
     psi_q = sp.Matrix([psi_sw, psi_st])
     A = psi_q.jacobian(qv)
-    sub = {ps_sw: psi_sw, ps_st: psi_st, dps[0]: (A * dqv)[0], dps[1]: (A * dqv)[1]}
-    W = sp.eye(2) if lim else A.T  # keep psi rows in the limit; else Lagrange's rows in q
+    sub = {ps_sw: psi_sw, ps_st: psi_st, **{d: e for d, e in zip(dps, A * dqv)}}
+    W = sp.eye(k) if lim else A.T  # keep psi rows in the limit; else Lagrange's rows in q
     M, C, G = (W * M * A).subs(sub), (W * C * A).subs(sub), (W * G).subs(sub)
     Mi, Bm = (W * Mi * A).subs(sub), (W * Bm * A).subs(sub)
     T, V = T.subs(sub), V.subs(sub)
-    points = {k: v.subs(sub) for k, v in points.items()}
+    points = {name: v.subs(sub) for name, v in points.items()}
     hip, foot = points["hip"], points["swing_foot"]
-    bodies = [(m_, pos.subs(sub), i_, psi.subs(sub)) for m_, pos, i_, psi in bodies]
+    bodies = [(m_, _pos(lin).subs(sub), i_, psi.subs(sub)) for m_, lin, i_, psi in bodies]
 
     # role swap: new stance leg = old swing leg (absolute angles), solved for the new q
     qn = sp.symbols([f"qn_{r}" for r in structure.roles], real=True)

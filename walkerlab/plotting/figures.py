@@ -25,15 +25,28 @@ MODEL_STYLES = ["-", "--", ":", "-."]
 
 
 def save(fig, folder: Path, stem: str) -> list[Path]:
-    """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure."""
+    """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure.
+
+    Each file is written atomically (temporary name, then rename; mode 0644): an
+    interrupted save leaves the previous figure or none, never a truncated file.
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        The folder cannot be written (one line).
+    """
+    from walkerlab.io.artifacts import atomic_write
+
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
     out = []
-    for ext in ("png", "svg"):
-        p = folder / f"{stem}.{ext}"
-        fig.savefig(p, dpi=150, bbox_inches="tight")
-        out.append(p)
-    plt.close(fig)
+    try:
+        for ext in ("png", "svg"):
+            p = folder / f"{stem}.{ext}"
+            atomic_write(p, lambda fh, ext=ext: fig.savefig(fh, format=ext, dpi=150,
+                                                            bbox_inches="tight"))
+            out.append(p)
+    finally:
+        plt.close(fig)
     return out
 
 
