@@ -264,8 +264,9 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
         out += ["", "**Differences from the published Table 3, measured:**", "",
                 f"- *Left/right step periods.* A period-1 gait has identical steps: ours are "
                 f"{num(ideal['t_left_s'])} s and {num(ideal['t_right_s'])} s. The published "
-                f"{printed(t3['t_left_s'][0])} s and {printed(t3['t_right_s'][0])} s cannot both belong "
-                f"to the period-1 fixed point of Eq. (11); their sum {printed(t3['t_cycle_s'][0])} s "
+                f"{printed(t3['t_left_s'][0])} s and {printed(t3['t_right_s'][0])} s cannot "
+                f"both belong to the period-1 fixed point of Eq. (11); their sum "
+                f"{printed(t3['t_cycle_s'][0])} s "
                 f"is within {num(abs(t3['t_cycle_s'][0] - ideal['t_cycle_s']), 2)} s of our "
                 f"cycle period {num(ideal['t_cycle_s'])} s.",
                 f"- *Step length Δx.* Eq. (11) itself implies Δx = 2 L sin((θ2 − θ1)/2) = "
