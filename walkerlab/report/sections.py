@@ -387,5 +387,5 @@ def bifurcation_section(paths: dict[str, Path]) -> list[str]:
             "where the most negative real Floquet multiplier crosses −1" if np.isfinite(onset)
             else "no period doubling on the grid")
     return ["## Bifurcation over the slope", "",
-            f"Grid {num(slopes[0])}–{num(slopes[-1])}° ({slopes.size} slopes): {text}; "
+            f"Grid {printed(slopes[0])}–{printed(slopes[-1])}° ({slopes.size} slopes): {text}; "
             f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}.", ""]
