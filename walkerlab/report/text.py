@@ -22,10 +22,12 @@ def fixedpoint_text(path: Path) -> str:
         lines = [f"fixed point ({f.attrs['model']}, {f.attrs['variant']} equations), "
                  "state just after heel strike:"]
         for n in names:
-            role = n.rsplit("_", 1)[0]
+            coord = n.rsplit("_", 1)[0]
+            role = next((r for r in sorted(legs, key=len, reverse=True)
+                         if coord == r or coord.startswith(r + "_")), None)
+            where = f"({legs[role]}, {role} leg)" if role else "(not on a leg)"
             unit = f["fixed_point/" + n].attrs["unit"]
-            lines.append(f"  {n:<14s} ({legs.get(role, role)}, {role} leg) "
-                         f"{f['fixed_point/' + n][()]: .10f} {unit}")
+            lines.append(f"  {n:<14s} {where} {f['fixed_point/' + n][()]: .10f} {unit}")
         lines.append(f"  step period     {f['step_period'][()]:.10f} s")
         lines.append(f"  residual        {f['residual'][()]:.2e}  (max |P(x*) - x*|)")
         re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
