@@ -352,8 +352,9 @@ class BasinSettings(_Strict):
     max_period: int = Field(8, ge=2, le=64, description="longest period looked for [steps]")
     rtol: float = Field(1e-8, gt=0, lt=1, description="integrator relative tolerance [-]")
     atol: float = Field(1e-8, gt=0, lt=1, description="integrator absolute tolerance")
-    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this ends the "
-                                   "cell as 'stalled' [s]")
+    max_step_time_s: float | None = Field(
+        None, gt=0, description="a step longer than this ends the cell as 'stalled' [s]; "
+        "null = fixedpoint.max_step_time_s")
 
 
 class Scene(_Strict):
