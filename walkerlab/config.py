@@ -216,8 +216,8 @@ class StateSpec(_Strict):
             if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
                 raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
                                  "<role>_rate_rad_per_s)")
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ValueError(f"{k}: must be a finite number")
+            if isinstance(v, bool) or not isinstance(v, int | float):
+                raise ValueError(f"{k}: must be a number")
         if not self.model_extra:
             raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
         return self
