@@ -27,7 +27,13 @@ def with_strides(scene: Scene, strides: int | None) -> Scene:
     """Scene with ``simulate.strides`` overridden (section created with defaults if absent)."""
     sim = scene.simulate or SimulateSettings()
     if strides is not None:
-        sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+        from pydantic import ValidationError
+
+        try:
+            sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+        except ValidationError as err:
+            raise StageError(f"--strides {strides}: {err.errors()[0]['msg'].lower()} "
+                             "(simulate.strides)") from None
     return scene.model_copy(update={"simulate": sim})
 
 

@@ -121,8 +121,9 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
     best, msg = math.inf, ""
     for source, g in tries:
         try:
+            # the sweep keeps the variational multipliers only: no finite-difference check
             res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
-                                   max_step_time=fp.max_step_time_s)
+                                   max_step_time=fp.max_step_time_s, fd_check=False)
         except FixedPointNotFound as exc:
             if not (exc.residual >= best):  # keeps NaN out unless nothing better
                 best = exc.residual if math.isfinite(exc.residual) else best
@@ -276,7 +277,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
         Steps requested (2 * ``contact_sim.n_strides``).
     """
     from walkerlab.contact import ContactSimSettings
-    from walkerlab.stages.contact_sim import simulate_from
+    from walkerlab.contact.scene import simulate_from
 
     # one code path with the contact-sim stage (terrain, initial state, solver, end time)
     cs = scene.contact_sim or ContactSimSettings()
