@@ -247,8 +247,8 @@ class StateSpec(_Strict):
             if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
                 raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
                                  "<role>_rate_rad_per_s)")
-            if isinstance(v, bool) or not isinstance(v, int | float):
-                raise ValueError(f"{k}: must be a number")
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ValueError(f"{k}: must be a finite number")  # as _Strict fields
         if not self.model_extra:
             raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
         return self
@@ -426,7 +426,9 @@ def _format_error(path: Path, err: ValidationError) -> str:
     errs = err.errors()
     # a union (``'fixed_point' | StateSpec``) reports one error per member: prefer the one
     # that went deepest into a mapping, it names the offending field
-    e = max(errs, key=lambda x: len([p for p in x["loc"] if _loc_part(p)]))
+    # (on a tie, the member's own validation error beats "Input should be 'fixed_point'")
+    e = max(errs, key=lambda x: (len([p for p in x["loc"] if _loc_part(p)]),
+                                 x["type"] != "literal_error"))
     loc = ".".join(str(p) for p in e["loc"] if _loc_part(p))
     msg = e["msg"].removeprefix("Value error, ")
     if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
