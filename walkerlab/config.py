@@ -249,7 +249,7 @@ class StateSpec(_Strict):
                 raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
                                  "<role>_rate_rad_per_s)")
             if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ValueError(f"{k}: must be a finite number")
+                raise ValueError(f"{k}: must be a finite number")  # as _Strict fields
         if not self.model_extra:
             raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
         return self
