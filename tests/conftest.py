@@ -1,5 +1,12 @@
 """Shared fixtures: the paper walker and its fixed point (computed once per session)."""
 
+import os
+import tempfile
+
+# generated model code: one cache shared by all test sessions (keyed by content, so safe)
+os.environ.setdefault("WALKERLAB_CACHE_DIR",
+                      os.path.join(tempfile.gettempdir(), "walkerlab-test-models"))
+
 from pathlib import Path
 
 import numpy as np

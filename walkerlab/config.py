@@ -19,7 +19,8 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError,
+                      model_validator)
 
 from walkerlab.contact.config import ContactSettings, ContactSimSettings, TerrainSettings
 
@@ -63,9 +64,91 @@ class CompassGaitParams(_Strict):
         return self.leg_length_m - self.leg_mass_from_foot_m
 
 
-# One walker model today; a kneed walker or a walker with a torso joins this union with a
-# discriminator on ``model`` (defaulting to "compass_gait" so existing scenes stay valid).
-WalkerParams = CompassGaitParams
+# ---- generic walker description (``model: biped``): bodies, joints, feet as data.
+# A kneed leg (``knee``) and round feet (``foot.kind: arc``) extend these classes.
+class PointMassBody(_Strict):
+    """A point mass on a leg link, at ``from_hip_m`` along the link from the hip."""
+
+    kind: Literal["point_mass"] = Field(description="body type")
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (points: swing_<name>)")
+    link: Literal["leg"] = Field("leg", description="leg link carrying the body")
+    mass_kg: float = Field(ge=0, le=1e4, description="mass [kg]; 0 = the limit m/M -> 0, "
+                           "taken symbolically (Garcia et al. 1998), not a small number")
+    from_hip_m: float = Field(ge=0, le=100, description="distance from the hip along the link [m]")
+
+
+class RodBody(_Strict):
+    """A rigid rod on a leg link: mass, centre of mass along the link, inertia about the COM."""
+
+    kind: Literal["rod"] = Field(description="body type")
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (points: swing_<name>)")
+    link: Literal["leg"] = Field("leg", description="leg link carrying the body")
+    mass_kg: float = Field(gt=0, le=1e4, description="mass [kg]")
+    com_from_hip_m: float = Field(ge=0, le=100, description="centre of mass from the hip [m]")
+    inertia_about_com_kg_m2: float = Field(ge=0, le=1e6, description="moment of inertia about "
+                                           "the centre of mass [kg m^2] (uniform rod: m l^2/12)")
+
+
+Body = Annotated[PointMassBody | RodBody, Field(discriminator="kind")]
+
+
+class PointFoot(_Strict):
+    """A point foot at the end of the leg (the contact point is fixed during stance)."""
+
+    kind: Literal["point"] = Field("point", description="foot shape")
+
+
+class LegSpec(_Strict):
+    """One leg (both legs are identical): a straight link from the hip to the foot."""
+
+    length_m: float = Field(gt=0, le=100, description="leg length l, hip to foot [m]")
+    bodies: list[Body] = Field(default_factory=list, description="bodies on the leg")
+    foot: PointFoot = Field(PointFoot(), description="foot shape")
+
+    @model_validator(mode="after")
+    def _bodies_on_leg(self) -> LegSpec:
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names):
+            raise ValueError(f"walker.leg.bodies: duplicate body names {names}")
+        if "foot" in names or "hip" in names:
+            raise ValueError("walker.leg.bodies: 'foot' and 'hip' are reserved point names")
+        for b in self.bodies:
+            d = b.from_hip_m if b.kind == "point_mass" else b.com_from_hip_m
+            if d > self.length_m:
+                raise ValueError(f"walker.leg.bodies.{b.name}: lies beyond the foot "
+                                 f"({d} m > leg length {self.length_m} m)")
+        return self
+
+
+class BipedParams(_Strict):
+    """A planar passive biped described as data (``model: biped``); its equations of motion,
+    guards and impact are derived symbolically (:mod:`walkerlab.models.symbolic`)."""
+
+    model: Literal["biped"] = Field(description="generic biped description")
+    coordinates: Literal["absolute", "slope_relative"] = Field(
+        "absolute", description="'absolute': leg angles from the vertical (swing, stance; paper "
+        "Eq. 1); 'slope_relative': stance angle from the slope normal and hip angle between "
+        "the legs (Garcia et al. 1998)")
+    gravity_m_per_s2: float = Field(9.81, gt=0, le=100, description="gravity g [m/s^2]")
+    hip_mass_kg: float = Field(ge=0, le=1e4, description="hip point mass [kg]")
+    leg: LegSpec = Field(description="each leg (both are identical)")
+
+    @model_validator(mode="after")
+    def _has_mass(self) -> BipedParams:
+        if self.hip_mass_kg + sum(b.mass_kg for b in self.leg.bodies) <= 0:
+            raise ValueError("walker: the walker has no mass (hip_mass_kg and all bodies are 0)")
+        return self
+
+
+# ``model`` is the discriminator; "compass_gait" is the paper's shorthand for a biped with a
+# hip mass and one point mass per leg (expanded by walkerlab.models.description).
+def _walker_tag(v: Any) -> str:
+    return (v.get("model", "compass_gait") if isinstance(v, dict)
+            else getattr(v, "model", "compass_gait"))
+
+
+WalkerParams = Annotated[Annotated[CompassGaitParams, Tag("compass_gait")]
+                         | Annotated[BipedParams, Tag("biped")], Discriminator(_walker_tag)]
 
 
 class SlopeSettings(_Strict):
@@ -208,7 +291,7 @@ class Scene(_Strict):
 
 def _format_error(path: Path, err: ValidationError) -> str:
     e = err.errors()[0]
-    tags = {"compass_gait"}  # discriminator tags of walker models: not part of the field path
+    tags = {"compass_gait", "biped", "point_mass", "rod", "point"}  # discriminator tags of walker models: not part of the field path
     loc = ".".join(str(p) for p in e["loc"]
                    if not str(p).startswith("function-after") and str(p) not in tags)
     msg = e["msg"].removeprefix("Value error, ")

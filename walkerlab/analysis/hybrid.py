@@ -121,8 +121,10 @@ def _events_for(phase: Phase, n: int):
     return evs
 
 
-def _grad(fun, x):
-    return complex_step_jacobian(lambda z: np.atleast_1d(fun(0.0, z)), x)[0]
+def _grad(guard, x):
+    if guard.gradient is not None:
+        return np.asarray(guard.gradient(x), dtype=float)
+    return complex_step_jacobian(lambda z: np.atleast_1d(guard.function(0.0, z)), x)[0]
 
 
 def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: float = 0.0,
@@ -199,11 +201,16 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         event = guard.name
         if guard.outcome == "next_phase":
             phase_times[guard.name] = t
+            x_minus = x
+            if guard.reset is not None:  # intra-step impact (e.g. knee strike)
+                x = np.asarray(guard.reset(x_minus), dtype=float)
             if k + 1 < len(walker.phases) and variational:
                 nxt = walker.phases[k + 1]
-                f_prev, f_next = phase.flow(t, x), nxt.flow(t, x)
-                dg = _grad(guard.function, x)
-                Phi = (np.eye(n) + np.outer(f_next - f_prev, dg) / (dg @ f_prev)) @ Phi
+                f_prev, f_next = phase.flow(t, x_minus), nxt.flow(t, x)
+                dg = _grad(guard, x_minus)
+                DR = np.eye(n) if guard.reset is None else guard.reset_jacobian(x_minus)
+                # saltation matrix: DR + (f+ - DR f-) dg^T / (dg . f-)
+                Phi = (DR + np.outer(f_next - DR @ f_prev, dg) / (dg @ f_prev)) @ Phi
             continue
         if guard.outcome == "fall":
             termination = "fall"
@@ -212,7 +219,7 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         x_next = walker.reset(x)
         if variational:
             f_prev = phase.flow(t, x)
-            dg = _grad(guard.function, x)
+            dg = _grad(guard, x)
             S = np.eye(n) - np.outer(f_prev, dg) / (dg @ f_prev)
             Phi = walker.reset_jacobian(x) @ S @ Phi
         break

@@ -53,6 +53,9 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
     """
+    from walkerlab.models.cache import set_cache_dir
+
+    set_cache_dir(Path(runs_root) / ".cache" / "models")  # generated model code lives in runs/
     path = artifact_path(scene, runs_root, stage)
     key = input_hash(stage, scene, sections, upstream)
     if not force and path.is_file() and stored_hash(path) == key:

@@ -1,0 +1,85 @@
+"""Build a :class:`~walkerlab.models.base.HybridWalker` from generated model code.
+
+Any biped described as data (:mod:`walkerlab.models.description`) becomes a walker here: the
+flow, its Jacobian, guards and their gradients, the heel-strike reset and its Jacobian,
+energies, points and leg angles all come from the generated module
+(:mod:`walkerlab.models.codegen`, cached by :mod:`walkerlab.models.cache`).
+
+Phases of a step (point feet, straight legs):
+
+- ``early_swing`` until ``swing_foot_ahead`` (``psi_sw - psi_st``) crosses zero upward (the
+  legs pass each other; the point foot scuffs through the ground there, which the ideal
+  model ignores, paper Sec. 3.2);
+- ``late_swing`` until ``heel_strike`` (``psi_sw + psi_st + 2 gamma`` decreasing through
+  zero: the swing foot reaches the slope), or a fall: the swing leg falls back behind the
+  stance leg, or the hip reaches the slope.
+"""
+
+from __future__ import annotations
+
+from walkerlab.models.base import Guard, HybridWalker, Phase
+from walkerlab.models.cache import generated_module
+from walkerlab.models.description import WalkerData
+
+LEGS = ("leg1", "leg2")
+
+
+def role_to_leg(stance_leg: str) -> dict[str, str]:
+    """``{"stance": stance_leg, "swing": other leg}``.
+
+    Raises
+    ------
+    KeyError
+        ``stance_leg`` is not ``leg1`` or ``leg2``.
+    """
+    other = {"leg1": "leg2", "leg2": "leg1"}[stance_leg]
+    return {"stance": stance_leg, "swing": other}
+
+
+def functions(data: WalkerData) -> dict:
+    """Generated functions of ``data`` with its parameters bound (see codegen's table)."""
+    return generated_module(data.structure)["make"](data.params)
+
+
+def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "derived",
+                      flow=None, flow_jacobian=None, reset=None, reset_jacobian=None
+                      ) -> HybridWalker:
+    """A hybrid walker from generated code; ``flow``/``reset`` may override the generated ones
+    (the paper's printed Appendix A variants).
+
+    Parameters
+    ----------
+    data : WalkerData
+    name, variant : str
+        Stored in artifacts.
+    flow, flow_jacobian, reset, reset_jacobian : callable, optional
+        Replacements for the generated functions (same signatures).
+
+    Returns
+    -------
+    HybridWalker
+    """
+    f = functions(data)
+    flow = flow or f["flow"]
+    fall = Guard("fall", f["guard_hip_height"], -1, "fall", gradient=f["grad_hip_height"])
+    ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
+    early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead), fall),
+                  jacobian=flow_jacobian or f["flow_jacobian"])
+    late = Phase("late_swing", flow, (
+        Guard("heel_strike", f["guard_heel_strike"], -1, "heel_strike", f["grad_heel_strike"]),
+        Guard("swing_leg_falls_back", ahead, -1, "fall", dahead), fall),
+        jacobian=flow_jacobian or f["flow_jacobian"])
+    structure = data.structure
+    params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
+              "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
+              **dict(zip(structure.param_names, data.params))}
+    coords = None if structure.coordinates == "absolute" else f["leg_angles"]
+    return HybridWalker(
+        name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=(early, late),
+        reset=reset or f["reset"], energies=f["energies"], points=f["points"],
+        section=f["section"], from_section=f["from_section"], role_to_leg=role_to_leg,
+        total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad, params=params,
+        variational=flow_jacobian or f["flow_jacobian"],
+        reset_jacobian=reset_jacobian or f["reset_jacobian"],
+        heel_strike_guard=f["guard_heel_strike"], leg_angles=coords,
+    )
