@@ -168,10 +168,10 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     x_next = None
     for k, phase in enumerate(walker.phases):
         if variational:
-            def rhs(tt, y, _f=phase.flow):
+            def rhs(tt, y, _f=phase.flow, _jac=phase.jacobian or walker.variational):
                 xs = y[:n]
                 P = y[n:].reshape(n, n)
-                A = walker.variational(tt, xs)
+                A = _jac(tt, xs)  # the phase's own flow Jacobian (e.g. knee locked)
                 return np.concatenate([_f(tt, xs), (A @ P).ravel()])
             y0 = np.concatenate([x, Phi.ravel()])
         else:

@@ -173,9 +173,10 @@ class HybridWalker:
 
     @property
     def coordinate_units(self) -> dict[str, str]:
-        """Units of the :meth:`leg_coordinates` series, by name."""
-        return {f"{leg}_{kind}": u for leg in self.legs
-                for kind, u in (("angle", "rad"), ("rate", "rad/s"))}
+        """Units of the :meth:`leg_coordinates` series, by name (``*_angle`` rad, ``*_rate``
+        rad/s; a kneed walker has ``<leg>_thigh_angle``, ``<leg>_shank_angle``, ...)."""
+        keys = self.leg_coordinates(np.zeros(2 * self.n_coordinates), self.legs[1])
+        return {k: ("rad" if k.endswith("_angle") else "rad/s") for k in keys}
 
     def leg_coordinates(self, X: np.ndarray, stance_leg: str) -> dict[str, np.ndarray]:
         """Absolute angle [rad] and rate [rad/s] of each physical leg, keyed ``<leg>_angle``,
