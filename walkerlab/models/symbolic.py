@@ -255,9 +255,10 @@ def derive(structure: Structure) -> Equations:
         Jn = J - Jf  # velocity Jacobian with the swing foot at rest (new pivot)
         Mi += mass * Jn.T * Jn + inertia * a.T * a
         Bm += mass * Jn.T * J + inertia * a.T * a
-    Mp = Mp.applyfunc(_trig)
-    Mi = Mi.applyfunc(_trig)
-    Bm = Bm.applyfunc(_trig)
+    if not (knee or arc):  # fu's tidy-up costs seconds per entry on the longer expressions
+        Mp = Mp.applyfunc(_trig)
+        Mi = Mi.applyfunc(_trig)
+        Bm = Bm.applyfunc(_trig)
     T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
     G = sp.Matrix([sp.diff(V, s) for s in psv])
     C = sp.zeros(n, n)
