@@ -10,7 +10,7 @@ import numpy as np
 import sympy as sp
 
 
-def lagrange(q, dq, bodies, g):
+def lagrange(q, dq, bodies, g, mass_matrix_only=False):
     """Mass matrix, velocity terms and gravity of ``T - V`` for planar bodies.
 
     Parameters
@@ -26,21 +26,24 @@ def lagrange(q, dq, bodies, g):
     M : Matrix (n, n); h : Matrix (n,) with ``M qdd + h = 0``; T, V : Expr
     """
     qv, dqv = sp.Matrix(q), sp.Matrix(dq)
-    T = sp.Integer(0)
+    n = len(q)
+    M = sp.zeros(n, n)
     V = sp.Integer(0)
     for m, inertia, p, ang in bodies:
-        v = p.jacobian(qv) * dqv
-        T += sp.Rational(1, 2) * m * (v.T * v)[0]
+        J = p.jacobian(qv)
+        M += m * J.T * J
         if inertia != 0:
-            w = (sp.Matrix([ang]).jacobian(qv) * dqv)[0]
-            T += sp.Rational(1, 2) * inertia * w**2
+            a = sp.Matrix([ang]).jacobian(qv)
+            M += inertia * a.T * a
         V += m * g * p[1]
-    M = sp.hessian(T, dqv)
-    # d/dt dL/ddq - dL/dq = M qdd + (dM/dt) dq - dT/dq + dV/dq
-    Mdot_dq = sp.Matrix([sum(sp.diff(M[i, j], q[k]) * dq[k] * dq[j]
-                             for j in range(len(q)) for k in range(len(q)))
-                         for i in range(len(q))])
-    h = Mdot_dq - sp.Matrix([sp.diff(T, qi) for qi in q]) + sp.Matrix([sp.diff(V, qi) for qi in q])
+    T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
+    if mass_matrix_only:
+        return M, None, T, V
+    # d/dt dT/ddq - dT/dq + dV/dq = M qdd + h
+    dM = [M.diff(qk) for qk in q]
+    h = sp.Matrix([sum((dM[k][i, j] - sp.Rational(1, 2) * dM[i][j, k]) * dq[j] * dq[k]
+                       for j in range(n) for k in range(n)) + sp.diff(V, q[i])
+                   for i in range(n)])
     return M, h, T, V
 
 

@@ -21,7 +21,7 @@ unlocks.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache, cached_property
 
 import numpy as np
 import sympy as sp
@@ -51,6 +51,7 @@ TEDRAKE_X0 = np.array([0.187700106303669, -0.288437140111164, -0.288437140111164
                        -1.101439041094875, -0.039885255927632, -0.039885255927632])
 
 
+@cache
 def _symbolic():
     q = sp.symbols("q1 q2 q3", real=True)
     dq = sp.symbols("dq1 dq2 dq3", real=True)
@@ -78,12 +79,21 @@ def _symbolic():
     xf, yf, dxf, dyf = sp.symbols("xf yf dxf dyf", real=True)
     qe, dqe = (*q, xf, yf), (*dq, dxf, dyf)
     off = sp.Matrix([xf, yf])
-    Me, _, _, _ = lagrange(qe, dqe, [(m, 0, p + off, a) for m, _, p, a in bodies], g)
+    Me, _, _, _ = lagrange(qe, dqe, [(m, 0, p + off, a) for m, _, p, a in bodies], g, mass_matrix_only=True)
     E = (pts["swing_foot"] + off).jacobian(sp.Matrix(qe))
     par = (g, lt, ls, mh, mt, ms, a1, b1, a2, b2)
     masses = {"stance_shank": ms, "stance_thigh": mt, "hip": mh, "swing_thigh": mt,
               "swing_shank": ms}
     return q, dq, par, M, h, T, V, Me, E, pts, masses
+
+
+@cache
+def _lambdified():
+    q, dq, par, M, h, T, V, Me, E, pts, masses = _symbolic()
+    a = (q, dq, par)
+    return {"M": lam((q, par), M), "h": lam(a, h), "T": lam(a, T), "V": lam((q, par), V),
+            "Me": lam((q, par), Me), "E": lam((q, par), E),
+            "pts": {k: lam((q, par), v) for k, v in pts.items()}}
 
 
 @dataclass
@@ -97,10 +107,7 @@ class KneedReference:
     @cached_property
     def _f(self):
         q, dq, par, M, h, T, V, Me, E, pts, masses = _symbolic()
-        a = (q, dq, par)
-        f = {"M": lam((q, par), M), "h": lam(a, h), "T": lam(a, T), "V": lam((q, par), V),
-             "Me": lam((q, par), Me), "E": lam((q, par), E),
-             "pts": {k: lam((q, par), v) for k, v in pts.items()}}
+        f = dict(_lambdified())
         f["mass_of"] = {k: float(v.subs({s: self._par()[i] for i, s in enumerate(par)}))
                         for k, v in masses.items()}
         return f

@@ -22,7 +22,7 @@ touches when ``psi_st = 0``; the contact point is then ``-R psi_st`` along the s
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache
 
 import numpy as np
 import sympy as sp
@@ -41,6 +41,7 @@ _Z = (0.189472782205104, -0.239124222551699, 0.378945564410209, -0.0536917039093
 BHOUNSULE_FIXED_POINT = np.array([_Z[0] - _Z[2] - 0.01, _Z[0] - 0.01, _Z[1] - _Z[3], _Z[1]])
 
 
+@cache
 def _symbolic():
     q = sp.symbols("th_sw th_st", real=True)
     dq = sp.symbols("w_sw w_st", real=True)
@@ -70,7 +71,7 @@ def _symbolic():
     xf, yf, dxf, dyf = sp.symbols("xf yf dxf dyf", real=True)
     qe, dqe = (*q, xf, yf), (*dq, dxf, dyf)
     off = sp.Matrix([xf, yf])
-    Me, _, _, _ = lagrange(qe, dqe, [(mm, ii, p + off, a) for mm, ii, p, a in bodies], g)
+    Me, _, _, _ = lagrange(qe, dqe, [(mm, ii, p + off, a) for mm, ii, p, a in bodies], g, mass_matrix_only=True)
     # velocity of the swing foot's material point at the contact: v_centre + w x (-R n)
     qev = sp.Matrix(qe)
     v_centre_J = (centre_sw + off).jacobian(qev)
@@ -81,6 +82,15 @@ def _symbolic():
     return q, dq, par, Mm, h, T, V, Me, E, pts
 
 
+@cache
+def _lambdified():
+    q, dq, par, Mm, h, T, V, Me, E, pts = _symbolic()
+    a = (q, dq, par)
+    return {"M": lam((q, par), Mm), "h": lam(a, h), "T": lam(a, T), "V": lam((q, par), V),
+            "Me": lam((q, par), Me), "E": lam((q, par), E),
+            "pts": {k: lam((q, par), v) for k, v in pts.items()}}
+
+
 @dataclass
 class RoundFeetReference:
     """Round-foot compass gait (independent prototype)."""
@@ -89,13 +99,9 @@ class RoundFeetReference:
     rtol: float = 1e-12
     atol: float = 1e-12
 
-    @cached_property
+    @property
     def _f(self):
-        q, dq, par, Mm, h, T, V, Me, E, pts = _symbolic()
-        a = (q, dq, par)
-        return {"M": lam((q, par), Mm), "h": lam(a, h), "T": lam(a, T), "V": lam((q, par), V),
-                "Me": lam((q, par), Me), "E": lam((q, par), E),
-                "pts": {k: lam((q, par), v) for k, v in pts.items()}}
+        return _lambdified()
 
     def _par(self):
         p = self.p
