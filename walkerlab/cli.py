@@ -197,15 +197,16 @@ def bifurcation(scene: Path | None = SceneArg,
                                               help="steps discarded before sampling"),
                 keep: int = typer.Option(30, "--keep", min=1, help="heel strikes kept per slope"),
                 workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
-                runs_dir: Path = RunsOpt) -> None:
+                runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Bifurcation diagram over the slope: fixed points, multipliers, period-doubling onset."""
-    from walkerlab.sweep.bifurcation import run_bifurcation
+    from walkerlab.stages import bifurcation as stage
     from walkerlab.sweep.params import parse_param
 
     axis = parse_param(f"slope.angle_deg={slopes}")
-    out = run_bifurcation(_load(scene), axis.values, runs_dir, transient, keep, workers)
-    typer.echo(f"period-doubling onset: {out['onset_deg']:.4f} deg")
-    typer.echo(f"wrote {out['artifact']} and {', '.join(str(p) for p in out['figures'])}")
+    out = stage.run(_load(scene), axis.values, runs_dir, transient, keep, workers, force=force)
+    typer.echo(f"period-doubling onset: {out.summary['onset_deg']:.4f} deg")
+    typer.echo(_status(out))
+    typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
 
 
 @app.command("stability-map")

@@ -313,6 +313,9 @@ class Scene(_Strict):
 
     name: str | None = Field(None, description="run folder name; default: YAML file stem")
     source: str | None = Field(None, description="citation of the parameter set")
+    published: str | None = Field(
+        None, description="walkerlab.published module whose printed numbers the report sets "
+        "next to ours (e.g. 'paper'); null: no published comparison")
     walker: WalkerParams
     slope: SlopeSettings
     ideal: IdealModelSettings = IdealModelSettings()
@@ -324,6 +327,16 @@ class Scene(_Strict):
     contact_sim: ContactSimSettings | None = None
     contact_solver: ContactSolverSettings | None = None
     workprecision: WorkPrecisionSettings | None = None
+
+    @model_validator(mode="after")
+    def _published_exists(self) -> Scene:
+        if self.published is not None:
+            from walkerlab.published import available
+
+            if self.published not in available():
+                raise ValueError(f"published: no module walkerlab.published.{self.published} "
+                                 f"(available: {', '.join(available())})")
+        return self
 
     def section_json(self, *names: str) -> str:
         """Canonical JSON of the named sections (for content hashes)."""

@@ -27,6 +27,7 @@ import h5py
 import numpy as np
 
 import walkerlab
+from walkerlab.io import netcdf
 
 
 class ArtifactError(RuntimeError):
@@ -45,10 +46,12 @@ def code_hash() -> str:
 
 
 def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "",
-        **attrs) -> h5py.Dataset:
+        dims: tuple[str | None, ...] | None = None, **attrs) -> h5py.Dataset:
     """Create dataset ``name`` (intermediate groups allowed) with unit and description.
 
-    Strings and lists of strings are stored as UTF-8 variable-length strings.
+    Strings and lists of strings are stored as UTF-8 variable-length strings.  ``dims``
+    names the dimension of each axis (netCDF-4 dimension scales, see
+    :mod:`walkerlab.io.netcdf`); ``units`` and ``long_name`` are added for netCDF readers.
     """
     if isinstance(data, str) or (isinstance(data, (list, tuple)) and data
                                  and isinstance(data[0], str)):
@@ -56,8 +59,12 @@ def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "
     ds = group.create_dataset(name, data=data)
     ds.attrs["unit"] = unit
     ds.attrs["description"] = description
+    ds.attrs["units"] = netcdf.cf_units(unit)
+    ds.attrs["long_name"] = description or name.rsplit("/", 1)[-1]
     for k, v in attrs.items():
         ds.attrs[k] = v
+    if dims is not None:
+        netcdf.attach(ds, dims)
     return ds
 
 
@@ -116,6 +123,7 @@ def write_artifact(path: Path, stage: str, scene, input_hash: str,
             for k, v in (extra_attrs or {}).items():
                 f.attrs[k] = v
             writer(f)
+            netcdf.finish(f)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -173,10 +173,9 @@ class HybridWalker:
 
     @property
     def coordinate_units(self) -> dict[str, str]:
-        """Units of the :meth:`leg_coordinates` series, by name (``*_angle`` rad, ``*_rate``
-        rad/s; a kneed walker has ``<leg>_thigh_angle``, ``<leg>_shank_angle``, ...)."""
-        keys = self.leg_coordinates(np.zeros(2 * self.n_coordinates), self.legs[1])
-        return {k: ("rad" if k.endswith("_angle") else "rad/s") for k in keys}
+        """Unit of each key of :meth:`leg_coordinates` (``*_angle`` [rad], ``*_rate`` [rad/s])."""
+        names = self.leg_coordinates(np.zeros(2 * self.n_coordinates), self.legs[-1])
+        return {k: ("rad" if k.endswith("_angle") else "rad/s") for k in names}
 
     def leg_coordinates(self, X: np.ndarray, stance_leg: str) -> dict[str, np.ndarray]:
         """Absolute angle [rad] and rate [rad/s] of each physical leg, keyed ``<leg>_angle``,
@@ -205,6 +204,8 @@ class HybridWalker:
         r2l = self.role_to_leg(stance_leg)
         out = {}
         for key, val in by_role.items():
-            role = next(r for r in sorted(r2l, key=len, reverse=True) if key.startswith(r + "_"))
-            out[r2l[role] + key[len(role):]] = np.asarray(val)
+            # role-prefixed series belong to a leg; others (a torso, say) keep their role name
+            role = next((r for r in sorted(r2l, key=len, reverse=True)
+                         if key.startswith(r + "_")), None)
+            out[key if role is None else r2l[role] + key[len(role):]] = np.asarray(val)
         return out

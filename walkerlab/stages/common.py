@@ -34,10 +34,12 @@ def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
 
 
 def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
-               upstream: tuple[Path, ...] = ()) -> str:
-    """Content hash of everything a stage's output depends on."""
+               upstream: tuple[Path, ...] = (), extra: str = "") -> str:
+    """Content hash of everything a stage's output depends on (``extra``: stage options
+    that are not scene sections, e.g. a bifurcation grid)."""
     h = hashlib.sha256()
     h.update(stage.encode())
+    h.update(extra.encode())
     h.update(scene.section_json(*sections).encode())
     h.update(walkerlab.__version__.encode())
     h.update(code_hash().encode())
@@ -48,7 +50,8 @@ def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
 
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
-               force: bool = False, extra_attrs: dict | None = None) -> StageOutcome:
+               force: bool = False, extra_attrs: dict | None = None,
+               extra_key: str = "") -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
@@ -57,7 +60,7 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
 
     set_cache_dir(Path(runs_root) / ".cache" / "models")  # generated model code lives in runs/
     path = artifact_path(scene, runs_root, stage)
-    key = input_hash(stage, scene, sections, upstream)
+    key = input_hash(stage, scene, sections, upstream, extra_key)
     if not force and path.is_file() and stored_hash(path) == key:
         return StageOutcome(stage, path, True, 0.0, {})
     t0 = time.perf_counter()

@@ -84,8 +84,11 @@ def named_trajectory(walker, res) -> NamedTrajectory:
         pts[f"{leg}_foot"] = np.asarray(feet)[:, i, :].T
         pts[f"{leg}_mass"] = hip + b * np.vstack([np.sin(th), -np.cos(th)])
     return NamedTrajectory(
-        time=t, legs=LEGS, angle={"leg1": X[:, 2], "leg2": X[:, 3]},
-        rate={"leg1": X[:, 6], "leg2": X[:, 7]}, stance_leg=stance, step_index=step,
+        time=t, legs=LEGS,
+        coordinates={"leg1_angle": X[:, 2], "leg2_angle": X[:, 3], "leg1_rate": X[:, 6],
+                     "leg2_rate": X[:, 7]},
+        units={"leg1_angle": "rad", "leg2_angle": "rad", "leg1_rate": "rad/s",
+               "leg2_rate": "rad/s"}, stance_leg=stance, step_index=step,
         kinetic=en["kinetic"], potential=en["potential"], points=pts)
 
 

@@ -11,13 +11,12 @@ from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import put
+from walkerlab.io.netcdf import coordinate
+from walkerlab.io.readers import load_fixed_point  # noqa: F401  (re-exported for stages)
 from walkerlab.models.registry import build_walker
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
-
-# The paper's Eq. (11), printed to these digits (rad, rad/s); role-ordered.
-PAPER_EQ11 = np.array([-0.2022, 0.1674, -0.60, -0.84])
 
 
 def _variants_for(scene: Scene) -> tuple[str, ...]:
@@ -40,7 +39,7 @@ def solve_variant(scene: Scene, variant: str):
 
 def _write_result(g, walker, res, guess) -> None:
     names = walker.state_names()
-    units = ["rad"] * walker.n_coordinates + ["rad/s"] * walker.n_coordinates
+    units = walker.state_units()
     g.attrs["variant"] = walker.variant
     g.attrs["roles"] = list(walker.roles)
     g.attrs["legs_by_role"] = json.dumps(walker.role_to_leg("leg2"))
@@ -52,10 +51,12 @@ def _write_result(g, walker, res, guess) -> None:
     put(g, "residual", res.residual, "rad or rad/s", "max |P(x*) - x*| over the state")
     for kind, ev, J in (("variational", res.multipliers_variational, res.jacobian_variational),
                         ("finite_difference", res.multipliers_fd, res.jacobian_fd)):
-        put(g, f"floquet/{kind}/real", ev.real, "-", f"Floquet multipliers ({kind}), real part")
-        put(g, f"floquet/{kind}/imag", ev.imag, "-", f"Floquet multipliers ({kind}), imag part")
+        put(g, f"floquet/{kind}/real", ev.real, "-", f"Floquet multipliers ({kind}), real part",
+            dims=("multiplier",))
+        put(g, f"floquet/{kind}/imag", ev.imag, "-", f"Floquet multipliers ({kind}), imag part",
+            dims=("multiplier",))
         put(g, f"floquet/{kind}/jacobian", J, "-", "DP, rows/cols in state_names order",
-            state_names=names)
+            dims=("state", "state_in"), state_names=names)
     put(g, "floquet/max_difference", res.multiplier_difference, "-",
         "max |multiplier(variational) - multiplier(finite difference)|")
     put(g, "floquet/stable", res.stable, "-", "all |multipliers| < 1")
@@ -92,9 +93,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
             f.attrs["model"] = walker.name
             f.attrs["variant"] = walker.variant
             f.attrs["state_names"] = walker.state_names()
+            names = walker.state_names()
+            coordinate(f, "state", names, "-", "state component (role-ordered)")
+            coordinate(f, "state_in", names, "-", "state component perturbed (Jacobian column)")
+            coordinate(f, "multiplier", np.arange(len(names)), "-",
+                       "Floquet multiplier number (sorted by modulus)")
             _write_result(f, walker, main, guess)
-            put(f, "paper/eq11", PAPER_EQ11, "rad, rad/s", "paper Eq. (11) as printed",
-                state_names=walker.state_names())
             for v, r in results.items():
                 if isinstance(r, Exception):
                     f.create_group(f"variants/{v}").attrs["error"] = str(r)
@@ -106,15 +110,3 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         return writer, summary
 
     return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force)
-
-
-def load_fixed_point(path: Path) -> tuple[np.ndarray, dict]:
-    """Fixed point (role-ordered state) and metadata from ``fixedpoint.h5``."""
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(path, "fixedpoint") as f:
-        names = [str(n) for n in f.attrs["state_names"]]
-        x = np.array([f[f"fixed_point/{n}"][()] for n in names])
-        meta = {"step_period_s": float(f["step_period"][()]), "state_names": names,
-                "stable": bool(f["floquet/stable"][()])}
-    return x, meta

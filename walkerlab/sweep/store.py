@@ -31,7 +31,7 @@ import h5py
 import numpy as np
 
 import walkerlab
-from walkerlab.sweep.outcomes import COLUMNS, OUTCOMES, STRING_COLUMNS
+from walkerlab.sweep.outcomes import OUTCOMES, STRING_COLUMNS, walker_columns
 from walkerlab.sweep.params import ParamAxis, SweepError
 
 __all__ = ["SweepStore", "partial_path", "load_sweep"]
@@ -98,7 +98,7 @@ class SweepStore:
         for name, desc in STRING_COLUMNS.items():
             mk(name, STR, "-", desc)
         mk("wall_time_s", np.float64, "s", "wall time of the point on its worker")
-        for name, (unit, desc) in COLUMNS[stage].items():
+        for name, (unit, desc) in walker_columns(stage, scene).items():
             mk(name, np.float64, unit, desc)
         f.flush()
         return cls(final, f, stage, axes)
@@ -149,8 +149,10 @@ class SweepStore:
         for name in STRING_COLUMNS:
             put(name, np.asarray([str(r.get(name, "")) for r in rows], dtype=object))
         put("wall_time_s", np.array([r["wall_time_s"] for r in rows], float))
-        for name in COLUMNS[self.stage]:
-            put(name, np.array([r.get(name, np.nan) for r in rows], float))
+        fixed = {"index", "wall_time_s", *STRING_COLUMNS}
+        for name, ds in g.items():  # the stage's float columns, as created for this walker
+            if isinstance(ds, h5py.Dataset) and name not in fixed:
+                put(name, np.array([r.get(name, np.nan) for r in rows], float))
         self.f.flush()
 
     def add_wall_time(self, seconds: float) -> None:
