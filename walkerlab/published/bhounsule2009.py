@@ -17,6 +17,8 @@ CITATION = ("T. McGeer, Passive dynamic walking, Int. J. Robotics Research 9(2),
             "parameters and root: P. A. Bhounsule, passivewalker.m, Cornell 2009 "
             "(github.com/pab47/pab47.github.io)")
 
+SHORT = "bhounsule2009"
+
 GRAVITY = 1.0                 # nondimensional
 HIP_TO_FOOT_CENTRE = 1.0      # l
 FOOT_RADIUS = 0.2             # r
@@ -38,3 +40,18 @@ def root_as_absolute_angles() -> dict:
     q1, u1, q2, u2 = ROOT_Q1_U1_Q2_U2
     return {"swing_angle_rad": q1 - q2 - SLOPE_RAD, "stance_angle_rad": q1 - SLOPE_RAD,
             "swing_rate_rad_per_s": u1 - u2, "stance_rate_rad_per_s": u1}
+
+
+# The report's published-fixed-point interface (named after the paper's Eq. 11): the printed
+# root as the role-ordered state [swing_angle, stance_angle, swing_rate, stance_rate].
+EQ11_NAMES = ("swing_angle", "stance_angle", "swing_rate", "stance_rate")
+EQ11_STATE = tuple(root_as_absolute_angles()[n + ("_rad" if n.endswith("_angle") else
+                                                   "_rad_per_s")] for n in EQ11_NAMES)
+FIXED_POINT_LABEL = "passivewalker.m root"
+FIXED_POINT_NOTE = (
+    "passivewalker.m's heel-strike law writes the old stance leg's spin angular momentum about "
+    "the hip as I (v1 - v2) instead of I v1 (v2 is the rate of the angle between the legs). "
+    "With I = 0 its law and ours agree to round-off (tests/test_kneed_round_feet.py); with the "
+    "printed I = 0.02 its root lies 3.4e-5 rad from our fixed point in the angles and 2.2e-3 "
+    "rad/s in the swing rate. Our gait is also the fixed point of the independent prototype "
+    "tests/independent/round_feet_reference.py.")

@@ -134,7 +134,8 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
         main = str(f.attrs["variant"])
         rows = []
         if eq is not None and eq.size == len(names):
-            rows.append([f"{pub.SHORT} Eq. (11) (printed)", *[num(v) for v in eq], "—", "—",
+            label = getattr(pub, "FIXED_POINT_LABEL", "Eq. (11)")
+            rows.append([f"{pub.SHORT} {label} (printed)", *[num(v) for v in eq], "—", "—",
                          "—"])
         fps = {}
         for v in f["variants"]:
@@ -153,6 +154,8 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
         out.append("")
         out.append("State right after heel strike, role-ordered (the swing leg is the one that "
                    "just left the ground).")
+        if eq is not None and getattr(pub, "FIXED_POINT_NOTE", None):
+            out += ["", f"**Why the numbers differ.** {pub.FIXED_POINT_NOTE}"]
         if eq is not None and "appendix_a" in fps and "derived" in fps:
             d = fps["derived"] - eq
             a = fps["appendix_a"] - eq
