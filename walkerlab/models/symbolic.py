@@ -44,6 +44,7 @@ Eq. 2-4), not a small-mass approximation.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 
 import sympy as sp
 
@@ -131,9 +132,12 @@ def _leg_angles(structure: Structure, q, gamma):
     return theta - gamma, theta - phi - gamma
 
 
-def _trig(e):
-    """Cheap trigonometric tidy-up: products of sines/cosines of two angles to cos(a - b)."""
-    return sp.trigsimp(sp.expand(e), method="fu") if e.has(sp.sin, sp.cos) else e
+def _pos(lin: dict) -> sp.Matrix:
+    """Position ``sum(length * e(angle))`` of a ``{angle: length}`` leg-vector sum."""
+    out = sp.zeros(2, 1)
+    for psi, length in lin.items():
+        out += length * _e(psi)
+    return out
 
 
 def _row_limit(rows: sp.Matrix, beta) -> tuple[sp.Matrix, bool]:
@@ -151,8 +155,9 @@ def _row_limit(rows: sp.Matrix, beta) -> tuple[sp.Matrix, bool]:
     return out, scaled
 
 
+@cache
 def derive(structure: Structure) -> Equations:
-    """Derive flow, impact, guards, energies and points of ``structure``.
+    """Derive flow, impact, guards, energies and points of ``structure`` (memoised per process).
 
     Returns
     -------
@@ -197,68 +202,84 @@ def derive(structure: Structure) -> Equations:
         ps_shank = ps_sw
     normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
     tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])  # along the slope, downhill
-    if arc:
-        R = P["R_foot"]
-        contact = -R * (ps_st + gamma) * tangent  # rolling without slip
-        hip = contact + R * normal - (L - R) * _e(ps_st)
-    else:
-        hip = -L * _e(ps_st)  # stance foot at the origin (A.2)
     lt = P["L_thigh"] if knee else 0
-    knee_pt = hip + lt * _e(ps_sw) if knee else hip
+    R = P["R_foot"] if arc else 0
+    # every position is a sum of leg vectors {link angle: length along it} times e(angle),
+    # plus, with arc feet, the rolling offset of the stance arc (contact + R n) - (L - R) stays
+    # on the leg: the stance arc's centre is at L - R from the hip
+    hip_lin = {ps_st: -(L - R)} if arc else {ps_st: -L}  # stance foot at the origin (A.2)
+    offset = (-R * (ps_st + gamma) * tangent + R * normal) if arc else sp.zeros(2, 1)
+
+    def at(lin):
+        return _pos(lin) + offset
+
+    def add(lin, psi, length):
+        out = dict(lin)
+        out[psi] = out.get(psi, 0) + length
+        return out
+
+    knee_lin = add(hip_lin, ps_sw, lt) if knee else hip_lin
+    foot_lin = add(knee_lin, ps_shank, L - lt - R)   # point foot, or the swing arc's centre
     if arc:
-        centre_sw = knee_pt + (L - lt - R) * _e(ps_shank)
+        centre_sw = at(foot_lin)
         swing_contact = centre_sw - R * normal
         swing_foot = swing_contact + R * (ps_shank + gamma) * tangent  # next reference point
     else:
-        swing_foot = knee_pt + (L - lt) * _e(ps_shank)
-        swing_contact = swing_foot
-    points = {"stance_foot": sp.zeros(2, 1), "hip": hip, "swing_foot": swing_foot}
+        swing_foot = swing_contact = at(foot_lin)
+    points = {"stance_foot": sp.zeros(2, 1), "hip": at(hip_lin), "swing_foot": swing_foot}
     if knee:
-        points["swing_knee"] = knee_pt
-        points["stance_knee"] = hip + lt * _e(ps_st)
+        points["swing_knee"] = at(knee_lin)
+        points["stance_knee"] = at(add(hip_lin, ps_st, lt))
     if arc:
-        points["stance_contact"] = contact
+        points["stance_contact"] = offset - R * normal
+        points["stance_foot_centre"] = offset
         points["swing_contact"] = swing_contact
-        points["stance_foot_centre"] = contact + R * normal
         points["swing_foot_centre"] = centre_sw
-    bodies = []  # (mass, position, inertia, link angle)
+    bodies = []  # (mass, {angle: length}, inertia, link angle)
     if structure.hip_mass:
-        bodies.append((P["M_hip"], hip, 0, ps_st))
+        bodies.append((P["M_hip"], hip_lin, 0, ps_st))
     for b in structure.bodies:
         mass = beta if b.massless else P[f"m_{b.name}"]
         inertia = P[f"I_{b.name}"] if b.kind == "rod" else 0
         d = P[f"d_{b.name}"]
-        swing = ((knee_pt + (d - lt) * _e(ps_shank), ps_shank) if b.link == "shank"
-                 else (hip + d * _e(ps_sw), ps_sw))
-        for role, (pos, psi) in (("stance", (hip + d * _e(ps_st), ps_st)), ("swing", swing)):
+        swing = ((add(knee_lin, ps_shank, d - lt), ps_shank) if b.link == "shank"
+                 else (add(hip_lin, ps_sw, d), ps_sw))
+        for role, (lin, psi) in (("stance", (add(hip_lin, ps_st, d), ps_st)), ("swing", swing)):
             if f"{role}_{b.name}" in points:
                 raise ValueError(f"walker.leg.bodies: body name {b.name!r} is reserved")
-            points[f"{role}_{b.name}"] = pos
-            bodies.append((mass, pos, inertia, psi))
+            points[f"{role}_{b.name}"] = at(lin)
+            bodies.append((mass, lin, inertia, psi))
 
-    foot = points["swing_foot"]
-    if arc:  # material point of the swing arc at the contact: v_centre + w x (-R n)
-        Jf = centre_sw.jacobian(psv) + R * tangent * sp.Matrix([[sp.diff(ps_shank, s)
-                                                                for s in psv]])
-    else:
-        Jf = foot.jacobian(psv)
-    T = sp.Integer(0)
     V = sp.Integer(0)
     Mi = sp.zeros(n, n)
     Bm = sp.zeros(n, n)
     Mp = sp.zeros(n, n)
-    for mass, pos, inertia, psi in bodies:
-        J = pos.jacobian(psv)
-        a = sp.Matrix([[sp.diff(psi, s) for s in psv]])
-        Mp += mass * J.T * J + inertia * a.T * a
-        V += mass * g * pos[1]
-        Jn = J - Jf  # velocity Jacobian with the swing foot at rest (new pivot)
-        Mi += mass * Jn.T * Jn + inertia * a.T * a
-        Bm += mass * Jn.T * J + inertia * a.T * a
-    if not (knee or arc):  # fu's tidy-up costs seconds per entry on the longer expressions
-        Mp = Mp.applyfunc(_trig)
-        Mi = Mi.applyfunc(_trig)
-        Bm = Bm.applyfunc(_trig)
+    if arc:  # material point of the swing arc at the contact: v_centre + w x (-R n)
+        Jf = centre_sw.jacobian(psv) + R * tangent * sp.Matrix([[sp.diff(ps_shank, s)
+                                                                for s in psv]])
+    for mass, lin, inertia, psi in bodies:
+        a = sp.Matrix([[1 if psi == k else 0 for k in psv]])
+        if arc:  # the rolling offset moves with psi_st: plain Jacobians
+            J = at(lin).jacobian(psv)
+            Jn = J - Jf  # velocity Jacobian with the swing arc's contact point at rest
+            Mp += mass * J.T * J
+            Mi += mass * Jn.T * Jn
+            Bm += mass * Jn.T * J
+        else:
+            # d(position)/d(psi_k) = lin[psi_k] e'(psi_k), and e'(a) . e'(b) = cos(a - b): the
+            # inertia matrices come out simplified without a trigonometric simplifier
+            new = {k: lin.get(k, 0) - foot_lin.get(k, 0) for k in psv}  # swing foot at rest
+            for i, pi_ in enumerate(psv):
+                for j, pj in enumerate(psv):
+                    c = sp.cos(pi_ - pj)
+                    Mp[i, j] += mass * lin.get(pi_, 0) * lin.get(pj, 0) * c
+                    Mi[i, j] += mass * new[pi_] * new[pj] * c
+                    Bm[i, j] += mass * new[pi_] * lin.get(pj, 0) * c
+        Mp += inertia * a.T * a
+        Mi += inertia * a.T * a
+        Bm += inertia * a.T * a
+        V += mass * g * at(lin)[1]
+    Mp, Mi, Bm = (X.applyfunc(sp.factor_terms) for X in (Mp, Mi, Bm))
     T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
     G = sp.Matrix([sp.diff(V, s) for s in psv])
     C = sp.zeros(n, n)
@@ -298,7 +319,7 @@ def derive(structure: Structure) -> Equations:
     points = {k: v.subs(sub) for k, v in points.items()}
     hip, foot = points["hip"], points["swing_foot"]
     swing_contact = swing_contact.subs(sub)
-    bodies = [(m_, pos.subs(sub), i_, psi.subs(sub)) for m_, pos, i_, psi in bodies]
+    bodies = [(m_, at(lin).subs(sub), i_, psi.subs(sub)) for m_, lin, i_, psi in bodies]
 
     # role swap: new stance leg = old swing leg (absolute angles), solved for the new q
     qn = sp.symbols([f"qn_{r}" for r in structure.roles], real=True)
