@@ -135,6 +135,17 @@ def test_kneed_energy_conserved_and_no_scuffing(kneed):
         assert np.min(_height(walker, walker.points(X)["swing_foot"])) > 0
 
 
+def test_kneed_swing_foot_through_the_ground_is_reported(kneed):
+    # swing leg thrown forward at 2 rad/s from the gait's start: the trailing foot is driven
+    # into the slope instead of lifting off - the step ends as a reported fall, not ignored
+    _, walker, fp = kneed
+    x = fp.x.copy()
+    for name in ("swing_thigh_rate", "swing_shank_rate"):
+        x[walker.state_names().index(name)] = 2.0
+    seg = integrate_step(walker, x, TIGHT)
+    assert (seg.termination, seg.event) == ("fall", "swing_foot_scuffs")
+
+
 def test_knee_strike_conserves_momenta_and_dissipates(kneed):
     _, walker, fp = kneed
     seg = integrate_step(walker, fp.x, TIGHT)
