@@ -150,8 +150,8 @@ def test_knee_strike_conserves_momenta_and_dissipates(kneed):
     _, walker, fp = kneed
     seg = integrate_step(walker, fp.x, TIGHT)
     # the state just before the knee strike: end of the first phase
-    _, sol, (_, tb) = seg.pieces[0]
-    xm = np.asarray(sol(tb))
+    tb = seg.phase_times["knee_strike"]
+    xm = seg.sample(np.array([tb]))[:, 0]   # the first phase's dense output at its end
     guard = walker.phases[0].guards[0]
     assert guard.name == "knee_strike" and abs(guard.function(0.0, xm)) < 1e-12
     xp = guard.reset(xm)

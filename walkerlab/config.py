@@ -15,12 +15,22 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import re
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import yaml
-from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError,
-                      model_validator)
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Discriminator,
+    Field,
+    PrivateAttr,
+    Tag,
+    ValidationError,
+    model_validator,
+)
 
 from walkerlab.contact.config import ContactSettings, ContactSimSettings, TerrainSettings
 
@@ -30,7 +40,26 @@ class SceneError(ValueError):
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    """Base of every config section: unknown keys rejected, frozen, strict finite numbers.
+
+    ``strict=True``: a bool is not a number (``leg_mass_kg: true`` is rejected, not read as
+    1 kg) and a string is not a number (``"5"``); a YAML int still validates as a float.
+    ``allow_inf_nan=False``: every float field must be finite (``.inf``/``.nan`` rejected)
+    unless a field says otherwise.  Nested sections still validate from plain mappings.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+
+
+def _list_to_tuple(v):
+    return tuple(v) if isinstance(v, list) else v
+
+
+# A fixed-length tuple given as a YAML list (strict mode alone would want a Python tuple).
+AsTuple = BeforeValidator(_list_to_tuple)
+
+# Caps that keep a run bounded (issue 12, D8): a bigger request is a one-line error.
+MAX_SIMULATE_STRIDES = 1000
 
 
 # --------------------------------------------------------------------------- walker
@@ -240,26 +269,56 @@ class ContactSolverSettings(_Strict):
 
     method: Literal["odeint", "LSODA", "Radau", "BDF", "RK45", "DOP853"] = Field(
         "odeint", description="scipy.integrate.odeint or a solve_ivp method")
-    rtol: float = Field(1e-8, gt=0, lt=1, description="relative tolerance [-]")
+    rtol: float = Field(1e-8, ge=1e-13, lt=1,
+                        description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
+                        "cannot meet a tighter one in double precision)")
     atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
     max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
 
 
 class StateSpec(_Strict):
-    """A compass-gait state right after heel strike, by role (Eq. 1: swing, stance)."""
+    """A walker state right after heel strike, by state name with its unit:
+    ``<role>_angle_rad`` and ``<role>_rate_rad_per_s`` for each role of the walker (compass
+    gait, Eq. 1: ``swing_angle_rad, stance_angle_rad, swing_rate_rad_per_s,
+    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``)."""
 
-    swing_angle_rad: float = Field(description="theta_1, swing-leg angle from vertical [rad]")
-    stance_angle_rad: float = Field(description="theta_2, stance-leg angle from vertical [rad]")
-    swing_rate_rad_per_s: float = Field(description="dtheta_1 [rad/s]")
-    stance_rate_rad_per_s: float = Field(description="dtheta_2 [rad/s]")
+    model_config = ConfigDict(extra="allow", frozen=True)
 
-    def as_array(self):
+    @model_validator(mode="after")
+    def _named_finite(self) -> StateSpec:
+        import re
+
+        for k, v in (self.model_extra or {}).items():
+            if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
+                raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
+                                 "<role>_rate_rad_per_s)")
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ValueError(f"{k}: must be a finite number")
+        if not self.model_extra:
+            raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
+        return self
+
+    def as_array(self, state_names: list[str] | None = None):
+        """State (2n,) in the order of ``state_names`` (a walker's ``state_names()``; default:
+        the compass gait's ``swing_angle, stance_angle, swing_rate, stance_rate``).
+
+        Raises
+        ------
+        ValueError
+            A state of the walker is missing, or a given name is not one of its states.
+        """
         import numpy as np
 
-        return np.array(
-            [self.swing_angle_rad, self.stance_angle_rad,
-             self.swing_rate_rad_per_s, self.stance_rate_rad_per_s]
-        )
+        names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
+        keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
+        given = dict(self.model_extra or {})
+        missing = [k for k in keys if k not in given]
+        extra = [k for k in given if k not in keys]
+        if missing or extra:
+            raise ValueError(f"state must give exactly {keys}" +
+                             (f"; missing {missing}" if missing else "") +
+                             (f"; unknown {extra}" if extra else ""))
+        return np.array([float(given[k]) for k in keys])
 
 
 class FixedPointSettings(_Strict):
@@ -274,7 +333,9 @@ class FixedPointSettings(_Strict):
 class SimulateSettings(_Strict):
     """Forward simulation of the rigid hybrid model."""
 
-    strides: int = Field(5, ge=1, le=10_000, description="number of strides (2 steps each)")
+    strides: int = Field(5, ge=1, le=MAX_SIMULATE_STRIDES,
+                         description="number of strides (2 steps each); at most 1000 "
+                         "(about 1 min at the paper's tolerances)")
     sample_rate_hz: float = Field(500.0, gt=0, le=1e6, description="dense output rate [Hz]")
     initial_state: Literal["fixed_point"] | StateSpec = Field(
         "fixed_point", description="'fixed_point' (from fixedpoint.h5) or an explicit state"
@@ -308,10 +369,43 @@ class WorkPrecisionSettings(_Strict):
                                           description="contact reference (odeint) rtol [-]")
 
 
+class BasinSettings(_Strict):
+    """Basin of attraction over a 2-D slice of the Poincaré section (Schwab & Wisse 2001).
+
+    Each cell is a state just after heel strike: the two axis coordinates come from the grid,
+    the coordinate fixed by the heel-strike surface from that constraint, the others from
+    the period-1 fixed point.  Axes are named by ``walker.state_names()``.
+    """
+
+    x_axis: str = Field("stance_angle", description="state name on the x axis")
+    y_axis: str = Field("stance_rate", description="state name on the y axis")
+    x_range: tuple[float, float] | None = Field(
+        None, description="x axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
+        "1.2 rad/s (rates)")
+    y_range: tuple[float, float] | None = Field(
+        None, description="y axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
+        "1.2 rad/s (rates)")
+    grid: tuple[Annotated[int, Field(ge=2, le=4000)], Annotated[int, Field(ge=2, le=4000)]] = \
+        Field((200, 200), description="cells along x and y")
+    max_steps: int = Field(50, ge=1, le=10_000, description="steps simulated per cell at most")
+    converge_tol: float = Field(1e-4, gt=0, lt=1, description="a cell has converged to the "
+                                "period-1 gait once max|x - x*| < this [rad, rad/s]")
+    period_tol: float = Field(1e-6, gt=0, lt=1, description="x_k and x_{k-p} closer than this "
+                              "(p >= 2) = another periodic attractor [rad, rad/s]")
+    max_period: int = Field(8, ge=2, le=64, description="longest period looked for [steps]")
+    rtol: float = Field(1e-8, gt=0, lt=1, description="integrator relative tolerance [-]")
+    atol: float = Field(1e-8, gt=0, lt=1, description="integrator absolute tolerance")
+    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this ends the "
+                                   "cell as 'stalled' [s]")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
-    name: str | None = Field(None, description="run folder name; default: YAML file stem")
+    name: str | None = Field(None, description="run folder name (runs/<name>/); default: "
+                             "YAML file stem. Letters, digits and . _ + - only, no path "
+                             "separators, not starting with a dot", max_length=100,
+                             pattern=r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
     source: str | None = Field(None, description="citation of the parameter set")
     published: str | None = Field(
         None, description="walkerlab.published module whose printed numbers the report sets "
@@ -327,6 +421,15 @@ class Scene(_Strict):
     contact_sim: ContactSimSettings | None = None
     contact_solver: ContactSolverSettings | None = None
     workprecision: WorkPrecisionSettings | None = None
+    # Resolved path of the YAML file the scene was read from (None when built in code);
+    # not part of the scene's content: it decides which file owns runs/<name>/.
+    _origin: Path | None = PrivateAttr(None)
+
+    @property
+    def origin(self) -> Path | None:
+        """Resolved path of the scene file, or None for a scene built in code."""
+        return self._origin
+    basin: BasinSettings | None = None
 
     @model_validator(mode="after")
     def _published_exists(self) -> Scene:
@@ -347,13 +450,34 @@ class Scene(_Strict):
         return hashlib.sha256(self.section_json(*names).encode()).hexdigest()
 
 
+_NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
+
+
+# discriminator tags of walker models and bodies: not part of a field's path
+_TAGS = {"compass_gait", "biped", "point_mass", "rod", "point", "arc"}
+
+
+def _loc_part(p) -> bool:
+    """Keep a location element that is a field name or index (not a union/type tag)."""
+    s = str(p)
+    if s.startswith(("function-after", "function-before", "literal[", "tuple[", "list[")):
+        return False
+    # union members appear as their class name (``StateSpec``) or a discriminator tag
+    return not (s[:1].isupper() and s.isidentifier()) and s not in _TAGS
+
+
 def _format_error(path: Path, err: ValidationError) -> str:
-    e = err.errors()[0]
-    tags = {"compass_gait", "biped", "point_mass", "rod", "point", "arc"}  # discriminator tags of walker models: not part of the field path
-    loc = ".".join(str(p) for p in e["loc"]
-                   if not str(p).startswith("function-after") and str(p) not in tags)
+    errs = err.errors()
+    # a union (``'fixed_point' | StateSpec``) reports one error per member: prefer the one
+    # that went deepest into a mapping, it names the offending field
+    e = max(errs, key=lambda x: len([p for p in x["loc"] if _loc_part(p)]))
+    loc = ".".join(str(p) for p in e["loc"] if _loc_part(p))
     msg = e["msg"].removeprefix("Value error, ")
-    extra = f" (+{len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
+    if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
+            and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
+                              "string_type", "float_parsing", "int_parsing"):
+        msg += f" (got {e['input']!r})"
+    extra = f" (+{len(errs) - 1} more)" if len(errs) > 1 else ""
     return f"{path}: {loc or '<scene>'}: {msg}{extra}"
 
 
@@ -377,18 +501,34 @@ def load_scene(path: str | Path) -> Scene:
         the file and the field).
     """
     path = Path(path)
+    if path.is_dir():
+        raise SceneError(f"{path}: is a directory, not a scene file")
     if not path.is_file():
         raise SceneError(f"{path}: scene file not found")
     try:
-        data = yaml.safe_load(path.read_text())
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not a text (UTF-8) YAML file (byte {exc.start} is "
+                         f"0x{exc.object[exc.start]:02x})") from None
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from None
+    try:
+        data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
         raise SceneError(f"{path}:{where} malformed YAML ({getattr(exc, 'problem', exc)})") from None
     if not isinstance(data, dict):
         raise SceneError(f"{path}: a scene must be a YAML mapping")
-    data.setdefault("name", path.stem)
-    return scene_from_dict(data, path)
+    if data.get("name") is None:
+        data["name"] = path.stem
+        if not _NAME_RE.match(path.stem):
+            raise SceneError(f"{path}: the file name gives the run-folder name {path.stem!r}, "
+                             "which is not allowed (letters, digits and . _ + - only, not "
+                             "starting with a dot); rename the file or set 'name:' in it")
+    scene = scene_from_dict(data, path)
+    scene._origin = path.resolve()
+    return scene
 
 
 def scene_from_dict(data: dict[str, Any], origin: str | Path = "<scene>") -> Scene:

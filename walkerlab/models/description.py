@@ -49,6 +49,9 @@ class Structure:
         True if there is a hip point mass.
     foot : str
         ``"point"`` or ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip).
+    variant : str
+        ``"derived"``; ``"appendix_a"`` only for the paper's compass gait: the flow with the
+        Coriolis matrix as printed in the paper (A.5, sign of ``C[1, 0]`` flipped).
     knee : bool
         True if the leg has a knee at ``L_thigh`` from the hip (roles :data:`KNEED_ROLES`).
     """
@@ -57,6 +60,7 @@ class Structure:
     bodies: tuple[BodySpec, ...]
     hip_mass: bool = True
     foot: str = "point"
+    variant: str = "derived"
     knee: bool = False
 
     @property
@@ -82,7 +86,8 @@ class Structure:
     def key(self) -> str:
         """Canonical JSON of the structure (part of the generated-code cache key)."""
         return json.dumps({"coordinates": self.coordinates, "foot": self.foot,
-                           "hip_mass": self.hip_mass, "knee": self.knee,
+                           "hip_mass": self.hip_mass, "variant": self.variant,
+                           "knee": self.knee,
                            "bodies": [[b.name, b.kind, b.massless, b.link]
                                       for b in self.bodies]})
 
@@ -152,7 +157,7 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     if hip:
         head.append(walker_cfg.hip_mass_kg)
     structure = Structure(walker_cfg.coordinates, tuple(bodies), hip, leg.foot.kind,
-                          leg.knee is not None)
+                          knee=leg.knee is not None)
     total = walker_cfg.hip_mass_kg + 2 * sum(b.mass_kg for b in leg.bodies)
     return WalkerData(structure, tuple(float(v) for v in head + values), total, leg.length_m,
                       walker_cfg.gravity_m_per_s2, slope_rad, extra)

@@ -19,8 +19,10 @@ Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen
 - ``unlocked_swing`` (three links) until ``knee_extension`` (shank minus thigh angle) crosses
   zero upward: the knee straightens against its stop, the plastic knee strike
   (``knee_reset``) locks it and the step goes on; a fall if the swing foot reaches the ground
-  first (``swing_foot_scuffs``: its clearance above the slope falls through zero - reported,
-  not ignored) or the hip reaches the slope;
+  first (``swing_foot_scuffs``: its clearance above the slope falls below
+  ``-SCUFF_DEPTH * L`` - reported, not ignored; the small depth makes a foot that starts on
+  the ground, clearance 0 to round-off, and is driven into it fire the guard) or the hip
+  reaches the slope;
 - ``locked_swing`` (two links, same coordinates, knee constraint) until ``heel_strike``; a
   fall if the swing leg falls back behind the stance leg, if the straight swing leg passes
   the stance leg (``swing_foot_scuffs``: its foot would go through the ground), or the hip
@@ -30,11 +32,20 @@ Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen
 
 from __future__ import annotations
 
+from functools import partial
+
 from walkerlab.models.base import Guard, HybridWalker, Phase
 from walkerlab.models.cache import generated_module
 from walkerlab.models.description import WalkerData
 
 LEGS = ("leg1", "leg2")
+#: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
+SCUFF_DEPTH = 1e-9
+
+
+def _below(clearance, depth, t, x):
+    """``clearance + depth``: crosses zero downward when the foot is ``depth`` deep."""
+    return clearance(t, x) + depth
 
 
 def role_to_leg(stance_leg: str) -> dict[str, str]:
@@ -83,7 +94,8 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
             Phase("unlocked_swing", flow, (
                 Guard("knee_strike", f["guard_knee_extension"], +1, "next_phase",
                       f["grad_knee_extension"], f["knee_reset"], f["knee_reset_jacobian"]),
-                Guard("swing_foot_scuffs", f["guard_swing_clearance"], -1, "fall",
+                Guard("swing_foot_scuffs", partial(_below, f["guard_swing_clearance"],
+                                                   SCUFF_DEPTH * data.leg_length_m), -1, "fall",
                       f["grad_swing_clearance"]), fall),
                 jacobian=f["flow_jacobian"]),
             Phase("locked_swing", f["flow_locked"], (

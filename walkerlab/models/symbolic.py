@@ -287,7 +287,11 @@ def derive(structure: Structure) -> Equations:
         for j in range(n):
             C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[k]) + sp.diff(Mp[i, k], psv[j])
                                                - sp.diff(Mp[j, k], psv[i])) * dps[k]
-                          for k in range(n))
+                          for k in range(n))  # Christoffel symbols of the first kind
+    if structure.variant == "appendix_a":  # the paper's printed A.5: C[1, 0] sign flipped
+        if structure.coordinates != "absolute" or len(structure.bodies) != 1 or knee or arc:
+            raise ValueError("ideal.variant: appendix_a exists only for the compass gait")
+        C[1, 0] = -C[1, 0]
     lim = any(b.massless for b in structure.bodies)
     M = Mp
     if lim:

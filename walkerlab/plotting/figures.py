@@ -25,15 +25,28 @@ MODEL_STYLES = ["-", "--", ":", "-."]
 
 
 def save(fig, folder: Path, stem: str) -> list[Path]:
-    """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure."""
+    """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure.
+
+    Each file is written atomically (temporary name, then rename; mode 0644): an
+    interrupted save leaves the previous figure or none, never a truncated file.
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        The folder cannot be written (one line).
+    """
+    from walkerlab.io.artifacts import atomic_write
+
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
     out = []
-    for ext in ("png", "svg"):
-        p = folder / f"{stem}.{ext}"
-        fig.savefig(p, dpi=150, bbox_inches="tight")
-        out.append(p)
-    plt.close(fig)
+    try:
+        for ext in ("png", "svg"):
+            p = folder / f"{stem}.{ext}"
+            atomic_write(p, lambda fh, ext=ext: fig.savefig(fh, format=ext, dpi=150,
+                                                            bbox_inches="tight"))
+            out.append(p)
+    finally:
+        plt.close(fig)
     return out
 
 
@@ -96,7 +109,8 @@ def fig9_limit_cycle(trajs: dict[str, NamedTrajectory]):
     pairs = next(iter(trajs.values())).phase_pairs()
     ncol = min(3, len(pairs))
     nrow = -(-len(pairs) // ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(5 * ncol, 4.5 * nrow), squeeze=False)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5 * ncol, 4.5 * nrow), squeeze=False,
+                             layout="constrained")
     for mi, (label, tr) in enumerate(trajs.items()):
         for k, (a, r) in enumerate(pairs):
             if a in tr.coordinates and r in tr.coordinates:

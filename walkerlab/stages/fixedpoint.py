@@ -16,15 +16,18 @@ from walkerlab.io.readers import load_fixed_point  # noqa: F401  (re-exported fo
 from walkerlab.models.registry import build_walker
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
-SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
+SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
 
 
-def _variants_for(scene: Scene) -> tuple[str, ...]:
-    if scene.walker.model == "compass_gait":
+def _variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
+    """The scene's own equation variant first, then (``compare``, for a compass gait compared
+    with published numbers) the other variants: they explain the difference from Eq. 11."""
+    own = (scene.ideal.variant,)
+    if compare and scene.walker.model == "compass_gait" and scene.published is not None:
         from walkerlab.models.compass_gait import VARIANTS
 
-        return VARIANTS
-    return (scene.ideal.variant,)
+        return own + tuple(v for v in VARIANTS if v != scene.ideal.variant)
+    return own
 
 
 def solve_variant(scene: Scene, variant: str):
@@ -32,7 +35,11 @@ def solve_variant(scene: Scene, variant: str):
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
     walker = build_walker(sc)
     fp = require(scene, "fixedpoint", "fixedpoint")
-    res = find_fixed_point(walker, fp.initial_guess.as_array(), Solver.from_settings(scene.solver),
+    try:
+        guess = fp.initial_guess.as_array(walker.state_names())
+    except ValueError as exc:
+        raise StageError(f"fixedpoint.initial_guess: {exc}") from None
+    res = find_fixed_point(walker, guess, Solver.from_settings(scene.solver),
                            xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
     return walker, res
 
@@ -65,8 +72,13 @@ def _write_result(g, walker, res, guess) -> None:
     put(g, "stats/wall_time", res.wall_time_s, "s", "fixed-point search + Jacobians")
 
 
-def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
-    """Find the fixed point (scene's variant, plus the other equation variants for comparison).
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
+        compare_variants: bool = False) -> StageOutcome:
+    """Find the fixed point of the scene's equation variant.
+
+    With ``compare_variants`` the other equation variants (printed Appendix A, ...) are solved
+    too, for the report's comparison with Eq. (11); a plain run reuses such an artifact
+    (a superset), and nothing else pays for them.
 
     Raises
     ------
@@ -77,7 +89,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
 
     def compute():
         results = {}
-        for variant in _variants_for(scene):
+        for variant in _variants_for(scene, compare_variants):
             try:
                 results[variant] = solve_variant(scene, variant)
             except FixedPointNotFound as exc:
@@ -87,7 +99,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                     raise StageError(f"fixedpoint: {exc}{hint}") from None
                 results[variant] = exc
         walker, main = results[scene.ideal.variant]
-        guess = fp_cfg.initial_guess.as_array()
+        guess = fp_cfg.initial_guess.as_array(walker.state_names())
 
         def writer(f):
             f.attrs["model"] = walker.name
@@ -109,4 +121,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                    "variants": {k: v for k, v in results.items()}}
         return writer, summary
 
-    return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force)
+    return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force,
+                      extra_key="variants" if compare_variants else "",
+                      also_accept=() if compare_variants else ("variants",))

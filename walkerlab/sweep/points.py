@@ -117,12 +117,13 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
     walker = build_walker(scene)
     solver = _solver(scene)
     tries = ([("neighbour", np.asarray(guess, float))] if guess is not None else []) \
-        + [("scene", fp.initial_guess.as_array())]
+        + [("scene", fp.initial_guess.as_array(walker.state_names()))]
     best, msg = math.inf, ""
     for source, g in tries:
         try:
+            # the sweep keeps the variational multipliers only: no finite-difference check
             res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
-                                   max_step_time=fp.max_step_time_s)
+                                   max_step_time=fp.max_step_time_s, fd_check=False)
         except FixedPointNotFound as exc:
             if not (exc.residual >= best):  # keeps NaN out unless nothing better
                 best = exc.residual if math.isfinite(exc.residual) else best
@@ -217,7 +218,7 @@ def simulate_point(scene: Scene, guess, options: dict):
         cols["guess_source"] = source
     else:
         walker = build_walker(scene)
-        x0 = sim.initial_state.as_array()
+        x0 = sim.initial_state.as_array(walker.state_names())
     cols.update(_state_columns(walker, x0, "x0_"))
     traj = simulate_steps(walker, x0, 2 * sim.strides, _solver(scene),
                           max_step_time=sim.max_step_time_s)
@@ -276,7 +277,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
         Steps requested (2 * ``contact_sim.n_strides``).
     """
     from walkerlab.contact import ContactSimSettings
-    from walkerlab.stages.contact_sim import simulate_from
+    from walkerlab.contact.scene import simulate_from
 
     # one code path with the contact-sim stage (terrain, initial state, solver, end time)
     cs = scene.contact_sim or ContactSimSettings()
