@@ -38,7 +38,7 @@ def fixedpoint_text(path: Path) -> str:
             # role prefix (a kneed walker's swing_thigh belongs to the swing leg)
             owner = next((r for r in sorted(legs, key=len, reverse=True)
                           if role == r or role.startswith(r + "_")), role)
-            lines.append(f"  {n:<14s} ({legs.get(owner, role)}, {role.replace('_', ' ')}) "
+            lines.append(f"  {n:<14s} ({legs.get(owner, role)}, {role.replace('_', ' ')} leg) "
                          f"{f['fixed_point/' + n][()]: .10f} {unit}")
         lines.append(f"  step period     {f['step_period'][()]:.10f} s")
         lines.append(f"  residual        {f['residual'][()]:.2e}  (max |P(x*) - x*|)")
