@@ -379,13 +379,14 @@ class BasinSettings(_Strict):
 
     x_axis: str = Field("stance_angle", description="state name on the x axis")
     y_axis: str = Field("stance_rate", description="state name on the y axis")
-    x_range: tuple[float, float] | None = Field(
+    x_range: Annotated[tuple[float, float] | None, AsTuple] = Field(
         None, description="x axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
         "1.2 rad/s (rates)")
-    y_range: tuple[float, float] | None = Field(
+    y_range: Annotated[tuple[float, float] | None, AsTuple] = Field(
         None, description="y axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
         "1.2 rad/s (rates)")
-    grid: tuple[Annotated[int, Field(ge=2, le=4000)], Annotated[int, Field(ge=2, le=4000)]] = \
+    grid: Annotated[tuple[Annotated[int, Field(ge=2, le=4000)],
+                          Annotated[int, Field(ge=2, le=4000)]], AsTuple] = \
         Field((200, 200), description="cells along x and y")
     max_steps: int = Field(50, ge=1, le=10_000, description="steps simulated per cell at most")
     converge_tol: float = Field(1e-4, gt=0, lt=1, description="a cell has converged to the "
