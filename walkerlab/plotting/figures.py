@@ -164,6 +164,8 @@ def _chains(tr: NamedTrajectory) -> list[tuple[str, list[str]]]:
     for leg in tr.legs:
         names = [n for n in tr.points if n.startswith(leg + "_") and not n.endswith("_mass")
                  and not n.endswith("_com")]
+        if any(n.endswith("_contact") for n in names):  # round feet: end at the contact,
+            names = [n for n in names if not n.endswith("_foot")]  # not the reference point
         names.sort(key=lambda n: (n.endswith("_foot"), float(np.hypot(*(tr.points[n][:, 0]
                                                                           - hip[:, 0])))))
         used.update(n for n in tr.points if n.startswith(leg + "_"))

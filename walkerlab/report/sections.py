@@ -17,6 +17,7 @@ from walkerlab.analysis.tables import TABLE3_ROWS, table3
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.readers import load_fixed_point
 from walkerlab.report.markdown import details, num, printed, table
+from walkerlab.report.text import zero_multipliers_text
 
 
 # --------------------------------------------------------------------------- data
@@ -234,8 +235,7 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
                        for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
                 "", f"Max difference between the two: {num(f['floquet/max_difference'][()], 2)}. "
                 f"Verdict: **{'stable' if f['floquet/stable'][()] else 'unstable'}** "
-                "(one multiplier is 0 by construction: the map lands on the heel-strike "
-                "surface).", ""]
+                f"({zero_multipliers_text(re, im)}).", ""]
     return out
 
 
