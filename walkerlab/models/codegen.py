@@ -1,4 +1,5 @@
-"""Python source of a walker's equations, generated from :class:`~walkerlab.models.symbolic.Equations`.
+"""Python source of a walker's equations, generated from
+:class:`~walkerlab.models.symbolic.Equations`.
 
 The generated module defines one function, ``make(p) -> dict[str, callable]``, that binds the
 parameter vector ``p`` (``Structure.param_names`` order) in closures.  The hot functions
@@ -204,8 +205,8 @@ def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     D = sp.zeros(n, 2 * n)
     for k in range(n):
         for i in range(n):
-            w = sum(dB[k * n * n + i * n + j] * dq[j] - dMi[k * n * n + i * n + j] * sp.Symbol(post[j])
-                    for j in range(n))
+            w = sum(dB[k * n * n + i * n + j] * dq[j]
+                    - dMi[k * n * n + i * n + j] * sp.Symbol(post[j]) for j in range(n))
             lines.append(f"{IND}_w{k}_{i} = {_PY.doprint(w)}")
         col = _matvec(inv, [f"_w{k}_{i}" for i in range(n)])
         for i in range(n):
