@@ -22,6 +22,16 @@ def total_mass_kg(walker) -> float:
     return float(walker.total_mass_kg)
 
 
+def _phase_of(seg, times: np.ndarray) -> np.ndarray:
+    """Index of the phase (piece of the segment) each sample time falls in, as
+    :meth:`Segment.sample` assigns it (a boundary time belongs to the earlier phase)."""
+    idx = np.full(times.size, -1, dtype=int)
+    for j, (_ph, _sol, (_ta, tb)) in enumerate(seg.pieces):
+        last = j == len(seg.pieces) - 1
+        idx[(idx < 0) & ((times <= tb) | last)] = j
+    return idx
+
+
 def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory:
     """Dense samples at ``rate_hz`` plus each step's end (pre-impact) state.
 
@@ -43,7 +53,7 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
     w = traj.walker
     legs = list(w.legs)
     units = dict(w.coordinate_units)
-    chunks = {k: [] for k in ("t", "stance", "step", "ke", "pe")}
+    chunks = {k: [] for k in ("t", "stance", "step", "ke", "pe", "phase")}
     coords: dict[str, list] = {name: [] for name in units}
     pts: dict[str, list] = {}
     g = w.params["gravity_m_per_s2"]
@@ -63,6 +73,7 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         chunks["pe"].append(np.broadcast_to(pe, times.shape))
         chunks["stance"].append(np.full(times.size, legs.index(seg.stance_leg)))
         chunks["step"].append(np.full(times.size, seg.index))
+        chunks["phase"].append(_phase_of(seg, times))
         for name, xy in w.points(X).items():
             key = _leg_point_name(name, r2l)
             pts.setdefault(key, []).append(np.asarray(xy) + seg.stance_foot_world[:, None])
@@ -73,6 +84,7 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         stance_leg=cat(chunks["stance"]), step_index=cat(chunks["step"]),
         kinetic=cat(chunks["ke"]), potential=cat(chunks["pe"]),
         points={k: np.hstack(v) for k, v in pts.items()},
+        phase=cat(chunks["phase"]), phase_names=[p.name for p in w.phases],
     )
 
 

@@ -1,27 +1,28 @@
 """Numba-compiled kernels of the floating compass walker with compliant feet.
 
-Internal module.  Everything is SI.  The packed parameter vector ``P`` (float64, (16,)) is:
+Internal module.  Everything is SI.  The packed parameter vector ``P`` (float64, (NPAR,)) is
+read only through the named index constants below (``P[I_PHI]``, never ``P[5]``):
 
-====  ======================  =====
-idx   meaning                 unit
-====  ======================  =====
-0     L leg length            m
-1     m leg mass              kg
-2     MH hip mass             kg
-3     b hip-to-leg-mass       m
-4     g gravity               m/s^2
-5     phi slope               rad
-6     k stiffness             N/m^e
-7     e exponent              -
-8     cmax max damping        N s/m
-9     dmax                    m
-10    mu_s                    -
-11    mu_d                    -
-12    v_s                     m/s
-13    v_d                     m/s
-14    patch half width        m
-15    continuous ground (1/0) -
-====  ======================  =====
+======  ======================  =====
+name    meaning                 unit
+======  ======================  =====
+I_L     L leg length            m
+I_M     m leg mass              kg
+I_MH    MH hip mass             kg
+I_B     b hip-to-leg-mass       m
+I_G     g gravity               m/s^2
+I_PHI   phi slope               rad
+I_K     k stiffness             N/m^e
+I_E     e exponent              -
+I_CMAX  cmax max damping        N s/m
+I_DMAX  dmax                    m
+I_MUS   mu_s                    -
+I_MUD   mu_d                    -
+I_VS    v_s                     m/s
+I_VD    v_d                     m/s
+I_HW    patch half width        m
+I_CONT  continuous ground (1/0) -
+======  ======================  =====
 
 ``c1``/``c2`` are the along-slope patch centres [m] of the lanes of leg1/leg2.
 State ``x = [hip_x, hip_y, theta1, theta2, vhip_x, vhip_y, dtheta1, dtheta2]``.
@@ -33,7 +34,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+# Named indices into ``P`` (module-level ints are compile-time constants under numba).
+I_L, I_M, I_MH, I_B, I_G, I_PHI = 0, 1, 2, 3, 4, 5
+I_K, I_E, I_CMAX, I_DMAX = 6, 7, 8, 9
+I_MUS, I_MUD, I_VS, I_VD = 10, 11, 12, 13
+I_HW, I_CONT = 14, 15
 NPAR = 16
+
+# Named indices into the state x (8,) of the floating walker.
+X_HIP_X, X_HIP_Y, X_TH1, X_TH2, X_VHIP_X, X_VHIP_Y, X_W1, X_W2 = range(8)
+X_TH = (X_TH1, X_TH2)
 
 
 @njit(cache=True)
@@ -86,11 +96,12 @@ def in_patch(s, centres, hw, continuous):
 @njit(cache=True)
 def foot_state(x, i, P):
     """Foot i (0/1) position and velocity: (px, py, vx, vy)."""
-    L = P[0]
-    th = x[2 + i]
-    w = x[6 + i]
+    L = P[I_L]
+    th = x[X_TH1 + i]
+    w = x[X_W1 + i]
     st, ct = np.sin(th), np.cos(th)
-    return x[0] + L * st, x[1] - L * ct, x[4] + L * ct * w, x[5] + L * st * w
+    return (x[X_HIP_X] + L * st, x[X_HIP_Y] - L * ct, x[X_VHIP_X] + L * ct * w,
+            x[X_VHIP_Y] + L * st * w)
 
 
 @njit(cache=True)
@@ -101,36 +112,43 @@ def foot_contact(x, i, P, centres):
     v_t [m/s] down-slope slip velocity, s [m] along-slope position, Fn [N] normal force,
     Ff [N] friction force along t = (cos phi, -sin phi).
     """
-    sp, cp = np.sin(P[5]), np.cos(P[5])
+    sp, cp = np.sin(P[I_PHI]), np.cos(P[I_PHI])
     px, py, vx, vy = foot_state(x, i, P)
     delta = -(px * sp + py * cp)
     ddot = -(vx * sp + vy * cp)
     vt = vx * cp - vy * sp
     s = px * cp - py * sp
     fn, dfd, dfdd, mu, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
-    if delta > 0.0 and in_patch(s, centres, P[14], P[15] > 0.5):
-        fn, dfd, dfdd = normal_force(delta, ddot, P[6], P[7], P[8], P[9])
+    if delta > 0.0 and in_patch(s, centres, P[I_HW], P[I_CONT] > 0.5):
+        fn, dfd, dfdd = normal_force(delta, ddot, P[I_K], P[I_E], P[I_CMAX], P[I_DMAX])
         if fn > 0.0:
-            mu, dmu = friction_mu(vt, P[10], P[11], P[12], P[13])
+            mu, dmu = friction_mu(vt, P[I_MUS], P[I_MUD], P[I_VS], P[I_VD])
     return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu
 
 
 @njit(cache=True)
-def msolve(th1, th2, P, r):
-    """Solve M(q) a = r for the 4x4 mass matrix by its 2x2 block structure.
+def mass_blocks(th1, th2, P):
+    """The one mass matrix of the floating walker, by blocks.
 
-    M = [[A I, B], [B^T, D I]], A = MH + 2m, D = m b^2, B = m b [[c1, c2], [s1, s2]].
-    ``r`` is (4,) or (4, n).
+    ``M(q) = [[A I, B], [B^T, D I]]`` with ``A = MH + 2 m`` [kg], ``D = m b^2`` [kg m^2] and
+    ``B = m b [[cos th1, cos th2], [sin th1, sin th2]]`` [kg m].  Returns (A, D, B00, B01,
+    B10, B11).  :func:`mass_matrix` and :func:`msolve` are both built from it.
     """
-    m, MH, b = P[1], P[2], P[3]
-    c1, s1, c2, s2 = np.cos(th1), np.sin(th1), np.cos(th2), np.sin(th2)
-    A = MH + 2.0 * m
-    D = m * b * b
-    B00, B01, B10, B11 = m * b * c1, m * b * c2, m * b * s1, m * b * s2
-    # Schur complement S = A I - B B^T / D
-    S00 = A - m * (c1 * c1 + c2 * c2)
-    S01 = -m * (c1 * s1 + c2 * s2)
-    S11 = A - m * (s1 * s1 + s2 * s2)
+    m, MH, b = P[I_M], P[I_MH], P[I_B]
+    return (MH + 2.0 * m, m * b * b, m * b * np.cos(th1), m * b * np.cos(th2),
+            m * b * np.sin(th1), m * b * np.sin(th2))
+
+
+@njit(cache=True)
+def msolve(th1, th2, P, r):
+    """Solve M(q) a = r for the 4x4 mass matrix (:func:`mass_blocks`) by its block structure.
+
+    ``r`` is (4,) or (4, n).  Schur complement ``S = A I - B B^T / D``.
+    """
+    A, D, B00, B01, B10, B11 = mass_blocks(th1, th2, P)
+    S00 = A - (B00 * B00 + B01 * B01) / D
+    S01 = -(B00 * B10 + B01 * B11) / D
+    S11 = A - (B10 * B10 + B11 * B11) / D
     det = S00 * S11 - S01 * S01
     out = np.empty_like(r)
     r0 = r[0] - (B00 * r[2] + B01 * r[3]) / D
@@ -147,13 +165,13 @@ def msolve(th1, th2, P, r):
 @njit(cache=True)
 def gen_force(x, P, c1, c2, use1, use2):
     """Generalized force Q - c (4,): gravity, centripetal terms, contact of feet used."""
-    L, m, MH, b, g, phi = P[0], P[1], P[2], P[3], P[4], P[5]
+    L, m, MH, b, g, phi = P[I_L], P[I_M], P[I_MH], P[I_B], P[I_G], P[I_PHI]
     sp, cp = np.sin(phi), np.cos(phi)
     Q = np.zeros(4)
     Q[1] = -(MH + 2.0 * m) * g
     for i in range(2):
-        th = x[2 + i]
-        w = x[6 + i]
+        th = x[X_TH1 + i]
+        w = x[X_W1 + i]
         st, ct = np.sin(th), np.cos(th)
         Q[2 + i] = -m * g * b * st
         # minus centripetal term c(q, qd)
@@ -176,7 +194,7 @@ def gen_force(x, P, c1, c2, use1, use2):
 def rhs(x, P, c1, c2):
     """Free-floating walker: dx/dt (8,)."""
     Q = gen_force(x, P, c1, c2, True, True)
-    qdd = msolve(x[2], x[3], P, Q)
+    qdd = msolve(x[X_TH1], x[X_TH2], P, Q)
     out = np.empty(8)
     out[:4] = x[4:]
     out[4:] = qdd
@@ -198,23 +216,23 @@ def rhs_flag(x, P, c1, c2, use_contact):
     Q = gen_force(x, P, c1, c2, use_contact, use_contact)
     out = np.empty(8)
     out[:4] = x[4:]
-    out[4:] = msolve(x[2], x[3], P, Q)
+    out[4:] = msolve(x[X_TH1], x[X_TH2], P, Q)
     return out
 
 
 @njit(cache=True)
 def jac_flag(x, P, c1, c2, use_contact):
     """:func:`jac` with the contact forces switched on/off."""
-    L, m, b, g, phi = P[0], P[1], P[3], P[4], P[5]
+    L, m, b, g, phi = P[I_L], P[I_M], P[I_B], P[I_G], P[I_PHI]
     sp, cp = np.sin(phi), np.cos(phi)
     Q = gen_force(x, P, c1, c2, use_contact, use_contact)
-    qdd = msolve(x[2], x[3], P, Q)
+    qdd = msolve(x[X_TH1], x[X_TH2], P, Q)
     dQq = np.zeros((4, 4))
     dQv = np.zeros((4, 4))
     for i in range(2):
         j = 2 + i
         th = x[j]
-        w = x[6 + i]
+        w = x[X_W1 + i]
         st, ct = np.sin(th), np.cos(th)
         # gravity
         dQq[j, j] += -m * g * b * ct
@@ -274,15 +292,15 @@ def jac_flag(x, P, c1, c2, use_contact):
     out = np.zeros((8, 8))
     for k in range(4):
         out[k, 4 + k] = 1.0
-    out[4:, :4] = msolve(x[2], x[3], P, dQq)
-    out[4:, 4:] = msolve(x[2], x[3], P, dQv)
+    out[4:, :4] = msolve(x[X_TH1], x[X_TH2], P, dQq)
+    out[4:, 4:] = msolve(x[X_TH1], x[X_TH2], P, dQv)
     return out
 
 
 @njit(cache=True)
 def rhs_pinned(z, P, c1, c2, pfx, pfy):
     """Reduced dynamics with foot 2 pinned at (pfx, pfy): z = [th1, th2, w1, w2] -> dz/dt."""
-    L = P[0]
+    L = P[I_L]
     th1, th2, w1, w2 = z[0], z[1], z[2], z[3]
     s2, c2_ = np.sin(th2), np.cos(th2)
     x = np.empty(8)
@@ -304,7 +322,7 @@ def rhs_pinned(z, P, c1, c2, pfx, pfy):
     Jp[1, 1] = -L * s2
     Jp[2, 0] = 1.0
     Jp[3, 1] = 1.0
-    M = mass_matrix(x[2], x[3], P)
+    M = mass_matrix(x[X_TH1], x[X_TH2], P)
     r = Jp.T @ (Q - M @ gam)
     Mr = Jp.T @ M @ Jp
     det = Mr[0, 0] * Mr[1, 1] - Mr[0, 1] * Mr[1, 0]
@@ -318,16 +336,17 @@ def rhs_pinned(z, P, c1, c2, pfx, pfy):
 
 @njit(cache=True)
 def mass_matrix(th1, th2, P):
-    """4x4 mass matrix M(q) [kg, kg m, kg m^2]."""
-    m, MH, b = P[1], P[2], P[3]
+    """4x4 mass matrix M(q) [kg, kg m, kg m^2] from :func:`mass_blocks`."""
+    A, D, B00, B01, B10, B11 = mass_blocks(th1, th2, P)
     M = np.zeros((4, 4))
-    M[0, 0] = MH + 2.0 * m
-    M[1, 1] = MH + 2.0 * m
-    for i in range(2):
-        th = th1 if i == 0 else th2
-        M[0, 2 + i] = M[2 + i, 0] = m * b * np.cos(th)
-        M[1, 2 + i] = M[2 + i, 1] = m * b * np.sin(th)
-        M[2 + i, 2 + i] = m * b * b
+    M[0, 0] = A
+    M[1, 1] = A
+    M[2, 2] = D
+    M[3, 3] = D
+    M[0, 2] = M[2, 0] = B00
+    M[0, 3] = M[3, 0] = B01
+    M[1, 2] = M[2, 1] = B10
+    M[1, 3] = M[3, 1] = B11
     return M
 
 
@@ -340,7 +359,7 @@ def contact_table(X, P, c1, c2):
     """
     n = X.shape[0]
     out = np.zeros((n, 2, 8))
-    sp, cp = np.sin(P[5]), np.cos(P[5])
+    sp, cp = np.sin(P[I_PHI]), np.cos(P[I_PHI])
     for r in range(n):
         x = X[r]
         for i in range(2):
@@ -353,40 +372,21 @@ def contact_table(X, P, c1, c2):
             for k in range(6):
                 out[r, i, k] = res[k]
             out[r, i, 6] = Fx * vx + Fy * vy
-            out[r, i, 7] = 1.0 if in_patch(res[3], cen, P[14], P[15] > 0.5) else 0.0
+            out[r, i, 7] = 1.0 if in_patch(res[3], cen, P[I_HW], P[I_CONT] > 0.5) else 0.0
     return out
 
 
 @njit(cache=True)
-def dead(x, P, c1, c2, hmin, dtrip):
-    """True once the walker has fallen (hip height x.n < hmin [m]) or tripped (a foot is
-    more than dtrip [m] below the surface of a patch, i.e. it came in through a patch side)."""
-    if x[0] * np.sin(P[5]) + x[1] * np.cos(P[5]) < hmin:
-        return True
-    for i in range(2):
-        cen = c1 if i == 0 else c2
-        px, py, vx, vy = foot_state(x, i, P)
-        delta = -(px * np.sin(P[5]) + py * np.cos(P[5]))
-        if delta > dtrip and in_patch(px * np.cos(P[5]) - py * np.sin(P[5]), cen, P[14],
-                                      P[15] > 0.5):
-            return True
-    return False
+def hip_height(x, P):
+    """Hip height above the ground line, hip . n [m]: the one fall test compares it with a
+    threshold (:meth:`walkerlab.contact.model.ContactWalker.fall_margin`)."""
+    return x[X_HIP_X] * np.sin(P[I_PHI]) + x[X_HIP_Y] * np.cos(P[I_PHI])
 
 
 @njit(cache=True)
-def rhs_guarded(x, P, c1, c2, hmin, dtrip):
-    """:func:`rhs`, but without any contact force once :func:`dead` (free fall).
-
-    A fallen walker (feet sinking through lane gaps, then re-entering patches far below their
-    surface, where the IMPACT law would give absurd forces) then costs almost nothing to
-    integrate; needed by drivers without event support (odeint).  Both sides of the switch
-    are smooth, so the integrator simply passes it (a zero-derivative freeze instead makes
-    LSODA creep towards the switching surface).
-    """
-    return rhs_flag(x, P, c1, c2, not dead(x, P, c1, c2, hmin, dtrip))
-
-
-@njit(cache=True)
-def jac_guarded(x, P, c1, c2, hmin, dtrip):
-    """Jacobian of :func:`rhs_guarded`."""
-    return jac_flag(x, P, c1, c2, not dead(x, P, c1, c2, hmin, dtrip))
+def hip_heights(X, P):
+    """:func:`hip_height` of each row of X (n, 8) -> (n,)."""
+    out = np.empty(X.shape[0])
+    for r in range(X.shape[0]):
+        out[r] = hip_height(X[r], P)
+    return out

@@ -25,7 +25,7 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
     dict
         ``scale`` (2,), ``objective``, ``evaluations``, ``grid_best`` (2,).
     """
-    from walkerlab.stages.contact_sim import settings, simulate_from
+    from .scene import settings, simulate_from
 
     n_strides = settings(scene)[2].n_strides
     L = scene.walker.leg_length_m
@@ -38,7 +38,7 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
         walker, res, _, _ = simulate_from(scene, x_fp, period, rate_scale=tuple(s))
         n_hs = len(res.heel_strike_times)
         want = 2 * n_strides
-        if n_hs < want or res.termination == "fall":
+        if n_hs < want or res.termination in ("fall", "trip"):
             return 1.0 + (want - min(n_hs, want))
         steps = [st for st in res.steps if np.isfinite(st.period)][-4:]
         T = np.array([st.period for st in steps])

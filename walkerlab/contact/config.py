@@ -8,11 +8,12 @@ explicitly to SI (NOTES.md: "a wrong unit here changes the answer by 10^6").
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
-__all__ = ["ContactParamsSI", "ContactSettings", "ContactSimSettings", "TerrainSettings"]
+__all__ = ["ContactParamsSI", "ContactSettings", "ContactSimSettings", "TerrainSettings",
+           "family_scaling"]
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,38 @@ class ContactParamsSI:
     v_d: float
 
 
+# Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
+# a YAML int still validates as a float.  Same rules as walkerlab.config._Strict.
+_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+
+# Longest contact run (D8): 100 strides is ~20x the paper's 5 and keeps the artifact < 100 MB.
+MAX_CONTACT_STRIDES = 100
+
+
+def _list_to_tuple(v):
+    return tuple(v) if isinstance(v, list) else v
+
+
+def family_scaling(cmax: float, dmax: float, e: float, kappa: float) -> tuple[float, float]:
+    """Damping and damping-ramp depth of the 'rigid_limit' stiffness family.
+
+    A point mass m dropping at speed v on ``F = k d^e + c(d) d'`` reaches the depth
+    ``d* ~ (m v^2 / k)^(1/(e+1))`` in the time ``d* / v``; in the scaled variables
+    ``d / d*``, ``t v / d*`` the equation is unchanged when ``c ~ k^(1/(e+1))`` and
+    ``dmax ~ d* ~ k^(-1/(e+1))``.  So with ``kappa = k / k_ref`` the family
+    ``cmax kappa^(1/(e+1))``, ``dmax kappa^(-1/(e+1))`` keeps the coefficient of restitution
+    of the reference contact for every k (gravity during the impact aside), and the contact
+    tends to the rigid plastic impact only through its duration ``~ k^(-1/(e+1))``.
+
+    Returns
+    -------
+    (cmax, dmax) : tuple of float
+        In the units of the inputs.
+    """
+    p = 1.0 / (e + 1.0)
+    return cmax * kappa ** p, dmax * kappa ** (-p)
+
+
 def _len_factor(unit_system: str) -> float:
     """Metres per length unit of ``unit_system``."""
     return {"mm-kg-s": 1e-3, "SI": 1.0}[unit_system]
@@ -57,13 +90,13 @@ class ContactSettings(BaseModel):
     ADAMS's default mm-kg-s units, with the ADAMS View defaults for the rest (NOTES.md).
     """
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = _STRICT
 
     unit_system: Literal["mm-kg-s", "SI"] = Field(
         "mm-kg-s", description="Unit system of the numbers below: 'mm-kg-s' (ADAMS default) or 'SI'."
     )
     stiffness: float = Field(
-        1e5, gt=0, description="IMPACT stiffness k.",
+        1e5, gt=0, le=1e12, description="IMPACT stiffness k (at most 1e12).",
         json_schema_extra={"unit": "N/<len>^e"},
     )
     exponent: float = Field(
@@ -91,6 +124,17 @@ class ContactSettings(BaseModel):
         json_schema_extra={"unit": "<len>/s"},
     )
 
+    stiffness_family: Literal["paper", "rigid_limit"] = Field(
+        "paper", description="How damping and dmax follow the stiffness: 'paper' keeps "
+        "max_damping and penetration_at_max_damping as given (a stiffer contact is then more "
+        "elastic); 'rigid_limit' scales them with kappa = stiffness / reference_stiffness as "
+        "cmax * kappa^(1/(e+1)), dmax * kappa^(-1/(e+1)), so a drop impact keeps the "
+        "restitution it has at the reference stiffness (near-plastic) as k grows.")
+    reference_stiffness: float = Field(
+        1e5, gt=0, description="Stiffness at which max_damping and penetration_at_max_damping "
+        "hold in the 'rigid_limit' family (paper: 1e5 N/mm^2.2).",
+        json_schema_extra={"unit": "N/<len>^e"})
+
     @model_validator(mode="after")
     def _check_relations(self) -> ContactSettings:
         if self.mu_dynamic > self.mu_static:
@@ -116,11 +160,15 @@ class ContactSettings(BaseModel):
         """
         f = _len_factor(self.unit_system)
         e = self.exponent
+        cmax, dmax = self.max_damping, self.penetration_at_max_damping
+        if self.stiffness_family == "rigid_limit":
+            kappa = self.stiffness / self.reference_stiffness
+            cmax, dmax = family_scaling(cmax, dmax, e, kappa)
         return ContactParamsSI(
             k=self.stiffness * f ** (-e),
             e=e,
-            cmax=self.max_damping / f,
-            dmax=self.penetration_at_max_damping * f,
+            cmax=cmax / f,
+            dmax=dmax * f,
             mu_s=self.mu_static,
             mu_d=self.mu_dynamic,
             v_s=self.stiction_velocity * f,
@@ -137,7 +185,7 @@ class TerrainSettings(BaseModel):
     the lane there is no ground (a gap), so the swing foot is not scuffed at mid-stance.
     """
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = _STRICT
 
     kind: Literal["checkerboard", "continuous"] = Field(
         "checkerboard", description="'checkerboard' (per-leg patches at footfalls) or 'continuous'."
@@ -150,11 +198,13 @@ class TerrainSettings(BaseModel):
 class ContactSimSettings(BaseModel):
     """Run settings of a contact simulation."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = _STRICT
 
-    n_strides: int = Field(5, ge=1, description="Strides (2 steps each) to simulate [-].")
+    n_strides: int = Field(5, ge=1, le=MAX_CONTACT_STRIDES,
+                           description="Strides (2 steps each) to simulate [-]; at most 100.")
     t_final_s: float | None = Field(
-        None, gt=0, description="Simulated time [s]; default n_strides * 2 * ideal step period."
+        None, gt=0, le=600, description="Simulated time [s] (at most 600); default "
+        "n_strides * 2 * ideal step period."
     )
     pin_stance_until: Literal["none", "first_touchdown", "time"] = Field(
         "none", description="Hold the first stance foot fixed until this moment."
@@ -163,11 +213,22 @@ class ContactSimSettings(BaseModel):
     fall_hip_height_m: float | None = Field(
         None, gt=0, description="Fall when hip height above ground < this [m]; default 0.5*L."
     )
-    sample_rate_hz: float = Field(1000.0, gt=0, description="Output sample rate [Hz].")
+    sample_rate_hz: float = Field(1000.0, gt=0, le=1e5, description="Output sample rate [Hz].")
     periodic_gait: bool = Field(
         False, description="Also find the contact walker's own periodic gait and its Floquet "
         "multipliers (walkerlab.contact.periodic; about 5-10 s)."
     )
-    initial_rate_scale: tuple[float, float] = Field(
+    initial_rate_scale: Annotated[tuple[float, float], BeforeValidator(_list_to_tuple)] = Field(
         (1.0, 1.0), description="Multipliers [-] on dtheta1, dtheta2 of the initial state."
     )
+    wall_time_limit_s: float | None = Field(
+        120.0, gt=0, description="Wall-time limit of one contact run [s]; when it runs out "
+        "the run ends with outcome 'time_limit' (null = none).",
+        json_schema_extra={"unit": "s"})
+    stop_after_strides: bool = Field(
+        True, description="Strides cap: stop once 2 * n_strides + 1 heel strikes have "
+        "happened, even if t_final_s is longer.")
+    periodic_time_limit_s: float | None = Field(
+        120.0, gt=0, description="Wall-time limit of the periodic-gait search [s]; when it "
+        "runs out the gait is reported as 'time_limit' (null = none).",
+        json_schema_extra={"unit": "s"})

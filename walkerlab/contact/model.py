@@ -73,9 +73,12 @@ class ContactWalker:
 
     def __post_init__(self):
         c = self.contact
-        P = np.array([self.L, self.m, self.MH, self.L - self.a, self.g, self.phi, c.k, c.e,
-                      c.cmax, c.dmax, c.mu_s, c.mu_d, c.v_s, c.v_d, self.patch_half_width,
-                      1.0 if self.continuous else 0.0])
+        P = np.empty(K.NPAR)
+        P[K.I_L], P[K.I_M], P[K.I_MH], P[K.I_B], P[K.I_G], P[K.I_PHI] = (
+            self.L, self.m, self.MH, self.L - self.a, self.g, self.phi)
+        P[K.I_K], P[K.I_E], P[K.I_CMAX], P[K.I_DMAX] = c.k, c.e, c.cmax, c.dmax
+        P[K.I_MUS], P[K.I_MUD], P[K.I_VS], P[K.I_VD] = c.mu_s, c.mu_d, c.v_s, c.v_d
+        P[K.I_HW], P[K.I_CONT] = self.patch_half_width, 1.0 if self.continuous else 0.0
         object.__setattr__(self, "lane1", np.ascontiguousarray(self.lane1, dtype=float))
         object.__setattr__(self, "lane2", np.ascontiguousarray(self.lane2, dtype=float))
         object.__setattr__(self, "_P", P)
@@ -161,8 +164,13 @@ class ContactWalker:
 
     def hip_height(self, X) -> np.ndarray:
         """Hip height above the ground line, hip . n [m], for X (n, 8) -> (n,)."""
-        X = np.atleast_2d(X)
-        return X[:, 0] * np.sin(self.phi) + X[:, 1] * np.cos(self.phi)
+        X = np.ascontiguousarray(np.atleast_2d(X), dtype=float)
+        return K.hip_heights(X, self._P)
+
+    def fall_margin(self, x, threshold: float) -> float:
+        """The one fall test: hip height of state ``x`` (8,) minus ``threshold`` [m]
+        (negative = fallen).  Used as the fall event of every integration."""
+        return float(K.hip_height(np.asarray(x, dtype=float), self._P)) - threshold
 
     def contact_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
         """Per-foot contact quantities for states X (n, 8).

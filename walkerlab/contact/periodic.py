@@ -74,12 +74,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.optimize import root
+from scipy.optimize import brentq, root
 
 from . import _kernels as K
 from .model import ContactWalker
 
-__all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait",
+__all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait", "PeriodicGaitError",
            "find_contact_periodic_gait", "section_guess_from_ideal", "rigid_limit_contact"]
 
 SECTION_NAMES = ("theta_stance", "dtheta_swing", "dtheta_stance", "delta_stance",
@@ -152,6 +152,15 @@ class ContactPeriodicGait:
         return float(np.max(np.abs(self.multipliers)))
 
 
+class PeriodicGaitError(RuntimeError):
+    """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
+    "time_limit", "solver_failure"."""
+
+    def __init__(self, kind: str, message: str):
+        super().__init__(message)
+        self.kind = kind
+
+
 class StepMap:
     """Mid-stance-to-mid-stance step map of a :class:`ContactWalker`.
 
@@ -171,7 +180,7 @@ class StepMap:
 
     def __init__(self, walker: ContactWalker, patch_spacing: float | None = None,
                  method: str = "LSODA", rtol: float = 1e-11, atol: float = 1e-13,
-                 t_max: float = 3.0):
+                 t_max: float = 3.0, deadline: float | None = None):
         if patch_spacing is None:
             if walker.lane1.size and walker.lane2.size:
                 patch_spacing = float(walker.lane1[0] - walker.lane2[0])
@@ -181,6 +190,7 @@ class StepMap:
         self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing]),
                                           lane2=np.array([0.0]), continuous=False)
         self.method, self.rtol, self.atol, self.t_max = method, rtol, atol, t_max
+        self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
         w = self.walker
         self._P, self._c1, self._c2 = w._P, w.lane1, w.lane2
@@ -208,6 +218,9 @@ class StepMap:
 
     # ------------------------------------------------------------------ the map
     def _rhs(self, t, x):
+        if time.perf_counter() > self.deadline:
+            raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
+                                    "reached")
         return K.rhs(x, self._P, self._c1, self._c2)
 
     def _jac(self, t, x):
@@ -224,39 +237,119 @@ class StepMap:
         mid.terminal = True
         mid.direction = 1.0
 
+        hth = 0.5 * self.walker.L
+
         def fall(t, x):
-            return x[0] * np.sin(self.walker.phi) + x[1] * np.cos(self.walker.phi) - 0.5
+            return self.walker.fall_margin(x, hth)
 
         fall.terminal = True
         fall.direction = -1.0
         sol = solve_ivp(self._rhs, (0.0, self.t_max), np.asarray(x0, float),
-                        method=self.method, jac=self._jac, rtol=self.rtol, atol=self.atol,
+                        method="LSODA" if self.method == "odeint" else self.method, jac=self._jac, rtol=self.rtol, atol=self.atol,
                         events=[mid, fall], dense_output=dense)
         self.nfev += 1
         return sol
+
+    def _step_odeint(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
+                     chunk_s: float = 0.25):
+        """``method="odeint"``: (t_e, x_e) of the next upward zero of theta_sw - theta_st.
+
+        scipy's odeint (LSODA without per-step Python overhead) on a ``dt`` grid in chunks;
+        the crossing is bracketed on the samples and located by ``scipy.optimize.brentq``
+        on short odeint integrations from the sample before it, so the section state
+        carries the integrator's accuracy, not an interpolant's.
+        """
+        from scipy.integrate import odeint
+
+        ist, isw = 2 + stance_to_come, 3 - stance_to_come
+        hth = 0.5 * self.walker.L
+        P, c1, c2 = self._P, self._c1, self._c2
+
+        def f(t, x):
+            return K.rhs(x, P, c1, c2)
+
+        def jf(t, x):
+            return K.jac(x, P, c1, c2)
+
+        def run(x, tg):
+            X, info = odeint(f, x, tg, Dfun=jf, tfirst=True, rtol=self.rtol, atol=self.atol,
+                             full_output=True, mxstep=500000)
+            if info["message"] != "Integration successful.":
+                raise PeriodicGaitError("solver_failure", f"step map: {info['message']}")
+            return X
+
+        ta, xa = 0.0, np.asarray(x0, float)
+        self.nfev += 1
+        while ta < self.t_max:
+            if time.perf_counter() > self.deadline:
+                raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
+                                        "reached")
+            tg = ta + dt * np.arange(int(round(chunk_s / dt)) + 1)
+            X = run(xa, tg)
+            g = X[:, isw] - X[:, ist]
+            hh = K.hip_heights(np.ascontiguousarray(X), P)
+            up = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0)) + 1
+            down = np.flatnonzero(hh < hth)
+            if down.size and (not up.size or down[0] <= up[0]):
+                raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+            if up.size:
+                k = int(up[0])
+                xk = X[k - 1]
+
+                def gap(t):
+                    if t <= tg[k - 1]:
+                        return g[k - 1]
+                    x = run(xk, np.array([tg[k - 1], t]))[-1]
+                    return x[isw] - x[ist]
+
+                te = brentq(gap, tg[k - 1], tg[k], xtol=1e-13, rtol=1e-14)
+                xe = run(xk, np.array([tg[k - 1], te]))[-1] if te > tg[k - 1] else xk
+                return float(te), xe
+            ta, xa = tg[-1], X[-1]
+        raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
+                                f"{self.t_max:g} s")
 
     def __call__(self, z):
         """One step: returns (P(z) (6,), period [s], step length [m]).
 
         Raises
         ------
-        RuntimeError
-            The walker fell, or did not reach the next mid-stance within ``t_max``.
+        PeriodicGaitError
+            The walker fell, did not reach the next mid-stance within ``t_max``, the solver
+            failed or the wall-time limit ran out.
         """
+        if self.method == "odeint":
+            te, xe = self._step_odeint(self.to_state(z))
+            z1, s1 = self.to_section(xe, 0)
+            return z1, te, s1
         sol = self.integrate(self.to_state(z))
         if sol.status != 1 or sol.t_events[0].size == 0:
-            why = "fell" if sol.t_events[1].size else f"no mid-stance ({sol.message})"
-            raise RuntimeError(f"step map failed: {why}")
+            if sol.t_events[1].size:
+                raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+            if sol.status < 0:
+                raise PeriodicGaitError("solver_failure", f"step map: {sol.message}")
+            raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
+                                    f"{self.t_max:g} s")
         xe = sol.y_events[0][0]
         z1, s1 = self.to_section(xe, 0)
         return z1, float(sol.t_events[0][0]), s1
 
     def patch_margin(self, z) -> float:
         """Smallest distance [m] of a loaded foot to its patch edge over one step."""
-        sol = self.integrate(self.to_state(z), dense=True)
-        te = sol.t_events[0][0] if sol.t_events[0].size else sol.t[-1]
-        tt = np.linspace(0.0, te, 2001)
-        X = sol.sol(tt).T
+        if self.method == "odeint":
+            from scipy.integrate import odeint
+
+            x0 = self.to_state(z)
+            te = self._step_odeint(x0)[0]
+            tt = np.linspace(0.0, te, 2001)
+            X = odeint(lambda t, x: K.rhs(x, self._P, self._c1, self._c2), x0, tt,
+                       Dfun=lambda t, x: K.jac(x, self._P, self._c1, self._c2), tfirst=True,
+                       rtol=self.rtol, atol=self.atol, mxstep=500000)
+        else:
+            sol = self.integrate(self.to_state(z), dense=True)
+            te = sol.t_events[0][0] if sol.t_events[0].size else sol.t[-1]
+            tt = np.linspace(0.0, te, 2001)
+            X = sol.sol(tt).T
         cq = self.walker.contact_quantities(X)
         hw = self.walker.patch_half_width
         margin = np.inf
@@ -288,7 +381,8 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
     x0 = initial_state_from_ideal(w, *x_ideal, rate_scale=rate_scale)
     sol = step_map.integrate(x0, stance_to_come=1)
     if sol.status != 1 or sol.t_events[0].size == 0:
-        raise RuntimeError("the ideal state does not reach mid-stance on the contact model")
+        raise PeriodicGaitError("fall" if sol.t_events[1].size else "no_mid_stance",
+                                "the ideal state does not reach mid-stance on the contact model")
     return step_map.to_section(sol.y_events[0][0], 1)[0]
 
 
@@ -315,23 +409,38 @@ def rigid_limit_contact(walker: ContactWalker, kappa: float, mu_s: float = 2.0,
 def _walker_and_guess(walker_or_scene, guess):
     if isinstance(walker_or_scene, ContactWalker):
         return walker_or_scene, guess, None
-    from walkerlab.stages.contact_sim import build
-    from walkerlab.stages.fixedpoint import solve_variant
+    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.models.registry import build_walker
+
+    from .scene import build
 
     scene = walker_or_scene
-    ideal = solve_variant(scene, "derived")[1]
+    sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})
+    fp = sc.fixedpoint
+    if fp is None:
+        raise ValueError(f"scene '{scene.name}' has no 'fixedpoint' section (initial guess of "
+                         "the ideal gait)")
+    ideal = find_fixed_point(build_walker(sc), fp.initial_guess.as_array(),
+                             Solver.from_settings(sc.solver), xtol=fp.tolerance,
+                             fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
     walker, _ = build(scene, ideal.x, 2)
     return walker, (ideal.x if guess is None else guess), ideal
 
 
-def fd_jacobian(F, z, scale, h):
-    """Central-difference Jacobian dF/dz (SI) with steps ``h * scale``."""
+def fd_jacobian(F, z, scale, h, central: bool = True, F0=None):
+    """Finite-difference Jacobian dF/dz (SI) with steps ``h * scale``: central, or forward
+    from ``F0 = F(z)`` (n calls instead of 2n; used only for the root finder's Newton
+    directions, never for the reported multipliers)."""
     n = len(z)
     J = np.empty((n, n))
+    if not central and F0 is None:
+        F0 = F(z)
     for j in range(n):
         dz = np.zeros(n)
         dz[j] = h * scale[j]
-        J[:, j] = (F(z + dz) - F(z - dz)) / (2 * dz[j])
+        J[:, j] = ((F(z + dz) - F(z - dz)) / (2 * dz[j]) if central
+                   else (F(z + dz) - F0) / dz[j])
     return J
 
 
@@ -346,13 +455,14 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
                                check_fd: bool = True, method: str = "LSODA",
                                rtol: float = 1e-11, atol: float = 1e-13,
                                jac_rtol: float = 1e-12, jac_atol: float = 1e-14,
-                               patch_spacing: float | None = None) -> ContactPeriodicGait:
+                               patch_spacing: float | None = None,
+                               time_limit_s: float | None = None) -> ContactPeriodicGait:
     """Periodic gait of the compliant-contact walker and its Floquet multipliers.
 
     Parameters
     ----------
     walker_or_scene : ContactWalker or walkerlab.config.Scene
-        A scene is built into a walker with :func:`walkerlab.stages.contact_sim.build`; then
+        A scene is built into a walker with :func:`walkerlab.contact.scene.build`; then
         the default guess is its ideal (derived) fixed point.
     guess : array_like, optional
         Either a section state (6,) (:data:`SECTION_NAMES`) or an ideal post-impact state (4,)
@@ -376,14 +486,23 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     jac_rtol, jac_atol : tighter tolerances of the map for the final FD Jacobian.
     patch_spacing : float, optional
         Swing-patch distance ahead of the stance foot [m]; default the walker's lane spacing.
+    time_limit_s : float, optional
+        Wall-time limit of the whole search [s].
 
     Returns
     -------
     ContactPeriodicGait
+
+    Raises
+    ------
+    PeriodicGaitError
+        A step of the map fell, found no mid-stance, the solver failed, or the wall-time
+        limit ran out (``kind`` says which).
     """
     wall = time.perf_counter()
+    deadline = None if time_limit_s is None else wall + time_limit_s
     walker, guess, ideal = _walker_and_guess(walker_or_scene, guess)
-    P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol)
+    P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol, deadline=deadline)
     scale = SCALES.copy()
     scale[3] = walker.static_penetration()
     guess = np.asarray(guess, float)
@@ -403,14 +522,16 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         return (P(u * scale)[0] - u * scale) / scale
 
     def dG(u):
-        return fd_jacobian(lambda v: P(v)[0], u * scale, scale, 10 * fd_step) \
+        return fd_jacobian(lambda v: P(v)[0], u * scale, scale, 10 * fd_step,
+                           central=method != "odeint") \
             * scale[None, :] / scale[:, None] - np.eye(6)
 
     sol = root(G, z / scale, jac=dG, method="hybr", options={"xtol": xtol})
     zs = sol.x * scale
     z1, T, ell = P(zs)
     res_si = z1 - zs
-    PJ = StepMap(walker, patch_spacing, method=method, rtol=jac_rtol, atol=jac_atol)
+    PJ = StepMap(walker, patch_spacing, method=method, rtol=jac_rtol, atol=jac_atol,
+                 deadline=deadline)
     FJ = lambda v: PJ(v)[0]  # noqa: E731
     J = fd_jacobian(FJ, zs, scale, fd_step)
     ev = _sorted_eig(J)

@@ -121,3 +121,27 @@ def finish(f: h5py.File) -> None:
         missing = [None if len(ds.dims[i]) else f"{base}_dim{i}" for i in range(ds.ndim)]
         if any(missing):
             attach(ds, missing)
+
+
+def finish_sweep(f: h5py.File) -> None:
+    """netCDF dimensions of a finalized sweep file: ``point`` (rows) and ``axis_<i>`` (grid).
+
+    Every dataset under ``points/`` is one value per row, so it gets dimension ``point``;
+    each ``grid/axis_<i>`` becomes its own coordinate variable.
+    """
+    g = f["points"]
+    n = int(g["index"].shape[0])
+    if "point" not in g:
+        sc = g.create_dataset("point", shape=(n,), dtype="f4")
+        sc.make_scale(f"{_NOVAR}{n:10d}")
+    rows: list[h5py.Dataset] = []
+    g.visititems(lambda _n, o: rows.append(o) if isinstance(o, h5py.Dataset)
+                 and not o.is_scale and o.ndim == 1 else None)
+    for ds in rows:
+        if not len(ds.dims[0]):
+            ds.dims[0].attach_scale(g["point"])
+    if "grid" in f:
+        for name, ds in f["grid"].items():
+            if isinstance(ds, h5py.Dataset) and not ds.is_scale:
+                ds.make_scale(name)
+    finish(f)

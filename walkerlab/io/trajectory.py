@@ -11,6 +11,8 @@ over the other, whatever the walker (compass gait: ``leg1_angle``, ``leg2_angle`
                                              ``HybridWalker.leg_coordinates``
 ``samples/stance_leg``               -       index into the ``legs`` attribute
 ``samples/step_index``               -       step each sample belongs to
+``samples/phase``                    -       continuous phase of the step (index into the
+                                             ``phases`` attribute; rigid walkers only)
 ``samples/energy/kinetic``           J
 ``samples/energy/potential``         J       relative to the first stance foot's height
 ``samples/energy/total``             J
@@ -61,6 +63,8 @@ class NamedTrajectory:
     kinetic: np.ndarray
     potential: np.ndarray
     points: dict[str, np.ndarray] = field(default_factory=dict)  # name -> (2, k)
+    phase: np.ndarray | None = None  # (k,) index into phase_names; None: not phased
+    phase_names: list[str] = field(default_factory=list)
 
     @property
     def total(self) -> np.ndarray:
@@ -100,6 +104,10 @@ def write_samples(f: h5py.Group, tr: NamedTrajectory) -> None:
         dims=t)
     put(g, "step_index", tr.step_index.astype(np.int32), "-", "step number of each sample",
         dims=t)
+    if tr.phase is not None:
+        g.attrs["phases"] = list(tr.phase_names)
+        put(g, "phase", tr.phase.astype(np.int8), "-", "continuous phase of the step "
+            "(index into attribute 'phases'); energy is conserved within a phase", dims=t)
     put(g, "energy/kinetic", tr.kinetic, "J", "kinetic energy", dims=t)
     put(g, "energy/potential", tr.potential, "J",
         "gravitational potential energy relative to the first stance foot's height", dims=t)
@@ -124,4 +132,6 @@ def read_samples(f: h5py.Group) -> NamedTrajectory:
         units={n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names},
         stance_leg=g["stance_leg"][()], step_index=g["step_index"][()],
         kinetic=g["energy/kinetic"][()], potential=g["energy/potential"][()], points=pts,
+        phase=g["phase"][()] if "phase" in g else None,
+        phase_names=[str(x) for x in g.attrs.get("phases", [])],
     )

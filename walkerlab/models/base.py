@@ -173,9 +173,10 @@ class HybridWalker:
 
     @property
     def coordinate_units(self) -> dict[str, str]:
-        """Unit of each key of :meth:`leg_coordinates` (``*_angle`` [rad], ``*_rate`` [rad/s])."""
-        names = self.leg_coordinates(np.zeros(2 * self.n_coordinates), self.legs[-1])
-        return {k: ("rad" if k.endswith("_angle") else "rad/s") for k in names}
+        """Units of the :meth:`leg_coordinates` series, by name (in their order)."""
+        X = np.zeros(2 * self.n_coordinates)
+        return {k: ("rad/s" if k.endswith("_rate") else "rad")
+                for k in self.leg_coordinates(X, self.legs[-1])}
 
     def leg_coordinates(self, X: np.ndarray, stance_leg: str) -> dict[str, np.ndarray]:
         """Absolute angle [rad] and rate [rad/s] of each physical leg, keyed ``<leg>_angle``,
@@ -204,8 +205,8 @@ class HybridWalker:
         r2l = self.role_to_leg(stance_leg)
         out = {}
         for key, val in by_role.items():
-            # role-prefixed series belong to a leg; others (a torso, say) keep their role name
             role = next((r for r in sorted(r2l, key=len, reverse=True)
                          if key.startswith(r + "_")), None)
+            # a coordinate on no leg (a torso) keeps its own name
             out[key if role is None else r2l[role] + key[len(role):]] = np.asarray(val)
         return out

@@ -29,7 +29,7 @@ Equation variants
 
 from __future__ import annotations
 
-import math
+from dataclasses import replace
 from functools import cache, partial
 
 import numpy as np
@@ -95,26 +95,6 @@ def flow(t: float, x: np.ndarray, p: tuple, variant: str = "derived") -> np.ndar
     M, C, G = matrices(q, dq, p, variant)
     qdd = np.linalg.solve(M, -C @ dq - G)
     return np.concatenate([dq, qdd])
-
-
-def printed_flow(p: tuple):
-    """Appendix A flow (A.4-A.6, printed C[1, 0] sign) as scalar code: ``(t, x) -> (4,)``."""
-    m, mh, L, a, g = p
-    b = L - a
-    m22 = mh * L**2 + m * (L**2 + a**2)
-    mbl = m * L * b
-    mb2 = m * b**2
-    g1, g2 = m * g * b, (mh * L + m * (a + L)) * g
-
-    def f(t, x):
-        t1, t2, w1, w2 = x.tolist()
-        c, s = math.cos(t2 - t1), math.sin(t2 - t1)
-        m12 = -mbl * c
-        r1 = -mbl * w2 * s * w2 - g1 * math.sin(t1)
-        r2 = -mbl * w1 * s * w1 + g2 * math.sin(t2)
-        det = mb2 * m22 - m12 * m12
-        return np.array((w1, w2, (m22 * r1 - m12 * r2) / det, (mb2 * r2 - m12 * r1) / det))
-    return f
 
 
 def complex_step_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
@@ -268,9 +248,10 @@ def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: floa
                       variant: str = "derived") -> HybridWalker:
     """Build the compass-gait :class:`HybridWalker` (all arguments SI).
 
-    ``derived`` is the generic biped (generated code); the ``appendix_a`` variants replace
-    the flow by the printed A.4-A.6 (and, for ``appendix_a_literal``, the impact by A.55 as
-    printed), with Jacobians by complex step.
+    ``derived`` is the generic biped (generated code); the ``appendix_a`` variants use the
+    printed flow A.4-A.6 (generated too, see :class:`~walkerlab.models.description.Structure`)
+    and, for ``appendix_a_literal``, the impact with A.55 as printed (Jacobian by complex
+    step).
 
     Raises
     ------
@@ -285,13 +266,12 @@ def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: floa
                  slope_rad)
     if variant == "derived":
         return make_rigid_walker(data, "compass_gait", variant)
-    p = (leg_mass_kg, hip_mass_kg, leg_length_m, leg_mass_from_foot_m, gravity_m_per_s2)
-    f = printed_flow(p)
-    fc = partial(flow, p=p, variant=variant)  # numpy version, complex-step safe
+    # printed flow (A.4-A.6): generated like any other, from the derived equations with the
+    # printed sign of C[1, 0]; appendix_a_literal also uses the printed impact (A.55)
+    data = replace(data, structure=replace(data.structure, variant="appendix_a"))
     kw = {}
     if variant == "appendix_a_literal":
+        p = (leg_mass_kg, hip_mass_kg, leg_length_m, leg_mass_from_foot_m, gravity_m_per_s2)
         reset = partial(impact, p=p, variant=variant)
         kw = {"reset": reset, "reset_jacobian": lambda x: complex_step_jacobian(reset, x)}
-    return make_rigid_walker(
-        data, "compass_gait", variant, flow=f,
-        flow_jacobian=lambda t, x: complex_step_jacobian(lambda z: fc(t, z), x), **kw)
+    return make_rigid_walker(data, "compass_gait", variant, **kw)

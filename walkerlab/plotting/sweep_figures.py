@@ -4,6 +4,9 @@
   period-doubling cascade), the period-1 branch, and its Floquet multipliers with the -1 line.
 - :func:`stability_map_figure`: outcome per grid point of a 2-D sweep (categorical map) and
   the run time per point.
+- :func:`gait_map_figure`: stability map of the contact gait (gait exists / stable / max
+  |multiplier| or why it fails, per cell) and the wall time per cell.
+- :func:`restitution_figure`: drop-test restitution against stiffness, both families.
 - :func:`save`: PNG (150 dpi) + SVG.
 """
 
@@ -35,7 +38,7 @@ def bifurcation_figure(data: dict, title: str = ""):
     data : dict
         Keys ``slope`` (n,) [deg], ``steady_state/interleg_angle`` (n, k) [deg],
         ``fixed_point/interleg_angle`` (n,) [deg], ``floquet/real``, ``floquet/imag``
-        (n, 2m), ``onset/slope`` [deg].
+        (n, 2m), ``onset/onset_slope`` [deg].
 
     Returns
     -------
@@ -46,7 +49,7 @@ def bifurcation_figure(data: dict, title: str = ""):
     fp_il = np.asarray(data["fixed_point/interleg_angle"], float)
     mult = np.asarray(data["floquet/real"]) + 1j * np.asarray(data["floquet/imag"])
     stable = np.max(np.abs(mult), axis=1) < 1
-    onset = float(data.get("onset/slope", np.nan))
+    onset = float(data.get("onset/onset_slope", np.nan))
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True,
                                    gridspec_kw={"height_ratios": [3, 2]})
     ss, yy = np.repeat(s, il.shape[1]), il.ravel()
@@ -162,3 +165,113 @@ _UNITS = {"slope.angle_deg": "slope φ [deg]", "slope.angle_rad": "slope φ [rad
 
 def _label(path: str) -> str:
     return _UNITS.get(path, path)
+
+
+GAIT_CLASSES = ("stable gait", "unstable gait", "off patch", "falls", "time limit",
+                "no convergence", "other failure")
+GAIT_COLORS = ("#2ca02c", "#ff7f0e", "#9467bd", "#d62728", "#17becf", "#7f7f7f", "#000000")
+_REASON_CLASS = {"off_patch": 2, "fall": 3, "no_mid_stance": 3, "time_limit": 4,
+                 "not_converged": 5}
+_REASON_SHORT = {"off_patch": "off", "fall": "fall", "no_mid_stance": "nomid",
+                 "time_limit": "time", "not_converged": "nc", "solver_failure": "solv",
+                 "no_ideal_gait": "noid", "invalid_config": "cfg", "error": "err"}
+
+
+def gait_map_figure(data: dict):
+    """Stability map of the contact gait from a loaded ``stability_map_<kind>.h5``.
+
+    Left: per cell, stable / unstable gait (text: max |Floquet multiplier|) or why no gait
+    was found (text: short reason).  Right: wall time per cell.  Title: the fractions of
+    cells where a gait exists and where it exists and is stable.
+
+    Parameters
+    ----------
+    data : dict
+        :func:`walkerlab.stages.stability_map.load` output: ``y_values`` (ny,),
+        ``slopes_deg`` (nx,), (ny, nx) arrays ``exists``, ``stable``, ``max_abs_multiplier``,
+        ``reason``, ``wall_time_s`` and ``attrs``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    yv, xv = np.asarray(data["y_values"], float), np.asarray(data["slopes_deg"], float)
+    ex = np.asarray(data["exists"], float) > 0.5
+    st = np.asarray(data["stable"], float) > 0.5
+    mm = np.asarray(data["max_abs_multiplier"], float)
+    reason = np.asarray(data["reason"], dtype=object)
+    code = np.zeros(ex.shape)
+    for (i, j), e in np.ndenumerate(ex):
+        code[i, j] = (0 if st[i, j] else 1) if e else _REASON_CLASS.get(str(reason[i, j]), 6)
+    attrs = data.get("attrs", {})
+    kind = str(attrs.get("kind", ""))
+    unit_sys = str(attrs.get("unit_system", "mm-kg-s"))
+    ylab = str(attrs.get("y_label", attrs.get("y_path", "y"))).replace(
+        "len", "mm" if unit_sys == "mm-kg-s" else "m")
+    if kind == "stiffness":
+        ylab += f", {attrs.get('stiffness_family', 'paper')} family"
+    cmap = ListedColormap(GAIT_COLORS)
+    norm = BoundaryNorm(np.arange(len(GAIT_CLASSES) + 1) - 0.5, cmap.N)
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.6))
+    xi, yi = np.arange(xv.size), np.arange(yv.size)
+    a1.pcolormesh(xi, yi, code, cmap=cmap, norm=norm, shading="nearest")
+    for (i, j), c in np.ndenumerate(code):
+        txt = f"{mm[i, j]:.2f}" if ex[i, j] else _REASON_SHORT.get(str(reason[i, j]), "?")
+        a1.text(j, i, txt, ha="center", va="center", fontsize=6,
+                color="k" if c in (1, 4) else "w")
+    for k, lab in enumerate(GAIT_CLASSES):
+        if np.any(code == k):
+            a1.plot([], [], "s", color=GAIT_COLORS[k], label=lab)
+    a1.plot([], [], " ", label="cell text: max |multiplier|\nor why no gait")
+    a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    wall = np.asarray(data["wall_time_s"], float)
+    im = a2.pcolormesh(xi, yi, wall, shading="nearest", cmap="viridis")
+    fig.colorbar(im, ax=a2, label="wall time per cell [s]")
+    log_y = yv.min() > 0 and yv.max() / yv.min() > 100
+    for ax in (a1, a2):
+        ax.set_xticks(xi, [f"{v:g}" for v in xv], fontsize=7)
+        ax.set_yticks(yi, [f"{v:.3g}" for v in yv], fontsize=7)
+        ax.set_xlabel("slope φ [deg]")
+        ax.set_ylabel(ylab + (" (log grid)" if log_y else ""), fontsize=8)
+    n = ex.size
+    a1.set_title(f"contact gait: exists in {ex.sum()}/{n} cells ({100 * ex.sum() / n:.0f} %), "
+                 f"stable in {(ex & st).sum()}/{n} ({100 * (ex & st).sum() / n:.0f} %)",
+                 fontsize=9)
+    a2.set_title("wall time per cell", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=None):
+    """Drop-test coefficient of restitution against stiffness for each family.
+
+    Parameters
+    ----------
+    stiffness : ndarray (n,)
+        Stiffness values (scene units).
+    curves : dict
+        ``{family: restitution (n,)}``.
+    unit : str
+        Label of the stiffness unit.
+    k_paper : float, optional
+        Stiffness of the scene, marked with a vertical line.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = plt.subplots(figsize=(5.5, 3.6))
+    labels = {"paper": "paper family (damping, dmax fixed)",
+              "rigid_limit": "rigid-limit family (c ~ k^(1/(e+1)), dmax ~ k^(-1/(e+1)))"}
+    for fam, e in curves.items():
+        ax.semilogx(stiffness, e, "o-", label=labels.get(fam, fam), ms=4)
+    if k_paper is not None:
+        ax.axvline(k_paper, color="0.5", ls=":", lw=1, label="scene stiffness")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlabel(f"stiffness k [{unit}]")
+    ax.set_ylabel("coefficient of restitution [-]")
+    ax.set_ylim(-0.03, 1.03)
+    ax.set_title("drop test: 20 kg at 0.3 m/s (rigid plastic impact: 0)", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 import walkerlab
+from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections
 from walkerlab.report.markdown import details, num, table, to_html
@@ -84,7 +85,7 @@ def write_report(scene, paths: dict[str, Path], report_dir: Path, figures_dir: P
         ["```json", json.dumps(scene.model_dump(mode="json", exclude_none=True), indent=1),
          "```"]))
     text = "\n".join(md)
-    (report_dir / "report.md").write_text(text)
+    atomic_text(report_dir / "report.md", text)
     html_path = report_dir / "report.html"
-    html_path.write_text(to_html(text, report_dir))
+    atomic_text(html_path, to_html(text, report_dir))
     return html_path

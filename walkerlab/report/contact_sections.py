@@ -10,6 +10,7 @@ import numpy as np
 
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.published import for_scene
+from walkerlab.report.markdown import printed
 from walkerlab.report.markdown import table as _table
 
 
@@ -55,11 +56,11 @@ def contact_section(scene, paths) -> list[str]:
         with open_artifact(paths["simulate"], "simulate") as f:
             i0 = {n: float(f[f"samples/coordinates/{n}"][0]) for n in f["samples/coordinates"]}
     rows = []
-    for key in c0:
+    for key in [k for k in table2 if k in c0] + [k for k in c0 if k not in table2]:
         sym, pm, pa = table2.get(key, (key, np.nan, np.nan))
         oi = i0.get(key, np.nan)
         pd = f"{100 * (abs(pa) - abs(pm)) / abs(pm):+.1f}%" if key in table2 else "—"
-        rows.append([sym, pm, pa, pd, oi, c0[key],
+        rows.append([sym, printed(pm), printed(pa), pd, oi, c0[key],
                      f"{100 * (abs(c0[key]) - abs(oi)) / abs(oi):+.1f}%"])
     head = ["state", "paper MATLAB", "paper ADAMS", "paper diff.", "ours ideal",
             "ours contact", "ours diff."]

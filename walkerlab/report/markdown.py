@@ -22,9 +22,16 @@ def num(v, digits: int = DIGITS) -> str:
     v = float(v)
     if not np.isfinite(v):
         return "—"
+    if v.is_integer() and abs(v) < 1e6 and v != 0:
+        return str(int(v))  # counts stored as floats
     if v != 0 and (abs(v) < 1e-3 or abs(v) >= 1e6):
         return f"{v:.{max(1, digits - 1)}e}"
     return f"{v:#.{digits}g}".rstrip(".")
+
+
+def printed(v) -> str:
+    """A published number with the digits it was printed with (no padding, no rounding)."""
+    return f"{float(v):g}" if np.isfinite(float(v)) else "—"
 
 
 def details(summary: str, body: str) -> list[str]:

@@ -16,20 +16,53 @@ import numpy as np
 from walkerlab.analysis.tables import TABLE3_ROWS, table3
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.readers import load_fixed_point
-from walkerlab.report.markdown import details, num, table
+from walkerlab.report.markdown import details, num, printed, table
+from walkerlab.report.text import zero_multipliers_text
 
 
 # --------------------------------------------------------------------------- data
 def energy_drift_in_swing(path: Path) -> tuple[float, float]:
-    """Largest change of the total energy within a step [J] and relative to it [-].
+    """Largest change of the total energy within a continuous phase [J] and relative [-].
 
-    Read from ``simulate.h5``: the rigid model conserves energy in swing, so this measures
-    the integration error.
+    Read from ``simulate.h5``: a passive rigid walker conserves energy between impacts
+    (heel strike, knee strike), so this measures the integration error.
     """
     with open_artifact(path, "simulate") as f:
-        tot, step = f["samples/energy/total"][()], f["samples/step_index"][()]
-    drift = max(float(np.ptp(tot[step == k])) for k in np.unique(step))
+        g = f["samples"]
+        tot, step = g["energy/total"][()], g["step_index"][()]
+        phase = g["phase"][()] if "phase" in g else np.zeros_like(step)
+    key = step.astype(np.int64) * 1000 + phase
+    drift = max(float(np.ptp(tot[key == k])) for k in np.unique(key))
     return drift, drift / float(np.max(np.abs(tot)))
+
+
+def swing_foot_clearance(path: Path, slope_rad: float, margin: float = 0.1) -> float:
+    """Lowest height [m] of the swing foot above the slope inside the steps of ``simulate.h5``.
+
+    Heights are normal to the slope through the first stance foot; the first and last
+    ``margin`` of each step (lift-off, heel strike, where the height is ~0) are left out.
+    A negative value means the foot passes through the ground (scuffing, which the rigid
+    model ignores).  Round feet use the ``<leg>_contact`` point when the walker has one.
+    """
+    from walkerlab.io.trajectory import read_samples
+
+    with open_artifact(path, "simulate") as f:
+        tr = read_samples(f)
+    lowest = np.inf
+    for k in np.unique(tr.step_index):
+        m = tr.step_index == k
+        t = tr.time[m]
+        inner = (t > t[0] + margin * (t[-1] - t[0])) & (t < t[-1] - margin * (t[-1] - t[0]))
+        swing = tr.legs[1 - int(tr.stance_leg[m][0])] if len(tr.legs) == 2 else None
+        if swing is None or not inner.any():
+            continue
+        foot = tr.points.get(f"{swing}_contact", tr.points.get(f"{swing}_foot"))
+        if foot is None:
+            continue
+        xy = foot[:, m][:, inner]
+        h = xy[1] * np.cos(slope_rad) + xy[0] * np.sin(slope_rad)
+        lowest = min(lowest, float(np.min(h)))
+    return lowest
 
 
 def _contact_summary(path: Path) -> dict:
@@ -54,6 +87,14 @@ def _gait_columns(paths: dict[str, Path]) -> dict[str, dict]:
     return table3(src, mass, g)
 
 
+def published_fixed_point(pub: ModuleType | None) -> tuple[tuple, tuple]:
+    """``(state names, values)`` of a published fixed point (``FIXED_POINT_NAMES/STATE``,
+    or the ``EQ11_NAMES/STATE`` spelling), empty when the source prints none."""
+    names = getattr(pub, "FIXED_POINT_NAMES", getattr(pub, "EQ11_NAMES", ()))
+    state = getattr(pub, "FIXED_POINT_STATE", getattr(pub, "EQ11_STATE", ()))
+    return tuple(names), tuple(state)
+
+
 # --------------------------------------------------------------------------- summary
 def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[str]:
     """Short verdicts and headline numbers, with the published values where they exist."""
@@ -69,9 +110,9 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
                        f"{num(meta['step_period_s'])} s.")
         bullets.append(f"- **Stable**: {'yes' if meta['stable'] else 'no'} (largest "
                        f"|Floquet multiplier| {num(meta['max_abs_multiplier'])}).")
-        eq = dict(zip(getattr(pub, "EQ11_NAMES", ()), getattr(pub, "EQ11_STATE", ())))
+        eq = dict(zip(*published_fixed_point(pub)))
         for n, v, u in zip(meta["state_names"], x, meta["state_units"]):
-            rows.append([f"fixed point {n}", u, num(v), num(eq[n]) if n in eq else "—"])
+            rows.append([f"fixed point {n}", u, num(v), printed(eq[n]) if n in eq else "—"])
         rows.append(["step period", "s", num(meta["step_period_s"]), "—"])
         rows.append(["max abs(multiplier)", "-", num(meta["max_abs_multiplier"]), "—"])
     elif "fixedpoint" not in paths and scene.fixedpoint is not None:
@@ -86,6 +127,13 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
                        f"({n_hs} heel strikes, ended by {term}); energy drift in swing "
                        f"{num(drift, 2)} J ({num(rel, 2)} relative).")
         rows.append(["energy drift in swing", "J", num(drift, 2), "—"])
+        clear = swing_foot_clearance(sim, scene.slope.phi_rad)
+        if np.isfinite(clear):
+            verdict = ("no scuffing" if clear > 0 else "the swing foot passes through the "
+                       "ground (scuffing), which the rigid model ignores")
+            bullets.append(f"- **Swing-foot clearance**: lowest {num(1e3 * clear, 3)} mm above "
+                           f"the slope inside the steps: {verdict}.")
+            rows.append(["lowest swing-foot clearance", "mm", num(1e3 * clear, 3), "—"])
     if "contact-sim" in paths:
         c = _contact_summary(paths["contact-sim"])
         walks = c["termination"] != "fall" and c["heel_strikes"] > 0
@@ -101,13 +149,13 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
         t3 = getattr(pub, "TABLE3", {})
         for key in ("t_cycle_s", "v_com_m_per_s"):
             name, _sym, unit = TABLE3_ROWS[key]
-            rows.append([name, unit, num(ideal[key]), num(t3[key][0]) if key in t3 else "—"])
+            rows.append([name, unit, num(ideal[key]), printed(t3[key][0]) if key in t3 else "—"])
         if "E_avg_J" in t3:
             rows.append(["average mechanical energy, PE from the stance foot", "J",
-                         num(ideal.get("E_avg_stance_frame_J", np.nan)), num(t3["E_avg_J"][0])])
+                         num(ideal.get("E_avg_stance_frame_J", np.nan)), printed(t3["E_avg_J"][0])])
         step_pub = getattr(pub, "STEP_LENGTH_M", None)
         rows.append(["step length", "m", num(ideal["step_length_m"]),
-                     num(step_pub) if step_pub is not None else "—"])
+                     printed(step_pub) if step_pub is not None else "—"])
     out += bullets
     if rows:
         header = ["quantity", "unit", "ours"]
@@ -126,15 +174,19 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
 # --------------------------------------------------------------------------- fixed point
 def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
     """Fixed point of every equation variant, Floquet multipliers, verdict."""
-    eq = np.array(getattr(pub, "EQ11_STATE", ()), float) if pub is not None else None
+    pub_fp = dict(zip(*published_fixed_point(pub)))
     out = ["## Fixed point of the Poincaré map", ""]
     with open_artifact(path, "fixedpoint") as f:
         names = [str(n) for n in f.attrs["state_names"]]
         units = [str(f[f"fixed_point/{n}"].attrs["unit"]) for n in names]
         main = str(f.attrs["variant"])
+        # the published state in this walker's state order (None if it does not name them all)
+        eq = np.array([pub_fp[n] for n in names], float) if pub_fp and set(names) <= set(
+            pub_fp) else None
         rows = []
-        if eq is not None and eq.size == len(names):
-            rows.append([f"{pub.SHORT} Eq. (11) (printed)", *[num(v) for v in eq], "—", "—",
+        if eq is not None:
+            label = getattr(pub, "FIXED_POINT_LABEL", "Eq. (11)")
+            rows.append([f"{pub.SHORT} {label} (printed)", *[printed(v) for v in eq], "—", "—",
                          "—"])
         fps = {}
         for v in f["variants"]:
@@ -153,6 +205,8 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
         out.append("")
         out.append("State right after heel strike, role-ordered (the swing leg is the one that "
                    "just left the ground).")
+        if eq is not None and getattr(pub, "FIXED_POINT_NOTE", None):
+            out += ["", f"**Why the numbers differ.** {pub.FIXED_POINT_NOTE}"]
         if eq is not None and "appendix_a" in fps and "derived" in fps:
             d = fps["derived"] - eq
             a = fps["appendix_a"] - eq
@@ -181,8 +235,7 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
                        for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
                 "", f"Max difference between the two: {num(f['floquet/max_difference'][()], 2)}. "
                 f"Verdict: **{'stable' if f['floquet/stable'][()] else 'unstable'}** "
-                "(one multiplier is 0 by construction: the map lands on the heel-strike "
-                "surface).", ""]
+                f"({zero_multipliers_text(re, im)}).", ""]
     return out
 
 
@@ -199,20 +252,20 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
     header += list(cols)
     rows = []
     for key, (name, sym, unit) in TABLE3_ROWS.items():
-        pubv = [num(v) for v in t3[key]] if t3 else []
+        pubv = [printed(v) for v in t3[key]] if t3 else []
         rows.append([name, sym, unit, *pubv, *(num(c[key]) for c in cols.values())])
     blank = ["", ""] if t3 else []
     rows.append(["Average mechanical energy, PE from the current stance foot", "E_avg'", "J",
                  *blank, *(num(c.get("E_avg_stance_frame_J", np.nan)) for c in cols.values())])
     step_pub = getattr(pub, "STEP_LENGTH_M", None)
-    rows.append(["Step length", "Δx", "m", *([num(step_pub)] * 2 if t3 else []),
+    rows.append(["Step length", "Δx", "m", *([printed(step_pub)] * 2 if t3 else []),
                  *(num(c["step_length_m"]) for c in cols.values())])
     title = "## Table 3 — gait characteristics" if t3 else "## Gait characteristics"
     out = [title, "", "Recomputed from the trajectory artifacts ("
            + ", ".join(f"`{paths[s].name}`" for s in ("simulate", "contact-sim") if s in paths)
            + ").", "", table(header, rows)]
     ideal = cols.get("ours, ideal")
-    eq = getattr(pub, "EQ11_STATE", None)
+    eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
     if ideal and t3 and eq is not None and step_pub is not None:
         L = float(scene.walker.leg_length_m)
         eqd = dict(zip(pub.EQ11_NAMES, eq))
@@ -222,20 +275,21 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
         out += ["", "**Differences from the published Table 3, measured:**", "",
                 f"- *Left/right step periods.* A period-1 gait has identical steps: ours are "
                 f"{num(ideal['t_left_s'])} s and {num(ideal['t_right_s'])} s. The published "
-                f"{num(t3['t_left_s'][0])} s and {num(t3['t_right_s'][0])} s cannot both belong "
-                f"to the period-1 fixed point of Eq. (11); their sum {num(t3['t_cycle_s'][0])} s "
+                f"{printed(t3['t_left_s'][0])} s and {printed(t3['t_right_s'][0])} s cannot "
+                f"both belong to the period-1 fixed point of Eq. (11); their sum "
+                f"{printed(t3['t_cycle_s'][0])} s "
                 f"is within {num(abs(t3['t_cycle_s'][0] - ideal['t_cycle_s']), 2)} s of our "
                 f"cycle period {num(ideal['t_cycle_s'])} s.",
                 f"- *Step length Δx.* Eq. (11) itself implies Δx = 2 L sin((θ2 − θ1)/2) = "
                 f"{num(dx_eq11)} m (ours: {num(ideal['step_length_m'])} m), about "
-                f"{dx_eq11 / step_pub:.0f}× the printed {num(step_pub)} m. With the printed Δx "
-                f"the speed formula gives {num(step_pub)}/{num(t3['t_cycle_s'][0])} = "
+                f"{dx_eq11 / step_pub:.0f}× the printed {printed(step_pub)} m. With the printed Δx "
+                f"the speed formula gives {printed(step_pub)}/{printed(t3['t_cycle_s'][0])} = "
                 f"{num(step_pub / t3['t_cycle_s'][0])} m/s, the printed v_com; the walker "
                 f"actually advances at {num(ideal['v_com_m_per_s'])} m/s (hip displacement over "
                 "whole cycles / time).",
                 f"- *Energy.* With the potential energy measured from the current stance foot "
                 f"we get E_avg' = {num(e_st)} J, within {num(abs(e_pub - e_st), 2)} J of the "
-                f"printed {num(e_pub)} J; measured from a fixed datum (first stance foot) the "
+                f"printed {printed(e_pub)} J; measured from a fixed datum (first stance foot) the "
                 f"average over 5 steps is {num(ideal['E_avg_J'])} J because the walker descends "
                 f"the {num(scene.slope.phi_rad)} rad slope by Δx sin φ per step."]
     out.append("")
@@ -337,12 +391,12 @@ def bifurcation_section(paths: dict[str, Path]) -> list[str]:
     if p is None:
         return []
     with open_artifact(p, "bifurcation") as f:
-        onset = float(f["onset/slope"][()])
+        onset = float(f["onset/onset_slope"][()])
         slopes = f["slope"][()]
         per = f["steady_state/attractor_period"][()]
     text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
             "where the most negative real Floquet multiplier crosses −1" if np.isfinite(onset)
             else "no period doubling on the grid")
     return ["## Bifurcation over the slope", "",
-            f"Grid {num(slopes[0])}–{num(slopes[-1])}° ({slopes.size} slopes): {text}; "
+            f"Grid {printed(slopes[0])}–{printed(slopes[-1])}° ({slopes.size} slopes): {text}; "
             f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}.", ""]

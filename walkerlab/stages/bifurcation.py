@@ -64,7 +64,7 @@ def run(scene: Scene, slopes_deg, runs_root: Path | str = "runs", n_transient: i
     out = run_cached("bifurcation", scene, runs_root, SECTIONS, (), compute, force,
                      extra_key=key)
     data = load_bifurcation(out.path)
-    out.summary.setdefault("onset_deg", float(data["onset/slope"]))
+    out.summary.setdefault("onset_deg", float(data["onset/onset_slope"]))
     model = str(getattr(scene.walker, "model", "walker")).replace("_", " ")
     figs = save(bifurcation_figure(data, f"{model}, scene {scene.name}"),
                 figures_dir(scene, runs_root), "bifurcation")

@@ -14,54 +14,26 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import ContactSolverSettings, Scene
-from walkerlab.contact.config import ContactSimSettings, TerrainSettings
+from walkerlab.contact import scene as contact_scene
 from walkerlab.io.artifacts import put
 from walkerlab.io.trajectory import NamedTrajectory, write_samples
 from walkerlab.stages import fixedpoint as fixedpoint_stage
 from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
 
 SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_solver")
+#: stiffness values (scene units) of the drop test stored with every contact run
+DROP_STIFFNESS = (1e4, 3e4, 1e5, 3e5, 1e6, 3e6, 1e7, 3e7, 1e8, 3e8, 1e9)
 LEGS = ["leg1", "leg2"]
 
 
 def settings(scene: Scene):
-    """Contact sections with defaults for the optional ones."""
-    contact = require(scene, "contact", "contact-sim")
-    return (contact, scene.terrain or TerrainSettings(), scene.contact_sim or ContactSimSettings(),
-            scene.contact_solver or ContactSolverSettings())
+    """Contact sections with defaults for the optional ones (StageError if no ``contact``)."""
+    require(scene, "contact", "contact-sim")
+    return contact_scene.settings(scene)
 
 
-def build(scene: Scene, x_fp: np.ndarray, n_steps: int):
-    """ContactWalker of the scene with checkerboard patches from the ideal step length."""
-    from walkerlab.contact.model import ContactWalker
-
-    contact, terrain, _, _ = settings(scene)
-    w = scene.walker
-    step_length = 2 * w.leg_length_m * np.sin((x_fp[1] - x_fp[0]) / 2)
-    return ContactWalker.from_settings(
-        contact, terrain, step_length=step_length, n_steps=n_steps + 4, L=w.leg_length_m,
-        m=w.leg_mass_kg, MH=w.hip_mass_kg, a=w.leg_mass_from_foot_m, g=w.gravity_m_per_s2,
-        phi=scene.slope.phi_rad), step_length
-
-
-def simulate_from(scene: Scene, x_fp: np.ndarray, period: float, rate_scale=None,
-                  solver: ContactSolverSettings | None = None, strides: int | None = None):
-    """Run the contact walker from the ideal fixed point ``x_fp`` (role-ordered, leg2 stance)."""
-    from walkerlab.contact.simulate import initial_state_from_ideal, simulate_contact
-
-    _, _, cs, sv = settings(scene)
-    sv = solver or sv
-    n_strides = strides or cs.n_strides
-    walker, step_length = build(scene, x_fp, 2 * n_strides)
-    scale = cs.initial_rate_scale if rate_scale is None else rate_scale
-    x0 = initial_state_from_ideal(walker, *x_fp, rate_scale=tuple(scale))
-    t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
-    res = simulate_contact(
-        walker, x0, t_final, method=sv.method, rtol=sv.rtol, atol=sv.atol,
-        max_step=sv.max_step_s or np.inf, sample_rate_hz=cs.sample_rate_hz,
-        pin_stance_until=cs.pin_stance_until, pin_time_s=cs.pin_time_s,
-        fall_hip_height_m=cs.fall_hip_height_m)
-    return walker, res, x0, step_length
+build = contact_scene.build
+simulate_from = contact_scene.simulate_from
 
 
 def named_trajectory(walker, res) -> NamedTrajectory:
@@ -117,25 +89,40 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             scale = adj["scale"]
         walker, res, x0, step_length = simulate_from(scene, x_fp, meta["step_period_s"], scale)
         tr = named_trajectory(walker, res)
-        gait = None
+        gait = gait_error = None
+        cs = settings(scene)[2]
         if periodic:
-            from walkerlab.contact.periodic import find_contact_periodic_gait
+            from walkerlab.contact.periodic import PeriodicGaitError, find_contact_periodic_gait
 
-            gait = find_contact_periodic_gait(walker, x_fp)
+            try:
+                gait = find_contact_periodic_gait(walker, x_fp,
+                                                  time_limit_s=cs.periodic_time_limit_s)
+            except PeriodicGaitError as exc:
+                gait_error = exc
+        from walkerlab.contact.drop import restitution_curve
+
+        drop = restitution_curve(settings(scene)[0], DROP_STIFFNESS)
         c = walker.contact
         steps = res.steps
         slips = np.array([s.stance_slip_mm for s in steps])
+        creep = np.array([s.double_support_creep_mm for s in steps])
         summary = {
             "termination": res.termination,
+            "outcome": res.outcome.kind,
             "heel_strikes": int(res.walked_steps),
             "strides_completed": int(res.walked_steps // 2),
-            "mean_abs_stance_slip_mm": float(np.nanmean(np.abs(slips))) if slips.size else np.nan,
+            "mean_abs_stance_slip_mm": float(np.nanmean(np.abs(slips)))
+            if np.isfinite(slips).any() else np.nan,
+            "max_abs_stance_slip_mm": float(res.max_stance_slip_mm),
+            "total_double_support_creep_mm": float(np.sum(creep)) if creep.size else 0.0,
             "peak_penetration_mm": float(max((s.peak_penetration_m for s in steps),
                                              default=np.nan) * 1e3),
             "total_bounces": int(sum(s.bounce_count for s in steps)),
+            "total_scuffs": int(sum(s.scuff_count for s in steps)),
             "nfev": int(res.nfev), "njev": int(res.njev), "wall_time_s": float(res.wall_time_s),
         }
         units = {"mean_abs_stance_slip_mm": "mm", "peak_penetration_mm": "mm",
+                 "max_abs_stance_slip_mm": "mm", "total_double_support_creep_mm": "mm",
                  "wall_time_s": "s"}
 
         def writer(f):
@@ -143,9 +130,35 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             f.attrs["legs"] = LEGS
             f.attrs["termination"] = res.termination
             f.attrs["method"] = res.method
+            f.attrs["outcome"] = res.outcome.kind
+            f.attrs["outcome_message"] = res.outcome.message
+            f.attrs["stiffness_family"] = settings(scene)[0].stiffness_family
             if res.fall_time is not None:
                 f.attrs["fall_time_s"] = res.fall_time
                 f.attrs["fall_reason"] = str(res.fall_reason)
+            o = res.outcome
+            g = f.create_group("outcome")
+            g.attrs["kind"] = o.kind
+            g.attrs["foot"] = o.foot
+            g.attrs["message"] = o.message
+            put(g, "time", o.time_s, "s", "time of the event that set the outcome (NaN: none)")
+            put(g, "patch_edge", o.patch_edge_m, "m", "along-slope position of the patch side "
+                "hit by a trip (NaN: no trip)")
+            put(g, "hip_height", o.hip_height_m, "m", "hip height above the ground line at "
+                "the outcome time")
+            g = f.create_group("drop_test")
+            g.attrs["method"] = ("point mass 20 kg meeting flat ground at 0.3 m/s, no gravity "
+                                 "(walkerlab.contact.drop); restitution = v_out / v_in")
+            lu = "mm" if settings(scene)[0].unit_system == "mm-kg-s" else "m"
+            put(g, "stiffness", drop["stiffness"], f"N/{lu}^e",
+                "IMPACT stiffness in the scene's unit system")
+            for fam in ("paper", "rigid_limit"):
+                put(g, f"{fam}/restitution", drop[fam]["restitution"], "-",
+                    f"coefficient of restitution, {fam} family")
+                put(g, f"{fam}/max_penetration", drop[fam]["max_penetration_m"], "m",
+                    "largest penetration in the drop")
+                put(g, f"{fam}/contact_time", drop[fam]["contact_time_s"], "s",
+                    "duration of the contact (NaN: comes to rest)")
             write_samples(f, tr)
             for name, val, unit in (("stiffness", c.k, "N/m^e"), ("exponent", c.e, "-"),
                                     ("max_damping", c.cmax, "N s/m"),
@@ -177,16 +190,22 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             put(f, "events/heel_strike_legs", list(res.heel_strike_legs) or [""], "-", "")
             g = f.create_group("steps")
             for fld, unit in (("t_start", "s"), ("t_end", "s"), ("period", "s"),
-                              ("stance_slip_mm", "mm"), ("bounce_count", "-"),
-                              ("peak_penetration_m", "m")):
+                              ("stance_slip_mm", "mm"), ("double_support_creep_mm", "mm"),
+                              ("bounce_count", "-"), ("scuff_count", "-"),
+                              ("peak_penetration_m", "m"), ("liftoff_time", "s")):
                 put(g, fld, np.array([getattr(s, fld) for s in steps], dtype=float), unit, fld)
             put(g, "stance_leg", [s.stance_leg for s in steps] or [""], "-", "")
             for k, v in summary.items():
-                if k != "termination":
+                if k not in ("termination", "outcome"):
                     put(f, f"summary/{k}", v, units.get(k, "-"), k)
+            if gait_error is not None:
+                g = f.create_group("periodic_gait")
+                g.attrs["outcome"] = gait_error.kind
+                g.attrs["message"] = str(gait_error)
             if gait is not None:
                 g = f.create_group("periodic_gait")
                 g.attrs["section"] = "mid-stance (legs aligned), stance foot loaded only"
+                g.attrs["outcome"] = "ok"
                 for k, v in gait.fixed_point.items():
                     g.attrs[f"fixed_point_{k}"] = float(v)
                 put(g, "step_period", gait.period_s, "s", "period of the contact gait")

@@ -16,13 +16,14 @@ from walkerlab.io.readers import load_fixed_point  # noqa: F401  (re-exported fo
 from walkerlab.models.registry import build_walker
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
-SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
+SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
 
 
 def _variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
-    """The scene's own equation variant first, then (``compare``) the others."""
+    """The scene's own equation variant first, then (``compare``, for a compass gait compared
+    with published numbers) the other variants: they explain the difference from Eq. 11."""
     own = (scene.ideal.variant,)
-    if compare and scene.walker.model == "compass_gait":
+    if compare and scene.walker.model == "compass_gait" and scene.published is not None:
         from walkerlab.models.compass_gait import VARIANTS
 
         return own + tuple(v for v in VARIANTS if v != scene.ideal.variant)
@@ -34,7 +35,11 @@ def solve_variant(scene: Scene, variant: str):
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
     walker = build_walker(sc)
     fp = require(scene, "fixedpoint", "fixedpoint")
-    res = find_fixed_point(walker, fp.initial_guess.as_array(), Solver.from_settings(scene.solver),
+    try:
+        guess = fp.initial_guess.as_array(walker.state_names())
+    except ValueError as exc:
+        raise StageError(f"fixedpoint.initial_guess: {exc}") from None
+    res = find_fixed_point(walker, guess, Solver.from_settings(scene.solver),
                            xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
     return walker, res
 
@@ -94,7 +99,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                     raise StageError(f"fixedpoint: {exc}{hint}") from None
                 results[variant] = exc
         walker, main = results[scene.ideal.variant]
-        guess = fp_cfg.initial_guess.as_array()
+        guess = fp_cfg.initial_guess.as_array(walker.state_names())
 
         def writer(f):
             f.attrs["model"] = walker.name

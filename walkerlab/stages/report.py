@@ -13,6 +13,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from walkerlab.config import Scene
+from walkerlab.io.runpaths import report_dir
 from walkerlab.report.build import write_report
 from walkerlab.stages.common import StageOutcome, artifact_path
 from walkerlab.stages.plot import figures_dir
@@ -72,6 +73,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     figs = plot.run(scene, runs_root) if any(
         o.stage in ("simulate", "contact-sim") for o in done) else []
     echo(f"         plot: {len([p for p in figs if p.suffix == '.png'])} figures")
-    rep_dir = Path(runs_root) / (scene.name or "scene") / "report"
+    rep_dir = report_dir(scene, runs_root, claim=True)
     return write_report(scene, existing_artifacts(scene, runs_root), rep_dir,
                         figures_dir(scene, runs_root), done)

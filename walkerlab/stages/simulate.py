@@ -15,7 +15,7 @@ from walkerlab.io.readers import load_fixed_point
 from walkerlab.io.trajectory import write_samples
 from walkerlab.models.registry import build_walker
 from walkerlab.stages import fixedpoint as fixedpoint_stage
-from walkerlab.stages.common import StageOutcome, artifact_path, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, artifact_path, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
 
@@ -27,7 +27,13 @@ def with_strides(scene: Scene, strides: int | None) -> Scene:
     """Scene with ``simulate.strides`` overridden (section created with defaults if absent)."""
     sim = scene.simulate or SimulateSettings()
     if strides is not None:
-        sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+        from pydantic import ValidationError
+
+        try:
+            sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+        except ValidationError as err:
+            raise StageError(f"--strides {strides}: {err.errors()[0]['msg'].lower()} "
+                             "(simulate.strides)") from None
     return scene.model_copy(update={"simulate": sim})
 
 
@@ -55,7 +61,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         if sim.initial_state == "fixed_point":
             x0, _ = load_fixed_point(upstream[0])
         else:
-            x0 = sim.initial_state.as_array()
+            try:
+                x0 = sim.initial_state.as_array(walker.state_names())
+            except ValueError as exc:
+                raise StageError(f"simulate.initial_state: {exc}") from None
         traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
                               max_step_time=sim.max_step_time_s)
         samples = sample_trajectory(traj, sim.sample_rate_hz)

@@ -348,11 +348,11 @@ def bifurcation_writer(res: BifurcationResult):
             "'walks' or how the steady-state run ended", dims=s)
         put(f, "steady_state/attractor_period", res.attractor_period, "steps",
             "distinct kept values (1, 2, 4, ...; n_keep: no period found)", dims=s)
-        put(f, "onset/slope", res.onset["onset_deg"], "deg",
+        put(f, "onset/onset_slope", res.onset["onset_deg"], "deg",
             "period-doubling onset: a multiplier crosses -1 (brentq)")
         put(f, "onset/bracket", res.onset["bracket_deg"], "deg", "grid bracket of the onset",
             dims=("bracket_end",))
-        put(f, "onset/multiplier", res.onset["multiplier_at_onset"], "-",
+        put(f, "onset/multiplier_at_onset", res.onset["multiplier_at_onset"], "-",
             "most negative real multiplier at the located onset")
         put(f, "stats/wall_time", res.wall_time_s, "s", "wall time per slope", dims=s)
         f.attrs["n_transient"] = res.n_transient

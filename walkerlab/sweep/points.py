@@ -117,7 +117,7 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
     walker = build_walker(scene)
     solver = _solver(scene)
     tries = ([("neighbour", np.asarray(guess, float))] if guess is not None else []) \
-        + [("scene", fp.initial_guess.as_array())]
+        + [("scene", fp.initial_guess.as_array(walker.state_names()))]
     best, msg = math.inf, ""
     for source, g in tries:
         try:
@@ -130,7 +130,8 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
             msg = str(exc)
             continue
         if interleg_angle(walker, res.x) < opts["min_interleg_angle_rad"]:
-            msg = (f"degenerate fixed point (inter-leg angle {interleg_angle(walker, res.x):.2e} rad "
+            il = interleg_angle(walker, res.x)
+            msg = (f"degenerate fixed point (inter-leg angle {il:.2e} rad "
                    f"< {opts['min_interleg_angle_rad']:g}): no step")
             best = min(best, res.residual)
             continue
@@ -218,7 +219,7 @@ def simulate_point(scene: Scene, guess, options: dict):
         cols["guess_source"] = source
     else:
         walker = build_walker(scene)
-        x0 = sim.initial_state.as_array()
+        x0 = sim.initial_state.as_array(walker.state_names())
     cols.update(_state_columns(walker, x0, "x0_"))
     traj = simulate_steps(walker, x0, 2 * sim.strides, _solver(scene),
                           max_step_time=sim.max_step_time_s)
@@ -277,7 +278,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
         Steps requested (2 * ``contact_sim.n_strides``).
     """
     from walkerlab.contact import ContactSimSettings
-    from walkerlab.stages.contact_sim import simulate_from
+    from walkerlab.contact.scene import simulate_from
 
     # one code path with the contact-sim stage (terrain, initial state, solver, end time)
     cs = scene.contact_sim or ContactSimSettings()

@@ -1,75 +1,236 @@
-"""Stability maps of the compliant-contact walker: outcome over (stiffness x slope) and
-(friction x slope).
+"""Stability maps of the compliant-contact gait itself.
 
-Each map is an ordinary ``contact-sim`` sweep (one artifact, one row per point: walks /
-falls / slips / bounces / solver failure, and the run time per point) plus a figure drawn
-from that artifact (:func:`walkerlab.plotting.sweep_figures.stability_map_figure`).
+Each cell of a map (a parameter y against the slope) asks: *does the contact model have a
+periodic gait here, is it stable, what is its largest |Floquet multiplier|, or why not?*
+The gait is the fixed point of the contact walker's own mid-stance step map
+(:func:`walkerlab.contact.periodic.find_contact_periodic_gait`).  Along each row (one y
+value, slopes ascending) every cell starts from the contact gait of its neighbour
+(continuation); when that fails or there is no neighbour yet it starts again from the ideal
+fixed point at that slope (placed on the contact model and iterated a few steps).
+
+Cell results (:data:`CELL_FIELDS`): ``exists`` (converged and every loaded foot stays on its
+patch), ``stable`` (all |multipliers| < 1), ``max_abs_multiplier``, ``step_period_s``,
+``patch_margin_m``, ``source`` ("neighbour" / "ideal"), ``reason`` ("" when the gait
+exists, else ``fall``, ``no_mid_stance``, ``solver_failure``, ``time_limit``,
+``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``), ``wall_time_s``.
+
+The cached stage is :mod:`walkerlab.stages.stability_map`; the figure
+:func:`walkerlab.plotting.sweep_figures.gait_map_figure`.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
+import time
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.config import Scene
-from walkerlab.sweep.outcomes import OUTCOMES
-from walkerlab.sweep.params import parse_param
+__all__ = ["MAP_KINDS", "CELL_FIELDS", "REASONS", "MapSpec", "default_spec", "gait_row",
+           "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS"]
 
-__all__ = ["stability_map", "outcome_counts", "DEFAULT_STIFFNESS", "DEFAULT_FRICTION",
-           "DEFAULT_SLOPES"]
+#: map kind -> (dotted scene path of the y axis, label)
+MAP_KINDS = {
+    "stiffness": ("contact.stiffness", "contact stiffness k [N/len^e]"),
+    "friction": ("contact.mu_static", "static friction mu_s [-] (mu_d = 7/9 mu_s)"),
+    "patch_width": ("terrain.patch_width_m", "patch width [m]"),
+}
 
-# contact.stiffness in the scene's contact.unit_system (default mm-kg-s: N/mm^e)
-DEFAULT_STIFFNESS = "contact.stiffness=1e3,3e3,1e4,3e4,1e5,1e6"
-# static friction; the base scene's mu_dynamic must not exceed the smallest value
-DEFAULT_FRICTION = "contact.mu_static=0.1,0.2,0.3,0.5,0.7,0.9"
-DEFAULT_SLOPES = "slope.angle_deg=0.5,1,1.5,2,2.5,3"
+REASONS = ("", "fall", "no_mid_stance", "solver_failure", "time_limit", "not_converged",
+           "off_patch", "no_ideal_gait", "invalid_config", "error")
+
+CELL_FIELDS = ("exists", "stable", "max_abs_multiplier", "step_period_s", "patch_margin_m",
+               "residual", "source", "reason", "wall_time_s")
+
+#: settings of the periodic-gait search in a map cell (odeint step map, rtol 1e-9; FD
+#: Jacobian at rtol 1e-10 with step 1e-3 x scale): looser than the contact-sim stage's, the
+#: map noise is then ~1e-8 (scaled) and the multipliers carry ~1e-4 absolute error.
+MAP_GAIT_OPTIONS = dict(method="odeint", check_fd=False, rtol=1e-9, atol=1e-12,
+                        jac_rtol=1e-10, jac_atol=1e-13, fd_step=1e-3, residual_tol=1e-6,
+                        xtol=1e-7)
 
 
-def outcome_counts(sweep: dict) -> dict[str, int]:
-    """Points per outcome of a loaded sweep (only outcomes that occur)."""
-    out = list(sweep["points"]["outcome"])
-    return {o: out.count(o) for o in OUTCOMES if out.count(o)}
+@dataclass(frozen=True)
+class MapSpec:
+    """Axes of one map.
+
+    Attributes
+    ----------
+    kind : str
+        Key of :data:`MAP_KINDS`.
+    y_values : tuple of float
+        Values of the y parameter (scene units).
+    slopes_deg : tuple of float
+        Slopes [deg] (x axis).
+    time_limit_s : float
+        Wall-time limit per cell [s].
+    """
+
+    kind: str
+    y_values: tuple
+    slopes_deg: tuple
+    time_limit_s: float = 60.0
+
+    @property
+    def y_path(self) -> str:
+        return MAP_KINDS[self.kind][0]
+
+    def key(self) -> str:
+        """Text that identifies the spec (part of the stage's input hash)."""
+        return (f"{self.kind}|{','.join(f'{v:.6g}' for v in self.y_values)}|"
+                f"{','.join(f'{v:.6g}' for v in self.slopes_deg)}|{self.time_limit_s:g}|"
+                + ",".join(f"{k}={v}" for k, v in sorted(MAP_GAIT_OPTIONS.items())))
 
 
-def stability_map(scene: Scene, y_param: str = DEFAULT_STIFFNESS,
-                  x_param: str = DEFAULT_SLOPES, stage: str = "contact-sim",
-                  runs_root: Path | str = "runs", name: str = "stability_stiffness",
-                  workers: int = 2, scheduler=None, resume: bool = False,
-                  progress: bool = True, options: dict | None = None) -> dict:
-    """Run a 2-D sweep and draw its stability map.
+def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0) -> MapSpec:
+    """The default ``n x n`` grid of a map kind (slopes 0.5-4 deg).
+
+    Raises
+    ------
+    ValueError
+        Unknown kind.
+    """
+    if kind not in MAP_KINDS:
+        raise ValueError(f"unknown stability-map kind {kind!r} (one of {', '.join(MAP_KINDS)})")
+    slopes = tuple(float(v) for v in np.round(np.linspace(0.5, 4.0, n), 4))
+    ys = {"stiffness": np.logspace(3, 9, n), "friction": np.linspace(0.1, 0.9, n),
+          "patch_width": np.linspace(0.02, 0.20, n)}[kind]
+    return MapSpec(kind, tuple(float(v) for v in np.round(ys, 6)), slopes, time_limit_s)
+
+
+def _cell_scene(base: dict, spec: MapSpec, y: float, slope_deg: float):
+    from walkerlab.sweep.params import apply_point
+
+    paths, values = ["slope.angle_deg", spec.y_path], [slope_deg, y]
+    if spec.kind == "friction":  # keep the paper's ratio mu_d / mu_s = 0.7 / 0.9
+        paths.append("contact.mu_dynamic")
+        values.append(round(y * 7.0 / 9.0, 9))
+    return apply_point(base, paths, tuple(values), "<stability-map>")
+
+
+def _empty_cell() -> dict:
+    return {"exists": False, "stable": False, "max_abs_multiplier": np.nan,
+            "step_period_s": np.nan, "patch_margin_m": np.nan, "residual": np.nan,
+            "source": "", "reason": "", "wall_time_s": np.nan}
+
+
+def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
+    """Cells of row ``iy`` (one y value), slopes ascending, with continuation.
+
+    Never raises (every failure becomes a ``reason``).  Top-level so it pickles for a
+    process pool.
+    """
+    from walkerlab.config import SceneError
+    from walkerlab.contact.periodic import PeriodicGaitError, find_contact_periodic_gait
+    from walkerlab.contact.scene import build
+    from walkerlab.sweep.points import _Outcome, ideal_fixed_point
+
+    y = spec.y_values[iy]
+    row, z_prev, x_ideal_prev = [], None, None
+    for slope in spec.slopes_deg:
+        cell = _empty_cell()
+        t0 = time.perf_counter()
+        deadline = t0 + spec.time_limit_s
+        try:
+            scene = _cell_scene(base, spec, y, slope)
+            _w, fp, _src = ideal_fixed_point(scene, x_ideal_prev)
+            x_ideal_prev = fp.x
+            walker, _ = build(scene, fp.x, 2)
+            tries = ([("neighbour", z_prev, 0)] if z_prev is not None else []) \
+                + [("ideal", fp.x, 6)]
+            gait, why = None, ""
+            for source, guess, warm in tries:
+                left = deadline - time.perf_counter()
+                if left <= 0:
+                    why = "time_limit"
+                    break
+                try:
+                    g = find_contact_periodic_gait(walker, guess, warmup_steps=warm,
+                                                   time_limit_s=left, **MAP_GAIT_OPTIONS)
+                except PeriodicGaitError as exc:
+                    why = exc.kind
+                    if exc.kind == "time_limit":
+                        break
+                    continue
+                if not g.converged:
+                    why = "not_converged"
+                    continue
+                gait = g
+                cell["source"] = source
+                break
+            if gait is not None:
+                on_patch = gait.patch_margin_m >= 0
+                cell.update(exists=bool(on_patch), stable=bool(on_patch and gait.stable),
+                            max_abs_multiplier=gait.max_multiplier,
+                            step_period_s=gait.period_s, patch_margin_m=gait.patch_margin_m,
+                            residual=gait.residual, reason="" if on_patch else "off_patch")
+                z_prev = gait.z
+            else:
+                cell["reason"] = why or "not_converged"
+                z_prev = None
+        except SceneError:
+            cell["reason"] = "invalid_config"
+        except _Outcome as exc:
+            cell["reason"] = "no_ideal_gait" if exc.outcome == "no_fixed_point" else "error"
+        except Exception:  # noqa: BLE001 - one cell must never end the map
+            cell["reason"] = "error"
+        cell["wall_time_s"] = time.perf_counter() - t0
+        row.append(cell)
+    return row
+
+
+def gait_map(scene, spec: MapSpec, workers: int = 2,
+             progress: Callable[[int, int], None] | None = None) -> dict:
+    """All cells of a map; rows in parallel on ``workers`` processes.
 
     Parameters
     ----------
-    scene : Scene
-        Base scene (its ``fixedpoint`` section seeds the ideal gait at every slope).
-    y_param, x_param : str
-        ``--param`` strings of the map's y axis (stiffness or friction) and x axis (slope).
-        The slope is the sweep's *first* axis, so the ideal fixed point that seeds each
-        contact run is continued along the slope.
-    stage : str
-        Swept stage (``contact-sim``; ``simulate`` to exercise the machinery on the rigid
-        model).
-    runs_root, name : output ``runs/<scene>/<name>.h5`` and ``<name>.png/.svg``.
+    scene : walkerlab.config.Scene
+        Base scene (needs ``contact`` and ``fixedpoint``).
+    spec : MapSpec
+    workers : int
+        Worker processes (1 = in this process).
+    progress : callable, optional
+        ``progress(rows_done, rows_total)``.
 
     Returns
     -------
     dict
-        ``artifact``, ``figures``, ``counts`` (outcome -> points), ``wall_time_s``.
+        ``y_values`` (ny,), ``slopes_deg`` (nx,) and one (ny, nx) array per field of
+        :data:`CELL_FIELDS`.
     """
-    from walkerlab.plotting.sweep_figures import save, stability_map_figure
-    from walkerlab.stages.sweep import run
-    from walkerlab.sweep.store import load_sweep
+    base = scene.model_dump(mode="json")
+    ny, nx = len(spec.y_values), len(spec.slopes_deg)
+    rows: list = [None] * ny
+    if workers <= 1:
+        for iy in range(ny):
+            rows[iy] = gait_row(base, spec, iy)
+            if progress:
+                progress(iy + 1, ny)
+    else:
+        with ProcessPoolExecutor(max_workers=workers) as ex:
+            futs = {ex.submit(gait_row, base, spec, iy): iy for iy in range(ny)}
+            done = 0
+            from concurrent.futures import as_completed
 
-    xa, ya = parse_param(x_param), parse_param(y_param)
-    path = run(scene, [x_param, y_param], stage, workers=workers, scheduler=scheduler,
-               resume=resume, runs_root=runs_root, name=name, options=options,
-               progress=progress)
-    data = load_sweep(path)
-    counts = outcome_counts(data)
-    title = f"{stage}: " + ", ".join(f"{k} {v}" for k, v in counts.items())
-    fig = stability_map_figure(data, x_path=xa.path, y_path=ya.path, title=title)
-    figs = save(fig, Path(path).parent, name)
-    return {"artifact": path, "figures": figs, "counts": counts,
-            "wall_time_s": float(data["attrs"]["wall_time_s"]),
-            "point_wall_time_s": np.asarray(data["points"]["wall_time_s"], float)}
+            for fut in as_completed(futs):
+                rows[futs[fut]] = fut.result()
+                done += 1
+                if progress:
+                    progress(done, ny)
+    out = {"y_values": np.asarray(spec.y_values, float),
+           "slopes_deg": np.asarray(spec.slopes_deg, float)}
+    for f in CELL_FIELDS:
+        vals = [[rows[i][j][f] for j in range(nx)] for i in range(ny)]
+        out[f] = np.array(vals, dtype=object if f in ("source", "reason") else float)
+    return out
+
+
+def stable_fraction(cells: dict) -> dict:
+    """Fractions of cells where a gait exists, and where it exists and is stable [-]."""
+    ex = np.asarray(cells["exists"], float) > 0.5
+    st = ex & (np.asarray(cells["stable"], float) > 0.5)
+    n = ex.size
+    return {"cells": int(n), "exists_fraction": float(ex.sum() / n),
+            "stable_fraction": float(st.sum() / n)}

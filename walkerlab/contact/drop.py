@@ -1,0 +1,89 @@
+"""Drop test of the IMPACT contact: coefficient of restitution against stiffness.
+
+A point mass ``m`` moving down at ``v_in`` meets flat ground governed by the IMPACT law
+(:func:`walkerlab.contact._kernels.normal_force`, the same kernel the walker uses) under
+gravity; the coefficient of restitution is ``e = v_out / v_in`` with ``v_out`` the upward
+speed at separation (force back to zero).  A plastic impact (the rigid model's heel strike)
+has ``e = 0``.  :func:`restitution_curve` sweeps the stiffness in the paper's family (damping
+fixed) and in the rigid-limit family (:func:`walkerlab.contact.config.family_scaling`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from . import _kernels as K
+from .config import ContactSettings
+
+__all__ = ["FAMILIES", "drop_restitution", "restitution_curve"]
+
+FAMILIES = ("paper", "rigid_limit")
+
+
+def drop_restitution(contact: ContactSettings, mass_kg: float = 20.0, v_in_m_per_s: float = 0.3,
+                     g: float = 0.0, rtol: float = 1e-10) -> dict:
+    """Coefficient of restitution of one drop.
+
+    Parameters
+    ----------
+    contact : ContactSettings
+        Contact law (its ``stiffness_family`` applies).
+    mass_kg : float
+        Dropped mass [kg] (default 20 kg = the paper walker's total mass).
+    v_in_m_per_s : float
+        Downward speed at first contact [m/s].
+    g : float
+        Gravity [m/s^2] during the impact (default 0: the impact alone, as in the issue's
+        numbers; with g the static weight holds a soft contact down).
+    rtol : float
+        Integrator tolerance (Radau with events).
+
+    Returns
+    -------
+    dict
+        ``restitution`` [-] (0 if the mass comes to rest in contact within 50 contact
+        times), ``max_penetration_m`` [m], ``contact_time_s`` [s].
+    """
+    c = contact.to_si()
+    vin = float(v_in_m_per_s)
+    dstar = ((c.e + 1) * mass_kg * vin**2 / (2 * c.k)) ** (1 / (c.e + 1))
+    tc = dstar / vin
+
+    def f(t, y):
+        d, dd = y
+        fn = K.normal_force(d, dd, c.k, c.e, c.cmax, c.dmax)[0]
+        return [dd, g - fn / mass_kg]
+
+    def sep(t, y):
+        return y[0] if t > 0 else 1.0
+
+    sep.terminal = True
+    sep.direction = -1
+    sol = solve_ivp(f, (0.0, 50 * tc), [0.0, vin], method="Radau", rtol=rtol,
+                    atol=[1e-6 * dstar, 1e-6 * vin], events=sep, max_step=tc / 10)
+    dmax = float(np.max(sol.y[0]))
+    if sol.t_events[0].size:
+        vout = -float(sol.y_events[0][0][1])
+        return {"restitution": max(vout, 0.0) / vin, "max_penetration_m": dmax,
+                "contact_time_s": float(sol.t_events[0][0])}
+    return {"restitution": 0.0, "max_penetration_m": dmax, "contact_time_s": float("nan")}
+
+
+def restitution_curve(base: ContactSettings, stiffness, families=FAMILIES, **kw) -> dict:
+    """Restitution of the drop test for each stiffness (scene units) in each family.
+
+    Returns
+    -------
+    dict
+        ``stiffness`` (n,) and per family ``{family: {"restitution": (n,),
+        "max_penetration_m": (n,), "contact_time_s": (n,)}}``.
+    """
+    ks = np.asarray(stiffness, float)
+    out: dict = {"stiffness": ks}
+    for fam in families:
+        rows = [drop_restitution(base.model_copy(update={"stiffness": float(k),
+                                                         "stiffness_family": fam}), **kw)
+                for k in ks]
+        out[fam] = {key: np.array([r[key] for r in rows]) for key in rows[0]}
+    return out

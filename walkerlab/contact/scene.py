@@ -1,0 +1,114 @@
+"""Build a contact walker from a validated scene and run it (the library side of ``contact-sim``).
+
+The ``contact-sim`` stage, :mod:`walkerlab.contact.adjust`, :mod:`walkerlab.contact.periodic`
+and the sweep points all go through these functions, so a scene means the same contact run
+everywhere.  This module never imports :mod:`walkerlab.stages` (dependencies point down).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from walkerlab.config import ContactSolverSettings, Scene
+
+from .config import ContactSimSettings, TerrainSettings
+from .model import ContactWalker
+
+__all__ = ["ContactSceneError", "settings", "ideal_step_length", "build", "simulate_from"]
+
+
+class ContactSceneError(ValueError):
+    """The scene lacks a section the contact model needs (one-line message)."""
+
+
+def settings(scene: Scene):
+    """Contact sections of ``scene`` with defaults for the optional ones.
+
+    Returns
+    -------
+    (ContactSettings, TerrainSettings, ContactSimSettings, ContactSolverSettings)
+
+    Raises
+    ------
+    ContactSceneError
+        The scene has no ``contact`` section.
+    """
+    if scene.contact is None:
+        raise ContactSceneError(f"scene '{scene.name}' has no 'contact' section, which the "
+                                "contact model needs")
+    return (scene.contact, scene.terrain or TerrainSettings(),
+            scene.contact_sim or ContactSimSettings(),
+            scene.contact_solver or ContactSolverSettings())
+
+
+def ideal_step_length(leg_length_m: float, x_ideal) -> float:
+    """Step length [m] of the ideal gait from its post-impact state ``[th_sw, th_st, ...]``:
+    ``2 L sin((th_st - th_sw) / 2)`` (foot-to-foot chord at heel strike)."""
+    th_sw, th_st = float(x_ideal[0]), float(x_ideal[1])
+    return 2 * leg_length_m * np.sin((th_st - th_sw) / 2)
+
+
+def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
+    """ContactWalker of the scene with checkerboard patches from the ideal step length.
+
+    Parameters
+    ----------
+    scene : Scene
+    x_ideal : ndarray (4,)
+        Ideal fixed point (role order: swing, stance angles and rates) [rad, rad/s].
+    n_steps : int
+        Steps the run may take (sets how many patches are laid out).
+
+    Returns
+    -------
+    walker : ContactWalker
+    step_length : float
+        Ideal step length [m] (patch spacing).
+    """
+    contact, terrain, _, _ = settings(scene)
+    w = scene.walker
+    step_length = ideal_step_length(w.leg_length_m, x_ideal)
+    return ContactWalker.from_settings(
+        contact, terrain, step_length=step_length, n_steps=n_steps + 4, L=w.leg_length_m,
+        m=w.leg_mass_kg, MH=w.hip_mass_kg, a=w.leg_mass_from_foot_m, g=w.gravity_m_per_s2,
+        phi=scene.slope.phi_rad), step_length
+
+
+def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=None,
+                  solver: ContactSolverSettings | None = None, strides: int | None = None):
+    """Run the contact walker of ``scene`` from the ideal fixed point ``x_ideal``.
+
+    Parameters
+    ----------
+    x_ideal : ndarray (4,)
+        Ideal post-impact state (role order, leg2 = stance) [rad, rad/s].
+    period : float
+        Ideal step period [s] (sets the default simulated time).
+    rate_scale : (float, float), optional
+        Multipliers on the initial rates (default ``contact_sim.initial_rate_scale``).
+    solver : ContactSolverSettings, optional
+    strides : int, optional
+        Strides to simulate (default ``contact_sim.n_strides``).
+
+    Returns
+    -------
+    walker, result, x0, step_length
+        :class:`ContactWalker`, :class:`~walkerlab.contact.simulate.ContactResult`, the
+        initial state (8,), the ideal step length [m].
+    """
+    from .simulate import initial_state_from_ideal, simulate_contact
+
+    _, _, cs, sv = settings(scene)
+    sv = solver or sv
+    n_strides = strides or cs.n_strides
+    walker, step_length = build(scene, x_ideal, 2 * n_strides)
+    scale = cs.initial_rate_scale if rate_scale is None else rate_scale
+    x0 = initial_state_from_ideal(walker, *x_ideal, rate_scale=tuple(scale))
+    t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
+    res = simulate_contact(
+        walker, x0, t_final, method=sv.method, rtol=sv.rtol, atol=sv.atol,
+        max_step=sv.max_step_s or np.inf, sample_rate_hz=cs.sample_rate_hz,
+        pin_stance_until=cs.pin_stance_until, pin_time_s=cs.pin_time_s,
+        fall_hip_height_m=cs.fall_hip_height_m, wall_time_limit_s=cs.wall_time_limit_s,
+        max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
+    return walker, res, x0, step_length

@@ -1,0 +1,109 @@
+"""Stage ``stability-map``: where the contact model has a stable periodic gait.
+
+One cached artifact per map kind, ``runs/<scene>/stability_map_<kind>.h5`` (input hash: the
+scene's physics sections, the code and the grid), and its figure
+``stability_map_<kind>.png/.svg`` next to it, drawn from the artifact.  The computation is
+:func:`walkerlab.sweep.stability.gait_map`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from walkerlab.config import Scene
+from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.stages.common import StageOutcome, require, run_cached
+from walkerlab.sweep.stability import (
+    CELL_FIELDS,
+    MAP_KINDS,
+    MapSpec,
+    default_spec,
+    gait_map,
+    stable_fraction,
+)
+
+SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
+_UNITS = {"max_abs_multiplier": "-", "step_period_s": "s", "patch_margin_m": "m",
+          "residual": "-", "wall_time_s": "s", "exists": "-", "stable": "-"}
+
+
+def stage_name(kind: str) -> str:
+    return f"stability-map-{kind.replace('_', '-')}"
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
+        kind: str = "stiffness", n: int = 8, workers: int = 2, time_limit_s: float = 60.0,
+        spec: MapSpec | None = None, progress=None) -> StageOutcome:
+    """Compute (or reuse) one stability map and draw its figure.
+
+    Raises
+    ------
+    StageError
+        The scene has no ``contact`` or ``fixedpoint`` section.
+    ValueError
+        Unknown ``kind``.
+    """
+    require(scene, "contact", "stability-map")
+    require(scene, "fixedpoint", "stability-map")
+    spec = spec or default_spec(kind, n, time_limit_s)
+
+    def compute():
+        cells = gait_map(scene, spec, workers=workers, progress=progress)
+        frac = stable_fraction(cells)
+        reasons = [str(r) for r in cells["reason"].ravel() if r]
+        summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
+
+        def writer(f):
+            f.attrs["kind"] = spec.kind
+            f.attrs["y_path"] = spec.y_path
+            f.attrs["y_label"] = MAP_KINDS[spec.kind][1]
+            f.attrs["stiffness_family"] = scene.contact.stiffness_family
+            f.attrs["unit_system"] = scene.contact.unit_system
+            f.attrs["time_limit_s"] = spec.time_limit_s
+            f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "
+                                 "step map, continued from its neighbour along the slope, "
+                                 "else from the ideal fixed point at that slope")
+            put(f, "y_values", cells["y_values"], "scene units", spec.y_path)
+            put(f, "slopes_deg", cells["slopes_deg"], "deg", "slope angle")
+            for fld in CELL_FIELDS:
+                v = cells[fld]
+                if v.dtype == object:
+                    put(f, fld, np.asarray([[str(x) for x in r] for r in v],
+                                           dtype=h5py.string_dtype()), "-", fld)
+                else:
+                    put(f, fld, np.asarray(v, float), _UNITS.get(fld, "-"), fld)
+            for k, v in frac.items():
+                put(f, f"summary/{k}", v, "-", k)
+        return writer, summary
+
+    out = run_cached(stage_name(spec.kind), scene, runs_root, SECTIONS, (), compute, force,
+                     extra_key=spec.key())
+    draw(out.path)
+    return out
+
+
+def load(path: Path | str) -> dict:
+    """A stability-map artifact as a dict of arrays (strings decoded)."""
+    out: dict = {}
+    with open_artifact(path) as f:
+        out["attrs"] = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+        for k in ("y_values", "slopes_deg", *CELL_FIELDS):
+            v = f[k][()]
+            if v.dtype.kind in ("S", "O"):
+                v = np.array([[x.decode() if isinstance(x, bytes) else str(x) for x in r]
+                              for r in v], dtype=object)
+            out[k] = v
+    return out
+
+
+def draw(path: Path | str) -> list[Path]:
+    """Figure of a stability-map artifact, next to it (``<stem>.png``, ``.svg``)."""
+    from walkerlab.plotting.sweep_figures import gait_map_figure, save
+
+    path = Path(path)
+    data = load(path)
+    fig = gait_map_figure(data)
+    return save(fig, path.parent, path.stem)
