@@ -101,7 +101,8 @@ class PointMassBody(_Strict):
 
     kind: Literal["point_mass"] = Field(description="body type")
     name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (points: swing_<name>)")
-    link: Literal["leg"] = Field("leg", description="leg link carrying the body")
+    link: Literal["leg", "thigh", "shank"] = Field(
+        "leg", description="leg link carrying the body ('thigh'/'shank' need a knee)")
     mass_kg: float = Field(ge=0, le=1e4, description="mass [kg]; 0 = the limit m/M -> 0, "
                            "taken symbolically (Garcia et al. 1998), not a small number")
     from_hip_m: float = Field(ge=0, le=100, description="distance from the hip along the link [m]")
@@ -112,7 +113,8 @@ class RodBody(_Strict):
 
     kind: Literal["rod"] = Field(description="body type")
     name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (points: swing_<name>)")
-    link: Literal["leg"] = Field("leg", description="leg link carrying the body")
+    link: Literal["leg", "thigh", "shank"] = Field(
+        "leg", description="leg link carrying the body ('thigh'/'shank' need a knee)")
     mass_kg: float = Field(gt=0, le=1e4, description="mass [kg]")
     com_from_hip_m: float = Field(ge=0, le=100, description="centre of mass from the hip [m]")
     inertia_about_com_kg_m2: float = Field(ge=0, le=1e6, description="moment of inertia about "
@@ -128,12 +130,37 @@ class PointFoot(_Strict):
     kind: Literal["point"] = Field("point", description="foot shape")
 
 
+class ArcFoot(_Strict):
+    """A circular-arc foot of radius R centred on the leg axis at ``l - R`` from the hip; the
+    stance foot rolls without slip (McGeer 1990).  R = 0 is the point foot."""
+
+    kind: Literal["arc"] = Field(description="foot shape")
+    radius_m: float = Field(ge=0, le=100, description="arc radius R [m]")
+
+
+Foot = Annotated[PointFoot | ArcFoot, Field(discriminator="kind")]
+
+
+class KneeSpec(_Strict):
+    """A knee joint splitting the leg into thigh (hip to knee) and shank (knee to foot).
+
+    The stance knee stays straight.  The swing knee is free until it straightens against its
+    stop (knee strike: a plastic impact that locks it); it stays locked until heel strike and
+    unlocks when that leg leaves the ground (McGeer 1990 'Passive walking with knees')."""
+
+    thigh_length_m: float = Field(gt=0, le=100, description="hip to knee [m]")
+    lock: Literal["plastic"] = Field("plastic", description="knee strike: plastic impact, then "
+                                     "the knee stays locked until heel strike")
+
+
 class LegSpec(_Strict):
-    """One leg (both legs are identical): a straight link from the hip to the foot."""
+    """One leg (both legs are identical): hip to foot, straight or with a knee."""
 
     length_m: float = Field(gt=0, le=100, description="leg length l, hip to foot [m]")
-    bodies: list[Body] = Field(default_factory=list, description="bodies on the leg")
-    foot: PointFoot = Field(PointFoot(), description="foot shape")
+    bodies: list[Body] = Field(default_factory=list, description="bodies on the leg; distances "
+                               "from the hip along the straightened leg")
+    foot: Foot = Field(PointFoot(), description="foot shape")
+    knee: KneeSpec | None = Field(None, description="knee joint (null: straight leg)")
 
     @model_validator(mode="after")
     def _bodies_on_leg(self) -> LegSpec:
@@ -147,6 +174,22 @@ class LegSpec(_Strict):
             if d > self.length_m:
                 raise ValueError(f"walker.leg.bodies.{b.name}: lies beyond the foot "
                                  f"({d} m > leg length {self.length_m} m)")
+            if self.knee is None and b.link != "leg":
+                raise ValueError(f"walker.leg.bodies.{b.name}: link {b.link!r} needs a knee")
+            if self.knee is not None:
+                lt = self.knee.thigh_length_m
+                if b.link == "leg" or b.mass_kg == 0:
+                    raise ValueError(f"walker.leg.bodies.{b.name}: with a knee, give every body "
+                                     "a massive 'thigh' or 'shank' link")
+                if (b.link == "thigh") != (d <= lt) and d != lt:
+                    raise ValueError(f"walker.leg.bodies.{b.name}: {d} m from the hip is not "
+                                     f"on the {b.link} (knee at {lt} m)")
+        if self.knee is not None and self.knee.thigh_length_m >= self.length_m:
+            raise ValueError("walker.leg.knee.thigh_length_m: the knee must lie above the foot")
+        if self.foot.kind == "arc" and self.foot.radius_m > self.length_m - (
+                self.knee.thigh_length_m if self.knee else 0.0):
+            raise ValueError("walker.leg.foot.radius_m: the arc's centre must lie on the "
+                             + ("shank" if self.knee else "leg"))
         return self
 
 
@@ -167,6 +210,8 @@ class BipedParams(_Strict):
     def _has_mass(self) -> BipedParams:
         if self.hip_mass_kg + sum(b.mass_kg for b in self.leg.bodies) <= 0:
             raise ValueError("walker: the walker has no mass (hip_mass_kg and all bodies are 0)")
+        if self.coordinates != "absolute" and (self.leg.knee or self.leg.foot.kind != "point"):
+            raise ValueError("walker.coordinates: a knee or arc feet need 'absolute'")
         return self
 
 
@@ -249,7 +294,7 @@ class StateSpec(_Strict):
                 raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
                                  "<role>_rate_rad_per_s)")
             if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ValueError(f"{k}: must be a finite number")
+                raise ValueError(f"{k}: must be a finite number")  # as _Strict fields
         if not self.model_extra:
             raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
         return self
@@ -352,8 +397,9 @@ class BasinSettings(_Strict):
     max_period: int = Field(8, ge=2, le=64, description="longest period looked for [steps]")
     rtol: float = Field(1e-8, gt=0, lt=1, description="integrator relative tolerance [-]")
     atol: float = Field(1e-8, gt=0, lt=1, description="integrator absolute tolerance")
-    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this ends the "
-                                   "cell as 'stalled' [s]")
+    max_step_time_s: float | None = Field(
+        None, gt=0, description="a step longer than this ends the cell as 'stalled' [s]; "
+        "null = fixedpoint.max_step_time_s")
 
 
 class Scene(_Strict):
@@ -418,7 +464,7 @@ _NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
 
 
 # discriminator tags of walker models and bodies: not part of a field's path
-_TAGS = {"compass_gait", "biped", "point_mass", "rod", "point"}
+_TAGS = {"compass_gait", "biped", "point_mass", "rod", "point", "arc"}
 
 
 def _loc_part(p) -> bool:

@@ -95,6 +95,7 @@ def _write(path: Path, body: str) -> None:
         fd, tmp = tempfile.mkstemp(prefix=path.stem, suffix=".tmp", dir=path.parent)
         with os.fdopen(fd, "w") as f:
             f.write(f"# sha256 {_digest(body)}\n{body}")
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a cache is shared like any run output
         os.replace(tmp, path)
     except OSError:
         pass  # read-only location: the code stays in memory for this process

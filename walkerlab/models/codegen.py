@@ -28,6 +28,8 @@ Generated functions (``x`` is the role-ordered state ``[q, dq]``, shape (2n,)):
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
@@ -94,7 +96,7 @@ def _array(rows) -> str:
     return "np.array((" + ", ".join(rows) + ",))"
 
 
-def _flow(eq: Equations, jac: bool) -> list[str]:
+def _flow(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     n = len(eq.q)
     q, dq = eq.q, eq.dq
     r = -eq.C * sp.Matrix(dq) - eq.G
@@ -111,7 +113,7 @@ def _flow(eq: Equations, jac: bool) -> list[str]:
     lines += inv_lines
     qdd = [f"_a{i}" for i in range(n)]
     lines += [f"{IND}{a} = {e}" for a, e in zip(qdd, _matvec(inv, rn))]
-    name = "flow_jacobian" if jac else "flow"
+    name = name or ("flow_jacobian" if jac else "flow")
     head = [f"    def {name}(t, x):", _unpack(eq)]
     if not jac:
         return head + lines + [f"{IND}return {_array([str(s) for s in dq] + qdd)}"]
@@ -142,7 +144,7 @@ def _flow(eq: Equations, jac: bool) -> list[str]:
     return head + lines + [f"{IND}return {_array(rows)}"]
 
 
-def _reset(eq: Equations, jac: bool) -> list[str]:
+def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     """``Mi dq+ = B dq-`` then the role swap ``q_new = relabel_q(q)``, ``dq_new = R dq+``."""
     n = len(eq.q)
     q, dq = eq.q, eq.dq
@@ -163,7 +165,7 @@ def _reset(eq: Equations, jac: bool) -> list[str]:
     R = eq.relabel_rate
     qn = [_PY.doprint(e) for e in eq.relabel_q]
     dqn = [_PY.doprint(e) for e in R * sp.Matrix([sp.Symbol(p) for p in post])]
-    name = "reset_jacobian" if jac else "reset"
+    name = name or ("reset_jacobian" if jac else "reset")
     head = [f"    def {name}(x):", _unpack(eq)]
     if not jac:
         return head + lines + [f"{IND}return {_array(qn + dqn)}"]
@@ -209,12 +211,15 @@ def _guards(eq: Equations) -> list[str]:
 def _section(eq: Equations) -> list[str]:
     n = len(eq.q)
     d = eq.section_drop
-    keep = [i for i in range(2 * n) if i != d]
-    z = sp.symbols(f"z0:{2 * n - 1}")
+    tied = eq.section_tied or {}
+    keep = [i for i in range(2 * n) if i != d and i not in tied]
+    z = sp.symbols(f"z0:{len(keep)}")
     full = sp.Matrix([*eq.q, *eq.dq])
     sub = {full[i]: z[k] for k, i in enumerate(keep)}
-    xs = [str(z[keep.index(i)]) if i != d else _PY.doprint(eq.drop_solution.subs(sub))
+    xs = [str(z[keep.index(i)]) if i in keep else _PY.doprint(eq.drop_solution.subs(sub))
           for i in range(2 * n)]
+    for i, j in tied.items():
+        xs[i] = xs[j]
     return [
         "    def section(x):",
         f"{IND}return np.asarray(x)[{keep!r}]",
@@ -287,6 +292,13 @@ def generate(eq: Equations, param_names, key: str) -> str:
     _COUNT[0] = 0
     fast = [*_flow(eq, False), *_flow(eq, True), *_reset(eq, False), *_reset(eq, True),
             *_guards(eq)]
+    if eq.locked is not None:  # kneed walker: knee-locked flow and the knee strike
+        lk = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
+        q_lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, len(eq.q)))])
+        kn = replace(eq, Mi=eq.knee_impact[0], B=eq.knee_impact[1], relabel_q=q_lock,
+                     relabel_rate=sp.eye(len(eq.q)))
+        fast += [*_flow(lk, False, "flow_locked"), *_flow(lk, True, "flow_locked_jacobian"),
+                 *_reset(kn, False, "knee_reset"), *_reset(kn, True, "knee_reset_jacobian")]
     body = [
         "def make(p):",
         f"    {', '.join(param_names)}, = p",
@@ -296,8 +308,8 @@ def generate(eq: Equations, param_names, key: str) -> str:
         f"{IND}d = _energies(x)",
         f"{IND}return d['kinetic'], d['potential']",
         *_numpy_fn("points", eq, eq.points),
-        *_numpy_fn("leg_angles", eq, {"stance_angle": la["stance"], "swing_angle": la["swing"],
-                                      "stance_rate": rates["stance"], "swing_rate": rates["swing"]}),
+        *_numpy_fn("leg_angles", eq, {**{f"{k}_angle": v for k, v in la.items()},
+                                      **{f"{k}_rate": v for k, v in rates.items()}}),
         *_numpy_fn("_matrices", eq, {"M": eq.M, "C": eq.C, "G": eq.G}),
         "    def matrices(x):",
         f"{IND}d = _matrices(x)",

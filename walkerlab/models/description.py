@@ -17,15 +17,19 @@ from dataclasses import dataclass
 
 #: Roles of the generalised coordinates for each coordinate scheme (see HybridWalker.roles).
 ROLES = {"absolute": ("swing", "stance"), "slope_relative": ("stance", "hip")}
+#: Roles with a knee: swing thigh and shank free, the stance leg straight (absolute angles).
+KNEED_ROLES = ("swing_thigh", "swing_shank", "stance")
 
 
 @dataclass(frozen=True)
 class BodySpec:
-    """One body on each leg: ``kind`` ``point_mass`` or ``rod``; ``massless``: mass -> 0 limit."""
+    """One body on each leg: ``kind`` ``point_mass`` or ``rod``; ``massless``: mass -> 0 limit;
+    ``link``: ``leg`` (straight leg), ``thigh`` or ``shank`` (kneed leg)."""
 
     name: str
     kind: str
     massless: bool = False
+    link: str = "leg"
 
 
 @dataclass(frozen=True)
@@ -44,10 +48,12 @@ class Structure:
     hip_mass : bool
         True if there is a hip point mass.
     foot : str
-        ``"point"``.
+        ``"point"`` or ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip).
     variant : str
         ``"derived"``; ``"appendix_a"`` only for the paper's compass gait: the flow with the
         Coriolis matrix as printed in the paper (A.5, sign of ``C[1, 0]`` flipped).
+    knee : bool
+        True if the leg has a knee at ``L_thigh`` from the hip (roles :data:`KNEED_ROLES`).
     """
 
     coordinates: str
@@ -55,10 +61,11 @@ class Structure:
     hip_mass: bool = True
     foot: str = "point"
     variant: str = "derived"
+    knee: bool = False
 
     @property
     def roles(self) -> tuple[str, ...]:
-        return ROLES[self.coordinates]
+        return KNEED_ROLES if self.knee else ROLES[self.coordinates]
 
     @property
     def param_names(self) -> tuple[str, ...]:
@@ -70,13 +77,19 @@ class Structure:
             names.append(f"d_{b.name}")
             if b.kind == "rod":
                 names.append(f"I_{b.name}")
+        if self.knee:
+            names.append("L_thigh")
+        if self.foot == "arc":
+            names.append("R_foot")
         return tuple(names)
 
     def key(self) -> str:
         """Canonical JSON of the structure (part of the generated-code cache key)."""
         return json.dumps({"coordinates": self.coordinates, "foot": self.foot,
                            "hip_mass": self.hip_mass, "variant": self.variant,
-                           "bodies": [[b.name, b.kind, b.massless] for b in self.bodies]})
+                           "knee": self.knee,
+                           "bodies": [[b.name, b.kind, b.massless, b.link]
+                                      for b in self.bodies]})
 
 
 @dataclass(frozen=True)
@@ -128,18 +141,23 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     bodies, values = [], []
     for b in leg.bodies:
         massless = b.mass_kg == 0.0
-        bodies.append(BodySpec(b.name, b.kind, massless))
+        bodies.append(BodySpec(b.name, b.kind, massless, b.link))
         if not massless:
             values.append(b.mass_kg)
         if b.kind == "rod":
             values += [b.com_from_hip_m, b.inertia_about_com_kg_m2]
         else:
             values.append(b.from_hip_m)
+    if leg.knee is not None:
+        values.append(leg.knee.thigh_length_m)
+    if leg.foot.kind == "arc":
+        values.append(leg.foot.radius_m)
     hip = walker_cfg.hip_mass_kg > 0
     head = [walker_cfg.gravity_m_per_s2, leg.length_m, slope_rad]
     if hip:
         head.append(walker_cfg.hip_mass_kg)
-    structure = Structure(walker_cfg.coordinates, tuple(bodies), hip, leg.foot.kind)
+    structure = Structure(walker_cfg.coordinates, tuple(bodies), hip, leg.foot.kind,
+                          knee=leg.knee is not None)
     total = walker_cfg.hip_mass_kg + 2 * sum(b.mass_kg for b in leg.bodies)
     return WalkerData(structure, tuple(float(v) for v in head + values), total, leg.length_m,
                       walker_cfg.gravity_m_per_s2, slope_rad, extra)

@@ -16,6 +16,23 @@ then
   hip height above the slope (fall);
 - energies, named points, absolute leg angles.
 
+Knees and round feet (same derivation, more links / another contact point):
+
+- knee (``structure.knee``): the swing leg is a thigh (``psi_swt``) and a shank (``psi_sws``);
+  the stance leg stays straight.  The locked knee is the constraint ``J_k dpsi = 0`` with
+  ``J_k = d(psi_sws - psi_swt)/dpsi`` on the same coordinates.  With ``S`` a basis of its null
+  space, a locked phase, a plastic knee strike and a heel strike with the knee locked are the
+  square systems ``[S^T M; J_k] qdd = [S^T (-C dq - G); 0]``, ``[S^T M; J_k] dq+ =
+  [S^T M; 0] dq-`` (angular momentum of the whole walker about the stance foot and of the
+  swing leg about the hip conserved, McGeer 1990 "Passive walking with knees") and
+  ``[S^T Mi; J_k] dq+ = [S^T B; 0] dq-``;
+- arc feet (``structure.foot == "arc"``, radius ``R``, centre on the leg axis at ``L - R``
+  from the hip): the stance arc rolls without slip, its contact point is ``-R (psi_st +
+  gamma)`` along the slope from the step's reference point (where the contact is when the
+  stance leg is normal to the slope).  The heel-strike impact is about the swing arc's
+  *material* contact point (velocity ``v_centre + w x (-R n)``).  ``swing_foot`` is the next
+  step's reference point, ``swing_contact`` the arc's lowest point; R = 0 is the point foot.
+
 Massless limit (Garcia et al. 1998).  A body with mass 0 gets the symbolic mass ``beta``;
 ``M, C, G`` (and ``Mi, B``) are linear in ``beta``.  A row of the equations that vanishes at
 ``beta = 0`` (the equation of a coordinate that moves only massless bodies) is replaced by its
@@ -66,7 +83,14 @@ class Equations:
         Index in ``q`` solved from the heel-strike guard; ``drop_solution`` is its expression.
     De, E : Matrix
         Extended impact matrices (coordinates ``[q, x_f, y_f]``, paper Eq. 6-7, A.7-A.24) for
-        the printed-equation variants.
+        the printed-equation variants (zeros for kneed or arc-footed walkers).
+    section_tied : dict[int, int]
+        State indices equal to another one on the section (kneed: the swing shank angle and
+        rate equal the thigh's just after heel strike).
+    locked : tuple (M, C, G) or None
+        Flow with the swing knee locked, as the square system described above.
+    knee_impact : tuple (Mk, Bk) or None
+        Plastic knee strike ``Mk dq+ = Bk dq-``.
     """
 
     q: tuple
@@ -89,6 +113,9 @@ class Equations:
     De: sp.Matrix
     E: sp.Matrix
     limit: bool
+    section_tied: dict | None = None
+    locked: tuple | None = None
+    knee_impact: tuple | None = None
 
 
 def _e(psi):
@@ -139,10 +166,14 @@ def derive(structure: Structure) -> Equations:
     Raises
     ------
     ValueError
-        A foot kind this derivation does not handle.
+        A foot kind this derivation does not handle, or a knee / arc feet with coordinates
+        other than ``absolute``.
     """
-    if structure.foot != "point":
+    if structure.foot not in ("point", "arc"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
+    knee, arc = structure.knee, structure.foot == "arc"
+    if (knee or arc) and structure.coordinates != "absolute":
+        raise ValueError("walker.coordinates: a knee or arc feet need 'absolute'")
     n = len(structure.roles)
     q = sp.symbols([f"q_{r}" for r in structure.roles], real=True)
     dq = sp.symbols([f"dq_{r}" for r in structure.roles], real=True)
@@ -150,100 +181,183 @@ def derive(structure: Structure) -> Equations:
     P = dict(zip(structure.param_names, par))
     beta = sp.Symbol("beta", positive=True)
     g, L, gamma = P["g"], P["L"], P["gamma"]
-    psi_st, psi_sw = _leg_angles(structure, q, gamma)
     qv, dqv = sp.Matrix(q), sp.Matrix(dq)
+    if knee:  # absolute angles (KNEED_ROLES): swing thigh, swing shank, stance
+        psi_q = list(q)
+        psi_sw, psi_st = q[0], q[2]
+    else:
+        psi_st, psi_sw = _leg_angles(structure, q, gamma)
+        psi_q = [psi_sw, psi_st]
 
-    # derive in absolute leg angles psi = (psi_sw, psi_st): each massless body then moves with
-    # one coordinate only, so the row limit below is exact; map to q at the end (psi = A q + c)
-    ps_sw, ps_st = sp.symbols("psi_swing psi_stance", real=True)
-    dps = sp.Matrix(sp.symbols("dpsi_swing dpsi_stance", real=True))
-    psv = sp.Matrix([ps_sw, ps_st])
-    # every position is a sum of leg vectors: {leg angle: length along it} times e(angle)
-    hip_lin = {ps_st: -L}  # stance foot at the origin (A.2)
-    foot_lin = {ps_st: -L, ps_sw: L}
-    points = {"stance_foot": sp.zeros(2, 1), "hip": _pos(hip_lin), "swing_foot": _pos(foot_lin)}
+    # derive in absolute link angles psi (swing link(s), stance): each massless body then moves
+    # with one coordinate only, so the row limit below is exact; map to q at the end
+    if knee:
+        ps_sw, ps_shank, ps_st = sp.symbols("psi_swing psi_swing_shank psi_stance", real=True)
+        dps = sp.Matrix(sp.symbols("dpsi_swing dpsi_swing_shank dpsi_stance", real=True))
+        psv = sp.Matrix([ps_sw, ps_shank, ps_st])
+    else:
+        ps_sw, ps_st = sp.symbols("psi_swing psi_stance", real=True)
+        dps = sp.Matrix(sp.symbols("dpsi_swing dpsi_stance", real=True))
+        psv = sp.Matrix([ps_sw, ps_st])
+        ps_shank = ps_sw
+    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
+    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])  # along the slope, downhill
+    lt = P["L_thigh"] if knee else 0
+    R = P["R_foot"] if arc else 0
+    # every position is a sum of leg vectors {link angle: length along it} times e(angle),
+    # plus, with arc feet, the rolling offset of the stance arc (contact + R n) - (L - R) stays
+    # on the leg: the stance arc's centre is at L - R from the hip
+    hip_lin = {ps_st: -(L - R)} if arc else {ps_st: -L}  # stance foot at the origin (A.2)
+    offset = (-R * (ps_st + gamma) * tangent + R * normal) if arc else sp.zeros(2, 1)
+
+    def at(lin):
+        return _pos(lin) + offset
+
+    def add(lin, psi, length):
+        out = dict(lin)
+        out[psi] = out.get(psi, 0) + length
+        return out
+
+    knee_lin = add(hip_lin, ps_sw, lt) if knee else hip_lin
+    foot_lin = add(knee_lin, ps_shank, L - lt - R)   # point foot, or the swing arc's centre
+    if arc:
+        centre_sw = at(foot_lin)
+        swing_contact = centre_sw - R * normal
+        swing_foot = swing_contact + R * (ps_shank + gamma) * tangent  # next reference point
+    else:
+        swing_foot = swing_contact = at(foot_lin)
+    points = {"stance_foot": sp.zeros(2, 1), "hip": at(hip_lin), "swing_foot": swing_foot}
+    if knee:
+        points["swing_knee"] = at(knee_lin)
+        points["stance_knee"] = at(add(hip_lin, ps_st, lt))
+    if arc:
+        points["stance_contact"] = offset - R * normal
+        points["stance_foot_centre"] = offset
+        points["swing_contact"] = swing_contact
+        points["swing_foot_centre"] = centre_sw
     bodies = []  # (mass, {angle: length}, inertia, link angle)
     if structure.hip_mass:
         bodies.append((P["M_hip"], hip_lin, 0, ps_st))
     for b in structure.bodies:
         mass = beta if b.massless else P[f"m_{b.name}"]
         inertia = P[f"I_{b.name}"] if b.kind == "rod" else 0
-        for role, psi in (("stance", ps_st), ("swing", ps_sw)):
-            lin = dict(hip_lin)
-            lin[psi] = lin.get(psi, 0) + P[f"d_{b.name}"]
+        d = P[f"d_{b.name}"]
+        swing = ((add(knee_lin, ps_shank, d - lt), ps_shank) if b.link == "shank"
+                 else (add(hip_lin, ps_sw, d), ps_sw))
+        for role, (lin, psi) in (("stance", (add(hip_lin, ps_st, d), ps_st)), ("swing", swing)):
             if f"{role}_{b.name}" in points:
                 raise ValueError(f"walker.leg.bodies: body name {b.name!r} is reserved")
-            points[f"{role}_{b.name}"] = _pos(lin)
+            points[f"{role}_{b.name}"] = at(lin)
             bodies.append((mass, lin, inertia, psi))
 
-    foot = points["swing_foot"]
     V = sp.Integer(0)
-    k = len(psv)  # links (absolute link angles)
-    Mi = sp.zeros(k, k)
-    Bm = sp.zeros(k, k)
-    Mp = sp.zeros(k, k)
+    Mi = sp.zeros(n, n)
+    Bm = sp.zeros(n, n)
+    Mp = sp.zeros(n, n)
+    if arc:  # material point of the swing arc at the contact: v_centre + w x (-R n)
+        Jf = centre_sw.jacobian(psv) + R * tangent * sp.Matrix([[sp.diff(ps_shank, s)
+                                                                for s in psv]])
     for mass, lin, inertia, psi in bodies:
-        # d(position)/d(psi_k) = lin[psi_k] e'(psi_k), and e'(a) . e'(b) = cos(a - b): the
-        # inertia matrices come out simplified without a trigonometric simplifier
-        new = {p_: lin.get(p_, 0) - foot_lin.get(p_, 0) for p_ in psv}  # swing foot at rest
-        a = sp.Matrix([[1 if psi == p_ else 0 for p_ in psv]])
-        for i, pi_ in enumerate(psv):
-            for j, pj in enumerate(psv):
-                c = sp.cos(pi_ - pj)
-                Mp[i, j] += mass * lin.get(pi_, 0) * lin.get(pj, 0) * c
-                Mi[i, j] += mass * new[pi_] * new[pj] * c
-                Bm[i, j] += mass * new[pi_] * lin.get(pj, 0) * c
+        a = sp.Matrix([[1 if psi == k else 0 for k in psv]])
+        if arc:  # the rolling offset moves with psi_st: plain Jacobians
+            J = at(lin).jacobian(psv)
+            Jn = J - Jf  # velocity Jacobian with the swing arc's contact point at rest
+            Mp += mass * J.T * J
+            Mi += mass * Jn.T * Jn
+            Bm += mass * Jn.T * J
+        else:
+            # d(position)/d(psi_k) = lin[psi_k] e'(psi_k), and e'(a) . e'(b) = cos(a - b): the
+            # inertia matrices come out simplified without a trigonometric simplifier
+            new = {k: lin.get(k, 0) - foot_lin.get(k, 0) for k in psv}  # swing foot at rest
+            for i, pi_ in enumerate(psv):
+                for j, pj in enumerate(psv):
+                    c = sp.cos(pi_ - pj)
+                    Mp[i, j] += mass * lin.get(pi_, 0) * lin.get(pj, 0) * c
+                    Mi[i, j] += mass * new[pi_] * new[pj] * c
+                    Bm[i, j] += mass * new[pi_] * lin.get(pj, 0) * c
         Mp += inertia * a.T * a
         Mi += inertia * a.T * a
         Bm += inertia * a.T * a
-        V += mass * g * _pos(lin)[1]
+        V += mass * g * at(lin)[1]
     Mp, Mi, Bm = (X.applyfunc(sp.factor_terms) for X in (Mp, Mi, Bm))
     T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
     G = sp.Matrix([sp.diff(V, s) for s in psv])
-    C = sp.zeros(k, k)
-    for i in range(k):
-        for j in range(k):
-            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[r]) + sp.diff(Mp[i, r], psv[j])
-                                               - sp.diff(Mp[j, r], psv[i])) * dps[r]
-                          for r in range(k))  # Christoffel symbols of the first kind
+    C = sp.zeros(n, n)
+    for i in range(n):
+        for j in range(n):
+            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[k]) + sp.diff(Mp[i, k], psv[j])
+                                               - sp.diff(Mp[j, k], psv[i])) * dps[k]
+                          for k in range(n))  # Christoffel symbols of the first kind
     if structure.variant == "appendix_a":  # the paper's printed A.5: C[1, 0] sign flipped
-        if structure.coordinates != "absolute" or len(structure.bodies) != 1:
+        if structure.coordinates != "absolute" or len(structure.bodies) != 1 or knee or arc:
             raise ValueError("ideal.variant: appendix_a exists only for the compass gait")
         C[1, 0] = -C[1, 0]
     lim = any(b.massless for b in structure.bodies)
     M = Mp
     if lim:
         flow, _ = _row_limit(Mp.row_join(C).row_join(G), beta)
-        M, C, G = flow[:, :k], flow[:, k:2 * k], flow[:, 2 * k]
+        M, C, G = flow[:, :n], flow[:, n:2 * n], flow[:, 2 * n]
         imp, _ = _row_limit(Mi.row_join(Bm), beta)
-        Mi, Bm = imp[:, :k], imp[:, k:]
+        Mi, Bm = imp[:, :n], imp[:, n:]
         T, V = T.subs(beta, 0), V.subs(beta, 0)
+    locked = knee_impact = None
+    if knee:  # knee lock J_k dpsi = 0; S spans its null space (thigh and shank together)
+        Jk = sp.Matrix([[-1, 1, 0]])
+        S = sp.Matrix([[1, 0], [1, 0], [0, 1]])
+        z = sp.zeros(1, n)
+        locked = (S.T * M).col_join(Jk), (S.T * C).col_join(z), (S.T * G).col_join(sp.zeros(1, 1))
+        knee_impact = (S.T * M).col_join(Jk), (S.T * M).col_join(z)
+        Mi, Bm = (S.T * Mi).col_join(Jk), (S.T * Bm).col_join(z)
     # to the scene's coordinates: psi = A q + c, dpsi = A dq
-    psi_q = sp.Matrix([psi_sw, psi_st])
+    psi_q = sp.Matrix(psi_q)
     A = psi_q.jacobian(qv)
-    sub = {ps_sw: psi_sw, ps_st: psi_st, **{d: e for d, e in zip(dps, A * dqv)}}
-    W = sp.eye(k) if lim else A.T  # keep psi rows in the limit; else Lagrange's rows in q
+    sub = {s: e for s, e in zip(psv, psi_q)}
+    sub.update({dps[i]: (A * dqv)[i] for i in range(n)})
+    W = sp.eye(n) if lim else A.T  # keep psi rows in the limit; else Lagrange's rows in q
     M, C, G = (W * M * A).subs(sub), (W * C * A).subs(sub), (W * G).subs(sub)
     Mi, Bm = (W * Mi * A).subs(sub), (W * Bm * A).subs(sub)
+    if knee:  # absolute coordinates: A = I, the systems are already in q
+        locked = tuple(m_.subs(sub) for m_ in locked)
+        knee_impact = tuple(m_.subs(sub) for m_ in knee_impact)
     T, V = T.subs(sub), V.subs(sub)
-    points = {name: v.subs(sub) for name, v in points.items()}
+    points = {k: v.subs(sub) for k, v in points.items()}
     hip, foot = points["hip"], points["swing_foot"]
-    bodies = [(m_, _pos(lin).subs(sub), i_, psi.subs(sub)) for m_, lin, i_, psi in bodies]
+    swing_contact = swing_contact.subs(sub)
+    bodies = [(m_, at(lin).subs(sub), i_, psi.subs(sub)) for m_, lin, i_, psi in bodies]
 
     # role swap: new stance leg = old swing leg (absolute angles), solved for the new q
     qn = sp.symbols([f"qn_{r}" for r in structure.roles], real=True)
-    nst, nsw = _leg_angles(structure, qn, gamma)
-    sol = sp.solve([nst - psi_sw, nsw - psi_st], qn, dict=True)[0]
+    if knee:  # the swing knee is locked at heel strike; the new swing knee starts straight
+        eqs = [qn[2] - psi_sw, qn[0] - psi_st, qn[1] - psi_st]
+    else:
+        nst, nsw = _leg_angles(structure, qn, gamma)
+        eqs = [nst - psi_sw, nsw - psi_st]
+    sol = sp.solve(eqs, qn, dict=True)[0]
     relabel_q = sp.Matrix([sp.expand(sol[s]) for s in qn])
     relabel_rate = relabel_q.jacobian(qv)
 
     sigma = sp.expand(psi_sw + psi_st + 2 * gamma)
     drop = SECTION_DROP[structure.coordinates]
     drop_solution = sp.solve(sigma, q[drop])[0]
-    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
     guards = {"heel_strike": sigma, "swing_foot_ahead": sp.expand(psi_sw - psi_st),
-              "hip_height": (hip.T * normal)[0]}
+              "hip_height": (hip.T * normal)[0],
+              "swing_clearance": (swing_contact.T * normal)[0]}
+    leg_angles = {"stance": psi_st, "swing": psi_sw}
+    tied = {}
+    if knee:
+        guards["knee_extension"] = q[1] - q[0]  # zero when straight, > 0 hyperextended
+        leg_angles = {"stance_thigh": psi_st, "stance_shank": psi_st, "swing_thigh": q[0],
+                      "swing_shank": q[1]}
+        tied = {1: 0, n + 1: n}
 
+    if knee or arc:  # the printed-equation variants exist for the point-foot compass gait only
+        return Equations(
+            q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=Bm,
+            relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=T, potential=V,
+            guards=guards, points=points, leg_angles=leg_angles, section_drop=drop,
+            drop_solution=drop_solution, De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2),
+            limit=lim, section_tied=tied, locked=locked, knee_impact=knee_impact,
+        )
     # extended coordinates (stance foot free at (x_f, y_f)) for the printed-equation variants
     xf, yf, dxf, dyf = sp.symbols("x_f y_f dx_f dy_f", real=True)
     qe, dqe = sp.Matrix([*q, xf, yf]), sp.Matrix([*dq, dxf, dyf])
@@ -258,6 +372,6 @@ def derive(structure: Structure) -> Equations:
     return Equations(
         q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=Bm,
         relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=T, potential=V, guards=guards,
-        points=points, leg_angles={"stance": psi_st, "swing": psi_sw}, section_drop=drop,
+        points=points, leg_angles=leg_angles, section_drop=drop,
         drop_solution=drop_solution, De=De, E=E, limit=lim,
     )

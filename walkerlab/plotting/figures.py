@@ -56,21 +56,30 @@ def _legend(ax, **kw):
         ax.legend(fontsize=8, **kw)
 
 
-def _coordinate_styles(names: list[str]) -> dict[str, dict]:
-    """Colour per coordinate stem (``leg1``, ``leg1_shank`` ...), shared by angle and rate."""
+def _coordinate_styles(names: list[str], model_index: int = 0) -> dict[str, dict]:
+    """Colour per leg (first word of the name: ``leg1``, ``torso``), line style per part of
+    that leg (``leg1_thigh`` solid, ``leg1_shank`` dashed) shifted by the model index, so
+    the parts of one leg stay distinguishable where they overlap (a locked knee)."""
     stems = list(dict.fromkeys(n.rsplit("_", 1)[0] for n in names))
-    return {n: dict(color=LEG_COLORS[stems.index(n.rsplit("_", 1)[0]) % len(LEG_COLORS)])
-            for n in names}
+    owners = list(dict.fromkeys(st.split("_", 1)[0] for st in stems))
+    out = {}
+    for n in names:
+        st = n.rsplit("_", 1)[0]
+        owner = st.split("_", 1)[0]
+        part = [x for x in stems if x.split("_", 1)[0] == owner].index(st)
+        out[n] = dict(color=LEG_COLORS[owners.index(owner) % len(LEG_COLORS)],
+                      ls=MODEL_STYLES[(model_index + part) % len(MODEL_STYLES)])
+    return out
 
 
 def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking"):
     """Fig. 7: every named angle [rad] (a) and rate [rad/s] (b) over time, every model."""
     fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     for mi, (label, tr) in enumerate(trajs.items()):
-        sty = _coordinate_styles(list(tr.coordinates))
+        sty = _coordinate_styles(list(tr.coordinates), mi)
         for ax, names in zip(axes, (tr.angle_names(), tr.rate_names())):
             for n in names:
-                ax.plot(tr.time, tr.coordinates[n], ls=MODEL_STYLES[mi % 4], lw=1.2,
+                ax.plot(tr.time, tr.coordinates[n], lw=1.2,
                         label=f"{n.rsplit('_', 1)[0]} - {label}", **sty[n])
     axes[0].set_ylabel("angle from vertical [rad]")
     axes[1].set_ylabel("angular rate [rad/s]")
@@ -155,6 +164,8 @@ def _chains(tr: NamedTrajectory) -> list[tuple[str, list[str]]]:
     for leg in tr.legs:
         names = [n for n in tr.points if n.startswith(leg + "_") and not n.endswith("_mass")
                  and not n.endswith("_com")]
+        if any(n.endswith("_contact") for n in names):  # round feet: end at the contact,
+            names = [n for n in names if not n.endswith("_foot")]  # not the reference point
         names.sort(key=lambda n: (n.endswith("_foot"), float(np.hypot(*(tr.points[n][:, 0]
                                                                           - hip[:, 0])))))
         used.update(n for n in tr.points if n.startswith(leg + "_"))

@@ -17,6 +17,7 @@ from walkerlab.analysis.tables import TABLE3_ROWS, table3
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.readers import load_fixed_point
 from walkerlab.report.markdown import details, num, printed, table
+from walkerlab.report.text import zero_multipliers_text
 
 
 # --------------------------------------------------------------------------- data
@@ -86,6 +87,14 @@ def _gait_columns(paths: dict[str, Path]) -> dict[str, dict]:
     return table3(src, mass, g)
 
 
+def published_fixed_point(pub: ModuleType | None) -> tuple[tuple, tuple]:
+    """``(state names, values)`` of a published fixed point (``FIXED_POINT_NAMES/STATE``,
+    or the ``EQ11_NAMES/STATE`` spelling), empty when the source prints none."""
+    names = getattr(pub, "FIXED_POINT_NAMES", getattr(pub, "EQ11_NAMES", ()))
+    state = getattr(pub, "FIXED_POINT_STATE", getattr(pub, "EQ11_STATE", ()))
+    return tuple(names), tuple(state)
+
+
 # --------------------------------------------------------------------------- summary
 def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[str]:
     """Short verdicts and headline numbers, with the published values where they exist."""
@@ -101,7 +110,7 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
                        f"{num(meta['step_period_s'])} s.")
         bullets.append(f"- **Stable**: {'yes' if meta['stable'] else 'no'} (largest "
                        f"|Floquet multiplier| {num(meta['max_abs_multiplier'])}).")
-        eq = dict(zip(getattr(pub, "EQ11_NAMES", ()), getattr(pub, "EQ11_STATE", ())))
+        eq = dict(zip(*published_fixed_point(pub)))
         for n, v, u in zip(meta["state_names"], x, meta["state_units"]):
             rows.append([f"fixed point {n}", u, num(v), printed(eq[n]) if n in eq else "—"])
         rows.append(["step period", "s", num(meta["step_period_s"]), "—"])
@@ -165,14 +174,17 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
 # --------------------------------------------------------------------------- fixed point
 def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
     """Fixed point of every equation variant, Floquet multipliers, verdict."""
-    eq = np.array(getattr(pub, "EQ11_STATE", ()), float) if pub is not None else None
+    pub_fp = dict(zip(*published_fixed_point(pub)))
     out = ["## Fixed point of the Poincaré map", ""]
     with open_artifact(path, "fixedpoint") as f:
         names = [str(n) for n in f.attrs["state_names"]]
         units = [str(f[f"fixed_point/{n}"].attrs["unit"]) for n in names]
         main = str(f.attrs["variant"])
+        # the published state in this walker's state order (None if it does not name them all)
+        eq = np.array([pub_fp[n] for n in names], float) if pub_fp and set(names) <= set(
+            pub_fp) else None
         rows = []
-        if eq is not None and eq.size == len(names):
+        if eq is not None:
             label = getattr(pub, "FIXED_POINT_LABEL", "Eq. (11)")
             rows.append([f"{pub.SHORT} {label} (printed)", *[printed(v) for v in eq], "—", "—",
                          "—"])
@@ -223,8 +235,7 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
                        for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
                 "", f"Max difference between the two: {num(f['floquet/max_difference'][()], 2)}. "
                 f"Verdict: **{'stable' if f['floquet/stable'][()] else 'unstable'}** "
-                "(one multiplier is 0 by construction: the map lands on the heel-strike "
-                "surface).", ""]
+                f"({zero_multipliers_text(re, im)}).", ""]
     return out
 
 
@@ -254,7 +265,7 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
            + ", ".join(f"`{paths[s].name}`" for s in ("simulate", "contact-sim") if s in paths)
            + ").", "", table(header, rows)]
     ideal = cols.get("ours, ideal")
-    eq = getattr(pub, "EQ11_STATE", None)
+    eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
     if ideal and t3 and eq is not None and step_pub is not None:
         L = float(scene.walker.leg_length_m)
         eqd = dict(zip(pub.EQ11_NAMES, eq))
@@ -264,8 +275,9 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
         out += ["", "**Differences from the published Table 3, measured:**", "",
                 f"- *Left/right step periods.* A period-1 gait has identical steps: ours are "
                 f"{num(ideal['t_left_s'])} s and {num(ideal['t_right_s'])} s. The published "
-                f"{printed(t3['t_left_s'][0])} s and {printed(t3['t_right_s'][0])} s cannot both belong "
-                f"to the period-1 fixed point of Eq. (11); their sum {printed(t3['t_cycle_s'][0])} s "
+                f"{printed(t3['t_left_s'][0])} s and {printed(t3['t_right_s'][0])} s cannot "
+                f"both belong to the period-1 fixed point of Eq. (11); their sum "
+                f"{printed(t3['t_cycle_s'][0])} s "
                 f"is within {num(abs(t3['t_cycle_s'][0] - ideal['t_cycle_s']), 2)} s of our "
                 f"cycle period {num(ideal['t_cycle_s'])} s.",
                 f"- *Step length Δx.* Eq. (11) itself implies Δx = 2 L sin((θ2 − θ1)/2) = "
@@ -386,5 +398,5 @@ def bifurcation_section(paths: dict[str, Path]) -> list[str]:
             "where the most negative real Floquet multiplier crosses −1" if np.isfinite(onset)
             else "no period doubling on the grid")
     return ["## Bifurcation over the slope", "",
-            f"Grid {num(slopes[0])}–{num(slopes[-1])}° ({slopes.size} slopes): {text}; "
+            f"Grid {printed(slopes[0])}–{printed(slopes[-1])}° ({slopes.size} slopes): {text}; "
             f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}.", ""]

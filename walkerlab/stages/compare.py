@@ -42,7 +42,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     """Run (or reuse) ``simulate`` and ``contact-sim``, then compare them."""
     simulate.run(scene, runs_root)
     contact_sim.run(scene, runs_root)
-    up = (artifact_path(scene, runs_root, "simulate"), artifact_path(scene, runs_root, "contact-sim"))
+    up = (artifact_path(scene, runs_root, "simulate"),
+          artifact_path(scene, runs_root, "contact-sim"))
 
     def compute():
         ideal, t, err, metrics, lc = compare_files(up[0], up[1])

@@ -115,9 +115,11 @@ def axis_values(settings, walker, x_star: np.ndarray,
     return out[0], out[1]
 
 
-def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings
-                  ) -> tuple[int, int, int]:
+def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
+                  max_step_time: float = 5.0) -> tuple[int, int, int]:
     """Iterate the Poincaré map from ``x0`` and classify where it goes.
+
+    ``max_step_time`` [s]: a longer step ends the cell as ``stalled``.
 
     Returns
     -------
@@ -133,7 +135,7 @@ def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings
     x = np.asarray(x0, dtype=float)
     hist = [x]
     for k in range(1, settings.max_steps + 1):
-        seg = integrate_step(walker, x, solver, max_step_time=settings.max_step_time_s)
+        seg = integrate_step(walker, x, solver, max_step_time=max_step_time)
         if seg.termination == "fall":
             hip = walker.points(seg.x_end)["hip"]
             return CODE["fell_forward" if float(hip[0]) > 0 else "fell_backward"], k, 0
@@ -181,7 +183,10 @@ def _walker_and_settings(base: dict):
     if key not in _WALKERS:
         scene = scene_from_dict(base)
         _WALKERS.clear()
-        _WALKERS[key] = (build_walker(scene), scene.basin or BasinSettings())
+        st = scene.basin or BasinSettings()
+        mst = st.max_step_time_s or (scene.fixedpoint.max_step_time_s if scene.fixedpoint
+                                     else 5.0)
+        _WALKERS[key] = (build_walker(scene), st, mst)
     return _WALKERS[key]
 
 
@@ -189,13 +194,13 @@ def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]``."""
     from walkerlab.analysis.hybrid import Solver
 
-    walker, st = _walker_and_settings(task.base)
+    walker, st, max_step_time = _walker_and_settings(task.base)
     solver = Solver("DOP853", st.rtol, st.atol)
     x_star = np.asarray(task.x_star, dtype=float)
     out = []
     for idx, vx, vy in task.cells:
         x0 = slice_state(walker, x_star, (st.x_axis, st.y_axis), (vx, vy))
-        out.append((int(idx), *classify_cell(walker, x0, x_star, solver, st)))
+        out.append((int(idx), *classify_cell(walker, x0, x_star, solver, st, max_step_time)))
     return out
 
 

@@ -130,7 +130,8 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
             msg = str(exc)
             continue
         if interleg_angle(walker, res.x) < opts["min_interleg_angle_rad"]:
-            msg = (f"degenerate fixed point (inter-leg angle {interleg_angle(walker, res.x):.2e} rad "
+            il = interleg_angle(walker, res.x)
+            msg = (f"degenerate fixed point (inter-leg angle {il:.2e} rad "
                    f"< {opts['min_interleg_angle_rad']:g}): no step")
             best = min(best, res.residual)
             continue
