@@ -78,7 +78,11 @@ def contact_text(path: Path) -> str:
             for k in f["summary"]:
                 ds = f["summary"][k]
                 lines.append(f"  {k:<28s} {ds[()]} {ds.attrs.get('unit', '')}")
-        if "periodic_gait" in f:
+        if "periodic_gait" in f and f["periodic_gait"].attrs.get("outcome", "ok") != "ok":
+            g = f["periodic_gait"]  # the search failed: the stage stores why, no numbers
+            lines.append(f"periodic contact gait: not found ({g.attrs['outcome']}: "
+                         f"{g.attrs.get('message', '')})")
+        elif "periodic_gait" in f:
             g = f["periodic_gait"]
             mult = g["multipliers/real"][()] + 1j * g["multipliers/imag"][()]
             lines.append(f"periodic contact gait: step period {g['step_period'][()]:.6f} s, "
