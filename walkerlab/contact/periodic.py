@@ -70,6 +70,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -259,7 +260,7 @@ class StepMap:
         on short odeint integrations from the sample before it, so the section state
         carries the integrator's accuracy, not an interpolant's.
         """
-        from scipy.integrate import odeint
+        from scipy.integrate import ODEintWarning, odeint
 
         ist, isw = 2 + stance_to_come, 3 - stance_to_come
         hth = 0.5 * self.walker.L
@@ -272,8 +273,10 @@ class StepMap:
             return K.jac(x, P, c1, c2)
 
         def run(x, tg):
-            X, info = odeint(f, x, tg, Dfun=jf, tfirst=True, rtol=self.rtol, atol=self.atol,
-                             full_output=True, mxstep=500000)
+            with warnings.catch_warnings():  # the message is checked below
+                warnings.simplefilter("ignore", ODEintWarning)
+                X, info = odeint(f, x, tg, Dfun=jf, tfirst=True, rtol=self.rtol,
+                                 atol=self.atol, full_output=True, mxstep=500000)
             if info["message"] != "Integration successful.":
                 raise PeriodicGaitError("solver_failure", f"step map: {info['message']}")
             return X

@@ -359,8 +359,13 @@ def _first_event(walker, t, X, hth, k0=1):
         k = int(below[0])
         if k == 0:
             best = ("fall", k0 - 1, float(tt[0]), "", np.nan)
-        else:
-            tc = float(np.interp(hth, [hh[k], hh[k - 1]], [tt[k], tt[k - 1]]))
+        else:  # on the Hermite interpolant of the hip height, slope = hip velocity . n
+            xa, xb = X[k0 - 1 + k - 1], X[k0 - 1 + k]
+            n = walker.normal
+            tc = _hermite_root(tt[k - 1], tt[k], hh[k - 1] - hth, hh[k] - hth,
+                               float(xa[4:6] @ n), float(xb[4:6] @ n), rising=False)
+            if tc is None:
+                tc = float(np.interp(hth, [hh[k], hh[k - 1]], [tt[k], tt[k - 1]]))
             best = ("fall", k0 - 1 + k, tc, "", np.nan)
     hw = walker.patch_half_width
     if not walker.continuous:
