@@ -485,7 +485,7 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
                      max_step: float = np.inf, sample_rate_hz: float = 1000.0, *,
                      t0: float = 0.0, pin_stance_until: str = "none", pin_time_s: float = 0.0,
                      fall_hip_height_m: float | None = None, use_jacobian: bool = True,
-                     chunk_s: float = 0.5, min_step_m: float = 0.05,
+                     chunk_s: float = 1.0, min_step_m: float = 0.05,
                      initial_stance: str = "leg2", wall_time_limit_s: float | None = None,
                      max_heel_strikes: int | None = None,
                      slip_limit_mm: float | None = None) -> ContactResult:
