@@ -1,5 +1,12 @@
 """Shared fixtures: the paper walker and its fixed point (computed once per session)."""
 
+import os
+import tempfile
+
+# generated model code: one cache shared by all test sessions (keyed by content, so safe)
+os.environ.setdefault("WALKERLAB_CACHE_DIR",
+                      os.path.join(tempfile.gettempdir(), "walkerlab-test-models"))
+
 from pathlib import Path
 
 import numpy as np
@@ -9,6 +16,7 @@ from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
+from walkerlab.published import paper
 
 ROOT = Path(__file__).resolve().parents[1]
 TIGHT = Solver("DOP853", 1e-12, 1e-12)
@@ -26,4 +34,4 @@ def paper_walker(paper_scene):
 
 @pytest.fixture(scope="session")
 def paper_fixed_point(paper_walker):
-    return find_fixed_point(paper_walker, np.array([-0.2022, 0.1674, -0.60, -0.84]), TIGHT)
+    return find_fixed_point(paper_walker, np.array(paper.EQ11_STATE), TIGHT)

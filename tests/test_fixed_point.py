@@ -6,8 +6,9 @@ import pytest
 from tests.conftest import TIGHT
 from walkerlab.analysis.poincare import find_fixed_point, poincare_map
 from walkerlab.models.compass_gait import make_compass_gait
+from walkerlab.published import paper
 
-EQ11 = np.array([-0.2022, 0.1674, -0.60, -0.84])
+EQ11 = np.array(paper.EQ11_STATE)  # role-ordered, as printed
 
 
 def test_fixed_point_residual_and_stability(paper_fixed_point):

@@ -54,8 +54,8 @@ def test_simulate_artifact_is_named_and_physical(ideal_scene, tmp_path):
 
     out = simulate.run(ideal_scene, tmp_path)
     with open_artifact(out.path, "simulate") as f:
-        assert f["samples/angle/leg1"].attrs["unit"] == "rad"
-        assert f["samples/rate/leg2"].attrs["unit"] == "rad/s"
+        assert f["samples/coordinates/leg1_angle"].attrs["unit"] == "rad"
+        assert f["samples/coordinates/leg2_rate"].attrs["unit"] == "rad/s"
         assert "scene_json" in f.attrs and f.attrs["wall_time_s"] > 0
         assert list(f["steps/termination"].asstr()[()]) == ["heel_strike"] * 2
         # total energy is constant within each step (PE from a fixed datum)
@@ -86,8 +86,11 @@ def _fake_trajectory(n=200):
     step = (t >= 1).astype(int)
     th = 0.2 * np.sin(np.pi * t)
     return NamedTrajectory(
-        time=t, legs=["leg1", "leg2"], angle={"leg1": th, "leg2": -th},
-        rate={"leg1": np.gradient(th, t), "leg2": -np.gradient(th, t)},
+        time=t, legs=["leg1", "leg2"],
+        coordinates={"leg1_angle": th, "leg2_angle": -th, "leg1_rate": np.gradient(th, t),
+                     "leg2_rate": -np.gradient(th, t)},
+        units={"leg1_angle": "rad", "leg2_angle": "rad", "leg1_rate": "rad/s",
+               "leg2_rate": "rad/s"},
         stance_leg=step.copy(), step_index=step, kinetic=1 + 0 * t, potential=100 + 0 * t,
         points={"hip": np.vstack([0.5 * t, 1 + 0 * t]),
                 "leg1_foot": np.vstack([0.5 * t + np.sin(th), 1 - np.cos(th)]),
@@ -112,10 +115,10 @@ def test_compare_of_a_trajectory_with_itself_is_zero():
     from walkerlab.analysis.compare import aligned_errors, limit_cycle_distance
 
     tr = _fake_trajectory()
-    t, ae, re = aligned_errors(tr, tr)
-    assert all(np.max(np.abs(v)) == 0 for v in ae.values())
-    assert all(np.max(np.abs(v)) == 0 for v in re.values())
-    assert limit_cycle_distance(tr, tr, "leg1") == 0
+    t, err = aligned_errors(tr, tr)
+    assert set(err) == {"leg1_angle", "leg2_angle", "leg1_rate", "leg2_rate"}
+    assert all(np.max(np.abs(v)) == 0 for v in err.values())
+    assert limit_cycle_distance(tr, tr, "leg1_angle", "leg1_rate") == 0
 
 
 def test_table3_is_recomputed_from_the_artifact(tmp_path, ideal_scene):

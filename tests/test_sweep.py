@@ -120,7 +120,8 @@ def test_max_steps_scuffing_solver_failure_error(base, monkeypatch):
     bad = dict(base, simulate={**base["simulate"],
                                "initial_state": {**FAR_STATE, "swing_rate_rad_per_s": float("nan")}})
     row, _ = evaluate("simulate", bad, ["slope.angle_deg"], (3.0,), 0, None, {})
-    assert row["outcome"] == "solver_failure" and "finite" in row["message"]
+    # a NaN initial state is refused by the scene's validation, naming the field
+    assert row["outcome"] == "invalid_config" and "initial_state" in row["message"]
 
     def boom(*a, **k):
         raise RuntimeError("kaboom")
@@ -181,17 +182,83 @@ def test_resume_after_interruption_keeps_finished_rows(scene, tmp_path):
 
 
 # ----------------------------------------------------------------------------- dask
-def test_dask_local_cluster_matches_local_runner(scene, tmp_path):
-    distributed = pytest.importorskip("distributed")
-    params = ["slope.angle_deg=2.5,3,3.5"]
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def dask_cluster():
+    """A Dask cluster as users start it: ``dask scheduler`` + two ``dask worker`` processes
+    (one process, one thread each) on 127.0.0.1; every process is killed at teardown."""
+    pytest.importorskip("distributed")
+    import os
+    import shutil
+    import signal
+    import subprocess
+    import sys
+
+    dask = shutil.which("dask", path=str(Path(sys.executable).parent)) or shutil.which("dask")
+    if dask is None:
+        pytest.skip("the dask command is not installed")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "DASK_DISTRIBUTED__WORKER__DAEMON": "False"}
+    port = _free_port()
+    addr = f"tcp://127.0.0.1:{port}"
+    procs = []
+
+    def start(*args):
+        p = subprocess.Popen([dask, *args], env=env, stdout=subprocess.DEVNULL,
+                             stderr=subprocess.DEVNULL, start_new_session=True)
+        procs.append(p)
+        return p
+
+    try:
+        start("scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard")
+        workers = [start("worker", addr, "--nworkers", "1", "--nthreads", "1",
+                         "--host", "127.0.0.1", "--no-dashboard", "--name", f"w{i}")
+                   for i in range(2)]
+        from distributed import Client
+
+        with Client(addr, timeout=60, set_as_default=False) as c:
+            c.wait_for_workers(2, timeout=60)
+        yield addr, workers
+    finally:
+        for p in procs:
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+            p.wait()
+
+
+def test_dask_cluster_matches_local_runner_and_survives_a_lost_worker(scene, tmp_path,
+                                                                      dask_cluster,
+                                                                      monkeypatch):
+    import os
+    import signal
+
+    from walkerlab.sweep import runner
+
+    addr, workers = dask_cluster
+    monkeypatch.setattr(runner, "PIECE_POINTS", 1)  # 4 pieces: work left after the kill
+    params = ["slope.angle_deg=2.8:3.1:0.1"]  # two continuation runs of 2 points each
     p_local = sweep_stage.run(scene, params, "fixedpoint", workers=1, runs_root=tmp_path,
                               name="local", progress=False)
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster:
-        p_dask = sweep_stage.run(scene, params, "fixedpoint", scheduler=cluster.scheduler_address,
-                                 runs_root=tmp_path, name="dask", progress=False)
+    killed = []
+
+    def kill_one_worker(done, total):
+        if not killed:  # rows arrived: a worker dies mid-sweep, Dask recomputes its piece
+            os.killpg(workers[0].pid, signal.SIGKILL)
+            killed.append(done)
+
+    p_dask = sweep_stage.run(scene, params, "fixedpoint", scheduler=addr, runs_root=tmp_path,
+                             name="dask", progress=False, on_chunk=kill_one_worker)
+    assert killed and killed[0] == 1 and workers[0].poll() is not None
     a, b = _rows(p_local), _rows(p_dask)
-    assert list(a["outcome"]) == list(b["outcome"]) == ["ok"] * 3
+    assert list(a["outcome"]) == list(b["outcome"]) == ["ok"] * 4
     for col in COLUMNS["fixedpoint"]:
         np.testing.assert_array_equal(a[col], b[col], err_msg=col)
 

@@ -1,9 +1,22 @@
 """Benchmarks behind ``walkerlab bench`` (speed goals are checked here, never in tests).
 
-``ideal``: wall time of the fixed-point search (compute part, derivation cached) and of a
-5-stride simulation (median of repeats), with RHS counts.  ``contact``: the contact
-walker's work-precision benchmark (:func:`walkerlab.contact.bench.run_benchmark`).
-Results are printed and written as JSON to ``OUT/<what>.json`` with the machine noted.
+=============  ===============================================================  ==========
+benchmark      what is timed                                                    target
+=============  ===============================================================  ==========
+``ideal``      5 strides (10 steps) of the paper walker from its fixed point,   <= 10 ms
+               DOP853 rtol = atol = 1e-10, compute only (median); per backend
+``fixedpoint`` ``walkerlab fixedpoint --force`` on the paper scene, whole       <= 1.0 s
+               process (median of runs, model code cache warm)
+``sweep``      fixed-point sweep over the slope, 2 worker processes             >= 50 pt/s
+``basin``      ``walkerlab basin --grid 200x200 --force``, paper walker,        <= 120 s
+               50 steps a cell at most, 2 workers, whole process
+``contact``    the contact walker's work-precision benchmark
+               (:func:`walkerlab.contact.bench.run_benchmark`)
+=============  ===============================================================  ==========
+
+The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
+Results are printed and written as JSON to ``OUT/<what>.json`` with the machine and its load
+noted (the machine may be shared: compare runs side by side, e.g. with ``farm-bench``).
 """
 
 from __future__ import annotations
@@ -11,55 +24,158 @@ from __future__ import annotations
 import json
 import os
 import platform
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
+BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact")
+
 
 def _machine() -> dict:
     return {"machine": platform.machine(), "processor": platform.processor(),
-            "cpus": os.cpu_count(), "python": platform.python_version()}
+            "cpus": os.cpu_count(), "python": platform.python_version(),
+            "loadavg_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
 
 
-def bench_ideal(repeats: int = 5) -> dict:
+def _paper_scene():
+    from walkerlab.cli import default_scene
+    from walkerlab.config import load_scene
+
+    return load_scene(default_scene())
+
+
+def bench_ideal(repeats: int = 7) -> dict:
+    """5 ideal strides at rtol 1e-10 per integrator backend, and the fixed-point search."""
     from walkerlab.analysis.hybrid import Solver, simulate_steps
     from walkerlab.analysis.poincare import find_fixed_point
-    from walkerlab.models.compass_gait import make_compass_gait
-    from walkerlab.models.derivation import compass_gait_functions
+    from walkerlab.models.registry import build_walker
 
+    scene = _paper_scene()
     t0 = time.perf_counter()
-    compass_gait_functions()
-    derive_s = time.perf_counter() - t0
-    w = make_compass_gait(1.0, 5.0, 10.0, 9.81, 0.5, 0.0174)
-    sv = Solver("DOP853", 1e-12, 1e-12)
-    fp_t, sim_t = [], []
-    for _ in range(repeats):
+    w = build_walker(scene)
+    build_s = time.perf_counter() - t0
+    guess = np.asarray(scene.fixedpoint.initial_guess.as_array(w.state_names())
+                       if _takes_names(scene) else scene.fixedpoint.initial_guess.as_array())
+    sv = Solver.from_settings(scene.solver)
+    fp = find_fixed_point(w, guess, sv)
+    out = {"build_walker_s": build_s}
+    for backend in ("cyrk", "scipy"):
+        s = Solver("DOP853", 1e-10, 1e-10, None, backend)
+        simulate_steps(w, fp.x, 10, s)  # warm (imports)
+        t, c = [], []
+        for _ in range(repeats):
+            t0, c0 = time.perf_counter(), time.process_time()
+            tr = simulate_steps(w, fp.x, 10, s)
+            t.append(time.perf_counter() - t0)
+            c.append(time.process_time() - c0)
+        out[f"simulate_5_strides_{backend}_median_s"] = float(np.median(t))
+        out[f"simulate_5_strides_{backend}_cpu_median_s"] = float(np.median(c))
+        out[f"simulate_5_strides_{backend}_nfev"] = tr.nfev
+    t = []
+    for _ in range(3):
         t0 = time.perf_counter()
-        fp = find_fixed_point(w, np.array([-0.2022, 0.1674, -0.60, -0.84]), sv)
-        fp_t.append(time.perf_counter() - t0)
+        fp = find_fixed_point(w, guess, sv)
+        t.append(time.perf_counter() - t0)
+    out.update({"fixedpoint_compute_median_s": float(np.median(t)), "fixedpoint_nfev": fp.nfev,
+                "fixedpoint_solver": f"{sv.method} rtol={sv.rtol:g} backend={sv.backend}",
+                "target_simulate_5_strides_s": 0.010})
+    return out
+
+
+def _takes_names(scene) -> bool:
+    import inspect
+
+    return bool(inspect.signature(scene.fixedpoint.initial_guess.as_array).parameters)
+
+
+def _cli(*args: str) -> list[str]:
+    return [sys.executable, "-m", "walkerlab.cli", *args]
+
+
+def _time_process(cmd: list[str], runs: int, cwd: Path | None = None) -> dict:
+    walls = []
+    for _ in range(runs):
         t0 = time.perf_counter()
-        tr = simulate_steps(w, fp.x, 10, sv)
-        sim_t.append(time.perf_counter() - t0)
-    return {"sympy_derivation_s": derive_s, "fixedpoint_median_s": float(np.median(fp_t)),
-            "fixedpoint_nfev": fp.nfev, "simulate_5_strides_median_s": float(np.median(sim_t)),
-            "simulate_5_strides_nfev": tr.nfev, "solver": "DOP853 rtol=atol=1e-12"}
+        subprocess.run(cmd, check=True, capture_output=True, cwd=cwd)
+        walls.append(time.perf_counter() - t0)
+    return {"wall_median_s": float(np.median(walls)), "wall_min_s": float(np.min(walls)),
+            "wall_max_s": float(np.max(walls)), "runs": runs}
+
+
+def bench_fixedpoint(runs: int = 5) -> dict:
+    """``walkerlab fixedpoint --force`` on the paper scene, whole process."""
+    with tempfile.TemporaryDirectory() as d:
+        cmd = _cli("fixedpoint", "--force", "--runs-dir", d)
+        subprocess.run(cmd, check=True, capture_output=True)  # warm the model code cache
+        return {**_time_process(cmd, runs), "command": " ".join(cmd[2:]), "target_s": 1.0}
+
+
+def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02") -> dict:
+    """Fixed-point sweep over the slope with ``workers`` local processes (points/s)."""
+    from walkerlab.stages.sweep import run
+    from walkerlab.sweep.store import load_sweep
+
+    scene = _paper_scene()
+    with tempfile.TemporaryDirectory() as d:
+        t0 = time.perf_counter()
+        p = run(scene, [f"slope.angle_deg={slopes}"], "fixedpoint", workers=workers,
+                runs_root=d, name="bench", progress=False)
+        wall = time.perf_counter() - t0
+        pts = load_sweep(p)["points"]
+        outcomes = pts["outcome"].astype(str)
+        n = int(outcomes.size)
+    kinds, counts = np.unique(outcomes, return_counts=True)
+    return {"points": n, "workers": workers, "wall_s": wall, "points_per_s": n / wall,
+            "outcomes": {str(k): int(c) for k, c in zip(kinds, counts)},
+            "note": "wall includes starting the process pool", "target_points_per_s": 50}
+
+
+def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
+    """``walkerlab basin --grid 200x200 --force`` on the paper scene, whole process."""
+    with tempfile.TemporaryDirectory() as d:
+        subprocess.run(_cli("fixedpoint", "--runs-dir", d), check=True, capture_output=True)
+        cmd = _cli("basin", "--grid", grid, "--workers", str(workers), "--force",
+                   "--runs-dir", d)
+        res = _time_process(cmd, 1)
+        from walkerlab.plotting.basin_figures import load_basin
+
+        b = load_basin(Path(d) / _paper_scene().name / "basin.h5")
+    out = b["outcome"]
+    return {**res, "grid": grid, "workers": workers, "target_s": 120.0,
+            "outcomes": {o: int(np.sum(out == i)) for i, o in enumerate(b["outcomes"])}}
 
 
 def run_bench(what: str, out: Path) -> list[str]:
-    """Run the named benchmarks; return printable lines."""
+    """Run the named benchmarks; return printable lines.
+
+    Raises
+    ------
+    ValueError
+        Unknown benchmark name.
+    """
     out.mkdir(parents=True, exist_ok=True)
     lines = []
-    todo = ["ideal", "contact"] if what == "all" else [what]
+    todo = ["ideal", "fixedpoint", "sweep", "contact"] if what == "all" else [what]
     for name in todo:
         if name == "ideal":
             res = bench_ideal()
+        elif name == "fixedpoint":
+            res = bench_fixedpoint()
+        elif name == "sweep":
+            res = bench_sweep()
+        elif name == "basin":
+            res = bench_basin()
         elif name == "contact":
             from walkerlab.contact.bench import run_benchmark
 
             res = run_benchmark()
         else:
-            raise ValueError(f"bench: unknown benchmark {name!r} (ideal | contact | all)")
+            raise ValueError(f"bench: unknown benchmark {name!r} "
+                             f"({' | '.join(BENCHMARKS)} | all)")
         res = {"benchmark": name, **_machine(), "result": res}
         (out / f"{name}.json").write_text(json.dumps(res, indent=1, default=str))
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")

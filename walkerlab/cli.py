@@ -1,10 +1,25 @@
 """Command-line interface (typer). Thin: parse arguments, call one stage, print a summary.
 
 Every command takes an optional scene path (default: ``configs/paper.yaml``).
+
+Errors and exit codes
+---------------------
+A traceback shown to a user is a bug.  Every command runs inside :func:`_guard`:
+
+- bad input (scene, names, paths, artifacts, a busy artifact, a read-only runs folder) and
+  a walker that falls (``simulate``, ``contact-sim``): one line ``error: ...`` on stderr,
+  exit code 1;
+- an unexpected exception: one line ``error: internal error (<type>): <message>`` and a hint
+  to rerun with ``WALKERLAB_DEBUG=1``, which shows the traceback instead; exit code 1;
+- Ctrl-C: ``interrupted``, exit code 130.
+
+typer's own usage errors (unknown option, a value out of an option's range) keep typer's
+message and exit code 2.
 """
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -39,8 +54,17 @@ def _fail(exc: Exception) -> None:
     raise typer.Exit(code=1)
 
 
+DEBUG_ENV = "WALKERLAB_DEBUG"
+
+
+def _one_line(text: str) -> str:
+    lines = [ln.strip() for ln in str(text).strip().splitlines() if ln.strip()]
+    return (lines[0] + (f" (+{len(lines) - 1} more lines)" if len(lines) > 1 else "")) \
+        if lines else ""
+
+
 def _guard(fn):
-    """Turn walkerlab's own errors into a one-line message and exit code 1."""
+    """Run a command so that every failure is one line on stderr and a non-zero exit code."""
     import functools
 
     @functools.wraps(fn)
@@ -48,13 +72,66 @@ def _guard(fn):
         from walkerlab.analysis.poincare import FixedPointNotFound
         from walkerlab.config import SceneError
         from walkerlab.io.artifacts import ArtifactError
+        from walkerlab.io.runpaths import ArtifactBusy
         from walkerlab.stages.common import StageError
 
+        debug = os.environ.get(DEBUG_ENV, "") not in ("", "0")
         try:
             return fn(*a, **k)
-        except (SceneError, ArtifactError, StageError, FixedPointNotFound, ValueError) as exc:
-            _fail(exc)
+        except (typer.Exit, typer.Abort, SystemExit):
+            raise
+        except KeyboardInterrupt:
+            typer.echo("interrupted", err=True)
+            raise typer.Exit(code=130) from None
+        except (SceneError, ArtifactError, ArtifactBusy, StageError, FixedPointNotFound,
+                ValueError) as exc:
+            if debug:
+                raise
+            typer.echo(f"error: {_one_line(exc)}", err=True)
+            raise typer.Exit(code=1) from None
+        except OSError as exc:  # read-only runs folder, disk full, ...
+            if debug:
+                raise
+            where = f"{exc.filename}: " if exc.filename else ""
+            typer.echo(f"error: {where}{exc.strerror or _one_line(exc)}", err=True)
+            raise typer.Exit(code=1) from None
+        except Exception as exc:  # noqa: BLE001 - a traceback shown to a user is a bug
+            if debug:
+                raise
+            typer.echo(f"error: internal error ({type(exc).__name__}): {_one_line(exc)} "
+                       f"[rerun with {DEBUG_ENV}=1 for the traceback]", err=True)
+            raise typer.Exit(code=1) from None
     return wrapper
+
+
+def _versions() -> str:
+    """walkerlab, Python and the numeric libraries' versions (for bug reports)."""
+    import platform
+    from importlib import metadata
+
+    import walkerlab
+
+    parts = [f"walkerlab {walkerlab.__version__}", f"python {platform.python_version()}"]
+    for dist in ("numpy", "scipy", "numba", "h5py", "pydantic", "matplotlib"):
+        try:
+            parts.append(f"{dist} {metadata.version(dist)}")
+        except metadata.PackageNotFoundError:
+            parts.append(f"{dist} not installed")
+    return ", ".join(parts) + f" ({platform.system()} {platform.machine()})"
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        typer.echo(_versions())
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(version: bool = typer.Option(False, "--version", callback=_version_callback,
+                                       is_eager=True,
+                                       help="print walkerlab, Python, numpy, scipy, numba "
+                                       "and h5py versions and exit")) -> None:
+    """walkerlab: passive-dynamic biped walkers, from fixed point to report."""
 
 
 def _status(o) -> str:
@@ -117,6 +194,14 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
     out = stage.run(sc, runs_dir, force, adjust=adjust, periodic=periodic)
     typer.echo(contact_text(out.path))
     typer.echo(_status(out))
+    from walkerlab.io.artifacts import open_artifact
+
+    with open_artifact(out.path, "contact-sim") as f:
+        term = str(f.attrs["termination"])
+        why = str(f.attrs.get("fall_reason", ""))
+    if term != "t_final":  # like simulate: a walker that does not finish the run exits 1
+        _fail(RuntimeError(f"the contact walker did not complete the run: {term}"
+                           + (f" ({why})" if why and why != "None" else "")))
 
 
 @app.command()
@@ -197,15 +282,48 @@ def bifurcation(scene: Path | None = SceneArg,
                                               help="steps discarded before sampling"),
                 keep: int = typer.Option(30, "--keep", min=1, help="heel strikes kept per slope"),
                 workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
-                runs_dir: Path = RunsOpt) -> None:
+                runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Bifurcation diagram over the slope: fixed points, multipliers, period-doubling onset."""
-    from walkerlab.sweep.bifurcation import run_bifurcation
+    from walkerlab.stages import bifurcation as stage
     from walkerlab.sweep.params import parse_param
 
     axis = parse_param(f"slope.angle_deg={slopes}")
-    out = run_bifurcation(_load(scene), axis.values, runs_dir, transient, keep, workers)
-    typer.echo(f"period-doubling onset: {out['onset_deg']:.4f} deg")
-    typer.echo(f"wrote {out['artifact']} and {', '.join(str(p) for p in out['figures'])}")
+    out = stage.run(_load(scene), axis.values, runs_dir, transient, keep, workers, force=force)
+    typer.echo(f"period-doubling onset: {out.summary['onset_deg']:.4f} deg")
+    typer.echo(_status(out))
+    typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
+
+
+@app.command()
+@_guard
+def basin(scene: Path | None = SceneArg,
+          grid: str | None = typer.Option(None, "--grid", help="cells NXxNY, e.g. 200x200 "
+                                          "(default: basin.grid of the scene, 200x200)"),
+          workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+          scheduler: str | None = typer.Option(None, "--scheduler",
+                                                help="Dask scheduler address (tcp://host:port)"),
+          resume: bool = typer.Option(True, "--resume/--no-resume",
+                                      help="continue an interrupted map with the same inputs"),
+          runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section."""
+    from walkerlab.stages import basin as stage
+
+    g = None
+    if grid is not None:
+        try:
+            nx, ny = (int(v) for v in grid.lower().split("x"))
+            if nx < 2 or ny < 2:
+                raise ValueError
+        except ValueError:
+            _fail(ValueError(f"--grid: expected NXxNY with NX, NY >= 2 (e.g. 200x200), "
+                             f"got {grid!r}"))
+        g = (nx, ny)
+    out = stage.run(_load(scene), runs_dir, force, grid=g, workers=workers,
+                    scheduler=scheduler, resume=resume)
+    if out.summary:
+        typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
+    typer.echo(_status(out))
+    typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir)}")
 
 
 @app.command("stability-map")
@@ -237,7 +355,9 @@ def stability_map(scene: Path | None = SceneArg,
 
 
 @app.command()
-def bench(what: str = typer.Argument("all", help="ideal | contact | all"),
+@_guard
+def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
+                                     " | all (all but basin)"),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
     from walkerlab.bench import run_bench

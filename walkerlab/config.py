@@ -15,11 +15,23 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import re
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Discriminator,
+    Field,
+    PrivateAttr,
+    Tag,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from walkerlab.contact.config import ContactSettings, ContactSimSettings, TerrainSettings
 
@@ -29,7 +41,26 @@ class SceneError(ValueError):
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    """Base of every config section: unknown keys rejected, frozen, strict finite numbers.
+
+    ``strict=True``: a bool is not a number (``leg_mass_kg: true`` is rejected, not read as
+    1 kg) and a string is not a number (``"5"``); a YAML int still validates as a float.
+    ``allow_inf_nan=False``: every float field must be finite (``.inf``/``.nan`` rejected)
+    unless a field says otherwise.  Nested sections still validate from plain mappings.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+
+
+def _list_to_tuple(v):
+    return tuple(v) if isinstance(v, list) else v
+
+
+# A fixed-length tuple given as a YAML list (strict mode alone would want a Python tuple).
+AsTuple = BeforeValidator(_list_to_tuple)
+
+# Caps that keep a run bounded (issue 12, D8): a bigger request is a one-line error.
+MAX_SIMULATE_STRIDES = 1000
 
 
 # --------------------------------------------------------------------------- walker
@@ -63,9 +94,136 @@ class CompassGaitParams(_Strict):
         return self.leg_length_m - self.leg_mass_from_foot_m
 
 
-# One walker model today; a kneed walker or a walker with a torso joins this union with a
-# discriminator on ``model`` (defaulting to "compass_gait" so existing scenes stay valid).
-WalkerParams = CompassGaitParams
+# ---- generic walker description (``model: biped``): bodies, joints, feet as data.
+# A kneed leg (``knee``) and round feet (``foot.kind: arc``) extend these classes.
+class PointMassBody(_Strict):
+    """A point mass on a leg link, at ``from_hip_m`` along the link from the hip."""
+
+    kind: Literal["point_mass"] = Field(description="body type")
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (points: swing_<name>)")
+    link: Literal["leg", "thigh", "shank"] = Field(
+        "leg", description="leg link carrying the body ('thigh'/'shank' need a knee)")
+    mass_kg: float = Field(ge=0, le=1e4, description="mass [kg]; 0 = the limit m/M -> 0, "
+                           "taken symbolically (Garcia et al. 1998), not a small number")
+    from_hip_m: float = Field(ge=0, le=100, description="distance from the hip along the link [m]")
+
+
+class RodBody(_Strict):
+    """A rigid rod on a leg link: mass, centre of mass along the link, inertia about the COM."""
+
+    kind: Literal["rod"] = Field(description="body type")
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (points: swing_<name>)")
+    link: Literal["leg", "thigh", "shank"] = Field(
+        "leg", description="leg link carrying the body ('thigh'/'shank' need a knee)")
+    mass_kg: float = Field(gt=0, le=1e4, description="mass [kg]")
+    com_from_hip_m: float = Field(ge=0, le=100, description="centre of mass from the hip [m]")
+    inertia_about_com_kg_m2: float = Field(ge=0, le=1e6, description="moment of inertia about "
+                                           "the centre of mass [kg m^2] (uniform rod: m l^2/12)")
+
+
+Body = Annotated[PointMassBody | RodBody, Field(discriminator="kind")]
+
+
+class PointFoot(_Strict):
+    """A point foot at the end of the leg (the contact point is fixed during stance)."""
+
+    kind: Literal["point"] = Field("point", description="foot shape")
+
+
+class ArcFoot(_Strict):
+    """A circular-arc foot of radius R centred on the leg axis at ``l - R`` from the hip; the
+    stance foot rolls without slip (McGeer 1990).  R = 0 is the point foot."""
+
+    kind: Literal["arc"] = Field(description="foot shape")
+    radius_m: float = Field(ge=0, le=100, description="arc radius R [m]")
+
+
+Foot = Annotated[PointFoot | ArcFoot, Field(discriminator="kind")]
+
+
+class KneeSpec(_Strict):
+    """A knee joint splitting the leg into thigh (hip to knee) and shank (knee to foot).
+
+    The stance knee stays straight.  The swing knee is free until it straightens against its
+    stop (knee strike: a plastic impact that locks it); it stays locked until heel strike and
+    unlocks when that leg leaves the ground (McGeer 1990 'Passive walking with knees')."""
+
+    thigh_length_m: float = Field(gt=0, le=100, description="hip to knee [m]")
+    lock: Literal["plastic"] = Field("plastic", description="knee strike: plastic impact, then "
+                                     "the knee stays locked until heel strike")
+
+
+class LegSpec(_Strict):
+    """One leg (both legs are identical): hip to foot, straight or with a knee."""
+
+    length_m: float = Field(gt=0, le=100, description="leg length l, hip to foot [m]")
+    bodies: list[Body] = Field(default_factory=list, description="bodies on the leg; distances "
+                               "from the hip along the straightened leg")
+    foot: Foot = Field(PointFoot(), description="foot shape")
+    knee: KneeSpec | None = Field(None, description="knee joint (null: straight leg)")
+
+    @model_validator(mode="after")
+    def _bodies_on_leg(self) -> LegSpec:
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names):
+            raise ValueError(f"walker.leg.bodies: duplicate body names {names}")
+        if "foot" in names or "hip" in names:
+            raise ValueError("walker.leg.bodies: 'foot' and 'hip' are reserved point names")
+        for b in self.bodies:
+            d = b.from_hip_m if b.kind == "point_mass" else b.com_from_hip_m
+            if d > self.length_m:
+                raise ValueError(f"walker.leg.bodies.{b.name}: lies beyond the foot "
+                                 f"({d} m > leg length {self.length_m} m)")
+            if self.knee is None and b.link != "leg":
+                raise ValueError(f"walker.leg.bodies.{b.name}: link {b.link!r} needs a knee")
+            if self.knee is not None:
+                lt = self.knee.thigh_length_m
+                if b.link == "leg" or b.mass_kg == 0:
+                    raise ValueError(f"walker.leg.bodies.{b.name}: with a knee, give every body "
+                                     "a massive 'thigh' or 'shank' link")
+                if (b.link == "thigh") != (d <= lt) and d != lt:
+                    raise ValueError(f"walker.leg.bodies.{b.name}: {d} m from the hip is not "
+                                     f"on the {b.link} (knee at {lt} m)")
+        if self.knee is not None and self.knee.thigh_length_m >= self.length_m:
+            raise ValueError("walker.leg.knee.thigh_length_m: the knee must lie above the foot")
+        if self.foot.kind == "arc" and self.foot.radius_m > self.length_m - (
+                self.knee.thigh_length_m if self.knee else 0.0):
+            raise ValueError("walker.leg.foot.radius_m: the arc's centre must lie on the "
+                             + ("shank" if self.knee else "leg"))
+        return self
+
+
+class BipedParams(_Strict):
+    """A planar passive biped described as data (``model: biped``); its equations of motion,
+    guards and impact are derived symbolically (:mod:`walkerlab.models.symbolic`)."""
+
+    model: Literal["biped"] = Field(description="generic biped description")
+    coordinates: Literal["absolute", "slope_relative"] = Field(
+        "absolute", description="'absolute': leg angles from the vertical (swing, stance; paper "
+        "Eq. 1); 'slope_relative': stance angle from the slope normal and hip angle between "
+        "the legs (Garcia et al. 1998)")
+    gravity_m_per_s2: float = Field(9.81, gt=0, le=100, description="gravity g [m/s^2]")
+    hip_mass_kg: float = Field(ge=0, le=1e4, description="hip point mass [kg]")
+    leg: LegSpec = Field(description="each leg (both are identical)")
+
+    @model_validator(mode="after")
+    def _has_mass(self) -> BipedParams:
+        if self.hip_mass_kg + sum(b.mass_kg for b in self.leg.bodies) <= 0:
+            raise ValueError("walker: the walker has no mass (hip_mass_kg and all bodies are 0)")
+        if self.coordinates != "absolute" and (self.leg.knee or self.leg.foot.kind != "point"):
+            raise ValueError("walker.coordinates: a knee or arc feet need 'absolute'")
+        return self
+
+
+# ``model`` is the discriminator; "compass_gait" is the paper's shorthand for a biped with a
+# hip mass and one point mass per leg (expanded by walkerlab.models.description).
+def _walker_tag(v: Any) -> str:
+    return (v.get("model", "compass_gait") if isinstance(v, dict)
+            else getattr(v, "model", "compass_gait"))
+
+
+WalkerParams = Annotated[Annotated[CompassGaitParams, Tag("compass_gait")]
+                         | Annotated[BipedParams, Tag("biped")], Discriminator(_walker_tag)]
 
 
 class SlopeSettings(_Strict):
@@ -112,26 +270,56 @@ class ContactSolverSettings(_Strict):
 
     method: Literal["odeint", "LSODA", "Radau", "BDF", "RK45", "DOP853"] = Field(
         "odeint", description="scipy.integrate.odeint or a solve_ivp method")
-    rtol: float = Field(1e-8, gt=0, lt=1, description="relative tolerance [-]")
+    rtol: float = Field(1e-8, ge=1e-13, lt=1,
+                        description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
+                        "cannot meet a tighter one in double precision)")
     atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
     max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
 
 
 class StateSpec(_Strict):
-    """A compass-gait state right after heel strike, by role (Eq. 1: swing, stance)."""
+    """A walker state right after heel strike, by state name with its unit:
+    ``<role>_angle_rad`` and ``<role>_rate_rad_per_s`` for each role of the walker (compass
+    gait, Eq. 1: ``swing_angle_rad, stance_angle_rad, swing_rate_rad_per_s,
+    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``)."""
 
-    swing_angle_rad: float = Field(description="theta_1, swing-leg angle from vertical [rad]")
-    stance_angle_rad: float = Field(description="theta_2, stance-leg angle from vertical [rad]")
-    swing_rate_rad_per_s: float = Field(description="dtheta_1 [rad/s]")
-    stance_rate_rad_per_s: float = Field(description="dtheta_2 [rad/s]")
+    model_config = ConfigDict(extra="allow", frozen=True)
 
-    def as_array(self):
+    @model_validator(mode="after")
+    def _named_finite(self) -> StateSpec:
+        import re
+
+        for k, v in (self.model_extra or {}).items():
+            if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
+                raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
+                                 "<role>_rate_rad_per_s)")
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ValueError(f"{k}: must be a finite number")  # as _Strict fields
+        if not self.model_extra:
+            raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
+        return self
+
+    def as_array(self, state_names: list[str] | None = None):
+        """State (2n,) in the order of ``state_names`` (a walker's ``state_names()``; default:
+        the compass gait's ``swing_angle, stance_angle, swing_rate, stance_rate``).
+
+        Raises
+        ------
+        ValueError
+            A state of the walker is missing, or a given name is not one of its states.
+        """
         import numpy as np
 
-        return np.array(
-            [self.swing_angle_rad, self.stance_angle_rad,
-             self.swing_rate_rad_per_s, self.stance_rate_rad_per_s]
-        )
+        names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
+        keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
+        given = dict(self.model_extra or {})
+        missing = [k for k in keys if k not in given]
+        extra = [k for k in given if k not in keys]
+        if missing or extra:
+            raise ValueError(f"state must give exactly {keys}" +
+                             (f"; missing {missing}" if missing else "") +
+                             (f"; unknown {extra}" if extra else ""))
+        return np.array([float(given[k]) for k in keys])
 
 
 class FixedPointSettings(_Strict):
@@ -146,7 +334,9 @@ class FixedPointSettings(_Strict):
 class SimulateSettings(_Strict):
     """Forward simulation of the rigid hybrid model."""
 
-    strides: int = Field(5, ge=1, le=10_000, description="number of strides (2 steps each)")
+    strides: int = Field(5, ge=1, le=MAX_SIMULATE_STRIDES,
+                         description="number of strides (2 steps each); at most 1000 "
+                         "(about 1 min at the paper's tolerances)")
     sample_rate_hz: float = Field(500.0, gt=0, le=1e6, description="dense output rate [Hz]")
     initial_state: Literal["fixed_point"] | StateSpec = Field(
         "fixed_point", description="'fixed_point' (from fixedpoint.h5) or an explicit state"
@@ -180,11 +370,48 @@ class WorkPrecisionSettings(_Strict):
                                           description="contact reference (odeint) rtol [-]")
 
 
+class BasinSettings(_Strict):
+    """Basin of attraction over a 2-D slice of the Poincaré section (Schwab & Wisse 2001).
+
+    Each cell is a state just after heel strike: the two axis coordinates come from the grid,
+    the coordinate fixed by the heel-strike surface from that constraint, the others from
+    the period-1 fixed point.  Axes are named by ``walker.state_names()``.
+    """
+
+    x_axis: str = Field("stance_angle", description="state name on the x axis")
+    y_axis: str = Field("stance_rate", description="state name on the y axis")
+    x_range: Annotated[tuple[float, float] | None, AsTuple] = Field(
+        None, description="x axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
+        "1.2 rad/s (rates)")
+    y_range: Annotated[tuple[float, float] | None, AsTuple] = Field(
+        None, description="y axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
+        "1.2 rad/s (rates)")
+    grid: Annotated[tuple[Annotated[int, Field(ge=2, le=4000)],
+                          Annotated[int, Field(ge=2, le=4000)]], AsTuple] = \
+        Field((200, 200), description="cells along x and y")
+    max_steps: int = Field(50, ge=1, le=10_000, description="steps simulated per cell at most")
+    converge_tol: float = Field(1e-4, gt=0, lt=1, description="a cell has converged to the "
+                                "period-1 gait once max|x - x*| < this [rad, rad/s]")
+    period_tol: float = Field(1e-6, gt=0, lt=1, description="x_k and x_{k-p} closer than this "
+                              "(p >= 2) = another periodic attractor [rad, rad/s]")
+    max_period: int = Field(8, ge=2, le=64, description="longest period looked for [steps]")
+    rtol: float = Field(1e-8, gt=0, lt=1, description="integrator relative tolerance [-]")
+    atol: float = Field(1e-8, gt=0, lt=1, description="integrator absolute tolerance")
+    max_step_time_s: float | None = Field(
+        None, gt=0, description="a step longer than this ends the cell as 'stalled' [s]; "
+        "null = fixedpoint.max_step_time_s")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
-    name: str | None = Field(None, description="run folder name; default: YAML file stem")
+    name: str | None = Field(None, description="run folder name (runs/<name>/); default: "
+                             "YAML file stem. Letters, digits and . _ + - only, no path "
+                             "separators, not starting with a dot", max_length=100)
     source: str | None = Field(None, description="citation of the parameter set")
+    published: str | None = Field(
+        None, description="walkerlab.published module whose printed numbers the report sets "
+        "next to ours (e.g. 'paper'); null: no published comparison")
     walker: WalkerParams
     slope: SlopeSettings
     ideal: IdealModelSettings = IdealModelSettings()
@@ -196,6 +423,33 @@ class Scene(_Strict):
     contact_sim: ContactSimSettings | None = None
     contact_solver: ContactSolverSettings | None = None
     workprecision: WorkPrecisionSettings | None = None
+    # Resolved path of the YAML file the scene was read from (None when built in code);
+    # not part of the scene's content: it decides which file owns runs/<name>/.
+    _origin: Path | None = PrivateAttr(None)
+
+    @property
+    def origin(self) -> Path | None:
+        """Resolved path of the scene file, or None for a scene built in code."""
+        return self._origin
+    basin: BasinSettings | None = None
+
+    @model_validator(mode="after")
+    def _published_exists(self) -> Scene:
+        if self.published is not None:
+            from walkerlab.published import available
+
+            if self.published not in available():
+                raise ValueError(f"published: no module walkerlab.published.{self.published} "
+                                 f"(available: {', '.join(available())})")
+        return self
+
+    @field_validator("name")
+    @classmethod
+    def _plain_name(cls, v: str | None) -> str | None:
+        if v is not None and not _NAME_RE.match(v):
+            raise ValueError(f"{v!r} is not a plain folder name: use letters, digits and "
+                             ". _ + - only (no path separators, not starting with a dot)")
+        return v
 
     def section_json(self, *names: str) -> str:
         """Canonical JSON of the named sections (for content hashes)."""
@@ -206,13 +460,40 @@ class Scene(_Strict):
         return hashlib.sha256(self.section_json(*names).encode()).hexdigest()
 
 
+_NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
+
+
+# discriminator tags of walker models and bodies: not part of a field's path
+_TAGS = {"compass_gait", "biped", "point_mass", "rod", "point", "arc"}
+
+
+def _loc_part(p) -> bool:
+    """Keep a location element that is a field name or index (not a union/type tag)."""
+    s = str(p)
+    if s.startswith(("function-after", "function-before", "literal[", "tuple[", "list[")):
+        return False
+    # union members appear as their class name (``StateSpec``) or a discriminator tag
+    return not (s[:1].isupper() and s.isidentifier()) and s not in _TAGS
+
+
 def _format_error(path: Path, err: ValidationError) -> str:
-    e = err.errors()[0]
-    tags = {"compass_gait"}  # discriminator tags of walker models: not part of the field path
-    loc = ".".join(str(p) for p in e["loc"]
-                   if not str(p).startswith("function-after") and str(p) not in tags)
+    errs = err.errors()
+    # a union (``'fixed_point' | StateSpec``) reports one error per member: prefer the one
+    # that went deepest into a mapping, it names the offending field
+    e = max(errs, key=lambda x: (len([p for p in x["loc"] if _loc_part(p)]),
+                                 x["type"] not in ("literal_error", "none_required")))
+    loc = ".".join(str(p) for p in e["loc"] if _loc_part(p))
     msg = e["msg"].removeprefix("Value error, ")
-    extra = f" (+{len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
+    if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
+            and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
+                              "string_type", "float_parsing", "int_parsing"):
+        msg += f" (got {e['input']!r})"
+    # other members of the same union are alternatives, not further errors
+    others = [x for x in errs if x is not e and
+              tuple(p for p in x["loc"] if _loc_part(p)) != tuple(p for p in e["loc"]
+                                                                  if _loc_part(p))[:len(
+                  [p for p in x["loc"] if _loc_part(p)])]]
+    extra = f" (+{len(others)} more)" if others else ""
     return f"{path}: {loc or '<scene>'}: {msg}{extra}"
 
 
@@ -236,18 +517,34 @@ def load_scene(path: str | Path) -> Scene:
         the file and the field).
     """
     path = Path(path)
+    if path.is_dir():
+        raise SceneError(f"{path}: is a directory, not a scene file")
     if not path.is_file():
         raise SceneError(f"{path}: scene file not found")
     try:
-        data = yaml.safe_load(path.read_text())
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not a text (UTF-8) YAML file (byte {exc.start} is "
+                         f"0x{exc.object[exc.start]:02x})") from None
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from None
+    try:
+        data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
         raise SceneError(f"{path}:{where} malformed YAML ({getattr(exc, 'problem', exc)})") from None
     if not isinstance(data, dict):
         raise SceneError(f"{path}: a scene must be a YAML mapping")
-    data.setdefault("name", path.stem)
-    return scene_from_dict(data, path)
+    if data.get("name") is None:
+        data["name"] = path.stem
+        if not _NAME_RE.match(path.stem):
+            raise SceneError(f"{path}: the file name gives the run-folder name {path.stem!r}, "
+                             "which is not allowed (letters, digits and . _ + - only, not "
+                             "starting with a dot); rename the file or set 'name:' in it")
+    scene = scene_from_dict(data, path)
+    scene._origin = path.resolve()
+    return scene
 
 
 def scene_from_dict(data: dict[str, Any], origin: str | Path = "<scene>") -> Scene:

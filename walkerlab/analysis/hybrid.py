@@ -1,9 +1,22 @@
-"""Integrate a :class:`~walkerlab.models.base.HybridWalker` step by step with scipy.
+"""Integrate a :class:`~walkerlab.models.base.HybridWalker` step by step.
 
 A trajectory is a list of :class:`Segment` (one per step), each with its termination reason
 (``heel_strike``, ``fall``, ``t_final``, ``solver_failure``) and the event time and state, as
-PyBaMM's solutions record why they stopped.  All integration is done by
-``scipy.integrate.solve_ivp``; the guards are its events.
+PyBaMM's solutions record why they stopped.
+
+Integrators come from libraries, chosen by :class:`Solver` ``backend``:
+
+- ``"scipy"``: ``scipy.integrate.solve_ivp`` (any of its methods); guards are its events.
+- ``"cyrk"``: ``CyRK.pysolve_ivp`` (Renaud, CyRK: the same explicit Runge-Kutta pairs as
+  scipy - RK23, RK45, DOP853 - with the adaptive stepping written in C++).  Guards are its
+  events, located like scipy's by Brent's method on the dense output (xtol = 4 eps).
+  On the compass gait it takes exactly scipy's steps (same time and state at heel strike to
+  round-off) 25-60 times faster: ``scripts/bench_integrators.py`` and the note of issue 10.
+- ``"auto"`` (default): ``cyrk`` for the methods it shares with scipy when it is installed,
+  else ``scipy``.
+
+Nothing here knows the walker's size: states are ``(2n,)`` arrays, guards and resets come
+from the walker's phases.
 """
 
 from __future__ import annotations
@@ -13,32 +26,209 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from walkerlab.models.base import HybridWalker, Phase
-from walkerlab.models.compass_gait import complex_step_jacobian
 
 Termination = Literal["heel_strike", "fall", "t_final", "solver_failure"]
+
+#: methods both backends implement with the same Runge-Kutta pair and step control
+CYRK_METHODS = ("RK23", "RK45", "DOP853")
+
+
+def complex_step_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
+    """Jacobian of an analytic function by the complex-step method (exact to round-off).
+
+    Squire & Trapp (1998), SIAM Review 40(1): ``df/dx_k = Im f(x + i h e_k) / h``.
+
+    Parameters
+    ----------
+    fun : callable ``(m,) -> (p,)``
+        Must accept complex input.
+    x : ndarray, shape (m,)
+
+    Returns
+    -------
+    ndarray, shape (p, m)
+    """
+    x = np.asarray(x, dtype=float)
+    cols = []
+    for k in range(x.size):
+        xc = x.astype(complex)
+        xc[k] += 1j * h
+        cols.append(np.imag(fun(xc)) / h)
+    return np.stack(cols, axis=1)
+
+
+def numeric_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
+    """Jacobian of ``fun`` at ``x``: complex step where ``fun`` takes complex input, else
+    central differences (step ``1e-6 (1 + |x_k|)``; for compiled functions of real input).
+
+    Returns
+    -------
+    ndarray, shape (p, m)
+    """
+    try:
+        return complex_step_jacobian(fun, x, h)
+    except (TypeError, ValueError):
+        x = np.asarray(x, dtype=float)
+        cols = []
+        for k in range(x.size):
+            e = np.zeros_like(x)
+            e[k] = 1e-6 * (1.0 + abs(x[k]))
+            cols.append((np.asarray(fun(x + e), float) - np.asarray(fun(x - e), float))
+                        / (2 * e[k]))
+        return np.stack(cols, axis=1)
+
+
+def _have_cyrk() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("CyRK") is not None
 
 
 @dataclass(frozen=True)
 class Solver:
-    """Integrator settings (mirrors :class:`walkerlab.config.SolverSettings`)."""
+    """Integrator settings (mirrors :class:`walkerlab.config.SolverSettings`).
+
+    Attributes
+    ----------
+    method : str
+        Runge-Kutta pair or implicit method name as in ``solve_ivp`` (``"DOP853"``, ...).
+    rtol, atol : float
+        Relative and absolute tolerance.
+    max_step_s : float or None
+        Largest step [s].
+    backend : {"auto", "scipy", "cyrk"}
+        Library that integrates (see the module docstring).
+    """
 
     method: str = "DOP853"
     rtol: float = 1e-10
     atol: float = 1e-10
     max_step_s: float | None = None
+    backend: str = "auto"
 
     @classmethod
     def from_settings(cls, s) -> Solver:
-        return cls(s.method, s.rtol, s.atol, s.max_step_s)
+        return cls(s.method, s.rtol, s.atol, s.max_step_s, getattr(s, "backend", "auto"))
 
     def kwargs(self) -> dict:
         kw = {"method": self.method, "rtol": self.rtol, "atol": self.atol}
         if self.max_step_s is not None:
             kw["max_step"] = self.max_step_s
         return kw
+
+    def resolved_backend(self) -> str:
+        """``"scipy"`` or ``"cyrk"``.
+
+        Raises
+        ------
+        ValueError
+            ``backend="cyrk"`` with a method CyRK does not share with scipy, or CyRK missing.
+        """
+        if self.backend == "scipy":
+            return "scipy"
+        ok = self.method in CYRK_METHODS
+        if self.backend == "cyrk":
+            if not ok:
+                raise ValueError(f"solver.backend: cyrk integrates {', '.join(CYRK_METHODS)}, "
+                                 f"not {self.method}")
+            if not _have_cyrk():
+                raise ValueError("solver.backend: cyrk is not installed (pip install CyRK)")
+            return "cyrk"
+        if self.backend != "auto":
+            raise ValueError(f"solver.backend: unknown backend {self.backend!r} "
+                             "(auto | scipy | cyrk)")
+        return "cyrk" if ok and _have_cyrk() else "scipy"
+
+
+@dataclass
+class _PhaseRun:
+    """What one phase's integration returned, whatever the backend."""
+
+    t_last: float          # time at the end (event time when a guard fired)
+    y_last: np.ndarray     # state at the end (event state when a guard fired)
+    failed: bool
+    message: str
+    event: int | None      # index of the guard that ended the phase
+    dense: object          # callable t -> (m,) or (m, k)
+    nfev: int
+
+
+class _CyDense:
+    """Dense output of a CyRK solution with scipy's ``OdeSolution`` calling convention."""
+
+    def __init__(self, res):
+        self._res = res
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        if t.ndim == 0:
+            return self._res.call(float(t))
+        return np.asarray(self._res.call_vectorize(np.ascontiguousarray(t))).reshape(-1, t.size)
+
+
+IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
+
+
+def _solve_phase(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
+                 solver: Solver, backend: str, jac=None) -> _PhaseRun:
+    """Integrate ``rhs`` from ``t0`` until the first guard (state rows ``:n``) fires or ``t1``.
+
+    ``jac`` (``(t, y) -> (m, m)``) is handed to scipy's implicit methods."""
+    evs = []
+    for gd in guards:
+        def ev(t, y, _g=gd.function):
+            return _g(t, y[:n])
+        ev.terminal = True
+        ev.direction = gd.direction
+        evs.append(ev)
+    y0 = np.ascontiguousarray(y0, dtype=float)
+    if backend == "cyrk":
+        from CyRK import pysolve_ivp
+
+        count = [0]
+
+        def counted(t, y):
+            count[0] += 1
+            return rhs(t, y)
+        res = pysolve_ivp(counted, (float(t0), float(t1)), y0, method=solver.method,
+                          dense_output=True, events=evs or None, rtol=solver.rtol,
+                          atol=solver.atol,
+                          max_step=solver.max_step_s if solver.max_step_s else np.inf)
+        t_events = res.t_events if evs else []
+        y_events = [np.asarray(ye).T for ye in res.y_events] if evs else []  # (k, m)
+        ts = res.t
+        failed = not res.success and not res.event_terminated
+        t_last = float(ts[-1]) if ts.size else float(t0)
+        y_last = res.y[:, -1] if ts.size else y0
+        msg, dense, nfev = res.message, _CyDense(res), count[0]
+    else:
+        from scipy.integrate import solve_ivp
+
+        kw = solver.kwargs()
+        if jac is not None and solver.method in IMPLICIT_METHODS:
+            kw["jac"] = jac
+        sol = solve_ivp(rhs, (t0, t1), y0, events=evs or None, dense_output=True, **kw)
+        t_events, y_events = (sol.t_events, sol.y_events) if evs else ([], [])
+        failed = sol.status == -1
+        t_last, y_last, msg = float(sol.t[-1]), sol.y[:, -1], sol.message
+        dense, nfev = sol.sol, sol.nfev
+    fired = [(te[0], i) for i, te in enumerate(t_events) if len(te)]
+    if fired and not failed:
+        te, i = min(fired)
+        return _PhaseRun(float(te), np.array(y_events[i][0], float), False, msg, i, dense, nfev)
+    return _PhaseRun(t_last, np.array(y_last, float), failed, msg, None, dense, nfev)
+
+
+def _phase_jacobian(walker: HybridWalker, phase: Phase):
+    """``(t, x) -> (2n, 2n)`` Jacobian of the phase's flow: the phase's own, the walker's,
+    or (last resort) a numerical one."""
+    if phase.jacobian is not None:
+        return phase.jacobian
+    if walker.variational is not None:
+        return walker.variational
+    return lambda t, x, _f=phase.flow: numeric_jacobian(lambda z: _f(t, z), x)
 
 
 @dataclass
@@ -110,19 +300,21 @@ class Segment:
         return out
 
 
-def _events_for(phase: Phase, n: int):
-    evs = []
-    for gd in phase.guards:
-        def ev(t, y, _g=gd.function):
-            return _g(t, y[:n])
-        ev.terminal = True
-        ev.direction = gd.direction
-        evs.append(ev)
-    return evs
+def _grad(guard, x):
+    """Gradient (2n,) of a guard function: the model's own, else numerical."""
+    gradient = getattr(guard, "gradient", None)
+    if gradient is not None:
+        return np.asarray(gradient(x), dtype=float)
+    return numeric_jacobian(lambda z: np.atleast_1d(guard.function(0.0, z)), x)[0]
 
 
-def _grad(fun, x):
-    return complex_step_jacobian(lambda z: np.atleast_1d(fun(0.0, z)), x)[0]
+def _saltation(f_prev: np.ndarray, f_next: np.ndarray, dg: np.ndarray,
+               DR: np.ndarray | None = None) -> np.ndarray:
+    """Saltation matrix ``DR + (f+ - DR f-) dg^T / (dg . f-)`` of a guard crossing with a
+    reset of Jacobian ``DR`` (identity when None); ``f-``/``f+`` are the flows before/after.
+    """
+    DR = np.eye(f_prev.size) if DR is None else DR
+    return DR + np.outer(f_next - DR @ f_prev, dg) / (dg @ f_prev)
 
 
 def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: float = 0.0,
@@ -144,14 +336,21 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     t_final : float, optional
         Absolute end time of the run [s].
     variational : bool
-        Also integrate the variational equations and apply saltation matrices; the
-        segment's ``monodromy`` is then the Jacobian of the Poincaré map (2n x 2n) at ``x0``
-        (including the reset), when the step ends in heel strike.
+        Also integrate the variational equations ``dPhi/dt = A(x) Phi`` (``A`` the analytic
+        Jacobian of the flow when the model gives one) and apply saltation matrices at the
+        guards; the segment's ``monodromy`` is then the Jacobian of the Poincaré map
+        (2n x 2n) at ``x0`` (including the reset), when the step ends in heel strike.
 
     Returns
     -------
     Segment
+
+    Raises
+    ------
+    ValueError
+        An unusable ``solver.backend`` (see :meth:`Solver.resolved_backend`).
     """
+    backend = solver.resolved_backend()
     n = x0.size
     t_stop = t0 + max_step_time
     if t_final is not None:
@@ -166,55 +365,62 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     x_next = None
     for k, phase in enumerate(walker.phases):
         if variational:
-            def rhs(tt, y, _f=phase.flow):
+            jac = _phase_jacobian(walker, phase)
+
+            def rhs(tt, y, _f=phase.flow, _A=jac):
                 xs = y[:n]
-                P = y[n:].reshape(n, n)
-                A = walker.variational(tt, xs)
-                return np.concatenate([_f(tt, xs), (A @ P).ravel()])
+                out = np.empty(n + n * n)
+                out[:n] = _f(tt, xs)
+                out[n:] = (_A(tt, xs) @ y[n:].reshape(n, n)).ravel()
+                return out
             y0 = np.concatenate([x, Phi.ravel()])
         else:
             rhs = phase.flow
             y0 = x
         if t >= t_stop:
             break
-        sol = solve_ivp(rhs, (t, t_stop), y0, events=_events_for(phase, n),
-                        dense_output=True, **solver.kwargs())
-        nfev += sol.nfev
-        message = sol.message
-        pieces.append((phase, sol.sol, (t, float(sol.t[-1]))))
-        if sol.status == -1:
-            termination, t, x = "solver_failure", float(sol.t[-1]), sol.y[:n, -1]
+        # the model's analytic Jacobian for scipy's implicit methods (not a numerical one:
+        # those methods approximate it themselves)
+        jac = (None if variational else phase.jacobian if phase.jacobian is not None
+               else walker.variational)
+        run = _solve_phase(rhs, t, t_stop, y0, phase.guards, n, solver, backend, jac)
+        nfev += run.nfev
+        message = run.message
+        pieces.append((phase, run.dense, (t, run.t_last)))
+        t, x = run.t_last, run.y_last[:n].copy()
+        if run.failed:
+            termination = "solver_failure"
             break
-        fired = [(te[0], i) for i, te in enumerate(sol.t_events) if len(te)]
-        if not fired:
-            t, x = float(sol.t[-1]), sol.y[:n, -1]
+        if run.event is None:
             termination = "t_final"
             break
-        te, i = min(fired)
-        guard = phase.guards[i]
-        y_ev = sol.y_events[i][0]
-        t, x = float(te), y_ev[:n].copy()
+        guard = phase.guards[run.event]
         if variational:
-            Phi = y_ev[n:].reshape(n, n)
+            Phi = run.y_last[n:].reshape(n, n)
         event = guard.name
         if guard.outcome == "next_phase":
             phase_times[guard.name] = t
+            x_minus = x
+            g_reset = getattr(guard, "reset", None)
+            if g_reset is not None:  # intra-step impact (e.g. knee strike)
+                x = np.asarray(g_reset(x_minus), dtype=float)
             if k + 1 < len(walker.phases) and variational:
                 nxt = walker.phases[k + 1]
-                f_prev, f_next = phase.flow(t, x), nxt.flow(t, x)
-                dg = _grad(guard.function, x)
-                Phi = (np.eye(n) + np.outer(f_next - f_prev, dg) / (dg @ f_prev)) @ Phi
+                DR = None if g_reset is None else np.asarray(guard.reset_jacobian(x_minus))
+                Phi = _saltation(np.asarray(phase.flow(t, x_minus)), np.asarray(nxt.flow(t, x)),
+                                 _grad(guard, x_minus), DR) @ Phi
             continue
         if guard.outcome == "fall":
             termination = "fall"
             break
         termination = "heel_strike"
-        x_next = walker.reset(x)
+        x_next = np.asarray(walker.reset(x), dtype=float)
         if variational:
-            f_prev = phase.flow(t, x)
-            dg = _grad(guard.function, x)
-            S = np.eye(n) - np.outer(f_prev, dg) / (dg @ f_prev)
-            Phi = walker.reset_jacobian(x) @ S @ Phi
+            f_prev = np.asarray(phase.flow(t, x))
+            S = _saltation(f_prev, np.zeros_like(f_prev), _grad(guard, x))
+            RJ = (walker.reset_jacobian(x) if walker.reset_jacobian is not None
+                  else numeric_jacobian(walker.reset, x))
+            Phi = RJ @ S @ Phi
         break
     return Segment(
         index=index, stance_leg=stance_leg, t_start=t0, t_end=t, x_start=np.asarray(x0, float),

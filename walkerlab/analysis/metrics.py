@@ -15,46 +15,76 @@ def _leg_point_name(name: str, roles_to_legs: dict[str, str]) -> str:
     return name
 
 
+def total_mass_kg(walker) -> float:
+    """Total mass [kg] of a walker, from its parameters (never recomputed from parts)."""
+    if "total_mass_kg" in walker.params:
+        return float(walker.params["total_mass_kg"])
+    return float(walker.total_mass_kg)
+
+
+def _phase_of(seg, times: np.ndarray) -> np.ndarray:
+    """Index of the phase (piece of the segment) each sample time falls in, as
+    :meth:`Segment.sample` assigns it (a boundary time belongs to the earlier phase)."""
+    idx = np.full(times.size, -1, dtype=int)
+    for j, (_ph, _sol, (_ta, tb)) in enumerate(seg.pieces):
+        last = j == len(seg.pieces) - 1
+        idx[(idx < 0) & ((times <= tb) | last)] = j
+    return idx
+
+
 def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory:
     """Dense samples at ``rate_hz`` plus each step's end (pre-impact) state.
 
-    Potential energy is measured from the first stance foot's height, so the total
-    mechanical energy is constant in swing and drops at each heel strike.
+    Coordinates are named by the walker (:meth:`HybridWalker.leg_coordinates`), so any
+    walker's trajectory has the same keys on every step.  Potential energy is measured from
+    the first stance foot's height, so the total mechanical energy is constant in swing and
+    drops at each heel strike.
+
+    Parameters
+    ----------
+    traj : HybridTrajectory
+    rate_hz : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    NamedTrajectory
     """
     w = traj.walker
-    n = w.n_coordinates
     legs = list(w.legs)
-    chunks = {k: [] for k in ("t", "stance", "step", "ke", "pe")}
-    ang = {leg: [] for leg in legs}
-    rat = {leg: [] for leg in legs}
+    units = dict(w.coordinate_units)
+    chunks = {k: [] for k in ("t", "stance", "step", "ke", "pe", "phase")}
+    coords: dict[str, list] = {name: [] for name in units}
     pts: dict[str, list] = {}
-    g = w.params.get("gravity_m_per_s2", 9.81)
+    g = w.params["gravity_m_per_s2"]
+    mass = total_mass_kg(w)
     for seg in traj.segments:
         dt = 1.0 / rate_hz
         times = np.arange(seg.t_start, seg.t_end, dt)
         times = np.append(times, seg.t_end)
         X = seg.sample(times)
         r2l = w.role_to_leg(seg.stance_leg)
-        for i, role in enumerate(w.roles):
-            ang[r2l[role]].append(X[i])
-            rat[r2l[role]].append(X[n + i])
+        for name, v in w.leg_coordinates(X, seg.stance_leg).items():
+            coords[name].append(v)
         ke, pe = w.energies(X)
-        pe = pe + w.total_mass_kg * g * seg.stance_foot_world[1]
+        pe = pe + mass * g * seg.stance_foot_world[1]
         chunks["t"].append(times)
         chunks["ke"].append(np.broadcast_to(ke, times.shape))
         chunks["pe"].append(np.broadcast_to(pe, times.shape))
         chunks["stance"].append(np.full(times.size, legs.index(seg.stance_leg)))
         chunks["step"].append(np.full(times.size, seg.index))
+        chunks["phase"].append(_phase_of(seg, times))
         for name, xy in w.points(X).items():
             key = _leg_point_name(name, r2l)
             pts.setdefault(key, []).append(np.asarray(xy) + seg.stance_foot_world[:, None])
     cat = np.concatenate
     return NamedTrajectory(
         time=cat(chunks["t"]), legs=legs,
-        angle={k: cat(v) for k, v in ang.items()}, rate={k: cat(v) for k, v in rat.items()},
+        coordinates={k: cat(v) for k, v in coords.items()}, units=units,
         stance_leg=cat(chunks["stance"]), step_index=cat(chunks["step"]),
         kinetic=cat(chunks["ke"]), potential=cat(chunks["pe"]),
         points={k: np.hstack(v) for k, v in pts.items()},
+        phase=cat(chunks["phase"]), phase_names=[p.name for p in w.phases],
     )
 
 

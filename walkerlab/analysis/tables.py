@@ -1,4 +1,7 @@
-"""Paper Tables 2 and 3, recomputed from artifacts (never typed in), beside the published values."""
+"""Paper Table 3 quantities, recomputed from trajectory artifacts (never typed in).
+
+The published values live in :mod:`walkerlab.published.paper`; this module only computes.
+"""
 
 from __future__ import annotations
 
@@ -9,21 +12,6 @@ import numpy as np
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.trajectory import NamedTrajectory, read_samples
 
-# Published values, paper Table 3 (MATLAB, MSC ADAMS) and Table 2.
-PAPER_TABLE3 = {
-    "t_left_s": (0.60, 0.59),
-    "t_right_s": (0.79, 0.77),
-    "t_cycle_s": (1.39, 1.38),
-    "v_com_m_per_s": (0.0246, 0.0248),
-    "E_avg_J": (150.13, 150.14),
-}
-PAPER_DELTA_X_M = 0.0342  # "the length of the robot's step is constant and equal to 0.0342 m"
-PAPER_TABLE2 = {  # MATLAB, MSC ADAMS
-    "theta1_rad": (-0.2022, -0.2021),
-    "theta2_rad": (0.1674, 0.1670),
-    "dtheta1_rad_per_s": (-0.60, -1.02),
-    "dtheta2_rad_per_s": (-0.84, -3.20),
-}
 TABLE3_ROWS = {
     "t_left_s": ("Left step period", "t_left", "s"),
     "t_right_s": ("Right step period", "t_right", "s"),

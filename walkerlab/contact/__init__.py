@@ -1,36 +1,26 @@
-"""Compliant-contact (MSC ADAMS-style) compass-gait walker: laws, model, simulation."""
+"""Compliant-contact (MSC ADAMS-style) compass-gait walker: laws, model, simulation.
 
-from .config import ContactParamsSI, ContactSettings, ContactSimSettings, TerrainSettings
-from .laws import (
-                   adams_step,
-                   adams_step_derivative,
-                   coulomb_friction_coefficient,
-                   impact_normal_force,
-)
-from .model import FOOT_NAMES, ContactWalker, checkerboard_lanes
-from .simulate import (
-                   ContactResult,
-                   FootTrace,
-                   StepSummary,
-                   initial_state_from_ideal,
-                   simulate_contact,
-)
+The names below are loaded on first use (PEP 562 ``__getattr__``): ``import
+walkerlab.contact.config`` (what :mod:`walkerlab.config` needs) must not load numba or
+scipy.integrate, which the model and the simulation need.
+"""
 
-__all__ = [
-                   "FOOT_NAMES",
-                   "ContactParamsSI",
-                   "ContactResult",
-                   "ContactSettings",
-                   "ContactSimSettings",
-                   "ContactWalker",
-                   "FootTrace",
-                   "StepSummary",
-                   "TerrainSettings",
-                   "adams_step",
-                   "adams_step_derivative",
-                   "checkerboard_lanes",
-                   "coulomb_friction_coefficient",
-                   "impact_normal_force",
-                   "initial_state_from_ideal",
-                   "simulate_contact",
-]
+from importlib import import_module
+
+_WHERE = {
+    "ContactParamsSI": "config", "ContactSettings": "config", "ContactSimSettings": "config",
+    "TerrainSettings": "config",
+    "adams_step": "laws", "adams_step_derivative": "laws",
+    "coulomb_friction_coefficient": "laws", "impact_normal_force": "laws",
+    "FOOT_NAMES": "model", "ContactWalker": "model", "checkerboard_lanes": "model",
+    "ContactResult": "simulate", "FootTrace": "simulate", "StepSummary": "simulate",
+    "initial_state_from_ideal": "simulate", "simulate_contact": "simulate",
+}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        return getattr(import_module(f"{__name__}.{_WHERE[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -8,9 +8,9 @@ explicitly to SI (NOTES.md: "a wrong unit here changes the answer by 10^6").
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 __all__ = ["ContactParamsSI", "ContactSettings", "ContactSimSettings", "TerrainSettings",
            "family_scaling"]
@@ -46,6 +46,18 @@ class ContactParamsSI:
     v_d: float
 
 
+# Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
+# a YAML int still validates as a float.  Same rules as walkerlab.config._Strict.
+_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+
+# Longest contact run (D8): 100 strides is ~20x the paper's 5 and keeps the artifact < 100 MB.
+MAX_CONTACT_STRIDES = 100
+
+
+def _list_to_tuple(v):
+    return tuple(v) if isinstance(v, list) else v
+
+
 def family_scaling(cmax: float, dmax: float, e: float, kappa: float) -> tuple[float, float]:
     """Damping and damping-ramp depth of the 'rigid_limit' stiffness family.
 
@@ -78,13 +90,13 @@ class ContactSettings(BaseModel):
     ADAMS's default mm-kg-s units, with the ADAMS View defaults for the rest (NOTES.md).
     """
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = _STRICT
 
     unit_system: Literal["mm-kg-s", "SI"] = Field(
         "mm-kg-s", description="Unit system of the numbers below: 'mm-kg-s' (ADAMS default) or 'SI'."
     )
     stiffness: float = Field(
-        1e5, gt=0, description="IMPACT stiffness k.",
+        1e5, gt=0, le=1e12, description="IMPACT stiffness k (at most 1e12).",
         json_schema_extra={"unit": "N/<len>^e"},
     )
     exponent: float = Field(
@@ -173,7 +185,7 @@ class TerrainSettings(BaseModel):
     the lane there is no ground (a gap), so the swing foot is not scuffed at mid-stance.
     """
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = _STRICT
 
     kind: Literal["checkerboard", "continuous"] = Field(
         "checkerboard", description="'checkerboard' (per-leg patches at footfalls) or 'continuous'."
@@ -186,11 +198,13 @@ class TerrainSettings(BaseModel):
 class ContactSimSettings(BaseModel):
     """Run settings of a contact simulation."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = _STRICT
 
-    n_strides: int = Field(5, ge=1, description="Strides (2 steps each) to simulate [-].")
+    n_strides: int = Field(5, ge=1, le=MAX_CONTACT_STRIDES,
+                           description="Strides (2 steps each) to simulate [-]; at most 100.")
     t_final_s: float | None = Field(
-        None, gt=0, description="Simulated time [s]; default n_strides * 2 * ideal step period."
+        None, gt=0, le=600, description="Simulated time [s] (at most 600); default "
+        "n_strides * 2 * ideal step period."
     )
     pin_stance_until: Literal["none", "first_touchdown", "time"] = Field(
         "none", description="Hold the first stance foot fixed until this moment."
@@ -199,12 +213,12 @@ class ContactSimSettings(BaseModel):
     fall_hip_height_m: float | None = Field(
         None, gt=0, description="Fall when hip height above ground < this [m]; default 0.5*L."
     )
-    sample_rate_hz: float = Field(1000.0, gt=0, description="Output sample rate [Hz].")
+    sample_rate_hz: float = Field(1000.0, gt=0, le=1e5, description="Output sample rate [Hz].")
     periodic_gait: bool = Field(
         False, description="Also find the contact walker's own periodic gait and its Floquet "
         "multipliers (walkerlab.contact.periodic; about 5-10 s)."
     )
-    initial_rate_scale: tuple[float, float] = Field(
+    initial_rate_scale: Annotated[tuple[float, float], BeforeValidator(_list_to_tuple)] = Field(
         (1.0, 1.0), description="Multipliers [-] on dtheta1, dtheta2 of the initial state."
     )
     wall_time_limit_s: float | None = Field(

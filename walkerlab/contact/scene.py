@@ -139,7 +139,10 @@ def named_trajectory(walker: ContactWalker, res, legs=("leg1", "leg2")):
         th = col[f"theta{i + 1}"]
         pts[f"{leg}_foot"] = feet[:, i, :].T
         pts[f"{leg}_mass"] = hip + walker.b * np.vstack([np.sin(th), -np.cos(th)])
+    coords, units = {}, {}
+    for i, leg in enumerate(legs):
+        coords[f"{leg}_angle"], units[f"{leg}_angle"] = col[f"theta{i + 1}"], "rad"
+        coords[f"{leg}_rate"], units[f"{leg}_rate"] = col[f"dtheta{i + 1}"], "rad/s"
     return NamedTrajectory(
-        time=t, legs=legs, angle={leg: col[f"theta{i + 1}"] for i, leg in enumerate(legs)},
-        rate={leg: col[f"dtheta{i + 1}"] for i, leg in enumerate(legs)}, stance_leg=stance,
+        time=t, legs=legs, coordinates=coords, units=units, stance_leg=stance,
         step_index=step, kinetic=en["kinetic"], potential=en["potential"], points=pts)

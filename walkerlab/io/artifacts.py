@@ -8,7 +8,13 @@ Layout conventions
 - Every dataset has ``unit`` and ``description`` attributes; time series are 1-D along
   ``time``; state is addressed by *name* (``samples/angle/leg1``), never by row number.
 - Files are written to a temporary name in the same folder and renamed, so a crash never
-  leaves a half-written artifact and never overwrites a good one.
+  leaves a half-written artifact and never overwrites a good one (:func:`atomic_write` does
+  the same for figures, reports and JSON).  Every output file is mode 0644.
+- ``content_hash`` (root attribute): SHA-256 over every dataset and attribute of the file
+  except ``content_hash``, ``created_utc`` and ``wall_time_s``.  A stage reuses its artifact
+  only if the stored hash still matches the content, and the cache key of a downstream stage
+  includes its upstream artifacts' *recomputed* content hashes, so an artifact edited by
+  hand (h5py) is detected, never trusted.
 """
 
 from __future__ import annotations
@@ -27,10 +33,113 @@ import h5py
 import numpy as np
 
 import walkerlab
+from walkerlab.io import netcdf
 
 
 class ArtifactError(RuntimeError):
     """An artifact is missing, unreadable, of another stage or of another walkerlab version."""
+
+
+FILE_MODE = 0o644
+_VOLATILE_ATTRS = ("content_hash", "created_utc", "wall_time_s")
+
+
+def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
+    """Write ``path`` atomically: ``write(binary file object)`` fills a temporary file in the
+    same folder, which is then renamed over ``path`` (a crash leaves the old file or none,
+    never a truncated one).
+
+    Raises
+    ------
+    ArtifactError
+        The folder cannot be created or written (one line).
+    """
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise ArtifactError(f"{path.parent}: cannot write there ({exc.strerror})") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise ArtifactError(f"{path}: cannot write ({exc.strerror})") from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+# HDF5 dimension-scale bookkeeping (netCDF-4 conventions): object references whose printed
+# form depends on the open file handle, not on the content; the scales themselves are hashed.
+_REFERENCE_ATTRS = frozenset({"DIMENSION_LIST", "REFERENCE_LIST"})
+
+
+def _hash_value(h, v) -> None:
+    if isinstance(v, h5py.Empty):
+        h.update(b"<empty>")
+        return
+    a = np.asarray(v)
+    if a.dtype.kind in "OSU":
+        h.update(repr([x.decode() if isinstance(x, bytes) else x
+                       for x in np.ravel(a).tolist()]).encode())
+        h.update(repr(a.shape).encode())
+    else:
+        h.update(a.dtype.str.encode() + repr(a.shape).encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+
+
+def content_hash_of(f: h5py.File) -> str:
+    """SHA-256 of an open file's datasets and attributes (volatile root attributes excluded)."""
+    h = hashlib.sha256()
+    names: list[str] = []
+    f.visit(names.append)
+    for key in sorted(f.attrs):
+        if key not in _VOLATILE_ATTRS:
+            h.update(f"@/{key}".encode())
+            _hash_value(h, f.attrs[key])
+    for name in sorted(names):
+        obj = f[name]
+        h.update(f"/{name}".encode())
+        if isinstance(obj, h5py.Dataset):
+            _hash_value(h, obj[()])
+        for key in sorted(obj.attrs):
+            if key in _REFERENCE_ATTRS:
+                continue
+            h.update(f"@{key}".encode())
+            _hash_value(h, obj.attrs[key])
+    return h.hexdigest()
+
+
+def content_hash(path: Path) -> str | None:
+    """Recomputed content hash of an artifact, or None when it is absent or unreadable."""
+    try:
+        with h5py.File(path, "r") as f:
+            return content_hash_of(f)
+    except (OSError, KeyError, ValueError):
+        return None
+
+
+def verified_hash(path: Path) -> str | None:
+    """``input_hash`` of an artifact whose content still matches its stored content hash.
+
+    None when the file is absent, unreadable, of another walkerlab version, or was modified
+    after it was written (edited with h5py, truncated, ...).
+    """
+    try:
+        with h5py.File(path, "r") as f:
+            if f.attrs.get("walkerlab_version") != walkerlab.__version__:
+                return None
+            stored = f.attrs.get("content_hash")
+            if stored is None or str(stored) != content_hash_of(f):
+                return None
+            return str(f.attrs.get("input_hash"))
+    except (OSError, KeyError, ValueError):
+        return None
 
 
 @lru_cache(maxsize=1)
@@ -45,10 +154,12 @@ def code_hash() -> str:
 
 
 def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "",
-        **attrs) -> h5py.Dataset:
+        dims: tuple[str | None, ...] | None = None, **attrs) -> h5py.Dataset:
     """Create dataset ``name`` (intermediate groups allowed) with unit and description.
 
-    Strings and lists of strings are stored as UTF-8 variable-length strings.
+    Strings and lists of strings are stored as UTF-8 variable-length strings.  ``dims``
+    names the dimension of each axis (netCDF-4 dimension scales, see
+    :mod:`walkerlab.io.netcdf`); ``units`` and ``long_name`` are added for netCDF readers.
     """
     if isinstance(data, str) or (isinstance(data, (list, tuple)) and data
                                  and isinstance(data[0], str)):
@@ -56,8 +167,12 @@ def put(group: h5py.Group, name: str, data, unit: str = "", description: str = "
     ds = group.create_dataset(name, data=data)
     ds.attrs["unit"] = unit
     ds.attrs["description"] = description
+    ds.attrs["units"] = netcdf.cf_units(unit)
+    ds.attrs["long_name"] = description or name.rsplit("/", 1)[-1]
     for k, v in attrs.items():
         ds.attrs[k] = v
+    if dims is not None:
+        netcdf.attach(ds, dims)
     return ds
 
 
@@ -100,9 +215,10 @@ def write_artifact(path: Path, stage: str, scene, input_hash: str,
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".h5.tmp", dir=path.parent)
     except OSError as exc:
-        raise ArtifactError(f"{path.parent}: cannot create run folder ({exc.strerror})") from None
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".h5.tmp", dir=path.parent)
+        raise ArtifactError(f"{path.parent}: cannot write the run folder ({exc.strerror})") \
+            from None
     os.close(fd)
     try:
         with h5py.File(tmp, "w") as f:
@@ -116,7 +232,15 @@ def write_artifact(path: Path, stage: str, scene, input_hash: str,
             for k, v in (extra_attrs or {}).items():
                 f.attrs[k] = v
             writer(f)
+            netcdf.finish(f)
+            f.attrs["content_hash"] = content_hash_of(f)
+        os.chmod(tmp, FILE_MODE)
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, (PermissionError, FileNotFoundError)) or exc.errno is not None:
+            raise ArtifactError(f"{path}: cannot write ({exc.strerror or exc})") from None
+        raise
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
@@ -150,7 +274,14 @@ def open_artifact(path: Path, stage: str | None = None,
         if check_version and ver != walkerlab.__version__:
             raise ArtifactError(f"{path}: written by walkerlab {ver}, this is "
                                 f"{walkerlab.__version__}; rerun the stage to refresh it")
-        yield f
+        try:
+            yield f
+        except KeyError as exc:  # a dataset or attribute the reader needs is missing
+            what = str(exc.args[0]) if exc.args else "?"
+            if "(" in what and what.endswith(")"):  # h5py: "Unable to ... (object 'x' ...)"
+                what = what[what.rindex("(") + 1:-1]
+            raise ArtifactError(f"{path}: {what} (the artifact is damaged or lacks what "
+                                "this reader needs); rerun its stage with --force") from None
     finally:
         f.close()
 

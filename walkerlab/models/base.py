@@ -1,11 +1,46 @@
-"""The data structure every rigid hybrid walker model fills in.
+"""The data structure every rigid hybrid walker model fills in - the contract downstream code
+relies on.
 
 A step of a hybrid walker is a sequence of continuous *phases* (compass gait: early swing
 until the swing leg passes the stance leg, then late swing until heel strike; a kneed
-walker would add a knee-locked phase).  Each phase has a flow ``f(t, x)`` and named guards;
-a guard either moves to the next phase, ends the step with the reset map (heel strike), or
-ends the run (fall).  The analysis layer (:mod:`walkerlab.analysis.hybrid`) integrates any
-model described this way.
+walker adds a knee-locked phase).  Each phase has a flow ``f(t, x)`` and named guards;
+a guard either moves to the next phase (optionally through its own reset map, e.g. a knee
+strike), ends the step with the reset map (heel strike), or ends the run (fall).  The analysis
+layer (:mod:`walkerlab.analysis.hybrid`) integrates any model described this way.
+
+Contract of :class:`HybridWalker` (nothing outside the model layer may assume more)
+-------------------------------------------------------------------------------------
+``roles``
+    Role-ordered generalised coordinates, prefixed ``swing``/``stance`` where they belong to
+    a leg: ``("swing", "stance")`` for the compass gait, ``("stance", "hip")`` for the
+    simplest walker (``hip`` = angle between the legs), e.g. ``("stance", "swing_thigh",
+    "swing_shank")`` for a kneed walker.  ``n = len(roles)``; the state is ``x = [n angles,
+    n rates]`` and its dimension is the same in every phase of a step (a locked knee is a
+    constraint on the same coordinates, not fewer states).
+``state_names()``, ``state_units()``
+    2n names (``<role>_angle``, ``<role>_rate``) and units (``rad``, ``rad/s``).
+``legs``, ``role_to_leg(stance_leg)``
+    Physical legs ``("leg1", "leg2")`` (``leg1`` starts as the swing leg, paper Eq. 11) and
+    the map ``{"stance": leg, "swing": other leg}`` for a step with ``stance_leg`` in stance.
+``leg_coordinates(X, stance_leg)`` and ``coordinate_units``
+    Physical, step-independent named series with the SAME keys on every step:
+    ``leg1_angle, leg2_angle, leg1_rate, leg2_rate`` (absolute leg angles from the vertical,
+    positive when the foot is ahead of the hip, and their rates) for every biped here, whatever
+    its state coordinates.  ``X`` is (2n,) or (2n, k); values are () or (k,).
+``points(X)``
+    Positions [m] relative to the step's stance reference point (the stance foot for point
+    feet), world axes (x horizontal downhill, y up); keys include ``hip``, ``stance_foot``,
+    ``swing_foot``; role-prefixed names (``swing_mass``, ...) are mapped to legs by prefix.
+    ``points(x_end)["swing_foot"]`` is the world offset of the next step's reference point.
+``energies(X)``
+    ``(kinetic, potential)`` [J]; potential relative to the reference point's height.
+``params``
+    Includes ``gravity_m_per_s2``, ``leg_length_m``, ``total_mass_kg``, ``slope_rad``.
+``section(x)`` / ``from_section(z)``, ``reset``, ``reset_jacobian``, ``variational``,
+``heel_strike_guard``
+    Poincaré-section coordinates (state minus the coordinate fixed by the heel-strike
+    surface) and its inverse; heel-strike map incl. the role swap and its Jacobian (2n, 2n);
+    flow Jacobian ``(t, x) -> (2n, 2n)``; the heel-strike guard function.
 """
 
 from __future__ import annotations
@@ -34,12 +69,20 @@ class Guard:
         Crossing direction as in ``scipy.integrate.solve_ivp`` events.
     outcome : {"next_phase", "heel_strike", "fall"}
         What happens when the guard fires.
+    gradient : callable ``x -> (2n,)``, optional
+        Gradient of ``function`` (saltation matrices); complex step on ``function`` if None.
+    reset, reset_jacobian : callable, optional
+        For ``next_phase`` guards: a map applied to the state when the guard fires (an
+        intra-step impact such as a knee strike, state dimension unchanged) and its Jacobian.
     """
 
     name: str
     function: Callable[[float, np.ndarray], float]
     direction: int
     outcome: GuardOutcome
+    gradient: Callable[[np.ndarray], np.ndarray] | None = None
+    reset: Callable[[np.ndarray], np.ndarray] | None = None
+    reset_jacobian: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 @dataclass(frozen=True)
@@ -89,6 +132,12 @@ class HybridWalker:
         ``(t, x) -> (2n, 2n)`` Jacobian of the flow, for the variational equations.
     reset_jacobian : callable or None
         ``x_minus -> (2n, 2n)`` Jacobian of the reset map.
+    heel_strike_guard : callable or None
+        ``(t, x) -> float``, zero on the heel-strike surface.
+    leg_angles : callable or None
+        ``X -> {"stance_angle", "swing_angle", "stance_rate", "swing_rate"}`` absolute leg
+        angles from the vertical [rad] and rates [rad/s], by role (used by
+        :meth:`leg_coordinates`); None: the coordinates are already absolute leg angles.
     """
 
     name: str
@@ -108,6 +157,7 @@ class HybridWalker:
     variational: Callable[[float, np.ndarray], np.ndarray] | None = None
     reset_jacobian: Callable[[np.ndarray], np.ndarray] | None = None
     heel_strike_guard: Callable[[float, np.ndarray], float] | None = None
+    leg_angles: Callable[[np.ndarray], dict[str, np.ndarray]] | None = None
 
     @property
     def n_coordinates(self) -> int:
@@ -116,3 +166,47 @@ class HybridWalker:
     def state_names(self) -> list[str]:
         """Role-ordered state names, e.g. ``['swing_angle', 'stance_angle', 'swing_rate', ...]``."""
         return [f"{r}_angle" for r in self.roles] + [f"{r}_rate" for r in self.roles]
+
+    def state_units(self) -> list[str]:
+        """Units of :meth:`state_names` (every coordinate is an angle)."""
+        return ["rad"] * self.n_coordinates + ["rad/s"] * self.n_coordinates
+
+    @property
+    def coordinate_units(self) -> dict[str, str]:
+        """Units of the :meth:`leg_coordinates` series, by name (in their order)."""
+        X = np.zeros(2 * self.n_coordinates)
+        return {k: ("rad/s" if k.endswith("_rate") else "rad")
+                for k in self.leg_coordinates(X, self.legs[-1])}
+
+    def leg_coordinates(self, X: np.ndarray, stance_leg: str) -> dict[str, np.ndarray]:
+        """Absolute angle [rad] and rate [rad/s] of each physical leg, keyed ``<leg>_angle``,
+        ``<leg>_rate`` (the same keys on every step).
+
+        Parameters
+        ----------
+        X : ndarray, shape (2n,) or (2n, k)
+            Role-ordered states of a step with ``stance_leg`` in stance.
+        stance_leg : str
+            One of :attr:`legs`.
+
+        Returns
+        -------
+        dict[str, ndarray]
+            Values of shape () or (k,).
+        """
+        X = np.asarray(X)
+        n = self.n_coordinates
+        if self.leg_angles is not None:
+            by_role = self.leg_angles(X)
+        else:
+            by_role = {}
+            for i, r in enumerate(self.roles):
+                by_role[f"{r}_angle"], by_role[f"{r}_rate"] = X[i], X[n + i]
+        r2l = self.role_to_leg(stance_leg)
+        out = {}
+        for key, val in by_role.items():
+            role = next((r for r in sorted(r2l, key=len, reverse=True)
+                         if key.startswith(r + "_")), None)
+            # a coordinate on no leg (a torso) keeps its own name
+            out[key if role is None else r2l[role] + key[len(role):]] = np.asarray(val)
+        return out

@@ -12,9 +12,14 @@ Three pure pieces (as in Drake's ``examples/compass_gait``):
 - guard  :func:`heel_strike_guard`, :func:`swing_foot_ahead`, :func:`swing_foot_height`
 - reset  :func:`impact`       plastic impact and role swap (Eq. 6-8, A.41-A.57)
 
+The ``derived`` equations are not written here: the compass gait is the generic biped of
+:mod:`walkerlab.models.description` (hip point mass, one point mass per leg) and its code is
+generated and cached (:mod:`walkerlab.models.symbolic`, :mod:`walkerlab.models.codegen`).
+This module keeps the paper's *printed* equations (Appendix A) for comparison.
+
 Equation variants
 -----------------
-``derived``      sympy derivation (:mod:`walkerlab.models.derivation`) - the default.
+``derived``      generic symbolic derivation - the default.
 ``appendix_a``   the printed Appendix A flow (A.4-A.6, including the wrong sign of
                  ``C[1, 0]`` in A.5) with the impact of A.57; reproduces the paper's Eq. 11.
 ``appendix_a_literal``  as ``appendix_a`` but also with the printed y-component of the
@@ -24,12 +29,12 @@ Equation variants
 
 from __future__ import annotations
 
-from functools import partial
+from dataclasses import replace
+from functools import cache, partial
 
 import numpy as np
 
-from walkerlab.models.base import Guard, HybridWalker, Phase
-from walkerlab.models.derivation import compass_gait_functions
+from walkerlab.models.base import HybridWalker
 
 VARIANTS = ("derived", "appendix_a", "appendix_a_literal")
 
@@ -54,9 +59,7 @@ def matrices(q, dq, p, variant: str = "derived"):
     G : ndarray, shape (2,)
     """
     if variant == "derived":
-        f = compass_gait_functions()
-        return (np.asarray(f["M"](q, p)), np.asarray(f["C"](q, dq, p)),
-                np.asarray(f["G"](q, p)).reshape(-1))
+        return _generated(tuple(p))["matrices"](np.concatenate([q, dq]))
     m, mh, L, a, g = p
     b = L - a
     t1, t2 = q
@@ -86,6 +89,8 @@ def flow(t: float, x: np.ndarray, p: tuple, variant: str = "derived") -> np.ndar
     -------
     ndarray, shape (4,)
     """
+    if variant == "derived":
+        return _generated(tuple(p))["flow"](t, x)
     q, dq = x[:2], x[2:]
     M, C, G = matrices(q, dq, p, variant)
     qdd = np.linalg.solve(M, -C @ dq - G)
@@ -157,9 +162,7 @@ def is_heel_strike(x: np.ndarray, phi: float, tol: float = 1e-9) -> bool:
 def impact_matrices(q, p, variant: str = "derived"):
     """Extended inertia ``De`` (4x4, coordinates ``[theta1, theta2, x_f, y_f]``, A.7-A.24)
     and swing-foot Jacobian ``E`` (2x4, A.56)."""
-    f = compass_gait_functions()
-    De = np.asarray(f["De"](q, p))
-    E = np.asarray(f["E"](q, p))
+    De, E = _generated(tuple(p))["impact_matrices"](np.asarray(q))
     if variant == "appendix_a_literal":
         m, mh, L, a, g = p
         t1, t2 = q
@@ -211,34 +214,33 @@ def energies(x: np.ndarray, p: tuple) -> tuple[np.ndarray, np.ndarray]:
 
     Potential energy is measured from the stance foot's height (world vertical).
     """
-    m, mh, L, a, g = p
-    b = L - a
-    t1, t2, w1, w2 = x
-    kin = 0.5 * (m * b**2 * w1**2 + (mh * L**2 + m * (L**2 + a**2)) * w2**2) \
-        - m * L * b * np.cos(t2 - t1) * w1 * w2
-    pot = g * ((m * a + mh * L + m * L) * np.cos(t2) - m * b * np.cos(t1))
-    return kin, pot
+    return _generated(tuple(p))["energies"](np.asarray(x))
 
 
 def points(x: np.ndarray, p: tuple) -> dict[str, np.ndarray]:
     """Positions [m] relative to the stance foot (A.1-A.3); each value (2,) or (2, k)."""
-    m, mh, L, a, g = p
-    b = L - a
-    t1, t2 = x[0], x[1]
-    hip = np.array([-L * np.sin(t2), L * np.cos(t2)])
-    return {
-        "stance_foot": np.zeros_like(hip),
-        "stance_mass": np.array([-a * np.sin(t2), a * np.cos(t2)]),
-        "hip": hip,
-        "swing_mass": hip + np.array([b * np.sin(t1), -b * np.cos(t1)]),
-        "swing_foot": hip + np.array([L * np.sin(t1), -L * np.cos(t1)]),
-    }
+    return _generated(tuple(p))["points"](np.asarray(x))
 
 
 # --------------------------------------------------------------------------- builder
-def _role_to_leg(stance_leg: str) -> dict[str, str]:
-    other = {"leg1": "leg2", "leg2": "leg1"}[stance_leg]
-    return {"stance": stance_leg, "swing": other}
+def _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_from_foot_m,
+          slope_rad):
+    from walkerlab.config import CompassGaitParams
+    from walkerlab.models.description import walker_data
+
+    w = CompassGaitParams(leg_length_m=leg_length_m, leg_mass_kg=leg_mass_kg,
+                          hip_mass_kg=hip_mass_kg, gravity_m_per_s2=gravity_m_per_s2,
+                          leg_mass_from_foot_m=leg_mass_from_foot_m)
+    return walker_data(w, slope_rad)
+
+
+@cache
+def _generated(p: tuple) -> dict:
+    """Generated functions for ``p = (m, M_H, L, a, g)`` (slope 0: flow, impact, energies)."""
+    from walkerlab.models.rigid import functions
+
+    m, mh, L, a, g = p
+    return functions(_data(L, m, mh, g, a, 0.0))
 
 
 def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: float,
@@ -246,41 +248,30 @@ def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: floa
                       variant: str = "derived") -> HybridWalker:
     """Build the compass-gait :class:`HybridWalker` (all arguments SI).
 
+    ``derived`` is the generic biped (generated code); the ``appendix_a`` variants use the
+    printed flow A.4-A.6 (generated too, see :class:`~walkerlab.models.description.Structure`)
+    and, for ``appendix_a_literal``, the impact with A.55 as printed (Jacobian by complex
+    step).
+
     Raises
     ------
     ValueError
         Unknown ``variant``.
     """
+    from walkerlab.models.rigid import make_rigid_walker
+
     if variant not in VARIANTS:
         raise ValueError(f"ideal.variant: unknown variant {variant!r}; choose from {VARIANTS}")
-    p = (leg_mass_kg, hip_mass_kg, leg_length_m, leg_mass_from_foot_m, gravity_m_per_s2)
-    L, phi = leg_length_m, slope_rad
-    f = partial(flow, p=p, variant=variant)
-    fall = Guard("fall", partial(hip_height, phi=phi, L=L), -1, "fall")
-    early = Phase("early_swing", f, (
-        Guard("midstance", swing_foot_ahead, +1, "next_phase"), fall))
-    late = Phase("late_swing", f, (
-        Guard("heel_strike", partial(heel_strike_guard, phi=phi), -1, "heel_strike"),
-        Guard("swing_leg_falls_back", swing_foot_ahead, -1, "fall"), fall))
-    reset = partial(impact, p=p, variant=variant)
-
-    def section(x):
-        return np.asarray(x)[1:]
-
-    def from_section(z):
-        z = np.asarray(z)
-        return np.concatenate([[-2.0 * phi - z[0]], z])
-
-    return HybridWalker(
-        name="compass_gait", variant=variant, roles=("swing", "stance"), legs=("leg1", "leg2"),
-        phases=(early, late), reset=reset, energies=partial(energies, p=p),
-        points=partial(points, p=p), section=section, from_section=from_section,
-        role_to_leg=_role_to_leg, total_mass_kg=hip_mass_kg + 2 * leg_mass_kg,
-        slope_rad=phi,
-        params={"leg_length_m": L, "leg_mass_kg": leg_mass_kg, "hip_mass_kg": hip_mass_kg,
-                "gravity_m_per_s2": gravity_m_per_s2,
-                "leg_mass_from_foot_m": leg_mass_from_foot_m, "slope_rad": phi},
-        variational=lambda t, x: complex_step_jacobian(lambda z: f(t, z), x),
-        reset_jacobian=lambda x: complex_step_jacobian(reset, x),
-        heel_strike_guard=partial(heel_strike_guard, phi=phi),
-    )
+    data = _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_from_foot_m,
+                 slope_rad)
+    if variant == "derived":
+        return make_rigid_walker(data, "compass_gait", variant)
+    # printed flow (A.4-A.6): generated like any other, from the derived equations with the
+    # printed sign of C[1, 0]; appendix_a_literal also uses the printed impact (A.55)
+    data = replace(data, structure=replace(data.structure, variant="appendix_a"))
+    kw = {}
+    if variant == "appendix_a_literal":
+        p = (leg_mass_kg, hip_mass_kg, leg_length_m, leg_mass_from_foot_m, gravity_m_per_s2)
+        reset = partial(impact, p=p, variant=variant)
+        kw = {"reset": reset, "reset_jacobian": lambda x: complex_step_jacobian(reset, x)}
+    return make_rigid_walker(data, "compass_gait", variant, **kw)

@@ -1,4 +1,4 @@
-"""Map a scene's ``walker.model`` to a model builder (the only place that knows the list)."""
+"""Map a scene's ``walker`` section to a hybrid walker (the only place that knows the list)."""
 
 from __future__ import annotations
 
@@ -8,10 +8,14 @@ from walkerlab.models.base import HybridWalker
 def build_walker(scene) -> HybridWalker:
     """Build the rigid hybrid walker of a :class:`~walkerlab.config.Scene`.
 
+    ``model: compass_gait`` (paper Table 1) supports the printed-equation variants
+    (``ideal.variant``); ``model: biped`` is any walker described as data, derived
+    symbolically (variant ``derived`` only).
+
     Raises
     ------
     ValueError
-        The scene names a walker model that has no rigid hybrid implementation.
+        The scene names a walker model or variant that has no rigid hybrid implementation.
     """
     w = scene.walker
     if w.model == "compass_gait":
@@ -21,4 +25,12 @@ def build_walker(scene) -> HybridWalker:
             w.leg_length_m, w.leg_mass_kg, w.hip_mass_kg, w.gravity_m_per_s2,
             w.leg_mass_from_foot_m, scene.slope.phi_rad, scene.ideal.variant,
         )
+    if w.model == "biped":
+        from walkerlab.models.description import walker_data
+        from walkerlab.models.rigid import make_rigid_walker
+
+        if scene.ideal.variant != "derived":
+            raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "
+                             "model: compass_gait (the paper's printed equations)")
+        return make_rigid_walker(walker_data(w, scene.slope.phi_rad), "biped", "derived")
     raise ValueError(f"walker.model: no rigid model for {w.model!r}")

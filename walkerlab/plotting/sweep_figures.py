@@ -37,8 +37,8 @@ def bifurcation_figure(data: dict, title: str = ""):
     ----------
     data : dict
         Keys ``slope`` (n,) [deg], ``steady_state/interleg_angle`` (n, k) [deg],
-        ``fixed_point/swing_angle``, ``fixed_point/stance_angle`` (n,) [rad],
-        ``floquet/real``, ``floquet/imag`` (n, 4), ``onset/slope`` [deg].
+        ``fixed_point/interleg_angle`` (n,) [deg], ``floquet/real``, ``floquet/imag``
+        (n, 2m), ``onset/onset_slope`` [deg].
 
     Returns
     -------
@@ -46,11 +46,10 @@ def bifurcation_figure(data: dict, title: str = ""):
     """
     s = np.asarray(data["slope"], float)
     il = np.asarray(data["steady_state/interleg_angle"], float)
-    fp_il = np.degrees(np.abs(np.asarray(data["fixed_point/stance_angle"])
-                              - np.asarray(data["fixed_point/swing_angle"])))
+    fp_il = np.asarray(data["fixed_point/interleg_angle"], float)
     mult = np.asarray(data["floquet/real"]) + 1j * np.asarray(data["floquet/imag"])
     stable = np.max(np.abs(mult), axis=1) < 1
-    onset = float(data.get("onset/slope", np.nan))
+    onset = float(data.get("onset/onset_slope", np.nan))
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True,
                                    gridspec_kw={"height_ratios": [3, 2]})
     ss, yy = np.repeat(s, il.shape[1]), il.ravel()

@@ -1,4 +1,4 @@
-"""Report sections built from the optional artifacts (work-precision, contact, compare).
+"""Report sections of the contact model (contact-sim, compare), from artifacts only.
 
 Each function returns Markdown, or an empty list when its artifact does not exist, so a
 scene gets only the sections it produces.
@@ -9,66 +9,32 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.io.artifacts import open_artifact
+from walkerlab.published import for_scene
+from walkerlab.report.markdown import printed
 from walkerlab.report.markdown import table as _table
-from walkerlab.stages.common import artifact_path
 
 
-def _default_solver(scene, model: str) -> str:
-    """The scene's solver for ``model`` (contact defaults come from the contact-sim stage)."""
-    if model == "ideal":
-        sv = scene.solver
-    else:
-        from walkerlab.contact.scene import settings
+def _table2_note(pub) -> str:
+    """The printed rate increases of Table 2 against the ones its own columns imply."""
+    if not hasattr(pub, "TABLE2_RATE_INCREASE_PERCENT"):
+        return ""
+    rates = [v for k, v in pub.TABLE2.items() if k.endswith("_rate")]
+    said = pub.TABLE2_RATE_INCREASE_PERCENT
+    got = [100 * (abs(pa) - abs(pm)) / abs(pm) for _s, pm, pa in rates]
+    return (" Note that the paper's ADAMS column is not the stated "
+            + " / ".join(f"+{v:.0f} %" for v in said) + ": "
+            + " and ".join(f"{pm:.2f} → {pa:.2f} is {g:+.0f} %"
+                           for (_s, pm, pa), g in zip(rates, got)) + ".")
 
-        sv = settings(scene)[3]
-    return f"{sv.method} rtol {sv.rtol:.0e}."
 
-
-def workprecision_section(scene, runs_root) -> list[str]:
-    p = artifact_path(scene, runs_root, "workprecision")
-    if not p.is_file():
+def contact_section(scene, paths) -> list[str]:
+    p = paths.get("contact-sim")
+    if p is None:
         return []
-    out = ["## Error against run time (work-precision)", ""]
-    with open_artifact(p, "workprecision") as f:
-        for model in f:
-            g = f[model]
-            rows = []
-            for m in g:
-                d = g[m]
-                for rt, t, e, n in zip(d["rtol"][()], d["time"][()], d["error"][()],
-                                       d["nfev"][()]):
-                    rows.append([model, m, float(rt), float(t * 1e3), float(e), int(n)])
-            out.append(f"### {model} model")
-            out.append("")
-            if "best_method" in g.attrs:
-                out.append(f"Pareto-best setting reaching the target error "
-                           f"{g.attrs['target_error']:.0e}: **{g.attrs['best_method']} rtol "
-                           f"{g.attrs['best_rtol']:.0e}** ({g.attrs['best_time'] * 1e3:.1f} ms, "
-                           f"error {g.attrs['best_error']:.1e}). Scene default: "
-                           + _default_solver(scene, model))
-            pm = [str(s) for s in g.attrs.get("pareto_methods", [])]
-            pr = list(g.attrs.get("pareto_rtol", []))
-            out.append("")
-            out.append("Pareto front (no setting is both faster and more accurate): "
-                       + ", ".join(f"{m} {r:.0e}" for m, r in zip(pm, pr)) + ".")
-            out.append("")
-            out.append(_table(["model", "method", "rtol", "median wall [ms]",
-                               "error vs reference", "RHS evals"], rows))
-            out.append("")
-    return out
-
-
-def contact_section(scene, runs_root) -> list[str]:
-    from walkerlab.analysis.tables import PAPER_TABLE2
-
-    p = artifact_path(scene, runs_root, "contact-sim")
-    if not p.is_file():
-        return []
+    pub = for_scene(scene)
+    table2 = getattr(pub, "TABLE2", {})
     with open_artifact(p, "contact-sim") as f:
-        x_id = f["initial_state_ideal"][()]
         scale = f["initial_rate_scale"][()]
-        g0 = f["initial_state_named"]
-        ours_c = np.array([g0[n][()] for n in ("theta1", "theta2", "dtheta1", "dtheta2")])
         summ = {k: f["summary"][k][()] for k in f["summary"]}
         cp = {k: (f["contact_params_si"][k][()], f["contact_params_si"][k].attrs["unit"])
               for k in f["contact_params_si"]}
@@ -80,7 +46,7 @@ def contact_section(scene, runs_root) -> list[str]:
         drop = None
         if "drop_test" in f:
             g = f["drop_test"]
-            drop = (g["stiffness"][()], g["stiffness"].attrs["unit"],
+            drop = (g["stiffness"][()], str(g["stiffness"].attrs["unit"]),
                     {fam: g[f"{fam}/restitution"][()] for fam in ("paper", "rigid_limit")},
                     str(f.attrs.get("stiffness_family", "paper")))
         periods = f["steps/period"][()]
@@ -94,20 +60,31 @@ def contact_section(scene, runs_root) -> list[str]:
             per = (float(g["step_period"][()]), float(g["step_length"][()]),
                    g["multipliers/real"][()] + 1j * g["multipliers/imag"][()],
                    bool(g["stable"][()]))
+    # initial states by name: the first sample of each trajectory artifact
+    with open_artifact(p, "contact-sim") as f:
+        c0 = {n: float(f[f"samples/coordinates/{n}"][0]) for n in f["samples/coordinates"]}
+    i0 = {}
+    if "simulate" in paths:
+        with open_artifact(paths["simulate"], "simulate") as f:
+            i0 = {n: float(f[f"samples/coordinates/{n}"][0]) for n in f["samples/coordinates"]}
     rows = []
-    for i, (key, (pm, pa)) in enumerate(PAPER_TABLE2.items()):
-        rows.append([key, pm, pa, f"{100 * (abs(pa) - abs(pm)) / abs(pm):+.1f}%", float(x_id[i]),
-                     float(ours_c[i]),
-                     f"{100 * (abs(ours_c[i]) - abs(x_id[i])) / abs(x_id[i]):+.1f}%"])
-    out = ["## Table 2 — initial states (ideal vs contact model)", "",
-           _table(["state", "paper MATLAB", "paper ADAMS", "paper diff.", "ours ideal",
-                   "ours contact", "ours diff."], rows), "",
+    for key in [k for k in table2 if k in c0] + [k for k in c0 if k not in table2]:
+        sym, pm, pa = table2.get(key, (key, np.nan, np.nan))
+        oi = i0.get(key, np.nan)
+        pd = f"{100 * (abs(pa) - abs(pm)) / abs(pm):+.1f}%" if key in table2 else "—"
+        rows.append([sym, printed(pm), printed(pa), pd, oi, c0[key],
+                     f"{100 * (abs(c0[key]) - abs(oi)) / abs(oi):+.1f}%"])
+    head = ["state", "paper MATLAB", "paper ADAMS", "paper diff.", "ours ideal",
+            "ours contact", "ours diff."]
+    if not table2:
+        head, rows = [head[0], *head[4:]], [[r[0], *r[4:]] for r in rows]
+    out = [("## Table 2 — " if table2 else "## ") + "initial states (ideal vs contact model)", "",
+           _table(head, rows), "",
            f"Our contact walker starts from our ideal fixed point with the initial rates scaled "
            f"by {np.array2string(scale, precision=3)}"
            + (f" (found by `--adjust`: objective {float(adj['objective']):.2e} after "
               f"{int(adj['evaluations'])} simulations)" if adj else "")
-           + ". Note that the paper's ADAMS column is not the stated +41 % / +74 %: "
-             "−0.60 → −1.02 is +70 % and −0.84 → −3.20 is +281 %.", "",
+           + "." + _table2_note(pub), "",
            "## Contact walker (MSC ADAMS-style model)", "",
            _table(["quantity", "value"], [[k, float(v) if np.ndim(v) == 0 else str(v)]
                                           for k, v in summ.items()] + [["termination", term]]),
@@ -124,8 +101,8 @@ def contact_section(scene, runs_root) -> list[str]:
         out += [f"**Periodic gait of the contact model**: not found ({per_fail[0]}: "
                 f"{per_fail[1]}).", ""]
     if drop is not None:
-        out += _drop_lines(scene, runs_root, p, *drop)
-    out += _map_lines(scene, runs_root, p)
+        out += _drop_lines(scene, p, *drop)
+    out += _map_lines(p)
     if per is not None:
         out += [f"**Periodic gait of the contact model** (fixed point of its step-to-step map, "
                 f"mid-stance section): step period {per[0]:.6f} s, step length {per[1]:.6f} m, "
@@ -135,7 +112,7 @@ def contact_section(scene, runs_root) -> list[str]:
     return out
 
 
-def _drop_lines(scene, runs_root, artifact, ks, unit, curves, family) -> list[str]:
+def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
     """Restitution-vs-stiffness figure (drop test stored in contact_sim.h5) and its text."""
     from walkerlab.plotting.figures import save
     from walkerlab.plotting.sweep_figures import restitution_figure
@@ -158,8 +135,8 @@ def _drop_lines(scene, runs_root, artifact, ks, unit, curves, family) -> list[st
                     "restitution, rigid-limit family"], rows), "", "</details>", ""]
 
 
-def _map_lines(scene, runs_root, artifact) -> list[str]:
-    """Stability maps of the contact gait, where their artifacts exist."""
+def _map_lines(artifact) -> list[str]:
+    """Stability maps of the contact gait, where their artifacts exist next to ``artifact``."""
     import shutil
 
     out = []
@@ -169,7 +146,8 @@ def _map_lines(scene, runs_root, artifact) -> list[str]:
         if not (p.is_file() and png.is_file()):
             continue
         with open_artifact(p) as f:
-            ex, stab = float(f["summary/exists_fraction"][()]), float(f["summary/stable_fraction"][()])
+            ex = float(f["summary/exists_fraction"][()])
+            stab = float(f["summary/stable_fraction"][()])
             n = int(f["summary/cells"][()])
         figdir = artifact.parent / "report" / "figures"
         figdir.mkdir(parents=True, exist_ok=True)
@@ -187,16 +165,18 @@ def _map_lines(scene, runs_root, artifact) -> list[str]:
     return out
 
 
-def compare_section(scene, runs_root) -> list[str]:
-    p = artifact_path(scene, runs_root, "compare")
-    if not p.is_file():
+def compare_section(scene, paths) -> list[str]:
+    p = paths.get("compare")
+    if p is None:
         return []
     with open_artifact(p, "compare") as f:
         g = f["errors"]
-        legs = [str(x) for x in g.attrs["legs"]]
-        rows = [[leg, float(np.max(np.abs(g[f"angle/{leg}"][()]))),
-                 float(np.max(np.abs(g[f"rate/{leg}"][()]))),
-                 float(g[f"limit_cycle_distance/{leg}"][()])] for leg in legs]
+        names = [str(x) for x in g.attrs["coordinates"]]
+        stems = list(g["limit_cycle_distance"])
+        rows = [[s, float(np.max(np.abs(g[f"coordinates/{s}_angle"][()]))),
+                 float(np.max(np.abs(g[f"coordinates/{s}_rate"][()]))),
+                 float(g[f"limit_cycle_distance/{s}"][()])] for s in stems
+                if f"{s}_angle" in names and f"{s}_rate" in names]
         t_end = float(g["time"][-1])
     return ["## Comparison ideal vs contact (Fig. 8)", "",
             f"Errors contact − ideal over the common span 0–{t_end:.2f} s:", "",
@@ -208,12 +188,12 @@ def compare_section(scene, runs_root) -> list[str]:
             "drift apart in phase; the limit cycles themselves stay close (last column).", ""]
 
 
-def sections(scene, runs_root) -> list[str]:
-    """All optional sections, in report order."""
+def sections(scene, paths) -> list[str]:
+    """All contact sections, in report order (``paths``: ``{stage: Path}`` that exist)."""
     out: list[str] = []
     for fn in _SECTION_FUNCS:
-        out += fn(scene, runs_root)
+        out += fn(scene, paths)
     return out
 
 
-_SECTION_FUNCS = [contact_section, compare_section, workprecision_section]
+_SECTION_FUNCS = [contact_section, compare_section]

@@ -10,11 +10,40 @@ from pathlib import Path
 import numpy as np
 
 
-def table(header: list[str], rows: list[list]) -> str:
-    """A Markdown table; floats shown with 6 significant digits, non-finite as a dash."""
+DIGITS = 4  # significant digits of every number in the report unless a column asks for more
+
+
+def num(v, digits: int = DIGITS) -> str:
+    """A number with ``digits`` significant digits (scientific below 1e-3 / from 1e6)."""
+    if isinstance(v, (bool, np.bool_)):
+        return "yes" if v else "no"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    v = float(v)
+    if not np.isfinite(v):
+        return "—"
+    if v.is_integer() and abs(v) < 1e6 and v != 0:
+        return str(int(v))  # counts stored as floats
+    if v != 0 and (abs(v) < 1e-3 or abs(v) >= 1e6):
+        return f"{v:.{max(1, digits - 1)}e}"
+    return f"{v:#.{digits}g}".rstrip(".")
+
+
+def printed(v) -> str:
+    """A published number with the digits it was printed with (no padding, no rounding)."""
+    return f"{float(v):g}" if np.isfinite(float(v)) else "—"
+
+
+def details(summary: str, body: str) -> list[str]:
+    """A folded block (``<details>``) around Markdown ``body`` (works in HTML and on GitHub)."""
+    return ["<details>", f"<summary>{summary}</summary>", "", body, "", "</details>", ""]
+
+
+def table(header: list[str], rows: list[list], digits: int = DIGITS) -> str:
+    """A Markdown table; floats with ``digits`` significant digits, non-finite as a dash."""
     def cell(v):
-        if isinstance(v, float):
-            return "—" if not np.isfinite(v) else f"{v:.6g}"
+        if isinstance(v, (float, np.floating)):
+            return num(v, digits)
         return str(v)
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(cell(v) for v in r) + " |" for r in rows]
@@ -47,7 +76,9 @@ def to_html(md: str, base: Path) -> str:
         if in_table:
             body.append("</table>")
             in_table = False
-        if line.startswith("!["):
+        if line.startswith(("<details", "</details", "<summary")):
+            body.append(line)
+        elif line.startswith("!["):
             cap = line[2:line.rindex("](")]
             src = line[line.rindex("](") + 2:-1]
             data = base64.b64encode((base / src).read_bytes()).decode()

@@ -14,6 +14,17 @@ def _fmt_mult(re, im) -> str:
     return ", ".join(f"{a:+.6f}{b:+.6f}j" if abs(b) > 0 else f"{a:+.6f}" for a, b in zip(re, im))
 
 
+def zero_multipliers_text(re, im) -> str:
+    """Why some Floquet multipliers are 0: the map lands on the heel-strike surface (and, for a
+    kneed walker, on the straight-knee surface: the swing knee starts straight and locked)."""
+    n0 = int(np.sum(np.hypot(re, im) < 1e-9))
+    if n0 <= 1:
+        return "one multiplier is 0 by construction: the map lands on the heel-strike surface"
+    return (f"{n0} multipliers are 0 by construction: the map lands on the heel-strike surface "
+            "and on the surface where the constrained coordinates (a straight swing knee) are "
+            "fixed")
+
+
 def fixedpoint_text(path: Path) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     with open_artifact(path, "fixedpoint") as f:
@@ -22,10 +33,12 @@ def fixedpoint_text(path: Path) -> str:
         lines = [f"fixed point ({f.attrs['model']}, {f.attrs['variant']} equations), "
                  "state just after heel strike:"]
         for n in names:
-            role = n.rsplit("_", 1)[0]
+            coord = n.rsplit("_", 1)[0]
+            role = next((r for r in sorted(legs, key=len, reverse=True)
+                         if coord == r or coord.startswith(r + "_")), None)
+            where = f"({legs[role]}, {role} leg)" if role else "(not on a leg)"
             unit = f["fixed_point/" + n].attrs["unit"]
-            lines.append(f"  {n:<14s} ({legs.get(role, role)}, {role} leg) "
-                         f"{f['fixed_point/' + n][()]: .10f} {unit}")
+            lines.append(f"  {n:<14s} {where} {f['fixed_point/' + n][()]: .10f} {unit}")
         lines.append(f"  step period     {f['step_period'][()]:.10f} s")
         lines.append(f"  residual        {f['residual'][()]:.2e}  (max |P(x*) - x*|)")
         re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
@@ -35,8 +48,8 @@ def fixedpoint_text(path: Path) -> str:
         lines.append(f"  max difference {f['floquet/max_difference'][()]:.2e}")
         mod = float(np.max(np.hypot(re, im)))
         verdict = "STABLE" if f["floquet/stable"][()] else "UNSTABLE"
-        lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; one multiplier is 0 "
-                     "by construction: the map lands on the heel-strike surface)")
+        lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; "
+                     f"{zero_multipliers_text(re, im)})")
     return "\n".join(lines)
 
 

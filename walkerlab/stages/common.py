@@ -1,8 +1,13 @@
-"""Shared stage plumbing: artifact paths, input hashes, skip-if-up-to-date."""
+"""Shared stage plumbing: artifact paths, input hashes, skip-if-up-to-date, locking.
+
+Run paths come from :mod:`walkerlab.io.runpaths` (the one place that builds
+``runs/<scene>/...``; names checked, every output inside the runs folder).
+"""
 
 from __future__ import annotations
 
 import hashlib
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -10,7 +15,8 @@ from pathlib import Path
 
 import walkerlab
 from walkerlab.config import Scene
-from walkerlab.io.artifacts import code_hash, stored_hash, write_artifact
+from walkerlab.io.artifacts import code_hash, content_hash, verified_hash, write_artifact
+from walkerlab.io.runpaths import artifact_lock, stage_artifact
 
 
 class StageError(RuntimeError):
@@ -29,42 +35,67 @@ class StageOutcome:
 
 
 def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
-    """``runs/<scene name>/<stage>.h5``."""
-    return Path(runs_root) / (scene.name or "scene") / f"{stage.replace('-', '_')}.h5"
+    """``runs/<scene name>/<stage>.h5`` (checked by :func:`walkerlab.io.runpaths.stage_artifact`).
+
+    Raises
+    ------
+    walkerlab.io.runpaths.RunPathError
+        Unsafe scene name, a path outside the runs folder, or a run folder owned by another
+        scene file of the same name.
+    """
+    return stage_artifact(scene, runs_root, stage)
 
 
 def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
-               upstream: tuple[Path, ...] = ()) -> str:
-    """Content hash of everything a stage's output depends on."""
+               upstream: tuple[Path, ...] = (), extra: str = "") -> str:
+    """Content hash of everything a stage's output depends on.
+
+    ``extra``: stage options that are not scene sections (e.g. a bifurcation grid).
+    Includes the upstream artifacts' *recomputed* content hashes
+    (:func:`walkerlab.io.artifacts.content_hash`), not the hashes they store: an upstream
+    artifact edited by hand changes the key.
+    """
     h = hashlib.sha256()
     h.update(stage.encode())
+    h.update(extra.encode())
     h.update(scene.section_json(*sections).encode())
     h.update(walkerlab.__version__.encode())
     h.update(code_hash().encode())
     for p in upstream:
-        h.update(str(stored_hash(p)).encode())
+        h.update(str(content_hash(p)).encode())
     return h.hexdigest()
+
+
+def _tell(msg: str) -> None:
+    print(msg, file=sys.stderr)
 
 
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
                force: bool = False, extra_attrs: dict | None = None,
-               extra_key: str = "") -> StageOutcome:
+               extra_key: str = "", also_accept: tuple[str, ...] = ()) -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
-    ``extra_key``: text of inputs that are not scene sections (e.g. a map's grid), hashed too.
+    ``extra_key`` enters the input hash; an artifact written with one of the ``also_accept``
+    keys (a superset of what is asked for) counts as up to date too.
     """
-    path = artifact_path(scene, runs_root, stage)
-    key = input_hash(stage, scene, sections, upstream)
-    if extra_key:
-        key = hashlib.sha256((key + extra_key).encode()).hexdigest()
-    if not force and path.is_file() and stored_hash(path) == key:
-        return StageOutcome(stage, path, True, 0.0, {})
-    t0 = time.perf_counter()
-    writer, summary = compute()
-    wall = time.perf_counter() - t0
-    write_artifact(path, stage, scene, key, writer, wall, extra_attrs)
+    from walkerlab.models.cache import set_cache_dir
+
+    set_cache_dir(Path(runs_root) / ".cache" / "models")  # generated model code lives in runs/
+    path = stage_artifact(scene, runs_root, stage, claim=True)
+    # one writer per artifact: a second identical run waits, then finds the result up to date
+    with artifact_lock(path, wait=True, on_wait=_tell):
+        key = input_hash(stage, scene, sections, upstream, extra_key)
+        if not force and path.is_file():
+            have = verified_hash(path)
+            if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
+                                  for a in also_accept):
+                return StageOutcome(stage, path, True, 0.0, {})
+        t0 = time.perf_counter()
+        writer, summary = compute()
+        wall = time.perf_counter() - t0
+        write_artifact(path, stage, scene, key, writer, wall, extra_attrs)
     return StageOutcome(stage, path, False, wall, summary)
 
 

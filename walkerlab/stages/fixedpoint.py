@@ -11,21 +11,23 @@ from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import put
+from walkerlab.io.netcdf import coordinate
+from walkerlab.io.readers import load_fixed_point  # noqa: F401  (re-exported for stages)
 from walkerlab.models.registry import build_walker
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
-SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
-
-# The paper's Eq. (11), printed to these digits (rad, rad/s); role-ordered.
-PAPER_EQ11 = np.array([-0.2022, 0.1674, -0.60, -0.84])
+SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
 
 
-def _variants_for(scene: Scene) -> tuple[str, ...]:
-    if scene.walker.model == "compass_gait":
+def _variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
+    """The scene's own equation variant first, then (``compare``, for a compass gait compared
+    with published numbers) the other variants: they explain the difference from Eq. 11."""
+    own = (scene.ideal.variant,)
+    if compare and scene.walker.model == "compass_gait" and scene.published is not None:
         from walkerlab.models.compass_gait import VARIANTS
 
-        return VARIANTS
-    return (scene.ideal.variant,)
+        return own + tuple(v for v in VARIANTS if v != scene.ideal.variant)
+    return own
 
 
 def solve_variant(scene: Scene, variant: str):
@@ -33,14 +35,18 @@ def solve_variant(scene: Scene, variant: str):
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
     walker = build_walker(sc)
     fp = require(scene, "fixedpoint", "fixedpoint")
-    res = find_fixed_point(walker, fp.initial_guess.as_array(), Solver.from_settings(scene.solver),
+    try:
+        guess = fp.initial_guess.as_array(walker.state_names())
+    except ValueError as exc:
+        raise StageError(f"fixedpoint.initial_guess: {exc}") from None
+    res = find_fixed_point(walker, guess, Solver.from_settings(scene.solver),
                            xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
     return walker, res
 
 
 def _write_result(g, walker, res, guess) -> None:
     names = walker.state_names()
-    units = ["rad"] * walker.n_coordinates + ["rad/s"] * walker.n_coordinates
+    units = walker.state_units()
     g.attrs["variant"] = walker.variant
     g.attrs["roles"] = list(walker.roles)
     g.attrs["legs_by_role"] = json.dumps(walker.role_to_leg("leg2"))
@@ -52,10 +58,12 @@ def _write_result(g, walker, res, guess) -> None:
     put(g, "residual", res.residual, "rad or rad/s", "max |P(x*) - x*| over the state")
     for kind, ev, J in (("variational", res.multipliers_variational, res.jacobian_variational),
                         ("finite_difference", res.multipliers_fd, res.jacobian_fd)):
-        put(g, f"floquet/{kind}/real", ev.real, "-", f"Floquet multipliers ({kind}), real part")
-        put(g, f"floquet/{kind}/imag", ev.imag, "-", f"Floquet multipliers ({kind}), imag part")
+        put(g, f"floquet/{kind}/real", ev.real, "-", f"Floquet multipliers ({kind}), real part",
+            dims=("multiplier",))
+        put(g, f"floquet/{kind}/imag", ev.imag, "-", f"Floquet multipliers ({kind}), imag part",
+            dims=("multiplier",))
         put(g, f"floquet/{kind}/jacobian", J, "-", "DP, rows/cols in state_names order",
-            state_names=names)
+            dims=("state", "state_in"), state_names=names)
     put(g, "floquet/max_difference", res.multiplier_difference, "-",
         "max |multiplier(variational) - multiplier(finite difference)|")
     put(g, "floquet/stable", res.stable, "-", "all |multipliers| < 1")
@@ -64,8 +72,13 @@ def _write_result(g, walker, res, guess) -> None:
     put(g, "stats/wall_time", res.wall_time_s, "s", "fixed-point search + Jacobians")
 
 
-def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
-    """Find the fixed point (scene's variant, plus the other equation variants for comparison).
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
+        compare_variants: bool = False) -> StageOutcome:
+    """Find the fixed point of the scene's equation variant.
+
+    With ``compare_variants`` the other equation variants (printed Appendix A, ...) are solved
+    too, for the report's comparison with Eq. (11); a plain run reuses such an artifact
+    (a superset), and nothing else pays for them.
 
     Raises
     ------
@@ -76,7 +89,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
 
     def compute():
         results = {}
-        for variant in _variants_for(scene):
+        for variant in _variants_for(scene, compare_variants):
             try:
                 results[variant] = solve_variant(scene, variant)
             except FixedPointNotFound as exc:
@@ -86,15 +99,18 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                     raise StageError(f"fixedpoint: {exc}{hint}") from None
                 results[variant] = exc
         walker, main = results[scene.ideal.variant]
-        guess = fp_cfg.initial_guess.as_array()
+        guess = fp_cfg.initial_guess.as_array(walker.state_names())
 
         def writer(f):
             f.attrs["model"] = walker.name
             f.attrs["variant"] = walker.variant
             f.attrs["state_names"] = walker.state_names()
+            names = walker.state_names()
+            coordinate(f, "state", names, "-", "state component (role-ordered)")
+            coordinate(f, "state_in", names, "-", "state component perturbed (Jacobian column)")
+            coordinate(f, "multiplier", np.arange(len(names)), "-",
+                       "Floquet multiplier number (sorted by modulus)")
             _write_result(f, walker, main, guess)
-            put(f, "paper/eq11", PAPER_EQ11, "rad, rad/s", "paper Eq. (11) as printed",
-                state_names=walker.state_names())
             for v, r in results.items():
                 if isinstance(r, Exception):
                     f.create_group(f"variants/{v}").attrs["error"] = str(r)
@@ -105,16 +121,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
                    "variants": {k: v for k, v in results.items()}}
         return writer, summary
 
-    return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force)
-
-
-def load_fixed_point(path: Path) -> tuple[np.ndarray, dict]:
-    """Fixed point (role-ordered state) and metadata from ``fixedpoint.h5``."""
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(path, "fixedpoint") as f:
-        names = [str(n) for n in f.attrs["state_names"]]
-        x = np.array([f[f"fixed_point/{n}"][()] for n in names])
-        meta = {"step_period_s": float(f["step_period"][()]), "state_names": names,
-                "stable": bool(f["floquet/stable"][()])}
-    return x, meta
+    return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force,
+                      extra_key="variants" if compare_variants else "",
+                      also_accept=() if compare_variants else ("variants",))

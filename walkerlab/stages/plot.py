@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import Scene
+from walkerlab.io import runpaths
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.trajectory import read_samples
 from walkerlab.plotting import figures as F
@@ -16,8 +17,9 @@ IDEAL_LABEL = "ideal (rigid, plastic impact)"
 CONTACT_LABEL = "contact (IMPACT + Coulomb)"
 
 
-def figures_dir(scene: Scene, runs_root: Path | str) -> Path:
-    return Path(runs_root) / (scene.name or "scene") / "report" / "figures"
+def figures_dir(scene: Scene, runs_root: Path | str, claim: bool = False) -> Path:
+    """``runs/<scene>/report/figures`` (see :func:`walkerlab.io.runpaths.figures_dir`)."""
+    return runpaths.figures_dir(scene, runs_root, claim)
 
 
 def load_trajectories(scene: Scene, runs_root: Path | str) -> dict:
@@ -44,13 +46,15 @@ def run(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     StageError
         No trajectory artifact exists yet.
     """
-    out_dir = figures_dir(scene, runs_root)
     trajs = load_trajectories(scene, runs_root)
     if not trajs:
         raise StageError(f"plot: no simulate.h5 or contact_sim.h5 under "
-                         f"{Path(runs_root) / (scene.name or '')}; run 'walkerlab simulate' first")
+                         f"{runpaths.scene_dir(scene, runs_root)}; run 'walkerlab simulate' "
+                         "first")
+    out_dir = figures_dir(scene, runs_root, claim=True)
     written: list[Path] = []
-    written += F.save(F.fig7_angles_rates(trajs), out_dir, "fig7_angles_rates")
+    title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
+    written += F.save(F.fig7_angles_rates(trajs, title), out_dir, "fig7_angles_rates")
     written += F.save(F.fig9_limit_cycle(trajs), out_dir, "fig9_limit_cycles")
     written += F.save(F.fig10_energy(trajs), out_dir, "fig10_energy")
     for label, tr in trajs.items():
@@ -60,11 +64,11 @@ def run(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     if cmp_path.is_file():
         with open_artifact(cmp_path, "compare") as f:
             g = f["errors"]
-            legs = [str(x) for x in g.attrs["legs"]]
+            names = [str(x) for x in g.attrs["coordinates"]]
             t = g["time"][()]
-            ae = {leg: g[f"angle/{leg}"][()] for leg in legs}
-            re = {leg: g[f"rate/{leg}"][()] for leg in legs}
-        written += F.save(F.fig8_errors(t, ae, re, "contact - ideal"), out_dir, "fig8_errors")
+            err = {n: g[f"coordinates/{n}"][()] for n in names}
+            units = {n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names}
+        written += F.save(F.fig8_errors(t, err, units, "contact - ideal"), out_dir, "fig8_errors")
     wp_path = artifact_path(scene, runs_root, "workprecision")
     if wp_path.is_file():
         with open_artifact(wp_path, "workprecision") as f:

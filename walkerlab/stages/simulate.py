@@ -7,13 +7,15 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.analysis.hybrid import Solver, simulate_steps
-from walkerlab.analysis.metrics import sample_trajectory, step_table
+from walkerlab.analysis.metrics import sample_trajectory, step_table, total_mass_kg
 from walkerlab.config import Scene, SimulateSettings
 from walkerlab.io.artifacts import put
+from walkerlab.io.netcdf import coordinate
+from walkerlab.io.readers import load_fixed_point
 from walkerlab.io.trajectory import write_samples
 from walkerlab.models.registry import build_walker
 from walkerlab.stages import fixedpoint as fixedpoint_stage
-from walkerlab.stages.common import StageOutcome, artifact_path, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, artifact_path, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
 
@@ -25,7 +27,13 @@ def with_strides(scene: Scene, strides: int | None) -> Scene:
     """Scene with ``simulate.strides`` overridden (section created with defaults if absent)."""
     sim = scene.simulate or SimulateSettings()
     if strides is not None:
-        sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+        from pydantic import ValidationError
+
+        try:
+            sim = SimulateSettings.model_validate({**sim.model_dump(), "strides": strides})
+        except ValidationError as err:
+            raise StageError(f"--strides {strides}: {err.errors()[0]['msg'].lower()} "
+                             "(simulate.strides)") from None
     return scene.model_copy(update={"simulate": sim})
 
 
@@ -51,9 +59,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     def compute():
         walker = build_walker(scene)
         if sim.initial_state == "fixed_point":
-            x0, _ = fixedpoint_stage.load_fixed_point(upstream[0])
+            x0, _ = load_fixed_point(upstream[0])
         else:
-            x0 = sim.initial_state.as_array()
+            try:
+                x0 = sim.initial_state.as_array(walker.state_names())
+            except ValueError as exc:
+                raise StageError(f"simulate.initial_state: {exc}") from None
         traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
                               max_step_time=sim.max_step_time_s)
         samples = sample_trajectory(traj, sim.sample_rate_hz)
@@ -76,21 +87,27 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             f.attrs["legs"] = list(walker.legs)
             f.attrs["termination"] = traj.termination
             f.attrs["strides_requested"] = sim.strides
+            f.attrs["total_mass_kg"] = total_mass_kg(walker)
+            f.attrs["gravity_m_per_s2"] = float(walker.params["gravity_m_per_s2"])
+            names = walker.state_names()
+            coordinate(f, "state", names, "-", "state component (role-ordered)")
             write_samples(f, samples)
             g = f.create_group("steps")
+            coordinate(g, "step", steps["index"], "-", "step number")
             for k, v in steps.items():
+                if k == "index":
+                    continue
                 if v.dtype.kind in "US":
-                    put(g, k, [str(s) for s in v], "-", k)
+                    put(g, k, [str(s) for s in v], "-", k, dims=("step",))
                 else:
-                    put(g, k, v, STEP_UNITS.get(k, "-"), k)
-            names = walker.state_names()
+                    put(g, k, v, STEP_UNITS.get(k, "-"), k, dims=("step",))
             for i, seg in enumerate(traj.segments):
                 sg = g.create_group(f"states/{i:04d}")
                 for nm, a, b in zip(names, seg.x_start, seg.x_end):
                     sg.attrs[f"start_{nm}"] = a
                     sg.attrs[f"end_{nm}"] = b
             put(f, "initial_state", x0, "rad, rad/s", "role-ordered initial state",
-                state_names=names)
+                dims=("state",), state_names=names)
             for k, v in summary.items():
                 if k != "termination":
                     put(f, f"summary/{k}", v, {"wall_time_s": "s", "mean_period_s": "s",

@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from walkerlab.config import Scene, load_scene
+from walkerlab.io.runpaths import named_artifact
 from walkerlab.sweep.params import ParamAxis, SweepError, params_hash, parse_param
 from walkerlab.sweep.runner import run_sweep
 
@@ -21,11 +22,17 @@ STAGE_NAMES = ("fixedpoint", "simulate", "contact-sim")
 
 
 def sweep_path(scene: Scene, axes: list[ParamAxis], stage: str, runs_root: Path | str = "runs",
-               name: str | None = None) -> Path:
-    """``runs/<scene>/sweep_<stage>_<short hash of params>.h5`` (or ``<name>.h5``)."""
-    stem = name.removesuffix(".h5") if name else \
-        f"sweep_{stage.replace('-', '_')}_{params_hash(axes, stage)}"
-    return Path(runs_root) / (scene.name or "scene") / f"{stem}.h5"
+               name: str | None = None, claim: bool = False) -> Path:
+    """``runs/<scene>/sweep_<stage>_<short hash of params>.h5`` (or ``<name>.h5``).
+
+    Raises
+    ------
+    walkerlab.io.runpaths.RunPathError
+        ``name`` is not a plain file name (path separators, ``..``), leaves the runs
+        folder, or is a stage artifact's name (``fixedpoint``, ``simulate``, ...).
+    """
+    stem = name if name else f"sweep_{stage.replace('-', '_')}_{params_hash(axes, stage)}"
+    return named_artifact(scene, runs_root, stem, "--name", claim=claim)
 
 
 def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str = "fixedpoint",
@@ -80,7 +87,10 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     if stage not in STAGE_NAMES:
         raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(STAGE_NAMES)}")
     axes = [parse_param(p) if isinstance(p, str) else p for p in params]
-    out = sweep_path(scene, axes, stage, runs_root, name)
+    out = sweep_path(scene, axes, stage, runs_root, name, claim=True)
+    from walkerlab.models.cache import set_cache_dir
+
+    set_cache_dir(Path(runs_root) / ".cache" / "models")  # before workers start: they inherit it
     return run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
                      resume=resume, options=options, chunk_size=chunk_size, progress=progress,
                      on_chunk=on_chunk, pool=pool)

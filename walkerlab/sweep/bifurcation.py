@@ -14,7 +14,9 @@ bracketed on the grid and located with :func:`scipy.optimize.brentq` on
 ``g(phi) = 1 + min real multiplier(phi)``.
 
 Grid chunks (the runs up and down from the scene's slope) are evaluated with the sweep
-executors (:func:`walkerlab.sweep.runner.iter_chunk_results`), locally or on Dask.
+executors (:func:`walkerlab.sweep.runner.iter_chunk_results`), locally or on Dask.  Arrays
+are sized by the walker (``walker.state_names()``); the cached stage that writes the
+artifact is :mod:`walkerlab.stages.bifurcation`.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from walkerlab.sweep.params import ParamAxis
 from walkerlab.sweep.runner import iter_chunk_results, plan_chunks
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
-           "min_real_multiplier", "write_bifurcation", "load_bifurcation"]
+           "min_real_multiplier", "bifurcation_writer", "load_bifurcation"]
 
 
 @dataclass(frozen=True)
@@ -57,13 +59,28 @@ def min_real_multiplier(mult: np.ndarray, tol: float = 1e-9) -> float:
     return float(real.min()) if real.size else math.nan
 
 
+def _rate_nudge(walker, size: float) -> np.ndarray:
+    """A state offset of ``size`` [rad/s] on the stance rate (by name), to leave the fixed point."""
+    names = walker.state_names()
+    dx = np.zeros(len(names))
+    dx[names.index("stance_rate") if "stance_rate" in names else
+       [k for k, n in enumerate(names) if n.endswith("_rate")][-1]] = size
+    return dx
+
+
+def _stance_angle(walker, x: np.ndarray) -> float:
+    """The ``stance_angle`` state of ``x`` [rad] (NaN for a walker without one)."""
+    names = walker.state_names()
+    return float(x[names.index("stance_angle")]) if "stance_angle" in names else math.nan
+
+
 def _bif_chunk(task: _BifTask) -> list[dict]:
     """Fixed point + steady state along one run of slopes (worker side)."""
     import warnings
 
     from walkerlab.analysis.hybrid import Solver, simulate_steps
     from walkerlab.models.registry import build_walker
-    from walkerlab.sweep.points import _Outcome, ideal_fixed_point, warm_up
+    from walkerlab.sweep.points import _Outcome, ideal_fixed_point, interleg_angle, warm_up
 
     warm_up()
     out = []
@@ -71,8 +88,9 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     x_att = None
     for index, (slope,) in task.points:
         t0 = time.perf_counter()
-        row = {"index": index, "slope_deg": slope, "x": np.full(4, np.nan),
-               "multipliers": np.full(4, np.nan, complex), "period_s": math.nan,
+        n = len(build_walker(_scene_at(task.base, slope)).state_names())
+        row = {"index": index, "slope_deg": slope, "x": np.full(n, np.nan),
+               "multipliers": np.full(n, np.nan, complex), "period_s": math.nan,
                "fp_outcome": "ok", "message": "", "hs_interleg": np.full(task.n_keep, np.nan),
                "hs_stance": np.full(task.n_keep, np.nan), "ss_outcome": "", "steps": 0}
         with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -93,7 +111,7 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
                 if x_att is not None:
                     x0 = walker.from_section(walker.section(x_att))
                 elif row["fp_outcome"] == "ok":
-                    x0 = row["x"] + np.array([0.0, 0.0, 0.0, 1e-6])
+                    x0 = row["x"] + _rate_nudge(walker, 1e-6)
                     x0 = walker.from_section(walker.section(x0))
                 else:
                     x0 = None
@@ -107,9 +125,10 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
                         row["ss_outcome"] = traj.termination
                         if len(segs) == task.n_transient:
                             keep = segs[-task.n_keep:]
-                            row["hs_interleg"] = np.array([abs(s.x_end[1] - s.x_end[0])
+                            row["hs_interleg"] = np.array([interleg_angle(walker, s.x_end)
                                                            for s in keep])
-                            row["hs_stance"] = np.array([s.x_next[1] for s in keep])
+                            row["hs_stance"] = np.array([_stance_angle(walker, s.x_next)
+                                                         for s in keep])
                             x_att = segs[-1].x_next
                             row["ss_outcome"] = "walks"
                         else:
@@ -139,9 +158,9 @@ def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
         Base scene mapping.
     slopes_deg : ndarray (n,)
         Grid slopes [deg], increasing.
-    mult : ndarray (n, 4) complex
-        Floquet multipliers at the grid slopes (NaN where no fixed point).
-    x : ndarray (n, 4)
+    mult : ndarray (n, 2m) complex
+        Floquet multipliers at the grid slopes (NaN where no fixed point); 2m states.
+    x : ndarray (n, 2m)
         Fixed points (continuation guesses for the refinement).
     xtol_deg : float
         brentq tolerance on the slope [deg].
@@ -184,9 +203,14 @@ class BifurcationResult:
     ----------
     slopes_deg : ndarray (n,)
         Slopes [deg].
-    fixed_point : ndarray (n, 4)
-        Period-1 fixed point just after heel strike [rad, rad, rad/s, rad/s] (NaN if none).
-    multipliers : ndarray (n, 4) complex
+    state_names, state_units : list of str (2m,)
+        The walker's state names and units (columns of ``fixed_point``).
+    fixed_point : ndarray (n, 2m)
+        Period-1 fixed point just after heel strike (NaN if none).
+    fixed_point_interleg_deg : ndarray (n,)
+        Inter-leg angle of the fixed point [deg] (see
+        :func:`walkerlab.sweep.points.interleg_angle`).
+    multipliers : ndarray (n, 2m) complex
         Floquet multipliers (variational), sorted by modulus.
     step_period_s : ndarray (n,)
         Period-1 step period [s].
@@ -208,7 +232,10 @@ class BifurcationResult:
     """
 
     slopes_deg: np.ndarray
+    state_names: list
+    state_units: list
     fixed_point: np.ndarray
+    fixed_point_interleg_deg: np.ndarray
     multipliers: np.ndarray
     step_period_s: np.ndarray
     fp_outcome: np.ndarray
@@ -266,8 +293,15 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
     mult = np.array([r["multipliers"] for r in rows])
     onset = locate_period_doubling(base, slopes, mult, x, xtol_deg)
     il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
+    from walkerlab.models.registry import build_walker
+    from walkerlab.sweep.points import interleg_angle
+
+    walker = build_walker(scene)
+    fp_il = np.degrees([interleg_angle(walker, xi) if np.all(np.isfinite(xi)) else math.nan
+                        for xi in x])
     return BifurcationResult(
-        slopes_deg=slopes, fixed_point=x, multipliers=mult,
+        slopes_deg=slopes, state_names=walker.state_names(), state_units=walker.state_units(),
+        fixed_point=x, fixed_point_interleg_deg=fp_il, multipliers=mult,
         step_period_s=np.array([r["period_s"] for r in rows]),
         fp_outcome=np.array([r["fp_outcome"] for r in rows], object),
         interleg_deg=il, stance_after_deg=np.degrees(np.array([r["hs_stance"] for r in rows])),
@@ -277,41 +311,54 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         n_transient=n_transient, n_keep=n_keep)
 
 
-def write_bifurcation(path: Path, scene: Scene, res: BifurcationResult, wall_time_s: float) -> Path:
-    """Write the diagram as a ``bifurcation`` artifact (atomic; units on every dataset)."""
-    from walkerlab.io.artifacts import put, write_artifact
-    from walkerlab.stages.common import input_hash
+def bifurcation_writer(res: BifurcationResult):
+    """``writer(h5file)`` filling a ``bifurcation`` artifact (netCDF dimensions ``slope``,
+    ``multiplier``, ``heel_strike``; units on every dataset)."""
+    from walkerlab.io.artifacts import put
+    from walkerlab.io.netcdf import coordinate
 
     def writer(f):
-        put(f, "slope", res.slopes_deg, "deg", "slope grid")
-        names = ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
-        for k, n in enumerate(names):
-            put(f, f"fixed_point/{n}", res.fixed_point[:, k], "rad" if k < 2 else "rad/s",
-                f"period-1 fixed point, {n} just after heel strike")
-        put(f, "fixed_point/step_period", res.step_period_s, "s", "period-1 step period")
+        coordinate(f, "slope", res.slopes_deg, "deg", "slope grid")
+        coordinate(f, "multiplier", np.arange(res.multipliers.shape[1]), "-",
+                   "Floquet multiplier number (sorted by modulus)")
+        coordinate(f, "heel_strike", np.arange(res.n_keep), "-",
+                   f"kept heel strike (last {res.n_keep} of {res.n_transient})")
+        f.attrs["state_names"] = list(res.state_names)
+        s = ("slope",)
+        for k, (n, u) in enumerate(zip(res.state_names, res.state_units)):
+            put(f, f"fixed_point/{n}", res.fixed_point[:, k], u,
+                f"period-1 fixed point, {n} just after heel strike", dims=s)
+        put(f, "fixed_point/interleg_angle", res.fixed_point_interleg_deg, "deg",
+            "inter-leg angle of the period-1 fixed point", dims=s)
+        put(f, "fixed_point/step_period", res.step_period_s, "s", "period-1 step period", dims=s)
         put(f, "fixed_point/outcome", [str(o) for o in res.fp_outcome], "-",
-            "typed outcome of the fixed-point search")
-        put(f, "floquet/real", res.multipliers.real, "-", "multipliers (n, 4), real part")
-        put(f, "floquet/imag", res.multipliers.imag, "-", "multipliers (n, 4), imaginary part")
+            "typed outcome of the fixed-point search", dims=s)
+        sm = ("slope", "multiplier")
+        put(f, "floquet/real", res.multipliers.real, "-", "Floquet multipliers, real part",
+            dims=sm)
+        put(f, "floquet/imag", res.multipliers.imag, "-", "Floquet multipliers, imaginary part",
+            dims=sm)
+        sh = ("slope", "heel_strike")
         put(f, "steady_state/interleg_angle", res.interleg_deg, "deg",
-            f"inter-leg angle at the last {res.n_keep} of {res.n_transient} heel strikes (n, k)")
+            f"inter-leg angle at the last {res.n_keep} of {res.n_transient} heel strikes",
+            dims=sh)
         put(f, "steady_state/stance_angle_after_impact", res.stance_after_deg, "deg",
-            "stance-leg angle just after those impacts (n, k)")
+            "stance-leg angle just after those impacts", dims=sh)
         put(f, "steady_state/outcome", [str(o) for o in res.ss_outcome], "-",
-            "'walks' or how the steady-state run ended")
+            "'walks' or how the steady-state run ended", dims=s)
         put(f, "steady_state/attractor_period", res.attractor_period, "steps",
-            "distinct kept values (1, 2, 4, ...; n_keep: no period found)")
-        put(f, "onset/slope", res.onset["onset_deg"], "deg",
+            "distinct kept values (1, 2, 4, ...; n_keep: no period found)", dims=s)
+        put(f, "onset/onset_slope", res.onset["onset_deg"], "deg",
             "period-doubling onset: a multiplier crosses -1 (brentq)")
-        put(f, "onset/bracket", res.onset["bracket_deg"], "deg", "grid bracket of the onset")
-        put(f, "onset/multiplier", res.onset["multiplier_at_onset"], "-",
+        put(f, "onset/bracket", res.onset["bracket_deg"], "deg", "grid bracket of the onset",
+            dims=("bracket_end",))
+        put(f, "onset/multiplier_at_onset", res.onset["multiplier_at_onset"], "-",
             "most negative real multiplier at the located onset")
-        put(f, "stats/wall_time", res.wall_time_s, "s", "wall time per slope")
+        put(f, "stats/wall_time", res.wall_time_s, "s", "wall time per slope", dims=s)
         f.attrs["n_transient"] = res.n_transient
         f.attrs["n_keep"] = res.n_keep
 
-    key = input_hash("bifurcation", scene, ("walker", "slope", "ideal", "solver", "fixedpoint"))
-    return write_artifact(Path(path), "bifurcation", scene, key, writer, wall_time_s)
+    return writer
 
 
 def load_bifurcation(path: Path) -> dict:
@@ -328,29 +375,3 @@ def load_bifurcation(path: Path) -> dict:
 
         f.visititems(visit)
     return out
-
-
-def run_bifurcation(scene: Scene, slopes_deg, runs_root: Path | str = "runs",
-                    n_transient: int = 100, n_keep: int = 30, workers: int = 2,
-                    scheduler=None, name: str = "bifurcation") -> dict:
-    """Compute, write ``runs/<scene>/<name>.h5`` and draw ``<name>.png/.svg`` from it.
-
-    Returns
-    -------
-    dict
-        ``artifact`` (Path), ``figures`` (list of Path), ``onset_deg`` (float),
-        ``wall_time_s`` (float).
-    """
-    from walkerlab.plotting.sweep_figures import bifurcation_figure, save
-
-    t0 = time.perf_counter()
-    res = bifurcation_diagram(scene, slopes_deg, n_transient, n_keep, workers, scheduler)
-    wall = time.perf_counter() - t0
-    folder = Path(runs_root) / (scene.name or "scene")
-    path = write_bifurcation(folder / f"{name}.h5", scene, res, wall)
-    w = scene.walker
-    title = (f"compass gait m={w.leg_mass_kg:g} kg, M_H={w.hip_mass_kg:g} kg, "
-             f"L={w.leg_length_m:g} m, a={w.leg_mass_from_foot_m:g} m")
-    figs = save(bifurcation_figure(load_bifurcation(path), title), folder, name)
-    return {"artifact": path, "figures": figs, "onset_deg": res.onset["onset_deg"],
-            "wall_time_s": wall}

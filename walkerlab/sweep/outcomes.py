@@ -28,18 +28,12 @@ from __future__ import annotations
 OUTCOMES = ("ok", "no_fixed_point", "fall", "trip", "scuffing", "slip", "bounce",
             "solver_failure", "max_steps", "time_limit", "invalid_config", "error")
 
-STATE_COLS = ("swing_angle_rad", "stance_angle_rad", "swing_rate_rad_per_s",
-              "stance_rate_rad_per_s")
-
-# column name -> (unit, description); all stored as float64 (NaN = not applicable)
+# column name -> (unit, description); all stored as float64 (NaN = not applicable).
+# Columns that depend on the walker's state (fixed point, initial state, multipliers) are
+# added by :func:`columns` from ``walker.state_names()``; these are the walker-free ones.
 _FP = {
-    **{c: ("rad" if "angle" in c else "rad/s", f"fixed point, {c} just after heel strike")
-       for c in STATE_COLS},
     "step_period_s": ("s", "step period of the period-1 gait"),
     "residual": ("rad or rad/s", "max |P(x) - x| at the last iterate"),
-    **{f"multiplier_{k}_{p}": ("-", f"Floquet multiplier {k} (variational, sorted by modulus), "
-                               f"{'real' if p == 're' else 'imaginary'} part")
-       for k in range(4) for p in ("re", "im")},
     "max_abs_multiplier": ("-", "largest |Floquet multiplier|"),
     "stable": ("-", "1 if all |multipliers| < 1, else 0"),
     "map_evaluations": ("-", "Poincare-map calls of the root finder"),
@@ -56,7 +50,6 @@ _SIM = {
     "interleg_angle_last_rad": ("rad", "inter-leg angle at the last heel strike"),
     "scuff_depth_m": ("m", "largest depth of the swing foot below the slope before heel "
                            "strike (the ideal model ignores it)"),
-    **{f"x0_{c}": ("rad" if "angle" in c else "rad/s", f"initial state, {c}") for c in STATE_COLS},
     "nfev": ("-", "right-hand-side evaluations"),
 }
 
@@ -93,6 +86,51 @@ STRING_COLUMNS = {
 }
 
 STAGES = tuple(COLUMNS)
+
+
+def state_column(name: str, unit: str) -> str:
+    """Column name of a state component: the name with its unit (``swing_angle_rad``)."""
+    return f"{name}_{unit.replace('/', '_per_')}"
+
+
+def columns(stage: str, state_names: list[str], state_units: list[str]) -> dict[str, tuple]:
+    """All float columns of ``stage`` for a walker with these state names and units.
+
+    Parameters
+    ----------
+    stage : str
+        One of :data:`STAGES`.
+    state_names, state_units : list of str, length 2n
+        ``walker.state_names()`` and ``walker.state_units()``.
+
+    Returns
+    -------
+    dict
+        column -> (unit, description); the fixed point (``<state>_<unit>``) and the 2n
+        Floquet multipliers (``multiplier_<k>_re|im``) for ``fixedpoint``, the initial state
+        (``x0_<state>_<unit>``) for ``simulate``.
+    """
+    out = dict(COLUMNS[stage])
+    named = [(state_column(n, u), u, n) for n, u in zip(state_names, state_units)]
+    if stage == "fixedpoint":
+        out.update({c: (u, f"fixed point, {n} just after heel strike") for c, u, n in named})
+        out.update({f"multiplier_{k}_{p}": ("-", f"Floquet multiplier {k} (variational, sorted "
+                                            f"by modulus), {'real' if p == 're' else 'imaginary'}"
+                                            " part")
+                    for k in range(len(state_names)) for p in ("re", "im")})
+    elif stage == "simulate":
+        out.update({f"x0_{c}": (u, f"initial state, {n}") for c, u, n in named})
+    return out
+
+
+def walker_columns(stage: str, scene) -> dict[str, tuple]:
+    """:func:`columns` for the rigid walker of ``scene`` (builds it to read its state names)."""
+    if stage not in ("fixedpoint", "simulate"):
+        return dict(COLUMNS[stage])
+    from walkerlab.models.registry import build_walker
+
+    w = build_walker(scene)
+    return columns(stage, w.state_names(), w.state_units())
 
 
 def empty_row(stage: str, index: int) -> dict:

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from walkerlab.config import Scene, SceneError
-from walkerlab.sweep.outcomes import STATE_COLS, empty_row
+from walkerlab.sweep.outcomes import empty_row, state_column
 from walkerlab.sweep.params import apply_point
 
 __all__ = ["Task", "run_chunk", "fixedpoint_point", "simulate_point", "contact_point",
@@ -117,19 +117,21 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
     walker = build_walker(scene)
     solver = _solver(scene)
     tries = ([("neighbour", np.asarray(guess, float))] if guess is not None else []) \
-        + [("scene", fp.initial_guess.as_array())]
+        + [("scene", fp.initial_guess.as_array(walker.state_names()))]
     best, msg = math.inf, ""
     for source, g in tries:
         try:
+            # the sweep keeps the variational multipliers only: no finite-difference check
             res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
-                                   max_step_time=fp.max_step_time_s)
+                                   max_step_time=fp.max_step_time_s, fd_check=False)
         except FixedPointNotFound as exc:
             if not (exc.residual >= best):  # keeps NaN out unless nothing better
                 best = exc.residual if math.isfinite(exc.residual) else best
             msg = str(exc)
             continue
-        if abs(res.x[1] - res.x[0]) < opts["min_interleg_angle_rad"]:
-            msg = (f"degenerate fixed point (inter-leg angle {abs(res.x[1] - res.x[0]):.2e} rad "
+        if interleg_angle(walker, res.x) < opts["min_interleg_angle_rad"]:
+            il = interleg_angle(walker, res.x)
+            msg = (f"degenerate fixed point (inter-leg angle {il:.2e} rad "
                    f"< {opts['min_interleg_angle_rad']:g}): no step")
             best = min(best, res.residual)
             continue
@@ -137,10 +139,27 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
     raise _Outcome("no_fixed_point", msg, residual=best if math.isfinite(best) else math.nan)
 
 
-def _fp_columns(res) -> dict:
-    cols = {c: float(v) for c, v in zip(STATE_COLS, res.x)}
+def interleg_angle(walker, x: np.ndarray) -> float:
+    """Angle [rad] between the legs, from the foot-to-foot distance ``d`` of state ``x``.
+
+    ``2 asin(d / 2L)`` with ``L = walker.params["leg_length_m"]``: for straight legs this is
+    ``|theta_swing - theta_stance|`` exactly; for any walker it is the angle of the isosceles
+    triangle hip-feet with the same step, so it needs no state row.
+    """
+    d = float(np.hypot(*walker.points(x)["swing_foot"]))
+    L = float(walker.params["leg_length_m"])
+    return float(2.0 * np.arcsin(min(1.0, d / (2.0 * L))))
+
+
+def _state_columns(walker, x, prefix: str = "") -> dict:
+    return {prefix + state_column(n, u): float(v)
+            for n, u, v in zip(walker.state_names(), walker.state_units(), x)}
+
+
+def _fp_columns(walker, res) -> dict:
+    cols = _state_columns(walker, res.x)
     mult = np.asarray(res.multipliers_variational, complex)
-    for k in range(4):
+    for k in range(len(walker.state_names())):
         z = mult[k] if k < mult.size else complex(math.nan, math.nan)
         cols[f"multiplier_{k}_re"], cols[f"multiplier_{k}_im"] = float(z.real), float(z.imag)
     cols.update(step_period_s=float(res.period_s), residual=float(res.residual),
@@ -161,8 +180,8 @@ def fixedpoint_point(scene: Scene, guess, options: dict):
     next_guess : ndarray (4,)
         The fixed point, for the next point of the chunk.
     """
-    _walker, res, source = ideal_fixed_point(scene, guess, options)
-    cols = _fp_columns(res)
+    walker, res, source = ideal_fixed_point(scene, guess, options)
+    cols = _fp_columns(walker, res)
     cols.update(outcome="ok", guess_source=source,
                 message="" if res.stable else "unstable period-1 gait (|multiplier| >= 1)")
     return cols, res.x
@@ -200,8 +219,8 @@ def simulate_point(scene: Scene, guess, options: dict):
         cols["guess_source"] = source
     else:
         walker = build_walker(scene)
-        x0 = sim.initial_state.as_array()
-    cols.update({f"x0_{c}": float(v) for c, v in zip(STATE_COLS, x0)})
+        x0 = sim.initial_state.as_array(walker.state_names())
+    cols.update(_state_columns(walker, x0, "x0_"))
     traj = simulate_steps(walker, x0, 2 * sim.strides, _solver(scene),
                           max_step_time=sim.max_step_time_s)
     segs = traj.segments
@@ -213,7 +232,7 @@ def simulate_point(scene: Scene, guess, options: dict):
         lengths = np.array([float(np.hypot(*walker.points(s.x_end)["swing_foot"])) for s in done])
         cols.update(mean_step_period_s=float(per.mean()), mean_step_length_m=float(lengths.mean()),
                     mean_hip_speed_m_per_s=float(lengths.mean() / per.mean()),
-                    interleg_angle_last_rad=float(abs(done[-1].x_end[1] - done[-1].x_end[0])))
+                    interleg_angle_last_rad=interleg_angle(walker, done[-1].x_end))
         depth = max(_scuff_depth(walker, s) for s in done)
         cols["scuff_depth_m"] = depth
     if last.termination == "fall":
@@ -360,7 +379,7 @@ def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: 
         except SceneError as exc:
             row.update(outcome="invalid_config", message=str(exc))
         except _Outcome as exc:
-            row.update({k: v for k, v in exc.cols.items() if k in row})
+            row.update(exc.cols)
             row.update(outcome=exc.outcome, message=exc.message)
         except (KeyboardInterrupt, SystemExit):
             raise

@@ -12,7 +12,18 @@ Executors
 - ``workers >= 2`` and no scheduler: ``concurrent.futures.ProcessPoolExecutor`` (forkserver
   processes on Linux, with the model functions built once in the server).
 - ``scheduler`` given: a Dask ``distributed`` cluster at that address (or a ``Client``);
-  the same :func:`walkerlab.sweep.points.run_chunk` runs on its workers.
+  the same :func:`run_piece` runs on its workers.
+
+Progress and robustness (issue 12)
+----------------------------------
+- A chunk is cut into *pieces* of at most :data:`PIECE_POINTS` points; the next piece of a
+  chunk is submitted when the previous one returns, with its last fixed point as the guess,
+  so continuation is unchanged while rows reach the file every few points (D12).
+- Local pool workers watch the main process and exit within about a second when it dies,
+  even by SIGKILL (D7); the forkserver and resource tracker then exit on their own.
+- The grid is capped at :data:`MAX_GRID_POINTS` points (product of the axes, D3).
+- One sweep per artifact at a time: a second identical sweep fails with one line (D4), and
+  an artifact is finalized only when every grid point has its row.
 """
 
 from __future__ import annotations
@@ -21,10 +32,12 @@ import hashlib
 import json
 import math
 import multiprocessing as mp
+import os
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, as_completed, wait
 from pathlib import Path
 from typing import Any
 
@@ -35,10 +48,14 @@ from walkerlab.config import Scene
 from walkerlab.io.artifacts import code_hash
 from walkerlab.sweep.outcomes import OUTCOMES, STAGES
 from walkerlab.sweep.params import ParamAxis, SweepError, grid_points
-from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, run_chunk, warm_up
-from walkerlab.sweep.store import SweepStore, partial_path
+from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, evaluate, run_chunk, warm_up
+from walkerlab.sweep.store import SweepStore, complete_sweep, partial_path
 
-__all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "sweep_input_hash"]
+__all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "iter_piece_results",
+           "run_piece", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS"]
+
+MAX_GRID_POINTS = 1_000_000   # a larger grid is refused (product of the axes' lengths)
+PIECE_POINTS = 4              # rows are saved at least every this many points per chunk
 
 
 def _dotted_get(d: dict, path: str):
@@ -121,6 +138,128 @@ def sweep_input_hash(scene: Scene, stage: str, axes: list[ParamAxis], options: d
     return h.hexdigest()
 
 
+def _process_alive(pid: int) -> bool:
+    """True while process ``pid`` exists and is not a zombie (Linux: /proc state 'Z')."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return True
+
+
+def _watch_parent(pid: int, period_s: float) -> None:
+    while _process_alive(pid):
+        time.sleep(period_s)
+    os._exit(1)  # the main process is gone: nobody will read our result
+
+
+def _worker_init(parent_pid: int, period_s: float = 0.5) -> None:
+    """Pool worker start-up: warm the model functions and watch the main process."""
+    threading.Thread(target=_watch_parent, args=(parent_pid, period_s), daemon=True,
+                     name="walkerlab-parent-watch").start()
+    warm_up()
+
+
+def run_piece(task: Task, guess: Any = None) -> tuple[list[dict], Any]:
+    """Evaluate a piece of a chunk in order, starting from the continuation ``guess``.
+
+    Returns
+    -------
+    rows : list of dict
+        One row per point (as :func:`walkerlab.sweep.points.run_chunk`).
+    guess : ndarray or None
+        Continuation guess for the chunk's next piece.
+    """
+    rows = []
+    for index, values in task.points:
+        row, nxt = evaluate(task.stage, task.base, task.paths, values, index, guess,
+                            task.options, task.origin)
+        rows.append(row)
+        guess = nxt if nxt is not None else guess
+    return rows, guess
+
+
+def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=None,
+                       pool: bool | None = None) -> Iterator[list[dict]]:
+    """Evaluate chains of pieces; yield each piece's rows as soon as it returns.
+
+    The pieces of one chain run one after the other (each starts from its predecessor's
+    last fixed point); different chains run in parallel.
+
+    Parameters
+    ----------
+    chains : list of list of Task
+    workers : int
+        Local processes (ignored with a scheduler).
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address or client; a worker lost mid-sweep is replaced by Dask
+        (its piece is recomputed elsewhere).
+    pool : bool, optional
+        Force (True) or forbid (False) a process pool; default: pool when ``workers > 1``.
+    """
+    chains = [c for c in chains if c]
+    if not chains:
+        return
+    if scheduler is not None:
+        from distributed import Client
+        from distributed import as_completed as dask_completed
+
+        own = isinstance(scheduler, str)
+        client = Client(scheduler, set_as_default=False) if own else scheduler
+        where = {}
+        futs = []
+        for ci, chain in enumerate(chains):
+            f = client.submit(run_piece, chain[0], None, pure=False)
+            where[f.key] = (ci, 0)
+            futs.append(f)
+        ac = dask_completed(futs, loop=client.loop)
+        try:
+            for fut in ac:
+                rows, guess = fut.result()
+                ci, k = where.pop(fut.key)
+                if k + 1 < len(chains[ci]):
+                    nf = client.submit(run_piece, chains[ci][k + 1], guess, pure=False)
+                    where[nf.key] = (ci, k + 1)
+                    futs.append(nf)
+                    ac.add(nf)
+                yield rows
+        finally:
+            client.cancel([f for f in futs if not f.done()])
+            if own:
+                client.close()
+        return
+    if not (pool if pool is not None else workers > 1):
+        warm_up()
+        for chain in chains:
+            guess = None
+            for t in chain:
+                rows, guess = run_piece(t, guess)
+                yield rows
+        return
+    ex = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=_mp_context(),
+                             initializer=_worker_init, initargs=(os.getpid(),))
+    try:
+        pending = {}
+        for ci, chain in enumerate(chains):
+            pending[ex.submit(run_piece, chain[0], None)] = (ci, 0)
+        while pending:
+            done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
+            for fut in done:
+                ci, k = pending.pop(fut)
+                rows, guess = fut.result()
+                if k + 1 < len(chains[ci]):
+                    pending[ex.submit(run_piece, chains[ci][k + 1], guess)] = (ci, k + 1)
+                yield rows
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
+
+
 def _mp_context():
     if sys.platform.startswith("linux"):
         ctx = mp.get_context("forkserver")
@@ -169,7 +308,7 @@ def iter_chunk_results(tasks: list[Task], workers: int = 2, scheduler=None,
             yield fn(t)
         return
     ex = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=_mp_context(),
-                             initializer=warm_up)
+                             initializer=_worker_init, initargs=(os.getpid(),))
     try:
         futs = [ex.submit(fn, t) for t in tasks]
         for fut in as_completed(futs):
@@ -208,7 +347,7 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     progress : bool
         Show a rich progress bar.
     on_chunk : callable(done_points, total_points), optional
-        Called after each chunk is written (raising ``KeyboardInterrupt`` there simulates
+        Called after each piece's rows are written (raising ``KeyboardInterrupt`` there simulates
         an interruption).
     pool : bool, optional
         Force a process pool even for one worker (True) or run in this process (False);
@@ -222,7 +361,10 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     Raises
     ------
     SweepError
-        Unknown stage, no axes, or a partial file of another sweep with ``resume``.
+        Unknown stage, no axes, a grid of more than :data:`MAX_GRID_POINTS` points, or a
+        partial file of another sweep with ``resume``.
+    walkerlab.io.runpaths.ArtifactBusy
+        Another process is running a sweep into the same artifact.
     KeyboardInterrupt
         Propagated after the finished rows are flushed to the partial file.
     """
@@ -233,16 +375,28 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     paths = [a.path for a in axes]
     if len(set(paths)) != len(paths):
         raise SweepError("sweep: a parameter is given twice")
+    n_total = math.prod(len(a) for a in axes)
+    if n_total > MAX_GRID_POINTS:
+        raise SweepError(f"sweep: the grid has {n_total:,} points "
+                         f"({' x '.join(str(len(a)) for a in axes)}); at most "
+                         f"{MAX_GRID_POINTS:,} are allowed")
     opts = {**DEFAULT_OPTIONS, **(options or {})}
     out_path = Path(out_path)
+    from walkerlab.io.runpaths import artifact_lock
+
+    with artifact_lock(out_path, wait=False):
+        return _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts,
+                           chunk_size, progress, on_chunk, pool, n_total)
+
+
+def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, chunk_size,
+                progress, on_chunk, pool, n_total) -> Path:
+    paths = [a.path for a in axes]
     key = sweep_input_hash(scene, stage, axes, opts)
     base = scene.model_dump(mode="json")
-    n_total = int(np.prod([len(a) for a in axes]))
     done: set[int] = set()
     if resume and out_path.is_file() and not partial_path(out_path).is_file():
-        from walkerlab.io.artifacts import stored_hash
-
-        if stored_hash(out_path) == key:
+        if complete_sweep(out_path, key):
             return out_path
     if resume and partial_path(out_path).is_file():
         store, done = SweepStore.resume(out_path, stage, axes, key)
@@ -251,7 +405,8 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     chunks = plan_chunks(axes, base, done, chunk_size, 1 if scheduler is None and workers <= 1
                          else max(2, workers))
     origin = scene.name or "<scene>"
-    tasks = [Task(stage, base, tuple(paths), tuple(c), opts, origin) for c in chunks]
+    chains = [[Task(stage, base, tuple(paths), tuple(c[k:k + PIECE_POINTS]), opts, origin)
+               for k in range(0, len(c), PIECE_POINTS)] for c in chunks]
     values_of = dict(enumerate(grid_points(axes)))
     t0 = time.perf_counter()
     from rich.progress import (
@@ -271,7 +426,7 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     try:
         with bar:
             tid = bar.add_task("points", total=n_total, completed=n_done, stats="")
-            for rows in iter_chunk_results(tasks, workers, scheduler, pool=pool):
+            for rows in iter_piece_results(chains, workers, scheduler, pool=pool):
                 store.append(rows, values_of)
                 n_done += len(rows)
                 for r in rows:
@@ -285,4 +440,4 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
         store.close()
         raise
     store.add_wall_time(time.perf_counter() - t0)
-    return store.finalize()
+    return store.finalize(n_total)

@@ -31,10 +31,11 @@ import h5py
 import numpy as np
 
 import walkerlab
-from walkerlab.sweep.outcomes import COLUMNS, OUTCOMES, STRING_COLUMNS
+from walkerlab.io import netcdf
+from walkerlab.sweep.outcomes import OUTCOMES, STRING_COLUMNS, walker_columns
 from walkerlab.sweep.params import ParamAxis, SweepError
 
-__all__ = ["SweepStore", "partial_path", "load_sweep"]
+__all__ = ["SweepStore", "partial_path", "load_sweep", "complete_sweep"]
 
 STR = h5py.string_dtype()
 
@@ -63,11 +64,18 @@ class SweepStore:
     def create(cls, final: Path, scene, stage: str, axes: list[ParamAxis], options: dict,
                input_hash: str) -> SweepStore:
         """Start a new partial file (an old one is overwritten)."""
+        from walkerlab.io.artifacts import ArtifactError
+
         final = Path(final)
-        final.parent.mkdir(parents=True, exist_ok=True)
         part = partial_path(final)
-        part.unlink(missing_ok=True)
-        f = h5py.File(part, "w")
+        try:
+            final.parent.mkdir(parents=True, exist_ok=True)
+            part.unlink(missing_ok=True)
+            f = h5py.File(part, "w")
+        except OSError as exc:
+            reason = exc.strerror or str(exc).rpartition("error message = ")[2].strip("' )")
+            raise ArtifactError(f"{part}: cannot create the sweep file ({reason})") from None
+        os.chmod(part, 0o644)
         f.attrs.update({
             "stage": "sweep", "walkerlab_version": walkerlab.__version__,
             "scene_name": scene.name or "", "scene_json": scene.model_dump_json(),
@@ -98,7 +106,7 @@ class SweepStore:
         for name, desc in STRING_COLUMNS.items():
             mk(name, STR, "-", desc)
         mk("wall_time_s", np.float64, "s", "wall time of the point on its worker")
-        for name, (unit, desc) in COLUMNS[stage].items():
+        for name, (unit, desc) in walker_columns(stage, scene).items():
             mk(name, np.float64, unit, desc)
         f.flush()
         return cls(final, f, stage, axes)
@@ -149,8 +157,10 @@ class SweepStore:
         for name in STRING_COLUMNS:
             put(name, np.asarray([str(r.get(name, "")) for r in rows], dtype=object))
         put("wall_time_s", np.array([r["wall_time_s"] for r in rows], float))
-        for name in COLUMNS[self.stage]:
-            put(name, np.array([r.get(name, np.nan) for r in rows], float))
+        fixed = {"index", "wall_time_s", *STRING_COLUMNS}
+        for name, ds in g.items():  # the stage's float columns, as created for this walker
+            if isinstance(ds, h5py.Dataset) and name not in fixed:
+                put(name, np.array([r.get(name, np.nan) for r in rows], float))
         self.f.flush()
 
     def add_wall_time(self, seconds: float) -> None:
@@ -163,10 +173,23 @@ class SweepStore:
         if self.f.id.valid:
             self.f.close()
 
-    def finalize(self) -> Path:
-        """Sort rows by index, write the outcome summary, rename to the final name."""
+    def finalize(self, n_expected: int | None = None) -> Path:
+        """Sort rows by index, write the outcome summary, rename to the final name.
+
+        Raises
+        ------
+        SweepError
+            Fewer distinct rows than ``n_expected`` grid points (the partial file is kept
+            for ``--resume``; a half-done sweep is never reported as done).
+        """
         f = self.f
         g = f["points"]
+        if n_expected is not None:
+            n_rows = np.unique(g["index"][()]).size
+            if n_rows != n_expected:
+                f.close()
+                raise SweepError(f"{partial_path(self.final)}: only {n_rows} of {n_expected} "
+                                 "grid points have a row; rerun with --resume")
         order = np.argsort(g["index"][()], kind="stable")
 
         def visit(name, obj):
@@ -181,9 +204,22 @@ class SweepStore:
         ds = f.create_dataset("summary/outcome_counts", data=counts)
         ds.attrs.update(outcomes=list(OUTCOMES), unit="-", description="points per outcome")
         f.attrs["complete"] = True
+        netcdf.finish_sweep(f)
         f.close()
         os.replace(partial_path(self.final), self.final)
         return self.final
+
+
+def complete_sweep(path: Path, input_hash: str) -> bool:
+    """True if ``path`` is a finished sweep of this input hash with a row per grid point."""
+    try:
+        with h5py.File(path, "r") as f:
+            return (f.attrs.get("walkerlab_version") == walkerlab.__version__
+                    and f.attrs.get("input_hash") == input_hash
+                    and bool(f.attrs.get("complete", False))
+                    and np.unique(f["points/index"][()]).size == int(f.attrs["n_points"]))
+    except (OSError, KeyError):
+        return False
 
 
 def load_sweep(path: Path) -> dict:

@@ -1,0 +1,88 @@
+"""Basin of attraction: cell classification, the stage's artifact and resuming (small grids)."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from walkerlab.config import BasinSettings, load_scene
+from walkerlab.sweep.basin import CODE, NOT_DONE, BasinError, classify_cell, slice_state
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _scene(tmp_path, walker, fp, **basin):
+    """Paper walker, ideal only; basin axes centred on the fixed point ``fp`` (5 x 3 cells,
+    so the middle cell is the fixed point itself)."""
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    for k in ("contact", "terrain", "contact_sim", "contact_solver", "workprecision",
+              "simulate"):
+        d.pop(k, None)
+    names = walker.state_names()
+    a, r = float(fp[names.index("stance_angle")]), float(fp[names.index("stance_rate")])
+    d["basin"] = {"x_range": [a - 0.3, a + 0.3], "y_range": [r - 1.2, r + 1.2],
+                  "grid": [5, 3], "max_steps": 25, **basin}
+    p = tmp_path / "basin_scene.yaml"
+    p.write_text(yaml.safe_dump(d))
+    return load_scene(p)
+
+
+def test_fixed_point_converges_and_far_cell_falls(paper_walker, paper_fixed_point):
+    from walkerlab.analysis.hybrid import Solver
+
+    fp = paper_fixed_point.x
+    st = BasinSettings(max_steps=25)
+    sv = Solver("DOP853", st.rtol, st.atol)
+    names = paper_walker.state_names()
+    x0 = slice_state(paper_walker, fp, ("stance_angle", "stance_rate"),
+                     (fp[names.index("stance_angle")], fp[names.index("stance_rate")]))
+    np.testing.assert_allclose(x0, fp, atol=1e-15)  # the slice passes through x*
+    code, steps, period = classify_cell(paper_walker, x0, fp, sv, st)
+    assert (code, steps, period) == (CODE["converged"], 1, 1)
+    # a small kick is damped (|multipliers| <= 0.59): back within 1e-4 in < 25 steps
+    x1 = slice_state(paper_walker, fp, ("stance_angle", "stance_rate"),
+                     (fp[names.index("stance_angle")] + 0.01, fp[names.index("stance_rate")]))
+    code, steps, _ = classify_cell(paper_walker, x1, fp, sv, st)
+    assert code == CODE["converged"] and 3 <= steps < 25
+    # leaning far back with the stance leg rotating backwards: it falls back, first step
+    xb = slice_state(paper_walker, fp, ("stance_angle", "stance_rate"), (0.3, 0.5))
+    assert classify_cell(paper_walker, xb, fp, sv, st)[:2] == (CODE["fell_backward"], 1)
+    # the heel-strike constraint fixes the swing angle: not a free axis
+    with pytest.raises(BasinError, match="basin.x_axis"):
+        slice_state(paper_walker, fp, ("swing_angle", "stance_rate"), (0.1, -1.0))
+
+
+def test_basin_stage_artifact_and_resume(tmp_path, paper_walker, paper_fixed_point):
+    from walkerlab.io.artifacts import open_artifact
+    from walkerlab.stages import basin
+
+    sc = _scene(tmp_path, paper_walker, paper_fixed_point.x)
+    runs = tmp_path / "runs"
+    calls = []
+
+    def interrupt(done, total):
+        calls.append(done)
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        basin.run(sc, runs, workers=1, on_chunk=interrupt)
+    part = runs / sc.name / "basin.h5.partial"
+    import h5py
+
+    with h5py.File(part, "r") as f:
+        first = f["outcome"][()]
+    assert np.sum(first != NOT_DONE) == calls[0] == 5  # one grid row stored
+    out = basin.run(sc, runs, workers=1)
+    assert not out.reused and not part.exists()
+    with open_artifact(out.path, "basin") as f:
+        assert f["stats/cells_computed"][()] == 10  # the resumed run did the other 2 rows
+        outcome = f["outcome"][()]
+        assert outcome.shape == (3, 5) and f["x"].attrs["unit"] == "rad"
+        assert [str(o) for o in f.attrs["outcomes"]][outcome[1, 2]] == "converged"
+        assert f["period"][1, 2] == 1
+    kept = first != NOT_DONE
+    np.testing.assert_array_equal(outcome[kept], first[kept])
+    assert np.all(outcome != NOT_DONE)
+    assert (runs / sc.name / "report" / "figures" / "basin.png").is_file()
+    assert basin.run(sc, runs, workers=1).reused

@@ -1,0 +1,120 @@
+"""Every shipped scene through fixedpoint -> simulate -> report -> a 3-point sweep.
+
+Parametrised over ``configs/*.yaml``, so a new scene is picked up without editing this file.
+Each scene is reduced to keep the test fast (1 stride, no work-precision study, no periodic
+contact gait, 1 contact stride); the contact stages run only where the scene has contact.
+Every artifact must open with ``xarray.open_dataset(engine="h5netcdf")`` in every group,
+with named dimensions (no anonymous "phony" dimensions) and ``units`` on every variable.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+from walkerlab.config import load_scene
+from walkerlab.io.readers import load_fixed_point
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = sorted((ROOT / "configs").glob("*.yaml"))
+
+
+def reduced(path: Path, tmp: Path):
+    """A fast copy of a scene: one stride, no work-precision study, one contact stride."""
+    d = yaml.safe_load(path.read_text())
+    d.setdefault("name", path.stem)
+    d.pop("workprecision", None)
+    if "simulate" in d:
+        d["simulate"]["strides"] = 1
+        d["simulate"]["sample_rate_hz"] = min(200, d["simulate"].get("sample_rate_hz", 200))
+    if "contact_sim" in d:
+        d["contact_sim"]["n_strides"] = 1
+        d["contact_sim"]["periodic_gait"] = False
+    p = tmp / path.name
+    p.write_text(yaml.safe_dump(d))
+    return load_scene(p)
+
+
+def groups(path: Path) -> list[str | None]:
+    out: list[str | None] = [None]
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda n, o: out.append(n) if isinstance(o, h5py.Group) else None)
+    return out
+
+
+def assert_netcdf(path: Path) -> None:
+    """Every group opens in xarray with named dimensions and units on every variable."""
+    import warnings
+
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # h5netcdf warns on anonymous dimensions
+        for g in groups(path):
+            with xr.open_dataset(path, engine="h5netcdf", group=g) as ds:
+                assert not [d for d in ds.dims if str(d).startswith("phony_dim")], (path, g)
+                for name, v in ds.variables.items():
+                    assert "units" in v.attrs, f"{path}:{g}/{name} has no units"
+
+
+@pytest.mark.parametrize("scene_path", SCENES, ids=[p.stem for p in SCENES])
+def test_scene_end_to_end(scene_path, tmp_path):
+    from walkerlab.stages import fixedpoint, report, simulate
+    from walkerlab.stages import sweep as sweep_stage
+    from walkerlab.sweep.store import load_sweep
+
+    scene = reduced(scene_path, tmp_path)
+    runs = tmp_path / "runs"
+    fp = fixedpoint.run(scene, runs)
+    x, meta = load_fixed_point(fp.path)
+    assert meta["residual"] < 1e-8  # the root finder's tolerance is far below this
+    assert x.shape == (len(meta["state_names"]),)
+    sim = simulate.run(scene, runs)
+    with h5py.File(sim.path, "r") as f:
+        names = [str(n) for n in f["samples"].attrs["coordinates"]]
+        tot, step = f["samples/energy/total"][()], f["samples/step_index"][()]
+        phase = f["samples/phase"][()]
+        assert str(f.attrs["termination"]) == "heel_strike"
+    # every coordinate of the walker appears by physical name (a kneed walker also names
+    # the stance leg's locked thigh and shank), each angle with its rate
+    angles = [n for n in names if n.endswith("_angle")]
+    assert len(names) >= len(meta["state_names"]) and len(names) == 2 * len(angles)
+    assert all(a.removesuffix("_angle") + "_rate" in names for a in angles)
+    # a passive rigid walker conserves energy between impacts (heel strike, knee strike):
+    # within each phase of each step (relative bound far above the solver's rtol 1e-10)
+    for k in np.unique(step):
+        for ph in np.unique(phase[step == k]):
+            e = tot[(step == k) & (phase == ph)]
+            assert np.ptp(e) < 1e-6 * np.max(np.abs(tot))
+
+    html = report.run(scene, runs, echo=lambda s: None)
+    md = (html.parent / "report.md").read_text()
+    assert md.index("## Summary") < md.index("## Fixed point")
+    assert "<details>" in md
+    has_contact = scene.contact is not None
+    assert ("## Comparison ideal vs contact" in md) == has_contact
+    assert ("work-precision" in md) is False  # reduced scenes have no work-precision section
+    assert (("published (" in md) == (scene.published is not None))
+    figs = {p.name for p in (html.parent / "figures").glob("*.png")}
+    assert {"fig7_angles_rates.png", "fig9_limit_cycles.png", "fig2_stick_ideal.png"} <= figs
+    assert ("fig8_errors.png" in figs) == has_contact
+
+    slope = scene.slope.angle_deg if scene.slope.angle_deg is not None else \
+        float(np.degrees(scene.slope.angle_rad))
+    grid = ",".join(f"{slope * f:.6g}" for f in (0.98, 1.0, 1.02))
+    sw = sweep_stage.run(scene, [f"slope.angle_deg={grid}"], "fixedpoint", workers=1,
+                         runs_root=runs, name="tiny", progress=False)
+    data = load_sweep(sw)["points"]
+    assert list(data["outcome"]).count("ok") >= 2, list(data["message"])
+    for n, u in zip(meta["state_names"], meta["state_units"]):
+        col = f"{n}_{u.replace('/', '_per_')}"
+        assert col in data  # one column per state, named by the walker
+    mid = data["outcome"] == "ok"
+    assert np.all(np.isfinite(data[f"multiplier_{len(meta['state_names']) - 1}_re"][mid]))
+
+    for p in [fp.path, sim.path, sw, *(runs / scene.name).glob("compare.h5")]:
+        assert_netcdf(p)

@@ -1,0 +1,147 @@
+"""netCDF-4 conventions on top of h5py, so other tools open walkerlab's artifacts.
+
+A netCDF-4 file is an HDF5 file in which every array is attached to named *dimension scales*
+and carries ``units`` and ``long_name`` attributes.  Following them makes
+``xarray.open_dataset(path, engine="h5netcdf", group="samples/coordinates")`` return named
+dimensions (``time``, ``state``, ``slope``, ``point`` ...) and units, while h5py stays the
+writer and walkerlab's own ``unit``/``description`` attributes stay as they are.
+
+- :func:`coordinate` writes a coordinate variable (a dataset that is its own dimension
+  scale, e.g. ``samples/time``);
+- :func:`attach` attaches named dimensions to a dataset, looking for the scale in the
+  dataset's group and its ancestors (netCDF scoping) and creating a dimension without a
+  coordinate variable when there is none of the right length;
+- :func:`finish` runs once before a file is closed: it adds ``units``/``long_name`` where
+  missing and attaches a fallback dimension ``<name>_dim<i>`` to any axis still without one,
+  so no reader ever sees an anonymous ("phony") dimension.
+
+Nested groups open with ``group="a/b"``; dimensions defined in a parent group are visible in
+its children, as in netCDF.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import h5py
+import numpy as np
+
+# netCDF-C's marker for a dimension that has no coordinate variable.
+_NOVAR = "This is a netCDF dimension but not a netCDF variable."
+
+
+def cf_units(unit: str) -> str:
+    """netCDF/UDUNITS spelling of a walkerlab unit string (``"-"`` or ``""`` -> ``"1"``)."""
+    return "1" if unit in ("", "-") else unit
+
+
+def coordinate(group: h5py.Group, name: str, values, unit: str, long_name: str) -> h5py.Dataset:
+    """Write a coordinate variable ``name`` that is the dimension scale ``name``.
+
+    Parameters
+    ----------
+    values : array_like, shape (k,)
+        Numbers or strings (stored as UTF-8 variable-length strings).
+    unit : str
+        walkerlab unit (stored as ``unit`` and, netCDF spelling, ``units``).
+    """
+    values = np.asarray(values)
+    if values.dtype.kind in "UO":
+        values = np.asarray([str(v) for v in values], dtype=h5py.string_dtype())
+    ds = group.create_dataset(name, data=values)
+    ds.make_scale(name)
+    ds.attrs["unit"] = unit
+    ds.attrs["units"] = cf_units(unit)
+    ds.attrs["description"] = long_name
+    ds.attrs["long_name"] = long_name
+    return ds
+
+
+def _find_scale(group: h5py.Group, name: str, size: int) -> h5py.Dataset | None:
+    g = group
+    while True:
+        obj = g.get(name)
+        if isinstance(obj, h5py.Dataset) and obj.is_scale and obj.shape[:1] == (size,):
+            return obj
+        if g.name == "/":
+            return None
+        g = g.parent
+
+
+def attach(ds: h5py.Dataset, dims: Sequence[str | None]) -> None:
+    """Attach dimension ``dims[i]`` to axis ``i`` of ``ds`` (None: leave the axis alone).
+
+    A scale of that name and length in the dataset's group or an ancestor is used; otherwise
+    a dimension without a coordinate variable is created in the dataset's group.
+
+    Raises
+    ------
+    ValueError
+        ``dims`` has the wrong length, or the name is taken by a dataset of another length
+        in the dataset's own group.
+    """
+    if len(dims) != ds.ndim:
+        raise ValueError(f"{ds.name}: {len(dims)} dimension names for a {ds.ndim}-D dataset")
+    for i, name in enumerate(dims):
+        if name is None:
+            continue
+        n = ds.shape[i]
+        sc = _find_scale(ds.parent, name, n)
+        if sc is None:
+            if name in ds.parent:
+                raise ValueError(f"{ds.name}: dimension '{name}' exists with another length")
+            maxshape = (None,) if ds.maxshape[i] is None else (n,)
+            sc = ds.parent.create_dataset(name, shape=(n,), maxshape=maxshape, dtype="f4",
+                                          chunks=(max(1, min(n, 256)),) if maxshape[0] is None
+                                          else None)
+            sc.make_scale(f"{_NOVAR}{n:10d}")
+        ds.dims[i].attach_scale(sc)
+
+
+def finish(f: h5py.File) -> None:
+    """Add ``units``/``long_name`` where missing and name every still anonymous axis."""
+    todo: list[h5py.Dataset] = []
+
+    def visit(_name, obj):
+        if isinstance(obj, h5py.Dataset):
+            todo.append(obj)
+
+    f.visititems(visit)
+    for ds in todo:
+        if ds.is_scale and str(ds.attrs.get("NAME", b"")).find(_NOVAR) >= 0:
+            continue
+        if "units" not in ds.attrs and "unit" in ds.attrs:
+            ds.attrs["units"] = cf_units(str(ds.attrs["unit"]))
+        if "long_name" not in ds.attrs:
+            ds.attrs["long_name"] = str(ds.attrs.get("description", "")) or ds.name.rsplit(
+                "/", 1)[-1]
+        if ds.is_scale or ds.ndim == 0:
+            continue
+        base = ds.name.rsplit("/", 1)[-1]
+        missing = [None if len(ds.dims[i]) else f"{base}_dim{i}" for i in range(ds.ndim)]
+        if any(missing):
+            attach(ds, missing)
+
+
+def finish_sweep(f: h5py.File) -> None:
+    """netCDF dimensions of a finalized sweep file: ``point`` (rows) and ``axis_<i>`` (grid).
+
+    Every dataset under ``points/`` is one value per row, so it gets dimension ``point``;
+    each ``grid/axis_<i>`` becomes its own coordinate variable.
+    """
+    g = f["points"]
+    n = int(g["index"].shape[0])
+    if "point" not in g:
+        sc = g.create_dataset("point", shape=(n,), dtype="f4")
+        sc.make_scale(f"{_NOVAR}{n:10d}")
+    rows: list[h5py.Dataset] = []
+    g.visititems(lambda _n, o: rows.append(o) if isinstance(o, h5py.Dataset)
+                 and not o.is_scale and o.ndim == 1 else None)
+    for ds in rows:
+        if not len(ds.dims[0]):
+            ds.dims[0].attach_scale(g["point"])
+    if "grid" in f:
+        for name, ds in f["grid"].items():
+            if isinstance(ds, h5py.Dataset) and not ds.is_scale:
+                ds.make_scale(name)
+    finish(f)

@@ -1,0 +1,331 @@
+"""Python source of a walker's equations, generated from :class:`~walkerlab.models.symbolic.Equations`.
+
+The generated module defines one function, ``make(p) -> dict[str, callable]``, that binds the
+parameter vector ``p`` (``Structure.param_names`` order) in closures.  The hot functions
+(``flow``, ``flow_jacobian``, ``reset``, ``reset_jacobian``, guards) are straight-line scalar
+code on Python floats (sympy ``cse`` + ``pycode``, ``math`` functions) with the small linear
+solve written out as an adjugate / determinant (the matrices are n x n with n <= 3); the
+functions used on whole trajectories (``energies``, ``points``, ``leg_angles``) are numpy code
+that accepts states of shape (2n,) or (2n, k).
+
+Generated functions (``x`` is the role-ordered state ``[q, dq]``, shape (2n,)):
+
+==================  ==========================================================================
+``flow(t, x)``      ``[dq, qdd]`` with ``M qdd = -C dq - G`` (2n,)
+``flow_jacobian``   ``(t, x) -> d flow / dx`` (2n, 2n), for variational equations / stiff solvers
+``reset(x)``        heel-strike impact and role swap (2n,)
+``reset_jacobian``  ``x -> d reset / dx`` (2n, 2n)
+``guard_<name>``    ``(t, x) -> float``; ``grad_<name>(x)`` its gradient (2n,)
+``section(x)``      state without the coordinate eliminated on the heel-strike surface (2n-1,)
+``from_section(z)`` inverse of ``section`` on that surface (2n,)
+``energies(X)``     ``(kinetic, potential)`` [J]
+``points(X)``       dict of named positions (2,) or (2, k) [m]
+``leg_angles(X)``   dict ``stance_angle, swing_angle, stance_rate, swing_rate`` (absolute)
+``matrices(x)``     ``(M, C, G)`` numpy arrays
+``impact_matrices`` ``q -> (De, E)`` extended impact system (paper Eq. 6-7)
+==================  ==========================================================================
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import sympy as sp
+from sympy.printing.numpy import NumPyPrinter
+from sympy.printing.pycode import PythonCodePrinter
+
+from walkerlab.models.symbolic import Equations
+
+_PY = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
+_NP = NumPyPrinter({"fully_qualified_modules": True})
+IND = "        "
+
+
+_HOISTED: list[str] = []  # parameter-only subexpressions, computed once in make(p)
+_PARAMS: set = set()
+_COUNT = [0]
+
+
+def _cse_lines(exprs, printer):
+    """``(lines, reduced)``: common subexpressions as assignments, and the reduced exprs.
+
+    Subexpressions of the parameters only are moved to ``make(p)`` (closure constants)."""
+    _COUNT[0] += 1
+    repl, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols(f"_c{_COUNT[0]}_"),
+                           order="none")
+    const = set(_PARAMS)
+    lines = []
+    for a, e in repl:
+        if e.free_symbols <= const:
+            const.add(a)
+            _HOISTED.append(f"    {printer.doprint(a)} = {printer.doprint(e)}")
+        else:
+            lines.append(f"{IND}{printer.doprint(a)} = {printer.doprint(e)}")
+    return lines, reduced
+
+
+def _unpack(eq: Equations) -> str:
+    names = ", ".join(str(s) for s in (*eq.q, *eq.dq))
+    return f"{IND}{names}, = x.tolist() if hasattr(x, 'tolist') else x"
+
+
+def _solve_lines(n: int, mnames, prefix: str) -> tuple[list[str], list[list[str]]]:
+    """Lines computing the inverse of the n x n matrix whose entries are named ``mnames``."""
+    S = sp.Matrix(n, n, lambda i, j: sp.Symbol(mnames[i][j]))
+    det = S.det(method="berkowitz")
+    adj = S.adjugate()
+    lines = [f"{IND}{prefix}id = 1.0 / ({_PY.doprint(det)})"]
+    inv = [[f"{prefix}{i}{j}" for j in range(n)] for i in range(n)]
+    for i in range(n):
+        for j in range(n):
+            lines.append(f"{IND}{inv[i][j]} = ({_PY.doprint(adj[i, j])}) * {prefix}id")
+    return lines, inv
+
+
+def _matvec(inv, vec) -> list[str]:
+    return [" + ".join(f"{inv[i][j]} * {vec[j]}" for j in range(len(vec))) for i in range(len(inv))]
+
+
+def _assign(names, exprs) -> list[str]:
+    return [f"{IND}{a} = {_PY.doprint(e)}" for a, e in zip(names, exprs)]
+
+
+def _array(rows) -> str:
+    if rows and isinstance(rows[0], list):
+        return "np.array((" + ", ".join("(" + ", ".join(r) + ",)" for r in rows) + ",))"
+    return "np.array((" + ", ".join(rows) + ",))"
+
+
+def _flow(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
+    n = len(eq.q)
+    q, dq = eq.q, eq.dq
+    r = -eq.C * sp.Matrix(dq) - eq.G
+    exprs = list(eq.M) + list(r)
+    if jac:
+        exprs += [sp.diff(eq.M[i, j], q[k]) for k in range(n) for i in range(n) for j in range(n)]
+        exprs += [sp.diff(r[i], q[k]) for k in range(n) for i in range(n)]
+        exprs += [sp.diff(r[i], dq[k]) for k in range(n) for i in range(n)]
+    lines, red = _cse_lines(exprs, _PY)
+    mn = [[f"_M{i}{j}" for j in range(n)] for i in range(n)]
+    rn = [f"_r{i}" for i in range(n)]
+    lines += _assign([x for row in mn for x in row] + rn, red[:n * n + n])
+    inv_lines, inv = _solve_lines(n, mn, "_i")
+    lines += inv_lines
+    qdd = [f"_a{i}" for i in range(n)]
+    lines += [f"{IND}{a} = {e}" for a, e in zip(qdd, _matvec(inv, rn))]
+    name = name or ("flow_jacobian" if jac else "flow")
+    head = [f"    def {name}(t, x):", _unpack(eq)]
+    if not jac:
+        return head + lines + [f"{IND}return {_array([str(s) for s in dq] + qdd)}"]
+    k0 = n * n + n
+    dM = red[k0:k0 + n ** 3]
+    dr_q = red[k0 + n ** 3:k0 + n ** 3 + n * n]
+    dr_dq = red[k0 + n ** 3 + n * n:]
+    cols = []
+    for k in range(n):  # d qdd / d q_k = Minv (dr/dq_k - dM/dq_k qdd)
+        w = []
+        for i in range(n):
+            terms = " + ".join(f"({_PY.doprint(dM[k * n * n + i * n + j])}) * {qdd[j]}"
+                               for j in range(n))
+            w.append(f"_w{k}_{i}")
+            lines.append(f"{IND}_w{k}_{i} = {_PY.doprint(dr_q[k * n + i])} - ({terms})")
+        cols.append(_matvec(inv, w))
+    for k in range(n):  # d qdd / d dq_k = Minv dr/d dq_k
+        w = []
+        for i in range(n):
+            w.append(f"_v{k}_{i}")
+            lines.append(f"{IND}_v{k}_{i} = {_PY.doprint(dr_dq[k * n + i])}")
+        cols.append(_matvec(inv, w))
+    rows = [["0.0"] * (2 * n) for _ in range(n)]
+    for i in range(n):
+        rows[i][n + i] = "1.0"
+    for i in range(n):
+        rows.append([f"({cols[c][i]})" for c in range(2 * n)])
+    return head + lines + [f"{IND}return {_array(rows)}"]
+
+
+def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
+    """``Mi dq+ = B dq-`` then the role swap ``q_new = relabel_q(q)``, ``dq_new = R dq+``."""
+    n = len(eq.q)
+    q, dq = eq.q, eq.dq
+    exprs = list(eq.Mi) + list(eq.B)
+    if jac:
+        exprs += [sp.diff(eq.Mi[i, j], q[k]) for k in range(n) for i in range(n) for j in range(n)]
+        exprs += [sp.diff(eq.B[i, j], q[k]) for k in range(n) for i in range(n) for j in range(n)]
+    lines, red = _cse_lines(exprs, _PY)
+    mn = [[f"_M{i}{j}" for j in range(n)] for i in range(n)]
+    bn = [[f"_B{i}{j}" for j in range(n)] for i in range(n)]
+    lines += _assign([x for row in mn + bn for x in row], red[:2 * n * n])
+    inv_lines, inv = _solve_lines(n, mn, "_i")
+    lines += inv_lines
+    dqs = [str(s) for s in dq]
+    lines += [f"{IND}_h{i} = {e}" for i, e in enumerate(_matvec(bn, dqs))]
+    post = [f"_p{i}" for i in range(n)]
+    lines += [f"{IND}{a} = {e}" for a, e in zip(post, _matvec(inv, [f"_h{i}" for i in range(n)]))]
+    R = eq.relabel_rate
+    qn = [_PY.doprint(e) for e in eq.relabel_q]
+    dqn = [_PY.doprint(e) for e in R * sp.Matrix([sp.Symbol(p) for p in post])]
+    name = name or ("reset_jacobian" if jac else "reset")
+    head = [f"    def {name}(x):", _unpack(eq)]
+    if not jac:
+        return head + lines + [f"{IND}return {_array(qn + dqn)}"]
+    k0 = 2 * n * n
+    dMi, dB = red[k0:k0 + n ** 3], red[k0 + n ** 3:]
+    # d dq+ / d q_k = Minv (dB/dq_k dq- - dMi/dq_k dq+);  d dq+ / d dq- = Minv B
+    D = sp.zeros(n, 2 * n)
+    for k in range(n):
+        for i in range(n):
+            w = sum(dB[k * n * n + i * n + j] * dq[j] - dMi[k * n * n + i * n + j] * sp.Symbol(post[j])
+                    for j in range(n))
+            lines.append(f"{IND}_w{k}_{i} = {_PY.doprint(w)}")
+        col = _matvec(inv, [f"_w{k}_{i}" for i in range(n)])
+        for i in range(n):
+            lines.append(f"{IND}_D{i}_{k} = {col[i]}")
+            D[i, k] = sp.Symbol(f"_D{i}_{k}")
+    for k in range(n):
+        col = _matvec(inv, [bn[i][k] for i in range(n)])
+        for i in range(n):
+            lines.append(f"{IND}_D{i}_{n + k} = {col[i]}")
+            D[i, n + k] = sp.Symbol(f"_D{i}_{n + k}")
+    Jq = eq.relabel_q.jacobian(sp.Matrix(q))
+    rows = [[_PY.doprint(Jq[i, j]) for j in range(n)] + ["0.0"] * n for i in range(n)]
+    RD = R * D
+    rows += [[_PY.doprint(RD[i, j]) for j in range(2 * n)] for i in range(n)]
+    return head + lines + [f"{IND}return {_array(rows)}"]
+
+
+def _guards(eq: Equations) -> list[str]:
+    x = sp.Matrix([*eq.q, *eq.dq])
+    out = []
+    for name, g in eq.guards.items():
+        lines, red = _cse_lines([g], _PY)
+        out += [f"    def guard_{name}(t, x):", _unpack(eq), *lines,
+                f"{IND}return {_PY.doprint(red[0])}"]
+        grad = [sp.diff(g, s) for s in x]
+        lines, red = _cse_lines(grad, _PY)
+        out += [f"    def grad_{name}(x):", _unpack(eq), *lines,
+                f"{IND}return {_array([_PY.doprint(e) for e in red])}"]
+    return out
+
+
+def _section(eq: Equations) -> list[str]:
+    n = len(eq.q)
+    d = eq.section_drop
+    tied = eq.section_tied or {}
+    keep = [i for i in range(2 * n) if i != d and i not in tied]
+    z = sp.symbols(f"z0:{len(keep)}")
+    full = sp.Matrix([*eq.q, *eq.dq])
+    sub = {full[i]: z[k] for k, i in enumerate(keep)}
+    xs = [str(z[keep.index(i)]) if i in keep else _PY.doprint(eq.drop_solution.subs(sub))
+          for i in range(2 * n)]
+    for i, j in tied.items():
+        xs[i] = xs[j]
+    return [
+        "    def section(x):",
+        f"{IND}return np.asarray(x)[{keep!r}]",
+        "    def from_section(z):",
+        f"{IND}{', '.join(str(s) for s in z)}, = z",
+        f"{IND}return {_array(xs)}",
+    ]
+
+
+def _numpy_fn(name: str, eq: Equations, named: dict, args: str = "x") -> list[str]:
+    """A numpy function returning ``{key: expr or Matrix}`` for states (2n,) or (2n, k)."""
+    keys = list(named)
+    flat, shapes = [], []
+    for k in keys:
+        e = named[k]
+        if isinstance(e, sp.MatrixBase):
+            shapes.append(e.shape)
+            flat += list(e)
+        else:
+            shapes.append(None)
+            flat.append(e)
+    _COUNT[0] += 1
+    repl, red = sp.cse(flat, symbols=sp.numbered_symbols(f"_n{_COUNT[0]}_"), order="none")
+    lines = [f"{IND}{_NP.doprint(a)} = {_NP.doprint(e)}" for a, e in repl]
+    state = set(eq.q + eq.dq)
+    for a, e in repl:  # cse symbols that depend on the state
+        if e.free_symbols & state:
+            state.add(a)
+    ref = str(eq.q[0])
+    out, pos = [], 0
+
+    def pr(e):  # constants are broadcast to the shape of the state's rows
+        s = _NP.doprint(e)
+        return s if e.free_symbols & state else f"({s}) + 0.0 * {ref}"
+
+    for k, shp in zip(keys, shapes):
+        if shp is None:
+            out.append(f"{k!r}: {pr(red[pos])}")
+            pos += 1
+        else:
+            r, c = shp
+            vals = [pr(e) for e in red[pos:pos + r * c]]
+            pos += r * c
+            if c == 1:
+                out.append(f"{k!r}: np.array(({', '.join(vals)},))")
+            else:
+                rows = ["(" + ", ".join(vals[i * c:(i + 1) * c]) + ",)" for i in range(r)]
+                out.append(f"{k!r}: np.array(({', '.join(rows)},))")
+    unpack = f"{IND}{', '.join(str(s) for s in (*eq.q, *eq.dq))}, = x" if args == "x" else \
+        f"{IND}{', '.join(str(s) for s in eq.q)}, = q"
+    return [f"    def {name}({args}):", unpack, *lines, f"{IND}return {{{', '.join(out)}}}"]
+
+
+def generate(eq: Equations, param_names, key: str) -> str:
+    """Source text of the generated module (see module docstring).
+
+    Parameters
+    ----------
+    eq : Equations
+    param_names : sequence of str
+        Parameter vector order.
+    key : str
+        Cache key, written into the header.
+    """
+    la = eq.leg_angles
+    rates = {k: sum(sp.diff(v, qi) * dqi for qi, dqi in zip(eq.q, eq.dq)) for k, v in la.items()}
+    _HOISTED.clear()
+    _PARAMS.clear()
+    _PARAMS.update(eq.params)
+    _COUNT[0] = 0
+    fast = [*_flow(eq, False), *_flow(eq, True), *_reset(eq, False), *_reset(eq, True),
+            *_guards(eq)]
+    if eq.locked is not None:  # kneed walker: knee-locked flow and the knee strike
+        lk = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
+        q_lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, len(eq.q)))])
+        kn = replace(eq, Mi=eq.knee_impact[0], B=eq.knee_impact[1], relabel_q=q_lock,
+                     relabel_rate=sp.eye(len(eq.q)))
+        fast += [*_flow(lk, False, "flow_locked"), *_flow(lk, True, "flow_locked_jacobian"),
+                 *_reset(kn, False, "knee_reset"), *_reset(kn, True, "knee_reset_jacobian")]
+    body = [
+        "def make(p):",
+        f"    {', '.join(param_names)}, = p",
+        *_HOISTED, *fast, *_section(eq),
+        *_numpy_fn("_energies", eq, {"kinetic": eq.kinetic, "potential": eq.potential}),
+        "    def energies(x):",
+        f"{IND}d = _energies(x)",
+        f"{IND}return d['kinetic'], d['potential']",
+        *_numpy_fn("points", eq, eq.points),
+        *_numpy_fn("leg_angles", eq, {**{f"{k}_angle": v for k, v in la.items()},
+                                      **{f"{k}_rate": v for k, v in rates.items()}}),
+        *_numpy_fn("_matrices", eq, {"M": eq.M, "C": eq.C, "G": eq.G}),
+        "    def matrices(x):",
+        f"{IND}d = _matrices(x)",
+        f"{IND}return d['M'], d['C'], d['G'][:, 0]",
+        *_numpy_fn("_impact_matrices", eq, {"De": eq.De, "E": eq.E}, args="q"),
+        "    def impact_matrices(q):",
+        f"{IND}d = _impact_matrices(q)",
+        f"{IND}return d['De'], d['E']",
+        "    return {k: v for k, v in locals().items() if callable(v) and not k.startswith('_')}",
+    ]
+    head = [
+        f"# walkerlab generated model code (walkerlab.models.codegen); key {key}",
+        "# Do not edit: regenerated when the walker description or the generator changes.",
+        "from math import sin, cos, tan, sqrt  # noqa: F401",
+        "import numpy  # noqa: F401",
+        "import numpy as np",
+        "",
+    ]
+    return "\n".join(head + body) + "\n"

@@ -1,0 +1,125 @@
+"""Build a :class:`~walkerlab.models.base.HybridWalker` from generated model code.
+
+Any biped described as data (:mod:`walkerlab.models.description`) becomes a walker here: the
+flow, its Jacobian, guards and their gradients, the heel-strike reset and its Jacobian,
+energies, points and leg angles all come from the generated module
+(:mod:`walkerlab.models.codegen`, cached by :mod:`walkerlab.models.cache`).
+
+Phases of a step (point feet, straight legs):
+
+- ``early_swing`` until ``swing_foot_ahead`` (``psi_sw - psi_st``) crosses zero upward (the
+  legs pass each other; the point foot scuffs through the ground there, which the ideal
+  model ignores, paper Sec. 3.2);
+- ``late_swing`` until ``heel_strike`` (``psi_sw + psi_st + 2 gamma`` decreasing through
+  zero: the swing foot reaches the slope), or a fall: the swing leg falls back behind the
+  stance leg, or the hip reaches the slope.
+
+Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen 2007):
+
+- ``unlocked_swing`` (three links) until ``knee_extension`` (shank minus thigh angle) crosses
+  zero upward: the knee straightens against its stop, the plastic knee strike
+  (``knee_reset``) locks it and the step goes on; a fall if the swing foot reaches the ground
+  first (``swing_foot_scuffs``: its clearance above the slope falls below
+  ``-SCUFF_DEPTH * L`` - reported, not ignored; the small depth makes a foot that starts on
+  the ground, clearance 0 to round-off, and is driven into it fire the guard) or the hip
+  reaches the slope;
+- ``locked_swing`` (two links, same coordinates, knee constraint) until ``heel_strike``; a
+  fall if the swing leg falls back behind the stance leg, if the straight swing leg passes
+  the stance leg (``swing_foot_scuffs``: its foot would go through the ground), or the hip
+  reaches the slope.  The heel strike takes place with the knee locked; the new swing knee
+  starts straight and free.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+from walkerlab.models.base import Guard, HybridWalker, Phase
+from walkerlab.models.cache import generated_module
+from walkerlab.models.description import WalkerData
+
+LEGS = ("leg1", "leg2")
+#: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
+SCUFF_DEPTH = 1e-9
+
+
+def _below(clearance, depth, t, x):
+    """``clearance + depth``: crosses zero downward when the foot is ``depth`` deep."""
+    return clearance(t, x) + depth
+
+
+def role_to_leg(stance_leg: str) -> dict[str, str]:
+    """``{"stance": stance_leg, "swing": other leg}``.
+
+    Raises
+    ------
+    KeyError
+        ``stance_leg`` is not ``leg1`` or ``leg2``.
+    """
+    other = {"leg1": "leg2", "leg2": "leg1"}[stance_leg]
+    return {"stance": stance_leg, "swing": other}
+
+
+def functions(data: WalkerData) -> dict:
+    """Generated functions of ``data`` with its parameters bound (see codegen's table)."""
+    return generated_module(data.structure)["make"](data.params)
+
+
+def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "derived",
+                      flow=None, flow_jacobian=None, reset=None, reset_jacobian=None
+                      ) -> HybridWalker:
+    """A hybrid walker from generated code; ``flow``/``reset`` may override the generated ones
+    (the paper's printed Appendix A variants).
+
+    Parameters
+    ----------
+    data : WalkerData
+    name, variant : str
+        Stored in artifacts.
+    flow, flow_jacobian, reset, reset_jacobian : callable, optional
+        Replacements for the generated functions (same signatures).
+
+    Returns
+    -------
+    HybridWalker
+    """
+    f = functions(data)
+    flow = flow or f["flow"]
+    fall = Guard("fall", f["guard_hip_height"], -1, "fall", gradient=f["grad_hip_height"])
+    ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
+    heel = Guard("heel_strike", f["guard_heel_strike"], -1, "heel_strike", f["grad_heel_strike"])
+    falls_back = Guard("swing_leg_falls_back", ahead, -1, "fall", dahead)
+    if data.structure.knee:
+        phases = (
+            Phase("unlocked_swing", flow, (
+                Guard("knee_strike", f["guard_knee_extension"], +1, "next_phase",
+                      f["grad_knee_extension"], f["knee_reset"], f["knee_reset_jacobian"]),
+                Guard("swing_foot_scuffs", partial(_below, f["guard_swing_clearance"],
+                                                   SCUFF_DEPTH * data.leg_length_m), -1, "fall",
+                      f["grad_swing_clearance"]), fall),
+                jacobian=f["flow_jacobian"]),
+            Phase("locked_swing", f["flow_locked"], (
+                heel, falls_back, Guard("swing_foot_scuffs", ahead, +1, "fall", dahead), fall),
+                jacobian=f["flow_locked_jacobian"]),
+        )
+    else:
+        early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead),
+                                            fall), jacobian=flow_jacobian or f["flow_jacobian"])
+        late = Phase("late_swing", flow, (heel, falls_back, fall),
+                     jacobian=flow_jacobian or f["flow_jacobian"])
+        phases = (early, late)
+    structure = data.structure
+    params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
+              "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
+              **dict(zip(structure.param_names, data.params))}
+    coords = (None if structure.coordinates == "absolute" and not structure.knee
+              else f["leg_angles"])
+    return HybridWalker(
+        name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=phases,
+        reset=reset or f["reset"], energies=f["energies"], points=f["points"],
+        section=f["section"], from_section=f["from_section"], role_to_leg=role_to_leg,
+        total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad, params=params,
+        variational=flow_jacobian or f["flow_jacobian"],
+        reset_jacobian=reset_jacobian or f["reset_jacobian"],
+        heel_strike_guard=f["guard_heel_strike"], leg_angles=coords,
+    )

@@ -1,0 +1,83 @@
+"""Basin-of-attraction figure, drawn from ``basin.h5`` only (as Schwab & Wisse 2001, Fig. 4)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+OUTCOME_COLORS = {
+    "converged": "#2ca02c", "other_attractor": "#9467bd", "fell_forward": "#d62728",
+    "fell_backward": "#1f77b4", "max_steps": "#ff7f0e", "stalled": "#7f7f7f",
+}
+
+
+def load_basin(path: Path) -> dict:
+    """Arrays and labels of a ``basin.h5`` artifact."""
+    from walkerlab.io.artifacts import open_artifact
+
+    with open_artifact(path, "basin") as f:
+        names = [str(n) for n in f.attrs["state_names"]]
+        d = {k: f[k][()] for k in ("x", "y", "outcome", "steps", "period")}
+        d["x_unit"], d["y_unit"] = str(f["x"].attrs["unit"]), str(f["y"].attrs["unit"])
+        d["x_axis"], d["y_axis"] = str(f.attrs["x_axis"]), str(f.attrs["y_axis"])
+        d["outcomes"] = [str(o) for o in f.attrs["outcomes"]]
+        d["fixed_point"] = {n: float(f[f"fixed_point/{n}"][()]) for n in names}
+        d["scene"] = str(f.attrs.get("scene_name", "")) if "scene_name" in f.attrs else ""
+        d["max_steps"] = int(f["settings/max_steps"][()])
+    return d
+
+
+def basin_figure(d: dict, title: str = ""):
+    """Outcome map (left) and steps to convergence of the converged cells (right).
+
+    Parameters
+    ----------
+    d : dict
+        From :func:`load_basin`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    x, y, out = d["x"], d["y"], d["outcome"]
+    dx = (x[1] - x[0]) / 2 if x.size > 1 else 0.5
+    dy = (y[1] - y[0]) / 2 if y.size > 1 else 0.5
+    extent = (x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy)
+    names = d["outcomes"]
+    cmap = ListedColormap([OUTCOME_COLORS.get(n, "k") for n in names])
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), constrained_layout=True)
+    ax = axes[0]
+    masked = np.ma.masked_less(out, 0)
+    ax.imshow(masked, origin="lower", extent=extent, aspect="auto", cmap=cmap,
+              vmin=-0.5, vmax=len(names) - 0.5, interpolation="nearest")
+    fp = d["fixed_point"]
+    for a in axes:
+        a.plot(fp[d["x_axis"]], fp[d["y_axis"]], marker="*", color="k", ms=12, mec="w",
+               ls="none", label="period-1 fixed point")
+        a.set_xlabel(f"{d['x_axis'].replace('_', ' ')} [{d['x_unit']}]")
+        a.set_ylabel(f"{d['y_axis'].replace('_', ' ')} [{d['y_unit']}]")
+    n_cells = out.size
+    handles = [Patch(color=OUTCOME_COLORS.get(n, "k"),
+                     label=f"{n.replace('_', ' ')} ({100 * np.mean(out == i):.1f} %)")
+               for i, n in enumerate(names) if np.any(out == i)]
+    ax.legend(handles=handles, fontsize=7, loc="best", framealpha=0.85)
+    ax.set_title(f"outcome after at most {d['max_steps']} steps ({n_cells} cells)",
+                 fontsize=10)
+    ax = axes[1]
+    conv = names.index("converged") if "converged" in names else -1
+    steps = np.ma.masked_where(out != conv, d["steps"].astype(float))
+    im = ax.imshow(steps, origin="lower", extent=extent, aspect="auto", cmap="viridis",
+                   interpolation="nearest")
+    fig.colorbar(im, ax=ax, label="steps to converge")
+    ax.set_title("steps to reach the period-1 gait (converged cells)", fontsize=10)
+    if title:
+        fig.suptitle(title, fontsize=11)
+    return fig

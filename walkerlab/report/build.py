@@ -1,0 +1,91 @@
+"""Assemble ``report.md`` and the self-contained ``report.html`` from existing artifacts.
+
+:func:`write_report` is all the report stage calls after it has run what the scene needs:
+it reads artifacts only (given as ``{stage: Path}``), never runs a stage.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import platform
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+import walkerlab
+from walkerlab.io.runpaths import atomic_text
+from walkerlab.published import for_scene
+from walkerlab.report import contact_sections, sections
+from walkerlab.report.markdown import details, num, table, to_html
+
+
+def _header(scene) -> list[str]:
+    import scipy
+
+    return [f"# walkerlab report — scene `{scene.name}`", "",
+            f"- source: {scene.source or '—'}",
+            f"- walkerlab {walkerlab.__version__}, Python {platform.python_version()}, "
+            f"numpy {np.__version__}, scipy {scipy.__version__}, machine {platform.machine()} "
+            f"({platform.processor() or platform.system()})",
+            f"- generated {_dt.datetime.now(_dt.UTC).strftime('%Y-%m-%d %H:%M UTC')}",
+            f"- slope φ = {num(scene.slope.phi_rad)} rad ({num(np.degrees(scene.slope.phi_rad))}°);"
+            f" ideal equations: `{scene.ideal.variant}`; solver {scene.solver.method} "
+            f"rtol {scene.solver.rtol:g} atol {scene.solver.atol:g}", ""]
+
+
+def write_report(scene, paths: dict[str, Path], report_dir: Path, figures_dir: Path,
+                 done: Iterable = ()) -> Path:
+    """Write ``report.md`` and ``report.html`` into ``report_dir``.
+
+    Parameters
+    ----------
+    scene : Scene
+    paths : dict[str, Path]
+        Artifacts that exist, by stage name (``fixedpoint``, ``simulate``, ``contact-sim``,
+        ``compare``, ``workprecision``, ``bifurcation``); absent stages give no section.
+    report_dir, figures_dir : Path
+        Output folder and the folder of the figures (PNG) to embed.
+    done : iterable of StageOutcome-like objects
+        ``stage``, ``path``, ``reused``, ``wall_time_s`` of what the report stage ran.
+
+    Returns
+    -------
+    Path
+        The HTML report.
+
+    Raises
+    ------
+    ValueError
+        The scene's ``published`` key names no module.
+    """
+    report_dir = Path(report_dir)
+    report_dir.mkdir(parents=True, exist_ok=True)
+    pub = for_scene(scene)
+    md = _header(scene)
+    md += sections.summary_section(scene, paths, pub)
+    done = list(done)
+    if done:
+        md += details("What ran (stages, artifacts, compute time)",
+                      table(["stage", "artifact", "status", "compute [s]"],
+                            [[o.stage, f"`{o.path}`", "reused" if o.reused else "computed",
+                              num(float(o.wall_time_s), 3)] for o in done]))
+    if "fixedpoint" in paths:
+        md += sections.fixedpoint_section(paths["fixedpoint"], pub)
+    md += sections.gait_section(scene, paths, pub)
+    md += contact_sections.sections(scene, paths)
+    md += sections.workprecision_summary(scene, paths)
+    md += sections.bifurcation_section(paths)
+    rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
+        report_dir) else Path(figures_dir)
+    md += sections.figures_section(Path(figures_dir), str(rel), paths)
+    md += ["## Scene", ""]
+    md += details("Resolved scene (JSON)", "\n".join(
+        ["```json", json.dumps(scene.model_dump(mode="json", exclude_none=True), indent=1),
+         "```"]))
+    text = "\n".join(md)
+    atomic_text(report_dir / "report.md", text)
+    html_path = report_dir / "report.html"
+    atomic_text(html_path, to_html(text, report_dir))
+    return html_path

@@ -1,0 +1,402 @@
+"""Report sections of the rigid walker (summary, fixed point, gait table, figures), from artifacts.
+
+Every function takes the scene, the artifact paths that exist (``{stage: Path}``) and the
+published-number module of the scene (or None) and returns Markdown lines; a section whose
+artifact is absent returns ``[]``, so a scene gets only what it produces.  Published values
+come from :mod:`walkerlab.published`, never from literals here.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+
+from walkerlab.analysis.tables import TABLE3_ROWS, table3
+from walkerlab.io.artifacts import open_artifact
+from walkerlab.io.readers import load_fixed_point
+from walkerlab.report.markdown import details, num, printed, table
+from walkerlab.report.text import zero_multipliers_text
+
+
+# --------------------------------------------------------------------------- data
+def energy_drift_in_swing(path: Path) -> tuple[float, float]:
+    """Largest change of the total energy within a continuous phase [J] and relative [-].
+
+    Read from ``simulate.h5``: a passive rigid walker conserves energy between impacts
+    (heel strike, knee strike), so this measures the integration error.
+    """
+    with open_artifact(path, "simulate") as f:
+        g = f["samples"]
+        tot, step = g["energy/total"][()], g["step_index"][()]
+        phase = g["phase"][()] if "phase" in g else np.zeros_like(step)
+    key = step.astype(np.int64) * 1000 + phase
+    drift = max(float(np.ptp(tot[key == k])) for k in np.unique(key))
+    return drift, drift / float(np.max(np.abs(tot)))
+
+
+def swing_foot_clearance(path: Path, slope_rad: float, margin: float = 0.1) -> float:
+    """Lowest height [m] of the swing foot above the slope inside the steps of ``simulate.h5``.
+
+    Heights are normal to the slope through the first stance foot; the first and last
+    ``margin`` of each step (lift-off, heel strike, where the height is ~0) are left out.
+    A negative value means the foot passes through the ground (scuffing, which the rigid
+    model ignores).  Round feet use the ``<leg>_contact`` point when the walker has one.
+    """
+    from walkerlab.io.trajectory import read_samples
+
+    with open_artifact(path, "simulate") as f:
+        tr = read_samples(f)
+    lowest = np.inf
+    for k in np.unique(tr.step_index):
+        m = tr.step_index == k
+        t = tr.time[m]
+        inner = (t > t[0] + margin * (t[-1] - t[0])) & (t < t[-1] - margin * (t[-1] - t[0]))
+        swing = tr.legs[1 - int(tr.stance_leg[m][0])] if len(tr.legs) == 2 else None
+        if swing is None or not inner.any():
+            continue
+        foot = tr.points.get(f"{swing}_contact", tr.points.get(f"{swing}_foot"))
+        if foot is None:
+            continue
+        xy = foot[:, m][:, inner]
+        h = xy[1] * np.cos(slope_rad) + xy[0] * np.sin(slope_rad)
+        lowest = min(lowest, float(np.min(h)))
+    return lowest
+
+
+def _contact_summary(path: Path) -> dict:
+    with open_artifact(path, "contact-sim") as f:
+        out = {"termination": str(f.attrs["termination"]),
+               "heel_strikes": int(len(f["events/heel_strike_times"][()])) if
+               "events/heel_strike_times" in f else 0}
+        if "periodic_gait" in f:
+            out["periodic_stable"] = bool(f["periodic_gait/stable"][()])
+    return out
+
+
+def _gait_columns(paths: dict[str, Path]) -> dict[str, dict]:
+    sim = paths.get("simulate")
+    if sim is None:
+        return {}
+    with open_artifact(sim, "simulate") as f:
+        mass, g = float(f.attrs["total_mass_kg"]), float(f.attrs["gravity_m_per_s2"])
+    src = {"ours, ideal": ("simulate", sim)}
+    if "contact-sim" in paths:
+        src["ours, contact"] = ("contact-sim", paths["contact-sim"])
+    return table3(src, mass, g)
+
+
+def published_fixed_point(pub: ModuleType | None) -> tuple[tuple, tuple]:
+    """``(state names, values)`` of a published fixed point (``FIXED_POINT_NAMES/STATE``,
+    or the ``EQ11_NAMES/STATE`` spelling), empty when the source prints none."""
+    names = getattr(pub, "FIXED_POINT_NAMES", getattr(pub, "EQ11_NAMES", ()))
+    state = getattr(pub, "FIXED_POINT_STATE", getattr(pub, "EQ11_STATE", ()))
+    return tuple(names), tuple(state)
+
+
+# --------------------------------------------------------------------------- summary
+def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[str]:
+    """Short verdicts and headline numbers, with the published values where they exist."""
+    out = ["## Summary", ""]
+    bullets = []
+    rows = []
+    pub_name = f"published ({pub.SHORT})" if pub is not None else None
+    fp = paths.get("fixedpoint")
+    if fp is not None:
+        x, meta = load_fixed_point(fp)
+        bullets.append(f"- **Gait found**: yes, period-1 fixed point (residual "
+                       f"{num(meta['residual'], 2)}), step period "
+                       f"{num(meta['step_period_s'])} s.")
+        bullets.append(f"- **Stable**: {'yes' if meta['stable'] else 'no'} (largest "
+                       f"|Floquet multiplier| {num(meta['max_abs_multiplier'])}).")
+        eq = dict(zip(*published_fixed_point(pub)))
+        for n, v, u in zip(meta["state_names"], x, meta["state_units"]):
+            rows.append([f"fixed point {n}", u, num(v), printed(eq[n]) if n in eq else "—"])
+        rows.append(["step period", "s", num(meta["step_period_s"]), "—"])
+        rows.append(["max abs(multiplier)", "-", num(meta["max_abs_multiplier"]), "—"])
+    elif "fixedpoint" not in paths and scene.fixedpoint is not None:
+        bullets.append("- **Gait found**: no fixed point artifact.")
+    sim = paths.get("simulate")
+    if sim is not None:
+        drift, rel = energy_drift_in_swing(sim)
+        with open_artifact(sim, "simulate") as f:
+            term = str(f.attrs["termination"])
+            n_hs = int(np.sum(f["steps/termination"].asstr()[()] == "heel_strike"))
+        bullets.append(f"- **Rigid walker walks**: {'yes' if term == 'heel_strike' else 'no'} "
+                       f"({n_hs} heel strikes, ended by {term}); energy drift in swing "
+                       f"{num(drift, 2)} J ({num(rel, 2)} relative).")
+        rows.append(["energy drift in swing", "J", num(drift, 2), "—"])
+        clear = swing_foot_clearance(sim, scene.slope.phi_rad)
+        if np.isfinite(clear):
+            verdict = ("no scuffing" if clear > 0 else "the swing foot passes through the "
+                       "ground (scuffing), which the rigid model ignores")
+            bullets.append(f"- **Swing-foot clearance**: lowest {num(1e3 * clear, 3)} mm above "
+                           f"the slope inside the steps: {verdict}.")
+            rows.append(["lowest swing-foot clearance", "mm", num(1e3 * clear, 3), "—"])
+    if "contact-sim" in paths:
+        c = _contact_summary(paths["contact-sim"])
+        walks = c["termination"] != "fall" and c["heel_strikes"] > 0
+        extra = ""
+        if "periodic_stable" in c:
+            extra = ("; its own periodic gait is " + ("stable" if c["periodic_stable"]
+                                                      else "unstable"))
+        bullets.append(f"- **Contact walker walks**: {'yes' if walks else 'no'} "
+                       f"({c['heel_strikes']} heel strikes, ended by {c['termination']}){extra}.")
+    cols = _gait_columns(paths)
+    ideal = cols.get("ours, ideal")
+    if ideal:
+        t3 = getattr(pub, "TABLE3", {})
+        for key in ("t_cycle_s", "v_com_m_per_s"):
+            name, _sym, unit = TABLE3_ROWS[key]
+            rows.append([name, unit, num(ideal[key]), printed(t3[key][0]) if key in t3 else "—"])
+        if "E_avg_J" in t3:
+            rows.append(["average mechanical energy, PE from the stance foot", "J",
+                         num(ideal.get("E_avg_stance_frame_J", np.nan)), printed(t3["E_avg_J"][0])])
+        step_pub = getattr(pub, "STEP_LENGTH_M", None)
+        rows.append(["step length", "m", num(ideal["step_length_m"]),
+                     printed(step_pub) if step_pub is not None else "—"])
+    out += bullets
+    if rows:
+        header = ["quantity", "unit", "ours"]
+        if pub_name:
+            header.append(pub_name)
+        else:
+            rows = [r[:3] for r in rows]
+        out += ["", table(header, rows)]
+        if pub is not None:
+            out += ["", f"Published values: {pub.CITATION} (`walkerlab.published.{pub.SHORT}`); "
+                    "the sections below explain each difference."]
+    out.append("")
+    return out
+
+
+# --------------------------------------------------------------------------- fixed point
+def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
+    """Fixed point of every equation variant, Floquet multipliers, verdict."""
+    pub_fp = dict(zip(*published_fixed_point(pub)))
+    out = ["## Fixed point of the Poincaré map", ""]
+    with open_artifact(path, "fixedpoint") as f:
+        names = [str(n) for n in f.attrs["state_names"]]
+        units = [str(f[f"fixed_point/{n}"].attrs["unit"]) for n in names]
+        main = str(f.attrs["variant"])
+        # the published state in this walker's state order (None if it does not name them all)
+        eq = np.array([pub_fp[n] for n in names], float) if pub_fp and set(names) <= set(
+            pub_fp) else None
+        rows = []
+        if eq is not None:
+            label = getattr(pub, "FIXED_POINT_LABEL", "Eq. (11)")
+            rows.append([f"{pub.SHORT} {label} (printed)", *[printed(v) for v in eq], "—", "—",
+                         "—"])
+        fps = {}
+        for v in f["variants"]:
+            g = f["variants"][v]
+            if "error" in g.attrs:
+                rows.append([v, *(["—"] * len(names)), "—", "—", g.attrs["error"]])
+                continue
+            x = np.array([g[f"fixed_point/{n}"][()] for n in names])
+            fps[v] = x
+            re, im = g["floquet/variational/real"][()], g["floquet/variational/imag"][()]
+            rows.append([f"walkerlab `{v}`" + (" (this scene)" if v == main else ""),
+                         *[num(a) for a in x], num(float(g["step_period"][()])),
+                         num(float(np.max(np.hypot(re, im)))), num(g["residual"][()], 2)])
+        out.append(table(["model", *[f"{n} [{u}]" for n, u in zip(names, units)],
+                          "step period [s]", "max abs(multiplier)", "residual"], rows))
+        out.append("")
+        out.append("State right after heel strike, role-ordered (the swing leg is the one that "
+                   "just left the ground).")
+        if eq is not None and getattr(pub, "FIXED_POINT_NOTE", None):
+            out += ["", f"**Why the numbers differ.** {pub.FIXED_POINT_NOTE}"]
+        if eq is not None and "appendix_a" in fps and "derived" in fps:
+            d = fps["derived"] - eq
+            a = fps["appendix_a"] - eq
+            ang = np.array([u == "rad" for u in units])
+            i_sr = names.index("stance_rate")
+            fmt = ", ".join
+            out.append("")
+            out.append(
+                "**Why the numbers differ.** The printed Appendix A (variant `appendix_a`) "
+                "reproduces Eq. (11): its deviation from the printed digits is "
+                f"[{fmt(num(v, 2) for v in a)}] (the stance rate {num(fps['appendix_a'][i_sr])} "
+                f"is printed as {eq[i_sr]:.2f}, i.e. truncated, not rounded). Its Coriolis matrix "
+                "(A.5) has the wrong sign in C[1,0] (+m L b θ̇1 sin(θ2−θ1) instead of −), so "
+                "energy is not conserved in swing. The energy-consistent derived model "
+                "(`derived`, the default) gives a different gait: deviation from Eq. (11) "
+                f"[{fmt(num(v, 2) for v in d)}], i.e. up to {num(np.max(np.abs(d[ang])), 2)} rad "
+                f"in the angles and {num(np.max(np.abs(d[~ang])), 2)} rad/s in the rates. Taking "
+                "the printed y-component of A.55 literally (`appendix_a_literal`) does not "
+                "reproduce Eq. (11) at all, so that sign is a typesetting error only.")
+        re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
+        re2, im2 = f["floquet/finite_difference/real"][()], f["floquet/finite_difference/imag"][()]
+        out += ["", f"### Floquet multipliers (`{main}`)", "",
+                table(["#", "variational equations", "finite differences", "abs value"],
+                      [[i + 1, f"{a:+.6f}{b:+.6f}j", f"{c:+.6f}{d:+.6f}j",
+                        num(float(np.hypot(a, b)))]
+                       for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
+                "", f"Max difference between the two: {num(f['floquet/max_difference'][()], 2)}. "
+                f"Verdict: **{'stable' if f['floquet/stable'][()] else 'unstable'}** "
+                f"({zero_multipliers_text(re, im)}).", ""]
+    return out
+
+
+# --------------------------------------------------------------------------- gait table
+def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[str]:
+    """Gait characteristics (paper Table 3 rows), ours beside the published ones."""
+    cols = _gait_columns(paths)
+    if not cols:
+        return []
+    t3 = getattr(pub, "TABLE3", None)
+    header = ["quantity", "symbol", "unit"]
+    if t3:
+        header += [f"{pub.SHORT} MATLAB", f"{pub.SHORT} ADAMS"]
+    header += list(cols)
+    rows = []
+    for key, (name, sym, unit) in TABLE3_ROWS.items():
+        pubv = [printed(v) for v in t3[key]] if t3 else []
+        rows.append([name, sym, unit, *pubv, *(num(c[key]) for c in cols.values())])
+    blank = ["", ""] if t3 else []
+    rows.append(["Average mechanical energy, PE from the current stance foot", "E_avg'", "J",
+                 *blank, *(num(c.get("E_avg_stance_frame_J", np.nan)) for c in cols.values())])
+    step_pub = getattr(pub, "STEP_LENGTH_M", None)
+    rows.append(["Step length", "Δx", "m", *([printed(step_pub)] * 2 if t3 else []),
+                 *(num(c["step_length_m"]) for c in cols.values())])
+    title = "## Table 3 — gait characteristics" if t3 else "## Gait characteristics"
+    out = [title, "", "Recomputed from the trajectory artifacts ("
+           + ", ".join(f"`{paths[s].name}`" for s in ("simulate", "contact-sim") if s in paths)
+           + ").", "", table(header, rows)]
+    ideal = cols.get("ours, ideal")
+    eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
+    if ideal and t3 and eq is not None and step_pub is not None:
+        L = float(scene.walker.leg_length_m)
+        eqd = dict(zip(pub.EQ11_NAMES, eq))
+        dx_eq11 = 2 * L * np.sin((eqd["stance_angle"] - eqd["swing_angle"]) / 2)
+        e_pub = t3["E_avg_J"][0]
+        e_st = ideal.get("E_avg_stance_frame_J", np.nan)
+        out += ["", "**Differences from the published Table 3, measured:**", "",
+                f"- *Left/right step periods.* A period-1 gait has identical steps: ours are "
+                f"{num(ideal['t_left_s'])} s and {num(ideal['t_right_s'])} s. The published "
+                f"{printed(t3['t_left_s'][0])} s and {printed(t3['t_right_s'][0])} s cannot "
+                f"both belong to the period-1 fixed point of Eq. (11); their sum "
+                f"{printed(t3['t_cycle_s'][0])} s "
+                f"is within {num(abs(t3['t_cycle_s'][0] - ideal['t_cycle_s']), 2)} s of our "
+                f"cycle period {num(ideal['t_cycle_s'])} s.",
+                f"- *Step length Δx.* Eq. (11) itself implies Δx = 2 L sin((θ2 − θ1)/2) = "
+                f"{num(dx_eq11)} m (ours: {num(ideal['step_length_m'])} m), about "
+                f"{dx_eq11 / step_pub:.0f}× the printed {printed(step_pub)} m. With the printed Δx "
+                f"the speed formula gives {printed(step_pub)}/{printed(t3['t_cycle_s'][0])} = "
+                f"{num(step_pub / t3['t_cycle_s'][0])} m/s, the printed v_com; the walker "
+                f"actually advances at {num(ideal['v_com_m_per_s'])} m/s (hip displacement over "
+                "whole cycles / time).",
+                f"- *Energy.* With the potential energy measured from the current stance foot "
+                f"we get E_avg' = {num(e_st)} J, within {num(abs(e_pub - e_st), 2)} J of the "
+                f"printed {printed(e_pub)} J; measured from a fixed datum (first stance foot) the "
+                f"average over 5 steps is {num(ideal['E_avg_J'])} J because the walker descends "
+                f"the {num(scene.slope.phi_rad)} rad slope by Δx sin φ per step."]
+    out.append("")
+    return out
+
+
+# --------------------------------------------------------------------------- figures
+CAPTIONS = [
+    ("fig7_angles_rates", "Fig. 7 — angles and angular rates over the simulated strides."),
+    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates."),
+    ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, per "
+                          "coordinate)."),
+    ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),
+    ("fig2_stick_ideal", "Fig. 2 — stick diagram of one gait cycle, ideal model."),
+    ("fig6_stick_contact", "Fig. 6 — stick diagram of one gait cycle, contact model."),
+    ("work_precision_ideal", "Work-precision diagram, ideal model."),
+    ("work_precision_contact", "Work-precision diagram, contact model."),
+    ("bifurcation", "Bifurcation diagram over the slope."),
+]
+
+
+def steps_table(path: Path) -> str:
+    """Per-step table of ``simulate.h5`` (period, step length, hip speed, impact loss)."""
+    with open_artifact(path, "simulate") as f:
+        s = f["steps"]
+        cols = ("period", "step_length", "hip_speed", "impact_energy_loss")
+        rows = [[int(i), str(leg), *[num(s[c][k]) for c in cols], str(term)]
+                for k, (i, leg, term) in enumerate(zip(s["step"][()], s["stance_leg"].asstr()[()],
+                                                       s["termination"].asstr()[()]))]
+    return table(["step", "stance leg", "period [s]", "step length [m]", "hip speed [m/s]",
+                  "impact loss [J]", "ended by"], rows)
+
+
+def workprecision_table(path: Path, model: str) -> str:
+    """Every (method, rtol) point of one model of ``workprecision.h5``."""
+    rows = []
+    with open_artifact(path, "workprecision") as f:
+        g = f[model]
+        for m in g:
+            d = g[m]
+            for rt, t, e, n in zip(d["rtol"][()], d["time"][()], d["error"][()], d["nfev"][()]):
+                rows.append([m, num(rt, 1), num(t * 1e3), num(e, 2), int(n)])
+    return table(["method", "rtol", "median wall [ms]", "error vs reference", "RHS evals"], rows)
+
+
+def figures_section(fig_dir: Path, rel: str, paths: dict[str, Path]) -> list[str]:
+    """Every figure that exists, with its raw data folded underneath where it is long."""
+    out = []
+    for stem, cap in CAPTIONS:
+        png = fig_dir / f"{stem}.png"
+        if not png.is_file():
+            continue
+        out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
+        if stem == "fig7_angles_rates" and "simulate" in paths:
+            out += details("Per-step data of the rigid walker (simulate.h5)",
+                           steps_table(paths["simulate"]))
+        if stem.startswith("work_precision_") and "workprecision" in paths:
+            out += details("All (method, tolerance) points",
+                           workprecision_table(paths["workprecision"],
+                                               stem.removeprefix("work_precision_")))
+    return ["## Figures", "", *out] if out else []
+
+
+# --------------------------------------------------------------------------- work-precision
+def _solver_text(scene, model: str) -> str:
+    from walkerlab.config import ContactSolverSettings
+
+    sv = scene.solver if model == "ideal" else (scene.contact_solver or ContactSolverSettings())
+    return f"{sv.method} rtol {sv.rtol:.0e}."
+
+
+def workprecision_summary(scene, paths: dict[str, Path]) -> list[str]:
+    """Pareto-best setting and Pareto front per model (raw points fold under the figure)."""
+    p = paths.get("workprecision")
+    if p is None:
+        return []
+    out = ["## Error against run time (work-precision)", ""]
+    with open_artifact(p, "workprecision") as f:
+        for model in f:
+            g = f[model]
+            out += [f"### {model} model", ""]
+            if "best_method" in g.attrs:
+                out.append(f"Pareto-best setting reaching the target error "
+                           f"{g.attrs['target_error']:.0e}: **{g.attrs['best_method']} rtol "
+                           f"{g.attrs['best_rtol']:.0e}** ({num(g.attrs['best_time'] * 1e3)} ms, "
+                           f"error {num(g.attrs['best_error'], 2)}). Scene default: "
+                           + _solver_text(scene, model))
+            pm = [str(s) for s in g.attrs.get("pareto_methods", [])]
+            pr = list(g.attrs.get("pareto_rtol", []))
+            out += ["", "Pareto front (no setting is both faster and more accurate): "
+                    + ", ".join(f"{m} {r:.0e}" for m, r in zip(pm, pr)) + ".", ""]
+    return out
+
+
+# --------------------------------------------------------------------------- bifurcation
+def bifurcation_section(paths: dict[str, Path]) -> list[str]:
+    """Period-doubling onset from ``bifurcation.h5`` (when the scene ran that stage)."""
+    p = paths.get("bifurcation")
+    if p is None:
+        return []
+    with open_artifact(p, "bifurcation") as f:
+        onset = float(f["onset/onset_slope"][()])
+        slopes = f["slope"][()]
+        per = f["steady_state/attractor_period"][()]
+    text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
+            "where the most negative real Floquet multiplier crosses −1" if np.isfinite(onset)
+            else "no period doubling on the grid")
+    return ["## Bifurcation over the slope", "",
+            f"Grid {printed(slopes[0])}–{printed(slopes[-1])}° ({slopes.size} slopes): {text}; "
+            f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}.", ""]

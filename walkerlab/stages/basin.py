@@ -1,0 +1,132 @@
+"""Stage ``basin``: basin of attraction of the period-1 gait -> ``basin.h5`` (+ figure).
+
+Reads the scene's ``basin`` section (defaults when absent) and the fixed point from
+``fixedpoint.h5``; the cells are classified by :func:`walkerlab.sweep.basin.compute_basin`
+(local processes or Dask, resumable).  Skipped when the scene sections, the grid, the
+upstream fixed point and the code are unchanged.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.config import BasinSettings, Scene
+from walkerlab.io.artifacts import put, write_artifact
+from walkerlab.io.netcdf import coordinate
+from walkerlab.stages import fixedpoint as fixedpoint_stage
+from walkerlab.stages.common import (
+    StageError,
+    StageOutcome,
+    artifact_path,
+    input_hash,
+    require,
+)
+
+SECTIONS = ("walker", "slope", "ideal", "basin")
+
+
+def figure_path(scene: Scene, runs_root: Path | str) -> Path:
+    """``runs/<scene>/report/figures/basin.png``."""
+    from walkerlab.stages.plot import figures_dir
+
+    return figures_dir(scene, runs_root) / "basin.png"
+
+
+def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
+    """Draw the basin figure (PNG + SVG) from ``basin.h5``."""
+    from walkerlab.plotting.basin_figures import basin_figure, load_basin
+    from walkerlab.plotting.figures import save
+
+    d = load_basin(artifact_path(scene, runs_root, "basin"))
+    fig = basin_figure(d, f"Basin of attraction - scene '{scene.name}'")
+    return save(fig, figure_path(scene, runs_root).parent, "basin")
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
+        grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
+        resume: bool = True, on_chunk=None) -> StageOutcome:
+    """Compute (or reuse) the basin map of the scene's rigid walker.
+
+    Parameters
+    ----------
+    grid : (nx, ny), optional
+        Cells along x and y; overrides ``basin.grid``.
+    workers : int
+        Local worker processes (1 = in this process).
+    scheduler : str, optional
+        Dask scheduler address.
+    resume : bool
+        Continue from the partial file of an interrupted run with the same inputs.
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section, or bad basin settings.
+    """
+    from walkerlab.sweep.basin import OUTCOMES, BasinError, compute_basin
+
+    require(scene, "fixedpoint", "basin")
+    st = scene.basin or BasinSettings()
+    grid = tuple(grid or st.grid)
+    fixedpoint_stage.run(scene, runs_root)
+    up = artifact_path(scene, runs_root, "fixedpoint")
+    path = artifact_path(scene, runs_root, "basin")
+    key = input_hash("basin", scene, SECTIONS, (up,), extra=f"grid={grid[0]}x{grid[1]}")
+    from walkerlab.io.artifacts import stored_hash
+
+    if not force and path.is_file() and stored_hash(path) == key:
+        if not figure_path(scene, runs_root).is_file():
+            draw(scene, runs_root)
+        return StageOutcome("basin", path, True, 0.0, {})
+    x_star, _ = fixedpoint_stage.load_fixed_point(up)
+    t0 = time.perf_counter()
+    try:
+        res = compute_basin(scene, x_star, key, path, grid, workers, scheduler,
+                            resume=resume and not force, on_chunk=on_chunk)
+    except BasinError as exc:
+        raise StageError(str(exc)) from None
+    walker = res["walker"]
+    names = walker.state_names()
+    units = walker.state_units() if hasattr(walker, "state_units") else [
+        "rad" if n.endswith("_angle") else "rad/s" for n in names]
+    unit = dict(zip(names, units))
+    counts = {o: int(np.sum(res["outcome"] == i)) for i, o in enumerate(OUTCOMES)}
+
+    def writer(f):
+        f.attrs["model"] = walker.name
+        f.attrs["state_names"] = names
+        f.attrs["x_axis"], f.attrs["y_axis"] = st.x_axis, st.y_axis
+        f.attrs["outcomes"] = list(OUTCOMES)
+        f.attrs["axis_order"] = "outcome[j, i]: j along y_axis, i along x_axis"
+        coordinate(f, "x", res["x"], unit[st.x_axis], f"cell centres, {st.x_axis}")
+        coordinate(f, "y", res["y"], unit[st.y_axis], f"cell centres, {st.y_axis}")
+        put(f, "outcome", res["outcome"], "-",
+            "index into attrs['outcomes'] (converged = period-1 gait)", dims=("y", "x"))
+        put(f, "steps", res["steps"], "steps", "steps until the outcome was decided",
+            dims=("y", "x"))
+        put(f, "period", res["period"], "steps", "period of the attractor reached "
+            "(1 = fixed point, 0 = none)", dims=("y", "x"))
+        for n, v in zip(names, x_star):
+            put(f, f"fixed_point/{n}", float(v), unit[n], f"{n} of the period-1 gait")
+        for o, c in counts.items():
+            put(f, f"counts/{o}", c, "cells", f"cells whose outcome is {o}")
+        put(f, "settings/max_steps", st.max_steps, "steps", "steps per cell at most")
+        put(f, "settings/converge_tol", st.converge_tol, "rad, rad/s",
+            "max|x - x*| that counts as converged")
+        put(f, "settings/period_tol", st.period_tol, "rad, rad/s",
+            "max|x_k - x_{k-p}| that counts as a period-p attractor")
+        put(f, "settings/rtol", st.rtol, "-", "integrator relative tolerance (DOP853)")
+        put(f, "settings/atol", st.atol, "rad, rad/s", "integrator absolute tolerance")
+        put(f, "stats/cells_computed", res["cells_computed"], "cells",
+            "cells computed by the last run (the rest came from a resumed partial file)")
+
+    wall = time.perf_counter() - t0
+    write_artifact(path, "basin", scene, key, writer, wall,
+                   {"workers": workers if scheduler is None else 0,
+                    "scheduler": str(scheduler or "")})
+    res["partial"].unlink(missing_ok=True)
+    draw(scene, runs_root)
+    return StageOutcome("basin", path, False, wall, {"counts": counts, "grid": grid})

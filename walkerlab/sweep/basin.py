@@ -1,0 +1,302 @@
+"""Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section.
+
+Schwab & Wisse (2001), "Basin of attraction of the simplest walking model", ASME DETC 2001:
+start the walker from every cell of a grid of post-heel-strike states, iterate the Poincaré
+map and record where each cell goes.  Here a cell's state takes its two axis coordinates
+(named by ``walker.state_names()``) from the grid, the coordinate fixed by the heel-strike
+surface from that constraint (``walker.from_section(walker.section(x))``), and every other
+coordinate from the fixed point ``x*``.
+
+Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
+
+``converged``        ``max|x_k - x*| < converge_tol`` after ``k`` steps (the period-1 gait)
+``other_attractor``  ``max|x_k - x_{k-p}| < period_tol`` for some ``1 <= p <= max_period``
+                     away from ``x*`` (a period-``p`` gait; ``p`` is stored)
+``fell_forward``     a fall guard fired with the hip ahead of the stance foot (x > 0)
+``fell_backward``    ... with the hip behind it
+``max_steps``        none of the above within ``max_steps`` steps
+``stalled``          a step longer than ``max_step_time_s``, or a solver failure
+
+Cells are evaluated in chunks (one grid row each) by
+:func:`walkerlab.sweep.runner.iter_chunk_results` - in this process, on a local process pool
+or on a Dask cluster - and written to a partial HDF5 file after every chunk, so an
+interrupted map resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+OUTCOMES = ("converged", "other_attractor", "fell_forward", "fell_backward", "max_steps",
+            "stalled")
+CODE = {name: i for i, name in enumerate(OUTCOMES)}
+NOT_DONE = -1
+
+__all__ = ["OUTCOMES", "CODE", "NOT_DONE", "BasinTask", "slice_state", "axis_values",
+           "classify_cell", "run_basin_chunk", "compute_basin"]
+
+
+class BasinError(ValueError):
+    """Bad basin settings (message names the field)."""
+
+
+def _index(names: list[str], name: str, field: str) -> int:
+    if name not in names:
+        raise BasinError(f"basin.{field}: unknown state {name!r}; choose from "
+                         f"{', '.join(names)}")
+    return names.index(name)
+
+
+def slice_state(walker, x_star: np.ndarray, axes: tuple[str, str],
+                values: tuple[float, float]) -> np.ndarray:
+    """Post-heel-strike state of one cell.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    x_star : ndarray, shape (2n,)
+        Period-1 fixed point (role-ordered, just after heel strike).
+    axes : (str, str)
+        State names of the two grid axes.
+    values : (float, float)
+        Their values [rad or rad/s].
+
+    Returns
+    -------
+    ndarray, shape (2n,)
+        ``x*`` with the two axis coordinates replaced, projected on the heel-strike surface.
+
+    Raises
+    ------
+    BasinError
+        An unknown state name, or an axis that the heel-strike constraint fixes.
+    """
+    names = walker.state_names()
+    ix = _index(names, axes[0], "x_axis")
+    iy = _index(names, axes[1], "y_axis")
+    if ix == iy:
+        raise BasinError("basin: x_axis and y_axis name the same state")
+    x = np.array(x_star, dtype=float)
+    x[ix], x[iy] = values
+    x = np.asarray(walker.from_section(walker.section(x)), dtype=float)
+    for i, field, v in ((ix, "x_axis", values[0]), (iy, "y_axis", values[1])):
+        if abs(x[i] - v) > 1e-12 * (1 + abs(v)):
+            raise BasinError(f"basin.{field}: {names[i]!r} is fixed by the heel-strike "
+                             "constraint; choose another state")
+    return x
+
+
+def axis_values(settings, walker, x_star: np.ndarray,
+                grid: tuple[int, int] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Cell-centre values of the x and y axes [rad or rad/s].
+
+    Default ranges: the fixed point -/+ 0.3 rad for an angle, -/+ 1.2 rad/s for a rate.
+    """
+    names = walker.state_names()
+    nx, ny = grid or settings.grid
+    out = []
+    for name, rng, n, field in ((settings.x_axis, settings.x_range, nx, "x_axis"),
+                                (settings.y_axis, settings.y_range, ny, "y_axis")):
+        c = float(x_star[_index(names, name, field)])
+        if rng is None:
+            half = 1.2 if name.endswith("_rate") else 0.3
+            rng = (c - half, c + half)
+        lo, hi = float(rng[0]), float(rng[1])
+        if not hi > lo:
+            raise BasinError(f"basin.{field[0]}_range: the upper end must exceed the lower")
+        edges = np.linspace(lo, hi, n + 1)
+        out.append(0.5 * (edges[:-1] + edges[1:]))
+    return out[0], out[1]
+
+
+def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
+                  max_step_time: float = 5.0) -> tuple[int, int, int]:
+    """Iterate the Poincaré map from ``x0`` and classify where it goes.
+
+    ``max_step_time`` [s]: a longer step ends the cell as ``stalled``.
+
+    Returns
+    -------
+    code : int
+        Index into :data:`OUTCOMES`.
+    steps : int
+        Steps taken until the outcome was decided.
+    period : int
+        Period of the attractor reached (1 for the fixed point, 0 if none).
+    """
+    from walkerlab.analysis.hybrid import integrate_step
+
+    x = np.asarray(x0, dtype=float)
+    hist = [x]
+    for k in range(1, settings.max_steps + 1):
+        seg = integrate_step(walker, x, solver, max_step_time=max_step_time)
+        if seg.termination == "fall":
+            hip = walker.points(seg.x_end)["hip"]
+            return CODE["fell_forward" if float(hip[0]) > 0 else "fell_backward"], k, 0
+        if seg.termination != "heel_strike":
+            return CODE["stalled"], k, 0
+        x = seg.x_next
+        if not np.all(np.isfinite(x)):
+            return CODE["stalled"], k, 0
+        if float(np.max(np.abs(x - x_star))) < settings.converge_tol:
+            return CODE["converged"], k, 1
+        for p in range(1, min(settings.max_period, len(hist)) + 1):
+            if float(np.max(np.abs(x - hist[-p]))) < settings.period_tol:
+                return CODE["other_attractor"], k, p
+        hist.append(x)
+    return CODE["max_steps"], settings.max_steps, 0
+
+
+@dataclass(frozen=True)
+class BasinTask:
+    """A chunk of cells evaluated by one worker (picklable).
+
+    Attributes
+    ----------
+    base : dict
+        Scene mapping (``Scene.model_dump(mode="json")``).
+    x_star : tuple of float
+        Fixed point (role-ordered).
+    cells : tuple of (int, float, float)
+        ``(flat index, x value, y value)``.
+    """
+
+    base: dict
+    x_star: tuple
+    cells: tuple
+
+
+_WALKERS: dict[str, object] = {}
+
+
+def _walker_and_settings(base: dict):
+    from walkerlab.config import BasinSettings, scene_from_dict
+    from walkerlab.models.registry import build_walker
+
+    key = json.dumps(base, sort_keys=True)
+    if key not in _WALKERS:
+        scene = scene_from_dict(base)
+        _WALKERS.clear()
+        st = scene.basin or BasinSettings()
+        mst = st.max_step_time_s or (scene.fixedpoint.max_step_time_s if scene.fixedpoint
+                                     else 5.0)
+        _WALKERS[key] = (build_walker(scene), st, mst)
+    return _WALKERS[key]
+
+
+def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
+    """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]``."""
+    from walkerlab.analysis.hybrid import Solver
+
+    walker, st, max_step_time = _walker_and_settings(task.base)
+    solver = Solver("DOP853", st.rtol, st.atol)
+    x_star = np.asarray(task.x_star, dtype=float)
+    out = []
+    for idx, vx, vy in task.cells:
+        x0 = slice_state(walker, x_star, (st.x_axis, st.y_axis), (vx, vy))
+        out.append((int(idx), *classify_cell(walker, x0, x_star, solver, st, max_step_time)))
+    return out
+
+
+def _partial(path: Path) -> Path:
+    return path.with_name(path.name + ".partial")
+
+
+def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
+                  grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
+                  resume: bool = True, on_chunk: Callable[[int, int], None] | None = None
+                  ) -> dict:
+    """Classify every cell of the basin grid; resumable through ``<out_path>.partial``.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``basin`` section (or the defaults) sets axes, ranges and tolerances.
+    x_star : ndarray, shape (2n,)
+        Period-1 fixed point.
+    key : str
+        Input hash; a partial file with another key is discarded.
+    out_path : Path
+        Final artifact (the partial file lives next to it).
+    grid : (nx, ny), optional
+        Overrides ``basin.grid``.
+    workers, scheduler
+        As for :func:`walkerlab.sweep.runner.iter_chunk_results`.
+    resume : bool
+        Keep the cells of a matching partial file.
+    on_chunk : callable(done, total), optional
+        Called after each chunk is stored.
+
+    Returns
+    -------
+    dict
+        ``x``, ``y`` (cell centres), ``outcome``, ``steps``, ``period`` (shape (ny, nx)),
+        ``wall_time_s`` (this call), ``cells_computed``.
+
+    Raises
+    ------
+    BasinError
+        Bad axes or ranges.
+    """
+    import h5py
+
+    from walkerlab.config import BasinSettings
+    from walkerlab.models.registry import build_walker
+    from walkerlab.sweep.runner import iter_chunk_results
+
+    st = scene.basin or BasinSettings()
+    walker = build_walker(scene)
+    xs, ys = axis_values(st, walker, x_star, grid)
+    slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]))  # validate axes
+    nx, ny = xs.size, ys.size
+    part = _partial(Path(out_path))
+    part.parent.mkdir(parents=True, exist_ok=True)
+    arrays = None
+    if resume and part.is_file():
+        try:
+            with h5py.File(part, "r") as f:
+                if f.attrs.get("input_hash") == key and f["outcome"].shape == (ny, nx):
+                    arrays = {k: f[k][()] for k in ("outcome", "steps", "period")}
+        except OSError:
+            arrays = None
+    if arrays is None:
+        arrays = {"outcome": np.full((ny, nx), NOT_DONE, np.int8),
+                  "steps": np.zeros((ny, nx), np.int16), "period": np.zeros((ny, nx), np.int8)}
+    base = scene.model_dump(mode="json")
+    tasks = []
+    for j in range(ny):
+        cells = tuple((j * nx + i, float(xs[i]), float(ys[j])) for i in range(nx)
+                      if arrays["outcome"][j, i] == NOT_DONE)
+        if cells:
+            tasks.append(BasinTask(base, tuple(float(v) for v in x_star), cells))
+    # rows through the fixed point converge slowly: start them first for load balance
+    jc = int(np.argmin(np.abs(ys - x_star[walker.state_names().index(st.y_axis)])))
+    tasks.sort(key=lambda t: abs(t.cells[0][0] // nx - jc))
+    total, done = nx * ny, int(np.sum(arrays["outcome"] != NOT_DONE))
+    t0 = time.perf_counter()
+    computed = 0
+    with h5py.File(part, "w") as f:
+        f.attrs["input_hash"] = key
+        dsets = {k: f.create_dataset(k, data=v) for k, v in arrays.items()}
+        f.flush()
+        for rows in iter_chunk_results(tasks, workers, scheduler, fn=run_basin_chunk):
+            for idx, code, steps, period in rows:
+                j, i = divmod(idx, nx)
+                arrays["outcome"][j, i] = code
+                arrays["steps"][j, i] = steps
+                arrays["period"][j, i] = period
+            for k, d in dsets.items():
+                d[...] = arrays[k]
+            f.flush()
+            computed += len(rows)
+            done += len(rows)
+            if on_chunk is not None:
+                on_chunk(done, total)
+    return {"x": xs, "y": ys, **arrays, "wall_time_s": time.perf_counter() - t0,
+            "cells_computed": computed, "partial": part, "settings": st, "walker": walker}
