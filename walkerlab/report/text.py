@@ -16,13 +16,15 @@ def _fmt_mult(re, im) -> str:
 
 def zero_multipliers_text(re, im) -> str:
     """Why some Floquet multipliers are 0: the map lands on the heel-strike surface (and, for a
-    kneed walker, on the straight-knee surface: the swing knee starts straight and locked)."""
+    kneed walker, on the straight-knee surface; for the simplest walker, whose swing leg has
+    no mass, the post-impact swing rate is a function of the stance-leg state)."""
     n0 = int(np.sum(np.hypot(re, im) < 1e-9))
     if n0 <= 1:
         return "one multiplier is 0 by construction: the map lands on the heel-strike surface"
     return (f"{n0} multipliers are 0 by construction: the map lands on the heel-strike surface "
-            "and on the surface where the constrained coordinates (a straight swing knee) are "
-            "fixed")
+            f"and the impact fixes {n0 - 1} more combination(s) of the state (e.g. a kneed "
+            "walker's straight, locked swing knee; the simplest walker's massless swing leg, "
+            "whose rate after heel strike follows from the stance leg's)")
 
 
 def fixedpoint_text(path: Path) -> str:
@@ -73,14 +75,15 @@ def simulate_text(path: Path) -> str:
 def contact_text(path: Path) -> str:
     """Summary of a contact-sim artifact."""
     with open_artifact(path, "contact-sim") as f:
-        lines = [f"contact walker: ended by {f.attrs.get('termination', '?')}"]
+        lines = [f"contact walker: outcome {f.attrs.get('outcome', '?')} "
+                 f"({f.attrs.get('outcome_message', f.attrs.get('termination', '?'))})"]
         if "summary" in f:
             for k in f["summary"]:
                 ds = f["summary"][k]
                 lines.append(f"  {k:<28s} {ds[()]} {ds.attrs.get('unit', '')}")
-        if "periodic_gait" in f and f["periodic_gait"].attrs.get("outcome", "ok") != "ok":
-            g = f["periodic_gait"]  # the search failed: the stage stores why, no numbers
-            lines.append(f"periodic contact gait: not found ({g.attrs['outcome']}: "
+        if "periodic_gait" in f and "step_period" not in f["periodic_gait"]:
+            g = f["periodic_gait"]
+            lines.append(f"periodic contact gait: not found ({g.attrs.get('outcome', '?')}: "
                          f"{g.attrs.get('message', '')})")
         elif "periodic_gait" in f:
             g = f["periodic_gait"]
