@@ -180,6 +180,6 @@ def run_bench(what: str, out: Path) -> list[str]:
         from walkerlab.io.artifacts import atomic_write
 
         text = json.dumps(res, indent=1, default=str).encode()
-        atomic_write(out / f"{name}.json", lambda fh: fh.write(text))
+        atomic_write(out / f"{name}.json", lambda fh, text=text: fh.write(text))
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines
