@@ -118,3 +118,27 @@ def test_scene_end_to_end(scene_path, tmp_path):
 
     for p in [fp.path, sim.path, sw, *(runs / scene.name).glob("compare.h5")]:
         assert_netcdf(p)
+
+
+def test_paper_scene_is_table1():
+    """configs/paper.yaml carries the parameters printed in the paper's Table 1."""
+    from walkerlab.published import for_scene, paper
+
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    assert for_scene(scene) is paper
+    for key, value in paper.TABLE1.items():
+        assert getattr(scene.walker, key) == value, key
+    # "the mass of the links is concentrated and placed in the middle of the legs"
+    assert scene.walker.leg_mass_from_foot_m == paper.TABLE1["leg_length_m"] / 2
+
+
+def test_unknown_published_module_is_one_line(tmp_path):
+    from walkerlab.config import SceneError
+
+    d = yaml.safe_load((ROOT / "configs" / "goswami1996.yaml").read_text())
+    d["published"] = "nobody2099"
+    p = tmp_path / "bad.yaml"
+    p.write_text(yaml.safe_dump(d))
+    with pytest.raises(SceneError, match=r"bad.yaml: .*published.*nobody2099") as exc:
+        load_scene(p)
+    assert "\n" not in str(exc.value)
