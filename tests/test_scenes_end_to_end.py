@@ -30,7 +30,7 @@ def reduced(path: Path, tmp: Path):
     d.pop("workprecision", None)
     if "simulate" in d:
         d["simulate"]["strides"] = 1
-        d["simulate"]["sample_rate_hz"] = min(200, d["simulate"].get("sample_rate_hz", 200))
+        d["simulate"]["sample_rate_hz"] = min(100, d["simulate"].get("sample_rate_hz", 100))
     if "contact_sim" in d:
         d["contact_sim"]["n_strides"] = 1
         d["contact_sim"]["periodic_gait"] = False
