@@ -61,8 +61,28 @@ def assert_netcdf(path: Path) -> None:
                     assert "units" in v.attrs, f"{path}:{g}/{name} has no units"
 
 
+@pytest.fixture()
+def png_only(monkeypatch):
+    """Figures as small PNGs only (SVG and 150 dpi cost half of this test's time and are
+    tested elsewhere: tests/test_stages.py draws the full set)."""
+    import matplotlib.pyplot as plt
+
+    from walkerlab.plotting import figures
+
+    def save(fig, folder, stem):
+        p = Path(folder) / f"{stem}.png"
+        p.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            fig.savefig(p, dpi=30)
+        finally:
+            plt.close(fig)
+        return [p]
+
+    monkeypatch.setattr(figures, "save", save)
+
+
 @pytest.mark.parametrize("scene_path", SCENES, ids=[p.stem for p in SCENES])
-def test_scene_end_to_end(scene_path, tmp_path):
+def test_scene_end_to_end(scene_path, tmp_path, png_only):
     from walkerlab.stages import fixedpoint, report, simulate
     from walkerlab.stages import sweep as sweep_stage
     from walkerlab.sweep.store import load_sweep
