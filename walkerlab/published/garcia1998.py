@@ -23,6 +23,8 @@ Where each number is printed
   moderate accuracy of finite-difference eigenvalues for this model).
 """
 
+import math
+
 CITATION = ("M. Garcia, A. Chatterjee, A. Ruina, M. Coleman, \"The simplest walking model: "
             "stability, complexity, and scaling\", J. Biomech. Eng. 120(2):281-288, 1998, "
             "doi:10.1115/1.2798313")
@@ -44,3 +46,12 @@ SHORT_MULTIPLIERS = (4.000, 0.459)
 
 #: slope range where the long-period gait is stable [rad] (abstract)
 STABLE_SLOPE_RANGE_RAD = (0.0, 0.015)
+
+# --- the same numbers as the report reads them (walkerlab state names, scene key
+# ``published: garcia1998``).  The hip angle and its rate are not printed: on the section
+# they follow from theta* (phi = 2 theta, phi_dot = theta_dot (1 - cos 2 theta), see above).
+SHORT = "garcia1998"
+FIXED_POINT_LABEL = "long-period gait at γ = 0.009 (hip angle and rate from θ*, θ̇*)"
+FIXED_POINT_NAMES = ("stance_angle", "hip_angle", "stance_rate", "hip_rate")
+FIXED_POINT_STATE = (LONG_THETA_RAD, 2 * LONG_THETA_RAD, LONG_THETA_DOT,
+                     LONG_THETA_DOT * (1 - math.cos(2 * LONG_THETA_RAD)))
