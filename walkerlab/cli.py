@@ -197,11 +197,13 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
     from walkerlab.io.artifacts import open_artifact
 
     with open_artifact(out.path, "contact-sim") as f:
-        term = str(f.attrs["termination"])
-        why = str(f.attrs.get("fall_reason", ""))
-    if term != "t_final":  # like simulate: a walker that does not finish the run exits 1
-        _fail(RuntimeError(f"the contact walker did not complete the run: {term}"
-                           + (f" ({why})" if why and why != "None" else "")))
+        kind = str(f.attrs.get("outcome", f.attrs["termination"]))
+        why = str(f.attrs.get("outcome_message", ""))
+    # like simulate: a walker that does not finish the run exits 1 (typed outcome of
+    # walkerlab.contact.simulate: trip, fall, solver_failure, time_limit)
+    if kind not in ("completed", "scuff", "slip", "t_final", "stride_cap"):
+        _fail(RuntimeError(f"the contact walker did not complete the run: {kind}"
+                           + (f" ({why})" if why else "")))
 
 
 @app.command()

@@ -51,7 +51,7 @@ def test_unscaled_ideal_state_drifts_off_narrow_patches():
     footfalls drift out of the patches placed at the ideal footfalls; on 30 cm patches the
     same start walks 10 steps."""
     w, r = _walk(0.10)
-    assert r.termination == "fall" and r.walked_steps < 10
+    assert r.termination in ("fall", "trip") and r.walked_steps < 10
     w, r = _walk(0.30)
     assert r.termination == "t_final" and r.walked_steps >= 10
     s_td = [np.interp(t, r.t, r.feet[leg].s) for t, leg in

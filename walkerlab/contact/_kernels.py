@@ -1,7 +1,7 @@
 """Numba-compiled kernels of the floating compass walker with compliant feet.
 
 Internal module.  Everything is SI.  The packed parameter vector ``P`` (float64, (NPAR,)) is
-read only through the named index constants below (``P[I_PHI]``, never ``P[5]``):
+read only through the named index constants below (``P[I_PHI]``, never a bare number):
 
 ======  ======================  =====
 name    meaning                 unit

@@ -120,6 +120,17 @@ class ContactWalker:
             load = self.total_mass * self.g * np.cos(self.phi)
         return (load / self.contact.k) ** (1.0 / self.contact.e)
 
+    # ------------------------------------------------------------------ state layout
+    @staticmethod
+    def state_names() -> tuple[str, ...]:
+        """Names of the 8 states, in order (leg i's angle ``theta{i}`` from the vertical)."""
+        return ("hip_x", "hip_y", "theta1", "theta2", "vhip_x", "vhip_y", "dtheta1", "dtheta2")
+
+    @staticmethod
+    def state_units() -> tuple[str, ...]:
+        """Units of :meth:`state_names`."""
+        return ("m", "m", "rad", "rad", "m/s", "m/s", "rad/s", "rad/s")
+
     # ------------------------------------------------------------------ dynamics
     def mass_matrix(self, q) -> np.ndarray:
         """M(q) (4, 4) [kg, kg m, kg m^2]."""

@@ -70,6 +70,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -259,7 +260,7 @@ class StepMap:
         on short odeint integrations from the sample before it, so the section state
         carries the integrator's accuracy, not an interpolant's.
         """
-        from scipy.integrate import odeint
+        from scipy.integrate import ODEintWarning, odeint
 
         ist, isw = 2 + stance_to_come, 3 - stance_to_come
         hth = 0.5 * self.walker.L
@@ -272,8 +273,10 @@ class StepMap:
             return K.jac(x, P, c1, c2)
 
         def run(x, tg):
-            X, info = odeint(f, x, tg, Dfun=jf, tfirst=True, rtol=self.rtol, atol=self.atol,
-                             full_output=True, mxstep=500000)
+            with warnings.catch_warnings():  # the message is checked below
+                warnings.simplefilter("ignore", ODEintWarning)
+                X, info = odeint(f, x, tg, Dfun=jf, tfirst=True, rtol=self.rtol,
+                                 atol=self.atol, full_output=True, mxstep=500000)
             if info["message"] != "Integration successful.":
                 raise PeriodicGaitError("solver_failure", f"step map: {info['message']}")
             return X
@@ -452,7 +455,7 @@ def _sorted_eig(J):
 def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 1.0),
                                warmup_steps: int = 8, xtol: float = 1e-11,
                                residual_tol: float = 1e-8, fd_step: float = 1e-4,
-                               check_fd: bool = True, method: str = "LSODA",
+                               check_fd: bool = True, method: str = "odeint",
                                rtol: float = 1e-11, atol: float = 1e-13,
                                jac_rtol: float = 1e-12, jac_atol: float = 1e-14,
                                patch_spacing: float | None = None,
@@ -482,7 +485,9 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         (the root finder's own Jacobians use ``10 * fd_step`` on the cheaper map).
     check_fd : bool
         Also compute the multipliers with ``fd_step * 3`` and ``/ 3`` (``multiplier_fd_spread``).
-    method, rtol, atol : integrator settings of the map (``solve_ivp``) while root finding.
+    method, rtol, atol : integrator settings of the map while root finding (``"odeint"``:
+        scipy odeint with the section crossing found by brentq, 3-10x faster than the
+        ``solve_ivp`` methods "LSODA", "Radau", "BDF", which locate it as an event).
     jac_rtol, jac_atol : tighter tolerances of the map for the final FD Jacobian.
     patch_spacing : float, optional
         Swing-patch distance ahead of the stance foot [m]; default the walker's lane spacing.

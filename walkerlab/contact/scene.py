@@ -14,7 +14,8 @@ from walkerlab.config import ContactSolverSettings, Scene
 from .config import ContactSimSettings, TerrainSettings
 from .model import ContactWalker
 
-__all__ = ["ContactSceneError", "settings", "ideal_step_length", "build", "simulate_from"]
+__all__ = ["ContactSceneError", "settings", "ideal_step_length", "build", "simulate_from",
+           "named_trajectory"]
 
 
 class ContactSceneError(ValueError):
@@ -112,3 +113,36 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
         fall_hip_height_m=cs.fall_hip_height_m, wall_time_limit_s=cs.wall_time_limit_s,
         max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
     return walker, res, x0, step_length
+
+
+def named_trajectory(walker: ContactWalker, res, legs=("leg1", "leg2")):
+    """A :class:`~walkerlab.contact.simulate.ContactResult` in the shared named layout of
+    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes)."""
+    from walkerlab.io.trajectory import NamedTrajectory
+
+    legs = list(legs)
+    t = res.t
+    stance = np.full(t.size, legs.index("leg2"))
+    step = np.zeros(t.size, dtype=int)
+    for k, (ths, leg) in enumerate(zip(res.heel_strike_times, res.heel_strike_legs)):
+        m = t >= ths
+        stance[m] = legs.index(leg)
+        step[m] = k + 1
+    X = res.x
+    en = walker.energies(X)
+    feet = np.asarray(walker.foot_positions(X))  # (n, 2, 2): foot, xy
+    names = walker.state_names()
+    col = {n: X[:, i] for i, n in enumerate(names)}
+    hip = np.vstack([col["hip_x"], col["hip_y"]])
+    pts = {"hip": hip}
+    for i, leg in enumerate(legs):
+        th = col[f"theta{i + 1}"]
+        pts[f"{leg}_foot"] = feet[:, i, :].T
+        pts[f"{leg}_mass"] = hip + walker.b * np.vstack([np.sin(th), -np.cos(th)])
+    coords, units = {}, {}
+    for i, leg in enumerate(legs):
+        coords[f"{leg}_angle"], units[f"{leg}_angle"] = col[f"theta{i + 1}"], "rad"
+        coords[f"{leg}_rate"], units[f"{leg}_rate"] = col[f"dtheta{i + 1}"], "rad/s"
+    return NamedTrajectory(
+        time=t, legs=legs, coordinates=coords, units=units, stance_leg=stance,
+        step_index=step, kinetic=en["kinetic"], potential=en["potential"], points=pts)

@@ -359,8 +359,13 @@ def _first_event(walker, t, X, hth, k0=1):
         k = int(below[0])
         if k == 0:
             best = ("fall", k0 - 1, float(tt[0]), "", np.nan)
-        else:
-            tc = float(np.interp(hth, [hh[k], hh[k - 1]], [tt[k], tt[k - 1]]))
+        else:  # on the Hermite interpolant of the hip height, slope = hip velocity . n
+            xa, xb = X[k0 - 1 + k - 1], X[k0 - 1 + k]
+            n = walker.normal
+            tc = _hermite_root(tt[k - 1], tt[k], hh[k - 1] - hth, hh[k] - hth,
+                               float(xa[4:6] @ n), float(xb[4:6] @ n), rising=False)
+            if tc is None:
+                tc = float(np.interp(hth, [hh[k], hh[k - 1]], [tt[k], tt[k - 1]]))
             best = ("fall", k0 - 1 + k, tc, "", np.nan)
     hw = walker.patch_half_width
     if not walker.continuous:
@@ -480,7 +485,7 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
                      max_step: float = np.inf, sample_rate_hz: float = 1000.0, *,
                      t0: float = 0.0, pin_stance_until: str = "none", pin_time_s: float = 0.0,
                      fall_hip_height_m: float | None = None, use_jacobian: bool = True,
-                     chunk_s: float = 0.5, min_step_m: float = 0.05,
+                     chunk_s: float = 1.0, min_step_m: float = 0.05,
                      initial_stance: str = "leg2", wall_time_limit_s: float | None = None,
                      max_heel_strikes: int | None = None,
                      slip_limit_mm: float | None = None) -> ContactResult:

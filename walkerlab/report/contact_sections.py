@@ -39,11 +39,23 @@ def contact_section(scene, paths) -> list[str]:
         cp = {k: (f["contact_params_si"][k][()], f["contact_params_si"][k].attrs["unit"])
               for k in f["contact_params_si"]}
         term = str(f.attrs["termination"])
+        outcome = (str(f.attrs.get("outcome", term)), str(f.attrs.get("outcome_message", "")))
         slips = f["steps/stance_slip_mm"][()]
+        creep = f["steps/double_support_creep_mm"][()] if "steps/double_support_creep_mm" in f \
+            else None
+        drop = None
+        if "drop_test" in f:
+            g = f["drop_test"]
+            drop = (g["stiffness"][()], str(g["stiffness"].attrs["unit"]),
+                    {fam: g[f"{fam}/restitution"][()] for fam in ("paper", "rigid_limit")},
+                    str(f.attrs.get("stiffness_family", "paper")))
         periods = f["steps/period"][()]
         adj = {k: f["adjust"][k][()] for k in f["adjust"]} if "adjust" in f else None
-        per = None
-        if "periodic_gait" in f:
+        per = per_fail = None
+        if "periodic_gait" in f and "step_period" not in f["periodic_gait"]:
+            per_fail = (str(f["periodic_gait"].attrs.get("outcome", "?")),
+                        str(f["periodic_gait"].attrs.get("message", "")))
+        elif "periodic_gait" in f:
             g = f["periodic_gait"]
             per = (float(g["step_period"][()]), float(g["step_length"][()]),
                    g["multipliers/real"][()] + 1j * g["multipliers/imag"][()],
@@ -78,15 +90,78 @@ def contact_section(scene, paths) -> list[str]:
                                           for k, v in summ.items()] + [["termination", term]]),
            "", "Contact parameters in SI (converted from the scene's unit system): "
            + ", ".join(f"{k} = {float(v):.4g} {u}" for k, (v, u) in cp.items()) + ".", "",
-           "Per-step stance slip [mm]: " + ", ".join(f"{v:.3f}" for v in slips)
+           f"Outcome: **{outcome[0]}** — {outcome[1]}", "",
+           "Per-step stance slip [mm] (touchdown to lift-off of the stance foot; nan: the "
+           "phase had not ended when the run did): " + ", ".join(f"{v:.3f}" for v in slips)
+           + (("; creep of both feet during double support [mm]: "
+               + ", ".join(f"{v:.3f}" for v in creep)) if creep is not None else "")
            + "; step periods [s]: " + ", ".join(f"{v:.4f}" for v in periods) + ".",
            "(% columns: change of magnitude relative to the ideal/MATLAB value.)", ""]
+    if per_fail is not None:
+        out += [f"**Periodic gait of the contact model**: not found ({per_fail[0]}: "
+                f"{per_fail[1]}).", ""]
+    if drop is not None:
+        out += _drop_lines(scene, p, *drop)
+    out += _map_lines(p)
     if per is not None:
         out += [f"**Periodic gait of the contact model** (fixed point of its step-to-step map, "
                 f"mid-stance section): step period {per[0]:.6f} s, step length {per[1]:.6f} m, "
                 f"{'stable' if per[3] else 'unstable'}; Floquet multipliers "
                 + ", ".join(f"{m:.4f}" for m in per[2][:3])
                 + " and three fast contact/creep modes ≈ 0.", ""]
+    return out
+
+
+def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
+    """Restitution-vs-stiffness figure (drop test stored in contact_sim.h5) and its text."""
+    from walkerlab.plotting.figures import save
+    from walkerlab.plotting.sweep_figures import restitution_figure
+
+    figdir = artifact.parent / "report" / "figures"
+    fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness))
+    save(fig, figdir, "drop_restitution")
+    rows = [[float(k), float(curves["paper"][i]), float(curves["rigid_limit"][i])]
+            for i, k in enumerate(ks)]
+    cap = ("Drop test — coefficient of restitution against stiffness, paper family (damping "
+           "and dmax fixed) and rigid-limit family (damping and dmax scaled with k).")
+    return ["### Stiffness is not rigidity (drop test)", "",
+            f"This scene follows the **{family}** family. With damping fixed, a stiffer IMPACT "
+            "contact is *more elastic*, not closer to the rigid model's plastic impact; the "
+            "rigid-limit family scales c ~ k^(1/(e+1)) and dmax ~ k^(-1/(e+1)), which keeps "
+            "the restitution of the reference contact (near-plastic) at every k.", "",
+            f"![{cap}](figures/drop_restitution.png)", "", f"*{cap}*", "",
+            "<details><summary>drop-test table</summary>", "",
+            _table([f"stiffness [{unit}]", "restitution, paper family",
+                    "restitution, rigid-limit family"], rows), "", "</details>", ""]
+
+
+def _map_lines(artifact) -> list[str]:
+    """Stability maps of the contact gait, where their artifacts exist next to ``artifact``."""
+    import shutil
+
+    out = []
+    for kind in ("stiffness", "friction", "patch_width"):
+        p = artifact.parent / f"stability_map_{kind}.h5"
+        png = p.with_suffix(".png")
+        if not (p.is_file() and png.is_file()):
+            continue
+        with open_artifact(p) as f:
+            ex = float(f["summary/exists_fraction"][()])
+            stab = float(f["summary/stable_fraction"][()])
+            n = int(f["summary/cells"][()])
+        figdir = artifact.parent / "report" / "figures"
+        figdir.mkdir(parents=True, exist_ok=True)
+        shutil.copy(png, figdir / png.name)
+        cap = (f"Stability map of the contact gait over {kind.replace('_', ' ')} × slope "
+               f"({n} cells): a periodic gait exists in {100 * ex:.0f} % of the cells and is "
+               f"stable in {100 * stab:.0f} %.")
+        if not out:
+            out += ["### Stability maps of the contact gait", "",
+                    "Each cell: the contact model's own periodic gait (fixed point of its "
+                    "mid-stance step map) continued from its neighbour along the slope, else "
+                    "from the ideal fixed point at that slope; cell text: max |Floquet "
+                    "multiplier|, or why no gait was found (`walkerlab stability-map`).", ""]
+        out += [f"![{cap}](figures/{png.name})", "", f"*{cap}*", ""]
     return out
 
 

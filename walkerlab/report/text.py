@@ -73,12 +73,17 @@ def simulate_text(path: Path) -> str:
 def contact_text(path: Path) -> str:
     """Summary of a contact-sim artifact."""
     with open_artifact(path, "contact-sim") as f:
-        lines = [f"contact walker: ended by {f.attrs.get('termination', '?')}"]
+        lines = [f"contact walker: outcome {f.attrs.get('outcome', '?')} "
+                 f"({f.attrs.get('outcome_message', f.attrs.get('termination', '?'))})"]
         if "summary" in f:
             for k in f["summary"]:
                 ds = f["summary"][k]
                 lines.append(f"  {k:<28s} {ds[()]} {ds.attrs.get('unit', '')}")
-        if "periodic_gait" in f:
+        if "periodic_gait" in f and "step_period" not in f["periodic_gait"]:
+            g = f["periodic_gait"]
+            lines.append(f"periodic contact gait: not found ({g.attrs.get('outcome', '?')}: "
+                         f"{g.attrs.get('message', '')})")
+        elif "periodic_gait" in f:
             g = f["periodic_gait"]
             mult = g["multipliers/real"][()] + 1j * g["multipliers/imag"][()]
             lines.append(f"periodic contact gait: step period {g['step_period'][()]:.6f} s, "

@@ -16,7 +16,7 @@ import numpy as np
 from walkerlab.config import ContactSolverSettings, Scene
 from walkerlab.contact import scene as contact_scene
 from walkerlab.io.artifacts import put
-from walkerlab.io.trajectory import NamedTrajectory, write_samples
+from walkerlab.io.trajectory import NamedTrajectory, write_samples  # noqa: F401
 from walkerlab.stages import fixedpoint as fixedpoint_stage
 from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
 
@@ -37,31 +37,8 @@ simulate_from = contact_scene.simulate_from
 
 
 def named_trajectory(walker, res) -> NamedTrajectory:
-    """Map a ContactResult onto the shared named layout (stance leg from heel strikes)."""
-    t = res.t
-    stance = np.full(t.size, LEGS.index("leg2"))
-    step = np.zeros(t.size, dtype=int)
-    for k, (ths, leg) in enumerate(zip(res.heel_strike_times, res.heel_strike_legs)):
-        m = t >= ths
-        stance[m] = LEGS.index(leg)
-        step[m] = k + 1
-    X = res.x
-    en = walker.energies(X)
-    feet = walker.foot_positions(X)  # (n, 2, 2): foot, xy
-    b = walker.b
-    hip = X[:, :2].T
-    pts = {"hip": hip}
-    for i, leg in enumerate(LEGS):
-        th = X[:, 2 + i]
-        pts[f"{leg}_foot"] = np.asarray(feet)[:, i, :].T
-        pts[f"{leg}_mass"] = hip + b * np.vstack([np.sin(th), -np.cos(th)])
-    return NamedTrajectory(
-        time=t, legs=LEGS,
-        coordinates={"leg1_angle": X[:, 2], "leg2_angle": X[:, 3], "leg1_rate": X[:, 6],
-                     "leg2_rate": X[:, 7]},
-        units={"leg1_angle": "rad", "leg2_angle": "rad", "leg1_rate": "rad/s",
-               "leg2_rate": "rad/s"}, stance_leg=stance, step_index=step,
-        kinetic=en["kinetic"], potential=en["potential"], points=pts)
+    """Map a ContactResult onto the shared named layout (see :mod:`walkerlab.contact.scene`)."""
+    return contact_scene.named_trajectory(walker, res, LEGS)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
@@ -173,7 +150,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             put(f, "terrain/patch_half_width", walker.patch_half_width, "m", "")
             put(f, "terrain/continuous", bool(walker.continuous), "-", "")
             put(f, "initial_state", x0, "m, rad, m/s, rad/s",
-                "[hip_x, hip_y, theta1, theta2] and rates", )
+                "[hip_x, hip_y, theta1, theta2] and rates",
+                names=list(walker.state_names()))
+            for name, val, unit in zip(walker.state_names(), x0, walker.state_units()):
+                put(f, f"initial_state_named/{name}", float(val), unit, f"initial {name}")
             put(f, "initial_state_ideal", x_fp, "rad, rad/s", "ideal fixed point (Table 2 MATLAB)")
             put(f, "initial_rate_scale", np.asarray(scale if scale is not None else
                                                     settings(scene)[2].initial_rate_scale),

@@ -6,7 +6,9 @@ Every point of a sweep ends in exactly one outcome (never an unhandled exception
 ``ok``              the stage succeeded (fixed point found / all steps walked)
 ``no_fixed_point``  the root finder stopped without a fixed point (``residual`` column)
 ``fall``            the walker fell (``fall_time_s``, ``fall_leg`` = stance leg, ``message``
-                    = guard that fired)
+                    = guard that fired; contact model: hip below the fall height)
+``trip``            contact model: a foot hit the side of a patch below its top
+                    (``fall_time_s``, ``fall_leg`` = the foot, ``trip_edge_m`` = the edge)
 ``scuffing``        the swing foot hit the ground before heel strike (contact model: a
                     touchdown of the swing foot that is not a heel strike; rigid model: only
                     when ``options["scuff_limit_m"]`` is set, since the ideal model ignores it)
@@ -15,6 +17,7 @@ Every point of a sweep ends in exactly one outcome (never an unhandled exception
 ``solver_failure``  the integrator stopped (``message`` = scipy's message)
 ``max_steps``       a budget ran out before a verdict: a step lasted longer than
                     ``max_step_time_s`` (rigid), or the contact walker stalled (too few steps)
+``time_limit``      contact model: the run's wall-time limit ran out first
 ``invalid_config``  the point's scene does not validate (``message`` = pydantic's, one line)
 ``error``           any other exception (type and message recorded; should not happen)
 ==================  =======================================================================
@@ -22,8 +25,8 @@ Every point of a sweep ends in exactly one outcome (never an unhandled exception
 
 from __future__ import annotations
 
-OUTCOMES = ("ok", "no_fixed_point", "fall", "scuffing", "slip", "bounce", "solver_failure",
-            "max_steps", "invalid_config", "error")
+OUTCOMES = ("ok", "no_fixed_point", "fall", "trip", "scuffing", "slip", "bounce",
+            "solver_failure", "max_steps", "time_limit", "invalid_config", "error")
 
 # column name -> (unit, description); all stored as float64 (NaN = not applicable).
 # Columns that depend on the walker's state (fixed point, initial state, multipliers) are
@@ -56,7 +59,11 @@ _CONTACT = {
     "t_end_s": ("s", "time at which the run ended"),
     "fall_time_s": ("s", "time of the fall (NaN if none)"),
     "mean_step_period_s": ("s", "mean period of the complete steps"),
-    "max_slip_mm": ("mm", "largest along-slope slide of a stance foot while in contact"),
+    "max_slip_mm": ("mm", "largest along-slope slide of a stance foot over a stance phase "
+                    "(touchdown to lift-off; phases that do not end are left out)"),
+    "double_support_creep_mm": ("mm", "along-slope travel of both feet while both are loaded"),
+    "trip_edge_m": ("m", "along-slope position of the patch side hit by a trip (NaN if none)"),
+    "hip_height_end_m": ("m", "hip height above the ground line at the end of the run"),
     "bounces": ("-", "touchdowns of a stance foot after it lifted off within its step"),
     "scuffs": ("-", "touchdowns of the swing foot that are not heel strikes"),
     "peak_penetration_mm": ("mm", "largest penetration of either foot"),

@@ -286,40 +286,23 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
     return cw, res, 2 * cs.n_strides
 
 
-def _contact_events(res) -> tuple[float, int, int, str]:
-    """Largest stance slip [mm], bounces, scuffs, and the stance leg at the run's end."""
-    t = res.t
-    starts = [float(t[0])] + [float(x) for x in res.heel_strike_times]
-    legs = [res.steps[0].stance_leg if res.steps else "leg2"] + list(res.heel_strike_legs)
-    ends = starts[1:] + [float(t[-1])]
-    max_slip = 0.0
-    for ta, tb, leg in zip(starts, ends, legs):
-        ft = res.feet[leg]
-        m = (t >= ta) & (t <= tb) & (ft.penetration > 0) & ft.on_ground
-        if m.sum() >= 2:
-            s = ft.s[m]
-            max_slip = max(max_slip, 1e3 * abs(float(s[-1] - s[0])))
-    hs = set(zip([round(x, 12) for x in starts[1:]], legs[1:]))
-    bounces = scuffs = 0
-    for leg, ft in res.feet.items():
-        for tt in ft.touchdown_times:
-            if tt <= t[0] or (round(float(tt), 12), leg) in hs:
-                continue
-            j = int(np.searchsorted(starts, tt, side="right")) - 1
-            if legs[j] == leg:
-                bounces += 1
-            else:
-                scuffs += 1
-    return max_slip, bounces, scuffs, legs[-1]
+#: contact outcome kind (walkerlab.contact.simulate.OUTCOME_KINDS) -> sweep outcome
+_CONTACT_OUTCOME = {"completed": "ok", "trip": "trip", "fall": "fall", "scuff": "scuffing",
+                    "slip": "slip", "solver_failure": "solver_failure",
+                    "time_limit": "time_limit"}
 
 
 def contact_point(scene: Scene, guess, options: dict):
     """Compliant-contact simulation started from the ideal gait at this point (``contact-sim``).
 
     The ideal fixed point (continuation from ``guess``) gives the initial state, the step
-    period and the checkerboard spacing; see :func:`contact_adapter`.
+    period and the checkerboard spacing; see :func:`contact_adapter`.  The point's outcome
+    is the contact run's typed outcome (trip, fall, scuff, slip beyond
+    ``options["slip_limit_mm"]``, solver failure, time limit), then ``bounce`` (a stance
+    foot left the ground and came back) and ``max_steps`` (stalled).
     """
     from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.contact.simulate import classify_complete
 
     opts = {**DEFAULT_OPTIONS, **options}
     walker, fp, source = ideal_fixed_point(scene, guess, options)
@@ -328,28 +311,32 @@ def contact_point(scene: Scene, guess, options: dict):
     cols = {"guess_source": source, "ideal_step_length_m": step_length,
             "ideal_step_period_s": float(fp.period_s)}
     _cw, res, n_steps = contact_adapter(scene, fp.x, fp.period_s, step_length)
-    slip, bounces, scuffs, last_leg = _contact_events(res)
+    out = res.outcome
+    if out.kind == "completed":
+        out = classify_complete(res.steps, opts["slip_limit_mm"], out.hip_height_m)
+    bounces = sum(s.bounce_count for s in res.steps)
+    scuffs = sum(s.scuff_count for s in res.steps)
     periods = [s.period for s in res.steps if math.isfinite(s.period)]
     peak = max((float(np.max(np.where(ft.on_ground, ft.penetration, 0.0))) for ft in
                 res.feet.values()), default=0.0)
     cols.update(heel_strikes=float(res.walked_steps), steps_expected=float(n_steps),
-                t_end_s=float(res.t[-1]), max_slip_mm=slip, bounces=float(bounces),
-                scuffs=float(scuffs), peak_penetration_mm=1e3 * max(peak, 0.0),
+                t_end_s=float(res.t[-1]), max_slip_mm=res.max_stance_slip_mm,
+                double_support_creep_mm=float(sum(s.double_support_creep_mm
+                                                  for s in res.steps)),
+                bounces=float(bounces), scuffs=float(scuffs),
+                peak_penetration_mm=1e3 * max(peak, 0.0),
                 mean_step_period_s=float(np.mean(periods)) if periods else math.nan,
-                integration_wall_time_s=float(res.wall_time_s), nfev=float(res.nfev))
-    if res.termination == "solver_failure":
-        raise _Outcome("solver_failure", res.message, **cols)
-    if res.termination == "fall":
-        raise _Outcome("fall", f"hip below the fall height at t = {res.fall_time:.4g} s after "
-                       f"{res.walked_steps} heel strikes", fall_time_s=float(res.fall_time),
-                       fall_leg=last_leg, **cols)
-    if slip > opts["slip_limit_mm"]:
-        raise _Outcome("slip", f"stance foot slid {slip:.3g} mm (limit "
-                       f"{opts['slip_limit_mm']:g} mm)", **cols)
+                integration_wall_time_s=float(res.wall_time_s), nfev=float(res.nfev),
+                hip_height_end_m=float(out.hip_height_m), trip_edge_m=float(out.patch_edge_m))
+    kind = _CONTACT_OUTCOME[out.kind]
+    if kind in ("trip", "fall"):
+        raise _Outcome(kind, out.message, fall_time_s=float(out.time_s),
+                       fall_leg=out.foot or (res.steps[-1].stance_leg if res.steps else ""),
+                       **cols)
+    if kind != "ok":
+        raise _Outcome(kind, out.message, **cols)
     if bounces:
         raise _Outcome("bounce", f"{bounces} stance-foot bounce(s)", **cols)
-    if scuffs:
-        raise _Outcome("scuffing", f"{scuffs} swing-foot touchdown(s) before heel strike", **cols)
     if res.walked_steps < n_steps - 1:
         raise _Outcome("max_steps", f"stalled: {res.walked_steps} of {n_steps} heel strikes by "
                        f"t = {res.t[-1]:.4g} s", **cols)
@@ -434,7 +421,18 @@ def run_chunk(task: Task) -> list[dict]:
 
 
 def warm_up() -> None:
-    """Build the lambdified model functions once (called in fresh worker processes)."""
+    """Build the lambdified model functions once (called in fresh worker processes) and
+    import the integration and root-finding libraries, so that processes forked from the
+    forkserver start warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise)."""
+    try:
+        import scipy.optimize  # noqa: F401
+
+        from walkerlab.analysis.hybrid import _have_cyrk
+
+        if _have_cyrk():
+            import CyRK  # noqa: F401
+    except Exception:  # noqa: BLE001 - warming is an optimisation only
+        pass
     try:
         from walkerlab.models.derivation import compass_gait_functions
 

@@ -1,0 +1,149 @@
+"""Contact model at the edges (issue 11): geometric trips, typed outcomes, slip per stance
+phase, stiffness families (drop test), layering and named parameter indices."""
+
+import ast
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from walkerlab.contact import (
+    ContactSettings,
+    ContactWalker,
+    TerrainSettings,
+    initial_state_from_ideal,
+    simulate_contact,
+)
+from walkerlab.contact.drop import restitution_curve
+from walkerlab.contact.simulate import OUTCOME_KINDS, _phase_slip
+
+FP = (-0.2042, 0.1694, -0.6058, -0.8610)  # approx. ideal fixed point (leg1 swing)
+STEP_LENGTH = 0.372  # ideal step length [m]
+PKG = Path(__file__).resolve().parents[2] / "walkerlab"
+
+
+def _walker(k=1e5, width=0.10, family="paper"):
+    c = ContactSettings(stiffness=k, stiffness_family=family)
+    return ContactWalker.from_settings(c, TerrainSettings(patch_width_m=width),
+                                       step_length=STEP_LENGTH, n_steps=12)
+
+
+def test_stiff_heel_strike_bounce_does_not_tunnel_into_a_trip():
+    """Issue 11 item 1: at k = 1e7 N/mm^2.2 the first heel strike bounces the foot; a long
+    solver step used to carry it 0.16 mm into the patch during the flight, which counted as
+    "dead" (force off) and ended the run as a fall at ~0.63 s.  Now the force is on in every
+    state over a patch, so the run goes on through the bounces past the first heel strike
+    (~0.58 s with the +10 % stance rate)."""
+    w = _walker(k=1e7)
+    x0 = initial_state_from_ideal(w, *FP, rate_scale=(1.0, 1.1))
+    r = simulate_contact(w, x0, 0.75, rtol=1e-8, atol=1e-11)
+    assert r.outcome.kind in ("completed", "scuff"), r.outcome
+    assert r.termination == "t_final"
+    assert r.walked_steps >= 1
+    assert r.steps[1].bounce_count >= 1  # the heel strike did bounce (elastic at 1e7)
+
+
+def test_trip_is_a_foot_hitting_a_patch_side():
+    """A foot moved sideways into a patch below its top is a trip, typed with the foot, the
+    patch edge and the time; nothing here depends on a penetration depth."""
+    w = _walker(width=0.10)
+    x0 = initial_state_from_ideal(w, *FP)
+    # put the walker 6 cm uphill with the stance foot (leg2) 2 mm below the ground level:
+    # it is in the gap uphill of its patch [-0.05, 0.05], moving downhill towards its side
+    x = x0.copy()
+    x[0] -= 0.06 * w.tangent[0]
+    x[1] -= 0.06 * w.tangent[1]
+    x[0] -= 0.002 * w.normal[0]
+    x[1] -= 0.002 * w.normal[1]  # 2 mm below the top, in the gap uphill of the patch
+    x[4:6] = 1.0 * w.tangent  # moving downhill towards the patch side at 1 m/s
+    r = simulate_contact(w, x, 0.2, rtol=1e-8, atol=1e-11)
+    assert r.outcome.kind == "trip", r.outcome
+    assert r.termination == "trip"
+    assert r.outcome.foot == "leg2"
+    assert r.outcome.patch_edge_m == pytest.approx(-0.05, abs=1e-12)
+    # the run ends at the event: the last sample is the foot on the edge, below the top
+    assert r.t[-1] == pytest.approx(r.outcome.time_s)
+    assert r.feet["leg2"].s[-1] == pytest.approx(-0.05, abs=1e-6)
+    assert r.feet["leg2"].penetration[-1] > 1e-3
+    assert "trip" in r.outcome.message and "leg2" in r.outcome.message
+
+
+def test_typed_outcomes_fall_time_limit_and_slip():
+    w = _walker(width=0.30)
+    x0 = initial_state_from_ideal(w, *FP)
+    # far too slow a swing: the walker falls backwards/forwards -> "fall" with hip height
+    r = simulate_contact(w, initial_state_from_ideal(w, *FP, rate_scale=(0.2, 0.2)), 3.0)
+    assert r.outcome.kind == "fall" and r.outcome.hip_height_m == pytest.approx(0.5, abs=1e-3)
+    # wall-time limit (tiny) -> time_limit after the first chunk
+    r = simulate_contact(w, x0, 3.0, wall_time_limit_s=1e-6, chunk_s=0.05)
+    assert r.outcome.kind == "time_limit" and r.t[-1] < 3.0
+    # slip limit below the ~0.5 mm creep of the regularized friction -> slip
+    r = simulate_contact(w, x0, 1.6, slip_limit_mm=0.01)
+    assert r.outcome.kind == "slip" and r.outcome.foot in ("leg1", "leg2")
+    assert set(OUTCOME_KINDS) >= {"completed", "trip", "fall", "scuff", "slip",
+                                  "solver_failure", "time_limit"}
+
+
+def test_slip_window_is_one_stance_phase():
+    """Slip = s(lift-off) - s(touchdown) per contact phase; flight excluded; NaN when the
+    phase has not ended."""
+    t = np.linspace(0.0, 1.0, 101)
+    s = np.where(t < 0.5, 0.01 * t, 0.005 + 1.0 * (t - 0.5))  # creeps, then flies away
+    # phase 1: touchdown 0, lift-off 0.3 -> 3 mm; flight 0.3..0.6; phase 2 from 0.6, open
+    assert _phase_slip(t, s, np.array([0.0]), np.array([0.3]), 0.0, 1.0) == pytest.approx(
+        0.003)
+    assert np.isnan(_phase_slip(t, s, np.array([0.0, 0.6]), np.array([0.3]), 0.0, 1.0))
+    # the paper run: every stance phase that ended slid < 2 mm, and the last, open phase of
+    # a run cut in double support is NaN, not hundreds of mm of creep
+    w = _walker(width=0.10)
+    r = simulate_contact(w, initial_state_from_ideal(w, *FP, rate_scale=(1.0, 1.1)), 1.45,
+                         rtol=1e-8, atol=1e-11)
+    ended = [st for st in r.steps if np.isfinite(st.stance_slip_mm)]
+    assert ended and all(abs(st.stance_slip_mm) < 2.0 for st in ended)
+    assert np.isnan(r.steps[-1].stance_slip_mm)
+    assert all(np.isfinite(st.double_support_creep_mm) for st in r.steps)
+
+
+def test_drop_restitution_monotone_per_family_rigid_limit_near_plastic():
+    """Issue 11 item 4 numbers (c = 90 N s/mm, dmax = 0.1 mm fixed): e = 0.03 (1e5), 0.16
+    (1e6), 0.58 (1e7), 0.91 (1e8), 0.99 (1e9).  The rigid-limit family keeps the reference
+    restitution (exact self-similarity of the drop without gravity)."""
+    ks = [1e5, 1e6, 1e7, 1e8, 1e9]
+    r = restitution_curve(ContactSettings(), ks, rtol=1e-8)
+    e_p, e_r = r["paper"]["restitution"], r["rigid_limit"]["restitution"]
+    assert np.all(np.diff(e_p) > 0)
+    np.testing.assert_allclose(e_p, [0.03, 0.16, 0.58, 0.91, 0.99], atol=0.01)
+    assert np.all(np.abs(np.diff(e_r)) < 1e-3)  # monotone (constant within 1e-3)
+    assert np.all(e_r < 0.05)  # near-plastic
+    # and the rigid-limit family's impacts get shorter like k^(-1/(e+1))
+    tc = r["rigid_limit"]["contact_time_s"]
+    np.testing.assert_allclose(tc[1:] / tc[:-1], 10 ** (-1 / 3.2), rtol=1e-3)
+
+
+def test_kernels_read_parameters_through_named_indices():
+    src = (PKG / "contact" / "_kernels.py").read_text()
+    assert not re.findall(r"\bP\[\d+\]", src), "bare P[number] in the contact kernels"
+
+
+def test_contact_package_never_imports_stages():
+    for path in (PKG / "contact").glob("*.py"):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                names = [node.module or ""]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            else:
+                continue
+            assert not any(n.startswith("walkerlab.stages") for n in names), path.name
+
+
+def test_one_mass_matrix():
+    """msolve inverts exactly the matrix mass_matrix builds (both from mass_blocks)."""
+    from walkerlab.contact import _kernels as K
+
+    w = _walker()
+    M = K.mass_matrix(0.3, -0.2, w._P)
+    r = np.array([1.0, -2.0, 0.5, 0.25])
+    np.testing.assert_allclose(M @ K.msolve(0.3, -0.2, w._P, r), r, rtol=1e-12, atol=1e-12)
