@@ -144,13 +144,16 @@ def test_samples_artifact_and_figures_name_the_torso(walker, fixed_point, scene,
         assert f["samples/coordinates/torso_rate"].attrs["unit"] == "rad/s"
         back = read_samples(f)
     np.testing.assert_array_equal(back.coordinates["torso_angle"], tr.coordinates["torso_angle"])
+    import matplotlib.pyplot as plt
+
     fig = F.fig9_limit_cycle({"ideal": back})
     assert sum(ax.get_visible() for ax in fig.axes) == 3  # leg1, leg2, torso
-    F.save(fig, tmp_path, "fig9")
     stick = F.stick_diagram(back, "torso test", slope_rad=scene.slope.phi_rad)
     assert len(stick.axes[0].lines) >= 3 * 14  # two legs and the torso per snapshot
-    F.save(stick, tmp_path, "stick")
-    F.save(F.fig7_angles_rates({"ideal": back}), tmp_path, "fig7")
+    fig7 = F.fig7_angles_rates({"ideal": back})
+    assert len(fig7.axes[0].lines) == 3 and len(fig7.axes[1].lines) == 3  # 3 angles, 3 rates
+    for f in (fig, stick, fig7):
+        plt.close(f)
 
 
 def test_sweep_columns_and_bifurcation_arrays_follow_the_walker(walker, fixed_point, scene,

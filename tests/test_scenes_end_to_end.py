@@ -30,7 +30,7 @@ def reduced(path: Path, tmp: Path):
     d.pop("workprecision", None)
     if "simulate" in d:
         d["simulate"]["strides"] = 1
-        d["simulate"]["sample_rate_hz"] = min(200, d["simulate"].get("sample_rate_hz", 200))
+        d["simulate"]["sample_rate_hz"] = min(100, d["simulate"].get("sample_rate_hz", 100))
     if "contact_sim" in d:
         d["contact_sim"]["n_strides"] = 1
         d["contact_sim"]["periodic_gait"] = False
@@ -61,8 +61,28 @@ def assert_netcdf(path: Path) -> None:
                     assert "units" in v.attrs, f"{path}:{g}/{name} has no units"
 
 
+@pytest.fixture()
+def png_only(monkeypatch):
+    """Figures as small PNGs only (SVG and 150 dpi cost half of this test's time and are
+    tested elsewhere: tests/test_stages.py draws the full set)."""
+    import matplotlib.pyplot as plt
+
+    from walkerlab.plotting import figures
+
+    def save(fig, folder, stem):
+        p = Path(folder) / f"{stem}.png"
+        p.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            fig.savefig(p, dpi=30)
+        finally:
+            plt.close(fig)
+        return [p]
+
+    monkeypatch.setattr(figures, "save", save)
+
+
 @pytest.mark.parametrize("scene_path", SCENES, ids=[p.stem for p in SCENES])
-def test_scene_end_to_end(scene_path, tmp_path):
+def test_scene_end_to_end(scene_path, tmp_path, png_only):
     from walkerlab.stages import fixedpoint, report, simulate
     from walkerlab.stages import sweep as sweep_stage
     from walkerlab.sweep.store import load_sweep
@@ -118,3 +138,27 @@ def test_scene_end_to_end(scene_path, tmp_path):
 
     for p in [fp.path, sim.path, sw, *(runs / scene.name).glob("compare.h5")]:
         assert_netcdf(p)
+
+
+def test_paper_scene_is_table1():
+    """configs/paper.yaml carries the parameters printed in the paper's Table 1."""
+    from walkerlab.published import for_scene, paper
+
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    assert for_scene(scene) is paper
+    for key, value in paper.TABLE1.items():
+        assert getattr(scene.walker, key) == value, key
+    # "the mass of the links is concentrated and placed in the middle of the legs"
+    assert scene.walker.leg_mass_from_foot_m == paper.TABLE1["leg_length_m"] / 2
+
+
+def test_unknown_published_module_is_one_line(tmp_path):
+    from walkerlab.config import SceneError
+
+    d = yaml.safe_load((ROOT / "configs" / "goswami1996.yaml").read_text())
+    d["published"] = "nobody2099"
+    p = tmp_path / "bad.yaml"
+    p.write_text(yaml.safe_dump(d))
+    with pytest.raises(SceneError, match=r"bad.yaml: .*published.*nobody2099") as exc:
+        load_scene(p)
+    assert "\n" not in str(exc.value)

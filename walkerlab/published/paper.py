@@ -31,7 +31,8 @@ TABLE1 = {
 EQ11_STATE = (-0.2022, 0.1674, -0.60, -0.84)
 EQ11_NAMES = ("swing_angle", "stance_angle", "swing_rate", "stance_rate")
 # The generic names the report looks for (any source's published fixed point).
-FIXED_POINT_STATE, FIXED_POINT_NAMES, FIXED_POINT_LABEL = EQ11_STATE, EQ11_NAMES, "Eq. (11)"
+FIXED_POINT_STATE, FIXED_POINT_NAMES = EQ11_STATE, EQ11_NAMES
+FIXED_POINT_LABEL = "Eq. (11) as printed"
 
 # Table 2: initial state in MATLAB (= Eq. 11) and in MSC ADAMS, by physical coordinate at
 # t = 0 (leg1 swings first).  Values: (MATLAB, MSC ADAMS); symbol as printed.

@@ -76,7 +76,7 @@ def write_report(scene, paths: dict[str, Path], report_dir: Path, figures_dir: P
     md += sections.gait_section(scene, paths, pub)
     md += contact_sections.sections(scene, paths)
     md += sections.workprecision_summary(scene, paths)
-    md += sections.bifurcation_section(paths)
+    md += sections.bifurcation_section(paths, pub)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
     md += sections.figures_section(Path(figures_dir), str(rel), paths)

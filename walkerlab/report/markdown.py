@@ -30,8 +30,9 @@ def num(v, digits: int = DIGITS) -> str:
 
 
 def printed(v) -> str:
-    """A published number with the digits it was printed with (no padding, no rounding)."""
-    return f"{float(v):g}" if np.isfinite(float(v)) else "—"
+    """A published number with the digits it was printed with (no padding; at most 10
+    significant digits)."""
+    return f"{float(v):.10g}" if np.isfinite(float(v)) else "—"
 
 
 def sig_digits(text: str) -> int:

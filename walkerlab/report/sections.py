@@ -187,9 +187,8 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
             pub_fp) else None
         rows = []
         if eq is not None:
-            label = getattr(pub, "FIXED_POINT_LABEL", "Eq. (11)")
-            rows.append([f"{pub.SHORT} {label} (printed)", *[printed(v) for v in eq], "—", "—",
-                         "—"])
+            label = getattr(pub, "FIXED_POINT_LABEL", "published")
+            rows.append([f"{pub.SHORT}: {label}", *[printed(v) for v in eq], "—", "—", "—"])
         fps = {}
         for v in f["variants"]:
             g = f["variants"][v]
@@ -387,7 +386,7 @@ def workprecision_summary(scene, paths: dict[str, Path]) -> list[str]:
 
 
 # --------------------------------------------------------------------------- bifurcation
-def bifurcation_section(paths: dict[str, Path]) -> list[str]:
+def bifurcation_section(paths: dict[str, Path], pub: ModuleType | None = None) -> list[str]:
     """Period-doubling onset from ``bifurcation.h5`` (when the scene ran that stage)."""
     p = paths.get("bifurcation")
     if p is None:
@@ -399,6 +398,12 @@ def bifurcation_section(paths: dict[str, Path]) -> list[str]:
     text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
             "where the most negative real Floquet multiplier crosses −1" if np.isfinite(onset)
             else "no period doubling on the grid")
-    return ["## Bifurcation over the slope", "",
-            f"Grid {printed(slopes[0])}–{printed(slopes[-1])}° ({slopes.size} slopes): {text}; "
-            f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}.", ""]
+    out = ["## Bifurcation over the slope", "",
+           f"Grid {printed(slopes[0])}–{printed(slopes[-1])}° ({slopes.size} slopes): {text}; "
+           f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}."]
+    rng = getattr(pub, "STABLE_SLOPE_RANGE_RAD", None)
+    if rng is not None:
+        out.append(f"Published ({pub.SHORT}): the period-1 gait is stable for "
+                   f"{printed(rng[0])} < γ < {printed(rng[1])} rad "
+                   f"({printed(round(np.degrees(rng[1]), 4))}°).")
+    return out + [""]

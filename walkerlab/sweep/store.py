@@ -255,7 +255,7 @@ def load_sweep(path: Path) -> dict:
         pts = {}
 
         def visit(name, obj):
-            if isinstance(obj, h5py.Dataset):
+            if isinstance(obj, h5py.Dataset) and not obj.is_scale:  # not the 'point' dimension
                 v = obj[()]
                 if v.dtype.kind == "O":
                     v = np.array([x.decode() if isinstance(x, bytes) else x for x in v], object)
