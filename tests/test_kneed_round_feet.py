@@ -18,7 +18,7 @@ from walkerlab.analysis.hybrid import Solver, integrate_step, simulate_steps
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import BipedParams
 from walkerlab.models.description import walker_data
-from walkerlab.models.rigid import make_rigid_walker
+from walkerlab.models.rigid import functions, make_rigid_walker
 from walkerlab.published import bhounsule2009, hsu_chen2007
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -144,6 +144,32 @@ def test_kneed_swing_foot_through_the_ground_is_reported(kneed):
         x[walker.state_names().index(name)] = 2.0
     seg = integrate_step(walker, x, TIGHT)
     assert (seg.termination, seg.event) == ("fall", "swing_foot_scuffs")
+
+
+def test_knee_stop_pushes_while_locked(kneed):
+    # the locked knee's constraint torque lam (M qdd + C dq + G = J_k^T lam, J_k = d(shank -
+    # thigh)) stays negative: the stop pushes the shank back, so a plain knee stop would hold
+    # the knee straight without a latch (prototype: -0.033 to -0.029 N m)
+    cfg, walker, fp = kneed
+    f = functions(walker_data(BipedParams.model_validate(cfg["walker"]),
+                              cfg["slope"]["angle_rad"]))
+    seg = integrate_step(walker, fp.x, TIGHT)
+    names = walker.state_names()
+    sh = names.index("swing_shank_angle")
+    lam = []
+    for t in np.linspace(seg.phase_times["knee_strike"], seg.t_end, 25):
+        x = seg.sample(np.array([t]))[:, 0]
+        M, C, G = f["matrices"](x)
+        n = walker.n_coordinates
+        tau = M @ f["flow_locked"](t, x)[n:] + C @ x[n:] + G
+        lam.append(tau[sh])
+        assert abs(tau[names.index("stance_angle")]) < 1e-9   # only the knee is constrained
+    ref = KneedReference()
+    order = [names.index(f"{r}_{k}") for k in ("angle", "rate")
+             for r in ("stance", "swing_thigh", "swing_shank")]
+    assert lam[0] == pytest.approx(ref.locked_accel(seg.sample(np.array(
+        [seg.phase_times["knee_strike"]]))[:, 0][order])[1], rel=1e-6)
+    assert max(lam) < 0
 
 
 def test_knee_strike_conserves_momenta_and_dissipates(kneed):
