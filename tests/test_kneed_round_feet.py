@@ -11,9 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-
 from independent.kneed_reference import KneedReference
 from independent.round_feet_reference import RoundFeetReference
+
 from walkerlab.analysis.hybrid import Solver, integrate_step, simulate_steps
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import BipedParams
