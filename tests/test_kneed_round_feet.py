@@ -295,3 +295,23 @@ def test_round_feet_with_zero_radius_is_the_point_foot_walker(paper_walker, pape
     seg0 = integrate_step(paper_walker, paper_fixed_point.x, TIGHT)
     seg1 = integrate_step(walker, paper_fixed_point.x, TIGHT)
     assert np.max(np.abs(seg1.x_next - seg0.x_next)) < 1e-12
+
+
+# ------------------------------------------------------------------------ config errors
+@pytest.mark.parametrize(("scene", "edit", "field"), [
+    ("kneed", lambda w: w["leg"]["bodies"][0].update(from_hip_m=0.7), "thigh_mass"),  # below knee
+    ("kneed", lambda w: w["leg"]["knee"].update(thigh_length_m=1.2), "thigh_length_m"),
+    ("kneed", lambda w: w["leg"]["bodies"][1].update(link="leg"), "shank_mass"),
+    ("kneed", lambda w: w.update(coordinates="slope_relative"), "coordinates"),
+    ("round_feet", lambda w: w["leg"]["foot"].update(radius_m=1.5), "radius_m"),
+    ("round_feet", lambda w: w["leg"]["bodies"][0].update(link="shank"), "needs a knee"),
+])
+def test_bad_knee_or_foot_field_is_named_in_one_line(scene, edit, field):
+    from walkerlab.config import SceneError, scene_from_dict
+
+    d = _scene(scene)
+    edit(d["walker"])
+    with pytest.raises(SceneError) as exc:
+        scene_from_dict(d, f"{scene}.yaml")
+    msg = str(exc.value)
+    assert field in msg and "\n" not in msg
