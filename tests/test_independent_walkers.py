@@ -7,7 +7,6 @@ yardstick the generic framework's kneed and round-foot walkers are compared with
 
 import numpy as np
 import pytest
-
 from independent.kneed_reference import TEDRAKE_X0, KneedReference
 from independent.round_feet_reference import RoundFeetReference
 

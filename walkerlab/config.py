@@ -164,6 +164,8 @@ class LegSpec(_Strict):
 
     @model_validator(mode="after")
     def _bodies_on_leg(self) -> LegSpec:
+        if self.knee is not None and self.knee.thigh_length_m >= self.length_m:
+            raise ValueError("knee.thigh_length_m: the knee must lie above the foot")
         names = [b.name for b in self.bodies]
         if len(set(names)) != len(names):
             raise ValueError(f"bodies: duplicate body names {names}")
@@ -188,8 +190,6 @@ class LegSpec(_Strict):
                 if (b.link == "thigh") != (d <= lt) and d != lt:
                     raise ValueError(f"bodies.{b.name}: {d} m from the hip is not "
                                      f"on the {b.link} (knee at {lt} m)")
-        if self.knee is not None and self.knee.thigh_length_m >= self.length_m:
-            raise ValueError("knee.thigh_length_m: the knee must lie above the foot")
         if self.foot.kind == "arc" and self.foot.radius_m > self.length_m - (
                 self.knee.thigh_length_m if self.knee else 0.0):
             raise ValueError("foot.radius_m: the arc's centre must lie on the "

@@ -79,7 +79,8 @@ def _symbolic():
     xf, yf, dxf, dyf = sp.symbols("xf yf dxf dyf", real=True)
     qe, dqe = (*q, xf, yf), (*dq, dxf, dyf)
     off = sp.Matrix([xf, yf])
-    Me, _, _, _ = lagrange(qe, dqe, [(m, 0, p + off, a) for m, _, p, a in bodies], g, mass_matrix_only=True)
+    Me, _, _, _ = lagrange(qe, dqe, [(m, 0, p + off, a) for m, _, p, a in bodies], g,
+                           mass_matrix_only=True)
     E = (pts["swing_foot"] + off).jacobian(sp.Matrix(qe))
     par = (g, lt, ls, mh, mt, ms, a1, b1, a2, b2)
     masses = {"stance_shank": ms, "stance_thigh": mt, "hip": mh, "swing_thigh": mt,

@@ -45,7 +45,7 @@ BHOUNSULE_FIXED_POINT = np.array([_Z[0] - _Z[2] - 0.01, _Z[0] - 0.01, _Z[1] - _Z
 def _symbolic():
     q = sp.symbols("th_sw th_st", real=True)
     dq = sp.symbols("w_sw w_st", real=True)
-    g, L, R, M, m, c, I, gm = sp.symbols("g L R M m c I gamma", real=True)
+    g, L, R, M, m, c, Ileg, gm = sp.symbols("g L R M m c I gamma", real=True)
     th_sw, th_st = q
     n = sp.Matrix([sp.sin(gm), sp.cos(gm)])       # slope normal (up)
     tt = sp.Matrix([sp.cos(gm), -sp.sin(gm)])     # slope tangent (downhill)
@@ -64,21 +64,22 @@ def _symbolic():
         "swing_contact": centre_sw - R * n,
         "next_reference": centre_sw - R * n + R * (th_sw + gm) * tt,
     }
-    bodies = [(M, 0, hip, th_st), (m, I, pts["stance_mass"], th_st),
-              (m, I, pts["swing_mass"], th_sw)]
+    bodies = [(M, 0, hip, th_st), (m, Ileg, pts["stance_mass"], th_st),
+              (m, Ileg, pts["swing_mass"], th_sw)]
     Mm, h, T, V = lagrange(q, dq, bodies, g)
     # heel strike: extended coordinates (the whole walker translated by (xf, yf))
     xf, yf, dxf, dyf = sp.symbols("xf yf dxf dyf", real=True)
     qe, dqe = (*q, xf, yf), (*dq, dxf, dyf)
     off = sp.Matrix([xf, yf])
-    Me, _, _, _ = lagrange(qe, dqe, [(mm, ii, p + off, a) for mm, ii, p, a in bodies], g, mass_matrix_only=True)
+    Me, _, _, _ = lagrange(qe, dqe, [(mm, ii, p + off, a) for mm, ii, p, a in bodies], g,
+                           mass_matrix_only=True)
     # velocity of the swing foot's material point at the contact: v_centre + w x (-R n)
     qev = sp.Matrix(qe)
     v_centre_J = (centre_sw + off).jacobian(qev)
     w_J = sp.Matrix([th_sw]).jacobian(qev)
     r = -R * n
     E = v_centre_J + sp.Matrix([[-r[1]], [r[0]]]) * w_J
-    par = (g, L, R, M, m, c, I, gm)
+    par = (g, L, R, M, m, c, Ileg, gm)
     return q, dq, par, Mm, h, T, V, Me, E, pts
 
 

@@ -343,7 +343,7 @@ def generate(eq: Equations, param_names, key: str) -> str:
         *_numpy_fn("_matrices", eq, {"M": eq.M, "C": eq.C, "G": eq.G}),
         "    def matrices(x):",
         f"{IND}d = _matrices(x)",
-        f"{IND}return d['M'], d['C'], d['G'][:, 0]",
+        f"{IND}return d['M'], d['C'], np.reshape(d['G'], (len(d['M']),) + np.shape(d['G'])[1:])",
         *_numpy_fn("_impact_matrices", eq, {"De": eq.De, "E": eq.E}, args="q"),
         "    def impact_matrices(q):",
         f"{IND}d = _impact_matrices(q)",

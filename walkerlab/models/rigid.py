@@ -19,7 +19,8 @@ Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen
 - ``unlocked_swing`` (three links) until ``knee_extension`` (shank minus thigh angle) crosses
   zero upward: the knee straightens against its stop, the plastic knee strike
   (``knee_reset``) locks it and the step goes on; a fall if the swing foot reaches the ground
-  first (``swing_foot_scuffs``: its clearance above the slope falls below
+  first - scuffing, or landing on a bent knee (``swing_foot_scuffs``: its clearance above the
+  slope falls below
   ``-SCUFF_DEPTH * L`` - reported, not ignored; the small depth makes a foot that starts on
   the ground, clearance 0 to round-off, and is driven into it fire the guard) or the hip
   reaches the slope;
