@@ -10,7 +10,6 @@ from walkerlab.config import Scene
 from walkerlab.io import runpaths
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.trajectory import read_samples
-from walkerlab.plotting import figures as F
 from walkerlab.stages.common import StageError, artifact_path
 
 IDEAL_LABEL = "ideal (rigid, plastic impact)"
@@ -46,6 +45,8 @@ def run(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     StageError
         No trajectory artifact exists yet.
     """
+    from walkerlab.plotting import figures as F  # matplotlib: only when drawing
+
     trajs = load_trajectories(scene, runs_root)
     if not trajs:
         raise StageError(f"plot: no simulate.h5 or contact_sim.h5 under "

@@ -48,6 +48,19 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
     return done
 
 
+def _figures_key(scene: Scene, runs_root) -> tuple[Path, str]:
+    """Stamp file of the drawn figures and the key they must match: the stored input hashes
+    of the artifacts they are drawn from and walkerlab's code (a rerun with nothing changed
+    does not redraw: matplotlib and ~16 PNG/SVG files are most of a rerun's time)."""
+    import json
+
+    from walkerlab.io.artifacts import code_hash, stored_hash
+
+    arts = {stage: str(stored_hash(p)) for stage, p in existing_artifacts(scene, runs_root).items()}
+    return (figures_dir(scene, runs_root) / ".drawn_from",
+            json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True))
+
+
 def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
     """``{stage: path}`` of the report's stages whose artifact exists for ``scene``."""
     out = {}
@@ -70,9 +83,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     from walkerlab.stages import plot
 
     done = _run_stages(scene, runs_root, force, echo)
-    figs = plot.run(scene, runs_root) if any(
-        o.stage in ("simulate", "contact-sim") for o in done) else []
-    echo(f"         plot: {len([p for p in figs if p.suffix == '.png'])} figures")
+    if any(o.stage in ("simulate", "contact-sim") for o in done):
+        stamp, key = _figures_key(scene, runs_root)
+        if not force and stamp.is_file() and stamp.read_text() == key:
+            echo("         plot: reused (artifacts and code unchanged)")
+        else:
+            figs = plot.run(scene, runs_root)
+            stamp.parent.mkdir(parents=True, exist_ok=True)
+            stamp.write_text(key)
+            echo(f"         plot: {len([p for p in figs if p.suffix == '.png'])} figures")
     rep_dir = report_dir(scene, runs_root, claim=True)
     return write_report(scene, existing_artifacts(scene, runs_root), rep_dir,
                         figures_dir(scene, runs_root), done)

@@ -14,8 +14,9 @@ Speed of the study itself (issue 10), without dropping a method or a tolerance:
 
 - every case (model, method, tolerance) is cached on its own under
   ``runs/<scene>/.cache/workprecision/`` (key: the model's scene sections, the fixed point,
-  the case, walkerlab's code); a rerun after an unrelated change (another target error, a
-  new tolerance, the contact section only) measures only what is new;
+  the case and the sources it runs, :data:`CASE_SOURCES`); a rerun after an unrelated change
+  (another target error, a new tolerance, the contact section only, report code) measures
+  only what is new;
 - the cases run on two worker processes, each pinned to its own core
   (``os.sched_setaffinity``) and single-threaded, so a case never shares its core with
   another case; both the wall time and the process CPU time of every run are stored (the
@@ -216,13 +217,36 @@ def run_cases(tasks: list[tuple], cache_dir: Path, workers: int = 2) -> dict:
     return out
 
 
-def _case_key(model: str, sections_json: str, fp_hash: str, strides: int, method: str,
-              rtol: float, atol: float, repeats: int) -> str:
-    from walkerlab.io.artifacts import code_hash
+#: the sources a case's result depends on (a change elsewhere - report text, plots, other
+#: stages - keeps the measured cases)
+CASE_SOURCES = {
+    "ideal": ("analysis", "models", "config.py", "stages/workprecision.py"),
+    "contact": ("analysis", "models", "contact", "config.py", "stages/workprecision.py",
+                "stages/contact_sim.py"),
+}
 
-    h = hashlib.sha256(json.dumps([model, sections_json, fp_hash, strides, method, rtol, atol,
-                                   repeats]).encode())
-    h.update(code_hash().encode())
+
+def _sources_hash(parts: tuple[str, ...]) -> str:
+    """SHA-256 over the walkerlab sources under ``parts`` (files or subpackages)."""
+    import walkerlab
+
+    root = Path(walkerlab.__file__).parent
+    h = hashlib.sha256(walkerlab.__version__.encode())
+    for part in parts:
+        p = root / part
+        for f in sorted(p.rglob("*.py")) if p.is_dir() else [p]:
+            h.update(str(f.relative_to(root)).encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def _case_key(model: str, sections_json: str, x0: tuple, strides: int, method: str,
+              rtol: float, atol: float, repeats: int) -> str:
+    """Key of one case: its inputs (the fixed point by value, so a recomputed but equal fixed
+    point keeps the cases) and the sources it runs."""
+    h = hashlib.sha256(json.dumps([model, sections_json, [repr(v) for v in x0], strides,
+                                   method, rtol, atol, repeats]).encode())
+    h.update(_sources_hash(CASE_SOURCES[model]).encode())
     return h.hexdigest()[:32]
 
 
@@ -253,7 +277,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         Processes measuring cases side by side, one pinned core each (1 = in this process).
         ``force`` also re-measures cached cases.
     """
-    from walkerlab.io.artifacts import stored_hash
     from walkerlab.stages.common import artifact_path as _ap
 
     wp = require(scene, "workprecision", "workprecision")
@@ -262,7 +285,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
     def compute():
         x0, _ = fixedpoint_stage.load_fixed_point(up[0])
-        fp_hash = str(stored_hash(up[0]))
         x0t = tuple(float(v) for v in x0)
         sj = json.dumps(scene.model_dump(mode="json"), sort_keys=True)
         rr = str(runs_root)
@@ -289,7 +311,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             cases = [(ref[0], ref[1], ref[2], 1)] + [(m, r, af * r, wp.repeats)
                                                      for m in methods for r in rtols]
             for m, r, a, rep in cases:
-                k = _case_key(model, secs, fp_hash, wp.strides, m, r, a, rep)
+                k = _case_key(model, secs, x0t, wp.strides, m, r, a, rep)
                 keys[(model, m, r, rep)] = k
                 tasks.append((k, model, sj, rr, x0t, wp.strides, m, r, a, rep))
         done = run_cases(tasks, cache, workers)
