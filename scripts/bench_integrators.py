@@ -26,6 +26,20 @@ from pathlib import Path
 import numpy as np
 
 
+def _cvode_functions(phase):
+    """CVODE's ``rhs(t, y, yp)`` and ``events(t, y, e)`` for one phase (3 arguments each:
+    scikit-sundae counts arguments to detect user data)."""
+    f, guards = phase.flow, phase.guards
+
+    def rhs(t, y, yp):
+        yp[:] = f(t, y)
+
+    def ev(t, y, e):
+        for i, gd in enumerate(guards):
+            e[i] = gd.function(t, y)
+    return rhs, ev
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
@@ -78,14 +92,8 @@ def main() -> None:
             def run():
                 t, x, nfev = 0.0, x0, 0
                 for ph in w.phases:
-                    def rhs(tt, y, yp, _f=ph.flow):
-                        yp[:] = _f(tt, y)
-
+                    rhs, ev = _cvode_functions(ph)
                     gds = ph.guards
-
-                    def ev(tt, y, e, _g=gds):
-                        for i, gd in enumerate(_g):
-                            e[i] = gd.function(tt, y)
                     ev.terminal = [True] * len(gds)
                     ev.direction = [gd.direction for gd in gds]
                     s = CVODE(rhs, method=method, rtol=rt, atol=rt, eventsfn=ev,

@@ -166,29 +166,33 @@ class LegSpec(_Strict):
     def _bodies_on_leg(self) -> LegSpec:
         names = [b.name for b in self.bodies]
         if len(set(names)) != len(names):
-            raise ValueError(f"walker.leg.bodies: duplicate body names {names}")
+            raise ValueError(f"bodies: duplicate body names {names}")
         if "foot" in names or "hip" in names:
-            raise ValueError("walker.leg.bodies: 'foot' and 'hip' are reserved point names")
+            raise ValueError("bodies: 'foot' and 'hip' are reserved point names")
+        if not any((b.from_hip_m if b.kind == "point_mass" else b.com_from_hip_m) > 0
+                   for b in self.bodies):
+            raise ValueError("bodies: the swing leg needs a body below the hip (a point mass "
+                             "with mass_kg: 0 at the foot gives the massless-leg limit)")
         for b in self.bodies:
             d = b.from_hip_m if b.kind == "point_mass" else b.com_from_hip_m
             if d > self.length_m:
-                raise ValueError(f"walker.leg.bodies.{b.name}: lies beyond the foot "
+                raise ValueError(f"bodies.{b.name}: lies beyond the foot "
                                  f"({d} m > leg length {self.length_m} m)")
             if self.knee is None and b.link != "leg":
-                raise ValueError(f"walker.leg.bodies.{b.name}: link {b.link!r} needs a knee")
+                raise ValueError(f"bodies.{b.name}: link {b.link!r} needs a knee")
             if self.knee is not None:
                 lt = self.knee.thigh_length_m
                 if b.link == "leg" or b.mass_kg == 0:
-                    raise ValueError(f"walker.leg.bodies.{b.name}: with a knee, give every body "
+                    raise ValueError(f"bodies.{b.name}: with a knee, give every body "
                                      "a massive 'thigh' or 'shank' link")
                 if (b.link == "thigh") != (d <= lt) and d != lt:
-                    raise ValueError(f"walker.leg.bodies.{b.name}: {d} m from the hip is not "
+                    raise ValueError(f"bodies.{b.name}: {d} m from the hip is not "
                                      f"on the {b.link} (knee at {lt} m)")
         if self.knee is not None and self.knee.thigh_length_m >= self.length_m:
-            raise ValueError("walker.leg.knee.thigh_length_m: the knee must lie above the foot")
+            raise ValueError("knee.thigh_length_m: the knee must lie above the foot")
         if self.foot.kind == "arc" and self.foot.radius_m > self.length_m - (
                 self.knee.thigh_length_m if self.knee else 0.0):
-            raise ValueError("walker.leg.foot.radius_m: the arc's centre must lie on the "
+            raise ValueError("foot.radius_m: the arc's centre must lie on the "
                              + ("shank" if self.knee else "leg"))
         return self
 
@@ -209,9 +213,9 @@ class BipedParams(_Strict):
     @model_validator(mode="after")
     def _has_mass(self) -> BipedParams:
         if self.hip_mass_kg + sum(b.mass_kg for b in self.leg.bodies) <= 0:
-            raise ValueError("walker: the walker has no mass (hip_mass_kg and all bodies are 0)")
+            raise ValueError("the walker has no mass (hip_mass_kg and all bodies are 0)")
         if self.coordinates != "absolute" and (self.leg.knee or self.leg.foot.kind != "point"):
-            raise ValueError("walker.coordinates: a knee or arc feet need 'absolute'")
+            raise ValueError("coordinates: a knee or arc feet need 'absolute'")
         return self
 
 

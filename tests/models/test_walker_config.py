@@ -39,3 +39,11 @@ def test_state_by_name_must_match_the_walker():
     assert sc.fixedpoint.initial_guess.as_array(w.state_names()).shape == (4,)
     with pytest.raises(ValueError, match="swing_angle_rad"):
         sc.fixedpoint.initial_guess.as_array()  # the compass gait's names: not this walker's
+
+
+def test_leg_without_a_body_below_the_hip_is_refused():
+    """Without a body below the hip the swing leg has no equation (singular mass matrix)."""
+    d = _simplest()
+    d["walker"]["leg"]["bodies"] = []
+    with pytest.raises(SceneError, match="walker.leg: bodies: the swing leg needs a body"):
+        scene_from_dict(d, "simplest.yaml")

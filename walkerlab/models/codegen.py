@@ -1,4 +1,5 @@
-"""Python source of a walker's equations, generated from :class:`~walkerlab.models.symbolic.Equations`.
+"""Python source of a walker's equations, generated from
+:class:`~walkerlab.models.symbolic.Equations`.
 
 The generated module defines one function, ``make(p) -> dict[str, callable]``, that binds the
 parameter vector ``p`` (``Structure.param_names`` order) in closures.  The hot functions
@@ -42,7 +43,7 @@ IND = "        "
 
 
 _HOISTED: list[str] = []  # parameter-only subexpressions, computed once in make(p)
-_PARAMS: set = set()
+_PARAMS: set = set()  # the parameters and every hoisted symbol
 _COUNT = [0]
 
 
@@ -53,11 +54,10 @@ def _cse_lines(exprs, printer):
     _COUNT[0] += 1
     repl, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols(f"_c{_COUNT[0]}_"),
                            order="none")
-    const = set(_PARAMS)
     lines = []
     for a, e in repl:
-        if e.free_symbols <= const:
-            const.add(a)
+        if e.free_symbols <= _PARAMS:
+            _PARAMS.add(a)
             _HOISTED.append(f"    {printer.doprint(a)} = {printer.doprint(e)}")
         else:
             lines.append(f"{IND}{printer.doprint(a)} = {printer.doprint(e)}")
@@ -65,29 +65,56 @@ def _cse_lines(exprs, printer):
 
 
 def _unpack(eq: Equations) -> str:
+    """Unpack ``x`` into Python floats (``tolist``: float arithmetic is faster than numpy's)."""
     names = ", ".join(str(s) for s in (*eq.q, *eq.dq))
-    return f"{IND}{names}, = x.tolist() if hasattr(x, 'tolist') else x"
+    return (f"{IND}try:\n{IND}    {names}, = x.tolist()\n{IND}except AttributeError:\n"
+            f"{IND}    {names}, = x")
+
+
+def _bind(names, exprs) -> tuple[list[str], list[str]]:
+    """Assign ``exprs`` to ``names``: zero entries become ``"0"`` (pruned by the solve and the
+    products below), parameter-only entries are computed once in ``make(p)``.
+
+    Returns the lines and the name (or ``"0"``) that now holds each expression."""
+    _COUNT[0] += 1
+    lines, out = [], []
+    for a, e in zip(names, exprs):
+        if e == 0:
+            out.append("0")
+        elif e.free_symbols <= _PARAMS:
+            h = f"_k{_COUNT[0]}{a}"
+            _HOISTED.append(f"    {h} = {_PY.doprint(e)}")
+            _PARAMS.add(sp.Symbol(h))
+            out.append(h)
+        else:
+            lines.append(f"{IND}{a} = {_PY.doprint(e)}")
+            out.append(a)
+    return lines, out
 
 
 def _solve_lines(n: int, mnames, prefix: str) -> tuple[list[str], list[list[str]]]:
-    """Lines computing the inverse of the n x n matrix whose entries are named ``mnames``."""
-    S = sp.Matrix(n, n, lambda i, j: sp.Symbol(mnames[i][j]))
+    """Lines computing the inverse of the n x n matrix whose entries are named ``mnames``
+    (``"0"`` for an entry known to vanish: the adjugate then drops its terms)."""
+    S = sp.Matrix(n, n, lambda i, j: 0 if mnames[i][j] == "0" else sp.Symbol(mnames[i][j]))
     det = S.det(method="berkowitz")
     adj = S.adjugate()
     lines = [f"{IND}{prefix}id = 1.0 / ({_PY.doprint(det)})"]
-    inv = [[f"{prefix}{i}{j}" for j in range(n)] for i in range(n)]
+    inv = [["0"] * n for _ in range(n)]
     for i in range(n):
         for j in range(n):
-            lines.append(f"{IND}{inv[i][j]} = ({_PY.doprint(adj[i, j])}) * {prefix}id")
+            if adj[i, j] != 0:
+                inv[i][j] = f"{prefix}{i}{j}"
+                lines.append(f"{IND}{inv[i][j]} = ({_PY.doprint(adj[i, j])}) * {prefix}id")
     return lines, inv
 
 
 def _matvec(inv, vec) -> list[str]:
-    return [" + ".join(f"{inv[i][j]} * {vec[j]}" for j in range(len(vec))) for i in range(len(inv))]
-
-
-def _assign(names, exprs) -> list[str]:
-    return [f"{IND}{a} = {_PY.doprint(e)}" for a, e in zip(names, exprs)]
+    """``inv @ vec`` as expressions, without the terms of entries named ``"0"``."""
+    out = []
+    for row in inv:
+        terms = [f"{a} * {b}" for a, b in zip(row, vec) if a != "0" and b != "0"]
+        out.append(" + ".join(terms) if terms else "0.0")
+    return out
 
 
 def _array(rows) -> str:
@@ -106,9 +133,11 @@ def _flow(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
         exprs += [sp.diff(r[i], q[k]) for k in range(n) for i in range(n)]
         exprs += [sp.diff(r[i], dq[k]) for k in range(n) for i in range(n)]
     lines, red = _cse_lines(exprs, _PY)
-    mn = [[f"_M{i}{j}" for j in range(n)] for i in range(n)]
-    rn = [f"_r{i}" for i in range(n)]
-    lines += _assign([x for row in mn for x in row] + rn, red[:n * n + n])
+    bound, names = _bind([f"_M{i}{j}" for i in range(n) for j in range(n)]
+                         + [f"_r{i}" for i in range(n)], red[:n * n + n])
+    lines += bound
+    mn = [names[i * n:(i + 1) * n] for i in range(n)]
+    rn = names[n * n:]
     inv_lines, inv = _solve_lines(n, mn, "_i")
     lines += inv_lines
     qdd = [f"_a{i}" for i in range(n)]
@@ -125,16 +154,15 @@ def _flow(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     for k in range(n):  # d qdd / d q_k = Minv (dr/dq_k - dM/dq_k qdd)
         w = []
         for i in range(n):
-            terms = " + ".join(f"({_PY.doprint(dM[k * n * n + i * n + j])}) * {qdd[j]}"
-                               for j in range(n))
-            w.append(f"_w{k}_{i}")
-            lines.append(f"{IND}_w{k}_{i} = {_PY.doprint(dr_q[k * n + i])} - ({terms})")
+            e = dr_q[k * n + i] - sum(dM[k * n * n + i * n + j] * sp.Symbol(qdd[j])
+                                      for j in range(n))
+            w.append("0" if e == 0 else f"_w{k}_{i}")
+            if e != 0:
+                lines.append(f"{IND}_w{k}_{i} = {_PY.doprint(e)}")
         cols.append(_matvec(inv, w))
     for k in range(n):  # d qdd / d dq_k = Minv dr/d dq_k
-        w = []
-        for i in range(n):
-            w.append(f"_v{k}_{i}")
-            lines.append(f"{IND}_v{k}_{i} = {_PY.doprint(dr_dq[k * n + i])}")
+        bound, w = _bind([f"_v{k}_{i}" for i in range(n)], dr_dq[k * n:(k + 1) * n])
+        lines += bound
         cols.append(_matvec(inv, w))
     rows = [["0.0"] * (2 * n) for _ in range(n)]
     for i in range(n):
@@ -153,9 +181,11 @@ def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
         exprs += [sp.diff(eq.Mi[i, j], q[k]) for k in range(n) for i in range(n) for j in range(n)]
         exprs += [sp.diff(eq.B[i, j], q[k]) for k in range(n) for i in range(n) for j in range(n)]
     lines, red = _cse_lines(exprs, _PY)
-    mn = [[f"_M{i}{j}" for j in range(n)] for i in range(n)]
-    bn = [[f"_B{i}{j}" for j in range(n)] for i in range(n)]
-    lines += _assign([x for row in mn + bn for x in row], red[:2 * n * n])
+    bound, names = _bind([f"_M{i}{j}" for i in range(n) for j in range(n)]
+                         + [f"_B{i}{j}" for i in range(n) for j in range(n)], red[:2 * n * n])
+    lines += bound
+    mn = [names[i * n:(i + 1) * n] for i in range(n)]
+    bn = [names[n * n + i * n:n * n + (i + 1) * n] for i in range(n)]
     inv_lines, inv = _solve_lines(n, mn, "_i")
     lines += inv_lines
     dqs = [str(s) for s in dq]
@@ -175,8 +205,8 @@ def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     D = sp.zeros(n, 2 * n)
     for k in range(n):
         for i in range(n):
-            w = sum(dB[k * n * n + i * n + j] * dq[j] - dMi[k * n * n + i * n + j] * sp.Symbol(post[j])
-                    for j in range(n))
+            w = sum(dB[k * n * n + i * n + j] * dq[j]
+                    - dMi[k * n * n + i * n + j] * sp.Symbol(post[j]) for j in range(n))
             lines.append(f"{IND}_w{k}_{i} = {_PY.doprint(w)}")
         col = _matvec(inv, [f"_w{k}_{i}" for i in range(n)])
         for i in range(n):

@@ -365,7 +365,8 @@ def derive(structure: Structure) -> Equations:
     for mass, pos, inertia, psi in bodies:
         ve = (pos + sp.Matrix([xf, yf])).jacobian(qe) * dqe
         a = sp.Matrix([[sp.diff(psi, qi) for qi in qe]])
-        Te += sp.Rational(1, 2) * mass * (ve.T * ve)[0] + sp.Rational(1, 2) * inertia * (a * dqe)[0] ** 2
+        Te += (sp.Rational(1, 2) * mass * (ve.T * ve)[0]
+               + sp.Rational(1, 2) * inertia * (a * dqe)[0] ** 2)
     Te = Te.subs(beta, 0) if lim else Te
     De = sp.hessian(Te, dqe)
     E = (foot + sp.Matrix([xf, yf])).jacobian(qe)

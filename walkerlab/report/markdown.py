@@ -34,6 +34,12 @@ def printed(v) -> str:
     return f"{float(v):g}" if np.isfinite(float(v)) else "—"
 
 
+def sig_digits(text: str) -> int:
+    """Significant digits of a number as written (``"-0.199473"`` -> 6, ``"0.0342"`` -> 3)."""
+    mant = text.lower().split("e")[0].lstrip("+-").replace(".", "").lstrip("0")
+    return max(1, len(mant))
+
+
 def details(summary: str, body: str) -> list[str]:
     """A folded block (``<details>``) around Markdown ``body`` (works in HTML and on GitHub)."""
     return ["<details>", f"<summary>{summary}</summary>", "", body, "", "</details>", ""]

@@ -16,7 +16,7 @@ import numpy as np
 from walkerlab.analysis.tables import TABLE3_ROWS, table3
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.readers import load_fixed_point
-from walkerlab.report.markdown import details, num, printed, table
+from walkerlab.report.markdown import details, num, printed, sig_digits, table
 from walkerlab.report.text import zero_multipliers_text
 
 
@@ -112,7 +112,9 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
                        f"|Floquet multiplier| {num(meta['max_abs_multiplier'])}).")
         eq = dict(zip(*published_fixed_point(pub)))
         for n, v, u in zip(meta["state_names"], x, meta["state_units"]):
-            rows.append([f"fixed point {n}", u, num(v), printed(eq[n]) if n in eq else "—"])
+            # as many digits as the published value has, so the two can be compared digit by digit
+            dig = max(4, sig_digits(printed(eq[n]))) if n in eq else 4
+            rows.append([f"fixed point {n}", u, num(v, dig), printed(eq[n]) if n in eq else "—"])
         rows.append(["step period", "s", num(meta["step_period_s"]), "—"])
         rows.append(["max abs(multiplier)", "-", num(meta["max_abs_multiplier"]), "—"])
     elif "fixedpoint" not in paths and scene.fixedpoint is not None:
@@ -124,9 +126,9 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
             term = str(f.attrs["termination"])
             n_hs = int(np.sum(f["steps/termination"].asstr()[()] == "heel_strike"))
         bullets.append(f"- **Rigid walker walks**: {'yes' if term == 'heel_strike' else 'no'} "
-                       f"({n_hs} heel strikes, ended by {term}); energy drift in swing "
+                       f"({n_hs} heel strikes, ended by {term}); energy drift between impacts "
                        f"{num(drift, 2)} J ({num(rel, 2)} relative).")
-        rows.append(["energy drift in swing", "J", num(drift, 2), "—"])
+        rows.append(["energy drift between impacts", "J", num(drift, 2), "—"])
         clear = swing_foot_clearance(sim, scene.slope.phi_rad)
         if np.isfinite(clear):
             verdict = ("no scuffing" if clear > 0 else "the swing foot passes through the "

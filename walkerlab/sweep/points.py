@@ -421,7 +421,18 @@ def run_chunk(task: Task) -> list[dict]:
 
 
 def warm_up() -> None:
-    """Build the lambdified model functions once (called in fresh worker processes)."""
+    """Build the lambdified model functions once (called in fresh worker processes) and
+    import the integration and root-finding libraries, so that processes forked from the
+    forkserver start warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise)."""
+    try:
+        import scipy.optimize  # noqa: F401
+
+        from walkerlab.analysis.hybrid import _have_cyrk
+
+        if _have_cyrk():
+            import CyRK  # noqa: F401
+    except Exception:  # noqa: BLE001 - warming is an optimisation only
+        pass
     try:
         from walkerlab.models.derivation import compass_gait_functions
 
