@@ -177,6 +177,9 @@ def run_bench(what: str, out: Path) -> list[str]:
             raise ValueError(f"bench: unknown benchmark {name!r} "
                              f"({' | '.join(BENCHMARKS)} | all)")
         res = {"benchmark": name, **_machine(), "result": res}
-        (out / f"{name}.json").write_text(json.dumps(res, indent=1, default=str))
+        from walkerlab.io.artifacts import atomic_write
+
+        text = json.dumps(res, indent=1, default=str).encode()
+        atomic_write(out / f"{name}.json", lambda fh, text=text: fh.write(text))
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines

@@ -171,6 +171,12 @@ def figures_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
     return d
 
 
+def model_cache_dir(runs_root: Path | str) -> Path:
+    """``<runs>/.cache/models``: generated model code, shared by all scenes of a runs folder
+    (content-keyed, see :mod:`walkerlab.models.cache`)."""
+    return Path(runs_root) / ".cache" / "models"
+
+
 def atomic_text(path: Path, text: str) -> Path:
     """Write a text file atomically (temporary name, then rename), mode 0644."""
     from walkerlab.io.artifacts import atomic_write

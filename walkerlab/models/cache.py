@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import os
 import tempfile
+from functools import cache
 from importlib import metadata
 from pathlib import Path
 
@@ -45,7 +46,9 @@ def cache_dir() -> Path:
     return _dir or Path(os.environ.get(ENV) or Path("runs") / ".cache" / "models")
 
 
+@cache
 def _generator_hash() -> str:
+    """sha256 of the generator's sources and the sympy version (once per process)."""
     h = hashlib.sha256()
     here = Path(__file__).parent
     for name in _GENERATOR_FILES:

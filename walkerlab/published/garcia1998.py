@@ -44,3 +44,18 @@ SHORT_MULTIPLIERS = (4.000, 0.459)
 
 #: slope range where the long-period gait is stable [rad] (abstract)
 STABLE_SLOPE_RANGE_RAD = (0.0, 0.015)
+
+SHORT = "garcia1998"
+
+# The report's published-fixed-point interface: the printed values by walkerlab state name
+# (configs/simplest.yaml: state [stance_angle, hip_angle, stance_rate, hip_rate]; the hip angle
+# and rate on the section follow from these, phi = 2 theta, phi_dot = theta_dot (1 - cos 2 theta),
+# and are not listed because they are not printed).
+FIXED_POINT_NAMES = ("stance_angle", "stance_rate")
+FIXED_POINT_STATE = (LONG_THETA_RAD, LONG_THETA_DOT)
+FIXED_POINT_LABEL = "long-period gait, gamma = 0.009"
+FIXED_POINT_NOTE = (
+    "Garcia et al.'s multipliers for this gait, -0.19121 +- 0.55633i (finite differences), "
+    "differ by 1e-3 from ours (-0.19010 +- 0.55760i, variational equations); an independent "
+    "stride map with their printed equations gives ours. The long-period gait is stable for "
+    "0 < gamma < 0.015 rad (their abstract); we find the period doubling at gamma = 0.01509 rad.")

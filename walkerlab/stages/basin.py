@@ -75,9 +75,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     up = artifact_path(scene, runs_root, "fixedpoint")
     path = artifact_path(scene, runs_root, "basin")
     key = input_hash("basin", scene, SECTIONS, (up,), extra=f"grid={grid[0]}x{grid[1]}")
-    from walkerlab.io.artifacts import stored_hash
+    from walkerlab.io.artifacts import verified_hash
 
-    if not force and path.is_file() and stored_hash(path) == key:
+    if not force and path.is_file() and verified_hash(path) == key:  # content still matches
         if not figure_path(scene, runs_root).is_file():
             draw(scene, runs_root)
         return StageOutcome("basin", path, True, 0.0, {})
