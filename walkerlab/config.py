@@ -272,8 +272,9 @@ class SolverSettings(_Strict):
 class ContactSolverSettings(_Strict):
     """Integrator of the stiff contact model: ``odeint`` (LSODA, low overhead) or solve_ivp."""
 
-    method: Literal["odeint", "LSODA", "Radau", "BDF", "RK45", "DOP853"] = Field(
-        "odeint", description="scipy.integrate.odeint or a solve_ivp method")
+    method: Literal["odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853"] = Field(
+        "odeint", description="scipy.integrate.odeint, numbalsoda (LSODA from compiled code; "
+        "optional extra 'walkerlab[numbalsoda]') or a solve_ivp method")
     rtol: float = Field(1e-8, ge=1e-13, lt=1,
                         description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
                         "cannot meet a tighter one in double precision)")

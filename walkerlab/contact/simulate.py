@@ -1,7 +1,9 @@
 """Time integration of the contact walker, gait events and typed outcomes.
 
 Integrators: ``"odeint"`` (scipy.integrate.odeint = LSODA with little overhead, run in chunks
-so a fall, a trip, the wall-time limit or the strides cap stops the run) or any stiff
+so a fall, a trip, the wall-time limit or the strides cap stops the run), ``"numbalsoda"``
+(the same chunks through numbalsoda's LSODA with a compiled RHS, no Python per evaluation;
+optional extra, see :mod:`walkerlab.contact._lsoda`) or any stiff
 ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``), all given the analytic Jacobian.
 
 Contact is decided by geometry only (:mod:`walkerlab.contact._kernels`): a foot gets the
@@ -412,6 +414,14 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
 
     if not use_jac:
         fjac = None
+    if method == "numbalsoda":
+        from . import _lsoda
+
+        if np.isfinite(max_step):
+            raise ValueError("contact_solver.max_step_s is not supported by method numbalsoda")
+        if not np.isscalar(atol):
+            raise ValueError("method numbalsoda needs a scalar atol")
+        data = _lsoda.pack(P, c1, c2)
     ts, Xs, nfev, njev = [np.array([t0])], [x0[None]], 0, 0
     ta, xa = t0, x0
     status, msg, event = "ok", "Integration successful.", None
@@ -430,6 +440,12 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
             ok = info["message"] == "Integration successful."
             nk = len(tg) if ok else int(np.count_nonzero(info["tcur"] >= tg[1:] - 1e-14)) + 1
             tn, Xn, m = tg[1:nk], X[1:nk], info["message"]
+        elif method == "numbalsoda":  # whole chunk in compiled code (FD Jacobian)
+            X, ok, nf = _lsoda.solve_chunk(xa, tg, data, rtol, atol)
+            nfev += nf
+            nk = len(tg) if ok else 1  # rows after a failure are undefined: drop the chunk
+            tn, Xn = tg[1:nk], X[1:nk]
+            m = "Integration successful." if ok else "numbalsoda LSODA failed in this chunk"
         else:
             def grhs(t, x):
                 if time.perf_counter() > deadline:
@@ -498,8 +514,10 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         Initial state [hip_x, hip_y, th1, th2, vhip_x, vhip_y, w1, w2] (SI).
     t_final : float
         End time [s].
-    method : {"odeint", "LSODA", "Radau", "BDF"}
-        Integrator (odeint = LSODA with lower overhead), run in chunks of ``chunk_s``.
+    method : {"odeint", "numbalsoda", "LSODA", "Radau", "BDF"}
+        Integrator (odeint = LSODA with lower overhead; numbalsoda = LSODA called from
+        compiled code, optional extra, finite-difference Jacobian, no ``max_step``), run in
+        chunks of ``chunk_s``.
     rtol, atol : float
         Tolerances; ``atol`` [m, rad, m/s, rad/s] must be well below the penetration depth
         (~6e-5 m for the paper's contact), default 1e-10.
@@ -536,10 +554,12 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
     Raises
     ------
     ValueError
-        Unknown ``method``.
+        Unknown ``method``; ``max_step`` with numbalsoda; ``method="numbalsoda"``
+        without the numbalsoda package
+        (:class:`walkerlab.contact._lsoda.MissingNumbalsoda`, also an ImportError).
     """
-    if method not in ("odeint", "LSODA", "Radau", "BDF", "RK45", "DOP853"):
-        raise ValueError(f"method must be odeint, LSODA, Radau or BDF, not {method!r}")
+    if method not in ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853"):
+        raise ValueError(f"method must be odeint, numbalsoda, LSODA, Radau or BDF, not {method!r}")
     x0 = np.asarray(x0, dtype=float)
     hth = 0.5 * walker.L if fall_hip_height_m is None else fall_hip_height_m
     wall = time.perf_counter()

@@ -1,0 +1,94 @@
+"""numbalsoda route for the contact walker: LSODA called from compiled code.
+
+Internal module, imported only when ``method="numbalsoda"`` is selected (numbalsoda is an
+optional extra: ``pip install 'walkerlab[numbalsoda]'``; building it from source needs a C++
+and a Fortran compiler and cmake).  The right-hand side :func:`walkerlab.contact._kernels.rhs`
+is wrapped in a numba ``cfunc`` so that LSODA (numbalsoda's C++ port) integrates a whole
+chunk of samples without re-entering Python.  numbalsoda's LSODA takes a scalar ``atol``, no
+largest step and no user Jacobian (it forms the stiff-phase Jacobian by finite differences;
+those RHS calls are counted in ``nfev``).
+
+The packed data vector handed to the cfunc is ``[n1, n2, P (NPAR), c1 (n1), c2 (n2), nfev]``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _kernels as K
+
+try:
+    from numbalsoda import lsoda, lsoda_sig
+except ImportError:  # pragma: no cover - depends on the optional extra
+    lsoda = lsoda_sig = None
+
+__all__ = ["MissingNumbalsoda", "available", "pack", "solve_chunk"]
+
+
+class MissingNumbalsoda(ValueError, ImportError):
+    """``method="numbalsoda"`` was selected but the package is not installed (a ValueError
+    so that the CLI reports it as one line with exit code 1)."""
+
+_FPTR = None
+
+
+def available() -> bool:
+    """Whether numbalsoda can be imported."""
+    return lsoda is not None
+
+
+def _build():
+    from numba import carray, cfunc
+
+    npar = K.NPAR
+
+    @cfunc(lsoda_sig, cache=True)
+    def rhs_c(t, u, du, p):  # pragma: no cover - runs compiled
+        n1 = int(p[0])
+        n2 = int(p[1])
+        d = carray(p, (2 + npar + n1 + n2 + 1,))
+        x = np.empty(8)
+        for i in range(8):
+            x[i] = u[i]
+        r = K.rhs(x, d[2:2 + npar], d[2 + npar:2 + npar + n1], d[2 + npar + n1:2 + npar + n1 + n2])
+        for i in range(8):
+            du[i] = r[i]
+        d[2 + npar + n1 + n2] += 1.0
+
+    return rhs_c.address
+
+
+def pack(P: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
+    """Data vector ``[n1, n2, P, c1, c2, nfev=0]`` (float64) for :func:`solve_chunk`."""
+    return np.concatenate([[len(c1), len(c2)], P, c1, c2, [0.0]]).astype(np.float64)
+
+
+def solve_chunk(x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray, rtol: float,
+                atol: float, mxstep: int = 500000):
+    """LSODA from ``x0`` over the sample times ``t_eval`` (n,) [s].
+
+    Returns
+    -------
+    X : ndarray (n, 8)
+        States at ``t_eval`` (rows after a failure are undefined).
+    ok : bool
+        LSODA reported success.
+    nfev : int
+        RHS evaluations of this call (finite-difference Jacobian columns included).
+
+    Raises
+    ------
+    MissingNumbalsoda
+        numbalsoda is not installed.
+    """
+    global _FPTR
+    if lsoda is None:
+        raise MissingNumbalsoda("contact_solver.method 'numbalsoda' needs the numbalsoda package: "
+                          "pip install 'walkerlab[numbalsoda]' (builds with cmake, g++, gfortran)")
+    if _FPTR is None:
+        _FPTR = _build()
+    n0 = data[-1]
+    X, ok = lsoda(_FPTR, np.ascontiguousarray(x0, dtype=np.float64),
+                  np.ascontiguousarray(t_eval, dtype=np.float64), data=data, rtol=float(rtol),
+                  atol=float(atol), mxstep=int(mxstep))
+    return X, bool(ok), int(data[-1] - n0)
