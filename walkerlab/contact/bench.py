@@ -36,7 +36,15 @@ def rhs_cost(walker: ContactWalker, x: np.ndarray, n: int = 2000) -> dict:
     return out
 
 
-def run_benchmark(n_strides: int = 5, methods=("odeint", "LSODA", "BDF", "Radau"),
+def _default_methods() -> tuple:
+    """odeint, LSODA, BDF, Radau, and numbalsoda when the optional extra is installed."""
+    from . import _lsoda
+
+    return ("odeint",) + (("numbalsoda",) if _lsoda.available() else ()) + \
+        ("LSODA", "BDF", "Radau")
+
+
+def run_benchmark(n_strides: int = 5, methods=None,
                   rtols=(1e-6, 1e-7, 1e-8, 1e-9), contact: ContactSettings | None = None,
                   patch_width_m: float = 0.3, rate_scale=(1.0, 1.0), ideal: dict | None = None,
                   repeats: int = 2) -> dict:
@@ -46,8 +54,9 @@ def run_benchmark(n_strides: int = 5, methods=("odeint", "LSODA", "BDF", "Radau"
     ----------
     n_strides : int
         Strides (2 steps each) [-].
-    methods : sequence of str
-        "odeint", "LSODA", "BDF", "Radau".
+    methods : sequence of str, optional
+        "odeint", "numbalsoda", "LSODA", "BDF", "Radau"; default all of them (numbalsoda
+        only when installed).
     rtols : sequence of float
         Relative tolerances; ``atol = 1e-3 * rtol`` [m, rad, ...].
     contact : ContactSettings, optional
@@ -68,6 +77,7 @@ def run_benchmark(n_strides: int = 5, methods=("odeint", "LSODA", "BDF", "Radau"
         ``{"t_final_s", "reference": {...}, "rhs_cost": {...}, "runs": [ {method, rtol,
         wall_time_s, nfev, njev, max_angle_error_rad, heel_strikes, termination}, ...]}``.
     """
+    methods = _default_methods() if methods is None else tuple(methods)
     ideal = dict(EXAMPLE_IDEAL if ideal is None else ideal)
     contact = contact or ContactSettings()
     n_steps = 2 * n_strides
