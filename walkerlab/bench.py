@@ -42,7 +42,7 @@ def _machine() -> dict:
 
 
 def _paper_scene():
-    from walkerlab.cli import default_scene
+    from walkerlab.config import default_scene_path as default_scene
     from walkerlab.config import load_scene
 
     return load_scene(default_scene())

@@ -35,12 +35,10 @@ ForceOpt = typer.Option(False, "--force", help="recompute even if the artifact i
 
 
 def default_scene() -> Path:
-    here = Path("configs/paper.yaml")
-    if here.is_file():
-        return here
-    import walkerlab
+    """``configs/paper.yaml`` (see :func:`walkerlab.config.default_scene_path`)."""
+    from walkerlab.config import default_scene_path
 
-    return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
+    return default_scene_path()
 
 
 def _load(scene: Path | None):

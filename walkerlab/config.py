@@ -501,6 +501,17 @@ def _format_error(path: Path, err: ValidationError) -> str:
     return f"{path}: {loc or '<scene>'}: {msg}{extra}"
 
 
+def default_scene_path() -> Path:
+    """The paper's scene: ``configs/paper.yaml`` in the working folder, else the one shipped
+    next to the package (an editable install)."""
+    here = Path("configs/paper.yaml")
+    if here.is_file():
+        return here
+    import walkerlab
+
+    return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
+
+
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene YAML file.
 
