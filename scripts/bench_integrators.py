@@ -47,7 +47,7 @@ def main() -> None:
     args = ap.parse_args()
     from walkerlab.analysis.hybrid import Solver, integrate_step
     from walkerlab.analysis.poincare import find_fixed_point
-    from walkerlab.cli import default_scene
+    from walkerlab.config import default_scene_path as default_scene
     from walkerlab.config import load_scene
     from walkerlab.models.registry import build_walker
 

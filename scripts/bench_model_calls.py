@@ -30,10 +30,10 @@ def main(paths: list[str]) -> None:
         except TypeError:  # checkouts before the state-by-name scenes
             x = sc.fixedpoint.initial_guess.as_array()
         f, J = w.phases[0].flow, w.variational
-        row = {"flow": per_call_us(lambda: f(0.0, x), 5000),
-               "flow_jacobian": per_call_us(lambda: J(0.0, x), 2000),
-               "reset": per_call_us(lambda: w.reset(x), 2000),
-               "reset_jacobian": per_call_us(lambda: w.reset_jacobian(x), 2000)}
+        row = {"flow": per_call_us(lambda f=f, x=x: f(0.0, x), 5000),
+               "flow_jacobian": per_call_us(lambda J=J, x=x: J(0.0, x), 2000),
+               "reset": per_call_us(lambda w=w, x=x: w.reset(x), 2000),
+               "reset_jacobian": per_call_us(lambda w=w, x=x: w.reset_jacobian(x), 2000)}
         print(Path(p).stem, "  ".join(f"{k} {v:.2f} us" for k, v in row.items()))
 
 

@@ -62,7 +62,8 @@ def main() -> None:
             "artifact": str(p),
             "_rows": d["points"],
         }
-        print(f"{label:>10} ({workers} worker(s)): {n} points in {wall:.2f} s -> {n / wall:.2f} points/s "
+        print(f"{label:>10} ({workers} worker(s)): {n} points in {wall:.2f} s -> "
+              f"{n / wall:.2f} points/s "
               f"(load avg before {load[0]:.2f})")
     rows = {k: v.pop("_rows") for k, v in results.items()}
     identical = all(np.array_equal(rows[k][c], rows["in-process"][c], equal_nan=True)

@@ -103,7 +103,8 @@ def test_figures_are_drawn_from_a_hand_built_artifact(tmp_path, ideal_scene):
     from walkerlab.stages import plot
 
     path = tmp_path / "ideal_only" / "simulate.h5"
-    A.write_artifact(path, "simulate", ideal_scene, "x", lambda f: write_samples(f, _fake_trajectory()),
+    A.write_artifact(path, "simulate", ideal_scene, "x",
+                     lambda f: write_samples(f, _fake_trajectory()),
                      0.0)
     written = plot.run(ideal_scene, tmp_path)
     assert {p.name for p in written} >= {"fig7_angles_rates.png", "fig9_limit_cycles.png",
@@ -156,7 +157,8 @@ def test_failed_write_leaves_the_good_artifact(tmp_path, ideal_scene):
     import walkerlab.io.artifacts as A
 
     path = tmp_path / "x.h5"
-    A.write_artifact(path, "simulate", ideal_scene, "good", lambda f: f.create_dataset("a", data=1), 0)
+    A.write_artifact(path, "simulate", ideal_scene, "good",
+                     lambda f: f.create_dataset("a", data=1), 0)
 
     def boom(f):
         f.create_dataset("a", data=2)

@@ -77,7 +77,8 @@ def test_plan_chunks_runs_from_scene_value_and_skips_done(base):
 
 # ----------------------------------------------------------------------------- outcomes
 def test_bad_value_is_an_invalid_config_row(scene, tmp_path):
-    p = sweep_stage.run(scene, ["walker.leg_mass_from_foot_m=0.5,1.5", "fixedpoint.tolerance=1e-10,1e-3"],
+    p = sweep_stage.run(scene, ["walker.leg_mass_from_foot_m=0.5,1.5",
+                                "fixedpoint.tolerance=1e-10,1e-3"],
                         "fixedpoint", workers=1, runs_root=tmp_path, progress=False)
     rows = _rows(p)
     assert p.name.startswith("sweep_fixedpoint_") and p.is_file()
@@ -118,7 +119,8 @@ def test_max_steps_scuffing_solver_failure_error(base, monkeypatch):
     row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None, {})
     assert row["outcome"] == "ok" and row["steps_completed"] == 2
     bad = dict(base, simulate={**base["simulate"],
-                               "initial_state": {**FAR_STATE, "swing_rate_rad_per_s": float("nan")}})
+                               "initial_state": {**FAR_STATE,
+                                                 "swing_rate_rad_per_s": float("nan")}})
     row, _ = evaluate("simulate", bad, ["slope.angle_deg"], (3.0,), 0, None, {})
     # a NaN initial state is refused by the scene's validation, naming the field
     assert row["outcome"] == "invalid_config" and "initial_state" in row["message"]

@@ -42,7 +42,7 @@ def _machine() -> dict:
 
 
 def _paper_scene():
-    from walkerlab.cli import default_scene
+    from walkerlab.config import default_scene_path as default_scene
     from walkerlab.config import load_scene
 
     return load_scene(default_scene())
@@ -142,8 +142,9 @@ def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
                    "--runs-dir", d)
         res = _time_process(cmd, 1)
         from walkerlab.plotting.basin_figures import load_basin
+        from walkerlab.stages.common import artifact_path
 
-        b = load_basin(Path(d) / _paper_scene().name / "basin.h5")
+        b = load_basin(artifact_path(_paper_scene(), d, "basin"))
     out = b["outcome"]
     return {**res, "grid": grid, "workers": workers, "target_s": 120.0,
             "outcomes": {o: int(np.sum(out == i)) for i, o in enumerate(b["outcomes"])}}

@@ -28,19 +28,18 @@ import typer
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="walkerlab: passive-dynamic biped walkers, from fixed point to report.")
 
-SceneArg = typer.Argument(None, help="scene YAML file (default: configs/paper.yaml, the paper's walker)",
+SceneArg = typer.Argument(None, help="scene YAML file (default: configs/paper.yaml, "
+                          "the paper's walker)",
                           show_default=False)
 RunsOpt = typer.Option(Path("runs"), "--runs-dir", help="folder for artifacts (runs/<scene>/)")
 ForceOpt = typer.Option(False, "--force", help="recompute even if the artifact is up to date")
 
 
 def default_scene() -> Path:
-    here = Path("configs/paper.yaml")
-    if here.is_file():
-        return here
-    import walkerlab
+    """``configs/paper.yaml`` (see :func:`walkerlab.config.default_scene_path`)."""
+    from walkerlab.config import default_scene_path
 
-    return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
+    return default_scene_path()
 
 
 def _load(scene: Path | None):

@@ -233,7 +233,8 @@ WalkerParams = Annotated[Annotated[CompassGaitParams, Tag("compass_gait")]
 class SlopeSettings(_Strict):
     """Ramp angle phi (the walker walks downhill in +x). Give exactly one of the two fields."""
 
-    angle_rad: float | None = Field(None, gt=-math.pi / 2, lt=math.pi / 2, description="slope [rad]")
+    angle_rad: float | None = Field(None, gt=-math.pi / 2, lt=math.pi / 2,
+                                    description="slope [rad]")
     angle_deg: float | None = Field(None, gt=-90, lt=90, description="slope [deg]")
 
     @model_validator(mode="after")
@@ -332,8 +333,10 @@ class FixedPointSettings(_Strict):
 
     initial_guess: StateSpec = Field(description="starting point of the root finder")
     tolerance: float = Field(1e-12, gt=0, lt=1e-3, description="root-finder xtol [-]")
-    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this is a failure [s]")
-    fd_step: float = Field(1e-7, gt=0, lt=1e-2, description="finite-difference step for the Jacobian")
+    max_step_time_s: float = Field(5.0, gt=0,
+                                   description="a step longer than this is a failure [s]")
+    fd_step: float = Field(1e-7, gt=0, lt=1e-2,
+                           description="finite-difference step for the Jacobian")
 
 
 class SimulateSettings(_Strict):
@@ -346,7 +349,8 @@ class SimulateSettings(_Strict):
     initial_state: Literal["fixed_point"] | StateSpec = Field(
         "fixed_point", description="'fixed_point' (from fixedpoint.h5) or an explicit state"
     )
-    max_step_time_s: float = Field(5.0, gt=0, description="a step longer than this ends the run [s]")
+    max_step_time_s: float = Field(5.0, gt=0,
+                                   description="a step longer than this ends the run [s]")
 
 
 class WorkPrecisionSettings(_Strict):
@@ -502,6 +506,17 @@ def _format_error(path: Path, err: ValidationError) -> str:
     return f"{path}: {loc or '<scene>'}: {msg}{extra}"
 
 
+def default_scene_path() -> Path:
+    """The paper's scene: ``configs/paper.yaml`` in the working folder, else the one shipped
+    next to the package (an editable install)."""
+    here = Path("configs/paper.yaml")
+    if here.is_file():
+        return here
+    import walkerlab
+
+    return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
+
+
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene YAML file.
 
@@ -538,7 +553,8 @@ def load_scene(path: str | Path) -> Scene:
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
-        raise SceneError(f"{path}:{where} malformed YAML ({getattr(exc, 'problem', exc)})") from None
+        problem = getattr(exc, "problem", exc)
+        raise SceneError(f"{path}:{where} malformed YAML ({problem})") from None
     if not isinstance(data, dict):
         raise SceneError(f"{path}: a scene must be a YAML mapping")
     if data.get("name") is None:

@@ -98,11 +98,11 @@ def test_angular_momentum_about_new_stance_foot_conserved_through_impact(which):
     legs' bodies and the hip); |H| ~ 10 kg m^2/s, round-off 1e-14."""
     gam = 0.0174
     if which == "compass":
-        s, params, masses, I = COMPASS, (9.81, 1.0, gam, 10.0, 5.0, 0.5), None, 0.0
+        s, params, masses, inertia = COMPASS, (9.81, 1.0, gam, 10.0, 5.0, 0.5), None, 0.0
         masses = {"hip": 10.0, "stance_mass": 5.0, "swing_mass": 5.0}
     else:
-        I = 5.0 / 12
-        s, params = RODS, (9.81, 1.0, gam, 10.0, 5.0, 0.5, I)
+        inertia = 5.0 / 12
+        s, params = RODS, (9.81, 1.0, gam, 10.0, 5.0, 0.5, inertia)
         masses = {"hip": 10.0, "stance_rod": 5.0, "swing_rod": 5.0}
     f = functions(WalkerData(s, params, 20.0, 1.0, 9.81, gam, {}))
     st = -0.19
@@ -120,8 +120,8 @@ def test_angular_momentum_about_new_stance_foot_conserved_through_impact(which):
         r = f["points"](xm)[name] - foot
         H_minus += m * (r[0] * v[1] - r[1] * v[0])
     la = f["leg_angles"](xm)
-    H_minus += I * (la["stance_rate"] + la["swing_rate"])
-    H_plus = _angular_momentum(f, params, xp, I, masses)
+    H_minus += inertia * (la["stance_rate"] + la["swing_rate"])
+    H_plus = _angular_momentum(f, params, xp, inertia, masses)
     assert abs(H_plus - H_minus) < 1e-13 * abs(H_minus)
     # and the positions do not jump: the new stance leg is the old swing leg
     np.testing.assert_allclose(f["points"](xp)["hip"], f["points"](xm)["hip"] - foot, atol=1e-15)

@@ -177,9 +177,14 @@ def _solve_phase(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
 
     ``jac`` (``(t, y) -> (m, m)``) is handed to scipy's implicit methods."""
     evs = []
+    whole = len(y0) == n  # no variational rows: the guard sees y itself (no slicing)
     for gd in guards:
-        def ev(t, y, _g=gd.function):
-            return _g(t, y[:n])
+        if whole:
+            def ev(t, y, _g=gd.function):
+                return _g(t, y)
+        else:
+            def ev(t, y, _g=gd.function):
+                return _g(t, y[:n])
         ev.terminal = True
         ev.direction = gd.direction
         evs.append(ev)

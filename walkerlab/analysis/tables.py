@@ -25,10 +25,11 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
                  mass_kg: float | None = None, g: float = 9.81) -> dict[str, float]:
     """Table 3 quantities of a named trajectory.
 
-    Steps are delimited by changes of ``stance_leg`` (the last sample closes the last step); a *left step* is a step in which the
-    left leg (``legs[0]`` unless given) swings.  Only complete steps (followed by another
-    step) count.  ``v_com`` is the hip's horizontal displacement over whole cycles divided by
-    their duration (over a periodic cycle the centre of mass and the hip advance alike).
+    Steps are delimited by changes of ``stance_leg`` (the last sample closes the last step);
+    a *left step* is a step in which the left leg (``legs[0]`` unless given) swings.  Only
+    complete steps (followed by another step) count.  ``v_com`` is the hip's horizontal
+    displacement over whole cycles divided by their duration (over a periodic cycle the
+    centre of mass and the hip advance alike).
     ``E_avg`` is the time average of KE + PE over the first ``n_energy_steps`` steps with PE
     from the first stance foot; ``E_avg_stance_frame`` measures PE from the current stance
     foot instead (needs ``mass_kg``).

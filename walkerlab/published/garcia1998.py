@@ -23,7 +23,6 @@ Where each number is printed
   moderate accuracy of finite-difference eigenvalues for this model).
 """
 
-import math
 
 CITATION = ("M. Garcia, A. Chatterjee, A. Ruina, M. Coleman, \"The simplest walking model: "
             "stability, complexity, and scaling\", J. Biomech. Eng. 120(2):281-288, 1998, "

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 
-
 DIGITS = 4  # significant digits of every number in the report unless a column asks for more
 
 

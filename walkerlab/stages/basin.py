@@ -16,10 +16,12 @@ import numpy as np
 from walkerlab.config import BasinSettings, Scene
 from walkerlab.io.artifacts import put, write_artifact
 from walkerlab.io.netcdf import coordinate
+from walkerlab.io.runpaths import artifact_lock, stage_artifact
 from walkerlab.stages import fixedpoint as fixedpoint_stage
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,
+    _tell,
     artifact_path,
     input_hash,
     require,
@@ -66,14 +68,22 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``fixedpoint`` section, or bad basin settings.
     """
-    from walkerlab.sweep.basin import OUTCOMES, BasinError, compute_basin
-
     require(scene, "fixedpoint", "basin")
     st = scene.basin or BasinSettings()
     grid = tuple(grid or st.grid)
     fixedpoint_stage.run(scene, runs_root)
     up = artifact_path(scene, runs_root, "fixedpoint")
-    path = artifact_path(scene, runs_root, "basin")
+    path = stage_artifact(scene, runs_root, "basin", claim=True)
+    # one writer per artifact (as run_cached): a second identical run waits, then reuses
+    with artifact_lock(path, wait=True, on_wait=_tell):
+        return _run_locked(scene, runs_root, force, grid, workers, scheduler, resume,
+                           on_chunk, st, up, path)
+
+
+def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_chunk, st, up,
+                path) -> StageOutcome:
+    from walkerlab.sweep.basin import OUTCOMES, BasinError, compute_basin
+
     key = input_hash("basin", scene, SECTIONS, (up,), extra=f"grid={grid[0]}x{grid[1]}")
     from walkerlab.io.artifacts import verified_hash
 

@@ -77,7 +77,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             "nfev": traj.nfev,
             "mean_period_s": float(np.mean(steps["period"][ok])) if ok.any() else np.nan,
             "mean_step_length_m": float(np.mean(steps["step_length"][ok])) if ok.any() else np.nan,
-            "mean_hip_speed_m_per_s": float(np.mean(steps["hip_speed"][ok])) if ok.any() else np.nan,
+            "mean_hip_speed_m_per_s": (float(np.mean(steps["hip_speed"][ok])) if ok.any()
+                                       else np.nan),
             "mean_total_energy_J": float(np.mean(samples.total)),
         }
 

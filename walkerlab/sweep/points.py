@@ -306,7 +306,8 @@ def contact_point(scene: Scene, guess, options: dict):
 
     opts = {**DEFAULT_OPTIONS, **options}
     walker, fp, source = ideal_fixed_point(scene, guess, options)
-    seg = integrate_step(walker, fp.x, _solver(scene), max_step_time=scene.fixedpoint.max_step_time_s)
+    seg = integrate_step(walker, fp.x, _solver(scene),
+                         max_step_time=scene.fixedpoint.max_step_time_s)
     step_length = float(np.hypot(*walker.points(seg.x_end)["swing_foot"]))
     cols = {"guess_source": source, "ideal_step_length_m": step_length,
             "ideal_step_period_s": float(fp.period_s)}
