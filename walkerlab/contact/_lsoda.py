@@ -47,10 +47,7 @@ def _build():
         n1 = int(p[0])
         n2 = int(p[1])
         d = carray(p, (2 + npar + n1 + n2 + 1,))
-        x = np.empty(8)
-        for i in range(8):
-            x[i] = u[i]
-        r = K.rhs(x, d[2:2 + npar], d[2 + npar:2 + npar + n1], d[2 + npar + n1:2 + npar + n1 + n2])
+        r = K.rhs(carray(u, (8,)), d[2:2 + npar], d[2 + npar:2 + npar + n1], d[2 + npar + n1:2 + npar + n1 + n2])
         for i in range(8):
             du[i] = r[i]
         d[2 + npar + n1 + n2] += 1.0
