@@ -30,6 +30,8 @@ class MissingNumbalsoda(ValueError, ImportError):
     so that the CLI reports it as one line with exit code 1)."""
 
 _FPTR = None
+#: Offsets in the packed data vector: lane sizes n1, n2, then P.
+D_N1, D_N2, D_P = 0, 1, 2
 
 
 def available() -> bool:
@@ -44,13 +46,15 @@ def _build():
 
     @cfunc(lsoda_sig, cache=True)
     def rhs_c(t, u, du, p):  # pragma: no cover - runs compiled
-        n1 = int(p[0])
-        n2 = int(p[1])
-        d = carray(p, (2 + npar + n1 + n2 + 1,))
-        r = K.rhs(carray(u, (8,)), d[2:2 + npar], d[2 + npar:2 + npar + n1], d[2 + npar + n1:2 + npar + n1 + n2])
+        n1 = int(p[D_N1])
+        n2 = int(p[D_N2])
+        a1 = D_P + npar  # start of c1
+        a2 = a1 + n1  # start of c2
+        d = carray(p, (a2 + n2 + 1,))
+        r = K.rhs(carray(u, (8,)), d[D_P:a1], d[a1:a2], d[a2:a2 + n2])
         for i in range(8):
             du[i] = r[i]
-        d[2 + npar + n1 + n2] += 1.0
+        d[a2 + n2] += 1.0  # nfev counter
 
     return rhs_c.address
 
