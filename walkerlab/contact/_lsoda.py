@@ -17,10 +17,36 @@ import numpy as np
 
 from . import _kernels as K
 
+
+
+def _load_driver():
+    """numbalsoda's LSODA driver module, or None when the package is not installed.
+
+    Loaded from its file, not through ``import numbalsoda``: the package's ``__init__`` also
+    imports its DOP853 ``solve_ivp`` driver, which compiles eagerly (~7 s per process on the
+    2-core machine), and only the LSODA driver (its ctypes entry point ``lsoda_wrapper`` and
+    the cfunc signature ``lsoda_sig``) is used here.
+    """
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.find_spec("numbalsoda")
+    if spec is None or spec.origin is None:
+        return None
+    path = Path(spec.origin).parent / "driver.py"
+    dspec = importlib.util.spec_from_file_location("_walkerlab_numbalsoda_driver", path)
+    mod = importlib.util.module_from_spec(dspec)
+    dspec.loader.exec_module(mod)
+    return mod
+
+
 try:
-    from numbalsoda import lsoda, lsoda_sig
-except ImportError:  # pragma: no cover - depends on the optional extra
-    lsoda = lsoda_sig = None
+    _DRIVER = _load_driver()
+except (ImportError, OSError):  # pragma: no cover - broken install
+    _DRIVER = None
+#: numbalsoda's C entry point (ctypes; called once per chunk from Python) or None.
+lsoda = None if _DRIVER is None else _DRIVER.lsoda_wrapper
+lsoda_sig = None if _DRIVER is None else _DRIVER.lsoda_sig
 
 __all__ = ["MissingNumbalsoda", "available", "pack", "solve_chunk"]
 
@@ -89,7 +115,11 @@ def solve_chunk(x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray, rtol: floa
     if _FPTR is None:
         _FPTR = _build()
     n0 = data[-1]
-    X, ok = lsoda(_FPTR, np.ascontiguousarray(x0, dtype=np.float64),
-                  np.ascontiguousarray(t_eval, dtype=np.float64), data=data, rtol=float(rtol),
-                  atol=float(atol), mxstep=int(mxstep))
-    return X, bool(ok), int(data[-1] - n0)
+    u0 = np.ascontiguousarray(x0, dtype=np.float64)
+    te = np.ascontiguousarray(t_eval, dtype=np.float64)
+    X = np.empty((len(te), len(u0)))
+    flag = np.array(999, np.int32)
+    # same call as numbalsoda.lsoda (its njit wrapper), without compiling that wrapper
+    lsoda(_FPTR, len(u0), u0.ctypes.data, data.ctypes.data, len(te), te.ctypes.data,
+          X.ctypes.data, float(rtol), float(atol), int(mxstep), flag.ctypes.data)
+    return X, bool(flag == 1), int(data[-1] - n0)
