@@ -55,6 +55,7 @@ class MissingNumbalsoda(ValueError, ImportError):
     """``method="numbalsoda"`` was selected but the package is not installed (a ValueError
     so that the CLI reports it as one line with exit code 1)."""
 
+
 _FPTR = None
 #: Offsets in the packed data vector: lane sizes n1, n2, then P.
 D_N1, D_N2, D_P = 0, 1, 2
