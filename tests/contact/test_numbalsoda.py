@@ -3,9 +3,14 @@
 import numpy as np
 import pytest
 
-from walkerlab.contact import ContactSettings, ContactWalker, TerrainSettings
-from walkerlab.contact import initial_state_from_ideal, simulate_contact
-from walkerlab.contact import _lsoda
+from walkerlab.contact import (
+    ContactSettings,
+    ContactWalker,
+    TerrainSettings,
+    _lsoda,
+    initial_state_from_ideal,
+    simulate_contact,
+)
 from walkerlab.contact.bench import EXAMPLE_IDEAL
 
 

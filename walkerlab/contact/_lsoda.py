@@ -18,7 +18,6 @@ import numpy as np
 from . import _kernels as K
 
 
-
 def _load_driver():
     """numbalsoda's LSODA driver module, or None when the package is not installed.
 

@@ -49,7 +49,8 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
             i = min(np.searchsorted(res.t, th), len(res.t) - 1)
             lens.append(np.hypot(*(feet[i, 0] - feet[i, 1])))
         lens = np.array(lens)
-        return float(np.mean(((T - period) / period) ** 2) + np.mean(((lens - l_star) / l_star) ** 2))
+        return float(np.mean(((T - period) / period) ** 2)
+                     + np.mean(((lens - l_star) / l_star) ** 2))
 
     lo, hi, n = grid
     x0, fval, _, _ = brute(J, ((lo, hi), (lo, hi)), Ns=n, full_output=True, finish=None)

@@ -93,7 +93,8 @@ class ContactSettings(BaseModel):
     model_config = _STRICT
 
     unit_system: Literal["mm-kg-s", "SI"] = Field(
-        "mm-kg-s", description="Unit system of the numbers below: 'mm-kg-s' (ADAMS default) or 'SI'."
+        "mm-kg-s",
+        description="Unit system of the numbers below: 'mm-kg-s' (ADAMS default) or 'SI'."
     )
     stiffness: float = Field(
         1e5, gt=0, le=1e12, description="IMPACT stiffness k (at most 1e12).",
@@ -209,7 +210,8 @@ class ContactSimSettings(BaseModel):
     pin_stance_until: Literal["none", "first_touchdown", "time"] = Field(
         "none", description="Hold the first stance foot fixed until this moment."
     )
-    pin_time_s: float = Field(0.0, ge=0, description="Pin duration when pin_stance_until='time' [s].")
+    pin_time_s: float = Field(0.0, ge=0,
+                              description="Pin duration when pin_stance_until='time' [s].")
     fall_hip_height_m: float | None = Field(
         None, gt=0, description="Fall when hip height above ground < this [m]; default 0.5*L."
     )

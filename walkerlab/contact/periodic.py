@@ -246,7 +246,8 @@ class StepMap:
         fall.terminal = True
         fall.direction = -1.0
         sol = solve_ivp(self._rhs, (0.0, self.t_max), np.asarray(x0, float),
-                        method="LSODA" if self.method == "odeint" else self.method, jac=self._jac, rtol=self.rtol, atol=self.atol,
+                        method="LSODA" if self.method == "odeint" else self.method,
+                        jac=self._jac, rtol=self.rtol, atol=self.atol,
                         events=[mid, fall], dense_output=dense)
         self.nfev += 1
         return sol
@@ -299,7 +300,7 @@ class StepMap:
                 k = int(up[0])
                 xk = X[k - 1]
 
-                def gap(t):
+                def gap(t, k=k, xk=xk, tg=tg, g=g):
                     if t <= tg[k - 1]:
                         return g[k - 1]
                     x = run(xk, np.array([tg[k - 1], t]))[-1]

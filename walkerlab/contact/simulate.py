@@ -301,7 +301,8 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, rate, rtol, atol, max_st
                     dense_output=True)
     t, Z = sol.t, sol.y.T
     if sol.status == 1:  # stopped on an event: append the event point
-        te = sol.t_events[1][0] if (until_touchdown and sol.t_events[1].size) else sol.t_events[0][0]
+        te = (sol.t_events[1][0] if (until_touchdown and sol.t_events[1].size)
+              else sol.t_events[0][0])
         if t.size == 0 or te > t[-1]:
             t = np.append(t, te)
             Z = np.vstack([Z, sol.sol(te)])
@@ -385,8 +386,8 @@ def _first_event(walker, t, X, hth, k0=1):
                 sa, sb = q["s"][k - 1], q["s"][k]
                 c = lane[int(np.argmin(np.abs(lane - sb)))]
                 edge = c - hw if sb < c else c + hw
-                te = _hermite_root(tt[k - 1], tt[k], sa - edge, sb - edge, q["slip_velocity"][k - 1],
-                                   q["slip_velocity"][k - 1 + 1])
+                vs = q["slip_velocity"]
+                te = _hermite_root(tt[k - 1], tt[k], sa - edge, sb - edge, vs[k - 1], vs[k])
                 if te is None:
                     te = float(tt[k])
                 xe = _hermite_state(walker, tt[k - 1], tt[k], X[k0 - 1 + k - 1], X[k0 - 1 + k], te)
@@ -572,7 +573,10 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         tp, Xp, nf, nj, status, msg = _run_pinned(
             walker, x0, t0, t_end, pin_stance_until == "first_touchdown", sample_rate_hz,
             rtol, atol, max_step, hth)
-        ts.append(tp); Xs.append(Xp); nfev += nf; njev += nj
+        ts.append(tp)
+        Xs.append(Xp)
+        nfev += nf
+        njev += nj
         t_pin, x0 = tp[-1], Xp[-1]
         if status == "fall":
             event = ("fall", len(tp) - 1, float(tp[-1]), "", np.nan)
@@ -582,7 +586,10 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
             use_jacobian, chunk_s, deadline, max_heel_strikes, min_step_m, initial_stance)
         if ts:
             tf, Xf = tf[1:], Xf[1:]
-        ts.append(tf); Xs.append(Xf); nfev += nf; njev += nj
+        ts.append(tf)
+        Xs.append(Xf)
+        nfev += nf
+        njev += nj
     wall = time.perf_counter() - wall
     t = np.concatenate(ts)
     X = np.vstack(Xs)
@@ -665,7 +672,7 @@ def _phase_slip(t, s, td, lo, ta, tb):
     """Slide [m] of a foot over its contact phases starting in [ta, tb): sum of s(lo) - s(td)
     per phase; NaN if the last such phase has no lift-off."""
     total, any_phase = 0.0, False
-    for j, tdj in enumerate(td):
+    for tdj in td:
         if not (ta - 1e-12 <= tdj < tb):
             continue
         any_phase = True
@@ -705,7 +712,10 @@ def _postprocess(walker, t, X, min_step_m, initial_stance, events_only=False):
             continue
         s_here = float(np.interp(tt, t, feet[name].s))
         if name != stance and s_here > s_stance + min_step_m:
-            hs_t.append(tt); hs_leg.append(name); bounces.append(0); scuffs.append(0)
+            hs_t.append(tt)
+            hs_leg.append(name)
+            bounces.append(0)
+            scuffs.append(0)
             stance, s_stance = name, s_here
         elif name == stance:
             bounces[-1] += 1
