@@ -361,7 +361,7 @@ def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | b
                                      " | all (all but basin)"),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
-    from walkerlab.bench import run_bench
+    from walkerlab.stages.bench import run_bench
 
     for line in run_bench(what, out):
         typer.echo(line)
