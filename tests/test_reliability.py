@@ -497,3 +497,26 @@ def test_d4_a_second_stage_run_waits_for_the_first_writer(tmp_path, capfd):
         holder.wait()
         holder.stdout.close()
     assert not out.reused and f"pid {holder.pid}" in capfd.readouterr().err
+
+
+def test_d6_memoised_content_hash_sees_an_edit(tmp_path, monkeypatch):
+    """The per-process memo of content hashes (a report checks each upstream file several
+    times) is keyed by the file's stamp: an edit after memoisation is still detected."""
+    from walkerlab.io import artifacts as A
+
+    scene = scene_from_dict({"name": "memo", "walker": {"leg_length_m": 1.0, "leg_mass_kg": 5.0,
+                             "hip_mass_kg": 10.0, "leg_mass_from_foot_m": 0.5},
+                             "slope": {"angle_rad": 0.0174}})
+    path = tmp_path / "memo" / "x.h5"
+    write_artifact(path, "simulate", scene, "k",
+                   lambda f: f.create_dataset("a", data=np.arange(3.0)), 0.0)
+    now = time.time_ns()
+    monkeypatch.setattr(A.time, "time_ns", lambda: now + 10_000_000_000)  # the file is "old"
+    first = A.content_hash(path)
+    assert A.verified_hash(path) == "k" and A.content_hash(path) == first
+    time.sleep(0.02)
+    with h5py.File(path, "r+") as f:  # same size, new value
+        f["a"][1] = 7.0
+    monkeypatch.setattr(A.time, "time_ns", lambda: now + 20_000_000_000)
+    assert A.content_hash(path) != first
+    assert A.verified_hash(path) is None

@@ -24,6 +24,7 @@ import hashlib
 import json
 import os
 import tempfile
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from functools import lru_cache
@@ -115,11 +116,32 @@ def content_hash_of(f: h5py.File) -> str:
     return h.hexdigest()
 
 
+# Recomputed content hashes, per process, keyed by the file's identity and modification
+# stamp: a report checks the same upstream files several times; any rewrite or edit of a
+# file changes its stamp, so it is hashed again.
+_HASH_MEMO: dict[tuple, str] = {}
+
+
+def _stamp(path: Path) -> tuple:
+    st = os.stat(path)
+    return (os.path.realpath(path), st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+
+
+def _content_hash_memo(path: Path, f: h5py.File) -> str:
+    key = _stamp(path)
+    if time.time_ns() - key[3] < 2_000_000_000:
+        # modified in the last 2 s: a second edit could keep the same coarse time stamp
+        return content_hash_of(f)
+    if key not in _HASH_MEMO:
+        _HASH_MEMO[key] = content_hash_of(f)
+    return _HASH_MEMO[key]
+
+
 def content_hash(path: Path) -> str | None:
     """Recomputed content hash of an artifact, or None when it is absent or unreadable."""
     try:
         with h5py.File(path, "r") as f:
-            return content_hash_of(f)
+            return _content_hash_memo(Path(path), f)
     except (OSError, KeyError, ValueError):
         return None
 
@@ -135,7 +157,7 @@ def verified_hash(path: Path) -> str | None:
             if f.attrs.get("walkerlab_version") != walkerlab.__version__:
                 return None
             stored = f.attrs.get("content_hash")
-            if stored is None or str(stored) != content_hash_of(f):
+            if stored is None or str(stored) != _content_hash_memo(Path(path), f):
                 return None
             return str(f.attrs.get("input_hash"))
     except (OSError, KeyError, ValueError):

@@ -114,12 +114,15 @@ def contact_section(scene, paths) -> list[str]:
 
 def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
     """Restitution-vs-stiffness figure (drop test stored in contact_sim.h5) and its text."""
-    from walkerlab.plotting.figures import save
-    from walkerlab.plotting.sweep_figures import restitution_figure
-
     figdir = artifact.parent / "report" / "figures"
-    fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness))
-    save(fig, figdir, "drop_restitution")
+    png = figdir / "drop_restitution.png"
+    # drawn from the artifact; redrawn only when the artifact is newer than the figure
+    if not png.is_file() or png.stat().st_mtime_ns < artifact.stat().st_mtime_ns:
+        from walkerlab.plotting.figures import save
+        from walkerlab.plotting.sweep_figures import restitution_figure
+
+        fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness))
+        save(fig, figdir, "drop_restitution")
     rows = [[float(k), float(curves["paper"][i]), float(curves["rigid_limit"][i])]
             for i, k in enumerate(ks)]
     cap = ("Drop test — coefficient of restitution against stiffness, paper family (damping "
