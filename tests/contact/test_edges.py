@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.contact.conftest import FP, STEP_LENGTH
 from walkerlab.contact import (
     ContactSettings,
     ContactWalker,
@@ -18,8 +19,6 @@ from walkerlab.contact import (
 from walkerlab.contact.drop import restitution_curve
 from walkerlab.contact.simulate import OUTCOME_KINDS, _phase_slip
 
-FP = (-0.2042, 0.1694, -0.6058, -0.8610)  # approx. ideal fixed point (leg1 swing)
-STEP_LENGTH = 0.372  # ideal step length [m]
 PKG = Path(__file__).resolve().parents[2] / "walkerlab"
 
 

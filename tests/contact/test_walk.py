@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from tests.contact.conftest import FP, STEP_LENGTH
 from walkerlab.contact import (
     ContactSettings,
     ContactWalker,
@@ -11,9 +12,6 @@ from walkerlab.contact import (
     simulate_contact,
 )
 from walkerlab.contact.bench import run_benchmark
-
-FP = (-0.2042, 0.1694, -0.6058, -0.8610)  # approx. ideal fixed point (leg1 swing)
-STEP_LENGTH = 0.372  # ideal step length [m]
 
 
 def _paper(width, n_steps=12):

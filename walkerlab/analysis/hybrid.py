@@ -27,36 +27,12 @@ from typing import Literal
 
 import numpy as np
 
-from walkerlab.models.base import HybridWalker, Phase
+from walkerlab.models.base import HybridWalker, Phase, complex_step_jacobian
 
 Termination = Literal["heel_strike", "fall", "t_final", "solver_failure"]
 
 #: methods both backends implement with the same Runge-Kutta pair and step control
 CYRK_METHODS = ("RK23", "RK45", "DOP853")
-
-
-def complex_step_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
-    """Jacobian of an analytic function by the complex-step method (exact to round-off).
-
-    Squire & Trapp (1998), SIAM Review 40(1): ``df/dx_k = Im f(x + i h e_k) / h``.
-
-    Parameters
-    ----------
-    fun : callable ``(m,) -> (p,)``
-        Must accept complex input.
-    x : ndarray, shape (m,)
-
-    Returns
-    -------
-    ndarray, shape (p, m)
-    """
-    x = np.asarray(x, dtype=float)
-    cols = []
-    for k in range(x.size):
-        xc = x.astype(complex)
-        xc[k] += 1j * h
-        cols.append(np.imag(fun(xc)) / h)
-    return np.stack(cols, axis=1)
 
 
 def numeric_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:

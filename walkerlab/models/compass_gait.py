@@ -34,7 +34,7 @@ from functools import cache, partial
 
 import numpy as np
 
-from walkerlab.models.base import HybridWalker
+from walkerlab.models.base import HybridWalker, complex_step_jacobian
 
 VARIANTS = ("derived", "appendix_a", "appendix_a_literal")
 
@@ -95,20 +95,6 @@ def flow(t: float, x: np.ndarray, p: tuple, variant: str = "derived") -> np.ndar
     M, C, G = matrices(q, dq, p, variant)
     qdd = np.linalg.solve(M, -C @ dq - G)
     return np.concatenate([dq, qdd])
-
-
-def complex_step_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
-    """Jacobian of an analytic function by the complex-step method (exact to round-off).
-
-    Squire & Trapp (1998), SIAM Review 40(1): ``df/dx_k = Im f(x + i h e_k) / h``.
-    """
-    x = np.asarray(x, dtype=float)
-    cols = []
-    for k in range(x.size):
-        xc = x.astype(complex)
-        xc[k] += 1j * h
-        cols.append(np.imag(fun(xc)) / h)
-    return np.stack(cols, axis=1)
 
 
 # ----------------------------------------------------------------------------- guard

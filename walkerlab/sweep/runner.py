@@ -38,6 +38,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, as_completed, wait
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -56,6 +57,23 @@ __all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "iter_piece_results
 
 MAX_GRID_POINTS = 1_000_000   # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows are saved at least every this many points per chunk
+
+
+@contextmanager
+def _dask_client(scheduler):
+    """``(client, futures)`` for a Dask scheduler address or client; on exit the unfinished
+    futures are cancelled and a client opened here is closed."""
+    from distributed import Client
+
+    own = isinstance(scheduler, str)
+    client = Client(scheduler, set_as_default=False) if own else scheduler
+    futs: list = []
+    try:
+        yield client, futs
+    finally:
+        client.cancel([f for f in futs if not f.done()])
+        if own:
+            client.close()
 
 
 def _dotted_get(d: dict, path: str):
@@ -207,19 +225,15 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     if not chains:
         return
     if scheduler is not None:
-        from distributed import Client
         from distributed import as_completed as dask_completed
 
-        own = isinstance(scheduler, str)
-        client = Client(scheduler, set_as_default=False) if own else scheduler
-        where = {}
-        futs = []
-        for ci, chain in enumerate(chains):
-            f = client.submit(run_piece, chain[0], None, pure=False)
-            where[f.key] = (ci, 0)
-            futs.append(f)
-        ac = dask_completed(futs, loop=client.loop)
-        try:
+        with _dask_client(scheduler) as (client, futs):
+            where = {}
+            for ci, chain in enumerate(chains):
+                f = client.submit(run_piece, chain[0], None, pure=False)
+                where[f.key] = (ci, 0)
+                futs.append(f)
+            ac = dask_completed(futs, loop=client.loop)
             for fut in ac:
                 rows, guess = fut.result()
                 ci, k = where.pop(fut.key)
@@ -229,10 +243,6 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
                     futs.append(nf)
                     ac.add(nf)
                 yield rows
-        finally:
-            client.cancel([f for f in futs if not f.done()])
-            if own:
-                client.close()
         return
     if not (pool if pool is not None else workers > 1):
         warm_up()
@@ -288,19 +298,12 @@ def iter_chunk_results(tasks: list[Task], workers: int = 2, scheduler=None,
     if not tasks:
         return
     if scheduler is not None:
-        from distributed import Client
         from distributed import as_completed as dask_completed
 
-        own = isinstance(scheduler, str)
-        client = Client(scheduler, set_as_default=False) if own else scheduler
-        futs = client.map(fn, tasks, pure=False)
-        try:
-            for fut in dask_completed(futs, loop=client.loop):
+        with _dask_client(scheduler) as (client, futs):
+            futs.extend(client.map(fn, tasks, pure=False))
+            for fut in dask_completed(list(futs), loop=client.loop):
                 yield fut.result()
-        finally:
-            client.cancel([f for f in futs if not f.done()])
-            if own:
-                client.close()
         return
     if not (pool if pool is not None else workers > 1):
         warm_up()
