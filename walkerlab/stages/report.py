@@ -34,6 +34,11 @@ class _Study:
     (:meth:`ready`), so no worker compiles them a second time.  With more cores this process
     keeps a core of its own; with one, the study runs after the other stages, in this
     process, as before.
+
+    Created before the fixed point: when the study has no artifact yet (a first run), the
+    first lane's worker process starts at once and imports its libraries on its core while
+    this process finds the fixed point; :meth:`start` (after the fixed point) starts the
+    study itself.
     """
 
     def __init__(self, scene: Scene, runs_root, force: bool, workers: int = 2):
@@ -57,9 +62,16 @@ class _Study:
         if scene.contact is not None:
             self.lanes.pending["contact"] = threading.Event()
         self._affinity = set(cores)
-        os.sched_setaffinity(0, {mine})  # threads started below inherit it
+        os.sched_setaffinity(0, {mine})  # threads started later inherit it
+        if not artifact_path(scene, runs_root, "workprecision").is_file():
+            self.lanes.workers = {c: workprecision.start_worker(c) for c in lanes
+                                  if c not in self.lanes.gates}
         self.thread = threading.Thread(target=self._run, name="workprecision", daemon=True)
-        self.thread.start()
+
+    def start(self) -> None:
+        """Start the study (the fixed-point artifact must exist)."""
+        if self.thread is not None:
+            self.thread.start()
 
     def _run(self):
         from walkerlab.stages import workprecision
@@ -104,7 +116,11 @@ class _Study:
             from walkerlab.stages import workprecision
 
             return workprecision.run(self.scene, self.runs_root, self.force)
-        self.thread.join()
+        if self.thread.ident is not None:  # started
+            self.thread.join()
+        for ex in self.lanes.workers.values():  # started but never used
+            ex.shutdown(wait=True, cancel_futures=True)
+        self.lanes.workers.clear()
         if self.error is not None:
             raise self.error
         return self.outcome
@@ -115,11 +131,13 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
 
     done: list[StageOutcome] = []
     drawn: list[str] = []
-    if scene.fixedpoint is not None:
-        done.append(fixedpoint.run(scene, runs_root, force, compare_variants=True))
     study = (_Study(scene, runs_root, force)
              if getattr(scene, "workprecision", None) is not None else None)
     try:
+        if scene.fixedpoint is not None:
+            done.append(fixedpoint.run(scene, runs_root, force, compare_variants=True))
+        if study is not None:
+            study.start()
         if study is not None and study.needs("contact"):
             from walkerlab.stages import workprecision
 
@@ -138,7 +156,7 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
         if any(o.stage in ("simulate", "contact-sim") for o in done):
             drawn.append(_draw(scene, runs_root, force, "trajectories"))
     except BaseException:
-        if study is not None:
+        if study is not None and study.thread is not None:
             study.release(cancel=True)
             try:
                 study.join()

@@ -193,11 +193,26 @@ def _run_case(task: Case) -> tuple:
 
 def _pin_worker(core: int) -> None:
     """Worker initializer: stay on ``core`` (the BLAS/OpenMP thread counts are set to 1 in
-    the environment the worker was started with, see :func:`_pinned_worker`)."""
+    the environment the worker was started with, see :func:`_pinned_worker`), then load the
+    libraries the runners use (a worker started ahead does this while its caller works)."""
     try:
         os.sched_setaffinity(0, {core})
     except Exception:  # noqa: BLE001 - pinning is best effort (not on every OS)
         pass
+    import scipy.integrate  # noqa: F401
+    import scipy.optimize  # noqa: F401
+
+    from walkerlab.analysis.hybrid import _have_cyrk
+
+    if _have_cyrk():
+        import CyRK  # noqa: F401  (and numba)
+
+
+def start_worker(core: int):
+    """A measuring worker process pinned to ``core``, started now (see :class:`Lanes`)."""
+    import multiprocessing as mp
+
+    return _pinned_worker(mp.get_context("spawn"), core)
 
 
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -252,6 +267,8 @@ class Lanes:
     #: set once the cache was looked up; ``todo_models``: models with cases to measure
     todo_known: threading.Event = field(default_factory=threading.Event)
     todo_models: set = field(default_factory=set)
+    #: worker processes started ahead (:func:`start_worker`), by core; a lane takes its own
+    workers: dict = field(default_factory=dict)
 
 
 #: scipy's implicit methods: the slow cases, started first so the lanes finish together
@@ -348,7 +365,7 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
                     time.sleep(0.05)
                     continue
                 if ex is None:
-                    ex = _pinned_worker(ctx, core)
+                    ex = lanes.workers.pop(core, None) or _pinned_worker(ctx, core)
                 store(*ex.submit(_run_case, t).result(), len(lanes.cores))
         except BaseException as exc:  # noqa: BLE001 - re-raised in the calling thread
             lanes.cancel.set()
