@@ -41,17 +41,28 @@ def _complete_on_first_use(pkg, spec) -> None:
     """Give the not-yet-executed package module a PEP 562 ``__getattr__`` that runs CyRK's
     ``__init__.py`` in it on the first lookup of a name it does not have yet."""
 
+    running = []  # non-empty while __init__.py runs (a lookup from inside it must not re-run it)
+
     def __getattr__(name: str):
-        with _LOCK:
-            if pkg.__dict__.get("__getattr__") is __getattr__:
-                del pkg.__getattr__
-                spec.loader.exec_module(pkg)
+        with _LOCK:  # another thread waits here until the package is complete
+            if not running and pkg.__dict__.get("__getattr__") is __getattr__:
+                running.append(True)
+                try:
+                    spec.loader.exec_module(pkg)
+                finally:
+                    del pkg.__getattr__
         try:
             return pkg.__dict__[name]
         except KeyError:
             raise AttributeError(f"module 'CyRK' has no attribute {name!r}") from None
 
     pkg.__getattr__ = __getattr__
+
+
+def _forget() -> None:
+    """Undo step 1 (and the pure-Python CPU-check module): a later import starts afresh."""
+    for name in ("CyRK._cpu_check", "CyRK"):
+        sys.modules.pop(name, None)
 
 
 def _shortcut():
@@ -66,12 +77,12 @@ def _shortcut():
         cpu = importlib.import_module("CyRK._cpu_check")
         check = cpu.check_cpu
     except (ImportError, AttributeError):
-        del sys.modules["CyRK"]  # nothing compiled is loaded yet: CyRK imports normally later
+        _forget()  # nothing compiled is loaded yet: CyRK imports normally later
         return None
     try:
         check()
     except BaseException:
-        del sys.modules["CyRK"]
+        _forget()
         raise
     try:
         solver = importlib.import_module("CyRK.cy.pysolver").pysolve_ivp
