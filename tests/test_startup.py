@@ -14,24 +14,29 @@ from pathlib import Path
 
 import pytest
 
+from walkerlab.cli import BLAS_THREADS_ENV, _single_threaded_blas
+
 ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("numba", "llvmlite", "sympy", "matplotlib", "CyRK.nb", "dask", "scipy.integrate")
 
 
 def _run(code: str, *args: str) -> dict:
-    """Run ``code`` in a fresh interpreter (the tests' environment and package) and return
-    the JSON it prints on its last line."""
+    """Run ``code`` in a fresh interpreter (the tests' environment and package, no
+    ``OPENBLAS_NUM_THREADS``) and return the JSON it prints on its last line."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         [str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+    env.pop(BLAS_THREADS_ENV, None)
     out = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
                          env=env, cwd=ROOT, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def _loaded(names) -> str:
-    """Code that prints which of ``names`` are in ``sys.modules`` (JSON)."""
-    return f"import json, sys\nprint(json.dumps({{m: m in sys.modules for m in {tuple(names)!r}}}))"
+def _loaded(names, extra: str = "{}") -> str:
+    """Code that prints which of ``names`` are in ``sys.modules``, merged with the dict
+    expression ``extra`` (JSON)."""
+    have = f"{{m: m in sys.modules for m in {tuple(names)!r}}}"
+    return f"import json, sys\nprint(json.dumps({{**{have}, **{extra}}}))"
 
 
 def test_cli_import_loads_no_numeric_library():
@@ -43,17 +48,32 @@ def test_cli_import_loads_no_numeric_library():
 
 @pytest.mark.usefixtures("paper_walker")  # generated model code in the shared cache
 def test_fixedpoint_command_loads_cyrk_without_numba(tmp_path):
-    """The whole ``walkerlab fixedpoint --force``: CyRK integrates, numba is not loaded."""
-    code = ("import sys\n"
+    """The whole ``walkerlab fixedpoint --force``: CyRK integrates, numba is not loaded, and
+    OpenBLAS started no thread pool (one OS thread in the process)."""
+    code = ("import os, sys\n"
             "from walkerlab.cli import app\n"
             "try:\n"
             "    app(['fixedpoint', 'configs/paper.yaml', '--force', '--runs-dir', sys.argv[1]])\n"
             "except SystemExit as exc:\n"
-            "    assert not exc.code, exc.code\n" + _loaded(HEAVY + ("CyRK",)))
+            "    assert not exc.code, exc.code\n"
+            "tasks = '/proc/self/task'\n"
+            "threads = len(os.listdir(tasks)) if os.path.isdir(tasks) else 1\n"
+            + _loaded(HEAVY + ("CyRK",),
+                      f"{{'blas': os.environ.get({BLAS_THREADS_ENV!r}), 'threads': threads}}"))
     got = _run(code, str(tmp_path / "runs"))
     assert (tmp_path / "runs" / "paper" / "fixedpoint.h5").is_file()
+    assert got.pop("blas") == "1" and got.pop("threads") == 1
     assert got.pop("CyRK"), "the paper scene integrates with CyRK (solver.backend auto)"
     assert not any(got.values()), got
+
+
+def test_blas_threads_default_keeps_the_users_choice(monkeypatch):
+    monkeypatch.delenv(BLAS_THREADS_ENV, raising=False)
+    _single_threaded_blas()
+    assert os.environ[BLAS_THREADS_ENV] == "1"
+    monkeypatch.setenv(BLAS_THREADS_ENV, "2")
+    _single_threaded_blas()
+    assert os.environ[BLAS_THREADS_ENV] == "2"
 
 
 def test_cyrk_loader_then_plain_import_gets_the_whole_package():
