@@ -134,7 +134,7 @@ def _single_threaded_blas() -> None:
 
     walkerlab's matrices have at most a few dozen rows, which OpenBLAS never splits across
     threads, but starting the thread pools of numpy's and scipy's OpenBLAS costs every
-    command ~50-100 ms of start-up on the 2-core machine (issue 10, note s3-startup).  Must
+    command ~50-100 ms of start-up on the 2-core machine (issue 10: 3 OS threads -> 1).  Must
     run before numpy is imported; worker processes (sweeps, basin) inherit it, as the
     work-precision workers already set it for themselves.
     """
