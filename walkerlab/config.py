@@ -271,13 +271,14 @@ class SolverSettings(_Strict):
 
 
 class ContactSolverSettings(_Strict):
-    """Integrator of the stiff contact model: ``odeint`` (LSODA, low overhead) or solve_ivp."""
+    """Integrator of the stiff contact model: ``cyrk_bdf`` (CyRK's BDF from compiled code,
+    the default), ``odeint`` (LSODA, low overhead), numbalsoda or solve_ivp."""
 
     method: Literal["odeint", "cyrk_bdf", "numbalsoda", "LSODA", "Radau", "BDF", "RK45",
                     "DOP853"] = Field(
-        "odeint", description="scipy.integrate.odeint, cyrk_bdf (CyRK's BDF from compiled "
-        "code), numbalsoda (LSODA from compiled code; optional extra 'walkerlab[numbalsoda]') "
-        "or a solve_ivp method")
+        "cyrk_bdf", description="cyrk_bdf (CyRK's BDF from compiled code), "
+        "scipy.integrate.odeint, numbalsoda (LSODA from compiled code; optional extra "
+        "'walkerlab[numbalsoda]') or a solve_ivp method")
     rtol: float = Field(1e-8, ge=1e-13, lt=1,
                         description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
                         "cannot meet a tighter one in double precision)")
