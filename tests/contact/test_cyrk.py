@@ -2,10 +2,9 @@
 
 import numpy as np
 
+from tests.contact.test_numbalsoda import _bench_case
 from walkerlab.contact import _cyrk, simulate_contact
 from walkerlab.contact.simulate import _grid
-
-from tests.contact.test_numbalsoda import _bench_case
 
 
 def test_cyrk_bdf_five_strides_match_odeint():
