@@ -427,6 +427,7 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
         data = _lsoda.pack(P, c1, c2)
     elif method in _cyrk.CYRK_METHODS:
         data = _cyrk.pack(P, c1, c2)
+
     def odeint_chunk(xs, tg):
         """odeint from ``xs`` at ``tg[0]``: (t, X) at the samples reached after ``tg[0]``,
         ok, message, nfev, njev."""
@@ -467,7 +468,8 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
             nfev += nf
             tn, Xn = tg[1:len(X)], X[1:]
             if not ok:  # a force jump BDF cannot step over (a foot hitting the side of a
-                # patch below its top): odeint, which can, from the last sample to the chunk end
+                # patch below its top): odeint, which grinds through it as a plain odeint run
+                # does, from the last sample reached to the chunk end
                 k = max(len(X) - 1, 0)
                 tr, Xr, ok, m, nf, nj = odeint_chunk(X[k] if len(X) else xa, tg[k:])
                 nfev += nf
