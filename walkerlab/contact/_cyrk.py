@@ -3,7 +3,8 @@
 Internal module, imported by :mod:`walkerlab.contact.simulate`; CyRK itself is imported only
 on the first chunk of a ``cyrk_*`` method.  CyRK (a main dependency, binary wheels, no
 Fortran) takes the right-hand side as a C function pointer (its numba bridge,
-``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The RHS :func:`walkerlab.contact._kernels.rhs` is wrapped in a numba ``cfunc`` (compiled once,
+``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The RHS
+:func:`walkerlab.contact._kernels.rhs` is wrapped in a numba ``cfunc`` (compiled once,
 cached on disk), so CyRK integrates a whole chunk of samples without re-entering Python.
 The physics is not repeated here: the cfunc only unpacks its data vector and calls the
 kernel.
