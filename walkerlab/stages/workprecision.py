@@ -25,9 +25,9 @@ Speed of the study itself (issue 10), without dropping a method or a tolerance:
   figure: ``cpu_time``).  ``walkerlab report`` starts the study right after the fixed point
   with one lane and runs its untimed stages (contact-sim, compare, figures) on the other
   core, whose lane starts once they are done;
-- each worker runs one untimed warm-up case per model before timing (compiled code is
-  loaded from the on-disk caches, not timed), and a run longer than :data:`SINGLE_RUN_S` is
-  timed once;
+- each worker runs every method of a model once, untimed, over one stride before timing
+  (compiled code is loaded from the on-disk caches, not timed), and a run longer than
+  :data:`SINGLE_RUN_S` is timed once;
 - the ideal model is also integrated with CyRK's DOP853/RK45 (group ``CyRK <method>``),
   next to scipy's ``solve_ivp`` methods, which is the integrator benchmark of the project.
 """
@@ -152,35 +152,42 @@ class Case(NamedTuple):
     rtol: float
     atol: float
     repeats: int
-    #: ``(method, rtol, atol)`` run once, untimed, when a worker builds the model's runner:
-    #: loading compiled code (numba's on-disk cache, generated model code, CyRK) and
-    #: first-call set-up then stay out of every timed run
+    #: ``((method, rtol, atol), ...)`` run once each, untimed, over :data:`WARM_STRIDES`
+    #: strides when a worker builds the model's runner: loading compiled code (numba's
+    #: on-disk cache, CyRK's compiled right-hand sides, generated model code) and first-call
+    #: set-up then stay out of every timed run
     warm: tuple
 
 
+#: strides of the untimed warm-up runs (one heel strike at least: every code path)
+WARM_STRIDES = 1
 _RUNNERS: dict = {}
 
 
+def _build_runner(model: str, scene_json: str, runs_root: str, x0: tuple, strides: int):
+    from walkerlab.config import scene_from_dict
+
+    scene = scene_from_dict(json.loads(scene_json))
+    if model == "ideal":
+        return ideal_runner(scene, np.asarray(x0), strides)
+    from walkerlab.stages.contact_sim import workprecision_runner
+
+    return workprecision_runner(scene, runs_root, np.asarray(x0), strides)
+
+
 def _runner_for(model: str, scene_json: str, runs_root: str, x0: tuple, strides: int,
-                warm: tuple | None = None):
+                warm: tuple = ()):
     key = (model, scene_json, runs_root, x0, strides)
     if key not in _RUNNERS:
-        from walkerlab.config import scene_from_dict
-
         _RUNNERS.clear()
-        scene = scene_from_dict(json.loads(scene_json))
-        if model == "ideal":
-            runner = ideal_runner(scene, np.asarray(x0), strides)
-        else:
-            from walkerlab.stages.contact_sim import workprecision_runner
-
-            runner = workprecision_runner(scene, runs_root, np.asarray(x0), strides)
-        if warm is not None:
-            try:
-                runner(*warm)
-            except Exception:  # noqa: BLE001 - the timed runs report failures
-                pass
-        _RUNNERS[key] = runner
+        if warm:
+            w = _build_runner(model, scene_json, runs_root, x0, WARM_STRIDES)
+            for case in warm:
+                try:
+                    w(*case)
+                except Exception:  # noqa: BLE001 - the timed runs report failures
+                    pass
+        _RUNNERS[key] = _build_runner(model, scene_json, runs_root, x0, strides)
     return _RUNNERS[key]
 
 
@@ -471,24 +478,24 @@ def plan(scene: Scene) -> dict:
     return out
 
 
-def _warm_case(model_plan) -> tuple:
-    """The cheapest case of a model (first method, loosest tolerance): the warm-up run."""
+def _warm_cases(model_plan) -> tuple:
+    """Each method of a model at its loosest tolerance: the warm-up runs."""
     methods, rtols, af = model_plan[:3]
     r = max(rtols)
-    return (methods[0], r, af * r)
+    return tuple((m, r, af * r) for m in methods)
 
 
 def warm_up(scene: Scene, runs_root: Path | str, model: str) -> None:
-    """Run ``model``'s cheapest case once in this process (untimed): compiles what it needs
-    into the on-disk caches (numba kernels of the contact model), so the timing workers only
-    load it.  Needs the fixed-point artifact."""
+    """Run ``model``'s warm-up cases in this process (untimed): compiles what they need into
+    the on-disk caches (numba kernels and CyRK right-hand sides of the contact model), so
+    the timing workers only load it.  Needs the fixed-point artifact."""
     p = plan(scene)
     if model not in p:
         return
     x0, _ = fixedpoint_stage.load_fixed_point(artifact_path(scene, runs_root, "fixedpoint"))
     wp = require(scene, "workprecision", "workprecision")
     _runner_for(model, json.dumps(scene.model_dump(mode="json"), sort_keys=True),
-                str(runs_root), tuple(float(v) for v in x0), wp.strides, _warm_case(p[model]))
+                str(runs_root), tuple(float(v) for v in x0), wp.strides, _warm_cases(p[model]))
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
@@ -522,7 +529,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         tasks, keys = [], {}
         for model, mp_ in models.items():
             methods, rtols, af, ref, _, secs = mp_
-            warm = _warm_case(mp_)
+            warm = _warm_cases(mp_)
             cases = [(ref[0], ref[1], ref[2], 1)] + [(m, r, af * r, wp.repeats)
                                                      for m in methods for r in rtols]
             for m, r, a, rep in cases:
@@ -562,9 +569,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                 g.attrs["target_error"] = (wp.target_error if model == "ideal"
                                            else wp.contact_target_error)
             f.attrs["timing"] = ("each case measured in a worker process pinned to its own "
-                                 "core, nothing else of walkerlab's on that core; one untimed "
-                                 "warm-up run per worker and model; wall and process CPU "
-                                 "time per run")
+                                 "core, nothing else of walkerlab's on that core; an untimed "
+                                 "one-stride warm-up run per worker and method; wall and "
+                                 "process CPU time per run")
             f.attrs["cases_reused_from_cache"] = n_cached
             f.attrs["cases_total"] = len(done)
         return writer, {k: v[1] for k, v in results.items()}
