@@ -1,6 +1,6 @@
 """First and second ``walkerlab report`` on a fresh copy of the scenes (issue 10, part 3).
 
-Copies ``configs/`` into an empty temporary folder (no runs, no model-code cache: a fresh
+Copies the measured tree's ``configs/`` into an empty temporary folder (no runs, no model-code cache: a fresh
 checkout, install excluded), runs ``walkerlab report`` there, then runs it again, and prints
 both wall times (targets: <= 60 s and <= 3 s on 2 cores) with the load average before each,
 the CPU time of the whole process tree and each stage's own "computed in" time.
@@ -43,11 +43,12 @@ def _children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def one(code: Path, scene: str, configs: Path, cold_numba: bool) -> dict:
-    """First run and rerun of ``walkerlab report`` with ``code`` on PYTHONPATH."""
+def one(code: Path, scene: str, cold_numba: bool) -> dict:
+    """First run and rerun of ``walkerlab report`` with ``code`` on PYTHONPATH, on a copy of
+    that tree's own ``configs/`` (scene files follow the code's schema)."""
     res = {"code": str(code)}
     with tempfile.TemporaryDirectory() as d:
-        shutil.copytree(configs, Path(d) / "configs")
+        shutil.copytree(code / "configs", Path(d) / "configs")
         env = {k: v for k, v in os.environ.items() if k != "WALKERLAB_CACHE_DIR"}
         env["PYTHONPATH"] = str(code)
         if cold_numba:
@@ -82,7 +83,6 @@ def main() -> None:
                     "checkout)")
     args = ap.parse_args()
     root = Path(__file__).resolve().parents[1]
-    configs = root / "configs"
     b = Path(args.code).resolve() if args.code else root
     a = Path(args.vs).resolve() if args.vs else None
     runs: list[dict] = []
@@ -92,7 +92,7 @@ def main() -> None:
         pair = {}
         for name, code in order:
             print(f"round {r + 1}, {name} = {code}", flush=True)
-            pair[name] = one(code, args.scene, configs, not args.warm_numba)
+            pair[name] = one(code, args.scene, not args.warm_numba)
         runs.append(pair)
     summary = {}
     for name in ("A", "B"):
