@@ -2,8 +2,9 @@
 
 Copies the measured tree's ``configs/`` into an empty temporary folder (no runs, no
 model-code cache: a fresh checkout, install excluded), runs ``walkerlab report`` there, then
-runs it again, and prints both wall times (targets: <= 60 s and <= 3 s on 2 cores) with the load average before each,
-the CPU time of the whole process tree and each stage's own "computed in" time.
+runs it again, and prints both wall times (targets: <= 60 s and <= 3 s on 2 cores) with
+the load average before each, the CPU time of the whole process tree and each stage's own
+"computed in" time.
 
 numba's on-disk cache lives next to the sources (``__pycache__``), so a plain run here would
 reuse kernels compiled by earlier runs; a fresh checkout has none.  By default the first run
