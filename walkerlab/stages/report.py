@@ -61,11 +61,16 @@ class _Study:
             self.lanes.gates[mine] = threading.Event()
         if scene.contact is not None:
             self.lanes.pending["contact"] = threading.Event()
+        first_run = not artifact_path(scene, runs_root, "workprecision").is_file()
         self._affinity = set(cores)
         os.sched_setaffinity(0, {mine})  # threads started later inherit it
-        if not artifact_path(scene, runs_root, "workprecision").is_file():
-            self.lanes.workers = {c: workprecision.start_worker(c) for c in lanes
-                                  if c not in self.lanes.gates}
+        try:
+            if first_run:
+                self.lanes.workers = {c: workprecision.start_worker(c) for c in lanes
+                                      if c not in self.lanes.gates}
+        except BaseException:
+            self.release(cancel=True)
+            raise
         self.thread = threading.Thread(target=self._run, name="workprecision", daemon=True)
 
     def start(self) -> None:
