@@ -87,12 +87,18 @@ class Guard:
 
 @dataclass(frozen=True)
 class Phase:
-    """A continuous phase of a step: its flow and the guards active during it."""
+    """A continuous phase of a step: its flow and the guards active during it.
+
+    ``compiled`` (optional) is a handle on the same flow compiled for CyRK's C++ integrators
+    (:class:`walkerlab.models.compiled.CompiledFlow`: ``address(variational)``, ``data()``),
+    used by the ``cyrk_compiled`` solver backend.
+    """
 
     name: str
     flow: Flow
     guards: tuple[Guard, ...]
     jacobian: Callable[[float, np.ndarray], np.ndarray] | None = None
+    compiled: object | None = None
 
 
 @dataclass(frozen=True)

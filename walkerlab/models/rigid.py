@@ -37,6 +37,7 @@ from functools import partial
 
 from walkerlab.models.base import Guard, HybridWalker, Phase
 from walkerlab.models.cache import generated_module
+from walkerlab.models.compiled import CompiledFlow
 from walkerlab.models.description import WalkerData
 
 LEGS = ("leg1", "leg2")
@@ -85,6 +86,11 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     HybridWalker
     """
     f = functions(data)
+    # the compiled flow is the generated one: none when the flow is replaced
+    cflow = cflocked = None
+    if flow is None and flow_jacobian is None:
+        cflow = CompiledFlow(data.structure, tuple(data.params), "flow")
+        cflocked = CompiledFlow(data.structure, tuple(data.params), "flow_locked")
     flow = flow or f["flow"]
     fall = Guard("fall", f["guard_hip_height"], -1, "fall", gradient=f["grad_hip_height"])
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
@@ -98,16 +104,17 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
                 Guard("swing_foot_scuffs", partial(_below, f["guard_swing_clearance"],
                                                    SCUFF_DEPTH * data.leg_length_m), -1, "fall",
                       f["grad_swing_clearance"]), fall),
-                jacobian=f["flow_jacobian"]),
+                jacobian=f["flow_jacobian"], compiled=cflow),
             Phase("locked_swing", f["flow_locked"], (
                 heel, falls_back, Guard("swing_foot_scuffs", ahead, +1, "fall", dahead), fall),
-                jacobian=f["flow_locked_jacobian"]),
+                jacobian=f["flow_locked_jacobian"], compiled=cflocked),
         )
     else:
         early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead),
-                                            fall), jacobian=flow_jacobian or f["flow_jacobian"])
+                                            fall), jacobian=flow_jacobian or f["flow_jacobian"],
+                      compiled=cflow)
         late = Phase("late_swing", flow, (heel, falls_back, fall),
-                     jacobian=flow_jacobian or f["flow_jacobian"])
+                     jacobian=flow_jacobian or f["flow_jacobian"], compiled=cflow)
         phases = (early, late)
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
