@@ -367,11 +367,12 @@ def generate(eq: Equations, param_names, key: str) -> str:
     return "\n".join(head + body) + "\n"
 
 
-def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational: bool
-           ) -> list[str]:
+def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational: bool,
+           guards: tuple[list[str], list]) -> list[str]:
     """A numba ``cfunc`` ``(dy, t, y, d)`` (CyRK's ``cyjit_sig``) writing the flow (and with
     ``variational`` the product ``A Phi`` of the flow Jacobian with ``y[2n:]``, row-major
-    (2n, 2n)) into ``dy``; ``d`` holds the constants, then a call counter."""
+    (2n, 2n)) into ``dy``, then the guard values (CyRK's extra outputs); ``d`` holds the
+    constants, then a call counter."""
     m = 2 * len(eq.q)
     names = [str(s) for s in (*eq.q, *eq.dq)]
     out = [f"@cfunc(SIG, cache=True, error_model='numpy')",
@@ -394,6 +395,9 @@ def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational
                     phi = f"y[{m + k * m + j}]"
                     terms.append(phi if a == "1.0" else f"({a}) * {phi}")
                 out.append(f"    dy[{m + i * m + j}] = {' + '.join(terms) or '0.0'}")
+    k0 = m + m * m if variational else m
+    out += [ln[4:] for ln in guards[0]]
+    out += [f"    dy[{k0 + j}] = {_PY.doprint(e)}" for j, e in enumerate(guards[1])]
     out.append(f"    d[{len(consts)}] += 1.0")
     return out
 
@@ -403,10 +407,11 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     C++ integrators (``CyRK.nb.numba_solver.cyjit_sig``), ``cache=True``.
 
     Defines ``constants(p) -> ndarray (NCONST + 1,)`` (the parameters, the parameter-only
-    subexpressions and a zeroed call counter: the data vector of every cfunc), ``NCONST``, and
-    the cfuncs ``flow`` (2n outputs) and ``flow_variational`` (``2n + (2n)^2`` outputs: the
-    flow and ``A(x) Phi``), plus ``flow_locked``/``flow_locked_variational`` for a kneed
-    walker.  The equations are those of :func:`generate` (same expressions, same key).
+    subexpressions and a zeroed call counter: the data vector of every cfunc), ``NCONST``,
+    ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
+    ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
+    ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
+    of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  The equations are those of :func:`generate` (same expressions, same key).
     """
     _HOISTED.clear()
     _PARAMS.clear()
@@ -417,15 +422,17 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
         flows["flow_locked"] = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
     parts = {k: (_flow(e, False, parts=True), _flow(e, True, parts=True))
              for k, e in flows.items()}
+    guards = _cse_lines(list(eq.guards.values()), _PY)
     consts = list(param_names) + [h.split("=")[0].strip() for h in _HOISTED]
     body = ["def constants(p):",
             f"    {', '.join(param_names)}, = p",
             *_HOISTED,
             f"    return np.array(({', '.join(consts)}, 0.0), dtype=np.float64)",
-            "", f"NCONST = {len(consts)}", ""]
+            "", f"NCONST = {len(consts)}",
+            f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", ""]
     for k, e in flows.items():
-        body += _cfunc(k, e, consts, parts[k], False) + [""]
-        body += _cfunc(f"{k}_variational", e, consts, parts[k], True) + [""]
+        body += _cfunc(k, e, consts, parts[k], False, guards) + [""]
+        body += _cfunc(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
     head = [
         f"# walkerlab compiled model code (walkerlab.models.codegen); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",

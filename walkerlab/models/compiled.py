@@ -73,11 +73,16 @@ class CompiledFlow:
         Parameter vector (``structure.param_names`` order).
     name : str
         ``"flow"`` or ``"flow_locked"`` (kneed walker, knee locked).
+    guards : tuple of (str, float), optional
+        For each guard of the phase, in order: the generated guard it is and a constant added
+        to it (``Guard.function = guard_<name> + offset``); the guards are then evaluated in
+        the cfunc (extra outputs).  None: the integrator calls the Python guards.
     """
 
     structure: object
     params: tuple
     name: str = "flow"
+    guards: tuple | None = None
     _memo: dict = field(default_factory=dict, repr=False, compare=False)
 
     def address(self, variational: bool = False) -> int:
@@ -96,3 +101,13 @@ class CompiledFlow:
         if "data" not in self._memo:
             self._memo["data"] = compiled_module(self.structure).constants(self.params)
         return self._memo["data"].copy()
+
+    def guard_columns(self) -> tuple[int, np.ndarray, np.ndarray] | None:
+        """``(n_extra, columns, offsets)``: how many extra outputs the cfuncs write and, for
+        each guard of the phase, its column among them and its offset; None without
+        :attr:`guards`."""
+        if self.guards is None:
+            return None
+        names = compiled_module(self.structure).GUARDS
+        return (len(names), np.array([names.index(g) for g, _ in self.guards]),
+                np.array([float(o) for _, o in self.guards]))

@@ -87,10 +87,12 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     """
     f = functions(data)
     # the compiled flow is the generated one: none when the flow is replaced
-    cflow = cflocked = None
-    if flow is None and flow_jacobian is None:
-        cflow = CompiledFlow(data.structure, tuple(data.params), "flow")
-        cflocked = CompiledFlow(data.structure, tuple(data.params), "flow_locked")
+    generated_flow = flow is None and flow_jacobian is None
+
+    def compiled(name, *guards):  # guards: (generated guard, offset) of each Phase guard
+        if generated_flow:
+            return CompiledFlow(data.structure, tuple(data.params), name, guards)
+        return None
     flow = flow or f["flow"]
     fall = Guard("fall", f["guard_hip_height"], -1, "fall", gradient=f["grad_hip_height"])
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
@@ -104,17 +106,24 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
                 Guard("swing_foot_scuffs", partial(_below, f["guard_swing_clearance"],
                                                    SCUFF_DEPTH * data.leg_length_m), -1, "fall",
                       f["grad_swing_clearance"]), fall),
-                jacobian=f["flow_jacobian"], compiled=cflow),
+                jacobian=f["flow_jacobian"],
+                compiled=compiled("flow", ("knee_extension", 0.0),
+                                  ("swing_clearance", SCUFF_DEPTH * data.leg_length_m),
+                                  ("hip_height", 0.0))),
             Phase("locked_swing", f["flow_locked"], (
                 heel, falls_back, Guard("swing_foot_scuffs", ahead, +1, "fall", dahead), fall),
-                jacobian=f["flow_locked_jacobian"], compiled=cflocked),
+                jacobian=f["flow_locked_jacobian"],
+                compiled=compiled("flow_locked", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
+                                  ("swing_foot_ahead", 0.0), ("hip_height", 0.0))),
         )
     else:
         early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead),
                                             fall), jacobian=flow_jacobian or f["flow_jacobian"],
-                      compiled=cflow)
+                      compiled=compiled("flow", ("swing_foot_ahead", 0.0), ("hip_height", 0.0)))
         late = Phase("late_swing", flow, (heel, falls_back, fall),
-                     jacobian=flow_jacobian or f["flow_jacobian"], compiled=cflow)
+                     jacobian=flow_jacobian or f["flow_jacobian"],
+                     compiled=compiled("flow", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
+                                       ("hip_height", 0.0)))
         phases = (early, late)
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
