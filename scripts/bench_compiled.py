@@ -58,6 +58,21 @@ def main(path: str = "configs/paper.yaml", repeats: int = 30) -> None:
         print(f"{'variational' if jac else 'plain'} map: cyrk {a * 1e3:.3f} ms, cyrk_compiled "
               f"{c * 1e3:.3f} ms (median CPU of {repeats}x{batch}), ratio {a / c:.1f}x; "
               f"max |x_A - x_B| {diff:.1e}{extra}")
+    from walkerlab.analysis.poincare import find_fixed_point
+
+    times = {b: [] for b in sv}
+    fps = {}
+    for _ in range(max(3, repeats // 5)):
+        for b, s in sv.items():
+            c0 = time.process_time()
+            fps[b] = find_fixed_point(w, x, s, fd_check=False)
+            times[b].append(time.process_time() - c0)
+    a, c = (np.median(times[b]) for b in sv)
+    print(f"fixed point (search + variational DP, no FD check): cyrk {a * 1e3:.1f} ms, "
+          f"cyrk_compiled {c * 1e3:.1f} ms, ratio {a / c:.1f}x; "
+          f"max |x*_A - x*_B| {np.max(np.abs(fps['cyrk'].x - fps['cyrk_compiled'].x)):.1e}, "
+          "max |mult_A - mult_B| "
+          f"{np.max(np.abs(fps['cyrk'].multipliers_variational - fps['cyrk_compiled'].multipliers_variational)):.1e}")
     for b in sv:
         t = [float(subprocess.run([sys.executable, "-c", FRESH.format(path=path, backend=b)],
                                   capture_output=True, text=True, check=True).stdout)

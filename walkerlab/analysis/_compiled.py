@@ -198,15 +198,16 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
                                            rtol, atol, hmax, h0) + [n_extra])
             dense.pieces.append([float(T[k - 1]), float(T[k]), step])
             out = np.empty(m + n_extra)
+            call, sp, op = ns.c_call, step.ptr, out.ctypes.data
             roots = []
             for i in np.flatnonzero(active):
                 if cols is not None:
-                    def g(t, _c=gcol[i], _o=goff[i]):
-                        ns.c_call(step.ptr, t, out.ctypes.data)
+                    def g(t, _c=int(gcol[i]), _o=float(goff[i])):
+                        call(sp, t, op)
                         return out[_c] + _o
                 else:
                     def g(t, _f=fns[i]):
-                        ns.c_call(step.ptr, t, out.ctypes.data)
+                        call(sp, t, op)
                         return _f(t, out[:n])
                 gk = g(T[k])
                 roots.append((float(T[k]) if gk == 0.0 else

@@ -108,6 +108,8 @@ class CompiledFlow:
         :attr:`guards`."""
         if self.guards is None:
             return None
-        names = compiled_module(self.structure).GUARDS
-        return (len(names), np.array([names.index(g) for g, _ in self.guards]),
-                np.array([float(o) for _, o in self.guards]))
+        if "guards" not in self._memo:
+            names = compiled_module(self.structure).GUARDS
+            self._memo["guards"] = (len(names), np.array([names.index(g) for g, _ in self.guards]),
+                                    np.array([float(o) for _, o in self.guards]))
+        return self._memo["guards"]
