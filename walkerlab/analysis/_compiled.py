@@ -150,10 +150,9 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     -------
     t_last, y_last (m,), failed, message, event index or None, dense, nfev
     """
-    from scipy.optimize import brentq
-
     from CyRK.cy.pyhelpers import find_ode_method_int
     from CyRK.nb import numba_solver as ns
+    from scipy.optimize import brentq
 
     addr = compiled.address(variational)
     data = compiled.data()
@@ -200,15 +199,15 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
             out = np.empty(m + n_extra)
             call, sp, op = ns.c_call, step.ptr, out.ctypes.data
             roots = []
-            for i in np.flatnonzero(active):
+            for i in np.flatnonzero(active):  # each g is used (by brentq) in its iteration only
                 if cols is not None:
-                    def g(t, _c=int(gcol[i]), _o=float(goff[i])):
-                        call(sp, t, op)
-                        return out[_c] + _o
+                    def g(t, _c=int(gcol[i]), _o=float(goff[i]), _a=(call, sp, op), _y=out):
+                        _a[0](_a[1], t, _a[2])
+                        return _y[_c] + _o
                 else:
-                    def g(t, _f=fns[i]):
-                        call(sp, t, op)
-                        return _f(t, out[:n])
+                    def g(t, _f=fns[i], _a=(call, sp, op), _y=out):
+                        _a[0](_a[1], t, _a[2])
+                        return _f(t, _y[:n])
                 gk = g(T[k])
                 roots.append((float(T[k]) if gk == 0.0 else
                               brentq(g, T[k - 1], T[k], xtol=4 * EPS, rtol=4 * EPS), int(i)))

@@ -375,7 +375,7 @@ def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational
     constants, then a call counter."""
     m = 2 * len(eq.q)
     names = [str(s) for s in (*eq.q, *eq.dq)]
-    out = [f"@cfunc(SIG, cache=True, error_model='numpy')",
+    out = ["@cfunc(SIG, cache=True, error_model='numpy')",
            f"def {name}(dy, t, y, d):  # pragma: no cover - runs compiled"]
     out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
     out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
@@ -411,7 +411,8 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
     ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
     ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
-    of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  The equations are those of :func:`generate` (same expressions, same key).
+    of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  The
+    equations are those of :func:`generate` (same expressions, same key).
     """
     _HOISTED.clear()
     _PARAMS.clear()
