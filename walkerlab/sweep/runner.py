@@ -2,9 +2,17 @@
 
 Chunks are *runs along the first axis*: for every combination of the other axes the points
 of the first axis are evaluated in order by one worker, so each point can start its
-fixed-point search from its neighbour's fixed point (continuation).  When the base scene's
-own value of the first parameter lies inside the axis, a line is split there into an
-upward run and a downward run, both starting next to the scene's initial guess.
+fixed-point search from its neighbours' fixed points (continuation: secant predictor and
+the previous Jacobian, :class:`walkerlab.sweep.points.Continuation`).  When the base
+scene's own value of the first parameter lies inside the axis, a line is split there into
+an upward run and a downward run, both starting next to the scene's initial guess.
+
+Balance: all chains run at once (each has one piece in flight), so the workers stay busy
+while there are at least as many unfinished chains as workers; the sweep's wall time is
+then about ``max(total / workers, longest chain)``.  A run longer than ``total / workers``
+is therefore dealt out *interleaved* into ``k`` chains (points ``0, k, 2k, ...``,
+``1, k+1, ...``): each still starts next to the scene's guess and continues in steps of
+``k`` grid points, so no chain needs a guess far from the anchor.
 
 Executors
 ---------
@@ -106,7 +114,8 @@ def plan_chunks(axes: list[ParamAxis], base: dict, done: set[int] | frozenset = 
     done : set of int
         Indices already computed (resume); they are left out.
     chunk_size : int, optional
-        Longest chunk; default: whole runs, halved until there are at least ``workers``.
+        Longest chunk (consecutive points); default: whole runs, each run longer than
+        ``ceil(total / workers)`` dealt out interleaved into that many chains.
     workers : int
 
     Returns
@@ -135,12 +144,9 @@ def plan_chunks(axes: list[ParamAxis], base: dict, done: set[int] | frozenset = 
                 runs.append(r)
     if chunk_size is not None:
         runs = [r[k:k + chunk_size] for r in runs for k in range(0, len(r), max(1, chunk_size))]
-    else:
-        while 0 < len(runs) < workers and max(len(r) for r in runs) > 1:
-            runs.sort(key=len)
-            r = runs.pop()
-            h = (len(r) + 1) // 2
-            runs += [r[:h], r[h:]]
+    elif workers > 1 and runs:
+        target = math.ceil(sum(len(r) for r in runs) / workers)
+        runs = [r[j::k] for r in runs for k in [math.ceil(len(r) / target)] for j in range(k)]
     runs.sort(key=len, reverse=True)
     return [[(i, pts[i]) for i in r] for r in runs]
 
