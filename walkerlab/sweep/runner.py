@@ -118,8 +118,9 @@ def plan_chunks(axes: list[ParamAxis], base: dict, done: set[int] | frozenset = 
     done : set of int
         Indices already computed (resume); they are left out.
     chunk_size : int, optional
-        Longest chunk (consecutive points); default: whole runs, each run longer than
-        ``ceil(total / workers)`` dealt out interleaved into that many chains.
+        Longest chunk (consecutive points); default: whole runs, a run of ``m`` points
+        longer than ``t = ceil(total / workers)`` dealt out interleaved into
+        ``ceil(m / t)`` chains.
     workers : int
 
     Returns
