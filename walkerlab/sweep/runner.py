@@ -462,7 +462,10 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
                         on_chunk(n_written, n_total)
     except BaseException:
         if pending and store.f.id.valid:
-            write()  # rows computed before the interruption are kept for --resume
+            try:
+                write()  # rows computed before the interruption are kept for --resume
+            except Exception:  # noqa: BLE001 - the original error is the one to report
+                pass
         store.add_wall_time(time.perf_counter() - t0)
         store.close()
         raise
