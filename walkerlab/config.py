@@ -271,11 +271,14 @@ class SolverSettings(_Strict):
 
 
 class ContactSolverSettings(_Strict):
-    """Integrator of the stiff contact model: ``odeint`` (LSODA, low overhead) or solve_ivp."""
+    """Integrator of the stiff contact model: ``cyrk_bdf`` (CyRK's BDF from compiled code,
+    the default), ``odeint`` (LSODA, low overhead), numbalsoda or solve_ivp."""
 
-    method: Literal["odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853"] = Field(
-        "odeint", description="scipy.integrate.odeint, numbalsoda (LSODA from compiled code; "
-        "optional extra 'walkerlab[numbalsoda]') or a solve_ivp method")
+    method: Literal["odeint", "cyrk_bdf", "numbalsoda", "LSODA", "Radau", "BDF", "RK45",
+                    "DOP853"] = Field(
+        "cyrk_bdf", description="cyrk_bdf (CyRK's BDF from compiled code), "
+        "scipy.integrate.odeint, numbalsoda (LSODA from compiled code; optional extra "
+        "'walkerlab[numbalsoda]') or a solve_ivp method")
     rtol: float = Field(1e-8, ge=1e-13, lt=1,
                         description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
                         "cannot meet a tighter one in double precision)")
@@ -368,8 +371,8 @@ class WorkPrecisionSettings(_Strict):
     target_error: float = Field(1e-8, gt=0, description="error the Pareto-best setting must "
                                 "reach [rad, rad/s]")
     models: list[Literal["ideal", "contact"]] = Field(["ideal"], description="models to study")
-    contact_methods: list[Literal["odeint", "LSODA", "Radau", "BDF"]] = Field(
-        ["odeint", "LSODA", "Radau", "BDF"],
+    contact_methods: list[Literal["odeint", "cyrk_bdf", "LSODA", "Radau", "BDF"]] = Field(
+        ["odeint", "cyrk_bdf", "LSODA", "Radau", "BDF"],
         description="methods for the stiff contact model (explicit methods are hopeless there)")
     contact_rtols: list[Annotated[float, Field(gt=0, lt=1)]] = Field(
         [1e-5, 1e-6, 1e-7, 1e-8, 1e-9], description="contact-model tolerances [-]")

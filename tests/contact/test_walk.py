@@ -72,7 +72,7 @@ def test_pinned_first_step_and_odeint_vs_radau():
 def test_fall_is_detected():
     w = _paper(0.1)
     x0 = initial_state_from_ideal(w, *FP, rate_scale=(1.0, 0.3))  # too slow: falls back
-    for method in ("odeint", "LSODA"):
+    for method in ("odeint", "cyrk_bdf", "LSODA"):
         r = simulate_contact(w, x0, 5.0, method=method, rtol=1e-8, atol=1e-11)
         assert r.termination == "fall" and r.fall_time is not None
         assert w.hip_height(r.x)[-1] == pytest.approx(0.5, abs=0.02)

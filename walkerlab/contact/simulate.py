@@ -1,10 +1,11 @@
 """Time integration of the contact walker, gait events and typed outcomes.
 
 Integrators: ``"odeint"`` (scipy.integrate.odeint = LSODA with little overhead, run in chunks
-so a fall, a trip, the wall-time limit or the strides cap stops the run), ``"numbalsoda"``
-(the same chunks through numbalsoda's LSODA with a compiled RHS, no Python per evaluation;
+so a fall, a trip, the wall-time limit or the strides cap stops the run), ``"cyrk_bdf"``
+(the same chunks through CyRK's BDF with a compiled RHS, no Python per evaluation; see
+:mod:`walkerlab.contact._cyrk`), ``"numbalsoda"`` (the same with numbalsoda's LSODA;
 optional extra, see :mod:`walkerlab.contact._lsoda`) or any stiff
-``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``), all given the analytic Jacobian.
+``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``), these given the analytic Jacobian.
 
 Contact is decided by geometry only (:mod:`walkerlab.contact._kernels`): a foot gets the
 IMPACT force whenever it is below the top of a patch and inside its horizontal extent, in
@@ -29,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
+from . import _cyrk
 from . import _kernels as K
 from .model import FOOT_NAMES, ContactWalker
 
@@ -423,6 +425,27 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
         if not np.isscalar(atol):
             raise ValueError("method numbalsoda needs a scalar atol")
         data = _lsoda.pack(P, c1, c2)
+    elif method in _cyrk.CYRK_METHODS:
+        data = _cyrk.pack(P, c1, c2)
+
+    def odeint_chunk(xs, tg):
+        """odeint from ``xs`` at ``tg[0]``: (t, X) at the samples reached after ``tg[0]``,
+        ok, message, nfev, njev."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ODEintWarning)
+            X, info = odeint(frhs, xs, tg, Dfun=fjac, tfirst=True, rtol=rtol, atol=atol,
+                             hmax=0.0 if not np.isfinite(max_step) else max_step,
+                             full_output=True, mxstep=200000)
+        ok = info["message"] == "Integration successful."
+        # after a failure odeint's info arrays past the last sample reached are not filled in
+        # (garbage was seen): use them up to that sample only
+        reached = info["tcur"] >= tg[1:] - 1e-14
+        nk = len(tg) if ok or reached.all() else int(np.argmin(reached)) + 1
+        if nk < 2:
+            return tg[1:1], X[1:1], ok, info["message"], 0, 0
+        return (tg[1:nk], X[1:nk], ok, info["message"], int(info["nfe"][nk - 2]),
+                int(info["nje"][nk - 2]))
+
     ts, Xs, nfev, njev = [np.array([t0])], [x0[None]], 0, 0
     ta, xa = t0, x0
     status, msg, event = "ok", "Integration successful.", None
@@ -431,22 +454,27 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
         tb = min(ta + chunk_s, t1)
         tg = _grid(ta, tb, rate)
         if method == "odeint":
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", ODEintWarning)
-                X, info = odeint(frhs, xa, tg, Dfun=fjac, tfirst=True, rtol=rtol, atol=atol,
-                                 hmax=0.0 if not np.isfinite(max_step) else max_step,
-                                 full_output=True, mxstep=200000)
-            nfev += int(info["nfe"][-1])
-            njev += int(info["nje"][-1])
-            ok = info["message"] == "Integration successful."
-            nk = len(tg) if ok else int(np.count_nonzero(info["tcur"] >= tg[1:] - 1e-14)) + 1
-            tn, Xn, m = tg[1:nk], X[1:nk], info["message"]
+            tn, Xn, ok, m, nf, nj = odeint_chunk(xa, tg)
+            nfev += nf
+            njev += nj
         elif method == "numbalsoda":  # whole chunk in compiled code (FD Jacobian)
             X, ok, nf = _lsoda.solve_chunk(xa, tg, data, rtol, atol)
             nfev += nf
             nk = len(tg) if ok else 1  # rows after a failure are undefined: drop the chunk
             tn, Xn = tg[1:nk], X[1:nk]
             m = "Integration successful." if ok else "numbalsoda LSODA failed in this chunk"
+        elif method in _cyrk.CYRK_METHODS:  # whole chunk in compiled code (CyRK BDF)
+            X, ok, nf, m = _cyrk.solve_chunk(method, xa, tg, data, rtol, atol, max_step)
+            nfev += nf
+            tn, Xn = tg[1:len(X)], X[1:]
+            if not ok:  # a force jump BDF cannot step over (a foot hitting the side of a
+                # patch below its top): odeint, which grinds through it as a plain odeint run
+                # does, from the last sample reached to the chunk end
+                k = max(len(X) - 1, 0)
+                tr, Xr, ok, m, nf, nj = odeint_chunk(X[k] if len(X) else xa, tg[k:])
+                nfev += nf
+                njev += nj
+                tn, Xn = np.concatenate([tn, tr]), np.vstack([Xn, Xr])
         else:
             def grhs(t, x):
                 if time.perf_counter() > deadline:
@@ -498,7 +526,7 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
 
 
 def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
-                     method: str = "odeint", rtol: float = 1e-8, atol: float = 1e-10,
+                     method: str = "cyrk_bdf", rtol: float = 1e-8, atol: float = 1e-10,
                      max_step: float = np.inf, sample_rate_hz: float = 1000.0, *,
                      t0: float = 0.0, pin_stance_until: str = "none", pin_time_s: float = 0.0,
                      fall_hip_height_m: float | None = None, use_jacobian: bool = True,
@@ -515,8 +543,9 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         Initial state [hip_x, hip_y, th1, th2, vhip_x, vhip_y, w1, w2] (SI).
     t_final : float
         End time [s].
-    method : {"odeint", "numbalsoda", "LSODA", "Radau", "BDF"}
-        Integrator (odeint = LSODA with lower overhead; numbalsoda = LSODA called from
+    method : {"odeint", "cyrk_bdf", "numbalsoda", "LSODA", "Radau", "BDF"}
+        Integrator (odeint = LSODA with lower overhead; cyrk_bdf = CyRK's BDF called from
+        compiled code, finite-difference Jacobian; numbalsoda = LSODA called from
         compiled code, optional extra, finite-difference Jacobian, no ``max_step``), run in
         chunks of ``chunk_s``.
     rtol, atol : float
@@ -532,7 +561,8 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
     fall_hip_height_m : float, optional
         Fall threshold of the hip height above ground [m] (default 0.5 L).
     use_jacobian : bool
-        Pass the analytic Jacobian to the integrator.
+        Pass the analytic Jacobian to the integrator (not to cyrk_bdf or numbalsoda, whose
+        compiled interfaces take none).
     chunk_s : float
         Chunk length [s]; trips, falls, the wall-time limit and the strides cap are checked
         between chunks (a trip or fall is then located exactly and the run cut there).
@@ -559,8 +589,10 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
         without the numbalsoda package
         (:class:`walkerlab.contact._lsoda.MissingNumbalsoda`, also an ImportError).
     """
-    if method not in ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853"):
-        raise ValueError(f"method must be odeint, numbalsoda, LSODA, Radau or BDF, not {method!r}")
+    if method not in ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853",
+                      *_cyrk.CYRK_METHODS):
+        raise ValueError(f"method must be odeint, cyrk_bdf, numbalsoda, LSODA, Radau or BDF, "
+                         f"not {method!r}")
     x0 = np.asarray(x0, dtype=float)
     hth = 0.5 * walker.L if fall_hip_height_m is None else fall_hip_height_m
     wall = time.perf_counter()

@@ -1,0 +1,132 @@
+"""CyRK route for the contact walker: CyRK's C++ integrators called with a compiled RHS.
+
+Internal module, imported by :mod:`walkerlab.contact.simulate`; CyRK itself is imported only
+on the first chunk of a ``cyrk_*`` method.  CyRK (a main dependency, binary wheels, no
+Fortran) takes the right-hand side as a C function pointer (its numba bridge,
+``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The RHS
+:func:`walkerlab.contact._kernels.rhs` is wrapped in a numba ``cfunc`` (compiled once,
+cached on disk), so CyRK integrates a whole chunk of samples without re-entering Python.
+The physics is not repeated here: the cfunc only unpacks its data vector and calls the
+kernel.
+
+CyRK's numba bridge passes no Jacobian (``numba_c_api_.cpp`` hands a null Jacobian to the
+solver), so its implicit methods (LSODA, BDF, Radau) form the Jacobian by finite
+differences; those RHS calls are counted in ``nfev`` like all others (the cfunc counts its
+own calls).  ``max_step`` and a scalar or per-state ``atol`` are passed through.
+
+The packed data vector is ``[n1, n2, P (NPAR), c1 (n1), c2 (n2), nfev]``; CyRK copies it
+into its solver, so the call counter is read back from the solver's copy.
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+
+from . import _kernels as K
+
+__all__ = ["CYRK_METHODS", "pack", "solve_chunk"]
+
+#: walkerlab method name -> CyRK method name.  Only BDF pays on the contact walker (bench,
+#: /work/notes/s3-ccontact.md): CyRK's LSODA needs ~1.3x the RHS calls of numbalsoda's, its
+#: Radau 3x, and the explicit pairs (RK45, DOP853) are held by stability at >= 40k calls
+#: for 5 strides whatever the tolerance (stance-contact eigenvalues ~ -3e3 1/s, impacts
+#: ~ -1e5 1/s).
+CYRK_METHODS = {"cyrk_bdf": "BDF"}
+
+#: Offsets in the packed data vector: lane sizes n1, n2, then P.
+D_N1, D_N2, D_P = 0, 1, 2
+_FPTR = None
+
+
+def _build() -> int:
+    """Compile (or load from numba's disk cache) the cfunc RHS; returns its address."""
+    from CyRK.nb.numba_solver import cyjit_sig
+    from numba import carray, cfunc
+
+    npar = K.NPAR
+
+    @cfunc(cyjit_sig, cache=True)
+    def rhs_c(dy, t, y, p):  # pragma: no cover - runs compiled
+        n1 = int(p[D_N1])
+        n2 = int(p[D_N2])
+        a1 = D_P + npar  # start of c1
+        a2 = a1 + n1  # start of c2
+        d = carray(p, (a2 + n2 + 1,))
+        r = K.rhs(carray(y, (8,)), d[D_P:a1], d[a1:a2], d[a2:a2 + n2])
+        for i in range(8):
+            dy[i] = r[i]
+        d[a2 + n2] += 1.0  # nfev counter
+
+    return rhs_c.address
+
+
+def pack(P: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
+    """Data vector ``[n1, n2, P, c1, c2, nfev=0]`` (float64) for :func:`solve_chunk`."""
+    return np.concatenate([[len(c1), len(c2)], P, c1, c2, [0.0]]).astype(np.float64)
+
+
+def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
+                rtol: float, atol, max_step: float = np.inf):
+    """Integrate from ``x0`` at ``t_eval[0]`` over the sample times ``t_eval`` (n,) [s].
+
+    Parameters
+    ----------
+    method : str
+        A key of :data:`CYRK_METHODS`.
+    x0 : ndarray (8,)
+    t_eval : ndarray (n,)
+        Increasing sample times [s]; the first is the start time.
+    data : ndarray
+        From :func:`pack`.
+    rtol : float
+    atol : float or ndarray (8,)
+        [m, rad, m/s, rad/s].
+    max_step : float
+        Largest step [s] (inf: none).
+
+    Returns
+    -------
+    X : ndarray (m, 8)
+        States at ``t_eval[:m]`` (``m = n`` on success; fewer when the solver stopped early).
+    ok : bool
+        CyRK reported success.
+    nfev : int
+        RHS evaluations of this call (finite-difference Jacobian columns included).
+    message : str
+        CyRK's status message.
+    """
+    global _FPTR
+    from CyRK.cy.pyhelpers import find_ode_method_int
+    from CyRK.nb import numba_solver as ns
+
+    if _FPTR is None:
+        _FPTR = _build()
+    u0 = np.ascontiguousarray(x0, dtype=np.float64)
+    te = np.ascontiguousarray(t_eval, dtype=np.float64)
+    rt = np.array([float(rtol)])
+    at = np.ascontiguousarray(np.atleast_1d(atol), dtype=np.float64)
+    hmax = float(max_step) if np.isfinite(max_step) else ns.MAX_SIZE
+    # the C entry point that CyRK's njit `nbsolve2_ivp` calls, called here through ctypes
+    # (one call per chunk; avoids compiling that njit wrapper in every process)
+    ptr = ns.c_numba_cysolve_ivp(
+        _FPTR, te[0], te[-1], u0.ctypes.data, u0.size, find_ode_method_int(CYRK_METHODS[method]),
+        0, 0, data.ctypes.data, data.size * 8, 0, 2000, False, te.ctypes.data, te.size,
+        None, None, 0, rt.ctypes.data, rt.size, at.ctypes.data, at.size, hmax, 0.0, True)
+    if not ptr:  # pragma: no cover - allocation failure inside CyRK
+        return np.empty((0, u0.size)), False, 0, "CyRK returned no result"
+    try:
+        ok = bool(ns.c_get_success(ptr))
+        n = int(ns.c_get_size(ptr))
+        ndy = int(ns.c_get_num_dy(ptr))
+        X = (np.ctypeslib.as_array(ns.c_get_y_ptr(ptr), (n, ndy))[:, :u0.size].copy() if n
+             else np.empty((0, u0.size)))
+        args = ctypes.cast(ns.c_get_args_ptr(ptr), ctypes.POINTER(ctypes.c_double))
+        nfev = int(args[data.size - 1] - data[-1])
+        buf = ctypes.create_string_buffer(256)
+        ns.c_get_msg_buf(ptr, ctypes.addressof(buf), 256)
+        msg = buf.value.decode(errors="replace")
+    finally:
+        ns.c_free(ptr)
+    return X, ok, nfev, msg
