@@ -125,12 +125,29 @@ def _version_callback(value: bool) -> None:
         raise typer.Exit()
 
 
+#: OpenBLAS thread pools (numpy's and scipy's each start one when loaded)
+BLAS_THREADS_ENV = "OPENBLAS_NUM_THREADS"
+
+
+def _single_threaded_blas() -> None:
+    """Ask OpenBLAS for one thread unless the user chose a number (``OPENBLAS_NUM_THREADS``).
+
+    walkerlab's matrices have at most a few dozen rows, which OpenBLAS never splits across
+    threads, but starting the thread pools of numpy's and scipy's OpenBLAS costs every
+    command ~50-100 ms of start-up on the 2-core machine (issue 10: 3 OS threads -> 1).  Must
+    run before numpy is imported; worker processes (sweeps, basin) inherit it, as the
+    work-precision workers already set it for themselves.
+    """
+    os.environ.setdefault(BLAS_THREADS_ENV, "1")
+
+
 @app.callback()
 def _main(version: bool = typer.Option(False, "--version", callback=_version_callback,
                                        is_eager=True,
                                        help="print walkerlab, Python, numpy, scipy, numba "
                                        "and h5py versions and exit")) -> None:
     """walkerlab: passive-dynamic biped walkers, from fixed point to report."""
+    _single_threaded_blas()
 
 
 def _status(o) -> str:

@@ -166,8 +166,9 @@ def _solve_phase(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
         evs.append(ev)
     y0 = np.ascontiguousarray(y0, dtype=float)
     if backend == "cyrk":
-        from CyRK import pysolve_ivp
+        from walkerlab.analysis.cyrk_loader import pysolve_ivp as cyrk_solver
 
+        pysolve_ivp = cyrk_solver()  # CyRK without its numba solvers (see cyrk_loader)
         count = [0]
 
         def counted(t, y):
