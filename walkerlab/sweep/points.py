@@ -508,21 +508,19 @@ def run_chunk(task: Task) -> list[dict]:
 
 
 def warm_up() -> None:
-    """Build the lambdified model functions once (called in fresh worker processes) and
-    import the integration and root-finding libraries, so that processes forked from the
-    forkserver start warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise)."""
+    """Import the root-finding and integration libraries once (called in fresh worker
+    processes and in the forkserver), so that processes forked from the forkserver start
+    warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise).  CyRK comes through
+    :mod:`walkerlab.analysis.cyrk_loader` (its ``pysolve_ivp`` without numba, ~0.2 s less);
+    the model code is built per scene by the points themselves (cached on disk)."""
     try:
         import scipy.optimize  # noqa: F401
 
         from walkerlab.analysis.hybrid import _have_cyrk
 
         if _have_cyrk():
-            import CyRK  # noqa: F401
-    except Exception:  # noqa: BLE001 - warming is an optimisation only
-        pass
-    try:
-        from walkerlab.models.derivation import compass_gait_functions
+            from walkerlab.analysis.cyrk_loader import pysolve_ivp
 
-        compass_gait_functions()
+            pysolve_ivp()
     except Exception:  # noqa: BLE001 - warming is an optimisation only
         pass
