@@ -85,6 +85,8 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     HybridWalker
     """
     f = functions(data)
+    # the generated variational right-hand side belongs to the generated flow only
+    var = f.get("flow_variational") if flow is None and flow_jacobian is None else None
     flow = flow or f["flow"]
     fall = Guard("fall", f["guard_hip_height"], -1, "fall", gradient=f["grad_hip_height"])
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
@@ -98,16 +100,18 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
                 Guard("swing_foot_scuffs", partial(_below, f["guard_swing_clearance"],
                                                    SCUFF_DEPTH * data.leg_length_m), -1, "fall",
                       f["grad_swing_clearance"]), fall),
-                jacobian=f["flow_jacobian"]),
+                jacobian=f["flow_jacobian"], variational=var),
             Phase("locked_swing", f["flow_locked"], (
                 heel, falls_back, Guard("swing_foot_scuffs", ahead, +1, "fall", dahead), fall),
-                jacobian=f["flow_locked_jacobian"]),
+                jacobian=f["flow_locked_jacobian"],
+                variational=f.get("flow_locked_variational")),
         )
     else:
         early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead),
-                                            fall), jacobian=flow_jacobian or f["flow_jacobian"])
+                                            fall), jacobian=flow_jacobian or f["flow_jacobian"],
+                      variational=var)
         late = Phase("late_swing", flow, (heel, falls_back, fall),
-                     jacobian=flow_jacobian or f["flow_jacobian"])
+                     jacobian=flow_jacobian or f["flow_jacobian"], variational=var)
         phases = (early, late)
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
