@@ -361,6 +361,8 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
                 out[:n] = _f(tt, xs)
                 out[n:] = (_A(tt, xs) @ y[n:].reshape(n, n)).ravel()
                 return out
+            if phase.variational is not None:  # the model's own, in one call
+                rhs = phase.variational
             y0 = np.concatenate([x, Phi.ravel()])
         else:
             rhs = phase.flow

@@ -14,6 +14,7 @@ Generated functions (``x`` is the role-ordered state ``[q, dq]``, shape (2n,)):
 ==================  ==========================================================================
 ``flow(t, x)``      ``[dq, qdd]`` with ``M qdd = -C dq - G`` (2n,)
 ``flow_jacobian``   ``(t, x) -> d flow / dx`` (2n, 2n), for variational equations / stiff solvers
+``flow_variational`` ``(t, [x, Phi]) -> [flow, (d flow / dx) Phi]`` (2n + 4n^2,), row-major Phi
 ``reset(x)``        heel-strike impact and role swap (2n,)
 ``reset_jacobian``  ``x -> d reset / dx`` (2n, 2n)
 ``guard_<name>``    ``(t, x) -> float``; ``grad_<name>(x)`` its gradient (2n,)
@@ -123,9 +124,14 @@ def _array(rows) -> str:
     return "np.array((" + ", ".join(rows) + ",))"
 
 
-def _flow(eq: Equations, jac: bool, name: str | None = None, parts: bool = False):
-    """Lines of ``flow`` (``jac``: ``flow_jacobian``); ``parts``: ``(body lines, outputs)``
-    instead, the outputs being the 2n expressions (flow) or 2n rows of 2n (Jacobian)."""
+def _flow(eq: Equations, jac: bool, name: str | None = None,
+          variational: str | None = None, parts: bool = False):
+    """``flow``, or with ``jac`` its Jacobian; with ``variational`` (a name) also the
+    right-hand side of the variational equations from the same lines,
+    ``(t, y) -> [flow(x), (flow_jacobian(x) @ Phi).ravel()]`` for ``y = [x, Phi.ravel()]``
+    (the Jacobian's entries are never put into an array, its identity rows are copies).
+    ``parts``: ``(body lines, outputs)`` instead, the outputs being the 2n expressions (flow)
+    or 2n rows of 2n (Jacobian), for :func:`generate_compiled`."""
     n = len(eq.q)
     q, dq = eq.q, eq.dq
     r = -eq.C * sp.Matrix(dq) - eq.G
@@ -175,7 +181,23 @@ def _flow(eq: Equations, jac: bool, name: str | None = None, parts: bool = False
         rows.append([f"({cols[c][i]})" for c in range(2 * n)])
     if parts:
         return lines, rows
-    return head + lines + [f"{IND}return {_array(rows)}"]
+    out = head + lines + [f"{IND}return {_array(rows)}"]
+    if variational:
+        N = 2 * n
+        names = ", ".join(str(v) for v in (*q, *dq))
+        head = [f"    def {variational}(t, y):",
+                f"{IND}_y = y.tolist() if hasattr(y, 'tolist') else list(y)",
+                f"{IND}{names}, = _y[:{N}]", f"{IND}_P = _y[{N}:]"]
+        ret = [str(v) for v in dq] + qdd
+        for i in range(n):  # d q / dt = dq: rows of Phi
+            ret += [f"_P[{(n + i) * N + k}]" for k in range(N)]
+        for i in range(n):
+            nz = [c for c in range(N) if cols[c][i] != "0.0"]
+            lines += [f"{IND}_J{i}_{c} = {cols[c][i]}" for c in nz]
+            ret += [" + ".join(f"_J{i}_{c} * _P[{c * N + k}]" for c in nz) or "0.0"
+                    for k in range(N)]
+        out += head + lines + [f"{IND}return {_array(ret)}"]
+    return out
 
 
 def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
@@ -326,14 +348,15 @@ def generate(eq: Equations, param_names, key: str) -> str:
     _PARAMS.clear()
     _PARAMS.update(eq.params)
     _COUNT[0] = 0
-    fast = [*_flow(eq, False), *_flow(eq, True), *_reset(eq, False), *_reset(eq, True),
-            *_guards(eq)]
+    fast = [*_flow(eq, False), *_flow(eq, True, variational="flow_variational"),
+            *_reset(eq, False), *_reset(eq, True), *_guards(eq)]
     if eq.locked is not None:  # kneed walker: knee-locked flow and the knee strike
         lk = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
         q_lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, len(eq.q)))])
         kn = replace(eq, Mi=eq.knee_impact[0], B=eq.knee_impact[1], relabel_q=q_lock,
                      relabel_rate=sp.eye(len(eq.q)))
-        fast += [*_flow(lk, False, "flow_locked"), *_flow(lk, True, "flow_locked_jacobian"),
+        fast += [*_flow(lk, False, "flow_locked"),
+                 *_flow(lk, True, "flow_locked_jacobian", variational="flow_locked_variational"),
                  *_reset(kn, False, "knee_reset"), *_reset(kn, True, "knee_reset_jacobian")]
     body = [
         "def make(p):",
