@@ -92,6 +92,10 @@ class Phase:
     ``jacobian`` is ``(t, x) -> d flow / dx`` (2n, 2n); ``variational``, if given, is the
     right-hand side of the variational equations in one call,
     ``(t, [x, Phi.ravel()]) -> [flow(t, x), (jacobian(t, x) @ Phi).ravel()]`` (2n + 4n^2,).
+
+    ``compiled`` (optional) is a handle on the same flow compiled for CyRK's C++ integrators
+    (:class:`walkerlab.models.compiled.CompiledFlow`: ``address(variational)``, ``data()``),
+    used by the ``cyrk_compiled`` solver backend.
     """
 
     name: str
@@ -99,6 +103,7 @@ class Phase:
     guards: tuple[Guard, ...]
     jacobian: Callable[[float, np.ndarray], np.ndarray] | None = None
     variational: Callable[[float, np.ndarray], np.ndarray] | None = None
+    compiled: object | None = None
 
 
 @dataclass(frozen=True)
