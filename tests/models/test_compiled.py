@@ -76,3 +76,22 @@ def test_kneed_steps_agree():
         assert np.max(np.abs(sa.x_end - sb.x_end)) < 1e-9
         ts = np.linspace(sa.t_start, sa.t_end, 9)
         assert np.max(np.abs(sa.sample(ts) - sb.sample(ts))) < 1e-9
+
+
+def test_a_fall_is_found_like_cyrk(paper_walker, paper_fixed_point):
+    """A start far off the gait falls within the first chunk of steps: the compiled backend
+    re-runs the crossing step with dense output and must find the same fall at the same
+    time. For this start (cell (0, 2) of an 80 x 80 basin of the paper walker) the re-run's
+    span rounded below twice its first step, CyRK refused the step, and the cell came out
+    ``stalled`` instead of ``fell_backward``."""
+    from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.sweep.basin import slice_state
+
+    x_star = np.asarray(paper_fixed_point.x, dtype=float)
+    x = slice_state(paper_walker, x_star, ("stance_angle", "stance_rate"),
+                    (-0.11185039149661627, -2.046040719984428))
+    a = integrate_step(paper_walker, x, Solver("DOP853", 1e-8, 1e-8, None, "cyrk"))
+    b = integrate_step(paper_walker, x, Solver("DOP853", 1e-8, 1e-8, None, "cyrk_compiled"))
+    assert a.termination == "fall"
+    assert b.termination == "fall", b.message
+    assert abs(a.t_end - b.t_end) < 1e-9

@@ -184,9 +184,10 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
         k, active = _first_crossing(values(T, Y), dirs) if T.size > 1 else (None, None)
         if k is not None:
             # the step T[k-1] -> T[k] again, with dense output (CyRK wants a first step of
-            # at most half the span: one more step follows, unused)
+            # at most half the span, so the span is 3 steps: T[k-1] + 2 hk can round below
+            # 2 hk, and CyRK then refuses the first step; the steps after it are unused)
             hk = T[k] - T[k - 1]
-            step, _, _, ok1, msg1, nf1 = _solve(addr, data, T[k - 1], T[k - 1] + 2 * hk,
+            step, _, _, ok1, msg1, nf1 = _solve(addr, data, T[k - 1], T[k - 1] + 3 * hk,
                                                  Y[k - 1, :m], method_int, rtol, atol, hmax, 0,
                                                  hk, True, n_extra)
             nfev += nf1
