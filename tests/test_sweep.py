@@ -75,6 +75,67 @@ def test_plan_chunks_runs_from_scene_value_and_skips_done(base):
     assert {i for c in left for i, _ in c} == set(range(4, 10))
 
 
+def test_plan_chunks_deals_a_long_run_out_interleaved(base):
+    ax = [parse_param("slope.angle_deg=2:5:0.25")]  # scene slope 3: runs 3..5 (9) and 2.75..2 (4)
+    chunks = plan_chunks(ax, base, workers=2)
+    vals = [[v[0] for _, v in c] for c in chunks]
+    # no chain longer than half the work: the 9-point run becomes 3, 3.5, ... and 3.25, 3.75, ...
+    assert vals == [[3.0, 3.5, 4.0, 4.5, 5.0], [3.25, 3.75, 4.25, 4.75], [2.75, 2.5, 2.25, 2.0]]
+    assert sorted(i for c in chunks for i, _ in c) == list(range(13))
+
+
+def test_continuation_matches_independent_fixed_points(scene, tmp_path):
+    """Secant predictor + the previous point's Jacobian (MINPACK hybrj) converge to the
+    fixed points and Floquet multipliers of independent searches from the scene's guess,
+    to well below the sweep's use (1e-9 rad, 1e-7), with fewer Poincare maps."""
+    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.models.registry import build_walker
+    from walkerlab.sweep.outcomes import state_column
+
+    slopes = np.round(np.arange(3.0, 3.31, 0.05), 10)
+    rows = _rows(sweep_stage.run(scene, ["slope.angle_deg=3:3.3:0.05"], "fixedpoint",
+                                 workers=1, runs_root=tmp_path, progress=False))
+    assert list(rows["param/slope.angle_deg"]) == list(slopes)
+    assert list(rows["outcome"]) == ["ok"] * 7
+    assert list(rows["guess_source"]) == ["scene"] + ["neighbour"] * 6
+    maps = []
+    for k, v in enumerate(slopes):
+        sc = apply_point(scene.model_dump(mode="json"), ["slope.angle_deg"], (float(v),))
+        w = build_walker(sc)
+        ref = find_fixed_point(w, sc.fixedpoint.initial_guess.as_array(w.state_names()),
+                               Solver.from_settings(sc.solver), xtol=sc.fixedpoint.tolerance,
+                               fd_check=False)
+        maps.append(ref.iterations)
+        x = [rows[state_column(n, u)][k] for n, u in zip(w.state_names(), w.state_units())]
+        assert np.max(np.abs(np.array(x) - ref.x)) < 1e-9
+        mult = rows["multiplier_0_re"][k] + 1j * rows["multiplier_0_im"][k]
+        assert abs(mult - ref.multipliers_variational[0]) < 1e-7
+        assert abs(rows["max_abs_multiplier"][k]
+                   - np.max(np.abs(ref.multipliers_variational))) < 1e-7
+    # from the third point on the predictor + Jacobian path runs: fewer maps than a cold start
+    assert np.median(rows["map_evaluations"][2:]) < np.median(maps[2:])
+
+
+def test_failed_point_and_bad_jacobian_do_not_poison_the_continuation(base):
+    from walkerlab.sweep.points import Continuation
+
+    cont = None
+    for v in (2.9, 3.0):
+        _, cont = evaluate("fixedpoint", base, ["slope.angle_deg"], (v,), 0, cont, {})
+    row, nxt = evaluate("fixedpoint", base, ["slope.angle_deg"], (0.0,), 0, cont, {})
+    assert row["outcome"] == "no_fixed_point" and nxt is None  # the caller keeps `cont`
+    ok, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.1,), 0, None, {})
+    row, nxt = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.1,), 0, cont, {})
+    assert row["outcome"] == "ok" and row["guess_source"] == "neighbour"
+    assert nxt.values == (3.0, 3.1) and abs(row["residual"]) < 1e-9
+    assert abs(row["step_period_s"] - ok["step_period_s"]) < 1e-9
+    # a useless Jacobian guess (zeros): hybrj fails or recovers, the plain search still wins
+    bad = Continuation(cont.values, cont.states, tuple(np.zeros_like(j) for j in cont.jacobians))
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (3.1,), 0, bad, {})
+    assert row["outcome"] == "ok" and abs(row["step_period_s"] - ok["step_period_s"]) < 1e-9
+
+
 # ----------------------------------------------------------------------------- outcomes
 def test_bad_value_is_an_invalid_config_row(scene, tmp_path):
     p = sweep_stage.run(scene, ["walker.leg_mass_from_foot_m=0.5,1.5",
@@ -98,7 +159,7 @@ def test_slope_zero_no_fixed_point_and_past_period_doubling(base):
     row, x = evaluate("fixedpoint", base, ["slope.angle_deg"], (5.0,), 1, None, {})
     assert row["outcome"] == "ok" and row["stable"] == 0.0
     assert row["multiplier_0_re"] < -1.0 and abs(row["multiplier_0_im"]) < 1e-12
-    assert x.shape == (4,)
+    assert x.x.shape == (4,)  # the continuation carries the fixed point on
 
 
 def test_far_initial_state_falls(base):
@@ -139,7 +200,7 @@ def test_tolerances_from_1e_3_to_1e_12(base):
         row, x = evaluate("fixedpoint", base, ["solver.rtol", "solver.atol"], (tol, tol), 0,
                           None, {})
         assert row["outcome"] in ("ok", "no_fixed_point"), row["message"]
-        xs[tol] = x if row["outcome"] == "ok" else None
+        xs[tol] = x.x if row["outcome"] == "ok" else None
     assert xs[1e-12] is not None and xs[1e-9] is not None
     assert np.max(np.abs(xs[1e-9] - xs[1e-12])) < 1e-6
     if xs[1e-3] is not None:

@@ -268,6 +268,10 @@ class SolverSettings(_Strict):
     rtol: float = Field(1e-10, gt=0, lt=1, description="relative tolerance [-]")
     atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
     max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
+    backend: Literal["auto", "scipy", "cyrk", "cyrk_compiled"] = Field(
+        "auto", description="library that integrates: auto (cyrk for RK23/RK45/DOP853, else "
+        "scipy), scipy, cyrk, or cyrk_compiled (CyRK with the flow compiled by numba: no "
+        "Python callbacks, ~1 s numba import per process; for many-point studies)")
 
 
 class ContactSolverSettings(_Strict):
@@ -409,6 +413,10 @@ class BasinSettings(_Strict):
     max_period: int = Field(8, ge=2, le=64, description="longest period looked for [steps]")
     rtol: float = Field(1e-8, gt=0, lt=1, description="integrator relative tolerance [-]")
     atol: float = Field(1e-8, gt=0, lt=1, description="integrator absolute tolerance")
+    backend: Literal["auto", "scipy", "cyrk", "cyrk_compiled"] = Field(
+        "auto", description="integrator library for the cells (DOP853), as "
+        "SolverSettings.backend; cyrk_compiled is slower here (most cells fall within a "
+        "step, so its fixed chunks overshoot, and each worker imports numba)")
     max_step_time_s: float | None = Field(
         None, gt=0, description="a step longer than this ends the cell as 'stalled' [s]; "
         "null = fixedpoint.max_step_time_s")

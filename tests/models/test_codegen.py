@@ -35,3 +35,19 @@ def test_flow_and_reset_jacobians_match_central_differences(case):
         assert np.max(np.abs(J - fd)) < 1e-7 * (1 + np.max(np.abs(J)))
         R = f["reset_jacobian"](x)
         assert np.max(np.abs(R - _central(f["reset"], x))) < 1e-7 * (1 + np.max(np.abs(R)))
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_variational_rhs_is_flow_and_jacobian_times_phi(case):
+    """``flow_variational(t, [x, Phi])`` evaluates the same expressions as ``flow`` and
+    ``flow_jacobian @ Phi``, only summed in another order: equal to round-off (1e-13
+    relative; entries are O(10), products of 4 terms)."""
+    s, p = CASES[case]
+    f = functions(WalkerData(s, p, 1.0, 1.0, p[0], p[2], {}))
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        x, Phi = rng.normal(size=4) * 0.3, rng.normal(size=(4, 4))
+        ref = np.concatenate([f["flow"](0.0, x), (f["flow_jacobian"](0.0, x) @ Phi).ravel()])
+        got = f["flow_variational"](0.0, np.concatenate([x, Phi.ravel()]))
+        assert got.shape == (20,)
+        assert np.max(np.abs(got - ref)) < 1e-13 * (1 + np.max(np.abs(ref)))

@@ -12,6 +12,12 @@ Integrators come from libraries, chosen by :class:`Solver` ``backend``:
   events, located like scipy's by Brent's method on the dense output (xtol = 4 eps).
   On the compass gait it takes exactly scipy's steps (same time and state at heel strike to
   round-off) 25-60 times faster: ``scripts/bench_integrators.py`` and the note of issue 10.
+- ``"cyrk_compiled"``: the same CyRK pairs with the phase's flow (and variational equations)
+  compiled by numba (:mod:`walkerlab.models.compiled`, cached on disk), so each phase runs in
+  C++ without Python callbacks; guards are located on the step points and by Brent's method
+  on the dense output (:mod:`walkerlab.analysis._compiled`).  Imports numba (about 1 s per
+  process): meant for many-point studies.  A phase without a compiled flow (a replaced flow)
+  falls back to ``cyrk``.
 - ``"auto"`` (default): ``cyrk`` for the methods it shares with scipy when it is installed,
   else ``scipy``.
 
@@ -74,7 +80,7 @@ class Solver:
         Relative and absolute tolerance.
     max_step_s : float or None
         Largest step [s].
-    backend : {"auto", "scipy", "cyrk"}
+    backend : {"auto", "scipy", "cyrk", "cyrk_compiled"}
         Library that integrates (see the module docstring).
     """
 
@@ -95,7 +101,7 @@ class Solver:
         return kw
 
     def resolved_backend(self) -> str:
-        """``"scipy"`` or ``"cyrk"``.
+        """``"scipy"``, ``"cyrk"`` or ``"cyrk_compiled"``.
 
         Raises
         ------
@@ -105,16 +111,16 @@ class Solver:
         if self.backend == "scipy":
             return "scipy"
         ok = self.method in CYRK_METHODS
-        if self.backend == "cyrk":
+        if self.backend in ("cyrk", "cyrk_compiled"):
             if not ok:
                 raise ValueError(f"solver.backend: cyrk integrates {', '.join(CYRK_METHODS)}, "
                                  f"not {self.method}")
             if not _have_cyrk():
                 raise ValueError("solver.backend: cyrk is not installed (pip install CyRK)")
-            return "cyrk"
+            return self.backend
         if self.backend != "auto":
             raise ValueError(f"solver.backend: unknown backend {self.backend!r} "
-                             "(auto | scipy | cyrk)")
+                             "(auto | scipy | cyrk | cyrk_compiled)")
         return "cyrk" if ok and _have_cyrk() else "scipy"
 
 
@@ -355,6 +361,8 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
                 out[:n] = _f(tt, xs)
                 out[n:] = (_A(tt, xs) @ y[n:].reshape(n, n)).ravel()
                 return out
+            if phase.variational is not None:  # the model's own, in one call
+                rhs = phase.variational
             y0 = np.concatenate([x, Phi.ravel()])
         else:
             rhs = phase.flow
@@ -365,7 +373,14 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         # those methods approximate it themselves)
         jac = (None if variational else phase.jacobian if phase.jacobian is not None
                else walker.variational)
-        run = _solve_phase(rhs, t, t_stop, y0, phase.guards, n, solver, backend, jac)
+        if backend == "cyrk_compiled" and phase.compiled is not None:
+            from walkerlab.analysis._compiled import solve_phase
+
+            run = _PhaseRun(*solve_phase(phase.compiled, variational, t, t_stop, y0,
+                                         phase.guards, n, solver))
+        else:
+            run = _solve_phase(rhs, t, t_stop, y0, phase.guards, n, solver,
+                               "cyrk" if backend == "cyrk_compiled" else backend, jac)
         nfev += run.nfev
         message = run.message
         pieces.append((phase, run.dense, (t, run.t_last)))

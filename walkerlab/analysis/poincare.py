@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.analysis.hybrid import Solver, integrate_step
+from walkerlab.analysis.hybrid import Solver, integrate_step, numeric_jacobian
 from walkerlab.models.base import HybridWalker
 
 
@@ -104,6 +104,9 @@ class FixedPointResult:
     nfev : int         RHS evaluations in total (search + Jacobians)
     iterations : int   map evaluations by the root finder
     wall_time_s : float
+    variational_maps : int
+        Maps with the variational equations: the one at the fixed point, plus any the root
+        finder asked for as a Jacobian
     stable : bool      all multipliers (variational) strictly inside the unit circle
     """
 
@@ -117,6 +120,7 @@ class FixedPointResult:
     nfev: int
     iterations: int
     wall_time_s: float
+    variational_maps: int = 1
 
     @property
     def stable(self) -> bool:
@@ -129,29 +133,40 @@ class FixedPointResult:
 
 def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xtol: float = 1e-12,
                      fd_step: float = 1e-7, max_step_time: float = 5.0,
-                     fd_check: bool = True) -> FixedPointResult:
+                     fd_check: bool = True,
+                     jacobian_guess: np.ndarray | None = None) -> FixedPointResult:
     """Find the period-1 fixed point of the Poincaré map and its Floquet multipliers.
 
-    The root finder is MINPACK's ``hybrd`` (``scipy.optimize.root``, method ``hybr``) on the
-    map reduced to the section, ``F(z) = section(P(from_section(z))) - z``, with its own
-    finite-difference start and rank-1 updates: on the compass gait one variational map costs
-    as much as ~30 plain maps (the augmented right-hand side is evaluated in Python), so
-    giving hybrj the variational Jacobian is slower (measured: 3 Jacobian calls instead of
-    3 extra plain maps).  ``DP`` is then computed once, by the variational equations, at the
-    fixed point.
+    The root finder is MINPACK (``scipy.optimize.root``, method ``hybr``) on the map reduced
+    to the section, ``F(z) = section(P(from_section(z))) - z``:
+
+    - without ``jacobian_guess``: ``hybrd``, with its own finite-difference start
+      (``2n - 1`` extra maps) and rank-1 (Broyden) updates;
+    - with ``jacobian_guess`` (``DP`` of a nearby fixed point, e.g. the previous point of a
+      continuation): ``hybrj`` starts from it and updates it by Broyden steps; only when
+      MINPACK asks for a Jacobian again (its updates stopped helping) is the true one
+      computed, by the variational equations at the current iterate.  One variational map
+      costs about five plain maps, so a stale Jacobian is never recomputed up front.
+
+    ``DP`` is then computed once, by the variational equations, at the fixed point.
+    Repeated evaluations at the same iterate (scipy evaluates ``F(z0)`` once to check its
+    shape, then MINPACK again) cost one map.
 
     Parameters
     ----------
     guess : ndarray, shape (2n,)
         Initial guess (projected on the guard surface through ``walker.section``).
     xtol : float
-        ``scipy.optimize.root`` (MINPACK hybrd) relative tolerance.
+        ``scipy.optimize.root`` (MINPACK hybrd/hybrj) relative tolerance.
     fd_step : float
         Step of the central finite-difference check of ``DP``.
     fd_check : bool
         Also compute ``DP`` by finite differences (``2 * 2n`` more map evaluations) and
         its multipliers, as an independent check of the variational equations.  Without it
         ``multipliers_fd``/``jacobian_fd`` are NaN.
+    jacobian_guess : ndarray, shape (2n, 2n), optional
+        Approximate Jacobian ``DP`` of the Poincaré map near the fixed point (full state,
+        as :attr:`FixedPointResult.jacobian_variational`).
 
     Returns
     -------
@@ -165,27 +180,61 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     from scipy.optimize import root
 
     t0 = time.perf_counter()
-    counter = {"nfev": 0, "calls": 0}
+    counter = {"nfev": 0, "calls": 0, "jacobians": 0}
+    last: dict = {}  # the last iterate's residual (z bytes -> F(z))
+    variational: dict = {}  # the last variational map asked as a Jacobian (z bytes -> map)
 
     def residual(z):
+        key = z.tobytes()
+        if key in last:
+            return last[key].copy()
         x = walker.from_section(z)
         counter["calls"] += 1
         try:
             xn, _, nf = poincare_map(walker, x, solver, max_step_time)
         except StepFailed:
-            return np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
-        counter["nfev"] += nf
-        return walker.section(xn) - z
+            r = np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
+        else:
+            counter["nfev"] += nf
+            r = walker.section(xn) - z
+        last.clear()
+        last[key] = r
+        return r.copy()
 
-    sol = root(residual, walker.section(np.asarray(guess, float)), method="hybr",
-               options={"xtol": xtol})
+    z0 = walker.section(np.asarray(guess, float))
+    if jacobian_guess is None:
+        sol = root(residual, z0, method="hybr", options={"xtol": xtol})
+    else:
+        start = {z0.tobytes(): _section_jacobian(walker, np.asarray(jacobian_guess, float),
+                                                 z0)}
+
+        def jacobian(z):
+            key = z.tobytes()
+            if key in start:  # the start: asked by scipy's shape check and by MINPACK
+                return start[key]
+            try:  # asked again: the updated guess stopped helping; the true one here
+                out = poincare_map(walker, walker.from_section(z), solver, max_step_time,
+                                   jacobian=True)
+            except StepFailed:
+                return next(iter(start.values()))
+            counter["nfev"] += out[3]
+            counter["jacobians"] += 1
+            variational.clear()
+            variational[key] = out  # MINPACK often stops at this iterate: DP is reused
+            return _section_jacobian(walker, out[2], z)
+
+        sol = root(residual, z0, method="hybr", jac=jacobian, options={"xtol": xtol})
     x = walker.from_section(sol.x)
-    try:
-        xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True)
-    except StepFailed as exc:
-        raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate ({exc})",
-                                 float("nan")) from None
-    counter["nfev"] += nf
+    if sol.x.tobytes() in variational:  # the Jacobian was last computed at the solution
+        xn, period, DP, _ = variational[sol.x.tobytes()]
+        counter["jacobians"] -= 1
+    else:
+        try:
+            xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True)
+        except StepFailed as exc:
+            raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate "
+                                     f"({exc})", float("nan")) from None
+        counter["nfev"] += nf
     res = float(np.max(np.abs(xn - x)))
     message = " ".join(str(sol.message).split())
     step = walker.points(x).get("swing_foot")
@@ -207,5 +256,15 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         multipliers_variational=sort_multipliers(np.linalg.eigvals(DP)),
         multipliers_fd=mult_fd, jacobian_variational=DP, jacobian_fd=Jfd,
         nfev=counter["nfev"] + nf2, iterations=counter["calls"],
-        wall_time_s=time.perf_counter() - t0,
+        wall_time_s=time.perf_counter() - t0, variational_maps=counter["jacobians"] + 1,
     )
+
+
+def _section_jacobian(walker: HybridWalker, DP: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Jacobian (2n-1, 2n-1) of ``F(z) = section(P(from_section(z))) - z`` from ``DP``
+    (2n, 2n), the section maps' Jacobians taken at ``from_section(z)`` (near a fixed point
+    ``P(x) = x``)."""
+    x = walker.from_section(z)
+    D_from = numeric_jacobian(walker.from_section, np.asarray(z, float))
+    D_sec = numeric_jacobian(walker.section, np.asarray(x, float))
+    return D_sec @ DP @ D_from - np.eye(z.size)

@@ -87,12 +87,23 @@ class Guard:
 
 @dataclass(frozen=True)
 class Phase:
-    """A continuous phase of a step: its flow and the guards active during it."""
+    """A continuous phase of a step: its flow and the guards active during it.
+
+    ``jacobian`` is ``(t, x) -> d flow / dx`` (2n, 2n); ``variational``, if given, is the
+    right-hand side of the variational equations in one call,
+    ``(t, [x, Phi.ravel()]) -> [flow(t, x), (jacobian(t, x) @ Phi).ravel()]`` (2n + 4n^2,).
+
+    ``compiled`` (optional) is a handle on the same flow compiled for CyRK's C++ integrators
+    (:class:`walkerlab.models.compiled.CompiledFlow`: ``address(variational)``, ``data()``),
+    used by the ``cyrk_compiled`` solver backend.
+    """
 
     name: str
     flow: Flow
     guards: tuple[Guard, ...]
     jacobian: Callable[[float, np.ndarray], np.ndarray] | None = None
+    variational: Callable[[float, np.ndarray], np.ndarray] | None = None
+    compiled: object | None = None
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ Generated functions (``x`` is the role-ordered state ``[q, dq]``, shape (2n,)):
 ==================  ==========================================================================
 ``flow(t, x)``      ``[dq, qdd]`` with ``M qdd = -C dq - G`` (2n,)
 ``flow_jacobian``   ``(t, x) -> d flow / dx`` (2n, 2n), for variational equations / stiff solvers
+``flow_variational`` ``(t, [x, Phi]) -> [flow, (d flow / dx) Phi]`` (2n + 4n^2,), row-major Phi
 ``reset(x)``        heel-strike impact and role swap (2n,)
 ``reset_jacobian``  ``x -> d reset / dx`` (2n, 2n)
 ``guard_<name>``    ``(t, x) -> float``; ``grad_<name>(x)`` its gradient (2n,)
@@ -123,7 +124,14 @@ def _array(rows) -> str:
     return "np.array((" + ", ".join(rows) + ",))"
 
 
-def _flow(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
+def _flow(eq: Equations, jac: bool, name: str | None = None,
+          variational: str | None = None, parts: bool = False):
+    """``flow``, or with ``jac`` its Jacobian; with ``variational`` (a name) also the
+    right-hand side of the variational equations from the same lines,
+    ``(t, y) -> [flow(x), (flow_jacobian(x) @ Phi).ravel()]`` for ``y = [x, Phi.ravel()]``
+    (the Jacobian's entries are never put into an array, its identity rows are copies).
+    ``parts``: ``(body lines, outputs)`` instead, the outputs being the 2n expressions (flow)
+    or 2n rows of 2n (Jacobian), for :func:`generate_compiled`."""
     n = len(eq.q)
     q, dq = eq.q, eq.dq
     r = -eq.C * sp.Matrix(dq) - eq.G
@@ -145,6 +153,8 @@ def _flow(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     name = name or ("flow_jacobian" if jac else "flow")
     head = [f"    def {name}(t, x):", _unpack(eq)]
     if not jac:
+        if parts:
+            return lines, [str(s) for s in dq] + qdd
         return head + lines + [f"{IND}return {_array([str(s) for s in dq] + qdd)}"]
     k0 = n * n + n
     dM = red[k0:k0 + n ** 3]
@@ -169,7 +179,25 @@ def _flow(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
         rows[i][n + i] = "1.0"
     for i in range(n):
         rows.append([f"({cols[c][i]})" for c in range(2 * n)])
-    return head + lines + [f"{IND}return {_array(rows)}"]
+    if parts:
+        return lines, rows
+    out = head + lines + [f"{IND}return {_array(rows)}"]
+    if variational:
+        N = 2 * n
+        names = ", ".join(str(v) for v in (*q, *dq))
+        head = [f"    def {variational}(t, y):",
+                f"{IND}_y = y.tolist() if hasattr(y, 'tolist') else list(y)",
+                f"{IND}{names}, = _y[:{N}]", f"{IND}_P = _y[{N}:]"]
+        ret = [str(v) for v in dq] + qdd
+        for i in range(n):  # d q / dt = dq: rows of Phi
+            ret += [f"_P[{(n + i) * N + k}]" for k in range(N)]
+        for i in range(n):
+            nz = [c for c in range(N) if cols[c][i] != "0.0"]
+            lines += [f"{IND}_J{i}_{c} = {cols[c][i]}" for c in nz]
+            ret += [" + ".join(f"_J{i}_{c} * _P[{c * N + k}]" for c in nz) or "0.0"
+                    for k in range(N)]
+        out += head + lines + [f"{IND}return {_array(ret)}"]
+    return out
 
 
 def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
@@ -320,14 +348,15 @@ def generate(eq: Equations, param_names, key: str) -> str:
     _PARAMS.clear()
     _PARAMS.update(eq.params)
     _COUNT[0] = 0
-    fast = [*_flow(eq, False), *_flow(eq, True), *_reset(eq, False), *_reset(eq, True),
-            *_guards(eq)]
+    fast = [*_flow(eq, False), *_flow(eq, True, variational="flow_variational"),
+            *_reset(eq, False), *_reset(eq, True), *_guards(eq)]
     if eq.locked is not None:  # kneed walker: knee-locked flow and the knee strike
         lk = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
         q_lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, len(eq.q)))])
         kn = replace(eq, Mi=eq.knee_impact[0], B=eq.knee_impact[1], relabel_q=q_lock,
                      relabel_rate=sp.eye(len(eq.q)))
-        fast += [*_flow(lk, False, "flow_locked"), *_flow(lk, True, "flow_locked_jacobian"),
+        fast += [*_flow(lk, False, "flow_locked"),
+                 *_flow(lk, True, "flow_locked_jacobian", variational="flow_locked_variational"),
                  *_reset(kn, False, "knee_reset"), *_reset(kn, True, "knee_reset_jacobian")]
     body = [
         "def make(p):",
@@ -356,6 +385,87 @@ def generate(eq: Equations, param_names, key: str) -> str:
         "from math import sin, cos, tan, sqrt  # noqa: F401",
         "import numpy  # noqa: F401",
         "import numpy as np",
+        "",
+    ]
+    return "\n".join(head + body) + "\n"
+
+
+def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational: bool,
+           guards: tuple[list[str], list]) -> list[str]:
+    """A numba ``cfunc`` ``(dy, t, y, d)`` (CyRK's ``cyjit_sig``) writing the flow (and with
+    ``variational`` the product ``A Phi`` of the flow Jacobian with ``y[2n:]``, row-major
+    (2n, 2n)) into ``dy``, then the guard values (CyRK's extra outputs); ``d`` holds the
+    constants, then a call counter."""
+    m = 2 * len(eq.q)
+    names = [str(s) for s in (*eq.q, *eq.dq)]
+    out = ["@cfunc(SIG, cache=True, error_model='numpy')",
+           f"def {name}(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
+    out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
+    (fl, fo) = parts[0]
+    out += [ln[4:] for ln in fl]
+    out += [f"    dy[{i}] = {e}" for i, e in enumerate(fo)]
+    if variational:
+        jl, rows = parts[1]
+        out += [ln[4:] for ln in jl]
+        for i in range(m):
+            for j in range(m):
+                terms = []
+                for k in range(m):
+                    a = rows[i][k].strip("()")
+                    if a in ("0", "0.0"):
+                        continue
+                    phi = f"y[{m + k * m + j}]"
+                    terms.append(phi if a == "1.0" else f"({a}) * {phi}")
+                out.append(f"    dy[{m + i * m + j}] = {' + '.join(terms) or '0.0'}")
+    k0 = m + m * m if variational else m
+    out += [ln[4:] for ln in guards[0]]
+    out += [f"    dy[{k0 + j}] = {_PY.doprint(e)}" for j, e in enumerate(guards[1])]
+    out.append(f"    d[{len(consts)}] += 1.0")
+    return out
+
+
+def generate_compiled(eq: Equations, param_names, key: str) -> str:
+    """Source of the compiled module of a walker: numba ``cfunc`` right-hand sides for CyRK's
+    C++ integrators (``CyRK.nb.numba_solver.cyjit_sig``), ``cache=True``.
+
+    Defines ``constants(p) -> ndarray (NCONST + 1,)`` (the parameters, the parameter-only
+    subexpressions and a zeroed call counter: the data vector of every cfunc), ``NCONST``,
+    ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
+    ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
+    ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
+    of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  The
+    equations are those of :func:`generate` (same expressions, same key).
+    """
+    _HOISTED.clear()
+    _PARAMS.clear()
+    _PARAMS.update(eq.params)
+    _COUNT[0] = 0
+    flows = {"flow": eq}
+    if eq.locked is not None:
+        flows["flow_locked"] = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
+    parts = {k: (_flow(e, False, parts=True), _flow(e, True, parts=True))
+             for k, e in flows.items()}
+    guards = _cse_lines(list(eq.guards.values()), _PY)
+    consts = list(param_names) + [h.split("=")[0].strip() for h in _HOISTED]
+    body = ["def constants(p):",
+            f"    {', '.join(param_names)}, = p",
+            *_HOISTED,
+            f"    return np.array(({', '.join(consts)}, 0.0), dtype=np.float64)",
+            "", f"NCONST = {len(consts)}",
+            f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", ""]
+    for k, e in flows.items():
+        body += _cfunc(k, e, consts, parts[k], False, guards) + [""]
+        body += _cfunc(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
+    head = [
+        f"# walkerlab compiled model code (walkerlab.models.codegen); key {key}",
+        "# Do not edit: regenerated when the walker description or the generator changes.",
+        "from math import sin, cos, tan, sqrt  # noqa: F401",
+        "import numpy as np",
+        "from numba import cfunc, types",
+        "",
+        "SIG = types.void(types.CPointer(types.float64), types.float64,",
+        "                 types.CPointer(types.float64), types.CPointer(types.float64))",
         "",
     ]
     return "\n".join(head + body) + "\n"

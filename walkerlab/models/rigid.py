@@ -37,6 +37,7 @@ from functools import partial
 
 from walkerlab.models.base import Guard, HybridWalker, Phase
 from walkerlab.models.cache import generated_module
+from walkerlab.models.compiled import CompiledFlow
 from walkerlab.models.description import WalkerData
 
 LEGS = ("leg1", "leg2")
@@ -85,6 +86,15 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     HybridWalker
     """
     f = functions(data)
+    # the compiled flow is the generated one: none when the flow is replaced
+    generated_flow = flow is None and flow_jacobian is None
+    # the generated variational right-hand side belongs to the generated flow only
+    var = f.get("flow_variational") if generated_flow else None
+
+    def compiled(name, *guards):  # guards: (generated guard, offset) of each Phase guard
+        if generated_flow:
+            return CompiledFlow(data.structure, tuple(data.params), name, guards)
+        return None
     flow = flow or f["flow"]
     fall = Guard("fall", f["guard_hip_height"], -1, "fall", gradient=f["grad_hip_height"])
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
@@ -98,16 +108,26 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
                 Guard("swing_foot_scuffs", partial(_below, f["guard_swing_clearance"],
                                                    SCUFF_DEPTH * data.leg_length_m), -1, "fall",
                       f["grad_swing_clearance"]), fall),
-                jacobian=f["flow_jacobian"]),
+                jacobian=f["flow_jacobian"], variational=var,
+                compiled=compiled("flow", ("knee_extension", 0.0),
+                                  ("swing_clearance", SCUFF_DEPTH * data.leg_length_m),
+                                  ("hip_height", 0.0))),
             Phase("locked_swing", f["flow_locked"], (
                 heel, falls_back, Guard("swing_foot_scuffs", ahead, +1, "fall", dahead), fall),
-                jacobian=f["flow_locked_jacobian"]),
+                jacobian=f["flow_locked_jacobian"],
+                variational=f.get("flow_locked_variational"),
+                compiled=compiled("flow_locked", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
+                                  ("swing_foot_ahead", 0.0), ("hip_height", 0.0))),
         )
     else:
         early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead),
-                                            fall), jacobian=flow_jacobian or f["flow_jacobian"])
+                                            fall), jacobian=flow_jacobian or f["flow_jacobian"],
+                      variational=var,
+                      compiled=compiled("flow", ("swing_foot_ahead", 0.0), ("hip_height", 0.0)))
         late = Phase("late_swing", flow, (heel, falls_back, fall),
-                     jacobian=flow_jacobian or f["flow_jacobian"])
+                     jacobian=flow_jacobian or f["flow_jacobian"], variational=var,
+                     compiled=compiled("flow", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
+                                       ("hip_height", 0.0)))
         phases = (early, late)
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,

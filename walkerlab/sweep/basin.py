@@ -195,7 +195,7 @@ def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     from walkerlab.analysis.hybrid import Solver
 
     walker, st, max_step_time = _walker_and_settings(task.base)
-    solver = Solver("DOP853", st.rtol, st.atol)
+    solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
     x_star = np.asarray(task.x_star, dtype=float)
     out = []
     for idx, vx, vy in task.cells:

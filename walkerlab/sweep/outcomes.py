@@ -37,6 +37,8 @@ _FP = {
     "max_abs_multiplier": ("-", "largest |Floquet multiplier|"),
     "stable": ("-", "1 if all |multipliers| < 1, else 0"),
     "map_evaluations": ("-", "Poincare-map calls of the root finder"),
+    "variational_maps": ("-", "maps with the variational equations (Jacobians asked by the "
+                         "root finder + the one for the multipliers)"),
     "nfev": ("-", "right-hand-side evaluations"),
 }
 
@@ -82,7 +84,8 @@ STRING_COLUMNS = {
     "outcome": "typed outcome (see walkerlab.sweep.outcomes)",
     "message": "human-readable detail (exception text, solver message, guard name)",
     "fall_leg": "physical leg in stance when the walker fell ('' if none)",
-    "guess_source": "fixed-point guess used: 'neighbour' (continuation), 'scene', or ''",
+    "guess_source": "fixed-point guess used: 'neighbour' (continuation from the chunk's "
+                    "previous fixed points), 'scene', or ''",
 }
 
 STAGES = tuple(COLUMNS)

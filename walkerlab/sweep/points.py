@@ -1,9 +1,10 @@
 """Evaluate sweep points: one function per swept stage, and the chunk runner workers call.
 
-Each point function takes a validated :class:`~walkerlab.config.Scene`, the fixed point of
-the previous point of the same chunk (continuation guess, or ``None``) and the sweep
-options, and returns ``(columns, next_guess)``.  :func:`run_chunk` wraps them so that every
-point ends in a typed outcome (:mod:`walkerlab.sweep.outcomes`), whatever happens.
+Each point function takes a validated :class:`~walkerlab.config.Scene`, the fixed points of
+the previous points of the same chunk (a :class:`Continuation`, or ``None``) and the sweep
+options, and returns ``(columns, fixed point result or None)``.  :func:`run_chunk` wraps
+them so that every point ends in a typed outcome (:mod:`walkerlab.sweep.outcomes`),
+whatever happens.
 
 The contact-sim point goes through :func:`contact_adapter`, the only place that knows the
 calling convention of :func:`walkerlab.contact.simulate.simulate_contact` (that model is being
@@ -28,8 +29,9 @@ from walkerlab.config import Scene, SceneError
 from walkerlab.sweep.outcomes import empty_row, state_column
 from walkerlab.sweep.params import apply_point
 
-__all__ = ["Task", "run_chunk", "fixedpoint_point", "simulate_point", "contact_point",
-           "contact_adapter", "ideal_fixed_point", "DEFAULT_OPTIONS", "POINT_FUNCTIONS"]
+__all__ = ["Task", "Continuation", "run_chunk", "fixedpoint_point", "simulate_point",
+           "contact_point", "contact_adapter", "ideal_fixed_point", "DEFAULT_OPTIONS",
+           "POINT_FUNCTIONS"]
 
 DEFAULT_OPTIONS: dict[str, Any] = {
     "scuff_limit_m": None,   # rigid model: report 'scuffing' if the swing foot dips deeper [m]
@@ -81,18 +83,88 @@ def _solver(scene: Scene):
     return Solver.from_settings(scene.solver)
 
 
+@dataclass(frozen=True)
+class Continuation:
+    """What a chunk's next point takes from the fixed points before it (picklable, small).
+
+    Attributes
+    ----------
+    values : tuple of float or None
+        Continuation-axis value of each kept fixed point, oldest first (at most two; ``None``
+        when the axis is not numeric, and then no extrapolation is done).
+    states : tuple of ndarray (2n,)
+        The fixed points (role-ordered state just after heel strike).
+    jacobians : tuple of ndarray (2n, 2n)
+        ``DP`` at each fixed point (variational equations).
+    target : float or None
+        Continuation-axis value of the point to predict (set by :meth:`aimed`).
+    """
+
+    values: tuple = ()
+    states: tuple = ()
+    jacobians: tuple = ()
+    target: float | None = None
+
+    def aimed(self, value) -> Continuation:
+        """This continuation, set to predict the point at ``value`` (``target``)."""
+        return Continuation(self.values, self.states, self.jacobians, _real(value))
+
+    @property
+    def x(self) -> np.ndarray:
+        """The last fixed point (2n,)."""
+        return self.states[-1]
+
+    def then(self, value, res) -> Continuation:
+        """This continuation with the fixed point ``res`` (a FixedPointResult) at ``value``
+        appended (only the last two are kept)."""
+        v = _real(value)
+        keep = slice(-1, None) if self.values and self.values[-1] is not None \
+            and v is not None else slice(0, 0)
+        return Continuation(self.values[keep] + (v,), self.states[keep] + (np.asarray(res.x),),
+                            self.jacobians[keep] + (np.asarray(res.jacobian_variational),))
+
+    def predict(self) -> tuple[np.ndarray, np.ndarray]:
+        """Guess of the fixed point and of ``DP`` at ``target``: secant (linear)
+        extrapolation from the last two fixed points of the chunk, or the last one.
+
+        Returns
+        -------
+        x : ndarray (2n,)
+        DP : ndarray (2n, 2n)
+        """
+        v = self.target
+        if len(self.values) < 2 or v is None or self.values[0] == self.values[1]:
+            return self.states[-1], self.jacobians[-1]
+        (v0, v1), (x0, x1), (J0, J1) = self.values, self.states, self.jacobians
+        s = (v - v1) / (v1 - v0)
+        return x1 + s * (x1 - x0), J1 + s * (J1 - J0)
+
+
+def _real(value) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        return None
+    v = float(value)
+    return v if math.isfinite(v) else None
+
+
 _FP_CACHE: dict[tuple, Any] = {}
 
 
-def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | None = None):
+def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     """Period-1 fixed point of the scene's rigid walker, trying the continuation guess first.
+
+    Tries, in order: the continuation's predicted fixed point and Jacobian (MINPACK hybrj
+    from the extrapolated ``DP``), the previous fixed point itself (hybrd), the scene's
+    ``fixedpoint.initial_guess`` (hybrd); the first that converges to a walking gait wins.
 
     Parameters
     ----------
     scene : Scene
         Needs a ``fixedpoint`` section (its ``initial_guess`` is the fallback guess).
-    guess : ndarray (4,) or None
-        Neighbour's fixed point (role-ordered state just after heel strike).
+    guess : Continuation, ndarray (2n,) or None
+        The chunk's previous fixed points (aimed at this point, see
+        :meth:`Continuation.aimed`), or a neighbour's fixed point (role-ordered state just
+        after heel strike).
 
     Returns
     -------
@@ -116,14 +188,21 @@ def ideal_fixed_point(scene: Scene, guess: np.ndarray | None, options: dict | No
                        "initial guess of the fixed point)")
     walker = build_walker(scene)
     solver = _solver(scene)
-    tries = ([("neighbour", np.asarray(guess, float))] if guess is not None else []) \
-        + [("scene", fp.initial_guess.as_array(walker.state_names()))]
+    tries = []
+    if isinstance(guess, Continuation) and guess.states:
+        x_pred, J_pred = guess.predict()
+        if x_pred.shape == guess.x.shape == (len(walker.state_names()),):
+            tries += [("neighbour", x_pred, J_pred), ("neighbour", guess.x, None)]
+    elif guess is not None:
+        tries.append(("neighbour", np.asarray(guess, float), None))
+    tries.append(("scene", fp.initial_guess.as_array(walker.state_names()), None))
     best, msg = math.inf, ""
-    for source, g in tries:
+    for source, g, J in tries:
         try:
             # the sweep keeps the variational multipliers only: no finite-difference check
             res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
-                                   max_step_time=fp.max_step_time_s, fd_check=False)
+                                   max_step_time=fp.max_step_time_s, fd_check=False,
+                                   jacobian_guess=J)
         except FixedPointNotFound as exc:
             if not (exc.residual >= best):  # keeps NaN out unless nothing better
                 best = exc.residual if math.isfinite(exc.residual) else best
@@ -164,7 +243,8 @@ def _fp_columns(walker, res) -> dict:
         cols[f"multiplier_{k}_re"], cols[f"multiplier_{k}_im"] = float(z.real), float(z.imag)
     cols.update(step_period_s=float(res.period_s), residual=float(res.residual),
                 max_abs_multiplier=float(np.max(np.abs(mult))), stable=float(res.stable),
-                map_evaluations=float(res.iterations), nfev=float(res.nfev))
+                map_evaluations=float(res.iterations),
+                variational_maps=float(res.variational_maps), nfev=float(res.nfev))
     return cols
 
 
@@ -177,14 +257,14 @@ def fixedpoint_point(scene: Scene, guess, options: dict):
     cols : dict
         Columns of :data:`walkerlab.sweep.outcomes.COLUMNS` ``["fixedpoint"]``, ``outcome``
         ``ok`` and ``guess_source``.
-    next_guess : ndarray (4,)
-        The fixed point, for the next point of the chunk.
+    fixed_point : FixedPointResult
+        For the next point of the chunk (continuation).
     """
     walker, res, source = ideal_fixed_point(scene, guess, options)
     cols = _fp_columns(walker, res)
     cols.update(outcome="ok", guess_source=source,
                 message="" if res.stable else "unstable period-1 gait (|multiplier| >= 1)")
-    return cols, res.x
+    return cols, res
 
 
 def _scuff_depth(walker, seg, n: int = 64) -> float:
@@ -215,7 +295,7 @@ def simulate_point(scene: Scene, guess, options: dict):
     next_guess = None
     if sim.initial_state == "fixed_point":
         walker, res, source = ideal_fixed_point(scene, guess, options)
-        x0, next_guess = res.x, res.x
+        x0, next_guess = res.x, res
         cols["guess_source"] = source
     else:
         walker = build_walker(scene)
@@ -342,7 +422,7 @@ def contact_point(scene: Scene, guess, options: dict):
         raise _Outcome("max_steps", f"stalled: {res.walked_steps} of {n_steps} heel strikes by "
                        f"t = {res.t[-1]:.4g} s", **cols)
     cols["outcome"] = "ok"
-    return cols, fp.x
+    return cols, fp
 
 
 POINT_FUNCTIONS: dict[str, Callable] = {
@@ -360,8 +440,10 @@ def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: 
     row : dict
         All columns of the stage (NaN / ``""`` where not applicable), ``index``,
         ``outcome``, ``message``, ``wall_time_s``.
-    next_guess : ndarray (4,) or None
-        Continuation guess for the next point (``None`` after a failure).
+    next_guess : Continuation or None
+        ``guess`` (a :class:`Continuation`) with this point's fixed point appended, for the
+        next point of the chunk (``None`` after a failure or without a fixed point: the
+        caller keeps the previous one, so a failed point never enters the extrapolation).
     """
     row = empty_row(stage, index)
     t0 = time.perf_counter()
@@ -375,8 +457,12 @@ def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: 
             warnings.simplefilter("always")
         try:
             scene = apply_point(base, list(paths), tuple(values), origin)
-            cols, next_guess = POINT_FUNCTIONS[stage](scene, guess, options)
+            cont = guess if isinstance(guess, Continuation) else None
+            start = cont.aimed(values[0]) if cont is not None and cont.states else guess
+            cols, fp = POINT_FUNCTIONS[stage](scene, start, options)
             row.update(cols)
+            if fp is not None:
+                next_guess = (cont or Continuation()).then(values[0], fp)
         except SceneError as exc:
             row.update(outcome="invalid_config", message=str(exc))
         except _Outcome as exc:
@@ -422,21 +508,19 @@ def run_chunk(task: Task) -> list[dict]:
 
 
 def warm_up() -> None:
-    """Build the lambdified model functions once (called in fresh worker processes) and
-    import the integration and root-finding libraries, so that processes forked from the
-    forkserver start warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise)."""
+    """Import the root-finding and integration libraries once (called in fresh worker
+    processes and in the forkserver), so that processes forked from the forkserver start
+    warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise).  CyRK comes through
+    :mod:`walkerlab.analysis.cyrk_loader` (its ``pysolve_ivp`` without numba, ~0.2 s less);
+    the model code is built per scene by the points themselves (cached on disk)."""
     try:
         import scipy.optimize  # noqa: F401
 
         from walkerlab.analysis.hybrid import _have_cyrk
 
         if _have_cyrk():
-            import CyRK  # noqa: F401
-    except Exception:  # noqa: BLE001 - warming is an optimisation only
-        pass
-    try:
-        from walkerlab.models.derivation import compass_gait_functions
+            from walkerlab.analysis.cyrk_loader import pysolve_ivp
 
-        compass_gait_functions()
+            pysolve_ivp()
     except Exception:  # noqa: BLE001 - warming is an optimisation only
         pass

@@ -2,9 +2,17 @@
 
 Chunks are *runs along the first axis*: for every combination of the other axes the points
 of the first axis are evaluated in order by one worker, so each point can start its
-fixed-point search from its neighbour's fixed point (continuation).  When the base scene's
-own value of the first parameter lies inside the axis, a line is split there into an
-upward run and a downward run, both starting next to the scene's initial guess.
+fixed-point search from its neighbours' fixed points (continuation: secant predictor and
+the previous Jacobian, :class:`walkerlab.sweep.points.Continuation`).  When the base
+scene's own value of the first parameter lies inside the axis, a line is split there into
+an upward run and a downward run, both starting next to the scene's initial guess.
+
+Balance: all chains run at once (each has one piece in flight), so the workers stay busy
+while there are at least as many unfinished chains as workers; the sweep's wall time is
+then about ``max(total / workers, longest chain)``.  A run longer than ``total / workers``
+is therefore dealt out *interleaved* into ``k`` chains (points ``0, k, 2k, ...``,
+``1, k+1, ...``): each still starts next to the scene's guess and continues in steps of
+``k`` grid points, so no chain needs a guess far from the anchor.
 
 Executors
 ---------
@@ -17,8 +25,11 @@ Executors
 Progress and robustness (issue 12)
 ----------------------------------
 - A chunk is cut into *pieces* of at most :data:`PIECE_POINTS` points; the next piece of a
-  chunk is submitted when the previous one returns, with its last fixed point as the guess,
-  so continuation is unchanged while rows reach the file every few points (D12).
+  chunk is submitted when the previous one returns, with its continuation state, so
+  continuation is unchanged while rows come back every few points (D12).  They are written
+  to the file after the first piece and then at least every :data:`FLUSH_EVERY_S` seconds
+  (one HDF5 append of every column costs the main process ~25 ms of CPU, taken from the
+  workers on a 2-core machine), and on an interruption.
 - Local pool workers watch the main process and exit within about a second when it dies,
   even by SIGKILL (D7); the forkserver and resource tracker then exit on their own.
 - The grid is capped at :data:`MAX_GRID_POINTS` points (product of the axes, D3).
@@ -53,10 +64,11 @@ from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, evaluate, run_chunk, w
 from walkerlab.sweep.store import SweepStore, complete_sweep, partial_path
 
 __all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "iter_piece_results",
-           "run_piece", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS"]
+           "run_piece", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
 
 MAX_GRID_POINTS = 1_000_000   # a larger grid is refused (product of the axes' lengths)
-PIECE_POINTS = 4              # rows are saved at least every this many points per chunk
+PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
+FLUSH_EVERY_S = 0.5           # rows are written to the partial file at least this often [s]
 
 
 @contextmanager
@@ -106,7 +118,9 @@ def plan_chunks(axes: list[ParamAxis], base: dict, done: set[int] | frozenset = 
     done : set of int
         Indices already computed (resume); they are left out.
     chunk_size : int, optional
-        Longest chunk; default: whole runs, halved until there are at least ``workers``.
+        Longest chunk (consecutive points); default: whole runs, a run of ``m`` points
+        longer than ``t = ceil(total / workers)`` dealt out interleaved into
+        ``ceil(m / t)`` chains.
     workers : int
 
     Returns
@@ -135,12 +149,9 @@ def plan_chunks(axes: list[ParamAxis], base: dict, done: set[int] | frozenset = 
                 runs.append(r)
     if chunk_size is not None:
         runs = [r[k:k + chunk_size] for r in runs for k in range(0, len(r), max(1, chunk_size))]
-    else:
-        while 0 < len(runs) < workers and max(len(r) for r in runs) > 1:
-            runs.sort(key=len)
-            r = runs.pop()
-            h = (len(r) + 1) // 2
-            runs += [r[:h], r[h:]]
+    elif workers > 1 and runs:
+        target = math.ceil(sum(len(r) for r in runs) / workers)
+        runs = [r[j::k] for r in runs for k in [math.ceil(len(r) / target)] for j in range(k)]
     runs.sort(key=len, reverse=True)
     return [[(i, pts[i]) for i in r] for r in runs]
 
@@ -350,8 +361,8 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
     progress : bool
         Show a rich progress bar.
     on_chunk : callable(done_points, total_points), optional
-        Called after each piece's rows are written (raising ``KeyboardInterrupt`` there simulates
-        an interruption).
+        Called after rows are written: after the first piece, then at least every
+        :data:`FLUSH_EVERY_S` (raising ``KeyboardInterrupt`` there simulates an interruption).
     pool : bool, optional
         Force a process pool even for one worker (True) or run in this process (False);
         default: a pool when ``workers > 1``.
@@ -425,22 +436,40 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
     bar = Progress(TextColumn(f"sweep {stage}"), BarColumn(), MofNCompleteColumn(),
                    TimeElapsedColumn(), TimeRemainingColumn(), TextColumn("{task.fields[stats]}"),
                    disable=not progress, transient=False)
-    n_done = len(done)
+    n_done = n_written = len(done)
+    pending: list[dict] = []
+    last_write = -math.inf
+
+    def write() -> None:
+        nonlocal pending, last_write, n_written
+        store.append(pending, values_of)
+        n_written += len(pending)
+        pending, last_write = [], time.perf_counter()
+
     try:
         with bar:
             tid = bar.add_task("points", total=n_total, completed=n_done, stats="")
             for rows in iter_piece_results(chains, workers, scheduler, pool=pool):
-                store.append(rows, values_of)
+                pending += rows
                 n_done += len(rows)
                 for r in rows:
                     counts[r["outcome"]] = counts.get(r["outcome"], 0) + 1
                 bar.update(tid, completed=n_done,
                            stats=" ".join(f"{k}:{v}" for k, v in counts.items() if v))
-                if on_chunk is not None:
-                    on_chunk(n_done, n_total)
+                if n_done == n_total or time.perf_counter() - last_write >= FLUSH_EVERY_S:
+                    write()
+                    if on_chunk is not None:
+                        on_chunk(n_written, n_total)
     except BaseException:
+        if pending and store.f.id.valid:
+            try:
+                write()  # rows computed before the interruption are kept for --resume
+            except Exception:  # noqa: BLE001 - the original error is the one to report
+                pass
         store.add_wall_time(time.perf_counter() - t0)
         store.close()
         raise
+    if pending:  # an executor that stopped early (the rows it gave are kept)
+        write()
     store.add_wall_time(time.perf_counter() - t0)
     return store.finalize(n_total)

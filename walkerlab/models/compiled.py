@@ -1,0 +1,115 @@
+"""Compiled right-hand sides of a walker's flow: numba ``cfunc``s for CyRK's C++ integrators.
+
+The source comes from :func:`walkerlab.models.codegen.generate_compiled` (the same symbolic
+equations as the Python module of :mod:`walkerlab.models.cache`) and is cached next to it as
+``<key>_nb.py`` (same key, same sha256 header check, atomic write).  It is imported as a real
+module so that numba's own disk cache (``cache=True``, in ``__pycache__`` of the same folder)
+keeps the machine code: a new process pays the numba import and a cache load, not a compile.
+
+numba and CyRK are imported only when :meth:`CompiledFlow.address` is first called (the
+``cyrk_compiled`` solver backend); building a walker does not import them.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from walkerlab.models import cache
+
+_modules: dict[str, object] = {}
+
+
+def compiled_module(structure):
+    """The imported compiled module of ``structure`` (generated on a cache miss).
+
+    Raises
+    ------
+    ImportError
+        numba is not installed.
+    """
+    key = cache.cache_key(structure)
+    if key in _modules:
+        return _modules[key]
+    path = cache.cache_dir() / f"{key}_nb.py"
+    ok = False
+    try:
+        first, body = path.read_text().split("\n", 1)
+        ok = first == f"# sha256 {cache._digest(body)}"
+    except (OSError, ValueError, UnicodeDecodeError):
+        pass
+    if not ok:
+        from walkerlab.models import codegen, symbolic
+
+        body = codegen.generate_compiled(symbolic.derive(structure), structure.param_names, key)
+        cache._write(path, body)
+        if not path.is_file():  # read-only cache folder: a private temporary copy
+            import tempfile
+
+            tmp = tempfile.mkdtemp(prefix="walkerlab_nb_")
+            path = type(path)(tmp) / path.name
+            path.write_text(f"# sha256 {cache._digest(body)}\n{body}")
+    name = f"walkerlab_compiled_{key}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod
+    spec.loader.exec_module(mod)
+    _modules[key] = mod
+    return mod
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledFlow:
+    """Handle on the compiled flow of one phase (built by the model layer, compiled lazily).
+
+    Attributes
+    ----------
+    structure : Structure
+        Walker structure (the cache key).
+    params : tuple of float
+        Parameter vector (``structure.param_names`` order).
+    name : str
+        ``"flow"`` or ``"flow_locked"`` (kneed walker, knee locked).
+    guards : tuple of (str, float), optional
+        For each guard of the phase, in order: the generated guard it is and a constant added
+        to it (``Guard.function = guard_<name> + offset``); the guards are then evaluated in
+        the cfunc (extra outputs).  None: the integrator calls the Python guards.
+    """
+
+    structure: object
+    params: tuple
+    name: str = "flow"
+    guards: tuple | None = None
+    _memo: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def address(self, variational: bool = False) -> int:
+        """C address of the cfunc ``(dy, t, y, d)``: the flow (2n outputs) or, with
+        ``variational``, the flow and ``A(x) Phi`` (``2n + (2n)^2`` outputs, ``Phi``
+        row-major in ``y[2n:]``)."""
+        k = (self.name, variational)
+        if k not in self._memo:
+            mod = compiled_module(self.structure)
+            fn = getattr(mod, f"{self.name}_variational" if variational else self.name)
+            self._memo[k] = fn.address
+        return self._memo[k]
+
+    def data(self) -> np.ndarray:
+        """A fresh data vector (constants, then a zeroed call counter as the last entry)."""
+        if "data" not in self._memo:
+            self._memo["data"] = compiled_module(self.structure).constants(self.params)
+        return self._memo["data"].copy()
+
+    def guard_columns(self) -> tuple[int, np.ndarray, np.ndarray] | None:
+        """``(n_extra, columns, offsets)``: how many extra outputs the cfuncs write and, for
+        each guard of the phase, its column among them and its offset; None without
+        :attr:`guards`."""
+        if self.guards is None:
+            return None
+        if "guards" not in self._memo:
+            names = compiled_module(self.structure).GUARDS
+            self._memo["guards"] = (len(names), np.array([names.index(g) for g, _ in self.guards]),
+                                    np.array([float(o) for _, o in self.guards]))
+        return self._memo["guards"]
