@@ -40,10 +40,14 @@ def save(fig, folder: Path, stem: str) -> list[Path]:
     folder = Path(folder)
     out = []
     try:
+        # the tight bounding box (what bbox_inches="tight" finds: a tick and text layout
+        # pass as long as a draw) once for both files instead of once per file
+        bbox = fig.get_tightbbox(fig.canvas.get_renderer()).padded(
+            matplotlib.rcParams["savefig.pad_inches"])
         for ext in ("png", "svg"):
             p = folder / f"{stem}.{ext}"
             atomic_write(p, lambda fh, ext=ext: fig.savefig(fh, format=ext, dpi=150,
-                                                            bbox_inches="tight"))
+                                                            bbox_inches=bbox))
             out.append(p)
     finally:
         plt.close(fig)

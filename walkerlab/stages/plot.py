@@ -32,8 +32,20 @@ def load_trajectories(scene: Scene, runs_root: Path | str) -> dict:
     return out
 
 
-def run(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
+#: figure groups and the stage artifacts each is drawn from
+PARTS = {"trajectories": ("simulate", "contact-sim", "compare"),
+         "workprecision": ("workprecision",)}
+
+
+def run(scene: Scene, runs_root: Path | str = "runs",
+        parts: tuple[str, ...] = tuple(PARTS)) -> list[Path]:
     """Draw every figure the scene's artifacts support.
+
+    Parameters
+    ----------
+    parts : tuple of str
+        Figure groups (:data:`PARTS`): the trajectory figures (Figs. 2, 6-10) and the
+        work-precision diagrams.
 
     Returns
     -------
@@ -43,10 +55,19 @@ def run(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     Raises
     ------
     StageError
-        No trajectory artifact exists yet.
+        Trajectory figures asked for and no trajectory artifact exists yet.
     """
     from walkerlab.plotting import figures as F  # matplotlib: only when drawing
 
+    written: list[Path] = []
+    if "trajectories" in parts:
+        written += _trajectory_figures(scene, runs_root, F)
+    if "workprecision" in parts:
+        written += _workprecision_figures(scene, runs_root, F)
+    return written
+
+
+def _trajectory_figures(scene: Scene, runs_root, F) -> list[Path]:
     trajs = load_trajectories(scene, runs_root)
     if not trajs:
         raise StageError(f"plot: no simulate.h5 or contact_sim.h5 under "
@@ -70,8 +91,33 @@ def run(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
             err = {n: g[f"coordinates/{n}"][()] for n in names}
             units = {n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names}
         written += F.save(F.fig8_errors(t, err, units, "contact - ideal"), out_dir, "fig8_errors")
+    written += _drop_figure(scene, runs_root, out_dir, F)
+    return written
+
+
+def _drop_figure(scene: Scene, runs_root, out_dir: Path, F) -> list[Path]:
+    """Restitution against stiffness (the drop test stored in ``contact_sim.h5``), the
+    figure the report's contact section embeds."""
+    p = artifact_path(scene, runs_root, "contact-sim")
+    if not p.is_file() or scene.contact is None:
+        return []
+    with open_artifact(p, "contact-sim") as f:
+        if "drop_test" not in f:
+            return []
+        g = f["drop_test"]
+        ks, unit = g["stiffness"][()], str(g["stiffness"].attrs["unit"])
+        curves = {fam: g[f"{fam}/restitution"][()] for fam in ("paper", "rigid_limit")}
+    from walkerlab.plotting.sweep_figures import restitution_figure
+
+    fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness))
+    return F.save(fig, out_dir, "drop_restitution")
+
+
+def _workprecision_figures(scene: Scene, runs_root, F) -> list[Path]:
+    written: list[Path] = []
     wp_path = artifact_path(scene, runs_root, "workprecision")
     if wp_path.is_file():
+        out_dir = figures_dir(scene, runs_root, claim=True)
         with open_artifact(wp_path, "workprecision") as f:
             for model in f:
                 g = f[model]

@@ -9,6 +9,7 @@ section skips that (expensive) stage.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 
@@ -22,42 +23,189 @@ REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecis
                  "bifurcation")
 
 
+class _Study:
+    """The work-precision stage in a thread of the report, overlapping the untimed stages.
+
+    Its timed cases run in worker processes pinned to their own cores
+    (:class:`walkerlab.stages.workprecision.Lanes`).  With two cores, the first core's lane
+    starts at once; this process (every thread of it) stays on the second core for the
+    untimed stages and figures, and that core's lane starts at :meth:`release`.  The
+    contact model's cases wait until its compiled kernels are in numba's on-disk cache
+    (:meth:`ready`), so no worker compiles them a second time.  With more cores this process
+    keeps a core of its own; with one, the study runs after the other stages, in this
+    process, as before.
+
+    Created before the fixed point: when the study has no artifact yet (a first run), the
+    first lane's worker process starts at once and imports its libraries on its core while
+    this process finds the fixed point; :meth:`start` (after the fixed point) starts the
+    study itself.
+    """
+
+    def __init__(self, scene: Scene, runs_root, force: bool, workers: int = 2):
+        import threading
+
+        from walkerlab.stages import workprecision
+
+        self.scene, self.runs_root, self.force = scene, runs_root, force
+        cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
+        self.lanes = None
+        self._affinity = None
+        self.outcome = self.error = None
+        self.thread = None
+        if len(cores) < 2:
+            return
+        lanes = cores[:workers]
+        mine = cores[workers] if len(cores) > workers else lanes[-1]
+        self.lanes = workprecision.Lanes(cores=lanes)
+        if mine in lanes:
+            self.lanes.gates[mine] = threading.Event()
+        if scene.contact is not None:
+            self.lanes.pending["contact"] = threading.Event()
+        first_run = not artifact_path(scene, runs_root, "workprecision").is_file()
+        self._affinity = set(cores)
+        os.sched_setaffinity(0, {mine})  # threads started later inherit it
+        try:
+            if first_run:
+                self.lanes.workers = {c: workprecision.start_worker(c) for c in lanes
+                                      if c not in self.lanes.gates}
+        except BaseException:
+            self.release(cancel=True)
+            raise
+        self.thread = threading.Thread(target=self._run, name="workprecision", daemon=True)
+
+    def start(self) -> None:
+        """Start the study (the fixed-point artifact must exist)."""
+        if self.thread is not None:
+            self.thread.start()
+
+    def _run(self):
+        from walkerlab.stages import workprecision
+
+        try:
+            self.outcome = workprecision.run(self.scene, self.runs_root, self.force,
+                                             lanes=self.lanes)
+        except BaseException as exc:  # noqa: BLE001 - re-raised by join()
+            self.error = exc
+
+    def needs(self, model: str) -> bool:
+        """Whether the study has ``model`` cases to measure (waits until it knows: a reused
+        stage or fully cached cases need none, and then nothing is warmed up)."""
+        if self.lanes is None or model not in self.lanes.pending:
+            return False
+        while not self.lanes.todo_known.wait(0.02):
+            if not self.thread.is_alive():
+                return False
+        return model in self.lanes.todo_models
+
+    def ready(self, model: str) -> None:
+        """``model``'s compiled code is on disk: its cases may start."""
+        if self.lanes is not None and model in self.lanes.pending:
+            self.lanes.pending[model].set()
+
+    def release(self, cancel: bool = False) -> None:
+        """This process is done with its core: the core's lane starts (``cancel``: no new
+        case is started at all)."""
+        if self.lanes is None:
+            return
+        if cancel:
+            self.lanes.cancel.set()
+        for ev in (*self.lanes.gates.values(), *self.lanes.pending.values()):
+            ev.set()
+        if self._affinity is not None:
+            os.sched_setaffinity(0, self._affinity)
+            self._affinity = None
+
+    def join(self) -> StageOutcome:
+        """The stage's outcome (runs it here when there is no second core)."""
+        if self.thread is None:
+            from walkerlab.stages import workprecision
+
+            return workprecision.run(self.scene, self.runs_root, self.force)
+        if self.thread.ident is not None:  # started
+            self.thread.join()
+        for ex in self.lanes.workers.values():  # started but never used
+            ex.shutdown(wait=True, cancel_futures=True)
+        self.lanes.workers.clear()
+        if self.error is not None:
+            raise self.error
+        return self.outcome
+
+
 def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome]:
     from walkerlab.stages import fixedpoint, simulate
 
     done: list[StageOutcome] = []
-    if scene.fixedpoint is not None:
-        done.append(fixedpoint.run(scene, runs_root, force, compare_variants=True))
-    if scene.simulate is not None:
-        done.append(simulate.run(scene, runs_root, force))
-    if scene.contact is not None:
-        from walkerlab.stages import contact_sim
+    drawn: list[str] = []
+    study = (_Study(scene, runs_root, force)
+             if getattr(scene, "workprecision", None) is not None else None)
+    try:
+        if scene.fixedpoint is not None:
+            done.append(fixedpoint.run(scene, runs_root, force, compare_variants=True))
+        if study is not None:
+            study.start()
+        if study is not None and study.needs("contact"):
+            from walkerlab.stages import workprecision
 
-        done.append(contact_sim.run(scene, runs_root, force))
+            workprecision.warm_up(scene, runs_root, "contact")  # numba compiles here, once
+            study.ready("contact")
         if scene.simulate is not None:
-            from walkerlab.stages import compare
+            done.append(simulate.run(scene, runs_root, force))
+        if scene.contact is not None:
+            from walkerlab.stages import contact_sim
 
-            done.append(compare.run(scene, runs_root, force))
-    if getattr(scene, "workprecision", None) is not None:
-        from walkerlab.stages import workprecision
+            done.append(contact_sim.run(scene, runs_root, force))
+            if scene.simulate is not None:
+                from walkerlab.stages import compare
 
-        done.append(workprecision.run(scene, runs_root, force))
+                done.append(compare.run(scene, runs_root, force))
+        if any(o.stage in ("simulate", "contact-sim") for o in done):
+            drawn.append(_draw(scene, runs_root, force, "trajectories"))
+    except BaseException:
+        if study is not None and study.thread is not None:
+            study.release(cancel=True)
+            try:
+                study.join()
+            except BaseException:  # noqa: BLE001 - the first error is the one to report
+                pass
+        raise
+    if study is not None:
+        study.release()
+        done.append(study.join())
+        drawn.append(_draw(scene, runs_root, force, "workprecision"))
     for o in done:
         echo(f"{o.stage:>13s}: " + ("reused (inputs unchanged)" if o.reused
                                     else f"computed in {o.wall_time_s:.2f} s") + f" -> {o.path}")
+    for line in drawn:
+        echo(line)
     return done
 
 
-def _figures_key(scene: Scene, runs_root) -> tuple[Path, str]:
-    """Stamp file of the drawn figures and the key they must match: the stored input hashes
-    of the artifacts they are drawn from and walkerlab's code (a rerun with nothing changed
-    does not redraw: matplotlib and ~16 PNG/SVG files are most of a rerun's time)."""
+def _draw(scene: Scene, runs_root, force: bool, part: str) -> str:
+    """Draw one figure group (:data:`walkerlab.stages.plot.PARTS`) unless it was drawn from
+    the same artifacts by the same code; returns the line to print."""
+    from walkerlab.stages import plot
+
+    stamp, key = _figures_key(scene, runs_root, part)
+    if not force and stamp.is_file() and stamp.read_text() == key:
+        return f"{'plot':>13s}: {part} figures reused (artifacts and code unchanged)"
+    figs = plot.run(scene, runs_root, parts=(part,))
+    stamp.parent.mkdir(parents=True, exist_ok=True)
+    stamp.write_text(key)
+    return f"{'plot':>13s}: {part}, {len([p for p in figs if p.suffix == '.png'])} figures"
+
+
+def _figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
+    """Stamp file of a drawn figure group and the key it must match: the stored input
+    hashes of the artifacts it is drawn from and walkerlab's code (a rerun with nothing
+    changed does not redraw: matplotlib and ~16 PNG/SVG files are most of a rerun's time)."""
     import json
 
     from walkerlab.io.artifacts import code_hash, stored_hash
+    from walkerlab.stages.plot import PARTS
 
-    arts = {stage: str(stored_hash(p)) for stage, p in existing_artifacts(scene, runs_root).items()}
-    return (figures_dir(scene, runs_root) / ".drawn_from",
+    arts = {stage: str(stored_hash(p)) for stage, p in existing_artifacts(scene, runs_root).items()
+            if stage in PARTS[part]}
+    return (figures_dir(scene, runs_root) / f".drawn_from_{part}",
             json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True))
 
 
@@ -80,18 +228,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     Path
         The HTML report.
     """
-    from walkerlab.stages import plot
-
     done = _run_stages(scene, runs_root, force, echo)
-    if any(o.stage in ("simulate", "contact-sim") for o in done):
-        stamp, key = _figures_key(scene, runs_root)
-        if not force and stamp.is_file() and stamp.read_text() == key:
-            echo("         plot: reused (artifacts and code unchanged)")
-        else:
-            figs = plot.run(scene, runs_root)
-            stamp.parent.mkdir(parents=True, exist_ok=True)
-            stamp.write_text(key)
-            echo(f"         plot: {len([p for p in figs if p.suffix == '.png'])} figures")
     rep_dir = report_dir(scene, runs_root, claim=True)
     return write_report(scene, existing_artifacts(scene, runs_root), rep_dir,
                         figures_dir(scene, runs_root), done)

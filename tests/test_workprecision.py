@@ -1,0 +1,58 @@
+"""The work-precision study as the report runs it: overlapped lanes, per-case cache, reuse."""
+
+import os
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from walkerlab.config import load_scene
+from walkerlab.io.artifacts import open_artifact
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _scene(tmp_path, **wp):
+    """The paper's walker, ideal model only, with a two-method, two-tolerance study."""
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    for k in ("contact", "terrain", "contact_sim", "contact_solver"):
+        d.pop(k, None)
+    d["simulate"]["strides"] = 1
+    d["workprecision"] = {"methods": ["RK45", "Radau"], "rtols": [1e-3, 1e-6], "repeats": 2,
+                          "strides": 1, "models": ["ideal"], **wp}
+    p = tmp_path / "wp_small.yaml"
+    p.write_text(yaml.safe_dump(d))
+    return load_scene(p)
+
+
+def test_report_study_measures_every_case_once_and_reuses_it(tmp_path):
+    from walkerlab.stages import report
+
+    runs = tmp_path / "runs"
+    affinity = os.sched_getaffinity(0)
+    lines: list[str] = []
+    html = report.run(_scene(tmp_path), runs, echo=lines.append)
+    assert os.sched_getaffinity(0) == affinity  # the report's own pinning is undone
+    assert any(s.strip().startswith("workprecision: computed") for s in lines)
+    wp = html.parents[1] / "workprecision.h5"
+    with open_artifact(wp, "workprecision") as f:
+        g = f["ideal"]
+        assert str(g.attrs["reference_method"]).endswith("DOP853")
+        for m in ("RK45", "Radau"):
+            err, rep = g[f"{m}/error"][()], g[f"{m}/repeats"][()]
+            # every tolerance ran; a 1000x tighter rtol is more accurate by > 10x
+            assert np.all(np.isfinite(err)) and err[1] < 0.1 * err[0]
+            assert set(rep) <= {1, 2}
+        methods = [m for m in g if hasattr(g[m], "keys")]  # scipy's, plus CyRK RK45
+        assert f.attrs["cases_total"] == 1 + 2 * len(methods)  # + the reference
+        assert f.attrs["cases_reused_from_cache"] == 0
+    assert (html.parent / "figures" / "work_precision_ideal.png").is_file()
+    # a rerun reuses the stage and both figure groups
+    lines.clear()
+    report.run(_scene(tmp_path), runs, echo=lines.append)
+    assert any("workprecision: reused" in s for s in lines)
+    assert sum("figures reused" in s for s in lines) == 2
+    # another target error: the stage reruns, every case comes from the case cache
+    report.run(_scene(tmp_path, target_error=1e-6), runs, echo=lambda s: None)
+    with open_artifact(wp, "workprecision") as f:
+        assert f.attrs["cases_reused_from_cache"] == f.attrs["cases_total"]
