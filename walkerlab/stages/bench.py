@@ -22,6 +22,7 @@ noted (the machine may be shared: compare runs side by side, e.g. with ``farm-be
 
 from __future__ import annotations
 
+import gc
 import json
 import os
 import platform
@@ -67,6 +68,11 @@ def bench_ideal(repeats: int = 7) -> dict:
     for backend in ("cyrk", "scipy"):
         s = Solver("DOP853", 1e-10, 1e-10, None, backend)
         simulate_steps(w, fp.x, 10, s)  # warm (imports)
+        # as the sweep/work-precision workers do: the loaded libraries' objects are not
+        # traversed by the cyclic GC in every timed run (without this the first dozen runs
+        # of a process take ~1.8x longer, which a 7-run median sees)
+        gc.collect()
+        gc.freeze()
         t, c = [], []
         for _ in range(repeats):
             t0, c0 = time.perf_counter(), time.process_time()
