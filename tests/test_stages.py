@@ -193,3 +193,30 @@ def test_cli_bad_scene_is_one_line(tmp_path):
     r = CliRunner().invoke(app, ["fixedpoint", str(p), "--runs-dir", str(tmp_path)])
     assert r.exit_code == 1
     assert r.output.strip().count("\n") == 0 and "bad.yaml" in r.output
+
+
+def test_saved_figure_is_not_cropped(tmp_path):
+    """``plotting.figures.save`` computes the tight box once for PNG and SVG; for a
+    constrained-layout figure that box must be the one after the layout (as
+    ``bbox_inches="tight"`` finds it), else tick labels and colorbars are cut off."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from walkerlab.plotting.figures import save
+
+    def make():
+        fig, axes = plt.subplots(1, 2, figsize=(8, 3), layout="constrained")
+        im = axes[1].imshow([[0, 1], [2, 3]])
+        fig.colorbar(im, ax=axes[1], label="steps")
+        axes[0].set_ylabel("stance rate [rad/s]")
+        return fig
+
+    (png,) = [p for p in save(make(), tmp_path, "ours") if p.suffix == ".png"]
+    ref = make()
+    ref.savefig(tmp_path / "ref.png", dpi=150, bbox_inches="tight")
+    plt.close(ref)
+    h, w = plt.imread(png).shape[:2]
+    hr, wr = plt.imread(tmp_path / "ref.png").shape[:2]
+    assert abs(w - wr) <= 2 and abs(h - hr) <= 2, ((w, h), (wr, hr))

@@ -41,7 +41,10 @@ def save(fig, folder: Path, stem: str) -> list[Path]:
     out = []
     try:
         # the tight bounding box (what bbox_inches="tight" finds: a tick and text layout
-        # pass as long as a draw) once for both files instead of once per file
+        # pass as long as a draw) once for both files instead of once per file; the layout
+        # engine (constrained_layout) must have run first, else the box is the pre-layout
+        # one and crops tick labels and colorbars
+        fig.draw_without_rendering()
         bbox = fig.get_tightbbox(fig.canvas.get_renderer()).padded(
             matplotlib.rcParams["savefig.pad_inches"])
         for ext in ("png", "svg"):
