@@ -26,7 +26,7 @@ import numpy as np
 
 from . import _kernels as K
 
-__all__ = ["CYRK_METHODS", "pack", "solve_chunk"]
+__all__ = ["CYRK_METHODS", "solve_chunk"]
 
 #: walkerlab method name -> CyRK method name.  Only BDF pays on the contact walker (bench,
 #: /work/notes/s3-ccontact.md): CyRK's LSODA needs ~1.3x the RHS calls of numbalsoda's, its
@@ -35,8 +35,6 @@ __all__ = ["CYRK_METHODS", "pack", "solve_chunk"]
 #: ~ -1e5 1/s).
 CYRK_METHODS = {"cyrk_bdf": "BDF"}
 
-#: Offsets in the packed data vector: lane sizes n1, n2, then P.
-D_N1, D_N2, D_P = 0, 1, 2
 _FPTR = None
 
 
@@ -45,26 +43,12 @@ def _build() -> int:
     from CyRK.nb.numba_solver import cyjit_sig
     from numba import carray, cfunc
 
-    npar = K.NPAR
-
     @cfunc(cyjit_sig, cache=True)
     def rhs_c(dy, t, y, p):  # pragma: no cover - runs compiled
-        n1 = int(p[D_N1])
-        n2 = int(p[D_N2])
-        a1 = D_P + npar  # start of c1
-        a2 = a1 + n1  # start of c2
-        d = carray(p, (a2 + n2 + 1,))
-        r = K.rhs(carray(y, (8,)), d[D_P:a1], d[a1:a2], d[a2:a2 + n2])
-        for i in range(8):
-            dy[i] = r[i]
-        d[a2 + n2] += 1.0  # nfev counter
+        K.rhs_packed(carray(y, (8,)), carray(p, (K.packed_size(p),)), carray(dy, (8,)))
 
     return rhs_c.address
 
-
-def pack(P: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
-    """Data vector ``[n1, n2, P, c1, c2, nfev=0]`` (float64) for :func:`solve_chunk`."""
-    return np.concatenate([[len(c1), len(c2)], P, c1, c2, [0.0]]).astype(np.float64)
 
 
 def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
@@ -79,7 +63,7 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     t_eval : ndarray (n,)
         Increasing sample times [s]; the first is the start time.
     data : ndarray
-        From :func:`pack`.
+        From :func:`walkerlab.contact._kernels.pack`.
     rtol : float
     atol : float or ndarray (8,)
         [m, rad, m/s, rad/s].

@@ -201,6 +201,37 @@ def rhs(x, P, c1, c2):
     return out
 
 
+#: Data vector handed to the compiled integrators (``_cyrk``, ``_lsoda``) through a C
+#: pointer: ``[n1, n2, P (NPAR), c1 (n1), c2 (n2), nfev]``; these are the offsets of the
+#: lane sizes and of P.
+D_N1, D_N2, D_P = 0, 1, 2
+
+
+def pack(P: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
+    """Data vector ``[n1, n2, P, c1, c2, nfev=0]`` (float64) for :func:`rhs_packed`."""
+    return np.concatenate([[len(c1), len(c2)], P, c1, c2, [0.0]]).astype(np.float64)
+
+
+@njit(cache=True)
+def packed_size(p):
+    """Length of the data vector (see :func:`pack`) whose lane sizes are ``p[D_N1]``,
+    ``p[D_N2]`` (``p`` may be a raw pointer in a cfunc)."""
+    return D_P + NPAR + int(p[D_N1]) + int(p[D_N2]) + 1
+
+
+@njit(cache=True)
+def rhs_packed(y, d, dy):
+    """:func:`rhs` of the state ``y`` (8,) with the lanes and parameters unpacked from the
+    data vector ``d`` (see :func:`pack`), written into ``dy`` (8,); counts the call in
+    ``d[-1]``."""
+    a1 = D_P + NPAR  # start of c1
+    a2 = a1 + int(d[D_N1])  # start of c2
+    r = rhs(y, d[D_P:a1], d[a1:a2], d[a2:d.size - 1])
+    for i in range(8):
+        dy[i] = r[i]
+    d[d.size - 1] += 1.0
+
+
 @njit(cache=True)
 def jac(x, P, c1, c2):
     """Analytic Jacobian d(rhs)/dx (8, 8) of the free-floating walker.

@@ -47,7 +47,7 @@ except (ImportError, OSError):  # pragma: no cover - broken install
 lsoda = None if _DRIVER is None else _DRIVER.lsoda_wrapper
 lsoda_sig = None if _DRIVER is None else _DRIVER.lsoda_sig
 
-__all__ = ["MissingNumbalsoda", "available", "pack", "solve_chunk"]
+__all__ = ["MissingNumbalsoda", "available", "solve_chunk"]
 
 
 class MissingNumbalsoda(ValueError, ImportError):
@@ -56,8 +56,6 @@ class MissingNumbalsoda(ValueError, ImportError):
 
 
 _FPTR = None
-#: Offsets in the packed data vector: lane sizes n1, n2, then P.
-D_N1, D_N2, D_P = 0, 1, 2
 
 
 def available() -> bool:
@@ -68,26 +66,12 @@ def available() -> bool:
 def _build():
     from numba import carray, cfunc
 
-    npar = K.NPAR
-
     @cfunc(lsoda_sig, cache=True)
     def rhs_c(t, u, du, p):  # pragma: no cover - runs compiled
-        n1 = int(p[D_N1])
-        n2 = int(p[D_N2])
-        a1 = D_P + npar  # start of c1
-        a2 = a1 + n1  # start of c2
-        d = carray(p, (a2 + n2 + 1,))
-        r = K.rhs(carray(u, (8,)), d[D_P:a1], d[a1:a2], d[a2:a2 + n2])
-        for i in range(8):
-            du[i] = r[i]
-        d[a2 + n2] += 1.0  # nfev counter
+        K.rhs_packed(carray(u, (8,)), carray(p, (K.packed_size(p),)), carray(du, (8,)))
 
     return rhs_c.address
 
-
-def pack(P: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
-    """Data vector ``[n1, n2, P, c1, c2, nfev=0]`` (float64) for :func:`solve_chunk`."""
-    return np.concatenate([[len(c1), len(c2)], P, c1, c2, [0.0]]).astype(np.float64)
 
 
 def solve_chunk(x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray, rtol: float,

@@ -424,9 +424,9 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
             raise ValueError("contact_solver.max_step_s is not supported by method numbalsoda")
         if not np.isscalar(atol):
             raise ValueError("method numbalsoda needs a scalar atol")
-        data = _lsoda.pack(P, c1, c2)
+        data = K.pack(P, c1, c2)
     elif method in _cyrk.CYRK_METHODS:
-        data = _cyrk.pack(P, c1, c2)
+        data = K.pack(P, c1, c2)
 
     def odeint_chunk(xs, tg):
         """odeint from ``xs`` at ``tg[0]``: (t, X) at the samples reached after ``tg[0]``,
