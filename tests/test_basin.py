@@ -86,3 +86,68 @@ def test_basin_stage_artifact_and_resume(tmp_path, paper_walker, paper_fixed_poi
     assert np.all(outcome != NOT_DONE)
     assert (runs / sc.name / "report" / "figures" / "basin.png").is_file()
     assert basin.run(sc, runs, workers=1).reused
+
+
+def _simplest(tmp_path, **basin):
+    d = yaml.safe_load((ROOT / "configs" / "schwab_wisse2001.yaml").read_text())
+    d["basin"].update(basin)
+    p = tmp_path / "sw.yaml"
+    p.write_text(yaml.safe_dump(d))
+    return load_scene(p)
+
+
+def test_heel_strike_cells_of_the_simplest_walker(tmp_path):
+    """``basin.start: heel_strike`` gives Schwab & Wisse's cells: for the simplest walker the
+    post-impact states satisfy phi = 2 theta and phi-dot = (1 - cos 2 theta) theta-dot
+    (Garcia et al. 1998, heel-strike equations, written here independently of the model's
+    generated reset), and the cell at the fixed point's values is the fixed point."""
+    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.models.registry import build_walker
+    from walkerlab.sweep.basin import heel_strike_slice, pre_impact_fixed_point
+
+    sc = _simplest(tmp_path)
+    w = build_walker(sc)
+    names = w.state_names()
+    th, ph, thd, phd = (names.index(n) for n in ("stance_angle", "hip_angle", "stance_rate",
+                                                   "hip_rate"))
+    fp = find_fixed_point(w, sc.fixedpoint.initial_guess.as_array(names),
+                          Solver("DOP853", 1e-12, 1e-12), max_step_time=20.0,
+                          fd_check=False).x
+    pre = pre_impact_fixed_point(w, fp, sc.basin, 20.0)
+    hs = heel_strike_slice(w, pre, ("stance_angle", "stance_rate"))
+    np.testing.assert_allclose(hs.state(w, (fp[th], fp[thd])), fp, atol=1e-9)
+    for a, r in ((0.05, -0.5), (0.2, -0.1), (0.35, -0.3), (0.15, 0.0)):
+        x = hs.state(w, (a, r))
+        assert x is not None
+        np.testing.assert_allclose([x[th], x[thd]], [a, r], atol=1e-12)
+        assert abs(x[ph] - 2 * a) < 1e-12
+        assert abs(x[phd] - (1 - np.cos(2 * a)) * r) < 1e-12
+    # the heel strike ties the hip angle to the stance angle: not a 2-D slice
+    with pytest.raises(BasinError, match="relation"):
+        heel_strike_slice(w, pre, ("stance_angle", "hip_angle"))
+
+
+def test_heel_strike_basin_of_the_simplest_walker_is_thin(tmp_path):
+    """Schwab & Wisse (2001): the basin is "a small, thin area".  On a coarse 40 x 40 grid over
+    their window (theta 0-0.4, theta-dot -0.6-0) the cell holding x* converges, under 2 % of
+    the cells do (0.6 % measured), the rest fall, and the converged cells lie along a line:
+    the standard deviations of their positions along and across it differ by > 8x (21.7x
+    measured)."""
+    from walkerlab.stages import basin
+
+    sc = _simplest(tmp_path, grid=[40, 40])
+    out = basin.run(sc, tmp_path / "runs", workers=1)
+    from walkerlab.io.artifacts import open_artifact
+
+    with open_artifact(out.path, "basin") as f:
+        o, x, y = f["outcome"][()], f["x"][()], f["y"][()]
+        assert f.attrs["start"] == "heel_strike"
+        fp = (f["fixed_point/stance_angle"][()], f["fixed_point/stance_rate"][()])
+    conv = o == CODE["converged"]
+    assert conv[np.argmin(abs(y - fp[1])), np.argmin(abs(x - fp[0]))]
+    assert 5 <= conv.sum() < 0.02 * o.size
+    assert np.all(conv | np.isin(o, [CODE["fell_forward"], CODE["fell_backward"]]))
+    jy, ix = np.nonzero(conv)
+    ev = np.linalg.eigvalsh(np.cov(np.c_[x[ix], y[jy]].T))
+    assert np.sqrt(ev[1] / ev[0]) > 8

@@ -420,6 +420,13 @@ class BasinSettings(_Strict):
     max_step_time_s: float | None = Field(
         None, gt=0, description="a step longer than this ends the cell as 'stalled' [s]; "
         "null = fixedpoint.max_step_time_s")
+    start: Literal["fixed_point", "heel_strike"] = Field(
+        "fixed_point", description="how a cell's other coordinates are set: 'fixed_point' = "
+        "from x* (then projected on the heel-strike surface); 'heel_strike' = the cell is a "
+        "state just after a heel strike, the heel-strike image of a pre-impact state on the "
+        "guard that differs from x*'s pre-impact state in the two coordinates the axes depend "
+        "on most (Schwab & Wisse 2001; for the simplest walker, whose post-impact states form "
+        "a 2-D set, the cell is then unique); a cell no heel strike reaches is 'unreachable'")
 
 
 class Scene(_Strict):

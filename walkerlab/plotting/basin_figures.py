@@ -9,6 +9,7 @@ import numpy as np
 OUTCOME_COLORS = {
     "converged": "#2ca02c", "other_attractor": "#9467bd", "fell_forward": "#d62728",
     "fell_backward": "#1f77b4", "max_steps": "#ff7f0e", "stalled": "#7f7f7f",
+    "unreachable": "#e8e8e8",
 }
 
 
@@ -25,6 +26,7 @@ def load_basin(path: Path) -> dict:
         d["fixed_point"] = {n: float(f[f"fixed_point/{n}"][()]) for n in names}
         d["scene"] = str(f.attrs.get("scene_name", "")) if "scene_name" in f.attrs else ""
         d["max_steps"] = int(f["settings/max_steps"][()])
+        d["start"] = str(f.attrs.get("start", "fixed_point"))
     return d
 
 
@@ -69,7 +71,9 @@ def basin_figure(d: dict, title: str = ""):
                      label=f"{n.replace('_', ' ')} ({100 * np.mean(out == i):.1f} %)")
                for i, n in enumerate(names) if np.any(out == i)]
     ax.legend(handles=handles, fontsize=7, loc="best", framealpha=0.85)
-    ax.set_title(f"outcome after at most {d['max_steps']} steps ({n_cells} cells)",
+    start = ("cells: states just after a heel strike" if d.get("start") == "heel_strike"
+             else "other coordinates from the fixed point")
+    ax.set_title(f"outcome after at most {d['max_steps']} steps ({n_cells} cells)\n{start}",
                  fontsize=10)
     ax = axes[1]
     conv = names.index("converged") if "converged" in names else -1

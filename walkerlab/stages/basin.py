@@ -109,6 +109,7 @@ def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_ch
         f.attrs["model"] = walker.name
         f.attrs["state_names"] = names
         f.attrs["x_axis"], f.attrs["y_axis"] = st.x_axis, st.y_axis
+        f.attrs["start"] = st.start
         f.attrs["outcomes"] = list(OUTCOMES)
         f.attrs["axis_order"] = "outcome[j, i]: j along y_axis, i along x_axis"
         coordinate(f, "x", res["x"], unit[st.x_axis], f"cell centres, {st.x_axis}")

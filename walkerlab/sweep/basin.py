@@ -3,9 +3,17 @@
 Schwab & Wisse (2001), "Basin of attraction of the simplest walking model", ASME DETC 2001:
 start the walker from every cell of a grid of post-heel-strike states, iterate the Poincaré
 map and record where each cell goes.  Here a cell's state takes its two axis coordinates
-(named by ``walker.state_names()``) from the grid, the coordinate fixed by the heel-strike
-surface from that constraint (``walker.from_section(walker.section(x))``), and every other
-coordinate from the fixed point ``x*``.
+(named by ``walker.state_names()``) from the grid, and either (``basin.start``)
+
+``fixed_point``  the coordinate fixed by the heel-strike surface from that constraint
+                 (``walker.from_section(walker.section(x))``) and every other coordinate from
+                 the fixed point ``x*`` (:func:`slice_state`), or
+``heel_strike``  the cell is a state just after a heel strike, as Schwab & Wisse's: the image
+                 ``walker.reset(x-)`` of a pre-impact state ``x-`` on the guard that equals
+                 the fixed point's pre-impact state but in the two section coordinates the
+                 axis values depend on most (:func:`heel_strike_slice`).  For the simplest
+                 walker the post-impact states form a 2-D set (the massless swing leg's rate
+                 follows from the stance leg's), so this cell is the only one there is.
 
 Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
 
@@ -16,6 +24,8 @@ Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
 ``fell_backward``    ... with the hip behind it
 ``max_steps``        none of the above within ``max_steps`` steps
 ``stalled``          a step longer than ``max_step_time_s``, or a solver failure
+``unreachable``      (``start: heel_strike``) no pre-impact state on the guard has a heel
+                     strike that lands on the cell
 
 Cells are evaluated in chunks (one grid row each) by
 :func:`walkerlab.sweep.runner.iter_chunk_results` - in this process, on a local process pool
@@ -34,12 +44,13 @@ from pathlib import Path
 import numpy as np
 
 OUTCOMES = ("converged", "other_attractor", "fell_forward", "fell_backward", "max_steps",
-            "stalled")
+            "stalled", "unreachable")
 CODE = {name: i for i, name in enumerate(OUTCOMES)}
 NOT_DONE = -1
 
-__all__ = ["OUTCOMES", "CODE", "NOT_DONE", "BasinTask", "slice_state", "axis_values",
-           "classify_cell", "run_basin_chunk", "compute_basin"]
+__all__ = ["OUTCOMES", "CODE", "NOT_DONE", "BasinTask", "slice_state", "HeelStrikeSlice",
+           "heel_strike_slice", "axis_values", "classify_cell", "run_basin_chunk",
+           "compute_basin"]
 
 
 class BasinError(ValueError):
@@ -90,6 +101,87 @@ def slice_state(walker, x_star: np.ndarray, axes: tuple[str, str],
             raise BasinError(f"basin.{field}: {names[i]!r} is fixed by the heel-strike "
                              "constraint; choose another state")
     return x
+
+
+@dataclass(frozen=True)
+class HeelStrikeSlice:
+    """Cells as states just after a heel strike (``basin.start: heel_strike``).
+
+    Attributes
+    ----------
+    z_pre : ndarray, shape (2n - 1,)
+        Section coordinates (``walker.section``) of the fixed point's pre-impact state.
+    free : ndarray of int, shape (2,)
+        Which of them vary from cell to cell: the two the post-impact axis values depend on
+        most (column-pivoted QR of that 2 x (2n - 1) Jacobian at ``z_pre``).
+    axes : ndarray of int, shape (2,)
+        State indices of the x and y axes.
+    """
+
+    z_pre: np.ndarray
+    free: np.ndarray
+    axes: np.ndarray
+
+    def post(self, walker, u: np.ndarray) -> np.ndarray:
+        """Post-impact state ``walker.reset(x-)`` of the pre-impact state with ``free = u``."""
+        z = self.z_pre.copy()
+        z[self.free] = u
+        return np.asarray(walker.reset(np.asarray(walker.from_section(z), dtype=float)),
+                          dtype=float)
+
+    def state(self, walker, values: tuple[float, float]) -> np.ndarray | None:
+        """The cell's post-impact state, or None where no heel strike lands on it.
+
+        The two free pre-impact coordinates are found by ``scipy.optimize.root`` (MINPACK
+        hybrd) from the fixed point's; the cell is unreachable unless the axis values are
+        matched to 1e-10 (relative) and the pre-impact state is finite.
+        """
+        from scipy.optimize import root
+
+        target = np.asarray(values, dtype=float)
+
+        def residual(u):
+            return self.post(walker, u)[self.axes] - target
+
+        with np.errstate(all="ignore"):
+            sol = root(residual, self.z_pre[self.free], method="hybr", options={"xtol": 1e-13})
+            x = self.post(walker, sol.x)
+        if not (np.all(np.isfinite(x)) and
+                np.max(np.abs(x[self.axes] - target)) <= 1e-10 * (1 + np.max(np.abs(target)))):
+            return None
+        return x
+
+
+def heel_strike_slice(walker, x_pre: np.ndarray, axes: tuple[str, str]) -> HeelStrikeSlice:
+    """Set up :class:`HeelStrikeSlice` from the fixed point's pre-impact state ``x_pre``
+    (shape (2n,), on the heel-strike guard).
+
+    Raises
+    ------
+    BasinError
+        An unknown axis name, or axes the heel strike leaves fixed (the 2 x (2n - 1)
+        Jacobian has rank < 2).
+    """
+    names = walker.state_names()
+    ax = np.array([_index(names, axes[0], "x_axis"), _index(names, axes[1], "y_axis")])
+    if ax[0] == ax[1]:
+        raise BasinError("basin: x_axis and y_axis name the same state")
+    from scipy.linalg import qr
+
+    z = np.asarray(walker.section(np.asarray(x_pre, dtype=float)), dtype=float)
+    base = HeelStrikeSlice(z, np.arange(z.size), ax)
+    jac = np.empty((2, z.size))
+    for k in range(z.size):  # central differences: only the pivot order is taken from it
+        h = 1e-6 * (1 + abs(z[k]))
+        zp, zm = z.copy(), z.copy()
+        zp[k] += h
+        zm[k] -= h
+        jac[:, k] = (base.post(walker, zp)[ax] - base.post(walker, zm)[ax]) / (2 * h)
+    _, r, piv = qr(jac, pivoting=True)
+    if abs(r[1, 1]) <= 1e-9 * max(abs(r[0, 0]), 1e-300):
+        raise BasinError(f"basin: the heel strike fixes a relation between {axes[0]!r} and "
+                         f"{axes[1]!r}; choose other axes or basin.start: fixed_point")
+    return HeelStrikeSlice(z, np.sort(piv[:2]), ax)
 
 
 def axis_values(settings, walker, x_star: np.ndarray,
@@ -170,6 +262,8 @@ class BasinTask:
     base: dict
     x_star: tuple
     cells: tuple
+    #: the fixed point's pre-impact state (``basin.start: heel_strike``), else empty
+    x_pre: tuple = ()
 
 
 _WALKERS: dict[str, object] = {}
@@ -197,11 +291,38 @@ def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     walker, st, max_step_time = _walker_and_settings(task.base)
     solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
     x_star = np.asarray(task.x_star, dtype=float)
+    axes = (st.x_axis, st.y_axis)
+    hs = heel_strike_slice(walker, np.asarray(task.x_pre), axes) if task.x_pre else None
     out = []
     for idx, vx, vy in task.cells:
-        x0 = slice_state(walker, x_star, (st.x_axis, st.y_axis), (vx, vy))
+        x0 = (slice_state(walker, x_star, axes, (vx, vy)) if hs is None
+              else hs.state(walker, (vx, vy)))
+        if x0 is None:
+            out.append((int(idx), CODE["unreachable"], 0, 0))
+            continue
         out.append((int(idx), *classify_cell(walker, x0, x_star, solver, st, max_step_time)))
     return out
+
+
+def pre_impact_fixed_point(walker, x_star: np.ndarray, settings, max_step_time: float
+                           ) -> np.ndarray:
+    """The fixed point's state just before its heel strike, shape (2n,) (one step of the
+    basin's integrator from ``x_star``).
+
+    Raises
+    ------
+    BasinError
+        The step from ``x_star`` does not end in a heel strike.
+    """
+    from walkerlab.analysis.hybrid import Solver, integrate_step
+
+    seg = integrate_step(walker, np.asarray(x_star, dtype=float),
+                         Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend),
+                         max_step_time=max_step_time)
+    if seg.termination != "heel_strike":
+        raise BasinError(f"basin.start: the step from the fixed point ended in "
+                         f"{seg.termination!r}, not a heel strike")
+    return np.asarray(seg.x_end, dtype=float)
 
 
 def _partial(path: Path) -> Path:
@@ -246,14 +367,18 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     """
     import h5py
 
-    from walkerlab.config import BasinSettings
-    from walkerlab.models.registry import build_walker
     from walkerlab.sweep.runner import iter_chunk_results
 
-    st = scene.basin or BasinSettings()
-    walker = build_walker(scene)
+    base = scene.model_dump(mode="json")
+    walker, st, mst = _walker_and_settings(base)
     xs, ys = axis_values(st, walker, x_star, grid)
-    slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]))  # validate axes
+    x_pre: tuple = ()
+    if st.start == "heel_strike":  # validates the axes too
+        pre = pre_impact_fixed_point(walker, x_star, st, mst)
+        heel_strike_slice(walker, pre, (st.x_axis, st.y_axis))
+        x_pre = tuple(float(v) for v in pre)
+    else:
+        slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]))  # validate axes
     nx, ny = xs.size, ys.size
     part = _partial(Path(out_path))
     part.parent.mkdir(parents=True, exist_ok=True)
@@ -268,13 +393,12 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     if arrays is None:
         arrays = {"outcome": np.full((ny, nx), NOT_DONE, np.int8),
                   "steps": np.zeros((ny, nx), np.int16), "period": np.zeros((ny, nx), np.int8)}
-    base = scene.model_dump(mode="json")
     tasks = []
     for j in range(ny):
         cells = tuple((j * nx + i, float(xs[i]), float(ys[j])) for i in range(nx)
                       if arrays["outcome"][j, i] == NOT_DONE)
         if cells:
-            tasks.append(BasinTask(base, tuple(float(v) for v in x_star), cells))
+            tasks.append(BasinTask(base, tuple(float(v) for v in x_star), cells, x_pre))
     # rows through the fixed point converge slowly: start them first for load balance
     jc = int(np.argmin(np.abs(ys - x_star[walker.state_names().index(st.y_axis)])))
     tasks.sort(key=lambda t: abs(t.cells[0][0] // nx - jc))
