@@ -2,7 +2,8 @@
 
 Parametrised over ``configs/*.yaml``, so a new scene is picked up without editing this file.
 Each scene is reduced to keep the test fast (1 stride, no work-precision study, no periodic
-contact gait, 1 contact stride); the contact stages run only where the scene has contact.
+contact gait, 1 contact stride, a 6 x 5 basin); the contact stages run only where the scene
+has contact.
 Every artifact must open with ``xarray.open_dataset(engine="h5netcdf")`` in every group,
 with named dimensions (no anonymous "phony" dimensions) and ``units`` on every variable.
 """
@@ -31,6 +32,9 @@ def reduced(path: Path, tmp: Path):
     if "simulate" in d:
         d["simulate"]["strides"] = 1
         d["simulate"]["sample_rate_hz"] = min(100, d["simulate"].get("sample_rate_hz", 100))
+    if "basin" in d:
+        d["basin"]["grid"] = [6, 5]
+        d["basin"]["max_steps"] = 10
     if "contact_sim" in d:
         d["contact_sim"]["n_strides"] = 1
         d["contact_sim"]["periodic_gait"] = False
@@ -122,6 +126,12 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
     figs = {p.name for p in (html.parent / "figures").glob("*.png")}
     assert {"fig7_angles_rates.png", "fig9_limit_cycles.png", "fig2_stick_ideal.png"} <= figs
     assert ("fig8_errors.png" in figs) == has_contact
+    # a scene that declares a basin gets it in its report (table of outcomes and figure)
+    has_basin = scene.basin is not None
+    assert ("## Basin of attraction" in md) == has_basin
+    assert ("basin.png" in figs) == has_basin
+    if has_basin:
+        assert "6 × 5 cells" in md
 
     slope = scene.slope.angle_deg if scene.slope.angle_deg is not None else \
         float(np.degrees(scene.slope.angle_rad))

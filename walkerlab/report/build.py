@@ -44,7 +44,8 @@ def write_report(scene, paths: dict[str, Path], report_dir: Path, figures_dir: P
     scene : Scene
     paths : dict[str, Path]
         Artifacts that exist, by stage name (``fixedpoint``, ``simulate``, ``contact-sim``,
-        ``compare``, ``workprecision``, ``bifurcation``); absent stages give no section.
+        ``compare``, ``workprecision``, ``bifurcation``, ``basin``); absent stages give no
+        section.
     report_dir, figures_dir : Path
         Output folder and the folder of the figures (PNG) to embed.
     done : iterable of StageOutcome-like objects
@@ -77,6 +78,7 @@ def write_report(scene, paths: dict[str, Path], report_dir: Path, figures_dir: P
     md += contact_sections.sections(scene, paths)
     md += sections.workprecision_summary(scene, paths)
     md += sections.bifurcation_section(paths, pub)
+    md += sections.basin_section(paths)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
     md += sections.figures_section(Path(figures_dir), str(rel), paths)

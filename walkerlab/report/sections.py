@@ -309,6 +309,8 @@ CAPTIONS = [
     ("work_precision_ideal", "Work-precision diagram, ideal model."),
     ("work_precision_contact", "Work-precision diagram, contact model."),
     ("bifurcation", "Bifurcation diagram over the slope."),
+    ("basin", "Basin of attraction: where each cell of the Poincaré-section slice goes "
+              "(left) and how many steps the converged cells take (right)."),
 ]
 
 
@@ -407,3 +409,31 @@ def bifurcation_section(paths: dict[str, Path], pub: ModuleType | None = None) -
                    f"{printed(rng[0])} < γ < {printed(rng[1])} rad "
                    f"({printed(round(np.degrees(rng[1]), 4))}°).")
     return out + [""]
+
+
+# --------------------------------------------------------------------------- basin
+def basin_section(paths: dict[str, Path]) -> list[str]:
+    """Outcome shares of ``basin.h5`` (when the scene ran that stage)."""
+    p = paths.get("basin")
+    if p is None:
+        return []
+    with open_artifact(p, "basin") as f:
+        names = [str(o) for o in f.attrs["outcomes"]]
+        counts = {o: int(f[f"counts/{o}"][()]) for o in names}
+        xa, ya = str(f.attrs["x_axis"]), str(f.attrs["y_axis"])
+        x, y = f["x"][()], f["y"][()]
+        xu, yu = str(f["x"].attrs["unit"]), str(f["y"].attrs["unit"])
+        start = str(f.attrs.get("start", "fixed_point"))
+        max_steps = int(f["settings/max_steps"][()])
+    n = sum(counts.values())
+    how = ("each cell a state just after a heel strike (the heel-strike image of a pre-impact "
+           "state on the guard)" if start == "heel_strike"
+           else "the other coordinates from the fixed point, projected on the heel-strike "
+           "surface")
+    rows = [[o.replace("_", " "), str(c), num(100 * c / n, 3)] for o, c in counts.items() if c]
+    return ["## Basin of attraction", "",
+            f"{x.size} × {y.size} cells over {xa} {printed(x[0])}…{printed(x[-1])} {xu} × "
+            f"{ya} {printed(y[0])}…{printed(y[-1])} {yu} (cell centres), {how}; at most "
+            f"{max_steps} steps a cell.  {num(100 * counts.get('converged', 0) / n, 3)} % of "
+            "the cells reach the period-1 gait.", "",
+            table(["outcome", "cells", "share [%]"], rows), ""]

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.config import ContactSolverSettings, Scene
+from walkerlab.config import Scene
 from walkerlab.contact import scene as contact_scene
 from walkerlab.io.artifacts import put
 from walkerlab.io.trajectory import NamedTrajectory, write_samples  # noqa: F401
@@ -205,16 +205,3 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
     return run_cached("contact-sim", scene, runs_root, sections, up, compute, force)
 
-
-def workprecision_runner(scene: Scene, runs_root, x_fp: np.ndarray, strides: int):
-    """``run(method, rtol, atol) -> (final [angles, rates], nfev)`` for the contact walker."""
-    _, meta = fixedpoint_stage.load_fixed_point(artifact_path(scene, runs_root, "fixedpoint"))
-
-    def run(method, rtol, atol):
-        sv = ContactSolverSettings(method=method, rtol=rtol, atol=atol)
-        _, res, _, _ = simulate_from(scene, x_fp, meta["step_period_s"], solver=sv,
-                                     strides=strides)
-        if res.termination != "t_final":
-            return None, res.nfev
-        return np.concatenate([res.q[-1, 2:], res.qdot[-1, 2:]]), res.nfev
-    return run

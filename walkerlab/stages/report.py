@@ -4,7 +4,9 @@ figures, then hand the artifacts to :func:`walkerlab.report.build.write_report`,
 
 Sections appear only when the scene produces their data: an ideal-only scene gets an
 ideal-only report, with no empty contact panels; a scene without a ``workprecision``
-section skips that (expensive) stage.
+section skips that (expensive) stage.  A scene with a ``basin`` section gets its basin of
+attraction (computed after the work-precision study, whose timed cases must not share their
+cores with the basin's workers).
 """
 
 from __future__ import annotations
@@ -20,14 +22,14 @@ from walkerlab.stages.common import StageOutcome, artifact_path
 from walkerlab.stages.plot import figures_dir
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation")
+                 "bifurcation", "basin")
 
 
 class _Study:
     """The work-precision stage in a thread of the report, overlapping the untimed stages.
 
     Its timed cases run in worker processes pinned to their own cores
-    (:class:`walkerlab.stages.workprecision.Lanes`).  With two cores, the first core's lane
+    (:class:`walkerlab.analysis.workprecision.Lanes`).  With two cores, the first core's lane
     starts at once; this process (every thread of it) stays on the second core for the
     untimed stages and figures, and that core's lane starts at :meth:`release`.  The
     contact model's cases wait until its compiled kernels are in numba's on-disk cache
@@ -44,7 +46,7 @@ class _Study:
     def __init__(self, scene: Scene, runs_root, force: bool, workers: int = 2):
         import threading
 
-        from walkerlab.stages import workprecision
+        from walkerlab.analysis.workprecision import Lanes, start_worker
 
         self.scene, self.runs_root, self.force = scene, runs_root, force
         cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
@@ -56,7 +58,7 @@ class _Study:
             return
         lanes = cores[:workers]
         mine = cores[workers] if len(cores) > workers else lanes[-1]
-        self.lanes = workprecision.Lanes(cores=lanes)
+        self.lanes = Lanes(cores=lanes)
         if mine in lanes:
             self.lanes.gates[mine] = threading.Event()
         if scene.contact is not None:
@@ -66,7 +68,7 @@ class _Study:
         os.sched_setaffinity(0, {mine})  # threads started later inherit it
         try:
             if first_run:
-                self.lanes.workers = {c: workprecision.start_worker(c) for c in lanes
+                self.lanes.workers = {c: start_worker(c) for c in lanes
                                       if c not in self.lanes.gates}
         except BaseException:
             self.release(cancel=True)
@@ -172,6 +174,11 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
         study.release()
         done.append(study.join())
         drawn.append(_draw(scene, runs_root, force, "workprecision"))
+    if scene.basin is not None and scene.fixedpoint is not None:
+        # after the study: its worker processes would share the timed cases' cores
+        from walkerlab.stages import basin
+
+        done.append(basin.run(scene, runs_root, force))
     for o in done:
         echo(f"{o.stage:>13s}: " + ("reused (inputs unchanged)" if o.reused
                                     else f"computed in {o.wall_time_s:.2f} s") + f" -> {o.path}")
