@@ -6,15 +6,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.config import load_scene
-from walkerlab.contact import simulate_contact
-from walkerlab.contact.model import checkerboard_lanes
-from walkerlab.contact.periodic import (
+from walkerlab.analysis.contact_periodic import (
     SECTION_NAMES,
     StepMap,
     find_contact_periodic_gait,
     rigid_limit_contact,
 )
+from walkerlab.config import load_scene
+from walkerlab.contact import simulate_contact
+from walkerlab.contact.model import checkerboard_lanes
 from walkerlab.stages.contact_sim import build
 from walkerlab.stages.fixedpoint import solve_variant
 

@@ -1,7 +1,8 @@
 """Build a contact walker from a validated scene and run it (the library side of ``contact-sim``).
 
-The ``contact-sim`` stage, :mod:`walkerlab.contact.adjust`, :mod:`walkerlab.contact.periodic`
-and the sweep points all go through these functions, so a scene means the same contact run
+The ``contact-sim`` stage, :mod:`walkerlab.contact.adjust`,
+:mod:`walkerlab.analysis.contact_periodic` and the sweep points all go through these
+functions, so a scene means the same contact run
 everywhere.  This module never imports :mod:`walkerlab.stages` (dependencies point down).
 """
 

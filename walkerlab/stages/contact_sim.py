@@ -69,7 +69,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         gait = gait_error = None
         cs = settings(scene)[2]
         if periodic:
-            from walkerlab.contact.periodic import PeriodicGaitError, find_contact_periodic_gait
+            from walkerlab.analysis.contact_periodic import (
+                PeriodicGaitError,
+                find_contact_periodic_gait,
+            )
 
             try:
                 gait = find_contact_periodic_gait(walker, x_fp,

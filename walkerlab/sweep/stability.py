@@ -3,8 +3,8 @@
 Each cell of a map (a parameter y against the slope) asks: *does the contact model have a
 periodic gait here, is it stable, what is its largest |Floquet multiplier|, or why not?*
 The gait is the fixed point of the contact walker's own mid-stance step map
-(:func:`walkerlab.contact.periodic.find_contact_periodic_gait`).  Along each row (one y
-value, slopes ascending) every cell starts from the contact gait of its neighbour
+(:func:`walkerlab.analysis.contact_periodic.find_contact_periodic_gait`).  Along each row
+(one y value, slopes ascending) every cell starts from the contact gait of its neighbour
 (continuation); when that fails or there is no neighbour yet it starts again from the ideal
 fixed point at that slope (placed on the contact model and iterated a few steps).
 
@@ -121,8 +121,8 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
     Never raises (every failure becomes a ``reason``).  Top-level so it pickles for a
     process pool.
     """
+    from walkerlab.analysis.contact_periodic import PeriodicGaitError, find_contact_periodic_gait
     from walkerlab.config import SceneError
-    from walkerlab.contact.periodic import PeriodicGaitError, find_contact_periodic_gait
     from walkerlab.contact.scene import build
     from walkerlab.sweep.points import _Outcome, ideal_fixed_point
 

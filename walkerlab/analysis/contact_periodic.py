@@ -77,8 +77,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
-from . import _kernels as K
-from .model import ContactWalker
+from walkerlab.contact import _kernels as K
+from walkerlab.contact.model import ContactWalker
 
 __all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait", "PeriodicGaitError",
            "find_contact_periodic_gait", "section_guess_from_ideal", "rigid_limit_contact"]
@@ -379,7 +379,7 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
     its static penetration, ``rate_scale`` on the rates) and integrated to the first
     mid-stance of leg2, where the section coordinates are read.
     """
-    from .simulate import initial_state_from_ideal
+    from walkerlab.contact.simulate import initial_state_from_ideal
 
     w = step_map.walker
     x0 = initial_state_from_ideal(w, *x_ideal, rate_scale=rate_scale)
@@ -415,9 +415,8 @@ def _walker_and_guess(walker_or_scene, guess):
         return walker_or_scene, guess, None
     from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.contact.scene import build
     from walkerlab.models.registry import build_walker
-
-    from .scene import build
 
     scene = walker_or_scene
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})
