@@ -421,7 +421,7 @@ def basin_section(paths: dict[str, Path]) -> list[str]:
         names = [str(o) for o in f.attrs["outcomes"]]
         counts = {o: int(f[f"counts/{o}"][()]) for o in names}
         xa, ya = str(f.attrs["x_axis"]), str(f.attrs["y_axis"])
-        x, y = f["x"][()], f["y"][()]
+        xc, yc = f["x"][()], f["y"][()]
         xu, yu = str(f["x"].attrs["unit"]), str(f["y"].attrs["unit"])
         start = str(f.attrs.get("start", "fixed_point"))
         max_steps = int(f["settings/max_steps"][()])
@@ -432,8 +432,8 @@ def basin_section(paths: dict[str, Path]) -> list[str]:
            "surface")
     rows = [[o.replace("_", " "), str(c), num(100 * c / n, 3)] for o, c in counts.items() if c]
     return ["## Basin of attraction", "",
-            f"{x.size} × {y.size} cells over {xa} {printed(x[0])}…{printed(x[-1])} {xu} × "
-            f"{ya} {printed(y[0])}…{printed(y[-1])} {yu} (cell centres), {how}; at most "
+            f"{xc.size} × {yc.size} cells over {xa} {printed(xc.min())}…{printed(xc.max())} {xu} × "
+            f"{ya} {printed(yc.min())}…{printed(yc.max())} {yu} (cell centres), {how}; at most "
             f"{max_steps} steps a cell.  {num(100 * counts.get('converged', 0) / n, 3)} % of "
             "the cells reach the period-1 gait.", "",
             table(["outcome", "cells", "share [%]"], rows), ""]
