@@ -49,10 +49,10 @@ def basin_figure(d: dict, title: str = ""):
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
-    x, y, out = d["x"], d["y"], d["outcome"]
-    dx = (x[1] - x[0]) / 2 if x.size > 1 else 0.5
-    dy = (y[1] - y[0]) / 2 if y.size > 1 else 0.5
-    extent = (x[0] - dx, x[-1] + dx, y[0] - dy, y[-1] + dy)
+    xc, yc, out = d["x"], d["y"], d["outcome"]  # cell centres (grid axes, not states)
+    dx = np.ptp(xc) / (xc.size - 1) / 2 if xc.size > 1 else 0.5
+    dy = np.ptp(yc) / (yc.size - 1) / 2 if yc.size > 1 else 0.5
+    extent = (xc.min() - dx, xc.max() + dx, yc.min() - dy, yc.max() + dy)
     names = d["outcomes"]
     cmap = ListedColormap([OUTCOME_COLORS.get(n, "k") for n in names])
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), constrained_layout=True)
