@@ -374,6 +374,19 @@ def stability_map(scene: Path | None = SceneArg,
 
 @app.command()
 @_guard
+def export(scene: Path | None = SceneArg,
+           fmt: str = typer.Option("urdf", "--format", help="urdf (Drake, Pinocchio) or mjcf "
+                                   "(MuJoCo)"),
+           runs_dir: Path = RunsOpt) -> None:
+    """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf or
+    walker.xml."""
+    from walkerlab.stages import export as stage
+
+    typer.echo(f"wrote {stage.run(_load(scene), runs_dir, fmt)}")
+
+
+@app.command()
+@_guard
 def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
                                      " | all (all but basin)"),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:

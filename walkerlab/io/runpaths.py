@@ -37,7 +37,8 @@ except ImportError:  # pragma: no cover
     fcntl = None
 
 __all__ = ["RunPathError", "ArtifactBusy", "check_name", "scene_dir", "stage_artifact",
-           "named_artifact", "report_dir", "figures_dir", "artifact_lock", "STAGE_FILES"]
+           "named_artifact", "scene_file", "report_dir", "figures_dir", "artifact_lock",
+           "STAGE_FILES"]
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
 MAX_NAME = 100
@@ -153,6 +154,20 @@ def named_artifact(scene, runs_root: Path | str, name: str, what: str = "--name"
                            "artifact; choose another name")
     d = scene_dir(scene, runs_root, claim)
     return _inside(Path(runs_root), d / f"{stem}.h5", f"{what} {name!r}")
+
+
+def scene_file(scene, runs_root: Path | str, filename: str, claim: bool = False) -> Path:
+    """``<runs>/<scene>/<filename>`` for a file that is not an HDF5 artifact (the exported
+    ``walker.urdf`` / ``walker.xml``).
+
+    Raises
+    ------
+    RunPathError
+        Unsafe file name, or the scene's folder is not allowed (see :func:`scene_dir`).
+    """
+    name = check_name(filename, "file name")
+    d = scene_dir(scene, runs_root, claim)
+    return _inside(Path(runs_root), d / name, f"file name {filename!r}")
 
 
 def report_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
