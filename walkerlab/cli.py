@@ -374,6 +374,20 @@ def stability_map(scene: Path | None = SceneArg,
 
 @app.command()
 @_guard
+def animate(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
+    """The walker walking (rigid, and contact beside it where contact_sim.h5 exists):
+    report/figures/animation.gif, and .mp4 if ffmpeg is installed."""
+    from walkerlab.stages import animate as stage
+
+    out = stage.run(_load(scene), runs_dir)
+    for p in out.paths:
+        typer.echo(f"wrote {p}")
+    if out.note:
+        typer.echo(out.note)
+
+
+@app.command()
+@_guard
 def export(scene: Path | None = SceneArg,
            fmt: str = typer.Option("urdf", "--format", help="urdf (Drake, Pinocchio) or mjcf "
                                    "(MuJoCo)"),

@@ -88,7 +88,8 @@ def to_html(md: str, base: Path) -> str:
             cap = line[2:line.rindex("](")]
             src = line[line.rindex("](") + 2:-1]
             data = base64.b64encode((base / src).read_bytes()).decode()
-            body.append(f'<img alt="{html.escape(cap)}" src="data:image/png;base64,{data}" '
+            mime = "image/gif" if src.endswith(".gif") else "image/png"
+            body.append(f'<img alt="{html.escape(cap)}" src="data:{mime};base64,{data}" '
                         'style="max-width:100%">')
         elif line.startswith("#"):
             lvl = len(line) - len(line.lstrip("#"))

@@ -341,6 +341,11 @@ def workprecision_table(path: Path, model: str) -> str:
 def figures_section(fig_dir: Path, rel: str, paths: dict[str, Path]) -> list[str]:
     """Every figure that exists, with its raw data folded underneath where it is long."""
     out = []
+    gif = fig_dir / "animation.gif"  # written by `walkerlab animate`, embedded when present
+    if gif.is_file():
+        cap = ("The walker walking (`walkerlab animate`; rigid model, and the contact model "
+               "beside it where it was simulated).")
+        out += [f"![{cap}]({rel}/{gif.name})", "", f"*{cap}*", ""]
     for stem, cap in CAPTIONS:
         png = fig_dir / f"{stem}.png"
         if not png.is_file():

@@ -1,0 +1,223 @@
+"""The walker walking: a matplotlib animation drawn from named trajectories.
+
+Everything is read from the trajectory's named points (``samples/points/<name>`` of
+``simulate.h5`` / ``contact_sim.h5``), so any walker is drawn right without knowing its state:
+
+- each leg is a chain ``hip -> <leg>_knee (if any) -> <leg>_foot``; with arc feet
+  (points ``<leg>_foot_centre`` and ``<leg>_contact``) the chain runs through the arc's centre
+  on to the arc, drawn as a circular arc of radius ``R = |contact - centre|`` about the leg's
+  axis (McGeer 1990), its contact point (lowest point relative to the slope) marked ``x``;
+- every other point of a leg (point masses, rods' centres) is a dot; the hip a larger dot;
+- the ground is the slope line ``y = -x tan(phi)`` through the first stance foot (world
+  frame, x downhill, y up), shaded below.
+
+Several trajectories (rigid and contact) are drawn side by side at the same times, each panel
+following its own hip.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from walkerlab.io.trajectory import NamedTrajectory
+
+__all__ = ["ARC_HALF_ANGLE_RAD", "WalkerFrames", "frame_times", "gif_writer", "leg_parts",
+           "walker_animation", "write_frames"]
+
+#: Half the angle the drawn foot arc spans about the leg axis [rad] (the stance arc's contact
+#: stays within about 0.3 rad of the axis for the shipped walkers).
+ARC_HALF_ANGLE_RAD = 0.6
+#: Points on a drawn arc.
+ARC_POINTS = 25
+LEG_COLOURS = ("tab:blue", "tab:orange")
+
+
+def leg_parts(tr: NamedTrajectory, leg: str) -> dict:
+    """Names of the points that draw one leg.
+
+    Returns
+    -------
+    dict
+        ``chain``: point names from the hip to the leg's end (knee if any, then the foot or
+        the arc's centre); ``arc``: ``(centre, contact)`` names or None; ``bodies``: the
+        leg's other points (masses), drawn as dots.
+    """
+    p = tr.points
+    knee, foot = f"{leg}_knee", f"{leg}_foot"
+    centre, contact = f"{leg}_foot_centre", f"{leg}_contact"
+    arc = (centre, contact) if centre in p and contact in p else None
+    chain = ["hip"] + ([knee] if knee in p else []) + [centre if arc else foot]
+    skip = {knee, foot, centre, contact}
+    bodies = [n for n in p if n.startswith(leg + "_") and n not in skip]
+    return {"chain": chain, "arc": arc, "bodies": bodies}
+
+
+def frame_times(trajs: dict[str, NamedTrajectory], fps: float, max_frames: int) -> np.ndarray:
+    """Frame times [s]: every ``1/fps`` over the time all trajectories cover, at most
+    ``max_frames`` (then spread evenly over that time: the animation runs faster)."""
+    t_end = min(float(tr.time[-1]) for tr in trajs.values())
+    t0 = max(float(tr.time[0]) for tr in trajs.values())
+    n = int(min(max_frames, max(2, np.floor((t_end - t0) * fps) + 1)))
+    return np.linspace(t0, t_end, n)
+
+
+def _leg_length(tr: NamedTrajectory) -> float:
+    """Hip to the farthest leg point at the first sample, plus the arc radius [m]."""
+    hip = tr.points["hip"][:, 0]
+    out = 0.0
+    for leg in tr.legs:
+        parts = leg_parts(tr, leg)
+        end = tr.points[parts["chain"][-1]][:, 0]
+        r = 0.0
+        if parts["arc"]:
+            c, k = parts["arc"]
+            r = float(np.hypot(*(tr.points[k][:, 0] - tr.points[c][:, 0])))
+        out = max(out, float(np.hypot(*(end - hip))) + r)
+    return out
+
+
+@dataclass
+class WalkerFrames:
+    """A figure and how to draw its frame ``j`` (``draw(j)``) at ``times[j]``."""
+
+    fig: object
+    times: np.ndarray
+    draw: Callable[[int], None]
+    dpi: int
+
+
+def gif_writer(fps: float, colours: int = 64):
+    """matplotlib's Pillow (GIF) writer, mapping every frame onto one palette taken from the
+    first frame (``colours`` entries, no dithering).
+
+    ``PillowWriter`` itself quantizes each frame separately (median cut), which costs ~60 ms
+    a frame and was most of the time of an animation; the frames here share their colours
+    (legs, ground, text), so one palette serves them all.
+    """
+    from io import BytesIO
+
+    from matplotlib.animation import PillowWriter
+    from PIL import Image
+
+    class PaletteWriter(PillowWriter):
+        palette = None
+
+        def grab_frame(self, **savefig_kwargs):
+            buf = BytesIO()
+            self.fig.savefig(buf, **{**savefig_kwargs, "format": "rgba", "dpi": self.dpi})
+            im = Image.frombuffer("RGBA", self.frame_size, buf.getbuffer(), "raw", "RGBA", 0,
+                                  1).convert("RGB")
+            if self.palette is None:
+                self.palette = im.quantize(colours, method=Image.Quantize.MEDIANCUT)
+            self._frames.append(im.quantize(palette=self.palette, dither=Image.Dither.NONE))
+
+    return PaletteWriter(fps=fps)
+
+
+def write_frames(frames: WalkerFrames, path: Path | str, writer) -> None:
+    """Draw every frame and hand it to a matplotlib animation writer (``PillowWriter``,
+    ``FFMpegWriter``): one figure draw per frame (``FuncAnimation.save`` draws each frame
+    three times)."""
+    with writer.saving(frames.fig, str(path), frames.dpi):
+        for j in range(len(frames.times)):
+            frames.draw(j)
+            writer.grab_frame()
+
+
+def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: float = 20.0,
+                     max_frames: int = 150, time_unit: str = "s", dpi: int = 80):
+    """The walkers walking side by side, one panel per trajectory.
+
+    Parameters
+    ----------
+    trajs : dict[str, NamedTrajectory]
+        Panel title -> trajectory with named points (``hip`` and each leg's points).
+    slope_rad : float
+        Slope angle phi [rad] (ground line ``y = -x tan(phi)``).
+    fps : float
+        Frames per second of the animation [1/s]; one frame per ``1/fps`` of walker time
+        unless that gives more than ``max_frames``.
+    max_frames : int
+        Cap on the number of frames (keeps GIFs small and quick to write).
+    time_unit : str
+        Unit of the trajectories' time (for the clock in the title).
+    dpi : int
+        Resolution of the saved frames.
+
+    Returns
+    -------
+    WalkerFrames
+        Write with :func:`write_frames`; close ``.fig`` afterwards.
+
+    Raises
+    ------
+    KeyError
+        A trajectory without a ``hip`` point.
+    """
+    times = frame_times(trajs, fps, max_frames)
+    n = len(trajs)
+    L = max(_leg_length(tr) for tr in trajs.values())
+    fig, axes = plt.subplots(1, n, figsize=(3.6 * n, 3.6), dpi=dpi, squeeze=False)
+    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.02, top=0.86, wspace=0.05)
+    axes = axes[0]
+    xmin = min(float(tr.points["hip"][0].min()) for tr in trajs.values()) - 3 * L
+    xmax = max(float(tr.points["hip"][0].max()) for tr in trajs.values()) + 3 * L
+    gx = np.array([xmin, xmax])
+    gy = -np.tan(slope_rad) * gx
+    panels = []
+    for ax, (title, tr) in zip(axes, trajs.items()):
+        ax.fill_between(gx, gy, gy - 3 * L, color="0.85", lw=0)
+        ax.plot(gx, gy, color="k", lw=1)
+        ax.set_aspect("equal")
+        ax.set_xticks([])
+        ax.set_yticks([])
+        idx = np.clip(np.searchsorted(tr.time, times), 0, tr.time.size - 1)
+        legs = []
+        for k, leg in enumerate(tr.legs):
+            c = LEG_COLOURS[k % len(LEG_COLOURS)]
+            parts = leg_parts(tr, leg)
+            legs.append({
+                "parts": parts,
+                "line": ax.plot([], [], color=c, lw=2.5, solid_capstyle="round")[0],
+                "arc": ax.plot([], [], color=c, lw=2.5)[0] if parts["arc"] else None,
+                "contact": ax.plot([], [], "x", color=c, ms=5)[0] if parts["arc"] else None,
+                "dots": ax.plot([], [], "o", color=c, ms=4)[0],
+            })
+        hip = ax.plot([], [], "o", color="k", ms=7)[0]
+        label = ax.set_title(title, fontsize=9)
+        panels.append((ax, tr, idx, legs, hip, label, title))
+
+    def draw(j: int) -> None:
+        for ax, tr, idx, legs, hip, label, title in panels:
+            i = idx[j]
+            P = {n: tr.points[n][:, i] for n in tr.points}
+            for lg in legs:
+                parts = lg["parts"]
+                xy = np.array([P[n] for n in parts["chain"]])
+                if parts["arc"]:
+                    c, k = (P[n] for n in parts["arc"])
+                    r = float(np.hypot(*(k - c)))
+                    u = (c - xy[-2]) / np.hypot(*(c - xy[-2]))  # the leg's (shank's) axis
+                    a = np.arctan2(u[1], u[0]) + np.linspace(-ARC_HALF_ANGLE_RAD,
+                                                             ARC_HALF_ANGLE_RAD, ARC_POINTS)
+                    lg["arc"].set_data(c[0] + r * np.cos(a), c[1] + r * np.sin(a))
+                    lg["contact"].set_data([k[0]], [k[1]])
+                    xy = np.vstack([xy, c + r * u])  # the leg runs on to its arc
+                lg["line"].set_data(xy[:, 0], xy[:, 1])
+                b = np.array([P[n] for n in parts["bodies"]]).reshape(-1, 2)
+                lg["dots"].set_data(b[:, 0], b[:, 1])
+            hx, hy = P["hip"]
+            hip.set_data([hx], [hy])
+            ax.set_xlim(hx - 1.1 * L, hx + 1.1 * L)
+            ax.set_ylim(hy - 1.35 * L, hy + 0.45 * L)
+            label.set_text(f"{title}\nt = {times[j]:.2f} {time_unit}")
+
+    return WalkerFrames(fig, times, draw, dpi)

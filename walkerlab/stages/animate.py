@@ -1,0 +1,106 @@
+"""Stage ``animate``: the walker walking, as ``report/figures/animation.gif`` (+ ``.mp4``).
+
+Not an HDF5 artifact (a figure, like ``walkerlab plot``'s); always redrawn (a few seconds).
+
+Drawn from the artifacts only: ``simulate.h5`` (run or reused first, as ``compare`` does) and,
+where it exists, ``contact_sim.h5`` beside it (rigid and contact side by side, same times).
+The slope comes from the resolved scene stored in ``simulate.h5``.  GIF through matplotlib's
+Pillow writer (one shared palette, :func:`walkerlab.plotting.animation.gif_writer`); MP4
+through its ffmpeg writer only when ffmpeg is installed.  Both written atomically (temporary
+name in the same folder, then rename).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from walkerlab.config import Scene, SlopeSettings
+from walkerlab.io.artifacts import open_artifact, scene_json_of
+from walkerlab.io.trajectory import read_samples
+from walkerlab.stages import simulate
+from walkerlab.stages.common import artifact_path
+from walkerlab.stages.plot import CONTACT_LABEL, IDEAL_LABEL, figures_dir
+
+#: Frames per second, and the most frames one animation gets (a 5-stride compass gait,
+#: 7 s, is 141 frames at 20 fps; longer runs play faster).
+FPS = 20.0
+MAX_FRAMES = 150
+
+
+@dataclass
+class AnimateOutcome:
+    """Files written and a one-line note (e.g. why there is no MP4)."""
+
+    paths: list[Path] = field(default_factory=list)
+    note: str = ""
+
+
+def _atomic_save(frames, path: Path, writer) -> Path:
+    """Write the frames to a temporary file of the same suffix in the same folder, then rename
+    (matplotlib's writers pick the format from the file name)."""
+    from walkerlab.plotting.animation import write_frames
+
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        write_frames(frames, tmp, writer)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    finally:
+        Path(tmp).unlink(missing_ok=True)
+    return path
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
+        max_frames: int = MAX_FRAMES) -> AnimateOutcome:
+    """Write ``runs/<scene>/report/figures/animation.gif`` (and ``.mp4`` with ffmpeg).
+
+    Parameters
+    ----------
+    scene : Scene
+    runs_root : Path or str
+    fps : float
+        Frames per second [1/s].
+    max_frames : int
+        Most frames (see :func:`walkerlab.plotting.animation.frame_times`).
+
+    Returns
+    -------
+    AnimateOutcome
+
+    Raises
+    ------
+    StageError
+        The rigid simulation cannot run (no ``simulate`` section, no fixed point, ...).
+    """
+    from matplotlib import pyplot as plt
+    from matplotlib.animation import FFMpegWriter, writers
+
+    from walkerlab.plotting.animation import gif_writer, walker_animation
+
+    simulate.run(scene, runs_root)
+    trajs, unit = {}, "s"
+    for stage, label in (("simulate", IDEAL_LABEL), ("contact-sim", CONTACT_LABEL)):
+        p = artifact_path(scene, runs_root, stage)
+        if p.is_file():
+            with open_artifact(p, stage) as f:
+                trajs[label] = read_samples(f)
+                unit = str(f["samples/time"].attrs.get("unit", unit)) if stage == "simulate" \
+                    else unit
+    slope = SlopeSettings.model_validate(
+        scene_json_of(artifact_path(scene, runs_root, "simulate"))["slope"]).phi_rad
+    folder = figures_dir(scene, runs_root, claim=True)
+    frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames, time_unit=unit)
+    out = AnimateOutcome()
+    try:
+        out.paths.append(_atomic_save(frames, folder / "animation.gif", gif_writer(fps)))
+        if writers.is_available("ffmpeg"):
+            out.paths.append(_atomic_save(frames, folder / "animation.mp4", FFMpegWriter(fps=fps)))
+        else:
+            out.note = "ffmpeg not found: wrote the GIF only (install ffmpeg for the MP4)"
+    finally:
+        plt.close(frames.fig)
+    return out
