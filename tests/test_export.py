@@ -93,6 +93,7 @@ class Pinocchio:
             # a continuous (unbounded revolute) joint is stored as (cos, sin)
             ql[iq:iq + nq] = (np.cos(a), np.sin(a)) if nq == 2 else (a,)
         vl = self.T @ dq
+        self.last_q = ql
         Ml = self.pin.crba(self.model, self.data, ql)
         Ml = np.triu(Ml) + np.triu(Ml, 1).T  # CRBA fills the upper triangle
         bl = self.pin.rnea(self.model, self.data, ql, vl, np.zeros(self.model.nv))
@@ -298,3 +299,30 @@ def test_arc_feet_and_knee_limit_in_files(tmp_path):
                                                               "mjcf")))
     knee = kneed.joint("leg1_knee")
     assert knee.limited[0] and knee.range[1] == 0.0 and knee.range[0] == pytest.approx(-np.pi)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_feet_where_the_walker_puts_them(name, tmp_path):
+    """The ``leg<i>_foot`` frame (Pinocchio) and site (MuJoCo) lie at the foot point, or the
+    arc's centre, ``hip + l_t e(thigh) + (L - l_t - R) e(shank)`` with
+    ``e(psi) = (sin psi, -cos psi)`` in (x, up): the sign convention of the joint axes."""
+    scene = _scene(name)
+    data, names, libs = _libraries(scene, tmp_path)
+    p = dict(zip(data.structure.param_names, data.params))
+    lt = p.get("L_thigh", 0.0)
+    to_centre = p["L"] - p.get("R_foot", 0.0) - lt
+    pin, mj = libs["pinocchio"], libs["mujoco"]
+    for q, dq in _states(len(names), seed=5):
+        pin(q, dq)  # sets the configuration
+        mj(q, dq)
+        pin.pin.framesForwardKinematics(pin.model, pin.data, pin.last_q)
+        for leg in ("leg1", "leg2"):
+            thigh = q[names.index(f"{leg}_thigh_angle" if lt else f"{leg}_angle")]
+            shank = q[names.index(f"{leg}_shank_angle")] if lt else thigh
+            x, y = q[:2] + lt * np.array([np.sin(thigh), -np.cos(thigh)]) \
+                + to_centre * np.array([np.sin(shank), -np.cos(shank)])
+            fid = pin.model.getFrameId(f"{leg}_foot", pin.pin.FrameType.BODY)
+            frame = pin.data.oMf[fid].translation
+            np.testing.assert_allclose(frame, [x, 0.0, y], atol=1e-13)
+            np.testing.assert_allclose(mj.data.site(f"{leg}_foot").xpos, [x, 0.0, y],
+                                       atol=1e-13)
