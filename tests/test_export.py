@@ -199,7 +199,9 @@ def test_reference_is_not_trivially_equal(tmp_path):
 # ---- (a) the hand-written compass-gait contact kernel and its numpy reference.  When the
 # kernel's mechanics are deleted (issue 17 part 4), drop this block; reference.py stays.
 def _compass_kernel(scene):
-    from walkerlab.contact import _kernels as K
+    K = pytest.importorskip("walkerlab.contact._kernels")
+    if not hasattr(K, "mass_matrix"):
+        pytest.skip("the hand-written compass kernel's mechanics are retired (issue 17 part 4)")
     from walkerlab.contact.reference import mass_matrix_ref, rhs_ref
 
     w = scene.walker
