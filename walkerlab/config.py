@@ -356,6 +356,12 @@ class FixedPointSettings(_Strict):
     fd_step: float = Field(1e-7, gt=0, lt=1e-2,
                            description="finite-difference step for the Jacobian")
 
+    @model_validator(mode="after")
+    def _guess_for_nearest(self) -> FixedPointSettings:
+        if self.gait == "nearest_guess" and self.initial_guess is None:
+            raise ValueError("gait: 'nearest_guess' needs an initial_guess")
+        return self
+
 
 class SimulateSettings(_Strict):
     """Forward simulation of the rigid hybrid model."""

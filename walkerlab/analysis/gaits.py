@@ -400,9 +400,10 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
         if guess is not None:
             near = nearest(range(len(gaits)))
             if near != k:
+                other = gaits[near].label.replace("_", "-")
                 search.notes.append(
-                    f"the gait nearest the initial guess is the {gaits[near].label.replace('_', '-')}"
-                    f" one, UNSTABLE (max |multiplier| {gaits[near].max_multiplier:.3g}); "
+                    f"the gait nearest the initial guess is the {other} one, UNSTABLE "
+                    f"(max |multiplier| {gaits[near].max_multiplier:.3g}); "
                     "fixedpoint.gait: nearest_guess selects it")
         return k
     search.notes.append("no stable period-1 gait found: "
@@ -412,8 +413,11 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
 
 
 def _short(msg: str) -> str:
-    """scipy's message without the repeated prefix, one line."""
-    return " ".join(str(msg).removeprefix("no fixed point found: ").split())
+    """scipy's message, one line, without the prefix and the residual (given apart)."""
+    import re
+
+    text = " ".join(str(msg).removeprefix("no fixed point found: ").split())
+    return re.sub(r" \(residual [^)]*\)$", "", text)
 
 
 def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
@@ -426,6 +430,6 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
     why = ""
     if walker.slope_rad <= 0:
         why = " a passive walker needs a downhill slope (slope > 0);"
-    return (f"no period-1 gait found (tried {' and '.join(tried)}; last: "
-            f"{_short(last) or 'every start fell'}{res});{why} the walker may have no "
+    return (f"no period-1 gait found (tried {' and '.join(tried)}{res}; last: scipy: "
+            f"{_short(last) or 'every start fell'});{why} the walker may have no "
             f"period-1 gait here; try: {nxt}")

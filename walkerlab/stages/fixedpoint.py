@@ -130,7 +130,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``fixedpoint`` section, or no fixed point for the scene's own variant.
     """
-    fp_cfg = require(scene, "fixedpoint", "fixedpoint")
+    require(scene, "fixedpoint", "fixedpoint")
 
     def compute():
         try:
