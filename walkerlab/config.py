@@ -356,11 +356,12 @@ class FixedPointSettings(_Strict):
     fd_step: float = Field(1e-7, gt=0, lt=1e-2,
                            description="finite-difference step for the Jacobian")
 
-    @model_validator(mode="after")
-    def _guess_for_nearest(self) -> FixedPointSettings:
-        if self.gait == "nearest_guess" and self.initial_guess is None:
-            raise ValueError("gait: 'nearest_guess' needs an initial_guess")
-        return self
+    @field_validator("gait")
+    @classmethod
+    def _guess_for_nearest(cls, v: str, info) -> str:
+        if v == "nearest_guess" and info.data.get("initial_guess") is None:
+            raise ValueError("'nearest_guess' needs an initial_guess")
+        return v
 
 
 class SimulateSettings(_Strict):

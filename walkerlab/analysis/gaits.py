@@ -306,7 +306,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         try:
             res = find_fixed_point(walker, x0, solver, deflate=deflate, **kw)
         except FixedPointNotFound as exc:
-            if math.isfinite(exc.residual):
+            if math.isfinite(exc.residual) and "standing" not in str(exc):
                 best = min(best, exc.residual)
             last_msg = str(exc)
             return None
@@ -423,13 +423,13 @@ def _short(msg: str) -> str:
 def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
              had_guess: bool) -> str:
     res = f", best residual {best:.2g}" if math.isfinite(best) else ""
-    nxt = ("continue from a walker whose gait is known (`walkerlab sweep SCENE --param "
-           "FIELD=KNOWN:THIS:STEP`, e.g. a body's mass_kg or slope.angle_deg in small steps) to "
-           "see where its gait ends, or give fixedpoint.initial_guess"
-           + (" nearer a gait" if had_guess else ""))
-    why = ""
-    if walker.slope_rad <= 0:
-        why = " a passive walker needs a downhill slope (slope > 0);"
-    return (f"no period-1 gait found (tried {' and '.join(tried)}{res}; last: scipy: "
-            f"{_short(last) or 'every start fell'});{why} the walker may have no "
-            f"period-1 gait here; try: {nxt}")
+    last = _short(last)
+    if last and "standing" not in last:
+        last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
+    why = (" a passive walker needs a downhill slope (slope > 0);"
+           if walker.slope_rad <= 0 else " the walker may have no period-1 gait here;")
+    return (f"no period-1 gait found (tried {' and '.join(tried)}{res}; last: "
+            f"{last or 'every start fell'});{why} try a continuation from a walker whose gait "
+            "is known (walkerlab sweep SCENE --param FIELD=KNOWN:THIS:STEP, small steps, e.g. a "
+            "body's mass_kg or slope.angle_deg) to see where the gait ends, or "
+            + ("an initial_guess nearer a gait" if had_guess else "give fixedpoint.initial_guess"))
