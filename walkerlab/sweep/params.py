@@ -276,12 +276,13 @@ def _check_path(scene: Scene, axis: ParamAxis) -> None:
             cls = models[0] if len(models) == 1 else None
 
 
-def check_axes(scene: Scene, axes: list[ParamAxis]) -> None:
+def check_axes(scene: Scene, axes: list[ParamAxis], values: bool = True) -> None:
     """Refuse a sweep whose axes cannot work, before anything runs: every path must name a
     field of the scene (lists by item name or index) and every value must validate.
 
     Each value is checked alone, on the base scene (at most 200 values per axis, evenly
     spread, the first and last included); combinations of axes are checked per point.
+    ``values=False`` checks the paths only.
 
     Raises
     ------
@@ -292,6 +293,7 @@ def check_axes(scene: Scene, axes: list[ParamAxis]) -> None:
     base = scene.model_dump(mode="json")
     for axis in axes:
         _check_path(scene, axis)
+    for axis in axes if values else ():
         vals = axis.values
         if len(vals) > 200:
             idx = sorted({round(k * (len(vals) - 1) / 199) for k in range(200)})
