@@ -116,6 +116,19 @@ def test_heavy_hip_walker_reports_both_gaits_and_picks_the_stable_one():
         assert _solve(sc).gait.label == want
 
 
+def test_sweep_point_chooses_the_gait_as_the_stage_does():
+    """A sweep's first point (no neighbour yet) follows fixedpoint.gait like the stage: the
+    heavy-hip walker's stable long-period gait, not the unstable one its guess reaches."""
+    base = scene_from_dict(HEAVY_HIP).model_dump(mode="json")
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (2.0,), 0, None, {})
+    assert row["outcome"] == "ok" and row["guess_source"] == "scene"
+    assert row["stable"] == 1.0 and 0.93 < row["step_period_s"] < 0.95
+    row, _ = evaluate("fixedpoint", dict(base, fixedpoint={**base["fixedpoint"],
+                                                          "gait": "nearest_guess"}),
+                      ["slope.angle_deg"], (2.0,), 0, None, {})
+    assert row["stable"] == 0.0 and abs(row["max_abs_multiplier"] - 4.08) < 0.01
+
+
 def test_fixedpoint_artifact_records_every_gait(tmp_path):
     """fixedpoint.h5: the selected gait at the top (what downstream stages read), every
     gait found under gaits/<label>, and the CLI prints both with the choice."""

@@ -255,7 +255,7 @@ def _is_new(res: FixedPointResult, found: list[Gait]) -> bool:
 def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = None,
                policy: str = "stable", other_gait: bool = True, xtol: float = 1e-12,
                fd_step: float = 1e-7, max_step_time: float = 5.0, fd_check: bool = True,
-               time_unit: str = "s") -> GaitSearch:
+               time_unit: str = "s", seeds: bool = True) -> GaitSearch:
     """Find the walker's period-1 gait(s) and choose one.
 
     Parameters
@@ -276,6 +276,8 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     time_unit : str
         Unit of the step period in messages (``s``, or ``sqrt(l/g)`` for a nondimensional
         scene).
+    seeds : bool
+        Try the scale-free seeds when the guess does not converge (always without a guess).
 
     Returns
     -------
@@ -322,7 +324,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         else:
             notes.append(f"the initial guess did not converge ({_short(last_msg)})")
     n_seeds = n_started = 0
-    if not found:
+    if not found and (seeds or guess is None):
         ranked, n_seeds = screen_seeds(walker, solver, max_step_time)
         for _err, _desc, x in ranked[:ROOT_STARTS]:
             n_started += 1

@@ -205,8 +205,8 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     best, msg = math.inf, ""
     for source, g, J in tries:
         try:
-            if source == "search":  # no initial guess: seeds, the scene's gait choice
-                res = _searched_gait(walker, solver, fp)
+            if source in ("scene", "search"):  # the scene's guess or seeds, its gait choice
+                res = _searched_gait(walker, solver, fp, g)
             else:
                 # the sweep keeps the variational multipliers only: no finite-difference check
                 res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
@@ -227,14 +227,16 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     raise _Outcome("no_fixed_point", msg, residual=best if math.isfinite(best) else math.nan)
 
 
-def _searched_gait(walker, solver, fp):
-    """The scene's period-1 gait found without an initial guess (scale-free seeds, then
-    ``fixedpoint.gait``; the other gait of the pair only when the choice needs it)."""
+def _searched_gait(walker, solver, fp, guess):
+    """The scene's period-1 gait as the fixedpoint stage chooses it (``fixedpoint.gait``):
+    from the scene's initial guess (no seeds when it fails: a sweep point stays cheap), or
+    without one from the scale-free seeds; the other gait of the pair is looked for only
+    when the choice needs it (``stable`` and the first gait unstable, ``long_period``...)."""
     from walkerlab.analysis.gaits import find_gaits
 
-    return find_gaits(walker, solver, None, policy=fp.gait, other_gait=False,
+    return find_gaits(walker, solver, guess, policy=fp.gait, other_gait=False,
                       xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
-                      fd_check=False).result
+                      fd_check=False, seeds=False).result
 
 
 def interleg_angle(walker, x: np.ndarray) -> float:
