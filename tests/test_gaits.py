@@ -68,8 +68,7 @@ def test_automatic_guess_finds_the_printed_guess_gait(name):
     """No initial guess: the seeds find the gait the printed guess gives (paper Eq. 11 for
     the compass gait; Tedrake's guess for the kneed walker), step period and Floquet
     multipliers to 1e-9 (both roots are converged to xtol 1e-12, so they agree to ~1e-11)."""
-    printed = _solve(load_scene(ROOT / "configs" / f"{name}.yaml")
-                     .model_copy(update={}))  # with the guess
+    printed = _solve(load_scene(ROOT / "configs" / f"{name}.yaml"))  # with the guess
     auto = _solve(_without_guess(name))
     ref, got = printed.result, auto.result
     assert auto.gait.source == "seed"

@@ -96,7 +96,7 @@ class Gait:
         return float(np.max(np.abs(self.result.multipliers_variational)))
 
     def describe(self, time_unit: str = "s") -> str:
-        """``long-period gait (T = 0.9398 s, max |multiplier| 0.593, stable)``."""
+        """``long-period gait (step period 0.9398 s, max |multiplier| 0.593, stable)``."""
         return (f"{self.label.replace('_', '-')} gait (step period {self.result.period_s:.4f} "
                 f"{time_unit}, max |multiplier| {self.max_multiplier:.3g}, "
                 f"{'stable' if self.result.stable else 'UNSTABLE'})")
@@ -133,19 +133,6 @@ class GaitSearch:
     @property
     def result(self) -> FixedPointResult:
         return self.gait.result
-
-    def summary(self, time_unit: str = "s") -> str:
-        """One line per gait and a line on the choice (for the CLI)."""
-        lines = [f"period-1 gaits found: {len(self.gaits)}"
-                 + ("" if len(self.gaits) > 1 else " (the other of the long/short-period "
-                    "pair, if it exists, was not found)")]
-        for k, g in enumerate(self.gaits):
-            mark = "*" if k == self.selected else " "
-            lines.append(f" {mark} {g.describe(time_unit)}, from the {g.source.replace('_', ' ')}")
-        lines.append(f"selected ({'fixedpoint.gait: ' + self.policy}): "
-                     f"{self.gait.label.replace('_', '-')} gait" +
-                     ("; " + "; ".join(self.notes) if self.notes else ""))
-        return "\n".join(lines)
 
 
 # ----------------------------------------------------------------------------- seeds

@@ -56,6 +56,11 @@ def fixedpoint_text(path: Path) -> str:
     return "\n".join(lines)
 
 
+_GAIT_SOURCES = {"initial_guess": "root finder from the initial guess",
+                 "seed": "root finder from a scale-free seed",
+                 "deflation": "deflated root finder near the other gait"}
+
+
 def gaits_text(f) -> list[str]:
     """Lines on the period-1 gaits recorded in an open ``fixedpoint.h5`` (every gait found,
     the one selected by ``fixedpoint.gait`` marked ``*``, and why)."""
@@ -73,7 +78,7 @@ def gaits_text(f) -> list[str]:
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
                      f"{g['step_period'][()]:.6f} s, max |multiplier| {mod:.4g}, "
                      f"{'stable' if g['floquet/stable'][()] else 'UNSTABLE'} "
-                     f"(from the {str(g.attrs['source']).replace('_', ' ')})")
+                     f"({_GAIT_SOURCES.get(str(g.attrs['source']), g.attrs['source'])})")
     notes = json.loads(f.attrs.get("gait_notes", "[]"))
     lines.append(f"selected (fixedpoint.gait: {f.attrs['gait_policy']}): "
                  f"{sel.replace('_', '-')} gait" + ("; " + "; ".join(notes) if notes else ""))
