@@ -338,12 +338,30 @@ class StateSpec(_Strict):
 class FixedPointSettings(_Strict):
     """Search for the period-1 fixed point of the Poincaré map (paper Sec. 3.3)."""
 
-    initial_guess: StateSpec = Field(description="starting point of the root finder")
+    initial_guess: StateSpec | None = Field(
+        None, description="starting point of the root finder; null: found automatically "
+        "(scale-free seeds from the slope and the walker's size, ranked on the heel-strike "
+        "section; walkerlab.analysis.gaits)")
+    gait: Literal["stable", "long_period", "short_period", "nearest_guess"] = Field(
+        "stable", description="which period-1 gait to use where two exist (Goswami et al. "
+        "1996, Garcia et al. 1998: long- and short-period pair): 'stable' (the stable one; "
+        "none stable: the one nearest the initial guess), 'long_period', 'short_period', or "
+        "'nearest_guess' (where the root finder goes from initial_guess)")
+    other_gait: bool = Field(
+        True, description="also look for the other gait of the pair (deflated root finding "
+        "near the first; about 0.2-2 s) and record both in fixedpoint.h5")
     tolerance: float = Field(1e-12, gt=0, lt=1e-3, description="root-finder xtol [-]")
     max_step_time_s: float = Field(5.0, gt=0,
                                    description="a step longer than this is a failure [s]")
     fd_step: float = Field(1e-7, gt=0, lt=1e-2,
                            description="finite-difference step for the Jacobian")
+
+    @field_validator("gait")
+    @classmethod
+    def _guess_for_nearest(cls, v: str, info) -> str:
+        if v == "nearest_guess" and info.data.get("initial_guess") is None:
+            raise ValueError("'nearest_guess' needs an initial_guess")
+        return v
 
 
 class SimulateSettings(_Strict):

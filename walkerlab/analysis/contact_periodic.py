@@ -413,8 +413,8 @@ def rigid_limit_contact(walker: ContactWalker, kappa: float, mu_s: float = 2.0,
 def _walker_and_guess(walker_or_scene, guess):
     if isinstance(walker_or_scene, ContactWalker):
         return walker_or_scene, guess, None
+    from walkerlab.analysis.gaits import find_gaits
     from walkerlab.analysis.hybrid import Solver
-    from walkerlab.analysis.poincare import find_fixed_point
     from walkerlab.contact.scene import build
     from walkerlab.models.registry import build_walker
 
@@ -424,9 +424,12 @@ def _walker_and_guess(walker_or_scene, guess):
     if fp is None:
         raise ValueError(f"scene '{scene.name}' has no 'fixedpoint' section (initial guess of "
                          "the ideal gait)")
-    ideal = find_fixed_point(build_walker(sc), fp.initial_guess.as_array(),
-                             Solver.from_settings(sc.solver), xtol=fp.tolerance,
-                             fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
+    iw = build_walker(sc)
+    ideal = find_gaits(iw, Solver.from_settings(sc.solver),
+                       None if fp.initial_guess is None
+                       else fp.initial_guess.as_array(iw.state_names()),
+                       policy=fp.gait, other_gait=False, xtol=fp.tolerance,
+                       fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
     walker, _ = build(scene, ideal.x, 2)
     return walker, (ideal.x if guess is None else guess), ideal
 

@@ -134,7 +134,8 @@ class FixedPointResult:
 def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xtol: float = 1e-12,
                      fd_step: float = 1e-7, max_step_time: float = 5.0,
                      fd_check: bool = True,
-                     jacobian_guess: np.ndarray | None = None) -> FixedPointResult:
+                     jacobian_guess: np.ndarray | None = None,
+                     deflate: tuple | list = ()) -> FixedPointResult:
     """Find the period-1 fixed point of the Poincaré map and its Floquet multipliers.
 
     The root finder is MINPACK (``scipy.optimize.root``, method ``hybr``) on the map reduced
@@ -167,6 +168,13 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     jacobian_guess : ndarray, shape (2n, 2n), optional
         Approximate Jacobian ``DP`` of the Poincaré map near the fixed point (full state,
         as :attr:`FixedPointResult.jacobian_variational`).
+    deflate : sequence of ndarray, shape (2n,) each
+        Fixed points already known (full states): the root finder solves the *deflated*
+        residual ``F(z) * prod_k (1 / |z - z_k|^2 + 1)`` instead (Farrell, Birkisson & Funke
+        2015, "Deflation techniques for finding distinct solutions of nonlinear PDEs", SIAM
+        J. Sci. Comput. 37(4)), whose roots are the roots of ``F`` other than the ``z_k``:
+        from a start near a known gait it converges to another one.  Not with
+        ``jacobian_guess``.
 
     Returns
     -------
@@ -197,10 +205,15 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         else:
             counter["nfev"] += nf
             r = walker.section(xn) - z
+            for zk in known:
+                r = r * (1.0 / max(float(np.sum((z - zk) ** 2)), 1e-300) + 1.0)
         last.clear()
         last[key] = r
         return r.copy()
 
+    known = [walker.section(np.asarray(xk, float)) for xk in deflate]
+    if known and jacobian_guess is not None:
+        raise ValueError("find_fixed_point: deflate and jacobian_guess exclude each other")
     z0 = walker.section(np.asarray(guess, float))
     if jacobian_guess is None:
         sol = root(residual, z0, method="hybr", options={"xtol": xtol})

@@ -52,7 +52,37 @@ def fixedpoint_text(path: Path) -> str:
         verdict = "STABLE" if f["floquet/stable"][()] else "UNSTABLE"
         lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; "
                      f"{zero_multipliers_text(re, im)})")
+        lines += gaits_text(f)
     return "\n".join(lines)
+
+
+_GAIT_SOURCES = {"initial_guess": "root finder from the initial guess",
+                 "seed": "root finder from a scale-free seed",
+                 "deflation": "deflated root finder near the other gait"}
+
+
+def gaits_text(f) -> list[str]:
+    """Lines on the period-1 gaits recorded in an open ``fixedpoint.h5`` (every gait found,
+    the one selected by ``fixedpoint.gait`` marked ``*``, and why)."""
+    if "gaits" not in f:
+        return []
+    labels = [str(s) for s in f.attrs["gaits"]]
+    sel = str(f.attrs["gait"])
+    lines = [f"period-1 gaits found: {len(labels)}" + (
+        "" if len(labels) > 1 else " (the other gait of the long/short-period pair, if it "
+        "exists, was not found)")]
+    for lab in labels:
+        g = f[f"gaits/{lab}"]
+        mod = float(np.max(np.hypot(g["floquet/variational/real"][()],
+                                    g["floquet/variational/imag"][()])))
+        lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
+                     f"{g['step_period'][()]:.6f} s, max |multiplier| {mod:.4g}, "
+                     f"{'stable' if g['floquet/stable'][()] else 'UNSTABLE'} "
+                     f"({_GAIT_SOURCES.get(str(g.attrs['source']), g.attrs['source'])})")
+    notes = json.loads(f.attrs.get("gait_notes", "[]"))
+    lines.append(f"selected (fixedpoint.gait: {f.attrs['gait_policy']}): "
+                 f"{sel.replace('_', '-')} gait" + ("; " + "; ".join(notes) if notes else ""))
+    return lines
 
 
 def simulate_text(path: Path) -> str:

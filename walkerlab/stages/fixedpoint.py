@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
 
+from walkerlab.analysis.gaits import GaitNotFound, find_gaits
 from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.config import Scene
@@ -30,16 +32,59 @@ def _variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
     return own
 
 
-def solve_variant(scene: Scene, variant: str):
-    """Fixed point of one equation variant of the scene's walker (raises FixedPointNotFound)."""
-    sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
-    walker = build_walker(sc)
+def _guess(scene: Scene, walker):
+    """The scene's initial guess by state name, or None (found automatically)."""
     fp = require(scene, "fixedpoint", "fixedpoint")
+    if fp.initial_guess is None:
+        return None
     try:
-        guess = fp.initial_guess.as_array(walker.state_names())
+        return fp.initial_guess.as_array(walker.state_names())
     except ValueError as exc:
         raise StageError(f"fixedpoint.initial_guess: {exc}") from None
-    res = find_fixed_point(walker, guess, Solver.from_settings(scene.solver),
+
+
+def _with_variant(scene: Scene, variant: str) -> Scene:
+    return scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
+
+
+def solve_scene(scene: Scene, fd_check: bool = True):
+    """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``.
+
+    Returns
+    -------
+    walker : HybridWalker
+    search : walkerlab.analysis.gaits.GaitSearch
+
+    Raises
+    ------
+    GaitNotFound
+        No gait (one line: what was tried, what to try next).
+    StageError
+        A malformed initial guess or gait choice.
+    """
+    fp = require(scene, "fixedpoint", "fixedpoint")
+    walker = build_walker(scene)
+    try:
+        search = find_gaits(walker, Solver.from_settings(scene.solver), _guess(scene, walker),
+                            policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
+                            fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
+                            fd_check=fd_check)
+    except ValueError as exc:
+        raise StageError(str(exc)) from None
+    return walker, search
+
+
+def solve_variant(scene: Scene, variant: str, guess=None):
+    """Fixed point of one equation variant of the scene's walker, from ``guess`` (default:
+    the scene's initial guess) - for the comparison of printed equations (raises
+    FixedPointNotFound)."""
+    sc = _with_variant(scene, variant)
+    walker = build_walker(sc)
+    fp = require(scene, "fixedpoint", "fixedpoint")
+    g = _guess(scene, walker) if guess is None else guess
+    if g is None:
+        raise FixedPointNotFound("no initial guess for this equation variant", math.nan)
+    res = find_fixed_point(walker, g, Solver.from_settings(scene.solver),
                            xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
     return walker, res
 
@@ -85,21 +130,23 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``fixedpoint`` section, or no fixed point for the scene's own variant.
     """
-    fp_cfg = require(scene, "fixedpoint", "fixedpoint")
+    require(scene, "fixedpoint", "fixedpoint")
 
     def compute():
-        results = {}
-        for variant in _variants_for(scene, compare_variants):
+        try:
+            walker, search = solve_scene(scene)
+        except GaitNotFound as exc:
+            raise StageError(f"fixedpoint: {exc}") from None
+        main = search.result
+        results = {scene.ideal.variant: (walker, main)}
+        init = _guess(scene, walker)
+        for variant in _variants_for(scene, compare_variants)[1:]:
             try:
-                results[variant] = solve_variant(scene, variant)
+                results[variant] = solve_variant(scene, variant,
+                                                 main.x if init is None else init)
             except FixedPointNotFound as exc:
-                if variant == scene.ideal.variant:
-                    hint = ("; a passive walker needs a downhill slope (slope > 0), level or "
-                            "uphill ground has no passive gait") if scene.slope.phi_rad <= 0 else ""
-                    raise StageError(f"fixedpoint: {exc}{hint}") from None
                 results[variant] = exc
-        walker, main = results[scene.ideal.variant]
-        guess = fp_cfg.initial_guess.as_array(walker.state_names())
+        guess = search.gait.start
 
         def writer(f):
             f.attrs["model"] = walker.name
@@ -111,13 +158,25 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             coordinate(f, "multiplier", np.arange(len(names)), "-",
                        "Floquet multiplier number (sorted by modulus)")
             _write_result(f, walker, main, guess)
+            f.attrs["gait"] = search.gait.label
+            f.attrs["gait_policy"] = search.policy
+            f.attrs["gait_source"] = search.gait.source
+            f.attrs["gaits"] = [g.label for g in search.gaits]
+            f.attrs["gait_notes"] = json.dumps(search.notes)
+            f.attrs["gait_search"] = json.dumps(search.tried)
+            for g in search.gaits:
+                grp = f.create_group(f"gaits/{g.label}")
+                _write_result(grp, walker, g.result, g.start)
+                grp.attrs["source"] = g.source
             for v, r in results.items():
                 if isinstance(r, Exception):
                     f.create_group(f"variants/{v}").attrs["error"] = str(r)
                 else:
-                    _write_result(f.create_group(f"variants/{v}"), r[0], r[1], guess)
+                    _write_result(f.create_group(f"variants/{v}"), r[0], r[1],
+                                  guess if v == scene.ideal.variant else
+                                  (main.x if init is None else init))
 
-        summary = {"walker": walker, "result": main,
+        summary = {"walker": walker, "result": main, "gaits": search,
                    "variants": {k: v for k, v in results.items()}}
         return writer, summary
 

@@ -9,12 +9,13 @@ and ``resume=True`` computes only the rest.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from walkerlab.config import Scene, load_scene
 from walkerlab.io.runpaths import named_artifact
-from walkerlab.sweep.params import ParamAxis, SweepError, params_hash, parse_param
-from walkerlab.sweep.runner import run_sweep
+from walkerlab.sweep.params import ParamAxis, SweepError, check_axes, params_hash, parse_param
+from walkerlab.sweep.runner import MAX_GRID_POINTS, run_sweep
 
 __all__ = ["run", "parse_param", "sweep_path", "SweepError", "STAGE_NAMES"]
 
@@ -80,13 +81,17 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     SceneError
         The base scene does not validate.
     SweepError
-        A malformed ``--param``, an unknown stage, or a resume file of another sweep.
+        A malformed ``--param``, a field the scene does not have (with the closest name), a
+        value that does not validate, an unknown stage, or a resume file of another sweep.
     """
     scene = scene_path_or_scene if isinstance(scene_path_or_scene, Scene) \
         else load_scene(scene_path_or_scene)
     if stage not in STAGE_NAMES:
         raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(STAGE_NAMES)}")
     axes = [parse_param(p) if isinstance(p, str) else p for p in params]
+    # an unknown field or a bad value: refused before anything runs (the values of a grid
+    # too large to run are left to run_sweep's refusal)
+    check_axes(scene, axes, values=math.prod(len(a) for a in axes) <= MAX_GRID_POINTS)
     out = sweep_path(scene, axes, stage, runs_root, name, claim=True)
     from walkerlab.io.runpaths import model_cache_dir
     from walkerlab.models.cache import set_cache_dir

@@ -85,7 +85,8 @@ STRING_COLUMNS = {
     "message": "human-readable detail (exception text, solver message, guard name)",
     "fall_leg": "physical leg in stance when the walker fell ('' if none)",
     "guess_source": "fixed-point guess used: 'neighbour' (continuation from the chunk's "
-                    "previous fixed points), 'scene', or ''",
+                    "previous fixed points), 'scene' (its initial_guess), 'search' (found "
+                    "without a guess: walkerlab.analysis.gaits), or ''",
 }
 
 STAGES = tuple(COLUMNS)

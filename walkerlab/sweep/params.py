@@ -1,26 +1,30 @@
 """Sweep parameters: parsing ``--param`` strings, building the grid, applying a point.
 
 A parameter is a dotted path into the scene mapping (``slope.angle_deg``,
-``contact.stiffness``, ``solver.rtol``) and a list of values, given either as an inclusive
-range ``start:stop:step`` or as a comma list ``a,b,c``.  A grid point is applied to the plain
-``dict`` of the base scene and validated again through the same pydantic types
-(:func:`walkerlab.config.scene_from_dict`), so a bad value is caught per point.
+``contact.stiffness``, ``solver.rtol``; an item of a list by its ``name`` or index:
+``walker.leg.bodies.thigh_mass.mass_kg``, ``walker.leg.bodies.1.mass_kg``) and a list of
+values, given either as an inclusive range ``start:stop:step`` or as a comma list ``a,b,c``.
+A grid point is applied to the plain ``dict`` of the base scene and validated again through
+the same pydantic types (:func:`walkerlab.config.scene_from_dict`): a bad value is caught per
+point, and :func:`check_axes` refuses an unknown field or a bad value before a sweep starts.
 """
 
 from __future__ import annotations
 
 import copy
+import difflib
 import hashlib
 import itertools
 import json
 import math
+import typing
 from dataclasses import dataclass
 from typing import Any
 
 from walkerlab.config import Scene, SceneError, scene_from_dict
 
 __all__ = ["SweepError", "ParamAxis", "parse_param", "grid_points", "apply_point",
-           "params_hash", "EXCLUSIVE_FIELDS"]
+           "check_axes", "params_hash", "EXCLUSIVE_FIELDS"]
 
 
 class SweepError(ValueError):
@@ -114,8 +118,10 @@ def parse_param(text: str) -> ParamAxis:
         raise SweepError(f"--param {text!r}: expected PATH=START:STOP:STEP or PATH=A,B,C")
     path, _, rhs = text.partition("=")
     path, rhs = path.strip(), rhs.strip()
-    if not path or any(not p.isidentifier() for p in path.split(".")):
-        raise SweepError(f"--param {text!r}: {path!r} is not a dotted field name")
+    if not path or any(not (p.isidentifier() or p.isdigit()) for p in path.split(".")):
+        raise SweepError(f"--param {text!r}: {path!r} is not a dotted field name (names and "
+                         "list indices separated by dots, e.g. walker.hip_mass_kg or "
+                         "walker.leg.bodies.thigh_mass.mass_kg)")
     if not rhs:
         raise SweepError(f"--param {text!r}: no values")
     if ":" in rhs and "," not in rhs:
@@ -155,16 +161,47 @@ def grid_points(axes: list[ParamAxis]) -> list[tuple]:
     return list(itertools.product(*(a.values for a in axes)))
 
 
+def _list_item(items: list, key: str, path: str):
+    """The item of a scene list (e.g. ``walker.leg.bodies``) named ``key`` (its ``name``
+    field) or at index ``key``.
+
+    Raises
+    ------
+    SceneError
+        No such item (the message lists the names and the index range).
+    """
+    names = [it.get("name") for it in items if isinstance(it, dict)]
+    if key.isdigit():
+        if int(key) < len(items):
+            return items[int(key)]
+        raise SceneError(f"{path}: index {key} is out of range (the list has {len(items)} "
+                         f"items: {', '.join(map(str, names)) or 'none'})")
+    hits = [it for it in items if isinstance(it, dict) and it.get("name") == key]
+    if len(hits) == 1:
+        return hits[0]
+    close = difflib.get_close_matches(key, [str(n) for n in names], 1)
+    raise SceneError(f"{path}: no item named {key!r}"
+                     + (f" (did you mean {close[0]!r}?)" if close else "")
+                     + f"; items: {', '.join(map(str, names)) or 'none'} "
+                     f"(or by index 0-{max(len(items) - 1, 0)})")
+
+
 def _set_dotted(d: dict, path: str, value) -> None:
     keys = path.split(".")
     node = d
     for k in keys[:-1]:
+        if isinstance(node, list):
+            node = _list_item(node, k, path)
+            continue
         nxt = node.get(k)
         if nxt is None:
             nxt = node[k] = {}
-        elif not isinstance(nxt, dict):
+        elif not isinstance(nxt, (dict, list)):
             raise SceneError(f"{path}: '{k}' is not a section (it is {nxt!r})")
         node = nxt
+    if isinstance(node, list):
+        raise SceneError(f"{path}: '{keys[-1]}' is a list item, not a field: name the item's "
+                         f"field ({path}.mass_kg, ...)")
     node[keys[-1]] = value
 
 
@@ -176,6 +213,98 @@ def _pop_dotted(d: dict, path: str) -> None:
         if not isinstance(node, dict):
             return
     node.pop(keys[-1], None)
+
+
+def _models_in(annotation) -> list:
+    """The pydantic model classes an annotation can hold (through Optional, unions,
+    Annotated and list)."""
+    from pydantic import BaseModel
+
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    out = []
+    for a in typing.get_args(annotation):
+        out += _models_in(a)
+    return out
+
+
+def _check_path(scene: Scene, axis: ParamAxis) -> None:
+    """The axis path names a field of the scene (by the schema, lists by name or index).
+
+    Raises
+    ------
+    SweepError
+        An unknown field (with the closest name), a list item that does not exist, or a
+        path that goes on below a number.
+    """
+    from pydantic import BaseModel
+
+    keys = axis.path.split(".")
+    obj: object = scene
+    cls = type(scene)
+    for i, k in enumerate(keys):
+        here = ".".join(keys[:i + 1])
+        if isinstance(obj, (list, tuple)):
+            items = [o.model_dump() if isinstance(o, BaseModel) else o for o in obj]
+            try:
+                item = _list_item(items, k, axis.path)
+            except SceneError as exc:
+                raise SweepError(f"--param {axis.spec!r}: {exc}") from None
+            obj = obj[items.index(item)]
+            cls = type(obj)
+            continue
+        if cls is None or not (isinstance(cls, type) and issubclass(cls, BaseModel)):
+            raise SweepError(f"--param {axis.spec!r}: {'.'.join(keys[:i])} is a value, not a "
+                             f"section: it has no field {k!r}")
+        if cls.model_config.get("extra") == "allow":  # a state given by name
+            return
+        fields = cls.model_fields
+        if k not in fields:
+            close = difflib.get_close_matches(k, list(fields), 1, 0.6)
+            raise SweepError(f"--param {axis.spec!r}: unknown field {here}"
+                             + (f" (did you mean {'.'.join(keys[:i] + [close[0]])}?)"
+                                if close else "")
+                             + f"; {'.'.join(keys[:i]) or 'a scene'} has "
+                             + ", ".join(fields))
+        obj = getattr(obj, k) if obj is not None else None
+        if isinstance(obj, BaseModel):
+            cls = type(obj)
+        elif isinstance(obj, (list, tuple)):
+            cls = None
+        else:
+            models = _models_in(fields[k].annotation)
+            cls = models[0] if len(models) == 1 else None
+
+
+def check_axes(scene: Scene, axes: list[ParamAxis], values: bool = True) -> None:
+    """Refuse a sweep whose axes cannot work, before anything runs: every path must name a
+    field of the scene (lists by item name or index) and every value must validate.
+
+    Each value is checked alone, on the base scene (at most 200 values per axis, evenly
+    spread, the first and last included); combinations of axes are checked per point.
+    ``values=False`` checks the paths only.
+
+    Raises
+    ------
+    SweepError
+        One line naming the ``--param``, the field and the closest known name, or the value
+        and pydantic's message.
+    """
+    base = scene.model_dump(mode="json")
+    for axis in axes:
+        _check_path(scene, axis)
+    for axis in axes if values else ():
+        vals = axis.values
+        if len(vals) > 200:
+            idx = sorted({round(k * (len(vals) - 1) / 199) for k in range(200)})
+            vals = tuple(vals[k] for k in idx)
+        for v in vals:
+            try:
+                apply_point(base, [axis.path], (v,), "<sweep>")
+            except SceneError as exc:
+                msg = str(exc).split("]: ", 1)[-1]
+                raise SweepError(f"--param {axis.spec!r}: value {v!r} is not valid: "
+                                 f"{msg}") from None
 
 
 def apply_point(base: dict, paths: list[str], values: tuple, origin: str = "<sweep>") -> Scene:

@@ -156,7 +156,9 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
 
     Tries, in order: the continuation's predicted fixed point and Jacobian (MINPACK hybrj
     from the extrapolated ``DP``), the previous fixed point itself (hybrd), the scene's
-    ``fixedpoint.initial_guess`` (hybrd); the first that converges to a walking gait wins.
+    ``fixedpoint.initial_guess`` (hybrd) or, without one, the automatic search
+    (:func:`walkerlab.analysis.gaits.find_gaits`, choosing by ``fixedpoint.gait``); the
+    first that converges to a walking gait wins.
 
     Parameters
     ----------
@@ -172,7 +174,7 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     walker : HybridWalker
     result : FixedPointResult
     source : str
-        ``"neighbour"`` or ``"scene"``.
+        ``"neighbour"``, ``"scene"`` or ``"search"``.
 
     Raises
     ------
@@ -196,14 +198,20 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
             tries += [("neighbour", x_pred, J_pred), ("neighbour", guess.x, None)]
     elif guess is not None:
         tries.append(("neighbour", np.asarray(guess, float), None))
-    tries.append(("scene", fp.initial_guess.as_array(walker.state_names()), None))
+    if fp.initial_guess is not None:
+        tries.append(("scene", fp.initial_guess.as_array(walker.state_names()), None))
+    else:
+        tries.append(("search", None, None))
     best, msg = math.inf, ""
     for source, g, J in tries:
         try:
-            # the sweep keeps the variational multipliers only: no finite-difference check
-            res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
-                                   max_step_time=fp.max_step_time_s, fd_check=False,
-                                   jacobian_guess=J)
+            if source in ("scene", "search"):  # the scene's guess or seeds, its gait choice
+                res = _searched_gait(walker, solver, fp, g)
+            else:
+                # the sweep keeps the variational multipliers only: no finite-difference check
+                res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
+                                       max_step_time=fp.max_step_time_s, fd_check=False,
+                                       jacobian_guess=J)
         except FixedPointNotFound as exc:
             if not (exc.residual >= best):  # keeps NaN out unless nothing better
                 best = exc.residual if math.isfinite(exc.residual) else best
@@ -217,6 +225,18 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
             continue
         return walker, res, source
     raise _Outcome("no_fixed_point", msg, residual=best if math.isfinite(best) else math.nan)
+
+
+def _searched_gait(walker, solver, fp, guess):
+    """The scene's period-1 gait as the fixedpoint stage chooses it (``fixedpoint.gait``):
+    from the scene's initial guess (no seeds when it fails: a sweep point stays cheap), or
+    without one from the scale-free seeds; the other gait of the pair is looked for only
+    when the choice needs it (``stable`` and the first gait unstable, ``long_period``...)."""
+    from walkerlab.analysis.gaits import find_gaits
+
+    return find_gaits(walker, solver, guess, policy=fp.gait, other_gait=False,
+                      xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
+                      fd_check=False, seeds=False).result
 
 
 def interleg_angle(walker, x: np.ndarray) -> float:

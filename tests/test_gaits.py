@@ -1,0 +1,222 @@
+"""Gait finding that helps (issue 18 part 2) and sweeps over any scene field (issue 19 item 8).
+
+- Without ``fixedpoint.initial_guess`` the gait is found from scale-free seeds: the same fixed
+  point as from the printed guess (paper Eq. 11; Tedrake's kneedCompassGait.m guess).
+- Where two period-1 gaits exist (Goswami et al. 1996, Garcia et al. 1998) both are found
+  and the stable one is chosen by default; ``fixedpoint.gait`` picks another.
+- A failed search says in one line what was tried and what to try next.
+- Sweeps address list items by name or index and refuse unknown fields before starting.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from walkerlab.analysis.gaits import GaitNotFound, find_gaits, state_from_legs
+from walkerlab.analysis.hybrid import Solver
+from walkerlab.cli import app
+from walkerlab.config import SceneError, load_scene, scene_from_dict
+from walkerlab.models.registry import build_walker
+from walkerlab.stages import fixedpoint as fixedpoint_stage
+from walkerlab.stages import sweep as sweep_stage
+from walkerlab.sweep.params import SweepError, check_axes, parse_param
+from walkerlab.sweep.points import evaluate
+from walkerlab.sweep.store import load_sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: the heavy-hip rod walker of issue 18: 20 kg hip, uniform 4 kg 1 m rods, 2 deg slope
+HEAVY_HIP = {
+    "name": "heavy_hip",
+    "walker": {"model": "biped", "hip_mass_kg": 20.0,
+               "leg": {"length_m": 1.0, "bodies": [
+                   {"kind": "rod", "name": "rod", "mass_kg": 4.0, "com_from_hip_m": 0.5,
+                    "inertia_about_com_kg_m2": 4.0 / 12.0}]}},
+    "slope": {"angle_deg": 2.0},
+    "solver": {"method": "DOP853", "rtol": 1e-12, "atol": 1e-12},
+    # configs/paper_rods.yaml's guess: from it the root finder lands on the short-period gait
+    "fixedpoint": {"initial_guess": {"swing_angle_rad": -0.221, "stance_angle_rad": 0.186,
+                                     "swing_rate_rad_per_s": -0.668,
+                                     "stance_rate_rad_per_s": -0.831}},
+}
+
+
+def _without_guess(name: str):
+    d = yaml.safe_load((ROOT / "configs" / f"{name}.yaml").read_text())
+    d["name"] = name
+    del d["fixedpoint"]["initial_guess"]
+    return scene_from_dict(d)
+
+
+def _solve(scene):
+    walker = build_walker(scene)
+    fp = scene.fixedpoint
+    guess = None if fp.initial_guess is None else fp.initial_guess.as_array(walker.state_names())
+    return find_gaits(walker, Solver.from_settings(scene.solver), guess, policy=fp.gait,
+                      other_gait=fp.other_gait, xtol=fp.tolerance,
+                      max_step_time=fp.max_step_time_s, fd_check=False)
+
+
+@pytest.mark.parametrize("name", ["paper", "kneed"])
+def test_automatic_guess_finds_the_printed_guess_gait(name):
+    """No initial guess: the seeds find the gait the printed guess gives (paper Eq. 11 for
+    the compass gait; Tedrake's guess for the kneed walker), step period and Floquet
+    multipliers to 1e-9 (both roots are converged to xtol 1e-12, so they agree to ~1e-11)."""
+    printed = _solve(load_scene(ROOT / "configs" / f"{name}.yaml"))  # with the guess
+    auto = _solve(_without_guess(name))
+    ref, got = printed.result, auto.result
+    assert auto.gait.source == "seed"
+    assert abs(got.period_s - ref.period_s) < 1e-9
+    assert np.max(np.abs(got.multipliers_variational - ref.multipliers_variational)) < 1e-9
+    assert np.max(np.abs(got.x - ref.x)) < 1e-9
+    assert got.stable  # both shipped walkers walk stably (the default choice: stable)
+
+
+def test_seed_states_put_both_feet_on_the_slope():
+    """A seed is a state on the heel-strike surface, by leg angle whatever the coordinates:
+    the slope-relative simplest walker's seed has its legs at the asked absolute angles."""
+    sc = load_scene(ROOT / "configs" / "simplest.yaml")
+    w = build_walker(sc)
+    g = sc.slope.phi_rad
+    x = state_from_legs(w, 0.2 - g, -0.2 - g, -0.2, -0.05)
+    legs = w.leg_coordinates(x, w.legs[-1])
+    assert abs(float(legs[f"{w.legs[-1]}_angle"]) - (0.2 - g)) < 1e-12
+    assert abs(float(legs[f"{w.legs[0]}_angle"]) - (-0.2 - g)) < 1e-12
+    assert abs(float(w.heel_strike_guard(0.0, x))) < 1e-12
+
+
+def test_heavy_hip_walker_reports_both_gaits_and_picks_the_stable_one():
+    """Issue 18: from the guess the root finder reaches the short-period gait (max
+    |multiplier| 4.08, unstable); the long-period one (0.94 s) is stable.  Both are found,
+    the stable one is chosen by default and the note says how to keep the other."""
+    scene = scene_from_dict(HEAVY_HIP)
+    search = _solve(scene)
+    labels = {g.label: g for g in search.gaits}
+    assert set(labels) == {"long_period", "short_period"}
+    long, short = labels["long_period"].result, labels["short_period"].result
+    assert long.period_s > short.period_s
+    assert long.stable and np.max(np.abs(long.multipliers_variational)) < 1.0
+    assert not short.stable
+    assert abs(np.max(np.abs(short.multipliers_variational)) - 4.08) < 0.01
+    assert max(long.residual, short.residual) < 1e-9
+    assert labels["short_period"].source == "initial_guess"
+    assert search.gait.label == "long_period"
+    assert any("nearest_guess" in n for n in search.notes)
+    for policy, want in (("nearest_guess", "short_period"), ("short_period", "short_period"),
+                         ("long_period", "long_period")):
+        sc = scene_from_dict({**HEAVY_HIP, "fixedpoint": {**HEAVY_HIP["fixedpoint"],
+                                                          "gait": policy}})
+        assert _solve(sc).gait.label == want
+
+
+def test_sweep_point_chooses_the_gait_as_the_stage_does():
+    """A sweep's first point (no neighbour yet) follows fixedpoint.gait like the stage: the
+    heavy-hip walker's stable long-period gait, not the unstable one its guess reaches."""
+    base = scene_from_dict(HEAVY_HIP).model_dump(mode="json")
+    row, _ = evaluate("fixedpoint", base, ["slope.angle_deg"], (2.0,), 0, None, {})
+    assert row["outcome"] == "ok" and row["guess_source"] == "scene"
+    assert row["stable"] == 1.0 and 0.93 < row["step_period_s"] < 0.95
+    row, _ = evaluate("fixedpoint", dict(base, fixedpoint={**base["fixedpoint"],
+                                                          "gait": "nearest_guess"}),
+                      ["slope.angle_deg"], (2.0,), 0, None, {})
+    assert row["stable"] == 0.0 and abs(row["max_abs_multiplier"] - 4.08) < 0.01
+
+
+def test_fixedpoint_artifact_records_every_gait(tmp_path):
+    """fixedpoint.h5: the selected gait at the top (what downstream stages read), every
+    gait found under gaits/<label>, and the CLI prints both with the choice."""
+    path = tmp_path / "heavy_hip.yaml"
+    path.write_text(yaml.safe_dump(HEAVY_HIP))
+    r = CliRunner().invoke(app, ["fixedpoint", str(path), "--runs-dir", str(tmp_path / "runs")])
+    assert r.exit_code == 0, r.output
+    assert "period-1 gaits found: 2" in r.output and "UNSTABLE" in r.output
+    assert "selected (fixedpoint.gait: stable): long-period gait" in r.output
+    x, meta = fixedpoint_stage.load_fixed_point(tmp_path / "runs" / "heavy_hip" / "fixedpoint.h5")
+    with h5py.File(tmp_path / "runs" / "heavy_hip" / "fixedpoint.h5") as f:
+        assert sorted(f["gaits"]) == ["long_period", "short_period"]
+        assert f.attrs["gait"] == "long_period"
+        assert f["gaits/long_period/step_period"][()] == meta["step_period_s"]
+        assert not f["gaits/short_period/floquet/stable"][()]
+    assert meta["stable"] and 0.9 < meta["step_period_s"] < 1.0
+
+
+def test_failed_search_says_what_was_tried_in_one_line():
+    """Level ground has no passive gait: the message names the attempts and the next step."""
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    d["slope"] = {"angle_rad": 0.0}
+    with pytest.raises(GaitNotFound) as exc:
+        _solve(scene_from_dict(d))
+    msg = str(exc.value)
+    assert "\n" not in msg
+    assert "tried the initial guess and" in msg and "scale-free seeds" in msg
+    assert "downhill slope" in msg and "try a continuation" in msg
+
+
+def test_nearest_guess_without_a_guess_is_refused():
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    del d["fixedpoint"]["initial_guess"]
+    d["fixedpoint"]["gait"] = "nearest_guess"
+    with pytest.raises(SceneError, match="fixedpoint.gait: 'nearest_guess' needs"):
+        scene_from_dict(d, "x.yaml")
+
+
+# ----------------------------------------------------------------------------- sweeps
+def test_sweep_over_a_body_mass_by_name(tmp_path):
+    """A sweep over the kneed walker's shank mass, the body addressed by name: more mass low
+    on the swing leg lengthens its pendulum (effective length sum m d^2 / sum m d grows as
+    the 0.65 m shank mass grows against the 0.3 m thigh mass), so the step period grows.
+    The same body by index gives the same point."""
+    scene = load_scene(ROOT / "configs" / "kneed.yaml")
+    p = sweep_stage.run(scene, ["walker.leg.bodies.shank_mass.mass_kg=0.03,0.05,0.07"],
+                        "fixedpoint", workers=1, runs_root=tmp_path, progress=False)
+    rows = load_sweep(p)["points"]
+    assert list(rows["outcome"]) == ["ok"] * 3
+    T = np.asarray(rows["step_period_s"])
+    assert np.all(np.diff(T) > 1e-3), T
+    row, _ = evaluate("fixedpoint", scene.model_dump(mode="json"),
+                      ["walker.leg.bodies.1.mass_kg"], (0.07,), 0, None, {})
+    assert row["outcome"] == "ok" and abs(row["step_period_s"] - T[-1]) < 1e-9
+    # position along the leg, by name: the thigh mass lower -> longer swing, longer step
+    lo, _ = evaluate("fixedpoint", scene.model_dump(mode="json"),
+                     ["walker.leg.bodies.thigh_mass.from_hip_m"], (0.35,), 0, None, {})
+    assert lo["outcome"] == "ok" and lo["step_period_s"] > T[1] + 1e-3
+
+
+@pytest.mark.parametrize("param, words", [
+    ("slope.angel_deg=1:3:0.5", ["unknown field slope.angel_deg", "did you mean slope.angle_deg"]),
+    ("foo.bar=1", ["unknown field foo"]),
+    ("solver.method=Euler", ["'Euler' is not valid", "solver.method"]),
+    ("walker.hip_mas_kg=1", ["did you mean walker.hip_mass_kg"]),
+    ("walker.leg_mass_kg=-1,2", ["value -1 is not valid", "walker.leg_mass_kg"]),
+    ("slope.angle_deg.x=1", ["slope.angle_deg is a value"]),
+])
+def test_sweep_over_an_unknown_field_is_refused(tmp_path, param, words):
+    """Issue 19 item 8: refused before anything runs (no artifact), one line, rc 1."""
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    with pytest.raises(SweepError) as exc:
+        sweep_stage.run(scene, [param], "fixedpoint", workers=1, runs_root=tmp_path,
+                        progress=False)
+    assert all(w in str(exc.value) for w in words), str(exc.value)
+    assert "\n" not in str(exc.value)
+    assert not list(tmp_path.rglob("sweep_*"))
+    r = CliRunner().invoke(app, ["sweep", str(ROOT / "configs" / "paper.yaml"), "--param",
+                                 param, "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 1 and len(r.output.strip().splitlines()) == 1, r.output
+
+
+def test_list_items_by_name_or_index_in_paths():
+    scene = load_scene(ROOT / "configs" / "kneed.yaml")
+    assert parse_param("walker.leg.bodies.1.mass_kg=0.1").path == "walker.leg.bodies.1.mass_kg"
+    check_axes(scene, [parse_param("walker.leg.bodies.thigh_mass.from_hip_m=0.3")])
+    for bad, word in (("walker.leg.bodies.shank_mas.mass_kg=0.1", "did you mean 'shank_mass'"),
+                      ("walker.leg.bodies.5.mass_kg=0.1", "out of range"),
+                      ("walker.leg.bodies.shank_mass.mass=0.1",
+                       "did you mean walker.leg.bodies.shank_mass.mass_kg")):
+        with pytest.raises(SweepError, match=word):
+            check_axes(scene, [parse_param(bad)])

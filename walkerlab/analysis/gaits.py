@@ -1,0 +1,424 @@
+"""Finding a walker's period-1 gaits without being told where they are, and choosing one.
+
+A passive walker on a shallow slope usually has *two* period-1 gaits: a long-period and a
+short-period one (Goswami, Thuilot & Espiau 1996, INRIA RR-2996; Garcia, Chatterjee, Ruina &
+Coleman 1998, J. Biomech. Eng. 120:281-288 - for the simplest walker the long-period gait is
+the stable one).  They lie close together on the Poincaré section (they differ mostly in the
+swing leg's rate), so a root finder started between them lands on either.  This module
+
+1. starts the root finder from the scene's initial guess, if there is one;
+2. otherwise (or when that fails) makes *scale-free seeds* from the walker's own data - a
+   step angle ``alpha = c * gamma^(1/3)`` (the small-slope scaling of the step angle,
+   Garcia et al. 1998), a stance-leg rate ``-k * alpha * sqrt(g / l)`` (their
+   ``theta_dot ~ -theta``), a swing-leg rate ``r`` times the stance rate, knees straight -
+   turns each into a state just after heel strike through the walker's own
+   ``leg_coordinates`` (by name, any coordinates), ranks them by one coarse step of the
+   Poincaré map (``|P(z) - z| / |z|`` on the heel-strike section) and roots from the best;
+3. looks for the other gait of the pair by *deflation* (Farrell, Birkisson & Funke 2015,
+   SIAM J. Sci. Comput. 37(4)): the root finder, on the residual divided by the distance to
+   the gait already found, from starts a few percent off it along each section coordinate;
+4. labels the gaits (``long_period`` / ``short_period`` by step period) and picks one by the
+   scene's policy (``stable``, ``long_period``, ``short_period``, ``nearest_guess``).
+
+Every root is found by :func:`walkerlab.analysis.poincare.find_fixed_point` (MINPACK through
+``scipy.optimize.root``); nothing here knows a state's row.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from walkerlab.analysis.hybrid import Solver
+from walkerlab.analysis.poincare import (
+    FixedPointNotFound,
+    FixedPointResult,
+    StepFailed,
+    find_fixed_point,
+    poincare_map,
+)
+from walkerlab.models.base import HybridWalker
+
+__all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "seed_states", "state_from_legs",
+           "find_gaits", "select_gait"]
+
+#: gait choices of ``fixedpoint.gait``
+POLICIES = ("stable", "long_period", "short_period", "nearest_guess")
+
+#: seed grid: step angle / gamma^(1/3), stance rate / (alpha sqrt(g/l)), swing / stance rate
+SEED_STEP = (0.5, 0.7, 0.9, 1.1, 1.3)
+SEED_STANCE_RATE = (0.8, 1.1, 1.4)
+SEED_SWING_RATIO = (0.0, 0.4, 0.8)
+#: seeds the root finder is started from (best first by the coarse residual)
+ROOT_STARTS = 6
+#: relative offset of the deflated starts from the gait already found
+DEFLATION_OFFSET = 0.05
+#: two fixed points closer than this (max |x1 - x2|, rad and rad/s) are the same gait
+SAME_GAIT = 1e-6
+
+
+class GaitNotFound(FixedPointNotFound):
+    """No period-1 gait: the message (one line) says what was tried and what to try next."""
+
+    def __init__(self, message: str, residual: float):
+        RuntimeError.__init__(self, message)
+        self.residual = residual
+
+
+@dataclass
+class Gait:
+    """One period-1 gait.
+
+    Attributes
+    ----------
+    label : str
+        ``"long_period"``/``"short_period"`` (two gaits found) or ``"period_1"`` (one).
+    result : FixedPointResult
+    source : str
+        Where the root finder started: ``"initial_guess"``, ``"seed"`` (scale-free seed) or
+        ``"deflation"`` (near the other gait, deflated).
+    start : ndarray (2n,)
+        The root finder's starting state.
+    """
+
+    label: str
+    result: FixedPointResult
+    source: str
+    start: np.ndarray
+
+    @property
+    def max_multiplier(self) -> float:
+        """Largest |Floquet multiplier| (variational) [-]."""
+        return float(np.max(np.abs(self.result.multipliers_variational)))
+
+    def describe(self, time_unit: str = "s") -> str:
+        """``long-period gait (step period 0.9398 s, max |multiplier| 0.593, stable)``."""
+        return (f"{self.label.replace('_', '-')} gait (step period {self.result.period_s:.4f} "
+                f"{time_unit}, max |multiplier| {self.max_multiplier:.3g}, "
+                f"{'stable' if self.result.stable else 'UNSTABLE'})")
+
+
+@dataclass
+class GaitSearch:
+    """The period-1 gaits found and the one chosen.
+
+    Attributes
+    ----------
+    gaits : list of Gait
+        Longest step period first.
+    selected : int
+        Index of the chosen gait in ``gaits``.
+    policy : str
+        One of :data:`POLICIES`.
+    notes : list of str
+        What happened on the way (an initial guess that failed, a policy that fell back).
+    tried : list of str
+        Every start of the root finder, for failure messages.
+    """
+
+    gaits: list[Gait]
+    selected: int
+    policy: str
+    notes: list[str] = field(default_factory=list)
+    tried: list[str] = field(default_factory=list)
+
+    @property
+    def gait(self) -> Gait:
+        return self.gaits[self.selected]
+
+    @property
+    def result(self) -> FixedPointResult:
+        return self.gait.result
+
+
+# ----------------------------------------------------------------------------- seeds
+def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: float,
+                    stance_rate: float, swing_rate: float) -> np.ndarray:
+    """Walker state (2n,) whose legs have the given absolute angles and rates.
+
+    Every link of the stance leg gets ``stance_angle`` [rad, from the vertical, positive with
+    the foot ahead of the hip] and ``stance_rate`` [rad/s], every link of the swing leg the
+    swing values (knees straight).  The state is found by least squares
+    (``scipy.optimize.least_squares``) on the walker's own ``leg_coordinates`` - so it works
+    for any coordinates (absolute, slope-relative) and any number of links - and projected on
+    the heel-strike surface (``from_section(section(x))``).
+
+    Returns
+    -------
+    ndarray, shape (2n,)
+        Role-ordered state, leg ``walker.legs[-1]`` in stance.
+    """
+    from scipy.optimize import least_squares
+
+    stance_leg = walker.legs[-1]
+    n = 2 * walker.n_coordinates
+    keys = list(walker.leg_coordinates(np.zeros(n), stance_leg))
+
+    def target(k: str) -> float:
+        stance = k.startswith(stance_leg + "_")
+        if k.endswith("_angle"):
+            return stance_angle if stance else swing_angle
+        return stance_rate if stance else swing_rate
+
+    tgt = np.array([target(k) for k in keys])
+
+    def residual(x):
+        d = walker.leg_coordinates(x, stance_leg)
+        return np.array([float(d[k]) for k in keys]) - tgt
+
+    sol = least_squares(residual, np.zeros(n), xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    return walker.from_section(walker.section(sol.x))
+
+
+def seed_states(walker: HybridWalker) -> list[tuple[str, np.ndarray]]:
+    """Scale-free seeds just after heel strike, from the slope and the walker's size.
+
+    Step half-angle ``alpha = c gamma^(1/3)`` (``c`` in :data:`SEED_STEP`; Garcia et al.
+    1998: the step angle of both gaits scales as gamma^(1/3) on small slopes), stance leg at
+    ``alpha - gamma`` and swing leg at ``-alpha - gamma`` from the vertical (so the feet lie on
+    the slope), stance rate ``-k alpha sqrt(g/l)`` (``k`` in :data:`SEED_STANCE_RATE`; their
+    ``theta_dot ~ -theta``), swing rate ``r`` times the stance rate (``r`` in
+    :data:`SEED_SWING_RATIO`).
+
+    Returns
+    -------
+    list of (str, ndarray (2n,))
+        A description and the state, for each seed.
+    """
+    gamma = max(float(walker.slope_rad), 1e-4)
+    omega = math.sqrt(float(walker.params["gravity_m_per_s2"])
+                      / float(walker.params["leg_length_m"]))
+    out = []
+    for c, k, r in itertools.product(SEED_STEP, SEED_STANCE_RATE, SEED_SWING_RATIO):
+        alpha = min(c * gamma ** (1.0 / 3.0), 0.6)
+        rate = -k * alpha * omega
+        x = state_from_legs(walker, alpha - gamma, -alpha - gamma, rate, r * rate)
+        out.append((f"step angle {c:g} gamma^(1/3), stance rate {k:g} alpha sqrt(g/l), "
+                    f"swing/stance rate {r:g}", x))
+    return out
+
+
+def _coarse(solver: Solver) -> Solver:
+    """The solver at a screening tolerance (1e-7, or the scene's if looser)."""
+    return dataclasses.replace(solver, rtol=max(solver.rtol, 1e-7), atol=max(solver.atol, 1e-9))
+
+
+def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
+                 ) -> tuple[list[tuple[float, str, np.ndarray]], int]:
+    """Seeds ranked by one coarse Poincaré-map step: ``|section(P(x)) - section(x)| /
+    |section(x)|`` (seeds that fall within the step are dropped).
+
+    Returns
+    -------
+    ranked : list of (float, str, ndarray (2n,))
+        Relative residual, description, state; smallest residual first.
+    n_seeds : int
+        Seeds tried.
+    """
+    coarse = _coarse(solver)
+    seeds = seed_states(walker)
+    ranked = []
+    for desc, x in seeds:
+        try:
+            xn, _, _ = poincare_map(walker, x, coarse, max_step_time)
+        except StepFailed:
+            continue
+        z = walker.section(x)
+        ranked.append((float(np.linalg.norm(walker.section(xn) - z) / np.linalg.norm(z)),
+                       desc, x))
+    ranked.sort(key=lambda t: t[0])
+    return ranked, len(seeds)
+
+
+# ----------------------------------------------------------------------------- search
+def _is_new(res: FixedPointResult, found: list[Gait]) -> bool:
+    return all(float(np.max(np.abs(res.x - g.result.x))) > SAME_GAIT for g in found)
+
+
+def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = None,
+               policy: str = "stable", other_gait: bool = True, xtol: float = 1e-12,
+               fd_step: float = 1e-7, max_step_time: float = 5.0, fd_check: bool = True,
+               time_unit: str = "s", seeds: bool = True) -> GaitSearch:
+    """Find the walker's period-1 gait(s) and choose one.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    solver : Solver
+    guess : ndarray (2n,), optional
+        Initial guess (role-ordered state just after heel strike); without it the root
+        finder starts from the best scale-free seeds (:func:`seed_states`).
+    policy : {"stable", "long_period", "short_period", "nearest_guess"}
+        Which gait to choose (:func:`select_gait`).
+    other_gait : bool
+        Also look for the other gait of the long/short-period pair (deflation; a few
+        root-finder runs, ~0.2-2 s).  Needed by the ``long_period``/``short_period``
+        policies and by ``stable`` when the first gait found is unstable.
+    xtol, fd_step, max_step_time, fd_check
+        As :func:`walkerlab.analysis.poincare.find_fixed_point`.
+    time_unit : str
+        Unit of the step period in messages (``s``, or ``sqrt(l/g)`` for a nondimensional
+        scene).
+    seeds : bool
+        Try the scale-free seeds when the guess does not converge (always without a guess).
+
+    Returns
+    -------
+    GaitSearch
+
+    Raises
+    ------
+    GaitNotFound
+        No gait from the guess nor from the seeds, or the policy's gait was not found; the
+        one-line message says what was tried and what to try next.
+    ValueError
+        Unknown ``policy``, or ``nearest_guess`` without a guess.
+    """
+    if policy not in POLICIES:
+        raise ValueError(f"fixedpoint.gait: {policy!r} is not one of {', '.join(POLICIES)}")
+    if policy == "nearest_guess" and guess is None:
+        raise ValueError("fixedpoint.gait: nearest_guess needs fixedpoint.initial_guess")
+    kw = {"xtol": xtol, "fd_step": fd_step, "max_step_time": max_step_time,
+          "fd_check": fd_check}
+    found: list[Gait] = []
+    tried: list[str] = []
+    notes: list[str] = []
+    best = math.inf
+    last_msg = ""
+
+    def attempt(x0, source: str, deflate=()) -> Gait | None:
+        nonlocal best, last_msg
+        try:
+            res = find_fixed_point(walker, x0, solver, deflate=deflate, **kw)
+        except FixedPointNotFound as exc:
+            if math.isfinite(exc.residual) and "standing" not in str(exc):
+                best = min(best, exc.residual)
+            last_msg = str(exc)
+            return None
+        if not _is_new(res, found):
+            return None
+        return Gait("period_1", res, source, np.asarray(x0, float))
+
+    if guess is not None:
+        tried.append("the initial guess")
+        g = attempt(np.asarray(guess, float), "initial_guess")
+        if g is not None:
+            found.append(g)
+        else:
+            notes.append(f"the initial guess did not converge ({_short(last_msg)})")
+    n_seeds = n_started = 0
+    if not found and (seeds or guess is None):
+        ranked, n_seeds = screen_seeds(walker, solver, max_step_time)
+        for _err, _desc, x in ranked[:ROOT_STARTS]:
+            n_started += 1
+            g = attempt(x, "seed")
+            if g is not None:
+                found.append(g)
+                break
+        tried.append(f"{n_started} of {n_seeds} scale-free seeds "
+                     f"({n_seeds - len(ranked)} fell within the first step)")
+    if not found:
+        raise GaitNotFound(_failure(walker, tried, best, last_msg, guess is not None), best)
+    need_other = other_gait or policy in ("long_period", "short_period") or (
+        policy == "stable" and not found[0].result.stable)
+    if need_other:
+        first = found[0].result.x
+        z1 = walker.section(first)
+        n_defl = 0
+        for j, sign in itertools.product(range(z1.size), (1.0, -1.0)):
+            dz = np.zeros(z1.size)
+            dz[j] = sign * DEFLATION_OFFSET * max(abs(float(z1[j])), 0.1)
+            n_defl += 1
+            g = attempt(walker.from_section(z1 + dz), "deflation", deflate=(first,))
+            if g is not None:
+                found.append(g)
+                break
+        tried.append(f"{n_defl} deflated starts near the first gait")
+    found.sort(key=lambda g: -g.result.period_s)
+    if len(found) == 2:
+        found[0].label, found[1].label = "long_period", "short_period"
+    search = GaitSearch(found, 0, policy, notes, tried)
+    search.selected = select_gait(search, guess, time_unit)
+    return search
+
+
+def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
+                time_unit: str = "s") -> int:
+    """Index of the gait ``search.policy`` chooses (notes on the choice go to
+    ``search.notes``).
+
+    - ``stable``: the stable gait (nearest the guess if several); none stable: the gait
+      nearest the guess (or, without a guess, the least unstable one), with a note;
+    - ``long_period``/``short_period``: by label (both gaits must have been found);
+    - ``nearest_guess``: the gait the root finder reached from the initial guess (else the
+      one nearest it, max-norm over the state).
+
+    Raises
+    ------
+    GaitNotFound
+        ``long_period``/``short_period`` asked but only one gait was found.
+    """
+    gaits, policy = search.gaits, search.policy
+
+    def nearest(cands):
+        cands = list(cands)
+        if guess is None:
+            return min(cands, key=lambda k: gaits[k].max_multiplier)
+        # the gait the root finder reached from the guess; else the closest (max-norm)
+        return min(cands, key=lambda k: (gaits[k].source != "initial_guess",
+                                         float(np.max(np.abs(gaits[k].result.x - guess)))))
+
+    if policy in ("long_period", "short_period"):
+        k = next((k for k, g in enumerate(gaits) if g.label == policy), None)
+        if k is None:
+            raise GaitNotFound(
+                f"fixedpoint.gait: {policy}: only one period-1 gait was found "
+                f"({gaits[0].describe(time_unit)}; tried {', '.join(search.tried)}); use "
+                "gait: stable or nearest_guess, or give an initial_guess near the other gait",
+                0.0)
+        return k
+    if policy == "nearest_guess":
+        return nearest(range(len(gaits)))
+    stable = [k for k, g in enumerate(gaits) if g.result.stable]
+    if stable:
+        k = nearest(stable)
+        if guess is not None:
+            near = nearest(range(len(gaits)))
+            if near != k:
+                other = gaits[near].label.replace("_", "-")
+                search.notes.append(
+                    f"the gait nearest the initial guess is the {other} one, UNSTABLE "
+                    f"(max |multiplier| {gaits[near].max_multiplier:.3g}); "
+                    "fixedpoint.gait: nearest_guess selects it")
+        return k
+    search.notes.append("no stable period-1 gait found: "
+                        + ("the one nearest the initial guess" if guess is not None
+                           else "the least unstable one"))
+    return nearest(range(len(gaits)))
+
+
+def _short(msg: str) -> str:
+    """scipy's message, one line, without the prefix and the residual (given apart)."""
+    import re
+
+    text = " ".join(str(msg).removeprefix("no fixed point found: ").split())
+    return re.sub(r" \(residual [^)]*\)$", "", text)
+
+
+def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
+             had_guess: bool) -> str:
+    res = f", best residual {best:.2g}" if math.isfinite(best) else ""
+    last = _short(last)
+    if last and "standing" not in last:
+        last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
+    why = (" a passive walker needs a downhill slope (slope > 0);"
+           if walker.slope_rad <= 0 else " the walker may have no period-1 gait here;")
+    return (f"no period-1 gait found (tried {' and '.join(tried)}{res}; last: "
+            f"{last or 'every start fell'});{why} try a continuation from a walker whose gait "
+            "is known (walkerlab sweep SCENE --param FIELD=KNOWN:THIS:STEP, small steps, e.g. a "
+            "body's mass_kg or slope.angle_deg) to see where the gait ends, or "
+            + ("an initial_guess nearer a gait" if had_guess else "give fixedpoint.initial_guess"))
