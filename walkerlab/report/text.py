@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.io.artifacts import open_artifact
+from walkerlab.report.markdown import num
+from walkerlab.units import for_artifact
 
 
 def _fmt_mult(re, im) -> str:
@@ -30,6 +32,7 @@ def zero_multipliers_text(re, im) -> str:
 def fixedpoint_text(path: Path) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     with open_artifact(path, "fixedpoint") as f:
+        u = for_artifact(f)
         names = [str(n) for n in f.attrs["state_names"]]
         legs = json.loads(f.attrs["legs_by_role"]) if "legs_by_role" in f.attrs else {}
         lines = [f"fixed point ({f.attrs['model']}, {f.attrs['variant']} equations), "
@@ -41,7 +44,7 @@ def fixedpoint_text(path: Path) -> str:
             where = f"({legs[role]}, {role} leg)" if role else "(not on a leg)"
             unit = f["fixed_point/" + n].attrs["unit"]
             lines.append(f"  {n:<14s} {where} {f['fixed_point/' + n][()]: .10f} {unit}")
-        lines.append(f"  step period     {f['step_period'][()]:.10f} s")
+        lines.append(f"  step period     {f['step_period'][()]:.10f} {u.time}")
         lines.append(f"  residual        {f['residual'][()]:.2e}  (max |P(x*) - x*|)")
         re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
         lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")
@@ -58,29 +61,42 @@ def fixedpoint_text(path: Path) -> str:
 def simulate_text(path: Path) -> str:
     """Steps completed, per-step period/length/speed, energy."""
     with open_artifact(path, "simulate") as f:
+        u = for_artifact(f)
         s = f["steps"]
         lines = [f"simulated {f.attrs['strides_requested']} strides: "
                  f"{int(np.sum(s['termination'][()] == b'heel_strike'))} heel strikes, "
                  f"ended by {f.attrs['termination']}"]
-        lines.append(f"  mean step period  {f['summary/mean_period_s'][()]:.6f} s")
-        lines.append(f"  mean step length  {f['summary/mean_step_length_m'][()]:.6f} m")
-        lines.append(f"  mean hip speed    {f['summary/mean_hip_speed_m_per_s'][()]:.6f} m/s")
-        lines.append(f"  mean total energy {f['summary/mean_total_energy_J'][()]:.4f} J "
-                     "(potential from the first stance foot)")
+        if u.nondimensional:
+            lines.append(f"  ({u.sentence()})")
+        lines.append(f"  mean step period  {num(f['summary/mean_period_s'][()], 7)} {u.time}")
+        lines.append(f"  mean step length  {num(f['summary/mean_step_length_m'][()], 7)} "
+                     f"{u.length}")
+        lines.append(f"  mean hip speed    {num(f['summary/mean_hip_speed_m_per_s'][()], 7)} "
+                     f"{u.speed}")
+        lines.append(f"  mean total energy {num(f['summary/mean_total_energy_J'][()], 7)} "
+                     f"{u.energy} (potential from the first stance foot)")
         lines.append(f"  RHS evaluations   {int(f['summary/nfev'][()])}, "
-                     f"integration {f['summary/wall_time_s'][()]:.3f} s")
+                     f"integration {num(f['summary/wall_time_s'][()], 3)} s (wall clock)")
     return "\n".join(lines)
 
 
 def contact_text(path: Path) -> str:
     """Summary of a contact-sim artifact."""
     with open_artifact(path, "contact-sim") as f:
-        lines = [f"contact walker: outcome {f.attrs.get('outcome', '?')} "
-                 f"({f.attrs.get('outcome_message', f.attrs.get('termination', '?'))})"]
+        kind = str(f.attrs.get("outcome", "?"))
+        why = str(f.attrs.get("outcome_message", f.attrs.get("termination", "")))
+        # the message only when it says more than the outcome's name
+        lines = [f"contact walker: outcome {kind}" + (f" ({why})" if why and why != kind
+                                                      else "")]
         if "summary" in f:
             for k in f["summary"]:
                 ds = f["summary"][k]
-                lines.append(f"  {k:<28s} {ds[()]} {ds.attrs.get('unit', '')}")
+                unit = str(ds.attrs.get("unit", ""))
+                lines.append(f"  {k:<32s} {num(ds[()])}" + (f" {unit}" if unit not in
+                                                              ("", "-") else ""))
+            if "wall_time_s" in f["summary"] and "wall_time_s" in f.attrs:
+                lines.append(f"  (wall_time_s: the walking run's integration; the whole stage "
+                             f"took {num(f.attrs['wall_time_s'], 3)} s)")
         if "periodic_gait" in f and "step_period" not in f["periodic_gait"]:
             g = f["periodic_gait"]
             lines.append(f"periodic contact gait: not found ({g.attrs.get('outcome', '?')}: "
@@ -88,8 +104,8 @@ def contact_text(path: Path) -> str:
         elif "periodic_gait" in f:
             g = f["periodic_gait"]
             mult = g["multipliers/real"][()] + 1j * g["multipliers/imag"][()]
-            lines.append(f"periodic contact gait: step period {g['step_period'][()]:.6f} s, "
-                         f"step length {g['step_length'][()]:.6f} m, "
+            lines.append(f"periodic contact gait: step period {num(g['step_period'][()], 6)} s, "
+                         f"step length {num(g['step_length'][()], 6)} m, "
                          f"{'stable' if g['stable'][()] else 'unstable'}")
             lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
                          + f" (+{len(mult) - 3} fast contact modes ~0)")
