@@ -8,7 +8,7 @@ quantity names its *SI* unit (``"s"``, ``"m/s"``, ``"J"``, ``"rad/s"``, ``"mm"``
 ``M g l``, ``rad/√(l/g)``, ``10⁻³ l`` instead.  Wall-clock and CPU times of a computation
 are real seconds in every scene: they are not passed through :class:`Units`.
 
-Artifacts carry the system in their ``unit_system`` attribute and their datasets' ``unit``
+Artifacts carry the system in their ``scene_units`` attribute and their datasets' ``unit``
 attributes follow it (:func:`relabel_artifact`).
 """
 
@@ -87,8 +87,8 @@ def for_scene(scene) -> Units:
 
 
 def for_artifact(f) -> Units:
-    """:class:`Units` of an open artifact (its ``unit_system`` attribute; SI if absent)."""
-    v = f.attrs.get("unit_system", SI)
+    """:class:`Units` of an open artifact (its ``scene_units`` attribute; SI if absent)."""
+    v = f.attrs.get("scene_units", SI)
     return Units(v.decode() if isinstance(v, bytes) else str(v))
 
 
@@ -100,8 +100,8 @@ def is_clock_time(name: str, attrs) -> bool:
 
 def relabel_artifact(f, units: Units) -> None:
     """Rewrite every dataset's ``unit`` (and CF ``units``) attribute of an open artifact to
-    ``units``' labels, except clock times; store ``unit_system``."""
-    f.attrs["unit_system"] = units.system
+    ``units``' labels, except clock times; store ``scene_units``."""
+    f.attrs["scene_units"] = units.system
     if not units.nondimensional:
         return
     import h5py

@@ -279,20 +279,49 @@ def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
     return fig
 
 
+def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 6) -> list:
+    """Annotate ``(x, y, text)`` points, skipping a label whose box would overlap one
+    already placed (tried at four offsets first): labels never cover each other."""
+    fig = ax.figure
+    fig.canvas.draw()  # a renderer and the final axis limits
+    renderer = fig.canvas.get_renderer()
+    placed, boxes = [], []
+    for x, y, text in points:
+        for dx, dy, ha, va in ((4, 3, "left", "bottom"), (4, -3, "left", "top"),
+                               (-4, 3, "right", "bottom"), (-4, -3, "right", "top")):
+            a = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
+                            fontsize=fontsize, alpha=0.7, ha=ha, va=va)
+            bb = a.get_window_extent(renderer).expanded(1.05, 1.1)
+            if not any(bb.overlaps(b) for b in boxes):
+                boxes.append(bb)
+                placed.append(a)
+                break
+            a.remove()
+    return placed
+
+
 def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None):
-    """Work-precision diagram: error vs wall time (log-log), one line per method."""
+    """Work-precision diagram: error vs wall time (log-log), one line per method; the
+    spread of the repeats (``time_min``..``time_max``) as horizontal bars, the tolerance
+    next to each point where its label does not cover another."""
     fig, ax = plt.subplots(figsize=(7, 5))
+    labels = []
     for method, d in rows.items():
         ok = np.isfinite(d["error"]) & (d["error"] > 0)
-        ax.loglog(d["time"][ok], d["error"][ok], "o-", label=method, ms=4)
-        for t, e, tol in zip(d["time"][ok], d["error"][ok], d["rtol"][ok]):
-            ax.annotate(f"{tol:.0e}", (t, e), fontsize=6, alpha=0.6)
+        line, = ax.loglog(d["time"][ok], d["error"][ok], "o-", label=method, ms=4)
+        if "time_min" in d and "time_max" in d:
+            ax.errorbar(d["time"][ok], d["error"][ok],
+                        xerr=[d["time"][ok] - d["time_min"][ok], d["time_max"][ok] - d["time"][ok]],
+                        fmt="none", ecolor=line.get_color(), elinewidth=0.8, capsize=2)
+        labels += [(t, e, f"{tol:.0e}") for t, e, tol in zip(d["time"][ok], d["error"][ok],
+                                                             d["rtol"][ok])]
     if pareto:
         pt = np.array([(p["time"], p["error"]) for p in pareto])
-        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front")
-    ax.set_xlabel("wall time (median of repeats) [s]")
+        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (median times)")
+    ax.set_xlabel("wall time [s] (median of repeats; bars: fastest to slowest run)")
     ax.set_ylabel("max state error vs reference [rad, rad/s]")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
     _legend(ax)
+    _place_labels(ax, labels)
     return fig

@@ -160,21 +160,19 @@ def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
 
 def _map_lines(artifact) -> list[str]:
     """Stability maps of the contact gait, where their artifacts exist next to ``artifact``."""
-    import shutil
-
     out = []
+    figdir = artifact.parent / "report" / "figures"
     for kind in ("stiffness", "friction", "patch_width"):
         p = artifact.parent / f"stability_map_{kind}.h5"
-        png = p.with_suffix(".png")
-        if not (p.is_file() and png.is_file()):
+        if not p.is_file():
+            continue
+        png = figdir / f"{p.stem}.png"  # the stage draws it there from the artifact
+        if not png.is_file():
             continue
         with open_artifact(p) as f:
             ex = float(f["summary/exists_fraction"][()])
             stab = float(f["summary/stable_fraction"][()])
             n = int(f["summary/cells"][()])
-        figdir = artifact.parent / "report" / "figures"
-        figdir.mkdir(parents=True, exist_ok=True)
-        shutil.copy(png, figdir / png.name)
         cap = (f"Stability map of the contact gait over {kind.replace('_', ' ')} × slope "
                f"({n} cells): a periodic gait exists in {100 * ex:.0f} % of the cells and is "
                f"stable in {100 * stab:.0f} %.")

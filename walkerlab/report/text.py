@@ -110,3 +110,67 @@ def contact_text(path: Path) -> str:
             lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
                          + f" (+{len(mult) - 3} fast contact modes ~0)")
     return "\n".join(lines)
+
+
+def compare_text(path: Path) -> str:
+    """Key errors of a compare artifact: largest angle and rate error contact − ideal per
+    coordinate, the limit cycles' mean distance, and the gait metrics side by side."""
+    with open_artifact(path, "compare") as f:
+        u = for_artifact(f)
+        g = f["errors"]
+        t = g["time"][()]
+        lines = [f"errors contact - ideal over the common span 0-{num(t[-1], 4)} {u.time}:",
+                 f"  max |angle error| {num(g['max_abs_angle'][()], 3)} rad, "
+                 f"max |rate error| {num(g['max_abs_rate'][()], 3)} {u.rate}"]
+        for n in [str(x) for x in g.attrs["coordinates"]]:
+            ds = g[f"coordinates/{n}"]
+            lines.append(f"  {n:<22s} max |error| {num(np.max(np.abs(ds[()])), 3)} "
+                         f"{ds.attrs['unit']}")
+        if "limit_cycle_distance" in g:
+            lines.append("  limit cycles, mean distance ideal -> contact: " + ", ".join(
+                f"{k} {num(g['limit_cycle_distance'][k][()], 3)}"
+                for k in g["limit_cycle_distance"]))
+        if "metrics" in f and {"ideal", "contact"} <= set(f["metrics"]):
+            m = f["metrics"]
+            lines.append(f"  {'gait metric':<22s} {'ideal':>11s} {'contact':>11s}")
+            for k in m["ideal"]:
+                if k in m["contact"]:
+                    lines.append(f"  {k:<22s} {num(m['ideal'][k][()]):>11s} "
+                                 f"{num(m['contact'][k][()]):>11s} "
+                                 f"{m['ideal'][k].attrs.get('unit', '')}")
+    return "\n".join(lines)
+
+
+def _ms(t: float) -> str:
+    return f"{num(1e3 * t, 3)} ms"
+
+
+def workprecision_choice(attrs) -> str:
+    """The work-precision study's choice for one model (attributes of its group), in one
+    sentence that says how noisy the timing was: a setting is named fastest only when its
+    slowest run beats every other qualifying setting's fastest run; otherwise the
+    timings cannot separate them."""
+    if "best_method" not in attrs:
+        return f"no setting reaches the target error {num(attrs['target_error'], 1)}."
+    target = num(attrs["target_error"], 1)
+    name = f"{attrs['best_method']} rtol {num(attrs['best_rtol'], 1)}"
+    if "best_separated" not in attrs:  # an artifact from before the spread was stored
+        return (f"fastest median run reaching the target error {target}: {name} "
+                f"({_ms(attrs['best_time'])}; timing spread not recorded).")
+    spread = (f"median {_ms(attrs['best_time'])}, {_ms(attrs['best_time_min'])}–"
+              f"{_ms(attrs['best_time_max'])} over {int(attrs['best_repeats'])} runs")
+    if bool(attrs["best_separated"]):
+        return (f"fastest setting reaching the target error {target}: **{name}** ({spread}; "
+                "faster than every run of any other setting that reaches it).")
+    tied = [f"{m} rtol {num(r, 1)} ({_ms(a)}–{_ms(b)})" for m, r, a, b in zip(
+        attrs["tied_methods"], attrs["tied_rtol"], attrs["tied_time_min"],
+        attrs["tied_time_max"])]
+    return (f"the timings cannot separate the settings reaching the target error {target}: "
+            + ", ".join(tied) + " (min–max wall time over the repeats overlap, or a setting "
+            "was timed once); the lowest median is " + name + ".")
+
+
+def workprecision_text(path: Path) -> str:
+    """One line per model of a workprecision artifact: its choice and the timing noise."""
+    with open_artifact(path, "workprecision") as f:
+        return "\n".join(f"{model}: {workprecision_choice(f[model].attrs)}" for model in f)

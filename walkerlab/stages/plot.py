@@ -125,7 +125,8 @@ def _workprecision_figures(scene: Scene, runs_root, F) -> list[Path]:
         with open_artifact(wp_path, "workprecision") as f:
             for model in f:
                 g = f[model]
-                rows = {m: {k: g[m][k][()] for k in ("time", "error", "rtol", "nfev")}
+                rows = {m: {k: g[m][k][()] for k in ("time", "time_min", "time_max", "error",
+                                                     "rtol", "nfev") if k in g[m]}
                         for m in g if isinstance(g[m], type(g))}
                 pareto = [dict(zip(("method", "rtol", "time", "error"), r))
                           for r in zip([str(s) for s in g.attrs.get("pareto_methods", [])],
