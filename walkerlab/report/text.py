@@ -151,9 +151,9 @@ def workprecision_choice(attrs) -> str:
     slowest run beats every other qualifying setting's fastest run; otherwise the
     timings cannot separate them."""
     if "best_method" not in attrs:
-        return f"no setting reaches the target error {num(attrs['target_error'], 1)}."
-    target = num(attrs["target_error"], 1)
-    name = f"{attrs['best_method']} rtol {num(attrs['best_rtol'], 1)}"
+        return f"no setting reaches the target error {attrs['target_error']:.0e}."
+    target = f"{attrs['target_error']:.0e}"  # settings, printed as given
+    name = f"{attrs['best_method']} rtol {attrs['best_rtol']:.0e}"
     if "best_separated" not in attrs:  # an artifact from before the spread was stored
         return (f"fastest median run reaching the target error {target}: {name} "
                 f"({_ms(attrs['best_time'])}; timing spread not recorded).")
@@ -162,7 +162,7 @@ def workprecision_choice(attrs) -> str:
     if bool(attrs["best_separated"]):
         return (f"fastest setting reaching the target error {target}: **{name}** ({spread}; "
                 "faster than every run of any other setting that reaches it).")
-    tied = [f"{m} rtol {num(r, 1)} ({_ms(a)}–{_ms(b)})" for m, r, a, b in zip(
+    tied = [f"{m} rtol {r:.0e} ({_ms(a)}–{_ms(b)})" for m, r, a, b in zip(
         attrs["tied_methods"], attrs["tied_rtol"], attrs["tied_time_min"],
         attrs["tied_time_max"])]
     return (f"the timings cannot separate the settings reaching the target error {target}: "
