@@ -46,7 +46,9 @@ def test_unit_labels_map_every_dimension_once():
     assert NONDIM("s") == "√(l/g)"
     assert NONDIM("m/s") == "√(g l)"
     assert NONDIM("J") == "M g l"
-    assert NONDIM("mm") == "10⁻³ l"
+    assert NONDIM("mm") == "10⁻³ l"  # artifacts store such lengths ×1e3
+    assert (NONDIM.small_length, NONDIM.small_scale) == ("l", 1.0)
+    assert (SI_U.small_length, SI_U.small_scale) == ("mm", 1e3)
     assert NONDIM("rad, rad/s") == "rad, rad/√(l/g)"
     assert NONDIM("rad") == "rad" and NONDIM("-") == "-" and NONDIM("deg") == "deg"
     assert NONDIM("rad, rad/s (, s)") == "rad, rad/√(l/g) (, √(l/g))"
@@ -178,7 +180,7 @@ def test_clearance_says_below_for_penetration():
     neg = clearance_text(-0.000364, SI_U)
     assert "0.364 mm below the slope" in neg and "penetration" in neg and "above" not in neg
     assert "0.500 mm above the slope" in clearance_text(0.0005, SI_U)
-    assert "10⁻³ l below" in clearance_text(-0.000364, NONDIM)
+    assert "3.64e-04 l below" in clearance_text(-0.000364, NONDIM)
 
 
 def test_compare_text_prints_the_key_errors(tmp_path):

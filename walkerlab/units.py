@@ -58,8 +58,14 @@ class Units:
 
     @property
     def small_length(self) -> str:
-        """Label of lengths shown ×1e3 (mm in SI)."""
-        return self("mm")
+        """Label of small lengths (clearances, penetration): mm in SI, l when
+        nondimensional; multiply metres by :attr:`small_scale` to show them."""
+        return "l" if self.nondimensional else "mm"
+
+    @property
+    def small_scale(self) -> float:
+        """Factor from the scene's length unit to :attr:`small_length` (1e3 in SI)."""
+        return 1.0 if self.nondimensional else 1e3
 
     @property
     def speed(self) -> str:
@@ -78,7 +84,7 @@ class Units:
         if self.nondimensional:
             return ("nondimensional scene (g = 1): lengths in units of l, masses in M, time "
                     "in √(l/g), speeds in √(g l), energies in M g l (the scene's numbers)")
-        return "SI units"
+        return "SI (m, kg, s)"
 
 
 def for_scene(scene) -> Units:

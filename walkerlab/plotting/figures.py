@@ -164,8 +164,8 @@ def fig9_limit_cycle(trajs: dict[str, NamedTrajectory], units: Units = SI_UNITS)
         ax.set_title(panel)
         ax.grid(alpha=0.3)
         _legend(ax)
-    fig.suptitle("Fig. 9 - limit cycles in the phase plane (a symmetric gait: both legs "
-                 "trace the same cycle, half a cycle apart)")
+    fig.suptitle("Fig. 9 - limit cycles in the phase plane\n(both legs per panel: in a "
+                 "symmetric gait they trace one cycle)", fontsize=10)
     return fig
 
 

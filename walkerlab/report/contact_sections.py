@@ -91,8 +91,10 @@ def contact_section(scene, paths) -> list[str]:
            _table(["quantity", "value", "unit"], _summary_rows(summ, stage_wall)
                   + [["termination", term, ""]]),
            "", "Contact parameters in SI (converted from the scene's unit system): "
-           + ", ".join(f"{k} = {num(v)} {u}" for k, (v, u) in cp.items()) + ".", "",
-           f"Outcome: **{outcome[0]}** — {outcome[1]}", "",
+           + ", ".join(f"{k} = {num(v)}" + (f" {u}" if u not in ("", "-") else "")
+                       for k, (v, u) in cp.items()) + ".", "",
+           f"Outcome: **{outcome[0]}**" + (f" — {outcome[1]}" if outcome[1] and
+                                            outcome[1] != outcome[0] else ""), "",
            "Per-step stance slip [mm] (touchdown to lift-off of the stance foot; nan: the "
            "phase had not ended when the run did): " + ", ".join(num(v, 3) for v in slips)
            + (("; creep of both feet during double support [mm]: "

@@ -98,15 +98,14 @@ def published_fixed_point(pub: ModuleType | None) -> tuple[tuple, tuple]:
 
 # --------------------------------------------------------------------------- summary
 def clearance_text(lowest: float, u: Units) -> str:
-    """The swing foot's lowest height above the slope [m] in words: clearance when positive,
-    penetration depth below the slope (foot scuffing) when negative; ``u``: the scene's
-    units (the value is shown ×1e3, mm in SI)."""
+    """The swing foot's lowest height above the slope (scene length unit) in words:
+    clearance when positive, penetration depth below the slope (foot scuffing) when
+    negative; ``u``: the scene's units (shown in mm in SI)."""
+    v, unit = num(abs(lowest) * u.small_scale, 3), u.small_length
     if lowest > 0:
-        return (f"lowest {num(1e3 * lowest, 3)} {u.small_length} above the slope inside the "
-                "steps: no scuffing")
-    return (f"the swing foot dips up to {num(-1e3 * lowest, 3)} {u.small_length} below the "
-            "slope inside the steps (penetration): foot scuffing, which the rigid model "
-            "ignores")
+        return f"lowest {v} {unit} above the slope inside the steps: no scuffing"
+    return (f"the swing foot dips up to {v} {unit} below the slope inside the steps "
+            "(penetration): foot scuffing, which the rigid model ignores")
 
 
 def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[str]:
@@ -148,7 +147,7 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
         if np.isfinite(clear):
             bullets.append("- **Swing-foot clearance**: " + clearance_text(clear, u) + ".")
             rows.append(["lowest swing-foot clearance (negative: penetration)", u.small_length,
-                         num(1e3 * clear, 3), "—"])
+                         num(u.small_scale * clear, 3), "—"])
     if "contact-sim" in paths:
         c = _contact_summary(paths["contact-sim"])
         walks = c["termination"] != "fall" and c["heel_strikes"] > 0
