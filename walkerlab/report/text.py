@@ -137,7 +137,7 @@ def compare_text(path: Path) -> str:
                 if k in m["contact"]:
                     lines.append(f"  {k:<22s} {num(m['ideal'][k][()]):>11s} "
                                  f"{num(m['contact'][k][()]):>11s} "
-                                 f"{m['ideal'][k].attrs.get('unit', '')}")
+                                 f"{m['ideal'][k].attrs.get('unit', '')}".replace(" -", ""))
     return "\n".join(lines)
 
 
