@@ -135,9 +135,10 @@ def compare_text(path: Path) -> str:
             lines.append(f"  {'gait metric':<22s} {'ideal':>11s} {'contact':>11s}")
             for k in m["ideal"]:
                 if k in m["contact"]:
+                    unit = str(m["ideal"][k].attrs.get("unit", ""))
                     lines.append(f"  {k:<22s} {num(m['ideal'][k][()]):>11s} "
-                                 f"{num(m['contact'][k][()]):>11s} "
-                                 f"{m['ideal'][k].attrs.get('unit', '')}".replace(" -", ""))
+                                 f"{num(m['contact'][k][()]):>11s}"
+                                 + (f" {unit}" if unit not in ("", "-") else ""))
     return "\n".join(lines)
 
 
