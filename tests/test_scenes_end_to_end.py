@@ -140,7 +140,11 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
                          runs_root=runs, name="tiny", progress=False)
     data = load_sweep(sw)["points"]
     assert list(data["outcome"]).count("ok") >= 2, list(data["message"])
-    for n, u in zip(meta["state_names"], meta["state_units"]):
+    # column names carry the SI unit spelling (identifiers, as the config's field names),
+    # also in a nondimensional scene whose artifacts label rates rad/√(l/g)
+    from walkerlab.models.registry import build_walker
+
+    for n, u in zip(meta["state_names"], build_walker(scene).state_units()):
         col = f"{n}_{u.replace('/', '_per_')}"
         assert col in data  # one column per state, named by the walker
     mid = data["outcome"] == "ok"

@@ -176,7 +176,8 @@ def simulate(scene: Path | None = SceneArg,
                  None, "--strides", min=1, help="strides to simulate (1 stride = 2 steps) "
                  "(default: simulate.strides of the scene)"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
-    """Simulate N strides of the rigid walker from its fixed point (or a given state)."""
+    """Simulate N strides of the rigid walker from its fixed point (or from the state given
+    as simulate.initial_state in the scene)."""
     from walkerlab.report.text import simulate_text
     from walkerlab.stages import simulate as stage
 
@@ -227,9 +228,11 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
             force: bool = ForceOpt) -> None:
     """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
+    from walkerlab.report.text import compare_text
     from walkerlab.stages import compare as stage
 
     out = stage.run(_load(scene), runs_dir, force)
+    typer.echo(compare_text(out.path))
     typer.echo(_status(out))
 
 
@@ -238,14 +241,11 @@ def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def workprecision(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                   force: bool = ForceOpt) -> None:
     """Work-precision study: error vs wall time for every solver and tolerance."""
+    from walkerlab.report.text import workprecision_text
     from walkerlab.stages import workprecision as stage
 
     out = stage.run(_load(scene), runs_dir, force)
-    for model, s in out.summary.items():
-        if s.get("best"):
-            m, rtol, t, e = s["best"]
-            typer.echo(f"{model}: Pareto-best setting reaching the target error: {m} "
-                       f"rtol={rtol:g} ({t * 1e3:.1f} ms, error {e:.1e})")
+    typer.echo(workprecision_text(out.path))
     typer.echo(_status(out))
 
 
@@ -295,7 +295,8 @@ def sweep(scene: Path | None = SceneArg,
 @_guard
 def bifurcation(scene: Path | None = SceneArg,
                 slopes: str = typer.Option("1:5.5:0.05", "--slopes",
-                                           help="slope grid [deg], start:stop:step or a,b,c"),
+                                           help="slope grid in degrees: start:stop:step "
+                                           "or a,b,c"),
                 transient: int = typer.Option(100, "--transient", min=1,
                                               help="steps discarded before sampling"),
                 keep: int = typer.Option(30, "--keep", min=1, help="heel strikes kept per slope"),
@@ -351,7 +352,7 @@ def stability_map(scene: Path | None = SceneArg,
                                            "patch_width | all (each against the slope)"),
                   n: int = typer.Option(8, "--n", min=2, help="grid size n x n"),
                   time_limit: float = typer.Option(60.0, "--time-limit", min=1.0,
-                                                   help="wall-time limit per cell [s]"),
+                                                   help="wall-time limit per cell, in seconds"),
                   workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
                   runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Stability maps of the contact gait: does a periodic gait exist, is it stable, max

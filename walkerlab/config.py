@@ -457,6 +457,10 @@ class Scene(_Strict):
     published: str | None = Field(
         None, description="walkerlab.published module whose printed numbers the report sets "
         "next to ours (e.g. 'paper'); null: no published comparison")
+    units: Literal["SI", "nondimensional"] = Field(
+        "SI", description="'SI': the *_m, *_kg, *_s fields are metres, kilograms, seconds; "
+        "'nondimensional': g = 1 and the numbers are in the walker's own units (length l, "
+        "mass M, time sqrt(l/g); Garcia et al. 1998), and every label says so")
     walker: WalkerParams
     slope: SlopeSettings
     ideal: IdealModelSettings = IdealModelSettings()
@@ -479,6 +483,14 @@ class Scene(_Strict):
     basin: BasinSettings | None = None
 
     @model_validator(mode="after")
+    def _units_consistent(self) -> Scene:
+        if self.units == "nondimensional" and self.walker.gravity_m_per_s2 != 1.0:
+            raise ValueError("units: a nondimensional scene measures accelerations in g, so "
+                             "walker.gravity_m_per_s2 must be 1 (got "
+                             f"{self.walker.gravity_m_per_s2:g})")
+        return self
+
+    @model_validator(mode="after")
     def _published_exists(self) -> Scene:
         if self.published is not None:
             from walkerlab.published import available
@@ -499,7 +511,10 @@ class Scene(_Strict):
     def section_json(self, *names: str) -> str:
         """Canonical JSON of the named sections (for content hashes)."""
         d = self.model_dump(mode="json")
-        return json.dumps({n: d.get(n) for n in names}, sort_keys=True)
+        out = {n: d.get(n) for n in names}
+        if self.units != "SI":  # labels of every artifact follow the unit system
+            out["units"] = self.units
+        return json.dumps(out, sort_keys=True)
 
     def section_hash(self, *names: str) -> str:
         return hashlib.sha256(self.section_json(*names).encode()).hexdigest()

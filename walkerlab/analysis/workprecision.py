@@ -113,17 +113,22 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
 
 
 def rows_from_cases(cases: dict, methods, rtols, reference) -> dict:
-    """``{method: {rtol, time, cpu_time, error, nfev, repeats}}`` (arrays over ``rtols``)
+    """``{method: {rtol, time, time_min, time_max, cpu_time, error, nfev, repeats}}``
+    (arrays over ``rtols``; ``time`` is the median of the repeats, ``time_min``/``time_max``
+    their spread)
     from ``{(method, rtol): time_case result}``; the error is the max-norm distance of the
     final vector from ``reference`` (inf where the run failed)."""
     out = {}
     for m in methods:
-        rows = {"rtol": [], "time": [], "cpu_time": [], "error": [], "nfev": [], "repeats": []}
+        rows = {"rtol": [], "time": [], "time_min": [], "time_max": [], "cpu_time": [],
+                "error": [], "nfev": [], "repeats": []}
         for rtol in rtols:
             c = cases[(m, rtol)]
             vec = c["vec"]
             rows["rtol"].append(rtol)
             rows["time"].append(float(np.median(c["times"])))
+            rows["time_min"].append(float(np.min(c["times"])))
+            rows["time_max"].append(float(np.max(c["times"])))
             rows["cpu_time"].append(float(np.median(c["cpu_times"])))
             rows["error"].append(np.inf if vec is None
                                  else float(np.max(np.abs(np.asarray(vec) - reference))))
@@ -407,13 +412,52 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
 
 
 def summarize(rows: dict, target: float) -> dict:
+    """Pareto front, and the fastest setting reaching ``target`` when the timings can tell.
+
+    Parameters
+    ----------
+    rows : dict
+        :func:`rows_from_cases` output (``time`` the median, ``time_min``/``time_max`` the
+        spread of the repeats; rows without a spread count as one run).
+    target : float
+        Error a setting must reach [rad, rad/s].
+
+    Returns
+    -------
+    dict
+        ``pareto``: ``[(method, rtol, median time, error)]``; ``best``: the setting with the
+        smallest median time among those reaching ``target`` (None if none does);
+        ``separated``: whether that choice exceeds the timing noise: its slowest run is
+        faster than the fastest run of every other setting reaching the target, each
+        measured at least twice (or it is the only one reaching it); ``tied``: the settings
+        the timings cannot separate from ``best`` (``best`` first), each
+        ``(method, rtol, min, median, max time, repeats)``.
+    """
     meth = [m for m in rows for _ in rows[m]["rtol"]]
-    rt = np.concatenate([rows[m]["rtol"] for m in rows])
-    tt = np.concatenate([rows[m]["time"] for m in rows])
-    ee = np.concatenate([rows[m]["error"] for m in rows])
+    cat = {k: np.concatenate([np.asarray(rows[m].get(k, rows[m]["time"]), float)
+                              for m in rows]) for k in ("rtol", "time", "time_min",
+                                                        "time_max", "error")}
+    reps = np.concatenate([np.asarray(rows[m].get("repeats", np.ones(len(rows[m]["rtol"]))))
+                           for m in rows])
+    rt, tt, ee = cat["rtol"], cat["time"], cat["error"]
+    lo, hi = cat["time_min"], cat["time_max"]
     idx = pareto_front(tt, ee)
     ok = np.flatnonzero(ee <= target)
     best = int(ok[np.argmin(tt[ok])]) if ok.size else None
+    tied, separated = [], False
+    if best is not None:
+        others = [int(j) for j in ok[np.argsort(tt[ok], kind="stable")] if j != best]
+        overlap = [j for j in others if lo[j] <= hi[best]]
+        measured = reps[best] >= 2 and (not others or reps[others[0]] >= 2)
+        separated = not overlap and measured
+        if not separated:
+            tied = [best, *(overlap or others[:1])]
+
+    def case(i):
+        return (meth[i], float(rt[i]), float(lo[i]), float(tt[i]), float(hi[i]), int(reps[i]))
     return {"pareto": [(meth[i], float(rt[i]), float(tt[i]), float(ee[i])) for i in idx],
             "best": None if best is None else (meth[best], float(rt[best]), float(tt[best]),
-                                               float(ee[best]))}
+                                               float(ee[best])),
+            "separated": bool(separated),
+            "best_spread": None if best is None else case(best),
+            "tied": [case(i) for i in tied]}

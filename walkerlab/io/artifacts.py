@@ -254,6 +254,9 @@ def write_artifact(path: Path, stage: str, scene, input_hash: str,
             for k, v in (extra_attrs or {}).items():
                 f.attrs[k] = v
             writer(f)
+            from walkerlab.units import for_scene, relabel_artifact
+
+            relabel_artifact(f, for_scene(scene))  # unit labels follow the scene's system
             netcdf.finish(f)
             f.attrs["content_hash"] = content_hash_of(f)
         os.chmod(tmp, FILE_MODE)

@@ -75,8 +75,9 @@ class NamedTrajectory:
         return [n for n in self.coordinates if self.units.get(n) == "rad"]
 
     def rate_names(self) -> list[str]:
-        """Coordinates measured in rad/s (velocities), in order."""
-        return [n for n in self.coordinates if self.units.get(n) == "rad/s"]
+        """Coordinates measured in rad/s (velocities; rad per time unit in a nondimensional
+        scene), in order."""
+        return [n for n in self.coordinates if str(self.units.get(n, "")).startswith("rad/")]
 
     def phase_pairs(self) -> list[tuple[str, str]]:
         """``(angle name, rate name)`` pairs of the same coordinate (``x_angle``/``x_rate``)."""

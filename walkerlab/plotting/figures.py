@@ -19,6 +19,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from walkerlab.io.trajectory import NamedTrajectory
+from walkerlab.units import Units
+
+SI_UNITS = Units()
 
 LEG_COLORS = ["tab:blue", "tab:red", "tab:green", "tab:purple"]
 MODEL_STYLES = ["-", "--", ":", "-."]
@@ -79,8 +82,10 @@ def _coordinate_styles(names: list[str], model_index: int = 0) -> dict[str, dict
     return out
 
 
-def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking"):
-    """Fig. 7: every named angle [rad] (a) and rate [rad/s] (b) over time, every model."""
+def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
+                      units: Units = SI_UNITS):
+    """Fig. 7: every named angle [rad] (a) and rate [rad/s] (b) over time, every model
+    (``units``: the scene's unit labels)."""
     fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     for mi, (label, tr) in enumerate(trajs.items()):
         sty = _coordinate_styles(list(tr.coordinates), mi)
@@ -89,8 +94,8 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking")
                 ax.plot(tr.time, tr.coordinates[n], lw=1.2,
                         label=f"{n.rsplit('_', 1)[0]} - {label}", **sty[n])
     axes[0].set_ylabel("angle from vertical [rad]")
-    axes[1].set_ylabel("angular rate [rad/s]")
-    axes[1].set_xlabel("time [s]")
+    axes[1].set_ylabel(f"angular rate [{units.rate}]")
+    axes[1].set_xlabel(f"time [{units.time}]")
     axes[0].set_title("(a) angles")
     axes[1].set_title("(b) angular rates")
     for ax in axes:
@@ -103,16 +108,16 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking")
 
 
 def fig8_errors(time: np.ndarray, errors: dict[str, np.ndarray], units: dict[str, str],
-                label: str):
+                label: str, scene_units: Units = SI_UNITS):
     """Fig. 8: error between two models (contact - ideal) of every angle [rad] and rate [rad/s]."""
     fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     sty = _coordinate_styles(list(errors))
     for n, e in errors.items():
-        ax = axes[0] if units[n] == "rad" else axes[1]
+        ax = axes[0] if units[n] == "rad" else axes[1]  # rates: rad/s or its relabel
         ax.plot(time, e, label=n.rsplit("_", 1)[0], lw=1, **sty[n])
     axes[0].set_ylabel("angle error [rad]")
-    axes[1].set_ylabel("rate error [rad/s]")
-    axes[1].set_xlabel("time [s]")
+    axes[1].set_ylabel(f"rate error [{scene_units.rate}]")
+    axes[1].set_xlabel(f"time [{scene_units.time}]")
     for ax in axes:
         ax.grid(alpha=0.3)
         _legend(ax)
@@ -120,32 +125,51 @@ def fig8_errors(time: np.ndarray, errors: dict[str, np.ndarray], units: dict[str
     return fig
 
 
-def fig9_limit_cycle(trajs: dict[str, NamedTrajectory]):
-    """Fig. 9: limit cycles in the phase plane, rate [rad/s] vs angle [rad], per coordinate."""
-    pairs = next(iter(trajs.values())).phase_pairs()
-    ncol = min(3, len(pairs))
-    nrow = -(-len(pairs) // ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(5 * ncol, 4.5 * nrow), squeeze=False,
+def _phase_panels(tr: NamedTrajectory) -> dict[str, list[tuple[str, str, str]]]:
+    """Phase-plane pairs grouped by part of the body: ``{panel: [(owner, angle, rate)]}``.
+
+    A leg's coordinate ``<leg>_<part>_angle`` goes to panel ``<part>`` (``thigh``,
+    ``shank``), a straight leg's ``<leg>_angle`` to panel ``leg``, anything else (a torso)
+    to a panel of its own: both legs of a walker share a panel, so a kneed walker gets one
+    panel per link, not one per leg and link."""
+    out: dict[str, list] = {}
+    for a, r in tr.phase_pairs():
+        stem = a.removesuffix("_angle")
+        owner = next((leg for leg in tr.legs if stem == leg or stem.startswith(leg + "_")),
+                     None)
+        panel = stem if owner is None else (stem[len(owner) + 1:] or "leg")
+        out.setdefault(panel, []).append((owner or stem, a, r))
+    return out
+
+
+def fig9_limit_cycle(trajs: dict[str, NamedTrajectory], units: Units = SI_UNITS):
+    """Fig. 9: limit cycles in the phase plane, rate [rad/s] vs angle [rad]: one panel per
+    link (both legs drawn in it, colour per leg, line style per model)."""
+    first = next(iter(trajs.values()))
+    panels = _phase_panels(first)
+    owners = list(dict.fromkeys(o for v in panels.values() for o, _, _ in v))
+    n = max(1, len(panels))
+    fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 4.8), squeeze=False,
                              layout="constrained")
-    for mi, (label, tr) in enumerate(trajs.items()):
-        for k, (a, r) in enumerate(pairs):
-            if a in tr.coordinates and r in tr.coordinates:
-                axes.flat[k].plot(tr.coordinates[a], tr.coordinates[r], ls=MODEL_STYLES[mi % 4],
-                                  color=LEG_COLORS[mi % 4], lw=1, label=label)
-    for k, (a, r) in enumerate(pairs):
+    for k, (panel, members) in enumerate(panels.items()):
         ax = axes.flat[k]
-        ax.set_xlabel(f"{a} [rad]")
-        ax.set_ylabel(f"{r} [rad/s]")
-        ax.set_title(a.removesuffix("_angle"))
+        for mi, (label, tr) in enumerate(trajs.items()):
+            for owner, a, r in members:
+                if a in tr.coordinates and r in tr.coordinates:
+                    ax.plot(tr.coordinates[a], tr.coordinates[r], ls=MODEL_STYLES[mi % 4],
+                            color=LEG_COLORS[owners.index(owner) % 4], lw=1,
+                            label=f"{owner} - {label}")
+        ax.set_xlabel(f"{panel} angle [rad]")
+        ax.set_ylabel(f"{panel} rate [{units.rate}]")
+        ax.set_title(panel)
         ax.grid(alpha=0.3)
         _legend(ax)
-    for ax in list(axes.flat)[len(pairs):]:
-        ax.set_visible(False)
-    fig.suptitle("Fig. 9 - limit cycles in the phase plane")
+    fig.suptitle("Fig. 9 - limit cycles in the phase plane\n(both legs per panel: in a "
+                 "symmetric gait they trace one cycle)", fontsize=10)
     return fig
 
 
-def fig10_energy(trajs: dict[str, NamedTrajectory]):
+def fig10_energy(trajs: dict[str, NamedTrajectory], units: Units = SI_UNITS):
     """Fig. 10: kinetic, potential and total mechanical energy [J] over time."""
     fig, axes = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True)
     for mi, (label, tr) in enumerate(trajs.items()):
@@ -154,27 +178,29 @@ def fig10_energy(trajs: dict[str, NamedTrajectory]):
         axes[1].plot(tr.time, tr.potential, **kw)
         axes[2].plot(tr.time, tr.total, **kw)
     for ax, name in zip(axes, ("kinetic", "potential", "total mechanical")):
-        ax.set_ylabel(f"{name} energy [J]")
+        ax.set_ylabel(f"{name} energy [{units.energy}]")
         ax.grid(alpha=0.3)
         _legend(ax)
-    axes[2].set_xlabel("time [s]")
+    axes[2].set_xlabel(f"time [{units.time}]")
     fig.suptitle("Fig. 10 - energies (potential from the first stance foot's height)")
     return fig
 
 
 def _chains(tr: NamedTrajectory) -> list[tuple[str, list[str]]]:
     """Point chains to draw as sticks: for each leg, hip -> its points (ordered by distance
-    from the hip at the first sample) -> its foot; other points hang from the hip."""
+    from the hip at the first sample) -> its foot; other points hang from the hip.  A round
+    foot's leg ends at its arc centre (``<leg>_foot_centre``; the arc is drawn by
+    :func:`_arc_feet`), not at the contact point, which lies off the leg axis."""
     hip = tr.points["hip"]
     out = []
     used = {"hip"}
     for leg in tr.legs:
         names = [n for n in tr.points if n.startswith(leg + "_") and not n.endswith("_mass")
                  and not n.endswith("_com")]
-        if any(n.endswith("_contact") for n in names):  # round feet: end at the contact,
-            names = [n for n in names if not n.endswith("_foot")]  # not the reference point
-        names.sort(key=lambda n: (n.endswith("_foot"), float(np.hypot(*(tr.points[n][:, 0]
-                                                                          - hip[:, 0])))))
+        if f"{leg}_foot_centre" in names:  # round feet: the leg axis ends at the arc centre
+            names = [n for n in names if not n.endswith(("_foot", "_contact"))]
+        names.sort(key=lambda n: (n.endswith(("_foot", "_foot_centre")),
+                                  float(np.hypot(*(tr.points[n][:, 0] - hip[:, 0])))))
         used.update(n for n in tr.points if n.startswith(leg + "_"))
         out.append((leg, ["hip", *names]))
     for n in tr.points:
@@ -184,28 +210,59 @@ def _chains(tr: NamedTrajectory) -> list[tuple[str, list[str]]]:
     return out
 
 
+#: half the opening of a drawn round foot's arc about the leg axis [rad]
+ARC_HALF_ANGLE_RAD = np.radians(45.0)
+
+
+def _arc_feet(tr: NamedTrajectory, i: int, n_pts: int = 25) -> list[np.ndarray]:
+    """Round feet at sample ``i``, each a polyline (2, n_pts + 3): the leg axis continued from
+    the arc centre to the arc, a break (NaN), then the arc of radius |contact - centre|
+    opening ±:data:`ARC_HALF_ANGLE_RAD` about the leg axis (hip -> arc centre)."""
+    arcs = []
+    hip = tr.points["hip"][:, i]
+    for leg in tr.legs:
+        c, p = tr.points.get(f"{leg}_foot_centre"), tr.points.get(f"{leg}_contact")
+        if c is None or p is None:
+            continue
+        r = float(np.hypot(*(p[:, i] - c[:, i])))
+        axis = c[:, i] - hip
+        a0 = np.arctan2(axis[1], axis[0])
+        ang = a0 + np.linspace(-ARC_HALF_ANGLE_RAD, ARC_HALF_ANGLE_RAD, n_pts)
+        arc = c[:, i, None] + r * np.vstack([np.cos(ang), np.sin(ang)])
+        spoke = np.column_stack([c[:, i], arc[:, n_pts // 2], [np.nan, np.nan]])
+        arcs.append(np.hstack([spoke, arc]))
+    return arcs
+
+
 def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
-                  slope_rad: float | None = None):
+                  slope_rad: float | None = None, units: Units = SI_UNITS):
     """Stick diagram of the first gait cycle (two steps), as the paper's Figs. 2 and 6.
 
     Draws whatever named points the walker has: per leg a chain hip -> knee/shank points ->
-    foot (sorted by distance from the hip), other points (torso ...) from the hip; point
-    masses and centres of mass (``*_mass``, ``*_com``) as dots.
+    foot (sorted by distance from the hip), round feet as arcs about their centre, other
+    points (torso ...) from the hip; point masses and centres of mass (``*_mass``,
+    ``*_com``) as dots.  The snapshots' colour is the time, shown by a colour bar.
     """
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
     steps = np.unique(tr.step_index)
     sel = np.isin(tr.step_index, steps[:2])
     idx = np.flatnonzero(sel)
     picks = idx[np.linspace(0, idx.size - 1, n_snapshots).astype(int)]
-    fig, ax = plt.subplots(figsize=(10, 3.8))
+    fig, ax = plt.subplots(figsize=(10, 3.8), layout="constrained")
     cmap = plt.get_cmap("viridis")
+    norm = Normalize(float(tr.time[picks[0]]), float(tr.time[picks[-1]]))
     hip = tr.points["hip"]
     chains = _chains(tr)
     dots = [n for n in tr.points if n.endswith(("_mass", "_com"))]
-    for j, i in enumerate(picks):
-        c = cmap(j / max(1, len(picks) - 1))
+    for i in picks:
+        c = cmap(norm(float(tr.time[i])))
         for k, (_owner, chain) in enumerate(chains):
             xy = np.array([tr.points[n][:, i] for n in chain])
             ax.plot(xy[:, 0], xy[:, 1], color=c, lw=2.2 if k == 0 else 1.2)
+        for k, arc in enumerate(_arc_feet(tr, i)):
+            ax.plot(arc[0], arc[1], color=c, lw=2.2 if k == 0 else 1.2)
         for n in dots:
             ax.plot(*tr.points[n][:, i], ".", color=c, ms=4)
         ax.plot(hip[0, i], hip[1, i], "o", color=c, ms=6)
@@ -213,28 +270,58 @@ def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
     if slope_rad is not None:
         ax.plot(xs, -np.tan(slope_rad) * xs, color="k", lw=1)
     ax.set_aspect("equal")
-    ax.set_xlabel("x [m] (downhill)")
-    ax.set_ylabel("y [m]")
-    ax.set_title(f"stick diagram, one gait cycle - {label} (thick: {tr.legs[0]}; "
-                 "colour: time)")
+    ax.set_xlabel(f"x [{units.length}] (downhill)")
+    ax.set_ylabel(f"y [{units.length}]")
+    ax.set_title(f"stick diagram, one gait cycle - {label} (thick: {tr.legs[0]})")
     ax.grid(alpha=0.3)
+    fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.8,
+                 label=f"time [{units.time}]")
     return fig
 
 
+def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 6) -> list:
+    """Annotate ``(x, y, text)`` points, skipping a label whose box would overlap one
+    already placed (tried at four offsets first): labels never cover each other."""
+    fig = ax.figure
+    fig.canvas.draw()  # a renderer and the final axis limits
+    renderer = fig.canvas.get_renderer()
+    placed, boxes = [], []
+    for x, y, text in points:
+        for dx, dy, ha, va in ((4, 3, "left", "bottom"), (4, -3, "left", "top"),
+                               (-4, 3, "right", "bottom"), (-4, -3, "right", "top")):
+            a = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
+                            fontsize=fontsize, alpha=0.7, ha=ha, va=va)
+            bb = a.get_window_extent(renderer).expanded(1.05, 1.1)
+            if not any(bb.overlaps(b) for b in boxes):
+                boxes.append(bb)
+                placed.append(a)
+                break
+            a.remove()
+    return placed
+
+
 def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None):
-    """Work-precision diagram: error vs wall time (log-log), one line per method."""
+    """Work-precision diagram: error vs wall time (log-log), one line per method; the
+    spread of the repeats (``time_min``..``time_max``) as horizontal bars, the tolerance
+    next to each point where its label does not cover another."""
     fig, ax = plt.subplots(figsize=(7, 5))
+    labels = []
     for method, d in rows.items():
         ok = np.isfinite(d["error"]) & (d["error"] > 0)
-        ax.loglog(d["time"][ok], d["error"][ok], "o-", label=method, ms=4)
-        for t, e, tol in zip(d["time"][ok], d["error"][ok], d["rtol"][ok]):
-            ax.annotate(f"{tol:.0e}", (t, e), fontsize=6, alpha=0.6)
+        line, = ax.loglog(d["time"][ok], d["error"][ok], "o-", label=method, ms=4)
+        if "time_min" in d and "time_max" in d:
+            ax.errorbar(d["time"][ok], d["error"][ok],
+                        xerr=[d["time"][ok] - d["time_min"][ok], d["time_max"][ok] - d["time"][ok]],
+                        fmt="none", ecolor=line.get_color(), elinewidth=0.8, capsize=2)
+        labels += [(t, e, f"{tol:.0e}") for t, e, tol in zip(d["time"][ok], d["error"][ok],
+                                                             d["rtol"][ok])]
     if pareto:
         pt = np.array([(p["time"], p["error"]) for p in pareto])
-        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front")
-    ax.set_xlabel("wall time (median of repeats) [s]")
+        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (median times)")
+    ax.set_xlabel("wall time [s] (median of repeats; bars: fastest to slowest run)")
     ax.set_ylabel("max state error vs reference [rad, rad/s]")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
     _legend(ax)
+    _place_labels(ax, labels)
     return fig

@@ -5,7 +5,7 @@
 - :func:`stability_map_figure`: outcome per grid point of a 2-D sweep (categorical map) and
   the run time per point.
 - :func:`gait_map_figure`: stability map of the contact gait (gait exists / stable / max
-  |multiplier| or why it fails, per cell) and the wall time per cell.
+  |multiplier| or why it fails, per cell; the cells' wall time in the title).
 - :func:`restitution_figure`: drop-test restitution against stiffness, both families.
 - :func:`save`: PNG (150 dpi) + SVG.
 """
@@ -20,6 +20,7 @@ import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
+from walkerlab.sweep.bifurcation import fall_onset
 from walkerlab.sweep.outcomes import OUTCOMES
 
 OUTCOME_COLORS = {
@@ -60,12 +61,17 @@ def bifurcation_figure(data: dict, title: str = ""):
     ax1.plot(np.where(~stable, s, np.nan), np.where(~stable, fp_il, np.nan), "--",
              color="tab:blue", lw=1.0, label="period-1 fixed point, unstable")
     ax1.set_ylabel("inter-leg angle at heel strike [deg]")
-    for ax in (ax1, ax2):
-        if np.isfinite(onset):
-            ax.axvline(onset, color="tab:red", lw=0.8, ls=":")
-    if np.isfinite(onset):
-        ax1.text(onset, ax1.get_ylim()[1], f" period doubling {onset:.3f}°", color="tab:red",
-                 va="top", fontsize=8)
+    for k, ax in enumerate((ax1, ax2)):
+        if np.isfinite(onset):  # named in the legend: a text label ran over the frame
+            ax.axvline(onset, color="tab:red", lw=0.8, ls=":",
+                       label=f"period doubling at {onset:.3f}°" if k == 0 else None)
+    falls = fall_onset(data)
+    if np.isfinite(falls):
+        half = 0.5 * float(np.min(np.diff(s))) if s.size > 1 else 0.0
+        for k, ax in enumerate((ax1, ax2)):
+            ax.axvspan(falls - half, s.max() + half, color="0.85", hatch="//", ec="0.6", lw=0,
+                       zorder=0, label=f"walker falls (no steady gait) from {falls:.3g}°"
+                       if k == 0 else None)
     ax1.legend(fontsize=8, loc="upper left")
     if title:
         ax1.set_title(title)
@@ -172,17 +178,19 @@ GAIT_CLASSES = ("stable gait", "unstable gait", "off patch", "falls", "time limi
 GAIT_COLORS = ("#2ca02c", "#ff7f0e", "#9467bd", "#d62728", "#17becf", "#7f7f7f", "#000000")
 _REASON_CLASS = {"off_patch": 2, "fall": 3, "no_mid_stance": 3, "time_limit": 4,
                  "not_converged": 5}
-_REASON_SHORT = {"off_patch": "off", "fall": "fall", "no_mid_stance": "nomid",
-                 "time_limit": "time", "not_converged": "nc", "solver_failure": "solv",
-                 "no_ideal_gait": "noid", "invalid_config": "cfg", "error": "err"}
+#: cell text of a cell without a gait (whole words, wrapped to fit a cell)
+_REASON_TEXT = {"off_patch": "off\npatch", "fall": "falls", "no_mid_stance": "no mid-\nstance",
+                "time_limit": "time\nlimit", "not_converged": "no con-\nvergence",
+                "solver_failure": "solver\nfailure", "no_ideal_gait": "no ideal\ngait",
+                "invalid_config": "invalid\nconfig", "error": "error"}
 
 
 def gait_map_figure(data: dict):
     """Stability map of the contact gait from a loaded ``stability_map_<kind>.h5``.
 
-    Left: per cell, stable / unstable gait (text: max |Floquet multiplier|) or why no gait
-    was found (text: short reason).  Right: wall time per cell.  Title: the fractions of
-    cells where a gait exists and where it exists and is stable.
+    Per cell: stable / unstable gait (text: max |Floquet multiplier|) or why no gait was
+    found (text: the reason in words).  Title: the fractions of cells where a gait exists
+    and where it exists and is stable; the cells' wall time (median, max) in the subtitle.
 
     Parameters
     ----------
@@ -212,33 +220,32 @@ def gait_map_figure(data: dict):
         ylab += f", {attrs.get('stiffness_family', 'paper')} family"
     cmap = ListedColormap(GAIT_COLORS)
     norm = BoundaryNorm(np.arange(len(GAIT_CLASSES) + 1) - 0.5, cmap.N)
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.6))
+    # cells wide enough for two short lines of text
+    fig, a1 = plt.subplots(figsize=(max(6.5, 0.75 * xv.size + 3.5), max(3.8, 0.5 * yv.size + 1.6)),
+                           layout="constrained")
     xi, yi = np.arange(xv.size), np.arange(yv.size)
     a1.pcolormesh(xi, yi, code, cmap=cmap, norm=norm, shading="nearest")
     for (i, j), c in np.ndenumerate(code):
-        txt = f"{mm[i, j]:.2f}" if ex[i, j] else _REASON_SHORT.get(str(reason[i, j]), "?")
-        a1.text(j, i, txt, ha="center", va="center", fontsize=6,
+        txt = f"{mm[i, j]:.2f}" if ex[i, j] else _REASON_TEXT.get(str(reason[i, j]), "?")
+        a1.text(j, i, txt, ha="center", va="center", fontsize=6, linespacing=0.9,
                 color="k" if c in (1, 4) else "w")
     for k, lab in enumerate(GAIT_CLASSES):
         if np.any(code == k):
             a1.plot([], [], "s", color=GAIT_COLORS[k], label=lab)
     a1.plot([], [], " ", label="cell text: max |multiplier|\nor why no gait")
     a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
-    wall = np.asarray(data["wall_time_s"], float)
-    im = a2.pcolormesh(xi, yi, wall, shading="nearest", cmap="viridis")
-    fig.colorbar(im, ax=a2, label="wall time per cell [s]")
     log_y = yv.min() > 0 and yv.max() / yv.min() > 100
-    for ax in (a1, a2):
-        ax.set_xticks(xi, [f"{v:g}" for v in xv], fontsize=7)
-        ax.set_yticks(yi, [f"{v:.3g}" for v in yv], fontsize=7)
-        ax.set_xlabel("slope φ [deg]")
-        ax.set_ylabel(ylab + (" (log grid)" if log_y else ""), fontsize=8)
+    a1.set_xticks(xi, [f"{v:g}" for v in xv], fontsize=7)
+    a1.set_yticks(yi, [f"{v:.3g}" for v in yv], fontsize=7)
+    a1.set_xlabel("slope φ [deg]")
+    a1.set_ylabel(ylab + (" (log grid)" if log_y else ""), fontsize=8)
     n = ex.size
+    wall = np.asarray(data["wall_time_s"], float)
+    wall_txt = (f"; wall time per cell: median {np.nanmedian(wall):.3g} s, max "
+                f"{np.nanmax(wall):.3g} s" if np.isfinite(wall).any() else "")
     a1.set_title(f"contact gait: exists in {ex.sum()}/{n} cells ({100 * ex.sum() / n:.0f} %), "
-                 f"stable in {(ex & st).sum()}/{n} ({100 * (ex & st).sum() / n:.0f} %)",
-                 fontsize=9)
-    a2.set_title("wall time per cell", fontsize=9)
-    fig.tight_layout()
+                 f"stable in {(ex & st).sum()}/{n} ({100 * (ex & st).sum() / n:.0f} %)"
+                 f"\n{wall_txt.lstrip('; ')}", fontsize=9)
     return fig
 
 

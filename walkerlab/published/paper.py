@@ -13,8 +13,23 @@ A scene compares itself with this module when it says ``published: paper``
 
 from __future__ import annotations
 
-CITATION = ("A Modeling Framework for Rigid Legs Passive Dynamic Biped Walkers in MSC ADAMS "
-            "(shared/seeds/000_cba74126b2033523.txt)")
+TITLE = "A Modeling Framework for Rigid Legs Passive Dynamic Biped Walkers in MSC ADAMS"
+# The copy of the paper this project holds (its text, shared with the project's notes) prints
+# the title, abstract, body and references but no authors, venue or year; its newest
+# references are from 2024.  Fill these in from the published version when known.
+AUTHORS: str | None = None
+VENUE: str | None = None
+YEAR: int | None = None
+
+
+def _citation() -> str:
+    who = AUTHORS or "authors not printed in our copy"
+    where = ", ".join(str(v) for v in (VENUE, YEAR) if v) or (
+        "venue and year not printed in our copy (it cites work from 2024)")
+    return f'{who}, "{TITLE}", {where}'
+
+
+CITATION = _citation()
 SHORT = "paper"
 
 # Table 1 (physical parameters of the compass biped walker); a = b = L/2 is stated in Sec. 2

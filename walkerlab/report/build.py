@@ -19,6 +19,7 @@ from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections
 from walkerlab.report.markdown import details, num, table, to_html
+from walkerlab.units import for_scene as units_for_scene
 
 
 def _header(scene) -> list[str]:
@@ -30,6 +31,7 @@ def _header(scene) -> list[str]:
             f"numpy {np.__version__}, scipy {scipy.__version__}, machine {platform.machine()} "
             f"({platform.processor() or platform.system()})",
             f"- generated {_dt.datetime.now(_dt.UTC).strftime('%Y-%m-%d %H:%M UTC')}",
+            f"- units: {units_for_scene(scene).sentence()}",
             f"- slope φ = {num(scene.slope.phi_rad)} rad ({num(np.degrees(scene.slope.phi_rad))}°);"
             f" ideal equations: `{scene.ideal.variant}`; solver {scene.solver.method} "
             f"rtol {scene.solver.rtol:g} atol {scene.solver.atol:g}", ""]

@@ -10,7 +10,7 @@ import numpy as np
 
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.published import for_scene
-from walkerlab.report.markdown import printed
+from walkerlab.report.markdown import num, printed
 from walkerlab.report.markdown import table as _table
 
 
@@ -35,7 +35,9 @@ def contact_section(scene, paths) -> list[str]:
     table2 = getattr(pub, "TABLE2", {})
     with open_artifact(p, "contact-sim") as f:
         scale = f["initial_rate_scale"][()]
-        summ = {k: f["summary"][k][()] for k in f["summary"]}
+        summ = {k: (f["summary"][k][()], str(f["summary"][k].attrs.get("unit", "")))
+                for k in f["summary"]}
+        stage_wall = float(f.attrs.get("wall_time_s", np.nan))
         cp = {k: (f["contact_params_si"][k][()], f["contact_params_si"][k].attrs["unit"])
               for k in f["contact_params_si"]}
         term = str(f.attrs["termination"])
@@ -81,21 +83,23 @@ def contact_section(scene, paths) -> list[str]:
     out = [("## Table 2 — " if table2 else "## ") + "initial states (ideal vs contact model)", "",
            _table(head, rows), "",
            f"Our contact walker starts from our ideal fixed point with the initial rates scaled "
-           f"by {np.array2string(scale, precision=3)}"
-           + (f" (found by `--adjust`: objective {float(adj['objective']):.2e} after "
+           f"by [{', '.join(num(v, 3) for v in np.atleast_1d(scale))}]"
+           + (f" (found by `--adjust`: objective {num(adj['objective'], 3)} after "
               f"{int(adj['evaluations'])} simulations)" if adj else "")
            + "." + _table2_note(pub), "",
            "## Contact walker (MSC ADAMS-style model)", "",
-           _table(["quantity", "value"], [[k, float(v) if np.ndim(v) == 0 else str(v)]
-                                          for k, v in summ.items()] + [["termination", term]]),
+           _table(["quantity", "value", "unit"], _summary_rows(summ, stage_wall)
+                  + [["termination", term, ""]]),
            "", "Contact parameters in SI (converted from the scene's unit system): "
-           + ", ".join(f"{k} = {float(v):.4g} {u}" for k, (v, u) in cp.items()) + ".", "",
-           f"Outcome: **{outcome[0]}** — {outcome[1]}", "",
+           + ", ".join(f"{k} = {num(v)}" + (f" {u}" if u not in ("", "-") else "")
+                       for k, (v, u) in cp.items()) + ".", "",
+           f"Outcome: **{outcome[0]}**" + (f" — {outcome[1]}" if outcome[1] and
+                                            outcome[1] != outcome[0] else ""), "",
            "Per-step stance slip [mm] (touchdown to lift-off of the stance foot; nan: the "
-           "phase had not ended when the run did): " + ", ".join(f"{v:.3f}" for v in slips)
+           "phase had not ended when the run did): " + ", ".join(num(v, 3) for v in slips)
            + (("; creep of both feet during double support [mm]: "
-               + ", ".join(f"{v:.3f}" for v in creep)) if creep is not None else "")
-           + "; step periods [s]: " + ", ".join(f"{v:.4f}" for v in periods) + ".",
+               + ", ".join(num(v, 3) for v in creep)) if creep is not None else "")
+           + "; step periods [s]: " + ", ".join(num(v, 4) for v in periods) + ".",
            "(% columns: change of magnitude relative to the ideal/MATLAB value.)", ""]
     if per_fail is not None:
         out += [f"**Periodic gait of the contact model**: not found ({per_fail[0]}: "
@@ -105,11 +109,29 @@ def contact_section(scene, paths) -> list[str]:
     out += _map_lines(p)
     if per is not None:
         out += [f"**Periodic gait of the contact model** (fixed point of its step-to-step map, "
-                f"mid-stance section): step period {per[0]:.6f} s, step length {per[1]:.6f} m, "
+                f"mid-stance section): step period {num(per[0], 6)} s, step length "
+                f"{num(per[1], 6)} m, "
                 f"{'stable' if per[3] else 'unstable'}; Floquet multipliers "
                 + ", ".join(f"{m:.4f}" for m in per[2][:3])
                 + " and three fast contact/creep modes ≈ 0.", ""]
     return out
+
+
+def _summary_rows(summ: dict, stage_wall_s: float) -> list[list]:
+    """Rows ``[quantity, value, unit]`` of the contact artifact's summary: counts as integers,
+    the walking run's integration time told apart from the stage's whole compute time."""
+    rows = []
+    for k, (v, unit) in summ.items():
+        if np.ndim(v) != 0:
+            rows.append([k, str(v), unit])
+            continue
+        label = k
+        if k == "wall_time_s":
+            label = ("wall time of the walking run's integration"
+                     + (f" (the whole stage, with drop test and periodic-gait search, took "
+                        f"{num(stage_wall_s, 3)} s)" if np.isfinite(stage_wall_s) else ""))
+        rows.append([label, num(v), "" if unit == "-" else unit])
+    return rows
 
 
 def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
@@ -140,21 +162,19 @@ def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
 
 def _map_lines(artifact) -> list[str]:
     """Stability maps of the contact gait, where their artifacts exist next to ``artifact``."""
-    import shutil
-
     out = []
+    figdir = artifact.parent / "report" / "figures"
     for kind in ("stiffness", "friction", "patch_width"):
         p = artifact.parent / f"stability_map_{kind}.h5"
-        png = p.with_suffix(".png")
-        if not (p.is_file() and png.is_file()):
+        if not p.is_file():
+            continue
+        png = figdir / f"{p.stem}.png"  # the stage draws it there from the artifact
+        if not png.is_file():
             continue
         with open_artifact(p) as f:
             ex = float(f["summary/exists_fraction"][()])
             stab = float(f["summary/stable_fraction"][()])
             n = int(f["summary/cells"][()])
-        figdir = artifact.parent / "report" / "figures"
-        figdir.mkdir(parents=True, exist_ok=True)
-        shutil.copy(png, figdir / png.name)
         cap = (f"Stability map of the contact gait over {kind.replace('_', ' ')} × slope "
                f"({n} cells): a periodic gait exists in {100 * ex:.0f} % of the cells and is "
                f"stable in {100 * stab:.0f} %.")

@@ -13,7 +13,15 @@ DIGITS = 4  # significant digits of every number in the report unless a column a
 
 
 def num(v, digits: int = DIGITS) -> str:
-    """A number with ``digits`` significant digits (scientific below 1e-3 / from 1e6)."""
+    """The one number formatter of walkerlab's printed text, report and tables.
+
+    ``digits`` significant digits (scientific notation below 1e-3 and from 1e6); integers,
+    and floats holding an integer (counts stored as floats), print as integers (``0``, not
+    ``0.000``); booleans as yes/no; non-finite values as a dash.  Numpy scalars and 0-d
+    arrays are accepted.
+    """
+    if isinstance(v, np.ndarray) and v.ndim == 0:
+        v = v[()]
     if isinstance(v, (bool, np.bool_)):
         return "yes" if v else "no"
     if isinstance(v, (int, np.integer)):
@@ -21,9 +29,9 @@ def num(v, digits: int = DIGITS) -> str:
     v = float(v)
     if not np.isfinite(v):
         return "—"
-    if v.is_integer() and abs(v) < 1e6 and v != 0:
-        return str(int(v))  # counts stored as floats
-    if v != 0 and (abs(v) < 1e-3 or abs(v) >= 1e6):
+    if v.is_integer() and abs(v) < 1e6:
+        return str(int(v))  # counts stored as floats (and 0, -0)
+    if abs(v) < 1e-3 or abs(v) >= 1e6:
         return f"{v:.{max(1, digits - 1)}e}"
     return f"{v:#.{digits}g}".rstrip(".")
 

@@ -17,7 +17,8 @@ from walkerlab.analysis.tables import TABLE3_ROWS, table3
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.readers import load_fixed_point
 from walkerlab.report.markdown import details, num, printed, sig_digits, table
-from walkerlab.report.text import zero_multipliers_text
+from walkerlab.report.text import workprecision_choice, zero_multipliers_text
+from walkerlab.units import Units, for_artifact, for_scene
 
 
 # --------------------------------------------------------------------------- data
@@ -96,9 +97,21 @@ def published_fixed_point(pub: ModuleType | None) -> tuple[tuple, tuple]:
 
 
 # --------------------------------------------------------------------------- summary
+def clearance_text(lowest: float, u: Units) -> str:
+    """The swing foot's lowest height above the slope (scene length unit) in words:
+    clearance when positive, penetration depth below the slope (foot scuffing) when
+    negative; ``u``: the scene's units (shown in mm in SI)."""
+    v, unit = num(abs(lowest) * u.small_scale, 3), u.small_length
+    if lowest > 0:
+        return f"lowest {v} {unit} above the slope inside the steps: no scuffing"
+    return (f"the swing foot dips up to {v} {unit} below the slope inside the steps "
+            "(penetration): foot scuffing, which the rigid model ignores")
+
+
 def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[str]:
     """Short verdicts and headline numbers, with the published values where they exist."""
     out = ["## Summary", ""]
+    u = for_scene(scene)
     bullets = []
     rows = []
     pub_name = f"published ({pub.SHORT})" if pub is not None else None
@@ -107,15 +120,16 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
         x, meta = load_fixed_point(fp)
         bullets.append(f"- **Gait found**: yes, period-1 fixed point (residual "
                        f"{num(meta['residual'], 2)}), step period "
-                       f"{num(meta['step_period_s'])} s.")
+                       f"{num(meta['step_period_s'])} {u.time}.")
         bullets.append(f"- **Stable**: {'yes' if meta['stable'] else 'no'} (largest "
                        f"|Floquet multiplier| {num(meta['max_abs_multiplier'])}).")
         eq = dict(zip(*published_fixed_point(pub)))
-        for n, v, u in zip(meta["state_names"], x, meta["state_units"]):
+        for n, v, un in zip(meta["state_names"], x, meta["state_units"]):
             # as many digits as the published value has, so the two can be compared digit by digit
             dig = max(4, sig_digits(printed(eq[n]))) if n in eq else 4
-            rows.append([f"fixed point {n}", u, num(v, dig), printed(eq[n]) if n in eq else "—"])
-        rows.append(["step period", "s", num(meta["step_period_s"]), "—"])
+            rows.append([f"fixed point {n}", un, num(v, dig),
+                         printed(eq[n]) if n in eq else "—"])
+        rows.append(["step period", u.time, num(meta["step_period_s"]), "—"])
         rows.append(["max abs(multiplier)", "-", num(meta["max_abs_multiplier"]), "—"])
     elif "fixedpoint" not in paths and scene.fixedpoint is not None:
         bullets.append("- **Gait found**: no fixed point artifact.")
@@ -127,15 +141,13 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
             n_hs = int(np.sum(f["steps/termination"].asstr()[()] == "heel_strike"))
         bullets.append(f"- **Rigid walker walks**: {'yes' if term == 'heel_strike' else 'no'} "
                        f"({n_hs} heel strikes, ended by {term}); energy drift between impacts "
-                       f"{num(drift, 2)} J ({num(rel, 2)} relative).")
-        rows.append(["energy drift between impacts", "J", num(drift, 2), "—"])
+                       f"{num(drift, 2)} {u.energy} ({num(rel, 2)} relative).")
+        rows.append(["energy drift between impacts", u.energy, num(drift, 2), "—"])
         clear = swing_foot_clearance(sim, scene.slope.phi_rad)
         if np.isfinite(clear):
-            verdict = ("no scuffing" if clear > 0 else "the swing foot passes through the "
-                       "ground (scuffing), which the rigid model ignores")
-            bullets.append(f"- **Swing-foot clearance**: lowest {num(1e3 * clear, 3)} mm above "
-                           f"the slope inside the steps: {verdict}.")
-            rows.append(["lowest swing-foot clearance", "mm", num(1e3 * clear, 3), "—"])
+            bullets.append("- **Swing-foot clearance**: " + clearance_text(clear, u) + ".")
+            rows.append(["lowest swing-foot clearance (negative: penetration)", u.small_length,
+                         num(u.small_scale * clear, 3), "—"])
     if "contact-sim" in paths:
         c = _contact_summary(paths["contact-sim"])
         walks = c["termination"] != "fall" and c["heel_strikes"] > 0
@@ -151,12 +163,13 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
         t3 = getattr(pub, "TABLE3", {})
         for key in ("t_cycle_s", "v_com_m_per_s"):
             name, _sym, unit = TABLE3_ROWS[key]
-            rows.append([name, unit, num(ideal[key]), printed(t3[key][0]) if key in t3 else "—"])
+            rows.append([name, u(unit), num(ideal[key]),
+                         printed(t3[key][0]) if key in t3 else "—"])
         if "E_avg_J" in t3:
-            rows.append(["average mechanical energy, PE from the stance foot", "J",
+            rows.append(["average mechanical energy, PE from the stance foot", u.energy,
                          num(ideal.get("E_avg_stance_frame_J", np.nan)), printed(t3["E_avg_J"][0])])
         step_pub = getattr(pub, "STEP_LENGTH_M", None)
-        rows.append(["step length", "m", num(ideal["step_length_m"]),
+        rows.append(["step length", u.length, num(ideal["step_length_m"]),
                      printed(step_pub) if step_pub is not None else "—"])
     out += bullets
     if rows:
@@ -202,7 +215,8 @@ def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
                          *[num(a) for a in x], num(float(g["step_period"][()])),
                          num(float(np.max(np.hypot(re, im)))), num(g["residual"][()], 2)])
         out.append(table(["model", *[f"{n} [{u}]" for n, u in zip(names, units)],
-                          "step period [s]", "max abs(multiplier)", "residual"], rows))
+                          f"step period [{for_artifact(f).time}]", "max abs(multiplier)",
+                          "residual"], rows))
         out.append("")
         out.append("State right after heel strike, role-ordered (the swing leg is the one that "
                    "just left the ground).")
@@ -246,6 +260,7 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
     cols = _gait_columns(paths)
     if not cols:
         return []
+    u = for_scene(scene)
     t3 = getattr(pub, "TABLE3", None)
     header = ["quantity", "symbol", "unit"]
     if t3:
@@ -254,12 +269,12 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
     rows = []
     for key, (name, sym, unit) in TABLE3_ROWS.items():
         pubv = [printed(v) for v in t3[key]] if t3 else []
-        rows.append([name, sym, unit, *pubv, *(num(c[key]) for c in cols.values())])
+        rows.append([name, sym, u(unit), *pubv, *(num(c[key]) for c in cols.values())])
     blank = ["", ""] if t3 else []
-    rows.append(["Average mechanical energy, PE from the current stance foot", "E_avg'", "J",
+    rows.append(["Average mechanical energy, PE from the current stance foot", "E_avg'", u.energy,
                  *blank, *(num(c.get("E_avg_stance_frame_J", np.nan)) for c in cols.values())])
     step_pub = getattr(pub, "STEP_LENGTH_M", None)
-    rows.append(["Step length", "Δx", "m", *([printed(step_pub)] * 2 if t3 else []),
+    rows.append(["Step length", "Δx", u.length, *([printed(step_pub)] * 2 if t3 else []),
                  *(num(c["step_length_m"]) for c in cols.values())])
     title = "## Table 3 — gait characteristics" if t3 else "## Gait characteristics"
     out = [title, "", "Recomputed from the trajectory artifacts ("
@@ -298,14 +313,14 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
 
 
 # --------------------------------------------------------------------------- figures
-CAPTIONS = [
-    ("fig7_angles_rates", "Fig. 7 — angles and angular rates over the simulated strides."),
-    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates."),
-    ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, per "
-                          "coordinate)."),
-    ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),
+CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond the paper
     ("fig2_stick_ideal", "Fig. 2 — stick diagram of one gait cycle, ideal model."),
     ("fig6_stick_contact", "Fig. 6 — stick diagram of one gait cycle, contact model."),
+    ("fig7_angles_rates", "Fig. 7 — angles and angular rates over the simulated strides."),
+    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates."),
+    ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, one "
+                          "panel per link, both legs in it)."),
+    ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),
     ("work_precision_ideal", "Work-precision diagram, ideal model."),
     ("work_precision_contact", "Work-precision diagram, contact model."),
     ("bifurcation", "Bifurcation diagram over the slope."),
@@ -317,13 +332,14 @@ CAPTIONS = [
 def steps_table(path: Path) -> str:
     """Per-step table of ``simulate.h5`` (period, step length, hip speed, impact loss)."""
     with open_artifact(path, "simulate") as f:
+        u = for_artifact(f)
         s = f["steps"]
         cols = ("period", "step_length", "hip_speed", "impact_energy_loss")
         rows = [[int(i), str(leg), *[num(s[c][k]) for c in cols], str(term)]
                 for k, (i, leg, term) in enumerate(zip(s["step"][()], s["stance_leg"].asstr()[()],
                                                        s["termination"].asstr()[()]))]
-    return table(["step", "stance leg", "period [s]", "step length [m]", "hip speed [m/s]",
-                  "impact loss [J]", "ended by"], rows)
+    return table(["step", "stance leg", f"period [{u.time}]", f"step length [{u.length}]",
+                  f"hip speed [{u.speed}]", f"impact loss [{u.energy}]", "ended by"], rows)
 
 
 def workprecision_table(path: Path, model: str) -> str:
@@ -333,9 +349,15 @@ def workprecision_table(path: Path, model: str) -> str:
         g = f[model]
         for m in g:
             d = g[m]
-            for rt, t, e, n in zip(d["rtol"][()], d["time"][()], d["error"][()], d["nfev"][()]):
-                rows.append([m, num(rt, 1), num(t * 1e3), num(e, 2), int(n)])
-    return table(["method", "rtol", "median wall [ms]", "error vs reference", "RHS evals"], rows)
+            lo = d["time_min"][()] if "time_min" in d else d["time"][()]
+            hi = d["time_max"][()] if "time_max" in d else d["time"][()]
+            reps = d["repeats"][()] if "repeats" in d else np.ones(len(lo), int)
+            for rt, t, a, b, k, e, n in zip(d["rtol"][()], d["time"][()], lo, hi, reps,
+                                            d["error"][()], d["nfev"][()]):
+                rows.append([m, num(rt, 1), num(t * 1e3, 3), f"{num(a * 1e3, 3)}–"
+                             f"{num(b * 1e3, 3)}", int(k), num(e, 2), int(n)])
+    return table(["method", "rtol", "median wall [ms]", "min–max wall [ms]", "runs",
+                  "error vs reference", "RHS evals"], rows)
 
 
 def figures_section(fig_dir: Path, rel: str, paths: dict[str, Path]) -> list[str]:
@@ -370,7 +392,8 @@ def _solver_text(scene, model: str) -> str:
 
 
 def workprecision_summary(scene, paths: dict[str, Path]) -> list[str]:
-    """Pareto-best setting and Pareto front per model (raw points fold under the figure)."""
+    """The fastest setting reaching the target error, only where the timing noise allows
+    naming one, and the Pareto front per model (raw points fold under the figure)."""
     p = paths.get("workprecision")
     if p is None:
         return []
@@ -379,12 +402,8 @@ def workprecision_summary(scene, paths: dict[str, Path]) -> list[str]:
         for model in f:
             g = f[model]
             out += [f"### {model} model", ""]
-            if "best_method" in g.attrs:
-                out.append(f"Pareto-best setting reaching the target error "
-                           f"{g.attrs['target_error']:.0e}: **{g.attrs['best_method']} rtol "
-                           f"{g.attrs['best_rtol']:.0e}** ({num(g.attrs['best_time'] * 1e3)} ms, "
-                           f"error {num(g.attrs['best_error'], 2)}). Scene default: "
-                           + _solver_text(scene, model))
+            out.append("Choice: " + workprecision_choice(g.attrs) + " Scene default: "
+                       + _solver_text(scene, model))
             pm = [str(s) for s in g.attrs.get("pareto_methods", [])]
             pr = list(g.attrs.get("pareto_rtol", []))
             out += ["", "Pareto front (no setting is both faster and more accurate): "
@@ -402,12 +421,19 @@ def bifurcation_section(paths: dict[str, Path], pub: ModuleType | None = None) -
         onset = float(f["onset/onset_slope"][()])
         slopes = f["slope"][()]
         per = f["steady_state/attractor_period"][()]
+        outcome = f["steady_state/outcome"].asstr()[()] if "steady_state/outcome" in f else None
+    from walkerlab.sweep.bifurcation import fall_onset
+
+    falls = fall_onset({"slope": slopes, "steady_state/outcome": outcome}) \
+        if outcome is not None else np.nan
     text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
             "where the most negative real Floquet multiplier crosses −1" if np.isfinite(onset)
             else "no period doubling on the grid")
     out = ["## Bifurcation over the slope", "",
            f"Grid {printed(slopes[0])}–{printed(slopes[-1])}° ({slopes.size} slopes): {text}; "
-           f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}."]
+           f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}"
+           + (f"; from {num(falls)}° on the walker falls (no steady gait)."
+              if np.isfinite(falls) else "; the walker walks up to the largest slope.")]
     rng = getattr(pub, "STABLE_SLOPE_RANGE_RAD", None)
     if rng is not None:
         out.append(f"Published ({pub.SHORT}): the period-1 gait is stable for "

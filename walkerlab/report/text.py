@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.io.artifacts import open_artifact
+from walkerlab.report.markdown import num
+from walkerlab.units import for_artifact
 
 
 def _fmt_mult(re, im) -> str:
@@ -30,6 +32,7 @@ def zero_multipliers_text(re, im) -> str:
 def fixedpoint_text(path: Path) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     with open_artifact(path, "fixedpoint") as f:
+        u = for_artifact(f)
         names = [str(n) for n in f.attrs["state_names"]]
         legs = json.loads(f.attrs["legs_by_role"]) if "legs_by_role" in f.attrs else {}
         lines = [f"fixed point ({f.attrs['model']}, {f.attrs['variant']} equations), "
@@ -41,7 +44,7 @@ def fixedpoint_text(path: Path) -> str:
             where = f"({legs[role]}, {role} leg)" if role else "(not on a leg)"
             unit = f["fixed_point/" + n].attrs["unit"]
             lines.append(f"  {n:<14s} {where} {f['fixed_point/' + n][()]: .10f} {unit}")
-        lines.append(f"  step period     {f['step_period'][()]:.10f} s")
+        lines.append(f"  step period     {f['step_period'][()]:.10f} {u.time}")
         lines.append(f"  residual        {f['residual'][()]:.2e}  (max |P(x*) - x*|)")
         re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
         lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")
@@ -88,29 +91,42 @@ def gaits_text(f) -> list[str]:
 def simulate_text(path: Path) -> str:
     """Steps completed, per-step period/length/speed, energy."""
     with open_artifact(path, "simulate") as f:
+        u = for_artifact(f)
         s = f["steps"]
         lines = [f"simulated {f.attrs['strides_requested']} strides: "
                  f"{int(np.sum(s['termination'][()] == b'heel_strike'))} heel strikes, "
                  f"ended by {f.attrs['termination']}"]
-        lines.append(f"  mean step period  {f['summary/mean_period_s'][()]:.6f} s")
-        lines.append(f"  mean step length  {f['summary/mean_step_length_m'][()]:.6f} m")
-        lines.append(f"  mean hip speed    {f['summary/mean_hip_speed_m_per_s'][()]:.6f} m/s")
-        lines.append(f"  mean total energy {f['summary/mean_total_energy_J'][()]:.4f} J "
-                     "(potential from the first stance foot)")
+        if u.nondimensional:
+            lines.append(f"  ({u.sentence()})")
+        lines.append(f"  mean step period  {num(f['summary/mean_period_s'][()], 7)} {u.time}")
+        lines.append(f"  mean step length  {num(f['summary/mean_step_length_m'][()], 7)} "
+                     f"{u.length}")
+        lines.append(f"  mean hip speed    {num(f['summary/mean_hip_speed_m_per_s'][()], 7)} "
+                     f"{u.speed}")
+        lines.append(f"  mean total energy {num(f['summary/mean_total_energy_J'][()], 7)} "
+                     f"{u.energy} (potential from the first stance foot)")
         lines.append(f"  RHS evaluations   {int(f['summary/nfev'][()])}, "
-                     f"integration {f['summary/wall_time_s'][()]:.3f} s")
+                     f"integration {num(f['summary/wall_time_s'][()], 3)} s (wall clock)")
     return "\n".join(lines)
 
 
 def contact_text(path: Path) -> str:
     """Summary of a contact-sim artifact."""
     with open_artifact(path, "contact-sim") as f:
-        lines = [f"contact walker: outcome {f.attrs.get('outcome', '?')} "
-                 f"({f.attrs.get('outcome_message', f.attrs.get('termination', '?'))})"]
+        kind = str(f.attrs.get("outcome", "?"))
+        why = str(f.attrs.get("outcome_message", f.attrs.get("termination", "")))
+        # the message only when it says more than the outcome's name
+        lines = [f"contact walker: outcome {kind}" + (f" ({why})" if why and why != kind
+                                                      else "")]
         if "summary" in f:
             for k in f["summary"]:
                 ds = f["summary"][k]
-                lines.append(f"  {k:<28s} {ds[()]} {ds.attrs.get('unit', '')}")
+                unit = str(ds.attrs.get("unit", ""))
+                lines.append(f"  {k:<32s} {num(ds[()])}" + (f" {unit}" if unit not in
+                                                              ("", "-") else ""))
+            if "wall_time_s" in f["summary"] and "wall_time_s" in f.attrs:
+                lines.append(f"  (wall_time_s: the walking run's integration; the whole stage "
+                             f"took {num(f.attrs['wall_time_s'], 3)} s)")
         if "periodic_gait" in f and "step_period" not in f["periodic_gait"]:
             g = f["periodic_gait"]
             lines.append(f"periodic contact gait: not found ({g.attrs.get('outcome', '?')}: "
@@ -118,9 +134,74 @@ def contact_text(path: Path) -> str:
         elif "periodic_gait" in f:
             g = f["periodic_gait"]
             mult = g["multipliers/real"][()] + 1j * g["multipliers/imag"][()]
-            lines.append(f"periodic contact gait: step period {g['step_period'][()]:.6f} s, "
-                         f"step length {g['step_length'][()]:.6f} m, "
+            lines.append(f"periodic contact gait: step period {num(g['step_period'][()], 6)} s, "
+                         f"step length {num(g['step_length'][()], 6)} m, "
                          f"{'stable' if g['stable'][()] else 'unstable'}")
             lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
                          + f" (+{len(mult) - 3} fast contact modes ~0)")
     return "\n".join(lines)
+
+
+def compare_text(path: Path) -> str:
+    """Key errors of a compare artifact: largest angle and rate error contact − ideal per
+    coordinate, the limit cycles' mean distance, and the gait metrics side by side."""
+    with open_artifact(path, "compare") as f:
+        u = for_artifact(f)
+        g = f["errors"]
+        t = g["time"][()]
+        lines = [f"errors contact - ideal over the common span 0-{num(t[-1], 4)} {u.time}:",
+                 f"  max |angle error| {num(g['max_abs_angle'][()], 3)} rad, "
+                 f"max |rate error| {num(g['max_abs_rate'][()], 3)} {u.rate}"]
+        for n in [str(x) for x in g.attrs["coordinates"]]:
+            ds = g[f"coordinates/{n}"]
+            lines.append(f"  {n:<22s} max |error| {num(np.max(np.abs(ds[()])), 3)} "
+                         f"{ds.attrs['unit']}")
+        if "limit_cycle_distance" in g:
+            lines.append("  limit cycles, mean distance ideal -> contact: " + ", ".join(
+                f"{k} {num(g['limit_cycle_distance'][k][()], 3)}"
+                for k in g["limit_cycle_distance"]))
+        if "metrics" in f and {"ideal", "contact"} <= set(f["metrics"]):
+            m = f["metrics"]
+            lines.append(f"  {'gait metric':<22s} {'ideal':>11s} {'contact':>11s}")
+            for k in m["ideal"]:
+                if k in m["contact"]:
+                    unit = str(m["ideal"][k].attrs.get("unit", ""))
+                    lines.append(f"  {k:<22s} {num(m['ideal'][k][()]):>11s} "
+                                 f"{num(m['contact'][k][()]):>11s}"
+                                 + (f" {unit}" if unit not in ("", "-") else ""))
+    return "\n".join(lines)
+
+
+def _ms(t: float) -> str:
+    return f"{num(1e3 * t, 3)} ms"
+
+
+def workprecision_choice(attrs) -> str:
+    """The work-precision study's choice for one model (attributes of its group), in one
+    sentence that says how noisy the timing was: a setting is named fastest only when its
+    slowest run beats every other qualifying setting's fastest run; otherwise the
+    timings cannot separate them."""
+    if "best_method" not in attrs:
+        return f"no setting reaches the target error {attrs['target_error']:.0e}."
+    target = f"{attrs['target_error']:.0e}"  # settings, printed as given
+    name = f"{attrs['best_method']} rtol {attrs['best_rtol']:.0e}"
+    if "best_separated" not in attrs:  # an artifact from before the spread was stored
+        return (f"fastest median run reaching the target error {target}: {name} "
+                f"({_ms(attrs['best_time'])}; timing spread not recorded).")
+    spread = (f"median {_ms(attrs['best_time'])}, {_ms(attrs['best_time_min'])}–"
+              f"{_ms(attrs['best_time_max'])} over {int(attrs['best_repeats'])} runs")
+    if bool(attrs["best_separated"]):
+        return (f"fastest setting reaching the target error {target}: **{name}** ({spread}; "
+                "faster than every run of any other setting that reaches it).")
+    tied = [f"{m} rtol {r:.0e} ({_ms(a)}–{_ms(b)})" for m, r, a, b in zip(
+        attrs["tied_methods"], attrs["tied_rtol"], attrs["tied_time_min"],
+        attrs["tied_time_max"])]
+    return (f"the timings cannot separate the settings reaching the target error {target}: "
+            + ", ".join(tied) + " (min–max wall time over the repeats overlap, or a setting "
+            "was timed once); the lowest median is " + name + ".")
+
+
+def workprecision_text(path: Path) -> str:
+    """One line per model of a workprecision artifact: its choice and the timing noise."""
+    with open_artifact(path, "workprecision") as f:
+        return "\n".join(f"{model}: {workprecision_choice(f[model].attrs)}" for model in f)

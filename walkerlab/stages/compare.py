@@ -48,7 +48,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     def compute():
         ideal, t, err, metrics, lc = compare_files(up[0], up[1])
         ang = [n for n in err if ideal.units[n] == "rad"]
-        rat = [n for n in err if ideal.units[n] == "rad/s"]
+        rat = [n for n in err if ideal.units[n].startswith("rad/")]  # rad/s, or per time unit
         summary = {"max_angle_error_rad": float(max(np.max(np.abs(err[n])) for n in ang)),
                    "max_rate_error_rad_per_s": float(max(np.max(np.abs(err[n])) for n in rat)),
                    "compared_until_s": float(t[-1]), "metrics": metrics,

@@ -11,6 +11,7 @@ from walkerlab.io import runpaths
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.trajectory import read_samples
 from walkerlab.stages.common import StageError, artifact_path
+from walkerlab.units import for_scene
 
 IDEAL_LABEL = "ideal (rigid, plastic impact)"
 CONTACT_LABEL = "contact (IMPACT + Coulomb)"
@@ -75,13 +76,15 @@ def _trajectory_figures(scene: Scene, runs_root, F) -> list[Path]:
                          "first")
     out_dir = figures_dir(scene, runs_root, claim=True)
     written: list[Path] = []
+    u = for_scene(scene)
     title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
-    written += F.save(F.fig7_angles_rates(trajs, title), out_dir, "fig7_angles_rates")
-    written += F.save(F.fig9_limit_cycle(trajs), out_dir, "fig9_limit_cycles")
-    written += F.save(F.fig10_energy(trajs), out_dir, "fig10_energy")
-    for label, tr in trajs.items():
+    for label, tr in trajs.items():  # paper order: Figs. 2, 6, then 7-10
         stem = "fig2_stick_ideal" if label == IDEAL_LABEL else "fig6_stick_contact"
-        written += F.save(F.stick_diagram(tr, label, slope_rad=scene.slope.phi_rad), out_dir, stem)
+        written += F.save(F.stick_diagram(tr, label, slope_rad=scene.slope.phi_rad, units=u),
+                          out_dir, stem)
+    written += F.save(F.fig7_angles_rates(trajs, title, units=u), out_dir, "fig7_angles_rates")
+    written += F.save(F.fig9_limit_cycle(trajs, units=u), out_dir, "fig9_limit_cycles")
+    written += F.save(F.fig10_energy(trajs, units=u), out_dir, "fig10_energy")
     cmp_path = artifact_path(scene, runs_root, "compare")
     if cmp_path.is_file():
         with open_artifact(cmp_path, "compare") as f:
@@ -90,7 +93,8 @@ def _trajectory_figures(scene: Scene, runs_root, F) -> list[Path]:
             t = g["time"][()]
             err = {n: g[f"coordinates/{n}"][()] for n in names}
             units = {n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names}
-        written += F.save(F.fig8_errors(t, err, units, "contact - ideal"), out_dir, "fig8_errors")
+        written += F.save(F.fig8_errors(t, err, units, "contact - ideal", scene_units=u),
+                          out_dir, "fig8_errors")
     written += _drop_figure(scene, runs_root, out_dir, F)
     return written
 
@@ -121,7 +125,8 @@ def _workprecision_figures(scene: Scene, runs_root, F) -> list[Path]:
         with open_artifact(wp_path, "workprecision") as f:
             for model in f:
                 g = f[model]
-                rows = {m: {k: g[m][k][()] for k in ("time", "error", "rtol", "nfev")}
+                rows = {m: {k: g[m][k][()] for k in ("time", "time_min", "time_max", "error",
+                                                     "rtol", "nfev") if k in g[m]}
                         for m in g if isinstance(g[m], type(g))}
                 pareto = [dict(zip(("method", "rtol", "time", "error"), r))
                           for r in zip([str(s) for s in g.attrs.get("pareto_methods", [])],

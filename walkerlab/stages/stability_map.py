@@ -2,7 +2,7 @@
 
 One cached artifact per map kind, ``runs/<scene>/stability_map_<kind>.h5`` (input hash: the
 scene's physics sections, the code and the grid), and its figure
-``stability_map_<kind>.png/.svg`` next to it, drawn from the artifact.  The computation is
+``report/figures/stability_map_<kind>.png/.svg``, drawn from the artifact.  The computation is
 :func:`walkerlab.sweep.stability.gait_map`.
 """
 
@@ -81,7 +81,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
     out = run_cached(stage_name(spec.kind), scene, runs_root, SECTIONS, (), compute, force,
                      extra_key=spec.key())
-    draw(out.path)
+    from walkerlab.io.runpaths import figures_dir
+
+    draw(out.path, figures_dir(scene, runs_root, claim=True))
     return out
 
 
@@ -99,11 +101,13 @@ def load(path: Path | str) -> dict:
     return out
 
 
-def draw(path: Path | str) -> list[Path]:
-    """Figure of a stability-map artifact, next to it (``<stem>.png``, ``.svg``)."""
+def draw(path: Path | str, out_dir: Path | str | None = None) -> list[Path]:
+    """Figure of a stability-map artifact (``<stem>.png``, ``.svg``) in ``out_dir`` (default:
+    the report's figures folder next to the artifact, ``report/figures/``)."""
     from walkerlab.plotting.sweep_figures import gait_map_figure, save
 
     path = Path(path)
     data = load(path)
     fig = gait_map_figure(data)
-    return save(fig, path.parent, path.stem)
+    return save(fig, Path(out_dir) if out_dir is not None else path.parent / "report" / "figures",
+                path.stem)

@@ -190,7 +190,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                 g.attrs["reference_method"], g.attrs["reference_rtol"] = ref[:2]
                 for m, d in rows.items():
                     put(g, f"{m}/rtol", d["rtol"], "-", "relative tolerance")
-                    put(g, f"{m}/time", d["time"], "s", "median wall time")
+                    put(g, f"{m}/time", d["time"], "s", "median wall time", clock="wall")
+                    put(g, f"{m}/time_min", d["time_min"], "s", "fastest of the repeats "
+                        "(wall time)", clock="wall")
+                    put(g, f"{m}/time_max", d["time_max"], "s", "slowest of the repeats "
+                        "(wall time)", clock="wall")
                     put(g, f"{m}/cpu_time", d["cpu_time"], "s", "median process CPU time")
                     put(g, f"{m}/repeats", d["repeats"], "-", "timed runs (1 when a run "
                         f"takes > {SINGLE_RUN_S:g} s)")
@@ -204,6 +208,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                 if summ["best"]:
                     g.attrs["best_method"], g.attrs["best_rtol"] = summ["best"][:2]
                     g.attrs["best_time"], g.attrs["best_error"] = summ["best"][2:]
+                    g.attrs["best_time_min"], g.attrs["best_time_max"] = \
+                        summ["best_spread"][2], summ["best_spread"][4]
+                    g.attrs["best_repeats"] = summ["best_spread"][5]
+                    # whether the fastest setting is faster than the timing noise
+                    g.attrs["best_separated"] = summ["separated"]
+                    g.attrs["tied_methods"] = [c[0] for c in summ["tied"]] or [""]
+                    g.attrs["tied_rtol"] = [c[1] for c in summ["tied"]] or [np.nan]
+                    g.attrs["tied_time_min"] = [c[2] for c in summ["tied"]] or [np.nan]
+                    g.attrs["tied_time_max"] = [c[4] for c in summ["tied"]] or [np.nan]
                 g.attrs["target_error"] = (wp.target_error if model == "ideal"
                                            else wp.contact_target_error)
             f.attrs["timing"] = ("each case measured in a worker process pinned to its own "

@@ -361,6 +361,22 @@ def bifurcation_writer(res: BifurcationResult):
     return writer
 
 
+def fall_onset(data: dict) -> float:
+    """Smallest slope [deg] of a bifurcation sweep from which on the walker no longer walks
+    (``steady_state/outcome`` is not ``walks`` there and at every larger slope); NaN if it
+    walks at the largest slope."""
+    out = data.get("steady_state/outcome")
+    if out is None:
+        return float("nan")
+    s = np.asarray(data["slope"], float)
+    walks = np.array([str(o) == "walks" for o in out])
+    if walks[-1]:
+        return float("nan")
+    last_walk = np.flatnonzero(walks)
+    i = int(last_walk[-1]) + 1 if last_walk.size else 0
+    return float(s[i])
+
+
 def load_bifurcation(path: Path) -> dict:
     """Arrays of a ``bifurcation`` artifact as a dict (names as in the file)."""
     from walkerlab.io.artifacts import open_artifact, read_named

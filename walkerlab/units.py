@@ -1,0 +1,124 @@
+"""The unit labels of a scene: one place that maps a physical dimension to its label.
+
+A scene is in SI units (``units: SI``, the default) or nondimensional (``units:
+nondimensional``; g = 1, lengths and masses in the units the scene's numbers are given in,
+e.g. Garcia et al. 1998: l = g = M = 1, time in √(l/g)).  Code that writes or shows a
+quantity names its *SI* unit (``"s"``, ``"m/s"``, ``"J"``, ``"rad/s"``, ``"mm"``) and asks
+:class:`Units` for the label; a nondimensional scene then says ``√(l/g)``, ``√(g l)``,
+``M g l``, ``rad/√(l/g)``, ``10⁻³ l`` instead.  Wall-clock and CPU times of a computation
+are real seconds in every scene: they are not passed through :class:`Units`.
+
+Artifacts carry the system in their ``scene_units`` attribute and their datasets' ``unit``
+attributes follow it (:func:`relabel_artifact`).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+SI = "SI"
+NONDIMENSIONAL = "nondimensional"
+
+#: label of each SI unit in a nondimensional scene (length unit l, mass unit M, g = 1)
+NONDIMENSIONAL_LABELS = {
+    "m/s^2": "g", "rad/s": "rad/√(l/g)", "m/s": "√(g l)", "kg m^2": "M l²", "mm": "10⁻³ l",
+    "Hz": "√(g/l)", "J": "M g l", "kg": "M", "N": "M g", "m": "l", "s": "√(l/g)",
+}
+_TOKEN = re.compile(r"(?<![\w/^])(" + "|".join(
+    re.escape(k) for k in sorted(NONDIMENSIONAL_LABELS, key=len, reverse=True))
+    + r")(?![\w/^²])")
+
+
+@dataclass(frozen=True)
+class Units:
+    """Unit labels of one unit system (``"SI"`` or ``"nondimensional"``)."""
+
+    system: str = SI
+
+    @property
+    def nondimensional(self) -> bool:
+        return self.system == NONDIMENSIONAL
+
+    def __call__(self, si: str) -> str:
+        """Label of a quantity whose SI unit is ``si`` (composite strings such as
+        ``"rad, rad/s"`` are relabelled token by token; ``"rad"``, ``"-"``, ``"deg"`` stay)."""
+        if not self.nondimensional or not si:
+            return si
+        return _TOKEN.sub(lambda m: NONDIMENSIONAL_LABELS[m.group(1)], si)
+
+    # the dimensions the report and the figures name most often
+    @property
+    def time(self) -> str:
+        return self("s")
+
+    @property
+    def length(self) -> str:
+        return self("m")
+
+    @property
+    def small_length(self) -> str:
+        """Label of small lengths (clearances, penetration): mm in SI, l when
+        nondimensional; multiply metres by :attr:`small_scale` to show them."""
+        return "l" if self.nondimensional else "mm"
+
+    @property
+    def small_scale(self) -> float:
+        """Factor from the scene's length unit to :attr:`small_length` (1e3 in SI)."""
+        return 1.0 if self.nondimensional else 1e3
+
+    @property
+    def speed(self) -> str:
+        return self("m/s")
+
+    @property
+    def rate(self) -> str:
+        return self("rad/s")
+
+    @property
+    def energy(self) -> str:
+        return self("J")
+
+    def sentence(self) -> str:
+        """One line saying what the numbers are measured in."""
+        if self.nondimensional:
+            return ("nondimensional scene (g = 1): lengths in units of l, masses in M, time "
+                    "in √(l/g), speeds in √(g l), energies in M g l (the scene's numbers)")
+        return "SI (m, kg, s)"
+
+
+def for_scene(scene) -> Units:
+    """:class:`Units` of a scene (``scene.units``; a scene without the field is SI)."""
+    return Units(getattr(scene, "units", SI) or SI)
+
+
+def for_artifact(f) -> Units:
+    """:class:`Units` of an open artifact (its ``scene_units`` attribute; SI if absent)."""
+    v = f.attrs.get("scene_units", SI)
+    return Units(v.decode() if isinstance(v, bytes) else str(v))
+
+
+def is_clock_time(name: str, attrs) -> bool:
+    """Whether a dataset holds the computer's wall-clock or CPU time (real seconds)."""
+    base = name.rsplit("/", 1)[-1]
+    return bool(attrs.get("clock", "")) or "wall_time" in base or "cpu_time" in base
+
+
+def relabel_artifact(f, units: Units) -> None:
+    """Rewrite every dataset's ``unit`` (and CF ``units``) attribute of an open artifact to
+    ``units``' labels, except clock times; store ``scene_units``."""
+    f.attrs["scene_units"] = units.system
+    if not units.nondimensional:
+        return
+    import h5py
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset) and "unit" in obj.attrs \
+                and not is_clock_time(name, obj.attrs):
+            old = obj.attrs["unit"]
+            old = old.decode() if isinstance(old, bytes) else str(old)
+            new = units(old)
+            if new != old:
+                obj.attrs["unit"] = new
+                obj.attrs["units"] = "1"  # CF: dimensionless
+    f.visititems(visit)
