@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _kernels as K
+from walkerlab.contact import _kernels as K
 
 
 def _load_driver():
