@@ -541,7 +541,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     walker, guess, ideal = _walker_and_guess(walker_or_scene, guess)
     P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol, deadline=deadline)
     scale = SCALES.copy()
-    scale[3] = walker.static_penetration()
+    scale[SECTION_NAMES.index("delta_stance")] = walker.static_penetration()
     coarse = coarse_rtol is not None and coarse_rtol > rtol
     # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
     PC = StepMap(walker, patch_spacing, method=method, rtol=coarse_rtol, atol=coarse_atol,
