@@ -126,17 +126,36 @@ def test_kernels_read_parameters_through_named_indices():
     assert not re.findall(r"\bP\[\d+\]", src), "bare P[number] in the contact kernels"
 
 
-def test_contact_package_never_imports_stages():
-    for path in (PKG / "contact").glob("*.py"):
-        tree = ast.parse(path.read_text())
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom):
-                names = [node.module or ""]
-            elif isinstance(node, ast.Import):
-                names = [a.name for a in node.names]
+def _imports(path):
+    """Absolute module names imported by ``path`` (relative imports resolved)."""
+    pkg = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1])
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg.rsplit(".", node.level - 1)[0] if node.level > 1 else pkg
+                yield f"{base}.{node.module}" if node.module else base
             else:
-                continue
-            assert not any(n.startswith("walkerlab.stages") for n in names), path.name
+                yield node.module or ""
+        elif isinstance(node, ast.Import):
+            yield from (a.name for a in node.names)
+
+
+@pytest.mark.parametrize("package,never", [
+    # the model holds the model only: no integration, analysis, sweep or stage above it
+    ("contact", ("walkerlab.stages", "walkerlab.analysis", "walkerlab.integrate",
+                 "walkerlab.sweep", "walkerlab.report")),
+    # settings lie under every model (the old config <-> contact.config cycle)
+    ("config", ("walkerlab.contact", "walkerlab.models", "walkerlab.analysis",
+                "walkerlab.integrate", "walkerlab.stages")),
+    # integration knows no gait analysis and no stage
+    ("integrate", ("walkerlab.analysis", "walkerlab.stages", "walkerlab.sweep")),
+])
+def test_package_imports_point_down(package, never):
+    paths = list((PKG / package).glob("*.py"))
+    assert paths
+    for path in paths:
+        bad = [n for n in _imports(path) if n.startswith(never)]
+        assert not bad, f"{path.name} imports {bad}"
 
 
 def test_one_mass_matrix():

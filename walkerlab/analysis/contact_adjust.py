@@ -39,7 +39,7 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
         walker, res, _, _ = simulate_from(scene, x_fp, period, rate_scale=tuple(s))
         n_hs = len(res.heel_strike_times)
         want = 2 * n_strides
-        if n_hs < want or not res.outcome.ok:
+        if n_hs < want or res.termination in ("fall", "trip", "airborne"):
             return 1.0 + (want - min(n_hs, want))
         steps = [st for st in res.steps if np.isfinite(st.period)][-4:]
         T = np.array([st.period for st in steps])

@@ -184,12 +184,15 @@ class _TimeLimit(Exception):
     """Internal: the wall-time limit ran out inside a right-hand side."""
 
 
-def _guarded(f, deadline):
-    """``f`` that raises :class:`_TimeLimit` once ``time.perf_counter()`` passes ``deadline``."""
+def _guarded(f, deadline, calls=None):
+    """``f`` that raises :class:`_TimeLimit` once ``time.perf_counter()`` passes ``deadline``
+    (and counts its calls in ``calls[0]``, if given: the count of a cut chunk)."""
     if not np.isfinite(deadline):
         return f
 
     def g(t, x, *a):
+        if calls is not None:
+            calls[0] += 1
         if time.perf_counter() > deadline:
             raise _TimeLimit
         return f(t, x, *a)
@@ -357,7 +360,8 @@ class _Backend:
     def __init__(self, walker, solver: ContactSolverSettings, use_jac: bool, deadline: float):
         self.walker, self.solver, self.method = walker, solver, solver.method
         self.max_step = solver.max_step_s if solver.max_step_s else np.inf
-        self.frhs = _guarded(walker.rhs, deadline)
+        self.calls = [0]  # RHS calls of the current chunk (Python backends)
+        self.frhs = _guarded(walker.rhs, deadline, self.calls)
         self.fjac = walker.jac if use_jac else None
         self.compiled = self.method == "numbalsoda" or self.method in _cyrk.CYRK_METHODS
         self.sized_by_wall = self.method == "numbalsoda"
@@ -427,9 +431,11 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
         tb = min(ta + span, t1)
         tg = sample_grid(ta, tb, rate)
         w0 = time.perf_counter()
+        be.calls[0] = 0
         try:
             tn, Xn, ok, m, nf, nj = be.chunk(xa, tg)
         except _TimeLimit:
+            nfev += be.calls[0]
             term, msg = "time_limit", "wall-time limit reached inside a chunk"
             break
         nfev += nf
