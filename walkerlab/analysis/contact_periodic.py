@@ -77,7 +77,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
-from walkerlab.contact import _kernels as K  # foot_state only: wants walker.foot_state()
+from walkerlab.contact.compiled import foot_state
 from walkerlab.contact.model import ContactWalker
 from walkerlab.integrate.contact import StateIndex
 
@@ -220,7 +220,7 @@ class StepMap:
 
     def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
         """Section coordinates (6,) and along-slope position s [m] of foot ``stance`` (0/1)."""
-        px, py, vx, vy = K.foot_state(np.asarray(x, float), stance, self.walker._P)
+        px, py, vx, vy = foot_state(x, stance, self.walker)
         p, v = np.array([px, py]), np.array([vx, vy])
         sw = 1 - stance
         z = np.array([x[self._angle[stance]], x[self._rate[sw]], x[self._rate[stance]],

@@ -4,7 +4,7 @@ Internal module, imported by :mod:`walkerlab.integrate.contact`; CyRK itself is 
 on the first chunk of a ``cyrk_*`` method.  CyRK (a main dependency, binary wheels, no
 Fortran) takes the right-hand side as a C function pointer (its numba bridge,
 ``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The RHS
-:func:`walkerlab.contact._kernels.rhs` is wrapped in a numba ``cfunc`` (compiled once,
+:func:`walkerlab.contact.compiled.rhs_packed` is wrapped in a numba ``cfunc`` (compiled once,
 cached on disk), so CyRK integrates a whole chunk of samples without re-entering Python.
 The physics is not repeated here: the cfunc only unpacks its data vector and calls the
 kernel.
@@ -24,7 +24,7 @@ import ctypes
 
 import numpy as np
 
-from walkerlab.contact import _kernels as K
+from walkerlab.contact import compiled as K
 
 __all__ = ["CYRK_METHODS", "solve_chunk"]
 
@@ -63,7 +63,7 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     t_eval : ndarray (n,)
         Increasing sample times [s]; the first is the start time.
     data : ndarray
-        From :func:`walkerlab.contact._kernels.pack`.
+        From :func:`walkerlab.contact.compiled.packed_data`.
     rtol : float
     atol : float or ndarray (8,)
         [m, rad, m/s, rad/s].

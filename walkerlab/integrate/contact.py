@@ -46,6 +46,7 @@ import numpy as np
 from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
 from walkerlab.config.contact import ContactSolverSettings
+from walkerlab.contact import compiled
 
 from . import _cyrk
 
@@ -299,14 +300,6 @@ def first_event(walker, t, X, limits: ContactLimits, k0=1):
     return best
 
 
-def _packed_data(walker) -> np.ndarray:
-    """The data vector of the compiled backends (what ``walker.packed_data()`` should give:
-    the one place here that knows the model's compiled kernel layout)."""
-    from walkerlab.contact import _kernels
-
-    return _kernels.pack(walker._P, walker.lane1, walker.lane2)
-
-
 def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline):
     """Integrate with leg2's foot held fixed.  Returns (t, X, nfev, njev, termination, msg)."""
     idx = StateIndex(walker)
@@ -367,7 +360,7 @@ class _Backend:
         self.sized_by_wall = self.method == "numbalsoda"
         if self.method == "numbalsoda" and np.isfinite(self.max_step):
             raise ValueError("contact_solver.max_step_s is not supported by method numbalsoda")
-        self.data = _packed_data(walker) if self.compiled else None
+        self.data = compiled.packed_data(walker) if self.compiled else None
 
     def odeint_chunk(self, xs, tg):
         with warnings.catch_warnings():
