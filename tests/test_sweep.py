@@ -178,7 +178,7 @@ def test_max_steps_scuffing_solver_failure_error(base, monkeypatch):
     b = dict(base, simulate={**base["simulate"], "strides": 1})
     row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None,
                       {"scuff_limit_m": 1e-4})
-    assert row["outcome"] == "scuffing" and row["scuff_depth_m"] > 1e-3  # ideal gait dips ~3.6 mm
+    assert row["outcome"] == "scuff" and row["scuff_depth_m"] > 1e-3  # ideal gait dips ~3.6 mm
     row, _ = evaluate("simulate", b, ["slope.angle_deg"], (3.0,), 0, None, {})
     assert row["outcome"] == "ok" and row["steps_completed"] == 2
     bad = dict(base, simulate={**base["simulate"],
@@ -210,7 +210,7 @@ def test_tolerances_from_1e_3_to_1e_12(base):
 
 
 def test_outcome_columns_declared():
-    assert set(OUTCOMES) >= {"ok", "no_fixed_point", "fall", "scuffing", "solver_failure",
+    assert set(OUTCOMES) >= {"ok", "no_fixed_point", "fall", "scuff", "solver_failure",
                              "max_steps", "invalid_config"}
     assert set(COLUMNS) == {"fixedpoint", "simulate", "contact-sim"}
 

@@ -216,9 +216,11 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
     with open_artifact(out.path, "contact-sim") as f:
         kind = str(f.attrs.get("outcome", f.attrs["termination"]))
         why = str(f.attrs.get("outcome_message", ""))
-    # like simulate: a walker that does not finish the run exits 1 (typed outcome of
-    # walkerlab.contact.simulate: trip, fall, solver_failure, time_limit)
-    if kind not in ("completed", "scuff", "slip", "t_final", "stride_cap"):
+    # like simulate: a walker that does not walk exits 1 (the shared run ends,
+    # walkerlab.integrate.ends: trip, fall, airborne, no_heel_strike, ...)
+    from walkerlab.integrate.ends import CONTACT_WALKED
+
+    if kind not in CONTACT_WALKED:
         _fail(RuntimeError(f"the contact walker did not complete the run: {kind}"
                            + (f" ({why})" if why else "")))
 

@@ -9,15 +9,13 @@ import numpy as np
 import pytest
 
 from tests.contact.conftest import FP, STEP_LENGTH
-from walkerlab.contact import (
-    ContactSettings,
-    ContactWalker,
-    TerrainSettings,
-    initial_state_from_ideal,
-    simulate_contact,
-)
-from walkerlab.contact.drop import restitution_curve
-from walkerlab.contact.simulate import OUTCOME_KINDS, _phase_slip
+from walkerlab.analysis.contact_drop import restitution_curve
+from walkerlab.analysis.contact_gait import CONTACT_OUTCOMES as OUTCOME_KINDS
+from walkerlab.analysis.contact_gait import phase_slip as _phase_slip
+from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
+from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.contact import ContactWalker
+from walkerlab.integrate.contact import ContactLimits
 
 PKG = Path(__file__).resolve().parents[2] / "walkerlab"
 
@@ -36,8 +34,8 @@ def test_stiff_heel_strike_bounce_does_not_tunnel_into_a_trip():
     (~0.58 s with the +10 % stance rate)."""
     w = _walker(k=1e7)
     x0 = initial_state_from_ideal(w, *FP, rate_scale=(1.0, 1.1))
-    r = simulate_contact(w, x0, 0.75, rtol=1e-8, atol=1e-11)
-    assert r.outcome.kind in ("completed", "scuff"), r.outcome
+    r = simulate_contact(w, x0, 0.75, ContactSolverSettings(rtol=1e-8, atol=1e-11))
+    assert r.outcome.kind in ("t_final", "scuff"), r.outcome
     assert r.termination == "t_final"
     assert r.walked_steps >= 1
     assert r.steps[1].bounce_count >= 1  # the heel strike did bounce (elastic at 1e7)
@@ -56,7 +54,7 @@ def test_trip_is_a_foot_hitting_a_patch_side():
     x[0] -= 0.002 * w.normal[0]
     x[1] -= 0.002 * w.normal[1]  # 2 mm below the top, in the gap uphill of the patch
     x[4:6] = 1.0 * w.tangent  # moving downhill towards the patch side at 1 m/s
-    r = simulate_contact(w, x, 0.2, rtol=1e-8, atol=1e-11)
+    r = simulate_contact(w, x, 0.2, ContactSolverSettings(rtol=1e-8, atol=1e-11))
     assert r.outcome.kind == "trip", r.outcome
     assert r.termination == "trip"
     assert r.outcome.foot == "leg2"
@@ -75,13 +73,16 @@ def test_typed_outcomes_fall_time_limit_and_slip():
     r = simulate_contact(w, initial_state_from_ideal(w, *FP, rate_scale=(0.2, 0.2)), 3.0)
     assert r.outcome.kind == "fall" and r.outcome.hip_height_m == pytest.approx(0.5, abs=1e-3)
     # wall-time limit (tiny) -> time_limit after the first chunk
-    r = simulate_contact(w, x0, 3.0, wall_time_limit_s=1e-6, chunk_s=0.05)
+    r = simulate_contact(w, x0, 3.0,
+                         ContactSolverSettings(),
+                         ContactLimits(wall_time_limit_s=1e-6, chunk_s=0.05))
     assert r.outcome.kind == "time_limit" and r.t[-1] < 3.0
     # slip limit below the ~0.5 mm creep of the regularized friction -> slip
     r = simulate_contact(w, x0, 1.6, slip_limit_mm=0.01)
     assert r.outcome.kind == "slip" and r.outcome.foot in ("leg1", "leg2")
-    assert set(OUTCOME_KINDS) >= {"completed", "trip", "fall", "scuff", "slip",
-                                  "solver_failure", "time_limit"}
+    assert set(OUTCOME_KINDS) >= {"heel_strike", "t_final", "trip", "fall", "scuff", "slip",
+                                  "airborne", "no_heel_strike", "solver_failure",
+                                  "time_limit"}
 
 
 def test_slip_window_is_one_stance_phase():
@@ -97,7 +98,7 @@ def test_slip_window_is_one_stance_phase():
     # a run cut in double support is NaN, not hundreds of mm of creep
     w = _walker(width=0.10)
     r = simulate_contact(w, initial_state_from_ideal(w, *FP, rate_scale=(1.0, 1.1)), 1.45,
-                         rtol=1e-8, atol=1e-11)
+                         ContactSolverSettings(rtol=1e-8, atol=1e-11))
     ended = [st for st in r.steps if np.isfinite(st.stance_slip_mm)]
     assert ended and all(abs(st.stance_slip_mm) < 2.0 for st in ended)
     assert np.isnan(r.steps[-1].stance_slip_mm)
@@ -125,17 +126,36 @@ def test_kernels_read_parameters_through_named_indices():
     assert not re.findall(r"\bP\[\d+\]", src), "bare P[number] in the contact kernels"
 
 
-def test_contact_package_never_imports_stages():
-    for path in (PKG / "contact").glob("*.py"):
-        tree = ast.parse(path.read_text())
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom):
-                names = [node.module or ""]
-            elif isinstance(node, ast.Import):
-                names = [a.name for a in node.names]
+def _imports(path):
+    """Absolute module names imported by ``path`` (relative imports resolved)."""
+    pkg = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1])
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg.rsplit(".", node.level - 1)[0] if node.level > 1 else pkg
+                yield f"{base}.{node.module}" if node.module else base
             else:
-                continue
-            assert not any(n.startswith("walkerlab.stages") for n in names), path.name
+                yield node.module or ""
+        elif isinstance(node, ast.Import):
+            yield from (a.name for a in node.names)
+
+
+@pytest.mark.parametrize("package,never", [
+    # the model holds the model only: no integration, analysis, sweep or stage above it
+    ("contact", ("walkerlab.stages", "walkerlab.analysis", "walkerlab.integrate",
+                 "walkerlab.sweep", "walkerlab.report")),
+    # settings lie under every model (the old config <-> contact.config cycle)
+    ("config", ("walkerlab.contact", "walkerlab.models", "walkerlab.analysis",
+                "walkerlab.integrate", "walkerlab.stages")),
+    # integration knows no gait analysis and no stage
+    ("integrate", ("walkerlab.analysis", "walkerlab.stages", "walkerlab.sweep")),
+])
+def test_package_imports_point_down(package, never):
+    paths = list((PKG / package).glob("*.py"))
+    assert paths
+    for path in paths:
+        bad = [n for n in _imports(path) if n.startswith(never)]
+        assert not bad, f"{path.name} imports {bad}"
 
 
 def test_one_mass_matrix():

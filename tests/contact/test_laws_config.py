@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
+from walkerlab.config import ContactSettings, ContactSimSettings, TerrainSettings
 from walkerlab.contact import _kernels as K
-from walkerlab.contact.config import ContactSettings, ContactSimSettings, TerrainSettings
 from walkerlab.contact.laws import (
     adams_step,
     adams_step_derivative,

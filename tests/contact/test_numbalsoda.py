@@ -3,15 +3,11 @@
 import numpy as np
 import pytest
 
-from walkerlab.contact import (
-    ContactSettings,
-    ContactWalker,
-    TerrainSettings,
-    _lsoda,
-    initial_state_from_ideal,
-    simulate_contact,
-)
-from walkerlab.contact.bench import EXAMPLE_IDEAL
+from walkerlab.analysis.contact_bench import EXAMPLE_IDEAL, leg_angle_columns
+from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
+from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.contact import ContactWalker
+from walkerlab.integrate import _lsoda
 
 
 def _bench_case():
@@ -31,20 +27,21 @@ def test_numbalsoda_five_strides_match_odeint():
     if not _lsoda.available():  # not importorskip: `import numbalsoda` compiles for ~7 s
         pytest.skip("numbalsoda (optional extra) not installed")
     w, x0, tf = _bench_case()
-    a = simulate_contact(w, x0, tf, method="odeint", rtol=1e-10, atol=1e-13)
-    b = simulate_contact(w, x0, tf, method="numbalsoda", rtol=1e-10, atol=1e-13)
+    a = simulate_contact(w, x0, tf, ContactSolverSettings(method="odeint", rtol=1e-10, atol=1e-13))
+    b = simulate_contact(w, x0, tf,
+                         ContactSolverSettings(method="numbalsoda", rtol=1e-10, atol=1e-13))
     assert b.method == "numbalsoda" and b.termination == a.termination == "t_final"
     assert b.nfev > 0 and b.walked_steps == a.walked_steps == 10
     assert b.heel_strike_legs == a.heel_strike_legs
     np.testing.assert_allclose(b.heel_strike_times, a.heel_strike_times, atol=1e-6)
     assert np.array_equal(a.t, b.t)
-    assert np.abs(b.q[:, 2:] - a.q[:, 2:]).max() < 1e-7
+    assert np.abs(b.x[:, leg_angle_columns(w)] - a.x[:, leg_angle_columns(w)]).max() < 1e-7
 
 
 def test_numbalsoda_missing_or_unsupported_is_one_clear_error(monkeypatch):
     w, x0, _ = _bench_case()
     with pytest.raises(ValueError, match="max_step_s"):
-        simulate_contact(w, x0, 0.01, method="numbalsoda", max_step=1e-3)
+        simulate_contact(w, x0, 0.01, ContactSolverSettings(method="numbalsoda", max_step_s=1e-3))
     monkeypatch.setattr(_lsoda, "lsoda", None)
     with pytest.raises(ValueError, match=r"pip install 'walkerlab\[numbalsoda\]'"):
-        simulate_contact(w, x0, 0.01, method="numbalsoda")
+        simulate_contact(w, x0, 0.01, ContactSolverSettings(method="numbalsoda"))

@@ -12,8 +12,8 @@ from walkerlab.analysis.contact_periodic import (
     find_contact_periodic_gait,
     rigid_limit_contact,
 )
-from walkerlab.config import load_scene
-from walkerlab.contact import simulate_contact
+from walkerlab.analysis.contact_sim import simulate_contact
+from walkerlab.config import ContactSolverSettings, load_scene
 from walkerlab.contact.model import checkerboard_lanes
 from walkerlab.stages.contact_sim import build
 from walkerlab.stages.fixedpoint import solve_variant
@@ -69,7 +69,7 @@ def test_period_close_to_ideal(setup, paper_gait):
     c1, c2 = checkerboard_lanes(g.step_length_m, 8)
     w = dataclasses.replace(walker, lane1=c1, lane2=c2, continuous=False)
     x0 = StepMap(walker).to_state(g.z)
-    r = simulate_contact(w, x0, 6 * g.period_s, rtol=1e-10, atol=1e-13)
+    r = simulate_contact(w, x0, 6 * g.period_s, ContactSolverSettings(rtol=1e-10, atol=1e-13))
     assert r.termination == "t_final"
     T = np.diff(r.heel_strike_times)
     assert len(T) >= 4

@@ -5,13 +5,10 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from walkerlab.contact import (
-    ContactSettings,
-    ContactWalker,
-    TerrainSettings,
-    initial_state_from_ideal,
-    simulate_contact,
-)
+from walkerlab.analysis.contact_bench import leg_angle_columns
+from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
+from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.contact import ContactWalker
 from walkerlab.contact.laws import coulomb_friction_coefficient
 
 PAPER_FP = (-0.2042, 0.1694, -0.6058, -0.8610)  # ideal fixed point after heel strike
@@ -29,7 +26,7 @@ def _standing(phi, settings=None, both_feet=False, t_final=0.5):
                       patch_half_width=1.0, continuous=False)
     x0 = initial_state_from_ideal(w, 0.0, 0.0, 0.0, 0.0)
     x0[1] += 1e-5  # start 10 µm higher: it has to settle, not just sit
-    return w, simulate_contact(w, x0, t_final, rtol=1e-10, atol=1e-13)
+    return w, simulate_contact(w, x0, t_final, ContactSolverSettings(rtol=1e-10, atol=1e-13))
 
 
 @pytest.mark.parametrize("both_feet", [False, True])
@@ -115,9 +112,9 @@ def test_rigid_limit_as_stiffness_grows():
         cs = ContactSettings(stiffness=k, mu_static=5, mu_dynamic=5, stiction_velocity=0.01,
                              friction_velocity=0.1)
         w = ContactWalker.from_settings(cs, TerrainSettings(), step_length=0.372, n_steps=4)
-        r = simulate_contact(w, initial_state_from_ideal(w, *PAPER_FP), 0.6, rtol=1e-10,
-                             atol=1e-13)
-        errs.append(np.abs(r.q[:, 2:] - ideal[:, :2]).max())
+        r = simulate_contact(w, initial_state_from_ideal(w, *PAPER_FP), 0.6,
+                             ContactSolverSettings(rtol=1e-10, atol=1e-13))
+        errs.append(np.abs(r.x[:, leg_angle_columns(w)] - ideal[:, :2]).max())
     errs = np.array(errs)
     assert np.all(np.diff(errs) < 0), errs  # monotone decrease
     assert errs[-1] < 0.15 * errs[0] and errs[-1] < 1e-5, errs

@@ -77,8 +77,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
-from walkerlab.contact import _kernels as K
+from walkerlab.contact.compiled import foot_state
 from walkerlab.contact.model import ContactWalker
+from walkerlab.integrate.contact import StateIndex
 
 __all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait", "PeriodicGaitError",
            "find_contact_periodic_gait", "section_guess_from_ideal", "rigid_limit_contact"]
@@ -194,8 +195,11 @@ class StepMap:
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
         w = self.walker
-        self._P, self._c1, self._c2 = w._P, w.lane1, w.lane2
         self.n, self.t = w.normal, w.tangent
+        self.idx = StateIndex(w)
+        # leg i's angle and rate by name (leg1 = 0, leg2 = 1), never by row
+        self._angle = [self.idx["theta1"], self.idx["theta2"]]
+        self._rate = [self.idx.rate_of("theta1"), self.idx.rate_of("theta2")]
 
     # ------------------------------------------------------------------ coordinates
     def to_state(self, z) -> np.ndarray:
@@ -206,15 +210,21 @@ class StepMap:
         v = vt * self.t - dd * self.n
         hip = p - L * np.array([np.sin(th), -np.cos(th)])
         vh = v - L * np.array([np.cos(th), np.sin(th)]) * wst
-        return np.array([hip[0], hip[1], th, th, vh[0], vh[1], wsw, wst])
+        ix = self.idx
+        x = np.empty(ix.n)
+        x[[ix["hip_x"], ix["hip_y"]]] = hip
+        x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] = vh
+        x[self._angle] = th
+        x[self._rate] = (wsw, wst)
+        return x
 
     def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
         """Section coordinates (6,) and along-slope position s [m] of foot ``stance`` (0/1)."""
-        px, py, vx, vy = K.foot_state(np.asarray(x, float), stance, self._P)
+        px, py, vx, vy = foot_state(x, stance, self.walker)
         p, v = np.array([px, py]), np.array([vx, vy])
         sw = 1 - stance
-        z = np.array([x[2 + stance], x[6 + sw], x[6 + stance], -p @ self.n, v @ self.t,
-                      -v @ self.n])
+        z = np.array([x[self._angle[stance]], x[self._rate[sw]], x[self._rate[stance]],
+                      -p @ self.n, v @ self.t, -v @ self.n])
         return z, float(p @ self.t)
 
     # ------------------------------------------------------------------ the map
@@ -222,15 +232,15 @@ class StepMap:
         if time.perf_counter() > self.deadline:
             raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
                                     "reached")
-        return K.rhs(x, self._P, self._c1, self._c2)
+        return self.walker.rhs(t, x)
 
     def _jac(self, t, x):
-        return K.jac(x, self._P, self._c1, self._c2)
+        return self.walker.jac(t, x)
 
     def integrate(self, x0, stance_to_come: int = 0, dense: bool = False):
         """Integrate from ``x0`` to the next upward zero of theta_sw - theta_st where the
         new stance leg is ``stance_to_come`` (0 = leg1).  Returns the solve_ivp solution."""
-        ist, isw = 2 + stance_to_come, 3 - stance_to_come
+        ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
 
         def mid(t, x):
             return x[isw] - x[ist]
@@ -263,15 +273,9 @@ class StepMap:
         """
         from scipy.integrate import ODEintWarning, odeint
 
-        ist, isw = 2 + stance_to_come, 3 - stance_to_come
+        ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
         hth = 0.5 * self.walker.L
-        P, c1, c2 = self._P, self._c1, self._c2
-
-        def f(t, x):
-            return K.rhs(x, P, c1, c2)
-
-        def jf(t, x):
-            return K.jac(x, P, c1, c2)
+        f, jf = self.walker.rhs, self.walker.jac
 
         def run(x, tg):
             with warnings.catch_warnings():  # the message is checked below
@@ -291,7 +295,7 @@ class StepMap:
             tg = ta + dt * np.arange(int(round(chunk_s / dt)) + 1)
             X = run(xa, tg)
             g = X[:, isw] - X[:, ist]
-            hh = K.hip_heights(np.ascontiguousarray(X), P)
+            hh = self.walker.hip_height(X)
             up = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0)) + 1
             down = np.flatnonzero(hh < hth)
             if down.size and (not up.size or down[0] <= up[0]):
@@ -346,8 +350,7 @@ class StepMap:
             x0 = self.to_state(z)
             te = self._step_odeint(x0)[0]
             tt = np.linspace(0.0, te, 2001)
-            X = odeint(lambda t, x: K.rhs(x, self._P, self._c1, self._c2), x0, tt,
-                       Dfun=lambda t, x: K.jac(x, self._P, self._c1, self._c2), tfirst=True,
+            X = odeint(self.walker.rhs, x0, tt, Dfun=self.walker.jac, tfirst=True,
                        rtol=self.rtol, atol=self.atol, mxstep=500000)
         else:
             sol = self.integrate(self.to_state(z), dense=True)
@@ -379,10 +382,14 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
     its static penetration, ``rate_scale`` on the rates) and integrated to the first
     mid-stance of leg2, where the section coordinates are read.
     """
-    from walkerlab.contact.simulate import initial_state_from_ideal
+    from walkerlab.analysis.contact_sim import initial_state_from_ideal
+    from walkerlab.contact.scene import IDEAL_ROLES
 
     w = step_map.walker
-    x0 = initial_state_from_ideal(w, *x_ideal, rate_scale=rate_scale)
+    ideal = dict(zip(IDEAL_ROLES, np.asarray(x_ideal, float)))
+    x0 = initial_state_from_ideal(w, ideal["swing_angle"], ideal["stance_angle"],
+                                  ideal["swing_rate"], ideal["stance_rate"],
+                                  rate_scale=rate_scale)
     sol = step_map.integrate(x0, stance_to_come=1)
     if sol.status != 1 or sol.t_events[0].size == 0:
         raise PeriodicGaitError("fall" if sol.t_events[1].size else "no_mid_stance",
@@ -537,7 +544,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     walker, guess, ideal = _walker_and_guess(walker_or_scene, guess)
     P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol, deadline=deadline)
     scale = SCALES.copy()
-    scale[3] = walker.static_penetration()
+    scale[SECTION_NAMES.index("delta_stance")] = walker.static_penetration()
     coarse = coarse_rtol is not None and coarse_rtol > rtol
     # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
     PC = StepMap(walker, patch_spacing, method=method, rtol=coarse_rtol, atol=coarse_atol,

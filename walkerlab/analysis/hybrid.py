@@ -35,7 +35,15 @@ import numpy as np
 
 from walkerlab.models.base import HybridWalker, Phase, complex_step_jacobian
 
-Termination = Literal["heel_strike", "fall", "t_final", "solver_failure"]
+#: How a rigid step ends: the rigid side of the shared run ends
+#: (:mod:`walkerlab.integrate.ends`); ``no_heel_strike`` is a heel strike at the step's own
+#: start (a walker that does not move: no step was taken).
+Termination = Literal["heel_strike", "fall", "t_final", "solver_failure", "no_heel_strike"]
+
+#: A heel strike this soon after the step began [s] is no step: the state sat on the
+#: heel-strike surface and never moved (slope 0, all-zero state; a passive step lasts
+#: tenths of a second or more).
+MIN_STEP_TIME_S = 1e-9
 
 #: methods both backends implement with the same Runge-Kutta pair and step control
 CYRK_METHODS = ("RK23", "RK45", "DOP853")
@@ -238,7 +246,8 @@ class Segment:
     x_next : ndarray (2n,) or None
         State after the reset (heel strike only).
     termination : str
-        ``heel_strike``, ``fall``, ``t_final`` or ``solver_failure``.
+        ``heel_strike``, ``fall``, ``t_final``, ``solver_failure`` or ``no_heel_strike``
+        (:mod:`walkerlab.integrate.ends`).
     event : str
         Name of the guard that fired (or ``""``).
     phase_times : dict[str, float]
@@ -409,6 +418,11 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
             continue
         if guard.outcome == "fall":
             termination = "fall"
+            break
+        if t - t0 <= MIN_STEP_TIME_S:
+            termination = "no_heel_strike"
+            message = (f"no step: the heel-strike guard fired at the step's start "
+                       f"(t = {t0:.4g} s); the walker does not move")
             break
         termination = "heel_strike"
         x_next = np.asarray(walker.reset(x), dtype=float)

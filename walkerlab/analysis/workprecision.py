@@ -97,18 +97,20 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
     The final vector is the leg angles [rad] and rates [rad/s] at the final time, read by
     name from the contact walker's state, None unless the run reached its final time.
     """
+    from walkerlab.analysis.contact_bench import leg_angle_columns
+    from walkerlab.analysis.contact_sim import simulate_from
     from walkerlab.config import ContactSolverSettings
-    from walkerlab.contact.scene import simulate_from
+    from walkerlab.integrate.contact import StateIndex
 
     def run(method, rtol, atol):
         sv = ContactSolverSettings(method=method, rtol=rtol, atol=atol)
         walker, res, _, _ = simulate_from(scene, x0, step_period, solver=sv, strides=strides)
         if res.termination != "t_final":
             return None, res.nfev
-        names = list(walker.state_names())
-        n = res.q.shape[1]
-        legs = [i for i, s in enumerate(names[:n]) if s.startswith("theta")]
-        return np.concatenate([res.q[-1, legs], res.qdot[-1, legs]]), res.nfev
+        idx = StateIndex(walker)
+        legs = leg_angle_columns(walker)
+        return np.concatenate([res.x[-1, legs], res.x[-1, [i + idx.n // 2 for i in legs]]]), \
+            res.nfev
     return run
 
 

@@ -1,20 +1,21 @@
-"""Compliant-contact (MSC ADAMS-style) compass-gait walker: laws, model, simulation.
+"""The compliant-contact (MSC ADAMS-style) walker model: contact laws, geometry, terrain and
+the floating walker.  Only the model: integrating it is :mod:`walkerlab.integrate.contact`,
+reading its gait :mod:`walkerlab.analysis.contact_gait` / :mod:`walkerlab.analysis.contact_sim`,
+its settings live in :mod:`walkerlab.config.contact`.
 
-The names below are loaded on first use (PEP 562 ``__getattr__``): ``import
-walkerlab.contact.config`` (what :mod:`walkerlab.config` needs) must not load numba or
-scipy.integrate, which the model and the simulation need.
+The names below are loaded on first use (PEP 562 ``__getattr__``), so importing a settings
+or law module does not load numba, which the model needs.
 """
 
 from importlib import import_module
 
 _WHERE = {
+    # the model's settings (defined in walkerlab.config.contact), as the model reads them
     "ContactParamsSI": "config", "ContactSettings": "config", "ContactSimSettings": "config",
     "TerrainSettings": "config",
     "adams_step": "laws", "adams_step_derivative": "laws",
     "coulomb_friction_coefficient": "laws", "impact_normal_force": "laws",
     "FOOT_NAMES": "model", "ContactWalker": "model", "checkerboard_lanes": "model",
-    "ContactResult": "simulate", "FootTrace": "simulate", "StepSummary": "simulate",
-    "initial_state_from_ideal": "simulate", "simulate_contact": "simulate",
 }
 
 __all__ = sorted(_WHERE)

@@ -1,22 +1,24 @@
-"""Build a contact walker from a validated scene and run it (the library side of ``contact-sim``).
+"""Build the contact walker of a validated scene (its model; running it is
+:mod:`walkerlab.analysis.contact_sim`).
 
-The ``contact-sim`` stage, :mod:`walkerlab.contact.adjust`,
-:mod:`walkerlab.analysis.contact_periodic` and the sweep points all go through these
-functions, so a scene means the same contact run
-everywhere.  This module never imports :mod:`walkerlab.stages` (dependencies point down).
+The ``contact-sim`` stage, the adjustment, :mod:`walkerlab.analysis.contact_periodic`, the
+stability maps and the sweep points all build their walker here, so a scene means the same
+contact model everywhere.  This module imports settings only (:mod:`walkerlab.config`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.config import ContactSolverSettings, Scene
+from walkerlab.config import ContactSimSettings, ContactSolverSettings, Scene, TerrainSettings
 
-from .config import ContactSimSettings, TerrainSettings
 from .model import ContactWalker
 
-__all__ = ["ContactSceneError", "settings", "ideal_step_length", "build", "simulate_from",
-           "named_trajectory"]
+__all__ = ["IDEAL_ROLES", "ContactSceneError", "build", "ideal_step_length", "settings"]
+
+#: Names of the ideal (rigid compass-gait) state the contact walker starts from, in the
+#: order of an ideal state vector (the rigid walker's ``state_names()``).
+IDEAL_ROLES = ("swing_angle", "stance_angle", "swing_rate", "stance_rate")
 
 
 class ContactSceneError(ValueError):
@@ -43,10 +45,11 @@ def settings(scene: Scene):
             scene.contact_solver or ContactSolverSettings())
 
 
-def ideal_step_length(leg_length_m: float, x_ideal) -> float:
-    """Step length [m] of the ideal gait from its post-impact state ``[th_sw, th_st, ...]``:
-    ``2 L sin((th_st - th_sw) / 2)`` (foot-to-foot chord at heel strike)."""
-    th_sw, th_st = float(x_ideal[0]), float(x_ideal[1])
+def ideal_step_length(leg_length_m: float, x_ideal, names=IDEAL_ROLES) -> float:
+    """Step length [m] of the ideal gait from its post-impact state ``x_ideal`` named by
+    ``names``: ``2 L sin((th_st - th_sw) / 2)`` (foot-to-foot chord at heel strike)."""
+    x = dict(zip(names, np.asarray(x_ideal, float)))
+    th_sw, th_st = x["swing_angle"], x["stance_angle"]
     return 2 * leg_length_m * np.sin((th_st - th_sw) / 2)
 
 
@@ -57,7 +60,7 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
     ----------
     scene : Scene
     x_ideal : ndarray (4,)
-        Ideal fixed point (role order: swing, stance angles and rates) [rad, rad/s].
+        Ideal fixed point, named by :data:`IDEAL_ROLES` [rad, rad/s].
     n_steps : int
         Steps the run may take (sets how many patches are laid out).
 
@@ -74,76 +77,3 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
         contact, terrain, step_length=step_length, n_steps=n_steps + 4, L=w.leg_length_m,
         m=w.leg_mass_kg, MH=w.hip_mass_kg, a=w.leg_mass_from_foot_m, g=w.gravity_m_per_s2,
         phi=scene.slope.phi_rad), step_length
-
-
-def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=None,
-                  solver: ContactSolverSettings | None = None, strides: int | None = None):
-    """Run the contact walker of ``scene`` from the ideal fixed point ``x_ideal``.
-
-    Parameters
-    ----------
-    x_ideal : ndarray (4,)
-        Ideal post-impact state (role order, leg2 = stance) [rad, rad/s].
-    period : float
-        Ideal step period [s] (sets the default simulated time).
-    rate_scale : (float, float), optional
-        Multipliers on the initial rates (default ``contact_sim.initial_rate_scale``).
-    solver : ContactSolverSettings, optional
-    strides : int, optional
-        Strides to simulate (default ``contact_sim.n_strides``).
-
-    Returns
-    -------
-    walker, result, x0, step_length
-        :class:`ContactWalker`, :class:`~walkerlab.contact.simulate.ContactResult`, the
-        initial state (8,), the ideal step length [m].
-    """
-    from .simulate import initial_state_from_ideal, simulate_contact
-
-    _, _, cs, sv = settings(scene)
-    sv = solver or sv
-    n_strides = strides or cs.n_strides
-    walker, step_length = build(scene, x_ideal, 2 * n_strides)
-    scale = cs.initial_rate_scale if rate_scale is None else rate_scale
-    x0 = initial_state_from_ideal(walker, *x_ideal, rate_scale=tuple(scale))
-    t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
-    res = simulate_contact(
-        walker, x0, t_final, method=sv.method, rtol=sv.rtol, atol=sv.atol,
-        max_step=sv.max_step_s or np.inf, sample_rate_hz=cs.sample_rate_hz,
-        pin_stance_until=cs.pin_stance_until, pin_time_s=cs.pin_time_s,
-        fall_hip_height_m=cs.fall_hip_height_m, wall_time_limit_s=cs.wall_time_limit_s,
-        max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
-    return walker, res, x0, step_length
-
-
-def named_trajectory(walker: ContactWalker, res, legs=("leg1", "leg2")):
-    """A :class:`~walkerlab.contact.simulate.ContactResult` in the shared named layout of
-    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes)."""
-    from walkerlab.io.trajectory import NamedTrajectory
-
-    legs = list(legs)
-    t = res.t
-    stance = np.full(t.size, legs.index("leg2"))
-    step = np.zeros(t.size, dtype=int)
-    for k, (ths, leg) in enumerate(zip(res.heel_strike_times, res.heel_strike_legs)):
-        m = t >= ths
-        stance[m] = legs.index(leg)
-        step[m] = k + 1
-    X = res.x
-    en = walker.energies(X)
-    feet = np.asarray(walker.foot_positions(X))  # (n, 2, 2): foot, xy
-    names = walker.state_names()
-    col = {n: X[:, i] for i, n in enumerate(names)}
-    hip = np.vstack([col["hip_x"], col["hip_y"]])
-    pts = {"hip": hip}
-    for i, leg in enumerate(legs):
-        th = col[f"theta{i + 1}"]
-        pts[f"{leg}_foot"] = feet[:, i, :].T
-        pts[f"{leg}_mass"] = hip + walker.b * np.vstack([np.sin(th), -np.cos(th)])
-    coords, units = {}, {}
-    for i, leg in enumerate(legs):
-        coords[f"{leg}_angle"], units[f"{leg}_angle"] = col[f"theta{i + 1}"], "rad"
-        coords[f"{leg}_rate"], units[f"{leg}_rate"] = col[f"dtheta{i + 1}"], "rad/s"
-    return NamedTrajectory(
-        time=t, legs=legs, coordinates=coords, units=units, stance_leg=stance,
-        step_index=step, kinetic=en["kinetic"], potential=en["potential"], points=pts)

@@ -24,9 +24,10 @@ from walkerlab.sweep.bifurcation import fall_onset
 from walkerlab.sweep.outcomes import OUTCOMES
 
 OUTCOME_COLORS = {
-    "ok": "#2ca02c", "no_fixed_point": "#7f7f7f", "fall": "#d62728", "scuffing": "#9467bd",
+    "ok": "#2ca02c", "no_fixed_point": "#7f7f7f", "fall": "#d62728", "scuff": "#9467bd",
     "slip": "#ff7f0e", "bounce": "#e7ba52", "solver_failure": "#000000", "max_steps": "#17becf",
     "invalid_config": "#c7c7c7", "error": "#8c564b", "trip": "#bcbd22", "time_limit": "#aec7e8",
+    "airborne": "#f7b6d2", "no_heel_strike": "#dbdb8d",
 }
 OUTCOME_LABELS = {"ok": "walks (ok)", "fall": "falls", "slip": "slips", "bounce": "bounces"}
 

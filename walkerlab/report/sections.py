@@ -69,6 +69,7 @@ def swing_foot_clearance(path: Path, slope_rad: float, margin: float = 0.1) -> f
 def _contact_summary(path: Path) -> dict:
     with open_artifact(path, "contact-sim") as f:
         out = {"termination": str(f.attrs["termination"]),
+               "outcome": str(f.attrs.get("outcome", f.attrs["termination"])),
                "heel_strikes": int(len(f["events/heel_strike_times"][()])) if
                "events/heel_strike_times" in f else 0}
         if "periodic_gait" in f:
@@ -150,13 +151,15 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
                          num(u.small_scale * clear, 3), "—"])
     if "contact-sim" in paths:
         c = _contact_summary(paths["contact-sim"])
-        walks = c["termination"] != "fall" and c["heel_strikes"] > 0
+        from walkerlab.integrate.ends import CONTACT_WALKED
+
+        walks = c["outcome"] in CONTACT_WALKED
         extra = ""
         if "periodic_stable" in c:
             extra = ("; its own periodic gait is " + ("stable" if c["periodic_stable"]
                                                       else "unstable"))
         bullets.append(f"- **Contact walker walks**: {'yes' if walks else 'no'} "
-                       f"({c['heel_strikes']} heel strikes, ended by {c['termination']}){extra}.")
+                       f"({c['heel_strikes']} heel strikes, outcome {c['outcome']}){extra}.")
     cols = _gait_columns(paths)
     ideal = cols.get("ours, ideal")
     if ideal:

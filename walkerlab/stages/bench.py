@@ -12,7 +12,7 @@ benchmark      what is timed                                                    
 ``basin``      ``walkerlab basin --grid 200x200 --force``, paper walker,        <= 120 s
                50 steps a cell at most, 2 workers, whole process
 ``contact``    the contact walker's work-precision benchmark
-               (:func:`walkerlab.contact.bench.run_benchmark`)
+               (:func:`walkerlab.analysis.contact_bench.run_benchmark`)
 =============  ===============================================================  ==========
 
 The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
@@ -199,7 +199,7 @@ def run_bench(what: str, out: Path) -> list[str]:
         elif name == "basin":
             res = bench_basin()
         elif name == "contact":
-            from walkerlab.contact.bench import run_benchmark
+            from walkerlab.analysis.contact_bench import run_benchmark
 
             res = run_benchmark()
         else:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.analysis import contact_sim as contact_run
 from walkerlab.config import Scene
 from walkerlab.contact import scene as contact_scene
 from walkerlab.io.artifacts import put
@@ -33,12 +34,13 @@ def settings(scene: Scene):
 
 
 build = contact_scene.build
-simulate_from = contact_scene.simulate_from
+simulate_from = contact_run.simulate_from
 
 
 def named_trajectory(walker, res) -> NamedTrajectory:
-    """Map a ContactResult onto the shared named layout (see :mod:`walkerlab.contact.scene`)."""
-    return contact_scene.named_trajectory(walker, res, LEGS)
+    """Map a ContactResult onto the shared named layout (see
+    :func:`walkerlab.analysis.contact_sim.named_trajectory`)."""
+    return contact_run.named_trajectory(walker, res, LEGS)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
@@ -60,7 +62,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         adj = None
         scale = None
         if adjust:
-            from walkerlab.contact.adjust import adjust_rates
+            from walkerlab.analysis.contact_adjust import adjust_rates
 
             adj = adjust_rates(scene, x_fp, meta["step_period_s"])
             scale = adj["scale"]
@@ -79,7 +81,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                                                   time_limit_s=cs.periodic_time_limit_s)
             except PeriodicGaitError as exc:
                 gait_error = exc
-        from walkerlab.contact.drop import restitution_curve
+        from walkerlab.analysis.contact_drop import restitution_curve
 
         drop = restitution_curve(settings(scene)[0], DROP_STIFFNESS)
         c = walker.contact
@@ -115,7 +117,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             f.attrs["stiffness_family"] = settings(scene)[0].stiffness_family
             if res.fall_time is not None:
                 f.attrs["fall_time_s"] = res.fall_time
-                f.attrs["fall_reason"] = str(res.fall_reason)
             o = res.outcome
             g = f.create_group("outcome")
             g.attrs["kind"] = o.kind
@@ -128,7 +129,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                 "the outcome time")
             g = f.create_group("drop_test")
             g.attrs["method"] = ("point mass 20 kg meeting flat ground at 0.3 m/s, no gravity "
-                                 "(walkerlab.contact.drop); restitution = v_out / v_in")
+                                 "(walkerlab.analysis.contact_drop); restitution = v_out / v_in")
             lu = "mm" if settings(scene)[0].unit_system == "mm-kg-s" else "m"
             put(g, "stiffness", drop["stiffness"], f"N/{lu}^e",
                 "IMPACT stiffness in the scene's unit system")
@@ -152,9 +153,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             put(f, "terrain/lane_leg2", walker.lane2, "m", "patch centres, along-slope s")
             put(f, "terrain/patch_half_width", walker.patch_half_width, "m", "")
             put(f, "terrain/continuous", bool(walker.continuous), "-", "")
-            put(f, "initial_state", x0, "m, rad, m/s, rad/s",
-                "[hip_x, hip_y, theta1, theta2] and rates",
-                names=list(walker.state_names()))
+            put(f, "initial_state", x0, ", ".join(walker.state_units()),
+                "initial state, named by state_names", names=list(walker.state_names()))
             for name, val, unit in zip(walker.state_names(), x0, walker.state_units()):
                 put(f, f"initial_state_named/{name}", float(val), unit, f"initial {name}")
             put(f, "initial_state_ideal", x_fp, "rad, rad/s", "ideal fixed point (Table 2 MATLAB)")

@@ -51,8 +51,8 @@ SECTIONS = ("walker", "slope", "ideal", "fixedpoint", "workprecision", "contact"
 #: the sources a case's result depends on (a change elsewhere - report text, plots, other
 #: stages - keeps the measured cases)
 CASE_SOURCES = {
-    "ideal": ("analysis", "models", "config.py"),
-    "contact": ("analysis", "models", "contact", "config.py"),
+    "ideal": ("analysis", "models", "integrate", "config"),
+    "contact": ("analysis", "models", "contact", "integrate", "config"),
 }
 
 

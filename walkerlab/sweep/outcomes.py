@@ -1,6 +1,9 @@
 """Typed outcomes of a sweep point and the result columns of each swept stage.
 
-Every point of a sweep ends in exactly one outcome (never an unhandled exception):
+Every point of a sweep ends in exactly one outcome (never an unhandled exception).  How a
+run ended uses the shared run-end names (:mod:`walkerlab.integrate.ends`: ``fall``, ``trip``,
+``scuff``, ``slip``, ``airborne``, ``no_heel_strike``, ``solver_failure``, ``time_limit``);
+a run that walked is ``ok``; the others are a sweep's own verdicts:
 
 ==================  =======================================================================
 ``ok``              the stage succeeded (fixed point found / all steps walked)
@@ -9,10 +12,12 @@ Every point of a sweep ends in exactly one outcome (never an unhandled exception
                     = guard that fired; contact model: hip below the fall height)
 ``trip``            contact model: a foot hit the side of a patch below its top
                     (``fall_time_s``, ``fall_leg`` = the foot, ``trip_edge_m`` = the edge)
-``scuffing``        the swing foot hit the ground before heel strike (contact model: a
+``scuff``           the swing foot hit the ground before heel strike (contact model: a
                     touchdown of the swing foot that is not a heel strike; rigid model: only
                     when ``options["scuff_limit_m"]`` is set, since the ideal model ignores it)
 ``slip``            contact model: the stance foot slid more than ``slip_limit_mm``
+``airborne``        contact model: the hip rose above 1.5 leg lengths (flew off the ground)
+``no_heel_strike``  the walker made no step (contact: no heel strike by the end time)
 ``bounce``          contact model: the stance foot left the ground and touched down again
 ``solver_failure``  the integrator stopped (``message`` = scipy's message)
 ``max_steps``       a budget ran out before a verdict: a step lasted longer than
@@ -25,8 +30,13 @@ Every point of a sweep ends in exactly one outcome (never an unhandled exception
 
 from __future__ import annotations
 
-OUTCOMES = ("ok", "no_fixed_point", "fall", "trip", "scuffing", "slip", "bounce",
-            "solver_failure", "max_steps", "time_limit", "invalid_config", "error")
+from walkerlab.integrate.ends import RUN_END_NAMES
+
+#: Run ends that are a verdict of their own (the others, heel_strike / t_final, are ``ok``).
+RUN_END_OUTCOMES = tuple(k for k in RUN_END_NAMES if k not in ("heel_strike", "t_final"))
+
+OUTCOMES = ("ok", "no_fixed_point", *RUN_END_OUTCOMES, "bounce", "max_steps",
+            "invalid_config", "error")
 
 # column name -> (unit, description); all stored as float64 (NaN = not applicable).
 # Columns that depend on the walker's state (fixed point, initial state, multipliers) are

@@ -7,8 +7,8 @@ them so that every point ends in a typed outcome (:mod:`walkerlab.sweep.outcomes
 whatever happens.
 
 The contact-sim point goes through :func:`contact_adapter`, the only place that knows the
-calling convention of :func:`walkerlab.contact.simulate.simulate_contact` (that model is being
-written in parallel; adjust the adapter, nothing else, when its interface changes).
+calling convention of :func:`walkerlab.analysis.contact_sim.simulate_from` (adjust the
+adapter, nothing else, when its interface changes).
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from walkerlab.config import Scene, SceneError
+from walkerlab.integrate.ends import RUN_END_NAMES
 from walkerlab.sweep.outcomes import empty_row, state_column
 from walkerlab.sweep.params import apply_point
 
@@ -35,7 +36,7 @@ __all__ = ["Task", "Continuation", "run_chunk", "fixedpoint_point", "simulate_po
            "POINT_FUNCTIONS"]
 
 DEFAULT_OPTIONS: dict[str, Any] = {
-    "scuff_limit_m": None,   # rigid model: report 'scuffing' if the swing foot dips deeper [m]
+    "scuff_limit_m": None,   # rigid model: report 'scuff' if the swing foot dips deeper [m]
     "slip_limit_mm": 5.0,    # contact model: 'slip' if a stance foot slides farther [mm]
     "min_interleg_angle_rad": 1e-3,  # smaller fixed-point inter-leg angle = degenerate gait
 }
@@ -347,7 +348,7 @@ def simulate_point(scene: Scene, guess, options: dict):
                        f"{sim.max_step_time_s:g} s (walker stalled)", **cols)
     lim = opts.get("scuff_limit_m")
     if lim is not None and cols.get("scuff_depth_m", 0.0) > lim:
-        raise _Outcome("scuffing", f"swing foot {1e3 * cols['scuff_depth_m']:.3g} mm below the "
+        raise _Outcome("scuff", f"swing foot {1e3 * cols['scuff_depth_m']:.3g} mm below the "
                        f"slope before heel strike (limit {1e3 * lim:g} mm)", **cols)
     cols["outcome"] = "ok"
     return cols, next_guess
@@ -378,8 +379,8 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
     n_steps : int
         Steps requested (2 * ``contact_sim.n_strides``).
     """
-    from walkerlab.contact import ContactSimSettings
-    from walkerlab.contact.scene import simulate_from
+    from walkerlab.analysis.contact_sim import simulate_from
+    from walkerlab.config import ContactSimSettings
 
     # one code path with the contact-sim stage (terrain, initial state, solver, end time)
     cs = scene.contact_sim or ContactSimSettings()
@@ -387,10 +388,10 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
     return cw, res, 2 * cs.n_strides
 
 
-#: contact outcome kind (walkerlab.contact.simulate.OUTCOME_KINDS) -> sweep outcome
-_CONTACT_OUTCOME = {"completed": "ok", "trip": "trip", "fall": "fall", "scuff": "scuffing",
-                    "slip": "slip", "solver_failure": "solver_failure",
-                    "time_limit": "time_limit"}
+#: contact outcome kind (walkerlab.analysis.contact_gait.CONTACT_OUTCOMES, the shared run
+#: ends) -> sweep outcome: a run that walked is "ok", every other end keeps its name
+_CONTACT_OUTCOME = {k: ("ok" if k in ("heel_strike", "t_final") else k)
+                    for k in RUN_END_NAMES}
 
 
 def contact_point(scene: Scene, guess, options: dict):
@@ -402,8 +403,8 @@ def contact_point(scene: Scene, guess, options: dict):
     ``options["slip_limit_mm"]``, solver failure, time limit), then ``bounce`` (a stance
     foot left the ground and came back) and ``max_steps`` (stalled).
     """
+    from walkerlab.analysis.contact_gait import classify_complete
     from walkerlab.analysis.hybrid import integrate_step
-    from walkerlab.contact.simulate import classify_complete
 
     opts = {**DEFAULT_OPTIONS, **options}
     walker, fp, source = ideal_fixed_point(scene, guess, options)
@@ -414,8 +415,8 @@ def contact_point(scene: Scene, guess, options: dict):
             "ideal_step_period_s": float(fp.period_s)}
     _cw, res, n_steps = contact_adapter(scene, fp.x, fp.period_s, step_length)
     out = res.outcome
-    if out.kind == "completed":
-        out = classify_complete(res.steps, opts["slip_limit_mm"], out.hip_height_m)
+    if out.ok:
+        out = classify_complete(res.steps, opts["slip_limit_mm"], out.hip_height_m, out.kind)
     bounces = sum(s.bounce_count for s in res.steps)
     scuffs = sum(s.scuff_count for s in res.steps)
     periods = [s.period for s in res.steps if math.isfinite(s.period)]

@@ -1,5 +1,10 @@
 """Typed scene configuration (YAML -> pydantic v2).
 
+The package is the bottom of the settings: :mod:`walkerlab.config.contact` holds the
+compliant-contact sections (contact law, terrain, run, solver) and this module the scene and
+the rigid model's sections; every section is importable from ``walkerlab.config``.  Nothing
+here imports a model package (the model packages import their settings from here).
+
 A *scene* declares only the sections it uses; every section is optional except the walker
 and the slope.  Every numeric field carries its unit in its name (``leg_length_m``) and a
 description; validation always runs and unknown keys are rejected (``extra="forbid"``).
@@ -33,7 +38,15 @@ from pydantic import (
     model_validator,
 )
 
-from walkerlab.contact.config import ContactSettings, ContactSimSettings, TerrainSettings
+from walkerlab.config.contact import (  # noqa: F401  (re-exported: one import path)
+    MAX_CONTACT_STRIDES,
+    ContactParamsSI,
+    ContactSettings,
+    ContactSimSettings,
+    ContactSolverSettings,
+    TerrainSettings,
+    family_scaling,
+)
 
 
 class SceneError(ValueError):
@@ -272,22 +285,6 @@ class SolverSettings(_Strict):
         "auto", description="library that integrates: auto (cyrk for RK23/RK45/DOP853, else "
         "scipy), scipy, cyrk, or cyrk_compiled (CyRK with the flow compiled by numba: no "
         "Python callbacks, ~1 s numba import per process; for many-point studies)")
-
-
-class ContactSolverSettings(_Strict):
-    """Integrator of the stiff contact model: ``cyrk_bdf`` (CyRK's BDF from compiled code,
-    the default), ``odeint`` (LSODA, low overhead), numbalsoda or solve_ivp."""
-
-    method: Literal["odeint", "cyrk_bdf", "numbalsoda", "LSODA", "Radau", "BDF", "RK45",
-                    "DOP853"] = Field(
-        "cyrk_bdf", description="cyrk_bdf (CyRK's BDF from compiled code), "
-        "scipy.integrate.odeint, numbalsoda (LSODA from compiled code; optional extra "
-        "'walkerlab[numbalsoda]') or a solve_ivp method")
-    rtol: float = Field(1e-8, ge=1e-13, lt=1,
-                        description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
-                        "cannot meet a tighter one in double precision)")
-    atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
-    max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
 
 
 class StateSpec(_Strict):

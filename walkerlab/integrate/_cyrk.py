@@ -1,10 +1,10 @@
 """CyRK route for the contact walker: CyRK's C++ integrators called with a compiled RHS.
 
-Internal module, imported by :mod:`walkerlab.contact.simulate`; CyRK itself is imported only
+Internal module, imported by :mod:`walkerlab.integrate.contact`; CyRK itself is imported only
 on the first chunk of a ``cyrk_*`` method.  CyRK (a main dependency, binary wheels, no
 Fortran) takes the right-hand side as a C function pointer (its numba bridge,
 ``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The RHS
-:func:`walkerlab.contact._kernels.rhs` is wrapped in a numba ``cfunc`` (compiled once,
+:func:`walkerlab.contact.compiled.rhs_packed` is wrapped in a numba ``cfunc`` (compiled once,
 cached on disk), so CyRK integrates a whole chunk of samples without re-entering Python.
 The physics is not repeated here: the cfunc only unpacks its data vector and calls the
 kernel.
@@ -24,7 +24,7 @@ import ctypes
 
 import numpy as np
 
-from . import _kernels as K
+from walkerlab.contact import compiled as K
 
 __all__ = ["CYRK_METHODS", "solve_chunk"]
 
@@ -52,7 +52,7 @@ def _build() -> int:
 
 
 def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
-                rtol: float, atol, max_step: float = np.inf):
+                rtol: float, atol, max_step: float = np.inf, max_num_steps: int = 0):
     """Integrate from ``x0`` at ``t_eval[0]`` over the sample times ``t_eval`` (n,) [s].
 
     Parameters
@@ -63,12 +63,16 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     t_eval : ndarray (n,)
         Increasing sample times [s]; the first is the start time.
     data : ndarray
-        From :func:`walkerlab.contact._kernels.pack`.
+        From :func:`walkerlab.contact.compiled.packed_data`.
     rtol : float
     atol : float or ndarray (8,)
         [m, rad, m/s, rad/s].
     max_step : float
         Largest step [s] (inf: none).
+    max_num_steps : int
+        Most solver steps in this call (0: CyRK's default); past it the call stops
+        unsuccessfully at the last sample reached (how a caller bounds the wall time of a
+        compiled chunk, which checks no clock).
 
     Returns
     -------
@@ -96,8 +100,9 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     # (one call per chunk; avoids compiling that njit wrapper in every process)
     ptr = ns.c_numba_cysolve_ivp(
         _FPTR, te[0], te[-1], u0.ctypes.data, u0.size, find_ode_method_int(CYRK_METHODS[method]),
-        0, 0, data.ctypes.data, data.size * 8, 0, 2000, False, te.ctypes.data, te.size,
-        None, None, 0, rt.ctypes.data, rt.size, at.ctypes.data, at.size, hmax, 0.0, True)
+        0, 0, data.ctypes.data, data.size * 8, int(max_num_steps), 2000, False,
+        te.ctypes.data, te.size, None, None, 0, rt.ctypes.data, rt.size, at.ctypes.data,
+        at.size, hmax, 0.0, True)
     if not ptr:  # pragma: no cover - allocation failure inside CyRK
         return np.empty((0, u0.size)), False, 0, "CyRK returned no result"
     try:

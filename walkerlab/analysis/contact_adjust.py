@@ -25,11 +25,12 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
     dict
         ``scale`` (2,), ``objective``, ``evaluations``, ``grid_best`` (2,).
     """
-    from .scene import settings, simulate_from
+    from walkerlab.contact.scene import ideal_step_length, settings
+
+    from .contact_sim import simulate_from
 
     n_strides = settings(scene)[2].n_strides
-    L = scene.walker.leg_length_m
-    l_star = 2 * L * np.sin((x_fp[1] - x_fp[0]) / 2)
+    l_star = ideal_step_length(scene.walker.leg_length_m, x_fp)
     count = {"n": 0}
 
     def J(s):
@@ -38,12 +39,11 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
         walker, res, _, _ = simulate_from(scene, x_fp, period, rate_scale=tuple(s))
         n_hs = len(res.heel_strike_times)
         want = 2 * n_strides
-        if n_hs < want or res.termination in ("fall", "trip"):
+        if n_hs < want or res.termination in ("fall", "trip", "airborne"):
             return 1.0 + (want - min(n_hs, want))
         steps = [st for st in res.steps if np.isfinite(st.period)][-4:]
         T = np.array([st.period for st in steps])
-        X = res.x
-        feet = np.asarray(walker.foot_positions(X))
+        feet = np.asarray(walker.foot_positions(res.x)).reshape(len(res.t), -1, 2)
         lens = []
         for th in res.heel_strike_times[-4:]:
             i = min(np.searchsorted(res.t, th), len(res.t) - 1)

@@ -11,16 +11,26 @@ import time
 
 import numpy as np
 
-from .config import ContactSettings, TerrainSettings
-from .model import ContactWalker
-from .simulate import initial_state_from_ideal, simulate_contact
+from walkerlab.config.contact import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.contact.model import ContactWalker
+from walkerlab.integrate.contact import StateIndex
 
-__all__ = ["EXAMPLE_IDEAL", "TARGET_RTOLS", "rhs_cost", "run_benchmark"]
+from .contact_sim import initial_state_from_ideal, simulate_contact
+
+__all__ = ["EXAMPLE_IDEAL", "TARGET_RTOLS", "leg_angle_columns", "rhs_cost", "run_benchmark"]
 
 #: Benchmark inputs only (approximate ideal fixed point of the paper walker on phi = 0.0174
 #: rad, leg1 swing / leg2 stance): the lead supplies exact values at run time.
 EXAMPLE_IDEAL = {"theta1": -0.2042, "theta2": 0.1694, "dtheta1": -0.6058, "dtheta2": -0.8610,
                  "step_length": 0.372, "step_period": 0.7036}
+
+
+def leg_angle_columns(walker) -> list[int]:
+    """State columns of the walker's leg angles: every generalised coordinate but the hip
+    position (``hip_x``, ``hip_y``), by name."""
+    idx = StateIndex(walker)
+    return [i for i in range(idx.coordinates.start, idx.coordinates.stop)
+            if idx.names[i] not in ("hip_x", "hip_y")]
 
 
 def rhs_cost(walker: ContactWalker, x: np.ndarray, n: int = 2000) -> dict:
@@ -39,7 +49,7 @@ def rhs_cost(walker: ContactWalker, x: np.ndarray, n: int = 2000) -> dict:
 def _default_methods() -> tuple:
     """odeint, cyrk_bdf, LSODA, BDF, Radau, and numbalsoda when the optional extra is
     installed."""
-    from . import _lsoda
+    from walkerlab.integrate import _lsoda
 
     return ("odeint", "cyrk_bdf") + (("numbalsoda",) if _lsoda.available() else ()) + \
         ("LSODA", "BDF", "Radau")
@@ -102,15 +112,22 @@ def run_benchmark(n_strides: int = 5, methods=None,
     x0 = initial_state_from_ideal(walker, ideal["theta1"], ideal["theta2"], ideal["dtheta1"],
                                   ideal["dtheta2"], rate_scale)
     t_final = 1.03 * n_steps * ideal["step_period"]  # the contact gait is ~1% slower
-    ref = simulate_contact(walker, x0, t_final, method="odeint", rtol=1e-12, atol=1e-15)
+    ref = simulate_contact(walker, x0, t_final,
+                           ContactSolverSettings(method="odeint", rtol=1e-12, atol=1e-15))
+    angles = leg_angle_columns(walker)
+
+    def error(r):
+        n = min(len(r.t), len(ref.t))
+        return float(np.abs(r.x[:n, angles] - ref.x[:n, angles]).max())
+
     def one(method, rtol, atol):
         best = None
         for _ in range(repeats):
-            r = simulate_contact(walker, x0, t_final, method=method, rtol=rtol, atol=atol)
+            r = simulate_contact(walker, x0, t_final,
+                                 ContactSolverSettings(method=method, rtol=rtol, atol=atol))
             if best is None or r.wall_time_s < best.wall_time_s:
                 best = r
-        n = min(len(best.t), len(ref.t))
-        return best, float(np.abs(best.q[:n, 2:] - ref.q[:n, 2:]).max())
+        return best, error(best)
 
     target = {}
     bands = TARGET_RTOLS if target_rtols is None else target_rtols
@@ -127,14 +144,13 @@ def run_benchmark(n_strides: int = 5, methods=None,
         for rtol in rtols:
             best = None
             for _ in range(repeats):
-                r = simulate_contact(walker, x0, t_final, method=method, rtol=rtol,
-                                     atol=1e-3 * rtol)
+                r = simulate_contact(walker, x0, t_final, ContactSolverSettings(
+                    method=method, rtol=rtol, atol=1e-3 * rtol))
                 if best is None or r.wall_time_s < best.wall_time_s:
                     best = r
-            n = min(len(best.t), len(ref.t))
             runs.append({"method": method, "rtol": rtol, "wall_time_s": best.wall_time_s,
                          "nfev": best.nfev, "njev": best.njev,
-                         "max_angle_error_rad": float(np.abs(best.q[:n, 2:] - ref.q[:n, 2:]).max()),
+                         "max_angle_error_rad": error(best),
                          "heel_strikes": best.walked_steps, "termination": best.termination})
     return {"t_final_s": t_final,
             "reference": {"method": "odeint", "rtol": 1e-12, "wall_time_s": ref.wall_time_s,

@@ -1,11 +1,11 @@
 """Drop test of the IMPACT contact: coefficient of restitution against stiffness.
 
 A point mass ``m`` moving down at ``v_in`` meets flat ground governed by the IMPACT law
-(:func:`walkerlab.contact._kernels.normal_force`, the same kernel the walker uses) under
+(:func:`walkerlab.contact.laws.impact_normal_force`, the law the walker's kernel compiles) under
 gravity; the coefficient of restitution is ``e = v_out / v_in`` with ``v_out`` the upward
 speed at separation (force back to zero).  A plastic impact (the rigid model's heel strike)
 has ``e = 0``.  :func:`restitution_curve` sweeps the stiffness in the paper's family (damping
-fixed) and in the rigid-limit family (:func:`walkerlab.contact.config.family_scaling`).
+fixed) and in the rigid-limit family (:func:`walkerlab.config.contact.family_scaling`).
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import _kernels as K
-from .config import ContactSettings
+from walkerlab.config.contact import ContactSettings
+from walkerlab.contact.laws import impact_normal_force
 
 __all__ = ["FAMILIES", "drop_restitution", "restitution_curve"]
 
@@ -52,7 +52,7 @@ def drop_restitution(contact: ContactSettings, mass_kg: float = 20.0, v_in_m_per
 
     def f(t, y):
         d, dd = y
-        fn = K.normal_force(d, dd, c.k, c.e, c.cmax, c.dmax)[0]
+        fn = float(impact_normal_force(d, dd, c.k, c.e, c.cmax, c.dmax))
         return [dd, g - fn / mass_kg]
 
     def sep(t, y):

@@ -2,11 +2,11 @@
 
 Internal module, imported only when ``method="numbalsoda"`` is selected (numbalsoda is an
 optional extra: ``pip install 'walkerlab[numbalsoda]'``; building it from source needs a C++
-and a Fortran compiler and cmake).  The right-hand side :func:`walkerlab.contact._kernels.rhs`
-is wrapped in a numba ``cfunc`` so that LSODA (numbalsoda's C++ port) integrates a whole
-chunk of samples without re-entering Python.  numbalsoda's LSODA takes a scalar ``atol``, no
-largest step and no user Jacobian (it forms the stiff-phase Jacobian by finite differences;
-those RHS calls are counted in ``nfev``).
+and a Fortran compiler and cmake).  The right-hand side
+:func:`walkerlab.contact.compiled.rhs_packed` is wrapped in a numba ``cfunc`` so that LSODA
+(numbalsoda's C++ port) integrates a whole chunk of samples without re-entering Python.
+numbalsoda's LSODA takes a scalar ``atol``, no largest step and no user Jacobian (it forms
+the stiff-phase Jacobian by finite differences; those RHS calls are counted in ``nfev``).
 
 The packed data vector handed to the cfunc is ``[n1, n2, P (NPAR), c1 (n1), c2 (n2), nfev]``.
 """
@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _kernels as K
+from walkerlab.contact import compiled as K
 
 
 def _load_driver():

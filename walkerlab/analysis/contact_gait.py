@@ -1,0 +1,446 @@
+"""What a contact run's samples mean: touchdowns, heel strikes, steps, and how the run ended.
+
+Input: the samples of :func:`walkerlab.integrate.contact.integrate_contact` (times, states
+named by ``walker.state_names()``) and the model's per-foot contact quantities
+(``walker.contact_quantities``).  Output: per-foot traces with touchdown / lift-off times,
+the heel strikes, one :class:`StepSummary` per step (slip, creep, bounces, scuffs, peak
+penetration) and the run's typed :class:`Outcome`, whose ``kind`` is one of the shared run
+ends (:mod:`walkerlab.integrate.ends`).  Nothing here integrates or reads a state by row.
+
+Touchdown and lift-off are the zero crossings of the penetration, located on the cubic
+Hermite interpolant of the samples and their rates; a heel strike is a touchdown of the
+non-stance foot at least ``min_step_m`` downhill of the stance foot's touchdown point, other
+touchdowns of that foot are scuffs, of the stance foot bounces.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from walkerlab.integrate.contact import hermite_root
+from walkerlab.integrate.ends import CONTACT_WALKED, RUN_END_NAMES
+
+__all__ = ["CONTACT_OUTCOMES", "ContactResult", "FootTrace", "Outcome", "StepSummary",
+           "classify", "classify_complete", "gait_events", "heel_strike_count", "phase_slip"]
+
+#: Outcome kinds of a contact run: the shared run ends (:mod:`walkerlab.integrate.ends`)
+#: that the contact model can produce.
+CONTACT_OUTCOMES = tuple(k for k in RUN_END_NAMES)
+
+
+@dataclass
+class Outcome:
+    """How a contact run ended (``kind``: one of :data:`CONTACT_OUTCOMES`).
+
+    Attributes
+    ----------
+    kind : str
+    time_s : float
+        Event time [s] (trip, fall, airborne: the event; scuff, slip: start of the offending
+        step; solver failure / time limit: last sample); NaN when the run walked to its end.
+    foot : str
+        The foot of a trip, scuff or slip ("" otherwise).
+    patch_edge_m : float
+        Along-slope position [m] of the patch side hit (trip), else NaN.
+    hip_height_m : float
+        Hip height above the ground line at ``time_s`` (or at the end) [m].
+    message : str
+        One line for people.
+    """
+
+    kind: str
+    time_s: float = float("nan")
+    foot: str = ""
+    patch_edge_m: float = float("nan")
+    hip_height_m: float = float("nan")
+    message: str = ""
+
+    @property
+    def ok(self) -> bool:
+        """The walker walked: made its heel strikes or reached its end time."""
+        return self.kind in ("heel_strike", "t_final")
+
+    @property
+    def walked(self) -> bool:
+        """A run that counts as a walk (exit code 0): :data:`CONTACT_WALKED`."""
+        return self.kind in CONTACT_WALKED
+
+
+@dataclass
+class FootTrace:
+    """Sampled contact quantities and events of one foot.
+
+    Attributes
+    ----------
+    normal_force, friction_force : ndarray (n,)
+        [N]; friction along the down-slope tangent t.
+    penetration : ndarray (n,)
+        Signed penetration [m] (negative = height above the ground line).
+    slip_velocity : ndarray (n,)
+        Down-slope foot velocity [m/s].
+    s : ndarray (n,)
+        Along-slope foot position [m].
+    on_ground : ndarray (n,) of bool
+        Whether the foot's lane has ground under it.
+    touchdown_times, liftoff_times : ndarray
+        Event times [s], located on the Hermite interpolant of the samples.
+    """
+
+    normal_force: np.ndarray
+    friction_force: np.ndarray
+    penetration: np.ndarray
+    slip_velocity: np.ndarray
+    s: np.ndarray
+    on_ground: np.ndarray
+    touchdown_times: np.ndarray
+    liftoff_times: np.ndarray
+
+
+@dataclass
+class StepSummary:
+    """One step, from a heel strike (or t0) to the next heel strike.
+
+    Attributes
+    ----------
+    index : int
+    stance_leg : str
+        The foot in stance (a key of ``walker.contact_quantities``).
+    t_start, t_end : float
+        [s]; ``t_end`` is nan if the run ended first.
+    period : float
+        ``t_end - t_start`` [s] (nan if incomplete).
+    stance_slip_mm : float
+        Along-slope slide of the stance foot over its stance phase(s) that start in this
+        step, each from touchdown to lift-off (flight between bounces excluded) [mm];
+        positive = downhill.  NaN when the stance phase does not end before the run does.
+    double_support_creep_mm : float
+        Along-slope travel of both feet (sum of |displacement|) while both are loaded, within
+        the step [mm] (the smoothed-stiction creep; reported apart from the slip).
+    bounce_count : int
+        Touchdowns of the stance foot within the step after the one that starts it.
+    scuff_count : int
+        Touchdowns of the swing foot within the step that are not its heel strike.
+    peak_penetration_m : float
+        Largest penetration of either foot within the step [m].
+    liftoff_time : float
+        Lift-off of the stance foot ending its stance [s] (nan if none).
+    """
+
+    index: int
+    stance_leg: str
+    t_start: float
+    t_end: float
+    period: float
+    stance_slip_mm: float
+    double_support_creep_mm: float
+    bounce_count: int
+    scuff_count: int
+    peak_penetration_m: float
+    liftoff_time: float = float("nan")
+
+
+@dataclass
+class ContactResult:
+    """A contact run: samples, gait events, steps and outcome (all SI unless named otherwise).
+
+    Attributes
+    ----------
+    t : ndarray (n,)
+        Sample times [s] (the last one is the event time if an event ended the run).
+    x : ndarray (n, N)
+        States, columns named by ``state_names``.
+    state_names : tuple of str
+        ``walker.state_names()``.
+    feet : dict[str, FootTrace]
+        Keyed by foot name.
+    heel_strike_times : ndarray
+        [s] (touchdowns of the swing foot ahead of the stance foot).
+    heel_strike_legs : list[str]
+        Foot that struck.
+    steps : list[StepSummary]
+    termination : str
+        How the integration stopped (:mod:`walkerlab.integrate.ends`): ``heel_strike``
+        (strides cap), ``t_final``, ``trip``, ``fall``, ``airborne``, ``solver_failure`` or
+        ``time_limit``.
+    outcome : Outcome
+        The run's verdict: the termination, or after a run that reached its end: ``slip``
+        beyond the slip limit, ``scuff``, ``no_heel_strike``.
+    message : str
+        Solver message.
+    nfev, njev : int
+        Right-hand side / Jacobian evaluations.
+    wall_time_s : float
+        Wall time of the integration (excluding post-processing) [s].
+    method : str
+    pin_end_time : float
+        End of the pinned phase [s] (= t0 if none).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    state_names: tuple
+    feet: dict
+    heel_strike_times: np.ndarray
+    heel_strike_legs: list
+    steps: list
+    termination: str
+    message: str
+    nfev: int
+    njev: int
+    wall_time_s: float
+    method: str
+    pin_end_time: float = 0.0
+    outcome: Outcome = field(default_factory=lambda: Outcome("t_final"))
+
+    def column(self, name: str) -> np.ndarray:
+        """Samples (n,) of the state ``name``."""
+        return self.x[:, list(self.state_names).index(name)]
+
+    @property
+    def walked_steps(self) -> int:
+        """Number of heel strikes."""
+        return len(self.heel_strike_times)
+
+    @property
+    def fall_time(self) -> float | None:
+        """[s] time of the trip or fall that ended the run, else None."""
+        return self.outcome.time_s if self.outcome.kind in ("trip", "fall") else None
+
+    @property
+    def max_stance_slip_mm(self) -> float:
+        """Largest |stance slip| over the stance phases that ended [mm] (0 if none)."""
+        v = [abs(s.stance_slip_mm) for s in self.steps if np.isfinite(s.stance_slip_mm)]
+        return float(max(v, default=0.0))
+
+
+# ---------------------------------------------------------------------------- events
+def _crossings(t, pen, rate, on):
+    """Touchdown / lift-off times from sampled penetration, its rate and ground flags.
+
+    Crossings of zero penetration are located on the cubic Hermite interpolant (values and
+    rates at the samples); a change of the ground flag (patch edge) counts at the sample.
+    """
+    c = (pen > 0) & on
+    td, lo = [], []
+    if c.size and c[0]:
+        td.append(t[0])
+    for k in np.flatnonzero(c[1:] != c[:-1]) + 1:
+        tc = t[k]
+        if on[k] and on[k - 1]:
+            r = hermite_root(t[k - 1], t[k], pen[k - 1], pen[k], rate[k - 1], rate[k],
+                             rising=bool(c[k]))
+            if r is not None:
+                tc = r
+        (td if c[k] else lo).append(tc)
+    return np.array(td), np.array(lo)
+
+
+def phase_slip(t, s, td, lo, ta, tb):
+    """Slide [m] of a foot over its contact phases starting in [ta, tb): sum of s(lo) - s(td)
+    per phase; NaN if the last such phase has no lift-off."""
+    total, any_phase = 0.0, False
+    for tdj in td:
+        if not (ta - 1e-12 <= tdj < tb):
+            continue
+        any_phase = True
+        nxt = lo[lo > tdj]
+        if not nxt.size:
+            return np.nan
+        total += float(np.interp(nxt[0], t, s) - np.interp(tdj, t, s))
+    return total if any_phase else np.nan
+
+
+def _intervals(td, lo, t_end):
+    """Contact intervals [(touchdown, lift-off)] of a foot (lift-off = ``t_end`` if none)."""
+    out = []
+    for a in td:
+        nxt = lo[lo > a]
+        out.append((float(a), float(nxt[0]) if nxt.size else t_end))
+    return out
+
+
+def _foot_traces(walker, t, X) -> dict[str, FootTrace]:
+    cq = walker.contact_quantities(X)
+    feet = {}
+    for name, d in cq.items():
+        on = d["on_ground"] > 0.5
+        td, lo = _crossings(t, d["penetration"], d["penetration_rate"], on)
+        feet[name] = FootTrace(d["normal_force"], d["friction_force"], d["penetration"],
+                               d["slip_velocity"], d["s"], on, td, lo)
+    return feet
+
+
+def _heel_strikes(t, feet, min_step_m, initial_stance):
+    """Heel strikes (times, feet) and the bounces / scuffs counted per step."""
+    evs = sorted((tt, name) for name in feet for tt in feet[name].touchdown_times)
+    stance = initial_stance
+    s_stance = float(np.interp(t[0], t, feet[stance].s))
+    hs_t, hs_leg, bounces, scuffs = [], [], [0], [0]
+    for tt, name in evs:
+        if tt == t[0]:
+            continue
+        s_here = float(np.interp(tt, t, feet[name].s))
+        if name != stance and s_here > s_stance + min_step_m:
+            hs_t.append(tt)
+            hs_leg.append(name)
+            bounces.append(0)
+            scuffs.append(0)
+            stance, s_stance = name, s_here
+        elif name == stance:
+            bounces[-1] += 1
+        else:
+            scuffs[-1] += 1
+    return hs_t, hs_leg, bounces, scuffs
+
+
+def heel_strike_count(walker, t, X, min_step_m: float = 0.05,
+                      initial_stance: str = "leg2") -> int:
+    """Heel strikes in the samples ``t`` (n,), ``X`` (n, N) (the strides cap's count)."""
+    feet = _foot_traces(walker, t, X)
+    return len(_heel_strikes(t, feet, min_step_m, initial_stance)[0])
+
+
+def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "leg2") -> dict:
+    """Foot traces, heel strikes and step summaries of a contact run's samples.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    t : ndarray (n,)
+        [s].
+    X : ndarray (n, N)
+        States named by ``walker.state_names()``.
+    min_step_m : float
+        A touchdown of the swing foot counts as a heel strike only if it lands at least this
+        far [m] downhill of the stance foot's touchdown point (else it is a scuff).
+    initial_stance : str
+        The foot in stance at ``t[0]``.
+
+    Returns
+    -------
+    dict
+        ``feet`` {foot: FootTrace}, ``hs_t`` (k,) [s], ``hs_leg`` [foot], ``steps``
+        [StepSummary].
+    """
+    feet = _foot_traces(walker, t, X)
+    hs_t, hs_leg, bounces, scuffs = _heel_strikes(t, feet, min_step_m, initial_stance)
+    names = list(feet)
+    starts = [t[0]] + hs_t
+    legs = [initial_stance] + hs_leg
+    loaded = {f: (feet[f].penetration > 0) & feet[f].on_ground for f in names}
+    # double-support intervals: overlaps of the feet's contact intervals (event times)
+    iv = {f: _intervals(feet[f].touchdown_times, feet[f].liftoff_times, float(t[-1]))
+          for f in names}
+    ds = [(max(a1, a2), min(b1, b2)) for a1, b1 in iv[names[0]] for a2, b2 in iv[names[1]]
+          if min(b1, b2) > max(a1, a2)]
+    steps = []
+    for j, (ta, leg) in enumerate(zip(starts, legs)):
+        tb = starts[j + 1] if j + 1 < len(starts) else np.nan
+        tb_or_end = tb if np.isfinite(tb) else t[-1]
+        # stance phases of this leg that begin between its heel strike and its next one
+        t_next = starts[j + 2] if j + 2 < len(starts) else np.inf
+        ft = feet[leg]
+        td = ft.touchdown_times
+        if j == 0 and (not td.size or td[0] > t[0]) and loaded[leg][0]:
+            td = np.concatenate([[t[0]], td])
+        slip = phase_slip(t, ft.s, td, ft.liftoff_times, ta, t_next)
+        lo_mine = ft.liftoff_times[(ft.liftoff_times > ta) & (ft.liftoff_times < t_next)]
+        sel = (t >= ta) & (t <= tb_or_end)
+        creep = 0.0
+        for a, b in ds:
+            a, b = max(a, ta), min(b, tb_or_end)
+            if b > a:
+                creep += sum(abs(float(np.interp(b, t, feet[f].s) - np.interp(a, t, feet[f].s)))
+                             for f in names)
+        peak = max(float(np.max(feet[f].penetration[sel] * feet[f].on_ground[sel]))
+                   for f in names) if sel.any() else np.nan
+        steps.append(StepSummary(j, leg, float(ta), float(tb), float(tb - ta),
+                                 float(1e3 * slip), float(1e3 * creep), int(bounces[j]),
+                                 int(scuffs[j]), max(peak, 0.0),
+                                 float(lo_mine[-1]) if lo_mine.size else np.nan))
+    return {"feet": feet, "hs_t": np.array(hs_t), "hs_leg": hs_leg, "steps": steps}
+
+
+# ---------------------------------------------------------------------------- outcome
+def classify_complete(steps, slip_limit_mm: float | None, hip_height_m: float,
+                      end: str = "t_final") -> Outcome:
+    """Outcome of a run that reached its end (``end``: ``t_final`` or ``heel_strike``):
+    ``no_heel_strike`` if it made no step, ``slip`` if a stance phase slid farther than
+    ``slip_limit_mm`` [mm], ``scuff`` if the swing foot touched down before its heel strike,
+    else ``end``."""
+    if len(steps) <= 1:
+        return Outcome("no_heel_strike", hip_height_m=hip_height_m,
+                       message="no heel strike: the walker reached the end of the run "
+                       "without taking a step")
+    if slip_limit_mm is not None:
+        for st in steps:
+            if np.isfinite(st.stance_slip_mm) and abs(st.stance_slip_mm) > slip_limit_mm:
+                return Outcome("slip", st.t_start, st.stance_leg, np.nan, hip_height_m,
+                               f"slip: {st.stance_leg} slid {st.stance_slip_mm:.3g} mm in the "
+                               f"stance phase from t = {st.t_start:.4g} s (limit "
+                               f"{slip_limit_mm:g} mm)")
+    for st in steps:
+        if st.scuff_count:
+            return Outcome("scuff", st.t_start, _other(steps, st.stance_leg), np.nan,
+                           hip_height_m, f"scuff: the swing foot touched ground "
+                           f"{st.scuff_count} time(s) before its heel strike in step "
+                           f"{st.index}")
+    return Outcome(end, hip_height_m=hip_height_m,
+                   message=f"walked: {len(steps) - 1} heel strikes"
+                   + (" (the number asked for)" if end == "heel_strike" else
+                      " by the end time"))
+
+
+def _other(steps, leg: str) -> str:
+    """The other foot than ``leg`` among the steps' stance legs ("" if unknown)."""
+    return next((s.stance_leg for s in steps if s.stance_leg != leg), "")
+
+
+def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps: list,
+             message: str, limits, slip_limit_mm: float | None,
+             wall_time_limit_s: float | None) -> Outcome:
+    """The typed outcome of a contact run from how its integration stopped.
+
+    Parameters
+    ----------
+    termination : str
+        :attr:`walkerlab.integrate.contact.ContactIntegration.termination`.
+    event : tuple or None
+        Its ``event``.
+    t : ndarray (n,)
+        Sample times [s].
+    hip_height_m : float
+        Hip height at the last sample [m].
+    steps : list[StepSummary]
+    message : str
+        The solver's message.
+    limits : ContactLimits
+    slip_limit_mm, wall_time_limit_s : float or None
+    """
+    n_hs = max(len(steps) - 1, 0)
+    te = float(t[-1])
+    if termination == "trip":
+        _, _, te, foot, edge = event
+        return Outcome("trip", te, foot, edge, hip_height_m,
+                       f"trip: {foot} hit the side of the patch edge at s = {edge:.4f} m at "
+                       f"t = {te:.4g} s after {n_hs} heel strikes")
+    if termination == "fall":
+        return Outcome("fall", te, "", np.nan, hip_height_m,
+                       f"fall: hip {hip_height_m:.3f} m above ground "
+                       f"(< {limits.fall_hip_height_m:g} m) at t = {te:.4g} s after {n_hs} "
+                       "heel strikes")
+    if termination == "airborne":
+        return Outcome("airborne", te, "", np.nan, hip_height_m,
+                       f"airborne: the hip rose {hip_height_m:.3g} m above the ground "
+                       f"(> {limits.airborne_hip_height_m:g} m) at t = {te:.4g} s after "
+                       f"{n_hs} heel strikes: the walker flew off the ground")
+    if termination == "solver_failure":
+        return Outcome("solver_failure", te, "", np.nan, hip_height_m,
+                       f"solver failure at t = {te:.4g} s: {message}")
+    if termination == "time_limit":
+        return Outcome("time_limit", te, "", np.nan, hip_height_m,
+                       f"time limit: {wall_time_limit_s:g} s of wall time used by t = "
+                       f"{te:.4g} s ({n_hs} heel strikes)")
+    return classify_complete(steps, slip_limit_mm, hip_height_m, end=termination)

@@ -1,0 +1,232 @@
+"""A contact run: integrate the compliant-contact walker, then read its gait (``contact-sim``).
+
+:func:`simulate_contact` = :func:`walkerlab.integrate.contact.integrate_contact` (samples,
+events) + :func:`walkerlab.analysis.contact_gait.gait_events` (heel strikes, steps) + the
+typed outcome.  :func:`simulate_from` runs the contact walker of a scene from the ideal
+gait, the one code path of the ``contact-sim`` stage, the adjustment
+(:mod:`walkerlab.analysis.contact_adjust`), the sweeps and the work-precision study, so a
+scene means the same contact run everywhere.  States are read by name
+(``walker.state_names()``), never by row.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from walkerlab.config import Scene
+from walkerlab.config.contact import ContactSolverSettings
+from walkerlab.contact.scene import IDEAL_ROLES, build, settings
+from walkerlab.integrate.contact import ContactLimits, StateIndex, integrate_contact
+
+from .contact_gait import ContactResult, classify, gait_events, heel_strike_count
+
+__all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
+           "simulate_contact", "simulate_from", "trajectory_names"]
+
+#: A walker whose hip rises above this many leg lengths has left the ground for good
+#: (a foot can touch the ground only while the hip is within one leg length of it).
+AIRBORNE_HEIGHT_FACTOR = 1.5
+
+
+def initial_state_from_ideal(walker, theta1, theta2, dtheta1, dtheta2,
+                             rate_scale=(1.0, 1.0)) -> np.ndarray:
+    """Floating-walker state from an ideal-model state (leg2 = stance).
+
+    The stance foot (leg2) is placed at s = 0 at its static penetration
+    ``(M g cos phi / k)^(1/e)`` [m] (along -n); the hip velocity follows from the pinned-foot
+    kinematics (``walker.pinned_to_full``).  ``rate_scale`` multiplies (dtheta1, dtheta2)
+    first.
+
+    Parameters
+    ----------
+    theta1, theta2 : float
+        Swing / stance leg angles [rad].
+    dtheta1, dtheta2 : float
+        Their rates [rad/s].
+    rate_scale : (float, float)
+        Multipliers [-].
+
+    Returns
+    -------
+    ndarray (N,)
+        Named by ``walker.state_names()``.
+    """
+    w1 = dtheta1 * rate_scale[0]
+    w2 = dtheta2 * rate_scale[1]
+    foot2 = -walker.static_penetration() * walker.normal
+    z = np.array([theta1, theta2, w1, w2], float)
+    return walker.pinned_to_full(z, foot2)
+
+
+def simulate_contact(walker, x0: np.ndarray, t_final: float,
+                     solver: ContactSolverSettings | None = None,
+                     limits: ContactLimits | None = None, *,
+                     max_heel_strikes: int | None = None, slip_limit_mm: float | None = None,
+                     min_step_m: float = 0.05, initial_stance: str = "leg2") -> ContactResult:
+    """Simulate the floating walker with compliant feet and classify its gait.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    x0 : ndarray (N,)
+        Initial state, named by ``walker.state_names()`` (SI).
+    t_final : float
+        End time [s].
+    solver : ContactSolverSettings, optional
+        The integrator, as one object (default: ``ContactSolverSettings()``, cyrk_bdf at
+        rtol 1e-8, atol 1e-10).
+    limits : ContactLimits, optional
+        Sampling, pinning, event heights, wall-time limit, chunking.  A
+        ``fall_hip_height_m`` / ``airborne_hip_height_m`` left at its default is set to 0.5
+        / :data:`AIRBORNE_HEIGHT_FACTOR` leg lengths.
+    max_heel_strikes : int, optional
+        Strides cap: stop (termination and outcome ``heel_strike``) at the end of the chunk
+        in which this many heel strikes have happened.
+    slip_limit_mm : float, optional
+        A stance phase sliding farther than this [mm] makes the outcome ``slip``.
+    min_step_m : float
+        A touchdown of the swing foot counts as a heel strike only if it lands at least this
+        far [m] downhill of the stance foot's touchdown point (else it is a scuff).
+    initial_stance : str
+        The foot in stance at the start.
+
+    Returns
+    -------
+    ContactResult
+
+    Raises
+    ------
+    ValueError
+        Unknown method; ``max_step_s`` with numbalsoda; numbalsoda not installed.
+    """
+    solver = solver or ContactSolverSettings()
+    limits = _with_heights(walker, limits or ContactLimits())
+    stop = None
+    if max_heel_strikes is not None:
+        def stop(t, X):
+            return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
+                >= max_heel_strikes
+    run = integrate_contact(walker, x0, 0.0, t_final, solver, limits, stop)
+    ev = gait_events(walker, run.t, run.X, min_step_m, initial_stance)
+    hh = float(walker.hip_height(run.X[-1:])[0])
+    out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
+                   slip_limit_mm, limits.wall_time_limit_s)
+    return ContactResult(t=run.t, x=run.X, state_names=tuple(walker.state_names()),
+                         feet=ev["feet"], heel_strike_times=ev["hs_t"],
+                         heel_strike_legs=ev["hs_leg"], steps=ev["steps"],
+                         termination=run.termination, message=run.message, nfev=run.nfev,
+                         njev=run.njev, wall_time_s=run.wall_time_s, method=solver.method,
+                         pin_end_time=run.pin_end_time, outcome=out)
+
+
+def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
+    """``limits`` with default event heights taken from the walker's leg length."""
+    d = ContactLimits()
+    upd = {}
+    if limits.fall_hip_height_m == d.fall_hip_height_m:
+        upd["fall_hip_height_m"] = 0.5 * walker.L
+    if limits.airborne_hip_height_m == d.airborne_hip_height_m:
+        upd["airborne_hip_height_m"] = AIRBORNE_HEIGHT_FACTOR * walker.L
+    return replace(limits, **upd)
+
+
+def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=None,
+                  solver: ContactSolverSettings | None = None, strides: int | None = None):
+    """Run the contact walker of ``scene`` from the ideal fixed point ``x_ideal``.
+
+    Parameters
+    ----------
+    x_ideal : ndarray (4,)
+        Ideal post-impact state, named by :data:`walkerlab.contact.scene.IDEAL_ROLES`
+        (leg2 = stance) [rad, rad/s].
+    period : float
+        Ideal step period [s] (sets the default simulated time).
+    rate_scale : (float, float), optional
+        Multipliers on the initial rates (default ``contact_sim.initial_rate_scale``).
+    solver : ContactSolverSettings, optional
+        Default: the scene's ``contact_solver``.
+    strides : int, optional
+        Strides to simulate (default ``contact_sim.n_strides``).
+
+    Returns
+    -------
+    walker, result, x0, step_length
+        :class:`ContactWalker`, :class:`ContactResult`, the initial state (N,), the ideal
+        step length [m].
+    """
+    _, _, cs, sv = settings(scene)
+    sv = solver or sv
+    n_strides = strides or cs.n_strides
+    walker, step_length = build(scene, x_ideal, 2 * n_strides)
+    scale = cs.initial_rate_scale if rate_scale is None else rate_scale
+    ideal = dict(zip(IDEAL_ROLES, np.asarray(x_ideal, float)))
+    x0 = initial_state_from_ideal(walker, ideal["swing_angle"], ideal["stance_angle"],
+                                  ideal["swing_rate"], ideal["stance_rate"],
+                                  rate_scale=tuple(scale))
+    t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
+    limits = ContactLimits(
+        sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,
+        pin_time_s=cs.pin_time_s,
+        fall_hip_height_m=cs.fall_hip_height_m or ContactLimits().fall_hip_height_m,
+        wall_time_limit_s=cs.wall_time_limit_s)
+    res = simulate_contact(walker, x0, t_final, sv, limits,
+                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
+    return walker, res, x0, step_length
+
+
+def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
+    """State name -> name in the shared trajectory layout (``<leg>_angle``, ``<leg>_rate``,
+    ...) for every leg coordinate of the walker (the hip position and velocity are points).
+
+    A state already named after a leg keeps its name; the compass walker's ``theta<i>`` /
+    ``dtheta<i>`` become ``<leg i>_angle`` / ``<leg i>_rate``.
+    """
+    idx = StateIndex(walker)
+    out = {}
+    for i in range(idx.coordinates.start, idx.coordinates.stop):
+        name = idx.names[i]
+        if name in ("hip_x", "hip_y"):
+            continue
+        if name.startswith("theta") and name[5:].isdigit():
+            new = f"{legs[int(name[5:]) - 1]}_angle"
+        else:
+            new = name
+        out[name] = new
+        rate = idx.names[idx.rate_of(name)]
+        out[rate] = new[:-len("_angle")] + "_rate" if new.endswith("_angle") else f"{new}_rate"
+    return out
+
+
+def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
+    """A :class:`ContactResult` in the shared named layout of
+    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes)."""
+    from walkerlab.io.trajectory import NamedTrajectory
+
+    legs = list(legs)
+    t = res.t
+    stance = np.full(t.size, legs.index("leg2"))
+    step = np.zeros(t.size, dtype=int)
+    for k, (ths, leg) in enumerate(zip(res.heel_strike_times, res.heel_strike_legs)):
+        m = t >= ths
+        stance[m] = legs.index(leg)
+        step[m] = k + 1
+    X = res.x
+    en = walker.energies(X)
+    feet = np.asarray(walker.foot_positions(X)).reshape(len(X), -1, 2)  # (n, foot, xy)
+    hip = np.vstack([res.column("hip_x"), res.column("hip_y")])
+    pts = {"hip": hip}
+    names = trajectory_names(walker, legs)
+    for i, leg in enumerate(legs):
+        pts[f"{leg}_foot"] = feet[:, i, :].T
+        angle = next((s for s, n in names.items() if n == f"{leg}_angle"), None)
+        if angle is not None and hasattr(walker, "b"):
+            th = res.column(angle)
+            pts[f"{leg}_mass"] = hip + walker.b * np.vstack([np.sin(th), -np.cos(th)])
+    units = dict(zip(walker.state_names(), walker.state_units()))
+    coords = {new: res.column(old) for old, new in names.items()}
+    return NamedTrajectory(
+        time=t, legs=legs, coordinates=coords, units={names[o]: units[o] for o in names},
+        stance_leg=stance, step_index=step, kinetic=en["kinetic"], potential=en["potential"],
+        points=pts)

@@ -1,0 +1,262 @@
+"""Validated settings of the compliant-contact model and its runs (pydantic v2).
+
+The scene sections ``contact``, ``terrain``, ``contact_sim`` and ``contact_solver`` (read
+through :mod:`walkerlab.config`).  The contact model package imports its settings from here;
+this module imports no model (settings lie under the models, not beside them).
+
+Numbers in :class:`ContactSettings` are written in the unit system named by
+``unit_system`` (ADAMS's default is mm-kg-s); :meth:`ContactSettings.to_si` converts them
+explicitly to SI (NOTES.md: "a wrong unit here changes the answer by 10^6").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+
+__all__ = ["MAX_CONTACT_STRIDES", "ContactParamsSI", "ContactSettings", "ContactSimSettings",
+           "ContactSolverSettings", "TerrainSettings", "family_scaling"]
+
+
+@dataclass(frozen=True)
+class ContactParamsSI:
+    """Contact parameters in SI units (what the model kernels use).
+
+    Attributes
+    ----------
+    k : float
+        Stiffness ``[N/m**e]``.
+    e : float
+        Force exponent ``[-]``.
+    cmax : float
+        Maximum damping ``[N s/m]``.
+    dmax : float
+        Penetration at full damping ``[m]``.
+    mu_s, mu_d : float
+        Static / dynamic friction coefficients ``[-]``.
+    v_s, v_d : float
+        Stiction / friction transition velocities ``[m/s]``.
+    """
+
+    k: float
+    e: float
+    cmax: float
+    dmax: float
+    mu_s: float
+    mu_d: float
+    v_s: float
+    v_d: float
+
+
+# Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
+# a YAML int still validates as a float.  Same rules as walkerlab.config._Strict.
+_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+
+# Longest contact run (D8): 100 strides is ~20x the paper's 5 and keeps the artifact < 100 MB.
+MAX_CONTACT_STRIDES = 100
+
+
+def _list_to_tuple(v):
+    return tuple(v) if isinstance(v, list) else v
+
+
+def family_scaling(cmax: float, dmax: float, e: float, kappa: float) -> tuple[float, float]:
+    """Damping and damping-ramp depth of the 'rigid_limit' stiffness family.
+
+    A point mass m dropping at speed v on ``F = k d^e + c(d) d'`` reaches the depth
+    ``d* ~ (m v^2 / k)^(1/(e+1))`` in the time ``d* / v``; in the scaled variables
+    ``d / d*``, ``t v / d*`` the equation is unchanged when ``c ~ k^(1/(e+1))`` and
+    ``dmax ~ d* ~ k^(-1/(e+1))``.  So with ``kappa = k / k_ref`` the family
+    ``cmax kappa^(1/(e+1))``, ``dmax kappa^(-1/(e+1))`` keeps the coefficient of restitution
+    of the reference contact for every k (gravity during the impact aside), and the contact
+    tends to the rigid plastic impact only through its duration ``~ k^(-1/(e+1))``.
+
+    Returns
+    -------
+    (cmax, dmax) : tuple of float
+        In the units of the inputs.
+    """
+    p = 1.0 / (e + 1.0)
+    return cmax * kappa ** p, dmax * kappa ** (-p)
+
+
+def _len_factor(unit_system: str) -> float:
+    """Metres per length unit of ``unit_system``."""
+    return {"mm-kg-s": 1e-3, "SI": 1.0}[unit_system]
+
+
+class ContactSettings(BaseModel):
+    """IMPACT normal force + Coulomb friction, numbers in ``unit_system``.
+
+    Defaults are the paper's values (k = 1e5, damping 90, mu_s = 0.9, mu_d = 0.7) read in
+    ADAMS's default mm-kg-s units, with the ADAMS View defaults for the rest (NOTES.md).
+    """
+
+    model_config = _STRICT
+
+    unit_system: Literal["mm-kg-s", "SI"] = Field(
+        "mm-kg-s",
+        description="Unit system of the numbers below: 'mm-kg-s' (ADAMS default) or 'SI'."
+    )
+    stiffness: float = Field(
+        1e5, gt=0, le=1e12, description="IMPACT stiffness k (at most 1e12).",
+        json_schema_extra={"unit": "N/<len>^e"},
+    )
+    exponent: float = Field(
+        2.2, ge=1.0, le=10.0, description="IMPACT force exponent e (ADAMS default 2.2).",
+        json_schema_extra={"unit": "-"},
+    )
+    max_damping: float = Field(
+        90.0, ge=0, description="IMPACT maximum damping cmax (paper: 'damping 90').",
+        json_schema_extra={"unit": "N s/<len>"},
+    )
+    penetration_at_max_damping: float = Field(
+        0.1, gt=0, description="IMPACT penetration dmax at which full damping is reached.",
+        json_schema_extra={"unit": "<len>"},
+    )
+    mu_static: float = Field(0.9, ge=0, description="Static friction coefficient.",
+                             json_schema_extra={"unit": "-"})
+    mu_dynamic: float = Field(0.7, ge=0, description="Dynamic friction coefficient.",
+                              json_schema_extra={"unit": "-"})
+    stiction_velocity: float = Field(
+        100.0, gt=0, description="Stiction transition velocity vs.",
+        json_schema_extra={"unit": "<len>/s"},
+    )
+    friction_velocity: float = Field(
+        1000.0, gt=0, description="Friction transition velocity vd (> vs).",
+        json_schema_extra={"unit": "<len>/s"},
+    )
+
+    stiffness_family: Literal["paper", "rigid_limit"] = Field(
+        "paper", description="How damping and dmax follow the stiffness: 'paper' keeps "
+        "max_damping and penetration_at_max_damping as given (a stiffer contact is then more "
+        "elastic); 'rigid_limit' scales them with kappa = stiffness / reference_stiffness as "
+        "cmax * kappa^(1/(e+1)), dmax * kappa^(-1/(e+1)), so a drop impact keeps the "
+        "restitution it has at the reference stiffness (near-plastic) as k grows.")
+    reference_stiffness: float = Field(
+        1e5, gt=0, description="Stiffness at which max_damping and penetration_at_max_damping "
+        "hold in the 'rigid_limit' family (paper: 1e5 N/mm^2.2).",
+        json_schema_extra={"unit": "N/<len>^e"})
+
+    @model_validator(mode="after")
+    def _check_relations(self) -> ContactSettings:
+        if self.mu_dynamic > self.mu_static:
+            raise ValueError(
+                f"mu_dynamic ({self.mu_dynamic}) must be <= mu_static ({self.mu_static})"
+            )
+        if not self.stiction_velocity < self.friction_velocity:
+            raise ValueError(
+                f"stiction_velocity ({self.stiction_velocity}) must be < "
+                f"friction_velocity ({self.friction_velocity})"
+            )
+        return self
+
+    def to_si(self) -> ContactParamsSI:
+        """Convert to SI: ``k_SI = k * f**-e``, ``c_SI = c / f``, lengths and velocities ``* f``.
+
+        ``f`` = metres per length unit (1e-3 for mm-kg-s).  E.g. ``k = 1e5 N/mm^2.2`` becomes
+        ``1e5 * 1000**2.2 N/m^2.2``.
+
+        Returns
+        -------
+        ContactParamsSI
+        """
+        f = _len_factor(self.unit_system)
+        e = self.exponent
+        cmax, dmax = self.max_damping, self.penetration_at_max_damping
+        if self.stiffness_family == "rigid_limit":
+            kappa = self.stiffness / self.reference_stiffness
+            cmax, dmax = family_scaling(cmax, dmax, e, kappa)
+        return ContactParamsSI(
+            k=self.stiffness * f ** (-e),
+            e=e,
+            cmax=cmax / f,
+            dmax=dmax * f,
+            mu_s=self.mu_static,
+            mu_d=self.mu_dynamic,
+            v_s=self.stiction_velocity * f,
+            v_d=self.friction_velocity * f,
+        )
+
+
+class TerrainSettings(BaseModel):
+    """Ground geometry: continuous slope or the paper's 'checkerboard' lanes.
+
+    For ``checkerboard`` each leg has its own lane with ground patches of width
+    ``patch_width_m`` centred on that leg's ideal footfalls: leg2 at ``s = 0, 2l, 4l, ...``,
+    leg1 at ``s = l, 3l, ...`` (``l`` = ideal step length, given at run time).  Elsewhere in
+    the lane there is no ground (a gap), so the swing foot is not scuffed at mid-stance.
+    """
+
+    model_config = _STRICT
+
+    kind: Literal["checkerboard", "continuous"] = Field(
+        "checkerboard", description="'checkerboard' (per-leg patches at footfalls) or 'continuous'."
+    )
+    patch_width_m: float = Field(
+        0.10, gt=0, description="Width of each checkerboard patch along the slope [m]."
+    )
+
+
+class ContactSimSettings(BaseModel):
+    """Run settings of a contact simulation."""
+
+    model_config = _STRICT
+
+    n_strides: int = Field(5, ge=1, le=MAX_CONTACT_STRIDES,
+                           description="Strides (2 steps each) to simulate [-]; at most 100.")
+    t_final_s: float | None = Field(
+        None, gt=0, le=600, description="Simulated time [s] (at most 600); default "
+        "n_strides * 2 * ideal step period."
+    )
+    pin_stance_until: Literal["none", "first_touchdown", "time"] = Field(
+        "none", description="Hold the first stance foot fixed until this moment."
+    )
+    pin_time_s: float = Field(0.0, ge=0,
+                              description="Pin duration when pin_stance_until='time' [s].")
+    fall_hip_height_m: float | None = Field(
+        None, gt=0, description="Fall when hip height above ground < this [m]; default 0.5*L."
+    )
+    sample_rate_hz: float = Field(1000.0, gt=0, le=1e5, description="Output sample rate [Hz].")
+    periodic_gait: bool = Field(
+        False, description="Also find the contact walker's own periodic gait and its Floquet "
+        "multipliers (walkerlab.analysis.contact_periodic; about 5-10 s)."
+    )
+    initial_rate_scale: Annotated[tuple[float, float], BeforeValidator(_list_to_tuple)] = Field(
+        (1.0, 1.0), description="Multipliers [-] on dtheta1, dtheta2 of the initial state."
+    )
+    wall_time_limit_s: float | None = Field(
+        120.0, gt=0, description="Wall-time limit of one contact run [s]; when it runs out "
+        "the run ends with outcome 'time_limit' (null = none).",
+        json_schema_extra={"unit": "s"})
+    stop_after_strides: bool = Field(
+        True, description="Strides cap: stop once 2 * n_strides + 1 heel strikes have "
+        "happened, even if t_final_s is longer.")
+    periodic_time_limit_s: float | None = Field(
+        120.0, gt=0, description="Wall-time limit of the periodic-gait search [s]; when it "
+        "runs out the gait is reported as 'time_limit' (null = none).",
+        json_schema_extra={"unit": "s"})
+
+
+class ContactSolverSettings(BaseModel):
+    """Integrator of the stiff contact model: ``cyrk_bdf`` (CyRK's BDF from compiled code,
+    the default), ``odeint`` (LSODA, low overhead), numbalsoda or solve_ivp.
+
+    The one object that carries the solver to every contact integration
+    (:func:`walkerlab.analysis.contact_sim.simulate_contact`), as
+    :class:`walkerlab.analysis.hybrid.Solver` does on the rigid side."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+
+    method: Literal["odeint", "cyrk_bdf", "numbalsoda", "LSODA", "Radau", "BDF", "RK45",
+                    "DOP853"] = Field(
+        "cyrk_bdf", description="cyrk_bdf (CyRK's BDF from compiled code), "
+        "scipy.integrate.odeint, numbalsoda (LSODA from compiled code; optional extra "
+        "'walkerlab[numbalsoda]') or a solve_ivp method")
+    rtol: float = Field(1e-8, ge=1e-13, lt=1,
+                        description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
+                        "cannot meet a tighter one in double precision)")
+    atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
+    max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")

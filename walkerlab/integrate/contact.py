@@ -1,0 +1,537 @@
+"""Time integration of the compliant-contact walker: backends, chunks and event location.
+
+Where this sits: :mod:`walkerlab.contact` is the model (laws, geometry, terrain, the floating
+walker); this module advances a model's state and finds where its run-ending events are;
+:mod:`walkerlab.analysis.contact_gait` says what the samples mean (touchdowns, heel strikes,
+steps, the run's outcome) and :mod:`walkerlab.analysis.contact_sim` puts the two together
+(``simulate_contact``, a scene's contact run).  This module knows no gait: the strides cap
+reaches it as a ``stop`` predicate over the samples.
+
+Backends (``ContactSolverSettings.method``): ``"odeint"`` (scipy.integrate.odeint = LSODA
+with little overhead), ``"cyrk_bdf"`` (CyRK's BDF over a compiled RHS, no Python per
+evaluation; :mod:`walkerlab.integrate._cyrk`), ``"numbalsoda"`` (numbalsoda's LSODA from
+compiled code; optional extra, :mod:`walkerlab.integrate._lsoda`) or a ``solve_ivp`` method
+(``"LSODA"``, ``"Radau"``, ``"BDF"``, ...), these given the model's analytic Jacobian.  All run
+in chunks so a fall, a trip, a flight, the wall-time limit or the strides cap stops the run.
+
+Wall-time limit: the Python right-hand sides (odeint, solve_ivp, the pinned phase) check the
+deadline at every call.  The compiled backends check no clock: a CyRK call stops after
+:data:`CYRK_STEPS_PER_CALL` steps (well above what a chunk of a walking run takes, so its
+samples do not change) and the chunk goes on in odeint, whose RHS checks the deadline;
+numbalsoda's chunks are sized in wall time (each aims at :data:`CHUNK_WALL_S` seconds from
+the cost of the chunk before, the first is short).
+
+Contact is decided by geometry only (the model): a foot gets the IMPACT force whenever it
+is below the top of a patch and inside its horizontal extent, in every state, so a step that
+would carry a foot from above a patch to deep inside it sees the force jump and is rejected
+by the integrator's local error test: no step jumps over a touchdown.
+
+Events (a trip, a fall, a flight) are located on the cubic Hermite interpolant of the
+samples and their time derivatives (the RHS at each sample).  A **trip** is a foot crossing
+the side of a patch (its along-slope edge) while below the patch's top; a **fall** is the hip
+crossing ``fall_hip_height_m`` downward (:meth:`ContactWalker.fall_margin`, the one fall
+test); **airborne** is the hip crossing ``airborne_hip_height_m`` upward (no leg reaches the
+ground any more).  Each ends the run at the event, whose state is appended as the last sample.
+Termination names are those of :mod:`walkerlab.integrate.ends`.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import ODEintWarning, odeint, solve_ivp
+
+from walkerlab.config.contact import ContactSolverSettings
+from walkerlab.contact import compiled
+
+from . import _cyrk
+
+__all__ = ["CHUNK_WALL_S", "CYRK_STEPS_PER_CALL", "METHODS", "ContactIntegration",
+           "ContactLimits", "StateIndex", "first_event", "hermite_root", "hermite_state",
+           "integrate_contact", "sample_grid"]
+
+#: Methods of :class:`ContactSolverSettings` this module runs.
+METHODS = ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853",
+           *_cyrk.CYRK_METHODS)
+
+#: Wall time [s] a numbalsoda chunk aims at (the limit is checked between chunks).
+CHUNK_WALL_S = 0.5
+
+#: Most CyRK BDF steps in one chunk call (a 1 s chunk of the paper's walk takes a few
+#: thousand): past it the chunk continues in odeint, whose RHS checks the wall-time limit.
+CYRK_STEPS_PER_CALL = 100_000
+
+
+class StateIndex:
+    """Columns of a walker's state by name (``walker.state_names()``), never by number.
+
+    ``idx["hip_x"]`` is a column; :meth:`rates_of` the rate columns of a set of coordinates;
+    :meth:`coordinates` the first half (positions), :meth:`rates` the second.
+    """
+
+    def __init__(self, walker):
+        self.names = tuple(walker.state_names())
+        self._col = {n: i for i, n in enumerate(self.names)}
+        self.n = len(self.names)
+
+    def __getitem__(self, name: str) -> int:
+        return self._col[name]
+
+    @property
+    def coordinates(self) -> slice:
+        """Columns of the generalised coordinates q (the first half of the state)."""
+        return slice(0, self.n // 2)
+
+    @property
+    def rates(self) -> slice:
+        """Columns of the rates (the second half of the state)."""
+        return slice(self.n // 2, self.n)
+
+    def rate_of(self, name: str) -> int:
+        """Column of the rate of coordinate ``name`` (same position in the second half)."""
+        return self._col[name] + self.n // 2
+
+    def hip_velocity(self, X) -> np.ndarray:
+        """Hip velocity (n, 2) [m/s] of states X (n, N): the rates of ``hip_x``, ``hip_y``."""
+        X = np.atleast_2d(X)
+        return X[:, [self.rate_of("hip_x"), self.rate_of("hip_y")]]
+
+
+@dataclass(frozen=True)
+class ContactLimits:
+    """How far a contact integration goes and what ends it (besides its end time).
+
+    Attributes
+    ----------
+    sample_rate_hz : float
+        Output sample rate [Hz] (events are located between samples).
+    pin_stance_until : {"none", "first_touchdown", "time"}
+        Hold leg2's foot fixed (constraint, reduced coordinates) until leg1 first touches
+        ground, or until ``t0 + pin_time_s``.
+    pin_time_s : float
+        [s].
+    fall_hip_height_m : float
+        Fall when the hip height above the ground line drops below this [m].
+    airborne_hip_height_m : float
+        The walker flew off when its hip rises above this [m] (inf: never).
+    wall_time_limit_s : float or None
+        Stop with ``time_limit`` once this much wall time is used [s].
+    chunk_s : float
+        Longest chunk of simulated time [s]; trips, falls, flights, the wall-time limit and
+        the ``stop`` predicate are checked between chunks.
+    use_jacobian : bool
+        Pass the analytic Jacobian to odeint / solve_ivp (the compiled backends take none).
+    """
+
+    sample_rate_hz: float = 1000.0
+    pin_stance_until: str = "none"
+    pin_time_s: float = 0.0
+    fall_hip_height_m: float = 0.5
+    airborne_hip_height_m: float = np.inf
+    wall_time_limit_s: float | None = None
+    chunk_s: float = 1.0
+    use_jacobian: bool = True
+
+
+@dataclass
+class ContactIntegration:
+    """Samples of one contact integration and why it stopped.
+
+    Attributes
+    ----------
+    t : ndarray (n,)
+        Sample times [s] (the last one is the event time if an event ended the run).
+    X : ndarray (n, N)
+        States, columns named by ``walker.state_names()``.
+    termination : str
+        ``t_final``, ``heel_strike`` (the ``stop`` predicate held: strides cap), ``fall``,
+        ``trip``, ``airborne``, ``solver_failure`` or ``time_limit``
+        (:mod:`walkerlab.integrate.ends`).
+    message : str
+    event : tuple or None
+        ``(kind, sample, time [s], foot, patch edge [m])`` of the trip / fall / flight.
+    nfev, njev : int
+    wall_time_s : float
+        [s].
+    pin_end_time : float
+        End of the pinned phase [s] (= t0 if none).
+    """
+
+    t: np.ndarray
+    X: np.ndarray
+    termination: str
+    message: str
+    event: tuple | None
+    nfev: int
+    njev: int
+    wall_time_s: float
+    pin_end_time: float
+
+
+def sample_grid(t0: float, t1: float, rate: float) -> np.ndarray:
+    """Sample times from ``t0`` to ``t1`` [s] at ``rate`` [Hz], ``t1`` always included."""
+    n = int(np.floor((t1 - t0) * rate + 1e-9))
+    t = t0 + np.arange(n + 1) / rate
+    if t1 - t[-1] > 1e-9:
+        t = np.append(t, t1)
+    return t
+
+
+class _TimeLimit(Exception):
+    """Internal: the wall-time limit ran out inside a right-hand side."""
+
+
+def _guarded(f, deadline, calls=None):
+    """``f`` that raises :class:`_TimeLimit` once ``time.perf_counter()`` passes ``deadline``
+    (and counts its calls in ``calls[0]``, if given: the count of a cut chunk)."""
+    if not np.isfinite(deadline):
+        return f
+
+    def g(t, x, *a):
+        if calls is not None:
+            calls[0] += 1
+        if time.perf_counter() > deadline:
+            raise _TimeLimit
+        return f(t, x, *a)
+    return g
+
+
+def hermite_root(ta, tb, ya, yb, da, db, rising=None):
+    """First root in [ta, tb] of the cubic Hermite interpolant (values y, slopes d), or None.
+
+    ``rising``: True keeps only upward crossings, False downward, None either."""
+    h = tb - ta
+    if h <= 0:
+        return None
+    # y(u) on u in [0, 1]: Hermite basis in power form
+    c3 = 2 * ya - 2 * yb + h * da + h * db
+    c2 = -3 * ya + 3 * yb - 2 * h * da - h * db
+    c1 = h * da
+    c0 = ya
+    r = np.roots([c3, c2, c1, c0]) if abs(c3) > 0 or abs(c2) > 0 else np.roots([c1, c0])
+    r = np.sort(r[(np.abs(r.imag) < 1e-9) & (r.real >= -1e-12) & (r.real <= 1 + 1e-12)].real)
+    for u in r:
+        slope = 3 * c3 * u * u + 2 * c2 * u + c1
+        if rising is None or (slope > 0) == rising:
+            return float(ta + min(max(u, 0.0), 1.0) * h)
+    return None
+
+
+def hermite_state(walker, ta, tb, xa, xb, tc):
+    """State at ``tc`` in [ta, tb] on the cubic Hermite interpolant of two samples."""
+    fa, fb = walker.rhs(ta, xa), walker.rhs(tb, xb)
+    h = tb - ta
+    u = (tc - ta) / h
+    h00, h10 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u
+    h01, h11 = -2 * u**3 + 3 * u**2, u**3 - u**2
+    return h00 * xa + h10 * h * fa + h01 * xb + h11 * h * fb
+
+
+def _hip_crossing(walker, idx, tt, X, hh, level, k0, down):
+    """First crossing of the hip height ``hh`` through ``level`` (downward if ``down``):
+    (sample, time) on the Hermite interpolant, or None."""
+    hit = np.flatnonzero(hh < level) if down else np.flatnonzero(hh > level)
+    if not hit.size:
+        return None
+    k = int(hit[0])
+    if k == 0:
+        return k0 - 1, float(tt[0])
+    n = walker.normal
+    v = idx.hip_velocity(X[k0 - 1 + k - 1:k0 - 1 + k + 1]) @ n  # hip velocity . n
+    tc = hermite_root(tt[k - 1], tt[k], hh[k - 1] - level, hh[k] - level, float(v[0]),
+                      float(v[1]), rising=not down)
+    if tc is None:
+        pair = [hh[k], hh[k - 1]] if down else [hh[k - 1], hh[k]]
+        times = [tt[k], tt[k - 1]] if down else [tt[k - 1], tt[k]]
+        tc = float(np.interp(level, pair, times))
+    return k0 - 1 + k, tc
+
+
+def first_event(walker, t, X, limits: ContactLimits, k0=1):
+    """First trip, fall or flight in samples ``k0..``: (kind, k, time, foot, edge) or None.
+
+    A trip is a foot crossing the along-slope edge of one of its lane's patches while below
+    the patch's top (penetration > 0 at the crossing, on the Hermite interpolant); a fall
+    is the hip height crossing ``limits.fall_hip_height_m`` downward, a flight
+    (``airborne``) ``limits.airborne_hip_height_m`` upward.
+    """
+    if len(t) <= k0:
+        return None
+    idx = StateIndex(walker)
+    sl = slice(k0 - 1, None)
+    hh = walker.hip_height(X[sl])
+    tt = t[sl]
+    best = None
+    for kind, level, down in (("fall", limits.fall_hip_height_m, True),
+                              ("airborne", limits.airborne_hip_height_m, False)):
+        c = _hip_crossing(walker, idx, tt, X, hh, level, k0, down)
+        if c is not None and (best is None or c[1] < best[2]):
+            best = (kind, c[0], c[1], "", np.nan)
+    if walker.continuous:
+        return best
+    cq = walker.contact_quantities(X[sl])
+    hw = walker.patch_half_width
+    for foot, lane in zip(cq, (walker.lane1, walker.lane2)):
+        q = cq[foot]
+        on = q["on_ground"] > 0.5
+        pen = q["penetration"]
+        # entering a patch horizontally (gap -> patch) with the foot below the top at
+        # either sample: find the edge crossing and the penetration there
+        cand = np.flatnonzero(~on[:-1] & on[1:] & ((pen[:-1] > 0) | (pen[1:] > 0))) + 1
+        for k in cand:
+            if best is not None and k0 - 1 + k > best[1]:
+                break
+            sa, sb = q["s"][k - 1], q["s"][k]
+            c = lane[int(np.argmin(np.abs(lane - sb)))]
+            edge = c - hw if sb < c else c + hw
+            vs = q["slip_velocity"]
+            te = hermite_root(tt[k - 1], tt[k], sa - edge, sb - edge, vs[k - 1], vs[k])
+            if te is None:
+                te = float(tt[k])
+            xe = hermite_state(walker, tt[k - 1], tt[k], X[k0 - 1 + k - 1], X[k0 - 1 + k], te)
+            pe = walker.contact_quantities(xe)[foot]["penetration"][0]
+            if pe > 0 and (best is None or te < best[2]):
+                best = ("trip", k0 - 1 + k, float(te), foot, float(edge))
+                break
+    return best
+
+
+def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline):
+    """Integrate with leg2's foot held fixed.  Returns (t, X, nfev, njev, termination, msg)."""
+    idx = StateIndex(walker)
+    foot2 = np.asarray(walker.foot_positions(x0)).reshape(-1, 2)[1]
+    angles = [idx["theta1"], idx["theta2"]]
+    z0 = np.concatenate([x0[angles], x0[[idx.rate_of(n) for n in ("theta1", "theta2")]]])
+
+    def f(t, z):
+        return walker.rhs_pinned(t, z, foot2)
+
+    def touch(t, z):
+        x = walker.pinned_to_full(z, foot2)
+        cq = walker.contact_quantities(x)["leg1"]
+        return -cq["penetration"][0] if cq["on_ground"][0] > 0 else 1.0
+
+    touch.terminal = True
+    touch.direction = -1
+
+    def fall(t, z):
+        return walker.fall_margin(walker.pinned_to_full(z, foot2), limits.fall_hip_height_m)
+
+    fall.terminal = True
+    fall.direction = -1
+    events = [fall] + ([touch] if until_touchdown else [])
+    try:
+        sol = solve_ivp(_guarded(f, deadline), (t0, t_end), z0, method="LSODA",
+                        rtol=solver.rtol, atol=solver.atol,
+                        max_step=solver.max_step_s or np.inf,
+                        t_eval=sample_grid(t0, t_end, limits.sample_rate_hz), events=events,
+                        dense_output=True)
+    except _TimeLimit:
+        return (np.array([t0]), x0[None], 0, 0, "time_limit",
+                "wall-time limit reached in the pinned phase")
+    t, Z = sol.t, sol.y.T
+    if sol.status == 1:  # stopped on an event: append the event point
+        te = (sol.t_events[1][0] if (until_touchdown and sol.t_events[1].size)
+              else sol.t_events[0][0])
+        if t.size == 0 or te > t[-1]:
+            t = np.append(t, te)
+            Z = np.vstack([Z, sol.sol(te)])
+    X = np.array([walker.pinned_to_full(z, foot2) for z in Z])
+    fell = sol.status == 1 and sol.t_events[0].size > 0
+    term = "fall" if fell else ("t_final" if sol.status >= 0 else "solver_failure")
+    return t, X, sol.nfev, sol.njev, term, sol.message
+
+
+class _Backend:
+    """One chunk of a backend: ``chunk(xa, tg) -> (t, X, ok, message, nfev, njev)`` with the
+    samples reached after ``tg[0]``; raises :class:`_TimeLimit` from a Python RHS."""
+
+    def __init__(self, walker, solver: ContactSolverSettings, use_jac: bool, deadline: float):
+        self.walker, self.solver, self.method = walker, solver, solver.method
+        self.max_step = solver.max_step_s if solver.max_step_s else np.inf
+        self.calls = [0]  # RHS calls of the current chunk (Python backends)
+        self.frhs = _guarded(walker.rhs, deadline, self.calls)
+        self.fjac = walker.jac if use_jac else None
+        self.compiled = self.method == "numbalsoda" or self.method in _cyrk.CYRK_METHODS
+        self.sized_by_wall = self.method == "numbalsoda"
+        if self.method == "numbalsoda" and np.isfinite(self.max_step):
+            raise ValueError("contact_solver.max_step_s is not supported by method numbalsoda")
+        self.data = compiled.packed_data(walker) if self.compiled else None
+
+    def odeint_chunk(self, xs, tg):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ODEintWarning)
+            X, info = odeint(self.frhs, xs, tg, Dfun=self.fjac, tfirst=True,
+                             rtol=self.solver.rtol, atol=self.solver.atol,
+                             hmax=self.max_step if np.isfinite(self.max_step) else 0.0,
+                             full_output=True, mxstep=200000)
+        ok = info["message"] == "Integration successful."
+        # after a failure odeint's info arrays past the last sample reached are not filled in
+        # (garbage was seen): use them up to that sample only
+        reached = info["tcur"] >= tg[1:] - 1e-14
+        nk = len(tg) if ok or reached.all() else int(np.argmin(reached)) + 1
+        if nk < 2:
+            return tg[1:1], X[1:1], ok, info["message"], 0, 0
+        return (tg[1:nk], X[1:nk], ok, info["message"], int(info["nfe"][nk - 2]),
+                int(info["nje"][nk - 2]))
+
+    def chunk(self, xa, tg):
+        s = self.solver
+        if self.method == "odeint":
+            return self.odeint_chunk(xa, tg)
+        if self.method == "numbalsoda":  # whole chunk in compiled code (FD Jacobian)
+            from . import _lsoda
+
+            X, ok, nf = _lsoda.solve_chunk(xa, tg, self.data, s.rtol, s.atol)
+            nk = len(tg) if ok else 1  # rows after a failure are undefined: drop the chunk
+            m = "Integration successful." if ok else "numbalsoda LSODA failed in this chunk"
+            return tg[1:nk], X[1:nk], ok, m, nf, 0
+        if self.method in _cyrk.CYRK_METHODS:  # whole chunk in compiled code (CyRK BDF)
+            X, ok, nf, m = _cyrk.solve_chunk(self.method, xa, tg, self.data, s.rtol, s.atol,
+                                             self.max_step, CYRK_STEPS_PER_CALL)
+            tn, Xn, nj = tg[1:len(X)], X[1:], 0
+            if not ok:  # a force jump BDF cannot step over (a foot hitting the side of a
+                # patch below its top): odeint, which grinds through it as a plain odeint run
+                # does, from the last sample reached to the chunk end
+                k = max(len(X) - 1, 0)
+                tr, Xr, ok, m, nf2, nj = self.odeint_chunk(X[k] if len(X) else xa, tg[k:])
+                nf += nf2
+                tn, Xn = np.concatenate([tn, tr]), np.vstack([Xn, Xr])
+            return tn, Xn, ok, m, nf, nj
+        kw = {"jac": self.fjac} if self.fjac is not None else {}
+        sol = solve_ivp(self.frhs, (tg[0], tg[-1]), xa, method=self.method, rtol=s.rtol,
+                        atol=s.atol, max_step=self.max_step, t_eval=tg, **kw)
+        return sol.t[1:], sol.y.T[1:], sol.status == 0, sol.message, sol.nfev, sol.njev
+
+
+def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
+    """Integrate the free walker until t1, an event, the deadline or ``stop``.
+
+    Returns (t, X, nfev, njev, termination, message, event)."""
+    be = _Backend(walker, solver, limits.use_jacobian, deadline)
+    rate = limits.sample_rate_hz
+    ts, Xs, nfev, njev = [np.array([t0])], [x0[None]], 0, 0
+    ta, xa = t0, x0
+    term, msg, event = "t_final", "Integration successful.", None
+    n_checked = 1
+    # numbalsoda: the first chunk is short, later ones sized to CHUNK_WALL_S
+    span = min(limits.chunk_s, 20.0 / rate) if be.sized_by_wall else limits.chunk_s
+    while ta < t1 - 1e-12:
+        tb = min(ta + span, t1)
+        tg = sample_grid(ta, tb, rate)
+        w0 = time.perf_counter()
+        be.calls[0] = 0
+        try:
+            tn, Xn, ok, m, nf, nj = be.chunk(xa, tg)
+        except _TimeLimit:
+            nfev += be.calls[0]
+            term, msg = "time_limit", "wall-time limit reached inside a chunk"
+            break
+        nfev += nf
+        njev += nj
+        if be.sized_by_wall and tn.size:
+            per_s = (time.perf_counter() - w0) / max(tn[-1] - ta, 1e-12)
+            left = max(min(CHUNK_WALL_S, deadline - time.perf_counter()), 1e-3)
+            span = float(np.clip(left / max(per_s, 1e-12), 2.0 / rate, limits.chunk_s))
+        ts.append(tn)
+        Xs.append(Xn)
+        t_all, X_all = np.concatenate(ts), np.vstack(Xs)
+        event = first_event(walker, t_all, X_all, limits, k0=n_checked)
+        n_checked = len(t_all)
+        if event is not None:
+            term = event[0]
+            break
+        if not ok:
+            term, msg = "solver_failure", str(m)
+            break
+        if time.perf_counter() > deadline and t_all[-1] < t1 - 1e-12:
+            term, msg = "time_limit", "wall-time limit reached"
+            break
+        if stop is not None and stop(t_all, X_all):
+            term, msg = "heel_strike", "the heel strikes asked for were made"
+            break
+        ta, xa = t_all[-1], X_all[-1]
+    t_all, X_all = np.concatenate(ts), np.vstack(Xs)
+    if event is not None:  # cut at the event and append the event state
+        _, k, te, _, _ = event
+        k = max(k, 1)
+        xe = hermite_state(walker, t_all[k - 1], t_all[k], X_all[k - 1], X_all[k], te) \
+            if te > t_all[k - 1] else X_all[k - 1]
+        t_all = np.append(t_all[:k], te) if te > t_all[k - 1] else t_all[:k]
+        X_all = np.vstack([X_all[:k], xe[None]]) if len(t_all) > k else X_all[:k]
+        msg = {"trip": "trip: a foot hit the side of a patch below its top",
+               "fall": "fall: hip below the fall height",
+               "airborne": "airborne: hip above the airborne height"}[event[0]]
+    return t_all, X_all, nfev, njev, term, msg, event
+
+
+def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
+                      solver: ContactSolverSettings, limits: ContactLimits,
+                      stop: Callable[[np.ndarray, np.ndarray], bool] | None = None
+                      ) -> ContactIntegration:
+    """Integrate the contact walker from ``x0`` at ``t0`` to ``t_final`` or an ending event.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    x0 : ndarray (N,)
+        Initial state, columns named by ``walker.state_names()`` (SI).
+    t0, t_final : float
+        Start and end time [s].
+    solver : ContactSolverSettings
+        Method, tolerances (``atol`` well below the penetration depth, ~6e-5 m for the
+        paper's contact), largest step.
+    limits : ContactLimits
+    stop : callable, optional
+        ``stop(t (n,), X (n, N)) -> bool``, asked after each chunk; True ends the run with
+        termination ``heel_strike`` (the strides cap of :mod:`walkerlab.analysis.contact_sim`).
+
+    Returns
+    -------
+    ContactIntegration
+
+    Raises
+    ------
+    ValueError
+        Unknown method; ``max_step_s`` with numbalsoda; numbalsoda not installed
+        (:class:`walkerlab.integrate._lsoda.MissingNumbalsoda`, also an ImportError).
+    """
+    if solver.method not in METHODS:
+        raise ValueError(f"contact_solver.method must be one of {', '.join(METHODS)}, "
+                         f"not {solver.method!r}")
+    x0 = np.asarray(x0, dtype=float)
+    wall = time.perf_counter()
+    deadline = wall + (limits.wall_time_limit_s if limits.wall_time_limit_s else np.inf)
+    ts, Xs, nfev, njev = [], [], 0, 0
+    term, msg, event = "t_final", "", None
+    t_pin = t0
+    if limits.pin_stance_until != "none":
+        t_end = (t_final if limits.pin_stance_until == "first_touchdown"
+                 else min(t0 + limits.pin_time_s, t_final))
+        tp, Xp, nf, nj, term, msg = _run_pinned(
+            walker, x0, t0, t_end, limits.pin_stance_until == "first_touchdown", limits,
+            solver, deadline)
+        ts.append(tp)
+        Xs.append(Xp)
+        nfev += nf
+        njev += nj
+        t_pin, x0 = tp[-1], Xp[-1]
+        if term == "fall":
+            event = ("fall", len(tp) - 1, float(tp[-1]), "", np.nan)
+    if term == "t_final" and t_pin < t_final - 1e-12:
+        tf, Xf, nf, nj, term, msg, event = _run_free(walker, x0, t_pin, t_final, solver,
+                                                     limits, deadline, stop)
+        if ts:
+            tf, Xf = tf[1:], Xf[1:]
+        ts.append(tf)
+        Xs.append(Xf)
+        nfev += nf
+        njev += nj
+    return ContactIntegration(t=np.concatenate(ts), X=np.vstack(Xs), termination=term,
+                              message=str(msg), event=event, nfev=int(nfev), njev=int(njev),
+                              wall_time_s=time.perf_counter() - wall,
+                              pin_end_time=float(t_pin))
