@@ -141,6 +141,24 @@ def _single_threaded_blas() -> None:
     os.environ.setdefault(BLAS_THREADS_ENV, "1")
 
 
+def _process_settings() -> None:
+    """Settings every command (and every worker it starts) runs with:
+
+    - numba's on-disk cache in the per-user cache (``NUMBA_CACHE_DIR``, unless set), never
+      in the installed package (:func:`walkerlab.usercache.use_for_numba`); before numba is
+      imported, and inherited by worker processes;
+    - ``SIGXFSZ`` ignored (a file-size limit, ``ulimit -f``, then makes a write fail with
+      EFBIG, reported as "disk full" in one line, instead of killing the process).
+    """
+    import signal
+
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()
+    if hasattr(signal, "SIGXFSZ"):
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+
+
 @app.callback()
 def _main(version: bool = typer.Option(False, "--version", callback=_version_callback,
                                        is_eager=True,
@@ -148,6 +166,7 @@ def _main(version: bool = typer.Option(False, "--version", callback=_version_cal
                                        "and h5py versions and exit")) -> None:
     """walkerlab: passive-dynamic biped walkers, from fixed point to report."""
     _single_threaded_blas()
+    _process_settings()
 
 
 def _status(o) -> str:

@@ -225,9 +225,9 @@ def _pin_worker(core: int) -> None:
 
 def start_worker(core: int):
     """A measuring worker process pinned to ``core``, started now (see :class:`Lanes`)."""
-    import multiprocessing as mp
+    from walkerlab.workers import mp_context
 
-    return _pinned_worker(mp.get_context("spawn"), core)
+    return _pinned_worker(mp_context("spawn"), core)
 
 
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -238,9 +238,10 @@ def _pinned_worker(ctx, core: int):
     """A one-process pool pinned to ``core``, started now with single-threaded BLAS/OpenMP
     (a thread pool is sized when numpy loads, before any initializer runs, so the limit
     must be in the environment the process starts with)."""
-    from concurrent.futures import ProcessPoolExecutor
+    from walkerlab.workers import process_pool
 
-    ex = ProcessPoolExecutor(1, mp_context=ctx, initializer=_pin_worker, initargs=(core,))
+    # ends with this process, even after SIGKILL or SIGTERM (walkerlab.workers)
+    ex = process_pool(1, ctx, _pin_worker, (core,))
     with _ENV_LOCK:
         old = {v: os.environ.get(v) for v in THREAD_VARS}
         os.environ.update({v: "1" for v in THREAD_VARS})
@@ -351,9 +352,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
         lanes = Lanes(cores=cores[:workers])
     if not todo:
         return out
-    import multiprocessing as mp
+    from walkerlab.workers import mp_context
 
-    ctx = mp.get_context("spawn")
+    ctx = mp_context("spawn")
     todo.sort(key=_cost_order)
     errors: list[BaseException] = []
 

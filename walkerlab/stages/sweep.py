@@ -88,10 +88,6 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
         raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(STAGE_NAMES)}")
     axes = [parse_param(p) if isinstance(p, str) else p for p in params]
     out = sweep_path(scene, axes, stage, runs_root, name, claim=True)
-    from walkerlab.io.runpaths import model_cache_dir
-    from walkerlab.models.cache import set_cache_dir
-
-    set_cache_dir(model_cache_dir(runs_root))  # before workers start: they inherit it
     return run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
                      resume=resume, options=options, chunk_size=chunk_size, progress=progress,
                      on_chunk=on_chunk, pool=pool)
