@@ -298,6 +298,28 @@ def _cost_order(t: Case) -> tuple:
     return (base not in IMPLICIT, round(float(np.log10(t.rtol)), 3), t.model != "contact")
 
 
+def _numbers(v, n: int | None = None) -> bool:
+    return (isinstance(v, list) and (n is None or len(v) == n)
+            and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v))
+
+
+def read_cached_case(path: Path) -> dict | None:
+    """A cached case result (:func:`time_case`) if the file holds a complete one, else None
+    (missing, unreadable, not JSON, or lacking/mistyping a field: the case is measured
+    again, issue 19)."""
+    try:
+        res = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(res, dict):
+        return None
+    times, cpu, vec = res.get("times"), res.get("cpu_times"), res.get("vec")
+    ok = (_numbers(times) and len(times) >= 1 and all(x >= 0 for x in times)
+          and _numbers(cpu, len(times)) and (vec is None or (_numbers(vec) and len(vec) >= 1))
+          and isinstance(res.get("nfev"), int) and not isinstance(res.get("nfev"), bool))
+    return res if ok else None
+
+
 def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
               lanes: Lanes | None = None) -> dict:
     """Results of every case, from the cache or measured (in pinned worker processes).
@@ -321,14 +343,11 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
     cache_dir.mkdir(parents=True, exist_ok=True)
     out, todo = {}, []
     for t in tasks:
-        f = cache_dir / f"{t.key}.json"
-        if f.is_file():
-            try:
-                out[t.key] = {**json.loads(f.read_text()), "cached": True}
-                continue
-            except (OSError, ValueError):
-                pass
-        todo.append(t)
+        res = read_cached_case(cache_dir / f"{t.key}.json")
+        if res is not None:
+            out[t.key] = {**res, "cached": True}
+        else:  # missing, damaged or incomplete: measured again
+            todo.append(t)
     if lanes is not None:
         lanes.todo_models.update(t.model for t in todo)
         lanes.todo_known.set()
@@ -337,9 +356,10 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
     def store(key, res, n_lanes):
         res = {**res, "measured_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                "parallel_workers": n_lanes}
-        tmp = cache_dir / f".{key}.tmp"
-        tmp.write_text(json.dumps(res))
-        os.replace(tmp, cache_dir / f"{key}.json")
+        from walkerlab.io.artifacts import atomic_write
+
+        text = json.dumps(res).encode()
+        atomic_write(cache_dir / f"{key}.json", lambda fh: fh.write(text))
         with lock:
             out[key] = {**res, "cached": False}
 

@@ -45,7 +45,8 @@ except ImportError:  # pragma: no cover
     fcntl = None
 
 __all__ = ["RunPathError", "ArtifactBusy", "check_name", "scene_dir", "stage_artifact",
-           "named_artifact", "report_dir", "figures_dir", "artifact_lock", "refuse_link",
+           "named_artifact", "report_dir", "figures_dir", "run_cache_dir", "artifact_lock",
+           "refuse_link",
            "STAGE_FILES"]
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
@@ -180,6 +181,13 @@ def figures_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
     if claim:
         _mkdir(d)
     return d
+
+
+def run_cache_dir(scene, runs_root: Path | str, name: str) -> Path:
+    """``<runs>/<scene>/.cache/<name>`` (measured data such as work-precision cases; never
+    code), which must resolve inside the runs folder."""
+    d = scene_dir(scene, runs_root) / ".cache" / check_name(name, "cache name")
+    return _inside(Path(runs_root), d, f"cache folder {name!r}")
 
 
 def atomic_text(path: Path, text: str) -> Path:

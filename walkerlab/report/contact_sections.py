@@ -140,7 +140,7 @@ def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
 
 def _map_lines(artifact) -> list[str]:
     """Stability maps of the contact gait, where their artifacts exist next to ``artifact``."""
-    import shutil
+    from walkerlab.io.artifacts import atomic_write
 
     out = []
     for kind in ("stiffness", "friction", "patch_width"):
@@ -153,8 +153,8 @@ def _map_lines(artifact) -> list[str]:
             stab = float(f["summary/stable_fraction"][()])
             n = int(f["summary/cells"][()])
         figdir = artifact.parent / "report" / "figures"
-        figdir.mkdir(parents=True, exist_ok=True)
-        shutil.copy(png, figdir / png.name)
+        data = png.read_bytes()
+        atomic_write(figdir / png.name, lambda fh, data=data: fh.write(data))  # no link
         cap = (f"Stability map of the contact gait over {kind.replace('_', ' ')} × slope "
                f"({n} cells): a periodic gait exists in {100 * ex:.0f} % of the cells and is "
                f"stable in {100 * stab:.0f} %.")
