@@ -368,8 +368,9 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
                          f"({' x '.join(str(len(a)) for a in axes)}); at most "
                          f"{MAX_GRID_POINTS:,} are allowed")
     opts = {**DEFAULT_OPTIONS, **(options or {})}
-    out_path = Path(out_path)
-    from walkerlab.io.runpaths import artifact_lock
+    from walkerlab.io.runpaths import artifact_lock, refuse_link
+
+    out_path = refuse_link(Path(out_path))  # the artifact is never written through a link
 
     with artifact_lock(out_path, wait=False):
         return _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts,
