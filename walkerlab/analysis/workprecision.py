@@ -220,6 +220,9 @@ def _pin_worker(core: int) -> None:
     from walkerlab.analysis.hybrid import _have_cyrk
 
     if _have_cyrk():
+        from walkerlab.usercache import use_for_numba
+
+        use_for_numba()  # numba's cache in the user cache (before numba loads)
         import CyRK  # noqa: F401  (and numba)
 
 
