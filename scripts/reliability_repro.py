@@ -585,7 +585,7 @@ def i19_2_tampered_model_cache(d):
     s = scene(d / "cfg", IDEAL, "paper.yaml")
     cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "runs", env=_uc(d))
     flag = d / "PWNED"
-    files = [p for p in d.rglob("*.py") if p.parent.name == "models"]
+    files = [p for p in d.rglob("*.py") if "__pycache__" not in p.parts]
     for p in files:
         body = f"open({str(flag)!r}, 'w').write('x')\n" + p.read_text().split("\n", 1)[1]
         p.write_text(f"# sha256 {hashlib.sha256(body.encode()).hexdigest()}\n{body}")
