@@ -40,7 +40,7 @@ def _runs_dir(value) -> Path:
     return Path(value)
 
 
-RunsOpt = typer.Option("runs", "--runs-dir", parser=_runs_dir,
+RunsOpt = typer.Option("runs", "--runs-dir", parser=_runs_dir, metavar="PATH",
                        help="folder for artifacts (runs/<scene>/)")
 ForceOpt = typer.Option(False, "--force", help="recompute even if the artifact is up to date")
 
