@@ -761,8 +761,11 @@ def i19_14_report_md_script(d):
     rc, msg, _ = cli(d / "cfg", "report", str(s), "--runs-dir", "runs", env=_uc(d),
                      timeout=600)
     md = (d / "cfg/runs/paper/report/report.md")
-    raw = "<script>" in md.read_text() if md.is_file() else "no report"
-    return rc, msg, f"report.md holds a raw <script>: {raw}"
+    if not md.is_file():
+        return rc, msg, "no report"
+    # code fences show HTML as text: only what lies outside them counts
+    prose = "".join(md.read_text().split("```")[::2])
+    return rc, msg, f"report.md holds a raw <script> outside code blocks: {'<script>' in prose}"
 
 
 @case
