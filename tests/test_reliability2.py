@@ -149,7 +149,7 @@ def test_i1_lock_kept_by_a_dead_holders_child_is_taken_over(tmp_path):
         holder.kill()
         holder.wait()
         with artifact_lock(target, wait=False):  # before: ArtifactBusy (pid of the dead)
-            assert (tmp_path / ".a.h5.lock").read_text().strip() == str(os.getpid())
+            assert (tmp_path / ".a.h5.lock").read_text().split()[0] == str(os.getpid())
     finally:
         holder.stdout.close()
         for k in child:
@@ -172,6 +172,39 @@ def test_i1_lock_of_a_live_holder_is_not_taken_over(tmp_path):
         with pytest.raises(runpaths.ArtifactBusy, match=f"pid {holder.pid}"):
             with artifact_lock(target, wait=False):
                 pass
+    finally:
+        holder.kill()
+        holder.wait()
+        holder.stdout.close()
+
+
+@pytest.mark.parametrize("host,taken_over", [("this", True), ("elsewhere.example", False)])
+def test_i1_only_a_dead_holder_of_this_host_is_taken_over(tmp_path, host, taken_over):
+    """A pid recorded by another machine sharing the folder cannot be checked here: its
+    lock is waited on, never taken over."""
+    import socket
+
+    target = tmp_path / "a.h5"
+    holder = subprocess.Popen([sys.executable, "-c", textwrap.dedent(f"""
+        import time
+        from pathlib import Path
+        from walkerlab.io.runpaths import artifact_lock
+        with artifact_lock(Path({str(target)!r})):
+            print('locked', flush=True); time.sleep(60)
+        """)], stdout=subprocess.PIPE, text=True, env=ENV)
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        name = socket.gethostname() if host == "this" else host
+        (tmp_path / ".a.h5.lock").write_text(f"{gone.pid} {name}\n")  # a dead pid
+        if taken_over:
+            with artifact_lock(target, wait=False):
+                pass
+        else:
+            with pytest.raises(runpaths.ArtifactBusy):
+                with artifact_lock(target, wait=False):
+                    pass
     finally:
         holder.kill()
         holder.wait()

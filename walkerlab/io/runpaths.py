@@ -240,11 +240,24 @@ def _same_file(fd: int, lock: Path) -> bool:
     return (a.st_dev, a.st_ino) == (b.st_dev, b.st_ino)
 
 
-def _holder(fd: int) -> int | None:
+def _host() -> str:
+    import socket
+
+    return socket.gethostname() or "?"
+
+
+def _holder(fd: int, local_only: bool = False) -> int | None:
+    """The pid recorded in a lock file (``"<pid> <host>"``); with ``local_only``, None
+    unless it was recorded on this host (a pid from another machine sharing the folder
+    cannot be checked here)."""
     try:
-        return int(os.pread(fd, 32, 0).decode(errors="replace").strip())
-    except (OSError, ValueError):
+        parts = os.pread(fd, 300, 0).decode(errors="replace").split()
+        pid = int(parts[0])
+    except (OSError, ValueError, IndexError):
         return None
+    if local_only and len(parts) > 1 and parts[1] != _host():
+        return None
+    return pid
 
 
 @contextmanager
@@ -269,7 +282,7 @@ def _take_over(fd: int, lock: Path) -> bool:
     from walkerlab.workers import process_alive
 
     with _folder_locked(lock.parent):
-        pid = _holder(fd)
+        pid = _holder(fd, local_only=True)
         if pid is None or pid == os.getpid() or process_alive(pid) or not _same_file(fd, lock):
             return False
         try:
@@ -290,12 +303,12 @@ def artifact_lock(path: Path, wait: bool = True,
                   on_wait: Callable[[str], None] | None = None) -> Iterator[None]:
     """Hold an exclusive lock on ``path`` (a hidden ``.<name>.lock`` next to it).
 
-    The lock is an ``flock`` on the lock file, which records the holder's pid.  The kernel
-    releases it when the holder dies; a lock still held although the recorded process is
-    dead (a descendant kept the file open) is *taken over*: the file is removed and a new one
-    locked, never waited on.  The lock file is opened without following a symbolic link
-    (a link in its place is a one-line error) and removed again on release; a waiter that
-    wins the lock of a removed file starts over on the current one.
+    The lock is an ``flock`` on the lock file, which records the holder's pid and host.
+    The kernel releases it when the holder dies; a lock still held although the recorded
+    process (of this host) is dead - a descendant kept the file open - is *taken over*: the
+    file is removed and a new one locked, never waited on.  The lock file is opened without
+    following a symbolic link (a link in its place is a one-line error) and removed again on
+    release; a waiter that wins the lock of a removed file starts over on the current one.
 
     Parameters
     ----------
@@ -347,7 +360,7 @@ def artifact_lock(path: Path, wait: bool = True,
             mine = _same_file(fd, lock)
             if mine:
                 os.ftruncate(fd, 0)
-                os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+                os.pwrite(fd, f"{os.getpid()} {_host()}\n".encode(), 0)
         if not mine:  # removed by its last holder (or taken over): start over
             os.close(fd)
             continue
