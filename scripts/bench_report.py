@@ -50,8 +50,15 @@ def one(code: Path, scene: str, cold_numba: bool) -> dict:
     res = {"code": str(code)}
     with tempfile.TemporaryDirectory() as d:
         shutil.copytree(code / "configs", Path(d) / "configs")
-        env = {k: v for k, v in os.environ.items() if k != "WALKERLAB_CACHE_DIR"}
+        # generated model code cold (a fresh user cache per run), numba's cache warm (the
+        # user's own) unless cold_numba
+        env = dict(os.environ)
         env["PYTHONPATH"] = str(code)
+        if not cold_numba and not env.get("NUMBA_CACHE_DIR"):  # walkerlab.usercache.root()
+            base = os.environ.get("WALKERLAB_CACHE_DIR") or str(
+                Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "walkerlab")
+            env["NUMBA_CACHE_DIR"] = str(Path(base) / "numba")
+        env["WALKERLAB_CACHE_DIR"] = str(Path(d) / "user_cache")
         if cold_numba:
             env["NUMBA_CACHE_DIR"] = str(Path(d) / "numba_cache")
         for label in ("first", "rerun"):

@@ -1,8 +1,11 @@
-"""Reproduce the defects of issue 12 against a walkerlab checkout, as a user would.
+"""Reproduce the defects of issues 12 and 19 against a walkerlab checkout, as a user would.
 
 Usage::
 
     PYTHONPATH=/work/wt/base python scripts/reliability_repro.py /tmp/repro_base [CASE ...]
+
+Cases ``d*`` are issue 12's, ``i19_<item>_*`` issue 19's (items 1, 2, 3, 7, 10, 14; every
+case gets its own user cache, ``WALKERLAB_CACHE_DIR=<case>/uc``).
 
 Each case runs the CLI (``python -m walkerlab.cli``) in a fresh folder under the given
 work directory and prints one Markdown table row: case, exit code, the first line of
@@ -479,6 +482,303 @@ def perms(d):
 def version(d):
     rc, msg, _ = cli(d, "--version")
     return rc, msg, ""
+
+
+# ------------------------------------------------------------------ issue 19
+def _uc(d: Path) -> dict:
+    return {"WALKERLAB_CACHE_DIR": str(d / "uc")}
+
+
+def _cmdline(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
+    except OSError:
+        return ""
+
+
+def _kill_tree(pid: int) -> None:
+    for k in [pid, *_children(pid)]:
+        try:
+            os.kill(k, signal.SIGKILL)
+        except OSError:
+            pass
+
+
+def _orphans_after(main: subprocess.Popen, sig: int, wait_s: float = 5.0) -> tuple[list, list]:
+    kids = _children(main.pid)
+    main.send_signal(sig)
+    main.wait()
+    time.sleep(wait_s)
+    alive = [k for k in kids if _alive(k)]
+    return kids, alive
+
+
+def _rerun_waits(cwd: Path, args: list[str], env: dict, seconds: float = 8.0) -> str:
+    """Start the same command again; after ``seconds``: does it wait on the dead lock?"""
+    p = subprocess.Popen([PY, "-m", "walkerlab.cli", *args], cwd=cwd, text=True,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         env={**os.environ, **env})
+    time.sleep(seconds)
+    _kill_tree(p.pid)
+    p.wait()
+    err = p.stderr.read()
+    p.stderr.close()
+    return "rerun WAITS on the dead pid" if "waiting" in err else "rerun proceeds"
+
+
+def _stability_kill(d: Path, sig: int):
+    s = scene(d / "cfg", PAPER, "paper.yaml")
+    args = ["stability-map", str(s), "--kind", "friction", "--n", "4", "--time-limit", "20",
+            "--runs-dir", "runs"]
+    main = subprocess.Popen([PY, "-m", "walkerlab.cli", *args], cwd=d / "cfg",
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            env={**os.environ, **_uc(d)})
+    time.sleep(12)
+    kids, alive = _orphans_after(main, sig)
+    rerun = _rerun_waits(d / "cfg", args, _uc(d))
+    for k in alive:
+        os.kill(k, signal.SIGKILL)
+    return (main.returncode, "", f"{len(kids)} descendants, {len(alive)} alive 5 s after "
+            f"{signal.Signals(sig).name}; {rerun}")
+
+
+@case
+def i19_1_stability_map_sigkill(d):
+    return _stability_kill(d, signal.SIGKILL)
+
+
+@case
+def i19_1_stability_map_sigterm(d):
+    return _stability_kill(d, signal.SIGTERM)
+
+
+@case
+def i19_1_report_workprecision_sigterm(d):
+    s = scene(d / "cfg", PAPER, "paper.yaml")
+    main = subprocess.Popen([PY, "-m", "walkerlab.cli", "report", str(s), "--runs-dir", "runs"],
+                            cwd=d / "cfg", stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            env={**os.environ, **_uc(d)})
+    t0 = time.time()
+    spawned: list = []
+    while time.time() - t0 < 600 and main.poll() is None:  # until measuring workers run
+        spawned = [k for k in _children(main.pid) if "spawn_main" in _cmdline(k)]
+        if len(spawned) >= 1 and (d / "cfg/runs/paper/.cache/workprecision").is_dir():
+            break
+        time.sleep(0.5)
+    time.sleep(3)
+    kids, alive = _orphans_after(main, signal.SIGTERM)
+    names = sorted({("tracker" if "resource_tracker" in _cmdline(k) else "worker")
+                    for k in alive})
+    for k in alive:
+        os.kill(k, signal.SIGKILL)
+    return (main.returncode, "", f"after {time.time() - t0:.0f} s: {len(kids)} descendants "
+            f"({len(spawned)} spawn workers), {len(alive)} alive 5 s after SIGTERM {names}")
+
+
+@case
+def i19_2_tampered_model_cache(d):
+    """Prepend a statement to every generated model file walkerlab left (runs/.cache/models
+    before, the user cache after), recompute its sha256 header, make it group-writable (as
+    in a shared folder) and rerun: does the statement run?"""
+    import hashlib
+
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "runs", env=_uc(d))
+    flag = d / "PWNED"
+    files = [p for p in d.rglob("*.py") if "__pycache__" not in p.parts]
+    for p in files:
+        body = f"open({str(flag)!r}, 'w').write('x')\n" + p.read_text().split("\n", 1)[1]
+        p.write_text(f"# sha256 {hashlib.sha256(body.encode()).hexdigest()}\n{body}")
+        os.chmod(p, 0o664)
+    rc, msg, _ = cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "runs", "--force",
+                     env=_uc(d))
+    where = sorted({str(p.parent.relative_to(d)) for p in files})
+    return rc, msg, f"model files in {where}; planted statement ran: {flag.exists()}"
+
+
+@case
+def i19_2_runs_folder_holds_no_code(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    rc, msg, _ = cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "runs", env=_uc(d))
+    code = [str(p.relative_to(d / "cfg/runs")) for p in (d / "cfg/runs").rglob("*.py")]
+    modes = {str(p.relative_to(d)): oct(stat.S_IMODE(p.stat().st_mode))
+             for p in (d / "uc").rglob("*")} if (d / "uc").is_dir() else {}
+    return rc, msg, f"code under runs/: {code or 'none'}; user cache: {modes}"
+
+
+@case
+def i19_14_numba_cache_location(d):
+    pkg = ROOT / "walkerlab" / "contact" / "__pycache__"
+    before = {p: p.stat().st_mtime_ns for p in pkg.glob("*.nb*")} if pkg.is_dir() else {}
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(_uc(d))
+    p = subprocess.run([PY, "-c", "from walkerlab.contact import _kernels as K; "
+                        "K.friction_mu(0.1, 0.9, 0.7, 0.01, 0.02)"], env=env,
+                       capture_output=True, text=True)
+    after = {q: q.stat().st_mtime_ns for q in pkg.glob("*.nb*")} if pkg.is_dir() else {}
+    touched = [q.name for q in after if before.get(q) != after[q]]
+    ucn = list((d / "uc").rglob("*.nbi")) if (d / "uc").is_dir() else []
+    return (p.returncode, (p.stderr.strip().splitlines() or [""])[-1][:100],
+            f"package __pycache__ index files written: {len(touched)} "
+            f"(present: {sum(1 for q in after if q.suffix == '.nbi')}); user cache: {len(ucn)}")
+
+
+@case
+def i19_3_lock_symlink(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "runs", env=_uc(d))
+    victim = d / "victim.txt"
+    victim.write_text("precious\n")
+    lock = d / "cfg/runs/paper/.fixedpoint.h5.lock"
+    lock.unlink(missing_ok=True)
+    lock.symlink_to(victim)
+    rc, msg, _ = cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "runs", "--force",
+                     env=_uc(d))
+    return rc, msg, f"victim.txt now {victim.read_text()!r}"
+
+
+@case
+def i19_3_basin_partial_symlink(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    (d / "cfg/runs/paper").mkdir(parents=True)
+    victim = d / "victim.txt"
+    victim.write_text("precious\n")
+    (d / "cfg/runs/paper/basin.h5.partial").symlink_to(victim)
+    rc, msg, _ = cli(d / "cfg", "basin", str(s), "--grid", "2x2", "--workers", "1",
+                     "--runs-dir", "runs", env=_uc(d))
+    head = victim.read_bytes()[:8]
+    return rc, msg, f"victim.txt starts {head!r}"
+
+
+@case
+def i19_3_report_dir_symlink(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    outside = d / "outside"
+    outside.mkdir()
+    (d / "cfg/runs/paper").mkdir(parents=True)
+    (d / "cfg/runs/paper/report").symlink_to(outside)
+    cli(d / "cfg", "simulate", str(s), "--strides", "2", "--runs-dir", "runs", env=_uc(d))
+    rc, msg, _ = cli(d / "cfg", "plot", str(s), "--runs-dir", "runs", env=_uc(d))
+    return rc, msg, f"files written outside runs/: {len(list(outside.rglob('*.*')))}"
+
+
+def _limited_cli(cwd: Path, limit: int, *args: str, env=None):
+    import resource
+
+    def pre():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    p = subprocess.run([PY, "-m", "walkerlab.cli", *args], cwd=cwd, capture_output=True,
+                       text=True, env={**os.environ, **(env or {})}, preexec_fn=pre)
+    return p.returncode, p.stderr.strip().splitlines()
+
+
+@case
+def i19_7_disk_full_ulimit(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    cli(d / "cfg", "simulate", str(s), "--strides", "1", "--runs-dir", "runs", env=_uc(d))
+    art = d / "cfg/runs/paper/simulate.h5"
+    old = art.read_bytes()
+    rc, err = _limited_cli(d / "cfg", 300 * 1024, "simulate", str(s), "--strides", "200",
+                           "--runs-dir", "runs", env=_uc(d))
+    stray = [p.name for p in (d / "cfg/runs").rglob("*") if p.name.endswith(".tmp")]
+    return (rc, (err[0] if err else "")[:160],
+            f"{len(err)} stderr lines; old artifact kept: {art.read_bytes() == old}; "
+            f"stray: {stray or 'none'}")
+
+
+@case
+def i19_7_disk_full_tmpfs(d):
+    mnt = d / "tmpfs"
+    mnt.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=300k", "tmpfs", str(mnt)],
+                      capture_output=True).returncode != 0:
+        return "-", "cannot mount a tmpfs here (needs root)", ""
+    try:
+        s = scene(d / "cfg", IDEAL, "paper.yaml")
+        runs = mnt / "runs"
+        cli(d / "cfg", "simulate", str(s), "--strides", "1", "--runs-dir", str(runs),
+            env=_uc(d))
+        art = runs / "paper/simulate.h5"
+        old = art.read_bytes() if art.is_file() else b""
+        p = subprocess.run([PY, "-m", "walkerlab.cli", "simulate", str(s), "--strides", "400",
+                            "--runs-dir", str(runs)], cwd=d / "cfg", capture_output=True,
+                           text=True, env={**os.environ, **_uc(d)})
+        err = p.stderr.strip().splitlines()
+        stray = [q.name for q in runs.rglob("*") if q.name.endswith(".tmp")]
+        kept = art.is_file() and art.read_bytes() == old
+        return (p.returncode, (err[0] if err else "")[:160],
+                f"{len(err)} stderr lines; old artifact kept: {kept}; stray: {stray or 'none'}")
+    finally:
+        subprocess.run(["umount", str(mnt)], capture_output=True)
+
+
+@case
+def i19_7_cache_write_full_disk(d):
+    import resource
+
+    def pre():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (2048, 2048))
+    code = ("from walkerlab.models import cache\n"
+            "from walkerlab.models.description import BodySpec, Structure\n"
+            "cache.generated_module(Structure('absolute', (BodySpec('mass', 'point_mass'),)))\n")
+    for _ in range(2):
+        p = subprocess.run([PY, "-c", code], cwd=d, capture_output=True, text=True,
+                           env={**os.environ, **_uc(d)}, preexec_fn=pre)
+    stray = [q.name for q in d.rglob("*") if q.is_file()]
+    err = p.stderr.strip().splitlines()
+    return p.returncode, (err[-1] if err else "")[:160], f"files left: {stray or 'none'}"
+
+
+@case
+def i19_10_damaged_workprecision_cache(d):
+    data = {**IDEAL, "workprecision": {"methods": ["RK45"], "rtols": [1e-3, 1e-4],
+                                       "repeats": 1, "strides": 1, "models": ["ideal"]}}
+    s = scene(d / "cfg", data, "wp.yaml")
+    cli(d / "cfg", "workprecision", str(s), "--runs-dir", "runs", env=_uc(d))
+    cache = sorted((d / "cfg/runs/wp/.cache/workprecision").glob("*.json"))
+    cache[0].write_text("{}")
+    (d / "cfg/runs/wp/workprecision.h5").unlink()  # the report needs the artifact again
+    rc, msg, _ = cli(d / "cfg", "workprecision", str(s), "--runs-dir", "runs", env=_uc(d))
+    return rc, msg, f"damaged entry now {cache[0].read_text()[:30]!r}"
+
+
+@case
+def i19_14_debug_false(d):
+    rc, msg, _ = cli(d, "fixedpoint", "missing.yaml", env={"WALKERLAB_DEBUG": "false"})
+    return rc, msg, ""
+
+
+@case
+def i19_14_runs_dir_empty(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    rc, msg, _ = cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "", env=_uc(d))
+    return rc, msg, f"written into the current folder: {(d / 'cfg' / 'paper').exists()}"
+
+
+@case
+def i19_14_report_md_script(d):
+    s = scene(d / "cfg", {**IDEAL, "source": "Smith <script>alert(1)</script>"}, "paper.yaml")
+    rc, msg, _ = cli(d / "cfg", "report", str(s), "--runs-dir", "runs", env=_uc(d),
+                     timeout=600)
+    md = (d / "cfg/runs/paper/report/report.md")
+    if not md.is_file():
+        return rc, msg, "no report"
+    # code fences show HTML as text: only what lies outside them counts
+    prose = "".join(md.read_text().split("```")[::2])
+    return rc, msg, f"report.md holds a raw <script> outside code blocks: {'<script>' in prose}"
+
+
+@case
+def i19_14_dev_zero(d):
+    rc, msg, _ = cli(d, "fixedpoint", "/dev/zero", env=_uc(d))
+    return rc, msg, ""
+
+
+@case
+def i19_14_bench_out_file(d):
+    (d / "FILE").write_text("keep")
+    rc, msg, _ = cli(d, "bench", "ideal", "--out", "FILE", env=_uc(d))
+    return rc, msg, f"FILE kept: {(d / 'FILE').read_text() == 'keep'}"
 
 
 def main():

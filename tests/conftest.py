@@ -3,7 +3,8 @@
 import os
 import tempfile
 
-# generated model code: one cache shared by all test sessions (keyed by content, so safe)
+# the per-user cache (generated model code, numba's cache): one shared by all test sessions
+# (keyed by content, so safe), not the user's own
 os.environ.setdefault("WALKERLAB_CACHE_DIR",
                       os.path.join(tempfile.gettempdir(), "walkerlab-test-models"))
 

@@ -31,7 +31,17 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_
 SceneArg = typer.Argument(None, help="scene YAML file (default: configs/paper.yaml, "
                           "the paper's walker)",
                           show_default=False)
-RunsOpt = typer.Option(Path("runs"), "--runs-dir", help="folder for artifacts (runs/<scene>/)")
+def _runs_dir(value) -> Path:
+    """``--runs-dir``: a folder name; an empty one (which would be the current folder) is
+    refused."""
+    if not str(value).strip():
+        raise typer.BadParameter("empty folder name (it would write into the current folder); "
+                                 "give a folder, e.g. --runs-dir runs")
+    return Path(value)
+
+
+RunsOpt = typer.Option("runs", "--runs-dir", parser=_runs_dir, metavar="PATH",
+                       help="folder for artifacts (runs/<scene>/)")
 ForceOpt = typer.Option(False, "--force", help="recompute even if the artifact is up to date")
 
 
@@ -54,12 +64,35 @@ def _fail(exc: Exception) -> None:
 
 
 DEBUG_ENV = "WALKERLAB_DEBUG"
+#: values of ``WALKERLAB_DEBUG`` that show tracebacks (case-insensitive); anything else
+#: (``0``, ``false``, ``no``, empty) keeps errors to one line
+DEBUG_ON = ("1", "true", "yes")
+#: longest error line; a longer message is cut at a sentence or field boundary
+MAX_ERROR_CHARS = 300
 
 
-def _one_line(text: str) -> str:
-    lines = [ln.strip() for ln in str(text).strip().splitlines() if ln.strip()]
-    return (lines[0] + (f" (+{len(lines) - 1} more lines)" if len(lines) > 1 else "")) \
-        if lines else ""
+def _debug() -> bool:
+    return os.environ.get(DEBUG_ENV, "").strip().lower() in DEBUG_ON
+
+
+def _one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
+    """A message as one line: its lines joined (a sentence wrapped over two lines stays
+    whole); longer than ``limit``, it is cut after the last sentence or field boundary
+    (``.``, ``;``, ``:``, ``,`` followed by a space) and says how to see the rest."""
+    line = " ".join(ln.strip() for ln in str(text).strip().splitlines() if ln.strip())
+    if len(line) <= limit:
+        return line
+    head = line[:limit]
+    cut = max(head.rfind(sep) for sep in (". ", "; ", ": ", ", "))
+    head = head[:cut + 1] if cut > limit // 3 else head[:head.rfind(" ")].rstrip()
+    return (f"{head} ... [{len(line) - len(head)} more characters: rerun with "
+            f"{DEBUG_ENV}=1 for the full message]")
+
+
+def _disk_full_line(exc: BaseException) -> str:
+    where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+    return (f"error: disk full: cannot write{where}; free some space (or raise the file-size "
+            "limit) and rerun")
 
 
 def _guard(fn):
@@ -70,11 +103,11 @@ def _guard(fn):
     def wrapper(*a, **k):
         from walkerlab.analysis.poincare import FixedPointNotFound
         from walkerlab.config import SceneError
-        from walkerlab.io.artifacts import ArtifactError
+        from walkerlab.io.artifacts import ArtifactError, is_disk_full
         from walkerlab.io.runpaths import ArtifactBusy
         from walkerlab.stages.common import StageError
 
-        debug = os.environ.get(DEBUG_ENV, "") not in ("", "0")
+        debug = _debug()
         try:
             return fn(*a, **k)
         except (typer.Exit, typer.Abort, SystemExit):
@@ -91,12 +124,18 @@ def _guard(fn):
         except OSError as exc:  # read-only runs folder, disk full, ...
             if debug:
                 raise
+            if is_disk_full(exc):
+                typer.echo(_disk_full_line(exc), err=True)
+                raise typer.Exit(code=1) from None
             where = f"{exc.filename}: " if exc.filename else ""
             typer.echo(f"error: {where}{exc.strerror or _one_line(exc)}", err=True)
             raise typer.Exit(code=1) from None
         except Exception as exc:  # noqa: BLE001 - a traceback shown to a user is a bug
             if debug:
                 raise
+            if is_disk_full(exc):  # HDF5 reports a full disk as a RuntimeError too
+                typer.echo(_disk_full_line(exc), err=True)
+                raise typer.Exit(code=1) from None
             typer.echo(f"error: internal error ({type(exc).__name__}): {_one_line(exc)} "
                        f"[rerun with {DEBUG_ENV}=1 for the traceback]", err=True)
             raise typer.Exit(code=1) from None
@@ -141,6 +180,24 @@ def _single_threaded_blas() -> None:
     os.environ.setdefault(BLAS_THREADS_ENV, "1")
 
 
+def _process_settings() -> None:
+    """Settings every command (and every worker it starts) runs with:
+
+    - numba's on-disk cache in the per-user cache (``NUMBA_CACHE_DIR``, unless set), never
+      in the installed package (:func:`walkerlab.usercache.use_for_numba`); before numba is
+      imported, and inherited by worker processes;
+    - ``SIGXFSZ`` ignored (a file-size limit, ``ulimit -f``, then makes a write fail with
+      EFBIG, reported as "disk full" in one line, instead of killing the process).
+    """
+    import signal
+
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()
+    if hasattr(signal, "SIGXFSZ"):
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+
+
 @app.callback()
 def _main(version: bool = typer.Option(False, "--version", callback=_version_callback,
                                        is_eager=True,
@@ -148,6 +205,7 @@ def _main(version: bool = typer.Option(False, "--version", callback=_version_cal
                                        "and h5py versions and exit")) -> None:
     """walkerlab: passive-dynamic biped walkers, from fixed point to report."""
     _single_threaded_blas()
+    _process_settings()
 
 
 def _status(o) -> str:

@@ -13,9 +13,9 @@ X = np.array([-0.2042, 0.1694, -0.6058, -0.8610])
 
 @pytest.fixture
 def fresh(tmp_path, monkeypatch):
-    monkeypatch.setattr(cache, "_USER", str(tmp_path))
+    monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
     cache.clear_memo()
-    yield tmp_path
+    yield tmp_path / "models"
     cache.clear_memo()
 
 

@@ -59,6 +59,9 @@ class CompiledDense:
         return piece[2]
 
     def _one(self, t: float) -> np.ndarray:
+        from walkerlab.usercache import use_for_numba
+
+        use_for_numba()  # numba's cache in the user cache (before numba loads)
         from CyRK.nb import numba_solver as ns
 
         for j, piece in enumerate(self.pieces):
@@ -79,6 +82,9 @@ class CompiledDense:
 def _solve(addr, data, t0, t1, y0, method_int, rtol, atol, hmax, max_steps, first_step, dense,
            n_extra=0):
     """One CyRK run; returns ``(result, T (k,), Y (k, m + n_extra), ok, message, nfev)``."""
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()  # numba's cache in the user cache (before numba loads)
     from CyRK.nb import numba_solver as ns
 
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
@@ -150,6 +156,9 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     -------
     t_last, y_last (m,), failed, message, event index or None, dense, nfev
     """
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()  # numba's cache in the user cache (before numba loads)
     from CyRK.cy.pyhelpers import find_ode_method_int
     from CyRK.nb import numba_solver as ns
     from scipy.optimize import brentq

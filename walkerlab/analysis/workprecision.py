@@ -227,14 +227,17 @@ def _pin_worker(core: int) -> None:
     from walkerlab.analysis.hybrid import _have_cyrk
 
     if _have_cyrk():
+        from walkerlab.usercache import use_for_numba
+
+        use_for_numba()  # numba's cache in the user cache (before numba loads)
         import CyRK  # noqa: F401  (and numba)
 
 
 def start_worker(core: int):
     """A measuring worker process pinned to ``core``, started now (see :class:`Lanes`)."""
-    import multiprocessing as mp
+    from walkerlab.workers import mp_context
 
-    return _pinned_worker(mp.get_context("spawn"), core)
+    return _pinned_worker(mp_context("spawn"), core)
 
 
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -245,9 +248,10 @@ def _pinned_worker(ctx, core: int):
     """A one-process pool pinned to ``core``, started now with single-threaded BLAS/OpenMP
     (a thread pool is sized when numpy loads, before any initializer runs, so the limit
     must be in the environment the process starts with)."""
-    from concurrent.futures import ProcessPoolExecutor
+    from walkerlab.workers import process_pool
 
-    ex = ProcessPoolExecutor(1, mp_context=ctx, initializer=_pin_worker, initargs=(core,))
+    # ends with this process, even after SIGKILL or SIGTERM (walkerlab.workers)
+    ex = process_pool(1, ctx, _pin_worker, (core,))
     with _ENV_LOCK:
         old = {v: os.environ.get(v) for v in THREAD_VARS}
         os.environ.update({v: "1" for v in THREAD_VARS})
@@ -304,6 +308,28 @@ def _cost_order(t: Case) -> tuple:
     return (base not in IMPLICIT, round(float(np.log10(t.rtol)), 3), t.model != "contact")
 
 
+def _numbers(v, n: int | None = None) -> bool:
+    return (isinstance(v, list) and (n is None or len(v) == n)
+            and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v))
+
+
+def read_cached_case(path: Path) -> dict | None:
+    """A cached case result (:func:`time_case`) if the file holds a complete one, else None
+    (missing, unreadable, not JSON, or lacking/mistyping a field: the case is measured
+    again, issue 19)."""
+    try:
+        res = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(res, dict):
+        return None
+    times, cpu, vec = res.get("times"), res.get("cpu_times"), res.get("vec")
+    ok = (_numbers(times) and len(times) >= 1 and all(x >= 0 for x in times)
+          and _numbers(cpu, len(times)) and (vec is None or (_numbers(vec) and len(vec) >= 1))
+          and isinstance(res.get("nfev"), int) and not isinstance(res.get("nfev"), bool))
+    return res if ok else None
+
+
 def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
               lanes: Lanes | None = None) -> dict:
     """Results of every case, from the cache or measured (in pinned worker processes).
@@ -327,14 +353,11 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
     cache_dir.mkdir(parents=True, exist_ok=True)
     out, todo = {}, []
     for t in tasks:
-        f = cache_dir / f"{t.key}.json"
-        if f.is_file():
-            try:
-                out[t.key] = {**json.loads(f.read_text()), "cached": True}
-                continue
-            except (OSError, ValueError):
-                pass
-        todo.append(t)
+        res = read_cached_case(cache_dir / f"{t.key}.json")
+        if res is not None:
+            out[t.key] = {**res, "cached": True}
+        else:  # missing, damaged or incomplete: measured again
+            todo.append(t)
     if lanes is not None:
         lanes.todo_models.update(t.model for t in todo)
         lanes.todo_known.set()
@@ -343,9 +366,10 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
     def store(key, res, n_lanes):
         res = {**res, "measured_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                "parallel_workers": n_lanes}
-        tmp = cache_dir / f".{key}.tmp"
-        tmp.write_text(json.dumps(res))
-        os.replace(tmp, cache_dir / f"{key}.json")
+        from walkerlab.io.artifacts import atomic_write
+
+        text = json.dumps(res).encode()
+        atomic_write(cache_dir / f"{key}.json", lambda fh: fh.write(text))
         with lock:
             out[key] = {**res, "cached": False}
 
@@ -358,9 +382,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
         lanes = Lanes(cores=cores[:workers])
     if not todo:
         return out
-    import multiprocessing as mp
+    from walkerlab.workers import mp_context
 
-    ctx = mp.get_context("spawn")
+    ctx = mp_context("spawn")
     todo.sort(key=_cost_order)
     errors: list[BaseException] = []
 

@@ -588,6 +588,8 @@ def load_scene(path: str | Path) -> Scene:
     if path.is_dir():
         raise SceneError(f"{path}: is a directory, not a scene file")
     if not path.is_file():
+        if path.exists():  # a device, FIFO or socket (/dev/zero)
+            raise SceneError(f"{path}: not a regular file; give a YAML scene file")
         raise SceneError(f"{path}: scene file not found")
     try:
         text = path.read_text(encoding="utf-8")

@@ -32,7 +32,12 @@ The pure-numpy reference of the same equations is :mod:`walkerlab.contact.refere
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from walkerlab.usercache import use_for_numba
+
+use_for_numba()  # cache=True below: numba's cache in the user cache, not in the package
+
+from numba import njit  # noqa: E402
 
 # Named indices into ``P`` (module-level ints are compile-time constants under numba).
 I_L, I_M, I_MH, I_B, I_G, I_PHI = 0, 1, 2, 3, 4, 5

@@ -40,6 +40,9 @@ _FPTR = None
 
 def _build() -> int:
     """Compile (or load from numba's disk cache) the cfunc RHS; returns its address."""
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()  # cache=True: numba's cache in the user cache, not in the package
     from CyRK.nb.numba_solver import cyjit_sig
     from numba import carray, cfunc
 

@@ -64,6 +64,9 @@ def available() -> bool:
 
 
 def _build():
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()  # cache=True: numba's cache in the user cache, not in the package
     from numba import carray, cfunc
 
     @cfunc(lsoda_sig, cache=True)

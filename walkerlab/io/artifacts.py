@@ -8,8 +8,12 @@ Layout conventions
 - Every dataset has ``unit`` and ``description`` attributes; time series are 1-D along
   ``time``; state is addressed by *name* (``samples/angle/leg1``), never by row number.
 - Files are written to a temporary name in the same folder and renamed, so a crash never
-  leaves a half-written artifact and never overwrites a good one (:func:`atomic_write` does
-  the same for figures, reports and JSON).  Every output file is mode 0644.
+  leaves a half-written artifact and never overwrites a good one (:func:`atomic_write`, for
+  artifacts, figures, reports and JSON).  An artifact is built in memory and written as one
+  image: a full disk is the one-line "disk full" error, the old artifact kept and nothing
+  left behind.  Nothing is written through a symbolic link (the temporary file is created
+  exclusively; a link in place of the target is a one-line error).  Every output file is
+  mode 0644.
 - ``content_hash`` (root attribute): SHA-256 over every dataset and attribute of the file
   except ``content_hash``, ``created_utc`` and ``wall_time_s``.  A stage reuses its artifact
   only if the stored hash still matches the content, and the cache key of a downstream stage
@@ -20,7 +24,9 @@ Layout conventions
 from __future__ import annotations
 
 import datetime as _dt
+import errno
 import hashlib
+import itertools
 import json
 import os
 import tempfile
@@ -45,21 +51,61 @@ FILE_MODE = 0o644
 _VOLATILE_ATTRS = ("content_hash", "created_utc", "wall_time_s")
 
 
+#: errno values that mean "no room": no space, file too large (``ulimit -f``), quota
+DISK_FULL_ERRNOS = frozenset(e for e in (getattr(errno, n, None) for n in
+                                         ("ENOSPC", "EFBIG", "EDQUOT")) if e is not None)
+
+
+def is_disk_full(exc: BaseException) -> bool:
+    """True for an OSError (or h5py's RuntimeError) that means the disk, the file-size limit
+    or the quota is full, also as reported inside an HDF5 error message (``errno = 28``)."""
+    if not isinstance(exc, (OSError, RuntimeError)):
+        return False
+    if getattr(exc, "errno", None) in DISK_FULL_ERRNOS:
+        return True
+    text = str(exc)
+    return any(f"errno = {e}," in text for e in DISK_FULL_ERRNOS) or \
+        "No space left on device" in text or "File too large" in text
+
+
+def disk_full_error(path: Path, exc: OSError) -> ArtifactError:
+    """The one-line "disk full" error of a write to ``path``."""
+    why = os.strerror(exc.errno) if exc.errno in DISK_FULL_ERRNOS else "no space left"
+    return ArtifactError(f"disk full: cannot write {path} ({why}); nothing was replaced - "
+                         "free some space (or raise the file-size limit) and rerun")
+
+
+def _write_error(path: Path, exc: OSError) -> ArtifactError:
+    if is_disk_full(exc):
+        return disk_full_error(path, exc)
+    return ArtifactError(f"{path}: cannot write ({exc.strerror or exc})")
+
+
 def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
     """Write ``path`` atomically: ``write(binary file object)`` fills a temporary file in the
     same folder, which is then renamed over ``path`` (a crash leaves the old file or none,
     never a truncated one).
 
+    The temporary file is created exclusively (``mkstemp``: ``O_CREAT | O_EXCL``, which does
+    not follow a symbolic link); ``path`` itself must not be a symbolic link.
+
     Raises
     ------
     ArtifactError
-        The folder cannot be created or written (one line).
+        The folder cannot be created or written; the disk is full ("disk full", the old file
+        is kept and nothing is left behind) (one line).
+    walkerlab.io.runpaths.RunPathError
+        ``path`` is a symbolic link.
     """
-    path = Path(path)
+    from walkerlab.io.runpaths import refuse_link
+
+    path = refuse_link(Path(path))
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     except OSError as exc:
+        if is_disk_full(exc):
+            raise disk_full_error(path, exc) from None
         raise ArtifactError(f"{path.parent}: cannot write there ({exc.strerror})") from None
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -68,7 +114,7 @@ def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
         os.replace(tmp, path)
     except OSError as exc:
         Path(tmp).unlink(missing_ok=True)
-        raise ArtifactError(f"{path}: cannot write ({exc.strerror})") from None
+        raise _write_error(path, exc) from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
@@ -209,6 +255,9 @@ def read_named(group: h5py.Group, name: str):
     return val
 
 
+_MEMORY_FILES = itertools.count()  # unique names of in-memory HDF5 files (core driver)
+
+
 def write_artifact(path: Path, stage: str, scene, input_hash: str,
                    writer: Callable[[h5py.File], None], wall_time_s: float,
                    extra_attrs: dict | None = None) -> Path:
@@ -232,44 +281,37 @@ def write_artifact(path: Path, stage: str, scene, input_hash: str,
     Raises
     ------
     ArtifactError
-        The folder cannot be created or written.
+        The folder cannot be created or written, or the disk is full (one line; the old
+        artifact is kept, nothing is left behind).
+    walkerlab.io.runpaths.RunPathError
+        ``path`` is a symbolic link.
     """
-    path = Path(path)
+    # built in memory (HDF5 core driver) and written as one image by atomic_write: HDF5 never
+    # writes the disk itself, so a full disk is one OSError with its errno (no HDF5 error
+    # stack, no half-closed file), and the file written is atomic_write's exclusive temporary
+    f = h5py.File(f"<memory {os.getpid()}.{next(_MEMORY_FILES)}: {Path(path).name}>", "w",
+                  driver="core", backing_store=False)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".h5.tmp", dir=path.parent)
-    except OSError as exc:
-        raise ArtifactError(f"{path.parent}: cannot write the run folder ({exc.strerror})") \
-            from None
-    os.close(fd)
-    try:
-        with h5py.File(tmp, "w") as f:
-            f.attrs["stage"] = stage
-            f.attrs["walkerlab_version"] = walkerlab.__version__
-            f.attrs["scene_name"] = scene.name or ""
-            f.attrs["scene_json"] = scene.model_dump_json()
-            f.attrs["input_hash"] = input_hash
-            f.attrs["created_utc"] = _dt.datetime.now(_dt.UTC).isoformat()
-            f.attrs["wall_time_s"] = float(wall_time_s)
-            for k, v in (extra_attrs or {}).items():
-                f.attrs[k] = v
-            writer(f)
-            from walkerlab.units import for_scene, relabel_artifact
+        f.attrs["stage"] = stage
+        f.attrs["walkerlab_version"] = walkerlab.__version__
+        f.attrs["scene_name"] = scene.name or ""
+        f.attrs["scene_json"] = scene.model_dump_json()
+        f.attrs["input_hash"] = input_hash
+        f.attrs["created_utc"] = _dt.datetime.now(_dt.UTC).isoformat()
+        f.attrs["wall_time_s"] = float(wall_time_s)
+        for k, v in (extra_attrs or {}).items():
+            f.attrs[k] = v
+        writer(f)
+        from walkerlab.units import for_scene, relabel_artifact
 
-            relabel_artifact(f, for_scene(scene))  # unit labels follow the scene's system
-            netcdf.finish(f)
-            f.attrs["content_hash"] = content_hash_of(f)
-        os.chmod(tmp, FILE_MODE)
-        os.replace(tmp, path)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        if isinstance(exc, (PermissionError, FileNotFoundError)) or exc.errno is not None:
-            raise ArtifactError(f"{path}: cannot write ({exc.strerror or exc})") from None
-        raise
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+        relabel_artifact(f, for_scene(scene))  # unit labels follow the scene's system
+        netcdf.finish(f)
+        f.attrs["content_hash"] = content_hash_of(f)
+        f.flush()
+        image = f.id.get_file_image()
+    finally:
+        f.close()
+    return atomic_write(Path(path), lambda fh: fh.write(image))
 
 
 @contextmanager

@@ -1,49 +1,39 @@
 """On-disk cache of generated model code, so a process start does not re-derive.
 
-Where: ``$WALKERLAB_CACHE_DIR`` if set, else ``runs/.cache/models`` under the current folder.
-Stages call :func:`set_cache_dir` with ``<runs root>/.cache/models`` (it also sets the
-environment variable, so worker processes of a sweep use the same folder); the product writes
-nothing outside the runs folder.
+Where: the per-user cache, ``<user cache>/models`` (:mod:`walkerlab.usercache`:
+``$WALKERLAB_CACHE_DIR`` or the platform's user cache folder, e.g. ``~/.cache/walkerlab``),
+never a runs folder: runs folders are shared, and code in them would run as whoever opens
+them.  The folder is created 0700 and files are written 0600; a file is executed only if it
+belongs to the current user and is not writable by group or others (else it is regenerated);
+without a private folder the code stays in memory.
 
 Key: sha256 of the walker :class:`~walkerlab.models.description.Structure` (no numbers: a
 sweep over masses shares one file) and of the generator's own source files (``symbolic.py``,
 ``codegen.py``, ``description.py``, ``cache.py``) and the sympy version, so editing the
-generator regenerates.  Files are written atomically (temporary name, then ``os.replace``);
-each starts with a sha256 of its body: a truncated or edited file is regenerated, as is one
-that fails to compile.  If the folder cannot be written, the code is kept in memory only.
+generator regenerates.  Files are written atomically (temporary name, then ``os.replace``;
+a failed write - disk full, read-only - leaves nothing behind); each starts with a sha256 of
+its body: a truncated or damaged file is regenerated, as is one that fails to compile.  (The
+header detects damage, not tampering: trust comes from the file's owner and mode.)
 """
 
 from __future__ import annotations
 
 import hashlib
-import os
-import tempfile
 from functools import cache
 from importlib import metadata
 from pathlib import Path
 
-ENV = "WALKERLAB_CACHE_DIR"
+from walkerlab import usercache
+
+ENV = usercache.ENV
 _GENERATOR_FILES = ("symbolic.py", "codegen.py", "description.py", "cache.py")
 _memo: dict[str, dict] = {}
-_USER = os.environ.get(ENV)  # set before start (by the user, or by a parent process): wins
-_dir: Path | None = None
 
 
-def set_cache_dir(path: str | Path) -> None:
-    """Use ``path`` for generated model code, in this process and in processes it starts
-    (stages call it with ``<runs root>/.cache/models``); ``$WALKERLAB_CACHE_DIR`` set before
-    the process started takes precedence."""
-    global _dir
-    _dir = Path(path)
-    if not _USER:
-        os.environ[ENV] = str(path)
-
-
-def cache_dir() -> Path:
-    """The folder generated model code is read from and written to."""
-    if _USER:
-        return Path(_USER)
-    return _dir or Path(os.environ.get(ENV) or Path("runs") / ".cache" / "models")
+def cache_dir() -> Path | None:
+    """The private folder generated model code is read from and written to (created 0700),
+    or None when there is none (the code is then kept in memory)."""
+    return usercache.private_dir("models")
 
 
 @cache
@@ -79,48 +69,53 @@ def _exec(source: str, origin: str) -> dict:
     return ns
 
 
+def read_source(path: Path) -> str | None:
+    """Body of a cache file that may be executed: private (this user's, not writable by
+    group/others, no link) and intact (its sha256 header matches), else None."""
+    text = usercache.read_private(path)
+    if text is None or "\n" not in text:
+        return None
+    first, body = text.split("\n", 1)
+    return body if first == f"# sha256 {_digest(body)}" else None
+
+
 def _read(path: Path) -> dict | None:
-    """The namespace of a valid cache file, or None (missing, corrupt, stale)."""
+    """The namespace of a valid cache file, or None (missing, corrupt, untrusted, stale)."""
+    body = read_source(path)
+    if body is None:
+        return None
     try:
-        text = path.read_text()
-        first, body = text.split("\n", 1)
-        if first != f"# sha256 {_digest(body)}":
-            return None
         return _exec(body, str(path))
-    except (OSError, ValueError, SyntaxError, UnicodeDecodeError):
+    except (ValueError, SyntaxError):
         return None
 
 
-def _write(path: Path, body: str) -> None:
-    """Atomic write: temporary file in the same folder, then rename."""
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=path.stem, suffix=".tmp", dir=path.parent)
-        with os.fdopen(fd, "w") as f:
-            f.write(f"# sha256 {_digest(body)}\n{body}")
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a cache is shared like any run output
-        os.replace(tmp, path)
-    except OSError:
-        pass  # read-only location: the code stays in memory for this process
+def write_source(path: Path, body: str) -> bool:
+    """Write a cache file (sha256 header + body) atomically, mode 0600; False when the
+    folder cannot be written (nothing is left behind)."""
+    return usercache.write_private(path, f"# sha256 {_digest(body)}\n{body}")
 
 
 def generated_module(structure) -> dict:
     """Namespace of the generated module of ``structure`` (its ``make(p)`` builds functions).
 
-    Reads the cache; on a miss (or a corrupt file) derives with sympy, generates, writes.
+    Reads the cache; on a miss (or a corrupt or untrusted file) derives with sympy,
+    generates, writes.
     """
     key = cache_key(structure)
     if key in _memo:
         return _memo[key]
-    path = cache_dir() / f"{key}.py"
-    ns = _read(path) if path.is_file() else None
+    folder = cache_dir()
+    path = folder / f"{key}.py" if folder is not None else None
+    ns = _read(path) if path is not None else None
     if ns is None:
         from walkerlab.models import codegen, symbolic
 
         eq = symbolic.derive(structure)
         body = codegen.generate(eq, structure.param_names, key)
-        ns = _exec(body, str(path))
-        _write(path, body)
+        ns = _exec(body, str(path or f"<walkerlab model {key}>"))
+        if path is not None:
+            write_source(path, body)
     _memo[key] = ns
     return ns
 

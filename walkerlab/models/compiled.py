@@ -2,9 +2,10 @@
 
 The source comes from :func:`walkerlab.models.codegen.generate_compiled` (the same symbolic
 equations as the Python module of :mod:`walkerlab.models.cache`) and is cached next to it as
-``<key>_nb.py`` (same key, same sha256 header check, atomic write).  It is imported as a real
-module so that numba's own disk cache (``cache=True``, in ``__pycache__`` of the same folder)
-keeps the machine code: a new process pays the numba import and a cache load, not a compile.
+``<key>_nb.py`` in the per-user cache (same key, same ownership/mode and sha256 checks,
+atomic write).  It is imported as a real module so that numba's own disk cache
+(``cache=True``, in ``<user cache>/numba``, :func:`walkerlab.usercache.use_for_numba`) keeps
+the machine code: a new process pays the numba import and a cache load, not a compile.
 
 numba and CyRK are imported only when :meth:`CompiledFlow.address` is first called (the
 ``cyrk_compiled`` solver backend); building a walker does not import them.
@@ -34,24 +35,23 @@ def compiled_module(structure):
     key = cache.cache_key(structure)
     if key in _modules:
         return _modules[key]
-    path = cache.cache_dir() / f"{key}_nb.py"
-    ok = False
-    try:
-        first, body = path.read_text().split("\n", 1)
-        ok = first == f"# sha256 {cache._digest(body)}"
-    except (OSError, ValueError, UnicodeDecodeError):
-        pass
-    if not ok:
+    from pathlib import Path
+
+    from walkerlab import usercache
+
+    usercache.use_for_numba()  # numba's cache in the user cache, not in a runs folder
+    folder = cache.cache_dir()
+    path = folder / f"{key}_nb.py" if folder is not None else None
+    if path is None or cache.read_source(path) is None:  # missing, damaged or untrusted
         from walkerlab.models import codegen, symbolic
 
         body = codegen.generate_compiled(symbolic.derive(structure), structure.param_names, key)
-        cache._write(path, body)
-        if not path.is_file():  # read-only cache folder: a private temporary copy
+        if path is None or not cache.write_source(path, body):
             import tempfile
 
-            tmp = tempfile.mkdtemp(prefix="walkerlab_nb_")
-            path = type(path)(tmp) / path.name
-            path.write_text(f"# sha256 {cache._digest(body)}\n{body}")
+            # no private cache folder: a private temporary copy (mkdtemp: mode 0700)
+            path = Path(tempfile.mkdtemp(prefix="walkerlab_nb_")) / f"{key}_nb.py"
+            cache.write_source(path, body)
     name = f"walkerlab_compiled_{key}"
     spec = importlib.util.spec_from_file_location(name, path)
     mod = importlib.util.module_from_spec(spec)

@@ -18,7 +18,7 @@ import walkerlab
 from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections
-from walkerlab.report.markdown import details, num, table, to_html
+from walkerlab.report.markdown import details, num, table, text, to_html
 from walkerlab.units import for_scene as units_for_scene
 
 
@@ -26,7 +26,7 @@ def _header(scene) -> list[str]:
     import scipy
 
     return [f"# walkerlab report — scene `{scene.name}`", "",
-            f"- source: {scene.source or '—'}",
+            f"- source: {text(scene.source) if scene.source else '—'}",
             f"- walkerlab {walkerlab.__version__}, Python {platform.python_version()}, "
             f"numpy {np.__version__}, scipy {scipy.__version__}, machine {platform.machine()} "
             f"({platform.processor() or platform.system()})",

@@ -115,8 +115,14 @@ def to_html(md: str, base: Path) -> str:
             f"<style>{style}</style></head><body>" + "\n".join(body) + "</body></html>")
 
 
+def text(s: str) -> str:
+    """Free text from a scene (``source:``) as one line of Markdown: HTML characters escaped
+    (``<script>`` is shown, never run, by a Markdown viewer), line breaks as spaces."""
+    return html.escape(" ".join(str(s).split()), quote=False)
+
+
 def inline(s: str) -> str:
-    s = html.escape(s)
+    s = html.escape(html.unescape(s))  # entities of the Markdown (see text) shown as such
     s = re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", s)
     s = re.sub(r"`(.+?)`", r"<code>\1</code>", s)
     s = re.sub(r"\*(.+?)\*", r"<i>\1</i>", s)

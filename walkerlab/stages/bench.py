@@ -186,9 +186,17 @@ def run_bench(what: str, out: Path) -> list[str]:
     ValueError
         Unknown benchmark name.
     """
-    out.mkdir(parents=True, exist_ok=True)
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"bench --out {out}: is a file; --out names a folder (results go to "
+                         f"<folder>/<benchmark>.json): give a folder or remove the file")
     lines = []
     todo = ["ideal", "fixedpoint", "sweep", "contact"] if what == "all" else [what]
+    unknown = [n for n in todo if n not in BENCHMARKS]
+    if unknown:
+        raise ValueError(f"bench: unknown benchmark {unknown[0]!r} "
+                         f"({' | '.join(BENCHMARKS)} | all)")
+    out.mkdir(parents=True, exist_ok=True)
     for name in todo:
         if name == "ideal":
             res = bench_ideal()

@@ -80,10 +80,6 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
     ``extra_key`` enters the input hash; an artifact written with one of the ``also_accept``
     keys (a superset of what is asked for) counts as up to date too.
     """
-    from walkerlab.io.runpaths import model_cache_dir
-    from walkerlab.models.cache import set_cache_dir
-
-    set_cache_dir(model_cache_dir(runs_root))  # generated model code lives in runs/
     path = stage_artifact(scene, runs_root, stage, claim=True)
     # one writer per artifact: a second identical run waits, then finds the result up to date
     with artifact_lock(path, wait=True, on_wait=_tell):

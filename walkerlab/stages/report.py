@@ -196,8 +196,9 @@ def _draw(scene: Scene, runs_root, force: bool, part: str) -> str:
     if not force and stamp.is_file() and stamp.read_text() == key:
         return f"{'plot':>13s}: {part} figures reused (artifacts and code unchanged)"
     figs = plot.run(scene, runs_root, parts=(part,))
-    stamp.parent.mkdir(parents=True, exist_ok=True)
-    stamp.write_text(key)
+    from walkerlab.io.runpaths import atomic_text
+
+    atomic_text(stamp, key)  # atomic, never through a symbolic link
     return f"{'plot':>13s}: {part}, {len([p for p in figs if p.suffix == '.png'])} figures"
 
 

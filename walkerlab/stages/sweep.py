@@ -93,10 +93,6 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     # too large to run are left to run_sweep's refusal)
     check_axes(scene, axes, values=math.prod(len(a) for a in axes) <= MAX_GRID_POINTS)
     out = sweep_path(scene, axes, stage, runs_root, name, claim=True)
-    from walkerlab.io.runpaths import model_cache_dir
-    from walkerlab.models.cache import set_cache_dir
-
-    set_cache_dir(model_cache_dir(runs_root))  # before workers start: they inherit it
     return run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
                      resume=resume, options=options, chunk_size=chunk_size, progress=progress,
                      on_chunk=on_chunk, pool=pool)

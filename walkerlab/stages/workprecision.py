@@ -41,6 +41,7 @@ from walkerlab.analysis.workprecision import (
 )
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import put
+from walkerlab.io.runpaths import run_cache_dir
 from walkerlab.stages import fixedpoint as fixedpoint_stage
 from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
 
@@ -148,7 +149,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         Explicit cores/gates for the measuring processes (see
         :func:`walkerlab.analysis.workprecision.run_cases`).
     """
-    from walkerlab.stages.common import artifact_path as _ap
 
     wp = require(scene, "workprecision", "workprecision")
     fixedpoint_stage.run(scene, runs_root)
@@ -159,7 +159,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         x0t = tuple(float(v) for v in x0)
         sj = json.dumps(scene.model_dump(mode="json"), sort_keys=True)
         period = float(meta["step_period_s"])
-        cache = _ap(scene, runs_root, "workprecision").parent / ".cache" / "workprecision"
+        cache = run_cache_dir(scene, runs_root, "workprecision")
         if force and cache.is_dir():
             for f in cache.glob("*.json"):
                 f.unlink()

@@ -376,7 +376,9 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     else:
         slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]))  # validate axes
     nx, ny = xs.size, ys.size
-    part = _partial(Path(out_path))
+    from walkerlab.io.runpaths import refuse_link
+
+    part = refuse_link(_partial(Path(out_path)))  # never written through a link
     part.parent.mkdir(parents=True, exist_ok=True)
     arrays = None
     if resume and part.is_file():
@@ -401,7 +403,8 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     total, done = nx * ny, int(np.sum(arrays["outcome"] != NOT_DONE))
     t0 = time.perf_counter()
     computed = 0
-    with h5py.File(part, "w") as f:
+    part.unlink(missing_ok=True)
+    with h5py.File(part, "x") as f:  # created exclusively (O_EXCL: no link followed)
         f.attrs["input_hash"] = key
         dsets = {k: f.create_dataset(k, data=v) for k, v in arrays.items()}
         f.flush()

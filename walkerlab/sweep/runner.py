@@ -31,7 +31,8 @@ Progress and robustness (issue 12)
   (one HDF5 append of every column costs the main process ~25 ms of CPU, taken from the
   workers on a 2-core machine), and on an interruption.
 - Local pool workers watch the main process and exit within about a second when it dies,
-  even by SIGKILL (D7); the forkserver and resource tracker then exit on their own.
+  even by SIGKILL (D7); the forkserver and resource tracker then exit on their own (one
+  mechanism for every pool of walkerlab: :mod:`walkerlab.workers`).
 - The grid is capped at :data:`MAX_GRID_POINTS` points (product of the axes, D3).
 - One sweep per artifact at a time: a second identical sweep fails with one line (D4), and
   an artifact is finalized only when every grid point has its row.
@@ -42,13 +43,9 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import multiprocessing as mp
-import os
-import sys
-import threading
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, as_completed, wait
+from concurrent.futures import FIRST_COMPLETED, as_completed, wait
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -62,6 +59,7 @@ from walkerlab.sweep.outcomes import OUTCOMES, STAGES
 from walkerlab.sweep.params import ParamAxis, SweepError, grid_points
 from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, evaluate, run_chunk, warm_up
 from walkerlab.sweep.store import SweepStore, complete_sweep, partial_path
+from walkerlab.workers import mp_context, process_alive, process_pool
 
 __all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "iter_piece_results",
            "run_piece", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
@@ -167,31 +165,12 @@ def sweep_input_hash(scene: Scene, stage: str, axes: list[ParamAxis], options: d
     return h.hexdigest()
 
 
-def _process_alive(pid: int) -> bool:
-    """True while process ``pid`` exists and is not a zombie (Linux: /proc state 'Z')."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return True
+# one parent watch and one process-start method for every pool (walkerlab.workers)
+_process_alive = process_alive
 
 
-def _watch_parent(pid: int, period_s: float) -> None:
-    while _process_alive(pid):
-        time.sleep(period_s)
-    os._exit(1)  # the main process is gone: nobody will read our result
-
-
-def _worker_init(parent_pid: int, period_s: float = 0.5) -> None:
-    """Pool worker start-up: warm the model functions and watch the main process."""
-    threading.Thread(target=_watch_parent, args=(parent_pid, period_s), daemon=True,
-                     name="walkerlab-parent-watch").start()
+def _worker_init() -> None:
+    """Pool worker start-up (after its parent watch started): warm the model functions."""
     warm_up()
 
 
@@ -263,8 +242,7 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
                 rows, guess = run_piece(t, guess)
                 yield rows
         return
-    ex = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=_mp_context(),
-                             initializer=_worker_init, initargs=(os.getpid(),))
+    ex = process_pool(workers, _mp_context(), _worker_init)
     try:
         pending = {}
         for ci, chain in enumerate(chains):
@@ -282,11 +260,7 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
 
 
 def _mp_context():
-    if sys.platform.startswith("linux"):
-        ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["walkerlab.sweep._preload"])
-        return ctx
-    return mp.get_context("spawn")
+    return mp_context(preload=("walkerlab.sweep._preload",))
 
 
 def iter_chunk_results(tasks: list[Task], workers: int = 2, scheduler=None,
@@ -321,8 +295,7 @@ def iter_chunk_results(tasks: list[Task], workers: int = 2, scheduler=None,
         for t in tasks:
             yield fn(t)
         return
-    ex = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=_mp_context(),
-                             initializer=_worker_init, initargs=(os.getpid(),))
+    ex = process_pool(workers, _mp_context(), _worker_init)
     try:
         futs = [ex.submit(fn, t) for t in tasks]
         for fut in as_completed(futs):
@@ -395,8 +368,9 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
                          f"({' x '.join(str(len(a)) for a in axes)}); at most "
                          f"{MAX_GRID_POINTS:,} are allowed")
     opts = {**DEFAULT_OPTIONS, **(options or {})}
-    out_path = Path(out_path)
-    from walkerlab.io.runpaths import artifact_lock
+    from walkerlab.io.runpaths import artifact_lock, refuse_link
+
+    out_path = refuse_link(Path(out_path))  # the artifact is never written through a link
 
     with artifact_lock(out_path, wait=False):
         return _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts,

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -190,7 +189,8 @@ def gait_map(scene, spec: MapSpec, workers: int = 2,
         Base scene (needs ``contact`` and ``fixedpoint``).
     spec : MapSpec
     workers : int
-        Worker processes (1 = in this process).
+        Worker processes (1 = in this process; more: :func:`walkerlab.workers.process_pool`,
+        ended within about a second when this process dies).
     progress : callable, optional
         ``progress(rows_done, rows_total)``.
 
@@ -209,16 +209,23 @@ def gait_map(scene, spec: MapSpec, workers: int = 2,
             if progress:
                 progress(iy + 1, ny)
     else:
-        with ProcessPoolExecutor(max_workers=workers) as ex:
+        from concurrent.futures import as_completed
+
+        from walkerlab.workers import process_pool
+
+        # workers that end with this process (SIGKILL, SIGTERM included) and do not inherit
+        # its open files (the artifact lock): walkerlab.workers
+        ex = process_pool(workers)
+        try:
             futs = {ex.submit(gait_row, base, spec, iy): iy for iy in range(ny)}
             done = 0
-            from concurrent.futures import as_completed
-
             for fut in as_completed(futs):
                 rows[futs[fut]] = fut.result()
                 done += 1
                 if progress:
                     progress(done, ny)
+        finally:
+            ex.shutdown(wait=True, cancel_futures=True)
     out = {"y_values": np.asarray(spec.y_values, float),
            "slopes_deg": np.asarray(spec.slopes_deg, float)}
     for f in CELL_FIELDS:

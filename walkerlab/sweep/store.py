@@ -70,8 +70,8 @@ class SweepStore:
         part = partial_path(final)
         try:
             final.parent.mkdir(parents=True, exist_ok=True)
-            part.unlink(missing_ok=True)
-            f = h5py.File(part, "w")
+            part.unlink(missing_ok=True)  # a link in its place is removed, not followed
+            f = h5py.File(part, "x")  # created exclusively (O_EXCL)
         except OSError as exc:
             reason = exc.strerror or str(exc).rpartition("error message = ")[2].strip("' )")
             raise ArtifactError(f"{part}: cannot create the sweep file ({reason})") from None
@@ -122,7 +122,9 @@ class SweepStore:
             Unreadable partial file, or one written for another sweep (other scene,
             parameters, stage, options or code).
         """
-        part = partial_path(final)
+        from walkerlab.io.runpaths import refuse_link
+
+        part = refuse_link(partial_path(final))  # never written through a link
         try:
             f = h5py.File(part, "a")
         except OSError:

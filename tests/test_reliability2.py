@@ -1,0 +1,487 @@
+"""Issue 19 (reliability, round two), items 1, 2, 3, 7, 10 and 14.
+
+Each test names its item (``i1`` ... ``i14``) and fails on the code before the fix
+(commit 5a8281f).  Processes are checked by behaviour bounds only ("gone within 10 s"),
+never by timings.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import signal
+import stat
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from walkerlab.cli import _one_line, app
+from walkerlab.config import scene_from_dict
+from walkerlab.io import runpaths
+from walkerlab.io.artifacts import ArtifactError, atomic_write, write_artifact
+from walkerlab.io.runpaths import RunPathError, artifact_lock
+from walkerlab.stages import common
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+IDEAL = {k: v for k, v in PAPER.items() if k in ("walker", "slope", "solver", "fixedpoint",
+                                                  "simulate")}
+ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
+
+
+def _cli(*args, env=None):
+    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+def _fake_compute(value: float):
+    def compute():
+        return (lambda f: f.create_dataset("x", data=np.array([value]))), {}
+    return compute
+
+
+def _descendants(pid: int) -> list[int]:
+    out = subprocess.run(["ps", "-e", "-o", "pid=,ppid="], capture_output=True,
+                         text=True).stdout
+    kids: dict[int, list[int]] = {}
+    for ln in out.splitlines():
+        a, b = map(int, ln.split())
+        kids.setdefault(b, []).append(a)
+    res, todo = [], [pid]
+    while todo:
+        for c in kids.get(todo.pop(), []):
+            res.append(c)
+            todo.append(c)
+    return res
+
+
+def _alive(pid: int) -> bool:
+    """Process ``pid`` exists and is not a zombie."""
+    try:
+        os.kill(pid, 0)
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (ProcessLookupError, FileNotFoundError):
+        return False
+
+
+def _kill_and_check_orphans(main: subprocess.Popen, want: int, sig: int,
+                            ready_s: float = 60) -> list[int]:
+    """Wait until ``main`` has ``want`` descendants (or ``ready_s``), send ``sig``; return
+    the descendants still alive 10 s later (they are then killed)."""
+    kids: list[int] = []
+    try:
+        deadline = time.monotonic() + ready_s
+        while time.monotonic() < deadline and len(kids) < want:
+            time.sleep(0.05)
+            kids = _descendants(main.pid)
+        time.sleep(1.0)
+        kids = _descendants(main.pid)
+        assert kids
+    finally:
+        main.send_signal(sig)
+        main.wait()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and any(_alive(k) for k in kids):
+        time.sleep(0.1)
+    alive = [k for k in kids if _alive(k)]
+    for k in alive:
+        os.kill(k, signal.SIGKILL)
+    return alive
+
+
+# ------------------------------------------------------------------ 1: worker lifecycle
+def test_i1_stability_map_workers_end_with_their_parent_and_free_the_lock(tmp_path):
+    """SIGKILL here, SIGTERM for the work-precision lane below: the same watch ends both."""
+    sig = signal.SIGKILL
+    script = textwrap.dedent(f"""
+        from walkerlab.config import load_scene
+        from walkerlab.stages import stability_map
+        sc = load_scene({str(ROOT / 'configs' / 'paper.yaml')!r})
+        stability_map.run(sc, {str(tmp_path)!r}, kind="friction", n=3, workers=2,
+                          time_limit_s=30)
+        """)
+    main = subprocess.Popen([sys.executable, "-c", script], env=ENV)
+    artifact = tmp_path / "paper" / "stability_map_friction.h5"
+    # 2 workers, forkserver and resource tracker (a forked pool has only the 2 workers)
+    alive = _kill_and_check_orphans(main, 4, sig, ready_s=20)
+    assert not alive, f"workers alive 10 s after {signal.Signals(sig).name} of their parent"
+    with artifact_lock(artifact, wait=False):  # a rerun is not kept waiting
+        pass
+
+
+def test_i1_work_precision_lane_worker_ends_with_its_parent():
+    script = textwrap.dedent("""
+        import time
+        from walkerlab.analysis.workprecision import start_worker
+        ex = start_worker(0)
+        ex.submit(time.sleep, 120)
+        time.sleep(120)
+        """)
+    main = subprocess.Popen([sys.executable, "-c", script], env=ENV)
+    alive = _kill_and_check_orphans(main, 2, signal.SIGTERM)  # worker + resource tracker
+    assert not alive, "spawned lane worker (or its resource tracker) outlived its parent"
+
+
+def test_i1_lock_kept_by_a_dead_holders_child_is_taken_over(tmp_path):
+    """The holder records its pid, forks a child that keeps the lock file open and is
+    killed: the lock is taken over at once, not waited on."""
+    target = tmp_path / "a.h5"
+    holder = subprocess.Popen([sys.executable, "-c", textwrap.dedent(f"""
+        import os, time
+        from pathlib import Path
+        from walkerlab.io.runpaths import artifact_lock
+        with artifact_lock(Path({str(target)!r})):
+            if os.fork() == 0:
+                time.sleep(60); os._exit(0)
+            print('locked', flush=True); time.sleep(60)
+        """)], stdout=subprocess.PIPE, text=True, env=ENV)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        child = [k for k in _descendants(holder.pid)]
+        holder.kill()
+        holder.wait()
+        with artifact_lock(target, wait=False):  # before: ArtifactBusy (pid of the dead)
+            assert (tmp_path / ".a.h5.lock").read_text().split()[0] == str(os.getpid())
+    finally:
+        holder.stdout.close()
+        for k in child:
+            if _alive(k):
+                os.kill(k, signal.SIGKILL)
+    assert not (tmp_path / ".a.h5.lock").exists()  # removed on release
+
+
+def test_i1_lock_of_a_live_holder_is_not_taken_over(tmp_path):
+    target = tmp_path / "a.h5"
+    holder = subprocess.Popen([sys.executable, "-c", textwrap.dedent(f"""
+        import time
+        from pathlib import Path
+        from walkerlab.io.runpaths import artifact_lock
+        with artifact_lock(Path({str(target)!r})):
+            print('locked', flush=True); time.sleep(60)
+        """)], stdout=subprocess.PIPE, text=True, env=ENV)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        with pytest.raises(runpaths.ArtifactBusy, match=f"pid {holder.pid}"):
+            with artifact_lock(target, wait=False):
+                pass
+    finally:
+        holder.kill()
+        holder.wait()
+        holder.stdout.close()
+
+
+@pytest.mark.parametrize("host,taken_over", [("this", True), ("elsewhere.example", False)])
+def test_i1_only_a_dead_holder_of_this_host_is_taken_over(tmp_path, host, taken_over):
+    """A pid recorded by another machine sharing the folder cannot be checked here: its
+    lock is waited on, never taken over."""
+    import socket
+
+    target = tmp_path / "a.h5"
+    holder = subprocess.Popen([sys.executable, "-c", textwrap.dedent(f"""
+        import time
+        from pathlib import Path
+        from walkerlab.io.runpaths import artifact_lock
+        with artifact_lock(Path({str(target)!r})):
+            print('locked', flush=True); time.sleep(60)
+        """)], stdout=subprocess.PIPE, text=True, env=ENV)
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        name = socket.gethostname() if host == "this" else host
+        (tmp_path / ".a.h5.lock").write_text(f"{gone.pid} {name}\n")  # a dead pid
+        if taken_over:
+            with artifact_lock(target, wait=False):
+                pass
+        else:
+            with pytest.raises(runpaths.ArtifactBusy):
+                with artifact_lock(target, wait=False):
+                    pass
+    finally:
+        holder.kill()
+        holder.wait()
+        holder.stdout.close()
+
+
+# ------------------------------------------------------------------ 2: the user cache
+def _simple_structure():
+    from walkerlab.models.description import BodySpec, Structure
+
+    return Structure("absolute", (BodySpec("mass", "point_mass"),))
+
+
+@pytest.fixture
+def user_cache(tmp_path, monkeypatch):
+    from walkerlab.models import cache
+
+    monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path / "uc"))
+    cache.clear_memo()
+    yield tmp_path / "uc"
+    cache.clear_memo()
+
+
+def test_i2_generated_code_lives_in_a_private_user_cache(user_cache, tmp_path):
+    from walkerlab.models import cache
+
+    cache.generated_module(_simple_structure())
+    folder = user_cache / "models"
+    files = list(folder.glob("*.py"))
+    assert len(files) == 1
+    assert stat.S_IMODE(folder.stat().st_mode) == 0o700
+    assert stat.S_IMODE(files[0].stat().st_mode) == 0o600
+
+
+@pytest.mark.parametrize("how", ["group_writable", "other_owner", "symlink"])
+def test_i2_untrusted_cache_file_is_regenerated_never_executed(user_cache, tmp_path, how):
+    import hashlib
+
+    from walkerlab.models import cache
+
+    s = _simple_structure()
+    cache.generated_module(s)
+    path = next((user_cache / "models").glob("*.py"))
+    good = path.read_text()
+    flag = tmp_path / "EXECUTED"
+    body = f"open({str(flag)!r}, 'w').write('x')\n" + good.split("\n", 1)[1]
+    evil = f"# sha256 {hashlib.sha256(body.encode()).hexdigest()}\n{body}"  # self-checksum
+    if how == "symlink":
+        other = tmp_path / "evil.py"
+        other.write_text(evil)
+        path.unlink()
+        path.symlink_to(other)
+    else:
+        path.write_text(evil)
+        if how == "group_writable":
+            os.chmod(path, 0o664)
+        else:
+            if os.geteuid() != 0:
+                pytest.skip("changing a file's owner needs root")
+            os.chown(path, 12345, -1)
+    cache.clear_memo()
+    cache.generated_module(s)
+    assert not flag.exists(), "code from an untrusted cache file was executed"
+    assert not path.is_symlink() and path.read_text() == good  # regenerated
+    assert stat.S_IMODE(path.stat().st_mode) == 0o600 and path.stat().st_uid == os.geteuid()
+
+
+def test_i2_nothing_from_a_runs_folder_is_executed(user_cache, tmp_path):
+    """A runs folder unpacked from someone else carries ``.cache/models``: never read."""
+    from walkerlab.models import cache
+
+    s = _simple_structure()
+    key = cache.cache_key(s)
+    flag = tmp_path / "EXECUTED"
+    planted = tmp_path / "runs" / ".cache" / "models" / f"{key}.py"
+    planted.parent.mkdir(parents=True)
+    body = f"open({str(flag)!r}, 'w').write('x')\ndef make(p):\n    return {{}}\n"
+    import hashlib
+
+    planted.write_text(f"# sha256 {hashlib.sha256(body.encode()).hexdigest()}\n{body}")
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    common.run_cached("fixedpoint", sc, tmp_path / "runs", ("walker",), (), _fake_compute(1.0))
+    cache.generated_module(s)
+    assert not flag.exists()
+
+
+def test_i14_numba_cache_is_written_to_the_user_cache(tmp_path):
+    env = {k: v for k, v in ENV.items() if k != "NUMBA_CACHE_DIR"}
+    env["WALKERLAB_CACHE_DIR"] = str(tmp_path / "uc")
+    out = subprocess.run([sys.executable, "-c", textwrap.dedent("""
+        import os
+        from walkerlab.contact import _kernels as K
+        K.friction_mu(0.1, 0.9, 0.7, 0.01, 0.02)
+        print(os.environ.get("NUMBA_CACHE_DIR"))
+        """)], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == str(tmp_path / "uc" / "numba")
+    assert list((tmp_path / "uc" / "numba").rglob("*.nbi")), "numba cached nothing there"
+
+
+# ------------------------------------------------------------------ 3: symbolic links
+def test_i3_lock_file_symlink_is_refused_and_its_target_untouched(tmp_path):
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    runs = tmp_path / "runs"
+    (runs / "paper").mkdir(parents=True)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    (runs / "paper" / ".fixedpoint.h5.lock").symlink_to(victim)
+    with pytest.raises(RunPathError, match="symbolic link"):
+        common.run_cached("fixedpoint", sc, runs, ("walker",), (), _fake_compute(1.0))
+    assert victim.read_text() == "precious\n"
+
+
+@pytest.mark.parametrize("name", ["fixedpoint.h5", "report.md", "basin.h5.partial"])
+def test_i3_writers_refuse_a_symlink_in_place(tmp_path, name):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    link = tmp_path / "paper" / name
+    link.parent.mkdir()
+    link.symlink_to(victim)
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    with pytest.raises(RunPathError, match="symbolic link"):
+        if name.endswith(".partial"):
+            from walkerlab.sweep import basin
+
+            monkey_fp = np.zeros(4)
+            basin.compute_basin(sc, monkey_fp, "k", link.with_name("basin.h5"), grid=(2, 2),
+                                workers=1)
+        elif name.endswith(".h5"):
+            write_artifact(link, "fixedpoint", sc, "k", lambda f: None, 0.0)
+        else:
+            atomic_write(link, lambda fh: fh.write(b"x"))
+    assert victim.read_text() == "precious\n" and link.is_symlink()
+
+
+def test_i3_basin_partial_symlink_is_one_line_error(tmp_path):
+    runs = tmp_path / "runs"
+    (runs / "paper").mkdir(parents=True)
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious\n")
+    (runs / "paper" / "basin.h5.partial").symlink_to(victim)
+    code, err, _ = _cli("basin", ROOT / "configs" / "paper.yaml", "--grid", "2x2",
+                        "--workers", "1", "--runs-dir", runs)
+    assert code == 1 and "symbolic link" in err and "\n" not in err, err
+    assert victim.read_text() == "precious\n"
+
+
+def test_i3_report_folder_symlink_leaving_runs_is_refused(tmp_path):
+    runs = tmp_path / "runs"
+    (runs / "paper").mkdir(parents=True)
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (runs / "paper" / "report").symlink_to(outside)
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    for fn in (runpaths.report_dir, runpaths.figures_dir):
+        with pytest.raises(RunPathError, match="outside the runs folder"):
+            fn(sc, runs, claim=True)
+    assert not any(outside.iterdir())
+
+
+# ------------------------------------------------------------------ 7: disk full
+def _limited(script: str, limit_bytes: int, cwd: Path, env=None) -> subprocess.CompletedProcess:
+    pre = (f"import resource\nresource.setrlimit(resource.RLIMIT_FSIZE, "
+           f"({limit_bytes}, {limit_bytes}))\n")
+    return subprocess.run([sys.executable, "-c", pre + textwrap.dedent(script)], cwd=cwd,
+                          env={**ENV, **(env or {})}, capture_output=True, text=True,
+                          timeout=300)
+
+
+def test_i7_full_disk_is_one_line_and_keeps_the_old_artifact(tmp_path):
+    scene = tmp_path / "paper.yaml"
+    scene.write_text(yaml.safe_dump(IDEAL))
+    code, err, _ = _cli("simulate", scene, "--strides", "1", "--runs-dir", tmp_path / "runs")
+    assert code == 0, err
+    old = (tmp_path / "runs" / "paper" / "simulate.h5").read_bytes()
+    assert len(old) < 200_000
+    # a file-size limit of 200 kB: the 40-stride artifact does not fit
+    r = _limited(f"""
+        import sys
+        from walkerlab.cli import app
+        sys.argv = ["walkerlab", "simulate", {str(scene)!r}, "--strides", "40",
+                    "--runs-dir", {str(tmp_path / 'runs')!r}]
+        app()
+        """, 200_000, tmp_path)
+    err = r.stderr.strip()
+    assert r.returncode == 1 and err.startswith("error: disk full") and "\n" not in err, err
+    assert (tmp_path / "runs" / "paper" / "simulate.h5").read_bytes() == old
+    assert not [p for p in (tmp_path / "runs").rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_i7_cache_write_on_a_full_disk_leaves_nothing(tmp_path):
+    r = _limited("""
+        from walkerlab.models import cache
+        from walkerlab.models.description import BodySpec, Structure
+        ns = cache.generated_module(Structure("absolute", (BodySpec("mass", "point_mass"),)))
+        assert callable(ns["make"])  # the code is still usable (kept in memory)
+        """, 2048, tmp_path, env={"WALKERLAB_CACHE_DIR": str(tmp_path / "uc")})
+    assert r.returncode == 0, r.stderr
+    assert not [p for p in (tmp_path / "uc").rglob("*") if p.is_file()]
+
+
+def test_i7_disk_full_errors_map_to_one_line(tmp_path):
+    def boom(fh):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    (tmp_path / "x.json").write_text("old")
+    with pytest.raises(ArtifactError, match="^disk full: cannot write .*x.json"):
+        atomic_write(tmp_path / "x.json", boom)
+    assert (tmp_path / "x.json").read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["x.json"]
+
+
+# ------------------------------------------------------------------ 10: damaged cache entry
+@pytest.mark.parametrize("damage", ["{}", "[]", "not json",
+                                    '{"vec": null, "nfev": 3, "times": [], "cpu_times": []}',
+                                    '{"vec": ["a"], "nfev": 3, "times": [0.1], '
+                                    '"cpu_times": [0.1]}'])
+def test_i10_damaged_work_precision_case_is_measured_again(tmp_path, monkeypatch, damage):
+    from walkerlab.analysis import workprecision as W
+
+    good = {"vec": [1.0, 2.0], "nfev": 10, "times": [0.01], "cpu_times": [0.01]}
+    monkeypatch.setattr(W, "_run_case", lambda t: (t.key, dict(good)))
+    case = W.Case("k1", "ideal", "{}", 1.0, (0.0,), 1, "RK45", 1e-3, 1e-6, 1, ())
+    (tmp_path / "k1.json").write_text(damage)
+    out = W.run_cases([case], tmp_path, workers=1)
+    assert out["k1"]["cached"] is False and out["k1"]["vec"] == good["vec"]
+    assert W.read_cached_case(tmp_path / "k1.json")["vec"] == good["vec"]  # repaired
+    assert W.run_cases([case], tmp_path, workers=1)["k1"]["cached"] is True
+
+
+# ------------------------------------------------------------------ 14: messages
+def test_i14_one_line_keeps_a_wrapped_sentence_and_cuts_at_a_boundary():
+    short = _one_line("the error is larger than allowed, as measured by the\nreference run.")
+    assert short == "the error is larger than allowed, as measured by the reference run."
+    long = _one_line("first field: bad value. " + "second sentence goes on " * 30 + "end.")
+    assert long.startswith("first field: bad value.") and "WALKERLAB_DEBUG=1" in long
+    assert "\n" not in long and len(long) < 400
+    assert "more lines" not in long
+
+
+@pytest.mark.parametrize("value,traceback", [("false", False), ("0", False), ("no", False),
+                                             ("", False), ("1", True), ("true", True),
+                                             ("YES", True)])
+def test_i14_debug_switch_accepts_1_true_yes_only(tmp_path, value, traceback):
+    r = CliRunner().invoke(app, ["fixedpoint", str(tmp_path / "missing.yaml")],
+                           env={"WALKERLAB_DEBUG": value})
+    assert r.exit_code == 1
+    assert (r.exception is not None and not isinstance(r.exception, SystemExit)) == traceback
+    if not traceback:
+        assert r.stderr.strip().startswith("error: ") and "scene file not found" in r.stderr
+
+
+def test_i14_empty_runs_dir_is_refused(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, err, _ = _cli("fixedpoint", ROOT / "configs" / "paper.yaml", "--runs-dir", "")
+    assert code == 2 and "empty folder name" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_i14_report_markdown_escapes_the_scene_source():
+    from walkerlab.report.build import _header
+    from walkerlab.report.markdown import to_html
+
+    sc = scene_from_dict({**IDEAL, "name": "x", "source": "Smith <script>alert(1)</script>\n& co"})
+    md = "\n".join(_header(sc))
+    assert "<script>" not in md and "&lt;script&gt;alert(1)&lt;/script&gt; &amp; co" in md
+    html = to_html(md, Path("."))
+    assert "<script>" not in html and "&lt;script&gt;" in html and "&amp;lt;" not in html
+
+
+def test_i14_device_as_scene_is_not_a_regular_file():
+    code, err, _ = _cli("fixedpoint", "/dev/zero")
+    assert code == 1 and err == "error: /dev/zero: not a regular file; give a YAML scene file"
+
+
+def test_i14_bench_out_naming_a_file_says_what_to_do(tmp_path):
+    f = tmp_path / "FILE"
+    f.write_text("keep")
+    code, err, _ = _cli("bench", "ideal", "--out", f)
+    assert code == 1 and "is a file; --out names a folder" in err and "\n" not in err
+    assert f.read_text() == "keep"

@@ -1,0 +1,105 @@
+"""Worker processes that never outlive the process that started them (one place, every pool).
+
+Every local process pool of walkerlab (sweeps and basin maps: :mod:`walkerlab.sweep.runner`;
+stability maps: :mod:`walkerlab.sweep.stability`; the work-precision study's pinned lanes:
+:mod:`walkerlab.analysis.workprecision`) is built by :func:`process_pool`:
+
+- workers are started by ``forkserver`` (Linux) or ``spawn``, never by ``fork``: a forked
+  worker would inherit the parent's open files, among them the artifact lock (it then held
+  the lock after the parent died, issue 19);
+- each worker runs :func:`watch_parent` first: a daemon thread that checks every
+  :data:`WATCH_PERIOD_S` whether the process that built the pool still exists and ends the
+  worker (``os._exit``) when it does not - after SIGKILL or SIGTERM of the parent as well as
+  after a crash.  The forkserver and multiprocessing's resource tracker end on their own once
+  the parent and the workers are gone (their pipes close);
+- :func:`process_alive` (pid exists and is not a zombie) is also what the artifact lock uses
+  to take over a lock whose recorded holder is dead (:func:`walkerlab.io.runpaths.artifact_lock`).
+
+Importing this module loads nothing heavy.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import sys
+import threading
+import time
+from collections.abc import Callable
+
+__all__ = ["process_alive", "watch_parent", "mp_context", "process_pool", "WATCH_PERIOD_S"]
+
+#: how often a worker checks that its parent is alive [s]
+WATCH_PERIOD_S = 0.5
+
+
+def process_alive(pid: int) -> bool:
+    """True while process ``pid`` exists and is not a zombie (Linux: /proc state 'Z')."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return True
+
+
+def _watch(pid: int, period_s: float) -> None:
+    while process_alive(pid):
+        time.sleep(period_s)
+    os._exit(1)  # the parent is gone: nobody will read our result
+
+
+def watch_parent(parent_pid: int, period_s: float = WATCH_PERIOD_S) -> None:
+    """Start the daemon thread that ends this process once ``parent_pid`` is gone."""
+    threading.Thread(target=_watch, args=(parent_pid, period_s), daemon=True,
+                     name="walkerlab-parent-watch").start()
+
+
+def _init(parent_pid: int, period_s: float, initializer: Callable | None,
+          initargs: tuple) -> None:
+    watch_parent(parent_pid, period_s)
+    if initializer is not None:
+        initializer(*initargs)
+
+
+def mp_context(method: str | None = None, preload: tuple[str, ...] = ()):
+    """The multiprocessing context of walkerlab's pools: ``forkserver`` on Linux (with the
+    modules ``preload`` imported once in the server), else ``spawn``; ``method`` forces one
+    (``"spawn"``).  Never ``fork`` (see the module docstring)."""
+    if method is None:
+        method = "forkserver" if sys.platform.startswith("linux") else "spawn"
+    if method == "fork":
+        raise ValueError("walkerlab pools do not fork (a forked worker inherits open locks)")
+    ctx = mp.get_context(method)
+    if method == "forkserver" and preload:
+        ctx.set_forkserver_preload(list(preload))
+    return ctx
+
+
+def process_pool(workers: int, context=None, initializer: Callable | None = None,
+                 initargs: tuple = (), period_s: float = WATCH_PERIOD_S):
+    """A ``ProcessPoolExecutor`` whose workers watch this process (see the module docstring).
+
+    Parameters
+    ----------
+    workers : int
+        Worker processes (at least 1).
+    context : multiprocessing context, optional
+        Default :func:`mp_context`.
+    initializer, initargs
+        Run in each worker after its watch has started (a top-level, picklable function).
+    period_s : float
+        Watch period [s].
+    """
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(max_workers=max(1, int(workers)),
+                               mp_context=context or mp_context(), initializer=_init,
+                               initargs=(os.getpid(), period_s, initializer, tuple(initargs)))
