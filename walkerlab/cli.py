@@ -6,6 +6,8 @@ Errors and exit codes
 ---------------------
 A traceback shown to a user is a bug.  Every command runs inside :func:`_guard`:
 
+- a scene that does not validate: every error on its own line ``error: <file>: <field>:
+  <message>``, unknown keys first (with the closest field name), exit code 1;
 - bad input (scene, names, paths, artifacts, a busy artifact, a read-only runs folder) and
   a walker that falls (``simulate``, ``contact-sim``): one line ``error: ...`` on stderr,
   exit code 1;
@@ -82,7 +84,13 @@ def _guard(fn):
         except KeyboardInterrupt:
             typer.echo("interrupted", err=True)
             raise typer.Exit(code=130) from None
-        except (SceneError, ArtifactError, ArtifactBusy, StageError, FixedPointNotFound,
+        except SceneError as exc:  # every config error, one line each
+            if debug:
+                raise
+            for line in str(exc).splitlines() or [""]:
+                typer.echo(f"error: {line.strip()}", err=True)
+            raise typer.Exit(code=1) from None
+        except (ArtifactError, ArtifactBusy, StageError, FixedPointNotFound,
                 ValueError) as exc:
             if debug:
                 raise

@@ -15,7 +15,8 @@ Every output of walkerlab lies inside the runs folder (``--runs-dir``, default `
   scene was moved or renamed), the folder passes to the new file.  Scenes built in code
   (sweeps, tests) have no file and are not checked;
 - :func:`artifact_lock` serialises writers of one artifact across processes (``flock``;
-  released by the kernel when a process dies, even by SIGKILL).
+  released by the kernel when a process dies, even by SIGKILL); the holder removes the lock
+  file when it lets go, so none stays behind (one left by a killed process is reused).
 
 Raises
 ------
@@ -209,25 +210,53 @@ def artifact_lock(path: Path, wait: bool = True,
         yield
         return
     lock = path.with_name(f".{path.name}.lock")
-    try:
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
-    except OSError as exc:
-        raise RunPathError(f"{path.parent}: cannot write the run folder ({exc.strerror})") \
-            from None
-    try:
+    told = False
+    while True:
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
-            msg = f"{path}: another walkerlab process (pid {holder}) is writing it"
-            if not wait:
-                raise ArtifactBusy(f"{msg}; wait for it to finish (or stop it) and rerun") \
-                    from None
-            if on_wait is not None:
-                on_wait(f"{msg}; waiting")
-            fcntl.flock(fd, fcntl.LOCK_EX)
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise RunPathError(f"{path.parent}: cannot write the run folder ({exc.strerror})") \
+                from None
+        try:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
+                msg = f"{path}: another walkerlab process (pid {holder}) is writing it"
+                if not wait:
+                    raise ArtifactBusy(f"{msg}; wait for it to finish (or stop it) and rerun") \
+                        from None
+                if on_wait is not None and not told:
+                    on_wait(f"{msg}; waiting")
+                    told = True
+                fcntl.flock(fd, fcntl.LOCK_EX)
+            if _same_file(fd, lock):
+                break
+        except BaseException:
+            os.close(fd)
+            raise
+        # the holder removed this lock file on release (see below): lock the current one
+        os.close(fd)
+    try:
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
         yield
     finally:
+        # the holder removes the lock file, with the lock held, so no lock file stays behind
+        # in runs/; a waiter that then gets the lock on the removed file sees that it is no
+        # longer the file at that name (_same_file) and locks the new one instead
+        try:
+            os.unlink(lock)
+        except OSError:
+            pass
         os.close(fd)
+
+
+def _same_file(fd: int, path: Path) -> bool:
+    """Whether the open file ``fd`` is still the file named ``path`` (not removed/replaced)."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return False
+    own = os.fstat(fd)
+    return (st.st_dev, st.st_ino) == (own.st_dev, own.st_ino)
