@@ -159,7 +159,7 @@ def _main(version: bool = typer.Option(False, "--version", callback=_version_cal
 
 
 def _status(o) -> str:
-    return (f"reused {o.path} (inputs unchanged)" if o.reused
+    return (f"reused {o.path} ({o.note or 'inputs unchanged'})" if o.reused
             else f"wrote {o.path} (compute {o.wall_time_s:.3f} s)")
 
 
