@@ -43,7 +43,8 @@ __all__ = ["load_dataset", "load_fixed_points", "xarray"]
 
 #: dimensions that mean the same thing in every group of an artifact
 SHARED_DIMS = frozenset({"time", "step", "state", "state_in", "contact_state", "rate",
-                         "multiplier", "x", "y", "point", "outcome", "stiffness", "heel_strike"})
+                         "multiplier", "x", "y", "point", "outcome_kind", "stiffness",
+                         "heel_strike"})
 #: group-path prefixes shortened in variable names (first match wins)
 _SHORT = (("samples/coordinates/", ""), ("samples/points/", ""), ("samples/", ""),
           ("errors/coordinates/", "error_"), ("grid/", ""))

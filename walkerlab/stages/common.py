@@ -110,7 +110,16 @@ def recompute_reason(path: Path, scene: Scene, sections: tuple[str, ...],
     if diff:
         more = f" (+{len(diff) - 3} more fields)" if len(diff) > 3 else ""
         return "scene changed: " + ", ".join(diff[:3]) + more
-    return "an upstream artifact, a stage option or walkerlab's code changed"
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            old_code = f.attrs.get("code_hash")
+    except OSError:
+        old_code = None
+    if old_code is not None and str(old_code) != code_hash():
+        return "walkerlab's code changed"
+    return "an upstream artifact or a stage option changed"
 
 
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
@@ -147,7 +156,8 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
         t0 = time.perf_counter()
         writer, summary = compute()
         wall = time.perf_counter() - t0
-        write_artifact(path, stage, scene, key, writer, wall, extra_attrs)
+        write_artifact(path, stage, scene, key, writer, wall,
+                       {"code_hash": code_hash(), **(extra_attrs or {})})
     return StageOutcome(stage, path, False, wall, summary, note)
 
 

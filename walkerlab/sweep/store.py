@@ -217,11 +217,11 @@ class SweepStore:
         counts = np.array([outc.count(o) for o in OUTCOMES], np.int64)
         if "summary" in f:
             del f["summary"]
-        netcdf.coordinate(f.create_group("summary"), "outcome", list(OUTCOMES), "-",
+        netcdf.coordinate(f.create_group("summary"), "outcome_kind", list(OUTCOMES), "-",
                           "outcome of a point (walkerlab.sweep.outcomes)")
         ds = f.create_dataset("summary/outcome_counts", data=counts)
         ds.attrs.update(outcomes=list(OUTCOMES), unit="-", description="points per outcome")
-        netcdf.attach(ds, ("outcome",))
+        netcdf.attach(ds, ("outcome_kind",))
         f.attrs["complete"] = True
         netcdf.finish_sweep(f)
         f.close()
