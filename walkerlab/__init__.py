@@ -1,6 +1,7 @@
 """walkerlab: a command-line lab for passive-dynamic biped walkers.
 
-The package is split by role (see ``STYLE.md`` of the project):
+The package is split by role (dependencies point down the list; the README describes
+the product):
 
 - :mod:`walkerlab.config`   typed YAML scenes (pydantic, ``extra="forbid"``)
 - :mod:`walkerlab.models`   walker models (flow, guard, reset as pure functions)
