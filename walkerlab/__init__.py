@@ -1,6 +1,6 @@
 """walkerlab: a command-line lab for passive-dynamic biped walkers.
 
-The package is split by role (dependencies point down the list; the README describes
+The package is split by role (lower layers first; the README describes
 the product):
 
 - :mod:`walkerlab.config`   typed YAML scenes (pydantic, ``extra="forbid"``)
