@@ -130,6 +130,13 @@ def test_api_reuses_the_cli_artifact_and_fixed_points_stack_the_variants(tmp_pat
     np.testing.assert_array_equal(every["fixed_point"].values[0], gait["fixed_point"].values)
 
 
+def test_top_level_sweep_is_the_api_even_after_the_sweep_package_is_imported(tmp_path):
+    import walkerlab.sweep  # noqa: F401 - Python binds walkerlab.sweep to the package
+
+    sw = wl.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
+    assert sw["outcome"].values.tolist() == ["ok"]
+
+
 def test_importing_walkerlab_and_its_api_loads_nothing_heavy():
     code = ("import sys, json, walkerlab, walkerlab.api\n"
             "f = walkerlab.simulate\n"

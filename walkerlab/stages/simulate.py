@@ -58,8 +58,8 @@ def _longer_run(scene: Scene, runs_root, upstream: tuple[Path, ...]) -> StageOut
     have = verified_hash(path)
     if have is None or have != input_hash("simulate", with_strides(scene, n), SECTIONS, upstream):
         return None
-    note = (f"kept {n} strides of an earlier 'simulate --strides {n}' (the scene asks for "
-            f"{scene.simulate.strides}; the first {scene.simulate.strides} are the same run)")
+    note = (f"kept {n} strides of an earlier 'simulate --strides {n}'; the scene asks for "
+            f"{scene.simulate.strides}, the first {scene.simulate.strides} are the same run")
     return StageOutcome("simulate", path, True, 0.0, {}, note)
 
 
