@@ -183,7 +183,8 @@ def test_cli_fixedpoint_prints_named_state(tmp_path):
     assert "rad/s" in r.output and "verdict: STABLE" in r.output
 
 
-def test_cli_bad_scene_is_one_line(tmp_path):
+def test_cli_bad_scene_is_one_line_per_error(tmp_path):
+    """Every validation error on its own line naming the file and the field, no traceback."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
@@ -192,7 +193,10 @@ def test_cli_bad_scene_is_one_line(tmp_path):
     p.write_text("walker: {leg_length_m: -1}\nslope: {angle_deg: 1}\n")
     r = CliRunner().invoke(app, ["fixedpoint", str(p), "--runs-dir", str(tmp_path)])
     assert r.exit_code == 1
-    assert r.output.strip().count("\n") == 0 and "bad.yaml" in r.output
+    lines = r.output.strip().splitlines()
+    assert all(ln.startswith(f"error: {p}: walker.") for ln in lines), lines
+    assert any("walker.leg_length_m: Input should be greater than 0" in ln for ln in lines)
+    assert "Traceback" not in r.output
 
 
 def test_saved_figure_is_not_cropped(tmp_path):

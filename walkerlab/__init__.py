@@ -1,6 +1,7 @@
 """walkerlab: a command-line lab for passive-dynamic biped walkers.
 
-The package is split by role (see ``STYLE.md`` of the project):
+The package is split by role (lower layers first; the README describes
+the product):
 
 - :mod:`walkerlab.config`   typed YAML scenes (pydantic, ``extra="forbid"``)
 - :mod:`walkerlab.models`   walker models (flow, guard, reset as pure functions)
@@ -10,8 +11,29 @@ The package is split by role (see ``STYLE.md`` of the project):
 - :mod:`walkerlab.stages`   one function per stage: config + upstream artifacts -> one artifact
 - :mod:`walkerlab.plotting` figures drawn from loaded artifacts only
 - :mod:`walkerlab.cli`      thin typer front end
+- :mod:`walkerlab.api`      the Python front door: ``walkerlab.load_scene``,
+  ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``, ``compare``,
+  ``sweep``, ``basin`` (each returns an ``xarray.Dataset`` read from the stage's artifact)
 
-Importing the package has no side effects and loads no heavy optional package.
+Importing the package has no side effects and loads no heavy optional package: the API's
+names are looked up on first use (PEP 562).
 """
 
 __version__ = "0.1.0"
+
+_API = ("load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
+        "compare", "sweep", "basin")
+__all__ = ["__version__", "api", *_API]
+
+
+def __getattr__(name: str):
+    if name in _API or name == "api":
+        import importlib
+
+        api = importlib.import_module("walkerlab.api")
+        return api if name == "api" else getattr(api, name)
+    raise AttributeError(f"module 'walkerlab' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

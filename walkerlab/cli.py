@@ -6,6 +6,8 @@ Errors and exit codes
 ---------------------
 A traceback shown to a user is a bug.  Every command runs inside :func:`_guard`:
 
+- a scene that does not validate: every error on its own line ``error: <file>: <field>:
+  <message>``, unknown keys first (with the closest field name), exit code 1;
 - bad input (scene, names, paths, artifacts, a busy artifact, a read-only runs folder) and
   a walker that falls (``simulate``, ``contact-sim``): one line ``error: ...`` on stderr,
   exit code 1;
@@ -115,7 +117,13 @@ def _guard(fn):
         except KeyboardInterrupt:
             typer.echo("interrupted", err=True)
             raise typer.Exit(code=130) from None
-        except (SceneError, ArtifactError, ArtifactBusy, StageError, FixedPointNotFound,
+        except SceneError as exc:  # every config error, one line each
+            if debug:
+                raise
+            for line in str(exc).splitlines() or [""]:
+                typer.echo(f"error: {line.strip()}", err=True)
+            raise typer.Exit(code=1) from None
+        except (ArtifactError, ArtifactBusy, StageError, FixedPointNotFound,
                 ValueError) as exc:
             if debug:
                 raise
@@ -209,7 +217,7 @@ def _main(version: bool = typer.Option(False, "--version", callback=_version_cal
 
 
 def _status(o) -> str:
-    return (f"reused {o.path} (inputs unchanged)" if o.reused
+    return (f"reused {o.path} ({o.note or 'inputs unchanged'})" if o.reused
             else f"wrote {o.path} (compute {o.wall_time_s:.3f} s)")
 
 

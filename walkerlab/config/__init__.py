@@ -50,7 +50,8 @@ from walkerlab.config.contact import (  # noqa: F401  (re-exported: one import p
 
 
 class SceneError(ValueError):
-    """A scene file cannot be read or does not validate (message is one line)."""
+    """A scene file cannot be read or does not validate (one line per error, each naming
+    the file and the field)."""
 
 
 class _Strict(BaseModel):
@@ -533,25 +534,80 @@ def _loc_part(p) -> bool:
     return not (s[:1].isupper() and s.isidentifier()) and s not in _TAGS
 
 
-def _format_error(path: Path, err: ValidationError) -> str:
-    errs = err.errors()
-    # a union (``'fixed_point' | StateSpec``) reports one error per member: prefer the one
-    # that went deepest into a mapping, it names the offending field
-    e = max(errs, key=lambda x: (len([p for p in x["loc"] if _loc_part(p)]),
-                                 x["type"] not in ("literal_error", "none_required")))
-    loc = ".".join(str(p) for p in e["loc"] if _loc_part(p))
+def _models_in(tp) -> list[type[BaseModel]]:
+    """The pydantic models a field annotation can hold (through Optional, unions, lists,
+    tuples, dict values and ``Annotated``)."""
+    import typing
+
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        return [tp]
+    out: list[type[BaseModel]] = []
+    for a in typing.get_args(tp):
+        out += [m for m in _models_in(a) if m not in out]
+    return out
+
+
+def _fields_at(loc: tuple) -> list[str]:
+    """Field names allowed at a validation-error location (the union of the candidate
+    models' fields where a union leaves the model open); [] when it cannot be told."""
+    import typing
+
+    current: list[type[BaseModel]] = [Scene]
+    for p in loc:
+        here = [m for m in current if isinstance(p, str) and p in m.model_fields]
+        if here:
+            nxt: list[type[BaseModel]] = []
+            for m in here:
+                nxt += [x for x in _models_in(m.model_fields[p].annotation) if x not in nxt]
+            current = nxt
+            continue
+        # a list index, a union member's class name or discriminator tag: narrow, or keep
+        tagged = [m for m in current if m.__name__ == p or any(
+            typing.get_args(f.annotation) == (p,) for f in m.model_fields.values())]
+        current = tagged or current
+    return sorted({k for m in current for k in m.model_fields})
+
+
+def _error_line(e: dict) -> str:
+    """One error as ``<field path>: <message>`` (an unknown key names the likely field)."""
+    import difflib
+
+    parts = [p for p in e["loc"] if _loc_part(p)]
+    loc = ".".join(str(p) for p in parts)
+    if e["type"] == "extra_forbidden":
+        key = str(e["loc"][-1])
+        close = difflib.get_close_matches(key, _fields_at(tuple(e["loc"][:-1])), n=1)
+        return f"{loc}: unknown field" + (f" (did you mean {close[0]}?)" if close else "")
     msg = e["msg"].removeprefix("Value error, ")
     if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
             and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
                               "string_type", "float_parsing", "int_parsing"):
         msg += f" (got {e['input']!r})"
-    # other members of the same union are alternatives, not further errors
-    others = [x for x in errs if x is not e and
-              tuple(p for p in x["loc"] if _loc_part(p)) != tuple(p for p in e["loc"]
-                                                                  if _loc_part(p))[:len(
-                  [p for p in x["loc"] if _loc_part(p)])]]
-    extra = f" (+{len(others)} more)" if others else ""
-    return f"{path}: {loc or '<scene>'}: {msg}{extra}"
+    return f"{loc or '<scene>'}: {msg}"
+
+
+def _format_error(path: Path, err: ValidationError) -> str:
+    """Every validation error, one line each, ``<file>: <field path>: <message>``.
+
+    Unknown keys (pydantic's ``extra_forbidden``, at their own location) come first, with
+    the closest allowed field name (``walker.hip_mas_kg: unknown field (did you mean
+    hip_mass_kg?)``); a union (``'fixed_point' | StateSpec``) reports one error per member:
+    only the members that went deepest into the mapping are kept, they name the offending
+    field; the other members are alternatives, not further errors.
+    """
+    errs = err.errors()
+    locs = [tuple(p for p in x["loc"] if _loc_part(p)) for x in errs]
+    keep = []
+    for i, x in enumerate(errs):
+        deeper = any(len(o) > len(locs[i]) and o[:len(locs[i])] == locs[i] for o in locs)
+        if deeper or (x["type"] in ("literal_error", "none_required")
+                      and sum(o == locs[i] for o in locs) > 1):
+            continue
+        keep.append(x)
+    keep = keep or errs[:1]
+    keep.sort(key=lambda x: x["type"] != "extra_forbidden")  # stable: file order otherwise
+    lines = list(dict.fromkeys(_error_line(x) for x in keep))
+    return "\n".join(f"{path}: {ln}" for ln in lines)
 
 
 def default_scene_path() -> Path:

@@ -9,8 +9,11 @@ writer and walkerlab's own ``unit``/``description`` attributes stay as they are.
 - :func:`coordinate` writes a coordinate variable (a dataset that is its own dimension
   scale, e.g. ``samples/time``);
 - :func:`attach` attaches named dimensions to a dataset, looking for the scale in the
-  dataset's group and its ancestors (netCDF scoping) and creating a dimension without a
-  coordinate variable when there is none of the right length;
+  dataset's group and its ancestors (netCDF scoping).  A coordinate variable found in an
+  ancestor is copied into the dataset's own group, so that every group opened on its own
+  (``group="samples/coordinates"``) shows its coordinates (xarray reads one group's
+  variables only); a dimension without a coordinate variable is created when there is no
+  scale of the right length;
 - :func:`finish` runs once before a file is closed: it adds ``units``/``long_name`` where
   missing and attaches a fallback dimension ``<name>_dim<i>`` to any axis still without one,
   so no reader ever sees an anonymous ("phony") dimension.
@@ -47,7 +50,8 @@ def coordinate(group: h5py.Group, name: str, values, unit: str, long_name: str) 
     """
     values = np.asarray(values)
     if values.dtype.kind in "UO":
-        values = np.asarray([str(v) for v in values], dtype=h5py.string_dtype())
+        values = np.asarray([v.decode() if isinstance(v, bytes) else str(v) for v in values],
+                            dtype=h5py.string_dtype())
     ds = group.create_dataset(name, data=values)
     ds.make_scale(name)
     ds.attrs["unit"] = unit
@@ -68,11 +72,20 @@ def _find_scale(group: h5py.Group, name: str, size: int) -> h5py.Dataset | None:
         g = g.parent
 
 
+def _is_coordinate_variable(ds: h5py.Dataset) -> bool:
+    name = ds.attrs.get("NAME", b"")
+    name = name.decode() if isinstance(name, bytes) else str(name)
+    return ds.is_scale and _NOVAR not in name
+
+
 def attach(ds: h5py.Dataset, dims: Sequence[str | None]) -> None:
     """Attach dimension ``dims[i]`` to axis ``i`` of ``ds`` (None: leave the axis alone).
 
-    A scale of that name and length in the dataset's group or an ancestor is used; otherwise
-    a dimension without a coordinate variable is created in the dataset's group.
+    A scale of that name and length in the dataset's group is used; one in an ancestor group
+    is copied into the dataset's group when it is a coordinate variable (values, units and
+    long name; the group then opens with its coordinates in xarray) and used as it is when
+    it is a bare dimension; otherwise a dimension without a coordinate variable is created
+    in the dataset's group.
 
     Raises
     ------
@@ -87,6 +100,10 @@ def attach(ds: h5py.Dataset, dims: Sequence[str | None]) -> None:
             continue
         n = ds.shape[i]
         sc = _find_scale(ds.parent, name, n)
+        if (sc is not None and sc.parent.name != ds.parent.name and name not in ds.parent
+                and _is_coordinate_variable(sc)):
+            sc = coordinate(ds.parent, name, sc[()], str(sc.attrs.get("unit", "-")),
+                            str(sc.attrs.get("long_name", name)))
         if sc is None:
             if name in ds.parent:
                 raise ValueError(f"{ds.name}: dimension '{name}' exists with another length")
@@ -124,16 +141,16 @@ def finish(f: h5py.File) -> None:
 
 
 def finish_sweep(f: h5py.File) -> None:
-    """netCDF dimensions of a finalized sweep file: ``point`` (rows) and ``axis_<i>`` (grid).
+    """netCDF dimensions of a finalized sweep file: ``point`` (rows) and the grid axes.
 
-    Every dataset under ``points/`` is one value per row, so it gets dimension ``point``;
-    each ``grid/axis_<i>`` becomes its own coordinate variable.
+    Every dataset under ``points/`` is one value per row, so it gets dimension ``point``, a
+    coordinate variable holding the flat grid index of each row; each ``grid/<path>`` (named
+    by the swept field, e.g. ``slope.angle_deg``) becomes its own coordinate variable.
     """
     g = f["points"]
-    n = int(g["index"].shape[0])
     if "point" not in g:
-        sc = g.create_dataset("point", shape=(n,), dtype="f4")
-        sc.make_scale(f"{_NOVAR}{n:10d}")
+        coordinate(g, "point", g["index"][()], "-",
+                   "flat grid index of the row (C order, first axis slowest)")
     rows: list[h5py.Dataset] = []
     g.visititems(lambda _n, o: rows.append(o) if isinstance(o, h5py.Dataset)
                  and not o.is_scale and o.ndim == 1 else None)

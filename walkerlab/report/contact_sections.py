@@ -64,11 +64,13 @@ def contact_section(scene, paths) -> list[str]:
                    bool(g["stable"][()]))
     # initial states by name: the first sample of each trajectory artifact
     with open_artifact(p, "contact-sim") as f:
-        c0 = {n: float(f[f"samples/coordinates/{n}"][0]) for n in f["samples/coordinates"]}
+        c0 = {str(n): float(f[f"samples/coordinates/{n}"][0])
+              for n in f["samples"].attrs["coordinates"]}
     i0 = {}
     if "simulate" in paths:
         with open_artifact(paths["simulate"], "simulate") as f:
-            i0 = {n: float(f[f"samples/coordinates/{n}"][0]) for n in f["samples/coordinates"]}
+            i0 = {str(n): float(f[f"samples/coordinates/{n}"][0])
+                  for n in f["samples"].attrs["coordinates"]}
     rows = []
     for key in [k for k in table2 if k in c0] + [k for k in c0 if k not in table2]:
         sym, pm, pa = table2.get(key, (key, np.nan, np.nan))

@@ -363,6 +363,18 @@ def workprecision_table(path: Path, model: str) -> str:
                   "error vs reference", "RHS evals"], rows)
 
 
+def _drawn_from(stem: str, paths: dict[str, Path]) -> bool:
+    """Whether a figure's artifacts are among the report's (a figure an earlier ``walkerlab
+    plot`` drew from an artifact the report leaves out is not shown)."""
+    for prefix, stages in (("fig2_", ("simulate",)), ("fig6_", ("contact-sim",)),
+                           ("fig8_", ("compare",)), ("fig", ("simulate", "contact-sim")),
+                           ("work_precision", ("workprecision",)),
+                           ("bifurcation", ("bifurcation",)), ("basin", ("basin",))):
+        if stem.startswith(prefix):
+            return any(s in paths for s in stages)
+    return True
+
+
 def figures_section(fig_dir: Path, rel: str, paths: dict[str, Path]) -> list[str]:
     """Every figure that exists, with its raw data folded underneath where it is long."""
     out = []
@@ -373,7 +385,7 @@ def figures_section(fig_dir: Path, rel: str, paths: dict[str, Path]) -> list[str
         out += [f"![{cap}]({rel}/{gif.name})", "", f"*{cap}*", ""]
     for stem, cap in CAPTIONS:
         png = fig_dir / f"{stem}.png"
-        if not png.is_file():
+        if not png.is_file() or not _drawn_from(stem, paths):
             continue
         out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
         if stem == "fig7_angles_rates" and "simulate" in paths:

@@ -91,6 +91,12 @@ def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_ch
         if not figure_path(scene, runs_root).is_file():
             draw(scene, runs_root)
         return StageOutcome("basin", path, True, 0.0, {})
+    note = ""
+    if not force and path.is_file():  # never replaced silently (as run_cached)
+        from walkerlab.stages.common import recompute_reason
+
+        note = recompute_reason(path, scene, SECTIONS, verified_hash(path))
+        _tell(f"basin: recomputing {path} ({note})")
     x_star, _ = fixedpoint_stage.load_fixed_point(up)
     t0 = time.perf_counter()
     try:
@@ -140,4 +146,4 @@ def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_ch
                     "scheduler": str(scheduler or "")})
     res["partial"].unlink(missing_ok=True)
     draw(scene, runs_root)
-    return StageOutcome("basin", path, False, wall, {"counts": counts, "grid": grid})
+    return StageOutcome("basin", path, False, wall, {"counts": counts, "grid": grid}, note)

@@ -32,6 +32,8 @@ class StageOutcome:
     reused: bool
     wall_time_s: float
     summary: dict = field(default_factory=dict)
+    #: why an existing artifact was recomputed, or what was reused in its place (one line)
+    note: str = ""
 
 
 def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
@@ -70,6 +72,56 @@ def _tell(msg: str) -> None:
     print(msg, file=sys.stderr)
 
 
+def _leaves(d, prefix: str = "") -> dict[str, object]:
+    if isinstance(d, dict):
+        out: dict[str, object] = {}
+        for k, v in d.items():
+            out.update(_leaves(v, f"{prefix}{k}."))
+        return out
+    return {prefix.rstrip("."): d}
+
+
+def changed_fields(path: Path, scene: Scene, sections: tuple[str, ...]) -> list[str]:
+    """``"simulate.strides 20 -> 5"`` for each scene field (of ``sections``) whose value in the
+    artifact's stored scene differs from ``scene``'s; [] when none or unreadable."""
+    import json
+
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            old = json.loads(str(f.attrs["scene_json"]))
+    except (OSError, KeyError, ValueError):
+        return []
+    new = json.loads(scene.model_dump_json())
+    was = _leaves({k: old.get(k) for k in sections})
+    now = _leaves({k: new.get(k) for k in sections})
+    return [f"{k} {was.get(k, '-')} -> {now.get(k, '-')}" for k in sorted(set(was) | set(now))
+            if was.get(k) != now.get(k)]
+
+
+def recompute_reason(path: Path, scene: Scene, sections: tuple[str, ...],
+                     have: str | None) -> str:
+    """One line saying why an existing artifact ``path`` is out of date (``have``: its
+    verified input hash, None when its content does not match its stored hash)."""
+    if have is None:
+        return "it was written by another walkerlab version or changed after it was written"
+    diff = changed_fields(path, scene, sections)
+    if diff:
+        more = f" (+{len(diff) - 3} more fields)" if len(diff) > 3 else ""
+        return "scene changed: " + ", ".join(diff[:3]) + more
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            old_code = f.attrs.get("code_hash")
+    except OSError:
+        old_code = None
+    if old_code is not None and str(old_code) != code_hash():
+        return "walkerlab's code changed"
+    return "an upstream artifact or a stage option changed"
+
+
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
                force: bool = False, extra_attrs: dict | None = None,
@@ -78,22 +130,31 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
     ``extra_key`` enters the input hash; an artifact written with one of the ``also_accept``
-    keys (a superset of what is asked for) counts as up to date too.
+    keys (a superset of what is asked for) counts as up to date too.  An existing artifact
+    that is recomputed is never replaced silently: one line on stderr says which and why
+    (the scene fields that changed, ``--force``, ...), also kept in ``StageOutcome.note``.
     """
     path = stage_artifact(scene, runs_root, stage, claim=True)
     # one writer per artifact: a second identical run waits, then finds the result up to date
     with artifact_lock(path, wait=True, on_wait=_tell):
         key = input_hash(stage, scene, sections, upstream, extra_key)
-        if not force and path.is_file():
+        note = ""
+        if path.is_file():
             have = verified_hash(path)
-            if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
-                                  for a in also_accept):
+            if not force and (have == key or any(
+                    have == input_hash(stage, scene, sections, upstream, a)
+                    for a in also_accept)):
                 return StageOutcome(stage, path, True, 0.0, {})
+            # never replace a result silently: say what is recomputed and why (one line)
+            note = "--force" if force else recompute_reason(path, scene, sections, have)
+            if not force:
+                _tell(f"{stage}: recomputing {path} ({note})")
         t0 = time.perf_counter()
         writer, summary = compute()
         wall = time.perf_counter() - t0
-        write_artifact(path, stage, scene, key, writer, wall, extra_attrs)
-    return StageOutcome(stage, path, False, wall, summary)
+        write_artifact(path, stage, scene, key, writer, wall,
+                       {"code_hash": code_hash(), **(extra_attrs or {})})
+    return StageOutcome(stage, path, False, wall, summary, note)
 
 
 def require(scene: Scene, section: str, stage: str):

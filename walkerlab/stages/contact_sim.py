@@ -17,6 +17,7 @@ from walkerlab.analysis import contact_sim as contact_run
 from walkerlab.config import Scene
 from walkerlab.contact import scene as contact_scene
 from walkerlab.io.artifacts import put
+from walkerlab.io.netcdf import coordinate
 from walkerlab.io.trajectory import NamedTrajectory, write_samples  # noqa: F401
 from walkerlab.stages import fixedpoint as fixedpoint_stage
 from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
@@ -131,15 +132,16 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             g.attrs["method"] = ("point mass 20 kg meeting flat ground at 0.3 m/s, no gravity "
                                  "(walkerlab.analysis.contact_drop); restitution = v_out / v_in")
             lu = "mm" if settings(scene)[0].unit_system == "mm-kg-s" else "m"
-            put(g, "stiffness", drop["stiffness"], f"N/{lu}^e",
-                "IMPACT stiffness in the scene's unit system")
+            coordinate(g, "stiffness", drop["stiffness"], f"N/{lu}^e",
+                       "IMPACT stiffness in the scene's unit system")
+            k = ("stiffness",)
             for fam in ("paper", "rigid_limit"):
                 put(g, f"{fam}/restitution", drop[fam]["restitution"], "-",
-                    f"coefficient of restitution, {fam} family")
+                    f"coefficient of restitution, {fam} family", dims=k)
                 put(g, f"{fam}/max_penetration", drop[fam]["max_penetration_m"], "m",
-                    "largest penetration in the drop")
+                    "largest penetration in the drop", dims=k)
                 put(g, f"{fam}/contact_time", drop[fam]["contact_time_s"], "s",
-                    "duration of the contact (NaN: comes to rest)")
+                    "duration of the contact (NaN: comes to rest)", dims=k)
             write_samples(f, tr)
             for name, val, unit in (("stiffness", c.k, "N/m^e"), ("exponent", c.e, "-"),
                                     ("max_damping", c.cmax, "N s/m"),
@@ -149,35 +151,60 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                                     ("friction_velocity", c.v_d, "m/s")):
                 put(f, f"contact_params_si/{name}", val, unit, f"{name} in SI")
             put(f, "terrain/step_length", step_length, "m", "ideal step length used for patches")
-            put(f, "terrain/lane_leg1", walker.lane1, "m", "patch centres, along-slope s")
-            put(f, "terrain/lane_leg2", walker.lane2, "m", "patch centres, along-slope s")
+            for leg, lane in (("leg1", walker.lane1), ("leg2", walker.lane2)):
+                coordinate(f.require_group("terrain"), f"patch_{leg}", np.arange(len(lane)),
+                           "-", f"patch number on {leg}'s lane")
+                put(f, f"terrain/lane_{leg}", lane, "m", "patch centres, along-slope s",
+                    dims=(f"patch_{leg}",))
             put(f, "terrain/patch_half_width", walker.patch_half_width, "m", "")
             put(f, "terrain/continuous", bool(walker.continuous), "-", "")
+            coordinate(f, "contact_state", list(walker.state_names()), "-",
+                       "state component of the floating contact walker")
             put(f, "initial_state", x0, ", ".join(walker.state_units()),
-                "initial state, named by state_names", names=list(walker.state_names()))
+                "initial state, named by state_names", names=list(walker.state_names()),
+                dims=("contact_state",))
             for name, val, unit in zip(walker.state_names(), x0, walker.state_units()):
                 put(f, f"initial_state_named/{name}", float(val), unit, f"initial {name}")
-            put(f, "initial_state_ideal", x_fp, "rad, rad/s", "ideal fixed point (Table 2 MATLAB)")
+            coordinate(f, "state", list(meta["state_names"]), "-",
+                       "state component of the rigid walker (role-ordered)")
+            put(f, "initial_state_ideal", x_fp, "rad, rad/s", "ideal fixed point (Table 2 MATLAB)",
+                dims=("state",))
+            coordinate(f, "rate", ["dtheta1", "dtheta2"], "-", "leg rate scaled")
             put(f, "initial_rate_scale", np.asarray(scale if scale is not None else
                                                     settings(scene)[2].initial_rate_scale),
-                "-", "multipliers on (dtheta1, dtheta2)")
+                "-", "multipliers on (dtheta1, dtheta2)", dims=("rate",))
             for leg, ft in res.feet.items():
                 g = f.create_group(f"feet/{leg}")
-                put(g, "normal_force", ft.normal_force, "N", "IMPACT normal force")
-                put(g, "friction_force", ft.friction_force, "N", "Coulomb friction, down-slope")
-                put(g, "penetration", ft.penetration, "m", "signed penetration (<0: above)")
-                put(g, "slip_velocity", ft.slip_velocity, "m/s", "tangential foot velocity")
-                put(g, "touchdown_times", ft.touchdown_times, "s", "")
-                put(g, "liftoff_times", ft.liftoff_times, "s", "")
-            put(f, "events/heel_strike_times", res.heel_strike_times, "s", "")
-            put(f, "events/heel_strike_legs", list(res.heel_strike_legs) or [""], "-", "")
+                coordinate(g, "time", tr.time, "s", "sample time")
+                t = ("time",)
+                put(g, "normal_force", ft.normal_force, "N", "IMPACT normal force", dims=t)
+                put(g, "friction_force", ft.friction_force, "N", "Coulomb friction, down-slope",
+                    dims=t)
+                put(g, "penetration", ft.penetration, "m", "signed penetration (<0: above)",
+                    dims=t)
+                put(g, "slip_velocity", ft.slip_velocity, "m/s", "tangential foot velocity",
+                    dims=t)
+                for ev in ("touchdown", "liftoff"):
+                    times = getattr(ft, f"{ev}_times")
+                    coordinate(g, ev, np.arange(len(times)), "-", f"{ev} number")
+                    put(g, f"{ev}_times", times, "s", f"{ev} times of {leg}'s foot", dims=(ev,))
+            g = f.create_group("events")
+            legs = list(res.heel_strike_legs) or [""]
+            coordinate(g, "heel_strike", np.arange(len(legs)), "-", "heel strike number")
+            put(g, "heel_strike_times", res.heel_strike_times, "s", "heel-strike times",
+                dims=("heel_strike",) if len(res.heel_strike_times) == len(legs) else None)
+            put(g, "heel_strike_legs", legs, "-", "leg striking", dims=("heel_strike",))
             g = f.create_group("steps")
+            coordinate(g, "step", np.arange(len(steps) or 1), "-", "step number")
+            s_dim = ("step",)
             for fld, unit in (("t_start", "s"), ("t_end", "s"), ("period", "s"),
                               ("stance_slip_mm", "mm"), ("double_support_creep_mm", "mm"),
                               ("bounce_count", "-"), ("scuff_count", "-"),
                               ("peak_penetration_m", "m"), ("liftoff_time", "s")):
-                put(g, fld, np.array([getattr(s, fld) for s in steps], dtype=float), unit, fld)
-            put(g, "stance_leg", [s.stance_leg for s in steps] or [""], "-", "")
+                put(g, fld, np.array([getattr(s, fld) for s in steps], dtype=float), unit, fld,
+                    dims=s_dim if steps else None)
+            put(g, "stance_leg", [s.stance_leg for s in steps] or [""], "-", "stance leg",
+                dims=s_dim)
             for k, v in summary.items():
                 if k not in ("termination", "outcome"):
                     put(f, f"summary/{k}", v, units.get(k, "-"), k)
@@ -194,8 +221,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                 put(g, "step_period", gait.period_s, "s", "period of the contact gait")
                 put(g, "step_length", gait.step_length_m, "m", "")
                 put(g, "residual", gait.residual, "-", "scaled map residual")
-                put(g, "multipliers/real", gait.multipliers.real, "-", "Floquet multipliers")
-                put(g, "multipliers/imag", gait.multipliers.imag, "-", "")
+                coordinate(g, "multiplier", np.arange(len(gait.multipliers)), "-",
+                           "Floquet multiplier number")
+                m = ("multiplier",)
+                put(g, "multipliers/real", gait.multipliers.real, "-",
+                    "Floquet multipliers, real part", dims=m)
+                put(g, "multipliers/imag", gait.multipliers.imag, "-",
+                    "Floquet multipliers, imag part", dims=m)
                 put(g, "multiplier_fd_spread", gait.multiplier_fd_spread, "-",
                     "change of the multipliers for FD steps x3 and /3")
                 put(g, "stable", bool(gait.stable), "-", "all |multipliers| < 1")
@@ -203,7 +235,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             if adj is not None:
                 for k, v in adj.items():
                     if isinstance(v, (int, float, np.ndarray, list, tuple)):
-                        put(f, f"adjust/{k}", np.asarray(v, dtype=float), "-", k)
+                        v = np.asarray(v, dtype=float)
+                        put(f, f"adjust/{k}", v, "-", k,
+                            dims=("rate",) if k == "scale" and v.shape == (2,) else None)
         return writer, summary
 
     return run_cached("contact-sim", scene, runs_root, sections, up, compute, force)

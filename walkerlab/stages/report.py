@@ -2,7 +2,8 @@
 figures, then hand the artifacts to :func:`walkerlab.report.build.write_report`, which writes
 ``runs/<scene>/report/report.html`` (self-contained) and ``report.md``.
 
-Sections appear only when the scene produces their data: an ideal-only scene gets an
+Sections appear only when the scene produces their data (artifacts an earlier standalone
+command left in the run folder are left out, in one line): an ideal-only scene gets an
 ideal-only report, with no empty contact panels; a scene without a ``workprecision``
 section skips that (expensive) stage.  A scene with a ``basin`` section gets its basin of
 attraction (computed after the work-precision study, whose timed cases must not share their
@@ -180,8 +181,13 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
 
         done.append(basin.run(scene, runs_root, force))
     for o in done:
-        echo(f"{o.stage:>13s}: " + ("reused (inputs unchanged)" if o.reused
-                                    else f"computed in {o.wall_time_s:.2f} s") + f" -> {o.path}")
+        status = ("reused (inputs unchanged)" if o.reused and not o.note else
+                  f"reused ({o.note})" if o.reused else
+                  f"computed in {o.wall_time_s:.2f} s")  # why: said when it started
+        echo(f"{o.stage:>13s}: {status} -> {o.path}")
+    if not any(o.stage in ("simulate", "contact-sim") for o in done):
+        echo(f"{'plot':>13s}: no trajectory figures (the scene has no 'simulate' or "
+             "'contact' section)")
     for line in drawn:
         echo(line)
     return done
@@ -217,6 +223,43 @@ def _figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
             json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True))
 
 
+#: why a report leaves out an artifact of a stage the scene does not run
+_NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' section",
+            "contact-sim": "no 'contact' section",
+            "compare": "needs both a 'simulate' and a 'contact' section",
+            "workprecision": "no 'workprecision' section",
+            "basin": "no 'basin' section (or no 'fixedpoint')"}
+
+
+def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
+                     ) -> tuple[dict[str, Path], str]:
+    """The artifacts the report shows and one line on what it leaves out ('' if nothing).
+
+    Only artifacts this scene's report produced (``done``) are used: an artifact left in the
+    run folder by an earlier standalone command (``walkerlab simulate`` on a scene without a
+    ``simulate`` section) is left out, and said so.  ``bifurcation.h5`` has no scene section
+    (the standalone ``walkerlab bifurcation`` makes it): it is shown when it was computed
+    for the scene's current walker, slope and solver.
+    """
+    produced = {o.stage for o in done}
+    paths, left = {}, []
+    for stage, p in existing_artifacts(scene, runs_root).items():
+        if stage in produced:
+            paths[stage] = p
+        elif stage == "bifurcation":
+            from walkerlab.stages import bifurcation
+            from walkerlab.stages.common import changed_fields
+
+            if changed_fields(p, scene, bifurcation.SECTIONS):
+                left.append(f"{p.name} (computed for another walker, slope or solver)")
+            else:
+                paths[stage] = p
+        else:
+            left.append(f"{p.name} (an earlier standalone run: the scene has "
+                        f"{_NOT_RUN.get(stage, 'no section for it')})")
+    return paths, ("report: leaves out " + "; ".join(left)) if left else ""
+
+
 def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
     """``{stage: path}`` of the report's stages whose artifact exists for ``scene``."""
     out = {}
@@ -237,6 +280,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         The HTML report.
     """
     done = _run_stages(scene, runs_root, force, echo)
+    paths, left_out = report_artifacts(scene, runs_root, done)
+    if left_out:
+        echo(left_out)
     rep_dir = report_dir(scene, runs_root, claim=True)
-    return write_report(scene, existing_artifacts(scene, runs_root), rep_dir,
-                        figures_dir(scene, runs_root), done)
+    return write_report(scene, paths, rep_dir, figures_dir(scene, runs_root), done)

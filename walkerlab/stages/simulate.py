@@ -37,12 +37,40 @@ def with_strides(scene: Scene, strides: int | None) -> Scene:
     return scene.model_copy(update={"simulate": sim})
 
 
+def _longer_run(scene: Scene, runs_root, upstream: tuple[Path, ...]) -> StageOutcome | None:
+    """The existing ``simulate.h5`` when it holds *more* strides of the same run (an earlier
+    ``simulate --strides N``) than the scene asks for: it contains the scene's strides, and
+    the result the user asked for is kept rather than replaced (``StageOutcome.note`` says
+    so; the CLI and the report print it)."""
+    import h5py
+
+    from walkerlab.io.artifacts import verified_hash
+    from walkerlab.stages.common import input_hash
+
+    path = artifact_path(scene, runs_root, "simulate")
+    try:
+        with h5py.File(path, "r") as f:
+            n = int(f.attrs["strides_requested"])
+    except (OSError, KeyError, ValueError, TypeError):
+        return None
+    if n <= scene.simulate.strides:
+        return None
+    have = verified_hash(path)
+    if have is None or have != input_hash("simulate", with_strides(scene, n), SECTIONS, upstream):
+        return None
+    note = (f"kept {n} strides of an earlier 'simulate --strides {n}'; the scene asks for "
+            f"{scene.simulate.strides}, the first {scene.simulate.strides} are the same run")
+    return StageOutcome("simulate", path, True, 0.0, {}, note)
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         strides: int | None = None) -> StageOutcome:
     """Simulate ``simulate.strides`` strides (2 steps each) and write ``simulate.h5``.
 
     The initial state is the fixed point from ``fixedpoint.h5`` (the fixedpoint stage is run
-    first if its artifact is missing or stale) or the scene's explicit state.
+    first if its artifact is missing or stale) or the scene's explicit state.  Without
+    ``strides`` (the scene's number), an existing run of the same walker with *more* strides
+    (``simulate --strides 20``) is reused, and said so, rather than replaced.
 
     Raises
     ------
@@ -55,6 +83,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     if sim.initial_state == "fixed_point":
         fixedpoint_stage.run(scene, runs_root)
         upstream = (artifact_path(scene, runs_root, "fixedpoint"),)
+    if strides is None and not force:
+        longer = _longer_run(scene, runs_root, upstream)
+        if longer is not None:
+            return longer
 
     def compute():
         walker = build_walker(scene)

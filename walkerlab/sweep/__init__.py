@@ -11,7 +11,24 @@
 The stage entry point is :func:`walkerlab.stages.sweep.run`.
 """
 
+import sys
+import types
+
 from walkerlab.sweep.outcomes import OUTCOMES
 from walkerlab.sweep.params import ParamAxis, SweepError, parse_param
 
 __all__ = ["OUTCOMES", "ParamAxis", "SweepError", "parse_param"]
+
+
+class _CallablePackage(types.ModuleType):
+    """``walkerlab.sweep`` is this package *and* the top-level API name
+    ``walkerlab.sweep(scene, param, values)``: once the package is imported, Python binds the
+    attribute ``walkerlab.sweep`` to it, so calling it calls :func:`walkerlab.api.sweep`."""
+
+    def __call__(self, *args, **kwargs):
+        from walkerlab.api import sweep
+
+        return sweep(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallablePackage

@@ -5,7 +5,9 @@ Layout (``stage`` attribute ``"sweep"``; every dataset has ``unit`` and ``descri
     /                      attrs: stage, walkerlab_version, scene_name, scene_json, input_hash,
                            created_utc, wall_time_s, sweep_stage, params_json, options_json,
                            grid_shape, n_points, complete
-    /grid/axis_<i>         values of axis i (float64 or string); attrs path, spec
+    /grid/<path>           values of axis i, named by the swept field (``slope.angle_deg``;
+                           ``/`` -> ``_``), a netCDF coordinate variable (float64 or
+                           string); attrs axis (= i), path, spec
     /points/index          (n,) int64 flat grid index, C order (first axis slowest):
                            grid position = numpy.unravel_index(index, grid_shape)
     /points/param/<path>   (n,) value of each swept field at the row
@@ -50,6 +52,18 @@ def _param_key(path: str) -> str:
     return path.replace("/", "_")
 
 
+#: unit suffixes of scene field names (units live in the names, ``slope.angle_deg``)
+_UNIT_SUFFIXES = (("_kg_m2", "kg m^2"), ("_m_per_s2", "m/s^2"), ("_m_per_s", "m/s"),
+                  ("_rad_per_s", "rad/s"), ("_deg", "deg"), ("_rad", "rad"), ("_kg", "kg"),
+                  ("_mm", "mm"), ("_m", "m"), ("_hz", "Hz"), ("_s", "s"))
+
+
+def field_unit(path: str) -> str:
+    """Unit of a scene field from its name (``slope.angle_deg`` -> ``deg``; ``"-"``: none)."""
+    leaf = path.rsplit(".", 1)[-1].lower()
+    return next((u for suf, u in _UNIT_SUFFIXES if leaf.endswith(suf)), "-")
+
+
 class SweepStore:
     """An open in-progress sweep file (use :meth:`create` or :meth:`resume`)."""
 
@@ -90,8 +104,9 @@ class SweepStore:
         for i, a in enumerate(axes):
             data = np.asarray(a.values, float) if a.numeric else \
                 np.asarray([str(v) for v in a.values], dtype=STR)
-            ds = f.create_dataset(f"grid/axis_{i}", data=data)
-            ds.attrs.update(path=a.path, spec=a.spec, unit="", description=f"values of {a.path}")
+            ds = f.create_dataset(f"grid/{_param_key(a.path)}", data=data)
+            ds.attrs.update(axis=i, path=a.path, spec=a.spec, unit=field_unit(a.path),
+                            description=f"values of {a.path}")
         g = f.create_group("points")
 
         def mk(name, dtype, unit, desc):
@@ -100,7 +115,8 @@ class SweepStore:
 
         mk("index", np.int64, "-", "flat grid index (C order, first axis slowest)")
         for a in axes:
-            mk(f"param/{_param_key(a.path)}", np.float64 if a.numeric else STR, "",
+            mk(f"param/{_param_key(a.path)}", np.float64 if a.numeric else STR,
+               field_unit(a.path) if a.numeric else "-",
                f"value of {a.path}")
             g[f"param/{_param_key(a.path)}"].attrs["path"] = a.path
         for name, desc in STRING_COLUMNS.items():
@@ -203,8 +219,11 @@ class SweepStore:
         counts = np.array([outc.count(o) for o in OUTCOMES], np.int64)
         if "summary" in f:
             del f["summary"]
+        netcdf.coordinate(f.create_group("summary"), "outcome_kind", list(OUTCOMES), "-",
+                          "outcome of a point (walkerlab.sweep.outcomes)")
         ds = f.create_dataset("summary/outcome_counts", data=counts)
         ds.attrs.update(outcomes=list(OUTCOMES), unit="-", description="points per outcome")
+        netcdf.attach(ds, ("outcome_kind",))
         f.attrs["complete"] = True
         netcdf.finish_sweep(f)
         f.close()
@@ -248,8 +267,10 @@ def load_sweep(path: Path) -> dict:
         attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
         attrs["params"] = json.loads(attrs["params_json"])
         axes = []
-        for i in range(len(attrs["params"])):
-            ds = f[f"grid/axis_{i}"]
+        by_axis = {int(ds.attrs.get("axis", -1)): ds for ds in f["grid"].values()
+                   if isinstance(ds, h5py.Dataset)}
+        for i, (p, _values, _spec) in enumerate(attrs["params"]):
+            ds = by_axis.get(i) or f["grid"].get(_param_key(p)) or f[f"grid/axis_{i}"]
             v = ds[()]
             if v.dtype.kind == "O":
                 v = np.array([x.decode() if isinstance(x, bytes) else x for x in v], object)

@@ -1,0 +1,292 @@
+"""Issue 18, part 1 and its defects: the Python API (walkerlab.api), the artifacts' xarray
+view, config errors that name the offending key, and caching that says what it does."""
+
+import json
+import os
+import re
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+
+import walkerlab as wl
+from walkerlab.config import SceneError, load_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+xr = pytest.importorskip("xarray")
+pytest.importorskip("h5netcdf")
+
+
+def _paper(drop=("contact", "contact_sim", "contact_solver", "terrain", "workprecision",
+                 "basin"), **update) -> dict:
+    with open(ROOT / "configs" / "paper.yaml") as fh:
+        d = yaml.safe_load(fh)
+    for k in drop:
+        d.pop(k, None)
+    d.update(update)
+    return d
+
+
+def _open(path, group):
+    with xr.open_dataset(path, engine="h5netcdf", group=group) as ds:
+        return ds.load()
+
+
+def _all_dims(path) -> set[str]:
+    """Every dimension name of every group's netCDF view."""
+    groups = ["/"]
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda n, o: groups.append(n) if isinstance(o, h5py.Group) else None)
+    return {d for g in groups for d in _open(path, g).dims}
+
+
+# ---------------------------------------------------------------- xarray view of artifacts
+def test_simulate_artifact_groups_open_with_their_time_coordinate(tmp_path, paper_fixed_point):
+    sim = wl.simulate(_paper(name="xa"), strides=1, runs_dir=tmp_path)
+    path = tmp_path / "xa" / "simulate.h5"
+    coords = _open(path, "samples/coordinates")
+    assert coords["leg1_angle"].dims == ("time",) and "time" in coords.coords
+    assert coords["time"].attrs["units"] == "s" and coords["leg1_angle"].attrs["units"] == "rad"
+    with h5py.File(path, "r") as f:
+        t = f["samples/time"][()]
+        a = f["samples/coordinates/leg1_angle"][()]
+    np.testing.assert_array_equal(coords["time"].values, t)  # the parent group's times
+    np.testing.assert_array_equal(_open(path, "samples/points/hip")["time"].values, t)
+    assert not [d for d in _all_dims(path) if re.search(r"_dim\d+$", d)]
+    # the API's dataset is the artifact, read back through the same view
+    np.testing.assert_array_equal(sim["leg1_angle"].values, a)
+    assert sim["leg1_angle"].dims == ("time",) and sim["energy_total"].attrs["units"] == "J"
+    assert sim.attrs["stage"] == "simulate" and sim.sizes["step"] == 2
+    # the walker starts on its fixed point (the one the conftest finds independently)
+    np.testing.assert_allclose(sim["initial_state"].values, paper_fixed_point.x, atol=1e-9)
+
+
+def test_sweep_grid_axis_is_named_by_the_swept_field(tmp_path):
+    sw = wl.sweep(_paper(name="sw"), "slope.angle_deg", [1.0, 1.5, 2.0], runs_dir=tmp_path,
+                  name="slopes")
+    path = tmp_path / "sw" / "slopes.h5"
+    grid = _open(path, "grid")
+    assert list(grid.dims) == ["slope.angle_deg"]
+    np.testing.assert_array_equal(grid["slope.angle_deg"].values, [1.0, 1.5, 2.0])
+    assert grid["slope.angle_deg"].attrs["units"] == "deg"
+    pts = _open(path, "points")
+    np.testing.assert_array_equal(pts["point"].values, [0, 1, 2])
+    assert not [d for d in _all_dims(path) if re.search(r"(_dim\d+|axis_\d+)$", d)]
+    # the API reshapes the rows onto the grid
+    assert sw["step_period_s"].dims == ("slope.angle_deg",)
+    assert list(sw["outcome"].values) == ["ok"] * 3
+    # physics: the compass gait's step period grows with the slope (Goswami et al. 1996)
+    assert np.all(np.diff(sw["step_period_s"].values) > 1e-4)
+    assert np.all(sw["max_abs_multiplier"].values < 1)
+
+
+def test_contact_artifact_arrays_have_named_dimensions(tmp_path):
+    d = _paper(drop=("workprecision", "basin"), name="ct")
+    d["contact_sim"].update(n_strides=1, periodic_gait=False, sample_rate_hz=200)
+    ct = wl.contact_simulate(d, runs_dir=tmp_path)
+    path = tmp_path / "ct" / "contact_sim.h5"
+    dims = _all_dims(path)
+    assert not [x for x in dims if re.search(r"_dim\d+$", x)], dims
+    feet = _open(path, "feet/leg1")
+    assert feet["normal_force"].dims == ("time",) and feet["normal_force"].attrs["units"] == "N"
+    np.testing.assert_array_equal(feet["time"].values, _open(path, "samples")["time"].values)
+    assert _open(path, "drop_test/paper")["restitution"].dims == ("stiffness",)
+    root = _open(path, "/")
+    assert root["initial_state"].dims == ("contact_state",)
+    assert "hip_y" in root["contact_state"].values
+    assert ct["feet_leg1_normal_force"].dims == ("time",)
+    # the feet carry the walker's weight: mean normal force over the run ~ m g (20 kg)
+    total = ct["feet_leg1_normal_force"] + ct["feet_leg2_normal_force"]
+    assert float(total.mean()) == pytest.approx(20 * 9.81, rel=0.1)
+
+
+# ---------------------------------------------------------------- the API and the CLI
+def test_api_reuses_the_cli_artifact_and_fixed_points_stack_the_variants(tmp_path):
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, ["fixedpoint", str(ROOT / "configs" / "paper.yaml"),
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    path = tmp_path / "paper" / "fixedpoint.h5"
+    stamp = path.stat().st_mtime_ns
+    gait = wl.fixed_point(ROOT / "configs" / "paper.yaml", runs_dir=tmp_path)
+    assert path.stat().st_mtime_ns == stamp  # one code path, one artifact: reused
+    with h5py.File(path, "r") as f:
+        assert gait.attrs["input_hash"] == f.attrs["input_hash"]
+        period = float(f["step_period"][()])
+    assert float(gait["step_period"]) == period and gait["step_period"].attrs["units"] == "s"
+    assert gait["multipliers"].dtype.kind == "c" and bool(gait["floquet_stable"])
+    assert list(gait["state_unit"].values) == ["rad", "rad", "rad/s", "rad/s"]
+    every = wl.fixed_points(ROOT / "configs" / "paper.yaml", runs_dir=tmp_path)
+    assert every["gait"].values[0] == "derived" and every.sizes["gait"] == 3
+    np.testing.assert_array_equal(every["fixed_point"].values[0], gait["fixed_point"].values)
+
+
+def test_top_level_sweep_is_the_api_even_after_the_sweep_package_is_imported(tmp_path):
+    import walkerlab.sweep  # noqa: F401 - Python binds walkerlab.sweep to the package
+
+    sw = wl.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
+    assert sw["outcome"].values.tolist() == ["ok"]
+
+
+def test_importing_walkerlab_and_its_api_loads_nothing_heavy():
+    code = ("import sys, json, walkerlab, walkerlab.api\n"
+            "f = walkerlab.simulate\n"
+            "print(json.dumps({m: m in sys.modules for m in ('numpy', 'xarray', 'h5py', "
+            "'pydantic', 'scipy', 'matplotlib')}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert not any(json.loads(out.stdout.strip().splitlines()[-1]).values())
+
+
+# ---------------------------------------------------------------- config errors
+def test_misspelt_field_is_named_first_with_the_field_it_resembles(tmp_path):
+    p = tmp_path / "typo.yaml"
+    p.write_text((ROOT / "configs" / "paper.yaml").read_text().replace("hip_mass_kg",
+                                                                       "hip_mas_kg"))
+    with pytest.raises(SceneError) as exc:
+        load_scene(p)
+    lines = str(exc.value).splitlines()
+    assert lines[0] == f"{p}: walker.hip_mas_kg: unknown field (did you mean hip_mass_kg?)"
+    assert lines[1] == f"{p}: walker.hip_mass_kg: Field required"
+    assert len(lines) == 2
+
+
+def test_every_config_error_one_line_each_unknown_keys_first():
+    d = yaml.safe_load((ROOT / "configs" / "kneed.yaml").read_text())
+    d["walker"]["leg"]["bodies"][0]["mas_kg"] = 1.0
+    d["simulate"] = {"stride": 3}
+    d["slope"] = {"angle_rad": "steep"}
+    with pytest.raises(SceneError) as exc:
+        wl.load_scene(d)
+    lines = str(exc.value).splitlines()
+    assert "walker.leg.bodies.0.mas_kg: unknown field (did you mean mass_kg?)" in lines[0]
+    assert "simulate.stride: unknown field (did you mean strides?)" in lines[1]
+    assert any("slope.angle_rad:" in ln and "'steep'" in ln for ln in lines[2:])
+
+
+def test_cli_prints_every_config_error_without_traceback_even_in_debug(tmp_path):
+    p = tmp_path / "typo.yaml"
+    p.write_text((ROOT / "configs" / "paper.yaml").read_text().replace("hip_mass_kg",
+                                                                       "hip_mas_kg"))
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    for debug in ("0", "1"):
+        out = subprocess.run([sys.executable, "-m", "walkerlab.cli", "fixedpoint", str(p),
+                              "--runs-dir", str(tmp_path)], capture_output=True, text=True,
+                             env={**env, "WALKERLAB_DEBUG": debug}, timeout=120)
+        assert out.returncode == 1
+        assert "walker.hip_mas_kg: unknown field (did you mean hip_mass_kg?)" in out.stderr
+        if debug == "0":
+            assert out.stderr.splitlines()[0].startswith("error: ")
+            assert "Traceback" not in out.stderr
+
+
+# ---------------------------------------------------------------- caching and locks
+def test_no_lock_file_is_left_behind(tmp_path):
+    from walkerlab.stages import simulate
+
+    simulate.run(wl.load_scene(_paper(name="lk")), tmp_path, strides=1)
+    assert (tmp_path / "lk" / "simulate.h5").is_file()
+    assert list((tmp_path / "lk").glob(".*.lock")) == []
+
+
+def test_lock_stays_exclusive_when_the_holder_removes_its_file(tmp_path):
+    """Writers that queue on a lock file its holder removes still run one at a time."""
+    from walkerlab.io.runpaths import artifact_lock
+
+    target = tmp_path / "x.h5"
+    inside, most, log = [0], [0], []
+    guard = threading.Lock()
+
+    def writer(k):
+        with artifact_lock(target, wait=True):
+            with guard:
+                inside[0] += 1
+                most[0] = max(most[0], inside[0])
+            time.sleep(0.05)
+            log.append(k)
+            with guard:
+                inside[0] -= 1
+
+    threads = [threading.Thread(target=writer, args=(k,)) for k in range(6)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    assert sorted(log) == list(range(6)) and most[0] == 1
+    assert not (tmp_path / ".x.h5.lock").exists()
+
+
+def test_fixedpoint_command_writes_the_artifact_the_report_needs(tmp_path):
+    from walkerlab.io.artifacts import content_hash
+    from walkerlab.stages import fixedpoint
+
+    sc = wl.load_scene(ROOT / "configs" / "paper.yaml")
+    first = fixedpoint.run(sc, tmp_path)  # what `walkerlab fixedpoint` runs
+    h = content_hash(first.path)
+    again = fixedpoint.run(sc, tmp_path, compare_variants=True)  # what the report runs
+    assert again.reused and content_hash(first.path) == h  # contact-sim keys on this hash
+    with h5py.File(first.path, "r") as f:
+        assert {"appendix_a", "appendix_a_literal"} <= set(f["variants"])
+
+
+def test_a_longer_simulate_run_is_kept_and_said_and_a_recompute_says_why(tmp_path, capfd):
+    from walkerlab.stages import simulate
+
+    sc = wl.load_scene(_paper(name="st", simulate={"strides": 1, "sample_rate_hz": 200}))
+    long = simulate.run(sc, tmp_path, strides=3)
+    capfd.readouterr()
+    out = simulate.run(sc, tmp_path)  # the scene's 1 stride, as the report asks
+    assert out.reused and "kept 3 strides" in out.note and out.path == long.path
+    with h5py.File(out.path, "r") as f:
+        assert int(f.attrs["strides_requested"]) == 3
+    simulate.run(sc, tmp_path, strides=2)  # fewer than stored: recomputed, and said why
+    err = capfd.readouterr().err
+    assert "simulate: recomputing" in err and "simulate.strides 3 -> 2" in err
+
+
+def test_report_uses_only_the_artifacts_the_scene_produces(tmp_path):
+    from walkerlab.stages import report, simulate
+
+    sc = wl.load_scene(_paper(drop=("simulate", "contact", "contact_sim", "contact_solver",
+                                    "terrain", "workprecision", "basin"), name="ideal"))
+    simulate.run(sc, tmp_path, strides=1)  # a standalone run leaves simulate.h5 behind
+    said: list[str] = []
+    html = report.run(sc, tmp_path, echo=said.append)
+    md = (html.parent / "report.md").read_text()
+    assert "simulate.h5" not in md and "Per-step data" not in md
+    assert any(s.startswith("report: leaves out simulate.h5") and "'simulate' section" in s
+               for s in said), said
+    assert any("no trajectory figures" in s for s in said)
+
+
+# ---------------------------------------------------------------- the example notebook
+def test_example_notebook_runs(tmp_path, monkeypatch):
+    """``examples/walkerlab_tour.ipynb`` executes top to bottom (nbclient), writing only into
+    a temporary runs folder."""
+    nbformat = pytest.importorskip("nbformat")
+    nbclient = pytest.importorskip("nbclient")
+    monkeypatch.setenv("WALKERLAB_TOUR_RUNS", str(tmp_path / "runs"))
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(
+        [str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+    nb = nbformat.read(ROOT / "examples" / "walkerlab_tour.ipynb", as_version=4)
+    before = set((ROOT / "runs").rglob("*")) if (ROOT / "runs").exists() else set()
+    nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
+                            resources={"metadata": {"path": str(ROOT / "examples")}}).execute()
+    outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]
+    assert not [o for o in outputs if o.output_type == "error"]
+    assert any("image/png" in o.get("data", {}) for o in outputs)  # the figure
+    text = "".join(o.get("text", "") for o in outputs)
+    assert "step period" in text and "-> stable" in text
+    assert (tmp_path / "runs" / "paper_rods" / "basin.h5").is_file()
+    after = set((ROOT / "runs").rglob("*")) if (ROOT / "runs").exists() else set()
+    assert after == before  # nothing written into the repository

@@ -1,0 +1,364 @@
+"""walkerlab's Python front door: scenes in, ``xarray.Dataset`` out.
+
+Every function runs the *same* stage as the command line (:mod:`walkerlab.stages`): it
+writes (or reuses, when up to date) the stage's HDF5 artifact in the runs folder
+(``runs_dir``, default ``runs/``, as ``--runs-dir``), then reads the artifact back with
+:func:`walkerlab.io.datasets.load_dataset`, through its netCDF-4 view.  So a notebook and
+``walkerlab report`` share one code path, one cache and one set of files, and a dataset holds
+exactly what the artifact holds: named dimensions (``time``, ``state``, ``step``,
+``multiplier``, the swept field ``slope.angle_deg``, ``x``/``y`` of a basin ...), coordinate
+variables, and ``units``/``long_name`` on every variable.
+
+``walkerlab.sweep`` is also the package :mod:`walkerlab.sweep`; calling it calls
+:func:`sweep` (the package is callable), so ``walkerlab.sweep(scene, param, values)`` works
+whether or not the package has been imported.
+
+Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
+Importing this module loads neither them nor the numeric stack: each function imports what
+it uses.
+
+Example
+-------
+>>> import walkerlab as wl
+>>> scene = wl.load_scene("configs/kneed.yaml")
+>>> gait = wl.fixed_point(scene, runs_dir="runs")        # doctest: +SKIP
+>>> float(gait.step_period), gait.multipliers.values      # doctest: +SKIP
+>>> run = wl.simulate(scene, strides=2)                   # doctest: +SKIP
+>>> run.leg1_angle.plot()                                 # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # pragma: no cover
+    import xarray
+
+    from walkerlab.config import Scene
+
+__all__ = ["load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
+           "compare", "sweep", "basin"]
+
+DEFAULT_RUNS = Path("runs")
+
+
+def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = None) -> Scene:
+    """Read and validate a scene from a YAML file or a plain mapping.
+
+    Parameters
+    ----------
+    path_or_dict : str, Path or dict
+        A scene YAML file (``configs/kneed.yaml``) or the same content as a mapping
+        (``{"walker": {...}, "slope": {...}, "fixedpoint": {...}}``).
+    name : str, optional
+        Run-folder name (``runs/<name>/``); default: the scene's ``name``, else the file
+        stem, else ``"scene"`` for a mapping.
+
+    Returns
+    -------
+    walkerlab.config.Scene
+        The validated, frozen scene (pass it to every other function here).
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        File missing, malformed YAML, or fields that do not validate (every error, one line
+        each, unknown keys first with the closest field name).
+    """
+    from walkerlab.config import Scene, scene_from_dict
+    from walkerlab.config import load_scene as _load
+
+    if isinstance(path_or_dict, Scene):
+        sc = path_or_dict
+    elif isinstance(path_or_dict, dict):
+        data = dict(path_or_dict)
+        data.setdefault("name", "scene")
+        sc = scene_from_dict(data)
+    else:
+        sc = _load(path_or_dict)
+    if name is not None:
+        origin = getattr(sc, "_origin", None)
+        sc = sc.model_copy(update={"name": name})
+        sc._origin = origin
+    return sc
+
+
+def _scene(scene) -> Scene:
+    from walkerlab.config import Scene
+
+    return scene if isinstance(scene, Scene) else load_scene(scene)
+
+
+def _read(path: Path) -> xarray.Dataset:
+    from walkerlab.io.datasets import load_dataset
+
+    return load_dataset(path)
+
+
+def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
+                force: bool = False) -> xarray.Dataset:
+    """The period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers.
+
+    Runs the ``fixedpoint`` stage (as ``walkerlab fixedpoint``) and reads
+    ``runs/<scene>/fixedpoint.h5``.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        A scene (see :func:`load_scene`); needs a ``fixedpoint`` section.
+    runs_dir : str or Path
+        Runs folder (``--runs-dir``); the artifact is reused when up to date.
+    force : bool
+        Recompute even if the artifact is up to date.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``fixed_point`` (state,) [rad, rad/s; per-state unit in coordinate ``state_unit``],
+        state just after heel strike; ``step_period`` () [s]; ``multipliers`` (multiplier,)
+        complex Floquet multipliers (variational equations), ``multipliers_fd`` (finite
+        differences); ``jacobian`` (state, state_in) of the Poincaré map; ``floquet_stable``
+        (all |multiplier| < 1); ``residual`` () max |P(x*) - x*|; ``initial_guess``.
+        Attributes: the artifact's (``scene_json``, ``input_hash``, ``variant`` ...).
+
+    Raises
+    ------
+    walkerlab.stages.common.StageError
+        No ``fixedpoint`` section, or no fixed point found (one line saying why).
+    walkerlab.config.SceneError
+        The scene does not validate.
+    ImportError
+        xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
+    """
+    from walkerlab.stages import fixedpoint as stage
+
+    return _read(stage.run(_scene(scene), runs_dir, force).path)
+
+
+def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
+                 force: bool = False) -> xarray.Dataset:
+    """Every period-1 gait stored for the scene, on a ``gait`` dimension.
+
+    The scene's own gait first (``gait`` = its equation variant), then the other equation
+    variants a compass gait compared with published numbers is solved with (the report's
+    comparison with Eq. 11).  Same stage and artifact as :func:`fixed_point`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``fixed_point`` (gait, state) [rad, rad/s], ``multipliers`` (gait, multiplier)
+        complex, ``step_period`` (gait,) [s], ``residual`` (gait,), ``stable`` (gait,).
+
+    Raises
+    ------
+    StageError, SceneError, ImportError
+        As :func:`fixed_point`.
+    """
+    from walkerlab.io.datasets import load_fixed_points
+    from walkerlab.stages import fixedpoint as stage
+
+    return load_fixed_points(stage.run(_scene(scene), runs_dir, force).path)
+
+
+def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
+             runs_dir: str | Path = DEFAULT_RUNS, force: bool = False) -> xarray.Dataset:
+    """Simulate strides of the rigid hybrid walker from its fixed point (``simulate`` stage).
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+    strides : int, optional
+        Strides (1 stride = 2 steps); default ``simulate.strides`` of the scene (5 when the
+        scene has no ``simulate`` section).  As ``walkerlab simulate --strides``.
+    runs_dir : str or Path
+    force : bool
+
+    Returns
+    -------
+    xarray.Dataset
+        On ``time`` (k,) [s]: every named coordinate (``leg1_angle`` [rad], ``leg1_rate``
+        [rad/s], ...), ``energy_kinetic``/``energy_potential``/``energy_total`` [J]
+        (potential from the first stance foot), ``<point>_x``/``<point>_y`` [m] (``hip``,
+        ``leg1_foot`` ...), ``stance_leg``, ``step_index``, ``phase``.  On ``step``: the
+        step table ``steps_period`` [s], ``steps_step_length`` [m], ``steps_hip_speed``
+        [m/s], ``steps_impact_energy_loss`` [J], ``steps_termination`` ...
+        Attribute ``termination``: ``heel_strike`` when every step completed; a walker
+        that falls is recorded (``fall``), not raised.
+
+    Raises
+    ------
+    StageError
+        Upstream failure (no fixed point), or ``strides`` < 1.
+    SceneError, ImportError
+        As :func:`fixed_point`.
+    """
+    from walkerlab.stages import simulate as stage
+
+    return _read(stage.run(_scene(scene), runs_dir, force, strides=strides).path)
+
+
+def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
+                     periodic: bool = False, runs_dir: str | Path = DEFAULT_RUNS,
+                     force: bool = False) -> xarray.Dataset:
+    """Simulate the compliant-contact (MSC ADAMS style) walker (``contact-sim`` stage).
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        Needs a ``contact`` section.
+    adjust : bool
+        Search the initial rates that make the contact walker match the ideal gait
+        (``--adjust``).
+    periodic : bool
+        Also find the contact walker's own periodic gait and its Floquet multipliers.
+    runs_dir, force
+        As :func:`fixed_point`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The trajectory on ``time`` as :func:`simulate` (same names), the feet's contact
+        forces ``feet_<leg>_normal_force`` / ``_friction_force`` [N], ``_penetration``
+        [m], ``_slip_velocity`` [m/s] on ``time``; touchdown/lift-off times; the per-step
+        table on ``step``; ``summary_*`` scalars; the drop test on ``stiffness``;
+        ``periodic_gait_multipliers`` (multiplier,) complex with ``periodic``.
+        Attribute ``outcome``: ``completed``, ``trip``, ``fall``, ... (recorded, not raised).
+
+    Raises
+    ------
+    StageError
+        No ``contact`` section, or no fixed point to start from.
+    SceneError, ImportError
+        As :func:`fixed_point`.
+    """
+    from walkerlab.stages import contact_sim as stage
+
+    return _read(stage.run(_scene(scene), runs_dir, force, adjust=adjust,
+                           periodic=periodic).path)
+
+
+def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
+            force: bool = False) -> xarray.Dataset:
+    """Errors and gait metrics between the rigid and the contact walker (``compare`` stage).
+
+    Runs (or reuses) :func:`simulate` and :func:`contact_simulate` first.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``error_<coordinate>`` (time,) contact - ideal on the ideal sample times [rad or
+        rad/s]; ``errors_max_abs_angle`` [rad], ``errors_max_abs_rate`` [rad/s];
+        ``metrics_ideal_*`` / ``metrics_contact_*`` scalars (Table 3: step times [s], speed
+        [m/s], mean energy [J], step length [m]); ``errors_limit_cycle_distance_*``.
+
+    Raises
+    ------
+    StageError, SceneError, ImportError
+        As :func:`contact_simulate`.
+    """
+    from walkerlab.stages import compare as stage
+
+    return _read(stage.run(_scene(scene), runs_dir, force).path)
+
+
+def _axis_spec(param: str, values: Sequence) -> str:
+    """``"slope.angle_deg=1.0,1.5"`` from a field and its values (as ``--param``)."""
+    import numbers
+
+    def text(v) -> str:
+        if isinstance(v, bool) or not isinstance(v, numbers.Real):
+            return str(v)
+        return str(int(v)) if isinstance(v, numbers.Integral) else repr(float(v))
+
+    vals = list(values)
+    if not vals:
+        raise ValueError(f"sweep {param}: no values given")
+    return f"{param}=" + ",".join(text(v) for v in vals)
+
+
+def sweep(scene: Scene | str | Path | dict, param: str, values: Sequence, *,
+          stage: str = "fixedpoint", workers: int = 1, name: str | None = None,
+          runs_dir: str | Path = DEFAULT_RUNS, progress: bool = False) -> xarray.Dataset:
+    """Run a stage over values of one scene field (``walkerlab sweep``).
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+    param : str
+        Dotted scene field, e.g. ``"slope.angle_deg"`` or ``"walker.hip_mass_kg"``.
+    values : sequence
+        Values of the field, in sweep order (continuation runs along them: each point
+        starts from its neighbour's fixed point).
+    stage : {"fixedpoint", "simulate", "contact-sim"}
+    workers : int
+        Local worker processes (1: in this process).
+    name : str, optional
+        Artifact name (``runs/<scene>/<name>.h5``); default ``sweep_<stage>_<hash>``.
+    runs_dir : str or Path
+    progress : bool
+        Show the progress bar.
+
+    Returns
+    -------
+    xarray.Dataset
+        One dimension named by the swept field (``slope.angle_deg``, its coordinate with the
+        field's unit); per point: ``outcome`` (``ok``, ``no_fixed_point``, ``fell`` ... see
+        :mod:`walkerlab.sweep.outcomes`), ``message``, the stage's columns (fixed point
+        ``<role>_angle_rad`` ..., ``step_period_s`` [s], ``max_abs_multiplier``, ``stable``
+        ...) and ``wall_time_s``.  A failed point is a row with its outcome, never an
+        exception.
+
+    Raises
+    ------
+    walkerlab.sweep.params.SweepError
+        Unknown field, values the field refuses, or an unknown stage.
+    SceneError, ImportError
+        As :func:`fixed_point`.
+    """
+    from walkerlab.stages import sweep as stage_mod
+
+    path = stage_mod.run(_scene(scene), [_axis_spec(param, values)], stage=stage,
+                         workers=workers, runs_root=runs_dir, name=name, progress=progress)
+    return _read(path)
+
+
+def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None, *,
+          workers: int = 1, runs_dir: str | Path = DEFAULT_RUNS,
+          force: bool = False) -> xarray.Dataset:
+    """Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        Needs a ``fixedpoint`` section; the ``basin`` section (axes, ranges, start) is
+        optional (defaults: :class:`walkerlab.config.BasinSettings`).
+    grid : (nx, ny), optional
+        Cells along x and y (default ``basin.grid``, 200 x 200; use e.g. (20, 20) to look).
+    workers : int
+        Local worker processes (1: in this process).
+    runs_dir, force
+        As :func:`fixed_point`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``outcome`` (y, x): index into attribute ``outcomes`` (``converged`` = reaches the
+        period-1 gait, other attractor, fell forward/backward ...); ``steps`` (y, x) steps
+        until decided; ``period`` (y, x); coordinates ``x``, ``y`` (cell centres, in the
+        units of the state components named by attributes ``x_axis``/``y_axis``);
+        ``counts_<outcome>`` cells per outcome; ``fixed_point_<state>``.
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section or bad basin settings.
+    SceneError, ImportError
+        As :func:`fixed_point`.
+    """
+    from walkerlab.stages import basin as stage
+
+    out = stage.run(_scene(scene), runs_dir, force, grid=tuple(grid) if grid else None,
+                    workers=workers)
+    return _read(out.path)
