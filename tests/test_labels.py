@@ -218,15 +218,20 @@ def test_report_cites_the_paper_not_a_path(tmp_path):
 
 
 # --------------------------------------------------------------------------- figures
-def test_figures_in_paper_order(tmp_path):
+def test_figures_in_paper_order(tmp_path, monkeypatch):
+    from walkerlab.report import sections
     from walkerlab.report.sections import CAPTIONS, figures_section
+
+    monkeypatch.setattr(sections, "steps_table", lambda path: [])  # no artifact read here
 
     stems = [s for s, _ in CAPTIONS]
     assert stems[:6] == ["fig2_stick_ideal", "fig6_stick_contact", "fig7_angles_rates",
                          "fig8_errors", "fig9_limit_cycles", "fig10_energy"]
     for s in stems[:6]:
         (tmp_path / f"{s}.png").write_bytes(b"")
-    md = "\n".join(figures_section(tmp_path, "figures", {}))
+    # every figure's artifacts are among the report's (figures of left-out artifacts are dropped)
+    paths = {k: tmp_path / f"{k}.h5" for k in ("simulate", "contact-sim", "compare")}
+    md = "\n".join(figures_section(tmp_path, "figures", paths))
     pos = [md.index(f"figures/{s}.png") for s in stems[:6]]
     assert pos == sorted(pos)
 
