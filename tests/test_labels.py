@@ -222,7 +222,7 @@ def test_figures_in_paper_order(tmp_path, monkeypatch):
     from walkerlab.report import sections
     from walkerlab.report.sections import CAPTIONS, figures_section
 
-    monkeypatch.setattr(sections, "steps_table", lambda path: [])  # no artifact read here
+    monkeypatch.setattr(sections, "steps_table", lambda path: "")  # no artifact read here
 
     stems = [s for s, _ in CAPTIONS]
     assert stems[:6] == ["fig2_stick_ideal", "fig6_stick_contact", "fig7_angles_rates",
