@@ -73,18 +73,21 @@ def _tell(msg: str) -> None:
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
                force: bool = False, extra_attrs: dict | None = None,
-               extra_key: str = "", also_accept: tuple[str, ...] = ()) -> StageOutcome:
+               extra_key: str = "", also_accept: tuple[str, ...] = (),
+               artifact: str | None = None) -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
     ``extra_key`` enters the input hash; an artifact written with one of the ``also_accept``
-    keys (a superset of what is asked for) counts as up to date too.
+    keys (a superset of what is asked for) counts as up to date too.  ``artifact``: the
+    file stem when it is not the stage's name (``bifurcation_<field>``; from
+    :mod:`walkerlab.io.runpaths`).
     """
     from walkerlab.io.runpaths import model_cache_dir
     from walkerlab.models.cache import set_cache_dir
 
     set_cache_dir(model_cache_dir(runs_root))  # generated model code lives in runs/
-    path = stage_artifact(scene, runs_root, stage, claim=True)
+    path = stage_artifact(scene, runs_root, artifact or stage, claim=True)
     # one writer per artifact: a second identical run waits, then finds the result up to date
     with artifact_lock(path, wait=True, on_wait=_tell):
         key = input_hash(stage, scene, sections, upstream, extra_key)
