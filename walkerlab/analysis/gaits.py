@@ -50,6 +50,7 @@ from walkerlab.analysis.poincare import (
 from walkerlab.models.base import HybridWalker
 
 __all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "seed_states", "state_from_legs",
+           "deflation_starts", "step_length",
            "find_gaits", "select_gait"]
 
 #: gait choices of ``fixedpoint.gait``
@@ -243,7 +244,7 @@ def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
 
 
 # ----------------------------------------------------------------------------- search
-def _step_length(walker: HybridWalker, x: np.ndarray) -> float:
+def step_length(walker: HybridWalker, x: np.ndarray) -> float:
     """Length of the step of a state just after heel strike [m] (the swing foot's offset
     from the stance foot; NaN for a walker without a ``swing_foot`` point)."""
     foot = walker.points(x).get("swing_foot")
@@ -274,7 +275,7 @@ def deflation_starts(walker: HybridWalker, first: FixedPointResult) -> list[np.n
             dz = np.zeros(z1.size)
             dz[j] = sign * DEFLATION_OFFSET * max(abs(float(z1[j])), 0.1)
             x = walker.from_section(z1 + dz)
-            pair.append((_step_length(walker, x), x))
+            pair.append((step_length(walker, x), x))
         (l_plus, x_plus), (l_minus, x_minus) = pair
         flip = math.isfinite(l_plus) and math.isfinite(l_minus) and \
             abs(l_plus - l_minus) > 1e-12 and ((l_minus < l_plus) == shorter_first)
@@ -303,7 +304,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         Which gait to choose (:func:`select_gait`).
     other_gait : bool
         Also look for the other gait of the long/short-period pair (deflation; a few
-        root-finder runs, ~0.2-2 s).  Needed by the ``long_period``/``short_period``
+        root-finder runs, about 0.05-0.4 s).  Needed by the ``long_period``/``short_period``
         policies and by ``stable`` when the first gait found is unstable.
     xtol, fd_step, max_step_time, fd_check
         As :func:`walkerlab.analysis.poincare.find_fixed_point`.
