@@ -178,7 +178,7 @@ def test_sweep_columns_and_bifurcation_arrays_follow_the_walker(walker, fixed_po
         abs(x["stance_angle"] - x["swing_angle"]), rel=1e-12)
     n = 2
     res = BifurcationResult(
-        slopes_deg=np.array([1.0, 1.1]), state_names=walker.state_names(),
+        values=np.array([1.0, 1.1]), state_names=walker.state_names(),
         state_units=walker.state_units(), fixed_point=np.tile(fixed_point.x, (n, 1)),
         fixed_point_interleg_deg=np.full(n, 20.0),
         multipliers=np.tile(fixed_point.multipliers_variational, (n, 1)),

@@ -362,21 +362,45 @@ def sweep(scene: Path | None = SceneArg,
 @app.command()
 @_guard
 def bifurcation(scene: Path | None = SceneArg,
-                slopes: str = typer.Option("1:5.5:0.05", "--slopes",
-                                           help="slope grid in degrees: start:stop:step "
-                                           "or a,b,c"),
+                slopes: str | None = typer.Option(None, "--slopes",
+                                                  help="slope grid in degrees: start:stop:step "
+                                                  "or a,b,c (default 1:5.5:0.05)",
+                                                  show_default=False),
+                param: str | None = typer.Option(None, "--param",
+                                                 help="continue over another numeric scene "
+                                                 "field instead of the slope, in the field's "
+                                                 "unit: FIELD=start:stop:step or FIELD=a,b,c "
+                                                 "(e.g. walker.leg.bodies.thigh_mass.mass_kg"
+                                                 "=0.3:0.7:0.05); writes "
+                                                 "bifurcation_<FIELD>.h5"),
                 transient: int = typer.Option(100, "--transient", min=1,
                                               help="steps discarded before sampling"),
-                keep: int = typer.Option(30, "--keep", min=1, help="heel strikes kept per slope"),
+                keep: int = typer.Option(30, "--keep", min=1,
+                                         help="heel strikes kept per grid value"),
                 workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
                 runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
-    """Bifurcation diagram over the slope: fixed points, multipliers, period-doubling onset."""
+    """Bifurcation diagram over the slope (or any numeric scene field, --param): fixed
+    points, multipliers, period-doubling onset."""
     from walkerlab.stages import bifurcation as stage
-    from walkerlab.sweep.params import parse_param
+    from walkerlab.sweep.params import SweepError, check_axes, parse_param
 
-    axis = parse_param(f"slope.angle_deg={slopes}")
-    out = stage.run(_load(scene), axis.values, runs_dir, transient, keep, workers, force=force)
-    typer.echo(f"period-doubling onset: {out.summary['onset_deg']:.4f} deg")
+    if slopes is not None and param is not None:
+        _fail(SweepError("--slopes and --param exclude each other (--slopes S is "
+                         "--param slope.angle_deg=S)"))
+    axis = parse_param(param if param is not None
+                       else f"slope.angle_deg={slopes or '1:5.5:0.05'}")
+    sc = _load(scene)
+    if param is not None:
+        check_axes(sc, [axis])
+        if not axis.numeric:
+            _fail(SweepError(f"--param {axis.spec!r}: a bifurcation needs numbers"))
+    out = stage.run(sc, axis.values, runs_dir, transient, keep, workers, force=force,
+                    param=axis.path)
+    onset, unit = out.summary["onset"], out.summary["unit"]
+    where = (f"{onset:.4f} deg" if axis.path == "slope.angle_deg"
+             else f"{axis.path} = {onset:.6g} {unit}".removesuffix(" -"))
+    typer.echo(f"period-doubling onset: {where}" if onset == onset
+               else "period-doubling onset: none on the grid")
     typer.echo(_status(out))
     typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
 

@@ -122,3 +122,23 @@ def relabel_artifact(f, units: Units) -> None:
                 obj.attrs["unit"] = new
                 obj.attrs["units"] = "1"  # CF: dimensionless
     f.visititems(visit)
+
+
+#: SI unit of a config field, by the suffix of its name (longest suffix first)
+FIELD_SUFFIX_UNITS = (
+    ("_rad_per_s", "rad/s"), ("_m_per_s2", "m/s^2"), ("_m_per_s", "m/s"),
+    ("_kg_m2", "kg m^2"), ("_deg", "deg"), ("_rad", "rad"), ("_kg", "kg"), ("_mm", "mm"),
+    ("_hz", "Hz"), ("_m", "m"), ("_s", "s"),
+)
+
+
+def field_unit(name: str) -> str | None:
+    """SI unit of a config field from the suffix of its name (``mass_kg`` -> ``"kg"``,
+    ``leg_length_m`` -> ``"m"``, ``angle_deg`` -> ``"deg"``, ``gravity_m_per_s2`` ->
+    ``"m/s^2"``); a dotted path is read by its last part.  None when the name carries no
+    unit (``contact.stiffness``: the unit is then in the field's metadata)."""
+    leaf = name.rsplit(".", 1)[-1]
+    for suffix, unit in FIELD_SUFFIX_UNITS:
+        if leaf.endswith(suffix):
+            return unit
+    return None

@@ -16,7 +16,13 @@ swing leg's rate), so a root finder started between them lands on either.  This 
    Poincaré map (``|P(z) - z| / |z|`` on the heel-strike section) and roots from the best;
 3. looks for the other gait of the pair by *deflation* (Farrell, Birkisson & Funke 2015,
    SIAM J. Sci. Comput. 37(4)): the root finder, on the residual divided by the distance to
-   the gait already found, from starts a few percent off it along each section coordinate;
+   the gait already found, from starts a few percent off it along each section coordinate
+   (:func:`deflation_starts`: along each coordinate the start towards the partner's expected
+   step length first - shorter when the first gait is stable, the long-period gait of the
+   pair on shallow slopes).  The deflated search runs at the screening tolerance
+   (:func:`_coarse`, cheaper maps, loose ``xtol``); the root it finds is then polished at
+   the scene's tolerance without deflation, MINPACK ``hybrj`` starting from the coarse
+   root's own variational Jacobian (a few maps);
 4. labels the gaits (``long_period`` / ``short_period`` by step period) and picks one by the
    scene's policy (``stable``, ``long_period``, ``short_period``, ``nearest_guess``).
 
@@ -44,6 +50,7 @@ from walkerlab.analysis.poincare import (
 from walkerlab.models.base import HybridWalker
 
 __all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "seed_states", "state_from_legs",
+           "deflation_starts", "step_length",
            "find_gaits", "select_gait"]
 
 #: gait choices of ``fixedpoint.gait``
@@ -59,6 +66,8 @@ ROOT_STARTS = 6
 DEFLATION_OFFSET = 0.05
 #: two fixed points closer than this (max |x1 - x2|, rad and rad/s) are the same gait
 SAME_GAIT = 1e-6
+#: root-finder xtol of the deflated search at the screening tolerance (then polished)
+COARSE_XTOL = 1e-7
 
 
 class GaitNotFound(FixedPointNotFound):
@@ -235,6 +244,45 @@ def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
 
 
 # ----------------------------------------------------------------------------- search
+def step_length(walker: HybridWalker, x: np.ndarray) -> float:
+    """Length of the step of a state just after heel strike [m] (the swing foot's offset
+    from the stance foot; NaN for a walker without a ``swing_foot`` point)."""
+    foot = walker.points(x).get("swing_foot")
+    return float(np.linalg.norm(foot)) if foot is not None else math.nan
+
+
+def deflation_starts(walker: HybridWalker, first: FixedPointResult) -> list[np.ndarray]:
+    """Starts of the deflated search for the other gait of the pair (states (2n,)).
+
+    ``first``'s section coordinates offset by :data:`DEFLATION_OFFSET` (relative, at least
+    0.1 absolute) one at a time, both ways.  Along each coordinate the way that moves the
+    step length towards the partner's comes first: shorter when ``first`` is stable (on
+    shallow slopes the stable gait of the pair is the long-period one with the longer step,
+    Goswami et al. 1996, Garcia et al. 1998), longer when it is unstable; a coordinate that
+    does not change the step (a rate) keeps ``+`` first.
+
+    Returns
+    -------
+    list of ndarray (2n,)
+        ``2 * (2n - 1)`` states on the heel-strike section.
+    """
+    z1 = walker.section(first.x)
+    shorter_first = bool(first.stable)
+    out = []
+    for j in range(z1.size):
+        pair = []
+        for sign in (1.0, -1.0):
+            dz = np.zeros(z1.size)
+            dz[j] = sign * DEFLATION_OFFSET * max(abs(float(z1[j])), 0.1)
+            x = walker.from_section(z1 + dz)
+            pair.append((step_length(walker, x), x))
+        (l_plus, x_plus), (l_minus, x_minus) = pair
+        flip = math.isfinite(l_plus) and math.isfinite(l_minus) and \
+            abs(l_plus - l_minus) > 1e-12 and ((l_minus < l_plus) == shorter_first)
+        out += [x_minus, x_plus] if flip else [x_plus, x_minus]
+    return out
+
+
 def _is_new(res: FixedPointResult, found: list[Gait]) -> bool:
     return all(float(np.max(np.abs(res.x - g.result.x))) > SAME_GAIT for g in found)
 
@@ -256,7 +304,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         Which gait to choose (:func:`select_gait`).
     other_gait : bool
         Also look for the other gait of the long/short-period pair (deflation; a few
-        root-finder runs, ~0.2-2 s).  Needed by the ``long_period``/``short_period``
+        root-finder runs, about 0.05-0.4 s).  Needed by the ``long_period``/``short_period``
         policies and by ``stable`` when the first gait found is unstable.
     xtol, fd_step, max_step_time, fd_check
         As :func:`walkerlab.analysis.poincare.find_fixed_point`.
@@ -290,10 +338,11 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     best = math.inf
     last_msg = ""
 
-    def attempt(x0, source: str, deflate=()) -> Gait | None:
+    def attempt(x0, source: str, deflate=(), jacobian_guess=None) -> Gait | None:
         nonlocal best, last_msg
         try:
-            res = find_fixed_point(walker, x0, solver, deflate=deflate, **kw)
+            res = find_fixed_point(walker, x0, solver, deflate=deflate,
+                                   jacobian_guess=jacobian_guess, **kw)
         except FixedPointNotFound as exc:
             if math.isfinite(exc.residual) and "standing" not in str(exc):
                 best = min(best, exc.residual)
@@ -326,15 +375,30 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     need_other = other_gait or policy in ("long_period", "short_period") or (
         policy == "stable" and not found[0].result.stable)
     if need_other:
-        first = found[0].result.x
-        z1 = walker.section(first)
+        first = found[0].result
+        coarse = _coarse(solver)
         n_defl = 0
-        for j, sign in itertools.product(range(z1.size), (1.0, -1.0)):
-            dz = np.zeros(z1.size)
-            dz[j] = sign * DEFLATION_OFFSET * max(abs(float(z1[j])), 0.1)
+        for x0 in deflation_starts(walker, first):
             n_defl += 1
-            g = attempt(walker.from_section(z1 + dz), "deflation", deflate=(first,))
-            if g is not None:
+            try:  # cheap maps and a loose xtol to find the partner ...
+                rough = find_fixed_point(walker, x0, coarse, xtol=COARSE_XTOL, fd_step=fd_step,
+                                         max_step_time=max_step_time, fd_check=False,
+                                         deflate=(first.x,))
+            except FixedPointNotFound as exc:
+                last_msg = str(exc)
+                continue
+            if not _is_new(rough, found):
+                continue
+            # ... then polished at the scene's tolerance (no deflation): MINPACK hybrj from
+            # the coarse root's own Jacobian, or, should its updates stall, hybrd
+            g = attempt(rough.x, "deflation", jacobian_guess=rough.jacobian_variational) \
+                or attempt(rough.x, "deflation")
+            if g is not None:  # the gait's start and costs include the coarse pass
+                g.start = np.asarray(x0, float)
+                g.result = dataclasses.replace(
+                    g.result, nfev=g.result.nfev + rough.nfev,
+                    iterations=g.result.iterations + rough.iterations,
+                    wall_time_s=g.result.wall_time_s + rough.wall_time_s)
                 found.append(g)
                 break
         tried.append(f"{n_defl} deflated starts near the first gait")

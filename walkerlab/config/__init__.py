@@ -347,7 +347,8 @@ class FixedPointSettings(_Strict):
         "'nearest_guess' (where the root finder goes from initial_guess)")
     other_gait: bool = Field(
         True, description="also look for the other gait of the pair (deflated root finding "
-        "near the first; about 0.2-2 s) and record both in fixedpoint.h5")
+        "near the first at a screening tolerance, then polished; about 0.05-0.4 s) and "
+        "record both in fixedpoint.h5")
     tolerance: float = Field(1e-12, gt=0, lt=1e-3, description="root-finder xtol [-]")
     max_step_time_s: float = Field(5.0, gt=0,
                                    description="a step longer than this is a failure [s]")

@@ -46,7 +46,7 @@ except ImportError:  # pragma: no cover
 
 __all__ = ["RunPathError", "ArtifactBusy", "check_name", "scene_dir", "stage_artifact",
            "named_artifact", "scene_file", "report_dir", "figures_dir", "run_cache_dir",
-           "artifact_lock", "refuse_link",
+           "artifact_lock", "refuse_link", "bifurcation_stem", "bifurcation_artifacts",
            "STAGE_FILES"]
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
@@ -55,7 +55,8 @@ MAX_NAME = 100
 # File stems that belong to stages (a sweep or any free --name may not take them).
 STAGE_FILES = frozenset({"fixedpoint", "simulate", "contact_sim", "compare", "workprecision",
                          "bifurcation", "basin", "report", "plot", "sweep"})
-STAGE_PREFIXES = ("stability_map", "stability-map")  # stability_map_<kind>.h5
+STAGE_PREFIXES = ("stability_map", "stability-map",  # stability_map_<kind>.h5
+                  "bifurcation_")                      # bifurcation_<field>.h5
 
 ORIGIN_FILE = ".scene"
 
@@ -145,6 +146,30 @@ def _mkdir(d: Path) -> None:
 def stage_artifact(scene, runs_root: Path | str, stage: str, claim: bool = False) -> Path:
     """``<runs>/<scene>/<stage>.h5`` (``contact-sim`` -> ``contact_sim.h5``)."""
     return scene_dir(scene, runs_root, claim) / f"{stage.replace('-', '_')}.h5"
+
+
+def bifurcation_stem(path: str) -> str:
+    """File stem of a bifurcation artifact over the dotted scene field ``path``:
+    ``bifurcation`` for the slope (``slope.angle_deg``, ``walkerlab bifurcation --slopes``),
+    ``bifurcation_<path>`` for any other field
+    (``bifurcation_walker.leg.bodies.thigh_mass.mass_kg``).
+
+    Raises
+    ------
+    RunPathError
+        The path does not make a safe file name.
+    """
+    if path == "slope.angle_deg":
+        return "bifurcation"
+    return check_name(f"bifurcation_{path}", "--param field")
+
+
+def bifurcation_artifacts(scene, runs_root: Path | str) -> dict[str, Path]:
+    """``{stem: path}`` of the scene's bifurcation artifacts over fields other than the
+    slope (``bifurcation_<field>.h5``), sorted by name."""
+    d = scene_dir(scene, runs_root)
+    return {p.stem: p for p in sorted(d.glob("bifurcation_*.h5")) if p.is_file()} \
+        if d.is_dir() else {}
 
 
 def named_artifact(scene, runs_root: Path | str, name: str, what: str = "--name",

@@ -1,7 +1,8 @@
 """Figures of sweeps, drawn from loaded artifacts only.
 
-- :func:`bifurcation_figure`: steady-state inter-leg angle at heel strike vs slope (the
-  period-doubling cascade), the period-1 branch, and its Floquet multipliers with the -1 line.
+- :func:`bifurcation_figure`: steady-state inter-leg angle at heel strike vs the slope or
+  any scene field (the period-doubling cascade), the period-1 branch, and its Floquet
+  multipliers with the -1 line; the axis named by the field and its unit.
 - :func:`stability_map_figure`: outcome per grid point of a 2-D sweep (categorical map) and
   the run time per point.
 - :func:`gait_map_figure`: stability map of the contact gait (gait exists / stable / max
@@ -20,7 +21,7 @@ import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
-from walkerlab.sweep.bifurcation import fall_onset
+from walkerlab.sweep.bifurcation import SLOPE_PATH, fall_onset, onset_value, parameter_values
 from walkerlab.sweep.outcomes import OUTCOMES
 
 OUTCOME_COLORS = {
@@ -38,20 +39,25 @@ def bifurcation_figure(data: dict, title: str = ""):
     Parameters
     ----------
     data : dict
-        Keys ``slope`` (n,) [deg], ``steady_state/interleg_angle`` (n, k) [deg],
+        Keys ``slope`` (n,) [deg] (or, with ``parameter_path`` and ``parameter_unit``, the
+        field's dotted path), ``steady_state/interleg_angle`` (n, k) [deg],
         ``fixed_point/interleg_angle`` (n,) [deg], ``floquet/real``, ``floquet/imag``
-        (n, 2m), ``onset/onset_slope`` [deg].
+        (n, 2m), ``onset/onset_slope`` [deg] (``onset/onset_value`` for another field).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    s = np.asarray(data["slope"], float)
+    s, path, unit = parameter_values(data)
+    xlabel = "slope φ [deg]" if path == SLOPE_PATH else f"{path} [{unit}]"
+
+    def at(v: float, fmt: str) -> str:  # a grid value with its unit, for the legend
+        return f"{v:{fmt}}°" if path == SLOPE_PATH else f"{v:.4g} {unit}".removesuffix(" -")
     il = np.asarray(data["steady_state/interleg_angle"], float)
     fp_il = np.asarray(data["fixed_point/interleg_angle"], float)
     mult = np.asarray(data["floquet/real"]) + 1j * np.asarray(data["floquet/imag"])
     stable = np.max(np.abs(mult), axis=1) < 1
-    onset = float(data.get("onset/onset_slope", np.nan))
+    onset = onset_value(data)
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True,
                                    gridspec_kw={"height_ratios": [3, 2]})
     ss, yy = np.repeat(s, il.shape[1]), il.ravel()
@@ -65,13 +71,13 @@ def bifurcation_figure(data: dict, title: str = ""):
     for k, ax in enumerate((ax1, ax2)):
         if np.isfinite(onset):  # named in the legend: a text label ran over the frame
             ax.axvline(onset, color="tab:red", lw=0.8, ls=":",
-                       label=f"period doubling at {onset:.3f}°" if k == 0 else None)
+                       label=f"period doubling at {at(onset, '.3f')}" if k == 0 else None)
     falls = fall_onset(data)
     if np.isfinite(falls):
         half = 0.5 * float(np.min(np.diff(s))) if s.size > 1 else 0.0
         for k, ax in enumerate((ax1, ax2)):
             ax.axvspan(falls - half, s.max() + half, color="0.85", hatch="//", ec="0.6", lw=0,
-                       zorder=0, label=f"walker falls (no steady gait) from {falls:.3g}°"
+                       zorder=0, label=f"walker falls (no steady gait) from {at(falls, '.3g')}"
                        if k == 0 else None)
     ax1.legend(fontsize=8, loc="upper left")
     if title:
@@ -81,7 +87,7 @@ def bifurcation_figure(data: dict, title: str = ""):
     ax2.plot(s, np.max(np.abs(mult), axis=1), "-", color="0.4", lw=1, label="max |multiplier|")
     ax2.axhline(-1.0, color="tab:red", lw=0.8)
     ax2.axhline(1.0, color="0.6", lw=0.6)
-    ax2.set_xlabel("slope φ [deg]")
+    ax2.set_xlabel(xlabel)
     ax2.set_ylabel("Floquet multiplier [-]")
     ax2.legend(fontsize=7, ncol=3, loc="lower left")
     fig.tight_layout()

@@ -383,7 +383,10 @@ def figures_section(fig_dir: Path, rel: str, paths: dict[str, Path]) -> list[str
         cap = ("The walker walking (`walkerlab animate`; rigid model, and the contact model "
                "beside it where it was simulated).")
         out += [f"![{cap}]({rel}/{gif.name})", "", f"*{cap}*", ""]
-    for stem, cap in CAPTIONS:
+    extra = [(png.stem, f"Bifurcation diagram over {png.stem.removeprefix('bifurcation_')} "
+                        "(`walkerlab bifurcation --param`).")
+             for png in sorted(fig_dir.glob("bifurcation_*.png"))]
+    for stem, cap in CAPTIONS + extra:
         png = fig_dir / f"{stem}.png"
         if not png.is_file() or not _drawn_from(stem, paths):
             continue
@@ -428,33 +431,66 @@ def workprecision_summary(scene, paths: dict[str, Path]) -> list[str]:
 
 # --------------------------------------------------------------------------- bifurcation
 def bifurcation_section(paths: dict[str, Path], pub: ModuleType | None = None) -> list[str]:
-    """Period-doubling onset from ``bifurcation.h5`` (when the scene ran that stage)."""
+    """Period-doubling onset from ``bifurcation.h5`` (when the scene ran that stage) and from
+    each ``bifurcation_<field>.h5`` (``bifurcation --param``), the grid named by its field
+    and unit."""
+    out = []
     p = paths.get("bifurcation")
-    if p is None:
-        return []
+    if p is not None:
+        out += _bifurcation_lines(p, pub)
+    for key in sorted(k for k in paths if k.startswith("bifurcation_")):
+        out += _bifurcation_lines(paths[key], None)
+    return out
+
+
+def _bifurcation_lines(p: Path, pub: ModuleType | None) -> list[str]:
+    from walkerlab.sweep.bifurcation import (
+        SLOPE_PATH,
+        fall_onset,
+        onset_value,
+        parameter_dim,
+    )
+
     with open_artifact(p, "bifurcation") as f:
-        onset = float(f["onset/onset_slope"][()])
-        slopes = f["slope"][()]
+        path = f.attrs.get("parameter_path", SLOPE_PATH)
+        path = path.decode() if isinstance(path, bytes) else str(path)
+        dim = parameter_dim(path)
+        values = f[dim][()]
+        unit = str(f[dim].attrs.get("unit", "deg"))
+        data = {"parameter_path": path, "parameter_unit": unit, dim: values}
+        for name in ("onset/onset_slope", "onset/onset_value"):
+            if name in f:
+                data[name] = f[name][()]
         per = f["steady_state/attractor_period"][()]
         outcome = f["steady_state/outcome"].asstr()[()] if "steady_state/outcome" in f else None
-    from walkerlab.sweep.bifurcation import fall_onset
-
-    falls = fall_onset({"slope": slopes, "steady_state/outcome": outcome}) \
+    onset = onset_value(data)
+    falls = fall_onset({**data, "steady_state/outcome": outcome}) \
         if outcome is not None else np.nan
-    text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
-            "where the most negative real Floquet multiplier crosses −1" if np.isfinite(onset)
+    periods = sorted(set(int(v) for v in per if v > 0))
+    if path == SLOPE_PATH:
+        text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
+                "where the most negative real Floquet multiplier crosses −1"
+                if np.isfinite(onset) else "no period doubling on the grid")
+        out = ["## Bifurcation over the slope", "",
+               f"Grid {printed(values[0])}–{printed(values[-1])}° ({values.size} slopes): "
+               f"{text}; steady-state periods seen: {periods}"
+               + (f"; from {num(falls)}° on the walker falls (no steady gait)."
+                  if np.isfinite(falls) else "; the walker walks up to the largest slope.")]
+        rng = getattr(pub, "STABLE_SLOPE_RANGE_RAD", None)
+        if rng is not None:
+            out.append(f"Published ({pub.SHORT}): the period-1 gait is stable for "
+                       f"{printed(rng[0])} < γ < {printed(rng[1])} rad "
+                       f"({printed(round(np.degrees(rng[1]), 4))}°).")
+        return out + [""]
+    u = "" if unit in ("", "-") else f" {unit}"
+    text = (f"period-doubling onset at {path} = {num(onset)}{u}, where the most negative "
+            "real Floquet multiplier crosses −1" if np.isfinite(onset)
             else "no period doubling on the grid")
-    out = ["## Bifurcation over the slope", "",
-           f"Grid {printed(slopes[0])}–{printed(slopes[-1])}° ({slopes.size} slopes): {text}; "
-           f"steady-state periods seen: {sorted(set(int(v) for v in per if v > 0))}"
-           + (f"; from {num(falls)}° on the walker falls (no steady gait)."
-              if np.isfinite(falls) else "; the walker walks up to the largest slope.")]
-    rng = getattr(pub, "STABLE_SLOPE_RANGE_RAD", None)
-    if rng is not None:
-        out.append(f"Published ({pub.SHORT}): the period-1 gait is stable for "
-                   f"{printed(rng[0])} < γ < {printed(rng[1])} rad "
-                   f"({printed(round(np.degrees(rng[1]), 4))}°).")
-    return out + [""]
+    return [f"## Bifurcation over `{path}`", "",
+            f"Grid {printed(values[0])}–{printed(values[-1])}{u} ({values.size} values, "
+            f"`{p.name}`): {text}; steady-state periods seen: {periods}"
+            + (f"; from {num(falls)}{u} on the walker falls (no steady gait)."
+               if np.isfinite(falls) else "; the walker walks up to the largest value."), ""]
 
 
 # --------------------------------------------------------------------------- basin

@@ -125,7 +125,8 @@ def recompute_reason(path: Path, scene: Scene, sections: tuple[str, ...],
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
                upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
                force: bool = False, extra_attrs: dict | None = None,
-               extra_key: str = "", also_accept: tuple[str, ...] = ()) -> StageOutcome:
+               extra_key: str = "", also_accept: tuple[str, ...] = (),
+               artifact: str | None = None) -> StageOutcome:
     """Run ``compute`` unless the artifact is up to date, then write it atomically.
 
     ``compute()`` returns ``(writer, summary)``; ``writer(h5file)`` fills the artifact.
@@ -133,8 +134,10 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
     keys (a superset of what is asked for) counts as up to date too.  An existing artifact
     that is recomputed is never replaced silently: one line on stderr says which and why
     (the scene fields that changed, ``--force``, ...), also kept in ``StageOutcome.note``.
+    ``artifact``: the file stem when it is not the stage's name (``bifurcation_<field>``;
+    from :mod:`walkerlab.io.runpaths`).
     """
-    path = stage_artifact(scene, runs_root, stage, claim=True)
+    path = stage_artifact(scene, runs_root, artifact or stage, claim=True)
     # one writer per artifact: a second identical run waits, then finds the result up to date
     with artifact_lock(path, wait=True, on_wait=_tell):
         key = input_hash(stage, scene, sections, upstream, extra_key)

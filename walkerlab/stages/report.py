@@ -261,12 +261,17 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
 
 
 def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
-    """``{stage: path}`` of the report's stages whose artifact exists for ``scene``."""
+    """``{stage: path}`` of the report's stages whose artifact exists for ``scene``, and
+    ``{bifurcation_<field>: path}`` of bifurcations over other fields (``bifurcation
+    --param``)."""
     out = {}
     for stage in REPORT_STAGES:
         p = artifact_path(scene, runs_root, stage)
         if p.is_file():
             out[stage] = p
+    from walkerlab.io.runpaths import bifurcation_artifacts
+
+    out.update(bifurcation_artifacts(scene, runs_root))  # bifurcation_<field>: --param runs
     return out
 
 

@@ -1,17 +1,24 @@
-"""Bifurcation diagram of the ideal (rigid) walker over the slope (Goswami et al. 1996).
+"""Bifurcation diagram of the ideal (rigid) walker over the slope (Goswami et al. 1996) or
+over any numeric scene field (a body's mass by name, ``walker.leg.bodies.thigh_mass.mass_kg``;
+``walker.hip_mass_kg``; ...).
 
-For each slope ``phi`` of a grid:
+For each value ``p`` of a grid (the slope ``phi`` by default):
 
 1. the period-1 fixed point and its Floquet multipliers (continuation from the neighbouring
-   slope's fixed point);
+   value's fixed point);
 2. the steady state: ``n_transient`` steps are simulated and the inter-leg angle at the last
    ``n_keep`` heel strikes is kept (the classic cascade plot).  The simulation starts from
-   the previous slope's final state projected on this slope's heel-strike surface
+   the previous value's final state projected on this value's heel-strike surface
    (attractor continuation), or from the period-1 fixed point slightly perturbed.
 
 The period-doubling onset is where the most negative real multiplier crosses -1; it is
 bracketed on the grid and located with :func:`scipy.optimize.brentq` on
-``g(phi) = 1 + min real multiplier(phi)``.
+``g(p) = 1 + min real multiplier(p)``.
+
+The artifact's parameter coordinate is ``slope`` [deg] for the slope (``bifurcation.h5``) and
+the field's dotted path with the field's unit (from its name or metadata,
+:func:`walkerlab.sweep.params.axis_unit`) otherwise (``bifurcation_<field>.h5``); either way
+it carries the field in its ``path`` attribute.
 
 Grid chunks (the runs up and down from the scene's slope) are evaluated with the sweep
 executors (:func:`walkerlab.sweep.runner.iter_chunk_results`), locally or on Dask.  Arrays
@@ -34,22 +41,37 @@ from walkerlab.sweep.params import ParamAxis
 from walkerlab.sweep.runner import iter_chunk_results, plan_chunks
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
-           "min_real_multiplier", "bifurcation_writer", "load_bifurcation"]
+           "min_real_multiplier", "bifurcation_writer", "load_bifurcation", "SLOPE_PATH",
+           "parameter_dim", "parameter_values", "onset_value", "fall_onset"]
+
+#: the default continuation parameter (``walkerlab bifurcation --slopes``)
+SLOPE_PATH = "slope.angle_deg"
+
+
+def parameter_dim(path: str) -> str:
+    """Name of the artifact's parameter coordinate: ``slope`` for :data:`SLOPE_PATH` (the
+    artifact of ``--slopes``, unchanged), else the field's dotted path."""
+    return "slope" if path == SLOPE_PATH else path
+
+
+def _onset_name(path: str) -> str:
+    return "onset/onset_slope" if path == SLOPE_PATH else "onset/onset_value"
 
 
 @dataclass(frozen=True)
 class _BifTask:
     base: dict
-    points: tuple            # ((index, (slope_deg,)), ...)
+    points: tuple            # ((index, (value,)), ...)
     n_transient: int
     n_keep: int
     steady_state: bool
+    path: str = SLOPE_PATH
 
 
-def _scene_at(base: dict, slope_deg: float) -> Scene:
+def _scene_at(base: dict, value: float, path: str = SLOPE_PATH) -> Scene:
     from walkerlab.sweep.params import apply_point
 
-    return apply_point(base, ["slope.angle_deg"], (slope_deg,), "<bifurcation>")
+    return apply_point(base, [path], (value,), "<bifurcation>")
 
 
 def min_real_multiplier(mult: np.ndarray, tol: float = 1e-9) -> float:
@@ -75,7 +97,7 @@ def _stance_angle(walker, x: np.ndarray) -> float:
 
 
 def _bif_chunk(task: _BifTask) -> list[dict]:
-    """Fixed point + steady state along one run of slopes (worker side)."""
+    """Fixed point + steady state along one run of parameter values (worker side)."""
     import warnings
 
     from walkerlab.analysis.hybrid import Solver, simulate_steps
@@ -86,16 +108,16 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     out = []
     guess = None
     x_att = None
-    for index, (slope,) in task.points:
+    for index, (value,) in task.points:
         t0 = time.perf_counter()
-        n = len(build_walker(_scene_at(task.base, slope)).state_names())
-        row = {"index": index, "slope_deg": slope, "x": np.full(n, np.nan),
+        n = len(build_walker(_scene_at(task.base, value, task.path)).state_names())
+        row = {"index": index, "value": value, "x": np.full(n, np.nan),
                "multipliers": np.full(n, np.nan, complex), "period_s": math.nan,
                "fp_outcome": "ok", "message": "", "hs_interleg": np.full(task.n_keep, np.nan),
                "hs_stance": np.full(task.n_keep, np.nan), "ss_outcome": "", "steps": 0}
         with warnings.catch_warnings(), np.errstate(all="ignore"):
             warnings.simplefilter("ignore")
-            scene = _scene_at(task.base, slope)
+            scene = _scene_at(task.base, value, task.path)
             try:
                 walker, res, _src = ideal_fixed_point(scene, guess)
                 guess = res.x
@@ -141,68 +163,85 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     return out
 
 
-def _g(scene_base: dict, slope_deg: float, guess) -> tuple[float, np.ndarray]:
+def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH
+       ) -> tuple[float, np.ndarray]:
     from walkerlab.sweep.points import ideal_fixed_point
 
-    _w, res, _s = ideal_fixed_point(_scene_at(scene_base, slope_deg), guess)
+    _w, res, _s = ideal_fixed_point(_scene_at(scene_base, value, path), guess)
     return 1.0 + min_real_multiplier(res.multipliers_variational), res.x
 
 
+def _onset_dict(onset: float, bracket, mult_at: float, n: int, path: str) -> dict:
+    out = {"onset": float(onset), "bracket": np.asarray(bracket, float),
+           "multiplier_at_onset": float(mult_at), "evaluations": int(n), "path": path}
+    if path == SLOPE_PATH:  # the slope's names, as before
+        out.update(onset_deg=out["onset"], bracket_deg=out["bracket"])
+    return out
+
+
 def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
-                           x: np.ndarray, xtol_deg: float = 1e-4) -> dict:
-    """Slope where the most negative real multiplier crosses -1 (first crossing upward).
+                           x: np.ndarray, xtol_deg: float = 1e-4,
+                           path: str = SLOPE_PATH) -> dict:
+    """Parameter value where the most negative real multiplier crosses -1.
+
+    The first grid interval where ``g = 1 + min real multiplier`` goes from > 0 to <= 0
+    (the crossing as the parameter grows: the slope's period doubling); when there is none,
+    the first where it goes from <= 0 to > 0 (period doubling as the parameter shrinks).
 
     Parameters
     ----------
     base : dict
         Base scene mapping.
     slopes_deg : ndarray (n,)
-        Grid slopes [deg], increasing.
+        Grid values of the parameter (slopes [deg] by default), increasing.
     mult : ndarray (n, 2m) complex
-        Floquet multipliers at the grid slopes (NaN where no fixed point); 2m states.
+        Floquet multipliers at the grid values (NaN where no fixed point); 2m states.
     x : ndarray (n, 2m)
         Fixed points (continuation guesses for the refinement).
     xtol_deg : float
-        brentq tolerance on the slope [deg].
+        brentq tolerance on the parameter (its unit: deg for the slope).
+    path : str
+        The dotted scene field of the grid (default :data:`SLOPE_PATH`).
 
     Returns
     -------
     dict
-        ``onset_deg`` (NaN if no crossing), ``bracket_deg`` (2,), ``multiplier_at_onset``,
-        ``evaluations``.
+        ``onset`` (NaN if no crossing), ``bracket`` (2,), ``multiplier_at_onset``,
+        ``evaluations``, ``path``; for the slope also ``onset_deg`` and ``bracket_deg``.
     """
+    vals = np.asarray(slopes_deg, float)
     g = np.array([1.0 + min_real_multiplier(m) if np.all(np.isfinite(m)) else math.nan
                   for m in mult])
     g = np.where(np.isnan(g) & np.all(np.isfinite(mult), axis=1), 1.0, g)  # complex pair: > -1
-    for k in range(len(g) - 1):
-        if g[k] > 0 and g[k + 1] <= 0:
-            lo, hi = float(slopes_deg[k]), float(slopes_deg[k + 1])
-            state = {"guess": x[k], "n": 0}
+    down = [k for k in range(len(g) - 1) if g[k] > 0 and g[k + 1] <= 0]
+    up = [k for k in range(len(g) - 1) if g[k] <= 0 and g[k + 1] > 0]
+    if down or up:
+        k, rising = (down[0], True) if down else (up[0], False)
+        lo, hi = float(vals[k]), float(vals[k + 1])
+        state = {"guess": x[k] if rising else x[k + 1], "n": 0}
 
-            def f(s, state=state):
-                val, xs = _g(base, s, state["guess"])
-                state["n"] += 1
-                state["guess"] = xs
-                return val
+        def f(s, state=state):
+            val, xs = _g(base, s, state["guess"], path)
+            state["n"] += 1
+            state["guess"] = xs
+            return val
 
-            if g[k + 1] == 0:
-                onset = hi
-            else:
-                onset = brentq(f, lo, hi, xtol=xtol_deg)
-            return {"onset_deg": float(onset), "bracket_deg": np.array([lo, hi]),
-                    "multiplier_at_onset": float(f(onset) - 1.0), "evaluations": state["n"]}
-    return {"onset_deg": math.nan, "bracket_deg": np.array([math.nan, math.nan]),
-            "multiplier_at_onset": math.nan, "evaluations": 0}
+        if g[k + 1 if rising else k] == 0:
+            onset = hi if rising else lo
+        else:
+            onset = brentq(f, lo, hi, xtol=xtol_deg)
+        return _onset_dict(onset, [lo, hi], f(onset) - 1.0, state["n"], path)
+    return _onset_dict(math.nan, [math.nan, math.nan], math.nan, 0, path)
 
 
 @dataclass
 class BifurcationResult:
-    """Bifurcation diagram data (all arrays along the slope grid, ``n`` slopes).
+    """Bifurcation diagram data (all arrays along the parameter grid, ``n`` values).
 
     Attributes
     ----------
-    slopes_deg : ndarray (n,)
-        Slopes [deg].
+    values : ndarray (n,)
+        Values of the parameter ``param`` [``unit``] (slopes [deg] by default).
     state_names, state_units : list of str (2m,)
         The walker's state names and units (columns of ``fixed_point``).
     fixed_point : ndarray (n, 2m)
@@ -227,11 +266,15 @@ class BifurcationResult:
     onset : dict
         See :func:`locate_period_doubling`.
     wall_time_s : ndarray (n,)
-        Per-slope wall time [s].
+        Per-value wall time [s].
     n_transient, n_keep : int
+    param : str
+        The dotted scene field of the grid (:data:`SLOPE_PATH` by default).
+    unit : str
+        Its SI unit (``deg`` for the slope; :func:`walkerlab.sweep.params.axis_unit`).
     """
 
-    slopes_deg: np.ndarray
+    values: np.ndarray
     state_names: list
     state_units: list
     fixed_point: np.ndarray
@@ -247,6 +290,13 @@ class BifurcationResult:
     wall_time_s: np.ndarray
     n_transient: int
     n_keep: int
+    param: str = SLOPE_PATH
+    unit: str = "deg"
+
+    @property
+    def slopes_deg(self) -> np.ndarray:
+        """The grid values (slopes [deg] when ``param`` is the slope)."""
+        return self.values
 
 
 def _distinct(v: np.ndarray, tol: float = 1e-4) -> int:
@@ -258,15 +308,18 @@ def _distinct(v: np.ndarray, tol: float = 1e-4) -> int:
 
 def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep: int = 30,
                         workers: int = 2, scheduler=None, steady_state: bool = True,
-                        xtol_deg: float = 1e-4) -> BifurcationResult:
-    """Compute the bifurcation diagram of the scene's rigid walker over the slope.
+                        xtol_deg: float | None = None, param: str = SLOPE_PATH,
+                        unit: str | None = None) -> BifurcationResult:
+    """Compute the bifurcation diagram of the scene's rigid walker over the slope or over any
+    numeric scene field.
 
     Parameters
     ----------
     scene : Scene
-        Walker, solver and ``fixedpoint`` settings (its slope anchors the continuation).
+        Walker, solver and ``fixedpoint`` settings (its value of ``param`` anchors the
+        continuation).
     slopes_deg : array_like (n,)
-        Slopes [deg], increasing.
+        Grid values of ``param``, increasing (slopes [deg] by default).
     n_transient : int
         Steps simulated per slope (transient + kept).
     n_keep : int
@@ -275,23 +328,42 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         As for :func:`walkerlab.sweep.runner.iter_chunk_results`.
     steady_state : bool
         Also simulate the steady state (False: fixed points and onset only).
-    xtol_deg : float
-        Onset tolerance [deg].
+    xtol_deg : float, optional
+        Onset tolerance in the parameter's unit (default 1e-4 deg for the slope, 1e-5 of
+        the grid's span otherwise).
+    param : str
+        Dotted scene field (lists by item name or index, as ``walkerlab sweep``).
+    unit : str, optional
+        Its SI unit (default: :func:`walkerlab.sweep.params.axis_unit`).
 
     Returns
     -------
     BifurcationResult
+
+    Raises
+    ------
+    walkerlab.sweep.params.SweepError
+        ``param`` names no field of the scene, or a grid value does not validate.
     """
+    from walkerlab.sweep.params import axis_unit, check_axes
+
     slopes = np.asarray(slopes_deg, float)
-    axis = ParamAxis("slope.angle_deg", tuple(float(s) for s in slopes), "bifurcation")
+    axis = ParamAxis(param, tuple(float(s) for s in slopes), f"{param}=<bifurcation grid>")
+    if param != SLOPE_PATH:
+        check_axes(scene, [axis])
+    unit = unit or axis_unit(scene, axis)
+    if xtol_deg is None:
+        span = float(np.ptp(slopes)) if slopes.size > 1 else 1.0
+        xtol_deg = 1e-4 if param == SLOPE_PATH else 1e-5 * (span or 1.0)
     base = scene.model_dump(mode="json")
     chunks = plan_chunks([axis], base, workers=max(1, workers))
-    tasks = [_BifTask(base, tuple(c), n_transient, n_keep, steady_state) for c in chunks]
+    tasks = [_BifTask(base, tuple(c), n_transient, n_keep, steady_state, param)
+             for c in chunks]
     rows = [r for rs in iter_chunk_results(tasks, workers, scheduler, fn=_bif_chunk) for r in rs]
     rows.sort(key=lambda r: r["index"])
     x = np.array([r["x"] for r in rows])
     mult = np.array([r["multipliers"] for r in rows])
-    onset = locate_period_doubling(base, slopes, mult, x, xtol_deg)
+    onset = locate_period_doubling(base, slopes, mult, x, xtol_deg, param)
     il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
     from walkerlab.models.registry import build_walker
     from walkerlab.sweep.points import interleg_angle
@@ -300,7 +372,7 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
     fp_il = np.degrees([interleg_angle(walker, xi) if np.all(np.isfinite(xi)) else math.nan
                         for xi in x])
     return BifurcationResult(
-        slopes_deg=slopes, state_names=walker.state_names(), state_units=walker.state_units(),
+        values=slopes, state_names=walker.state_names(), state_units=walker.state_units(),
         fixed_point=x, fixed_point_interleg_deg=fp_il, multipliers=mult,
         step_period_s=np.array([r["period_s"] for r in rows]),
         fp_outcome=np.array([r["fp_outcome"] for r in rows], object),
@@ -308,23 +380,33 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         ss_outcome=np.array([r["ss_outcome"] for r in rows], object),
         attractor_period=np.array([_distinct(np.radians(v)) for v in il]),
         onset=onset, wall_time_s=np.array([r["wall_time_s"] for r in rows]),
-        n_transient=n_transient, n_keep=n_keep)
+        n_transient=n_transient, n_keep=n_keep, param=param, unit=unit)
 
 
 def bifurcation_writer(res: BifurcationResult):
-    """``writer(h5file)`` filling a ``bifurcation`` artifact (netCDF dimensions ``slope``,
-    ``multiplier``, ``heel_strike``; units on every dataset)."""
+    """``writer(h5file)`` filling a ``bifurcation`` artifact (netCDF dimensions: the
+    parameter (:func:`parameter_dim`: ``slope`` or the field's dotted path; attributes
+    ``unit``, ``path``), ``multiplier``, ``heel_strike``; units on every dataset; the onset
+    in ``onset/onset_slope`` for the slope, ``onset/onset_value`` otherwise)."""
     from walkerlab.io.artifacts import put
     from walkerlab.io.netcdf import coordinate
 
+    path, unit = res.param, res.unit
+    dim = parameter_dim(path)
+    what = "slope" if path == SLOPE_PATH else "grid value"
+
     def writer(f):
-        coordinate(f, "slope", res.slopes_deg, "deg", "slope grid")
+        c = coordinate(f, dim, res.values, unit,
+                       "slope grid" if path == SLOPE_PATH else f"grid of {path}")
+        c.attrs["path"] = path
+        f.attrs["parameter_path"] = path
+        f.attrs["parameter_dim"] = dim
         coordinate(f, "multiplier", np.arange(res.multipliers.shape[1]), "-",
                    "Floquet multiplier number (sorted by modulus)")
         coordinate(f, "heel_strike", np.arange(res.n_keep), "-",
                    f"kept heel strike (last {res.n_keep} of {res.n_transient})")
         f.attrs["state_names"] = list(res.state_names)
-        s = ("slope",)
+        s = (dim,)
         for k, (n, u) in enumerate(zip(res.state_names, res.state_units)):
             put(f, f"fixed_point/{n}", res.fixed_point[:, k], u,
                 f"period-1 fixed point, {n} just after heel strike", dims=s)
@@ -333,12 +415,12 @@ def bifurcation_writer(res: BifurcationResult):
         put(f, "fixed_point/step_period", res.step_period_s, "s", "period-1 step period", dims=s)
         put(f, "fixed_point/outcome", [str(o) for o in res.fp_outcome], "-",
             "typed outcome of the fixed-point search", dims=s)
-        sm = ("slope", "multiplier")
+        sm = (dim, "multiplier")
         put(f, "floquet/real", res.multipliers.real, "-", "Floquet multipliers, real part",
             dims=sm)
         put(f, "floquet/imag", res.multipliers.imag, "-", "Floquet multipliers, imaginary part",
             dims=sm)
-        sh = ("slope", "heel_strike")
+        sh = (dim, "heel_strike")
         put(f, "steady_state/interleg_angle", res.interleg_deg, "deg",
             f"inter-leg angle at the last {res.n_keep} of {res.n_transient} heel strikes",
             dims=sh)
@@ -348,27 +430,43 @@ def bifurcation_writer(res: BifurcationResult):
             "'walks' or how the steady-state run ended", dims=s)
         put(f, "steady_state/attractor_period", res.attractor_period, "steps",
             "distinct kept values (1, 2, 4, ...; n_keep: no period found)", dims=s)
-        put(f, "onset/onset_slope", res.onset["onset_deg"], "deg",
+        onset = res.onset  # the slope's onset dict may carry only its *_deg names
+        put(f, _onset_name(path), onset.get("onset", onset.get("onset_deg")), unit,
             "period-doubling onset: a multiplier crosses -1 (brentq)")
-        put(f, "onset/bracket", res.onset["bracket_deg"], "deg", "grid bracket of the onset",
-            dims=("bracket_end",))
+        put(f, "onset/bracket", onset.get("bracket", onset.get("bracket_deg")), unit,
+            "grid bracket of the onset", dims=("bracket_end",))
         put(f, "onset/multiplier_at_onset", res.onset["multiplier_at_onset"], "-",
             "most negative real multiplier at the located onset")
-        put(f, "stats/wall_time", res.wall_time_s, "s", "wall time per slope", dims=s)
+        put(f, "stats/wall_time", res.wall_time_s, "s", f"wall time per {what}", dims=s)
         f.attrs["n_transient"] = res.n_transient
         f.attrs["n_keep"] = res.n_keep
 
     return writer
 
 
+def parameter_values(data: dict) -> tuple[np.ndarray, str, str]:
+    """The grid of loaded bifurcation data (:func:`load_bifurcation`, or a dict with a
+    ``slope`` array): values (n,), the field's dotted path and its unit."""
+    path = str(data.get("parameter_path", SLOPE_PATH))
+    unit = str(data.get("parameter_unit", "deg"))
+    return np.asarray(data[parameter_dim(path)], float), path, unit
+
+
+def onset_value(data: dict) -> float:
+    """Period-doubling onset of loaded bifurcation data, in the parameter's unit (NaN when
+    none)."""
+    _v, path, _u = parameter_values(data)
+    return float(data.get(_onset_name(path), np.nan))
+
+
 def fall_onset(data: dict) -> float:
-    """Smallest slope [deg] of a bifurcation sweep from which on the walker no longer walks
-    (``steady_state/outcome`` is not ``walks`` there and at every larger slope); NaN if it
-    walks at the largest slope."""
+    """Smallest grid value (slope [deg] by default) of a bifurcation sweep from which on the
+    walker no longer walks (``steady_state/outcome`` is not ``walks`` there and at every
+    larger value); NaN if it walks at the largest value."""
     out = data.get("steady_state/outcome")
     if out is None:
         return float("nan")
-    s = np.asarray(data["slope"], float)
+    s = parameter_values(data)[0]
     walks = np.array([str(o) == "walks" for o in out])
     if walks[-1]:
         return float("nan")
@@ -378,11 +476,20 @@ def fall_onset(data: dict) -> float:
 
 
 def load_bifurcation(path: Path) -> dict:
-    """Arrays of a ``bifurcation`` artifact as a dict (names as in the file)."""
+    """Arrays of a ``bifurcation`` artifact as a dict (names as in the file), with
+    ``parameter_path``, ``parameter_dim`` and ``parameter_unit`` (the grid's field, its
+    coordinate's name and unit; the slope in an artifact without them)."""
     from walkerlab.io.artifacts import open_artifact, read_named
 
     out = {}
     with open_artifact(Path(path), "bifurcation") as f:
+        ppath = f.attrs.get("parameter_path", SLOPE_PATH)
+        ppath = ppath.decode() if isinstance(ppath, bytes) else str(ppath)
+        dim = parameter_dim(ppath)
+        unit = f[dim].attrs.get("unit", "deg")
+        out.update(parameter_path=ppath, parameter_dim=dim,
+                   parameter_unit=unit.decode() if isinstance(unit, bytes) else str(unit))
+
         def visit(name, obj):
             import h5py
 

@@ -24,7 +24,7 @@ from typing import Any
 from walkerlab.config import Scene, SceneError, scene_from_dict
 
 __all__ = ["SweepError", "ParamAxis", "parse_param", "grid_points", "apply_point",
-           "check_axes", "params_hash", "EXCLUSIVE_FIELDS"]
+           "check_axes", "axis_unit", "list_item", "params_hash", "EXCLUSIVE_FIELDS"]
 
 
 class SweepError(ValueError):
@@ -161,7 +161,7 @@ def grid_points(axes: list[ParamAxis]) -> list[tuple]:
     return list(itertools.product(*(a.values for a in axes)))
 
 
-def _list_item(items: list, key: str, path: str):
+def list_item(items: list, key: str, path: str):
     """The item of a scene list (e.g. ``walker.leg.bodies``) named ``key`` (its ``name``
     field) or at index ``key``.
 
@@ -191,7 +191,7 @@ def _set_dotted(d: dict, path: str, value) -> None:
     node = d
     for k in keys[:-1]:
         if isinstance(node, list):
-            node = _list_item(node, k, path)
+            node = list_item(node, k, path)
             continue
         nxt = node.get(k)
         if nxt is None:
@@ -228,8 +228,13 @@ def _models_in(annotation) -> list:
     return out
 
 
-def _check_path(scene: Scene, axis: ParamAxis) -> None:
+def _check_path(scene: Scene, axis: ParamAxis):
     """The axis path names a field of the scene (by the schema, lists by name or index).
+
+    Returns
+    -------
+    pydantic.fields.FieldInfo or None
+        The named field's schema entry (None for a state given by name).
 
     Raises
     ------
@@ -247,7 +252,7 @@ def _check_path(scene: Scene, axis: ParamAxis) -> None:
         if isinstance(obj, (list, tuple)):
             items = [o.model_dump() if isinstance(o, BaseModel) else o for o in obj]
             try:
-                item = _list_item(items, k, axis.path)
+                item = list_item(items, k, axis.path)
             except SceneError as exc:
                 raise SweepError(f"--param {axis.spec!r}: {exc}") from None
             obj = obj[items.index(item)]
@@ -257,7 +262,7 @@ def _check_path(scene: Scene, axis: ParamAxis) -> None:
             raise SweepError(f"--param {axis.spec!r}: {'.'.join(keys[:i])} is a value, not a "
                              f"section: it has no field {k!r}")
         if cls.model_config.get("extra") == "allow":  # a state given by name
-            return
+            return None
         fields = cls.model_fields
         if k not in fields:
             close = difflib.get_close_matches(k, list(fields), 1, 0.6)
@@ -274,6 +279,29 @@ def _check_path(scene: Scene, axis: ParamAxis) -> None:
         else:
             models = _models_in(fields[k].annotation)
             cls = models[0] if len(models) == 1 else None
+        info = fields[k]
+    return info
+
+
+def axis_unit(scene: Scene, axis: ParamAxis) -> str:
+    """SI unit of the field an axis sweeps: the field's ``unit`` metadata (contact
+    fields: ``<len>`` read in the scene's ``contact.unit_system``), else the suffix of its
+    name (:func:`walkerlab.units.field_unit`: ``mass_kg`` -> ``kg``), else ``"-"``.
+
+    Raises
+    ------
+    SweepError
+        The path names no field of the scene (as :func:`check_axes`).
+    """
+    from walkerlab.units import field_unit
+
+    info = _check_path(scene, axis)
+    extra = getattr(info, "json_schema_extra", None)
+    unit = extra.get("unit") if isinstance(extra, dict) else None
+    if unit and "<len>" in unit:
+        system = getattr(getattr(scene, "contact", None), "unit_system", "SI")
+        unit = unit.replace("<len>", "mm" if system == "mm-kg-s" else "m")
+    return unit or field_unit(axis.path) or "-"
 
 
 def check_axes(scene: Scene, axes: list[ParamAxis], values: bool = True) -> None:

@@ -87,8 +87,19 @@ def _dask_client(scheduler):
 
 
 def _dotted_get(d: dict, path: str):
+    """Value at a dotted path of a scene mapping (list items by name or index); None if
+    absent."""
+    from walkerlab.config import SceneError
+    from walkerlab.sweep.params import list_item
+
     node: Any = d
     for k in path.split("."):
+        if isinstance(node, list):
+            try:
+                node = list_item(node, k, path)
+            except SceneError:
+                return None
+            continue
         if not isinstance(node, dict) or k not in node:
             return None
         node = node[k]
