@@ -323,7 +323,10 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
         f = cache_dir / f"{t.key}.json"
         if f.is_file():
             try:
-                out[t.key] = {**json.loads(f.read_text()), "cached": True}
+                from walkerlab.io.bounded import read_regular
+
+                out[t.key] = {**json.loads(read_regular(f, 1 << 20, "cache entry")),
+                              "cached": True}
                 continue
             except (OSError, ValueError):
                 pass

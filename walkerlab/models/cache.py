@@ -82,7 +82,9 @@ def _exec(source: str, origin: str) -> dict:
 def _read(path: Path) -> dict | None:
     """The namespace of a valid cache file, or None (missing, corrupt, stale)."""
     try:
-        text = path.read_text()
+        from walkerlab.io.bounded import read_regular
+
+        text = read_regular(path, 16 << 20, "model cache entry").decode()
         first, body = text.split("\n", 1)
         if first != f"# sha256 {_digest(body)}":
             return None

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.config import Scene
+from walkerlab.config import CommandOptions, Scene, validate_option
 from walkerlab.stages.common import StageOutcome, require, run_cached
 from walkerlab.stages.plot import figures_dir
 
@@ -52,6 +52,10 @@ def run(scene: Scene, slopes_deg, runs_root: Path | str = "runs", n_transient: i
     )
 
     require(scene, "fixedpoint", "bifurcation")
+    n_transient = validate_option(CommandOptions, "bifurcation_transient", n_transient,
+                                  "--transient")
+    n_keep = validate_option(CommandOptions, "bifurcation_keep", n_keep, "--keep")
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
     slopes = [float(s) for s in np.asarray(slopes_deg, float)]
     key = json.dumps({"slopes_deg": slopes, "n_transient": n_transient, "n_keep": n_keep,
                       "steady_state": steady_state})

@@ -13,7 +13,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from walkerlab.config import Scene
+from walkerlab.config import CommandOptions, Scene, validate_option
 from walkerlab.io.artifacts import open_artifact, put
 from walkerlab.stages.common import StageOutcome, require, run_cached
 from walkerlab.sweep.stability import (
@@ -48,6 +48,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     require(scene, "contact", "stability-map")
     require(scene, "fixedpoint", "stability-map")
+    n = validate_option(CommandOptions, "stability_map_n", n, "--n")
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
+    time_limit_s = validate_option(CommandOptions, "stability_map_time_limit_s",
+                                   float(time_limit_s), "--time-limit")
     spec = spec or default_spec(kind, n, time_limit_s)
 
     def compute():
