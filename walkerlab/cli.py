@@ -145,9 +145,16 @@ def _single_threaded_blas() -> None:
 def _main(version: bool = typer.Option(False, "--version", callback=_version_callback,
                                        is_eager=True,
                                        help="print walkerlab, Python, numpy, scipy, numba "
-                                       "and h5py versions and exit")) -> None:
+                                       "and h5py versions and exit"),
+          quiet: bool = typer.Option(False, "--quiet", "-q",
+                                     help="no progress display and no notices on stderr "
+                                     "(errors are still shown); progress is also off when "
+                                     "stderr is not a terminal")) -> None:
     """walkerlab: passive-dynamic biped walkers, from fixed point to report."""
     _single_threaded_blas()
+    from walkerlab import progress
+
+    progress.install(progress.sink_for_terminal(quiet))
 
 
 def _status(o) -> str:

@@ -21,7 +21,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Protocol
 
-__all__ = ["Sink", "Task", "task", "note", "use", "current", "QuietSink", "RichSink"]
+__all__ = ["Sink", "Task", "task", "note", "use", "current", "install", "sink_for_terminal",
+           "QuietSink", "RichSink"]
 
 
 class Sink(Protocol):
@@ -118,6 +119,22 @@ _NEXT = [0]
 def current() -> Sink:
     """The installed sink."""
     return _SINK
+
+
+def install(sink: Sink) -> None:
+    """Install ``sink`` for the rest of the process (the CLI, once per command)."""
+    global _SINK
+    _SINK = sink
+
+
+def sink_for_terminal(quiet: bool, stream=None) -> Sink:
+    """The CLI's sink: nothing under ``--quiet``, rich progress when ``stream`` (stderr) is a
+    terminal, notices only otherwise."""
+    stream = sys.stderr if stream is None else stream
+    if quiet:
+        return QuietSink(silent=True)
+    isatty = getattr(stream, "isatty", None)
+    return RichSink() if isatty is not None and isatty() else QuietSink()
 
 
 @contextmanager

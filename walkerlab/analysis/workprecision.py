@@ -298,7 +298,7 @@ def _cost_order(t: Case) -> tuple:
 
 
 def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
-              lanes: Lanes | None = None) -> dict:
+              lanes: Lanes | None = None, on_case=None) -> dict:
     """Results of every case, from the cache or measured (in pinned worker processes).
 
     Parameters
@@ -311,6 +311,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
         cores than workers: every case in this process, one after the other).
     lanes : Lanes, optional
         Explicit cores, gates and pending models (``walkerlab report``).
+    on_case : callable(done, total), optional
+        Progress: called with ``(0, cases to measure)`` once the cache was read, then after
+        each measured case (from the lanes' threads).
 
     Returns
     -------
@@ -331,6 +334,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
             except (OSError, ValueError):
                 pass
         todo.append(t)
+    n_todo, n_done = len(todo), [0]
+    if on_case is not None:
+        on_case(0, n_todo)
     if lanes is not None:
         lanes.todo_models.update(t.model for t in todo)
         lanes.todo_known.set()
@@ -344,6 +350,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
         os.replace(tmp, cache_dir / f"{key}.json")
         with lock:
             out[key] = {**res, "cached": False}
+            n_done[0] += 1
+        if on_case is not None:
+            on_case(n_done[0], n_todo)
 
     if lanes is None:
         cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []

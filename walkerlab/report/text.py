@@ -77,6 +77,10 @@ def contact_text(path: Path) -> str:
     with open_artifact(path, "contact-sim") as f:
         lines = [f"contact walker: outcome {f.attrs.get('outcome', '?')} "
                  f"({f.attrs.get('outcome_message', f.attrs.get('termination', '?'))})"]
+        if "initial_rate_scale" in f and "adjust" in f:  # --adjust: the scale it found
+            s = np.atleast_1d(f["initial_rate_scale"][()])
+            lines.append("adjusted initial rate scale (found by --adjust): "
+                         + ", ".join(f"{v:.4g}" for v in s))
         if "summary" in f:
             for k in f["summary"]:
                 ds = f["summary"][k]

@@ -55,7 +55,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     spec = spec or default_spec(kind, n, time_limit_s)
 
     def compute():
-        cells = gait_map(scene, spec, workers=workers, progress=progress)
+        from walkerlab import progress as _progress
+
+        ny = len(spec.y_values)
+        with _progress.task(f"stability map {spec.kind}: {ny}x{len(spec.slopes_deg)} cells "
+                            "(rows)", ny) as bar:
+            def tick(done, total):
+                bar.update(done)
+                if progress is not None:
+                    progress(done, total)
+
+            cells = gait_map(scene, spec, workers=workers, progress=tick)
         frac = stable_fraction(cells)
         reasons = [str(r) for r in cells["reason"].ravel() if r]
         summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
