@@ -482,11 +482,11 @@ def version(d):
 
 
 # ------------------------------------------------------------------ issue 19 (rel-b)
-def _wait_rows(p: Path, n: int, timeout: float = 300) -> None:
+def _wait_rows(p: Path, n: int, proc, timeout: float = 300) -> None:
     import h5py
 
     t0 = time.time()
-    while time.time() - t0 < timeout:
+    while time.time() - t0 < timeout and proc.poll() is None:
         try:
             with h5py.File(p, "r") as f:
                 if f["points/index"].shape[0] >= n:
@@ -543,15 +543,16 @@ def i19_4_edited_basin_partial(d):
                      f"{conv}, uninterrupted {conv_ref}")
 
 
-def _interrupted_sweep(d, edit=None, param="slope.angle_deg=1:5:0.05"):
+def _interrupted_sweep(d, edit=None):
     s = scene(d / "cfg", IDEAL, "paper.yaml")
-    args = ["sweep", str(s), "--param", param, "--workers", "2", "--runs-dir", "runs",
+    args = ["sweep", str(s), "--param", "slope.angle_deg=1:5:0.05", "--param",
+            "walker.hip_mass_kg=8,10,12", "--workers", "2", "--runs-dir", "runs",
             "--name", "sw"]
     p = subprocess.Popen([PY, "-m", "walkerlab.cli", *args], cwd=d / "cfg",
                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                          start_new_session=True)
     part = d / "cfg/runs/paper/sw.h5.partial"
-    _wait_rows(part, 30)
+    _wait_rows(part, 60, p)
     os.killpg(p.pid, signal.SIGTERM)
     p.wait(timeout=60)
     if edit is not None:

@@ -71,6 +71,14 @@ def _param_key(path: str) -> str:
 _BOOKKEEPING = ("row_hash",)
 
 
+def _datasets(g: h5py.Group) -> dict[str, h5py.Dataset]:
+    """Every dataset under ``g`` by relative name (``param/<path>`` included)."""
+    out: dict[str, h5py.Dataset] = {}
+    g.visititems(lambda name, obj: out.__setitem__(name, obj)
+                 if isinstance(obj, h5py.Dataset) else None)
+    return out
+
+
 def row_hashes(columns: dict[str, np.ndarray], key: str) -> list[str]:
     """SHA-256 (hex) of each row: every column's value by name, and the input hash ``key``.
 
@@ -240,7 +248,8 @@ class SweepStore:
                              "stage, options or code changed); rerun without --resume")
         try:
             g = f["points"]
-            cols = {name: ds[()] for name, ds in g.items() if isinstance(ds, h5py.Dataset)}
+            dsets = _datasets(g)
+            cols = {name: ds[()] for name, ds in dsets.items()}
             idx = np.asarray(cols["index"], np.int64)
             starts = f["plan/chain_start"][()]
             order = f["plan/index"][()]
@@ -291,11 +300,10 @@ class SweepStore:
             if tell is not None:
                 tell(msg)
         if not keep.all():
-            for name, ds in g.items():
-                if isinstance(ds, h5py.Dataset):
-                    v = cols[name][keep]
-                    ds.resize((int(keep.sum()),))
-                    ds[...] = v
+            for name, ds in dsets.items():
+                v = cols[name][keep]
+                ds.resize((int(keep.sum()),))
+                ds[...] = v
             for c in range(len(plan)):
                 if c not in start:
                     f["plan/done"][c] = 0
@@ -339,8 +347,8 @@ class SweepStore:
             if isinstance(ds, h5py.Dataset) and name not in fixed:
                 put(name, np.array([r.get(name, np.nan) for r in rows], float))
         if "row_hash" in g:  # hashed as read back, so resume recomputes the same bytes
-            cols = {name: ds[n0:n1] for name, ds in g.items() if isinstance(ds, h5py.Dataset)
-                    and name != "row_hash"}
+            cols = {name: ds[n0:n1] for name, ds in _datasets(g).items()
+                    if name != "row_hash"}
             put("row_hash", np.asarray(row_hashes(cols, str(self.f.attrs["input_hash"])),
                                        dtype=object))
         self.f.flush()
