@@ -488,7 +488,7 @@ def _wait_rows(p: Path, n: int, proc, timeout: float = 300) -> None:
     t0 = time.time()
     while time.time() - t0 < timeout and proc.poll() is None:
         try:
-            with h5py.File(p, "r") as f:
+            with h5py.File(p, "r", locking=False) as f:
                 if f["points/index"].shape[0] >= n:
                     return
         except (OSError, KeyError):
@@ -518,7 +518,7 @@ def i19_4_edited_basin_partial(d):
     t0 = time.time()
     while time.time() - t0 < 120:
         try:
-            with h5py.File(part, "r") as f:
+            with h5py.File(part, "r", locking=False) as f:
                 if np.sum(f["outcome"][()] >= 0) >= 24:
                     break
         except (OSError, KeyError):
@@ -545,14 +545,14 @@ def i19_4_edited_basin_partial(d):
 
 def _interrupted_sweep(d, edit=None):
     s = scene(d / "cfg", IDEAL, "paper.yaml")
-    args = ["sweep", str(s), "--param", "slope.angle_deg=1:5:0.05", "--param",
+    args = ["sweep", str(s), "--param", "slope.angle_deg=1:5:0.01", "--param",
             "walker.hip_mass_kg=8,10,12", "--workers", "2", "--runs-dir", "runs",
             "--name", "sw"]
     p = subprocess.Popen([PY, "-m", "walkerlab.cli", *args], cwd=d / "cfg",
                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                          start_new_session=True)
     part = d / "cfg/runs/paper/sw.h5.partial"
-    _wait_rows(part, 60, p)
+    _wait_rows(part, 150, p)
     os.killpg(p.pid, signal.SIGTERM)
     p.wait(timeout=60)
     if edit is not None:

@@ -68,6 +68,7 @@ def _guard(fn):
 
     @functools.wraps(fn)
     def wrapper(*a, **k):
+        from walkerlab import progress
         from walkerlab.analysis.poincare import FixedPointNotFound
         from walkerlab.config import SceneError
         from walkerlab.io.artifacts import ArtifactError
@@ -76,7 +77,9 @@ def _guard(fn):
 
         debug = os.environ.get(DEBUG_ENV, "") not in ("", "0")
         try:
-            return fn(*a, **k)
+            # a spinner with the elapsed time on a terminal: never silent while it works
+            with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
+                return fn(*a, **k)
         except (typer.Exit, typer.Abort, SystemExit):
             raise
         except KeyboardInterrupt:

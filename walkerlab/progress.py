@@ -73,18 +73,28 @@ class RichSink:
             from rich.console import Console
             from rich.progress import (
                 BarColumn,
-                MofNCompleteColumn,
                 Progress,
+                ProgressColumn,
                 SpinnerColumn,
                 TextColumn,
                 TimeElapsedColumn,
-                TimeRemainingColumn,
             )
+            from rich.text import Text
+
+            class Left(ProgressColumn):
+                """``done/total  ~m:ss left`` (nothing for a task of unknown length)."""
+
+                def render(self, task):
+                    if task.total is None:
+                        return Text("")
+                    r = task.time_remaining
+                    left = ("estimating" if r is None else
+                            f"~{int(r) // 60}:{int(r) % 60:02d} left")
+                    return Text(f"{int(task.completed)}/{int(task.total)}  {left}")
 
             self._progress = Progress(
                 SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
-                MofNCompleteColumn(), TimeElapsedColumn(), TextColumn("left"),
-                TimeRemainingColumn(), TextColumn("{task.fields[info]}"),
+                Left(), TimeElapsedColumn(), TextColumn("{task.fields[info]}"),
                 console=Console(stderr=True), transient=False, refresh_per_second=4)
             self._progress.start()
         return self._progress
