@@ -80,6 +80,8 @@ MAX_BIFURCATION_TRANSIENT = 100_000
 MAX_BIFURCATION_KEEP = 10_000
 #: characters of a scene's ``source:`` citation (copied into every artifact)
 MAX_SOURCE_CHARS = 4000
+#: points of a sweep grid (product of the axes' lengths, and each axis)
+MAX_SWEEP_POINTS = 1_000_000
 #: bytes of a scene YAML file
 MAX_SCENE_BYTES = 1_000_000
 #: nesting depth of a scene YAML file (mappings and lists)

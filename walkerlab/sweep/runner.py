@@ -57,7 +57,7 @@ import numpy as np
 
 import walkerlab
 from walkerlab import progress as _progress
-from walkerlab.config import Scene
+from walkerlab.config import MAX_SWEEP_POINTS, Scene
 from walkerlab.io.artifacts import code_hash
 from walkerlab.sweep.outcomes import OUTCOMES, STAGES
 from walkerlab.sweep.params import ParamAxis, SweepError, grid_points
@@ -67,7 +67,7 @@ from walkerlab.sweep.store import SweepStore, complete_sweep, partial_path
 __all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "iter_piece_results",
            "run_piece", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
 
-MAX_GRID_POINTS = 1_000_000   # a larger grid is refused (product of the axes' lengths)
+MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
 FLUSH_EVERY_S = 0.5           # rows are written to the partial file at least this often [s]
 
