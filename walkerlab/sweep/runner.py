@@ -35,6 +35,19 @@ Progress and robustness (issue 12)
 - The grid is capped at :data:`MAX_GRID_POINTS` points (product of the axes, D3).
 - One sweep per artifact at a time: a second identical sweep fails with one line (D4), and
   an artifact is finalized only when every grid point has its row.
+
+Resume (issue 19, items 4 and 13)
+---------------------------------
+A point's fixed point depends, to round-off (~1e-13, within the root finder's xtol), on the
+predictor it started from, i.e. on its chain.  Re-planning the chains from the points left
+(as before) restarted them from the scene's guess at a different point and changed the
+interleaving, so 785 of 1053 resumed rows differed by up to 2.8e-13 and 6 in
+``guess_source``.  Now the plan made when the sweep starts is stored in the partial file with
+a checkpoint per chain (points written, continuation state as exact JSON, hashed); a resumed
+chain continues from its checkpoint, so its rows are bit-identical to an uninterrupted run's
+with the same plan (the plan depends on the ``workers`` the sweep *started* with).  Every row
+is hashed as written (:func:`walkerlab.sweep.store.row_hashes`); a row or checkpoint that
+does not match on resume drops its chain's rows and the chain is computed again.
 """
 
 from __future__ import annotations
