@@ -460,9 +460,11 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
 
     def write() -> None:
         nonlocal pending, last_write, n_written
-        store.append(pending, values_of)
+        # rows and checkpoints, then one flush: the file is consistent between writes
+        store.append(pending, values_of, flush=False)
         for c, (n, g) in marks.items():
             store.checkpoint(c, n, g, key)
+        store.flush()
         marks.clear()
         n_written += len(pending)
         pending, last_write = [], time.perf_counter()

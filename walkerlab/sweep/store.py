@@ -254,15 +254,26 @@ class SweepStore:
             starts = f["plan/chain_start"][()]
             order = f["plan/index"][()]
             plan = [[int(i) for i in order[a:b]] for a, b in zip(starts[:-1], starts[1:])]
+        except (KeyError, ValueError, OSError):
+            f.close()
+            raise SweepError(f"{part}: damaged partial sweep file; rerun without --resume") \
+                from None
+        try:  # checkpoints (rewritten as chains advance): unreadable = every chain restarts
             ndone = f["plan/done"][()]
             guesses = [x.decode() if isinstance(x, bytes) else str(x)
                        for x in f["plan/guess"][()]]
             checks = [x.decode() if isinstance(x, bytes) else str(x)
                       for x in f["plan/check"][()]]
         except (KeyError, ValueError, OSError):
-            f.close()
-            raise SweepError(f"{part}: damaged partial sweep file; rerun without --resume") \
-                from None
+            ndone, guesses, checks = np.zeros(len(plan), np.int64), [], []
+            for name in ("plan/done", "plan/guess", "plan/check"):
+                if name in f:
+                    del f[name]
+            f.create_dataset("plan/done", data=np.zeros(len(plan), np.int64))
+            f.create_dataset("plan/guess", data=np.array(["null"] * len(plan), dtype=object),
+                             dtype=STR)
+            f.create_dataset("plan/check", data=np.array(["?"] * len(plan), dtype=object),
+                             dtype=STR)
         stored = [x.decode() if isinstance(x, bytes) else str(x) for x in cols["row_hash"]]
         good_row = np.array([a == b for a, b in zip(row_hashes(cols, input_hash), stored)],
                             bool)
@@ -320,8 +331,12 @@ class SweepStore:
         self.f["plan/guess"][chain] = text
         self.f["plan/check"][chain] = _chain_check(chain, done, text, key)
 
+    def flush(self) -> None:
+        """Write what is buffered to disk (rows and checkpoints together)."""
+        self.f.flush()
+
     # ------------------------------------------------------------------ write
-    def append(self, rows: list[dict], values_of: dict[int, tuple]) -> None:
+    def append(self, rows: list[dict], values_of: dict[int, tuple], flush: bool = True) -> None:
         """Append rows (dicts from :func:`walkerlab.sweep.points.evaluate`) and flush."""
         if not rows:
             return
@@ -351,7 +366,8 @@ class SweepStore:
                     if name != "row_hash"}
             put("row_hash", np.asarray(row_hashes(cols, str(self.f.attrs["input_hash"])),
                                        dtype=object))
-        self.f.flush()
+        if flush:
+            self.f.flush()
 
     def add_wall_time(self, seconds: float) -> None:
         """Add elapsed sweep wall time [s] (accumulates over resumed sessions)."""
