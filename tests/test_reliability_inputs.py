@@ -223,6 +223,15 @@ def test_item4_edited_checkpoint_restarts_its_chain(tmp_path, fake_points):
     _assert_same_rows(_rows(_interrupted(tmp_path, "forged", at=20, edit=edit)), ref)
 
 
+def test_item4_unreadable_checkpoints_restart_every_chain(tmp_path, fake_points):
+    ref = _rows(_sweep(tmp_path, "ref"))
+
+    def edit(f):  # as after a kill in the middle of a checkpoint write
+        del f["plan/guess"]
+
+    _assert_same_rows(_rows(_interrupted(tmp_path, "lost", at=20, edit=edit)), ref)
+
+
 def test_item4_finished_sweep_carries_a_content_hash(tmp_path, fake_points):
     out = _sweep(tmp_path, "fin")
     from walkerlab.sweep.runner import sweep_input_hash
@@ -431,6 +440,14 @@ def test_progress_sweep_counts_are_monotone_and_end_at_the_total(tmp_path, fake_
     t = rec.one("sweep")
     assert t["total"] == 30
     _assert_monotone_to_total(t)
+
+
+def test_progress_module_and_libraries_do_not_load_rich():
+    code = ("import sys, walkerlab.progress, walkerlab.sweep.basin, walkerlab.sweep.runner, "
+            "walkerlab.sweep.bifurcation; print('rich' in sys.modules)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=120)
+    assert r.stdout.strip() == "False", r.stderr
 
 
 def test_progress_sink_follows_the_terminal_and_quiet():
