@@ -498,3 +498,41 @@ def test_progress_quiet_silences_notices(tmp_path, paper_scene, monkeypatch, qui
         assert r.stderr == ""
     else:
         assert len(r.stderr.strip().splitlines()) == 1 and "integrity" in r.stderr
+
+
+def test_progress_adjust_counts_contact_runs(monkeypatch):
+    """contact-sim --adjust: one count per contact run, up to the most there can be."""
+    from types import SimpleNamespace
+
+    from walkerlab.contact import adjust
+    from walkerlab.contact import scene as contact_scene
+
+    calls = []
+
+    def fake_simulate_from(scene, x_fp, period, rate_scale=None):
+        calls.append(rate_scale)
+        return None, SimpleNamespace(heel_strike_times=[], termination="fall"), None, None
+
+    monkeypatch.setattr(contact_scene, "simulate_from", fake_simulate_from)
+    rec = Recorder()
+    with progress.use(rec):
+        out = adjust.adjust_rates(scene_from_dict({**PAPER, "name": "paper"}), X_GUESS, 0.7,
+                                  grid=(0.8, 1.5, 3))
+    t = rec.one("adjust")
+    c = t["counts"]
+    assert all(b > a for a, b in zip(c, c[1:])) and c[-1] == len(calls) == out["evaluations"]
+    assert c[-1] <= t["total"] and t["finished"]
+
+
+def test_contact_text_shows_the_rate_scale_adjust_found(tmp_path):
+    from walkerlab.report.text import contact_text
+
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+
+    def writer(f):
+        f.attrs["outcome"] = "completed"
+        f.create_dataset("initial_rate_scale", data=np.array([1.41, 1.74]))
+        f.create_dataset("adjust/objective", data=1e-4)
+
+    p = write_artifact(tmp_path / "contact.h5", "contact-sim", sc, "k", writer, 1.0)
+    assert "adjusted initial rate scale (found by --adjust): 1.41, 1.74" in contact_text(p)
