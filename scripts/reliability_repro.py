@@ -745,6 +745,141 @@ def i19_10_damaged_workprecision_cache(d):
 @case
 def i19_14_debug_false(d):
     rc, msg, _ = cli(d, "fixedpoint", "missing.yaml", env={"WALKERLAB_DEBUG": "false"})
+
+# ------------------------------------------------------------------ issue 19 (rel-b)
+def _wait_rows(p: Path, n: int, proc, timeout: float = 300) -> None:
+    import h5py
+
+    t0 = time.time()
+    while time.time() - t0 < timeout and proc.poll() is None:
+        try:
+            with h5py.File(p, "r", locking=False) as f:
+                if f["points/index"].shape[0] >= n:
+                    return
+        except (OSError, KeyError):
+            pass
+        time.sleep(0.5)
+
+
+def _sweep_rows(p: Path) -> dict:
+    import h5py
+
+    with h5py.File(p, "r") as f:
+        return {k: v[()] for k, v in f["points"].items()
+                if isinstance(v, h5py.Dataset) and k != "wall_time_s"}
+
+
+@case
+def i19_4_edited_basin_partial(d):
+    import h5py
+    import numpy as np
+
+    s = scene(d / "cfg", {**IDEAL, "basin": {"grid": [12, 12]}}, "paper.yaml")
+    cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "runs")
+    p = subprocess.Popen([PY, "-m", "walkerlab.cli", "basin", str(s), "--workers", "1",
+                          "--runs-dir", "runs"], cwd=d / "cfg", stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL)
+    part = d / "cfg/runs/paper/basin.h5.partial"
+    t0 = time.time()
+    while time.time() - t0 < 120:
+        try:
+            with h5py.File(part, "r", locking=False) as f:
+                if np.sum(f["outcome"][()] >= 0) >= 24:
+                    break
+        except (OSError, KeyError):
+            pass
+        time.sleep(0.3)
+    p.send_signal(signal.SIGTERM)
+    p.wait(timeout=60)
+    with h5py.File(part, "a") as f:
+        o = f["outcome"][()]
+        edited = int(np.sum(o > 0))
+        o[o > 0] = 0  # every done cell "converged"
+        f["outcome"][...] = o
+    rc, msg, _ = cli(d / "cfg", "basin", str(s), "--workers", "1", "--runs-dir", "runs")
+    with h5py.File(d / "cfg/runs/paper/basin.h5", "r") as f:
+        conv = int(f["counts/converged"][()])
+    ref = d / "ref"
+    scene(ref, {**IDEAL, "basin": {"grid": [12, 12]}}, "paper.yaml")
+    cli(ref, "basin", str(ref / "paper.yaml"), "--workers", "1", "--runs-dir", "runs")
+    with h5py.File(ref / "runs/paper/basin.h5", "r") as f:
+        conv_ref = int(f["counts/converged"][()])
+    return rc, msg, (f"{edited} done cells edited to 'converged'; converged after resume "
+                     f"{conv}, uninterrupted {conv_ref}")
+
+
+def _interrupted_sweep(d, edit=None):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    args = ["sweep", str(s), "--param", "slope.angle_deg=1:5:0.01", "--param",
+            "walker.hip_mass_kg=8,10,12", "--workers", "2", "--runs-dir", "runs",
+            "--name", "sw"]
+    p = subprocess.Popen([PY, "-m", "walkerlab.cli", *args], cwd=d / "cfg",
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                         start_new_session=True)
+    part = d / "cfg/runs/paper/sw.h5.partial"
+    _wait_rows(part, 150, p)
+    os.killpg(p.pid, signal.SIGTERM)
+    p.wait(timeout=60)
+    if edit is not None:
+        edit(part)
+    rc, msg, _ = cli(d / "cfg", *args, "--resume", timeout=600)
+    shutil.copytree(d / "cfg", d / "ref", ignore=shutil.ignore_patterns("runs"))
+    cli(d / "ref", *args, timeout=600)
+    return rc, msg, _sweep_rows(d / "cfg/runs/paper/sw.h5"), \
+        _sweep_rows(d / "ref/runs/paper/sw.h5")
+
+
+@case
+def i19_4_edited_sweep_partial(d):
+    import h5py
+    import numpy as np
+
+    def edit(part):
+        with h5py.File(part, "a") as f:
+            f["points/step_period_s"][...] = 999.0
+
+    rc, msg, got, ref = _interrupted_sweep(d, edit)
+    return rc, msg, (f"rows with step_period_s = 999 after resume: "
+                     f"{int(np.sum(got['step_period_s'] == 999))}; rows differing from an "
+                     f"uninterrupted run: {_n_diff(got, ref)}")
+
+
+def _n_diff(got, ref) -> str:
+    import numpy as np
+
+    n = got["index"].size
+    diff = np.zeros(n, bool)
+    worst = 0.0
+    for k, v in ref.items():
+        if k == "row_hash" or k not in got:
+            continue
+        a, b = got[k], v
+        if a.dtype.kind in "fc":
+            same = (a == b) | (np.isnan(a) & np.isnan(b))
+            if (~same).any():
+                worst = max(worst, float(np.nanmax(np.abs(a - b)[~same])))
+        else:
+            same = a == b
+        diff |= ~same
+    return f"{int(diff.sum())} of {n} (largest difference {worst:.2g})"
+
+
+@case
+def i19_13_sigterm_resume_identical(d):
+    rc, msg, got, ref = _interrupted_sweep(d)
+    return rc, msg, f"rows differing from an uninterrupted run: {_n_diff(got, ref)}"
+
+
+def _bad_scene_text(d, text: str, name="s.yaml"):
+    p = d / name
+    p.write_text(text)
+    return cli(d, "fixedpoint", str(p), "--runs-dir", "runs")[:2]
+
+
+@case
+def i19_5_basin_grid_5000(d):
+    s = scene(d, IDEAL, "paper.yaml")
+    rc, msg, _ = cli(d, "basin", str(s), "--grid", "5000x5000", "--runs-dir", "runs", timeout=30)
     return rc, msg, ""
 
 
@@ -771,6 +906,11 @@ def i19_14_report_md_script(d):
 @case
 def i19_14_dev_zero(d):
     rc, msg, _ = cli(d, "fixedpoint", "/dev/zero", env=_uc(d))
+
+def i19_5_basin_grid_100000(d):
+    s = scene(d, IDEAL, "paper.yaml")
+    rc, msg, _ = cli(d, "basin", str(s), "--grid", "100000x100000", "--runs-dir", "runs",
+                     timeout=60)
     return rc, msg, ""
 
 
@@ -779,6 +919,82 @@ def i19_14_bench_out_file(d):
     (d / "FILE").write_text("keep")
     rc, msg, _ = cli(d, "bench", "ideal", "--out", "FILE", env=_uc(d))
     return rc, msg, f"FILE kept: {(d / 'FILE').read_text() == 'keep'}"
+
+def i19_5_simulate_samples(d):
+    s = scene(d, with_(IDEAL, simulate={"strides": 1000, "sample_rate_hz": 1e6}), "paper.yaml")
+    rc, msg, _ = cli(d, "simulate", str(s), "--runs-dir", "runs", timeout=300)
+    return rc, msg, ""
+
+
+@case
+def i19_5_max_step_tiny(d):
+    s = scene(d, with_(IDEAL, solver__max_step_s=1e-12), "paper.yaml")
+    rc, msg, _ = cli(d, "fixedpoint", str(s), "--runs-dir", "runs", timeout=60)
+    return rc, msg, ""
+
+
+@case
+def i19_5_stability_map_n(d):
+    rc, msg, _ = cli(d, "stability-map", str(ROOT / "configs/paper.yaml"), "--n", "100000",
+                     "--runs-dir", "runs", timeout=60)
+    return rc, msg, ""
+
+
+@case
+def i19_5_stability_map_workers(d):
+    rc, msg, _ = cli(d, "stability-map", str(ROOT / "configs/paper.yaml"), "--workers", "300",
+                     "--kind", "friction", "--n", "2", "--runs-dir", "runs", timeout=60)
+    return rc, msg, ""
+
+
+@case
+def i19_5_scene_marker_dev_zero(d):
+    s = scene(d, IDEAL, "paper.yaml")
+    (d / "runs/paper").mkdir(parents=True)
+    os.symlink("/dev/zero", d / "runs/paper/.scene")
+    rc, msg, _ = cli(d, "fixedpoint", str(s), "--runs-dir", "runs", timeout=60)
+    return rc, msg, ""
+
+
+@case
+def i19_5_scene_marker_fifo(d):
+    s = scene(d, IDEAL, "paper.yaml")
+    (d / "runs/paper").mkdir(parents=True)
+    os.mkfifo(d / "runs/paper/.scene")
+    rc, msg, _ = cli(d, "fixedpoint", str(s), "--runs-dir", "runs", timeout=30)
+    return rc, msg, ""
+
+
+@case
+def i19_5_source_50mb(d):
+    s = scene(d, {**IDEAL, "source": "x" * 50_000_000}, "paper.yaml")
+    rc, msg, _ = cli(d, "fixedpoint", str(s), "--runs-dir", "runs", timeout=120)
+    h5 = d / "runs/paper/fixedpoint.h5"
+    return rc, msg, f"fixedpoint.h5: {h5.stat().st_size if h5.exists() else 0:,} bytes"
+
+
+@case
+def i19_11_force_keeps_downstream(d):
+    s = scene(d, IDEAL, "paper.yaml")
+    cli(d, "simulate", str(s), "--runs-dir", "runs")
+    cli(d, "fixedpoint", str(s), "--runs-dir", "runs", "--force")
+    rc, msg, _ = cli(d, "simulate", str(s), "--runs-dir", "runs")
+    return rc, msg, "after fixedpoint --force"
+
+
+@case
+def i19_12_deep_nesting(d):
+    return (*_bad_scene_text(d, "a: " + "[" * 20000 + "]" * 20000 + "\n"), "")
+
+
+@case
+def i19_12_5000_digit_int(d):
+    return (*_bad_scene_text(d, yaml.safe_dump(IDEAL) + "foo: " + "9" * 5000 + "\n"), "")
+
+
+@case
+def i19_12_duplicate_key(d):
+    return (*_bad_scene_text(d, yaml.safe_dump(IDEAL) + "slope:\n  angle_deg: 3.0\n"), "")
 
 
 def main():

@@ -398,11 +398,11 @@ def test_d4_second_identical_sweep_fails_in_one_line_while_the_first_runs(tmp_pa
 
 def test_d4_half_done_sweep_is_never_finalized(tmp_path, monkeypatch, fake_points):
     def lossy(chains, *a, **k):  # an executor that loses a piece
-        for chain in chains[1:]:
+        for ci, chain in enumerate(chains[1:], 1):
             guess = None
-            for t in chain:
+            for j, t in enumerate(chain):
                 rows, guess = runner.run_piece(t, guess)
-                yield rows
+                yield ci, j, rows, guess
 
     monkeypatch.setattr(runner, "iter_piece_results", lossy)
     with pytest.raises(SweepError, match="grid points have a row"):

@@ -103,6 +103,7 @@ def _guard(fn):
 
     @functools.wraps(fn)
     def wrapper(*a, **k):
+        from walkerlab import progress
         from walkerlab.analysis.poincare import FixedPointNotFound
         from walkerlab.config import SceneError
         from walkerlab.io.artifacts import ArtifactError, is_disk_full
@@ -111,7 +112,9 @@ def _guard(fn):
 
         debug = _debug()
         try:
-            return fn(*a, **k)
+            # a spinner with the elapsed time on a terminal: never silent while it works
+            with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
+                return fn(*a, **k)
         except (typer.Exit, typer.Abort, SystemExit):
             raise
         except KeyboardInterrupt:
@@ -210,10 +213,17 @@ def _process_settings() -> None:
 def _main(version: bool = typer.Option(False, "--version", callback=_version_callback,
                                        is_eager=True,
                                        help="print walkerlab, Python, numpy, scipy, numba "
-                                       "and h5py versions and exit")) -> None:
+                                       "and h5py versions and exit"),
+          quiet: bool = typer.Option(False, "--quiet", "-q",
+                                     help="no progress display and no notices on stderr "
+                                     "(errors are still shown); progress is also off when "
+                                     "stderr is not a terminal")) -> None:
     """walkerlab: passive-dynamic biped walkers, from fixed point to report."""
     _single_threaded_blas()
     _process_settings()
+    from walkerlab import progress
+
+    progress.install(progress.sink_for_terminal(quiet))
 
 
 def _status(o) -> str:

@@ -52,10 +52,20 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
         return float(np.mean(((T - period) / period) ** 2)
                      + np.mean(((lens - l_star) / l_star) ** 2))
 
+    from walkerlab import progress
+
     lo, hi, n = grid
-    x0, fval, _, _ = brute(J, ((lo, hi), (lo, hi)), Ns=n, full_output=True, finish=None)
-    res = minimize(J, x0, method="Nelder-Mead", options={"xatol": 1e-3, "fatol": 1e-8,
-                                                          "maxfev": 60})
+    with progress.task("adjust: contact runs (grid, then Nelder-Mead; at most)",
+                       n * n + 60) as bar:
+        def J_shown(s):  # progress: contact runs done of the most there can be
+            v = J(s)
+            bar.update(count["n"], info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: J {v:.3g}")
+            return v
+
+        x0, fval, _, _ = brute(J_shown, ((lo, hi), (lo, hi)), Ns=n, full_output=True,
+                               finish=None)
+        res = minimize(J_shown, x0, method="Nelder-Mead",
+                       options={"xatol": 1e-3, "fatol": 1e-8, "maxfev": 60})
     best = res.x if res.fun <= fval else x0
     return {"scale": np.asarray(best, float), "objective": float(min(res.fun, fval)),
             "evaluations": count["n"], "grid_best": np.asarray(x0, float)}

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from walkerlab.analysis.hybrid import HybridTrajectory
@@ -49,7 +51,21 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
     Returns
     -------
     NamedTrajectory
+
+    Raises
+    ------
+    ValueError
+        More than :data:`walkerlab.config.MAX_SIMULATE_SAMPLES` samples (checked before any
+        is taken; the message names ``simulate.sample_rate_hz``).
     """
+    from walkerlab.config import MAX_SIMULATE_SAMPLES
+
+    n = sum(math.ceil(max(s.t_end - s.t_start, 0.0) * rate_hz) + 1 for s in traj.segments)
+    if n > MAX_SIMULATE_SAMPLES:
+        span = sum(s.t_end - s.t_start for s in traj.segments)
+        raise ValueError(f"simulate.sample_rate_hz: {rate_hz:g} Hz over {span:.3g} s "
+                         f"gives {n:,} samples; at most {MAX_SIMULATE_SAMPLES:,} are kept "
+                         "(lower simulate.sample_rate_hz or simulate.strides)")
     w = traj.walker
     legs = list(w.legs)
     units = dict(w.coordinate_units)

@@ -317,9 +317,11 @@ def read_cached_case(path: Path) -> dict | None:
     """A cached case result (:func:`time_case`) if the file holds a complete one, else None
     (missing, unreadable, not JSON, or lacking/mistyping a field: the case is measured
     again, issue 19)."""
+    from walkerlab.io.bounded import read_regular
+
     try:
-        res = json.loads(path.read_text())
-    except (OSError, ValueError):
+        res = json.loads(read_regular(path, 1 << 20, "cache entry"))
+    except (OSError, ValueError):  # missing, not a bounded regular file, not JSON
         return None
     if not isinstance(res, dict):
         return None
@@ -331,7 +333,7 @@ def read_cached_case(path: Path) -> dict | None:
 
 
 def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
-              lanes: Lanes | None = None) -> dict:
+              lanes: Lanes | None = None, on_case=None) -> dict:
     """Results of every case, from the cache or measured (in pinned worker processes).
 
     Parameters
@@ -344,6 +346,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
         cores than workers: every case in this process, one after the other).
     lanes : Lanes, optional
         Explicit cores, gates and pending models (``walkerlab report``).
+    on_case : callable(done, total), optional
+        Progress: called with ``(0, cases to measure)`` once the cache was read, then after
+        each measured case (from the lanes' threads).
 
     Returns
     -------
@@ -358,6 +363,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
             out[t.key] = {**res, "cached": True}
         else:  # missing, damaged or incomplete: measured again
             todo.append(t)
+    n_todo, n_done = len(todo), [0]
+    if on_case is not None:
+        on_case(0, n_todo)
     if lanes is not None:
         lanes.todo_models.update(t.model for t in todo)
         lanes.todo_known.set()
@@ -372,6 +380,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
         atomic_write(cache_dir / f"{key}.json", lambda fh: fh.write(text))
         with lock:
             out[key] = {**res, "cached": False}
+            n_done[0] += 1
+        if on_case is not None:
+            on_case(n_done[0], n_todo)
 
     if lanes is None:
         cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []

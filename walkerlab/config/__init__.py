@@ -20,6 +20,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 import re
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -73,8 +74,34 @@ def _list_to_tuple(v):
 # A fixed-length tuple given as a YAML list (strict mode alone would want a Python tuple).
 AsTuple = BeforeValidator(_list_to_tuple)
 
-# Caps that keep a run bounded (issue 12, D8): a bigger request is a one-line error.
+# Caps that keep a run bounded (issue 12, D8; issue 19, item 5): a bigger request is a
+# one-line error.  Each size a user can type has one cap, defined here; the CLI validates its
+# options through the same pydantic fields (:func:`validate_option`).
 MAX_SIMULATE_STRIDES = 1000
+#: dense samples of one ``simulate`` run (strides x 2 x step period x sample_rate_hz)
+MAX_SIMULATE_SAMPLES = 5_000_000
+#: integrator steps a ``solver.max_step_s`` may imply for the longest allowed walking step
+#: (``max_step_time_s / max_step_s``)
+MAX_STEPS_PER_WALKING_STEP = 100_000
+#: cells along one axis of a basin map
+MAX_BASIN_CELLS_PER_AXIS = 4000
+#: cells along one axis of a stability map (each cell is a contact-model search)
+MAX_STABILITY_MAP_N = 64
+#: local worker processes: 4 per core
+MAX_WORKERS = 4 * (os.cpu_count() or 1)
+#: bifurcation: steps discarded / heel strikes kept per slope
+MAX_BIFURCATION_TRANSIENT = 100_000
+MAX_BIFURCATION_KEEP = 10_000
+#: characters of a scene's ``source:`` citation (copied into every artifact)
+MAX_SOURCE_CHARS = 4000
+#: points of a sweep grid (product of the axes' lengths, and each axis)
+MAX_SWEEP_POINTS = 1_000_000
+#: bytes of a scene YAML file
+MAX_SCENE_BYTES = 1_000_000
+#: nesting depth of a scene YAML file (mappings and lists)
+MAX_YAML_DEPTH = 32
+#: seconds a single walking step may take before it counts as a failure
+MAX_STEP_TIME_S = 600.0
 
 
 # --------------------------------------------------------------------------- walker
@@ -350,7 +377,7 @@ class FixedPointSettings(_Strict):
         "near the first at a screening tolerance, then polished; about 0.05-0.4 s) and "
         "record both in fixedpoint.h5")
     tolerance: float = Field(1e-12, gt=0, lt=1e-3, description="root-finder xtol [-]")
-    max_step_time_s: float = Field(5.0, gt=0,
+    max_step_time_s: float = Field(5.0, gt=0, le=MAX_STEP_TIME_S,
                                    description="a step longer than this is a failure [s]")
     fd_step: float = Field(1e-7, gt=0, lt=1e-2,
                            description="finite-difference step for the Jacobian")
@@ -373,7 +400,7 @@ class SimulateSettings(_Strict):
     initial_state: Literal["fixed_point"] | StateSpec = Field(
         "fixed_point", description="'fixed_point' (from fixedpoint.h5) or an explicit state"
     )
-    max_step_time_s: float = Field(5.0, gt=0,
+    max_step_time_s: float = Field(5.0, gt=0, le=MAX_STEP_TIME_S,
                                    description="a step longer than this ends the run [s]")
 
 
@@ -419,9 +446,10 @@ class BasinSettings(_Strict):
     y_range: Annotated[tuple[float, float] | None, AsTuple] = Field(
         None, description="y axis [rad or rad/s]; null = fixed point -/+ 0.3 rad (angles) or "
         "1.2 rad/s (rates)")
-    grid: Annotated[tuple[Annotated[int, Field(ge=2, le=4000)],
-                          Annotated[int, Field(ge=2, le=4000)]], AsTuple] = \
-        Field((200, 200), description="cells along x and y")
+    grid: Annotated[tuple[Annotated[int, Field(ge=2, le=MAX_BASIN_CELLS_PER_AXIS)],
+                          Annotated[int, Field(ge=2, le=MAX_BASIN_CELLS_PER_AXIS)]], AsTuple] = \
+        Field((200, 200), description=f"cells along x and y (2 to {MAX_BASIN_CELLS_PER_AXIS} "
+              "each)")
     max_steps: int = Field(50, ge=1, le=10_000, description="steps simulated per cell at most")
     converge_tol: float = Field(1e-4, gt=0, lt=1, description="a cell has converged to the "
                                 "period-1 gait once max|x - x*| < this [rad, rad/s]")
@@ -435,7 +463,8 @@ class BasinSettings(_Strict):
         "SolverSettings.backend; cyrk_compiled is slower here (most cells fall within a "
         "step, so its fixed chunks overshoot, and each worker imports numba)")
     max_step_time_s: float | None = Field(
-        None, gt=0, description="a step longer than this ends the cell as 'stalled' [s]; "
+        None, gt=0, le=MAX_STEP_TIME_S,
+        description="a step longer than this ends the cell as 'stalled' [s]; "
         "null = fixedpoint.max_step_time_s")
     start: Literal["fixed_point", "heel_strike"] = Field(
         "fixed_point", description="how a cell's other coordinates are set: 'fixed_point' = "
@@ -452,7 +481,9 @@ class Scene(_Strict):
     name: str | None = Field(None, description="run folder name (runs/<name>/); default: "
                              "YAML file stem. Letters, digits and . _ + - only, no path "
                              "separators, not starting with a dot", max_length=100)
-    source: str | None = Field(None, description="citation of the parameter set")
+    source: str | None = Field(None, max_length=MAX_SOURCE_CHARS,
+                               description="citation of the parameter set (at most "
+                               f"{MAX_SOURCE_CHARS} characters)")
     published: str | None = Field(
         None, description="walkerlab.published module whose printed numbers the report sets "
         "next to ours (e.g. 'paper'); null: no published comparison")
@@ -497,6 +528,24 @@ class Scene(_Strict):
             if self.published not in available():
                 raise ValueError(f"published: no module walkerlab.published.{self.published} "
                                  f"(available: {', '.join(available())})")
+        return self
+
+    @model_validator(mode="after")
+    def _bounded_integrator_steps(self) -> Scene:
+        # a tiny max_step_s runs for minutes without output: bound the steps it implies for
+        # the longest walking step the scene allows (issue 19, item 5)
+        if self.solver.max_step_s is None:
+            return self
+        longest = max([5.0] + [s.max_step_time_s for s in (self.fixedpoint, self.simulate,
+                                                            self.basin)
+                               if s is not None and s.max_step_time_s is not None])
+        n = longest / self.solver.max_step_s
+        if n > MAX_STEPS_PER_WALKING_STEP:
+            raise ValueError(
+                f"solver.max_step_s: {self.solver.max_step_s:g} s would allow "
+                f"{n:.3g} integrator steps in a walking step of up to {longest:g} s "
+                f"(max_step_time_s); at most {MAX_STEPS_PER_WALKING_STEP:,} are allowed, so "
+                f"use max_step_s >= {longest / MAX_STEPS_PER_WALKING_STEP:g} s")
         return self
 
     @field_validator("name")
@@ -584,6 +633,8 @@ def _error_line(e: dict) -> str:
             and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
                               "string_type", "float_parsing", "int_parsing"):
         msg += f" (got {e['input']!r})"
+    if not loc and re.match(r"^[a-z_]+(\.[a-z_]+)+: ", msg):  # a cross-field check names it
+        return msg
     return f"{loc or '<scene>'}: {msg}"
 
 
@@ -622,6 +673,59 @@ def default_scene_path() -> Path:
     return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
 
 
+class _SceneLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses duplicate keys and nesting deeper than
+    :data:`MAX_YAML_DEPTH` (the composer recurses once per level: 20000 levels would exhaust
+    Python's stack)."""
+
+    _depth = 0
+
+    def compose_node(self, parent, index):
+        self._depth += 1
+        try:
+            if self._depth > MAX_YAML_DEPTH:
+                raise yaml.composer.ComposerError(
+                    None, None, f"nesting deeper than {MAX_YAML_DEPTH} levels",
+                    self.peek_event().start_mark)
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen: dict = {}
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    first = seen.setdefault(key, key_node.start_mark.line)
+                except TypeError:  # unhashable key: SafeConstructor reports it
+                    continue
+                if first != key_node.start_mark.line:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"duplicate key {key!r} (first given on line {first + 1})",
+                        key_node.start_mark)
+        return super().construct_mapping(node, deep=deep)
+
+
+def _first_line(exc: BaseException) -> str:
+    return (str(exc).strip().splitlines() or [""])[0][:200]
+
+
+def parse_yaml(text: str):
+    """Parse YAML text with :class:`_SceneLoader` (duplicate keys and deep nesting refused).
+
+    Raises
+    ------
+    yaml.YAMLError
+        Malformed YAML, a duplicate key or nesting deeper than :data:`MAX_YAML_DEPTH`.
+    ValueError
+        A number Python will not convert (an integer of more than 4300 digits).
+    """
+    return yaml.load(text, Loader=_SceneLoader)  # noqa: S506 - a SafeLoader subclass
+
+
 def load_scene(path: str | Path) -> Scene:
     """Read and validate a scene YAML file.
 
@@ -641,6 +745,8 @@ def load_scene(path: str | Path) -> Scene:
         File missing, malformed YAML, or a field that fails validation (one line, naming
         the file and the field).
     """
+    from walkerlab.io.bounded import NotARegularFile, read_regular
+
     path = Path(path)
     if path.is_dir():
         raise SceneError(f"{path}: is a directory, not a scene file")
@@ -649,18 +755,29 @@ def load_scene(path: str | Path) -> Scene:
             raise SceneError(f"{path}: not a regular file; give a YAML scene file")
         raise SceneError(f"{path}: scene file not found")
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_regular(path, MAX_SCENE_BYTES, "scene file").decode("utf-8")
+    except NotARegularFile as exc:
+        raise SceneError(str(exc)) from None
     except UnicodeDecodeError as exc:
         raise SceneError(f"{path}: not a text (UTF-8) YAML file (byte {exc.start} is "
                          f"0x{exc.object[exc.start]:02x})") from None
     except OSError as exc:
         raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from None
     try:
-        data = yaml.safe_load(text)
+        data = parse_yaml(text)
+    except ValueError as exc:  # int(...) of a 5000-digit number
+        what = ("an integer longer than Python reads (4300 digits)" if "digits" in str(exc)
+                else _first_line(exc))
+        raise SceneError(f"{path}: unreadable number: {what}") from None
+    except RecursionError:
+        raise SceneError(f"{path}: nesting too deep (at most {MAX_YAML_DEPTH} levels)") \
+            from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", exc)
+        if str(problem).startswith(("duplicate key", "nesting deeper")):
+            raise SceneError(f"{path}:{where} {problem}") from None
         raise SceneError(f"{path}:{where} malformed YAML ({problem})") from None
     if not isinstance(data, dict):
         raise SceneError(f"{path}: a scene must be a YAML mapping")
@@ -681,3 +798,59 @@ def scene_from_dict(data: dict[str, Any], origin: str | Path = "<scene>") -> Sce
         return Scene.model_validate(data)
     except ValidationError as err:
         raise SceneError(_format_error(Path(str(origin)), err)) from None
+
+
+class CommandOptions(_Strict):
+    """Sizes typed on the command line only (each with the one cap defined above)."""
+
+    workers: int = Field(2, ge=1, le=MAX_WORKERS,
+                         description=f"local worker processes (at most {MAX_WORKERS}: 4 per core)")
+    stability_map_n: int = Field(8, ge=2, le=MAX_STABILITY_MAP_N,
+                                 description="stability-map grid size n x n")
+    stability_map_time_limit_s: float = Field(60.0, ge=1.0, le=3600.0,
+                                              description="wall-time limit per map cell [s]")
+    bifurcation_transient: int = Field(100, ge=1, le=MAX_BIFURCATION_TRANSIENT,
+                                       description="steps discarded before sampling")
+    bifurcation_keep: int = Field(30, ge=1, le=MAX_BIFURCATION_KEEP,
+                                  description="heel strikes kept per slope")
+
+
+def validate_option(model: type[BaseModel], field: str, value: Any, option: str,
+                    yaml_field: str | None = None) -> Any:
+    """Validate one command-line value through the pydantic field that caps it in YAML.
+
+    Parameters
+    ----------
+    model : pydantic model class
+        Section holding the field (``BasinSettings``, ``CommandOptions``, ...).
+    field : str
+        Field name (``"grid"``).
+    value
+        The option's value.
+    option : str
+        Option name for the message (``"--grid"``).
+    yaml_field : str, optional
+        The scene field with the same cap, named in the message (``"basin.grid"``).
+
+    Returns
+    -------
+    The validated value.
+
+    Raises
+    ------
+    SceneError
+        One line: ``--grid 5000x5000: ... (basin.grid)``.
+    """
+    from pydantic import TypeAdapter
+
+    info = model.model_fields[field]
+    adapter = TypeAdapter(Annotated[info.annotation, info],
+                          config=ConfigDict(strict=True, allow_inf_nan=False))
+    try:
+        return adapter.validate_python(value)
+    except ValidationError as err:
+        e = err.errors()[0]
+        shown = "x".join(str(v) for v in value) if isinstance(value, tuple) else value
+        also = f" (as {yaml_field})" if yaml_field else ""
+        raise SceneError(f"{option} {shown}: {e['msg'][:1].lower() + e['msg'][1:]}{also}") \
+            from None

@@ -15,10 +15,16 @@ Layout conventions
   exclusively; a link in place of the target is a one-line error).  Every output file is
   mode 0644.
 - ``content_hash`` (root attribute): SHA-256 over every dataset and attribute of the file
-  except ``content_hash``, ``created_utc`` and ``wall_time_s``.  A stage reuses its artifact
-  only if the stored hash still matches the content, and the cache key of a downstream stage
-  includes its upstream artifacts' *recomputed* content hashes, so an artifact edited by
-  hand (h5py) is detected, never trusted.
+  that holds a *result*: run-dependent records are left out (issue 19, item 11), i.e. the
+  root attributes in :data:`VOLATILE_ATTRS` (``content_hash``, ``created_utc``,
+  ``wall_time_s``, ``workers``, ``scheduler``, ``hostname``) and every dataset or attribute
+  whose own name is in :data:`VOLATILE_NAMES` (wall times such as ``stats/wall_time``,
+  ``summary/wall_time_s`` or a sweep's ``points/wall_time_s``, and ``cells_computed``), so
+  a bit-identical recomputation keeps its hash and nothing downstream is recomputed.
+  Timings that *are* the result (the work-precision study's ``time``) are hashed.
+  A stage reuses its artifact only if the stored hash still matches the content, and the
+  cache key of a downstream stage includes its upstream artifacts' *recomputed* content
+  hashes, so an artifact edited by hand (h5py) is detected, never trusted.
 """
 
 from __future__ import annotations
@@ -48,7 +54,14 @@ class ArtifactError(RuntimeError):
 
 
 FILE_MODE = 0o644
-_VOLATILE_ATTRS = ("content_hash", "created_utc", "wall_time_s")
+#: root attributes that record the run, not its result (not hashed)
+VOLATILE_ATTRS = frozenset({"content_hash", "created_utc", "wall_time_s", "workers",
+                            "scheduler", "hostname"})
+#: dataset / attribute names (last path component) that record timings or how much this
+#: run computed (resumed runs), not results (not hashed)
+VOLATILE_NAMES = frozenset({"wall_time", "wall_time_s", "integration_wall_time_s",
+                            "cells_computed"})
+
 
 
 #: errno values that mean "no room": no space, file too large (``ulimit -f``), quota
@@ -146,16 +159,18 @@ def content_hash_of(f: h5py.File) -> str:
     names: list[str] = []
     f.visit(names.append)
     for key in sorted(f.attrs):
-        if key not in _VOLATILE_ATTRS:
+        if key not in VOLATILE_ATTRS:
             h.update(f"@/{key}".encode())
             _hash_value(h, f.attrs[key])
     for name in sorted(names):
+        if name.rsplit("/", 1)[-1] in VOLATILE_NAMES:
+            continue
         obj = f[name]
         h.update(f"/{name}".encode())
         if isinstance(obj, h5py.Dataset):
             _hash_value(h, obj[()])
         for key in sorted(obj.attrs):
-            if key in _REFERENCE_ATTRS:
+            if key in _REFERENCE_ATTRS or key in VOLATILE_NAMES:
                 continue
             h.update(f"@{key}".encode())
             _hash_value(h, obj.attrs[key])

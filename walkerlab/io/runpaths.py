@@ -59,6 +59,7 @@ STAGE_PREFIXES = ("stability_map", "stability-map",  # stability_map_<kind>.h5
                   "bifurcation_")                      # bifurcation_<field>.h5
 
 ORIGIN_FILE = ".scene"
+MAX_MARKER_BYTES = 8192  # a resolved path of the scene file
 
 
 class RunPathError(ValueError):
@@ -123,9 +124,14 @@ def scene_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
             _mkdir(d)
         return d
     marker = d / ORIGIN_FILE
-    try:
-        owner = Path(marker.read_text().strip())
-    except (OSError, UnicodeDecodeError):
+    from walkerlab.io.bounded import NotARegularFile, read_regular
+
+    try:  # a bounded regular file: a FIFO or /dev/zero in its place must not hang or fill RAM
+        owner = Path(read_regular(marker, MAX_MARKER_BYTES, "run-folder marker")
+                     .decode().strip())
+    except NotARegularFile as exc:
+        raise RunPathError(f"{exc}; remove it") from None
+    except (OSError, UnicodeDecodeError, ValueError):
         owner = None
     if owner is not None and owner != Path(origin) and owner.is_file():
         raise RunPathError(f"{d}: run folder of {owner}; {origin} has the same name "

@@ -118,6 +118,10 @@ def contact_text(path: Path) -> str:
         # the message only when it says more than the outcome's name
         lines = [f"contact walker: outcome {kind}" + (f" ({why})" if why and why != kind
                                                       else "")]
+        if "initial_rate_scale" in f and "adjust" in f:  # --adjust: the scale it found
+            s = np.atleast_1d(f["initial_rate_scale"][()])
+            lines.append("adjusted initial rate scale (found by --adjust): "
+                         + ", ".join(f"{v:.4g}" for v in s))
         if "summary" in f:
             for k in f["summary"]:
                 ds = f["summary"][k]

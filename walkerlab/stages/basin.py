@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.config import BasinSettings, Scene
+from walkerlab.config import BasinSettings, CommandOptions, Scene, validate_option
 from walkerlab.io.artifacts import put, write_artifact
 from walkerlab.io.netcdf import coordinate
 from walkerlab.io.runpaths import artifact_lock, stage_artifact
@@ -70,6 +70,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     require(scene, "fixedpoint", "basin")
     st = scene.basin or BasinSettings()
+    if grid is not None:  # the scene's cap on basin.grid, for --grid too
+        grid = validate_option(BasinSettings, "grid", tuple(grid), "--grid", "basin.grid")
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
     grid = tuple(grid or st.grid)
     fixedpoint_stage.run(scene, runs_root)
     up = artifact_path(scene, runs_root, "fixedpoint")

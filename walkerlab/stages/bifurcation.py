@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.config import Scene
+from walkerlab.config import CommandOptions, Scene, validate_option
 from walkerlab.stages.common import StageOutcome, require, run_cached
 from walkerlab.stages.plot import figures_dir
 
@@ -65,6 +65,10 @@ def run(scene: Scene, slopes_deg, runs_root: Path | str = "runs", n_transient: i
     from walkerlab.sweep.params import ParamAxis, axis_unit, check_axes
 
     require(scene, "fixedpoint", "bifurcation")
+    n_transient = validate_option(CommandOptions, "bifurcation_transient", n_transient,
+                                  "--transient")
+    n_keep = validate_option(CommandOptions, "bifurcation_keep", n_keep, "--keep")
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
     slopes = [float(s) for s in np.asarray(slopes_deg, float)]
     stem = bifurcation_stem(param)
     if param == SLOPE_PATH:  # the slope's cache key, as before

@@ -134,16 +134,31 @@ class _Study:
         return self.outcome
 
 
-def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome]:
+def planned_stages(scene: Scene) -> list[str]:
+    """The stages ``report`` runs for this scene, in order (for its progress display)."""
+    sim, contact = scene.simulate is not None, scene.contact is not None
+    return [n for n, on in (("fixedpoint", scene.fixedpoint is not None), ("simulate", sim),
+                            ("contact-sim", contact), ("compare", contact and sim),
+                            ("workprecision", getattr(scene, "workprecision", None) is not None),
+                            ("basin", scene.basin is not None and scene.fixedpoint is not None))
+            if on]
+
+
+def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None) -> list[StageOutcome]:
     from walkerlab.stages import fixedpoint, simulate
 
     done: list[StageOutcome] = []
+
+    def add(o: StageOutcome) -> None:
+        done.append(o)
+        if bar is not None:
+            bar.advance(info=f"{o.stage} {'reused' if o.reused else 'computed'}")
     drawn: list[str] = []
     study = (_Study(scene, runs_root, force)
              if getattr(scene, "workprecision", None) is not None else None)
     try:
         if scene.fixedpoint is not None:
-            done.append(fixedpoint.run(scene, runs_root, force, compare_variants=True))
+            add(fixedpoint.run(scene, runs_root, force, compare_variants=True))
         if study is not None:
             study.start()
         if study is not None and study.needs("contact"):
@@ -152,15 +167,15 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
             workprecision.warm_up(scene, runs_root, "contact")  # numba compiles here, once
             study.ready("contact")
         if scene.simulate is not None:
-            done.append(simulate.run(scene, runs_root, force))
+            add(simulate.run(scene, runs_root, force))
         if scene.contact is not None:
             from walkerlab.stages import contact_sim
 
-            done.append(contact_sim.run(scene, runs_root, force))
+            add(contact_sim.run(scene, runs_root, force))
             if scene.simulate is not None:
                 from walkerlab.stages import compare
 
-                done.append(compare.run(scene, runs_root, force))
+                add(compare.run(scene, runs_root, force))
         if any(o.stage in ("simulate", "contact-sim") for o in done):
             drawn.append(_draw(scene, runs_root, force, "trajectories"))
     except BaseException:
@@ -173,13 +188,13 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo) -> list[StageOutcome
         raise
     if study is not None:
         study.release()
-        done.append(study.join())
+        add(study.join())
         drawn.append(_draw(scene, runs_root, force, "workprecision"))
     if scene.basin is not None and scene.fixedpoint is not None:
         # after the study: its worker processes would share the timed cases' cores
         from walkerlab.stages import basin
 
-        done.append(basin.run(scene, runs_root, force))
+        add(basin.run(scene, runs_root, force))
     for o in done:
         status = ("reused (inputs unchanged)" if o.reused and not o.note else
                   f"reused ({o.note})" if o.reused else
@@ -284,7 +299,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     Path
         The HTML report.
     """
-    done = _run_stages(scene, runs_root, force, echo)
+    from walkerlab import progress
+
+    stages = planned_stages(scene)
+    with progress.task(f"report: {len(stages)} stages ({', '.join(stages)})",
+                       len(stages)) as bar:
+        done = _run_stages(scene, runs_root, force, echo, bar)
     paths, left_out = report_artifacts(scene, runs_root, done)
     if left_out:
         echo(left_out)

@@ -8,7 +8,7 @@ import numpy as np
 
 from walkerlab.analysis.hybrid import Solver, simulate_steps
 from walkerlab.analysis.metrics import sample_trajectory, step_table, total_mass_kg
-from walkerlab.config import Scene, SimulateSettings
+from walkerlab.config import MAX_SIMULATE_SAMPLES, Scene, SimulateSettings
 from walkerlab.io.artifacts import put
 from walkerlab.io.netcdf import coordinate
 from walkerlab.io.readers import load_fixed_point
@@ -91,7 +91,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     def compute():
         walker = build_walker(scene)
         if sim.initial_state == "fixed_point":
-            x0, _ = load_fixed_point(upstream[0])
+            x0, meta = load_fixed_point(upstream[0])
+            # refuse before integrating what could not be sampled (sample_trajectory checks
+            # the exact count afterwards for any initial state)
+            n = 2 * sim.strides * meta["step_period_s"] * sim.sample_rate_hz
+            if n > MAX_SIMULATE_SAMPLES:
+                raise StageError(f"simulate.sample_rate_hz: {sim.sample_rate_hz:g} Hz over "
+                                 f"{sim.strides} strides of {2 * meta['step_period_s']:.3g} s "
+                                 f"gives {n:.3g} samples; at most {MAX_SIMULATE_SAMPLES:,} "
+                                 "are kept (lower simulate.sample_rate_hz or simulate.strides)")
         else:
             try:
                 x0 = sim.initial_state.as_array(walker.state_names())

@@ -13,7 +13,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from walkerlab.config import Scene
+from walkerlab.config import CommandOptions, Scene, validate_option
 from walkerlab.io.artifacts import open_artifact, put
 from walkerlab.stages.common import StageOutcome, require, run_cached
 from walkerlab.sweep.stability import (
@@ -48,10 +48,24 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     require(scene, "contact", "stability-map")
     require(scene, "fixedpoint", "stability-map")
+    n = validate_option(CommandOptions, "stability_map_n", n, "--n")
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
+    time_limit_s = validate_option(CommandOptions, "stability_map_time_limit_s",
+                                   float(time_limit_s), "--time-limit")
     spec = spec or default_spec(kind, n, time_limit_s)
 
     def compute():
-        cells = gait_map(scene, spec, workers=workers, progress=progress)
+        from walkerlab import progress as _progress
+
+        ny = len(spec.y_values)
+        with _progress.task(f"stability map {spec.kind}: {ny}x{len(spec.slopes_deg)} cells "
+                            "(rows)", ny) as bar:
+            def tick(done, total):
+                bar.update(done)
+                if progress is not None:
+                    progress(done, total)
+
+            cells = gait_map(scene, spec, workers=workers, progress=tick)
         frac = stable_fraction(cells)
         reasons = [str(r) for r in cells["reason"].ravel() if r]
         summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}

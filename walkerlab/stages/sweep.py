@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from walkerlab.config import Scene, load_scene
+from walkerlab.config import CommandOptions, Scene, load_scene, validate_option
 from walkerlab.io.runpaths import named_artifact
 from walkerlab.sweep.params import ParamAxis, SweepError, check_axes, params_hash, parse_param
 from walkerlab.sweep.runner import MAX_GRID_POINTS, run_sweep
@@ -86,6 +86,7 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     """
     scene = scene_path_or_scene if isinstance(scene_path_or_scene, Scene) \
         else load_scene(scene_path_or_scene)
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
     if stage not in STAGE_NAMES:
         raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(STAGE_NAMES)}")
     axes = [parse_param(p) if isinstance(p, str) else p for p in params]

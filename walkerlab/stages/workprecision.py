@@ -174,7 +174,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                 k = _case_key(model, secs, x0t, wp.strides, m, r, a, rep)
                 keys[(model, m, r, rep)] = k
                 tasks.append(Case(k, model, sj, period, x0t, wp.strides, m, r, a, rep, warm))
-        done = run_cases(tasks, cache, workers, lanes)
+        from walkerlab import progress
+
+        with progress.task(f"work-precision: timing {len(tasks)} cases (uncached)") as bar:
+            done = run_cases(tasks, cache, workers, lanes,
+                             on_case=lambda k, n: bar.update(k, total=n))
         results = {}
         for model, (methods, rtols, _, ref, target, _) in models.items():
             refvec = done[keys[(model, ref[0], ref[1], 1)]]["vec"]

@@ -30,7 +30,9 @@ Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
 Cells are evaluated in chunks (one grid row each) by
 :func:`walkerlab.sweep.runner.iter_chunk_results` - in this process, on a local process pool
 or on a Dask cluster - and written to a partial HDF5 file after every chunk, so an
-interrupted map resumes where it stopped.
+interrupted map resumes where it stopped.  Each finished grid row is stored with its hash
+(:func:`row_digest`, ``/row_hash``); on resume a row whose cells no longer match it (edited,
+damaged) is computed again (issue 19, item 4).
 """
 
 from __future__ import annotations
@@ -325,6 +327,18 @@ def _partial(path: Path) -> Path:
     return path.with_name(path.name + ".partial")
 
 
+def row_digest(arrays: dict, j: int, key: str) -> str:
+    """SHA-256 of grid row ``j`` (outcome, steps, period) and the input hash ``key``: the
+    integrity check of a partial basin file (a row that does not match is computed again)."""
+    import hashlib
+
+    h = hashlib.sha256(f"{key}|{j}".encode())
+    for k in ("outcome", "steps", "period"):
+        a = np.ascontiguousarray(arrays[k][j])
+        h.update(k.encode() + a.dtype.str.encode() + a.tobytes())
+    return h.hexdigest()
+
+
 def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
                   grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
                   resume: bool = True, on_chunk: Callable[[int, int], None] | None = None
@@ -381,16 +395,36 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     part = refuse_link(_partial(Path(out_path)))  # never written through a link
     part.parent.mkdir(parents=True, exist_ok=True)
     arrays = None
+    row_hash = np.array([""] * ny, dtype=object)
     if resume and part.is_file():
         try:
             with h5py.File(part, "r") as f:
                 if f.attrs.get("input_hash") == key and f["outcome"].shape == (ny, nx):
                     arrays = {k: f[k][()] for k in ("outcome", "steps", "period")}
-        except OSError:
+                    stored = [x.decode() if isinstance(x, bytes) else str(x)
+                              for x in f["row_hash"][()]] if "row_hash" in f else [""] * ny
+        except (OSError, KeyError, ValueError):
             arrays = None
     if arrays is None:
         arrays = {"outcome": np.full((ny, nx), NOT_DONE, np.int8),
                   "steps": np.zeros((ny, nx), np.int16), "period": np.zeros((ny, nx), np.int8)}
+    else:  # keep only grid rows whose cells still match the hash written with them
+        bad = 0
+        for j in range(ny):
+            done_row = bool(np.any(arrays["outcome"][j] != NOT_DONE))
+            if stored[j] and stored[j] == row_digest(arrays, j, key) and \
+                    bool(np.all(arrays["outcome"][j] != NOT_DONE)):
+                row_hash[j] = stored[j]
+                continue
+            bad += done_row
+            arrays["outcome"][j] = NOT_DONE
+            arrays["steps"][j] = 0
+            arrays["period"][j] = 0
+        if bad:
+            from walkerlab import progress
+
+            progress.note(f"{part}: {bad} grid row(s) failed their integrity check; "
+                          "computing them again")
     tasks = []
     for j in range(ny):
         cells = tuple((j * nx + i, float(xs[i]), float(ys[j])) for i in range(nx)
@@ -403,10 +437,14 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     total, done = nx * ny, int(np.sum(arrays["outcome"] != NOT_DONE))
     t0 = time.perf_counter()
     computed = 0
+    from walkerlab import progress
+
     part.unlink(missing_ok=True)
-    with h5py.File(part, "x") as f:  # created exclusively (O_EXCL: no link followed)
+    with h5py.File(part, "x") as f, \
+            progress.task(f"basin {nx}x{ny} cells", total, done) as bar:
         f.attrs["input_hash"] = key
         dsets = {k: f.create_dataset(k, data=v) for k, v in arrays.items()}
+        hashes = f.create_dataset("row_hash", data=row_hash, dtype=h5py.string_dtype())
         f.flush()
         for rows in iter_chunk_results(tasks, workers, scheduler, fn=run_basin_chunk):
             for idx, code, steps, period in rows:
@@ -414,11 +452,16 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
                 arrays["outcome"][j, i] = code
                 arrays["steps"][j, i] = steps
                 arrays["period"][j, i] = period
+            for j in sorted({idx // nx for idx, *_ in rows}):
+                if np.all(arrays["outcome"][j] != NOT_DONE):
+                    row_hash[j] = row_digest(arrays, j, key)
             for k, d in dsets.items():
                 d[...] = arrays[k]
+            hashes[...] = row_hash
             f.flush()
             computed += len(rows)
             done += len(rows)
+            bar.update(done)
             if on_chunk is not None:
                 on_chunk(done, total)
     return {"x": xs, "y": ys, **arrays, "wall_time_s": time.perf_counter() - t0,

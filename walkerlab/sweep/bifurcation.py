@@ -359,7 +359,13 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
     chunks = plan_chunks([axis], base, workers=max(1, workers))
     tasks = [_BifTask(base, tuple(c), n_transient, n_keep, steady_state, param)
              for c in chunks]
-    rows = [r for rs in iter_chunk_results(tasks, workers, scheduler, fn=_bif_chunk) for r in rs]
+    from walkerlab import progress
+
+    rows = []
+    with progress.task(f"bifurcation: {slopes.size} values of {param}", slopes.size) as bar:
+        for rs in iter_chunk_results(tasks, workers, scheduler, fn=_bif_chunk):
+            rows += rs
+            bar.update(len(rows))
     rows.sort(key=lambda r: r["index"])
     x = np.array([r["x"] for r in rows])
     mult = np.array([r["multipliers"] for r in rows])

@@ -136,8 +136,10 @@ def parse_param(text: str) -> ParamAxis:
             raise SweepError(f"--param {text!r}: step {step:g} does not go from {start:g} "
                              f"towards {stop:g}")
         n = int(math.floor(span + 1e-9)) + 1
-        if n > 1_000_000:
-            raise SweepError(f"--param {text!r}: {n} values is too many")
+        from walkerlab.config import MAX_SWEEP_POINTS
+
+        if n > MAX_SWEEP_POINTS:
+            raise SweepError(f"--param {text!r}: {n:,} values; at most {MAX_SWEEP_POINTS:,}")
         # round away binary noise (0.1 + 2*0.05 -> 0.2) to 12 significant digits
         vals = tuple(float(f"{start + k * step:.12g}") for k in range(n))
     else:

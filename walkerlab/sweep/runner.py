@@ -36,6 +36,19 @@ Progress and robustness (issue 12)
 - The grid is capped at :data:`MAX_GRID_POINTS` points (product of the axes, D3).
 - One sweep per artifact at a time: a second identical sweep fails with one line (D4), and
   an artifact is finalized only when every grid point has its row.
+
+Resume (issue 19, items 4 and 13)
+---------------------------------
+A point's fixed point depends, to round-off (~1e-13, within the root finder's xtol), on the
+predictor it started from, i.e. on its chain.  Re-planning the chains from the points left
+(as before) restarted them from the scene's guess at a different point and changed the
+interleaving, so 785 of 1053 resumed rows differed by up to 2.8e-13 and 6 in
+``guess_source``.  Now the plan made when the sweep starts is stored in the partial file with
+a checkpoint per chain (points written, continuation state as exact JSON, hashed); a resumed
+chain continues from its checkpoint, so its rows are bit-identical to an uninterrupted run's
+with the same plan (the plan depends on the ``workers`` the sweep *started* with).  Every row
+is hashed as written (:func:`walkerlab.sweep.store.row_hashes`); a row or checkpoint that
+does not match on resume drops its chain's rows and the chain is computed again.
 """
 
 from __future__ import annotations
@@ -46,14 +59,15 @@ import math
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, as_completed, wait
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 import walkerlab
-from walkerlab.config import Scene
+from walkerlab import progress as _progress
+from walkerlab.config import MAX_SWEEP_POINTS, Scene
 from walkerlab.io.artifacts import code_hash
 from walkerlab.sweep.outcomes import OUTCOMES, STAGES
 from walkerlab.sweep.params import ParamAxis, SweepError, grid_points
@@ -64,7 +78,7 @@ from walkerlab.workers import mp_context, process_alive, process_pool
 __all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "iter_piece_results",
            "run_piece", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
 
-MAX_GRID_POINTS = 1_000_000   # a larger grid is refused (product of the axes' lengths)
+MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
 FLUSH_EVERY_S = 0.5           # rows are written to the partial file at least this often [s]
 
@@ -205,8 +219,10 @@ def run_piece(task: Task, guess: Any = None) -> tuple[list[dict], Any]:
 
 
 def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=None,
-                       pool: bool | None = None) -> Iterator[list[dict]]:
-    """Evaluate chains of pieces; yield each piece's rows as soon as it returns.
+                       pool: bool | None = None, guesses: list | None = None
+                       ) -> Iterator[tuple[int, int, list[dict], Any]]:
+    """Evaluate chains of pieces; yield ``(chain, piece, rows, continuation after them)``
+    for each piece as soon as it returns.
 
     The pieces of one chain run one after the other (each starts from its predecessor's
     last fixed point); different chains run in parallel.
@@ -214,6 +230,8 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     Parameters
     ----------
     chains : list of list of Task
+    guesses : list, optional
+        Continuation each chain starts from (a resumed chain's checkpoint); default None.
     workers : int
         Local processes (ignored with a scheduler).
     scheduler : str or distributed.Client, optional
@@ -222,16 +240,17 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     pool : bool, optional
         Force (True) or forbid (False) a process pool; default: pool when ``workers > 1``.
     """
-    chains = [c for c in chains if c]
-    if not chains:
+    first = list(guesses) if guesses is not None else [None] * len(chains)
+    live = [ci for ci, c in enumerate(chains) if c]
+    if not live:
         return
     if scheduler is not None:
         from distributed import as_completed as dask_completed
 
         with _dask_client(scheduler) as (client, futs):
             where = {}
-            for ci, chain in enumerate(chains):
-                f = client.submit(run_piece, chain[0], None, pure=False)
+            for ci in live:
+                f = client.submit(run_piece, chains[ci][0], first[ci], pure=False)
                 where[f.key] = (ci, 0)
                 futs.append(f)
             ac = dask_completed(futs, loop=client.loop)
@@ -243,21 +262,21 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
                     where[nf.key] = (ci, k + 1)
                     futs.append(nf)
                     ac.add(nf)
-                yield rows
+                yield ci, k, rows, guess
         return
     if not (pool if pool is not None else workers > 1):
         warm_up()
-        for chain in chains:
-            guess = None
-            for t in chain:
+        for ci in live:
+            guess = first[ci]
+            for k, t in enumerate(chains[ci]):
                 rows, guess = run_piece(t, guess)
-                yield rows
+                yield ci, k, rows, guess
         return
     ex = process_pool(workers, _mp_context(), _worker_init)
     try:
         pending = {}
-        for ci, chain in enumerate(chains):
-            pending[ex.submit(run_piece, chain[0], None)] = (ci, 0)
+        for ci in live:
+            pending[ex.submit(run_piece, chains[ci][0], first[ci])] = (ci, 0)
         while pending:
             done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
             for fut in done:
@@ -265,7 +284,7 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
                 rows, guess = fut.result()
                 if k + 1 < len(chains[ci]):
                     pending[ex.submit(run_piece, chains[ci][k + 1], guess)] = (ci, k + 1)
-                yield rows
+                yield ci, k, rows, guess
     finally:
         ex.shutdown(wait=True, cancel_futures=True)
 
@@ -397,50 +416,58 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
     if resume and out_path.is_file() and not partial_path(out_path).is_file():
         if complete_sweep(out_path, key):
             return out_path
+    start: dict = {}
     if resume and partial_path(out_path).is_file():
-        store, done = SweepStore.resume(out_path, stage, axes, key)
+        # the chunk plan of the interrupted run (not re-planned from what is left: a point's
+        # continuation guess, hence its row, depends on the chain it is in, issue 19 item 13)
+        store, plan, start = SweepStore.resume(out_path, stage, axes, key, tell=_progress.note)
     else:
-        store = SweepStore.create(out_path, scene, stage, axes, opts, key)
-    chunks = plan_chunks(axes, base, done, chunk_size, 1 if scheduler is None and workers <= 1
-                         else max(2, workers))
-    origin = scene.name or "<scene>"
-    chains = [[Task(stage, base, tuple(paths), tuple(c[k:k + PIECE_POINTS]), opts, origin)
-               for k in range(0, len(c), PIECE_POINTS)] for c in chunks]
+        plan = [[i for i, _ in c] for c in
+                plan_chunks(axes, base, frozenset(), chunk_size,
+                            1 if scheduler is None and workers <= 1 else max(2, workers))]
+        store = SweepStore.create(out_path, scene, stage, axes, opts, key, plan)
     values_of = dict(enumerate(grid_points(axes)))
+    origin = scene.name or "<scene>"
+    offset = [start.get(c, (0, None))[0] for c in range(len(plan))]
+    done = {i for c, chain in enumerate(plan) for i in chain[:offset[c]]}
+    chains = [[Task(stage, base, tuple(paths),
+                    tuple((i, values_of[i]) for i in chain[offset[c]:][k:k + PIECE_POINTS]),
+                    opts, origin)
+               for k in range(0, len(chain) - offset[c], PIECE_POINTS)]
+              for c, chain in enumerate(plan)]
+    guesses = [start.get(c, (0, None))[1] for c in range(len(plan))]
     t0 = time.perf_counter()
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
-
     counts = {o: 0 for o in OUTCOMES}
-    bar = Progress(TextColumn(f"sweep {stage}"), BarColumn(), MofNCompleteColumn(),
-                   TimeElapsedColumn(), TimeRemainingColumn(), TextColumn("{task.fields[stats]}"),
-                   disable=not progress, transient=False)
     n_done = n_written = len(done)
     pending: list[dict] = []
+    marks: dict[int, tuple[int, Any]] = {}  # chain -> (points done, continuation) pending
     last_write = -math.inf
 
     def write() -> None:
         nonlocal pending, last_write, n_written
-        store.append(pending, values_of)
+        # rows and checkpoints, then one flush: the file is consistent between writes
+        store.append(pending, values_of, flush=False)
+        for c, (n, g) in marks.items():
+            store.checkpoint(c, n, g, key)
+        store.flush()
+        marks.clear()
         n_written += len(pending)
         pending, last_write = [], time.perf_counter()
 
     try:
-        with bar:
-            tid = bar.add_task("points", total=n_total, completed=n_done, stats="")
-            for rows in iter_piece_results(chains, workers, scheduler, pool=pool):
+        with (_progress.task(f"sweep {stage} ({n_total} points)", n_total, n_done)
+              if progress else nullcontext()) as bar:
+            for ci, k, rows, guess in iter_piece_results(chains, workers, scheduler, pool=pool,
+                                                         guesses=guesses):
                 pending += rows
+                marks[ci] = (offset[ci] + min((k + 1) * PIECE_POINTS,
+                                              len(plan[ci]) - offset[ci]), guess)
                 n_done += len(rows)
                 for r in rows:
                     counts[r["outcome"]] = counts.get(r["outcome"], 0) + 1
-                bar.update(tid, completed=n_done,
-                           stats=" ".join(f"{k}:{v}" for k, v in counts.items() if v))
+                if bar is not None:
+                    bar.update(n_done, info=" ".join(f"{o}:{v}" for o, v in counts.items()
+                                                     if v))
                 if n_done == n_total or time.perf_counter() - last_write >= FLUSH_EVERY_S:
                     write()
                     if on_chunk is not None:

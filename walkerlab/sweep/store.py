@@ -19,12 +19,30 @@ Layout (``stage`` attribute ``"sweep"``; every dataset has ``unit`` and ``descri
 
 While running, the file is ``<name>.h5.partial`` next to the final name; rows are appended
 in completion order and flushed after every chunk.  :meth:`SweepStore.finalize` sorts the
-rows by ``index`` and renames the file to ``<name>.h5``.
+rows by ``index``, drops the resume bookkeeping, stores the ``content_hash`` (as every
+artifact, :func:`walkerlab.io.artifacts.content_hash_of`) and renames the file to
+``<name>.h5``.
+
+Resume bookkeeping of the partial file (issue 19, items 4 and 13)::
+
+    /points/row_hash       (n,) str, SHA-256 of the row's columns and the input hash
+    /plan/index            (n_points,) int64, grid indices in chain order (the chunk plan
+                           fixed when the sweep started: it does not depend on what is done)
+    /plan/chain_start      (n_chains + 1,) int64, offsets of each chain in plan/index
+    /plan/done             (n_chains,) int64, points of each chain whose rows are written
+    /plan/guess            (n_chains,) str, JSON of the continuation after them
+    /plan/check            (n_chains,) str, SHA-256 of chain, done, guess and input hash
+
+A resumed sweep recomputes the hashes: a row that does not match (edited, damaged) and every
+row of a chain whose checkpoint does not match are dropped, and that chain is computed again
+from its start; an intact chain continues from its checkpoint with the stored continuation,
+so a resumed sweep writes the same rows, bit for bit, as an uninterrupted one.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import hashlib
 import json
 import os
 from pathlib import Path
@@ -64,6 +82,78 @@ def field_unit(path: str) -> str:
     return next((u for suf, u in _UNIT_SUFFIXES if leaf.endswith(suf)), "-")
 
 
+_BOOKKEEPING = ("row_hash",)
+
+
+def _datasets(g: h5py.Group) -> dict[str, h5py.Dataset]:
+    """Every dataset under ``g`` by relative name (``param/<path>`` included)."""
+    out: dict[str, h5py.Dataset] = {}
+    g.visititems(lambda name, obj: out.__setitem__(name, obj)
+                 if isinstance(obj, h5py.Dataset) else None)
+    return out
+
+
+def row_hashes(columns: dict[str, np.ndarray], key: str) -> list[str]:
+    """SHA-256 (hex) of each row: every column's value by name, and the input hash ``key``.
+
+    Parameters
+    ----------
+    columns : dict
+        Column name -> (n,) array (numbers or strings), as stored under ``/points``.
+    key : str
+        The sweep's input hash (a row of another sweep does not match).
+    """
+    names = sorted(c for c in columns if c not in _BOOKKEEPING)
+    n = len(columns[names[0]]) if names else 0
+    cols = []
+    for c in names:
+        a = np.asarray(columns[c])
+        if a.dtype.kind in "OSU":
+            cols.append([(x.decode() if isinstance(x, bytes) else str(x)).encode() for x in a])
+        else:
+            a = np.ascontiguousarray(a, dtype=a.dtype.newbyteorder("<"))
+            cols.append([v.tobytes() for v in a])
+    out = []
+    for i in range(n):
+        h = hashlib.sha256(key.encode())
+        for c, col in zip(names, cols):
+            b = col[i]
+            h.update(f"{c}:{len(b)}:".encode())
+            h.update(b)
+        out.append(h.hexdigest())
+    return out
+
+
+def guess_to_json(guess) -> str:
+    """JSON of a continuation state (:class:`walkerlab.sweep.points.Continuation` or None);
+    floats are written with ``repr`` precision, so it reads back bit for bit."""
+    if guess is None:
+        return "null"
+    if isinstance(guess, np.ndarray):  # a bare state (the continuation of a state guess)
+        return json.dumps({"array": guess.tolist(), "dtype": guess.dtype.str})
+    return json.dumps({"values": list(guess.values),
+                       "states": [np.asarray(x, float).tolist() for x in guess.states],
+                       "jacobians": [np.asarray(j, float).tolist() for j in guess.jacobians],
+                       "target": guess.target})
+
+
+def guess_from_json(text: str):
+    """Inverse of :func:`guess_to_json` (data only: nothing in the file is executed)."""
+    d = json.loads(text)
+    if d is None:
+        return None
+    if "array" in d:
+        return np.asarray(d["array"], dtype=np.dtype(str(d["dtype"])))
+    from walkerlab.sweep.points import Continuation
+
+    return Continuation(tuple(d["values"]), tuple(np.asarray(x, float) for x in d["states"]),
+                        tuple(np.asarray(j, float) for j in d["jacobians"]), d["target"])
+
+
+def _chain_check(chain: int, done: int, guess: str, key: str) -> str:
+    return hashlib.sha256(f"{key}|{chain}|{done}|{guess}".encode()).hexdigest()
+
+
 class SweepStore:
     """An open in-progress sweep file (use :meth:`create` or :meth:`resume`)."""
 
@@ -76,8 +166,11 @@ class SweepStore:
     # ------------------------------------------------------------------ open
     @classmethod
     def create(cls, final: Path, scene, stage: str, axes: list[ParamAxis], options: dict,
-               input_hash: str) -> SweepStore:
-        """Start a new partial file (an old one is overwritten)."""
+               input_hash: str, plan: list[list[int]] | None = None) -> SweepStore:
+        """Start a new partial file (an old one is overwritten).
+
+        ``plan``: the chains of grid indices, in evaluation order (stored for resume).
+        """
         from walkerlab.io.artifacts import ArtifactError
 
         final = Path(final)
@@ -124,13 +217,34 @@ class SweepStore:
         mk("wall_time_s", np.float64, "s", "wall time of the point on its worker")
         for name, (unit, desc) in walker_columns(stage, scene).items():
             mk(name, np.float64, unit, desc)
+        mk("row_hash", STR, "-", "SHA-256 of the row and the input hash (resume check)")
+        plan = plan if plan is not None else []
+        idx = np.array([i for c in plan for i in c], np.int64)
+        f.create_dataset("plan/index", data=idx)
+        f.create_dataset("plan/chain_start",
+                         data=np.cumsum([0] + [len(c) for c in plan]).astype(np.int64))
+        f.create_dataset("plan/done", data=np.zeros(len(plan), np.int64))
+        f.create_dataset("plan/guess", data=np.array(["null"] * len(plan), dtype=object),
+                         dtype=STR)
+        f.create_dataset("plan/check", data=np.array(
+            [_chain_check(c, 0, "null", input_hash) for c in range(len(plan))], dtype=object),
+            dtype=STR)
         f.flush()
         return cls(final, f, stage, axes)
 
     @classmethod
     def resume(cls, final: Path, stage: str, axes: list[ParamAxis],
-               input_hash: str) -> tuple[SweepStore, set[int]]:
-        """Reopen a partial file; returns the store and the indices already done.
+               input_hash: str, tell=None) -> tuple[SweepStore, list[list[int]], dict]:
+        """Reopen a partial file after checking every row and chain checkpoint.
+
+        Returns
+        -------
+        store : SweepStore
+        plan : list of list of int
+            The chains as planned when the sweep started.
+        start : dict
+            Chain number -> ``(points done, continuation)`` for every chain that continues
+            from its checkpoint; the other chains start again (their rows were dropped).
 
         Raises
         ------
@@ -150,11 +264,97 @@ class SweepStore:
             f.close()
             raise SweepError(f"{part}: partial file of a different sweep (scene, parameters, "
                              "stage, options or code changed); rerun without --resume")
-        done = set(int(i) for i in f["points/index"][()])
-        return cls(final, f, stage, axes), done
+        try:
+            g = f["points"]
+            dsets = _datasets(g)
+            cols = {name: ds[()] for name, ds in dsets.items()}
+            idx = np.asarray(cols["index"], np.int64)
+            starts = f["plan/chain_start"][()]
+            order = f["plan/index"][()]
+            plan = [[int(i) for i in order[a:b]] for a, b in zip(starts[:-1], starts[1:])]
+        except (KeyError, ValueError, OSError):
+            f.close()
+            raise SweepError(f"{part}: damaged partial sweep file; rerun without --resume") \
+                from None
+        try:  # checkpoints (rewritten as chains advance): unreadable = every chain restarts
+            ndone = f["plan/done"][()]
+            guesses = [x.decode() if isinstance(x, bytes) else str(x)
+                       for x in f["plan/guess"][()]]
+            checks = [x.decode() if isinstance(x, bytes) else str(x)
+                      for x in f["plan/check"][()]]
+        except (KeyError, ValueError, OSError):
+            ndone, guesses, checks = np.zeros(len(plan), np.int64), [], []
+            for name in ("plan/done", "plan/guess", "plan/check"):
+                if name in f:
+                    del f[name]
+            f.create_dataset("plan/done", data=np.zeros(len(plan), np.int64))
+            f.create_dataset("plan/guess", data=np.array(["null"] * len(plan), dtype=object),
+                             dtype=STR)
+            f.create_dataset("plan/check", data=np.array(["?"] * len(plan), dtype=object),
+                             dtype=STR)
+        stored = [x.decode() if isinstance(x, bytes) else str(x) for x in cols["row_hash"]]
+        good_row = np.array([a == b for a, b in zip(row_hashes(cols, input_hash), stored)],
+                            bool)
+        valid = {int(i) for i, ok in zip(idx, good_row) if ok}
+        start: dict = {}
+        keep_idx: set[int] = set()
+        restarted = 0
+        present = set(idx.tolist())
+        for c, chain in enumerate(plan):
+            n = int(ndone[c]) if c < len(ndone) else 0
+            ok = (c < len(checks) and 0 <= n <= len(chain)
+                  and checks[c] == _chain_check(c, n, guesses[c], input_hash)
+                  and all(i in valid for i in chain[:n]))
+            if ok and n > 0:
+                try:
+                    start[c] = (n, guess_from_json(guesses[c]))
+                except (ValueError, KeyError, TypeError):
+                    ok = False
+            if ok:
+                keep_idx.update(chain[:n])
+            elif any(i in present for i in chain):
+                restarted += 1
+        keep = np.array([int(i) in keep_idx for i in idx], bool)
+        # one row per index: a chain's rows past its checkpoint are computed again
+        _, first = np.unique(idx, return_index=True)
+        once = np.zeros(idx.size, bool)
+        once[first] = True
+        keep &= once
+        bad = int(np.sum(~good_row))
+        if bad or restarted:
+            msg = (f"{part}: {bad} row(s) failed their integrity check; " if bad
+                   else f"{part}: ")
+            msg += (f"{restarted} chain(s) of points will be computed again from their start "
+                    f"({int(np.sum(~keep))} row(s) dropped)")
+            if tell is not None:
+                tell(msg)
+        if not keep.all():
+            for name, ds in dsets.items():
+                v = cols[name][keep]
+                ds.resize((int(keep.sum()),))
+                ds[...] = v
+            for c in range(len(plan)):
+                if c not in start:
+                    f["plan/done"][c] = 0
+                    f["plan/guess"][c] = "null"
+                    f["plan/check"][c] = _chain_check(c, 0, "null", input_hash)
+            f.flush()
+        return cls(final, f, stage, axes), plan, start
+
+    def checkpoint(self, chain: int, done: int, guess, key: str) -> None:
+        """Record that the first ``done`` points of ``chain`` are written and the
+        continuation after them (call after :meth:`append` of those rows)."""
+        text = guess_to_json(guess)
+        self.f["plan/done"][chain] = done
+        self.f["plan/guess"][chain] = text
+        self.f["plan/check"][chain] = _chain_check(chain, done, text, key)
+
+    def flush(self) -> None:
+        """Write what is buffered to disk (rows and checkpoints together)."""
+        self.f.flush()
 
     # ------------------------------------------------------------------ write
-    def append(self, rows: list[dict], values_of: dict[int, tuple]) -> None:
+    def append(self, rows: list[dict], values_of: dict[int, tuple], flush: bool = True) -> None:
         """Append rows (dicts from :func:`walkerlab.sweep.points.evaluate`) and flush."""
         if not rows:
             return
@@ -175,11 +375,17 @@ class SweepStore:
         for name in STRING_COLUMNS:
             put(name, np.asarray([str(r.get(name, "")) for r in rows], dtype=object))
         put("wall_time_s", np.array([r["wall_time_s"] for r in rows], float))
-        fixed = {"index", "wall_time_s", *STRING_COLUMNS}
+        fixed = {"index", "wall_time_s", "row_hash", *STRING_COLUMNS}
         for name, ds in g.items():  # the stage's float columns, as created for this walker
             if isinstance(ds, h5py.Dataset) and name not in fixed:
                 put(name, np.array([r.get(name, np.nan) for r in rows], float))
-        self.f.flush()
+        if "row_hash" in g:  # hashed as read back, so resume recomputes the same bytes
+            cols = {name: ds[n0:n1] for name, ds in _datasets(g).items()
+                    if name != "row_hash"}
+            put("row_hash", np.asarray(row_hashes(cols, str(self.f.attrs["input_hash"])),
+                                       dtype=object))
+        if flush:
+            self.f.flush()
 
     def add_wall_time(self, seconds: float) -> None:
         """Add elapsed sweep wall time [s] (accumulates over resumed sessions)."""
@@ -225,7 +431,13 @@ class SweepStore:
         ds.attrs.update(outcomes=list(OUTCOMES), unit="-", description="points per outcome")
         netcdf.attach(ds, ("outcome_kind",))
         f.attrs["complete"] = True
+        for name in ("plan", "points/row_hash"):  # resume bookkeeping
+            if name in f:
+                del f[name]
         netcdf.finish_sweep(f)
+        from walkerlab.io.artifacts import content_hash_of
+
+        f.attrs["content_hash"] = content_hash_of(f)
         f.close()
         os.replace(partial_path(self.final), self.final)
         return self.final
@@ -233,12 +445,15 @@ class SweepStore:
 
 def complete_sweep(path: Path, input_hash: str) -> bool:
     """True if ``path`` is a finished sweep of this input hash with a row per grid point."""
+    from walkerlab.io.artifacts import content_hash_of
+
     try:
         with h5py.File(path, "r") as f:
             return (f.attrs.get("walkerlab_version") == walkerlab.__version__
                     and f.attrs.get("input_hash") == input_hash
                     and bool(f.attrs.get("complete", False))
-                    and np.unique(f["points/index"][()]).size == int(f.attrs["n_points"]))
+                    and np.unique(f["points/index"][()]).size == int(f.attrs["n_points"])
+                    and str(f.attrs.get("content_hash")) == content_hash_of(f))
     except (OSError, KeyError):
         return False
 

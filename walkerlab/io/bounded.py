@@ -1,0 +1,72 @@
+"""Reading files that a user or another process may have replaced: bounded regular files only.
+
+Every file walkerlab reads from a runs folder or a scene path (the scene YAML, the
+``runs/<name>/.scene`` marker, cache entries) goes through :func:`read_regular`: it is
+opened without blocking (a FIFO in its place cannot hang the open), must be a regular file
+(``S_ISREG`` of the *opened* file: a symlink to ``/dev/zero`` is refused, not read forever)
+and no larger than the caller's cap, which is checked before a byte is read (issue 19, item 5).
+"""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+__all__ = ["NotARegularFile", "read_regular"]
+
+
+class NotARegularFile(ValueError):
+    """The path is a device, FIFO, socket or directory, or larger than its cap (one line)."""
+
+
+def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
+    """Contents of a regular file of at most ``max_bytes`` bytes.
+
+    Parameters
+    ----------
+    path : str or Path
+    max_bytes : int
+        Largest accepted size [bytes].
+    what : str
+        What the file is, for the message (``"scene file"``).
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    FileNotFoundError
+        The path does not exist.
+    NotARegularFile
+        Not a regular file (FIFO, device, directory, socket), or larger than ``max_bytes``;
+        the message names the path.
+    OSError
+        Other errors of ``open``/``read`` (permissions).
+    """
+    path = Path(path)
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = ("a directory" if stat.S_ISDIR(st.st_mode) else
+                    "a FIFO" if stat.S_ISFIFO(st.st_mode) else
+                    "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else
+                    "not a regular file")
+            raise NotARegularFile(f"{path}: {what} is {kind}, not a regular file")
+        if st.st_size > max_bytes:
+            raise NotARegularFile(f"{path}: {what} is {st.st_size:,} bytes; at most "
+                                  f"{max_bytes:,} are read")
+        chunks, n = [], 0
+        while True:  # the file may grow after fstat: never read past the cap
+            b = os.read(fd, min(1 << 20, max_bytes + 1 - n))
+            if not b:
+                break
+            chunks.append(b)
+            n += len(b)
+            if n > max_bytes:
+                raise NotARegularFile(f"{path}: {what} is larger than {max_bytes:,} bytes")
+        return b"".join(chunks)
+    finally:
+        os.close(fd)

@@ -1,0 +1,204 @@
+"""Progress of long work, reported by libraries and rendered by the command line.
+
+Libraries (basin, bifurcation, sweeps, stability maps, work-precision, the contact
+adjustment, the report) never print progress themselves and never import ``rich``: they
+open a :func:`task` and update it, and send one-line notices through :func:`note`.  What
+happens with those calls is decided by the installed *sink* (:func:`use`):
+
+- no sink (library use, tests): nothing is shown; notices go to stderr as one line;
+- the CLI installs :class:`RichSink` when stderr is a terminal and ``--quiet`` is not given
+  (a ``rich.progress`` display on stderr: what is being done, count, elapsed time and an
+  estimate of what is left; a spinner with the elapsed time where no count is known), and
+  :class:`QuietSink` otherwise (``--quiet``: nothing; stderr not a terminal: notices only).
+
+A sink is any object with the :class:`Sink` methods; a test can install a recorder.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Protocol
+
+__all__ = ["Sink", "Task", "task", "note", "use", "current", "install", "sink_for_terminal",
+           "QuietSink", "RichSink"]
+
+
+class Sink(Protocol):
+    """Receives progress (one object per display)."""
+
+    def start(self, key: int, description: str, total: int | None, completed: int) -> None:
+        """A task began (``total`` None: unknown length)."""
+
+    def update(self, key: int, completed: int, total: int | None, info: str) -> None:
+        """``completed`` of ``total`` units are done (monotone within a task)."""
+
+    def finish(self, key: int) -> None:
+        """The task ended (normally or not)."""
+
+    def note(self, message: str) -> None:
+        """A one-line notice (e.g. rows of a resumed file that were dropped)."""
+
+
+class QuietSink:
+    """Shows no progress; notices go to stderr unless ``silent``."""
+
+    def __init__(self, silent: bool = False):
+        self.silent = silent
+
+    def start(self, key, description, total, completed):
+        pass
+
+    def update(self, key, completed, total, info):
+        pass
+
+    def finish(self, key):
+        pass
+
+    def note(self, message):
+        if not self.silent:
+            print(message, file=sys.stderr, flush=True)
+
+
+class RichSink:
+    """``rich.progress`` on stderr (imported when the first task starts)."""
+
+    def __init__(self):
+        self._progress = None
+        self._ids: dict[int, int] = {}
+
+    def _ensure(self):
+        if self._progress is None:
+            from rich.console import Console
+            from rich.progress import (
+                BarColumn,
+                Progress,
+                ProgressColumn,
+                SpinnerColumn,
+                TextColumn,
+                TimeElapsedColumn,
+            )
+            from rich.text import Text
+
+            class Left(ProgressColumn):
+                """``done/total  ~m:ss left`` (nothing for a task of unknown length)."""
+
+                def render(self, task):
+                    if task.total is None:
+                        return Text("")
+                    r = task.time_remaining
+                    left = ("estimating" if r is None else
+                            f"~{int(r) // 60}:{int(r) % 60:02d} left")
+                    return Text(f"{int(task.completed)}/{int(task.total)}  {left}")
+
+            self._progress = Progress(
+                SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
+                Left(), TimeElapsedColumn(), TextColumn("{task.fields[info]}"),
+                console=Console(stderr=True), transient=False, refresh_per_second=4)
+            self._progress.start()
+        return self._progress
+
+    def start(self, key, description, total, completed):
+        p = self._ensure()
+        self._ids[key] = p.add_task(description, total=total, completed=completed, info="")
+
+    def update(self, key, completed, total, info):
+        if key in self._ids:
+            self._progress.update(self._ids[key], completed=completed, total=total, info=info)
+
+    def finish(self, key):
+        tid = self._ids.pop(key, None)
+        if tid is not None and self._progress is not None:
+            self._progress.stop_task(tid)
+        if not self._ids and self._progress is not None:
+            self._progress.stop()
+            self._progress = None
+
+    def note(self, message):
+        if self._progress is not None:
+            self._progress.console.print(message, markup=False, highlight=False)
+        else:
+            print(message, file=sys.stderr, flush=True)
+
+
+_SINK: Sink = QuietSink()
+_NEXT = [0]
+
+
+def current() -> Sink:
+    """The installed sink."""
+    return _SINK
+
+
+def install(sink: Sink) -> None:
+    """Install ``sink`` for the rest of the process (the CLI, once per command)."""
+    global _SINK
+    _SINK = sink
+
+
+def sink_for_terminal(quiet: bool, stream=None) -> Sink:
+    """The CLI's sink: nothing under ``--quiet``, rich progress when ``stream`` (stderr) is a
+    terminal, notices only otherwise."""
+    stream = sys.stderr if stream is None else stream
+    if quiet:
+        return QuietSink(silent=True)
+    isatty = getattr(stream, "isatty", None)
+    return RichSink() if isatty is not None and isatty() else QuietSink()
+
+
+@contextmanager
+def use(sink: Sink) -> Iterator[Sink]:
+    """Install ``sink`` for the duration of the block (the previous one is restored)."""
+    global _SINK
+    old, _SINK = _SINK, sink
+    try:
+        yield sink
+    finally:
+        _SINK = old
+
+
+class Task:
+    """Handle of a running task (see :func:`task`)."""
+
+    def __init__(self, sink: Sink, key: int, total: int | None, completed: int):
+        self._sink, self.key, self.total, self.completed = sink, key, total, completed
+
+    def update(self, completed: int, total: int | None = None, info: str = "") -> None:
+        """Set the count of completed units (and the total, when it became known)."""
+        if total is not None:
+            self.total = total
+        self.completed = max(self.completed, int(completed))
+        self._sink.update(self.key, self.completed, self.total, info)
+
+    def advance(self, n: int = 1, info: str = "") -> None:
+        """Add ``n`` completed units."""
+        self.update(self.completed + n, info=info)
+
+
+@contextmanager
+def task(description: str, total: int | None = None, completed: int = 0) -> Iterator[Task]:
+    """Report a unit of long work: ``with task("basin 200x200 cells", 40000) as t: ...``.
+
+    Parameters
+    ----------
+    description : str
+        What is being done (shown next to the bar).
+    total : int, optional
+        Units of work; None shows a spinner with the elapsed time.
+    completed : int
+        Units already done (a resumed run).
+    """
+    sink = _SINK
+    _NEXT[0] += 1
+    key = _NEXT[0]
+    sink.start(key, description, total, int(completed))
+    try:
+        yield Task(sink, key, total, int(completed))
+    finally:
+        sink.finish(key)
+
+
+def note(message: str) -> None:
+    """Send a one-line notice to the installed sink."""
+    _SINK.note(message)
