@@ -401,7 +401,7 @@ def test_item5_scene_file_is_a_bounded_regular_file(tmp_path, kind):
         os.symlink("/dev/zero", p)
     else:
         p.write_text("source: '" + "x" * 1_100_000 + "'\n")
-    with pytest.raises(SceneError, match="s.yaml: scene file is"):
+    with pytest.raises(SceneError, match=r"s\.yaml: (scene file is|not a regular file)"):
         load_scene(p)
 
 
