@@ -504,8 +504,8 @@ def test_progress_adjust_counts_contact_runs(monkeypatch):
     """contact-sim --adjust: one count per contact run, up to the most there can be."""
     from types import SimpleNamespace
 
-    from walkerlab.contact import adjust
-    from walkerlab.contact import scene as contact_scene
+    from walkerlab.analysis import contact_adjust as adjust
+    from walkerlab.analysis import contact_sim
 
     calls = []
 
@@ -513,7 +513,7 @@ def test_progress_adjust_counts_contact_runs(monkeypatch):
         calls.append(rate_scale)
         return None, SimpleNamespace(heel_strike_times=[], termination="fall"), None, None
 
-    monkeypatch.setattr(contact_scene, "simulate_from", fake_simulate_from)
+    monkeypatch.setattr(contact_sim, "simulate_from", fake_simulate_from)
     rec = Recorder()
     with progress.use(rec):
         out = adjust.adjust_rates(scene_from_dict({**PAPER, "name": "paper"}), X_GUESS, 0.7,
