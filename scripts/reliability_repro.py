@@ -4,8 +4,8 @@ Usage::
 
     PYTHONPATH=/work/wt/base python scripts/reliability_repro.py /tmp/repro_base [CASE ...]
 
-Cases ``d*`` are issue 12's, ``i19_<item>_*`` issue 19's (items 1, 2, 3, 7, 10, 14; every
-case gets its own user cache, ``WALKERLAB_CACHE_DIR=<case>/uc``).
+Cases ``d*`` are issue 12's, ``i19_<item>_*`` issue 19's (items 1-14; every case gets its
+own user cache, ``WALKERLAB_CACHE_DIR=<case>/uc``).
 
 Each case runs the CLI (``python -m walkerlab.cli``) in a fresh folder under the given
 work directory and prints one Markdown table row: case, exit code, the first line of
@@ -995,6 +995,62 @@ def i19_12_5000_digit_int(d):
 @case
 def i19_12_duplicate_key(d):
     return (*_bad_scene_text(d, yaml.safe_dump(IDEAL) + "slope:\n  angle_deg: 3.0\n"), "")
+
+
+# issue 19 items 6, 8, 9 (contact outcomes, sweeps over unknown fields, time limits)
+@case
+def i19_6_contact_flies_away(d):
+    s = scene(d, with_(PAPER, contact_sim__initial_rate_scale=[1000.0, 1000.0]), "paper.yaml")
+    rc, msg, t = cli(d, "contact-sim", str(s), "--runs-dir", "runs", env=_uc(d), timeout=300)
+    return rc, msg, f"{t:.1f} s"
+
+
+@case
+def i19_6_contact_rate_1e10(d):
+    s = scene(d, with_(PAPER, contact_sim__initial_rate_scale=[1e10, 1.0]), "paper.yaml")
+    rc, msg, t = cli(d, "contact-sim", str(s), "--runs-dir", "runs", env=_uc(d), timeout=300)
+    return rc, msg, f"{t:.1f} s"
+
+
+@case
+def i19_6_rigid_never_moves(d):
+    sc = with_(IDEAL, slope__angle_rad=0.0)
+    sc["simulate"] = {"strides": 5, "sample_rate_hz": 500, "initial_state": {
+        "swing_angle_rad": 0.0, "stance_angle_rad": 0.0, "swing_rate_rad_per_s": 0.0,
+        "stance_rate_rad_per_s": 0.0}}
+    s = scene(d, sc, "paper.yaml")
+    rc, msg, t = cli(d, "simulate", str(s), "--runs-dir", "runs", env=_uc(d))
+    return rc, msg, f"{t:.1f} s"
+
+
+def _sweep_unknown(d, param):
+    s = scene(d, IDEAL, "paper.yaml")
+    rc, msg, _ = cli(d, "sweep", str(s), "--param", param, "--workers", "1",
+                     "--runs-dir", "runs", env=_uc(d))
+    return rc, msg, f"files: {ls(d / 'runs') if (d / 'runs').exists() else '-'}"
+
+
+@case
+def i19_8_sweep_misspelt_field(d):
+    return _sweep_unknown(d, "slope.angel_deg=1:3:0.5")
+
+
+@case
+def i19_8_sweep_unknown_section(d):
+    return _sweep_unknown(d, "foo.bar=1")
+
+
+@case
+def i19_8_sweep_bad_method(d):
+    return _sweep_unknown(d, "solver.method=Euler")
+
+
+@case
+def i19_9_contact_time_limit_20s(d):
+    s = scene(d, with_(PAPER, contact_sim__initial_rate_scale=[1e6, 1e6],
+                       contact_sim__wall_time_limit_s=20.0), "paper.yaml")
+    rc, msg, t = cli(d, "contact-sim", str(s), "--runs-dir", "runs", env=_uc(d), timeout=600)
+    return rc, msg, f"command {t:.1f} s (limit 20 s on the integration)"
 
 
 def main():
