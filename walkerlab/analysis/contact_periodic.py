@@ -77,7 +77,6 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
-from walkerlab.contact import _kernels as K
 from walkerlab.contact.model import ContactWalker
 
 __all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait", "PeriodicGaitError",
@@ -194,23 +193,29 @@ class StepMap:
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
         w = self.walker
-        self._P, self._c1, self._c2 = w._P, w.lane1, w.lane2
+        if w.structure.knee:
+            raise ValueError("contact periodic gait: the mid-stance section is defined for "
+                             "straight legs only")
+        kern = w.kernels
+        args = (w.contact_params, w.walker_params, w.lane1, w.lane2)
+        self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
+        self._fj = lambda x: kern.jac(x, *args)  # noqa: E731
         self.n, self.t = w.normal, w.tangent
 
     # ------------------------------------------------------------------ coordinates
     def to_state(self, z) -> np.ndarray:
         """Full state (8,) from section coordinates (leg2 stance, stance foot at s = 0)."""
         th, wsw, wst, d, vt, dd = np.asarray(z, float)
-        L = self.walker.L
         p = -d * self.n
         v = vt * self.t - dd * self.n
-        hip = p - L * np.array([np.sin(th), -np.cos(th)])
-        vh = v - L * np.array([np.cos(th), np.sin(th)]) * wst
-        return np.array([hip[0], hip[1], th, th, vh[0], vh[1], wsw, wst])
+        # stance foot at p and at rest, then the whole walker translated at v
+        x = self.walker.pinned_to_full(np.array([th, th, wsw, wst]), p)
+        x[4:6] += v
+        return x
 
     def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
         """Section coordinates (6,) and along-slope position s [m] of foot ``stance`` (0/1)."""
-        px, py, vx, vy = K.foot_state(np.asarray(x, float), stance, self._P)
+        px, py, vx, vy = self.walker.foot_state(np.asarray(x, float), stance)
         p, v = np.array([px, py]), np.array([vx, vy])
         sw = 1 - stance
         z = np.array([x[2 + stance], x[6 + sw], x[6 + stance], -p @ self.n, v @ self.t,
@@ -222,10 +227,10 @@ class StepMap:
         if time.perf_counter() > self.deadline:
             raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
                                     "reached")
-        return K.rhs(x, self._P, self._c1, self._c2)
+        return self._f(x)
 
     def _jac(self, t, x):
-        return K.jac(x, self._P, self._c1, self._c2)
+        return self._fj(x)
 
     def integrate(self, x0, stance_to_come: int = 0, dense: bool = False):
         """Integrate from ``x0`` to the next upward zero of theta_sw - theta_st where the
@@ -265,13 +270,13 @@ class StepMap:
 
         ist, isw = 2 + stance_to_come, 3 - stance_to_come
         hth = 0.5 * self.walker.L
-        P, c1, c2 = self._P, self._c1, self._c2
+        frhs, fjac = self._f, self._fj
 
         def f(t, x):
-            return K.rhs(x, P, c1, c2)
+            return frhs(x)
 
         def jf(t, x):
-            return K.jac(x, P, c1, c2)
+            return fjac(x)
 
         def run(x, tg):
             with warnings.catch_warnings():  # the message is checked below
@@ -291,7 +296,7 @@ class StepMap:
             tg = ta + dt * np.arange(int(round(chunk_s / dt)) + 1)
             X = run(xa, tg)
             g = X[:, isw] - X[:, ist]
-            hh = K.hip_heights(np.ascontiguousarray(X), P)
+            hh = self.walker.hip_height(X)
             up = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0)) + 1
             down = np.flatnonzero(hh < hth)
             if down.size and (not up.size or down[0] <= up[0]):
@@ -346,8 +351,8 @@ class StepMap:
             x0 = self.to_state(z)
             te = self._step_odeint(x0)[0]
             tt = np.linspace(0.0, te, 2001)
-            X = odeint(lambda t, x: K.rhs(x, self._P, self._c1, self._c2), x0, tt,
-                       Dfun=lambda t, x: K.jac(x, self._P, self._c1, self._c2), tfirst=True,
+            X = odeint(lambda t, x: self._f(x), x0, tt,
+                       Dfun=lambda t, x: self._fj(x), tfirst=True,
                        rtol=self.rtol, atol=self.atol, mxstep=500000)
         else:
             sol = self.integrate(self.to_state(z), dense=True)

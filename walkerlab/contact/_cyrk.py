@@ -3,9 +3,9 @@
 Internal module, imported by :mod:`walkerlab.contact.simulate`; CyRK itself is imported only
 on the first chunk of a ``cyrk_*`` method.  CyRK (a main dependency, binary wheels, no
 Fortran) takes the right-hand side as a C function pointer (its numba bridge,
-``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The RHS
-:func:`walkerlab.contact._kernels.rhs` is wrapped in a numba ``cfunc`` (compiled once,
-cached on disk), so CyRK integrates a whole chunk of samples without re-entering Python.
+``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The walker's
+generated RHS (:mod:`walkerlab.contact.generated`) is wrapped in a numba ``cfunc`` (compiled
+once per walker structure, cached on disk), so CyRK integrates a whole chunk of samples without re-entering Python.
 The physics is not repeated here: the cfunc only unpacks its data vector and calls the
 kernel.
 
@@ -14,7 +14,7 @@ solver), so its implicit methods (LSODA, BDF, Radau) form the Jacobian by finite
 differences; those RHS calls are counted in ``nfev`` like all others (the cfunc counts its
 own calls).  ``max_step`` and a scalar or per-state ``atol`` are passed through.
 
-The packed data vector is ``[n1, n2, P (NPAR), c1 (n1), c2 (n2), nfev]``; CyRK copies it
+The packed data vector is ``[n1, n2, PC, p, c1 (n1), c2 (n2), nfev]``; CyRK copies it
 into its solver, so the call counter is read back from the solver's copy.
 """
 
@@ -23,8 +23,6 @@ from __future__ import annotations
 import ctypes
 
 import numpy as np
-
-from . import _kernels as K
 
 __all__ = ["CYRK_METHODS", "solve_chunk"]
 
@@ -35,44 +33,41 @@ __all__ = ["CYRK_METHODS", "solve_chunk"]
 #: ~ -1e5 1/s).
 CYRK_METHODS = {"cyrk_bdf": "BDF"}
 
-_FPTR = None
+_FPTR: dict = {}  # generated kernels module name -> cfunc address
 
 
-def _build() -> int:
-    """Compile (or load from numba's disk cache) the cfunc RHS; returns its address."""
-    from CyRK.nb.numba_solver import cyjit_sig
-    from numba import carray, cfunc
-
-    @cfunc(cyjit_sig, cache=True)
-    def rhs_c(dy, t, y, p):  # pragma: no cover - runs compiled
-        K.rhs_packed(carray(y, (8,)), carray(p, (K.packed_size(p),)), carray(dy, (8,)))
-
-    return rhs_c.address
-
+def address(kernels) -> int:
+    """C address of the cfunc of ``kernels.rhs_packed`` (compiled once per walker structure,
+    numba disk cache)."""
+    if kernels.__name__ not in _FPTR:
+        _FPTR[kernels.__name__] = kernels.build_cyrk()
+    return _FPTR[kernels.__name__]
 
 
 def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
-                rtol: float, atol, max_step: float = np.inf):
+                rtol: float, atol, max_step: float = np.inf, *, kernels=None):
     """Integrate from ``x0`` at ``t_eval[0]`` over the sample times ``t_eval`` (n,) [s].
 
     Parameters
     ----------
     method : str
         A key of :data:`CYRK_METHODS`.
-    x0 : ndarray (8,)
+    x0 : ndarray (2 nq,)
     t_eval : ndarray (n,)
         Increasing sample times [s]; the first is the start time.
     data : ndarray
-        From :func:`walkerlab.contact._kernels.pack`.
+        From :meth:`walkerlab.contact.model.ContactWalker.pack`.
     rtol : float
-    atol : float or ndarray (8,)
+    atol : float or ndarray (2 nq,)
         [m, rad, m/s, rad/s].
     max_step : float
         Largest step [s] (inf: none).
+    kernels : module
+        The walker's generated kernels (``ContactWalker.kernels``).
 
     Returns
     -------
-    X : ndarray (m, 8)
+    X : ndarray (m, 2 nq)
         States at ``t_eval[:m]`` (``m = n`` on success; fewer when the solver stopped early).
     ok : bool
         CyRK reported success.
@@ -81,12 +76,10 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     message : str
         CyRK's status message.
     """
-    global _FPTR
     from CyRK.cy.pyhelpers import find_ode_method_int
     from CyRK.nb import numba_solver as ns
 
-    if _FPTR is None:
-        _FPTR = _build()
+    fptr = address(kernels)
     u0 = np.ascontiguousarray(x0, dtype=np.float64)
     te = np.ascontiguousarray(t_eval, dtype=np.float64)
     rt = np.array([float(rtol)])
@@ -95,7 +88,7 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     # the C entry point that CyRK's njit `nbsolve2_ivp` calls, called here through ctypes
     # (one call per chunk; avoids compiling that njit wrapper in every process)
     ptr = ns.c_numba_cysolve_ivp(
-        _FPTR, te[0], te[-1], u0.ctypes.data, u0.size, find_ode_method_int(CYRK_METHODS[method]),
+        fptr, te[0], te[-1], u0.ctypes.data, u0.size, find_ode_method_int(CYRK_METHODS[method]),
         0, 0, data.ctypes.data, data.size * 8, 0, 2000, False, te.ctypes.data, te.size,
         None, None, 0, rt.ctypes.data, rt.size, at.ctypes.data, at.size, hmax, 0.0, True)
     if not ptr:  # pragma: no cover - allocation failure inside CyRK

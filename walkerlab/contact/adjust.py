@@ -28,14 +28,12 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
     from .scene import settings, simulate_from
 
     n_strides = settings(scene)[2].n_strides
-    L = scene.walker.leg_length_m
-    l_star = 2 * L * np.sin((x_fp[1] - x_fp[0]) / 2)
     count = {"n": 0}
 
     def J(s):
         count["n"] += 1
         s = np.clip(np.asarray(s, float), 0.2, 5.0)
-        walker, res, _, _ = simulate_from(scene, x_fp, period, rate_scale=tuple(s))
+        walker, res, _, l_star = simulate_from(scene, x_fp, period, rate_scale=tuple(s))
         n_hs = len(res.heel_strike_times)
         want = 2 * n_strides
         if n_hs < want or res.termination in ("fall", "trip"):

@@ -100,7 +100,7 @@ def run_benchmark(n_strides: int = 5, methods=None,
     walker = ContactWalker.from_settings(contact, TerrainSettings(patch_width_m=patch_width_m),
                                          step_length=ideal["step_length"], n_steps=n_steps + 2)
     x0 = initial_state_from_ideal(walker, ideal["theta1"], ideal["theta2"], ideal["dtheta1"],
-                                  ideal["dtheta2"], rate_scale)
+                                  ideal["dtheta2"], rate_scale=rate_scale)
     t_final = 1.03 * n_steps * ideal["step_period"]  # the contact gait is ~1% slower
     ref = simulate_contact(walker, x0, t_final, method="odeint", rtol=1e-12, atol=1e-15)
     def one(method, rtol, atol):

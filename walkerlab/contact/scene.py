@@ -43,21 +43,25 @@ def settings(scene: Scene):
             scene.contact_solver or ContactSolverSettings())
 
 
-def ideal_step_length(leg_length_m: float, x_ideal) -> float:
-    """Step length [m] of the ideal gait from its post-impact state ``[th_sw, th_st, ...]``:
-    ``2 L sin((th_st - th_sw) / 2)`` (foot-to-foot chord at heel strike)."""
-    th_sw, th_st = float(x_ideal[0]), float(x_ideal[1])
-    return 2 * leg_length_m * np.sin((th_st - th_sw) / 2)
+def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
+    """Step length [m] of the ideal gait from its post-impact state ``x_ideal`` (role order of
+    the rigid model): the distance between the two feet's contact points with the stance leg
+    placed by :meth:`ContactWalker.link_state_from_ideal` (compass gait:
+    ``2 L sin((th_st - th_sw) / 2)``, the foot-to-foot chord at heel strike)."""
+    x = walker.pinned_to_full(walker.link_state_from_ideal(x_ideal), np.zeros(2))
+    feet = walker.foot_positions(x)
+    return float(np.hypot(*(feet[1] - feet[0])))
 
 
 def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
-    """ContactWalker of the scene with checkerboard patches from the ideal step length.
+    """ContactWalker of the scene (any walker with positive leg masses) with checkerboard
+    patches from the ideal step length.
 
     Parameters
     ----------
     scene : Scene
-    x_ideal : ndarray (4,)
-        Ideal fixed point (role order: swing, stance angles and rates) [rad, rad/s].
+    x_ideal : ndarray (2n,)
+        Ideal fixed point (role order of the rigid walker, leg2 = stance) [rad, rad/s].
     n_steps : int
         Steps the run may take (sets how many patches are laid out).
 
@@ -66,14 +70,26 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
     walker : ContactWalker
     step_length : float
         Ideal step length [m] (patch spacing).
+
+    Raises
+    ------
+    ContactSceneError
+        No ``contact`` section, or a walker with a massless body (one line).
     """
+    from walkerlab.models.description import walker_data
+    from walkerlab.models.floating import check_masses
+
     contact, terrain, _, _ = settings(scene)
-    w = scene.walker
-    step_length = ideal_step_length(w.leg_length_m, x_ideal)
-    return ContactWalker.from_settings(
-        contact, terrain, step_length=step_length, n_steps=n_steps + 4, L=w.leg_length_m,
-        m=w.leg_mass_kg, MH=w.hip_mass_kg, a=w.leg_mass_from_foot_m, g=w.gravity_m_per_s2,
-        phi=scene.slope.phi_rad), step_length
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    try:
+        check_masses(data.structure)
+    except ValueError as err:
+        raise ContactSceneError(f"scene '{scene.name}': {err}") from None
+    probe = ContactWalker(contact=contact.to_si(), data=data,
+                          knee_stop=contact.knee_stop.to_si())
+    step_length = ideal_step_length(probe, x_ideal)
+    return ContactWalker.from_settings(contact, terrain, step_length=step_length,
+                                       n_steps=n_steps + 4, data=data), step_length
 
 
 def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=None,
@@ -118,7 +134,9 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
 
 def named_trajectory(walker: ContactWalker, res, legs=("leg1", "leg2")):
     """A :class:`~walkerlab.contact.simulate.ContactResult` in the shared named layout of
-    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes)."""
+    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes);
+    coordinates ``<leg>_angle``/``<leg>_rate`` (kneed: ``<leg>_thigh_angle``, ...), points
+    from the generated floating view (hip, bodies ``<leg>_<body>``, feet, knees)."""
     from walkerlab.io.trajectory import NamedTrajectory
 
     legs = list(legs)
@@ -131,19 +149,15 @@ def named_trajectory(walker: ContactWalker, res, legs=("leg1", "leg2")):
         step[m] = k + 1
     X = res.x
     en = walker.energies(X)
-    feet = np.asarray(walker.foot_positions(X))  # (n, 2, 2): foot, xy
-    names = walker.state_names()
-    col = {n: X[:, i] for i, n in enumerate(names)}
-    hip = np.vstack([col["hip_x"], col["hip_y"]])
-    pts = {"hip": hip}
-    for i, leg in enumerate(legs):
-        th = col[f"theta{i + 1}"]
-        pts[f"{leg}_foot"] = feet[:, i, :].T
-        pts[f"{leg}_mass"] = hip + walker.b * np.vstack([np.sin(th), -np.cos(th)])
+    pts = {k: np.asarray(v) for k, v in walker.points(X).items()}
     coords, units = {}, {}
-    for i, leg in enumerate(legs):
-        coords[f"{leg}_angle"], units[f"{leg}_angle"] = col[f"theta{i + 1}"], "rad"
-        coords[f"{leg}_rate"], units[f"{leg}_rate"] = col[f"dtheta{i + 1}"], "rad/s"
+    nq = walker.nq
+    for i, name in enumerate(walker.coordinate_names()):
+        if not name.startswith(tuple(legs)):
+            continue
+        base = name.removesuffix("_angle")
+        coords[f"{base}_angle"], units[f"{base}_angle"] = X[:, i], "rad"
+        coords[f"{base}_rate"], units[f"{base}_rate"] = X[:, nq + i], "rad/s"
     return NamedTrajectory(
         time=t, legs=legs, coordinates=coords, units=units, stance_leg=stance,
         step_index=step, kinetic=en["kinetic"], potential=en["potential"], points=pts)

@@ -7,7 +7,7 @@ so a fall, a trip, the wall-time limit or the strides cap stops the run), ``"cyr
 optional extra, see :mod:`walkerlab.contact._lsoda`) or any stiff
 ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``), these given the analytic Jacobian.
 
-Contact is decided by geometry only (:mod:`walkerlab.contact._kernels`): a foot gets the
+Contact is decided by geometry only (:mod:`walkerlab.contact.generated`): a foot gets the
 IMPACT force whenever it is below the top of a patch and inside its horizontal extent, in
 every state (no "dead" state that switches the force off).  A step that would carry a foot
 from above a patch to deep inside it therefore sees the force jump and is rejected by the
@@ -31,7 +31,6 @@ import numpy as np
 from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
 from . import _cyrk
-from . import _kernels as K
 from .model import FOOT_NAMES, ContactWalker
 
 __all__ = [
@@ -168,8 +167,9 @@ class ContactResult:
     ----------
     t : ndarray (n,)
         Sample times [s] (the last one is the event time if a trip or fall ended the run).
-    q, qdot : ndarray (n, 4)
-        [hip_x, hip_y, theta1, theta2] [m, m, rad, rad] and their rates.
+    q, qdot : ndarray (n, nq)
+        Floating coordinates (``walker.state_names()[:nq]``: hip_x, hip_y, link angles)
+        [m, m, rad...] and their rates.
     feet : dict[str, FootTrace]
         Keys "leg1", "leg2".
     heel_strike_times : ndarray
@@ -219,7 +219,7 @@ class ContactResult:
 
     @property
     def x(self) -> np.ndarray:
-        """States (n, 8)."""
+        """States (n, 2 nq)."""
         return np.hstack([self.q, self.qdot])
 
     @property
@@ -234,32 +234,30 @@ class ContactResult:
         return float(max(v, default=0.0))
 
 
-def initial_state_from_ideal(walker: ContactWalker, theta1, theta2, dtheta1, dtheta2,
+def initial_state_from_ideal(walker: ContactWalker, *x_ideal,
                              rate_scale=(1.0, 1.0)) -> np.ndarray:
-    """Floating-walker state (8,) from an ideal-model state (leg2 = stance).
+    """Floating-walker state (2 nq,) from an ideal-model state (leg1 = swing, leg2 = stance).
 
     The stance foot (leg2) is placed at s = 0 at its static penetration
-    ``(M g cos phi / k)^(1/e)`` [m] (along -n); the hip velocity follows from the pinned-foot
-    kinematics hip = foot2 + L (-sin th2, cos th2).  ``rate_scale`` multiplies
-    (dtheta1, dtheta2) first.
+    ``(M g cos phi / k)^(1/e)`` [m] (along -n) and held at rest there: the hip follows from
+    the stance leg's links (:meth:`ContactWalker.pinned_to_full`).  ``rate_scale``
+    multiplies leg1's and leg2's rates first.
 
     Parameters
     ----------
-    theta1, theta2 : float
-        Swing / stance leg angles [rad].
-    dtheta1, dtheta2 : float
-        Their rates [rad/s].
+    *x_ideal : float
+        The rigid model's state in its role order, e.g. ``theta1, theta2, dtheta1,
+        dtheta2`` (swing / stance leg angles [rad] and rates [rad/s]) for the compass gait
+        (:meth:`ContactWalker.link_state_from_ideal`).
     rate_scale : (float, float)
-        Multipliers [-].
+        Multipliers [-] on leg1's (swing) and leg2's (stance) rates.
 
     Returns
     -------
-    ndarray (8,)
+    ndarray (2 nq,)
     """
-    w1 = dtheta1 * rate_scale[0]
-    w2 = dtheta2 * rate_scale[1]
     foot2 = -walker.static_penetration() * walker.normal
-    z = np.array([theta1, theta2, w1, w2], float)
+    z = walker.link_state_from_ideal(np.asarray(x_ideal, float).ravel(), rate_scale)
     return walker.pinned_to_full(z, foot2)
 
 
@@ -279,7 +277,7 @@ class _TimeLimit(Exception):
 def _run_pinned(walker, x0, t0, t_end, until_touchdown, rate, rtol, atol, max_step, hth):
     """Integrate with leg2's foot held fixed.  Returns (t, X, nfev, njev, status, msg)."""
     foot2 = walker.foot_positions(x0)[1]
-    z0 = x0[[2, 3, 6, 7]]
+    z0 = walker.pinned_state(x0)
 
     def f(t, z):
         return walker.rhs_pinned(t, z, foot2)
@@ -336,7 +334,7 @@ def _hermite_root(ta, tb, ya, yb, da, db, rising=None):
 
 
 def _hermite_state(walker, ta, tb, xa, xb, tc):
-    """State (8,) at ``tc`` in [ta, tb] on the cubic Hermite interpolant of two samples."""
+    """State (2 nq,) at ``tc`` in [ta, tb] on the cubic Hermite interpolant of two samples."""
     fa, fb = walker.rhs(ta, xa), walker.rhs(tb, xb)
     h = tb - ta
     u = (tc - ta) / h
@@ -355,6 +353,7 @@ def _first_event(walker, t, X, hth, k0=1):
     if len(t) <= k0:
         return None
     sl = slice(k0 - 1, None)
+    nq = walker.nq
     cq = walker.contact_quantities(X[sl])
     hh = walker.hip_height(X[sl])
     tt = t[sl]
@@ -368,7 +367,8 @@ def _first_event(walker, t, X, hth, k0=1):
             xa, xb = X[k0 - 1 + k - 1], X[k0 - 1 + k]
             n = walker.normal
             tc = _hermite_root(tt[k - 1], tt[k], hh[k - 1] - hth, hh[k] - hth,
-                               float(xa[4:6] @ n), float(xb[4:6] @ n), rising=False)
+                               float(xa[nq:nq + 2] @ n), float(xb[nq:nq + 2] @ n),
+                               rising=False)
             if tc is None:
                 tc = float(np.interp(hth, [hh[k], hh[k - 1]], [tt[k], tt[k - 1]]))
             best = ("fall", k0 - 1 + k, tc, "", np.nan)
@@ -407,13 +407,14 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
     Returns (t, X, nfev, njev, status, message, event) with status "ok", "cap", "trip",
     "fall", "fail" or "time_limit" and event the :func:`_first_event` tuple (or None).
     """
-    P, c1, c2 = walker._P, walker.lane1, walker.lane2
+    kern = walker.kernels
+    PC, p, c1, c2 = walker.contact_params, walker.walker_params, walker.lane1, walker.lane2
 
     def frhs(t, x):
-        return K.rhs(x, P, c1, c2)
+        return kern.rhs(x, PC, p, c1, c2)
 
     def fjac(t, x):
-        return K.jac(x, P, c1, c2)
+        return kern.jac(x, PC, p, c1, c2)
 
     if not use_jac:
         fjac = None
@@ -424,9 +425,9 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
             raise ValueError("contact_solver.max_step_s is not supported by method numbalsoda")
         if not np.isscalar(atol):
             raise ValueError("method numbalsoda needs a scalar atol")
-        data = K.pack(P, c1, c2)
+        data = walker.pack()
     elif method in _cyrk.CYRK_METHODS:
-        data = K.pack(P, c1, c2)
+        data = walker.pack()
 
     def odeint_chunk(xs, tg):
         """odeint from ``xs`` at ``tg[0]``: (t, X) at the samples reached after ``tg[0]``,
@@ -458,13 +459,14 @@ def _run_free(walker, x0, t0, t1, method, rtol, atol, max_step, rate, hth, use_j
             nfev += nf
             njev += nj
         elif method == "numbalsoda":  # whole chunk in compiled code (FD Jacobian)
-            X, ok, nf = _lsoda.solve_chunk(xa, tg, data, rtol, atol)
+            X, ok, nf = _lsoda.solve_chunk(xa, tg, data, rtol, atol, kernels=kern)
             nfev += nf
             nk = len(tg) if ok else 1  # rows after a failure are undefined: drop the chunk
             tn, Xn = tg[1:nk], X[1:nk]
             m = "Integration successful." if ok else "numbalsoda LSODA failed in this chunk"
         elif method in _cyrk.CYRK_METHODS:  # whole chunk in compiled code (CyRK BDF)
-            X, ok, nf, m = _cyrk.solve_chunk(method, xa, tg, data, rtol, atol, max_step)
+            X, ok, nf, m = _cyrk.solve_chunk(method, xa, tg, data, rtol, atol, max_step,
+                                             kernels=kern)
             nfev += nf
             tn, Xn = tg[1:len(X)], X[1:]
             if not ok:  # a force jump BDF cannot step over (a foot hitting the side of a
@@ -539,8 +541,8 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
     Parameters
     ----------
     walker : ContactWalker
-    x0 : ndarray (8,)
-        Initial state [hip_x, hip_y, th1, th2, vhip_x, vhip_y, w1, w2] (SI).
+    x0 : ndarray (2 nq,)
+        Initial state in ``walker.state_names()`` order (SI).
     t_final : float
         End time [s].
     method : {"odeint", "cyrk_bdf", "numbalsoda", "LSODA", "Radau", "BDF"}
@@ -650,7 +652,7 @@ def simulate_contact(walker: ContactWalker, x0: np.ndarray, t_final: float,
                       f"{t[-1]:.4g} s ({len(res['hs_t'])} heel strikes)")
     else:
         out = classify_complete(res["steps"], slip_limit_mm, float(hh))
-    return ContactResult(t=t, q=X[:, :4], qdot=X[:, 4:], feet=res["feet"],
+    return ContactResult(t=t, q=X[:, :walker.nq], qdot=X[:, walker.nq:], feet=res["feet"],
                          heel_strike_times=res["hs_t"], heel_strike_legs=res["hs_leg"],
                          steps=res["steps"], termination=termination, fall_time=fall_time,
                          message=str(msg), nfev=int(nfev), njev=int(njev), wall_time_s=wall,
