@@ -5,7 +5,8 @@ on the first chunk of a ``cyrk_*`` method.  CyRK (a main dependency, binary whee
 Fortran) takes the right-hand side as a C function pointer (its numba bridge,
 ``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The walker's
 generated RHS (:mod:`walkerlab.contact.generated`) is wrapped in a numba ``cfunc`` (compiled
-once per walker structure, cached on disk), so CyRK integrates a whole chunk of samples without re-entering Python.
+once per walker structure, cached on disk), so CyRK integrates a whole chunk of samples
+without re-entering Python.
 The physics is not repeated here: the cfunc only unpacks its data vector and calls the
 kernel.
 

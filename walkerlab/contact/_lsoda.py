@@ -3,9 +3,10 @@
 Internal module, imported only when ``method="numbalsoda"`` is selected (numbalsoda is an
 optional extra: ``pip install 'walkerlab[numbalsoda]'``; building it from source needs a C++
 and a Fortran compiler and cmake).  The walker's generated right-hand side
-(:mod:`walkerlab.contact.generated`) is wrapped in a numba ``cfunc`` so that LSODA (numbalsoda's C++ port) integrates a whole
-chunk of samples without re-entering Python.  numbalsoda's LSODA takes a scalar ``atol``, no
-largest step and no user Jacobian (it forms the stiff-phase Jacobian by finite differences;
+(:mod:`walkerlab.contact.generated`) is wrapped in a numba ``cfunc`` so that LSODA
+(numbalsoda's C++ port) integrates a whole chunk of samples without re-entering Python.
+numbalsoda's LSODA takes a scalar ``atol``, no largest step and no user Jacobian (it forms the
+stiff-phase Jacobian by finite differences;
 those RHS calls are counted in ``nfev``).
 
 The packed data vector handed to the cfunc is ``[n1, n2, PC, p, c1 (n1), c2 (n2), nfev]``.
@@ -90,6 +91,6 @@ def solve_chunk(x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray, rtol: floa
     X = np.empty((len(te), len(u0)))
     flag = np.array(999, np.int32)
     # same call as numbalsoda.lsoda (its njit wrapper), without compiling that wrapper
-    lsoda(_FPTR[kernels.__name__], len(u0), u0.ctypes.data, data.ctypes.data, len(te), te.ctypes.data,
-          X.ctypes.data, float(rtol), float(atol), int(mxstep), flag.ctypes.data)
+    lsoda(_FPTR[kernels.__name__], len(u0), u0.ctypes.data, data.ctypes.data, len(te),
+          te.ctypes.data, X.ctypes.data, float(rtol), float(atol), int(mxstep), flag.ctypes.data)
     return X, bool(flag == 1), int(data[-1] - n0)

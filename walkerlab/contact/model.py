@@ -35,8 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .config import ContactParamsSI, ContactSettings, KneeStopSettings, KneeStopSI, \
-    TerrainSettings
+from .config import ContactParamsSI, ContactSettings, KneeStopSettings, KneeStopSI, TerrainSettings
 
 __all__ = ["FOOT_NAMES", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
            "compass_gait_data", "state_name"]
@@ -258,22 +257,6 @@ class ContactWalker:
     def jac(self, t, x) -> np.ndarray:
         """Analytic Jacobian d(rhs)/dx (2 nq, 2 nq) (numba)."""
         return self.kernels.jac(np.asarray(x, dtype=float), *self._args())
-
-    def rhs_numpy(self, t, x) -> np.ndarray:
-        """Pure-numpy reference of :meth:`rhs` (slow; the paper's compass gait only).
-
-        Raises
-        ------
-        ValueError
-            The walker is not a point-mass compass gait.
-        """
-        from .reference import rhs_ref
-
-        if not np.isfinite(self.m):
-            raise ValueError("rhs_numpy: the numpy reference covers the compass gait only")
-        return rhs_ref(np.asarray(x, float), self.L, self.m, self.MH, self.a, self.g, self.phi,
-                       self.contact, (self.lane1, self.lane2), self.patch_half_width,
-                       self.continuous)
 
     def _check_pin(self):
         if self.structure.foot != "point":

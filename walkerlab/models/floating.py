@@ -1,7 +1,8 @@
 """The floating view of a walker: the same bodies, links and feet as the rigid hybrid model
 (:mod:`walkerlab.models.symbolic`), with no foot pinned (what the compliant-contact model
-integrates).  Derived symbolically (sympy) from the :class:`~walkerlab.models.description.Structure`,
-emitted as numba-compiled code, cached on disk through :mod:`walkerlab.models.cache`.
+integrates).  Derived symbolically (sympy) from the
+:class:`~walkerlab.models.description.Structure`, emitted as numba-compiled code, cached on
+disk through :mod:`walkerlab.models.cache`.
 
 Conventions (shared with the rigid view and the contact model)
 --------------------------------------------------------------
@@ -306,7 +307,7 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
     F = sp.Matrix(2, 2, sp.symbols("F0:4", real=True))
     outs = []
     JtF = sp.zeros(nq, 1)
-    for i, (pos, J) in enumerate(eq.feet):
+    for i, (_, J) in enumerate(eq.feet):
         dV = (J * dqv).jacobian(qv)
         outs += [(f"dV[{i}, {r}, {k}]", dV[r, k]) for r in range(2) for k in range(nq)]
         JtF += J.T * F[i, :].T
