@@ -111,9 +111,12 @@ class KneeStopSettings(BaseModel):
     straight), torque ``k ext^e + STEP(ext, 0, 0, dmax, cmax) ext'`` pushing the knee back
     (MSC ADAMS models joint stops this way).  Used by kneed walkers only; SI units.
 
-    Defaults: stiff enough that the kneed walker of ``configs/kneed.yaml`` (Hsu Chen 2007)
-    stands on a straight knee with a hyperextension of ~1e-3 rad, and damped so that a knee
-    strike is nearly plastic within ~1 ms, like the rigid model's knee strike.
+    Defaults (chosen on the walker of ``configs/kneed.yaml``, Hsu Chen 2007, standing on one
+    leg): the stop holds the knee within ~5e-6 rad of straight under ~0.05 N m; full damping
+    is reached at 1e-5 rad so the stop is overdamped from the first micro-radians (stiffness
+    there ~1.5 k sqrt(delta) ~ 5e2 N m/rad against ~0.3 kg m^2 above the knee: critical
+    damping ~25 N m s/rad < 200) and a knee strike is nearly plastic, like the rigid model's.
+    A less damped stop rebounds, and a free knee that rebounds into flexion under load buckles.
     """
 
     model_config = _STRICT
@@ -124,10 +127,10 @@ class KneeStopSettings(BaseModel):
     exponent: float = Field(1.5, ge=1.0, le=10.0, description="Stop force exponent e [-].",
                             json_schema_extra={"unit": "-"})
     max_damping_N_m_s_per_rad: float = Field(
-        50.0, ge=0, description="Stop maximum damping cmax [N m s/rad].",
+        200.0, ge=0, description="Stop maximum damping cmax [N m s/rad].",
         json_schema_extra={"unit": "N m s/rad"})
     penetration_at_max_damping_rad: float = Field(
-        1e-3, gt=0, description="Hyperextension dmax at which full damping is reached [rad].",
+        1e-5, gt=0, description="Hyperextension dmax at which full damping is reached [rad].",
         json_schema_extra={"unit": "rad"})
 
     def to_si(self) -> KneeStopSI:

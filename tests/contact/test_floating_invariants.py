@@ -1,0 +1,229 @@
+"""The rigid hybrid view and the floating (contact) view of every shipped walker with masses
+are one walker (issue 17, part 6): both are generated from the same description, by two
+different derivations (the rigid one with the stance foot pinned from the start,
+:mod:`walkerlab.models.symbolic`; the floating one with hip coordinates,
+:mod:`walkerlab.models.floating`).
+
+Tolerances: the exact identities (pinned mass matrix, impact projections) compare the same
+closed forms reached by different algebra, in double precision: 1e-12 relative leaves ~1e3 x
+round-off.  Dynamic checks state their own tolerance next to them.
+"""
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from walkerlab.config import load_scene
+from walkerlab.contact.config import ContactSettings
+from walkerlab.contact.model import ContactWalker
+from walkerlab.models.description import walker_data
+from walkerlab.models.floating import MASSLESS_MESSAGE, floating_view
+from walkerlab.models.rigid import functions
+
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+WALKERS = ("paper", "paper_rods", "kneed", "round_feet", "goswami1996")
+
+
+def _data(name):
+    sc = load_scene(CONFIGS / f"{name}.yaml")
+    return walker_data(sc.walker, sc.slope.phi_rad)
+
+
+def _walker(data, **kw):
+    """Contact walker of ``data`` with no ground under either foot (free flight)."""
+    return ContactWalker(contact=ContactSettings().to_si(), data=data, lane1=np.array([1e3]),
+                         lane2=np.array([-1e3]), continuous=False, **kw)
+
+
+def _link_map(structure):
+    """A (nq - 2, n_rigid): link angles (leg1 = swing, leg2 = stance) from the rigid
+    coordinates (absolute; kneed: swing thigh, swing shank, stance with a straight knee)."""
+    if structure.knee:
+        return np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0], [0, 0, 1.0]])
+    return np.eye(2)
+
+
+def _pinned_jacobian(w, q_links):
+    """Jp (nq, nq - 2): floating rates from link rates with leg2's material contact point
+    at rest (the rigid model's stance foot; rolling for arc feet)."""
+    x = np.zeros(2 * w.nq)
+    x[2:w.nq] = q_links
+    P, V, J = np.empty((2, 2)), np.empty((2, 2)), np.empty((2, 2, w.nq))
+    w.kernels.feet(x, w.walker_params, P, V, J)
+    Jp = np.zeros((w.nq, w.nq - 2))
+    Jp[:2] = -J[1, :, 2:]
+    Jp[2:] = np.eye(w.nq - 2)
+    return Jp, J
+
+
+def _rigid_states(structure, rng, n):
+    """Random rigid states (role order), kneed ones with the swing knee straight."""
+    k = 3 if structure.knee else 2
+    for _ in range(n):
+        q = rng.uniform(-0.4, 0.4, k)
+        dq = rng.normal(0, 1.5, k)
+        if structure.knee:
+            q[1], dq[1] = q[0], dq[0]
+        yield q, dq
+
+
+@pytest.mark.parametrize("name", WALKERS)
+def test_pinned_floating_mass_matrix_is_the_rigid_one(name):
+    """J^T M J over the rigid coordinates (stance foot pinned, stance knee straight)."""
+    data = _data(name)
+    w = _walker(data)
+    rigid = functions(data)
+    A = _link_map(data.structure)
+    worst = 0.0
+    for q, dq in _rigid_states(data.structure, np.random.default_rng(1), 20):
+        if data.structure.knee:  # a bent swing knee is fine for the (unlocked) flow matrix
+            q[1] += 0.3
+        Jp, _ = _pinned_jacobian(w, A @ q)
+        T = Jp @ A
+        Mf = w.mass_matrix(np.concatenate([[0.0, 0.0], A @ q]))
+        Mr = rigid["matrices"](np.concatenate([q, dq]))[0]
+        worst = max(worst, np.max(np.abs(T.T @ Mf @ T - Mr)) / np.max(np.abs(Mr)))
+    assert worst <= 1e-12
+
+
+def _project(M, C, v):
+    """Plastic impulse projection: v+ = v- + M^-1 C^T L with C v+ = 0 (Drake's collision
+    dynamics for an inelastic contact)."""
+    Minv_Ct = np.linalg.solve(M, C.T)
+    lam = -np.linalg.solve(C @ Minv_Ct, C @ v)
+    return v + Minv_Ct @ lam
+
+
+@pytest.mark.parametrize("name", WALKERS)
+def test_heel_strike_is_the_floating_impulse_projection(name):
+    """The rigid reset (impact and role swap) equals the plastic impulse at the swing foot's
+    material contact point of the floating model (knees locked through the impact)."""
+    data = _data(name)
+    st = data.structure
+    w = _walker(data)
+    rigid = functions(data)
+    A = _link_map(st)
+    worst = 0.0
+    for q, dq in _rigid_states(st, np.random.default_rng(2), 20):
+        Jp, J = _pinned_jacobian(w, A @ q)
+        v = Jp @ (A @ dq)
+        M = w.mass_matrix(np.concatenate([[0.0, 0.0], A @ q]))
+        C = J[0]  # leg1 (the swing leg) strikes
+        if st.knee:  # both knees locked during the impact (rigid model's assumption)
+            C = np.vstack([C, [0, 0, -1, 1, 0, 0], [0, 0, 0, 0, -1, 1]])
+        vp = _project(M, C, v)
+        after = rigid["reset"](np.concatenate([q, dq]))
+        n = len(q)
+        if st.knee:  # new roles: swing thigh, swing shank = old stance (leg2); stance = leg1
+            want = np.array([vp[4], vp[5], vp[2]])
+        else:
+            want = np.array([vp[3], vp[2]])
+        worst = max(worst, np.max(np.abs(after[n:] - want)) / np.max(np.abs(want)))
+    assert worst <= 1e-12
+
+
+def test_knee_strike_is_the_floating_impulse_projection():
+    """The rigid knee strike (kneed walker) equals the plastic impulse that locks the swing
+    knee, with the stance foot pinned and the stance knee locked."""
+    data = _data("kneed")
+    w = _walker(data)
+    rigid = functions(data)
+    A = _link_map(data.structure)
+    rng = np.random.default_rng(3)
+    worst = 0.0
+    for _ in range(20):
+        q = rng.uniform(-0.4, 0.4, 3)
+        dq = rng.normal(0, 1.5, 3)
+        Jp, J = _pinned_jacobian(w, A @ q)
+        v = Jp @ (A @ dq)
+        M = w.mass_matrix(np.concatenate([[0.0, 0.0], A @ q]))
+        C = np.vstack([J[1], [0, 0, -1, 1, 0, 0], [0, 0, 0, 0, -1, 1]])
+        vp = _project(M, C, v)
+        after = rigid["knee_reset"](np.concatenate([q, dq]))
+        want = np.array([vp[2], vp[3], vp[4]])
+        worst = max(worst, np.max(np.abs(after[3:] - want)) / np.max(np.abs(want)))
+    assert worst <= 1e-12
+
+
+def _com_and_mass(w, X):
+    """Centre of mass (2, k) [m] and total mass [kg] from the named points."""
+    st, p = w.structure, dict(zip(w.structure.param_names, w.walker_params))
+    pts = w.points(X)
+    num = p.get("M_hip", 0.0) * pts["hip"]
+    mass = p.get("M_hip", 0.0)
+    for b in st.bodies:
+        for leg in ("leg1", "leg2"):
+            num = num + p[f"m_{b.name}"] * pts[f"{leg}_{b.name}"]
+            mass += p[f"m_{b.name}"]
+    return num / mass, mass
+
+
+@pytest.mark.parametrize("name", WALKERS)
+def test_free_flight_conserves_energy_and_momenta(name):
+    """No contact: total energy, horizontal momentum and angular momentum about the centre of
+    mass are conserved.  DOP853 at rtol 1e-11 over 0.4 s (~100 steps): the global error of
+    each invariant stays below ~1e-9 of its scale; 1e-8 leaves margin and still fails for a
+    missing bias term (O(1e-2) drift)."""
+    data = _data(name)
+    w = _walker(data)
+    rng = np.random.default_rng(4)
+    nq = w.nq
+    x0 = np.zeros(2 * nq)
+    x0[1] = 5.0  # hip 5 m up, no ground under the feet anyway
+    x0[2:nq] = rng.uniform(-0.5, 0.5, nq - 2)
+    x0[nq:] = rng.normal(0, 1.0, nq)
+    if data.structure.knee:  # knees bent: the stops stay open
+        x0[3], x0[5] = x0[2] - 0.6, x0[4] - 0.6
+        x0[nq + 3], x0[nq + 5] = x0[nq + 2] - 1.0, x0[nq + 4] - 1.0
+    sol = solve_ivp(w.rhs, (0, 0.4), x0, method="DOP853", rtol=1e-11, atol=1e-12,
+                    dense_output=True)
+    X = sol.sol(np.linspace(0, 0.4, 41)).T
+    if data.structure.knee:
+        assert all(q["torque"].max() == 0 for q in w.knee_stop_quantities(X).values())
+    E = w.energies(X)["total"]
+    p = np.array([w.mass_matrix(x) @ x[nq:] for x in X])  # generalised momenta
+    com, _ = _com_and_mass(w, X)
+    # angular momentum about c = p . (generalised velocity of a unit rigid rotation about c)
+    xi = np.zeros((len(X), nq))
+    xi[:, 0] = -(X[:, 1] - com[1])
+    xi[:, 1] = X[:, 0] - com[0]
+    xi[:, 2:] = 1.0
+    Lc = np.sum(p * xi, axis=1)
+    scale_E = np.max(np.abs(w.energies(X)["kinetic"]))
+    assert np.max(np.abs(E - E[0])) <= 1e-8 * scale_E
+    assert np.max(np.abs(p[:, 0] - p[0, 0])) <= 1e-8 * np.max(np.abs(p))
+    assert np.max(np.abs(Lc - Lc[0])) <= 1e-8 * np.max(np.abs(p))
+    assert np.ptp(Lc) < np.ptp(p[:, 2])  # the invariant, not a constant by construction
+
+
+def test_massless_legs_have_no_floating_view():
+    sc = load_scene(CONFIGS / "simplest.yaml")
+    data = walker_data(sc.walker, sc.slope.phi_rad)
+    with pytest.raises(ValueError, match=re.escape(MASSLESS_MESSAGE)):
+        floating_view(data)
+    with pytest.raises(ValueError, match=re.escape(MASSLESS_MESSAGE)):
+        ContactWalker(data=data)
+
+
+@pytest.mark.parametrize("name", WALKERS)
+def test_floating_view_api(name):
+    """The agreed public API: coordinate names, M symmetric positive definite, the bias at
+    rest is gravity (total weight on hip_y)."""
+    data = _data(name)
+    v = floating_view(data)
+    names = v.coordinate_names()
+    if data.structure.knee:
+        assert names == ("hip_x", "hip_y", "leg1_thigh_angle", "leg1_shank_angle",
+                         "leg2_thigh_angle", "leg2_shank_angle")
+    else:
+        assert names == ("hip_x", "hip_y", "leg1_angle", "leg2_angle")
+    q = np.concatenate([[0.3, 1.0], np.linspace(-0.3, 0.2, len(names) - 2)])
+    M = v.mass_matrix(q)
+    np.testing.assert_allclose(M, M.T, rtol=0, atol=1e-15)
+    assert np.all(np.linalg.eigvalsh(M) > 0)
+    h = v.bias(q, np.zeros(len(names)))
+    assert h[0] == 0.0
+    assert h[1] == pytest.approx(data.total_mass_kg * data.gravity_m_per_s2, rel=1e-14)
