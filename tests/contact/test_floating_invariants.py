@@ -302,3 +302,22 @@ def test_compliant_knee_strike_loses_the_rigid_knee_strike_energy(rate):
     E0 = w.energies(x0)["total"][0]
     E1 = w.energies(x1)["total"][0] + ks.k * ext ** (ks.e + 1) / (ks.e + 1)
     assert (E0 - E1) == pytest.approx(loss_rigid, rel=5e-3)
+
+
+@pytest.mark.parametrize("name", WALKERS)
+def test_straight_line_rhs_is_the_floating_view(name):
+    """The contact walker's generated straight-line right-hand side (unrolled Cholesky)
+    solves M qdd = -h of the floating view (feet in the air, knees open); 1e-12 relative."""
+    data = _data(name)
+    w = _walker(data)
+    v = floating_view(data)
+    rng = np.random.default_rng(6)
+    for _ in range(10):
+        x = np.concatenate([[0.1, 3.0], rng.uniform(-0.4, 0.4, w.nq - 2),
+                            rng.normal(0, 1.0, w.nq)])
+        if data.structure.knee:
+            x[3], x[5] = x[2] - 0.5, x[4] - 0.5
+        q, dq = x[:w.nq], x[w.nq:]
+        want = np.linalg.solve(v.mass_matrix(q), -v.bias(q, dq))
+        np.testing.assert_allclose(w.rhs(0, x)[w.nq:], want, rtol=1e-12,
+                                   atol=1e-12 * np.max(np.abs(want)))
