@@ -44,13 +44,22 @@ def settings(scene: Scene):
 
 
 def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
-    """Step length [m] of the ideal gait from its post-impact state ``x_ideal`` (role order of
-    the rigid model): the distance between the two feet's contact points with the stance leg
-    placed by :meth:`ContactWalker.link_state_from_ideal` (compass gait:
-    ``2 L sin((th_st - th_sw) / 2)``, the foot-to-foot chord at heel strike)."""
-    x = walker.pinned_to_full(walker.link_state_from_ideal(x_ideal), np.zeros(2))
+    """Advance [m] of the ideal gait per step, from its post-impact state ``x_ideal`` (role
+    order of the rigid model): the distance between the two feet's contact points with the
+    stance leg placed by :meth:`ContactWalker.link_state_from_ideal` (the foot-to-foot chord
+    at heel strike; compass gait ``2 L sin((th_st - th_sw) / 2)``), plus, for arc feet of
+    radius R, the roll ``R (th_st - th_sw)`` of the stance arc over the step (on the periodic
+    gait the stance leg turns from the post-impact stance angle to the post-impact swing
+    angle).  The checkerboard patches are spaced by it."""
+    z = walker.link_state_from_ideal(x_ideal)
+    x = walker.pinned_to_full(z, np.zeros(2))
     feet = walker.foot_positions(x)
-    return float(np.hypot(*(feet[1] - feet[0])))
+    chord = float(np.hypot(*(feet[1] - feet[0])))
+    if walker.structure.foot != "arc":
+        return chord
+    R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
+    m = walker.nq - 2  # link angles: leg1's, then leg2's; the foot is on each leg's last link
+    return chord + R * (z[m - 1] - z[m // 2 - 1])
 
 
 def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
