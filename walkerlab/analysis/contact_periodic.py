@@ -154,7 +154,7 @@ class ContactPeriodicGait:
 
 class PeriodicGaitError(RuntimeError):
     """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
-    "time_limit", "solver_failure"."""
+    "time_limit", "solver_failure", "unsupported" (kneed walker: no section)."""
 
     def __init__(self, kind: str, message: str):
         super().__init__(message)
@@ -194,8 +194,8 @@ class StepMap:
         self.nfev = 0
         w = self.walker
         if w.structure.knee:
-            raise ValueError("contact periodic gait: the mid-stance section is defined for "
-                             "straight legs only")
+            raise PeriodicGaitError("unsupported", "contact periodic gait: the mid-stance "
+                                    "section is defined for straight legs only")
         kern = w.kernels
         args = (w.contact_params, w.walker_params, w.lane1, w.lane2)
         self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
