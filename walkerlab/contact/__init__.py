@@ -1,4 +1,6 @@
-"""Compliant-contact (MSC ADAMS-style) compass-gait walker: laws, model, simulation.
+"""Compliant-contact (MSC ADAMS-style) walker of any walker description with positive leg
+masses (generated from its floating view, :mod:`walkerlab.models.floating`): laws, model,
+simulation.
 
 The names below are loaded on first use (PEP 562 ``__getattr__``): ``import
 walkerlab.contact.config`` (what :mod:`walkerlab.config` needs) must not load numba or
@@ -9,7 +11,7 @@ from importlib import import_module
 
 _WHERE = {
     "ContactParamsSI": "config", "ContactSettings": "config", "ContactSimSettings": "config",
-    "TerrainSettings": "config",
+    "KneeStopSI": "config", "KneeStopSettings": "config", "TerrainSettings": "config",
     "adams_step": "laws", "adams_step_derivative": "laws",
     "coulomb_friction_coefficient": "laws", "impact_normal_force": "laws",
     "FOOT_NAMES": "model", "ContactWalker": "model", "checkerboard_lanes": "model",
