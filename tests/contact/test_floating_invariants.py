@@ -321,3 +321,71 @@ def test_straight_line_rhs_is_the_floating_view(name):
         want = np.linalg.solve(v.mass_matrix(q), -v.bias(q, dq))
         np.testing.assert_allclose(w.rhs(0, x)[w.nq:], want, rtol=1e-12,
                                    atol=1e-12 * np.max(np.abs(want)))
+
+
+def _constrained(w, q_links, dq_links, lock_leg1_knee):
+    """Floating accelerations and multipliers with leg2's material contact point held
+    (J qdd + d(J dq)/dt = 0) and the knees locked as in the rigid phase (M qdd + h = C^T L)."""
+    nq = w.nq
+    x = w.pinned_to_full(np.concatenate([q_links, dq_links]), np.zeros(2))
+    M = w.mass_matrix(x)
+    P, V, J = np.empty((2, 2)), np.empty((2, 2)), np.empty((2, 2, nq))
+    w.kernels.feet(x, w.walker_params, P, V, J)
+    dV, dJtF = np.empty((2, 2, nq)), np.empty((nq, nq))
+    w.kernels.feet_jac(x, np.zeros((2, 2)), w.walker_params, dV, dJtF)
+    h = floating_view(w.data).bias(x[:nq], x[nq:])
+    rows, rhs = [J[1]], [-(dV[1] @ x[nq:])]
+    if w.structure.knee:
+        rows.append(np.array([[0, 0, 0, 0, -1.0, 1]]))  # stance knee locked
+        rhs.append(np.zeros(1))
+        if lock_leg1_knee:
+            rows.append(np.array([[0, 0, -1.0, 1, 0, 0]]))
+            rhs.append(np.zeros(1))
+    C = np.vstack(rows)
+    m = len(C)
+    K = np.block([[M, -C.T], [C, np.zeros((m, m))]])
+    sol = np.linalg.solve(K, np.concatenate([-h, *rhs]))
+    return sol[:nq], sol[nq:]
+
+
+@pytest.mark.parametrize("name", WALKERS)
+def test_pinned_floating_dynamics_are_the_rigid_flow(name):
+    """With the stance foot's material point held (rolling for arc feet) and the knees locked
+    as in each rigid phase, the floating dynamics (M, bias, contact Jacobians and their
+    rates) give the rigid flow's accelerations: the bias term and the contact kinematics
+    are the rigid walker's too, not only the mass matrix.  1e-10 relative: a 2n x 2n KKT
+    solve with condition number ~1e4 on round-off-level data."""
+    data = _data(name)
+    w = _walker(data)
+    rigid = functions(data)
+    A = _link_map(data.structure)
+    flows = [("flow", False)] + ([("flow_locked", True)] if data.structure.knee else [])
+    for fname, locked in flows:
+        worst = 0.0
+        for q, dq in _rigid_states(data.structure, np.random.default_rng(7), 10):
+            if data.structure.knee and not locked:
+                q[1] -= 0.3
+                dq[1] += 0.5
+            qdd, _ = _constrained(w, A @ q, A @ dq, locked)
+            want = rigid[fname](0.0, np.concatenate([q, dq]))[len(q):]
+            got = qdd[2:][[0, 1, 2]] if data.structure.knee else qdd[2:]
+            worst = max(worst, np.max(np.abs(got - want)) / np.max(np.abs(want)))
+        assert worst <= 1e-10, fname
+
+
+def test_kneed_rigid_gait_pulls_on_the_stance_knee_early_in_stance():
+    """Why the kneed walker of configs/kneed.yaml buckles on compliant ground: at the start of
+    its step (Tedrake's initial condition, near the fixed point) the rigid gait's locked
+    stance knee needs a torque that resists *flexion* (~0.08 N m), which a one-sided stop
+    (it only resists hyperextension) cannot give.  The multiplier's sign is read in the
+    stop's convention: the stop adds +T to the thigh's and -T to the shank's equation."""
+    data = _data("kneed")
+    w = _walker(data)
+    sc = load_scene(CONFIGS / "kneed.yaml")
+    x = sc.fixedpoint.initial_guess.as_array(
+        ["swing_thigh_angle", "swing_shank_angle", "stance_angle", "swing_thigh_rate",
+         "swing_shank_rate", "stance_rate"])
+    A = _link_map(data.structure)
+    _, lam = _constrained(w, A @ x[:3], A @ x[3:], True)
+    stop_torque_needed = -lam[2]  # C row (0, 0, 0, 0, -1, 1): Q_thigh = -lam, Q_shank = +lam
+    assert stop_torque_needed < -0.05
