@@ -218,17 +218,24 @@ def test_report_cites_the_paper_not_a_path(tmp_path):
 
 
 # --------------------------------------------------------------------------- figures
-def test_figures_in_paper_order(tmp_path):
+def test_figures_in_paper_order(tmp_path, monkeypatch):
+    from walkerlab.report import sections
     from walkerlab.report.sections import CAPTIONS, figures_section
+
+    monkeypatch.setattr(sections, "steps_table", lambda path: "(steps)")  # no artifact here
 
     stems = [s for s, _ in CAPTIONS]
     assert stems[:6] == ["fig2_stick_ideal", "fig6_stick_contact", "fig7_angles_rates",
                          "fig8_errors", "fig9_limit_cycles", "fig10_energy"]
     for s in stems[:6]:
         (tmp_path / f"{s}.png").write_bytes(b"")
-    md = "\n".join(figures_section(tmp_path, "figures", {}))
+    paths = {s: tmp_path / f"{s}.h5" for s in ("simulate", "contact-sim", "compare")}
+    md = "\n".join(figures_section(tmp_path, "figures", paths))
     pos = [md.index(f"figures/{s}.png") for s in stems[:6]]
     assert pos == sorted(pos)
+    # a figure drawn from an artifact the report leaves out is not shown
+    md = "\n".join(figures_section(tmp_path, "figures", {"simulate": paths["simulate"]}))
+    assert "figures/fig2_stick_ideal.png" in md and "fig6_stick_contact" not in md
 
 
 def _walker_trajectory(round_feet: bool = False, knee: bool = False) -> NamedTrajectory:
