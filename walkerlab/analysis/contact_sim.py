@@ -171,31 +171,29 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
 
 
 def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
-    """State name -> name in the shared trajectory layout (``<leg>_angle``, ``<leg>_rate``,
-    ...) for every leg coordinate of the walker (the hip position and velocity are points).
-
-    A state already named after a leg keeps its name; the compass walker's ``theta<i>`` /
-    ``dtheta<i>`` become ``<leg i>_angle`` / ``<leg i>_rate``.
+    """State name -> name in the shared trajectory layout for every leg coordinate of the
+    walker (the hip position and velocity are points): the floating coordinate's name
+    (``<leg>_angle``, kneed ``<leg>_thigh_angle``, ``<leg>_shank_angle``; the same names as
+    the rigid walker's ``leg_coordinates``) and ``..._rate`` for its rate.
     """
     idx = StateIndex(walker)
+    n = idx.coordinates.stop
     out = {}
-    for i in range(idx.coordinates.start, idx.coordinates.stop):
-        name = idx.names[i]
-        if name in ("hip_x", "hip_y"):
+    for i, coord in enumerate(walker.coordinate_names()):
+        if coord in ("hip_x", "hip_y"):
             continue
-        if name.startswith("theta") and name[5:].isdigit():
-            new = f"{legs[int(name[5:]) - 1]}_angle"
-        else:
-            new = name
-        out[name] = new
-        rate = idx.names[idx.rate_of(name)]
-        out[rate] = new[:-len("_angle")] + "_rate" if new.endswith("_angle") else f"{new}_rate"
+        leg = coord.split("_", 1)[0]
+        new = coord if leg not in ("leg1", "leg2") else legs[int(leg[-1]) - 1] + coord[4:]
+        out[idx.names[i]] = new
+        out[idx.names[n + i]] = new.removesuffix("_angle") + "_rate"
     return out
 
 
 def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
     """A :class:`ContactResult` in the shared named layout of
-    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes)."""
+    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes;
+    coordinates by :func:`trajectory_names`, points from the generated floating view: hip,
+    each body ``<leg>_<body>``, feet, knees)."""
     from walkerlab.io.trajectory import NamedTrajectory
 
     legs = list(legs)
@@ -208,16 +206,8 @@ def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
         step[m] = k + 1
     X = res.x
     en = walker.energies(X)
-    feet = np.asarray(walker.foot_positions(X)).reshape(len(X), -1, 2)  # (n, foot, xy)
-    hip = np.vstack([res.column("hip_x"), res.column("hip_y")])
-    pts = {"hip": hip}
+    pts = {k: np.asarray(v, float).reshape(2, -1) for k, v in walker.points(X).items()}
     names = trajectory_names(walker, legs)
-    for i, leg in enumerate(legs):
-        pts[f"{leg}_foot"] = feet[:, i, :].T
-        angle = next((s for s, n in names.items() if n == f"{leg}_angle"), None)
-        if angle is not None and hasattr(walker, "b"):
-            th = res.column(angle)
-            pts[f"{leg}_mass"] = hip + walker.b * np.vstack([np.sin(th), -np.cos(th)])
     units = dict(zip(walker.state_names(), walker.state_units()))
     coords = {new: res.column(old) for old, new in names.items()}
     return NamedTrajectory(

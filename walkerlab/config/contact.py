@@ -65,12 +65,18 @@ class KneeStopSI:
         Maximum damping ``[N m s/rad]``.
     dmax : float
         Hyperextension at full damping ``[rad]``.
+    latch : bool
+        The stop also holds a loaded leg's knee against flexion (knee latch).
+    latch_load : float
+        Foot load at which the latch holds fully ``[N]``.
     """
 
     k: float
     e: float
     cmax: float
     dmax: float
+    latch: bool = False
+    latch_load: float = 1.0
 
 
 # Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
@@ -138,10 +144,21 @@ class KneeStopSettings(BaseModel):
         1e-5, gt=0, description="Hyperextension dmax at which full damping is reached [rad].",
         json_schema_extra={"unit": "rad"})
 
+    latch: bool = Field(
+        False, description="Knee latch: while a leg's foot carries load the stop also acts "
+        "in flexion (the same law mirrored), so the stance knee is held straight both ways, "
+        "as the suction cups / magnets of real kneed passive walkers (McGeer 1990; Cornell) "
+        "and the rigid model's locked knee do; it releases as the foot lifts off.  Engagement "
+        "STEP(Fn, 0, 0, latch_full_load_N, 1) of that foot's normal force Fn.")
+    latch_full_load_N: float = Field(
+        1.0, gt=0, description="Foot normal force at which the latch holds fully [N].",
+        json_schema_extra={"unit": "N"})
+
     def to_si(self) -> KneeStopSI:
         """The same numbers as a :class:`KneeStopSI`."""
         return KneeStopSI(self.stiffness_N_m_per_rad, self.exponent,
-                          self.max_damping_N_m_s_per_rad, self.penetration_at_max_damping_rad)
+                          self.max_damping_N_m_s_per_rad, self.penetration_at_max_damping_rad,
+                          self.latch, self.latch_full_load_N)
 
 
 class ContactSettings(BaseModel):

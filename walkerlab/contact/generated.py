@@ -29,7 +29,15 @@ I_KK      knee-stop stiffness                       N m/rad^e
 I_KE      knee-stop exponent                        -
 I_KC      knee-stop max damping                     N m s/rad
 I_KD      knee-stop penetration at max damping      rad
+I_KL      knee latch on (1/0)                       -
+I_KF      foot load at which the latch holds fully  N
 ========  ========================================  ==============
+
+Knee latch (``contact.knee_stop.latch``): while a leg's foot carries load, its knee stop acts
+in both directions (flexion too, with the same IMPACT law mirrored), weighted by
+``STEP(Fn, 0, 0, I_KF, 1)`` of that foot's normal force Fn; a foot that lifts off releases
+it.  A pinned stance foot (``rhs_pinned``) counts as loaded.  The analytic Jacobian holds the
+weight constant (its dependence on the foot's load is left out: Newton directions only).
 
 Packed data vector of the compiled integrators (``_cyrk``, ``_lsoda``):
 ``[n1, n2, PC (NPC), p (NP), c1 (n1), c2 (n2), nfev]`` (``p`` the walker's parameter vector,
@@ -62,18 +70,18 @@ from walkerlab.models.description import Structure
 __all__ = ["ASSEMBLY", "NPC", "contact_module", "rhs_source"]
 
 #: Number of contact parameters (see the table above).
-NPC = 15
+NPC = 17
 
 ASSEMBLY = '''
 # ---------------------------------------------------------------- contact assembly
 # (walkerlab.contact.generated.ASSEMBLY: walker-independent; laws from contact._kernels)
 from math import sin as _sin, cos as _cos
-from walkerlab.contact._kernels import normal_force, friction_mu, in_patch
+from walkerlab.contact._kernels import normal_force, friction_mu, in_patch, step
 
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
-I_KK, I_KE, I_KC, I_KD = 11, 12, 13, 14
-NPC = 15
+I_KK, I_KE, I_KC, I_KD, I_KL, I_KF = 11, 12, 13, 14, 15, 16
+NPC = 17
 NX = 2 * NQ
 D_N1, D_N2, D_PC = 0, 1, 2
 D_P = D_PC + NPC
@@ -136,12 +144,27 @@ def _foot(P, V, i, PC, cen):
 
 
 @njit(cache=True)
-def _knee(x, k, PC):
-    """Knee stop of knee k: (extension, rate, torque, dT/dext, dT/drate)."""
+def _latch_weight(fn, PC):
+    """Latch engagement in [0, 1] of a knee whose foot carries the normal force fn [N]."""
+    if PC[I_KL] < 0.5:
+        return 0.0
+    return step(fn, 0.0, 0.0, PC[I_KF], 1.0)[0]
+
+
+@njit(cache=True)
+def _knee(x, k, PC, fn):
+    """Knee stop (and latch, its foot loaded with fn [N]) of knee k: (extension, rate,
+    torque, dT/dext, dT/drate)."""
     t, s = 2 + 2 * k, 3 + 2 * k
     ext = x[s] - x[t]
     rate = x[NQ + s] - x[NQ + t]
-    if ext <= 0.0:
+    if ext < 0.0:
+        w = _latch_weight(fn, PC)
+        if w <= 0.0:
+            return ext, rate, 0.0, 0.0, 0.0
+        T, dd, dr = normal_force(-ext, -rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])
+        return ext, rate, -w * T, w * dd, w * dr
+    if ext == 0.0:
         return ext, rate, 0.0, 0.0, 0.0
     T, dd, dr = normal_force(ext, rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])
     return ext, rate, T, dd, dr
@@ -170,7 +193,8 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
                 Q[k] += J[i, 0, k] * Fx + J[i, 1, k] * Fy
     if KNEE:
         for k in range(2):
-            res = _knee(x, k, PC)
+            used = (k == 0 and use1) or (k == 1 and use2)
+            res = _knee(x, k, PC, info[k, 4] if used else np.inf)  # pinned foot: loaded
             for j in range(5):
                 knees[k, j] = res[j]
             T = res[2]
@@ -196,9 +220,15 @@ def _foot_force(px, py, vx, vy, sp, cp, PC, cen):
 
 
 @njit(cache=True)
-def _knee_torque(ext, rate, PC):
-    """Knee-stop torque [N m] (>= 0) at hyperextension ``ext`` [rad], rate [rad/s]."""
-    if ext <= 0.0:
+def _knee_torque(ext, rate, PC, fn):
+    """Knee-stop torque [N m] (>= 0 past straight) at hyperextension ``ext`` [rad], rate
+    [rad/s]; with the latch on and the leg's foot loaded with fn [N], also < 0 in flexion."""
+    if ext < 0.0:
+        w = _latch_weight(fn, PC)
+        if w <= 0.0:
+            return 0.0
+        return -w * normal_force(-ext, -rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
+    if ext == 0.0:
         return 0.0
     return normal_force(ext, rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
 
@@ -371,16 +401,22 @@ def contact_table(X, PC, p, c1, c2):
 
 
 @njit(cache=True)
-def knee_table(X, PC, p):
+def knee_table(X, PC, p, c1, c2):
     """(n, 2, 4): per knee extension [rad] (> 0 hyperextended), its rate [rad/s], stop
-    torque [N m] (>= 0, pushing the knee straight) and the stop's power [W] (<= 0 while it
+    torque [N m] (> 0 pushing the knee straight from hyperextension; < 0 the latch holding
+    a loaded leg's knee against flexion) and the stop's power [W] (<= 0 while it
     dissipates)."""
     n = X.shape[0]
     out = np.zeros((n, 2, 4))
+    P = np.empty((2, 2))
+    V = np.empty((2, 2))
+    J = np.empty((2, 2, NQ))
     if KNEE:
         for r in range(n):
+            feet(X[r], p, P, V, J)
             for k in range(2):
-                ext, rate, T, _, _ = _knee(X[r], k, PC)
+                fn = _foot(P, V, k, PC, c1 if k == 0 else c2)[4]
+                ext, rate, T, _, _ = _knee(X[r], k, PC, fn)
                 out[r, k, 0] = ext
                 out[r, k, 1] = rate
                 out[r, k, 2] = T
@@ -477,8 +513,9 @@ def rhs_source(eq) -> str:
     if nq == 6:  # knees: (thigh, shank) = (2, 3), (4, 5)
         for k, (t, sh) in enumerate(((2, 3), (4, 5))):
             T = sp.Symbol(f"_T{k}", real=True)
+            fn = f"({Fs[2 * k]} * _sp + {Fs[2 * k + 1]} * _cp)"  # normal force of leg k's foot
             lines.append(f"    {T} = _knee_torque({eq.q[sh]} - {eq.q[t]}, "
-                         f"{eq.dq[sh]} - {eq.dq[t]}, PC)")
+                         f"{eq.dq[sh]} - {eq.dq[t]}, PC, {fn})")
             Q[t] += T
             Q[sh] -= T
     nz = {(i, j) for i in range(nq) for j in range(i + 1) if eq.M[i, j] != 0}

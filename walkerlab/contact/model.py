@@ -161,6 +161,7 @@ class ContactWalker:
         PC[mod.I_MUS], PC[mod.I_MUD], PC[mod.I_VS], PC[mod.I_VD] = c.mu_s, c.mu_d, c.v_s, c.v_d
         PC[mod.I_HW], PC[mod.I_CONT] = self.patch_half_width, 1.0 if self.continuous else 0.0
         PC[mod.I_KK], PC[mod.I_KE], PC[mod.I_KC], PC[mod.I_KD] = ks.k, ks.e, ks.cmax, ks.dmax
+        PC[mod.I_KL], PC[mod.I_KF] = (1.0 if ks.latch else 0.0), ks.latch_load
         set_(self, "lane1", np.ascontiguousarray(self.lane1, dtype=float))
         set_(self, "lane2", np.ascontiguousarray(self.lane2, dtype=float))
         set_(self, "kernels", mod)
@@ -368,12 +369,13 @@ class ContactWalker:
         dict
             ``{"leg1": {...}, "leg2": {...}}`` each with arrays (n,): ``extension`` [rad]
             (shank - thigh angle, > 0 hyperextended), ``extension_rate`` [rad/s],
-            ``torque`` [N m] (>= 0: pushes the knee straight), ``power`` [W] (of the stop
-            on the walker).
+            ``torque`` [N m] (> 0: pushes the knee straight from hyperextension; < 0: the
+            latch holds a loaded leg's knee against flexion), ``power`` [W] (of the stop on
+            the walker).
         """
         if not self.structure.knee:
             return {}
-        tab = self.kernels.knee_table(self._rows(X), self.contact_params, self.walker_params)
+        tab = self.kernels.knee_table(self._rows(X), *self._args())
         names = ("extension", "extension_rate", "torque", "power")
         return {leg: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
                 for i, leg in enumerate(FOOT_NAMES)}
