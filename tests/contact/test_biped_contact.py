@@ -73,7 +73,7 @@ def test_massless_walker_contact_sim_is_one_line(tmp_path):
     assert "Traceback" not in r.output
 
 
-@pytest.mark.parametrize("name", ["paper_rods", "round_feet", "goswami1996"])
+@pytest.mark.parametrize("name", ["paper_rods", "round_feet", "goswami1996", "kneed"])
 def test_shipped_biped_scenes_have_contact(name):
     """The shipped walkers with masses carry a contact section (issue 17 part 3)."""
     from walkerlab.config import load_scene

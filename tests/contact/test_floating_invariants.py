@@ -389,3 +389,59 @@ def test_kneed_rigid_gait_pulls_on_the_stance_knee_early_in_stance():
     _, lam = _constrained(w, A @ x[:3], A @ x[3:], True)
     stop_torque_needed = -lam[2]  # C row (0, 0, 0, 0, -1, 1): Q_thigh = -lam, Q_shank = +lam
     assert stop_torque_needed < -0.05
+
+
+def _latched(data, **kw):
+    from walkerlab.contact.config import KneeStopSettings
+
+    ks = KneeStopSettings(latch=True, **kw).to_si()
+    return ContactWalker(contact=ContactSettings().to_si(), data=data, knee_stop=ks)
+
+
+def test_straight_line_rhs_is_the_array_assembly_with_contact_and_latch():
+    """With both feet in the ground and both knees flexed within the latch's capture angle,
+    the generated straight-line rhs (forces and latch torques printed inline) equals the
+    array assembly (``_force``, which the Jacobian, the pinned dynamics and the knee table
+    use) solved with M: 1e-9 relative (the contact forces reach ~1e2 N)."""
+    data = _data("kneed")
+    w = _latched(data)
+    rng = np.random.default_rng(3)
+    nq = w.nq
+    for _ in range(8):
+        z = np.concatenate([[-0.2, -0.2 - rng.uniform(0, 4e-3), 0.2, 0.2 - rng.uniform(0, 4e-3)],
+                            rng.normal(0, 0.5, nq - 2)])
+        z[5], z[7] = z[4] - 0.01, z[6] - 0.01  # knees flexing slowly: the latch pushes back
+        x = w.pinned_to_full(z, -2e-4 * w.normal)  # leg2's foot 0.2 mm deep
+        x[1] -= 1e-4  # both feet a little deeper
+        M, P, V, J = (np.empty((nq, nq)), np.empty((2, 2)), np.empty((2, 2)),
+                      np.empty((2, 2, nq)))
+        info, knees = np.zeros((2, 10)), np.zeros((2, 5))
+        Q = w.kernels._force(x, *w._args(), True, True, M, P, V, J, info, knees)
+        assert np.all(knees[:, 2] < 0) and np.all(info[:, 4] > 0)  # latches hold, feet loaded
+        want = np.linalg.solve(M, Q)
+        np.testing.assert_allclose(w.rhs(0, x)[nq:], want, rtol=1e-9,
+                                   atol=1e-9 * np.max(np.abs(want)))
+
+
+def test_knee_latch_holds_a_loaded_knee_against_flexion_and_releases_in_the_air():
+    """A flexed knee (2e-3 rad, inside the capture angle) of a leg whose foot is on the
+    ground gets a torque that extends it (< 0 in the stop's sign convention) and a larger
+    extending acceleration than without the latch; the same leg with its foot 5 mm above the
+    ground (past the 2 mm release height) is free (torque 0); a knee bent 0.1 rad (past the
+    capture angle) is not snapped straight (torque 0)."""
+    data = _data("kneed")
+    w, off = _latched(data), _walker(data)
+    on = ContactWalker(contact=w.contact, data=data)  # same ground, latch off
+    z = np.array([-0.2, -0.2, 0.1, 0.1 - 2e-3, 0, 0, 0, 0], float)
+    x = w.pinned_to_full(z, -w.static_penetration() * w.normal)
+    T = w.knee_stop_quantities(x)["leg2"]["torque"][0]
+    assert T < 0
+    ext_acc = (w.rhs(0, x)[11] - w.rhs(0, x)[10]), (on.rhs(0, x)[11] - on.rhs(0, x)[10])
+    assert ext_acc[0] > ext_acc[1]
+    up = x.copy()
+    up[:2] += 5e-3 * w.normal
+    assert w.knee_stop_quantities(up)["leg2"]["torque"][0] == 0.0
+    bent = w.pinned_to_full(np.array([-0.2, -0.2, 0.1, 0.0, 0, 0, 0, 0]),
+                            -w.static_penetration() * w.normal)
+    assert w.knee_stop_quantities(bent)["leg2"]["torque"][0] == 0.0
+    assert off.knee_stop_quantities(x)["leg2"]["torque"][0] == 0.0

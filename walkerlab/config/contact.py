@@ -67,8 +67,10 @@ class KneeStopSI:
         Hyperextension at full damping ``[rad]``.
     latch : bool
         The stop also holds a loaded leg's knee against flexion (knee latch).
-    latch_load : float
-        Foot load at which the latch holds fully ``[N]``.
+    latch_height : float
+        Height of the foot above the ground at which the latch has released ``[m]``.
+    latch_capture : float
+        Flexion beyond which the latch does not hold ``[rad]``.
     """
 
     k: float
@@ -76,7 +78,8 @@ class KneeStopSI:
     cmax: float
     dmax: float
     latch: bool = False
-    latch_load: float = 1.0
+    latch_height: float = 0.002
+    latch_capture: float = 0.01
 
 
 # Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
@@ -145,20 +148,26 @@ class KneeStopSettings(BaseModel):
         json_schema_extra={"unit": "rad"})
 
     latch: bool = Field(
-        False, description="Knee latch: while a leg's foot carries load the stop also acts "
-        "in flexion (the same law mirrored), so the stance knee is held straight both ways, "
-        "as the suction cups / magnets of real kneed passive walkers (McGeer 1990; Cornell) "
-        "and the rigid model's locked knee do; it releases as the foot lifts off.  Engagement "
-        "STEP(Fn, 0, 0, latch_full_load_N, 1) of that foot's normal force Fn.")
-    latch_full_load_N: float = Field(
-        1.0, gt=0, description="Foot normal force at which the latch holds fully [N].",
-        json_schema_extra={"unit": "N"})
+        False, description="Knee latch: while a leg's foot is on the ground the stop also "
+        "acts in flexion (the same law mirrored), so the stance knee is held straight both "
+        "ways, as the suction cups / magnets of real kneed passive walkers (McGeer 1990; "
+        "Cornell) and the rigid model's locked knee do; it holds through the other leg's "
+        "heel strike and releases as its foot rises above latch_release_height_m.")
+    latch_release_height_m: float = Field(
+        0.002, gt=0, le=0.1, description="Height of the foot above the ground at which its "
+        "knee's latch has released (engagement STEP(penetration, -h, 0, 0, 1)) [m].",
+        json_schema_extra={"unit": "m"})
+    latch_capture_rad: float = Field(
+        0.01, gt=0, le=0.5, description="Flexion within which the latch captures the knee "
+        "(full hold within half of it) [rad]: a knee bent farther when its foot touches down "
+        "is not snapped straight.", json_schema_extra={"unit": "rad"})
 
     def to_si(self) -> KneeStopSI:
         """The same numbers as a :class:`KneeStopSI`."""
         return KneeStopSI(self.stiffness_N_m_per_rad, self.exponent,
                           self.max_damping_N_m_s_per_rad, self.penetration_at_max_damping_rad,
-                          self.latch, self.latch_full_load_N)
+                          self.latch, self.latch_release_height_m,
+                          self.latch_capture_rad)
 
 
 class ContactSettings(BaseModel):

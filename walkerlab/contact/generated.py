@@ -30,14 +30,19 @@ I_KE      knee-stop exponent                        -
 I_KC      knee-stop max damping                     N m s/rad
 I_KD      knee-stop penetration at max damping      rad
 I_KL      knee latch on (1/0)                       -
-I_KF      foot load at which the latch holds fully  N
+I_KF      latch release height of the foot          m
+I_KA      latch capture angle                       rad
 ========  ========================================  ==============
 
-Knee latch (``contact.knee_stop.latch``): while a leg's foot carries load, its knee stop acts
-in both directions (flexion too, with the same IMPACT law mirrored), weighted by
-``STEP(Fn, 0, 0, I_KF, 1)`` of that foot's normal force Fn; a foot that lifts off releases
-it.  A pinned stance foot (``rhs_pinned``) counts as loaded.  The analytic Jacobian holds the
-weight constant (its dependence on the foot's load is left out: Newton directions only).
+Knee latch (``contact.knee_stop.latch``): while a leg's foot is on (or within the release
+height I_KF of) the ground, its knee stop acts in both directions (flexion too, with the
+same IMPACT law mirrored), weighted by ``STEP(delta, -I_KF, 0, 0, 1)`` of that foot's
+penetration delta (so it holds through the heel strike of the other leg, as the rigid
+model's locked knee does, and releases as the foot rises) and by
+``STEP(ext, -I_KA, 0, -I_KA / 2, 1)`` of the knee's extension (a latch captures a knee only
+near straight: a bent knee whose foot touches down is not snapped straight).  A pinned
+stance foot (``rhs_pinned``) counts as on the ground.  The analytic Jacobian holds the
+weight constant (left out: its dependence on the foot's height; Newton directions only).
 
 Packed data vector of the compiled integrators (``_cyrk``, ``_lsoda``):
 ``[n1, n2, PC (NPC), p (NP), c1 (n1), c2 (n2), nfev]`` (``p`` the walker's parameter vector,
@@ -70,7 +75,7 @@ from walkerlab.models.description import Structure
 __all__ = ["ASSEMBLY", "NPC", "contact_module", "rhs_source"]
 
 #: Number of contact parameters (see the table above).
-NPC = 17
+NPC = 18
 
 ASSEMBLY = '''
 # ---------------------------------------------------------------- contact assembly
@@ -80,8 +85,8 @@ from walkerlab.contact._kernels import normal_force, friction_mu, in_patch, step
 
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
-I_KK, I_KE, I_KC, I_KD, I_KL, I_KF = 11, 12, 13, 14, 15, 16
-NPC = 17
+I_KK, I_KE, I_KC, I_KD, I_KL, I_KF, I_KA = 11, 12, 13, 14, 15, 16, 17
+NPC = 18
 NX = 2 * NQ
 D_N1, D_N2, D_PC = 0, 1, 2
 D_P = D_PC + NPC
@@ -144,22 +149,24 @@ def _foot(P, V, i, PC, cen):
 
 
 @njit(cache=True)
-def _latch_weight(fn, PC):
-    """Latch engagement in [0, 1] of a knee whose foot carries the normal force fn [N]."""
+def _latch_weight(delta, ext, PC):
+    """Latch engagement in [0, 1] of a knee at extension ext [rad] (< 0 flexed) whose foot
+    has the penetration delta [m] (< 0: above the ground)."""
     if PC[I_KL] < 0.5:
         return 0.0
-    return step(fn, 0.0, 0.0, PC[I_KF], 1.0)[0]
+    return (step(delta, -PC[I_KF], 0.0, 0.0, 1.0)[0]
+            * step(ext, -PC[I_KA], 0.0, -0.5 * PC[I_KA], 1.0)[0])
 
 
 @njit(cache=True)
-def _knee(x, k, PC, fn):
-    """Knee stop (and latch, its foot loaded with fn [N]) of knee k: (extension, rate,
-    torque, dT/dext, dT/drate)."""
+def _knee(x, k, PC, delta):
+    """Knee stop (and latch, its foot at penetration delta [m]) of knee k: (extension,
+    rate, torque, dT/dext, dT/drate)."""
     t, s = 2 + 2 * k, 3 + 2 * k
     ext = x[s] - x[t]
     rate = x[NQ + s] - x[NQ + t]
     if ext < 0.0:
-        w = _latch_weight(fn, PC)
+        w = _latch_weight(delta, ext, PC)
         if w <= 0.0:
             return ext, rate, 0.0, 0.0, 0.0
         T, dd, dr = normal_force(-ext, -rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])
@@ -194,7 +201,7 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
     if KNEE:
         for k in range(2):
             used = (k == 0 and use1) or (k == 1 and use2)
-            res = _knee(x, k, PC, info[k, 4] if used else np.inf)  # pinned foot: loaded
+            res = _knee(x, k, PC, info[k, 0] if used else np.inf)  # pinned: on the ground
             for j in range(5):
                 knees[k, j] = res[j]
             T = res[2]
@@ -220,11 +227,12 @@ def _foot_force(px, py, vx, vy, sp, cp, PC, cen):
 
 
 @njit(cache=True)
-def _knee_torque(ext, rate, PC, fn):
+def _knee_torque(ext, rate, PC, delta):
     """Knee-stop torque [N m] (>= 0 past straight) at hyperextension ``ext`` [rad], rate
-    [rad/s]; with the latch on and the leg's foot loaded with fn [N], also < 0 in flexion."""
+    [rad/s]; with the latch on and the leg's foot at penetration delta [m] (near or on the
+    ground), also < 0 in flexion."""
     if ext < 0.0:
-        w = _latch_weight(fn, PC)
+        w = _latch_weight(delta, ext, PC)
         if w <= 0.0:
             return 0.0
         return -w * normal_force(-ext, -rate, PC[I_KK], PC[I_KE], PC[I_KC], PC[I_KD])[0]
@@ -415,8 +423,8 @@ def knee_table(X, PC, p, c1, c2):
         for r in range(n):
             feet(X[r], p, P, V, J)
             for k in range(2):
-                fn = _foot(P, V, k, PC, c1 if k == 0 else c2)[4]
-                ext, rate, T, _, _ = _knee(X[r], k, PC, fn)
+                delta = _foot(P, V, k, PC, c1 if k == 0 else c2)[0]
+                ext, rate, T, _, _ = _knee(X[r], k, PC, delta)
                 out[r, k, 0] = ext
                 out[r, k, 1] = rate
                 out[r, k, 2] = T
@@ -513,9 +521,10 @@ def rhs_source(eq) -> str:
     if nq == 6:  # knees: (thigh, shank) = (2, 3), (4, 5)
         for k, (t, sh) in enumerate(((2, 3), (4, 5))):
             T = sp.Symbol(f"_T{k}", real=True)
-            fn = f"({Fs[2 * k]} * _sp + {Fs[2 * k + 1]} * _cp)"  # normal force of leg k's foot
+            # penetration of leg k's foot, -(p . n)
+            dl = f"-(({pr.doprint(red[4 * k])}) * _sp + ({pr.doprint(red[4 * k + 1])}) * _cp)"
             lines.append(f"    {T} = _knee_torque({eq.q[sh]} - {eq.q[t]}, "
-                         f"{eq.dq[sh]} - {eq.dq[t]}, PC, {fn})")
+                         f"{eq.dq[sh]} - {eq.dq[t]}, PC, {dl})")
             Q[t] += T
             Q[sh] -= T
     nz = {(i, j) for i in range(nq) for j in range(i + 1) if eq.M[i, j] != 0}

@@ -161,7 +161,8 @@ class ContactWalker:
         PC[mod.I_MUS], PC[mod.I_MUD], PC[mod.I_VS], PC[mod.I_VD] = c.mu_s, c.mu_d, c.v_s, c.v_d
         PC[mod.I_HW], PC[mod.I_CONT] = self.patch_half_width, 1.0 if self.continuous else 0.0
         PC[mod.I_KK], PC[mod.I_KE], PC[mod.I_KC], PC[mod.I_KD] = ks.k, ks.e, ks.cmax, ks.dmax
-        PC[mod.I_KL], PC[mod.I_KF] = (1.0 if ks.latch else 0.0), ks.latch_load
+        PC[mod.I_KL], PC[mod.I_KF] = (1.0 if ks.latch else 0.0), ks.latch_height
+        PC[mod.I_KA] = ks.latch_capture
         set_(self, "lane1", np.ascontiguousarray(self.lane1, dtype=float))
         set_(self, "lane2", np.ascontiguousarray(self.lane2, dtype=float))
         set_(self, "kernels", mod)
