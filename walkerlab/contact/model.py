@@ -327,7 +327,8 @@ class ContactWalker:
         """Contact points (n, 2, 2) [m] (foot, xy) for states X (n, 2 nq), or (2, 2) for one."""
         X = self._rows(X)
         pts = self.kernels.points(X.T, self.walker_params)
-        out = np.stack([np.stack([pts[f"{leg}_foot"][0], pts[f"{leg}_foot"][1]], axis=-1)
+        key = "contact" if self.structure.foot == "arc" else "foot"  # the arc's lowest point
+        out = np.stack([np.stack([pts[f"{leg}_{key}"][0], pts[f"{leg}_{key}"][1]], axis=-1)
                         for leg in FOOT_NAMES], axis=1)
         return out if len(out) > 1 else out[0]
 

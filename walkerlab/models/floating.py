@@ -115,6 +115,9 @@ class FloatingEquations:
         point there.
     kinetic, potential : Expr
     points : dict[str, Matrix (2, 1)]
+        Named as the rigid model's: ``hip``, ``<leg>_<body>``, ``<leg>_foot`` (end of the
+        leg axis), arc feet ``<leg>_foot_centre`` and ``<leg>_contact`` (lowest point),
+        kneed ``<leg>_knee``.
     """
 
     q: tuple
@@ -182,8 +185,11 @@ def derive_floating(structure: Structure) -> FloatingEquations:
         if arc:
             sel = sp.Matrix([[1 if k == lower else 0 for k in range(nq)]])
             feet.append((centre - R * n_vec, Jc + R * t_vec * sel))
+            # named as the rigid model's points: the arc's lowest point (contact) and the
+            # end of the leg axis (foot)
             points[f"{leg}_foot_centre"] = centre
-            points[f"{leg}_foot"] = centre - R * n_vec
+            points[f"{leg}_contact"] = centre - R * n_vec
+            points[f"{leg}_foot"] = centre + R * e(q[lower])
         else:
             feet.append((centre, Jc))
             points[f"{leg}_foot"] = centre
@@ -456,7 +462,8 @@ class FloatingView:
         return self._mod.energies(X, self.params)
 
     def points(self, X) -> dict:
-        """Named points (hip, each body, feet, knees) (2,) or (2, k) [m]."""
+        """Named points (hip, each body, feet, arc feet's centres and contact points, knees)
+        (2,) or (2, k) [m], named as the rigid model's."""
         return self._mod.points(X, self.params)
 
 
