@@ -67,6 +67,6 @@ def test_missing_file(tmp_path):
 
 
 def test_sections_not_used_are_absent():
-    """goswami1996 declares no contact sections: they stay None, not dummies."""
-    scene = load_scene(ROOT / "configs" / "goswami1996.yaml")
+    """schwab_wisse2001 declares no contact sections: they stay None, not dummies."""
+    scene = load_scene(ROOT / "configs" / "schwab_wisse2001.yaml")
     assert scene.contact is None and scene.terrain is None and scene.contact_sim is None

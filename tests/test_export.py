@@ -29,7 +29,6 @@ ROOT = Path(__file__).resolve().parents[1]
 #: Every shipped walker with masses (simplest.yaml and schwab_wisse2001.yaml: massless legs).
 SCENES = ("paper", "paper_rods", "kneed", "round_feet", "goswami1996")
 #: Compass-gait scenes the hand-written contact kernel describes.
-COMPASS = ("paper", "goswami1996")
 TOL = 1e-10
 N_STATES = 5
 
@@ -196,43 +195,7 @@ def test_reference_is_not_trivially_equal(tmp_path):
     assert np.abs(M - Mr).max() > 1e-4
 
 
-# ---- (a) the hand-written compass-gait contact kernel and its numpy reference.  When the
-# kernel's mechanics are deleted (issue 17 part 4), drop this block; reference.py stays.
-def _compass_kernel(scene):
-    K = pytest.importorskip("walkerlab.contact._kernels")
-    if not hasattr(K, "mass_matrix"):
-        pytest.skip("the hand-written compass kernel's mechanics are retired (issue 17 part 4)")
-    from walkerlab.contact.reference import mass_matrix_ref, rhs_ref
-
-    w = scene.walker
-    L, m, MH, a, g = (w.leg_length_m, w.leg_mass_kg, w.hip_mass_kg, w.leg_mass_from_foot_m,
-                      w.gravity_m_per_s2)
-    P = np.zeros(K.NPAR)
-    P[K.I_L], P[K.I_M], P[K.I_MH], P[K.I_B], P[K.I_G] = L, m, MH, L - a, g
-    P[K.I_PHI] = scene.slope.phi_rad
-
-    def kernel(q, dq):
-        M = K.mass_matrix(q[2], q[3], P)
-        # the numpy reference's free flight (hip raised 10 leg lengths: no contact force)
-        x = np.concatenate([[q[0], q[1] + 10 * L], q[2:], dq])
-        qdd = rhs_ref(x, L, m, MH, a, g, scene.slope.phi_rad, None, ([], []), 0.0, True)[4:]
-        Mr = mass_matrix_ref(q, L, m, MH, a)
-        assert np.abs(M - Mr).max() <= 1e-14 * np.abs(M).max()
-        return M, -Mr @ qdd
-
-    return kernel
-
-
-@pytest.mark.parametrize("name", COMPASS)
-def test_libraries_match_compass_kernel(name, tmp_path):
-    """Pinocchio and MuJoCo equal the hand-written floating compass gait
-    (``contact._kernels.mass_matrix``, bias from ``contact.reference.rhs_ref``)."""
-    scene = _scene(name)
-    for lib, (_, rel_m, _, rel_b) in agreement(name, tmp_path, _compass_kernel(scene)).items():
-        assert rel_m <= TOL and rel_b <= TOL, (lib, rel_m, rel_b)
-
-
-# ---- (b) the generated floating view (walkerlab.models.floating, issue 17 part 1)
+# ---- the generated floating view (walkerlab.models.floating, issue 17 part 1)
 @pytest.mark.parametrize("name", SCENES)
 def test_libraries_match_floating_view(name, tmp_path):
     """Pinocchio and MuJoCo equal the generated floating view: same coordinate names, mass

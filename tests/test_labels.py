@@ -234,6 +234,9 @@ def test_figures_in_paper_order(tmp_path, monkeypatch):
     md = "\n".join(figures_section(tmp_path, "figures", paths))
     pos = [md.index(f"figures/{s}.png") for s in stems[:6]]
     assert pos == sorted(pos)
+    # a figure drawn from an artifact the report leaves out is not shown
+    md = "\n".join(figures_section(tmp_path, "figures", {"simulate": paths["simulate"]}))
+    assert "figures/fig2_stick_ideal.png" in md and "fig6_stick_contact" not in md
 
 
 def _walker_trajectory(round_feet: bool = False, knee: bool = False) -> NamedTrajectory:

@@ -4,8 +4,10 @@ import sys
 from pathlib import Path
 
 _ROOT = str(Path(__file__).resolve().parents[2])
-if _ROOT not in sys.path:
-    sys.path.insert(0, _ROOT)
+_TESTS = str(Path(__file__).resolve().parents[1])  # tests/independent (reference walkers)
+for _p in (_ROOT, _TESTS):
+    if _p not in sys.path:
+        sys.path.insert(0, _p)
 
 # approx. ideal fixed point of the paper walker (leg1 swing, rad and rad/s) and its step
 # length [m]: starting states and patch placement of the contact tests

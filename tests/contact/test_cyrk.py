@@ -37,8 +37,8 @@ def test_cyrk_bdf_failure_is_finished_by_odeint(monkeypatch):
     real = _cyrk.solve_chunk
     nbdf = []
 
-    def stops_halfway(method, x, tg, *args):
-        X, ok, nf, _ = real(method, x, tg[: len(tg) // 2], *args)
+    def stops_halfway(method, x, tg, *args, **kw):
+        X, ok, nf, _ = real(method, x, tg[: len(tg) // 2], *args, **kw)
         nbdf.append(nf)
         return X, False, nf, "stopped (test)"
 

@@ -122,8 +122,10 @@ def test_drop_restitution_monotone_per_family_rigid_limit_near_plastic():
 
 
 def test_kernels_read_parameters_through_named_indices():
-    src = (PKG / "contact" / "_kernels.py").read_text()
-    assert not re.findall(r"\bP\[\d+\]", src), "bare P[number] in the contact kernels"
+    from walkerlab.contact.generated import ASSEMBLY
+
+    for src in ((PKG / "contact" / "_kernels.py").read_text(), ASSEMBLY):
+        assert not re.findall(r"\bPC?\[\d+\]", src), "bare P[number] in the contact kernels"
 
 
 def _imports(path):
@@ -159,10 +161,23 @@ def test_package_imports_point_down(package, never):
 
 
 def test_one_mass_matrix():
-    """msolve inverts exactly the matrix mass_matrix builds (both from mass_blocks)."""
-    from walkerlab.contact import _kernels as K
+    """The mass matrix the right-hand side solves with is the generated one, and equals the
+    independent numpy reference (written from the Lagrangian by hand)."""
+    from independent.contact_reference import mass_matrix_ref
 
     w = _walker()
-    M = K.mass_matrix(0.3, -0.2, w._P)
-    r = np.array([1.0, -2.0, 0.5, 0.25])
-    np.testing.assert_allclose(M @ K.msolve(0.3, -0.2, w._P, r), r, rtol=1e-12, atol=1e-12)
+    q = np.array([0.1, 1.2, 0.3, -0.2])
+    M = w.mass_matrix(q)
+    np.testing.assert_allclose(M, mass_matrix_ref(q, w.L, w.m, w.MH, w.a), rtol=1e-14,
+                               atol=1e-14)
+    x = np.concatenate([q, [0.2, -0.1, 0.7, -1.1]])  # feet in the air: no contact force
+    qdd = w.rhs(0.0, x)[4:]
+    np.testing.assert_allclose(qdd, _ref(w, x)[4:], rtol=1e-12, atol=1e-12)
+
+
+def _ref(w, x):
+    """The independent numpy right-hand side (tests/independent/contact_reference.py)."""
+    from independent.contact_reference import rhs_ref
+
+    return rhs_ref(np.asarray(x, float), w.L, w.m, w.MH, w.a, w.g, w.phi, w.contact,
+                   (w.lane1, w.lane2), w.patch_half_width, w.continuous)

@@ -25,18 +25,17 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
     dict
         ``scale`` (2,), ``objective``, ``evaluations``, ``grid_best`` (2,).
     """
-    from walkerlab.contact.scene import ideal_step_length, settings
+    from walkerlab.contact.scene import settings
 
     from .contact_sim import simulate_from
 
     n_strides = settings(scene)[2].n_strides
-    l_star = ideal_step_length(scene.walker.leg_length_m, x_fp)
     count = {"n": 0}
 
     def J(s):
         count["n"] += 1
         s = np.clip(np.asarray(s, float), 0.2, 5.0)
-        walker, res, _, _ = simulate_from(scene, x_fp, period, rate_scale=tuple(s))
+        walker, res, _, l_star = simulate_from(scene, x_fp, period, rate_scale=tuple(s))
         n_hs = len(res.heel_strike_times)
         want = 2 * n_strides
         if n_hs < want or res.termination in ("fall", "trip", "airborne"):

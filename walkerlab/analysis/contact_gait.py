@@ -237,9 +237,12 @@ def _crossings(t, pen, rate, on):
     return np.array(td), np.array(lo)
 
 
-def phase_slip(t, s, td, lo, ta, tb):
+def phase_slip(t, s, td, lo, ta, tb, v=None):
     """Slide [m] of a foot over its contact phases starting in [ta, tb): sum of s(lo) - s(td)
-    per phase; NaN if the last such phase has no lift-off."""
+    per phase (a point foot: its contact point is its material point), or, given the
+    material point's tangential velocity ``v`` (n,) [m/s], its integral over each phase (an
+    arc foot: the contact point also moves as the foot rolls, ``R dtheta``, which is not
+    slip); NaN if the last such phase has no lift-off."""
     total, any_phase = 0.0, False
     for tdj in td:
         if not (ta - 1e-12 <= tdj < tb):
@@ -248,7 +251,13 @@ def phase_slip(t, s, td, lo, ta, tb):
         nxt = lo[lo > tdj]
         if not nxt.size:
             return np.nan
-        total += float(np.interp(nxt[0], t, s) - np.interp(tdj, t, s))
+        if v is None:
+            total += float(np.interp(nxt[0], t, s) - np.interp(tdj, t, s))
+        else:
+            m = (t > tdj) & (t < nxt[0])
+            tt = np.concatenate([[tdj], t[m], [nxt[0]]])
+            vv = np.concatenate([[np.interp(tdj, t, v)], v[m], [np.interp(nxt[0], t, v)]])
+            total += float(np.trapezoid(vv, tt))
     return total if any_phase else np.nan
 
 
@@ -326,6 +335,7 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
     """
     feet = _foot_traces(walker, t, X)
     hs_t, hs_leg, bounces, scuffs = _heel_strikes(t, feet, min_step_m, initial_stance)
+    rolling = getattr(getattr(walker, "structure", None), "foot", "point") == "arc"
     names = list(feet)
     starts = [t[0]] + hs_t
     legs = [initial_stance] + hs_leg
@@ -345,7 +355,8 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
         td = ft.touchdown_times
         if j == 0 and (not td.size or td[0] > t[0]) and loaded[leg][0]:
             td = np.concatenate([[t[0]], td])
-        slip = phase_slip(t, ft.s, td, ft.liftoff_times, ta, t_next)
+        slip = phase_slip(t, ft.s, td, ft.liftoff_times, ta, t_next,
+                          ft.slip_velocity if rolling else None)
         lo_mine = ft.liftoff_times[(ft.liftoff_times > ta) & (ft.liftoff_times < t_next)]
         sel = (t >= ta) & (t <= tb_or_end)
         creep = 0.0

@@ -77,7 +77,6 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
-from walkerlab.contact.compiled import foot_state
 from walkerlab.contact.model import ContactWalker
 from walkerlab.integrate.contact import StateIndex
 
@@ -156,7 +155,7 @@ class ContactPeriodicGait:
 
 class PeriodicGaitError(RuntimeError):
     """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
-    "time_limit", "solver_failure"."""
+    "time_limit", "solver_failure", "unsupported" (kneed walker: no section)."""
 
     def __init__(self, kind: str, message: str):
         super().__init__(message)
@@ -195,6 +194,13 @@ class StepMap:
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
         w = self.walker
+        if w.structure.knee:
+            raise PeriodicGaitError("unsupported", "contact periodic gait: the mid-stance "
+                                    "section is defined for straight legs only")
+        kern = w.kernels
+        args = (w.contact_params, w.walker_params, w.lane1, w.lane2)
+        self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
+        self._fj = lambda x: kern.jac(x, *args)  # noqa: E731
         self.n, self.t = w.normal, w.tangent
         self.idx = StateIndex(w)
         # leg i's angle and rate by name (leg1 = 0, leg2 = 1), never by row
@@ -205,22 +211,17 @@ class StepMap:
     def to_state(self, z) -> np.ndarray:
         """Full state (8,) from section coordinates (leg2 stance, stance foot at s = 0)."""
         th, wsw, wst, d, vt, dd = np.asarray(z, float)
-        L = self.walker.L
         p = -d * self.n
         v = vt * self.t - dd * self.n
-        hip = p - L * np.array([np.sin(th), -np.cos(th)])
-        vh = v - L * np.array([np.cos(th), np.sin(th)]) * wst
+        # stance foot at p and at rest, then the whole walker translated at v
         ix = self.idx
-        x = np.empty(ix.n)
-        x[[ix["hip_x"], ix["hip_y"]]] = hip
-        x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] = vh
-        x[self._angle] = th
-        x[self._rate] = (wsw, wst)
+        x = self.walker.pinned_to_full(np.array([th, th, wsw, wst]), p)
+        x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] += v
         return x
 
     def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
         """Section coordinates (6,) and along-slope position s [m] of foot ``stance`` (0/1)."""
-        px, py, vx, vy = foot_state(x, stance, self.walker)
+        px, py, vx, vy = self.walker.foot_state(np.asarray(x, float), stance)
         p, v = np.array([px, py]), np.array([vx, vy])
         sw = 1 - stance
         z = np.array([x[self._angle[stance]], x[self._rate[sw]], x[self._rate[stance]],
@@ -232,10 +233,10 @@ class StepMap:
         if time.perf_counter() > self.deadline:
             raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
                                     "reached")
-        return self.walker.rhs(t, x)
+        return self._f(x)
 
     def _jac(self, t, x):
-        return self.walker.jac(t, x)
+        return self._fj(x)
 
     def integrate(self, x0, stance_to_come: int = 0, dense: bool = False):
         """Integrate from ``x0`` to the next upward zero of theta_sw - theta_st where the
@@ -275,7 +276,13 @@ class StepMap:
 
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
         hth = 0.5 * self.walker.L
-        f, jf = self.walker.rhs, self.walker.jac
+        frhs, fjac = self._f, self._fj
+
+        def f(t, x):
+            return frhs(x)
+
+        def jf(t, x):
+            return fjac(x)
 
         def run(x, tg):
             with warnings.catch_warnings():  # the message is checked below
@@ -350,7 +357,8 @@ class StepMap:
             x0 = self.to_state(z)
             te = self._step_odeint(x0)[0]
             tt = np.linspace(0.0, te, 2001)
-            X = odeint(self.walker.rhs, x0, tt, Dfun=self.walker.jac, tfirst=True,
+            X = odeint(lambda t, x: self._f(x), x0, tt,
+                       Dfun=lambda t, x: self._fj(x), tfirst=True,
                        rtol=self.rtol, atol=self.atol, mxstep=500000)
         else:
             sol = self.integrate(self.to_state(z), dense=True)
@@ -376,20 +384,17 @@ SCALES = np.array([1.0, 1.0, 1.0, 6e-5, 1e-3, 1e-3])
 
 
 def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
-    """Section state from an ideal-model post-impact state ``[th_sw, th_st, w_sw, w_st]``.
+    """Section state from an ideal-model post-impact state (the rigid walkers
+    ``state_names()`` order, e.g. ``[th_sw, th_st, w_sw, w_st]``).
 
     The ideal state is placed as :func:`initial_state_from_ideal` does (stance foot leg2 at
     its static penetration, ``rate_scale`` on the rates) and integrated to the first
     mid-stance of leg2, where the section coordinates are read.
     """
     from walkerlab.analysis.contact_sim import initial_state_from_ideal
-    from walkerlab.contact.scene import IDEAL_ROLES
 
     w = step_map.walker
-    ideal = dict(zip(IDEAL_ROLES, np.asarray(x_ideal, float)))
-    x0 = initial_state_from_ideal(w, ideal["swing_angle"], ideal["stance_angle"],
-                                  ideal["swing_rate"], ideal["stance_rate"],
-                                  rate_scale=rate_scale)
+    x0 = initial_state_from_ideal(w, *np.asarray(x_ideal, float), rate_scale=rate_scale)
     sol = step_map.integrate(x0, stance_to_come=1)
     if sol.status != 1 or sol.t_events[0].size == 0:
         raise PeriodicGaitError("fall" if sol.t_events[1].size else "no_mid_stance",

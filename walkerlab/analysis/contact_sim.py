@@ -17,7 +17,7 @@ import numpy as np
 
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSolverSettings
-from walkerlab.contact.scene import IDEAL_ROLES, build, settings
+from walkerlab.contact.scene import build, settings
 from walkerlab.integrate.contact import ContactLimits, StateIndex, integrate_contact
 
 from .contact_gait import ContactResult, classify, gait_events, heel_strike_count
@@ -30,33 +30,30 @@ __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajecto
 AIRBORNE_HEIGHT_FACTOR = 1.5
 
 
-def initial_state_from_ideal(walker, theta1, theta2, dtheta1, dtheta2,
-                             rate_scale=(1.0, 1.0)) -> np.ndarray:
-    """Floating-walker state from an ideal-model state (leg2 = stance).
+def initial_state_from_ideal(walker, *x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
+    """Floating-walker state from an ideal-model state (leg1 = swing, leg2 = stance).
 
     The stance foot (leg2) is placed at s = 0 at its static penetration
-    ``(M g cos phi / k)^(1/e)`` [m] (along -n); the hip velocity follows from the pinned-foot
-    kinematics (``walker.pinned_to_full``).  ``rate_scale`` multiplies (dtheta1, dtheta2)
-    first.
+    ``(M g cos phi / k)^(1/e)`` [m] (along -n) and held at rest there: the hip follows from
+    the stance leg's links (``walker.pinned_to_full``).  ``rate_scale`` multiplies leg1's
+    and leg2's rates first.
 
     Parameters
     ----------
-    theta1, theta2 : float
-        Swing / stance leg angles [rad].
-    dtheta1, dtheta2 : float
-        Their rates [rad/s].
+    *x_ideal : float
+        The rigid model's state in the order of its ``state_names()``, e.g. ``theta1,
+        theta2, dtheta1, dtheta2`` (swing / stance leg angles [rad] and rates [rad/s]) for
+        the compass gait (``walker.link_state_from_ideal``).
     rate_scale : (float, float)
-        Multipliers [-].
+        Multipliers [-] on leg1's (swing) and leg2's (stance) rates.
 
     Returns
     -------
     ndarray (N,)
         Named by ``walker.state_names()``.
     """
-    w1 = dtheta1 * rate_scale[0]
-    w2 = dtheta2 * rate_scale[1]
     foot2 = -walker.static_penetration() * walker.normal
-    z = np.array([theta1, theta2, w1, w2], float)
+    z = walker.link_state_from_ideal(np.asarray(x_ideal, float).ravel(), rate_scale)
     return walker.pinned_to_full(z, foot2)
 
 
@@ -138,9 +135,9 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
 
     Parameters
     ----------
-    x_ideal : ndarray (4,)
-        Ideal post-impact state, named by :data:`walkerlab.contact.scene.IDEAL_ROLES`
-        (leg2 = stance) [rad, rad/s].
+    x_ideal : ndarray (n,)
+        Ideal post-impact state in the rigid walker's ``state_names()`` order (leg1 = swing,
+        leg2 = stance) [rad, rad/s].
     period : float
         Ideal step period [s] (sets the default simulated time).
     rate_scale : (float, float), optional
@@ -161,10 +158,7 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
     n_strides = strides or cs.n_strides
     walker, step_length = build(scene, x_ideal, 2 * n_strides)
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
-    ideal = dict(zip(IDEAL_ROLES, np.asarray(x_ideal, float)))
-    x0 = initial_state_from_ideal(walker, ideal["swing_angle"], ideal["stance_angle"],
-                                  ideal["swing_rate"], ideal["stance_rate"],
-                                  rate_scale=tuple(scale))
+    x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
     t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
     limits = ContactLimits(
         sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,
@@ -177,31 +171,29 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
 
 
 def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
-    """State name -> name in the shared trajectory layout (``<leg>_angle``, ``<leg>_rate``,
-    ...) for every leg coordinate of the walker (the hip position and velocity are points).
-
-    A state already named after a leg keeps its name; the compass walker's ``theta<i>`` /
-    ``dtheta<i>`` become ``<leg i>_angle`` / ``<leg i>_rate``.
+    """State name -> name in the shared trajectory layout for every leg coordinate of the
+    walker (the hip position and velocity are points): the floating coordinate's name
+    (``<leg>_angle``, kneed ``<leg>_thigh_angle``, ``<leg>_shank_angle``; the same names as
+    the rigid walker's ``leg_coordinates``) and ``..._rate`` for its rate.
     """
     idx = StateIndex(walker)
+    n = idx.coordinates.stop
     out = {}
-    for i in range(idx.coordinates.start, idx.coordinates.stop):
-        name = idx.names[i]
-        if name in ("hip_x", "hip_y"):
+    for i, coord in enumerate(walker.coordinate_names()):
+        if coord in ("hip_x", "hip_y"):
             continue
-        if name.startswith("theta") and name[5:].isdigit():
-            new = f"{legs[int(name[5:]) - 1]}_angle"
-        else:
-            new = name
-        out[name] = new
-        rate = idx.names[idx.rate_of(name)]
-        out[rate] = new[:-len("_angle")] + "_rate" if new.endswith("_angle") else f"{new}_rate"
+        leg = coord.split("_", 1)[0]
+        new = coord if leg not in ("leg1", "leg2") else legs[int(leg[-1]) - 1] + coord[4:]
+        out[idx.names[i]] = new
+        out[idx.names[n + i]] = new.removesuffix("_angle") + "_rate"
     return out
 
 
 def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
     """A :class:`ContactResult` in the shared named layout of
-    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes)."""
+    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes;
+    coordinates by :func:`trajectory_names`, points from the generated floating view: hip,
+    each body ``<leg>_<body>``, feet, knees)."""
     from walkerlab.io.trajectory import NamedTrajectory
 
     legs = list(legs)
@@ -214,16 +206,8 @@ def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
         step[m] = k + 1
     X = res.x
     en = walker.energies(X)
-    feet = np.asarray(walker.foot_positions(X)).reshape(len(X), -1, 2)  # (n, foot, xy)
-    hip = np.vstack([res.column("hip_x"), res.column("hip_y")])
-    pts = {"hip": hip}
+    pts = {k: np.asarray(v, float).reshape(2, -1) for k, v in walker.points(X).items()}
     names = trajectory_names(walker, legs)
-    for i, leg in enumerate(legs):
-        pts[f"{leg}_foot"] = feet[:, i, :].T
-        angle = next((s for s, n in names.items() if n == f"{leg}_angle"), None)
-        if angle is not None and hasattr(walker, "b"):
-            th = res.column(angle)
-            pts[f"{leg}_mass"] = hip + walker.b * np.vstack([np.sin(th), -np.cos(th)])
     units = dict(zip(walker.state_names(), walker.state_units()))
     coords = {new: res.column(old) for old, new in names.items()}
     return NamedTrajectory(

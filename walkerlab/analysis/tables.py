@@ -27,7 +27,9 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
 
     Steps are delimited by changes of ``stance_leg`` (the last sample closes the last step);
     a *left step* is a step in which the left leg (``legs[0]`` unless given) swings.  Only
-    complete steps (followed by another step) count.  ``v_com`` is the hip's horizontal
+    complete steps count: the last step only if it lasts at least 90 % of the median of the
+    others (a rigid run ends at its last heel strike; a contact run at its end time, within
+    a step, whose length and duration are not a step's).  ``v_com`` is the hip's horizontal
     displacement over whole cycles divided by their duration (over a periodic cycle the
     centre of mass and the hip advance alike).
     ``E_avg`` is the time average of KE + PE over the first ``n_energy_steps`` steps with PE
@@ -47,8 +49,11 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     t_b = tr.time[bounds]
     periods = np.diff(t_b)
     stance = tr.stance_leg[bounds[:-1]]
-    left_steps = periods[stance != li]  # left leg swings when it is not in stance
-    right_steps = periods[stance == li]
+    done = np.ones(periods.size, dtype=bool)
+    if periods.size > 1 and periods[-1] < 0.9 * np.median(periods[:-1]):
+        done[-1] = False  # the run ended within this step
+    left_steps = periods[(stance != li) & done]  # left leg swings when it is not in stance
+    right_steps = periods[(stance == li) & done]
     hip = tr.points.get("hip")
     out = {"n_steps": int(periods.size)}
     out["t_left_s"] = float(np.mean(left_steps)) if left_steps.size else np.nan
@@ -61,7 +66,7 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
         feet = [tr.points.get(f"{leg}_foot") for leg in tr.legs]
         if all(f is not None for f in feet):
             lengths = []
-            for k in range(1, periods.size + 1):
+            for k in range(1, int(done.sum()) + 1):
                 i = bounds[k] - 1 if k < len(bounds) - 1 else bounds[k]
                 d = feet[0][:, i] - feet[1][:, i]
                 lengths.append(np.hypot(*d))

@@ -17,7 +17,8 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 __all__ = ["MAX_CONTACT_STRIDES", "ContactParamsSI", "ContactSettings", "ContactSimSettings",
-           "ContactSolverSettings", "TerrainSettings", "family_scaling"]
+           "ContactSolverSettings", "KneeStopSI", "KneeStopSettings", "TerrainSettings",
+           "family_scaling"]
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,37 @@ class ContactParamsSI:
     mu_d: float
     v_s: float
     v_d: float
+
+
+@dataclass(frozen=True)
+class KneeStopSI:
+    """Knee-stop parameters in SI (the IMPACT law on the knee's hyperextension angle).
+
+    Attributes
+    ----------
+    k : float
+        Stiffness ``[N m/rad**e]``.
+    e : float
+        Exponent ``[-]``.
+    cmax : float
+        Maximum damping ``[N m s/rad]``.
+    dmax : float
+        Hyperextension at full damping ``[rad]``.
+    latch : bool
+        The stop also holds a loaded leg's knee against flexion (knee latch).
+    latch_height : float
+        Height of the foot above the ground at which the latch has released ``[m]``.
+    latch_capture : float
+        Flexion beyond which the latch does not hold ``[rad]``.
+    """
+
+    k: float
+    e: float
+    cmax: float
+    dmax: float
+    latch: bool = False
+    latch_height: float = 0.002
+    latch_capture: float = 0.01
 
 
 # Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
@@ -85,6 +117,57 @@ def family_scaling(cmax: float, dmax: float, e: float, kappa: float) -> tuple[fl
 def _len_factor(unit_system: str) -> float:
     """Metres per length unit of ``unit_system``."""
     return {"mm-kg-s": 1e-3, "SI": 1.0}[unit_system]
+
+
+class KneeStopSettings(BaseModel):
+    """The knee's stop (straight leg) as a one-sided compliant rotational contact: the IMPACT
+    law of the feet applied to the hyperextension angle ``shank - thigh`` (> 0 past
+    straight), torque ``k ext^e + STEP(ext, 0, 0, dmax, cmax) ext'`` pushing the knee back
+    (MSC ADAMS models joint stops this way).  Used by kneed walkers only; SI units.
+
+    Defaults (chosen on the walker of ``configs/kneed.yaml``, Hsu Chen 2007, standing on one
+    leg): the stop holds the knee within ~5e-6 rad of straight under ~0.05 N m; full damping
+    is reached at 1e-5 rad so the stop is overdamped from the first micro-radians (stiffness
+    there ~1.5 k sqrt(delta) ~ 5e2 N m/rad against ~0.3 kg m^2 above the knee: critical
+    damping ~25 N m s/rad < 200) and a knee strike is nearly plastic, like the rigid model's.
+    A less damped stop rebounds, and a free knee that rebounds into flexion under load buckles.
+    """
+
+    model_config = _STRICT
+
+    stiffness_N_m_per_rad: float = Field(
+        1e5, gt=0, le=1e12, description="Stop stiffness k [N m/rad^e].",
+        json_schema_extra={"unit": "N m/rad^e"})
+    exponent: float = Field(1.5, ge=1.0, le=10.0, description="Stop force exponent e [-].",
+                            json_schema_extra={"unit": "-"})
+    max_damping_N_m_s_per_rad: float = Field(
+        200.0, ge=0, description="Stop maximum damping cmax [N m s/rad].",
+        json_schema_extra={"unit": "N m s/rad"})
+    penetration_at_max_damping_rad: float = Field(
+        1e-5, gt=0, description="Hyperextension dmax at which full damping is reached [rad].",
+        json_schema_extra={"unit": "rad"})
+
+    latch: bool = Field(
+        False, description="Knee latch: while a leg's foot is on the ground the stop also "
+        "acts in flexion (the same law mirrored), so the stance knee is held straight both "
+        "ways, as the suction cups / magnets of real kneed passive walkers (McGeer 1990; "
+        "Cornell) and the rigid model's locked knee do; it holds through the other leg's "
+        "heel strike and releases as its foot rises above latch_release_height_m.")
+    latch_release_height_m: float = Field(
+        0.002, gt=0, le=0.1, description="Height of the foot above the ground at which its "
+        "knee's latch has released (engagement STEP(penetration, -h, 0, 0, 1)) [m].",
+        json_schema_extra={"unit": "m"})
+    latch_capture_rad: float = Field(
+        0.01, gt=0, le=0.5, description="Flexion within which the latch captures the knee "
+        "(full hold within half of it) [rad]: a knee bent farther when its foot touches down "
+        "is not snapped straight.", json_schema_extra={"unit": "rad"})
+
+    def to_si(self) -> KneeStopSI:
+        """The same numbers as a :class:`KneeStopSI`."""
+        return KneeStopSI(self.stiffness_N_m_per_rad, self.exponent,
+                          self.max_damping_N_m_s_per_rad, self.penetration_at_max_damping_rad,
+                          self.latch, self.latch_release_height_m,
+                          self.latch_capture_rad)
 
 
 class ContactSettings(BaseModel):
@@ -139,6 +222,10 @@ class ContactSettings(BaseModel):
         1e5, gt=0, description="Stiffness at which max_damping and penetration_at_max_damping "
         "hold in the 'rigid_limit' family (paper: 1e5 N/mm^2.2).",
         json_schema_extra={"unit": "N/<len>^e"})
+    knee_stop: KneeStopSettings = Field(
+        default_factory=KneeStopSettings, description="Knee stops of a kneed walker (SI, "
+        "unit_system does not apply): stiffness_N_m_per_rad, exponent, "
+        "max_damping_N_m_s_per_rad, penetration_at_max_damping_rad.")
 
     @model_validator(mode="after")
     def _check_relations(self) -> ContactSettings:

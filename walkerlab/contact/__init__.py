@@ -1,7 +1,8 @@
-"""The compliant-contact (MSC ADAMS-style) walker model: contact laws, geometry, terrain and
-the floating walker.  Only the model: integrating it is :mod:`walkerlab.integrate.contact`,
-reading its gait :mod:`walkerlab.analysis.contact_gait` / :mod:`walkerlab.analysis.contact_sim`,
-its settings live in :mod:`walkerlab.config.contact`.
+"""The compliant-contact (MSC ADAMS-style) walker model of any walker description with positive
+leg masses (generated from its floating view, :mod:`walkerlab.models.floating`): contact laws,
+geometry, terrain, knee stops and the floating walker.  Only the model: integrating it is
+:mod:`walkerlab.integrate.contact`, reading its gait :mod:`walkerlab.analysis.contact_gait` /
+:mod:`walkerlab.analysis.contact_sim`, its settings live in :mod:`walkerlab.config.contact`.
 
 The names below are loaded on first use (PEP 562 ``__getattr__``), so importing a settings
 or law module does not load numba, which the model needs.
@@ -12,7 +13,7 @@ from importlib import import_module
 _WHERE = {
     # the model's settings (defined in walkerlab.config.contact), as the model reads them
     "ContactParamsSI": "config", "ContactSettings": "config", "ContactSimSettings": "config",
-    "TerrainSettings": "config",
+    "KneeStopSI": "config", "KneeStopSettings": "config", "TerrainSettings": "config",
     "adams_step": "laws", "adams_step_derivative": "laws",
     "coulomb_friction_coefficient": "laws", "impact_normal_force": "laws",
     "FOOT_NAMES": "model", "ContactWalker": "model", "checkerboard_lanes": "model",

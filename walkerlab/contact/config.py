@@ -10,6 +10,8 @@ from walkerlab.config.contact import (  # noqa: F401
     ContactSettings,
     ContactSimSettings,
     ContactSolverSettings,
+    KneeStopSettings,
+    KneeStopSI,
     TerrainSettings,
     family_scaling,
 )

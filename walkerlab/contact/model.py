@@ -1,9 +1,32 @@
-"""Floating compass-gait walker with compliant ADAMS-style feet (:class:`ContactWalker`).
+"""Floating walker with compliant ADAMS-style feet (:class:`ContactWalker`), for any walker
+with positive leg masses (compass gait, rods, knees, arc feet).
 
-Conventions (shared with the rigid model): x downhill, y up, gravity (0, -g); ground line
-y = -x tan(phi), outward normal n = (sin phi, cos phi), down-slope tangent
-t = (cos phi, -sin phi).  foot_i = hip + L (sin th_i, -cos th_i); leg mass i at distance
-b = L - a from the hip.  q = [hip_x, hip_y, theta1, theta2] [m, m, rad, rad], x = [q, qdot].
+Conventions (shared with the rigid model, :mod:`walkerlab.models.floating`): x downhill, y up,
+gravity (0, -g); ground line y = -x tan(phi), outward normal n = (sin phi, cos phi),
+down-slope tangent t = (cos phi, -sin phi).  The mechanics (mass matrix, bias, contact points,
+Jacobians) are generated from the walker description; the contact forces use the laws of
+:mod:`walkerlab.contact.laws` (numba twins in :mod:`walkerlab.contact._kernels`); the knees
+of a kneed walker are free, each held by a compliant stop
+(:class:`~walkerlab.contact.config.KneeStopSettings`).
+
+State names
+-----------
+``x = [q, dq]``.  The floating coordinates are named by
+:func:`walkerlab.models.floating.coordinate_names` (``hip_x``, ``hip_y``, ``leg1_angle``, ...);
+the contact model keeps its established state vocabulary, mapped one to one
+(:data:`STATE_OF_COORDINATE`):
+
+============================  ===========================  ==========================
+coordinate                    state                        rate state
+============================  ===========================  ==========================
+``hip_x``, ``hip_y``          ``hip_x``, ``hip_y``         ``vhip_x``, ``vhip_y``
+``leg{i}_angle``              ``theta{i}``                 ``dtheta{i}``
+``leg{i}_thigh_angle``        ``theta{i}_thigh``           ``dtheta{i}_thigh``
+``leg{i}_shank_angle``        ``theta{i}_shank``           ``dtheta{i}_shank``
+============================  ===========================  ==========================
+
+so the paper walker's states are unchanged: ``[hip_x, hip_y, theta1, theta2, vhip_x, vhip_y,
+dtheta1, dtheta2]``.
 """
 
 from __future__ import annotations
@@ -12,13 +35,29 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _kernels as K
-from .config import ContactParamsSI, ContactSettings, TerrainSettings
-from .reference import rhs_ref
+from .config import ContactParamsSI, ContactSettings, KneeStopSettings, KneeStopSI, TerrainSettings
 
-__all__ = ["FOOT_NAMES", "ContactWalker", "checkerboard_lanes"]
+__all__ = ["FOOT_NAMES", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
+           "compass_gait_data", "state_name"]
 
 FOOT_NAMES = ("leg1", "leg2")
+
+
+def state_name(coordinate: str, rate: bool = False) -> str:
+    """State name of a floating coordinate (module docstring's table)."""
+    if coordinate in ("hip_x", "hip_y"):
+        return ("v" if rate else "") + coordinate
+    leg, rest = coordinate.split("_", 1)
+    i = leg[-1]
+    link = rest[:-len("_angle")]
+    base = f"theta{i}" + ("" if link == "" else f"_{link}")
+    return ("d" if rate else "") + base
+
+
+#: Floating coordinate name -> state name (angle), e.g. ``leg1_angle -> theta1``.
+STATE_OF_COORDINATE = {c: state_name(c) for c in
+                       ("hip_x", "hip_y", "leg1_angle", "leg2_angle", "leg1_thigh_angle",
+                        "leg1_shank_angle", "leg2_thigh_angle", "leg2_shank_angle")}
 
 
 def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np.ndarray]:
@@ -38,25 +77,46 @@ def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np
     return c1, c2
 
 
+def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
+    """:class:`~walkerlab.models.description.WalkerData` of the paper's compass gait (Table 1):
+    leg length L [m], leg mass m [kg] at ``a`` [m] from the foot, hip mass MH [kg]."""
+    from walkerlab.models.derivation import compass_gait_structure
+    from walkerlab.models.description import WalkerData
+
+    st = compass_gait_structure()
+    vals = {"g": g, "L": L, "gamma": phi, "M_hip": MH, "m_mass": m, "d_mass": L - a}
+    return WalkerData(st, tuple(float(vals[n]) for n in st.param_names), MH + 2 * m, L, g, phi,
+                      {"leg_mass_kg": m, "hip_mass_kg": MH, "leg_mass_from_foot_m": a})
+
+
 @dataclass(frozen=True, eq=False)
 class ContactWalker:
-    """Walker parameters, slope, SI contact parameters and terrain.
+    """A walker, slope, SI contact parameters and terrain.
 
     Attributes
     ----------
-    L, m, MH, a, g : float
-        Leg length [m], leg mass [kg], hip mass [kg], foot-to-leg-mass distance [m],
-        gravity [m/s^2].
-    phi : float
-        Slope [rad], > 0 downhill in +x.
+    L, m, MH, a, g, phi : float
+        The paper compass gait's shorthand (leg length [m], leg mass [kg], hip mass [kg],
+        foot-to-leg-mass distance [m], gravity [m/s^2], slope [rad]), used only when ``data``
+        is None.  With ``data`` they are set from it (``L``, ``g``, ``phi``; ``m``, ``MH``,
+        ``a`` NaN unless the walker is a compass gait).
     contact : ContactParamsSI
-        IMPACT and friction parameters in SI.
+        IMPACT and friction parameters of the feet in SI.
     lane1, lane2 : ndarray
         Patch centres [m] of leg1's / leg2's lane (ignored if ``continuous``).
     patch_half_width : float
         Half width of each patch [m].
     continuous : bool
         Ground everywhere (no lanes/gaps).
+    data : WalkerData, optional
+        Any walker description (:func:`walkerlab.models.description.walker_data`).
+    knee_stop : KneeStopSI, optional
+        Knee-stop law (kneed walkers; default :class:`KneeStopSettings` ()).
+
+    Raises
+    ------
+    ValueError
+        A body of the walker has mass 0 (a floating (contact) model needs positive leg masses).
     """
 
     L: float = 1.0
@@ -70,39 +130,73 @@ class ContactWalker:
     lane2: np.ndarray = field(default_factory=lambda: np.zeros(0))
     patch_half_width: float = 0.05
     continuous: bool = True
+    data: object = None
+    knee_stop: KneeStopSI | None = None
 
     def __post_init__(self):
-        c = self.contact
-        P = np.empty(K.NPAR)
-        P[K.I_L], P[K.I_M], P[K.I_MH], P[K.I_B], P[K.I_G], P[K.I_PHI] = (
-            self.L, self.m, self.MH, self.L - self.a, self.g, self.phi)
-        P[K.I_K], P[K.I_E], P[K.I_CMAX], P[K.I_DMAX] = c.k, c.e, c.cmax, c.dmax
-        P[K.I_MUS], P[K.I_MUD], P[K.I_VS], P[K.I_VD] = c.mu_s, c.mu_d, c.v_s, c.v_d
-        P[K.I_HW], P[K.I_CONT] = self.patch_half_width, 1.0 if self.continuous else 0.0
-        object.__setattr__(self, "lane1", np.ascontiguousarray(self.lane1, dtype=float))
-        object.__setattr__(self, "lane2", np.ascontiguousarray(self.lane2, dtype=float))
-        object.__setattr__(self, "_P", P)
+        from walkerlab.models.floating import check_masses, coordinate_names
+
+        from .generated import NPC, contact_module
+
+        set_ = object.__setattr__
+        if self.data is None:
+            set_(self, "data", compass_gait_data(self.L, self.m, self.MH, self.a, self.g,
+                                                 self.phi))
+        d = self.data
+        check_masses(d.structure)
+        set_(self, "L", float(d.leg_length_m))
+        set_(self, "g", float(d.gravity_m_per_s2))
+        set_(self, "phi", float(d.slope_rad))
+        ex = d.extra or {}
+        for name, key in (("m", "leg_mass_kg"), ("MH", "hip_mass_kg"),
+                          ("a", "leg_mass_from_foot_m")):
+            set_(self, name, float(ex.get(key, np.nan)))
+        if self.knee_stop is None:
+            set_(self, "knee_stop", KneeStopSettings().to_si())
+        c, ks = self.contact, self.knee_stop
+        mod = contact_module(d.structure)
+        PC = np.empty(NPC)
+        PC[mod.I_PHI] = self.phi
+        PC[mod.I_K], PC[mod.I_E], PC[mod.I_CMAX], PC[mod.I_DMAX] = c.k, c.e, c.cmax, c.dmax
+        PC[mod.I_MUS], PC[mod.I_MUD], PC[mod.I_VS], PC[mod.I_VD] = c.mu_s, c.mu_d, c.v_s, c.v_d
+        PC[mod.I_HW], PC[mod.I_CONT] = self.patch_half_width, 1.0 if self.continuous else 0.0
+        PC[mod.I_KK], PC[mod.I_KE], PC[mod.I_KC], PC[mod.I_KD] = ks.k, ks.e, ks.cmax, ks.dmax
+        PC[mod.I_KL], PC[mod.I_KF] = (1.0 if ks.latch else 0.0), ks.latch_height
+        PC[mod.I_KA] = ks.latch_capture
+        set_(self, "lane1", np.ascontiguousarray(self.lane1, dtype=float))
+        set_(self, "lane2", np.ascontiguousarray(self.lane2, dtype=float))
+        set_(self, "kernels", mod)
+        set_(self, "contact_params", PC)
+        set_(self, "walker_params", np.asarray(d.params, dtype=float))
+        set_(self, "_coords", coordinate_names(d.structure))
 
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_settings(cls, contact: ContactSettings, terrain: TerrainSettings, *,
                       step_length: float, n_steps: int, L=1.0, m=5.0, MH=10.0, a=0.5,
-                      g=9.81, phi=0.0174) -> ContactWalker:
-        """Build from validated settings; ``step_length`` [m] is the ideal gait's step length."""
+                      g=9.81, phi=0.0174, data=None) -> ContactWalker:
+        """Build from validated settings; ``step_length`` [m] is the ideal gait's step length
+        (patch spacing).  ``data`` (a WalkerData) replaces the compass-gait shorthand."""
         c1, c2 = checkerboard_lanes(step_length, n_steps)
         return cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=contact.to_si(), lane1=c1,
                    lane2=c2, patch_half_width=0.5 * terrain.patch_width_m,
-                   continuous=terrain.kind == "continuous")
+                   continuous=terrain.kind == "continuous", data=data,
+                   knee_stop=contact.knee_stop.to_si())
+
+    @property
+    def structure(self):
+        """The walker's :class:`~walkerlab.models.description.Structure`."""
+        return self.data.structure
 
     @property
     def b(self) -> float:
-        """Hip to leg-mass distance [m]."""
+        """Hip to leg-mass distance [m] (compass gait only; NaN otherwise)."""
         return self.L - self.a
 
     @property
     def total_mass(self) -> float:
-        """MH + 2 m [kg]."""
-        return self.MH + 2.0 * self.m
+        """Total mass [kg]."""
+        return float(self.data.total_mass_kg)
 
     @property
     def normal(self) -> np.ndarray:
@@ -121,98 +215,182 @@ class ContactWalker:
         return (load / self.contact.k) ** (1.0 / self.contact.e)
 
     # ------------------------------------------------------------------ state layout
-    @staticmethod
-    def state_names() -> tuple[str, ...]:
-        """Names of the 8 states, in order (leg i's angle ``theta{i}`` from the vertical)."""
-        return ("hip_x", "hip_y", "theta1", "theta2", "vhip_x", "vhip_y", "dtheta1", "dtheta2")
+    @property
+    def nq(self) -> int:
+        """Number of generalised coordinates."""
+        return len(self._coords)
 
-    @staticmethod
-    def state_units() -> tuple[str, ...]:
+    def coordinate_names(self) -> tuple[str, ...]:
+        """Floating coordinates (:func:`walkerlab.models.floating.coordinate_names`)."""
+        return self._coords
+
+    def state_names(self) -> tuple[str, ...]:
+        """Names of the states, in order (module docstring)."""
+        return (tuple(state_name(c) for c in self._coords)
+                + tuple(state_name(c, rate=True) for c in self._coords))
+
+    def state_units(self) -> tuple[str, ...]:
         """Units of :meth:`state_names`."""
-        return ("m", "m", "rad", "rad", "m/s", "m/s", "rad/s", "rad/s")
+        u = ("m", "m") + ("rad",) * (self.nq - 2)
+        return u + tuple(f"{s}/s" for s in u)
+
+    def leg_angle_states(self, leg: str) -> tuple[str, ...]:
+        """State names of ``leg``'s link angles, proximal first (``theta1`` or
+        ``theta1_thigh``, ``theta1_shank``)."""
+        i = FOOT_NAMES.index(leg) + 1
+        return tuple(s for s in self.state_names()[:self.nq] if s.startswith(f"theta{i}"))
 
     # ------------------------------------------------------------------ dynamics
+    def _args(self):
+        return self.contact_params, self.walker_params, self.lane1, self.lane2
+
     def mass_matrix(self, q) -> np.ndarray:
-        """M(q) (4, 4) [kg, kg m, kg m^2]."""
-        return K.mass_matrix(float(q[2]), float(q[3]), self._P)
+        """M(q) (nq, nq) [kg, kg m, kg m^2]."""
+        x = np.zeros(2 * self.nq)
+        x[:self.nq] = np.asarray(q, float)[:self.nq]
+        M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
+        self.kernels.dyn(x, self.walker_params, M, h)
+        return M
 
     def rhs(self, t, x) -> np.ndarray:
-        """dx/dt (8,) (numba).  ``t`` [s] unused (autonomous)."""
-        return K.rhs(np.asarray(x, dtype=float), self._P, self.lane1, self.lane2)
+        """dx/dt (2 nq,) (numba).  ``t`` [s] unused (autonomous)."""
+        return self.kernels.rhs(np.asarray(x, dtype=float), *self._args())
 
     def jac(self, t, x) -> np.ndarray:
-        """Analytic Jacobian d(rhs)/dx (8, 8) (numba)."""
-        return K.jac(np.asarray(x, dtype=float), self._P, self.lane1, self.lane2)
+        """Analytic Jacobian d(rhs)/dx (2 nq, 2 nq) (numba)."""
+        return self.kernels.jac(np.asarray(x, dtype=float), *self._args())
 
-    def rhs_numpy(self, t, x) -> np.ndarray:
-        """Pure-numpy reference of :meth:`rhs` (slow)."""
-        return rhs_ref(np.asarray(x, float), self.L, self.m, self.MH, self.a, self.g, self.phi,
-                       self.contact, (self.lane1, self.lane2), self.patch_half_width,
-                       self.continuous)
+    def _check_pin(self):
+        if self.structure.foot != "point":
+            raise ValueError("contact_sim.pin_stance_until: pinning the stance foot needs "
+                             "point feet")
+
+    def pinned_state(self, x) -> np.ndarray:
+        """Pinned state ``z = [link angles, their rates]`` (2 nq - 4,) of a full state."""
+        x = np.asarray(x, float)
+        n = self.nq
+        return np.concatenate([x[2:n], x[n + 2:]])
 
     def rhs_pinned(self, t, z, foot2) -> np.ndarray:
-        """Reduced dynamics dz/dt (4,) with leg2's foot held at ``foot2`` (2,) [m].
+        """Reduced dynamics dz/dt with leg2's foot held at ``foot2`` (2,) [m] (point feet).
 
-        z = [theta1, theta2, dtheta1, dtheta2]; leg1's foot still feels its contact.
+        ``z = [link angles, their rates]`` (:meth:`pinned_state`); leg1's foot still feels
+        its contact, the knees their stops.
         """
-        return K.rhs_pinned(np.asarray(z, float), self._P, self.lane1, self.lane2,
-                            float(foot2[0]), float(foot2[1]))
+        self._check_pin()
+        return self.kernels.rhs_pinned(np.asarray(z, float), *self._args(),
+                                       np.asarray(foot2, float))
 
     def pinned_to_full(self, z, foot2) -> np.ndarray:
-        """Full state x (8,) from the pinned state z (4,) and the pinned foot position [m]."""
-        t1, t2, w1, w2 = z
-        L = self.L
-        return np.array([foot2[0] - L * np.sin(t2), foot2[1] + L * np.cos(t2), t1, t2,
-                         -L * np.cos(t2) * w2, -L * np.sin(t2) * w2, w1, w2])
+        """Full state (2 nq,) from the pinned state z and the pinned foot position [m]."""
+        return self.kernels.pinned_to_full(np.asarray(z, float), self.walker_params,
+                                           np.asarray(foot2, float))
+
+    def link_state_from_ideal(self, x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
+        """Pinned state z (link angles and rates, leg1 swing / leg2 stance) from a rigid
+        model's state ``x_ideal`` (role order of the rigid walker), ``rate_scale`` =
+        multipliers on leg1's and leg2's rates.
+
+        Straight legs, absolute coordinates: ``[th_sw, th_st, w_sw, w_st]``; kneed:
+        ``[th_swing_thigh, th_swing_shank, th_stance, rates]`` (the stance knee straight);
+        other coordinate schemes through the rigid model's leg angles.
+        """
+        x = np.asarray(x_ideal, float)
+        st = self.structure
+        s1, s2 = float(rate_scale[0]), float(rate_scale[1])
+        if st.knee:
+            ang = [x[0], x[1], x[2], x[2]]
+            rates = [s1 * x[3], s1 * x[4], s2 * x[5], s2 * x[5]]
+        elif st.coordinates == "absolute":
+            ang, rates = [x[0], x[1]], [s1 * x[2], s2 * x[3]]
+        else:
+            from walkerlab.models.rigid import functions
+
+            la = functions(self.data)["leg_angles"](x)
+            ang = [la["swing_angle"], la["stance_angle"]]
+            rates = [s1 * la["swing_rate"], s2 * la["stance_rate"]]
+        return np.array(ang + rates, dtype=float)
 
     # ------------------------------------------------------------------ post-processing
+    def _rows(self, X) -> np.ndarray:
+        return np.ascontiguousarray(np.atleast_2d(X), dtype=float)
+
+    def foot_state(self, x, i: int) -> tuple[float, float, float, float]:
+        """Contact point of foot ``i`` (0/1) and the velocity of the material point there:
+        (px, py, vx, vy) [m, m/s]."""
+        n = self.nq
+        P, V, J = np.empty((2, 2)), np.empty((2, 2)), np.empty((2, 2, n))
+        self.kernels.feet(np.asarray(x, float), self.walker_params, P, V, J)
+        return float(P[i, 0]), float(P[i, 1]), float(V[i, 0]), float(V[i, 1])
+
     def foot_positions(self, X) -> np.ndarray:
-        """Foot positions (n, 2, 2) [m] for states X (n, 8) or (8,) -> (2, 2)."""
-        X = np.atleast_2d(X)
-        th = X[:, 2:4]
-        P = np.stack([X[:, [0]] + self.L * np.sin(th), X[:, [1]] - self.L * np.cos(th)], axis=-1)
-        return P if len(P) > 1 else P[0]
+        """Contact points (n, 2, 2) [m] (foot, xy) for states X (n, 2 nq), or (2, 2) for one."""
+        X = self._rows(X)
+        pts = self.kernels.points(X.T, self.walker_params)
+        key = "contact" if self.structure.foot == "arc" else "foot"  # the arc's lowest point
+        out = np.stack([np.stack([pts[f"{leg}_{key}"][0], pts[f"{leg}_{key}"][1]], axis=-1)
+                        for leg in FOOT_NAMES], axis=1)
+        return out if len(out) > 1 else out[0]
+
+    def points(self, X) -> dict:
+        """Named points (2, n) [m]: hip, each body (``leg1_<body>``), feet, knees."""
+        return self.kernels.points(self._rows(X).T, self.walker_params)
 
     def hip_height(self, X) -> np.ndarray:
-        """Hip height above the ground line, hip . n [m], for X (n, 8) -> (n,)."""
-        X = np.ascontiguousarray(np.atleast_2d(X), dtype=float)
-        return K.hip_heights(X, self._P)
+        """Hip height above the ground line, hip . n [m], for X (n, 2 nq) -> (n,)."""
+        return self.kernels.hip_heights(self._rows(X), self.contact_params)
 
     def fall_margin(self, x, threshold: float) -> float:
-        """The one fall test: hip height of state ``x`` (8,) minus ``threshold`` [m]
+        """The one fall test: hip height of state ``x`` minus ``threshold`` [m]
         (negative = fallen).  Used as the fall event of every integration."""
-        return float(K.hip_height(np.asarray(x, dtype=float), self._P)) - threshold
+        return float(self.hip_height(x)[0]) - threshold
 
     def contact_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
-        """Per-foot contact quantities for states X (n, 8).
+        """Per-foot contact quantities for states X (n, 2 nq).
 
         Returns
         -------
         dict
             ``{"leg1": {...}, "leg2": {...}}`` each with arrays (n,): ``penetration`` [m]
             (signed; negative = height above ground), ``penetration_rate`` [m/s],
-            ``slip_velocity`` [m/s] (down-slope), ``s`` [m] along-slope position,
-            ``normal_force`` [N], ``friction_force`` [N] (along t), ``power`` [W] (F . v),
-            ``on_ground`` (1.0 where the foot's lane has ground, else 0.0).
+            ``slip_velocity`` [m/s] (down-slope, of the material point), ``s`` [m]
+            along-slope position, ``normal_force`` [N], ``friction_force`` [N] (along t),
+            ``power`` [W] (F . v), ``on_ground`` (1.0 where the foot's lane has ground).
         """
-        X = np.ascontiguousarray(np.atleast_2d(X), dtype=float)
-        tab = K.contact_table(X, self._P, self.lane1, self.lane2)
+        tab = self.kernels.contact_table(self._rows(X), *self._args())
         names = ("penetration", "penetration_rate", "slip_velocity", "s", "normal_force",
                  "friction_force", "power", "on_ground")
         return {foot: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
                 for i, foot in enumerate(FOOT_NAMES)}
 
+    def knee_stop_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
+        """Per-knee stop quantities for states X (n, 2 nq); empty for straight legs.
+
+        Returns
+        -------
+        dict
+            ``{"leg1": {...}, "leg2": {...}}`` each with arrays (n,): ``extension`` [rad]
+            (shank - thigh angle, > 0 hyperextended), ``extension_rate`` [rad/s],
+            ``torque`` [N m] (> 0: pushes the knee straight from hyperextension; < 0: the
+            latch holds a loaded leg's knee against flexion), ``power`` [W] (of the stop on
+            the walker).
+        """
+        if not self.structure.knee:
+            return {}
+        tab = self.kernels.knee_table(self._rows(X), *self._args())
+        names = ("extension", "extension_rate", "torque", "power")
+        return {leg: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
+                for i, leg in enumerate(FOOT_NAMES)}
+
     def energies(self, X) -> dict[str, np.ndarray]:
-        """Kinetic, potential (relative to y = 0) and total energy [J] for X (n, 8)."""
-        X = np.atleast_2d(X)
-        m, MH, b, g = self.m, self.MH, self.b, self.g
-        vh2 = X[:, 4] ** 2 + X[:, 5] ** 2
-        T = 0.5 * MH * vh2
-        V = MH * g * X[:, 1]
-        for j in (2, 3):
-            th, w = X[:, j], X[:, j + 4]
-            vx = X[:, 4] + b * np.cos(th) * w
-            vy = X[:, 5] + b * np.sin(th) * w
-            T = T + 0.5 * m * (vx**2 + vy**2)
-            V = V + m * g * (X[:, 1] - b * np.cos(th))
+        """Kinetic, potential (relative to y = 0) and total energy [J] for X (n, 2 nq)."""
+        T, V = self.kernels.energies(self._rows(X).T, self.walker_params)
         return {"kinetic": T, "potential": V, "total": T + V}
+
+    # ------------------------------------------------------------------ compiled integrators
+    def pack(self) -> np.ndarray:
+        """Data vector ``[n1, n2, PC, p, c1, c2, nfev=0]`` of the compiled right-hand side
+        (:mod:`walkerlab.contact.generated`)."""
+        return np.concatenate([[len(self.lane1), len(self.lane2)], self.contact_params,
+                               self.walker_params, self.lane1, self.lane2, [0.0]]
+                              ).astype(np.float64)

@@ -14,11 +14,7 @@ from walkerlab.config import ContactSimSettings, ContactSolverSettings, Scene, T
 
 from .model import ContactWalker
 
-__all__ = ["IDEAL_ROLES", "ContactSceneError", "build", "ideal_step_length", "settings"]
-
-#: Names of the ideal (rigid compass-gait) state the contact walker starts from, in the
-#: order of an ideal state vector (the rigid walker's ``state_names()``).
-IDEAL_ROLES = ("swing_angle", "stance_angle", "swing_rate", "stance_rate")
+__all__ = ["ContactSceneError", "build", "ideal_step_length", "settings"]
 
 
 class ContactSceneError(ValueError):
@@ -45,22 +41,34 @@ def settings(scene: Scene):
             scene.contact_solver or ContactSolverSettings())
 
 
-def ideal_step_length(leg_length_m: float, x_ideal, names=IDEAL_ROLES) -> float:
-    """Step length [m] of the ideal gait from its post-impact state ``x_ideal`` named by
-    ``names``: ``2 L sin((th_st - th_sw) / 2)`` (foot-to-foot chord at heel strike)."""
-    x = dict(zip(names, np.asarray(x_ideal, float)))
-    th_sw, th_st = x["swing_angle"], x["stance_angle"]
-    return 2 * leg_length_m * np.sin((th_st - th_sw) / 2)
+def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
+    """Advance [m] of the ideal gait per step, from its post-impact state ``x_ideal`` (role
+    order of the rigid model): the distance between the two feet's contact points with the
+    stance leg placed by :meth:`ContactWalker.link_state_from_ideal` (the foot-to-foot chord
+    at heel strike; compass gait ``2 L sin((th_st - th_sw) / 2)``), plus, for arc feet of
+    radius R, the roll ``R (th_st - th_sw)`` of the stance arc over the step (on the periodic
+    gait the stance leg turns from the post-impact stance angle to the post-impact swing
+    angle).  The checkerboard patches are spaced by it."""
+    z = walker.link_state_from_ideal(x_ideal)
+    x = walker.pinned_to_full(z, np.zeros(2))
+    feet = walker.foot_positions(x)
+    chord = float(np.hypot(*(feet[1] - feet[0])))
+    if walker.structure.foot != "arc":
+        return chord
+    R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
+    m = walker.nq - 2  # link angles: leg1's, then leg2's; the foot is on each leg's last link
+    return chord + R * (z[m - 1] - z[m // 2 - 1])
 
 
 def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
-    """ContactWalker of the scene with checkerboard patches from the ideal step length.
+    """ContactWalker of the scene (any walker with positive leg masses) with checkerboard
+    patches from the ideal step length.
 
     Parameters
     ----------
     scene : Scene
-    x_ideal : ndarray (4,)
-        Ideal fixed point, named by :data:`IDEAL_ROLES` [rad, rad/s].
+    x_ideal : ndarray (2n,)
+        Ideal fixed point (role order of the rigid walker, leg2 = stance) [rad, rad/s].
     n_steps : int
         Steps the run may take (sets how many patches are laid out).
 
@@ -69,11 +77,24 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
     walker : ContactWalker
     step_length : float
         Ideal step length [m] (patch spacing).
+
+    Raises
+    ------
+    ContactSceneError
+        No ``contact`` section, or a walker with a massless body (one line).
     """
+    from walkerlab.models.description import walker_data
+    from walkerlab.models.floating import check_masses
+
     contact, terrain, _, _ = settings(scene)
-    w = scene.walker
-    step_length = ideal_step_length(w.leg_length_m, x_ideal)
-    return ContactWalker.from_settings(
-        contact, terrain, step_length=step_length, n_steps=n_steps + 4, L=w.leg_length_m,
-        m=w.leg_mass_kg, MH=w.hip_mass_kg, a=w.leg_mass_from_foot_m, g=w.gravity_m_per_s2,
-        phi=scene.slope.phi_rad), step_length
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    try:
+        check_masses(data.structure)
+    except ValueError as err:
+        raise ContactSceneError(f"scene '{scene.name}': {err}") from None
+    probe = ContactWalker(contact=contact.to_si(), data=data,
+                          knee_stop=contact.knee_stop.to_si())
+    step_length = ideal_step_length(probe, x_ideal)
+    return ContactWalker.from_settings(contact, terrain, step_length=step_length,
+                                       n_steps=n_steps + 4, data=data), step_length
+

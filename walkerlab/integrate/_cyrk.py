@@ -3,9 +3,10 @@
 Internal module, imported by :mod:`walkerlab.integrate.contact`; CyRK itself is imported only
 on the first chunk of a ``cyrk_*`` method.  CyRK (a main dependency, binary wheels, no
 Fortran) takes the right-hand side as a C function pointer (its numba bridge,
-``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The RHS
-:func:`walkerlab.contact.compiled.rhs_packed` is wrapped in a numba ``cfunc`` (compiled once,
-cached on disk), so CyRK integrates a whole chunk of samples without re-entering Python.
+``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The walker's
+generated RHS (:mod:`walkerlab.contact.generated`) is wrapped in a numba ``cfunc`` (compiled
+once per walker structure, cached on disk), so CyRK integrates a whole chunk of samples
+without re-entering Python.
 The physics is not repeated here: the cfunc only unpacks its data vector and calls the
 kernel.
 
@@ -14,7 +15,7 @@ solver), so its implicit methods (LSODA, BDF, Radau) form the Jacobian by finite
 differences; those RHS calls are counted in ``nfev`` like all others (the cfunc counts its
 own calls).  ``max_step`` and a scalar or per-state ``atol`` are passed through.
 
-The packed data vector is ``[n1, n2, P (NPAR), c1 (n1), c2 (n2), nfev]``; CyRK copies it
+The packed data vector is ``[n1, n2, PC, p, c1 (n1), c2 (n2), nfev]``; CyRK copies it
 into its solver, so the call counter is read back from the solver's copy.
 """
 
@@ -23,8 +24,6 @@ from __future__ import annotations
 import ctypes
 
 import numpy as np
-
-from walkerlab.contact import compiled as K
 
 __all__ = ["CYRK_METHODS", "solve_chunk"]
 
@@ -35,43 +34,38 @@ __all__ = ["CYRK_METHODS", "solve_chunk"]
 #: ~ -1e5 1/s).
 CYRK_METHODS = {"cyrk_bdf": "BDF"}
 
-_FPTR = None
+_FPTR: dict = {}  # generated kernels module name -> cfunc address
 
 
-def _build() -> int:
-    """Compile (or load from numba's disk cache) the cfunc RHS; returns its address."""
-    from walkerlab.usercache import use_for_numba
-
-    use_for_numba()  # cache=True: numba's cache in the user cache, not in the package
-    from CyRK.nb.numba_solver import cyjit_sig
-    from numba import carray, cfunc
-
-    @cfunc(cyjit_sig, cache=True)
-    def rhs_c(dy, t, y, p):  # pragma: no cover - runs compiled
-        K.rhs_packed(carray(y, (8,)), carray(p, (K.packed_size(p),)), carray(dy, (8,)))
-
-    return rhs_c.address
-
+def address(kernels) -> int:
+    """C address of the cfunc of ``kernels.rhs_packed`` (compiled once per walker structure,
+    numba disk cache)."""
+    if kernels.__name__ not in _FPTR:
+        _FPTR[kernels.__name__] = kernels.build_cyrk()
+    return _FPTR[kernels.__name__]
 
 
 def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
-                rtol: float, atol, max_step: float = np.inf, max_num_steps: int = 0):
+                rtol: float, atol, max_step: float = np.inf, max_num_steps: int = 0, *,
+                kernels=None):
     """Integrate from ``x0`` at ``t_eval[0]`` over the sample times ``t_eval`` (n,) [s].
 
     Parameters
     ----------
     method : str
         A key of :data:`CYRK_METHODS`.
-    x0 : ndarray (8,)
+    x0 : ndarray (2 nq,)
     t_eval : ndarray (n,)
         Increasing sample times [s]; the first is the start time.
     data : ndarray
-        From :func:`walkerlab.contact.compiled.packed_data`.
+        From :meth:`walkerlab.contact.model.ContactWalker.pack`.
     rtol : float
-    atol : float or ndarray (8,)
+    atol : float or ndarray (2 nq,)
         [m, rad, m/s, rad/s].
     max_step : float
         Largest step [s] (inf: none).
+    kernels : module
+        The walker's generated kernels (``ContactWalker.kernels``).
     max_num_steps : int
         Most solver steps in this call (0: CyRK's default); past it the call stops
         unsuccessfully at the last sample reached (how a caller bounds the wall time of a
@@ -79,7 +73,7 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
 
     Returns
     -------
-    X : ndarray (m, 8)
+    X : ndarray (m, 2 nq)
         States at ``t_eval[:m]`` (``m = n`` on success; fewer when the solver stopped early).
     ok : bool
         CyRK reported success.
@@ -88,12 +82,10 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     message : str
         CyRK's status message.
     """
-    global _FPTR
     from CyRK.cy.pyhelpers import find_ode_method_int
     from CyRK.nb import numba_solver as ns
 
-    if _FPTR is None:
-        _FPTR = _build()
+    fptr = address(kernels)
     u0 = np.ascontiguousarray(x0, dtype=np.float64)
     te = np.ascontiguousarray(t_eval, dtype=np.float64)
     rt = np.array([float(rtol)])
@@ -102,7 +94,7 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     # the C entry point that CyRK's njit `nbsolve2_ivp` calls, called here through ctypes
     # (one call per chunk; avoids compiling that njit wrapper in every process)
     ptr = ns.c_numba_cysolve_ivp(
-        _FPTR, te[0], te[-1], u0.ctypes.data, u0.size, find_ode_method_int(CYRK_METHODS[method]),
+        fptr, te[0], te[-1], u0.ctypes.data, u0.size, find_ode_method_int(CYRK_METHODS[method]),
         0, 0, data.ctypes.data, data.size * 8, int(max_num_steps), 2000, False,
         te.ctypes.data, te.size, None, None, 0, rt.ctypes.data, rt.size, at.ctypes.data,
         at.size, hmax, 0.0, True)

@@ -2,20 +2,19 @@
 
 Internal module, imported only when ``method="numbalsoda"`` is selected (numbalsoda is an
 optional extra: ``pip install 'walkerlab[numbalsoda]'``; building it from source needs a C++
-and a Fortran compiler and cmake).  The right-hand side
-:func:`walkerlab.contact.compiled.rhs_packed` is wrapped in a numba ``cfunc`` so that LSODA
+and a Fortran compiler and cmake).  The walker's generated right-hand side
+(:mod:`walkerlab.contact.generated`) is wrapped in a numba ``cfunc`` so that LSODA
 (numbalsoda's C++ port) integrates a whole chunk of samples without re-entering Python.
-numbalsoda's LSODA takes a scalar ``atol``, no largest step and no user Jacobian (it forms
-the stiff-phase Jacobian by finite differences; those RHS calls are counted in ``nfev``).
+numbalsoda's LSODA takes a scalar ``atol``, no largest step and no user Jacobian (it forms the
+stiff-phase Jacobian by finite differences;
+those RHS calls are counted in ``nfev``).
 
-The packed data vector handed to the cfunc is ``[n1, n2, P (NPAR), c1 (n1), c2 (n2), nfev]``.
+The packed data vector handed to the cfunc is ``[n1, n2, PC, p, c1 (n1), c2 (n2), nfev]``.
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from walkerlab.contact import compiled as K
 
 
 def _load_driver():
@@ -55,7 +54,7 @@ class MissingNumbalsoda(ValueError, ImportError):
     so that the CLI reports it as one line with exit code 1)."""
 
 
-_FPTR = None
+_FPTR: dict = {}  # generated kernels module name -> cfunc address
 
 
 def available() -> bool:
@@ -63,27 +62,13 @@ def available() -> bool:
     return lsoda is not None
 
 
-def _build():
-    from walkerlab.usercache import use_for_numba
-
-    use_for_numba()  # cache=True: numba's cache in the user cache, not in the package
-    from numba import carray, cfunc
-
-    @cfunc(lsoda_sig, cache=True)
-    def rhs_c(t, u, du, p):  # pragma: no cover - runs compiled
-        K.rhs_packed(carray(u, (8,)), carray(p, (K.packed_size(p),)), carray(du, (8,)))
-
-    return rhs_c.address
-
-
-
 def solve_chunk(x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray, rtol: float,
-                atol: float, mxstep: int = 500000):
+                atol: float, mxstep: int = 500000, *, kernels=None):
     """LSODA from ``x0`` over the sample times ``t_eval`` (n,) [s].
 
     Returns
     -------
-    X : ndarray (n, 8)
+    X : ndarray (n, 2 nq)
         States at ``t_eval`` (rows after a failure are undefined).
     ok : bool
         LSODA reported success.
@@ -95,18 +80,17 @@ def solve_chunk(x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray, rtol: floa
     MissingNumbalsoda
         numbalsoda is not installed.
     """
-    global _FPTR
     if lsoda is None:
         raise MissingNumbalsoda("contact_solver.method 'numbalsoda' needs the numbalsoda package: "
                           "pip install 'walkerlab[numbalsoda]' (builds with cmake, g++, gfortran)")
-    if _FPTR is None:
-        _FPTR = _build()
+    if kernels.__name__ not in _FPTR:
+        _FPTR[kernels.__name__] = kernels.build_lsoda(lsoda_sig)
     n0 = data[-1]
     u0 = np.ascontiguousarray(x0, dtype=np.float64)
     te = np.ascontiguousarray(t_eval, dtype=np.float64)
     X = np.empty((len(te), len(u0)))
     flag = np.array(999, np.int32)
     # same call as numbalsoda.lsoda (its njit wrapper), without compiling that wrapper
-    lsoda(_FPTR, len(u0), u0.ctypes.data, data.ctypes.data, len(te), te.ctypes.data,
-          X.ctypes.data, float(rtol), float(atol), int(mxstep), flag.ctypes.data)
+    lsoda(_FPTR[kernels.__name__], len(u0), u0.ctypes.data, data.ctypes.data, len(te),
+          te.ctypes.data, X.ctypes.data, float(rtol), float(atol), int(mxstep), flag.ctypes.data)
     return X, bool(flag == 1), int(data[-1] - n0)

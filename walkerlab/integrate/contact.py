@@ -46,7 +46,6 @@ import numpy as np
 from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
 from walkerlab.config.contact import ContactSolverSettings
-from walkerlab.contact import compiled
 
 from . import _cyrk
 
@@ -302,10 +301,8 @@ def first_event(walker, t, X, limits: ContactLimits, k0=1):
 
 def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline):
     """Integrate with leg2's foot held fixed.  Returns (t, X, nfev, njev, termination, msg)."""
-    idx = StateIndex(walker)
     foot2 = np.asarray(walker.foot_positions(x0)).reshape(-1, 2)[1]
-    angles = [idx["theta1"], idx["theta2"]]
-    z0 = np.concatenate([x0[angles], x0[[idx.rate_of(n) for n in ("theta1", "theta2")]]])
+    z0 = walker.pinned_state(x0)
 
     def f(t, z):
         return walker.rhs_pinned(t, z, foot2)
@@ -360,7 +357,7 @@ class _Backend:
         self.sized_by_wall = self.method == "numbalsoda"
         if self.method == "numbalsoda" and np.isfinite(self.max_step):
             raise ValueError("contact_solver.max_step_s is not supported by method numbalsoda")
-        self.data = compiled.packed_data(walker) if self.compiled else None
+        self.data = walker.pack() if self.compiled else None
 
     def odeint_chunk(self, xs, tg):
         with warnings.catch_warnings():
@@ -386,13 +383,15 @@ class _Backend:
         if self.method == "numbalsoda":  # whole chunk in compiled code (FD Jacobian)
             from . import _lsoda
 
-            X, ok, nf = _lsoda.solve_chunk(xa, tg, self.data, s.rtol, s.atol)
+            X, ok, nf = _lsoda.solve_chunk(xa, tg, self.data, s.rtol, s.atol,
+                                            kernels=self.walker.kernels)
             nk = len(tg) if ok else 1  # rows after a failure are undefined: drop the chunk
             m = "Integration successful." if ok else "numbalsoda LSODA failed in this chunk"
             return tg[1:nk], X[1:nk], ok, m, nf, 0
         if self.method in _cyrk.CYRK_METHODS:  # whole chunk in compiled code (CyRK BDF)
             X, ok, nf, m = _cyrk.solve_chunk(self.method, xa, tg, self.data, s.rtol, s.atol,
-                                             self.max_step, CYRK_STEPS_PER_CALL)
+                                             self.max_step, CYRK_STEPS_PER_CALL,
+                                             kernels=self.walker.kernels)
             tn, Xn, nj = tg[1:len(X)], X[1:], 0
             if not ok:  # a force jump BDF cannot step over (a foot hitting the side of a
                 # patch below its top): odeint, which grinds through it as a plain odeint run

@@ -35,6 +35,8 @@ def contact_section(scene, paths) -> list[str]:
     table2 = getattr(pub, "TABLE2", {})
     with open_artifact(p, "contact-sim") as f:
         scale = f["initial_rate_scale"][()]
+        scaled = ([str(v) for v in f["rate"][()].astype(str)] if "rate" in f
+                  else ["leg1", "leg2"])
         summ = {k: (f["summary"][k][()], str(f["summary"][k].attrs.get("unit", "")))
                 for k in f["summary"]}
         stage_wall = float(f.attrs.get("wall_time_s", np.nan))
@@ -85,7 +87,9 @@ def contact_section(scene, paths) -> list[str]:
     out = [("## Table 2 — " if table2 else "## ") + "initial states (ideal vs contact model)", "",
            _table(head, rows), "",
            f"Our contact walker starts from our ideal fixed point with the initial rates scaled "
-           f"by [{', '.join(num(v, 3) for v in np.atleast_1d(scale))}]"
+           f"by [{', '.join(num(v, 3) for v in np.atleast_1d(scale))}] ("
+           + "; ".join(f"{n} × {num(v, 3)}" for n, v in zip(scaled, np.atleast_1d(scale)))
+           + ")"
            + (f" (found by `--adjust`: objective {num(adj['objective'], 3)} after "
               f"{int(adj['evaluations'])} simulations)" if adj else "")
            + "." + _table2_note(pub), "",

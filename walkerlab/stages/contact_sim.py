@@ -44,6 +44,14 @@ def named_trajectory(walker, res) -> NamedTrajectory:
     return contact_run.named_trajectory(walker, res, LEGS)
 
 
+def rate_states(walker, leg: str) -> list[str]:
+    """Names of the rate states of ``leg``'s links (what one entry of
+    ``initial_rate_scale`` multiplies): ``dtheta1``; kneed ``dtheta1_thigh dtheta1_shank``."""
+    idx = walker.state_names()
+    n = walker.nq
+    return [idx[idx.index(s) + n] for s in walker.leg_angle_states(leg)]
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         adjust: bool = False, periodic: bool = False) -> StageOutcome:
     """Simulate the contact walker (optionally after ``--adjust``) and write the artifact.
@@ -109,7 +117,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                  "wall_time_s": "s"}
 
         def writer(f):
-            f.attrs["model"] = "compass_gait_contact"
+            f.attrs["model"] = ("compass_gait_contact" if walker.nq == 4
+                                and walker.structure.foot == "point" else "biped_contact")
             f.attrs["legs"] = LEGS
             f.attrs["termination"] = res.termination
             f.attrs["method"] = res.method
@@ -169,10 +178,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                        "state component of the rigid walker (role-ordered)")
             put(f, "initial_state_ideal", x_fp, "rad, rad/s", "ideal fixed point (Table 2 MATLAB)",
                 dims=("state",))
-            coordinate(f, "rate", ["dtheta1", "dtheta2"], "-", "leg rate scaled")
+            scaled = [" ".join(rate_states(walker, leg)) for leg in LEGS]
+            coordinate(f, "rate", scaled, "-", "rates scaled (leg1 swing, leg2 stance)")
             put(f, "initial_rate_scale", np.asarray(scale if scale is not None else
                                                     settings(scene)[2].initial_rate_scale),
-                "-", "multipliers on (dtheta1, dtheta2)", dims=("rate",))
+                "-", f"multipliers on ({'; '.join(scaled)})", dims=("rate",))
             for leg, ft in res.feet.items():
                 g = f.create_group(f"feet/{leg}")
                 coordinate(g, "time", tr.time, "s", "sample time")

@@ -1,7 +1,9 @@
 """Pure-numpy reference implementation of the contact walker's equations of motion.
 
 Slow (~tens of µs per call) but written directly from the Lagrangian, independently of the
-numba kernels in :mod:`walkerlab.contact._kernels`; tests check the two agree.
+generated kernels (:mod:`walkerlab.contact.generated`); tests check the two agree.  Test-only
+(it moved here from ``walkerlab/contact/reference.py`` when the hand-written numba kernel
+retired, issue 17).
 
 Lagrangian of the floating walker, q = [hip_x, hip_y, theta1, theta2] (SI):
 ``T = 1/2 MH |v_hip|^2 + sum_i 1/2 m |v_hip + b (cos th_i, sin th_i) w_i|^2``,
@@ -14,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .laws import coulomb_friction_coefficient, impact_normal_force
+from walkerlab.contact.laws import coulomb_friction_coefficient, impact_normal_force
 
 __all__ = ["contact_forces_ref", "mass_matrix_ref", "rhs_ref"]
 

@@ -1,0 +1,478 @@
+"""The floating view of a walker: the same bodies, links and feet as the rigid hybrid model
+(:mod:`walkerlab.models.symbolic`), with no foot pinned (what the compliant-contact model
+integrates).  Derived symbolically (sympy) from the
+:class:`~walkerlab.models.description.Structure`, emitted as numba-compiled code, cached on
+disk through :mod:`walkerlab.models.cache`.
+
+Conventions (shared with the rigid view and the contact model)
+--------------------------------------------------------------
+World axes x downhill, y up, gravity ``(0, -g)``; ground line ``y = -x tan(phi)`` with outward
+normal ``n = (sin phi, cos phi)`` and down-slope tangent ``t = (cos phi, -sin phi)``.
+Generalised coordinates ``q = [hip_x, hip_y, angles of leg1's links, angles of leg2's links]``
+[m, m, rad...]: a straight leg has one link (``leg{i}_angle``), a kneed leg a thigh then a
+shank (``leg{i}_thigh_angle``, ``leg{i}_shank_angle``); each angle is absolute, from the
+vertical, positive when the foot is ahead of the hip.  A point at distance ``d`` along a link
+at angle ``psi`` from the link's proximal joint is at ``joint + d (sin psi, -cos psi)``.
+
+Equations
+---------
+``M(q) qdd + h(q, dq) = sum_i J_i(q)^T F_i + Q_stop`` with ``T = sum 1/2 m |v|^2 + 1/2 I w^2``,
+``V = sum m g y``, ``M`` the Hessian of ``T`` in ``dq`` and the bias
+``h = d(M dq)/dq dq - dT/dq + dV/dq`` (= ``C(q, dq) dq + G(q)``).  For every foot the contact
+point is
+
+- point foot: the foot point;
+- arc foot (radius ``R``, centre on the shank axis at ``L - R`` from the hip): the arc's
+  lowest point ``centre - R n`` (where the penetration is measured).  The force acts on the
+  *material* point of the arc there, whose velocity is ``v_centre + w x (-R n) = v_centre +
+  R w t`` (``w`` the shank's rate), so its Jacobian is ``J_centre + R t e_shank^T`` and rolling
+  emerges from friction.
+
+Generated numba functions (``x = [q, dq]``, ``p`` the parameter vector in
+``Structure.param_names`` order, outputs written into preallocated arrays):
+
+=====================================  ========================================================
+``dyn(x, p, M, h)``                    ``M`` (nq, nq) [kg, kg m, kg m^2], ``h`` (nq,) [N, N m]
+``dyn_jac(x, a, p, Dq, Dv)``           ``d(M a + h)/dq``, ``dh/d dq`` (nq, nq), ``a`` fixed
+``feet(x, p, P, V, J)``                contact points ``P`` (2, 2) [m], material velocities
+                                       ``V`` (2, 2) [m/s], Jacobians ``J`` (2, 2, nq)
+``feet_jac(x, F, p, dV, dJtF)``        ``dV = d V_i / dq`` (2, 2, nq) and
+                                       ``dJtF = d(sum_i J_i^T F_i)/dq`` (nq, nq), ``F`` (2, 2) fixed
+``energies(X, p)``                     numpy: kinetic, potential [J] of states (2 nq, k)
+``points(X, p)``                       numpy: named points (2, k) [m]
+=====================================  ========================================================
+
+Massless bodies (the simplest walker's legs) have no floating model: :func:`check_masses`
+raises.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import sys
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.models.description import Structure, WalkerData
+
+__all__ = ["MASSLESS_MESSAGE", "FloatingEquations", "FloatingView", "check_masses",
+           "coordinate_names", "derive_floating", "floating_module", "floating_view",
+           "knee_pairs", "link_names"]
+
+MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
+LEGS = ("leg1", "leg2")
+
+
+def link_names(structure: Structure) -> tuple[str, ...]:
+    """Links of one leg, proximal first: ``("leg",)`` or ``("thigh", "shank")``."""
+    return ("thigh", "shank") if structure.knee else ("leg",)
+
+
+def coordinate_names(structure: Structure) -> tuple[str, ...]:
+    """Names of the floating view's generalised coordinates (module docstring)."""
+    if structure.knee:
+        ang = tuple(f"{leg}_{ln}_angle" for leg in LEGS for ln in ("thigh", "shank"))
+    else:
+        ang = tuple(f"{leg}_angle" for leg in LEGS)
+    return ("hip_x", "hip_y") + ang
+
+
+def knee_pairs(structure: Structure) -> tuple[tuple[int, int], ...]:
+    """(thigh index, shank index) in ``q`` of each leg's knee; empty without knees."""
+    return ((2, 3), (4, 5)) if structure.knee else ()
+
+
+def check_masses(structure: Structure) -> None:
+    """Raise if a body has mass 0 (the massless limit has no floating model).
+
+    Raises
+    ------
+    ValueError
+        One line: :data:`MASSLESS_MESSAGE`.
+    """
+    light = [b.name for b in structure.bodies if b.massless]
+    if light:
+        raise ValueError(f"{MASSLESS_MESSAGE} (walker.leg.bodies: {', '.join(light)} has "
+                         "mass_kg 0)")
+
+
+@dataclass(frozen=True)
+class FloatingEquations:
+    """Symbolic floating view (all sympy; ``nq = len(q)``).
+
+    Attributes
+    ----------
+    q, dq : tuple of Symbol (nq,)
+    params : tuple of Symbol
+        ``structure.param_names`` order.
+    M : Matrix (nq, nq); h : Matrix (nq, 1)
+    feet : tuple of (Matrix (2, 1), Matrix (2, nq))
+        Per leg: contact point (lowest point of an arc) and the Jacobian of the material
+        point there.
+    kinetic, potential : Expr
+    points : dict[str, Matrix (2, 1)]
+        Named as the rigid model's: ``hip``, ``<leg>_<body>``, ``<leg>_foot`` (end of the
+        leg axis), arc feet ``<leg>_foot_centre`` and ``<leg>_contact`` (lowest point),
+        kneed ``<leg>_knee``.
+    """
+
+    q: tuple
+    dq: tuple
+    params: tuple
+    M: object
+    h: object
+    feet: tuple
+    kinetic: object
+    potential: object
+    points: dict
+
+
+@cache
+def derive_floating(structure: Structure) -> FloatingEquations:
+    """Derive the floating view of ``structure`` (memoised per process).
+
+    Raises
+    ------
+    ValueError
+        Massless bodies (:func:`check_masses`) or a foot kind other than point / arc.
+    """
+    import sympy as sp
+
+    check_masses(structure)
+    if structure.foot not in ("point", "arc"):
+        raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
+    names = coordinate_names(structure)
+    q = sp.symbols(names, real=True)
+    dq = sp.symbols([f"d_{n}" for n in names], real=True)
+    par = sp.symbols(structure.param_names, real=True)
+    P = dict(zip(structure.param_names, par))
+    g, L, gamma = P["g"], P["L"], P["gamma"]
+    knee, arc = structure.knee, structure.foot == "arc"
+    lt = P["L_thigh"] if knee else 0
+    R = P["R_foot"] if arc else 0
+    n_vec = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
+    t_vec = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
+    nq = len(q)
+    hip = sp.Matrix([q[0], q[1]])
+
+    def e(psi):
+        return sp.Matrix([sp.sin(psi), -sp.cos(psi)])
+
+    # every point is hip + sum(length * e(angle)): kept as {angle index: length} so that the
+    # mass matrix comes out in cos(psi_i - psi_j) form without a trigonometric simplifier
+    bodies = []  # (mass, {k: length}, inertia, link index)
+    feet, points = [], {"hip": hip}
+    if structure.hip_mass:
+        bodies.append((P["M_hip"], {}, 0, None))
+    for i, leg in enumerate(LEGS):
+        ks = (2 + 2 * i, 3 + 2 * i) if knee else (2 + i,)
+        upper, lower = ks[0], ks[-1]
+        for b in structure.bodies:
+            d = P[f"d_{b.name}"]
+            lin = ({upper: lt, lower: d - lt} if b.link == "shank" else {upper: d})
+            link = lower if b.link == "shank" else upper
+            inertia = P[f"I_{b.name}"] if b.kind == "rod" else 0
+            bodies.append((P[f"m_{b.name}"], lin, inertia, link))
+            points[f"{leg}_{b.name}"] = hip + sum((v * e(q[k]) for k, v in lin.items()),
+                                                 sp.zeros(2, 1))
+        foot_lin = {upper: lt, lower: L - lt - R} if knee else {upper: L - R}
+        centre = hip + sum((v * e(q[k]) for k, v in foot_lin.items()), sp.zeros(2, 1))
+        Jc = centre.jacobian(sp.Matrix(q))
+        if arc:
+            sel = sp.Matrix([[1 if k == lower else 0 for k in range(nq)]])
+            feet.append((centre - R * n_vec, Jc + R * t_vec * sel))
+            # named as the rigid model's points: the arc's lowest point (contact) and the
+            # end of the leg axis (foot)
+            points[f"{leg}_foot_centre"] = centre
+            points[f"{leg}_contact"] = centre - R * n_vec
+            points[f"{leg}_foot"] = centre + R * e(q[lower])
+        else:
+            feet.append((centre, Jc))
+            points[f"{leg}_foot"] = centre
+        if knee:
+            points[f"{leg}_knee"] = hip + lt * e(q[upper])
+
+    M = sp.zeros(nq, nq)
+    V = sp.Integer(0)
+    for mass, lin, inertia, link in bodies:
+        M[0, 0] += mass
+        M[1, 1] += mass
+        for k, lk in lin.items():
+            M[0, k] += mass * lk * sp.cos(q[k])
+            M[1, k] += mass * lk * sp.sin(q[k])
+            for j, lj in lin.items():
+                M[k, j] += mass * lk * lj * sp.cos(q[k] - q[j])
+        if link is not None and inertia != 0:
+            M[link, link] += inertia
+        y = q[1] - sum((lk * sp.cos(q[k]) for k, lk in lin.items()), sp.Integer(0))
+        V += mass * g * y
+    for k in range(2, nq):
+        M[k, 0], M[k, 1] = M[0, k], M[1, k]
+    M = M.applyfunc(sp.factor_terms)
+    dqv, qv = sp.Matrix(dq), sp.Matrix(q)
+    T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
+    h = (M * dqv).jacobian(qv) * dqv - sp.Matrix([sp.diff(T, s) for s in q]) \
+        + sp.Matrix([sp.diff(V, s) for s in q])
+    h = h.applyfunc(sp.expand)
+    return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, h=h,
+                             feet=tuple(feet), kinetic=T, potential=V, points=points)
+
+
+# ---------------------------------------------------------------------------- code generation
+def _printer():
+    from sympy.printing.pycode import PythonCodePrinter
+
+    return PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
+
+
+def _fn(name: str, args: str, eq: FloatingEquations, outputs, pr, jit: bool = True) -> list[str]:
+    """A straight-line numba function assigning ``outputs`` [(target, expr)] after a cse."""
+    import sympy as sp
+
+    exprs = [e for _, e in outputs]
+    repl, red = sp.cse(exprs, symbols=sp.numbered_symbols("_c"), order="none")
+    nq = len(eq.q)
+    lines = (["@njit(cache=True, error_model='numpy')"] if jit else []) + [f"def {name}({args}):"]
+    lines.append(f"    {', '.join(str(s) for s in eq.params)}, = p")
+    lines += [f"    {s} = x[{i}]" for i, s in enumerate(eq.q)]
+    lines += [f"    {s} = x[{nq + i}]" for i, s in enumerate(eq.dq)]
+    lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
+    lines += [f"    {t} = {pr.doprint(r)}" for (t, _), r in zip(outputs, red)]
+    return lines + [""]
+
+
+def _numpy_fn(name: str, eq: FloatingEquations, named: dict) -> list[str]:
+    """A vectorised numpy function of states ``X`` (2 nq,) or (2 nq, k) returning a dict."""
+    import sympy as sp
+    from sympy.printing.numpy import NumPyPrinter
+
+    pr = NumPyPrinter({"fully_qualified_modules": True})
+    keys, flat, shapes = list(named), [], []
+    for k in keys:
+        v = named[k]
+        if isinstance(v, sp.MatrixBase):
+            shapes.append(v.shape[0])
+            flat += list(v)
+        else:
+            shapes.append(None)
+            flat.append(v)
+    repl, red = sp.cse(flat, symbols=sp.numbered_symbols("_n"), order="none")
+    nq = len(eq.q)
+    lines = [f"def {name}(X, p):", f"    {', '.join(str(s) for s in eq.params)}, = p",
+             "    X = np.asarray(X, dtype=float)"]
+    lines += [f"    {s} = X[{i}]" for i, s in enumerate(eq.q)]
+    lines += [f"    {s} = X[{nq + i}]" for i, s in enumerate(eq.dq)]
+    lines.append(f"    _z = 0.0 * {eq.q[0]}")
+    lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
+    out, pos = [], 0
+    for k, shp in zip(keys, shapes):
+        if shp is None:
+            out.append(f"{k!r}: {pr.doprint(red[pos])} + _z")
+            pos += 1
+        else:
+            vals = [f"{pr.doprint(r)} + _z" for r in red[pos:pos + shp]]
+            pos += shp
+            out.append(f"{k!r}: np.array(({', '.join(vals)},))")
+    return lines + [f"    return {{{', '.join(out)}}}", ""]
+
+
+def generate_floating(eq: FloatingEquations, key: str) -> str:
+    """Source of the numba module of the floating view (module docstring's table)."""
+    import sympy as sp
+
+    pr = _printer()
+    nq = len(eq.q)
+    qv, dqv = sp.Matrix(eq.q), sp.Matrix(eq.dq)
+    a = sp.Matrix(sp.symbols(f"a0:{nq}", real=True))
+    body = []
+    # M and h
+    outs = [(f"M[{i}, {j}]", eq.M[i, j]) for i in range(nq) for j in range(nq)]
+    outs += [(f"h[{i}]", eq.h[i]) for i in range(nq)]
+    body += _fn("dyn", "x, p, M, h", eq, outs, pr)
+    # d(M a + h)/dq, dh/d dq
+    E = eq.M * a + eq.h
+    Dq, Dv = E.jacobian(qv), eq.h.jacobian(dqv)
+    outs = [(f"Dq[{i}, {j}]", Dq[i, j]) for i in range(nq) for j in range(nq)]
+    outs += [(f"Dv[{i}, {j}]", Dv[i, j]) for i in range(nq) for j in range(nq)]
+    lines = _fn("dyn_jac", "x, a, p, Dq, Dv", eq, outs, pr)
+    lines.insert(2, f"    {', '.join(str(s) for s in a)}, = a[0], "
+                 + ", ".join(f"a[{i}]" for i in range(1, nq)))
+    body += lines
+    # feet
+    outs = []
+    for i, (pos, J) in enumerate(eq.feet):
+        v = J * dqv
+        outs += [(f"P[{i}, {r}]", pos[r]) for r in range(2)]
+        outs += [(f"V[{i}, {r}]", v[r]) for r in range(2)]
+        outs += [(f"J[{i}, {r}, {k}]", J[r, k]) for r in range(2) for k in range(nq)]
+    body += _fn("feet", "x, p, P, V, J", eq, outs, pr)
+    F = sp.Matrix(2, 2, sp.symbols("F0:4", real=True))
+    outs = []
+    JtF = sp.zeros(nq, 1)
+    for i, (_, J) in enumerate(eq.feet):
+        dV = (J * dqv).jacobian(qv)
+        outs += [(f"dV[{i}, {r}, {k}]", dV[r, k]) for r in range(2) for k in range(nq)]
+        JtF += J.T * F[i, :].T
+    dJ = JtF.jacobian(qv)
+    outs += [(f"dJtF[{i}, {k}]", dJ[i, k]) for i in range(nq) for k in range(nq)]
+    lines = _fn("feet_jac", "x, F, p, dV, dJtF", eq, outs, pr)
+    lines.insert(2, "    F0, F1, F2, F3 = F[0, 0], F[0, 1], F[1, 0], F[1, 1]")
+    body += lines
+    body += _numpy_fn("_energies", eq, {"kinetic": eq.kinetic, "potential": eq.potential})
+    body += ["def energies(X, p):", "    d = _energies(X, p)",
+             "    return d['kinetic'], d['potential']", ""]
+    body += _numpy_fn("points", eq, eq.points)
+    head = [f"# walkerlab generated floating model code (walkerlab.models.floating); key {key}",
+            "# Do not edit: regenerated when the walker description or the generator changes.",
+            "from math import sin, cos, tan, sqrt  # noqa: F401",
+            "import numpy  # noqa: F401", "import numpy as np", "from numba import njit", "",
+            f"NQ = {nq}", f"COORDINATES = {tuple(str(s) for s in eq.q)!r}", ""]
+    return "\n".join(head + body) + "\n"
+
+
+# ---------------------------------------------------------------------------- cache
+_modules: dict[str, object] = {}
+
+
+def _source_hash(paths) -> str:
+    h = hashlib.sha256()
+    for p in paths:
+        h.update(Path(p).read_bytes())
+    return h.hexdigest()
+
+
+def module_key(structure: Structure, tag: str, sources=()) -> str:
+    """Cache key: the rigid generator's key of ``structure`` (structure + generator + sympy),
+    this file and ``sources`` (files whose text is part of the module), and ``tag``."""
+    from walkerlab.models import cache
+
+    h = hashlib.sha256(cache.cache_key(structure).encode())
+    h.update(tag.encode())
+    h.update(_source_hash([__file__, *sources]).encode())
+    return h.hexdigest()[:24]
+
+
+def load_generated(structure: Structure, tag: str, build, sources=()):
+    """Import the generated module ``<key>_<tag>.py`` of the cache folder
+    (:func:`walkerlab.models.cache.cache_dir`), writing it with ``build(key) -> str`` on a
+    miss (or a corrupt file).  Imported as a real module so numba's ``cache=True`` keeps its
+    machine code (in the user cache, :func:`walkerlab.usercache.use_for_numba`); no private
+    cache folder, or one that cannot be written, falls back to a private temporary copy.
+    """
+    from walkerlab import usercache
+    from walkerlab.models import cache
+
+    key = module_key(structure, tag, sources)
+    if key in _modules:
+        return _modules[key]
+    usercache.use_for_numba()  # numba's cache in the user cache, not in a runs folder
+    folder = cache.cache_dir()
+    path = folder / f"{key}_{tag}.py" if folder is not None else None
+    if path is None or cache.read_source(path) is None:  # missing, damaged or untrusted
+        body = build(key)
+        if path is None or not cache.write_source(path, body):
+            import tempfile
+
+            # no private cache folder: a private temporary copy (mkdtemp: mode 0700)
+            path = Path(tempfile.mkdtemp(prefix="walkerlab_fl_")) / f"{key}_{tag}.py"
+            cache.write_source(path, body)
+    name = f"walkerlab_{tag}_{key}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[name] = mod
+    spec.loader.exec_module(mod)
+    _modules[key] = mod
+    return mod
+
+
+def floating_source(structure: Structure, key: str) -> str:
+    """Generated source of the floating view of ``structure`` (numba functions, no imports of
+    other walkerlab packages)."""
+    return generate_floating(derive_floating(structure), key)
+
+
+def floating_module(structure: Structure):
+    """The imported (compiled on first call, cached) floating module of ``structure``.
+
+    Raises
+    ------
+    ValueError
+        Massless bodies (:data:`MASSLESS_MESSAGE`).
+    """
+    check_masses(structure)
+    return load_generated(structure, "floating", lambda key: floating_source(structure, key))
+
+
+class FloatingView:
+    """The floating view of one walker (structure + numbers).
+
+    Parameters
+    ----------
+    data : WalkerData
+    """
+
+    def __init__(self, data: WalkerData):
+        check_masses(data.structure)
+        self.data = data
+        self.structure = data.structure
+        self.params = np.asarray(data.params, dtype=float)
+        self._mod = floating_module(data.structure)
+        self.nq = int(self._mod.NQ)
+
+    def coordinate_names(self) -> tuple[str, ...]:
+        """Generalised coordinates, in order (module docstring)."""
+        return coordinate_names(self.structure)
+
+    def _x(self, q, dq=None) -> np.ndarray:
+        x = np.zeros(2 * self.nq)
+        x[:self.nq] = np.asarray(q, dtype=float)
+        if dq is not None:
+            x[self.nq:] = np.asarray(dq, dtype=float)
+        return x
+
+    def mass_matrix(self, q) -> np.ndarray:
+        """M(q) (nq, nq) [kg, kg m, kg m^2]."""
+        M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
+        self._mod.dyn(self._x(q), self.params, M, h)
+        return M
+
+    def bias(self, q, dq) -> np.ndarray:
+        """h(q, dq) = C(q, dq) dq + G(q) (nq,) [N, N m]: ``M qdd + h = sum J^T F``."""
+        M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
+        self._mod.dyn(self._x(q, dq), self.params, M, h)
+        return h
+
+    def gravity(self, q) -> np.ndarray:
+        """G(q) = h(q, 0) (nq,) [N, N m]."""
+        return self.bias(q, np.zeros(self.nq))
+
+    def contact_points(self, q, dq=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per foot (leg1, leg2): contact point (2, 2) [m], velocity of the material point
+        there (2, 2) [m/s] and its Jacobian (2, 2, nq)."""
+        P, V, J = np.empty((2, 2)), np.empty((2, 2)), np.empty((2, 2, self.nq))
+        self._mod.feet(self._x(q, dq), self.params, P, V, J)
+        return P, V, J
+
+    def energies(self, X) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic and potential energy [J] of states ``X`` (2 nq,) or (2 nq, k)."""
+        return self._mod.energies(X, self.params)
+
+    def points(self, X) -> dict:
+        """Named points (hip, each body, feet, arc feet's centres and contact points, knees)
+        (2,) or (2, k) [m], named as the rigid model's."""
+        return self._mod.points(X, self.params)
+
+
+def floating_view(data: WalkerData) -> FloatingView:
+    """The floating view of a walker (see :class:`FloatingView`).
+
+    Raises
+    ------
+    ValueError
+        A body with mass 0: :data:`MASSLESS_MESSAGE`.
+    """
+    return FloatingView(data)
