@@ -317,7 +317,7 @@ def read_cached_case(path: Path) -> dict | None:
     """A cached case result (:func:`time_case`) if the file holds a complete one, else None
     (missing, unreadable, not JSON, or lacking/mistyping a field: the case is measured
     again, issue 19)."""
-    from walkerlab.io.bounded import read_regular
+    from walkerlab.safefs import read_regular
 
     try:
         res = json.loads(read_regular(path, 1 << 20, "cache entry"))

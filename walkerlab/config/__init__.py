@@ -745,7 +745,7 @@ def load_scene(path: str | Path) -> Scene:
         File missing, malformed YAML, or a field that fails validation (one line, naming
         the file and the field).
     """
-    from walkerlab.io.bounded import NotARegularFile, read_regular
+    from walkerlab.safefs import NotARegularFile, read_regular
 
     path = Path(path)
     if path.is_dir():

@@ -110,7 +110,7 @@ def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
     walkerlab.io.runpaths.RunPathError
         ``path`` is a symbolic link.
     """
-    from walkerlab.io.runpaths import refuse_link
+    from walkerlab.safefs import refuse_link
 
     path = refuse_link(Path(path))
     try:

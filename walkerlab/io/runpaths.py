@@ -39,6 +39,8 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from walkerlab.safefs import RunPathError, refuse_link  # noqa: F401 (part of this API)
+
 try:  # POSIX; elsewhere runs are not locked
     import fcntl
 except ImportError:  # pragma: no cover
@@ -60,10 +62,6 @@ STAGE_PREFIXES = ("stability_map", "stability-map",  # stability_map_<kind>.h5
 
 ORIGIN_FILE = ".scene"
 MAX_MARKER_BYTES = 8192  # a resolved path of the scene file
-
-
-class RunPathError(ValueError):
-    """A name or output path is not allowed (one-line message)."""
 
 
 class ArtifactBusy(RuntimeError):
@@ -124,7 +122,7 @@ def scene_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
             _mkdir(d)
         return d
     marker = d / ORIGIN_FILE
-    from walkerlab.io.bounded import NotARegularFile, read_regular
+    from walkerlab.safefs import NotARegularFile, read_regular
 
     try:  # a bounded regular file: a FIFO or /dev/zero in its place must not hang or fill RAM
         owner = Path(read_regular(marker, MAX_MARKER_BYTES, "run-folder marker")
@@ -240,21 +238,6 @@ def atomic_text(path: Path, text: str) -> Path:
     from walkerlab.io.artifacts import atomic_write
 
     return atomic_write(path, lambda fh: fh.write(text.encode()))
-
-
-def refuse_link(path: Path | str) -> Path:
-    """``path`` if it is not a symbolic link; walkerlab never writes through one.
-
-    Raises
-    ------
-    RunPathError
-        ``path`` is a symbolic link (one line: remove it and rerun).
-    """
-    path = Path(path)
-    if os.path.islink(path):
-        raise RunPathError(f"{path}: is a symbolic link; walkerlab does not write through "
-                           "links (remove it and rerun)")
-    return path
 
 
 #: polling period while waiting for another writer's lock [s]

@@ -1,5 +1,11 @@
-"""Reading files that a user or another process may have replaced: bounded regular files only.
+"""File-system primitives for files a user or another process may have replaced: bounded
+regular files only when reading, never through a symbolic link when writing.
 
+The lowest layer of walkerlab's I/O: the scene loader (:mod:`walkerlab.config`), the run
+paths and locks (:mod:`walkerlab.io.runpaths`) and the atomic writer
+(:mod:`walkerlab.io.artifacts`) all build on it, and it imports nothing of walkerlab.
+
+Reading:
 Every file walkerlab reads from a runs folder or a scene path (the scene YAML, the
 ``runs/<name>/.scene`` marker, cache entries) goes through :func:`read_regular`: it is
 opened without blocking (a FIFO in its place cannot hang the open), must be a regular file
@@ -13,7 +19,26 @@ import os
 import stat
 from pathlib import Path
 
-__all__ = ["NotARegularFile", "read_regular"]
+__all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link"]
+
+
+class RunPathError(ValueError):
+    """A name or output path is not allowed (one-line message)."""
+
+
+def refuse_link(path: Path | str) -> Path:
+    """``path`` if it is not a symbolic link; walkerlab never writes through one.
+
+    Raises
+    ------
+    RunPathError
+        ``path`` is a symbolic link (one line: remove it and rerun).
+    """
+    path = Path(path)
+    if os.path.islink(path):
+        raise RunPathError(f"{path}: is a symbolic link; walkerlab does not write through "
+                           "links (remove it and rerun)")
+    return path
 
 
 class NotARegularFile(ValueError):
