@@ -188,44 +188,60 @@ class StepMap:
             else:
                 patch_spacing = 0.372
         self.spacing = float(patch_spacing)
+        # straight legs scuff the ground at mid-stance: footfall-relative lanes (module doc);
+        # a kneed swing leg is flexed there, so its continuous ground is kept
+        keep_ground = walker.continuous and walker.structure.knee
         self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing]),
-                                          lane2=np.array([0.0]), continuous=False)
+                                          lane2=np.array([0.0]), continuous=keep_ground)
         self.method, self.rtol, self.atol, self.t_max = method, rtol, atol, t_max
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
         w = self.walker
-        if w.structure.knee:
-            raise PeriodicGaitError("unsupported", "contact periodic gait: the mid-stance "
-                                    "section is defined for straight legs only")
         kern = w.kernels
         args = (w.contact_params, w.walker_params, w.lane1, w.lane2)
         self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
         self._fj = lambda x: kern.jac(x, *args)  # noqa: E731
         self.n, self.t = w.normal, w.tangent
         self.idx = StateIndex(w)
-        # leg i's angle and rate by name (leg1 = 0, leg2 = 1), never by row
-        self._angle = [self.idx["theta1"], self.idx["theta2"]]
-        self._rate = [self.idx.rate_of("theta1"), self.idx.rate_of("theta2")]
+        # every column by name (leg1 = 0, leg2 = 1), never by row: each leg's link angles,
+        # proximal first (the section is the crossing of the two proximal links)
+        self._links = [w.leg_angle_states("leg1"), w.leg_angle_states("leg2")]
+        self._angle = [self.idx[a[0]] for a in self._links]
+        self._rate = [self.idx.rate_of(a[0]) for a in self._links]
+        self.names, self.units, self.scale = section_coordinates(w)
+
+    def _columns(self, stance: int) -> list[int]:
+        """State columns of the link coordinates in section order, with foot ``stance``."""
+        ix, st, sw = self.idx, self._links[stance], self._links[1 - stance]
+        return ([ix[a] for a in st] + [ix[a] for a in sw[1:]]
+                + [ix.rate_of(a) for a in sw] + [ix.rate_of(a) for a in st])
 
     # ------------------------------------------------------------------ coordinates
     def to_state(self, z) -> np.ndarray:
-        """Full state (8,) from section coordinates (leg2 stance, stance foot at s = 0)."""
-        th, wsw, wst, d, vt, dd = np.asarray(z, float)
+        """Full state (2 nq,) from section coordinates (leg2 stance, stance foot at s = 0)."""
+        z = np.asarray(z, float)
+        nl = len(z) - 3
+        d, vt, dd = z[nl:]
         p = -d * self.n
         v = vt * self.t - dd * self.n
-        # stance foot at p and at rest, then the whole walker translated at v
+        # link state by name: the swing leg's proximal link aligned with the stance one's
+        val = dict(zip(self._columns(1), z[:nl]))
+        val[self._angle[0]] = val[self._angle[1]]
         ix = self.idx
-        x = self.walker.pinned_to_full(np.array([th, th, wsw, wst]), p)
+        cols = [ix[c] for c in ix.names[ix.coordinates] if c not in ("hip_x", "hip_y")]
+        zp = np.array([val[c] for c in cols] + [val[c + ix.n // 2] for c in cols])
+        # stance foot at p and at rest, then the whole walker translated at v
+        x = self.walker.pinned_to_full(zp, p)
         x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] += v
         return x
 
     def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
-        """Section coordinates (6,) and along-slope position s [m] of foot ``stance`` (0/1)."""
-        px, py, vx, vy = self.walker.foot_state(np.asarray(x, float), stance)
+        """Section coordinates (:attr:`names`) and along-slope position s [m] of foot
+        ``stance`` (0/1)."""
+        x = np.asarray(x, float)
+        px, py, vx, vy = self.walker.foot_state(x, stance)
         p, v = np.array([px, py]), np.array([vx, vy])
-        sw = 1 - stance
-        z = np.array([x[self._angle[stance]], x[self._rate[sw]], x[self._rate[stance]],
-                      -p @ self.n, v @ self.t, -v @ self.n])
+        z = np.concatenate([x[self._columns(stance)], [-p @ self.n, v @ self.t, -v @ self.n]])
         return z, float(p @ self.t)
 
     # ------------------------------------------------------------------ the map
@@ -365,6 +381,8 @@ class StepMap:
             te = sol.t_events[0][0] if sol.t_events[0].size else sol.t[-1]
             tt = np.linspace(0.0, te, 2001)
             X = sol.sol(tt).T
+        if self.walker.continuous:
+            return np.inf  # continuous ground: no patch edges
         cq = self.walker.contact_quantities(X)
         hw = self.walker.patch_half_width
         margin = np.inf
@@ -378,9 +396,44 @@ class StepMap:
         return margin
 
 
-#: coordinate scales (SI) used for the root finder, the residual and the FD steps; the
-#: penetration scale is replaced by the walker's static penetration at run time.
+#: coordinate scales (SI) of the straight-legged section (:data:`SECTION_NAMES`) used for
+#: the root finder, the residual and the FD steps; the penetration scale is replaced by the
+#: walker's static penetration at run time (:func:`section_coordinates` for any walker).
 SCALES = np.array([1.0, 1.0, 1.0, 6e-5, 1e-3, 1e-3])
+
+
+def _role_name(state: str, role: str) -> str:
+    """``theta1_thigh`` -> ``theta_<role>_thigh``, ``dtheta2`` -> ``dtheta_<role>``."""
+    head, _, tail = state.partition("_")
+    return head.rstrip("12") + f"_{role}" + (f"_{tail}" if tail else "")
+
+
+def section_coordinates(walker: ContactWalker) -> tuple[tuple, tuple, np.ndarray]:
+    """Names, units and scales of the mid-stance section coordinates of ``walker``.
+
+    All states minus the section constraint (the swing leg's proximal link aligned with the
+    stance leg's) minus the along-slope translation, the hip position replaced by the stance
+    foot's contact: the stance leg's link angles, the swing leg's other link angles, the
+    swing leg's link rates, the stance leg's link rates, then ``delta_stance`` [m],
+    ``v_t_stance`` [m/s], ``ddelta_stance`` [m/s].  Straight legs: :data:`SECTION_NAMES`
+    (6); kneed legs: 10.
+
+    Returns
+    -------
+    names : tuple of str
+    units : tuple of str
+    scale : ndarray (n,)
+        1 rad, 1 rad/s, the static penetration, 1 mm/s, 1 mm/s (:data:`SCALES`).
+    """
+    st, sw = walker.leg_angle_states("leg2"), walker.leg_angle_states("leg1")
+    angles = [_role_name(a, "stance") for a in st] + [_role_name(a, "swing") for a in sw[1:]]
+    rates = ([_role_name("d" + a, "swing") for a in sw]
+             + [_role_name("d" + a, "stance") for a in st])
+    names = tuple(angles + rates) + SECTION_NAMES[-3:]
+    units = ("rad",) * len(angles) + ("rad/s",) * len(rates) + SECTION_UNITS[-3:]
+    scale = np.array([1.0] * (len(angles) + len(rates))
+                     + [walker.static_penetration(), 1e-3, 1e-3])
+    return names, units, scale
 
 
 def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
@@ -548,19 +601,19 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     deadline = None if time_limit_s is None else wall + time_limit_s
     walker, guess, ideal = _walker_and_guess(walker_or_scene, guess)
     P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol, deadline=deadline)
-    scale = SCALES.copy()
-    scale[SECTION_NAMES.index("delta_stance")] = walker.static_penetration()
+    scale = P.scale
     coarse = coarse_rtol is not None and coarse_rtol > rtol
     # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
     PC = StepMap(walker, patch_spacing, method=method, rtol=coarse_rtol, atol=coarse_atol,
                  deadline=deadline) if coarse else P
     guess = np.asarray(guess, float)
-    if guess.size == 4:
-        z = section_guess_from_ideal(PC, guess, rate_scale)
-    elif guess.size == 6:
+    if guess.size == len(P.names):
         z = guess.copy()
+    elif guess.size == 2 * len(walker.structure.roles):
+        z = section_guess_from_ideal(PC, guess, rate_scale)
     else:
-        raise ValueError("guess must be a section state (6,) or an ideal state (4,)")
+        raise ValueError(f"guess must be a section state ({len(P.names)},) or an ideal state "
+                         f"({2 * len(walker.structure.roles)},)")
     hist = []
     for _ in range(warmup_steps):
         z1 = PC(z)[0]
@@ -574,7 +627,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         return _last_call_memo(
             lambda u: fd_jacobian(lambda v: M(v)[0], u * scale, scale, 10 * fd_step,
                                   central=method != "odeint")
-            * scale[None, :] / scale[:, None] - np.eye(6))
+            * scale[None, :] / scale[:, None] - np.eye(len(scale)))
 
     root_nfev = 0
     jac = dG_of(P)
@@ -618,7 +671,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         info["ideal_multipliers"] = ideal.multipliers_variational
     resid = float(np.max(np.abs(res_si / scale)))
     return ContactPeriodicGait(
-        z=zs, fixed_point=dict(zip(SECTION_NAMES, map(float, zs))), period_s=T,
+        z=zs, fixed_point=dict(zip(P.names, map(float, zs))), period_s=T,
         step_length_m=ell, residual=resid, residual_si=res_si, jacobian=J, multipliers=ev,
         multiplier_fd_spread=spread, stable=bool(np.all(np.abs(ev) < 1)),
         converged=bool(resid < residual_tol), message=sol.message,
