@@ -2,16 +2,20 @@
 
 Poincaré section
 ----------------
-Mid-stance single support: the legs are aligned, ``theta_swing - theta_stance`` crosses zero
-upward.  In the compliant model a heel strike is not an instant but a double-support phase
+Mid-stance single support: the legs' proximal links are aligned (straight legs: the legs;
+kneed legs: the thighs), ``theta_swing - theta_stance`` of those links crosses zero upward
+(the links are found by name, ``walker.leg_angle_states(leg)[0]``).  In the compliant model a heel strike is not an instant but a double-support phase
 (both feet loaded for ~10 ms), so a touchdown section would cut through an impact transient;
 at mid-stance only the stance foot is loaded and the state is smooth.
 
-Section coordinates (6 = 8 states - section constraint - translation along the slope)::
+Section coordinates (all states - section constraint - translation along the slope, by
+name, :func:`section_coordinates`); straight legs (6 = 8 - 2)::
 
     z = [theta_stance, dtheta_swing, dtheta_stance,
          delta_stance, v_t_stance, ddelta_stance]
 
+kneed legs (10 = 12 - 2): ``theta_stance_thigh, theta_stance_shank, theta_swing_shank``, the
+four link rates (swing leg first), then the three stance-foot coordinates.
 ``theta_swing = theta_stance`` on the section [rad]; rates [rad/s]; ``delta_stance`` is the
 stance foot's penetration [m] (along -n), ``v_t_stance`` its down-slope slip velocity [m/s],
 ``ddelta_stance`` its penetration rate [m/s].  The along-slope position of the stance foot is
@@ -29,7 +33,9 @@ length (along-slope displacement of the stance foot from one mid-stance to the n
 
 Terrain (the choice made here, and why)
 ---------------------------------------
-*Continuous ground* is not usable at this section: with rigid legs of equal length the swing
+Kneed walkers keep their scene's *continuous ground*: at the section the swing knee is
+flexed (~0.5 rad on ``configs/kneed.yaml``) and the swing foot ~5 cm above the ground.
+For straight legs, *continuous ground* is not usable at this section: with rigid legs of equal length the swing
 foot is exactly at stance-foot depth when the legs are aligned, i.e. it penetrates the ground
 (foot scuffing) precisely on the section.  *Checkerboard at fixed positions* breaks the
 translation invariance (the gait's steps are ~12 mm shorter than the ideal ones, so footfalls
@@ -94,8 +100,9 @@ class ContactPeriodicGait:
 
     Attributes
     ----------
-    z : ndarray (6,)
-        Fixed point in :data:`SECTION_NAMES` order (units :data:`SECTION_UNITS`).
+    z : ndarray (n,)
+        Fixed point in the section's order (:func:`section_coordinates`; straight legs
+        :data:`SECTION_NAMES`, units :data:`SECTION_UNITS`; n = 6, kneed 10).
     fixed_point : dict[str, float]
         The same, named.
     period_s : float
@@ -105,11 +112,11 @@ class ContactPeriodicGait:
         Along-slope advance of the stance foot per step [m].
     residual : float
         max |(P(z) - z) / scale| (scaled, see :data:`SCALES`) [-].
-    residual_si : ndarray (6,)
+    residual_si : ndarray (n,)
         P(z) - z in SI units.
-    jacobian : ndarray (6, 6)
-        dP/dz in SI (rows/cols in :data:`SECTION_NAMES` order).
-    multipliers : ndarray (6,) complex
+    jacobian : ndarray (n, n)
+        dP/dz in SI (rows/cols in the section's order).
+    multipliers : ndarray (n,) complex
         Floquet multipliers, sorted by decreasing modulus.
     multiplier_fd_spread : float
         max change of the slow (|lambda| > 1e-3) sorted multipliers when the FD step is
@@ -121,8 +128,9 @@ class ContactPeriodicGait:
     nfev : int
         Step-map evaluations (root finding + Jacobian).
     patch_margin_m : float
-        Smallest distance [m] of a loaded foot to the edge of its patch on the orbit.
-    full_state : ndarray (8,)
+        Smallest distance [m] of a loaded foot to the edge of its patch on the orbit (inf on
+        continuous ground).
+    full_state : ndarray (2 nq,)
         Full state at the section (leg2 stance at s = 0).
     wall_time_s : float
     info : dict
@@ -155,7 +163,7 @@ class ContactPeriodicGait:
 
 class PeriodicGaitError(RuntimeError):
     """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
-    "time_limit", "solver_failure", "unsupported" (kneed walker: no section)."""
+    "time_limit", "solver_failure"."""
 
     def __init__(self, kind: str, message: str):
         super().__init__(message)
@@ -168,7 +176,8 @@ class StepMap:
     Parameters
     ----------
     walker : ContactWalker
-        Parameters and contact law; its lanes are replaced by footfall-relative lanes.
+        Parameters and contact law; its lanes are replaced by footfall-relative lanes
+        (kneed walkers on continuous ground keep it).  Any walker the contact model builds.
     patch_spacing : float, optional
         Distance [m] ahead of the stance foot of the swing lane's patch (default: the
         walker's lane spacing ``lane1[0] - lane2[0]`` if it has lanes, else 0.372 m).
@@ -341,7 +350,7 @@ class StepMap:
                                 f"{self.t_max:g} s")
 
     def __call__(self, z):
-        """One step: returns (P(z) (6,), period [s], step length [m]).
+        """One step: returns (P(z) (n,), period [s], step length [m]).
 
         Raises
         ------
@@ -553,10 +562,11 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         A scene is built into a walker with :func:`walkerlab.contact.scene.build`; then
         the default guess is its ideal (derived) fixed point.
     guess : array_like, optional
-        Either a section state (6,) (:data:`SECTION_NAMES`) or an ideal post-impact state (4,)
-        ``[th_swing, th_stance, w_swing, w_stance]`` (role order, as ``solve_variant``).
+        Either a section state (n,) (:func:`section_coordinates`) or an ideal post-impact
+        state (role order of the rigid walker, as ``solve_variant``; compass gait
+        ``[th_swing, th_stance, w_swing, w_stance]``).
     rate_scale : (float, float)
-        Multipliers on the rates of a (4,) guess.
+        Multipliers on the swing and stance legs' rates of an ideal-state guess.
     warmup_steps : int
         Steps of the map iterated from the guess before root finding (the gait is stable,
         so this brings the guess into the Newton basin).
