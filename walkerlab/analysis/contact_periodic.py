@@ -484,26 +484,42 @@ def rigid_limit_contact(walker: ContactWalker, kappa: float, mu_s: float = 2.0,
     return dataclasses.replace(walker, contact=new)
 
 
-def _walker_and_guess(walker_or_scene, guess):
-    if isinstance(walker_or_scene, ContactWalker):
-        return walker_or_scene, guess, None
+def ideal_gait(scene):
+    """The rigid (derived) periodic gait of ``scene`` from its ``fixedpoint`` section.
+
+    Returns
+    -------
+    walkerlab.analysis.gaits result (``x`` role-order post-impact state, ``period_s``, ...)
+
+    Raises
+    ------
+    ValueError
+        The scene has no ``fixedpoint`` section.
+    """
     from walkerlab.analysis.gaits import find_gaits
     from walkerlab.analysis.hybrid import Solver
-    from walkerlab.contact.scene import build
     from walkerlab.models.registry import build_walker
 
-    scene = walker_or_scene
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})
     fp = sc.fixedpoint
     if fp is None:
         raise ValueError(f"scene '{scene.name}' has no 'fixedpoint' section (initial guess of "
                          "the ideal gait)")
     iw = build_walker(sc)
-    ideal = find_gaits(iw, Solver.from_settings(sc.solver),
-                       None if fp.initial_guess is None
-                       else fp.initial_guess.as_array(iw.state_names()),
-                       policy=fp.gait, other_gait=False, xtol=fp.tolerance,
-                       fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
+    return find_gaits(iw, Solver.from_settings(sc.solver),
+                      None if fp.initial_guess is None
+                      else fp.initial_guess.as_array(iw.state_names()),
+                      policy=fp.gait, other_gait=False, xtol=fp.tolerance,
+                      fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
+
+
+def _walker_and_guess(walker_or_scene, guess):
+    if isinstance(walker_or_scene, ContactWalker):
+        return walker_or_scene, guess, None
+    from walkerlab.contact.scene import build
+
+    scene = walker_or_scene
+    ideal = ideal_gait(scene)
     walker, _ = build(scene, ideal.x, 2)
     return walker, (ideal.x if guess is None else guess), ideal
 
