@@ -4,7 +4,8 @@ Poincaré section
 ----------------
 Mid-stance single support: the legs' proximal links are aligned (straight legs: the legs;
 kneed legs: the thighs), ``theta_swing - theta_stance`` of those links crosses zero upward
-(the links are found by name, ``walker.leg_angle_states(leg)[0]``).  In the compliant model a heel strike is not an instant but a double-support phase
+(the links are found by name, ``walker.leg_angle_states(leg)[0]``).  In the compliant
+model a heel strike is not an instant but a double-support phase
 (both feet loaded for ~10 ms), so a touchdown section would cut through an impact transient;
 at mid-stance only the stance foot is loaded and the state is smooth.
 
@@ -23,36 +24,37 @@ dropped (the dynamics are invariant under translation along the slope, see *Terr
 
 Step map
 --------
-``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 =
-stance, leg1 = swing: the legs are identical, so one orientation suffices), integrate with
+``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 = stance,
+leg1 = swing: the legs are identical, so one orientation suffices), integrate with
 ``solve_ivp`` (LSODA or Radau with the analytic numba Jacobian) until the next upward zero
-of ``theta2 - theta1`` (mid-stance of the other leg), located by ``solve_ivp``'s event
-root-finding on the dense output; swap the leg roles and express the state relative to the
-new stance foot (leg1).  Outputs besides ``P(z)``: the step period ``T`` [s] and the step
-length (along-slope displacement of the stance foot from one mid-stance to the next) [m].
+of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), located by
+``solve_ivp``'s event root-finding on the dense output; swap the leg roles and express the
+state relative to the new stance foot (leg1).  Outputs besides ``P(z)``: the step period
+``T`` [s] and the step length (along-slope displacement of the stance foot from one
+mid-stance to the next) [m].
 
 Terrain (the choice made here, and why)
 ---------------------------------------
 Kneed walkers keep their scene's *continuous ground*: at the section the swing knee is
 flexed (~0.5 rad on ``configs/kneed.yaml``) and the swing foot ~5 cm above the ground.
-For straight legs, *continuous ground* is not usable at this section: with rigid legs of equal length the swing
-foot is exactly at stance-foot depth when the legs are aligned, i.e. it penetrates the ground
-(foot scuffing) precisely on the section.  *Checkerboard at fixed positions* breaks the
-translation invariance (the gait's steps are ~12 mm shorter than the ideal ones, so footfalls
-drift across the patches).  We therefore use **checkerboard lanes placed relative to the
-current footfall**: during each step the stance lane has one patch centred on the stance
-foot's section position (s = 0) and the swing lane one patch centred one *ideal* step length
-``l`` ahead (the paper's rule: patches around the footfalls of the ideal gait).  The swing
-foot passes over a gap at mid-stance exactly as in the ADAMS model.  The re-centring is
-physically invisible as long as each foot stays inside its patch during its stance (the
-IMPACT force only depends on the patch membership, not on the distance to the centre):
-:func:`find_contact_periodic_gait` reports the worst margin to a patch edge
+For straight legs, *continuous ground* is not usable at this section: with rigid legs of
+equal length the swing foot is exactly at stance-foot depth when the legs are aligned, i.e.
+it penetrates the ground (foot scuffing) precisely on the section.  *Checkerboard at fixed
+positions* breaks the translation invariance (the gait's steps are ~12 mm shorter than the
+ideal ones, so footfalls drift across the patches).  We therefore use **checkerboard lanes
+placed relative to the current footfall**: during each step the stance lane has one patch
+centred on the stance foot's section position (s = 0) and the swing lane one patch centred
+one *ideal* step length ``l`` ahead (the paper's rule: patches around the footfalls of the
+ideal gait).  The swing foot passes over a gap at mid-stance exactly as in the ADAMS model.
+The re-centring is physically invisible as long as each foot stays inside its patch during
+its stance (the IMPACT force only depends on the patch membership, not on the distance to
+the centre): :func:`find_contact_periodic_gait` reports the worst margin to a patch edge
 (``patch_margin_m``), and the fixed point is then a true periodic gait of a checkerboard
 whose patches are spaced by the gait's own step length.
 
 Floquet multipliers
 -------------------
-Eigenvalues of the 6x6 Jacobian of ``P`` at the fixed point, by central finite differences
+Eigenvalues of the n x n Jacobian of ``P`` (n = 6, kneed 10) at the fixed point, by central finite differences
 in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the coordinate scale
 (:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1 mm/s, 1 mm/s), with
 the map integrated at rtol 1e-12 / atol 1e-14.  Measured on the paper's contact: the map's
