@@ -165,7 +165,8 @@ def run_benchmark(n_strides: int = 5, methods=None,
 #: rtols scanned (loose to tight) for the band reaching the target error; each band is
 #: ``r * BAND_FACTORS`` (the step sequence jumps with tiny tolerance changes, so a single
 #: rtol could land on a lucky or unlucky run: the band's worst error and median time count).
-SCAN_RTOLS = (1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 3e-10, 1e-10, 3e-11)
+SCAN_RTOLS = (1e-6, 5e-7, 2e-7, 1e-7, 5e-8, 2e-8, 1e-8, 5e-9, 2e-9, 1e-9, 5e-10, 2e-10, 1e-10,
+              5e-11)
 BAND_FACTORS = (1.0, 1 / 1.5, 1 / 2, 1 / 3)
 
 
