@@ -54,17 +54,20 @@ whose patches are spaced by the gait's own step length.
 
 Floquet multipliers
 -------------------
-Eigenvalues of the n x n Jacobian of ``P`` (n = 6, kneed 10) at the fixed point, by central finite differences
-in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the coordinate scale
-(:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1 mm/s, 1 mm/s), with
-the map integrated at rtol 1e-12 / atol 1e-14.  Measured on the paper's contact: the map's
-noise (adaptive-step jitter) is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD
-noise is ~1e-10 / h ~ 1e-6, and the truncation error O(h^2) is ~1e-8; the multipliers
-agree to ~1e-5 between h = 1e-3, 1e-4 and 1e-5 (``multiplier_fd_spread`` reports the
-change for h*3 and h/3).  The three "fast" multipliers (normal contact mode, tangential
-creep of the stance foot, both damped within milliseconds) are ~1e-5..1e-8, i.e. zero
-within the FD noise; the three slow ones belong to the swing dynamics and correspond to the
-ideal model's nonzero multipliers (section-independent for a periodic orbit).
+Eigenvalues of the n x n Jacobian of ``P`` (n = 6, kneed 10) at the fixed point, by central
+finite differences in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the
+coordinate scale (:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1
+mm/s, 1 mm/s; kneed: every angle 1 rad, every rate 1 rad/s), with the map integrated at rtol
+1e-12 / atol 1e-14.  Measured on the paper's contact: the map's noise (adaptive-step jitter)
+is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD noise is ~1e-10 / h ~ 1e-6,
+and the truncation error O(h^2) is ~1e-8; the multipliers agree to ~1e-5 between h = 1e-3,
+1e-4 and 1e-5 (``multiplier_fd_spread`` reports the change for h*3 and h/3).  The three
+"fast" multipliers (normal contact mode, tangential creep of the stance foot, both damped
+within milliseconds) are ~1e-5..1e-8, i.e. zero within the FD noise; the three slow ones
+belong to the swing dynamics and correspond to the ideal model's nonzero multipliers
+(section-independent for a periodic orbit).  Kneed walker (``configs/kneed.yaml``): the same
+three slow ones (0.469 +- 0.498j, 0.113; rigid 0.548 +- 0.499j, 0.108), the seven others
+(contact and knee-stop modes) < 1e-4.
 
 Rigid limit
 -----------
