@@ -170,6 +170,8 @@ def test_d9_scene_file_errors_are_one_line(tmp_path, kind, match):
 # ------------------------------------------------------------------ D3, D9, D11: CLI layer
 @pytest.mark.parametrize("args,match", [
     (["bench", "nonsense"], "unknown benchmark"),
+    (["bench", "ideal", "{scene}"], "apply to 'bench contact' only"),
+    (["bench", "contact", "no_such_scene.yaml"], "no_such_scene.yaml"),
     (["simulate", "{scene}", "--strides", "10000000"], "--strides 10000000"),
     (["sweep", "{scene}", "--param", "slope.angle_deg=0:99999:1", "--param",
       "walker.hip_mass_kg=0:99999:1"], "at most 1,000,000"),

@@ -506,11 +506,15 @@ def export(scene: Path | None = SceneArg,
 @_guard
 def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
                                      " | all (all but basin)"),
+          scenes: list[Path] | None = typer.Argument(
+              None, help="contact only: scene YAML files whose walkers are timed (5 contact "
+              "strides at <= 1e-6 rad against a tight reference), e.g. configs/kneed.yaml "
+              "configs/paper.yaml", show_default=False),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
     from walkerlab.stages.bench import run_bench
 
-    for line in run_bench(what, out):
+    for line in run_bench(what, out, scenes=scenes or None):
         typer.echo(line)
 
 

@@ -1,10 +1,12 @@
 """Gait-level checks: the paper walker on the checkerboard, pinning, falls, benchmark."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from tests.contact.conftest import FP, STEP_LENGTH
-from walkerlab.analysis.contact_bench import run_benchmark
+from walkerlab.analysis.contact_bench import BAND_FACTORS, run_benchmark, run_scene_benchmark
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
 from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
 from walkerlab.contact import ContactWalker
@@ -84,3 +86,23 @@ def test_benchmark_runs():
     assert out["rhs_cost"]["rhs_numba_us"] > 0 and out["rhs_cost"]["jac_numba_us"] > 0
     for run in out["runs"]:
         assert run["heel_strikes"] >= 2 and run["max_angle_error_rad"] < 1e-4
+
+
+def test_scene_benchmark_finds_the_band_reaching_the_target():
+    """The scene benchmark (``walkerlab bench contact configs/kneed.yaml``), cut to one
+    stride and a loose 1e-4 rad target so it runs in ~1 s: the band it reports is the
+    loosest of its scan whose four runs all reach the target, and the scan shows a looser
+    rtol missing it (so the search did search).  No time is asserted."""
+    from walkerlab.config import load_scene
+
+    scene = load_scene(Path(__file__).resolve().parents[2] / "configs" / "kneed.yaml")
+    out = run_scene_benchmark(scene, n_strides=1, methods=("cyrk_bdf",),
+                              target_error_rad=1e-4, repeats=1)
+    assert out["reference"]["termination"] == "t_final"
+    assert out["reference"]["heel_strikes"] >= 2
+    t = out["target"]["cyrk_bdf"]
+    assert t["reached"] and t["worst_error_rad"] <= 1e-4
+    assert t["rtols"] == pytest.approx([t["rtols"][0] * f for f in BAND_FACTORS])
+    scan = out["scan"]["cyrk_bdf"]
+    assert any(r["error"] > 1e-4 and r["rtol"] > t["rtols"][0] for r in scan)
+    assert t["median_wall_time_s"] > 0

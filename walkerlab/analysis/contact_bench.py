@@ -17,7 +17,8 @@ from walkerlab.integrate.contact import StateIndex
 
 from .contact_sim import initial_state_from_ideal, simulate_contact
 
-__all__ = ["EXAMPLE_IDEAL", "TARGET_RTOLS", "leg_angle_columns", "rhs_cost", "run_benchmark"]
+__all__ = ["BAND_FACTORS", "EXAMPLE_IDEAL", "SCAN_RTOLS", "TARGET_RTOLS", "leg_angle_columns",
+           "rhs_cost", "run_benchmark", "run_scene_benchmark"]
 
 #: Benchmark inputs only (approximate ideal fixed point of the paper walker on phi = 0.0174
 #: rad, leg1 swing / leg2 stance): the lead supplies exact values at run time.
@@ -159,3 +160,108 @@ def run_benchmark(n_strides: int = 5, methods=None,
             "rhs_cost": rhs_cost(walker, x0),
             "issue10_target": target,
             "runs": runs}
+
+
+#: rtols scanned (loose to tight) for the band reaching the target error; each band is
+#: ``r * BAND_FACTORS`` (the step sequence jumps with tiny tolerance changes, so a single
+#: rtol could land on a lucky or unlucky run: the band's worst error and median time count).
+SCAN_RTOLS = (1e-6, 5e-7, 2e-7, 1e-7, 5e-8, 2e-8, 1e-8, 5e-9, 2e-9, 1e-9, 5e-10, 2e-10, 1e-10,
+              5e-11)
+BAND_FACTORS = (1.0, 1 / 1.5, 1 / 2, 1 / 3)
+
+
+def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"),
+                        target_error_rad: float = 1e-6, repeats: int = 5,
+                        reference_rtol: float = 1e-11) -> dict:
+    """Time for ``n_strides`` contact strides of any scene's walker at a target accuracy.
+
+    The walker, start and limits are the scene's contact run
+    (:func:`walkerlab.analysis.contact_sim.scene_start`) from its rigid fixed point; the
+    reference is odeint at ``reference_rtol`` (``atol = 1e-3 rtol``); the time span is 3 %
+    longer than ``2 n_strides`` rigid step periods.  For each method, the loosest band
+    ``r * BAND_FACTORS`` (``r`` from :data:`SCAN_RTOLS`, ``atol = 0.1 rtol``) whose worst
+    leg-angle error (every link angle, on the common samples) is <= ``target_error_rad`` is
+    reported with the median wall time (per rtol the median of ``repeats`` runs, then the
+    median over the band).
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+        A scene with a ``contact`` and a ``fixedpoint`` section.
+    n_strides : int
+        Strides (2 steps each) [-].
+    methods : sequence of str
+        Contact integrators (:class:`ContactSolverSettings` ``method``).
+    target_error_rad : float
+        Worst leg-angle error allowed [rad].
+    repeats : int
+        Runs per tolerance (median wall time).
+    reference_rtol : float
+        Tolerance of the reference run [-].
+
+    Returns
+    -------
+    dict
+        ``{"scene", "n_strides", "t_final_s", "reference": {...}, "rhs_cost": {...},
+        "target": {method: {rtols, max_angle_error_rad, wall_time_s, nfev,
+        median_wall_time_s, worst_error_rad, reached}}, "scan": {method: [{rtol, error,
+        wall_time_s, nfev}]}}``.
+
+    Raises
+    ------
+    ValueError
+        The scene has no ``fixedpoint`` section.
+    ContactSceneError
+        The scene has no ``contact`` section or a massless body.
+    """
+    from .contact_periodic import ideal_gait
+    from .contact_sim import scene_start
+
+    ideal = ideal_gait(scene)
+    walker, x0, limits, _ = scene_start(scene, ideal.x, n_strides + 1)
+    t_final = 1.03 * 2 * n_strides * ideal.period_s
+    ref = simulate_contact(walker, x0, t_final, ContactSolverSettings(
+        method="odeint", rtol=reference_rtol, atol=1e-3 * reference_rtol), limits)
+    angles = leg_angle_columns(walker)
+
+    def error(r):
+        n = min(len(r.t), len(ref.t))
+        return float(np.abs(r.x[:n, angles] - ref.x[:n, angles]).max())
+
+    def timed(method, rtol):
+        rs = [simulate_contact(walker, x0, t_final, ContactSolverSettings(
+            method=method, rtol=rtol, atol=0.1 * rtol), limits) for _ in range(repeats)]
+        return (float(np.median([r.wall_time_s for r in rs])), error(rs[0]), rs[0].nfev,
+                rs[0].termination)
+
+    target, scan = {}, {}
+    for method in methods:
+        scan[method] = []
+        best = None
+        for r0 in SCAN_RTOLS:
+            band = [r0 * f for f in BAND_FACTORS]
+            rows = []
+            for rt in band:
+                t, e, nf, term = timed(method, rt)
+                rows.append({"rtol": rt, "error": e, "wall_time_s": t, "nfev": nf,
+                             "termination": term})
+                if e > target_error_rad:
+                    break  # this band misses the target: the next tighter one
+            scan[method] += rows
+            if len(rows) == len(band) and all(r["error"] <= target_error_rad for r in rows):
+                best = rows
+                break
+        target[method] = {"reached": best is not None}
+        if best is not None:
+            target[method].update(
+                rtols=[r["rtol"] for r in best], atol_over_rtol=0.1,
+                max_angle_error_rad=[r["error"] for r in best],
+                wall_time_s=[r["wall_time_s"] for r in best], nfev=[r["nfev"] for r in best],
+                median_wall_time_s=float(np.median([r["wall_time_s"] for r in best])),
+                worst_error_rad=float(max(r["error"] for r in best)))
+    return {"scene": scene.name, "n_strides": n_strides, "t_final_s": t_final,
+            "reference": {"method": "odeint", "rtol": reference_rtol,
+                          "wall_time_s": ref.wall_time_s, "nfev": ref.nfev,
+                          "heel_strikes": len(ref.heel_strike_times),
+                          "termination": ref.termination},
+            "rhs_cost": rhs_cost(walker, x0), "target": target, "scan": scan}

@@ -2,16 +2,21 @@
 
 Poincaré section
 ----------------
-Mid-stance single support: the legs are aligned, ``theta_swing - theta_stance`` crosses zero
-upward.  In the compliant model a heel strike is not an instant but a double-support phase
+Mid-stance single support: the legs' proximal links are aligned (straight legs: the legs;
+kneed legs: the thighs), ``theta_swing - theta_stance`` of those links crosses zero upward
+(the links are found by name, ``walker.leg_angle_states(leg)[0]``).  In the compliant
+model a heel strike is not an instant but a double-support phase
 (both feet loaded for ~10 ms), so a touchdown section would cut through an impact transient;
 at mid-stance only the stance foot is loaded and the state is smooth.
 
-Section coordinates (6 = 8 states - section constraint - translation along the slope)::
+Section coordinates (all states - section constraint - translation along the slope, by
+name, :func:`section_coordinates`); straight legs (6 = 8 - 2)::
 
     z = [theta_stance, dtheta_swing, dtheta_stance,
          delta_stance, v_t_stance, ddelta_stance]
 
+kneed legs (10 = 12 - 2): ``theta_stance_thigh, theta_stance_shank, theta_swing_shank``, the
+four link rates (swing leg first), then the three stance-foot coordinates.
 ``theta_swing = theta_stance`` on the section [rad]; rates [rad/s]; ``delta_stance`` is the
 stance foot's penetration [m] (along -n), ``v_t_stance`` its down-slope slip velocity [m/s],
 ``ddelta_stance`` its penetration rate [m/s].  The along-slope position of the stance foot is
@@ -19,44 +24,50 @@ dropped (the dynamics are invariant under translation along the slope, see *Terr
 
 Step map
 --------
-``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 =
-stance, leg1 = swing: the legs are identical, so one orientation suffices), integrate with
+``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 = stance,
+leg1 = swing: the legs are identical, so one orientation suffices), integrate with
 ``solve_ivp`` (LSODA or Radau with the analytic numba Jacobian) until the next upward zero
-of ``theta2 - theta1`` (mid-stance of the other leg), located by ``solve_ivp``'s event
-root-finding on the dense output; swap the leg roles and express the state relative to the
-new stance foot (leg1).  Outputs besides ``P(z)``: the step period ``T`` [s] and the step
-length (along-slope displacement of the stance foot from one mid-stance to the next) [m].
+of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), located by
+``solve_ivp``'s event root-finding on the dense output; swap the leg roles and express the
+state relative to the new stance foot (leg1).  Outputs besides ``P(z)``: the step period
+``T`` [s] and the step length (along-slope displacement of the stance foot from one
+mid-stance to the next) [m].
 
 Terrain (the choice made here, and why)
 ---------------------------------------
-*Continuous ground* is not usable at this section: with rigid legs of equal length the swing
-foot is exactly at stance-foot depth when the legs are aligned, i.e. it penetrates the ground
-(foot scuffing) precisely on the section.  *Checkerboard at fixed positions* breaks the
-translation invariance (the gait's steps are ~12 mm shorter than the ideal ones, so footfalls
-drift across the patches).  We therefore use **checkerboard lanes placed relative to the
-current footfall**: during each step the stance lane has one patch centred on the stance
-foot's section position (s = 0) and the swing lane one patch centred one *ideal* step length
-``l`` ahead (the paper's rule: patches around the footfalls of the ideal gait).  The swing
-foot passes over a gap at mid-stance exactly as in the ADAMS model.  The re-centring is
-physically invisible as long as each foot stays inside its patch during its stance (the
-IMPACT force only depends on the patch membership, not on the distance to the centre):
-:func:`find_contact_periodic_gait` reports the worst margin to a patch edge
+Kneed walkers keep their scene's *continuous ground*: at the section the swing knee is
+flexed (~0.5 rad on ``configs/kneed.yaml``) and the swing foot ~5 cm above the ground.
+For straight legs, *continuous ground* is not usable at this section: with rigid legs of
+equal length the swing foot is exactly at stance-foot depth when the legs are aligned, i.e.
+it penetrates the ground (foot scuffing) precisely on the section.  *Checkerboard at fixed
+positions* breaks the translation invariance (the gait's steps are ~12 mm shorter than the
+ideal ones, so footfalls drift across the patches).  We therefore use **checkerboard lanes
+placed relative to the current footfall**: during each step the stance lane has one patch
+centred on the stance foot's section position (s = 0) and the swing lane one patch centred
+one *ideal* step length ``l`` ahead (the paper's rule: patches around the footfalls of the
+ideal gait).  The swing foot passes over a gap at mid-stance exactly as in the ADAMS model.
+The re-centring is physically invisible as long as each foot stays inside its patch during
+its stance (the IMPACT force only depends on the patch membership, not on the distance to
+the centre): :func:`find_contact_periodic_gait` reports the worst margin to a patch edge
 (``patch_margin_m``), and the fixed point is then a true periodic gait of a checkerboard
 whose patches are spaced by the gait's own step length.
 
 Floquet multipliers
 -------------------
-Eigenvalues of the 6x6 Jacobian of ``P`` at the fixed point, by central finite differences
-in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the coordinate scale
-(:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1 mm/s, 1 mm/s), with
-the map integrated at rtol 1e-12 / atol 1e-14.  Measured on the paper's contact: the map's
-noise (adaptive-step jitter) is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD
-noise is ~1e-10 / h ~ 1e-6, and the truncation error O(h^2) is ~1e-8; the multipliers
-agree to ~1e-5 between h = 1e-3, 1e-4 and 1e-5 (``multiplier_fd_spread`` reports the
-change for h*3 and h/3).  The three "fast" multipliers (normal contact mode, tangential
-creep of the stance foot, both damped within milliseconds) are ~1e-5..1e-8, i.e. zero
-within the FD noise; the three slow ones belong to the swing dynamics and correspond to the
-ideal model's nonzero multipliers (section-independent for a periodic orbit).
+Eigenvalues of the n x n Jacobian of ``P`` (n = 6, kneed 10) at the fixed point, by central
+finite differences in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the
+coordinate scale (:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1
+mm/s, 1 mm/s; kneed: every angle 1 rad, every rate 1 rad/s), with the map integrated at rtol
+1e-12 / atol 1e-14.  Measured on the paper's contact: the map's noise (adaptive-step jitter)
+is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD noise is ~1e-10 / h ~ 1e-6,
+and the truncation error O(h^2) is ~1e-8; the multipliers agree to ~1e-5 between h = 1e-3,
+1e-4 and 1e-5 (``multiplier_fd_spread`` reports the change for h*3 and h/3).  The three
+"fast" multipliers (normal contact mode, tangential creep of the stance foot, both damped
+within milliseconds) are ~1e-5..1e-8, i.e. zero within the FD noise; the three slow ones
+belong to the swing dynamics and correspond to the ideal model's nonzero multipliers
+(section-independent for a periodic orbit).  Kneed walker (``configs/kneed.yaml``): the same
+three slow ones (0.469 +- 0.498j, 0.113; rigid 0.548 +- 0.499j, 0.108), the seven others
+(contact and knee-stop modes) < 1e-4.
 
 Rigid limit
 -----------
@@ -94,8 +105,9 @@ class ContactPeriodicGait:
 
     Attributes
     ----------
-    z : ndarray (6,)
-        Fixed point in :data:`SECTION_NAMES` order (units :data:`SECTION_UNITS`).
+    z : ndarray (n,)
+        Fixed point in the section's order (:func:`section_coordinates`; straight legs
+        :data:`SECTION_NAMES`, units :data:`SECTION_UNITS`; n = 6, kneed 10).
     fixed_point : dict[str, float]
         The same, named.
     period_s : float
@@ -105,11 +117,11 @@ class ContactPeriodicGait:
         Along-slope advance of the stance foot per step [m].
     residual : float
         max |(P(z) - z) / scale| (scaled, see :data:`SCALES`) [-].
-    residual_si : ndarray (6,)
+    residual_si : ndarray (n,)
         P(z) - z in SI units.
-    jacobian : ndarray (6, 6)
-        dP/dz in SI (rows/cols in :data:`SECTION_NAMES` order).
-    multipliers : ndarray (6,) complex
+    jacobian : ndarray (n, n)
+        dP/dz in SI (rows/cols in the section's order).
+    multipliers : ndarray (n,) complex
         Floquet multipliers, sorted by decreasing modulus.
     multiplier_fd_spread : float
         max change of the slow (|lambda| > 1e-3) sorted multipliers when the FD step is
@@ -121,8 +133,9 @@ class ContactPeriodicGait:
     nfev : int
         Step-map evaluations (root finding + Jacobian).
     patch_margin_m : float
-        Smallest distance [m] of a loaded foot to the edge of its patch on the orbit.
-    full_state : ndarray (8,)
+        Smallest distance [m] of a loaded foot to the edge of its patch on the orbit (inf on
+        continuous ground).
+    full_state : ndarray (2 nq,)
         Full state at the section (leg2 stance at s = 0).
     wall_time_s : float
     info : dict
@@ -155,7 +168,7 @@ class ContactPeriodicGait:
 
 class PeriodicGaitError(RuntimeError):
     """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
-    "time_limit", "solver_failure", "unsupported" (kneed walker: no section)."""
+    "time_limit", "solver_failure"."""
 
     def __init__(self, kind: str, message: str):
         super().__init__(message)
@@ -168,7 +181,8 @@ class StepMap:
     Parameters
     ----------
     walker : ContactWalker
-        Parameters and contact law; its lanes are replaced by footfall-relative lanes.
+        Parameters and contact law; its lanes are replaced by footfall-relative lanes
+        (kneed walkers on continuous ground keep it).  Any walker the contact model builds.
     patch_spacing : float, optional
         Distance [m] ahead of the stance foot of the swing lane's patch (default: the
         walker's lane spacing ``lane1[0] - lane2[0]`` if it has lanes, else 0.372 m).
@@ -188,44 +202,60 @@ class StepMap:
             else:
                 patch_spacing = 0.372
         self.spacing = float(patch_spacing)
+        # straight legs scuff the ground at mid-stance: footfall-relative lanes (module doc);
+        # a kneed swing leg is flexed there, so its continuous ground is kept
+        keep_ground = walker.continuous and walker.structure.knee
         self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing]),
-                                          lane2=np.array([0.0]), continuous=False)
+                                          lane2=np.array([0.0]), continuous=keep_ground)
         self.method, self.rtol, self.atol, self.t_max = method, rtol, atol, t_max
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
         w = self.walker
-        if w.structure.knee:
-            raise PeriodicGaitError("unsupported", "contact periodic gait: the mid-stance "
-                                    "section is defined for straight legs only")
         kern = w.kernels
         args = (w.contact_params, w.walker_params, w.lane1, w.lane2)
         self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
         self._fj = lambda x: kern.jac(x, *args)  # noqa: E731
         self.n, self.t = w.normal, w.tangent
         self.idx = StateIndex(w)
-        # leg i's angle and rate by name (leg1 = 0, leg2 = 1), never by row
-        self._angle = [self.idx["theta1"], self.idx["theta2"]]
-        self._rate = [self.idx.rate_of("theta1"), self.idx.rate_of("theta2")]
+        # every column by name (leg1 = 0, leg2 = 1), never by row: each leg's link angles,
+        # proximal first (the section is the crossing of the two proximal links)
+        self._links = [w.leg_angle_states("leg1"), w.leg_angle_states("leg2")]
+        self._angle = [self.idx[a[0]] for a in self._links]
+        self._rate = [self.idx.rate_of(a[0]) for a in self._links]
+        self.names, self.units, self.scale = section_coordinates(w)
+
+    def _columns(self, stance: int) -> list[int]:
+        """State columns of the link coordinates in section order, with foot ``stance``."""
+        ix, st, sw = self.idx, self._links[stance], self._links[1 - stance]
+        return ([ix[a] for a in st] + [ix[a] for a in sw[1:]]
+                + [ix.rate_of(a) for a in sw] + [ix.rate_of(a) for a in st])
 
     # ------------------------------------------------------------------ coordinates
     def to_state(self, z) -> np.ndarray:
-        """Full state (8,) from section coordinates (leg2 stance, stance foot at s = 0)."""
-        th, wsw, wst, d, vt, dd = np.asarray(z, float)
+        """Full state (2 nq,) from section coordinates (leg2 stance, stance foot at s = 0)."""
+        z = np.asarray(z, float)
+        nl = len(z) - 3
+        d, vt, dd = z[nl:]
         p = -d * self.n
         v = vt * self.t - dd * self.n
-        # stance foot at p and at rest, then the whole walker translated at v
+        # link state by name: the swing leg's proximal link aligned with the stance one's
+        val = dict(zip(self._columns(1), z[:nl]))
+        val[self._angle[0]] = val[self._angle[1]]
         ix = self.idx
-        x = self.walker.pinned_to_full(np.array([th, th, wsw, wst]), p)
+        cols = [ix[c] for c in ix.names[ix.coordinates] if c not in ("hip_x", "hip_y")]
+        zp = np.array([val[c] for c in cols] + [val[c + ix.n // 2] for c in cols])
+        # stance foot at p and at rest, then the whole walker translated at v
+        x = self.walker.pinned_to_full(zp, p)
         x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] += v
         return x
 
     def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
-        """Section coordinates (6,) and along-slope position s [m] of foot ``stance`` (0/1)."""
-        px, py, vx, vy = self.walker.foot_state(np.asarray(x, float), stance)
+        """Section coordinates (:attr:`names`) and along-slope position s [m] of foot
+        ``stance`` (0/1)."""
+        x = np.asarray(x, float)
+        px, py, vx, vy = self.walker.foot_state(x, stance)
         p, v = np.array([px, py]), np.array([vx, vy])
-        sw = 1 - stance
-        z = np.array([x[self._angle[stance]], x[self._rate[sw]], x[self._rate[stance]],
-                      -p @ self.n, v @ self.t, -v @ self.n])
+        z = np.concatenate([x[self._columns(stance)], [-p @ self.n, v @ self.t, -v @ self.n]])
         return z, float(p @ self.t)
 
     # ------------------------------------------------------------------ the map
@@ -325,7 +355,7 @@ class StepMap:
                                 f"{self.t_max:g} s")
 
     def __call__(self, z):
-        """One step: returns (P(z) (6,), period [s], step length [m]).
+        """One step: returns (P(z) (n,), period [s], step length [m]).
 
         Raises
         ------
@@ -365,6 +395,8 @@ class StepMap:
             te = sol.t_events[0][0] if sol.t_events[0].size else sol.t[-1]
             tt = np.linspace(0.0, te, 2001)
             X = sol.sol(tt).T
+        if self.walker.continuous:
+            return np.inf  # continuous ground: no patch edges
         cq = self.walker.contact_quantities(X)
         hw = self.walker.patch_half_width
         margin = np.inf
@@ -378,9 +410,44 @@ class StepMap:
         return margin
 
 
-#: coordinate scales (SI) used for the root finder, the residual and the FD steps; the
-#: penetration scale is replaced by the walker's static penetration at run time.
+#: coordinate scales (SI) of the straight-legged section (:data:`SECTION_NAMES`) used for
+#: the root finder, the residual and the FD steps; the penetration scale is replaced by the
+#: walker's static penetration at run time (:func:`section_coordinates` for any walker).
 SCALES = np.array([1.0, 1.0, 1.0, 6e-5, 1e-3, 1e-3])
+
+
+def _role_name(state: str, role: str) -> str:
+    """``theta1_thigh`` -> ``theta_<role>_thigh``, ``dtheta2`` -> ``dtheta_<role>``."""
+    head, _, tail = state.partition("_")
+    return head.rstrip("12") + f"_{role}" + (f"_{tail}" if tail else "")
+
+
+def section_coordinates(walker: ContactWalker) -> tuple[tuple, tuple, np.ndarray]:
+    """Names, units and scales of the mid-stance section coordinates of ``walker``.
+
+    All states minus the section constraint (the swing leg's proximal link aligned with the
+    stance leg's) minus the along-slope translation, the hip position replaced by the stance
+    foot's contact: the stance leg's link angles, the swing leg's other link angles, the
+    swing leg's link rates, the stance leg's link rates, then ``delta_stance`` [m],
+    ``v_t_stance`` [m/s], ``ddelta_stance`` [m/s].  Straight legs: :data:`SECTION_NAMES`
+    (6); kneed legs: 10.
+
+    Returns
+    -------
+    names : tuple of str
+    units : tuple of str
+    scale : ndarray (n,)
+        1 rad, 1 rad/s, the static penetration, 1 mm/s, 1 mm/s (:data:`SCALES`).
+    """
+    st, sw = walker.leg_angle_states("leg2"), walker.leg_angle_states("leg1")
+    angles = [_role_name(a, "stance") for a in st] + [_role_name(a, "swing") for a in sw[1:]]
+    rates = ([_role_name("d" + a, "swing") for a in sw]
+             + [_role_name("d" + a, "stance") for a in st])
+    names = tuple(angles + rates) + SECTION_NAMES[-3:]
+    units = ("rad",) * len(angles) + ("rad/s",) * len(rates) + SECTION_UNITS[-3:]
+    scale = np.array([1.0] * (len(angles) + len(rates))
+                     + [walker.static_penetration(), 1e-3, 1e-3])
+    return names, units, scale
 
 
 def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
@@ -422,26 +489,42 @@ def rigid_limit_contact(walker: ContactWalker, kappa: float, mu_s: float = 2.0,
     return dataclasses.replace(walker, contact=new)
 
 
-def _walker_and_guess(walker_or_scene, guess):
-    if isinstance(walker_or_scene, ContactWalker):
-        return walker_or_scene, guess, None
+def ideal_gait(scene):
+    """The rigid (derived) periodic gait of ``scene`` from its ``fixedpoint`` section.
+
+    Returns
+    -------
+    walkerlab.analysis.gaits result (``x`` role-order post-impact state, ``period_s``, ...)
+
+    Raises
+    ------
+    ValueError
+        The scene has no ``fixedpoint`` section.
+    """
     from walkerlab.analysis.gaits import find_gaits
     from walkerlab.analysis.hybrid import Solver
-    from walkerlab.contact.scene import build
     from walkerlab.models.registry import build_walker
 
-    scene = walker_or_scene
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})
     fp = sc.fixedpoint
     if fp is None:
         raise ValueError(f"scene '{scene.name}' has no 'fixedpoint' section (initial guess of "
                          "the ideal gait)")
     iw = build_walker(sc)
-    ideal = find_gaits(iw, Solver.from_settings(sc.solver),
-                       None if fp.initial_guess is None
-                       else fp.initial_guess.as_array(iw.state_names()),
-                       policy=fp.gait, other_gait=False, xtol=fp.tolerance,
-                       fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
+    return find_gaits(iw, Solver.from_settings(sc.solver),
+                      None if fp.initial_guess is None
+                      else fp.initial_guess.as_array(iw.state_names()),
+                      policy=fp.gait, other_gait=False, xtol=fp.tolerance,
+                      fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
+
+
+def _walker_and_guess(walker_or_scene, guess):
+    if isinstance(walker_or_scene, ContactWalker):
+        return walker_or_scene, guess, None
+    from walkerlab.contact.scene import build
+
+    scene = walker_or_scene
+    ideal = ideal_gait(scene)
     walker, _ = build(scene, ideal.x, 2)
     return walker, (ideal.x if guess is None else guess), ideal
 
@@ -500,10 +583,11 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         A scene is built into a walker with :func:`walkerlab.contact.scene.build`; then
         the default guess is its ideal (derived) fixed point.
     guess : array_like, optional
-        Either a section state (6,) (:data:`SECTION_NAMES`) or an ideal post-impact state (4,)
-        ``[th_swing, th_stance, w_swing, w_stance]`` (role order, as ``solve_variant``).
+        Either a section state (n,) (:func:`section_coordinates`) or an ideal post-impact
+        state (role order of the rigid walker, as ``solve_variant``; compass gait
+        ``[th_swing, th_stance, w_swing, w_stance]``).
     rate_scale : (float, float)
-        Multipliers on the rates of a (4,) guess.
+        Multipliers on the swing and stance legs' rates of an ideal-state guess.
     warmup_steps : int
         Steps of the map iterated from the guess before root finding (the gait is stable,
         so this brings the guess into the Newton basin).
@@ -548,19 +632,19 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     deadline = None if time_limit_s is None else wall + time_limit_s
     walker, guess, ideal = _walker_and_guess(walker_or_scene, guess)
     P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol, deadline=deadline)
-    scale = SCALES.copy()
-    scale[SECTION_NAMES.index("delta_stance")] = walker.static_penetration()
+    scale = P.scale
     coarse = coarse_rtol is not None and coarse_rtol > rtol
     # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
     PC = StepMap(walker, patch_spacing, method=method, rtol=coarse_rtol, atol=coarse_atol,
                  deadline=deadline) if coarse else P
     guess = np.asarray(guess, float)
-    if guess.size == 4:
-        z = section_guess_from_ideal(PC, guess, rate_scale)
-    elif guess.size == 6:
+    if guess.size == len(P.names):
         z = guess.copy()
+    elif guess.size == 2 * len(walker.structure.roles):
+        z = section_guess_from_ideal(PC, guess, rate_scale)
     else:
-        raise ValueError("guess must be a section state (6,) or an ideal state (4,)")
+        raise ValueError(f"guess must be a section state ({len(P.names)},) or an ideal state "
+                         f"({2 * len(walker.structure.roles)},)")
     hist = []
     for _ in range(warmup_steps):
         z1 = PC(z)[0]
@@ -574,7 +658,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         return _last_call_memo(
             lambda u: fd_jacobian(lambda v: M(v)[0], u * scale, scale, 10 * fd_step,
                                   central=method != "odeint")
-            * scale[None, :] / scale[:, None] - np.eye(6))
+            * scale[None, :] / scale[:, None] - np.eye(len(scale)))
 
     root_nfev = 0
     jac = dG_of(P)
@@ -618,7 +702,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         info["ideal_multipliers"] = ideal.multipliers_variational
     resid = float(np.max(np.abs(res_si / scale)))
     return ContactPeriodicGait(
-        z=zs, fixed_point=dict(zip(SECTION_NAMES, map(float, zs))), period_s=T,
+        z=zs, fixed_point=dict(zip(P.names, map(float, zs))), period_s=T,
         step_length_m=ell, residual=resid, residual_si=res_si, jacobian=J, multipliers=ev,
         multiplier_fd_spread=spread, stable=bool(np.all(np.abs(ev) < 1)),
         converged=bool(resid < residual_tol), message=sol.message,

@@ -23,7 +23,7 @@ from walkerlab.integrate.contact import ContactLimits, StateIndex, integrate_con
 from .contact_gait import ContactResult, classify, gait_events, heel_strike_count
 
 __all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
-           "simulate_contact", "simulate_from", "trajectory_names"]
+           "scene_start", "simulate_contact", "simulate_from", "trajectory_names"]
 
 #: A walker whose hip rises above this many leg lengths has left the ground for good
 #: (a foot can touch the ground only while the hip is within one leg length of it).
@@ -129,6 +129,37 @@ def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
     return replace(limits, **upd)
 
 
+def scene_start(scene: Scene, x_ideal: np.ndarray, n_strides: int, rate_scale=None):
+    """The contact walker of ``scene``, its initial state and run limits (the start of
+    :func:`simulate_from`, shared with the benchmark).
+
+    Parameters
+    ----------
+    x_ideal : ndarray (n,)
+        Ideal post-impact state (rigid walker's ``state_names()`` order) [rad, rad/s].
+    n_strides : int
+        Strides the run may take (patches are laid out for them).
+    rate_scale : (float, float), optional
+        Multipliers on the initial rates (default ``contact_sim.initial_rate_scale``).
+
+    Returns
+    -------
+    walker, x0, limits, step_length
+        :class:`ContactWalker`, the initial state (N,), :class:`ContactLimits` from the
+        scene's ``contact_sim`` section, the ideal step length [m].
+    """
+    cs = settings(scene)[2]
+    walker, step_length = build(scene, x_ideal, 2 * n_strides)
+    scale = cs.initial_rate_scale if rate_scale is None else rate_scale
+    x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
+    limits = ContactLimits(
+        sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,
+        pin_time_s=cs.pin_time_s,
+        fall_hip_height_m=cs.fall_hip_height_m or ContactLimits().fall_hip_height_m,
+        wall_time_limit_s=cs.wall_time_limit_s)
+    return walker, x0, limits, step_length
+
+
 def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=None,
                   solver: ContactSolverSettings | None = None, strides: int | None = None):
     """Run the contact walker of ``scene`` from the ideal fixed point ``x_ideal``.
@@ -156,15 +187,8 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
     _, _, cs, sv = settings(scene)
     sv = solver or sv
     n_strides = strides or cs.n_strides
-    walker, step_length = build(scene, x_ideal, 2 * n_strides)
-    scale = cs.initial_rate_scale if rate_scale is None else rate_scale
-    x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
+    walker, x0, limits, step_length = scene_start(scene, x_ideal, n_strides, rate_scale)
     t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
-    limits = ContactLimits(
-        sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,
-        pin_time_s=cs.pin_time_s,
-        fall_hip_height_m=cs.fall_hip_height_m or ContactLimits().fall_hip_height_m,
-        wall_time_limit_s=cs.wall_time_limit_s)
     res = simulate_contact(walker, x0, t_final, sv, limits,
                            max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
     return walker, res, x0, step_length

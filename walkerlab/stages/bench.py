@@ -12,7 +12,11 @@ benchmark      what is timed                                                    
 ``basin``      ``walkerlab basin --grid 200x200 --force``, paper walker,        <= 120 s
                50 steps a cell at most, 2 workers, whole process
 ``contact``    the contact walker's work-precision benchmark
-               (:func:`walkerlab.analysis.contact_bench.run_benchmark`)
+               (:func:`walkerlab.analysis.contact_bench.run_benchmark`); with scene
+               files (``walkerlab bench contact configs/kneed.yaml ...``): each
+               scene's walker, 5 contact strides at <= 1e-6 rad against a tight     kneed:
+               reference, median time of the loosest tolerance band reaching it     <= 0.1 s
+               (:func:`walkerlab.analysis.contact_bench.run_scene_benchmark`)
 =============  ===============================================================  ==========
 
 The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
@@ -178,14 +182,54 @@ def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
             "outcomes": {o: int(np.sum(out == i)) for i, o in enumerate(b["outcomes"])}}
 
 
-def run_bench(what: str, out: Path) -> list[str]:
+def _scene_line(res: dict) -> str:
+    parts = []
+    for method, t in res["target"].items():
+        if t["reached"]:
+            parts.append(f"{method} {t['median_wall_time_s']:.4f} s (rtol {t['rtols'][-1]:.2g}"
+                         f"..{t['rtols'][0]:.2g}, worst error {t['worst_error_rad']:.2g} rad)")
+        else:
+            parts.append(f"{method} did not reach the target")
+    return (f"contact {res['scene']}: {res['n_strides']} strides at <= 1e-6 rad: "
+            + "; ".join(parts) + f" [reference {res['reference']['wall_time_s']:.3f} s]")
+
+
+def bench_contact_scenes(scenes) -> dict:
+    """:func:`~walkerlab.analysis.contact_bench.run_scene_benchmark` for each scene file.
+
+    Raises
+    ------
+    ConfigError
+        A scene file is missing or invalid (one line, from :func:`load_scene`).
+    """
+    from walkerlab.analysis.contact_bench import run_scene_benchmark
+    from walkerlab.config import load_scene
+
+    loaded = [load_scene(p) for p in scenes]  # every file checked before the first run
+    return {"scenes": [run_scene_benchmark(sc) for sc in loaded]}
+
+
+def run_bench(what: str, out: Path, scenes=None) -> list[str]:
     """Run the named benchmarks; return printable lines.
+
+    Parameters
+    ----------
+    what : str
+        A name of :data:`BENCHMARKS` or "all".
+    out : Path
+        Folder of the JSON results.
+    scenes : sequence of Path, optional
+        Contact benchmark only: scene files timed by
+        :func:`walkerlab.analysis.contact_bench.run_scene_benchmark` instead of the paper
+        walker's work-precision study.
 
     Raises
     ------
     ValueError
-        Unknown benchmark name.
+        Unknown benchmark name; scene files given for another benchmark than contact.
     """
+    if scenes and what != "contact":
+        raise ValueError(f"bench {what}: scene files apply to 'bench contact' only")
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"bench --out {out}: is a file; --out names a folder (results go to "
@@ -207,9 +251,12 @@ def run_bench(what: str, out: Path) -> list[str]:
         elif name == "basin":
             res = bench_basin()
         elif name == "contact":
-            from walkerlab.analysis.contact_bench import run_benchmark
+            if scenes:
+                res = bench_contact_scenes(scenes)
+            else:
+                from walkerlab.analysis.contact_bench import run_benchmark
 
-            res = run_benchmark()
+                res = run_benchmark()
         else:
             raise ValueError(f"bench: unknown benchmark {name!r} "
                              f"({' | '.join(BENCHMARKS)} | all)")
@@ -218,5 +265,7 @@ def run_bench(what: str, out: Path) -> list[str]:
 
         text = json.dumps(res, indent=1, default=str).encode()
         atomic_write(out / f"{name}.json", lambda fh, text=text: fh.write(text))
+        if name == "contact" and scenes:
+            lines += [_scene_line(r) for r in res["result"]["scenes"]]
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines

@@ -224,7 +224,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                 g.attrs["message"] = str(gait_error)
             if gait is not None:
                 g = f.create_group("periodic_gait")
-                g.attrs["section"] = "mid-stance (legs aligned), stance foot loaded only"
+                g.attrs["section"] = "mid-stance (proximal links aligned), stance foot loaded only"
                 g.attrs["outcome"] = "ok"
                 for k, v in gait.fixed_point.items():
                     g.attrs[f"fixed_point_{k}"] = float(v)
