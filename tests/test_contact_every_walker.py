@@ -1,0 +1,50 @@
+"""The contact side's figures and reports for any walker, checked as a user reads them
+(issue 17 part 3): a leg and a link keep their colour across models, the models their
+line style."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _kneed_trajectory(order: list[str]):
+    from walkerlab.io.trajectory import NamedTrajectory
+
+    t = np.linspace(0.0, 1.0, 5)
+    coords, units = {}, {}
+    for leg in order:
+        for part in ("thigh", "shank"):
+            coords[f"{leg}_{part}_angle"], units[f"{leg}_{part}_angle"] = t, "rad"
+    for leg in order:
+        for part in ("thigh", "shank"):
+            coords[f"{leg}_{part}_rate"], units[f"{leg}_{part}_rate"] = t, "rad/s"
+    z = np.zeros_like(t, dtype=int)
+    return NamedTrajectory(time=t, legs=["leg1", "leg2"], coordinates=coords, units=units,
+                           stance_leg=z, step_index=z, kinetic=t, potential=t)
+
+
+def test_fig7_colours_follow_the_coordinate_name_and_styles_the_model():
+    """The rigid kneed walker lists the stance leg (leg2) first, the contact walker leg1
+    first: before the fix ideal leg2 and contact leg1 were both blue, and ideal shank and
+    contact thigh were both dashed.  Now every (leg, link) has one colour in both models and
+    each model one line style, so no two curves of the figure share colour and style."""
+    import matplotlib.pyplot as plt
+
+    from walkerlab.plotting import figures as F
+
+    fig = F.fig7_angles_rates({"ideal": _kneed_trajectory(["leg2", "leg1"]),
+                               "contact": _kneed_trajectory(["leg1", "leg2"])})
+    try:
+        for ax in fig.axes[:2]:
+            seen = {}
+            for line in ax.get_lines():
+                name, model = line.get_label().split(" - ")
+                seen[(name, model)] = (line.get_color(), line.get_linestyle())
+            assert len(seen) == 8
+            assert len(set(seen.values())) == 8  # no two curves look alike
+            for name in ("leg1_thigh", "leg1_shank", "leg2_thigh", "leg2_shank"):
+                assert seen[(name, "ideal")][0] == seen[(name, "contact")][0]
+            assert {s for (_, m), (_, s) in seen.items() if m == "ideal"} == {"-"}
+            assert {s for (_, m), (_, s) in seen.items() if m == "contact"} == {"--"}
+    finally:
+        plt.close(fig)
