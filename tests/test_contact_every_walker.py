@@ -48,3 +48,23 @@ def test_fig7_colours_follow_the_coordinate_name_and_styles_the_model():
             assert {s for (_, m), (_, s) in seen.items() if m == "contact"} == {"--"}
     finally:
         plt.close(fig)
+
+
+def test_patch_width_map_on_continuous_ground_says_it_does_not_apply(tmp_path):
+    """kneed.yaml walks on continuous ground: before, ``stability-map --kind patch_width``
+    computed 9 cells of 'no_ideal_gait'/'unsupported' and exited 0; now one line, rc 1,
+    naming the field, and ``--kind all`` skips that map with a note."""
+    import pytest
+
+    from walkerlab.config import load_scene
+    from walkerlab.stages import stability_map
+    from walkerlab.stages.common import StageError
+
+    scene = load_scene("configs/kneed.yaml")
+    with pytest.raises(StageError, match=r"does not apply.*continuous.*terrain\.kind") as e:
+        stability_map.run(scene, tmp_path, kind="patch_width", n=2)
+    assert "\n" not in str(e.value)
+    assert not list(tmp_path.rglob("*.h5"))
+    assert stability_map.not_applicable(scene, "friction") == ""
+    assert stability_map.not_applicable(load_scene("configs/paper_rods.yaml"),
+                                        "patch_width") == ""

@@ -15,7 +15,7 @@ import numpy as np
 
 from walkerlab.config import CommandOptions, Scene, validate_option
 from walkerlab.io.artifacts import open_artifact, put
-from walkerlab.stages.common import StageOutcome, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.sweep.stability import (
     CELL_FIELDS,
     MAP_KINDS,
@@ -34,6 +34,17 @@ def stage_name(kind: str) -> str:
     return f"stability-map-{kind.replace('_', '-')}"
 
 
+def not_applicable(scene: Scene, kind: str) -> str:
+    """One line saying why map ``kind`` does not apply to the scene, or "" if it does (a
+    patch-width map needs the checkerboard terrain: on continuous ground there are no
+    patches)."""
+    terrain = scene.terrain
+    if kind == "patch_width" and terrain is not None and terrain.kind != "checkerboard":
+        return (f"stability-map --kind patch_width does not apply to scene '{scene.name}': "
+                f"its terrain is {terrain.kind} ground, which has no patches (terrain.kind)")
+    return ""
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         kind: str = "stiffness", n: int = 8, workers: int = 2, time_limit_s: float = 60.0,
         spec: MapSpec | None = None, progress=None) -> StageOutcome:
@@ -48,6 +59,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     require(scene, "contact", "stability-map")
     require(scene, "fixedpoint", "stability-map")
+    why = not_applicable(scene, kind)
+    if why:
+        raise StageError(why)
     n = validate_option(CommandOptions, "stability_map_n", n, "--n")
     workers = validate_option(CommandOptions, "workers", workers, "--workers")
     time_limit_s = validate_option(CommandOptions, "stability_map_time_limit_s",
