@@ -68,3 +68,38 @@ def test_patch_width_map_on_continuous_ground_says_it_does_not_apply(tmp_path):
     assert stability_map.not_applicable(scene, "friction") == ""
     assert stability_map.not_applicable(load_scene("configs/paper_rods.yaml"),
                                         "patch_width") == ""
+
+
+def test_stability_map_figure_names_scene_units_and_unsupported_cells():
+    """round_feet.yaml is nondimensional (contact.unit_system SI reads metres as l): before,
+    its patch-width map's axis read 'patch width [m]'; a kneed cell whose periodic-gait
+    search has no section read '?'."""
+    from walkerlab.plotting.sweep_figures import gait_map_figure, plt
+    from walkerlab.sweep.stability import MAP_KINDS, REASONS
+
+    assert "unsupported" in REASONS
+    reason = np.array([["", "unsupported"]], dtype=object)
+    d = {"y_values": np.array([0.2]), "slopes_deg": np.array([1.0, 2.0]),
+         "exists": np.array([[1, 0]]), "stable": np.array([[1, 0]]),
+         "max_abs_multiplier": np.array([[0.5, np.nan]]), "reason": reason,
+         "wall_time_s": np.array([[1.0, 2.0]]),
+         "attrs": {"kind": "patch_width", "y_label": MAP_KINDS["patch_width"][1],
+                   "unit_system": "SI", "scene_units": "nondimensional"}}
+    fig = gait_map_figure(d)
+    try:
+        assert fig.axes[0].get_ylabel() == "patch width [l]"
+        assert "not sup-\nported" in [t.get_text() for t in fig.axes[0].texts]
+    finally:
+        plt.close(fig)
+    d["attrs"] = {**d["attrs"], "kind": "stiffness", "y_label": MAP_KINDS["stiffness"][1]}
+    fig = gait_map_figure(d)
+    try:
+        assert fig.axes[0].get_ylabel().startswith("contact stiffness k [M g/l^e]")
+    finally:
+        plt.close(fig)
+    d["attrs"] = {**d["attrs"], "scene_units": "SI", "unit_system": "mm-kg-s"}
+    fig = gait_map_figure(d)
+    try:
+        assert fig.axes[0].get_ylabel().startswith("contact stiffness k [N/mm^e]")
+    finally:
+        plt.close(fig)

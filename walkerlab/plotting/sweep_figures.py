@@ -23,6 +23,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
 from walkerlab.sweep.bifurcation import SLOPE_PATH, fall_onset, onset_value, parameter_values
 from walkerlab.sweep.outcomes import OUTCOMES
+from walkerlab.units import Units
 
 OUTCOME_COLORS = {
     "ok": "#2ca02c", "no_fixed_point": "#7f7f7f", "fall": "#d62728", "scuff": "#9467bd",
@@ -189,7 +190,8 @@ _REASON_CLASS = {"off_patch": 2, "fall": 3, "no_mid_stance": 3, "time_limit": 4,
 _REASON_TEXT = {"off_patch": "off\npatch", "fall": "falls", "no_mid_stance": "no mid-\nstance",
                 "time_limit": "time\nlimit", "not_converged": "no con-\nvergence",
                 "solver_failure": "solver\nfailure", "no_ideal_gait": "no ideal\ngait",
-                "invalid_config": "invalid\nconfig", "error": "error"}
+                "invalid_config": "invalid\nconfig", "error": "error",
+                "unsupported": "not sup-\nported"}
 
 
 def gait_map_figure(data: dict):
@@ -221,8 +223,12 @@ def gait_map_figure(data: dict):
     attrs = data.get("attrs", {})
     kind = str(attrs.get("kind", ""))
     unit_sys = str(attrs.get("unit_system", "mm-kg-s"))
-    ylab = str(attrs.get("y_label", attrs.get("y_path", "y"))).replace(
-        "len", "mm" if unit_sys == "mm-kg-s" else "m")
+    ylab = str(attrs.get("y_label", attrs.get("y_path", "y")))
+    units = Units(str(attrs.get("scene_units", "SI")))
+    if units.nondimensional and unit_sys != "mm-kg-s":  # the scene's lengths are in l
+        ylab = ylab.replace("[N/len^e]", f"[{units('N')}/{units('m')}^e]").replace(
+            "[m]", f"[{units('m')}]")
+    ylab = ylab.replace("len", "mm" if unit_sys == "mm-kg-s" else "m")
     if kind == "stiffness":
         ylab += f", {attrs.get('stiffness_family', 'paper')} family"
     cmap = ListedColormap(GAIT_COLORS)

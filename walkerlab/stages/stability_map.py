@@ -94,7 +94,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "
                                  "step map, continued from its neighbour along the slope, "
                                  "else from the ideal fixed point at that slope")
-            put(f, "y_values", cells["y_values"], "scene units", spec.y_path)
+            put(f, "y_values", cells["y_values"],
+                {"patch_width": "m", "friction": "-"}.get(spec.kind, "scene units"),
+                spec.y_path)
             put(f, "slopes_deg", cells["slopes_deg"], "deg", "slope angle")
             for fld in CELL_FIELDS:
                 v = cells[fld]

@@ -12,7 +12,8 @@ Cell results (:data:`CELL_FIELDS`): ``exists`` (converged and every loaded foot 
 patch), ``stable`` (all |multipliers| < 1), ``max_abs_multiplier``, ``step_period_s``,
 ``patch_margin_m``, ``source`` ("neighbour" / "ideal"), ``reason`` ("" when the gait
 exists, else ``fall``, ``no_mid_stance``, ``solver_failure``, ``time_limit``,
-``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``), ``wall_time_s``.
+``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``, ``unsupported``:
+the periodic-gait search has no section for this walker), ``wall_time_s``.
 
 The cached stage is :mod:`walkerlab.stages.stability_map`; the figure
 :func:`walkerlab.plotting.sweep_figures.gait_map_figure`.
@@ -37,7 +38,7 @@ MAP_KINDS = {
 }
 
 REASONS = ("", "fall", "no_mid_stance", "solver_failure", "time_limit", "not_converged",
-           "off_patch", "no_ideal_gait", "invalid_config", "error")
+           "off_patch", "no_ideal_gait", "invalid_config", "unsupported", "error")
 
 CELL_FIELDS = ("exists", "stable", "max_abs_multiplier", "step_period_s", "patch_margin_m",
                "residual", "source", "reason", "wall_time_s")
