@@ -103,3 +103,25 @@ def test_stability_map_figure_names_scene_units_and_unsupported_cells():
         assert fig.axes[0].get_ylabel().startswith("contact stiffness k [N/mm^e]")
     finally:
         plt.close(fig)
+
+
+def test_sweep_artifact_units_follow_a_nondimensional_scene(tmp_path):
+    """round_feet.yaml is nondimensional: every other artifact labels its lengths 'l' and
+    times '√(l/g)', but a sweep's columns said 'm' and 's' (the store never relabelled).
+    Wall times stay real seconds."""
+    import h5py
+
+    from walkerlab.config import load_scene
+    from walkerlab.stages.sweep import run
+
+    scene = load_scene("configs/round_feet.yaml")
+    out = run(scene, ["walker.hip_mass_kg=1.0"], stage="fixedpoint", workers=1,
+              runs_root=tmp_path, progress=False, pool=False)
+    with h5py.File(out) as f:
+        assert f.attrs["scene_units"] == "nondimensional"
+        p = f["points"]
+        assert p["outcome"][0] == b"ok"
+        assert p["step_period_s"].attrs["unit"] == "√(l/g)"
+        assert p["stance_rate_rad_per_s"].attrs["unit"] == "rad/√(l/g)"
+        assert p["param/walker.hip_mass_kg"].attrs["unit"] == "M"
+        assert p["wall_time_s"].attrs["unit"] == "s"
