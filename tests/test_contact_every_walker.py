@@ -125,3 +125,36 @@ def test_sweep_artifact_units_follow_a_nondimensional_scene(tmp_path):
         assert p["stance_rate_rad_per_s"].attrs["unit"] == "rad/√(l/g)"
         assert p["param/walker.hip_mass_kg"].attrs["unit"] == "M"
         assert p["wall_time_s"].attrs["unit"] == "s"
+
+
+def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
+    """The drop test dropped the paper walker (20 kg, k from 1e4 to 1e9 scene units) for every
+    scene: for round_feet.yaml (SI, k = 4e9 N/m^2.2, mass 2) its grid stopped below the
+    scene's stiffness and the rigid-limit family started from the paper's 1e5, read as
+    N/m^2.2 (restitution 0 throughout).  Now the grid is the scene's k x 0.1 ... 1e4 and
+    both families pass through the scene's own contact; the paper scene's numbers do not
+    move."""
+    from walkerlab.analysis.contact_drop import drop_restitution
+    from walkerlab.config import load_scene
+    from walkerlab.contact.scene import settings
+    from walkerlab.stages.contact_sim import drop_test
+
+    rf = load_scene("configs/round_feet.yaml")
+    d = drop_test(rf, 2.0)
+    k = rf.contact.stiffness
+    assert d["stiffness"][0] < k < d["stiffness"][-1]
+    i = int(np.argmin(abs(d["stiffness"] - k)))
+    own = drop_restitution(settings(rf)[0], mass_kg=2.0, v_in_m_per_s=0.3)["restitution"]
+    assert 0 < own < 0.2  # near-plastic, as the scene's comment intends
+    assert d["paper"]["restitution"][i] == own
+    # the rigid-limit family keeps the scene contact's restitution at every k (self-similar
+    # drop without gravity; Radau rtol 1e-10 -> ~1e-6 between the k)
+    np.testing.assert_allclose(d["rigid_limit"]["restitution"], own, atol=1e-5)
+    # the paper scene (k = 1e5 N/mm^2.2, 20 kg, reference_stiffness = its k) keeps its grid
+    from walkerlab.stages.contact_sim import DROP_STIFFNESS_RATIO
+
+    paper = load_scene("configs/paper.yaml").contact
+    assert paper.stiffness == paper.reference_stiffness == 1e5
+    np.testing.assert_allclose(np.multiply(DROP_STIFFNESS_RATIO, paper.stiffness),
+                               [1e4, 3e4, 1e5, 3e5, 1e6, 3e6, 1e7, 3e7, 1e8, 3e8, 1e9],
+                               rtol=1e-15)

@@ -262,7 +262,9 @@ def gait_map_figure(data: dict):
     return fig
 
 
-def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=None):
+def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=None,
+                       mass_kg: float = 20.0, speed_m_per_s: float = 0.3,
+                       units: Units | None = None):
     """Drop-test coefficient of restitution against stiffness for each family.
 
     Parameters
@@ -275,6 +277,10 @@ def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=No
         Label of the stiffness unit.
     k_paper : float, optional
         Stiffness of the scene, marked with a vertical line.
+    mass_kg, speed_m_per_s : float
+        The dropped mass (the walker's) [kg] and its speed at first contact [m/s].
+    units : Units, optional
+        The scene's unit labels (default SI).
 
     Returns
     -------
@@ -291,7 +297,9 @@ def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=No
     ax.set_xlabel(f"stiffness k [{unit}]")
     ax.set_ylabel("coefficient of restitution [-]")
     ax.set_ylim(-0.03, 1.03)
-    ax.set_title("drop test: 20 kg at 0.3 m/s (rigid plastic impact: 0)", fontsize=9)
+    u = units or Units()
+    ax.set_title(f"drop test: {mass_kg:.3g} {u('kg')} at {speed_m_per_s:g} {u('m/s')} (rigid "
+                 "plastic impact: 0)", fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
     return fig

@@ -111,9 +111,12 @@ def _drop_figure(scene: Scene, runs_root, out_dir: Path, F) -> list[Path]:
         g = f["drop_test"]
         ks, unit = g["stiffness"][()], str(g["stiffness"].attrs["unit"])
         curves = {fam: g[f"{fam}/restitution"][()] for fam in ("paper", "rigid_limit")}
+        mass = float(g.attrs.get("mass_kg", 20.0))
     from walkerlab.plotting.sweep_figures import restitution_figure
+    from walkerlab.units import for_scene
 
-    fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness))
+    fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness),
+                             mass_kg=mass, units=for_scene(scene))
     return F.save(fig, out_dir, "drop_restitution")
 
 
