@@ -158,3 +158,15 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     np.testing.assert_allclose(np.multiply(DROP_STIFFNESS_RATIO, paper.stiffness),
                                [1e4, 3e4, 1e5, 3e5, 1e6, 3e6, 1e7, 3e7, 1e8, 3e8, 1e9],
                                rtol=1e-15)
+
+
+def test_contact_law_units_relabel_in_a_nondimensional_scene():
+    """The drop test's stiffness axis and the SI contact parameters of round_feet.yaml read
+    'N/m^e' and 'N s/m' in a scene whose lengths are l and masses M."""
+    from walkerlab.units import Units
+
+    u = Units("nondimensional")
+    assert u("N/m^e") == "M g/l^e"
+    assert u("N s/m") == "M √(g/l)"  # kg/s
+    assert u("N/mm^e") == "N/mm^e"  # the ADAMS mm-kg-s system is not the scene's
+    assert Units()("N/m^e") == "N/m^e"
