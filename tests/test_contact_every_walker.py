@@ -170,3 +170,21 @@ def test_contact_law_units_relabel_in_a_nondimensional_scene():
     assert u("N s/m") == "M √(g/l)"  # kg/s
     assert u("N/mm^e") == "N/mm^e"  # the ADAMS mm-kg-s system is not the scene's
     assert Units()("N/m^e") == "N/m^e"
+
+
+def test_work_precision_axis_follows_the_scene_units():
+    """round_feet.yaml's work-precision study (models: [ideal, contact]) wrote its errors in
+    rad/√(l/g) but the diagram's axis said rad/s."""
+    from walkerlab.plotting import figures as F
+    from walkerlab.units import Units
+
+    rows = {"cyrk_bdf": {"time": np.array([0.01, 0.03]), "error": np.array([3e-6, 5e-7]),
+                         "rtol": np.array([1e-6, 1e-7])}}
+    for units, label in ((Units("nondimensional"), "[rad, rad/√(l/g)]"),
+                         (Units(), "[rad, rad/s]")):
+        fig = F.work_precision(rows, "work-precision, contact model", units=units)
+        try:
+            assert fig.axes[0].get_ylabel().endswith(label)
+            assert fig.axes[0].get_xlabel().startswith("wall time [s]")  # real seconds
+        finally:
+            F.plt.close(fig)

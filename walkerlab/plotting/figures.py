@@ -312,10 +312,12 @@ def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 
     return placed
 
 
-def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None):
+def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None,
+                   units: Units = SI_UNITS):
     """Work-precision diagram: error vs wall time (log-log), one line per method; the
     spread of the repeats (``time_min``..``time_max``) as horizontal bars, the tolerance
-    next to each point where its label does not cover another."""
+    next to each point where its label does not cover another.  The error is in the
+    scene's units (``units``: rad, rad/s or rad/√(l/g)); the wall time in real seconds."""
     fig, ax = plt.subplots(figsize=(7, 5))
     labels = []
     for method, d in rows.items():
@@ -331,7 +333,7 @@ def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: l
         pt = np.array([(p["time"], p["error"]) for p in pareto])
         ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (median times)")
     ax.set_xlabel("wall time [s] (median of repeats; bars: fastest to slowest run)")
-    ax.set_ylabel("max state error vs reference [rad, rad/s]")
+    ax.set_ylabel(f"max state error vs reference [rad, {units.rate}]")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
     _legend(ax)
