@@ -188,3 +188,28 @@ def test_work_precision_axis_follows_the_scene_units():
             assert fig.axes[0].get_xlabel().startswith("wall time [s]")  # real seconds
         finally:
             F.plt.close(fig)
+
+
+def test_work_precision_contact_runner_reads_a_kneed_walkers_legs_by_name():
+    """The work-precision study's contact series on the kneed walker: the final vector is
+    the four link angles [rad] and their four rates, read by name (no hip position: |angle|
+    < 1 rad, where hip_x is ~0.95 m after a stride), and it converges with the tolerance."""
+    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.analysis.workprecision import contact_runner
+    from walkerlab.config import load_scene
+    from walkerlab.models.registry import build_walker
+
+    scene = load_scene("configs/kneed.yaml")
+    walker = build_walker(scene)
+    g = scene.fixedpoint.initial_guess.model_dump()
+    guess = np.array([g[n + ("_rad" if n.endswith("_angle") else "_rad_per_s")]
+                      for n in walker.state_names()])
+    fp = find_fixed_point(walker, guess, Solver("DOP853", 1e-12, 1e-12), fd_check=False)
+    run = contact_runner(scene, fp.x, fp.period_s, strides=1)
+    loose, _ = run("cyrk_bdf", 1e-6, 1e-8)
+    tight, nfev = run("cyrk_bdf", 1e-8, 1e-10)
+    assert loose is not None and tight is not None and nfev > 0
+    assert loose.shape == tight.shape == (8,)
+    assert np.all(np.abs(tight[:4]) < 1.0)
+    assert np.abs(loose - tight).max() < 1e-3
