@@ -213,3 +213,21 @@ def test_work_precision_contact_runner_reads_a_kneed_walkers_legs_by_name():
     assert loose.shape == tight.shape == (8,)
     assert np.all(np.abs(tight[:4]) < 1.0)
     assert np.abs(loose - tight).max() < 1e-3
+
+
+def test_stability_map_default_axes_bracket_the_scenes_own_contact():
+    """The stiffness axis was 1e3 ... 1e9 and the patch widths 0.02 ... 0.20 in scene units
+    for every scene: round_feet.yaml (k = 4e9 N/m^2.2, patches 0.30 l) lay outside both.
+    Now the axes are the scene's own value x 1e-2 ... 1e4 and x 0.2 ... 2; the paper
+    scene's grids are unchanged (bit for bit: its cached maps stay valid)."""
+    from walkerlab.sweep.stability import default_spec
+
+    k = default_spec("stiffness", 3, stiffness=4e9).y_values
+    w = default_spec("patch_width", 3, patch_width_m=0.30).y_values
+    assert k[0] < 4e9 < k[-1] and np.allclose(k, [4e7, 4e10, 4e13], rtol=1e-12)
+    assert w[0] < 0.30 < w[-1] and np.allclose(w, [0.06, 0.33, 0.60], rtol=1e-12)
+    for n in (3, 8):
+        assert default_spec("stiffness", n).y_values == tuple(
+            float(v) for v in np.round(np.logspace(3, 9, n), 6))
+        assert default_spec("patch_width", n).y_values == tuple(
+            float(v) for v in np.round(np.linspace(0.02, 0.20, n), 6))

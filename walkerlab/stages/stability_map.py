@@ -66,7 +66,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     workers = validate_option(CommandOptions, "workers", workers, "--workers")
     time_limit_s = validate_option(CommandOptions, "stability_map_time_limit_s",
                                    float(time_limit_s), "--time-limit")
-    spec = spec or default_spec(kind, n, time_limit_s)
+    terrain = scene.terrain
+    spec = spec or default_spec(kind, n, time_limit_s, stiffness=scene.contact.stiffness,
+                                patch_width_m=terrain.patch_width_m if terrain is not None
+                                else 0.10)
 
     def compute():
         from walkerlab import progress as _progress
