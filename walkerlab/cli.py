@@ -467,6 +467,9 @@ def stability_map(scene: Path | None = SceneArg,
     for k in kinds:
         if k not in MAP_KINDS:
             _fail(ValueError(f"--kind: unknown map {k!r} (stiffness, friction, patch_width, all)"))
+        if kind == "all" and stage.not_applicable(sc, k):
+            typer.echo(f"{k}: skipped ({stage.not_applicable(sc, k).split(': ', 1)[1]})")
+            continue
         out = stage.run(sc, runs_dir, force, kind=k, n=n, workers=workers,
                         time_limit_s=time_limit)
         s = out.summary

@@ -24,6 +24,7 @@ NONDIMENSIONAL = "nondimensional"
 NONDIMENSIONAL_LABELS = {
     "m/s^2": "g", "rad/s": "rad/√(l/g)", "m/s": "√(g l)", "kg m^2": "M l²", "mm": "10⁻³ l",
     "Hz": "√(g/l)", "J": "M g l", "kg": "M", "N": "M g", "m": "l", "s": "√(l/g)",
+    "N/m^e": "M g/l^e", "N s/m": "M √(g/l)",  # IMPACT stiffness and damping
 }
 _TOKEN = re.compile(r"(?<![\w/^])(" + "|".join(
     re.escape(k) for k in sorted(NONDIMENSIONAL_LABELS, key=len, reverse=True))

@@ -109,8 +109,8 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
             return None, res.nfev
         idx = StateIndex(walker)
         legs = leg_angle_columns(walker)
-        return np.concatenate([res.x[-1, legs], res.x[-1, [i + idx.n // 2 for i in legs]]]), \
-            res.nfev
+        rates = [idx.rate_of(idx.names[i]) for i in legs]
+        return np.concatenate([res.x[-1, legs], res.x[-1, rates]]), res.nfev
     return run
 
 

@@ -25,6 +25,9 @@ SI_UNITS = Units()
 
 LEG_COLORS = ["tab:blue", "tab:red", "tab:green", "tab:purple"]
 MODEL_STYLES = ["-", "--", ":", "-."]
+#: colours of the parts of each leg (thigh, shank), leg by leg; the first is LEG_COLORS'
+PART_COLORS = [("tab:blue", "tab:cyan"), ("tab:red", "tab:orange"),
+               ("tab:green", "tab:olive"), ("tab:purple", "tab:pink")]
 
 
 def save(fig, folder: Path, stem: str) -> list[Path]:
@@ -66,19 +69,28 @@ def _legend(ax, **kw):
         ax.legend(fontsize=8, **kw)
 
 
+def _owners(names) -> list[str]:
+    """The owners (first word of a coordinate name: ``leg1``, ``leg2``, ``torso``) in sorted
+    order, so a leg has the same colour in every model's trajectory whatever order the
+    model lists its coordinates in (the rigid kneed walker lists the stance leg first)."""
+    return sorted({n.split("_", 1)[0] for n in names})
+
+
 def _coordinate_styles(names: list[str], model_index: int = 0) -> dict[str, dict]:
-    """Colour per leg (first word of the name: ``leg1``, ``torso``), line style per part of
-    that leg (``leg1_thigh`` solid, ``leg1_shank`` dashed) shifted by the model index, so
-    the parts of one leg stay distinguishable where they overlap (a locked knee)."""
+    """Colour per leg and part of it (``leg1_thigh`` blue, ``leg1_shank`` cyan; first word
+    of the name: ``leg1``, ``torso``), line style per model (``model_index``: ideal solid,
+    contact dashed), so every curve is told apart by colour *and* the models by style,
+    also where the parts of one leg overlap (a locked knee)."""
     stems = list(dict.fromkeys(n.rsplit("_", 1)[0] for n in names))
-    owners = list(dict.fromkeys(st.split("_", 1)[0] for st in stems))
+    owners = _owners(stems)
     out = {}
     for n in names:
         st = n.rsplit("_", 1)[0]
         owner = st.split("_", 1)[0]
         part = [x for x in stems if x.split("_", 1)[0] == owner].index(st)
-        out[n] = dict(color=LEG_COLORS[owners.index(owner) % len(LEG_COLORS)],
-                      ls=MODEL_STYLES[(model_index + part) % len(MODEL_STYLES)])
+        shades = PART_COLORS[owners.index(owner) % len(PART_COLORS)]
+        out[n] = dict(color=shades[part % len(shades)],
+                      ls=MODEL_STYLES[model_index % len(MODEL_STYLES)])
     return out
 
 
@@ -90,7 +102,7 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
     for mi, (label, tr) in enumerate(trajs.items()):
         sty = _coordinate_styles(list(tr.coordinates), mi)
         for ax, names in zip(axes, (tr.angle_names(), tr.rate_names())):
-            for n in names:
+            for n in sorted(names, key=lambda n: n.split("_", 1)[0]):  # legend: leg by leg
                 ax.plot(tr.time, tr.coordinates[n], lw=1.2,
                         label=f"{n.rsplit('_', 1)[0]} - {label}", **sty[n])
     axes[0].set_ylabel("angle from vertical [rad]")
@@ -147,7 +159,7 @@ def fig9_limit_cycle(trajs: dict[str, NamedTrajectory], units: Units = SI_UNITS)
     link (both legs drawn in it, colour per leg, line style per model)."""
     first = next(iter(trajs.values()))
     panels = _phase_panels(first)
-    owners = list(dict.fromkeys(o for v in panels.values() for o, _, _ in v))
+    owners = _owners(o for v in panels.values() for o, _, _ in v)
     n = max(1, len(panels))
     fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 4.8), squeeze=False,
                              layout="constrained")
@@ -300,10 +312,12 @@ def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 
     return placed
 
 
-def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None):
+def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None,
+                   units: Units = SI_UNITS):
     """Work-precision diagram: error vs wall time (log-log), one line per method; the
     spread of the repeats (``time_min``..``time_max``) as horizontal bars, the tolerance
-    next to each point where its label does not cover another."""
+    next to each point where its label does not cover another.  The error is in the
+    scene's units (``units``: rad, rad/s or rad/√(l/g)); the wall time in real seconds."""
     fig, ax = plt.subplots(figsize=(7, 5))
     labels = []
     for method, d in rows.items():
@@ -319,7 +333,7 @@ def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: l
         pt = np.array([(p["time"], p["error"]) for p in pareto])
         ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (median times)")
     ax.set_xlabel("wall time [s] (median of repeats; bars: fastest to slowest run)")
-    ax.set_ylabel("max state error vs reference [rad, rad/s]")
+    ax.set_ylabel(f"max state error vs reference [rad, {units.rate}]")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
     _legend(ax)

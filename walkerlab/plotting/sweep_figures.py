@@ -23,6 +23,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
 from walkerlab.sweep.bifurcation import SLOPE_PATH, fall_onset, onset_value, parameter_values
 from walkerlab.sweep.outcomes import OUTCOMES
+from walkerlab.units import Units
 
 OUTCOME_COLORS = {
     "ok": "#2ca02c", "no_fixed_point": "#7f7f7f", "fall": "#d62728", "scuff": "#9467bd",
@@ -189,7 +190,8 @@ _REASON_CLASS = {"off_patch": 2, "fall": 3, "no_mid_stance": 3, "time_limit": 4,
 _REASON_TEXT = {"off_patch": "off\npatch", "fall": "falls", "no_mid_stance": "no mid-\nstance",
                 "time_limit": "time\nlimit", "not_converged": "no con-\nvergence",
                 "solver_failure": "solver\nfailure", "no_ideal_gait": "no ideal\ngait",
-                "invalid_config": "invalid\nconfig", "error": "error"}
+                "invalid_config": "invalid\nconfig", "error": "error",
+                "unsupported": "not sup-\nported"}
 
 
 def gait_map_figure(data: dict):
@@ -221,8 +223,12 @@ def gait_map_figure(data: dict):
     attrs = data.get("attrs", {})
     kind = str(attrs.get("kind", ""))
     unit_sys = str(attrs.get("unit_system", "mm-kg-s"))
-    ylab = str(attrs.get("y_label", attrs.get("y_path", "y"))).replace(
-        "len", "mm" if unit_sys == "mm-kg-s" else "m")
+    ylab = str(attrs.get("y_label", attrs.get("y_path", "y")))
+    units = Units(str(attrs.get("scene_units", "SI")))
+    if units.nondimensional and unit_sys != "mm-kg-s":  # the scene's lengths are in l
+        ylab = ylab.replace("[N/len^e]", f"[{units('N')}/{units('m')}^e]").replace(
+            "[m]", f"[{units('m')}]")
+    ylab = ylab.replace("len", "mm" if unit_sys == "mm-kg-s" else "m")
     if kind == "stiffness":
         ylab += f", {attrs.get('stiffness_family', 'paper')} family"
     cmap = ListedColormap(GAIT_COLORS)
@@ -256,7 +262,9 @@ def gait_map_figure(data: dict):
     return fig
 
 
-def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=None):
+def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=None,
+                       mass_kg: float = 20.0, speed_m_per_s: float = 0.3,
+                       units: Units | None = None):
     """Drop-test coefficient of restitution against stiffness for each family.
 
     Parameters
@@ -269,6 +277,10 @@ def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=No
         Label of the stiffness unit.
     k_paper : float, optional
         Stiffness of the scene, marked with a vertical line.
+    mass_kg, speed_m_per_s : float
+        The dropped mass (the walker's) [kg] and its speed at first contact [m/s].
+    units : Units, optional
+        The scene's unit labels (default SI).
 
     Returns
     -------
@@ -285,7 +297,9 @@ def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=No
     ax.set_xlabel(f"stiffness k [{unit}]")
     ax.set_ylabel("coefficient of restitution [-]")
     ax.set_ylim(-0.03, 1.03)
-    ax.set_title("drop test: 20 kg at 0.3 m/s (rigid plastic impact: 0)", fontsize=9)
+    u = units or Units()
+    ax.set_title(f"drop test: {mass_kg:.3g} {u('kg')} at {speed_m_per_s:g} {u('m/s')} (rigid "
+                 "plastic impact: 0)", fontsize=9)
     ax.legend(fontsize=7)
     fig.tight_layout()
     return fig

@@ -12,6 +12,7 @@ from walkerlab.io.artifacts import open_artifact
 from walkerlab.published import for_scene
 from walkerlab.report.markdown import num, printed
 from walkerlab.report.markdown import table as _table
+from walkerlab.units import for_scene as units_for
 
 
 def _table2_note(pub) -> str:
@@ -52,7 +53,8 @@ def contact_section(scene, paths) -> list[str]:
             g = f["drop_test"]
             drop = (g["stiffness"][()], str(g["stiffness"].attrs["unit"]),
                     {fam: g[f"{fam}/restitution"][()] for fam in ("paper", "rigid_limit")},
-                    str(f.attrs.get("stiffness_family", "paper")))
+                    str(f.attrs.get("stiffness_family", "paper")),
+                    float(g.attrs.get("mass_kg", 20.0)))
         periods = f["steps/period"][()]
         adj = {k: f["adjust"][k][()] for k in f["adjust"]} if "adjust" in f else None
         per = per_fail = None
@@ -140,7 +142,7 @@ def _summary_rows(summ: dict, stage_wall_s: float) -> list[list]:
     return rows
 
 
-def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
+def _drop_lines(scene, artifact, ks, unit, curves, family, mass_kg=20.0) -> list[str]:
     """Restitution-vs-stiffness figure (drop test stored in contact_sim.h5) and its text."""
     figdir = artifact.parent / "report" / "figures"
     png = figdir / "drop_restitution.png"
@@ -149,12 +151,16 @@ def _drop_lines(scene, artifact, ks, unit, curves, family) -> list[str]:
         from walkerlab.plotting.figures import save
         from walkerlab.plotting.sweep_figures import restitution_figure
 
-        fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness))
+        fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness),
+                                 mass_kg=mass_kg, units=units_for(scene))
         save(fig, figdir, "drop_restitution")
     rows = [[float(k), float(curves["paper"][i]), float(curves["rigid_limit"][i])]
             for i, k in enumerate(ks)]
-    cap = ("Drop test — coefficient of restitution against stiffness, paper family (damping "
-           "and dmax fixed) and rigid-limit family (damping and dmax scaled with k).")
+    u = units_for(scene)
+    cap = (f"Drop test — the walker's mass ({num(mass_kg, 3)} {u('kg')}) meeting flat ground at "
+           f"0.3 {u('m/s')}: coefficient of restitution against stiffness, paper family "
+           "(damping and dmax fixed) and rigid-limit family (damping and dmax scaled with k "
+           "from the scene's contact).")
     return ["### Stiffness is not rigidity (drop test)", "",
             f"This scene follows the **{family}** family. With damping fixed, a stiffer IMPACT "
             "contact is *more elastic*, not closer to the rigid model's plastic impact; the "

@@ -120,8 +120,11 @@ def contact_text(path: Path) -> str:
                                                       else "")]
         if "initial_rate_scale" in f and "adjust" in f:  # --adjust: the scale it found
             s = np.atleast_1d(f["initial_rate_scale"][()])
+            # per named coordinate: the rates of leg1 (swing) and leg2 (stance) at the start
+            names = ([str(v) for v in f["rate"][()].astype(str)] if "rate" in f
+                     else ["leg1 rates", "leg2 rates"])
             lines.append("adjusted initial rate scale (found by --adjust): "
-                         + ", ".join(f"{v:.4g}" for v in s))
+                         + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s)))
         if "summary" in f:
             for k in f["summary"]:
                 ds = f["summary"][k]

@@ -23,8 +23,30 @@ from walkerlab.stages import fixedpoint as fixedpoint_stage
 from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
 
 SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_solver")
-#: stiffness values (scene units) of the drop test stored with every contact run
-DROP_STIFFNESS = (1e4, 3e4, 1e5, 3e5, 1e6, 3e6, 1e7, 3e7, 1e8, 3e8, 1e9)
+#: stiffness values of the drop test stored with every contact run, relative to the scene's
+#: own stiffness (the paper's k = 1e5 N/mm^2.2: 1e4 ... 1e9 N/mm^2.2)
+DROP_STIFFNESS_RATIO = (0.1, 0.3, 1.0, 3.0, 1e1, 3e1, 1e2, 3e2, 1e3, 3e3, 1e4)
+#: downward speed of the drop test at first contact [m/s, or the scene's speed unit]
+DROP_SPEED = 0.3
+
+
+def drop_test(scene: Scene, mass_kg: float) -> dict:
+    """The drop test of the scene's contact law (:func:`walkerlab.analysis.contact_drop.
+    restitution_curve`): the walker's total mass ``mass_kg`` [kg] meeting flat ground at
+    :data:`DROP_SPEED`, at the stiffnesses :data:`DROP_STIFFNESS_RATIO` x the scene's.
+
+    The rigid-limit family starts from the scene's own contact (its stiffness is the
+    reference) when the scene follows the paper family, so both curves pass through the
+    scene's contact whatever its unit system (``reference_stiffness`` defaults to the
+    paper's 1e5 N/mm^2.2, which means nothing in SI units, e.g. round_feet.yaml's 4e9 N/m^2.2).
+    """
+    from walkerlab.analysis.contact_drop import restitution_curve
+
+    base = settings(scene)[0]
+    if base.stiffness_family == "paper":
+        base = base.model_copy(update={"reference_stiffness": base.stiffness})
+    ks = [base.stiffness * r for r in DROP_STIFFNESS_RATIO]
+    return restitution_curve(base, ks, mass_kg=float(mass_kg), v_in_m_per_s=DROP_SPEED)
 LEGS = ["leg1", "leg2"]
 
 
@@ -90,9 +112,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                                                   time_limit_s=cs.periodic_time_limit_s)
             except PeriodicGaitError as exc:
                 gait_error = exc
-        from walkerlab.analysis.contact_drop import restitution_curve
-
-        drop = restitution_curve(settings(scene)[0], DROP_STIFFNESS)
+        drop = drop_test(scene, walker.total_mass)
         c = walker.contact
         steps = res.steps
         slips = np.array([s.stance_slip_mm for s in steps])
@@ -138,8 +158,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             put(g, "hip_height", o.hip_height_m, "m", "hip height above the ground line at "
                 "the outcome time")
             g = f.create_group("drop_test")
-            g.attrs["method"] = ("point mass 20 kg meeting flat ground at 0.3 m/s, no gravity "
+            g.attrs["method"] = (f"point mass {walker.total_mass:.6g} kg (the walker's) meeting "
+                                 f"flat ground at {DROP_SPEED} m/s, no gravity "
                                  "(walkerlab.analysis.contact_drop); restitution = v_out / v_in")
+            g.attrs["mass_kg"] = float(walker.total_mass)
             lu = "mm" if settings(scene)[0].unit_system == "mm-kg-s" else "m"
             coordinate(g, "stiffness", drop["stiffness"], f"N/{lu}^e",
                        "IMPACT stiffness in the scene's unit system")

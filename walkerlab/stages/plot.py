@@ -111,9 +111,11 @@ def _drop_figure(scene: Scene, runs_root, out_dir: Path, F) -> list[Path]:
         g = f["drop_test"]
         ks, unit = g["stiffness"][()], str(g["stiffness"].attrs["unit"])
         curves = {fam: g[f"{fam}/restitution"][()] for fam in ("paper", "rigid_limit")}
+        mass = float(g.attrs.get("mass_kg", 20.0))
     from walkerlab.plotting.sweep_figures import restitution_figure
 
-    fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness))
+    fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness),
+                             mass_kg=mass, units=for_scene(scene))
     return F.save(fig, out_dir, "drop_restitution")
 
 
@@ -134,5 +136,6 @@ def _workprecision_figures(scene: Scene, runs_root, F) -> list[Path]:
                                        np.asarray(g.attrs.get("pareto_time", [])),
                                        np.asarray(g.attrs.get("pareto_error", [])))]
                 written += F.save(F.work_precision(rows, f"work-precision, {model} model",
-                                                   pareto), out_dir, f"work_precision_{model}")
+                                                   pareto, units=for_scene(scene)),
+                                  out_dir, f"work_precision_{model}")
     return written

@@ -15,7 +15,7 @@ import numpy as np
 
 from walkerlab.config import CommandOptions, Scene, validate_option
 from walkerlab.io.artifacts import open_artifact, put
-from walkerlab.stages.common import StageOutcome, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.sweep.stability import (
     CELL_FIELDS,
     MAP_KINDS,
@@ -34,6 +34,17 @@ def stage_name(kind: str) -> str:
     return f"stability-map-{kind.replace('_', '-')}"
 
 
+def not_applicable(scene: Scene, kind: str) -> str:
+    """One line saying why map ``kind`` does not apply to the scene, or "" if it does (a
+    patch-width map needs the checkerboard terrain: on continuous ground there are no
+    patches)."""
+    terrain = scene.terrain
+    if kind == "patch_width" and terrain is not None and terrain.kind != "checkerboard":
+        return (f"stability-map --kind patch_width does not apply to scene '{scene.name}': "
+                f"its terrain is {terrain.kind} ground, which has no patches (terrain.kind)")
+    return ""
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         kind: str = "stiffness", n: int = 8, workers: int = 2, time_limit_s: float = 60.0,
         spec: MapSpec | None = None, progress=None) -> StageOutcome:
@@ -48,11 +59,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     require(scene, "contact", "stability-map")
     require(scene, "fixedpoint", "stability-map")
+    why = not_applicable(scene, kind)
+    if why:
+        raise StageError(why)
     n = validate_option(CommandOptions, "stability_map_n", n, "--n")
     workers = validate_option(CommandOptions, "workers", workers, "--workers")
     time_limit_s = validate_option(CommandOptions, "stability_map_time_limit_s",
                                    float(time_limit_s), "--time-limit")
-    spec = spec or default_spec(kind, n, time_limit_s)
+    terrain = scene.terrain
+    spec = spec or default_spec(kind, n, time_limit_s, stiffness=scene.contact.stiffness,
+                                patch_width_m=terrain.patch_width_m if terrain is not None
+                                else 0.10)
 
     def compute():
         from walkerlab import progress as _progress
@@ -80,7 +97,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "
                                  "step map, continued from its neighbour along the slope, "
                                  "else from the ideal fixed point at that slope")
-            put(f, "y_values", cells["y_values"], "scene units", spec.y_path)
+            put(f, "y_values", cells["y_values"],
+                {"patch_width": "m", "friction": "-"}.get(spec.kind, "scene units"),
+                spec.y_path)
             put(f, "slopes_deg", cells["slopes_deg"], "deg", "slope angle")
             for fld in CELL_FIELDS:
                 v = cells[fld]

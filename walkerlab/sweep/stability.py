@@ -12,7 +12,8 @@ Cell results (:data:`CELL_FIELDS`): ``exists`` (converged and every loaded foot 
 patch), ``stable`` (all |multipliers| < 1), ``max_abs_multiplier``, ``step_period_s``,
 ``patch_margin_m``, ``source`` ("neighbour" / "ideal"), ``reason`` ("" when the gait
 exists, else ``fall``, ``no_mid_stance``, ``solver_failure``, ``time_limit``,
-``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``), ``wall_time_s``.
+``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``, ``unsupported``:
+the periodic-gait search has no section for this walker), ``wall_time_s``.
 
 The cached stage is :mod:`walkerlab.stages.stability_map`; the figure
 :func:`walkerlab.plotting.sweep_figures.gait_map_figure`.
@@ -37,7 +38,7 @@ MAP_KINDS = {
 }
 
 REASONS = ("", "fall", "no_mid_stance", "solver_failure", "time_limit", "not_converged",
-           "off_patch", "no_ideal_gait", "invalid_config", "error")
+           "off_patch", "no_ideal_gait", "invalid_config", "unsupported", "error")
 
 CELL_FIELDS = ("exists", "stable", "max_abs_multiplier", "step_period_s", "patch_margin_m",
                "residual", "source", "reason", "wall_time_s")
@@ -82,8 +83,19 @@ class MapSpec:
                 + ",".join(f"{k}={v}" for k, v in sorted(MAP_GAIT_OPTIONS.items())))
 
 
-def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0) -> MapSpec:
-    """The default ``n x n`` grid of a map kind (slopes 0.5-4 deg).
+def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0,
+                 stiffness: float = 1e5, patch_width_m: float = 0.10) -> MapSpec:
+    """The default ``n x n`` grid of a map kind (slopes 0.5-4 deg), its y axis around the
+    scene's own value: stiffness ``stiffness`` x 1e-2 ... 1e4 (log), patch width
+    ``patch_width_m`` x 0.2 ... 2, static friction 0.1 ... 0.9.  The paper's scene (k = 1e5
+    N/mm^2.2, patches 0.10 m) gets 1e3 ... 1e9 and 0.02 ... 0.20 m.
+
+    Parameters
+    ----------
+    stiffness : float
+        The scene's contact stiffness (scene units, ``contact.stiffness``).
+    patch_width_m : float
+        The scene's patch width (scene length unit, ``terrain.patch_width_m``).
 
     Raises
     ------
@@ -93,8 +105,9 @@ def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0) -> MapSpec:
     if kind not in MAP_KINDS:
         raise ValueError(f"unknown stability-map kind {kind!r} (one of {', '.join(MAP_KINDS)})")
     slopes = tuple(float(v) for v in np.round(np.linspace(0.5, 4.0, n), 4))
-    ys = {"stiffness": np.logspace(3, 9, n), "friction": np.linspace(0.1, 0.9, n),
-          "patch_width": np.linspace(0.02, 0.20, n)}[kind]
+    lk = np.log10(stiffness)
+    ys = {"stiffness": np.logspace(lk - 2, lk + 4, n), "friction": np.linspace(0.1, 0.9, n),
+          "patch_width": np.linspace(0.2 * patch_width_m, 2.0 * patch_width_m, n)}[kind]
     return MapSpec(kind, tuple(float(v) for v in np.round(ys, 6)), slopes, time_limit_s)
 
 

@@ -218,6 +218,9 @@ class SweepStore:
         for name, (unit, desc) in walker_columns(stage, scene).items():
             mk(name, np.float64, unit, desc)
         mk("row_hash", STR, "-", "SHA-256 of the row and the input hash (resume check)")
+        from walkerlab.units import for_scene, relabel_artifact
+
+        relabel_artifact(f, for_scene(scene))  # unit labels follow the scene's system
         plan = plan if plan is not None else []
         idx = np.array([i for c in plan for i in c], np.int64)
         f.create_dataset("plan/index", data=idx)
