@@ -49,7 +49,9 @@ def cli(cwd: Path, *args: str, timeout: float = 120, env=None, user=None):
     if any("Traceback" in ln for ln in err):
         first = "TRACEBACK: " + (err[-1] if err else "")
     else:
-        first = err[0] if err else (p.stdout.strip().splitlines() or [""])[-1]
+        # the error line, not a note before it ("simulate: recomputing ... (scene changed ...)")
+        first = next((ln for ln in err if ln.startswith("error")), err[0] if err else
+                     (p.stdout.strip().splitlines() or [""])[-1])
         if len(err) > 1:
             first += f" (+{len(err) - 1} more lines)"
     return p.returncode, first[:160], time.time() - t0
@@ -690,7 +692,7 @@ def i19_7_disk_full_ulimit(d):
 def i19_7_disk_full_tmpfs(d):
     mnt = d / "tmpfs"
     mnt.mkdir()
-    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=300k", "tmpfs", str(mnt)],
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=600k", "tmpfs", str(mnt)],
                       capture_output=True).returncode != 0:
         return "-", "cannot mount a tmpfs here (needs root)", ""
     try:
@@ -699,14 +701,17 @@ def i19_7_disk_full_tmpfs(d):
         cli(d / "cfg", "simulate", str(s), "--strides", "1", "--runs-dir", str(runs),
             env=_uc(d))
         art = runs / "paper/simulate.h5"
-        old = art.read_bytes() if art.is_file() else b""
+        if not art.is_file():
+            return "-", "the 1-stride artifact does not fit the tmpfs (setup)", ""
+        old = art.read_bytes()
         p = subprocess.run([PY, "-m", "walkerlab.cli", "simulate", str(s), "--strides", "400",
                             "--runs-dir", str(runs)], cwd=d / "cfg", capture_output=True,
                            text=True, env={**os.environ, **_uc(d)})
         err = p.stderr.strip().splitlines()
         stray = [q.name for q in runs.rglob("*") if q.name.endswith(".tmp")]
         kept = art.is_file() and art.read_bytes() == old
-        return (p.returncode, (err[0] if err else "")[:160],
+        line = next((ln for ln in err if ln.startswith("error")), err[0] if err else "")
+        return (p.returncode, line[:160],
                 f"{len(err)} stderr lines; old artifact kept: {kept}; stray: {stray or 'none'}")
     finally:
         subprocess.run(["umount", str(mnt)], capture_output=True)
@@ -745,8 +750,45 @@ def i19_10_damaged_workprecision_cache(d):
 @case
 def i19_14_debug_false(d):
     rc, msg, _ = cli(d, "fixedpoint", "missing.yaml", env={"WALKERLAB_DEBUG": "false"})
+    return rc, msg, ""
+
+
+@case
+def i19_14_runs_dir_empty(d):
+    s = scene(d / "cfg", IDEAL, "paper.yaml")
+    rc, msg, _ = cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "", env=_uc(d))
+    return rc, msg, f"written into the current folder: {(d / 'cfg' / 'paper').exists()}"
+
+
+@case
+def i19_14_report_md_script(d):
+    s = scene(d / "cfg", {**IDEAL, "source": "Smith <script>alert(1)</script>"}, "paper.yaml")
+    rc, msg, _ = cli(d / "cfg", "report", str(s), "--runs-dir", "runs", env=_uc(d),
+                     timeout=600)
+    md = (d / "cfg/runs/paper/report/report.md")
+    if not md.is_file():
+        return rc, msg, "no report"
+    # code fences show HTML as text: only what lies outside them counts
+    prose = "".join(md.read_text().split("```")[::2])
+    return rc, msg, f"report.md holds a raw <script> outside code blocks: {'<script>' in prose}"
+
+
+@case
+def i19_14_dev_zero(d):
+    rc, msg, _ = cli(d, "fixedpoint", "/dev/zero", env=_uc(d))
+    return rc, msg, ""
+
+
+@case
+def i19_14_bench_out_file(d):
+    (d / "FILE").write_text("keep")
+    rc, msg, _ = cli(d, "bench", "ideal", "--out", "FILE", env=_uc(d))
+    return rc, msg, f"FILE kept: {(d / 'FILE').read_text() == 'keep'}"
+
 
 # ------------------------------------------------------------------ issue 19 (rel-b)
+
+
 def _wait_rows(p: Path, n: int, proc, timeout: float = 300) -> None:
     import h5py
 
@@ -884,29 +926,6 @@ def i19_5_basin_grid_5000(d):
 
 
 @case
-def i19_14_runs_dir_empty(d):
-    s = scene(d / "cfg", IDEAL, "paper.yaml")
-    rc, msg, _ = cli(d / "cfg", "fixedpoint", str(s), "--runs-dir", "", env=_uc(d))
-    return rc, msg, f"written into the current folder: {(d / 'cfg' / 'paper').exists()}"
-
-
-@case
-def i19_14_report_md_script(d):
-    s = scene(d / "cfg", {**IDEAL, "source": "Smith <script>alert(1)</script>"}, "paper.yaml")
-    rc, msg, _ = cli(d / "cfg", "report", str(s), "--runs-dir", "runs", env=_uc(d),
-                     timeout=600)
-    md = (d / "cfg/runs/paper/report/report.md")
-    if not md.is_file():
-        return rc, msg, "no report"
-    # code fences show HTML as text: only what lies outside them counts
-    prose = "".join(md.read_text().split("```")[::2])
-    return rc, msg, f"report.md holds a raw <script> outside code blocks: {'<script>' in prose}"
-
-
-@case
-def i19_14_dev_zero(d):
-    rc, msg, _ = cli(d, "fixedpoint", "/dev/zero", env=_uc(d))
-
 def i19_5_basin_grid_100000(d):
     s = scene(d, IDEAL, "paper.yaml")
     rc, msg, _ = cli(d, "basin", str(s), "--grid", "100000x100000", "--runs-dir", "runs",
@@ -915,11 +934,6 @@ def i19_5_basin_grid_100000(d):
 
 
 @case
-def i19_14_bench_out_file(d):
-    (d / "FILE").write_text("keep")
-    rc, msg, _ = cli(d, "bench", "ideal", "--out", "FILE", env=_uc(d))
-    return rc, msg, f"FILE kept: {(d / 'FILE').read_text() == 'keep'}"
-
 def i19_5_simulate_samples(d):
     s = scene(d, with_(IDEAL, simulate={"strides": 1000, "sample_rate_hz": 1e6}), "paper.yaml")
     rc, msg, _ = cli(d, "simulate", str(s), "--runs-dir", "runs", timeout=300)
@@ -997,7 +1011,6 @@ def i19_12_duplicate_key(d):
     return (*_bad_scene_text(d, yaml.safe_dump(IDEAL) + "slope:\n  angle_deg: 3.0\n"), "")
 
 
-# issue 19 items 6, 8, 9 (contact outcomes, sweeps over unknown fields, time limits)
 @case
 def i19_6_contact_flies_away(d):
     s = scene(d, with_(PAPER, contact_sim__initial_rate_scale=[1000.0, 1000.0]), "paper.yaml")
