@@ -62,7 +62,8 @@ def drop_restitution(contact: ContactSettings, mass_kg: float = 20.0, v_in_m_per
     sep.direction = -1
     sol = solve_ivp(f, (0.0, 50 * tc), [0.0, vin], method="Radau", rtol=rtol,
                     atol=[1e-6 * dstar, 1e-6 * vin], events=sep, max_step=tc / 10)
-    dmax = float(np.max(sol.y[0]))
+    penetration, _rate = sol.y  # the point mass's state [delta (m), d delta/dt (m/s)]
+    dmax = float(np.max(penetration))
     if sol.t_events[0].size:
         vout = -float(sol.y_events[0][0][1])
         return {"restitution": max(vout, 0.0) / vin, "max_penetration_m": dmax,

@@ -126,7 +126,7 @@ def fig8_errors(time: np.ndarray, errors: dict[str, np.ndarray], units: dict[str
     sty = _coordinate_styles(list(errors))
     for n, e in errors.items():
         ax = axes[0] if units[n] == "rad" else axes[1]  # rates: rad/s or its relabel
-        ax.plot(time, e, label=n.rsplit("_", 1)[0], lw=1, **sty[n])
+        ax.plot(time, e, label=n.rpartition("_")[0] or n, lw=1, **sty[n])
     axes[0].set_ylabel("angle error [rad]")
     axes[1].set_ylabel(f"rate error [{scene_units.rate}]")
     axes[1].set_xlabel(f"time [{scene_units.time}]")
