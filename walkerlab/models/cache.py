@@ -120,6 +120,43 @@ def generated_module(structure) -> dict:
     return ns
 
 
+_imported: dict[str, object] = {}
+
+
+def import_generated(filename: str, module_name: str, build):
+    """Import the generated module ``filename`` of the cache folder as a real module (so that
+    numba's ``cache=True`` keeps its machine code, in the user cache:
+    :func:`walkerlab.usercache.use_for_numba`); memoised per process by ``filename``.
+
+    ``build() -> str`` gives the source on a miss, a damaged or an untrusted file (see
+    :func:`read_source`); it is written atomically (mode 0600).  Without a private cache
+    folder, or one that cannot be written, the module is imported from a private temporary
+    copy (``mkdtemp``: mode 0700).  Used by :mod:`walkerlab.models.compiled` and
+    :mod:`walkerlab.models.floating` (and through it :mod:`walkerlab.contact.generated`).
+    """
+    if filename in _imported:
+        return _imported[filename]
+    import importlib.util
+    import sys
+
+    usercache.use_for_numba()  # numba's cache in the user cache, not in a runs folder
+    folder = cache_dir()
+    path = folder / filename if folder is not None else None
+    if path is None or read_source(path) is None:  # missing, damaged or untrusted
+        body = build()
+        if path is None or not write_source(path, body):
+            import tempfile
+
+            path = Path(tempfile.mkdtemp(prefix="walkerlab_gen_")) / filename
+            write_source(path, body)
+    spec = importlib.util.spec_from_file_location(module_name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = mod
+    spec.loader.exec_module(mod)
+    _imported[filename] = mod
+    return mod
+
+
 def clear_memo() -> None:
     """Forget modules loaded in this process (tests)."""
     _memo.clear()

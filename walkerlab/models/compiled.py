@@ -13,15 +13,11 @@ numba and CyRK are imported only when :meth:`CompiledFlow.address` is first call
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from walkerlab.models import cache
-
-_modules: dict[str, object] = {}
 
 
 def compiled_module(structure):
@@ -33,32 +29,13 @@ def compiled_module(structure):
         numba is not installed.
     """
     key = cache.cache_key(structure)
-    if key in _modules:
-        return _modules[key]
-    from pathlib import Path
 
-    from walkerlab import usercache
-
-    usercache.use_for_numba()  # numba's cache in the user cache, not in a runs folder
-    folder = cache.cache_dir()
-    path = folder / f"{key}_nb.py" if folder is not None else None
-    if path is None or cache.read_source(path) is None:  # missing, damaged or untrusted
+    def build() -> str:
         from walkerlab.models import codegen, symbolic
 
-        body = codegen.generate_compiled(symbolic.derive(structure), structure.param_names, key)
-        if path is None or not cache.write_source(path, body):
-            import tempfile
+        return codegen.generate_compiled(symbolic.derive(structure), structure.param_names, key)
 
-            # no private cache folder: a private temporary copy (mkdtemp: mode 0700)
-            path = Path(tempfile.mkdtemp(prefix="walkerlab_nb_")) / f"{key}_nb.py"
-            cache.write_source(path, body)
-    name = f"walkerlab_compiled_{key}"
-    spec = importlib.util.spec_from_file_location(name, path)
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[name] = mod
-    spec.loader.exec_module(mod)
-    _modules[key] = mod
-    return mod
+    return cache.import_generated(f"{key}_nb.py", f"walkerlab_compiled_{key}", build)
 
 
 @dataclass(frozen=True, eq=False)

@@ -49,8 +49,6 @@ raises.
 from __future__ import annotations
 
 import hashlib
-import importlib.util
-import sys
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -335,7 +333,6 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
 
 
 # ---------------------------------------------------------------------------- cache
-_modules: dict[str, object] = {}
 
 
 def _source_hash(paths) -> str:
@@ -357,36 +354,14 @@ def module_key(structure: Structure, tag: str, sources=()) -> str:
 
 
 def load_generated(structure: Structure, tag: str, build, sources=()):
-    """Import the generated module ``<key>_<tag>.py`` of the cache folder
-    (:func:`walkerlab.models.cache.cache_dir`), writing it with ``build(key) -> str`` on a
-    miss (or a corrupt file).  Imported as a real module so numba's ``cache=True`` keeps its
-    machine code (in the user cache, :func:`walkerlab.usercache.use_for_numba`); no private
-    cache folder, or one that cannot be written, falls back to a private temporary copy.
-    """
-    from walkerlab import usercache
+    """Import the generated module ``<key>_<tag>.py`` of the cache folder, writing it with
+    ``build(key) -> str`` on a miss (or a damaged or untrusted file): one mechanism with the
+    rigid compiled flows, :func:`walkerlab.models.cache.import_generated`."""
     from walkerlab.models import cache
 
     key = module_key(structure, tag, sources)
-    if key in _modules:
-        return _modules[key]
-    usercache.use_for_numba()  # numba's cache in the user cache, not in a runs folder
-    folder = cache.cache_dir()
-    path = folder / f"{key}_{tag}.py" if folder is not None else None
-    if path is None or cache.read_source(path) is None:  # missing, damaged or untrusted
-        body = build(key)
-        if path is None or not cache.write_source(path, body):
-            import tempfile
-
-            # no private cache folder: a private temporary copy (mkdtemp: mode 0700)
-            path = Path(tempfile.mkdtemp(prefix="walkerlab_fl_")) / f"{key}_{tag}.py"
-            cache.write_source(path, body)
-    name = f"walkerlab_{tag}_{key}"
-    spec = importlib.util.spec_from_file_location(name, path)
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[name] = mod
-    spec.loader.exec_module(mod)
-    _modules[key] = mod
-    return mod
+    return cache.import_generated(f"{key}_{tag}.py", f"walkerlab_{tag}_{key}",
+                                  lambda: build(key))
 
 
 def floating_source(structure: Structure, key: str) -> str:
