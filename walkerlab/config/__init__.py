@@ -46,7 +46,6 @@ from walkerlab.config.contact import (  # noqa: F401  (re-exported: one import p
     ContactSimSettings,
     ContactSolverSettings,
     TerrainSettings,
-    family_scaling,
 )
 
 

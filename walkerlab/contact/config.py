@@ -13,5 +13,4 @@ from walkerlab.config.contact import (  # noqa: F401
     KneeStopSettings,
     KneeStopSI,
     TerrainSettings,
-    family_scaling,
 )
