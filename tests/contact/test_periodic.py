@@ -11,11 +11,11 @@ from walkerlab.analysis.contact_periodic import (
     StepMap,
     find_contact_periodic_gait,
 )
-from walkerlab.analysis.rigid_limit import convergence, observed_order
-from walkerlab.contact.rigid_limit import expected_order
 from walkerlab.analysis.contact_sim import simulate_contact
+from walkerlab.analysis.rigid_limit import convergence, observed_order
 from walkerlab.config import ContactSolverSettings, load_scene
 from walkerlab.contact.model import checkerboard_lanes
+from walkerlab.contact.rigid_limit import expected_order
 from walkerlab.stages.contact_sim import build
 from walkerlab.stages.fixedpoint import solve_variant
 

@@ -72,8 +72,8 @@ three slow ones (0.469 +- 0.498j, 0.113; rigid 0.548 +- 0.499j, 0.108), the seve
 Rigid limit
 -----------
 The one rigid-limit family of the contact is :mod:`walkerlab.contact.rigid_limit`
-(:func:`~walkerlab.contact.rigid_limit.scale_walker`); :func:`walkerlab.analysis.rigid_limit.convergence` follows this
-gait along it (:mod:`walkerlab.analysis.rigid_limit`).
+(:func:`~walkerlab.contact.rigid_limit.scale_walker`);
+:func:`walkerlab.analysis.rigid_limit.convergence` follows this gait along it.
 """
 
 from __future__ import annotations

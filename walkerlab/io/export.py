@@ -255,8 +255,9 @@ def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     for leg, (y, centres) in zip(LANE_BITS, ((0.05, extra.lanes[0]), (-0.05, extra.lanes[1]))):
         for i, s in enumerate(centres):
             d = off + depth  # box centre below the surface
-            out.append(f'    <geom name="{leg}_patch{i}" type="box" size="{_v(half, 0.04 * mb.leg_length_m, depth)}"'
-                       f' pos="{_v(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])}"'
+            size = _v(half, 0.04 * mb.leg_length_m, depth)
+            pos = _v(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])
+            out.append(f'    <geom name="{leg}_patch{i}" type="box" size="{size}" pos="{pos}"'
                        f' euler="{_v(0, phi, 0)}" contype="{LANE_BITS[leg]}" conaffinity="0"'
                        ' rgba="0.8 0.8 0.8 1"/>')
     return out

@@ -12,13 +12,12 @@ import json
 from pathlib import Path
 
 import walkerlab
+from walkerlab.analysis.export_scene import check_exportable, mjcf_scene
 from walkerlab.config import Scene
 from walkerlab.io import runpaths
-from walkerlab.analysis.export_scene import check_exportable, mjcf_scene
 from walkerlab.io.export import FORMATS, mjcf_text, urdf_text
 from walkerlab.models.description import walker_data
 from walkerlab.models.multibody import multibody
-
 
 #: The URDF's keyframe sidecar in ``runs/<scene>/``.
 SIDECAR = "walker.gait.json"
