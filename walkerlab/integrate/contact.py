@@ -46,6 +46,12 @@ import numpy as np
 from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
 from walkerlab.config.contact import ContactSolverSettings
+from walkerlab.contact.energy import (
+    energy_rise_bound,
+    first_energy_violation,
+    side_entry,
+    total_energy,
+)
 
 from . import _cyrk
 
@@ -417,6 +423,10 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
     ta, xa = t0, x0
     term, msg, event = "t_final", "Integration successful.", None
     n_checked = 1
+    # the energy guard (walkerlab.contact.energy): no sample above the start's energy + bound
+    e_start = float(total_energy(walker, x0)[0])
+    e_bound = energy_rise_bound(walker, x0, solver.rtol)
+    guarded = False  # the energy guard ended the run (no event state to interpolate)
     # numbalsoda: the first chunk is short, later ones sized to CHUNK_WALL_S
     span = min(limits.chunk_s, 20.0 / rate) if be.sized_by_wall else limits.chunk_s
     while ta < t1 - 1e-12:
@@ -432,6 +442,26 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             break
         nfev += nf
         njev += nj
+        bad = first_energy_violation(walker, Xn, e_start, e_bound) if tn.size else None
+        if bad is not None:  # blown-up samples are not data: end at the last good one
+            last = Xn[bad - 1] if bad else xa
+            trip = side_entry(walker, last, 2.0 / rate)
+            ts.append(tn[:bad])
+            Xs.append(Xn[:bad])
+            msg = (f"total energy rose above its start by more than {e_bound:.3g} J at "
+                   f"t = {tn[bad]:.6g} s (a contact walker cannot gain energy): the run ends "
+                   "at the last trustworthy sample")
+            term = "solver_failure"
+            if trip is not None:  # the cause: a foot in a gap entered a patch's side
+                foot, edge, ahead, depth = trip
+                t_last = float(tn[bad - 1]) if bad else float(ta)
+                n_all = sum(len(t) for t in ts)
+                event = ("trip", n_all - 1, t_last + ahead, foot, edge)
+                term = "trip"
+                msg = (f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
+                       f"entered a patch from its side; {msg}")
+            guarded = True
+            break
         if be.sized_by_wall and tn.size:
             per_s = (time.perf_counter() - w0) / max(tn[-1] - ta, 1e-12)
             left = max(min(CHUNK_WALL_S, deadline - time.perf_counter()), 1e-3)
@@ -455,7 +485,7 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             break
         ta, xa = t_all[-1], X_all[-1]
     t_all, X_all = np.concatenate(ts), np.vstack(Xs)
-    if event is not None:  # cut at the event and append the event state
+    if event is not None and not guarded:  # cut at the event and append the event state
         _, k, te, _, _ = event
         k = max(k, 1)
         xe = hermite_state(walker, t_all[k - 1], t_all[k], X_all[k - 1], X_all[k], te) \
