@@ -11,11 +11,11 @@ written sample has more energy than the start + the bound.
 import numpy as np
 import pytest
 
+from tests.contact.test_periodic import SCENE
 from walkerlab.analysis.contact_sim import simulate_from
 from walkerlab.config import load_scene
 from walkerlab.contact.energy import energy_rise_bound, total_energy
 from walkerlab.stages.fixedpoint import solve_variant
-from tests.contact.test_periodic import SCENE
 
 RODS = SCENE.parent / "paper_rods.yaml"
 

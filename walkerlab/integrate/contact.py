@@ -442,12 +442,27 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             break
         nfev += nf
         njev += nj
+        if be.sized_by_wall and tn.size:
+            per_s = (time.perf_counter() - w0) / max(tn[-1] - ta, 1e-12)
+            left = max(min(CHUNK_WALL_S, deadline - time.perf_counter()), 1e-3)
+            span = float(np.clip(left / max(per_s, 1e-12), 2.0 / rate, limits.chunk_s))
         bad = first_energy_violation(walker, Xn, e_start, e_bound) if tn.size else None
-        if bad is not None:  # blown-up samples are not data: end at the last good one
+        n_prev = sum(len(t) for t in ts)
+        ts.append(tn)
+        Xs.append(Xn)
+        t_all, X_all = np.concatenate(ts), np.vstack(Xs)
+        # events among the trustworthy samples and the first one past them (a trip's first
+        # sample on the patch already carries the spring's energy)
+        n_ok = len(t_all) if bad is None else n_prev + bad + 1
+        event = first_event(walker, t_all[:n_ok], X_all[:n_ok], limits, k0=n_checked)
+        n_checked = len(t_all)
+        if event is not None and bad is not None and event[1] >= n_prev + bad \
+                and event[0] != "trip":
+            event = None  # a fall or flight seen only on a blown-up sample is not one
+        if event is None and bad is not None:  # blown-up samples are not data
+            ts[-1], Xs[-1] = tn[:bad], Xn[:bad]
             last = Xn[bad - 1] if bad else xa
             trip = side_entry(walker, last, 2.0 / rate)
-            ts.append(tn[:bad])
-            Xs.append(Xn[:bad])
             msg = (f"total energy rose above its start by more than {e_bound:.3g} J at "
                    f"t = {tn[bad]:.6g} s (a contact walker cannot gain energy): the run ends "
                    "at the last trustworthy sample")
@@ -455,22 +470,12 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             if trip is not None:  # the cause: a foot in a gap entered a patch's side
                 foot, edge, ahead, depth = trip
                 t_last = float(tn[bad - 1]) if bad else float(ta)
-                n_all = sum(len(t) for t in ts)
-                event = ("trip", n_all - 1, t_last + ahead, foot, edge)
+                event = ("trip", n_prev + bad - 1, t_last + ahead, foot, edge)
                 term = "trip"
                 msg = (f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
                        f"entered a patch from its side; {msg}")
             guarded = True
             break
-        if be.sized_by_wall and tn.size:
-            per_s = (time.perf_counter() - w0) / max(tn[-1] - ta, 1e-12)
-            left = max(min(CHUNK_WALL_S, deadline - time.perf_counter()), 1e-3)
-            span = float(np.clip(left / max(per_s, 1e-12), 2.0 / rate, limits.chunk_s))
-        ts.append(tn)
-        Xs.append(Xn)
-        t_all, X_all = np.concatenate(ts), np.vstack(Xs)
-        event = first_event(walker, t_all, X_all, limits, k0=n_checked)
-        n_checked = len(t_all)
         if event is not None:
             term = event[0]
             break
