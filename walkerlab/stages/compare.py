@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.analysis.compare import aligned_errors, limit_cycle_distance
+from walkerlab.analysis.compare import aligned_errors, limit_cycle_distance, phase_aligned_errors
 from walkerlab.analysis.tables import gait_metrics
 from walkerlab.config import Scene
 from walkerlab.io.artifacts import open_artifact, put
@@ -31,11 +31,12 @@ def compare_files(ideal_path: Path, contact_path: Path):
     with open_artifact(contact_path, "contact-sim") as f:
         contact = read_samples(f)
     t, err = aligned_errors(ideal, contact)
+    phase = phase_aligned_errors(ideal, contact)
     metrics = {"ideal": gait_metrics(ideal, mass_kg=mass_kg, g=g),
                "contact": gait_metrics(contact, mass_kg=mass_kg, g=g)}
     lc = {a.removesuffix("_angle"): limit_cycle_distance(ideal, contact, a, r)
           for a, r in ideal.phase_pairs() if a in contact.coordinates and r in contact.coordinates}
-    return ideal, t, err, metrics, lc
+    return ideal, t, err, metrics, lc, phase
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
@@ -46,10 +47,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
           artifact_path(scene, runs_root, "contact-sim"))
 
     def compute():
-        ideal, t, err, metrics, lc = compare_files(up[0], up[1])
+        ideal, t, err, metrics, lc, (step_phase, perr) = compare_files(up[0], up[1])
         ang = [n for n in err if ideal.units[n] == "rad"]
         rat = [n for n in err if ideal.units[n].startswith("rad/")]  # rad/s, or per time unit
         summary = {"max_angle_error_rad": float(max(np.max(np.abs(err[n])) for n in ang)),
+                   "max_phase_aligned_angle_error_rad": float(max(
+                       (np.max(np.abs(perr[n])) for n in ang if perr[n].size), default=np.nan)),
                    "max_rate_error_rad_per_s": float(max(np.max(np.abs(err[n])) for n in rat)),
                    "compared_until_s": float(t[-1]), "metrics": metrics,
                    "limit_cycle_distance": lc}
@@ -66,6 +69,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
             for stem, d in lc.items():
                 put(g, f"limit_cycle_distance/{stem}", d, "rad (rates in rad/s)",
                     f"mean distance from the ideal phase curve of {stem} to the contact one")
+            p = f.create_group("errors_phase_aligned")
+            p.attrs["legs"] = ideal.legs
+            p.attrs["coordinates"] = list(perr)
+            p.attrs["definition"] = ("contact - ideal at the same fraction of the same step "
+                                     "(each step on normalised step time; "
+                                     "walkerlab.analysis.compare.phase_aligned_errors)")
+            coordinate(p, "step_phase", step_phase, "-",
+                       "step number + fraction of the step (heel strike to heel strike)")
+            for n, e in perr.items():
+                put(p, f"coordinates/{n}", e, ideal.units[n],
+                    f"{n} error (contact - ideal) at the same step phase", dims=("step_phase",))
             put(g, "max_abs_angle", summary["max_angle_error_rad"], "rad", "")
             put(g, "max_abs_rate", summary["max_rate_error_rad_per_s"], "rad/s", "")
             for model, m in metrics.items():

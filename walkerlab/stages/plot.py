@@ -93,8 +93,13 @@ def _trajectory_figures(scene: Scene, runs_root, F) -> list[Path]:
             t = g["time"][()]
             err = {n: g[f"coordinates/{n}"][()] for n in names}
             units = {n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names}
-        written += F.save(F.fig8_errors(t, err, units, "contact - ideal", scene_units=u),
-                          out_dir, "fig8_errors")
+            phase = None
+            if "errors_phase_aligned" in f:
+                p = f["errors_phase_aligned"]
+                phase = (p["step_phase"][()], {n: p[f"coordinates/{n}"][()] for n in names
+                                               if f"coordinates/{n}" in p})
+        written += F.save(F.fig8_errors(t, err, units, "contact - ideal", scene_units=u,
+                                        phase=phase), out_dir, "fig8_errors")
     written += _drop_figure(scene, runs_root, out_dir, F)
     return written
 
