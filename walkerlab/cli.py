@@ -304,11 +304,25 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 @app.command()
 @_guard
 def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-            force: bool = ForceOpt) -> None:
+            force: bool = ForceOpt,
+            rigid_limit: bool = typer.Option(
+                False, "--rigid-limit", help="instead: the contact periodic gait along the "
+                "rigid-limit family (rigid_limit.h5 and its figure)")) -> None:
     """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
     from walkerlab.report.text import compare_text
     from walkerlab.stages import compare as stage
 
+    if rigid_limit:
+        from walkerlab.stages import rigid_limit as rl
+
+        sc = _load(scene)
+        out = rl.run(sc, runs_dir, force)
+        for line in rl.table_lines(out.path):
+            typer.echo(line)
+        for p in rl.draw(sc, runs_dir, out.path):
+            typer.echo(f"wrote {p}")
+        typer.echo(_status(out))
+        return
     out = stage.run(_load(scene), runs_dir, force)
     typer.echo(compare_text(out.path))
     typer.echo(_status(out))
