@@ -11,6 +11,7 @@ from walkerlab.stages import rigid_limit
 ROOT = Path(__file__).resolve().parents[1]
 
 
+@pytest.mark.slow
 def test_rigid_limit_stage_writes_table_and_figure(tmp_path):
     """Two stiffness factors of the paper's contact: the artifact holds the contact gait
     against the rigid one (period gap 7.37 ms at kappa 1, 2.50 ms at 10, measured), the table
