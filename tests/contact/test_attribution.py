@@ -9,12 +9,12 @@ from the contact forces sample by sample; gravity's work from the step length al
 import numpy as np
 import pytest
 
+from tests.contact.test_periodic import SCENE
 from walkerlab.analysis.attribution import energy_by_sink
 from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
 from walkerlab.config import load_scene
 from walkerlab.stages.contact_sim import build
 from walkerlab.stages.fixedpoint import solve_variant
-from tests.contact.test_periodic import SCENE
 
 
 def test_sinks_add_up_to_gravity_work_over_the_step():
