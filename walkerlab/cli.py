@@ -354,11 +354,13 @@ def plot(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
 @app.command()
 @_guard
 def report(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-           force: bool = ForceOpt) -> None:
+           force: bool = ForceOpt,
+           full: bool = typer.Option(False, "--full", help="also measure the work-precision "
+                                     "diagram (times every solver setting; ~30 s)")) -> None:
     """Run every stage the scene needs (skipping up-to-date ones) and write the report."""
     from walkerlab.stages import report as stage
 
-    out = stage.run(_load(scene), runs_dir, force, echo=typer.echo)
+    out = stage.run(_load(scene), runs_dir, force, echo=typer.echo, full=full)
     typer.echo(f"report: {out}")
 
 

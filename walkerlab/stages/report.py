@@ -134,17 +134,26 @@ class _Study:
         return self.outcome
 
 
-def planned_stages(scene: Scene) -> list[str]:
-    """The stages ``report`` runs for this scene, in order (for its progress display)."""
+def planned_stages(scene: Scene, full: bool = False) -> list[str]:
+    """The stages ``report`` runs for this scene, in order (for its progress display); the
+    work-precision study only with ``full`` (``walkerlab report --full``)."""
     sim, contact = scene.simulate is not None, scene.contact is not None
     return [n for n, on in (("fixedpoint", scene.fixedpoint is not None), ("simulate", sim),
                             ("contact-sim", contact), ("compare", contact and sim),
-                            ("workprecision", getattr(scene, "workprecision", None) is not None),
+                            ("workprecision", wants_workprecision(scene, full)),
                             ("basin", scene.basin is not None and scene.fixedpoint is not None))
             if on]
 
 
-def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None) -> list[StageOutcome]:
+def wants_workprecision(scene: Scene, full: bool) -> bool:
+    """The report measures the work-precision diagram: opt-in (``--full``), it times every
+    solver setting (~30 s of a ~33 s cold report, issue 25) and a shared machine's timings
+    are noise unless repeated; ``walkerlab workprecision`` runs it alone."""
+    return full and getattr(scene, "workprecision", None) is not None
+
+
+def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
+                full: bool = False) -> list[StageOutcome]:
     from walkerlab.stages import fixedpoint, simulate
 
     done: list[StageOutcome] = []
@@ -154,8 +163,7 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None) -> list[St
         if bar is not None:
             bar.advance(info=f"{o.stage} {'reused' if o.reused else 'computed'}")
     drawn: list[str] = []
-    study = (_Study(scene, runs_root, force)
-             if getattr(scene, "workprecision", None) is not None else None)
+    study = _Study(scene, runs_root, force) if wants_workprecision(scene, full) else None
     try:
         if scene.fixedpoint is not None:
             add(fixedpoint.run(scene, runs_root, force, compare_variants=True))
@@ -246,7 +254,7 @@ _NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' 
             "basin": "no 'basin' section (or no 'fixedpoint')"}
 
 
-def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
+def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
                      ) -> tuple[dict[str, Path], str]:
     """The artifacts the report shows and one line on what it leaves out ('' if nothing).
 
@@ -261,6 +269,16 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
     for stage, p in existing_artifacts(scene, runs_root).items():
         if stage in produced:
             paths[stage] = p
+        elif stage == "workprecision" and getattr(scene, "workprecision", None) is not None \
+                and not full:
+            from walkerlab.stages import workprecision
+            from walkerlab.stages.common import changed_fields
+
+            if changed_fields(p, scene, workprecision.SECTIONS):
+                left.append(f"{p.name} (measured for other settings; `walkerlab report "
+                            "--full` measures it again)")
+            else:
+                paths[stage] = p  # measured earlier (--full or `walkerlab workprecision`)
         elif stage == "bifurcation":
             from walkerlab.stages import bifurcation
             from walkerlab.stages.common import changed_fields
@@ -291,8 +309,9 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        echo: Callable[[str], None] = print) -> Path:
-    """Run the needed stages, draw figures, write ``report.md`` and ``report.html``.
+        echo: Callable[[str], None] = print, full: bool = False) -> Path:
+    """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
+    ``full``: also the work-precision study (:func:`wants_workprecision`).
 
     Returns
     -------
@@ -301,11 +320,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     from walkerlab import progress
 
-    stages = planned_stages(scene)
+    stages = planned_stages(scene, full)
     with progress.task(f"report: {len(stages)} stages ({', '.join(stages)})",
                        len(stages)) as bar:
-        done = _run_stages(scene, runs_root, force, echo, bar)
-    paths, left_out = report_artifacts(scene, runs_root, done)
+        done = _run_stages(scene, runs_root, force, echo, bar, full)
+    paths, left_out = report_artifacts(scene, runs_root, done, full)
+    if getattr(scene, "workprecision", None) is not None and "workprecision" not in paths:
+        echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
     if left_out:
         echo(left_out)
     rep_dir = report_dir(scene, runs_root, claim=True)
