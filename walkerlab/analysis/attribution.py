@@ -68,10 +68,23 @@ class Attribution:
     energy_J: dict
 
 
-def _no_creep(walker):
+def _no_creep(walker, factor: float = CREEP_OFF):
     c = walker.contact
     return dataclasses.replace(walker, contact=dataclasses.replace(
-        c, v_s=c.v_s * CREEP_OFF, v_d=c.v_d * CREEP_OFF))
+        c, v_s=c.v_s * factor, v_d=c.v_d * factor))
+
+
+def _gap_or_nan(find, T0, L0):
+    """(period gap, step gap, z) of a periodic-gait search; NaN gaps if it fails."""
+    from walkerlab.analysis.contact_periodic import PeriodicGaitError
+
+    try:
+        g = find()
+    except PeriodicGaitError:
+        return np.nan, np.nan, None
+    if not g.converged:
+        return np.nan, np.nan, None
+    return g.period_s - T0, g.step_length_m - L0, g.z
 
 
 def energy_by_sink(walker, z, n_samples: int = 20000) -> dict[str, float]:
@@ -129,12 +142,19 @@ def attribute(walker, ideal, **search) -> Attribution:
     search.setdefault("check_fd", False)
     T0, L0 = float(ideal.period_s), ideal_step_length(walker, ideal.x)
     g = find_contact_periodic_gait(walker, ideal.x, **search)
+    gaps = [(g.period_s - T0, g.step_length_m - L0)]
+    z = g.z
+    for f in (0.1, CREEP_OFF):  # warm starts towards the creep-free contact
+        if z is not None:
+            dT, dL, z = _gap_or_nan(lambda f=f, z=z: find_contact_periodic_gait(
+                _no_creep(walker, f), z, **search), T0, L0)
+    gaps.append((dT, dL) if z is not None else (np.nan, np.nan))
     nc = _no_creep(walker)
-    g_nc = find_contact_periodic_gait(nc, g.z, **search)
-    g_stiff = g_nc
     for kappa in (10.0, 100.0, COMPLIANCE_OFF):  # warm starts up the family
-        g_stiff = find_contact_periodic_gait(scale_walker(nc, kappa), g_stiff.z, **search)
-    gaps = [(x.period_s - T0, x.step_length_m - L0) for x in (g, g_nc, g_stiff)]
+        if z is not None:
+            dT, dL, z = _gap_or_nan(lambda k=kappa, z=z: find_contact_periodic_gait(
+                scale_walker(nc, k), z, **search), T0, L0)
+    gaps.append((dT, dL) if z is not None else (np.nan, np.nan))
     return Attribution(gaps[0][0], gaps[0][1], gaps[0][0] - gaps[1][0], gaps[0][1] - gaps[1][1],
                        gaps[1][0] - gaps[2][0], gaps[1][1] - gaps[2][1], gaps[2][0], gaps[2][1],
                        energy_by_sink(walker, g.z))
