@@ -7,9 +7,10 @@ contact walker's own periodic gait (:mod:`walkerlab.analysis.contact_periodic`):
 - **friction creep**: the stiction regularisation lets a loaded stance foot creep at
   ``~ v_s F_t / (1.5 mu_s F_n)``; switched off by dividing ``v_s`` and ``v_d`` by
   :data:`CREEP_OFF` (the creep vanishes with ``v_s``);
-- **compliance**: the finite stiffness (impact duration, sinking); switched off by going
-  :data:`COMPLIANCE_OFF` times stiffer along the rigid-limit family
-  (:mod:`walkerlab.contact.rigid_limit`) with the creep already off;
+- **compliance**: the finite stiffness (impact duration, sinking): the creep-free gap less
+  the gap :data:`COMPLIANCE_OFF` times stiffer along the rigid-limit family
+  (:mod:`walkerlab.contact.rigid_limit`, whose ``v_s ~ kappa^(-1/2)`` takes the creep down
+  too; a creep-free contact that stiff is too stiff for the step map's integrator);
 - **residual**: what remains at that stiffness (the family's gap there).
 
 The initial-rate adjustment does not change a periodic gait (an attractor forgets its
@@ -149,11 +150,11 @@ def attribute(walker, ideal, **search) -> Attribution:
             dT, dL, z = _gap_or_nan(lambda f=f, z=z: find_contact_periodic_gait(
                 _no_creep(walker, f), z, **search), T0, L0)
     gaps.append((dT, dL) if z is not None else (np.nan, np.nan))
-    nc = _no_creep(walker)
-    for kappa in (10.0, 100.0, COMPLIANCE_OFF):  # warm starts up the family
+    z = g.z
+    for kappa in (10.0, 100.0, COMPLIANCE_OFF):  # warm starts up the family (creep too)
         if z is not None:
             dT, dL, z = _gap_or_nan(lambda k=kappa, z=z: find_contact_periodic_gait(
-                scale_walker(nc, k), z, **search), T0, L0)
+                scale_walker(walker, k), z, **search), T0, L0)
     gaps.append((dT, dL) if z is not None else (np.nan, np.nan))
     return Attribution(gaps[0][0], gaps[0][1], gaps[0][0] - gaps[1][0], gaps[0][1] - gaps[1][1],
                        gaps[1][0] - gaps[2][0], gaps[1][1] - gaps[2][1], gaps[2][0], gaps[2][1],
