@@ -34,6 +34,9 @@ class StageOutcome:
     summary: dict = field(default_factory=dict)
     #: why an existing artifact was recomputed, or what was reused in its place (one line)
     note: str = ""
+    #: why the run did not reach its goal (a walker that fell: one line), "" when it did;
+    #: the CLI exits 1 on it
+    failure: str = ""
 
 
 def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:

@@ -2,19 +2,14 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
-
-import numpy as np
 
 from walkerlab.analysis.gaits import GaitNotFound, find_gaits
 from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.config import Scene
-from walkerlab.io.artifacts import put
-from walkerlab.io.netcdf import coordinate
-from walkerlab.io.readers import load_fixed_point  # noqa: F401  (re-exported for stages)
+from walkerlab.io.schemas.fixedpoint import FixedPointRun, write_fixedpoint
 from walkerlab.models.registry import build_walker
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
@@ -89,34 +84,6 @@ def solve_variant(scene: Scene, variant: str, guess=None):
     return walker, res
 
 
-def _write_result(g, walker, res, guess) -> None:
-    names = walker.state_names()
-    units = walker.state_units()
-    g.attrs["variant"] = walker.variant
-    g.attrs["roles"] = list(walker.roles)
-    g.attrs["legs_by_role"] = json.dumps(walker.role_to_leg("leg2"))
-    for name, val, u in zip(names, res.x, units):
-        put(g, f"fixed_point/{name}", float(val), u, f"{name} just after heel strike")
-    for name, val, u in zip(names, guess, units):
-        put(g, f"initial_guess/{name}", float(val), u, "root-finder starting point")
-    put(g, "step_period", res.period_s, "s", "step period of the period-1 gait")
-    put(g, "residual", res.residual, "rad or rad/s", "max |P(x*) - x*| over the state")
-    for kind, ev, J in (("variational", res.multipliers_variational, res.jacobian_variational),
-                        ("finite_difference", res.multipliers_fd, res.jacobian_fd)):
-        put(g, f"floquet/{kind}/real", ev.real, "-", f"Floquet multipliers ({kind}), real part",
-            dims=("multiplier",))
-        put(g, f"floquet/{kind}/imag", ev.imag, "-", f"Floquet multipliers ({kind}), imag part",
-            dims=("multiplier",))
-        put(g, f"floquet/{kind}/jacobian", J, "-", "DP, rows/cols in state_names order",
-            dims=("state", "state_in"), state_names=names)
-    put(g, "floquet/max_difference", res.multiplier_difference, "-",
-        "max |multiplier(variational) - multiplier(finite difference)|")
-    put(g, "floquet/stable", res.stable, "-", "all |multipliers| < 1")
-    put(g, "stats/nfev", res.nfev, "-", "right-hand-side evaluations")
-    put(g, "stats/map_evaluations", res.iterations, "-", "Poincare-map calls by the root finder")
-    put(g, "stats/wall_time", res.wall_time_s, "s", "fixed-point search + Jacobians")
-
-
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         compare_variants: bool = True) -> StageOutcome:
     """Find the fixed point of the scene's equation variant.
@@ -148,39 +115,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                                                  main.x if init is None else init)
             except FixedPointNotFound as exc:
                 results[variant] = exc
-        guess = search.gait.start
-
-        def writer(f):
-            f.attrs["model"] = walker.name
-            f.attrs["variant"] = walker.variant
-            f.attrs["state_names"] = walker.state_names()
-            names = walker.state_names()
-            coordinate(f, "state", names, "-", "state component (role-ordered)")
-            coordinate(f, "state_in", names, "-", "state component perturbed (Jacobian column)")
-            coordinate(f, "multiplier", np.arange(len(names)), "-",
-                       "Floquet multiplier number (sorted by modulus)")
-            _write_result(f, walker, main, guess)
-            f.attrs["gait"] = search.gait.label
-            f.attrs["gait_policy"] = search.policy
-            f.attrs["gait_source"] = search.gait.source
-            f.attrs["gaits"] = [g.label for g in search.gaits]
-            f.attrs["gait_notes"] = json.dumps(search.notes)
-            f.attrs["gait_search"] = json.dumps(search.tried)
-            for g in search.gaits:
-                grp = f.create_group(f"gaits/{g.label}")
-                _write_result(grp, walker, g.result, g.start)
-                grp.attrs["source"] = g.source
-            for v, r in results.items():
-                if isinstance(r, Exception):
-                    f.create_group(f"variants/{v}").attrs["error"] = str(r)
-                else:
-                    _write_result(f.create_group(f"variants/{v}"), r[0], r[1],
-                                  guess if v == scene.ideal.variant else
-                                  (main.x if init is None else init))
-
+        run = FixedPointRun(walker, search, results, scene.ideal.variant,
+                            main.x if init is None else init)
         summary = {"walker": walker, "result": main, "gaits": search,
                    "variants": {k: v for k, v in results.items()}}
-        return writer, summary
+        return (lambda f: write_fixedpoint(f, run)), summary
 
     return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force,
                       extra_key="variants" if compare_variants else "",
