@@ -47,6 +47,24 @@ def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     return save(fig, figure_path(scene, runs_root).parent, "basin")
 
 
+def check(scene: Scene, grid: tuple[int, int] | None = None, workers: int = 2,
+          **_options) -> tuple[tuple[int, int], int]:
+    """The grid and worker count to use, checked before anything runs (the scene's cap on
+    ``basin.grid`` holds for ``--grid`` too).
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section, or a grid or worker count out of bounds (one line).
+    """
+    require(scene, "fixedpoint", "basin")
+    st = scene.basin or BasinSettings()
+    if grid is not None:
+        grid = validate_option(BasinSettings, "grid", tuple(grid), "--grid", "basin.grid")
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
+    return tuple(grid or st.grid), workers
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
         resume: bool = True, on_chunk=None) -> StageOutcome:
@@ -68,12 +86,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``fixedpoint`` section, or bad basin settings.
     """
-    require(scene, "fixedpoint", "basin")
     st = scene.basin or BasinSettings()
-    if grid is not None:  # the scene's cap on basin.grid, for --grid too
-        grid = validate_option(BasinSettings, "grid", tuple(grid), "--grid", "basin.grid")
-    workers = validate_option(CommandOptions, "workers", workers, "--workers")
-    grid = tuple(grid or st.grid)
+    grid, workers = check(scene, grid, workers)
     up = artifact_path(scene, runs_root, "fixedpoint")
     path = stage_artifact(scene, runs_root, "basin", claim=True)
     # one writer per artifact (as run_cached): a second identical run waits, then reuses

@@ -68,15 +68,20 @@ def run_upstream(stage: str, scene: Scene, runs_root: Path | str = "runs") -> No
 
 def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **options):
     """Run ``stage`` after what it needs: ``stage_module(stage).run(scene, runs_root,
-    *args, **options)`` once every upstream artifact is up to date.
+    *args, **options)`` once every upstream artifact is up to date.  A stage module with a
+    ``check(scene, **options)`` function has its options checked first, so a bad option is
+    refused before anything runs.
 
     Raises
     ------
     StageError, walkerlab.io.artifacts.ArtifactError
         As the stages do (one line).
     """
+    mod = stage_module(stage)
+    if hasattr(mod, "check"):
+        mod.check(scene, **options)
     run_upstream(stage, scene, runs_root)
-    return stage_module(stage).run(scene, runs_root, *args, **options)
+    return mod.run(scene, runs_root, *args, **options)
 
 
 def report_plan(scene: Scene) -> list[str]:
