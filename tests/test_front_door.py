@@ -254,6 +254,7 @@ def test_a_longer_simulate_run_is_kept_and_said_and_a_recompute_says_why(tmp_pat
     assert "simulate: recomputing" in err and "simulate.strides 3 -> 2" in err
 
 
+@pytest.mark.slow  # end to end: a whole report
 def test_report_uses_only_the_artifacts_the_scene_produces(tmp_path):
     from walkerlab.stages import pipeline, report
 
@@ -270,6 +271,7 @@ def test_report_uses_only_the_artifacts_the_scene_produces(tmp_path):
 
 
 # ---------------------------------------------------------------- the example notebook
+@pytest.mark.slow  # end to end: every stage the notebook calls
 def test_example_notebook_runs(tmp_path, monkeypatch):
     """``examples/walkerlab_tour.ipynb`` executes top to bottom (nbclient), writing only into
     a temporary runs folder."""

@@ -85,6 +85,7 @@ def png_only(monkeypatch):
     monkeypatch.setattr(figures, "save", save)
 
 
+@pytest.mark.slow  # end to end: a whole report
 @pytest.mark.parametrize("scene_path", SCENES, ids=[p.stem for p in SCENES])
 def test_scene_end_to_end(scene_path, tmp_path, png_only):
     from walkerlab.stages import fixedpoint, report, simulate

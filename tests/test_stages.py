@@ -67,6 +67,7 @@ def test_simulate_artifact_is_named_and_physical(ideal_scene, tmp_path):
         assert tot[step == 1][0] < tot[step == 0][-1]
 
 
+@pytest.mark.slow  # end to end: a whole report
 def test_report_of_ideal_only_scene_has_no_contact_sections(ideal_scene, tmp_path):
     from walkerlab.stages import report
 

@@ -1,4 +1,5 @@
-"""Issue 12: runs stay inside runs/, atomic writes, content-keyed cache, one-line errors.
+"""Runs stay inside runs/, writes are atomic, the cache is keyed on content, errors are one
+line (issue 12).
 
 Each test names the defect (D1-D12) it covers; each fails on the code before the fix.
 Bad-input tests are parametrised.  Heavy computations are replaced by small fakes where the

@@ -1,5 +1,5 @@
-"""Issue 19 items 4, 5, 11, 12, 13 (resumable files that cannot lie, bounded inputs, hashes
-of results not timings, YAML limits, bit-identical resume) and issue 18 part 4 (progress).
+"""Resumable files that cannot lie, bounded inputs, hashes of results not timings, YAML
+limits, bit-identical resume (issue 19 items 4, 5, 11, 12, 13) and progress (issue 18 part 4).
 
 Each test fails on the code before the fix.  The physics is replaced by small fakes where
 the behaviour under test (partial files, caps, hashing, progress plumbing) does not depend
