@@ -101,7 +101,7 @@ def test_guard_fires_at_heel_strike_not_at_midstance_scuffing(paper_walker, pape
     """One step from the fixed point: the swing foot height vanishes twice after the start -
     at mid-stance (legs aligned, scuffing: ignored) and at heel strike (the event)."""
     from tests.conftest import TIGHT
-    from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.integrate.rigid import integrate_step
 
     seg = integrate_step(paper_walker, paper_fixed_point.x, TIGHT)
     assert seg.termination == "heel_strike"

@@ -38,7 +38,8 @@ def ideal_runner(scene, x0: np.ndarray, strides: int):
     final vector is the state and time at the last of ``2 * strides`` heel strikes
     (shape (2n + 1,)), None if the run did not end in a heel strike.
     """
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     walker = build_walker(scene)
@@ -224,9 +225,9 @@ def _pin_worker(core: int) -> None:
     import scipy.integrate  # noqa: F401
     import scipy.optimize  # noqa: F401
 
-    from walkerlab.analysis.hybrid import _have_cyrk
+    from walkerlab.integrate.solver import available_backends
 
-    if _have_cyrk():
+    if "cyrk" in available_backends():
         from walkerlab.usercache import use_for_numba
 
         use_for_numba()  # numba's cache in the user cache (before numba loads)

@@ -6,7 +6,7 @@ until the swing leg passes the stance leg, then late swing until heel strike; a 
 walker adds a knee-locked phase).  Each phase has a flow ``f(t, x)`` and named guards;
 a guard either moves to the next phase (optionally through its own reset map, e.g. a knee
 strike), ends the step with the reset map (heel strike), or ends the run (fall).  The analysis
-layer (:mod:`walkerlab.analysis.hybrid`) integrates any model described this way.
+layer (:mod:`walkerlab.integrate.rigid`) integrates any model described this way.
 
 Contract of :class:`HybridWalker` (nothing outside the model layer may assume more)
 -------------------------------------------------------------------------------------

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.analysis.gaits import GaitNotFound, find_gaits
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.config import Scene
+from walkerlab.integrate.solver import Solver
 from walkerlab.io.artifacts import put
 from walkerlab.io.netcdf import coordinate
 from walkerlab.io.readers import load_fixed_point  # noqa: F401  (re-exported for stages)

@@ -220,7 +220,7 @@ def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
     period : int
         Period of the attractor reached (1 for the fixed point, 0 if none).
     """
-    from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.integrate.rigid import integrate_step
 
     x = np.asarray(x0, dtype=float)
     hist = [x]
@@ -284,7 +284,7 @@ def _walker_and_settings(base: dict):
 
 def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]``."""
-    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.integrate.solver import Solver
 
     walker, st, max_step_time = _walker_and_settings(task.base)
     solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
@@ -312,7 +312,8 @@ def pre_impact_fixed_point(walker, x_star: np.ndarray, settings, max_step_time: 
     BasinError
         The step from ``x_star`` does not end in a heel strike.
     """
-    from walkerlab.analysis.hybrid import Solver, integrate_step
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
 
     seg = integrate_step(walker, np.asarray(x_star, dtype=float),
                          Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend),

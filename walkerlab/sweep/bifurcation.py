@@ -100,7 +100,8 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     """Fixed point + steady state along one run of parameter values (worker side)."""
     import warnings
 
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
     from walkerlab.sweep.points import _Outcome, ideal_fixed_point, interleg_angle, warm_up
 
