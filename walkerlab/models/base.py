@@ -176,11 +176,15 @@ class HybridWalker:
 
     def state_names(self) -> list[str]:
         """Role-ordered state names, e.g. ``['swing_angle', 'stance_angle', 'swing_rate', ...]``."""
-        return [f"{r}_angle" for r in self.roles] + [f"{r}_rate" for r in self.roles]
+        from walkerlab.models.description import state_names
+
+        return state_names(self.roles)
 
     def state_units(self) -> list[str]:
         """Units of :meth:`state_names` (every coordinate is an angle)."""
-        return ["rad"] * self.n_coordinates + ["rad/s"] * self.n_coordinates
+        from walkerlab.models.description import state_units
+
+        return state_units(self.roles)
 
     @property
     def coordinate_units(self) -> dict[str, str]:

@@ -30,7 +30,7 @@ class _Study:
     """The work-precision stage in a thread of the report, overlapping the untimed stages.
 
     Its timed cases run in worker processes pinned to their own cores
-    (:class:`walkerlab.analysis.workprecision.Lanes`).  With two cores, the first core's lane
+    (:class:`walkerlab.execution.lanes.Lanes`).  With two cores, the first core's lane
     starts at once; this process (every thread of it) stays on the second core for the
     untimed stages and figures, and that core's lane starts at :meth:`release`.  The
     contact model's cases wait until its compiled kernels are in numba's on-disk cache
@@ -47,7 +47,8 @@ class _Study:
     def __init__(self, scene: Scene, runs_root, force: bool, workers: int = 2):
         import threading
 
-        from walkerlab.analysis.workprecision import Lanes, start_worker
+        from walkerlab.analysis.workprecision import start_worker
+        from walkerlab.execution.lanes import Lanes
 
         self.scene, self.runs_root, self.force = scene, runs_root, force
         cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []

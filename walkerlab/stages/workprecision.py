@@ -33,13 +33,13 @@ from walkerlab.analysis.workprecision import (
     CYRK_PREFIX,
     SINGLE_RUN_S,
     Case,
-    Lanes,
     rows_from_cases,
     run_cases,
     runner_for,
     summarize,
 )
 from walkerlab.config import Scene
+from walkerlab.execution.lanes import Lanes
 from walkerlab.io.artifacts import put
 from walkerlab.io.runpaths import run_cache_dir
 from walkerlab.stages import fixedpoint as fixedpoint_stage
