@@ -15,7 +15,7 @@ from walkerlab.analysis.contact_periodic import (
 from walkerlab.analysis.contact_sim import simulate_contact
 from walkerlab.config import ContactSolverSettings, load_scene
 from walkerlab.contact.model import checkerboard_lanes
-from walkerlab.stages.contact_sim import build
+from walkerlab.contact.scene import build
 from walkerlab.stages.fixedpoint import solve_variant
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "paper.yaml"
