@@ -29,7 +29,7 @@ def _scene(tmp_path, walker, fp, **basin):
 
 
 def test_fixed_point_converges_and_far_cell_falls(paper_walker, paper_fixed_point):
-    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.integrate.solver import Solver
 
     fp = paper_fixed_point.x
     st = BasinSettings(max_steps=25)
@@ -101,8 +101,8 @@ def test_heel_strike_cells_of_the_simplest_walker(tmp_path):
     post-impact states satisfy phi = 2 theta and phi-dot = (1 - cos 2 theta) theta-dot
     (Garcia et al. 1998, heel-strike equations, written here independently of the model's
     generated reset), and the cell at the fixed point's values is the fixed point."""
-    from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
     from walkerlab.sweep.basin import heel_strike_slice, pre_impact_fixed_point
 

@@ -196,10 +196,10 @@ def test_work_precision_contact_runner_reads_a_kneed_walkers_legs_by_name():
     """The work-precision study's contact series on the kneed walker: the final vector is
     the four link angles [rad] and their four rates, read by name (no hip position: |angle|
     < 1 rad, where hip_x is ~0.95 m after a stride), and it converges with the tolerance."""
-    from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import find_fixed_point
     from walkerlab.analysis.workprecision import contact_runner
     from walkerlab.config import load_scene
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     scene = load_scene("configs/kneed.yaml")

@@ -68,8 +68,8 @@ def test_simulate_artifact_groups_open_with_their_time_coordinate(tmp_path, pape
 
 
 def test_sweep_grid_axis_is_named_by_the_swept_field(tmp_path):
-    sw = wl.sweep(_paper(name="sw"), "slope.angle_deg", [1.0, 1.5, 2.0], runs_dir=tmp_path,
-                  name="slopes")
+    sw = wl.api.sweep(_paper(name="sw"), "slope.angle_deg", [1.0, 1.5, 2.0],
+                      runs_dir=tmp_path, name="slopes")
     path = tmp_path / "sw" / "slopes.h5"
     grid = _open(path, "grid")
     assert list(grid.dims) == ["slope.angle_deg"]
@@ -130,10 +130,11 @@ def test_api_reuses_the_cli_artifact_and_fixed_points_stack_the_variants(tmp_pat
     np.testing.assert_array_equal(every["fixed_point"].values[0], gait["fixed_point"].values)
 
 
-def test_top_level_sweep_is_the_api_even_after_the_sweep_package_is_imported(tmp_path):
-    import walkerlab.sweep  # noqa: F401 - Python binds walkerlab.sweep to the package
+def test_sweep_package_is_a_plain_package_and_the_api_sweep_lives_in_api(tmp_path):
+    import walkerlab.sweep as package
 
-    sw = wl.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
+    assert not callable(package) and type(package) is type(wl)
+    sw = wl.api.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
     assert sw["outcome"].values.tolist() == ["ok"]
 
 

@@ -19,9 +19,9 @@ import yaml
 from typer.testing import CliRunner
 
 from walkerlab.analysis.gaits import GaitNotFound, find_gaits, state_from_legs
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
+from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.models.registry import build_walker
 from walkerlab.stages import sweep as sweep_stage

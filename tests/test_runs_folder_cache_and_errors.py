@@ -27,6 +27,7 @@ from typer.testing import CliRunner
 
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
+from walkerlab.execution.workers import process_alive
 from walkerlab.io.artifacts import ArtifactError, atomic_write, open_artifact, write_artifact
 from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock
 from walkerlab.stages import common
@@ -469,9 +470,9 @@ def test_d7_sigkill_of_the_main_process_leaves_no_workers(tmp_path):
         main.kill()
         main.wait()
     deadline = time.monotonic() + 10
-    while time.monotonic() < deadline and any(runner._process_alive(k) for k in kids):
+    while time.monotonic() < deadline and any(process_alive(k) for k in kids):
         time.sleep(0.1)
-    alive = [k for k in kids if runner._process_alive(k)]
+    alive = [k for k in kids if process_alive(k)]
     names = {}
     for k in alive:
         try:

@@ -9,9 +9,8 @@ exactly what the artifact holds: named dimensions (``time``, ``state``, ``step``
 ``multiplier``, the swept field ``slope.angle_deg``, ``x``/``y`` of a basin ...), coordinate
 variables, and ``units``/``long_name`` on every variable.
 
-``walkerlab.sweep`` is also the package :mod:`walkerlab.sweep`; calling it calls
-:func:`sweep` (the package is callable), so ``walkerlab.sweep(scene, param, values)`` works
-whether or not the package has been imported.
+``walkerlab.sweep`` is the package :mod:`walkerlab.sweep` (sweeps, basins, maps); the sweep
+of the front door is :func:`walkerlab.api.sweep` (``wl.api.sweep(scene, param, values)``).
 
 Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what

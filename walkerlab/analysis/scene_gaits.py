@@ -8,9 +8,9 @@ from __future__ import annotations
 import math
 
 from walkerlab.analysis.gaits import find_gaits
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
 from walkerlab.config import Scene
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 
 

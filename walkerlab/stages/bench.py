@@ -56,8 +56,9 @@ def _paper_scene():
 
 def bench_ideal(repeats: int = 7) -> dict:
     """5 ideal strides at rtol 1e-10 per integrator backend, and the fixed-point search."""
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
     from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     scene = _paper_scene()

@@ -34,14 +34,16 @@ def planned_stages(scene: Scene) -> list[str]:
 
 def _study(scene: Scene, runs_root, force: bool):
     """The work-precision stage in a thread of the report, overlapping the untimed stages
-    (:class:`walkerlab.scheduling.BackgroundStudy`); its contact cases wait until the contact
-    model's kernels are compiled."""
-    from walkerlab.scheduling import BackgroundStudy
+    (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
+    the contact model's kernels are compiled."""
+    from walkerlab.analysis.workprecision import start_worker
+    from walkerlab.execution.background import BackgroundStudy
 
     wp = stage_module("workprecision")
     first_run = not artifact_path(scene, runs_root, "workprecision").is_file()
     return BackgroundStudy(lambda lanes: wp.run(scene, runs_root, force, lanes=lanes),
-                           first_run, ("contact",) if scene.contact is not None else ())
+                           start_worker, first_run,
+                           ("contact",) if scene.contact is not None else ())
 
 
 def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None) -> list[StageOutcome]:

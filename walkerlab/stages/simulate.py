@@ -6,9 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.analysis.hybrid import Solver, simulate_steps
 from walkerlab.analysis.metrics import sample_trajectory, step_table, total_mass_kg
 from walkerlab.config import MAX_SIMULATE_SAMPLES, Scene, SimulateSettings
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.schemas.simulate import SimulateRun, run_end, strides_of, write_simulate
 from walkerlab.models.registry import build_walker

@@ -32,13 +32,13 @@ import numpy as np
 from walkerlab.analysis.workprecision import (
     CYRK_PREFIX,
     Case,
-    Lanes,
     rows_from_cases,
     run_cases,
     runner_for,
     summarize,
 )
 from walkerlab.config import Scene
+from walkerlab.execution.lanes import Lanes
 from walkerlab.io.runpaths import run_cache_dir
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.schemas.workprecision import WorkPrecisionRun, write_workprecision
@@ -88,9 +88,9 @@ def _reference_method() -> str:
     """The ideal model's reference integrator: CyRK's DOP853 when installed (the same steps
     as scipy's DOP853, measured: the two reference vectors at rtol 1e-13 differ by 1.0e-13,
     the accuracy both reach, at 0.06 s instead of 0.7 s CPU), else scipy's."""
-    from walkerlab.analysis.hybrid import _have_cyrk
+    from walkerlab.integrate.solver import available_backends
 
-    return CYRK_PREFIX + "DOP853" if _have_cyrk() else "DOP853"
+    return CYRK_PREFIX + "DOP853" if "cyrk" in available_backends() else "DOP853"
 
 
 def plan(scene: Scene) -> dict:
@@ -99,10 +99,10 @@ def plan(scene: Scene) -> dict:
     wp = require(scene, "workprecision", "workprecision")
     out = {}
     if "ideal" in wp.models:
-        from walkerlab.analysis.hybrid import CYRK_METHODS, _have_cyrk
+        from walkerlab.integrate.solver import CYRK_METHODS, available_backends
 
         extra = ([CYRK_PREFIX + m for m in wp.methods if m in CYRK_METHODS]
-                 if _have_cyrk() else [])
+                 if "cyrk" in available_backends() else [])
         out["ideal"] = (list(wp.methods) + extra, list(wp.rtols), wp.atol_factor,
                         (_reference_method(), wp.reference_rtol, wp.reference_rtol),
                         wp.target_error, scene.section_json(*IDEAL_SECTIONS))

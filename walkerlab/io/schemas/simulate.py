@@ -39,7 +39,7 @@ class SimulateRun:
     ----------
     walker : walkerlab.models.base.HybridWalker
         The walker simulated (name, variant, legs, state names, parameters).
-    trajectory : walkerlab.analysis.hybrid.HybridTrajectory
+    trajectory : walkerlab.integrate.rigid.HybridTrajectory
         Segments of the run (termination, start/end states).
     samples : NamedTrajectory
         Sampled trajectory.

@@ -2,8 +2,8 @@
 
 :class:`BackgroundStudy` is how ``walkerlab report`` overlaps the work-precision study
 (whose timed cases run in worker processes pinned to their own cores,
-:class:`walkerlab.analysis.workprecision.Lanes`) with the stages that are not timed.  It
-knows nothing of stages: it runs the callable it is given.
+:class:`walkerlab.execution.lanes.Lanes`) with the stages that are not timed.  It knows
+nothing of stages: it runs the callable it is given.
 """
 
 from __future__ import annotations
@@ -31,6 +31,9 @@ class BackgroundStudy:
     ----------
     run : callable(lanes) -> result
         The study; ``lanes`` is None when it runs in this process.
+    start_worker : callable(core) -> executor
+        Starts a measuring worker process pinned to ``core``
+        (:func:`walkerlab.analysis.workprecision.start_worker`).
     first_run : bool
         Start the worker processes now (nothing is cached yet).
     pending : tuple of str
@@ -39,9 +42,9 @@ class BackgroundStudy:
         Cores given to the study's lanes.
     """
 
-    def __init__(self, run: Callable, first_run: bool, pending: tuple[str, ...] = (),
-                 workers: int = 2):
-        from walkerlab.analysis.workprecision import Lanes, start_worker
+    def __init__(self, run: Callable, start_worker: Callable, first_run: bool,
+                 pending: tuple[str, ...] = (), workers: int = 2):
+        from walkerlab.execution.lanes import Lanes
 
         self._run_study = run
         cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
