@@ -1,15 +1,16 @@
-"""Stage ``simulate``: N strides of the rigid hybrid walker -> ``simulate.h5``."""
+"""Stage ``simulate``: N strides of the rigid hybrid walker -> ``simulate.h5``.
+
+The run is :func:`walkerlab.analysis.rigid_run.simulate_scene`; the layout
+:mod:`walkerlab.io.schemas.simulate`.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
-from walkerlab.analysis.metrics import sample_trajectory, step_table, total_mass_kg
+from walkerlab.analysis.metrics import total_mass_kg
+from walkerlab.analysis.rigid_run import simulate_scene
 from walkerlab.config import MAX_SIMULATE_SAMPLES, Scene, SimulateSettings
-from walkerlab.integrate.rigid import simulate_steps
-from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.schemas.simulate import SimulateRun, run_end, strides_of, write_simulate
 from walkerlab.models.registry import build_walker
@@ -103,23 +104,7 @@ def _compute(scene: Scene, upstream: tuple[Path, ...]):
             x0 = sim.initial_state.as_array(walker.state_names())
         except ValueError as exc:
             raise StageError(f"simulate.initial_state: {exc}") from None
-    traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
-                          max_step_time=sim.max_step_time_s)
-    samples = sample_trajectory(traj, sim.sample_rate_hz)
-    steps = step_table(traj)
-    ok = steps["termination"] == "heel_strike"
-    summary = {
-        "termination": traj.termination,
-        "steps_completed": int(ok.sum()),
-        "wall_time_s": traj.wall_time_s,
-        "nfev": traj.nfev,
-        "mean_period_s": float(np.mean(steps["period"][ok])) if ok.any() else np.nan,
-        "mean_step_length_m": float(np.mean(steps["step_length"][ok])) if ok.any() else np.nan,
-        "mean_hip_speed_m_per_s": (float(np.mean(steps["hip_speed"][ok])) if ok.any()
-                                   else np.nan),
-        "mean_total_energy_J": float(np.mean(samples.total)),
-    }
-
-    run = SimulateRun(walker, traj, samples, steps, x0, sim.strides,
-                      total_mass_kg(walker), summary)
-    return (lambda f: write_simulate(f, run)), summary
+    r = simulate_scene(scene, walker, x0)
+    run = SimulateRun(walker, r.trajectory, r.samples, r.steps, x0, sim.strides,
+                      total_mass_kg(walker), r.summary)
+    return (lambda f: write_simulate(f, run)), r.summary
