@@ -13,8 +13,8 @@ from tests.contact.test_periodic import SCENE
 from walkerlab.analysis.attribution import energy_by_sink
 from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
 from walkerlab.config import load_scene
-from walkerlab.stages.contact_sim import build
-from walkerlab.stages.fixedpoint import solve_variant
+from walkerlab.contact.scene import build
+from walkerlab.analysis.scene_gaits import solve_variant
 
 
 def test_sinks_add_up_to_gravity_work_over_the_step():

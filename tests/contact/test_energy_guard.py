@@ -15,7 +15,7 @@ from tests.contact.test_periodic import SCENE
 from walkerlab.analysis.contact_sim import simulate_from
 from walkerlab.config import load_scene
 from walkerlab.contact.energy import energy_rise_bound, total_energy
-from walkerlab.stages.fixedpoint import solve_variant
+from walkerlab.analysis.scene_gaits import solve_variant
 
 RODS = SCENE.parent / "paper_rods.yaml"
 
@@ -40,7 +40,7 @@ def test_frictionless_rods_end_as_a_trip_without_blown_up_samples():
 def test_total_energy_counts_the_stored_elastic_energy():
     """A point foot pressed into its patch by d stores k d^(e+1)/(e+1) (IMPACT's spring):
     total_energy exceeds kinetic + potential by exactly that (rtol 1e-12)."""
-    from walkerlab.stages.contact_sim import build
+    from walkerlab.contact.scene import build
 
     sc = load_scene(SCENE)
     ideal = solve_variant(sc, "derived")[1]

@@ -13,11 +13,11 @@ from walkerlab.analysis.contact_periodic import (
 )
 from walkerlab.analysis.contact_sim import simulate_contact
 from walkerlab.analysis.rigid_limit import convergence, observed_order
+from walkerlab.analysis.scene_gaits import solve_variant
 from walkerlab.config import ContactSolverSettings, load_scene
 from walkerlab.contact.model import checkerboard_lanes
 from walkerlab.contact.rigid_limit import expected_order
-from walkerlab.stages.contact_sim import build
-from walkerlab.stages.fixedpoint import solve_variant
+from walkerlab.contact.scene import build
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "paper.yaml"
 

@@ -174,7 +174,8 @@ def adjustment_effect(scene, ideal, strides: int = 5) -> dict:
         ``rigid_heel_strikes``.
     """
     from walkerlab.analysis.contact_sim import simulate_from
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)
