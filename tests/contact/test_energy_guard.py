@@ -13,9 +13,9 @@ import pytest
 
 from tests.contact.test_periodic import SCENE
 from walkerlab.analysis.contact_sim import simulate_from
+from walkerlab.analysis.scene_gaits import solve_variant
 from walkerlab.config import load_scene
 from walkerlab.contact.energy import energy_rise_bound, total_energy
-from walkerlab.analysis.scene_gaits import solve_variant
 
 RODS = SCENE.parent / "paper_rods.yaml"
 
