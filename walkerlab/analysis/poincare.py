@@ -36,35 +36,52 @@ class FixedPointNotFound(RuntimeError):
 
 
 def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
-                 max_step_time: float = 5.0, jacobian: bool = False):
-    """One step of the Poincaré map ``x_{n+1} = P(x_n)`` (Eq. 10).
+                 max_step_time: float = 5.0, jacobian: bool = False,
+                 steps: list | None = None):
+    """The Poincaré map ``x_{n+1} = P(x_n)`` (Eq. 10): one step, or one stride (two steps,
+    ``legs[0]`` swinging first) for a walker whose legs differ (``walker.mirror``).
 
     Parameters
     ----------
     x : ndarray, shape (2n,)
-        State just after heel strike (role-ordered).
+        State just after heel strike (role-ordered), ``legs[0]`` about to swing.
     jacobian : bool
-        Also return ``DP`` (2n x 2n) from the variational equations.
+        Also return ``DP`` (2n x 2n) from the variational equations (with saltation at every
+        guard; for a stride the product of the two steps' Jacobians).
+    steps : list, optional
+        The steps' :class:`~walkerlab.analysis.hybrid.Segment` are appended to it.
 
     Returns
     -------
     x_next : ndarray, shape (2n,)
     period : float
-        Step period [s].
+        Period of the map [s]: the step period, or the stride period.
     DP : ndarray (2n, 2n), only if ``jacobian``.
     nfev : int
 
     Raises
     ------
     StepFailed
-        The step ended in a fall, a solver failure or ran past ``max_step_time``.
+        A step ended in a fall, a solver failure or ran past ``max_step_time``.
     """
-    seg = integrate_step(walker, x, solver, max_step_time=max_step_time, variational=jacobian)
-    if seg.termination != "heel_strike":
-        raise StepFailed(seg.termination, seg.t_end, seg.x_end, seg.message)
+    legs = walker.legs
+    period, nfev, DP = 0.0, 0, np.eye(np.size(x))
+    for k in range(walker.steps_per_map):
+        stance = legs[1] if k == 0 else legs[0]
+        seg = integrate_step(walker.for_stance(stance), x, solver, t0=period,
+                             max_step_time=max_step_time, variational=jacobian, index=k,
+                             stance_leg=stance)
+        if steps is not None:
+            steps.append(seg)
+        nfev += seg.nfev
+        if seg.termination != "heel_strike":
+            raise StepFailed(seg.termination, seg.t_end, seg.x_end, seg.message)
+        x, period = seg.x_next, seg.t_end
+        if jacobian:
+            DP = seg.monodromy @ DP
     if jacobian:
-        return seg.x_next, seg.period, seg.monodromy, seg.nfev
-    return seg.x_next, seg.period, seg.nfev
+        return x, period, DP, nfev
+    return x, period, nfev
 
 
 def fd_jacobian(walker: HybridWalker, x: np.ndarray, solver: Solver, h: float = 1e-7,
