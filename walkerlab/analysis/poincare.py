@@ -125,6 +125,10 @@ class FixedPointResult:
         Maps with the variational equations: the one at the fixed point, plus any the root
         finder asked for as a Jacobian
     stable : bool      all multipliers (variational) strictly inside the unit circle
+    step_periods_s, step_lengths_m : tuple of float
+        Each step of the map [s], [m] (one step; two, ``legs[0]`` swinging first, when the
+        map is a stride); a step's length is the distance from its stance foot to the
+        swing foot at heel strike
     """
 
     x: np.ndarray
@@ -138,6 +142,8 @@ class FixedPointResult:
     iterations: int
     wall_time_s: float
     variational_maps: int = 1
+    step_periods_s: tuple = ()
+    step_lengths_m: tuple = ()
 
     @property
     def stable(self) -> bool:
@@ -242,25 +248,28 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
             key = z.tobytes()
             if key in start:  # the start: asked by scipy's shape check and by MINPACK
                 return start[key]
+            segs: list = []
             try:  # asked again: the updated guess stopped helping; the true one here
                 out = poincare_map(walker, walker.from_section(z), solver, max_step_time,
-                                   jacobian=True)
+                                   jacobian=True, steps=segs)
             except StepFailed:
                 return next(iter(start.values()))
             counter["nfev"] += out[3]
             counter["jacobians"] += 1
             variational.clear()
-            variational[key] = out  # MINPACK often stops at this iterate: DP is reused
+            variational[key] = (*out, segs)  # MINPACK often stops at this iterate: reused
             return _section_jacobian(walker, out[2], z)
 
         sol = root(residual, z0, method="hybr", jac=jacobian, options={"xtol": xtol})
     x = walker.from_section(sol.x)
     if sol.x.tobytes() in variational:  # the Jacobian was last computed at the solution
-        xn, period, DP, _ = variational[sol.x.tobytes()]
+        xn, period, DP, _, segs = variational[sol.x.tobytes()]
         counter["jacobians"] -= 1
     else:
+        segs = []
         try:
-            xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True)
+            xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True,
+                                              steps=segs)
         except StepFailed as exc:
             raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate "
                                      f"({exc})", float("nan")) from None
@@ -287,6 +296,10 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         multipliers_fd=mult_fd, jacobian_variational=DP, jacobian_fd=Jfd,
         nfev=counter["nfev"] + nf2, iterations=counter["calls"],
         wall_time_s=time.perf_counter() - t0, variational_maps=counter["jacobians"] + 1,
+        step_periods_s=tuple(float(sg.period) for sg in segs),
+        step_lengths_m=tuple(
+            float(np.linalg.norm(walker.for_stance(sg.stance_leg).points(sg.x_end)["swing_foot"]))
+            for sg in segs),
     )
 
 

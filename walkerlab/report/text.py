@@ -45,6 +45,14 @@ def fixedpoint_text(path: Path) -> str:
             unit = f["fixed_point/" + n].attrs["unit"]
             lines.append(f"  {n:<14s} {where} {f['fixed_point/' + n][()]: .10f} {unit}")
         lines.append(f"  step period     {f['step_period'][()]:.10f} {u.time}")
+        if "stride_period" in f:  # legs that differ: the Poincare map is a stride
+            lines.append(f"  stride period   {f['stride_period'][()]:.10f} {u.time} (the map "
+                         "is a stride: the legs differ)")
+            for leg, T, d in zip(f["steps/swing_leg"][()], f["steps/period"][()],
+                                 f["steps/length"][()]):
+                leg = leg.decode() if isinstance(leg, bytes) else str(leg)
+                lines.append(f"    step with {leg} swinging: period {T:.10f} {u.time}, "
+                             f"length {d:.10f} m")
         lines.append(f"  residual        {f['residual'][()]:.2e}  (max |P(x*) - x*|)")
         re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
         lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")

@@ -99,7 +99,20 @@ def _write_result(g, walker, res, guess) -> None:
         put(g, f"fixed_point/{name}", float(val), u, f"{name} just after heel strike")
     for name, val, u in zip(names, guess, units):
         put(g, f"initial_guess/{name}", float(val), u, "root-finder starting point")
-    put(g, "step_period", res.period_s, "s", "step period of the period-1 gait")
+    steps = len(res.step_periods_s)
+    if steps > 1:  # legs that differ: the map is a stride; each step on its own
+        put(g, "step_period", res.period_s / steps, "s", "mean step period of the period-1 "
+            "gait (the Poincare map is a stride of two steps)")
+        put(g, "stride_period", res.period_s, "s", "stride period (period of the map)")
+        coordinate(g, "step", np.arange(steps), "-", "step of the stride (leg1 swings first)")
+        put(g, "steps/period", np.array(res.step_periods_s), "s", "period of each step",
+            dims=("step",))
+        put(g, "steps/length", np.array(res.step_lengths_m), "m", "length of each step "
+            "(stance foot to swing foot at heel strike)", dims=("step",))
+        put(g, "steps/swing_leg", np.array([b"leg1", b"leg2"][:steps]), "-",
+            "swing leg of each step", dims=("step",))
+    else:
+        put(g, "step_period", res.period_s, "s", "step period of the period-1 gait")
     put(g, "residual", res.residual, "rad or rad/s", "max |P(x*) - x*| over the state")
     for kind, ev, J in (("variational", res.multipliers_variational, res.jacobian_variational),
                         ("finite_difference", res.multipliers_fd, res.jacobian_fd)):
