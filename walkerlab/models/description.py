@@ -265,8 +265,8 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
             steps[1].append([k, sb * r, c])
         else:  # torso to one leg: that leg's role changes, one entry per role
             pairs += [pa, pb]
-            steps[0] += [[k, sa * r, c], [0.0, 0.0, 0.0]]
-            steps[1] += [[0.0, 0.0, 0.0], [k, sb * r, c]]
+            steps[0].extend([[k, sa * r, c], [0.0, 0.0, 0.0]])
+            steps[1].extend([[0.0, 0.0, 0.0], [k, sb * r, c]])
     hip = walker_cfg.hip_mass_kg > 0
     head = [walker_cfg.gravity_m_per_s2, leg.length_m, slope_rad]
     if hip:

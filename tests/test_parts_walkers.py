@@ -1,0 +1,190 @@
+"""Walkers from parts (issue 22): legs that differ, a hip spring, an upper body on a bisecting
+hip mechanism - the generated rigid model against an independent reference
+(``tests/independent/parts_reference.py``: the coupling enforced by a multiplier, the impact by
+the extended-coordinate method) and the physics invariants.
+
+Tolerances: flows and resets are closed-form algebra on both sides, compared at 1e-11
+relative (round-off of two different formulations, a few hundred operations); fixed points
+are compared through the reference's own integration (DOP853, rtol = atol = 1e-12 over a
+0.5-1.4 s map) at 1e-8.
+"""
+
+import numpy as np
+import pytest
+from independent.parts_reference import Parts, PartsReference
+
+from walkerlab.analysis.hybrid import Solver, integrate_step, simulate_steps
+from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.models.description import walker_data
+from walkerlab.models.registry import build_walker
+
+SOLVER = Solver("DOP853", 1e-12, 1e-12)
+GUESS = np.array([-0.2022, 0.1674, -0.60, -0.84])
+REFS = {
+    "asymmetric_legs": Parts(legs={"A": (5.0, 0.5), "B": (5.5, 0.5)}),
+    "hip_spring": Parts(spring=(20.0, 0.0, 0.0)),
+    "torso_bhm": Parts(torso=(5.0, 0.2, 0.0, 0.0)),
+}
+
+
+def _walker(name):
+    return build_walker(load_scene(f"configs/{name}.yaml"))
+
+
+def _with(walker_extra: dict, base="torso_bhm"):
+    """A scene dict from ``configs/<base>.yaml`` with ``walker`` keys replaced."""
+    import yaml
+
+    with open(f"configs/{base}.yaml") as fh:
+        d = yaml.safe_load(fh)
+    d["walker"].update(walker_extra)
+    return scene_from_dict(d, origin=f"{base}.yaml")
+
+
+@pytest.fixture(scope="module")
+def fixed_points():
+    out = {}
+    for name in REFS:
+        w = _walker(name)
+        out[name] = (w, find_fixed_point(w, GUESS, SOLVER, fd_check=False))
+    return out
+
+
+@pytest.mark.parametrize("name", list(REFS))
+def test_flow_and_reset_match_the_independent_reference(name):
+    w, ref = _walker(name), PartsReference(REFS[name])
+    rng = np.random.default_rng(7)
+    for stance, step_walker in (("B", w), ("A", w.for_stance("leg1"))):
+        for _ in range(4):
+            x = rng.uniform([-0.4, -0.4, -1.5, -1.5], [0.4, 0.4, 1.5, 1.5])
+            ours, theirs = step_walker.phases[0].flow(0.0, x), ref.flow(x, stance)
+            assert ours == pytest.approx(theirs, rel=1e-11, abs=1e-11)
+            x[0] = -2 * 0.0174 - x[1]  # on the heel-strike surface
+            assert step_walker.reset(x) == pytest.approx(ref.reset(x, stance), rel=1e-11,
+                                                         abs=1e-12)
+
+
+def test_legs_that_differ_make_a_stride_map_and_others_one_step():
+    assert _walker("asymmetric_legs").steps_per_map == 2
+    assert _walker("hip_spring").steps_per_map == 1
+    assert _walker("torso_bhm").steps_per_map == 1
+    # a rest angle breaks the mirror symmetry of equal legs; a torso-to-leg spring too
+    spring = {"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 5.0, "rest_angle_rad": 0.1}
+    assert build_walker(_with({"springs": [spring]})).steps_per_map == 2
+    spring = {"between": ["torso", "leg1"], "stiffness_n_m_per_rad": 5.0}
+    assert build_walker(_with({"springs": [spring]})).steps_per_map == 2
+
+
+def test_leg_shorthand_expands_to_the_same_walker_as_an_equal_pair():
+    sc = load_scene("configs/torso_bhm.yaml")
+    leg = sc.walker.leg.model_dump()
+    pair = _with({"leg": None, "legs": [leg, leg]})
+    a = walker_data(sc.walker, sc.slope.phi_rad)
+    b = walker_data(pair.walker, pair.slope.phi_rad)
+    assert (a.structure, a.params, a.mirror_params) == (b.structure, b.params, None)
+
+
+@pytest.mark.parametrize("name", list(REFS))
+def test_fixed_point_maps_to_itself_under_the_reference(name, fixed_points):
+    w, fp = fixed_points[name]
+    ref = PartsReference(REFS[name])
+    x = fp.x.copy()
+    T = 0.0
+    for stance in ("B", "A")[:w.steps_per_map]:
+        t, _, x, _ = ref.step(x, stance)
+        T += t
+    assert np.max(np.abs(x - fp.x)) < 1e-8
+    assert T == pytest.approx(fp.period_s, abs=1e-9)
+    assert fp.stable and fp.residual < 1e-10
+
+
+def test_stride_steps_differ_and_compose(fixed_points):
+    w, fp = fixed_points["asymmetric_legs"]
+    assert len(fp.step_periods_s) == 2 and sum(fp.step_periods_s) == pytest.approx(fp.period_s)
+    # the heavier leg B swings slower: its step lasts longer (measured 0.678 vs 0.714 s)
+    assert fp.step_periods_s[1] - fp.step_periods_s[0] > 0.02
+    # the stride's DP is the product of the steps' (variational with saltation) DPs
+    s1 = integrate_step(w, fp.x, SOLVER, variational=True, stance_leg="leg2")
+    s2 = integrate_step(w.mirror, s1.x_next, SOLVER, variational=True, stance_leg="leg1")
+    assert s2.monodromy @ s1.monodromy == pytest.approx(fp.jacobian_variational, abs=1e-12)
+
+
+def test_energy_with_spring_potential_is_conserved_in_swing(fixed_points):
+    w, fp = fixed_points["hip_spring"]
+    seg = integrate_step(w, fp.x, SOLVER)
+    X = seg.sample(np.linspace(seg.t_start, seg.t_end, 80))
+    E = np.sum(w.energies(X), axis=0)
+    ref = PartsReference(REFS["hip_spring"])
+    assert sum(ref.energy(fp.x, "B")) == pytest.approx(E[0], rel=1e-13)  # spring included
+    # ~150 J; DOP853 at 1e-12 over a 0.52 s step: drift a few 1e-12 relative
+    assert np.ptp(E) < 1e-10 * abs(E[0])
+    # without the spring's potential the total is not conserved (the test can fail)
+    nospring = PartsReference(Parts())
+    E0 = np.array([sum(nospring.energy(x, "B")) for x in X.T])
+    assert np.ptp(E0) > 1e-3
+
+
+def test_damper_dissipates_exactly_c_times_relative_rate_squared():
+    spring = {"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 20.0,
+              "damping_n_m_s_per_rad": 0.5}
+    w = build_walker(_with({"springs": [spring]}, base="hip_spring"))
+    x0 = np.array([-0.18, 0.15, -0.7, -0.9])
+    seg = integrate_step(w, x0, SOLVER)
+    t = np.linspace(seg.t_start, seg.t_end, 4001)
+    X = seg.sample(t)
+    E = np.sum(w.energies(X), axis=0)
+    rate = X[3] - X[2]  # d(delta)/dt between the legs
+    from scipy.integrate import simpson
+
+    lost = 0.5 * simpson(rate ** 2, x=t)
+    assert lost > 1e-3
+    assert E[0] - E[-1] == pytest.approx(lost, rel=1e-7)  # Simpson's rule, 4000 intervals
+
+
+def test_bisecting_coupling_holds_along_a_run(fixed_points):
+    w, fp = fixed_points["torso_bhm"]
+    traj = simulate_steps(w, fp.x, 4, SOLVER)
+    worst = 0.0
+    for seg in traj.segments:
+        X = seg.sample(np.linspace(seg.t_start, seg.t_end, 50))
+        P = w.points(X)
+        hip, torso = P["hip"], P["torso_mass"]
+        t_angle = np.arctan2(-(torso[0] - hip[0]), torso[1] - hip[1])  # from upward vertical
+        legs = [np.arctan2(P[f][0] - hip[0], -(P[f][1] - hip[1]))
+                for f in ("stance_foot", "swing_foot")]
+        worst = max(worst, float(np.max(np.abs(t_angle - 0.5 * (legs[0] + legs[1])))))
+    assert len(traj.segments) == 4 and traj.termination == "heel_strike"
+    assert worst < 1e-10  # geometry of the generated points (round-off ~1e-16)
+    # leaning back (behind the hip, -x) when both feet are ahead (+x) of the hip
+    P = w.points(np.array([0.2, 0.2, 0.0, 0.0]))
+    assert P["swing_foot"][0] > P["hip"][0] and P["torso_mass"][0] < P["hip"][0]
+
+
+@pytest.mark.parametrize("name", list(REFS))
+def test_heel_strike_conserves_angular_momentum_about_the_impact_point(name, fixed_points):
+    w, fp = fixed_points[name]
+    ref = PartsReference(REFS[name])
+    seg = integrate_step(w, fp.x, SOLVER)
+    xm = seg.x_end
+    xp = w.reset(xm)
+    foot = ref.swing_foot(xm, "B")
+    before = ref.angular_momentum(xm, "B", foot)
+    # after: the new stance leg (A) at the origin; the same point, the walker shifted by foot
+    after = ref.angular_momentum(xp, "A", np.zeros(2))
+    assert after == pytest.approx(before, rel=1e-12)
+
+
+def test_one_line_errors_for_the_new_parts():
+    from walkerlab.config import SceneError
+
+    bad = [({"legs": [{"length_m": 1.0, "bodies": [{"kind": "point_mass", "name": "m",
+                                                    "mass_kg": 5, "from_hip_m": 0.5}]}]},
+            "walker.legs"),
+           ({"springs": [{"between": ["leg1", "leg1"], "stiffness_n_m_per_rad": 1.0}]},
+            "springs"),
+           ({"torso": {"bodies": []}}, "walker.torso.bodies")]
+    for extra, field in bad:
+        with pytest.raises(SceneError) as e:
+            _with(extra)
+        assert field in str(e.value) and "Traceback" not in str(e.value)
