@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import sympy as sp
-from independent._lagrange import lam, lagrange
+
+from independent._lagrange import lagrange, lam
 
 
 @dataclass(frozen=True)
@@ -50,7 +51,7 @@ class PartsReference:
             foot = sp.Matrix([x, y])
             hip = foot + p.L * sp.Matrix([-sp.sin(st), sp.cos(st)])
 
-            def on_leg(psi, s):
+            def on_leg(psi, s, hip=hip):
                 return hip + s * sp.Matrix([sp.sin(psi), -sp.cos(psi)])
             bodies = [(p.M_hip, 0, hip, 0),
                       (p.legs[stance][0], 0, on_leg(st, p.legs[stance][1]), st),
