@@ -65,6 +65,31 @@ def test_flow_and_reset_match_the_independent_reference(name):
                                                          abs=1e-12)
 
 
+def test_off_axis_rigid_upper_body_matches_the_reference():
+    # a rigid body with inertia, its centre of mass off the torso's axis, on legs that differ
+    # (leg B's point mass 3 cm ahead of its axis)
+    body = {"kind": "rigid_body", "name": "trunk", "mass_kg": 4.0, "com_from_hip_m": 0.3,
+            "com_off_axis_m": 0.05, "inertia_about_com_kg_m2": 0.2}
+    leg = {"length_m": 1.0, "bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 5.0,
+                                        "from_hip_m": 0.5}]}
+    heavy = {**leg, "bodies": [{**leg["bodies"][0], "mass_kg": 6.0, "from_hip_m": 0.4,
+                                "off_axis_m": 0.03}]}
+    w = build_walker(_with({"leg": None, "legs": [leg, heavy],
+                            "torso": {"bodies": [body]}}))
+    ref = PartsReference(Parts(legs={"A": (5.0, 0.5), "B": (6.0, 0.4, 0.03)},
+                               torso=(4.0, 0.3, 0.05, 0.2)))
+    rng = np.random.default_rng(3)
+    for stance, step_walker in (("B", w), ("A", w.mirror)):
+        x = rng.uniform([-0.4, -0.4, -1.5, -1.5], [0.4, 0.4, 1.5, 1.5])
+        assert step_walker.phases[0].flow(0.0, x) == pytest.approx(ref.flow(x, stance),
+                                                                   rel=1e-11, abs=1e-11)
+        x[0] = -2 * 0.0174 - x[1]
+        assert step_walker.reset(x) == pytest.approx(ref.reset(x, stance), rel=1e-11,
+                                                     abs=1e-12)
+        assert sum(step_walker.energies(x)) == pytest.approx(sum(ref.energy(x, stance)),
+                                                             rel=1e-12)
+
+
 def test_legs_that_differ_make_a_stride_map_and_others_one_step():
     assert _walker("asymmetric_legs").steps_per_map == 2
     assert _walker("hip_spring").steps_per_map == 1

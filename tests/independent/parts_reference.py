@@ -27,7 +27,8 @@ from independent._lagrange import lagrange, lam
 
 @dataclass(frozen=True)
 class Parts:
-    """Numbers of a walker (SI).  ``legs``: ``{"A": (mass, from_hip), "B": ...}``."""
+    """Numbers of a walker (SI).  ``legs``: ``{"A": (mass, from_hip[, off_axis]), "B": ...}``
+    (a leg's point mass, ``off_axis`` ahead of the leg's axis)."""
 
     L: float = 1.0
     M_hip: float = 10.0
@@ -51,11 +52,12 @@ class PartsReference:
             foot = sp.Matrix([x, y])
             hip = foot + p.L * sp.Matrix([-sp.sin(st), sp.cos(st)])
 
-            def on_leg(psi, s, hip=hip):
-                return hip + s * sp.Matrix([sp.sin(psi), -sp.cos(psi)])
+            def on_leg(psi, s, e=0.0, hip=hip):
+                return (hip + s * sp.Matrix([sp.sin(psi), -sp.cos(psi)])
+                        + e * sp.Matrix([sp.cos(psi), sp.sin(psi)]))
             bodies = [(p.M_hip, 0, hip, 0),
-                      (p.legs[stance][0], 0, on_leg(st, p.legs[stance][1]), st),
-                      (p.legs[swing][0], 0, on_leg(sw, p.legs[swing][1]), sw)]
+                      (p.legs[stance][0], 0, on_leg(st, *p.legs[stance][1:]), st),
+                      (p.legs[swing][0], 0, on_leg(sw, *p.legs[swing][1:]), sw)]
             if p.torso is not None:
                 m, d, e, inertia = p.torso
                 pos = hip + d * sp.Matrix([-sp.sin(th), sp.cos(th)]) \
