@@ -90,6 +90,23 @@ def test_off_axis_rigid_upper_body_matches_the_reference():
                                                              rel=1e-12)
 
 
+@pytest.mark.parametrize("name", list(REFS))
+def test_floating_view_matches_the_reference(name):
+    # the compliant-contact model's mass matrix and bias (floating base, no foot pinned)
+    from walkerlab.models.floating import floating_view
+
+    sc = load_scene(f"configs/{name}.yaml")
+    view = floating_view(walker_data(sc.walker, sc.slope.phi_rad))
+    ref = PartsReference(REFS[name])
+    rng = np.random.default_rng(11)
+    for _ in range(4):
+        q = rng.uniform([-0.3, 0.8, -0.4, -0.4], [0.3, 1.0, 0.4, 0.4])
+        dq = rng.uniform(-1.5, 1.5, 4)
+        M, h = ref.floating(q, dq)
+        assert view.mass_matrix(q) == pytest.approx(M, rel=1e-12, abs=1e-12)
+        assert view.bias(q, dq) == pytest.approx(h, rel=1e-11, abs=1e-11)
+
+
 def test_legs_that_differ_make_a_stride_map_and_others_one_step():
     assert _walker("asymmetric_legs").steps_per_map == 2
     assert _walker("hip_spring").steps_per_map == 1

@@ -75,6 +75,7 @@ class PartsReference:
                                + c * ddelta * sp.diff(delta, q) for q in qe])
             args = (sw, st, th, dsw, dst, dth)
             sub = {x: 0, y: 0, dx: 0, dy: 0}
+            h_ext = lam((*args, dx, dy), h.subs({x: 0, y: 0}))
             # pinned stance foot: the angle block of the extended system
             Ma, ha = M[2:, 2:].subs(sub), h[2:, :].subs(sub)
             self._fns[stance] = {
@@ -84,9 +85,31 @@ class PartsReference:
                 "swing_foot": lam(args, swing_foot.subs(sub)),
                 "points": lam(args, sp.Matrix.hstack(*[b[2] for b in bodies]).subs(sub)),
                 "masses": [b[0] for b in bodies], "angles": [b[3] for b in bodies],
+                "h_ext": h_ext,
             }
         # the coupling th - (sw + st) / 2 = 0 (bisecting hip), as a constraint row
         self.a = np.array([-0.5, -0.5, 1.0])
+
+    def floating(self, qf, dqf):
+        """Mass matrix and bias ``M qdd + h = 0`` (no contact) in floating coordinates
+        ``(hip_x, hip_y, psi_A, psi_B)`` [m, m, rad, rad], from the extended system (stance
+        foot free at (x, y), leg B's foot there) through ``q_ext = (hip + L e(psi_B),
+        psi_A, psi_B, (psi_A + psi_B) / 2)``."""
+        f = self._fns["B"]
+        hx, hy, pa, pb = qf
+        L = self.p.L
+        T = np.zeros((5, 4))
+        T[0, 0] = T[1, 1] = T[2, 2] = T[3, 3] = 1.0
+        T[0, 3], T[1, 3] = L * np.cos(pb), L * np.sin(pb)
+        T[4, 2:] = 0.5 if self.p.torso is not None else 0.0
+        Tdot_dq = np.array([-L * np.sin(pb), L * np.cos(pb), 0, 0, 0]) * dqf[3] ** 2
+        v = T @ np.asarray(dqf, float)
+        args = (pa, pb, 0.5 * (pa + pb), v[2], v[3], v[4], v[0], v[1])
+        M = np.asarray(f["De"](*args[:6]), float)
+        h = np.asarray(f["h_ext"](*args), float).ravel()
+        if self.p.torso is None:
+            M, h, T, Tdot_dq = M[:4, :4], h[:4], T[:4], Tdot_dq[:4]
+        return T.T @ M @ T, T.T @ (M @ Tdot_dq + h)
 
     def _full(self, x):
         sw, st, dsw, dst = x
