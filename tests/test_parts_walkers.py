@@ -230,3 +230,39 @@ def test_one_line_errors_for_the_new_parts():
         with pytest.raises(SceneError) as e:
             _with(extra)
         assert field in str(e.value) and "Traceback" not in str(e.value)
+
+
+def test_exported_legs_that_differ_match_pinocchio_mujoco_and_the_reference(tmp_path):
+    # URDF / MJCF of the asymmetric walker: Pinocchio's CRBA/RNEA and MuJoCo's qM/qfrc_bias
+    # against the independent reference (MuJoCo's inertia floor 1e-12 kg m^2 bounds M's gap)
+    from tests.test_export import MuJoCo, Pinocchio
+
+    from walkerlab.stages import export as export_stage
+
+    sc = load_scene("configs/asymmetric_legs.yaml")
+    names = ("hip_x", "hip_y", "leg1_angle", "leg2_angle")
+    libs = {"pinocchio": Pinocchio(export_stage.run(sc, tmp_path, "urdf"), names, 9.81),
+            "mujoco": MuJoCo(export_stage.run(sc, tmp_path, "mjcf"), names)}
+    ref = PartsReference(REFS["asymmetric_legs"])
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        q = rng.uniform([-0.3, 0.8, -0.4, -0.4], [0.3, 1.0, 0.4, 0.4])
+        dq = rng.uniform(-1.5, 1.5, 4)
+        Mr, hr = ref.floating(q, dq)
+        for lib in libs.values():
+            M, h = lib(q, dq)
+            assert np.abs(M - Mr).max() <= 1e-10 * np.abs(Mr).max()
+            assert np.abs(h - hr).max() <= 1e-10 * np.abs(hr).max()
+
+
+@pytest.mark.parametrize("name, part", [("hip_spring", "springs"),
+                                        ("torso_bhm", "an upper body")])
+def test_export_refuses_parts_it_cannot_write_in_one_line(name, part, tmp_path):
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, ["export", f"configs/{name}.yaml", "--runs-dir",
+                                 str(tmp_path)])
+    assert r.exit_code == 1 and r.output.strip().count("\n") == 0 and part in r.output
+    assert not list(tmp_path.rglob("walker.*"))
