@@ -236,7 +236,6 @@ def test_exported_legs_that_differ_match_pinocchio_mujoco_and_the_reference(tmp_
     # URDF / MJCF of the asymmetric walker: Pinocchio's CRBA/RNEA and MuJoCo's qM/qfrc_bias
     # against the independent reference (MuJoCo's inertia floor 1e-12 kg m^2 bounds M's gap)
     from tests.test_export import MuJoCo, Pinocchio
-
     from walkerlab.stages import export as export_stage
 
     sc = load_scene("configs/asymmetric_legs.yaml")
