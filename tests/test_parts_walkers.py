@@ -280,3 +280,16 @@ def test_table3_gives_each_legs_step_where_legs_differ(fixed_points):
     assert m["t_left_s"] == pytest.approx(fp.step_periods_s[0], abs=1e-9)
     # impact losses with each step's own walker: every step loses energy
     assert np.all(step_table(traj)["impact_energy_loss"] > 0)
+
+
+def test_basin_iterates_strides_where_legs_differ(fixed_points):
+    from walkerlab.config import BasinSettings
+    from walkerlab.sweep.basin import CODE, classify_cell
+
+    w, fp = fixed_points["asymmetric_legs"]
+    st = BasinSettings()
+    near = fp.x + np.array([0.0, 0.0, 0.01, 0.0])
+    # iterated with one walker for every step it would go to another gait (leg1's numbers
+    # swinging every step), never within 1e-4 of the stride's fixed point
+    code, steps, period = classify_cell(w, near, fp.x, SOLVER, st)
+    assert code == CODE["converged"] and period == 1 and steps % 2 == 0
