@@ -122,7 +122,7 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
                 walker, res, _src = ideal_fixed_point(scene, guess)
                 guess = res.x
                 row.update(x=res.x, multipliers=np.asarray(res.multipliers_variational, complex),
-                           period_s=res.period_s)
+                           period_s=res.period_s / walker.steps_per_map)  # per step
             except _Outcome as exc:
                 row.update(fp_outcome=exc.outcome, message=exc.message)
                 walker = build_walker(scene)
