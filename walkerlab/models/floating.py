@@ -116,6 +116,9 @@ class FloatingEquations:
         Named as the rigid model's: ``hip``, ``<leg>_<body>``, ``<leg>_foot`` (end of the
         leg axis), arc feet ``<leg>_foot_centre`` and ``<leg>_contact`` (lowest point),
         kneed ``<leg>_knee``.
+    knees : tuple of (int, int)
+        Per leg with a knee, the indices in ``q`` of its thigh and shank angles
+        (:func:`knee_pairs`); empty for straight legs.
     """
 
     q: tuple
@@ -127,6 +130,7 @@ class FloatingEquations:
     kinetic: object
     potential: object
     points: dict
+    knees: tuple = ()
 
 
 @cache
@@ -253,7 +257,8 @@ def derive_floating(structure: Structure) -> FloatingEquations:
         + sp.Matrix([sp.diff(V, s) for s in q]) + damping * dqv
     h = h.applyfunc(sp.expand)
     return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, h=h,
-                             feet=tuple(feet), kinetic=T, potential=V, points=points)
+                             feet=tuple(feet), kinetic=T, potential=V, points=points,
+                             knees=knee_pairs(structure))
 
 
 # ---------------------------------------------------------------------------- code generation

@@ -137,8 +137,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                  "wall_time_s": "s"}
 
         def writer(f):
-            f.attrs["model"] = ("compass_gait_contact" if walker.nq == 4
-                                and walker.structure.foot == "point" else "biped_contact")
+            f.attrs["model"] = walker.model_name
             f.attrs["legs"] = LEGS
             f.attrs["termination"] = res.termination
             f.attrs["method"] = res.method
