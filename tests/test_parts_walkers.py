@@ -293,3 +293,27 @@ def test_basin_iterates_strides_where_legs_differ(fixed_points):
     # swinging every step), never within 1e-4 of the stride's fixed point
     code, steps, period = classify_cell(w, near, fp.x, SOLVER, st)
     assert code == CODE["converged"] and period == 1 and steps % 2 == 0
+
+
+def test_gait_search_without_a_guess_finds_the_stride_fixed_point(fixed_points):
+    from walkerlab.analysis.gaits import find_gaits
+
+    w, fp = fixed_points["asymmetric_legs"]
+    search = find_gaits(w, SOLVER, None, other_gait=False, fd_check=False)
+    found = search.gaits[search.selected].result
+    assert np.max(np.abs(found.x - fp.x)) < 1e-9 and found.stable
+
+
+@pytest.mark.slow
+def test_contact_view_walks_the_hip_spring_walker_near_its_rigid_gait(fixed_points):
+    # the compliant-contact walker generated from the same description (spring in the
+    # floating equations): 2 strides from the rigid fixed point, step periods within 2 %
+    # of the rigid 0.5222 s (measured: 0.5245, 0.5281, 0.5290, 0.5284 s)
+    from walkerlab.analysis.contact_sim import simulate_from
+
+    w, fp = fixed_points["hip_spring"]
+    sc = load_scene("configs/hip_spring.yaml")
+    _cw, res, _x0, _d = simulate_from(sc, fp.x, fp.period_s, strides=2)
+    periods = np.diff(np.concatenate([[0.0], res.heel_strike_times]))
+    assert len(periods) >= 3
+    assert np.all(np.abs(periods / fp.period_s - 1) < 0.02)
