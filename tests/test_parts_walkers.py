@@ -225,7 +225,9 @@ def test_one_line_errors_for_the_new_parts():
             "walker.legs"),
            ({"springs": [{"between": ["leg1", "leg1"], "stiffness_n_m_per_rad": 1.0}]},
             "springs"),
-           ({"torso": {"bodies": []}}, "walker.torso.bodies")]
+           ({"torso": {"bodies": []}}, "walker.torso.bodies"),
+           ({"springs": [{"between": ["torso", "leg1"], "stiffness_n_m_per_rad": 1.0}],
+             "torso": None}, "needs a 'torso'")]
     for extra, field in bad:
         with pytest.raises(SceneError) as e:
             _with(extra)

@@ -374,6 +374,9 @@ class BipedParams(_Strict):
             raise ValueError(f"coordinates: {new[0]} needs 'absolute'")
         if new and pair[0].knee is not None:
             raise ValueError(f"{new[0]}: not available with a knee yet (straight legs only)")
+        if self.springs and any(b.mass_kg == 0 for leg in pair for b in leg.bodies):
+            raise ValueError("springs: not with massless bodies (a sprung massless leg has "
+                             "no flow in the limit m -> 0)")
         if any("torso" in s.between for s in self.springs) and self.torso is None:
             raise ValueError("springs: a spring on the torso needs a 'torso'")
         return self
