@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 from independent.parts_reference import Parts, PartsReference
 
-from walkerlab.analysis.hybrid import Solver, integrate_step, simulate_steps
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.integrate.rigid import integrate_step, simulate_steps
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.description import walker_data
 from walkerlab.models.registry import build_walker
 

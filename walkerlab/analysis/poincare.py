@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.analysis.hybrid import Solver, integrate_step, numeric_jacobian
+from walkerlab.integrate.rigid import integrate_step, numeric_jacobian
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.base import HybridWalker
 
 
@@ -49,7 +50,7 @@ def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
         Also return ``DP`` (2n x 2n) from the variational equations (with saltation at every
         guard; for a stride the product of the two steps' Jacobians).
     steps : list, optional
-        The steps' :class:`~walkerlab.analysis.hybrid.Segment` are appended to it.
+        The steps' :class:`~walkerlab.integrate.rigid.Segment` are appended to it.
 
     Returns
     -------
