@@ -28,6 +28,10 @@ REFS = {
     "torso_bhm": Parts(torso=(5.0, 0.2, 0.0, 0.0)),
 }
 
+SHIPPED = {"asymmetric_legs": (1.3928103873, 0.3531098),  # a stride: 0.67839 + 0.71442 s
+           "hip_spring": (0.5221933351, 0.6320066),
+           "torso_bhm": (0.8509063711, 0.4412226)}
+
 
 def _walker(name):
     return build_walker(load_scene(f"configs/{name}.yaml"))
@@ -140,6 +144,10 @@ def test_fixed_point_maps_to_itself_under_the_reference(name, fixed_points):
     assert np.max(np.abs(x - fp.x)) < 1e-8
     assert T == pytest.approx(fp.period_s, abs=1e-9)
     assert fp.stable and fp.residual < 1e-10
+    # the shipped scenes' numbers (closing note of issue 22): map period [s], max |multiplier|
+    period, mult = SHIPPED[name]
+    assert fp.period_s == pytest.approx(period, abs=1e-9)
+    assert np.max(np.abs(fp.multipliers_variational)) == pytest.approx(mult, abs=1e-6)
 
 
 def test_stride_steps_differ_and_compose(fixed_points):
