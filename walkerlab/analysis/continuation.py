@@ -1,0 +1,1052 @@
+"""Pseudo-arclength continuation of periodic gaits: special points, branch switching,
+two-parameter continuation of a fold or period doubling.
+
+A gait of period ``k`` (1, 2, 4, ... steps) is a fixed point of the ``k``-step Poincaré map
+reduced to the heel-strike section (``walker.section`` coordinates, ``m = 2n - 1`` of them),
+
+    F(z, p) = section(P^k(from_section(z); p)) - z = 0,
+
+``p`` any numeric scene field (a dotted path, :mod:`walkerlab.sweep.params`).  The branch
+``(z(s), p(s))`` is followed by pseudo-arclength continuation (Keller 1977; Allgower & Georg,
+"Introduction to numerical continuation methods", SIAM 2003, ch. 2): a tangent predictor
+``u + ds t`` (``t`` spans the null space of ``[F_z  F_p]``, ``scipy.linalg.null_space``) and
+a corrector on the bordered system ``[F(u); t . (u - u_pred)] = 0`` solved by
+``scipy.optimize.root`` (MINPACK ``hybrj``) with the analytic Jacobian
+``[[F_z, F_p], [t^T]]``.  ``F_z = D section . DP^k . D from_section - I`` is exact: ``DP`` comes
+from the variational equations with saltation matrices at every guard
+(:func:`walkerlab.analysis.hybrid.integrate_step`).  ``F_p`` is a central finite difference
+in ``p`` (step ``1e-6 (1 + |p|)``; two plain maps): it only steers the predictor and the
+corrector's start, the solution itself is fixed by ``F = 0`` and the hyperplane.  The
+parameter enters the arclength scaled by ``p_scale`` (the span of the range asked for).
+The step length adapts (halved on a failed correction or a tangent that turned by more
+than ~25 degrees, grown by 1.5 after an easy one); the branch turns around folds because
+``p`` is an unknown like the state.
+
+Special points (test functions on the reduced Jacobian ``M = F_z + I`` with eigenvalues
+``mu``, the Floquet multipliers without the one that is zero by construction):
+
+- fold: ``det(M - I)`` (a multiplier through +1);
+- period doubling: ``det(M + I)`` (a multiplier through -1);
+- Neimark-Sacker: ``prod_{i<j} (mu_i mu_j - 1)`` (the bialternate product; a sign change
+  counts only when the pair with ``mu_i mu_j`` nearest 1 is complex);
+- branch end: the step map fails (fall, no heel strike, swing foot scuffing, the knee
+  strike lost, the section's coordinates leaving their domain) - located by bisection
+  (``scipy.optimize.brentq`` on the distance to the failure is not defined there: the
+  failing side has no gait) down to ``1e-8`` of the arclength, or the swing foot's
+  clearance inside the step turning negative (for walkers whose starting gait clears the
+  ground), located by ``brentq`` on the clearance.
+
+A sign change between two accepted points is located by ``scipy.optimize.brentq`` on the
+test function along the branch: each trial arclength ``s`` is corrected on the hyperplane
+``t . (u - u_a) = s`` (a full re-correction of the fixed point), to ``xtol = 1e-12`` in
+``s``, i.e. far below ``1e-8`` in the parameter.
+
+Branch switching at a period doubling of the period-``k`` branch: the period-``2k`` branch
+leaves the point ``(x*, p*)`` along ``v``, the eigenvector of the multiplier -1; its first
+point is the fixed point of the ``2k``-step map with the amplitude fixed,
+``v . (z - z*) = eps``, the parameter free (a pitchfork of ``P^2k``: ``p - p* ~ eps^2``),
+then continued as any branch, away from ``(z*, p*)``.
+
+Two-parameter continuation: the augmented system ``[F(z, p1, p2); psi(z, p1, p2)] = 0``
+(``psi`` the fold or period-doubling test function) is solved for ``(z, p1)`` at each ``p2``
+by ``scipy.optimize.root`` (rows of ``F`` analytic, the row of ``psi`` by central
+differences), with a secant predictor in ``p2``.
+
+Nothing here knows a state's row: states are ``(2n,)`` arrays of the walker's
+``state_names()``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from walkerlab.analysis.hybrid import Solver, integrate_step, numeric_jacobian
+from walkerlab.models.base import HybridWalker
+
+__all__ = ["WalkerFamily", "BranchPoint", "SpecialPoint", "Branch", "ContinuationResult",
+           "MapFailed", "continue_branch", "continuation", "switch_period_doubling",
+           "two_parameter", "TwoParameterCurve", "SPECIAL_KINDS", "fixed_point_at",
+           "homotopy", "HomotopyResult"]
+
+SPECIAL_KINDS = ("fold", "period_doubling", "neimark_sacker", "branch_end")
+
+#: a residual ``max |F|`` below this is a fixed point [rad, rad/s]
+RESIDUAL_TOL = 1e-10
+
+
+class MapFailed(RuntimeError):
+    """The ``k``-step map failed; ``cause`` says why in the field's words."""
+
+    def __init__(self, cause: str, detail: str = ""):
+        super().__init__(f"{cause}{': ' + detail if detail else ''}")
+        self.cause = cause
+
+
+# ----------------------------------------------------------------------------- family
+@dataclass
+class WalkerFamily:
+    """The scene's walker as a function of one or two numeric scene fields.
+
+    Attributes
+    ----------
+    base : dict
+        The scene as a plain mapping (``Scene.model_dump(mode="json")``).
+    path : str
+        Dotted scene field of the parameter (``slope.angle_deg``,
+        ``walker.leg.bodies.rod.mass_kg``, ...).
+    solver : Solver
+    max_step_time : float
+        A step longer than this is a failure [s].
+    fixed : dict
+        Other fields held at a value (the second parameter of a two-parameter run).
+    """
+
+    base: dict
+    path: str
+    solver: Solver
+    max_step_time: float = 5.0
+    fixed: dict = field(default_factory=dict)
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def walker(self, p: float) -> HybridWalker:
+        """The walker at ``p`` (built once per value; raises ``MapFailed`` if the scene at
+        ``p`` does not validate)."""
+        from walkerlab.config import SceneError
+        from walkerlab.models.registry import build_walker
+        from walkerlab.sweep.params import apply_point
+
+        key = float(p)
+        w = self._cache.get(key)
+        if w is None:
+            paths = [self.path, *self.fixed]
+            try:
+                scene = apply_point(self.base, paths, (key, *self.fixed.values()),
+                                    "<continuation>")
+            except SceneError as exc:
+                raise MapFailed("parameter leaves the scene's domain",
+                                str(exc).split("]: ", 1)[-1]) from None
+            w = build_walker(scene)
+            if len(self._cache) > 64:
+                self._cache.clear()
+            self._cache[key] = w
+        return w
+
+    def at(self, **fixed) -> WalkerFamily:
+        """This family with more fields held fixed (by dotted path)."""
+        return dataclasses.replace(self, fixed={**self.fixed, **fixed}, _cache={})
+
+
+def _cause(walker: HybridWalker, seg) -> str:
+    """The reason a step did not end in heel strike, in the field's words."""
+    names = [g.name for ph in walker.phases for g in ph.guards]
+    if seg.termination == "no_heel_strike":
+        return "no heel strike (the walker does not move)"
+    if seg.termination == "t_final":
+        return "no heel strike within the step time limit"
+    if seg.termination == "solver_failure":
+        return "integrator failure"
+    if "knee_strike" in names and "knee_strike" not in seg.phase_times:
+        return f"knee strike lost ({seg.event})"
+    if seg.event == "swing_foot_scuffs":
+        return "swing foot scuffing"
+    if seg.event == "swing_leg_falls_back":
+        return "no heel strike (the swing leg falls back)"
+    return f"fall ({seg.event})" if seg.event else "fall"
+
+
+def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,
+             jacobian: bool = False, max_step_time: float = 5.0, segments: bool = False):
+    """The ``k``-step Poincaré map ``P^k`` and (optionally) its Jacobian.
+
+    Parameters
+    ----------
+    x : ndarray (2n,)
+        State just after heel strike (role-ordered).
+    k : int
+        Steps (1: step map, 2: stride map, ...).
+    jacobian : bool
+        Also ``D(P^k)`` (2n, 2n), the product of the steps' variational Jacobians (with
+        saltation matrices).
+
+    Returns
+    -------
+    x_k : ndarray (2n,)
+    period : float
+        Sum of the ``k`` step periods [s].
+    J : ndarray (2n, 2n) or None
+    segs : list of Segment, only with ``segments=True``
+
+    Raises
+    ------
+    MapFailed
+        A step did not end in heel strike (``cause``: fall, no heel strike, scuffing, knee
+        strike lost, ...), or the state is not finite.
+    """
+    x = np.asarray(x, float)
+    if not np.all(np.isfinite(x)):
+        raise MapFailed("section coordinates leave their domain", "non-finite state")
+    J = np.eye(x.size) if jacobian else None
+    T = 0.0
+    segs = []
+    for _ in range(k):
+        seg = integrate_step(walker, x, solver, max_step_time=max_step_time,
+                             variational=jacobian)
+        if seg.termination != "heel_strike":
+            raise MapFailed(_cause(walker, seg), seg.message)
+        if jacobian:
+            J = seg.monodromy @ J
+        T += seg.period
+        x = seg.x_next
+        segs.append(seg)
+    out = (x, T, J)
+    return (*out, segs) if segments else out
+
+
+def _from_section(walker: HybridWalker, z: np.ndarray) -> np.ndarray:
+    with np.errstate(all="ignore"):
+        try:
+            x = np.asarray(walker.from_section(np.asarray(z, float)), float)
+        except (ValueError, ArithmeticError) as exc:
+            raise MapFailed("section coordinates leave their domain", str(exc)) from None
+    if not np.all(np.isfinite(x)):
+        raise MapFailed("section coordinates leave their domain", "non-finite state")
+    return x
+
+
+# ----------------------------------------------------------------------------- system
+class _System:
+    """``F(z, p)`` of the period-``k`` branch with memoised maps (one per iterate)."""
+
+    def __init__(self, family: WalkerFamily, k: int, p_scale: float):
+        self.family, self.k, self.p_scale = family, k, p_scale
+        self.n_maps = 0
+        self.n_variational = 0
+        self._last: dict = {}
+
+    def residual(self, z: np.ndarray, p: float) -> np.ndarray:
+        key = (np.asarray(z, float).tobytes(), float(p))
+        if key in self._last:
+            return self._last[key].copy()
+        w = self.family.walker(p)
+        x = _from_section(w, z)
+        xk, _, _ = step_map(w, x, self.family.solver, self.k,
+                            max_step_time=self.family.max_step_time)
+        self.n_maps += self.k
+        r = np.asarray(w.section(xk), float) - z
+        self._last.clear()
+        self._last[key] = r
+        return r.copy()
+
+    def dp(self, z: np.ndarray, p: float) -> np.ndarray:
+        """``dF/dp`` (m,) by central differences (step ``1e-6 (1 + |p|)``)."""
+        h = 1e-6 * (1.0 + abs(p))
+        return (self.residual(z, p + h) - self.residual(z, p - h)) / (2 * h)
+
+    def full(self, z: np.ndarray, p: float) -> dict:
+        """Everything at ``(z, p)``: state, period, ``D(P^k)``, ``F_z``, reduced ``M``."""
+        w = self.family.walker(p)
+        x = _from_section(w, z)
+        xk, T, J = step_map(w, x, self.family.solver, self.k, jacobian=True,
+                            max_step_time=self.family.max_step_time)
+        self.n_variational += self.k
+        D_from = numeric_jacobian(w.from_section, np.asarray(z, float))
+        D_sec = numeric_jacobian(w.section, np.asarray(xk, float))
+        M = D_sec @ J @ D_from
+        return {"x": x, "period": T, "J": J, "M": M, "Fz": M - np.eye(z.size),
+                "F": np.asarray(w.section(xk), float) - z, "walker": w}
+
+
+def _test_functions(M: np.ndarray) -> dict:
+    """Fold, period-doubling and Neimark-Sacker test functions of the reduced Jacobian."""
+    mu = np.linalg.eigvals(M)
+    m = mu.size
+    pairs = [(i, j) for i in range(m) for j in range(i + 1, m)]
+    prod = np.array([mu[i] * mu[j] for i, j in pairs]) if pairs else np.zeros(0)
+    ns = float(np.prod(prod - 1.0).real) if pairs else 1.0
+    return {"fold": float(np.linalg.det(M - np.eye(m))),
+            "period_doubling": float(np.linalg.det(M + np.eye(m))),
+            "neimark_sacker": ns, "mu": mu}
+
+
+# ----------------------------------------------------------------------------- results
+@dataclass
+class BranchPoint:
+    """One point of a branch (a fixed point of the ``k``-step map).
+
+    Attributes
+    ----------
+    p : float          parameter [the field's unit]
+    z : ndarray (m,)   section coordinates
+    x : ndarray (2n,)  state just after heel strike
+    period_s : float   duration of the ``k`` steps [s]
+    multipliers : ndarray (2n,) complex   eigenvalues of ``D(P^k)``, by decreasing modulus
+    tests : dict       test-function values
+    tangent : ndarray (m + 1,)   unit tangent in scaled ``(z, p / p_scale)``
+    residual : float   ``max |F|``
+    """
+
+    p: float
+    z: np.ndarray
+    x: np.ndarray
+    period_s: float
+    multipliers: np.ndarray
+    tests: dict
+    tangent: np.ndarray
+    residual: float
+    M: np.ndarray = field(repr=False, default=None)
+
+    @property
+    def stable(self) -> bool:
+        return bool(np.max(np.abs(self.multipliers)) < 1.0)
+
+
+@dataclass
+class SpecialPoint:
+    """A located special point.
+
+    Attributes
+    ----------
+    kind : str          ``fold``, ``period_doubling``, ``neimark_sacker`` or ``branch_end``
+    p : float           located parameter value [the field's unit]
+    period : int        steps of the branch it lies on (1, 2, 4, ...)
+    x : ndarray (2n,)   state (NaN for a branch end without a gait)
+    multipliers : ndarray (2n,) complex
+    cause : str         branch ends: why (fall, no heel strike, scuffing, ...); else ""
+    eigenvector : ndarray (m,) or None   the critical multiplier's (section coordinates)
+    point : BranchPoint or None          the corrected point there
+    """
+
+    kind: str
+    p: float
+    period: int
+    x: np.ndarray
+    multipliers: np.ndarray
+    cause: str = ""
+    eigenvector: np.ndarray | None = None
+    point: BranchPoint | None = None
+    branch: int = 0
+
+
+@dataclass
+class Branch:
+    """A continued branch: points in order of arclength, the branch's period ``k``."""
+
+    period: int
+    points: list[BranchPoint]
+    specials: list[SpecialPoint]
+    direction: int = 1
+
+    def params(self) -> np.ndarray:
+        return np.array([q.p for q in self.points])
+
+
+@dataclass
+class ContinuationResult:
+    """Every branch of a run and its special points.
+
+    Attributes
+    ----------
+    path, unit : str          the parameter's dotted field and unit
+    state_names, state_units : list of str (2n,)
+    branches : list of Branch
+    specials : list of SpecialPoint  (each with ``branch``, an index into ``branches``)
+    start : float             the scene's own value of the parameter
+    wall_time_s : float
+    maps, variational_maps : int      step maps integrated (plain / with variational eqs)
+    """
+
+    path: str
+    unit: str
+    state_names: list
+    state_units: list
+    branches: list[Branch]
+    specials: list[SpecialPoint]
+    start: float
+    wall_time_s: float = 0.0
+    maps: int = 0
+    variational_maps: int = 0
+
+
+# ----------------------------------------------------------------------------- corrector
+def _null_tangent(Fz: np.ndarray, Fp_scaled: np.ndarray) -> np.ndarray:
+    from scipy.linalg import null_space
+
+    A = np.column_stack([Fz, Fp_scaled])
+    ns = null_space(A, rcond=1e-10)
+    if ns.shape[1] == 0:  # numerically full rank: the smallest right singular vector
+        ns = np.linalg.svd(A)[2][-1:].T
+    t = ns[:, 0]
+    return t / np.linalg.norm(t)
+
+
+def _correct(sys: _System, u0: np.ndarray, row: np.ndarray, target: float,
+             J0: np.ndarray | None = None, xtol: float = 1e-13):
+    """Solve ``[F(z, p); row . u - target] = 0`` from ``u0`` (scaled ``u = (z, p/p_scale)``)
+    with ``scipy.optimize.root`` (``hybr``, analytic bordered Jacobian).
+
+    Returns
+    -------
+    u : ndarray (m + 1,) or None (no convergence)
+    info : dict or None   :meth:`_System.full` at the solution
+    """
+    from scipy.optimize import root
+
+    s = sys.p_scale
+    failure: list = []
+
+    def G(u):
+        try:
+            r = sys.residual(u[:-1], u[-1] * s)
+        except MapFailed as exc:
+            failure[:] = [exc]
+            r = np.full(u.size - 1, 1e3 * (1.0 + np.linalg.norm(u)))
+        return np.append(r, row @ u - target)
+
+    cache: dict = {}
+
+    def jac(u):
+        key = u.tobytes()
+        if J0 is not None and not cache:
+            cache[key] = J0
+        if key in cache:
+            return cache[key]
+        try:
+            info = sys.full(u[:-1], u[-1] * s)
+            Fp = sys.dp(u[:-1], u[-1] * s) * s
+        except MapFailed as exc:
+            failure[:] = [exc]
+            return next(iter(cache.values())) if cache else np.eye(u.size)
+        out = np.vstack([np.column_stack([info["Fz"], Fp]), row])
+        cache[key] = out
+        return out
+
+    with np.errstate(all="ignore"):
+        sol = root(G, np.asarray(u0, float), jac=jac, method="hybr",
+                   options={"xtol": xtol, "maxfev": 60})
+    u = sol.x
+    try:
+        r = sys.residual(u[:-1], u[-1] * s)
+    except MapFailed as exc:
+        return None, exc
+    if not np.all(np.isfinite(r)) or float(np.max(np.abs(r))) > RESIDUAL_TOL:
+        return None, failure[-1] if failure else None
+    try:
+        info = sys.full(u[:-1], u[-1] * s)
+    except MapFailed as exc:
+        return None, exc
+    return u, info
+
+
+def _point(sys: _System, u: np.ndarray, info: dict, t_prev: np.ndarray | None) -> BranchPoint:
+    from walkerlab.analysis.poincare import sort_multipliers
+
+    s = sys.p_scale
+    Fp = sys.dp(u[:-1], u[-1] * s) * s
+    t = _null_tangent(info["Fz"], Fp)
+    if t_prev is not None and t @ t_prev < 0:
+        t = -t
+    tests = _test_functions(info["M"])
+    return BranchPoint(p=float(u[-1] * s), z=u[:-1].copy(), x=info["x"],
+                       period_s=float(info["period"]),
+                       multipliers=sort_multipliers(np.linalg.eigvals(info["J"])),
+                       tests=tests, tangent=t, residual=float(np.max(np.abs(info["F"]))),
+                       M=info["M"])
+
+
+def _u(q: BranchPoint, s: float) -> np.ndarray:
+    return np.append(q.z, q.p / s)
+
+
+def _critical_vector(M: np.ndarray, target: complex) -> tuple[np.ndarray, complex]:
+    mu, V = np.linalg.eig(M)
+    i = int(np.argmin(np.abs(mu - target)))
+    v = V[:, i].real if abs(mu[i].imag) < 1e-12 else V[:, i]
+    return v / np.linalg.norm(v), mu[i]
+
+
+# ----------------------------------------------------------------------------- locate
+def _locate(sys: _System, a: BranchPoint, b_s: float, kind: str, guess_b: np.ndarray,
+            period: int, scuff_ref: float | None = None) -> SpecialPoint | None:
+    """brentq along the branch between ``a`` (s = 0) and the point at ``s = b_s``."""
+    from scipy.optimize import brentq
+
+    sc = sys.p_scale
+    ua = _u(a, sc)
+    t = a.tangent
+    memo: dict = {}
+
+    def corrected(s):
+        if s in memo:
+            return memo[s]
+        lam = s / b_s
+        u0 = (1 - lam) * ua + lam * guess_b
+        u, info = _correct(sys, u0, t, t @ ua + s)
+        memo[s] = (u, info)
+        return u, info
+
+    def f(s):
+        u, info = corrected(s)
+        if u is None:
+            raise MapFailed("correction failed while locating a special point")
+        if kind == "scuff":
+            return _clearance(sys, u, sc) - 0.0
+        return _test_functions(info["M"])[kind]
+
+    try:
+        s_star = brentq(f, 0.0, b_s, xtol=1e-12, rtol=4 * np.finfo(float).eps)
+    except (MapFailed, ValueError):
+        return None
+    u, info = corrected(s_star)
+    q = _point(sys, u, info, t)
+    target = {"fold": 1.0, "period_doubling": -1.0}.get(kind)
+    vec = None
+    if target is not None:
+        vec, _ = _critical_vector(q.M, target)
+    if kind == "neimark_sacker":
+        mu = q.tests["mu"]
+        prods = [(abs(mu[i] * mu[j] - 1), i, j) for i in range(mu.size)
+                 for j in range(i + 1, mu.size)]
+        _d, i, j = min(prods)
+        if abs(mu[i].imag) < 1e-9:  # a real pair mu_i mu_j = 1: a neutral saddle, no NS
+            return None
+    if kind == "scuff":
+        return SpecialPoint("branch_end", q.p, period, q.x, q.multipliers,
+                            cause="swing foot scuffing (clearance inside the step reaches 0)",
+                            point=q)
+    return SpecialPoint(kind, q.p, period, q.x, q.multipliers, eigenvector=vec, point=q)
+
+
+def _clearance(sys: _System, u: np.ndarray, sc: float, n: int = 200) -> float:
+    """Lowest height [m] of the swing foot above the slope strictly inside the steps."""
+    w = sys.family.walker(u[-1] * sc)
+    x = _from_section(w, u[:-1])
+    _xk, _T, _J, segs = step_map(w, x, sys.family.solver, sys.k,
+                                 max_step_time=sys.family.max_step_time, segments=True)
+    low = math.inf
+    phi = w.slope_rad
+    for seg in segs:
+        span = seg.t_end - seg.t_start
+        ts = seg.t_start + span * np.linspace(0.08, 0.92, n)  # the feet touch at both ends
+        X = seg.sample(ts)
+        foot = w.points(X)["swing_foot"]
+        h = foot[1] * math.cos(phi) + foot[0] * math.sin(phi)
+        low = min(low, float(np.min(h)))
+    return low
+
+
+def _end(sys: _System, a: BranchPoint, ds: float, exc, period: int,
+         tol: float = 1e-9) -> SpecialPoint:
+    """A branch end past ``a``: bisection in the arclength between the last point that has
+    a gait and the first that fails, down to ``tol`` (scaled)."""
+    sc = sys.p_scale
+    ua, t = _u(a, sc), a.tangent
+    lo, hi, last, cause = 0.0, ds, a, getattr(exc, "cause", "no fixed point")
+    guess = ua
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        u, info = _correct(sys, guess + (mid - lo) * t, t, t @ ua + mid)
+        if u is None:
+            hi = mid
+            if isinstance(info, MapFailed):
+                cause = info.cause
+        else:
+            lo, guess = mid, u
+            last = _point(sys, u, info, t)
+    sp = SpecialPoint("branch_end", last.p, period, last.x, last.multipliers, cause=cause,
+                      point=last)
+    return sp
+
+
+# ----------------------------------------------------------------------------- continue
+def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: tuple,
+                    p_scale: float, direction: int = 1, ds: float = 0.02,
+                    ds_min: float = 1e-6, ds_max: float = 0.1, max_points: int = 400,
+                    check_clearance: bool = False, away_from: np.ndarray | None = None,
+                    stats: dict | None = None) -> Branch:
+    """Follow the period-``k`` branch through ``first`` until ``p`` leaves ``p_range`` or the
+    branch ends.
+
+    Parameters
+    ----------
+    family : WalkerFamily
+    first : BranchPoint
+        A corrected point of the branch (its ``tangent`` oriented or not).
+    k : int
+        Steps of the map (1, 2, 4, ...).
+    p_range : (float, float)
+        The parameter's range [its unit]; the last point lies on the bound.
+    p_scale : float
+        Scale of the parameter in the arclength [its unit].
+    direction : {1, -1}
+        Along ``+tangent`` (oriented towards growing ``p`` where it is not a fold) or back.
+    ds, ds_min, ds_max : float
+        Initial, smallest and largest arclength step (scaled units).
+    check_clearance : bool
+        End the branch where the swing foot's clearance inside the step reaches 0.
+    away_from : ndarray (m + 1,), optional
+        Orient the first tangent away from this scaled point (branch switching).
+
+    Returns
+    -------
+    Branch
+    """
+    sys = _System(family, k, p_scale)
+    lo, hi = min(p_range), max(p_range)
+    t = first.tangent.copy()
+    if away_from is not None:
+        if t @ (_u(first, p_scale) - away_from) < 0:
+            t = -t
+    elif t[-1] < 0:
+        t = -t
+    t = direction * t
+    pts = [dataclasses.replace(first, tangent=t)]
+    specials: list[SpecialPoint] = []
+    ds_cur = ds
+    while len(pts) < max_points:
+        a = pts[-1]
+        ua = _u(a, p_scale)
+        up = ua + ds_cur * a.tangent
+        p_pred = up[-1] * p_scale
+        at_bound = None
+        if p_pred > hi or p_pred < lo:
+            at_bound = hi if p_pred > hi else lo
+            if abs(a.p - at_bound) < 1e-12 * max(1.0, abs(at_bound)):
+                break
+            # the last point on the bound: natural-parameter correction there
+            row = np.zeros(ua.size)
+            row[-1] = 1.0
+            frac = (at_bound / p_scale - ua[-1]) / (up[-1] - ua[-1])
+            u, info = _correct(sys, ua + frac * (up - ua), row, at_bound / p_scale)
+            s_b = float(a.tangent @ (u - ua)) if u is not None else None
+        else:
+            u, info = _correct(sys, up, a.tangent, a.tangent @ ua + ds_cur)
+            s_b = ds_cur
+        if u is None:
+            if ds_cur / 2 < ds_min:
+                specials.append(_end(sys, a, ds_cur, info, k))
+                break
+            ds_cur /= 2
+            continue
+        b = _point(sys, u, info, a.tangent)
+        if b.tangent @ a.tangent < 0.9 and ds_cur / 2 >= ds_min:
+            ds_cur /= 2
+            continue
+        # special points between a and b (the hyperplane through a with a's tangent)
+        if at_bound is None or (s_b is not None and s_b > 0):
+            for kind in ("fold", "period_doubling", "neimark_sacker"):
+                if np.sign(a.tests[kind]) != np.sign(b.tests[kind]) and a.tests[kind] != 0:
+                    sp = _locate(sys, a, s_b, kind, u, k) if at_bound is None else \
+                        _locate_on_bound(sys, a, b, kind, k)
+                    if sp is not None:
+                        specials.append(sp)
+            if check_clearance and _clearance(sys, u, p_scale) < 0 <= _clearance(
+                    sys, ua, p_scale):
+                sp = (_locate(sys, a, s_b, "scuff", u, k) if at_bound is None else None)
+                specials.append(sp or SpecialPoint(
+                    "branch_end", b.p, k, b.x, b.multipliers, cause="swing foot scuffing",
+                    point=b))
+                pts.append(b)
+                break
+        pts.append(b)
+        if at_bound is not None:
+            break
+        ds_cur = min(ds_max, ds_cur * 1.5) if b.tangent @ a.tangent > 0.995 else ds_cur
+    if stats is not None:
+        stats["maps"] = stats.get("maps", 0) + sys.n_maps
+        stats["variational_maps"] = stats.get("variational_maps", 0) + sys.n_variational
+    return Branch(k, pts, specials, direction)
+
+
+def _locate_on_bound(sys, a, b, kind, k):
+    """A special point between ``a`` and the bound point ``b``: along ``a``'s tangent to
+    the arclength of ``b``."""
+    ua, ub = _u(a, sys.p_scale), _u(b, sys.p_scale)
+    s_b = float(a.tangent @ (ub - ua))
+    if s_b <= 0:
+        return None
+    return _locate(sys, a, s_b, kind, ub, k)
+
+
+def first_point(family: WalkerFamily, p: float, x: np.ndarray, k: int, p_scale: float
+                ) -> BranchPoint:
+    """The corrected point of the period-``k`` branch at ``p`` from the state ``x`` (natural
+    parameter: ``p`` held).
+
+    Raises
+    ------
+    MapFailed
+        No fixed point near ``x``.
+    """
+    sys = _System(family, k, p_scale)
+    w = family.walker(p)
+    z = np.asarray(w.section(np.asarray(x, float)), float)
+    row = np.zeros(z.size + 1)
+    row[-1] = 1.0
+    u, info = _correct(sys, np.append(z, p / p_scale), row, p / p_scale)
+    if u is None:
+        raise MapFailed("no fixed point near the start", str(info) if info else "")
+    return _point(sys, u, info, None)
+
+
+def fixed_point_at(family: WalkerFamily, p: float, x: np.ndarray, k: int = 1) -> BranchPoint:
+    """Fixed point of the ``k``-step map at ``p`` from a guess ``x`` (2n,)."""
+    return first_point(family, p, x, k, max(1.0, abs(p)))
+
+
+def switch_period_doubling(family: WalkerFamily, sp: SpecialPoint, p_scale: float,
+                           eps: float = 1e-3) -> BranchPoint:
+    """First point of the period-``2k`` branch born at the period doubling ``sp`` (on the
+    period-``k`` branch): the fixed point of the ``2k``-step map with ``v . (z - z*) = eps``
+    (``v`` the eigenvector of the multiplier -1), the parameter free.
+
+    Raises
+    ------
+    MapFailed
+        No period-``2k`` fixed point near ``z* + eps v`` (nor ``z* - eps v``).
+    """
+    k2 = 2 * sp.period
+    sys = _System(family, k2, p_scale)
+    z0 = sp.point.z
+    v = np.real(sp.eigenvector)
+    v = v / np.linalg.norm(v)
+    u_star = np.append(z0, sp.p / p_scale)
+    for sign in (1.0, -1.0):
+        row = np.append(sign * v, 0.0)
+        u, info = _correct(sys, u_star + np.append(sign * eps * v, 0.0), row,
+                           row @ u_star + eps)
+        if u is not None and float(np.max(np.abs(u[:-1] - z0))) > 0.1 * eps:
+            q = _point(sys, u, info, None)
+            return q
+    raise MapFailed(f"no period-{k2} branch found next to the period doubling at "
+                    f"{sp.p:.6g}")
+
+
+# ----------------------------------------------------------------------------- driver
+def continuation(family: WalkerFamily, p0: float, x0: np.ndarray, p_range: tuple,
+                 unit: str = "-", switch: int = 0, ds: float = 0.02, ds_max: float = 0.1,
+                 check_clearance: bool | None = None) -> ContinuationResult:
+    """Continue the gait ``x0`` at the scene's own value ``p0`` both ways over ``p_range``,
+    locate its special points and (``switch`` >= 1) switch at period doublings to the
+    period-2 branch, (``switch`` >= 2) again to period 4.
+
+    Parameters
+    ----------
+    family : WalkerFamily
+    p0 : float
+        The scene's own value of the parameter [its unit] (inside ``p_range``, else the
+        nearer bound is used).
+    x0 : ndarray (2n,)
+        The scene's period-1 gait at ``p0`` (a guess is enough).
+    p_range : (float, float)
+    unit : str
+    switch : int
+        Period doublings to follow (0: none, 1: to period 2, 2: to period 4).
+    check_clearance : bool, optional
+        End branches where the swing foot's clearance reaches 0; default: when the starting
+        gait's swing foot clears the ground (a kneed walker; a compass gait scuffs at
+        mid-stance by construction and the rigid model ignores it).
+
+    Returns
+    -------
+    ContinuationResult
+    """
+    t0 = time.perf_counter()
+    lo, hi = min(p_range), max(p_range)
+    p0 = min(max(float(p0), lo), hi)
+    scale = (hi - lo) or max(1.0, abs(p0))
+    stats: dict = {}
+    first = first_point(family, p0, x0, 1, scale)
+    w = family.walker(p0)
+    if check_clearance is None:
+        sys = _System(family, 1, scale)
+        check_clearance = _clearance(sys, _u(first, scale), scale) > 0
+    kw = {"ds": ds, "ds_max": ds_max, "check_clearance": check_clearance, "stats": stats}
+    up = continue_branch(family, first, 1, (lo, hi), scale, 1, **kw)
+    down = continue_branch(family, first, 1, (lo, hi), scale, -1, **kw)
+    branches = [_join(down, up)]
+    todo = [(0, sp) for sp in branches[0].specials if sp.kind == "period_doubling"]
+    level = 0
+    while todo and level < switch:
+        level += 1
+        nxt = []
+        for _bi, sp in todo:
+            try:
+                q = switch_period_doubling(family, sp, scale)
+            except MapFailed:
+                continue
+            away = np.append(sp.point.z, sp.p / scale)
+            br = continue_branch(family, q, 2 * sp.period, (lo, hi), scale, 1,
+                                 away_from=away, **kw)
+            branches.append(br)
+            nxt += [(len(branches) - 1, s) for s in br.specials
+                    if s.kind == "period_doubling"]
+        todo = nxt
+    specials = []
+    for bi, br in enumerate(branches):
+        for sp in br.specials:
+            sp.branch = bi
+            specials.append(sp)
+    return ContinuationResult(
+        path=family.path, unit=unit, state_names=w.state_names(),
+        state_units=w.state_units(), branches=branches, specials=specials, start=p0,
+        wall_time_s=time.perf_counter() - t0, maps=stats.get("maps", 0),
+        variational_maps=stats.get("variational_maps", 0))
+
+
+def _join(down: Branch, up: Branch) -> Branch:
+    """One branch from the two halves (the start point once), in arclength order."""
+    pts = down.points[:0:-1] + up.points
+    return Branch(up.period, pts, down.specials + up.specials, 1)
+
+
+# ----------------------------------------------------------------------------- two-param
+@dataclass
+class TwoParameterCurve:
+    """A curve of fold or period-doubling points in the plane of two fields.
+
+    Attributes
+    ----------
+    kind : str            ``fold`` or ``period_doubling``
+    period : int          the branch's period ``k``
+    path, path2 : str     the two fields; unit, unit2 their units
+    p : ndarray (N,)      first parameter at the special point
+    p2 : ndarray (N,)     second parameter
+    x : ndarray (N, 2n)   states there
+    multiplier : ndarray (N,) complex   the critical multiplier (+1 or -1)
+    """
+
+    kind: str
+    period: int
+    path: str
+    path2: str
+    unit: str
+    unit2: str
+    p: np.ndarray
+    p2: np.ndarray
+    x: np.ndarray
+    multiplier: np.ndarray
+
+
+def special_point_at(family: WalkerFamily, kind: str, k: int, p_guess: float,
+                     z_guess: np.ndarray, p_scale: float) -> tuple[float, BranchPoint]:
+    """Solve the augmented system ``[F(z, p); psi(z, p)] = 0`` for ``(z, p)``
+    (``scipy.optimize.root``, ``hybr``; ``F``'s rows analytic, ``psi``'s by central
+    differences).
+
+    Raises
+    ------
+    MapFailed
+        No convergence.
+    """
+    from scipy.optimize import root
+
+    sys = _System(family, k, p_scale)
+    target = 1.0 if kind == "fold" else -1.0
+
+    def psi(u):
+        info = sys.full(u[:-1], u[-1] * p_scale)
+        return _test_functions(info["M"])[kind], info
+
+    def G(u):
+        try:
+            F = sys.residual(u[:-1], u[-1] * p_scale)
+            return np.append(F, psi(u)[0])
+        except MapFailed:
+            return np.full(u.size, 1e3)
+
+    def jac(u):
+        try:
+            val, info = psi(u)
+            Fp = sys.dp(u[:-1], u[-1] * p_scale) * p_scale
+            grad = np.empty(u.size)
+            for i in range(u.size):
+                h = 1e-6 * (1 + abs(u[i]))
+                e = np.zeros(u.size)
+                e[i] = h
+                grad[i] = (psi(u + e)[0] - psi(u - e)[0]) / (2 * h)
+        except MapFailed:
+            return np.eye(u.size)
+        return np.vstack([np.column_stack([info["Fz"], Fp]), grad])
+
+    u0 = np.append(z_guess, p_guess / p_scale)
+    sol = root(G, u0, jac=jac, method="hybr", options={"xtol": 1e-12, "maxfev": 40})
+    u = sol.x
+    try:
+        info = sys.full(u[:-1], u[-1] * p_scale)
+    except MapFailed as exc:
+        raise MapFailed("no special point", str(exc)) from None
+    if float(np.max(np.abs(info["F"]))) > RESIDUAL_TOL or not sol.success:
+        raise MapFailed("no special point", " ".join(str(sol.message).split()))
+    q = _point(sys, u, info, None)
+    _v, mu = _critical_vector(q.M, target)
+    if abs(mu - target) > 1e-5:
+        raise MapFailed("no special point", f"critical multiplier {mu:.6g}")
+    return float(u[-1] * p_scale), q
+
+
+def two_parameter(family: WalkerFamily, sp: SpecialPoint, path2: str, p2_start: float,
+                  p2_values: np.ndarray, p_scale: float, unit: str = "-",
+                  unit2: str = "-") -> TwoParameterCurve:
+    """Continue the fold or period doubling ``sp`` (located at ``path2 = p2_start``) over
+    ``p2_values`` (both ways from ``p2_start``, secant predictor in ``p2``); stops where the
+    augmented system fails.
+
+    Returns
+    -------
+    TwoParameterCurve
+        Points sorted by ``p2``.
+    """
+    rows = [(p2_start, sp.p, sp.x, sp.point.z, complex(-1 if sp.kind != "fold" else 1))]
+    vals = np.asarray(p2_values, float)
+    for side in (vals[vals > p2_start], vals[vals < p2_start][::-1]):
+        hist = [(p2_start, sp.p, sp.point.z)]
+        for p2 in side:
+            fam = family.at(**{path2: float(p2)})
+            if len(hist) >= 2:
+                (a2, ap, az), (b2, bp, bz) = hist[-2], hist[-1]
+                lam = (p2 - b2) / (b2 - a2)
+                pg, zg = bp + lam * (bp - ap), bz + lam * (bz - az)
+            else:
+                pg, zg = hist[-1][1], hist[-1][2]
+            try:
+                p, q = special_point_at(fam, sp.kind, sp.period, pg, zg, p_scale)
+            except MapFailed:
+                break
+            mu = _critical_vector(q.M, 1.0 if sp.kind == "fold" else -1.0)[1]
+            rows.append((float(p2), p, q.x, q.z, mu))
+            hist.append((float(p2), p, q.z))
+    rows.sort(key=lambda r: r[0])
+    return TwoParameterCurve(sp.kind, sp.period, family.path, path2, unit, unit2,
+                             np.array([r[1] for r in rows]), np.array([r[0] for r in rows]),
+                             np.array([r[2] for r in rows]), np.array([r[4] for r in rows]))
+
+
+# ----------------------------------------------------------------------------- homotopy
+@dataclass
+class HomotopyResult:
+    """The known gait carried to the new walker.
+
+    Attributes
+    ----------
+    x : ndarray (2n,)     fixed point of the new walker (state just after heel strike)
+    fields : dict         the numeric fields that differ: path -> (known, new)
+    branch : Branch       the path in the homotopy parameter ``lambda`` in [0, 1]
+    specials : list of SpecialPoint   folds / period doublings / ends met on the way
+    reached : bool        ``lambda = 1`` reached
+    """
+
+    x: np.ndarray
+    fields: dict
+    branch: Branch
+    specials: list
+    reached: bool
+
+
+def numeric_fields(a: dict, b: dict, prefix: str = "") -> dict:
+    """Dotted paths of the numeric leaves that differ between two scene mappings (lists of
+    items matched by ``name``, else by index): ``path -> (a value, b value)``.
+
+    Raises
+    ------
+    ValueError
+        The two scenes differ in structure (a field or list item present in one only, or a
+        non-numeric value that differs), naming the first such field.
+    """
+    out: dict = {}
+    if isinstance(a, dict) and isinstance(b, dict):
+        for k in sorted(set(a) | set(b)):
+            if k in ("name", "source", "published", "fixedpoint", "simulate", "contact",
+                     "contact_sim", "contact_solver", "terrain", "workprecision", "report",
+                     "solver", "units", "stability_map", "basin", "animate") and not prefix:
+                continue
+            p = f"{prefix}{k}"
+            if k not in a or k not in b:
+                if a.get(k) is None and b.get(k) is None:
+                    continue
+                raise ValueError(f"{p}: given in one scene only")
+            out.update(numeric_fields(a[k], b[k], p + "."))
+        return out
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            raise ValueError(f"{prefix[:-1]}: {len(a)} items vs {len(b)}")
+        for i, (x, y) in enumerate(zip(a, b)):
+            key = x.get("name") if isinstance(x, dict) and x.get("name") else str(i)
+            out.update(numeric_fields(x, y, f"{prefix}{key}."))
+        return out
+    num = (int, float)
+    if isinstance(a, num) and isinstance(b, num) and not isinstance(a, bool) \
+            and not isinstance(b, bool):
+        if float(a) != float(b):
+            out[prefix[:-1]] = (float(a), float(b))
+        return out
+    if a != b:
+        raise ValueError(f"{prefix[:-1]}: {a!r} vs {b!r} (only numeric fields can be "
+                         "joined by a homotopy)")
+    return out
+
+
+def homotopy(known: dict, new: dict, x_known: np.ndarray, solver: Solver,
+             max_step_time: float = 5.0, ds: float = 0.05) -> HomotopyResult:
+    """Continue the known walker's gait along the straight line between the two scenes'
+    numeric fields, ``f(lambda) = (1 - lambda) f_known + lambda f_new``, to ``lambda = 1``.
+
+    Parameters
+    ----------
+    known, new : dict
+        Scene mappings (``model_dump(mode="json")``); same walker structure.
+    x_known : ndarray (2n,)
+        A fixed point (or a good guess) of the known walker.
+
+    Returns
+    -------
+    HomotopyResult
+
+    Raises
+    ------
+    ValueError
+        The scenes differ in structure (see :func:`numeric_fields`).
+    MapFailed
+        No fixed point at ``lambda = 0``.
+    """
+    fields = numeric_fields(known, new)
+    fam = _HomotopyFamily(known, fields, solver, max_step_time)
+    first = first_point(fam, 0.0, x_known, 1, 1.0)
+    br = continue_branch(fam, first, 1, (0.0, 1.0), 1.0, 1, ds=ds, ds_max=0.2)
+    last = br.points[-1]
+    reached = abs(last.p - 1.0) < 1e-12
+    return HomotopyResult(last.x, fields, br, br.specials, reached)
+
+
+class _HomotopyFamily(WalkerFamily):
+    """The walker at ``lambda`` on the straight line between two scenes."""
+
+    def __init__(self, base: dict, fields: dict, solver: Solver, max_step_time: float):
+        super().__init__(base, "homotopy.lambda", solver, max_step_time)
+        self.fields = fields
+
+    def walker(self, p: float) -> HybridWalker:
+        from walkerlab.config import SceneError
+        from walkerlab.models.registry import build_walker
+        from walkerlab.sweep.params import apply_point
+
+        key = float(p)
+        w = self._cache.get(key)
+        if w is None:
+            paths = list(self.fields)
+            vals = tuple((1 - key) * a + key * b for a, b in self.fields.values())
+            try:
+                scene = apply_point(self.base, paths, vals, "<homotopy>")
+            except SceneError as exc:
+                raise MapFailed("parameter leaves the scene's domain",
+                                str(exc).split("]: ", 1)[-1]) from None
+            w = build_walker(scene)
+            if len(self._cache) > 64:
+                self._cache.clear()
+            self._cache[key] = w
+        return w
+
