@@ -61,6 +61,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -71,7 +72,7 @@ from walkerlab.models.base import HybridWalker
 __all__ = ["WalkerFamily", "BranchPoint", "SpecialPoint", "Branch", "ContinuationResult",
            "MapFailed", "continue_branch", "continuation", "switch_period_doubling",
            "two_parameter", "TwoParameterCurve", "SPECIAL_KINDS", "fixed_point_at",
-           "homotopy", "HomotopyResult"]
+           "homotopy", "HomotopyResult", "step_map", "first_point", "special_point_at"]
 
 SPECIAL_KINDS = ("fold", "period_doubling", "neimark_sacker", "branch_end")
 
@@ -90,23 +91,24 @@ class MapFailed(RuntimeError):
 # ----------------------------------------------------------------------------- family
 @dataclass
 class WalkerFamily:
-    """The scene's walker as a function of one or two numeric scene fields.
+    """A walker as a function of one or more named numeric parameters.
 
     Attributes
     ----------
-    base : dict
-        The scene as a plain mapping (``Scene.model_dump(mode="json")``).
+    make : callable ``dict[str, float] -> HybridWalker``
+        Builds the walker for the parameter values (by name: the dotted scene fields,
+        :func:`walkerlab.sweep.continuation.scene_family`); raises :class:`MapFailed` when
+        the values leave the model's domain.
     path : str
-        Dotted scene field of the parameter (``slope.angle_deg``,
-        ``walker.leg.bodies.rod.mass_kg``, ...).
+        Name of the continuation parameter (``slope.angle_deg``, ...).
     solver : Solver
     max_step_time : float
         A step longer than this is a failure [s].
     fixed : dict
-        Other fields held at a value (the second parameter of a two-parameter run).
+        Other parameters held at a value (the second parameter of a two-parameter run).
     """
 
-    base: dict
+    make: Callable[[dict], HybridWalker]
     path: str
     solver: Solver
     max_step_time: float = 5.0
@@ -114,30 +116,24 @@ class WalkerFamily:
     _cache: dict = field(default_factory=dict, repr=False)
 
     def walker(self, p: float) -> HybridWalker:
-        """The walker at ``p`` (built once per value; raises ``MapFailed`` if the scene at
-        ``p`` does not validate)."""
-        from walkerlab.config import SceneError
-        from walkerlab.models.registry import build_walker
-        from walkerlab.sweep.params import apply_point
+        """The walker at ``p`` (built once per value).
 
+        Raises
+        ------
+        MapFailed
+            ``p`` leaves the model's domain.
+        """
         key = float(p)
         w = self._cache.get(key)
         if w is None:
-            paths = [self.path, *self.fixed]
-            try:
-                scene = apply_point(self.base, paths, (key, *self.fixed.values()),
-                                    "<continuation>")
-            except SceneError as exc:
-                raise MapFailed("parameter leaves the scene's domain",
-                                str(exc).split("]: ", 1)[-1]) from None
-            w = build_walker(scene)
+            w = self.make({self.path: key, **self.fixed})
             if len(self._cache) > 64:
                 self._cache.clear()
             self._cache[key] = w
         return w
 
     def at(self, **fixed) -> WalkerFamily:
-        """This family with more fields held fixed (by dotted path)."""
+        """This family with more parameters held fixed (by name)."""
         return dataclasses.replace(self, fixed={**self.fixed, **fixed}, _cache={})
 
 
@@ -711,17 +707,26 @@ def switch_period_doubling(family: WalkerFamily, sp: SpecialPoint, p_scale: floa
     """
     k2 = 2 * sp.period
     sys = _System(family, k2, p_scale)
+    base = _System(family, sp.period, p_scale)
     z0 = sp.point.z
-    v = np.real(sp.eigenvector)
-    v = v / np.linalg.norm(v)
     u_star = np.append(z0, sp.p / p_scale)
-    for sign in (1.0, -1.0):
-        row = np.append(sign * v, 0.0)
-        u, info = _correct(sys, u_star + np.append(sign * eps * v, 0.0), row,
-                           row @ u_star + eps)
-        if u is not None and float(np.max(np.abs(u[:-1] - z0))) > 0.1 * eps:
-            q = _point(sys, u, info, None)
-            return q
+    v = np.append(np.real(sp.eigenvector), 0.0)
+    t_old = sp.point.tangent
+    w = v - (v @ t_old) * t_old  # across the old branch (which is a 2k-step fixed point too)
+    w /= np.linalg.norm(w)
+    for e in (eps, eps / 4, eps / 16):
+        for sign in (1.0, -1.0):
+            row = sign * w
+            u, info = _correct(sys, u_star + sign * e * w, row, row @ u_star + e)
+            if u is None:
+                continue
+            # a genuine period-2k orbit: the k-step map moves it (else: the old branch)
+            try:
+                rk = base.residual(u[:-1], u[-1] * p_scale)
+            except MapFailed:
+                continue
+            if float(np.max(np.abs(rk))) > 0.1 * e:
+                return _point(sys, u, info, None)
     raise MapFailed(f"no period-{k2} branch found next to the period doubling at "
                     f"{sp.p:.6g}")
 
@@ -947,106 +952,31 @@ class HomotopyResult:
     reached: bool
 
 
-def numeric_fields(a: dict, b: dict, prefix: str = "") -> dict:
-    """Dotted paths of the numeric leaves that differ between two scene mappings (lists of
-    items matched by ``name``, else by index): ``path -> (a value, b value)``.
-
-    Raises
-    ------
-    ValueError
-        The two scenes differ in structure (a field or list item present in one only, or a
-        non-numeric value that differs), naming the first such field.
-    """
-    out: dict = {}
-    if isinstance(a, dict) and isinstance(b, dict):
-        for k in sorted(set(a) | set(b)):
-            if k in ("name", "source", "published", "fixedpoint", "simulate", "contact",
-                     "contact_sim", "contact_solver", "terrain", "workprecision", "report",
-                     "solver", "units", "stability_map", "basin", "animate") and not prefix:
-                continue
-            p = f"{prefix}{k}"
-            if k not in a or k not in b:
-                if a.get(k) is None and b.get(k) is None:
-                    continue
-                raise ValueError(f"{p}: given in one scene only")
-            out.update(numeric_fields(a[k], b[k], p + "."))
-        return out
-    if isinstance(a, list) and isinstance(b, list):
-        if len(a) != len(b):
-            raise ValueError(f"{prefix[:-1]}: {len(a)} items vs {len(b)}")
-        for i, (x, y) in enumerate(zip(a, b)):
-            key = x.get("name") if isinstance(x, dict) and x.get("name") else str(i)
-            out.update(numeric_fields(x, y, f"{prefix}{key}."))
-        return out
-    num = (int, float)
-    if isinstance(a, num) and isinstance(b, num) and not isinstance(a, bool) \
-            and not isinstance(b, bool):
-        if float(a) != float(b):
-            out[prefix[:-1]] = (float(a), float(b))
-        return out
-    if a != b:
-        raise ValueError(f"{prefix[:-1]}: {a!r} vs {b!r} (only numeric fields can be "
-                         "joined by a homotopy)")
-    return out
-
-
-def homotopy(known: dict, new: dict, x_known: np.ndarray, solver: Solver,
+def homotopy(make: Callable[[dict], HybridWalker], x_known: np.ndarray, solver: Solver,
              max_step_time: float = 5.0, ds: float = 0.05) -> HomotopyResult:
-    """Continue the known walker's gait along the straight line between the two scenes'
-    numeric fields, ``f(lambda) = (1 - lambda) f_known + lambda f_new``, to ``lambda = 1``.
+    """Continue the known walker's gait (``lambda = 0``) to the new walker (``lambda = 1``)
+    along a one-parameter family ``make({"lambda": value})`` (the straight line between two
+    scenes' numeric fields, :func:`walkerlab.sweep.continuation.homotopy_family`).
 
     Parameters
     ----------
-    known, new : dict
-        Scene mappings (``model_dump(mode="json")``); same walker structure.
+    make : callable ``{"lambda": float} -> HybridWalker``
     x_known : ndarray (2n,)
         A fixed point (or a good guess) of the known walker.
 
     Returns
     -------
     HomotopyResult
+        ``fields`` is empty here (the caller knows them).
 
     Raises
     ------
-    ValueError
-        The scenes differ in structure (see :func:`numeric_fields`).
     MapFailed
         No fixed point at ``lambda = 0``.
     """
-    fields = numeric_fields(known, new)
-    fam = _HomotopyFamily(known, fields, solver, max_step_time)
+    fam = WalkerFamily(make, "lambda", solver, max_step_time)
     first = first_point(fam, 0.0, x_known, 1, 1.0)
     br = continue_branch(fam, first, 1, (0.0, 1.0), 1.0, 1, ds=ds, ds_max=0.2)
     last = br.points[-1]
     reached = abs(last.p - 1.0) < 1e-12
-    return HomotopyResult(last.x, fields, br, br.specials, reached)
-
-
-class _HomotopyFamily(WalkerFamily):
-    """The walker at ``lambda`` on the straight line between two scenes."""
-
-    def __init__(self, base: dict, fields: dict, solver: Solver, max_step_time: float):
-        super().__init__(base, "homotopy.lambda", solver, max_step_time)
-        self.fields = fields
-
-    def walker(self, p: float) -> HybridWalker:
-        from walkerlab.config import SceneError
-        from walkerlab.models.registry import build_walker
-        from walkerlab.sweep.params import apply_point
-
-        key = float(p)
-        w = self._cache.get(key)
-        if w is None:
-            paths = list(self.fields)
-            vals = tuple((1 - key) * a + key * b for a, b in self.fields.values())
-            try:
-                scene = apply_point(self.base, paths, vals, "<homotopy>")
-            except SceneError as exc:
-                raise MapFailed("parameter leaves the scene's domain",
-                                str(exc).split("]: ", 1)[-1]) from None
-            w = build_walker(scene)
-            if len(self._cache) > 64:
-                self._cache.clear()
-            self._cache[key] = w
-        return w
-
+    return HomotopyResult(last.x, {}, br, br.specials, reached)
