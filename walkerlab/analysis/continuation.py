@@ -624,7 +624,10 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
             s_b = ds_cur
         if u is None:
             if ds_cur / 2 < ds_min:
-                specials.append(_end(sys, a, ds_cur, info, k))
+                end = _end(sys, a, ds_cur, info, k)
+                specials.append(end)
+                if end.point is not None and end.point is not a:
+                    pts.append(dataclasses.replace(end.point, tangent=a.tangent))
                 break
             ds_cur /= 2
             continue
@@ -640,6 +643,8 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
                         _locate_on_bound(sys, a, b, kind, k)
                     if sp is not None:
                         specials.append(sp)
+                        if sp.point is not None:  # the branch passes through it
+                            pts.append(dataclasses.replace(sp.point, tangent=a.tangent))
             if check_clearance and _clearance(sys, u, p_scale) < 0 <= _clearance(
                     sys, ua, p_scale):
                 sp = (_locate(sys, a, s_b, "scuff", u, k) if at_bound is None else None)
