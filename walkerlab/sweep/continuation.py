@@ -74,7 +74,7 @@ def scene_value(scene: Scene, path: str) -> float:
 
 def run_continuation(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
                      path2: str | None = None, range2: tuple | None = None,
-                     n2: int = 25) -> tuple[ContinuationResult, list]:
+                     n2: int = 25, ds_max: float = 0.1) -> tuple[ContinuationResult, list]:
     """Continue the scene's gait over ``path`` in ``[start, stop]``.
 
     Parameters
@@ -91,6 +91,8 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
     path2, range2, n2
         Second field, its range and number of values: each fold and period doubling of the
         period-1 branch is continued in the plane (``path``, ``path2``).
+    ds_max : float
+        Largest arclength step (scaled: the range's span is 1).
 
     Returns
     -------
@@ -116,7 +118,8 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
         _w, gait, _src = ideal_fixed_point(at, None)
     except _Outcome as exc:
         raise MapFailed("no gait at the scene's own value", exc.message) from None
-    res = continuation(fam, min(max(p0, lo), hi), gait.x, (lo, hi), unit, switch=switch)
+    res = continuation(fam, min(max(p0, lo), hi), gait.x, (lo, hi), unit, switch=switch,
+                       ds=min(0.02, ds_max), ds_max=ds_max)
     curves = []
     if path2 is not None:
         unit2 = axis_unit(scene, ParamAxis(path2, (), path2))

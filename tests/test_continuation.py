@@ -1,0 +1,207 @@
+"""Pseudo-arclength continuation of gaits (issue 23): special points against independent
+computations.
+
+The independent checks share no code with :mod:`walkerlab.analysis.continuation`: fixed
+points by :func:`scipy.optimize.root` on the (k-step) Poincaré map with MINPACK's own
+finite-difference Jacobian, multipliers from a central finite-difference Jacobian of the
+map (not the variational equations), and the onset by :func:`scipy.optimize.brentq` in the
+parameter on ``1 + (most negative real multiplier)``.  Finite-difference multipliers carry
+~1e-7 of error (NOTES.md: ~9 digits for the map's Jacobian at h = 1e-7 ... 1e-5), which moves
+an onset by ~1e-7 / |d mu / d p|, far inside the 1e-4 asked.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq, root
+
+from walkerlab.analysis.continuation import SPECIAL_KINDS
+from walkerlab.analysis.hybrid import Solver
+from walkerlab.analysis.poincare import poincare_map
+from walkerlab.config import load_scene
+from walkerlab.models.registry import build_walker
+from walkerlab.sweep.continuation import run_continuation
+from walkerlab.sweep.params import apply_point
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _walker(scene, path, p):
+    return build_walker(apply_point(scene.model_dump(mode="json"), [path], (p,)))
+
+
+def _kmap(walker, x, solver, k, tmax):
+    for _ in range(k):
+        x, _T, _n = poincare_map(walker, x, solver, tmax)
+    return x
+
+
+def _independent_orbit(scene, path, p, guess, k):
+    """Fixed point of the k-step map (scipy root, MINPACK finite differences) and the
+    multipliers of a central finite-difference Jacobian of the map there."""
+    w = _walker(scene, path, p)
+    s = Solver.from_settings(scene.solver)
+    tmax = scene.fixedpoint.max_step_time_s
+    sol = root(lambda z: w.section(_kmap(w, w.from_section(z), s, k, tmax)) - z,
+               w.section(guess), method="hybr", options={"xtol": 1e-13})
+    x = w.from_section(sol.x)
+    assert np.max(np.abs(_kmap(w, x, s, k, tmax) - x)) < 1e-10
+    n, h = x.size, 1e-6
+    J = np.empty((n, n))
+    for j in range(n):
+        e = np.zeros(n)
+        e[j] = h
+        J[:, j] = (_kmap(w, x + e, s, k, tmax) - _kmap(w, x - e, s, k, tmax)) / (2 * h)
+    return x, np.linalg.eigvals(J)
+
+
+def _independent_onset(scene, path, lo, hi, guess, k):
+    """brentq on 1 + min real multiplier of the independent k-step orbit, in ``p``."""
+    state = {"x": guess}
+
+    def g(p):
+        x, mu = _independent_orbit(scene, path, p, state["x"], k)
+        state["x"] = x
+        real = mu[np.abs(mu.imag) < 1e-6].real
+        return 1.0 + real.min()
+
+    return brentq(g, lo, hi, xtol=1e-9)
+
+
+def _special(res, kind, period):
+    return [s for s in res.specials if s.kind == kind and s.period == period]
+
+
+@pytest.fixture(scope="module")
+def paper():
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    res, _ = run_continuation(scene, "slope.angle_deg", 3.8, 4.97, switch=1)
+    return scene, res
+
+
+@pytest.fixture(scope="module")
+def simplest():
+    scene = load_scene(ROOT / "configs" / "simplest.yaml")
+    res, _ = run_continuation(scene, "slope.angle_rad", 0.012, 0.0179, switch=1)
+    return scene, res
+
+
+@pytest.mark.slow
+def test_paper_period_doubling_onsets_match_independent_brentq(paper):
+    """Period 1 -> 2 (Goswami et al. 1996: 4.37 deg; this project's sweep 4.391 deg) and
+    period 2 -> 4, each to 1e-4 deg of the independent computation."""
+    scene, res = paper
+    (pd1,), (pd2,) = _special(res, "period_doubling", 1), _special(res, "period_doubling", 2)
+    assert abs(pd1.p - 4.391) < 2e-3  # the project's brute-force sweep (0.05 deg grid)
+    ref1 = _independent_onset(scene, "slope.angle_deg", pd1.p - 0.05, pd1.p + 0.05, pd1.x, 1)
+    assert abs(pd1.p - ref1) < 1e-4, (pd1.p, ref1)
+    ref2 = _independent_onset(scene, "slope.angle_deg", pd2.p - 0.01, pd2.p + 0.01, pd2.x, 2)
+    assert abs(pd2.p - ref2) < 1e-4, (pd2.p, ref2)
+    # the multiplier at the located points is -1 (variational equations)
+    for sp in (pd1, pd2):
+        real = sp.multipliers[np.abs(sp.multipliers.imag) < 1e-9].real
+        assert abs(real.min() + 1.0) < 1e-6
+
+
+@pytest.mark.slow
+def test_simplest_period_doubling_onsets_match_garcia_and_independent(simplest):
+    """Garcia et al. 1998 (J. Biomech. Eng. 120:281): period doubling at gamma ~ 0.0151
+    (the scene is nondimensional, slope in rad); period 4 from the period-2 branch."""
+    scene, res = simplest
+    (pd1,), (pd2,) = _special(res, "period_doubling", 1), _special(res, "period_doubling", 2)
+    assert abs(pd1.p - 0.0151) < 1e-4
+    ref1 = _independent_onset(scene, "slope.angle_rad", pd1.p - 5e-4, pd1.p + 5e-4, pd1.x, 1)
+    assert abs(pd1.p - ref1) < 1e-4 * 1e-2, (pd1.p, ref1)  # rad: far inside 1e-4
+    ref2 = _independent_onset(scene, "slope.angle_rad", pd2.p - 3e-4, pd2.p + 3e-4, pd2.x, 2)
+    assert abs(pd2.p - ref2) < 1e-6, (pd2.p, ref2)
+    assert 0.0151 < pd2.p < 0.019  # after period 2, before Garcia's chaos (~0.019)
+
+
+@pytest.mark.slow
+def test_branches_agree_with_independent_fixed_points():
+    """At >= 20 points along the period-1 and along the period-2 branch the continuation's
+    state equals an independent fixed-point solve (k-step map) at the same parameter to
+    1e-9 (both solved to ~1e-12)."""
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    res, _ = run_continuation(scene, "slope.angle_deg", 4.0, 4.8, switch=1, ds_max=0.04)
+    assert [b.period for b in res.branches] == [1, 2]
+    for br in res.branches:
+        assert len(br.points) >= 20, len(br.points)
+        worst = 0.0
+        for q in br.points:
+            x, _mu = _independent_orbit(scene, "slope.angle_deg", q.p, q.x, br.period)
+            worst = max(worst, float(np.max(np.abs(x - q.x))))
+        assert worst < 1e-9, (br.period, worst)
+
+
+@pytest.mark.slow
+def test_kneed_gait_ends_in_a_fold_where_a_scan_loses_it():
+    """Moving the kneed walker's thigh mass towards the hip the gait ends (issue 23: a sweep
+    reported ``no_fixed_point`` near 0.268 m): a fold, multiplier +1 to 1e-6; a natural-
+    parameter scan with the root finder (independent of the continuation) finds gaits above
+    the fold and none 2 mm below it."""
+    from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
+
+    scene = load_scene(ROOT / "configs" / "kneed.yaml")
+    path = "walker.leg.bodies.thigh_mass.from_hip_m"
+    res, _ = run_continuation(scene, path, 0.255, 0.31)
+    folds = _special(res, "fold", 1)
+    assert len(folds) == 1
+    f = folds[0]
+    assert 0.26 < f.p < 0.27
+    mu = f.multipliers
+    assert np.min(np.abs(mu - 1.0)) < 1e-6
+    s = Solver.from_settings(scene.solver)
+    x = f.x
+    for p in (f.p + 3e-3, f.p + 1e-3, f.p + 2e-4):  # towards the fold from above: found
+        x = find_fixed_point(_walker(scene, path, p), x, s, fd_check=False).x
+    with pytest.raises(FixedPointNotFound):
+        find_fixed_point(_walker(scene, path, f.p - 2e-3), x, s, fd_check=False)
+
+
+def test_paper_rods_bifurcation_chain_keeps_the_stable_long_gait():
+    """Issue 23's defect: ``bifurcation --param walker.leg.bodies.rod.mass_kg=3:7:0.5``
+    reported the unstable short-period gait at 3 kg (T 0.8227 s, |mu| 3.23).  The chains
+    start at the scene's value (5 kg) and follow the branch by pseudo-arclength: at 3 kg the
+    stable long gait (T 1.0223 s, |mu| 0.778, as ``fixedpoint`` and ``sweep`` there)."""
+    from walkerlab.sweep.bifurcation import bifurcation_diagram
+
+    scene = load_scene(ROOT / "configs" / "paper_rods.yaml")
+    r = bifurcation_diagram(scene, np.arange(3.0, 7.01, 0.5), steady_state=False, workers=1,
+                            param="walker.leg.bodies.rod.mass_kg")
+    assert abs(r.step_period_s[0] - 1.0223) < 1e-4
+    assert abs(np.max(np.abs(r.multipliers[0])) - 0.778) < 1e-3
+    assert np.all(np.max(np.abs(r.multipliers), axis=1) < 1)
+
+
+@pytest.mark.slow
+def test_artifact_round_trip_and_cli(tmp_path):
+    """The CLI writes continuation_<field>.h5 (kinds as strings, the parameter in its unit,
+    the branch period) and its figure; the loader reads back the located points."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.continuation import load_continuation
+
+    r = CliRunner().invoke(app, ["continuation", str(ROOT / "configs" / "paper_rods.yaml"),
+                                 "--param", "walker.leg.bodies.rod.mass_kg=2.5:3.0",
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert "period_doubling" in r.output
+    path = tmp_path / "paper_rods" / "continuation_walker.leg.bodies.rod.mass_kg.h5"
+    data = load_continuation(path)
+    assert data.unit == "kg" and set(data.special["kind"]) <= set(SPECIAL_KINDS)
+    (i,) = np.flatnonzero(data.special["kind"] == "period_doubling")
+    assert 2.6 < data.special["param"][i] < 2.8 and data.special["period"][i] == 1
+    b = data.branches[0]
+    assert b["period"] == 1 and b["multipliers"].shape[1] == 4
+    assert b["stable"][np.argmax(b["param"])] and not b["stable"][np.argmin(b["param"])]
+    assert (tmp_path / "paper_rods" / "report" / "figures"
+            / "continuation_walker.leg.bodies.rod.mass_kg.png").is_file()
+    bad = CliRunner().invoke(app, ["continuation", str(ROOT / "configs" / "paper.yaml"),
+                                   "--param", "slope.angle_deg=1:1", "--runs-dir",
+                                   str(tmp_path)])
+    assert bad.exit_code == 1 and "FIELD=START:STOP" in bad.output
