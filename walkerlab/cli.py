@@ -234,13 +234,17 @@ def _status(o) -> str:
 @app.command()
 @_guard
 def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-               force: bool = ForceOpt) -> None:
+               force: bool = ForceOpt,
+               known: Path | None = typer.Option(None, "--from", help="a scene whose gait is "
+                                                 "known: continue it along the straight line "
+                                                 "between the two scenes' numeric fields to "
+                                                 "this walker (homotopy)")) -> None:
     """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
     from walkerlab.report.text import fixedpoint_text
     from walkerlab.stages import fixedpoint as stage
 
     sc = _load(scene)
-    out = stage.run(sc, runs_dir, force)
+    out = stage.run(sc, runs_dir, force, known=known)
     typer.echo(fixedpoint_text(out.path))
     typer.echo(_status(out))
 

@@ -360,13 +360,64 @@ class StateSpec(_Strict):
         return np.array([float(given[k]) for k in keys])
 
 
+class GuessFromArtifact(_Strict):
+    """A starting state read from a continuation artifact (issue 23): the state of a branch
+    at a parameter value, instead of digits copied by hand."""
+
+    model_config = ConfigDict(populate_by_name=True)
+
+    from_: str = Field(alias="from", min_length=1, description="continuation artifact "
+                       "(runs/<scene>/continuation_<field>.h5), relative to the current "
+                       "folder")
+    at: float = Field(description="value of the artifact's parameter on the branch [the "
+                      "artifact's field unit]")
+    branch: int = Field(0, ge=0, le=1000, description="branch index in the artifact (0: the "
+                        "period-1 branch through the scene's own gait)")
+
+    def as_array(self, state_names: list[str] | None = None):
+        """State (2n,) of the branch at ``at`` (linear interpolation between its two nearest
+        points), in the order of ``state_names``.
+
+        Raises
+        ------
+        ValueError
+            Artifact missing or damaged, ``at`` off the branch, or other state names.
+        """
+        import numpy as np
+
+        from walkerlab.io.artifacts import ArtifactError
+        from walkerlab.io.schemas.continuation import load_continuation
+
+        try:
+            data = load_continuation(Path(self.from_))
+        except ArtifactError as exc:
+            raise ValueError(str(exc)) from None
+        if self.branch >= len(data.branches):
+            raise ValueError(f"branch {self.branch}: {self.from_} has "
+                             f"{len(data.branches)} branches")
+        x = data.state_at(self.at, self.branch)
+        names = state_names or data.state_names
+        if sorted(names) != sorted(data.state_names):
+            raise ValueError(f"{self.from_} holds states {data.state_names}, the walker has "
+                             f"{list(names)}")
+        return np.array([x[data.state_names.index(n)] for n in names])
+
+
 class FixedPointSettings(_Strict):
     """Search for the period-1 fixed point of the Poincaré map (paper Sec. 3.3)."""
 
-    initial_guess: StateSpec | None = Field(
-        None, description="starting point of the root finder; null: found automatically "
+    model_config = ConfigDict(populate_by_name=True)
+
+    initial_guess: StateSpec | GuessFromArtifact | None = Field(
+        None, description="starting point of the root finder, by state name or "
+        "{from: <continuation artifact>, at: <parameter value>}; null: found automatically "
         "(scale-free seeds from the slope and the walker's size, ranked on the heel-strike "
         "section; walkerlab.analysis.gaits)")
+    from_: str | None = Field(
+        None, alias="from", description="a scene YAML whose gait is known: its gait is "
+        "continued along the straight line between the two scenes' numeric walker and slope "
+        "fields to this walker (homotopy), and used as the initial guess; relative to this "
+        "scene's folder")
     gait: Literal["stable", "long_period", "short_period", "nearest_guess"] = Field(
         "stable", description="which period-1 gait to use where two exist (Goswami et al. "
         "1996, Garcia et al. 1998: long- and short-period pair): 'stable' (the stable one; "

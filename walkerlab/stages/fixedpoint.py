@@ -47,8 +47,62 @@ def _with_variant(scene: Scene, variant: str) -> Scene:
     return scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
 
 
-def solve_scene(scene: Scene, fd_check: bool = True):
-    """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``.
+def known_scene(scene: Scene, known: Scene | Path | str | None = None) -> Scene | None:
+    """The scene of a known gait to start a homotopy from: ``known`` (``--from``), else the
+    scene's ``fixedpoint.from`` (relative to the scene's folder), else None.
+
+    Raises
+    ------
+    StageError
+        The file does not load (one line).
+    """
+    from walkerlab.config import SceneError, load_scene
+
+    fp = require(scene, "fixedpoint", "fixedpoint")
+    if known is None and fp.from_ is None:
+        return None
+    if isinstance(known, Scene):
+        return known
+    path = Path(known if known is not None else fp.from_)
+    if known is None and not path.is_absolute() and scene.origin is not None:
+        path = scene.origin.parent / path
+    try:
+        return load_scene(path)
+    except SceneError as exc:
+        raise StageError(f"fixedpoint.from: {exc}") from None
+
+
+def homotopy_guess(scene: Scene, known: Scene):
+    """The known scene's gait carried to this walker (a guess for the root finder) and the
+    homotopy's result (:func:`walkerlab.sweep.continuation.homotopy_gait`).
+
+    Raises
+    ------
+    StageError
+        The walkers differ in structure, the known scene has no gait, or the path does not
+        reach this walker (the special point where it ends named).
+    """
+    from walkerlab.analysis.continuation import MapFailed
+    from walkerlab.sweep.continuation import homotopy_gait
+
+    try:
+        res = homotopy_gait(known, scene)
+    except (ValueError, MapFailed) as exc:
+        raise StageError(f"fixedpoint.from {known.name}: {exc}") from None
+    if not res.reached:
+        lam = res.branch.points[-1].p
+        why = "; ".join(f"{s.kind} at lambda {s.p:.4g}" + (f" ({s.cause})" if s.cause else "")
+                        for s in res.specials) or "the branch left [0, 1]"
+        raise StageError(f"fixedpoint.from {known.name}: the known gait does not reach this "
+                         f"walker along the straight line (stopped at lambda = {lam:.4g}: "
+                         f"{why})")
+    return res.x, res
+
+
+def solve_scene(scene: Scene, fd_check: bool = True, known: Scene | Path | str | None = None):
+    """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``; with a
+    known scene (``known`` or ``fixedpoint.from``), started from its gait carried here by
+    homotopy.
 
     Returns
     -------
@@ -64,8 +118,10 @@ def solve_scene(scene: Scene, fd_check: bool = True):
     """
     fp = require(scene, "fixedpoint", "fixedpoint")
     walker = build_walker(scene)
+    src = known_scene(scene, known)
+    guess = homotopy_guess(scene, src)[0] if src is not None else _guess(scene, walker)
     try:
-        search = find_gaits(walker, Solver.from_settings(scene.solver), _guess(scene, walker),
+        search = find_gaits(walker, Solver.from_settings(scene.solver), guess,
                             policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
                             fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
                             fd_check=fd_check)
@@ -118,7 +174,8 @@ def _write_result(g, walker, res, guess) -> None:
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        compare_variants: bool = True) -> StageOutcome:
+        compare_variants: bool = True, known: Scene | Path | str | None = None
+        ) -> StageOutcome:
     """Find the fixed point of the scene's equation variant.
 
     With ``compare_variants`` (the default) the other equation variants (printed Appendix A,
@@ -133,10 +190,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         No ``fixedpoint`` section, or no fixed point for the scene's own variant.
     """
     require(scene, "fixedpoint", "fixedpoint")
+    src = known_scene(scene, known)
+    from_key = "" if src is None else "from:" + json.dumps(src.model_dump(mode="json"),
+                                                          sort_keys=True)
 
     def compute():
         try:
-            walker, search = solve_scene(scene)
+            walker, search = solve_scene(scene, known=src)
         except GaitNotFound as exc:
             raise StageError(f"fixedpoint: {exc}") from None
         main = search.result
@@ -183,5 +243,5 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         return writer, summary
 
     return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force,
-                      extra_key="variants" if compare_variants else "",
-                      also_accept=() if compare_variants else ("variants",))
+                      extra_key=("variants" if compare_variants else "") + from_key,
+                      also_accept=() if compare_variants else ("variants" + from_key,))
