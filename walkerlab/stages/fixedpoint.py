@@ -119,7 +119,8 @@ def solve_scene(scene: Scene, fd_check: bool = True, known: Scene | Path | str |
     fp = require(scene, "fixedpoint", "fixedpoint")
     walker = build_walker(scene)
     src = known_scene(scene, known)
-    guess = homotopy_guess(scene, src)[0] if src is not None else _guess(scene, walker)
+    hom = homotopy_guess(scene, src) if src is not None else None
+    guess = hom[0] if hom is not None else _guess(scene, walker)
     try:
         search = find_gaits(walker, Solver.from_settings(scene.solver), guess,
                             policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
@@ -127,6 +128,13 @@ def solve_scene(scene: Scene, fd_check: bool = True, known: Scene | Path | str |
                             fd_check=fd_check)
     except ValueError as exc:
         raise StageError(str(exc)) from None
+    if hom is not None:
+        res = hom[1]
+        on_way = ", ".join(f"{s.kind.replace('_', ' ')} at lambda {s.p:.4g}"
+                           for s in res.specials) or "no special point"
+        search.notes.append(f"initial guess carried from scene {src.name} by homotopy over "
+                            f"{', '.join(res.fields)} ({len(res.branch.points)} continuation "
+                            f"points; {on_way} on the way)")
     return walker, search
 
 
