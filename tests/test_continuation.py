@@ -205,3 +205,72 @@ def test_artifact_round_trip_and_cli(tmp_path):
                                    "--param", "slope.angle_deg=1:1", "--runs-dir",
                                    str(tmp_path)])
     assert bad.exit_code == 1 and "FIELD=START:STOP" in bad.output
+
+
+@pytest.mark.slow
+def test_two_parameter_period_doubling_curve_matches_independent_onsets():
+    """The paper walker's period-doubling boundary in the plane slope x hip mass (Goswami
+    et al.'s chart over mu = m_H / m, m = 5 kg): the curve's point at m_H = 20 kg equals an
+    independent brentq onset there to 1e-4 deg; the onset falls as the hip gets heavier
+    (Goswami, Thuilot & Espiau 1998, Fig. 10: the period-doubling slope decreases with mu)."""
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    _res, curves = run_continuation(scene, "slope.angle_deg", 4.2, 4.6, 0,
+                                    "walker.hip_mass_kg", (10.0, 20.0), n2=3)
+    (c,) = curves
+    assert c.kind == "period_doubling" and list(c.p2) == [10.0, 15.0, 20.0]
+    assert np.all(np.diff(c.p) < 0)
+    assert np.all(np.abs(c.multiplier + 1.0) < 1e-6)
+    heavy = apply_point(scene.model_dump(mode="json"), ["walker.hip_mass_kg"], (20.0,))
+    ref = _independent_onset(heavy, "slope.angle_deg", c.p[-1] - 0.05, c.p[-1] + 0.05,
+                             c.x[-1], 1)
+    assert abs(c.p[-1] - ref) < 1e-4, (c.p[-1], ref)
+
+
+@pytest.mark.slow
+def test_homotopy_and_initial_guess_from_an_artifact(tmp_path):
+    """``fixedpoint --from`` carries the kneed gait to a steeper, heavier-hipped design (both
+    fields change at once) and reports the period doubling passed on the way; an
+    ``initial_guess`` naming a continuation artifact and a parameter value starts the root
+    finder on that branch: it converges to the continuation's own fixed point there."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = yaml.safe_load((ROOT / "configs" / "kneed.yaml").read_text())
+    d["slope"]["angle_rad"], d["walker"]["hip_mass_kg"] = 0.12, 1.0
+    del d["fixedpoint"]["initial_guess"]
+    new = tmp_path / "kneed_steep.yaml"
+    new.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["fixedpoint", str(new), "--from",
+                                 str(ROOT / "configs" / "kneed.yaml"), "--runs-dir",
+                                 str(tmp_path / "runs")])
+    assert r.exit_code == 0, r.output
+    assert "by homotopy over slope.angle_rad, walker.hip_mass_kg" in r.output
+    assert "period doubling at lambda" in r.output
+    assert "step period     0.65393" in r.output  # the gait the seeds find too
+    # a design whose straight line leaves the gait: one line naming where and why
+    d["slope"]["angle_rad"], d["walker"]["hip_mass_kg"] = 0.02, 0.5
+    far = tmp_path / "kneed_shallow.yaml"
+    far.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["fixedpoint", str(far), "--from",
+                                 str(ROOT / "configs" / "kneed.yaml"), "--runs-dir",
+                                 str(tmp_path / "runs")])
+    assert r.exit_code == 1 and "fold at lambda" in r.output
+    # initial_guess from a continuation artifact
+    scene = load_scene(ROOT / "configs" / "paper_rods.yaml")
+    from walkerlab.stages import continuation as stage
+
+    out = stage.run(scene, "walker.leg.bodies.rod.mass_kg", 3.0, 5.0, runs_root=tmp_path)
+    data = out.summary["data"]
+    rod = scene.model_dump(mode="json")
+    rod["fixedpoint"]["initial_guess"] = {"from": str(out.path), "at": 3.5}
+    rod["walker"]["leg"]["bodies"][0]["mass_kg"] = 3.5
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages.fixedpoint import solve_scene
+
+    _w, search = solve_scene(scene_from_dict(rod), fd_check=False)
+    ref = _independent_orbit(scene_from_dict(rod), "walker.leg.bodies.rod.mass_kg", 3.5,
+                             data.state_at(3.5), 1)[0]
+    assert np.max(np.abs(search.result.x - ref)) < 1e-9
+    assert search.gait.source == "initial_guess"

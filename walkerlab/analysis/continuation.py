@@ -247,13 +247,14 @@ class _System:
         """Everything at ``(z, p)``: state, period, ``D(P^k)``, ``F_z``, reduced ``M``."""
         w = self.family.walker(p)
         x = _from_section(w, z)
-        xk, T, J = step_map(w, x, self.family.solver, self.k, jacobian=True,
-                            max_step_time=self.family.max_step_time)
+        xk, T, J, segs = step_map(w, x, self.family.solver, self.k, jacobian=True,
+                                  max_step_time=self.family.max_step_time, segments=True)
         self.n_variational += self.k
         D_from = numeric_jacobian(w.from_section, np.asarray(z, float))
         D_sec = numeric_jacobian(w.section, np.asarray(xk, float))
         M = D_sec @ J @ D_from
         return {"x": x, "period": T, "J": J, "M": M, "Fz": M - np.eye(z.size),
+                "orbit": np.array([sg.x_start for sg in segs]),
                 "F": np.asarray(w.section(xk), float) - z, "walker": w}
 
 
@@ -284,6 +285,7 @@ class BranchPoint:
     tests : dict       test-function values
     tangent : ndarray (m + 1,)   unit tangent in scaled ``(z, p / p_scale)``
     residual : float   ``max |F|``
+    orbit : ndarray (k, 2n)   the states just after each of the orbit's ``k`` heel strikes
     """
 
     p: float
@@ -295,6 +297,7 @@ class BranchPoint:
     tangent: np.ndarray
     residual: float
     M: np.ndarray = field(repr=False, default=None)
+    orbit: np.ndarray = field(repr=False, default=None)
 
     @property
     def stable(self) -> bool:
@@ -451,7 +454,7 @@ def _point(sys: _System, u: np.ndarray, info: dict, t_prev: np.ndarray | None) -
                        period_s=float(info["period"]),
                        multipliers=sort_multipliers(np.linalg.eigvals(info["J"])),
                        tests=tests, tangent=t, residual=float(np.max(np.abs(info["F"]))),
-                       M=info["M"])
+                       M=info["M"], orbit=info["orbit"])
 
 
 def _u(q: BranchPoint, s: float) -> np.ndarray:

@@ -1,8 +1,8 @@
 """Figures of a continuation artifact (:mod:`walkerlab.io.schemas.continuation`), drawn from
 the loaded data only.
 
-- :func:`continuation_figure`: the branches (stance-leg angle just after heel strike, one
-  heel strike of each period-``k`` orbit) against the parameter, stable solid, unstable
+- :func:`continuation_figure`: the branches (stance-leg angle just after each of the ``k``
+  heel strikes of a period-``k`` orbit) against the parameter, stable solid, unstable
   dashed, period 1/2/4 in colours; special points marked and labelled; a branch of one
   point drawn as a marker; the steady states of a brute-force ``bifurcation`` artifact over
   the same field overlaid as dots; below, the largest |Floquet multiplier| of each branch.
@@ -73,7 +73,9 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
     seen = set()
     for b in data.branches:
         k, p = b["period"], np.asarray(b["param"], float)
-        y, ylabel = _y(data, b["states"])
+        ys, ylabel = _y(data, b.get("orbit", b["states"]))
+        ys = ys.reshape(p.size, -1)
+        y = ys[:, 0]
         mmax = np.max(np.abs(b["multipliers"]), axis=1)
         c = PERIOD_COLORS.get(k, "tab:gray")
         for i, j, st in _runs(np.asarray(b["stable"], bool)):
@@ -85,8 +87,10 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
             if p.size == 1:
                 ax1.plot(p, y, "o", color=c, mfc=c if st else "w", label=lab)
                 ax2.plot(p, mmax, "o", color=c, mfc=c if st else "w")
-            else:
-                ax1.plot(p[sl], y[sl], ls, color=c, lw=1.4, label=lab, zorder=3)
+            else:  # every heel strike of the period-k orbit: k curves
+                for h in range(ys.shape[1]):
+                    ax1.plot(p[sl], ys[sl, h], ls, color=c, lw=1.4,
+                             label=lab if h == 0 else None, zorder=3)
                 ax2.plot(p[sl], mmax[sl], ls, color=c, lw=1.2, zorder=3)
     sp = data.special
     for i, kind in enumerate(sp.get("kind", [])):
@@ -106,7 +110,7 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
                          ha="right" if i % 2 else "left")
         ax2.axvline(pv, color=col, lw=0.5, ls=":")
     ax1.margins(x=0.04, y=0.12)
-    ax1.axvline(data.start, color="0.5", lw=0.6, ls="-.", label="the scene's own value")
+    ax1.axvline(data.start, color="0.5", lw=0.6, ls="-.", label="start (the scene's gait)")
     ax1.set_ylabel(ylabel if data.branches else "")
     ax2.axhline(1.0, color="0.5", lw=0.8)
     ax2.set_ylabel("max |Floquet multiplier| [-]")

@@ -7,7 +7,8 @@ Layout
   ``parameter_start`` (the scene's own value, where the continuation started);
 - ``branches/<i>/`` for each branch ``i`` (attribute ``branch_period``: 1, 2, 4 steps):
   ``param`` [field unit] (points,), ``state/<name>`` [rad or rad/s] (points,) just after
-  heel strike, ``period`` [s] (duration of the branch's ``k`` steps), ``multipliers/real``
+  heel strike, ``orbit/<name>`` (points, k) after each of the orbit's heel strikes,
+  ``period`` [s] (duration of the branch's ``k`` steps), ``multipliers/real``
   and ``multipliers/imag`` (points, 2n) of ``D(P^k)``, ``stable`` (points,) 0/1;
 - ``special_points/``: ``kind`` (strings ``fold``, ``period_doubling``,
   ``neimark_sacker``, ``branch_end``), ``param`` [field unit], ``period`` (1, 2, 4: the
@@ -58,6 +59,10 @@ def continuation_writer(res, curves=()):
             g.attrs["branch_period"] = int(br.period)
             put(g, "param", br.params(), res.unit, f"{res.path} along the branch")
             states(g, [q.x for q in br.points], f"period-{br.period} fixed point")
+            orb = np.array([q.orbit for q in br.points], float)  # (points, k, 2n)
+            for k, (n, u) in enumerate(zip(names, units)):
+                put(g, f"orbit/{n}", orb[:, :, k], u, f"{n} just after each of the "
+                    f"orbit's {br.period} heel strikes (points, heel strike)")
             put(g, "period", [q.period_s for q in br.points], "s",
                 f"duration of the {br.period} step(s) of the gait")
             mults(g, [q.multipliers for q in br.points], f"the {br.period}-step map")
@@ -97,7 +102,7 @@ class ContinuationData:
     """A loaded continuation artifact (see the module docstring for the meaning).
 
     ``branches``: list of dicts with ``period`` (int), ``param`` (N,), ``states`` (name ->
-    (N,)), ``step_period`` (N,) [s], ``multipliers`` (N, 2n) complex, ``stable`` (N,) bool.
+    (N,)), ``orbit`` (name -> (N, k)), ``step_period`` (N,) [s], ``multipliers`` (N, 2n) complex, ``stable`` (N,) bool.
     ``special``: dict of arrays ``kind``, ``param``, ``period``, ``branch``, ``cause``,
     ``states`` (name -> (S,)), ``multipliers`` (S, 2n).  ``curves``: list of dicts ``kind``,
     ``period``, ``param``, ``param2``, ``path2``, ``unit2``, ``multiplier``.
@@ -167,6 +172,7 @@ def load_continuation(path: Path) -> ContinuationData:
             out.branches.append({
                 "period": int(g.attrs["branch_period"]), "param": g["param"][()],
                 "states": {n: g[f"state/{n}"][()] for n in names},
+                "orbit": {n: g[f"orbit/{n}"][()] for n in names},
                 "step_period": g["period"][()], "multipliers": mult(g),
                 "stable": g["stable"][()].astype(bool)})
         g = f["special_points"]
