@@ -795,6 +795,7 @@ def continuation(family: WalkerFamily, p0: float, x0: np.ndarray, p_range: tuple
             away = np.append(sp.point.z, sp.p / scale)
             br = continue_branch(family, q, 2 * sp.period, (lo, hi), scale, 1,
                                  away_from=away, **kw)
+            br.points.insert(0, _doubled(sp.point))  # the branch starts at the bifurcation
             branches.append(br)
             nxt += [(len(branches) - 1, s) for s in br.specials
                     if s.kind == "period_doubling"]
@@ -809,6 +810,15 @@ def continuation(family: WalkerFamily, p0: float, x0: np.ndarray, p_range: tuple
         state_units=w.state_units(), branches=branches, specials=specials, start=p0,
         wall_time_s=time.perf_counter() - t0, maps=stats.get("maps", 0),
         variational_maps=stats.get("variational_maps", 0))
+
+
+def _doubled(q: BranchPoint) -> BranchPoint:
+    """A period-k point seen as a period-2k orbit: the orbit twice, multipliers squared."""
+    from walkerlab.analysis.poincare import sort_multipliers
+
+    return dataclasses.replace(q, period_s=2 * q.period_s,
+                               multipliers=sort_multipliers(q.multipliers ** 2),
+                               orbit=np.concatenate([q.orbit, q.orbit]))
 
 
 def _join(down: Branch, up: Branch) -> Branch:

@@ -113,6 +113,9 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
     ax1.axvline(data.start, color="0.5", lw=0.6, ls="-.", label="start (the scene's gait)")
     ax1.set_ylabel(ylabel if data.branches else "")
     ax2.axhline(1.0, color="0.5", lw=0.8)
+    big = [np.max(np.abs(b["multipliers"])) for b in data.branches if len(b["param"])]
+    if big and max(big) > 20:  # an unstable branch far out: log scale keeps |mu| = 1 visible
+        ax2.set_yscale("log")
     ax2.set_ylabel("max |Floquet multiplier| [-]")
     ax2.set_xlabel(f"{data.path}{unit}")
     ax1.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
