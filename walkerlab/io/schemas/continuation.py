@@ -102,7 +102,8 @@ class ContinuationData:
     """A loaded continuation artifact (see the module docstring for the meaning).
 
     ``branches``: list of dicts with ``period`` (int), ``param`` (N,), ``states`` (name ->
-    (N,)), ``orbit`` (name -> (N, k)), ``step_period`` (N,) [s], ``multipliers`` (N, 2n) complex, ``stable`` (N,) bool.
+    (N,)), ``orbit`` (name -> (N, k)), ``step_period`` (N,) [s], ``multipliers`` (N, 2n)
+    complex, ``stable`` (N,) bool.
     ``special``: dict of arrays ``kind``, ``param``, ``period``, ``branch``, ``cause``,
     ``states`` (name -> (S,)), ``multipliers`` (S, 2n).  ``curves``: list of dicts ``kind``,
     ``period``, ``param``, ``param2``, ``path2``, ``unit2``, ``multiplier``.
