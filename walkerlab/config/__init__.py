@@ -315,51 +315,6 @@ class SolverSettings(_Strict):
         "Python callbacks, ~1 s numba import per process; for many-point studies)")
 
 
-class StateSpec(_Strict):
-    """A walker state right after heel strike, by state name with its unit:
-    ``<role>_angle_rad`` and ``<role>_rate_rad_per_s`` for each role of the walker (compass
-    gait, Eq. 1: ``swing_angle_rad, stance_angle_rad, swing_rate_rad_per_s,
-    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``)."""
-
-    model_config = ConfigDict(extra="allow", frozen=True)
-
-    @model_validator(mode="after")
-    def _named_finite(self) -> StateSpec:
-        import re
-
-        for k, v in (self.model_extra or {}).items():
-            if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
-                raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
-                                 "<role>_rate_rad_per_s)")
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise ValueError(f"{k}: must be a finite number")  # as _Strict fields
-        if not self.model_extra:
-            raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
-        return self
-
-    def as_array(self, state_names: list[str] | None = None):
-        """State (2n,) in the order of ``state_names`` (a walker's ``state_names()``; default:
-        the compass gait's ``swing_angle, stance_angle, swing_rate, stance_rate``).
-
-        Raises
-        ------
-        ValueError
-            A state of the walker is missing, or a given name is not one of its states.
-        """
-        import numpy as np
-
-        names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
-        keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
-        given = dict(self.model_extra or {})
-        missing = [k for k in keys if k not in given]
-        extra = [k for k in given if k not in keys]
-        if missing or extra:
-            raise ValueError(f"state must give exactly {keys}" +
-                             (f"; missing {missing}" if missing else "") +
-                             (f"; unknown {extra}" if extra else ""))
-        return np.array([float(given[k]) for k in keys])
-
-
 class GuessFromArtifact(_Strict):
     """A starting state read from a continuation artifact (issue 23): the state of a branch
     at a parameter value, instead of digits copied by hand."""
@@ -403,12 +358,70 @@ class GuessFromArtifact(_Strict):
         return np.array([x[data.state_names.index(n)] for n in names])
 
 
+class StateSpec(_Strict):
+    """A walker state right after heel strike, by state name with its unit:
+    ``<role>_angle_rad`` and ``<role>_rate_rad_per_s`` for each role of the walker (compass
+    gait, Eq. 1: ``swing_angle_rad, stance_angle_rad, swing_rate_rad_per_s,
+    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``), or a state
+    read from a continuation artifact, ``{from: <artifact>, at: <parameter value>, branch:
+    0}`` (:class:`GuessFromArtifact`)."""
+
+    model_config = ConfigDict(extra="allow", frozen=True)
+
+    @model_validator(mode="after")
+    def _named_finite(self) -> StateSpec:
+        import re
+
+        extra = self.model_extra or {}
+        if "from" in extra:  # a state read from a continuation artifact (issue 23)
+            try:
+                GuessFromArtifact.model_validate(extra)
+            except ValidationError as exc:
+                err = exc.errors()[0]
+                where = ".".join(str(x) for x in err["loc"])
+                raise ValueError(f"{where}: {err['msg']}" if where else err["msg"]) from None
+            return self
+        for k, v in extra.items():
+            if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
+                raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
+                                 "<role>_rate_rad_per_s)")
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ValueError(f"{k}: must be a finite number")  # as _Strict fields
+        if not self.model_extra:
+            raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
+        return self
+
+    def as_array(self, state_names: list[str] | None = None):
+        """State (2n,) in the order of ``state_names`` (a walker's ``state_names()``; default:
+        the compass gait's ``swing_angle, stance_angle, swing_rate, stance_rate``).
+
+        Raises
+        ------
+        ValueError
+            A state of the walker is missing, or a given name is not one of its states.
+        """
+        import numpy as np
+
+        if "from" in (self.model_extra or {}):
+            return GuessFromArtifact.model_validate(self.model_extra).as_array(state_names)
+        names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
+        keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
+        given = dict(self.model_extra or {})
+        missing = [k for k in keys if k not in given]
+        extra = [k for k in given if k not in keys]
+        if missing or extra:
+            raise ValueError(f"state must give exactly {keys}" +
+                             (f"; missing {missing}" if missing else "") +
+                             (f"; unknown {extra}" if extra else ""))
+        return np.array([float(given[k]) for k in keys])
+
+
 class FixedPointSettings(_Strict):
     """Search for the period-1 fixed point of the Poincaré map (paper Sec. 3.3)."""
 
     model_config = ConfigDict(populate_by_name=True)
 
-    initial_guess: StateSpec | GuessFromArtifact | None = Field(
+    initial_guess: StateSpec | None = Field(
         None, description="starting point of the root finder, by state name or "
         "{from: <continuation artifact>, at: <parameter value>}; null: found automatically "
         "(scale-free seeds from the slope and the walker's size, ranked on the heel-strike "
