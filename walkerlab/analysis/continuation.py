@@ -69,7 +69,8 @@ import numpy as np
 from walkerlab.analysis.hybrid import Solver, integrate_step, numeric_jacobian
 from walkerlab.models.base import HybridWalker
 
-__all__ = ["WalkerFamily", "BranchPoint", "SpecialPoint", "Branch", "ContinuationResult",
+__all__ = ["VALIDITY", "normal_force_ratio", "WalkerFamily", "BranchPoint", "SpecialPoint",
+           "Branch", "ContinuationResult",
            "MapFailed", "continue_branch", "continuation", "switch_period_doubling",
            "two_parameter", "TwoParameterCurve", "SPECIAL_KINDS", "fixed_point_at",
            "homotopy", "HomotopyResult", "step_map", "first_point", "special_point_at"]
@@ -470,7 +471,7 @@ def _critical_vector(M: np.ndarray, target: complex) -> tuple[np.ndarray, comple
 
 # ----------------------------------------------------------------------------- locate
 def _locate(sys: _System, a: BranchPoint, b_s: float, kind: str, guess_b: np.ndarray,
-            period: int, scuff_ref: float | None = None) -> SpecialPoint | None:
+            period: int) -> SpecialPoint | None:
     """brentq along the branch between ``a`` (s = 0) and the point at ``s = b_s``."""
     from scipy.optimize import brentq
 
@@ -492,8 +493,8 @@ def _locate(sys: _System, a: BranchPoint, b_s: float, kind: str, guess_b: np.nda
         u, info = corrected(s)
         if u is None:
             raise MapFailed("correction failed while locating a special point")
-        if kind == "scuff":
-            return _clearance(sys, u, sc) - 0.0
+        if kind in VALIDITY:
+            return VALIDITY[kind][0](sys, u, sc)
         return _test_functions(info["M"])[kind]
 
     try:
@@ -513,10 +514,9 @@ def _locate(sys: _System, a: BranchPoint, b_s: float, kind: str, guess_b: np.nda
         _d, i, j = min(prods)
         if abs(mu[i].imag) < 1e-9:  # a real pair mu_i mu_j = 1: a neutral saddle, no NS
             return None
-    if kind == "scuff":
+    if kind in VALIDITY:
         return SpecialPoint("branch_end", q.p, period, q.x, q.multipliers,
-                            cause="swing foot scuffing (clearance inside the step reaches 0)",
-                            point=q)
+                            cause=VALIDITY[kind][1], point=q)
     return SpecialPoint(kind, q.p, period, q.x, q.multipliers, eigenvector=vec, point=q)
 
 
@@ -536,6 +536,76 @@ def _clearance(sys: _System, u: np.ndarray, sc: float, n: int = 200) -> float:
         h = foot[1] * math.cos(phi) + foot[0] * math.sin(phi)
         low = min(low, float(np.min(h)))
     return low
+
+
+def _mass_points(w: HybridWalker) -> dict | None:
+    """Masses [kg] of the walker's named points (``hip``: ``M_hip``; ``<role>_<body>``:
+    ``m_<body>``), or None when they do not add up to the walker's total mass (a model whose
+    points this convention does not cover)."""
+    p = w.params
+    names = w.points(np.zeros(2 * w.n_coordinates))
+    out = {"hip": float(p.get("M_hip", 0.0))}
+    for name in names:
+        for role in ("stance_", "swing_"):
+            key = f"m_{name[len(role):]}"
+            if name.startswith(role) and key in p:
+                out[name] = float(p[key])
+    total = float(w.total_mass_kg)
+    return out if total > 0 and abs(sum(out.values()) - total) <= 1e-9 * total else None
+
+
+def normal_force_ratio(w: HybridWalker, segs, n: int = 200) -> float:
+    """Smallest ground normal force on the stance foot over the steps, as a fraction of the
+    walker's weight ``M g`` [-].
+
+    The only external forces in a step are gravity and the stance foot's contact force, so
+    ``F = M (a_com - g_vec)``; its component along the slope normal ``(sin phi, cos phi)`` is
+    ``N = M (a_com . n + g cos phi)``.  ``a_com`` is the second time derivative of the centre
+    of mass (the named mass points, :func:`_mass_points`) on the dense output of each phase
+    (central differences on ``n`` points inside the phase, so an intra-step impact such as a
+    knee strike is not differentiated across).  A negative value means the stance foot would
+    have to be pulled: the rigid model (foot pinned) is not valid there.  NaN when the mass
+    points are not known.
+    """
+    masses = _mass_points(w)
+    if masses is None:
+        return math.nan
+    M = sum(masses.values())
+    g = float(w.params["gravity_m_per_s2"])
+    phi = float(w.slope_rad)
+    nrm = np.array([math.sin(phi), math.cos(phi)])
+    low = math.inf
+    for seg in segs:
+        for _ph, dense, (ta, tb) in seg.pieces:
+            if tb - ta <= 1e-6:
+                continue
+            ts = np.linspace(ta, tb, n)
+            X = np.atleast_2d(dense(ts))[:2 * w.n_coordinates]
+            pts = w.points(X)
+            com = sum(m * np.asarray(pts[k], float) for k, m in masses.items()) / M
+            dt = ts[1] - ts[0]
+            acc = np.gradient(np.gradient(com, dt, axis=1), dt, axis=1)[:, 2:-2]
+            N = (nrm @ acc + g * math.cos(phi)) / g
+            low = min(low, float(np.min(N)))
+    return low
+
+
+def _normal_force(sys: _System, u: np.ndarray, sc: float) -> float:
+    w = sys.family.walker(u[-1] * sc)
+    x = _from_section(w, u[:-1])
+    segs = step_map(w, x, sys.family.solver, sys.k, max_step_time=sys.family.max_step_time,
+                    segments=True)[3]
+    return normal_force_ratio(w, segs)
+
+
+#: validity checks along a branch: name -> (function (system, u, p_scale) -> value that
+#: turns negative where the rigid model stops being valid, the branch end's cause)
+VALIDITY = {
+    "clearance": (lambda sys, u, sc: _clearance(sys, u, sc),
+                  "swing foot scuffing (its clearance inside the step reaches 0)"),
+    "normal_force": (_normal_force, "stance foot lifting (the ground's normal force on it "
+                     "reaches 0: the rigid model is not valid beyond)"),
+}
 
 
 def _end(sys: _System, a: BranchPoint, ds: float, exc, period: int,
@@ -565,7 +635,7 @@ def _end(sys: _System, a: BranchPoint, ds: float, exc, period: int,
 def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: tuple,
                     p_scale: float, direction: int = 1, ds: float = 0.02,
                     ds_min: float = 1e-6, ds_max: float = 0.1, max_points: int = 400,
-                    check_clearance: bool = False, away_from: np.ndarray | None = None,
+                    checks: tuple = (), away_from: np.ndarray | None = None,
                     stats: dict | None = None) -> Branch:
     """Follow the period-``k`` branch through ``first`` until ``p`` leaves ``p_range`` or the
     branch ends.
@@ -585,8 +655,9 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
         Along ``+tangent`` (oriented towards growing ``p`` where it is not a fold) or back.
     ds, ds_min, ds_max : float
         Initial, smallest and largest arclength step (scaled units).
-    check_clearance : bool
-        End the branch where the swing foot's clearance inside the step reaches 0.
+    checks : tuple of str
+        Validity checks (keys of :data:`VALIDITY`: ``clearance``, ``normal_force``): the
+        branch ends where one of them reaches 0 (located by brentq along the branch).
     away_from : ndarray (m + 1,), optional
         Orient the first tangent away from this scaled point (branch switching).
 
@@ -648,13 +719,17 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
                         specials.append(sp)
                         if sp.point is not None:  # the branch passes through it
                             pts.append(dataclasses.replace(sp.point, tangent=a.tangent))
-            if check_clearance and _clearance(sys, u, p_scale) < 0 <= _clearance(
-                    sys, ua, p_scale):
-                sp = (_locate(sys, a, s_b, "scuff", u, k) if at_bound is None else None)
-                specials.append(sp or SpecialPoint(
-                    "branch_end", b.p, k, b.x, b.multipliers, cause="swing foot scuffing",
-                    point=b))
-                pts.append(b)
+            ended = False
+            for name in checks:
+                fun, cause = VALIDITY[name]
+                if fun(sys, u, p_scale) < 0 <= fun(sys, ua, p_scale):
+                    sp = _locate(sys, a, s_b, name, u, k) if at_bound is None else None
+                    specials.append(sp or SpecialPoint("branch_end", b.p, k, b.x,
+                                                       b.multipliers, cause=cause, point=b))
+                    pts.append(sp.point if sp is not None else b)
+                    ended = True
+                    break
+            if ended:
                 break
         pts.append(b)
         if at_bound is not None:
@@ -742,7 +817,7 @@ def switch_period_doubling(family: WalkerFamily, sp: SpecialPoint, p_scale: floa
 # ----------------------------------------------------------------------------- driver
 def continuation(family: WalkerFamily, p0: float, x0: np.ndarray, p_range: tuple,
                  unit: str = "-", switch: int = 0, ds: float = 0.02, ds_max: float = 0.1,
-                 check_clearance: bool | None = None) -> ContinuationResult:
+                 checks: tuple | None = None) -> ContinuationResult:
     """Continue the gait ``x0`` at the scene's own value ``p0`` both ways over ``p_range``,
     locate its special points and (``switch`` >= 1) switch at period doublings to the
     period-2 branch, (``switch`` >= 2) again to period 4.
@@ -759,10 +834,12 @@ def continuation(family: WalkerFamily, p0: float, x0: np.ndarray, p_range: tuple
     unit : str
     switch : int
         Period doublings to follow (0: none, 1: to period 2, 2: to period 4).
-    check_clearance : bool, optional
-        End branches where the swing foot's clearance reaches 0; default: when the starting
-        gait's swing foot clears the ground (a kneed walker; a compass gait scuffs at
-        mid-stance by construction and the rigid model ignores it).
+    checks : tuple of str, optional
+        Validity checks ending a branch (:data:`VALIDITY`); default: ``normal_force`` when
+        the starting gait's stance foot is pressed on the ground and the walker's mass points
+        are known, and ``clearance`` when the starting gait's swing foot clears the ground
+        (a kneed walker; a compass gait scuffs at mid-stance by construction and the rigid
+        model ignores it).
 
     Returns
     -------
@@ -775,10 +852,12 @@ def continuation(family: WalkerFamily, p0: float, x0: np.ndarray, p_range: tuple
     stats: dict = {}
     first = first_point(family, p0, x0, 1, scale)
     w = family.walker(p0)
-    if check_clearance is None:
+    if checks is None:
         sys = _System(family, 1, scale)
-        check_clearance = _clearance(sys, _u(first, scale), scale) > 0
-    kw = {"ds": ds, "ds_max": ds_max, "check_clearance": check_clearance, "stats": stats}
+        u0 = _u(first, scale)
+        checks = tuple(n for n in ("clearance", "normal_force")
+                       if VALIDITY[n][0](sys, u0, scale) > 0)
+    kw = {"ds": ds, "ds_max": ds_max, "checks": checks, "stats": stats}
     up = continue_branch(family, first, 1, (lo, hi), scale, 1, **kw)
     down = continue_branch(family, first, 1, (lo, hi), scale, -1, **kw)
     branches = [_join(down, up)]
