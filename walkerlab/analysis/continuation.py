@@ -299,6 +299,7 @@ class BranchPoint:
     residual: float
     M: np.ndarray = field(repr=False, default=None)
     orbit: np.ndarray = field(repr=False, default=None)
+    Fp: np.ndarray = field(repr=False, default=None)
 
     @property
     def stable(self) -> bool:
@@ -446,8 +447,8 @@ def _point(sys: _System, u: np.ndarray, info: dict, t_prev: np.ndarray | None) -
     from walkerlab.analysis.poincare import sort_multipliers
 
     s = sys.p_scale
-    Fp = sys.dp(u[:-1], u[-1] * s) * s
-    t = _null_tangent(info["Fz"], Fp)
+    Fp = sys.dp(u[:-1], u[-1] * s)
+    t = _null_tangent(info["Fz"], Fp * s)
     if t_prev is not None and t @ t_prev < 0:
         t = -t
     tests = _test_functions(info["M"])
@@ -455,7 +456,15 @@ def _point(sys: _System, u: np.ndarray, info: dict, t_prev: np.ndarray | None) -
                        period_s=float(info["period"]),
                        multipliers=sort_multipliers(np.linalg.eigvals(info["J"])),
                        tests=tests, tangent=t, residual=float(np.max(np.abs(info["F"]))),
-                       M=info["M"], orbit=info["orbit"])
+                       M=info["M"], orbit=info["orbit"], Fp=Fp)
+
+
+def _jac0(a: BranchPoint, row: np.ndarray, s: float) -> np.ndarray | None:
+    """The bordered Jacobian at ``a`` with the constraint ``row`` (a start for MINPACK's
+    Broyden updates near ``a``: no variational map spent up front)."""
+    if a.M is None or a.Fp is None:
+        return None
+    return np.vstack([np.column_stack([a.M - np.eye(a.z.size), a.Fp * s]), row])
 
 
 def _u(q: BranchPoint, s: float) -> np.ndarray:
@@ -485,7 +494,7 @@ def _locate(sys: _System, a: BranchPoint, b_s: float, kind: str, guess_b: np.nda
             return memo[s]
         lam = s / b_s
         u0 = (1 - lam) * ua + lam * guess_b
-        u, info = _correct(sys, u0, t, t @ ua + s)
+        u, info = _correct(sys, u0, t, t @ ua + s, _jac0(a, t, sc))
         memo[s] = (u, info)
         return u, info
 
@@ -691,10 +700,12 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
             row = np.zeros(ua.size)
             row[-1] = 1.0
             frac = (at_bound / p_scale - ua[-1]) / (up[-1] - ua[-1])
-            u, info = _correct(sys, ua + frac * (up - ua), row, at_bound / p_scale)
+            u, info = _correct(sys, ua + frac * (up - ua), row, at_bound / p_scale,
+                               _jac0(a, row, p_scale))
             s_b = float(a.tangent @ (u - ua)) if u is not None else None
         else:
-            u, info = _correct(sys, up, a.tangent, a.tangent @ ua + ds_cur)
+            u, info = _correct(sys, up, a.tangent, a.tangent @ ua + ds_cur,
+                               _jac0(a, a.tangent, p_scale))
             s_b = ds_cur
         if u is None:
             if ds_cur / 2 < ds_min:

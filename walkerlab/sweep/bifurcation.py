@@ -105,8 +105,10 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     from walkerlab.sweep.points import _Outcome, ideal_fixed_point, interleg_angle, warm_up
 
     warm_up()
+    from walkerlab.sweep.continuation import scene_family
+
     out = []
-    guess = prev = None
+    guess = prev = fam = None
     x_att = None
     for index, (value,) in task.points:
         t0 = time.perf_counter()
@@ -119,7 +121,9 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
             warnings.simplefilter("ignore")
             scene = _scene_at(task.base, value, task.path)
             try:
-                q = _arclength_step(scene, task.path, prev, value)
+                if fam is None:  # the walker over the grid's field, built once a chunk
+                    fam = scene_family(scene, task.path)
+                q = _arclength_step(fam, prev, value)
                 if q is not None:  # the neighbour's branch followed to this value
                     walker = build_walker(scene)
                     row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
@@ -170,7 +174,7 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     return out
 
 
-def _arclength_step(scene: Scene, path: str, prev, value: float):
+def _arclength_step(fam, prev, value: float):
     """The fixed point at ``value`` on the branch of the previous grid value's
     (``prev = (value, BranchPoint or state)``), by pseudo-arclength continuation
     (:func:`walkerlab.analysis.continuation.continue_branch`), which does not jump to the
@@ -179,7 +183,6 @@ def _arclength_step(scene: Scene, path: str, prev, value: float):
     ``value`` (a fold in between): the caller falls back to the root finder.
     """
     from walkerlab.analysis.continuation import MapFailed, continue_branch, first_point
-    from walkerlab.sweep.continuation import scene_family
 
     if prev is None:
         return None
@@ -187,12 +190,11 @@ def _arclength_step(scene: Scene, path: str, prev, value: float):
     span = abs(value - v0)
     if span == 0:
         return None
-    fam = scene_family(scene, path)
     try:
         if isinstance(q0, np.ndarray):
             q0 = first_point(fam, v0, q0, 1, span)
         br = continue_branch(fam, q0, 1, (min(v0, value), max(v0, value)), span,
-                             1 if value > v0 else -1, ds=0.25, ds_max=0.5)
+                             1 if value > v0 else -1, ds=1.0, ds_max=1.0)
     except MapFailed:
         return None
     last = br.points[-1]
