@@ -129,9 +129,13 @@ def test_branches_agree_with_independent_fixed_points():
     res, _ = run_continuation(scene, "slope.angle_deg", 4.0, 4.8, switch=1, ds_max=0.04)
     assert [b.period for b in res.branches] == [1, 2]
     for br in res.branches:
-        assert len(br.points) >= 20, len(br.points)
+        # the period doubling a switched branch starts at is not an isolated fixed point of
+        # the 2-step map (a multiplier +1 there: the root finder's answer is only good to
+        # ~sqrt(eps)), so it is left out
+        pts = [q for q in br.points if np.min(np.abs(q.multipliers - 1.0)) > 1e-3]
+        assert len(pts) >= 20, len(pts)
         worst = 0.0
-        for q in br.points:
+        for q in pts:
             x, _mu = _independent_orbit(scene, "slope.angle_deg", q.p, q.x, br.period)
             worst = max(worst, float(np.max(np.abs(x - q.x))))
         assert worst < 1e-9, (br.period, worst)
