@@ -30,11 +30,13 @@ Special points (test functions on the reduced Jacobian ``M = F_z + I`` with eige
 - Neimark-Sacker: ``prod_{i<j} (mu_i mu_j - 1)`` (the bialternate product; a sign change
   counts only when the pair with ``mu_i mu_j`` nearest 1 is complex);
 - branch end: the step map fails (fall, no heel strike, swing foot scuffing, the knee
-  strike lost, the section's coordinates leaving their domain) - located by bisection
-  (``scipy.optimize.brentq`` on the distance to the failure is not defined there: the
-  failing side has no gait) down to ``1e-8`` of the arclength, or the swing foot's
-  clearance inside the step turning negative (for walkers whose starting gait clears the
-  ground), located by ``brentq`` on the clearance.
+  strike lost, the section's coordinates leaving their domain) - located by bisection in
+  the arclength down to ``1e-9`` (a test function for ``brentq`` is not defined there: the
+  failing side has no gait); or a validity check (:data:`VALIDITY`) turning negative,
+  located by ``brentq`` on it: the swing foot's clearance inside the step (for walkers
+  whose starting gait clears the ground: a compass gait scuffs at mid-stance by
+  construction) and the ground's normal force on the stance foot (the rigid model pins the
+  foot: where the force would pull, the model is not valid).
 
 A sign change between two accepted points is located by ``scipy.optimize.brentq`` on the
 test function along the branch: each trial arclength ``s`` is corrected on the hyperplane
@@ -320,6 +322,7 @@ class SpecialPoint:
     cause : str         branch ends: why (fall, no heel strike, scuffing, ...); else ""
     eigenvector : ndarray (m,) or None   the critical multiplier's (section coordinates)
     point : BranchPoint or None          the corrected point there
+    branch : int        index of its branch in :attr:`ContinuationResult.branches`
     """
 
     kind: str
@@ -620,8 +623,9 @@ VALIDITY = {
 def _end(sys: _System, a: BranchPoint, ds: float, exc, period: int,
          tol: float = 1e-9) -> SpecialPoint:
     """A branch end past ``a``: bisection in the arclength between the last point that has
-    a gait and the first that fails, down to ``tol`` (scaled)."""
+    a gait and the first that fails, down to ``tol`` in the parameter's unit."""
     sc = sys.p_scale
+    tol = tol / max(sc, 1e-300)  # |dp| <= p_scale |ds|
     ua, t = _u(a, sc), a.tangent
     lo, hi, last, cause = 0.0, ds, a, getattr(exc, "cause", "no fixed point")
     guess = ua
