@@ -63,7 +63,9 @@ def bifurcation_figure(data: dict, title: str = ""):
                                    gridspec_kw={"height_ratios": [3, 2]})
     ss, yy = np.repeat(s, il.shape[1]), il.ravel()
     m = np.isfinite(yy)
-    ax1.plot(ss[m], yy[m], ".", ms=2.0, color="k", label="steady state (last heel strikes)")
+    # on top of the fixed-point line: a period-1 steady state sits on it and stays visible
+    ax1.plot(ss[m], yy[m], ".", ms=2.5, color="k", zorder=4,
+             label="steady state (last heel strikes)")
     # markers on every fixed point: a single stable or unstable point (no neighbour to draw
     # a line to) is drawn too
     ax1.plot(np.where(stable, s, np.nan), np.where(stable, fp_il, np.nan), "-", color="tab:blue",
