@@ -19,9 +19,9 @@ import pytest
 from scipy.optimize import brentq, root
 
 from walkerlab.analysis.continuation import SPECIAL_KINDS
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import poincare_map
 from walkerlab.config import load_scene
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.sweep.continuation import run_continuation
 from walkerlab.sweep.params import apply_point
@@ -270,8 +270,8 @@ def test_homotopy_and_initial_guess_from_an_artifact(tmp_path):
     rod = scene.model_dump(mode="json")
     rod["fixedpoint"]["initial_guess"] = {"from": str(out.path), "at": 3.5}
     rod["walker"]["leg"]["bodies"][0]["mass_kg"] = 3.5
+    from walkerlab.analysis.scene_gaits import solve_scene
     from walkerlab.config import scene_from_dict
-    from walkerlab.stages.fixedpoint import solve_scene
 
     _w, search = solve_scene(scene_from_dict(rod), fd_check=False)
     ref = _independent_orbit(scene_from_dict(rod), "walker.leg.bodies.rod.mass_kg", 3.5,

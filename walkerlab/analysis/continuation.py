@@ -14,7 +14,7 @@ a corrector on the bordered system ``[F(u); t . (u - u_pred)] = 0`` solved by
 ``scipy.optimize.root`` (MINPACK ``hybrj``) with the analytic Jacobian
 ``[[F_z, F_p], [t^T]]``.  ``F_z = D section . DP^k . D from_section - I`` is exact: ``DP`` comes
 from the variational equations with saltation matrices at every guard
-(:func:`walkerlab.analysis.hybrid.integrate_step`).  ``F_p`` is a central finite difference
+(:func:`walkerlab.integrate.rigid.integrate_step`).  ``F_p`` is a central finite difference
 in ``p`` (step ``1e-6 (1 + |p|)``; two plain maps): it only steers the predictor and the
 corrector's start, the solution itself is fixed by ``F = 0`` and the hyperplane.  The
 parameter enters the arclength scaled by ``p_scale`` (the span of the range asked for).
@@ -68,7 +68,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.analysis.hybrid import Solver, integrate_step, numeric_jacobian
+from walkerlab.integrate.rigid import integrate_step, numeric_jacobian
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.base import HybridWalker
 
 __all__ = ["VALIDITY", "normal_force_ratio", "WalkerFamily", "BranchPoint", "SpecialPoint",

@@ -24,12 +24,12 @@ from walkerlab.analysis.continuation import (
     homotopy,
     two_parameter,
 )
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.config import Scene, SceneError
+from walkerlab.integrate.solver import Solver
 from walkerlab.sweep.params import ParamAxis, apply_point, axis_unit, check_axes
 
 __all__ = ["scene_family", "scene_value", "run_continuation", "numeric_fields",
-           "homotopy_family", "homotopy_gait"]
+           "homotopy_family", "homotopy_gait", "known_scene", "homotopy_start"]
 
 #: top-level sections that do not describe the rigid walker (left out of a homotopy)
 NOT_WALKER = ("name", "source", "published", "fixedpoint", "simulate", "contact", "units",
@@ -238,3 +238,63 @@ def homotopy_gait(known: Scene, new: Scene):
                    fp.max_step_time_s if fp is not None else 5.0)
     res.fields = fields
     return res
+
+
+def known_scene(scene: Scene, known=None) -> Scene | None:
+    """The scene of a known gait to start a homotopy from: ``known`` (a Scene or a YAML path,
+    ``--from``), else the scene's ``fixedpoint.from`` (relative to the scene's folder), else
+    None.
+
+    Raises
+    ------
+    SceneError
+        The file does not load (one line).
+    """
+    from pathlib import Path
+
+    from walkerlab.config import load_scene
+
+    fp = scene.fixedpoint
+    if known is None and (fp is None or fp.from_ is None):
+        return None
+    if isinstance(known, Scene):
+        return known
+    path = Path(known if known is not None else fp.from_)
+    if known is None and not path.is_absolute() and scene.origin is not None:
+        path = scene.origin.parent / path
+    return load_scene(path)
+
+
+def homotopy_start(scene: Scene, known: Scene):
+    """The known scene's gait carried to this walker (a start for the root finder) and a
+    note on the way it went.
+
+    Returns
+    -------
+    x : ndarray (2n,)
+    note : str
+
+    Raises
+    ------
+    ValueError
+        The walkers differ in structure, the known scene has no gait, or the known gait does
+        not reach this walker along the straight line (the special point where it ends
+        named) - one line.
+    """
+    try:
+        res = homotopy_gait(known, scene)
+    except (ValueError, MapFailed) as exc:
+        raise ValueError(f"fixedpoint.from {known.name}: {exc}") from None
+    if not res.reached:
+        lam = res.branch.points[-1].p
+        why = "; ".join(f"{s.kind} at lambda {s.p:.4g}" + (f" ({s.cause})" if s.cause else "")
+                        for s in res.specials) or "the branch left [0, 1]"
+        raise ValueError(f"fixedpoint.from {known.name}: the known gait does not reach this "
+                         f"walker along the straight line (stopped at lambda = {lam:.4g}: "
+                         f"{why})")
+    on_way = ", ".join(f"{s.kind.replace('_', ' ')} at lambda {s.p:.4g}"
+                       for s in res.specials) or "no special point"
+    note = (f"initial guess carried from scene {known.name} by homotopy over "
+            f"{', '.join(res.fields)} ({len(res.branch.points)} continuation points; "
+            f"{on_way} on the way)")
+    return res.x, note
