@@ -7,7 +7,8 @@
 
 Each case runs ``--repeats`` times in this process (the generated model code is built once,
 outside the timing: one warm-up run); the median wall time is printed with the special points
-found and the map counts.  The machine may be shared: give the load with the numbers.
+found and the map counts, and the CPU time of this process (the run is serial: on a shared
+machine the wall time is the CPU time stretched by the load; give the load with the numbers).
 
 Usage::
 
@@ -47,19 +48,22 @@ def main() -> None:
     for name, (cfg, path, a, b, switch, goal) in CASES.items():
         scene = load_scene(ROOT / "configs" / cfg)
         build_walker(scene)  # generated code built / loaded once, not timed
-        times = []
+        times, cpu = [], []
         for _ in range(args.repeats):
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             res, _c = run_continuation(scene, path, a, b, switch)
             times.append(time.perf_counter() - t0)
+            cpu.append(time.process_time() - c0)
         med = statistics.median(times)
         out["cases"][name] = {
             "median_s": round(med, 3), "runs_s": [round(t, 3) for t in times],
+            "median_cpu_s": round(statistics.median(cpu), 3),
             "goal_s": goal, "met": med <= goal, "maps": res.maps,
             "variational_maps": res.variational_maps,
             "special_points": [(s.kind, s.period, round(s.p, 10), s.cause)
                                for s in res.specials]}
-        print(f"{name}: median {med:.2f} s (goal {goal:g} s) runs "
+        print(f"{name}: median {med:.2f} s wall, {statistics.median(cpu):.2f} s CPU "
+              f"(goal {goal:g} s) runs "
               f"{', '.join(f'{t:.2f}' for t in times)}; {res.maps} maps + "
               f"{res.variational_maps} variational; "
               + "; ".join(f"{s.kind} (period {s.period}) at {s.p:.8g}" for s in res.specials),
