@@ -243,9 +243,23 @@ class _System:
         return r.copy()
 
     def dp(self, z: np.ndarray, p: float) -> np.ndarray:
-        """``dF/dp`` (m,) by central differences (step ``1e-6 (1 + |p|)``)."""
+        """``dF/dp`` (m,) by central differences (step ``1e-6 (1 + |p|)``); one-sided next
+        to a branch end, where the map fails on one side.
+
+        Raises
+        ------
+        MapFailed
+            The map fails on both sides of ``p``.
+        """
         h = 1e-6 * (1.0 + abs(p))
-        return (self.residual(z, p + h) - self.residual(z, p - h)) / (2 * h)
+        try:
+            up = self.residual(z, p + h)
+        except MapFailed:
+            return (self.residual(z, p) - self.residual(z, p - h)) / h
+        try:
+            return (up - self.residual(z, p - h)) / (2 * h)
+        except MapFailed:
+            return (up - self.residual(z, p)) / h
 
     def full(self, z: np.ndarray, p: float) -> dict:
         """Everything at ``(z, p)``: state, period, ``D(P^k)``, ``F_z``, reduced ``M``."""
@@ -515,7 +529,10 @@ def _locate(sys: _System, a: BranchPoint, b_s: float, kind: str, guess_b: np.nda
     except (MapFailed, ValueError):
         return None
     u, info = corrected(s_star)
-    q = _point(sys, u, info, t)
+    try:
+        q = _point(sys, u, info, t)
+    except MapFailed:
+        return None
     target = {"fold": 1.0, "period_doubling": -1.0}.get(kind)
     vec = None
     if target is not None:
@@ -638,8 +655,12 @@ def _end(sys: _System, a: BranchPoint, ds: float, exc, period: int,
             if isinstance(info, MapFailed):
                 cause = info.cause
         else:
+            try:
+                last = _point(sys, u, info, t)
+            except MapFailed as exc:
+                hi, cause = mid, exc.cause
+                continue
             lo, guess = mid, u
-            last = _point(sys, u, info, t)
     sp = SpecialPoint("branch_end", last.p, period, last.x, last.multipliers, cause=cause,
                       point=last)
     return sp
@@ -721,7 +742,17 @@ def continue_branch(family: WalkerFamily, first: BranchPoint, k: int, p_range: t
                 break
             ds_cur /= 2
             continue
-        b = _point(sys, u, info, a.tangent)
+        try:
+            b = _point(sys, u, info, a.tangent)
+        except MapFailed as exc:  # the map fails on both sides of the new point's p
+            u, info = None, exc
+        if u is None:
+            if ds_cur / 2 < ds_min:
+                end = _end(sys, a, ds_cur, info, k)
+                specials.append(end)
+                break
+            ds_cur /= 2
+            continue
         if b.tangent @ a.tangent < 0.9 and ds_cur / 2 >= ds_min:
             ds_cur /= 2
             continue
