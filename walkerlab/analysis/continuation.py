@@ -49,10 +49,9 @@ point is the fixed point of the ``2k``-step map with the amplitude fixed,
 ``v . (z - z*) = eps``, the parameter free (a pitchfork of ``P^2k``: ``p - p* ~ eps^2``),
 then continued as any branch, away from ``(z*, p*)``.
 
-Two-parameter continuation: the augmented system ``[F(z, p1, p2); psi(z, p1, p2)] = 0``
-(``psi`` the fold or period-doubling test function) is solved for ``(z, p1)`` at each ``p2``
-by ``scipy.optimize.root`` (rows of ``F`` analytic, the row of ``psi`` by central
-differences), with a secant predictor in ``p2``.
+Two-parameter continuation of a fold or period doubling is
+:mod:`walkerlab.analysis.two_parameter`; the homotopy between two walkers
+:mod:`walkerlab.analysis.homotopy`.
 
 Nothing here knows a state's row: states are ``(2n,)`` arrays of the walker's
 ``state_names()``.
@@ -75,8 +74,7 @@ from walkerlab.models.base import HybridWalker
 __all__ = ["VALIDITY", "normal_force_ratio", "WalkerFamily", "BranchPoint", "SpecialPoint",
            "Branch", "ContinuationResult",
            "MapFailed", "continue_branch", "continuation", "switch_period_doubling",
-           "two_parameter", "TwoParameterCurve", "SPECIAL_KINDS", "fixed_point_at",
-           "homotopy", "HomotopyResult", "step_map", "first_point", "special_point_at"]
+           "SPECIAL_KINDS", "fixed_point_at", "step_map", "first_point"]
 
 SPECIAL_KINDS = ("fold", "period_doubling", "neimark_sacker", "branch_end")
 
@@ -951,176 +949,3 @@ def _join(down: Branch, up: Branch) -> Branch:
     """One branch from the two halves (the start point once), in arclength order."""
     pts = down.points[:0:-1] + up.points
     return Branch(up.period, pts, down.specials + up.specials, 1)
-
-
-# ----------------------------------------------------------------------------- two-param
-@dataclass
-class TwoParameterCurve:
-    """A curve of fold or period-doubling points in the plane of two fields.
-
-    Attributes
-    ----------
-    kind : str            ``fold`` or ``period_doubling``
-    period : int          the branch's period ``k``
-    path, path2 : str     the two fields; unit, unit2 their units
-    p : ndarray (N,)      first parameter at the special point
-    p2 : ndarray (N,)     second parameter
-    x : ndarray (N, 2n)   states there
-    multiplier : ndarray (N,) complex   the critical multiplier (+1 or -1)
-    """
-
-    kind: str
-    period: int
-    path: str
-    path2: str
-    unit: str
-    unit2: str
-    p: np.ndarray
-    p2: np.ndarray
-    x: np.ndarray
-    multiplier: np.ndarray
-
-
-def special_point_at(family: WalkerFamily, kind: str, k: int, p_guess: float,
-                     z_guess: np.ndarray, p_scale: float) -> tuple[float, BranchPoint]:
-    """Solve the augmented system ``[F(z, p); psi(z, p)] = 0`` for ``(z, p)``
-    (``scipy.optimize.root``, ``hybr``; ``F``'s rows analytic, ``psi``'s by central
-    differences).
-
-    Raises
-    ------
-    MapFailed
-        No convergence.
-    """
-    from scipy.optimize import root
-
-    sys = _System(family, k, p_scale)
-    target = 1.0 if kind == "fold" else -1.0
-
-    def psi(u):
-        info = sys.full(u[:-1], u[-1] * p_scale)
-        return _test_functions(info["M"])[kind], info
-
-    def G(u):
-        try:
-            F = sys.residual(u[:-1], u[-1] * p_scale)
-            return np.append(F, psi(u)[0])
-        except MapFailed:
-            return np.full(u.size, 1e3)
-
-    def jac(u):
-        try:
-            val, info = psi(u)
-            Fp = sys.dp(u[:-1], u[-1] * p_scale) * p_scale
-            grad = np.empty(u.size)
-            for i in range(u.size):
-                h = 1e-6 * (1 + abs(u[i]))
-                e = np.zeros(u.size)
-                e[i] = h
-                grad[i] = (psi(u + e)[0] - psi(u - e)[0]) / (2 * h)
-        except MapFailed:
-            return np.eye(u.size)
-        return np.vstack([np.column_stack([info["Fz"], Fp]), grad])
-
-    u0 = np.append(z_guess, p_guess / p_scale)
-    sol = root(G, u0, jac=jac, method="hybr", options={"xtol": 1e-12, "maxfev": 40})
-    u = sol.x
-    try:
-        info = sys.full(u[:-1], u[-1] * p_scale)
-    except MapFailed as exc:
-        raise MapFailed("no special point", str(exc)) from None
-    if float(np.max(np.abs(info["F"]))) > RESIDUAL_TOL or not sol.success:
-        raise MapFailed("no special point", " ".join(str(sol.message).split()))
-    q = _point(sys, u, info, None)
-    _v, mu = _critical_vector(q.M, target)
-    if abs(mu - target) > 1e-5:
-        raise MapFailed("no special point", f"critical multiplier {mu:.6g}")
-    return float(u[-1] * p_scale), q
-
-
-def two_parameter(family: WalkerFamily, sp: SpecialPoint, path2: str, p2_start: float,
-                  p2_values: np.ndarray, p_scale: float, unit: str = "-",
-                  unit2: str = "-") -> TwoParameterCurve:
-    """Continue the fold or period doubling ``sp`` (located at ``path2 = p2_start``) over
-    ``p2_values`` (both ways from ``p2_start``, secant predictor in ``p2``); stops where the
-    augmented system fails.
-
-    Returns
-    -------
-    TwoParameterCurve
-        Points sorted by ``p2``.
-    """
-    rows = [(p2_start, sp.p, sp.x, sp.point.z, complex(-1 if sp.kind != "fold" else 1))]
-    vals = np.asarray(p2_values, float)
-    for side in (vals[vals > p2_start], vals[vals < p2_start][::-1]):
-        hist = [(p2_start, sp.p, sp.point.z)]
-        for p2 in side:
-            fam = family.at(**{path2: float(p2)})
-            if len(hist) >= 2:
-                (a2, ap, az), (b2, bp, bz) = hist[-2], hist[-1]
-                lam = (p2 - b2) / (b2 - a2)
-                pg, zg = bp + lam * (bp - ap), bz + lam * (bz - az)
-            else:
-                pg, zg = hist[-1][1], hist[-1][2]
-            try:
-                p, q = special_point_at(fam, sp.kind, sp.period, pg, zg, p_scale)
-            except MapFailed:
-                break
-            mu = _critical_vector(q.M, 1.0 if sp.kind == "fold" else -1.0)[1]
-            rows.append((float(p2), p, q.x, q.z, mu))
-            hist.append((float(p2), p, q.z))
-    rows.sort(key=lambda r: r[0])
-    return TwoParameterCurve(sp.kind, sp.period, family.path, path2, unit, unit2,
-                             np.array([r[1] for r in rows]), np.array([r[0] for r in rows]),
-                             np.array([r[2] for r in rows]), np.array([r[4] for r in rows]))
-
-
-# ----------------------------------------------------------------------------- homotopy
-@dataclass
-class HomotopyResult:
-    """The known gait carried to the new walker.
-
-    Attributes
-    ----------
-    x : ndarray (2n,)     fixed point of the new walker (state just after heel strike)
-    fields : dict         the numeric fields that differ: path -> (known, new)
-    branch : Branch       the path in the homotopy parameter ``lambda`` in [0, 1]
-    specials : list of SpecialPoint   folds / period doublings / ends met on the way
-    reached : bool        ``lambda = 1`` reached
-    """
-
-    x: np.ndarray
-    fields: dict
-    branch: Branch
-    specials: list
-    reached: bool
-
-
-def homotopy(make: Callable[[dict], HybridWalker], x_known: np.ndarray, solver: Solver,
-             max_step_time: float = 5.0, ds: float = 0.05) -> HomotopyResult:
-    """Continue the known walker's gait (``lambda = 0``) to the new walker (``lambda = 1``)
-    along a one-parameter family ``make({"lambda": value})`` (the straight line between two
-    scenes' numeric fields, :func:`walkerlab.sweep.continuation.homotopy_family`).
-
-    Parameters
-    ----------
-    make : callable ``{"lambda": float} -> HybridWalker``
-    x_known : ndarray (2n,)
-        A fixed point (or a good guess) of the known walker.
-
-    Returns
-    -------
-    HomotopyResult
-        ``fields`` is empty here (the caller knows them).
-
-    Raises
-    ------
-    MapFailed
-        No fixed point at ``lambda = 0``.
-    """
-    fam = WalkerFamily(make, "lambda", solver, max_step_time)
-    first = first_point(fam, 0.0, x_known, 1, 1.0)
-    br = continue_branch(fam, first, 1, (0.0, 1.0), 1.0, 1, ds=ds, ds_max=0.2)
-    last = br.points[-1]
-    reached = abs(last.p - 1.0) < 1e-12
-    return HomotopyResult(last.x, {}, br, br.specials, reached)

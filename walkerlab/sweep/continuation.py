@@ -21,9 +21,9 @@ from walkerlab.analysis.continuation import (
     MapFailed,
     WalkerFamily,
     continuation,
-    homotopy,
-    two_parameter,
 )
+from walkerlab.analysis.homotopy import homotopy
+from walkerlab.analysis.two_parameter import two_parameter
 from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.solver import Solver
 from walkerlab.sweep.params import ParamAxis, apply_point, axis_unit, check_axes
@@ -212,7 +212,7 @@ def homotopy_family(known: Scene, new: Scene):
 
 def homotopy_gait(known: Scene, new: Scene):
     """The known scene's gait carried to the new scene's walker (see
-    :func:`walkerlab.analysis.continuation.homotopy`).
+    :func:`walkerlab.analysis.homotopy.homotopy`).
 
     Returns
     -------
