@@ -37,13 +37,17 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     from walkerlab.plotting.figures import save
     from walkerlab.sweep.bifurcation import load_bifurcation
     from walkerlab.sweep.continuation import run_continuation, scene_family
+    from walkerlab.sweep.params import SweepError
 
     require(scene, "fixedpoint", "continuation")
     if switch not in (0, 1, 2):
         raise StageError(f"--switch: {switch} is not 0, 1 or 2 (period doublings to follow)")
     scene_family(scene, path)  # an unknown field: one line before anything runs
     if path2 is not None:
-        scene_family(scene, path2)
+        try:
+            scene_family(scene, path2)
+        except SweepError as exc:
+            raise SweepError(str(exc).replace("--param ", "--param2 ", 1)) from None
     stem = check_name(f"continuation_{path}", "--param field")
     key = json.dumps({"param": path, "range": [start, stop], "switch": switch,
                       "param2": path2, "range2": list(range2) if range2 else None})
