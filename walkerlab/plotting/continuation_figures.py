@@ -105,7 +105,7 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
         seen.add(lab)
         if np.isfinite(y[0]):
             ax1.annotate(f"{short}{int(sp['period'][i])} {pv:.5g}", (pv, y[0]),
-                         textcoords="offset points", xytext=(6, 8 + 10 * (i % 2)),
+                         textcoords="offset points", xytext=(6, 8 + 12 * (i % 3)),
                          fontsize=7, color=col, annotation_clip=True,
                          ha="right" if i % 2 else "left")
         ax2.axvline(pv, color=col, lw=0.5, ls=":")
