@@ -441,11 +441,56 @@ class SolverSettings(_Strict):
         "Python callbacks, ~1 s numba import per process; for many-point studies)")
 
 
+class GuessFromArtifact(_Strict):
+    """A starting state read from a continuation artifact (issue 23): the state of a branch
+    at a parameter value, instead of digits copied by hand."""
+
+    model_config = ConfigDict(populate_by_name=True)
+
+    from_: str = Field(alias="from", min_length=1, description="continuation artifact "
+                       "(runs/<scene>/continuation_<field>.h5), relative to the current "
+                       "folder")
+    at: float = Field(description="value of the artifact's parameter on the branch [the "
+                      "artifact's field unit]")
+    branch: int = Field(0, ge=0, le=1000, description="branch index in the artifact (0: the "
+                        "period-1 branch through the scene's own gait)")
+
+    def as_array(self, state_names: list[str] | None = None):
+        """State (2n,) of the branch at ``at`` (linear interpolation between its two nearest
+        points), in the order of ``state_names``.
+
+        Raises
+        ------
+        ValueError
+            Artifact missing or damaged, ``at`` off the branch, or other state names.
+        """
+        import numpy as np
+
+        from walkerlab.io.artifacts import ArtifactError
+        from walkerlab.io.schemas.continuation import load_continuation
+
+        try:
+            data = load_continuation(Path(self.from_))
+        except ArtifactError as exc:
+            raise ValueError(str(exc)) from None
+        if self.branch >= len(data.branches):
+            raise ValueError(f"branch {self.branch}: {self.from_} has "
+                             f"{len(data.branches)} branches")
+        x = data.state_at(self.at, self.branch)
+        names = state_names or data.state_names
+        if sorted(names) != sorted(data.state_names):
+            raise ValueError(f"{self.from_} holds states {data.state_names}, the walker has "
+                             f"{list(names)}")
+        return np.array([x[data.state_names.index(n)] for n in names])
+
+
 class StateSpec(_Strict):
     """A walker state right after heel strike, by state name with its unit:
     ``<role>_angle_rad`` and ``<role>_rate_rad_per_s`` for each role of the walker (compass
     gait, Eq. 1: ``swing_angle_rad, stance_angle_rad, swing_rate_rad_per_s,
-    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``)."""
+    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``), or a state
+    read from a continuation artifact, ``{from: <artifact>, at: <parameter value>, branch:
+    0}`` (:class:`GuessFromArtifact`)."""
 
     model_config = ConfigDict(extra="allow", frozen=True)
 
@@ -453,7 +498,16 @@ class StateSpec(_Strict):
     def _named_finite(self) -> StateSpec:
         import re
 
-        for k, v in (self.model_extra or {}).items():
+        extra = self.model_extra or {}
+        if "from" in extra:  # a state read from a continuation artifact (issue 23)
+            try:
+                GuessFromArtifact.model_validate(extra)
+            except ValidationError as exc:
+                err = exc.errors()[0]
+                where = ".".join(str(x) for x in err["loc"])
+                raise ValueError(f"{where}: {err['msg']}" if where else err["msg"]) from None
+            return self
+        for k, v in extra.items():
             if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
                 raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
                                  "<role>_rate_rad_per_s)")
@@ -474,6 +528,8 @@ class StateSpec(_Strict):
         """
         import numpy as np
 
+        if "from" in (self.model_extra or {}):
+            return GuessFromArtifact.model_validate(self.model_extra).as_array(state_names)
         names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
         keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
         given = dict(self.model_extra or {})
@@ -489,10 +545,18 @@ class StateSpec(_Strict):
 class FixedPointSettings(_Strict):
     """Search for the period-1 fixed point of the Poincaré map (paper Sec. 3.3)."""
 
+    model_config = ConfigDict(populate_by_name=True)
+
     initial_guess: StateSpec | None = Field(
-        None, description="starting point of the root finder; null: found automatically "
+        None, description="starting point of the root finder, by state name or "
+        "{from: <continuation artifact>, at: <parameter value>}; null: found automatically "
         "(scale-free seeds from the slope and the walker's size, ranked on the heel-strike "
         "section; walkerlab.analysis.gaits)")
+    from_: str | None = Field(
+        None, alias="from", description="a scene YAML whose gait is known: its gait is "
+        "continued along the straight line between the two scenes' numeric walker and slope "
+        "fields to this walker (homotopy), and used as the initial guess; relative to this "
+        "scene's folder")
     gait: Literal["stable", "long_period", "short_period", "nearest_guess"] = Field(
         "stable", description="which period-1 gait to use where two exist (Goswami et al. "
         "1996, Garcia et al. 1998: long- and short-period pair): 'stable' (the stable one; "
