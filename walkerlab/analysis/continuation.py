@@ -166,7 +166,8 @@ def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,
     x : ndarray (2n,)
         State just after heel strike (role-ordered).
     k : int
-        Steps (1: step map, 2: stride map, ...).
+        Maps composed (1: the Poincaré map, 2: its square, ...); a map is one step, or one
+        stride (two steps) for a walker whose legs differ (``walker.steps_per_map``).
     jacobian : bool
         Also ``D(P^k)`` (2n, 2n), the product of the steps' variational Jacobians (with
         saltation matrices).
@@ -191,9 +192,11 @@ def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,
     J = np.eye(x.size) if jacobian else None
     T = 0.0
     segs = []
-    for _ in range(k):
-        seg = integrate_step(walker, x, solver, max_step_time=max_step_time,
-                             variational=jacobian)
+    legs = walker.legs
+    for i in range(k * walker.steps_per_map):  # a walker whose legs differ: a map is a stride
+        stance = legs[1] if i % 2 == 0 else legs[0]
+        seg = integrate_step(walker.for_stance(stance), x, solver, max_step_time=max_step_time,
+                             variational=jacobian, stance_leg=stance)
         if seg.termination != "heel_strike":
             raise MapFailed(_cause(walker, seg), seg.message)
         if jacobian:
