@@ -34,6 +34,7 @@ import numpy as np
 #: How a step of one row ended (``outcome`` codes are indices into this tuple).
 STEP_OUTCOMES = ("heel_strike", "fall", "timeout", "solver_failure")
 HEEL_STRIKE, FALL, TIMEOUT, SOLVER_FAILURE = range(4)
+EPS = np.finfo(float).eps
 
 _KERNEL = None
 
@@ -281,13 +282,13 @@ class BatchStepMap:
                     if todo.any():
                         cols_t, D_t = cols[todo], Dr[todo]
 
-                        def ft(t, idx, _c=cols_t, _D=D_t, _j=j):
+                        def ft(t, idx, _c=cols_t, _D=D_t, _j=j, _d=dense):
                             # find_root passes only its unconverged elements (and their idx)
                             i = idx.astype(int)
-                            return guards(_dense_rows(dense, _c[i], t), _D[i])[:, _j]
+                            return guards(_dense_rows(_d, _c[i], t), _D[i])[:, _j]
                         res = find_root(ft, (a[todo], b[todo]),
                                         args=(np.arange(cols_t.shape[0], dtype=float),),
-                                        tolerances={"xatol": 1e-15, "xrtol": 4 * np.finfo(float).eps})
+                                        tolerances={"xatol": 1e-15, "xrtol": 4 * EPS})
                         tj[todo] = res.x
                     better = tj < te[r]
                     te[r[better]] = tj[better]

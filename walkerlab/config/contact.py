@@ -24,8 +24,8 @@ from pydantic import (
 )
 
 __all__ = ["MAX_CONTACT_STRIDES", "ContactParamsSI", "ContactSettings", "ContactSimSettings",
-           "ContactSolverSettings", "KneeStopSI", "KneeStopSettings", "PerStepTerrain", "TerrainSettings",
-           "family_scaling"]
+           "ContactSolverSettings", "KneeStopSI", "KneeStopSettings", "PerStepTerrain",
+           "TerrainSettings", "family_scaling"]
 
 
 @dataclass(frozen=True)
