@@ -63,6 +63,23 @@ def _kernel():
     return _KERNEL
 
 
+def _entry(kern, f, Y, D, dY, G) -> None:
+    """Call the kernel; after its first compilation through the compiled entry point of its
+    one signature (the dispatcher's typing of a first-class function argument costs about
+    twice the call itself on a few hundred rows)."""
+    ep = _ENTRY.get(id(kern))
+    if ep is None:
+        kern(f, Y, D, dY, G)
+        sigs = kern.signatures
+        if len(sigs) == 1 and hasattr(kern.overloads.get(sigs[0]), "entry_point"):
+            _ENTRY[id(kern)] = kern.overloads[sigs[0]].entry_point
+        return
+    ep(f, Y, D, dY, G)
+
+
+_ENTRY: dict = {}
+
+
 @dataclass
 class BatchStep:
     """One step of ``N`` rows.
@@ -236,7 +253,7 @@ class BatchStepMap:
         def guards(Yr, Dr):
             dY = np.empty_like(Yr)
             G = np.empty((Yr.shape[0], n_extra))
-            kern(cfunc, np.ascontiguousarray(Yr), np.ascontiguousarray(Dr), dY, G)
+            _entry(kern, cfunc, np.ascontiguousarray(Yr), np.ascontiguousarray(Dr), dY, G)
             return G[:, gcols] + goffs
 
         def make_solver(Y0, Dr, t0, h):
@@ -244,7 +261,7 @@ class BatchStepMap:
                 Yr = y.reshape(-1, m)
                 dY = np.empty_like(Yr)
                 G = np.empty((Yr.shape[0], n_extra))
-                kern(cfunc, Yr, _D, dY, G)
+                _entry(kern, cfunc, Yr, _D, dY, G)
                 return dY.ravel()
             scale = np.sqrt(Y0.size)
             return DOP853(fun, t0, Y0.ravel().copy(), t_bound=t0 + float(cap.max()) + 1.0,

@@ -262,7 +262,8 @@ def gauss_hermite(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarra
 
 
 def transition_matrix(images: np.ndarray, ok: np.ndarray, weights: np.ndarray,
-                      verts: np.ndarray, chart: MeshChart, h: float, radius: float):
+                      verts: np.ndarray, chart: MeshChart, h: float, radius: float,
+                      interpolation: str = "multilinear"):
     """Sparse transition matrix among vertices from the images of every vertex.
 
     Parameters
@@ -273,6 +274,9 @@ def transition_matrix(images: np.ndarray, ok: np.ndarray, weights: np.ndarray,
         Heel strike (else a fall).
     weights : ndarray (q,)
     verts : ndarray of int (k, d)
+    interpolation : {"multilinear", "nearest"}
+        Spread an image on the ``2^d`` vertices of its cell (Byl & Tedrake's barycentric
+        idea on a lattice), or put it on its nearest vertex.
 
     Returns
     -------
@@ -298,6 +302,12 @@ def transition_matrix(images: np.ndarray, ok: np.ndarray, weights: np.ndarray,
     out = r > lim  # off the mesh: counted with the falls (absorbing), and reported
     np.add.at(escaped, src[out], wq[out])
     src, wq, U = src[~out], wq[~out], U[~out]
+    if interpolation == "nearest":  # all of an image's weight on its nearest vertex
+        tgt = np.array([index.get(tuple(v), -1) for v in np.rint(U).astype(int).tolist()])
+        good = tgt >= 0
+        np.add.at(escaped, src[~good], wq[~good])
+        Q = coo_matrix((wq[good], (src[good], tgt[good])), shape=(k, k)).tocsr()
+        return Q, escaped
     base = np.floor(U).astype(int)
     frac = U - base
     for corner in itertools.product((0, 1), repeat=d):

@@ -19,7 +19,7 @@ from walkerlab.analysis import mfpt as M
 from walkerlab.analysis.batch_step import HEEL_STRIKE, BatchStepMap
 
 #: walks per Monte Carlo task, rows per mesh task
-WALKS_PER_TASK = 200
+WALKS_PER_TASK = 500
 ROWS_PER_TASK = 4000
 
 _MAPS: dict[str, BatchStepMap] = {}
