@@ -202,3 +202,51 @@ def test_mfpt_stage_artifact_and_figure(tmp_path):
     assert stage.figure_path(sc, tmp_path / "runs").is_file()
     again = stage.run(sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
     assert again.reused
+
+
+def test_step_down_of_zero_is_the_ordinary_heel_strike(paper_map, paper_fixed_point):
+    """The step-down guard (swing-foot clearance reaching -drop) with drop 0 lands where the
+    heel-strike guard does (to the root finder's tolerance); a 10 mm step-down lands the
+    foot 10 mm below the slope line through the stance foot."""
+    X = np.tile(paper_fixed_point.x, (2, 1))
+    a = paper_map.step(X)
+    b = paper_map.step(X, drop_m=np.array([0.0, 0.01]))
+    np.testing.assert_allclose(b.x_next[0], a.x_next[0], rtol=0, atol=1e-12)
+    foot = paper_map.walker.points(b.x_pre[1])["swing_foot"]
+    below = -(foot[1] + foot[0] * math.tan(paper_map.slope_rad))
+    assert abs(below - 0.01) < 1e-4  # vertical drop; clearance ~ perpendicular (cos 1 deg)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("disturbance", ["slope", "floor_height"])
+def test_gait_sensitivity_norm_linear_equals_nonlinear(paper_scene, paper_fixed_point,
+                                                       disturbance):
+    """Hobbelen & Wisse's GSN from the linearised step-to-step map (A from the variational
+    equations) equals the nonlinear map's response to a 1e-5 impulse to 1e-3 relative
+    (measured ~1e-6: central differences with steps 1e-6, impulse response O(e^2))."""
+    from walkerlab.analysis import robustness as R
+
+    sm = BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-12, 1e-12)
+    lin = R.linearise(sm, paper_fixed_point.x, paper_fixed_point.jacobian_variational,
+                      disturbance)
+    g_lin = lin.gsn()
+    g_nl = R.gsn_nonlinear(sm, paper_fixed_point.x, disturbance, 1e-5, steps=60)
+    assert g_lin > 1.0
+    assert abs(g_lin - g_nl) / g_lin < 1e-3
+
+
+def test_state_norm_depends_on_coordinates_multipliers_do_not(paper_fixed_point, paper_scene):
+    """Jin et al. 2021: the multipliers are the same in absolute and relative angles
+    (similar Jacobians, to 1e-12), a state-indicator norm is not (differs by > 0.1 %)."""
+    from walkerlab.analysis import robustness as R
+
+    A = paper_fixed_point.jacobian_variational
+    names = build_walker(paper_scene).state_names()
+    T = R.relative_coordinates(names)
+    ev = np.sort(np.abs(np.linalg.eigvals(A)))
+    evT = np.sort(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T))))
+    np.testing.assert_allclose(ev, evT, rtol=0, atol=1e-12)
+    lin = R.Linearisation(A, np.array([-0.96, -1.04, -1.19, -2.43]), np.zeros((3, 4)),
+                          np.zeros(3))
+    a, b = R.state_gsn(lin), R.state_gsn(lin, T)
+    assert abs(a - b) / a > 1e-3

@@ -157,6 +157,13 @@ class BatchStepMap:
             n_extra, cols, offs = cf.guard_columns()
             self.phases.append((ph, getattr(mod, cf.name), n_extra, cols, offs,
                                 np.array([g.direction for g in ph.guards])))
+        # a step-down (or up) of the ground at the footfall: the last phase's heel strike
+        # becomes the swing foot's clearance above the slope line reaching -drop
+        lastc = walker.phases[-1].compiled
+        names = compiled_module(lastc.structure).GUARDS
+        self._hs = [j for j, g in enumerate(walker.phases[-1].guards)
+                    if g.outcome == "heel_strike"]
+        self._clear = names.index("swing_clearance") if "swing_clearance" in names else None
         first = walker.phases[0].compiled
         self._constants = compiled_module(first.structure).constants
         self._params = np.array(first.params, dtype=float)
@@ -205,7 +212,8 @@ class BatchStepMap:
         return np.ascontiguousarray(np.stack(rows)[inv.ravel()])
 
     # -- the map --------------------------------------------------------------------------
-    def step(self, X: np.ndarray, gamma: np.ndarray | float | None = None) -> BatchStep:
+    def step(self, X: np.ndarray, gamma: np.ndarray | float | None = None,
+             drop_m: np.ndarray | float | None = None) -> BatchStep:
         """One step of every row.
 
         Parameters
@@ -214,6 +222,17 @@ class BatchStepMap:
             Role-ordered states just after a heel strike.
         gamma : ndarray (N,) or float, optional
             Slope of this step [rad] for each row; default the walker's slope.
+        drop_m : ndarray (N,) or float, optional
+            The ground at this step's footfall lies ``drop_m`` [m] below the slope line
+            through the stance foot (a step-down; negative: a step-up), measured as the
+            model's swing-foot clearance above that line: the heel strike is the clearance
+            reaching ``-drop_m`` after mid-stance (``drop_m = 0`` is the ordinary heel
+            strike, up to its root).
+
+        Raises
+        ------
+        ValueError
+            ``drop_m`` for a walker whose generated model has no swing-foot clearance.
 
         Returns
         -------
@@ -224,22 +243,34 @@ class BatchStepMap:
         gamma = np.broadcast_to(self.slope_rad if gamma is None else
                                 np.asarray(gamma, dtype=float), (N,)).copy()
         D = self.data(gamma)
+        nc = D.shape[1]
+        if drop_m is not None:
+            if self._clear is None:
+                raise ValueError(f"{self.walker.name}: no swing-foot clearance in the model; "
+                                 "a step-down cannot be located")
+            drop = np.broadcast_to(np.asarray(drop_m, dtype=float), (N,))
+            D = np.hstack([D, drop[:, None]])
         out = BatchStep(np.full(N, TIMEOUT, np.int8), np.full((N, m), np.nan),
                         np.full((N, m), np.nan), np.full(N, np.nan))
         rows, Y, T = np.arange(N), X.copy(), np.zeros(N)
         for k, phase in enumerate(self.phases):
             if rows.size == 0:
                 break
-            rows, Y, T = self._phase(k, phase, rows, Y, T, D, gamma, out)
+            rows, Y, T = self._phase(k, phase, rows, Y, T, D, nc, gamma, out)
         return out
 
-    def _phase(self, k, phase, rows, Y, T, D, gamma, out):
+    def _phase(self, k, phase, rows, Y, T, D, nc, gamma, out):
         """Integrate rows through phase ``k``; returns the rows that go on to phase k + 1
-        (their entry states and times)."""
+        (their entry states and times).  ``D[:, :nc]`` are the data vectors; a column
+        after them is the per-row drop of the footfall [m] (last phase only)."""
         from scipy.integrate import DOP853
         from scipy.optimize.elementwise import find_root
 
         ph, cfunc, n_extra, gcols, goffs, dirs = phase
+        drop = D.shape[1] > nc and k == len(self.phases) - 1
+        if drop:
+            gcols = gcols.copy()
+            gcols[self._hs] = self._clear
         kern = _kernel()
         m = self.n
         last = k == len(self.phases) - 1
@@ -253,11 +284,15 @@ class BatchStepMap:
         def guards(Yr, Dr):
             dY = np.empty_like(Yr)
             G = np.empty((Yr.shape[0], n_extra))
-            _entry(kern, cfunc, np.ascontiguousarray(Yr), np.ascontiguousarray(Dr), dY, G)
-            return G[:, gcols] + goffs
+            _entry(kern, cfunc, np.ascontiguousarray(Yr), np.ascontiguousarray(Dr[:, :nc]), dY,
+                   G)
+            vals = G[:, gcols] + goffs
+            if drop:
+                vals[:, self._hs] += Dr[:, nc:nc + 1]
+            return vals
 
         def make_solver(Y0, Dr, t0, h):
-            def fun(t, y, _D=Dr):
+            def fun(t, y, _D=np.ascontiguousarray(Dr[:, :nc])):
                 Yr = y.reshape(-1, m)
                 dY = np.empty_like(Yr)
                 G = np.empty((Yr.shape[0], n_extra))
