@@ -234,7 +234,8 @@ class MeshResult:
     h, radius : float
         Spacing and ball radius [standard deviations].
     escaped : float
-        Largest probability, over vertices, of a transition leaving the ball (pulled back).
+        Share of the quasi-stationary fall rate that is probability leaving the ball
+        (counted as falls).
     steps_evaluated : int
     """
 
@@ -324,21 +325,31 @@ def transition_matrix(images: np.ndarray, ok: np.ndarray, weights: np.ndarray,
     return Q, escaped
 
 
-def solve_mesh(Q, start: int) -> tuple[float, float, float, np.ndarray]:
-    """``(mfpt from start, quasi-stationary mfpt, lambda_2, expected heel strikes (k,))``
-    of the absorbing chain with transient block ``Q`` (heel strikes = transitions - 1)."""
+def solve_mesh(Q, start: int, escaped: np.ndarray | None = None):
+    """``(mfpt from start, quasi-stationary mfpt, lambda_2, expected heel strikes (k,),
+    escape share)`` of the absorbing chain with transient block ``Q`` (heel strikes =
+    transitions - 1).  ``escape share``: the part of the quasi-stationary fall rate that is
+    probability leaving the mesh (``escaped``, per vertex), NaN without it."""
     from scipy.sparse import identity
-    from scipy.sparse.linalg import eigs, spsolve
+    from scipy.sparse.linalg import ArpackNoConvergence, eigs, spsolve
 
     k = Q.shape[0]
     m = spsolve((identity(k, format="csc") - Q.tocsc()), np.ones(k))
-    try:
-        lam = eigs(Q, k=1, which="LM", return_eigenvectors=False, maxiter=5000, tol=1e-10)
-        lam2 = float(np.max(np.real(lam)))
-    except Exception:  # noqa: BLE001 - ARPACK non-convergence: dense fallback on a small mesh
-        lam2 = float(np.max(np.real(np.linalg.eigvals(Q.toarray())))) if k < 4000 else math.nan
+    try:  # the quasi-stationary distribution: left eigenvector of lambda_2
+        lam, vec = eigs(Q.T.tocsr(), k=1, which="LM", maxiter=5000, tol=1e-10)
+        lam2, pi = float(np.real(lam[0])), np.abs(np.real(vec[:, 0]))
+    except ArpackNoConvergence:
+        w, V = np.linalg.eig(Q.toarray().T)
+        j = int(np.argmax(np.real(w)))
+        lam2, pi = float(np.real(w[j])), np.abs(np.real(V[:, j]))
+    pi = pi / pi.sum()
+    share = math.nan
+    if escaped is not None:
+        fall = 1.0 - np.asarray(Q.sum(axis=1)).ravel()
+        rate = float(pi @ fall)
+        share = float(pi @ escaped) / rate if rate > 0 else 0.0
     qs = 1.0 / (1.0 - lam2) - 1.0 if lam2 < 1 else math.inf
-    return float(m[start] - 1.0), qs, lam2, m - 1.0
+    return float(m[start] - 1.0), qs, lam2, m - 1.0, share
 
 
 def mesh_mfpt(step_map: BatchStepMap, chart: MeshChart, sd: float, h: float, radius: float,
@@ -370,8 +381,8 @@ def mesh_mfpt(step_map: BatchStepMap, chart: MeshChart, sd: float, h: float, rad
     Q, esc = transition_matrix(xn.reshape(k, q, -1), ok.reshape(k, q), w, verts, chart, h,
                                radius)
     start = int(np.flatnonzero(np.all(verts == 0, axis=1))[0])
-    m0, qs, lam2, m = solve_mesh(Q, start)
-    return MeshResult(m0, qs, lam2, k, h, radius, float(esc.max()), k * q, m)
+    m0, qs, lam2, m, share = solve_mesh(Q, start, esc)
+    return MeshResult(m0, qs, lam2, k, h, radius, share, k * q, m)
 
 
 def mesh_mfpt_converged(step_map: BatchStepMap, chart: MeshChart, sd: float,

@@ -13,7 +13,7 @@ Layout (netCDF-4 conventions: ``sigma_rad`` is the coordinate / dimension scale)
     mesh_cells                      (sigma,)  -      vertices of the finest mesh
     mesh_change                     (sigma,)  -      relative MFPT change at the last refinement
     mesh_converged                  (sigma,)  -      change < the scene's mesh_rel_change
-    mesh_escaped                    (sigma,)  -      largest off-mesh probability of a vertex
+    mesh_escaped                    (sigma,)  -      off-mesh share of the fall rate
     mesh_wall_time_s, montecarlo_wall_time_s (sigma,) s
 """
 
@@ -40,8 +40,8 @@ VARIABLES = {
     "mesh_cells": ("-", "vertices of the finest mesh"),
     "mesh_change": ("-", "relative MFPT change between the last two meshes"),
     "mesh_converged": ("-", "1 if mesh_change < mfpt.mesh_rel_change"),
-    "mesh_escaped": ("-", "largest probability of leaving the mesh from a vertex "
-                     "(counted as a fall)"),
+    "mesh_escaped": ("-", "share of the quasi-stationary fall rate that is probability "
+                     "leaving the mesh (counted as falls)"),
     "mesh_wall_time_s": ("s", "mesh wall time (all refinements)"),
 }
 
@@ -87,7 +87,7 @@ def write(f, data: MfptData) -> None:
     units = ("rad", "standard deviations", "-", "steps", "-")
     for c, u in zip(cols, units):
         put(f, f"mesh_history/{c}", np.array([r[c] for r in hist], float), u,
-            f"every mesh computed: {c}")
+            f"every mesh computed: {c}", dims=("mesh",))
 
 
 def load(path: Path) -> MfptData:
