@@ -204,14 +204,16 @@ def test_mfpt_stage_artifact_and_figure(tmp_path):
     assert again.reused
 
 
-def test_step_down_of_zero_is_the_ordinary_heel_strike(paper_map, paper_fixed_point):
-    """The step-down guard (swing-foot clearance reaching -drop) with drop 0 lands where the
-    heel-strike guard does (to the root finder's tolerance); a 10 mm step-down lands the
-    foot 10 mm below the slope line through the stance foot."""
+def test_step_down_guard_agrees_with_heel_strike_guard(paper_map, paper_fixed_point):
+    """The step-down guard (swing-foot clearance reaching -drop, armed once the foot has
+    risen) with a 1 nm drop lands where the heel-strike guard does (the two guards share
+    their zero set; 1 nm moves the state by ~1e-8); a 10 mm step-down lands the foot 10 mm
+    below the slope line through the stance foot."""
     X = np.tile(paper_fixed_point.x, (2, 1))
     a = paper_map.step(X)
-    b = paper_map.step(X, drop_m=np.array([0.0, 0.01]))
-    np.testing.assert_allclose(b.x_next[0], a.x_next[0], rtol=0, atol=1e-12)
+    b = paper_map.step(X, drop_m=np.array([1e-9, 0.01]))
+    np.testing.assert_allclose(b.x_next[0], a.x_next[0], rtol=0, atol=1e-7)
+    assert np.max(np.abs(b.x_next[0] - a.x_next[0])) > 0  # the clearance guard was used
     foot = paper_map.walker.points(b.x_pre[1])["swing_foot"]
     below = -(foot[1] + foot[0] * math.tan(paper_map.slope_rad))
     assert abs(below - 0.01) < 1e-4  # vertical drop; clearance ~ perpendicular (cos 1 deg)
@@ -250,3 +252,15 @@ def test_state_norm_depends_on_coordinates_multipliers_do_not(paper_fixed_point,
                           np.zeros(3))
     a, b = R.state_gsn(lin), R.state_gsn(lin, T)
     assert abs(a - b) / a > 1e-3
+
+
+def test_largest_step_down_and_up_of_the_paper_walker(paper_map, paper_fixed_point):
+    """The paper walker survives a single step-down of a few millimetres only (measured 5 mm
+    down, 3 mm up on a 1 mm grid): survival is monotone on the grid (every value below the
+    answer survives 40 steps, the next one falls), and the answer is between 1 and 20 mm."""
+    from walkerlab.analysis import robustness as R
+
+    for sign in (1.0, -1.0):
+        h = R.largest_tolerable(paper_map, paper_fixed_point.x, "floor_height", 0.02, 0.001,
+                                sign=sign)
+        assert 0.001 <= h < 0.02

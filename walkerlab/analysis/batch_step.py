@@ -226,8 +226,8 @@ class BatchStepMap:
             The ground at this step's footfall lies ``drop_m`` [m] below the slope line
             through the stance foot (a step-down; negative: a step-up), measured as the
             model's swing-foot clearance above that line: the heel strike is the clearance
-            reaching ``-drop_m`` after mid-stance (``drop_m = 0`` is the ordinary heel
-            strike, up to its root).
+            reaching ``-drop_m`` after the foot has risen above both ground levels (rows
+            with ``drop_m = 0`` keep the ordinary heel-strike guard).
 
         Raises
         ------
@@ -267,10 +267,12 @@ class BatchStepMap:
         from scipy.optimize.elementwise import find_root
 
         ph, cfunc, n_extra, gcols, goffs, dirs = phase
+        # a step-down/up (rows with a nonzero drop, last phase): the heel strike is the
+        # swing foot's clearance reaching -drop, armed once the foot has risen above both
+        # ground levels (just after mid-stance a point foot is below the slope line: the
+        # scuffing the ideal model ignores, which must not count as the landing)
         drop = D.shape[1] > nc and k == len(self.phases) - 1
-        if drop:
-            gcols = gcols.copy()
-            gcols[self._hs] = self._clear
+        hs = self._hs[0] if self._hs else None
         kern = _kernel()
         m = self.n
         last = k == len(self.phases) - 1
@@ -280,6 +282,8 @@ class BatchStepMap:
         out.outcome[rows[~ok]] = TIMEOUT
         rows, Y, T, cap = rows[ok], Y[ok], T[ok], cap[ok]
         Dk = D[rows]
+        if drop:  # one more column: armed (1) or not (0)
+            Dk = np.hstack([Dk, np.zeros((rows.size, 1))])
 
         def guards(Yr, Dr):
             dY = np.empty_like(Yr)
@@ -288,7 +292,8 @@ class BatchStepMap:
                    G)
             vals = G[:, gcols] + goffs
             if drop:
-                vals[:, self._hs] += Dr[:, nc:nc + 1]
+                dr = Dr[:, nc] != 0
+                vals[dr, hs] = G[dr, self._clear] + Dr[dr, nc]
             return vals
 
         def make_solver(Y0, Dr, t0, h):
@@ -316,6 +321,11 @@ class BatchStepMap:
             up = (G_old <= 0) & (G_new >= 0) & (dirs >= 0)
             down = (G_old >= 0) & (G_new <= 0) & (dirs <= 0)
             hit = up | down
+            if drop:
+                dr = Dk[:, nc] != 0
+                hit[dr, hs] &= Dk[dr, nc + 1] > 0
+                clearance = G_new[:, hs] - Dk[:, nc]
+                Dk[dr & (clearance > np.maximum(0.0, -Dk[:, nc])), nc + 1] = 1.0
             done = hit.any(axis=1)
             te = np.full(rows.size, np.inf)
             which = np.full(rows.size, -1)
