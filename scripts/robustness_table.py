@@ -22,9 +22,9 @@ WALKERS = ("paper", "goswami1996", "paper_rods", "round_feet", "kneed", "simples
 def row(name: str) -> str:
     from walkerlab.analysis import robustness as R
     from walkerlab.analysis.batch_step import BatchStepMap
+    from walkerlab.analysis.scene_gaits import solve_scene
     from walkerlab.config import load_scene
     from walkerlab.models.registry import build_walker
-    from walkerlab.stages.fixedpoint import solve_scene
     from walkerlab.sweep.mfpt import scene_walker_at
 
     t = time.perf_counter()

@@ -10,8 +10,8 @@ import yaml
 
 from walkerlab.analysis import mfpt as M
 from walkerlab.analysis.batch_step import HEEL_STRIKE, BatchStepMap
-from walkerlab.analysis.hybrid import Solver, integrate_step
 from walkerlab.config import load_scene
+from walkerlab.integrate.rigid import Solver, integrate_step
 from walkerlab.models.registry import build_walker
 from walkerlab.sweep.mfpt import scene_walker_at
 
@@ -104,7 +104,7 @@ def test_no_noise_no_fall_and_unstable_gait_falls(paper_scene, paper_map):
     """sigma -> 0: walks on the stable long-period gait (|lambda| 0.586) never fall (MFPT
     infinite); from the unstable short-period gait (|lambda| 2.44) the same noise makes
     walks fall within a few steps (those that do not fall drift to the stable gait)."""
-    from walkerlab.stages.fixedpoint import solve_scene
+    from walkerlab.analysis.scene_gaits import solve_scene
 
     _, search = solve_scene(paper_scene, fd_check=False)
     gaits = {g.label: g.result for g in search.gaits}
@@ -183,6 +183,7 @@ def test_mfpt_stage_artifact_and_figure(tmp_path):
     coordinate and variables, read back by its loader, and the figure."""
     from walkerlab.io.schemas.mfpt import VARIABLES, load
     from walkerlab.stages import mfpt as stage
+    from walkerlab.stages import pipeline
 
     d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
     for k in ("contact", "terrain", "contact_sim", "contact_solver", "workprecision",
@@ -192,7 +193,7 @@ def test_mfpt_stage_artifact_and_figure(tmp_path):
     p = tmp_path / "paper_mfpt.yaml"
     p.write_text(yaml.safe_dump(d))
     sc = load_scene(p)
-    out = stage.run(sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
+    out = pipeline.run("mfpt", sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
     data = load(out.path)
     assert list(data.sigma_rad) == [0.008]
     assert set(VARIABLES) <= set(data.values)
@@ -200,7 +201,7 @@ def test_mfpt_stage_artifact_and_figure(tmp_path):
     assert 0 <= m < 60 and data["montecarlo_falls"][0] > 0
     assert np.isnan(data["mfpt_steps_mesh"][0])
     assert stage.figure_path(sc, tmp_path / "runs").is_file()
-    again = stage.run(sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
+    again = pipeline.run("mfpt", sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
     assert again.reused
 
 

@@ -400,8 +400,8 @@ def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import mfpt as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_scene(scene), runs_dir, force, sigma_rad=sigma_rad, method=method,
-                    workers=workers)
+    out = pipeline.run("mfpt", _scene(scene), runs_dir, force, sigma_rad=sigma_rad,
+                       method=method, workers=workers)
     return _read(out.path)

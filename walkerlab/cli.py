@@ -460,9 +460,11 @@ def mfpt(scene: Path | None = SceneArg,
         except ValueError:
             _fail(ValueError(f"--sigma-rad: expected numbers separated by commas, got "
                              f"{sigma_rad!r}"))
+    from walkerlab.stages import pipeline
+
     sc = _load(scene)
-    out = stage.run(sc, runs_dir, force, sigma_rad=sig, method=method, workers=workers,
-                    scheduler=scheduler)
+    out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
+                       workers=workers, scheduler=scheduler)
     if out.summary:
         for s, m, me in zip(out.summary["sigma_rad"], out.summary["mfpt_steps_montecarlo"],
                             out.summary["mfpt_steps_mesh"]):

@@ -1,6 +1,7 @@
 """Stage ``mfpt``: mean first-passage time on per-step random slopes -> ``mfpt.h5`` (+ figure).
 
-Reads the scene's ``mfpt`` section (defaults when absent), ``terrain.per_step`` (distribution
+Reads (after the pipeline has run ``fixedpoint``, :mod:`walkerlab.stages.pipeline`) the
+scene's ``mfpt`` section (defaults when absent), ``terrain.per_step`` (distribution
 and seed) and the gait from ``fixedpoint.h5``; the walks and mesh cells run on local
 processes or Dask (:mod:`walkerlab.sweep.mfpt`).  Skipped when the scene sections, the sigma
 list, the method, the upstream gait and the code are unchanged.
@@ -16,7 +17,7 @@ import numpy as np
 
 from walkerlab.config import CommandOptions, MfptSettings, Scene, validate_option
 from walkerlab.io.runpaths import artifact_lock, stage_artifact
-from walkerlab.stages import fixedpoint as fixedpoint_stage
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,
@@ -47,6 +48,29 @@ def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     return save(fig, figure_path(scene, runs_root).parent, "mfpt")
 
 
+def check(scene: Scene, sigma_rad: list[float] | None = None, method: str | None = None,
+          workers: int = 2, **_options) -> tuple[MfptSettings, int]:
+    """The settings (``mfpt`` section with the command-line overrides) and worker count,
+    checked before anything runs.
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section, or an option out of bounds (one line).
+    """
+    require(scene, "fixedpoint", "mfpt")
+    st = scene.mfpt or MfptSettings()
+    if sigma_rad is not None:
+        sigma_rad = validate_option(MfptSettings, "sigma_rad", list(sigma_rad), "--sigma-rad",
+                                    "mfpt.sigma_rad")
+    if method is not None:
+        method = validate_option(MfptSettings, "method", method, "--method", "mfpt.method")
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
+    st = st.model_copy(update={k: v for k, v in (("sigma_rad", sigma_rad), ("method", method))
+                               if v is not None})
+    return st, workers
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         sigma_rad: list[float] | None = None, method: str | None = None, workers: int = 2,
         scheduler=None) -> StageOutcome:
@@ -69,17 +93,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         No ``fixedpoint`` section, bad settings, or a walker the per-step terrain cannot
         carry (one line).
     """
-    require(scene, "fixedpoint", "mfpt")
-    st = scene.mfpt or MfptSettings()
-    if sigma_rad is not None:
-        sigma_rad = validate_option(MfptSettings, "sigma_rad", list(sigma_rad), "--sigma-rad",
-                                    "mfpt.sigma_rad")
-    if method is not None:
-        method = validate_option(MfptSettings, "method", method, "--method", "mfpt.method")
-    workers = validate_option(CommandOptions, "workers", workers, "--workers")
-    st = st.model_copy(update={k: v for k, v in (("sigma_rad", sigma_rad), ("method", method))
-                               if v is not None})
-    fixedpoint_stage.run(scene, runs_root)
+    st, workers = check(scene, sigma_rad, method, workers)
     up = artifact_path(scene, runs_root, "fixedpoint")
     path = stage_artifact(scene, runs_root, "mfpt", claim=True)
     with artifact_lock(path, wait=True, on_wait=_tell):
@@ -102,7 +116,7 @@ def _run_locked(scene, runs_root, force, st, workers, scheduler, up, path) -> St
 
         note = recompute_reason(path, scene, SECTIONS, verified_hash(path))
         _tell(f"mfpt: recomputing {path} ({note})")
-    x_star, _ = fixedpoint_stage.load_fixed_point(up)
+    x_star = load_fixedpoint(up).x
     t0 = time.perf_counter()
     try:
         data = compute(scene, x_star, st, workers, scheduler)

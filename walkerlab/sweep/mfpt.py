@@ -3,8 +3,8 @@
 Monte Carlo walks are dealt out in chunks of walk numbers (each walk's slopes come from its
 own random stream, so a chunk's result does not depend on the chunking or the executor);
 the mesh's step-map images are dealt out in chunks of (state, slope) rows.  Both go through
-:func:`walkerlab.sweep.runner.iter_chunk_results` (in this process, a local process pool or a
-Dask cluster, unchanged).
+:func:`walkerlab.execution.executor.run_each` on :func:`walkerlab.sweep.runner.sweep_executor`
+(in this process, a local process pool or a Dask cluster, unchanged).
 """
 
 from __future__ import annotations
@@ -95,7 +95,8 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
                 ) -> M.MonteCarloResult:
     """Monte Carlo MFPT walks of a scene at one sigma [rad] (see
     :func:`walkerlab.analysis.mfpt.monte_carlo`), chunked over the executor."""
-    from walkerlab.sweep.runner import iter_chunk_results
+    from walkerlab.execution.executor import run_each
+    from walkerlab.sweep.runner import sweep_executor
 
     base = scene.model_dump(mode="json")
     tasks = [WalkTask(base, tuple(float(v) for v in x0), float(sd),
@@ -104,15 +105,17 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
              for i, a in enumerate(range(0, walks, WALKS_PER_TASK))]
     steps = np.zeros(walks, dtype=np.int64)
     fell = np.zeros(walks, dtype=bool)
-    for i, s, f in iter_chunk_results(tasks, workers, scheduler, fn=run_walks):
-        a = i * WALKS_PER_TASK
-        steps[a:a + s.size], fell[a:a + f.size] = s, f
+    with sweep_executor(workers, scheduler) as ex:
+        for _, (i, s, f) in run_each(ex, run_walks, [(t,) for t in tasks]):
+            a = i * WALKS_PER_TASK
+            steps[a:a + s.size], fell[a:a + f.size] = s, f
     return M.MonteCarloResult(steps, fell)
 
 
 def image_evaluator(scene, workers: int = 1, scheduler=None):
     """``(X, gamma) -> (x_next, ok)`` over the executor (for :func:`M.mesh_mfpt`)."""
-    from walkerlab.sweep.runner import iter_chunk_results
+    from walkerlab.execution.executor import run_each
+    from walkerlab.sweep.runner import sweep_executor
 
     base = scene.model_dump(mode="json")
 
@@ -122,8 +125,9 @@ def image_evaluator(scene, workers: int = 1, scheduler=None):
                  for a in range(0, n, ROWS_PER_TASK)]
         xn = np.full_like(X, np.nan)
         ok = np.zeros(n, dtype=bool)
-        for a, x, o in iter_chunk_results(tasks, workers, scheduler, fn=run_images):
-            xn[a:a + x.shape[0]], ok[a:a + o.size] = x, o
+        with sweep_executor(workers, scheduler) as ex:
+            for _, (a, x, o) in run_each(ex, run_images, [(t,) for t in tasks]):
+                xn[a:a + x.shape[0]], ok[a:a + o.size] = x, o
         return xn, ok
     return evaluate
 
