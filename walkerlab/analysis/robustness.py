@@ -53,7 +53,10 @@ def _indicators(sm: BatchStepMap, res) -> np.ndarray:
         Xp = res.x_pre[ok].T
         foot = np.asarray(w.points(Xp)["swing_foot"])
         stance = w.legs[-1]
-        ang = np.asarray(w.leg_coordinates(Xp, stance)[f"{stance}_angle"])
+        coords = w.leg_coordinates(Xp, stance)
+        # the stance leg is straight: its angle, or (kneed walker) its thigh's
+        key = f"{stance}_angle" if f"{stance}_angle" in coords else f"{stance}_thigh_angle"
+        ang = np.asarray(coords[key])
         out[ok] = np.column_stack([res.step_time_s[ok], np.hypot(foot[0], foot[1]), ang])
     return out
 
