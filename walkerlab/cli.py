@@ -234,13 +234,17 @@ def _status(o) -> str:
 @app.command()
 @_guard
 def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-               force: bool = ForceOpt) -> None:
+               force: bool = ForceOpt,
+               known: Path | None = typer.Option(None, "--from", help="a scene whose gait is "
+                                                 "known: continue it along the straight line "
+                                                 "between the two scenes' numeric fields to "
+                                                 "this walker (homotopy)")) -> None:
     """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
     from walkerlab.io.schemas.fixedpoint import load_fixedpoint
     from walkerlab.report.text import fixedpoint_text
     from walkerlab.stages import pipeline
 
-    out = pipeline.run("fixedpoint", _load(scene), runs_dir, force)
+    out = pipeline.run("fixedpoint", _load(scene), runs_dir, force, known=known)
     typer.echo(fixedpoint_text(load_fixedpoint(out.path)))
     typer.echo(_status(out))
 
@@ -400,6 +404,60 @@ def bifurcation(scene: Path | None = SceneArg,
              else f"{axis.path} = {onset:.6g} {unit}".removesuffix(" -"))
     typer.echo(f"period-doubling onset: {where}" if onset == onset
                else "period-doubling onset: none on the grid")
+    typer.echo(_status(out))
+    typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
+
+
+def _range_spec(text: str, opt: str) -> tuple[str, float, float]:
+    """``FIELD=START:STOP`` -> (field, start, stop); one-line error otherwise."""
+    from walkerlab.sweep.params import SweepError
+
+    path, _, rhs = text.partition("=")
+    parts = rhs.split(":")
+    try:
+        if not path.strip() or len(parts) != 2:
+            raise ValueError
+        a, b = float(parts[0]), float(parts[1])
+        if not (a == a and b == b) or a == b:
+            raise ValueError
+    except ValueError:
+        raise SweepError(f"{opt} {text!r}: expected FIELD=START:STOP (two different "
+                         "numbers in the field's unit)") from None
+    return path.strip(), a, b
+
+
+@app.command()
+@_guard
+def continuation(scene: Path | None = SceneArg,
+                 param: str = typer.Option(..., "--param", help="FIELD=START:STOP, any "
+                                           "numeric scene field in its unit (e.g. "
+                                           "slope.angle_deg=0.5:5.2)"),
+                 switch: bool = typer.Option(False, "--switch", help="switch at period "
+                                             "doublings to the period-2 and period-4 "
+                                             "branches"),
+                 param2: str | None = typer.Option(None, "--param2", help="FIELD2=START:STOP: "
+                                                   "continue each fold and period doubling "
+                                                   "in the plane of both fields"),
+                 runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Pseudo-arclength continuation of the scene's gait over a field: folds, period
+    doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5."""
+    from walkerlab.stages import continuation as stage
+
+    path, a, b = _range_spec(param, "--param")
+    p2 = _range_spec(param2, "--param2") if param2 else None
+    out = stage.run(_load(scene), path, a, b, 2 if switch else 0,
+                    p2[0] if p2 else None, p2[1:] if p2 else None, runs_dir, force)
+    data = out.summary["data"]
+    sp = data.special
+    unit = "" if data.unit == "-" else f" {data.unit}"
+    for i, kind in enumerate(sp["kind"]):
+        cause = f" ({sp['cause'][i]})" if kind == "branch_end" else ""
+        typer.echo(f"{kind:16s} period {int(sp['period'][i])}  {path} = "
+                   f"{float(sp['param'][i]):.10g}{unit}{cause}")
+    if not len(sp["kind"]):
+        typer.echo("no special point in the range")
+    for c in data.curves:
+        typer.echo(f"{c['kind']} curve over {c['path2']}: {len(c['param2'])} points")
     typer.echo(_status(out))
     typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
 

@@ -208,6 +208,12 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     step_pub = getattr(pub, "STEP_LENGTH_M", None)
     rows.append(["Step length", "Δx", u.length, *([printed(step_pub)] * 2 if t3 else []),
                  *(num(c["step_length_m"]) for c in cols.values())])
+    per_leg = [(c.get("step_length_left_m", np.nan), c.get("step_length_right_m", np.nan))
+               for c in cols.values()]
+    if any(abs(a - b) > 1e-4 for a, b in per_leg):  # legs that differ: each leg's step
+        for i, side in enumerate(("Left", "Right")):
+            rows.append([f"{side} step length", f"Δx_{side[0].lower()}", u.length, *blank,
+                         *(num(v[i]) for v in per_leg)])
     title = "## Table 3 — gait characteristics" if t3 else "## Gait characteristics"
     out = [title, "", "Recomputed from the trajectory artifacts ("
            + ", ".join(f"`{arts[s].path.name}`" for s in ("simulate", "contact-sim") if s in arts)
