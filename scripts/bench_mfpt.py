@@ -19,8 +19,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def cpu_s() -> float:
-    """User + system CPU time of this process and its reaped children (the pool's workers)
-    [s]: the figure to quote on a shared machine, where wall time depends on the load."""
+    """User + system CPU time of this process and its reaped children [s] (worker processes
+    started through a forkserver are not its children: time the whole command from outside,
+    e.g. ``/usr/bin/time -v``, for their CPU time)."""
     import resource
 
     a, b = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -52,8 +53,8 @@ def main() -> None:
     out["montecarlo"] = {"sigma_rad": a.sigma_mc, "steps": n, "wall_s": wall, "cpu_s": cpu,
                          "us_per_step": 1e6 * wall / n, "falls": int(mc.fell.sum()),
                          "goal": "1e5 steps <= 10 s"}
-    print(f"Monte Carlo: {n} steps in {wall:.2f} s wall, {cpu:.2f} s CPU "
-          f"({1e6 * cpu / n:.0f} us CPU/step, {a.workers} workers)")
+    print(f"Monte Carlo: {n} steps in {wall:.2f} s wall ({1e6 * wall / n:.0f} us/step, "
+          f"{a.workers} workers; this process's CPU {cpu:.2f} s)")
     if not a.skip_mesh:
         st = MfptSettings()
         t, c = time.perf_counter(), cpu_s()
