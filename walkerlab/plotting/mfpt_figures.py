@@ -32,7 +32,8 @@ def mfpt_figure(d, title: str = ""):
     okm = np.isfinite(me)
     if okm.any():
         conv = d["mesh_converged"] > 0.5
-        ax.plot(s[okm], me[okm], "s--", color="#d62728", mfc="none", label="mesh")
+        ax.plot(s[okm], me[okm], "s--", color="#d62728", mfc="none",
+                label="mesh (open: not converged)")
         if (okm & conv).any():
             ax.plot(s[okm & conv], me[okm & conv], "s", color="#d62728",
                     label="mesh, converged (< 5 % on refinement)")
