@@ -512,6 +512,41 @@ def basin(scene: Path | None = SceneArg,
     typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir)}")
 
 
+@app.command()
+@_guard
+def mfpt(scene: Path | None = SceneArg,
+         sigma_rad: str | None = typer.Option(None, "--sigma-rad", help="per-step slope "
+                                              "standard deviations in rad, e.g. "
+                                              "0.002,0.003,0.004 (default: mfpt.sigma_rad)"),
+         method: str | None = typer.Option(None, "--method", help="mesh | montecarlo | both "
+                                           "(default: mfpt.method, both)"),
+         workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+         scheduler: str | None = typer.Option(None, "--scheduler",
+                                               help="Dask scheduler address (tcp://host:port)"),
+         runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Mean first-passage time (steps before the fall) on per-step random slopes."""
+    from walkerlab.stages import mfpt as stage
+
+    sig = None
+    if sigma_rad is not None:
+        try:
+            sig = [float(v) for v in sigma_rad.split(",") if v.strip()]
+        except ValueError:
+            _fail(ValueError(f"--sigma-rad: expected numbers separated by commas, got "
+                             f"{sigma_rad!r}"))
+    from walkerlab.stages import pipeline
+
+    sc = _load(scene)
+    out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
+                       workers=workers, scheduler=scheduler)
+    if out.summary:
+        for s, m, me in zip(out.summary["sigma_rad"], out.summary["mfpt_steps_montecarlo"],
+                            out.summary["mfpt_steps_mesh"]):
+            typer.echo(f"sigma {s:.4g} rad: MFPT Monte Carlo {m:.4g}, mesh {me:.4g} steps")
+    typer.echo(_status(out))
+    typer.echo(f"figure: {stage.figure_path(sc, runs_dir)}")
+
+
 @app.command("stability-map")
 @_guard
 def stability_map(scene: Path | None = SceneArg,

@@ -14,10 +14,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    model_serializer,
+    model_validator,
+)
 
 __all__ = ["MAX_CONTACT_STRIDES", "ContactParamsSI", "ContactSettings", "ContactSimSettings",
-           "ContactSolverSettings", "KneeStopSI", "KneeStopSettings", "TerrainSettings"]
+           "ContactSolverSettings", "KneeStopSI", "KneeStopSettings", "PerStepTerrain",
+           "TerrainSettings"]
 
 
 @dataclass(frozen=True)
@@ -248,6 +256,24 @@ class ContactSettings(BaseModel):
         )
 
 
+class PerStepTerrain(BaseModel):
+    """Per-step ground of the rigid model (Byl & Tedrake 2009, "Metastable walking machines").
+
+    Step ``n`` is taken on the straight line through the stance foot at slope ``gamma_n``
+    (for a compass walker the heel-strike guard becomes ``theta_swing + theta_stance =
+    -2 gamma_n``).  ``gamma_n`` is drawn i.i.d. about the scene's slope (``slope_sd_rad``;
+    ``normal`` or ``uniform`` with the same standard deviation), reproducibly from ``seed``.
+    """
+
+    model_config = _STRICT
+
+    slope_distribution: Literal["normal", "uniform"] = Field(
+        "normal", description="distribution of each step's slope about the scene's slope")
+    slope_sd_rad: float = Field(0.0, ge=0, le=0.2,
+                                description="standard deviation of each step's slope [rad]")
+    seed: int = Field(0, ge=0, description="seed of the per-step draws [-]")
+
+
 class TerrainSettings(BaseModel):
     """Ground geometry: continuous slope or the paper's 'checkerboard' lanes.
 
@@ -265,6 +291,17 @@ class TerrainSettings(BaseModel):
     patch_width_m: float = Field(
         0.10, gt=0, description="Width of each checkerboard patch along the slope [m]."
     )
+    per_step: PerStepTerrain | None = Field(
+        None, description="Ground that changes from step to step (rough terrain, a step-down); "
+        "used by the rigid model's metastability and disturbance studies (walkerlab mfpt)")
+
+    @model_serializer(mode="wrap")
+    def _drop_unset_per_step(self, handler):
+        # a scene without per-step terrain serialises as before (same content hashes)
+        d = handler(self)
+        if isinstance(d, dict) and d.get("per_step") is None:
+            d.pop("per_step", None)
+        return d
 
 
 class ContactSimSettings(BaseModel):
