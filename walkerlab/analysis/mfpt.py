@@ -18,25 +18,27 @@ Monte Carlo (:func:`monte_carlo`)
     ``p = F / (S + F)``, delta method).
 
 Mesh (:func:`mesh_mfpt`)
-    The post-impact section is meshed: the post-impact states of a walker on per-step slopes
-    fill a set of dimension ``d`` (``2n - 1`` section coordinates plus the previous step's
-    slope: ``d = 4`` for a compass walker; linear constraints such as a locked knee's reduce
-    it).  The mesh lives in the principal axes of the stationary covariance of the linearised
-    noisy map (``Sigma = A Sigma A^T + sd^2 b b^T``, ``A`` the Poincaré-map Jacobian from
-    the variational equations, ``b = dP/dgamma``; :func:`scipy.linalg.solve_discrete_lyapunov`),
-    in units of its standard deviations, as a lattice of spacing ``h`` inside the ball of
-    radius ``R``: the mesh adapts to the gait and to the walker, whatever its states are
-    called.  From each vertex the step map is taken at the Gauss-Hermite nodes of the slope
-    distribution; an image is spread on the ``2^d`` vertices around it by multilinear
-    weights (an image outside the ball is pulled back radially to it, and that probability
-    is reported as ``escaped``), a fall goes to the absorbing state.  With ``Q`` the
-    transition matrix among vertices (``scipy.sparse``), the quasi-stationary MFPT is
-    ``1 / (1 - lambda_2) - 1`` (``lambda_2`` the largest eigenvalue of ``Q``,
-    ``scipy.sparse.linalg.eigs``) and the expected heel strikes from each vertex solve
+    The post-impact section is meshed where the walker actually goes (Byl & Tedrake's
+    "reachable" mesh): the nodes are post-impact states visited by noisy walks from the gait
+    at ``sd``, ``1.5 sd`` and ``2 sd`` (:func:`visited_states`), thinned to one per voxel
+    of a lattice in the whitened coordinates of that cloud (:func:`whitening`,
+    :func:`voxel_nodes`), so the tails where falls start are meshed as finely as the core.
+    The region is fixed in absolute units by the walks, not scaled to a box: a state carries
+    all it needs (the post-impact state on a per-step slope already encodes the previous
+    step's slope: ``2n`` coordinates, ``d = 4`` for a compass walker; directions without
+    spread, such as a locked knee's, drop out of the metric).  Each node is a Voronoi cell
+    (nearest node, :class:`scipy.spatial.cKDTree`); from each node the step map is taken at
+    the Gauss-Hermite nodes of the slope distribution, an image goes to its nearest node,
+    and only a genuine fall (no heel strike) goes to the absorbing state; images farther
+    from every node than 99 % of the nodes are from their neighbour are reported
+    (``escaped``: their probability per step from the quasi-stationary distribution).
+    With ``Q`` the transition matrix among nodes (``scipy.sparse``), the quasi-stationary
+    MFPT is ``1 / (1 - lambda_2) - 1`` (``lambda_2`` the largest eigenvalue of ``Q``,
+    ``scipy.sparse.linalg.eigs``) and the expected heel strikes from each node solve
     ``(I - Q) m = 1`` (minus the falling step); the MFPT from the gait is ``m`` at the gait's
-    vertex minus one.  A coarse mesh spreads probability toward the fall boundary and
-    underestimates the MFPT: :func:`mesh_mfpt_converged` refines ``h`` until the MFPT changes
-    by less than 5 %.
+    node minus one.  A coarse mesh is biased (a lattice mesh with multilinear weights
+    spreads probability toward the fall boundary): :func:`mesh_mfpt_converged` doubles the
+    nodes until the MFPT changes by less than 5 %, and that change is the stated error.
 """
 
 from __future__ import annotations
@@ -157,65 +159,48 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
 
 # -- the mesh ------------------------------------------------------------------------------
 
-@dataclass
-class MeshChart:
-    """Coordinates of the mesh: ``x = x_ref + V (scale * u)``.
+def visited_states(step_map: BatchStepMap, x0: np.ndarray, sds, walks: int, steps: int,
+                   seed: int, burn_in: int = 1) -> np.ndarray:
+    """Post-impact states visited by noisy walks from ``x0`` (the mesh's nodes).
 
-    Attributes
+    Parameters
     ----------
-    x_ref : ndarray (2n,)
-        The gait's post-impact state.
-    V : ndarray (2n, d)
-        Principal axes of the stationary covariance (orthonormal columns).
-    scale : ndarray (d,)
-        Their standard deviations at the reference sd [rad, rad/s].
+    x0 : ndarray, shape (2n,)
+    sds : sequence of float
+        Slope standard deviations [rad]; ``walks`` walks of ``steps`` steps at each.
+    burn_in : int
+        Steps of each walk not recorded.
+
+    Returns
+    -------
+    ndarray, shape (k, 2n)
+        Every post-impact state after the burn-in, falls left out, in a seeded random order
+        (so the first ``N`` rows are a fair sample of all, and meshes of growing ``N`` are
+        nested).
     """
-
-    x_ref: np.ndarray
-    V: np.ndarray
-    scale: np.ndarray
-
-    def to_state(self, U: np.ndarray) -> np.ndarray:
-        return self.x_ref + (U * self.scale) @ self.V.T
-
-    def to_chart(self, X: np.ndarray) -> np.ndarray:
-        return ((X - self.x_ref) @ self.V) / self.scale
-
-
-def slope_sensitivity(step_map: BatchStepMap, x_star: np.ndarray, h: float = 1e-6
-                      ) -> np.ndarray:
-    """``b = dP/dgamma`` (2n,) at the gait: central difference of the step map in the
-    slope of the step (the map itself is exact to ~1e-11, so ~1e-5 relative)."""
-    g = step_map.slope_rad
-    r = step_map.step(np.tile(x_star, (2, 1)), np.array([g + h, g - h]))
-    return (r.x_next[0] - r.x_next[1]) / (2 * h)
+    pts = []
+    for i, sd in enumerate(sds):
+        rng = np.random.default_rng([int(seed), 24, i])
+        X = np.tile(np.asarray(x0, float), (walks, 1))
+        for k in range(steps):
+            r = step_map.step(X, step_map.slope_rad + sd * rng.standard_normal(len(X)))
+            X = r.x_next[r.outcome == HEEL_STRIKE]
+            if k >= burn_in:
+                pts.append(X)
+            if len(X) == 0:
+                break
+    P = np.concatenate(pts) if pts else np.empty((0, len(x0)))
+    return P[np.random.default_rng([int(seed), 25]).permutation(len(P))]
 
 
-def chart_for(A: np.ndarray, b: np.ndarray, x_star: np.ndarray, sd: float,
-              rank_tol: float = 1e-9, floor: float = 0.25) -> MeshChart:
-    """Principal axes of ``Sigma = A Sigma A^T + sd^2 b b^T`` (shapes (2n, 2n), (2n,)),
-    keeping the directions whose variance exceeds ``rank_tol`` times the largest.
-
-    ``floor``: no axis is scaled below this fraction of the largest standard deviation (a
-    thin direction of the linear covariance is where the map's curvature shows first: an
-    axis scaled to its tiny linear spread would put every nonlinear image off the mesh)."""
-    from scipy.linalg import solve_discrete_lyapunov
-
-    S = solve_discrete_lyapunov(A, sd ** 2 * np.outer(b, b))
-    S = 0.5 * (S + S.T)
-    w, V = np.linalg.eigh(S)
+def whitening(P: np.ndarray, rank_tol: float = 1e-10) -> np.ndarray:
+    """``W`` (2n, d): ``(x - x') @ W`` measures distances in standard deviations of the
+    cloud ``P`` (k, 2n) along its principal axes; directions without spread (a locked
+    knee's equal thigh and shank angles) drop out, so ``d`` is the dimension of the set the
+    post-impact states fill (4 for a compass walker on per-step slopes)."""
+    w, V = np.linalg.eigh(np.cov(np.asarray(P, float).T))
     keep = w > rank_tol * w.max()
-    w, V = w[keep][::-1], V[:, keep][:, ::-1]
-    sdev = np.sqrt(w)
-    return MeshChart(np.asarray(x_star, float), V, np.maximum(sdev, floor * sdev[0]))
-
-
-def lattice(d: int, h: float, radius: float) -> np.ndarray:
-    """Integer vertices ``i`` (k, d) with ``|h i| <= radius`` (the ball of the mesh)."""
-    n = int(math.floor(radius / h))
-    axes = np.arange(-n, n + 1)
-    grid = np.stack(np.meshgrid(*([axes] * d), indexing="ij"), -1).reshape(-1, d)
-    return grid[np.sum((h * grid) ** 2, axis=1) <= radius ** 2 + 1e-12]
+    return V[:, keep] / np.sqrt(w[keep])
 
 
 @dataclass
@@ -225,17 +210,19 @@ class MeshResult:
     Attributes
     ----------
     mfpt_steps : float
-        Expected heel strikes before the fall from the gait's vertex.
+        Expected heel strikes before the fall from the gait's node.
     mfpt_quasi_stationary_steps : float
         ``1 / (1 - lambda_2) - 1``.
     lambda2 : float
     cells : int
-        Mesh vertices.
-    h, radius : float
-        Spacing and ball radius [standard deviations].
+        Nodes (Voronoi cells) of the mesh.
+    h : float
+        Voxel side of the node selection (:func:`voxel_nodes`) [standard deviations of the
+        visited cloud].
     escaped : float
-        Share of the quasi-stationary fall rate that is probability leaving the ball
-        (counted as falls).
+        Probability per step, from the quasi-stationary distribution, that a heel strike
+        lands off the mesh (farther from every node than 99 % of the nodes are from their
+        nearest neighbour); such images go to their nearest node.
     steps_evaluated : int
     """
 
@@ -244,7 +231,6 @@ class MeshResult:
     lambda2: float
     cells: int
     h: float
-    radius: float
     escaped: float
     steps_evaluated: int
     expected_steps: np.ndarray = field(repr=False, default=None)
@@ -263,73 +249,53 @@ def gauss_hermite(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarra
 
 
 def transition_matrix(images: np.ndarray, ok: np.ndarray, weights: np.ndarray,
-                      verts: np.ndarray, chart: MeshChart, h: float, radius: float,
-                      interpolation: str = "multilinear"):
-    """Sparse transition matrix among vertices from the images of every vertex.
+                      nodes: np.ndarray, W: np.ndarray):
+    """Sparse transition matrix among the Voronoi cells of ``nodes``.
 
     Parameters
     ----------
     images : ndarray (k, q, 2n)
-        Post-impact state from vertex ``i`` on slope node ``j``.
+        Post-impact state from node ``i`` on slope node ``j``.
     ok : ndarray of bool (k, q)
-        Heel strike (else a fall).
+        Heel strike (else a fall: the absorbing state).
     weights : ndarray (q,)
-    verts : ndarray of int (k, d)
-    interpolation : {"multilinear", "nearest"}
-        Spread an image on the ``2^d`` vertices of its cell (Byl & Tedrake's barycentric
-        idea on a lattice), or put it on its nearest vertex.
+        Quadrature weights.
+    nodes : ndarray (k, 2n)
+    W : ndarray (2n, d)
+        The metric (:func:`whitening`).
 
     Returns
     -------
     Q : scipy.sparse.csr_matrix (k, k)
-        Probability of going from vertex i to vertex j (rows sum to 1 - P(fall)).
-    escaped : ndarray (k,)
-        Probability of leaving the ball from each vertex.
+        Probability of going from node i to the cell of node j (rows sum to 1 - P(fall)).
+    off : ndarray (k,)
+        Probability from each node of landing off the mesh (see ``MeshResult.escaped``).
+    h : float
+        Median nearest-neighbour distance of the nodes.
     """
-    import itertools
-
     from scipy.sparse import coo_matrix
+    from scipy.spatial import cKDTree
 
     k, q, _ = images.shape
-    d = verts.shape[1]
-    index = {tuple(v): i for i, v in enumerate(verts.tolist())}
-    rows, cols, vals = [], [], []
-    escaped = np.zeros(k)
+    Z = nodes @ W
+    tree = cKDTree(Z)
+    nn = tree.query(Z, k=2)[0][:, 1]
     src = np.repeat(np.arange(k), q)[ok.ravel()]
     wq = np.tile(weights, k)[ok.ravel()]
-    U = chart.to_chart(images.reshape(k * q, -1)[ok.ravel()]) / h  # lattice units
-    r = np.linalg.norm(U, axis=1) * h
-    lim = radius - h * math.sqrt(d)  # every corner of a cell inside lim lies in the ball
-    out = r > lim  # off the mesh: counted with the falls (absorbing), and reported
-    np.add.at(escaped, src[out], wq[out])
-    src, wq, U = src[~out], wq[~out], U[~out]
-    if interpolation == "nearest":  # all of an image's weight on its nearest vertex
-        tgt = np.array([index.get(tuple(v), -1) for v in np.rint(U).astype(int).tolist()])
-        good = tgt >= 0
-        np.add.at(escaped, src[~good], wq[~good])
-        Q = coo_matrix((wq[good], (src[good], tgt[good])), shape=(k, k)).tocsr()
-        return Q, escaped
-    base = np.floor(U).astype(int)
-    frac = U - base
-    for corner in itertools.product((0, 1), repeat=d):
-        c = np.array(corner)
-        w = np.prod(np.where(c, frac, 1 - frac), axis=1) * wq
-        tgt = [index.get(tuple(v)) for v in (base + c).tolist()]
-        tgt = np.array([-1 if t is None else t for t in tgt])
-        good = (tgt >= 0) & (w > 0)
-        rows.append(src[good])
-        cols.append(tgt[good])
-        vals.append(w[good])
-    Q = coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                   shape=(k, k)).tocsr()
-    return Q, escaped
+    dist, tgt = tree.query(images.reshape(k * q, -1)[ok.ravel()] @ W)
+    off = np.zeros(k)
+    far = dist > np.percentile(nn, 99)
+    np.add.at(off, src[far], wq[far])
+    Q = coo_matrix((wq, (src, tgt)), shape=(k, k)).tocsr()
+    return Q, off, float(np.median(nn))
 
 
-def solve_mesh(Q, start: int, escaped: np.ndarray | None = None):
+def solve_mesh(Q, start: int):
     """``(mfpt from start, quasi-stationary mfpt, lambda_2, expected heel strikes (k,),
-    escape share)`` of the absorbing chain with transient block ``Q`` (heel strikes =
-    transitions - 1).  ``escape share``: the part of the quasi-stationary fall rate that is
-    probability leaving the mesh (``escaped``, per vertex), NaN without it."""
+    quasi-stationary distribution (k,))`` of the absorbing chain with transient block ``Q``
+    (k, k) (heel strikes = transitions - 1): ``(I - Q) m = 1``
+    (:func:`scipy.sparse.linalg.spsolve`) and the largest eigenvalue of ``Q`` with its left
+    eigenvector (:func:`scipy.sparse.linalg.eigs`)."""
     from scipy.sparse import identity
     from scipy.sparse.linalg import ArpackNoConvergence, eigs, spsolve
 
@@ -343,67 +309,103 @@ def solve_mesh(Q, start: int, escaped: np.ndarray | None = None):
         j = int(np.argmax(np.real(w)))
         lam2, pi = float(np.real(w[j])), np.abs(np.real(V[:, j]))
     pi = pi / pi.sum()
-    share = math.nan
-    if escaped is not None:
-        fall = 1.0 - np.asarray(Q.sum(axis=1)).ravel()
-        rate = float(pi @ fall)
-        share = float(pi @ escaped) / rate if rate > 0 else 0.0
     qs = 1.0 / (1.0 - lam2) - 1.0 if lam2 < 1 else math.inf
-    return float(m[start] - 1.0), qs, lam2, m - 1.0, share
+    return float(m[start] - 1.0), qs, lam2, m - 1.0, pi
 
 
-def mesh_mfpt(step_map: BatchStepMap, chart: MeshChart, sd: float, h: float, radius: float,
-              nodes: int = 15, evaluate=None) -> MeshResult:
-    """MFPT on one mesh (see the module docstring).
+def voxel_nodes(Z: np.ndarray, cells: int) -> tuple[np.ndarray, float]:
+    """One state per occupied voxel of side ``r``: ``(indices into Z, r)`` with ``r``
+    bisected so that about ``cells`` voxels are occupied (row 0, the gait, always in).
+
+    ``Z`` (k, d): the states in the whitened chart.  Nodes spread evenly over the visited
+    region, so the tails (where the falls start) are meshed as finely as the core."""
+    lo, hi = 1e-3, 10.0
+    best = None
+    for _ in range(40):
+        r = math.sqrt(lo * hi)
+        _, idx = np.unique(np.floor(Z / r).astype(np.int64), axis=0, return_index=True)
+        best = (idx, r) if best is None or abs(len(idx) - cells) < abs(len(best[0]) - cells) \
+            else best
+        if len(idx) > cells:
+            lo = r
+        else:
+            hi = r
+        if hi / lo < 1.001:
+            break
+    idx, r = best
+    return np.unique(np.concatenate([[0], idx])), r
+
+
+def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndarray,
+              sd: float, quadrature: int = 9, evaluate=None, cache: dict | None = None
+              ) -> MeshResult:
+    """MFPT on the Voronoi mesh of the nodes ``P[idx]`` (see the module docstring).
 
     Parameters
     ----------
-    chart : MeshChart
-        From :func:`chart_for` (its ``scale`` at this sd).
-    h, radius : float
-        Lattice spacing and ball radius [standard deviations].
-    nodes : int
+    P : ndarray (k, 2n)
+        Candidate nodes (post-impact states); ``P[0]`` is the gait (the start).
+    idx : ndarray of int (c,)
+        The nodes of this mesh (``idx[0] == 0``).
+    W : ndarray (2n, d)
+        The metric (:func:`whitening`).
+    sd : float
+        Slope standard deviation [rad].
+    quadrature : int
         Gauss-Hermite nodes of the slope distribution.
     evaluate : callable ``(X (k, 2n), gamma (k,)) -> (x_next (k, 2n), ok (k,))``, optional
         How the images are computed (e.g. on worker processes); default ``step_map.step``.
+    cache : dict, optional
+        Images of candidates computed by earlier meshes (reused and extended).
     """
-    verts = lattice(chart.V.shape[1], h, radius)
-    g, w = gauss_hermite(nodes, step_map.slope_rad, sd)
-    X = chart.to_state(verts * h)
-    k, q = len(verts), len(g)
-    XX = np.repeat(X, q, axis=0)
-    GG = np.tile(g, k)
-    if evaluate is None:
-        r = step_map.step(XX, GG)
-        xn, ok = r.x_next, r.outcome == HEEL_STRIKE
-    else:
-        xn, ok = evaluate(XX, GG)
-    Q, esc = transition_matrix(xn.reshape(k, q, -1), ok.reshape(k, q), w, verts, chart, h,
-                               radius)
-    start = int(np.flatnonzero(np.all(verts == 0, axis=1))[0])
-    m0, qs, lam2, m, share = solve_mesh(Q, start, esc)
-    return MeshResult(m0, qs, lam2, k, h, radius, share, k * q, m)
+    g, w = gauss_hermite(quadrature, step_map.slope_rad, sd)
+    q = len(g)
+    cache = {} if cache is None else cache
+    if "x" not in cache:
+        cache["x"] = np.full((len(P), q, P.shape[1]), np.nan)
+        cache["ok"] = np.zeros((len(P), q), dtype=bool)
+        cache["done"] = np.zeros(len(P), dtype=bool)
+    new = idx[~cache["done"][idx]]
+    if new.size:
+        XX = np.repeat(P[new], q, axis=0)
+        GG = np.tile(g, new.size)
+        if evaluate is None:
+            r = step_map.step(XX, GG)
+            xn, ok = r.x_next, r.outcome == HEEL_STRIKE
+        else:
+            xn, ok = evaluate(XX, GG)
+        cache["x"][new] = xn.reshape(new.size, q, -1)
+        cache["ok"][new] = ok.reshape(new.size, q)
+        cache["done"][new] = True
+    Q, off, h = transition_matrix(cache["x"][idx], cache["ok"][idx], w, P[idx], W)
+    m0, qs, lam2, m, pi = solve_mesh(Q, 0)
+    return MeshResult(m0, qs, lam2, len(idx), h, float(pi @ off),
+                      int(cache["done"].sum()) * q, m)
 
 
-def mesh_mfpt_converged(step_map: BatchStepMap, chart: MeshChart, sd: float,
-                        radius: float = 4.0, h0: float = 1.0, refine: float = 0.75,
-                        rel_change: float = 0.05, max_cells: int = 60_000, nodes: int = 15,
-                        evaluate=None) -> tuple[MeshResult, list[MeshResult]]:
-    """Refine the mesh (``h <- refine h``) until the MFPT changes by less than
-    ``rel_change`` between two meshes, or the next mesh would exceed ``max_cells``.
+def mesh_mfpt_converged(step_map: BatchStepMap, pool: np.ndarray, x0: np.ndarray, sd: float,
+                        cells: int = 1000, refine: float = 2.0, rel_change: float = 0.05,
+                        max_cells: int = 16_000, quadrature: int = 9, evaluate=None
+                        ) -> tuple[MeshResult, list[MeshResult]]:
+    """Refine the mesh (``cells <- refine cells``: smaller voxels of the visited states
+    ``pool`` (k, 2n) plus the gait ``x0``, :func:`voxel_nodes`) until the MFPT changes by
+    less than ``rel_change`` between two meshes, or the pool or ``max_cells`` is exhausted.
 
     Returns
     -------
     (last mesh, all meshes) ; ``last.converged`` says whether the criterion was met, and
     ``last.change`` is the relative change it was judged by (the mesh's stated error).
     """
-    d = chart.V.shape[1]
+    P = np.concatenate([np.asarray(x0, float)[None], np.asarray(pool, float)])
+    W = whitening(P)
+    Z = (P - P[0]) @ W
+    cache: dict = {}
     results: list[MeshResult] = []
-    h = h0
-    while len(lattice(d, h, radius)) > max_cells:  # the first mesh fits the cap
-        h /= refine
+    n = min(cells, len(P))
     while True:
-        res = mesh_mfpt(step_map, chart, sd, h, radius, nodes, evaluate)
+        idx, r = voxel_nodes(Z, n)
+        res = mesh_mfpt(step_map, P, idx, W, sd, quadrature, evaluate, cache)
+        res.h = r
         results.append(res)
         if len(results) >= 2:
             a, b = results[-2].mfpt_steps, res.mfpt_steps
@@ -411,7 +413,6 @@ def mesh_mfpt_converged(step_map: BatchStepMap, chart: MeshChart, sd: float,
             if res.change < rel_change:
                 res.converged = True
                 return res, results
-        h *= refine
-        if len(lattice(d, h, radius)) > max_cells:
-            res.converged = False
+        if n >= min(max_cells, len(P)) or len(idx) >= 0.9 * len(P):
             return res, results
+        n = min(int(round(refine * n)), max_cells, len(P))

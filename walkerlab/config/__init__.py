@@ -682,12 +682,12 @@ class MfptSettings(_Strict):
                       "when that is given)")
     quadrature_nodes: int = Field(9, ge=3, le=41, description="Gauss-Hermite nodes of the "
                                   "slope distribution in the mesh [-]")
-    mesh_spacing: float = Field(1.0, gt=0.05, le=4, description="first mesh spacing "
-                                "[standard deviations of the walk's post-impact cloud]")
-    mesh_refine: float = Field(0.75, gt=0.2, lt=1, description="spacing factor per "
+    mesh_cells: int = Field(1000, ge=10, le=1_000_000, description="nodes of the first "
+                            "mesh [-]")
+    mesh_refine: float = Field(2.0, gt=1, le=8, description="node-count factor per "
                                "refinement [-]")
-    mesh_max_cells: int = Field(8000, ge=10, le=2_000_000,
-                                description="largest mesh [vertices]; refinement stops there")
+    mesh_max_cells: int = Field(16000, ge=10, le=2_000_000,
+                                description="largest mesh [nodes]; refinement stops there")
     mesh_rel_change: float = Field(0.05, gt=0, lt=1, description="refine until the MFPT "
                                    "changes by less than this between meshes [-]")
     rtol: float = Field(1e-9, ge=1e-12, lt=1e-3, description="integrator relative "

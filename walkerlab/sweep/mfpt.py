@@ -132,49 +132,26 @@ def image_evaluator(scene, workers: int = 1, scheduler=None):
     return evaluate
 
 
-def cloud_chart(sm: BatchStepMap, x0: np.ndarray, sd: float, seed: int, walks: int = 400,
-                steps: int = 20, floor: float = 0.25) -> tuple[M.MeshChart, float]:
-    """The mesh chart from the post-impact states of short noisy walks (their principal
-    axes, scaled by their standard deviations, floored at ``floor`` times the largest) and
-    the ball radius that holds 99.9 % of them, times 1.25 (in those units).
-
-    Linear constraints of the post-impact set (a locked knee: thigh and shank angles and
-    rates equal) have zero spread and drop out of the chart."""
-    X = np.tile(np.asarray(x0, float), (walks, 1))
-    pts = []
-    for k in range(steps):
-        g = sm.slope_rad + sd * np.random.default_rng([seed, 7, k]).standard_normal(len(X))
-        r = sm.step(X, g)
-        X = r.x_next[r.outcome == HEEL_STRIKE]
-        if k >= 2:
-            pts.append(X)
-        if len(X) == 0:
-            break
-    P = np.concatenate(pts) if pts else np.empty((0, len(x0)))
-    if len(P) < 10 * len(x0):
-        raise ValueError(f"mfpt: sigma {sd:g} rad: the walks fall too soon to shape a mesh "
-                         "(fewer post-impact states than needed)")
-    w, V = np.linalg.eigh(np.cov(P.T))
-    w, V = w[::-1], V[:, ::-1]
-    sdev = np.sqrt(np.clip(w, 0, None))
-    keep = sdev > 1e-7 * sdev[0]
-    chart = M.MeshChart(np.asarray(x0, float), V[:, keep],
-                        np.maximum(sdev[keep], floor * sdev[0]))
-    radius = 1.25 * float(np.percentile(np.linalg.norm(chart.to_chart(P), axis=1), 99.9))
-    return chart, max(radius, 2.0)
-
-
 def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler=None):
-    """Converged (or capped) mesh MFPT at one sigma: ``(last MeshResult, all meshes)``."""
+    """Converged (or capped) mesh MFPT at one sigma: ``(last MeshResult, all meshes)``.
+
+    The nodes are the post-impact states visited by noisy walks from the gait at ``sd`` and
+    at ``1.5 sd`` and ``2 sd`` (so the tails, where the falls start, are meshed too); the
+    images of the nodes are computed over the executor."""
     base = scene.model_dump(mode="json")
     sm = step_map_for(base)
-    chart, radius = cloud_chart(sm, x0, sd, settings.seed)
+    n = settings.mesh_max_cells
+    walks = 100
+    steps = max(20, math.ceil(2 * n / (3 * walks)) + 2)  # a pool of about 2 max_cells
+    pool = M.visited_states(sm, x0, (sd, 1.5 * sd, 2.0 * sd), walks, steps, settings.seed)
+    if len(pool) < 10 * len(x0):
+        raise ValueError(f"mfpt: sigma {sd:g} rad: the walks fall too soon to shape a mesh "
+                         "(fewer post-impact states than needed)")
     ev = image_evaluator(scene, workers, scheduler)
-    return M.mesh_mfpt_converged(sm, chart, sd, radius=radius, h0=settings.mesh_spacing,
+    return M.mesh_mfpt_converged(sm, pool, x0, sd, cells=settings.mesh_cells,
                                  refine=settings.mesh_refine,
-                                 rel_change=settings.mesh_rel_change,
-                                 max_cells=settings.mesh_max_cells,
-                                 nodes=settings.quadrature_nodes, evaluate=ev)
+                                 rel_change=settings.mesh_rel_change, max_cells=n,
+                                 quadrature=settings.quadrature_nodes, evaluate=ev)
 
 
 def _finite(v: float) -> float:
