@@ -167,7 +167,8 @@ def visited_states(step_map: BatchStepMap, x0: np.ndarray, sds, walks: int, step
     ----------
     x0 : ndarray, shape (2n,)
     sds : sequence of float
-        Slope standard deviations [rad]; ``walks`` walks of ``steps`` steps at each.
+        Slope standard deviations [rad]; ``walks`` walks of ``steps`` steps at each (a walk
+        that falls starts again from ``x0``, so about ``walks * steps`` states per sd).
     burn_in : int
         Steps of each walk not recorded.
 
@@ -179,16 +180,16 @@ def visited_states(step_map: BatchStepMap, x0: np.ndarray, sds, walks: int, step
         nested).
     """
     pts = []
+    x0 = np.asarray(x0, float)
     for i, sd in enumerate(sds):
         rng = np.random.default_rng([int(seed), 24, i])
         X = np.tile(np.asarray(x0, float), (walks, 1))
         for k in range(steps):
             r = step_map.step(X, step_map.slope_rad + sd * rng.standard_normal(len(X)))
-            X = r.x_next[r.outcome == HEEL_STRIKE]
+            ok = r.outcome == HEEL_STRIKE
             if k >= burn_in:
-                pts.append(X)
-            if len(X) == 0:
-                break
+                pts.append(r.x_next[ok])
+            X = np.where(ok[:, None], r.x_next, x0)  # a fallen walk starts again on the gait
     P = np.concatenate(pts) if pts else np.empty((0, len(x0)))
     return P[np.random.default_rng([int(seed), 25]).permutation(len(P))]
 
@@ -337,7 +338,7 @@ def voxel_nodes(Z: np.ndarray, cells: int) -> tuple[np.ndarray, float]:
 
 
 def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndarray,
-              sd: float, quadrature: int = 9, evaluate=None, cache: dict | None = None
+              sd: float, quadrature: int = 21, evaluate=None, cache: dict | None = None
               ) -> MeshResult:
     """MFPT on the Voronoi mesh of the nodes ``P[idx]`` (see the module docstring).
 
@@ -385,7 +386,7 @@ def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndar
 
 def mesh_mfpt_converged(step_map: BatchStepMap, pool: np.ndarray, x0: np.ndarray, sd: float,
                         cells: int = 1000, refine: float = 2.0, rel_change: float = 0.05,
-                        max_cells: int = 16_000, quadrature: int = 9, evaluate=None
+                        max_cells: int = 16_000, quadrature: int = 21, evaluate=None
                         ) -> tuple[MeshResult, list[MeshResult]]:
     """Refine the mesh (``cells <- refine cells``: smaller voxels of the visited states
     ``pool`` (k, 2n) plus the gait ``x0``, :func:`voxel_nodes`) until the MFPT changes by

@@ -142,7 +142,7 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
     sm = step_map_for(base)
     n = settings.mesh_max_cells
     walks = 100
-    steps = max(20, math.ceil(2 * n / (3 * walks)) + 2)  # a pool of about 2 max_cells
+    steps = max(20, math.ceil(2 * n / (3 * walks)) + 2)  # a pool of ~2 max_cells
     pool = M.visited_states(sm, x0, (sd, 1.5 * sd, 2.0 * sd), walks, steps, settings.seed)
     if len(pool) < 10 * len(x0):
         raise ValueError(f"mfpt: sigma {sd:g} rad: the walks fall too soon to shape a mesh "

@@ -8,12 +8,12 @@ Layout (netCDF-4 conventions: ``sigma_rad`` is the coordinate / dimension scale)
                                                      inf: no walk fell)
     mfpt_steps_montecarlo_stderr    (sigma,)  steps
     montecarlo_walks, montecarlo_falls, montecarlo_heel_strikes      (sigma,)
-    mfpt_steps_mesh                 (sigma,)  steps  from the gait's vertex, finest mesh
+    mfpt_steps_mesh                 (sigma,)  steps  from the gait's node, finest mesh
     mfpt_steps_mesh_quasi_stationary(sigma,)  steps  1 / (1 - lambda_2) - 1
-    mesh_cells                      (sigma,)  -      vertices of the finest mesh
+    mesh_cells                      (sigma,)  -      nodes (Voronoi cells) of the finest mesh
     mesh_change                     (sigma,)  -      relative MFPT change at the last refinement
     mesh_converged                  (sigma,)  -      change < the scene's mesh_rel_change
-    mesh_escaped                    (sigma,)  -      off-mesh share of the fall rate
+    mesh_escaped                    (sigma,)  -      off-mesh probability per step
     mesh_wall_time_s, montecarlo_wall_time_s (sigma,) s
 """
 
@@ -35,13 +35,15 @@ VARIABLES = {
     "montecarlo_falls": ("-", "walks that fell (the rest reached the step cap)"),
     "montecarlo_heel_strikes": ("steps", "heel strikes of all walks"),
     "montecarlo_wall_time_s": ("s", "Monte Carlo wall time"),
-    "mfpt_steps_mesh": ("steps", "mesh MFPT from the gait's vertex (finest mesh)"),
+    "mfpt_steps_mesh": ("steps", "mesh MFPT from the gait's node (finest mesh)"),
     "mfpt_steps_mesh_quasi_stationary": ("steps", "mesh MFPT 1/(1 - lambda_2) - 1"),
-    "mesh_cells": ("-", "vertices of the finest mesh"),
+    "mesh_cells": ("-", "nodes (Voronoi cells of visited post-impact states) of "
+                   "the finest mesh"),
     "mesh_change": ("-", "relative MFPT change between the last two meshes"),
     "mesh_converged": ("-", "1 if mesh_change < mfpt.mesh_rel_change"),
-    "mesh_escaped": ("-", "share of the quasi-stationary fall rate that is probability "
-                     "leaving the mesh (counted as falls)"),
+    "mesh_escaped": ("-", "probability per step, from the quasi-stationary "
+                     "distribution, of landing off the mesh (then on the nearest node; not "
+                     "a fall)"),
     "mesh_wall_time_s": ("s", "mesh wall time (all refinements)"),
 }
 
