@@ -20,7 +20,7 @@ Monte Carlo (:func:`monte_carlo`)
 Mesh (:func:`mesh_mfpt`)
     The post-impact section is meshed where the walker actually goes (Byl & Tedrake's
     "reachable" mesh): the nodes are post-impact states visited by noisy walks from the gait
-    at ``sd``, ``1.5 sd`` and ``2 sd`` (:func:`visited_states`), thinned to one per voxel
+    at ``sd`` and ``1.5 sd`` (:func:`visited_states`), thinned to one per voxel
     of a lattice in the whitened coordinates of that cloud (:func:`whitening`,
     :func:`voxel_nodes`), so the tails where falls start are meshed as finely as the core.
     The region is fixed in absolute units by the walks, not scaled to a box: a state carries

@@ -684,7 +684,7 @@ class MfptSettings(_Strict):
                                   "slope distribution in the mesh [-] (they integrate a fall "
                                   "indicator, whose tails 9 nodes resolve too coarsely: +20 % "
                                   "MFPT for the paper walker at 0.004 rad)")
-    mesh_cells: int = Field(1000, ge=10, le=1_000_000, description="nodes of the first "
+    mesh_cells: int = Field(2000, ge=10, le=1_000_000, description="nodes of the first "
                             "mesh [-]")
     mesh_refine: float = Field(2.0, gt=1, le=8, description="node-count factor per "
                                "refinement [-]")

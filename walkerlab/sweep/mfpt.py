@@ -136,14 +136,14 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
     """Converged (or capped) mesh MFPT at one sigma: ``(last MeshResult, all meshes)``.
 
     The nodes are the post-impact states visited by noisy walks from the gait at ``sd`` and
-    at ``1.5 sd`` and ``2 sd`` (so the tails, where the falls start, are meshed too); the
-    images of the nodes are computed over the executor."""
+    at ``1.5 sd`` (so the tails, where the falls start, are meshed too; a fallen walk starts
+    again on the gait); the images of the nodes are computed over the executor."""
     base = scene.model_dump(mode="json")
     sm = step_map_for(base)
     n = settings.mesh_max_cells
     walks = 100
-    steps = max(20, math.ceil(2 * n / (3 * walks)) + 2)  # a pool of ~2 max_cells
-    pool = M.visited_states(sm, x0, (sd, 1.5 * sd, 2.0 * sd), walks, steps, settings.seed)
+    steps = max(20, math.ceil(n / walks) + 2)  # a pool of ~2 max_cells
+    pool = M.visited_states(sm, x0, (sd, 1.5 * sd), walks, steps, settings.seed)
     if len(pool) < 10 * len(x0):
         raise ValueError(f"mfpt: sigma {sd:g} rad: the walks fall too soon to shape a mesh "
                          "(fewer post-impact states than needed)")
