@@ -193,9 +193,9 @@ def test_cli_prints_every_config_error_without_traceback_even_in_debug(tmp_path)
 
 # ---------------------------------------------------------------- caching and locks
 def test_no_lock_file_is_left_behind(tmp_path):
-    from walkerlab.stages import simulate
+    from walkerlab.stages import pipeline
 
-    simulate.run(wl.load_scene(_paper(name="lk")), tmp_path, strides=1)
+    pipeline.run("simulate", wl.load_scene(_paper(name="lk")), tmp_path, strides=1)
     assert (tmp_path / "lk" / "simulate.h5").is_file()
     assert list((tmp_path / "lk").glob(".*.lock")) == []
 
@@ -241,26 +241,27 @@ def test_fixedpoint_command_writes_the_artifact_the_report_needs(tmp_path):
 
 
 def test_a_longer_simulate_run_is_kept_and_said_and_a_recompute_says_why(tmp_path, capfd):
-    from walkerlab.stages import simulate
+    from walkerlab.stages import pipeline
 
     sc = wl.load_scene(_paper(name="st", simulate={"strides": 1, "sample_rate_hz": 200}))
-    long = simulate.run(sc, tmp_path, strides=3)
+    long = pipeline.run("simulate", sc, tmp_path, strides=3)
     capfd.readouterr()
-    out = simulate.run(sc, tmp_path)  # the scene's 1 stride, as the report asks
+    out = pipeline.run("simulate", sc, tmp_path)  # the scene's 1 stride, as the report asks
     assert out.reused and "kept 3 strides" in out.note and out.path == long.path
     with h5py.File(out.path, "r") as f:
         assert int(f.attrs["strides_requested"]) == 3
-    simulate.run(sc, tmp_path, strides=2)  # fewer than stored: recomputed, and said why
+    pipeline.run("simulate", sc, tmp_path, strides=2)  # fewer than stored: recomputed, and said why
     err = capfd.readouterr().err
     assert "simulate: recomputing" in err and "simulate.strides 3 -> 2" in err
 
 
+@pytest.mark.slow  # end to end: a whole report
 def test_report_uses_only_the_artifacts_the_scene_produces(tmp_path):
-    from walkerlab.stages import report, simulate
+    from walkerlab.stages import pipeline, report
 
     sc = wl.load_scene(_paper(drop=("simulate", "contact", "contact_sim", "contact_solver",
                                     "terrain", "workprecision", "basin"), name="ideal"))
-    simulate.run(sc, tmp_path, strides=1)  # a standalone run leaves simulate.h5 behind
+    pipeline.run("simulate", sc, tmp_path, strides=1)  # a standalone run leaves simulate.h5 behind
     said: list[str] = []
     html = report.run(sc, tmp_path, echo=said.append)
     md = (html.parent / "report.md").read_text()
@@ -271,6 +272,7 @@ def test_report_uses_only_the_artifacts_the_scene_produces(tmp_path):
 
 
 # ---------------------------------------------------------------- the example notebook
+@pytest.mark.slow  # end to end: every stage the notebook calls
 def test_example_notebook_runs(tmp_path, monkeypatch):
     """``examples/walkerlab_tour.ipynb`` executes top to bottom (nbclient), writing only into
     a temporary runs folder."""

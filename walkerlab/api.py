@@ -131,9 +131,9 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
     ImportError
         xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
     """
-    from walkerlab.stages import fixedpoint as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), runs_dir, force).path)
+    return _read(pipeline.run("fixedpoint", _scene(scene), runs_dir, force).path)
 
 
 def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -156,9 +156,10 @@ def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEF
         As :func:`fixed_point`.
     """
     from walkerlab.io.datasets import load_fixed_points
-    from walkerlab.stages import fixedpoint as stage
+    from walkerlab.stages import pipeline
 
-    return load_fixed_points(stage.run(_scene(scene), runs_dir, force).path)
+    return load_fixed_points(pipeline.run("fixedpoint", _scene(scene), runs_dir,
+                                          force).path)
 
 
 def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
@@ -193,9 +194,10 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import simulate as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), runs_dir, force, strides=strides).path)
+    return _read(pipeline.run("simulate", _scene(scene), runs_dir, force,
+                              strides=strides).path)
 
 
 def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
@@ -232,10 +234,10 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import contact_sim as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), runs_dir, force, adjust=adjust,
-                           periodic=periodic).path)
+    return _read(pipeline.run("contact-sim", _scene(scene), runs_dir, force, adjust=adjust,
+                              periodic=periodic).path)
 
 
 def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -257,9 +259,9 @@ def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_
     StageError, SceneError, ImportError
         As :func:`contact_simulate`.
     """
-    from walkerlab.stages import compare as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), runs_dir, force).path)
+    return _read(pipeline.run("compare", _scene(scene), runs_dir, force).path)
 
 
 def _axis_spec(param: str, values: Sequence) -> str:
@@ -356,8 +358,8 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import basin as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_scene(scene), runs_dir, force, grid=tuple(grid) if grid else None,
-                    workers=workers)
+    out = pipeline.run("basin", _scene(scene), runs_dir, force,
+                       grid=tuple(grid) if grid else None, workers=workers)
     return _read(out.path)
