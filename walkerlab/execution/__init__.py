@@ -6,6 +6,8 @@ Dask) and the worker processes behind it.
   bifurcation diagrams, stability maps)
 - :mod:`walkerlab.execution.lanes`     pinned single-process lanes of the work-precision
   study (one worker per core, gates)
+- :mod:`walkerlab.execution.background` a timed study in a thread beside untimed work
+  (``walkerlab report``)
 - :mod:`walkerlab.execution.workers`   worker processes that end with their parent
   (forkserver/spawn, parent watch), :func:`process_alive`
 
