@@ -84,6 +84,14 @@ def _one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
     line = " ".join(ln.strip() for ln in str(text).strip().splitlines() if ln.strip())
     if len(line) <= limit:
         return line
+    # a trailing "[detail]" (a solver's report) is cut first: the advice before it stays whole
+    start = line.rfind(" [")
+    if line.endswith("]") and 0 < start <= limit:
+        more = f" ... rerun with {DEBUG_ENV}=1 for the rest]"
+        detail = line[start:-1]
+        # up to 80 characters past the limit for the detail's start (what was tried)
+        cut = detail[:max(limit + 80 - start - len(more), 2)].rfind(" ")
+        return line[:start] + (detail[:cut].rstrip(",;:( ") if cut > 2 else " [") + more
     head = line[:limit]
     cut = max(head.rfind(sep) for sep in (". ", "; ", ": ", ", "))
     head = head[:cut + 1] if cut > limit // 3 else head[:head.rfind(" ")].rstrip()

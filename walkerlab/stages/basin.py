@@ -24,7 +24,7 @@ from walkerlab.stages.common import (
     _tell,
     artifact_path,
     input_hash,
-    require,
+    with_defaults,
 )
 
 SECTIONS = ("walker", "slope", "ideal", "basin")
@@ -68,7 +68,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``fixedpoint`` section, or bad basin settings.
     """
-    require(scene, "fixedpoint", "basin")
+    scene = with_defaults(scene, "fixedpoint", "basin")
     st = scene.basin or BasinSettings()
     if grid is not None:  # the scene's cap on basin.grid, for --grid too
         grid = validate_option(BasinSettings, "grid", tuple(grid), "--grid", "basin.grid")

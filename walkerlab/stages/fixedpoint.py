@@ -16,7 +16,7 @@ from walkerlab.io.artifacts import put
 from walkerlab.io.netcdf import coordinate
 from walkerlab.io.readers import load_fixed_point  # noqa: F401  (re-exported for stages)
 from walkerlab.models.registry import build_walker
-from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
 
@@ -132,7 +132,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``fixedpoint`` section, or no fixed point for the scene's own variant.
     """
-    require(scene, "fixedpoint", "fixedpoint")
+    scene = with_defaults(scene, "fixedpoint", "fixedpoint")
 
     def compute():
         try:

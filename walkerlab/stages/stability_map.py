@@ -15,7 +15,7 @@ import numpy as np
 
 from walkerlab.config import CommandOptions, Scene, validate_option
 from walkerlab.io.artifacts import open_artifact, put
-from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached, with_defaults
 from walkerlab.sweep.stability import (
     CELL_FIELDS,
     MAP_KINDS,
@@ -58,7 +58,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         Unknown ``kind``.
     """
     require(scene, "contact", "stability-map")
-    require(scene, "fixedpoint", "stability-map")
+    scene = with_defaults(scene, "fixedpoint", "stability-map")
     why = not_applicable(scene, kind)
     if why:
         raise StageError(why)

@@ -1,0 +1,63 @@
+"""The daily loop without friction (issue 26, rough edges 1-7, 13): what a researcher types
+every day says what happened, in the scene's units, and keeps the work already done."""
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from walkerlab.cli import app
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+#: the paper's walker and slope only: every other section left out
+BARE = {"walker": PAPER["walker"], "slope": PAPER["slope"], "solver": PAPER["solver"]}
+
+
+def _cli(*args):
+    r = CliRunner().invoke(app, [str(a) for a in args])
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+def _scene(tmp_path, data, name="scene") -> Path:
+    p = tmp_path / f"{name}.yaml"
+    p.write_text(yaml.safe_dump(data))
+    return p
+
+
+# --------------------------------------------------------------- 1: optional sections
+def test_fixedpoint_without_a_fixedpoint_section_runs_on_defaults(tmp_path):
+    """Every field of ``fixedpoint:`` is optional: leaving the section out is ``{}``, and
+    finds the paper's gait (step period 0.7036 s, paper Sec. 3.3)."""
+    rc, err, out = _cli("fixedpoint", _scene(tmp_path, BARE), "--runs-dir", tmp_path / "runs")
+    assert rc == 0, err
+    with h5py.File(tmp_path / "runs" / "scene" / "fixedpoint.h5") as f:
+        assert f["step_period"][()] == pytest.approx(0.7036, abs=5e-5)
+
+
+def test_api_fixed_point_of_a_mapping_without_the_section(tmp_path):
+    wl = pytest.importorskip("walkerlab")
+    pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    gait = wl.fixed_point(dict(BARE), runs_dir=tmp_path / "runs")
+    assert float(gait.step_period) == pytest.approx(0.7036, abs=5e-5)
+
+
+def test_a_section_with_a_required_field_is_still_needed(tmp_path):
+    rc, err, _ = _cli("contact-sim", _scene(tmp_path, BARE), "--runs-dir", tmp_path / "runs")
+    assert rc == 1 and err.startswith("error: scene 'scene' has no 'contact' section")
+
+
+# --------------------------------------------------------------- 2: no-gait advice whole
+def test_no_gait_error_keeps_its_advice_whole(tmp_path):
+    """An uphill slope has no passive gait: the one error line ends the advice with what
+    to give (fixedpoint.initial_guess); only the solver's detail is shortened."""
+    d = {**BARE, "slope": {"angle_deg": -1.0}, "fixedpoint": {}}
+    rc, err, _ = _cli("fixedpoint", _scene(tmp_path, d), "--runs-dir", tmp_path / "runs")
+    assert rc == 1 and len(err.splitlines()) == 1
+    assert "downhill slope" in err and "give fixedpoint.initial_guess" in err
+    assert "try a continuation from a walker whose gait is known" in err
+    assert "more characters" not in err.split("give fixedpoint.initial_guess")[0]
