@@ -61,3 +61,28 @@ def test_no_gait_error_keeps_its_advice_whole(tmp_path):
     assert "downhill slope" in err and "give fixedpoint.initial_guess" in err
     assert "try a continuation from a walker whose gait is known" in err
     assert "more characters" not in err.split("give fixedpoint.initial_guess")[0]
+
+
+# --------------------------------------------------------------- 4: units everywhere
+def test_fixedpoint_printout_of_a_nondimensional_scene_has_no_seconds(tmp_path):
+    """The simplest walker (Garcia et al. 1998) is nondimensional: every period printed,
+    the gait list's included, is in √(l/g)."""
+    rc, err, out = _cli("fixedpoint", ROOT / "configs" / "simplest.yaml",
+                        "--runs-dir", tmp_path / "runs")
+    assert rc == 0, err
+    periods = [ln for ln in out.splitlines() if "step period" in ln]
+    assert len(periods) == 3  # the fixed point's and the two gaits'
+    assert all("√(l/g)" in ln and " s," not in ln and not ln.endswith(" s")
+               for ln in periods), periods
+
+
+@pytest.mark.parametrize("fmt, name", [("urdf", "walker.urdf"), ("mjcf", "walker.xml")])
+def test_export_header_of_a_nondimensional_scene_names_its_units(tmp_path, fmt, name):
+    rc, err, _ = _cli("export", ROOT / "configs" / "round_feet.yaml", "--format", fmt,
+                      "--runs-dir", tmp_path / "runs")
+    assert rc == 0, err
+    comments = [ln for ln in (tmp_path / "runs" / "round_feet" / name).read_text().splitlines()
+                if ln.startswith("<!--")]
+    text = " ".join(comments)
+    assert "m/s^2" not in text and "[m]" not in text and " m;" not in text
+    assert "[l]" in text and "L = 1.2 l;" in text and "the hip's position" in text

@@ -69,6 +69,7 @@ def gaits_text(f) -> list[str]:
     the one selected by ``fixedpoint.gait`` marked ``*``, and why)."""
     if "gaits" not in f:
         return []
+    u = for_artifact(f)
     labels = [str(s) for s in f.attrs["gaits"]]
     sel = str(f.attrs["gait"])
     lines = [f"period-1 gaits found: {len(labels)}" + (
@@ -79,7 +80,7 @@ def gaits_text(f) -> list[str]:
         mod = float(np.max(np.hypot(g["floquet/variational/real"][()],
                                     g["floquet/variational/imag"][()])))
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
-                     f"{g['step_period'][()]:.6f} s, max |multiplier| {mod:.4g}, "
+                     f"{g['step_period'][()]:.6f} {u.time}, max |multiplier| {mod:.4g}, "
                      f"{'stable' if g['floquet/stable'][()] else 'UNSTABLE'} "
                      f"({_GAIT_SOURCES.get(str(g.attrs['source']), g.attrs['source'])})")
     notes = json.loads(f.attrs.get("gait_notes", "[]"))
@@ -141,8 +142,9 @@ def contact_text(path: Path) -> str:
         elif "periodic_gait" in f:
             g = f["periodic_gait"]
             mult = g["multipliers/real"][()] + 1j * g["multipliers/imag"][()]
-            lines.append(f"periodic contact gait: step period {num(g['step_period'][()], 6)} s, "
-                         f"step length {num(g['step_length'][()], 6)} m, "
+            u = for_artifact(f)
+            lines.append(f"periodic contact gait: step period {num(g['step_period'][()], 6)} "
+                         f"{u.time}, step length {num(g['step_length'][()], 6)} {u.length}, "
                          f"{'stable' if g['stable'][()] else 'unstable'}")
             lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
                          + f" (+{len(mult) - 3} fast contact modes ~0)")

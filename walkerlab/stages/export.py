@@ -16,6 +16,7 @@ from walkerlab.io import runpaths
 from walkerlab.io.export import FORMATS, mjcf_text, urdf_text
 from walkerlab.models.description import walker_data
 from walkerlab.models.multibody import multibody
+from walkerlab.units import for_scene
 
 
 def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = False) -> Path:
@@ -58,4 +59,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path
     text = (urdf_text if fmt == "urdf" else mjcf_text)(mb, scene.name or "walker",
                                                       walkerlab.__version__)
     path = export_path(scene, runs_root, fmt, claim=True)
-    return runpaths.atomic_text(path, text)
+    return runpaths.atomic_text(path, _comments_in_scene_units(text, for_scene(scene)))
+
+
+def _comments_in_scene_units(text: str, units) -> str:
+    """The header comments' unit labels in the scene's unit system (a nondimensional scene:
+    ``l``, ``g``, not ``m``, ``m/s^2``); the XML itself carries numbers only."""
+    if not units.nondimensional:
+        return text
+    import re
+
+    # a unit follows a number ("1.2 m") or stands in brackets ("[m]"); prose is left alone
+    unit = re.compile(r"(?:(?<=\d )|(?<=\[))(m/s\^2|kg m\^2|kg|m|s)(?=[\];.,) ])")
+    return "\n".join(unit.sub(lambda m: units(m.group(1)), ln)
+                     if ln.lstrip().startswith("<!--") else ln for ln in text.split("\n"))
