@@ -86,3 +86,22 @@ def test_export_header_of_a_nondimensional_scene_names_its_units(tmp_path, fmt, 
     text = " ".join(comments)
     assert "m/s^2" not in text and "[m]" not in text and " m;" not in text
     assert "[l]" in text and "L = 1.2 l;" in text and "the hip's position" in text
+
+
+# --------------------------------------------------------------- 5: a fall is not a success
+def test_simulate_of_a_falling_scene_says_when_it_fell(tmp_path):
+    """At 12° the paper's walker has only unstable gaits (largest |multiplier| ≈ 8): from
+    its fixed point it falls within 20 strides.  No mean-step summary, one error line,
+    exit code 1, the run kept in simulate.h5."""
+    d = {**BARE, "slope": {"angle_deg": 12.0}, "fixedpoint": {},
+         "simulate": {"strides": 20, "sample_rate_hz": 100}}
+    rc, err, out = _cli("simulate", _scene(tmp_path, d), "--runs-dir", tmp_path / "runs")
+    assert rc == 1
+    lines = err.splitlines()
+    assert len([ln for ln in lines if ln.startswith("error:")]) == 1
+    n = int(lines[-1].split("fell after ")[1].split()[0])
+    assert 0 < n < 40
+    assert lines[-1] == (f"error: the walker fell after {n} heel strikes "
+                         f"({n / 2:g} strides of the 20 asked)")
+    assert "mean step" not in out and "simulated" not in out
+    assert (tmp_path / "runs" / "scene" / "simulate.h5").is_file()

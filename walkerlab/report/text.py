@@ -89,14 +89,35 @@ def gaits_text(f) -> list[str]:
     return lines
 
 
+#: how a rigid run that did not complete its strides ended, as a verb
+_ENDED = {"fall": "fell", "solver_failure": "stopped by a solver failure",
+          "t_final": "stopped (a step took longer than max_step_time_s)"}
+
+
+def simulate_ending(path: Path) -> str | None:
+    """``"fell after 17 heel strikes (8.5 strides of the 20 asked)"`` for a run that did not
+    complete its strides; None for one that did."""
+    with open_artifact(path, "simulate") as f:
+        term = str(f.attrs["termination"])
+        if term == "heel_strike":
+            return None
+        n = int(np.sum(f["steps"]["termination"][()] == b"heel_strike"))
+        asked = int(f.attrs["strides_requested"])
+    return (f"{_ENDED.get(term, f'ended by {term}')} after {n} heel strike"
+            f"{'' if n == 1 else 's'} ({n / 2:g} strides of the {asked} asked)")
+
+
 def simulate_text(path: Path) -> str:
-    """Steps completed, per-step period/length/speed, energy."""
+    """Steps completed, per-step period/length/speed, energy; for a run that did not
+    complete its strides, only how it ended (:func:`simulate_ending`)."""
+    ending = simulate_ending(path)
+    if ending is not None:
+        return ending
     with open_artifact(path, "simulate") as f:
         u = for_artifact(f)
         s = f["steps"]
         lines = [f"simulated {f.attrs['strides_requested']} strides: "
-                 f"{int(np.sum(s['termination'][()] == b'heel_strike'))} heel strikes, "
-                 f"ended by {f.attrs['termination']}"]
+                 f"{int(np.sum(s['termination'][()] == b'heel_strike'))} heel strikes"]
         if u.nondimensional:
             lines.append(f"  ({u.sentence()})")
         lines.append(f"  mean step period  {num(f['summary/mean_period_s'][()], 7)} {u.time}")
