@@ -105,3 +105,26 @@ def test_simulate_of_a_falling_scene_says_when_it_fell(tmp_path):
                          f"({n / 2:g} strides of the 20 asked)")
     assert "mean step" not in out and "simulated" not in out
     assert (tmp_path / "runs" / "scene" / "simulate.h5").is_file()
+
+
+# --------------------------------------------------------------- 6: a coarse basin map
+def test_basin_on_another_grid_keeps_the_scenes_own_map(tmp_path):
+    """``basin --grid 3x3`` beside a scene whose basin.grid is 4x4: its own artifact and
+    figure (basin_3x3), the report's basin.h5 untouched (same bytes)."""
+    d = {**BARE, "fixedpoint": {**PAPER["fixedpoint"], "other_gait": False},
+         "basin": {"grid": [4, 4], "max_steps": 3}}
+    sc = _scene(tmp_path, d)
+    runs = tmp_path / "runs"
+    rc, err, _ = _cli("basin", sc, "--workers", 1, "--runs-dir", runs)
+    assert rc == 0, err
+    own = (runs / "scene" / "basin.h5").read_bytes()
+    rc, err, out = _cli("basin", sc, "--grid", "3x3", "--workers", 1, "--runs-dir", runs)
+    assert rc == 0, err
+    assert (runs / "scene" / "basin.h5").read_bytes() == own
+    with h5py.File(runs / "scene" / "basin_3x3.h5") as f:
+        assert f["outcome"].shape == (3, 3)
+    assert (runs / "scene" / "report" / "figures" / "basin_3x3.png").is_file()
+    assert "basin_3x3.png" in out and "recomputing" not in err
+    # the scene's own grid given explicitly is the scene's map, reused
+    rc, err, out = _cli("basin", sc, "--grid", "4x4", "--workers", 1, "--runs-dir", runs)
+    assert rc == 0 and "reused" in out and (runs / "scene" / "basin.h5").read_bytes() == own

@@ -450,7 +450,7 @@ def basin(scene: Path | None = SceneArg,
     if out.summary:
         typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
     typer.echo(_status(out))
-    typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir)}")
+    typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir, g)}")
 
 
 @app.command("stability-map")
