@@ -4,7 +4,6 @@ every day says what happened, in the scene's units, and keeps the work already d
 from pathlib import Path
 
 import h5py
-import numpy as np
 import pytest
 import yaml
 from typer.testing import CliRunner
@@ -128,3 +127,36 @@ def test_basin_on_another_grid_keeps_the_scenes_own_map(tmp_path):
     # the scene's own grid given explicitly is the scene's map, reused
     rc, err, out = _cli("basin", sc, "--grid", "4x4", "--workers", 1, "--runs-dir", runs)
     assert rc == 0 and "reused" in out and (runs / "scene" / "basin.h5").read_bytes() == own
+
+
+# --------------------------------------------------------------- 7: what a sweep found
+def test_sweep_prints_outcomes_and_result_ranges_and_draws_a_figure(tmp_path):
+    """Slopes 0 (level ground: no passive gait) and 1-2° (the paper's gait, step period
+    0.7036 s at 0.997°, rising with the slope)."""
+    d = {**BARE, "fixedpoint": {**PAPER["fixedpoint"], "other_gait": False}}
+    rc, err, out = _cli("sweep", _scene(tmp_path, d), "--param", "slope.angle_deg=0,1,2",
+                        "--workers", 1, "--runs-dir", tmp_path / "runs")
+    assert rc == 0, err
+    lines = out.splitlines()
+    assert lines[0] == "3 points: ok 2, no_fixed_point 1"
+    rng = next(ln for ln in lines if ln.split()[0] == "step_period_s").split()
+    lo, hi = float(rng[1]), float(rng[3])
+    assert 0.70 < lo < hi < 0.73 and rng[4] == "s"
+    fig = Path(lines[-1].removeprefix("figure: "))
+    assert fig.is_file() and fig.suffix == ".png" and fig.with_suffix(".svg").is_file()
+    art = Path(lines[-2].removeprefix("wrote "))
+    assert fig.stem == art.stem
+
+
+def test_the_swept_value_is_a_coordinate_of_the_points(tmp_path):
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    from walkerlab.stages import sweep as stage
+
+    d = {**BARE, "fixedpoint": {**PAPER["fixedpoint"], "other_gait": False}}
+    path = stage.run(_scene(tmp_path, d), ["slope.angle_deg=1,2"], workers=1,
+                     runs_root=tmp_path / "runs", progress=False, figure=False)
+    with xr.open_dataset(path, engine="h5netcdf", group="points") as ds:
+        assert "slope.angle_deg" in ds.coords
+        assert ds["step_period_s"].coords["slope.angle_deg"].values.tolist() == [1.0, 2.0]
+        assert ds["slope.angle_deg"].attrs["units"] == "deg"

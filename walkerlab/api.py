@@ -107,7 +107,7 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
     Parameters
     ----------
     scene : Scene, str, Path or dict
-        A scene (see :func:`load_scene`); needs a ``fixedpoint`` section.
+        A scene (see :func:`load_scene`); without a ``fixedpoint`` section, its defaults.
     runs_dir : str or Path
         Runs folder (``--runs-dir``); the artifact is reused when up to date.
     force : bool
@@ -332,10 +332,11 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     Parameters
     ----------
     scene : Scene, str, Path or dict
-        Needs a ``fixedpoint`` section; the ``basin`` section (axes, ranges, start) is
-        optional (defaults: :class:`walkerlab.config.BasinSettings`).
+        The ``fixedpoint`` and ``basin`` sections (axes, ranges, start) are optional
+        (defaults: :class:`walkerlab.config.FixedPointSettings`, ``BasinSettings``).
     grid : (nx, ny), optional
-        Cells along x and y (default ``basin.grid``, 200 x 200; use e.g. (20, 20) to look).
+        Cells along x and y (default ``basin.grid``, 200 x 200; use e.g. (20, 20) to look);
+        a grid other than the scene's is written to its own ``basin_<nx>x<ny>.h5``.
     workers : int
         Local worker processes (1: in this process).
     runs_dir, force
