@@ -12,7 +12,7 @@ the product):
 - :mod:`walkerlab.plotting` figures drawn from loaded artifacts only
 - :mod:`walkerlab.cli`      thin typer front end
 - :mod:`walkerlab.api`      the Python front door: ``walkerlab.load_scene``,
-  ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``, ``compare``,
+  ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``, ``compare``,
   ``sweep``, ``basin`` (each returns an ``xarray.Dataset`` read from the stage's artifact)
 
 Importing the package has no side effects and loads no heavy optional package: the API's
@@ -21,8 +21,8 @@ names are looked up on first use (PEP 562).
 
 __version__ = "0.1.0"
 
-_API = ("load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
-        "compare", "sweep", "basin")
+_API = ("load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
+        "contact_simulate", "compare", "sweep", "basin")
 __all__ = ["__version__", "api", *_API]
 
 

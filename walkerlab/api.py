@@ -38,7 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
+__all__ = ["load_scene", "with_changes", "fixed_point", "fixed_points", "simulate", "contact_simulate",
            "compare", "sweep", "basin"]
 
 DEFAULT_RUNS = Path("runs")
@@ -83,6 +83,56 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
         sc = sc.model_copy(update={"name": name})
         sc._origin = origin
     return sc
+
+
+def with_changes(scene: Scene | str | Path | dict, changes: dict[str, Any]) -> Scene:
+    """A new scene: ``scene`` with fields set by the dotted paths of ``--param``.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        The base scene (see :func:`load_scene`); it is not changed (a scene is frozen).
+    changes : dict
+        Dotted scene field -> value, as ``walkerlab sweep --param`` names fields:
+        ``{"slope.angle_deg": 2, "walker.leg.bodies.thigh_mass.mass_kg": 0.4}`` (a list
+        item by its ``name`` or index).  Setting ``slope.angle_deg`` replaces
+        ``slope.angle_rad`` and vice versa; a missing section is created with its defaults.
+
+    Returns
+    -------
+    walkerlab.config.Scene
+        Validated and frozen; same ``name`` and scene file (its artifacts go to the same
+        run folder, recomputed where the change matters, as after editing the YAML file).
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        An unknown field (with the closest name) or a value that does not validate: one
+        line naming the path.
+
+    Examples
+    --------
+    >>> steeper = wl.with_changes(wl.load_scene("configs/paper.yaml"),
+    ...                           {"slope.angle_deg": 2})          # doctest: +SKIP
+    """
+    from walkerlab.config import SceneError
+    from walkerlab.sweep.params import ParamAxis, SweepError, apply_point, check_axes
+
+    base = _scene(scene)
+    if not isinstance(changes, dict) or not all(isinstance(k, str) for k in changes):
+        raise SceneError("with_changes: give a mapping of dotted field paths to values, "
+                         "e.g. {'slope.angle_deg': 2}")
+    axes = [ParamAxis(k, (v,), f"{k}={v!r}") for k, v in changes.items()]
+    try:
+        check_axes(base, axes, values=False)
+        out = apply_point(base.model_dump(mode="json"), list(changes), tuple(changes.values()),
+                          "with_changes")
+    except SweepError as exc:
+        raise SceneError("with_changes: " + str(exc).removeprefix("--param ")) from None
+    except SceneError as exc:
+        raise SceneError(str(exc).replace("with_changes [", "with_changes: [", 1)) from None
+    out._origin = base.origin
+    return out
 
 
 def _scene(scene) -> Scene:

@@ -27,6 +27,24 @@ from pathlib import Path
 
 import typer
 
+def _flags_take_no_value() -> None:
+    """``--help`` lists an on/off flag (``--force``, ``--help``) without a value type: typer
+    0.29 with click 8.2+ shows ``<bool>`` beside it, as if it took a value (issue 26)."""
+    from typer.core import TyperOption
+
+    shown = TyperOption.display_type_rich
+    if getattr(shown, "_walkerlab", False):
+        return
+
+    def display_type_rich(self, ctx):
+        return None if self.is_flag and self.metavar is None else shown(self, ctx)
+
+    display_type_rich._walkerlab = True
+    TyperOption.display_type_rich = display_type_rich
+
+
+_flags_take_no_value()
+
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="walkerlab: passive-dynamic biped walkers, from fixed point to report.")
 
@@ -257,7 +275,7 @@ def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 @_guard
 def simulate(scene: Path | None = SceneArg,
              strides: int | None = typer.Option(
-                 None, "--strides", min=1, help="strides to simulate (1 stride = 2 steps) "
+                 None, "--strides", help="strides to simulate (1 stride = 2 steps) "
                  "(default: simulate.strides of the scene)"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Simulate N strides of the rigid walker from its fixed point (or from the state given
@@ -402,18 +420,33 @@ def bifurcation(scene: Path | None = SceneArg,
     """Bifurcation diagram over the slope (or any numeric scene field, --param): fixed
     points, multipliers, period-doubling onset."""
     from walkerlab.stages import bifurcation as stage
-    from walkerlab.sweep.params import SweepError, check_axes, parse_param
+    from walkerlab.sweep.params import (
+        SweepError,
+        check_axes,
+        parse_param,
+        takes_whole_numbers,
+    )
 
     if slopes is not None and param is not None:
         _fail(SweepError("--slopes and --param exclude each other (--slopes S is "
                          "--param slope.angle_deg=S)"))
-    axis = parse_param(param if param is not None
-                       else f"slope.angle_deg={slopes or '1:5.5:0.05'}")
+    try:
+        axis = parse_param(param if param is not None
+                           else f"slope.angle_deg={slopes or '1:5.5:0.05'}")
+    except SweepError as exc:  # name the option the user typed
+        if param is not None:
+            raise
+        _fail(SweepError(str(exc).replace(f"--param 'slope.angle_deg={slopes}'",
+                                          f"--slopes {slopes!r}")))
     sc = _load(scene)
     if param is not None:
-        check_axes(sc, [axis])
+        check_axes(sc, [axis], values=not takes_whole_numbers(sc, axis))
         if not axis.numeric:
             _fail(SweepError(f"--param {axis.spec!r}: a bifurcation needs numbers"))
+        if takes_whole_numbers(sc, axis):
+            _fail(SweepError(f"--param {axis.spec!r}: {axis.path} takes whole numbers; a "
+                             "bifurcation continues over a real-valued field (e.g. "
+                             "slope.angle_deg or a body's mass_kg)"))
     out = stage.run(sc, axis.values, runs_dir, transient, keep, workers, force=force,
                     param=axis.path)
     onset, unit = out.summary["onset"], out.summary["unit"]
