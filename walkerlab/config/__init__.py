@@ -658,9 +658,12 @@ WALKER_VOCABULARY = (
 
 
 def _walker_vocabulary_applies(e: dict) -> bool:
-    """An unknown key or kind inside ``walker``: the schema's end, not a typo, perhaps."""
-    return bool(e["loc"]) and e["loc"][0] == "walker" and e["type"] in (
-        "extra_forbidden", "union_tag_invalid")
+    """An unknown kind, or an unknown key close to no field, inside ``walker``: the
+    vocabulary's end rather than a typo."""
+    if not e["loc"] or e["loc"][0] != "walker":
+        return False
+    return e["type"] == "union_tag_invalid" or (e["type"] == "extra_forbidden"
+                                                 and not _suggestion(e))
 
 
 _BOUND_ERRORS = ("less_than", "less_than_equal", "greater_than", "greater_than_equal")
