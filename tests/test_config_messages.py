@@ -10,8 +10,8 @@ import yaml
 from typer.testing import CliRunner
 
 import walkerlab as wl
-from walkerlab.cli import app
 from walkerlab import config
+from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import typer
 
+
 def _flags_take_no_value() -> None:
     """``--help`` lists an on/off flag (``--force``, ``--help``) without a value type: typer
     0.29 with click 8.2+ shows ``<bool>`` beside it, as if it took a value (issue 26)."""
