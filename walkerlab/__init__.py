@@ -12,8 +12,8 @@ the product):
 - :mod:`walkerlab.plotting` figures drawn from loaded artifacts only
 - :mod:`walkerlab.cli`      thin typer front end
 - :mod:`walkerlab.api`      the Python front door: ``walkerlab.load_scene``,
-  ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``, ``compare``,
-  ``sweep``, ``basin`` (each returns an ``xarray.Dataset`` read from the stage's artifact)
+  ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``,
+  ``compare``, ``sweep``, ``basin`` (each returns an ``xarray.Dataset`` read from the stage's artifact)
 
 Importing the package has no side effects and loads no heavy optional package: the API's
 names are looked up on first use (PEP 562).

@@ -38,8 +38,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["load_scene", "with_changes", "fixed_point", "fixed_points", "simulate", "contact_simulate",
-           "compare", "sweep", "basin"]
+__all__ = ["load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
+           "contact_simulate", "compare", "sweep", "basin"]
 
 DEFAULT_RUNS = Path("runs")
 
