@@ -13,7 +13,8 @@ the product):
 - :mod:`walkerlab.cli`      thin typer front end
 - :mod:`walkerlab.api`      the Python front door: ``walkerlab.load_scene``,
   ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``,
-  ``compare``, ``sweep``, ``basin`` (each returns an ``xarray.Dataset`` read from the stage's artifact)
+  ``compare``, ``sweep``, ``basin`` (each returns an ``xarray.Dataset`` read from the
+  stage's artifact)
 
 Importing the package has no side effects and loads no heavy optional package: the API's
 names are looked up on first use (PEP 562).
