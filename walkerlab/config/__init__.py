@@ -557,18 +557,20 @@ class Scene(_Strict):
         return v
 
     def model_copy(self, *, update: dict[str, Any] | None = None, deep: bool = False) -> Scene:
-        """A copy; with ``update``, the changed scene validated again (pydantic's own
-        ``model_copy`` stores an update unchecked: a section given as a mapping would stay a
-        ``dict``).  The scene file (``origin``) is kept.  To change fields by dotted path,
-        use :func:`walkerlab.api.with_changes`.
+        """A copy; with an ``update`` that gives a section as a mapping or a list, the
+        changed scene validated again (pydantic's own ``model_copy`` stores an update
+        unchecked: the section would stay a ``dict``).  The scene file (``origin``) is
+        kept.  To change fields by dotted path, use :func:`walkerlab.api.with_changes`.
 
         Raises
         ------
         SceneError
             The updated scene does not validate (one line per error).
         """
-        if not update:
-            return super().model_copy(deep=deep)
+        if not update or not any(isinstance(v, dict | list) for v in update.values()):
+            # model instances (walkerlab's own copies: a section's settings, a name) as
+            # pydantic copies them
+            return super().model_copy(update=update, deep=deep)
         data = self.model_dump()
         data.update({k: v.model_dump() if isinstance(v, BaseModel) else v
                      for k, v in update.items()})

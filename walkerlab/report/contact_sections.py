@@ -57,6 +57,9 @@ def contact_section(scene, paths) -> list[str]:
                     float(g.attrs.get("mass_kg", 20.0)))
         periods = f["steps/period"][()]
         adj = {k: f["adjust"][k][()] for k in f["adjust"]} if "adjust" in f else None
+        if adj is not None:
+            adj.update(kept=str(f["adjust"].attrs.get("kept", "adjusted")),
+                       why=str(f["adjust"].attrs.get("kept_reason", "")))
         per = per_fail = None
         if "periodic_gait" in f and "step_period" not in f["periodic_gait"]:
             per_fail = (str(f["periodic_gait"].attrs.get("outcome", "?")),
@@ -93,7 +96,9 @@ def contact_section(scene, paths) -> list[str]:
            + "; ".join(f"{n} × {num(v, 3)}" for n, v in zip(scaled, np.atleast_1d(scale)))
            + ")"
            + (f" (found by `--adjust`: objective {num(adj['objective'], 3)} after "
-              f"{int(adj['evaluations'])} simulations)" if adj else "")
+              f"{int(adj['evaluations'])} simulations)" if adj and adj["kept"] != "scene"
+              else f" (the scene's own: `--adjust` found a scale that walks worse; {adj['why']})"
+              if adj else "")
            + "." + _table2_note(pub), "",
            "## Contact walker (MSC ADAMS-style model)", "",
            _table(["quantity", "value", "unit"], _summary_rows(summ, stage_wall)

@@ -145,8 +145,18 @@ def contact_text(path: Path) -> str:
             # per named coordinate: the rates of leg1 (swing) and leg2 (stance) at the start
             names = ([str(v) for v in f["rate"][()].astype(str)] if "rate" in f
                      else ["leg1 rates", "leg2 rates"])
-            lines.append("adjusted initial rate scale (found by --adjust): "
-                         + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s)))
+            kept = str(f["adjust"].attrs.get("kept", "adjusted"))
+            why = str(f["adjust"].attrs.get("kept_reason", ""))
+            found = np.atleast_1d(f["adjust/scale"][()]) if "scale" in f["adjust"] else s
+            if kept == "scene":
+                lines.append("--adjust: kept the scene's initial rate scale ("
+                             + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
+                             + "), which walks better than the adjusted one ("
+                             + ", ".join(f"{v:.4g}" for v in found) + f"): {why}")
+            else:
+                lines.append("--adjust: kept the adjusted initial rate scale: "
+                             + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
+                             + (f" ({why})" if why else ""))
         if "summary" in f:
             for k in f["summary"]:
                 ds = f["summary"][k]

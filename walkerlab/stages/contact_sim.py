@@ -93,11 +93,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         adj = None
         scale = None
         if adjust:
-            from walkerlab.analysis.contact_adjust import adjust_rates
+            from walkerlab.analysis.contact_adjust import adjust_rates, better_start
 
             adj = adjust_rates(scene, x_fp, meta["step_period_s"])
             scale = adj["scale"]
-        walker, res, x0, step_length = simulate_from(scene, x_fp, meta["step_period_s"], scale)
+        run = simulate_from(scene, x_fp, meta["step_period_s"], scale)
+        if adjust:  # the adjusted start must walk at least as well as the scene's own
+            plain = simulate_from(scene, x_fp, meta["step_period_s"], None)
+            adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
+            if adj["kept"] == "scene":
+                run, scale = plain, None
+        walker, res, x0, step_length = run
         tr = named_trajectory(walker, res)
         gait = gait_error = None
         cs = settings(scene)[2]
@@ -270,6 +276,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                         v = np.asarray(v, dtype=float)
                         put(f, f"adjust/{k}", v, "-", k,
                             dims=("rate",) if k == "scale" and v.shape == (2,) else None)
+                # which start the run is from, and why (both runs' outcomes)
+                f["adjust"].attrs["kept"] = adj["kept"]
+                f["adjust"].attrs["kept_reason"] = adj["kept_reason"]
         return writer, summary
 
     return run_cached("contact-sim", scene, runs_root, sections, up, compute, force)
