@@ -194,6 +194,26 @@ _REASON_TEXT = {"off_patch": "off\npatch", "fall": "falls", "no_mid_stance": "no
                 "unsupported": "not sup-\nported"}
 
 
+def _scene_point(xv, yv, attrs) -> tuple[float, float] | None:
+    """The scene's (slope, y) in the map's cell-index coordinates (interpolated, log on a
+    log grid), or None when the artifact does not store it."""
+    try:
+        sx, sy = float(attrs["scene_slope_deg"]), float(attrs["scene_y"])
+    except (KeyError, TypeError, ValueError):
+        return None
+    if not (np.isfinite(sx) and np.isfinite(sy)) or xv.size < 1 or yv.size < 1:
+        return None
+    log = yv.min() > 0 and sy > 0 and yv.max() / yv.min() > 100
+
+    def idx(v, grid, take_log=False):
+        g = np.log10(grid) if take_log else grid
+        v = np.log10(v) if take_log else v
+        order = np.argsort(g)
+        return float(np.interp(v, g[order], np.arange(g.size)[order]))
+
+    return idx(sx, xv), idx(sy, yv, log)
+
+
 def gait_map_figure(data: dict):
     """Stability map of the contact gait from a loaded ``stability_map_<kind>.h5``.
 
@@ -245,6 +265,10 @@ def gait_map_figure(data: dict):
     for k, lab in enumerate(GAIT_CLASSES):
         if np.any(code == k):
             a1.plot([], [], "s", color=GAIT_COLORS[k], label=lab)
+    at = _scene_point(xv, yv, attrs)
+    if at is not None:  # the scene's own contact and slope, between cells if need be
+        a1.plot(*at, marker="*", ms=16, mfc="none", mec="k", mew=1.6, ls="none",
+                label="this scene", zorder=5)
     a1.plot([], [], " ", label="cell text: max |multiplier|\nor why no gait")
     a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     log_y = yv.min() > 0 and yv.max() / yv.min() > 100
@@ -286,7 +310,7 @@ def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=No
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = plt.subplots(figsize=(5.5, 3.6))
+    fig, ax = plt.subplots(figsize=(5.5, 4.2), layout="constrained")
     labels = {"paper": "paper family (damping, dmax fixed)",
               "rigid_limit": "rigid-limit family (c ~ k^(1/(e+1)), dmax ~ k^(-1/(e+1)))"}
     for fam, e in curves.items():
@@ -300,8 +324,9 @@ def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=No
     u = units or Units()
     ax.set_title(f"drop test: {mass_kg:.3g} {u('kg')} at {speed_m_per_s:g} {u('m/s')} (rigid "
                  "plastic impact: 0)", fontsize=9)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
+    # below the axes: inside them the legend covered the scene's stiffness line
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", fontsize=8,
+               ncol=1, frameon=False)
     return fig
 
 

@@ -93,7 +93,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
     slope = SlopeSettings.model_validate(
         scene_json_of(artifact_path(scene, runs_root, "simulate"))["slope"]).phi_rad
     folder = figures_dir(scene, runs_root, claim=True)
-    frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames, time_unit=unit)
+    ground = {}
+    if CONTACT_LABEL in trajs:  # the checkerboard the contact walker walks on
+        from walkerlab.io.terrain import load_terrain
+
+        ground[CONTACT_LABEL] = load_terrain(artifact_path(scene, runs_root, "contact-sim"))
+    frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames, time_unit=unit,
+                              terrain=ground)
     out = AnimateOutcome()
     try:
         out.paths.append(_atomic_save(frames, folder / "animation.gif", gif_writer(fps)))

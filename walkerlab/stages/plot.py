@@ -80,8 +80,13 @@ def _trajectory_figures(scene: Scene, runs_root, F) -> list[Path]:
     title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
     for label, tr in trajs.items():  # paper order: Figs. 2, 6, then 7-10
         stem = "fig2_stick_ideal" if label == IDEAL_LABEL else "fig6_stick_contact"
-        written += F.save(F.stick_diagram(tr, label, slope_rad=scene.slope.phi_rad, units=u),
-                          out_dir, stem)
+        ground = None
+        if label != IDEAL_LABEL:  # the contact walker's checkerboard
+            from walkerlab.io.terrain import load_terrain
+
+            ground = load_terrain(artifact_path(scene, runs_root, "contact-sim"))
+        written += F.save(F.stick_diagram(tr, label, slope_rad=scene.slope.phi_rad, units=u,
+                                          terrain=ground), out_dir, stem)
     written += F.save(F.fig7_angles_rates(trajs, title, units=u), out_dir, "fig7_angles_rates")
     written += F.save(F.fig9_limit_cycle(trajs, units=u), out_dir, "fig9_limit_cycles")
     written += F.save(F.fig10_energy(trajs, units=u), out_dir, "fig10_energy")

@@ -252,16 +252,17 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
 
     Only artifacts this scene's report produced (``done``) are used: an artifact left in the
     run folder by an earlier standalone command (``walkerlab simulate`` on a scene without a
-    ``simulate`` section) is left out, and said so.  ``bifurcation.h5`` has no scene section
-    (the standalone ``walkerlab bifurcation`` makes it): it is shown when it was computed
-    for the scene's current walker, slope and solver.
+    ``simulate`` section) is left out, and said so.  ``bifurcation.h5`` and the
+    ``bifurcation_<field>.h5`` of ``bifurcation --param`` have no scene section (the
+    standalone ``walkerlab bifurcation`` makes them): each is shown when it was computed for
+    the scene's current walker, slope and solver.
     """
     produced = {o.stage for o in done}
     paths, left = {}, []
     for stage, p in existing_artifacts(scene, runs_root).items():
         if stage in produced:
             paths[stage] = p
-        elif stage == "bifurcation":
+        elif stage == "bifurcation" or stage.startswith("bifurcation_"):  # and --param
             from walkerlab.stages import bifurcation
             from walkerlab.stages.common import changed_fields
 

@@ -94,6 +94,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             f.attrs["stiffness_family"] = scene.contact.stiffness_family
             f.attrs["unit_system"] = scene.contact.unit_system
             f.attrs["time_limit_s"] = spec.time_limit_s
+            # the scene's own point (slope, y), marked on the map wherever the grid lies
+            f.attrs["scene_slope_deg"] = float(np.degrees(scene.slope.phi_rad))
+            f.attrs["scene_y"] = _scene_value(scene, spec.y_path)
             f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "
                                  "step map, continued from its neighbour along the slope, "
                                  "else from the ideal fixed point at that slope")
@@ -118,6 +121,18 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
     draw(out.path, figures_dir(scene, runs_root, claim=True))
     return out
+
+
+def _scene_value(scene: Scene, path: str) -> float:
+    """The scene's value of a map's y field (``contact.stiffness``; a missing optional
+    section at its default: ``terrain.patch_width_m`` 0.10); NaN if it has none."""
+    from walkerlab.config import TerrainSettings
+
+    d = scene.model_dump()
+    d["terrain"] = d.get("terrain") or TerrainSettings().model_dump()
+    for k in path.split("."):
+        d = d.get(k) if isinstance(d, dict) else None
+    return float(d) if isinstance(d, int | float) else float("nan")
 
 
 def load(path: Path | str) -> dict:
