@@ -160,3 +160,20 @@ def test_the_swept_value_is_a_coordinate_of_the_points(tmp_path):
         assert "slope.angle_deg" in ds.coords
         assert ds["step_period_s"].coords["slope.angle_deg"].values.tolist() == [1.0, 2.0]
         assert ds["slope.angle_deg"].attrs["units"] == "deg"
+
+
+# --------------------------------------------------------------- 13: the report shows them
+def test_report_shows_a_bifurcation_over_another_field(tmp_path):
+    """``bifurcation --param`` writes bifurcation_<field>.h5 beside the scene's artifacts;
+    the scene's report shows it (as the README says), not 'an earlier standalone run'."""
+    d = {**BARE, "fixedpoint": {**PAPER["fixedpoint"], "other_gait": False}}
+    sc, runs = _scene(tmp_path, d), tmp_path / "runs"
+    rc, err, _ = _cli("bifurcation", sc, "--param", "walker.hip_mass_kg=10,10.5",
+                      "--transient", 4, "--keep", 2, "--workers", 1, "--runs-dir", runs)
+    assert rc == 0, err
+    assert (runs / "scene" / "bifurcation_walker.hip_mass_kg.h5").is_file()
+    rc, err, out = _cli("report", sc, "--runs-dir", runs)
+    assert rc == 0, err
+    assert "leaves out" not in out + err
+    md = (runs / "scene" / "report" / "report.md").read_text()
+    assert "walker.hip_mass_kg" in md and "bifurcation_walker.hip_mass_kg" in md
