@@ -2,6 +2,7 @@
 minimise the period and step-length mismatch, which does not promise a better walk; the run
 kept is the one that walks better, and the command says which and why."""
 
+import re
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -65,11 +66,12 @@ def test_adjust_keeps_the_scenes_start_when_the_adjusted_one_walks_worse(tmp_pat
     assert r.exit_code == 0, r.stderr
     line = next(ln for ln in r.stdout.splitlines() if ln.startswith("--adjust:"))
     assert line.startswith("--adjust: kept the scene's initial rate scale")
-    assert "adjusted start:" in line and "the scene's start: heel_strike after 10" in line
+    assert "adjusted start: fall after" in line
+    assert re.search(r"the scene's start: (t_final|heel_strike) after 10 heel strikes", line)
     with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:
         assert f["initial_rate_scale"][()].tolist() == [1.0, 1.1]
         assert f["adjust"].attrs["kept"] == "scene"
-        assert f.attrs["outcome"] == "heel_strike"
+        assert f.attrs["outcome"] in ("heel_strike", "t_final")  # walked (CONTACT_WALKED)
 
 
 @pytest.mark.slow
