@@ -157,8 +157,8 @@ def test_misspelt_field_is_named_first_with_the_field_it_resembles(tmp_path):
         load_scene(p)
     lines = str(exc.value).splitlines()
     assert lines[0] == f"{p}: walker.hip_mas_kg: unknown field (did you mean hip_mass_kg?)"
-    assert lines[1] == f"{p}: walker.hip_mass_kg: Field required"
-    assert len(lines) == 2
+    # the "walker.hip_mass_kg: Field required" it causes is the same mistake: not repeated
+    assert len(lines) == 1  # (issue 26, item 10)
 
 
 def test_every_config_error_one_line_each_unknown_keys_first():

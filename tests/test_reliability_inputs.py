@@ -535,7 +535,7 @@ def test_contact_text_shows_the_rate_scale_adjust_found(tmp_path):
         f.create_dataset("adjust/objective", data=1e-4)
 
     p = write_artifact(tmp_path / "contact.h5", "contact-sim", sc, "k", writer, 1.0)
-    assert ("adjusted initial rate scale (found by --adjust): leg1 rates × 1.41; "
+    assert ("--adjust: kept the adjusted initial rate scale: leg1 rates × 1.41; "
             "leg2 rates × 1.74") in contact_text(p)
 
     def named(f):  # the stage writes the scaled rates by name (a kneed walker: two a leg)
@@ -544,5 +544,5 @@ def test_contact_text_shows_the_rate_scale_adjust_found(tmp_path):
                                        "dtheta2_thigh dtheta2_shank"])
 
     p = write_artifact(tmp_path / "named.h5", "contact-sim", sc, "k", named, 1.0)
-    assert ("adjusted initial rate scale (found by --adjust): dtheta1_thigh dtheta1_shank × "
+    assert ("--adjust: kept the adjusted initial rate scale: dtheta1_thigh dtheta1_shank × "
             "1.41; dtheta2_thigh dtheta2_shank × 1.74") in contact_text(p)
