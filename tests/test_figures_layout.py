@@ -68,8 +68,10 @@ def test_fig7_of_the_kneed_walker_legend_inside_curves_distinct_text_readable(kn
     sizes += [ax.xaxis.label.get_fontsize() for ax in fig.axes]
     sizes += [t.get_fontsize() for ax in fig.axes for t in ax.get_yticklabels()]
     assert min(sizes) >= 9
-    # as the report shows it (at most 1100 px wide, 150 dpi PNG): still >= 8 pt at 96 dpi
-    shown = min(1.0, 1100 / (fig.get_figwidth() * 150))
+    # as the report shows it (the saved PNG: tight box at 150 dpi, shown at most 1100 px
+    # wide): still >= 8 pt at 96 dpi
+    saved_in = fig.get_tightbbox(fig.canvas.get_renderer()).width
+    shown = min(1.0, 1100 / (saved_in * 150))
     assert min(sizes) * 150 / 72 * shown / (96 / 72) >= 8
 
 
