@@ -163,12 +163,13 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
 def _default_section(scene: Scene, section: str):
     """The section's settings with every field at its default, or None when the section has
     a required field (``contact``: a contact law must be chosen)."""
+    import typing
+
     from pydantic import BaseModel, ValidationError
 
-    from walkerlab.config import _models_in
-
-    models = [m for m in _models_in(type(scene).model_fields[section].annotation)
-              if issubclass(m, BaseModel)]
+    ann = type(scene).model_fields[section].annotation  # ``FixedPointSettings | None``
+    models = [m for m in typing.get_args(ann) or (ann,)
+              if isinstance(m, type) and issubclass(m, BaseModel)]
     if len(models) != 1:
         return None
     try:
