@@ -115,9 +115,9 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
         ax.tick_params(labelsize=9)
     h, lab = axes[0].get_legend_handles_labels()
     # below the panels, inside the figure with its margin (constrained layout makes room)
-    # two columns for more than four curves (a kneed walker's 8): no wider than the panels
-    fig.legend(h, lab, loc="outside lower center", ncol=min(4 if len(h) <= 4 else 2, len(h)),
-               fontsize=9)
+    # two columns (a model's legs side by side): no wider than the panels, so the report's
+    # scaled image keeps its text size
+    fig.legend(h, lab, loc="outside lower center", ncol=min(2, len(h)), fontsize=9)
     fig.suptitle(f"Fig. 7 - {title}, angles and rates", fontsize=11)
     return fig
 
