@@ -107,6 +107,7 @@ def test_simulate_of_a_falling_scene_says_when_it_fell(tmp_path):
 
 
 # --------------------------------------------------------------- 6: a coarse basin map
+@pytest.mark.slow
 def test_basin_on_another_grid_keeps_the_scenes_own_map(tmp_path):
     """``basin --grid 3x3`` beside a scene whose basin.grid is 4x4: its own artifact and
     figure (basin_3x3), the report's basin.h5 untouched (same bytes)."""
