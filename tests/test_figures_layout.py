@@ -16,7 +16,7 @@ from walkerlab.config import scene_from_dict
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.trajectory import read_samples
 from walkerlab.plotting import figures as F
-from walkerlab.stages import simulate
+from walkerlab.stages import pipeline
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -29,7 +29,7 @@ def _trajectory(tmp_path, config: str):
     d["fixedpoint"] = {**d.get("fixedpoint", {}), "other_gait": False}
     d["simulate"] = {"strides": 1, "sample_rate_hz": 200}
     sc = scene_from_dict(d)
-    out = simulate.run(sc, tmp_path / "runs")
+    out = pipeline.run("simulate", sc, tmp_path / "runs")
     with open_artifact(out.path, "simulate") as f:
         return sc, read_samples(f)
 
@@ -131,13 +131,16 @@ def test_stability_map_marks_the_scenes_point_with_three_cells_a_side():
     log10 interpolation: y index (5 - 3) / 3 = 0.667, x index (0.997 - 0.5) / 1.75."""
     from walkerlab.plotting.sweep_figures import gait_map_figure
 
+    from walkerlab.io.schemas.stability_map import StabilityMap
+
     n = 3
-    data = {"y_values": np.array([1e3, 1e6, 1e9]), "slopes_deg": np.array([0.5, 2.25, 4.0]),
-            "exists": np.ones((n, n)), "stable": np.ones((n, n)),
-            "max_abs_multiplier": np.full((n, n), 0.5),
-            "reason": np.full((n, n), "", dtype=object), "wall_time_s": np.ones((n, n)),
-            "attrs": {"kind": "stiffness", "y_label": "contact stiffness k [N/len^e]",
-                      "scene_slope_deg": 0.997, "scene_y": 1e5}}
+    data = StabilityMap(
+        attrs={"kind": "stiffness", "y_label": "contact stiffness k [N/len^e]",
+               "scene_slope_deg": 0.997, "scene_y": 1e5},
+        y_values=np.array([1e3, 1e6, 1e9]), slopes_deg=np.array([0.5, 2.25, 4.0]),
+        cells={"exists": np.ones((n, n)), "stable": np.ones((n, n)),
+               "max_abs_multiplier": np.full((n, n), 0.5),
+               "reason": np.full((n, n), "", dtype=object), "wall_time_s": np.ones((n, n))})
     fig = gait_map_figure(data)
     (star,) = [ln for ln in fig.axes[0].get_lines() if ln.get_label() == "this scene"]
     x, y = star.get_xdata()[0], star.get_ydata()[0]

@@ -9,9 +9,8 @@ exactly what the artifact holds: named dimensions (``time``, ``state``, ``step``
 ``multiplier``, the swept field ``slope.angle_deg``, ``x``/``y`` of a basin ...), coordinate
 variables, and ``units``/``long_name`` on every variable.
 
-``walkerlab.sweep`` is also the package :mod:`walkerlab.sweep`; calling it calls
-:func:`sweep` (the package is callable), so ``walkerlab.sweep(scene, param, values)`` works
-whether or not the package has been imported.
+``walkerlab.sweep`` is the package :mod:`walkerlab.sweep` (sweeps, basins, maps); the sweep
+of the front door is :func:`walkerlab.api.sweep` (``wl.api.sweep(scene, param, values)``).
 
 Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what
@@ -182,9 +181,9 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
     ImportError
         xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
     """
-    from walkerlab.stages import fixedpoint as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), runs_dir, force).path)
+    return _read(pipeline.run("fixedpoint", _scene(scene), runs_dir, force).path)
 
 
 def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -207,9 +206,10 @@ def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEF
         As :func:`fixed_point`.
     """
     from walkerlab.io.datasets import load_fixed_points
-    from walkerlab.stages import fixedpoint as stage
+    from walkerlab.stages import pipeline
 
-    return load_fixed_points(stage.run(_scene(scene), runs_dir, force).path)
+    return load_fixed_points(pipeline.run("fixedpoint", _scene(scene), runs_dir,
+                                          force).path)
 
 
 def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
@@ -244,9 +244,10 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import simulate as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), runs_dir, force, strides=strides).path)
+    return _read(pipeline.run("simulate", _scene(scene), runs_dir, force,
+                              strides=strides).path)
 
 
 def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
@@ -283,10 +284,10 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import contact_sim as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), runs_dir, force, adjust=adjust,
-                           periodic=periodic).path)
+    return _read(pipeline.run("contact-sim", _scene(scene), runs_dir, force, adjust=adjust,
+                              periodic=periodic).path)
 
 
 def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -308,9 +309,9 @@ def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_
     StageError, SceneError, ImportError
         As :func:`contact_simulate`.
     """
-    from walkerlab.stages import compare as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), runs_dir, force).path)
+    return _read(pipeline.run("compare", _scene(scene), runs_dir, force).path)
 
 
 def _axis_spec(param: str, values: Sequence) -> str:
@@ -408,8 +409,8 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import basin as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_scene(scene), runs_dir, force, grid=tuple(grid) if grid else None,
-                    workers=workers)
+    out = pipeline.run("basin", _scene(scene), runs_dir, force,
+                       grid=tuple(grid) if grid else None, workers=workers)
     return _read(out.path)

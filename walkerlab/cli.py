@@ -263,12 +263,12 @@ def _status(o) -> str:
 def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                force: bool = ForceOpt) -> None:
     """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
     from walkerlab.report.text import fixedpoint_text
-    from walkerlab.stages import fixedpoint as stage
+    from walkerlab.stages import pipeline
 
-    sc = _load(scene)
-    out = stage.run(sc, runs_dir, force)
-    typer.echo(fixedpoint_text(out.path))
+    out = pipeline.run("fixedpoint", _load(scene), runs_dir, force)
+    typer.echo(fixedpoint_text(load_fixedpoint(out.path)))
     typer.echo(_status(out))
 
 
@@ -281,17 +281,18 @@ def simulate(scene: Path | None = SceneArg,
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Simulate N strides of the rigid walker from its fixed point (or from the state given
     as simulate.initial_state in the scene)."""
+    from walkerlab.io.schemas.simulate import load_simulate
     from walkerlab.report.text import simulate_ending, simulate_text
-    from walkerlab.stages import simulate as stage
+    from walkerlab.stages import pipeline
 
-    sc = _load(scene)
-    out = stage.run(sc, runs_dir, force, strides=strides)
-    ending = simulate_ending(out.path)
+    out = pipeline.run("simulate", _load(scene), runs_dir, force, strides=strides)
+    sim = load_simulate(out.path)
+    ending = simulate_ending(sim)  # a fall: no success-style summary (issue 26, item 5)
     if ending is None:
-        typer.echo(simulate_text(out.path))
+        typer.echo(simulate_text(sim))
     typer.echo(_status(out))
-    if ending is not None:  # recorded in the artifact, and an error: one line, exit 1
-        _fail(RuntimeError(f"the walker {ending}"))
+    if out.failure:  # recorded in the artifact, and an error: one line, exit 1
+        _fail(RuntimeError(f"the walker {ending}" if ending else out.failure))
 
 
 @app.command("contact-sim")
@@ -305,25 +306,16 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                                               "multipliers (about 10 s)")
                 ) -> None:
     """Simulate the compliant-contact (MSC ADAMS style) walker on the scene's terrain."""
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
     from walkerlab.report.text import contact_text
-    from walkerlab.stages import contact_sim as stage
+    from walkerlab.stages import pipeline
 
-    sc = _load(scene)
-    out = stage.run(sc, runs_dir, force, adjust=adjust, periodic=periodic)
-    typer.echo(contact_text(out.path))
+    out = pipeline.run("contact-sim", _load(scene), runs_dir, force, adjust=adjust,
+                       periodic=periodic)
+    typer.echo(contact_text(load_contact_sim(out.path)))
     typer.echo(_status(out))
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(out.path, "contact-sim") as f:
-        kind = str(f.attrs.get("outcome", f.attrs["termination"]))
-        why = str(f.attrs.get("outcome_message", ""))
-    # like simulate: a walker that does not walk exits 1 (the shared run ends,
-    # walkerlab.integrate.ends: trip, fall, airborne, no_heel_strike, ...)
-    from walkerlab.integrate.ends import CONTACT_WALKED
-
-    if kind not in CONTACT_WALKED:
-        _fail(RuntimeError(f"the contact walker did not complete the run: {kind}"
-                           + (f" ({why})" if why else "")))
+    if out.failure:
+        _fail(RuntimeError(out.failure))
 
 
 @app.command()
@@ -331,11 +323,12 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
             force: bool = ForceOpt) -> None:
     """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
+    from walkerlab.io.schemas.compare import load_compare
     from walkerlab.report.text import compare_text
-    from walkerlab.stages import compare as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_load(scene), runs_dir, force)
-    typer.echo(compare_text(out.path))
+    out = pipeline.run("compare", _load(scene), runs_dir, force)
+    typer.echo(compare_text(load_compare(out.path)))
     typer.echo(_status(out))
 
 
@@ -344,11 +337,12 @@ def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def workprecision(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                   force: bool = ForceOpt) -> None:
     """Work-precision study: error vs wall time for every solver and tolerance."""
+    from walkerlab.io.schemas.workprecision import load_workprecision
     from walkerlab.report.text import workprecision_text
-    from walkerlab.stages import workprecision as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_load(scene), runs_dir, force)
-    typer.echo(workprecision_text(out.path))
+    out = pipeline.run("workprecision", _load(scene), runs_dir, force)
+    typer.echo(workprecision_text(load_workprecision(out.path)))
     typer.echo(_status(out))
 
 
@@ -471,7 +465,6 @@ def basin(scene: Path | None = SceneArg,
                                       help="continue an interrupted map with the same inputs"),
           runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section."""
-    from walkerlab.stages import basin as stage
 
     g = None
     if grid is not None:
@@ -483,12 +476,16 @@ def basin(scene: Path | None = SceneArg,
             _fail(ValueError(f"--grid: expected NXxNY with NX, NY >= 2 (e.g. 200x200), "
                              f"got {grid!r}"))
         g = (nx, ny)
-    out = stage.run(_load(scene), runs_dir, force, grid=g, workers=workers,
-                    scheduler=scheduler, resume=resume)
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("basin", _load(scene), runs_dir, force, grid=g, workers=workers,
+                       scheduler=scheduler, resume=resume)
     if out.summary:
         typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
     typer.echo(_status(out))
-    typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir, g)}")
+    from walkerlab.stages.basin import figure_path
+
+    typer.echo(f"figure: {figure_path(_load(scene), runs_dir, g)}")
 
 
 @app.command("stability-map")
@@ -527,9 +524,9 @@ def stability_map(scene: Path | None = SceneArg,
 def animate(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
     """The walker walking (rigid, and contact beside it where contact_sim.h5 exists):
     report/figures/animation.gif, and .mp4 if ffmpeg is installed."""
-    from walkerlab.stages import animate as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_load(scene), runs_dir)
+    out = pipeline.run("animate", _load(scene), runs_dir)
     for p in out.paths:
         typer.echo(f"wrote {p}")
     if out.note:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from walkerlab.analysis.hybrid import HybridTrajectory
+from walkerlab.integrate.rigid import HybridTrajectory
 from walkerlab.io.trajectory import NamedTrajectory
 
 

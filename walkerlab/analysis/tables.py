@@ -1,16 +1,13 @@
-"""Paper Table 3 quantities, recomputed from trajectory artifacts (never typed in).
+"""Paper Table 3 quantities, computed from trajectories (never typed in).
 
 The published values live in :mod:`walkerlab.published.paper`; this module only computes.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact
-from walkerlab.io.trajectory import NamedTrajectory, read_samples
+from walkerlab.io.trajectory import NamedTrajectory
 
 TABLE3_ROWS = {
     "t_left_s": ("Left step period", "t_left", "s"),
@@ -90,11 +87,8 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     return out
 
 
-def table3(paths: dict[str, Path], mass_kg: float, g: float) -> dict[str, dict[str, float]]:
-    """Table 3 columns recomputed from trajectory artifacts ``{label: path}``."""
-    cols = {}
-    for label, (stage, p) in paths.items():
-        with open_artifact(p, stage) as f:
-            tr = read_samples(f)
-        cols[label] = gait_metrics(tr, mass_kg=mass_kg, g=g)
-    return cols
+def table3(trajectories: dict[str, NamedTrajectory], mass_kg: float,
+           g: float) -> dict[str, dict[str, float]]:
+    """Table 3 columns of loaded trajectories ``{label: NamedTrajectory}`` (total mass
+    ``mass_kg`` [kg], gravity ``g`` [m/s^2])."""
+    return {label: gait_metrics(tr, mass_kg=mass_kg, g=g) for label, tr in trajectories.items()}

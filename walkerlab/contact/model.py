@@ -7,7 +7,7 @@ down-slope tangent t = (cos phi, -sin phi).  The mechanics (mass matrix, bias, c
 Jacobians) are generated from the walker description; the contact forces use the laws of
 :mod:`walkerlab.contact.laws` (numba twins in :mod:`walkerlab.contact._kernels`); the knees
 of a kneed walker are free, each held by a compliant stop
-(:class:`~walkerlab.contact.config.KneeStopSettings`).
+(:class:`~walkerlab.config.contact.KneeStopSettings`).
 
 State names
 -----------
@@ -35,7 +35,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .config import ContactParamsSI, ContactSettings, KneeStopSettings, KneeStopSI, TerrainSettings
+from walkerlab.config.contact import (
+    ContactParamsSI,
+    ContactSettings,
+    KneeStopSettings,
+    KneeStopSI,
+    TerrainSettings,
+)
 
 __all__ = ["FOOT_NAMES", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
            "compass_gait_data", "state_name"]
@@ -80,7 +86,7 @@ def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np
 def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
     """:class:`~walkerlab.models.description.WalkerData` of the paper's compass gait (Table 1):
     leg length L [m], leg mass m [kg] at ``a`` [m] from the foot, hip mass MH [kg]."""
-    from walkerlab.models.derivation import compass_gait_structure
+    from walkerlab.models.compass_gait import compass_gait_structure
     from walkerlab.models.description import WalkerData
 
     st = compass_gait_structure()

@@ -6,7 +6,7 @@ until the swing leg passes the stance leg, then late swing until heel strike; a 
 walker adds a knee-locked phase).  Each phase has a flow ``f(t, x)`` and named guards;
 a guard either moves to the next phase (optionally through its own reset map, e.g. a knee
 strike), ends the step with the reset map (heel strike), or ends the run (fall).  The analysis
-layer (:mod:`walkerlab.analysis.hybrid`) integrates any model described this way.
+layer (:mod:`walkerlab.integrate.rigid`) integrates any model described this way.
 
 Contract of :class:`HybridWalker` (nothing outside the model layer may assume more)
 -------------------------------------------------------------------------------------
@@ -176,11 +176,15 @@ class HybridWalker:
 
     def state_names(self) -> list[str]:
         """Role-ordered state names, e.g. ``['swing_angle', 'stance_angle', 'swing_rate', ...]``."""
-        return [f"{r}_angle" for r in self.roles] + [f"{r}_rate" for r in self.roles]
+        from walkerlab.models.description import state_names
+
+        return state_names(self.roles)
 
     def state_units(self) -> list[str]:
         """Units of :meth:`state_names` (every coordinate is an angle)."""
-        return ["rad"] * self.n_coordinates + ["rad/s"] * self.n_coordinates
+        from walkerlab.models.description import state_units
+
+        return state_units(self.roles)
 
     @property
     def coordinate_units(self) -> dict[str, str]:

@@ -92,6 +92,17 @@ class Structure:
                                       for b in self.bodies]})
 
 
+def state_names(roles) -> list[str]:
+    """Role-ordered state names of a walker with coordinate ``roles``: every role's angle, then
+    every role's rate (``['swing_angle', 'stance_angle', 'swing_rate', 'stance_rate']``)."""
+    return [f"{r}_angle" for r in roles] + [f"{r}_rate" for r in roles]
+
+
+def state_units(roles) -> list[str]:
+    """Units of :func:`state_names` (every coordinate is an angle): rad, then rad/s."""
+    return ["rad"] * len(roles) + ["rad/s"] * len(roles)
+
+
 @dataclass(frozen=True)
 class WalkerData:
     """A structure plus its numbers: ``params`` in ``structure.param_names`` order."""

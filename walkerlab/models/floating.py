@@ -58,16 +58,10 @@ import numpy as np
 from walkerlab.models.description import Structure, WalkerData
 
 __all__ = ["MASSLESS_MESSAGE", "FloatingEquations", "FloatingView", "check_masses",
-           "coordinate_names", "derive_floating", "floating_module", "floating_view",
-           "knee_pairs", "link_names"]
+           "coordinate_names", "derive_floating", "floating_module", "floating_view"]
 
 MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
 LEGS = ("leg1", "leg2")
-
-
-def link_names(structure: Structure) -> tuple[str, ...]:
-    """Links of one leg, proximal first: ``("leg",)`` or ``("thigh", "shank")``."""
-    return ("thigh", "shank") if structure.knee else ("leg",)
 
 
 def coordinate_names(structure: Structure) -> tuple[str, ...]:
@@ -77,11 +71,6 @@ def coordinate_names(structure: Structure) -> tuple[str, ...]:
     else:
         ang = tuple(f"{leg}_angle" for leg in LEGS)
     return ("hip_x", "hip_y") + ang
-
-
-def knee_pairs(structure: Structure) -> tuple[tuple[int, int], ...]:
-    """(thigh index, shank index) in ``q`` of each leg's knee; empty without knees."""
-    return ((2, 3), (4, 5)) if structure.knee else ()
 
 
 def check_masses(structure: Structure) -> None:

@@ -223,24 +223,24 @@ def gait_map_figure(data: dict):
 
     Parameters
     ----------
-    data : dict
-        :func:`walkerlab.stages.stability_map.load` output: ``y_values`` (ny,),
-        ``slopes_deg`` (nx,), (ny, nx) arrays ``exists``, ``stable``, ``max_abs_multiplier``,
-        ``reason``, ``wall_time_s`` and ``attrs``.
+    data : walkerlab.io.schemas.stability_map.StabilityMap
+        A loaded map: ``y_values`` (ny,), ``slopes_deg`` (nx,), (ny, nx) cell arrays
+        ``exists``, ``stable``, ``max_abs_multiplier``, ``reason``, ``wall_time_s`` and
+        ``attrs``.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    yv, xv = np.asarray(data["y_values"], float), np.asarray(data["slopes_deg"], float)
-    ex = np.asarray(data["exists"], float) > 0.5
-    st = np.asarray(data["stable"], float) > 0.5
-    mm = np.asarray(data["max_abs_multiplier"], float)
-    reason = np.asarray(data["reason"], dtype=object)
+    yv, xv = np.asarray(data.y_values, float), np.asarray(data.slopes_deg, float)
+    ex = np.asarray(data.cells["exists"], float) > 0.5
+    st = np.asarray(data.cells["stable"], float) > 0.5
+    mm = np.asarray(data.cells["max_abs_multiplier"], float)
+    reason = np.asarray(data.cells["reason"], dtype=object)
     code = np.zeros(ex.shape)
     for (i, j), e in np.ndenumerate(ex):
         code[i, j] = (0 if st[i, j] else 1) if e else _REASON_CLASS.get(str(reason[i, j]), 6)
-    attrs = data.get("attrs", {})
+    attrs = data.attrs
     kind = str(attrs.get("kind", ""))
     unit_sys = str(attrs.get("unit_system", "mm-kg-s"))
     ylab = str(attrs.get("y_label", attrs.get("y_path", "y")))
@@ -277,7 +277,7 @@ def gait_map_figure(data: dict):
     a1.set_xlabel("slope φ [deg]")
     a1.set_ylabel(ylab + (" (log grid)" if log_y else ""), fontsize=8)
     n = ex.size
-    wall = np.asarray(data["wall_time_s"], float)
+    wall = np.asarray(data.cells["wall_time_s"], float)
     wall_txt = (f"; wall time per cell: median {np.nanmedian(wall):.3g} s, max "
                 f"{np.nanmax(wall):.3g} s" if np.isfinite(wall).any() else "")
     a1.set_title(f"contact gait: exists in {ex.sum()}/{n} cells ({100 * ex.sum() / n:.0f} %), "

@@ -28,7 +28,7 @@ Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
                      strike that lands on the cell
 
 Cells are evaluated in chunks (one grid row each) by
-:func:`walkerlab.sweep.runner.iter_chunk_results` - in this process, on a local process pool
+:func:`walkerlab.sweep.runner.sweep_executor` - in this process, on a local process pool
 or on a Dask cluster - and written to a partial HDF5 file after every chunk, so an
 interrupted map resumes where it stopped.  Each finished grid row is stored with its hash
 (:func:`row_digest`, ``/row_hash``); on resume a row whose cells no longer match it (edited,
@@ -220,7 +220,7 @@ def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
     period : int
         Period of the attractor reached (1 for the fixed point, 0 if none).
     """
-    from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.integrate.rigid import integrate_step
 
     x = np.asarray(x0, dtype=float)
     hist = [x]
@@ -284,7 +284,7 @@ def _walker_and_settings(base: dict):
 
 def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]``."""
-    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.integrate.solver import Solver
 
     walker, st, max_step_time = _walker_and_settings(task.base)
     solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
@@ -312,7 +312,8 @@ def pre_impact_fixed_point(walker, x_star: np.ndarray, settings, max_step_time: 
     BasinError
         The step from ``x_star`` does not end in a heel strike.
     """
-    from walkerlab.analysis.hybrid import Solver, integrate_step
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
 
     seg = integrate_step(walker, np.asarray(x_star, dtype=float),
                          Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend),
@@ -358,7 +359,7 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     grid : (nx, ny), optional
         Overrides ``basin.grid``.
     workers, scheduler
-        As for :func:`walkerlab.sweep.runner.iter_chunk_results`.
+        As for :func:`walkerlab.sweep.runner.sweep_executor`.
     resume : bool
         Keep the cells of a matching partial file.
     on_chunk : callable(done, total), optional
@@ -377,7 +378,8 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     """
     import h5py
 
-    from walkerlab.sweep.runner import iter_chunk_results
+    from walkerlab.execution.executor import run_each
+    from walkerlab.sweep.runner import sweep_executor
 
     base = scene.model_dump(mode="json")
     walker, st, mst = _walker_and_settings(base)
@@ -446,23 +448,24 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
         dsets = {k: f.create_dataset(k, data=v) for k, v in arrays.items()}
         hashes = f.create_dataset("row_hash", data=row_hash, dtype=h5py.string_dtype())
         f.flush()
-        for rows in iter_chunk_results(tasks, workers, scheduler, fn=run_basin_chunk):
-            for idx, code, steps, period in rows:
-                j, i = divmod(idx, nx)
-                arrays["outcome"][j, i] = code
-                arrays["steps"][j, i] = steps
-                arrays["period"][j, i] = period
-            for j in sorted({idx // nx for idx, *_ in rows}):
-                if np.all(arrays["outcome"][j] != NOT_DONE):
-                    row_hash[j] = row_digest(arrays, j, key)
-            for k, d in dsets.items():
-                d[...] = arrays[k]
-            hashes[...] = row_hash
-            f.flush()
-            computed += len(rows)
-            done += len(rows)
-            bar.update(done)
-            if on_chunk is not None:
-                on_chunk(done, total)
+        with sweep_executor(workers, scheduler) as ex:
+            for _, rows in run_each(ex, run_basin_chunk, [(t,) for t in tasks]):
+                for idx, code, steps, period in rows:
+                    j, i = divmod(idx, nx)
+                    arrays["outcome"][j, i] = code
+                    arrays["steps"][j, i] = steps
+                    arrays["period"][j, i] = period
+                for j in sorted({idx // nx for idx, *_ in rows}):
+                    if np.all(arrays["outcome"][j] != NOT_DONE):
+                        row_hash[j] = row_digest(arrays, j, key)
+                for k, d in dsets.items():
+                    d[...] = arrays[k]
+                hashes[...] = row_hash
+                f.flush()
+                computed += len(rows)
+                done += len(rows)
+                bar.update(done)
+                if on_chunk is not None:
+                    on_chunk(done, total)
     return {"x": xs, "y": ys, **arrays, "wall_time_s": time.perf_counter() - t0,
             "cells_computed": computed, "partial": part, "settings": st, "walker": walker}

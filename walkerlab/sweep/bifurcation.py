@@ -21,7 +21,7 @@ the field's dotted path with the field's unit (from its name or metadata,
 it carries the field in its ``path`` attribute.
 
 Grid chunks (the runs up and down from the scene's slope) are evaluated with the sweep
-executors (:func:`walkerlab.sweep.runner.iter_chunk_results`), locally or on Dask.  Arrays
+executors (:func:`walkerlab.sweep.runner.sweep_executor`), locally or on Dask.  Arrays
 are sized by the walker (``walker.state_names()``); the cached stage that writes the
 artifact is :mod:`walkerlab.stages.bifurcation`.
 """
@@ -37,8 +37,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 from walkerlab.config import Scene
+from walkerlab.execution.executor import run_each
 from walkerlab.sweep.params import ParamAxis
-from walkerlab.sweep.runner import iter_chunk_results, plan_chunks
+from walkerlab.sweep.runner import plan_chunks, sweep_executor
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
            "min_real_multiplier", "bifurcation_writer", "load_bifurcation", "SLOPE_PATH",
@@ -100,7 +101,8 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     """Fixed point + steady state along one run of parameter values (worker side)."""
     import warnings
 
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
     from walkerlab.sweep.points import _Outcome, ideal_fixed_point, interleg_angle, warm_up
 
@@ -325,7 +327,7 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
     n_keep : int
         Last heel strikes kept per slope.
     workers, scheduler
-        As for :func:`walkerlab.sweep.runner.iter_chunk_results`.
+        As for :func:`walkerlab.sweep.runner.sweep_executor`.
     steady_state : bool
         Also simulate the steady state (False: fixed points and onset only).
     xtol_deg : float, optional
@@ -363,9 +365,10 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
 
     rows = []
     with progress.task(f"bifurcation: {slopes.size} values of {param}", slopes.size) as bar:
-        for rs in iter_chunk_results(tasks, workers, scheduler, fn=_bif_chunk):
-            rows += rs
-            bar.update(len(rows))
+        with sweep_executor(workers, scheduler) as ex:
+            for _, rs in run_each(ex, _bif_chunk, [(t,) for t in tasks]):
+                rows += rs
+                bar.update(len(rows))
     rows.sort(key=lambda r: r["index"])
     x = np.array([r["x"] for r in rows])
     mult = np.array([r["multipliers"] for r in rows])

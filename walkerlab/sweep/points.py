@@ -80,7 +80,7 @@ class Task:
 
 # ----------------------------------------------------------------------------- helpers
 def _solver(scene: Scene):
-    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.integrate.solver import Solver
 
     return Solver.from_settings(scene.solver)
 
@@ -306,8 +306,8 @@ def simulate_point(scene: Scene, guess, options: dict):
     The initial state is the scene's explicit state, or (``initial_state: fixed_point``)
     the fixed point found at this point (continuation from ``guess``).
     """
-    from walkerlab.analysis.hybrid import simulate_steps
     from walkerlab.config import SimulateSettings
+    from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.models.registry import build_walker
 
     opts = {**DEFAULT_OPTIONS, **options}
@@ -403,8 +403,8 @@ def contact_point(scene: Scene, guess, options: dict):
     foot left the ground and came back) and ``max_steps`` (stalled).
     """
     from walkerlab.analysis.contact_gait import classify_complete
-    from walkerlab.analysis.hybrid import integrate_step
     from walkerlab.config import FixedPointSettings
+    from walkerlab.integrate.rigid import integrate_step
 
     opts = {**DEFAULT_OPTIONS, **options}
     walker, fp, source = ideal_fixed_point(scene, guess, options)
@@ -534,15 +534,15 @@ def warm_up() -> None:
     """Import the root-finding and integration libraries once (called in fresh worker
     processes and in the forkserver), so that processes forked from the forkserver start
     warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise).  CyRK comes through
-    :mod:`walkerlab.analysis.cyrk_loader` (its ``pysolve_ivp`` without numba, ~0.2 s less);
+    :mod:`walkerlab.integrate.cyrk_loader` (its ``pysolve_ivp`` without numba, ~0.2 s less);
     the model code is built per scene by the points themselves (cached on disk)."""
     try:
         import scipy.optimize  # noqa: F401
 
-        from walkerlab.analysis.hybrid import _have_cyrk
+        from walkerlab.integrate.solver import available_backends
 
-        if _have_cyrk():
-            from walkerlab.analysis.cyrk_loader import pysolve_ivp
+        if "cyrk" in available_backends():
+            from walkerlab.integrate.cyrk_loader import pysolve_ivp
 
             pysolve_ivp()
     except Exception:  # noqa: BLE001 - warming is an optimisation only

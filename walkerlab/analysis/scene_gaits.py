@@ -1,0 +1,99 @@
+"""The period-1 gait of a scene's rigid walker: the scene's solver and fixed-point settings
+applied to :func:`walkerlab.analysis.gaits.find_gaits`, and the other equation variants
+of a compass gait compared with published numbers (what the ``fixedpoint`` stage stores).
+"""
+
+from __future__ import annotations
+
+import math
+
+from walkerlab.analysis.gaits import find_gaits
+from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
+from walkerlab.config import Scene
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.registry import build_walker
+
+
+def _settings(scene: Scene):
+    """The scene's ``fixedpoint`` section; left out, its defaults (every field is optional:
+    the gait is then found from scale-free seeds)."""
+    from walkerlab.config import FixedPointSettings
+
+    return scene.fixedpoint if scene.fixedpoint is not None else FixedPointSettings()
+
+
+def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
+    """The scene's own equation variant first, then (``compare``, for a compass gait compared
+    with published numbers) the other variants: they explain the difference from Eq. 11."""
+    own = (scene.ideal.variant,)
+    if compare and scene.walker.model == "compass_gait" and scene.published is not None:
+        from walkerlab.models.compass_gait import VARIANTS
+
+        return own + tuple(v for v in VARIANTS if v != scene.ideal.variant)
+    return own
+
+
+def initial_guess(scene: Scene, walker):
+    """The scene's initial guess by state name, or None (found automatically).
+
+    Raises
+    ------
+    ValueError
+        The guess does not name the walker's states (one line naming the field).
+    """
+    fp = _settings(scene)
+    if fp.initial_guess is None:
+        return None
+    try:
+        return fp.initial_guess.as_array(walker.state_names())
+    except ValueError as exc:
+        raise ValueError(f"fixedpoint.initial_guess: {exc}") from None
+
+
+def with_variant(scene: Scene, variant: str) -> Scene:
+    """The scene with ``ideal.variant`` set to ``variant``."""
+    return scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
+
+
+def solve_scene(scene: Scene, fd_check: bool = True):
+    """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``.
+
+    Returns
+    -------
+    walker : HybridWalker
+    search : walkerlab.analysis.gaits.GaitSearch
+
+    Raises
+    ------
+    GaitNotFound
+        No gait (one line: what was tried, what to try next).
+    ValueError
+        A malformed initial guess or gait choice, or no ``fixedpoint`` section (one line).
+    """
+    fp = _settings(scene)
+    walker = build_walker(scene)
+    search = find_gaits(walker, Solver.from_settings(scene.solver), initial_guess(scene, walker),
+                        policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
+                        fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
+                        fd_check=fd_check)
+    return walker, search
+
+
+def solve_variant(scene: Scene, variant: str, guess=None):
+    """Fixed point of one equation variant of the scene's walker, from ``guess`` (default:
+    the scene's initial guess) - for the comparison of printed equations.
+
+    Raises
+    ------
+    FixedPointNotFound
+        No fixed point from the guess (or no guess).
+    """
+    sc = with_variant(scene, variant)
+    walker = build_walker(sc)
+    fp = _settings(scene)
+    g = initial_guess(scene, walker) if guess is None else guess
+    if g is None:
+        raise FixedPointNotFound("no initial guess for this equation variant", math.nan)
+    res = find_fixed_point(walker, g, Solver.from_settings(scene.solver),
+                           xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
+    return walker, res
