@@ -83,7 +83,8 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
 
 #: how a rigid run that did not complete its strides ended, as a verb
 _ENDED = {"fall": "fell", "solver_failure": "stopped by a solver failure",
-          "t_final": "stopped (a step took longer than max_step_time_s)"}
+          "t_final": "stopped (a step took longer than max_step_time_s)",
+          "no_heel_strike": "made no step (no_heel_strike)"}
 
 
 def simulate_ending(sim: SimulateArtifact) -> str | None:
