@@ -129,9 +129,8 @@ def test_stability_map_marks_the_scenes_point_with_three_cells_a_side():
     """A 3x3 paper stiffness map (k = 1e3, 1e6, 1e9; slopes 0.5, 2.25, 4°) has no cell at
     the scene's k = 1e5 N/mm^2.2, φ = 0.997°: the star sits between cells, at
     log10 interpolation: y index (5 - 3) / 3 = 0.667, x index (0.997 - 0.5) / 1.75."""
-    from walkerlab.plotting.sweep_figures import gait_map_figure
-
     from walkerlab.io.schemas.stability_map import StabilityMap
+    from walkerlab.plotting.sweep_figures import gait_map_figure
 
     n = 3
     data = StabilityMap(

@@ -41,6 +41,12 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
         where = f"({legs[role]}, {role} leg)" if role else "(not on a leg)"
         lines.append(f"  {n:<14s} {where} {x: .10f} {unit}")
     lines.append(f"  step period     {fp.step_period_s:.10f} {u.time}")
+    if fp.stride_period_s is not None:  # legs that differ: the Poincare map is a stride
+        lines.append(f"  stride period   {fp.stride_period_s:.10f} {u.time} (the map is a "
+                     "stride: the legs differ)")
+        for leg, T, d in zip(fp.step_swing_legs, fp.step_periods_s, fp.step_lengths_m):
+            lines.append(f"    step with {leg} swinging: period {T:.10f} {u.time}, "
+                         f"length {d:.10f} {u.length}")
     lines.append(f"  residual        {fp.residual:.2e}  (max |P(x*) - x*|)")
     re, im = fp.multipliers.real, fp.multipliers.imag
     lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")
