@@ -59,7 +59,7 @@ import math
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, as_completed, wait
-from contextlib import contextmanager, nullcontext
+from contextlib import nullcontext
 from pathlib import Path
 from typing import Any
 
@@ -83,21 +83,12 @@ PIECE_POINTS = 4              # rows come back from a worker every this many poi
 FLUSH_EVERY_S = 0.5           # rows are written to the partial file at least this often [s]
 
 
-@contextmanager
 def _dask_client(scheduler):
-    """``(client, futures)`` for a Dask scheduler address or client; on exit the unfinished
-    futures are cancelled and a client opened here is closed."""
-    from distributed import Client
+    """``(client, futures)`` for a Dask scheduler address or client (see
+    :func:`walkerlab.sweep.dask_client.open_client`)."""
+    from walkerlab.sweep.dask_client import open_client
 
-    own = isinstance(scheduler, str)
-    client = Client(scheduler, set_as_default=False) if own else scheduler
-    futs: list = []
-    try:
-        yield client, futs
-    finally:
-        client.cancel([f for f in futs if not f.done()])
-        if own:
-            client.close()
+    return open_client(scheduler)
 
 
 def _dotted_get(d: dict, path: str):
@@ -245,7 +236,7 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
     if not live:
         return
     if scheduler is not None:
-        from distributed import as_completed as dask_completed
+        from walkerlab.sweep.dask_client import completed, result
 
         with _dask_client(scheduler) as (client, futs):
             where = {}
@@ -253,9 +244,9 @@ def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=Non
                 f = client.submit(run_piece, chains[ci][0], first[ci], pure=False)
                 where[f.key] = (ci, 0)
                 futs.append(f)
-            ac = dask_completed(futs, loop=client.loop)
+            ac = completed(client, futs)  # bounded wait for workers, one line if lost
             for fut in ac:
-                rows, guess = fut.result()
+                rows, guess = result(client, fut)
                 ci, k = where.pop(fut.key)
                 if k + 1 < len(chains[ci]):
                     nf = client.submit(run_piece, chains[ci][k + 1], guess, pure=False)
@@ -313,12 +304,12 @@ def iter_chunk_results(tasks: list[Task], workers: int = 2, scheduler=None,
     if not tasks:
         return
     if scheduler is not None:
-        from distributed import as_completed as dask_completed
+        from walkerlab.sweep.dask_client import completed, result
 
         with _dask_client(scheduler) as (client, futs):
             futs.extend(client.map(fn, tasks, pure=False))
-            for fut in dask_completed(list(futs), loop=client.loop):
-                yield fut.result()
+            for fut in completed(client, futs):
+                yield result(client, fut)
         return
     if not (pool if pool is not None else workers > 1):
         warm_up()

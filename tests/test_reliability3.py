@@ -1,0 +1,136 @@
+"""Issue 26, "Reliability, round three": each test reproduces one probe finding through the
+CLI or the API and failed on the code before the fix (branch point f894f40).
+
+Dask clusters are ``distributed.LocalCluster`` on 127.0.0.1 in a child process of the test
+(so that its scheduler can be SIGKILLed); every process is killed at teardown.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = ROOT / "configs" / "paper.yaml"
+
+
+def _env(tmp_path: Path, **extra) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(ROOT), **extra}
+    env.pop("WALKERLAB_DEBUG", None)
+    return env
+
+
+def _run(args, env, timeout=120, cwd=None):
+    return subprocess.run([sys.executable, "-m", "walkerlab.cli", *map(str, args)], env=env,
+                          capture_output=True, text=True, timeout=timeout, cwd=cwd)
+
+
+# ----------------------------------------------------------------------------- Dask (High)
+_CLUSTER = textwrap.dedent("""
+    import os, time
+    from distributed import Client, LocalCluster
+
+    if __name__ == "__main__":
+        cluster = LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1",
+                               dashboard_address=None, processes=True)
+
+        async def _no_restart():
+            return None
+
+        for nanny in cluster.workers.values():
+            nanny.instantiate = _no_restart  # a SIGKILLed worker stays dead
+        client = Client(cluster)
+        (wpid,) = client.run(os.getpid).values()
+        print(cluster.scheduler_address, wpid, flush=True)
+        while True:
+            time.sleep(1)
+""")
+
+
+@pytest.fixture
+def one_worker_cluster(tmp_path):
+    """``(address, worker pid, cluster process)``: a scheduler and one worker process."""
+    pytest.importorskip("distributed")
+    script = tmp_path / "cluster.py"
+    script.write_text(_CLUSTER)
+    proc = subprocess.Popen([sys.executable, str(script)], env=_env(tmp_path),
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                            start_new_session=True)
+    try:
+        line = proc.stdout.readline().split()
+        if len(line) != 2:
+            pytest.skip("LocalCluster did not start")
+        yield line[0], int(line[1]), proc
+    finally:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        proc.wait(timeout=30)
+        proc.stdout.close()
+
+
+def _sweep_files(folder: Path) -> set[str]:
+    return {p.name for p in folder.iterdir()} if folder.is_dir() else set()
+
+
+@pytest.mark.slow
+def test_h1_dask_only_worker_killed_bounded_wait_one_line_resume(tmp_path, one_worker_cluster):
+    addr, wpid, _ = one_worker_cluster
+    os.kill(wpid, signal.SIGKILL)  # the only worker dies; its nanny does not restart it
+    env = _env(tmp_path, WALKERLAB_DASK_WORKER_WAIT_S="3")
+    args = ["sweep", PAPER, "--param", "slope.angle_deg=1:1.3:0.1", "--name", "dk",
+            "--runs-dir", tmp_path / "runs"]
+    t0 = time.monotonic()
+    r = _run([*args, "--scheduler", addr], env, timeout=90)  # before: waited for ever
+    assert time.monotonic() - t0 < 60
+    assert r.returncode == 1, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "no worker for 3 s" in lines[0] and "--resume" in lines[0], lines
+    folder = tmp_path / "runs" / "paper"
+    assert _sweep_files(folder) == {".scene", "dk.h5.partial"}  # lock released, rows kept
+    r = _run([*args, "--resume", "--workers", "1"], env)
+    assert r.returncode == 0, r.stderr
+    files = _sweep_files(folder)
+    assert "dk.h5" in files and not {"dk.h5.partial", ".dk.h5.lock"} & files, files
+
+
+@pytest.mark.slow
+def test_h1_dask_scheduler_killed_one_line_suggests_resume(tmp_path, one_worker_cluster):
+    addr, wpid, proc = one_worker_cluster
+    env = _env(tmp_path)
+    folder = tmp_path / "runs" / "paper"
+    p = subprocess.Popen([sys.executable, "-m", "walkerlab.cli", "sweep", str(PAPER),
+                          "--param", "slope.angle_deg=1:4:0.005", "--name", "dk",
+                          "--runs-dir", str(tmp_path / "runs"), "--scheduler", addr],
+                         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        import psutil  # a dependency of distributed
+
+        port = int(addr.rsplit(":", 1)[1])
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and p.poll() is None:  # until it is connected
+            if any(c.raddr and c.raddr.port == port and c.status == "ESTABLISHED"
+                   for c in psutil.Process(p.pid).net_connections("tcp")):
+                break
+            time.sleep(0.1)
+        time.sleep(2.0)  # tasks submitted, rows coming in
+        assert p.poll() is None, p.communicate()
+        os.killpg(proc.pid, signal.SIGKILL)  # scheduler and worker gone
+        out, err = p.communicate(timeout=90)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    lines = err.strip().splitlines()
+    assert p.returncode == 1
+    assert len(lines) == 1, err  # before: ~40 lines, 2 tracebacks, internal error
+    assert "internal error" not in lines[0] and "--resume" in lines[0], lines
+    assert _sweep_files(folder) == {".scene", "dk.h5.partial"}

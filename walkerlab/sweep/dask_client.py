@@ -1,0 +1,212 @@
+"""A Dask client that never waits forever and fails in one line (issue 26, reliability).
+
+Dask's scheduler keeps a task whose worker died and waits - silently, for ever - until
+another worker joins; a scheduler that dies cancels every future and its client logs
+tracebacks while it tries to reconnect.  Here:
+
+- :func:`open_client` connects to a scheduler address (or wraps a given client), keeps the
+  ``distributed`` loggers quiet while it is open (their tracebacks are not for users) and, on
+  exit, cancels unfinished futures and closes a client it opened;
+- :func:`completed` yields futures as they finish, like ``distributed.as_completed``, but
+  raises :class:`DaskLost` (a :class:`~walkerlab.sweep.params.SweepError`, one line) when
+  the scheduler has had no worker for :func:`worker_wait_s` seconds while work is pending,
+  or when the connection to the scheduler is lost (cancelled futures).  A task that fails
+  on its own raises its own error, unchanged.
+
+The wait for workers is ``$WALKERLAB_DASK_WORKER_WAIT_S`` seconds (default
+:data:`WORKER_WAIT_S`): long enough for a worker to be restarted by its nanny or a batch
+system, short enough that a sweep whose workers are gone ends.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+from walkerlab.sweep.params import SweepError
+
+__all__ = ["DaskLost", "open_client", "completed", "result", "worker_wait_s",
+           "WORKER_WAIT_S", "WAIT_ENV"]
+
+#: default time a sweep waits for a Dask worker while none is connected [s]
+WORKER_WAIT_S = 60.0
+WAIT_ENV = "WALKERLAB_DASK_WORKER_WAIT_S"
+#: how often finished futures are looked for [s]
+POLL_S = 0.02
+#: how often the scheduler is asked for its workers while nothing finishes [s]
+CHECK_S = 1.0
+
+
+class DaskLost(SweepError):
+    """The Dask cluster cannot finish the work (no workers, scheduler gone); one line."""
+
+
+def worker_wait_s() -> float:
+    """Seconds to wait for a worker: ``$WALKERLAB_DASK_WORKER_WAIT_S`` or
+    :data:`WORKER_WAIT_S`.
+
+    Raises
+    ------
+    SweepError
+        The variable is not a positive number.
+    """
+    raw = os.environ.get(WAIT_ENV, "").strip()
+    if not raw:
+        return WORKER_WAIT_S
+    try:
+        v = float(raw)
+    except ValueError:
+        v = float("nan")
+    if not (0 < v < 1e6):
+        raise SweepError(f"{WAIT_ENV}={raw!r}: give a number of seconds > 0")
+    return v
+
+
+@contextmanager
+def _quiet_distributed():
+    names = ["distributed"] + [n for n in list(logging.root.manager.loggerDict)
+                               if n.startswith("distributed.")]
+    logs = [logging.getLogger(n) for n in names]  # children have levels of their own
+    levels = [log.level for log in logs]
+    for log in logs:
+        log.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for log, level in zip(logs, levels):
+            log.setLevel(level)
+
+
+@contextmanager
+def open_client(scheduler):
+    """``(client, futures)`` for a scheduler address or a ``distributed.Client``.
+
+    On exit the unfinished futures in the list are cancelled and a client opened here is
+    closed.
+
+    Raises
+    ------
+    DaskLost
+        The scheduler cannot be reached (one line naming the address).
+    """
+    from distributed import Client
+
+    own = isinstance(scheduler, str)
+    with _quiet_distributed():
+        if own:
+            try:
+                client = Client(scheduler, set_as_default=False)
+            except (OSError, TimeoutError) as exc:
+                raise DaskLost(f"Dask scheduler {scheduler}: cannot connect ({exc})") from None
+        else:
+            client = scheduler
+        futs: list = []
+        try:
+            yield client, futs
+        finally:
+            try:
+                client.cancel([f for f in futs if not f.done()])
+            except Exception:  # noqa: BLE001 - a lost scheduler: nothing left to cancel
+                pass
+            if own:
+                try:
+                    client.close(timeout=5)
+                except Exception:  # noqa: BLE001 - closing a client whose scheduler died
+                    pass
+
+
+def _lost(client) -> DaskLost:
+    where = getattr(client.scheduler, "address", None) or "the Dask scheduler"
+    return DaskLost(f"lost the connection to the Dask scheduler {where}; the rows finished so "
+                    "far are kept: restart the scheduler and its workers and rerun with "
+                    "--resume")
+
+
+def _n_workers(client) -> int | None:
+    try:
+        return len(client.scheduler_info().get("workers", {}))
+    except Exception:  # noqa: BLE001 - the scheduler is unreachable: reported as lost
+        return None
+
+
+def completed(client, futures, wait_s: float | None = None) -> Iterator:
+    """Yield ``futures`` as they finish, like ``distributed.as_completed`` (a future added
+    with the iterator's ``add`` while iterating is waited for too); each yielded future is
+    done and not cancelled.
+
+    Parameters
+    ----------
+    client : distributed.Client
+    futures : list of distributed.Future
+    wait_s : float, optional
+        Longest time without any worker while futures are pending [s]; default
+        :func:`worker_wait_s`.
+
+    Raises
+    ------
+    DaskLost
+        No worker for ``wait_s`` seconds, or the scheduler is gone.
+    """
+    return _Completed(client, futures, worker_wait_s() if wait_s is None else wait_s)
+
+
+class _Completed:
+    def __init__(self, client, futures, wait_s: float):
+        from distributed import as_completed
+
+        self.client, self.wait_s = client, wait_s
+        self.ac = as_completed(list(futures), loop=client.loop)
+
+    def add(self, fut) -> None:
+        self.ac.add(fut)
+
+    def __iter__(self):
+        no_workers_since: float | None = None
+        checked = time.monotonic()
+        while not self.ac.is_empty():
+            if self.ac.has_ready():
+                no_workers_since = None
+                for fut in self.ac.next_batch(block=False):
+                    if fut.status == "cancelled":
+                        raise _lost(self.client)
+                    yield fut
+                continue
+            time.sleep(POLL_S)
+            now = time.monotonic()
+            if now - checked < CHECK_S:
+                continue
+            checked = now
+            if self.client.status not in ("running", "connecting"):
+                raise _lost(self.client)
+            n = _n_workers(self.client)
+            if n is None:
+                raise _lost(self.client)
+            if n:
+                no_workers_since = None
+            elif no_workers_since is None:
+                no_workers_since = now
+            elif now - no_workers_since >= self.wait_s:
+                where = getattr(self.client.scheduler, "address", None) or "the scheduler"
+                raise DaskLost(f"Dask scheduler {where} has had no worker for "
+                               f"{self.wait_s:g} s ({self.ac.count()} task(s) waiting); the "
+                               "rows finished so far are kept: start workers (or raise "
+                               f"{WAIT_ENV}) and rerun with --resume")
+
+
+def result(client, fut):
+    """``fut.result()``; a task that killed its workers or was cancelled by a lost scheduler
+    raises :class:`DaskLost` (one line), an error of the task itself propagates unchanged."""
+    from distributed.client import FutureCancelledError
+    from distributed.scheduler import KilledWorker
+
+    try:
+        return fut.result()
+    except KilledWorker as exc:
+        raise DaskLost(f"a Dask task ended the worker running it, again and again ({exc}); the "
+                       "rows finished so far are kept: rerun with --resume (locally, without "
+                       "--scheduler, to see the error)") from None
+    except FutureCancelledError:
+        raise _lost(client) from None
