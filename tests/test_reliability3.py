@@ -134,3 +134,110 @@ def test_h1_dask_scheduler_killed_one_line_suggests_resume(tmp_path, one_worker_
     assert len(lines) == 1, err  # before: ~40 lines, 2 tracebacks, internal error
     assert "internal error" not in lines[0] and "--resume" in lines[0], lines
     assert _sweep_files(folder) == {".scene", "dk.h5.partial"}
+
+
+# ----------------------------------------------------------------------------- user cache
+def _fifo_all(folder: Path, suffixes=None) -> int:
+    n = 0
+    for p in sorted(folder.rglob("*")):
+        if p.is_file() and (suffixes is None or p.suffix in suffixes):
+            p.unlink()
+            os.mkfifo(p)
+            n += 1
+    return n
+
+
+def test_h2_fifos_in_the_user_cache_do_not_hang_fixedpoint(tmp_path):
+    cache = tmp_path / "cache"
+    env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(cache), TMPDIR=str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    args = ["fixedpoint", PAPER, "--runs-dir", tmp_path / "runs", "--force"]
+    assert _run(args, env).returncode == 0
+    assert _fifo_all(cache) >= 1  # every generated module replaced by a FIFO
+    r = _run(args, env, timeout=60)  # before: hung in open() for ever
+    assert r.returncode == 0, r.stderr
+    assert "step period     0.70359" in r.stdout
+    assert not any(p.is_fifo() for p in (cache / "models").iterdir())  # rebuilt in place
+
+
+_KERNEL = ("from walkerlab.contact import _kernels as k; "
+           "print(k.step(0.25, 0.0, 0.0, 1.0, 1.0)[0], k.friction_mu(0.5, 0.9, 0.7, 0.1, 1.0)[0])")
+
+
+def _kernel_run(env):
+    return subprocess.run([sys.executable, "-c", _KERNEL], env=env, capture_output=True,
+                          text=True, timeout=120)
+
+
+@pytest.mark.parametrize("damage", ["garbage", "empty", "fifo"])
+def test_m1_damaged_numba_cache_files_are_rebuilt(tmp_path, damage):
+    cache = tmp_path / "cache"
+    env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(cache), TMPDIR=str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    first = _kernel_run(env)
+    assert first.returncode == 0, first.stderr
+    files = [p for p in (cache / "numba").rglob("*") if p.suffix in (".nbi", ".nbc")
+             and ("_kernels.step-" in p.name or "_kernels.friction_mu-" in p.name)]
+    assert {p.suffix for p in files} == {".nbi", ".nbc"}
+    for p in files:
+        p.unlink()
+        if damage == "fifo":
+            os.mkfifo(p)
+        else:
+            p.write_bytes(b"" if damage == "empty" else b"\x80\x05garbage" * 7)
+    r = _kernel_run(env)  # before: UnpicklingError / EOFError for good (FIFO: a hang)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == first.stdout.split()  # STEP(0.25) = 0.15625; mu(0.5) < 0
+    assert float(r.stdout.split()[0]) == 0.25 ** 2 * (3 - 2 * 0.25)
+    again = [p for p in (cache / "numba").rglob("*") if "_kernels.step-" in p.name]
+    assert again and all(p.is_file() and p.stat().st_size > 0 for p in again)  # rewritten
+
+
+def _package_pycache() -> set[Path]:
+    return {p for p in (ROOT / "walkerlab").rglob("*.nbi")} | \
+        {p for p in (ROOT / "walkerlab").rglob("*.nbc")}
+
+
+@pytest.mark.parametrize("how", ["group_writable", "symlink", "not_creatable", "read_only"])
+def test_m2_unusable_numba_cache_never_writes_into_the_package(tmp_path, how):
+    if how == "read_only" and os.geteuid() == 0:
+        pytest.skip("root writes into read-only folders (not_creatable covers the fallback)")
+    cache, tmp = tmp_path / "cache", tmp_path / "tmp"
+    tmp.mkdir()
+    env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(cache), TMPDIR=str(tmp))
+    env.pop("NUMBA_CACHE_DIR", None)
+    cache.mkdir(mode=0o700)
+    if how == "not_creatable":  # the cache root lies under a regular file
+        (cache / "file").write_text("")
+        env["WALKERLAB_CACHE_DIR"] = str(cache / "file" / "walkerlab")
+    elif how == "group_writable":
+        (cache / "numba").mkdir()
+        os.chmod(cache / "numba", 0o770)
+    elif how == "symlink":
+        (tmp_path / "elsewhere").mkdir(mode=0o700)
+        os.symlink(tmp_path / "elsewhere", cache / "numba")
+    else:
+        (cache / "numba").mkdir(mode=0o700)
+        (cache / "models").mkdir(mode=0o700)
+        os.chmod(cache / "numba", 0o500)
+        os.chmod(cache / "models", 0o500)
+        os.chmod(cache, 0o500)
+    before = _package_pycache()
+    try:
+        for _ in range(2):
+            r = _kernel_run(env)
+            assert r.returncode == 0, r.stderr
+            r = _run(["fixedpoint", PAPER, "--runs-dir", tmp_path / "runs", "--force"], env)
+            assert r.returncode == 0, r.stderr
+    finally:
+        os.chmod(cache, 0o700)
+        for p in cache.iterdir():
+            if not p.is_symlink():
+                os.chmod(p, 0o700)
+    new = _package_pycache() - before
+    for p in new:  # do not leave them for the next run
+        p.unlink()
+    assert not new, sorted(map(str, new))[:3]  # before: machine code in walkerlab/__pycache__
+    assert list(tmp.iterdir()) == []  # before: a walkerlab_gen_* folder per run
+    if how == "symlink":
+        assert list((tmp_path / "elsewhere").iterdir()) == []

@@ -45,7 +45,8 @@ class NotARegularFile(ValueError):
     """The path is a device, FIFO, socket or directory, or larger than its cap (one line)."""
 
 
-def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
+def read_regular(path: str | Path, max_bytes: int, what: str = "file",
+                 follow_links: bool = True, check=None) -> bytes:
     """Contents of a regular file of at most ``max_bytes`` bytes.
 
     Parameters
@@ -55,6 +56,11 @@ def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
         Largest accepted size [bytes].
     what : str
         What the file is, for the message (``"scene file"``).
+    follow_links : bool
+        False: a symbolic link at ``path`` is refused (``O_NOFOLLOW``: an ``OSError``).
+    check : callable, optional
+        ``check(os.stat_result) -> bool`` on the opened file; False refuses it
+        (:class:`NotARegularFile`), e.g. a cache file that is not the user's own.
 
     Returns
     -------
@@ -71,7 +77,10 @@ def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
         Other errors of ``open``/``read`` (permissions).
     """
     path = Path(path)
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0)
+    if not follow_links:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
+    fd = os.open(path, flags)
     try:
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
@@ -80,6 +89,8 @@ def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
                     "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else
                     "not a regular file")
             raise NotARegularFile(f"{path}: {what} is {kind}, not a regular file")
+        if check is not None and not check(st):
+            raise NotARegularFile(f"{path}: {what} is not trusted (owner or mode)")
         if st.st_size > max_bytes:
             raise NotARegularFile(f"{path}: {what} is {st.st_size:,} bytes; at most "
                                   f"{max_bytes:,} are read")
