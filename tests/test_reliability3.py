@@ -241,3 +241,54 @@ def test_m2_unusable_numba_cache_never_writes_into_the_package(tmp_path, how):
     assert list(tmp.iterdir()) == []  # before: a walkerlab_gen_* folder per run
     if how == "symlink":
         assert list((tmp_path / "elsewhere").iterdir()) == []
+
+
+# ----------------------------------------------------------------------------- API (Medium)
+def test_m5_api_runs_dir_empty_is_refused_not_the_current_folder(tmp_path, monkeypatch):
+    import walkerlab.api as wl
+    from walkerlab.safefs import RunPathError
+
+    monkeypatch.chdir(tmp_path)
+    scene = wl.load_scene(PAPER)
+    for bad in ("", "  ", None, 5):
+        with pytest.raises(RunPathError, match="runs_dir"):
+            wl.fixed_point(scene, runs_dir=bad)
+        with pytest.raises(RunPathError, match="runs_dir"):
+            wl.sweep(scene, "walker.hip_mass_kg", [10.0], runs_dir=bad)
+    assert list(tmp_path.iterdir()) == []  # before: ./paper/fixedpoint.h5
+
+
+def test_m5_api_sweep_values_must_be_a_sequence(tmp_path):
+    import walkerlab.api as wl
+    from walkerlab.sweep.params import SweepError
+
+    scene = wl.load_scene(PAPER)
+    for bad in ("10", "1,2", b"10", 10):
+        with pytest.raises(SweepError, match="give a sequence"):  # before: swept "1" and "0"
+            wl.sweep(scene, "walker.hip_mass_kg", bad, runs_dir=tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_m5_api_load_scene_name_is_validated():
+    import walkerlab.api as wl
+    from walkerlab.config import SceneError
+
+    for bad in (5, "", "a/b", "..", ".hidden", 1.5):
+        with pytest.raises(SceneError, match="name"):
+            wl.load_scene(PAPER, name=bad)
+    assert wl.load_scene(PAPER, name="steep_1").name == "steep_1"
+
+
+def test_m5_a_5000_digit_integer_is_one_line_naming_the_field():
+    import yaml
+
+    import walkerlab.api as wl
+    from walkerlab.config import SceneError
+
+    d = yaml.safe_load(PAPER.read_text())
+    d["walker"]["hip_mass_kg"] = 10 ** 5000
+    with pytest.raises(SceneError) as err:  # before: ValueError (int-to-str digit limit)
+        wl.load_scene(d)
+    msg = str(err.value)
+    assert "\n" not in msg and len(msg) < 200
+    assert "walker.hip_mass_kg" in msg and "5001 digits" in msg

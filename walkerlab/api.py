@@ -29,7 +29,7 @@ Example
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -65,9 +65,10 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
     ------
     walkerlab.config.SceneError
         File missing, malformed YAML, or fields that do not validate (every error, one line
-        each, unknown keys first with the closest field name).
+        each, unknown keys first with the closest field name); ``name`` not a string or not
+        a safe folder name (empty, path separators).
     """
-    from walkerlab.config import Scene, scene_from_dict
+    from walkerlab.config import Scene, SceneError, scene_from_dict
     from walkerlab.config import load_scene as _load
 
     if isinstance(path_or_dict, Scene):
@@ -79,6 +80,15 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
     else:
         sc = _load(path_or_dict)
     if name is not None:
+        from walkerlab.io.runpaths import check_name
+
+        if not isinstance(name, str):
+            raise SceneError(f"name={name!r}: give the run folder name as a string, e.g. "
+                             "name='paper_steep'")
+        try:
+            check_name(name, "name")
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
         origin = getattr(sc, "_origin", None)
         sc = sc.model_copy(update={"name": name})
         sc._origin = origin
@@ -89,6 +99,21 @@ def _scene(scene) -> Scene:
     from walkerlab.config import Scene
 
     return scene if isinstance(scene, Scene) else load_scene(scene)
+
+
+def _runs(runs_dir) -> Path:
+    """``runs_dir`` as a path; an empty name (which would be the current folder) or a value
+    that is not a path is refused in one line, as ``--runs-dir ''`` is."""
+    import os
+
+    from walkerlab.safefs import RunPathError
+
+    if not isinstance(runs_dir, (str, os.PathLike)) or isinstance(runs_dir, bytes):
+        raise RunPathError(f"runs_dir={runs_dir!r}: give a folder name, e.g. runs_dir='runs'")
+    if not str(runs_dir).strip():
+        raise RunPathError("runs_dir='': empty folder name (it would write into the current "
+                           "folder); give a folder, e.g. runs_dir='runs'")
+    return Path(runs_dir)
 
 
 def _read(path: Path) -> xarray.Dataset:
@@ -129,12 +154,14 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
         No ``fixedpoint`` section, or no fixed point found (one line saying why).
     walkerlab.config.SceneError
         The scene does not validate.
+    walkerlab.safefs.RunPathError
+        ``runs_dir`` empty (it would be the current folder) or not a path.
     ImportError
         xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
     """
     from walkerlab.stages import fixedpoint as stage
 
-    return _read(stage.run(_scene(scene), runs_dir, force).path)
+    return _read(stage.run(_scene(scene), _runs(runs_dir), force).path)
 
 
 def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -159,7 +186,7 @@ def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEF
     from walkerlab.io.datasets import load_fixed_points
     from walkerlab.stages import fixedpoint as stage
 
-    return load_fixed_points(stage.run(_scene(scene), runs_dir, force).path)
+    return load_fixed_points(stage.run(_scene(scene), _runs(runs_dir), force).path)
 
 
 def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
@@ -196,7 +223,7 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
     """
     from walkerlab.stages import simulate as stage
 
-    return _read(stage.run(_scene(scene), runs_dir, force, strides=strides).path)
+    return _read(stage.run(_scene(scene), _runs(runs_dir), force, strides=strides).path)
 
 
 def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
@@ -235,7 +262,7 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     """
     from walkerlab.stages import contact_sim as stage
 
-    return _read(stage.run(_scene(scene), runs_dir, force, adjust=adjust,
+    return _read(stage.run(_scene(scene), _runs(runs_dir), force, adjust=adjust,
                            periodic=periodic).path)
 
 
@@ -260,7 +287,7 @@ def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_
     """
     from walkerlab.stages import compare as stage
 
-    return _read(stage.run(_scene(scene), runs_dir, force).path)
+    return _read(stage.run(_scene(scene), _runs(runs_dir), force).path)
 
 
 def _axis_spec(param: str, values: Sequence) -> str:
@@ -272,6 +299,12 @@ def _axis_spec(param: str, values: Sequence) -> str:
             return str(v)
         return str(int(v)) if isinstance(v, numbers.Integral) else repr(float(v))
 
+    from walkerlab.sweep.params import SweepError
+
+    if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+        raise SweepError(f"sweep {param}: values={values!r}: give a sequence of values, e.g. "
+                         f"[{values if isinstance(values, (int, float)) else 10}] or "
+                         "[8, 10, 12] (a string would be swept character by character)")
     vals = list(values)
     if not vals:
         raise ValueError(f"sweep {param}: no values given")
@@ -313,14 +346,15 @@ def sweep(scene: Scene | str | Path | dict, param: str, values: Sequence, *,
     Raises
     ------
     walkerlab.sweep.params.SweepError
-        Unknown field, values the field refuses, or an unknown stage.
+        Unknown field, values the field refuses, ``values`` a string or a single number
+        instead of a sequence, or an unknown stage.
     SceneError, ImportError
         As :func:`fixed_point`.
     """
     from walkerlab.stages import sweep as stage_mod
 
     path = stage_mod.run(_scene(scene), [_axis_spec(param, values)], stage=stage,
-                         workers=workers, runs_root=runs_dir, name=name, progress=progress)
+                         workers=workers, runs_root=_runs(runs_dir), name=name, progress=progress)
     return _read(path)
 
 
@@ -359,6 +393,6 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     """
     from walkerlab.stages import basin as stage
 
-    out = stage.run(_scene(scene), runs_dir, force, grid=tuple(grid) if grid else None,
+    out = stage.run(_scene(scene), _runs(runs_dir), force, grid=tuple(grid) if grid else None,
                     workers=workers)
     return _read(out.path)

@@ -618,6 +618,14 @@ def _fields_at(loc: tuple) -> list[str]:
     return sorted({k for m in current for k in m.model_fields})
 
 
+def _input_text(value) -> str:
+    """``repr`` of an input value for a message; an integer too long to print (Python caps
+    int-to-str at 4300 digits) or to read is described instead."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 100:
+        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    return repr(value)
+
+
 def _error_line(e: dict) -> str:
     """One error as ``<field path>: <message>`` (an unknown key names the likely field)."""
     import difflib
@@ -632,7 +640,7 @@ def _error_line(e: dict) -> str:
     if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
             and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
                               "string_type", "float_parsing", "int_parsing"):
-        msg += f" (got {e['input']!r})"
+        msg += f" (got {_input_text(e['input'])})"
     if not loc and re.match(r"^[a-z_]+(\.[a-z_]+)+: ", msg):  # a cross-field check names it
         return msg
     return f"{loc or '<scene>'}: {msg}"
