@@ -292,3 +292,34 @@ def test_m5_a_5000_digit_integer_is_one_line_naming_the_field():
     msg = str(err.value)
     assert "\n" not in msg and len(msg) < 200
     assert "walker.hip_mass_kg" in msg and "5001 digits" in msg
+
+
+# ----------------------------------------------------------------------------- guess (Medium)
+def test_m6_a_spinning_initial_guess_fails_fast_in_one_line(tmp_path):
+    import yaml
+
+    d = yaml.safe_load(PAPER.read_text())
+    d["fixedpoint"]["initial_guess"]["swing_rate_rad_per_s"] = 1.0e6
+    scene = tmp_path / "spin.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    t0 = time.monotonic()
+    r = _run(["fixedpoint", scene, "--runs-dir", tmp_path / "runs"], _env(tmp_path), timeout=60)
+    assert time.monotonic() - t0 < 30  # before: 74 s, then internal error (OverflowError)
+    assert r.returncode == 1
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "swing_rate_rad_per_s: 1e+06" in lines[0], lines
+    assert "62.6 rad/s" in lines[0]  # 20 sqrt(9.81 / 1.0)
+
+
+def test_m6_every_shipped_initial_guess_is_within_the_walking_bound():
+    from walkerlab.config import load_scene
+    from walkerlab.models.registry import build_walker
+    from walkerlab.stages.fixedpoint import _guess
+
+    n = 0
+    for path in sorted((ROOT / "configs").glob("*.yaml")):
+        scene = load_scene(path)
+        if scene.fixedpoint is not None and scene.fixedpoint.initial_guess is not None:
+            assert _guess(scene, build_walker(scene)) is not None, path.name
+            n += 1
+    assert n >= 3
