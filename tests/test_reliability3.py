@@ -323,3 +323,70 @@ def test_m6_every_shipped_initial_guess_is_within_the_walking_bound():
             assert _guess(scene, build_walker(scene)) is not None, path.name
             n += 1
     assert n >= 3
+
+
+# ----------------------------------------------------------------------------- Low
+def _dead_pid() -> int:
+    p = subprocess.Popen(["true"])
+    p.wait()
+    return p.pid  # exited and reaped: not alive (a reuse of the pid would keep the file)
+
+
+@pytest.mark.slow
+def test_low_killed_animate_temp_files_are_removed_and_a_linked_gif_refused(tmp_path):
+    env = _env(tmp_path)
+    args = ["animate", PAPER, "--runs-dir", tmp_path / "runs"]
+    assert _run(args, env).returncode == 0
+    folder = tmp_path / "runs" / "paper"
+    figs = folder / "report" / "figures"
+    dead, old = _dead_pid(), time.time() - 3600
+    stale = [figs / f".animation.{dead}.abcd1234.gif", folder / f".simulate.h5.{dead}.k2j4h5g6.tmp",
+             figs / f".report.md.{dead}.zz99yy88.tmp"]
+    kept = [figs / f".animation.{os.getpid()}.live0000.gif",  # a live writer's
+            figs / f".animation.{dead}.abcd1234.png"]  # not a name walkerlab writes
+    for p in stale + kept:
+        p.write_bytes(b"partial")
+        os.utime(p, (old, old))
+    r = _run(args, env)  # before: SIGTERM/SIGKILL left-overs were never removed
+    assert r.returncode == 0, r.stderr
+    assert [p.name for p in stale if p.exists()] == []
+    assert all(p.exists() for p in kept)
+    # animation.gif replaced by a link: refused in one line, the target untouched
+    target = tmp_path / "elsewhere.gif"
+    target.write_bytes(b"mine")
+    (figs / "animation.gif").unlink()
+    os.symlink(target, figs / "animation.gif")
+    r = _run(args, env)
+    assert r.returncode == 1
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "symbolic link" in lines[0] and "animation.gif" in lines[0]
+    assert target.read_bytes() == b"mine" and (figs / "animation.gif").is_symlink()
+
+
+def test_low_knee_latch_on_a_straight_leg_walker_is_an_error(tmp_path):
+    import yaml
+
+    for cfg in ("paper.yaml", "round_feet.yaml"):
+        d = yaml.safe_load((ROOT / "configs" / cfg).read_text())
+        d.setdefault("contact", {})["knee_stop"] = {"latch": True}
+        scene = tmp_path / cfg
+        scene.write_text(yaml.safe_dump(d))
+        r = _run(["contact-sim", scene, "--runs-dir", tmp_path / "runs"], _env(tmp_path))
+        assert r.returncode == 1  # before: accepted, the latch silently ignored
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and "contact.knee_stop.latch" in lines[0] and "no knee" in lines[0]
+    assert not (tmp_path / "runs").exists()
+
+
+def test_low_cache_dir_symlink_is_refused_before_anything_is_created(tmp_path):
+    target = tmp_path / "target"
+    target.mkdir(mode=0o700)
+    link = tmp_path / "cache_link"
+    os.symlink(target, link)
+    (tmp_path / "tmp").mkdir()
+    env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(link), TMPDIR=str(tmp_path / "tmp"))
+    env.pop("NUMBA_CACHE_DIR", None)
+    r = _run(["fixedpoint", PAPER, "--runs-dir", tmp_path / "runs"], env)
+    assert r.returncode == 0, r.stderr
+    assert list(target.iterdir()) == []  # before: models/ and numba/ made inside the target
+    assert list((tmp_path / "tmp").iterdir()) == []  # the private fallback removed at exit

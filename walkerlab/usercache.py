@@ -182,9 +182,13 @@ def write_private(path: Path, text: str) -> bool:
     folder cannot be written (read-only, disk full, ...)."""
     import tempfile
 
+    from walkerlab.safefs import remove_stale_temps, temp_prefix
+
     tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".tmp", dir=path.parent)
+        remove_stale_temps(path.parent, path.stem)  # of a killed earlier run
+        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.stem), suffix=".tmp",
+                                   dir=path.parent)
         with os.fdopen(fd, "wb") as fh:
             fh.write(text.encode())
         os.chmod(tmp, 0o600)

@@ -521,6 +521,21 @@ class Scene(_Strict):
         return self
 
     @model_validator(mode="after")
+    def _knee_stop_needs_a_knee(self) -> Scene:
+        # a latch that cannot act is a mistake, as an unknown key is (issue 26): an error,
+        # not a warning, so a latch the user counts on is never silently absent (the stop's
+        # other numbers have defaults and are dumped with every scene: not checked)
+        c = self.contact
+        if c is None or not c.knee_stop.latch:
+            return self
+        leg = getattr(self.walker, "leg", None)
+        if leg is None or getattr(leg, "knee", None) is None:
+            raise ValueError("contact.knee_stop.latch: the walker's legs are straight (no "
+                             "walker.leg.knee), so there is no knee to latch: remove it or "
+                             "give the leg a knee")
+        return self
+
+    @model_validator(mode="after")
     def _published_exists(self) -> Scene:
         if self.published is not None:
             from walkerlab.published import available

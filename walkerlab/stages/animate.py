@@ -40,10 +40,16 @@ class AnimateOutcome:
 
 def _atomic_save(frames, path: Path, writer) -> Path:
     """Write the frames to a temporary file of the same suffix in the same folder, then rename
-    (matplotlib's writers pick the format from the file name)."""
+    (matplotlib's writers pick the format from the file name).  ``path`` must not be a
+    symbolic link (RunPathError, one line); temporary files of a killed earlier run
+    (``.animation.<pid>.*.gif``) are removed first."""
     from walkerlab.plotting.animation import write_frames
+    from walkerlab.safefs import refuse_link, remove_stale_temps, temp_prefix
 
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    refuse_link(path)
+    remove_stale_temps(path.parent, path.stem, (path.suffix,))
+    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.stem), suffix=path.suffix,
+                               dir=path.parent)
     os.close(fd)
     try:
         write_frames(frames, tmp, writer)
