@@ -390,3 +390,104 @@ def test_low_cache_dir_symlink_is_refused_before_anything_is_created(tmp_path):
     assert r.returncode == 0, r.stderr
     assert list(target.iterdir()) == []  # before: models/ and numba/ made inside the target
     assert list((tmp_path / "tmp").iterdir()) == []  # the private fallback removed at exit
+
+
+# ----------------------------------------------------------------------------- figures (Medium)
+def _rigid_scene(tmp_path: Path) -> Path:
+    import yaml
+
+    d = yaml.safe_load(PAPER.read_text())
+    keep = {k: v for k, v in d.items()
+            if k in ("walker", "slope", "solver", "fixedpoint", "simulate", "published")}
+    p = tmp_path / "rigid.yaml"
+    p.write_text(yaml.safe_dump(keep))
+    return p
+
+
+def _edit(path: Path, dataset: str, factor: float = 3.0) -> None:
+    import h5py
+
+    with h5py.File(path, "r+") as f:
+        f[dataset][...] = f[dataset][()] * factor
+
+
+def _digests(folder: Path) -> dict[str, str]:
+    import hashlib
+
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in folder.glob("*.png")}
+
+
+@pytest.mark.slow
+def test_m4_figures_and_report_key_on_the_content_they_draw(tmp_path):
+    scene, env = _rigid_scene(tmp_path), _env(tmp_path)
+    runs = tmp_path / "runs"
+    folder, figs = runs / "rigid", runs / "rigid" / "report" / "figures"
+    assert _run(["report", scene, "--runs-dir", runs], env).returncode == 0
+    drawn = _digests(figs)
+    assert {"fig7_angles_rates.png", "fig9_limit_cycles.png"} <= set(drawn)
+    _edit(folder / "simulate.h5", "samples/coordinates/leg1_angle")
+    r = _run(["plot", scene, "--runs-dir", runs], env)  # before: drew the edited numbers
+    assert r.returncode == 1
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "simulate.h5" in lines[0] and "changed after" in lines[0]
+    assert _digests(figs) == drawn
+    # figures drawn from other content (the edited file, as the old `plot` did) are redrawn
+    import shutil
+
+    stamp = figs / ".drawn_from_trajectories"
+    assert not stamp.exists()  # removed before drawing: a refused or killed plot leaves none
+    stale = '{"artifacts": {"simulate": "0"}, "code": "0"}'
+    stamp.write_text(stale)
+    r = _run(["report", scene, "--runs-dir", runs], env)
+    assert r.returncode == 0, r.stderr
+    assert "trajectories figures reused" not in r.stdout  # before: "reused"
+    assert "plot: trajectories, " in " ".join(r.stdout.split())
+    assert stamp.read_text() != stale
+    # a bifurcation.h5 edited by hand is left out of the report, and said so
+    assert _run(["bifurcation", scene, "--slopes", "1:1.1:0.1", "--runs-dir", runs],
+                env).returncode == 0
+    r = _run(["report", scene, "--runs-dir", runs], env)
+    assert "bifurcation" in (folder / "report" / "report.md").read_text().lower()
+    _edit(folder / "bifurcation.h5", _first_float_dataset(folder / "bifurcation.h5"))
+    r = _run(["report", scene, "--runs-dir", runs], env)
+    assert r.returncode == 0, r.stderr
+    out = " ".join((r.stdout + r.stderr).split())
+    assert "bifurcation.h5 (changed after it was written" in out  # before: shown as is
+    shutil.rmtree(runs)
+
+
+def _first_float_dataset(path: Path) -> str:
+    import h5py
+
+    names: list[str] = []
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset)
+                     and o.dtype.kind == "f" and o.size > 1 else None)
+    return names[0]
+
+
+@pytest.mark.slow
+def test_m4_animate_leaves_out_a_stale_or_edited_contact_sim(tmp_path):
+    import yaml
+
+    env, runs = _env(tmp_path), tmp_path / "runs"
+    d = yaml.safe_load(PAPER.read_text())
+    d["simulate"]["strides"] = 2
+    d["name"] = "anim"
+    scene = tmp_path / "anim.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    assert _run(["contact-sim", scene, "--runs-dir", runs], env).returncode == 0
+    r = _run(["animate", scene, "--runs-dir", runs], env)
+    assert r.returncode == 0 and "rigid walker only" not in r.stdout, r.stdout + r.stderr
+    d["walker"]["hip_mass_kg"] = 12.0  # the scene changes; contact_sim.h5 is the old one
+    scene.write_text(yaml.safe_dump(d))
+    r = _run(["animate", scene, "--runs-dir", runs], env)
+    assert r.returncode == 0, r.stderr  # before: drew the old contact walker beside the new
+    assert "animated the rigid walker only: contact_sim.h5 was computed for another scene" \
+        in " ".join(r.stdout.split())
+    d["walker"]["hip_mass_kg"] = 10.0
+    scene.write_text(yaml.safe_dump(d))
+    _edit(runs / "anim" / "contact_sim.h5", _first_float_dataset(runs / "anim" / "contact_sim.h5"))
+    r = _run(["animate", scene, "--runs-dir", runs], env)
+    assert r.returncode == 0, r.stderr  # before: drew the hand-edited one
+    assert "contact_sim.h5 was changed after it was written" in " ".join(r.stdout.split())

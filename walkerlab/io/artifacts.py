@@ -211,6 +211,17 @@ def content_hash(path: Path) -> str | None:
         return None
 
 
+def stored_content_hash_matches(path: Path) -> bool:
+    """True when the artifact's content equals the content hash stored when it was written
+    (False: changed afterwards - edited by hand or with h5py - or unreadable)."""
+    try:
+        with h5py.File(path, "r") as f:
+            stored = f.attrs.get("content_hash")
+            return stored is not None and str(stored) == _content_hash_memo(Path(path), f)
+    except (OSError, KeyError, ValueError):
+        return False
+
+
 def verified_hash(path: Path) -> str | None:
     """``input_hash`` of an artifact whose content still matches its stored content hash.
 
