@@ -491,3 +491,15 @@ def test_m4_animate_leaves_out_a_stale_or_edited_contact_sim(tmp_path):
     r = _run(["animate", scene, "--runs-dir", runs], env)
     assert r.returncode == 0, r.stderr  # before: drew the hand-edited one
     assert "contact_sim.h5 was changed after it was written" in " ".join(r.stdout.split())
+
+
+def test_h1_dask_garbage_scheduler_address_is_one_line_at_once(tmp_path):
+    pytest.importorskip("distributed")
+    for addr in ("not an address", "tcp://host", "inproc://x"):
+        t0 = time.monotonic()
+        r = _run(["sweep", PAPER, "--param", "slope.angle_deg=1,1.1", "--runs-dir",
+                  tmp_path / "runs", "--scheduler", addr], _env(tmp_path), timeout=90)
+        assert time.monotonic() - t0 < 30  # before: one line, then a 60 s hang and a traceback
+        assert r.returncode == 1
+        lines = r.stderr.strip().splitlines()
+        assert len(lines) == 1 and "not a Dask scheduler address" in lines[0], lines

@@ -230,9 +230,14 @@ _guarded: list[bool] = []
 
 
 def _discard(path: str) -> None:
-    """Remove a damaged or non-regular numba cache file (it is rebuilt)."""
+    """Remove a damaged or non-regular numba cache entry (it is rebuilt); a folder in its
+    place too (the numba folder is private: nobody else put it there)."""
+    import shutil
+
     try:
-        if not os.path.isdir(path):
+        if os.path.isdir(path) and not os.path.islink(path):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
             os.unlink(path)
     except OSError:
         pass
@@ -255,7 +260,7 @@ def _patch_numba_caching(caching) -> None:
                                follow_links=False)
         except FileNotFoundError:
             return {}
-        except (OSError, NotARegularFile):
+        except (OSError, NotARegularFile):  # FIFO, device, folder, huge, unreadable
             _discard(self._index_path)
             return {}
         try:
@@ -294,6 +299,15 @@ def _patch_numba_caching(caching) -> None:
             return None
 
     caching.Cache.load_overload = load_overload
+    original_save = caching.Cache.save_overload
+
+    def save_overload(self, sig, data):
+        try:
+            return original_save(self, sig, data)
+        except OSError:  # a cache that cannot be written costs a recompile, not the run
+            return None
+
+    caching.Cache.save_overload = save_overload
     cls._walkerlab_guarded = True
 
 

@@ -80,6 +80,21 @@ def _quiet_distributed():
             log.setLevel(level)
 
 
+def _check_address(address: str) -> None:
+    """Refuse an address the client cannot parse before a ``Client`` exists (a half-built
+    client blocks the interpreter's exit for a minute, then prints a traceback)."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, loc = parse_address(address)
+        if scheme not in ("tcp", "tls", "ws", "wss"):  # inproc:// etc.: not across processes
+            raise ValueError(f"scheme {scheme}:// is not a network address")
+        parse_host_port(loc)
+    except (ValueError, TypeError) as exc:
+        raise DaskLost(f"--scheduler {address!r}: not a Dask scheduler address ({exc}); give "
+                       "tcp://host:port") from None
+
+
 @contextmanager
 def open_client(scheduler):
     """``(client, futures)`` for a scheduler address or a ``distributed.Client``.
@@ -95,6 +110,8 @@ def open_client(scheduler):
     from distributed import Client
 
     own = isinstance(scheduler, str)
+    if own:
+        _check_address(scheduler)
     with _quiet_distributed():
         if own:
             try:
