@@ -22,7 +22,7 @@ FRESH = """
 import time; t0 = time.perf_counter()
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
-from walkerlab.analysis.hybrid import Solver
+from walkerlab.integrate.solver import Solver
 from walkerlab.analysis.poincare import poincare_map
 sc = load_scene({path!r}); w = build_walker(sc)
 x = sc.fixedpoint.initial_guess.as_array(w.state_names())
@@ -32,9 +32,9 @@ print(time.perf_counter() - t0)
 
 
 def main(path: str = "configs/paper.yaml", repeats: int = 30) -> None:
-    from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import poincare_map
     from walkerlab.config import load_scene
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     sc = load_scene(path)

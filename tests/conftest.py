@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import load_scene
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.published import paper
 

@@ -12,7 +12,7 @@ from PIL import Image
 from walkerlab.config import load_scene
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.trajectory import read_samples
-from walkerlab.stages import animate
+from walkerlab.stages import pipeline
 
 ROOT = Path(__file__).resolve().parents[1]
 FRAMES = 12  # enough to see the walker move, quick to write
@@ -29,7 +29,7 @@ def _frames(path):
 
 def _animate(name, tmp_path):
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
-    out = animate.run(scene, tmp_path, max_frames=FRAMES)
+    out = pipeline.run("animate", scene, tmp_path, max_frames=FRAMES)
     gif = tmp_path / name / "report" / "figures" / "animation.gif"
     return scene, out, gif
 
@@ -62,10 +62,9 @@ def test_kneed_and_arc_feet_animate(name, tmp_path):
 
 
 def _trajectory(name, tmp_path):
-    from walkerlab.stages import simulate
 
     scene = load_scene(ROOT / "configs" / f"{name}.yaml")
-    path = simulate.run(scene, tmp_path).path
+    path = pipeline.run("simulate", scene, tmp_path).path
     with open_artifact(path, "simulate") as f:
         return scene, read_samples(f)
 

@@ -97,8 +97,8 @@ def walker(scene):
 
 @pytest.fixture(scope="module")
 def fixed_point(walker, scene):
-    from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.integrate.solver import Solver
 
     g = dict(zip(["swing_angle", "stance_angle", "swing_rate", "stance_rate"],
                  scene.fixedpoint.initial_guess.as_array()))
@@ -120,8 +120,9 @@ def test_samples_artifact_and_figures_name_the_torso(walker, fixed_point, scene,
     import h5py
 
     import walkerlab.io.artifacts as A
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
     from walkerlab.analysis.metrics import sample_trajectory
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.io.trajectory import read_samples, write_samples
     from walkerlab.plotting import figures as F
 

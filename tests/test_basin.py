@@ -29,7 +29,7 @@ def _scene(tmp_path, walker, fp, **basin):
 
 
 def test_fixed_point_converges_and_far_cell_falls(paper_walker, paper_fixed_point):
-    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.integrate.solver import Solver
 
     fp = paper_fixed_point.x
     st = BasinSettings(max_steps=25)
@@ -55,7 +55,7 @@ def test_fixed_point_converges_and_far_cell_falls(paper_walker, paper_fixed_poin
 
 def test_basin_stage_artifact_and_resume(tmp_path, paper_walker, paper_fixed_point):
     from walkerlab.io.artifacts import open_artifact
-    from walkerlab.stages import basin
+    from walkerlab.stages import pipeline
 
     sc = _scene(tmp_path, paper_walker, paper_fixed_point.x)
     runs = tmp_path / "runs"
@@ -66,14 +66,14 @@ def test_basin_stage_artifact_and_resume(tmp_path, paper_walker, paper_fixed_poi
         raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        basin.run(sc, runs, workers=1, on_chunk=interrupt)
+        pipeline.run("basin", sc, runs, workers=1, on_chunk=interrupt)
     part = runs / sc.name / "basin.h5.partial"
     import h5py
 
     with h5py.File(part, "r") as f:
         first = f["outcome"][()]
     assert np.sum(first != NOT_DONE) == calls[0] == 5  # one grid row stored
-    out = basin.run(sc, runs, workers=1)
+    out = pipeline.run("basin", sc, runs, workers=1)
     assert not out.reused and not part.exists()
     with open_artifact(out.path, "basin") as f:
         assert f["stats/cells_computed"][()] == 10  # the resumed run did the other 2 rows
@@ -85,7 +85,7 @@ def test_basin_stage_artifact_and_resume(tmp_path, paper_walker, paper_fixed_poi
     np.testing.assert_array_equal(outcome[kept], first[kept])
     assert np.all(outcome != NOT_DONE)
     assert (runs / sc.name / "report" / "figures" / "basin.png").is_file()
-    assert basin.run(sc, runs, workers=1).reused
+    assert pipeline.run("basin", sc, runs, workers=1).reused
 
 
 def _simplest(tmp_path, **basin):
@@ -101,8 +101,8 @@ def test_heel_strike_cells_of_the_simplest_walker(tmp_path):
     post-impact states satisfy phi = 2 theta and phi-dot = (1 - cos 2 theta) theta-dot
     (Garcia et al. 1998, heel-strike equations, written here independently of the model's
     generated reset), and the cell at the fixed point's values is the fixed point."""
-    from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
     from walkerlab.sweep.basin import heel_strike_slice, pre_impact_fixed_point
 
@@ -134,10 +134,10 @@ def test_heel_strike_basin_of_the_simplest_walker_is_thin(tmp_path):
     the cells do (0.6 % measured), the rest fall, and the converged cells lie along a line:
     the standard deviations of their positions along and across it differ by > 8x (21.7x
     measured)."""
-    from walkerlab.stages import basin
+    from walkerlab.stages import pipeline
 
     sc = _simplest(tmp_path, grid=[40, 40])
-    out = basin.run(sc, tmp_path / "runs", workers=1)
+    out = pipeline.run("basin", sc, tmp_path / "runs", workers=1)
     from walkerlab.io.artifacts import open_artifact
 
     with open_artifact(out.path, "basin") as f:

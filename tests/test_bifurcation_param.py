@@ -34,7 +34,7 @@ def test_bifurcation_over_a_body_mass_by_name(tmp_path):
 
     from walkerlab.plotting.sweep_figures import bifurcation_figure, plt
     from walkerlab.report.sections import bifurcation_section
-    from walkerlab.stages.report import existing_artifacts
+    from walkerlab.stages.report import existing_artifacts, load_inputs
     from walkerlab.sweep.bifurcation import load_bifurcation
 
     scene = load_scene(ROOT / "configs" / "kneed.yaml")
@@ -62,8 +62,8 @@ def test_bifurcation_over_a_body_mass_by_name(tmp_path):
     plt.close(fig)
     assert (tmp_path / "kneed" / "report" / "figures" / f"bifurcation_{SHANK}.png").is_file()
     # the report finds the artifact and names the grid by field and unit
-    paths = existing_artifacts(scene, tmp_path)
-    text = "\n".join(bifurcation_section(paths))
+    inputs = load_inputs(scene, existing_artifacts(scene, tmp_path), tmp_path)
+    text = "\n".join(bifurcation_section(inputs.artifacts))
     assert f"## Bifurcation over `{SHANK}`" in text and "0.03–0.07 kg (3 values" in text
     # a rerun with the same grid reuses the artifact
     assert bif_stage.run(scene, grid, tmp_path, n_transient=6, n_keep=3, workers=1,

@@ -5,15 +5,14 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from walkerlab.models.compass_gait import (
+    compass_gait_structure,
     energies,
     flow,
-    heel_strike_guard,
     impact,
-    is_heel_strike,
     make_compass_gait,
     swing_foot_height,
 )
-from walkerlab.models.derivation import compass_gait_symbolic
+from walkerlab.models.symbolic import derive
 
 P = (5.0, 10.0, 1.0, 0.5, 9.81)  # m, M_H, L, a, g (Table 1)
 PHI = 0.0174
@@ -35,7 +34,7 @@ def test_energy_rate_zero_symbolically():
     """dE/dt = 0 along the derived equations, exactly (sympy), as Drake checks to 2e-13."""
     import sympy as sp
 
-    d = compass_gait_symbolic()
+    d = derive(compass_gait_structure())
     q, dq = sp.Matrix(d.q), sp.Matrix(d.dq)
     qdd = d.M.LUsolve(-d.C * dq - d.G)
     E = d.kinetic + d.potential
@@ -53,7 +52,7 @@ def test_appendix_a_flow_does_not_conserve_energy():
     assert np.ptp(ke + pe) > 1e-3  # J; ~1e9 times the derived model's drift
 
 
-def test_angular_momentum_about_new_stance_foot_conserved_through_impact():
+def test_angular_momentum_about_new_stance_foot_conserved_through_impact(paper_walker):
     """Through the plastic impact the walker's angular momentum about the new stance foot is
     conserved (the impulse acts there).  Positions and velocities are built here from the
     geometry (A.1-A.3), independently of the impact equations; round-off level is ~1e-15
@@ -63,7 +62,7 @@ def test_angular_momentum_about_new_stance_foot_conserved_through_impact():
     t2, w1, w2 = -0.2042, -0.7, -0.9
     t1 = -2 * PHI - t2
     xm = np.array([t1, t2, w1, w2])
-    assert is_heel_strike(np.array([t1, t2, 0.5, -0.9]), PHI)
+    assert _heel_strike_fires(paper_walker, np.array([t1, t2, 0.5, -0.9]))
     xp = impact(xm, P, "derived")
     assert xp[0] == t2 and xp[1] == t1  # roles swapped, positions unchanged
 
@@ -97,25 +96,45 @@ def test_appendix_a_literal_impact_breaks_momentum():
 
 
 # ------------------------------------------------------------------------------ guard
+def _guard(walker, phase: str, name: str):
+    """The walker's generated guard ``name`` of ``phase`` (what integrate_step locates)."""
+    ph = next(p for p in walker.phases if p.name == phase)
+    return ph, next(g for g in ph.guards if g.name == name)
+
+
+def _heel_strike_fires(walker, x, tol: float = 1e-9) -> bool:
+    """Does the generated heel-strike guard end a step at ``x``, as integrate_step runs it?
+    It is armed only in late swing (entered once the generated ``midstance`` guard,
+    ``swing_foot_ahead``, crossed zero upward: the swing foot is ahead) and fires where it
+    crosses zero in its direction along the generated flow."""
+    _, ahead = _guard(walker, "early_swing", "midstance")
+    late, heel = _guard(walker, "late_swing", "heel_strike")
+    rate = float(np.asarray(heel.gradient(x)) @ np.asarray(late.flow(0.0, x)))
+    return bool(ahead.function(0.0, x) > tol and abs(heel.function(0.0, x)) <= tol
+                and np.sign(rate) == heel.direction)
+
+
 def test_guard_fires_at_heel_strike_not_at_midstance_scuffing(paper_walker, paper_fixed_point):
     """One step from the fixed point: the swing foot height vanishes twice after the start -
     at mid-stance (legs aligned, scuffing: ignored) and at heel strike (the event)."""
     from tests.conftest import TIGHT
-    from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.integrate.rigid import integrate_step
 
     seg = integrate_step(paper_walker, paper_fixed_point.x, TIGHT)
-    assert seg.termination == "heel_strike"
+    assert seg.termination == "heel_strike" and seg.event == "heel_strike"
     t_mid = seg.phase_times["midstance"]
     assert 0.0 < t_mid < seg.t_end
     x_mid = seg.sample(np.array([t_mid]))[:, 0]
     # at mid-stance the point foot is on the ground line (scuffing) ...
     assert abs(swing_foot_height(x_mid, PHI, 1.0)) < 1e-9
-    assert not is_heel_strike(x_mid, PHI)
+    assert not _heel_strike_fires(paper_walker, x_mid)
     # ... but the step ends only at heel strike, with the swing foot ahead and descending
-    assert is_heel_strike(seg.x_end, PHI)
-    assert abs(heel_strike_guard(0, seg.x_end, PHI)) < 1e-10
+    assert _heel_strike_fires(paper_walker, seg.x_end)
+    _, heel = _guard(paper_walker, "late_swing", "heel_strike")
+    assert abs(heel.function(0.0, seg.x_end)) < 1e-10
     # right after the impact the state is on the guard surface but must not re-trigger
-    assert not is_heel_strike(seg.x_next, PHI)
+    assert abs(heel.function(0.0, seg.x_next)) < 1e-10
+    assert not _heel_strike_fires(paper_walker, seg.x_next)
 
 
 @pytest.mark.parametrize(
@@ -127,8 +146,10 @@ def test_guard_fires_at_heel_strike_not_at_midstance_scuffing(paper_walker, pape
         (np.array([0.1694 - 2 * PHI, -0.1694, 1.5, -0.5]), False),  # foot rising
     ],
 )
-def test_guard_sign_in_each_situation(x, expected):
-    assert is_heel_strike(x, PHI) is expected
+def test_guard_sign_in_each_situation(paper_walker, x, expected):
+    """The generated heel-strike guard (the one integrate_step locates), in the situations
+    of Drake's compass_gait_test: it fires only with the swing foot ahead and descending."""
+    assert _heel_strike_fires(paper_walker, x) is expected
 
 
 def test_unknown_variant_is_rejected():

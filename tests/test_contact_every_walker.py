@@ -74,30 +74,32 @@ def test_stability_map_figure_names_scene_units_and_unsupported_cells():
     """round_feet.yaml is nondimensional (contact.unit_system SI reads metres as l): before,
     its patch-width map's axis read 'patch width [m]'; a kneed cell whose periodic-gait
     search has no section read '?'."""
+    from walkerlab.io.schemas.stability_map import StabilityMap
     from walkerlab.plotting.sweep_figures import gait_map_figure, plt
     from walkerlab.sweep.stability import MAP_KINDS, REASONS
 
     assert "unsupported" in REASONS
     reason = np.array([["", "unsupported"]], dtype=object)
-    d = {"y_values": np.array([0.2]), "slopes_deg": np.array([1.0, 2.0]),
-         "exists": np.array([[1, 0]]), "stable": np.array([[1, 0]]),
-         "max_abs_multiplier": np.array([[0.5, np.nan]]), "reason": reason,
-         "wall_time_s": np.array([[1.0, 2.0]]),
-         "attrs": {"kind": "patch_width", "y_label": MAP_KINDS["patch_width"][1],
-                   "unit_system": "SI", "scene_units": "nondimensional"}}
+    d = StabilityMap(
+        attrs={"kind": "patch_width", "y_label": MAP_KINDS["patch_width"][1],
+               "unit_system": "SI", "scene_units": "nondimensional"},
+        y_values=np.array([0.2]), slopes_deg=np.array([1.0, 2.0]),
+        cells={"exists": np.array([[1, 0]]), "stable": np.array([[1, 0]]),
+               "max_abs_multiplier": np.array([[0.5, np.nan]]), "reason": reason,
+               "wall_time_s": np.array([[1.0, 2.0]])})
     fig = gait_map_figure(d)
     try:
         assert fig.axes[0].get_ylabel() == "patch width [l]"
         assert "not sup-\nported" in [t.get_text() for t in fig.axes[0].texts]
     finally:
         plt.close(fig)
-    d["attrs"] = {**d["attrs"], "kind": "stiffness", "y_label": MAP_KINDS["stiffness"][1]}
+    d.attrs = {**d.attrs, "kind": "stiffness", "y_label": MAP_KINDS["stiffness"][1]}
     fig = gait_map_figure(d)
     try:
         assert fig.axes[0].get_ylabel().startswith("contact stiffness k [M g/l^e]")
     finally:
         plt.close(fig)
-    d["attrs"] = {**d["attrs"], "scene_units": "SI", "unit_system": "mm-kg-s"}
+    d.attrs = {**d.attrs, "scene_units": "SI", "unit_system": "mm-kg-s"}
     fig = gait_map_figure(d)
     try:
         assert fig.axes[0].get_ylabel().startswith("contact stiffness k [N/mm^e]")
@@ -135,9 +137,9 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     both families pass through the scene's own contact; the paper scene's numbers do not
     move."""
     from walkerlab.analysis.contact_drop import drop_restitution
+    from walkerlab.analysis.contact_record import drop_test
     from walkerlab.config import load_scene
     from walkerlab.contact.scene import settings
-    from walkerlab.stages.contact_sim import drop_test
 
     rf = load_scene("configs/round_feet.yaml")
     d = drop_test(rf, 2.0)
@@ -151,7 +153,7 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     # drop without gravity; Radau rtol 1e-10 -> ~1e-6 between the k)
     np.testing.assert_allclose(d["rigid_limit"]["restitution"], own, atol=1e-5)
     # the paper scene (k = 1e5 N/mm^2.2, 20 kg, reference_stiffness = its k) keeps its grid
-    from walkerlab.stages.contact_sim import DROP_STIFFNESS_RATIO
+    from walkerlab.analysis.contact_record import DROP_STIFFNESS_RATIO
 
     paper = load_scene("configs/paper.yaml").contact
     assert paper.stiffness == paper.reference_stiffness == 1e5
@@ -194,10 +196,10 @@ def test_work_precision_contact_runner_reads_a_kneed_walkers_legs_by_name():
     """The work-precision study's contact series on the kneed walker: the final vector is
     the four link angles [rad] and their four rates, read by name (no hip position: |angle|
     < 1 rad, where hip_x is ~0.95 m after a stride), and it converges with the tolerance."""
-    from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import find_fixed_point
     from walkerlab.analysis.workprecision import contact_runner
     from walkerlab.config import load_scene
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     scene = load_scene("configs/kneed.yaml")

@@ -68,8 +68,8 @@ def test_simulate_artifact_groups_open_with_their_time_coordinate(tmp_path, pape
 
 
 def test_sweep_grid_axis_is_named_by_the_swept_field(tmp_path):
-    sw = wl.sweep(_paper(name="sw"), "slope.angle_deg", [1.0, 1.5, 2.0], runs_dir=tmp_path,
-                  name="slopes")
+    sw = wl.api.sweep(_paper(name="sw"), "slope.angle_deg", [1.0, 1.5, 2.0],
+                      runs_dir=tmp_path, name="slopes")
     path = tmp_path / "sw" / "slopes.h5"
     grid = _open(path, "grid")
     assert list(grid.dims) == ["slope.angle_deg"]
@@ -130,10 +130,11 @@ def test_api_reuses_the_cli_artifact_and_fixed_points_stack_the_variants(tmp_pat
     np.testing.assert_array_equal(every["fixed_point"].values[0], gait["fixed_point"].values)
 
 
-def test_top_level_sweep_is_the_api_even_after_the_sweep_package_is_imported(tmp_path):
-    import walkerlab.sweep  # noqa: F401 - Python binds walkerlab.sweep to the package
+def test_sweep_package_is_a_plain_package_and_the_api_sweep_lives_in_api(tmp_path):
+    import walkerlab.sweep as package
 
-    sw = wl.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
+    assert not callable(package) and type(package) is type(wl)
+    sw = wl.api.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
     assert sw["outcome"].values.tolist() == ["ok"]
 
 
@@ -192,9 +193,9 @@ def test_cli_prints_every_config_error_without_traceback_even_in_debug(tmp_path)
 
 # ---------------------------------------------------------------- caching and locks
 def test_no_lock_file_is_left_behind(tmp_path):
-    from walkerlab.stages import simulate
+    from walkerlab.stages import pipeline
 
-    simulate.run(wl.load_scene(_paper(name="lk")), tmp_path, strides=1)
+    pipeline.run("simulate", wl.load_scene(_paper(name="lk")), tmp_path, strides=1)
     assert (tmp_path / "lk" / "simulate.h5").is_file()
     assert list((tmp_path / "lk").glob(".*.lock")) == []
 
@@ -240,26 +241,27 @@ def test_fixedpoint_command_writes_the_artifact_the_report_needs(tmp_path):
 
 
 def test_a_longer_simulate_run_is_kept_and_said_and_a_recompute_says_why(tmp_path, capfd):
-    from walkerlab.stages import simulate
+    from walkerlab.stages import pipeline
 
     sc = wl.load_scene(_paper(name="st", simulate={"strides": 1, "sample_rate_hz": 200}))
-    long = simulate.run(sc, tmp_path, strides=3)
+    long = pipeline.run("simulate", sc, tmp_path, strides=3)
     capfd.readouterr()
-    out = simulate.run(sc, tmp_path)  # the scene's 1 stride, as the report asks
+    out = pipeline.run("simulate", sc, tmp_path)  # the scene's 1 stride, as the report asks
     assert out.reused and "kept 3 strides" in out.note and out.path == long.path
     with h5py.File(out.path, "r") as f:
         assert int(f.attrs["strides_requested"]) == 3
-    simulate.run(sc, tmp_path, strides=2)  # fewer than stored: recomputed, and said why
+    pipeline.run("simulate", sc, tmp_path, strides=2)  # fewer than stored: recomputed, and said why
     err = capfd.readouterr().err
     assert "simulate: recomputing" in err and "simulate.strides 3 -> 2" in err
 
 
+@pytest.mark.slow  # end to end: a whole report
 def test_report_uses_only_the_artifacts_the_scene_produces(tmp_path):
-    from walkerlab.stages import report, simulate
+    from walkerlab.stages import pipeline, report
 
     sc = wl.load_scene(_paper(drop=("simulate", "contact", "contact_sim", "contact_solver",
                                     "terrain", "workprecision", "basin"), name="ideal"))
-    simulate.run(sc, tmp_path, strides=1)  # a standalone run leaves simulate.h5 behind
+    pipeline.run("simulate", sc, tmp_path, strides=1)  # a standalone run leaves simulate.h5 behind
     said: list[str] = []
     html = report.run(sc, tmp_path, echo=said.append)
     md = (html.parent / "report.md").read_text()
@@ -270,6 +272,7 @@ def test_report_uses_only_the_artifacts_the_scene_produces(tmp_path):
 
 
 # ---------------------------------------------------------------- the example notebook
+@pytest.mark.slow  # end to end: every stage the notebook calls
 def test_example_notebook_runs(tmp_path, monkeypatch):
     """``examples/walkerlab_tour.ipynb`` executes top to bottom (nbclient), writing only into
     a temporary runs folder."""

@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.analysis.gaits import deflation_starts, find_gaits, step_length
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.config import load_scene
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -19,11 +19,11 @@ import yaml
 from typer.testing import CliRunner
 
 from walkerlab.analysis.gaits import GaitNotFound, find_gaits, state_from_legs
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
+from walkerlab.integrate.solver import Solver
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.models.registry import build_walker
-from walkerlab.stages import fixedpoint as fixedpoint_stage
 from walkerlab.stages import sweep as sweep_stage
 from walkerlab.sweep.params import SweepError, check_axes, parse_param
 from walkerlab.sweep.points import evaluate
@@ -137,13 +137,14 @@ def test_fixedpoint_artifact_records_every_gait(tmp_path):
     assert r.exit_code == 0, r.output
     assert "period-1 gaits found: 2" in r.output and "UNSTABLE" in r.output
     assert "selected (fixedpoint.gait: stable): long-period gait" in r.output
-    x, meta = fixedpoint_stage.load_fixed_point(tmp_path / "runs" / "heavy_hip" / "fixedpoint.h5")
+    fp = load_fixedpoint(tmp_path / "runs" / "heavy_hip" / "fixedpoint.h5")
     with h5py.File(tmp_path / "runs" / "heavy_hip" / "fixedpoint.h5") as f:
         assert sorted(f["gaits"]) == ["long_period", "short_period"]
         assert f.attrs["gait"] == "long_period"
-        assert f["gaits/long_period/step_period"][()] == meta["step_period_s"]
+        assert f["gaits/long_period/step_period"][()] == fp.step_period_s
         assert not f["gaits/short_period/floquet/stable"][()]
-    assert meta["stable"] and 0.9 < meta["step_period_s"] < 1.0
+    assert fp.stable and 0.9 < fp.step_period_s < 1.0
+    assert fp.gaits["long_period"].step_period_s == fp.step_period_s
 
 
 def test_failed_search_says_what_was_tried_in_one_line():

@@ -14,9 +14,10 @@ import yaml
 from independent.kneed_reference import KneedReference
 from independent.round_feet_reference import RoundFeetReference
 
-from walkerlab.analysis.hybrid import Solver, integrate_step, simulate_steps
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import BipedParams
+from walkerlab.integrate.rigid import integrate_step, simulate_steps
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.description import walker_data
 from walkerlab.models.rigid import functions, make_rigid_walker
 from walkerlab.published import bhounsule2009, hsu_chen2007

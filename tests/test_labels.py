@@ -66,19 +66,21 @@ def test_nondimensional_section_hash_differs_only_for_nondimensional_scenes():
 @pytest.fixture(scope="module")
 def simplest_run(tmp_path_factory):
     """simulate + fixedpoint of the simplest walker (nondimensional), one stride."""
-    from walkerlab.stages import simulate
+    from walkerlab.stages import pipeline
 
     root = tmp_path_factory.mktemp("runs")
     d = load_scene("configs/simplest.yaml").model_dump(mode="json", exclude_none=True)
     d["simulate"]["strides"] = 1
     sc = scene_from_dict(d)
-    out = simulate.run(sc, root)
+    out = pipeline.run("simulate", sc, root)
     return sc, root, out.path
 
 
 def test_nondimensional_artifact_units_and_cli_text(simplest_run):
     """The artifact's unit attributes follow the scene (clock times stay seconds) and the
     CLI summary prints no SI unit for a nondimensional scene."""
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.io.schemas.simulate import load_simulate
     from walkerlab.report.text import fixedpoint_text, simulate_text
     from walkerlab.stages.common import artifact_path
 
@@ -88,10 +90,10 @@ def test_nondimensional_artifact_units_and_cli_text(simplest_run):
         assert f["summary/mean_period_s"].attrs["unit"] == "√(l/g)"
         assert f["summary/mean_hip_speed_m_per_s"].attrs["unit"] == "√(g l)"
         assert f["summary/wall_time_s"].attrs["unit"] == "s"  # the computer's seconds
-    text = simulate_text(path)
+    text = simulate_text(load_simulate(path))
     assert "√(l/g)" in text and "M g l" in text and "nondimensional" in text
     assert not re.search(r"\d (s|m|m/s|J)\b(?! \(wall)", text), text
-    fp = fixedpoint_text(artifact_path(sc, root, "fixedpoint"))
+    fp = fixedpoint_text(load_fixedpoint(artifact_path(sc, root, "fixedpoint")))
     assert "step period" in fp and "√(l/g)" in fp and "rad/√(l/g)" in fp
     assert not re.search(r"\d (s|rad/s)$", fp, re.M), fp
 
@@ -101,13 +103,13 @@ def test_nondimensional_report_and_figures_follow_the_scene(simplest_run):
     from walkerlab.plotting import figures as F
     from walkerlab.report import sections
     from walkerlab.stages.plot import load_trajectories
-    from walkerlab.stages.report import existing_artifacts
+    from walkerlab.stages.report import existing_artifacts, load_inputs
     from walkerlab.units import for_scene
 
     sc, root, _ = simplest_run
-    paths = existing_artifacts(sc, root)
-    md = "\n".join(sections.summary_section(sc, paths, None)
-                   + sections.gait_section(sc, paths, None))
+    inputs = load_inputs(sc, existing_artifacts(sc, root), root)
+    md = "\n".join(sections.summary_section(sc, inputs, None)
+                   + sections.gait_section(sc, inputs, None))
     assert "√(l/g)" in md and "M g l" in md
     assert not re.search(r"\| (s|J|m|m/s|mm) \|", md), md
     assert not re.search(r"\d (s|J|mm)\b", md), md
@@ -135,27 +137,19 @@ def test_one_number_formatter(value, text):
     assert num(value) == text
 
 
-def _artifact(path, stage, writer):
-    from walkerlab.io.artifacts import write_artifact
-
-    write_artifact(path, stage, load_scene("configs/paper.yaml"), "key", writer, 11.0)
-    return path
-
-
 def test_contact_text_counts_integers_no_repeated_outcome(tmp_path):
     """contact-sim's printout: 4 significant digits, counts as integers, the outcome once,
     and the walking run's integration told apart from the stage's 11 s."""
-    from walkerlab.io.artifacts import put
+    from walkerlab.io.schemas.contact_sim import ContactSimArtifact
     from walkerlab.report.text import contact_text
 
-    def writer(f):
-        f.attrs["outcome"] = f.attrs["outcome_message"] = "completed"
-        f.attrs["termination"] = "t_final"
-        put(f, "summary/max_abs_stance_slip_mm", 0.9576663533079621, "mm", "")
-        put(f, "summary/total_bounces", 0, "-", "")
-        put(f, "summary/heel_strikes", 10, "-", "")
-        put(f, "summary/wall_time_s", 0.124, "s", "")
-    text = contact_text(_artifact(tmp_path / "contact_sim.h5", "contact-sim", writer))
+    art = ContactSimArtifact(
+        tmp_path / "contact_sim.h5", SI_U, "t_final", "completed", "completed",
+        summary={"heel_strikes": (np.int64(10), "-"),
+                 "max_abs_stance_slip_mm": (np.float64(0.9576663533079621), "mm"),
+                 "total_bounces": (np.int64(0), "-"), "wall_time_s": (np.float64(0.124), "s")},
+        stage_wall_time_s=11.0)
+    text = contact_text(art)
     assert "outcome completed" in text and "(completed)" not in text
     assert "0.9577 mm" in text and not re.search(r"\d{6,}", text)
     assert re.search(r"total_bounces\s+0$", text, re.M)
@@ -185,21 +179,18 @@ def test_clearance_says_below_for_penetration():
 
 def test_compare_text_prints_the_key_errors(tmp_path):
     """``walkerlab compare`` shows the errors it computed, not only the file it wrote."""
-    from walkerlab.io.artifacts import put
+    from walkerlab.io.schemas.compare import Comparison
     from walkerlab.report.text import compare_text
 
-    def writer(f):
-        g = f.create_group("errors")
-        g.attrs["coordinates"] = ["leg1_angle", "leg1_rate"]
-        put(g, "time", np.linspace(0, 3.5, 8), "s", "")
-        put(g, "coordinates/leg1_angle", np.linspace(0, 2.5e-3, 8), "rad", "")
-        put(g, "coordinates/leg1_rate", -np.linspace(0, 4e-2, 8), "rad/s", "")
-        put(g, "max_abs_angle", 2.5e-3, "rad", "")
-        put(g, "max_abs_rate", 4e-2, "rad/s", "")
-        put(g, "limit_cycle_distance/leg1", 1.2e-3, "rad", "")
-        put(f, "metrics/ideal/t_cycle_s", 1.3841, "s", "")
-        put(f, "metrics/contact/t_cycle_s", 1.4213, "s", "")
-    text = compare_text(_artifact(tmp_path / "compare.h5", "compare", writer))
+    c = Comparison(
+        legs=["leg1", "leg2"], time=np.linspace(0, 3.5, 8),
+        errors={"leg1_angle": np.linspace(0, 2.5e-3, 8), "leg1_rate": -np.linspace(0, 4e-2, 8)},
+        error_units={"leg1_angle": "rad", "leg1_rate": "rad/s"},
+        limit_cycle_distance={"leg1": 1.2e-3}, max_abs_angle_rad=2.5e-3,
+        max_abs_rate_rad_per_s=4e-2,
+        metrics={"ideal": {"t_cycle_s": 1.3841}, "contact": {"t_cycle_s": 1.4213}},
+        metric_units={"t_cycle_s": "s"}, path=tmp_path / "compare.h5", units=SI_U)
+    text = compare_text(c)
     assert "max |angle error| 0.00250 rad" in text and "0.0400 rad/s" in text
     assert re.search(r"t_cycle_s\s+1.384\s+1.421 s", text), text
     assert "leg1 0.00120" in text
@@ -208,12 +199,13 @@ def test_compare_text_prints_the_key_errors(tmp_path):
 # --------------------------------------------------------------------------- citation
 def test_report_cites_the_paper_not_a_path(tmp_path):
     from walkerlab.published import paper
+    from walkerlab.report.build import ReportInputs
     from walkerlab.report.sections import summary_section
 
     assert paper.TITLE in paper.CITATION
     assert not re.search(r"seeds|\.txt|/", paper.CITATION), paper.CITATION
     sc = load_scene("configs/paper.yaml")
-    md = "\n".join(summary_section(sc, {}, paper))
+    md = "\n".join(summary_section(sc, ReportInputs({}), paper))
     assert "seeds" not in md
 
 
@@ -401,13 +393,16 @@ def test_bifurcation_figure_marks_falls_and_keeps_labels_inside():
 
 
 def test_stability_map_figure_whole_words_one_panel():
+    from walkerlab.io.schemas.stability_map import StabilityMap
     from walkerlab.plotting.sweep_figures import gait_map_figure, plt
 
     reason = np.array([["", "solver_failure"], ["not_converged", ""]], dtype=object)
-    d = {"y_values": np.array([1e4, 1e5]), "slopes_deg": np.array([1.0, 2.0]),
-         "exists": np.array([[1, 0], [0, 1]]), "stable": np.array([[1, 0], [0, 0]]),
-         "max_abs_multiplier": np.array([[0.5, np.nan], [np.nan, 1.2]]), "reason": reason,
-         "wall_time_s": np.array([[1.0, 2.0], [3.0, 4.0]]), "attrs": {"kind": "friction"}}
+    d = StabilityMap(
+        attrs={"kind": "friction"}, y_values=np.array([1e4, 1e5]),
+        slopes_deg=np.array([1.0, 2.0]),
+        cells={"exists": np.array([[1, 0], [0, 1]]), "stable": np.array([[1, 0], [0, 0]]),
+               "max_abs_multiplier": np.array([[0.5, np.nan], [np.nan, 1.2]]),
+               "reason": reason, "wall_time_s": np.array([[1.0, 2.0], [3.0, 4.0]])})
     fig = gait_map_figure(d)
     texts = [t.get_text() for t in fig.axes[0].texts]
     assert "solver\nfailure" in texts and "no con-\nvergence" in texts
@@ -417,13 +412,14 @@ def test_stability_map_figure_whole_words_one_panel():
 
 
 def test_stability_map_figure_lands_in_report_figures(tmp_path, monkeypatch):
+    from walkerlab.io.schemas.stability_map import StabilityMap
     from walkerlab.stages import stability_map
 
-    monkeypatch.setattr(stability_map, "load", lambda p: {
-        "y_values": np.array([1e4, 1e5]), "slopes_deg": np.array([1.0, 2.0]),
-        "exists": np.ones((2, 2)), "stable": np.ones((2, 2)),
-        "max_abs_multiplier": np.full((2, 2), 0.5), "reason": np.full((2, 2), "", object),
-        "wall_time_s": np.ones((2, 2)), "attrs": {}})
+    monkeypatch.setattr(stability_map, "load_stability_map", lambda p: StabilityMap(
+        attrs={}, y_values=np.array([1e4, 1e5]), slopes_deg=np.array([1.0, 2.0]),
+        cells={"exists": np.ones((2, 2)), "stable": np.ones((2, 2)),
+               "max_abs_multiplier": np.full((2, 2), 0.5),
+               "reason": np.full((2, 2), "", object), "wall_time_s": np.ones((2, 2))}))
     out = stability_map.draw(tmp_path / "stability_map_friction.h5")
     assert {p.parent for p in out} == {tmp_path / "report" / "figures"}
 

@@ -312,15 +312,15 @@ def test_m6_a_spinning_initial_guess_fails_fast_in_one_line(tmp_path):
 
 
 def test_m6_every_shipped_initial_guess_is_within_the_walking_bound():
+    from walkerlab.analysis.scene_gaits import initial_guess
     from walkerlab.config import load_scene
     from walkerlab.models.registry import build_walker
-    from walkerlab.stages.fixedpoint import _guess
 
     n = 0
     for path in sorted((ROOT / "configs").glob("*.yaml")):
         scene = load_scene(path)
         if scene.fixedpoint is not None and scene.fixedpoint.initial_guess is not None:
-            assert _guess(scene, build_walker(scene)) is not None, path.name
+            assert initial_guess(scene, build_walker(scene)) is not None, path.name
             n += 1
     assert n >= 3
 

@@ -18,7 +18,7 @@ import pytest
 import yaml
 
 from walkerlab.config import load_scene
-from walkerlab.io.readers import load_fixed_point
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = sorted((ROOT / "configs").glob("*.yaml"))
@@ -85,6 +85,7 @@ def png_only(monkeypatch):
     monkeypatch.setattr(figures, "save", save)
 
 
+@pytest.mark.slow  # end to end: a whole report
 @pytest.mark.parametrize("scene_path", SCENES, ids=[p.stem for p in SCENES])
 def test_scene_end_to_end(scene_path, tmp_path, png_only):
     from walkerlab.stages import fixedpoint, report, simulate
@@ -94,9 +95,9 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
     scene = reduced(scene_path, tmp_path)
     runs = tmp_path / "runs"
     fp = fixedpoint.run(scene, runs)
-    x, meta = load_fixed_point(fp.path)
-    assert meta["residual"] < 1e-8  # the root finder's tolerance is far below this
-    assert x.shape == (len(meta["state_names"]),)
+    art = load_fixedpoint(fp.path)
+    assert art.residual < 1e-8  # the root finder's tolerance is far below this
+    assert art.x.shape == (len(art.state_names),)
     sim = simulate.run(scene, runs)
     with h5py.File(sim.path, "r") as f:
         names = [str(n) for n in f["samples"].attrs["coordinates"]]
@@ -106,7 +107,7 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
     # every coordinate of the walker appears by physical name (a kneed walker also names
     # the stance leg's locked thigh and shank), each angle with its rate
     angles = [n for n in names if n.endswith("_angle")]
-    assert len(names) >= len(meta["state_names"]) and len(names) == 2 * len(angles)
+    assert len(names) >= len(art.state_names) and len(names) == 2 * len(angles)
     assert all(a.removesuffix("_angle") + "_rate" in names for a in angles)
     # a passive rigid walker conserves energy between impacts (heel strike, knee strike):
     # within each phase of each step (relative bound far above the solver's rtol 1e-10)
@@ -144,11 +145,11 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
     # also in a nondimensional scene whose artifacts label rates rad/√(l/g)
     from walkerlab.models.registry import build_walker
 
-    for n, u in zip(meta["state_names"], build_walker(scene).state_units()):
+    for n, u in zip(art.state_names, build_walker(scene).state_units()):
         col = f"{n}_{u.replace('/', '_per_')}"
         assert col in data  # one column per state, named by the walker
     mid = data["outcome"] == "ok"
-    assert np.all(np.isfinite(data[f"multiplier_{len(meta['state_names']) - 1}_re"][mid]))
+    assert np.all(np.isfinite(data[f"multiplier_{len(art.state_names) - 1}_re"][mid]))
 
     for p in [fp.path, sim.path, sw, *(runs / scene.name).glob("compare.h5")]:
         assert_netcdf(p)

@@ -27,12 +27,12 @@ def ideal_scene(tmp_path):
 
 
 def test_stage_reuse_and_invalidation(ideal_scene, tmp_path):
-    from walkerlab.stages import fixedpoint, simulate
+    from walkerlab.stages import fixedpoint, pipeline
 
     runs = tmp_path / "runs"
-    a = simulate.run(ideal_scene, runs)
+    a = pipeline.run("simulate", ideal_scene, runs)
     assert not a.reused
-    assert simulate.run(ideal_scene, runs).reused
+    assert pipeline.run("simulate", ideal_scene, runs).reused
     assert fixedpoint.run(ideal_scene, runs).reused
     # change the slope: both stages that depend on it rerun
     d = ideal_scene.model_dump(mode="json", exclude_none=True)
@@ -41,18 +41,18 @@ def test_stage_reuse_and_invalidation(ideal_scene, tmp_path):
 
     steeper = scene_from_dict(d)
     assert not fixedpoint.run(steeper, runs).reused
-    assert not simulate.run(steeper, runs).reused
+    assert not pipeline.run("simulate", steeper, runs).reused
     # a change of simulate-only settings leaves the fixed point alone
     d["simulate"]["sample_rate_hz"] = 100
     s2 = scene_from_dict(d)
     assert fixedpoint.run(s2, runs).reused
-    assert not simulate.run(s2, runs).reused
+    assert not pipeline.run("simulate", s2, runs).reused
 
 
 def test_simulate_artifact_is_named_and_physical(ideal_scene, tmp_path):
-    from walkerlab.stages import simulate
+    from walkerlab.stages import pipeline
 
-    out = simulate.run(ideal_scene, tmp_path)
+    out = pipeline.run("simulate", ideal_scene, tmp_path)
     with open_artifact(out.path, "simulate") as f:
         assert f["samples/coordinates/leg1_angle"].attrs["unit"] == "rad"
         assert f["samples/coordinates/leg2_rate"].attrs["unit"] == "rad/s"
@@ -67,6 +67,7 @@ def test_simulate_artifact_is_named_and_physical(ideal_scene, tmp_path):
         assert tot[step == 1][0] < tot[step == 0][-1]
 
 
+@pytest.mark.slow  # end to end: a whole report
 def test_report_of_ideal_only_scene_has_no_contact_sections(ideal_scene, tmp_path):
     from walkerlab.stages import report
 

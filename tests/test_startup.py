@@ -2,7 +2,7 @@
 
 Structural facts checked in fresh interpreters (``sys.modules`` after the command), never
 timings: ``walkerlab fixedpoint`` integrates with CyRK but loads neither numba (CyRK's numba
-solvers, see :mod:`walkerlab.analysis.cyrk_loader`) nor sympy nor matplotlib, and a later
+solvers, see :mod:`walkerlab.integrate.cyrk_loader`) nor sympy nor matplotlib, and a later
 plain ``import CyRK`` still gets the whole package.
 """
 
@@ -82,7 +82,7 @@ def test_cyrk_loader_then_plain_import_gets_the_whole_package():
     code = (
         "import json, sys, importlib.metadata\n"
         "import numpy as np\n"
-        "from walkerlab.analysis.cyrk_loader import pysolve_ivp\n"
+        "from walkerlab.integrate.cyrk_loader import pysolve_ivp\n"
         "solve = pysolve_ivp()\n"
         "before = 'numba' in sys.modules\n"
         "r = solve(lambda t, y: -y, (0.0, 1.0), np.array([1.0]), method='DOP853', rtol=1e-12,"
@@ -112,7 +112,7 @@ def test_cyrk_loader_runs_cyrk_cpu_check_before_any_compiled_module():
         "    raise ImportError('This build of CyRK is compiled for AVX2 (test)')\n"
         "fake.check_cpu = check_cpu\n"
         "sys.modules['CyRK._cpu_check'] = fake\n"
-        "from walkerlab.analysis.cyrk_loader import pysolve_ivp\n"
+        "from walkerlab.integrate.cyrk_loader import pysolve_ivp\n"
         "try:\n"
         "    pysolve_ivp()\n"
         "    msg = ''\n"

@@ -88,8 +88,8 @@ def test_continuation_matches_independent_fixed_points(scene, tmp_path):
     """Secant predictor + the previous point's Jacobian (MINPACK hybrj) converge to the
     fixed points and Floquet multipliers of independent searches from the scene's guess,
     to well below the sweep's use (1e-9 rad, 1e-7), with fewer Poincare maps."""
-    from walkerlab.analysis.hybrid import Solver
     from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
     from walkerlab.sweep.outcomes import state_column
 

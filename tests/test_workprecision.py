@@ -4,6 +4,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+import pytest
 import yaml
 
 from walkerlab.config import load_scene
@@ -25,6 +26,7 @@ def _scene(tmp_path, **wp):
     return load_scene(p)
 
 
+@pytest.mark.slow  # end to end: a whole report
 def test_report_study_measures_every_case_once_and_reuses_it(tmp_path):
     from walkerlab.stages import report
 

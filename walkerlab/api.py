@@ -9,9 +9,8 @@ exactly what the artifact holds: named dimensions (``time``, ``state``, ``step``
 ``multiplier``, the swept field ``slope.angle_deg``, ``x``/``y`` of a basin ...), coordinate
 variables, and ``units``/``long_name`` on every variable.
 
-``walkerlab.sweep`` is also the package :mod:`walkerlab.sweep`; calling it calls
-:func:`sweep` (the package is callable), so ``walkerlab.sweep(scene, param, values)`` works
-whether or not the package has been imported.
+``walkerlab.sweep`` is the package :mod:`walkerlab.sweep` (sweeps, basins, maps); the sweep
+of the front door is :func:`walkerlab.api.sweep` (``wl.api.sweep(scene, param, values)``).
 
 Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what
@@ -39,7 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
 
 __all__ = ["load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
-           "compare", "sweep", "basin"]
+           "compare", "sweep", "basin", "continuation"]
 
 DEFAULT_RUNS = Path("runs")
 
@@ -159,9 +158,9 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
     ImportError
         xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
     """
-    from walkerlab.stages import fixedpoint as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), _runs(runs_dir), force).path)
+    return _read(pipeline.run("fixedpoint", _scene(scene), _runs(runs_dir), force).path)
 
 
 def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -184,9 +183,10 @@ def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEF
         As :func:`fixed_point`.
     """
     from walkerlab.io.datasets import load_fixed_points
-    from walkerlab.stages import fixedpoint as stage
+    from walkerlab.stages import pipeline
 
-    return load_fixed_points(stage.run(_scene(scene), _runs(runs_dir), force).path)
+    return load_fixed_points(pipeline.run("fixedpoint", _scene(scene), _runs(runs_dir),
+                                          force).path)
 
 
 def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
@@ -221,9 +221,10 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import simulate as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), _runs(runs_dir), force, strides=strides).path)
+    return _read(pipeline.run("simulate", _scene(scene), _runs(runs_dir), force,
+                              strides=strides).path)
 
 
 def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
@@ -260,10 +261,10 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import contact_sim as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), _runs(runs_dir), force, adjust=adjust,
-                           periodic=periodic).path)
+    return _read(pipeline.run("contact-sim", _scene(scene), _runs(runs_dir), force, adjust=adjust,
+                              periodic=periodic).path)
 
 
 def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -285,9 +286,9 @@ def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_
     StageError, SceneError, ImportError
         As :func:`contact_simulate`.
     """
-    from walkerlab.stages import compare as stage
+    from walkerlab.stages import pipeline
 
-    return _read(stage.run(_scene(scene), _runs(runs_dir), force).path)
+    return _read(pipeline.run("compare", _scene(scene), _runs(runs_dir), force).path)
 
 
 def _axis_spec(param: str, values: Sequence) -> str:
@@ -391,8 +392,55 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     SceneError, ImportError
         As :func:`fixed_point`.
     """
-    from walkerlab.stages import basin as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_scene(scene), _runs(runs_dir), force, grid=tuple(grid) if grid else None,
-                    workers=workers)
+    out = pipeline.run("basin", _scene(scene), _runs(runs_dir), force,
+                       grid=tuple(grid) if grid else None, workers=workers)
     return _read(out.path)
+
+
+def continuation(scene: Scene | str | Path | dict, param: str, start: float, stop: float, *,
+                 switch: bool = False, param2: str | None = None,
+                 range2: tuple[float, float] | None = None,
+                 runs_dir: str | Path = DEFAULT_RUNS, force: bool = False):
+    """Pseudo-arclength continuation of the scene's gait over a numeric scene field
+    (``walkerlab continuation``): folds, period doublings, Neimark-Sacker points and branch
+    ends located; with ``switch`` the period-2 and period-4 branches; with ``param2`` the
+    fold / period-doubling curves in the plane of both fields.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        Needs a ``fixedpoint`` section (its gait at its own value of ``param`` starts).
+    param : str
+        Dotted scene field (``"slope.angle_deg"``, ``"walker.leg.bodies.rod.mass_kg"``).
+    start, stop : float
+        The range, in the field's unit.
+    switch : bool
+        Switch at period doublings (period 2, then period 4).
+    param2, range2
+        Second field and its range for the two-parameter curves.
+    runs_dir, force
+        As :func:`fixed_point`.
+
+    Returns
+    -------
+    walkerlab.io.schemas.continuation.ContinuationData
+        ``branches`` (list: ``period``, ``param`` (N,) [unit], ``states`` by name, ``step_period``
+        [s], ``multipliers`` (N, 2n), ``stable``), ``special`` (``kind``, ``param``,
+        ``period``, ``cause`` ...), ``curves``; read from ``continuation_<param>.h5``.
+
+    Raises
+    ------
+    walkerlab.stages.common.StageError
+        No ``fixedpoint`` section or no gait at the scene's own value (one line).
+    walkerlab.sweep.params.SweepError
+        ``param`` names no field of the scene.
+    """
+    from walkerlab.io.schemas.continuation import load_continuation
+    from walkerlab.stages import continuation as stage
+
+    out = stage.run(_scene(scene), param, float(start), float(stop), 2 if switch else 0,
+                    param2, tuple(range2) if range2 is not None else None, _runs(runs_dir),
+                    force)
+    return load_continuation(out.path)

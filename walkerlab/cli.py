@@ -234,14 +234,18 @@ def _status(o) -> str:
 @app.command()
 @_guard
 def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-               force: bool = ForceOpt) -> None:
+               force: bool = ForceOpt,
+               known: Path | None = typer.Option(None, "--from", help="a scene whose gait is "
+                                                 "known: continue it along the straight line "
+                                                 "between the two scenes' numeric fields to "
+                                                 "this walker (homotopy)")) -> None:
     """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
     from walkerlab.report.text import fixedpoint_text
-    from walkerlab.stages import fixedpoint as stage
+    from walkerlab.stages import pipeline
 
-    sc = _load(scene)
-    out = stage.run(sc, runs_dir, force)
-    typer.echo(fixedpoint_text(out.path))
+    out = pipeline.run("fixedpoint", _load(scene), runs_dir, force, known=known)
+    typer.echo(fixedpoint_text(load_fixedpoint(out.path)))
     typer.echo(_status(out))
 
 
@@ -254,19 +258,15 @@ def simulate(scene: Path | None = SceneArg,
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Simulate N strides of the rigid walker from its fixed point (or from the state given
     as simulate.initial_state in the scene)."""
+    from walkerlab.io.schemas.simulate import load_simulate
     from walkerlab.report.text import simulate_text
-    from walkerlab.stages import simulate as stage
+    from walkerlab.stages import pipeline
 
-    sc = _load(scene)
-    out = stage.run(sc, runs_dir, force, strides=strides)
-    typer.echo(simulate_text(out.path))
+    out = pipeline.run("simulate", _load(scene), runs_dir, force, strides=strides)
+    typer.echo(simulate_text(load_simulate(out.path)))
     typer.echo(_status(out))
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(out.path, "simulate") as f:
-        term = str(f.attrs["termination"])
-    if term != "heel_strike":
-        _fail(RuntimeError(f"the walker did not complete the run: {term}"))
+    if out.failure:
+        _fail(RuntimeError(out.failure))
 
 
 @app.command("contact-sim")
@@ -280,25 +280,16 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                                               "multipliers (about 10 s)")
                 ) -> None:
     """Simulate the compliant-contact (MSC ADAMS style) walker on the scene's terrain."""
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
     from walkerlab.report.text import contact_text
-    from walkerlab.stages import contact_sim as stage
+    from walkerlab.stages import pipeline
 
-    sc = _load(scene)
-    out = stage.run(sc, runs_dir, force, adjust=adjust, periodic=periodic)
-    typer.echo(contact_text(out.path))
+    out = pipeline.run("contact-sim", _load(scene), runs_dir, force, adjust=adjust,
+                       periodic=periodic)
+    typer.echo(contact_text(load_contact_sim(out.path)))
     typer.echo(_status(out))
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(out.path, "contact-sim") as f:
-        kind = str(f.attrs.get("outcome", f.attrs["termination"]))
-        why = str(f.attrs.get("outcome_message", ""))
-    # like simulate: a walker that does not walk exits 1 (the shared run ends,
-    # walkerlab.integrate.ends: trip, fall, airborne, no_heel_strike, ...)
-    from walkerlab.integrate.ends import CONTACT_WALKED
-
-    if kind not in CONTACT_WALKED:
-        _fail(RuntimeError(f"the contact walker did not complete the run: {kind}"
-                           + (f" ({why})" if why else "")))
+    if out.failure:
+        _fail(RuntimeError(out.failure))
 
 
 @app.command()
@@ -306,11 +297,12 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
             force: bool = ForceOpt) -> None:
     """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
+    from walkerlab.io.schemas.compare import load_compare
     from walkerlab.report.text import compare_text
-    from walkerlab.stages import compare as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_load(scene), runs_dir, force)
-    typer.echo(compare_text(out.path))
+    out = pipeline.run("compare", _load(scene), runs_dir, force)
+    typer.echo(compare_text(load_compare(out.path)))
     typer.echo(_status(out))
 
 
@@ -319,11 +311,12 @@ def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 def workprecision(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                   force: bool = ForceOpt) -> None:
     """Work-precision study: error vs wall time for every solver and tolerance."""
+    from walkerlab.io.schemas.workprecision import load_workprecision
     from walkerlab.report.text import workprecision_text
-    from walkerlab.stages import workprecision as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_load(scene), runs_dir, force)
-    typer.echo(workprecision_text(out.path))
+    out = pipeline.run("workprecision", _load(scene), runs_dir, force)
+    typer.echo(workprecision_text(load_workprecision(out.path)))
     typer.echo(_status(out))
 
 
@@ -415,6 +408,60 @@ def bifurcation(scene: Path | None = SceneArg,
     typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
 
 
+def _range_spec(text: str, opt: str) -> tuple[str, float, float]:
+    """``FIELD=START:STOP`` -> (field, start, stop); one-line error otherwise."""
+    from walkerlab.sweep.params import SweepError
+
+    path, _, rhs = text.partition("=")
+    parts = rhs.split(":")
+    try:
+        if not path.strip() or len(parts) != 2:
+            raise ValueError
+        a, b = float(parts[0]), float(parts[1])
+        if not (a == a and b == b) or a == b:
+            raise ValueError
+    except ValueError:
+        raise SweepError(f"{opt} {text!r}: expected FIELD=START:STOP (two different "
+                         "numbers in the field's unit)") from None
+    return path.strip(), a, b
+
+
+@app.command()
+@_guard
+def continuation(scene: Path | None = SceneArg,
+                 param: str = typer.Option(..., "--param", help="FIELD=START:STOP, any "
+                                           "numeric scene field in its unit (e.g. "
+                                           "slope.angle_deg=0.5:5.2)"),
+                 switch: bool = typer.Option(False, "--switch", help="switch at period "
+                                             "doublings to the period-2 and period-4 "
+                                             "branches"),
+                 param2: str | None = typer.Option(None, "--param2", help="FIELD2=START:STOP: "
+                                                   "continue each fold and period doubling "
+                                                   "in the plane of both fields"),
+                 runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Pseudo-arclength continuation of the scene's gait over a field: folds, period
+    doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5."""
+    from walkerlab.stages import continuation as stage
+
+    path, a, b = _range_spec(param, "--param")
+    p2 = _range_spec(param2, "--param2") if param2 else None
+    out = stage.run(_load(scene), path, a, b, 2 if switch else 0,
+                    p2[0] if p2 else None, p2[1:] if p2 else None, runs_dir, force)
+    data = out.summary["data"]
+    sp = data.special
+    unit = "" if data.unit == "-" else f" {data.unit}"
+    for i, kind in enumerate(sp["kind"]):
+        cause = f" ({sp['cause'][i]})" if kind == "branch_end" else ""
+        typer.echo(f"{kind:16s} period {int(sp['period'][i])}  {path} = "
+                   f"{float(sp['param'][i]):.10g}{unit}{cause}")
+    if not len(sp["kind"]):
+        typer.echo("no special point in the range")
+    for c in data.curves:
+        typer.echo(f"{c['kind']} curve over {c['path2']}: {len(c['param2'])} points")
+    typer.echo(_status(out))
+    typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
+
+
 @app.command()
 @_guard
 def basin(scene: Path | None = SceneArg,
@@ -439,8 +486,10 @@ def basin(scene: Path | None = SceneArg,
             _fail(ValueError(f"--grid: expected NXxNY with NX, NY >= 2 (e.g. 200x200), "
                              f"got {grid!r}"))
         g = (nx, ny)
-    out = stage.run(_load(scene), runs_dir, force, grid=g, workers=workers,
-                    scheduler=scheduler, resume=resume)
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("basin", _load(scene), runs_dir, force, grid=g, workers=workers,
+                       scheduler=scheduler, resume=resume)
     if out.summary:
         typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
     typer.echo(_status(out))
@@ -483,9 +532,9 @@ def stability_map(scene: Path | None = SceneArg,
 def animate(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
     """The walker walking (rigid, and contact beside it where contact_sim.h5 exists):
     report/figures/animation.gif, and .mp4 if ffmpeg is installed."""
-    from walkerlab.stages import animate as stage
+    from walkerlab.stages import pipeline
 
-    out = stage.run(_load(scene), runs_dir)
+    out = pipeline.run("animate", _load(scene), runs_dir)
     for p in out.paths:
         typer.echo(f"wrote {p}")
     if out.note:

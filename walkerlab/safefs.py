@@ -64,7 +64,7 @@ def remove_stale_temps(folder: Path | str, name: str | None = None,
     characters><suffix>`` (:func:`temp_prefix` + ``mkstemp``) whose pid is not alive and
     which are older than this process.  ``name`` None: any name.  Another name, a live
     writer, a newer file, a folder: left alone.  Returns the number removed."""
-    from walkerlab.workers import process_alive  # light; imported when first needed
+    from walkerlab.execution.workers import process_alive  # light; imported when first needed
 
     try:
         entries = list(os.scandir(folder))

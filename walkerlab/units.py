@@ -111,10 +111,8 @@ def relabel_artifact(f, units: Units) -> None:
     f.attrs["scene_units"] = units.system
     if not units.nondimensional:
         return
-    import h5py
-
     def visit(name, obj):
-        if isinstance(obj, h5py.Dataset) and "unit" in obj.attrs \
+        if hasattr(obj, "shape") and "unit" in obj.attrs \
                 and not is_clock_time(name, obj.attrs):
             old = obj.attrs["unit"]
             old = old.decode() if isinstance(old, bytes) else str(old)

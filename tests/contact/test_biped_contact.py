@@ -42,9 +42,9 @@ def test_biped_scene_contact_sim_and_compare(tmp_path):
     assert np.isfinite(periods[:2]).all()
     # the rigid gait's step period (fixedpoint) within 15 %: the first steps still carry the
     # start's transient (the contact periodic gait, 0.9009 s, is 0.5 % above the rigid one)
-    from walkerlab.io.readers import load_fixed_point
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 
-    T = load_fixed_point(runs / "paper_rods" / "fixedpoint.h5")[1]["step_period_s"]
+    T = load_fixedpoint(runs / "paper_rods" / "fixedpoint.h5").step_period_s
     assert np.all(np.abs(periods[:2] / T - 1) < 0.15), (periods, T)
     assert 0 <= slip < 5.0  # mm: the feet grip (mu 0.9); a sliding foot would show cm
 

@@ -146,7 +146,7 @@ def _imports(path):
     # the model holds the model only: no integration, analysis, sweep or stage above it
     ("contact", ("walkerlab.stages", "walkerlab.analysis", "walkerlab.integrate",
                  "walkerlab.sweep", "walkerlab.report")),
-    # settings lie under every model (the old config <-> contact.config cycle)
+    # settings lie under every model (no config <-> contact cycle)
     ("config", ("walkerlab.contact", "walkerlab.models", "walkerlab.analysis",
                 "walkerlab.integrate", "walkerlab.stages")),
     # integration knows no gait analysis and no stage

@@ -17,7 +17,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from walkerlab.config import load_scene
-from walkerlab.contact.config import ContactSettings
+from walkerlab.config.contact import ContactSettings
 from walkerlab.contact.model import ContactWalker
 from walkerlab.models.description import walker_data
 from walkerlab.models.floating import MASSLESS_MESSAGE, floating_view
@@ -392,7 +392,7 @@ def test_kneed_rigid_gait_pulls_on_the_stance_knee_early_in_stance():
 
 
 def _latched(data, **kw):
-    from walkerlab.contact.config import KneeStopSettings
+    from walkerlab.config.contact import KneeStopSettings
 
     ks = KneeStopSettings(latch=True, **kw).to_si()
     return ContactWalker(contact=ContactSettings().to_si(), data=data, knee_stop=ks)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from independent.contact_reference import rhs_ref
 
-from walkerlab.contact.config import ContactSettings
+from walkerlab.config.contact import ContactSettings
 from walkerlab.contact.model import ContactWalker
 
 

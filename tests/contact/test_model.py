@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from walkerlab.contact import ContactSettings, ContactWalker
+from walkerlab.config.contact import ContactSettings
+from walkerlab.contact import ContactWalker
 from walkerlab.contact.model import checkerboard_lanes
 
 

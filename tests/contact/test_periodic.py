@@ -13,10 +13,10 @@ from walkerlab.analysis.contact_periodic import (
     rigid_limit_contact,
 )
 from walkerlab.analysis.contact_sim import simulate_contact
+from walkerlab.analysis.scene_gaits import solve_variant
 from walkerlab.config import ContactSolverSettings, load_scene
 from walkerlab.contact.model import checkerboard_lanes
-from walkerlab.stages.contact_sim import build
-from walkerlab.stages.fixedpoint import solve_variant
+from walkerlab.contact.scene import build
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "paper.yaml"
 

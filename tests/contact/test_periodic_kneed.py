@@ -8,9 +8,9 @@ import pytest
 
 from walkerlab.analysis.contact_periodic import StepMap, find_contact_periodic_gait
 from walkerlab.analysis.contact_sim import simulate_contact
+from walkerlab.analysis.scene_gaits import solve_variant
 from walkerlab.config import ContactSolverSettings, load_scene
-from walkerlab.stages.contact_sim import build
-from walkerlab.stages.fixedpoint import solve_variant
+from walkerlab.contact.scene import build
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "kneed.yaml"
 

@@ -81,14 +81,12 @@ def test_wall_time_limit_holds_inside_a_chunk(method):
 
 def test_one_vocabulary():
     """Contact outcomes, rigid terminations and the walked set are names of one tuple."""
-    from typing import get_args
-
     from walkerlab.analysis.contact_gait import CONTACT_OUTCOMES
-    from walkerlab.analysis.hybrid import Termination
+    from walkerlab.integrate.ends import RIGID_ENDS
     from walkerlab.sweep.outcomes import OUTCOMES
 
     assert set(CONTACT_OUTCOMES) <= set(RUN_END_NAMES)
-    assert set(get_args(Termination)) <= set(RUN_END_NAMES)
+    assert set(RIGID_ENDS) <= set(RUN_END_NAMES)
     assert set(CONTACT_WALKED) <= set(RUN_END_NAMES)
     assert set(RUN_END_NAMES) - {"heel_strike", "t_final"} <= set(OUTCOMES)
 

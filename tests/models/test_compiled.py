@@ -1,7 +1,7 @@
 """The ``cyrk_compiled`` backend (numba cfuncs in CyRK's C++ solvers) against ``cyrk``.
 
 Both backends integrate the same equations with the same DOP853 pair; the compiled one only
-restarts the solver at chunk boundaries (``walkerlab.analysis._compiled``), so results agree
+restarts the solver at chunk boundaries (``walkerlab.integrate._compiled``), so results agree
 to a few rtol, far below the tolerances asserted here (fixed point 1e-10: the root finder's
 xtol is 1e-12; multipliers 1e-8: eigenvalues of DP, whose entries are O(1) and agree to
 ~1e-14 in ``scripts/bench_compiled.py``).
@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 
 from tests.conftest import ROOT
-from walkerlab.analysis.hybrid import Solver, simulate_steps
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import load_scene
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.compiled import compiled_module
 from walkerlab.models.registry import build_walker
 from walkerlab.published import paper
@@ -84,7 +85,7 @@ def test_a_fall_is_found_like_cyrk(paper_walker, paper_fixed_point):
     time. For this start (cell (0, 2) of an 80 x 80 basin of the paper walker) the re-run's
     span rounded below twice its first step, CyRK refused the step, and the cell came out
     ``stalled`` instead of ``fell_backward``."""
-    from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.integrate.rigid import integrate_step
     from walkerlab.sweep.basin import slice_state
 
     x_star = np.asarray(paper_fixed_point.x, dtype=float)

@@ -1,1 +1,1 @@
-"""Analysis on top of the models: hybrid integration, Poincaré map, fixed points, metrics."""
+"""Analysis on top of the models and the solver layer: Poincaré map, fixed points, metrics."""

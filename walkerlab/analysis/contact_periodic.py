@@ -502,7 +502,7 @@ def ideal_gait(scene):
         The scene has no ``fixedpoint`` section.
     """
     from walkerlab.analysis.gaits import find_gaits
-    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})

@@ -19,6 +19,7 @@ from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSolverSettings
 from walkerlab.contact.scene import build, settings
 from walkerlab.integrate.contact import ContactLimits, StateIndex, integrate_contact
+from walkerlab.integrate.solver import Solver
 
 from .contact_gait import ContactResult, classify, gait_events, heel_strike_count
 
@@ -58,7 +59,7 @@ def initial_state_from_ideal(walker, *x_ideal, rate_scale=(1.0, 1.0)) -> np.ndar
 
 
 def simulate_contact(walker, x0: np.ndarray, t_final: float,
-                     solver: ContactSolverSettings | None = None,
+                     solver: Solver | ContactSolverSettings | None = None,
                      limits: ContactLimits | None = None, *,
                      max_heel_strikes: int | None = None, slip_limit_mm: float | None = None,
                      min_step_m: float = 0.05, initial_stance: str = "leg2") -> ContactResult:
@@ -71,9 +72,9 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         Initial state, named by ``walker.state_names()`` (SI).
     t_final : float
         End time [s].
-    solver : ContactSolverSettings, optional
+    solver : Solver or ContactSolverSettings, optional
         The integrator, as one object (default: ``ContactSolverSettings()``, cyrk_bdf at
-        rtol 1e-8, atol 1e-10).
+        rtol 1e-8, atol 1e-10); the scene's settings become a :class:`Solver` here.
     limits : ContactLimits, optional
         Sampling, pinning, event heights, wall-time limit, chunking.  A
         ``fall_hip_height_m`` / ``airborne_hip_height_m`` left at its default is set to 0.5
@@ -98,7 +99,7 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
     ValueError
         Unknown method; ``max_step_s`` with numbalsoda; numbalsoda not installed.
     """
-    solver = solver or ContactSolverSettings()
+    solver = Solver.from_settings(solver or ContactSolverSettings())
     limits = _with_heights(walker, limits or ContactLimits())
     stop = None
     if max_heel_strikes is not None:

@@ -39,7 +39,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.analysis.hybrid import Solver
 from walkerlab.analysis.poincare import (
     FixedPointNotFound,
     FixedPointResult,
@@ -47,6 +46,7 @@ from walkerlab.analysis.poincare import (
     find_fixed_point,
     poincare_map,
 )
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.base import HybridWalker
 
 __all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "seed_states", "state_from_legs",

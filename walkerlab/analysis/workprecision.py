@@ -7,11 +7,11 @@ plans the cases from the scene, caches them and writes the artifact):
   (final vector, nfev)`` for the rigid hybrid walker and the compliant-contact walker;
 - timing (:func:`time_case`): a case is run ``repeats`` times (once if a run takes longer
   than :data:`SINGLE_RUN_S`), wall and process CPU time of every run;
-- where the cases run (:class:`Lanes`, :func:`run_cases`): one single-threaded worker
-  process per core, pinned to it (``os.sched_setaffinity``), so a timed case never shares
-  its core with another case; each worker runs every method once, untimed, over one stride
-  before timing (compiled code is loaded from the on-disk caches, not timed), then freezes
-  its heap for the garbage collector;
+- where the cases run (:func:`run_cases` on :class:`walkerlab.execution.lanes.Lanes`): one
+  single-threaded worker process per core, pinned to it (``os.sched_setaffinity``), so a
+  timed case never shares its core with another case; each worker runs every method once,
+  untimed, over one stride before timing (compiled code is loaded from the on-disk caches,
+  not timed), then freezes its heap for the garbage collector;
 - the Pareto front and the Pareto-best setting (:func:`pareto_front`, :func:`summarize`).
 """
 
@@ -22,11 +22,12 @@ import json
 import os
 import threading
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
+
+from walkerlab.execution.lanes import Lanes, pinned_worker, run_on_lanes
 
 CYRK_PREFIX = "CyRK "
 
@@ -38,7 +39,8 @@ def ideal_runner(scene, x0: np.ndarray, strides: int):
     final vector is the state and time at the last of ``2 * strides`` heel strikes
     (shape (2n + 1,)), None if the run did not end in a heel strike.
     """
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     walker = build_walker(scene)
@@ -213,20 +215,14 @@ def _run_case(task: Case) -> tuple:
     return task.key, time_case(runner, task.method, task.rtol, task.atol, task.repeats)
 
 
-def _pin_worker(core: int) -> None:
-    """Worker initializer: stay on ``core`` (the BLAS/OpenMP thread counts are set to 1 in
-    the environment the worker was started with, see :func:`_pinned_worker`), then load the
-    libraries the runners use (a worker started ahead does this while its caller works)."""
-    try:
-        os.sched_setaffinity(0, {core})
-    except Exception:  # noqa: BLE001 - pinning is best effort (not on every OS)
-        pass
+def load_libraries() -> None:
+    """Lane worker warm-up (after pinning): load the libraries the runners use."""
     import scipy.integrate  # noqa: F401
     import scipy.optimize  # noqa: F401
 
-    from walkerlab.analysis.hybrid import _have_cyrk
+    from walkerlab.integrate.solver import available_backends
 
-    if _have_cyrk():
+    if "cyrk" in available_backends():
         from walkerlab.usercache import use_for_numba
 
         use_for_numba()  # numba's cache in the user cache (before numba loads)
@@ -234,67 +230,9 @@ def _pin_worker(core: int) -> None:
 
 
 def start_worker(core: int):
-    """A measuring worker process pinned to ``core``, started now (see :class:`Lanes`)."""
-    from walkerlab.workers import mp_context
-
-    return _pinned_worker(mp_context("spawn"), core)
-
-
-THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-_ENV_LOCK = threading.Lock()
-
-
-def _pinned_worker(ctx, core: int):
-    """A one-process pool pinned to ``core``, started now with single-threaded BLAS/OpenMP
-    (a thread pool is sized when numpy loads, before any initializer runs, so the limit
-    must be in the environment the process starts with)."""
-    from walkerlab.workers import process_pool
-
-    # ends with this process, even after SIGKILL or SIGTERM (walkerlab.workers)
-    ex = process_pool(1, ctx, _pin_worker, (core,))
-    with _ENV_LOCK:
-        old = {v: os.environ.get(v) for v in THREAD_VARS}
-        os.environ.update({v: "1" for v in THREAD_VARS})
-        try:
-            ex.submit(int)  # a spawn-context pool starts its process in submit()
-        finally:
-            for v, val in old.items():
-                if val is None:
-                    os.environ.pop(v, None)
-                else:
-                    os.environ[v] = val
-    return ex
-
-
-@dataclass
-class Lanes:
-    """Where the timed cases run: one single-threaded worker process per core, pinned to it,
-    so a timed case never shares its core with another case or with the caller's work.
-
-    Attributes
-    ----------
-    cores : list of int
-        One lane (worker process) per core.
-    gates : dict[int, threading.Event]
-        A lane whose core is listed starts only once its event is set (``walkerlab report``
-        runs its untimed stages on that core meanwhile).
-    pending : dict[str, threading.Event]
-        Cases of a listed model are taken only once its event is set (the report sets it
-        when the model's compiled code is in numba's on-disk cache, so a worker loads it
-        instead of compiling it a second time); other models' cases go first.
-    cancel : threading.Event
-        Set: the lanes take no new case.
-    """
-
-    cores: list
-    gates: dict = field(default_factory=dict)
-    pending: dict = field(default_factory=dict)
-    cancel: threading.Event = field(default_factory=threading.Event)
-    #: set once the cache was looked up; ``todo_models``: models with cases to measure
-    todo_known: threading.Event = field(default_factory=threading.Event)
-    todo_models: set = field(default_factory=set)
-    #: worker processes started ahead (:func:`start_worker`), by core; a lane takes its own
-    workers: dict = field(default_factory=dict)
+    """A measuring worker process pinned to ``core``, started now
+    (:func:`walkerlab.execution.lanes.pinned_worker`; see :class:`Lanes`)."""
+    return pinned_worker(core, load_libraries)
 
 
 #: scipy's implicit methods: the slow cases, started first so the lanes finish together
@@ -393,58 +331,9 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
         lanes = Lanes(cores=cores[:workers])
     if not todo:
         return out
-    from walkerlab.workers import mp_context
-
-    ctx = mp_context("spawn")
     todo.sort(key=_cost_order)
-    errors: list[BaseException] = []
-
-    def take():
-        """Next case whose model is ready; None: nothing left; False: wait."""
-        with lock:
-            if not todo or lanes.cancel.is_set():
-                return None
-            for i, t in enumerate(todo):
-                ev = lanes.pending.get(t.model)
-                if ev is None or ev.is_set():
-                    return todo.pop(i)
-            return False
-
-    def lane(core):
-        gate = lanes.gates.get(core)
-        while gate is not None and not gate.wait(0.1):
-            if take_nothing_left():
-                return
-        ex = None  # the worker starts with the lane's first case
-        try:
-            while (t := take()) is not None:
-                if t is False:
-                    time.sleep(0.05)
-                    continue
-                if ex is None:
-                    ex = lanes.workers.pop(core, None) or _pinned_worker(ctx, core)
-                store(*ex.submit(_run_case, t).result(), len(lanes.cores))
-        except BaseException as exc:  # noqa: BLE001 - re-raised in the calling thread
-            lanes.cancel.set()
-            errors.append(exc)
-        finally:
-            if ex is not None:
-                ex.shutdown(wait=True, cancel_futures=True)
-
-    def take_nothing_left():
-        with lock:
-            return not todo or lanes.cancel.is_set()
-
-    threads = [threading.Thread(target=lane, args=(c,), name=f"workprecision-core{c}")
-               for c in lanes.cores]
-    for th in threads:
-        th.start()
-    for th in threads:
-        th.join()
-    if errors:
-        raise errors[0]
-    if lanes.cancel.is_set() and todo:
-        raise RuntimeError("workprecision: cancelled")
+    run_on_lanes(lanes, todo, _run_case, lambda kr: store(*kr, len(lanes.cores)),
+                 group=lambda t: t.model, warm=load_libraries, name="workprecision")
     return out
 
 

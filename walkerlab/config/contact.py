@@ -333,7 +333,7 @@ class ContactSolverSettings(BaseModel):
 
     The one object that carries the solver to every contact integration
     (:func:`walkerlab.analysis.contact_sim.simulate_contact`), as
-    :class:`walkerlab.analysis.hybrid.Solver` does on the rigid side."""
+    becomes :class:`walkerlab.integrate.solver.Solver`, as the rigid side's settings do."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 

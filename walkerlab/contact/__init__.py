@@ -11,9 +11,6 @@ or law module does not load numba, which the model needs.
 from importlib import import_module
 
 _WHERE = {
-    # the model's settings (defined in walkerlab.config.contact), as the model reads them
-    "ContactParamsSI": "config", "ContactSettings": "config", "ContactSimSettings": "config",
-    "KneeStopSI": "config", "KneeStopSettings": "config", "TerrainSettings": "config",
     "adams_step": "laws", "adams_step_derivative": "laws",
     "coulomb_friction_coefficient": "laws", "impact_normal_force": "laws",
     "FOOT_NAMES": "model", "ContactWalker": "model", "checkerboard_lanes": "model",

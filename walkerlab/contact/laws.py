@@ -2,7 +2,7 @@
 
 All functions are pure and vectorized (numpy broadcasting).  They are unit-agnostic: the
 caller must pass every argument in one consistent unit system (``walkerlab.contact`` uses SI
-internally, see :meth:`walkerlab.contact.config.ContactSettings.to_si`).
+internally, see :meth:`walkerlab.config.contact.ContactSettings.to_si`).
 
 Sources
 -------

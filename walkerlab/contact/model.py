@@ -7,7 +7,7 @@ down-slope tangent t = (cos phi, -sin phi).  The mechanics (mass matrix, bias, c
 Jacobians) are generated from the walker description; the contact forces use the laws of
 :mod:`walkerlab.contact.laws` (numba twins in :mod:`walkerlab.contact._kernels`); the knees
 of a kneed walker are free, each held by a compliant stop
-(:class:`~walkerlab.contact.config.KneeStopSettings`).
+(:class:`~walkerlab.config.contact.KneeStopSettings`).
 
 State names
 -----------
@@ -35,7 +35,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .config import ContactParamsSI, ContactSettings, KneeStopSettings, KneeStopSI, TerrainSettings
+from walkerlab.config.contact import (
+    ContactParamsSI,
+    ContactSettings,
+    KneeStopSettings,
+    KneeStopSI,
+    TerrainSettings,
+)
 
 __all__ = ["FOOT_NAMES", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
            "compass_gait_data", "state_name"]
@@ -80,7 +86,7 @@ def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np
 def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
     """:class:`~walkerlab.models.description.WalkerData` of the paper's compass gait (Table 1):
     leg length L [m], leg mass m [kg] at ``a`` [m] from the foot, hip mass MH [kg]."""
-    from walkerlab.models.derivation import compass_gait_structure
+    from walkerlab.models.compass_gait import compass_gait_structure
     from walkerlab.models.description import WalkerData
 
     st = compass_gait_structure()
@@ -216,6 +222,15 @@ class ContactWalker:
 
     # ------------------------------------------------------------------ state layout
     @property
+    def model_name(self) -> str:
+        """``compass_gait_contact`` for two straight point-footed legs alike with their
+        bodies on the axis and nothing else (the paper's family), else ``biped_contact``."""
+        st = self.structure
+        extra = (st.knee or st.torso or st.springs or st.asymmetric or st.foot != "point"
+                 or any(b.off_axis for b in st.bodies))
+        return "biped_contact" if extra else "compass_gait_contact"
+
+    @property
     def nq(self) -> int:
         """Number of generalised coordinates."""
         return len(self._coords)
@@ -298,11 +313,17 @@ class ContactWalker:
         x = np.asarray(x_ideal, float)
         st = self.structure
         s1, s2 = float(rate_scale[0]), float(rate_scale[1])
+        roles = st.roles  # the rigid walker's state, by name (<role>_angle, <role>_rate)
+        by = {f"{r}_angle": x[i] for i, r in enumerate(roles)}
+        by.update({f"{r}_rate": x[len(roles) + i] for i, r in enumerate(roles)})
         if st.knee:
-            ang = [x[0], x[1], x[2], x[2]]
-            rates = [s1 * x[3], s1 * x[4], s2 * x[5], s2 * x[5]]
+            ang = [by["swing_thigh_angle"], by["swing_shank_angle"], by["stance_angle"],
+                   by["stance_angle"]]
+            rates = [s1 * by["swing_thigh_rate"], s1 * by["swing_shank_rate"],
+                     s2 * by["stance_rate"], s2 * by["stance_rate"]]
         elif st.coordinates == "absolute":
-            ang, rates = [x[0], x[1]], [s1 * x[2], s2 * x[3]]
+            ang = [by["swing_angle"], by["stance_angle"]]
+            rates = [s1 * by["swing_rate"], s2 * by["stance_rate"]]
         else:
             from walkerlab.models.rigid import functions
 

@@ -7,12 +7,13 @@ steps, the run's outcome) and :mod:`walkerlab.analysis.contact_sim` puts the two
 (``simulate_contact``, a scene's contact run).  This module knows no gait: the strides cap
 reaches it as a ``stop`` predicate over the samples.
 
-Backends (``ContactSolverSettings.method``): ``"odeint"`` (scipy.integrate.odeint = LSODA
-with little overhead), ``"cyrk_bdf"`` (CyRK's BDF over a compiled RHS, no Python per
-evaluation; :mod:`walkerlab.integrate._cyrk`), ``"numbalsoda"`` (numbalsoda's LSODA from
-compiled code; optional extra, :mod:`walkerlab.integrate._lsoda`) or a ``solve_ivp`` method
-(``"LSODA"``, ``"Radau"``, ``"BDF"``, ...), these given the model's analytic Jacobian.  All run
-in chunks so a fall, a trip, a flight, the wall-time limit or the strides cap stops the run.
+Backends (:class:`~walkerlab.integrate.solver.Solver` ``method``): ``"odeint"``
+(scipy.integrate.odeint = LSODA with little overhead), ``"cyrk_bdf"`` (CyRK's BDF over a
+compiled RHS, no Python per evaluation; :mod:`walkerlab.integrate._cyrk`), ``"numbalsoda"``
+(numbalsoda's LSODA from compiled code; optional extra, :mod:`walkerlab.integrate._lsoda`)
+or a ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``, ...), these given the
+model's analytic Jacobian.  All run in chunks so a fall, a trip, a flight, the wall-time
+limit or the strides cap stops the run.
 
 Wall-time limit: the Python right-hand sides (odeint, solve_ivp, the pinned phase) check the
 deadline at every call.  The compiled backends check no clock: a CyRK call stops after
@@ -45,15 +46,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
-from walkerlab.config.contact import ContactSolverSettings
-
 from . import _cyrk
+from .ends import RunEnd
+from .solver import Solver
 
 __all__ = ["CHUNK_WALL_S", "CYRK_STEPS_PER_CALL", "METHODS", "ContactIntegration",
            "ContactLimits", "StateIndex", "first_event", "hermite_root", "hermite_state",
            "integrate_contact", "sample_grid"]
 
-#: Methods of :class:`ContactSolverSettings` this module runs.
+#: Solver methods this module runs.
 METHODS = ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853",
            *_cyrk.CYRK_METHODS)
 
@@ -265,8 +266,8 @@ def first_event(walker, t, X, limits: ContactLimits, k0=1):
     hh = walker.hip_height(X[sl])
     tt = t[sl]
     best = None
-    for kind, level, down in (("fall", limits.fall_hip_height_m, True),
-                              ("airborne", limits.airborne_hip_height_m, False)):
+    for kind, level, down in ((RunEnd.FALL.value, limits.fall_hip_height_m, True),
+                              (RunEnd.AIRBORNE.value, limits.airborne_hip_height_m, False)):
         c = _hip_crossing(walker, idx, tt, X, hh, level, k0, down)
         if c is not None and (best is None or c[1] < best[2]):
             best = (kind, c[0], c[1], "", np.nan)
@@ -294,7 +295,7 @@ def first_event(walker, t, X, limits: ContactLimits, k0=1):
             xe = hermite_state(walker, tt[k - 1], tt[k], X[k0 - 1 + k - 1], X[k0 - 1 + k], te)
             pe = walker.contact_quantities(xe)[foot]["penetration"][0]
             if pe > 0 and (best is None or te < best[2]):
-                best = ("trip", k0 - 1 + k, float(te), foot, float(edge))
+                best = (RunEnd.TRIP.value, k0 - 1 + k, float(te), foot, float(edge))
                 break
     return best
 
@@ -328,7 +329,7 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline
                         t_eval=sample_grid(t0, t_end, limits.sample_rate_hz), events=events,
                         dense_output=True)
     except _TimeLimit:
-        return (np.array([t0]), x0[None], 0, 0, "time_limit",
+        return (np.array([t0]), x0[None], 0, 0, RunEnd.TIME_LIMIT,
                 "wall-time limit reached in the pinned phase")
     t, Z = sol.t, sol.y.T
     if sol.status == 1:  # stopped on an event: append the event point
@@ -339,7 +340,8 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline
             Z = np.vstack([Z, sol.sol(te)])
     X = np.array([walker.pinned_to_full(z, foot2) for z in Z])
     fell = sol.status == 1 and sol.t_events[0].size > 0
-    term = "fall" if fell else ("t_final" if sol.status >= 0 else "solver_failure")
+    term = (RunEnd.FALL if fell else RunEnd.T_FINAL if sol.status >= 0
+            else RunEnd.SOLVER_FAILURE)
     return t, X, sol.nfev, sol.njev, term, sol.message
 
 
@@ -347,7 +349,7 @@ class _Backend:
     """One chunk of a backend: ``chunk(xa, tg) -> (t, X, ok, message, nfev, njev)`` with the
     samples reached after ``tg[0]``; raises :class:`_TimeLimit` from a Python RHS."""
 
-    def __init__(self, walker, solver: ContactSolverSettings, use_jac: bool, deadline: float):
+    def __init__(self, walker, solver: Solver, use_jac: bool, deadline: float):
         self.walker, self.solver, self.method = walker, solver, solver.method
         self.max_step = solver.max_step_s if solver.max_step_s else np.inf
         self.calls = [0]  # RHS calls of the current chunk (Python backends)
@@ -415,7 +417,7 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
     rate = limits.sample_rate_hz
     ts, Xs, nfev, njev = [np.array([t0])], [x0[None]], 0, 0
     ta, xa = t0, x0
-    term, msg, event = "t_final", "Integration successful.", None
+    term, msg, event = RunEnd.T_FINAL, "Integration successful.", None
     n_checked = 1
     # numbalsoda: the first chunk is short, later ones sized to CHUNK_WALL_S
     span = min(limits.chunk_s, 20.0 / rate) if be.sized_by_wall else limits.chunk_s
@@ -428,7 +430,7 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             tn, Xn, ok, m, nf, nj = be.chunk(xa, tg)
         except _TimeLimit:
             nfev += be.calls[0]
-            term, msg = "time_limit", "wall-time limit reached inside a chunk"
+            term, msg = RunEnd.TIME_LIMIT, "wall-time limit reached inside a chunk"
             break
         nfev += nf
         njev += nj
@@ -442,16 +444,16 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
         event = first_event(walker, t_all, X_all, limits, k0=n_checked)
         n_checked = len(t_all)
         if event is not None:
-            term = event[0]
+            term = RunEnd(event[0])
             break
         if not ok:
-            term, msg = "solver_failure", str(m)
+            term, msg = RunEnd.SOLVER_FAILURE, str(m)
             break
         if time.perf_counter() > deadline and t_all[-1] < t1 - 1e-12:
-            term, msg = "time_limit", "wall-time limit reached"
+            term, msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
             break
         if stop is not None and stop(t_all, X_all):
-            term, msg = "heel_strike", "the heel strikes asked for were made"
+            term, msg = RunEnd.HEEL_STRIKE, "the heel strikes asked for were made"
             break
         ta, xa = t_all[-1], X_all[-1]
     t_all, X_all = np.concatenate(ts), np.vstack(Xs)
@@ -462,14 +464,14 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             if te > t_all[k - 1] else X_all[k - 1]
         t_all = np.append(t_all[:k], te) if te > t_all[k - 1] else t_all[:k]
         X_all = np.vstack([X_all[:k], xe[None]]) if len(t_all) > k else X_all[:k]
-        msg = {"trip": "trip: a foot hit the side of a patch below its top",
-               "fall": "fall: hip below the fall height",
-               "airborne": "airborne: hip above the airborne height"}[event[0]]
+        msg = {RunEnd.TRIP: "trip: a foot hit the side of a patch below its top",
+               RunEnd.FALL: "fall: hip below the fall height",
+               RunEnd.AIRBORNE: "airborne: hip above the airborne height"}[term]
     return t_all, X_all, nfev, njev, term, msg, event
 
 
 def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
-                      solver: ContactSolverSettings, limits: ContactLimits,
+                      solver: Solver, limits: ContactLimits,
                       stop: Callable[[np.ndarray, np.ndarray], bool] | None = None
                       ) -> ContactIntegration:
     """Integrate the contact walker from ``x0`` at ``t0`` to ``t_final`` or an ending event.
@@ -481,9 +483,9 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
         Initial state, columns named by ``walker.state_names()`` (SI).
     t0, t_final : float
         Start and end time [s].
-    solver : ContactSolverSettings
-        Method, tolerances (``atol`` well below the penetration depth, ~6e-5 m for the
-        paper's contact), largest step.
+    solver : Solver
+        Method (:data:`METHODS`; ``backend`` is not read), tolerances (``atol`` well below
+        the penetration depth, ~6e-5 m for the paper's contact), largest step.
     limits : ContactLimits
     stop : callable, optional
         ``stop(t (n,), X (n, N)) -> bool``, asked after each chunk; True ends the run with
@@ -506,7 +508,7 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
     wall = time.perf_counter()
     deadline = wall + (limits.wall_time_limit_s if limits.wall_time_limit_s else np.inf)
     ts, Xs, nfev, njev = [], [], 0, 0
-    term, msg, event = "t_final", "", None
+    term, msg, event = RunEnd.T_FINAL, "", None
     t_pin = t0
     if limits.pin_stance_until != "none":
         t_end = (t_final if limits.pin_stance_until == "first_touchdown"
@@ -519,9 +521,9 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
         nfev += nf
         njev += nj
         t_pin, x0 = tp[-1], Xp[-1]
-        if term == "fall":
-            event = ("fall", len(tp) - 1, float(tp[-1]), "", np.nan)
-    if term == "t_final" and t_pin < t_final - 1e-12:
+        if term is RunEnd.FALL:
+            event = (RunEnd.FALL.value, len(tp) - 1, float(tp[-1]), "", np.nan)
+    if term is RunEnd.T_FINAL and t_pin < t_final - 1e-12:
         tf, Xf, nf, nj, term, msg, event = _run_free(walker, x0, t_pin, t_final, solver,
                                                      limits, deadline, stop)
         if ts:
@@ -530,7 +532,7 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
         Xs.append(Xf)
         nfev += nf
         njev += nj
-    return ContactIntegration(t=np.concatenate(ts), X=np.vstack(Xs), termination=term,
+    return ContactIntegration(t=np.concatenate(ts), X=np.vstack(Xs), termination=term.value,
                               message=str(msg), event=event, nfev=int(nfev), njev=int(njev),
                               wall_time_s=time.perf_counter() - wall,
                               pin_end_time=float(t_pin))

@@ -1,6 +1,6 @@
 """How a run ended: one vocabulary for the rigid hybrid model and the compliant-contact model.
 
-The rigid side's segment terminations (:mod:`walkerlab.analysis.hybrid`: a step ends in
+The rigid side's segment terminations (:mod:`walkerlab.integrate.rigid`: a step ends in
 ``heel_strike``, ``fall``, ``t_final`` or ``solver_failure``) extended with what only the
 contact model can do (trip, scuff, slip, fly away) and with the verdicts a whole run needs
 (no heel strike at all, the wall-time limit).  Every producer and reader uses these names:
@@ -27,35 +27,63 @@ sweeps (:mod:`walkerlab.sweep.outcomes`, which add their own verdicts such as
 ``solver_failure`` the integrator stopped
 ``time_limit``     the wall-time limit ran out first
 =================  ==========================================================================
+
+:class:`RunEnd` is the vocabulary: a ``str``-valued enum, so ``RunEnd.FALL == "fall"``.  The
+integrators decide with its members and hand their results over with the member's value (a
+plain ``str``, which h5py stores as it stores any string: artifacts, JSON and pickles carry
+the same names as before).
 """
 
 from __future__ import annotations
 
-__all__ = ["CONTACT_WALKED", "RUN_ENDS", "RUN_END_NAMES", "describe"]
+from enum import StrEnum
 
-#: name -> one line (the table above).
-RUN_ENDS: dict[str, str] = {
-    "heel_strike": "ended at a heel strike (rigid step; contact run: the heel strikes asked "
-                   "for were made)",
-    "t_final": "reached its end time (rigid step: cut after max_step_time_s, the walker "
-               "stalled)",
-    "fall": "the hip fell below the fall height / a fall guard fired",
-    "trip": "a foot hit the side of a ground patch below its top",
-    "scuff": "the swing foot touched the ground before its heel strike",
-    "slip": "a stance foot slid farther than the slip limit",
-    "airborne": "the hip rose above the airborne height (the walker flew off the ground)",
-    "no_heel_strike": "the walker made no step (no heel strike, or a step that ended where "
-                      "it began)",
-    "solver_failure": "the integrator stopped",
-    "time_limit": "the wall-time limit ran out first",
+__all__ = ["CONTACT_WALKED", "RIGID_ENDS", "RUN_ENDS", "RUN_END_NAMES", "RunEnd", "describe"]
+
+
+class RunEnd(StrEnum):
+    """How a run (or a rigid step) ended; the value is the name written to artifacts."""
+
+    HEEL_STRIKE = "heel_strike"
+    T_FINAL = "t_final"
+    FALL = "fall"
+    TRIP = "trip"
+    SCUFF = "scuff"
+    SLIP = "slip"
+    AIRBORNE = "airborne"
+    NO_HEEL_STRIKE = "no_heel_strike"
+    SOLVER_FAILURE = "solver_failure"
+    TIME_LIMIT = "time_limit"
+
+
+#: run end -> one line (the table above).
+RUN_ENDS: dict[RunEnd, str] = {
+    RunEnd.HEEL_STRIKE: "ended at a heel strike (rigid step; contact run: the heel strikes "
+                        "asked for were made)",
+    RunEnd.T_FINAL: "reached its end time (rigid step: cut after max_step_time_s, the walker "
+                    "stalled)",
+    RunEnd.FALL: "the hip fell below the fall height / a fall guard fired",
+    RunEnd.TRIP: "a foot hit the side of a ground patch below its top",
+    RunEnd.SCUFF: "the swing foot touched the ground before its heel strike",
+    RunEnd.SLIP: "a stance foot slid farther than the slip limit",
+    RunEnd.AIRBORNE: "the hip rose above the airborne height (the walker flew off the ground)",
+    RunEnd.NO_HEEL_STRIKE: "the walker made no step (no heel strike, or a step that ended "
+                           "where it began)",
+    RunEnd.SOLVER_FAILURE: "the integrator stopped",
+    RunEnd.TIME_LIMIT: "the wall-time limit ran out first",
 }
 
-#: The names, in the order of :data:`RUN_ENDS`.
-RUN_END_NAMES: tuple[str, ...] = tuple(RUN_ENDS)
+#: The names (plain strings), in the order of :class:`RunEnd`.
+RUN_END_NAMES: tuple[str, ...] = tuple(e.value for e in RunEnd)
+
+#: How a rigid step can end (:func:`walkerlab.integrate.rigid.integrate_step`).
+RIGID_ENDS: tuple[RunEnd, ...] = (RunEnd.HEEL_STRIKE, RunEnd.FALL, RunEnd.T_FINAL,
+                                  RunEnd.SOLVER_FAILURE, RunEnd.NO_HEEL_STRIKE)
 
 #: Contact outcomes of a run that walked (exit code 0): made its heel strikes or reached its
 #: end time, possibly with a scuff or a slip beyond the limit noted on the way.
-CONTACT_WALKED: tuple[str, ...] = ("heel_strike", "t_final", "scuff", "slip")
+CONTACT_WALKED: tuple[str, ...] = tuple(e.value for e in (RunEnd.HEEL_STRIKE, RunEnd.T_FINAL,
+                                                          RunEnd.SCUFF, RunEnd.SLIP))
 
 
 def describe(name: str) -> str:
@@ -63,7 +91,7 @@ def describe(name: str) -> str:
 
     Raises
     ------
-    KeyError
+    ValueError
         ``name`` is not one of :data:`RUN_END_NAMES`.
     """
-    return RUN_ENDS[name]
+    return RUN_ENDS[RunEnd(name)]

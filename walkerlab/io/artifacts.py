@@ -33,7 +33,6 @@ import datetime as _dt
 import errno
 import hashlib
 import itertools
-import json
 import os
 import tempfile
 import time
@@ -394,6 +393,13 @@ def stored_hash(path: Path) -> str | None:
         return None
 
 
-def scene_json_of(path: Path) -> dict:
-    with open_artifact(path) as f:
-        return json.loads(f.attrs["scene_json"])
+def root_attrs(path: Path, *names: str) -> dict:
+    """The root attributes ``names`` of an artifact that has them (strings decoded), without
+    any check of version or content: what an out-of-date artifact was written with.  {} when
+    the file is absent or unreadable."""
+    try:
+        with h5py.File(path, "r") as f:
+            out = {n: f.attrs[n] for n in names if n in f.attrs}
+    except OSError:
+        return {}
+    return {k: v.decode() if isinstance(v, bytes) else v for k, v in out.items()}

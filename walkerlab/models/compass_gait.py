@@ -9,7 +9,9 @@ cos theta2)`` (A.1-A.3).  The walker walks in +x down a slope of angle ``phi``.
 Three pure pieces (as in Drake's ``examples/compass_gait``):
 
 - flow   :func:`flow`        ``M(q) qdd + C(q, dq) dq + G(q) = 0`` (Eq. 3-4)
-- guard  :func:`heel_strike_guard`, :func:`swing_foot_ahead`, :func:`swing_foot_height`
+- guard  generated with the flow (:func:`walkerlab.models.rigid.make_rigid_walker`:
+         ``heel_strike`` armed in late swing, after ``midstance``); :func:`swing_foot_height`
+         is the geometry both factors of it come from
 - reset  :func:`impact`       plastic impact and role swap (Eq. 6-8, A.41-A.57)
 
 The ``derived`` equations are not written here: the compass gait is the generic biped of
@@ -109,41 +111,6 @@ def swing_foot_height(x: np.ndarray, phi: float, L: float) -> np.ndarray:
     return L * (np.cos(x[1] + phi) - np.cos(x[0] + phi))
 
 
-def heel_strike_guard(t: float, x: np.ndarray, phi: float) -> float:
-    """Heel-strike guard ``sigma = theta1 + theta2 + 2 phi`` (Eq. 9-2 on a slope).
-
-    The swing foot touches the ground on ``sigma = 0`` *with the swing foot ahead*
-    (``theta1 > theta2``) and ``sigma`` decreasing.  This factor of the swing-foot height
-    excludes the other factor, ``theta1 - theta2``, which vanishes at mid-stance when the
-    legs are aligned and the point foot would scuff the ground; the ideal model ignores
-    scuffing (paper Sec. 3.2, "we do not consider the scuffing with the ground").  Because
-    ``sigma`` is also zero right *after* heel strike, the integrator only arms this guard
-    in the late-swing phase, after :func:`swing_foot_ahead` has crossed zero upward.
-    """
-    return x[0] + x[1] + 2.0 * phi
-
-
-def swing_foot_ahead(t: float, x: np.ndarray) -> float:
-    """``theta1 - theta2`` [rad]: positive when the swing foot is ahead of the stance foot."""
-    return x[0] - x[1]
-
-
-def hip_height(t: float, x: np.ndarray, phi: float, L: float) -> float:
-    """Hip height above the slope [m]; zero means the walker has fallen (fall guard)."""
-    return L * np.cos(x[1] + phi)
-
-
-def is_heel_strike(x: np.ndarray, phi: float, tol: float = 1e-9) -> bool:
-    """True if ``x`` is a heel-strike state: ``sigma = 0``, swing foot ahead, foot descending.
-
-    Returns False on the mid-stance scuffing surface (``theta1 = theta2``) and right after
-    an impact (swing foot behind).
-    """
-    sigma = heel_strike_guard(0.0, x, phi)
-    sigma_dot = x[2] + x[3]
-    return bool(abs(sigma) <= tol and swing_foot_ahead(0.0, x) > tol and sigma_dot < 0)
-
-
 # ----------------------------------------------------------------------------- reset
 def impact_matrices(q, p, variant: str = "derived"):
     """Extended inertia ``De`` (4x4, coordinates ``[theta1, theta2, x_f, y_f]``, A.7-A.24)
@@ -209,6 +176,14 @@ def points(x: np.ndarray, p: tuple) -> dict[str, np.ndarray]:
 
 
 # --------------------------------------------------------------------------- builder
+def compass_gait_structure():
+    """The compass gait (paper A.1-A.3) as a generic biped structure: a hip point mass and one
+    point mass per leg (:class:`~walkerlab.models.description.Structure`)."""
+    from walkerlab.models.description import BodySpec, Structure
+
+    return Structure("absolute", (BodySpec("mass", "point_mass"),))
+
+
 def _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_from_foot_m,
           slope_rad):
     from walkerlab.config import CompassGaitParams

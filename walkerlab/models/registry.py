@@ -5,6 +5,21 @@ from __future__ import annotations
 from walkerlab.models.base import HybridWalker
 
 
+def state_layout(scene) -> tuple[list[str], list[str]]:
+    """State names and units of the rigid walker of ``scene``, from its description alone
+    (no equations derived, no code loaded): what :func:`build_walker` ``(scene)``'s
+    ``state_names()`` and ``state_units()`` return.
+
+    Returns
+    -------
+    names, units : list of str, length 2n
+    """
+    from walkerlab.models.description import state_names, state_units, walker_data
+
+    roles = walker_data(scene.walker, scene.slope.phi_rad).structure.roles
+    return state_names(roles), state_units(roles)
+
+
 def build_walker(scene) -> HybridWalker:
     """Build the rigid hybrid walker of a :class:`~walkerlab.config.Scene`.
 

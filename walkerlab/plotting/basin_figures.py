@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 OUTCOME_COLORS = {
@@ -13,30 +11,13 @@ OUTCOME_COLORS = {
 }
 
 
-def load_basin(path: Path) -> dict:
-    """Arrays and labels of a ``basin.h5`` artifact."""
-    from walkerlab.io.artifacts import open_artifact
-
-    with open_artifact(path, "basin") as f:
-        names = [str(n) for n in f.attrs["state_names"]]
-        d = {k: f[k][()] for k in ("x", "y", "outcome", "steps", "period")}
-        d["x_unit"], d["y_unit"] = str(f["x"].attrs["unit"]), str(f["y"].attrs["unit"])
-        d["x_axis"], d["y_axis"] = str(f.attrs["x_axis"]), str(f.attrs["y_axis"])
-        d["outcomes"] = [str(o) for o in f.attrs["outcomes"]]
-        d["fixed_point"] = {n: float(f[f"fixed_point/{n}"][()]) for n in names}
-        d["scene"] = str(f.attrs.get("scene_name", "")) if "scene_name" in f.attrs else ""
-        d["max_steps"] = int(f["settings/max_steps"][()])
-        d["start"] = str(f.attrs.get("start", "fixed_point"))
-    return d
-
-
-def basin_figure(d: dict, title: str = ""):
+def basin_figure(d, title: str = ""):
     """Outcome map (left) and steps to convergence of the converged cells (right).
 
     Parameters
     ----------
-    d : dict
-        From :func:`load_basin`.
+    d : walkerlab.io.schemas.basin.BasinArtifact
+        A loaded ``basin.h5``.
 
     Returns
     -------
@@ -49,35 +30,35 @@ def basin_figure(d: dict, title: str = ""):
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
-    xc, yc, out = d["x"], d["y"], d["outcome"]  # cell centres (grid axes, not states)
+    xc, yc, out = d.x, d.y, d.outcome  # cell centres (grid axes, not states)
     dx = np.ptp(xc) / (xc.size - 1) / 2 if xc.size > 1 else 0.5
     dy = np.ptp(yc) / (yc.size - 1) / 2 if yc.size > 1 else 0.5
     extent = (xc.min() - dx, xc.max() + dx, yc.min() - dy, yc.max() + dy)
-    names = d["outcomes"]
+    names = d.outcomes
     cmap = ListedColormap([OUTCOME_COLORS.get(n, "k") for n in names])
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), constrained_layout=True)
     ax = axes[0]
     masked = np.ma.masked_less(out, 0)
     ax.imshow(masked, origin="lower", extent=extent, aspect="auto", cmap=cmap,
               vmin=-0.5, vmax=len(names) - 0.5, interpolation="nearest")
-    fp = d["fixed_point"]
+    fp = d.fixed_point
     for a in axes:
-        a.plot(fp[d["x_axis"]], fp[d["y_axis"]], marker="*", color="k", ms=12, mec="w",
+        a.plot(fp[d.x_axis], fp[d.y_axis], marker="*", color="k", ms=12, mec="w",
                ls="none", label="period-1 fixed point")
-        a.set_xlabel(f"{d['x_axis'].replace('_', ' ')} [{d['x_unit']}]")
-        a.set_ylabel(f"{d['y_axis'].replace('_', ' ')} [{d['y_unit']}]")
+        a.set_xlabel(f"{d.x_axis.replace('_', ' ')} [{d.x_unit}]")
+        a.set_ylabel(f"{d.y_axis.replace('_', ' ')} [{d.y_unit}]")
     n_cells = out.size
     handles = [Patch(color=OUTCOME_COLORS.get(n, "k"),
                      label=f"{n.replace('_', ' ')} ({100 * np.mean(out == i):.1f} %)")
                for i, n in enumerate(names) if np.any(out == i)]
     ax.legend(handles=handles, fontsize=7, loc="best", framealpha=0.85)
-    start = ("cells: states just after a heel strike" if d.get("start") == "heel_strike"
+    start = ("cells: states just after a heel strike" if d.start == "heel_strike"
              else "other coordinates from the fixed point")
-    ax.set_title(f"outcome after at most {d['max_steps']} steps ({n_cells} cells)\n{start}",
+    ax.set_title(f"outcome after at most {d.max_steps} steps ({n_cells} cells)\n{start}",
                  fontsize=10)
     ax = axes[1]
     conv = names.index("converged") if "converged" in names else -1
-    steps = np.ma.masked_where(out != conv, d["steps"].astype(float))
+    steps = np.ma.masked_where(out != conv, d.steps.astype(float))
     im = ax.imshow(steps, origin="lower", extent=extent, aspect="auto", cmap="viridis",
                    interpolation="nearest")
     fig.colorbar(im, ax=ax, label="steps to converge")

@@ -59,15 +59,20 @@ def bifurcation_figure(data: dict, title: str = ""):
     mult = np.asarray(data["floquet/real"]) + 1j * np.asarray(data["floquet/imag"])
     stable = np.max(np.abs(mult), axis=1) < 1
     onset = onset_value(data)
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True,
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9.5, 7), sharex=True,
                                    gridspec_kw={"height_ratios": [3, 2]})
     ss, yy = np.repeat(s, il.shape[1]), il.ravel()
     m = np.isfinite(yy)
-    ax1.plot(ss[m], yy[m], ".", ms=2.0, color="k", label="steady state (last heel strikes)")
+    # on top of the fixed-point line: a period-1 steady state sits on it and stays visible
+    ax1.plot(ss[m], yy[m], ".", ms=2.5, color="k", zorder=4,
+             label="steady state (last heel strikes)")
+    # markers on every fixed point: a single stable or unstable point (no neighbour to draw
+    # a line to) is drawn too
     ax1.plot(np.where(stable, s, np.nan), np.where(stable, fp_il, np.nan), "-", color="tab:blue",
-             lw=1.2, label="period-1 fixed point, stable")
+             lw=1.2, marker="o", ms=2.5, label="period-1 fixed point, stable")
     ax1.plot(np.where(~stable, s, np.nan), np.where(~stable, fp_il, np.nan), "--",
-             color="tab:blue", lw=1.0, label="period-1 fixed point, unstable")
+             color="tab:blue", lw=1.0, marker="o", ms=3, mfc="w",
+             label="period-1 fixed point, unstable")
     ax1.set_ylabel("inter-leg angle at heel strike [deg]")
     for k, ax in enumerate((ax1, ax2)):
         if np.isfinite(onset):  # named in the legend: a text label ran over the frame
@@ -80,7 +85,8 @@ def bifurcation_figure(data: dict, title: str = ""):
             ax.axvspan(falls - half, s.max() + half, color="0.85", hatch="//", ec="0.6", lw=0,
                        zorder=0, label=f"walker falls (no steady gait) from {at(falls, '.3g')}"
                        if k == 0 else None)
-    ax1.legend(fontsize=8, loc="upper left")
+    # legends outside the axes: they never cover data (issue 23)
+    ax1.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     if title:
         ax1.set_title(title)
     for k in range(mult.shape[1]):
@@ -90,7 +96,7 @@ def bifurcation_figure(data: dict, title: str = ""):
     ax2.axhline(1.0, color="0.6", lw=0.6)
     ax2.set_xlabel(xlabel)
     ax2.set_ylabel("Floquet multiplier [-]")
-    ax2.legend(fontsize=7, ncol=3, loc="lower left")
+    ax2.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     fig.tight_layout()
     return fig
 
@@ -203,24 +209,24 @@ def gait_map_figure(data: dict):
 
     Parameters
     ----------
-    data : dict
-        :func:`walkerlab.stages.stability_map.load` output: ``y_values`` (ny,),
-        ``slopes_deg`` (nx,), (ny, nx) arrays ``exists``, ``stable``, ``max_abs_multiplier``,
-        ``reason``, ``wall_time_s`` and ``attrs``.
+    data : walkerlab.io.schemas.stability_map.StabilityMap
+        A loaded map: ``y_values`` (ny,), ``slopes_deg`` (nx,), (ny, nx) cell arrays
+        ``exists``, ``stable``, ``max_abs_multiplier``, ``reason``, ``wall_time_s`` and
+        ``attrs``.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    yv, xv = np.asarray(data["y_values"], float), np.asarray(data["slopes_deg"], float)
-    ex = np.asarray(data["exists"], float) > 0.5
-    st = np.asarray(data["stable"], float) > 0.5
-    mm = np.asarray(data["max_abs_multiplier"], float)
-    reason = np.asarray(data["reason"], dtype=object)
+    yv, xv = np.asarray(data.y_values, float), np.asarray(data.slopes_deg, float)
+    ex = np.asarray(data.cells["exists"], float) > 0.5
+    st = np.asarray(data.cells["stable"], float) > 0.5
+    mm = np.asarray(data.cells["max_abs_multiplier"], float)
+    reason = np.asarray(data.cells["reason"], dtype=object)
     code = np.zeros(ex.shape)
     for (i, j), e in np.ndenumerate(ex):
         code[i, j] = (0 if st[i, j] else 1) if e else _REASON_CLASS.get(str(reason[i, j]), 6)
-    attrs = data.get("attrs", {})
+    attrs = data.attrs
     kind = str(attrs.get("kind", ""))
     unit_sys = str(attrs.get("unit_system", "mm-kg-s"))
     ylab = str(attrs.get("y_label", attrs.get("y_path", "y")))
@@ -253,7 +259,7 @@ def gait_map_figure(data: dict):
     a1.set_xlabel("slope φ [deg]")
     a1.set_ylabel(ylab + (" (log grid)" if log_y else ""), fontsize=8)
     n = ex.size
-    wall = np.asarray(data["wall_time_s"], float)
+    wall = np.asarray(data.cells["wall_time_s"], float)
     wall_txt = (f"; wall time per cell: median {np.nanmedian(wall):.3g} s, max "
                 f"{np.nanmax(wall):.3g} s" if np.isfinite(wall).any() else "")
     a1.set_title(f"contact gait: exists in {ex.sum()}/{n} cells ({100 * ex.sum() / n:.0f} %), "

@@ -1,7 +1,8 @@
-"""Assemble ``report.md`` and the self-contained ``report.html`` from existing artifacts.
+"""Assemble ``report.md`` and the self-contained ``report.html`` from loaded artifacts.
 
-:func:`write_report` is all the report stage calls after it has run what the scene needs:
-it reads artifacts only (given as ``{stage: Path}``), never runs a stage.
+:func:`write_report` is all the report stage calls after it has run what the scene needs
+and loaded its artifacts (:class:`ReportInputs`): it opens no artifact, draws no figure
+and computes no result; it never runs a stage.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import datetime as _dt
 import json
 import platform
 from collections.abc import Iterable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +22,33 @@ from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections
 from walkerlab.report.markdown import details, num, table, text, to_html
 from walkerlab.units import for_scene as units_for_scene
+
+
+@dataclass
+class ReportInputs:
+    """What the report shows: loaded artifacts and the numbers computed from them.
+
+    Attributes
+    ----------
+    artifacts : dict[str, object]
+        Loaded artifacts (:mod:`walkerlab.io.schemas`) by stage name: ``fixedpoint``,
+        ``simulate``, ``contact-sim``, ``compare``, ``workprecision``, ``basin``,
+        ``bifurcation`` and ``bifurcation_<field>``, ``stability_map_<kind>``; an absent
+        stage gives no section.
+    gait_columns : dict[str, dict[str, float]]
+        Table 3 columns (:func:`walkerlab.analysis.tables.table3`) by label ("ours, ideal",
+        "ours, contact").
+    energy_drift : (float, float)
+        Largest energy change within a phase of the rigid run [J] and relative [-]
+        (:func:`walkerlab.analysis.gait_checks.energy_drift_in_swing`).
+    swing_clearance : float
+        Lowest swing-foot height above the slope [m] (NaN: none).
+    """
+
+    artifacts: dict
+    gait_columns: dict = field(default_factory=dict)
+    energy_drift: tuple = (float("nan"), float("nan"))
+    swing_clearance: float = float("nan")
 
 
 def _header(scene) -> list[str]:
@@ -37,17 +66,15 @@ def _header(scene) -> list[str]:
             f"rtol {scene.solver.rtol:g} atol {scene.solver.atol:g}", ""]
 
 
-def write_report(scene, paths: dict[str, Path], report_dir: Path, figures_dir: Path,
+def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Path,
                  done: Iterable = ()) -> Path:
     """Write ``report.md`` and ``report.html`` into ``report_dir``.
 
     Parameters
     ----------
     scene : Scene
-    paths : dict[str, Path]
-        Artifacts that exist, by stage name (``fixedpoint``, ``simulate``, ``contact-sim``,
-        ``compare``, ``workprecision``, ``bifurcation``, ``basin``); absent stages give no
-        section.
+    inputs : ReportInputs
+        The loaded artifacts and the numbers computed from them.
     report_dir, figures_dir : Path
         Output folder and the folder of the figures (PNG) to embed.
     done : iterable of StageOutcome-like objects
@@ -67,23 +94,24 @@ def write_report(scene, paths: dict[str, Path], report_dir: Path, figures_dir: P
     report_dir.mkdir(parents=True, exist_ok=True)
     pub = for_scene(scene)
     md = _header(scene)
-    md += sections.summary_section(scene, paths, pub)
+    arts = inputs.artifacts
+    md += sections.summary_section(scene, inputs, pub)
     done = list(done)
     if done:
         md += details("What ran (stages, artifacts, compute time)",
                       table(["stage", "artifact", "status", "compute [s]"],
                             [[o.stage, f"`{o.path}`", "reused" if o.reused else "computed",
                               num(float(o.wall_time_s), 3)] for o in done]))
-    if "fixedpoint" in paths:
-        md += sections.fixedpoint_section(paths["fixedpoint"], pub)
-    md += sections.gait_section(scene, paths, pub)
-    md += contact_sections.sections(scene, paths)
-    md += sections.workprecision_summary(scene, paths)
-    md += sections.bifurcation_section(paths, pub)
-    md += sections.basin_section(paths)
+    if "fixedpoint" in arts:
+        md += sections.fixedpoint_section(arts["fixedpoint"], pub)
+    md += sections.gait_section(scene, inputs, pub)
+    md += contact_sections.sections(scene, arts)
+    md += sections.workprecision_summary(scene, arts)
+    md += sections.bifurcation_section(arts, pub)
+    md += sections.basin_section(arts)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
-    md += sections.figures_section(Path(figures_dir), str(rel), paths)
+    md += sections.figures_section(Path(figures_dir), str(rel), arts)
     md += ["## Scene", ""]
     md += details("Resolved scene (JSON)", "\n".join(
         ["```json", json.dumps(scene.model_dump(mode="json", exclude_none=True), indent=1),

@@ -1,14 +1,14 @@
-"""Report sections of the contact model (contact-sim, compare), from artifacts only.
+"""Report sections of the contact model (contact-sim, compare), from loaded artifacts only.
 
-Each function returns Markdown, or an empty list when its artifact does not exist, so a
-scene gets only the sections it produces.
+Each function takes the scene and the loaded artifacts by stage name (``contact-sim``,
+``simulate``, ``compare``, ``stability_map_<kind>``) and returns Markdown, or an empty list
+when its artifact does not exist, so a scene gets only the sections it produces.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact
 from walkerlab.published import for_scene
 from walkerlab.report.markdown import num, printed
 from walkerlab.report.markdown import table as _table
@@ -28,53 +28,33 @@ def _table2_note(pub) -> str:
                            for (_s, pm, pa), g in zip(rates, got)) + ".")
 
 
-def contact_section(scene, paths) -> list[str]:
-    p = paths.get("contact-sim")
-    if p is None:
+def contact_section(scene, arts) -> list[str]:
+    c = arts.get("contact-sim")
+    if c is None:
         return []
     pub = for_scene(scene)
     table2 = getattr(pub, "TABLE2", {})
-    with open_artifact(p, "contact-sim") as f:
-        scale = f["initial_rate_scale"][()]
-        scaled = ([str(v) for v in f["rate"][()].astype(str)] if "rate" in f
-                  else ["leg1", "leg2"])
-        summ = {k: (f["summary"][k][()], str(f["summary"][k].attrs.get("unit", "")))
-                for k in f["summary"]}
-        stage_wall = float(f.attrs.get("wall_time_s", np.nan))
-        cp = {k: (f["contact_params_si"][k][()], f["contact_params_si"][k].attrs["unit"])
-              for k in f["contact_params_si"]}
-        term = str(f.attrs["termination"])
-        outcome = (str(f.attrs.get("outcome", term)), str(f.attrs.get("outcome_message", "")))
-        slips = f["steps/stance_slip_mm"][()]
-        creep = f["steps/double_support_creep_mm"][()] if "steps/double_support_creep_mm" in f \
-            else None
-        drop = None
-        if "drop_test" in f:
-            g = f["drop_test"]
-            drop = (g["stiffness"][()], str(g["stiffness"].attrs["unit"]),
-                    {fam: g[f"{fam}/restitution"][()] for fam in ("paper", "rigid_limit")},
-                    str(f.attrs.get("stiffness_family", "paper")),
-                    float(g.attrs.get("mass_kg", 20.0)))
-        periods = f["steps/period"][()]
-        adj = {k: f["adjust"][k][()] for k in f["adjust"]} if "adjust" in f else None
-        per = per_fail = None
-        if "periodic_gait" in f and "step_period" not in f["periodic_gait"]:
-            per_fail = (str(f["periodic_gait"].attrs.get("outcome", "?")),
-                        str(f["periodic_gait"].attrs.get("message", "")))
-        elif "periodic_gait" in f:
-            g = f["periodic_gait"]
-            per = (float(g["step_period"][()]), float(g["step_length"][()]),
-                   g["multipliers/real"][()] + 1j * g["multipliers/imag"][()],
-                   bool(g["stable"][()]))
+    scale = c.initial_rate_scale
+    scaled = c.rate_names or ["leg1", "leg2"]
+    summ, stage_wall, cp = c.summary, c.stage_wall_time_s, c.contact_params_si
+    term = c.termination
+    outcome = (c.outcome, c.outcome_message)
+    slips = c.steps["stance_slip_mm"]
+    creep = c.steps.get("double_support_creep_mm")
+    drop = c.drop
+    periods = c.steps["period"]
+    adj = c.adjust
+    per = per_fail = None
+    if c.periodic is not None and not c.periodic.found:
+        per_fail = (c.periodic.outcome, c.periodic.message)
+    elif c.periodic is not None:
+        g = c.periodic
+        per = (g.step_period_s, g.step_length_m, g.multipliers, g.stable)
     # initial states by name: the first sample of each trajectory artifact
-    with open_artifact(p, "contact-sim") as f:
-        c0 = {str(n): float(f[f"samples/coordinates/{n}"][0])
-              for n in f["samples"].attrs["coordinates"]}
+    c0 = {n: float(v[0]) for n, v in c.samples.coordinates.items()}
     i0 = {}
-    if "simulate" in paths:
-        with open_artifact(paths["simulate"], "simulate") as f:
-            i0 = {str(n): float(f[f"samples/coordinates/{n}"][0])
-                  for n in f["samples"].attrs["coordinates"]}
+    if "simulate" in arts:
+        i0 = {n: float(v[0]) for n, v in arts["simulate"].samples.coordinates.items()}
     rows = []
     for key in [k for k in table2 if k in c0] + [k for k in c0 if k not in table2]:
         sym, pm, pa = table2.get(key, (key, np.nan, np.nan))
@@ -113,8 +93,8 @@ def contact_section(scene, paths) -> list[str]:
         out += [f"**Periodic gait of the contact model**: not found ({per_fail[0]}: "
                 f"{per_fail[1]}).", ""]
     if drop is not None:
-        out += _drop_lines(scene, p, *drop)
-    out += _map_lines(p)
+        out += _drop_lines(scene, drop, c.stiffness_family)
+    out += _map_lines(arts)
     if per is not None:
         out += [f"**Periodic gait of the contact model** (fixed point of its step-to-step map, "
                 f"mid-stance section): step period {num(per[0], 6)} s, step length "
@@ -142,18 +122,10 @@ def _summary_rows(summ: dict, stage_wall_s: float) -> list[list]:
     return rows
 
 
-def _drop_lines(scene, artifact, ks, unit, curves, family, mass_kg=20.0) -> list[str]:
-    """Restitution-vs-stiffness figure (drop test stored in contact_sim.h5) and its text."""
-    figdir = artifact.parent / "report" / "figures"
-    png = figdir / "drop_restitution.png"
-    # drawn from the artifact; redrawn only when the artifact is newer than the figure
-    if not png.is_file() or png.stat().st_mtime_ns < artifact.stat().st_mtime_ns:
-        from walkerlab.plotting.figures import save
-        from walkerlab.plotting.sweep_figures import restitution_figure
-
-        fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness),
-                                 mass_kg=mass_kg, units=units_for(scene))
-        save(fig, figdir, "drop_restitution")
+def _drop_lines(scene, drop, family: str) -> list[str]:
+    """Text and table of the drop test stored in contact_sim.h5 (its restitution-vs-stiffness
+    figure, ``figures/drop_restitution.png``, is drawn by the plot stage)."""
+    ks, unit, curves, mass_kg = drop.stiffness, drop.unit, drop.restitution, drop.mass_kg
     rows = [[float(k), float(curves["paper"][i]), float(curves["rigid_limit"][i])]
             for i, k in enumerate(ks)]
     u = units_for(scene)
@@ -172,21 +144,18 @@ def _drop_lines(scene, artifact, ks, unit, curves, family, mass_kg=20.0) -> list
                     "restitution, rigid-limit family"], rows), "", "</details>", ""]
 
 
-def _map_lines(artifact) -> list[str]:
-    """Stability maps of the contact gait, where their artifacts exist next to ``artifact``."""
+def _map_lines(arts) -> list[str]:
+    """Stability maps of the contact gait (``arts["stability_map_<kind>"]``: loaded maps whose
+    figure exists)."""
     out = []
-    figdir = artifact.parent / "report" / "figures"
     for kind in ("stiffness", "friction", "patch_width"):
-        p = artifact.parent / f"stability_map_{kind}.h5"
-        if not p.is_file():
+        m = arts.get(f"stability_map_{kind}")
+        if m is None:
             continue
-        png = figdir / f"{p.stem}.png"  # the stage draws it there from the artifact
-        if not png.is_file():
-            continue
-        with open_artifact(p) as f:
-            ex = float(f["summary/exists_fraction"][()])
-            stab = float(f["summary/stable_fraction"][()])
-            n = int(f["summary/cells"][()])
+        png_name = f"stability_map_{kind}.png"  # the stage draws it from the artifact
+        ex = float(m.summary["exists_fraction"])
+        stab = float(m.summary["stable_fraction"])
+        n = int(m.summary["cells"])
         cap = (f"Stability map of the contact gait over {kind.replace('_', ' ')} × slope "
                f"({n} cells): a periodic gait exists in {100 * ex:.0f} % of the cells and is "
                f"stable in {100 * stab:.0f} %.")
@@ -196,23 +165,19 @@ def _map_lines(artifact) -> list[str]:
                     "mid-stance step map) continued from its neighbour along the slope, else "
                     "from the ideal fixed point at that slope; cell text: max |Floquet "
                     "multiplier|, or why no gait was found (`walkerlab stability-map`).", ""]
-        out += [f"![{cap}](figures/{png.name})", "", f"*{cap}*", ""]
+        out += [f"![{cap}](figures/{png_name})", "", f"*{cap}*", ""]
     return out
 
 
-def compare_section(scene, paths) -> list[str]:
-    p = paths.get("compare")
-    if p is None:
+def compare_section(scene, arts) -> list[str]:
+    c = arts.get("compare")
+    if c is None:
         return []
-    with open_artifact(p, "compare") as f:
-        g = f["errors"]
-        names = [str(x) for x in g.attrs["coordinates"]]
-        stems = list(g["limit_cycle_distance"])
-        rows = [[s, float(np.max(np.abs(g[f"coordinates/{s}_angle"][()]))),
-                 float(np.max(np.abs(g[f"coordinates/{s}_rate"][()]))),
-                 float(g[f"limit_cycle_distance/{s}"][()])] for s in stems
-                if f"{s}_angle" in names and f"{s}_rate" in names]
-        t_end = float(g["time"][-1])
+    rows = [[s, float(np.max(np.abs(c.errors[f"{s}_angle"]))),
+             float(np.max(np.abs(c.errors[f"{s}_rate"]))), float(d)]
+            for s, d in c.limit_cycle_distance.items()
+            if f"{s}_angle" in c.errors and f"{s}_rate" in c.errors]
+    t_end = float(c.time[-1])
     return ["## Comparison ideal vs contact (Fig. 8)", "",
             f"Errors contact − ideal over the common span 0–{t_end:.2f} s:", "",
             _table(["leg", "max abs angle error [rad]", "max abs rate error [rad/s]",
@@ -223,11 +188,11 @@ def compare_section(scene, paths) -> list[str]:
             "drift apart in phase; the limit cycles themselves stay close (last column).", ""]
 
 
-def sections(scene, paths) -> list[str]:
-    """All contact sections, in report order (``paths``: ``{stage: Path}`` that exist)."""
+def sections(scene, arts) -> list[str]:
+    """All contact sections, in report order (``arts``: loaded artifacts by stage name)."""
     out: list[str] = []
     for fn in _SECTION_FUNCS:
-        out += fn(scene, paths)
+        out += fn(scene, arts)
     return out
 
 

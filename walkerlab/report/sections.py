@@ -1,9 +1,11 @@
-"""Report sections of the rigid walker (summary, fixed point, gait table, figures), from artifacts.
+"""Report sections of the rigid walker (summary, fixed point, gait table, figures), from
+loaded artifacts.
 
-Every function takes the scene, the artifact paths that exist (``{stage: Path}``) and the
-published-number module of the scene (or None) and returns Markdown lines; a section whose
-artifact is absent returns ``[]``, so a scene gets only what it produces.  Published values
-come from :mod:`walkerlab.published`, never from literals here.
+Every function takes the scene, the report's inputs (:class:`walkerlab.report.build.
+ReportInputs`: the loaded artifacts by stage name and the numbers computed from them) and
+the published-number module of the scene (or None) and returns Markdown lines; a section
+whose artifact is absent returns ``[]``, so a scene gets only what it produces.  Published
+values come from :mod:`walkerlab.published`, never from literals here.
 """
 
 from __future__ import annotations
@@ -13,82 +15,15 @@ from types import ModuleType
 
 import numpy as np
 
-from walkerlab.analysis.tables import TABLE3_ROWS, table3
-from walkerlab.io.artifacts import open_artifact
-from walkerlab.io.readers import load_fixed_point
+from walkerlab.analysis.tables import TABLE3_ROWS
+from walkerlab.io.schemas.simulate import SimulateArtifact
+from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 from walkerlab.report.markdown import details, num, printed, sig_digits, table
 from walkerlab.report.text import workprecision_choice, zero_multipliers_text
-from walkerlab.units import Units, for_artifact, for_scene
+from walkerlab.units import Units, for_scene
 
 
 # --------------------------------------------------------------------------- data
-def energy_drift_in_swing(path: Path) -> tuple[float, float]:
-    """Largest change of the total energy within a continuous phase [J] and relative [-].
-
-    Read from ``simulate.h5``: a passive rigid walker conserves energy between impacts
-    (heel strike, knee strike), so this measures the integration error.
-    """
-    with open_artifact(path, "simulate") as f:
-        g = f["samples"]
-        tot, step = g["energy/total"][()], g["step_index"][()]
-        phase = g["phase"][()] if "phase" in g else np.zeros_like(step)
-    key = step.astype(np.int64) * 1000 + phase
-    drift = max(float(np.ptp(tot[key == k])) for k in np.unique(key))
-    return drift, drift / float(np.max(np.abs(tot)))
-
-
-def swing_foot_clearance(path: Path, slope_rad: float, margin: float = 0.1) -> float:
-    """Lowest height [m] of the swing foot above the slope inside the steps of ``simulate.h5``.
-
-    Heights are normal to the slope through the first stance foot; the first and last
-    ``margin`` of each step (lift-off, heel strike, where the height is ~0) are left out.
-    A negative value means the foot passes through the ground (scuffing, which the rigid
-    model ignores).  Round feet use the ``<leg>_contact`` point when the walker has one.
-    """
-    from walkerlab.io.trajectory import read_samples
-
-    with open_artifact(path, "simulate") as f:
-        tr = read_samples(f)
-    lowest = np.inf
-    for k in np.unique(tr.step_index):
-        m = tr.step_index == k
-        t = tr.time[m]
-        inner = (t > t[0] + margin * (t[-1] - t[0])) & (t < t[-1] - margin * (t[-1] - t[0]))
-        swing = tr.legs[1 - int(tr.stance_leg[m][0])] if len(tr.legs) == 2 else None
-        if swing is None or not inner.any():
-            continue
-        foot = tr.points.get(f"{swing}_contact", tr.points.get(f"{swing}_foot"))
-        if foot is None:
-            continue
-        xy = foot[:, m][:, inner]
-        h = xy[1] * np.cos(slope_rad) + xy[0] * np.sin(slope_rad)
-        lowest = min(lowest, float(np.min(h)))
-    return lowest
-
-
-def _contact_summary(path: Path) -> dict:
-    with open_artifact(path, "contact-sim") as f:
-        out = {"termination": str(f.attrs["termination"]),
-               "outcome": str(f.attrs.get("outcome", f.attrs["termination"])),
-               "heel_strikes": int(len(f["events/heel_strike_times"][()])) if
-               "events/heel_strike_times" in f else 0}
-        if "periodic_gait" in f:
-            out["periodic_stable"] = bool(f["periodic_gait/stable"][()])
-    return out
-
-
-def _gait_columns(paths: dict[str, Path]) -> dict[str, dict]:
-    sim = paths.get("simulate")
-    if sim is None:
-        return {}
-    with open_artifact(sim, "simulate") as f:
-        mass, g = float(f.attrs["total_mass_kg"]), float(f.attrs["gravity_m_per_s2"])
-    src = {"ours, ideal": ("simulate", sim)}
-    if "contact-sim" in paths:
-        src["ours, contact"] = ("contact-sim", paths["contact-sim"])
-    return table3(src, mass, g)
-
-
 def published_fixed_point(pub: ModuleType | None) -> tuple[tuple, tuple]:
     """``(state names, values)`` of a published fixed point (``FIXED_POINT_NAMES/STATE``,
     or the ``EQ11_NAMES/STATE`` spelling), empty when the source prints none."""
@@ -109,58 +44,56 @@ def clearance_text(lowest: float, u: Units) -> str:
             "(penetration): foot scuffing, which the rigid model ignores")
 
 
-def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[str]:
+def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     """Short verdicts and headline numbers, with the published values where they exist."""
+    arts = inputs.artifacts
     out = ["## Summary", ""]
     u = for_scene(scene)
     bullets = []
     rows = []
     pub_name = f"published ({pub.SHORT})" if pub is not None else None
-    fp = paths.get("fixedpoint")
+    fp = arts.get("fixedpoint")
     if fp is not None:
-        x, meta = load_fixed_point(fp)
         bullets.append(f"- **Gait found**: yes, period-1 fixed point (residual "
-                       f"{num(meta['residual'], 2)}), step period "
-                       f"{num(meta['step_period_s'])} {u.time}.")
-        bullets.append(f"- **Stable**: {'yes' if meta['stable'] else 'no'} (largest "
-                       f"|Floquet multiplier| {num(meta['max_abs_multiplier'])}).")
+                       f"{num(fp.residual, 2)}), step period "
+                       f"{num(fp.step_period_s)} {u.time}.")
+        bullets.append(f"- **Stable**: {'yes' if fp.stable else 'no'} (largest "
+                       f"|Floquet multiplier| {num(fp.max_abs_multiplier())}).")
         eq = dict(zip(*published_fixed_point(pub)))
-        for n, v, un in zip(meta["state_names"], x, meta["state_units"]):
+        for n, v, un in zip(fp.state_names, fp.x, fp.state_units):
             # as many digits as the published value has, so the two can be compared digit by digit
             dig = max(4, sig_digits(printed(eq[n]))) if n in eq else 4
             rows.append([f"fixed point {n}", un, num(v, dig),
                          printed(eq[n]) if n in eq else "—"])
-        rows.append(["step period", u.time, num(meta["step_period_s"]), "—"])
-        rows.append(["max abs(multiplier)", "-", num(meta["max_abs_multiplier"]), "—"])
-    elif "fixedpoint" not in paths and scene.fixedpoint is not None:
+        rows.append(["step period", u.time, num(fp.step_period_s), "—"])
+        rows.append(["max abs(multiplier)", "-", num(fp.max_abs_multiplier()), "—"])
+    elif "fixedpoint" not in arts and scene.fixedpoint is not None:
         bullets.append("- **Gait found**: no fixed point artifact.")
-    sim = paths.get("simulate")
+    sim = arts.get("simulate")
     if sim is not None:
-        drift, rel = energy_drift_in_swing(sim)
-        with open_artifact(sim, "simulate") as f:
-            term = str(f.attrs["termination"])
-            n_hs = int(np.sum(f["steps/termination"].asstr()[()] == "heel_strike"))
+        drift, rel = inputs.energy_drift
+        term, n_hs = sim.termination, sim.heel_strike_count()
         bullets.append(f"- **Rigid walker walks**: {'yes' if term == 'heel_strike' else 'no'} "
                        f"({n_hs} heel strikes, ended by {term}); energy drift between impacts "
                        f"{num(drift, 2)} {u.energy} ({num(rel, 2)} relative).")
         rows.append(["energy drift between impacts", u.energy, num(drift, 2), "—"])
-        clear = swing_foot_clearance(sim, scene.slope.phi_rad)
+        clear = inputs.swing_clearance
         if np.isfinite(clear):
             bullets.append("- **Swing-foot clearance**: " + clearance_text(clear, u) + ".")
             rows.append(["lowest swing-foot clearance (negative: penetration)", u.small_length,
                          num(u.small_scale * clear, 3), "—"])
-    if "contact-sim" in paths:
-        c = _contact_summary(paths["contact-sim"])
+    c = arts.get("contact-sim")
+    if c is not None:
         from walkerlab.integrate.ends import CONTACT_WALKED
 
-        walks = c["outcome"] in CONTACT_WALKED
+        walks = c.outcome in CONTACT_WALKED
         extra = ""
-        if "periodic_stable" in c:
-            extra = ("; its own periodic gait is " + ("stable" if c["periodic_stable"]
+        if c.periodic is not None and c.periodic.found:
+            extra = ("; its own periodic gait is " + ("stable" if c.periodic.stable
                                                       else "unstable"))
         bullets.append(f"- **Contact walker walks**: {'yes' if walks else 'no'} "
-                       f"({c['heel_strikes']} heel strikes, outcome {c['outcome']}){extra}.")
-    cols = _gait_columns(paths)
+                       f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}){extra}.")
+    cols = inputs.gait_columns
     ideal = cols.get("ours, ideal")
     if ideal:
         t3 = getattr(pub, "TABLE3", {})
@@ -190,77 +123,73 @@ def summary_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> li
 
 
 # --------------------------------------------------------------------------- fixed point
-def fixedpoint_section(path: Path, pub: ModuleType | None) -> list[str]:
-    """Fixed point of every equation variant, Floquet multipliers, verdict."""
+def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
+    """Fixed point of every equation variant, Floquet multipliers, verdict (``fp``: the loaded
+    ``fixedpoint.h5``)."""
     pub_fp = dict(zip(*published_fixed_point(pub)))
     out = ["## Fixed point of the Poincaré map", ""]
-    with open_artifact(path, "fixedpoint") as f:
-        names = [str(n) for n in f.attrs["state_names"]]
-        units = [str(f[f"fixed_point/{n}"].attrs["unit"]) for n in names]
-        main = str(f.attrs["variant"])
-        # the published state in this walker's state order (None if it does not name them all)
-        eq = np.array([pub_fp[n] for n in names], float) if pub_fp and set(names) <= set(
-            pub_fp) else None
-        rows = []
-        if eq is not None:
-            label = getattr(pub, "FIXED_POINT_LABEL", "published")
-            rows.append([f"{pub.SHORT}: {label}", *[printed(v) for v in eq], "—", "—", "—"])
-        fps = {}
-        for v in f["variants"]:
-            g = f["variants"][v]
-            if "error" in g.attrs:
-                rows.append([v, *(["—"] * len(names)), "—", "—", g.attrs["error"]])
-                continue
-            x = np.array([g[f"fixed_point/{n}"][()] for n in names])
-            fps[v] = x
-            re, im = g["floquet/variational/real"][()], g["floquet/variational/imag"][()]
-            rows.append([f"walkerlab `{v}`" + (" (this scene)" if v == main else ""),
-                         *[num(a) for a in x], num(float(g["step_period"][()])),
-                         num(float(np.max(np.hypot(re, im)))), num(g["residual"][()], 2)])
-        out.append(table(["model", *[f"{n} [{u}]" for n, u in zip(names, units)],
-                          f"step period [{for_artifact(f).time}]", "max abs(multiplier)",
-                          "residual"], rows))
+    names, units, main = fp.state_names, fp.state_units, fp.variant
+    # the published state in this walker's state order (None if it does not name them all)
+    eq = np.array([pub_fp[n] for n in names], float) if pub_fp and set(names) <= set(
+        pub_fp) else None
+    rows = []
+    if eq is not None:
+        label = getattr(pub, "FIXED_POINT_LABEL", "published")
+        rows.append([f"{pub.SHORT}: {label}", *[printed(v) for v in eq], "—", "—", "—"])
+    fps = {}
+    for v, g in fp.variants.items():
+        if g.error:
+            rows.append([v, *(["—"] * len(names)), "—", "—", g.error])
+            continue
+        fps[v] = g.x
+        re, im = g.multipliers.real, g.multipliers.imag
+        rows.append([f"walkerlab `{v}`" + (" (this scene)" if v == main else ""),
+                     *[num(a) for a in g.x], num(float(g.step_period_s)),
+                     num(float(np.max(np.hypot(re, im)))), num(g.residual, 2)])
+    out.append(table(["model", *[f"{n} [{u}]" for n, u in zip(names, units)],
+                      f"step period [{fp.units.time}]", "max abs(multiplier)",
+                      "residual"], rows))
+    out.append("")
+    out.append("State right after heel strike, role-ordered (the swing leg is the one that "
+               "just left the ground).")
+    if eq is not None and getattr(pub, "FIXED_POINT_NOTE", None):
+        out += ["", f"**Why the numbers differ.** {pub.FIXED_POINT_NOTE}"]
+    if eq is not None and "appendix_a" in fps and "derived" in fps:
+        d = fps["derived"] - eq
+        a = fps["appendix_a"] - eq
+        ang = np.array([u == "rad" for u in units])
+        i_sr = names.index("stance_rate")
+        fmt = ", ".join
         out.append("")
-        out.append("State right after heel strike, role-ordered (the swing leg is the one that "
-                   "just left the ground).")
-        if eq is not None and getattr(pub, "FIXED_POINT_NOTE", None):
-            out += ["", f"**Why the numbers differ.** {pub.FIXED_POINT_NOTE}"]
-        if eq is not None and "appendix_a" in fps and "derived" in fps:
-            d = fps["derived"] - eq
-            a = fps["appendix_a"] - eq
-            ang = np.array([u == "rad" for u in units])
-            i_sr = names.index("stance_rate")
-            fmt = ", ".join
-            out.append("")
-            out.append(
-                "**Why the numbers differ.** The printed Appendix A (variant `appendix_a`) "
-                "reproduces Eq. (11): its deviation from the printed digits is "
-                f"[{fmt(num(v, 2) for v in a)}] (the stance rate {num(fps['appendix_a'][i_sr])} "
-                f"is printed as {eq[i_sr]:.2f}, i.e. truncated, not rounded). Its Coriolis matrix "
-                "(A.5) has the wrong sign in C[1,0] (+m L b θ̇1 sin(θ2−θ1) instead of −), so "
-                "energy is not conserved in swing. The energy-consistent derived model "
-                "(`derived`, the default) gives a different gait: deviation from Eq. (11) "
-                f"[{fmt(num(v, 2) for v in d)}], i.e. up to {num(np.max(np.abs(d[ang])), 2)} rad "
-                f"in the angles and {num(np.max(np.abs(d[~ang])), 2)} rad/s in the rates. Taking "
-                "the printed y-component of A.55 literally (`appendix_a_literal`) does not "
-                "reproduce Eq. (11) at all, so that sign is a typesetting error only.")
-        re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
-        re2, im2 = f["floquet/finite_difference/real"][()], f["floquet/finite_difference/imag"][()]
-        out += ["", f"### Floquet multipliers (`{main}`)", "",
-                table(["#", "variational equations", "finite differences", "abs value"],
-                      [[i + 1, f"{a:+.6f}{b:+.6f}j", f"{c:+.6f}{d:+.6f}j",
-                        num(float(np.hypot(a, b)))]
-                       for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
-                "", f"Max difference between the two: {num(f['floquet/max_difference'][()], 2)}. "
-                f"Verdict: **{'stable' if f['floquet/stable'][()] else 'unstable'}** "
-                f"({zero_multipliers_text(re, im)}).", ""]
+        out.append(
+            "**Why the numbers differ.** The printed Appendix A (variant `appendix_a`) "
+            "reproduces Eq. (11): its deviation from the printed digits is "
+            f"[{fmt(num(v, 2) for v in a)}] (the stance rate {num(fps['appendix_a'][i_sr])} "
+            f"is printed as {eq[i_sr]:.2f}, i.e. truncated, not rounded). Its Coriolis matrix "
+            "(A.5) has the wrong sign in C[1,0] (+m L b θ̇1 sin(θ2−θ1) instead of −), so "
+            "energy is not conserved in swing. The energy-consistent derived model "
+            "(`derived`, the default) gives a different gait: deviation from Eq. (11) "
+            f"[{fmt(num(v, 2) for v in d)}], i.e. up to {num(np.max(np.abs(d[ang])), 2)} rad "
+            f"in the angles and {num(np.max(np.abs(d[~ang])), 2)} rad/s in the rates. Taking "
+            "the printed y-component of A.55 literally (`appendix_a_literal`) does not "
+            "reproduce Eq. (11) at all, so that sign is a typesetting error only.")
+    re, im = fp.multipliers.real, fp.multipliers.imag
+    re2, im2 = fp.multipliers_fd.real, fp.multipliers_fd.imag
+    out += ["", f"### Floquet multipliers (`{main}`)", "",
+            table(["#", "variational equations", "finite differences", "abs value"],
+                  [[i + 1, f"{a:+.6f}{b:+.6f}j", f"{c:+.6f}{d:+.6f}j",
+                    num(float(np.hypot(a, b)))]
+                   for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
+            "", f"Max difference between the two: {num(fp.max_difference, 2)}. "
+            f"Verdict: **{'stable' if fp.stable else 'unstable'}** "
+            f"({zero_multipliers_text(re, im)}).", ""]
     return out
 
 
 # --------------------------------------------------------------------------- gait table
-def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[str]:
+def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     """Gait characteristics (paper Table 3 rows), ours beside the published ones."""
-    cols = _gait_columns(paths)
+    cols, arts = inputs.gait_columns, inputs.artifacts
     if not cols:
         return []
     u = for_scene(scene)
@@ -279,9 +208,15 @@ def gait_section(scene, paths: dict[str, Path], pub: ModuleType | None) -> list[
     step_pub = getattr(pub, "STEP_LENGTH_M", None)
     rows.append(["Step length", "Δx", u.length, *([printed(step_pub)] * 2 if t3 else []),
                  *(num(c["step_length_m"]) for c in cols.values())])
+    per_leg = [(c.get("step_length_left_m", np.nan), c.get("step_length_right_m", np.nan))
+               for c in cols.values()]
+    if any(abs(a - b) > 1e-4 for a, b in per_leg):  # legs that differ: each leg's step
+        for i, side in enumerate(("Left", "Right")):
+            rows.append([f"{side} step length", f"Δx_{side[0].lower()}", u.length, *blank,
+                         *(num(v[i]) for v in per_leg)])
     title = "## Table 3 — gait characteristics" if t3 else "## Gait characteristics"
     out = [title, "", "Recomputed from the trajectory artifacts ("
-           + ", ".join(f"`{paths[s].name}`" for s in ("simulate", "contact-sim") if s in paths)
+           + ", ".join(f"`{arts[s].path.name}`" for s in ("simulate", "contact-sim") if s in arts)
            + ").", "", table(header, rows)]
     ideal = cols.get("ours, ideal")
     eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
@@ -332,38 +267,33 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
 ]
 
 
-def steps_table(path: Path) -> str:
+def steps_table(sim: SimulateArtifact) -> str:
     """Per-step table of ``simulate.h5`` (period, step length, hip speed, impact loss)."""
-    with open_artifact(path, "simulate") as f:
-        u = for_artifact(f)
-        s = f["steps"]
-        cols = ("period", "step_length", "hip_speed", "impact_energy_loss")
-        rows = [[int(i), str(leg), *[num(s[c][k]) for c in cols], str(term)]
-                for k, (i, leg, term) in enumerate(zip(s["step"][()], s["stance_leg"].asstr()[()],
-                                                       s["termination"].asstr()[()]))]
+    u, s = sim.units, sim.steps
+    cols = ("period", "step_length", "hip_speed", "impact_energy_loss")
+    rows = [[int(i), str(leg), *[num(s[c][k]) for c in cols], str(term)]
+            for k, (i, leg, term) in enumerate(zip(s["step"], s["stance_leg"],
+                                                   s["termination"]))]
     return table(["step", "stance leg", f"period [{u.time}]", f"step length [{u.length}]",
                   f"hip speed [{u.speed}]", f"impact loss [{u.energy}]", "ended by"], rows)
 
 
-def workprecision_table(path: Path, model: str) -> str:
+def workprecision_table(wp: WorkPrecisionArtifact, model: str) -> str:
     """Every (method, rtol) point of one model of ``workprecision.h5``."""
     rows = []
-    with open_artifact(path, "workprecision") as f:
-        g = f[model]
-        for m in g:
-            d = g[m]
-            lo = d["time_min"][()] if "time_min" in d else d["time"][()]
-            hi = d["time_max"][()] if "time_max" in d else d["time"][()]
-            reps = d["repeats"][()] if "repeats" in d else np.ones(len(lo), int)
-            for rt, t, a, b, k, e, n in zip(d["rtol"][()], d["time"][()], lo, hi, reps,
-                                            d["error"][()], d["nfev"][()]):
-                rows.append([m, num(rt, 1), num(t * 1e3, 3), f"{num(a * 1e3, 3)}–"
-                             f"{num(b * 1e3, 3)}", int(k), num(e, 2), int(n)])
+    for m, d in wp.models[model].rows.items():
+        lo = d.get("time_min", d["time"])
+        hi = d.get("time_max", d["time"])
+        reps = d["repeats"] if "repeats" in d else np.ones(len(lo), int)
+        for rt, t, a, b, k, e, n in zip(d["rtol"], d["time"], lo, hi, reps, d["error"],
+                                        d["nfev"]):
+            rows.append([m, num(rt, 1), num(t * 1e3, 3), f"{num(a * 1e3, 3)}–"
+                         f"{num(b * 1e3, 3)}", int(k), num(e, 2), int(n)])
     return table(["method", "rtol", "median wall [ms]", "min–max wall [ms]", "runs",
                   "error vs reference", "RHS evals"], rows)
 
 
-def _drawn_from(stem: str, paths: dict[str, Path]) -> bool:
+def _drawn_from(stem: str, arts: dict) -> bool:
     """Whether a figure's artifacts are among the report's (a figure an earlier ``walkerlab
     plot`` drew from an artifact the report leaves out is not shown)."""
     for prefix, stages in (("fig2_", ("simulate",)), ("fig6_", ("contact-sim",)),
@@ -371,12 +301,13 @@ def _drawn_from(stem: str, paths: dict[str, Path]) -> bool:
                            ("work_precision", ("workprecision",)),
                            ("bifurcation", ("bifurcation",)), ("basin", ("basin",))):
         if stem.startswith(prefix):
-            return any(s in paths for s in stages)
+            return any(s in arts for s in stages)
     return True
 
 
-def figures_section(fig_dir: Path, rel: str, paths: dict[str, Path]) -> list[str]:
-    """Every figure that exists, with its raw data folded underneath where it is long."""
+def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
+    """Every figure that exists, with its raw data folded underneath where it is long
+    (``arts``: the loaded artifacts by stage name)."""
     out = []
     gif = fig_dir / "animation.gif"  # written by `walkerlab animate`, embedded when present
     if gif.is_file():
@@ -388,15 +319,15 @@ def figures_section(fig_dir: Path, rel: str, paths: dict[str, Path]) -> list[str
              for png in sorted(fig_dir.glob("bifurcation_*.png"))]
     for stem, cap in CAPTIONS + extra:
         png = fig_dir / f"{stem}.png"
-        if not png.is_file() or not _drawn_from(stem, paths):
+        if not png.is_file() or not _drawn_from(stem, arts):
             continue
         out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
-        if stem == "fig7_angles_rates" and "simulate" in paths:
+        if stem == "fig7_angles_rates" and "simulate" in arts:
             out += details("Per-step data of the rigid walker (simulate.h5)",
-                           steps_table(paths["simulate"]))
-        if stem.startswith("work_precision_") and "workprecision" in paths:
+                           steps_table(arts["simulate"]))
+        if stem.startswith("work_precision_") and "workprecision" in arts:
             out += details("All (method, tolerance) points",
-                           workprecision_table(paths["workprecision"],
+                           workprecision_table(arts["workprecision"],
                                                stem.removeprefix("work_precision_")))
     return ["## Figures", "", *out] if out else []
 
@@ -409,63 +340,46 @@ def _solver_text(scene, model: str) -> str:
     return f"{sv.method} rtol {sv.rtol:.0e}."
 
 
-def workprecision_summary(scene, paths: dict[str, Path]) -> list[str]:
+def workprecision_summary(scene, arts: dict) -> list[str]:
     """The fastest setting reaching the target error, only where the timing noise allows
     naming one, and the Pareto front per model (raw points fold under the figure)."""
-    p = paths.get("workprecision")
-    if p is None:
+    wp = arts.get("workprecision")
+    if wp is None:
         return []
     out = ["## Error against run time (work-precision)", ""]
-    with open_artifact(p, "workprecision") as f:
-        for model in f:
-            g = f[model]
-            out += [f"### {model} model", ""]
-            out.append("Choice: " + workprecision_choice(g.attrs) + " Scene default: "
-                       + _solver_text(scene, model))
-            pm = [str(s) for s in g.attrs.get("pareto_methods", [])]
-            pr = list(g.attrs.get("pareto_rtol", []))
-            out += ["", "Pareto front (no setting is both faster and more accurate): "
-                    + ", ".join(f"{m} {r:.0e}" for m, r in zip(pm, pr)) + ".", ""]
+    for model, m in wp.models.items():
+        out += [f"### {model} model", ""]
+        out.append("Choice: " + workprecision_choice(m.choice) + " Scene default: "
+                   + _solver_text(scene, model))
+        pm = [str(s) for s in m.choice.get("pareto_methods", [])]
+        pr = list(m.choice.get("pareto_rtol", []))
+        out += ["", "Pareto front (no setting is both faster and more accurate): "
+                + ", ".join(f"{a} {r:.0e}" for a, r in zip(pm, pr)) + ".", ""]
     return out
 
 
 # --------------------------------------------------------------------------- bifurcation
-def bifurcation_section(paths: dict[str, Path], pub: ModuleType | None = None) -> list[str]:
+def bifurcation_section(arts: dict, pub: ModuleType | None = None) -> list[str]:
     """Period-doubling onset from ``bifurcation.h5`` (when the scene ran that stage) and from
     each ``bifurcation_<field>.h5`` (``bifurcation --param``), the grid named by its field
-    and unit."""
+    and unit (``arts``: loaded :class:`walkerlab.io.schemas.bifurcation.BifurcationSummary`
+    by artifact key)."""
     out = []
-    p = paths.get("bifurcation")
-    if p is not None:
-        out += _bifurcation_lines(p, pub)
-    for key in sorted(k for k in paths if k.startswith("bifurcation_")):
-        out += _bifurcation_lines(paths[key], None)
+    b = arts.get("bifurcation")
+    if b is not None:
+        out += _bifurcation_lines(b, pub)
+    for key in sorted(k for k in arts if k.startswith("bifurcation_")):
+        out += _bifurcation_lines(arts[key], None)
     return out
 
 
-def _bifurcation_lines(p: Path, pub: ModuleType | None) -> list[str]:
-    from walkerlab.sweep.bifurcation import (
-        SLOPE_PATH,
-        fall_onset,
-        onset_value,
-        parameter_dim,
-    )
+def _bifurcation_lines(b, pub: ModuleType | None) -> list[str]:
+    from walkerlab.sweep.bifurcation import SLOPE_PATH, fall_onset, onset_value
 
-    with open_artifact(p, "bifurcation") as f:
-        path = f.attrs.get("parameter_path", SLOPE_PATH)
-        path = path.decode() if isinstance(path, bytes) else str(path)
-        dim = parameter_dim(path)
-        values = f[dim][()]
-        unit = str(f[dim].attrs.get("unit", "deg"))
-        data = {"parameter_path": path, "parameter_unit": unit, dim: values}
-        for name in ("onset/onset_slope", "onset/onset_value"):
-            if name in f:
-                data[name] = f[name][()]
-        per = f["steady_state/attractor_period"][()]
-        outcome = f["steady_state/outcome"].asstr()[()] if "steady_state/outcome" in f else None
+    p, data, values, per = b.path, b.data, b.values, b.attractor_period
+    path, unit = data["parameter_path"], data["parameter_unit"]
     onset = onset_value(data)
-    falls = fall_onset({**data, "steady_state/outcome": outcome}) \
-        if outcome is not None else np.nan
+    falls = fall_onset(data)
     periods = sorted(set(int(v) for v in per if v > 0))
     if path == SLOPE_PATH:
         text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
@@ -494,19 +408,13 @@ def _bifurcation_lines(p: Path, pub: ModuleType | None) -> list[str]:
 
 
 # --------------------------------------------------------------------------- basin
-def basin_section(paths: dict[str, Path]) -> list[str]:
+def basin_section(arts: dict) -> list[str]:
     """Outcome shares of ``basin.h5`` (when the scene ran that stage)."""
-    p = paths.get("basin")
-    if p is None:
+    b = arts.get("basin")
+    if b is None:
         return []
-    with open_artifact(p, "basin") as f:
-        names = [str(o) for o in f.attrs["outcomes"]]
-        counts = {o: int(f[f"counts/{o}"][()]) for o in names}
-        xa, ya = str(f.attrs["x_axis"]), str(f.attrs["y_axis"])
-        xc, yc = f["x"][()], f["y"][()]
-        xu, yu = str(f["x"].attrs["unit"]), str(f["y"].attrs["unit"])
-        start = str(f.attrs.get("start", "fixed_point"))
-        max_steps = int(f["settings/max_steps"][()])
+    counts, xa, ya, xc, yc = b.counts, b.x_axis, b.y_axis, b.x, b.y
+    xu, yu, start, max_steps = b.x_unit, b.y_unit, b.start, b.max_steps
     n = sum(counts.values())
     how = ("each cell a state just after a heel strike (the heel-strike image of a pre-impact "
            "state on the guard)" if start == "heel_strike"

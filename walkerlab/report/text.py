@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact
+from walkerlab.io.schemas.compare import Comparison
+from walkerlab.io.schemas.contact_sim import ContactSimArtifact
+from walkerlab.io.schemas.fixedpoint import FixedPointArtifact
+from walkerlab.io.schemas.simulate import SimulateArtifact
+from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 from walkerlab.report.markdown import num
-from walkerlab.units import for_artifact
 
 
 def _fmt_mult(re, im) -> str:
@@ -29,33 +29,35 @@ def zero_multipliers_text(re, im) -> str:
             "whose rate after heel strike follows from the stance leg's)")
 
 
-def fixedpoint_text(path: Path) -> str:
+def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
-    with open_artifact(path, "fixedpoint") as f:
-        u = for_artifact(f)
-        names = [str(n) for n in f.attrs["state_names"]]
-        legs = json.loads(f.attrs["legs_by_role"]) if "legs_by_role" in f.attrs else {}
-        lines = [f"fixed point ({f.attrs['model']}, {f.attrs['variant']} equations), "
-                 "state just after heel strike:"]
-        for n in names:
-            coord = n.rsplit("_", 1)[0]
-            role = next((r for r in sorted(legs, key=len, reverse=True)
-                         if coord == r or coord.startswith(r + "_")), None)
-            where = f"({legs[role]}, {role} leg)" if role else "(not on a leg)"
-            unit = f["fixed_point/" + n].attrs["unit"]
-            lines.append(f"  {n:<14s} {where} {f['fixed_point/' + n][()]: .10f} {unit}")
-        lines.append(f"  step period     {f['step_period'][()]:.10f} {u.time}")
-        lines.append(f"  residual        {f['residual'][()]:.2e}  (max |P(x*) - x*|)")
-        re, im = f["floquet/variational/real"][()], f["floquet/variational/imag"][()]
-        lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")
-        re2, im2 = f["floquet/finite_difference/real"][()], f["floquet/finite_difference/imag"][()]
-        lines.append(f"Floquet multipliers (finite diff.): {_fmt_mult(re2, im2)}")
-        lines.append(f"  max difference {f['floquet/max_difference'][()]:.2e}")
-        mod = float(np.max(np.hypot(re, im)))
-        verdict = "STABLE" if f["floquet/stable"][()] else "UNSTABLE"
-        lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; "
-                     f"{zero_multipliers_text(re, im)})")
-        lines += gaits_text(f)
+    u, legs = fp.units, fp.legs_by_role
+    lines = [f"fixed point ({fp.model}, {fp.variant} equations), "
+             "state just after heel strike:"]
+    for n, x, unit in zip(fp.state_names, fp.x, fp.state_units):
+        coord = n.rsplit("_", 1)[0]
+        role = next((r for r in sorted(legs, key=len, reverse=True)
+                     if coord == r or coord.startswith(r + "_")), None)
+        where = f"({legs[role]}, {role} leg)" if role else "(not on a leg)"
+        lines.append(f"  {n:<14s} {where} {x: .10f} {unit}")
+    lines.append(f"  step period     {fp.step_period_s:.10f} {u.time}")
+    if fp.stride_period_s is not None:  # legs that differ: the Poincare map is a stride
+        lines.append(f"  stride period   {fp.stride_period_s:.10f} {u.time} (the map is a "
+                     "stride: the legs differ)")
+        for leg, T, d in zip(fp.step_swing_legs, fp.step_periods_s, fp.step_lengths_m):
+            lines.append(f"    step with {leg} swinging: period {T:.10f} {u.time}, "
+                         f"length {d:.10f} {u.length}")
+    lines.append(f"  residual        {fp.residual:.2e}  (max |P(x*) - x*|)")
+    re, im = fp.multipliers.real, fp.multipliers.imag
+    lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")
+    lines.append(f"Floquet multipliers (finite diff.): "
+                 f"{_fmt_mult(fp.multipliers_fd.real, fp.multipliers_fd.imag)}")
+    lines.append(f"  max difference {fp.max_difference:.2e}")
+    mod = float(np.max(np.hypot(re, im)))
+    verdict = "STABLE" if fp.stable else "UNSTABLE"
+    lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; "
+                 f"{zero_multipliers_text(re, im)})")
+    lines += gaits_text(fp)
     return "\n".join(lines)
 
 
@@ -64,118 +66,96 @@ _GAIT_SOURCES = {"initial_guess": "root finder from the initial guess",
                  "deflation": "deflated root finder near the other gait"}
 
 
-def gaits_text(f) -> list[str]:
-    """Lines on the period-1 gaits recorded in an open ``fixedpoint.h5`` (every gait found,
-    the one selected by ``fixedpoint.gait`` marked ``*``, and why)."""
-    if "gaits" not in f:
+def gaits_text(fp: FixedPointArtifact) -> list[str]:
+    """Lines on the period-1 gaits recorded in ``fixedpoint.h5`` (every gait found, the one
+    selected by ``fixedpoint.gait`` marked ``*``, and why)."""
+    if not fp.gaits:
         return []
-    labels = [str(s) for s in f.attrs["gaits"]]
-    sel = str(f.attrs["gait"])
+    labels, sel = list(fp.gaits), fp.gait
     lines = [f"period-1 gaits found: {len(labels)}" + (
         "" if len(labels) > 1 else " (the other gait of the long/short-period pair, if it "
         "exists, was not found)")]
-    for lab in labels:
-        g = f[f"gaits/{lab}"]
-        mod = float(np.max(np.hypot(g["floquet/variational/real"][()],
-                                    g["floquet/variational/imag"][()])))
+    for lab, g in fp.gaits.items():
+        mod = float(np.max(np.hypot(g.multipliers.real, g.multipliers.imag)))
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
-                     f"{g['step_period'][()]:.6f} s, max |multiplier| {mod:.4g}, "
-                     f"{'stable' if g['floquet/stable'][()] else 'UNSTABLE'} "
-                     f"({_GAIT_SOURCES.get(str(g.attrs['source']), g.attrs['source'])})")
-    notes = json.loads(f.attrs.get("gait_notes", "[]"))
-    lines.append(f"selected (fixedpoint.gait: {f.attrs['gait_policy']}): "
+                     f"{g.step_period_s:.6f} s, max |multiplier| {mod:.4g}, "
+                     f"{'stable' if g.stable else 'UNSTABLE'} "
+                     f"({_GAIT_SOURCES.get(g.source, g.source)})")
+    notes = fp.gait_notes
+    lines.append(f"selected (fixedpoint.gait: {fp.gait_policy}): "
                  f"{sel.replace('_', '-')} gait" + ("; " + "; ".join(notes) if notes else ""))
     return lines
 
 
-def simulate_text(path: Path) -> str:
+def simulate_text(sim: SimulateArtifact) -> str:
     """Steps completed, per-step period/length/speed, energy."""
-    with open_artifact(path, "simulate") as f:
-        u = for_artifact(f)
-        s = f["steps"]
-        lines = [f"simulated {f.attrs['strides_requested']} strides: "
-                 f"{int(np.sum(s['termination'][()] == b'heel_strike'))} heel strikes, "
-                 f"ended by {f.attrs['termination']}"]
-        if u.nondimensional:
-            lines.append(f"  ({u.sentence()})")
-        lines.append(f"  mean step period  {num(f['summary/mean_period_s'][()], 7)} {u.time}")
-        lines.append(f"  mean step length  {num(f['summary/mean_step_length_m'][()], 7)} "
-                     f"{u.length}")
-        lines.append(f"  mean hip speed    {num(f['summary/mean_hip_speed_m_per_s'][()], 7)} "
-                     f"{u.speed}")
-        lines.append(f"  mean total energy {num(f['summary/mean_total_energy_J'][()], 7)} "
-                     f"{u.energy} (potential from the first stance foot)")
-        lines.append(f"  RHS evaluations   {int(f['summary/nfev'][()])}, "
-                     f"integration {num(f['summary/wall_time_s'][()], 3)} s (wall clock)")
+    u, s = sim.units, sim.summary
+    lines = [f"simulated {sim.strides_requested} strides: "
+             f"{sim.heel_strike_count()} heel strikes, ended by {sim.termination}"]
+    if u.nondimensional:
+        lines.append(f"  ({u.sentence()})")
+    lines.append(f"  mean step period  {num(s['mean_period_s'], 7)} {u.time}")
+    lines.append(f"  mean step length  {num(s['mean_step_length_m'], 7)} {u.length}")
+    lines.append(f"  mean hip speed    {num(s['mean_hip_speed_m_per_s'], 7)} {u.speed}")
+    lines.append(f"  mean total energy {num(s['mean_total_energy_J'], 7)} "
+                 f"{u.energy} (potential from the first stance foot)")
+    lines.append(f"  RHS evaluations   {int(s['nfev'])}, "
+                 f"integration {num(s['wall_time_s'], 3)} s (wall clock)")
     return "\n".join(lines)
 
 
-def contact_text(path: Path) -> str:
+def contact_text(c: ContactSimArtifact) -> str:
     """Summary of a contact-sim artifact."""
-    with open_artifact(path, "contact-sim") as f:
-        kind = str(f.attrs.get("outcome", "?"))
-        why = str(f.attrs.get("outcome_message", f.attrs.get("termination", "")))
-        # the message only when it says more than the outcome's name
-        lines = [f"contact walker: outcome {kind}" + (f" ({why})" if why and why != kind
-                                                      else "")]
-        if "initial_rate_scale" in f and "adjust" in f:  # --adjust: the scale it found
-            s = np.atleast_1d(f["initial_rate_scale"][()])
-            # per named coordinate: the rates of leg1 (swing) and leg2 (stance) at the start
-            names = ([str(v) for v in f["rate"][()].astype(str)] if "rate" in f
-                     else ["leg1 rates", "leg2 rates"])
-            lines.append("adjusted initial rate scale (found by --adjust): "
-                         + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s)))
-        if "summary" in f:
-            for k in f["summary"]:
-                ds = f["summary"][k]
-                unit = str(ds.attrs.get("unit", ""))
-                lines.append(f"  {k:<32s} {num(ds[()])}" + (f" {unit}" if unit not in
-                                                              ("", "-") else ""))
-            if "wall_time_s" in f["summary"] and "wall_time_s" in f.attrs:
-                lines.append(f"  (wall_time_s: the walking run's integration; the whole stage "
-                             f"took {num(f.attrs['wall_time_s'], 3)} s)")
-        if "periodic_gait" in f and "step_period" not in f["periodic_gait"]:
-            g = f["periodic_gait"]
-            lines.append(f"periodic contact gait: not found ({g.attrs.get('outcome', '?')}: "
-                         f"{g.attrs.get('message', '')})")
-        elif "periodic_gait" in f:
-            g = f["periodic_gait"]
-            mult = g["multipliers/real"][()] + 1j * g["multipliers/imag"][()]
-            lines.append(f"periodic contact gait: step period {num(g['step_period'][()], 6)} s, "
-                         f"step length {num(g['step_length'][()], 6)} m, "
-                         f"{'stable' if g['stable'][()] else 'unstable'}")
-            lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
-                         + f" (+{len(mult) - 3} fast contact modes ~0)")
+    kind = c.outcome
+    why = c.outcome_message
+    # the message only when it says more than the outcome's name
+    lines = [f"contact walker: outcome {kind}" + (f" ({why})" if why and why != kind else "")]
+    if c.adjust is not None:  # --adjust: the scale it found
+        s = np.atleast_1d(c.initial_rate_scale)
+        # per named coordinate: the rates of leg1 (swing) and leg2 (stance) at the start
+        names = c.rate_names or ["leg1 rates", "leg2 rates"]
+        lines.append("adjusted initial rate scale (found by --adjust): "
+                     + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s)))
+    for k, (v, unit) in c.summary.items():
+        lines.append(f"  {k:<32s} {num(v)}" + (f" {unit}" if unit not in ("", "-") else ""))
+    if "wall_time_s" in c.summary and np.isfinite(c.stage_wall_time_s):
+        lines.append(f"  (wall_time_s: the walking run's integration; the whole stage "
+                     f"took {num(c.stage_wall_time_s, 3)} s)")
+    per = c.periodic
+    if per is not None and not per.found:
+        lines.append(f"periodic contact gait: not found ({per.outcome}: {per.message})")
+    elif per is not None:
+        mult = per.multipliers
+        lines.append(f"periodic contact gait: step period {num(per.step_period_s, 6)} s, "
+                     f"step length {num(per.step_length_m, 6)} m, "
+                     f"{'stable' if per.stable else 'unstable'}")
+        lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
+                     + f" (+{len(mult) - 3} fast contact modes ~0)")
     return "\n".join(lines)
 
 
-def compare_text(path: Path) -> str:
+def compare_text(c: Comparison) -> str:
     """Key errors of a compare artifact: largest angle and rate error contact − ideal per
     coordinate, the limit cycles' mean distance, and the gait metrics side by side."""
-    with open_artifact(path, "compare") as f:
-        u = for_artifact(f)
-        g = f["errors"]
-        t = g["time"][()]
-        lines = [f"errors contact - ideal over the common span 0-{num(t[-1], 4)} {u.time}:",
-                 f"  max |angle error| {num(g['max_abs_angle'][()], 3)} rad, "
-                 f"max |rate error| {num(g['max_abs_rate'][()], 3)} {u.rate}"]
-        for n in [str(x) for x in g.attrs["coordinates"]]:
-            ds = g[f"coordinates/{n}"]
-            lines.append(f"  {n:<22s} max |error| {num(np.max(np.abs(ds[()])), 3)} "
-                         f"{ds.attrs['unit']}")
-        if "limit_cycle_distance" in g:
-            lines.append("  limit cycles, mean distance ideal -> contact: " + ", ".join(
-                f"{k} {num(g['limit_cycle_distance'][k][()], 3)}"
-                for k in g["limit_cycle_distance"]))
-        if "metrics" in f and {"ideal", "contact"} <= set(f["metrics"]):
-            m = f["metrics"]
-            lines.append(f"  {'gait metric':<22s} {'ideal':>11s} {'contact':>11s}")
-            for k in m["ideal"]:
-                if k in m["contact"]:
-                    unit = str(m["ideal"][k].attrs.get("unit", ""))
-                    lines.append(f"  {k:<22s} {num(m['ideal'][k][()]):>11s} "
-                                 f"{num(m['contact'][k][()]):>11s}"
-                                 + (f" {unit}" if unit not in ("", "-") else ""))
+    u = c.units
+    lines = [f"errors contact - ideal over the common span 0-{num(c.time[-1], 4)} {u.time}:",
+             f"  max |angle error| {num(c.max_abs_angle_rad, 3)} rad, "
+             f"max |rate error| {num(c.max_abs_rate_rad_per_s, 3)} {u.rate}"]
+    for n, e in c.errors.items():
+        lines.append(f"  {n:<22s} max |error| {num(np.max(np.abs(e)), 3)} "
+                     f"{c.error_units[n]}")
+    if c.limit_cycle_distance:
+        lines.append("  limit cycles, mean distance ideal -> contact: " + ", ".join(
+            f"{k} {num(v, 3)}" for k, v in c.limit_cycle_distance.items()))
+    m = c.metrics
+    if {"ideal", "contact"} <= set(m):
+        lines.append(f"  {'gait metric':<22s} {'ideal':>11s} {'contact':>11s}")
+        for k in m["ideal"]:
+            if k in m["contact"]:
+                unit = c.metric_units.get(k, "")
+                lines.append(f"  {k:<22s} {num(m['ideal'][k]):>11s} "
+                             f"{num(m['contact'][k]):>11s}"
+                             + (f" {unit}" if unit not in ("", "-") else ""))
     return "\n".join(lines)
 
 
@@ -208,7 +188,7 @@ def workprecision_choice(attrs) -> str:
             "was timed once); the lowest median is " + name + ".")
 
 
-def workprecision_text(path: Path) -> str:
+def workprecision_text(wp: WorkPrecisionArtifact) -> str:
     """One line per model of a workprecision artifact: its choice and the timing noise."""
-    with open_artifact(path, "workprecision") as f:
-        return "\n".join(f"{model}: {workprecision_choice(f[model].attrs)}" for model in f)
+    return "\n".join(f"{model}: {workprecision_choice(m.choice)}"
+                     for model, m in wp.models.items())

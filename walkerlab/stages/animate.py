@@ -14,15 +14,15 @@ name in the same folder, then rename).
 
 from __future__ import annotations
 
+import json
 import os
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from walkerlab.config import Scene, SlopeSettings
-from walkerlab.io.artifacts import open_artifact, scene_json_of
-from walkerlab.io.trajectory import read_samples
-from walkerlab.stages import simulate
+from walkerlab.io.schemas.contact_sim import load_contact_sim
+from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.stages.common import artifact_path
 from walkerlab.stages.plot import CONTACT_LABEL, IDEAL_LABEL, figures_dir
 
@@ -107,22 +107,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
 
     from walkerlab.plotting.animation import gif_writer, walker_animation
 
-    simulate.run(scene, runs_root)
-    trajs, unit, notes = {}, "s", []
-    for stage, label in (("simulate", IDEAL_LABEL), ("contact-sim", CONTACT_LABEL)):
-        p = artifact_path(scene, runs_root, stage)
-        why = contact_left_out(scene, runs_root, p) if stage == "contact-sim" and \
-            p.is_file() else ""
-        if why:
-            notes.append(f"animated the rigid walker only: {why} (rerun 'walkerlab "
-                         "contact-sim' to animate the contact walker beside it)")
-        elif p.is_file():
-            with open_artifact(p, stage) as f:
-                trajs[label] = read_samples(f)
-                unit = str(f["samples/time"].attrs.get("unit", unit)) if stage == "simulate" \
-                    else unit
-    slope = SlopeSettings.model_validate(
-        scene_json_of(artifact_path(scene, runs_root, "simulate"))["slope"]).phi_rad
+    sim = load_simulate(artifact_path(scene, runs_root, "simulate"))
+    trajs, notes = {IDEAL_LABEL: sim.samples}, []
+    contact = artifact_path(scene, runs_root, "contact-sim")
+    why = contact_left_out(scene, runs_root, contact) if contact.is_file() else ""
+    if why:
+        notes.append(f"animated the rigid walker only: {why} (rerun 'walkerlab contact-sim' "
+                     "to animate the contact walker beside it)")
+    elif contact.is_file():
+        trajs[CONTACT_LABEL] = load_contact_sim(contact).samples
+    unit = sim.units.time
+    slope = SlopeSettings.model_validate(json.loads(sim.scene_json)["slope"]).phi_rad
     folder = figures_dir(scene, runs_root, claim=True)
     frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames, time_unit=unit)
     out = AnimateOutcome(note="; ".join(notes))

@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import BasinSettings, CommandOptions, Scene, validate_option
-from walkerlab.io.artifacts import put, write_artifact
-from walkerlab.io.netcdf import coordinate
+from walkerlab.io.artifacts import write_artifact
 from walkerlab.io.runpaths import artifact_lock, stage_artifact
-from walkerlab.stages import fixedpoint as fixedpoint_stage
+from walkerlab.io.schemas.basin import BasinRun, load_basin, write_basin
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,
@@ -39,12 +39,30 @@ def figure_path(scene: Scene, runs_root: Path | str) -> Path:
 
 def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     """Draw the basin figure (PNG + SVG) from ``basin.h5``."""
-    from walkerlab.plotting.basin_figures import basin_figure, load_basin
+    from walkerlab.plotting.basin_figures import basin_figure
     from walkerlab.plotting.figures import save
 
     d = load_basin(artifact_path(scene, runs_root, "basin"))
     fig = basin_figure(d, f"Basin of attraction - scene '{scene.name}'")
     return save(fig, figure_path(scene, runs_root).parent, "basin")
+
+
+def check(scene: Scene, grid: tuple[int, int] | None = None, workers: int = 2,
+          **_options) -> tuple[tuple[int, int], int]:
+    """The grid and worker count to use, checked before anything runs (the scene's cap on
+    ``basin.grid`` holds for ``--grid`` too).
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section, or a grid or worker count out of bounds (one line).
+    """
+    require(scene, "fixedpoint", "basin")
+    st = scene.basin or BasinSettings()
+    if grid is not None:
+        grid = validate_option(BasinSettings, "grid", tuple(grid), "--grid", "basin.grid")
+    workers = validate_option(CommandOptions, "workers", workers, "--workers")
+    return tuple(grid or st.grid), workers
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
@@ -68,13 +86,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``fixedpoint`` section, or bad basin settings.
     """
-    require(scene, "fixedpoint", "basin")
     st = scene.basin or BasinSettings()
-    if grid is not None:  # the scene's cap on basin.grid, for --grid too
-        grid = validate_option(BasinSettings, "grid", tuple(grid), "--grid", "basin.grid")
-    workers = validate_option(CommandOptions, "workers", workers, "--workers")
-    grid = tuple(grid or st.grid)
-    fixedpoint_stage.run(scene, runs_root)
+    grid, workers = check(scene, grid, workers)
     up = artifact_path(scene, runs_root, "fixedpoint")
     path = stage_artifact(scene, runs_root, "basin", claim=True)
     # one writer per artifact (as run_cached): a second identical run waits, then reuses
@@ -100,7 +113,7 @@ def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_ch
 
         note = recompute_reason(path, scene, SECTIONS, verified_hash(path))
         _tell(f"basin: recomputing {path} ({note})")
-    x_star, _ = fixedpoint_stage.load_fixed_point(up)
+    x_star = load_fixedpoint(up).x
     t0 = time.perf_counter()
     try:
         res = compute_basin(scene, x_star, key, path, grid, workers, scheduler,
@@ -108,43 +121,10 @@ def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_ch
     except BasinError as exc:
         raise StageError(str(exc)) from None
     walker = res["walker"]
-    names = walker.state_names()
-    units = walker.state_units() if hasattr(walker, "state_units") else [
-        "rad" if n.endswith("_angle") else "rad/s" for n in names]
-    unit = dict(zip(names, units))
     counts = {o: int(np.sum(res["outcome"] == i)) for i, o in enumerate(OUTCOMES)}
-
-    def writer(f):
-        f.attrs["model"] = walker.name
-        f.attrs["state_names"] = names
-        f.attrs["x_axis"], f.attrs["y_axis"] = st.x_axis, st.y_axis
-        f.attrs["start"] = st.start
-        f.attrs["outcomes"] = list(OUTCOMES)
-        f.attrs["axis_order"] = "outcome[j, i]: j along y_axis, i along x_axis"
-        coordinate(f, "x", res["x"], unit[st.x_axis], f"cell centres, {st.x_axis}")
-        coordinate(f, "y", res["y"], unit[st.y_axis], f"cell centres, {st.y_axis}")
-        put(f, "outcome", res["outcome"], "-",
-            "index into attrs['outcomes'] (converged = period-1 gait)", dims=("y", "x"))
-        put(f, "steps", res["steps"], "steps", "steps until the outcome was decided",
-            dims=("y", "x"))
-        put(f, "period", res["period"], "steps", "period of the attractor reached "
-            "(1 = fixed point, 0 = none)", dims=("y", "x"))
-        for n, v in zip(names, x_star):
-            put(f, f"fixed_point/{n}", float(v), unit[n], f"{n} of the period-1 gait")
-        for o, c in counts.items():
-            put(f, f"counts/{o}", c, "cells", f"cells whose outcome is {o}")
-        put(f, "settings/max_steps", st.max_steps, "steps", "steps per cell at most")
-        put(f, "settings/converge_tol", st.converge_tol, "rad, rad/s",
-            "max|x - x*| that counts as converged")
-        put(f, "settings/period_tol", st.period_tol, "rad, rad/s",
-            "max|x_k - x_{k-p}| that counts as a period-p attractor")
-        put(f, "settings/rtol", st.rtol, "-", "integrator relative tolerance (DOP853)")
-        put(f, "settings/atol", st.atol, "rad, rad/s", "integrator absolute tolerance")
-        put(f, "stats/cells_computed", res["cells_computed"], "cells",
-            "cells computed by the last run (the rest came from a resumed partial file)")
-
+    run = BasinRun(walker, res, x_star, st, list(OUTCOMES), counts)
     wall = time.perf_counter() - t0
-    write_artifact(path, "basin", scene, key, writer, wall,
+    write_artifact(path, "basin", scene, key, lambda f: write_basin(f, run), wall,
                    {"workers": workers if scheduler is None else 0,
                     "scheduler": str(scheduler or "")})
     res["partial"].unlink(missing_ok=True)

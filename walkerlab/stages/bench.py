@@ -56,8 +56,9 @@ def _paper_scene():
 
 def bench_ideal(repeats: int = 7) -> dict:
     """5 ideal strides at rtol 1e-10 per integrator backend, and the fixed-point search."""
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
     from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     scene = _paper_scene()
@@ -173,13 +174,13 @@ def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
         cmd = _cli("basin", "--grid", grid, "--workers", str(workers), "--force",
                    "--runs-dir", d)
         res = _time_process(cmd, 1)
-        from walkerlab.plotting.basin_figures import load_basin
+        from walkerlab.io.schemas.basin import load_basin
         from walkerlab.stages.common import artifact_path
 
         b = load_basin(artifact_path(_paper_scene(), d, "basin"))
-    out = b["outcome"]
+    out = b.outcome
     return {**res, "grid": grid, "workers": workers, "target_s": 120.0,
-            "outcomes": {o: int(np.sum(out == i)) for i, o in enumerate(b["outcomes"])}}
+            "outcomes": {o: int(np.sum(out == i)) for i, o in enumerate(b.outcomes)}}
 
 
 def _scene_line(res: dict) -> str:

@@ -15,7 +15,13 @@ from pathlib import Path
 
 import walkerlab
 from walkerlab.config import Scene
-from walkerlab.io.artifacts import code_hash, content_hash, verified_hash, write_artifact
+from walkerlab.io.artifacts import (
+    code_hash,
+    content_hash,
+    root_attrs,
+    verified_hash,
+    write_artifact,
+)
 from walkerlab.io.runpaths import artifact_lock, stage_artifact
 
 
@@ -34,6 +40,9 @@ class StageOutcome:
     summary: dict = field(default_factory=dict)
     #: why an existing artifact was recomputed, or what was reused in its place (one line)
     note: str = ""
+    #: why the run did not reach its goal (a walker that fell: one line), "" when it did;
+    #: the CLI exits 1 on it
+    failure: str = ""
 
 
 def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
@@ -86,12 +95,9 @@ def changed_fields(path: Path, scene: Scene, sections: tuple[str, ...]) -> list[
     artifact's stored scene differs from ``scene``'s; [] when none or unreadable."""
     import json
 
-    import h5py
-
     try:
-        with h5py.File(path, "r") as f:
-            old = json.loads(str(f.attrs["scene_json"]))
-    except (OSError, KeyError, ValueError):
+        old = json.loads(str(root_attrs(path, "scene_json")["scene_json"]))
+    except (KeyError, ValueError):
         return []
     new = json.loads(scene.model_dump_json())
     was = _leaves({k: old.get(k) for k in sections})
@@ -110,13 +116,7 @@ def recompute_reason(path: Path, scene: Scene, sections: tuple[str, ...],
     if diff:
         more = f" (+{len(diff) - 3} more fields)" if len(diff) > 3 else ""
         return "scene changed: " + ", ".join(diff[:3]) + more
-    import h5py
-
-    try:
-        with h5py.File(path, "r") as f:
-            old_code = f.attrs.get("code_hash")
-    except OSError:
-        old_code = None
+    old_code = root_attrs(path, "code_hash").get("code_hash")
     if old_code is not None and str(old_code) != code_hash():
         return "walkerlab's code changed"
     return "an upstream artifact or a stage option changed"

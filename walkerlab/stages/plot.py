@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from walkerlab.config import Scene
 from walkerlab.io import runpaths
-from walkerlab.io.artifacts import open_artifact
-from walkerlab.io.trajectory import read_samples
+from walkerlab.io.schemas.compare import load_compare
+from walkerlab.io.schemas.contact_sim import load_contact_sim
+from walkerlab.io.schemas.simulate import load_simulate
+from walkerlab.io.schemas.workprecision import load_workprecision, pareto
 from walkerlab.stages.common import StageError, artifact_path
 from walkerlab.units import for_scene
 
@@ -68,12 +68,12 @@ def load_trajectories(scene: Scene, runs_root: Path | str) -> dict:
         An artifact was changed after it was written (:func:`check_unedited`).
     """
     out = {}
-    for stage, label in (("simulate", IDEAL_LABEL), ("contact-sim", CONTACT_LABEL)):
+    for stage, label, load in (("simulate", IDEAL_LABEL, load_simulate),
+                               ("contact-sim", CONTACT_LABEL, load_contact_sim)):
         p = artifact_path(scene, runs_root, stage)
         if p.is_file():
             check_unedited(p)
-            with open_artifact(p, stage) as f:
-                out[label] = read_samples(f)
+            out[label] = load(p).samples
     return out
 
 
@@ -142,14 +142,9 @@ def _trajectory_figures(scene: Scene, runs_root, F) -> list[Path]:
     cmp_path = artifact_path(scene, runs_root, "compare")
     if cmp_path.is_file():
         check_unedited(cmp_path)
-        with open_artifact(cmp_path, "compare") as f:
-            g = f["errors"]
-            names = [str(x) for x in g.attrs["coordinates"]]
-            t = g["time"][()]
-            err = {n: g[f"coordinates/{n}"][()] for n in names}
-            units = {n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names}
-        written += F.save(F.fig8_errors(t, err, units, "contact - ideal", scene_units=u),
-                          out_dir, "fig8_errors")
+        c = load_compare(cmp_path)
+        written += F.save(F.fig8_errors(c.time, c.errors, c.error_units, "contact - ideal",
+                                        scene_units=u), out_dir, "fig8_errors")
     written += _drop_figure(scene, runs_root, out_dir, F)
     return written
 
@@ -160,17 +155,14 @@ def _drop_figure(scene: Scene, runs_root, out_dir: Path, F) -> list[Path]:
     p = artifact_path(scene, runs_root, "contact-sim")
     if not p.is_file() or scene.contact is None:
         return []
-    with open_artifact(p, "contact-sim") as f:
-        if "drop_test" not in f:
-            return []
-        g = f["drop_test"]
-        ks, unit = g["stiffness"][()], str(g["stiffness"].attrs["unit"])
-        curves = {fam: g[f"{fam}/restitution"][()] for fam in ("paper", "rigid_limit")}
-        mass = float(g.attrs.get("mass_kg", 20.0))
+    drop = load_contact_sim(p).drop
+    if drop is None:
+        return []
     from walkerlab.plotting.sweep_figures import restitution_figure
 
-    fig = restitution_figure(ks, curves, unit=unit, k_paper=float(scene.contact.stiffness),
-                             mass_kg=mass, units=for_scene(scene))
+    fig = restitution_figure(drop.stiffness, drop.restitution, unit=drop.unit,
+                             k_paper=float(scene.contact.stiffness), mass_kg=drop.mass_kg,
+                             units=for_scene(scene))
     return F.save(fig, out_dir, "drop_restitution")
 
 
@@ -180,18 +172,10 @@ def _workprecision_figures(scene: Scene, runs_root, F) -> list[Path]:
     if wp_path.is_file():
         check_unedited(wp_path)
         out_dir = figures_dir(scene, runs_root, claim=True)
-        with open_artifact(wp_path, "workprecision") as f:
-            for model in f:
-                g = f[model]
-                rows = {m: {k: g[m][k][()] for k in ("time", "time_min", "time_max", "error",
-                                                     "rtol", "nfev") if k in g[m]}
-                        for m in g if isinstance(g[m], type(g))}
-                pareto = [dict(zip(("method", "rtol", "time", "error"), r))
-                          for r in zip([str(s) for s in g.attrs.get("pareto_methods", [])],
-                                       np.asarray(g.attrs.get("pareto_rtol", [])),
-                                       np.asarray(g.attrs.get("pareto_time", [])),
-                                       np.asarray(g.attrs.get("pareto_error", [])))]
-                written += F.save(F.work_precision(rows, f"work-precision, {model} model",
-                                                   pareto, units=for_scene(scene)),
-                                  out_dir, f"work_precision_{model}")
+        for model, m in load_workprecision(wp_path).models.items():
+            rows = {meth: {k: v for k, v in cols.items() if k != "repeats"}
+                    for meth, cols in m.rows.items()}
+            written += F.save(F.work_precision(rows, f"work-precision, {model} model",
+                                               pareto(m.choice), units=for_scene(scene)),
+                              out_dir, f"work_precision_{model}")
     return written

@@ -12,141 +12,42 @@ cores with the basin's workers).
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable
 from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io.runpaths import report_dir
-from walkerlab.report.build import write_report
+from walkerlab.report.build import ReportInputs, write_report
 from walkerlab.stages.common import StageOutcome, artifact_path
+from walkerlab.stages.pipeline import report_plan, stage_module
 from walkerlab.stages.plot import figures_dir
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
                  "bifurcation", "basin")
 
 
-class _Study:
-    """The work-precision stage in a thread of the report, overlapping the untimed stages.
-
-    Its timed cases run in worker processes pinned to their own cores
-    (:class:`walkerlab.analysis.workprecision.Lanes`).  With two cores, the first core's lane
-    starts at once; this process (every thread of it) stays on the second core for the
-    untimed stages and figures, and that core's lane starts at :meth:`release`.  The
-    contact model's cases wait until its compiled kernels are in numba's on-disk cache
-    (:meth:`ready`), so no worker compiles them a second time.  With more cores this process
-    keeps a core of its own; with one, the study runs after the other stages, in this
-    process, as before.
-
-    Created before the fixed point: when the study has no artifact yet (a first run), the
-    first lane's worker process starts at once and imports its libraries on its core while
-    this process finds the fixed point; :meth:`start` (after the fixed point) starts the
-    study itself.
-    """
-
-    def __init__(self, scene: Scene, runs_root, force: bool, workers: int = 2):
-        import threading
-
-        from walkerlab.analysis.workprecision import Lanes, start_worker
-
-        self.scene, self.runs_root, self.force = scene, runs_root, force
-        cores = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
-        self.lanes = None
-        self._affinity = None
-        self.outcome = self.error = None
-        self.thread = None
-        if len(cores) < 2:
-            return
-        lanes = cores[:workers]
-        mine = cores[workers] if len(cores) > workers else lanes[-1]
-        self.lanes = Lanes(cores=lanes)
-        if mine in lanes:
-            self.lanes.gates[mine] = threading.Event()
-        if scene.contact is not None:
-            self.lanes.pending["contact"] = threading.Event()
-        first_run = not artifact_path(scene, runs_root, "workprecision").is_file()
-        self._affinity = set(cores)
-        os.sched_setaffinity(0, {mine})  # threads started later inherit it
-        try:
-            if first_run:
-                self.lanes.workers = {c: start_worker(c) for c in lanes
-                                      if c not in self.lanes.gates}
-        except BaseException:
-            self.release(cancel=True)
-            raise
-        self.thread = threading.Thread(target=self._run, name="workprecision", daemon=True)
-
-    def start(self) -> None:
-        """Start the study (the fixed-point artifact must exist)."""
-        if self.thread is not None:
-            self.thread.start()
-
-    def _run(self):
-        from walkerlab.stages import workprecision
-
-        try:
-            self.outcome = workprecision.run(self.scene, self.runs_root, self.force,
-                                             lanes=self.lanes)
-        except BaseException as exc:  # noqa: BLE001 - re-raised by join()
-            self.error = exc
-
-    def needs(self, model: str) -> bool:
-        """Whether the study has ``model`` cases to measure (waits until it knows: a reused
-        stage or fully cached cases need none, and then nothing is warmed up)."""
-        if self.lanes is None or model not in self.lanes.pending:
-            return False
-        while not self.lanes.todo_known.wait(0.02):
-            if not self.thread.is_alive():
-                return False
-        return model in self.lanes.todo_models
-
-    def ready(self, model: str) -> None:
-        """``model``'s compiled code is on disk: its cases may start."""
-        if self.lanes is not None and model in self.lanes.pending:
-            self.lanes.pending[model].set()
-
-    def release(self, cancel: bool = False) -> None:
-        """This process is done with its core: the core's lane starts (``cancel``: no new
-        case is started at all)."""
-        if self.lanes is None:
-            return
-        if cancel:
-            self.lanes.cancel.set()
-        for ev in (*self.lanes.gates.values(), *self.lanes.pending.values()):
-            ev.set()
-        if self._affinity is not None:
-            os.sched_setaffinity(0, self._affinity)
-            self._affinity = None
-
-    def join(self) -> StageOutcome:
-        """The stage's outcome (runs it here when there is no second core)."""
-        if self.thread is None:
-            from walkerlab.stages import workprecision
-
-            return workprecision.run(self.scene, self.runs_root, self.force)
-        if self.thread.ident is not None:  # started
-            self.thread.join()
-        for ex in self.lanes.workers.values():  # started but never used
-            ex.shutdown(wait=True, cancel_futures=True)
-        self.lanes.workers.clear()
-        if self.error is not None:
-            raise self.error
-        return self.outcome
-
-
 def planned_stages(scene: Scene) -> list[str]:
-    """The stages ``report`` runs for this scene, in order (for its progress display)."""
-    sim, contact = scene.simulate is not None, scene.contact is not None
-    return [n for n, on in (("fixedpoint", scene.fixedpoint is not None), ("simulate", sim),
-                            ("contact-sim", contact), ("compare", contact and sim),
-                            ("workprecision", getattr(scene, "workprecision", None) is not None),
-                            ("basin", scene.basin is not None and scene.fixedpoint is not None))
-            if on]
+    """The stages ``report`` runs for this scene, in order (:func:`walkerlab.stages.pipeline.
+    report_plan`)."""
+    return report_plan(scene)
+
+
+def _study(scene: Scene, runs_root, force: bool):
+    """The work-precision stage in a thread of the report, overlapping the untimed stages
+    (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
+    the contact model's kernels are compiled."""
+    from walkerlab.analysis.workprecision import start_worker
+    from walkerlab.execution.background import BackgroundStudy
+
+    wp = stage_module("workprecision")
+    first_run = not artifact_path(scene, runs_root, "workprecision").is_file()
+    return BackgroundStudy(lambda lanes: wp.run(scene, runs_root, force, lanes=lanes),
+                           start_worker, first_run,
+                           ("contact",) if scene.contact is not None else ())
 
 
 def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None) -> list[StageOutcome]:
-    from walkerlab.stages import fixedpoint, simulate
-
+    plan = report_plan(scene)
     done: list[StageOutcome] = []
 
     def add(o: StageOutcome) -> None:
@@ -154,47 +55,32 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None) -> list[St
         if bar is not None:
             bar.advance(info=f"{o.stage} {'reused' if o.reused else 'computed'}")
     drawn: list[str] = []
-    study = (_Study(scene, runs_root, force)
-             if getattr(scene, "workprecision", None) is not None else None)
+    study = _study(scene, runs_root, force) if "workprecision" in plan else None
     try:
-        if scene.fixedpoint is not None:
-            add(fixedpoint.run(scene, runs_root, force, compare_variants=True))
+        if "fixedpoint" in plan:
+            add(stage_module("fixedpoint").run(scene, runs_root, force, compare_variants=True))
         if study is not None:
             study.start()
         if study is not None and study.needs("contact"):
-            from walkerlab.stages import workprecision
-
-            workprecision.warm_up(scene, runs_root, "contact")  # numba compiles here, once
+            # numba compiles here, once
+            stage_module("workprecision").warm_up(scene, runs_root, "contact")
             study.ready("contact")
-        if scene.simulate is not None:
-            add(simulate.run(scene, runs_root, force))
-        if scene.contact is not None:
-            from walkerlab.stages import contact_sim
-
-            add(contact_sim.run(scene, runs_root, force))
-            if scene.simulate is not None:
-                from walkerlab.stages import compare
-
-                add(compare.run(scene, runs_root, force))
+        for name in ("simulate", "contact-sim", "compare"):
+            if name in plan:
+                add(stage_module(name).run(scene, runs_root, force))
         if any(o.stage in ("simulate", "contact-sim") for o in done):
             drawn.append(_draw(scene, runs_root, force, "trajectories"))
     except BaseException:
-        if study is not None and study.thread is not None:
-            study.release(cancel=True)
-            try:
-                study.join()
-            except BaseException:  # noqa: BLE001 - the first error is the one to report
-                pass
+        if study is not None:
+            study.cancel()
         raise
     if study is not None:
         study.release()
         add(study.join())
         drawn.append(_draw(scene, runs_root, force, "workprecision"))
-    if scene.basin is not None and scene.fixedpoint is not None:
+    if "basin" in plan:
         # after the study: its worker processes would share the timed cases' cores
-        from walkerlab.stages import basin
-
-        add(basin.run(scene, runs_root, force))
+        add(stage_module("basin").run(scene, runs_root, force))
     for o in done:
         status = ("reused (inputs unchanged)" if o.reused and not o.note else
                   f"reused ({o.note})" if o.reused else
@@ -294,7 +180,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     from walkerlab import progress
 
-    stages = planned_stages(scene)
+    stages = report_plan(scene)
     with progress.task(f"report: {len(stages)} stages ({', '.join(stages)})",
                        len(stages)) as bar:
         done = _run_stages(scene, runs_root, force, echo, bar)
@@ -302,4 +188,49 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     if left_out:
         echo(left_out)
     rep_dir = report_dir(scene, runs_root, claim=True)
-    return write_report(scene, paths, rep_dir, figures_dir(scene, runs_root), done)
+    figs = figures_dir(scene, runs_root)
+    return write_report(scene, load_inputs(scene, paths, figs), rep_dir, figs, done)
+
+
+def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportInputs:
+    """Load the report's artifacts (``paths``: ``{stage: Path}``) through
+    :mod:`walkerlab.io.schemas` and compute what the report states from them: Table 3
+    columns, the rigid run's energy drift and swing-foot clearance.  Stability maps whose
+    figure is in ``figures`` are loaded too (``stability_map_<kind>``)."""
+    from walkerlab.analysis.gait_checks import energy_drift_in_swing, swing_foot_clearance
+    from walkerlab.analysis.tables import table3
+    from walkerlab.io.schemas import (
+        basin,
+        bifurcation,
+        compare,
+        contact_sim,
+        fixedpoint,
+        simulate,
+        stability_map,
+        workprecision,
+    )
+
+    loaders = {"fixedpoint": fixedpoint.load_fixedpoint, "simulate": simulate.load_simulate,
+               "contact-sim": contact_sim.load_contact_sim, "compare": compare.load_compare,
+               "workprecision": workprecision.load_workprecision, "basin": basin.load_basin}
+    arts: dict = {}
+    for key, p in paths.items():
+        load = (bifurcation.load_bifurcation_summary if key.startswith("bifurcation")
+                else loaders[key])
+        arts[key] = load(p)
+    inputs = ReportInputs(arts)
+    if "contact-sim" in paths:
+        folder = paths["contact-sim"].parent
+        for kind in ("stiffness", "friction", "patch_width"):
+            p = folder / f"stability_map_{kind}.h5"
+            if p.is_file() and (figures / f"{p.stem}.png").is_file():
+                arts[p.stem] = stability_map.load_stability_map(p)
+    sim = arts.get("simulate")
+    if sim is not None:
+        inputs.energy_drift = energy_drift_in_swing(sim.samples)
+        inputs.swing_clearance = swing_foot_clearance(sim.samples, scene.slope.phi_rad)
+        trajs = {"ours, ideal": sim.samples}
+        if "contact-sim" in arts:
+            trajs["ours, contact"] = arts["contact-sim"].samples
+        inputs.gait_columns = table3(trajs, sim.total_mass_kg, sim.gravity_m_per_s2)
+    return inputs

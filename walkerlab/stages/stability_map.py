@@ -10,15 +10,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import h5py
-import numpy as np
-
 from walkerlab.config import CommandOptions, Scene, validate_option
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.schemas.stability_map import (
+    StabilityMapRun,
+    load_stability_map,
+    write_stability_map,
+)
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.sweep.stability import (
-    CELL_FIELDS,
-    MAP_KINDS,
     MapSpec,
     default_spec,
     gait_map,
@@ -26,8 +25,6 @@ from walkerlab.sweep.stability import (
 )
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
-_UNITS = {"max_abs_multiplier": "-", "step_period_s": "s", "patch_margin_m": "m",
-          "residual": "-", "wall_time_s": "s", "exists": "-", "stable": "-"}
 
 
 def stage_name(kind: str) -> str:
@@ -87,30 +84,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         reasons = [str(r) for r in cells["reason"].ravel() if r]
         summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
 
-        def writer(f):
-            f.attrs["kind"] = spec.kind
-            f.attrs["y_path"] = spec.y_path
-            f.attrs["y_label"] = MAP_KINDS[spec.kind][1]
-            f.attrs["stiffness_family"] = scene.contact.stiffness_family
-            f.attrs["unit_system"] = scene.contact.unit_system
-            f.attrs["time_limit_s"] = spec.time_limit_s
-            f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "
-                                 "step map, continued from its neighbour along the slope, "
-                                 "else from the ideal fixed point at that slope")
-            put(f, "y_values", cells["y_values"],
-                {"patch_width": "m", "friction": "-"}.get(spec.kind, "scene units"),
-                spec.y_path)
-            put(f, "slopes_deg", cells["slopes_deg"], "deg", "slope angle")
-            for fld in CELL_FIELDS:
-                v = cells[fld]
-                if v.dtype == object:
-                    put(f, fld, np.asarray([[str(x) for x in r] for r in v],
-                                           dtype=h5py.string_dtype()), "-", fld)
-                else:
-                    put(f, fld, np.asarray(v, float), _UNITS.get(fld, "-"), fld)
-            for k, v in frac.items():
-                put(f, f"summary/{k}", v, "-", k)
-        return writer, summary
+        run = StabilityMapRun(spec, cells, frac, scene.contact.stiffness_family,
+                              scene.contact.unit_system)
+        return (lambda f: write_stability_map(f, run)), summary
 
     out = run_cached(stage_name(spec.kind), scene, runs_root, SECTIONS, (), compute, force,
                      extra_key=spec.key())
@@ -120,27 +96,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     return out
 
 
-def load(path: Path | str) -> dict:
-    """A stability-map artifact as a dict of arrays (strings decoded)."""
-    out: dict = {}
-    with open_artifact(path) as f:
-        out["attrs"] = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
-        for k in ("y_values", "slopes_deg", *CELL_FIELDS):
-            v = f[k][()]
-            if v.dtype.kind in ("S", "O"):
-                v = np.array([[x.decode() if isinstance(x, bytes) else str(x) for x in r]
-                              for r in v], dtype=object)
-            out[k] = v
-    return out
-
-
 def draw(path: Path | str, out_dir: Path | str | None = None) -> list[Path]:
     """Figure of a stability-map artifact (``<stem>.png``, ``.svg``) in ``out_dir`` (default:
     the report's figures folder next to the artifact, ``report/figures/``)."""
     from walkerlab.plotting.sweep_figures import gait_map_figure, save
 
     path = Path(path)
-    data = load(path)
+    data = load_stability_map(path)
     fig = gait_map_figure(data)
     return save(fig, Path(out_dir) if out_dir is not None else path.parent / "report" / "figures",
                 path.stem)

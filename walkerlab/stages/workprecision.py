@@ -31,18 +31,17 @@ import numpy as np
 
 from walkerlab.analysis.workprecision import (
     CYRK_PREFIX,
-    SINGLE_RUN_S,
     Case,
-    Lanes,
     rows_from_cases,
     run_cases,
     runner_for,
     summarize,
 )
 from walkerlab.config import Scene
-from walkerlab.io.artifacts import put
+from walkerlab.execution.lanes import Lanes
 from walkerlab.io.runpaths import run_cache_dir
-from walkerlab.stages import fixedpoint as fixedpoint_stage
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.io.schemas.workprecision import WorkPrecisionRun, write_workprecision
 from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "fixedpoint", "workprecision", "contact", "terrain",
@@ -89,9 +88,9 @@ def _reference_method() -> str:
     """The ideal model's reference integrator: CyRK's DOP853 when installed (the same steps
     as scipy's DOP853, measured: the two reference vectors at rtol 1e-13 differ by 1.0e-13,
     the accuracy both reach, at 0.06 s instead of 0.7 s CPU), else scipy's."""
-    from walkerlab.analysis.hybrid import _have_cyrk
+    from walkerlab.integrate.solver import available_backends
 
-    return CYRK_PREFIX + "DOP853" if _have_cyrk() else "DOP853"
+    return CYRK_PREFIX + "DOP853" if "cyrk" in available_backends() else "DOP853"
 
 
 def plan(scene: Scene) -> dict:
@@ -100,10 +99,10 @@ def plan(scene: Scene) -> dict:
     wp = require(scene, "workprecision", "workprecision")
     out = {}
     if "ideal" in wp.models:
-        from walkerlab.analysis.hybrid import CYRK_METHODS, _have_cyrk
+        from walkerlab.integrate.solver import CYRK_METHODS, available_backends
 
         extra = ([CYRK_PREFIX + m for m in wp.methods if m in CYRK_METHODS]
-                 if _have_cyrk() else [])
+                 if "cyrk" in available_backends() else [])
         out["ideal"] = (list(wp.methods) + extra, list(wp.rtols), wp.atol_factor,
                         (_reference_method(), wp.reference_rtol, wp.reference_rtol),
                         wp.target_error, scene.section_json(*IDEAL_SECTIONS))
@@ -129,10 +128,10 @@ def warm_up(scene: Scene, runs_root: Path | str, model: str) -> None:
     p = plan(scene)
     if model not in p:
         return
-    x0, meta = fixedpoint_stage.load_fixed_point(artifact_path(scene, runs_root, "fixedpoint"))
+    fp = load_fixedpoint(artifact_path(scene, runs_root, "fixedpoint"))
     wp = require(scene, "workprecision", "workprecision")
     runner_for(model, json.dumps(scene.model_dump(mode="json"), sort_keys=True),
-               float(meta["step_period_s"]), tuple(float(v) for v in x0), wp.strides,
+               float(fp.step_period_s), tuple(float(v) for v in fp.x), wp.strides,
                _warm_cases(p[model]))
 
 
@@ -151,14 +150,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
 
     wp = require(scene, "workprecision", "workprecision")
-    fixedpoint_stage.run(scene, runs_root)
     up = (artifact_path(scene, runs_root, "fixedpoint"),)
 
     def compute():
-        x0, meta = fixedpoint_stage.load_fixed_point(up[0])
-        x0t = tuple(float(v) for v in x0)
+        fp = load_fixedpoint(up[0])
+        x0t = tuple(float(v) for v in fp.x)
         sj = json.dumps(scene.model_dump(mode="json"), sort_keys=True)
-        period = float(meta["step_period_s"])
+        period = float(fp.step_period_s)
         cache = run_cache_dir(scene, runs_root, "workprecision")
         if force and cache.is_dir():
             for f in cache.glob("*.json"):
@@ -188,47 +186,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             results[model] = (rows, summarize(rows, target), ref)
         n_cached = sum(1 for v in done.values() if v.get("cached"))
 
-        def writer(f):
-            for model, (rows, summ, ref) in results.items():
-                g = f.create_group(model)
-                g.attrs["reference_method"], g.attrs["reference_rtol"] = ref[:2]
-                for m, d in rows.items():
-                    put(g, f"{m}/rtol", d["rtol"], "-", "relative tolerance")
-                    put(g, f"{m}/time", d["time"], "s", "median wall time", clock="wall")
-                    put(g, f"{m}/time_min", d["time_min"], "s", "fastest of the repeats "
-                        "(wall time)", clock="wall")
-                    put(g, f"{m}/time_max", d["time_max"], "s", "slowest of the repeats "
-                        "(wall time)", clock="wall")
-                    put(g, f"{m}/cpu_time", d["cpu_time"], "s", "median process CPU time")
-                    put(g, f"{m}/repeats", d["repeats"], "-", "timed runs (1 when a run "
-                        f"takes > {SINGLE_RUN_S:g} s)")
-                    put(g, f"{m}/error", d["error"], "rad, rad/s (, s)",
-                        "max-norm error vs the reference (inf: run failed)")
-                    put(g, f"{m}/nfev", d["nfev"], "-", "RHS evaluations")
-                g.attrs["pareto_methods"] = [p[0] for p in summ["pareto"]]
-                g.attrs["pareto_rtol"] = [p[1] for p in summ["pareto"]]
-                g.attrs["pareto_time"] = [p[2] for p in summ["pareto"]]
-                g.attrs["pareto_error"] = [p[3] for p in summ["pareto"]]
-                if summ["best"]:
-                    g.attrs["best_method"], g.attrs["best_rtol"] = summ["best"][:2]
-                    g.attrs["best_time"], g.attrs["best_error"] = summ["best"][2:]
-                    g.attrs["best_time_min"], g.attrs["best_time_max"] = \
-                        summ["best_spread"][2], summ["best_spread"][4]
-                    g.attrs["best_repeats"] = summ["best_spread"][5]
-                    # whether the fastest setting is faster than the timing noise
-                    g.attrs["best_separated"] = summ["separated"]
-                    g.attrs["tied_methods"] = [c[0] for c in summ["tied"]] or [""]
-                    g.attrs["tied_rtol"] = [c[1] for c in summ["tied"]] or [np.nan]
-                    g.attrs["tied_time_min"] = [c[2] for c in summ["tied"]] or [np.nan]
-                    g.attrs["tied_time_max"] = [c[4] for c in summ["tied"]] or [np.nan]
-                g.attrs["target_error"] = (wp.target_error if model == "ideal"
-                                           else wp.contact_target_error)
-            f.attrs["timing"] = ("each case measured in a worker process pinned to its own "
-                                 "core, nothing else of walkerlab's on that core; an untimed "
-                                 "one-stride warm-up run per worker and method; wall and "
-                                 "process CPU time per run")
-            f.attrs["cases_reused_from_cache"] = n_cached
-            f.attrs["cases_total"] = len(done)
-        return writer, {k: v[1] for k, v in results.items()}
+        run = WorkPrecisionRun(results, n_cached, len(done), wp.target_error,
+                               wp.contact_target_error)
+        return (lambda f: write_workprecision(f, run)), {k: v[1] for k, v in results.items()}
 
     return run_cached("workprecision", scene, runs_root, SECTIONS, up, compute, force)

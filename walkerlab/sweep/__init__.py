@@ -8,27 +8,11 @@
 - :mod:`walkerlab.sweep.bifurcation` period-doubling diagram of the ideal walker over the slope
 - :mod:`walkerlab.sweep.stability`  stability maps of the contact model
 
-The stage entry point is :func:`walkerlab.stages.sweep.run`.
+The stage entry point is :func:`walkerlab.stages.sweep.run`; the Python front door's is
+:func:`walkerlab.api.sweep`.
 """
-
-import sys
-import types
 
 from walkerlab.sweep.outcomes import OUTCOMES
 from walkerlab.sweep.params import ParamAxis, SweepError, parse_param
 
 __all__ = ["OUTCOMES", "ParamAxis", "SweepError", "parse_param"]
-
-
-class _CallablePackage(types.ModuleType):
-    """``walkerlab.sweep`` is this package *and* the top-level API name
-    ``walkerlab.sweep(scene, param, values)``: once the package is imported, Python binds the
-    attribute ``walkerlab.sweep`` to it, so calling it calls :func:`walkerlab.api.sweep`."""
-
-    def __call__(self, *args, **kwargs):
-        from walkerlab.api import sweep
-
-        return sweep(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallablePackage

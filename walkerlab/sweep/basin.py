@@ -28,7 +28,7 @@ Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
                      strike that lands on the cell
 
 Cells are evaluated in chunks (one grid row each) by
-:func:`walkerlab.sweep.runner.iter_chunk_results` - in this process, on a local process pool
+:func:`walkerlab.sweep.runner.sweep_executor` - in this process, on a local process pool
 or on a Dask cluster - and written to a partial HDF5 file after every chunk, so an
 interrupted map resumes where it stopped.  Each finished grid row is stored with its hash
 (:func:`row_digest`, ``/row_hash``); on resume a row whose cells no longer match it (edited,
@@ -125,10 +125,12 @@ class HeelStrikeSlice:
     axes: np.ndarray
 
     def post(self, walker, u: np.ndarray) -> np.ndarray:
-        """Post-impact state ``walker.reset(x-)`` of the pre-impact state with ``free = u``."""
+        """Post-impact state ``walker.reset(x-)`` of the pre-impact state with ``free = u``
+        (legs that differ: the heel strike that closes a stride, leg2 swinging)."""
         z = self.z_pre.copy()
         z[self.free] = u
-        return np.asarray(walker.reset(np.asarray(walker.from_section(z), dtype=float)),
+        last = walker.for_stance(walker.legs[0])
+        return np.asarray(last.reset(np.asarray(last.from_section(z), dtype=float)),
                           dtype=float)
 
     def state(self, walker, values: tuple[float, float]) -> np.ndarray | None:
@@ -218,22 +220,28 @@ def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
     steps : int
         Steps taken until the outcome was decided.
     period : int
-        Period of the attractor reached (1 for the fixed point, 0 if none).
+        Period of the attractor reached, in Poincare maps (strides when the legs differ;
+        1 for the fixed point, 0 if none).
     """
-    from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.integrate.rigid import integrate_step
 
     x = np.asarray(x0, dtype=float)
     hist = [x]
+    per_map = walker.steps_per_map  # legs that differ: the section is reached every stride
     for k in range(1, settings.max_steps + 1):
-        seg = integrate_step(walker, x, solver, max_step_time=max_step_time)
+        stance = walker.legs[1] if (k - 1) % per_map == 0 else walker.legs[0]
+        step_walker = walker.for_stance(stance)
+        seg = integrate_step(step_walker, x, solver, max_step_time=max_step_time)
         if seg.termination == "fall":
-            hip = walker.points(seg.x_end)["hip"]
+            hip = step_walker.points(seg.x_end)["hip"]
             return CODE["fell_forward" if float(hip[0]) > 0 else "fell_backward"], k, 0
         if seg.termination != "heel_strike":
             return CODE["stalled"], k, 0
         x = seg.x_next
         if not np.all(np.isfinite(x)):
             return CODE["stalled"], k, 0
+        if k % per_map:  # mid-stride: not on the Poincare section of a stride map
+            continue
         if float(np.max(np.abs(x - x_star))) < settings.converge_tol:
             return CODE["converged"], k, 1
         for p in range(1, min(settings.max_period, len(hist)) + 1):
@@ -284,7 +292,7 @@ def _walker_and_settings(base: dict):
 
 def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]``."""
-    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.integrate.solver import Solver
 
     walker, st, max_step_time = _walker_and_settings(task.base)
     solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
@@ -312,11 +320,17 @@ def pre_impact_fixed_point(walker, x_star: np.ndarray, settings, max_step_time: 
     BasinError
         The step from ``x_star`` does not end in a heel strike.
     """
-    from walkerlab.analysis.hybrid import Solver, integrate_step
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
 
-    seg = integrate_step(walker, np.asarray(x_star, dtype=float),
-                         Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend),
-                         max_step_time=max_step_time)
+    solver = Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend)
+    x = np.asarray(x_star, dtype=float)
+    for k in range(walker.steps_per_map):  # legs that differ: the stride's closing step
+        seg = integrate_step(walker.for_stance(walker.legs[1 - k % 2]), x, solver,
+                             max_step_time=max_step_time)
+        if seg.termination != "heel_strike":
+            break
+        x = seg.x_next
     if seg.termination != "heel_strike":
         raise BasinError(f"basin.start: the step from the fixed point ended in "
                          f"{seg.termination!r}, not a heel strike")
@@ -358,7 +372,7 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     grid : (nx, ny), optional
         Overrides ``basin.grid``.
     workers, scheduler
-        As for :func:`walkerlab.sweep.runner.iter_chunk_results`.
+        As for :func:`walkerlab.sweep.runner.sweep_executor`.
     resume : bool
         Keep the cells of a matching partial file.
     on_chunk : callable(done, total), optional
@@ -377,7 +391,8 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     """
     import h5py
 
-    from walkerlab.sweep.runner import iter_chunk_results
+    from walkerlab.execution.executor import run_each
+    from walkerlab.sweep.runner import sweep_executor
 
     base = scene.model_dump(mode="json")
     walker, st, mst = _walker_and_settings(base)
@@ -446,23 +461,24 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
         dsets = {k: f.create_dataset(k, data=v) for k, v in arrays.items()}
         hashes = f.create_dataset("row_hash", data=row_hash, dtype=h5py.string_dtype())
         f.flush()
-        for rows in iter_chunk_results(tasks, workers, scheduler, fn=run_basin_chunk):
-            for idx, code, steps, period in rows:
-                j, i = divmod(idx, nx)
-                arrays["outcome"][j, i] = code
-                arrays["steps"][j, i] = steps
-                arrays["period"][j, i] = period
-            for j in sorted({idx // nx for idx, *_ in rows}):
-                if np.all(arrays["outcome"][j] != NOT_DONE):
-                    row_hash[j] = row_digest(arrays, j, key)
-            for k, d in dsets.items():
-                d[...] = arrays[k]
-            hashes[...] = row_hash
-            f.flush()
-            computed += len(rows)
-            done += len(rows)
-            bar.update(done)
-            if on_chunk is not None:
-                on_chunk(done, total)
+        with sweep_executor(workers, scheduler) as ex:
+            for _, rows in run_each(ex, run_basin_chunk, [(t,) for t in tasks]):
+                for idx, code, steps, period in rows:
+                    j, i = divmod(idx, nx)
+                    arrays["outcome"][j, i] = code
+                    arrays["steps"][j, i] = steps
+                    arrays["period"][j, i] = period
+                for j in sorted({idx // nx for idx, *_ in rows}):
+                    if np.all(arrays["outcome"][j] != NOT_DONE):
+                        row_hash[j] = row_digest(arrays, j, key)
+                for k, d in dsets.items():
+                    d[...] = arrays[k]
+                hashes[...] = row_hash
+                f.flush()
+                computed += len(rows)
+                done += len(rows)
+                bar.update(done)
+                if on_chunk is not None:
+                    on_chunk(done, total)
     return {"x": xs, "y": ys, **arrays, "wall_time_s": time.perf_counter() - t0,
             "cells_computed": computed, "partial": part, "settings": st, "walker": walker}

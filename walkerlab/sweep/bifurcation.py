@@ -21,7 +21,7 @@ the field's dotted path with the field's unit (from its name or metadata,
 it carries the field in its ``path`` attribute.
 
 Grid chunks (the runs up and down from the scene's slope) are evaluated with the sweep
-executors (:func:`walkerlab.sweep.runner.iter_chunk_results`), locally or on Dask.  Arrays
+executors (:func:`walkerlab.sweep.runner.sweep_executor`), locally or on Dask.  Arrays
 are sized by the walker (``walker.state_names()``); the cached stage that writes the
 artifact is :mod:`walkerlab.stages.bifurcation`.
 """
@@ -37,8 +37,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 from walkerlab.config import Scene
+from walkerlab.execution.executor import run_each
 from walkerlab.sweep.params import ParamAxis
-from walkerlab.sweep.runner import iter_chunk_results, plan_chunks
+from walkerlab.sweep.runner import plan_chunks, sweep_executor
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
            "min_real_multiplier", "bifurcation_writer", "load_bifurcation", "SLOPE_PATH",
@@ -100,13 +101,16 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     """Fixed point + steady state along one run of parameter values (worker side)."""
     import warnings
 
-    from walkerlab.analysis.hybrid import Solver, simulate_steps
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
     from walkerlab.sweep.points import _Outcome, ideal_fixed_point, interleg_angle, warm_up
 
     warm_up()
+    from walkerlab.sweep.continuation import scene_family
+
     out = []
-    guess = None
+    guess = prev = fam = None
     x_att = None
     for index, (value,) in task.points:
         t0 = time.perf_counter()
@@ -119,10 +123,19 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
             warnings.simplefilter("ignore")
             scene = _scene_at(task.base, value, task.path)
             try:
-                walker, res, _src = ideal_fixed_point(scene, guess)
-                guess = res.x
-                row.update(x=res.x, multipliers=np.asarray(res.multipliers_variational, complex),
-                           period_s=res.period_s)
+                if fam is None:  # the walker over the grid's field, built once a chunk
+                    fam = scene_family(scene, task.path)
+                q = _arclength_step(fam, prev, value)
+                if q is not None:  # the neighbour's branch followed to this value
+                    walker = build_walker(scene)
+                    row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
+                               period_s=q.period_s / walker.steps_per_map)  # per step
+                else:
+                    walker, res, _src = ideal_fixed_point(scene, guess)
+                    row.update(x=res.x, period_s=res.period_s / walker.steps_per_map,
+                               multipliers=np.asarray(res.multipliers_variational, complex))
+                guess = row["x"]
+                prev = (value, q if q is not None else row["x"])
             except _Outcome as exc:
                 row.update(fp_outcome=exc.outcome, message=exc.message)
                 walker = build_walker(scene)
@@ -161,6 +174,33 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
         row["wall_time_s"] = time.perf_counter() - t0
         out.append(row)
     return out
+
+
+def _arclength_step(fam, prev, value: float):
+    """The fixed point at ``value`` on the branch of the previous grid value's
+    (``prev = (value, BranchPoint or state)``), by pseudo-arclength continuation
+    (:func:`walkerlab.analysis.continuation.continue_branch`), which does not jump to the
+    other gait of a long/short-period pair as a large natural-parameter step can (paper_rods
+    at 3 kg, issue 23).  None when there is no previous point or the branch does not reach
+    ``value`` (a fold in between): the caller falls back to the root finder.
+    """
+    from walkerlab.analysis.continuation import MapFailed, continue_branch, first_point
+
+    if prev is None:
+        return None
+    v0, q0 = prev
+    span = abs(value - v0)
+    if span == 0:
+        return None
+    try:
+        if isinstance(q0, np.ndarray):
+            q0 = first_point(fam, v0, q0, 1, span)
+        br = continue_branch(fam, q0, 1, (min(v0, value), max(v0, value)), span,
+                             1 if value > v0 else -1, ds=1.0, ds_max=1.0)
+    except MapFailed:
+        return None
+    last = br.points[-1]
+    return last if abs(last.p - value) <= 1e-12 * max(1.0, abs(value)) else None
 
 
 def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH
@@ -325,7 +365,7 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
     n_keep : int
         Last heel strikes kept per slope.
     workers, scheduler
-        As for :func:`walkerlab.sweep.runner.iter_chunk_results`.
+        As for :func:`walkerlab.sweep.runner.sweep_executor`.
     steady_state : bool
         Also simulate the steady state (False: fixed points and onset only).
     xtol_deg : float, optional
@@ -363,9 +403,10 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
 
     rows = []
     with progress.task(f"bifurcation: {slopes.size} values of {param}", slopes.size) as bar:
-        for rs in iter_chunk_results(tasks, workers, scheduler, fn=_bif_chunk):
-            rows += rs
-            bar.update(len(rows))
+        with sweep_executor(workers, scheduler) as ex:
+            for _, rs in run_each(ex, _bif_chunk, [(t,) for t in tasks]):
+                rows += rs
+                bar.update(len(rows))
     rows.sort(key=lambda r: r["index"])
     x = np.array([r["x"] for r in rows])
     mult = np.array([r["multipliers"] for r in rows])

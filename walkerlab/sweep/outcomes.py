@@ -138,13 +138,13 @@ def columns(stage: str, state_names: list[str], state_units: list[str]) -> dict[
 
 
 def walker_columns(stage: str, scene) -> dict[str, tuple]:
-    """:func:`columns` for the rigid walker of ``scene`` (builds it to read its state names)."""
+    """:func:`columns` for the rigid walker of ``scene`` (its state names from the walker's
+    description: :func:`walkerlab.models.registry.state_layout`, no walker built)."""
     if stage not in ("fixedpoint", "simulate"):
         return dict(COLUMNS[stage])
-    from walkerlab.models.registry import build_walker
+    from walkerlab.models.registry import state_layout
 
-    w = build_walker(scene)
-    return columns(stage, w.state_names(), w.state_units())
+    return columns(stage, *state_layout(scene))
 
 
 def empty_row(stage: str, index: int) -> dict:

@@ -80,7 +80,7 @@ class Task:
 
 # ----------------------------------------------------------------------------- helpers
 def _solver(scene: Scene):
-    from walkerlab.analysis.hybrid import Solver
+    from walkerlab.integrate.solver import Solver
 
     return Solver.from_settings(scene.solver)
 
@@ -263,7 +263,9 @@ def _fp_columns(walker, res) -> dict:
     for k in range(len(walker.state_names())):
         z = mult[k] if k < mult.size else complex(math.nan, math.nan)
         cols[f"multiplier_{k}_re"], cols[f"multiplier_{k}_im"] = float(z.real), float(z.imag)
-    cols.update(step_period_s=float(res.period_s), residual=float(res.residual),
+    # per step: a stride map's period (legs that differ) is two steps'
+    cols.update(step_period_s=float(res.period_s) / walker.steps_per_map,
+                residual=float(res.residual),
                 max_abs_multiplier=float(np.max(np.abs(mult))), stable=float(res.stable),
                 map_evaluations=float(res.iterations),
                 variational_maps=float(res.variational_maps), nfev=float(res.nfev))
@@ -307,8 +309,8 @@ def simulate_point(scene: Scene, guess, options: dict):
     The initial state is the scene's explicit state, or (``initial_state: fixed_point``)
     the fixed point found at this point (continuation from ``guess``).
     """
-    from walkerlab.analysis.hybrid import simulate_steps
     from walkerlab.config import SimulateSettings
+    from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.models.registry import build_walker
 
     opts = {**DEFAULT_OPTIONS, **options}
@@ -404,7 +406,7 @@ def contact_point(scene: Scene, guess, options: dict):
     foot left the ground and came back) and ``max_steps`` (stalled).
     """
     from walkerlab.analysis.contact_gait import classify_complete
-    from walkerlab.analysis.hybrid import integrate_step
+    from walkerlab.integrate.rigid import integrate_step
 
     opts = {**DEFAULT_OPTIONS, **options}
     walker, fp, source = ideal_fixed_point(scene, guess, options)
@@ -533,15 +535,15 @@ def warm_up() -> None:
     """Import the root-finding and integration libraries once (called in fresh worker
     processes and in the forkserver), so that processes forked from the forkserver start
     warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise).  CyRK comes through
-    :mod:`walkerlab.analysis.cyrk_loader` (its ``pysolve_ivp`` without numba, ~0.2 s less);
+    :mod:`walkerlab.integrate.cyrk_loader` (its ``pysolve_ivp`` without numba, ~0.2 s less);
     the model code is built per scene by the points themselves (cached on disk)."""
     try:
         import scipy.optimize  # noqa: F401
 
-        from walkerlab.analysis.hybrid import _have_cyrk
+        from walkerlab.integrate.solver import available_backends
 
-        if _have_cyrk():
-            from walkerlab.analysis.cyrk_loader import pysolve_ivp
+        if "cyrk" in available_backends():
+            from walkerlab.integrate.cyrk_loader import pysolve_ivp
 
             pysolve_ivp()
     except Exception:  # noqa: BLE001 - warming is an optimisation only

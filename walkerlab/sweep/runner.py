@@ -16,9 +16,12 @@ is therefore dealt out *interleaved* into ``k`` chains (points ``0, k, 2k, ...``
 
 Executors
 ---------
+The chains run on the one executor protocol of :mod:`walkerlab.execution`
+(:func:`sweep_executor`):
+
 - ``workers == 1`` and no scheduler: in this process (no start-up cost).
-- ``workers >= 2`` and no scheduler: ``concurrent.futures.ProcessPoolExecutor`` (forkserver
-  processes on Linux, with the model functions built once in the server).
+- ``workers >= 2`` and no scheduler: a local process pool (forkserver processes on Linux,
+  with the model functions built once in the server).
 - ``scheduler`` given: a Dask ``distributed`` cluster at that address (or a ``Client``);
   the same :func:`run_piece` runs on its workers.
 
@@ -32,7 +35,7 @@ Progress and robustness (issue 12)
   workers on a 2-core machine), and on an interruption.
 - Local pool workers watch the main process and exit within about a second when it dies,
   even by SIGKILL (D7); the forkserver and resource tracker then exit on their own (one
-  mechanism for every pool of walkerlab: :mod:`walkerlab.workers`).
+  mechanism for every pool of walkerlab: :mod:`walkerlab.execution.workers`).
 - The grid is capped at :data:`MAX_GRID_POINTS` points (product of the axes, D3).
 - One sweep per artifact at a time: a second identical sweep fails with one line (D4), and
   an artifact is finalized only when every grid point has its row.
@@ -58,7 +61,6 @@ import json
 import math
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, as_completed, wait
 from contextlib import nullcontext
 from pathlib import Path
 from typing import Any
@@ -68,27 +70,20 @@ import numpy as np
 import walkerlab
 from walkerlab import progress as _progress
 from walkerlab.config import MAX_SWEEP_POINTS, Scene
+from walkerlab.execution.executor import make_executor, run_chains
+from walkerlab.execution.workers import mp_context
 from walkerlab.io.artifacts import code_hash
 from walkerlab.sweep.outcomes import OUTCOMES, STAGES
 from walkerlab.sweep.params import ParamAxis, SweepError, grid_points
-from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, evaluate, run_chunk, warm_up
+from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, evaluate, warm_up
 from walkerlab.sweep.store import SweepStore, complete_sweep, partial_path
-from walkerlab.workers import mp_context, process_alive, process_pool
 
-__all__ = ["plan_chunks", "run_sweep", "iter_chunk_results", "iter_piece_results",
-           "run_piece", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
+__all__ = ["plan_chunks", "run_sweep", "iter_piece_results", "run_piece", "sweep_executor",
+           "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
 
 MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
 FLUSH_EVERY_S = 0.5           # rows are written to the partial file at least this often [s]
-
-
-def _dask_client(scheduler):
-    """``(client, futures)`` for a Dask scheduler address or client (see
-    :func:`walkerlab.sweep.dask_client.open_client`)."""
-    from walkerlab.sweep.dask_client import open_client
-
-    return open_client(scheduler)
 
 
 def _dotted_get(d: dict, path: str):
@@ -181,10 +176,6 @@ def sweep_input_hash(scene: Scene, stage: str, axes: list[ParamAxis], options: d
     return h.hexdigest()
 
 
-# one parent watch and one process-start method for every pool (walkerlab.workers)
-_process_alive = process_alive
-
-
 def _worker_init() -> None:
     """Pool worker start-up (after its parent watch started): warm the model functions."""
     warm_up()
@@ -209,120 +200,49 @@ def run_piece(task: Task, guess: Any = None) -> tuple[list[dict], Any]:
     return rows, guess
 
 
+def _mp_context():
+    """The sweep pools' process context: forkserver with the model functions built once in
+    the server (:mod:`walkerlab.sweep._preload`)."""
+    return mp_context(preload=("walkerlab.sweep._preload",))
+
+
+def sweep_executor(workers: int = 2, scheduler=None, pool: bool | None = None):
+    """The executor of a sweep, a basin map or a bifurcation diagram
+    (:func:`walkerlab.execution.make_executor`): workers warmed with the model functions.
+
+    Parameters
+    ----------
+    workers : int
+        Local processes (ignored with a scheduler).
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address or client; a worker lost mid-study is replaced by Dask (its
+        job is recomputed elsewhere).
+    pool : bool, optional
+        Force (True) or forbid (False) a process pool; default: pool when ``workers > 1``.
+    """
+    return make_executor(workers, scheduler, pool, initializer=_worker_init,
+                         context=_mp_context)
+
+
 def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=None,
                        pool: bool | None = None, guesses: list | None = None
                        ) -> Iterator[tuple[int, int, list[dict], Any]]:
     """Evaluate chains of pieces; yield ``(chain, piece, rows, continuation after them)``
-    for each piece as soon as it returns.
-
-    The pieces of one chain run one after the other (each starts from its predecessor's
-    last fixed point); different chains run in parallel.
+    for each piece as soon as it returns (:func:`walkerlab.execution.run_chains` of
+    :func:`run_piece` on :func:`sweep_executor`).
 
     Parameters
     ----------
     chains : list of list of Task
     guesses : list, optional
         Continuation each chain starts from (a resumed chain's checkpoint); default None.
-    workers : int
-        Local processes (ignored with a scheduler).
-    scheduler : str or distributed.Client, optional
-        Dask scheduler address or client; a worker lost mid-sweep is replaced by Dask
-        (its piece is recomputed elsewhere).
-    pool : bool, optional
-        Force (True) or forbid (False) a process pool; default: pool when ``workers > 1``.
+    workers, scheduler, pool
+        As for :func:`sweep_executor`.
     """
-    first = list(guesses) if guesses is not None else [None] * len(chains)
-    live = [ci for ci, c in enumerate(chains) if c]
-    if not live:
+    if not any(chains):
         return
-    if scheduler is not None:
-        from walkerlab.sweep.dask_client import completed, result
-
-        with _dask_client(scheduler) as (client, futs):
-            where = {}
-            for ci in live:
-                f = client.submit(run_piece, chains[ci][0], first[ci], pure=False)
-                where[f.key] = (ci, 0)
-                futs.append(f)
-            ac = completed(client, futs)  # bounded wait for workers, one line if lost
-            for fut in ac:
-                rows, guess = result(client, fut)
-                ci, k = where.pop(fut.key)
-                if k + 1 < len(chains[ci]):
-                    nf = client.submit(run_piece, chains[ci][k + 1], guess, pure=False)
-                    where[nf.key] = (ci, k + 1)
-                    futs.append(nf)
-                    ac.add(nf)
-                yield ci, k, rows, guess
-        return
-    if not (pool if pool is not None else workers > 1):
-        warm_up()
-        for ci in live:
-            guess = first[ci]
-            for k, t in enumerate(chains[ci]):
-                rows, guess = run_piece(t, guess)
-                yield ci, k, rows, guess
-        return
-    ex = process_pool(workers, _mp_context(), _worker_init)
-    try:
-        pending = {}
-        for ci in live:
-            pending[ex.submit(run_piece, chains[ci][0], first[ci])] = (ci, 0)
-        while pending:
-            done, _ = wait(list(pending), return_when=FIRST_COMPLETED)
-            for fut in done:
-                ci, k = pending.pop(fut)
-                rows, guess = fut.result()
-                if k + 1 < len(chains[ci]):
-                    pending[ex.submit(run_piece, chains[ci][k + 1], guess)] = (ci, k + 1)
-                yield ci, k, rows, guess
-    finally:
-        ex.shutdown(wait=True, cancel_futures=True)
-
-
-def _mp_context():
-    return mp_context(preload=("walkerlab.sweep._preload",))
-
-
-def iter_chunk_results(tasks: list[Task], workers: int = 2, scheduler=None,
-                       fn: Callable = run_chunk, pool: bool | None = None) -> Iterator[Any]:
-    """Evaluate ``fn(task)`` for every task and yield results as they complete.
-
-    Parameters
-    ----------
-    tasks : list
-        Picklable task objects.
-    workers : int
-        Local processes (ignored with a scheduler).
-    scheduler : str or distributed.Client, optional
-        Dask scheduler address (``"tcp://..."``) or an existing client.
-    fn : callable
-        Top-level (picklable) function of one task.
-    pool : bool, optional
-        Force (True) or forbid (False) a process pool; default: pool when ``workers > 1``.
-    """
-    if not tasks:
-        return
-    if scheduler is not None:
-        from walkerlab.sweep.dask_client import completed, result
-
-        with _dask_client(scheduler) as (client, futs):
-            futs.extend(client.map(fn, tasks, pure=False))
-            for fut in completed(client, futs):
-                yield result(client, fut)
-        return
-    if not (pool if pool is not None else workers > 1):
-        warm_up()
-        for t in tasks:
-            yield fn(t)
-        return
-    ex = process_pool(workers, _mp_context(), _worker_init)
-    try:
-        futs = [ex.submit(fn, t) for t in tasks]
-        for fut in as_completed(futs):
-            yield fut.result()
-    finally:
-        ex.shutdown(wait=True, cancel_futures=True)
+    with sweep_executor(workers, scheduler, pool) as ex:
+        yield from run_chains(ex, run_piece, chains, guesses)
 
 
 def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,

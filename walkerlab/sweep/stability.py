@@ -202,8 +202,9 @@ def gait_map(scene, spec: MapSpec, workers: int = 2,
         Base scene (needs ``contact`` and ``fixedpoint``).
     spec : MapSpec
     workers : int
-        Worker processes (1 = in this process; more: :func:`walkerlab.workers.process_pool`,
-        ended within about a second when this process dies).
+        Worker processes (1 = in this process; more: a local process pool of
+        :func:`walkerlab.execution.executor.make_executor`, ended within about a second when
+        this process dies).
     progress : callable, optional
         ``progress(rows_done, rows_total)``.
 
@@ -216,29 +217,16 @@ def gait_map(scene, spec: MapSpec, workers: int = 2,
     base = scene.model_dump(mode="json")
     ny, nx = len(spec.y_values), len(spec.slopes_deg)
     rows: list = [None] * ny
-    if workers <= 1:
-        for iy in range(ny):
-            rows[iy] = gait_row(base, spec, iy)
+    from walkerlab.execution.executor import make_executor, run_each
+
+    # pool workers end with this process (SIGKILL, SIGTERM included) and do not inherit its
+    # open files (the artifact lock): walkerlab.execution.workers
+    with make_executor(workers) as ex:
+        for done, (iy, row) in enumerate(run_each(ex, gait_row,
+                                                  [(base, spec, iy) for iy in range(ny)]), 1):
+            rows[iy] = row
             if progress:
-                progress(iy + 1, ny)
-    else:
-        from concurrent.futures import as_completed
-
-        from walkerlab.workers import process_pool
-
-        # workers that end with this process (SIGKILL, SIGTERM included) and do not inherit
-        # its open files (the artifact lock): walkerlab.workers
-        ex = process_pool(workers)
-        try:
-            futs = {ex.submit(gait_row, base, spec, iy): iy for iy in range(ny)}
-            done = 0
-            for fut in as_completed(futs):
-                rows[futs[fut]] = fut.result()
-                done += 1
-                if progress:
-                    progress(done, ny)
-        finally:
-            ex.shutdown(wait=True, cancel_futures=True)
+                progress(done, ny)
     out = {"y_values": np.asarray(spec.y_values, float),
            "slopes_deg": np.asarray(spec.slopes_deg, float)}
     for f in CELL_FIELDS:

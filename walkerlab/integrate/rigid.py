@@ -4,7 +4,8 @@ A trajectory is a list of :class:`Segment` (one per step), each with its termina
 (``heel_strike``, ``fall``, ``t_final``, ``solver_failure``) and the event time and state, as
 PyBaMM's solutions record why they stopped.
 
-Integrators come from libraries, chosen by :class:`Solver` ``backend``:
+Integrators come from libraries, chosen by :class:`~walkerlab.integrate.solver.Solver`
+``backend``:
 
 - ``"scipy"``: ``scipy.integrate.solve_ivp`` (any of its methods); guards are its events.
 - ``"cyrk"``: ``CyRK.pysolve_ivp`` (Renaud, CyRK: the same explicit Runge-Kutta pairs as
@@ -15,7 +16,7 @@ Integrators come from libraries, chosen by :class:`Solver` ``backend``:
 - ``"cyrk_compiled"``: the same CyRK pairs with the phase's flow (and variational equations)
   compiled by numba (:mod:`walkerlab.models.compiled`, cached on disk), so each phase runs in
   C++ without Python callbacks; guards are located on the step points and by Brent's method
-  on the dense output (:mod:`walkerlab.analysis._compiled`).  Imports numba (about 1 s per
+  on the dense output (:mod:`walkerlab.integrate._compiled`).  Imports numba (about 1 s per
   process): meant for many-point studies.  A phase without a compiled flow (a replaced flow)
   falls back to ``cyrk``.
 - ``"auto"`` (default): ``cyrk`` for the methods it shares with scipy when it is installed,
@@ -29,24 +30,18 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Literal
 
 import numpy as np
 
 from walkerlab.models.base import HybridWalker, Phase, complex_step_jacobian
 
-#: How a rigid step ends: the rigid side of the shared run ends
-#: (:mod:`walkerlab.integrate.ends`); ``no_heel_strike`` is a heel strike at the step's own
-#: start (a walker that does not move: no step was taken).
-Termination = Literal["heel_strike", "fall", "t_final", "solver_failure", "no_heel_strike"]
+from .ends import RunEnd
+from .solver import Solver
 
 #: A heel strike this soon after the step began [s] is no step: the state sat on the
 #: heel-strike surface and never moved (slope 0, all-zero state; a passive step lasts
 #: tenths of a second or more).
 MIN_STEP_TIME_S = 1e-9
-
-#: methods both backends implement with the same Runge-Kutta pair and step control
-CYRK_METHODS = ("RK23", "RK45", "DOP853")
 
 
 def numeric_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
@@ -68,68 +63,6 @@ def numeric_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
             cols.append((np.asarray(fun(x + e), float) - np.asarray(fun(x - e), float))
                         / (2 * e[k]))
         return np.stack(cols, axis=1)
-
-
-def _have_cyrk() -> bool:
-    import importlib.util
-
-    return importlib.util.find_spec("CyRK") is not None
-
-
-@dataclass(frozen=True)
-class Solver:
-    """Integrator settings (mirrors :class:`walkerlab.config.SolverSettings`).
-
-    Attributes
-    ----------
-    method : str
-        Runge-Kutta pair or implicit method name as in ``solve_ivp`` (``"DOP853"``, ...).
-    rtol, atol : float
-        Relative and absolute tolerance.
-    max_step_s : float or None
-        Largest step [s].
-    backend : {"auto", "scipy", "cyrk", "cyrk_compiled"}
-        Library that integrates (see the module docstring).
-    """
-
-    method: str = "DOP853"
-    rtol: float = 1e-10
-    atol: float = 1e-10
-    max_step_s: float | None = None
-    backend: str = "auto"
-
-    @classmethod
-    def from_settings(cls, s) -> Solver:
-        return cls(s.method, s.rtol, s.atol, s.max_step_s, getattr(s, "backend", "auto"))
-
-    def kwargs(self) -> dict:
-        kw = {"method": self.method, "rtol": self.rtol, "atol": self.atol}
-        if self.max_step_s is not None:
-            kw["max_step"] = self.max_step_s
-        return kw
-
-    def resolved_backend(self) -> str:
-        """``"scipy"``, ``"cyrk"`` or ``"cyrk_compiled"``.
-
-        Raises
-        ------
-        ValueError
-            ``backend="cyrk"`` with a method CyRK does not share with scipy, or CyRK missing.
-        """
-        if self.backend == "scipy":
-            return "scipy"
-        ok = self.method in CYRK_METHODS
-        if self.backend in ("cyrk", "cyrk_compiled"):
-            if not ok:
-                raise ValueError(f"solver.backend: cyrk integrates {', '.join(CYRK_METHODS)}, "
-                                 f"not {self.method}")
-            if not _have_cyrk():
-                raise ValueError("solver.backend: cyrk is not installed (pip install CyRK)")
-            return self.backend
-        if self.backend != "auto":
-            raise ValueError(f"solver.backend: unknown backend {self.backend!r} "
-                             "(auto | scipy | cyrk | cyrk_compiled)")
-        return "cyrk" if ok and _have_cyrk() else "scipy"
 
 
 @dataclass
@@ -180,7 +113,7 @@ def _solve_phase(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
         evs.append(ev)
     y0 = np.ascontiguousarray(y0, dtype=float)
     if backend == "cyrk":
-        from walkerlab.analysis.cyrk_loader import pysolve_ivp as cyrk_solver
+        from walkerlab.integrate.cyrk_loader import pysolve_ivp as cyrk_solver
 
         pysolve_ivp = cyrk_solver()  # CyRK without its numba solvers (see cyrk_loader)
         count = [0]
@@ -246,8 +179,9 @@ class Segment:
     x_next : ndarray (2n,) or None
         State after the reset (heel strike only).
     termination : str
-        ``heel_strike``, ``fall``, ``t_final``, ``solver_failure`` or ``no_heel_strike``
-        (:mod:`walkerlab.integrate.ends`).
+        ``heel_strike``, ``fall``, ``t_final``, ``solver_failure`` or ``no_heel_strike``: the
+        value of a :class:`~walkerlab.integrate.ends.RunEnd` of
+        :data:`~walkerlab.integrate.ends.RIGID_ENDS`.
     event : str
         Name of the guard that fired (or ``""``).
     phase_times : dict[str, float]
@@ -358,7 +292,7 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     nfev = 0
     pieces = []
     phase_times = {}
-    termination, event, message = "t_final", "", ""
+    termination, event, message = RunEnd.T_FINAL, "", ""
     x_next = None
     for k, phase in enumerate(walker.phases):
         if variational:
@@ -383,7 +317,7 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         jac = (None if variational else phase.jacobian if phase.jacobian is not None
                else walker.variational)
         if backend == "cyrk_compiled" and phase.compiled is not None:
-            from walkerlab.analysis._compiled import solve_phase
+            from walkerlab.integrate._compiled import solve_phase
 
             run = _PhaseRun(*solve_phase(phase.compiled, variational, t, t_stop, y0,
                                          phase.guards, n, solver))
@@ -395,10 +329,10 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         pieces.append((phase, run.dense, (t, run.t_last)))
         t, x = run.t_last, run.y_last[:n].copy()
         if run.failed:
-            termination = "solver_failure"
+            termination = RunEnd.SOLVER_FAILURE
             break
         if run.event is None:
-            termination = "t_final"
+            termination = RunEnd.T_FINAL
             break
         guard = phase.guards[run.event]
         if variational:
@@ -417,14 +351,14 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
                                  _grad(guard, x_minus), DR) @ Phi
             continue
         if guard.outcome == "fall":
-            termination = "fall"
+            termination = RunEnd.FALL
             break
         if t - t0 <= MIN_STEP_TIME_S:
-            termination = "no_heel_strike"
+            termination = RunEnd.NO_HEEL_STRIKE
             message = (f"no step: the heel-strike guard fired at the step's start "
                        f"(t = {t0:.4g} s); the walker does not move")
             break
-        termination = "heel_strike"
+        termination = RunEnd.HEEL_STRIKE
         x_next = np.asarray(walker.reset(x), dtype=float)
         if variational:
             f_prev = np.asarray(phase.flow(t, x))
@@ -435,10 +369,11 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         break
     return Segment(
         index=index, stance_leg=stance_leg, t_start=t0, t_end=t, x_start=np.asarray(x0, float),
-        x_end=x, x_next=x_next, termination=termination, event=event, phase_times=phase_times,
+        x_end=x, x_next=x_next, termination=termination.value, event=event,
+        phase_times=phase_times,
         nfev=nfev, message=message, pieces=pieces,
         stance_foot_world=np.zeros(2) if stance_foot_world is None else stance_foot_world,
-        monodromy=Phi if (variational and termination == "heel_strike") else None,
+        monodromy=Phi if (variational and termination is RunEnd.HEEL_STRIKE) else None,
     )
 
 
@@ -456,7 +391,7 @@ class HybridTrajectory:
 
     @property
     def termination(self) -> str:
-        return self.segments[-1].termination if self.segments else "t_final"
+        return self.segments[-1].termination if self.segments else RunEnd.T_FINAL.value
 
 
 def other_leg(walker: HybridWalker, leg: str) -> str:
@@ -491,11 +426,12 @@ def simulate_steps(walker: HybridWalker, x0: np.ndarray, n_steps: int, solver: S
     x, t, leg = np.asarray(x0, float), 0.0, first_stance_leg
     foot = np.zeros(2)
     for k in range(n_steps):
-        seg = integrate_step(walker, x, solver, t0=t, max_step_time=max_step_time, index=k,
-                             stance_leg=leg, stance_foot_world=foot.copy())
+        step_walker = walker.for_stance(leg)  # legs that differ: each leg's own numbers
+        seg = integrate_step(step_walker, x, solver, t0=t, max_step_time=max_step_time,
+                             index=k, stance_leg=leg, stance_foot_world=foot.copy())
         segs.append(seg)
-        if seg.termination != "heel_strike":
+        if seg.termination != RunEnd.HEEL_STRIKE:
             break
-        foot = foot + walker.points(seg.x_end)["swing_foot"]
+        foot = foot + step_walker.points(seg.x_end)["swing_foot"]
         x, t, leg = seg.x_next, seg.t_end, other_leg(walker, leg)
     return HybridTrajectory(segs, time.perf_counter() - t0, walker)

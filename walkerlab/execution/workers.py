@@ -1,8 +1,8 @@
 """Worker processes that never outlive the process that started them (one place, every pool).
 
-Every local process pool of walkerlab (sweeps and basin maps: :mod:`walkerlab.sweep.runner`;
-stability maps: :mod:`walkerlab.sweep.stability`; the work-precision study's pinned lanes:
-:mod:`walkerlab.analysis.workprecision`) is built by :func:`process_pool`:
+Every local process pool of walkerlab (the pool executor of sweeps, basin maps, bifurcation
+diagrams and stability maps: :mod:`walkerlab.execution.executor`; the work-precision study's
+pinned lanes: :mod:`walkerlab.execution.lanes`) is built by :func:`process_pool`:
 
 - workers are started by ``forkserver`` (Linux) or ``spawn``, never by ``fork``: a forked
   worker would inherit the parent's open files, among them the artifact lock (it then held

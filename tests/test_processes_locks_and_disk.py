@@ -1,4 +1,5 @@
-"""Issue 19 (reliability, round two), items 1, 2, 3, 7, 10 and 14.
+"""Worker processes end with their parent, locks, a private code cache, symbolic links and a
+full disk (issue 19, round two: items 1, 2, 3, 7, 10 and 14).
 
 Each test names its item (``i1`` ... ``i14``) and fails on the code before the fix
 (commit 5a8281f).  Processes are checked by behaviour bounds only ("gone within 10 s"),

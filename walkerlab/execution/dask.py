@@ -1,17 +1,18 @@
-"""A Dask client that never waits forever and fails in one line (issue 26, reliability).
+"""Dask client helpers of :class:`walkerlab.execution.executor.DaskExecutor`: never wait
+forever, fail in one line (issue 26, reliability).
 
 Dask's scheduler keeps a task whose worker died and waits - silently, for ever - until
 another worker joins; a scheduler that dies cancels every future and its client logs
 tracebacks while it tries to reconnect.  Here:
 
-- :func:`open_client` connects to a scheduler address (or wraps a given client), keeps the
-  ``distributed`` loggers quiet while it is open (their tracebacks are not for users) and, on
-  exit, cancels unfinished futures and closes a client it opened;
+- :func:`connect` checks a scheduler address before a ``Client`` exists and connects
+  (one line when it cannot); :func:`quiet_distributed` keeps the ``distributed`` loggers
+  quiet while the executor is open (their tracebacks are not for users);
 - :func:`completed` yields futures as they finish, like ``distributed.as_completed``, but
-  raises :class:`DaskLost` (a :class:`~walkerlab.sweep.params.SweepError`, one line) when
-  the scheduler has had no worker for :func:`worker_wait_s` seconds while work is pending,
-  or when the connection to the scheduler is lost (cancelled futures).  A task that fails
-  on its own raises its own error, unchanged.
+  raises :class:`DaskLost` (a ``ValueError``, one line) when the scheduler has had no worker
+  for :func:`worker_wait_s` seconds while work is pending, or when the connection to the
+  scheduler is lost (cancelled futures); :func:`result` turns a cancelled or killed task
+  into that line too.  A task that fails on its own raises its own error, unchanged.
 
 The wait for workers is ``$WALKERLAB_DASK_WORKER_WAIT_S`` seconds (default
 :data:`WORKER_WAIT_S`): long enough for a worker to be restarted by its nanny or a batch
@@ -26,10 +27,8 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from walkerlab.sweep.params import SweepError
-
-__all__ = ["DaskLost", "open_client", "completed", "result", "worker_wait_s",
-           "WORKER_WAIT_S", "WAIT_ENV"]
+__all__ = ["DaskLost", "connect", "quiet_distributed", "completed", "result",
+           "worker_wait_s", "WORKER_WAIT_S", "WAIT_ENV"]
 
 #: default time a sweep waits for a Dask worker while none is connected [s]
 WORKER_WAIT_S = 60.0
@@ -40,7 +39,7 @@ POLL_S = 0.02
 CHECK_S = 1.0
 
 
-class DaskLost(SweepError):
+class DaskLost(ValueError):
     """The Dask cluster cannot finish the work (no workers, scheduler gone); one line."""
 
 
@@ -50,7 +49,7 @@ def worker_wait_s() -> float:
 
     Raises
     ------
-    SweepError
+    DaskLost
         The variable is not a positive number.
     """
     raw = os.environ.get(WAIT_ENV, "").strip()
@@ -61,12 +60,15 @@ def worker_wait_s() -> float:
     except ValueError:
         v = float("nan")
     if not (0 < v < 1e6):
-        raise SweepError(f"{WAIT_ENV}={raw!r}: give a number of seconds > 0")
+        raise DaskLost(f"{WAIT_ENV}={raw!r}: give a number of seconds > 0")
     return v
 
 
 @contextmanager
-def _quiet_distributed():
+def quiet_distributed():
+    """Silence the ``distributed`` loggers (each has a level of its own) until exit."""
+    import distributed  # noqa: F401 - its loggers (and their levels) exist from here on
+
     names = ["distributed"] + [n for n in list(logging.root.manager.loggerDict)
                                if n.startswith("distributed.")]
     logs = [logging.getLogger(n) for n in names]  # children have levels of their own
@@ -95,44 +97,21 @@ def _check_address(address: str) -> None:
                        "tcp://host:port") from None
 
 
-@contextmanager
-def open_client(scheduler):
-    """``(client, futures)`` for a scheduler address or a ``distributed.Client``.
-
-    On exit the unfinished futures in the list are cancelled and a client opened here is
-    closed.
+def connect(address: str):
+    """A ``distributed.Client`` of the scheduler at ``address``.
 
     Raises
     ------
     DaskLost
-        The scheduler cannot be reached (one line naming the address).
+        Not a network address, or the scheduler cannot be reached (one line naming it).
     """
     from distributed import Client
 
-    own = isinstance(scheduler, str)
-    if own:
-        _check_address(scheduler)
-    with _quiet_distributed():
-        if own:
-            try:
-                client = Client(scheduler, set_as_default=False)
-            except (OSError, TimeoutError) as exc:
-                raise DaskLost(f"Dask scheduler {scheduler}: cannot connect ({exc})") from None
-        else:
-            client = scheduler
-        futs: list = []
-        try:
-            yield client, futs
-        finally:
-            try:
-                client.cancel([f for f in futs if not f.done()])
-            except Exception:  # noqa: BLE001 - a lost scheduler: nothing left to cancel
-                pass
-            if own:
-                try:
-                    client.close(timeout=5)
-                except Exception:  # noqa: BLE001 - closing a client whose scheduler died
-                    pass
+    _check_address(address)
+    try:
+        return Client(address, set_as_default=False)
+    except (OSError, TimeoutError) as exc:
+        raise DaskLost(f"Dask scheduler {address}: cannot connect ({exc})") from None
 
 
 def _lost(client) -> DaskLost:
@@ -181,16 +160,17 @@ class _Completed:
         self.ac.add(fut)
 
     def __iter__(self):
+        return self
+
+    def __next__(self):
         no_workers_since: float | None = None
         checked = time.monotonic()
         while not self.ac.is_empty():
             if self.ac.has_ready():
-                no_workers_since = None
-                for fut in self.ac.next_batch(block=False):
-                    if fut.status == "cancelled":
-                        raise _lost(self.client)
-                    yield fut
-                continue
+                fut = next(self.ac)
+                if fut.status == "cancelled":
+                    raise _lost(self.client)
+                return fut
             time.sleep(POLL_S)
             now = time.monotonic()
             if now - checked < CHECK_S:
@@ -211,6 +191,7 @@ class _Completed:
                                f"{self.wait_s:g} s ({self.ac.count()} task(s) waiting); the "
                                "rows finished so far are kept: start workers (or raise "
                                f"{WAIT_ENV}) and rerun with --resume")
+        raise StopIteration
 
 
 def result(client, fut):

@@ -1,6 +1,6 @@
 """``cyrk_compiled`` backend: one phase integrated by CyRK's C++ solver with a compiled RHS.
 
-Internal module of :mod:`walkerlab.analysis.hybrid`.  The phase's flow (or flow plus
+Internal module of :mod:`walkerlab.integrate.rigid`.  The phase's flow (or flow plus
 variational equations) is the numba ``cfunc`` of :class:`walkerlab.models.compiled.CompiledFlow`,
 handed to CyRK's C entry point (``CyRK.nb.numba_solver.c_numba_cysolve_ivp``, through ctypes
 as in :mod:`walkerlab.contact._cyrk`), so the Runge-Kutta steps run without Python callbacks.

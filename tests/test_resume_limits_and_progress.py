@@ -1,5 +1,5 @@
-"""Issue 19 items 4, 5, 11, 12, 13 (resumable files that cannot lie, bounded inputs, hashes
-of results not timings, YAML limits, bit-identical resume) and issue 18 part 4 (progress).
+"""Resumable files that cannot lie, bounded inputs, hashes of results not timings, YAML
+limits, bit-identical resume (issue 19 items 4, 5, 11, 12, 13) and progress (issue 18 part 4).
 
 Each test fails on the code before the fix.  The physics is replaced by small fakes where
 the behaviour under test (partial files, caps, hashing, progress plumbing) does not depend
@@ -525,24 +525,16 @@ def test_progress_adjust_counts_contact_runs(monkeypatch):
 
 
 def test_contact_text_shows_the_rate_scale_adjust_found(tmp_path):
+    from walkerlab.io.schemas.contact_sim import ContactSimArtifact
     from walkerlab.report.text import contact_text
+    from walkerlab.units import Units
 
-    sc = scene_from_dict({**IDEAL, "name": "paper"})
-
-    def writer(f):
-        f.attrs["outcome"] = "completed"
-        f.create_dataset("initial_rate_scale", data=np.array([1.41, 1.74]))
-        f.create_dataset("adjust/objective", data=1e-4)
-
-    p = write_artifact(tmp_path / "contact.h5", "contact-sim", sc, "k", writer, 1.0)
+    c = ContactSimArtifact(tmp_path / "contact.h5", Units(), "t_final", "completed",
+                           initial_rate_scale=np.array([1.41, 1.74]),
+                           adjust={"objective": 1e-4})
     assert ("adjusted initial rate scale (found by --adjust): leg1 rates × 1.41; "
-            "leg2 rates × 1.74") in contact_text(p)
-
-    def named(f):  # the stage writes the scaled rates by name (a kneed walker: two a leg)
-        writer(f)
-        f.create_dataset("rate", data=["dtheta1_thigh dtheta1_shank",
-                                       "dtheta2_thigh dtheta2_shank"])
-
-    p = write_artifact(tmp_path / "named.h5", "contact-sim", sc, "k", named, 1.0)
+            "leg2 rates × 1.74") in contact_text(c)
+    # the stage writes the scaled rates by name (a kneed walker: two a leg)
+    c.rate_names = ["dtheta1_thigh dtheta1_shank", "dtheta2_thigh dtheta2_shank"]
     assert ("adjusted initial rate scale (found by --adjust): dtheta1_thigh dtheta1_shank × "
-            "1.41; dtheta2_thigh dtheta2_shank × 1.74") in contact_text(p)
+            "1.41; dtheta2_thigh dtheta2_shank × 1.74") in contact_text(c)

@@ -1,0 +1,72 @@
+"""What a contact run records beside its trajectory: the drop test of the scene's contact
+law, the rates an initial rate scale multiplies, and the run's headline numbers.
+
+Used by the ``contact-sim`` stage (:mod:`walkerlab.stages.contact_sim`), which writes them
+through :mod:`walkerlab.io.schemas.contact_sim`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from walkerlab.config import Scene
+from walkerlab.contact.scene import settings
+
+#: stiffness values of the drop test stored with every contact run, relative to the scene's
+#: own stiffness (the paper's k = 1e5 N/mm^2.2: 1e4 ... 1e9 N/mm^2.2)
+DROP_STIFFNESS_RATIO = (0.1, 0.3, 1.0, 3.0, 1e1, 3e1, 1e2, 3e2, 1e3, 3e3, 1e4)
+#: downward speed of the drop test at first contact [m/s, or the scene's speed unit]
+DROP_SPEED = 0.3
+#: the legs of a contact run, in the order of ``initial_rate_scale`` (swing, stance)
+LEGS = ["leg1", "leg2"]
+
+
+def drop_test(scene: Scene, mass_kg: float) -> dict:
+    """The drop test of the scene's contact law (:func:`walkerlab.analysis.contact_drop.
+    restitution_curve`): the walker's total mass ``mass_kg`` [kg] meeting flat ground at
+    :data:`DROP_SPEED`, at the stiffnesses :data:`DROP_STIFFNESS_RATIO` x the scene's.
+
+    The rigid-limit family starts from the scene's own contact (its stiffness is the
+    reference) when the scene follows the paper family, so both curves pass through the
+    scene's contact whatever its unit system (``reference_stiffness`` defaults to the
+    paper's 1e5 N/mm^2.2, which means nothing in SI units, e.g. round_feet.yaml's 4e9 N/m^2.2).
+    """
+    from walkerlab.analysis.contact_drop import restitution_curve
+
+    base = settings(scene)[0]
+    if base.stiffness_family == "paper":
+        base = base.model_copy(update={"reference_stiffness": base.stiffness})
+    ks = [base.stiffness * r for r in DROP_STIFFNESS_RATIO]
+    return restitution_curve(base, ks, mass_kg=float(mass_kg), v_in_m_per_s=DROP_SPEED)
+
+
+def rate_states(walker, leg: str) -> list[str]:
+    """Names of the rate states of ``leg``'s links (what one entry of
+    ``initial_rate_scale`` multiplies): ``dtheta1``; kneed ``dtheta1_thigh dtheta1_shank``."""
+    idx = walker.state_names()
+    n = walker.nq
+    return [idx[idx.index(s) + n] for s in walker.leg_angle_states(leg)]
+
+
+def run_summary(res) -> dict:
+    """Headline numbers of a contact run ``res`` (ContactResult): how it ended, heel strikes,
+    strides, stance slip and double-support creep [mm], peak penetration [mm], bounces,
+    scuffs, RHS/Jacobian evaluations and the integration's wall time [s]."""
+    steps = res.steps
+    slips = np.array([s.stance_slip_mm for s in steps])
+    creep = np.array([s.double_support_creep_mm for s in steps])
+    return {
+        "termination": res.termination,
+        "outcome": res.outcome.kind,
+        "heel_strikes": int(res.walked_steps),
+        "strides_completed": int(res.walked_steps // 2),
+        "mean_abs_stance_slip_mm": float(np.nanmean(np.abs(slips)))
+        if np.isfinite(slips).any() else np.nan,
+        "max_abs_stance_slip_mm": float(res.max_stance_slip_mm),
+        "total_double_support_creep_mm": float(np.sum(creep)) if creep.size else 0.0,
+        "peak_penetration_mm": float(max((s.peak_penetration_m for s in steps),
+                                         default=np.nan) * 1e3),
+        "total_bounces": int(sum(s.bounce_count for s in steps)),
+        "total_scuffs": int(sum(s.scuff_count for s in steps)),
+        "nfev": int(res.nfev), "njev": int(res.njev), "wall_time_s": float(res.wall_time_s),
+    }

@@ -1,0 +1,13 @@
+"""Where many-point work runs: one executor protocol (in this process, a local process pool,
+Dask) and the worker processes behind it.
+
+- :mod:`walkerlab.execution.executor`  :class:`Executor` (inline, pool, Dask),
+  :func:`make_executor`, :func:`run_chains` / :func:`run_each` (used by sweeps, basin maps,
+  bifurcation diagrams, stability maps)
+- :mod:`walkerlab.execution.lanes`     pinned single-process lanes of the work-precision
+  study (one worker per core, gates)
+- :mod:`walkerlab.execution.workers`   worker processes that end with their parent
+  (forkserver/spawn, parent watch), :func:`process_alive`
+
+Importing this package loads nothing heavy.
+"""

@@ -1,0 +1,109 @@
+"""``compare.h5``: the contact walker against the rigid one (writer and loader side by side).
+
+Layout: ``errors/`` (attributes ``legs``, ``coordinates``, ``definition``; dimension
+``time``: the ideal sample times within the common span [s]; ``coordinates/<name>``: error
+contact - ideal of each named coordinate, in its unit; ``limit_cycle_distance/<coordinate>``:
+mean distance between the two phase curves; ``max_abs_angle`` [rad], ``max_abs_rate``
+[rad/s]); ``metrics/{ideal,contact}/<name>``: the gait metrics of paper Table 3 (units in
+:data:`METRIC_UNITS`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.netcdf import coordinate
+from walkerlab.units import Units, for_artifact
+
+STAGE = "compare"
+METRIC_UNITS = {"t_left_s": "s", "t_right_s": "s", "t_cycle_s": "s", "v_com_m_per_s": "m/s",
+                "E_avg_J": "J", "E_avg_stance_frame_J": "J", "step_length_m": "m",
+                "step_length_left_m": "m", "step_length_right_m": "m",
+                "n_steps": "-"}
+
+
+@dataclass
+class Comparison:
+    """Errors and metrics of a contact run against the rigid run (the writer's input, and
+    what :func:`load_compare` returns with ``path`` and ``units`` set).
+
+    Attributes
+    ----------
+    legs : list of str
+    time : ndarray (k,)
+        Ideal sample times within the common span [s].
+    errors : dict[str, ndarray (k,)]
+        Error contact - ideal per named coordinate.
+    error_units : dict[str, str]
+    limit_cycle_distance : dict[str, float]
+        Per coordinate stem (``leg1`` ...): mean distance of the phase curves.
+    max_abs_angle_rad, max_abs_rate_rad_per_s : float
+    metrics : dict[str, dict[str, float]]
+        ``{"ideal": {...}, "contact": {...}}`` gait metrics (units :data:`METRIC_UNITS`).
+    metric_units : dict[str, str]
+    """
+
+    legs: list
+    time: np.ndarray
+    errors: dict
+    error_units: dict
+    limit_cycle_distance: dict
+    max_abs_angle_rad: float
+    max_abs_rate_rad_per_s: float
+    metrics: dict
+    metric_units: dict
+    path: Path | None = None
+    units: Units | None = None
+
+
+def write_compare(f, c: Comparison) -> None:
+    """Fill an open (in-memory) artifact with ``c`` (layout in the module docstring)."""
+    g = f.create_group("errors")
+    g.attrs["legs"] = c.legs
+    g.attrs["coordinates"] = list(c.errors)
+    g.attrs["definition"] = "contact - ideal, on the ideal sample times"
+    coordinate(g, "time", c.time, "s", "ideal sample times within the common span")
+    for n, e in c.errors.items():
+        put(g, f"coordinates/{n}", e, c.error_units[n], f"{n} error (contact - ideal)",
+            dims=("time",))
+    for stem, d in c.limit_cycle_distance.items():
+        put(g, f"limit_cycle_distance/{stem}", d, "rad (rates in rad/s)",
+            f"mean distance from the ideal phase curve of {stem} to the contact one")
+    put(g, "max_abs_angle", c.max_abs_angle_rad, "rad", "")
+    put(g, "max_abs_rate", c.max_abs_rate_rad_per_s, "rad/s", "")
+    for model, m in c.metrics.items():
+        for k, v in m.items():
+            put(f, f"metrics/{model}/{k}", v, METRIC_UNITS.get(k, "-"), k)
+
+
+def load_compare(path: Path) -> Comparison:
+    """Load ``compare.h5``.
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
+    """
+    with open_artifact(path, STAGE) as f:
+        g = f["errors"]
+        names = [str(x) for x in g.attrs["coordinates"]]
+        metrics, munits = {}, {}
+        if "metrics" in f:
+            for model in f["metrics"]:
+                m = f["metrics"][model]
+                metrics[model] = {k: m[k][()] for k in m}
+                munits.update({k: str(m[k].attrs.get("unit", "")) for k in m})
+        return Comparison(
+            legs=[str(x) for x in g.attrs["legs"]], time=g["time"][()],
+            errors={n: g[f"coordinates/{n}"][()] for n in names},
+            error_units={n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names},
+            limit_cycle_distance=({k: float(g["limit_cycle_distance"][k][()])
+                                   for k in g["limit_cycle_distance"]}
+                                  if "limit_cycle_distance" in g else {}),
+            max_abs_angle_rad=float(g["max_abs_angle"][()]),
+            max_abs_rate_rad_per_s=float(g["max_abs_rate"][()]),
+            metrics=metrics, metric_units=munits, path=Path(path), units=for_artifact(f))

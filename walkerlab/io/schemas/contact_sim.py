@@ -1,0 +1,371 @@
+"""``contact_sim.h5``: the compliant-contact walker's run (writer and loader side by side).
+
+Layout: the named ``samples/`` of :mod:`walkerlab.io.trajectory` (as ``simulate.h5``);
+root attributes ``model``, ``legs``, ``termination``, ``method``, ``outcome``,
+``outcome_message``, ``stiffness_family`` (``fall_time_s`` when it fell); ``outcome/``
+(event time [s], patch edge [m], hip height [m]); ``drop_test/`` (restitution, largest
+penetration [m] and contact time [s] of both stiffness families on dimension
+``stiffness``); ``contact_params_si/`` (the contact law in SI); ``terrain/`` (patch
+centres [m] per lane); ``initial_state`` (named by ``contact_state``),
+``initial_state_named/``, ``initial_state_ideal`` (the rigid fixed point it started from),
+``initial_rate_scale`` (on dimension ``rate``); ``feet/<leg>/`` (normal and friction force
+[N], penetration [m], slip velocity [m/s], touchdown/lift-off times [s]); ``events/``
+(heel-strike times [s] and legs); ``steps/`` (per step: times [s], stance slip and creep
+[mm], bounces, scuffs, peak penetration [m]); ``summary/``; optional ``periodic_gait/``
+(the contact model's own gait: period [s], step length [m], Floquet multipliers) and
+``adjust/`` (``--adjust``'s search).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.netcdf import coordinate
+from walkerlab.io.trajectory import NamedTrajectory, read_samples, write_samples
+from walkerlab.units import Units, for_artifact
+
+STAGE = "contact-sim"
+#: unit of each ``summary/`` entry (others: "-")
+SUMMARY_UNITS = {"mean_abs_stance_slip_mm": "mm", "peak_penetration_mm": "mm",
+                 "max_abs_stance_slip_mm": "mm", "total_double_support_creep_mm": "mm",
+                 "wall_time_s": "s"}
+
+
+@dataclass
+class ContactSimRun:
+    """What the contact-sim stage computed (the writer's input).
+
+    Attributes
+    ----------
+    walker : walkerlab.contact.generated walker
+        The floating contact walker (state names/units, lanes, contact law in SI).
+    result : ContactResult
+        The run (feet, events, steps, outcome).
+    samples : NamedTrajectory
+        The run on the shared named layout.
+    initial_state : ndarray (n_contact_states,)
+        Start state of the floating walker.
+    step_length_m : float
+        Ideal step length used to place the patches [m].
+    fixed_point : ndarray (2n,)
+        Rigid fixed point it started from [rad, rad/s].
+    fixed_point_names : list of str
+        Its role-ordered state names.
+    legs : list of str
+    rate_names : list of str
+        Per leg, the rate states one entry of the initial rate scale multiplies.
+    initial_rate_scale : ndarray (2,)
+        Multipliers used (the scene's or ``--adjust``'s).
+    stiffness_family : str
+    unit_system : str
+        The contact section's unit system ("mm-kg-s" or SI).
+    drop : dict
+        Drop test (:func:`walkerlab.analysis.contact_drop.restitution_curve`).
+    drop_speed_m_per_s : float
+    summary : dict
+    gait, gait_error : periodic contact gait or its error (or None)
+    adjust : dict or None
+        ``--adjust``'s result.
+    """
+
+    walker: object
+    result: object
+    samples: NamedTrajectory
+    initial_state: np.ndarray
+    step_length_m: float
+    fixed_point: np.ndarray
+    fixed_point_names: list
+    legs: list
+    rate_names: list
+    initial_rate_scale: np.ndarray
+    stiffness_family: str
+    unit_system: str
+    drop: dict
+    drop_speed_m_per_s: float
+    summary: dict
+    gait: object = None
+    gait_error: Exception | None = None
+    adjust: dict | None = None
+
+
+def _write_outcome_and_drop(f, run: ContactSimRun) -> None:
+    walker, res, drop = run.walker, run.result, run.drop
+    f.attrs["model"] = walker.model_name
+    f.attrs["legs"] = run.legs
+    f.attrs["termination"] = res.termination
+    f.attrs["method"] = res.method
+    f.attrs["outcome"] = res.outcome.kind
+    f.attrs["outcome_message"] = res.outcome.message
+    f.attrs["stiffness_family"] = run.stiffness_family
+    if res.fall_time is not None:
+        f.attrs["fall_time_s"] = res.fall_time
+    o = res.outcome
+    g = f.create_group("outcome")
+    g.attrs["kind"] = o.kind
+    g.attrs["foot"] = o.foot
+    g.attrs["message"] = o.message
+    put(g, "time", o.time_s, "s", "time of the event that set the outcome (NaN: none)")
+    put(g, "patch_edge", o.patch_edge_m, "m", "along-slope position of the patch side "
+        "hit by a trip (NaN: no trip)")
+    put(g, "hip_height", o.hip_height_m, "m", "hip height above the ground line at "
+        "the outcome time")
+    g = f.create_group("drop_test")
+    g.attrs["method"] = (f"point mass {walker.total_mass:.6g} kg (the walker's) meeting "
+                         f"flat ground at {run.drop_speed_m_per_s} m/s, no gravity "
+                         "(walkerlab.analysis.contact_drop); restitution = v_out / v_in")
+    g.attrs["mass_kg"] = float(walker.total_mass)
+    lu = "mm" if run.unit_system == "mm-kg-s" else "m"
+    coordinate(g, "stiffness", drop["stiffness"], f"N/{lu}^e",
+               "IMPACT stiffness in the scene's unit system")
+    k = ("stiffness",)
+    for fam in ("paper", "rigid_limit"):
+        put(g, f"{fam}/restitution", drop[fam]["restitution"], "-",
+            f"coefficient of restitution, {fam} family", dims=k)
+        put(g, f"{fam}/max_penetration", drop[fam]["max_penetration_m"], "m",
+            "largest penetration in the drop", dims=k)
+        put(g, f"{fam}/contact_time", drop[fam]["contact_time_s"], "s",
+            "duration of the contact (NaN: comes to rest)", dims=k)
+
+
+def _write_setup(f, run: ContactSimRun) -> None:
+    walker, c, x0 = run.walker, run.walker.contact, run.initial_state
+    for name, val, unit in (("stiffness", c.k, "N/m^e"), ("exponent", c.e, "-"),
+                            ("max_damping", c.cmax, "N s/m"),
+                            ("penetration_at_max_damping", c.dmax, "m"),
+                            ("mu_static", c.mu_s, "-"), ("mu_dynamic", c.mu_d, "-"),
+                            ("stiction_velocity", c.v_s, "m/s"),
+                            ("friction_velocity", c.v_d, "m/s")):
+        put(f, f"contact_params_si/{name}", val, unit, f"{name} in SI")
+    put(f, "terrain/step_length", run.step_length_m, "m", "ideal step length used for patches")
+    for leg, lane in (("leg1", walker.lane1), ("leg2", walker.lane2)):
+        coordinate(f.require_group("terrain"), f"patch_{leg}", np.arange(len(lane)),
+                   "-", f"patch number on {leg}'s lane")
+        put(f, f"terrain/lane_{leg}", lane, "m", "patch centres, along-slope s",
+            dims=(f"patch_{leg}",))
+    put(f, "terrain/patch_half_width", walker.patch_half_width, "m", "")
+    put(f, "terrain/continuous", bool(walker.continuous), "-", "")
+    coordinate(f, "contact_state", list(walker.state_names()), "-",
+               "state component of the floating contact walker")
+    put(f, "initial_state", x0, ", ".join(walker.state_units()),
+        "initial state, named by state_names", names=list(walker.state_names()),
+        dims=("contact_state",))
+    for name, val, unit in zip(walker.state_names(), x0, walker.state_units()):
+        put(f, f"initial_state_named/{name}", float(val), unit, f"initial {name}")
+    coordinate(f, "state", list(run.fixed_point_names), "-",
+               "state component of the rigid walker (role-ordered)")
+    put(f, "initial_state_ideal", run.fixed_point, "rad, rad/s",
+        "ideal fixed point (Table 2 MATLAB)", dims=("state",))
+    coordinate(f, "rate", run.rate_names, "-", "rates scaled (leg1 swing, leg2 stance)")
+    put(f, "initial_rate_scale", np.asarray(run.initial_rate_scale), "-",
+        f"multipliers on ({'; '.join(run.rate_names)})", dims=("rate",))
+
+
+def _write_feet_events_steps(f, run: ContactSimRun) -> None:
+    res, tr = run.result, run.samples
+    for leg, ft in res.feet.items():
+        g = f.create_group(f"feet/{leg}")
+        coordinate(g, "time", tr.time, "s", "sample time")
+        t = ("time",)
+        put(g, "normal_force", ft.normal_force, "N", "IMPACT normal force", dims=t)
+        put(g, "friction_force", ft.friction_force, "N", "Coulomb friction, down-slope",
+            dims=t)
+        put(g, "penetration", ft.penetration, "m", "signed penetration (<0: above)", dims=t)
+        put(g, "slip_velocity", ft.slip_velocity, "m/s", "tangential foot velocity", dims=t)
+        for ev in ("touchdown", "liftoff"):
+            times = getattr(ft, f"{ev}_times")
+            coordinate(g, ev, np.arange(len(times)), "-", f"{ev} number")
+            put(g, f"{ev}_times", times, "s", f"{ev} times of {leg}'s foot", dims=(ev,))
+    g = f.create_group("events")
+    legs = list(res.heel_strike_legs) or [""]
+    coordinate(g, "heel_strike", np.arange(len(legs)), "-", "heel strike number")
+    put(g, "heel_strike_times", res.heel_strike_times, "s", "heel-strike times",
+        dims=("heel_strike",) if len(res.heel_strike_times) == len(legs) else None)
+    put(g, "heel_strike_legs", legs, "-", "leg striking", dims=("heel_strike",))
+    steps = res.steps
+    g = f.create_group("steps")
+    coordinate(g, "step", np.arange(len(steps) or 1), "-", "step number")
+    s_dim = ("step",)
+    for fld, unit in (("t_start", "s"), ("t_end", "s"), ("period", "s"),
+                      ("stance_slip_mm", "mm"), ("double_support_creep_mm", "mm"),
+                      ("bounce_count", "-"), ("scuff_count", "-"),
+                      ("peak_penetration_m", "m"), ("liftoff_time", "s")):
+        put(g, fld, np.array([getattr(s, fld) for s in steps], dtype=float), unit, fld,
+            dims=s_dim if steps else None)
+    put(g, "stance_leg", [s.stance_leg for s in steps] or [""], "-", "stance leg",
+        dims=s_dim)
+
+
+def _write_periodic_and_adjust(f, run: ContactSimRun) -> None:
+    gait, gait_error, adj = run.gait, run.gait_error, run.adjust
+    if gait_error is not None:
+        g = f.create_group("periodic_gait")
+        g.attrs["outcome"] = gait_error.kind
+        g.attrs["message"] = str(gait_error)
+    if gait is not None:
+        g = f.create_group("periodic_gait")
+        g.attrs["section"] = "mid-stance (proximal links aligned), stance foot loaded only"
+        g.attrs["outcome"] = "ok"
+        for k, v in gait.fixed_point.items():
+            g.attrs[f"fixed_point_{k}"] = float(v)
+        put(g, "step_period", gait.period_s, "s", "period of the contact gait")
+        put(g, "step_length", gait.step_length_m, "m", "")
+        put(g, "residual", gait.residual, "-", "scaled map residual")
+        coordinate(g, "multiplier", np.arange(len(gait.multipliers)), "-",
+                   "Floquet multiplier number")
+        m = ("multiplier",)
+        put(g, "multipliers/real", gait.multipliers.real, "-",
+            "Floquet multipliers, real part", dims=m)
+        put(g, "multipliers/imag", gait.multipliers.imag, "-",
+            "Floquet multipliers, imag part", dims=m)
+        put(g, "multiplier_fd_spread", gait.multiplier_fd_spread, "-",
+            "change of the multipliers for FD steps x3 and /3")
+        put(g, "stable", bool(gait.stable), "-", "all |multipliers| < 1")
+        put(g, "converged", bool(gait.converged), "-", "residual below tolerance")
+    if adj is not None:
+        for k, v in adj.items():
+            if isinstance(v, (int, float, np.ndarray, list, tuple)):
+                v = np.asarray(v, dtype=float)
+                put(f, f"adjust/{k}", v, "-", k,
+                    dims=("rate",) if k == "scale" and v.shape == (2,) else None)
+
+
+def write_contact_sim(f, run: ContactSimRun) -> None:
+    """Fill an open (in-memory) artifact with ``run`` (layout in the module docstring)."""
+    _write_outcome_and_drop(f, run)
+    write_samples(f, run.samples)
+    _write_setup(f, run)
+    _write_feet_events_steps(f, run)
+    for k, v in run.summary.items():
+        if k not in ("termination", "outcome"):
+            put(f, f"summary/{k}", v, SUMMARY_UNITS.get(k, "-"), k)
+    _write_periodic_and_adjust(f, run)
+
+
+@dataclass
+class DropTest:
+    """The drop test stored with a contact run.
+
+    Attributes
+    ----------
+    stiffness : ndarray (n,)
+        IMPACT stiffnesses in the scene's unit system (``unit``).
+    unit : str
+    restitution : dict[str, ndarray (n,)]
+        Coefficient of restitution per family ("paper", "rigid_limit") [-].
+    mass_kg : float
+        Mass dropped [kg].
+    """
+
+    stiffness: np.ndarray
+    unit: str
+    restitution: dict
+    mass_kg: float
+
+
+@dataclass
+class PeriodicGait:
+    """The contact model's own periodic gait (or why it was not found: ``found`` False,
+    ``outcome`` and ``message``).  Period [s], step length [m], multipliers complex."""
+
+    found: bool
+    outcome: str
+    message: str = ""
+    step_period_s: float = np.nan
+    step_length_m: float = np.nan
+    multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0, complex))
+    stable: bool = False
+
+
+@dataclass
+class ContactSimArtifact:
+    """A loaded ``contact_sim.h5`` (units in the module docstring).
+
+    ``summary`` maps each ``summary/`` name to ``(value, unit)``; ``initial_rate_scale``
+    multiplies the rates named in ``rate_names`` (None in artifacts without them);
+    ``stage_wall_time_s``: the whole stage's compute time [s].
+    """
+
+    path: Path
+    units: Units
+    termination: str
+    outcome: str
+    outcome_message: str = ""
+    stiffness_family: str = "paper"
+    samples: NamedTrajectory | None = None
+    summary: dict = field(default_factory=dict)
+    stage_wall_time_s: float = np.nan
+    contact_params_si: dict = field(default_factory=dict)
+    initial_rate_scale: np.ndarray = field(default_factory=lambda: np.ones(2))
+    rate_names: list | None = None
+    heel_strike_times: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    steps: dict = field(default_factory=dict)
+    drop: DropTest | None = None
+    periodic: PeriodicGait | None = None
+    adjust: dict | None = None
+
+
+def _periodic(f) -> PeriodicGait | None:
+    if "periodic_gait" not in f:
+        return None
+    g = f["periodic_gait"]
+    if "step_period" not in g:
+        return PeriodicGait(False, str(g.attrs.get("outcome", "?")),
+                            str(g.attrs.get("message", "")))
+    return PeriodicGait(True, "ok", "", float(g["step_period"][()]),
+                        float(g["step_length"][()]),
+                        g["multipliers/real"][()] + 1j * g["multipliers/imag"][()],
+                        bool(g["stable"][()]))
+
+
+def load_contact_sim(path: Path) -> ContactSimArtifact:
+    """Load ``contact_sim.h5`` (a hand-built artifact may lack the setup records: they are
+    then empty).
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
+    """
+    with open_artifact(path, STAGE) as f:
+        term = str(f.attrs["termination"])
+        drop = None
+        if "drop_test" in f:
+            g = f["drop_test"]
+            drop = DropTest(g["stiffness"][()], str(g["stiffness"].attrs["unit"]),
+                            {fam: g[f"{fam}/restitution"][()]
+                             for fam in ("paper", "rigid_limit")},
+                            float(g.attrs.get("mass_kg", 20.0)))
+        steps = {k: f[f"steps/{k}"][()] for k in ("stance_slip_mm", "double_support_creep_mm",
+                                                   "period") if f"steps/{k}" in f}
+        return ContactSimArtifact(
+            path=Path(path), units=for_artifact(f), termination=term,
+            outcome=str(f.attrs.get("outcome", term)),
+            outcome_message=str(f.attrs.get("outcome_message", "")),
+            stiffness_family=str(f.attrs.get("stiffness_family", "paper")),
+            samples=read_samples(f),
+            summary={k: (f["summary"][k][()], str(f["summary"][k].attrs.get("unit", "")))
+                     for k in f["summary"]} if "summary" in f else {},
+            stage_wall_time_s=float(f.attrs.get("wall_time_s", np.nan)),
+            contact_params_si={k: (f["contact_params_si"][k][()],
+                                   str(f["contact_params_si"][k].attrs["unit"]))
+                               for k in f["contact_params_si"]}
+            if "contact_params_si" in f else {},
+            initial_rate_scale=(f["initial_rate_scale"][()] if "initial_rate_scale" in f
+                                else np.ones(2)),
+            rate_names=([str(v) for v in f["rate"][()].astype(str)] if "rate" in f else None),
+            heel_strike_times=(f["events/heel_strike_times"][()]
+                               if "events/heel_strike_times" in f else np.zeros(0)),
+            steps=steps, drop=drop, periodic=_periodic(f),
+            adjust={k: f["adjust"][k][()] for k in f["adjust"]} if "adjust" in f else None)
+
+
+def run_end(path: Path) -> tuple[str, str]:
+    """``(outcome, message)`` of a contact run (the outcome's name, e.g. "walked", "trip";
+    the message may be "")."""
+    with open_artifact(path, STAGE) as f:
+        return (str(f.attrs.get("outcome", f.attrs["termination"])),
+                str(f.attrs.get("outcome_message", "")))

@@ -1,0 +1,252 @@
+"""``fixedpoint.h5``: the period-1 gait of the rigid walker (writer and loader side by side).
+
+Layout: root attributes ``model``, ``variant``, ``state_names``, ``gait`` (label of the
+selected gait), ``gait_policy``, ``gait_source``, ``gaits``, ``gait_notes``,
+``gait_search``; dimension scales ``state``, ``state_in``, ``multiplier``; the selected
+gait's result at the root and every gait found under ``gaits/<label>/``, every equation
+variant under ``variants/<variant>/`` (or its ``error`` attribute), each with:
+``fixed_point/<state>`` [rad, rad/s] just after heel strike, ``initial_guess/<state>``,
+``step_period`` [s] (legs that differ: the mean step, with ``stride_period`` [s] and
+``steps/{period,length,swing_leg}`` on dimension ``step``), ``residual``,
+``floquet/{variational,finite_difference}/{real,imag,jacobian}``,
+``floquet/max_difference``, ``floquet/stable``, ``stats/`` (RHS evaluations, map
+evaluations, wall time [s]).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.netcdf import coordinate
+from walkerlab.units import Units, for_artifact
+
+STAGE = "fixedpoint"
+
+
+@dataclass
+class FixedPointRun:
+    """What the fixedpoint stage computed (the writer's input).
+
+    Attributes
+    ----------
+    walker : HybridWalker
+    search : walkerlab.analysis.gaits.GaitSearch
+        Every period-1 gait found and the one selected.
+    variants : dict[str, (HybridWalker, FixedPointResult) or Exception]
+        The scene's own equation variant first, then the others solved for comparison.
+    own_variant : str
+    other_guess : ndarray (2n,)
+        Starting point of the other variants' root finder.
+    """
+
+    walker: object
+    search: object
+    variants: dict
+    own_variant: str
+    other_guess: np.ndarray
+
+
+def _write_result(g, walker, res, guess) -> None:
+    names = walker.state_names()
+    units = walker.state_units()
+    g.attrs["variant"] = walker.variant
+    g.attrs["roles"] = list(walker.roles)
+    g.attrs["legs_by_role"] = json.dumps(walker.role_to_leg("leg2"))
+    for name, val, u in zip(names, res.x, units):
+        put(g, f"fixed_point/{name}", float(val), u, f"{name} just after heel strike")
+    for name, val, u in zip(names, guess, units):
+        put(g, f"initial_guess/{name}", float(val), u, "root-finder starting point")
+    steps = len(getattr(res, "step_periods_s", ()))
+    if steps > 1:  # legs that differ: the map is a stride; each step on its own
+        put(g, "step_period", res.period_s / steps, "s", "mean step period of the period-1 "
+            "gait (the Poincare map is a stride of two steps)")
+        put(g, "stride_period", res.period_s, "s", "stride period (period of the map)")
+        coordinate(g, "step", np.arange(steps), "-", "step of the stride (leg1 swings first)")
+        put(g, "steps/period", np.array(res.step_periods_s), "s", "period of each step",
+            dims=("step",))
+        put(g, "steps/length", np.array(res.step_lengths_m), "m", "length of each step "
+            "(stance foot to swing foot at heel strike)", dims=("step",))
+        put(g, "steps/swing_leg", np.array([b"leg1", b"leg2"][:steps]), "-",
+            "swing leg of each step", dims=("step",))
+    else:
+        put(g, "step_period", res.period_s, "s", "step period of the period-1 gait")
+    put(g, "residual", res.residual, "rad or rad/s", "max |P(x*) - x*| over the state")
+    for kind, ev, J in (("variational", res.multipliers_variational, res.jacobian_variational),
+                        ("finite_difference", res.multipliers_fd, res.jacobian_fd)):
+        put(g, f"floquet/{kind}/real", ev.real, "-", f"Floquet multipliers ({kind}), real part",
+            dims=("multiplier",))
+        put(g, f"floquet/{kind}/imag", ev.imag, "-", f"Floquet multipliers ({kind}), imag part",
+            dims=("multiplier",))
+        put(g, f"floquet/{kind}/jacobian", J, "-", "DP, rows/cols in state_names order",
+            dims=("state", "state_in"), state_names=names)
+    put(g, "floquet/max_difference", res.multiplier_difference, "-",
+        "max |multiplier(variational) - multiplier(finite difference)|")
+    put(g, "floquet/stable", res.stable, "-", "all |multipliers| < 1")
+    put(g, "stats/nfev", res.nfev, "-", "right-hand-side evaluations")
+    put(g, "stats/map_evaluations", res.iterations, "-", "Poincare-map calls by the root finder")
+    put(g, "stats/wall_time", res.wall_time_s, "s", "fixed-point search + Jacobians")
+
+
+def write_fixedpoint(f, run: FixedPointRun) -> None:
+    """Fill an open (in-memory) artifact with ``run`` (layout in the module docstring)."""
+    walker, search = run.walker, run.search
+    f.attrs["model"] = walker.name
+    f.attrs["variant"] = walker.variant
+    f.attrs["state_names"] = walker.state_names()
+    names = walker.state_names()
+    coordinate(f, "state", names, "-", "state component (role-ordered)")
+    coordinate(f, "state_in", names, "-", "state component perturbed (Jacobian column)")
+    coordinate(f, "multiplier", np.arange(len(names)), "-",
+               "Floquet multiplier number (sorted by modulus)")
+    guess = search.gait.start
+    _write_result(f, walker, search.result, guess)
+    f.attrs["gait"] = search.gait.label
+    f.attrs["gait_policy"] = search.policy
+    f.attrs["gait_source"] = search.gait.source
+    f.attrs["gaits"] = [g.label for g in search.gaits]
+    f.attrs["gait_notes"] = json.dumps(search.notes)
+    f.attrs["gait_search"] = json.dumps(search.tried)
+    for g in search.gaits:
+        grp = f.create_group(f"gaits/{g.label}")
+        _write_result(grp, walker, g.result, g.start)
+        grp.attrs["source"] = g.source
+    for v, r in run.variants.items():
+        if isinstance(r, Exception):
+            f.create_group(f"variants/{v}").attrs["error"] = str(r)
+        else:
+            _write_result(f.create_group(f"variants/{v}"), r[0], r[1],
+                          guess if v == run.own_variant else run.other_guess)
+
+
+@dataclass
+class GaitResult:
+    """One period-1 gait as stored (a group of ``fixedpoint.h5``).
+
+    Attributes
+    ----------
+    x : ndarray (2n,)
+        Fixed point in ``state_names`` order [rad, rad/s], just after heel strike.
+    step_period_s : float
+    residual : float
+        max |P(x*) - x*|.
+    multipliers, multipliers_fd : ndarray (2n,) complex
+        Floquet multipliers from the variational equations and from finite differences.
+    max_difference : float
+    stable : bool
+    source : str
+        How the gait was found ("initial_guess", "seed", "deflation"; "" at the root).
+    error : str
+        Why no fixed point was found ("" when found; then the other fields are NaN).
+    """
+
+    x: np.ndarray
+    step_period_s: float
+    residual: float
+    multipliers: np.ndarray
+    multipliers_fd: np.ndarray
+    max_difference: float
+    stable: bool
+    source: str = ""
+    error: str = ""
+    stride_period_s: float | None = None
+    step_periods_s: tuple = ()
+    step_lengths_m: tuple = ()
+    step_swing_legs: tuple = ()
+
+    def max_abs_multiplier(self) -> float:
+        """Largest |Floquet multiplier| (variational)."""
+        return float(np.max(np.abs(self.multipliers)))
+
+
+def _gait(g, names: list[str]) -> GaitResult:
+    if "error" in g.attrs:
+        return GaitResult(np.full(len(names), np.nan), np.nan, np.nan, np.zeros(0, complex),
+                          np.zeros(0, complex), np.nan, False, "", str(g.attrs["error"]))
+    return GaitResult(
+        x=np.array([g[f"fixed_point/{n}"][()] for n in names]),
+        step_period_s=float(g["step_period"][()]), residual=float(g["residual"][()]),
+        multipliers=g["floquet/variational/real"][()] + 1j * g["floquet/variational/imag"][()],
+        multipliers_fd=(g["floquet/finite_difference/real"][()]
+                        + 1j * g["floquet/finite_difference/imag"][()]),
+        max_difference=float(g["floquet/max_difference"][()]),
+        stable=bool(g["floquet/stable"][()]), source=str(g.attrs.get("source", "")),
+        **_stride(g))
+
+
+def _stride(g) -> dict:
+    """A stride map's own fields (legs that differ), empty otherwise."""
+    if "stride_period" not in g:
+        return {}
+    return {"stride_period_s": float(g["stride_period"][()]),
+            "step_periods_s": tuple(float(v) for v in g["steps/period"][()]),
+            "step_lengths_m": tuple(float(v) for v in g["steps/length"][()]),
+            "step_swing_legs": tuple(v.decode() if isinstance(v, bytes) else str(v)
+                                     for v in g["steps/swing_leg"][()])}
+
+
+@dataclass
+class FixedPointArtifact(GaitResult):
+    """A loaded ``fixedpoint.h5``: the selected gait (the inherited fields) and the rest.
+
+    Attributes
+    ----------
+    path : Path
+    units : Units
+        The scene's unit system.
+    model, variant : str
+        Walker model and the scene's equation variant.
+    state_names, state_units : list of str
+        Role-ordered state names and their units.
+    legs_by_role : dict[str, str]
+        Physical leg of each role ("swing" -> "leg1" ...).
+    gait, gait_policy : str
+        Label of the selected gait and the scene's ``fixedpoint.gait``.
+    gait_notes : list of str
+    gaits : dict[str, GaitResult]
+        Every gait found, by label.
+    variants : dict[str, GaitResult]
+        Every equation variant solved, by name (``error`` set where none was found).
+    """
+
+    path: Path = Path()
+    units: Units | None = None
+    model: str = ""
+    variant: str = ""
+    state_names: list = field(default_factory=list)
+    state_units: list = field(default_factory=list)
+    legs_by_role: dict = field(default_factory=dict)
+    gait: str = ""
+    gait_policy: str = ""
+    gait_notes: list = field(default_factory=list)
+    gaits: dict = field(default_factory=dict)
+    variants: dict = field(default_factory=dict)
+
+
+def load_fixedpoint(path: Path) -> FixedPointArtifact:
+    """Load ``fixedpoint.h5``.
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
+    """
+    with open_artifact(path, STAGE) as f:
+        names = [str(n) for n in f.attrs["state_names"]]
+        main = _gait(f, names)
+        return FixedPointArtifact(
+            **vars(main), path=Path(path), units=for_artifact(f), model=str(f.attrs["model"]),
+            variant=str(f.attrs["variant"]), state_names=names,
+            state_units=[str(f[f"fixed_point/{n}"].attrs["unit"]) for n in names],
+            legs_by_role=(json.loads(f.attrs["legs_by_role"]) if "legs_by_role" in f.attrs
+                          else {}),
+            gait=str(f.attrs.get("gait", "")), gait_policy=str(f.attrs.get("gait_policy", "")),
+            gait_notes=json.loads(f.attrs.get("gait_notes", "[]")),
+            gaits={str(lab): _gait(f[f"gaits/{lab}"], names)
+                   for lab in f.attrs.get("gaits", [])} if "gaits" in f else {},
+            variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
+            if "variants" in f else {})

@@ -1,0 +1,192 @@
+"""``simulate.h5``: N strides of the rigid hybrid walker (writer and loader side by side).
+
+Layout: root attributes ``model``, ``variant``, ``legs``, ``termination``,
+``strides_requested``, ``total_mass_kg``, ``gravity_m_per_s2``; ``state`` (dimension scale,
+role-ordered state names); ``samples/`` (:mod:`walkerlab.io.trajectory`); ``steps/`` (one
+row per step on dimension ``step``: ``t_start``, ``t_end``, ``period`` [s], ``step_length``
+[m], ``hip_speed`` [m/s], ``impact_energy_loss`` [J], ``stance_leg``, ``termination`` ...;
+``steps/states/<i>`` start/end state of each segment as attributes); ``initial_state``
+[rad, rad/s]; ``summary/<name>`` (mean step period [s], step length [m], hip speed [m/s],
+total energy [J], RHS evaluations, integration wall time [s]).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.netcdf import coordinate
+from walkerlab.io.trajectory import NamedTrajectory, read_samples, write_samples
+from walkerlab.units import Units, for_artifact
+
+STAGE = "simulate"
+#: unit of each ``steps/`` column
+STEP_UNITS = {"t_start": "s", "t_end": "s", "period": "s", "step_length": "m",
+              "hip_speed": "m/s", "impact_energy_loss": "J", "midstance_time": "s"}
+#: unit of each ``summary/`` entry (others: "-")
+SUMMARY_UNITS = {"wall_time_s": "s", "mean_period_s": "s", "mean_step_length_m": "m",
+                 "mean_hip_speed_m_per_s": "m/s", "mean_total_energy_J": "J"}
+
+
+@dataclass
+class SimulateRun:
+    """What the simulate stage computed (the writer's input).
+
+    Attributes
+    ----------
+    walker : walkerlab.models.base.HybridWalker
+        The walker simulated (name, variant, legs, state names, parameters).
+    trajectory : walkerlab.integrate.rigid.HybridTrajectory
+        Segments of the run (termination, start/end states).
+    samples : NamedTrajectory
+        Sampled trajectory.
+    steps : dict[str, ndarray (n_steps,)]
+        Per-step table (:func:`walkerlab.analysis.metrics.step_table`).
+    initial_state : ndarray (2n,)
+        Role-ordered initial state [rad, rad/s].
+    strides_requested : int
+    total_mass_kg : float
+    summary : dict
+        Headline numbers (``termination`` plus :data:`SUMMARY_UNITS` keys, ``nfev``,
+        ``steps_completed``).
+    """
+
+    walker: object
+    trajectory: object
+    samples: NamedTrajectory
+    steps: dict
+    initial_state: np.ndarray
+    strides_requested: int
+    total_mass_kg: float
+    summary: dict
+
+
+def write_simulate(f, run: SimulateRun) -> None:
+    """Fill an open (in-memory) artifact with ``run`` (layout in the module docstring)."""
+    walker, traj, steps = run.walker, run.trajectory, run.steps
+    f.attrs["model"] = walker.name
+    f.attrs["variant"] = walker.variant
+    f.attrs["legs"] = list(walker.legs)
+    f.attrs["termination"] = traj.termination
+    f.attrs["strides_requested"] = run.strides_requested
+    f.attrs["total_mass_kg"] = run.total_mass_kg
+    f.attrs["gravity_m_per_s2"] = float(walker.params["gravity_m_per_s2"])
+    names = walker.state_names()
+    coordinate(f, "state", names, "-", "state component (role-ordered)")
+    write_samples(f, run.samples)
+    g = f.create_group("steps")
+    coordinate(g, "step", steps["index"], "-", "step number")
+    for k, v in steps.items():
+        if k == "index":
+            continue
+        if v.dtype.kind in "US":
+            put(g, k, [str(s) for s in v], "-", k, dims=("step",))
+        else:
+            put(g, k, v, STEP_UNITS.get(k, "-"), k, dims=("step",))
+    for i, seg in enumerate(traj.segments):
+        sg = g.create_group(f"states/{i:04d}")
+        for nm, a, b in zip(names, seg.x_start, seg.x_end):
+            sg.attrs[f"start_{nm}"] = a
+            sg.attrs[f"end_{nm}"] = b
+    put(f, "initial_state", run.initial_state, "rad, rad/s", "role-ordered initial state",
+        dims=("state",), state_names=names)
+    for k, v in run.summary.items():
+        if k != "termination":
+            put(f, f"summary/{k}", v, SUMMARY_UNITS.get(k, "-"), k)
+
+
+@dataclass
+class SimulateArtifact:
+    """A loaded ``simulate.h5``.
+
+    Attributes
+    ----------
+    path : Path
+    units : Units
+        The scene's unit system (labels of times, lengths, energies).
+    termination : str
+        How the run ended ("heel_strike", "fall", ...).
+    strides_requested : int
+    total_mass_kg : float
+        [kg]
+    gravity_m_per_s2 : float
+        [m/s^2]
+    samples : NamedTrajectory
+    steps : dict[str, ndarray (n_steps,)]
+        ``step`` (int), ``stance_leg`` and ``termination`` (str), and the numeric columns
+        (units in :data:`STEP_UNITS`).
+    summary : dict[str, float]
+        ``summary/`` entries.
+    scene_json : str
+        The resolved scene the artifact was written for.
+    """
+
+    path: Path
+    units: Units
+    termination: str
+    strides_requested: int
+    total_mass_kg: float
+    gravity_m_per_s2: float
+    samples: NamedTrajectory
+    steps: dict = field(default_factory=dict)
+    summary: dict = field(default_factory=dict)
+    scene_json: str = "{}"
+
+    def heel_strike_count(self) -> int:
+        """Number of steps that ended by a heel strike."""
+        return int(np.sum(self.steps["termination"] == "heel_strike"))
+
+
+def load_simulate(path: Path) -> SimulateArtifact:
+    """Load ``simulate.h5`` (a hand-built artifact may hold only ``samples/``: what it lacks
+    of the rest is empty or NaN).
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing, unreadable, of another stage or version, or lacking a dataset (one line).
+    """
+    with open_artifact(path, STAGE) as f:
+        steps = {}
+        for k in f["steps"] if "steps" in f else ():
+            ds = f["steps"][k]
+            if not hasattr(ds, "dtype"):
+                continue  # the states/ group
+            steps[k] = ds.asstr()[()] if ds.dtype.kind == "O" else ds[()]
+        a = f.attrs
+        return SimulateArtifact(
+            path=Path(path), units=for_artifact(f), termination=str(a.get("termination", "")),
+            strides_requested=int(a.get("strides_requested", 0)),
+            total_mass_kg=float(a.get("total_mass_kg", np.nan)),
+            gravity_m_per_s2=float(a.get("gravity_m_per_s2", np.nan)),
+            samples=read_samples(f), steps=steps,
+            summary={k: f["summary"][k][()] for k in f["summary"]} if "summary" in f else {},
+            scene_json=str(a["scene_json"]))
+
+
+def strides_of(path: Path) -> int | None:
+    """``strides_requested`` of an existing ``simulate.h5``; None when absent or unreadable
+    (no version check: the caller verifies the hash)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            return int(f.attrs["strides_requested"])
+    except (OSError, KeyError, ValueError, TypeError):
+        return None
+
+
+def run_end(path: Path) -> str:
+    """How the run of ``simulate.h5`` ended (``termination``: "heel_strike" when every step
+    completed, "fall", ...).
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing or unreadable artifact (one line).
+    """
+    with open_artifact(path, STAGE) as f:
+        return str(f.attrs["termination"])

@@ -1,0 +1,110 @@
+"""``stability_map_<kind>.h5``: where the contact model has a periodic gait, over one
+contact parameter × the slope (writer and loader side by side).
+
+Layout: root attributes ``kind``, ``y_path`` (the scene field varied), ``y_label``,
+``stiffness_family``, ``unit_system``, ``time_limit_s``, ``method``; ``y_values`` (ny,)
+and ``slopes_deg`` (nx,) [deg]; one (ny, nx) array per cell field
+(:data:`walkerlab.sweep.stability.CELL_FIELDS`: ``exists``, ``stable``,
+``max_abs_multiplier``, ``step_period_s`` [s], ``patch_margin_m`` [m], ``residual``,
+``reason`` (why no gait, text), ``wall_time_s`` [s] ...); ``summary/<fraction>``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from walkerlab.io.artifacts import open_artifact, put
+
+_UNITS = {"max_abs_multiplier": "-", "step_period_s": "s", "patch_margin_m": "m",
+          "residual": "-", "wall_time_s": "s", "exists": "-", "stable": "-"}
+
+
+@dataclass
+class StabilityMapRun:
+    """What the stability-map stage computed (the writer's input).
+
+    Attributes
+    ----------
+    spec : walkerlab.sweep.stability.MapSpec
+    cells : dict[str, ndarray]
+        :func:`walkerlab.sweep.stability.gait_map`'s result.
+    fractions : dict[str, float]
+        :func:`walkerlab.sweep.stability.stable_fraction` of the cells.
+    stiffness_family, unit_system : str
+        Of the scene's contact law.
+    """
+
+    spec: object
+    cells: dict
+    fractions: dict
+    stiffness_family: str
+    unit_system: str
+
+
+def write_stability_map(f, run: StabilityMapRun) -> None:
+    """Fill an open (in-memory) artifact with ``run`` (layout in the module docstring)."""
+    from walkerlab.sweep.stability import CELL_FIELDS, MAP_KINDS
+
+    f.attrs["kind"] = run.spec.kind
+    f.attrs["y_path"] = run.spec.y_path
+    f.attrs["y_label"] = MAP_KINDS[run.spec.kind][1]
+    f.attrs["stiffness_family"] = run.stiffness_family
+    f.attrs["unit_system"] = run.unit_system
+    f.attrs["time_limit_s"] = run.spec.time_limit_s
+    f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "
+                         "step map, continued from its neighbour along the slope, "
+                         "else from the ideal fixed point at that slope")
+    put(f, "y_values", run.cells["y_values"],
+        {"patch_width": "m", "friction": "-"}.get(run.spec.kind, "scene units"),
+        run.spec.y_path)
+    put(f, "slopes_deg", run.cells["slopes_deg"], "deg", "slope angle")
+    for fld in CELL_FIELDS:
+        v = run.cells[fld]
+        if v.dtype == object:
+            put(f, fld, np.asarray([[str(x) for x in r] for r in v],
+                                   dtype=h5py.string_dtype()), "-", fld)
+        else:
+            put(f, fld, np.asarray(v, float), _UNITS.get(fld, "-"), fld)
+    for k, v in run.fractions.items():
+        put(f, f"summary/{k}", v, "-", k)
+
+
+@dataclass
+class StabilityMap:
+    """A loaded stability map: ``attrs`` (root attributes, strings decoded), ``y_values``
+    (ny,), ``slopes_deg`` (nx,) [deg], ``cells`` (each cell field, (ny, nx); ``reason`` as
+    str), ``summary`` (``exists_fraction``, ``stable_fraction``, ``cells`` ...)."""
+
+    attrs: dict
+    y_values: np.ndarray
+    slopes_deg: np.ndarray
+    cells: dict
+    summary: dict = field(default_factory=dict)
+
+
+def load_stability_map(path: Path | str) -> StabilityMap:
+    """Load a ``stability_map_<kind>.h5``.
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing, unreadable, of another walkerlab version, or lacking a dataset (one line).
+    """
+    from walkerlab.sweep.stability import CELL_FIELDS
+
+    with open_artifact(path) as f:
+        cells = {}
+        for k in CELL_FIELDS:
+            v = f[k][()]
+            if v.dtype.kind in ("S", "O"):
+                v = np.array([[x.decode() if isinstance(x, bytes) else str(x) for x in r]
+                              for r in v], dtype=object)
+            cells[k] = v
+        return StabilityMap(
+            attrs={k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()},
+            y_values=f["y_values"][()], slopes_deg=f["slopes_deg"][()], cells=cells,
+            summary={k: f["summary"][k][()] for k in f["summary"]} if "summary" in f else {})

@@ -1,0 +1,96 @@
+"""Which stages a scene needs and in what order: the one place stages are chained.
+
+A stage reads the artifacts of the stages it depends on and never runs them itself;
+:func:`run` runs the upstream stages a stage needs for the scene (each with its default
+options, reusing an up-to-date artifact), then the stage.  :func:`report_plan` is the
+report's DAG: the stages the report runs for a scene, in order.
+
+==============  ====================================================================
+stage           needs (for this scene)
+==============  ====================================================================
+fixedpoint      -
+simulate        fixedpoint (when ``simulate.initial_state`` is the fixed point)
+contact-sim     fixedpoint
+compare         simulate, contact-sim
+workprecision   fixedpoint
+basin           fixedpoint
+animate         simulate
+==============  ====================================================================
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+
+from walkerlab.config import Scene
+
+#: module of each stage under walkerlab.stages
+MODULES = {"fixedpoint": "fixedpoint", "simulate": "simulate", "contact-sim": "contact_sim",
+           "compare": "compare", "workprecision": "workprecision", "basin": "basin",
+           "animate": "animate"}
+
+
+def needs(stage: str, scene: Scene) -> tuple[str, ...]:
+    """The stages ``stage`` reads the artifacts of, for ``scene`` (direct dependencies)."""
+    if stage == "simulate":
+        sim = scene.simulate
+        return ("fixedpoint",) if sim is None or sim.initial_state == "fixed_point" else ()
+    return {"contact-sim": ("fixedpoint",), "compare": ("simulate", "contact-sim"),
+            "workprecision": ("fixedpoint",), "basin": ("fixedpoint",),
+            "animate": ("simulate",)}.get(stage, ())
+
+
+def order(stage: str, scene: Scene) -> list[str]:
+    """``stage`` and everything upstream of it, each once, upstream first."""
+    out: list[str] = []
+
+    def visit(s: str) -> None:
+        for up in needs(s, scene):
+            visit(up)
+        if s not in out:
+            out.append(s)
+
+    visit(stage)
+    return out
+
+
+def stage_module(stage: str):
+    """The module of ``stage`` (imported on first use: the CLI stays light)."""
+    return importlib.import_module(f"walkerlab.stages.{MODULES[stage]}")
+
+
+def run_upstream(stage: str, scene: Scene, runs_root: Path | str = "runs") -> None:
+    """Run (or reuse) every stage upstream of ``stage``, with default options."""
+    for s in order(stage, scene)[:-1]:
+        stage_module(s).run(scene, runs_root)
+
+
+def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **options):
+    """Run ``stage`` after what it needs: ``stage_module(stage).run(scene, runs_root,
+    *args, **options)`` once every upstream artifact is up to date.  A stage module with a
+    ``check(scene, **options)`` function has its options checked first, so a bad option is
+    refused before anything runs.
+
+    Raises
+    ------
+    StageError, walkerlab.io.artifacts.ArtifactError
+        As the stages do (one line).
+    """
+    mod = stage_module(stage)
+    if hasattr(mod, "check"):
+        mod.check(scene, **options)
+    run_upstream(stage, scene, runs_root)
+    return mod.run(scene, runs_root, *args, **options)
+
+
+def report_plan(scene: Scene) -> list[str]:
+    """The stages ``report`` runs for this scene, in order (its progress display and DAG):
+    fixed point, rigid run, contact run, their comparison, the work-precision study, the
+    basin of attraction - each only when the scene has its sections."""
+    sim, contact = scene.simulate is not None, scene.contact is not None
+    return [n for n, on in (("fixedpoint", scene.fixedpoint is not None), ("simulate", sim),
+                            ("contact-sim", contact), ("compare", contact and sim),
+                            ("workprecision", getattr(scene, "workprecision", None) is not None),
+                            ("basin", scene.basin is not None and scene.fixedpoint is not None))
+            if on]
