@@ -38,7 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
 
 __all__ = ["load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
-           "compare", "sweep", "basin", "continuation"]
+           "compare", "sweep", "basin", "continuation", "mfpt"]
 
 DEFAULT_RUNS = Path("runs")
 
@@ -444,3 +444,45 @@ def continuation(scene: Scene | str | Path | dict, param: str, start: float, sto
                     param2, tuple(range2) if range2 is not None else None, _runs(runs_dir),
                     force)
     return load_continuation(out.path)
+
+
+def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None, *,
+         method: str | None = None, workers: int = 1, runs_dir: str | Path = DEFAULT_RUNS,
+         force: bool = False) -> xarray.Dataset:
+    """Mean first-passage time (heel strikes before the fall) on per-step random slopes
+    (Byl & Tedrake 2009), by Monte Carlo and/or the mesh of the post-impact section.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        Needs a ``fixedpoint`` section; ``mfpt`` (walks, step cap, mesh settings) and
+        ``terrain.per_step`` (distribution, seed) are optional.
+    sigma_rad : list of float, optional
+        Standard deviations of the per-step slope [rad] (default ``mfpt.sigma_rad``).
+    method : {"mesh", "montecarlo", "both"}, optional
+        Default ``mfpt.method`` (both).
+    workers : int
+        Local worker processes (1: in this process).
+    runs_dir, force
+        As :func:`fixed_point`.
+
+    Returns
+    -------
+    xarray.Dataset
+        On the coordinate ``sigma_rad`` [rad]: ``mfpt_steps_montecarlo`` and its
+        ``mfpt_steps_montecarlo_stderr``, ``mfpt_steps_mesh``, ``mesh_cells``,
+        ``mesh_change``, ``mesh_converged`` ... (:mod:`walkerlab.io.schemas.mfpt`).
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section, bad settings, or a walker whose state coordinates are
+        measured from the slope.
+    SceneError, ImportError
+        As :func:`fixed_point`.
+    """
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("mfpt", _scene(scene), runs_dir, force, sigma_rad=sigma_rad,
+                       method=method, workers=workers)
+    return _read(out.path)

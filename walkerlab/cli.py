@@ -295,12 +295,26 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 @app.command()
 @_guard
 def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-            force: bool = ForceOpt) -> None:
+            force: bool = ForceOpt,
+            rigid_limit: bool = typer.Option(
+                False, "--rigid-limit", help="instead: the contact periodic gait along the "
+                "rigid-limit family (rigid_limit.h5 and its figure)")) -> None:
     """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
     from walkerlab.io.schemas.compare import load_compare
     from walkerlab.report.text import compare_text
     from walkerlab.stages import pipeline
 
+    if rigid_limit:
+        from walkerlab.stages import rigid_limit as rl
+
+        sc = _load(scene)
+        out = rl.run(sc, runs_dir, force)
+        for line in rl.table_lines(out.path):
+            typer.echo(line)
+        for p in rl.draw(sc, runs_dir, out.path):
+            typer.echo(f"wrote {p}")
+        typer.echo(_status(out))
+        return
     out = pipeline.run("compare", _load(scene), runs_dir, force)
     typer.echo(compare_text(load_compare(out.path)))
     typer.echo(_status(out))
@@ -333,11 +347,13 @@ def plot(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
 @app.command()
 @_guard
 def report(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-           force: bool = ForceOpt) -> None:
+           force: bool = ForceOpt,
+           full: bool = typer.Option(False, "--full", help="also measure the work-precision "
+                                     "diagram (times every solver setting; ~30 s)")) -> None:
     """Run every stage the scene needs (skipping up-to-date ones) and write the report."""
     from walkerlab.stages import report as stage
 
-    out = stage.run(_load(scene), runs_dir, force, echo=typer.echo)
+    out = stage.run(_load(scene), runs_dir, force, echo=typer.echo, full=full)
     typer.echo(f"report: {out}")
 
 
@@ -494,6 +510,41 @@ def basin(scene: Path | None = SceneArg,
         typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
     typer.echo(_status(out))
     typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir)}")
+
+
+@app.command()
+@_guard
+def mfpt(scene: Path | None = SceneArg,
+         sigma_rad: str | None = typer.Option(None, "--sigma-rad", help="per-step slope "
+                                              "standard deviations in rad, e.g. "
+                                              "0.002,0.003,0.004 (default: mfpt.sigma_rad)"),
+         method: str | None = typer.Option(None, "--method", help="mesh | montecarlo | both "
+                                           "(default: mfpt.method, both)"),
+         workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+         scheduler: str | None = typer.Option(None, "--scheduler",
+                                               help="Dask scheduler address (tcp://host:port)"),
+         runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Mean first-passage time (steps before the fall) on per-step random slopes."""
+    from walkerlab.stages import mfpt as stage
+
+    sig = None
+    if sigma_rad is not None:
+        try:
+            sig = [float(v) for v in sigma_rad.split(",") if v.strip()]
+        except ValueError:
+            _fail(ValueError(f"--sigma-rad: expected numbers separated by commas, got "
+                             f"{sigma_rad!r}"))
+    from walkerlab.stages import pipeline
+
+    sc = _load(scene)
+    out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
+                       workers=workers, scheduler=scheduler)
+    if out.summary:
+        for s, m, me in zip(out.summary["sigma_rad"], out.summary["mfpt_steps_montecarlo"],
+                            out.summary["mfpt_steps_mesh"]):
+            typer.echo(f"sigma {s:.4g} rad: MFPT Monte Carlo {m:.4g}, mesh {me:.4g} steps")
+    typer.echo(_status(out))
+    typer.echo(f"figure: {stage.figure_path(sc, runs_dir)}")
 
 
 @app.command("stability-map")

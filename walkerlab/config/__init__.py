@@ -45,8 +45,8 @@ from walkerlab.config.contact import (  # noqa: F401  (re-exported: one import p
     ContactSettings,
     ContactSimSettings,
     ContactSolverSettings,
+    PerStepTerrain,
     TerrainSettings,
-    family_scaling,
 )
 
 
@@ -665,6 +665,39 @@ class BasinSettings(_Strict):
         "a 2-D set, the cell is then unique); a cell no heel strike reaches is 'unreachable'")
 
 
+class MfptSettings(_Strict):
+    """Mean first-passage time on per-step random slopes (``walkerlab mfpt``; Byl & Tedrake
+    2009).  The slope of each step is normal (or ``terrain.per_step.slope_distribution``)
+    about the scene's slope with standard deviation ``sigma``; walks start on the gait."""
+
+    sigma_rad: list[Annotated[float, Field(gt=0, le=0.2)]] = Field(
+        [0.002, 0.003, 0.004, 0.006], min_length=1, max_length=64,
+        description="standard deviations of the per-step slope [rad]")
+    method: Literal["mesh", "montecarlo", "both"] = Field(
+        "both", description="mesh (rigid model), Monte Carlo, or both side by side")
+    walks: int = Field(400, ge=1, le=1_000_000, description="Monte Carlo walks per sigma")
+    max_steps: int = Field(2000, ge=1, le=1_000_000,
+                           description="Monte Carlo step cap per walk (censoring) [steps]")
+    seed: int = Field(0, ge=0, description="Monte Carlo seed [-] (terrain.per_step.seed "
+                      "when that is given)")
+    quadrature_nodes: int = Field(9, ge=3, le=41, description="Gauss-Hermite nodes of the "
+                                  "slope distribution in the mesh [-]")
+    mesh_spacing: float = Field(1.0, gt=0.05, le=4, description="first mesh spacing "
+                                "[standard deviations of the walk's post-impact cloud]")
+    mesh_refine: float = Field(0.75, gt=0.2, lt=1, description="spacing factor per "
+                               "refinement [-]")
+    mesh_max_cells: int = Field(8000, ge=10, le=2_000_000,
+                                description="largest mesh [vertices]; refinement stops there")
+    mesh_rel_change: float = Field(0.05, gt=0, lt=1, description="refine until the MFPT "
+                                   "changes by less than this between meshes [-]")
+    rtol: float = Field(1e-9, ge=1e-12, lt=1e-3, description="integrator relative "
+                        "tolerance per walk [-]")
+    atol: float = Field(1e-9, gt=0, lt=1e-3, description="integrator absolute tolerance "
+                        "per walk [rad, rad/s]")
+    max_step_time_s: float = Field(5.0, gt=0, le=MAX_STEP_TIME_S, description="no heel "
+                                   "strike within this = a fall [s]")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
@@ -701,6 +734,7 @@ class Scene(_Strict):
         """Resolved path of the scene file, or None for a scene built in code."""
         return self._origin
     basin: BasinSettings | None = None
+    mfpt: MfptSettings | None = None
 
     @model_validator(mode="after")
     def _units_consistent(self) -> Scene:

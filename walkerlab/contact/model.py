@@ -183,11 +183,13 @@ class ContactWalker:
                       g=9.81, phi=0.0174, data=None) -> ContactWalker:
         """Build from validated settings; ``step_length`` [m] is the ideal gait's step length
         (patch spacing).  ``data`` (a WalkerData) replaces the compass-gait shorthand."""
+        from .rigid_limit import contact_si
+
         c1, c2 = checkerboard_lanes(step_length, n_steps)
-        return cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=contact.to_si(), lane1=c1,
+        si, knee = contact_si(contact)  # the scene's stiffness family applied
+        return cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=si, lane1=c1,
                    lane2=c2, patch_half_width=0.5 * terrain.patch_width_m,
-                   continuous=terrain.kind == "continuous", data=data,
-                   knee_stop=contact.knee_stop.to_si())
+                   continuous=terrain.kind == "continuous", data=data, knee_stop=knee)
 
     @property
     def structure(self):

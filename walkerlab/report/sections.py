@@ -255,7 +255,10 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
     ("fig2_stick_ideal", "Fig. 2 — stick diagram of one gait cycle, ideal model."),
     ("fig6_stick_contact", "Fig. 6 — stick diagram of one gait cycle, contact model."),
     ("fig7_angles_rates", "Fig. 7 — angles and angular rates over the simulated strides."),
-    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates."),
+    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates: left time-aligned "
+     "(both at the same time since the start, so a different step period shows as a growing "
+     "phase drift), right phase-aligned (both at the same fraction of the same step: the "
+     "difference of the gaits themselves)."),
     ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, one "
                           "panel per link, both legs in it)."),
     ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),

@@ -14,6 +14,7 @@ contact-sim     fixedpoint
 compare         simulate, contact-sim
 workprecision   fixedpoint
 basin           fixedpoint
+mfpt            fixedpoint
 animate         simulate
 ==============  ====================================================================
 """
@@ -28,7 +29,7 @@ from walkerlab.config import Scene
 #: module of each stage under walkerlab.stages
 MODULES = {"fixedpoint": "fixedpoint", "simulate": "simulate", "contact-sim": "contact_sim",
            "compare": "compare", "workprecision": "workprecision", "basin": "basin",
-           "animate": "animate"}
+           "animate": "animate", "mfpt": "mfpt"}
 
 
 def needs(stage: str, scene: Scene) -> tuple[str, ...]:
@@ -38,6 +39,7 @@ def needs(stage: str, scene: Scene) -> tuple[str, ...]:
         return ("fixedpoint",) if sim is None or sim.initial_state == "fixed_point" else ()
     return {"contact-sim": ("fixedpoint",), "compare": ("simulate", "contact-sim"),
             "workprecision": ("fixedpoint",), "basin": ("fixedpoint",),
+            "mfpt": ("fixedpoint",),
             "animate": ("simulate",)}.get(stage, ())
 
 

@@ -26,10 +26,12 @@ REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecis
                  "bifurcation", "basin")
 
 
-def planned_stages(scene: Scene) -> list[str]:
+def planned_stages(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order (:func:`walkerlab.stages.pipeline.
-    report_plan`)."""
-    return report_plan(scene)
+    report_plan`); the work-precision study only with ``full`` (``walkerlab report --full``):
+    it times every solver setting (~30 s of a ~33 s cold report, issue 25) and a shared
+    machine's timings are noise unless repeated; ``walkerlab workprecision`` runs it alone."""
+    return [s for s in report_plan(scene) if full or s != "workprecision"]
 
 
 def _study(scene: Scene, runs_root, force: bool):
@@ -46,8 +48,9 @@ def _study(scene: Scene, runs_root, force: bool):
                            ("contact",) if scene.contact is not None else ())
 
 
-def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None) -> list[StageOutcome]:
-    plan = report_plan(scene)
+def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
+                full: bool = False) -> list[StageOutcome]:
+    plan = planned_stages(scene, full)
     done: list[StageOutcome] = []
 
     def add(o: StageOutcome) -> None:
@@ -121,7 +124,7 @@ _NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' 
             "basin": "no 'basin' section (or no 'fixedpoint')"}
 
 
-def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
+def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
                      ) -> tuple[dict[str, Path], str]:
     """The artifacts the report shows and one line on what it leaves out ('' if nothing).
 
@@ -136,6 +139,16 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
     for stage, p in existing_artifacts(scene, runs_root).items():
         if stage in produced:
             paths[stage] = p
+        elif stage == "workprecision" and getattr(scene, "workprecision", None) is not None \
+                and not full:
+            from walkerlab.stages import workprecision
+            from walkerlab.stages.common import changed_fields
+
+            if changed_fields(p, scene, workprecision.SECTIONS):
+                left.append(f"{p.name} (measured for other settings; `walkerlab report "
+                            "--full` measures it again)")
+            else:
+                paths[stage] = p  # measured earlier (--full or `walkerlab workprecision`)
         elif stage == "bifurcation":
             from walkerlab.io.artifacts import stored_content_hash_matches
             from walkerlab.stages import bifurcation
@@ -170,8 +183,9 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        echo: Callable[[str], None] = print) -> Path:
-    """Run the needed stages, draw figures, write ``report.md`` and ``report.html``.
+        echo: Callable[[str], None] = print, full: bool = False) -> Path:
+    """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
+    ``full``: also the work-precision study (:func:`planned_stages`).
 
     Returns
     -------
@@ -180,11 +194,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     from walkerlab import progress
 
-    stages = report_plan(scene)
+    stages = planned_stages(scene, full)
     with progress.task(f"report: {len(stages)} stages ({', '.join(stages)})",
                        len(stages)) as bar:
-        done = _run_stages(scene, runs_root, force, echo, bar)
-    paths, left_out = report_artifacts(scene, runs_root, done)
+        done = _run_stages(scene, runs_root, force, echo, bar, full)
+    paths, left_out = report_artifacts(scene, runs_root, done, full)
+    if getattr(scene, "workprecision", None) is not None and "workprecision" not in paths:
+        echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
     if left_out:
         echo(left_out)
     rep_dir = report_dir(scene, runs_root, claim=True)
