@@ -483,6 +483,6 @@ def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None,
     """
     from walkerlab.stages import pipeline
 
-    out = pipeline.run("mfpt", _scene(scene), runs_dir, force, sigma_rad=sigma_rad,
+    out = pipeline.run("mfpt", _scene(scene), _runs(runs_dir), force, sigma_rad=sigma_rad,
                        method=method, workers=workers)
     return _read(out.path)
