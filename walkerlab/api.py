@@ -28,7 +28,7 @@ Example
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -64,9 +64,10 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
     ------
     walkerlab.config.SceneError
         File missing, malformed YAML, or fields that do not validate (every error, one line
-        each, unknown keys first with the closest field name).
+        each, unknown keys first with the closest field name); ``name`` not a string or not
+        a safe folder name (empty, path separators).
     """
-    from walkerlab.config import Scene, scene_from_dict
+    from walkerlab.config import Scene, SceneError, scene_from_dict
     from walkerlab.config import load_scene as _load
 
     if isinstance(path_or_dict, Scene):
@@ -78,6 +79,15 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
     else:
         sc = _load(path_or_dict)
     if name is not None:
+        from walkerlab.io.runpaths import check_name
+
+        if not isinstance(name, str):
+            raise SceneError(f"name={name!r}: give the run folder name as a string, e.g. "
+                             "name='paper_steep'")
+        try:
+            check_name(name, "name")
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
         origin = getattr(sc, "_origin", None)
         sc = sc.model_copy(update={"name": name})
         sc._origin = origin
@@ -140,6 +150,21 @@ def _scene(scene) -> Scene:
     return scene if isinstance(scene, Scene) else load_scene(scene)
 
 
+def _runs(runs_dir) -> Path:
+    """``runs_dir`` as a path; an empty name (which would be the current folder) or a value
+    that is not a path is refused in one line, as ``--runs-dir ''`` is."""
+    import os
+
+    from walkerlab.safefs import RunPathError
+
+    if not isinstance(runs_dir, (str, os.PathLike)) or isinstance(runs_dir, bytes):
+        raise RunPathError(f"runs_dir={runs_dir!r}: give a folder name, e.g. runs_dir='runs'")
+    if not str(runs_dir).strip():
+        raise RunPathError("runs_dir='': empty folder name (it would write into the current "
+                           "folder); give a folder, e.g. runs_dir='runs'")
+    return Path(runs_dir)
+
+
 def _read(path: Path) -> xarray.Dataset:
     from walkerlab.io.datasets import load_dataset
 
@@ -178,12 +203,14 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
         No ``fixedpoint`` section, or no fixed point found (one line saying why).
     walkerlab.config.SceneError
         The scene does not validate.
+    walkerlab.safefs.RunPathError
+        ``runs_dir`` empty (it would be the current folder) or not a path.
     ImportError
         xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
     """
     from walkerlab.stages import pipeline
 
-    return _read(pipeline.run("fixedpoint", _scene(scene), runs_dir, force).path)
+    return _read(pipeline.run("fixedpoint", _scene(scene), _runs(runs_dir), force).path)
 
 
 def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -208,7 +235,7 @@ def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEF
     from walkerlab.io.datasets import load_fixed_points
     from walkerlab.stages import pipeline
 
-    return load_fixed_points(pipeline.run("fixedpoint", _scene(scene), runs_dir,
+    return load_fixed_points(pipeline.run("fixedpoint", _scene(scene), _runs(runs_dir),
                                           force).path)
 
 
@@ -246,7 +273,7 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
     """
     from walkerlab.stages import pipeline
 
-    return _read(pipeline.run("simulate", _scene(scene), runs_dir, force,
+    return _read(pipeline.run("simulate", _scene(scene), _runs(runs_dir), force,
                               strides=strides).path)
 
 
@@ -286,7 +313,7 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     """
     from walkerlab.stages import pipeline
 
-    return _read(pipeline.run("contact-sim", _scene(scene), runs_dir, force, adjust=adjust,
+    return _read(pipeline.run("contact-sim", _scene(scene), _runs(runs_dir), force, adjust=adjust,
                               periodic=periodic).path)
 
 
@@ -311,7 +338,7 @@ def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_
     """
     from walkerlab.stages import pipeline
 
-    return _read(pipeline.run("compare", _scene(scene), runs_dir, force).path)
+    return _read(pipeline.run("compare", _scene(scene), _runs(runs_dir), force).path)
 
 
 def _axis_spec(param: str, values: Sequence) -> str:
@@ -323,6 +350,12 @@ def _axis_spec(param: str, values: Sequence) -> str:
             return str(v)
         return str(int(v)) if isinstance(v, numbers.Integral) else repr(float(v))
 
+    from walkerlab.sweep.params import SweepError
+
+    if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+        raise SweepError(f"sweep {param}: values={values!r}: give a sequence of values, e.g. "
+                         f"[{values if isinstance(values, (int, float)) else 10}] or "
+                         "[8, 10, 12] (a string would be swept character by character)")
     vals = list(values)
     if not vals:
         raise ValueError(f"sweep {param}: no values given")
@@ -364,14 +397,15 @@ def sweep(scene: Scene | str | Path | dict, param: str, values: Sequence, *,
     Raises
     ------
     walkerlab.sweep.params.SweepError
-        Unknown field, values the field refuses, or an unknown stage.
+        Unknown field, values the field refuses, ``values`` a string or a single number
+        instead of a sequence, or an unknown stage.
     SceneError, ImportError
         As :func:`fixed_point`.
     """
     from walkerlab.stages import sweep as stage_mod
 
     path = stage_mod.run(_scene(scene), [_axis_spec(param, values)], stage=stage,
-                         workers=workers, runs_root=runs_dir, name=name, progress=progress)
+                         workers=workers, runs_root=_runs(runs_dir), name=name, progress=progress)
     return _read(path)
 
 
@@ -411,7 +445,7 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     """
     from walkerlab.stages import pipeline
 
-    out = pipeline.run("basin", _scene(scene), runs_dir, force,
+    out = pipeline.run("basin", _scene(scene), _runs(runs_dir), force,
                        grid=tuple(grid) if grid else None, workers=workers)
     return _read(out.path)
 
@@ -458,7 +492,8 @@ def continuation(scene: Scene | str | Path | dict, param: str, start: float, sto
     from walkerlab.stages import continuation as stage
 
     out = stage.run(_scene(scene), param, float(start), float(stop), 2 if switch else 0,
-                    param2, tuple(range2) if range2 is not None else None, runs_dir, force)
+                    param2, tuple(range2) if range2 is not None else None, _runs(runs_dir),
+                    force)
     return load_continuation(out.path)
 
 
@@ -499,6 +534,6 @@ def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None,
     """
     from walkerlab.stages import pipeline
 
-    out = pipeline.run("mfpt", _scene(scene), runs_dir, force, sigma_rad=sigma_rad,
+    out = pipeline.run("mfpt", _scene(scene), _runs(runs_dir), force, sigma_rad=sigma_rad,
                        method=method, workers=workers)
     return _read(out.path)

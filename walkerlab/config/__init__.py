@@ -745,6 +745,21 @@ class Scene(_Strict):
         return self
 
     @model_validator(mode="after")
+    def _knee_stop_needs_a_knee(self) -> Scene:
+        # a latch that cannot act is a mistake, as an unknown key is (issue 26): an error,
+        # not a warning, so a latch the user counts on is never silently absent (the stop's
+        # other numbers have defaults and are dumped with every scene: not checked)
+        c = self.contact
+        if c is None or not c.knee_stop.latch:
+            return self
+        leg = getattr(self.walker, "leg", None)
+        if leg is None or getattr(leg, "knee", None) is None:
+            raise ValueError("contact.knee_stop.latch: the walker's legs are straight (no "
+                             "walker.leg.knee), so there is no knee to latch: remove it or "
+                             "give the leg a knee")
+        return self
+
+    @model_validator(mode="after")
     def _published_exists(self) -> Scene:
         if self.published is not None:
             from walkerlab.published import available
@@ -867,6 +882,14 @@ def _fields_at(loc: tuple) -> list[str]:
     return sorted({k for m in current for k in m.model_fields})
 
 
+def _input_text(value) -> str:
+    """``repr`` of an input value for a message; an integer too long to print (Python caps
+    int-to-str at 4300 digits) or to read is described instead."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 100:
+        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    return repr(value)
+
+
 def _suggestion(e: dict) -> list[str]:
     """The field an unknown key most likely meant ([] when none is close)."""
     import difflib
@@ -941,7 +964,7 @@ def _error_line(e: dict) -> str:
     if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
             and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
                               "string_type", "float_parsing", "int_parsing"):
-        msg += f" (got {e['input']!r})"
+        msg += f" (got {_input_text(e['input'])})"
         if isinstance(e["input"], str) and re.fullmatch(
                 r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+", e["input"].strip()):
             # YAML 1.1 (PyYAML) reads a float only with a dot and a signed exponent
