@@ -199,3 +199,109 @@ def largest_tolerable(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
     dead = np.flatnonzero(~alive)
     return float(v[dead[0] - 1]) if dead.size and dead[0] > 0 else (
         0.0 if dead.size else float(v[-1]))
+
+
+def survives(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, values: np.ndarray,
+             steps: int = 40) -> np.ndarray:
+    """Survival (N,) bool of the single disturbances ``values`` (N,) [rad or m] on step 0,
+    followed by ``steps`` undisturbed steps (one batch; a fall or timeout on any step is
+    death)."""
+    v = np.asarray(values, float)
+    X = np.tile(x_star, (v.size, 1))
+    alive = np.ones(v.size, bool)
+    for k in range(steps + 1):
+        idx = np.flatnonzero(alive)
+        if idx.size == 0:
+            break
+        xn, _, ok = one_step(sm, X[idx], disturbance, v[idx] if k == 0 else np.zeros(idx.size))
+        alive[idx[~ok]] = False
+        X[idx[ok]] = xn[ok]
+    return alive
+
+
+def largest_by_bisection(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
+                         max_value: float, tol: float, steps: int = 40, sign: float = 1.0,
+                         sections: int = 8) -> tuple[float, float]:
+    """Bracket ``(lo, hi)`` of the largest single disturbance ``sign * v`` the gait survives.
+
+    A bracketing multisection (bisection with ``sections - 1`` interior points walked in one
+    batch per round): the invariant is "``lo`` survives, ``hi`` falls"; each round replaces
+    the bracket by the sub-interval between the last survivor before the first fall and that
+    fall.  Stops when ``hi - lo <= tol``: the bracket then holds a survival flip to ``tol``
+    (``ceil(log(max_value / tol) / log(sections))`` rounds).  Survival need not be monotone
+    in ``v``; the bracket holds the lowest flip the grids saw.
+
+    Returns
+    -------
+    (lo, hi) : floats [rad or m]
+        ``hi = inf`` when ``max_value`` survives (nothing falls up to it).
+    """
+    if survives(sm, x_star, disturbance, [sign * max_value], steps)[0]:
+        return float(max_value), float("inf")
+    lo, hi = 0.0, float(max_value)
+    while hi - lo > tol:
+        v = np.linspace(lo, hi, sections + 1)[1:-1]
+        alive = survives(sm, x_star, disturbance, sign * v, steps)
+        dead = np.flatnonzero(~alive)
+        if dead.size:
+            j = dead[0]
+            hi = float(v[j])
+            lo = float(v[j - 1]) if j > 0 else lo
+        else:
+            lo = float(v[-1])
+    return lo, hi
+
+
+def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None):
+    """Everything ``robustness.h5`` holds for a scene with a ``robustness`` section and its
+    gait ``x_star`` (2n,): ``|lambda|max`` and the state norms in absolute and relative leg
+    angles, the GSN of each disturbance (linearised, and the nonlinear check at an impulse
+    of 1e-5), the step-down/up brackets (search cap a quarter leg length) and the Monte Carlo
+    MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.sweep.mfpt.monte_carlo`).
+
+    Returns
+    -------
+    walkerlab.io.schemas.robustness.RobustnessData
+
+    Raises
+    ------
+    ValueError
+        A walker the batched step map cannot carry (one line).
+    """
+    from walkerlab.analysis.poincare import poincare_map
+    from walkerlab.config import RobustnessSettings
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.io.schemas.robustness import RobustnessData
+    from walkerlab.models.registry import build_walker
+    from walkerlab.sweep import mfpt as work
+
+    st = scene.robustness or RobustnessSettings()
+    walker = build_walker(scene)
+    sm = BatchStepMap(walker, work.scene_walker_at(scene), 1e-12, 1e-12)
+    if walker.steps_per_map != 1:
+        raise ValueError("robustness: legs that differ (a stride map) are not supported")
+    A = poincare_map(walker, x_star, Solver("DOP853", 1e-12, 1e-12, None, "scipy"),
+                     jacobian=True)[2]
+    names = walker.state_names()
+    T = relative_coordinates(names)
+    lam = {"absolute": float(np.max(np.abs(np.linalg.eigvals(A)))),
+           "relative": float(np.max(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T)))))}
+    gsn, gnl, norm = {}, {}, {"absolute": {}, "relative": {}}
+    for d in st.disturbances:
+        lin = linearise(sm, x_star, A, d)
+        gsn[d], gnl[d] = lin.gsn(), gsn_nonlinear(sm, x_star, d, 1e-5, steps=60)
+        norm["absolute"][d], norm["relative"][d] = state_gsn(lin), state_gsn(lin, T)
+    cap = 0.25 * float(walker.params.get("leg_length_m", 1.0))
+    down = largest_by_bisection(sm, x_star, "floor_height", cap, st.resolution_m,
+                                st.survival_steps)
+    up = largest_by_bisection(sm, x_star, "floor_height", cap, st.resolution_m,
+                              st.survival_steps, sign=-1.0)
+    mc = work.monte_carlo(scene, x_star, st.sigma_rad, st.montecarlo_walks,
+                          st.montecarlo_max_steps, st.seed, "normal", workers, scheduler)
+    m, se = mc.mfpt
+    sc = {"step_down_m/lo": down[0], "step_down_m/hi": down[1], "step_up_m/lo": up[0],
+          "step_up_m/hi": up[1], "sigma_rad": st.sigma_rad, "mfpt_steps": m,
+          "mfpt_steps_stderr": se, "montecarlo_walks": mc.steps.size,
+          "montecarlo_falls": int(mc.fell.sum())}
+    return RobustnessData(list(st.disturbances), {d: UNITS[d] for d in st.disturbances}, lam,
+                          gsn, gnl, norm, sc, names)
