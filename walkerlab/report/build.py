@@ -20,8 +20,8 @@ import walkerlab
 from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections
-from walkerlab.report.robustness_section import robustness_section
 from walkerlab.report.markdown import details, num, table, text, to_html
+from walkerlab.report.robustness_section import robustness_section
 from walkerlab.units import for_scene as units_for_scene
 
 
