@@ -559,15 +559,19 @@ def robustness(scene: Path | None = SceneArg,
     (the scene's robustness section); writes robustness.h5."""
     from walkerlab.stages import pipeline
 
+    from walkerlab.io.schemas.robustness import per_unit
+
     out = pipeline.run("robustness", _load(scene), runs_dir, force, workers=workers,
                        scheduler=scheduler)
     d = out.summary.get("data")
     if d is not None:
         for k in d.disturbances:
-            typer.echo(f"GSN {k}: {d.gsn[k]:.4g} 1/{d.units[k]}")
+            typer.echo(f"GSN {k}: {d.gsn[k]:.4g} {per_unit(d.units[k])}")
         typer.echo(f"step-down {1000 * d['step_down_m/lo']:.0f} mm, step-up "
                    f"{1000 * d['step_up_m/lo']:.0f} mm; MFPT {d['mfpt_steps']:.4g} "
                    f"± {d['mfpt_steps_stderr']:.2g} steps at sigma {d['sigma_rad']:g} rad")
+        typer.echo(f"largest mid-stance push {d['push_forward_m_per_s/lo']:.3f} m/s forward, "
+                   f"{d['push_backward_m_per_s/lo']:.3f} m/s backward (hip velocity change)")
     typer.echo(_status(out))
 
 

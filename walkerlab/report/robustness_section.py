@@ -5,15 +5,17 @@ from __future__ import annotations
 
 import math
 
+from walkerlab.io.schemas.robustness import per_unit
 from walkerlab.report.markdown import num, table
 
-_LABEL = {"slope": "slope change", "floor_height": "floor height step"}
+_LABEL = {"slope": "slope change", "floor_height": "floor height step",
+          "push": "mid-stance push"}
 
 
-def _mm(lo: float, hi: float) -> str:
+def _mm(lo: float, hi: float, scale: float = 1000) -> str:
     if not math.isfinite(hi):
-        return f"≥ {num(1000 * lo)} (none falls up to the search cap)"
-    return f"{num(1000 * lo)} (falls at {num(1000 * hi)})"
+        return f"≥ {num(scale * lo, 3)} (none falls up to the search cap)"
+    return f"{num(scale * lo, 3)} (falls at {num(scale * hi, 3)})"
 
 
 def robustness_section(arts: dict) -> list[str]:
@@ -23,7 +25,7 @@ def robustness_section(arts: dict) -> list[str]:
     if r is None:
         return []
     lam = r.max_abs_multiplier
-    rows = [[f"{_LABEL.get(d, d)} [1/{r.units[d]}]", r.gsn[d],
+    rows = [[f"{_LABEL.get(d, d)} [{per_unit(r.units[d])}]", r.gsn[d],
              f"{abs(r.gsn[d] - r.gsn_nonlinear[d]) / r.gsn[d]:.0e}",
              r.state_norm["absolute"][d], r.state_norm["relative"][d]] for d in r.disturbances]
     m, se = r["mfpt_steps"], r["mfpt_steps_stderr"]
@@ -36,7 +38,12 @@ def robustness_section(arts: dict) -> list[str]:
             f"- MFPT on per-step random slopes, σ = {num(r['sigma_rad'])} rad (Monte Carlo, "
             f"{num(r['montecarlo_walks'])} walks, {num(r['montecarlo_falls'])} fell): {mfpt}.",
             f"- largest single step-down survived: {_mm(r['step_down_m/lo'], r['step_down_m/hi'])}"
-            f" mm; step-up: {_mm(r['step_up_m/lo'], r['step_up_m/hi'])} mm (bisection).", "",
+            f" mm; step-up: {_mm(r['step_up_m/lo'], r['step_up_m/hi'])} mm (bisection).",
+            "- largest mid-stance push survived (an impulsive horizontal push at the hip when "
+            "the stance leg is vertical, the stance foot pinned; as the hip's velocity change): "
+            f"forward {_mm(r['push_forward_m_per_s/lo'], r['push_forward_m_per_s/hi'], 1)} "
+            f"m/s, backward {_mm(r['push_backward_m_per_s/lo'], r['push_backward_m_per_s/hi'], 1)}"
+            " m/s.", "",
             "Gait sensitivity norm (Hobbelen & Wisse 2007; indicators step time, step length, "
             "stance angle at heel strike), with the relative difference to the nonlinear "
             "response to a small impulse, and the norm with the post-impact state as "

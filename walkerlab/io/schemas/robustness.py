@@ -7,6 +7,7 @@ Layout (every value a scalar dataset with its unit)::
     gsn_nonlinear/<disturbance>                       1/unit GSN, small nonlinear impulse
     state_norm/{absolute,relative}/<disturbance>      1/unit state-indicator norm (Jin et al.)
     step_down_m/{lo,hi}, step_up_m/{lo,hi}            m      bisection bracket (lo survives)
+    push_{forward,backward}_m_per_s/{lo,hi}           m/s    mid-stance push bracket
     sigma_rad                                         rad    per-step slope sigma of the MFPT
     mfpt_steps, mfpt_steps_stderr                     steps  Monte Carlo MFPT (censored MLE)
     montecarlo_walks, montecarlo_falls                -
@@ -21,12 +22,22 @@ from pathlib import Path
 
 STAGE = "robustness"
 COORDINATES = ("absolute", "relative")
+
+
+def per_unit(unit: str) -> str:
+    """Unit of a sensitivity per unit disturbance (``m/s`` -> ``s/m``)."""
+    return "s/m" if unit == "m/s" else f"1/{unit}"
 SCALARS = {
     "step_down_m/lo": ("m", "largest step-down survived (bisection bracket, lower end)"),
     "step_down_m/hi": ("m", "smallest step-down that falls (upper end; inf: none up to "
                        "the search cap)"),
     "step_up_m/lo": ("m", "largest step-up survived (lower end)"),
     "step_up_m/hi": ("m", "smallest step-up that falls (upper end)"),
+    "push_forward_m_per_s/lo": ("m/s", "largest forward mid-stance push survived (hip "
+                                "velocity change; lower end)"),
+    "push_forward_m_per_s/hi": ("m/s", "smallest forward push that falls (upper end)"),
+    "push_backward_m_per_s/lo": ("m/s", "largest backward mid-stance push survived"),
+    "push_backward_m_per_s/hi": ("m/s", "smallest backward push that falls"),
     "sigma_rad": ("rad", "per-step slope standard deviation of the MFPT"),
     "mfpt_steps": ("steps", "Monte Carlo MFPT: heel strikes before the fall"),
     "mfpt_steps_stderr": ("steps", "standard error of mfpt_steps"),
@@ -76,7 +87,7 @@ def write(f, d: RobustnessData) -> None:
         put(f, f"max_abs_multiplier/{c}", float(d.max_abs_multiplier[c]), "-",
             f"largest |Floquet multiplier|, {c} leg angles")
     for dist in d.disturbances:
-        u = f"1/{d.units[dist]}"
+        u = per_unit(d.units[dist])
         put(f, f"gsn/{dist}", float(d.gsn[dist]), u, "gait sensitivity norm (linearised)")
         put(f, f"gsn_nonlinear/{dist}", float(d.gsn_nonlinear[dist]), u,
             "gait sensitivity norm (nonlinear response to a small impulse)")
