@@ -557,9 +557,8 @@ def robustness(scene: Path | None = SceneArg,
                runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Gait sensitivity norms, largest step-down/up and MFPT at the scene's sigma
     (the scene's robustness section); writes robustness.h5."""
-    from walkerlab.stages import pipeline
-
     from walkerlab.io.schemas.robustness import per_unit
+    from walkerlab.stages import pipeline
 
     out = pipeline.run("robustness", _load(scene), runs_dir, force, workers=workers,
                        scheduler=scheduler)
