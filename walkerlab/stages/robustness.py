@@ -28,15 +28,16 @@ SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt", "robustness")
 
 
 def check(scene: Scene, workers: int = 2, **_options) -> int:
-    """The worker count, checked before anything runs.
+    """The worker count, checked before anything runs (a scene without a ``robustness``
+    section runs with its defaults, as ``walkerlab mfpt`` does; only the report needs the
+    section).
 
     Raises
     ------
     StageError
-        No ``fixedpoint`` or ``robustness`` section, or a bad worker count (one line).
+        A bad worker count (one line).
     """
     require(scene, "fixedpoint", "robustness")
-    require(scene, "robustness", "robustness")
     return validate_option(CommandOptions, "workers", workers, "--workers")
 
 
