@@ -597,6 +597,33 @@ def mfpt(scene: Path | None = SceneArg,
     typer.echo(f"figure: {stage.figure_path(sc, runs_dir)}")
 
 
+@app.command()
+@_guard
+def robustness(scene: Path | None = SceneArg,
+               workers: int = typer.Option(2, "--workers", min=1,
+                                           help="local worker processes (Monte Carlo)"),
+               scheduler: str | None = typer.Option(None, "--scheduler",
+                                                     help="Dask scheduler address"),
+               runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Gait sensitivity norms, largest step-down/up and MFPT at the scene's sigma
+    (the scene's robustness section); writes robustness.h5."""
+    from walkerlab.io.schemas.robustness import per_unit
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("robustness", _load(scene), runs_dir, force, workers=workers,
+                       scheduler=scheduler)
+    d = out.summary.get("data")
+    if d is not None:
+        for k in d.disturbances:
+            typer.echo(f"GSN {k}: {d.gsn[k]:.4g} {per_unit(d.units[k])}")
+        typer.echo(f"step-down {1000 * d['step_down_m/lo']:.0f} mm, step-up "
+                   f"{1000 * d['step_up_m/lo']:.0f} mm; MFPT {d['mfpt_steps']:.4g} "
+                   f"± {d['mfpt_steps_stderr']:.2g} steps at sigma {d['sigma_rad']:g} rad")
+        typer.echo(f"largest mid-stance push {d['push_forward_m_per_s/lo']:.3f} m/s forward, "
+                   f"{d['push_backward_m_per_s/lo']:.3f} m/s backward (hip velocity change)")
+    typer.echo(_status(out))
+
+
 @app.command("stability-map")
 @_guard
 def stability_map(scene: Path | None = SceneArg,

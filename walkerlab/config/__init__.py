@@ -698,6 +698,31 @@ class MfptSettings(_Strict):
                                    "strike within this = a fall [s]")
 
 
+class RobustnessSettings(_Strict):
+    """Robustness of the gait beyond |lambda| (``walkerlab robustness``; issue 24): gait
+    sensitivity norms (Hobbelen & Wisse 2007), the largest single step-down and step-up
+    (bisection), and the MFPT at one per-step slope sigma by Monte Carlo (Byl & Tedrake 2009)."""
+
+    sigma_rad: float = Field(0.003, gt=0, le=0.2, description="per-step slope standard "
+                             "deviation of the MFPT [rad]")
+    disturbances: list[Literal["slope", "floor_height", "push"]] = Field(
+        ["slope", "floor_height", "push"], min_length=1, description="GSN disturbances: slope "
+        "change [rad], floor height step [m] (one step), horizontal push at the hip at "
+        "mid-stance (hip velocity change [m/s])")
+    montecarlo_walks: int = Field(100, ge=1, le=100_000, description="Monte Carlo walks [-]")
+    montecarlo_max_steps: int = Field(500, ge=1, le=1_000_000,
+                                      description="step cap per walk (censoring) [steps]")
+    seed: int = Field(0, ge=0, description="Monte Carlo seed [-]")
+    resolution_m: float = Field(0.001, gt=0, le=0.05, description="bracket width of the "
+                                "largest step-down/up bisection [m]")
+    push_resolution_m_per_s: float = Field(0.001, gt=0, le=0.1, description="bracket "
+                                           "width of the largest push bisection [m/s]")
+    push_cap_m_per_s: float = Field(1.0, gt=0, le=10, description="largest push searched "
+                                    "(hip velocity change) [m/s]")
+    survival_steps: int = Field(40, ge=1, le=1000, description="undisturbed steps a walker "
+                                "must take after a disturbance to survive it [steps]")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
@@ -735,6 +760,7 @@ class Scene(_Strict):
         return self._origin
     basin: BasinSettings | None = None
     mfpt: MfptSettings | None = None
+    robustness: RobustnessSettings | None = None
 
     @model_validator(mode="after")
     def _units_consistent(self) -> Scene:

@@ -23,7 +23,7 @@ from walkerlab.stages.pipeline import report_plan, stage_module
 from walkerlab.stages.plot import figures_dir
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation", "basin")
+                 "bifurcation", "basin", "robustness")
 
 
 def planned_stages(scene: Scene, full: bool = False) -> list[str]:
@@ -84,6 +84,8 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
     if "basin" in plan:
         # after the study: its worker processes would share the timed cases' cores
         add(stage_module("basin").run(scene, runs_root, force))
+    if "robustness" in plan:
+        add(stage_module("robustness").run(scene, runs_root, force))
     for o in done:
         status = ("reused (inputs unchanged)" if o.reused and not o.note else
                   f"reused ({o.note})" if o.reused else
@@ -121,7 +123,8 @@ _NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' 
             "contact-sim": "no 'contact' section",
             "compare": "needs both a 'simulate' and a 'contact' section",
             "workprecision": "no 'workprecision' section",
-            "basin": "no 'basin' section (or no 'fixedpoint')"}
+            "basin": "no 'basin' section (or no 'fixedpoint')",
+            "robustness": "no 'robustness' section (or no 'fixedpoint')"}
 
 
 def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
@@ -222,6 +225,7 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
         compare,
         contact_sim,
         fixedpoint,
+        robustness,
         simulate,
         stability_map,
         workprecision,
@@ -229,7 +233,8 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
 
     loaders = {"fixedpoint": fixedpoint.load_fixedpoint, "simulate": simulate.load_simulate,
                "contact-sim": contact_sim.load_contact_sim, "compare": compare.load_compare,
-               "workprecision": workprecision.load_workprecision, "basin": basin.load_basin}
+               "workprecision": workprecision.load_workprecision, "basin": basin.load_basin,
+               "robustness": robustness.load}
     arts: dict = {}
     for key, p in paths.items():
         load = (bifurcation.load_bifurcation_summary if key.startswith("bifurcation")
