@@ -1,6 +1,10 @@
-"""Stage ``report``: run what the scene needs (reusing up-to-date artifacts), draw the
-figures, then hand the artifacts to :func:`walkerlab.report.build.write_report`, which writes
-``runs/<scene>/report/report.html`` (self-contained) and ``report.md``.
+"""Stage ``report``: run the stages of the scene's plan (:func:`walkerlab.stages.pipeline.
+report_plan`, reusing up-to-date artifacts), draw the figures, load the artifacts through
+:mod:`walkerlab.io.schemas` and compute what the report states from them (Table 3, energy
+drift, swing-foot clearance: :func:`load_inputs`), then hand them to
+:func:`walkerlab.report.build.write_report`, which writes ``runs/<scene>/report/report.html``
+(self-contained) and ``report.md``.  The work-precision study runs in a background thread
+on cores of its own (:class:`walkerlab.execution.background.BackgroundStudy`).
 
 Sections appear only when the scene produces their data (artifacts an earlier standalone
 command left in the run folder are left out, in one line): an ideal-only scene gets an
@@ -24,12 +28,6 @@ from walkerlab.stages.plot import figures_dir
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
                  "bifurcation", "basin")
-
-
-def planned_stages(scene: Scene) -> list[str]:
-    """The stages ``report`` runs for this scene, in order (:func:`walkerlab.stages.pipeline.
-    report_plan`)."""
-    return report_plan(scene)
 
 
 def _study(scene: Scene, runs_root, force: bool):

@@ -31,6 +31,7 @@ import numpy as np
 
 from walkerlab.analysis.workprecision import (
     CYRK_PREFIX,
+    SINGLE_RUN_S,
     Case,
     rows_from_cases,
     run_cases,
@@ -187,7 +188,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         n_cached = sum(1 for v in done.values() if v.get("cached"))
 
         run = WorkPrecisionRun(results, n_cached, len(done), wp.target_error,
-                               wp.contact_target_error)
+                               wp.contact_target_error, SINGLE_RUN_S)
         return (lambda f: write_workprecision(f, run)), {k: v[1] for k, v in results.items()}
 
     return run_cached("workprecision", scene, runs_root, SECTIONS, up, compute, force)
