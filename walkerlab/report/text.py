@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from walkerlab.io.schemas.compare import Comparison
-from walkerlab.io.schemas.contact_sim import ContactSimArtifact
-from walkerlab.io.schemas.fixedpoint import FixedPointArtifact
-from walkerlab.io.schemas.simulate import SimulateArtifact
-from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 from walkerlab.report.markdown import num
+
+if TYPE_CHECKING:  # the loaded artifacts these summaries print
+    from walkerlab.io.schemas.compare import Comparison
+    from walkerlab.io.schemas.contact_sim import ContactSimArtifact
+    from walkerlab.io.schemas.fixedpoint import FixedPointArtifact
+    from walkerlab.io.schemas.simulate import SimulateArtifact
+    from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 
 
 def _fmt_mult(re, im) -> str:
