@@ -54,9 +54,9 @@ def _joint_map(names):
     rows = {}
     for j, c in enumerate(names):
         row = np.zeros(len(names))
-        if c in ("hip_x", "hip_y"):
+        if c in ("hip_x", "hip_y"):  # the slide joints are named by their axis: hip_x, hip_z
             row[j] = 1.0
-            rows[c] = row
+            rows["hip_z" if c == "hip_y" else c] = row
         elif c.endswith("_shank_angle"):
             leg = c.split("_")[0]
             row[j], row[names.index(f"{leg}_thigh_angle")] = 1.0, -1.0
@@ -227,7 +227,7 @@ def test_export_writes_files_in_run_folder(tmp_path):
         path = tmp_path / "kneed" / fname
         assert f"wrote {path}" in r.output
         text = path.read_text()
-        for joint in ("hip_x", "hip_y", "leg1_hip", "leg1_knee", "leg2_hip", "leg2_knee"):
+        for joint in ("hip_x", "hip_z", "leg1_hip", "leg1_knee", "leg2_hip", "leg2_knee"):
             assert f'name="{joint}"' in text
     assert not list((tmp_path / "kneed").glob(".*.tmp"))
 

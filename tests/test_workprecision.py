@@ -33,7 +33,11 @@ def test_report_study_measures_every_case_once_and_reuses_it(tmp_path):
     runs = tmp_path / "runs"
     affinity = os.sched_getaffinity(0)
     lines: list[str] = []
-    html = report.run(_scene(tmp_path), runs, echo=lines.append)
+    quick: list[str] = []  # the default report does not time solvers (opt-in --full)
+    report.run(_scene(tmp_path), tmp_path / "quick", echo=quick.append)
+    assert any("workprecision: not measured (opt-in" in s for s in quick)
+    assert not (tmp_path / "quick" / "wp_small" / "workprecision.h5").exists()
+    html = report.run(_scene(tmp_path), runs, echo=lines.append, full=True)
     assert os.sched_getaffinity(0) == affinity  # the report's own pinning is undone
     assert any(s.strip().startswith("workprecision: computed") for s in lines)
     wp = html.parents[1] / "workprecision.h5"
@@ -51,10 +55,15 @@ def test_report_study_measures_every_case_once_and_reuses_it(tmp_path):
     assert (html.parent / "figures" / "work_precision_ideal.png").is_file()
     # a rerun reuses the stage and both figure groups
     lines.clear()
-    report.run(_scene(tmp_path), runs, echo=lines.append)
+    report.run(_scene(tmp_path), runs, echo=lines.append, full=True)
     assert any("workprecision: reused" in s for s in lines)
     assert sum("figures reused" in s for s in lines) == 2
+    # the default report shows the measured study (inputs unchanged) without timing again
+    lines.clear()
+    report.run(_scene(tmp_path), runs, echo=lines.append)
+    assert not any("workprecision" in s and "not measured" in s for s in lines)
+    assert "Work-precision" in (html.parent / "report.md").read_text()
     # another target error: the stage reruns, every case comes from the case cache
-    report.run(_scene(tmp_path, target_error=1e-6), runs, echo=lambda s: None)
+    report.run(_scene(tmp_path, target_error=1e-6), runs, echo=lambda s: None, full=True)
     with open_artifact(wp, "workprecision") as f:
         assert f.attrs["cases_reused_from_cache"] == f.attrs["cases_total"]

@@ -38,7 +38,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from walkerlab.config import Scene
 
 __all__ = ["load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
-           "compare", "sweep", "basin"]
+           "compare", "sweep", "basin", "continuation", "mfpt"]
 
 DEFAULT_RUNS = Path("runs")
 
@@ -362,4 +362,92 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
 
     out = pipeline.run("basin", _scene(scene), runs_dir, force,
                        grid=tuple(grid) if grid else None, workers=workers)
+    return _read(out.path)
+
+
+def continuation(scene: Scene | str | Path | dict, param: str, start: float, stop: float, *,
+                 switch: bool = False, param2: str | None = None,
+                 range2: tuple[float, float] | None = None,
+                 runs_dir: str | Path = DEFAULT_RUNS, force: bool = False):
+    """Pseudo-arclength continuation of the scene's gait over a numeric scene field
+    (``walkerlab continuation``): folds, period doublings, Neimark-Sacker points and branch
+    ends located; with ``switch`` the period-2 and period-4 branches; with ``param2`` the
+    fold / period-doubling curves in the plane of both fields.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        Needs a ``fixedpoint`` section (its gait at its own value of ``param`` starts).
+    param : str
+        Dotted scene field (``"slope.angle_deg"``, ``"walker.leg.bodies.rod.mass_kg"``).
+    start, stop : float
+        The range, in the field's unit.
+    switch : bool
+        Switch at period doublings (period 2, then period 4).
+    param2, range2
+        Second field and its range for the two-parameter curves.
+    runs_dir, force
+        As :func:`fixed_point`.
+
+    Returns
+    -------
+    walkerlab.io.schemas.continuation.ContinuationData
+        ``branches`` (list: ``period``, ``param`` (N,) [unit], ``states`` by name, ``step_period``
+        [s], ``multipliers`` (N, 2n), ``stable``), ``special`` (``kind``, ``param``,
+        ``period``, ``cause`` ...), ``curves``; read from ``continuation_<param>.h5``.
+
+    Raises
+    ------
+    walkerlab.stages.common.StageError
+        No ``fixedpoint`` section or no gait at the scene's own value (one line).
+    walkerlab.sweep.params.SweepError
+        ``param`` names no field of the scene.
+    """
+    from walkerlab.io.schemas.continuation import load_continuation
+    from walkerlab.stages import continuation as stage
+
+    out = stage.run(_scene(scene), param, float(start), float(stop), 2 if switch else 0,
+                    param2, tuple(range2) if range2 is not None else None, runs_dir, force)
+    return load_continuation(out.path)
+
+
+def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None, *,
+         method: str | None = None, workers: int = 1, runs_dir: str | Path = DEFAULT_RUNS,
+         force: bool = False) -> xarray.Dataset:
+    """Mean first-passage time (heel strikes before the fall) on per-step random slopes
+    (Byl & Tedrake 2009), by Monte Carlo and/or the mesh of the post-impact section.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        Needs a ``fixedpoint`` section; ``mfpt`` (walks, step cap, mesh settings) and
+        ``terrain.per_step`` (distribution, seed) are optional.
+    sigma_rad : list of float, optional
+        Standard deviations of the per-step slope [rad] (default ``mfpt.sigma_rad``).
+    method : {"mesh", "montecarlo", "both"}, optional
+        Default ``mfpt.method`` (both).
+    workers : int
+        Local worker processes (1: in this process).
+    runs_dir, force
+        As :func:`fixed_point`.
+
+    Returns
+    -------
+    xarray.Dataset
+        On the coordinate ``sigma_rad`` [rad]: ``mfpt_steps_montecarlo`` and its
+        ``mfpt_steps_montecarlo_stderr``, ``mfpt_steps_mesh``, ``mesh_cells``,
+        ``mesh_change``, ``mesh_converged`` ... (:mod:`walkerlab.io.schemas.mfpt`).
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section, bad settings, or a walker whose state coordinates are
+        measured from the slope.
+    SceneError, ImportError
+        As :func:`fixed_point`.
+    """
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("mfpt", _scene(scene), runs_dir, force, sigma_rad=sigma_rad,
+                       method=method, workers=workers)
     return _read(out.path)

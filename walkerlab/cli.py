@@ -234,13 +234,17 @@ def _status(o) -> str:
 @app.command()
 @_guard
 def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-               force: bool = ForceOpt) -> None:
+               force: bool = ForceOpt,
+               known: Path | None = typer.Option(None, "--from", help="a scene whose gait is "
+                                                 "known: continue it along the straight line "
+                                                 "between the two scenes' numeric fields to "
+                                                 "this walker (homotopy)")) -> None:
     """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
     from walkerlab.io.schemas.fixedpoint import load_fixedpoint
     from walkerlab.report.text import fixedpoint_text
     from walkerlab.stages import pipeline
 
-    out = pipeline.run("fixedpoint", _load(scene), runs_dir, force)
+    out = pipeline.run("fixedpoint", _load(scene), runs_dir, force, known=known)
     typer.echo(fixedpoint_text(load_fixedpoint(out.path)))
     typer.echo(_status(out))
 
@@ -291,12 +295,28 @@ def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 @app.command()
 @_guard
 def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-            force: bool = ForceOpt) -> None:
+            force: bool = ForceOpt,
+            rigid_limit: bool = typer.Option(
+                False, "--rigid-limit", help="instead: the contact periodic gait along the "
+                "rigid-limit family (rigid_limit.h5 and its figure)")) -> None:
     """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
     from walkerlab.io.schemas.compare import load_compare
     from walkerlab.report.text import compare_text
     from walkerlab.stages import pipeline
 
+    if rigid_limit:
+        from walkerlab.io.schemas.rigid_limit import load_rigid_limit
+        from walkerlab.report.text import rigid_limit_text
+        from walkerlab.stages import rigid_limit as rl
+
+        sc = _load(scene)
+        out = rl.run(sc, runs_dir, force)
+        for line in rigid_limit_text(load_rigid_limit(out.path)):
+            typer.echo(line)
+        for p in rl.draw(sc, runs_dir, out.path):
+            typer.echo(f"wrote {p}")
+        typer.echo(_status(out))
+        return
     out = pipeline.run("compare", _load(scene), runs_dir, force)
     typer.echo(compare_text(load_compare(out.path)))
     typer.echo(_status(out))
@@ -329,11 +349,13 @@ def plot(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
 @app.command()
 @_guard
 def report(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-           force: bool = ForceOpt) -> None:
+           force: bool = ForceOpt,
+           full: bool = typer.Option(False, "--full", help="also measure the work-precision "
+                                     "diagram (times every solver setting; ~30 s)")) -> None:
     """Run every stage the scene needs (skipping up-to-date ones) and write the report."""
     from walkerlab.stages import report as stage
 
-    out = stage.run(_load(scene), runs_dir, force, echo=typer.echo)
+    out = stage.run(_load(scene), runs_dir, force, echo=typer.echo, full=full)
     typer.echo(f"report: {out}")
 
 
@@ -404,6 +426,60 @@ def bifurcation(scene: Path | None = SceneArg,
     typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
 
 
+def _range_spec(text: str, opt: str) -> tuple[str, float, float]:
+    """``FIELD=START:STOP`` -> (field, start, stop); one-line error otherwise."""
+    from walkerlab.sweep.params import SweepError
+
+    path, _, rhs = text.partition("=")
+    parts = rhs.split(":")
+    try:
+        if not path.strip() or len(parts) != 2:
+            raise ValueError
+        a, b = float(parts[0]), float(parts[1])
+        if not (a == a and b == b) or a == b:
+            raise ValueError
+    except ValueError:
+        raise SweepError(f"{opt} {text!r}: expected FIELD=START:STOP (two different "
+                         "numbers in the field's unit)") from None
+    return path.strip(), a, b
+
+
+@app.command()
+@_guard
+def continuation(scene: Path | None = SceneArg,
+                 param: str = typer.Option(..., "--param", help="FIELD=START:STOP, any "
+                                           "numeric scene field in its unit (e.g. "
+                                           "slope.angle_deg=0.5:5.2)"),
+                 switch: bool = typer.Option(False, "--switch", help="switch at period "
+                                             "doublings to the period-2 and period-4 "
+                                             "branches"),
+                 param2: str | None = typer.Option(None, "--param2", help="FIELD2=START:STOP: "
+                                                   "continue each fold and period doubling "
+                                                   "in the plane of both fields"),
+                 runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Pseudo-arclength continuation of the scene's gait over a field: folds, period
+    doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5."""
+    from walkerlab.stages import continuation as stage
+
+    path, a, b = _range_spec(param, "--param")
+    p2 = _range_spec(param2, "--param2") if param2 else None
+    out = stage.run(_load(scene), path, a, b, 2 if switch else 0,
+                    p2[0] if p2 else None, p2[1:] if p2 else None, runs_dir, force)
+    data = out.summary["data"]
+    sp = data.special
+    unit = "" if data.unit == "-" else f" {data.unit}"
+    for i, kind in enumerate(sp["kind"]):
+        cause = f" ({sp['cause'][i]})" if kind == "branch_end" else ""
+        typer.echo(f"{kind:16s} period {int(sp['period'][i])}  {path} = "
+                   f"{float(sp['param'][i]):.10g}{unit}{cause}")
+    if not len(sp["kind"]):
+        typer.echo("no special point in the range")
+    for c in data.curves:
+        typer.echo(f"{c['kind']} curve over {c['path2']}: {len(c['param2'])} points")
+    typer.echo(_status(out))
+    typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
+
+
 @app.command()
 @_guard
 def basin(scene: Path | None = SceneArg,
@@ -436,6 +512,41 @@ def basin(scene: Path | None = SceneArg,
         typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
     typer.echo(_status(out))
     typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir)}")
+
+
+@app.command()
+@_guard
+def mfpt(scene: Path | None = SceneArg,
+         sigma_rad: str | None = typer.Option(None, "--sigma-rad", help="per-step slope "
+                                              "standard deviations in rad, e.g. "
+                                              "0.002,0.003,0.004 (default: mfpt.sigma_rad)"),
+         method: str | None = typer.Option(None, "--method", help="mesh | montecarlo | both "
+                                           "(default: mfpt.method, both)"),
+         workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+         scheduler: str | None = typer.Option(None, "--scheduler",
+                                               help="Dask scheduler address (tcp://host:port)"),
+         runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Mean first-passage time (steps before the fall) on per-step random slopes."""
+    from walkerlab.stages import mfpt as stage
+
+    sig = None
+    if sigma_rad is not None:
+        try:
+            sig = [float(v) for v in sigma_rad.split(",") if v.strip()]
+        except ValueError:
+            _fail(ValueError(f"--sigma-rad: expected numbers separated by commas, got "
+                             f"{sigma_rad!r}"))
+    from walkerlab.stages import pipeline
+
+    sc = _load(scene)
+    out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
+                       workers=workers, scheduler=scheduler)
+    if out.summary:
+        for s, m, me in zip(out.summary["sigma_rad"], out.summary["mfpt_steps_montecarlo"],
+                            out.summary["mfpt_steps_mesh"]):
+            typer.echo(f"sigma {s:.4g} rad: MFPT Monte Carlo {m:.4g}, mesh {me:.4g} steps")
+    typer.echo(_status(out))
+    typer.echo(f"figure: {stage.figure_path(sc, runs_dir)}")
 
 
 @app.command("stability-map")

@@ -45,3 +45,48 @@ def limit_cycle_distance(ref: NamedTrajectory, other: NamedTrajectory, angle: st
 
     d, _ = cKDTree(b).query(a)
     return float(np.mean(d))
+
+
+def phase_aligned_errors(ref: NamedTrajectory, other: NamedTrajectory, n_per_step: int = 100):
+    """Errors ``other - ref`` with each step on normalised step time (the phase, not the
+    clock: two gaits of different step periods are compared at the same fraction of the
+    same step).
+
+    Step ``k`` of a trajectory runs from its first sample with ``step_index == k`` to the first
+    sample of step ``k + 1`` (its heel strike); steps that both trajectories complete are
+    compared.  On each, both are interpolated linearly at ``n_per_step`` equally spaced
+    fractions ``s`` in [0, 1) of the step's duration.
+
+    Returns
+    -------
+    step_phase : ndarray (m,)
+        ``k + s`` [-] (step number plus the fraction of the step), m = n_steps * n_per_step.
+    errors : dict[name, ndarray (m,)]
+        Per coordinate both have, in the coordinate's unit (``ref.units``).
+    """
+    def bounds(tr):
+        steps = np.unique(tr.step_index)
+        starts = {int(k): float(tr.time[np.argmax(tr.step_index == k)]) for k in steps}
+        return {k: (starts[k], starts[k + 1]) for k in starts if k + 1 in starts}
+
+    br, bo = bounds(ref), bounds(other)
+    common = sorted(set(br) & set(bo))
+    s = np.arange(n_per_step) / n_per_step
+    phase = np.concatenate([k + s for k in common]) if common else np.zeros(0)
+    names = [n for n in ref.coordinates if n in other.coordinates]
+    err = {n: [] for n in names}
+    for k in common:
+        tr_ = br[k][0] + s * (br[k][1] - br[k][0])
+        to_ = bo[k][0] + s * (bo[k][1] - bo[k][0])
+        for n in names:
+            err[n].append(_interp(other, n, to_) - _interp(ref, n, tr_))
+    return phase, {n: np.concatenate(v) if v else np.zeros(0) for n, v in err.items()}
+
+
+def _interp(tr: NamedTrajectory, name: str, t):
+    """``tr``'s coordinate at times ``t`` (at a repeated impact time: the later, post-impact
+    sample)."""
+    rev_t = tr.time[::-1]
+    _, last = np.unique(rev_t, return_index=True)
+    idx = len(tr.time) - 1 - last
+    return np.interp(t, tr.time[idx], tr.coordinates[name][idx])

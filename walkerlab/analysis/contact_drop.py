@@ -5,7 +5,7 @@ A point mass ``m`` moving down at ``v_in`` meets flat ground governed by the IMP
 gravity; the coefficient of restitution is ``e = v_out / v_in`` with ``v_out`` the upward
 speed at separation (force back to zero).  A plastic impact (the rigid model's heel strike)
 has ``e = 0``.  :func:`restitution_curve` sweeps the stiffness in the paper's family (damping
-fixed) and in the rigid-limit family (:func:`walkerlab.config.contact.family_scaling`).
+fixed) and in the rigid-limit family (:mod:`walkerlab.contact.rigid_limit`).
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from scipy.integrate import solve_ivp
 
 from walkerlab.config.contact import ContactSettings
 from walkerlab.contact.laws import impact_normal_force
+from walkerlab.contact.rigid_limit import contact_si
 
 __all__ = ["FAMILIES", "drop_restitution", "restitution_curve"]
 
@@ -45,7 +46,7 @@ def drop_restitution(contact: ContactSettings, mass_kg: float = 20.0, v_in_m_per
         ``restitution`` [-] (0 if the mass comes to rest in contact within 50 contact
         times), ``max_penetration_m`` [m], ``contact_time_s`` [s].
     """
-    c = contact.to_si()
+    c = contact_si(contact)[0]
     vin = float(v_in_m_per_s)
     dstar = ((c.e + 1) * mass_kg * vin**2 / (2 * c.k)) ** (1 / (c.e + 1))
     tc = dstar / vin

@@ -71,10 +71,9 @@ three slow ones (0.469 +- 0.498j, 0.113; rigid 0.548 +- 0.499j, 0.108), the seve
 
 Rigid limit
 -----------
-:func:`rigid_limit_contact` scales the contact towards the ideal model's assumptions
-(stiff, plastic, no slip): ``k -> kappa k``, ``dmax -> kappa^(-1/e) dmax`` (follows the
-penetration), ``cmax -> kappa^(1/(2e)) cmax`` (constant damping ratio of the stance
-contact), ``v_s, v_d -> kappa^(-1/2) v_s, v_d`` (less friction creep) and high friction.
+The one rigid-limit family of the contact is :mod:`walkerlab.contact.rigid_limit`
+(:func:`~walkerlab.contact.rigid_limit.scale_walker`);
+:func:`walkerlab.analysis.rigid_limit.convergence` follows this gait along it.
 """
 
 from __future__ import annotations
@@ -92,7 +91,7 @@ from walkerlab.contact.model import ContactWalker
 from walkerlab.integrate.contact import StateIndex
 
 __all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait", "PeriodicGaitError",
-           "find_contact_periodic_gait", "section_guess_from_ideal", "rigid_limit_contact"]
+           "find_contact_periodic_gait", "section_guess_from_ideal"]
 
 SECTION_NAMES = ("theta_stance", "dtheta_swing", "dtheta_stance", "delta_stance",
                  "v_t_stance", "ddelta_stance")
@@ -467,26 +466,6 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
         raise PeriodicGaitError("fall" if sol.t_events[1].size else "no_mid_stance",
                                 "the ideal state does not reach mid-stance on the contact model")
     return step_map.to_section(sol.y_events[0][0], 1)[0]
-
-
-def rigid_limit_contact(walker: ContactWalker, kappa: float, mu_s: float = 2.0,
-                        mu_d: float | None = None) -> ContactWalker:
-    """Copy of ``walker`` with a contact ``kappa`` times stiffer (family in the module doc).
-
-    Parameters
-    ----------
-    kappa : float
-        Stiffness factor [-] (1 keeps k, dmax, cmax, v_s, v_d).
-    mu_s, mu_d : float
-        Friction coefficients [-] (``mu_d`` default ``0.8 mu_s``).
-    """
-    c = walker.contact
-    e = c.e
-    new = dataclasses.replace(
-        c, k=c.k * kappa, dmax=c.dmax * kappa ** (-1.0 / e),
-        cmax=c.cmax * kappa ** (0.5 / e), v_s=c.v_s / np.sqrt(kappa),
-        v_d=c.v_d / np.sqrt(kappa), mu_s=mu_s, mu_d=0.8 * mu_s if mu_d is None else mu_d)
-    return dataclasses.replace(walker, contact=new)
 
 
 def ideal_gait(scene):

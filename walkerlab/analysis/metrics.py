@@ -82,7 +82,8 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         r2l = w.role_to_leg(seg.stance_leg)
         for name, v in w.leg_coordinates(X, seg.stance_leg).items():
             coords[name].append(v)
-        ke, pe = w.energies(X)
+        sw = w.for_stance(seg.stance_leg)  # legs that differ: that step's own numbers
+        ke, pe = sw.energies(X)
         pe = pe + mass * g * seg.stance_foot_world[1]
         chunks["t"].append(times)
         chunks["ke"].append(np.broadcast_to(ke, times.shape))
@@ -90,7 +91,7 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         chunks["stance"].append(np.full(times.size, legs.index(seg.stance_leg)))
         chunks["step"].append(np.full(times.size, seg.index))
         chunks["phase"].append(_phase_of(seg, times))
-        for name, xy in w.points(X).items():
+        for name, xy in sw.points(X).items():
             key = _leg_point_name(name, r2l)
             pts.setdefault(key, []).append(np.asarray(xy) + seg.stance_foot_world[:, None])
     cat = np.concatenate
@@ -126,12 +127,13 @@ def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
         rows["event"].append(seg.event)
         rows["nfev"].append(seg.nfev)
         rows["midstance_time"].append(seg.phase_times.get("midstance", np.nan))
-        p0, p1 = w.points(seg.x_start), w.points(seg.x_end)
+        sw = w.for_stance(seg.stance_leg)  # legs that differ: that step's own numbers
+        p0, p1 = sw.points(seg.x_start), sw.points(seg.x_end)
         if seg.termination == "heel_strike":
             rows["step_length"].append(float(np.linalg.norm(p1["swing_foot"])))
             rows["hip_speed"].append(float((p1["hip"][0] - p0["hip"][0]) / seg.period))
-            ke_m, _ = w.energies(seg.x_end)
-            ke_p, _ = w.energies(seg.x_next)
+            ke_m, _ = sw.energies(seg.x_end)
+            ke_p, _ = w.for_stance(r2l.get("swing", seg.stance_leg)).energies(seg.x_next)
             rows["impact_energy_loss"].append(float(ke_m - ke_p))
         else:
             rows["step_length"].append(np.nan)

@@ -37,35 +37,52 @@ class FixedPointNotFound(RuntimeError):
 
 
 def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
-                 max_step_time: float = 5.0, jacobian: bool = False):
-    """One step of the Poincaré map ``x_{n+1} = P(x_n)`` (Eq. 10).
+                 max_step_time: float = 5.0, jacobian: bool = False,
+                 steps: list | None = None):
+    """The Poincaré map ``x_{n+1} = P(x_n)`` (Eq. 10): one step, or one stride (two steps,
+    ``legs[0]`` swinging first) for a walker whose legs differ (``walker.mirror``).
 
     Parameters
     ----------
     x : ndarray, shape (2n,)
-        State just after heel strike (role-ordered).
+        State just after heel strike (role-ordered), ``legs[0]`` about to swing.
     jacobian : bool
-        Also return ``DP`` (2n x 2n) from the variational equations.
+        Also return ``DP`` (2n x 2n) from the variational equations (with saltation at every
+        guard; for a stride the product of the two steps' Jacobians).
+    steps : list, optional
+        The steps' :class:`~walkerlab.integrate.rigid.Segment` are appended to it.
 
     Returns
     -------
     x_next : ndarray, shape (2n,)
     period : float
-        Step period [s].
+        Period of the map [s]: the step period, or the stride period.
     DP : ndarray (2n, 2n), only if ``jacobian``.
     nfev : int
 
     Raises
     ------
     StepFailed
-        The step ended in a fall, a solver failure or ran past ``max_step_time``.
+        A step ended in a fall, a solver failure or ran past ``max_step_time``.
     """
-    seg = integrate_step(walker, x, solver, max_step_time=max_step_time, variational=jacobian)
-    if seg.termination != "heel_strike":
-        raise StepFailed(seg.termination, seg.t_end, seg.x_end, seg.message)
+    legs = walker.legs
+    period, nfev, DP = 0.0, 0, np.eye(np.size(x))
+    for k in range(walker.steps_per_map):
+        stance = legs[1] if k == 0 else legs[0]
+        seg = integrate_step(walker.for_stance(stance), x, solver, t0=period,
+                             max_step_time=max_step_time, variational=jacobian, index=k,
+                             stance_leg=stance)
+        if steps is not None:
+            steps.append(seg)
+        nfev += seg.nfev
+        if seg.termination != "heel_strike":
+            raise StepFailed(seg.termination, seg.t_end, seg.x_end, seg.message)
+        x, period = seg.x_next, seg.t_end
+        if jacobian:
+            DP = seg.monodromy @ DP
     if jacobian:
-        return seg.x_next, seg.period, seg.monodromy, seg.nfev
-    return seg.x_next, seg.period, seg.nfev
+        return x, period, DP, nfev
+    return x, period, nfev
 
 
 def fd_jacobian(walker: HybridWalker, x: np.ndarray, solver: Solver, h: float = 1e-7,
@@ -109,6 +126,10 @@ class FixedPointResult:
         Maps with the variational equations: the one at the fixed point, plus any the root
         finder asked for as a Jacobian
     stable : bool      all multipliers (variational) strictly inside the unit circle
+    step_periods_s, step_lengths_m : tuple of float
+        Each step of the map [s], [m] (one step; two, ``legs[0]`` swinging first, when the
+        map is a stride); a step's length is the distance from its stance foot to the
+        swing foot at heel strike
     """
 
     x: np.ndarray
@@ -122,6 +143,8 @@ class FixedPointResult:
     iterations: int
     wall_time_s: float
     variational_maps: int = 1
+    step_periods_s: tuple = ()
+    step_lengths_m: tuple = ()
 
     @property
     def stable(self) -> bool:
@@ -226,25 +249,28 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
             key = z.tobytes()
             if key in start:  # the start: asked by scipy's shape check and by MINPACK
                 return start[key]
+            segs: list = []
             try:  # asked again: the updated guess stopped helping; the true one here
                 out = poincare_map(walker, walker.from_section(z), solver, max_step_time,
-                                   jacobian=True)
+                                   jacobian=True, steps=segs)
             except StepFailed:
                 return next(iter(start.values()))
             counter["nfev"] += out[3]
             counter["jacobians"] += 1
             variational.clear()
-            variational[key] = out  # MINPACK often stops at this iterate: DP is reused
+            variational[key] = (*out, segs)  # MINPACK often stops at this iterate: reused
             return _section_jacobian(walker, out[2], z)
 
         sol = root(residual, z0, method="hybr", jac=jacobian, options={"xtol": xtol})
     x = walker.from_section(sol.x)
     if sol.x.tobytes() in variational:  # the Jacobian was last computed at the solution
-        xn, period, DP, _ = variational[sol.x.tobytes()]
+        xn, period, DP, _, segs = variational[sol.x.tobytes()]
         counter["jacobians"] -= 1
     else:
+        segs = []
         try:
-            xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True)
+            xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True,
+                                              steps=segs)
         except StepFailed as exc:
             raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate "
                                      f"({exc})", float("nan")) from None
@@ -271,6 +297,10 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         multipliers_fd=mult_fd, jacobian_variational=DP, jacobian_fd=Jfd,
         nfev=counter["nfev"] + nf2, iterations=counter["calls"],
         wall_time_s=time.perf_counter() - t0, variational_maps=counter["jacobians"] + 1,
+        step_periods_s=tuple(float(sg.period) for sg in segs),
+        step_lengths_m=tuple(
+            float(np.linalg.norm(walker.for_stance(sg.stance_leg).points(sg.x_end)["swing_foot"]))
+            for sg in segs),
     )
 
 

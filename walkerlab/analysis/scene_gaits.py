@@ -54,8 +54,10 @@ def with_variant(scene: Scene, variant: str) -> Scene:
     return scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
 
 
-def solve_scene(scene: Scene, fd_check: bool = True):
-    """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``.
+def solve_scene(scene: Scene, fd_check: bool = True, guess=None):
+    """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
+    ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
+    scene's initial guess.
 
     Returns
     -------
@@ -71,7 +73,8 @@ def solve_scene(scene: Scene, fd_check: bool = True):
     """
     fp = _settings(scene)
     walker = build_walker(scene)
-    search = find_gaits(walker, Solver.from_settings(scene.solver), initial_guess(scene, walker),
+    start = initial_guess(scene, walker) if guess is None else guess
+    search = find_gaits(walker, Solver.from_settings(scene.solver), start,
                         policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
                         fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
                         fd_check=fd_check)

@@ -37,7 +37,8 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     -------
     dict
         ``t_left_s``, ``t_right_s``, ``t_cycle_s``, ``v_com_m_per_s``, ``E_avg_J``,
-        ``E_avg_stance_frame_J``, ``step_length_m``, ``n_steps``.
+        ``E_avg_stance_frame_J``, ``step_length_m`` (and per leg, ``step_length_left_m``,
+        ``step_length_right_m``: the steps the left / right leg's swing ends), ``n_steps``.
     """
     left = left_leg or tr.legs[0]
     li = tr.legs.index(left)
@@ -62,12 +63,18 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
         out["v_com_m_per_s"] = float((hip[0, i1] - hip[0, i0]) / (tr.time[i1] - tr.time[i0]))
         feet = [tr.points.get(f"{leg}_foot") for leg in tr.legs]
         if all(f is not None for f in feet):
-            lengths = []
+            lengths, left_step = [], []
             for k in range(1, int(done.sum()) + 1):
                 i = bounds[k] - 1 if k < len(bounds) - 1 else bounds[k]
                 d = feet[0][:, i] - feet[1][:, i]
                 lengths.append(np.hypot(*d))
+                left_step.append(stance[k - 1] != li)
             out["step_length_m"] = float(np.mean(lengths)) if lengths else np.nan
+            lengths, left_step = np.array(lengths), np.array(left_step, dtype=bool)
+            # per leg (legs that differ take steps of two lengths): the step its swing ends
+            for side, m in (("left", left_step), ("right", ~left_step)):
+                out[f"step_length_{side}_m"] = (float(np.mean(lengths[m])) if m.any()
+                                                else np.nan)
     else:
         out["v_com_m_per_s"] = np.nan
     out.setdefault("step_length_m", np.nan)

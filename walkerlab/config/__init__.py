@@ -45,8 +45,8 @@ from walkerlab.config.contact import (  # noqa: F401  (re-exported: one import p
     ContactSettings,
     ContactSimSettings,
     ContactSolverSettings,
+    PerStepTerrain,
     TerrainSettings,
-    family_scaling,
 )
 
 
@@ -147,6 +147,9 @@ class PointMassBody(_Strict):
     mass_kg: float = Field(ge=0, le=1e4, description="mass [kg]; 0 = the limit m/M -> 0, "
                            "taken symbolically (Garcia et al. 1998), not a small number")
     from_hip_m: float = Field(ge=0, le=100, description="distance from the hip along the link [m]")
+    off_axis_m: float = Field(0.0, ge=-100, le=100, description="distance from the link's axis "
+                              "[m], positive ahead of the axis (+x when the link hangs "
+                              "straight down; McGeer's offset masses)")
 
 
 class RodBody(_Strict):
@@ -160,6 +163,8 @@ class RodBody(_Strict):
     com_from_hip_m: float = Field(ge=0, le=100, description="centre of mass from the hip [m]")
     inertia_about_com_kg_m2: float = Field(ge=0, le=1e6, description="moment of inertia about "
                                            "the centre of mass [kg m^2] (uniform rod: m l^2/12)")
+    com_off_axis_m: float = Field(0.0, ge=-100, le=100, description="centre of mass off the "
+                                  "link's axis [m], positive ahead of it (as off_axis_m)")
 
 
 Body = Annotated[PointMassBody | RodBody, Field(discriminator="kind")]
@@ -238,9 +243,93 @@ class LegSpec(_Strict):
         return self
 
 
+class TorsoPointMass(_Strict):
+    """A point mass on the upper body, ``from_hip_m`` up its axis from the hip."""
+
+    kind: Literal["point_mass"] = Field(description="body type")
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (point: torso_<name>)")
+    mass_kg: float = Field(gt=0, le=1e4, description="mass [kg]")
+    from_hip_m: float = Field(ge=0, le=100, description="distance from the hip up the torso's "
+                              "axis [m]")
+    off_axis_m: float = Field(0.0, ge=-100, le=100, description="distance from the torso's axis "
+                              "[m], positive ahead of it (+x when upright)")
+
+
+class TorsoRigidBody(_Strict):
+    """A rigid body on the upper body: mass, centre of mass (on or off the axis), inertia."""
+
+    kind: Literal["rigid_body"] = Field(description="body type")
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]*$", description="body name (point: torso_<name>)")
+    mass_kg: float = Field(gt=0, le=1e4, description="mass [kg]")
+    com_from_hip_m: float = Field(ge=0, le=100, description="centre of mass up the torso's axis "
+                                  "from the hip [m]")
+    com_off_axis_m: float = Field(0.0, ge=-100, le=100, description="centre of mass off the "
+                                  "axis [m], positive ahead of it (+x when upright)")
+    inertia_about_com_kg_m2: float = Field(ge=0, le=1e6, description="moment of inertia about "
+                                           "the centre of mass [kg m^2]")
+
+
+TorsoBody = Annotated[TorsoPointMass | TorsoRigidBody, Field(discriminator="kind")]
+
+
+class TorsoSpec(_Strict):
+    """An upper body (torso) hinged at the hip, held by a coupling to the legs.
+
+    ``coupling: bisecting_hip`` (Wisse, Schwab & van der Helm 2004, "Passive dynamic walking
+    model with upper body", Robotica 22(6); Wisse, Hobbelen & Schwab 2007, IEEE T-RO 23(1)):
+    the upper body lies on the bisector of the angle between the legs, extended up through the
+    hip; with leg angles theta1, theta2 from the downward vertical (positive foot ahead), the
+    torso's angle from the upward vertical is (theta1 + theta2) / 2, positive leaning back.
+    The coupling is a holonomic linear constraint between link angles; the rigid model
+    eliminates it (the torso adds bodies, not coordinates)."""
+
+    coupling: Literal["bisecting_hip"] = Field(
+        "bisecting_hip", description="linear constraint between the torso's and the legs' "
+        "angles: 'bisecting_hip' = torso angle (from the upward vertical, positive leaning "
+        "back) equals the mean of the two leg angles")
+    bodies: list[TorsoBody] = Field(min_length=1, description="bodies on the upper body")
+
+    @model_validator(mode="after")
+    def _names(self) -> TorsoSpec:
+        names = [b.name for b in self.bodies]
+        if len(set(names)) != len(names):
+            raise ValueError(f"bodies: duplicate body names {names}")
+        return self
+
+
+class SpringSpec(_Strict):
+    """A linear torsional spring and viscous damper between two links sharing a joint point
+    (the hip): torque ``-k (delta - rest) - c d(delta)/dt`` on the second link and the
+    opposite on the first, ``delta`` = angle(second) - angle(first) (leg angles from the
+    downward vertical, the torso's from the upward vertical; all positive foot ahead /
+    leaning back).  A hip spring between the legs (Kuo 2002, J. Biomech. Eng. 124(1)):
+    ``between: [leg1, leg2]``."""
+
+    between: list[Literal["leg1", "leg2", "torso"]] = Field(
+        min_length=2, max_length=2,
+        description="the two links the spring joins (leg1 starts as the swing leg)")
+    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
+                                         "[N m/rad]")
+    rest_angle_rad: float = Field(0.0, ge=-3.2, le=3.2, description="relative angle at which "
+                                  "the spring is relaxed [rad]")
+    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
+                                         "[N m s/rad]")
+
+    @model_validator(mode="after")
+    def _two_links(self) -> SpringSpec:
+        if self.between[0] == self.between[1]:
+            raise ValueError("between: a spring joins two different links")
+        return self
+
+
 class BipedParams(_Strict):
     """A planar passive biped described as data (``model: biped``); its equations of motion,
-    guards and impact are derived symbolically (:mod:`walkerlab.models.symbolic`)."""
+    guards and impact are derived symbolically (:mod:`walkerlab.models.symbolic`).
+
+    Give ``leg`` (both legs identical, the shorthand) or ``legs`` (a pair: ``leg1``, which
+    starts as the swing leg, then ``leg2``; same length, foot and body names, the numbers
+    may differ).  Legs that differ, a spring with a rest angle, or a spring between the torso
+    and one leg make the walker a non-mirror-symmetric one: its Poincaré map is a stride."""
 
     model: Literal["biped"] = Field(description="generic biped description")
     coordinates: Literal["absolute", "slope_relative"] = Field(
@@ -249,15 +338,52 @@ class BipedParams(_Strict):
         "the legs (Garcia et al. 1998)")
     gravity_m_per_s2: float = Field(9.81, gt=0, le=100, description="gravity g [m/s^2]")
     hip_mass_kg: float = Field(ge=0, le=1e4, description="hip point mass [kg]")
-    leg: LegSpec = Field(description="each leg (both are identical)")
+    leg: LegSpec | None = Field(None, description="each leg (both identical; shorthand for "
+                                "a 'legs' pair of two equal legs)")
+    legs: list[LegSpec] | None = Field(None, min_length=2, max_length=2, description="the two "
+                                       "legs, leg1 (swing in the first step) then leg2")
+    torso: TorsoSpec | None = Field(None, description="upper body on the hip (null: none)")
+    springs: list[SpringSpec] = Field(default_factory=list, description="torsional springs "
+                                      "and dampers between links at the hip")
 
     @model_validator(mode="after")
     def _has_mass(self) -> BipedParams:
-        if self.hip_mass_kg + sum(b.mass_kg for b in self.leg.bodies) <= 0:
+        if (self.leg is None) == (self.legs is None):
+            raise ValueError("give either 'leg' (both legs identical) or 'legs' (a pair)")
+        pair = self.leg_pair()
+        if self.legs is not None:
+            a, b = pair
+            for what, va, vb in (("length_m", a.length_m, b.length_m),
+                                 ("foot", a.foot, b.foot), ("knee", a.knee, b.knee),
+                                 ("bodies (kind, name, link)",
+                                  [(x.kind, x.name, x.link) for x in a.bodies],
+                                  [(x.kind, x.name, x.link) for x in b.bodies])):
+                if va != vb:
+                    raise ValueError(f"legs: both legs need the same {what} (masses, "
+                                     "distances and inertias may differ)")
+            for x, y in zip(a.bodies, b.bodies):
+                if (x.mass_kg == 0) != (y.mass_kg == 0):
+                    raise ValueError(f"legs: body {x.name!r} is massless on one leg only")
+        if self.hip_mass_kg + sum(b.mass_kg for leg in pair for b in leg.bodies) <= 0:
             raise ValueError("the walker has no mass (hip_mass_kg and all bodies are 0)")
-        if self.coordinates != "absolute" and (self.leg.knee or self.leg.foot.kind != "point"):
+        if self.coordinates != "absolute" and (pair[0].knee or pair[0].foot.kind != "point"):
             raise ValueError("coordinates: a knee or arc feet need 'absolute'")
+        new = [n for n, on in (("legs", self.legs is not None), ("torso", self.torso),
+                               ("springs", self.springs)) if on]
+        if new and self.coordinates != "absolute":
+            raise ValueError(f"coordinates: {new[0]} needs 'absolute'")
+        if new and pair[0].knee is not None:
+            raise ValueError(f"{new[0]}: not available with a knee yet (straight legs only)")
+        if self.springs and any(b.mass_kg == 0 for leg in pair for b in leg.bodies):
+            raise ValueError("springs: not with massless bodies (a sprung massless leg has "
+                             "no flow in the limit m -> 0)")
+        if any("torso" in s.between for s in self.springs) and self.torso is None:
+            raise ValueError("springs: a spring on the torso needs a 'torso'")
         return self
+
+    def leg_pair(self) -> tuple[LegSpec, LegSpec]:
+        """``(leg1, leg2)``: the ``legs`` pair, or ``leg`` twice."""
+        return (self.leg, self.leg) if self.leg is not None else tuple(self.legs)
 
 
 # ``model`` is the discriminator; "compass_gait" is the paper's shorthand for a biped with a
@@ -315,11 +441,56 @@ class SolverSettings(_Strict):
         "Python callbacks, ~1 s numba import per process; for many-point studies)")
 
 
+class GuessFromArtifact(_Strict):
+    """A starting state read from a continuation artifact (issue 23): the state of a branch
+    at a parameter value, instead of digits copied by hand."""
+
+    model_config = ConfigDict(populate_by_name=True)
+
+    from_: str = Field(alias="from", min_length=1, description="continuation artifact "
+                       "(runs/<scene>/continuation_<field>.h5), relative to the current "
+                       "folder")
+    at: float = Field(description="value of the artifact's parameter on the branch [the "
+                      "artifact's field unit]")
+    branch: int = Field(0, ge=0, le=1000, description="branch index in the artifact (0: the "
+                        "period-1 branch through the scene's own gait)")
+
+    def as_array(self, state_names: list[str] | None = None):
+        """State (2n,) of the branch at ``at`` (linear interpolation between its two nearest
+        points), in the order of ``state_names``.
+
+        Raises
+        ------
+        ValueError
+            Artifact missing or damaged, ``at`` off the branch, or other state names.
+        """
+        import numpy as np
+
+        from walkerlab.io.artifacts import ArtifactError
+        from walkerlab.io.schemas.continuation import load_continuation
+
+        try:
+            data = load_continuation(Path(self.from_))
+        except ArtifactError as exc:
+            raise ValueError(str(exc)) from None
+        if self.branch >= len(data.branches):
+            raise ValueError(f"branch {self.branch}: {self.from_} has "
+                             f"{len(data.branches)} branches")
+        x = data.state_at(self.at, self.branch)
+        names = state_names or data.state_names
+        if sorted(names) != sorted(data.state_names):
+            raise ValueError(f"{self.from_} holds states {data.state_names}, the walker has "
+                             f"{list(names)}")
+        return np.array([x[data.state_names.index(n)] for n in names])
+
+
 class StateSpec(_Strict):
     """A walker state right after heel strike, by state name with its unit:
     ``<role>_angle_rad`` and ``<role>_rate_rad_per_s`` for each role of the walker (compass
     gait, Eq. 1: ``swing_angle_rad, stance_angle_rad, swing_rate_rad_per_s,
-    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``)."""
+    stance_rate_rad_per_s``; simplest walker: ``stance_...`` and ``hip_...``), or a state
+    read from a continuation artifact, ``{from: <artifact>, at: <parameter value>, branch:
+    0}`` (:class:`GuessFromArtifact`)."""
 
     model_config = ConfigDict(extra="allow", frozen=True)
 
@@ -327,7 +498,16 @@ class StateSpec(_Strict):
     def _named_finite(self) -> StateSpec:
         import re
 
-        for k, v in (self.model_extra or {}).items():
+        extra = self.model_extra or {}
+        if "from" in extra:  # a state read from a continuation artifact (issue 23)
+            try:
+                GuessFromArtifact.model_validate(extra)
+            except ValidationError as exc:
+                err = exc.errors()[0]
+                where = ".".join(str(x) for x in err["loc"])
+                raise ValueError(f"{where}: {err['msg']}" if where else err["msg"]) from None
+            return self
+        for k, v in extra.items():
             if not re.fullmatch(r"[a-z][a-z0-9_]*_(angle_rad|rate_rad_per_s)", k):
                 raise ValueError(f"{k}: not a state name (<role>_angle_rad or "
                                  "<role>_rate_rad_per_s)")
@@ -348,6 +528,8 @@ class StateSpec(_Strict):
         """
         import numpy as np
 
+        if "from" in (self.model_extra or {}):
+            return GuessFromArtifact.model_validate(self.model_extra).as_array(state_names)
         names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
         keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
         given = dict(self.model_extra or {})
@@ -363,10 +545,18 @@ class StateSpec(_Strict):
 class FixedPointSettings(_Strict):
     """Search for the period-1 fixed point of the Poincaré map (paper Sec. 3.3)."""
 
+    model_config = ConfigDict(populate_by_name=True)
+
     initial_guess: StateSpec | None = Field(
-        None, description="starting point of the root finder; null: found automatically "
+        None, description="starting point of the root finder, by state name or "
+        "{from: <continuation artifact>, at: <parameter value>}; null: found automatically "
         "(scale-free seeds from the slope and the walker's size, ranked on the heel-strike "
         "section; walkerlab.analysis.gaits)")
+    from_: str | None = Field(
+        None, alias="from", description="a scene YAML whose gait is known: its gait is "
+        "continued along the straight line between the two scenes' numeric walker and slope "
+        "fields to this walker (homotopy), and used as the initial guess; relative to this "
+        "scene's folder")
     gait: Literal["stable", "long_period", "short_period", "nearest_guess"] = Field(
         "stable", description="which period-1 gait to use where two exist (Goswami et al. "
         "1996, Garcia et al. 1998: long- and short-period pair): 'stable' (the stable one; "
@@ -475,6 +665,39 @@ class BasinSettings(_Strict):
         "a 2-D set, the cell is then unique); a cell no heel strike reaches is 'unreachable'")
 
 
+class MfptSettings(_Strict):
+    """Mean first-passage time on per-step random slopes (``walkerlab mfpt``; Byl & Tedrake
+    2009).  The slope of each step is normal (or ``terrain.per_step.slope_distribution``)
+    about the scene's slope with standard deviation ``sigma``; walks start on the gait."""
+
+    sigma_rad: list[Annotated[float, Field(gt=0, le=0.2)]] = Field(
+        [0.002, 0.003, 0.004, 0.006], min_length=1, max_length=64,
+        description="standard deviations of the per-step slope [rad]")
+    method: Literal["mesh", "montecarlo", "both"] = Field(
+        "both", description="mesh (rigid model), Monte Carlo, or both side by side")
+    walks: int = Field(400, ge=1, le=1_000_000, description="Monte Carlo walks per sigma")
+    max_steps: int = Field(2000, ge=1, le=1_000_000,
+                           description="Monte Carlo step cap per walk (censoring) [steps]")
+    seed: int = Field(0, ge=0, description="Monte Carlo seed [-] (terrain.per_step.seed "
+                      "when that is given)")
+    quadrature_nodes: int = Field(9, ge=3, le=41, description="Gauss-Hermite nodes of the "
+                                  "slope distribution in the mesh [-]")
+    mesh_spacing: float = Field(1.0, gt=0.05, le=4, description="first mesh spacing "
+                                "[standard deviations of the walk's post-impact cloud]")
+    mesh_refine: float = Field(0.75, gt=0.2, lt=1, description="spacing factor per "
+                               "refinement [-]")
+    mesh_max_cells: int = Field(8000, ge=10, le=2_000_000,
+                                description="largest mesh [vertices]; refinement stops there")
+    mesh_rel_change: float = Field(0.05, gt=0, lt=1, description="refine until the MFPT "
+                                   "changes by less than this between meshes [-]")
+    rtol: float = Field(1e-9, ge=1e-12, lt=1e-3, description="integrator relative "
+                        "tolerance per walk [-]")
+    atol: float = Field(1e-9, gt=0, lt=1e-3, description="integrator absolute tolerance "
+                        "per walk [rad, rad/s]")
+    max_step_time_s: float = Field(5.0, gt=0, le=MAX_STEP_TIME_S, description="no heel "
+                                   "strike within this = a fall [s]")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
@@ -511,6 +734,7 @@ class Scene(_Strict):
         """Resolved path of the scene file, or None for a scene built in code."""
         return self._origin
     basin: BasinSettings | None = None
+    mfpt: MfptSettings | None = None
 
     @model_validator(mode="after")
     def _units_consistent(self) -> Scene:

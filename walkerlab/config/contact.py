@@ -14,11 +14,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    model_serializer,
+    model_validator,
+)
 
 __all__ = ["MAX_CONTACT_STRIDES", "ContactParamsSI", "ContactSettings", "ContactSimSettings",
-           "ContactSolverSettings", "KneeStopSI", "KneeStopSettings", "TerrainSettings",
-           "family_scaling"]
+           "ContactSolverSettings", "KneeStopSI", "KneeStopSettings", "PerStepTerrain",
+           "TerrainSettings"]
 
 
 @dataclass(frozen=True)
@@ -92,26 +99,6 @@ MAX_CONTACT_STRIDES = 100
 
 def _list_to_tuple(v):
     return tuple(v) if isinstance(v, list) else v
-
-
-def family_scaling(cmax: float, dmax: float, e: float, kappa: float) -> tuple[float, float]:
-    """Damping and damping-ramp depth of the 'rigid_limit' stiffness family.
-
-    A point mass m dropping at speed v on ``F = k d^e + c(d) d'`` reaches the depth
-    ``d* ~ (m v^2 / k)^(1/(e+1))`` in the time ``d* / v``; in the scaled variables
-    ``d / d*``, ``t v / d*`` the equation is unchanged when ``c ~ k^(1/(e+1))`` and
-    ``dmax ~ d* ~ k^(-1/(e+1))``.  So with ``kappa = k / k_ref`` the family
-    ``cmax kappa^(1/(e+1))``, ``dmax kappa^(-1/(e+1))`` keeps the coefficient of restitution
-    of the reference contact for every k (gravity during the impact aside), and the contact
-    tends to the rigid plastic impact only through its duration ``~ k^(-1/(e+1))``.
-
-    Returns
-    -------
-    (cmax, dmax) : tuple of float
-        In the units of the inputs.
-    """
-    p = 1.0 / (e + 1.0)
-    return cmax * kappa ** p, dmax * kappa ** (-p)
 
 
 def _len_factor(unit_system: str) -> float:
@@ -215,9 +202,12 @@ class ContactSettings(BaseModel):
     stiffness_family: Literal["paper", "rigid_limit"] = Field(
         "paper", description="How damping and dmax follow the stiffness: 'paper' keeps "
         "max_damping and penetration_at_max_damping as given (a stiffer contact is then more "
-        "elastic); 'rigid_limit' scales them with kappa = stiffness / reference_stiffness as "
-        "cmax * kappa^(1/(e+1)), dmax * kappa^(-1/(e+1)), so a drop impact keeps the "
-        "restitution it has at the reference stiffness (near-plastic) as k grows.")
+        "elastic); 'rigid_limit' reads them, the transition velocities and the knee latch's "
+        "release height as holding at reference_stiffness and follows the one rigid-limit "
+        "family (walkerlab.contact.rigid_limit) with kappa = stiffness / reference_stiffness: "
+        "cmax * kappa^(1/(e+1)), dmax and latch height * kappa^(-1/(e+1)), vs and vd * "
+        "kappa^(-1/2), so a drop impact keeps its (near-plastic) restitution and the periodic "
+        "gait converges to the rigid one as k grows.")
     reference_stiffness: float = Field(
         1e5, gt=0, description="Stiffness at which max_damping and penetration_at_max_damping "
         "hold in the 'rigid_limit' family (paper: 1e5 N/mm^2.2).",
@@ -244,7 +234,8 @@ class ContactSettings(BaseModel):
         """Convert to SI: ``k_SI = k * f**-e``, ``c_SI = c / f``, lengths and velocities ``* f``.
 
         ``f`` = metres per length unit (1e-3 for mm-kg-s).  E.g. ``k = 1e5 N/mm^2.2`` becomes
-        ``1e5 * 1000**2.2 N/m^2.2``.
+        ``1e5 * 1000**2.2 N/m^2.2``.  The numbers as written: the ``stiffness_family`` is
+        applied by :func:`walkerlab.contact.rigid_limit.contact_si`.
 
         Returns
         -------
@@ -253,9 +244,6 @@ class ContactSettings(BaseModel):
         f = _len_factor(self.unit_system)
         e = self.exponent
         cmax, dmax = self.max_damping, self.penetration_at_max_damping
-        if self.stiffness_family == "rigid_limit":
-            kappa = self.stiffness / self.reference_stiffness
-            cmax, dmax = family_scaling(cmax, dmax, e, kappa)
         return ContactParamsSI(
             k=self.stiffness * f ** (-e),
             e=e,
@@ -266,6 +254,24 @@ class ContactSettings(BaseModel):
             v_s=self.stiction_velocity * f,
             v_d=self.friction_velocity * f,
         )
+
+
+class PerStepTerrain(BaseModel):
+    """Per-step ground of the rigid model (Byl & Tedrake 2009, "Metastable walking machines").
+
+    Step ``n`` is taken on the straight line through the stance foot at slope ``gamma_n``
+    (for a compass walker the heel-strike guard becomes ``theta_swing + theta_stance =
+    -2 gamma_n``).  ``gamma_n`` is drawn i.i.d. about the scene's slope (``slope_sd_rad``;
+    ``normal`` or ``uniform`` with the same standard deviation), reproducibly from ``seed``.
+    """
+
+    model_config = _STRICT
+
+    slope_distribution: Literal["normal", "uniform"] = Field(
+        "normal", description="distribution of each step's slope about the scene's slope")
+    slope_sd_rad: float = Field(0.0, ge=0, le=0.2,
+                                description="standard deviation of each step's slope [rad]")
+    seed: int = Field(0, ge=0, description="seed of the per-step draws [-]")
 
 
 class TerrainSettings(BaseModel):
@@ -285,6 +291,17 @@ class TerrainSettings(BaseModel):
     patch_width_m: float = Field(
         0.10, gt=0, description="Width of each checkerboard patch along the slope [m]."
     )
+    per_step: PerStepTerrain | None = Field(
+        None, description="Ground that changes from step to step (rough terrain, a step-down); "
+        "used by the rigid model's metastability and disturbance studies (walkerlab mfpt)")
+
+    @model_serializer(mode="wrap")
+    def _drop_unset_per_step(self, handler):
+        # a scene without per-step terrain serialises as before (same content hashes)
+        d = handler(self)
+        if isinstance(d, dict) and d.get("per_step") is None:
+            d.pop("per_step", None)
+        return d
 
 
 class ContactSimSettings(BaseModel):

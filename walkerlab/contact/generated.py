@@ -518,8 +518,8 @@ def rhs_source(eq) -> str:
     Q = -eq.h
     for i, (_, J) in enumerate(eq.feet):
         Q += J.T * sp.Matrix([Fs[2 * i], Fs[2 * i + 1]])
-    if nq == 6:  # knees: (thigh, shank) = (2, 3), (4, 5)
-        for k, (t, sh) in enumerate(((2, 3), (4, 5))):
+    if eq.knees:  # each leg's knee: (thigh, shank) indices in q, leg k's foot is foot k
+        for k, (t, sh) in enumerate(eq.knees):
             T = sp.Symbol(f"_T{k}", real=True)
             # penetration of leg k's foot, -(p . n)
             dl = f"-(({pr.doprint(red[4 * k])}) * _sp + ({pr.doprint(red[4 * k + 1])}) * _cp)"

@@ -183,11 +183,13 @@ class ContactWalker:
                       g=9.81, phi=0.0174, data=None) -> ContactWalker:
         """Build from validated settings; ``step_length`` [m] is the ideal gait's step length
         (patch spacing).  ``data`` (a WalkerData) replaces the compass-gait shorthand."""
+        from .rigid_limit import contact_si
+
         c1, c2 = checkerboard_lanes(step_length, n_steps)
-        return cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=contact.to_si(), lane1=c1,
+        si, knee = contact_si(contact)  # the scene's stiffness family applied
+        return cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=si, lane1=c1,
                    lane2=c2, patch_half_width=0.5 * terrain.patch_width_m,
-                   continuous=terrain.kind == "continuous", data=data,
-                   knee_stop=contact.knee_stop.to_si())
+                   continuous=terrain.kind == "continuous", data=data, knee_stop=knee)
 
     @property
     def structure(self):
@@ -221,6 +223,15 @@ class ContactWalker:
         return (load / self.contact.k) ** (1.0 / self.contact.e)
 
     # ------------------------------------------------------------------ state layout
+    @property
+    def model_name(self) -> str:
+        """``compass_gait_contact`` for two straight point-footed legs alike with their
+        bodies on the axis and nothing else (the paper's family), else ``biped_contact``."""
+        st = self.structure
+        extra = (st.knee or st.torso or st.springs or st.asymmetric or st.foot != "point"
+                 or any(b.off_axis for b in st.bodies))
+        return "biped_contact" if extra else "compass_gait_contact"
+
     @property
     def nq(self) -> int:
         """Number of generalised coordinates."""
@@ -304,11 +315,17 @@ class ContactWalker:
         x = np.asarray(x_ideal, float)
         st = self.structure
         s1, s2 = float(rate_scale[0]), float(rate_scale[1])
+        roles = st.roles  # the rigid walker's state, by name (<role>_angle, <role>_rate)
+        by = {f"{r}_angle": x[i] for i, r in enumerate(roles)}
+        by.update({f"{r}_rate": x[len(roles) + i] for i, r in enumerate(roles)})
         if st.knee:
-            ang = [x[0], x[1], x[2], x[2]]
-            rates = [s1 * x[3], s1 * x[4], s2 * x[5], s2 * x[5]]
+            ang = [by["swing_thigh_angle"], by["swing_shank_angle"], by["stance_angle"],
+                   by["stance_angle"]]
+            rates = [s1 * by["swing_thigh_rate"], s1 * by["swing_shank_rate"],
+                     s2 * by["stance_rate"], s2 * by["stance_rate"]]
         elif st.coordinates == "absolute":
-            ang, rates = [x[0], x[1]], [s1 * x[2], s2 * x[3]]
+            ang = [by["swing_angle"], by["stance_angle"]]
+            rates = [s1 * by["swing_rate"], s2 * by["stance_rate"]]
         else:
             from walkerlab.models.rigid import functions
 

@@ -13,6 +13,7 @@ import numpy as np
 from walkerlab.config import ContactSimSettings, ContactSolverSettings, Scene, TerrainSettings
 
 from .model import ContactWalker
+from .rigid_limit import contact_si
 
 __all__ = ["ContactSceneError", "build", "ideal_step_length", "settings"]
 
@@ -92,8 +93,8 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
         check_masses(data.structure)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
-    probe = ContactWalker(contact=contact.to_si(), data=data,
-                          knee_stop=contact.knee_stop.to_si())
+    si, knee = contact_si(contact)
+    probe = ContactWalker(contact=si, data=data, knee_stop=knee)
     step_length = ideal_step_length(probe, x_ideal)
     return ContactWalker.from_settings(contact, terrain, step_length=step_length,
                                        n_steps=n_steps + 4, data=data), step_length

@@ -46,6 +46,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
+from walkerlab.contact.energy import (
+    energy_rise_bound,
+    first_energy_violation,
+    side_entry,
+    total_energy,
+)
+
 from . import _cyrk
 from .ends import RunEnd
 from .solver import Solver
@@ -419,6 +426,10 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
     ta, xa = t0, x0
     term, msg, event = RunEnd.T_FINAL, "Integration successful.", None
     n_checked = 1
+    # the energy guard (walkerlab.contact.energy): no sample above the start's energy + bound
+    e_start = float(total_energy(walker, x0)[0])
+    e_bound = energy_rise_bound(walker, x0, solver.rtol)
+    guarded = False  # the energy guard ended the run (no event state to interpolate)
     # numbalsoda: the first chunk is short, later ones sized to CHUNK_WALL_S
     span = min(limits.chunk_s, 20.0 / rate) if be.sized_by_wall else limits.chunk_s
     while ta < t1 - 1e-12:
@@ -438,11 +449,36 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             per_s = (time.perf_counter() - w0) / max(tn[-1] - ta, 1e-12)
             left = max(min(CHUNK_WALL_S, deadline - time.perf_counter()), 1e-3)
             span = float(np.clip(left / max(per_s, 1e-12), 2.0 / rate, limits.chunk_s))
+        bad = first_energy_violation(walker, Xn, e_start, e_bound) if tn.size else None
+        n_prev = sum(len(t) for t in ts)
         ts.append(tn)
         Xs.append(Xn)
         t_all, X_all = np.concatenate(ts), np.vstack(Xs)
-        event = first_event(walker, t_all, X_all, limits, k0=n_checked)
+        # events among the trustworthy samples and the first one past them (a trip's first
+        # sample on the patch already carries the spring's energy)
+        n_ok = len(t_all) if bad is None else n_prev + bad + 1
+        event = first_event(walker, t_all[:n_ok], X_all[:n_ok], limits, k0=n_checked)
         n_checked = len(t_all)
+        if event is not None and bad is not None and event[1] >= n_prev + bad \
+                and event[0] != "trip":
+            event = None  # a fall or flight seen only on a blown-up sample is not one
+        if event is None and bad is not None:  # blown-up samples are not data
+            ts[-1], Xs[-1] = tn[:bad], Xn[:bad]
+            last = Xn[bad - 1] if bad else xa
+            trip = side_entry(walker, last, 2.0 / rate)
+            msg = (f"total energy rose above its start by more than {e_bound:.3g} J at "
+                   f"t = {tn[bad]:.6g} s (a contact walker cannot gain energy): the run ends "
+                   "at the last trustworthy sample")
+            term = RunEnd.SOLVER_FAILURE
+            if trip is not None:  # the cause: a foot in a gap entered a patch's side
+                foot, edge, ahead, depth = trip
+                t_last = float(tn[bad - 1]) if bad else float(ta)
+                event = ("trip", n_prev + bad - 1, t_last + ahead, foot, edge)
+                term = RunEnd.TRIP
+                msg = (f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
+                       f"entered a patch from its side; {msg}")
+            guarded = True
+            break
         if event is not None:
             term = RunEnd(event[0])
             break
@@ -457,7 +493,7 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             break
         ta, xa = t_all[-1], X_all[-1]
     t_all, X_all = np.concatenate(ts), np.vstack(Xs)
-    if event is not None:  # cut at the event and append the event state
+    if event is not None and not guarded:  # cut at the event and append the event state
         _, k, te, _, _ = event
         k = max(k, 1)
         xe = hermite_state(walker, t_all[k - 1], t_all[k], X_all[k - 1], X_all[k], te) \

@@ -426,11 +426,12 @@ def simulate_steps(walker: HybridWalker, x0: np.ndarray, n_steps: int, solver: S
     x, t, leg = np.asarray(x0, float), 0.0, first_stance_leg
     foot = np.zeros(2)
     for k in range(n_steps):
-        seg = integrate_step(walker, x, solver, t0=t, max_step_time=max_step_time, index=k,
-                             stance_leg=leg, stance_foot_world=foot.copy())
+        step_walker = walker.for_stance(leg)  # legs that differ: each leg's own numbers
+        seg = integrate_step(step_walker, x, solver, t0=t, max_step_time=max_step_time,
+                             index=k, stance_leg=leg, stance_foot_world=foot.copy())
         segs.append(seg)
         if seg.termination != RunEnd.HEEL_STRIKE:
             break
-        foot = foot + walker.points(seg.x_end)["swing_foot"]
+        foot = foot + step_walker.points(seg.x_end)["swing_foot"]
         x, t, leg = seg.x_next, seg.t_end, other_leg(walker, leg)
     return HybridTrajectory(segs, time.perf_counter() - t0, walker)

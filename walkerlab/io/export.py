@@ -11,7 +11,7 @@ Coordinates and names (both formats):
 joint         type        walkerlab floating coordinate
 ============  ==========  ================================================================
 hip_x         prismatic   ``hip_x`` [m] (the base translates along world x)
-hip_y         prismatic   ``hip_y`` [m] (along world z, up)
+hip_z         prismatic   ``hip_y`` [m] (along world z, up; named by its axis)
 leg<i>_hip    revolute    ``leg<i>_angle`` (kneed: ``leg<i>_thigh_angle``) [rad]
 leg<i>_knee   revolute    ``leg<i>_shank_angle - leg<i>_thigh_angle`` [rad]; limit [-pi, 0]:
                           0 is the straight-leg stop (positive = hyperextended)
@@ -42,20 +42,26 @@ Formats:
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.models.multibody import Link, Multibody
 
-__all__ = ["FORMATS", "MJCF_MIN_INERTIA_KG_M2", "MJCF_MIN_MASS_KG", "mjcf_text", "urdf_text"]
+__all__ = ["FORMATS", "LANE_BITS", "MJCF_MIN_INERTIA_KG_M2", "MJCF_MIN_LENGTH_M",
+           "MJCF_MIN_MASS_KG", "MjcfScene", "mjcf_text", "point_foot_radius", "urdf_text"]
 
 #: Export formats and their file names in ``runs/<scene>/``.
 FORMATS = {"urdf": "walker.urdf", "mjcf": "walker.xml"}
 #: Floor of a MuJoCo principal inertia [kg m^2] (MuJoCo's mjMINVAL is 1e-15).
 MJCF_MIN_INERTIA_KG_M2 = 1e-12
-#: Floor of the MuJoCo hip body's mass [kg] (only for a walker without a hip mass).
+#: Floor of the MuJoCo hip body's mass [kg] (only for a walker without a hip mass); a link
+#: lighter than this is refused (MuJoCo refuses bodies below mjMINVAL = 1e-15 kg).
 MJCF_MIN_MASS_KG = 1e-12
+#: Shortest link or foot radius [m] an export accepts: the point foot's sphere is L/1000 and
+#: MuJoCo refuses geometry below mjMINVAL (1e-15), e.g. "fromto points too close".
+MJCF_MIN_LENGTH_M = 1e-9
 #: Joint-axis of every hinge: world -y, so that a positive angle moves the foot ahead.
 AXIS = "0 -1 0"
 
@@ -73,16 +79,24 @@ def _header(mb: Multibody, name: str, fmt: str, version: str) -> list[str]:
     knee = ("; leg<i>_knee = shank - thigh angle, limit [-pi, 0], 0 = straight-leg stop"
             if mb.knee else "")
     foot = (f"arc feet, radius R = {_f(mb.foot_radius_m)} m, centre at L - R from the hip"
-            if mb.foot == "arc" else "point feet")
-    return [f"<!-- walker {name!s} exported by walkerlab {version} ({fmt}). -->",
-            "<!-- Floating planar walker in the x-z plane: x downhill (horizontal), z up; "
-            "joint axes along -y (positive angle = foot ahead). -->",
-            "<!-- Joints: hip_x, hip_y (prismatic, the hip's position [m]); leg<i>_hip = "
-            f"absolute link angle from the vertical [rad]{knee}. -->",
-            f"<!-- Gravity g = {_f(mb.gravity_m_per_s2)} m/s^2 along -z. Ground: slope "
-            f"{_f(mb.slope_rad)} rad, falling towards +x (the ground is tilted, not "
-            "gravity). -->",
-            f"<!-- Leg length L = {_f(mb.leg_length_m)} m; {foot}. -->"]
+            if _arc(mb) else "point feet")
+    return [_comment(f"walker {name!s} exported by walkerlab {version} ({fmt})."),
+            _comment("Floating planar walker in the x-z plane: x downhill (horizontal), z up; "
+                     "joint axes along -y (positive angle = foot ahead)."),
+            _comment("Joints: hip_x, hip_z (prismatic, the hip's position along world x and z "
+                     f"[m]); leg<i>_hip = absolute link angle from the vertical [rad]{knee}."),
+            _comment(f"Gravity g = {_f(mb.gravity_m_per_s2)} m/s^2 along -z. Ground: slope "
+                     f"{_f(mb.slope_rad)} rad, falling towards +x (the ground is tilted, not "
+                     "gravity)."),
+            _comment(f"Leg length L = {_f(mb.leg_length_m)} m; {foot}.")]
+
+
+def _comment(text: str) -> str:
+    """An XML comment holding ``text``: "--" may not occur inside one (XML 1.0, section
+    2.5), nor may it end in "-", so each "-" that follows a "-" gets a space before it."""
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return f"<!-- {text} -->"
 
 
 def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
@@ -100,7 +114,7 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
     Returns
     -------
     str
-        URDF XML; the base is ``world -> hip_x (prismatic x) -> hip_y (prismatic z) -> hip``
+        URDF XML; the base is ``world -> hip_x (prismatic x) -> hip_z (prismatic z) -> hip``
         through a massless ``hip_slider`` link; hip joints are ``continuous``.
     """
     width = mb.leg_length_m / 50  # visual thickness of the links
@@ -108,7 +122,7 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
            f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
            '  <link name="hip_slider"/>']
     for joint, parent, child, axis in (("hip_x", "world", "hip_slider", "1 0 0"),
-                                       ("hip_y", "hip_slider", "hip", "0 0 1")):
+                                       ("hip_z", "hip_slider", "hip", "0 0 1")):
         out += [f'  <joint name="{joint}" type="prismatic">', f'    <parent link="{parent}"/>',
                 f'    <child link="{child}"/>', '    <origin xyz="0 0 0" rpy="0 0 0"/>',
                 f'    <axis xyz="{axis}"/>',
@@ -148,12 +162,12 @@ def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
             "</geometry></visual>", "  </link>"]
     if ln.foot_m is not None:
         foot = ln.name.split("_")[0] + "_foot"
-        if mb.foot == "arc":  # cylinder axis (z) turned onto y
+        if _arc(mb):  # cylinder axis (z) turned onto y
             geom = (f'<origin xyz="{_v(0, 0, 0)}" rpy="{_v(math.pi / 2, 0, 0)}"/><geometry>'
                     f'<cylinder radius="{_f(mb.foot_radius_m)}" length="{_f(2 * width)}"/>'
                     "</geometry>")
         else:
-            geom = f'<geometry><sphere radius="{_f(mb.leg_length_m / 1000)}"/></geometry>'
+            geom = f'<geometry><sphere radius="{_f(point_foot_radius(mb))}"/></geometry>'
         out += [f'  <joint name="{foot}" type="fixed">', f'    <parent link="{ln.name}"/>',
                 f'    <child link="{foot}"/>',
                 f'    <origin xyz="{_v(0, 0, -ln.foot_m)}" rpy="0 0 0"/>', "  </joint>",
@@ -161,7 +175,96 @@ def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
     return out
 
 
-def mjcf_text(mb: Multibody, name: str, version: str = "") -> str:
+@dataclass(frozen=True)
+class MjcfScene:
+    """What the MJCF carries beyond the walker: the gait, the terrain, the contact.
+
+    Computed from the scene by :mod:`walkerlab.analysis.export_scene`; this module only
+    writes it.
+
+    Attributes
+    ----------
+    qpos, qvel : tuple of float
+        The ``gait`` keyframe in the export's joint order (``hip_x``, ``hip_z``, then the
+        link joints as in :attr:`Multibody.links`) [m, rad; m/s, rad/s].
+    lanes : tuple of (tuple of float, tuple of float) or None
+        Checkerboard patch centres along the slope [m] of leg1's and leg2's lane; None: a
+        continuous plane.
+    patch_width_m : float
+        Patch width along the slope [m].
+    ground_offset_m : float
+        The ground's surface lies this far below the feet's reference points along the slope
+        normal [m] (the point foot's sphere radius; 0 for arc feet).
+    timestep_s : float
+        MuJoCo ``option timestep`` [s].
+    solref : (float, float)
+        Contact ``solref`` (time constant [s], damping ratio [-]).
+    solimp : tuple of float
+        Contact ``solimp`` (d0, dwidth, width [m], midpoint, power).
+    friction : float
+        Sliding friction coefficient [-].
+    latch : (float, float) or None
+        Knee latch (release height above the ground [m], capture flexion [rad]); None without.
+    notes : tuple of str
+        Comments written into the file (how the numbers were derived).
+    """
+
+    qpos: tuple
+    qvel: tuple
+    lanes: tuple | None
+    patch_width_m: float
+    ground_offset_m: float
+    timestep_s: float
+    solref: tuple
+    solimp: tuple
+    friction: float
+    latch: tuple | None = None
+    notes: tuple = ()
+
+
+#: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot
+#: touches only its own lane (the paper's checkerboard, NOTES.md); continuous: both bits.
+LANE_BITS = {"leg1": 2, "leg2": 4}
+
+
+def point_foot_radius(mb: Multibody) -> float:
+    """Radius [m] of the sphere that stands for a point foot: ``L / 1000`` (the paper's ADAMS
+    feet carry a 1 mm bevel on a 1 m leg)."""
+    return mb.leg_length_m / 1000
+
+
+def _arc(mb: Multibody) -> bool:
+    """Arc feet with a radius (``R = 0`` is the point foot, as in the models)."""
+    return mb.foot == "arc" and mb.foot_radius_m > 0
+
+
+def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
+    phi = mb.slope_rad
+    if extra is None:
+        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{_v(0, phi, 0)}"'
+                ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>']
+    n = (math.sin(phi), math.cos(phi))  # slope normal in (x, z)
+    t = (math.cos(phi), -math.sin(phi))  # downhill along the slope
+    off = extra.ground_offset_m
+    if extra.lanes is None:
+        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{_v(0, phi, 0)}" '
+                f'pos="{_v(-off * n[0], 0, -off * n[1])}" contype="6" conaffinity="0" '
+                'rgba="0.8 0.8 0.8 1"/>']
+    half, depth = extra.patch_width_m / 2, extra.patch_width_m / 10
+    out = []
+    for leg, (y, centres) in zip(LANE_BITS, ((0.05, extra.lanes[0]), (-0.05, extra.lanes[1]))):
+        for i, s in enumerate(centres):
+            d = off + depth  # box centre below the surface
+            size = _v(half, 0.04 * mb.leg_length_m, depth)
+            pos = _v(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])
+            out.append(f'    <geom name="{leg}_patch{i}" type="box" size="{size}" pos="{pos}"'
+                       f' euler="{_v(0, phi, 0)}" contype="{LANE_BITS[leg]}" conaffinity="0"'
+                       ' rgba="0.8 0.8 0.8 1"/>')
+    return out
+
+
+def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | None = None
+              ) -> str:
     """The walker as a MuJoCo model (MJCF; MuJoCo XML Reference,
     https://mujoco.readthedocs.io/en/stable/XMLreference.html).
 
@@ -173,29 +276,41 @@ def mjcf_text(mb: Multibody, name: str, version: str = "") -> str:
         Model name (the scene's name).
     version : str
         walkerlab version, for the header comment.
+    extra : MjcfScene, optional
+        The gait keyframe, terrain, contact setting and knee latch of the scene; without it
+        a plane through the feet and MuJoCo's default contact.
 
     Returns
     -------
     str
-        MJCF XML: a tilted ground plane, the hip body with both slide joints, the links as
-        nested bodies with hinges, feet as contact geoms (only feet touch the ground), and a
-        keyframe ``standing`` (legs vertical, the feet on the ground at x = 0).
+        MJCF XML: the ground, the hip body with both slide joints, the links as nested
+        bodies with hinges, feet as contact geoms (only feet touch the ground), a keyframe
+        ``standing`` (legs vertical, the feet at the ground line at x = 0) and, with
+        ``extra``, a keyframe ``gait`` and the knee latches as joint equality constraints
+        named ``leg<i>_latch``.
     """
     width = mb.leg_length_m / 50
     lo = MJCF_MIN_INERTIA_KG_M2
     hip_mass = mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG
     out = [*_header(mb, name, "MJCF", version), f"<mujoco model={quoteattr(name)}>",
-           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>',
-           f'  <option gravity="{_v(0, 0, -mb.gravity_m_per_s2)}"/>',
-           '  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/></default>',
-           "  <worldbody>",
-           f'    <geom name="ground" type="plane" size="0 0 1" euler="{_v(0, mb.slope_rad, 0)}"'
-           ' contype="1" conaffinity="0" rgba="0.8 0.8 0.8 1"/>',
-           '    <body name="hip" pos="0 0 0">',
-           '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
-           '      <joint name="hip_y" type="slide" axis="0 0 1"/>',
-           f'      <inertial pos="0 0 0" mass="{_f(hip_mass)}" diaginertia="{_v(lo, lo, lo)}"/>',
-           f'      <geom type="sphere" size="{_f(2 * width)}"/>']
+           *(_comment(note) for note in (extra.notes if extra else ())),
+           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
+    if extra is None:
+        out.append(f'  <option gravity="{_v(0, 0, -mb.gravity_m_per_s2)}"/>')
+        out.append('  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/>'
+                   '</default>')
+    else:
+        out.append(f'  <option gravity="{_v(0, 0, -mb.gravity_m_per_s2)}" '
+                   f'timestep="{_f(extra.timestep_s)}" integrator="implicitfast"/>')
+        out.append(f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
+                   f'solref="{_v(*extra.solref)}" solimp="{_v(*extra.solimp)}" '
+                   f'friction="{_v(extra.friction, 0, 0)}" condim="3"/></default>')
+    out += ["  <worldbody>", *_ground(mb, extra),
+            '    <body name="hip" pos="0 0 0">',
+            '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
+            '      <joint name="hip_z" type="slide" axis="0 0 1"/>',
+            f'      <inertial pos="0 0 0" mass="{_f(hip_mass)}" diaginertia="{_v(lo, lo, lo)}"/>',
+            f'      <geom type="sphere" size="{_f(2 * width)}"/>']
     children: dict[str, list[Link]] = {}
     for ln in mb.links:
         children.setdefault(ln.parent, []).append(ln)
@@ -210,15 +325,19 @@ def mjcf_text(mb: Multibody, name: str, version: str = "") -> str:
                  f'{indent}  <geom type="capsule" fromto="{_v(0, 0, 0, 0, 0, -ln.length_m)}" '
                  f'size="{_f(width / 2)}"/>']
         if ln.foot_m is not None:
-            foot = ln.name.split("_")[0] + "_foot"
+            leg = ln.name.split("_")[0]
+            foot = leg + "_foot"
             z = -ln.foot_m
-            if mb.foot == "arc":
-                geom = (f'type="cylinder" fromto="{_v(0, -width, z, 0, width, z)}" '
+            y = 0.0 if extra is None or extra.lanes is None else (
+                0.05 if leg == "leg1" else -0.05) * mb.leg_length_m
+            if _arc(mb):
+                geom = (f'type="cylinder" fromto="{_v(0, y - width, z, 0, y + width, z)}" '
                         f'size="{_f(mb.foot_radius_m)}"')
             else:
-                geom = f'type="sphere" pos="{_v(0, 0, z)}" size="{_f(mb.leg_length_m / 1000)}"'
+                geom = f'type="sphere" pos="{_v(0, y, z)}" size="{_f(point_foot_radius(mb))}"'
             lines += [f'{indent}  <site name="{foot}" pos="{_v(0, 0, z)}"/>',
-                      f'{indent}  <geom name="{foot}" {geom} contype="0" conaffinity="1"/>']
+                      f'{indent}  <geom name="{foot}" {geom} contype="0" '
+                      f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
         for child in children.get(ln.name, []):
             lines += body(child, indent + "  ")
         return lines + [f"{indent}</body>"]
@@ -226,7 +345,22 @@ def mjcf_text(mb: Multibody, name: str, version: str = "") -> str:
     for ln in children["hip"]:
         out += body(ln, "      ")
     standing = [0.0, mb.leg_length_m] + [0.0] * len(mb.links)
-    out += ["    </body>", "  </worldbody>",
-            f'  <keyframe><key name="standing" qpos="{_v(*standing)}"/></keyframe>',
-            "</mujoco>", ""]
+    out += ["    </body>", "  </worldbody>"]
+    keys = [f'    <key name="standing" qpos="{_v(*standing)}"/>']
+    if extra is not None:
+        keys.append(f'    <key name="gait" qpos="{_v(*extra.qpos)}" qvel="{_v(*extra.qvel)}"/>')
+        knees = [ln.joint for ln in mb.links if ln.joint.endswith("_knee")]
+        if knees and extra.latch is not None:
+            # the gait keyframe starts with leg2 in stance: its latch holds, leg1's is free
+            out += ["  <equality>", *(f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
+                                      f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"'
+                                      '/>' for k in knees), "  </equality>"]
+    if extra is not None:  # what a stepping loop needs (walkerlab.analysis.mujoco_walk)
+        arc = mb.foot_radius_m if _arc(mb) else 0.0
+        custom = {"slope_rad": mb.slope_rad, "foot_height_offset_m": arc}
+        if extra.latch is not None and mb.knee:
+            custom.update(latch_release_height_m=extra.latch[0], latch_capture_rad=extra.latch[1])
+        out += ["  <custom>", *(f'    <numeric name="{k}" data="{_f(v)}"/>'
+                                for k, v in custom.items()), "  </custom>"]
+    out += ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>", ""]
     return "\n".join(out)

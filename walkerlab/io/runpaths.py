@@ -56,7 +56,7 @@ MAX_NAME = 100
 
 # File stems that belong to stages (a sweep or any free --name may not take them).
 STAGE_FILES = frozenset({"fixedpoint", "simulate", "contact_sim", "compare", "workprecision",
-                         "bifurcation", "basin", "report", "plot", "sweep"})
+                         "bifurcation", "basin", "report", "plot", "sweep", "rigid_limit"})
 STAGE_PREFIXES = ("stability_map", "stability-map",  # stability_map_<kind>.h5
                   "bifurcation_")                      # bifurcation_<field>.h5
 

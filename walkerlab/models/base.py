@@ -149,6 +149,11 @@ class HybridWalker:
         ``X -> {"stance_angle", "swing_angle", "stance_rate", "swing_rate"}`` absolute leg
         angles from the vertical [rad] and rates [rad/s], by role (used by
         :meth:`leg_coordinates`); None: the coordinates are already absolute leg angles.
+    mirror : HybridWalker or None
+        The walker of the steps with ``legs[0]`` in stance when they differ from this one's
+        (legs that differ: same roles and state, other numbers); None when the legs are
+        mirror images.  This walker takes the steps with ``legs[1]`` in stance (``legs[0]``
+        swings first, paper Eq. 11); with a mirror the Poincaré map is a stride (two steps).
     """
 
     name: str
@@ -169,6 +174,18 @@ class HybridWalker:
     reset_jacobian: Callable[[np.ndarray], np.ndarray] | None = None
     heel_strike_guard: Callable[[float, np.ndarray], float] | None = None
     leg_angles: Callable[[np.ndarray], dict[str, np.ndarray]] | None = None
+    mirror: HybridWalker | None = None
+
+    def for_stance(self, stance_leg: str) -> HybridWalker:
+        """The walker of a step with ``stance_leg`` in stance (this one or :attr:`mirror`)."""
+        if self.mirror is not None and stance_leg == self.legs[0]:
+            return self.mirror
+        return self
+
+    @property
+    def steps_per_map(self) -> int:
+        """Steps in one Poincaré map: 1 (mirror-image legs) or 2 (a stride)."""
+        return 1 if self.mirror is None else 2
 
     @property
     def n_coordinates(self) -> int:

@@ -30,6 +30,17 @@ class BodySpec:
     kind: str
     massless: bool = False
     link: str = "leg"
+    off_axis: bool = False
+
+    def key(self) -> list:
+        out = [self.name, self.kind, self.massless, self.link]
+        return out + ["off_axis"] if self.off_axis else out
+
+
+#: Short role tags of per-leg parameters (``m_sw_<body>``) when the legs differ.
+ROLE_TAG = {"swing": "sw", "stance": "st"}
+#: Order of the links a spring may join (a spring's pair is stored in this order).
+SPRING_LINKS = ("swing", "stance", "torso")
 
 
 @dataclass(frozen=True)
@@ -54,6 +65,16 @@ class Structure:
         Coriolis matrix as printed in the paper (A.5, sign of ``C[1, 0]`` flipped).
     knee : bool
         True if the leg has a knee at ``L_thigh`` from the hip (roles :data:`KNEED_ROLES`).
+    asymmetric : bool
+        The legs' numbers may differ: each body's parameters exist per role
+        (``m_sw_<name>``, ``m_st_<name>``, ...), bound per step (the swing leg's numbers
+        under ``sw``).
+    torso : tuple of BodySpec
+        Bodies on an upper body held on the bisector of the legs (kinds ``point_mass``,
+        ``rigid_body``); its angle is eliminated, ``(psi_swing + psi_stance) / 2``.
+    springs : tuple of (str, str)
+        Torsional spring-dampers, each between two of :data:`SPRING_LINKS` (in that order);
+        ``delta = angle(second) - angle(first)``; parameters ``k_s<i>, r_s<i>, c_s<i>``.
     """
 
     coordinates: str
@@ -62,6 +83,9 @@ class Structure:
     foot: str = "point"
     variant: str = "derived"
     knee: bool = False
+    asymmetric: bool = False
+    torso: tuple[BodySpec, ...] = ()
+    springs: tuple[tuple[str, str], ...] = ()
 
     @property
     def roles(self) -> tuple[str, ...]:
@@ -71,25 +95,43 @@ class Structure:
     def param_names(self) -> tuple[str, ...]:
         """Names of the parameter vector, in order (SI units; ``gamma`` is the slope [rad])."""
         names = ["g", "L", "gamma"] + (["M_hip"] if self.hip_mass else [])
+        tags = [f"{ROLE_TAG[r]}_" for r in ("swing", "stance")] if self.asymmetric else [""]
         for b in self.bodies:
-            if not b.massless:
-                names.append(f"m_{b.name}")
-            names.append(f"d_{b.name}")
-            if b.kind == "rod":
-                names.append(f"I_{b.name}")
+            for t in tags:
+                if not b.massless:
+                    names.append(f"m_{t}{b.name}")
+                names.append(f"d_{t}{b.name}")
+                if b.kind == "rod":
+                    names.append(f"I_{t}{b.name}")
+                if b.off_axis:
+                    names.append(f"e_{t}{b.name}")
         if self.knee:
             names.append("L_thigh")
         if self.foot == "arc":
             names.append("R_foot")
+        for b in self.torso:
+            names += [f"m_torso_{b.name}", f"d_torso_{b.name}"]
+            if b.off_axis:
+                names.append(f"e_torso_{b.name}")
+            if b.kind == "rigid_body":
+                names.append(f"I_torso_{b.name}")
+        for i in range(len(self.springs)):
+            names += [f"k_s{i}", f"r_s{i}", f"c_s{i}"]
         return tuple(names)
 
     def key(self) -> str:
         """Canonical JSON of the structure (part of the generated-code cache key)."""
-        return json.dumps({"coordinates": self.coordinates, "foot": self.foot,
-                           "hip_mass": self.hip_mass, "variant": self.variant,
-                           "knee": self.knee,
-                           "bodies": [[b.name, b.kind, b.massless, b.link]
-                                      for b in self.bodies]})
+        d = {"coordinates": self.coordinates, "foot": self.foot,
+             "hip_mass": self.hip_mass, "variant": self.variant,
+             "knee": self.knee,
+             "bodies": [b.key() for b in self.bodies]}
+        if self.asymmetric:  # new parts only when present: older structures keep their keys
+            d["asymmetric"] = True
+        if self.torso:
+            d["torso"] = [b.key() for b in self.torso]
+        if self.springs:
+            d["springs"] = [list(s) for s in self.springs]
+        return json.dumps(d)
 
 
 def state_names(roles) -> list[str]:
@@ -114,6 +156,17 @@ class WalkerData:
     gravity_m_per_s2: float
     slope_rad: float
     extra: dict
+    mirror_params: tuple[float, ...] | None = None
+
+    @property
+    def mirror(self) -> WalkerData | None:
+        """The walker of the next step (leg2 swinging) when it differs from this one (legs
+        that differ, a spring with a rest angle ...): a stride is then the Poincaré map's
+        period; None when the legs are mirror images (one step)."""
+        if self.mirror_params is None:
+            return None
+        return WalkerData(self.structure, self.mirror_params, self.total_mass_kg,
+                          self.leg_length_m, self.gravity_m_per_s2, self.slope_rad, self.extra)
 
 
 def compass_gait_as_biped(w) -> dict:
@@ -127,8 +180,43 @@ def compass_gait_as_biped(w) -> dict:
     }
 
 
+def _leg_values(leg) -> list[tuple[list[float], float]]:
+    """Per-body ``(numbers, off-axis distance)`` of one leg (:attr:`Structure.param_names`
+    order: mass unless massless, distance, inertia for a rod)."""
+    out = []
+    for b in leg.bodies:
+        vals = []
+        if b.mass_kg != 0.0:
+            vals.append(b.mass_kg)
+        if b.kind == "rod":
+            vals += [b.com_from_hip_m, b.inertia_about_com_kg_m2]
+            off = b.com_off_axis_m
+        else:
+            vals.append(b.from_hip_m)
+            off = b.off_axis_m
+        out.append((vals, off))
+    return out
+
+
+def _spring_roles(between, stance_leg: str) -> tuple[tuple[str, str], float]:
+    """A config spring's link pair in role terms for the step with ``stance_leg`` in stance,
+    ordered as :data:`SPRING_LINKS`, and the sign of its ``delta`` in that order."""
+    role = {"torso": "torso", stance_leg: "stance"}
+    role.setdefault("leg1", "swing")
+    role.setdefault("leg2", "swing")
+    a, b = role[between[0]], role[between[1]]
+    if SPRING_LINKS.index(a) <= SPRING_LINKS.index(b):
+        return (a, b), 1.0
+    return (b, a), -1.0
+
+
 def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     """Structure and parameters of a scene's ``walker`` section.
+
+    The parameter vector is that of the first step (``leg1`` swinging, paper Eq. 11); when the
+    next step's differs (legs that differ, a spring with a rest angle or on the torso and one
+    leg), ``mirror_params`` is the next step's (``leg2`` swinging) and the Poincaré map is a
+    stride.
 
     Parameters
     ----------
@@ -148,27 +236,65 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
         extra = {"leg_mass_kg": walker_cfg.leg_mass_kg, "hip_mass_kg": walker_cfg.hip_mass_kg,
                  "leg_mass_from_foot_m": walker_cfg.leg_mass_from_foot_m}
         walker_cfg = BipedParams.model_validate(compass_gait_as_biped(walker_cfg))
-    leg = walker_cfg.leg
-    bodies, values = [], []
-    for b in leg.bodies:
-        massless = b.mass_kg == 0.0
-        bodies.append(BodySpec(b.name, b.kind, massless, b.link))
-        if not massless:
-            values.append(b.mass_kg)
-        if b.kind == "rod":
-            values += [b.com_from_hip_m, b.inertia_about_com_kg_m2]
-        else:
-            values.append(b.from_hip_m)
+    leg1, leg2 = walker_cfg.leg_pair()
+    leg = leg1
+    v1, v2 = _leg_values(leg1), _leg_values(leg2)
+    asym = v1 != v2
+    bodies = [BodySpec(b.name, b.kind, b.mass_kg == 0.0, b.link,
+                       any(v[1] != 0.0 for v in (v1[i], v2[i])))
+              for i, b in enumerate(leg.bodies)]
+
+    def leg_block(swing_vals, stance_vals) -> list[float]:
+        out = []
+        for i, b in enumerate(bodies):
+            for vals, off in ((swing_vals[i], stance_vals[i]) if asym else (swing_vals[i],)):
+                out += vals + ([off] if b.off_axis else [])
+        return out
+
+    tail = []
     if leg.knee is not None:
-        values.append(leg.knee.thigh_length_m)
+        tail.append(leg.knee.thigh_length_m)
     if leg.foot.kind == "arc":
-        values.append(leg.foot.radius_m)
+        tail.append(leg.foot.radius_m)
+    torso = []
+    if walker_cfg.torso is not None:
+        for b in walker_cfg.torso.bodies:
+            rigid = b.kind == "rigid_body"
+            off = b.com_off_axis_m if rigid else b.off_axis_m
+            torso.append(BodySpec(b.name, b.kind, False, "torso", off != 0.0))
+            tail += [b.mass_kg, b.com_from_hip_m if rigid else b.from_hip_m]
+            tail += [off] if off != 0.0 else []
+            tail += [b.inertia_about_com_kg_m2] if rigid else []
+    # springs: the role pairs of both steps (leg1 swinging, then leg2), each with its numbers
+    pairs, steps = [], ([], [])
+    for spr in walker_cfg.springs:
+        (pa, sa), (pb, sb) = (_spring_roles(spr.between, st) for st in ("leg2", "leg1"))
+        k, r, c = spr.stiffness_n_m_per_rad, spr.rest_angle_rad, spr.damping_n_m_s_per_rad
+        if pa == pb:  # leg to leg: the same pair in both steps, the rest angle's sign flips
+            pairs.append(pa)
+            steps[0].append([k, sa * r, c])
+            steps[1].append([k, sb * r, c])
+        else:  # torso to one leg: that leg's role changes, one entry per role
+            pairs += [pa, pb]
+            steps[0].extend([[k, sa * r, c], [0.0, 0.0, 0.0]])
+            steps[1].extend([[0.0, 0.0, 0.0], [k, sb * r, c]])
     hip = walker_cfg.hip_mass_kg > 0
     head = [walker_cfg.gravity_m_per_s2, leg.length_m, slope_rad]
     if hip:
         head.append(walker_cfg.hip_mass_kg)
     structure = Structure(walker_cfg.coordinates, tuple(bodies), hip, leg.foot.kind,
-                          knee=leg.knee is not None)
-    total = walker_cfg.hip_mass_kg + 2 * sum(b.mass_kg for b in leg.bodies)
-    return WalkerData(structure, tuple(float(v) for v in head + values), total, leg.length_m,
-                      walker_cfg.gravity_m_per_s2, slope_rad, extra)
+                          knee=leg.knee is not None, asymmetric=asym, torso=tuple(torso),
+                          springs=tuple(pairs))
+
+    def params(swing_vals, stance_vals, springs) -> tuple[float, ...]:
+        vals = head + leg_block(swing_vals, stance_vals) + tail
+        for k in springs:
+            vals += k
+        return tuple(float(v) for v in vals)
+
+    p1 = params(v1, v2, steps[0])
+    p2 = params(v2, v1, steps[1])
+    total = (walker_cfg.hip_mass_kg + sum(b.mass_kg for lg in (leg1, leg2) for b in lg.bodies)
+             + sum(b.mass_kg for b in (walker_cfg.torso.bodies if walker_cfg.torso else ())))
+    return WalkerData(structure, p1, total, leg.length_m, walker_cfg.gravity_m_per_s2,
+                      slope_rad, extra, None if p2 == p1 else p2)

@@ -105,6 +105,9 @@ class FloatingEquations:
         Named as the rigid model's: ``hip``, ``<leg>_<body>``, ``<leg>_foot`` (end of the
         leg axis), arc feet ``<leg>_foot_centre`` and ``<leg>_contact`` (lowest point),
         kneed ``<leg>_knee``.
+    knees : tuple of (int, int)
+        Per leg with a knee, the indices in ``q`` of its thigh and shank angles (by
+        their names); empty for straight legs.
     """
 
     q: tuple
@@ -116,6 +119,7 @@ class FloatingEquations:
     kinetic: object
     potential: object
     points: dict
+    knees: tuple = ()
 
 
 @cache
@@ -149,22 +153,29 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     def e(psi):
         return sp.Matrix([sp.sin(psi), -sp.cos(psi)])
 
-    # every point is hip + sum(length * e(angle)): kept as {angle index: length} so that the
-    # mass matrix comes out in cos(psi_i - psi_j) form without a trigonometric simplifier
-    bodies = []  # (mass, {k: length}, inertia, link index)
+    # every point is hip + sum(length * e(angle)): kept as {angle: length} (an angle is a
+    # coordinate, or a linear expression of them: an off-axis body's psi + pi/2, the torso's
+    # eliminated angle) so that the mass matrix comes out in cos(a - b) form without a
+    # trigonometric simplifier
+    bodies = []  # (mass, {angle: length}, inertia, link angle or None)
     feet, points = [], {"hip": hip}
     if structure.hip_mass:
         bodies.append((P["M_hip"], {}, 0, None))
+    # the parameter vector is the rigid view's first step (leg1 swinging, paper Eq. 11): with
+    # legs that differ, leg1's numbers are the swing role's (``sw``), leg2's the stance's
+    tags = ("sw_", "st_") if structure.asymmetric else ("", "")
     for i, leg in enumerate(LEGS):
         ks = (2 + 2 * i, 3 + 2 * i) if knee else (2 + i,)
         upper, lower = ks[0], ks[-1]
         for b in structure.bodies:
-            d = P[f"d_{b.name}"]
-            lin = ({upper: lt, lower: d - lt} if b.link == "shank" else {upper: d})
-            link = lower if b.link == "shank" else upper
-            inertia = P[f"I_{b.name}"] if b.kind == "rod" else 0
-            bodies.append((P[f"m_{b.name}"], lin, inertia, link))
-            points[f"{leg}_{b.name}"] = hip + sum((v * e(q[k]) for k, v in lin.items()),
+            d = P[f"d_{tags[i]}{b.name}"]
+            lin = ({q[upper]: lt, q[lower]: d - lt} if b.link == "shank" else {q[upper]: d})
+            link = q[lower] if b.link == "shank" else q[upper]
+            if b.off_axis:  # ahead of the link's axis
+                lin[link + sp.pi / 2] = P[f"e_{tags[i]}{b.name}"]
+            inertia = P[f"I_{tags[i]}{b.name}"] if b.kind == "rod" else 0
+            bodies.append((P[f"m_{tags[i]}{b.name}"], lin, inertia, link))
+            points[f"{leg}_{b.name}"] = hip + sum((v * e(a) for a, v in lin.items()),
                                                  sp.zeros(2, 1))
         foot_lin = {upper: lt, lower: L - lt - R} if knee else {upper: L - R}
         centre = hip + sum((v * e(q[k]) for k, v in foot_lin.items()), sp.zeros(2, 1))
@@ -183,30 +194,62 @@ def derive_floating(structure: Structure) -> FloatingEquations:
         if knee:
             points[f"{leg}_knee"] = hip + lt * e(q[upper])
 
+    # the upper body on the bisecting hip mechanism: eliminated as in the rigid view (its
+    # angle from the upward vertical is the mean of the leg angles; both legs are free here,
+    # the mechanism couples them); a point d up its axis at hip - d e(t)
+    psi_t = (q[2] + q[3]) / 2 if structure.torso else None
+    for b in structure.torso:
+        lin = {psi_t: -P[f"d_torso_{b.name}"]}
+        if b.off_axis:
+            lin[psi_t + sp.pi / 2] = P[f"e_torso_{b.name}"]
+        inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
+        bodies.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t))
+        points[f"torso_{b.name}"] = hip + sum((v * e(a) for a, v in lin.items()),
+                                              sp.zeros(2, 1))
+
     M = sp.zeros(nq, nq)
     V = sp.Integer(0)
     for mass, lin, inertia, link in bodies:
         M[0, 0] += mass
         M[1, 1] += mass
-        for k, lk in lin.items():
-            M[0, k] += mass * lk * sp.cos(q[k])
-            M[1, k] += mass * lk * sp.sin(q[k])
-            for j, lj in lin.items():
-                M[k, j] += mass * lk * lj * sp.cos(q[k] - q[j])
+        # d position / d q_k = sum over angles a of length * da/dq_k * (cos a, sin a)
+        terms = [[(a, lk * sp.diff(a, q[k])) for a, lk in lin.items() if sp.diff(a, q[k]) != 0]
+                 for k in range(nq)]
+        for k in range(2, nq):
+            for a, ca in terms[k]:
+                M[0, k] += mass * ca * sp.cos(a)
+                M[1, k] += mass * ca * sp.sin(a)
+            for j in range(2, nq):
+                for a, ca in terms[k]:
+                    for b_, cb in terms[j]:
+                        M[k, j] += mass * ca * cb * sp.cos(a - b_)
         if link is not None and inertia != 0:
-            M[link, link] += inertia
-        y = q[1] - sum((lk * sp.cos(q[k]) for k, lk in lin.items()), sp.Integer(0))
+            w = sp.Matrix([[sp.diff(link, s) for s in q]])
+            M += inertia * w.T * w
+        y = q[1] - sum((lk * sp.cos(a) for a, lk in lin.items()), sp.Integer(0))
         V += mass * g * y
     for k in range(2, nq):
         M[k, 0], M[k, 1] = M[0, k], M[1, k]
     M = M.applyfunc(sp.factor_terms)
     dqv, qv = sp.Matrix(dq), sp.Matrix(q)
     T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
+    # torsional spring-dampers (roles of the rigid view's first step: swing = leg1, stance =
+    # leg2): V_s = k (delta - r)^2 / 2 joins V; the damper's -c J^T J dq joins the bias
+    angle = {"swing": q[2], "stance": q[3], "torso": psi_t}
+    damping = sp.zeros(nq, nq)
+    for i, (first, second) in enumerate(structure.springs):
+        delta = angle[second] - angle[first]
+        V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
+        Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
+        damping += P[f"c_s{i}"] * Jd.T * Jd
     h = (M * dqv).jacobian(qv) * dqv - sp.Matrix([sp.diff(T, s) for s in q]) \
-        + sp.Matrix([sp.diff(V, s) for s in q])
+        + sp.Matrix([sp.diff(V, s) for s in q]) + damping * dqv
     h = h.applyfunc(sp.expand)
     return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, h=h,
-                             feet=tuple(feet), kinetic=T, potential=V, points=points)
+                             feet=tuple(feet), kinetic=T, potential=V, points=points,
+                             knees=tuple((names.index(f"{leg}_thigh_angle"),
+                                          names.index(f"{leg}_shank_angle"))
+                                         for leg in LEGS if knee))
 
 
 # ---------------------------------------------------------------------------- code generation

@@ -142,20 +142,33 @@ def multibody(data: WalkerData) -> Multibody:
         A link carries no mass (one line, naming the link).
     """
     s = data.structure
+    missing = [what for what, on in (("an upper body and its coupling (MJCF equality)",
+                                      s.torso),
+                                     ("springs (joint stiffness / tendons)", s.springs),
+                                     ("bodies off a link's axis",
+                                      any(b.off_axis for b in s.bodies))) if on]
+    if missing:
+        raise ValueError(f"export: {missing[0]} cannot be exported yet (URDF/MJCF writers "
+                         "know straight links with on-axis bodies)")
     p = dict(zip(s.param_names, data.params))
     L = p["L"]
     lt = p["L_thigh"] if s.knee else 0.0
     R = p["R_foot"] if s.foot == "arc" else 0.0
     segments = ("thigh", "shank") if s.knee else ("leg",)
-    per_segment: dict[str, list] = {seg: [] for seg in segments}
-    for b in s.bodies:
-        start = lt if b.link == "shank" else 0.0  # mass 0 adds nothing; a link without mass
-        per_segment[b.link].append((0.0 if b.massless else p[f"m_{b.name}"],  # is refused
-                                    p[f"d_{b.name}"] - start,
-                                    p.get(f"I_{b.name}", 0.0), b.name))
+    # the first step's numbers: with legs that differ leg1's are the swing role's (``sw``)
+    tags = ("sw_", "st_") if s.asymmetric else ("", "")
+    per_leg: list[dict[str, list]] = []
+    for tag in tags:
+        per_segment: dict[str, list] = {seg: [] for seg in segments}
+        for b in s.bodies:
+            start = lt if b.link == "shank" else 0.0  # mass 0 adds nothing; a link without
+            per_segment[b.link].append((0.0 if b.massless else p[f"m_{tag}{b.name}"],
+                                        p[f"d_{tag}{b.name}"] - start,  # mass is refused
+                                        p.get(f"I_{tag}{b.name}", 0.0), b.name))
+        per_leg.append(per_segment)
     foot_from_hip = L - R  # the foot point, or the arc's centre
     links = []
-    for leg in LEGS:
+    for leg, per_segment in zip(LEGS, per_leg):
         for seg in segments:
             name = leg if seg == "leg" else f"{leg}_{seg}"
             m, c, inertia = _combine(f"{seg} ({name})", per_segment[seg])

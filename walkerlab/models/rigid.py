@@ -33,6 +33,7 @@ Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import partial
 
 from walkerlab.models.base import Guard, HybridWalker, Phase
@@ -134,7 +135,10 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
               "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
               **dict(zip(structure.param_names, data.params))}
     coords = (None if structure.coordinates == "absolute" and not structure.knee
-              else f["leg_angles"])
+              and not structure.torso else f["leg_angles"])
+    mirror = data.mirror
+    if mirror is not None:  # legs that differ: the next step's walker (leg2 swinging)
+        mirror = make_rigid_walker(replace(mirror, mirror_params=None), name, variant)
     return HybridWalker(
         name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=phases,
         reset=reset or f["reset"], energies=f["energies"], points=f["points"],
@@ -142,5 +146,5 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
         total_mass_kg=data.total_mass_kg, slope_rad=data.slope_rad, params=params,
         variational=flow_jacobian or f["flow_jacobian"],
         reset_jacobian=reset_jacobian or f["reset_jacobian"],
-        heel_strike_guard=f["guard_heel_strike"], leg_angles=coords,
+        heel_strike_guard=f["guard_heel_strike"], leg_angles=coords, mirror=mirror,
     )

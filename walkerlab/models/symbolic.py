@@ -48,7 +48,7 @@ from functools import cache
 
 import sympy as sp
 
-from walkerlab.models.description import Structure
+from walkerlab.models.description import ROLE_TAG, Structure
 
 #: coordinate of ``q`` eliminated on the heel-strike surface (the rest parametrise the section)
 SECTION_DROP = {"absolute": 0, "slope_relative": 1}
@@ -138,6 +138,25 @@ def _pos(lin: dict) -> sp.Matrix:
     for psi, length in lin.items():
         out += length * _e(psi)
     return out
+
+
+def _velocity_terms(lin: dict, psv) -> list[list[tuple]]:
+    """For each ``psi_k``: the ``(angle, coefficient)`` terms of ``d position / d psi_k =
+    sum coefficient * e'(angle)`` of a ``{angle: length}`` leg-vector sum."""
+    out = []
+    for s in psv:
+        terms = []
+        for a, length in lin.items():
+            da = sp.diff(a, s)
+            if length != 0 and da != 0:
+                terms.append((a, length * da))
+        out.append(terms)
+    return out
+
+
+def _dot_terms(u: list, v: list):
+    """``(sum cu e'(a)) . (sum cv e'(b)) = sum cu cv cos(a - b)``."""
+    return sum((cu * cv * sp.cos(a - b) for a, cu in u for b, cv in v), sp.Integer(0))
 
 
 def _row_limit(rows: sp.Matrix, beta) -> tuple[sp.Matrix, bool]:
@@ -238,17 +257,38 @@ def derive(structure: Structure) -> Equations:
     bodies = []  # (mass, {angle: length}, inertia, link angle)
     if structure.hip_mass:
         bodies.append((P["M_hip"], hip_lin, 0, ps_st))
+
+    def bp(kind, name, role):  # a leg body's parameter (per role when the legs differ)
+        return P[f"{kind}_{ROLE_TAG[role]}_{name}" if structure.asymmetric else f"{kind}_{name}"]
+
     for b in structure.bodies:
-        mass = beta if b.massless else P[f"m_{b.name}"]
-        inertia = P[f"I_{b.name}"] if b.kind == "rod" else 0
-        d = P[f"d_{b.name}"]
-        swing = ((add(knee_lin, ps_shank, d - lt), ps_shank) if b.link == "shank"
-                 else (add(hip_lin, ps_sw, d), ps_sw))
-        for role, (lin, psi) in (("stance", (add(hip_lin, ps_st, d), ps_st)), ("swing", swing)):
+        for role in ("stance", "swing"):
+            mass = beta if b.massless else bp("m", b.name, role)
+            inertia = bp("I", b.name, role) if b.kind == "rod" else 0
+            d = bp("d", b.name, role)
+            if role == "stance":
+                lin, psi = add(hip_lin, ps_st, d), ps_st
+            elif b.link == "shank":
+                lin, psi = add(knee_lin, ps_shank, d - lt), ps_shank
+            else:
+                lin, psi = add(hip_lin, ps_sw, d), ps_sw
+            if b.off_axis:  # ahead of the link's axis: e(psi + pi/2) = (cos psi, sin psi)
+                lin = add(lin, psi + sp.pi / 2, bp("e", b.name, role))
             if f"{role}_{b.name}" in points:
                 raise ValueError(f"walker.leg.bodies: body name {b.name!r} is reserved")
             points[f"{role}_{b.name}"] = at(lin)
             bodies.append((mass, lin, inertia, psi))
+    # upper body on the bisecting hip mechanism (the coupling eliminated): its angle from the
+    # upward vertical, positive leaning back, is the mean of the leg angles; a point d up its
+    # axis lies at hip - d e(psi_t), one e ahead of the axis at + e e(psi_t + pi/2)
+    psi_t = (ps_sw + ps_st) / 2
+    for b in structure.torso:
+        lin = add(hip_lin, psi_t, -P[f"d_torso_{b.name}"])
+        if b.off_axis:
+            lin = add(lin, psi_t + sp.pi / 2, P[f"e_torso_{b.name}"])
+        points[f"torso_{b.name}"] = at(lin)
+        inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
+        bodies.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t))
 
     V = sp.Integer(0)
     Mi = sp.zeros(n, n)
@@ -258,7 +298,7 @@ def derive(structure: Structure) -> Equations:
         Jf = centre_sw.jacobian(psv) + R * tangent * sp.Matrix([[sp.diff(ps_shank, s)
                                                                 for s in psv]])
     for mass, lin, inertia, psi in bodies:
-        a = sp.Matrix([[1 if psi == k else 0 for k in psv]])
+        a = sp.Matrix([[sp.diff(psi, k) for k in psv]])
         if arc:  # the rolling offset moves with psi_st: plain Jacobians
             J = at(lin).jacobian(psv)
             Jn = J - Jf  # velocity Jacobian with the swing arc's contact point at rest
@@ -266,21 +306,33 @@ def derive(structure: Structure) -> Equations:
             Mi += mass * Jn.T * Jn
             Bm += mass * Jn.T * J
         else:
-            # d(position)/d(psi_k) = lin[psi_k] e'(psi_k), and e'(a) . e'(b) = cos(a - b): the
-            # inertia matrices come out simplified without a trigonometric simplifier
-            new = {k: lin.get(k, 0) - foot_lin.get(k, 0) for k in psv}  # swing foot at rest
-            for i, pi_ in enumerate(psv):
-                for j, pj in enumerate(psv):
-                    c = sp.cos(pi_ - pj)
-                    Mp[i, j] += mass * lin.get(pi_, 0) * lin.get(pj, 0) * c
-                    Mi[i, j] += mass * new[pi_] * new[pj] * c
-                    Bm[i, j] += mass * new[pi_] * lin.get(pj, 0) * c
+            # d(position)/d(psi_k) = sum over the angles a of lin[a] da/dpsi_k e'(a), and
+            # e'(a) . e'(b) = cos(a - b): the inertia matrices come out simplified without a
+            # trigonometric simplifier (a = psi_k for a body on a leg's axis)
+            new = {k: lin.get(k, 0) - foot_lin.get(k, 0)
+                   for k in {**lin, **foot_lin}}  # swing foot at rest
+            dl, dn = _velocity_terms(lin, psv), _velocity_terms(new, psv)
+            for i in range(n):
+                for j in range(n):
+                    Mp[i, j] += mass * _dot_terms(dl[i], dl[j])
+                    Mi[i, j] += mass * _dot_terms(dn[i], dn[j])
+                    Bm[i, j] += mass * _dot_terms(dn[i], dl[j])
         Mp += inertia * a.T * a
         Mi += inertia * a.T * a
         Bm += inertia * a.T * a
         V += mass * g * at(lin)[1]
     Mp, Mi, Bm = (X.applyfunc(sp.factor_terms) for X in (Mp, Mi, Bm))
     T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
+    # torsional spring-dampers: V_s = k (delta - r)^2 / 2 joins the potential (so G and the
+    # energy include it); the damper's generalised force -c J^T J dpsi joins C dq
+    link_angle = {"swing": ps_sw, "stance": ps_st, "torso": psi_t}
+    D = sp.zeros(n, n)
+    for i, (first, second) in enumerate(structure.springs):
+        delta = link_angle[second] - link_angle[first]
+        k_, r_, c_ = P[f"k_s{i}"], P[f"r_s{i}"], P[f"c_s{i}"]
+        V += k_ * (delta - r_) ** 2 / 2
+        Jd = sp.Matrix([[sp.diff(delta, s) for s in psv]])
+        D += c_ * Jd.T * Jd
     G = sp.Matrix([sp.diff(V, s) for s in psv])
     C = sp.zeros(n, n)
     for i in range(n):
@@ -288,6 +340,7 @@ def derive(structure: Structure) -> Equations:
             C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(Mp[i, j], psv[k]) + sp.diff(Mp[i, k], psv[j])
                                                - sp.diff(Mp[j, k], psv[i])) * dps[k]
                           for k in range(n))  # Christoffel symbols of the first kind
+    C += D
     if structure.variant == "appendix_a":  # the paper's printed A.5: C[1, 0] sign flipped
         if structure.coordinates != "absolute" or len(structure.bodies) != 1 or knee or arc:
             raise ValueError("ideal.variant: appendix_a exists only for the compass gait")
@@ -343,6 +396,8 @@ def derive(structure: Structure) -> Equations:
               "hip_height": (hip.T * normal)[0],
               "swing_clearance": (swing_contact.T * normal)[0]}
     leg_angles = {"stance": psi_st, "swing": psi_sw}
+    if structure.torso:
+        leg_angles["torso"] = psi_t.subs(sub)
     tied = {}
     if knee:
         guards["knee_extension"] = q[1] - q[0]  # zero when straight, > 0 hyperextended

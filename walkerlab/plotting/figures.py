@@ -120,19 +120,34 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
 
 
 def fig8_errors(time: np.ndarray, errors: dict[str, np.ndarray], units: dict[str, str],
-                label: str, scene_units: Units = SI_UNITS):
-    """Fig. 8: error between two models (contact - ideal) of every angle [rad] and rate [rad/s]."""
-    fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+                label: str, scene_units: Units = SI_UNITS,
+                phase: tuple[np.ndarray, dict[str, np.ndarray]] | None = None):
+    """Fig. 8: error between two models (contact - ideal) of every angle [rad] and rate [rad/s].
+
+    Left: time-aligned (both at the same time since the start: measures the phase drift as
+    much as the model).  Right, with ``phase = (step_phase (m,), errors)``: phase-aligned
+    (both at the same fraction of the same step: measures the gaits' shapes).
+    """
+    ncol = 1 if phase is None else 2
+    fig, axes = plt.subplots(2, ncol, figsize=(9 if ncol == 1 else 13, 6), sharex="col",
+                             squeeze=False)
     sty = _coordinate_styles(list(errors))
-    for n, e in errors.items():
-        ax = axes[0] if units[n] == "rad" else axes[1]  # rates: rad/s or its relabel
-        ax.plot(time, e, label=n.rpartition("_")[0] or n, lw=1, **sty[n])
-    axes[0].set_ylabel("angle error [rad]")
-    axes[1].set_ylabel(f"rate error [{scene_units.rate}]")
-    axes[1].set_xlabel(f"time [{scene_units.time}]")
-    for ax in axes:
-        ax.grid(alpha=0.3)
-        _legend(ax)
+    panels = [(axes[:, 0], time, errors, f"time [{scene_units.time}]",
+               "time-aligned (same time since the start)")]
+    if phase is not None:
+        panels.append((axes[:, 1], phase[0], phase[1], "step number + fraction of the step",
+                       "phase-aligned (same fraction of the same step)"))
+    for col, x, errs, xlabel, title in panels:
+        for n, e in errs.items():
+            ax = col[0] if units[n] == "rad" else col[1]  # rates: rad/s or its relabel
+            ax.plot(x, e, label=n.rpartition("_")[0] or n, lw=1, **sty[n])
+        col[0].set_ylabel("angle error [rad]")
+        col[1].set_ylabel(f"rate error [{scene_units.rate}]")
+        col[1].set_xlabel(xlabel)
+        col[0].set_title(title, fontsize=10)
+        for ax in col:
+            ax.grid(alpha=0.3)
+            _legend(ax)
     fig.suptitle(f"Fig. 8 - error {label}")
     return fig
 

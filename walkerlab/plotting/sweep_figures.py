@@ -59,15 +59,20 @@ def bifurcation_figure(data: dict, title: str = ""):
     mult = np.asarray(data["floquet/real"]) + 1j * np.asarray(data["floquet/imag"])
     stable = np.max(np.abs(mult), axis=1) < 1
     onset = onset_value(data)
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 7), sharex=True,
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9.5, 7), sharex=True,
                                    gridspec_kw={"height_ratios": [3, 2]})
     ss, yy = np.repeat(s, il.shape[1]), il.ravel()
     m = np.isfinite(yy)
-    ax1.plot(ss[m], yy[m], ".", ms=2.0, color="k", label="steady state (last heel strikes)")
+    # on top of the fixed-point line: a period-1 steady state sits on it and stays visible
+    ax1.plot(ss[m], yy[m], ".", ms=2.5, color="k", zorder=4,
+             label="steady state (last heel strikes)")
+    # markers on every fixed point: a single stable or unstable point (no neighbour to draw
+    # a line to) is drawn too
     ax1.plot(np.where(stable, s, np.nan), np.where(stable, fp_il, np.nan), "-", color="tab:blue",
-             lw=1.2, label="period-1 fixed point, stable")
+             lw=1.2, marker="o", ms=2.5, label="period-1 fixed point, stable")
     ax1.plot(np.where(~stable, s, np.nan), np.where(~stable, fp_il, np.nan), "--",
-             color="tab:blue", lw=1.0, label="period-1 fixed point, unstable")
+             color="tab:blue", lw=1.0, marker="o", ms=3, mfc="w",
+             label="period-1 fixed point, unstable")
     ax1.set_ylabel("inter-leg angle at heel strike [deg]")
     for k, ax in enumerate((ax1, ax2)):
         if np.isfinite(onset):  # named in the legend: a text label ran over the frame
@@ -80,7 +85,8 @@ def bifurcation_figure(data: dict, title: str = ""):
             ax.axvspan(falls - half, s.max() + half, color="0.85", hatch="//", ec="0.6", lw=0,
                        zorder=0, label=f"walker falls (no steady gait) from {at(falls, '.3g')}"
                        if k == 0 else None)
-    ax1.legend(fontsize=8, loc="upper left")
+    # legends outside the axes: they never cover data (issue 23)
+    ax1.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     if title:
         ax1.set_title(title)
     for k in range(mult.shape[1]):
@@ -90,7 +96,7 @@ def bifurcation_figure(data: dict, title: str = ""):
     ax2.axhline(1.0, color="0.6", lw=0.6)
     ax2.set_xlabel(xlabel)
     ax2.set_ylabel("Floquet multiplier [-]")
-    ax2.legend(fontsize=7, ncol=3, loc="lower left")
+    ax2.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     fig.tight_layout()
     return fig
 

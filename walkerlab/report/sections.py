@@ -211,6 +211,12 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     step_pub = getattr(pub, "STEP_LENGTH_M", None)
     rows.append(["Step length", "Δx", u.length, *([printed(step_pub)] * 2 if t3 else []),
                  *(num(c["step_length_m"]) for c in cols.values())])
+    per_leg = [(c.get("step_length_left_m", np.nan), c.get("step_length_right_m", np.nan))
+               for c in cols.values()]
+    if any(abs(a - b) > 1e-4 for a, b in per_leg):  # legs that differ: each leg's step
+        for i, side in enumerate(("Left", "Right")):
+            rows.append([f"{side} step length", f"Δx_{side[0].lower()}", u.length, *blank,
+                         *(num(v[i]) for v in per_leg)])
     title = "## Table 3 — gait characteristics" if t3 else "## Gait characteristics"
     out = [title, "", "Recomputed from the trajectory artifacts ("
            + ", ".join(f"`{arts[s].path.name}`" for s in ("simulate", "contact-sim") if s in arts)
@@ -252,7 +258,10 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
     ("fig2_stick_ideal", "Fig. 2 — stick diagram of one gait cycle, ideal model."),
     ("fig6_stick_contact", "Fig. 6 — stick diagram of one gait cycle, contact model."),
     ("fig7_angles_rates", "Fig. 7 — angles and angular rates over the simulated strides."),
-    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates."),
+    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates: left time-aligned "
+     "(both at the same time since the start, so a different step period shows as a growing "
+     "phase drift), right phase-aligned (both at the same fraction of the same step: the "
+     "difference of the gaits themselves)."),
     ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, one "
                           "panel per link, both legs in it)."),
     ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),

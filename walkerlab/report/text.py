@@ -45,6 +45,12 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
         where = f"({legs[role]}, {role} leg)" if role else "(not on a leg)"
         lines.append(f"  {n:<14s} {where} {x: .10f} {unit}")
     lines.append(f"  step period     {fp.step_period_s:.10f} {u.time}")
+    if fp.stride_period_s is not None:  # legs that differ: the Poincare map is a stride
+        lines.append(f"  stride period   {fp.stride_period_s:.10f} {u.time} (the map is a "
+                     "stride: the legs differ)")
+        for leg, T, d in zip(fp.step_swing_legs, fp.step_periods_s, fp.step_lengths_m):
+            lines.append(f"    step with {leg} swinging: period {T:.10f} {u.time}, "
+                         f"length {d:.10f} {u.length}")
     lines.append(f"  residual        {fp.residual:.2e}  (max |P(x*) - x*|)")
     re, im = fp.multipliers.real, fp.multipliers.imag
     lines.append(f"Floquet multipliers (variational): {_fmt_mult(re, im)}")
@@ -190,3 +196,23 @@ def workprecision_text(wp: WorkPrecisionArtifact) -> str:
     """One line per model of a workprecision artifact: its choice and the timing noise."""
     return "\n".join(f"{model}: {workprecision_choice(m.choice)}"
                      for model, m in wp.models.items())
+
+
+def rigid_limit_text(d: dict) -> list[str]:
+    """The convergence table of a loaded ``rigid_limit.h5`` (``d``:
+    :func:`walkerlab.io.schemas.rigid_limit.load_rigid_limit`): per ``kappa`` the period and
+    step-length gaps to the rigid gait [ms, mm], the stored observed orders, each multiplier."""
+    gT = d["period"] - d["rigid_period"]
+    gL = d["step_length"] - d["rigid_step_length"]
+    oT, oL = d["observed_order"]["period"], d["observed_order"]["step_length"]
+    lam = d["multipliers"]
+    head = (f"{'kappa':>8} {'period gap [ms]':>16} {'order':>6} {'step gap [mm]':>14} "
+            f"{'order':>6}  multipliers (rigid: "
+            + ", ".join(f"{x:.4f}" for x in d["rigid_multipliers"]) + ")")
+    out = [head]
+    for i, k in enumerate(d["kappa"]):
+        o1 = f"{oT[i - 1]:6.3f}" if i else " " * 6
+        o2 = f"{oL[i - 1]:6.3f}" if i else " " * 6
+        out.append(f"{k:8.3g} {gT[i] * 1e3:+16.4f} {o1} {gL[i] * 1e3:+14.4f} {o2}  "
+                   + ", ".join(f"{x:.4f}" for x in lam[i]))
+    return out

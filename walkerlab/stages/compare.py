@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.analysis.compare import aligned_errors, limit_cycle_distance
+from walkerlab.analysis.compare import aligned_errors, limit_cycle_distance, phase_aligned_errors
 from walkerlab.analysis.tables import gait_metrics
 from walkerlab.config import Scene
 from walkerlab.io.schemas.compare import METRIC_UNITS, Comparison, write_compare
@@ -27,6 +27,7 @@ def compare_files(ideal_path: Path, contact_path: Path) -> Comparison:
     ideal, contact = sim.samples, load_contact_sim(contact_path).samples
     mass_kg, g = sim.total_mass_kg, sim.gravity_m_per_s2
     t, err = aligned_errors(ideal, contact)
+    step_phase, perr = phase_aligned_errors(ideal, contact)
     metrics = {"ideal": gait_metrics(ideal, mass_kg=mass_kg, g=g),
                "contact": gait_metrics(contact, mass_kg=mass_kg, g=g)}
     lc = {a.removesuffix("_angle"): limit_cycle_distance(ideal, contact, a, r)
@@ -38,7 +39,7 @@ def compare_files(ideal_path: Path, contact_path: Path) -> Comparison:
         limit_cycle_distance=lc,
         max_abs_angle_rad=float(max(np.max(np.abs(err[n])) for n in ang)),
         max_abs_rate_rad_per_s=float(max(np.max(np.abs(err[n])) for n in rat)),
-        metrics=metrics, metric_units=METRIC_UNITS)
+        metrics=metrics, metric_units=METRIC_UNITS, step_phase=step_phase, phase_errors=perr)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
@@ -51,6 +52,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         c = compare_files(*up)
         summary = {"max_angle_error_rad": c.max_abs_angle_rad,
                    "max_rate_error_rad_per_s": c.max_abs_rate_rad_per_s,
+                   "max_phase_aligned_angle_error_rad": float(max(
+                       (np.max(np.abs(e)) for n, e in c.phase_errors.items()
+                        if c.error_units[n] == "rad" and e.size), default=np.nan)),
                    "compared_until_s": float(c.time[-1]), "metrics": c.metrics,
                    "limit_cycle_distance": c.limit_cycle_distance}
         return (lambda f: write_compare(f, c)), summary

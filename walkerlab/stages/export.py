@@ -8,14 +8,19 @@ upstream artifact), atomically (temporary name, then rename).  Formats and conve
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import walkerlab
+from walkerlab.analysis.export_scene import check_exportable, mjcf_scene
 from walkerlab.config import Scene
 from walkerlab.io import runpaths
 from walkerlab.io.export import FORMATS, mjcf_text, urdf_text
 from walkerlab.models.description import walker_data
 from walkerlab.models.multibody import multibody
+
+#: The URDF's keyframe sidecar in ``runs/<scene>/``.
+SIDECAR = "walker.gait.json"
 
 
 def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = False) -> Path:
@@ -54,8 +59,28 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path
         The run folder is not allowed.
     """
     path = export_path(scene, runs_root, fmt)  # check the format before building anything
-    mb = multibody(walker_data(scene.walker, scene.slope.phi_rad))
-    text = (urdf_text if fmt == "urdf" else mjcf_text)(mb, scene.name or "walker",
-                                                      walkerlab.__version__)
+    check_exportable(scene)
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    mb = multibody(data)
+    name = scene.name or "walker"
+    extra = mjcf_scene(scene, mb, data) if scene.fixedpoint is not None else None
+    if fmt == "urdf":
+        text = urdf_text(mb, name, walkerlab.__version__)
+    else:
+        text = mjcf_text(mb, name, walkerlab.__version__, extra)
     path = export_path(scene, runs_root, fmt, claim=True)
+    if fmt == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
+        runpaths.atomic_text(runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
+                             keyframe_json(mb, extra))
     return runpaths.atomic_text(path, text)
+
+
+def keyframe_json(mb, extra) -> str:
+    """The ``gait`` keyframe as JSON: ``{"joints": [...], "qpos": [...], "qvel": [...],
+    "units": [...]}`` in the URDF's joint names and order (the sidecar of ``walker.urdf``)."""
+    joints = ["hip_x", "hip_z", *(ln.joint for ln in mb.links)]
+    units = ["m", "m", *("rad" for _ in mb.links)]
+    return json.dumps({"keyframe": "gait", "description": "rigid fixed point just after heel "
+                       "strike, leg2 in stance, its foot at the origin on the ground line",
+                       "joints": joints, "units": units, "qpos": list(extra.qpos),
+                       "qvel": list(extra.qvel)}, indent=1) + "\n"

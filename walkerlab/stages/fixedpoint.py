@@ -23,8 +23,15 @@ from walkerlab.stages.common import StageError, StageOutcome, require, run_cache
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
 
 
-def _compute(scene: Scene, compare_variants: bool):
-    walker, search = solve_scene(scene)
+def _compute(scene: Scene, compare_variants: bool, known: Scene | None = None):
+    guess = note = None
+    if known is not None:  # the known gait carried here (walkerlab.sweep.continuation)
+        from walkerlab.sweep.continuation import homotopy_start
+
+        guess, note = homotopy_start(scene, known)
+    walker, search = solve_scene(scene, guess=guess)
+    if note:
+        search.notes.append(note)
     main = search.result
     results = {scene.ideal.variant: (walker, main)}
     init = initial_guess(scene, walker)
@@ -40,7 +47,8 @@ def _compute(scene: Scene, compare_variants: bool):
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        compare_variants: bool = True) -> StageOutcome:
+        compare_variants: bool = True, known: Scene | Path | str | None = None
+        ) -> StageOutcome:
     """Find the fixed point of the scene's equation variant.
 
     With ``compare_variants`` (the default) the other equation variants (printed Appendix A,
@@ -48,22 +56,35 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     report's comparison with Eq. (11): ``walkerlab fixedpoint`` then writes the very artifact
     the report needs, so the report does not recompute it (nor the contact simulation, which
     keys on its content).  ``compare_variants=False`` reuses such an artifact (a superset).
+    ``known`` (or the scene's ``fixedpoint.from``): a scene whose gait is carried to this
+    walker by homotopy and used as the initial guess (``walkerlab fixedpoint --from``).
 
     Raises
     ------
     StageError
         No ``fixedpoint`` section, or no fixed point for the scene's own variant.
     """
+    import json
+
+    from walkerlab.config import SceneError
+    from walkerlab.sweep.continuation import known_scene
+
     require(scene, "fixedpoint", "fixedpoint")
+    try:
+        src = known_scene(scene, known)
+    except SceneError as exc:
+        raise StageError(f"fixedpoint.from: {exc}") from None
+    from_key = "" if src is None else "from:" + json.dumps(src.model_dump(mode="json"),
+                                                          sort_keys=True)
 
     def compute():
         try:
-            return _compute(scene, compare_variants)
+            return _compute(scene, compare_variants, src)
         except GaitNotFound as exc:
             raise StageError(f"fixedpoint: {exc}") from None
         except ValueError as exc:  # a malformed initial guess or gait choice (one line)
             raise StageError(str(exc)) from None
 
     return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force,
-                      extra_key="variants" if compare_variants else "",
-                      also_accept=() if compare_variants else ("variants",))
+                      extra_key=("variants" if compare_variants else "") + from_key,
+                      also_accept=() if compare_variants else ("variants" + from_key,))

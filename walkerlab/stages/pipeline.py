@@ -14,6 +14,7 @@ contact-sim     fixedpoint
 compare         simulate, contact-sim
 workprecision   fixedpoint
 basin           fixedpoint
+mfpt            fixedpoint
 animate         simulate
 ==============  ====================================================================
 """
@@ -28,7 +29,7 @@ from walkerlab.config import Scene
 #: module of each stage under walkerlab.stages
 MODULES = {"fixedpoint": "fixedpoint", "simulate": "simulate", "contact-sim": "contact_sim",
            "compare": "compare", "workprecision": "workprecision", "basin": "basin",
-           "animate": "animate"}
+           "animate": "animate", "mfpt": "mfpt"}
 
 
 def needs(stage: str, scene: Scene) -> tuple[str, ...]:
@@ -38,6 +39,7 @@ def needs(stage: str, scene: Scene) -> tuple[str, ...]:
         return ("fixedpoint",) if sim is None or sim.initial_state == "fixed_point" else ()
     return {"contact-sim": ("fixedpoint",), "compare": ("simulate", "contact-sim"),
             "workprecision": ("fixedpoint",), "basin": ("fixedpoint",),
+            "mfpt": ("fixedpoint",),
             "animate": ("simulate",)}.get(stage, ())
 
 
@@ -84,13 +86,17 @@ def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **optio
     return mod.run(scene, runs_root, *args, **options)
 
 
-def report_plan(scene: Scene) -> list[str]:
+def report_plan(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order (its progress display and DAG):
     fixed point, rigid run, contact run, their comparison, the work-precision study, the
-    basin of attraction - each only when the scene has its sections."""
+    basin of attraction - each only when the scene has its sections; the work-precision
+    study only with ``full`` (``walkerlab report --full``: it times every solver setting,
+    most of a cold report, and a shared machine's timings are noise unless repeated;
+    ``walkerlab workprecision`` runs it alone)."""
     sim, contact = scene.simulate is not None, scene.contact is not None
+    wp = full and getattr(scene, "workprecision", None) is not None
     return [n for n, on in (("fixedpoint", scene.fixedpoint is not None), ("simulate", sim),
                             ("contact-sim", contact), ("compare", contact and sim),
-                            ("workprecision", getattr(scene, "workprecision", None) is not None),
+                            ("workprecision", wp),
                             ("basin", scene.basin is not None and scene.fixedpoint is not None))
             if on]

@@ -88,8 +88,9 @@ def _trajectory_figures(scene: Scene, runs_root, F) -> list[Path]:
     cmp_path = artifact_path(scene, runs_root, "compare")
     if cmp_path.is_file():
         c = load_compare(cmp_path)
+        phase = (c.step_phase, c.phase_errors) if c.phase_errors is not None else None
         written += F.save(F.fig8_errors(c.time, c.errors, c.error_units, "contact - ideal",
-                                        scene_units=u), out_dir, "fig8_errors")
+                                        scene_units=u, phase=phase), out_dir, "fig8_errors")
     written += _drop_figure(scene, runs_root, out_dir, F)
     return written
 

@@ -44,8 +44,9 @@ def _study(scene: Scene, runs_root, force: bool):
                            ("contact",) if scene.contact is not None else ())
 
 
-def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None) -> list[StageOutcome]:
-    plan = report_plan(scene)
+def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
+                full: bool = False) -> list[StageOutcome]:
+    plan = report_plan(scene, full)
     done: list[StageOutcome] = []
 
     def add(o: StageOutcome) -> None:
@@ -130,7 +131,7 @@ _NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' 
             "basin": "no 'basin' section (or no 'fixedpoint')"}
 
 
-def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
+def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
                      ) -> tuple[dict[str, Path], str]:
     """The artifacts the report shows and one line on what it leaves out ('' if nothing).
 
@@ -145,6 +146,16 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome]
     for stage, p in existing_artifacts(scene, runs_root).items():
         if stage in produced:
             paths[stage] = p
+        elif stage == "workprecision" and getattr(scene, "workprecision", None) is not None \
+                and not full:
+            from walkerlab.stages import workprecision
+            from walkerlab.stages.common import changed_fields
+
+            if changed_fields(p, scene, workprecision.SECTIONS):
+                left.append(f"{p.name} (measured for other settings; `walkerlab report "
+                            "--full` measures it again)")
+            else:
+                paths[stage] = p  # measured earlier (--full or `walkerlab workprecision`)
         elif stage == "bifurcation":
             from walkerlab.stages import bifurcation
             from walkerlab.stages.common import changed_fields
@@ -175,8 +186,9 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        echo: Callable[[str], None] = print) -> Path:
-    """Run the needed stages, draw figures, write ``report.md`` and ``report.html``.
+        echo: Callable[[str], None] = print, full: bool = False) -> Path:
+    """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
+    ``full``: also the work-precision study (:func:`walkerlab.stages.pipeline.report_plan`).
 
     Returns
     -------
@@ -185,11 +197,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     from walkerlab import progress
 
-    stages = report_plan(scene)
+    stages = report_plan(scene, full)
     with progress.task(f"report: {len(stages)} stages ({', '.join(stages)})",
                        len(stages)) as bar:
-        done = _run_stages(scene, runs_root, force, echo, bar)
-    paths, left_out = report_artifacts(scene, runs_root, done)
+        done = _run_stages(scene, runs_root, force, echo, bar, full)
+    paths, left_out = report_artifacts(scene, runs_root, done, full)
+    if getattr(scene, "workprecision", None) is not None and "workprecision" not in paths:
+        echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
     if left_out:
         echo(left_out)
     rep_dir = report_dir(scene, runs_root, claim=True)

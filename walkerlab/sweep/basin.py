@@ -125,10 +125,12 @@ class HeelStrikeSlice:
     axes: np.ndarray
 
     def post(self, walker, u: np.ndarray) -> np.ndarray:
-        """Post-impact state ``walker.reset(x-)`` of the pre-impact state with ``free = u``."""
+        """Post-impact state ``walker.reset(x-)`` of the pre-impact state with ``free = u``
+        (legs that differ: the heel strike that closes a stride, leg2 swinging)."""
         z = self.z_pre.copy()
         z[self.free] = u
-        return np.asarray(walker.reset(np.asarray(walker.from_section(z), dtype=float)),
+        last = walker.for_stance(walker.legs[0])
+        return np.asarray(last.reset(np.asarray(last.from_section(z), dtype=float)),
                           dtype=float)
 
     def state(self, walker, values: tuple[float, float]) -> np.ndarray | None:
@@ -218,22 +220,28 @@ def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
     steps : int
         Steps taken until the outcome was decided.
     period : int
-        Period of the attractor reached (1 for the fixed point, 0 if none).
+        Period of the attractor reached, in Poincare maps (strides when the legs differ;
+        1 for the fixed point, 0 if none).
     """
     from walkerlab.integrate.rigid import integrate_step
 
     x = np.asarray(x0, dtype=float)
     hist = [x]
+    per_map = walker.steps_per_map  # legs that differ: the section is reached every stride
     for k in range(1, settings.max_steps + 1):
-        seg = integrate_step(walker, x, solver, max_step_time=max_step_time)
+        stance = walker.legs[1] if (k - 1) % per_map == 0 else walker.legs[0]
+        step_walker = walker.for_stance(stance)
+        seg = integrate_step(step_walker, x, solver, max_step_time=max_step_time)
         if seg.termination == "fall":
-            hip = walker.points(seg.x_end)["hip"]
+            hip = step_walker.points(seg.x_end)["hip"]
             return CODE["fell_forward" if float(hip[0]) > 0 else "fell_backward"], k, 0
         if seg.termination != "heel_strike":
             return CODE["stalled"], k, 0
         x = seg.x_next
         if not np.all(np.isfinite(x)):
             return CODE["stalled"], k, 0
+        if k % per_map:  # mid-stride: not on the Poincare section of a stride map
+            continue
         if float(np.max(np.abs(x - x_star))) < settings.converge_tol:
             return CODE["converged"], k, 1
         for p in range(1, min(settings.max_period, len(hist)) + 1):
@@ -315,9 +323,14 @@ def pre_impact_fixed_point(walker, x_star: np.ndarray, settings, max_step_time: 
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
 
-    seg = integrate_step(walker, np.asarray(x_star, dtype=float),
-                         Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend),
-                         max_step_time=max_step_time)
+    solver = Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend)
+    x = np.asarray(x_star, dtype=float)
+    for k in range(walker.steps_per_map):  # legs that differ: the stride's closing step
+        seg = integrate_step(walker.for_stance(walker.legs[1 - k % 2]), x, solver,
+                             max_step_time=max_step_time)
+        if seg.termination != "heel_strike":
+            break
+        x = seg.x_next
     if seg.termination != "heel_strike":
         raise BasinError(f"basin.start: the step from the fixed point ended in "
                          f"{seg.termination!r}, not a heel strike")

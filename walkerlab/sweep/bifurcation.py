@@ -107,8 +107,10 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
     from walkerlab.sweep.points import _Outcome, ideal_fixed_point, interleg_angle, warm_up
 
     warm_up()
+    from walkerlab.sweep.continuation import scene_family
+
     out = []
-    guess = None
+    guess = prev = fam = None
     x_att = None
     for index, (value,) in task.points:
         t0 = time.perf_counter()
@@ -121,10 +123,19 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
             warnings.simplefilter("ignore")
             scene = _scene_at(task.base, value, task.path)
             try:
-                walker, res, _src = ideal_fixed_point(scene, guess)
-                guess = res.x
-                row.update(x=res.x, multipliers=np.asarray(res.multipliers_variational, complex),
-                           period_s=res.period_s)
+                if fam is None:  # the walker over the grid's field, built once a chunk
+                    fam = scene_family(scene, task.path)
+                q = _arclength_step(fam, prev, value)
+                if q is not None:  # the neighbour's branch followed to this value
+                    walker = build_walker(scene)
+                    row.update(x=q.x, multipliers=np.asarray(q.multipliers, complex),
+                               period_s=q.period_s / walker.steps_per_map)  # per step
+                else:
+                    walker, res, _src = ideal_fixed_point(scene, guess)
+                    row.update(x=res.x, period_s=res.period_s / walker.steps_per_map,
+                               multipliers=np.asarray(res.multipliers_variational, complex))
+                guess = row["x"]
+                prev = (value, q if q is not None else row["x"])
             except _Outcome as exc:
                 row.update(fp_outcome=exc.outcome, message=exc.message)
                 walker = build_walker(scene)
@@ -163,6 +174,33 @@ def _bif_chunk(task: _BifTask) -> list[dict]:
         row["wall_time_s"] = time.perf_counter() - t0
         out.append(row)
     return out
+
+
+def _arclength_step(fam, prev, value: float):
+    """The fixed point at ``value`` on the branch of the previous grid value's
+    (``prev = (value, BranchPoint or state)``), by pseudo-arclength continuation
+    (:func:`walkerlab.analysis.continuation.continue_branch`), which does not jump to the
+    other gait of a long/short-period pair as a large natural-parameter step can (paper_rods
+    at 3 kg, issue 23).  None when there is no previous point or the branch does not reach
+    ``value`` (a fold in between): the caller falls back to the root finder.
+    """
+    from walkerlab.analysis.continuation import MapFailed, continue_branch, first_point
+
+    if prev is None:
+        return None
+    v0, q0 = prev
+    span = abs(value - v0)
+    if span == 0:
+        return None
+    try:
+        if isinstance(q0, np.ndarray):
+            q0 = first_point(fam, v0, q0, 1, span)
+        br = continue_branch(fam, q0, 1, (min(v0, value), max(v0, value)), span,
+                             1 if value > v0 else -1, ds=1.0, ds_max=1.0)
+    except MapFailed:
+        return None
+    last = br.points[-1]
+    return last if abs(last.p - value) <= 1e-12 * max(1.0, abs(value)) else None
 
 
 def _g(scene_base: dict, value: float, guess, path: str = SLOPE_PATH

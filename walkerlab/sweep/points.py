@@ -263,7 +263,9 @@ def _fp_columns(walker, res) -> dict:
     for k in range(len(walker.state_names())):
         z = mult[k] if k < mult.size else complex(math.nan, math.nan)
         cols[f"multiplier_{k}_re"], cols[f"multiplier_{k}_im"] = float(z.real), float(z.imag)
-    cols.update(step_period_s=float(res.period_s), residual=float(res.residual),
+    # per step: a stride map's period (legs that differ) is two steps'
+    cols.update(step_period_s=float(res.period_s) / walker.steps_per_map,
+                residual=float(res.residual),
                 max_abs_multiplier=float(np.max(np.abs(mult))), stable=float(res.stable),
                 map_evaluations=float(res.iterations),
                 variational_maps=float(res.variational_maps), nfev=float(res.nfev))

@@ -4,8 +4,10 @@ Layout: ``errors/`` (attributes ``legs``, ``coordinates``, ``definition``; dimen
 ``time``: the ideal sample times within the common span [s]; ``coordinates/<name>``: error
 contact - ideal of each named coordinate, in its unit; ``limit_cycle_distance/<coordinate>``:
 mean distance between the two phase curves; ``max_abs_angle`` [rad], ``max_abs_rate``
-[rad/s]); ``metrics/{ideal,contact}/<name>``: the gait metrics of paper Table 3 (units in
-:data:`METRIC_UNITS`).
+[rad/s]); ``errors_phase_aligned/`` (dimension ``step_phase``: step number + fraction of
+the step [-]; ``coordinates/<name>``: error contact - ideal at the same fraction of the same
+step, :func:`walkerlab.analysis.compare.phase_aligned_errors`); ``metrics/{ideal,contact}/
+<name>``: the gait metrics of paper Table 3 (units in :data:`METRIC_UNITS`).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from walkerlab.units import Units, for_artifact
 STAGE = "compare"
 METRIC_UNITS = {"t_left_s": "s", "t_right_s": "s", "t_cycle_s": "s", "v_com_m_per_s": "m/s",
                 "E_avg_J": "J", "E_avg_stance_frame_J": "J", "step_length_m": "m",
+                "step_length_left_m": "m", "step_length_right_m": "m",
                 "n_steps": "-"}
 
 
@@ -44,6 +47,10 @@ class Comparison:
     metrics : dict[str, dict[str, float]]
         ``{"ideal": {...}, "contact": {...}}`` gait metrics (units :data:`METRIC_UNITS`).
     metric_units : dict[str, str]
+    step_phase : ndarray (m,) or None
+        Step number + fraction of the step [-] of the phase-aligned errors.
+    phase_errors : dict[str, ndarray (m,)] or None
+        Error contact - ideal at the same fraction of the same step, per named coordinate.
     """
 
     legs: list
@@ -55,6 +62,8 @@ class Comparison:
     max_abs_rate_rad_per_s: float
     metrics: dict
     metric_units: dict
+    step_phase: np.ndarray | None = None
+    phase_errors: dict | None = None
     path: Path | None = None
     units: Units | None = None
 
@@ -72,6 +81,17 @@ def write_compare(f, c: Comparison) -> None:
     for stem, d in c.limit_cycle_distance.items():
         put(g, f"limit_cycle_distance/{stem}", d, "rad (rates in rad/s)",
             f"mean distance from the ideal phase curve of {stem} to the contact one")
+    if c.phase_errors is not None:
+        p = f.create_group("errors_phase_aligned")
+        p.attrs["legs"] = c.legs
+        p.attrs["coordinates"] = list(c.phase_errors)
+        p.attrs["definition"] = ("contact - ideal at the same fraction of the same step (each "
+                                 "step on normalised step time)")
+        coordinate(p, "step_phase", c.step_phase, "-",
+                   "step number + fraction of the step (heel strike to heel strike)")
+        for n, e in c.phase_errors.items():
+            put(p, f"coordinates/{n}", e, c.error_units[n],
+                f"{n} error (contact - ideal) at the same step phase", dims=("step_phase",))
     put(g, "max_abs_angle", c.max_abs_angle_rad, "rad", "")
     put(g, "max_abs_rate", c.max_abs_rate_rad_per_s, "rad/s", "")
     for model, m in c.metrics.items():
@@ -96,8 +116,15 @@ def load_compare(path: Path) -> Comparison:
                 m = f["metrics"][model]
                 metrics[model] = {k: m[k][()] for k in m}
                 munits.update({k: str(m[k].attrs.get("unit", "")) for k in m})
+        step_phase = phase_errors = None
+        if "errors_phase_aligned" in f:
+            p = f["errors_phase_aligned"]
+            step_phase = p["step_phase"][()]
+            phase_errors = {n: p[f"coordinates/{n}"][()] for n in
+                            (str(x) for x in p.attrs["coordinates"])}
         return Comparison(
             legs=[str(x) for x in g.attrs["legs"]], time=g["time"][()],
+            step_phase=step_phase, phase_errors=phase_errors,
             errors={n: g[f"coordinates/{n}"][()] for n in names},
             error_units={n: str(g[f"coordinates/{n}"].attrs["unit"]) for n in names},
             limit_cycle_distance=({k: float(g["limit_cycle_distance"][k][()])

@@ -94,8 +94,7 @@ class ContactSimRun:
 
 def _write_outcome_and_drop(f, run: ContactSimRun) -> None:
     walker, res, drop = run.walker, run.result, run.drop
-    f.attrs["model"] = ("compass_gait_contact" if walker.nq == 4
-                        and walker.structure.foot == "point" else "biped_contact")
+    f.attrs["model"] = walker.model_name
     f.attrs["legs"] = run.legs
     f.attrs["termination"] = res.termination
     f.attrs["method"] = res.method

@@ -6,9 +6,11 @@ selected gait), ``gait_policy``, ``gait_source``, ``gaits``, ``gait_notes``,
 gait's result at the root and every gait found under ``gaits/<label>/``, every equation
 variant under ``variants/<variant>/`` (or its ``error`` attribute), each with:
 ``fixed_point/<state>`` [rad, rad/s] just after heel strike, ``initial_guess/<state>``,
-``step_period`` [s], ``residual``, ``floquet/{variational,finite_difference}/{real,imag,
-jacobian}``, ``floquet/max_difference``, ``floquet/stable``, ``stats/`` (RHS evaluations,
-map evaluations, wall time [s]).
+``step_period`` [s] (legs that differ: the mean step, with ``stride_period`` [s] and
+``steps/{period,length,swing_leg}`` on dimension ``step``), ``residual``,
+``floquet/{variational,finite_difference}/{real,imag,jacobian}``,
+``floquet/max_difference``, ``floquet/stable``, ``stats/`` (RHS evaluations, map
+evaluations, wall time [s]).
 """
 
 from __future__ import annotations
@@ -59,7 +61,20 @@ def _write_result(g, walker, res, guess) -> None:
         put(g, f"fixed_point/{name}", float(val), u, f"{name} just after heel strike")
     for name, val, u in zip(names, guess, units):
         put(g, f"initial_guess/{name}", float(val), u, "root-finder starting point")
-    put(g, "step_period", res.period_s, "s", "step period of the period-1 gait")
+    steps = len(getattr(res, "step_periods_s", ()))
+    if steps > 1:  # legs that differ: the map is a stride; each step on its own
+        put(g, "step_period", res.period_s / steps, "s", "mean step period of the period-1 "
+            "gait (the Poincare map is a stride of two steps)")
+        put(g, "stride_period", res.period_s, "s", "stride period (period of the map)")
+        coordinate(g, "step", np.arange(steps), "-", "step of the stride (leg1 swings first)")
+        put(g, "steps/period", np.array(res.step_periods_s), "s", "period of each step",
+            dims=("step",))
+        put(g, "steps/length", np.array(res.step_lengths_m), "m", "length of each step "
+            "(stance foot to swing foot at heel strike)", dims=("step",))
+        put(g, "steps/swing_leg", np.array([b"leg1", b"leg2"][:steps]), "-",
+            "swing leg of each step", dims=("step",))
+    else:
+        put(g, "step_period", res.period_s, "s", "step period of the period-1 gait")
     put(g, "residual", res.residual, "rad or rad/s", "max |P(x*) - x*| over the state")
     for kind, ev, J in (("variational", res.multipliers_variational, res.jacobian_variational),
                         ("finite_difference", res.multipliers_fd, res.jacobian_fd)):
@@ -138,6 +153,10 @@ class GaitResult:
     stable: bool
     source: str = ""
     error: str = ""
+    stride_period_s: float | None = None
+    step_periods_s: tuple = ()
+    step_lengths_m: tuple = ()
+    step_swing_legs: tuple = ()
 
     def max_abs_multiplier(self) -> float:
         """Largest |Floquet multiplier| (variational)."""
@@ -155,7 +174,19 @@ def _gait(g, names: list[str]) -> GaitResult:
         multipliers_fd=(g["floquet/finite_difference/real"][()]
                         + 1j * g["floquet/finite_difference/imag"][()]),
         max_difference=float(g["floquet/max_difference"][()]),
-        stable=bool(g["floquet/stable"][()]), source=str(g.attrs.get("source", "")))
+        stable=bool(g["floquet/stable"][()]), source=str(g.attrs.get("source", "")),
+        **_stride(g))
+
+
+def _stride(g) -> dict:
+    """A stride map's own fields (legs that differ), empty otherwise."""
+    if "stride_period" not in g:
+        return {}
+    return {"stride_period_s": float(g["stride_period"][()]),
+            "step_periods_s": tuple(float(v) for v in g["steps/period"][()]),
+            "step_lengths_m": tuple(float(v) for v in g["steps/length"][()]),
+            "step_swing_legs": tuple(v.decode() if isinstance(v, bytes) else str(v)
+                                     for v in g["steps/swing_leg"][()])}
 
 
 @dataclass

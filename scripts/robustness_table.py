@@ -1,0 +1,67 @@
+"""Robustness table of shipped walkers (issue 24): |lambda|max in absolute and relative
+angles, the gait sensitivity norm of each disturbance (linearised, and the nonlinear check),
+the state-indicator norm in both coordinate choices (Jin et al. 2021), and the largest
+tolerable single step-down and step-up (1 mm grid).
+
+    python scripts/robustness_table.py [paper kneed ...]
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+WALKERS = ("paper", "goswami1996", "paper_rods", "round_feet", "kneed", "simplest",
+           "schwab_wisse2001")
+
+
+def row(name: str) -> str:
+    from walkerlab.analysis import robustness as R
+    from walkerlab.analysis.batch_step import BatchStepMap
+    from walkerlab.analysis.scene_gaits import solve_scene
+    from walkerlab.config import load_scene
+    from walkerlab.models.registry import build_walker
+    from walkerlab.sweep.mfpt import scene_walker_at
+
+    t = time.perf_counter()
+    sc = load_scene(ROOT / "configs" / f"{name}.yaml")
+    try:
+        sm = BatchStepMap(build_walker(sc), scene_walker_at(sc), 1e-12, 1e-12)
+    except ValueError as exc:
+        return f"| {name} | not supported: {exc} |"
+    w, s = solve_scene(sc, fd_check=False)
+    g = s.gait.result
+    A, x = g.jacobian_variational, g.x
+    T = R.relative_coordinates(w.state_names())
+    lam = np.max(np.abs(np.linalg.eigvals(A)))
+    lam_rel = np.max(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T))))
+    cells = [name, f"{lam:.4f} / {lam_rel:.4f}"]
+    for dist in ("slope", "floor_height"):
+        lin = R.linearise(sm, x, A, dist)
+        gl = lin.gsn()
+        gn = R.gsn_nonlinear(sm, x, dist, 1e-5, steps=60)
+        cells += [f"{gl:.4g} ({abs(gl - gn) / gl:.0e})",
+                  f"{R.state_gsn(lin):.4g} / {R.state_gsn(lin, T):.4g}"]
+    L = float(w.params.get("leg_length_m", 1.0))
+    down = R.largest_tolerable(sm, x, "floor_height", 0.25 * L, 0.001)
+    up = R.largest_tolerable(sm, x, "floor_height", 0.25 * L, 0.001, sign=-1.0)
+    cells += [f"{1000 * down:.0f}", f"{1000 * up:.0f}", f"{time.perf_counter() - t:.0f}"]
+    return "| " + " | ".join(cells) + " |"
+
+
+def main() -> None:
+    names = sys.argv[1:] or WALKERS
+    print("| walker | abs lambda max (abs / rel angles) | GSN slope [1/rad] (lin vs nonlin) "
+          "| state norm slope (abs / rel) | GSN floor height [1/m] (lin vs nonlin) "
+          "| state norm height (abs / rel) | step-down [mm] | step-up [mm] | s |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for n in names:
+        print(row(n), flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,41 @@
+"""The one rigid-limit family (walkerlab.contact.rigid_limit): its exponents, and the scene's
+``stiffness_family: rigid_limit`` is the same family (not a second definition)."""
+
+import pytest
+
+from walkerlab.config.contact import ContactSettings, KneeStopSettings
+from walkerlab.contact.rigid_limit import contact_si, expected_order, scale
+
+
+def test_family_exponents():
+    c, k = ContactSettings().to_si(), KneeStopSettings().to_si()
+    kappa = 1e4
+    c2, k2 = scale(c, k, kappa)
+    p = 1 / (c.e + 1)  # 1/3.2
+    assert c2.k == pytest.approx(c.k * kappa, rel=1e-15)
+    assert c2.cmax == pytest.approx(c.cmax * kappa ** p, rel=1e-15)
+    assert c2.dmax == pytest.approx(c.dmax * kappa ** -p, rel=1e-15)
+    assert c2.v_s == pytest.approx(c.v_s * 1e-2, rel=1e-15)  # kappa^(-1/2)
+    assert c2.v_d / c2.v_s == pytest.approx(c.v_d / c.v_s, rel=1e-15)
+    assert (c2.mu_s, c2.mu_d) == (c.mu_s, c.mu_d)
+    assert k2.latch_height == pytest.approx(k.latch_height * kappa ** -p, rel=1e-15)
+    pk = 1 / (k.e + 1)
+    assert k2.cmax == pytest.approx(k.cmax * kappa ** pk, rel=1e-15)
+    assert expected_order(2.2) == pytest.approx(1 / 3.2)
+    with pytest.raises(ValueError, match="kappa"):
+        scale(c, k, 0.0)
+
+
+def test_scene_family_is_the_one_family():
+    """stiffness 1e7 N/mm^2.2 in the rigid_limit family = the reference contact scaled by
+    kappa = 100, friction velocities included (the old config family left them)."""
+    ref = ContactSettings()
+    stiff = ref.model_copy(update={"stiffness": 1e7, "stiffness_family": "rigid_limit"})
+    got, knee = contact_si(stiff)
+    want, want_knee = scale(*contact_si(ref), 100.0)
+    for f in ("k", "cmax", "dmax", "v_s", "v_d"):
+        assert getattr(got, f) == pytest.approx(getattr(want, f), rel=1e-12), f
+    assert knee.latch_height == pytest.approx(want_knee.latch_height, rel=1e-12)
+    # the paper family keeps the numbers as written
+    paper = ref.model_copy(update={"stiffness": 1e7})
+    assert contact_si(paper)[0].v_s == ref.to_si().v_s

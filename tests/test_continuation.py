@@ -1,0 +1,321 @@
+"""Pseudo-arclength continuation of gaits (issue 23): special points against independent
+computations.
+
+The independent checks share no code with :mod:`walkerlab.analysis.continuation`: fixed
+points by :func:`scipy.optimize.root` on the (k-step) Poincaré map with MINPACK's own
+finite-difference Jacobian, multipliers from a central finite-difference Jacobian of the
+map (not the variational equations), and the onset by :func:`scipy.optimize.brentq` in the
+parameter on ``1 + (most negative real multiplier)``.  Finite-difference multipliers carry
+~1e-7 of error (NOTES.md: ~9 digits for the map's Jacobian at h = 1e-7 ... 1e-5), which moves
+an onset by ~1e-7 / |d mu / d p|, far inside the 1e-4 asked.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq, root
+
+from walkerlab.analysis.continuation import SPECIAL_KINDS
+from walkerlab.analysis.poincare import poincare_map
+from walkerlab.config import load_scene
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.registry import build_walker
+from walkerlab.sweep.continuation import run_continuation
+from walkerlab.sweep.params import apply_point
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _walker(scene, path, p):
+    return build_walker(apply_point(scene.model_dump(mode="json"), [path], (p,)))
+
+
+def _kmap(walker, x, solver, k, tmax):
+    for _ in range(k):
+        x, _T, _n = poincare_map(walker, x, solver, tmax)
+    return x
+
+
+def _independent_orbit(scene, path, p, guess, k):
+    """Fixed point of the k-step map (scipy root, MINPACK finite differences) and the
+    multipliers of a central finite-difference Jacobian of the map there."""
+    w = _walker(scene, path, p)
+    s = Solver.from_settings(scene.solver)
+    tmax = scene.fixedpoint.max_step_time_s
+    sol = root(lambda z: w.section(_kmap(w, w.from_section(z), s, k, tmax)) - z,
+               w.section(guess), method="hybr", options={"xtol": 1e-13})
+    x = w.from_section(sol.x)
+    assert np.max(np.abs(_kmap(w, x, s, k, tmax) - x)) < 1e-10
+    n, h = x.size, 1e-6
+    J = np.empty((n, n))
+    for j in range(n):
+        e = np.zeros(n)
+        e[j] = h
+        J[:, j] = (_kmap(w, x + e, s, k, tmax) - _kmap(w, x - e, s, k, tmax)) / (2 * h)
+    return x, np.linalg.eigvals(J)
+
+
+def _independent_onset(scene, path, lo, hi, guess, k):
+    """brentq on 1 + min real multiplier of the independent k-step orbit, in ``p``."""
+    state = {"x": guess}
+
+    def g(p):
+        x, mu = _independent_orbit(scene, path, p, state["x"], k)
+        state["x"] = x
+        real = mu[np.abs(mu.imag) < 1e-6].real
+        return 1.0 + real.min()
+
+    return brentq(g, lo, hi, xtol=1e-9)
+
+
+def _special(res, kind, period):
+    return [s for s in res.specials if s.kind == kind and s.period == period]
+
+
+@pytest.fixture(scope="module")
+def paper():
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    res, _ = run_continuation(scene, "slope.angle_deg", 3.8, 4.97, switch=1)
+    return scene, res
+
+
+@pytest.fixture(scope="module")
+def simplest():
+    scene = load_scene(ROOT / "configs" / "simplest.yaml")
+    res, _ = run_continuation(scene, "slope.angle_rad", 0.012, 0.0179, switch=1)
+    return scene, res
+
+
+@pytest.mark.slow
+def test_paper_period_doubling_onsets_match_independent_brentq(paper):
+    """Period 1 -> 2 (Goswami et al. 1996: 4.37 deg; this project's sweep 4.391 deg) and
+    period 2 -> 4, each to 1e-4 deg of the independent computation."""
+    scene, res = paper
+    (pd1,), (pd2,) = _special(res, "period_doubling", 1), _special(res, "period_doubling", 2)
+    assert abs(pd1.p - 4.391) < 2e-3  # the project's brute-force sweep (0.05 deg grid)
+    ref1 = _independent_onset(scene, "slope.angle_deg", pd1.p - 0.05, pd1.p + 0.05, pd1.x, 1)
+    assert abs(pd1.p - ref1) < 1e-4, (pd1.p, ref1)
+    ref2 = _independent_onset(scene, "slope.angle_deg", pd2.p - 0.01, pd2.p + 0.01, pd2.x, 2)
+    assert abs(pd2.p - ref2) < 1e-4, (pd2.p, ref2)
+    # the multiplier at the located points is -1 (variational equations)
+    for sp in (pd1, pd2):
+        real = sp.multipliers[np.abs(sp.multipliers.imag) < 1e-9].real
+        assert abs(real.min() + 1.0) < 1e-6
+
+
+@pytest.mark.slow
+def test_simplest_period_doubling_onsets_match_garcia_and_independent(simplest):
+    """Garcia et al. 1998 (J. Biomech. Eng. 120:281): period doubling at gamma ~ 0.0151
+    (the scene is nondimensional, slope in rad); period 4 from the period-2 branch."""
+    scene, res = simplest
+    (pd1,), (pd2,) = _special(res, "period_doubling", 1), _special(res, "period_doubling", 2)
+    assert abs(pd1.p - 0.0151) < 1e-4
+    ref1 = _independent_onset(scene, "slope.angle_rad", pd1.p - 5e-4, pd1.p + 5e-4, pd1.x, 1)
+    assert abs(pd1.p - ref1) < 1e-4 * 1e-2, (pd1.p, ref1)  # rad: far inside 1e-4
+    ref2 = _independent_onset(scene, "slope.angle_rad", pd2.p - 3e-4, pd2.p + 3e-4, pd2.x, 2)
+    assert abs(pd2.p - ref2) < 1e-6, (pd2.p, ref2)
+    assert 0.0151 < pd2.p < 0.019  # after period 2, before Garcia's chaos (~0.019)
+
+
+@pytest.mark.slow
+def test_branches_agree_with_independent_fixed_points():
+    """At >= 20 points along the period-1 and along the period-2 branch the continuation's
+    state equals an independent fixed-point solve (k-step map) at the same parameter to
+    1e-9 (both solved to ~1e-12)."""
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    res, _ = run_continuation(scene, "slope.angle_deg", 4.0, 4.8, switch=1, ds_max=0.04)
+    assert [b.period for b in res.branches] == [1, 2]
+    for br in res.branches:
+        # the period doubling a switched branch starts at is not an isolated fixed point of
+        # the 2-step map (a multiplier +1 there: the root finder's answer is only good to
+        # ~sqrt(eps)), so it is left out
+        pts = [q for q in br.points if np.min(np.abs(q.multipliers - 1.0)) > 1e-3]
+        assert len(pts) >= 20, len(pts)
+        worst = 0.0
+        for q in pts:
+            x, _mu = _independent_orbit(scene, "slope.angle_deg", q.p, q.x, br.period)
+            worst = max(worst, float(np.max(np.abs(x - q.x))))
+        assert worst < 1e-9, (br.period, worst)
+
+
+@pytest.mark.slow
+def test_kneed_gait_ends_in_a_fold_where_a_scan_loses_it():
+    """Moving the kneed walker's thigh mass towards the hip the gait ends (issue 23: a sweep
+    reported ``no_fixed_point`` near 0.268 m): a fold, multiplier +1 to 1e-6; a natural-
+    parameter scan with the root finder (independent of the continuation) finds gaits above
+    the fold and none 2 mm below it."""
+    from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
+
+    scene = load_scene(ROOT / "configs" / "kneed.yaml")
+    path = "walker.leg.bodies.thigh_mass.from_hip_m"
+    res, _ = run_continuation(scene, path, 0.255, 0.31)
+    folds = _special(res, "fold", 1)
+    assert len(folds) == 1
+    f = folds[0]
+    assert 0.26 < f.p < 0.27
+    mu = f.multipliers
+    assert np.min(np.abs(mu - 1.0)) < 1e-6
+    s = Solver.from_settings(scene.solver)
+    x = f.x
+    for p in (f.p + 3e-3, f.p + 1e-3, f.p + 2e-4):  # towards the fold from above: found
+        x = find_fixed_point(_walker(scene, path, p), x, s, fd_check=False).x
+    with pytest.raises(FixedPointNotFound):
+        find_fixed_point(_walker(scene, path, f.p - 2e-3), x, s, fd_check=False)
+
+
+def test_paper_rods_bifurcation_chain_keeps_the_stable_long_gait():
+    """Issue 23's defect: ``bifurcation --param walker.leg.bodies.rod.mass_kg=3:7:0.5``
+    reported the unstable short-period gait at 3 kg (T 0.8227 s, |mu| 3.23).  The chains
+    start at the scene's value (5 kg) and follow the branch by pseudo-arclength: at 3 kg the
+    stable long gait (T 1.0223 s, |mu| 0.778, as ``fixedpoint`` and ``sweep`` there)."""
+    from walkerlab.sweep.bifurcation import bifurcation_diagram
+
+    scene = load_scene(ROOT / "configs" / "paper_rods.yaml")
+    r = bifurcation_diagram(scene, np.arange(3.0, 7.01, 0.5), steady_state=False, workers=1,
+                            param="walker.leg.bodies.rod.mass_kg")
+    assert abs(r.step_period_s[0] - 1.0223) < 1e-4
+    assert abs(np.max(np.abs(r.multipliers[0])) - 0.778) < 1e-3
+    assert np.all(np.max(np.abs(r.multipliers), axis=1) < 1)
+
+
+@pytest.mark.slow
+def test_artifact_round_trip_and_cli(tmp_path):
+    """The CLI writes continuation_<field>.h5 (kinds as strings, the parameter in its unit,
+    the branch period) and its figure; the loader reads back the located points."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.continuation import load_continuation
+
+    r = CliRunner().invoke(app, ["continuation", str(ROOT / "configs" / "paper_rods.yaml"),
+                                 "--param", "walker.leg.bodies.rod.mass_kg=2.5:3.0",
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert "period_doubling" in r.output
+    path = tmp_path / "paper_rods" / "continuation_walker.leg.bodies.rod.mass_kg.h5"
+    data = load_continuation(path)
+    assert data.unit == "kg" and set(data.special["kind"]) <= set(SPECIAL_KINDS)
+    (i,) = np.flatnonzero(data.special["kind"] == "period_doubling")
+    assert 2.6 < data.special["param"][i] < 2.8 and data.special["period"][i] == 1
+    b = data.branches[0]
+    assert b["period"] == 1 and b["multipliers"].shape[1] == 4
+    assert b["stable"][np.argmax(b["param"])] and not b["stable"][np.argmin(b["param"])]
+    assert (tmp_path / "paper_rods" / "report" / "figures"
+            / "continuation_walker.leg.bodies.rod.mass_kg.png").is_file()
+    bad = CliRunner().invoke(app, ["continuation", str(ROOT / "configs" / "paper.yaml"),
+                                   "--param", "slope.angle_deg=1:1", "--runs-dir",
+                                   str(tmp_path)])
+    assert bad.exit_code == 1 and "FIELD=START:STOP" in bad.output
+
+
+@pytest.mark.slow
+def test_two_parameter_period_doubling_curve_matches_independent_onsets():
+    """The paper walker's period-doubling boundary in the plane slope x hip mass (Goswami
+    et al.'s chart over mu = m_H / m, m = 5 kg): the curve's point at m_H = 20 kg equals an
+    independent brentq onset there to 1e-4 deg; the onset falls as the hip gets heavier
+    (Goswami, Thuilot & Espiau 1998, Fig. 10: the period-doubling slope decreases with mu)."""
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    _res, curves = run_continuation(scene, "slope.angle_deg", 4.2, 4.6, 0,
+                                    "walker.hip_mass_kg", (10.0, 20.0), n2=3)
+    (c,) = curves
+    assert c.kind == "period_doubling" and list(c.p2) == [10.0, 15.0, 20.0]
+    assert np.all(np.diff(c.p) < 0)
+    assert np.all(np.abs(c.multiplier + 1.0) < 1e-6)
+    heavy = apply_point(scene.model_dump(mode="json"), ["walker.hip_mass_kg"], (20.0,))
+    ref = _independent_onset(heavy, "slope.angle_deg", c.p[-1] - 0.05, c.p[-1] + 0.05,
+                             c.x[-1], 1)
+    assert abs(c.p[-1] - ref) < 1e-4, (c.p[-1], ref)
+
+
+@pytest.mark.slow
+def test_homotopy_and_initial_guess_from_an_artifact(tmp_path):
+    """``fixedpoint --from`` carries the kneed gait to a steeper, heavier-hipped design (both
+    fields change at once) and reports the period doubling passed on the way; an
+    ``initial_guess`` naming a continuation artifact and a parameter value starts the root
+    finder on that branch: it converges to the continuation's own fixed point there."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = yaml.safe_load((ROOT / "configs" / "kneed.yaml").read_text())
+    d["slope"]["angle_rad"], d["walker"]["hip_mass_kg"] = 0.12, 1.0
+    del d["fixedpoint"]["initial_guess"]
+    new = tmp_path / "kneed_steep.yaml"
+    new.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["fixedpoint", str(new), "--from",
+                                 str(ROOT / "configs" / "kneed.yaml"), "--runs-dir",
+                                 str(tmp_path / "runs")])
+    assert r.exit_code == 0, r.output
+    assert "by homotopy over slope.angle_rad, walker.hip_mass_kg" in r.output
+    assert "period doubling at lambda" in r.output
+    assert "step period     0.65393" in r.output  # the gait the seeds find too
+    # a design whose straight line leaves the gait: one line naming where and why
+    d["slope"]["angle_rad"], d["walker"]["hip_mass_kg"] = 0.02, 0.5
+    far = tmp_path / "kneed_shallow.yaml"
+    far.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["fixedpoint", str(far), "--from",
+                                 str(ROOT / "configs" / "kneed.yaml"), "--runs-dir",
+                                 str(tmp_path / "runs")])
+    assert r.exit_code == 1 and "fold at lambda" in r.output
+    # initial_guess from a continuation artifact
+    scene = load_scene(ROOT / "configs" / "paper_rods.yaml")
+    from walkerlab.stages import continuation as stage
+
+    out = stage.run(scene, "walker.leg.bodies.rod.mass_kg", 3.0, 5.0, runs_root=tmp_path)
+    data = out.summary["data"]
+    rod = scene.model_dump(mode="json")
+    rod["fixedpoint"]["initial_guess"] = {"from": str(out.path), "at": 3.5}
+    rod["walker"]["leg"]["bodies"][0]["mass_kg"] = 3.5
+    from walkerlab.analysis.scene_gaits import solve_scene
+    from walkerlab.config import scene_from_dict
+
+    _w, search = solve_scene(scene_from_dict(rod), fd_check=False)
+    ref = _independent_orbit(scene_from_dict(rod), "walker.leg.bodies.rod.mass_kg", 3.5,
+                             data.state_at(3.5), 1)[0]
+    assert np.max(np.abs(search.result.x - ref)) < 1e-9
+    assert search.gait.source == "initial_guess"
+
+
+def test_stance_foot_normal_force_from_the_equations_of_motion():
+    """The branch-end check 'stance foot lifting' differentiates the centre of mass on the
+    dense output; here the same force from the equations of motion instead: the centre of
+    mass of the paper walker's masses by name (hip 10 kg, two 5 kg leg masses, Table 1),
+    its acceleration as the derivative of its velocity along the flow vector field, N = M (a .
+    n + g cos phi) with n the slope normal.  The smallest N / (M g) over the step agrees to
+    1e-5 (the second difference on 200 points a phase errs by ~h^2 |d^4 com/dt^4| / 12,
+    measured 3e-6 here; at a branch end this moves the located parameter by 1e-5 / |dN/dp|)."""
+    from walkerlab.analysis.continuation import normal_force_ratio, step_map
+
+    scene = load_scene(ROOT / "configs" / "paper.yaml")
+    w = build_walker(scene)
+    s = Solver.from_settings(scene.solver)
+    x0 = np.array([-0.3234, 0.2187, -0.3801, -1.0932])  # near the gait: any step will do
+    segs = step_map(w, w.from_section(w.section(x0)), s, 1, segments=True)[3]
+    got = normal_force_ratio(w, segs)
+    masses = {"hip": 10.0, "stance_mass": 5.0, "swing_mass": 5.0}
+    M, g, phi = 20.0, 9.81, 0.0174
+    nrm = np.array([np.sin(phi), np.cos(phi)])
+    n = w.n_coordinates
+
+    def com(x):
+        pts = w.points(x)
+        return sum(m * np.asarray(pts[k], float) for k, m in masses.items()) / M
+
+    def v_com(x):  # d com / dt = D com(q) . qdot, by a central difference along qdot
+        e = np.concatenate([x[n:], np.zeros(n)]) * 1e-6
+        return (com(x + e) - com(x - e)) / 2e-6
+
+    low = np.inf
+    for seg in segs:
+        for ph, dense, (ta, tb) in seg.pieces:
+            for t in np.linspace(ta, tb, 200)[2:-2]:
+                x = np.asarray(dense(t), float).ravel()[:2 * n]
+                f = np.asarray(ph.flow(t, x), float)
+                a = (v_com(x + 1e-6 * f) - v_com(x - 1e-6 * f)) / 2e-6
+                low = min(low, float((nrm @ a + g * np.cos(phi)) / g))
+    assert 0.5 < low < 1.0
+    assert abs(got - low) < 1e-5, (got, low)

@@ -1,0 +1,267 @@
+"""Metastability on per-step random slopes: the batched step map, the Monte Carlo estimator,
+the mesh machinery and the mfpt stage (Byl & Tedrake 2009)."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from walkerlab.analysis import mfpt as M
+from walkerlab.analysis.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.config import load_scene
+from walkerlab.integrate.rigid import Solver, integrate_step
+from walkerlab.models.registry import build_walker
+from walkerlab.sweep.mfpt import scene_walker_at
+
+ROOT = Path(__file__).resolve().parents[1]
+TIGHT = Solver("DOP853", 1e-12, 1e-12)
+
+
+@pytest.fixture(scope="module")
+def paper_map(paper_scene):
+    return BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-10, 1e-10)
+
+
+def test_batched_step_matches_one_step_integration(paper_scene, paper_map, paper_fixed_point):
+    """Each row of the stacked system equals integrate_step of the walker on that row's slope
+    (scipy DOP853 at 1e-12 with solve_ivp's event location): the rows' tolerances are
+    1e-10, so agreement to 1e-8 in state and step time checks the row-wise event location,
+    the per-row slope and the reset; a wrong slope (1e-3 rad apart) moves x_next by ~1e-3."""
+    rng = np.random.default_rng(3)
+    X = paper_fixed_point.x + 0.01 * rng.standard_normal((8, 4))
+    gam = paper_scene.slope.phi_rad + 0.004 * rng.standard_normal(8)
+    names = paper_map.walker.state_names()
+    X[6:, names.index("stance_rate")] *= [0.5, 1.8]  # too slow (falls back), too fast
+    r = paper_map.step(X, gam)
+    at = scene_walker_at(paper_scene)
+    ends = []
+    for i in range(8):
+        seg = integrate_step(at(gam[i]), X[i], TIGHT)
+        ends.append(seg.termination)
+        assert (r.outcome[i] == HEEL_STRIKE) == (seg.termination == "heel_strike")
+        if seg.termination == "heel_strike":
+            np.testing.assert_allclose(r.x_next[i], seg.x_next, rtol=0, atol=1e-8)
+            assert abs(r.step_time_s[i] - seg.period) < 1e-8
+        else:  # the same fall guard at the same time
+            np.testing.assert_allclose(r.x_pre[i], seg.x_end, rtol=0, atol=1e-8)
+    assert ends.count("heel_strike") >= 4 and ends.count("fall") >= 1
+
+
+def test_heel_strike_on_each_steps_own_slope(paper_scene, paper_map, paper_fixed_point):
+    """The compass walker's heel strike lands on theta_swing + theta_stance = -2 gamma_n of
+    the row's own slope (the guard of the line through the stance foot at gamma_n)."""
+    names = paper_map.walker.state_names()
+    gam = paper_scene.slope.phi_rad + np.array([-0.004, 0.0, 0.003])
+    r = paper_map.step(np.tile(paper_fixed_point.x, (3, 1)), gam)
+    s = r.x_pre[:, names.index("swing_angle")] + r.x_pre[:, names.index("stance_angle")]
+    np.testing.assert_allclose(s, -2 * gam, rtol=0, atol=1e-12)
+
+
+def test_kneed_walker_two_phases_and_knee_strike(paper_scene):
+    """The kneed walker (unlocked swing, knee strike reset, locked swing) through the batched
+    map equals integrate_step on two slopes."""
+    sc = load_scene(ROOT / "configs" / "kneed.yaml")
+    w = build_walker(sc)
+    from walkerlab.analysis.poincare import find_fixed_point
+
+    g = sc.fixedpoint.initial_guess.as_array(w.state_names())
+    x = find_fixed_point(w, g, TIGHT, fd_check=False).x
+    bm = BatchStepMap(w, scene_walker_at(sc), 1e-10, 1e-10)
+    gam = sc.slope.phi_rad + np.array([-0.002, 0.002])
+    r = bm.step(np.tile(x, (2, 1)), gam)
+    at = scene_walker_at(sc)
+    for i in range(2):
+        seg = integrate_step(at(gam[i]), x, TIGHT)
+        np.testing.assert_allclose(r.x_next[i], seg.x_next, rtol=0, atol=1e-8)
+
+
+def test_censored_geometric_mle_recovers_known_mfpt():
+    """Walks with a known per-step fall probability p (MFPT (1 - p) / p = 99), censored at 60
+    steps (most walks are censored): the estimate lies within 3 standard errors of 99, and
+    the naive mean of the steps (censoring ignored) does not (it is < 60)."""
+    rng = np.random.default_rng(11)
+    p, cap, n = 0.01, 60, 20000
+    k = rng.geometric(p, n) - 1  # heel strikes before the fall
+    fell = k < cap
+    steps = np.minimum(k, cap)
+    m, se = M.geometric_mle(int(steps.sum()), int(fell.sum()))
+    assert abs(m - 99.0) < 3 * se
+    assert se < 5.0
+    assert steps.mean() < 60 < m - 3 * se
+
+
+def test_slope_draws_do_not_depend_on_grouping():
+    a = M.draw_slopes(5, 17, 100, 0.01, 0.002)
+    b = M.draw_slopes(5, 17, 40, 0.01, 0.002)
+    np.testing.assert_array_equal(a[:40], b)
+    u = M.draw_slopes(5, 17, 20000, 0.0, 0.002, "uniform")
+    assert abs(u.std() - 0.002) < 5e-5 and np.all(np.abs(u) <= math.sqrt(3) * 0.002)
+
+
+def test_no_noise_no_fall_and_unstable_gait_falls(paper_scene, paper_map):
+    """sigma -> 0: walks on the stable long-period gait (|lambda| 0.586) never fall (MFPT
+    infinite); from the unstable short-period gait (|lambda| 2.44) the same noise makes
+    walks fall within a few steps (those that do not fall drift to the stable gait)."""
+    from walkerlab.analysis.scene_gaits import solve_scene
+
+    _, search = solve_scene(paper_scene, fd_check=False)
+    gaits = {g.label: g.result for g in search.gaits}
+    stable, unstable = gaits["long_period"], gaits["short_period"]
+    assert np.max(np.abs(unstable.multipliers_variational)) > 1 > \
+        np.max(np.abs(stable.multipliers_variational))
+    r = M.monte_carlo(paper_map, stable.x, 1e-6, range(20), 40, seed=1)
+    assert not r.fell.any() and r.mfpt[0] == math.inf
+    r = M.monte_carlo(paper_map, unstable.x, 1e-6, range(20), 40, seed=1)
+    assert r.fell.sum() >= 5
+    assert np.median(r.steps[r.fell]) < 20
+
+
+def _ar1_mesh_and_mc(a, sd, c, h):
+    """An AR(1) map x' = a x + gamma (gamma ~ N(0, sd^2)), falling when |x'| > c: the mesh
+    machinery (chart, Gauss-Hermite transitions, multilinear weights, sparse solve) on a map
+    with no walker in it, against plain Monte Carlo of the same chain."""
+    class Chart(M.MeshChart):
+        pass
+    s = sd / math.sqrt(1 - a * a)
+    chart = Chart(np.zeros(1), np.ones((1, 1)), np.array([s]))
+    radius = c / s + 2 * h
+    verts = M.lattice(1, h, radius)
+    g, w = M.gauss_hermite(41, 0.0, sd)
+    x = chart.to_state(verts * h)[:, 0]
+    img = a * x[:, None] + g[None, :]
+    ok = (np.abs(img) <= c) & (np.abs(x)[:, None] <= c)
+    Q, _ = M.transition_matrix(img[..., None], ok, w, verts, chart, h, radius)
+    start = int(np.flatnonzero(verts[:, 0] == 0)[0])
+    return M.solve_mesh(Q, start)[0]
+
+
+def test_mesh_converges_to_monte_carlo_on_a_known_chain():
+    """AR(1) with a = 0.6 and the boundary at 2.4 stationary sd's (MFPT ~ 100 steps): the
+    mesh MFPT rises as the mesh is refined (multilinear spreading underestimates it), the
+    finest two differ by < 5 %, and the finest agrees with 40,000 Monte Carlo walks within
+    2 standard errors + that 5 %."""
+    a, sd = 0.6, 1.0
+    c = 2.4 * sd / math.sqrt(1 - a * a)
+    ms = [_ar1_mesh_and_mc(a, sd, c, h) for h in (0.4, 0.1, 0.025, 0.0125)]
+    assert ms[0] < ms[1] < ms[3]
+    assert abs(ms[3] - ms[2]) / ms[3] < 0.05
+    rng = np.random.default_rng(0)
+    n, x, alive, steps = 40000, np.zeros(40000), np.ones(40000, bool), np.zeros(40000, int)
+    for _ in range(3000):
+        x = a * x + sd * rng.standard_normal(n)
+        ok = alive & (np.abs(x) <= c)
+        steps += ok
+        alive = ok
+        if not alive.any():
+            break
+    m, se = M.geometric_mle(int(steps.sum()), int((~alive).sum()))
+    assert abs(ms[3] - m) < 2 * se + 0.05 * ms[3]
+
+
+def test_terrain_per_step_validates_and_keeps_old_hashes(tmp_path):
+    """A shipped scene's terrain serialises exactly as before (no per_step key: content
+    hashes unchanged); per_step validates with units in its names."""
+    sc = load_scene(ROOT / "configs" / "paper.yaml")
+    assert "per_step" not in sc.section_json("terrain")
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    d["terrain"]["per_step"] = {"slope_sd_rad": 0.003, "seed": 4}
+    p = tmp_path / "rough.yaml"
+    p.write_text(yaml.safe_dump(d))
+    s2 = load_scene(p)
+    assert s2.terrain.per_step.slope_sd_rad == 0.003
+    d["terrain"]["per_step"] = {"slope_sd": 0.003}
+    p.write_text(yaml.safe_dump(d))
+    with pytest.raises(Exception, match="slope_sd"):
+        load_scene(p)
+
+
+@pytest.mark.slow
+def test_mfpt_stage_artifact_and_figure(tmp_path):
+    """walkerlab mfpt (Monte Carlo, one sigma, a few walks) writes mfpt.h5 with the schema's
+    coordinate and variables, read back by its loader, and the figure."""
+    from walkerlab.io.schemas.mfpt import VARIABLES, load
+    from walkerlab.stages import mfpt as stage
+    from walkerlab.stages import pipeline
+
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    for k in ("contact", "terrain", "contact_sim", "contact_solver", "workprecision",
+              "simulate"):
+        d.pop(k, None)
+    d["mfpt"] = {"walks": 30, "max_steps": 60, "method": "montecarlo"}
+    p = tmp_path / "paper_mfpt.yaml"
+    p.write_text(yaml.safe_dump(d))
+    sc = load_scene(p)
+    out = pipeline.run("mfpt", sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
+    data = load(out.path)
+    assert list(data.sigma_rad) == [0.008]
+    assert set(VARIABLES) <= set(data.values)
+    m = data["mfpt_steps_montecarlo"][0]
+    assert 0 <= m < 60 and data["montecarlo_falls"][0] > 0
+    assert np.isnan(data["mfpt_steps_mesh"][0])
+    assert stage.figure_path(sc, tmp_path / "runs").is_file()
+    again = pipeline.run("mfpt", sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
+    assert again.reused
+
+
+def test_step_down_guard_agrees_with_heel_strike_guard(paper_map, paper_fixed_point):
+    """The step-down guard (swing-foot clearance reaching -drop, armed once the foot has
+    risen) with a 1 nm drop lands where the heel-strike guard does (the two guards share
+    their zero set; 1 nm moves the state by ~1e-8); a 10 mm step-down lands the foot 10 mm
+    below the slope line through the stance foot."""
+    X = np.tile(paper_fixed_point.x, (2, 1))
+    a = paper_map.step(X)
+    b = paper_map.step(X, drop_m=np.array([1e-9, 0.01]))
+    np.testing.assert_allclose(b.x_next[0], a.x_next[0], rtol=0, atol=1e-7)
+    assert np.max(np.abs(b.x_next[0] - a.x_next[0])) > 0  # the clearance guard was used
+    foot = paper_map.walker.points(b.x_pre[1])["swing_foot"]
+    below = -(foot[1] + foot[0] * math.tan(paper_map.slope_rad))
+    assert abs(below - 0.01) < 1e-4  # vertical drop; clearance ~ perpendicular (cos 1 deg)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("disturbance", ["slope", "floor_height"])
+def test_gait_sensitivity_norm_linear_equals_nonlinear(paper_scene, paper_fixed_point,
+                                                       disturbance):
+    """Hobbelen & Wisse's GSN from the linearised step-to-step map (A from the variational
+    equations) equals the nonlinear map's response to a 1e-5 impulse to 1e-3 relative
+    (measured ~1e-6: central differences with steps 1e-6, impulse response O(e^2))."""
+    from walkerlab.analysis import robustness as R
+
+    sm = BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-12, 1e-12)
+    lin = R.linearise(sm, paper_fixed_point.x, paper_fixed_point.jacobian_variational,
+                      disturbance)
+    g_lin = lin.gsn()
+    g_nl = R.gsn_nonlinear(sm, paper_fixed_point.x, disturbance, 1e-5, steps=60)
+    assert g_lin > 1.0
+    assert abs(g_lin - g_nl) / g_lin < 1e-3
+
+
+def test_state_norm_depends_on_coordinates_multipliers_do_not(paper_fixed_point, paper_scene):
+    """Jin et al. 2021: the multipliers are the same in absolute and relative angles
+    (similar Jacobians, to 1e-12), a state-indicator norm is not (differs by > 0.1 %)."""
+    from walkerlab.analysis import robustness as R
+
+    A = paper_fixed_point.jacobian_variational
+    names = build_walker(paper_scene).state_names()
+    T = R.relative_coordinates(names)
+    ev = np.sort(np.abs(np.linalg.eigvals(A)))
+    evT = np.sort(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T))))
+    np.testing.assert_allclose(ev, evT, rtol=0, atol=1e-12)
+    lin = R.Linearisation(A, np.array([-0.96, -1.04, -1.19, -2.43]), np.zeros((3, 4)),
+                          np.zeros(3))
+    a, b = R.state_gsn(lin), R.state_gsn(lin, T)
+    assert abs(a - b) / a > 1e-3
+
+
+def test_largest_step_down_and_up_of_the_paper_walker(paper_map, paper_fixed_point):
+    """The paper walker survives a single step-down of a few millimetres only (measured 5 mm
+    down, 3 mm up on a 1 mm grid): survival is monotone on the grid (every value below the
+    answer survives 40 steps, the next one falls), and the answer is between 1 and 20 mm."""
+    from walkerlab.analysis import robustness as R
+
+    for sign in (1.0, -1.0):
+        h = R.largest_tolerable(paper_map, paper_fixed_point.x, "floor_height", 0.02, 0.001,
+                                sign=sign)
+        assert 0.001 <= h < 0.02

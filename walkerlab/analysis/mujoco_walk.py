@@ -1,0 +1,135 @@
+"""Run an exported MJCF walker in MuJoCo from its ``gait`` keyframe and read its heel strikes.
+
+MuJoCo is an optional (dev/test) dependency: imported inside the functions.
+
+A heel strike of leg i is the first contact of its foot geom (``leg<i>_foot``) with the
+ground after the foot has been off the ground for at least ``min_air_s`` (shorter gaps are
+bounces of the soft contact, not steps).  The knee latch of a kneed export (equality
+constraints ``leg<i>_latch``) is switched before every step by :func:`latch_rule`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["MujocoWalk", "latch_rule", "walk"]
+
+LEGS = ("leg1", "leg2")
+
+
+@dataclass
+class MujocoWalk:
+    """Heel strikes of a MuJoCo run.
+
+    Attributes
+    ----------
+    times_s : ndarray (n,)
+        Heel-strike times [s].
+    legs : list of str
+        The striking leg of each.
+    positions_m : ndarray (n,)
+        Along-slope position of the striking foot's site at the strike [m].
+    fell : bool
+        The hip dropped below half a leg length above the ground.
+    t_end_s : float
+        Simulated time [s].
+    """
+
+    times_s: np.ndarray
+    legs: list
+    positions_m: np.ndarray
+    fell: bool
+    t_end_s: float
+
+    @property
+    def alternating(self) -> bool:
+        """Every strike is by the other leg than the one before."""
+        return all(a != b for a, b in zip(self.legs, self.legs[1:]))
+
+    @property
+    def step_periods_s(self) -> np.ndarray:
+        """Times between successive heel strikes [s], (n - 1,)."""
+        return np.diff(self.times_s)
+
+    @property
+    def step_lengths_m(self) -> np.ndarray:
+        """Along-slope distances between successive footfalls [m], (n - 1,)."""
+        return np.diff(self.positions_m)
+
+
+def _numeric(model, name, default=None):
+    import mujoco
+
+    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, name)
+    if i < 0:
+        return default
+    return float(model.numeric_data[model.numeric_adr[i]])
+
+
+def latch_rule(foot_height_m: float, knee_rad: float, release_height_m: float,
+               capture_rad: float) -> bool:
+    """walkerlab's knee latch as an on/off rule: hold the knee straight while the foot is
+    less than ``release_height_m`` above the ground and the knee is flexed less than
+    ``capture_rad`` (the contact model weights the same two conditions by cubic steps,
+    :mod:`walkerlab.contact.generated`)."""
+    return foot_height_m < release_height_m and knee_rad > -capture_rad
+
+
+def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
+    """Run the MJCF at ``xml_path`` from its ``gait`` keyframe for ``t_final_s`` [s].
+
+    Returns
+    -------
+    MujocoWalk
+
+    Raises
+    ------
+    ValueError
+        The file has no ``gait`` keyframe (exported without a scene).
+    """
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_path(str(xml_path))
+    data = mujoco.MjData(model)
+    key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "gait")
+    if key < 0:
+        raise ValueError(f"{xml_path}: no 'gait' keyframe")
+    mujoco.mj_resetDataKeyframe(model, data, key)
+    phi = _numeric(model, "slope_rad", 0.0)
+    off = _numeric(model, "foot_height_offset_m", 0.0)
+    h_rel = _numeric(model, "latch_release_height_m")
+    cap = _numeric(model, "latch_capture_rad")
+    n, t = np.array([math.sin(phi), math.cos(phi)]), np.array([math.cos(phi), -math.sin(phi)])
+    foot_geom = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{g}_foot") for g in LEGS]
+    site = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{g}_foot") for g in LEGS]
+    latch = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, f"{g}_latch") for g in LEGS]
+    knee = [model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{g}_knee")]
+            if latch[0] >= 0 else -1 for g in LEGS]
+    hip = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")]
+    mujoco.mj_forward(model, data)
+    L = float(np.hypot(*(data.site_xpos[site[1]][[0, 2]] - data.qpos[[hip, hip + 1]])))
+    last_contact = [data.time, data.time]  # both feet at the ground at the keyframe
+    times, legs, pos = [], [], []
+    fell = False
+    while data.time < t_final_s:
+        if latch[0] >= 0 and h_rel is not None:
+            for i in range(2):
+                p = data.site_xpos[site[i]][[0, 2]]
+                data.eq_active[latch[i]] = latch_rule(float(p @ n) - off,
+                                                      float(data.qpos[knee[i]]), h_rel, cap)
+        mujoco.mj_step(model, data)
+        geoms = data.contact.geom[:data.ncon]
+        for i in range(2):
+            if data.ncon and (geoms == foot_geom[i]).any():
+                if data.time - last_contact[i] > min_air_s:
+                    times.append(data.time)
+                    legs.append(LEGS[i])
+                    pos.append(float(data.site_xpos[site[i]][[0, 2]] @ t))
+                last_contact[i] = data.time
+        if float(data.qpos[[hip, hip + 1]] @ n) < 0.5 * L:
+            fell = True
+            break
+    return MujocoWalk(np.array(times), legs, np.array(pos), fell, float(data.time))

@@ -1,0 +1,79 @@
+"""Stage ``continuation``: the scene's gait continued over a scene field, special points,
+period-doubling switches, optional two-parameter curves -> ``continuation_<field>.h5``
+(:mod:`walkerlab.io.schemas.continuation`) and its figure(s) in the report's figures folder.
+The computation is :func:`walkerlab.sweep.continuation.run_continuation`."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from walkerlab.config import Scene
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
+from walkerlab.stages.plot import figures_dir
+
+SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
+
+
+def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
+        path2: str | None = None, range2: tuple | None = None, runs_root: Path | str = "runs",
+        force: bool = False) -> StageOutcome:
+    """Compute (or reuse) ``continuation_<path>.h5`` and draw ``continuation_<path>.png``.
+
+    Raises
+    ------
+    StageError
+        No ``fixedpoint`` section, no gait at the scene's own value, or a bad ``switch``.
+    walkerlab.sweep.params.SweepError
+        A field that does not exist (one line).
+    """
+    from walkerlab.analysis.continuation import MapFailed
+    from walkerlab.io.runpaths import bifurcation_artifacts, check_name
+    from walkerlab.io.schemas.continuation import continuation_writer, load_continuation
+    from walkerlab.plotting.continuation_figures import (
+        continuation_figure,
+        two_parameter_figure,
+    )
+    from walkerlab.plotting.figures import save
+    from walkerlab.sweep.bifurcation import load_bifurcation
+    from walkerlab.sweep.continuation import run_continuation, scene_family
+    from walkerlab.sweep.params import SweepError
+
+    require(scene, "fixedpoint", "continuation")
+    if switch not in (0, 1, 2):
+        raise StageError(f"--switch: {switch} is not 0, 1 or 2 (period doublings to follow)")
+    scene_family(scene, path)  # an unknown field: one line before anything runs
+    if path2 is not None:
+        try:
+            scene_family(scene, path2)
+        except SweepError as exc:
+            raise SweepError(str(exc).replace("--param ", "--param2 ", 1)) from None
+    stem = check_name(f"continuation_{path}", "--param field")
+    key = json.dumps({"param": path, "range": [start, stop], "switch": switch,
+                      "param2": path2, "range2": list(range2) if range2 else None})
+
+    def compute():
+        try:
+            res, curves = run_continuation(scene, path, start, stop, switch, path2, range2)
+        except MapFailed as exc:
+            raise StageError(f"continuation of {path}: {exc}") from None
+        summary = {"special_points": [(s.kind, s.p, s.period, s.cause) for s in res.specials]}
+        return continuation_writer(res, curves), summary
+
+    out = run_cached("continuation", scene, runs_root, SECTIONS, (), compute, force,
+                     extra_key=key, artifact=stem)
+    data = load_continuation(out.path)
+    brute = None
+    bif = ("bifurcation" if path == "slope.angle_deg" else f"bifurcation_{path}")
+    cand = {**bifurcation_artifacts(scene, runs_root),
+            "bifurcation": out.path.parent / "bifurcation.h5"}.get(bif)
+    if cand is not None and cand.is_file():
+        brute = load_bifurcation(cand)
+    model = str(getattr(scene.walker, "model", "walker")).replace("_", " ")
+    figdir = figures_dir(scene, runs_root)
+    figs = save(continuation_figure(data, f"{model}, scene {scene.name}", brute), figdir, stem)
+    if data.curves:
+        figs += save(two_parameter_figure(data, f"{model}, scene {scene.name}"), figdir,
+                     stem + "_two_parameter")
+    out.summary.update(figures=figs, data=data)
+    return out

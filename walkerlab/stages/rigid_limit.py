@@ -1,0 +1,69 @@
+"""Stage ``rigid-limit``: the contact walker's periodic gait along the one rigid-limit family
+-> ``rigid_limit.h5`` (``walkerlab compare --rigid-limit``).
+
+For each stiffness factor ``kappa`` (default :data:`KAPPAS`) the scene's contact is scaled by
+:mod:`walkerlab.contact.rigid_limit` and the contact walker's own periodic gait is found
+(:func:`walkerlab.analysis.rigid_limit.convergence`); the artifact holds its step period, step
+length and slow Floquet multipliers against ``kappa``, the rigid gait's as scalars, and the
+observed orders of convergence (layout: :mod:`walkerlab.io.schemas.rigid_limit`).  Any
+walker with a ``contact`` and a ``fixedpoint`` section.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from walkerlab.config import Scene
+from walkerlab.io.schemas.rigid_limit import RigidLimitRun, load_rigid_limit, write_rigid_limit
+from walkerlab.stages.common import StageOutcome, require, run_cached
+
+SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
+#: Default stiffness factors [-]: the scene's contact and three decades stiffer.
+KAPPAS = (1.0, 10.0, 100.0, 1000.0)
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
+        kappas=KAPPAS) -> StageOutcome:
+    """Compute (or reuse) ``rigid_limit.h5``.
+
+    Raises
+    ------
+    StageError
+        No ``contact`` or ``fixedpoint`` section (one line).
+    """
+    require(scene, "contact", "rigid-limit")
+    require(scene, "fixedpoint", "rigid-limit")
+    kappas = tuple(float(k) for k in kappas)
+
+    def compute():
+        from walkerlab.analysis.contact_periodic import ideal_gait
+        from walkerlab.analysis.rigid_limit import convergence, observed_order
+        from walkerlab.contact.rigid_limit import expected_order
+        from walkerlab.contact.scene import build
+
+        ideal = ideal_gait(scene)
+        walker, _ = build(scene, ideal.x, 2)
+        tab = convergence(walker, ideal, kappas)
+        orders = {"period": observed_order(tab.kappa, tab.period_gap_s),
+                  "step_length": observed_order(tab.kappa, tab.step_gap_m)}
+        summary = {"kappa": tab.kappa.tolist(), "period_gap_s": tab.period_gap_s.tolist(),
+                   "step_gap_m": tab.step_gap_m.tolist(),
+                   "observed_order_period": orders["period"].tolist(),
+                   "observed_order_step_length": orders["step_length"].tolist(),
+                   "expected_order": expected_order(walker.contact.e)}
+
+        run = RigidLimitRun(tab, orders, summary["expected_order"])
+        return (lambda f: write_rigid_limit(f, run)), summary
+
+    return run_cached("rigid-limit", scene, runs_root, SECTIONS, (), compute, force,
+                      extra_key=repr(kappas))
+
+
+def draw(scene: Scene, runs_root: Path | str, path: Path) -> list[Path]:
+    """Draw ``rigid_limit.png/svg`` into the scene's figures folder from the artifact."""
+    from walkerlab.io.runpaths import figures_dir
+    from walkerlab.plotting.figures import save
+    from walkerlab.plotting.rigid_limit_figure import rigid_limit_figure
+
+    return save(rigid_limit_figure(load_rigid_limit(path), scene.name or "walker"),
+                figures_dir(scene, runs_root, claim=True), "rigid_limit")
