@@ -82,7 +82,7 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
     for lab, g in fp.gaits.items():
         mod = float(np.max(np.hypot(g.multipliers.real, g.multipliers.imag)))
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
-                     f"{g.step_period_s:.6f} s, max |multiplier| {mod:.4g}, "
+                     f"{g.step_period_s:.6f} {fp.units.time}, max |multiplier| {mod:.4g}, "
                      f"{'stable' if g.stable else 'UNSTABLE'} "
                      f"({_GAIT_SOURCES.get(g.source, g.source)})")
     notes = fp.gait_notes
@@ -91,11 +91,32 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
     return lines
 
 
+#: how a rigid run that did not complete its strides ended, as a verb
+_ENDED = {"fall": "fell", "solver_failure": "stopped by a solver failure",
+          "t_final": "stopped (a step took longer than max_step_time_s)",
+          "no_heel_strike": "made no step (no_heel_strike)"}
+
+
+def simulate_ending(sim: SimulateArtifact) -> str | None:
+    """``"fell after 17 heel strikes (8.5 strides of the 20 asked)"`` for a run that did not
+    complete its strides; None for one that did."""
+    if sim.termination == "heel_strike":
+        return None
+    n = sim.heel_strike_count()
+    return (f"{_ENDED.get(sim.termination, f'ended by {sim.termination}')} after {n} heel "
+            f"strike{'' if n == 1 else 's'} ({n / 2:g} strides of the "
+            f"{sim.strides_requested} asked)")
+
+
 def simulate_text(sim: SimulateArtifact) -> str:
-    """Steps completed, per-step period/length/speed, energy."""
+    """Steps completed, per-step period/length/speed, energy; for a run that did not
+    complete its strides, only how it ended (:func:`simulate_ending`)."""
+    ending = simulate_ending(sim)
+    if ending is not None:
+        return ending
     u, s = sim.units, sim.summary
     lines = [f"simulated {sim.strides_requested} strides: "
-             f"{sim.heel_strike_count()} heel strikes, ended by {sim.termination}"]
+             f"{sim.heel_strike_count()} heel strikes"]
     if u.nondimensional:
         lines.append(f"  ({u.sentence()})")
     lines.append(f"  mean step period  {num(s['mean_period_s'], 7)} {u.time}")
@@ -118,8 +139,17 @@ def contact_text(c: ContactSimArtifact) -> str:
         s = np.atleast_1d(c.initial_rate_scale)
         # per named coordinate: the rates of leg1 (swing) and leg2 (stance) at the start
         names = c.rate_names or ["leg1 rates", "leg2 rates"]
-        lines.append("adjusted initial rate scale (found by --adjust): "
-                     + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s)))
+        kept, why = str(c.adjust.get("kept", "adjusted")), str(c.adjust.get("kept_reason", ""))
+        found = np.atleast_1d(c.adjust.get("scale", s))
+        if kept == "scene":  # the adjusted start walked worse (issue 26, item 3)
+            lines.append("--adjust: kept the scene's initial rate scale ("
+                         + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
+                         + "), which walks better than the adjusted one ("
+                         + ", ".join(f"{v:.4g}" for v in found) + f"): {why}")
+        else:
+            lines.append("--adjust: kept the adjusted initial rate scale: "
+                         + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
+                         + (f" ({why})" if why else ""))
     for k, (v, unit) in c.summary.items():
         lines.append(f"  {k:<32s} {num(v)}" + (f" {unit}" if unit not in ("", "-") else ""))
     if "wall_time_s" in c.summary and np.isfinite(c.stage_wall_time_s):
@@ -130,8 +160,9 @@ def contact_text(c: ContactSimArtifact) -> str:
         lines.append(f"periodic contact gait: not found ({per.outcome}: {per.message})")
     elif per is not None:
         mult = per.multipliers
-        lines.append(f"periodic contact gait: step period {num(per.step_period_s, 6)} s, "
-                     f"step length {num(per.step_length_m, 6)} m, "
+        lines.append(f"periodic contact gait: step period {num(per.step_period_s, 6)} "
+                     f"{c.units.time}, step length {num(per.step_length_m, 6)} "
+                     f"{c.units.length}, "
                      f"{'stable' if per.stable else 'unstable'}")
         lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
                      + f" (+{len(mult) - 3} fast contact modes ~0)")

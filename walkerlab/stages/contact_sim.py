@@ -35,12 +35,17 @@ def _compute(scene: Scene, fixedpoint: Path, adjust: bool, periodic: bool):
     law, _terrain, cs = contact_scene.settings(scene)[:3]
     adj = scale = None
     if adjust:
-        from walkerlab.analysis.contact_adjust import adjust_rates
+        from walkerlab.analysis.contact_adjust import adjust_rates, better_start
 
         adj = adjust_rates(scene, fp.x, fp.step_period_s)
         scale = adj["scale"]
-    walker, res, x0, step_length = contact_run.simulate_from(scene, fp.x, fp.step_period_s,
-                                                             scale)
+    run = contact_run.simulate_from(scene, fp.x, fp.step_period_s, scale)
+    if adjust:  # the adjusted start must walk at least as well as the scene's own
+        plain = contact_run.simulate_from(scene, fp.x, fp.step_period_s, None)
+        adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
+        if adj["kept"] == "scene":
+            run, scale = plain, None
+    walker, res, x0, step_length = run
     gait = gait_error = None
     if periodic:
         from walkerlab.analysis.contact_periodic import (

@@ -95,32 +95,21 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
 
 def _draw(scene: Scene, runs_root, force: bool, part: str) -> str:
     """Draw one figure group (:data:`walkerlab.stages.plot.PARTS`) unless it was drawn from
-    the same artifacts by the same code; returns the line to print."""
+    the same artifact content by the same code (:func:`walkerlab.stages.plot.figures_key`:
+    matplotlib and ~16 PNG/SVG files are most of a rerun's time); returns the line to
+    print."""
+    from walkerlab.safefs import NotARegularFile, read_regular
     from walkerlab.stages import plot
 
-    stamp, key = _figures_key(scene, runs_root, part)
-    if not force and stamp.is_file() and stamp.read_text() == key:
-        return f"{'plot':>13s}: {part} figures reused (artifacts and code unchanged)"
-    figs = plot.run(scene, runs_root, parts=(part,))
-    from walkerlab.io.runpaths import atomic_text
-
-    atomic_text(stamp, key)  # atomic, never through a symbolic link
+    stamp, key = plot.figures_key(scene, runs_root, part)
+    try:  # bounded, non-blocking: a FIFO or a huge file in its place is no match
+        same = read_regular(stamp, 1 << 16, "figure stamp").decode() == key
+    except (OSError, NotARegularFile, UnicodeDecodeError):
+        same = False
+    if not force and same:
+        return f"{'plot':>13s}: {part} figures reused (drawn from these artifacts' content)"
+    figs = plot.run(scene, runs_root, parts=(part,))  # writes the stamp
     return f"{'plot':>13s}: {part}, {len([p for p in figs if p.suffix == '.png'])} figures"
-
-
-def _figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
-    """Stamp file of a drawn figure group and the key it must match: the stored input
-    hashes of the artifacts it is drawn from and walkerlab's code (a rerun with nothing
-    changed does not redraw: matplotlib and ~16 PNG/SVG files are most of a rerun's time)."""
-    import json
-
-    from walkerlab.io.artifacts import code_hash, stored_hash
-    from walkerlab.stages.plot import PARTS
-
-    arts = {stage: str(stored_hash(p)) for stage, p in existing_artifacts(scene, runs_root).items()
-            if stage in PARTS[part]}
-    return (figures_dir(scene, runs_root) / f".drawn_from_{part}",
-            json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True))
 
 
 #: why a report leaves out an artifact of a stage the scene does not run
@@ -137,9 +126,10 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bo
 
     Only artifacts this scene's report produced (``done``) are used: an artifact left in the
     run folder by an earlier standalone command (``walkerlab simulate`` on a scene without a
-    ``simulate`` section) is left out, and said so.  ``bifurcation.h5`` has no scene section
-    (the standalone ``walkerlab bifurcation`` makes it): it is shown when it was computed
-    for the scene's current walker, slope and solver.
+    ``simulate`` section) is left out, and said so.  ``bifurcation.h5`` and the
+    ``bifurcation_<field>.h5`` of ``bifurcation --param`` have no scene section (the
+    standalone ``walkerlab bifurcation`` makes them): each is shown when it was computed for
+    the scene's current walker, slope and solver.
     """
     produced = {o.stage for o in done}
     paths, left = {}, []
@@ -156,11 +146,15 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bo
                             "--full` measures it again)")
             else:
                 paths[stage] = p  # measured earlier (--full or `walkerlab workprecision`)
-        elif stage == "bifurcation":
+        elif stage == "bifurcation" or stage.startswith("bifurcation_"):  # and --param
+            from walkerlab.io.artifacts import stored_content_hash_matches
             from walkerlab.stages import bifurcation
             from walkerlab.stages.common import changed_fields
 
-            if changed_fields(p, scene, bifurcation.SECTIONS):
+            if not stored_content_hash_matches(p):  # edited by hand: never shown (issue 26)
+                left.append(f"{p.name} (changed after it was written: rerun 'walkerlab "
+                            "bifurcation')")
+            elif changed_fields(p, scene, bifurcation.SECTIONS):
                 left.append(f"{p.name} (computed for another walker, slope or solver)")
             else:
                 paths[stage] = p

@@ -40,6 +40,8 @@ class StabilityMapRun:
         :func:`walkerlab.sweep.stability.stable_fraction` of the cells.
     stiffness_family, unit_system : str
         Of the scene's contact law.
+    scene_point : (float, float), optional
+        The scene's own slope [deg] and y value (``scene_slope_deg``, ``scene_y``).
     """
 
     spec: object
@@ -49,6 +51,8 @@ class StabilityMapRun:
     unit_system: str
     cell_fields: tuple = ()
     y_label: str = ""
+    #: the scene's own point (slope [deg], y in the map's unit), marked on the map
+    scene_point: tuple[float, float] | None = None
 
 
 def write_stability_map(f, run: StabilityMapRun) -> None:
@@ -59,6 +63,8 @@ def write_stability_map(f, run: StabilityMapRun) -> None:
     f.attrs["stiffness_family"] = run.stiffness_family
     f.attrs["unit_system"] = run.unit_system
     f.attrs["time_limit_s"] = run.spec.time_limit_s
+    if run.scene_point is not None:  # marked on the map wherever the grid lies
+        f.attrs["scene_slope_deg"], f.attrs["scene_y"] = (float(v) for v in run.scene_point)
     f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "
                          "step map, continued from its neighbour along the slope, "
                          "else from the ideal fixed point at that slope")
