@@ -335,11 +335,13 @@ def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
     from walkerlab.stages import pipeline
 
     if rigid_limit:
+        from walkerlab.io.schemas.rigid_limit import load_rigid_limit
+        from walkerlab.report.text import rigid_limit_text
         from walkerlab.stages import rigid_limit as rl
 
         sc = _load(scene)
         out = rl.run(sc, runs_dir, force)
-        for line in rl.table_lines(out.path):
+        for line in rigid_limit_text(load_rigid_limit(out.path)):
             typer.echo(line)
         for p in rl.draw(sc, runs_dir, out.path):
             typer.echo(f"wrote {p}")

@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from walkerlab.io.schemas.compare import Comparison
-from walkerlab.io.schemas.contact_sim import ContactSimArtifact
-from walkerlab.io.schemas.fixedpoint import FixedPointArtifact
-from walkerlab.io.schemas.simulate import SimulateArtifact
-from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 from walkerlab.report.markdown import num
+
+if TYPE_CHECKING:  # the loaded artifacts these summaries print
+    from walkerlab.io.schemas.compare import Comparison
+    from walkerlab.io.schemas.contact_sim import ContactSimArtifact
+    from walkerlab.io.schemas.fixedpoint import FixedPointArtifact
+    from walkerlab.io.schemas.simulate import SimulateArtifact
+    from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 
 
 def _fmt_mult(re, im) -> str:
@@ -223,3 +227,23 @@ def workprecision_text(wp: WorkPrecisionArtifact) -> str:
     """One line per model of a workprecision artifact: its choice and the timing noise."""
     return "\n".join(f"{model}: {workprecision_choice(m.choice)}"
                      for model, m in wp.models.items())
+
+
+def rigid_limit_text(d: dict) -> list[str]:
+    """The convergence table of a loaded ``rigid_limit.h5`` (``d``:
+    :func:`walkerlab.io.schemas.rigid_limit.load_rigid_limit`): per ``kappa`` the period and
+    step-length gaps to the rigid gait [ms, mm], the stored observed orders, each multiplier."""
+    gT = d["period"] - d["rigid_period"]
+    gL = d["step_length"] - d["rigid_step_length"]
+    oT, oL = d["observed_order"]["period"], d["observed_order"]["step_length"]
+    lam = d["multipliers"]
+    head = (f"{'kappa':>8} {'period gap [ms]':>16} {'order':>6} {'step gap [mm]':>14} "
+            f"{'order':>6}  multipliers (rigid: "
+            + ", ".join(f"{x:.4f}" for x in d["rigid_multipliers"]) + ")")
+    out = [head]
+    for i, k in enumerate(d["kappa"]):
+        o1 = f"{oT[i - 1]:6.3f}" if i else " " * 6
+        o2 = f"{oL[i - 1]:6.3f}" if i else " " * 6
+        out.append(f"{k:8.3g} {gT[i] * 1e3:+16.4f} {o1} {gL[i] * 1e3:+14.4f} {o2}  "
+                   + ", ".join(f"{x:.4f}" for x in lam[i]))
+    return out

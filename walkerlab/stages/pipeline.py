@@ -88,15 +88,18 @@ def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **optio
     return mod.run(scene, runs_root, *args, **options)
 
 
-def report_plan(scene: Scene) -> list[str]:
+def report_plan(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order (its progress display and DAG):
     fixed point, rigid run, contact run, their comparison, the work-precision study, the
     basin of attraction, the robustness measures - each only when the scene has its
-    sections."""
+    sections; the work-precision study only with ``full`` (``walkerlab report --full``: it
+    times every solver setting, most of a cold report, and a shared machine's timings are
+    noise unless repeated; ``walkerlab workprecision`` runs it alone)."""
     sim, contact = scene.simulate is not None, scene.contact is not None
+    wp = full and getattr(scene, "workprecision", None) is not None
     return [n for n, on in (("fixedpoint", scene.fixedpoint is not None), ("simulate", sim),
                             ("contact-sim", contact), ("compare", contact and sim),
-                            ("workprecision", getattr(scene, "workprecision", None) is not None),
+                            ("workprecision", wp),
                             ("basin", scene.basin is not None and scene.fixedpoint is not None),
                             ("robustness", scene.robustness is not None
                              and scene.fixedpoint is not None))

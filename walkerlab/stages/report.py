@@ -1,6 +1,10 @@
-"""Stage ``report``: run what the scene needs (reusing up-to-date artifacts), draw the
-figures, then hand the artifacts to :func:`walkerlab.report.build.write_report`, which writes
-``runs/<scene>/report/report.html`` (self-contained) and ``report.md``.
+"""Stage ``report``: run the stages of the scene's plan (:func:`walkerlab.stages.pipeline.
+report_plan`, reusing up-to-date artifacts), draw the figures, load the artifacts through
+:mod:`walkerlab.io.schemas` and compute what the report states from them (Table 3, energy
+drift, swing-foot clearance: :func:`load_inputs`), then hand them to
+:func:`walkerlab.report.build.write_report`, which writes ``runs/<scene>/report/report.html``
+(self-contained) and ``report.md``.  The work-precision study runs in a background thread
+on cores of its own (:class:`walkerlab.execution.background.BackgroundStudy`).
 
 Sections appear only when the scene produces their data (artifacts an earlier standalone
 command left in the run folder are left out, in one line): an ideal-only scene gets an
@@ -26,14 +30,6 @@ REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecis
                  "bifurcation", "basin", "robustness")
 
 
-def planned_stages(scene: Scene, full: bool = False) -> list[str]:
-    """The stages ``report`` runs for this scene, in order (:func:`walkerlab.stages.pipeline.
-    report_plan`); the work-precision study only with ``full`` (``walkerlab report --full``):
-    it times every solver setting (~30 s of a ~33 s cold report, issue 25) and a shared
-    machine's timings are noise unless repeated; ``walkerlab workprecision`` runs it alone."""
-    return [s for s in report_plan(scene) if full or s != "workprecision"]
-
-
 def _study(scene: Scene, runs_root, force: bool):
     """The work-precision stage in a thread of the report, overlapping the untimed stages
     (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
@@ -50,7 +46,7 @@ def _study(scene: Scene, runs_root, force: bool):
 
 def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
                 full: bool = False) -> list[StageOutcome]:
-    plan = planned_stages(scene, full)
+    plan = report_plan(scene, full)
     done: list[StageOutcome] = []
 
     def add(o: StageOutcome) -> None:
@@ -189,7 +185,7 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         echo: Callable[[str], None] = print, full: bool = False) -> Path:
     """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
-    ``full``: also the work-precision study (:func:`planned_stages`).
+    ``full``: also the work-precision study (:func:`walkerlab.stages.pipeline.report_plan`).
 
     Returns
     -------
@@ -198,7 +194,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     from walkerlab import progress
 
-    stages = planned_stages(scene, full)
+    stages = report_plan(scene, full)
     with progress.task(f"report: {len(stages)} stages ({', '.join(stages)})",
                        len(stages)) as bar:
         done = _run_stages(scene, runs_root, force, echo, bar, full)

@@ -19,6 +19,8 @@ from walkerlab.io.schemas.stability_map import (
 )
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.sweep.stability import (
+    CELL_FIELDS,
+    MAP_KINDS,
     MapSpec,
     default_spec,
     gait_map,
@@ -86,7 +88,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
 
         run = StabilityMapRun(spec, cells, frac, scene.contact.stiffness_family,
-                              scene.contact.unit_system,
+                              scene.contact.unit_system, CELL_FIELDS, MAP_KINDS[spec.kind][1],
                               (math.degrees(scene.slope.phi_rad),
                                _scene_value(scene, spec.y_path)))
         return (lambda f: write_stability_map(f, run)), summary
