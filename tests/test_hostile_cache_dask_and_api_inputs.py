@@ -24,6 +24,8 @@ PAPER = ROOT / "configs" / "paper.yaml"
 def _env(tmp_path: Path, **extra) -> dict:
     env = {**os.environ, "PYTHONPATH": str(ROOT), **extra}
     env.pop("WALKERLAB_DEBUG", None)
+    if "WALKERLAB_CACHE_DIR" in extra:  # an earlier test in this process may have set numba's
+        env.pop("NUMBA_CACHE_DIR", None)  # folder: the child derives it from the cache given
     return env
 
 
