@@ -329,7 +329,8 @@ def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 
 
 def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None,
                    units: Units = SI_UNITS):
-    """Work-precision diagram: error vs wall time (log-log), one line per method; the
+    """Work-precision diagram: error vs CPU time of the integration (log-log; older
+    artifacts: wall time), one line per method; the
     spread of the repeats (``time_min``..``time_max``) as horizontal bars, the tolerance
     next to each point where its label does not cover another.  The error is in the
     scene's units (``units``: rad, rad/s or rad/√(l/g)); the wall time in real seconds."""
@@ -346,8 +347,10 @@ def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: l
                                                              d["rtol"][ok])]
     if pareto:
         pt = np.array([(p["time"], p["error"]) for p in pareto])
-        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (median times)")
-    ax.set_xlabel("wall time [s] (median of repeats; bars: fastest to slowest run)")
+        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (beyond the spread)")
+    clock = ("CPU time of the integration" if any("wall_time" in d for d in rows.values())
+             else "wall time")
+    ax.set_xlabel(f"{clock} [s] (median of repeats; bars: fastest to slowest run)")
     ax.set_ylabel(f"max state error vs reference [rad, {units.rate}]")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
