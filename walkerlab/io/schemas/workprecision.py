@@ -4,8 +4,8 @@ Layout: one group per model (``ideal``, ``contact``), one subgroup per method wi
 row per relative tolerance: ``rtol``, ``time`` (median CPU time of the integration alone
 over the repeats [s]), ``time_min``, ``time_max`` (fastest and slowest repeat [s]),
 ``wall_time`` (median wall time of the whole run [s]), ``repeats``, ``error`` (max-norm
-error against the reference run), ``nfev``; the model group's attributes hold the reference setting, the
-Pareto front (``pareto_methods/rtol/time/error``), the fastest setting reaching the target
+error against the reference run), ``nfev``; the model group's attributes hold the
+reference setting, the Pareto front (``pareto_methods/rtol/time/error``), the fastest setting reaching the target
 error (``best_*``), the settings the timing noise cannot separate from it (``tied_*``) and
 ``target_error``.  Root attributes: ``timing``, ``cases_reused_from_cache``,
 ``cases_total``.
