@@ -5,10 +5,10 @@ row per relative tolerance: ``rtol``, ``time`` (median CPU time of the integrati
 over the repeats [s]), ``time_min``, ``time_max`` (fastest and slowest repeat [s]),
 ``wall_time`` (median wall time of the whole run [s]), ``repeats``, ``error`` (max-norm
 error against the reference run), ``nfev``; the model group's attributes hold the
-reference setting, the Pareto front (``pareto_methods/rtol/time/error``), the fastest setting reaching the target
-error (``best_*``), the settings the timing noise cannot separate from it (``tied_*``) and
-``target_error``.  Root attributes: ``timing``, ``cases_reused_from_cache``,
-``cases_total``.
+reference setting, the Pareto front (``pareto_methods/rtol/time/error``), the fastest
+setting reaching the target error (``best_*``), the settings the timing noise cannot
+separate from it (``tied_*``) and ``target_error``.  Root attributes: ``timing``,
+``cases_reused_from_cache``, ``cases_total``.
 """
 
 from __future__ import annotations
