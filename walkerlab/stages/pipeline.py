@@ -15,6 +15,7 @@ compare         simulate, contact-sim
 workprecision   fixedpoint
 basin           fixedpoint
 mfpt            fixedpoint
+attribution     fixedpoint
 animate         simulate
 ==============  ====================================================================
 """
@@ -29,7 +30,7 @@ from walkerlab.config import Scene
 #: module of each stage under walkerlab.stages
 MODULES = {"fixedpoint": "fixedpoint", "simulate": "simulate", "contact-sim": "contact_sim",
            "compare": "compare", "workprecision": "workprecision", "basin": "basin",
-           "animate": "animate", "mfpt": "mfpt"}
+           "animate": "animate", "mfpt": "mfpt", "attribution": "attribution"}
 
 
 def needs(stage: str, scene: Scene) -> tuple[str, ...]:
@@ -39,7 +40,7 @@ def needs(stage: str, scene: Scene) -> tuple[str, ...]:
         return ("fixedpoint",) if sim is None or sim.initial_state == "fixed_point" else ()
     return {"contact-sim": ("fixedpoint",), "compare": ("simulate", "contact-sim"),
             "workprecision": ("fixedpoint",), "basin": ("fixedpoint",),
-            "mfpt": ("fixedpoint",),
+            "mfpt": ("fixedpoint",), "attribution": ("fixedpoint",),
             "animate": ("simulate",)}.get(stage, ())
 
 
@@ -89,10 +90,13 @@ def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **optio
 def report_plan(scene: Scene) -> list[str]:
     """The stages ``report`` runs for this scene, in order (its progress display and DAG):
     fixed point, rigid run, contact run, their comparison, the work-precision study, the
-    basin of attraction - each only when the scene has its sections."""
+    basin of attraction, the Section-5 attribution - each only when the scene has its
+    sections (the report runs the work-precision study and the attribution only with
+    ``--full``: :func:`walkerlab.stages.report.planned_stages`)."""
     sim, contact = scene.simulate is not None, scene.contact is not None
     return [n for n, on in (("fixedpoint", scene.fixedpoint is not None), ("simulate", sim),
                             ("contact-sim", contact), ("compare", contact and sim),
                             ("workprecision", getattr(scene, "workprecision", None) is not None),
-                            ("basin", scene.basin is not None and scene.fixedpoint is not None))
+                            ("basin", scene.basin is not None and scene.fixedpoint is not None),
+                            ("attribution", contact and scene.fixedpoint is not None))
             if on]

@@ -23,15 +23,19 @@ from walkerlab.stages.pipeline import report_plan, stage_module
 from walkerlab.stages.plot import figures_dir
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation", "basin")
+                 "bifurcation", "basin", "attribution")
+#: stages the report runs only with ``--full`` (an up-to-date artifact is shown without it)
+OPT_IN = ("workprecision", "attribution")
 
 
 def planned_stages(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order (:func:`walkerlab.stages.pipeline.
-    report_plan`); the work-precision study only with ``full`` (``walkerlab report --full``):
-    it times every solver setting (~30 s of a ~33 s cold report, issue 25) and a shared
-    machine's timings are noise unless repeated; ``walkerlab workprecision`` runs it alone."""
-    return [s for s in report_plan(scene) if full or s != "workprecision"]
+    report_plan`); the work-precision study and the Section-5 attribution only with
+    ``full`` (``walkerlab report --full``): the study times every solver setting (~30 s of
+    a ~33 s cold report, issue 25) and a shared machine's timings are noise unless
+    repeated (``walkerlab workprecision`` runs it alone); the attribution is seven
+    periodic-gait searches and three runs (~17 s CPU on the paper scene)."""
+    return [s for s in report_plan(scene) if full or s not in OPT_IN]
 
 
 def _study(scene: Scene, runs_root, force: bool):
@@ -84,6 +88,8 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
     if "basin" in plan:
         # after the study: its worker processes would share the timed cases' cores
         add(stage_module("basin").run(scene, runs_root, force))
+    if "attribution" in plan:  # after the study, too (its timed cases own their cores)
+        add(stage_module("attribution").run(scene, runs_root, force))
     for o in done:
         status = ("reused (inputs unchanged)" if o.reused and not o.note else
                   f"reused ({o.note})" if o.reused else
@@ -132,7 +138,8 @@ _NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' 
             "contact-sim": "no 'contact' section",
             "compare": "needs both a 'simulate' and a 'contact' section",
             "workprecision": "no 'workprecision' section",
-            "basin": "no 'basin' section (or no 'fixedpoint')"}
+            "basin": "no 'basin' section (or no 'fixedpoint')",
+            "attribution": "no 'contact' or 'fixedpoint' section"}
 
 
 def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
@@ -160,6 +167,15 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bo
                             "--full` measures it again)")
             else:
                 paths[stage] = p  # measured earlier (--full or `walkerlab workprecision`)
+        elif stage == "attribution" and scene.contact is not None and not full:
+            from walkerlab.stages import attribution
+            from walkerlab.stages.common import changed_fields
+
+            if changed_fields(p, scene, attribution.SECTIONS):
+                left.append(f"{p.name} (computed for other settings; `walkerlab report "
+                            "--full` computes it again)")
+            else:
+                paths[stage] = p  # computed earlier (--full)
         elif stage == "bifurcation":
             from walkerlab.stages import bifurcation
             from walkerlab.stages.common import changed_fields
@@ -192,7 +208,7 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         echo: Callable[[str], None] = print, full: bool = False) -> Path:
     """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
-    ``full``: also the work-precision study (:func:`planned_stages`).
+    ``full``: also the work-precision study and the attribution (:func:`planned_stages`).
 
     Returns
     -------
@@ -208,6 +224,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     paths, left_out = report_artifacts(scene, runs_root, done, full)
     if getattr(scene, "workprecision", None) is not None and "workprecision" not in paths:
         echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
+    if scene.contact is not None and scene.fixedpoint is not None \
+            and "attribution" not in paths:
+        echo(f"{'attribution':>13s}: not computed (opt-in, ~17 s CPU on the paper scene: "
+             "`walkerlab report --full`)")
     if left_out:
         echo(left_out)
     rep_dir = report_dir(scene, runs_root, claim=True)
@@ -223,6 +243,7 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
     from walkerlab.analysis.gait_checks import energy_drift_in_swing, swing_foot_clearance
     from walkerlab.analysis.tables import table3
     from walkerlab.io.schemas import (
+        attribution,
         basin,
         bifurcation,
         compare,
@@ -235,7 +256,8 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
 
     loaders = {"fixedpoint": fixedpoint.load_fixedpoint, "simulate": simulate.load_simulate,
                "contact-sim": contact_sim.load_contact_sim, "compare": compare.load_compare,
-               "workprecision": workprecision.load_workprecision, "basin": basin.load_basin}
+               "workprecision": workprecision.load_workprecision, "basin": basin.load_basin,
+               "attribution": attribution.load_attribution}
     arts: dict = {}
     for key, p in paths.items():
         load = (bifurcation.load_bifurcation_summary if key.startswith("bifurcation")
