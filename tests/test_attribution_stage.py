@@ -24,8 +24,9 @@ def _fake_run():
 
 
 def test_attribution_artifact_round_trip_and_report_section(tmp_path):
-    """Writer -> loader keeps every number; the section reads the loaded object, in the scene's units, and says the paper's x1.1 start lies outside the
-    rigid walker's basin (the rigid run fell after 2 heel strikes)."""
+    """Writer -> loader keeps every number; the section reads the loaded object, in the
+    scene's units, and says the paper's x1.1 start lies outside the rigid walker's basin
+    (the rigid run fell after 2 heel strikes)."""
     from walkerlab.io.artifacts import write_artifact
     from walkerlab.io.schemas.attribution import load_attribution, write_attribution
     from walkerlab.report.attribution_section import attribution_section
