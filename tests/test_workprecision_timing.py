@@ -45,3 +45,35 @@ def test_pareto_front_keeps_only_differences_beyond_the_spread():
             assert hi[a] < lo[b] or hi[b] < lo[a]
     # a failed run (inf error) is never on the front
     assert 0 not in pareto_front(t, np.array([np.inf, 1e-8, 1e-10, 1e-4]), lo, hi)
+
+
+def test_work_precision_labels_cover_no_label_legend_or_other_marker():
+    """Seven methods x ten tolerances crowded into one decade of time (as the paper's
+    ideal study is): every tolerance label that is drawn covers no other label, not the
+    legend and not another setting's marker (4 px half-width)."""
+    from walkerlab.plotting import figures as F
+
+    rng = np.random.default_rng(0)
+    rows = {}
+    for k in range(7):
+        rt = 10.0 ** -np.arange(3, 13)
+        t = 0.01 * (1 + 0.3 * k) * (1 + 0.2 * np.arange(10)) * rng.uniform(0.95, 1.05, 10)
+        rows[f"M{k}"] = {"rtol": rt, "time": t, "time_min": 0.9 * t, "time_max": 1.1 * t,
+                         "error": rt * (1 + k), "wall_time": 2 * t}
+    fig = F.work_precision(rows, "t")
+    ax = fig.axes[0]
+    r = fig.canvas.get_renderer()
+    boxes = [t.get_window_extent(r) for t in ax.texts]
+    legend = ax.get_legend().get_window_extent(r)
+    assert 10 <= len(boxes) < 70  # crowded: some labels had to go
+    assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    assert not any(b.overlaps(legend) for b in boxes)
+    pts = ax.transData.transform(np.concatenate(
+        [np.c_[d["time"], d["error"]] for d in rows.values()]))
+    for t, b in zip(ax.texts, boxes):
+        own = ax.transData.transform(np.asarray(t.xy, float)[None])[0]
+        for px, py in pts:
+            if np.hypot(px - own[0], py - own[1]) > 1e-6:  # another setting's marker
+                assert not (b.x0 - 4 < px < b.x1 + 4 and b.y0 - 4 < py < b.y1 + 4)
+    assert "CPU time of the integration" in ax.get_xlabel()
+    F.plt.close(fig)

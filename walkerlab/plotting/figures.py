@@ -306,20 +306,34 @@ def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
     return fig
 
 
-def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 6) -> list:
+def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 6,
+                  avoid_legend: bool = False, marker_px: float = 0.0) -> list:
     """Annotate ``(x, y, text)`` points, skipping a label whose box would overlap one
-    already placed (tried at four offsets first): labels never cover each other."""
+    already placed (tried at four offsets first): labels never cover each other.
+
+    ``avoid_legend``: a label never covers the legend either; ``marker_px`` > 0: nor the
+    marker of another point (a square of that half-width [px] around it)."""
+    from matplotlib.transforms import Bbox
+
     fig = ax.figure
     fig.canvas.draw()  # a renderer and the final axis limits
     renderer = fig.canvas.get_renderer()
     placed, boxes = [], []
-    for x, y, text in points:
+    leg = ax.get_legend()
+    if avoid_legend and leg is not None:
+        boxes.append(leg.get_window_extent(renderer))
+    pix = ax.transData.transform(np.array([(x, y) for x, y, _ in points], float)
+                                 ) if points else np.zeros((0, 2))
+    markers = [Bbox.from_extents(px - marker_px, py - marker_px, px + marker_px,
+                                 py + marker_px) for px, py in pix] if marker_px > 0 else []
+    for k, (x, y, text) in enumerate(points):
+        others = boxes + [m for j, m in enumerate(markers) if j != k]
         for dx, dy, ha, va in ((4, 3, "left", "bottom"), (4, -3, "left", "top"),
                                (-4, 3, "right", "bottom"), (-4, -3, "right", "top")):
             a = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
                             fontsize=fontsize, alpha=0.7, ha=ha, va=va)
             bb = a.get_window_extent(renderer).expanded(1.05, 1.1)
-            if not any(bb.overlaps(b) for b in boxes):
+            if not any(bb.overlaps(b) for b in others):
                 boxes.append(bb)
                 placed.append(a)
                 break
@@ -355,5 +369,6 @@ def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: l
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
     _legend(ax)
-    _place_labels(ax, labels)
+    # labels cover neither each other, nor the legend, nor another setting's marker
+    _place_labels(ax, labels, avoid_legend=True, marker_px=4.0)
     return fig
