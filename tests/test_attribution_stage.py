@@ -49,14 +49,13 @@ def test_attribution_artifact_round_trip_and_report_section(tmp_path):
 def test_report_runs_attribution_only_with_full():
     """Opt-in: the default report plan leaves it out, ``--full`` runs it (contact scenes)."""
     from walkerlab.stages.pipeline import needs, report_plan
-    from walkerlab.stages.report import planned_stages
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
-    assert "attribution" in report_plan(scene) and needs("attribution", scene) == ("fixedpoint",)
-    assert "attribution" not in planned_stages(scene)
-    assert planned_stages(scene, full=True)[-1] == "attribution"
+    assert needs("attribution", scene) == ("fixedpoint",)
+    assert "attribution" not in report_plan(scene)
+    assert report_plan(scene, full=True)[-1] == "attribution"
     ideal_only = scene.model_copy(update={"contact": None})
-    assert "attribution" not in report_plan(ideal_only)
+    assert "attribution" not in report_plan(ideal_only, full=True)
 
 
 def test_attribution_stage_writes_and_reuses(tmp_path, monkeypatch):

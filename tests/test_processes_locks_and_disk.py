@@ -346,7 +346,8 @@ def test_i3_basin_partial_symlink_is_one_line_error(tmp_path):
     (runs / "paper").mkdir(parents=True)
     victim = tmp_path / "victim.txt"
     victim.write_text("precious\n")
-    (runs / "paper" / "basin.h5.partial").symlink_to(victim)
+    # --grid 2x2 (not the scene's grid) writes basin_2x2.h5 (issue 26, item 6)
+    (runs / "paper" / "basin_2x2.h5.partial").symlink_to(victim)
     code, err, _ = _cli("basin", ROOT / "configs" / "paper.yaml", "--grid", "2x2",
                         "--workers", "1", "--runs-dir", runs)
     assert code == 1 and "symbolic link" in err and "\n" not in err, err

@@ -21,6 +21,7 @@ from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections
 from walkerlab.report.markdown import details, num, table, text, to_html
+from walkerlab.report.robustness_section import robustness_section
 from walkerlab.units import for_scene as units_for_scene
 
 
@@ -112,6 +113,7 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     md += sections.workprecision_summary(scene, arts)
     md += sections.bifurcation_section(arts, pub)
     md += sections.basin_section(arts)
+    md += robustness_section(arts)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
     md += sections.figures_section(Path(figures_dir), str(rel), arts)

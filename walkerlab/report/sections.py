@@ -12,15 +12,18 @@ from __future__ import annotations
 
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from walkerlab.analysis.tables import TABLE3_ROWS
-from walkerlab.io.schemas.simulate import SimulateArtifact
-from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 from walkerlab.report.markdown import details, num, printed, sig_digits, table
 from walkerlab.report.text import workprecision_choice, zero_multipliers_text
 from walkerlab.units import Units, for_scene
+
+if TYPE_CHECKING:  # loaded artifacts (walkerlab.io.schemas)
+    from walkerlab.io.schemas.simulate import SimulateArtifact
+    from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 
 
 # --------------------------------------------------------------------------- data

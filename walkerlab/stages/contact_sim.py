@@ -44,8 +44,9 @@ def _compute(scene: Scene, fixedpoint: Path, adjust: bool, periodic: bool):
     law, _terrain, cs = contact_scene.settings(scene)[:3]
     adj = scale = None
     gait = gait_error = None
-    if adjust or cs.start == "adjusted":
-        from walkerlab.analysis.contact_adjust import adjust_rates
+    adjust = adjust or cs.start == "adjusted"
+    if adjust:
+        from walkerlab.analysis.contact_adjust import adjust_rates, better_start
 
         adj = adjust_rates(scene, fp.x, fp.step_period_s)
         scale = adj["scale"]
@@ -60,8 +61,13 @@ def _compute(scene: Scene, fixedpoint: Path, adjust: bool, periodic: bool):
                              f"contact walker's periodic gait was not found ({exc})") from None
         scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
     else:
-        walker, res, x0, step_length = contact_run.simulate_from(scene, fp.x,
-                                                                 fp.step_period_s, scale)
+        run = contact_run.simulate_from(scene, fp.x, fp.step_period_s, scale)
+        if adjust:  # the adjusted start must walk at least as well as the scene's own
+            plain = contact_run.simulate_from(scene, fp.x, fp.step_period_s, None)
+            adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
+            if adj["kept"] == "scene":
+                run, scale = plain, None
+        walker, res, x0, step_length = run
     if periodic and gait is None:
         from walkerlab.analysis.contact_periodic import (
             PeriodicGaitError,

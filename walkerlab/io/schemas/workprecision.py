@@ -35,6 +35,9 @@ class WorkPrecisionRun:
         (:func:`walkerlab.analysis.workprecision.summarize`), the reference setting.
     cases_reused, cases_total : int
     target_error, contact_target_error : float
+    single_run_s : float
+        A case slower than this [s] is timed once
+        (:data:`walkerlab.analysis.workprecision.SINGLE_RUN_S`).
     """
 
     results: dict
@@ -42,12 +45,11 @@ class WorkPrecisionRun:
     cases_total: int
     target_error: float
     contact_target_error: float
+    single_run_s: float
 
 
 def write_workprecision(f, run: WorkPrecisionRun) -> None:
     """Fill an open (in-memory) artifact with ``run`` (layout in the module docstring)."""
-    from walkerlab.analysis.workprecision import SINGLE_RUN_S
-
     for model, (rows, summ, ref) in run.results.items():
         g = f.create_group(model)
         g.attrs["reference_method"], g.attrs["reference_rtol"] = ref[:2]
@@ -62,7 +64,7 @@ def write_workprecision(f, run: WorkPrecisionRun) -> None:
             put(g, f"{m}/wall_time", d["wall_time"], "s", "median wall time of the whole "
                 "run (set-up included; shared cores make it noisy)", clock="wall")
             put(g, f"{m}/repeats", d["repeats"], "-", "timed runs (1 when a run "
-                f"takes > {SINGLE_RUN_S:g} s)")
+                f"takes > {run.single_run_s:g} s)")
             put(g, f"{m}/error", d["error"], "rad, rad/s (, s)",
                 "max-norm error vs the reference (inf: run failed)")
             put(g, f"{m}/nfev", d["nfev"], "-", "RHS evaluations")
