@@ -1,5 +1,7 @@
 """Contact runs started from the contact model's own periodic gait (issue 25, item 4)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -48,3 +50,27 @@ def test_start_setting_is_typed_and_the_default_keeps_the_scene_hash():
     d["contact_sim"]["start"] = "steady"
     with pytest.raises((SceneError, ValueError), match="start"):
         scene_from_dict(d)
+
+
+@pytest.mark.slow  # the contact-sim stage from the periodic gait (~5 s CPU)
+def test_contact_sim_stage_starts_from_the_periodic_gait(tmp_path):
+    """``contact_sim.start: periodic_gait`` through the stage: the artifact stores the gait
+    it started from, the run walks, its first heel strike comes about half a period after
+    the start (mid-stance) and every full step lasts the gait's period (tolerance as in
+    the test above)."""
+    import yaml
+
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
+    from walkerlab.stages import pipeline
+
+    d = yaml.safe_load(Path("configs/paper.yaml").read_text())
+    d["contact_sim"].update({"start": "periodic_gait", "n_strides": 1})
+    p = tmp_path / "paper_steady.yaml"
+    p.write_text(yaml.safe_dump(d))
+    out = pipeline.run("contact-sim", load_scene(p), tmp_path / "runs")
+    assert not out.failure
+    cs = load_contact_sim(out.path)
+    assert cs.periodic is not None and cs.periodic.found
+    hs = cs.heel_strike_times
+    assert hs.size == 3 and hs[0] < 0.6 * cs.periodic.step_period_s  # started mid-stance
+    assert np.all(np.abs(np.diff(hs) - cs.periodic.step_period_s) < 2e-5)
