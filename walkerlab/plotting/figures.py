@@ -342,20 +342,34 @@ def _hip_height(tr: NamedTrajectory) -> float:
     return max(float(np.hypot(*(p[:, 0] - hip))) for p in tr.points.values()) or 1.0
 
 
-def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 6) -> list:
+def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 6,
+                  avoid_legend: bool = False, marker_px: float = 0.0) -> list:
     """Annotate ``(x, y, text)`` points, skipping a label whose box would overlap one
-    already placed (tried at four offsets first): labels never cover each other."""
+    already placed (tried at four offsets first): labels never cover each other.
+
+    ``avoid_legend``: a label never covers the legend either; ``marker_px`` > 0: nor the
+    marker of another point (a square of that half-width [px] around it)."""
+    from matplotlib.transforms import Bbox
+
     fig = ax.figure
     fig.canvas.draw()  # a renderer and the final axis limits
     renderer = fig.canvas.get_renderer()
     placed, boxes = [], []
-    for x, y, text in points:
+    leg = ax.get_legend()
+    if avoid_legend and leg is not None:
+        boxes.append(leg.get_window_extent(renderer))
+    pix = ax.transData.transform(np.array([(x, y) for x, y, _ in points], float)
+                                 ) if points else np.zeros((0, 2))
+    markers = [Bbox.from_extents(px - marker_px, py - marker_px, px + marker_px,
+                                 py + marker_px) for px, py in pix] if marker_px > 0 else []
+    for k, (x, y, text) in enumerate(points):
+        others = boxes + [m for j, m in enumerate(markers) if j != k]
         for dx, dy, ha, va in ((4, 3, "left", "bottom"), (4, -3, "left", "top"),
                                (-4, 3, "right", "bottom"), (-4, -3, "right", "top")):
             a = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
                             fontsize=fontsize, alpha=0.7, ha=ha, va=va)
             bb = a.get_window_extent(renderer).expanded(1.05, 1.1)
-            if not any(bb.overlaps(b) for b in boxes):
+            if not any(bb.overlaps(b) for b in others):
                 boxes.append(bb)
                 placed.append(a)
                 break
@@ -365,7 +379,8 @@ def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 
 
 def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None,
                    units: Units = SI_UNITS):
-    """Work-precision diagram: error vs wall time (log-log), one line per method; the
+    """Work-precision diagram: error vs CPU time of the integration (log-log; older
+    artifacts: wall time), one line per method; the
     spread of the repeats (``time_min``..``time_max``) as horizontal bars, the tolerance
     next to each point where its label does not cover another.  The error is in the
     scene's units (``units``: rad, rad/s or rad/√(l/g)); the wall time in real seconds."""
@@ -382,11 +397,14 @@ def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: l
                                                              d["rtol"][ok])]
     if pareto:
         pt = np.array([(p["time"], p["error"]) for p in pareto])
-        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (median times)")
-    ax.set_xlabel("wall time [s] (median of repeats; bars: fastest to slowest run)")
+        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (beyond the spread)")
+    clock = ("CPU time of the integration" if any("wall_time" in d for d in rows.values())
+             else "wall time")
+    ax.set_xlabel(f"{clock} [s] (median of repeats; bars: fastest to slowest run)")
     ax.set_ylabel(f"max state error vs reference [rad, {units.rate}]")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
     _legend(ax)
-    _place_labels(ax, labels)
+    # labels cover neither each other, nor the legend, nor another setting's marker
+    _place_labels(ax, labels, avoid_legend=True, marker_px=4.0)
     return fig

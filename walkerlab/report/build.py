@@ -94,6 +94,8 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
     pub = for_scene(scene)
+    from walkerlab.report.attribution_section import attribution_section
+
     md = _header(scene)
     arts = inputs.artifacts
     md += sections.summary_section(scene, inputs, pub)
@@ -107,6 +109,7 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
         md += sections.fixedpoint_section(arts["fixedpoint"], pub)
     md += sections.gait_section(scene, inputs, pub)
     md += contact_sections.sections(scene, arts)
+    md += attribution_section(scene, arts)
     md += sections.workprecision_summary(scene, arts)
     md += sections.bifurcation_section(arts, pub)
     md += sections.basin_section(arts)

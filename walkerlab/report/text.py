@@ -210,7 +210,7 @@ def workprecision_choice(attrs) -> str:
     if "best_separated" not in attrs:  # an artifact from before the spread was stored
         return (f"fastest median run reaching the target error {target}: {name} "
                 f"({_ms(attrs['best_time'])}; timing spread not recorded).")
-    spread = (f"median {_ms(attrs['best_time'])}, {_ms(attrs['best_time_min'])}–"
+    spread = (f"median {_ms(attrs['best_time'])} CPU, {_ms(attrs['best_time_min'])}–"
               f"{_ms(attrs['best_time_max'])} over {int(attrs['best_repeats'])} runs")
     if bool(attrs["best_separated"]):
         return (f"fastest setting reaching the target error {target}: **{name}** ({spread}; "
@@ -219,8 +219,9 @@ def workprecision_choice(attrs) -> str:
         attrs["tied_methods"], attrs["tied_rtol"], attrs["tied_time_min"],
         attrs["tied_time_max"])]
     return (f"the timings cannot separate the settings reaching the target error {target}: "
-            + ", ".join(tied) + " (min–max wall time over the repeats overlap, or a setting "
-            "was timed once); the lowest median is " + name + ".")
+            + ", ".join(tied) + " (min–max CPU time of the integration over the repeats "
+            "overlap, or a setting was timed once): indistinguishable; the lowest median is "
+            + name + ".")
 
 
 def workprecision_text(wp: WorkPrecisionArtifact) -> str:

@@ -27,7 +27,7 @@ from walkerlab.stages.pipeline import report_plan, stage_module
 from walkerlab.stages.plot import figures_dir
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation", "basin", "robustness")
+                 "bifurcation", "basin", "robustness", "attribution")
 
 
 def _study(scene: Scene, runs_root, force: bool):
@@ -82,6 +82,8 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
         add(stage_module("basin").run(scene, runs_root, force))
     if "robustness" in plan:
         add(stage_module("robustness").run(scene, runs_root, force))
+    if "attribution" in plan:  # after the study, too (its timed cases own their cores)
+        add(stage_module("attribution").run(scene, runs_root, force))
     for o in done:
         status = ("reused (inputs unchanged)" if o.reused and not o.note else
                   f"reused ({o.note})" if o.reused else
@@ -120,7 +122,8 @@ _NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' 
             "compare": "needs both a 'simulate' and a 'contact' section",
             "workprecision": "no 'workprecision' section",
             "basin": "no 'basin' section (or no 'fixedpoint')",
-            "robustness": "no 'robustness' section (or no 'fixedpoint')"}
+            "robustness": "no 'robustness' section (or no 'fixedpoint')",
+            "attribution": "no 'contact' or 'fixedpoint' section"}
 
 
 def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
@@ -149,6 +152,15 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bo
                             "--full` measures it again)")
             else:
                 paths[stage] = p  # measured earlier (--full or `walkerlab workprecision`)
+        elif stage == "attribution" and scene.contact is not None and not full:
+            from walkerlab.stages import attribution
+            from walkerlab.stages.common import changed_fields
+
+            if changed_fields(p, scene, attribution.SECTIONS):
+                left.append(f"{p.name} (computed for other settings; `walkerlab report "
+                            "--full` computes it again)")
+            else:
+                paths[stage] = p  # computed earlier (--full)
         elif stage == "bifurcation" or stage.startswith("bifurcation_"):  # and --param
             from walkerlab.io.artifacts import stored_content_hash_matches
             from walkerlab.stages import bifurcation
@@ -185,7 +197,8 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         echo: Callable[[str], None] = print, full: bool = False) -> Path:
     """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
-    ``full``: also the work-precision study (:func:`walkerlab.stages.pipeline.report_plan`).
+    ``full``: also the work-precision study and the attribution
+    (:func:`walkerlab.stages.pipeline.report_plan`).
 
     Returns
     -------
@@ -201,6 +214,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     paths, left_out = report_artifacts(scene, runs_root, done, full)
     if getattr(scene, "workprecision", None) is not None and "workprecision" not in paths:
         echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
+    if scene.contact is not None and scene.fixedpoint is not None \
+            and "attribution" not in paths:
+        echo(f"{'attribution':>13s}: not computed (opt-in, ~17 s CPU on the paper scene: "
+             "`walkerlab report --full`)")
     if left_out:
         echo(left_out)
     rep_dir = report_dir(scene, runs_root, claim=True)
@@ -216,6 +233,7 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
     from walkerlab.analysis.gait_checks import energy_drift_in_swing, swing_foot_clearance
     from walkerlab.analysis.tables import table3
     from walkerlab.io.schemas import (
+        attribution,
         basin,
         bifurcation,
         compare,
@@ -230,7 +248,7 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
     loaders = {"fixedpoint": fixedpoint.load_fixedpoint, "simulate": simulate.load_simulate,
                "contact-sim": contact_sim.load_contact_sim, "compare": compare.load_compare,
                "workprecision": workprecision.load_workprecision, "basin": basin.load_basin,
-               "robustness": robustness.load}
+               "robustness": robustness.load, "attribution": attribution.load_attribution}
     arts: dict = {}
     for key, p in paths.items():
         load = (bifurcation.load_bifurcation_summary if key.startswith("bifurcation")
