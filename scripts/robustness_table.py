@@ -1,7 +1,8 @@
 """Robustness table of shipped walkers (issue 24): |lambda|max in absolute and relative
 angles, the gait sensitivity norm of each disturbance (linearised, and the nonlinear check),
-the state-indicator norm in both coordinate choices (Jin et al. 2021), and the largest
-tolerable single step-down and step-up (1 mm grid).
+the state-indicator norm in both coordinate choices (Jin et al. 2021), for the slope change,
+floor height step and mid-stance push, and the largest tolerable single step-down and step-up
+(bisection brackets, 1 mm) and mid-stance push forward/backward (1 mm/s).
 
     python scripts/robustness_table.py [paper kneed ...]
 """
@@ -40,16 +41,19 @@ def row(name: str) -> str:
     lam = np.max(np.abs(np.linalg.eigvals(A)))
     lam_rel = np.max(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T))))
     cells = [name, f"{lam:.4f} / {lam_rel:.4f}"]
-    for dist in ("slope", "floor_height"):
+    for dist in ("slope", "floor_height", "push"):
         lin = R.linearise(sm, x, A, dist)
         gl = lin.gsn()
         gn = R.gsn_nonlinear(sm, x, dist, 1e-5, steps=60)
         cells += [f"{gl:.4g} ({abs(gl - gn) / gl:.0e})",
                   f"{R.state_gsn(lin):.4g} / {R.state_gsn(lin, T):.4g}"]
     L = float(w.params.get("leg_length_m", 1.0))
-    down = R.largest_tolerable(sm, x, "floor_height", 0.25 * L, 0.001)
-    up = R.largest_tolerable(sm, x, "floor_height", 0.25 * L, 0.001, sign=-1.0)
-    cells += [f"{1000 * down:.0f}", f"{1000 * up:.0f}", f"{time.perf_counter() - t:.0f}"]
+    for dist, cap, tol, scale in (("floor_height", 0.25 * L, 0.001, 1000),
+                                  ("push", 1.0, 0.001, 1)):
+        for sign in (1.0, -1.0):
+            lo, hi = R.largest_by_bisection(sm, x, dist, cap, tol, sign=sign)
+            cells.append(f"{scale * lo:.4g}-{scale * hi:.4g}")
+    cells.append(f"{time.perf_counter() - t:.0f}")
     return "| " + " | ".join(cells) + " |"
 
 
@@ -57,8 +61,10 @@ def main() -> None:
     names = sys.argv[1:] or WALKERS
     print("| walker | abs lambda max (abs / rel angles) | GSN slope [1/rad] (lin vs nonlin) "
           "| state norm slope (abs / rel) | GSN floor height [1/m] (lin vs nonlin) "
-          "| state norm height (abs / rel) | step-down [mm] | step-up [mm] | s |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| state norm height (abs / rel) | GSN push [s/m] (lin vs nonlin) "
+          "| state norm push (abs / rel) | step-down [mm] | step-up [mm] "
+          "| push forward [m/s] | push backward [m/s] | s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for n in names:
         print(row(n), flush=True)
 

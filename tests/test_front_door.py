@@ -158,8 +158,8 @@ def test_misspelt_field_is_named_first_with_the_field_it_resembles(tmp_path):
         load_scene(p)
     lines = str(exc.value).splitlines()
     assert lines[0] == f"{p}: walker.hip_mas_kg: unknown field (did you mean hip_mass_kg?)"
-    assert lines[1] == f"{p}: walker.hip_mass_kg: Field required"
-    assert len(lines) == 2
+    # the "walker.hip_mass_kg: Field required" it causes is the same mistake: not repeated
+    assert len(lines) == 1  # (issue 26, item 10)
 
 
 def test_every_config_error_one_line_each_unknown_keys_first():
@@ -290,6 +290,7 @@ def test_example_notebook_runs(tmp_path, monkeypatch):
     assert any("image/png" in o.get("data", {}) for o in outputs)  # the figure
     text = "".join(o.get("text", "") for o in outputs)
     assert "step period" in text and "-> stable" in text
-    assert (tmp_path / "runs" / "paper_rods" / "basin.h5").is_file()
+    # a grid other than the scene's (200x200) has its own artifact (issue 26, item 6)
+    assert (tmp_path / "runs" / "paper_rods" / "basin_10x10.h5").is_file()
     after = set((ROOT / "runs").rglob("*")) if (ROOT / "runs").exists() else set()
     assert after == before  # nothing written into the repository

@@ -335,7 +335,8 @@ def _wp_rows(times: dict) -> dict:
     cases, methods, rtols = {}, list(times), [1e-6, 1e-8]
     for m, per in times.items():
         for r, ts in zip(rtols, per):
-            cases[(m, r)] = {"vec": [r], "times": ts, "cpu_times": ts, "nfev": 1}
+            cases[(m, r)] = {"vec": [r], "times": [9.0] * len(ts), "cpu_times": ts,
+                             "nfev": 1}  # the CPU times rank, not the wall times
     return rows_from_cases(cases, methods, rtols, np.zeros(1))
 
 

@@ -346,7 +346,8 @@ def test_i3_basin_partial_symlink_is_one_line_error(tmp_path):
     (runs / "paper").mkdir(parents=True)
     victim = tmp_path / "victim.txt"
     victim.write_text("precious\n")
-    (runs / "paper" / "basin.h5.partial").symlink_to(victim)
+    # --grid 2x2 (not the scene's grid) writes basin_2x2.h5 (issue 26, item 6)
+    (runs / "paper" / "basin_2x2.h5.partial").symlink_to(victim)
     code, err, _ = _cli("basin", ROOT / "configs" / "paper.yaml", "--grid", "2x2",
                         "--workers", "1", "--runs-dir", runs)
     assert code == 1 and "symbolic link" in err and "\n" not in err, err
@@ -421,11 +422,15 @@ def test_i7_disk_full_errors_map_to_one_line(tmp_path):
 @pytest.mark.parametrize("damage", ["{}", "[]", "not json",
                                     '{"vec": null, "nfev": 3, "times": [], "cpu_times": []}',
                                     '{"vec": ["a"], "nfev": 3, "times": [0.1], '
+                                    '"cpu_times": [0.1]}',
+                                    # measured before the integration's CPU time was timed
+                                    '{"vec": [1.0], "nfev": 3, "times": [0.1], '
                                     '"cpu_times": [0.1]}'])
 def test_i10_damaged_work_precision_case_is_measured_again(tmp_path, monkeypatch, damage):
     from walkerlab.analysis import workprecision as W
 
-    good = {"vec": [1.0, 2.0], "nfev": 10, "times": [0.01], "cpu_times": [0.01]}
+    good = {"vec": [1.0, 2.0], "nfev": 10, "times": [0.01], "cpu_times": [0.01],
+            "clock": "thread_cpu_integration"}
     monkeypatch.setattr(W, "_run_case", lambda t: (t.key, dict(good)))
     case = W.Case("k1", "ideal", "{}", 1.0, (0.0,), 1, "RK45", 1e-3, 1e-6, 1, ())
     (tmp_path / "k1.json").write_text(damage)

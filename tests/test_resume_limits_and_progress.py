@@ -532,9 +532,9 @@ def test_contact_text_shows_the_rate_scale_adjust_found(tmp_path):
     c = ContactSimArtifact(tmp_path / "contact.h5", Units(), "t_final", "completed",
                            initial_rate_scale=np.array([1.41, 1.74]),
                            adjust={"objective": 1e-4})
-    assert ("adjusted initial rate scale (found by --adjust): leg1 rates × 1.41; "
+    assert ("--adjust: kept the adjusted initial rate scale: leg1 rates × 1.41; "
             "leg2 rates × 1.74") in contact_text(c)
     # the stage writes the scaled rates by name (a kneed walker: two a leg)
     c.rate_names = ["dtheta1_thigh dtheta1_shank", "dtheta2_thigh dtheta2_shank"]
-    assert ("adjusted initial rate scale (found by --adjust): dtheta1_thigh dtheta1_shank × "
+    assert ("--adjust: kept the adjusted initial rate scale: dtheta1_thigh dtheta1_shank × "
             "1.41; dtheta2_thigh dtheta2_shank × 1.74") in contact_text(c)

@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene
+from walkerlab.io.schemas.rigid_limit import load_rigid_limit
+from walkerlab.report.text import rigid_limit_text
 from walkerlab.stages import rigid_limit
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -18,12 +20,12 @@ def test_rigid_limit_stage_writes_table_and_figure(tmp_path):
     prints one row per kappa with the observed order, the figure is drawn from the file."""
     scene = load_scene(ROOT / "configs" / "paper.yaml")
     out = rigid_limit.run(scene, tmp_path, kappas=(1.0, 10.0))
-    d = rigid_limit.load(out.path)
+    d = load_rigid_limit(out.path)
     assert d["rigid_period"] == pytest.approx(0.703597, abs=1e-6)
     gap = d["period"] - d["rigid_period"]
     assert gap[0] == pytest.approx(7.37e-3, rel=0.01) and 0 < gap[1] < gap[0] / 2
     assert d["multipliers"].shape == (2, 3)
-    lines = rigid_limit.table_lines(out.path)
+    lines = rigid_limit_text(d)
     assert len(lines) == 3 and "+7.37" in lines[1]
     files = rigid_limit.draw(scene, tmp_path, out.path)
     assert {p.suffix for p in files} == {".png", ".svg"}

@@ -12,9 +12,9 @@ the product):
 - :mod:`walkerlab.plotting` figures drawn from loaded artifacts only
 - :mod:`walkerlab.cli`      thin typer front end
 - :mod:`walkerlab.api`      the Python front door: ``walkerlab.load_scene``,
-  ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``, ``compare``,
-  ``basin`` and ``api.sweep`` (each returns an ``xarray.Dataset`` read from the stage's
-  artifact; ``walkerlab.sweep`` is the package of sweeps, basins and maps),
+  ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``,
+  ``compare``, ``basin`` and ``api.sweep`` (each returns an ``xarray.Dataset`` read from the
+  stage's artifact; ``walkerlab.sweep`` is the package of sweeps, basins and maps),
   ``continuation`` (the loaded continuation artifact)
 
 Importing the package has no side effects and loads no heavy optional package: the API's
@@ -23,8 +23,8 @@ names are looked up on first use (PEP 562).
 
 __version__ = "0.1.0"
 
-_API = ("load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
-        "compare", "basin", "continuation")
+_API = ("load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
+        "contact_simulate", "compare", "basin", "continuation")
 __all__ = ["__version__", "api", *_API]
 
 

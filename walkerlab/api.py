@@ -28,7 +28,7 @@ Example
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -37,8 +37,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["load_scene", "fixed_point", "fixed_points", "simulate", "contact_simulate",
-           "compare", "sweep", "basin", "continuation", "mfpt"]
+__all__ = ["load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
+           "contact_simulate", "compare", "sweep", "basin", "continuation", "mfpt"]
 
 DEFAULT_RUNS = Path("runs")
 
@@ -64,9 +64,10 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
     ------
     walkerlab.config.SceneError
         File missing, malformed YAML, or fields that do not validate (every error, one line
-        each, unknown keys first with the closest field name).
+        each, unknown keys first with the closest field name); ``name`` not a string or not
+        a safe folder name (empty, path separators).
     """
-    from walkerlab.config import Scene, scene_from_dict
+    from walkerlab.config import Scene, SceneError, scene_from_dict
     from walkerlab.config import load_scene as _load
 
     if isinstance(path_or_dict, Scene):
@@ -78,16 +79,90 @@ def load_scene(path_or_dict: str | Path | dict[str, Any], name: str | None = Non
     else:
         sc = _load(path_or_dict)
     if name is not None:
+        from walkerlab.io.runpaths import check_name
+
+        if not isinstance(name, str):
+            raise SceneError(f"name={name!r}: give the run folder name as a string, e.g. "
+                             "name='paper_steep'")
+        try:
+            check_name(name, "name")
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
         origin = getattr(sc, "_origin", None)
         sc = sc.model_copy(update={"name": name})
         sc._origin = origin
     return sc
 
 
+def with_changes(scene: Scene | str | Path | dict, changes: dict[str, Any]) -> Scene:
+    """A new scene: ``scene`` with fields set by the dotted paths of ``--param``.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        The base scene (see :func:`load_scene`); it is not changed (a scene is frozen).
+    changes : dict
+        Dotted scene field -> value, as ``walkerlab sweep --param`` names fields:
+        ``{"slope.angle_deg": 2, "walker.leg.bodies.thigh_mass.mass_kg": 0.4}`` (a list
+        item by its ``name`` or index).  Setting ``slope.angle_deg`` replaces
+        ``slope.angle_rad`` and vice versa; a missing section is created with its defaults.
+
+    Returns
+    -------
+    walkerlab.config.Scene
+        Validated and frozen; same ``name`` and scene file (its artifacts go to the same
+        run folder, recomputed where the change matters, as after editing the YAML file).
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        An unknown field (with the closest name) or a value that does not validate: one
+        line naming the path.
+
+    Examples
+    --------
+    >>> steeper = wl.with_changes(wl.load_scene("configs/paper.yaml"),
+    ...                           {"slope.angle_deg": 2})          # doctest: +SKIP
+    """
+    from walkerlab.config import SceneError
+    from walkerlab.sweep.params import ParamAxis, SweepError, apply_point, check_axes
+
+    base = _scene(scene)
+    if not isinstance(changes, dict) or not all(isinstance(k, str) for k in changes):
+        raise SceneError("with_changes: give a mapping of dotted field paths to values, "
+                         "e.g. {'slope.angle_deg': 2}")
+    axes = [ParamAxis(k, (v,), f"{k}={v!r}") for k, v in changes.items()]
+    try:
+        check_axes(base, axes, values=False)
+        out = apply_point(base.model_dump(mode="json"), list(changes), tuple(changes.values()),
+                          "with_changes")
+    except SweepError as exc:
+        raise SceneError("with_changes: " + str(exc).removeprefix("--param ")) from None
+    except SceneError as exc:
+        raise SceneError(str(exc).replace("with_changes [", "with_changes: [", 1)) from None
+    out._origin = base.origin
+    return out
+
+
 def _scene(scene) -> Scene:
     from walkerlab.config import Scene
 
     return scene if isinstance(scene, Scene) else load_scene(scene)
+
+
+def _runs(runs_dir) -> Path:
+    """``runs_dir`` as a path; an empty name (which would be the current folder) or a value
+    that is not a path is refused in one line, as ``--runs-dir ''`` is."""
+    import os
+
+    from walkerlab.safefs import RunPathError
+
+    if not isinstance(runs_dir, (str, os.PathLike)) or isinstance(runs_dir, bytes):
+        raise RunPathError(f"runs_dir={runs_dir!r}: give a folder name, e.g. runs_dir='runs'")
+    if not str(runs_dir).strip():
+        raise RunPathError("runs_dir='': empty folder name (it would write into the current "
+                           "folder); give a folder, e.g. runs_dir='runs'")
+    return Path(runs_dir)
 
 
 def _read(path: Path) -> xarray.Dataset:
@@ -106,7 +181,7 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
     Parameters
     ----------
     scene : Scene, str, Path or dict
-        A scene (see :func:`load_scene`); needs a ``fixedpoint`` section.
+        A scene (see :func:`load_scene`); without a ``fixedpoint`` section, its defaults.
     runs_dir : str or Path
         Runs folder (``--runs-dir``); the artifact is reused when up to date.
     force : bool
@@ -128,12 +203,14 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
         No ``fixedpoint`` section, or no fixed point found (one line saying why).
     walkerlab.config.SceneError
         The scene does not validate.
+    walkerlab.safefs.RunPathError
+        ``runs_dir`` empty (it would be the current folder) or not a path.
     ImportError
         xarray/h5netcdf missing (``pip install 'walkerlab[api]'``).
     """
     from walkerlab.stages import pipeline
 
-    return _read(pipeline.run("fixedpoint", _scene(scene), runs_dir, force).path)
+    return _read(pipeline.run("fixedpoint", _scene(scene), _runs(runs_dir), force).path)
 
 
 def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -158,7 +235,7 @@ def fixed_points(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEF
     from walkerlab.io.datasets import load_fixed_points
     from walkerlab.stages import pipeline
 
-    return load_fixed_points(pipeline.run("fixedpoint", _scene(scene), runs_dir,
+    return load_fixed_points(pipeline.run("fixedpoint", _scene(scene), _runs(runs_dir),
                                           force).path)
 
 
@@ -196,7 +273,7 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
     """
     from walkerlab.stages import pipeline
 
-    return _read(pipeline.run("simulate", _scene(scene), runs_dir, force,
+    return _read(pipeline.run("simulate", _scene(scene), _runs(runs_dir), force,
                               strides=strides).path)
 
 
@@ -236,7 +313,7 @@ def contact_simulate(scene: Scene | str | Path | dict, *, adjust: bool = False,
     """
     from walkerlab.stages import pipeline
 
-    return _read(pipeline.run("contact-sim", _scene(scene), runs_dir, force, adjust=adjust,
+    return _read(pipeline.run("contact-sim", _scene(scene), _runs(runs_dir), force, adjust=adjust,
                               periodic=periodic).path)
 
 
@@ -261,7 +338,7 @@ def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_
     """
     from walkerlab.stages import pipeline
 
-    return _read(pipeline.run("compare", _scene(scene), runs_dir, force).path)
+    return _read(pipeline.run("compare", _scene(scene), _runs(runs_dir), force).path)
 
 
 def _axis_spec(param: str, values: Sequence) -> str:
@@ -273,6 +350,12 @@ def _axis_spec(param: str, values: Sequence) -> str:
             return str(v)
         return str(int(v)) if isinstance(v, numbers.Integral) else repr(float(v))
 
+    from walkerlab.sweep.params import SweepError
+
+    if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+        raise SweepError(f"sweep {param}: values={values!r}: give a sequence of values, e.g. "
+                         f"[{values if isinstance(values, (int, float)) else 10}] or "
+                         "[8, 10, 12] (a string would be swept character by character)")
     vals = list(values)
     if not vals:
         raise ValueError(f"sweep {param}: no values given")
@@ -314,14 +397,15 @@ def sweep(scene: Scene | str | Path | dict, param: str, values: Sequence, *,
     Raises
     ------
     walkerlab.sweep.params.SweepError
-        Unknown field, values the field refuses, or an unknown stage.
+        Unknown field, values the field refuses, ``values`` a string or a single number
+        instead of a sequence, or an unknown stage.
     SceneError, ImportError
         As :func:`fixed_point`.
     """
     from walkerlab.stages import sweep as stage_mod
 
     path = stage_mod.run(_scene(scene), [_axis_spec(param, values)], stage=stage,
-                         workers=workers, runs_root=runs_dir, name=name, progress=progress)
+                         workers=workers, runs_root=_runs(runs_dir), name=name, progress=progress)
     return _read(path)
 
 
@@ -333,10 +417,11 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     Parameters
     ----------
     scene : Scene, str, Path or dict
-        Needs a ``fixedpoint`` section; the ``basin`` section (axes, ranges, start) is
-        optional (defaults: :class:`walkerlab.config.BasinSettings`).
+        The ``fixedpoint`` and ``basin`` sections (axes, ranges, start) are optional
+        (defaults: :class:`walkerlab.config.FixedPointSettings`, ``BasinSettings``).
     grid : (nx, ny), optional
-        Cells along x and y (default ``basin.grid``, 200 x 200; use e.g. (20, 20) to look).
+        Cells along x and y (default ``basin.grid``, 200 x 200; use e.g. (20, 20) to look);
+        a grid other than the scene's is written to its own ``basin_<nx>x<ny>.h5``.
     workers : int
         Local worker processes (1: in this process).
     runs_dir, force
@@ -360,7 +445,7 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     """
     from walkerlab.stages import pipeline
 
-    out = pipeline.run("basin", _scene(scene), runs_dir, force,
+    out = pipeline.run("basin", _scene(scene), _runs(runs_dir), force,
                        grid=tuple(grid) if grid else None, workers=workers)
     return _read(out.path)
 
@@ -407,7 +492,8 @@ def continuation(scene: Scene | str | Path | dict, param: str, start: float, sto
     from walkerlab.stages import continuation as stage
 
     out = stage.run(_scene(scene), param, float(start), float(stop), 2 if switch else 0,
-                    param2, tuple(range2) if range2 is not None else None, runs_dir, force)
+                    param2, tuple(range2) if range2 is not None else None, _runs(runs_dir),
+                    force)
     return load_continuation(out.path)
 
 
@@ -448,6 +534,6 @@ def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None,
     """
     from walkerlab.stages import pipeline
 
-    out = pipeline.run("mfpt", _scene(scene), runs_dir, force, sigma_rad=sigma_rad,
+    out = pipeline.run("mfpt", _scene(scene), _runs(runs_dir), force, sigma_rad=sigma_rad,
                        method=method, workers=workers)
     return _read(out.path)

@@ -27,6 +27,25 @@ from pathlib import Path
 
 import typer
 
+
+def _flags_take_no_value() -> None:
+    """``--help`` lists an on/off flag (``--force``, ``--help``) without a value type: typer
+    0.29 with click 8.2+ shows ``<bool>`` beside it, as if it took a value (issue 26)."""
+    from typer.core import TyperOption
+
+    shown = TyperOption.display_type_rich
+    if getattr(shown, "_walkerlab", False):
+        return
+
+    def display_type_rich(self, ctx):
+        return None if self.is_flag and self.metavar is None else shown(self, ctx)
+
+    display_type_rich._walkerlab = True
+    TyperOption.display_type_rich = display_type_rich
+
+
+_flags_take_no_value()
+
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
                   help="walkerlab: passive-dynamic biped walkers, from fixed point to report.")
 
@@ -84,6 +103,14 @@ def _one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
     line = " ".join(ln.strip() for ln in str(text).strip().splitlines() if ln.strip())
     if len(line) <= limit:
         return line
+    # a trailing "[detail]" (a solver's report) is cut first: the advice before it stays whole
+    start = line.rfind(" [")
+    if line.endswith("]") and 0 < start <= limit:
+        more = f" ... rerun with {DEBUG_ENV}=1 for the rest]"
+        detail = line[start:-1]
+        # up to 80 characters past the limit for the detail's start (what was tried)
+        cut = detail[:max(limit + 80 - start - len(more), 2)].rfind(" ")
+        return line[:start] + (detail[:cut].rstrip(",;:( ") if cut > 2 else " [") + more
     head = line[:limit]
     cut = max(head.rfind(sep) for sep in (". ", "; ", ": ", ", "))
     head = head[:cut + 1] if cut > limit // 3 else head[:head.rfind(" ")].rstrip()
@@ -253,20 +280,23 @@ def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
 @_guard
 def simulate(scene: Path | None = SceneArg,
              strides: int | None = typer.Option(
-                 None, "--strides", min=1, help="strides to simulate (1 stride = 2 steps) "
+                 None, "--strides", help="strides to simulate (1 stride = 2 steps) "
                  "(default: simulate.strides of the scene)"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Simulate N strides of the rigid walker from its fixed point (or from the state given
     as simulate.initial_state in the scene)."""
     from walkerlab.io.schemas.simulate import load_simulate
-    from walkerlab.report.text import simulate_text
+    from walkerlab.report.text import simulate_ending, simulate_text
     from walkerlab.stages import pipeline
 
     out = pipeline.run("simulate", _load(scene), runs_dir, force, strides=strides)
-    typer.echo(simulate_text(load_simulate(out.path)))
+    sim = load_simulate(out.path)
+    ending = simulate_ending(sim)  # a fall: no success-style summary (issue 26, item 5)
+    if ending is None:
+        typer.echo(simulate_text(sim))
     typer.echo(_status(out))
-    if out.failure:
-        _fail(RuntimeError(out.failure))
+    if out.failure:  # recorded in the artifact, and an error: one line, exit 1
+        _fail(RuntimeError(f"the walker {ending}" if ending else out.failure))
 
 
 @app.command("contact-sim")
@@ -305,11 +335,13 @@ def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
     from walkerlab.stages import pipeline
 
     if rigid_limit:
+        from walkerlab.io.schemas.rigid_limit import load_rigid_limit
+        from walkerlab.report.text import rigid_limit_text
         from walkerlab.stages import rigid_limit as rl
 
         sc = _load(scene)
         out = rl.run(sc, runs_dir, force)
-        for line in rl.table_lines(out.path):
+        for line in rigid_limit_text(load_rigid_limit(out.path)):
             typer.echo(line)
         for p in rl.draw(sc, runs_dir, out.path):
             typer.echo(f"wrote {p}")
@@ -349,7 +381,9 @@ def plot(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
 def report(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
            force: bool = ForceOpt,
            full: bool = typer.Option(False, "--full", help="also measure the work-precision "
-                                     "diagram (times every solver setting; ~30 s)")) -> None:
+                                     "diagram (times every solver setting; ~30 s) and compute "
+                                     "the Section-5 attribution (contact scenes; ~17 s CPU)"),
+           ) -> None:
     """Run every stage the scene needs (skipping up-to-date ones) and write the report."""
     from walkerlab.stages import report as stage
 
@@ -371,11 +405,15 @@ def sweep(scene: Path | None = SceneArg,
           name: str | None = typer.Option(None, "--name", help="artifact name"),
           runs_dir: Path = RunsOpt) -> None:
     """Run a stage over a grid of scene fields; one row per point, failures recorded."""
+    from walkerlab.report.sweep_text import sweep_text
     from walkerlab.stages import sweep as stage_mod
 
-    path = stage_mod.run(scene or default_scene(), param, stage=stage, workers=workers,
+    sc = _load(scene)
+    path = stage_mod.run(sc, param, stage=stage, workers=workers,
                          scheduler=scheduler, resume=resume, runs_root=runs_dir, name=name)
+    typer.echo(sweep_text(path))
     typer.echo(f"wrote {path}")
+    typer.echo(f"figure: {stage_mod.figure_path(sc, path, runs_dir)}")
 
 
 @app.command()
@@ -401,18 +439,33 @@ def bifurcation(scene: Path | None = SceneArg,
     """Bifurcation diagram over the slope (or any numeric scene field, --param): fixed
     points, multipliers, period-doubling onset."""
     from walkerlab.stages import bifurcation as stage
-    from walkerlab.sweep.params import SweepError, check_axes, parse_param
+    from walkerlab.sweep.params import (
+        SweepError,
+        check_axes,
+        parse_param,
+        takes_whole_numbers,
+    )
 
     if slopes is not None and param is not None:
         _fail(SweepError("--slopes and --param exclude each other (--slopes S is "
                          "--param slope.angle_deg=S)"))
-    axis = parse_param(param if param is not None
-                       else f"slope.angle_deg={slopes or '1:5.5:0.05'}")
+    try:
+        axis = parse_param(param if param is not None
+                           else f"slope.angle_deg={slopes or '1:5.5:0.05'}")
+    except SweepError as exc:  # name the option the user typed
+        if param is not None:
+            raise
+        _fail(SweepError(str(exc).replace(f"--param 'slope.angle_deg={slopes}'",
+                                          f"--slopes {slopes!r}")))
     sc = _load(scene)
     if param is not None:
-        check_axes(sc, [axis])
+        check_axes(sc, [axis], values=not takes_whole_numbers(sc, axis))
         if not axis.numeric:
             _fail(SweepError(f"--param {axis.spec!r}: a bifurcation needs numbers"))
+        if takes_whole_numbers(sc, axis):
+            _fail(SweepError(f"--param {axis.spec!r}: {axis.path} takes whole numbers; a "
+                             "bifurcation continues over a real-valued field (e.g. "
+                             "slope.angle_deg or a body's mass_kg)"))
     out = stage.run(sc, axis.values, runs_dir, transient, keep, workers, force=force,
                     param=axis.path)
     onset, unit = out.summary["onset"], out.summary["unit"]
@@ -490,7 +543,6 @@ def basin(scene: Path | None = SceneArg,
                                       help="continue an interrupted map with the same inputs"),
           runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section."""
-    from walkerlab.stages import basin as stage
 
     g = None
     if grid is not None:
@@ -509,7 +561,9 @@ def basin(scene: Path | None = SceneArg,
     if out.summary:
         typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
     typer.echo(_status(out))
-    typer.echo(f"figure: {stage.figure_path(_load(scene), runs_dir)}")
+    from walkerlab.stages.basin import figure_path
+
+    typer.echo(f"figure: {figure_path(_load(scene), runs_dir, g)}")
 
 
 @app.command()
@@ -545,6 +599,33 @@ def mfpt(scene: Path | None = SceneArg,
             typer.echo(f"sigma {s:.4g} rad: MFPT Monte Carlo {m:.4g}, mesh {me:.4g} steps")
     typer.echo(_status(out))
     typer.echo(f"figure: {stage.figure_path(sc, runs_dir)}")
+
+
+@app.command()
+@_guard
+def robustness(scene: Path | None = SceneArg,
+               workers: int = typer.Option(2, "--workers", min=1,
+                                           help="local worker processes (Monte Carlo)"),
+               scheduler: str | None = typer.Option(None, "--scheduler",
+                                                     help="Dask scheduler address"),
+               runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Gait sensitivity norms, largest step-down/up and MFPT at the scene's sigma
+    (the scene's robustness section); writes robustness.h5."""
+    from walkerlab.io.schemas.robustness import per_unit
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("robustness", _load(scene), runs_dir, force, workers=workers,
+                       scheduler=scheduler)
+    d = out.summary.get("data")
+    if d is not None:
+        for k in d.disturbances:
+            typer.echo(f"GSN {k}: {d.gsn[k]:.4g} {per_unit(d.units[k])}")
+        typer.echo(f"step-down {1000 * d['step_down_m/lo']:.0f} mm, step-up "
+                   f"{1000 * d['step_up_m/lo']:.0f} mm; MFPT {d['mfpt_steps']:.4g} "
+                   f"± {d['mfpt_steps_stderr']:.2g} steps at sigma {d['sigma_rad']:g} rad")
+        typer.echo(f"largest mid-stance push {d['push_forward_m_per_s/lo']:.3f} m/s forward, "
+                   f"{d['push_backward_m_per_s/lo']:.3f} m/s backward (hip velocity change)")
+    typer.echo(_status(out))
 
 
 @app.command("stability-map")

@@ -3,7 +3,12 @@ regular files only when reading, never through a symbolic link when writing.
 
 The lowest layer of walkerlab's I/O: the scene loader (:mod:`walkerlab.config`), the run
 paths and locks (:mod:`walkerlab.io.runpaths`) and the atomic writer
-(:mod:`walkerlab.io.artifacts`) all build on it, and it imports nothing of walkerlab.
+(:mod:`walkerlab.io.artifacts`) all build on it; it imports nothing of walkerlab at import
+time.
+
+Temporary files are named ``.<name>.<pid>.<random><suffix>`` (:func:`temp_prefix`), so a
+run removes those a killed run left (:func:`remove_stale_temps`: run folders when claimed,
+the folder of each atomic write).
 
 Reading:
 Every file walkerlab reads from a runs folder or a scene path (the scene YAML, the
@@ -17,9 +22,15 @@ from __future__ import annotations
 
 import os
 import stat
+import time
 from pathlib import Path
 
-__all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link"]
+__all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link", "temp_prefix",
+           "remove_stale_temps"]
+
+#: when this process started (wall clock) [s]; a temporary file older than this whose
+#: writer is gone is stale
+PROCESS_START = time.time()
 
 
 class RunPathError(ValueError):
@@ -41,11 +52,51 @@ def refuse_link(path: Path | str) -> Path:
     return path
 
 
+def temp_prefix(name: str) -> str:
+    """Prefix of this process's temporary files for ``name``: ``.<name>.<pid>.`` (a
+    rerun after a SIGKILL can then tell them from those of a live writer)."""
+    return f".{name}.{os.getpid()}."
+
+
+def remove_stale_temps(folder: Path | str, name: str | None = None,
+                       suffixes: tuple[str, ...] = (".tmp",)) -> int:
+    """Remove temporary files left by a killed writer: ``<folder>/.<name>.<pid>.<8
+    characters><suffix>`` (:func:`temp_prefix` + ``mkstemp``) whose pid is not alive and
+    which are older than this process.  ``name`` None: any name.  Another name, a live
+    writer, a newer file, a folder: left alone.  Returns the number removed."""
+    from walkerlab.execution.workers import process_alive  # light; imported when first needed
+
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return 0
+    n = 0
+    for e in entries:
+        suffix = next((x for x in suffixes if e.name.endswith(x)), None)
+        if suffix is None or not e.name.startswith("."):
+            continue
+        parts = e.name[1:len(e.name) - len(suffix)].rsplit(".", 2)
+        if len(parts) != 3 or (name is not None and parts[0] != name) \
+                or not parts[1].isdigit() or len(parts[2]) != 8:
+            continue
+        try:
+            st = e.stat(follow_symlinks=False)
+            if (stat.S_ISDIR(st.st_mode) or st.st_mtime >= PROCESS_START
+                    or process_alive(int(parts[1]))):
+                continue
+            os.unlink(e.path)
+            n += 1
+        except OSError:
+            continue
+    return n
+
+
 class NotARegularFile(ValueError):
     """The path is a device, FIFO, socket or directory, or larger than its cap (one line)."""
 
 
-def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
+def read_regular(path: str | Path, max_bytes: int, what: str = "file",
+                 follow_links: bool = True, check=None) -> bytes:
     """Contents of a regular file of at most ``max_bytes`` bytes.
 
     Parameters
@@ -55,6 +106,11 @@ def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
         Largest accepted size [bytes].
     what : str
         What the file is, for the message (``"scene file"``).
+    follow_links : bool
+        False: a symbolic link at ``path`` is refused (``O_NOFOLLOW``: an ``OSError``).
+    check : callable, optional
+        ``check(os.stat_result) -> bool`` on the opened file; False refuses it
+        (:class:`NotARegularFile`), e.g. a cache file that is not the user's own.
 
     Returns
     -------
@@ -71,7 +127,10 @@ def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
         Other errors of ``open``/``read`` (permissions).
     """
     path = Path(path)
-    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    flags = os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0)
+    if not follow_links:
+        flags |= getattr(os, "O_NOFOLLOW", 0)
+    fd = os.open(path, flags)
     try:
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
@@ -80,6 +139,8 @@ def read_regular(path: str | Path, max_bytes: int, what: str = "file") -> bytes:
                     "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else
                     "not a regular file")
             raise NotARegularFile(f"{path}: {what} is {kind}, not a regular file")
+        if check is not None and not check(st):
+            raise NotARegularFile(f"{path}: {what} is not trusted (owner or mode)")
         if st.st_size > max_bytes:
             raise NotARegularFile(f"{path}: {what} is {st.st_size:,} bytes; at most "
                                   f"{max_bytes:,} are read")

@@ -68,3 +68,48 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
     best = res.x if res.fun <= fval else x0
     return {"scale": np.asarray(best, float), "objective": float(min(res.fun, fval)),
             "evaluations": count["n"], "grid_best": np.asarray(x0, float)}
+
+
+#: run ends of a contact walker that walked cleanly; then those that walked with a defect
+_CLEAN = ("heel_strike", "t_final")
+_DEFECT = ("scuff", "slip")
+
+
+def _standing(res) -> tuple:
+    """Sort key of a contact run (smaller is better): walked cleanly, then walked with a
+    scuff or a slip beyond the limit, then failed; then more heel strikes; then less slip."""
+    kind = res.outcome.kind
+    tier = 0 if kind in _CLEAN else 1 if kind in _DEFECT else 2
+    slip = res.max_stance_slip_mm if np.isfinite(res.max_stance_slip_mm) else np.inf
+    return (tier, -int(res.walked_steps), slip)
+
+
+def _said(res) -> str:
+    slip = res.max_stance_slip_mm
+    return (f"{res.outcome.kind} after {int(res.walked_steps)} heel strikes"
+            + (f", max slip {slip:.3g} mm" if np.isfinite(slip) else ""))
+
+
+def better_start(scene_run, adjusted_run) -> tuple[str, str]:
+    """Which start of ``contact-sim --adjust`` to keep: the adjusted rates minimise the
+    period and step-length mismatch (:func:`adjust_rates`), which does not guarantee a
+    better walk, so the two runs are compared by outcome (walked cleanly > walked with a
+    scuff or slip > failed), then heel strikes, then the largest stance slip.
+
+    Parameters
+    ----------
+    scene_run, adjusted_run : ContactResult
+        The run from the scene's ``contact_sim.initial_rate_scale`` and from the adjusted
+        scale.
+
+    Returns
+    -------
+    kept : {"adjusted", "scene"}
+        The adjusted start unless the scene's is strictly better.
+    reason : str
+        One line: both outcomes (``t_final after 10 heel strikes, max slip 1.4 mm``).
+    """
+    a, s = _standing(adjusted_run), _standing(scene_run)
+    kept = "scene" if s < a else "adjusted"
+    why = f"adjusted start: {_said(adjusted_run)}; the scene's start: {_said(scene_run)}"
+    return kept, why

@@ -477,18 +477,18 @@ def ideal_gait(scene):
 
     Raises
     ------
-    ValueError
-        The scene has no ``fixedpoint`` section.
+    GaitNotFound
+        No ideal gait (a scene without a ``fixedpoint`` section searches from scale-free
+        seeds).
     """
     from walkerlab.analysis.gaits import find_gaits
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
 
     sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})
-    fp = sc.fixedpoint
-    if fp is None:
-        raise ValueError(f"scene '{scene.name}' has no 'fixedpoint' section (initial guess of "
-                         "the ideal gait)")
+    from walkerlab.config import FixedPointSettings
+
+    fp = sc.fixedpoint or FixedPointSettings()  # every field optional: the defaults
     iw = build_walker(sc)
     return find_gaits(iw, Solver.from_settings(sc.solver),
                       None if fp.initial_guess is None

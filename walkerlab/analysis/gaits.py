@@ -479,10 +479,12 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
     last = _short(last)
     if last and "standing" not in last:
         last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
-    why = (" a passive walker needs a downhill slope (slope > 0);"
-           if walker.slope_rad <= 0 else " the walker may have no period-1 gait here;")
-    return (f"no period-1 gait found (tried {' and '.join(tried)}{res}; last: "
-            f"{last or 'every start fell'});{why} try a continuation from a walker whose gait "
-            "is known (walkerlab sweep SCENE --param FIELD=KNOWN:THIS:STEP, small steps, e.g. a "
-            "body's mass_kg or slope.angle_deg) to see where the gait ends, or "
-            + ("an initial_guess nearer a gait" if had_guess else "give fixedpoint.initial_guess"))
+    why = ("a passive walker needs a downhill slope (slope > 0)"
+           if walker.slope_rad <= 0 else "the walker may have no period-1 gait here")
+    # the advice first, the solver's detail last: a one-line display that must shorten the
+    # message cuts the detail, never the advice (issue 26, item 2)
+    return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "
+            "from a walker whose gait is known (walkerlab sweep SCENE --param "
+            "FIELD=KNOWN:THIS:STEP, e.g. slope.angle_deg), or "
+            + ("an initial_guess nearer a gait" if had_guess else "give fixedpoint.initial_guess")
+            + f" [tried {' and '.join(tried)}{res}; last: {last or 'every start fell'}]")

@@ -18,7 +18,10 @@ tolerance 1e-12, i.e. ~1e-6 relative.  :func:`gsn_nonlinear` checks it: the resp
 nonlinear map to a small impulse, divided by its size.
 
 Disturbances (scalar, one step): ``slope`` (that step's slope changes by ``e`` [rad]),
-``floor_height`` (the ground at that step's footfall lies ``e`` [m] lower: a step-down).
+``floor_height`` (the ground at that step's footfall lies ``e`` [m] lower: a step-down),
+``push`` (an impulsive horizontal push at the hip at mid-stance changing the hip's forward
+velocity by ``e`` [m/s], :func:`apply_push`; those rows are integrated one by one by scipy's
+DOP853 at 1e-12, :func:`pushed_step`).
 Indicators: ``step_time_s``, ``step_length_m`` (distance from stance foot to swing foot at
 heel strike), ``stance_angle_rad`` (the stance leg's absolute angle from the vertical at
 heel strike).
@@ -38,10 +41,10 @@ import numpy as np
 
 from walkerlab.analysis.batch_step import HEEL_STRIKE, BatchStepMap
 
-DISTURBANCES = ("slope", "floor_height")
+DISTURBANCES = ("slope", "floor_height", "push")
 INDICATORS = ("step_time_s", "step_length_m", "stance_angle_rad")
 #: disturbance units
-UNITS = {"slope": "rad", "floor_height": "m"}
+UNITS = {"slope": "rad", "floor_height": "m", "push": "m/s"}
 
 
 def _indicators(sm: BatchStepMap, res) -> np.ndarray:
@@ -66,7 +69,14 @@ def one_step(sm: BatchStepMap, X: np.ndarray, disturbance: str, e: np.ndarray):
 
     Returns ``(x_next (N, 2n), indicators (N, 3), ok (N,))``."""
     e = np.asarray(e, dtype=float)
-    if disturbance == "slope":
+    if disturbance == "push":  # pushed rows one by one (scipy), the others batched
+        e = np.broadcast_to(e, (X.shape[0],))
+        r = sm.step(X, None)
+        for i in np.flatnonzero(e != 0):
+            p = pushed_step(sm.walker, X[i], e[i:i + 1])
+            for name in ("outcome", "x_pre", "x_next", "step_time_s"):
+                getattr(r, name)[i] = getattr(p, name)[0]
+    elif disturbance == "slope":
         r = sm.step(X, sm.slope_rad + e)
     elif disturbance == "floor_height":
         r = sm.step(X, None, drop_m=e)
@@ -199,3 +209,235 @@ def largest_tolerable(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
     dead = np.flatnonzero(~alive)
     return float(v[dead[0] - 1]) if dead.size and dead[0] > 0 else (
         0.0 if dead.size else float(v[-1]))
+
+
+def survives(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, values: np.ndarray,
+             steps: int = 40) -> np.ndarray:
+    """Survival (N,) bool of the single disturbances ``values`` (N,) [rad or m] on step 0,
+    followed by ``steps`` undisturbed steps (one batch; a fall or timeout on any step is
+    death)."""
+    v = np.asarray(values, float)
+    X = np.tile(x_star, (v.size, 1))
+    alive = np.ones(v.size, bool)
+    for k in range(steps + 1):
+        idx = np.flatnonzero(alive)
+        if idx.size == 0:
+            break
+        xn, _, ok = one_step(sm, X[idx], disturbance, v[idx] if k == 0 else np.zeros(idx.size))
+        alive[idx[~ok]] = False
+        X[idx[ok]] = xn[ok]
+    return alive
+
+
+def largest_by_bisection(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
+                         max_value: float, tol: float, steps: int = 40, sign: float = 1.0,
+                         sections: int = 8) -> tuple[float, float]:
+    """Bracket ``(lo, hi)`` of the largest single disturbance ``sign * v`` the gait survives.
+
+    A bracketing multisection (bisection with ``sections - 1`` interior points walked in one
+    batch per round): the invariant is "``lo`` survives, ``hi`` falls"; each round replaces
+    the bracket by the sub-interval between the last survivor before the first fall and that
+    fall.  Stops when ``hi - lo <= tol``: the bracket then holds a survival flip to ``tol``
+    (``ceil(log(max_value / tol) / log(sections))`` rounds).  Survival need not be monotone
+    in ``v``; the bracket holds the lowest flip the grids saw.
+
+    Returns
+    -------
+    (lo, hi) : floats [rad or m]
+        ``hi = inf`` when ``max_value`` survives (nothing falls up to it).
+    """
+    if survives(sm, x_star, disturbance, [sign * max_value], steps)[0]:
+        return float(max_value), float("inf")
+    lo, hi = 0.0, float(max_value)
+    while hi - lo > tol:
+        v = np.linspace(lo, hi, sections + 1)[1:-1]
+        alive = survives(sm, x_star, disturbance, sign * v, steps)
+        dead = np.flatnonzero(~alive)
+        if dead.size:
+            j = dead[0]
+            hi = float(v[j])
+            lo = float(v[j - 1]) if j > 0 else lo
+        else:
+            lo = float(v[-1])
+    return lo, hi
+
+
+def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None):
+    """Everything ``robustness.h5`` holds for a scene with a ``robustness`` section and its
+    gait ``x_star`` (2n,): ``|lambda|max`` and the state norms in absolute and relative leg
+    angles, the GSN of each disturbance (linearised, and the nonlinear check at an impulse
+    of 1e-5), the step-down/up brackets (search cap a quarter leg length), the largest
+    forward and backward mid-stance pushes (:func:`apply_push`) and the Monte Carlo
+    MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.sweep.mfpt.monte_carlo`).
+
+    Returns
+    -------
+    walkerlab.io.schemas.robustness.RobustnessData
+
+    Raises
+    ------
+    ValueError
+        A walker the batched step map cannot carry (one line).
+    """
+    from walkerlab.analysis.poincare import poincare_map
+    from walkerlab.config import RobustnessSettings
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.io.schemas.robustness import RobustnessData
+    from walkerlab.models.registry import build_walker
+    from walkerlab.sweep import mfpt as work
+
+    st = scene.robustness or RobustnessSettings()
+    walker = build_walker(scene)
+    sm = BatchStepMap(walker, work.scene_walker_at(scene), 1e-12, 1e-12)
+    if walker.steps_per_map != 1:
+        raise ValueError("robustness: legs that differ (a stride map) are not supported")
+    A = poincare_map(walker, x_star, Solver("DOP853", 1e-12, 1e-12, None, "scipy"),
+                     jacobian=True)[2]
+    names = walker.state_names()
+    T = relative_coordinates(names)
+    lam = {"absolute": float(np.max(np.abs(np.linalg.eigvals(A)))),
+           "relative": float(np.max(np.abs(np.linalg.eigvals(T @ A @ np.linalg.inv(T)))))}
+    gsn, gnl, norm = {}, {}, {"absolute": {}, "relative": {}}
+    for d in st.disturbances:
+        lin = linearise(sm, x_star, A, d)
+        gsn[d], gnl[d] = lin.gsn(), gsn_nonlinear(sm, x_star, d, 1e-5, steps=60)
+        norm["absolute"][d], norm["relative"][d] = state_gsn(lin), state_gsn(lin, T)
+    cap = 0.25 * float(walker.params.get("leg_length_m", 1.0))
+    down = largest_by_bisection(sm, x_star, "floor_height", cap, st.resolution_m,
+                                st.survival_steps)
+    up = largest_by_bisection(sm, x_star, "floor_height", cap, st.resolution_m,
+                              st.survival_steps, sign=-1.0)
+    fwd = largest_by_bisection(sm, x_star, "push", st.push_cap_m_per_s,
+                               st.push_resolution_m_per_s, st.survival_steps)
+    back = largest_by_bisection(sm, x_star, "push", st.push_cap_m_per_s,
+                                st.push_resolution_m_per_s, st.survival_steps, sign=-1.0)
+    mc = work.monte_carlo(scene, x_star, st.sigma_rad, st.montecarlo_walks,
+                          st.montecarlo_max_steps, st.seed, "normal", workers, scheduler)
+    m, se = mc.mfpt
+    sc = {"step_down_m/lo": down[0], "step_down_m/hi": down[1], "step_up_m/lo": up[0],
+          "step_up_m/hi": up[1], "push_forward_m_per_s/lo": fwd[0],
+          "push_forward_m_per_s/hi": fwd[1], "push_backward_m_per_s/lo": back[0],
+          "push_backward_m_per_s/hi": back[1], "sigma_rad": st.sigma_rad, "mfpt_steps": m,
+          "mfpt_steps_stderr": se, "montecarlo_walks": mc.steps.size,
+          "montecarlo_falls": int(mc.fell.sum())}
+    return RobustnessData(list(st.disturbances), {d: UNITS[d] for d in st.disturbances}, lam,
+                          gsn, gnl, norm, sc, names)
+
+
+# --------------------------------------------------------------------------- mid-stance push
+def mass_matrix(walker, x: np.ndarray) -> np.ndarray:
+    """``M(q)`` (n, n) of a rigid walker at state ``x`` (2n,), from its kinetic energy
+    ``T = 1/2 qd^T M(q) qd`` (``walker.energies``) by polarisation: ``M_ii = 2 T(e_i)``,
+    ``M_ij = T(e_i + e_j) - T(e_i) - T(e_j)`` (exact: ``T`` is quadratic in the rates)."""
+    n = walker.n_coordinates
+    q = np.asarray(x, float)[:n]
+
+    def T(qd):
+        return float(np.asarray(walker.energies(np.concatenate([q, qd])))[0])
+
+    E = np.eye(n)
+    Ti = [T(E[i]) for i in range(n)]
+    M = np.diag([2 * t for t in Ti])
+    for i in range(n):
+        for j in range(i + 1, n):
+            M[i, j] = M[j, i] = T(E[i] + E[j]) - Ti[i] - Ti[j]
+    return M
+
+
+def hip_jacobian(walker, x: np.ndarray, h: float = 1e-6) -> np.ndarray:
+    """``J`` (2, n): d(hip position, world x forward / y up) / dq, central differences
+    (``walker.points``; error O(h^2) ~ 1e-12 m/rad)."""
+    n = walker.n_coordinates
+    x = np.asarray(x, float)
+    J = np.empty((2, n))
+    for i in range(n):
+        e = np.zeros(x.size)
+        e[i] = h
+        J[:, i] = (np.asarray(walker.points(x + e)["hip"])
+                   - np.asarray(walker.points(x - e)["hip"])) / (2 * h)
+    return J
+
+
+def apply_push(walker, x: np.ndarray, dv_mps: float) -> tuple[np.ndarray, float]:
+    """An impulsive horizontal push at the hip that changes the hip's horizontal velocity by
+    ``dv_mps`` [m/s] (positive forward), the stance foot pinned.
+
+    The push is a physical impulse ``P`` [N s] along world x at the hip: the generalised
+    impulse is ``J_x^T P`` (``J_x`` the hip's horizontal Jacobian row), so the rates jump by
+    ``dqd = M^-1 J_x^T P`` (the impulse-momentum balance ``M dqd = J^T P``; the ground's
+    impulse at the pinned stance foot does no virtual work in these coordinates).  ``P`` is
+    chosen so that ``J_x dqd = dv``: ``P = dv / (J_x M^-1 J_x^T)``.  The hip's vertical
+    velocity changes too (``J_y dqd``): the stance leg is rigid.
+
+    Returns
+    -------
+    x_plus : ndarray (2n,)
+    impulse_Ns : float
+    """
+    n = walker.n_coordinates
+    M = mass_matrix(walker, x)
+    jx = hip_jacobian(walker, x)[0]
+    w = np.linalg.solve(M, jx)
+    P = float(dv_mps) / float(jx @ w)
+    xp = np.array(x, float)
+    xp[n:] += P * w
+    return xp, P
+
+
+def _stance_angle(walker, X: np.ndarray) -> np.ndarray:
+    """Absolute stance-leg (stance thigh) angle from the vertical of states ``X`` (2n, k)."""
+    c = walker.leg_coordinates(X, walker.legs[-1])
+    s = walker.legs[-1]
+    return np.asarray(c[f"{s}_angle"] if f"{s}_angle" in c else c[f"{s}_thigh_angle"])
+
+
+def pushed_step(walker, x0: np.ndarray, dv_mps: np.ndarray, solver=None,
+                max_step_time: float = 5.0):
+    """One step from the post-impact state ``x0`` with a mid-stance push ``dv_mps[i]``
+    (:func:`apply_push`) for each value: mid-stance is where the stance leg is vertical
+    (its absolute angle crosses 0, located by :func:`scipy.optimize.brentq` on the step's
+    dense output); the step goes on from the pushed state in the phase active there.
+
+    Returns
+    -------
+    BatchStep of ``dv_mps.size`` rows (outcome, x_pre, x_next, step_time_s).
+
+    Raises
+    ------
+    ValueError
+        The gait's stance leg never passes the vertical in the step.
+    """
+    import dataclasses
+
+    from scipy.optimize import brentq
+
+    from walkerlab.analysis.batch_step import FALL, BatchStep
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
+
+    solver = solver or Solver("DOP853", 1e-12, 1e-12, None, "scipy")
+    seg = integrate_step(walker, np.asarray(x0, float), solver, max_step_time=max_step_time)
+    ts = np.linspace(seg.t_start, seg.t_end, 201)
+    a = _stance_angle(walker, seg.sample(ts))
+    cross = np.flatnonzero(np.sign(a[:-1]) != np.sign(a[1:]))
+    if cross.size == 0:
+        raise ValueError("push: the stance leg does not pass the vertical in the gait's step")
+    j = cross[0]
+    tm = brentq(lambda t: float(_stance_angle(walker, seg.sample([t]))[0]), ts[j], ts[j + 1],
+                xtol=1e-14)
+    xm = seg.sample([tm])[:, 0]
+    k = next(i for i, (_ph, _s, (ta, tb)) in enumerate(seg.pieces) if tm <= tb or
+             i == len(seg.pieces) - 1)
+    rest = dataclasses.replace(walker, phases=walker.phases[k:])
+    dv = np.atleast_1d(np.asarray(dv_mps, float))
+    N, m = dv.size, xm.size
+    out = BatchStep(np.full(N, FALL, np.int8), np.full((N, m), np.nan),
+                    np.full((N, m), np.nan), np.full(N, np.nan))
+    for i, v in enumerate(dv):
+        s2 = integrate_step(rest, apply_push(walker, xm, v)[0], solver,
+                            max_step_time=max_step_time)
+        if s2.termination == "heel_strike" and s2.x_next is not None:
+            out.outcome[i] = HEEL_STRIKE
+            out.x_pre[i], out.x_next[i] = s2.x_end, s2.x_next
+            out.step_time_s[i] = tm - seg.t_start + s2.period
+    return out

@@ -15,10 +15,11 @@ from walkerlab.models.registry import build_walker
 
 
 def _settings(scene: Scene):
-    if scene.fixedpoint is None:
-        raise ValueError(f"scene '{scene.name}' has no 'fixedpoint' section, which stage "
-                         "'fixedpoint' needs")
-    return scene.fixedpoint
+    """The scene's ``fixedpoint`` section; left out, its defaults (every field is optional:
+    the gait is then found from scale-free seeds)."""
+    from walkerlab.config import FixedPointSettings
+
+    return scene.fixedpoint if scene.fixedpoint is not None else FixedPointSettings()
 
 
 def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
@@ -38,15 +39,54 @@ def initial_guess(scene: Scene, walker):
     Raises
     ------
     ValueError
-        The guess does not name the walker's states (one line naming the field).
+        The guess does not name the walker's states, or is no walking state
+        (:func:`check_walking_state`) (one line naming the field).
     """
     fp = _settings(scene)
     if fp.initial_guess is None:
         return None
     try:
-        return fp.initial_guess.as_array(walker.state_names())
+        guess = fp.initial_guess.as_array(walker.state_names())
     except ValueError as exc:
         raise ValueError(f"fixedpoint.initial_guess: {exc}") from None
+    check_walking_state(guess, walker, scene)
+    return guess
+
+
+#: largest leg angular rate of an initial guess, in units of sqrt(g/l)
+MAX_GUESS_RATE = 20.0
+
+
+def check_walking_state(x, walker, scene: Scene) -> None:
+    """Refuse a guess no walking gait is near, before the root finder spends minutes on it.
+
+    A leg turning at ``omega`` needs a centripetal acceleration ``omega^2 l`` at its far end;
+    above ``g`` the stance foot would leave the ground, so a walking gait has rates of the
+    order of ``sqrt(g/l)`` (paper walker: 3.1 rad/s; its fixed point 0.86 rad/s).  Rates above
+    :data:`MAX_GUESS_RATE` ``sqrt(g/l)`` (or angles beyond pi) send the map's integration
+    into spinning legs (issue 26: 1e6 rad/s ran 74 s, then ``OverflowError``).
+
+    Raises
+    ------
+    ValueError
+        One line naming the field, its value and the bound.
+    """
+    from walkerlab.units import for_scene
+
+    g = walker.params.get("gravity_m_per_s2")
+    length = walker.params.get("leg_length_m")
+    if not g or not length:
+        return
+    max_rate = MAX_GUESS_RATE * math.sqrt(g / length)
+    for name, v in zip(walker.state_names(), x, strict=True):
+        if name.endswith("_rate") and abs(v) > max_rate:
+            raise ValueError(
+                f"fixedpoint.initial_guess.{name}_rad_per_s: {v:g} is not a walking state: "
+                f"give at most {max_rate:.3g} {for_scene(scene).rate} ({MAX_GUESS_RATE:g} "
+                "sqrt(g/l); a leg this fast would leave the ground)")
+        if name.endswith("_angle") and abs(v) > math.pi:
+            raise ValueError(f"fixedpoint.initial_guess.{name}_rad: {v:g} rad is more than "
+                             "half a turn: give an angle within [-pi, pi]")
 
 
 def with_variant(scene: Scene, variant: str) -> Scene:

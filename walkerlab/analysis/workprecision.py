@@ -4,15 +4,19 @@ The library behind the ``workprecision`` stage (:mod:`walkerlab.stages.workpreci
 plans the cases from the scene, caches them and writes the artifact):
 
 - runners (:func:`ideal_runner`, :func:`contact_runner`): ``run(method, rtol, atol) ->
-  (final vector, nfev)`` for the rigid hybrid walker and the compliant-contact walker;
+  (final vector, nfev, CPU time [s])`` for the rigid hybrid walker and the compliant-contact
+  walker; the CPU time is this thread's (``time.thread_time``) around the integration call
+  alone (model, initial state and limits are built once, outside it), so neither set-up nor
+  another process on a shared core is counted;
 - timing (:func:`time_case`): a case is run ``repeats`` times (once if a run takes longer
-  than :data:`SINGLE_RUN_S`), wall and process CPU time of every run;
+  than :data:`SINGLE_RUN_S`), the integration's CPU time and the wall time of every run;
 - where the cases run (:func:`run_cases` on :class:`walkerlab.execution.lanes.Lanes`): one
   single-threaded worker process per core, pinned to it (``os.sched_setaffinity``), so a
   timed case never shares its core with another case; each worker runs every method once,
   untimed, over one stride before timing (compiled code is loaded from the on-disk caches,
   not timed), then freezes its heap for the garbage collector;
-- the Pareto front and the Pareto-best setting (:func:`pareto_front`, :func:`summarize`).
+- the Pareto front and the fastest setting (:func:`pareto_front`, :func:`summarize`), both
+  only where the settings' CPU times differ by more than the spread of their repeats.
 """
 
 from __future__ import annotations
@@ -33,11 +37,13 @@ CYRK_PREFIX = "CyRK "
 
 
 def ideal_runner(scene, x0: np.ndarray, strides: int):
-    """``run(method, rtol, atol) -> (final vector, nfev)`` for the rigid hybrid walker.
+    """``run(method, rtol, atol) -> (final vector, nfev, CPU time [s])`` for the rigid
+    hybrid walker.
 
     ``method`` is a ``solve_ivp`` method, or ``"CyRK <method>"`` for CyRK's integrator; the
     final vector is the state and time at the last of ``2 * strides`` heel strikes
-    (shape (2n + 1,)), None if the run did not end in a heel strike.
+    (shape (2n + 1,)), None if the run did not end in a heel strike; the CPU time is the
+    thread's around :func:`walkerlab.integrate.rigid.simulate_steps` alone.
     """
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
@@ -49,23 +55,48 @@ def ideal_runner(scene, x0: np.ndarray, strides: int):
         backend = "scipy"
         if method.startswith(CYRK_PREFIX):
             method, backend = method[len(CYRK_PREFIX):], "cyrk"
-        tr = simulate_steps(walker, x0, 2 * strides, Solver(method, rtol, atol, None, backend))
+        solver = Solver(method, rtol, atol, None, backend)
+        c0 = time.thread_time()
+        tr = simulate_steps(walker, x0, 2 * strides, solver)
+        cpu = time.thread_time() - c0
         seg = tr.segments[-1]
         if seg.termination != "heel_strike":
-            return None, tr.nfev
-        return np.concatenate([seg.x_end, [seg.t_end]]), tr.nfev
+            return None, tr.nfev, cpu
+        return np.concatenate([seg.x_end, [seg.t_end]]), tr.nfev, cpu
     return run
 
 
-def pareto_front(times: np.ndarray, errors: np.ndarray) -> np.ndarray:
-    """Indices of the non-dominated points (faster *and* more accurate than no other)."""
-    order = np.argsort(times, kind="stable")
-    best = np.inf
+def pareto_front(times: np.ndarray, errors: np.ndarray, time_min: np.ndarray | None = None,
+                 time_max: np.ndarray | None = None) -> np.ndarray:
+    """Indices of the non-dominated points, ordered by time.
+
+    Without a spread: a point stays unless another is at most as slow and at least as
+    accurate (one of the two strictly).  With the spread of the repeats (``time_min``,
+    ``time_max``, shape like ``times`` [s]), times are compared only beyond it: point ``j``
+    dominates ``i`` when it is at least as accurate and either clearly faster
+    (``time_max[j] < time_min[i]``) or indistinguishable in time (the ranges overlap) and
+    strictly more accurate.  So the front never holds two settings whose time ranges
+    overlap (the less accurate of them is dominated), and a point is not dropped for a
+    difference in time that lies inside the timing noise.
+    """
+    t = np.asarray(times, float)
+    e = np.asarray(errors, float)
+    lo = t if time_min is None else np.asarray(time_min, float)
+    hi = t if time_max is None else np.asarray(time_max, float)
     keep = []
-    for i in order:
-        if np.isfinite(errors[i]) and errors[i] < best:
-            keep.append(i)
-            best = errors[i]
+    for i in np.argsort(t, kind="stable"):
+        if not np.isfinite(e[i]):
+            continue
+        if time_min is None and time_max is None:
+            dominated = any(np.isfinite(e[j]) and e[j] <= e[i] and t[j] <= t[i]
+                            and (e[j] < e[i] or t[j] < t[i]) for j in range(t.size) if j != i)
+        else:
+            dominated = any(
+                np.isfinite(e[j]) and e[j] <= e[i]
+                and (hi[j] < lo[i] or (e[j] < e[i] and lo[j] <= hi[i] and lo[i] <= hi[j]))
+                for j in range(t.size) if j != i)
+        if not dominated:
+            keep.append(int(i))
     return np.asarray(keep, dtype=int)
 
 
@@ -76,64 +107,78 @@ SINGLE_RUN_S = 1.0
 
 def time_case(runner, method: str, rtol: float, atol: float, repeats: int) -> dict:
     """Run one case up to ``repeats`` times (once if the first run takes longer than
-    :data:`SINGLE_RUN_S`): final vector (or None), nfev, wall and CPU times [s]."""
+    :data:`SINGLE_RUN_S` of CPU time): final vector (or None), nfev, the CPU times of the
+    integration alone (``cpu_times``, the runner's ``time.thread_time`` around its
+    integration call) and the wall times of the whole runner call (``times``) [s].  A run
+    that raised is timed by the thread's CPU time around the whole call."""
     times, cpu, vec, nfev = [], [], None, 0
     for _ in range(repeats):
-        if times and times[0] > SINGLE_RUN_S:
+        if cpu and cpu[0] > SINGLE_RUN_S:
             break
-        t0, c0 = time.perf_counter(), time.process_time()
+        t0, c0 = time.perf_counter(), time.thread_time()
         try:
-            vec, nfev = runner(method, rtol, atol)
+            vec, nfev, c = runner(method, rtol, atol)
         except Exception:
-            vec = None
-        cpu.append(time.process_time() - c0)
+            vec, c = None, time.thread_time() - c0
+        cpu.append(float(c))
         times.append(time.perf_counter() - t0)
     return {"vec": None if vec is None else [float(v) for v in vec], "nfev": int(nfev),
-            "times": times, "cpu_times": cpu}
+            "times": times, "cpu_times": cpu, "clock": "thread_cpu_integration"}
 
 
 def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
-    """``run(method, rtol, atol) -> (final vector, nfev)`` for the compliant-contact walker
-    started from the rigid walker's fixed point ``x0`` (step period ``step_period`` [s]).
+    """``run(method, rtol, atol) -> (final vector, nfev, CPU time [s])`` for the
+    compliant-contact walker started from the rigid walker's fixed point ``x0`` (step period
+    ``step_period`` [s]).
 
     The final vector is the leg angles [rad] and rates [rad/s] at the final time, read by
-    name from the contact walker's state, None unless the run reached its final time.
+    name from the contact walker's state, None unless the run reached its final time.  The
+    walker, its initial state and run limits are built once
+    (:func:`walkerlab.analysis.contact_sim.scene_start`); the CPU time is the thread's
+    around :func:`walkerlab.analysis.contact_sim.simulate_contact` alone.
     """
     from walkerlab.analysis.contact_bench import leg_angle_columns
-    from walkerlab.analysis.contact_sim import simulate_from
+    from walkerlab.analysis.contact_sim import scene_start, settings, simulate_contact
     from walkerlab.config import ContactSolverSettings
     from walkerlab.integrate.contact import StateIndex
 
+    cs = settings(scene)[2]
+    walker, z0, limits, _ = scene_start(scene, x0, strides)
+    t_final = cs.t_final_s or (2 * strides + 0.5) * step_period
+    max_hs = 2 * strides + 1 if cs.stop_after_strides else None
+    idx = StateIndex(walker)
+    legs = leg_angle_columns(walker)
+    rates = [idx.rate_of(idx.names[i]) for i in legs]
+
     def run(method, rtol, atol):
         sv = ContactSolverSettings(method=method, rtol=rtol, atol=atol)
-        walker, res, _, _ = simulate_from(scene, x0, step_period, solver=sv, strides=strides)
+        c0 = time.thread_time()
+        res = simulate_contact(walker, z0, t_final, sv, limits, max_heel_strikes=max_hs)
+        cpu = time.thread_time() - c0
         if res.termination != "t_final":
-            return None, res.nfev
-        idx = StateIndex(walker)
-        legs = leg_angle_columns(walker)
-        rates = [idx.rate_of(idx.names[i]) for i in legs]
-        return np.concatenate([res.x[-1, legs], res.x[-1, rates]]), res.nfev
+            return None, res.nfev, cpu
+        return np.concatenate([res.x[-1, legs], res.x[-1, rates]]), res.nfev, cpu
     return run
 
 
 def rows_from_cases(cases: dict, methods, rtols, reference) -> dict:
-    """``{method: {rtol, time, time_min, time_max, cpu_time, error, nfev, repeats}}``
-    (arrays over ``rtols``; ``time`` is the median of the repeats, ``time_min``/``time_max``
-    their spread)
+    """``{method: {rtol, time, time_min, time_max, wall_time, error, nfev, repeats}}``
+    (arrays over ``rtols``; ``time`` is the median CPU time of the integration over the
+    repeats, ``time_min``/``time_max`` their spread, ``wall_time`` the median wall time)
     from ``{(method, rtol): time_case result}``; the error is the max-norm distance of the
     final vector from ``reference`` (inf where the run failed)."""
     out = {}
     for m in methods:
-        rows = {"rtol": [], "time": [], "time_min": [], "time_max": [], "cpu_time": [],
+        rows = {"rtol": [], "time": [], "time_min": [], "time_max": [], "wall_time": [],
                 "error": [], "nfev": [], "repeats": []}
         for rtol in rtols:
             c = cases[(m, rtol)]
             vec = c["vec"]
             rows["rtol"].append(rtol)
-            rows["time"].append(float(np.median(c["times"])))
-            rows["time_min"].append(float(np.min(c["times"])))
-            rows["time_max"].append(float(np.max(c["times"])))
-            rows["cpu_time"].append(float(np.median(c["cpu_times"])))
+            rows["time"].append(float(np.median(c["cpu_times"])))
+            rows["time_min"].append(float(np.min(c["cpu_times"])))
+            rows["time_max"].append(float(np.max(c["cpu_times"])))
+            rows["wall_time"].append(float(np.median(c["times"])))
             rows["error"].append(np.inf if vec is None
                                  else float(np.max(np.abs(np.asarray(vec) - reference))))
             rows["nfev"].append(c["nfev"])
@@ -143,7 +188,7 @@ def rows_from_cases(cases: dict, methods, rtols, reference) -> dict:
 
 
 def study(runner, methods, rtols, atol_factor, repeats, reference) -> dict:
-    """Run every (method, rtol) here; returns ``{method: {rtol, time, cpu_time, error, nfev}}``."""
+    """Run every (method, rtol) here; returns :func:`rows_from_cases`'s rows."""
     cases = {(m, r): time_case(runner, m, r, atol_factor * r, repeats)
              for m in methods for r in rtols}
     return rows_from_cases(cases, methods, rtols, reference)
@@ -264,7 +309,8 @@ def read_cached_case(path: Path) -> dict | None:
     if not isinstance(res, dict):
         return None
     times, cpu, vec = res.get("times"), res.get("cpu_times"), res.get("vec")
-    ok = (_numbers(times) and len(times) >= 1 and all(x >= 0 for x in times)
+    ok = (res.get("clock") == "thread_cpu_integration"
+          and _numbers(times) and len(times) >= 1 and all(x >= 0 for x in times)
           and _numbers(cpu, len(times)) and (vec is None or (_numbers(vec) and len(vec) >= 1))
           and isinstance(res.get("nfev"), int) and not isinstance(res.get("nfev"), bool))
     return res if ok else None
@@ -367,7 +413,7 @@ def summarize(rows: dict, target: float) -> dict:
                            for m in rows])
     rt, tt, ee = cat["rtol"], cat["time"], cat["error"]
     lo, hi = cat["time_min"], cat["time_max"]
-    idx = pareto_front(tt, ee)
+    idx = pareto_front(tt, ee, lo, hi)
     ok = np.flatnonzero(ee <= target)
     best = int(ok[np.argmin(tt[ok])]) if ok.size else None
     tied, separated = [], False

@@ -700,6 +700,31 @@ class MfptSettings(_Strict):
                                    "strike within this = a fall [s]")
 
 
+class RobustnessSettings(_Strict):
+    """Robustness of the gait beyond |lambda| (``walkerlab robustness``; issue 24): gait
+    sensitivity norms (Hobbelen & Wisse 2007), the largest single step-down and step-up
+    (bisection), and the MFPT at one per-step slope sigma by Monte Carlo (Byl & Tedrake 2009)."""
+
+    sigma_rad: float = Field(0.003, gt=0, le=0.2, description="per-step slope standard "
+                             "deviation of the MFPT [rad]")
+    disturbances: list[Literal["slope", "floor_height", "push"]] = Field(
+        ["slope", "floor_height", "push"], min_length=1, description="GSN disturbances: slope "
+        "change [rad], floor height step [m] (one step), horizontal push at the hip at "
+        "mid-stance (hip velocity change [m/s])")
+    montecarlo_walks: int = Field(100, ge=1, le=100_000, description="Monte Carlo walks [-]")
+    montecarlo_max_steps: int = Field(500, ge=1, le=1_000_000,
+                                      description="step cap per walk (censoring) [steps]")
+    seed: int = Field(0, ge=0, description="Monte Carlo seed [-]")
+    resolution_m: float = Field(0.001, gt=0, le=0.05, description="bracket width of the "
+                                "largest step-down/up bisection [m]")
+    push_resolution_m_per_s: float = Field(0.001, gt=0, le=0.1, description="bracket "
+                                           "width of the largest push bisection [m/s]")
+    push_cap_m_per_s: float = Field(1.0, gt=0, le=10, description="largest push searched "
+                                    "(hip velocity change) [m/s]")
+    survival_steps: int = Field(40, ge=1, le=1000, description="undisturbed steps a walker "
+                                "must take after a disturbance to survive it [steps]")
+
+
 class Scene(_Strict):
     """A complete scene. Only ``walker`` and ``slope`` are mandatory."""
 
@@ -737,6 +762,7 @@ class Scene(_Strict):
         return self._origin
     basin: BasinSettings | None = None
     mfpt: MfptSettings | None = None
+    robustness: RobustnessSettings | None = None
 
     @model_validator(mode="after")
     def _units_consistent(self) -> Scene:
@@ -744,6 +770,21 @@ class Scene(_Strict):
             raise ValueError("units: a nondimensional scene measures accelerations in g, so "
                              "walker.gravity_m_per_s2 must be 1 (got "
                              f"{self.walker.gravity_m_per_s2:g})")
+        return self
+
+    @model_validator(mode="after")
+    def _knee_stop_needs_a_knee(self) -> Scene:
+        # a latch that cannot act is a mistake, as an unknown key is (issue 26): an error,
+        # not a warning, so a latch the user counts on is never silently absent (the stop's
+        # other numbers have defaults and are dumped with every scene: not checked)
+        c = self.contact
+        if c is None or not c.knee_stop.latch:
+            return self
+        leg = getattr(self.walker, "leg", None)
+        if leg is None or getattr(leg, "knee", None) is None:
+            raise ValueError("contact.knee_stop.latch: the walker's legs are straight (no "
+                             "walker.leg.knee), so there is no knee to latch: remove it or "
+                             "give the leg a knee")
         return self
 
     @model_validator(mode="after")
@@ -781,6 +822,31 @@ class Scene(_Strict):
             raise ValueError(f"{v!r} is not a plain folder name: use letters, digits and "
                              ". _ + - only (no path separators, not starting with a dot)")
         return v
+
+    def model_copy(self, *, update: dict[str, Any] | None = None, deep: bool = False) -> Scene:
+        """A copy; with an ``update`` that gives a section as a mapping or a list, the
+        changed scene validated again (pydantic's own ``model_copy`` stores an update
+        unchecked: the section would stay a ``dict``).  The scene file (``origin``) is
+        kept.  To change fields by dotted path, use :func:`walkerlab.api.with_changes`.
+
+        Raises
+        ------
+        SceneError
+            The updated scene does not validate (one line per error).
+        """
+        if not update or not any(isinstance(v, dict | list) for v in update.values()):
+            # model instances (walkerlab's own copies: a section's settings, a name) as
+            # pydantic copies them
+            return super().model_copy(update=update, deep=deep)
+        data = self.model_dump()
+        data.update({k: v.model_dump() if isinstance(v, BaseModel) else v
+                     for k, v in update.items()})
+        try:
+            out = type(self).model_validate(data)
+        except ValidationError as err:
+            raise SceneError(_format_error(Path("model_copy"), err)) from None
+        out._origin = self._origin
+        return out
 
     def section_json(self, *names: str) -> str:
         """Canonical JSON of the named sections (for content hashes)."""
@@ -844,23 +910,103 @@ def _fields_at(loc: tuple) -> list[str]:
     return sorted({k for m in current for k in m.model_fields})
 
 
-def _error_line(e: dict) -> str:
-    """One error as ``<field path>: <message>`` (an unknown key names the likely field)."""
+def _input_text(value) -> str:
+    """``repr`` of an input value for a message; an integer too long to print (Python caps
+    int-to-str at 4300 digits) or to read is described instead."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 100:
+        return f"an integer of about {int(value.bit_length() * 0.30103) + 1} digits"
+    return repr(value)
+
+
+def _suggestion(e: dict) -> list[str]:
+    """The field an unknown key most likely meant ([] when none is close)."""
     import difflib
 
+    return difflib.get_close_matches(str(e["loc"][-1]), _fields_at(tuple(e["loc"][:-1])), n=1)
+
+
+#: What a walker can be today, said by an error on an unknown walker field or kind and by
+#: the README (one place: update it as the walker vocabulary grows)
+WALKER_VOCABULARY = (
+    "a walker today is planar and passive: model compass_gait (hip mass, one point mass per "
+    "leg) or biped (hip_mass_kg and two identical legs: length_m, bodies (point_mass or "
+    "rod), an optional knee, foot kind point or arc); no torso, springs, ankles, flat feet "
+    "or actuation yet")
+
+
+def _walker_vocabulary_applies(e: dict) -> bool:
+    """An unknown kind, or an unknown key close to no field, inside ``walker``: the
+    vocabulary's end rather than a typo."""
+    if not e["loc"] or e["loc"][0] != "walker":
+        return False
+    return e["type"] == "union_tag_invalid" or (e["type"] == "extra_forbidden"
+                                                 and not _suggestion(e))
+
+
+_BOUND_ERRORS = ("less_than", "less_than_equal", "greater_than", "greater_than_equal")
+
+
+def _unit_hint(e: dict, parts: list) -> str:
+    """A likely unit mistake behind a bound error (issue 26, item 9): an angle in degrees
+    given to a ``*_rad`` field (``3 rad = 172°; did you mean angle_deg?``), a length in
+    millimetres given to a ``*_m`` field (``1000 m: a length in mm? 1000 mm = 1 m``)."""
+    v = e.get("input")
+    if e["type"] not in _BOUND_ERRORS or isinstance(v, bool) or not isinstance(v, int | float) \
+            or not parts:
+        return ""
+    leaf = str(parts[-1])
+    if leaf.endswith("_rad"):
+        deg = leaf.removesuffix("_rad") + "_deg"
+        sibling = deg in _fields_at(tuple(e["loc"][:-1]))
+        return (f" ({v:g} rad = {math.degrees(v):.0f}°"
+                + (f"; did you mean {deg}?)" if sibling else "; an angle in degrees?)"))
+    if leaf.endswith("_m") and e["type"].startswith("less") and abs(v) >= 10:
+        return f" ({v:g} m: a length in mm? {v:g} mm = {v / 1000:g} m)"
+    return ""
+
+
+#: a slope in degrees below this looks like radians (``angle_deg: 0.0174``): a warning
+SMALL_SLOPE_DEG = 0.1
+
+
+def unit_warnings(scene: Scene) -> list[str]:
+    """Values that validate but look like a unit mistake (one line each, naming the field):
+    ``slope.angle_deg`` below :data:`SMALL_SLOPE_DEG` (radians given as degrees?)."""
+    out = []
+    d = scene.slope.angle_deg
+    if d is not None and 0 < abs(d) < SMALL_SLOPE_DEG:
+        out.append(f"slope.angle_deg: {d:g}° is a very small slope; it looks like radians "
+                   f"({d:g} rad = {math.degrees(d):.3g}°): if so, write angle_rad: {d:g}")
+    return out
+
+
+def _error_line(e: dict) -> str:
+    """One error as ``<field path>: <message>`` (an unknown key names the likely field)."""
     parts = [p for p in e["loc"] if _loc_part(p)]
     loc = ".".join(str(p) for p in parts)
     if e["type"] == "extra_forbidden":
-        key = str(e["loc"][-1])
-        close = difflib.get_close_matches(key, _fields_at(tuple(e["loc"][:-1])), n=1)
+        close = _suggestion(e)
         return f"{loc}: unknown field" + (f" (did you mean {close[0]}?)" if close else "")
-    msg = e["msg"].removeprefix("Value error, ")
+    msg = e["msg"].removeprefix("Value error, ").replace(
+        " found using _walker_tag() ", " (walker.model) ") + _unit_hint(e, parts)
     if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
             and e["type"] in ("float_type", "int_type", "finite_number", "bool_type",
                               "string_type", "float_parsing", "int_parsing"):
-        msg += f" (got {e['input']!r})"
-    if not loc and re.match(r"^[a-z_]+(\.[a-z_]+)+: ", msg):  # a cross-field check names it
+        msg += f" (got {_input_text(e['input'])})"
+        if isinstance(e["input"], str) and re.fullmatch(
+                r"[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+", e["input"].strip()):
+            # YAML 1.1 (PyYAML) reads a float only with a dot and a signed exponent
+            m, x = re.split("[eE]", e["input"].strip())
+            x = x if x[:1] in "+-" else "+" + x
+            msg += (f"; YAML reads {e['input']} as text: write "
+                    f"{m if '.' in m else m + '.0'}e{x}")
+    if not loc and re.match(r"^[a-z_]+(\.[a-z_]+)*: ", msg) \
+            and msg.split(".", 1)[0].split(":", 1)[0] in Scene.model_fields:
+        return msg  # a cross-field check names its field ("published: ...")
+    if loc and msg.startswith(f"{loc}: "):  # the section's own check names it already
         return msg
+    if loc and msg.startswith(f"{loc.rsplit('.', 1)[-1]}: "):  # "slope: give exactly one"
+        return f"{loc}: {msg.split(': ', 1)[1]}"
     return f"{loc or '<scene>'}: {msg}"
 
 
@@ -883,8 +1029,15 @@ def _format_error(path: Path, err: ValidationError) -> str:
             continue
         keep.append(x)
     keep = keep or errs[:1]
+    # a misspelt required key is one mistake: "unknown field (did you mean X?)" says it, so
+    # the "X: Field required" it causes is left out
+    meant = {(*locs[errs.index(x)][:-1], m) for x in keep if x["type"] == "extra_forbidden"
+             for m in _suggestion(x)}
+    keep = [x for x in keep if not (x["type"] == "missing" and locs[errs.index(x)] in meant)]
     keep.sort(key=lambda x: x["type"] != "extra_forbidden")  # stable: file order otherwise
-    lines = list(dict.fromkeys(_error_line(x) for x in keep))
+    said = next((x for x in keep if _walker_vocabulary_applies(x)), None)
+    lines = list(dict.fromkeys(_error_line(x) + (f"; {WALKER_VOCABULARY}" if x is said else "")
+                               for x in keep))  # the vocabulary once, on the first such line
     return "\n".join(f"{path}: {ln}" for ln in lines)
 
 
@@ -1015,6 +1168,11 @@ def load_scene(path: str | Path) -> Scene:
                              "starting with a dot); rename the file or set 'name:' in it")
     scene = scene_from_dict(data, path)
     scene._origin = path.resolve()
+    if unit_warnings(scene):
+        from walkerlab import progress
+
+        for line in unit_warnings(scene):
+            progress.note(f"warning: {path}: {line}")
     return scene
 
 

@@ -342,6 +342,20 @@ class ContactSimSettings(BaseModel):
         120.0, gt=0, description="Wall-time limit of the periodic-gait search [s]; when it "
         "runs out the gait is reported as 'time_limit' (null = none).",
         json_schema_extra={"unit": "s"})
+    start: Literal["ideal", "adjusted", "periodic_gait"] = Field(
+        "ideal", description="Initial state of the run: 'ideal' (the rigid fixed point, rates "
+        "times initial_rate_scale; the default), 'adjusted' (rates searched as `contact-sim "
+        "--adjust`), 'periodic_gait' (the contact model's own periodic gait at mid-stance, "
+        "on patches spaced by its step length: steady state without start-up transients; "
+        "adds the periodic-gait search, about 5-10 s).")
+
+    @model_serializer(mode="wrap")
+    def _drop_default_start(self, handler):
+        # a scene with the default start serialises as before (same content hashes)
+        d = handler(self)
+        if isinstance(d, dict) and d.get("start") == "ideal":
+            d.pop("start", None)
+        return d
 
 
 class ContactSolverSettings(BaseModel):

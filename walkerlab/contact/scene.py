@@ -61,7 +61,7 @@ def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
     return chord + R * (z[m - 1] - z[m // 2 - 1])
 
 
-def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
+def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
     """ContactWalker of the scene (any walker with positive leg masses) with checkerboard
     patches from the ideal step length.
 
@@ -72,12 +72,15 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
         Ideal fixed point (role order of the rigid walker, leg2 = stance) [rad, rad/s].
     n_steps : int
         Steps the run may take (sets how many patches are laid out).
+    step_length_m : float, optional
+        Patch spacing [m] instead of the ideal step length (a run started on the contact
+        model's own periodic gait lays its patches at that gait's footfalls).
 
     Returns
     -------
     walker : ContactWalker
     step_length : float
-        Ideal step length [m] (patch spacing).
+        Ideal step length [m] (the patch spacing unless ``step_length_m`` is given).
 
     Raises
     ------
@@ -96,6 +99,6 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int):
     si, knee = contact_si(contact)
     probe = ContactWalker(contact=si, data=data, knee_stop=knee)
     step_length = ideal_step_length(probe, x_ideal)
-    return ContactWalker.from_settings(contact, terrain, step_length=step_length,
+    return ContactWalker.from_settings(contact, terrain, step_length=step_length_m or step_length,
                                        n_steps=n_steps + 4, data=data), step_length
 

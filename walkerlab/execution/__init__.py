@@ -4,8 +4,11 @@ Dask) and the worker processes behind it.
 - :mod:`walkerlab.execution.executor`  :class:`Executor` (inline, pool, Dask),
   :func:`make_executor`, :func:`run_chains` / :func:`run_each` (used by sweeps, basin maps,
   bifurcation diagrams, stability maps)
+- :mod:`walkerlab.execution.dask`      Dask client helpers (connect, never wait for ever)
 - :mod:`walkerlab.execution.lanes`     pinned single-process lanes of the work-precision
   study (one worker per core, gates)
+- :mod:`walkerlab.execution.background` a timed study in a thread beside untimed work
+  (``walkerlab report``)
 - :mod:`walkerlab.execution.workers`   worker processes that end with their parent
   (forkserver/spawn, parent watch), :func:`process_alive`
 

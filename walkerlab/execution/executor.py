@@ -141,42 +141,69 @@ class PoolExecutor(_Context):
 class DaskExecutor(_Context):
     """Jobs on a Dask ``distributed`` cluster.
 
+    Never waits for ever: with no worker connected for ``$WALKERLAB_DASK_WORKER_WAIT_S``
+    seconds (default 60) while jobs are pending, or with the scheduler gone,
+    :meth:`next_done` raises :class:`walkerlab.execution.dask.DaskLost` (one line suggesting
+    ``--resume``); ``distributed``'s own log lines are kept quiet while it is open.
+
     Parameters
     ----------
     scheduler : str or distributed.Client
         Scheduler address (``"tcp://..."``; a client is opened here and closed on exit) or
         an existing client (left open).
+
+    Raises
+    ------
+    walkerlab.execution.dask.DaskLost
+        The address is not one, or the scheduler cannot be reached (one line).
     """
 
     slots = None
 
     def __init__(self, scheduler):
-        from distributed import Client
+        from walkerlab.execution.dask import connect, quiet_distributed
 
         self._own = isinstance(scheduler, str)
-        self.client = Client(scheduler, set_as_default=False) if self._own else scheduler
+        self._quiet = quiet_distributed()
+        self._quiet.__enter__()
+        try:
+            self.client = connect(scheduler) if self._own else scheduler
+        except BaseException:
+            self._quiet.__exit__(None, None, None)
+            raise
         self._futures: list = []
         self._ac = None
 
     def submit(self, fn: Callable, *args):
-        from distributed import as_completed
+        from walkerlab.execution.dask import completed
 
         fut = self.client.submit(fn, *args, pure=False)
         self._futures.append(fut)
         if self._ac is None:
-            self._ac = as_completed([fut], loop=self.client.loop)
+            self._ac = completed(self.client, [fut])
         else:
             self._ac.add(fut)
         return fut.key
 
     def next_done(self) -> tuple[Any, Any]:
+        from walkerlab.execution.dask import result
+
         fut = next(self._ac)
-        return fut.key, fut.result()
+        return fut.key, result(self.client, fut)
 
     def close(self) -> None:
-        self.client.cancel([f for f in self._futures if not f.done()])
-        if self._own:
-            self.client.close()
+        try:
+            try:
+                self.client.cancel([f for f in self._futures if not f.done()])
+            except Exception:  # noqa: BLE001 - a lost scheduler: nothing left to cancel
+                pass
+            if self._own:
+                try:
+                    self.client.close(timeout=5)
+                except Exception:  # noqa: BLE001 - closing a client whose scheduler died
+                    pass
+        finally:
+            self._quiet.__exit__(None, None, None)
 
 
 def make_executor(workers: int = 1, scheduler=None, pool: bool | None = None,

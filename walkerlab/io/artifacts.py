@@ -99,7 +99,9 @@ def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
     never a truncated one).
 
     The temporary file is created exclusively (``mkstemp``: ``O_CREAT | O_EXCL``, which does
-    not follow a symbolic link); ``path`` itself must not be a symbolic link.
+    not follow a symbolic link) as ``.<name>.<pid>.*.tmp``; those of a killed earlier writer
+    are removed first (:func:`walkerlab.safefs.remove_stale_temps`); ``path`` itself must not
+    be a symbolic link.
 
     Raises
     ------
@@ -109,12 +111,14 @@ def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
     walkerlab.io.runpaths.RunPathError
         ``path`` is a symbolic link.
     """
-    from walkerlab.safefs import refuse_link
+    from walkerlab.safefs import refuse_link, remove_stale_temps, temp_prefix
 
     path = refuse_link(Path(path))
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        remove_stale_temps(path.parent, path.name)  # of a killed earlier run
+        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.name), suffix=".tmp",
+                                   dir=path.parent)
     except OSError as exc:
         if is_disk_full(exc):
             raise disk_full_error(path, exc) from None
@@ -204,6 +208,17 @@ def content_hash(path: Path) -> str | None:
             return _content_hash_memo(Path(path), f)
     except (OSError, KeyError, ValueError):
         return None
+
+
+def stored_content_hash_matches(path: Path) -> bool:
+    """True when the artifact's content equals the content hash stored when it was written
+    (False: changed afterwards - edited by hand or with h5py - or unreadable)."""
+    try:
+        with h5py.File(path, "r") as f:
+            stored = f.attrs.get("content_hash")
+            return stored is not None and str(stored) == _content_hash_memo(Path(path), f)
+    except (OSError, KeyError, ValueError):
+        return False
 
 
 def verified_hash(path: Path) -> str | None:

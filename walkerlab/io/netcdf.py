@@ -157,6 +157,21 @@ def finish_sweep(f: h5py.File) -> None:
     for ds in rows:
         if not len(ds.dims[0]):
             ds.dims[0].attach_scale(g["point"])
+    # the swept values as coordinates of the rows (CF ``coordinates``): opened alone, the
+    # ``points`` group shows each row's slope.angle_deg beside its results (issue 26, item 7)
+    swept = []
+    for ds in (g["param"].values() if "param" in g else ()):
+        path = str(ds.attrs.get("path", ds.name.rsplit("/", 1)[-1]))
+        if isinstance(ds, h5py.Dataset) and path not in g:
+            aux = g.create_dataset(path, data=ds[()])
+            aux.attrs.update({k: v for k, v in ds.attrs.items() if k != "DIMENSION_LIST"})
+            aux.attrs["swept"] = 1
+            aux.dims[0].attach_scale(g["point"])
+        swept.append(path)
+    for ds in g.values():
+        if swept and isinstance(ds, h5py.Dataset) and not ds.is_scale \
+                and "swept" not in ds.attrs:
+            ds.attrs["coordinates"] = " ".join(swept)
     if "grid" in f:
         for name, ds in f["grid"].items():
             if isinstance(ds, h5py.Dataset) and not ds.is_scale:

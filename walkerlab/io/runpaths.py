@@ -134,17 +134,26 @@ def scene_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
     if owner is not None and owner != Path(origin) and owner.is_file():
         raise RunPathError(f"{d}: run folder of {owner}; {origin} has the same name "
                            f"{name!r}: set another 'name:' in one of them or use --runs-dir")
-    if claim and owner != Path(origin):
+    if claim:
         _mkdir(d)
-        atomic_text(marker, f"{origin}\n")
+        if owner != Path(origin):
+            atomic_text(marker, f"{origin}\n")
     return d
 
 
+#: suffixes of walkerlab's temporary files in run folders (artifacts, figures, animation)
+TEMP_SUFFIXES = (".tmp", ".gif", ".mp4")
+
+
 def _mkdir(d: Path) -> None:
+    """Create a run folder and remove the temporary files a killed run left in it."""
+    from walkerlab.safefs import remove_stale_temps
+
     try:
         d.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise RunPathError(f"{d}: cannot create the run folder ({exc.strerror})") from None
+    remove_stale_temps(d, None, TEMP_SUFFIXES)
 
 
 def stage_artifact(scene, runs_root: Path | str, stage: str, claim: bool = False) -> Path:

@@ -6,7 +6,7 @@ Everything is read from the trajectory's named points (``samples/points/<name>``
 - each leg is a chain ``hip -> <leg>_knee (if any) -> <leg>_foot``; with arc feet
   (points ``<leg>_foot_centre`` and ``<leg>_contact``) the chain runs through the arc's centre
   on to the arc, drawn as a circular arc of radius ``R = |contact - centre|`` about the leg's
-  axis (McGeer 1990), its contact point (lowest point relative to the slope) marked ``x``;
+  axis (McGeer 1990), its contact point (lowest point relative to the slope) a small dot;
 - every other point of a leg (point masses, rods' centres) is a dot; the hip a larger dot;
 - the ground is the slope line ``y = -x tan(phi)`` through the first stance foot (world
   frame, x downhill, y up), shaded below.
@@ -132,8 +132,13 @@ def write_frames(frames: WalkerFrames, path: Path | str, writer) -> None:
             writer.grab_frame()
 
 
+#: width of the animation [px] at least (two panels side by side: 480 px each)
+MIN_WIDTH_PX = 960
+
+
 def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: float = 20.0,
-                     max_frames: int = 150, time_unit: str = "s", dpi: int = 80):
+                     max_frames: int = 150, time_unit: str = "s", dpi: int = 100,
+                     terrain: dict | None = None):
     """The walkers walking side by side, one panel per trajectory.
 
     Parameters
@@ -150,7 +155,10 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
     time_unit : str
         Unit of the trajectories' time (for the clock in the title).
     dpi : int
-        Resolution of the saved frames.
+        Resolution of the saved frames; the figure is at least :data:`MIN_WIDTH_PX` wide.
+    terrain : dict, optional
+        Panel title -> the contact walker's ground (:func:`walkerlab.io.terrain.
+        load_terrain`): its checkerboard patches are drawn under that panel's slope line.
 
     Returns
     -------
@@ -165,8 +173,10 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
     times = frame_times(trajs, fps, max_frames)
     n = len(trajs)
     L = max(_leg_length(tr) for tr in trajs.values())
-    fig, axes = plt.subplots(1, n, figsize=(3.6 * n, 3.6), dpi=dpi, squeeze=False)
-    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.02, top=0.86, wspace=0.05)
+    width = max(MIN_WIDTH_PX / dpi, 4.8 * n)
+    fig, axes = plt.subplots(1, n, figsize=(width, 0.92 * width / n), dpi=dpi,
+                             squeeze=False)
+    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.88, wspace=0.03)
     axes = axes[0]
     xmin = min(float(tr.points["hip"][0].min()) for tr in trajs.values()) - 3 * L
     xmax = max(float(tr.points["hip"][0].max()) for tr in trajs.values()) + 3 * L
@@ -174,8 +184,15 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
     gy = -np.tan(slope_rad) * gx
     panels = []
     for ax, (title, tr) in zip(axes, trajs.items()):
-        ax.fill_between(gx, gy, gy - 3 * L, color="0.85", lw=0)
-        ax.plot(gx, gy, color="k", lw=1)
+        ground = (terrain or {}).get(title)
+        if ground is not None and not ground["continuous"]:  # patches over gaps
+            from walkerlab.plotting.figures import draw_patches
+
+            draw_patches(ax, ground, slope_rad, 0.12 * L)
+            ax.plot(gx, gy, color="0.6", lw=0.8, ls=":")
+        else:
+            ax.fill_between(gx, gy, gy - 3 * L, color="0.85", lw=0)
+            ax.plot(gx, gy, color="k", lw=1)
         ax.set_aspect("equal")
         ax.set_xticks([])
         ax.set_yticks([])
@@ -186,13 +203,13 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
             parts = leg_parts(tr, leg)
             legs.append({
                 "parts": parts,
-                "line": ax.plot([], [], color=c, lw=2.5, solid_capstyle="round")[0],
-                "arc": ax.plot([], [], color=c, lw=2.5)[0] if parts["arc"] else None,
-                "contact": ax.plot([], [], "x", color=c, ms=5)[0] if parts["arc"] else None,
-                "dots": ax.plot([], [], "o", color=c, ms=4)[0],
+                "line": ax.plot([], [], color=c, lw=3, solid_capstyle="round")[0],
+                "arc": ax.plot([], [], color=c, lw=3)[0] if parts["arc"] else None,
+                "contact": ax.plot([], [], "o", color=c, ms=3)[0] if parts["arc"] else None,
+                "dots": ax.plot([], [], "o", color=c, ms=6)[0],
             })
-        hip = ax.plot([], [], "o", color="k", ms=7)[0]
-        label = ax.set_title(title, fontsize=9)
+        hip = ax.plot([], [], "o", color="k", ms=9)[0]
+        label = ax.set_title(title, fontsize=13)
         panels.append((ax, tr, idx, legs, hip, label, title))
 
     def draw(j: int) -> None:

@@ -26,8 +26,8 @@ SI_UNITS = Units()
 LEG_COLORS = ["tab:blue", "tab:red", "tab:green", "tab:purple"]
 MODEL_STYLES = ["-", "--", ":", "-."]
 #: colours of the parts of each leg (thigh, shank), leg by leg; the first is LEG_COLORS'
-PART_COLORS = [("tab:blue", "tab:cyan"), ("tab:red", "tab:orange"),
-               ("tab:green", "tab:olive"), ("tab:purple", "tab:pink")]
+PART_COLORS = [("tab:blue", "tab:green"), ("tab:red", "tab:purple"),
+               ("tab:olive", "tab:cyan"), ("tab:brown", "tab:pink")]
 
 
 def save(fig, folder: Path, stem: str) -> list[Path]:
@@ -98,24 +98,27 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
                       units: Units = SI_UNITS):
     """Fig. 7: every named angle [rad] (a) and rate [rad/s] (b) over time, every model
     (``units``: the scene's unit labels)."""
-    fig, axes = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    fig, axes = plt.subplots(2, 1, figsize=(8, 6.4), sharex=True, layout="constrained")
     for mi, (label, tr) in enumerate(trajs.items()):
         sty = _coordinate_styles(list(tr.coordinates), mi)
         for ax, names in zip(axes, (tr.angle_names(), tr.rate_names())):
             for n in sorted(names, key=lambda n: n.split("_", 1)[0]):  # legend: leg by leg
                 ax.plot(tr.time, tr.coordinates[n], lw=1.2,
                         label=f"{n.rsplit('_', 1)[0]} - {label}", **sty[n])
-    axes[0].set_ylabel("angle from vertical [rad]")
-    axes[1].set_ylabel(f"angular rate [{units.rate}]")
-    axes[1].set_xlabel(f"time [{units.time}]")
-    axes[0].set_title("(a) angles")
-    axes[1].set_title("(b) angular rates")
+    axes[0].set_ylabel("angle from vertical [rad]", fontsize=10)
+    axes[1].set_ylabel(f"angular rate [{units.rate}]", fontsize=10)
+    axes[1].set_xlabel(f"time [{units.time}]", fontsize=10)
+    axes[0].set_title("(a) angles", fontsize=10)
+    axes[1].set_title("(b) angular rates", fontsize=10)
     for ax in axes:
         ax.grid(alpha=0.3)
+        ax.tick_params(labelsize=9)
     h, lab = axes[0].get_legend_handles_labels()
-    fig.legend(h, lab, loc="lower center", ncol=min(4, len(h)), fontsize=8)
-    fig.subplots_adjust(bottom=0.16 + 0.03 * ((len(h) - 1) // 4), hspace=0.3)
-    fig.suptitle(f"Fig. 7 - {title}, angles and rates")
+    # below the panels, inside the figure with its margin (constrained layout makes room)
+    # two columns (a model's legs side by side): no wider than the panels, so the report's
+    # scaled image keeps its text size
+    fig.legend(h, lab, loc="outside lower center", ncol=min(2, len(h)), fontsize=9)
+    fig.suptitle(f"Fig. 7 - {title}, angles and rates", fontsize=11)
     return fig
 
 
@@ -261,14 +264,38 @@ def _arc_feet(tr: NamedTrajectory, i: int, n_pts: int = 25) -> list[np.ndarray]:
     return arcs
 
 
+def draw_patches(ax, terrain: dict, slope_rad: float, depth: float,
+                 xlim: tuple[float, float] | None = None) -> None:
+    """The checkerboard's ground patches (:func:`walkerlab.io.terrain.load_terrain`) as
+    slabs under the slope line ``y = -x tan(phi)``: each leg's lane in its own shade (leg1
+    light, leg2 dark), ``depth`` deep; patches outside ``xlim`` are left out."""
+    from matplotlib.patches import Polygon
+
+    c, s = np.cos(slope_rad), np.sin(slope_rad)
+    w = float(terrain["half_width"])
+    for k, (_leg, centres) in enumerate(sorted(terrain["lanes"].items())):
+        for sc in np.asarray(centres, float):
+            corners = np.array([[sc - w, 0.0], [sc + w, 0.0], [sc + w, -depth],
+                                [sc - w, -depth]])  # along-slope, normal
+            xy = np.column_stack([corners[:, 0] * c + corners[:, 1] * s,
+                                  -corners[:, 0] * s + corners[:, 1] * c])
+            if xlim is not None and (xy[:, 0].max() < xlim[0] or xy[:, 0].min() > xlim[1]):
+                continue
+            ax.add_patch(Polygon(xy, closed=True, lw=0.6, ec="0.25",
+                                 fc=("0.8", "0.45")[k % 2], zorder=1))
+
+
 def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
-                  slope_rad: float | None = None, units: Units = SI_UNITS):
+                  slope_rad: float | None = None, units: Units = SI_UNITS,
+                  terrain: dict | None = None):
     """Stick diagram of the first gait cycle (two steps), as the paper's Figs. 2 and 6.
 
     Draws whatever named points the walker has: per leg a chain hip -> knee/shank points ->
     foot (sorted by distance from the hip), round feet as arcs about their centre, other
     points (torso ...) from the hip; point masses and centres of mass (``*_mass``,
     ``*_com``) as dots.  The snapshots' colour is the time, shown by a colour bar.
+    ``terrain`` (the contact walker's checkerboard, :func:`walkerlab.io.terrain.
+    load_terrain`): its ground patches drawn under the slope line (:func:`draw_patches`).
     """
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
@@ -296,6 +323,9 @@ def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
     xs = np.array([hip[0, idx].min() - 0.4, hip[0, idx].max() + 0.4])
     if slope_rad is not None:
         ax.plot(xs, -np.tan(slope_rad) * xs, color="k", lw=1)
+        if terrain is not None and not terrain["continuous"]:
+            draw_patches(ax, terrain, slope_rad, 0.04 * _hip_height(tr), tuple(xs))
+            label += ", ground patches shaded by lane"
     ax.set_aspect("equal")
     ax.set_xlabel(f"x [{units.length}] (downhill)")
     ax.set_ylabel(f"y [{units.length}]")
@@ -306,20 +336,40 @@ def stick_diagram(tr: NamedTrajectory, label: str, n_snapshots: int = 14,
     return fig
 
 
-def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 6) -> list:
+def _hip_height(tr: NamedTrajectory) -> float:
+    """Largest hip-to-point distance at the first sample (about the leg length)."""
+    hip = tr.points["hip"][:, 0]
+    return max(float(np.hypot(*(p[:, 0] - hip))) for p in tr.points.values()) or 1.0
+
+
+def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 6,
+                  avoid_legend: bool = False, marker_px: float = 0.0) -> list:
     """Annotate ``(x, y, text)`` points, skipping a label whose box would overlap one
-    already placed (tried at four offsets first): labels never cover each other."""
+    already placed (tried at four offsets first): labels never cover each other.
+
+    ``avoid_legend``: a label never covers the legend either; ``marker_px`` > 0: nor the
+    marker of another point (a square of that half-width [px] around it)."""
+    from matplotlib.transforms import Bbox
+
     fig = ax.figure
     fig.canvas.draw()  # a renderer and the final axis limits
     renderer = fig.canvas.get_renderer()
     placed, boxes = [], []
-    for x, y, text in points:
+    leg = ax.get_legend()
+    if avoid_legend and leg is not None:
+        boxes.append(leg.get_window_extent(renderer))
+    pix = ax.transData.transform(np.array([(x, y) for x, y, _ in points], float)
+                                 ) if points else np.zeros((0, 2))
+    markers = [Bbox.from_extents(px - marker_px, py - marker_px, px + marker_px,
+                                 py + marker_px) for px, py in pix] if marker_px > 0 else []
+    for k, (x, y, text) in enumerate(points):
+        others = boxes + [m for j, m in enumerate(markers) if j != k]
         for dx, dy, ha, va in ((4, 3, "left", "bottom"), (4, -3, "left", "top"),
                                (-4, 3, "right", "bottom"), (-4, -3, "right", "top")):
             a = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points",
                             fontsize=fontsize, alpha=0.7, ha=ha, va=va)
             bb = a.get_window_extent(renderer).expanded(1.05, 1.1)
-            if not any(bb.overlaps(b) for b in boxes):
+            if not any(bb.overlaps(b) for b in others):
                 boxes.append(bb)
                 placed.append(a)
                 break
@@ -329,7 +379,8 @@ def _place_labels(ax, points: list[tuple[float, float, str]], fontsize: float = 
 
 def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: list | None = None,
                    units: Units = SI_UNITS):
-    """Work-precision diagram: error vs wall time (log-log), one line per method; the
+    """Work-precision diagram: error vs CPU time of the integration (log-log; older
+    artifacts: wall time), one line per method; the
     spread of the repeats (``time_min``..``time_max``) as horizontal bars, the tolerance
     next to each point where its label does not cover another.  The error is in the
     scene's units (``units``: rad, rad/s or rad/√(l/g)); the wall time in real seconds."""
@@ -346,11 +397,14 @@ def work_precision(rows: dict[str, dict[str, np.ndarray]], title: str, pareto: l
                                                              d["rtol"][ok])]
     if pareto:
         pt = np.array([(p["time"], p["error"]) for p in pareto])
-        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (median times)")
-    ax.set_xlabel("wall time [s] (median of repeats; bars: fastest to slowest run)")
+        ax.loglog(pt[:, 0], pt[:, 1], "k--", lw=1, label="Pareto front (beyond the spread)")
+    clock = ("CPU time of the integration" if any("wall_time" in d for d in rows.values())
+             else "wall time")
+    ax.set_xlabel(f"{clock} [s] (median of repeats; bars: fastest to slowest run)")
     ax.set_ylabel(f"max state error vs reference [rad, {units.rate}]")
     ax.set_title(title)
     ax.grid(alpha=0.3, which="both")
     _legend(ax)
-    _place_labels(ax, labels)
+    # labels cover neither each other, nor the legend, nor another setting's marker
+    _place_labels(ax, labels, avoid_legend=True, marker_px=4.0)
     return fig

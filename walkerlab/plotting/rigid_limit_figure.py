@@ -15,7 +15,7 @@ def rigid_limit_figure(d: dict, title: str):
     Parameters
     ----------
     d : dict
-        :func:`walkerlab.stages.rigid_limit.load`.
+        :func:`walkerlab.io.schemas.rigid_limit.load_rigid_limit`.
     title : str
     """
     fig, axes = plt.subplots(1, 3, figsize=(13, 4))

@@ -200,6 +200,26 @@ _REASON_TEXT = {"off_patch": "off\npatch", "fall": "falls", "no_mid_stance": "no
                 "unsupported": "not sup-\nported"}
 
 
+def _scene_point(xv, yv, attrs) -> tuple[float, float] | None:
+    """The scene's (slope, y) in the map's cell-index coordinates (interpolated, log on a
+    log grid), or None when the artifact does not store it."""
+    try:
+        sx, sy = float(attrs["scene_slope_deg"]), float(attrs["scene_y"])
+    except (KeyError, TypeError, ValueError):
+        return None
+    if not (np.isfinite(sx) and np.isfinite(sy)) or xv.size < 1 or yv.size < 1:
+        return None
+    log = yv.min() > 0 and sy > 0 and yv.max() / yv.min() > 100
+
+    def idx(v, grid, take_log=False):
+        g = np.log10(grid) if take_log else grid
+        v = np.log10(v) if take_log else v
+        order = np.argsort(g)
+        return float(np.interp(v, g[order], np.arange(g.size)[order]))
+
+    return idx(sx, xv), idx(sy, yv, log)
+
+
 def gait_map_figure(data: dict):
     """Stability map of the contact gait from a loaded ``stability_map_<kind>.h5``.
 
@@ -251,6 +271,10 @@ def gait_map_figure(data: dict):
     for k, lab in enumerate(GAIT_CLASSES):
         if np.any(code == k):
             a1.plot([], [], "s", color=GAIT_COLORS[k], label=lab)
+    at = _scene_point(xv, yv, attrs)
+    if at is not None:  # the scene's own contact and slope, between cells if need be
+        a1.plot(*at, marker="*", ms=16, mfc="none", mec="k", mew=1.6, ls="none",
+                label="this scene", zorder=5)
     a1.plot([], [], " ", label="cell text: max |multiplier|\nor why no gait")
     a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     log_y = yv.min() > 0 and yv.max() / yv.min() > 100
@@ -292,7 +316,7 @@ def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=No
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = plt.subplots(figsize=(5.5, 3.6))
+    fig, ax = plt.subplots(figsize=(5.5, 4.2), layout="constrained")
     labels = {"paper": "paper family (damping, dmax fixed)",
               "rigid_limit": "rigid-limit family (c ~ k^(1/(e+1)), dmax ~ k^(-1/(e+1)))"}
     for fam, e in curves.items():
@@ -306,6 +330,77 @@ def restitution_figure(stiffness, curves: dict, unit: str = "N/mm^e", k_paper=No
     u = units or Units()
     ax.set_title(f"drop test: {mass_kg:.3g} {u('kg')} at {speed_m_per_s:g} {u('m/s')} (rigid "
                  "plastic impact: 0)", fontsize=9)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
+    # below the axes: inside them the legend covered the scene's stiffness line
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", fontsize=8,
+               ncol=1, frameon=False)
+    return fig
+
+
+_COLUMN_LABELS = {"max_abs_multiplier": "max |Floquet multiplier|\n(dashed: 1)",
+                  "steps_completed": "steps completed", "heel_strikes": "heel strikes"}
+
+
+def sweep_figure(data: dict, title: str = ""):
+    """The main results of a sweep against its first swept field, from a loaded sweep
+    (:func:`walkerlab.sweep.store.load_sweep`).
+
+    One panel per main result column (:data:`walkerlab.report.sweep_text.MAIN_COLUMNS`);
+    points that walk (outcome ``ok``) joined by a line, one line per value of the other
+    swept fields; a point that does not walk is a cross at the panel's foot in its outcome's
+    colour (legend).  Axis labels carry the scene's units.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from walkerlab.report.sweep_text import column_unit, main_columns
+    from walkerlab.sweep.store import field_unit
+
+    units = Units(str(data["attrs"].get("scene_units", "SI")))
+    pts = data["points"]
+    (xpath, _), *others = data["axes"]
+    x = np.asarray(pts[f"param/{xpath}"])
+    numeric = x.dtype.kind in "fi"
+    if not numeric:
+        cats = list(dict.fromkeys(x.tolist()))
+        x = np.array([cats.index(v) for v in x], float)
+    outcome = np.asarray(pts["outcome"]).astype(str)
+    ok = outcome == "ok"
+    groups = [tuple(str(pts[f"param/{p}"][i]) for p, _ in others) for i in range(x.size)]
+    cols = main_columns(data)
+    fig, axes = plt.subplots(max(len(cols), 1), 1, figsize=(6.4, 1.2 + 1.9 * max(len(cols), 1)),
+                             sharex=True, constrained_layout=True, squeeze=False)
+    xunit = units(field_unit(xpath))
+    xlabel = _label(xpath) if xpath in _UNITS else f"{xpath} [{xunit}]"
+    for ax, c in zip(axes[:, 0], cols):
+        y = np.asarray(pts[c], float)
+        for gi, g in enumerate(dict.fromkeys(groups)):
+            sel = ok & np.array([gg == g for gg in groups])
+            o = np.argsort(x[sel], kind="stable")
+            lab = ", ".join(f"{p} = {v}" for (p, _), v in zip(others, g)) or None
+            ax.plot(x[sel][o], y[sel][o], "o-", ms=3, lw=1.2, color=f"C{gi % 10}", label=lab)
+        unit = column_unit(c, units)
+        name = _COLUMN_LABELS.get(c) or c.removesuffix("_mm").removesuffix("_s") \
+            .removesuffix("_m_per_s").replace("_", " ")
+        ax.set_ylabel(name + (f" [{unit}]" if unit else ""))
+        if c == "max_abs_multiplier":
+            ax.axhline(1.0, color="0.4", ls="--", lw=0.8)
+        ax.grid(alpha=0.3)
+        for kind in dict.fromkeys(outcome[~ok]):
+            sel = outcome == kind
+            ax.plot(x[sel], np.zeros(sel.sum()), "x", transform=ax.get_xaxis_transform(),
+                    color=OUTCOME_COLORS.get(kind, "k"), ms=6, clip_on=False,
+                    label=OUTCOME_LABELS.get(kind, kind))
+    ax0 = axes[0, 0]
+    if any(h.get_label() and not h.get_label().startswith("_")
+           for h in ax0.get_lines()):
+        ax0.legend(fontsize=8, loc="best")
+    last = axes[-1, 0]
+    last.set_xlabel(xlabel)
+    if not numeric:
+        last.set_xticks(range(len(cats)), cats)
+    ok_n = int(ok.sum())
+    fig.suptitle((title + "\n" if title else "")
+                 + f"{data['attrs'].get('sweep_stage', '')} sweep: {ok_n} of {x.size} points "
+                 "ok (crosses: the others, by outcome)", fontsize=10)
     return fig

@@ -21,6 +21,7 @@ from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections
 from walkerlab.report.markdown import details, num, table, text, to_html
+from walkerlab.report.robustness_section import robustness_section
 from walkerlab.units import for_scene as units_for_scene
 
 
@@ -93,6 +94,8 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)
     pub = for_scene(scene)
+    from walkerlab.report.attribution_section import attribution_section
+
     md = _header(scene)
     arts = inputs.artifacts
     md += sections.summary_section(scene, inputs, pub)
@@ -106,9 +109,11 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
         md += sections.fixedpoint_section(arts["fixedpoint"], pub)
     md += sections.gait_section(scene, inputs, pub)
     md += contact_sections.sections(scene, arts)
+    md += attribution_section(scene, arts)
     md += sections.workprecision_summary(scene, arts)
     md += sections.bifurcation_section(arts, pub)
     md += sections.basin_section(arts)
+    md += robustness_section(arts)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
     md += sections.figures_section(Path(figures_dir), str(rel), arts)

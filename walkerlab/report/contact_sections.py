@@ -43,7 +43,9 @@ def contact_section(scene, arts) -> list[str]:
     creep = c.steps.get("double_support_creep_mm")
     drop = c.drop
     periods = c.steps["period"]
-    adj = c.adjust
+    adj = dict(c.adjust) if c.adjust is not None else None
+    if adj is not None:
+        adj.update(kept=str(adj.get("kept", "adjusted")), why=str(adj.get("kept_reason", "")))
     per = per_fail = None
     if c.periodic is not None and not c.periodic.found:
         per_fail = (c.periodic.outcome, c.periodic.message)
@@ -73,7 +75,9 @@ def contact_section(scene, arts) -> list[str]:
            + "; ".join(f"{n} × {num(v, 3)}" for n, v in zip(scaled, np.atleast_1d(scale)))
            + ")"
            + (f" (found by `--adjust`: objective {num(adj['objective'], 3)} after "
-              f"{int(adj['evaluations'])} simulations)" if adj else "")
+              f"{int(adj['evaluations'])} simulations)" if adj and adj["kept"] != "scene"
+              else f" (the scene's own: `--adjust` found a scale that walks worse; {adj['why']})"
+              if adj else "")
            + "." + _table2_note(pub), "",
            "## Contact walker (MSC ADAMS-style model)", "",
            _table(["quantity", "value", "unit"], _summary_rows(summ, stage_wall)

@@ -12,15 +12,18 @@ from __future__ import annotations
 
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from walkerlab.analysis.tables import TABLE3_ROWS
-from walkerlab.io.schemas.simulate import SimulateArtifact
-from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 from walkerlab.report.markdown import details, num, printed, sig_digits, table
 from walkerlab.report.text import workprecision_choice, zero_multipliers_text
 from walkerlab.units import Units, for_scene
+
+if TYPE_CHECKING:  # loaded artifacts (walkerlab.io.schemas)
+    from walkerlab.io.schemas.simulate import SimulateArtifact
+    from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 
 
 # --------------------------------------------------------------------------- data
@@ -283,8 +286,10 @@ def steps_table(sim: SimulateArtifact) -> str:
 
 def workprecision_table(wp: WorkPrecisionArtifact, model: str) -> str:
     """Every (method, rtol) point of one model of ``workprecision.h5``."""
-    rows = []
+    rows, clock = [], "wall"
     for m, d in wp.models[model].rows.items():
+        if "wall_time" in d:  # times are the integration's CPU time (older artifacts: wall)
+            clock = "CPU"
         lo = d.get("time_min", d["time"])
         hi = d.get("time_max", d["time"])
         reps = d["repeats"] if "repeats" in d else np.ones(len(lo), int)
@@ -292,7 +297,7 @@ def workprecision_table(wp: WorkPrecisionArtifact, model: str) -> str:
                                         d["nfev"]):
             rows.append([m, num(rt, 1), num(t * 1e3, 3), f"{num(a * 1e3, 3)}–"
                          f"{num(b * 1e3, 3)}", int(k), num(e, 2), int(n)])
-    return table(["method", "rtol", "median wall [ms]", "min–max wall [ms]", "runs",
+    return table(["method", "rtol", f"median {clock} [ms]", f"min–max {clock} [ms]", "runs",
                   "error vs reference", "RHS evals"], rows)
 
 
@@ -356,7 +361,9 @@ def workprecision_summary(scene, arts: dict) -> list[str]:
                    + _solver_text(scene, model))
         pm = [str(s) for s in m.choice.get("pareto_methods", [])]
         pr = list(m.choice.get("pareto_rtol", []))
-        out += ["", "Pareto front (no setting is both faster and more accurate): "
+        out += ["", "Pareto front (no setting is both more accurate and faster by more than "
+                "the spread of the repeats' CPU times; of two settings whose times overlap "
+                "only the more accurate is kept): "
                 + ", ".join(f"{a} {r:.0e}" for a, r in zip(pm, pr)) + ".", ""]
     return out
 

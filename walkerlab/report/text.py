@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from walkerlab.io.schemas.compare import Comparison
-from walkerlab.io.schemas.contact_sim import ContactSimArtifact
-from walkerlab.io.schemas.fixedpoint import FixedPointArtifact
-from walkerlab.io.schemas.simulate import SimulateArtifact
-from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 from walkerlab.report.markdown import num
+
+if TYPE_CHECKING:  # the loaded artifacts these summaries print
+    from walkerlab.io.schemas.compare import Comparison
+    from walkerlab.io.schemas.contact_sim import ContactSimArtifact
+    from walkerlab.io.schemas.fixedpoint import FixedPointArtifact
+    from walkerlab.io.schemas.simulate import SimulateArtifact
+    from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
 
 
 def _fmt_mult(re, im) -> str:
@@ -78,7 +82,7 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
     for lab, g in fp.gaits.items():
         mod = float(np.max(np.hypot(g.multipliers.real, g.multipliers.imag)))
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
-                     f"{g.step_period_s:.6f} s, max |multiplier| {mod:.4g}, "
+                     f"{g.step_period_s:.6f} {fp.units.time}, max |multiplier| {mod:.4g}, "
                      f"{'stable' if g.stable else 'UNSTABLE'} "
                      f"({_GAIT_SOURCES.get(g.source, g.source)})")
     notes = fp.gait_notes
@@ -87,11 +91,32 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
     return lines
 
 
+#: how a rigid run that did not complete its strides ended, as a verb
+_ENDED = {"fall": "fell", "solver_failure": "stopped by a solver failure",
+          "t_final": "stopped (a step took longer than max_step_time_s)",
+          "no_heel_strike": "made no step (no_heel_strike)"}
+
+
+def simulate_ending(sim: SimulateArtifact) -> str | None:
+    """``"fell after 17 heel strikes (8.5 strides of the 20 asked)"`` for a run that did not
+    complete its strides; None for one that did."""
+    if sim.termination == "heel_strike":
+        return None
+    n = sim.heel_strike_count()
+    return (f"{_ENDED.get(sim.termination, f'ended by {sim.termination}')} after {n} heel "
+            f"strike{'' if n == 1 else 's'} ({n / 2:g} strides of the "
+            f"{sim.strides_requested} asked)")
+
+
 def simulate_text(sim: SimulateArtifact) -> str:
-    """Steps completed, per-step period/length/speed, energy."""
+    """Steps completed, per-step period/length/speed, energy; for a run that did not
+    complete its strides, only how it ended (:func:`simulate_ending`)."""
+    ending = simulate_ending(sim)
+    if ending is not None:
+        return ending
     u, s = sim.units, sim.summary
     lines = [f"simulated {sim.strides_requested} strides: "
-             f"{sim.heel_strike_count()} heel strikes, ended by {sim.termination}"]
+             f"{sim.heel_strike_count()} heel strikes"]
     if u.nondimensional:
         lines.append(f"  ({u.sentence()})")
     lines.append(f"  mean step period  {num(s['mean_period_s'], 7)} {u.time}")
@@ -114,8 +139,17 @@ def contact_text(c: ContactSimArtifact) -> str:
         s = np.atleast_1d(c.initial_rate_scale)
         # per named coordinate: the rates of leg1 (swing) and leg2 (stance) at the start
         names = c.rate_names or ["leg1 rates", "leg2 rates"]
-        lines.append("adjusted initial rate scale (found by --adjust): "
-                     + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s)))
+        kept, why = str(c.adjust.get("kept", "adjusted")), str(c.adjust.get("kept_reason", ""))
+        found = np.atleast_1d(c.adjust.get("scale", s))
+        if kept == "scene":  # the adjusted start walked worse (issue 26, item 3)
+            lines.append("--adjust: kept the scene's initial rate scale ("
+                         + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
+                         + "), which walks better than the adjusted one ("
+                         + ", ".join(f"{v:.4g}" for v in found) + f"): {why}")
+        else:
+            lines.append("--adjust: kept the adjusted initial rate scale: "
+                         + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
+                         + (f" ({why})" if why else ""))
     for k, (v, unit) in c.summary.items():
         lines.append(f"  {k:<32s} {num(v)}" + (f" {unit}" if unit not in ("", "-") else ""))
     if "wall_time_s" in c.summary and np.isfinite(c.stage_wall_time_s):
@@ -126,8 +160,9 @@ def contact_text(c: ContactSimArtifact) -> str:
         lines.append(f"periodic contact gait: not found ({per.outcome}: {per.message})")
     elif per is not None:
         mult = per.multipliers
-        lines.append(f"periodic contact gait: step period {num(per.step_period_s, 6)} s, "
-                     f"step length {num(per.step_length_m, 6)} m, "
+        lines.append(f"periodic contact gait: step period {num(per.step_period_s, 6)} "
+                     f"{c.units.time}, step length {num(per.step_length_m, 6)} "
+                     f"{c.units.length}, "
                      f"{'stable' if per.stable else 'unstable'}")
         lines.append("  Floquet multipliers: " + ", ".join(f"{m:.5f}" for m in mult[:3])
                      + f" (+{len(mult) - 3} fast contact modes ~0)")
@@ -175,7 +210,7 @@ def workprecision_choice(attrs) -> str:
     if "best_separated" not in attrs:  # an artifact from before the spread was stored
         return (f"fastest median run reaching the target error {target}: {name} "
                 f"({_ms(attrs['best_time'])}; timing spread not recorded).")
-    spread = (f"median {_ms(attrs['best_time'])}, {_ms(attrs['best_time_min'])}–"
+    spread = (f"median {_ms(attrs['best_time'])} CPU, {_ms(attrs['best_time_min'])}–"
               f"{_ms(attrs['best_time_max'])} over {int(attrs['best_repeats'])} runs")
     if bool(attrs["best_separated"]):
         return (f"fastest setting reaching the target error {target}: **{name}** ({spread}; "
@@ -184,11 +219,32 @@ def workprecision_choice(attrs) -> str:
         attrs["tied_methods"], attrs["tied_rtol"], attrs["tied_time_min"],
         attrs["tied_time_max"])]
     return (f"the timings cannot separate the settings reaching the target error {target}: "
-            + ", ".join(tied) + " (min–max wall time over the repeats overlap, or a setting "
-            "was timed once); the lowest median is " + name + ".")
+            + ", ".join(tied) + " (min–max CPU time of the integration over the repeats "
+            "overlap, or a setting was timed once): indistinguishable; the lowest median is "
+            + name + ".")
 
 
 def workprecision_text(wp: WorkPrecisionArtifact) -> str:
     """One line per model of a workprecision artifact: its choice and the timing noise."""
     return "\n".join(f"{model}: {workprecision_choice(m.choice)}"
                      for model, m in wp.models.items())
+
+
+def rigid_limit_text(d: dict) -> list[str]:
+    """The convergence table of a loaded ``rigid_limit.h5`` (``d``:
+    :func:`walkerlab.io.schemas.rigid_limit.load_rigid_limit`): per ``kappa`` the period and
+    step-length gaps to the rigid gait [ms, mm], the stored observed orders, each multiplier."""
+    gT = d["period"] - d["rigid_period"]
+    gL = d["step_length"] - d["rigid_step_length"]
+    oT, oL = d["observed_order"]["period"], d["observed_order"]["step_length"]
+    lam = d["multipliers"]
+    head = (f"{'kappa':>8} {'period gap [ms]':>16} {'order':>6} {'step gap [mm]':>14} "
+            f"{'order':>6}  multipliers (rigid: "
+            + ", ".join(f"{x:.4f}" for x in d["rigid_multipliers"]) + ")")
+    out = [head]
+    for i, k in enumerate(d["kappa"]):
+        o1 = f"{oT[i - 1]:6.3f}" if i else " " * 6
+        o2 = f"{oL[i - 1]:6.3f}" if i else " " * 6
+        out.append(f"{k:8.3g} {gT[i] * 1e3:+16.4f} {o1} {gL[i] * 1e3:+14.4f} {o2}  "
+                   + ", ".join(f"{x:.4f}" for x in lam[i]))
+    return out

@@ -3,7 +3,9 @@
 Not an HDF5 artifact (a figure, like ``walkerlab plot``'s); always redrawn (a few seconds).
 
 Drawn from the artifacts only: ``simulate.h5`` (run or reused first, as ``compare`` does) and,
-where it exists, ``contact_sim.h5`` beside it (rigid and contact side by side, same times).
+where it exists and is current, ``contact_sim.h5`` beside it (rigid and contact side by side,
+same times).  A ``contact_sim.h5`` of another scene (or of an earlier fixed point) or one
+changed after it was written is left out, and a one-line note says why (issue 26).
 The slope comes from the resolved scene stored in ``simulate.h5``.  GIF through matplotlib's
 Pillow writer (one shared palette, :func:`walkerlab.plotting.animation.gif_writer`); MP4
 through its ffmpeg writer only when ffmpeg is installed.  Both written atomically (temporary
@@ -40,10 +42,16 @@ class AnimateOutcome:
 
 def _atomic_save(frames, path: Path, writer) -> Path:
     """Write the frames to a temporary file of the same suffix in the same folder, then rename
-    (matplotlib's writers pick the format from the file name)."""
+    (matplotlib's writers pick the format from the file name).  ``path`` must not be a
+    symbolic link (RunPathError, one line); temporary files of a killed earlier run
+    (``.animation.<pid>.*.gif``) are removed first."""
     from walkerlab.plotting.animation import write_frames
+    from walkerlab.safefs import refuse_link, remove_stale_temps, temp_prefix
 
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    refuse_link(path)
+    remove_stale_temps(path.parent, path.stem, (path.suffix,))
+    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.stem), suffix=path.suffix,
+                               dir=path.parent)
     os.close(fd)
     try:
         write_frames(frames, tmp, writer)
@@ -52,6 +60,24 @@ def _atomic_save(frames, path: Path, writer) -> Path:
     finally:
         Path(tmp).unlink(missing_ok=True)
     return path
+
+
+def contact_left_out(scene: Scene, runs_root, path: Path) -> str:
+    """Why ``contact_sim.h5`` must not be drawn beside the current rigid walker ('' if it
+    may): changed after it was written, or written for other inputs than the scene's
+    current ones (any of the contact stage's variants: plain, ``--adjust``, ``--periodic``)."""
+    from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
+    from walkerlab.stages import contact_sim
+    from walkerlab.stages.common import input_hash
+
+    if not stored_content_hash_matches(path):
+        return f"{path.name} was changed after it was written"
+    up = (artifact_path(scene, runs_root, "fixedpoint"),)
+    have = stored_hash(path)
+    for extra in ((), ("adjust",), ("periodic",), ("adjust", "periodic")):
+        if have == input_hash("contact-sim", scene, contact_sim.SECTIONS + extra, up):
+            return ""
+    return f"{path.name} was computed for another scene or fixed point"
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
@@ -82,21 +108,32 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
     from walkerlab.plotting.animation import gif_writer, walker_animation
 
     sim = load_simulate(artifact_path(scene, runs_root, "simulate"))
-    trajs = {IDEAL_LABEL: sim.samples}
+    trajs, notes = {IDEAL_LABEL: sim.samples}, []
     contact = artifact_path(scene, runs_root, "contact-sim")
-    if contact.is_file():
+    why = contact_left_out(scene, runs_root, contact) if contact.is_file() else ""
+    if why:
+        notes.append(f"animated the rigid walker only: {why} (rerun 'walkerlab contact-sim' "
+                     "to animate the contact walker beside it)")
+    elif contact.is_file():
         trajs[CONTACT_LABEL] = load_contact_sim(contact).samples
     unit = sim.units.time
     slope = SlopeSettings.model_validate(json.loads(sim.scene_json)["slope"]).phi_rad
     folder = figures_dir(scene, runs_root, claim=True)
-    frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames, time_unit=unit)
-    out = AnimateOutcome()
+    ground = {}
+    if CONTACT_LABEL in trajs:  # the checkerboard the contact walker walks on
+        from walkerlab.io.terrain import load_terrain
+
+        ground[CONTACT_LABEL] = load_terrain(artifact_path(scene, runs_root, "contact-sim"))
+    frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames, time_unit=unit,
+                              terrain=ground)
+    out = AnimateOutcome(note="; ".join(notes))
     try:
         out.paths.append(_atomic_save(frames, folder / "animation.gif", gif_writer(fps)))
         if writers.is_available("ffmpeg"):
             out.paths.append(_atomic_save(frames, folder / "animation.mp4", FFMpegWriter(fps=fps)))
         else:
-            out.note = "ffmpeg not found: wrote the GIF only (install ffmpeg for the MP4)"
+            out.note = "; ".join(notes + ["ffmpeg not found: wrote the GIF only (install "
+                                          "ffmpeg for the MP4)"])
     finally:
         plt.close(frames.fig)
     return out

@@ -30,21 +30,33 @@ from walkerlab.stages.common import (
 SECTIONS = ("walker", "slope", "ideal", "basin")
 
 
-def figure_path(scene: Scene, runs_root: Path | str) -> Path:
-    """``runs/<scene>/report/figures/basin.png``."""
+def stem(scene: Scene, grid: tuple[int, int] | None = None) -> str:
+    """File stem of a basin map: ``basin`` on the scene's grid (``basin.grid``, the map the
+    report shows), ``basin_<nx>x<ny>`` on another grid (``--grid 40x40``), so a quick
+    coarse map never replaces the scene's own (as sweeps get their own artifacts)."""
+    own = tuple((scene.basin or BasinSettings()).grid)
+    return "basin" if grid is None or tuple(grid) == own else f"basin_{grid[0]}x{grid[1]}"
+
+
+def figure_path(scene: Scene, runs_root: Path | str, grid: tuple[int, int] | None = None
+                ) -> Path:
+    """``runs/<scene>/report/figures/<stem>.png`` (:func:`stem`)."""
     from walkerlab.stages.plot import figures_dir
 
-    return figures_dir(scene, runs_root) / "basin.png"
+    return figures_dir(scene, runs_root) / f"{stem(scene, grid)}.png"
 
 
-def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
-    """Draw the basin figure (PNG + SVG) from ``basin.h5``."""
+def draw(scene: Scene, runs_root: Path | str = "runs",
+         grid: tuple[int, int] | None = None) -> list[Path]:
+    """Draw the basin figure (PNG + SVG) from ``<stem>.h5``."""
     from walkerlab.plotting.basin_figures import basin_figure
     from walkerlab.plotting.figures import save
 
-    d = load_basin(artifact_path(scene, runs_root, "basin"))
-    fig = basin_figure(d, f"Basin of attraction - scene '{scene.name}'")
-    return save(fig, figure_path(scene, runs_root).parent, "basin")
+    name = stem(scene, grid)
+    d = load_basin(artifact_path(scene, runs_root, name))
+    title = f"Basin of attraction - scene '{scene.name}'" + (
+        "" if name == "basin" else f" ({grid[0]}x{grid[1]} cells)")
+    return save(basin_figure(d, title), figure_path(scene, runs_root).parent, name)
 
 
 def check(scene: Scene, grid: tuple[int, int] | None = None, workers: int = 2,
@@ -89,7 +101,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     st = scene.basin or BasinSettings()
     grid, workers = check(scene, grid, workers)
     up = artifact_path(scene, runs_root, "fixedpoint")
-    path = stage_artifact(scene, runs_root, "basin", claim=True)
+    path = stage_artifact(scene, runs_root, stem(scene, grid), claim=True)
     # one writer per artifact (as run_cached): a second identical run waits, then reuses
     with artifact_lock(path, wait=True, on_wait=_tell):
         return _run_locked(scene, runs_root, force, grid, workers, scheduler, resume,
@@ -104,8 +116,8 @@ def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_ch
     from walkerlab.io.artifacts import verified_hash
 
     if not force and path.is_file() and verified_hash(path) == key:  # content still matches
-        if not figure_path(scene, runs_root).is_file():
-            draw(scene, runs_root)
+        if not figure_path(scene, runs_root, grid).is_file():
+            draw(scene, runs_root, grid)
         return StageOutcome("basin", path, True, 0.0, {})
     note = ""
     if not force and path.is_file():  # never replaced silently (as run_cached)
@@ -128,5 +140,5 @@ def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_ch
                    {"workers": workers if scheduler is None else 0,
                     "scheduler": str(scheduler or "")})
     res["partial"].unlink(missing_ok=True)
-    draw(scene, runs_root)
+    draw(scene, runs_root, grid)
     return StageOutcome("basin", path, False, wall, {"counts": counts, "grid": grid}, note)

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import CommandOptions, Scene, validate_option
-from walkerlab.stages.common import StageOutcome, require, run_cached
+from walkerlab.stages.common import StageOutcome, run_cached, with_defaults
 from walkerlab.stages.plot import figures_dir
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
@@ -64,7 +64,7 @@ def run(scene: Scene, slopes_deg, runs_root: Path | str = "runs", n_transient: i
     )
     from walkerlab.sweep.params import ParamAxis, axis_unit, check_axes
 
-    require(scene, "fixedpoint", "bifurcation")
+    scene = with_defaults(scene, "fixedpoint", "bifurcation")
     n_transient = validate_option(CommandOptions, "bifurcation_transient", n_transient,
                                   "--transient")
     n_keep = validate_option(CommandOptions, "bifurcation_keep", n_keep, "--keep")

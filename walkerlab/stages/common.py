@@ -160,10 +160,48 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
     return StageOutcome(stage, path, False, wall, summary, note)
 
 
+def _default_section(scene: Scene, section: str):
+    """The section's settings with every field at its default, or None when the section has
+    a required field (``contact``: a contact law must be chosen)."""
+    import typing
+
+    from pydantic import BaseModel, ValidationError
+
+    ann = type(scene).model_fields[section].annotation  # ``FixedPointSettings | None``
+    models = [m for m in typing.get_args(ann) or (ann,)
+              if isinstance(m, type) and issubclass(m, BaseModel)]
+    if len(models) != 1:
+        return None
+    try:
+        return models[0]()
+    except ValidationError:
+        return None
+
+
 def require(scene: Scene, section: str, stage: str):
-    """Return the scene section a stage needs, or raise a one-line StageError."""
+    """Return the scene section a stage needs; a missing section whose fields are all
+    optional is its defaults (``fixedpoint:`` left out runs as ``fixedpoint: {}``); a missing
+    section with a required field raises a one-line StageError."""
     val = getattr(scene, section)
+    if val is None:
+        val = _default_section(scene, section)
     if val is None:
         raise StageError(f"scene '{scene.name}' has no '{section}' section, which stage "
                          f"'{stage}' needs")
     return val
+
+
+def with_defaults(scene: Scene, section: str, stage: str) -> Scene:
+    """``scene`` with ``section`` filled with its defaults when it is missing and every field
+    of it is optional (see :func:`require`); the scene's file (``origin``) is kept.
+
+    Raises
+    ------
+    StageError
+        The section is missing and has a required field.
+    """
+    if getattr(scene, section) is not None:
+        return scene
+    out = scene.model_copy(update={section: require(scene, section, stage)})
+    out._origin = scene.origin
+    return out

@@ -2,7 +2,10 @@
 
 The walker of the scene as free bodies on the scene's terrain, started from the ideal fixed
 point (``fixedpoint.h5``; paper Table 2, MATLAB column) with the stance foot at its static
-penetration, initial rates scaled by ``contact_sim.initial_rate_scale``.  Layout:
+penetration, initial rates scaled by ``contact_sim.initial_rate_scale`` (``contact_sim.start:
+ideal``, the default), or by the rates ``--adjust`` searches (``start: adjusted``), or from
+the contact model's own periodic gait at mid-stance (``start: periodic_gait``: the steady
+state without start-up transients; the gait is stored as with ``periodic_gait: true``).  Layout:
 :mod:`walkerlab.io.schemas.contact_sim`.
 """
 
@@ -25,7 +28,13 @@ from walkerlab.contact import scene as contact_scene
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.schemas.contact_sim import ContactSimRun, run_end, write_contact_sim
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
+from walkerlab.stages.common import (
+    StageError,
+    StageOutcome,
+    artifact_path,
+    require,
+    run_cached,
+)
 
 SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_solver")
 
@@ -34,15 +43,32 @@ def _compute(scene: Scene, fixedpoint: Path, adjust: bool, periodic: bool):
     fp = load_fixedpoint(fixedpoint)
     law, _terrain, cs = contact_scene.settings(scene)[:3]
     adj = scale = None
+    gait = gait_error = None
+    adjust = adjust or cs.start == "adjusted"
     if adjust:
-        from walkerlab.analysis.contact_adjust import adjust_rates
+        from walkerlab.analysis.contact_adjust import adjust_rates, better_start
 
         adj = adjust_rates(scene, fp.x, fp.step_period_s)
         scale = adj["scale"]
-    walker, res, x0, step_length = contact_run.simulate_from(scene, fp.x, fp.step_period_s,
-                                                             scale)
-    gait = gait_error = None
-    if periodic:
+    if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
+        from walkerlab.analysis.contact_periodic import PeriodicGaitError
+
+        try:
+            walker, res, x0, step_length, gait = contact_run.simulate_from_periodic_gait(
+                scene, fp.x)
+        except PeriodicGaitError as exc:
+            raise StageError(f"scene '{scene.name}': contact_sim.start: periodic_gait: the "
+                             f"contact walker's periodic gait was not found ({exc})") from None
+        scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
+    else:
+        run = contact_run.simulate_from(scene, fp.x, fp.step_period_s, scale)
+        if adjust:  # the adjusted start must walk at least as well as the scene's own
+            plain = contact_run.simulate_from(scene, fp.x, fp.step_period_s, None)
+            adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
+            if adj["kept"] == "scene":
+                run, scale = plain, None
+        walker, res, x0, step_length = run
+    if periodic and gait is None:
         from walkerlab.analysis.contact_periodic import (
             PeriodicGaitError,
             find_contact_periodic_gait,

@@ -18,6 +18,7 @@ from walkerlab.io import runpaths
 from walkerlab.io.export import FORMATS, mjcf_text, urdf_text
 from walkerlab.models.description import walker_data
 from walkerlab.models.multibody import multibody
+from walkerlab.units import for_scene
 
 #: The URDF's keyframe sidecar in ``runs/<scene>/``.
 SIDECAR = "walker.gait.json"
@@ -72,7 +73,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path
     if fmt == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
         runpaths.atomic_text(runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
                              keyframe_json(mb, extra))
-    return runpaths.atomic_text(path, text)
+    return runpaths.atomic_text(path, _comments_in_scene_units(text, for_scene(scene)))
 
 
 def keyframe_json(mb, extra) -> str:
@@ -84,3 +85,16 @@ def keyframe_json(mb, extra) -> str:
                        "strike, leg2 in stance, its foot at the origin on the ground line",
                        "joints": joints, "units": units, "qpos": list(extra.qpos),
                        "qvel": list(extra.qvel)}, indent=1) + "\n"
+
+
+def _comments_in_scene_units(text: str, units) -> str:
+    """The header comments' unit labels in the scene's unit system (a nondimensional scene:
+    ``l``, ``g``, not ``m``, ``m/s^2``); the XML itself carries numbers only."""
+    if not units.nondimensional:
+        return text
+    import re
+
+    # a unit follows a number ("1.2 m") or stands in brackets ("[m]"); prose is left alone
+    unit = re.compile(r"(?:(?<=\d )|(?<=\[))(m/s\^2|kg m\^2|kg|m|s)(?=[\];.,) ])")
+    return "\n".join(unit.sub(lambda m: units(m.group(1)), ln)
+                     if ln.lstrip().startswith("<!--") else ln for ln in text.split("\n"))

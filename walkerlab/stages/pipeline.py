@@ -15,6 +15,8 @@ compare         simulate, contact-sim
 workprecision   fixedpoint
 basin           fixedpoint
 mfpt            fixedpoint
+robustness      fixedpoint
+attribution     fixedpoint
 animate         simulate
 ==============  ====================================================================
 """
@@ -29,7 +31,8 @@ from walkerlab.config import Scene
 #: module of each stage under walkerlab.stages
 MODULES = {"fixedpoint": "fixedpoint", "simulate": "simulate", "contact-sim": "contact_sim",
            "compare": "compare", "workprecision": "workprecision", "basin": "basin",
-           "animate": "animate", "mfpt": "mfpt"}
+           "animate": "animate", "mfpt": "mfpt",
+           "robustness": "robustness", "attribution": "attribution"}
 
 
 def needs(stage: str, scene: Scene) -> tuple[str, ...]:
@@ -39,7 +42,8 @@ def needs(stage: str, scene: Scene) -> tuple[str, ...]:
         return ("fixedpoint",) if sim is None or sim.initial_state == "fixed_point" else ()
     return {"contact-sim": ("fixedpoint",), "compare": ("simulate", "contact-sim"),
             "workprecision": ("fixedpoint",), "basin": ("fixedpoint",),
-            "mfpt": ("fixedpoint",),
+            "mfpt": ("fixedpoint",), "robustness": ("fixedpoint",),
+            "attribution": ("fixedpoint",),
             "animate": ("simulate",)}.get(stage, ())
 
 
@@ -86,13 +90,22 @@ def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **optio
     return mod.run(scene, runs_root, *args, **options)
 
 
-def report_plan(scene: Scene) -> list[str]:
+def report_plan(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order (its progress display and DAG):
     fixed point, rigid run, contact run, their comparison, the work-precision study, the
-    basin of attraction - each only when the scene has its sections."""
+    basin of attraction, the robustness measures, the Section-5 attribution - each only
+    when the scene has its sections; the work-precision study and the attribution only
+    with ``full`` (``walkerlab report --full``: the study times every solver setting, most
+    of a cold report, and a shared machine's timings are noise unless repeated;
+    ``walkerlab workprecision`` runs it alone; the attribution is seven periodic-gait
+    searches and three runs, ~15-17 s CPU on the paper scene)."""
     sim, contact = scene.simulate is not None, scene.contact is not None
+    wp = full and getattr(scene, "workprecision", None) is not None
     return [n for n, on in (("fixedpoint", scene.fixedpoint is not None), ("simulate", sim),
                             ("contact-sim", contact), ("compare", contact and sim),
-                            ("workprecision", getattr(scene, "workprecision", None) is not None),
-                            ("basin", scene.basin is not None and scene.fixedpoint is not None))
+                            ("workprecision", wp),
+                            ("basin", scene.basin is not None and scene.fixedpoint is not None),
+                            ("robustness", scene.robustness is not None
+                             and scene.fixedpoint is not None),
+                            ("attribution", full and contact and scene.fixedpoint is not None))
             if on]

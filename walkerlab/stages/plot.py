@@ -22,13 +22,57 @@ def figures_dir(scene: Scene, runs_root: Path | str, claim: bool = False) -> Pat
     return runpaths.figures_dir(scene, runs_root, claim)
 
 
+def check_unedited(path: Path) -> Path:
+    """``path`` if its content still matches the content hash stored when it was written.
+
+    Raises
+    ------
+    StageError
+        The artifact was changed after it was written (edited by hand, by h5py, ...): one
+        line naming it and the command that rewrites it.
+    """
+    from walkerlab.io.artifacts import stored_content_hash_matches
+
+    if not stored_content_hash_matches(path):
+        stage = path.stem.replace("_", "-")
+        raise StageError(f"{path}: changed after it was written (its content no longer matches "
+                         f"its stored content hash); figures are drawn only from what a stage "
+                         f"wrote: rerun 'walkerlab {stage} --force' (or 'walkerlab report')")
+    return path
+
+
+def figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
+    """Stamp file of a drawn figure group (:data:`PARTS`) and its key: the *recomputed*
+    content hashes of the artifacts it is drawn from and walkerlab's code.  A figure group
+    whose stamp matches was drawn from exactly these bytes (a hand edit, or a recompute
+    after one, changes the key; issue 26)."""
+    import json
+
+    from walkerlab.io.artifacts import code_hash, content_hash
+
+    arts = {}
+    for stage in PARTS[part]:
+        p = artifact_path(scene, runs_root, stage)
+        if p.is_file():
+            arts[stage] = str(content_hash(p))
+    return (runpaths.figures_dir(scene, runs_root) / f".drawn_from_{part}",
+            json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True))
+
+
 def load_trajectories(scene: Scene, runs_root: Path | str) -> dict:
-    """Named trajectories of every trajectory artifact present, keyed by model label."""
+    """Named trajectories of every trajectory artifact present, keyed by model label.
+
+    Raises
+    ------
+    StageError
+        An artifact was changed after it was written (:func:`check_unedited`).
+    """
     out = {}
     for stage, label, load in (("simulate", IDEAL_LABEL, load_simulate),
                                ("contact-sim", CONTACT_LABEL, load_contact_sim)):
         p = artifact_path(scene, runs_root, stage)
         if p.is_file():
+            check_unedited(p)
             out[label] = load(p).samples
     return out
 
@@ -53,18 +97,28 @@ def run(scene: Scene, runs_root: Path | str = "runs",
     list of Path
         Written files (PNG and SVG).
 
+    Each group drawn records what it was drawn from (:func:`figures_key`, in
+    ``report/figures/.drawn_from_<part>``), so ``report`` redraws when that changes.
+
     Raises
     ------
     StageError
-        Trajectory figures asked for and no trajectory artifact exists yet.
+        Trajectory figures asked for and no trajectory artifact exists yet; an artifact was
+        changed after it was written.
     """
     from walkerlab.plotting import figures as F  # matplotlib: only when drawing
 
     written: list[Path] = []
-    if "trajectories" in parts:
-        written += _trajectory_figures(scene, runs_root, F)
-    if "workprecision" in parts:
-        written += _workprecision_figures(scene, runs_root, F)
+    for part, draw in (("trajectories", _trajectory_figures),
+                       ("workprecision", _workprecision_figures)):
+        if part not in parts:
+            continue
+        stamp, key = figures_key(scene, runs_root, part)
+        stamp.unlink(missing_ok=True)  # no stamp while the group is half drawn
+        figs = draw(scene, runs_root, F)
+        written += figs
+        if figs:
+            runpaths.atomic_text(stamp, key)  # atomic, never through a symbolic link
     return written
 
 
@@ -80,13 +134,19 @@ def _trajectory_figures(scene: Scene, runs_root, F) -> list[Path]:
     title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
     for label, tr in trajs.items():  # paper order: Figs. 2, 6, then 7-10
         stem = "fig2_stick_ideal" if label == IDEAL_LABEL else "fig6_stick_contact"
-        written += F.save(F.stick_diagram(tr, label, slope_rad=scene.slope.phi_rad, units=u),
-                          out_dir, stem)
+        ground = None
+        if label != IDEAL_LABEL:  # the contact walker's checkerboard
+            from walkerlab.io.terrain import load_terrain
+
+            ground = load_terrain(artifact_path(scene, runs_root, "contact-sim"))
+        written += F.save(F.stick_diagram(tr, label, slope_rad=scene.slope.phi_rad, units=u,
+                                          terrain=ground), out_dir, stem)
     written += F.save(F.fig7_angles_rates(trajs, title, units=u), out_dir, "fig7_angles_rates")
     written += F.save(F.fig9_limit_cycle(trajs, units=u), out_dir, "fig9_limit_cycles")
     written += F.save(F.fig10_energy(trajs, units=u), out_dir, "fig10_energy")
     cmp_path = artifact_path(scene, runs_root, "compare")
     if cmp_path.is_file():
+        check_unedited(cmp_path)
         c = load_compare(cmp_path)
         phase = (c.step_phase, c.phase_errors) if c.phase_errors is not None else None
         written += F.save(F.fig8_errors(c.time, c.errors, c.error_units, "contact - ideal",
@@ -116,6 +176,7 @@ def _workprecision_figures(scene: Scene, runs_root, F) -> list[Path]:
     written: list[Path] = []
     wp_path = artifact_path(scene, runs_root, "workprecision")
     if wp_path.is_file():
+        check_unedited(wp_path)
         out_dir = figures_dir(scene, runs_root, claim=True)
         for model, m in load_workprecision(wp_path).models.items():
             rows = {meth: {k: v for k, v in cols.items() if k != "repeats"}

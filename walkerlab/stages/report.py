@@ -1,6 +1,10 @@
-"""Stage ``report``: run what the scene needs (reusing up-to-date artifacts), draw the
-figures, then hand the artifacts to :func:`walkerlab.report.build.write_report`, which writes
-``runs/<scene>/report/report.html`` (self-contained) and ``report.md``.
+"""Stage ``report``: run the stages of the scene's plan (:func:`walkerlab.stages.pipeline.
+report_plan`, reusing up-to-date artifacts), draw the figures, load the artifacts through
+:mod:`walkerlab.io.schemas` and compute what the report states from them (Table 3, energy
+drift, swing-foot clearance: :func:`load_inputs`), then hand them to
+:func:`walkerlab.report.build.write_report`, which writes ``runs/<scene>/report/report.html``
+(self-contained) and ``report.md``.  The work-precision study runs in a background thread
+on cores of its own (:class:`walkerlab.execution.background.BackgroundStudy`).
 
 Sections appear only when the scene produces their data (artifacts an earlier standalone
 command left in the run folder are left out, in one line): an ideal-only scene gets an
@@ -23,15 +27,7 @@ from walkerlab.stages.pipeline import report_plan, stage_module
 from walkerlab.stages.plot import figures_dir
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation", "basin")
-
-
-def planned_stages(scene: Scene, full: bool = False) -> list[str]:
-    """The stages ``report`` runs for this scene, in order (:func:`walkerlab.stages.pipeline.
-    report_plan`); the work-precision study only with ``full`` (``walkerlab report --full``):
-    it times every solver setting (~30 s of a ~33 s cold report, issue 25) and a shared
-    machine's timings are noise unless repeated; ``walkerlab workprecision`` runs it alone."""
-    return [s for s in report_plan(scene) if full or s != "workprecision"]
+                 "bifurcation", "basin", "robustness", "attribution")
 
 
 def _study(scene: Scene, runs_root, force: bool):
@@ -50,7 +46,7 @@ def _study(scene: Scene, runs_root, force: bool):
 
 def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
                 full: bool = False) -> list[StageOutcome]:
-    plan = planned_stages(scene, full)
+    plan = report_plan(scene, full)
     done: list[StageOutcome] = []
 
     def add(o: StageOutcome) -> None:
@@ -84,6 +80,10 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
     if "basin" in plan:
         # after the study: its worker processes would share the timed cases' cores
         add(stage_module("basin").run(scene, runs_root, force))
+    if "robustness" in plan:
+        add(stage_module("robustness").run(scene, runs_root, force))
+    if "attribution" in plan:  # after the study, too (its timed cases own their cores)
+        add(stage_module("attribution").run(scene, runs_root, force))
     for o in done:
         status = ("reused (inputs unchanged)" if o.reused and not o.note else
                   f"reused ({o.note})" if o.reused else
@@ -99,32 +99,21 @@ def _run_stages(scene: Scene, runs_root, force: bool, echo, bar=None,
 
 def _draw(scene: Scene, runs_root, force: bool, part: str) -> str:
     """Draw one figure group (:data:`walkerlab.stages.plot.PARTS`) unless it was drawn from
-    the same artifacts by the same code; returns the line to print."""
+    the same artifact content by the same code (:func:`walkerlab.stages.plot.figures_key`:
+    matplotlib and ~16 PNG/SVG files are most of a rerun's time); returns the line to
+    print."""
+    from walkerlab.safefs import NotARegularFile, read_regular
     from walkerlab.stages import plot
 
-    stamp, key = _figures_key(scene, runs_root, part)
-    if not force and stamp.is_file() and stamp.read_text() == key:
-        return f"{'plot':>13s}: {part} figures reused (artifacts and code unchanged)"
-    figs = plot.run(scene, runs_root, parts=(part,))
-    from walkerlab.io.runpaths import atomic_text
-
-    atomic_text(stamp, key)  # atomic, never through a symbolic link
+    stamp, key = plot.figures_key(scene, runs_root, part)
+    try:  # bounded, non-blocking: a FIFO or a huge file in its place is no match
+        same = read_regular(stamp, 1 << 16, "figure stamp").decode() == key
+    except (OSError, NotARegularFile, UnicodeDecodeError):
+        same = False
+    if not force and same:
+        return f"{'plot':>13s}: {part} figures reused (drawn from these artifacts' content)"
+    figs = plot.run(scene, runs_root, parts=(part,))  # writes the stamp
     return f"{'plot':>13s}: {part}, {len([p for p in figs if p.suffix == '.png'])} figures"
-
-
-def _figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
-    """Stamp file of a drawn figure group and the key it must match: the stored input
-    hashes of the artifacts it is drawn from and walkerlab's code (a rerun with nothing
-    changed does not redraw: matplotlib and ~16 PNG/SVG files are most of a rerun's time)."""
-    import json
-
-    from walkerlab.io.artifacts import code_hash, stored_hash
-    from walkerlab.stages.plot import PARTS
-
-    arts = {stage: str(stored_hash(p)) for stage, p in existing_artifacts(scene, runs_root).items()
-            if stage in PARTS[part]}
-    return (figures_dir(scene, runs_root) / f".drawn_from_{part}",
-            json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True))
 
 
 #: why a report leaves out an artifact of a stage the scene does not run
@@ -132,7 +121,9 @@ _NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' 
             "contact-sim": "no 'contact' section",
             "compare": "needs both a 'simulate' and a 'contact' section",
             "workprecision": "no 'workprecision' section",
-            "basin": "no 'basin' section (or no 'fixedpoint')"}
+            "basin": "no 'basin' section (or no 'fixedpoint')",
+            "robustness": "no 'robustness' section (or no 'fixedpoint')",
+            "attribution": "no 'contact' or 'fixedpoint' section"}
 
 
 def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
@@ -141,9 +132,10 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bo
 
     Only artifacts this scene's report produced (``done``) are used: an artifact left in the
     run folder by an earlier standalone command (``walkerlab simulate`` on a scene without a
-    ``simulate`` section) is left out, and said so.  ``bifurcation.h5`` has no scene section
-    (the standalone ``walkerlab bifurcation`` makes it): it is shown when it was computed
-    for the scene's current walker, slope and solver.
+    ``simulate`` section) is left out, and said so.  ``bifurcation.h5`` and the
+    ``bifurcation_<field>.h5`` of ``bifurcation --param`` have no scene section (the
+    standalone ``walkerlab bifurcation`` makes them): each is shown when it was computed for
+    the scene's current walker, slope and solver.
     """
     produced = {o.stage for o in done}
     paths, left = {}, []
@@ -160,11 +152,24 @@ def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bo
                             "--full` measures it again)")
             else:
                 paths[stage] = p  # measured earlier (--full or `walkerlab workprecision`)
-        elif stage == "bifurcation":
+        elif stage == "attribution" and scene.contact is not None and not full:
+            from walkerlab.stages import attribution
+            from walkerlab.stages.common import changed_fields
+
+            if changed_fields(p, scene, attribution.SECTIONS):
+                left.append(f"{p.name} (computed for other settings; `walkerlab report "
+                            "--full` computes it again)")
+            else:
+                paths[stage] = p  # computed earlier (--full)
+        elif stage == "bifurcation" or stage.startswith("bifurcation_"):  # and --param
+            from walkerlab.io.artifacts import stored_content_hash_matches
             from walkerlab.stages import bifurcation
             from walkerlab.stages.common import changed_fields
 
-            if changed_fields(p, scene, bifurcation.SECTIONS):
+            if not stored_content_hash_matches(p):  # edited by hand: never shown (issue 26)
+                left.append(f"{p.name} (changed after it was written: rerun 'walkerlab "
+                            "bifurcation')")
+            elif changed_fields(p, scene, bifurcation.SECTIONS):
                 left.append(f"{p.name} (computed for another walker, slope or solver)")
             else:
                 paths[stage] = p
@@ -192,7 +197,8 @@ def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         echo: Callable[[str], None] = print, full: bool = False) -> Path:
     """Run the needed stages, draw figures, write ``report.md`` and ``report.html``;
-    ``full``: also the work-precision study (:func:`planned_stages`).
+    ``full``: also the work-precision study and the attribution
+    (:func:`walkerlab.stages.pipeline.report_plan`).
 
     Returns
     -------
@@ -201,13 +207,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     from walkerlab import progress
 
-    stages = planned_stages(scene, full)
+    stages = report_plan(scene, full)
     with progress.task(f"report: {len(stages)} stages ({', '.join(stages)})",
                        len(stages)) as bar:
         done = _run_stages(scene, runs_root, force, echo, bar, full)
     paths, left_out = report_artifacts(scene, runs_root, done, full)
     if getattr(scene, "workprecision", None) is not None and "workprecision" not in paths:
         echo(f"{'workprecision':>13s}: not measured (opt-in: `walkerlab report --full`)")
+    if scene.contact is not None and scene.fixedpoint is not None \
+            and "attribution" not in paths:
+        echo(f"{'attribution':>13s}: not computed (opt-in, ~17 s CPU on the paper scene: "
+             "`walkerlab report --full`)")
     if left_out:
         echo(left_out)
     rep_dir = report_dir(scene, runs_root, claim=True)
@@ -223,11 +233,13 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
     from walkerlab.analysis.gait_checks import energy_drift_in_swing, swing_foot_clearance
     from walkerlab.analysis.tables import table3
     from walkerlab.io.schemas import (
+        attribution,
         basin,
         bifurcation,
         compare,
         contact_sim,
         fixedpoint,
+        robustness,
         simulate,
         stability_map,
         workprecision,
@@ -235,7 +247,8 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
 
     loaders = {"fixedpoint": fixedpoint.load_fixedpoint, "simulate": simulate.load_simulate,
                "contact-sim": contact_sim.load_contact_sim, "compare": compare.load_compare,
-               "workprecision": workprecision.load_workprecision, "basin": basin.load_basin}
+               "workprecision": workprecision.load_workprecision, "basin": basin.load_basin,
+               "robustness": robustness.load, "attribution": attribution.load_attribution}
     arts: dict = {}
     for key, p in paths.items():
         load = (bifurcation.load_bifurcation_summary if key.startswith("bifurcation")

@@ -8,6 +8,7 @@ scene's physics sections, the code and the grid), and its figure
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from walkerlab.config import CommandOptions, Scene, validate_option
@@ -18,6 +19,8 @@ from walkerlab.io.schemas.stability_map import (
 )
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.sweep.stability import (
+    CELL_FIELDS,
+    MAP_KINDS,
     MapSpec,
     default_spec,
     gait_map,
@@ -85,7 +88,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
 
         run = StabilityMapRun(spec, cells, frac, scene.contact.stiffness_family,
-                              scene.contact.unit_system)
+                              scene.contact.unit_system, CELL_FIELDS, MAP_KINDS[spec.kind][1],
+                              (math.degrees(scene.slope.phi_rad),
+                               _scene_value(scene, spec.y_path)))
         return (lambda f: write_stability_map(f, run)), summary
 
     out = run_cached(stage_name(spec.kind), scene, runs_root, SECTIONS, (), compute, force,
@@ -94,6 +99,18 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
     draw(out.path, figures_dir(scene, runs_root, claim=True))
     return out
+
+
+def _scene_value(scene: Scene, path: str) -> float:
+    """The scene's value of a map's y field (``contact.stiffness``; a missing optional
+    section at its default: ``terrain.patch_width_m`` 0.10); NaN if it has none."""
+    from walkerlab.config import TerrainSettings
+
+    d = scene.model_dump()
+    d["terrain"] = d.get("terrain") or TerrainSettings().model_dump()
+    for k in path.split("."):
+        d = d.get(k) if isinstance(d, dict) else None
+    return float(d) if isinstance(d, int | float) else float("nan")
 
 
 def draw(path: Path | str, out_dir: Path | str | None = None) -> list[Path]:

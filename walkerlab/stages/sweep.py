@@ -40,7 +40,7 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
         workers: int = 2, scheduler: str | None = None, resume: bool = False,
         runs_root: str | Path = "runs", name: str | None = None, *,
         options: dict | None = None, chunk_size: int | None = None, progress: bool = True,
-        on_chunk=None, pool: bool | None = None) -> Path:
+        on_chunk=None, pool: bool | None = None, figure: bool = True) -> Path:
     """Sweep ``stage`` over the grid of ``params`` and write one HDF5 artifact.
 
     Parameters
@@ -70,6 +70,9 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
         Hook after each chunk is written.
     pool : bool, optional
         Force a process pool even with one worker (benchmarks) or forbid it.
+    figure : bool
+        Draw the results against the first swept field (:func:`draw`) into the report's
+        figures folder.
 
     Returns
     -------
@@ -94,6 +97,27 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     # too large to run are left to run_sweep's refusal)
     check_axes(scene, axes, values=math.prod(len(a) for a in axes) <= MAX_GRID_POINTS)
     out = sweep_path(scene, axes, stage, runs_root, name, claim=True)
-    return run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
+    path = run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
                      resume=resume, options=options, chunk_size=chunk_size, progress=progress,
                      on_chunk=on_chunk, pool=pool)
+    if figure:
+        draw(scene, path, runs_root)
+    return path
+
+
+def figure_path(scene: Scene, path: Path, runs_root: str | Path = "runs") -> Path:
+    """``runs/<scene>/report/figures/<sweep artifact stem>.png``."""
+    from walkerlab.stages.plot import figures_dir
+
+    return figures_dir(scene, runs_root) / f"{Path(path).stem}.png"
+
+
+def draw(scene: Scene, path: Path, runs_root: str | Path = "runs") -> list[Path]:
+    """Draw the sweep's main results against its first swept field (PNG + SVG) from the
+    artifact ``path`` (:func:`walkerlab.plotting.sweep_figures.sweep_figure`)."""
+    from walkerlab.plotting.sweep_figures import save, sweep_figure
+    from walkerlab.stages.plot import figures_dir
+    from walkerlab.sweep.store import load_sweep
+
+    fig = sweep_figure(load_sweep(path), f"scene '{scene.name}'")
+    return save(fig, figures_dir(scene, runs_root, claim=True), Path(path).stem)

@@ -353,6 +353,43 @@ def row_digest(arrays: dict, j: int, key: str) -> str:
     return h.hexdigest()
 
 
+def _resumed_cells(part: Path, key: str, nx: int, ny: int):
+    """``(arrays, row_hash)`` of a partial basin file of input hash ``key`` and grid
+    ``(ny, nx)``, keeping only grid rows whose cells still match the hash written with them
+    (the others are set back to not done); ``(None, None)`` without a usable file."""
+    import h5py
+
+    if not part.is_file():
+        return None, None
+    try:
+        with h5py.File(part, "r") as f:
+            if f.attrs.get("input_hash") != key or f["outcome"].shape != (ny, nx):
+                return None, None
+            arrays = {k: f[k][()] for k in ("outcome", "steps", "period")}
+            stored = [x.decode() if isinstance(x, bytes) else str(x)
+                      for x in f["row_hash"][()]] if "row_hash" in f else [""] * ny
+    except (OSError, KeyError, ValueError):
+        return None, None
+    row_hash = np.array([""] * ny, dtype=object)
+    bad = 0
+    for j in range(ny):
+        done_row = bool(np.any(arrays["outcome"][j] != NOT_DONE))
+        if stored[j] and stored[j] == row_digest(arrays, j, key) and \
+                bool(np.all(arrays["outcome"][j] != NOT_DONE)):
+            row_hash[j] = stored[j]
+            continue
+        bad += done_row
+        arrays["outcome"][j] = NOT_DONE
+        arrays["steps"][j] = 0
+        arrays["period"][j] = 0
+    if bad:
+        from walkerlab import progress
+
+        progress.note(f"{part}: {bad} grid row(s) failed their integrity check; "
+                      "computing them again")
+    return arrays, row_hash
+
+
 def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
                   grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
                   resume: bool = True, on_chunk: Callable[[int, int], None] | None = None
@@ -409,37 +446,11 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
 
     part = refuse_link(_partial(Path(out_path)))  # never written through a link
     part.parent.mkdir(parents=True, exist_ok=True)
-    arrays = None
-    row_hash = np.array([""] * ny, dtype=object)
-    if resume and part.is_file():
-        try:
-            with h5py.File(part, "r") as f:
-                if f.attrs.get("input_hash") == key and f["outcome"].shape == (ny, nx):
-                    arrays = {k: f[k][()] for k in ("outcome", "steps", "period")}
-                    stored = [x.decode() if isinstance(x, bytes) else str(x)
-                              for x in f["row_hash"][()]] if "row_hash" in f else [""] * ny
-        except (OSError, KeyError, ValueError):
-            arrays = None
+    arrays, row_hash = _resumed_cells(part, key, nx, ny) if resume else (None, None)
     if arrays is None:
         arrays = {"outcome": np.full((ny, nx), NOT_DONE, np.int8),
                   "steps": np.zeros((ny, nx), np.int16), "period": np.zeros((ny, nx), np.int8)}
-    else:  # keep only grid rows whose cells still match the hash written with them
-        bad = 0
-        for j in range(ny):
-            done_row = bool(np.any(arrays["outcome"][j] != NOT_DONE))
-            if stored[j] and stored[j] == row_digest(arrays, j, key) and \
-                    bool(np.all(arrays["outcome"][j] != NOT_DONE)):
-                row_hash[j] = stored[j]
-                continue
-            bad += done_row
-            arrays["outcome"][j] = NOT_DONE
-            arrays["steps"][j] = 0
-            arrays["period"][j] = 0
-        if bad:
-            from walkerlab import progress
-
-            progress.note(f"{part}: {bad} grid row(s) failed their integrity check; "
-                          "computing them again")
+        row_hash = np.array([""] * ny, dtype=object)
     tasks = []
     for j in range(ny):
         cells = tuple((j * nx + i, float(xs[i]), float(ys[j])) for i in range(nx)

@@ -140,8 +140,12 @@ def parse_param(text: str) -> ParamAxis:
 
         if n > MAX_SWEEP_POINTS:
             raise SweepError(f"--param {text!r}: {n:,} values; at most {MAX_SWEEP_POINTS:,}")
-        # round away binary noise (0.1 + 2*0.05 -> 0.2) to 12 significant digits
-        vals = tuple(float(f"{start + k * step:.12g}") for k in range(n))
+        # round away binary noise (0.1 + 2*0.05 -> 0.2) to 12 significant digits; a range
+        # of whole numbers written as such (1:10:1) stays whole (an integer field takes it)
+        whole = all(isinstance(_scalar(p), int) and not isinstance(_scalar(p), bool)
+                    for p in parts)
+        vals = tuple(int(round(start + k * step)) if whole
+                     else float(f"{start + k * step:.12g}") for k in range(n))
     else:
         items = [s for s in (p.strip() for p in rhs.split(",")) if s != ""]
         if not items:
@@ -283,6 +287,19 @@ def _check_path(scene: Scene, axis: ParamAxis):
             cls = models[0] if len(models) == 1 else None
         info = fields[k]
     return info
+
+
+def takes_whole_numbers(scene: Scene, axis: ParamAxis) -> bool:
+    """Whether the field an axis names is an integer field (``simulate.strides``).
+
+    Raises
+    ------
+    SweepError
+        The path names no field of the scene (as :func:`check_axes`).
+    """
+    info = _check_path(scene, axis)
+    return info is not None and int in typing.get_args(info.annotation) + (info.annotation,) \
+        and float not in typing.get_args(info.annotation) + (info.annotation,)
 
 
 def axis_unit(scene: Scene, axis: ParamAxis) -> str:

@@ -186,10 +186,9 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     from walkerlab.models.registry import build_walker
 
     opts = {**DEFAULT_OPTIONS, **(options or {})}
-    fp = scene.fixedpoint
-    if fp is None:
-        raise _Outcome("invalid_config", "scene has no 'fixedpoint' section (needed for the "
-                       "initial guess of the fixed point)")
+    from walkerlab.config import FixedPointSettings
+
+    fp = scene.fixedpoint or FixedPointSettings()  # every field optional: the defaults
     walker = build_walker(scene)
     solver = _solver(scene)
     tries = []
@@ -406,12 +405,14 @@ def contact_point(scene: Scene, guess, options: dict):
     foot left the ground and came back) and ``max_steps`` (stalled).
     """
     from walkerlab.analysis.contact_gait import classify_complete
+    from walkerlab.config import FixedPointSettings
     from walkerlab.integrate.rigid import integrate_step
 
     opts = {**DEFAULT_OPTIONS, **options}
     walker, fp, source = ideal_fixed_point(scene, guess, options)
     seg = integrate_step(walker, fp.x, _solver(scene),
-                         max_step_time=scene.fixedpoint.max_step_time_s)
+                         max_step_time=(scene.fixedpoint
+                                        or FixedPointSettings()).max_step_time_s)
     step_length = float(np.hypot(*walker.points(seg.x_end)["swing_foot"]))
     cols = {"guess_source": source, "ideal_step_length_m": step_length,
             "ideal_step_period_s": float(fp.period_s)}

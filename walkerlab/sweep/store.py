@@ -496,7 +496,8 @@ def load_sweep(path: Path) -> dict:
         pts = {}
 
         def visit(name, obj):
-            if isinstance(obj, h5py.Dataset) and not obj.is_scale:  # not the 'point' dimension
+            # not the 'point' dimension, nor the swept values' copy (a coordinate of the rows)
+            if isinstance(obj, h5py.Dataset) and not obj.is_scale and "swept" not in obj.attrs:
                 v = obj[()]
                 if v.dtype.kind == "O":
                     v = np.array([x.decode() if isinstance(x, bytes) else x for x in v], object)

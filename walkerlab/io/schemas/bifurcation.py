@@ -18,6 +18,10 @@ import numpy as np
 from walkerlab.io.artifacts import open_artifact
 
 STAGE = "bifurcation"
+#: the grid of ``bifurcation --slopes``: its coordinate is named ``slope`` (any other
+#: field's grid is named by the field's dotted path; as
+#: :func:`walkerlab.sweep.bifurcation.parameter_dim` writes it)
+SLOPE_PATH = "slope.angle_deg"
 
 
 @dataclass
@@ -52,12 +56,10 @@ def load_bifurcation_summary(path: Path) -> BifurcationSummary:
     walkerlab.io.artifacts.ArtifactError
         Missing, unreadable, of another stage or version, or lacking a dataset (one line).
     """
-    from walkerlab.sweep.bifurcation import SLOPE_PATH, parameter_dim
-
     with open_artifact(path, STAGE) as f:
         ppath = f.attrs.get("parameter_path", SLOPE_PATH)
         ppath = ppath.decode() if isinstance(ppath, bytes) else str(ppath)
-        dim = parameter_dim(ppath)
+        dim = "slope" if ppath == SLOPE_PATH else ppath
         values = f[dim][()]
         data = {"parameter_path": ppath, "parameter_unit": str(f[dim].attrs.get("unit", "deg")),
                 dim: values}

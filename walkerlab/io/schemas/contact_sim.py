@@ -231,6 +231,9 @@ def _write_periodic_and_adjust(f, run: ContactSimRun) -> None:
                 v = np.asarray(v, dtype=float)
                 put(f, f"adjust/{k}", v, "-", k,
                     dims=("rate",) if k == "scale" and v.shape == (2,) else None)
+        for k in ("kept", "kept_reason"):  # which start the run is from, and why
+            if k in adj:
+                f.require_group("adjust").attrs[k] = str(adj[k])
 
 
 def write_contact_sim(f, run: ContactSimRun) -> None:
@@ -360,7 +363,9 @@ def load_contact_sim(path: Path) -> ContactSimArtifact:
             heel_strike_times=(f["events/heel_strike_times"][()]
                                if "events/heel_strike_times" in f else np.zeros(0)),
             steps=steps, drop=drop, periodic=_periodic(f),
-            adjust={k: f["adjust"][k][()] for k in f["adjust"]} if "adjust" in f else None)
+            adjust={**{k: f["adjust"][k][()] for k in f["adjust"]},
+                    **{k: str(v) for k, v in f["adjust"].attrs.items()}}
+            if "adjust" in f else None)
 
 
 def run_end(path: Path) -> tuple[str, str]:

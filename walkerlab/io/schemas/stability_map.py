@@ -32,10 +32,16 @@ class StabilityMapRun:
     spec : walkerlab.sweep.stability.MapSpec
     cells : dict[str, ndarray]
         :func:`walkerlab.sweep.stability.gait_map`'s result.
+    cell_fields : tuple of str
+        The per-cell arrays written, in order (:data:`walkerlab.sweep.stability.CELL_FIELDS`).
+    y_label : str
+        Axis label of the varied parameter.
     fractions : dict[str, float]
         :func:`walkerlab.sweep.stability.stable_fraction` of the cells.
     stiffness_family, unit_system : str
         Of the scene's contact law.
+    scene_point : (float, float), optional
+        The scene's own slope [deg] and y value (``scene_slope_deg``, ``scene_y``).
     """
 
     spec: object
@@ -43,18 +49,22 @@ class StabilityMapRun:
     fractions: dict
     stiffness_family: str
     unit_system: str
+    cell_fields: tuple = ()
+    y_label: str = ""
+    #: the scene's own point (slope [deg], y in the map's unit), marked on the map
+    scene_point: tuple[float, float] | None = None
 
 
 def write_stability_map(f, run: StabilityMapRun) -> None:
     """Fill an open (in-memory) artifact with ``run`` (layout in the module docstring)."""
-    from walkerlab.sweep.stability import CELL_FIELDS, MAP_KINDS
-
     f.attrs["kind"] = run.spec.kind
     f.attrs["y_path"] = run.spec.y_path
-    f.attrs["y_label"] = MAP_KINDS[run.spec.kind][1]
+    f.attrs["y_label"] = run.y_label
     f.attrs["stiffness_family"] = run.stiffness_family
     f.attrs["unit_system"] = run.unit_system
     f.attrs["time_limit_s"] = run.spec.time_limit_s
+    if run.scene_point is not None:  # marked on the map wherever the grid lies
+        f.attrs["scene_slope_deg"], f.attrs["scene_y"] = (float(v) for v in run.scene_point)
     f.attrs["method"] = ("each cell: fixed point of the contact walker's mid-stance "
                          "step map, continued from its neighbour along the slope, "
                          "else from the ideal fixed point at that slope")
@@ -62,7 +72,7 @@ def write_stability_map(f, run: StabilityMapRun) -> None:
         {"patch_width": "m", "friction": "-"}.get(run.spec.kind, "scene units"),
         run.spec.y_path)
     put(f, "slopes_deg", run.cells["slopes_deg"], "deg", "slope angle")
-    for fld in CELL_FIELDS:
+    for fld in run.cell_fields:
         v = run.cells[fld]
         if v.dtype == object:
             put(f, fld, np.asarray([[str(x) for x in r] for r in v],
@@ -94,11 +104,12 @@ def load_stability_map(path: Path | str) -> StabilityMap:
     walkerlab.io.artifacts.ArtifactError
         Missing, unreadable, of another walkerlab version, or lacking a dataset (one line).
     """
-    from walkerlab.sweep.stability import CELL_FIELDS
-
     with open_artifact(path) as f:
         cells = {}
-        for k in CELL_FIELDS:
+        for k in f:  # every (ny, nx) cell array (the writer's cell fields)
+            if k in ("y_values", "slopes_deg") or not hasattr(f[k], "shape") \
+                    or f[k].ndim != 2:
+                continue
             v = f[k][()]
             if v.dtype.kind in ("S", "O"):
                 v = np.array([[x.decode() if isinstance(x, bytes) else str(x) for x in r]

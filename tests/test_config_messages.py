@@ -1,0 +1,172 @@
+"""What a scene error says (issue 26, rough edges 8-11, 14): one line per mistake, naming the
+field, with the likely unit mistake, once; scenes varied in Python by the CLI's dotted paths;
+the command line's options refused alike."""
+
+import math
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+import walkerlab as wl
+from walkerlab import config
+from walkerlab.cli import app
+from walkerlab.config import SceneError, load_scene, scene_from_dict
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+WALKER = PAPER["walker"]
+
+
+def _errors(data: dict) -> list[str]:
+    with pytest.raises(SceneError) as exc:
+        scene_from_dict(data, "s.yaml")
+    return str(exc.value).splitlines()
+
+
+def _cli(*args):
+    r = CliRunner().invoke(app, [str(a) for a in args])
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+# --------------------------------------------------------------- 8: varying a loaded scene
+def test_with_changes_sets_a_field_by_its_dotted_path():
+    sc = wl.load_scene(ROOT / "configs" / "paper.yaml")
+    steeper = wl.with_changes(sc, {"slope.angle_deg": 2})
+    assert steeper.slope.phi_rad == pytest.approx(math.radians(2), rel=1e-15)
+    assert steeper.slope.angle_rad is None  # the other spelling is replaced
+    assert sc.slope.angle_rad == 0.0174  # the loaded scene is unchanged
+    assert steeper.origin == sc.origin and steeper.name == sc.name
+    kneed = wl.load_scene(ROOT / "configs" / "kneed.yaml")
+    name = kneed.walker.leg.bodies[0].name
+    k2 = wl.with_changes(kneed, {f"walker.leg.bodies.{name}.mass_kg": 0.4})
+    assert k2.walker.leg.bodies[0].mass_kg == 0.4
+
+
+@pytest.mark.parametrize("changes, says", [
+    ({"slope.angle_dgg": 2}, "unknown field slope.angle_dgg (did you mean slope.angle_deg?)"),
+    ({"slope.angle_deg": 200}, "slope.angle_deg: Input should be less than 90"),
+    ({"walker.hip_mass_kg": "heavy"}, "walker.hip_mass_kg: Input should be a valid number"),
+])
+def test_with_changes_refuses_in_one_line(changes, says):
+    sc = wl.load_scene(ROOT / "configs" / "paper.yaml")
+    with pytest.raises(SceneError) as exc:
+        wl.with_changes(sc, changes)
+    msg = str(exc.value)
+    assert "\n" not in msg and msg.startswith("with_changes") and says in msg
+
+
+def test_a_loaded_scene_is_immutable_and_a_copy_is_validated():
+    sc = wl.load_scene(ROOT / "configs" / "paper.yaml")
+    with pytest.raises(Exception, match="frozen"):
+        sc.slope = {"angle_deg": 2}
+    with pytest.raises(Exception, match="frozen"):
+        sc.slope.angle_rad = 0.1
+    copy = sc.model_copy(update={"slope": {"angle_deg": 2}})
+    assert copy.slope.phi_rad == pytest.approx(math.radians(2), rel=1e-15)  # not a dict
+    with pytest.raises(SceneError, match="slope: give exactly one"):
+        sc.model_copy(update={"slope": {"angle_deg": 2, "angle_rad": 0.1}})
+
+
+# --------------------------------------------------------------- 9: unit mistakes
+def test_degrees_given_as_radians_are_named():
+    (line,) = _errors({"walker": WALKER, "slope": {"angle_rad": 3.0}})
+    assert line.endswith("slope.angle_rad: Input should be less than 1.5707963267948966 "
+                         "(3 rad = 172°; did you mean angle_deg?)")
+
+
+def test_millimetres_given_as_metres_are_named():
+    (line,) = _errors({"walker": {**WALKER, "leg_length_m": 1000, "leg_mass_from_foot_m": 500},
+                       "slope": {"angle_deg": 1}})
+    assert "walker.leg_length_m:" in line and "1000 mm = 1 m" in line
+
+
+def test_a_slope_below_a_tenth_of_a_degree_is_warned(tmp_path, capsys):
+    """0.0174 is the paper's slope in radians; as degrees it validates, with a warning."""
+    p = tmp_path / "tiny.yaml"
+    p.write_text(yaml.safe_dump({"walker": WALKER, "slope": {"angle_deg": 0.0174}}))
+    load_scene(p)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "slope.angle_deg" in err[0] and "write angle_rad: 0.0174" in err[0]
+    p.write_text(yaml.safe_dump({"walker": WALKER, "slope": {"angle_deg": 1.0}}))
+    load_scene(p)
+    assert capsys.readouterr().err == ""
+
+
+def test_a_number_yaml_reads_as_text_says_how_to_write_it(tmp_path):
+    p = tmp_path / "e4.yaml"
+    p.write_text("walker: {model: compass_gait, leg_length_m: 1, leg_mass_kg: 1e4, "
+                 "hip_mass_kg: 10, leg_mass_from_foot_m: 0.5}\nslope: {angle_deg: 1}\n")
+    with pytest.raises(SceneError) as exc:
+        load_scene(p)
+    assert str(exc.value).endswith("(got '1e4'); YAML reads 1e4 as text: write 1.0e+4")
+    assert yaml.safe_load("x: 1.0e+4")["x"] == 1e4  # the advice is what YAML reads
+
+
+# --------------------------------------------------------------- 10: said once
+def test_messages_are_not_doubled():
+    d = {"walker": {k: v for k, v in WALKER.items() if k != "leg_mass_from_foot_m"}
+         | {"leg_mas_from_foot_m": 0.5}, "slope": {"angle_deg": 1, "angle_rad": 0.1}}
+    lines = _errors(d)
+    assert lines == [
+        "s.yaml: walker.leg_mas_from_foot_m: unknown field (did you mean leg_mass_from_foot_m?)",
+        "s.yaml: slope: give exactly one of angle_rad or angle_deg"]
+
+
+def test_a_published_error_names_the_file_once():
+    (line,) = _errors({"walker": WALKER, "slope": {"angle_deg": 1}, "published": "nope"})
+    assert line.startswith("s.yaml: published: no module walkerlab.published.nope")
+
+
+# --------------------------------------------------------------- 11: the command line
+@pytest.mark.parametrize("n, says", [(0, "greater than or equal to 1"),
+                                     (100000, "less than or equal to 1000")])
+def test_strides_out_of_range_is_one_line_either_way(tmp_path, n, says):
+    rc, err, _ = _cli("simulate", ROOT / "configs" / "paper.yaml", "--strides", n,
+                      "--runs-dir", tmp_path)
+    assert rc == 1 and err == f"error: --strides {n}: input should be {says} (simulate.strides)"
+
+
+def test_a_bad_slopes_option_is_quoted_as_typed(tmp_path):
+    rc, err, _ = _cli("bifurcation", ROOT / "configs" / "paper.yaml", "--slopes", "1:5",
+                      "--runs-dir", tmp_path)
+    assert rc == 1 and err == "error: --slopes '1:5': a range is START:STOP:STEP"
+
+
+def test_help_shows_flags_without_a_value():
+    r = CliRunner().invoke(app, ["simulate", "--help"], env={"COLUMNS": "120"})
+    assert r.exit_code == 0
+    assert "<bool>" not in r.stdout and "--force" in r.stdout and "<int>" in r.stdout
+
+
+def test_an_integer_field_over_a_range_of_whole_numbers(tmp_path):
+    from walkerlab.sweep.params import check_axes, parse_param
+
+    axis = parse_param("simulate.strides=1:3:1")
+    assert axis.values == (1, 2, 3) and all(type(v) is int for v in axis.values)
+    check_axes(load_scene(ROOT / "configs" / "paper.yaml"), [axis])  # validates
+    assert parse_param("slope.angle_deg=1:2:0.5").values == (1.0, 1.5, 2.0)
+    rc, err, _ = _cli("bifurcation", ROOT / "configs" / "paper.yaml", "--param",
+                      "simulate.strides=1,2", "--runs-dir", tmp_path)
+    assert rc == 1 and "simulate.strides takes whole numbers" in err
+    assert "got 1.0" not in err
+
+
+# --------------------------------------------------------------- 14: the vocabulary's end
+@pytest.mark.parametrize("walker", [
+    {**WALKER, "torso": {"mass_kg": 1.0}},
+    {**WALKER, "actuation": "hip_torque"},
+    {"model": "biped", "hip_mass_kg": 10, "leg": {
+        "length_m": 1.0, "foot": {"kind": "flat"},
+        "bodies": [{"kind": "point_mass", "name": "m", "mass_kg": 5, "from_hip_m": 0.5}]}},
+    {"model": "hexapod"},
+])
+def test_an_unknown_walker_part_says_what_a_walker_can_be(walker):
+    vocabulary = getattr(config, "WALKER_VOCABULARY", "(none)")
+    lines = _errors({"walker": walker, "slope": {"angle_deg": 1}})
+    assert sum(vocabulary in ln for ln in lines) == 1
+    assert "no torso, springs, ankles, flat feet or actuation yet" in vocabulary
+    assert "walker" in (ROOT / "README.md").read_text() and \
+        "no torso, no leg spring, no ankle, no flat foot and no actuation" in \
+        (ROOT / "README.md").read_text()

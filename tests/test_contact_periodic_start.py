@@ -1,0 +1,76 @@
+"""Contact runs started from the contact model's own periodic gait (issue 25, item 4)."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from walkerlab.config import load_scene, scene_from_dict
+
+
+@pytest.mark.slow  # a periodic-gait search (~3 s CPU) and a 2-stride contact run
+def test_run_from_the_periodic_gait_has_constant_step_periods():
+    """From the gait's mid-stance state every full step lasts the gait's period.
+
+    Tolerance 2e-5 s: the periodic solve converges to a scaled residual < 1e-8 (here
+    ~2e-11), so the orbit itself is periodic to far below 1 us; what remains is the run's
+    integrator (the scene's contact solver, looser than the search's rtol 1e-12) and its
+    heel-strike location, measured as a steady offset of 6-7 us with a spread of ~1.5 us
+    over 6 steps.  The start from the ideal fixed point (x 1.1 rates) has a first step of
+    0.58 s against 0.71 s: 10^4 times that tolerance."""
+    from walkerlab.analysis.contact_periodic import ideal_gait
+    from walkerlab.analysis.contact_sim import simulate_from_periodic_gait
+
+    scene = load_scene("configs/paper.yaml")
+    ideal = ideal_gait(scene)
+    _, res, _, _, gait = simulate_from_periodic_gait(scene, ideal.x, strides=2)
+    assert gait.converged and gait.residual < 1e-8
+    hs = np.asarray(res.heel_strike_times)
+    assert hs.size == 5 and res.heel_strike_legs[:2] == ["leg1", "leg2"]
+    periods = np.diff(hs)  # full steps (the first heel strike ends a half step)
+    assert np.all(np.abs(periods - gait.period_s) < 2e-5)
+    assert np.ptp(periods) < 5e-6
+    # the steady gait is the contact model's, not the rigid one (0.7036 s): > 5 ms apart
+    assert abs(gait.period_s - ideal.period_s) > 5e-3
+
+
+def test_start_setting_is_typed_and_the_default_keeps_the_scene_hash():
+    """``contact_sim.start`` accepts the three starts only, and a scene that leaves it at
+    the default serialises as before (its cached artifacts and shipped numbers stay)."""
+    from walkerlab.config import SceneError
+
+    scene = load_scene("configs/paper.yaml")
+    assert scene.contact_sim.start == "ideal"
+    assert "start" not in scene.section_json("contact_sim")
+    d = scene.model_dump(mode="json")
+    d["contact_sim"]["start"] = "periodic_gait"
+    s2 = scene_from_dict(d)
+    assert s2.contact_sim.start == "periodic_gait"
+    assert '"start": "periodic_gait"' in s2.section_json("contact_sim").replace("\":\"", "\": \"")
+    d["contact_sim"]["start"] = "steady"
+    with pytest.raises((SceneError, ValueError), match="start"):
+        scene_from_dict(d)
+
+
+@pytest.mark.slow  # the contact-sim stage from the periodic gait (~5 s CPU)
+def test_contact_sim_stage_starts_from_the_periodic_gait(tmp_path):
+    """``contact_sim.start: periodic_gait`` through the stage: the artifact stores the gait
+    it started from, the run walks, its first heel strike comes about half a period after
+    the start (mid-stance) and every full step lasts the gait's period (tolerance as in
+    the test above)."""
+    import yaml
+
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
+    from walkerlab.stages import pipeline
+
+    d = yaml.safe_load(Path("configs/paper.yaml").read_text())
+    d["contact_sim"].update({"start": "periodic_gait", "n_strides": 1})
+    p = tmp_path / "paper_steady.yaml"
+    p.write_text(yaml.safe_dump(d))
+    out = pipeline.run("contact-sim", load_scene(p), tmp_path / "runs")
+    assert not out.failure
+    cs = load_contact_sim(out.path)
+    assert cs.periodic is not None and cs.periodic.found
+    hs = cs.heel_strike_times
+    assert hs.size == 3 and hs[0] < 0.6 * cs.periodic.step_period_s  # started mid-stance
+    assert np.all(np.abs(np.diff(hs) - cs.periodic.step_period_s) < 2e-5)

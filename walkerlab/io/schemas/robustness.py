@@ -1,0 +1,124 @@
+"""``robustness.h5``: robustness of the gait beyond |lambda|, writer and reader side by side.
+
+Layout (every value a scalar dataset with its unit)::
+
+    max_abs_multiplier/{absolute,relative}            -      |lambda|max in two coordinates
+    gsn/<disturbance>                                 1/unit GSN, linearised step-to-step map
+    gsn_nonlinear/<disturbance>                       1/unit GSN, small nonlinear impulse
+    state_norm/{absolute,relative}/<disturbance>      1/unit state-indicator norm (Jin et al.)
+    step_down_m/{lo,hi}, step_up_m/{lo,hi}            m      bisection bracket (lo survives)
+    push_{forward,backward}_m_per_s/{lo,hi}           m/s    mid-stance push bracket
+    sigma_rad                                         rad    per-step slope sigma of the MFPT
+    mfpt_steps, mfpt_steps_stderr                     steps  Monte Carlo MFPT (censored MLE)
+    montecarlo_walks, montecarlo_falls                -
+
+attributes: ``disturbances`` (names), ``units`` (unit of each disturbance), ``state_names``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+STAGE = "robustness"
+COORDINATES = ("absolute", "relative")
+
+
+def per_unit(unit: str) -> str:
+    """Unit of a sensitivity per unit disturbance (``m/s`` -> ``s/m``)."""
+    return "s/m" if unit == "m/s" else f"1/{unit}"
+SCALARS = {
+    "step_down_m/lo": ("m", "largest step-down survived (bisection bracket, lower end)"),
+    "step_down_m/hi": ("m", "smallest step-down that falls (upper end; inf: none up to "
+                       "the search cap)"),
+    "step_up_m/lo": ("m", "largest step-up survived (lower end)"),
+    "step_up_m/hi": ("m", "smallest step-up that falls (upper end)"),
+    "push_forward_m_per_s/lo": ("m/s", "largest forward mid-stance push survived (hip "
+                                "velocity change; lower end)"),
+    "push_forward_m_per_s/hi": ("m/s", "smallest forward push that falls (upper end)"),
+    "push_backward_m_per_s/lo": ("m/s", "largest backward mid-stance push survived"),
+    "push_backward_m_per_s/hi": ("m/s", "smallest backward push that falls"),
+    "sigma_rad": ("rad", "per-step slope standard deviation of the MFPT"),
+    "mfpt_steps": ("steps", "Monte Carlo MFPT: heel strikes before the fall"),
+    "mfpt_steps_stderr": ("steps", "standard error of mfpt_steps"),
+    "montecarlo_walks": ("-", "Monte Carlo walks"),
+    "montecarlo_falls": ("-", "walks that fell (the rest reached the step cap)"),
+}
+
+
+@dataclass
+class RobustnessData:
+    """The contents of ``robustness.h5``.
+
+    Attributes
+    ----------
+    disturbances : list of str
+    units : dict[str, str]
+        Unit of each disturbance (``rad``, ``m``).
+    max_abs_multiplier : dict[str, float]
+        By coordinate choice (:data:`COORDINATES`).
+    gsn, gsn_nonlinear : dict[str, float]
+        By disturbance [1/unit].
+    state_norm : dict[str, dict[str, float]]
+        By coordinate choice, then disturbance.
+    scalars : dict[str, float]
+        Every name of :data:`SCALARS`.
+    state_names : list of str
+    """
+
+    disturbances: list
+    units: dict
+    max_abs_multiplier: dict
+    gsn: dict
+    gsn_nonlinear: dict
+    state_norm: dict
+    scalars: dict
+    state_names: list = field(default_factory=list)
+
+    def __getitem__(self, name: str) -> float:
+        return self.scalars[name]
+
+
+def write(f, d: RobustnessData) -> None:
+    """Fill an open artifact (``write_artifact``'s writer) with ``d``."""
+    from walkerlab.io.artifacts import put
+
+    for c in COORDINATES:
+        put(f, f"max_abs_multiplier/{c}", float(d.max_abs_multiplier[c]), "-",
+            f"largest |Floquet multiplier|, {c} leg angles")
+    for dist in d.disturbances:
+        u = per_unit(d.units[dist])
+        put(f, f"gsn/{dist}", float(d.gsn[dist]), u, "gait sensitivity norm (linearised)")
+        put(f, f"gsn_nonlinear/{dist}", float(d.gsn_nonlinear[dist]), u,
+            "gait sensitivity norm (nonlinear response to a small impulse)")
+        for c in COORDINATES:
+            put(f, f"state_norm/{c}/{dist}", float(d.state_norm[c][dist]), u,
+                f"sensitivity norm with the post-impact state as indicator, {c} angles")
+    for name, (unit, desc) in SCALARS.items():
+        put(f, name, float(d.scalars[name]), unit, desc)
+    f.attrs["disturbances"] = list(d.disturbances)
+    f.attrs["disturbance_units"] = [d.units[k] for k in d.disturbances]
+    f.attrs["state_names"] = list(d.state_names)
+
+
+def load(path: Path) -> RobustnessData:
+    """Read ``robustness.h5``.
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing, damaged or another stage's file.
+    """
+    from walkerlab.io.artifacts import open_artifact
+
+    with open_artifact(path, STAGE) as f:
+        dists = [str(s) for s in f.attrs["disturbances"]]
+        units = dict(zip(dists, (str(s) for s in f.attrs["disturbance_units"])))
+        return RobustnessData(
+            dists, units,
+            {c: float(f[f"max_abs_multiplier/{c}"][()]) for c in COORDINATES},
+            {k: float(f[f"gsn/{k}"][()]) for k in dists},
+            {k: float(f[f"gsn_nonlinear/{k}"][()]) for k in dists},
+            {c: {k: float(f[f"state_norm/{c}/{k}"][()]) for k in dists} for c in COORDINATES},
+            {k: float(f[k][()]) for k in SCALARS},
+            [str(s) for s in f.attrs["state_names"]])

@@ -1,0 +1,54 @@
+"""The report's robustness section, from a loaded ``robustness.h5``
+(:class:`walkerlab.io.schemas.robustness.RobustnessData`) only."""
+
+from __future__ import annotations
+
+import math
+
+from walkerlab.io.schemas.robustness import per_unit
+from walkerlab.report.markdown import num, table
+
+_LABEL = {"slope": "slope change", "floor_height": "floor height step",
+          "push": "mid-stance push"}
+
+
+def _mm(lo: float, hi: float, scale: float = 1000) -> str:
+    if not math.isfinite(hi):
+        return f"≥ {num(scale * lo, 3)} (none falls up to the search cap)"
+    return f"{num(scale * lo, 3)} (falls at {num(scale * hi, 3)})"
+
+
+def robustness_section(arts: dict) -> list[str]:
+    """|lambda|max and GSN in two state coordinates, the MFPT at the scene's sigma, the
+    largest step-down/up (rigid model; empty when the scene ran no robustness stage)."""
+    r = arts.get("robustness")
+    if r is None:
+        return []
+    lam = r.max_abs_multiplier
+    rows = [[f"{_LABEL.get(d, d)} [{per_unit(r.units[d])}]", r.gsn[d],
+             f"{abs(r.gsn[d] - r.gsn_nonlinear[d]) / r.gsn[d]:.0e}",
+             r.state_norm["absolute"][d], r.state_norm["relative"][d]] for d in r.disturbances]
+    m, se = r["mfpt_steps"], r["mfpt_steps_stderr"]
+    mfpt = (f"≥ {num(r['montecarlo_walks'])} walks reached the step cap (no fall)"
+            if not math.isfinite(m) else f"{num(m)} ± {num(se)} steps (standard error)")
+    return ["## Robustness (rigid model)", "",
+            f"- largest |Floquet multiplier|: {num(lam['absolute'])} in absolute leg angles, "
+            f"{num(lam['relative'])} in angles relative to the stance leg (the Jacobians "
+            "are similar matrices: the multipliers do not depend on the coordinates).",
+            f"- MFPT on per-step random slopes, σ = {num(r['sigma_rad'])} rad (Monte Carlo, "
+            f"{num(r['montecarlo_walks'])} walks, {num(r['montecarlo_falls'])} fell): {mfpt}.",
+            f"- largest single step-down survived: {_mm(r['step_down_m/lo'], r['step_down_m/hi'])}"
+            f" mm; step-up: {_mm(r['step_up_m/lo'], r['step_up_m/hi'])} mm (bisection).",
+            "- largest mid-stance push survived (an impulsive horizontal push at the hip when "
+            "the stance leg is vertical, the stance foot pinned; as the hip's velocity change): "
+            f"forward {_mm(r['push_forward_m_per_s/lo'], r['push_forward_m_per_s/hi'], 1)} "
+            f"m/s, backward {_mm(r['push_backward_m_per_s/lo'], r['push_backward_m_per_s/hi'], 1)}"
+            " m/s.", "",
+            "Gait sensitivity norm (Hobbelen & Wisse 2007; indicators step time, step length, "
+            "stance angle at heel strike), with the relative difference to the nonlinear "
+            "response to a small impulse, and the norm with the post-impact state as "
+            "indicator in two state coordinates.  Jin et al. (2021, R. Soc. Open Sci. 8: "
+            "201122) caution that local measures like this can rank walkers differently in "
+            "different state coordinates: compare walkers only in one stated choice.", "",
+            table(["disturbance", "GSN", "linear vs nonlinear", "state norm (absolute)",
+                   "state norm (relative)"], rows), ""]

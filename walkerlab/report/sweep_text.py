@@ -1,0 +1,63 @@
+"""Plain-text summary of a sweep artifact, printed by ``walkerlab sweep``: the points per
+outcome and the range of the stage's main results over the points that walk."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.report.markdown import num
+from walkerlab.units import Units
+
+#: the main results of each swept stage (columns of ``points``), in the order printed
+MAIN_COLUMNS = {
+    "fixedpoint": ("step_period_s", "max_abs_multiplier"),
+    "simulate": ("steps_completed", "mean_step_period_s", "mean_hip_speed_m_per_s"),
+    "contact-sim": ("heel_strikes", "mean_step_period_s", "max_slip_mm",
+                    "peak_penetration_mm"),
+}
+#: SI unit of a result column by its suffix (labelled through :class:`Units`)
+_SUFFIX = (("_m_per_s", "m/s"), ("_mm", "mm"), ("_s", "s"), ("_m", "m"))
+
+
+def column_unit(name: str, units: Units) -> str:
+    """Label of a result column's unit (``step_period_s`` -> ``s`` or ``√(l/g)``)."""
+    for suffix, si in _SUFFIX:
+        if name.endswith(suffix):
+            return units(si)
+    return ""
+
+
+def main_columns(data: dict) -> list[str]:
+    """The stage's main result columns present in a loaded sweep (``load_sweep``)."""
+    stage = str(data["attrs"].get("sweep_stage", ""))
+    return [c for c in MAIN_COLUMNS.get(stage, ()) if c in data["points"]]
+
+
+def sweep_text(path: Path) -> str:
+    """``5 points: ok 5``, then for each main result its range over the points that walk
+    (``step_period_s 0.7036 .. 0.7343 s over slope.angle_deg 1 .. 3 deg``)."""
+    from walkerlab.sweep.store import field_unit, load_sweep
+
+    data = load_sweep(path)
+    units = Units(str(data["attrs"].get("scene_units", "SI")))
+    outcome = np.asarray(data["points"]["outcome"]).astype(str)
+    kinds, counts = np.unique(outcome, return_counts=True)
+    order = np.argsort(-counts, kind="stable")
+    lines = [f"{outcome.size} points: " + ", ".join(f"{kinds[i]} {counts[i]}" for i in order)]
+    ok = outcome == "ok"
+    for path_, _values in data["axes"]:
+        v = np.asarray(data["points"][f"param/{path_}"])
+        if v.dtype.kind in "fi" and v.size:
+            u = units(field_unit(path_) or "")
+            lines.append(f"  {path_:<28s} {num(np.min(v))} .. {num(np.max(v))}"
+                         + (f" {u}" if u not in ("", "-") else ""))
+    for c in main_columns(data):
+        v = np.asarray(data["points"][c], float)[ok]
+        v = v[np.isfinite(v)]
+        u = column_unit(c, units)
+        rng = (f"{num(v.min())} .. {num(v.max())}" + (f" {u}" if u else "")
+               if v.size else "no point walks")
+        lines.append(f"  {c:<28s} {rng}")
+    return "\n".join(lines)

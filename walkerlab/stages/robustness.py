@@ -1,0 +1,79 @@
+"""Stage ``robustness``: robustness of the gait beyond |lambda| -> ``robustness.h5``.
+
+Reads the scene's ``robustness`` section and the gait from ``fixedpoint.h5`` (the pipeline
+runs ``fixedpoint`` first, :mod:`walkerlab.stages.pipeline`); computes by
+:func:`walkerlab.analysis.robustness.scene_robustness` the gait sensitivity norms, the
+largest step-down/up and the Monte Carlo MFPT at the scene's sigma.  Skipped when the scene
+sections, the upstream gait and the code are unchanged.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from walkerlab.config import CommandOptions, Scene, validate_option
+from walkerlab.io.runpaths import artifact_lock, stage_artifact
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.stages.common import (
+    StageError,
+    StageOutcome,
+    _tell,
+    artifact_path,
+    input_hash,
+    require,
+)
+
+SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt", "robustness")
+
+
+def check(scene: Scene, workers: int = 2, **_options) -> int:
+    """The worker count, checked before anything runs (a scene without a ``robustness``
+    section runs with its defaults, as ``walkerlab mfpt`` does; only the report needs the
+    section).
+
+    Raises
+    ------
+    StageError
+        A bad worker count (one line).
+    """
+    require(scene, "fixedpoint", "robustness")
+    return validate_option(CommandOptions, "workers", workers, "--workers")
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False, workers: int = 2,
+        scheduler=None) -> StageOutcome:
+    """Compute (or reuse) ``robustness.h5`` of the scene's rigid walker.
+
+    Raises
+    ------
+    StageError
+        Missing sections, or a walker the batched step map cannot carry (one line).
+    """
+    workers = check(scene, workers)
+    up = artifact_path(scene, runs_root, "fixedpoint")
+    path = stage_artifact(scene, runs_root, "robustness", claim=True)
+    with artifact_lock(path, wait=True, on_wait=_tell):
+        from walkerlab.io.artifacts import verified_hash, write_artifact
+        from walkerlab.io.schemas import robustness as schema
+
+        key = input_hash("robustness", scene, SECTIONS, (up,))
+        if not force and path.is_file() and verified_hash(path) == key:
+            return StageOutcome("robustness", path, True, 0.0, {})
+        note = ""
+        if not force and path.is_file():
+            from walkerlab.stages.common import recompute_reason
+
+            note = recompute_reason(path, scene, SECTIONS, verified_hash(path))
+            _tell(f"robustness: recomputing {path} ({note})")
+        from walkerlab.analysis.robustness import scene_robustness
+
+        t0 = time.perf_counter()
+        try:
+            data = scene_robustness(scene, load_fixedpoint(up).x, workers, scheduler)
+        except ValueError as exc:
+            raise StageError(str(exc)) from None
+        wall = time.perf_counter() - t0
+        write_artifact(path, "robustness", scene, key, lambda f: schema.write(f, data), wall,
+                       {"workers": workers if scheduler is None else 0})
+        return StageOutcome("robustness", path, False, wall, {"data": data}, note)
