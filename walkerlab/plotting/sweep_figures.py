@@ -35,7 +35,7 @@ OUTCOME_LABELS = {"ok": "walks (ok)", "fall": "falls", "slip": "slips", "bounce"
 
 
 def bifurcation_figure(data: dict, title: str = ""):
-    """Bifurcation diagram from :func:`walkerlab.sweep.bifurcation.load_bifurcation` data.
+    """Bifurcation diagram from :func:`walkerlab.io.schemas.bifurcation.load_bifurcation` data.
 
     Parameters
     ----------
