@@ -37,19 +37,12 @@ from scipy.optimize import brentq
 
 from walkerlab.config import Scene
 from walkerlab.execution.executor import run_each
-from walkerlab.io.schemas.bifurcation import (  # noqa: F401  (re-exported)
-    SLOPE_PATH,
-    bifurcation_writer,
-    load_bifurcation,
-    onset_name,
-    parameter_dim,
-)
+from walkerlab.io.schemas.bifurcation import SLOPE_PATH, onset_name, parameter_dim
 from walkerlab.sweep.params import ParamAxis
 from walkerlab.sweep.runner import plan_chunks, sweep_executor
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
-           "min_real_multiplier", "bifurcation_writer", "load_bifurcation", "SLOPE_PATH",
-           "parameter_dim", "parameter_values", "onset_value", "fall_onset"]
+           "min_real_multiplier", "parameter_values", "onset_value", "fall_onset"]
 
 @dataclass(frozen=True)
 class _BifTask:
@@ -423,8 +416,9 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
 
 
 def parameter_values(data: dict) -> tuple[np.ndarray, str, str]:
-    """The grid of loaded bifurcation data (:func:`load_bifurcation`, or a dict with a
-    ``slope`` array): values (n,), the field's dotted path and its unit."""
+    """The grid of loaded bifurcation data
+    (:func:`walkerlab.io.schemas.bifurcation.load_bifurcation`, or a dict with a ``slope``
+    array): values (n,), the field's dotted path and its unit."""
     path = str(data.get("parameter_path", SLOPE_PATH))
     unit = str(data.get("parameter_unit", "deg"))
     return np.asarray(data[parameter_dim(path)], float), path, unit
