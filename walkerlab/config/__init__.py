@@ -31,6 +31,7 @@ from walkerlab.config.contact import (
     PerStepTerrain,
     TerrainSettings,
 )
+from walkerlab.config.errors import WALKER_VOCABULARY
 from walkerlab.config.limits import (
     MAX_BASIN_CELLS_PER_AXIS,
     MAX_BIFURCATION_KEEP,
@@ -46,14 +47,13 @@ from walkerlab.config.limits import (
     MAX_WORKERS,
     MAX_YAML_DEPTH,
     SMALL_SLOPE_DEG,
-    unit_warnings,
 )
 from walkerlab.config.loader import (
-    WALKER_VOCABULARY,
     default_scene_path,
     load_scene,
     parse_yaml,
     scene_from_dict,
+    unit_warnings,
     validate_option,
 )
 from walkerlab.config.schema import (

@@ -7,12 +7,7 @@ validate through them.
 
 from __future__ import annotations
 
-import math
 import os
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from walkerlab.config.schema import Scene
 
 # Caps that keep a run bounded (issue 12, D8; issue 19, item 5): a bigger request is a
 # one-line error.  Each size a user can type has one cap, defined here; the CLI validates its
@@ -46,14 +41,3 @@ MAX_STEP_TIME_S = 600.0
 
 #: a slope in degrees below this looks like radians (``angle_deg: 0.0174``): a warning
 SMALL_SLOPE_DEG = 0.1
-
-
-def unit_warnings(scene: Scene) -> list[str]:
-    """Values that validate but look like a unit mistake (one line each, naming the field):
-    ``slope.angle_deg`` below :data:`SMALL_SLOPE_DEG` (radians given as degrees?)."""
-    out = []
-    d = scene.slope.angle_deg
-    if d is not None and 0 < abs(d) < SMALL_SLOPE_DEG:
-        out.append(f"slope.angle_deg: {d:g}° is a very small slope; it looks like radians "
-                   f"({d:g} rad = {math.degrees(d):.3g}°): if so, write angle_rad: {d:g}")
-    return out

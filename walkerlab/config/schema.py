@@ -34,6 +34,7 @@ from walkerlab.config.contact import (
     ContactSolverSettings,
     TerrainSettings,
 )
+from walkerlab.config.errors import format_error
 from walkerlab.config.limits import (
     MAX_BASIN_CELLS_PER_AXIS,
     MAX_BIFURCATION_KEEP,
@@ -810,9 +811,7 @@ class Scene(_Strict):
         try:
             out = type(self).model_validate(data)
         except ValidationError as err:
-            from walkerlab.config.loader import format_error
-
-            raise SceneError(format_error(Path("model_copy"), err)) from None
+            raise SceneError(format_error(Path("model_copy"), err, Scene)) from None
         out._origin = self._origin
         return out
 

@@ -13,16 +13,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import h5py
 import numpy as np
 
 from walkerlab.io.artifacts import open_artifact, put, read_named
 from walkerlab.io.netcdf import coordinate
-
-if TYPE_CHECKING:
-    from walkerlab.sweep.bifurcation import BifurcationResult
 
 STAGE = "bifurcation"
 #: the grid of ``bifurcation --slopes``: its coordinate is named ``slope`` (any other
@@ -91,7 +87,7 @@ def load_bifurcation_summary(path: Path) -> BifurcationSummary:
                                   f["steady_state/attractor_period"][()])
 
 
-def bifurcation_writer(res: BifurcationResult):
+def bifurcation_writer(res):  # res: walkerlab.sweep.bifurcation.BifurcationResult
     """``writer(h5file)`` filling a ``bifurcation`` artifact (netCDF dimensions: the
     parameter (:func:`parameter_dim`: ``slope`` or the field's dotted path; attributes
     ``unit``, ``path``), ``multiplier``, ``heel_strike``; units on every dataset; the onset
