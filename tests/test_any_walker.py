@@ -164,7 +164,8 @@ def test_sweep_columns_and_bifurcation_arrays_follow_the_walker(walker, fixed_po
     import xarray as xr
 
     import walkerlab.io.artifacts as A
-    from walkerlab.sweep.bifurcation import BifurcationResult, bifurcation_writer
+    from walkerlab.io.schemas.bifurcation import bifurcation_writer
+    from walkerlab.sweep.bifurcation import BifurcationResult
     from walkerlab.sweep.outcomes import columns
     from walkerlab.sweep.points import _fp_columns, interleg_angle
 

@@ -166,7 +166,7 @@ def test_an_unknown_walker_part_says_what_a_walker_can_be(walker):
     vocabulary = getattr(config, "WALKER_VOCABULARY", "(none)")
     lines = _errors({"walker": walker, "slope": {"angle_deg": 1}})
     assert sum(vocabulary in ln for ln in lines) == 1
-    assert "no torso, springs, ankles, flat feet or actuation yet" in vocabulary
+    assert "no ankles, flat feet, elastic knees or actuation yet" in vocabulary
     assert "walker" in (ROOT / "README.md").read_text() and \
-        "no torso, no leg spring, no ankle, no flat foot and no actuation" in \
+        "no ankle, no flat foot, no elastic knee and no actuation" in \
         (ROOT / "README.md").read_text()

@@ -100,9 +100,10 @@ def test_nondimensional_artifact_units_and_cli_text(simplest_run):
 
 def test_nondimensional_report_and_figures_follow_the_scene(simplest_run):
     """Report summary, gait table and the figures' axis labels of a nondimensional scene."""
+    from walkerlab.io.runpaths import stage_artifact
+    from walkerlab.io.schemas.simulate import load_simulate
     from walkerlab.plotting import figures as F
     from walkerlab.report import sections
-    from walkerlab.stages.plot import load_trajectories
     from walkerlab.stages.report import existing_artifacts, load_inputs
     from walkerlab.units import for_scene
 
@@ -114,7 +115,7 @@ def test_nondimensional_report_and_figures_follow_the_scene(simplest_run):
     assert not re.search(r"\| (s|J|m|m/s|mm) \|", md), md
     assert not re.search(r"\d (s|J|mm)\b", md), md
     u = for_scene(sc)
-    trajs = load_trajectories(sc, root)
+    trajs = {"ideal": load_simulate(stage_artifact(sc, root, "simulate")).samples}
     fig7 = F.fig7_angles_rates(trajs, units=u)
     assert fig7.axes[1].get_xlabel() == "time [√(l/g)]"
     assert fig7.axes[1].get_ylabel() == "angular rate [rad/√(l/g)]"

@@ -688,3 +688,41 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         nfev=P.nfev + (PJ.nfev if PJ is not P else 0) + (PC.nfev if coarse else 0),
         patch_margin_m=margin, full_state=P.to_state(zs),
         wall_time_s=time.perf_counter() - wall, info=info)
+
+
+def simulate_from_periodic_gait(scene, x_ideal: np.ndarray, strides: int | None = None,
+                                solver=None):  # scene: Scene, solver: ContactSolverSettings
+    """Run the contact walker of ``scene`` from its own periodic gait (``contact_sim.start:
+    periodic_gait``): steady state, no start-up transient.
+
+    The gait is found from the ideal fixed point ``x_ideal``
+    (:func:`walkerlab.analysis.contact_periodic.find_contact_periodic_gait`, within
+    ``contact_sim.periodic_time_limit_s``); the run starts at its mid-stance section (leg2
+    stance, stance foot at s = 0) on patches spaced by the gait's step length, so every
+    footfall lands where the gait's does, and runs ``(2 strides + 1)`` gait periods.
+
+    Returns
+    -------
+    walker, result, x0, step_length, gait
+        As :func:`walkerlab.analysis.contact_sim.simulate_from`, plus the
+        :class:`ContactPeriodicGait` started from.
+
+    Raises
+    ------
+    walkerlab.analysis.contact_periodic.PeriodicGaitError
+        The periodic gait was not found (fell, no mid-stance, solver failure, time limit).
+    """
+    from walkerlab.analysis.contact_sim import scene_start, simulate_contact
+    from walkerlab.contact.scene import build, settings
+
+    _, _, cs, sv = settings(scene)
+    sv = solver or sv
+    n_strides = strides or cs.n_strides
+    probe, _, limits, _ = scene_start(scene, x_ideal, n_strides)
+    gait = find_contact_periodic_gait(probe, x_ideal, time_limit_s=cs.periodic_time_limit_s)
+    walker, step_length = build(scene, x_ideal, 2 * n_strides, step_length_m=gait.step_length_m)
+    x0 = np.asarray(gait.full_state, float)
+    t_final = cs.t_final_s or (2 * n_strides + 1) * gait.period_s
+    res = simulate_contact(walker, x0, t_final, sv, limits,
+                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
+    return walker, res, x0, step_length, gait

@@ -195,42 +195,6 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
     return walker, res, x0, step_length
 
 
-def simulate_from_periodic_gait(scene: Scene, x_ideal: np.ndarray, strides: int | None = None,
-                                solver: ContactSolverSettings | None = None):
-    """Run the contact walker of ``scene`` from its own periodic gait (``contact_sim.start:
-    periodic_gait``): steady state, no start-up transient.
-
-    The gait is found from the ideal fixed point ``x_ideal``
-    (:func:`walkerlab.analysis.contact_periodic.find_contact_periodic_gait`, within
-    ``contact_sim.periodic_time_limit_s``); the run starts at its mid-stance section (leg2
-    stance, stance foot at s = 0) on patches spaced by the gait's step length, so every
-    footfall lands where the gait's does, and runs ``(2 strides + 1)`` gait periods.
-
-    Returns
-    -------
-    walker, result, x0, step_length, gait
-        As :func:`simulate_from`, plus the :class:`ContactPeriodicGait` started from.
-
-    Raises
-    ------
-    walkerlab.analysis.contact_periodic.PeriodicGaitError
-        The periodic gait was not found (fell, no mid-stance, solver failure, time limit).
-    """
-    from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
-
-    _, _, cs, sv = settings(scene)
-    sv = solver or sv
-    n_strides = strides or cs.n_strides
-    probe, _, limits, _ = scene_start(scene, x_ideal, n_strides)
-    gait = find_contact_periodic_gait(probe, x_ideal, time_limit_s=cs.periodic_time_limit_s)
-    walker, step_length = build(scene, x_ideal, 2 * n_strides, step_length_m=gait.step_length_m)
-    x0 = np.asarray(gait.full_state, float)
-    t_final = cs.t_final_s or (2 * n_strides + 1) * gait.period_s
-    res = simulate_contact(walker, x0, t_final, sv, limits,
-                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
-    return walker, res, x0, step_length, gait
-
-
 def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
     """State name -> name in the shared trajectory layout for every leg coordinate of the
     walker (the hip position and velocity are points): the floating coordinate's name

@@ -51,7 +51,7 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
     data : walkerlab.io.schemas.continuation.ContinuationData
     title : str
     brute : dict, optional
-        :func:`walkerlab.sweep.bifurcation.load_bifurcation` data over the same field:
+        :func:`walkerlab.io.schemas.bifurcation.load_bifurcation` data over the same field:
         its steady states are drawn as dots.
 
     Returns

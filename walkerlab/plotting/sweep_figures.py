@@ -20,8 +20,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
+from walkerlab.io.schemas.bifurcation import SLOPE_PATH
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
-from walkerlab.sweep.bifurcation import SLOPE_PATH, fall_onset, onset_value, parameter_values
+from walkerlab.sweep.bifurcation import fall_onset, onset_value, parameter_values
 from walkerlab.sweep.outcomes import OUTCOMES
 from walkerlab.units import Units
 
@@ -35,7 +36,7 @@ OUTCOME_LABELS = {"ok": "walks (ok)", "fall": "falls", "slip": "slips", "bounce"
 
 
 def bifurcation_figure(data: dict, title: str = ""):
-    """Bifurcation diagram from :func:`walkerlab.sweep.bifurcation.load_bifurcation` data.
+    """Bifurcation diagram from :func:`walkerlab.io.schemas.bifurcation.load_bifurcation` data.
 
     Parameters
     ----------

@@ -384,7 +384,8 @@ def bifurcation_section(arts: dict, pub: ModuleType | None = None) -> list[str]:
 
 
 def _bifurcation_lines(b, pub: ModuleType | None) -> list[str]:
-    from walkerlab.sweep.bifurcation import SLOPE_PATH, fall_onset, onset_value
+    from walkerlab.io.schemas.bifurcation import SLOPE_PATH
+    from walkerlab.sweep.bifurcation import fall_onset, onset_value
 
     p, data, values, per = b.path, b.data, b.values, b.attractor_period
     path, unit = data["parameter_path"], data["parameter_unit"]

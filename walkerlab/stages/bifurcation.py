@@ -54,14 +54,9 @@ def run(scene: Scene, slopes_deg, runs_root: Path | str = "runs", n_transient: i
         before anything runs).
     """
     from walkerlab.io.runpaths import bifurcation_stem
+    from walkerlab.io.schemas.bifurcation import SLOPE_PATH, bifurcation_writer, load_bifurcation
     from walkerlab.plotting.sweep_figures import bifurcation_figure, save
-    from walkerlab.sweep.bifurcation import (
-        SLOPE_PATH,
-        bifurcation_diagram,
-        bifurcation_writer,
-        load_bifurcation,
-        onset_value,
-    )
+    from walkerlab.sweep.bifurcation import bifurcation_diagram, onset_value
     from walkerlab.sweep.params import ParamAxis, axis_unit, check_axes
 
     scene = with_defaults(scene, "fixedpoint", "bifurcation")

@@ -51,10 +51,13 @@ def _compute(scene: Scene, fixedpoint: Path, adjust: bool, periodic: bool):
         adj = adjust_rates(scene, fp.x, fp.step_period_s)
         scale = adj["scale"]
     if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
-        from walkerlab.analysis.contact_periodic import PeriodicGaitError
+        from walkerlab.analysis.contact_periodic import (
+            PeriodicGaitError,
+            simulate_from_periodic_gait,
+        )
 
         try:
-            walker, res, x0, step_length, gait = contact_run.simulate_from_periodic_gait(
+            walker, res, x0, step_length, gait = simulate_from_periodic_gait(
                 scene, fp.x)
         except PeriodicGaitError as exc:
             raise StageError(f"scene '{scene.name}': contact_sim.start: periodic_gait: the "

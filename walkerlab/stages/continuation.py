@@ -29,13 +29,13 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     """
     from walkerlab.analysis.continuation import MapFailed
     from walkerlab.io.runpaths import bifurcation_artifacts, check_name
+    from walkerlab.io.schemas.bifurcation import load_bifurcation
     from walkerlab.io.schemas.continuation import continuation_writer, load_continuation
     from walkerlab.plotting.continuation_figures import (
         continuation_figure,
         two_parameter_figure,
     )
     from walkerlab.plotting.figures import save
-    from walkerlab.sweep.bifurcation import load_bifurcation
     from walkerlab.sweep.continuation import run_continuation, scene_family
     from walkerlab.sweep.params import SweepError
 

@@ -67,13 +67,16 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     import json
 
     from walkerlab.config import SceneError
-    from walkerlab.sweep.continuation import known_scene
 
     require(scene, "fixedpoint", "fixedpoint")
-    try:
-        src = known_scene(scene, known)
-    except SceneError as exc:
-        raise StageError(f"fixedpoint.from: {exc}") from None
+    src = None
+    if known is not None or getattr(scene.fixedpoint, "from_", None) is not None:
+        from walkerlab.sweep.continuation import known_scene  # only for a homotopy start
+
+        try:
+            src = known_scene(scene, known)
+        except SceneError as exc:
+            raise StageError(f"fixedpoint.from: {exc}") from None
     from_key = "" if src is None else "from:" + json.dumps(src.model_dump(mode="json"),
                                                           sort_keys=True)
 

@@ -357,18 +357,10 @@ def _resumed_cells(part: Path, key: str, nx: int, ny: int):
     """``(arrays, row_hash)`` of a partial basin file of input hash ``key`` and grid
     ``(ny, nx)``, keeping only grid rows whose cells still match the hash written with them
     (the others are set back to not done); ``(None, None)`` without a usable file."""
-    import h5py
+    from walkerlab.io.basin_partial import read_basin_partial
 
-    if not part.is_file():
-        return None, None
-    try:
-        with h5py.File(part, "r") as f:
-            if f.attrs.get("input_hash") != key or f["outcome"].shape != (ny, nx):
-                return None, None
-            arrays = {k: f[k][()] for k in ("outcome", "steps", "period")}
-            stored = [x.decode() if isinstance(x, bytes) else str(x)
-                      for x in f["row_hash"][()]] if "row_hash" in f else [""] * ny
-    except (OSError, KeyError, ValueError):
+    arrays, stored = read_basin_partial(part, key, (ny, nx))
+    if arrays is None:
         return None, None
     row_hash = np.array([""] * ny, dtype=object)
     bad = 0
@@ -426,9 +418,8 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     BasinError
         Bad axes or ranges.
     """
-    import h5py
-
     from walkerlab.execution.executor import run_each
+    from walkerlab.io.basin_partial import basin_partial_writer
     from walkerlab.sweep.runner import sweep_executor
 
     base = scene.model_dump(mode="json")
@@ -466,12 +457,8 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     from walkerlab import progress
 
     part.unlink(missing_ok=True)
-    with h5py.File(part, "x") as f, \
+    with basin_partial_writer(part, key, arrays, row_hash) as write, \
             progress.task(f"basin {nx}x{ny} cells", total, done) as bar:
-        f.attrs["input_hash"] = key
-        dsets = {k: f.create_dataset(k, data=v) for k, v in arrays.items()}
-        hashes = f.create_dataset("row_hash", data=row_hash, dtype=h5py.string_dtype())
-        f.flush()
         with sweep_executor(workers, scheduler) as ex:
             for _, rows in run_each(ex, run_basin_chunk, [(t,) for t in tasks]):
                 for idx, code, steps, period in rows:
@@ -482,10 +469,7 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
                 for j in sorted({idx // nx for idx, *_ in rows}):
                     if np.all(arrays["outcome"][j] != NOT_DONE):
                         row_hash[j] = row_digest(arrays, j, key)
-                for k, d in dsets.items():
-                    d[...] = arrays[k]
-                hashes[...] = row_hash
-                f.flush()
+                write(arrays, row_hash)
                 computed += len(rows)
                 done += len(rows)
                 bar.update(done)

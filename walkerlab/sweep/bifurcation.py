@@ -31,33 +31,18 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from scipy.optimize import brentq
 
 from walkerlab.config import Scene
 from walkerlab.execution.executor import run_each
+from walkerlab.io.schemas.bifurcation import SLOPE_PATH, onset_name, parameter_dim
 from walkerlab.sweep.params import ParamAxis
 from walkerlab.sweep.runner import plan_chunks, sweep_executor
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
-           "min_real_multiplier", "bifurcation_writer", "load_bifurcation", "SLOPE_PATH",
-           "parameter_dim", "parameter_values", "onset_value", "fall_onset"]
-
-#: the default continuation parameter (``walkerlab bifurcation --slopes``)
-SLOPE_PATH = "slope.angle_deg"
-
-
-def parameter_dim(path: str) -> str:
-    """Name of the artifact's parameter coordinate: ``slope`` for :data:`SLOPE_PATH` (the
-    artifact of ``--slopes``, unchanged), else the field's dotted path."""
-    return "slope" if path == SLOPE_PATH else path
-
-
-def _onset_name(path: str) -> str:
-    return "onset/onset_slope" if path == SLOPE_PATH else "onset/onset_value"
-
+           "min_real_multiplier", "parameter_values", "onset_value", "fall_onset"]
 
 @dataclass(frozen=True)
 class _BifTask:
@@ -430,70 +415,10 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         n_transient=n_transient, n_keep=n_keep, param=param, unit=unit)
 
 
-def bifurcation_writer(res: BifurcationResult):
-    """``writer(h5file)`` filling a ``bifurcation`` artifact (netCDF dimensions: the
-    parameter (:func:`parameter_dim`: ``slope`` or the field's dotted path; attributes
-    ``unit``, ``path``), ``multiplier``, ``heel_strike``; units on every dataset; the onset
-    in ``onset/onset_slope`` for the slope, ``onset/onset_value`` otherwise)."""
-    from walkerlab.io.artifacts import put
-    from walkerlab.io.netcdf import coordinate
-
-    path, unit = res.param, res.unit
-    dim = parameter_dim(path)
-    what = "slope" if path == SLOPE_PATH else "grid value"
-
-    def writer(f):
-        c = coordinate(f, dim, res.values, unit,
-                       "slope grid" if path == SLOPE_PATH else f"grid of {path}")
-        c.attrs["path"] = path
-        f.attrs["parameter_path"] = path
-        f.attrs["parameter_dim"] = dim
-        coordinate(f, "multiplier", np.arange(res.multipliers.shape[1]), "-",
-                   "Floquet multiplier number (sorted by modulus)")
-        coordinate(f, "heel_strike", np.arange(res.n_keep), "-",
-                   f"kept heel strike (last {res.n_keep} of {res.n_transient})")
-        f.attrs["state_names"] = list(res.state_names)
-        s = (dim,)
-        for k, (n, u) in enumerate(zip(res.state_names, res.state_units)):
-            put(f, f"fixed_point/{n}", res.fixed_point[:, k], u,
-                f"period-1 fixed point, {n} just after heel strike", dims=s)
-        put(f, "fixed_point/interleg_angle", res.fixed_point_interleg_deg, "deg",
-            "inter-leg angle of the period-1 fixed point", dims=s)
-        put(f, "fixed_point/step_period", res.step_period_s, "s", "period-1 step period", dims=s)
-        put(f, "fixed_point/outcome", [str(o) for o in res.fp_outcome], "-",
-            "typed outcome of the fixed-point search", dims=s)
-        sm = (dim, "multiplier")
-        put(f, "floquet/real", res.multipliers.real, "-", "Floquet multipliers, real part",
-            dims=sm)
-        put(f, "floquet/imag", res.multipliers.imag, "-", "Floquet multipliers, imaginary part",
-            dims=sm)
-        sh = (dim, "heel_strike")
-        put(f, "steady_state/interleg_angle", res.interleg_deg, "deg",
-            f"inter-leg angle at the last {res.n_keep} of {res.n_transient} heel strikes",
-            dims=sh)
-        put(f, "steady_state/stance_angle_after_impact", res.stance_after_deg, "deg",
-            "stance-leg angle just after those impacts", dims=sh)
-        put(f, "steady_state/outcome", [str(o) for o in res.ss_outcome], "-",
-            "'walks' or how the steady-state run ended", dims=s)
-        put(f, "steady_state/attractor_period", res.attractor_period, "steps",
-            "distinct kept values (1, 2, 4, ...; n_keep: no period found)", dims=s)
-        onset = res.onset  # the slope's onset dict may carry only its *_deg names
-        put(f, _onset_name(path), onset.get("onset", onset.get("onset_deg")), unit,
-            "period-doubling onset: a multiplier crosses -1 (brentq)")
-        put(f, "onset/bracket", onset.get("bracket", onset.get("bracket_deg")), unit,
-            "grid bracket of the onset", dims=("bracket_end",))
-        put(f, "onset/multiplier_at_onset", res.onset["multiplier_at_onset"], "-",
-            "most negative real multiplier at the located onset")
-        put(f, "stats/wall_time", res.wall_time_s, "s", f"wall time per {what}", dims=s)
-        f.attrs["n_transient"] = res.n_transient
-        f.attrs["n_keep"] = res.n_keep
-
-    return writer
-
-
 def parameter_values(data: dict) -> tuple[np.ndarray, str, str]:
-    """The grid of loaded bifurcation data (:func:`load_bifurcation`, or a dict with a
-    ``slope`` array): values (n,), the field's dotted path and its unit."""
+    """The grid of loaded bifurcation data
+    (:func:`walkerlab.io.schemas.bifurcation.load_bifurcation`, or a dict with a ``slope``
+    array): values (n,), the field's dotted path and its unit."""
     path = str(data.get("parameter_path", SLOPE_PATH))
     unit = str(data.get("parameter_unit", "deg"))
     return np.asarray(data[parameter_dim(path)], float), path, unit
@@ -503,7 +428,7 @@ def onset_value(data: dict) -> float:
     """Period-doubling onset of loaded bifurcation data, in the parameter's unit (NaN when
     none)."""
     _v, path, _u = parameter_values(data)
-    return float(data.get(_onset_name(path), np.nan))
+    return float(data.get(onset_name(path), np.nan))
 
 
 def fall_onset(data: dict) -> float:
@@ -520,28 +445,3 @@ def fall_onset(data: dict) -> float:
     last_walk = np.flatnonzero(walks)
     i = int(last_walk[-1]) + 1 if last_walk.size else 0
     return float(s[i])
-
-
-def load_bifurcation(path: Path) -> dict:
-    """Arrays of a ``bifurcation`` artifact as a dict (names as in the file), with
-    ``parameter_path``, ``parameter_dim`` and ``parameter_unit`` (the grid's field, its
-    coordinate's name and unit; the slope in an artifact without them)."""
-    from walkerlab.io.artifacts import open_artifact, read_named
-
-    out = {}
-    with open_artifact(Path(path), "bifurcation") as f:
-        ppath = f.attrs.get("parameter_path", SLOPE_PATH)
-        ppath = ppath.decode() if isinstance(ppath, bytes) else str(ppath)
-        dim = parameter_dim(ppath)
-        unit = f[dim].attrs.get("unit", "deg")
-        out.update(parameter_path=ppath, parameter_dim=dim,
-                   parameter_unit=unit.decode() if isinstance(unit, bytes) else str(unit))
-
-        def visit(name, obj):
-            import h5py
-
-            if isinstance(obj, h5py.Dataset):
-                out[name] = read_named(f, name)
-
-        f.visititems(visit)
-    return out

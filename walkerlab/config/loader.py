@@ -1,0 +1,215 @@
+"""Reading a scene: YAML parsing (duplicate keys and deep nesting refused), validation,
+and one error line per mistake naming the file and the field.
+
+Raises
+------
+SceneError
+    One line naming the file and the offending field, for every bad input.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any
+
+import yaml
+from pydantic import BaseModel, ConfigDict, ValidationError
+
+from walkerlab.config.errors import format_error
+from walkerlab.config.limits import MAX_SCENE_BYTES, MAX_YAML_DEPTH, SMALL_SLOPE_DEG
+from walkerlab.config.schema import SCENE_NAME_RE, Scene, SceneError
+
+
+def default_scene_path() -> Path:
+    """The paper's scene: ``configs/paper.yaml`` in the working folder, else the one shipped
+    next to the package (an editable install)."""
+    here = Path("configs/paper.yaml")
+    if here.is_file():
+        return here
+    import walkerlab
+
+    return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
+
+
+class _SceneLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses duplicate keys and nesting deeper than
+    :data:`MAX_YAML_DEPTH` (the composer recurses once per level: 20000 levels would exhaust
+    Python's stack)."""
+
+    _depth = 0
+
+    def compose_node(self, parent, index):
+        self._depth += 1
+        try:
+            if self._depth > MAX_YAML_DEPTH:
+                raise yaml.composer.ComposerError(
+                    None, None, f"nesting deeper than {MAX_YAML_DEPTH} levels",
+                    self.peek_event().start_mark)
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen: dict = {}
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    first = seen.setdefault(key, key_node.start_mark.line)
+                except TypeError:  # unhashable key: SafeConstructor reports it
+                    continue
+                if first != key_node.start_mark.line:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"duplicate key {key!r} (first given on line {first + 1})",
+                        key_node.start_mark)
+        return super().construct_mapping(node, deep=deep)
+
+
+def _first_line(exc: BaseException) -> str:
+    return (str(exc).strip().splitlines() or [""])[0][:200]
+
+
+def parse_yaml(text: str):
+    """Parse YAML text with :class:`_SceneLoader` (duplicate keys and deep nesting refused).
+
+    Raises
+    ------
+    yaml.YAMLError
+        Malformed YAML, a duplicate key or nesting deeper than :data:`MAX_YAML_DEPTH`.
+    ValueError
+        A number Python will not convert (an integer of more than 4300 digits).
+    """
+    return yaml.load(text, Loader=_SceneLoader)  # noqa: S506 - a SafeLoader subclass
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene YAML file.
+
+    Parameters
+    ----------
+    path : str or Path
+        YAML scene file.
+
+    Returns
+    -------
+    Scene
+        Validated, frozen scene; ``name`` defaults to the file stem.
+
+    Raises
+    ------
+    SceneError
+        File missing, malformed YAML, or a field that fails validation (one line, naming
+        the file and the field).
+    """
+    from walkerlab.safefs import NotARegularFile, read_regular
+
+    path = Path(path)
+    if path.is_dir():
+        raise SceneError(f"{path}: is a directory, not a scene file")
+    if not path.is_file():
+        if path.exists():  # a device, FIFO or socket (/dev/zero)
+            raise SceneError(f"{path}: not a regular file; give a YAML scene file")
+        raise SceneError(f"{path}: scene file not found")
+    try:
+        text = read_regular(path, MAX_SCENE_BYTES, "scene file").decode("utf-8")
+    except NotARegularFile as exc:
+        raise SceneError(str(exc)) from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not a text (UTF-8) YAML file (byte {exc.start} is "
+                         f"0x{exc.object[exc.start]:02x})") from None
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read the scene file ({exc.strerror})") from None
+    try:
+        data = parse_yaml(text)
+    except ValueError as exc:  # int(...) of a 5000-digit number
+        what = ("an integer longer than Python reads (4300 digits)" if "digits" in str(exc)
+                else _first_line(exc))
+        raise SceneError(f"{path}: unreadable number: {what}") from None
+    except RecursionError:
+        raise SceneError(f"{path}: nesting too deep (at most {MAX_YAML_DEPTH} levels)") \
+            from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" line {mark.line + 1}" if mark is not None else ""
+        problem = getattr(exc, "problem", exc)
+        if str(problem).startswith(("duplicate key", "nesting deeper")):
+            raise SceneError(f"{path}:{where} {problem}") from None
+        raise SceneError(f"{path}:{where} malformed YAML ({problem})") from None
+    if not isinstance(data, dict):
+        raise SceneError(f"{path}: a scene must be a YAML mapping")
+    if data.get("name") is None:
+        data["name"] = path.stem
+        if not SCENE_NAME_RE.match(path.stem):
+            raise SceneError(f"{path}: the file name gives the run-folder name {path.stem!r}, "
+                             "which is not allowed (letters, digits and . _ + - only, not "
+                             "starting with a dot); rename the file or set 'name:' in it")
+    scene = scene_from_dict(data, path)
+    scene._origin = path.resolve()
+    if unit_warnings(scene):
+        from walkerlab import progress
+
+        for line in unit_warnings(scene):
+            progress.note(f"warning: {path}: {line}")
+    return scene
+
+
+def scene_from_dict(data: dict[str, Any], origin: str | Path = "<scene>") -> Scene:
+    """Validate a scene given as a plain mapping (used by sweeps). Raises SceneError."""
+    try:
+        return Scene.model_validate(data)
+    except ValidationError as err:
+        raise SceneError(format_error(Path(str(origin)), err, Scene)) from None
+
+def validate_option(model: type[BaseModel], field: str, value: Any, option: str,
+                    yaml_field: str | None = None) -> Any:
+    """Validate one command-line value through the pydantic field that caps it in YAML.
+
+    Parameters
+    ----------
+    model : pydantic model class
+        Section holding the field (``BasinSettings``, ``CommandOptions``, ...).
+    field : str
+        Field name (``"grid"``).
+    value
+        The option's value.
+    option : str
+        Option name for the message (``"--grid"``).
+    yaml_field : str, optional
+        The scene field with the same cap, named in the message (``"basin.grid"``).
+
+    Returns
+    -------
+    The validated value.
+
+    Raises
+    ------
+    SceneError
+        One line: ``--grid 5000x5000: ... (basin.grid)``.
+    """
+    from pydantic import TypeAdapter
+
+    info = model.model_fields[field]
+    adapter = TypeAdapter(Annotated[info.annotation, info],
+                          config=ConfigDict(strict=True, allow_inf_nan=False))
+    try:
+        return adapter.validate_python(value)
+    except ValidationError as err:
+        e = err.errors()[0]
+        shown = "x".join(str(v) for v in value) if isinstance(value, tuple) else value
+        also = f" (as {yaml_field})" if yaml_field else ""
+        raise SceneError(f"{option} {shown}: {e['msg'][:1].lower() + e['msg'][1:]}{also}") \
+            from None
+
+
+def unit_warnings(scene: Scene) -> list[str]:
+    """Values that validate but look like a unit mistake (one line each, naming the field):
+    ``slope.angle_deg`` below :data:`SMALL_SLOPE_DEG` (radians given as degrees?)."""
+    out = []
+    d = scene.slope.angle_deg
+    if d is not None and 0 < abs(d) < SMALL_SLOPE_DEG:
+        out.append(f"slope.angle_deg: {d:g}° is a very small slope; it looks like radians "
+                   f"({d:g} rad = {math.degrees(d):.3g}°): if so, write angle_rad: {d:g}")
+    return out
