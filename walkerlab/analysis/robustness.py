@@ -133,7 +133,6 @@ def gsn_nonlinear(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, e: flo
     impulses and halves their difference (central), so the error is O(e^2) relative."""
     X = np.tile(x_star, (3, 1))
     ee = np.array([0.0, e, -e])
-    total = np.zeros(len(INDICATORS))
     acc = 0.0
     for k in range(steps):
         xn, y, ok = one_step(sm, X, disturbance, ee if k == 0 else np.zeros(3))
@@ -141,7 +140,6 @@ def gsn_nonlinear(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, e: flo
             raise ValueError("gsn_nonlinear: the disturbed walker fell; use a smaller e")
         dy = (y[1] - y[2]) / 2
         acc += float(dy @ dy)
-        total += np.abs(dy)
         X = xn
     return float(np.sqrt(acc)) / abs(e)
 

@@ -64,9 +64,9 @@ def scene_family(scene: Scene, path: str) -> WalkerFamily:
 
 def scene_value(scene: Scene, path: str) -> float:
     """The scene's own value of a numeric field (the slope in either unit)."""
-    from walkerlab.sweep.runner import _base_value
+    from walkerlab.sweep.runner import base_value
 
-    v = _base_value(scene.model_dump(mode="json"), path)
+    v = base_value(scene.model_dump(mode="json"), path)
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise SceneError(f"{path}: the scene's value {v!r} is not a number")
     return float(v)

@@ -112,10 +112,10 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
     return M.MonteCarloResult(steps, fell)
 
 
-def image_evaluator(scene, workers: int = 1, scheduler=None):
-    """``(X, gamma) -> (x_next, ok)`` over the executor (for :func:`M.mesh_mfpt`)."""
+def image_evaluator(scene, ex):
+    """``(X, gamma) -> (x_next, ok)`` on the open executor ``ex`` (for
+    :func:`M.mesh_mfpt`; one worker pool serves every mesh of a refinement)."""
     from walkerlab.execution.executor import run_each
-    from walkerlab.sweep.runner import sweep_executor
 
     base = scene.model_dump(mode="json")
 
@@ -125,9 +125,8 @@ def image_evaluator(scene, workers: int = 1, scheduler=None):
                  for a in range(0, n, ROWS_PER_TASK)]
         xn = np.full_like(X, np.nan)
         ok = np.zeros(n, dtype=bool)
-        with sweep_executor(workers, scheduler) as ex:
-            for _, (a, x, o) in run_each(ex, run_images, [(t,) for t in tasks]):
-                xn[a:a + x.shape[0]], ok[a:a + o.size] = x, o
+        for _, (a, x, o) in run_each(ex, run_images, [(t,) for t in tasks]):
+            xn[a:a + x.shape[0]], ok[a:a + o.size] = x, o
         return xn, ok
     return evaluate
 
@@ -147,11 +146,14 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
     if len(pool) < 10 * len(x0):
         raise ValueError(f"mfpt: sigma {sd:g} rad: the walks fall too soon to shape a mesh "
                          "(fewer post-impact states than needed)")
-    ev = image_evaluator(scene, workers, scheduler)
-    return M.mesh_mfpt_converged(sm, pool, x0, sd, cells=settings.mesh_cells,
-                                 refine=settings.mesh_refine,
-                                 rel_change=settings.mesh_rel_change, max_cells=n,
-                                 quadrature=settings.quadrature_nodes, evaluate=ev)
+    from walkerlab.sweep.runner import sweep_executor
+
+    with sweep_executor(workers, scheduler) as ex:
+        return M.mesh_mfpt_converged(sm, pool, x0, sd, cells=settings.mesh_cells,
+                                     refine=settings.mesh_refine,
+                                     rel_change=settings.mesh_rel_change, max_cells=n,
+                                     quadrature=settings.quadrature_nodes,
+                                     evaluate=image_evaluator(scene, ex))
 
 
 def _finite(v: float) -> float:

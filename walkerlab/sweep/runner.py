@@ -78,8 +78,8 @@ from walkerlab.sweep.params import ParamAxis, SweepError, grid_points
 from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, evaluate, warm_up
 from walkerlab.sweep.store import SweepStore, complete_sweep, partial_path
 
-__all__ = ["plan_chunks", "run_sweep", "iter_piece_results", "run_piece", "sweep_executor",
-           "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
+__all__ = ["base_value", "plan_chunks", "run_sweep", "iter_piece_results", "run_piece",
+           "sweep_executor", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
 
 MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
 PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
@@ -106,7 +106,10 @@ def _dotted_get(d: dict, path: str):
     return node
 
 
-def _base_value(base: dict, path: str):
+def base_value(base: dict, path: str):
+    """The value of a dotted field in a scene dump ``base`` (the slope in either unit:
+    ``slope.angle_deg`` of a scene given in radians, and the other way round); None if
+    absent."""
     v = _dotted_get(base, path)
     if v is None and path == "slope.angle_deg" and _dotted_get(base, "slope.angle_rad") is not None:
         v = math.degrees(_dotted_get(base, "slope.angle_rad"))
@@ -141,7 +144,7 @@ def plan_chunks(axes: list[ParamAxis], base: dict, done: set[int] | frozenset = 
     pts = grid_points(axes)
     a0 = axes[0]
     anchor = None
-    bv = _base_value(base, a0.path)
+    bv = base_value(base, a0.path)
     if a0.numeric and isinstance(bv, (int, float)) and not isinstance(bv, bool) and len(a0) > 1:
         vals = np.asarray(a0.values, float)
         anchor = int(np.argmin(np.abs(vals - float(bv))))
