@@ -195,8 +195,9 @@ class _Completed:
 
 
 def result(client, fut):
-    """``fut.result()``; a task that killed its workers or was cancelled by a lost scheduler
-    raises :class:`DaskLost` (one line), an error of the task itself propagates unchanged."""
+    """``fut.result()``; a task that killed its workers, or was cancelled or failed because
+    the scheduler was lost, raises :class:`DaskLost` (one line); an error of the task itself
+    (scheduler still there) propagates unchanged."""
     from distributed.client import FutureCancelledError
     from distributed.scheduler import KilledWorker
 
@@ -208,3 +209,9 @@ def result(client, fut):
                        "--scheduler, to see the error)") from None
     except FutureCancelledError:
         raise _lost(client) from None
+    except Exception:  # noqa: BLE001 - re-raised unless the scheduler is gone
+        # a task that failed because its scheduler died mid-flight (the comm closed) is not
+        # an error of the task: say the scheduler is lost, as for a cancelled future
+        if client.status not in ("running", "connecting") or _n_workers(client) is None:
+            raise _lost(client) from None
+        raise
