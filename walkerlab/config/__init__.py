@@ -57,6 +57,7 @@ from walkerlab.config.loader import (
     validate_option,
 )
 from walkerlab.config.schema import (
+    AnkleSpec,
     ArcFoot,
     AsTuple,
     BasinSettings,
@@ -65,6 +66,7 @@ from walkerlab.config.schema import (
     CommandOptions,
     CompassGaitParams,
     FixedPointSettings,
+    FlatFoot,
     Foot,
     GuessFromArtifact,
     IdealModelSettings,
@@ -91,6 +93,7 @@ from walkerlab.config.schema import (
 )
 
 __all__ = [
+    "AnkleSpec",
     "ArcFoot",
     "AsTuple",
     "BasinSettings",
@@ -103,6 +106,7 @@ __all__ = [
     "ContactSimSettings",
     "ContactSolverSettings",
     "FixedPointSettings",
+    "FlatFoot",
     "Foot",
     "GuessFromArtifact",
     "IdealModelSettings",
