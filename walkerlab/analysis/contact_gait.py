@@ -2,7 +2,9 @@
 
 Input: the samples of :func:`walkerlab.integrate.contact.integrate_contact` (times, states
 named by ``walker.state_names()``) and the model's per-foot contact quantities
-(``walker.contact_quantities``).  Output: per-foot traces with touchdown / lift-off times,
+(``walker.foot_quantities``: per leg; a flat foot's heel and toe combined, and
+``walker.contact_quantities`` per contact point).  Output: per-foot traces with touchdown /
+lift-off times,
 the heel strikes, one :class:`StepSummary` per step (slip, creep, bounces, scuffs, peak
 penetration) and the run's typed :class:`Outcome`, whose ``kind`` is one of the shared run
 ends (:mod:`walkerlab.integrate.ends`).  Nothing here integrates or reads a state by row.
@@ -154,7 +156,7 @@ class ContactResult:
     state_names : tuple of str
         ``walker.state_names()``.
     feet : dict[str, FootTrace]
-        Keyed by foot name.
+        Keyed by foot name (leg).
     heel_strike_times : ndarray
         [s] (touchdowns of the swing foot ahead of the stance foot).
     heel_strike_legs : list[str]
@@ -176,6 +178,10 @@ class ContactResult:
     method : str
     pin_end_time : float
         End of the pinned phase [s] (= t0 if none).
+    points : dict[str, FootTrace]
+        Per contact point (``walker.contact_names()``; a flat foot's ``leg1_heel``,
+        ``leg1_toe``, ...): its trace and touchdown / lift-off times; ``feet`` again
+        when each leg has one point.
     """
 
     t: np.ndarray
@@ -193,6 +199,7 @@ class ContactResult:
     method: str
     pin_end_time: float = 0.0
     outcome: Outcome = field(default_factory=lambda: Outcome("t_final"))
+    points: dict = field(default_factory=dict)
 
     def column(self, name: str) -> np.ndarray:
         """Samples (n,) of the state ``name``."""
@@ -270,8 +277,9 @@ def _intervals(td, lo, t_end):
     return out
 
 
-def _foot_traces(walker, t, X) -> dict[str, FootTrace]:
-    cq = walker.contact_quantities(X)
+def _foot_traces(walker, t, X, points: bool = False) -> dict[str, FootTrace]:
+    """Traces per leg (``walker.foot_quantities``), or per contact point (``points``)."""
+    cq = walker.contact_quantities(X) if points else walker.foot_quantities(X)
     feet = {}
     for name, d in cq.items():
         on = d["on_ground"] > 0.5
@@ -331,11 +339,15 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
     -------
     dict
         ``feet`` {foot: FootTrace}, ``hs_t`` (k,) [s], ``hs_leg`` [foot], ``steps``
-        [StepSummary].
+        [StepSummary], ``points`` {contact point: FootTrace} (the contact table per point
+        with its touchdowns and lift-offs: a flat foot's heel and toe; the same traces as
+        ``feet`` for one point per leg).
     """
     feet = _foot_traces(walker, t, X)
     hs_t, hs_leg, bounces, scuffs = _heel_strikes(t, feet, min_step_m, initial_stance)
-    rolling = getattr(getattr(walker, "structure", None), "foot", "point") == "arc"
+    # an arc's contact point moves as it rolls, a flat foot's loaded point changes from heel
+    # to toe: their slip is the integral of the material point's tangential velocity
+    rolling = getattr(getattr(walker, "structure", None), "foot", "point") in ("arc", "flat")
     names = list(feet)
     starts = [t[0]] + hs_t
     legs = [initial_stance] + hs_leg
@@ -371,7 +383,10 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
                                  float(1e3 * slip), float(1e3 * creep), int(bounces[j]),
                                  int(scuffs[j]), max(peak, 0.0),
                                  float(lo_mine[-1]) if lo_mine.size else np.nan))
-    return {"feet": feet, "hs_t": np.array(hs_t), "hs_leg": hs_leg, "steps": steps}
+    points = feet if tuple(walker.contact_names()) == tuple(feet) else \
+        _foot_traces(walker, t, X, points=True)
+    return {"feet": feet, "hs_t": np.array(hs_t), "hs_leg": hs_leg, "steps": steps,
+            "points": points}
 
 
 # ---------------------------------------------------------------------------- outcome

@@ -217,6 +217,34 @@ class ContactSettings(BaseModel):
         "unit_system does not apply): stiffness_N_m_per_rad, exponent, "
         "max_damping_N_m_s_per_rad, penetration_at_max_damping_rad.")
 
+    flat_foot_mass_kg: float | None = Field(
+        None, gt=0, le=100, description="Flat feet only (SI, unit_system does not apply): "
+        "each foot's mass [kg], at its ankle.  The walker description's flat foot is "
+        "massless (the rigid view); the floating contact model regularises it with this "
+        "small mass, a contact-model setting like the stiffness (with zero mass the foot's "
+        "angle would have no dynamics of its own).",
+        json_schema_extra={"unit": "kg"})
+    flat_foot_inertia_kg_m2: float | None = Field(
+        None, gt=0, le=100, description="Flat feet only (SI): each foot's moment of inertia "
+        "about its ankle [kg m^2] (regularisation, see flat_foot_mass_kg).",
+        json_schema_extra={"unit": "kg m^2"})
+
+    @model_serializer(mode="wrap")
+    def _drop_unset_flat_foot(self, handler):
+        # a scene without flat feet serialises as before (same content hashes)
+        d = handler(self)
+        if isinstance(d, dict):
+            for k in ("flat_foot_mass_kg", "flat_foot_inertia_kg_m2"):
+                if d.get(k) is None:
+                    d.pop(k, None)
+        return d
+
+    def flat_foot(self) -> tuple[float, float] | None:
+        """``(flat_foot_mass_kg, flat_foot_inertia_kg_m2)`` or None if either is unset."""
+        if self.flat_foot_mass_kg is None or self.flat_foot_inertia_kg_m2 is None:
+            return None
+        return float(self.flat_foot_mass_kg), float(self.flat_foot_inertia_kg_m2)
+
     @model_validator(mode="after")
     def _check_relations(self) -> ContactSettings:
         if self.mu_dynamic > self.mu_static:

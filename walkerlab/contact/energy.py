@@ -91,7 +91,8 @@ def side_entry(walker, x, dt: float) -> tuple[str, float, float, float] | None:
     if walker.continuous:
         return None
     cq = walker.contact_quantities(np.atleast_2d(x))
-    for (foot, q), lane in zip(cq.items(), (walker.lane1, walker.lane2)):
+    for foot, q in cq.items():  # every contact point on its leg's lane
+        lane = walker.lane(foot)
         if q["on_ground"][0] > 0.5 or q["penetration"][0] <= 0:
             continue
         s, v = float(q["s"][0]), float(q["slip_velocity"][0])

@@ -45,18 +45,24 @@ stance foot (``rhs_pinned``) counts as on the ground.  The analytic Jacobian hol
 weight constant (left out: its dependence on the foot's height; Newton directions only).
 
 Packed data vector of the compiled integrators (``_cyrk``, ``_lsoda``):
-``[n1, n2, PC (NPC), p (NP), c1 (n1), c2 (n2), nfev]`` (``p`` the walker's parameter vector,
-``c1``/``c2`` the patch centres of leg1's / leg2's lane [m]).
+``[n1, n2, PC (NPC), p (NP), c1 (n1), c2 (n2), nfev]`` (``p`` the floating view's parameter
+vector, :func:`walkerlab.models.floating.param_names`; ``c1``/``c2`` the patch centres of
+leg1's / leg2's lane [m]).
+
+Contact points: ``NF`` of them, named ``CONTACTS`` (``('leg1', 'leg2')`` for point and arc
+feet, ``('leg1_heel', 'leg1_toe', 'leg2_heel', 'leg2_toe')`` for flat feet), each with the
+IMPACT and Coulomb laws on its leg's lane (``POINT_LEG``); ``PIN`` is leg2's first point
+(the point a pinned stance foot holds).
 
 Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.models.floating` for ``q``):
 
 =======================================  =================================================
 ``rhs(x, PC, p, c1, c2)``                dx/dt (NX,)
 ``jac(x, PC, p, c1, c2)``                d rhs / dx (NX, NX), patch membership locally constant
-``rhs_pinned(z, PC, p, c1, c2, foot2)``  leg2's (point) foot held at ``foot2``:
+``rhs_pinned(z, PC, p, c1, c2, foot2)``  leg2's point PIN held at ``foot2``:
                                          ``z = [link angles, their rates]`` -> dz/dt
 ``pinned_to_full(z, p, foot2)``          full state (NX,) of a pinned state
-``contact_table(X, PC, p, c1, c2)``      (n, 2, 8) per foot: penetration, its rate, slip
+``contact_table(X, PC, p, c1, c2)``      (n, NF, 8) per point: penetration, its rate, slip
                                          velocity, s, Fn, Ff, power, on_ground
 ``knee_table(X, PC, p)``                 (n, 2, 4) per knee: extension, its rate, stop torque,
                                          power
@@ -72,7 +78,7 @@ from pathlib import Path
 
 from walkerlab.models.description import Structure
 
-__all__ = ["ASSEMBLY", "NPC", "contact_module", "rhs_source"]
+__all__ = ["ASSEMBLY", "NPC", "contact_module", "contact_source", "rhs_source"]
 
 #: Number of contact parameters (see the table above).
 NPC = 18
@@ -90,6 +96,8 @@ NPC = 18
 NX = 2 * NQ
 D_N1, D_N2, D_PC = 0, 1, 2
 D_P = D_PC + NPC
+# contact points: NF of them (generated feet order), POINT_LEG[i] = leg of point i (its
+# lane: c1 for leg1, c2 for leg2), PIN = leg2's first point (the pinned stance foot)
 
 
 @njit(cache=True)
@@ -132,7 +140,7 @@ def _chol_solve(L, B):
 
 @njit(cache=True)
 def _foot(P, V, i, PC, cen):
-    """Contact of foot i from its contact point P[i] and material velocity V[i]:
+    """Contact of point i from its position P[i] and material velocity V[i]:
     (delta, ddot, vt, s, Fn, Ff, dFn/ddelta, dFn/dddot, mu, dmu/dvt)."""
     sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
     px, py, vx, vy = P[i, 0], P[i, 1], V[i, 0], V[i, 1]
@@ -179,17 +187,19 @@ def _knee(x, k, PC, delta):
 
 @njit(cache=True)
 def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
-    """Q - h (NQ,) with the contact forces of the feet used and the knee stops; fills M, the
-    feet's P, V, J, per-foot ``info`` (2, 10) (see _foot) and ``knees`` (2, 5)."""
+    """Q - h (NQ,) with the contact forces of the legs' points used and the knee stops;
+    fills M, the points' P, V, J, per-point ``info`` (NF, 10) (see _foot) and ``knees``
+    (2, 5) (knees only with one contact point per leg: point k is leg k's)."""
     h = np.empty(NQ)
     dyn(x, p, M, h)
     feet(x, p, P, V, J)
     Q = -h
     sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
-    for i in range(2):
-        if not ((i == 0 and use1) or (i == 1 and use2)):
+    for i in range(NF):
+        leg = POINT_LEG[i]
+        if not ((leg == 0 and use1) or (leg == 1 and use2)):
             continue
-        res = _foot(P, V, i, PC, c1 if i == 0 else c2)
+        res = _foot(P, V, i, PC, c1 if leg == 0 else c2)
         for k in range(10):
             info[i, k] = res[k]
         fn, ff = res[4], res[5]
@@ -245,10 +255,10 @@ def _knee_torque(ext, rate, PC, delta):
 def jac(x, PC, p, c1, c2):
     """Analytic d rhs / dx (NX, NX); patch membership locally constant."""
     M = np.empty((NQ, NQ))
-    P = np.empty((2, 2))
-    V = np.empty((2, 2))
-    J = np.empty((2, 2, NQ))
-    info = np.zeros((2, 10))
+    P = np.empty((NF, 2))
+    V = np.empty((NF, 2))
+    J = np.empty((NF, 2, NQ))
+    info = np.zeros((NF, 10))
     knees = np.zeros((2, 5))
     Q = _force(x, PC, p, c1, c2, True, True, M, P, V, J, info, knees)
     L = _chol(M)
@@ -257,13 +267,13 @@ def jac(x, PC, p, c1, c2):
     Dv = np.empty((NQ, NQ))
     dyn_jac(x, a, p, Dq, Dv)
     sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
-    F = np.zeros((2, 2))
-    for i in range(2):
+    F = np.zeros((NF, 2))
+    for i in range(NF):
         fn, ff = info[i, 4], info[i, 5]
         if fn > 0.0:
             F[i, 0] = fn * sp + ff * cp
             F[i, 1] = fn * cp - ff * sp
-    dV = np.empty((2, 2, NQ))
+    dV = np.empty((NF, 2, NQ))
     dJtF = np.empty((NQ, NQ))
     feet_jac(x, F, p, dV, dJtF)
     B = np.empty((NQ, 2 * NQ))
@@ -271,7 +281,7 @@ def jac(x, PC, p, c1, c2):
         for k in range(NQ):
             B[r, k] = dJtF[r, k] - Dq[r, k]
             B[r, NQ + k] = -Dv[r, k]
-    for i in range(2):
+    for i in range(NF):
         fn = info[i, 4]
         if fn <= 0.0:
             continue
@@ -315,20 +325,20 @@ def jac(x, PC, p, c1, c2):
 
 @njit(cache=True)
 def pinned_to_full(z, p, foot2):
-    """Full state (NX,) with leg2's foot at ``foot2`` (2,) and at rest; ``z = [link angles
-    (NQ - 2), their rates]``."""
+    """Full state (NX,) with leg2's (first) contact point PIN at ``foot2`` (2,) and at
+    rest; ``z = [link angles (NQ - 2), their rates]``."""
     x = np.zeros(NX)
     for k in range(NQ - 2):
         x[2 + k] = z[k]
         x[NQ + 2 + k] = z[NQ - 2 + k]
-    P = np.empty((2, 2))
-    V = np.empty((2, 2))
-    J = np.empty((2, 2, NQ))
+    P = np.empty((NF, 2))
+    V = np.empty((NF, 2))
+    J = np.empty((NF, 2, NQ))
     feet(x, p, P, V, J)  # hip at the origin, at rest: foot offset and velocity
-    x[0] = foot2[0] - P[1, 0]
-    x[1] = foot2[1] - P[1, 1]
-    x[NQ] = -V[1, 0]
-    x[NQ + 1] = -V[1, 1]
+    x[0] = foot2[0] - P[PIN, 0]
+    x[1] = foot2[1] - P[PIN, 1]
+    x[NQ] = -V[PIN, 0]
+    x[NQ + 1] = -V[PIN, 1]
     return x
 
 
@@ -338,26 +348,26 @@ def rhs_pinned(z, PC, p, c1, c2, foot2):
     ``qdd = Jp zdd + gam``; ``Jp^T M Jp zdd = Jp^T (Q - h - M gam)`` (leg1 keeps its contact)."""
     x = pinned_to_full(z, p, foot2)
     M = np.empty((NQ, NQ))
-    P = np.empty((2, 2))
-    V = np.empty((2, 2))
-    J = np.empty((2, 2, NQ))
-    info = np.zeros((2, 10))
+    P = np.empty((NF, 2))
+    V = np.empty((NF, 2))
+    J = np.empty((NF, 2, NQ))
+    info = np.zeros((NF, 10))
     knees = np.zeros((2, 5))
     Q = _force(x, PC, p, c1, c2, True, False, M, P, V, J, info, knees)
-    dV = np.empty((2, 2, NQ))
+    dV = np.empty((NF, 2, NQ))
     dJtF = np.empty((NQ, NQ))
-    feet_jac(x, np.zeros((2, 2)), p, dV, dJtF)
+    feet_jac(x, np.zeros((NF, 2)), p, dV, dJtF)
     m = NQ - 2
     Jp = np.zeros((NQ, m))
     for k in range(m):
-        Jp[0, k] = -J[1, 0, 2 + k]
-        Jp[1, k] = -J[1, 1, 2 + k]
+        Jp[0, k] = -J[PIN, 0, 2 + k]
+        Jp[1, k] = -J[PIN, 1, 2 + k]
         Jp[2 + k, k] = 1.0
     gam = np.zeros(NQ)
     for r in range(2):
         s = 0.0
         for k in range(NQ):
-            s += dV[1, r, k] * x[NQ + k]
+            s += dV[PIN, r, k] * x[NQ + k]
         gam[r] = -s
     rhs_q = Q.copy()
     for i in range(NQ):
@@ -385,18 +395,18 @@ def rhs_pinned(z, PC, p, c1, c2, foot2):
 
 @njit(cache=True)
 def contact_table(X, PC, p, c1, c2):
-    """(n, 2, 8): per foot penetration [m], its rate [m/s], slip velocity [m/s], s [m],
-    Fn [N], Ff [N], power F . v [W], on_ground (1/0)."""
+    """(n, NF, 8): per contact point penetration [m], its rate [m/s], slip velocity [m/s],
+    s [m], Fn [N], Ff [N], power F . v [W], on_ground (1/0)."""
     n = X.shape[0]
-    out = np.zeros((n, 2, 8))
+    out = np.zeros((n, NF, 8))
     sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
-    P = np.empty((2, 2))
-    V = np.empty((2, 2))
-    J = np.empty((2, 2, NQ))
+    P = np.empty((NF, 2))
+    V = np.empty((NF, 2))
+    J = np.empty((NF, 2, NQ))
     for r in range(n):
         feet(X[r], p, P, V, J)
-        for i in range(2):
-            cen = c1 if i == 0 else c2
+        for i in range(NF):
+            cen = c1 if POINT_LEG[i] == 0 else c2
             res = _foot(P, V, i, PC, cen)
             fn, ff = res[4], res[5]
             Fx = fn * sp + ff * cp
@@ -416,9 +426,9 @@ def knee_table(X, PC, p, c1, c2):
     dissipates)."""
     n = X.shape[0]
     out = np.zeros((n, 2, 4))
-    P = np.empty((2, 2))
-    V = np.empty((2, 2))
-    J = np.empty((2, 2, NQ))
+    P = np.empty((NF, 2))
+    V = np.empty((NF, 2))
+    J = np.empty((NF, 2, NQ))
     if KNEE:
         for r in range(n):
             feet(X[r], p, P, V, J)
@@ -510,15 +520,15 @@ def rhs_source(eq) -> str:
         kin += [pos[0], pos[1], v[0], v[1]]
     repl, red = sp.cse(kin, symbols=sp.numbered_symbols("_k"), order="none")
     lines += [f"    {pr.doprint(a)} = {pr.doprint(b)}" for a, b in repl]
-    Fs = sp.symbols("_Fx0 _Fy0 _Fx1 _Fy1", real=True)
-    for i, cen in enumerate(("c1", "c2")):
+    Fs = sp.symbols(" ".join(f"_Fx{i} _Fy{i}" for i in range(len(eq.feet))), real=True)
+    for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
         args = ", ".join(pr.doprint(e) for e in red[4 * i:4 * i + 4])
         lines.append(f"    {Fs[2 * i]}, {Fs[2 * i + 1]} = _foot_force({args}, _sp, _cp, PC, "
-                     f"{cen})")
+                     f"{('c1', 'c2')[leg]})")
     Q = -eq.h
     for i, (_, J) in enumerate(eq.feet):
         Q += J.T * sp.Matrix([Fs[2 * i], Fs[2 * i + 1]])
-    if eq.knees:  # each leg's knee: (thigh, shank) indices in q, leg k's foot is foot k
+    if eq.knees:  # each leg's knee: (thigh, shank) indices in q, leg k's foot is point k
         for k, (t, sh) in enumerate(eq.knees):
             T = sp.Symbol(f"_T{k}", real=True)
             # penetration of leg k's foot, -(p . n)
@@ -562,6 +572,22 @@ def rhs_source(eq) -> str:
     return "\n".join(lines) + "\n"
 
 
+def contact_source(structure: Structure, key: str) -> str:
+    """Source of the generated contact module of ``structure`` (its floating view, the
+    constants ``NP``, ``KNEE``, ``NF``, ``POINT_LEG``, ``PIN``, ``CONTACTS``, then
+    :data:`ASSEMBLY` and the straight-line ``rhs``)."""
+    from walkerlab.models import floating
+
+    eq = floating.derive_floating(structure)
+    if structure.knee and len(eq.feet) != 2:
+        raise ValueError("a kneed walker's contact model needs one contact point per leg")
+    fl = floating.floating_source(structure, key)
+    legs = tuple(eq.point_legs)
+    return (fl + f"\nNP = {len(eq.params)}\nKNEE = {bool(structure.knee)}\n"
+            f"NF = {len(eq.feet)}\nPOINT_LEG = {legs!r}\nPIN = {legs.index(1)}\n"
+            f"CONTACTS = {tuple(eq.contacts)!r}\n" + ASSEMBLY + "\n\n" + rhs_source(eq))
+
+
 def contact_module(structure: Structure):
     """The imported generated contact module of ``structure`` (compiled lazily by numba,
     cached on disk).
@@ -574,12 +600,6 @@ def contact_module(structure: Structure):
     from walkerlab.models import floating
 
     floating.check_masses(structure)
-
-    def build(key):
-        fl = floating.floating_source(structure, key)
-        np_ = len(structure.param_names)
-        fast = rhs_source(floating.derive_floating(structure))
-        return (fl + f"\nNP = {np_}\nKNEE = {bool(structure.knee)}\n" + ASSEMBLY + "\n\n"
-                + fast)
-
-    return floating.load_generated(structure, "contact", build, sources=(Path(__file__),))
+    return floating.load_generated(structure, "contact",
+                                   lambda key: contact_source(structure, key),
+                                   sources=(Path(__file__),))

@@ -26,7 +26,16 @@ coordinate                    state                        rate state
 ============================  ===========================  ==========================
 
 so the paper walker's states are unchanged: ``[hip_x, hip_y, theta1, theta2, vhip_x, vhip_y,
-dtheta1, dtheta2]``.
+dtheta1, dtheta2]``; a flat foot's absolute angle ``leg{i}_foot_angle`` is ``theta{i}_foot``.
+
+Contact points
+--------------
+Each contact point carries the IMPACT and Coulomb laws on its leg's lane and has its own
+row of the contact table (:meth:`ContactWalker.contact_quantities`), named by
+:meth:`ContactWalker.contact_names`: ``leg1``, ``leg2`` for point and arc feet (the tables
+of the walkers before flat feet, unchanged), ``leg1_heel``, ``leg1_toe``, ``leg2_heel``,
+``leg2_toe`` for flat feet.  The gait analysis reads each *leg* as one foot
+(:meth:`ContactWalker.foot_quantities`: a flat foot's points combined).
 """
 
 from __future__ import annotations
@@ -44,7 +53,7 @@ from walkerlab.config.contact import (
 )
 
 __all__ = ["FOOT_NAMES", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
-           "compass_gait_data", "state_name"]
+           "compass_gait_data", "flat_foot_numbers", "footprint_offsets", "state_name"]
 
 FOOT_NAMES = ("leg1", "leg2")
 
@@ -63,7 +72,29 @@ def state_name(coordinate: str, rate: bool = False) -> str:
 #: Floating coordinate name -> state name (angle), e.g. ``leg1_angle -> theta1``.
 STATE_OF_COORDINATE = {c: state_name(c) for c in
                        ("hip_x", "hip_y", "leg1_angle", "leg2_angle", "leg1_thigh_angle",
-                        "leg1_shank_angle", "leg2_thigh_angle", "leg2_shank_angle")}
+                        "leg1_shank_angle", "leg2_thigh_angle", "leg2_shank_angle",
+                        "leg1_foot_angle", "leg2_foot_angle")}
+
+
+def flat_foot_numbers(data) -> list[dict]:
+    """Per leg (leg1, leg2) a flat foot's numbers ``heel``, ``toe`` [m], ``r`` [rad] from the
+    parameter vector (leg1 the swing role's when the legs differ); [] for other feet."""
+    st = data.structure
+    if st.foot != "flat":
+        return []
+    P = dict(zip(st.param_names, data.params))
+    tags = ("sw_", "st_") if st.asymmetric else ("", "")
+    return [{"heel": P[f"heel_{t}m"], "toe": P[f"toe_{t}m"], "r": P[f"r_{t}ankle"]}
+            for t in tags]
+
+
+def footprint_offsets(data) -> tuple[float, float]:
+    """Along-slope offset [m] of each leg's footprint centre from its reference point (the
+    point the ideal footfalls are measured to): 0 for point and arc feet, ``(heel + toe) /
+    2`` for a flat foot (reference = its heel's touchdown point; the foot lies flat from
+    there to ``heel + toe`` downhill)."""
+    f = flat_foot_numbers(data)
+    return tuple(0.5 * (n["heel"] + n["toe"]) for n in f) if f else (0.0, 0.0)
 
 
 def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np.ndarray]:
@@ -118,11 +149,17 @@ class ContactWalker:
         Any walker description (:func:`walkerlab.models.description.walker_data`).
     knee_stop : KneeStopSI, optional
         Knee-stop law (kneed walkers; default :class:`KneeStopSettings` ()).
+    flat_foot : (float, float), optional
+        A flat foot's regularising mass [kg] (at the ankle) and inertia about the ankle
+        [kg m^2] (``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``);
+        required for flat feet, ignored otherwise.
 
     Raises
     ------
     ValueError
-        A body of the walker has mass 0 (a floating (contact) model needs positive leg masses).
+        A body of the walker has mass 0 (a floating (contact) model needs positive leg
+        masses); flat feet without ``flat_foot``
+        (:data:`walkerlab.models.floating.FLAT_FOOT_MESSAGE`).
     """
 
     L: float = 1.0
@@ -138,9 +175,10 @@ class ContactWalker:
     continuous: bool = True
     data: object = None
     knee_stop: KneeStopSI | None = None
+    flat_foot: tuple[float, float] | None = None
 
     def __post_init__(self):
-        from walkerlab.models.floating import check_masses, coordinate_names
+        from walkerlab.models.floating import check_masses, coordinate_names, floating_params
 
         from .generated import NPC, contact_module
 
@@ -150,6 +188,7 @@ class ContactWalker:
                                                  self.phi))
         d = self.data
         check_masses(d.structure)
+        params = floating_params(d, *(self.flat_foot or (None, None)))
         set_(self, "L", float(d.leg_length_m))
         set_(self, "g", float(d.gravity_m_per_s2))
         set_(self, "phi", float(d.slope_rad))
@@ -173,8 +212,10 @@ class ContactWalker:
         set_(self, "lane2", np.ascontiguousarray(self.lane2, dtype=float))
         set_(self, "kernels", mod)
         set_(self, "contact_params", PC)
-        set_(self, "walker_params", np.asarray(d.params, dtype=float))
+        set_(self, "walker_params", params)
         set_(self, "_coords", coordinate_names(d.structure))
+        set_(self, "_contacts", tuple(mod.CONTACTS))
+        set_(self, "_point_legs", tuple(mod.POINT_LEG))
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -182,14 +223,19 @@ class ContactWalker:
                       step_length: float, n_steps: int, L=1.0, m=5.0, MH=10.0, a=0.5,
                       g=9.81, phi=0.0174, data=None) -> ContactWalker:
         """Build from validated settings; ``step_length`` [m] is the ideal gait's step length
-        (patch spacing).  ``data`` (a WalkerData) replaces the compass-gait shorthand."""
+        (patch spacing; each lane shifted by the leg's :func:`footprint_offsets`).  ``data``
+        (a WalkerData) replaces the compass-gait shorthand."""
         from .rigid_limit import contact_si
 
         c1, c2 = checkerboard_lanes(step_length, n_steps)
+        if data is not None:
+            o1, o2 = footprint_offsets(data)
+            c1, c2 = c1 + o1, c2 + o2
         si, knee = contact_si(contact)  # the scene's stiffness family applied
         return cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=si, lane1=c1,
                    lane2=c2, patch_half_width=0.5 * terrain.patch_width_m,
-                   continuous=terrain.kind == "continuous", data=data, knee_stop=knee)
+                   continuous=terrain.kind == "continuous", data=data, knee_stop=knee,
+                   flat_foot=contact.flat_foot())
 
     @property
     def structure(self):
@@ -323,6 +369,15 @@ class ContactWalker:
                    by["stance_angle"]]
             rates = [s1 * by["swing_thigh_rate"], s1 * by["swing_shank_rate"],
                      s2 * by["stance_rate"], s2 * by["stance_rate"]]
+        elif st.foot == "flat":
+            # the swing foot at its spring's rest (massless in the rigid view), the stance
+            # foot at the rigid view's ankle angle (0 after heel strike, at rest)
+            f1, f2 = flat_foot_numbers(self.data)
+            a, da = by.get("stance_ankle_angle", 0.0), by.get("stance_ankle_rate", 0.0)
+            w1, w2 = s1 * by["swing_rate"], s2 * by["stance_rate"]
+            ang = [by["swing_angle"], by["stance_angle"], by["swing_angle"] + f1["r"],
+                   by["stance_angle"] + a]
+            rates = [w1, w2, w1, w2 + da]
         elif st.coordinates == "absolute":
             ang = [by["swing_angle"], by["stance_angle"]]
             rates = [s1 * by["swing_rate"], s2 * by["stance_rate"]]
@@ -338,19 +393,35 @@ class ContactWalker:
     def _rows(self, X) -> np.ndarray:
         return np.ascontiguousarray(np.atleast_2d(X), dtype=float)
 
+    def contact_names(self) -> tuple[str, ...]:
+        """Names of the contact points, in the order of the generated kernels (module
+        docstring): ``leg1``, ``leg2``; flat feet ``leg1_heel``, ``leg1_toe``, ..."""
+        return self._contacts
+
+    def contact_leg(self, name: str) -> str:
+        """The leg (``leg1``/``leg2``) of contact point ``name``."""
+        return FOOT_NAMES[self._point_legs[self._contacts.index(name)]]
+
+    def lane(self, name: str) -> np.ndarray:
+        """Patch centres [m] of the lane of contact point (or leg) ``name``."""
+        leg = name if name in FOOT_NAMES else self.contact_leg(name)
+        return self.lane1 if leg == "leg1" else self.lane2
+
     def foot_state(self, x, i: int) -> tuple[float, float, float, float]:
-        """Contact point of foot ``i`` (0/1) and the velocity of the material point there:
-        (px, py, vx, vy) [m, m/s]."""
-        n = self.nq
-        P, V, J = np.empty((2, 2)), np.empty((2, 2)), np.empty((2, 2, n))
+        """Reference contact point of leg ``i`` (0/1) (its only point; a flat foot's heel)
+        and the velocity of the material point there: (px, py, vx, vy) [m, m/s]."""
+        n, nf = self.nq, len(self._contacts)
+        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
         self.kernels.feet(np.asarray(x, float), self.walker_params, P, V, J)
+        i = self._point_legs.index(i)
         return float(P[i, 0]), float(P[i, 1]), float(V[i, 0]), float(V[i, 1])
 
     def foot_positions(self, X) -> np.ndarray:
-        """Contact points (n, 2, 2) [m] (foot, xy) for states X (n, 2 nq), or (2, 2) for one."""
+        """Reference contact point of each leg (n, 2, 2) [m] (leg, xy) for states X (n, 2 nq),
+        or (2, 2) for one: the foot point, an arc's lowest point, a flat foot's heel."""
         X = self._rows(X)
         pts = self.kernels.points(X.T, self.walker_params)
-        key = "contact" if self.structure.foot == "arc" else "foot"  # the arc's lowest point
+        key = {"arc": "contact", "flat": "heel"}.get(self.structure.foot, "foot")
         out = np.stack([np.stack([pts[f"{leg}_{key}"][0], pts[f"{leg}_{key}"][1]], axis=-1)
                         for leg in FOOT_NAMES], axis=1)
         return out if len(out) > 1 else out[0]
@@ -369,22 +440,51 @@ class ContactWalker:
         return float(self.hip_height(x)[0]) - threshold
 
     def contact_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
-        """Per-foot contact quantities for states X (n, 2 nq).
+        """Per-contact-point quantities for states X (n, 2 nq) (the contact table).
 
         Returns
         -------
         dict
-            ``{"leg1": {...}, "leg2": {...}}`` each with arrays (n,): ``penetration`` [m]
-            (signed; negative = height above ground), ``penetration_rate`` [m/s],
-            ``slip_velocity`` [m/s] (down-slope, of the material point), ``s`` [m]
-            along-slope position, ``normal_force`` [N], ``friction_force`` [N] (along t),
-            ``power`` [W] (F . v), ``on_ground`` (1.0 where the foot's lane has ground).
+            Keyed by :meth:`contact_names` (``{"leg1": {...}, "leg2": {...}}`` for point
+            and arc feet), each with arrays (n,): ``penetration`` [m] (signed; negative =
+            height above ground), ``penetration_rate`` [m/s], ``slip_velocity`` [m/s]
+            (down-slope, of the material point), ``s`` [m] along-slope position,
+            ``normal_force`` [N], ``friction_force`` [N] (along t), ``power`` [W] (F . v),
+            ``on_ground`` (1.0 where the point's lane has ground).
         """
         tab = self.kernels.contact_table(self._rows(X), *self._args())
         names = ("penetration", "penetration_rate", "slip_velocity", "s", "normal_force",
                  "friction_force", "power", "on_ground")
         return {foot: {nm: tab[:, i, k].copy() for k, nm in enumerate(names)}
-                for i, foot in enumerate(FOOT_NAMES)}
+                for i, foot in enumerate(self._contacts)}
+
+    def foot_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
+        """Per-leg contact quantities (``leg1``, ``leg2``) for states X (n, 2 nq): the
+        contact table itself for one point per leg; a flat foot's points combined: forces
+        and power summed, the deepest point's penetration, its rate, slip velocity, ``s``
+        and ``on_ground`` (the point that touches down first and lifts off last).
+
+        Returns
+        -------
+        dict
+            ``{"leg1": {...}, "leg2": {...}}``, arrays (n,) as :meth:`contact_quantities`.
+        """
+        cq = self.contact_quantities(X)
+        if self._contacts == FOOT_NAMES:
+            return cq
+        out = {}
+        for leg in FOOT_NAMES:
+            pts = [cq[c] for c in self._contacts if self.contact_leg(c) == leg]
+            pen = np.stack([q["penetration"] for q in pts])
+            # the deepest point on ground (a point over a gap does not count)
+            on = np.stack([q["on_ground"] for q in pts]) > 0.5
+            deep = np.argmax(np.where(on, pen, pen - 1e3), axis=0)
+            d = {k: np.take_along_axis(np.stack([q[k] for q in pts]), deep[None], 0)[0]
+                 for k in pts[0]}
+            for k in ("normal_force", "friction_force", "power"):
+                d[k] = np.sum([q[k] for q in pts], axis=0)
+            out[leg] = d
+        return out
 
     def knee_stop_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
         """Per-knee stop quantities for states X (n, 2 nq); empty for straight legs.

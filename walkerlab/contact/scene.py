@@ -12,7 +12,7 @@ import numpy as np
 
 from walkerlab.config import ContactSimSettings, ContactSolverSettings, Scene, TerrainSettings
 
-from .model import ContactWalker
+from .model import ContactWalker, flat_foot_numbers
 from .rigid_limit import contact_si
 
 __all__ = ["ContactSceneError", "build", "ideal_step_length", "settings"]
@@ -49,11 +49,20 @@ def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
     at heel strike; compass gait ``2 L sin((th_st - th_sw) / 2)``), plus, for arc feet of
     radius R, the roll ``R (th_st - th_sw)`` of the stance arc over the step (on the periodic
     gait the stance leg turns from the post-impact stance angle to the post-impact swing
-    angle).  The checkerboard patches are spaced by it."""
+    angle).  For flat feet, the along-slope distance from the trailing foot's heel, laid
+    flat under its ankle, to the new stance heel (the rigid view's reference points are the
+    heels' touchdown points; its trailing foot, on its toe or flat at heel strike, has
+    snapped to its rest angle in the post-impact state, so its heel is placed from its
+    ankle).  The checkerboard patches are spaced by it."""
     z = walker.link_state_from_ideal(x_ideal)
     x = walker.pinned_to_full(z, np.zeros(2))
     feet = walker.foot_positions(x)
     chord = float(np.hypot(*(feet[1] - feet[0])))
+    if walker.structure.foot == "flat":
+        pts = walker.points(x)
+        heel1 = (np.asarray(pts["leg1_ankle"], float).ravel() @ walker.tangent
+                 - flat_foot_numbers(walker.data)[0]["heel"])
+        return float(np.asarray(pts["leg2_heel"], float).ravel() @ walker.tangent - heel1)
     if walker.structure.foot != "arc":
         return chord
     R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
@@ -85,10 +94,11 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, or a walker with a massless body (one line).
+        No ``contact`` section, a walker with a massless body, or flat feet without
+        ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2`` (one line).
     """
     from walkerlab.models.description import walker_data
-    from walkerlab.models.floating import check_masses
+    from walkerlab.models.floating import FLAT_FOOT_MESSAGE, check_masses
 
     contact, terrain, _, _ = settings(scene)
     data = walker_data(scene.walker, scene.slope.phi_rad)
@@ -96,8 +106,11 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
         check_masses(data.structure)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
+    if data.structure.foot == "flat" and contact.flat_foot() is None:
+        raise ContactSceneError(f"scene '{scene.name}': {FLAT_FOOT_MESSAGE}")
     si, knee = contact_si(contact)
-    probe = ContactWalker(contact=si, data=data, knee_stop=knee)
+    probe = ContactWalker(contact=si, data=data, knee_stop=knee,
+                          flat_foot=contact.flat_foot())
     step_length = ideal_step_length(probe, x_ideal)
     return ContactWalker.from_settings(contact, terrain, step_length=step_length_m or step_length,
                                        n_steps=n_steps + 4, data=data), step_length

@@ -282,8 +282,8 @@ def first_event(walker, t, X, limits: ContactLimits, k0=1):
         return best
     cq = walker.contact_quantities(X[sl])
     hw = walker.patch_half_width
-    for foot, lane in zip(cq, (walker.lane1, walker.lane2)):
-        q = cq[foot]
+    for foot in cq:  # every contact point on its leg's lane
+        q, lane = cq[foot], walker.lane(foot)
         on = q["on_ground"] > 0.5
         pen = q["penetration"]
         # entering a patch horizontally (gap -> patch) with the foot below the top at

@@ -27,17 +27,32 @@ point is
   *material* point of the arc there, whose velocity is ``v_centre + w x (-R n) = v_centre +
   R w t`` (``w`` the shank's rate), so its Jacobian is ``J_centre + R t e_shank^T`` and rolling
   emerges from friction.
+- flat foot (Wisse et al. 2006, "Ankle springs instead of arc-shaped feet"): a foot link
+  per leg on a revolute ankle at the leg's end, with its own absolute angle
+  ``leg{i}_foot_angle`` (coordinates after the legs'; equal to the leg's angle when the
+  ankle is at rest with rest angle 0, sole direction ``u = (cos psi_f, sin psi_f)``, so a
+  foot flat on the slope has ``psi_f = -phi``), and two contact points, the heel at
+  ``ankle - heel u`` and the toe at ``ankle + toe u`` (material points of the foot).  The
+  ankle's spring-damper acts on ``delta = psi_f - psi_leg`` (toe up > 0): ``V_a = k (delta -
+  r)^2 / 2`` and the damper's ``-c J_d^T J_d dq``.  The walker description's foot is massless;
+  this view regularises it with a mass ``m_foot`` at the ankle and an inertia ``I_foot``
+  about the ankle (:data:`FOOT_PARAMS`, set by the contact section,
+  ``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``), appended to the
+  parameter vector (:func:`param_names`).
+
+The contact points are named by :func:`contact_names` (``leg1``, ``leg2``; flat feet
+``leg1_heel``, ``leg1_toe``, ``leg2_heel``, ``leg2_toe``); ``nf`` below is their number.
 
 Generated numba functions (``x = [q, dq]``, ``p`` the parameter vector in
-``Structure.param_names`` order, outputs written into preallocated arrays):
+:func:`param_names` order, outputs written into preallocated arrays):
 
 =====================================  ========================================================
 ``dyn(x, p, M, h)``                    ``M`` (nq, nq) [kg, kg m, kg m^2], ``h`` (nq,) [N, N m]
 ``dyn_jac(x, a, p, Dq, Dv)``           ``d(M a + h)/dq``, ``dh/d dq`` (nq, nq), ``a`` fixed
-``feet(x, p, P, V, J)``                contact points ``P`` (2, 2) [m], material velocities
-                                       ``V`` (2, 2) [m/s], Jacobians ``J`` (2, 2, nq)
-``feet_jac(x, F, p, dV, dJtF)``        ``dV = d V_i / dq`` (2, 2, nq) and
-                                       ``dJtF = d(sum_i J_i^T F_i)/dq`` (nq, nq), ``F`` (2, 2) fixed
+``feet(x, p, P, V, J)``                contact points ``P`` (nf, 2) [m], material velocities
+                                       ``V`` (nf, 2) [m/s], Jacobians ``J`` (nf, 2, nq)
+``feet_jac(x, F, p, dV, dJtF)``        ``dV = d V_i / dq`` (nf, 2, nq) and
+                                       ``dJtF = d(sum_i J_i^T F_i)/dq`` (nq, nq), ``F`` (nf, 2)
 ``energies(X, p)``                     numpy: kinetic, potential [J] of states (2 nq, k)
 ``points(X, p)``                       numpy: named points (2, k) [m]
 =====================================  ========================================================
@@ -57,11 +72,19 @@ import numpy as np
 
 from walkerlab.models.description import Structure, WalkerData
 
-__all__ = ["MASSLESS_MESSAGE", "FloatingEquations", "FloatingView", "check_masses",
-           "coordinate_names", "derive_floating", "floating_module", "floating_view"]
+__all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "MASSLESS_MESSAGE", "FloatingEquations",
+           "FloatingView", "check_masses", "contact_names", "coordinate_names",
+           "derive_floating", "floating_module", "floating_params", "floating_view",
+           "param_names"]
 
 MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
 LEGS = ("leg1", "leg2")
+#: Floating-view parameters of a flat foot (not in the walker description, whose foot is
+#: massless): its mass at the ankle [kg] and its inertia about the ankle [kg m^2].
+FOOT_PARAMS = ("m_foot", "I_foot")
+FLAT_FOOT_MESSAGE = ("contact.flat_foot_mass_kg and contact.flat_foot_inertia_kg_m2: a "
+                     "flat-footed walker's contact model needs its feet's mass and inertia "
+                     "(the rigid view's feet are massless)")
 
 
 def coordinate_names(structure: Structure) -> tuple[str, ...]:
@@ -70,7 +93,44 @@ def coordinate_names(structure: Structure) -> tuple[str, ...]:
         ang = tuple(f"{leg}_{ln}_angle" for leg in LEGS for ln in ("thigh", "shank"))
     else:
         ang = tuple(f"{leg}_angle" for leg in LEGS)
+    if structure.foot == "flat":  # the feet's absolute angles after the legs'
+        ang += tuple(f"{leg}_foot_angle" for leg in LEGS)
     return ("hip_x", "hip_y") + ang
+
+
+def param_names(structure: Structure) -> tuple[str, ...]:
+    """Names of the floating view's parameter vector: ``structure.param_names``, then for
+    flat feet the contact model's regularising foot mass ``m_foot`` [kg] and inertia about
+    the ankle ``I_foot`` [kg m^2] (:data:`FOOT_PARAMS`; the rigid view's foot is
+    massless)."""
+    extra = FOOT_PARAMS if structure.foot == "flat" else ()
+    return tuple(structure.param_names) + extra
+
+
+def contact_names(structure: Structure) -> tuple[str, ...]:
+    """Names of the contact points, in the order of the generated ``feet`` (one per leg,
+    ``leg1``, ``leg2``, for point and arc feet; ``leg1_heel``, ``leg1_toe``,
+    ``leg2_heel``, ``leg2_toe`` for flat feet)."""
+    if structure.foot == "flat":
+        return tuple(f"{leg}_{end}" for leg in LEGS for end in ("heel", "toe"))
+    return LEGS
+
+
+def floating_params(data: WalkerData, foot_mass_kg: float | None = None,
+                    foot_inertia_kg_m2: float | None = None) -> np.ndarray:
+    """The floating view's parameter vector (:func:`param_names` order) of ``data``.
+
+    Raises
+    ------
+    ValueError
+        A flat-footed walker without a foot mass and inertia (:data:`FLAT_FOOT_MESSAGE`).
+    """
+    p = [float(v) for v in data.params]
+    if data.structure.foot == "flat":
+        if foot_mass_kg is None or foot_inertia_kg_m2 is None:
+            raise ValueError(FLAT_FOOT_MESSAGE)
+        p += [float(foot_mass_kg), float(foot_inertia_kg_m2)]
+    return np.asarray(p, dtype=float)
 
 
 def check_masses(structure: Structure) -> None:
@@ -95,19 +155,24 @@ class FloatingEquations:
     ----------
     q, dq : tuple of Symbol (nq,)
     params : tuple of Symbol
-        ``structure.param_names`` order.
+        :func:`param_names` order.
     M : Matrix (nq, nq); h : Matrix (nq, 1)
     feet : tuple of (Matrix (2, 1), Matrix (2, nq))
-        Per leg: contact point (lowest point of an arc) and the Jacobian of the material
-        point there.
+        Per contact point (``contacts``): its position (an arc's lowest point) and the
+        Jacobian of the material point there.
     kinetic, potential : Expr
     points : dict[str, Matrix (2, 1)]
         Named as the rigid model's: ``hip``, ``<leg>_<body>``, ``<leg>_foot`` (end of the
         leg axis), arc feet ``<leg>_foot_centre`` and ``<leg>_contact`` (lowest point),
-        kneed ``<leg>_knee``.
+        kneed ``<leg>_knee``, flat feet ``<leg>_ankle`` (= ``<leg>_foot``),
+        ``<leg>_heel``, ``<leg>_toe``.
     knees : tuple of (int, int)
         Per leg with a knee, the indices in ``q`` of its thigh and shank angles (by
         their names); empty for straight legs.
+    contacts : tuple of str
+        Names of the contact points, in the order of ``feet`` (:func:`contact_names`).
+    point_legs : tuple of int
+        Leg (0 = leg1, 1 = leg2) of each contact point.
     """
 
     q: tuple
@@ -120,6 +185,8 @@ class FloatingEquations:
     potential: object
     points: dict
     knees: tuple = ()
+    contacts: tuple = LEGS
+    point_legs: tuple = (0, 1)
 
 
 @cache
@@ -129,20 +196,22 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     Raises
     ------
     ValueError
-        Massless bodies (:func:`check_masses`) or a foot kind other than point / arc.
+        Massless bodies (:func:`check_masses`) or a foot kind other than point / arc /
+        flat.
     """
     import sympy as sp
 
     check_masses(structure)
-    if structure.foot not in ("point", "arc"):
+    if structure.foot not in ("point", "arc", "flat"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
     names = coordinate_names(structure)
     q = sp.symbols(names, real=True)
     dq = sp.symbols([f"d_{n}" for n in names], real=True)
-    par = sp.symbols(structure.param_names, real=True)
-    P = dict(zip(structure.param_names, par))
+    pnames = param_names(structure)
+    par = sp.symbols(pnames, real=True)
+    P = dict(zip(pnames, par))
     g, L, gamma = P["g"], P["L"], P["gamma"]
-    knee, arc = structure.knee, structure.foot == "arc"
+    knee, arc, flat = structure.knee, structure.foot == "arc", structure.foot == "flat"
     lt = P["L_thigh"] if knee else 0
     R = P["R_foot"] if arc else 0
     n_vec = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
@@ -188,6 +257,20 @@ def derive_floating(structure: Structure) -> FloatingEquations:
             points[f"{leg}_foot_centre"] = centre
             points[f"{leg}_contact"] = centre - R * n_vec
             points[f"{leg}_foot"] = centre + R * e(q[lower])
+        elif flat:
+            # the foot link on a revolute ankle at the leg's end (the ankle on the sole
+            # line): sole direction u = (cos psi_f, sin psi_f) = e(psi_f + pi/2), psi_f the
+            # foot's absolute angle (= the leg's at the spring's rest with r = 0); heel and
+            # toe are material points of the foot; the foot's mass sits at the ankle
+            psi_f = q[names.index(f"{leg}_foot_angle")]
+            u = e(psi_f + sp.pi / 2)
+            for end, d in (("heel", -P[f"heel_{tags[i]}m"]), ("toe", P[f"toe_{tags[i]}m"])):
+                pos = centre + d * u
+                feet.append((pos, pos.jacobian(sp.Matrix(q))))
+                points[f"{leg}_{end}"] = pos
+            points[f"{leg}_foot"] = centre
+            points[f"{leg}_ankle"] = centre
+            bodies.append((P["m_foot"], {q[upper]: L}, P["I_foot"], psi_f))
         else:
             feet.append((centre, Jc))
             points[f"{leg}_foot"] = centre
@@ -242,6 +325,12 @@ def derive_floating(structure: Structure) -> FloatingEquations:
         V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
         Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
         damping += P[f"c_s{i}"] * Jd.T * Jd
+    if flat:  # ankle spring-dampers, delta = foot angle - leg angle (toe up > 0)
+        for i, leg in enumerate(LEGS):
+            delta = q[names.index(f"{leg}_foot_angle")] - q[2 + i]
+            V += P[f"k_{tags[i]}ankle"] * (delta - P[f"r_{tags[i]}ankle"]) ** 2 / 2
+            Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
+            damping += P[f"c_{tags[i]}ankle"] * Jd.T * Jd
     h = (M * dqv).jacobian(qv) * dqv - sp.Matrix([sp.diff(T, s) for s in q]) \
         + sp.Matrix([sp.diff(V, s) for s in q]) + damping * dqv
     h = h.applyfunc(sp.expand)
@@ -249,7 +338,9 @@ def derive_floating(structure: Structure) -> FloatingEquations:
                              feet=tuple(feet), kinetic=T, potential=V, points=points,
                              knees=tuple((names.index(f"{leg}_thigh_angle"),
                                           names.index(f"{leg}_shank_angle"))
-                                         for leg in LEGS if knee))
+                                         for leg in LEGS if knee),
+                             contacts=contact_names(structure),
+                             point_legs=tuple(int(c[3]) - 1 for c in contact_names(structure)))
 
 
 # ---------------------------------------------------------------------------- code generation
@@ -340,7 +431,8 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
         outs += [(f"V[{i}, {r}]", v[r]) for r in range(2)]
         outs += [(f"J[{i}, {r}, {k}]", J[r, k]) for r in range(2) for k in range(nq)]
     body += _fn("feet", "x, p, P, V, J", eq, outs, pr)
-    F = sp.Matrix(2, 2, sp.symbols("F0:4", real=True))
+    nf = len(eq.feet)
+    F = sp.Matrix(nf, 2, sp.symbols(f"F0:{2 * nf}", real=True))
     outs = []
     JtF = sp.zeros(nq, 1)
     for i, (_, J) in enumerate(eq.feet):
@@ -350,7 +442,8 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
     dJ = JtF.jacobian(qv)
     outs += [(f"dJtF[{i}, {k}]", dJ[i, k]) for i in range(nq) for k in range(nq)]
     lines = _fn("feet_jac", "x, F, p, dV, dJtF", eq, outs, pr)
-    lines.insert(2, "    F0, F1, F2, F3 = F[0, 0], F[0, 1], F[1, 0], F[1, 1]")
+    lines.insert(2, f"    {', '.join(str(f) for f in F)} = "
+                 + ", ".join(f"F[{i}, {r}]" for i in range(nf) for r in range(2)))
     body += lines
     body += _numpy_fn("_energies", eq, {"kinetic": eq.kinetic, "potential": eq.potential})
     body += ["def energies(X, p):", "    d = _energies(X, p)",
@@ -420,13 +513,22 @@ class FloatingView:
     Parameters
     ----------
     data : WalkerData
+    foot_mass_kg, foot_inertia_kg_m2 : float, optional
+        A flat foot's mass [kg] (at the ankle) and inertia about the ankle [kg m^2]
+        (required for flat feet, ignored otherwise).
+
+    Raises
+    ------
+    ValueError
+        Massless bodies; a flat foot without its mass and inertia.
     """
 
-    def __init__(self, data: WalkerData):
+    def __init__(self, data: WalkerData, foot_mass_kg: float | None = None,
+                 foot_inertia_kg_m2: float | None = None):
         check_masses(data.structure)
         self.data = data
         self.structure = data.structure
-        self.params = np.asarray(data.params, dtype=float)
+        self.params = floating_params(data, foot_mass_kg, foot_inertia_kg_m2)
         self._mod = floating_module(data.structure)
         self.nq = int(self._mod.NQ)
 
@@ -457,10 +559,15 @@ class FloatingView:
         """G(q) = h(q, 0) (nq,) [N, N m]."""
         return self.bias(q, np.zeros(self.nq))
 
+    def contact_names(self) -> tuple[str, ...]:
+        """Names of the contact points (:func:`contact_names`)."""
+        return contact_names(self.structure)
+
     def contact_points(self, q, dq=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per foot (leg1, leg2): contact point (2, 2) [m], velocity of the material point
-        there (2, 2) [m/s] and its Jacobian (2, 2, nq)."""
-        P, V, J = np.empty((2, 2)), np.empty((2, 2)), np.empty((2, 2, self.nq))
+        """Per contact point (:meth:`contact_names`): its position (nf, 2) [m], the velocity
+        of the material point there (nf, 2) [m/s] and its Jacobian (nf, 2, nq)."""
+        nf = len(self.contact_names())
+        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, self.nq))
         self._mod.feet(self._x(q, dq), self.params, P, V, J)
         return P, V, J
 
@@ -474,12 +581,14 @@ class FloatingView:
         return self._mod.points(X, self.params)
 
 
-def floating_view(data: WalkerData) -> FloatingView:
+def floating_view(data: WalkerData, foot_mass_kg: float | None = None,
+                  foot_inertia_kg_m2: float | None = None) -> FloatingView:
     """The floating view of a walker (see :class:`FloatingView`).
 
     Raises
     ------
     ValueError
-        A body with mass 0: :data:`MASSLESS_MESSAGE`.
+        A body with mass 0: :data:`MASSLESS_MESSAGE`; flat feet without their mass and
+        inertia: :data:`FLAT_FOOT_MESSAGE`.
     """
-    return FloatingView(data)
+    return FloatingView(data, foot_mass_kg, foot_inertia_kg_m2)
