@@ -165,7 +165,8 @@ def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: floa
 
     stance_leg = walker.legs[-1]
     n = 2 * walker.n_coordinates
-    keys = list(walker.leg_coordinates(np.zeros(n), stance_leg))
+    # leg links only: an ankle's angle (a flat foot's) is not a leg's and starts at 0
+    keys = [k for k in walker.leg_coordinates(np.zeros(n), stance_leg) if "_ankle_" not in k]
 
     def target(k: str) -> float:
         stance = k.startswith(stance_leg + "_")

@@ -42,6 +42,9 @@ from .solver import Solver
 #: heel-strike surface and never moved (slope 0, all-zero state; a passive step lasts
 #: tenths of a second or more).
 MIN_STEP_TIME_S = 1e-9
+#: Phase switches allowed in one step (a phase graph with a cycle must not loop for ever;
+#: a flat-footed step has at most five).
+MAX_PHASE_SWITCHES = 64
 
 
 def numeric_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
@@ -185,7 +188,11 @@ class Segment:
     event : str
         Name of the guard that fired (or ``""``).
     phase_times : dict[str, float]
-        Time at which each phase after the first began (e.g. ``midstance``).
+        Time at which each phase after the first began (e.g. ``midstance``), by the name of
+        the guard that began it.
+    phase_log : list of (str, float, float, str)
+        Each phase of the step in order: ``(phase name, t_start, t_end, guard that ended
+        it)`` (the guard is ``""`` when the step was cut or the solver failed).
     nfev : int
         Right-hand-side evaluations.
     message : str
@@ -211,6 +218,7 @@ class Segment:
     pieces: list = field(default_factory=list, repr=False)
     stance_foot_world: np.ndarray = field(default_factory=lambda: np.zeros(2))
     monodromy: np.ndarray | None = None
+    phase_log: list = field(default_factory=list)
 
     @property
     def period(self) -> float:
@@ -294,7 +302,12 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     phase_times = {}
     termination, event, message = RunEnd.T_FINAL, "", ""
     x_next = None
-    for k, phase in enumerate(walker.phases):
+    phase_log = []
+    index_of = {ph.name: i for i, ph in enumerate(walker.phases)}
+    k, switches = 0, 0
+    while k < len(walker.phases) and switches <= MAX_PHASE_SWITCHES:
+        phase = walker.phases[k]
+        switches += 1
         if variational:
             jac = _phase_jacobian(walker, phase)
 
@@ -327,6 +340,8 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         nfev += run.nfev
         message = run.message
         pieces.append((phase, run.dense, (t, run.t_last)))
+        phase_log.append((phase.name, t, run.t_last,
+                          "" if run.event is None or run.failed else phase.guards[run.event].name))
         t, x = run.t_last, run.y_last[:n].copy()
         if run.failed:
             termination = RunEnd.SOLVER_FAILURE
@@ -344,11 +359,14 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
             g_reset = getattr(guard, "reset", None)
             if g_reset is not None:  # intra-step impact (e.g. knee strike)
                 x = np.asarray(g_reset(x_minus), dtype=float)
-            if k + 1 < len(walker.phases) and variational:
-                nxt = walker.phases[k + 1]
+            target = getattr(guard, "next_phase", None)
+            k_next = k + 1 if target is None else index_of[target]
+            if k_next < len(walker.phases) and variational:
+                nxt = walker.phases[k_next]
                 DR = None if g_reset is None else np.asarray(guard.reset_jacobian(x_minus))
                 Phi = _saltation(np.asarray(phase.flow(t, x_minus)), np.asarray(nxt.flow(t, x)),
                                  _grad(guard, x_minus), DR) @ Phi
+            k = k_next
             continue
         if guard.outcome == "fall":
             termination = RunEnd.FALL
@@ -359,18 +377,21 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
                        f"(t = {t0:.4g} s); the walker does not move")
             break
         termination = RunEnd.HEEL_STRIKE
-        x_next = np.asarray(walker.reset(x), dtype=float)
+        # a phase's own heel-strike map (a flat foot's depends on its mode), else the walker's
+        reset, reset_jac = ((guard.reset, guard.reset_jacobian)
+                            if getattr(guard, "reset", None) is not None
+                            else (walker.reset, walker.reset_jacobian))
+        x_next = np.asarray(reset(x), dtype=float)
         if variational:
             f_prev = np.asarray(phase.flow(t, x))
             S = _saltation(f_prev, np.zeros_like(f_prev), _grad(guard, x))
-            RJ = (walker.reset_jacobian(x) if walker.reset_jacobian is not None
-                  else numeric_jacobian(walker.reset, x))
+            RJ = reset_jac(x) if reset_jac is not None else numeric_jacobian(reset, x)
             Phi = RJ @ S @ Phi
         break
     return Segment(
         index=index, stance_leg=stance_leg, t_start=t0, t_end=t, x_start=np.asarray(x0, float),
         x_end=x, x_next=x_next, termination=termination.value, event=event,
-        phase_times=phase_times,
+        phase_times=phase_times, phase_log=phase_log,
         nfev=nfev, message=message, pieces=pieces,
         stance_foot_world=np.zeros(2) if stance_foot_world is None else stance_foot_world,
         monodromy=Phi if (variational and termination is RunEnd.HEEL_STRIKE) else None,

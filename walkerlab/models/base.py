@@ -74,6 +74,13 @@ class Guard:
     reset, reset_jacobian : callable, optional
         For ``next_phase`` guards: a map applied to the state when the guard fires (an
         intra-step impact such as a knee strike, state dimension unchanged) and its Jacobian.
+        For a ``heel_strike`` guard: the heel-strike map of this phase (role swap included)
+        in place of the walker's :attr:`HybridWalker.reset` (a flat foot's depends on the
+        stance foot's mode).
+    next_phase : str, optional
+        For ``next_phase`` guards: the name of the phase that follows (the phases of a step
+        then form a graph, e.g. a flat foot's modes crossed with early / late swing); None:
+        the next phase in :attr:`HybridWalker.phases`.
     """
 
     name: str
@@ -83,6 +90,7 @@ class Guard:
     gradient: Callable[[np.ndarray], np.ndarray] | None = None
     reset: Callable[[np.ndarray], np.ndarray] | None = None
     reset_jacobian: Callable[[np.ndarray], np.ndarray] | None = None
+    next_phase: str | None = None
 
 
 @dataclass(frozen=True)

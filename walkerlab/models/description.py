@@ -19,6 +19,9 @@ from dataclasses import dataclass
 ROLES = {"absolute": ("swing", "stance"), "slope_relative": ("stance", "hip")}
 #: Roles with a knee: swing thigh and shank free, the stance leg straight (absolute angles).
 KNEED_ROLES = ("swing_thigh", "swing_shank", "stance")
+#: Roles with flat feet: the absolute leg angles and the stance ankle's angle (the swing
+#: foot is massless and sits at its spring's rest angle: no coordinate).
+FLAT_ROLES = ("swing", "stance", "stance_ankle")
 
 
 @dataclass(frozen=True)
@@ -93,6 +96,8 @@ class Structure:
 
     @property
     def roles(self) -> tuple[str, ...]:
+        if self.foot == "flat":
+            return FLAT_ROLES
         return KNEED_ROLES if self.knee else ROLES[self.coordinates]
 
     @property

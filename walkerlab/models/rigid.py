@@ -86,6 +86,10 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     -------
     HybridWalker
     """
+    if data.structure.foot == "flat":  # modes of a flat foot: their own phase graph
+        from walkerlab.models.rigid_flat import make_flat_walker
+
+        return make_flat_walker(data, name, variant)
     f = functions(data)
     # the compiled flow is the generated one: none when the flow is replaced
     generated_flow = flow is None and flow_jacobian is None
