@@ -49,20 +49,25 @@ def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
     at heel strike; compass gait ``2 L sin((th_st - th_sw) / 2)``), plus, for arc feet of
     radius R, the roll ``R (th_st - th_sw)`` of the stance arc over the step (on the periodic
     gait the stance leg turns from the post-impact stance angle to the post-impact swing
-    angle).  For flat feet, the along-slope distance from the trailing foot's heel, laid
-    flat under its ankle, to the new stance heel (the rigid view's reference points are the
-    heels' touchdown points; its trailing foot, on its toe or flat at heel strike, has
-    snapped to its rest angle in the post-impact state, so its heel is placed from its
-    ankle).  The checkerboard patches are spaced by it."""
+    angle).  For flat feet, from the trailing foot's heel touchdown point to the new stance
+    heel (the rigid view's reference points): at heel strike the trailing foot stands on its
+    toe (heel off; flat if its ankle is on the slope), so its toe lies on the slope at
+    ``toe`` from its ankle, ``s_toe = s_ankle + sqrt(toe^2 - h_ankle^2)``, and its heel
+    touched down at ``s_toe - (heel + toe)`` (the post-impact state keeps the legs' angles;
+    only the trailing foot's angle is lost, snapped to rest).  The checkerboard patches are
+    spaced by it."""
     z = walker.link_state_from_ideal(x_ideal)
     x = walker.pinned_to_full(z, np.zeros(2))
     feet = walker.foot_positions(x)
     chord = float(np.hypot(*(feet[1] - feet[0])))
     if walker.structure.foot == "flat":
         pts = walker.points(x)
-        heel1 = (np.asarray(pts["leg1_ankle"], float).ravel() @ walker.tangent
-                 - flat_foot_numbers(walker.data)[0]["heel"])
-        return float(np.asarray(pts["leg2_heel"], float).ravel() @ walker.tangent - heel1)
+        f1 = flat_foot_numbers(walker.data)[0]
+        ankle = np.asarray(pts["leg1_ankle"], float).ravel()
+        h = min(max(float(ankle @ walker.normal), 0.0), f1["toe"])
+        s_toe = float(ankle @ walker.tangent) + np.sqrt(f1["toe"] ** 2 - h ** 2)
+        heel2 = float(np.asarray(pts["leg2_heel"], float).ravel() @ walker.tangent)
+        return heel2 - (s_toe - f1["heel"] - f1["toe"])
     if walker.structure.foot != "arc":
         return chord
     R = dict(zip(walker.structure.param_names, walker.walker_params))["R_foot"]
