@@ -87,7 +87,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
-from walkerlab.contact.model import ContactWalker
+from walkerlab.contact.model import ContactWalker, footprint_offsets
 from walkerlab.integrate.contact import StateIndex
 
 __all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait", "PeriodicGaitError",
@@ -204,8 +204,10 @@ class StepMap:
         # straight legs scuff the ground at mid-stance: footfall-relative lanes (module doc);
         # a kneed swing leg is flexed there, so its continuous ground is kept
         keep_ground = walker.continuous and walker.structure.knee
-        self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing]),
-                                          lane2=np.array([0.0]), continuous=keep_ground)
+        # each patch centred on its foot's footprint (a flat foot's lies ahead of its heel)
+        o2 = footprint_offsets(walker.data)[1]
+        self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing + o2]),
+                                          lane2=np.array([o2]), continuous=keep_ground)
         self.method, self.rtol, self.atol, self.t_max = method, rtol, atol, t_max
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
@@ -399,8 +401,8 @@ class StepMap:
         cq = self.walker.contact_quantities(X)
         hw = self.walker.patch_half_width
         margin = np.inf
-        for leg, c in (("leg1", self.spacing), ("leg2", 0.0)):
-            q = cq[leg]
+        for name, q in cq.items():  # every contact point on its leg's patch
+            c = float(self.walker.lane(name)[0])
             loaded = q["penetration"] > 0
             near = np.abs(q["s"] - c) <= 2 * hw  # in or next to this leg's patch
             sel = loaded & near

@@ -9,7 +9,9 @@ penetration [m] and contact time [s] of both stiffness families on dimension
 centres [m] per lane); ``initial_state`` (named by ``contact_state``),
 ``initial_state_named/``, ``initial_state_ideal`` (the rigid fixed point it started from),
 ``initial_rate_scale`` (on dimension ``rate``); ``feet/<leg>/`` (normal and friction force
-[N], penetration [m], slip velocity [m/s], touchdown/lift-off times [s]); ``events/``
+[N], penetration [m], slip velocity [m/s], touchdown/lift-off times [s]; a flat foot's
+heel and toe combined); ``contact_points/<point>/`` (flat feet only: the same per contact
+point, ``leg1_heel``, ``leg1_toe``, ...: which points are loaded when); ``events/``
 (heel-strike times [s] and legs); ``steps/`` (per step: times [s], stance slip and creep
 [mm], bounces, scuffs, peak penetration [m]); ``summary/``; optional ``periodic_gait/``
 (the contact model's own gait: period [s], step length [m], Floquet multipliers) and
@@ -164,21 +166,30 @@ def _write_setup(f, run: ContactSimRun) -> None:
         f"multipliers on ({'; '.join(run.rate_names)})", dims=("rate",))
 
 
+def _write_trace(g, ft, time, what: str) -> None:
+    """One foot's (or contact point's) trace and its touchdown / lift-off times."""
+    coordinate(g, "time", time, "s", "sample time")
+    t = ("time",)
+    put(g, "normal_force", ft.normal_force, "N", "IMPACT normal force", dims=t)
+    put(g, "friction_force", ft.friction_force, "N", "Coulomb friction, down-slope",
+        dims=t)
+    put(g, "penetration", ft.penetration, "m", "signed penetration (<0: above)", dims=t)
+    put(g, "slip_velocity", ft.slip_velocity, "m/s", "tangential foot velocity", dims=t)
+    for ev in ("touchdown", "liftoff"):
+        times = getattr(ft, f"{ev}_times")
+        coordinate(g, ev, np.arange(len(times)), "-", f"{ev} number")
+        put(g, f"{ev}_times", times, "s", f"{ev} times of {what}", dims=(ev,))
+
+
 def _write_feet_events_steps(f, run: ContactSimRun) -> None:
     res, tr = run.result, run.samples
     for leg, ft in res.feet.items():
-        g = f.create_group(f"feet/{leg}")
-        coordinate(g, "time", tr.time, "s", "sample time")
-        t = ("time",)
-        put(g, "normal_force", ft.normal_force, "N", "IMPACT normal force", dims=t)
-        put(g, "friction_force", ft.friction_force, "N", "Coulomb friction, down-slope",
-            dims=t)
-        put(g, "penetration", ft.penetration, "m", "signed penetration (<0: above)", dims=t)
-        put(g, "slip_velocity", ft.slip_velocity, "m/s", "tangential foot velocity", dims=t)
-        for ev in ("touchdown", "liftoff"):
-            times = getattr(ft, f"{ev}_times")
-            coordinate(g, ev, np.arange(len(times)), "-", f"{ev} number")
-            put(g, f"{ev}_times", times, "s", f"{ev} times of {leg}'s foot", dims=(ev,))
+        _write_trace(f.create_group(f"feet/{leg}"), ft, tr.time, f"{leg}'s foot")
+    points = getattr(res, "points", None) or {}
+    if set(points) != set(res.feet):  # several contact points per foot (flat feet)
+        for name, ft in points.items():
+            _write_trace(f.create_group(f"contact_points/{name}"), ft, tr.time,
+                         f"contact point {name}")
     g = f.create_group("events")
     legs = list(res.heel_strike_legs) or [""]
     coordinate(g, "heel_strike", np.arange(len(legs)), "-", "heel strike number")
