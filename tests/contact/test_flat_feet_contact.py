@@ -32,10 +32,12 @@ SCENE = {"name": "flat_contact_test",
 MF, IF = 0.1, 5e-4
 
 
-def _scene(slope=0.04, damping=0.0, contact=True):
+def _scene(slope=0.04, damping=0.0, contact=True, rest=None):
     d = copy.deepcopy(SCENE)
     d["slope"]["angle_rad"] = slope
     d["walker"]["leg"]["foot"]["ankle"]["damping_n_m_s_per_rad"] = damping
+    if rest is not None:
+        d["walker"]["leg"]["foot"]["ankle"]["rest_angle_rad"] = rest
     if not contact:
         d["contact"] = {}
     return scene_from_dict(d, "flat_contact_test.yaml")
@@ -48,8 +50,8 @@ def _ref_params(sc) -> dict:
             "tt": FOOT["toe_m"]}
 
 
-def _walker(slope=0.04, damping=0.0, **kw) -> ContactWalker:
-    sc = _scene(slope, damping)
+def _walker(slope=0.04, damping=0.0, rest=None, **kw) -> ContactWalker:
+    sc = _scene(slope, damping, rest=rest)
     return ContactWalker(data=walker_data(sc.walker, sc.slope.phi_rad), flat_foot=(MF, IF),
                          **kw)
 
@@ -152,6 +154,30 @@ def test_contact_run_energy_balance():
     assert abs((E[-1] - E[0]) - work) < 1e-7
     assert damped > 1e-3
     assert abs(work) > 1.0
+
+
+def test_foot_slap_matches_the_rigid_view():
+    """From the rigid view's fixed point of configs/flat_feet.yaml (k = 90 N m/rad, rest 0,
+    slope 0.04 rad; 22a's rigid view: heel contact until the foot slap at 0.018917 s, then
+    foot flat), the contact table's modes of the stance foot (leg2) are heel contact, then
+    foot flat at the toe's touchdown within 1 ms of the rigid slap (the heel's 0.06 mm
+    penetration and the 0.1 kg / 5e-4 kg m^2 foot's own inertia; measured 0.2 ms)."""
+    from walkerlab.analysis.contact_gait import foot_modes, gait_events
+    from walkerlab.analysis.contact_sim import initial_state_from_ideal
+    from walkerlab.integrate.contact import ContactLimits, integrate_contact
+    from walkerlab.integrate.solver import Solver
+
+    w = _walker(rest=0.0, lane1=np.array([0.86]), lane2=np.array([0.075]), continuous=False,
+                patch_half_width=0.2)
+    x0 = initial_state_from_ideal(w, -0.45336407, 0.34250396, 0.0, -1.78684385, -1.46953548,
+                                  -19.34053395)
+    run = integrate_contact(w, x0, 0.0, 0.03, Solver(method="odeint", rtol=1e-10, atol=1e-12),
+                            ContactLimits(sample_rate_hz=1e5))
+    ev = gait_events(w, run.t, run.X)
+    modes = foot_modes(run.t, ev["points"], "leg2")
+    assert [m for m, *_ in modes[:2]] == ["heel_contact", "foot_flat"]
+    assert modes[1][1] == pytest.approx(0.018917, abs=1e-3)
+    assert ev["points"]["leg2_toe"].touchdown_times[0] == pytest.approx(0.018917, abs=1e-3)
 
 
 def test_standing_foot_carries_its_load_by_moment_balance():

@@ -24,8 +24,9 @@ import numpy as np
 from walkerlab.integrate.contact import hermite_root
 from walkerlab.integrate.ends import CONTACT_WALKED, RUN_END_NAMES
 
-__all__ = ["CONTACT_OUTCOMES", "ContactResult", "FootTrace", "Outcome", "StepSummary",
-           "classify", "classify_complete", "gait_events", "heel_strike_count", "phase_slip"]
+__all__ = ["CONTACT_OUTCOMES", "FOOT_MODES", "ContactResult", "FootTrace", "Outcome",
+           "StepSummary", "classify", "classify_complete", "foot_modes", "gait_events",
+           "heel_strike_count", "phase_slip"]
 
 #: Outcome kinds of a contact run: the shared run ends (:mod:`walkerlab.integrate.ends`)
 #: that the contact model can produce.
@@ -387,6 +388,47 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
         _foot_traces(walker, t, X, points=True)
     return {"feet": feet, "hs_t": np.array(hs_t), "hs_leg": hs_leg, "steps": steps,
             "points": points}
+
+
+# ---------------------------------------------------------------------------- foot modes
+#: Mode of a flat foot by which of its points carry load (heel, toe): the rigid view's
+#: names (:mod:`walkerlab.models.rigid_flat`), ``off`` when neither does.
+FOOT_MODES = {(True, False): "heel_contact", (True, True): "foot_flat",
+              (False, True): "heel_off", (False, False): "off"}
+
+
+def foot_modes(t, points: dict, leg: str, t0: float = -np.inf,
+               t1: float = np.inf) -> list[tuple[str, float, float]]:
+    """The modes of ``leg``'s flat foot read from the contact table: which of its heel and
+    toe carry a normal force, sample by sample (:data:`FOOT_MODES`), merged into segments.
+
+    Parameters
+    ----------
+    t : ndarray (n,)
+        Sample times [s].
+    points : dict[str, FootTrace]
+        Per contact point (``ContactResult.points``), with ``<leg>_heel``, ``<leg>_toe``.
+    leg : str
+    t0, t1 : float
+        Window [s] (e.g. one step, heel strike to heel strike).
+
+    Returns
+    -------
+    list of (mode, start [s], end [s])
+        Consecutive segments at the samples' resolution.
+    """
+    sel = (t >= t0) & (t <= t1)
+    heel = points[f"{leg}_heel"].normal_force[sel] > 0
+    toe = points[f"{leg}_toe"].normal_force[sel] > 0
+    ts = t[sel]
+    out: list[tuple[str, float, float]] = []
+    for k in range(ts.size):
+        m = FOOT_MODES[(bool(heel[k]), bool(toe[k]))]
+        if out and out[-1][0] == m:
+            out[-1] = (m, out[-1][1], float(ts[k]))
+        else:
+            out.append((m, float(ts[k]), float(ts[k])))
+    return out
 
 
 # ---------------------------------------------------------------------------- outcome
