@@ -356,6 +356,8 @@ class ContactWalker:
 
         Straight legs, absolute coordinates: ``[th_sw, th_st, w_sw, w_st]``; kneed:
         ``[th_swing_thigh, th_swing_shank, th_stance, rates]`` (the stance knee straight);
+        flat feet: ``[th_sw, th_st, th_sw + r_sw, th_st + ankle, rates]`` (the swing foot at
+        its spring's rest angle ``r``, the stance foot at the rigid view's ankle angle);
         other coordinate schemes through the rigid model's leg angles.
         """
         x = np.asarray(x_ideal, float)
@@ -370,12 +372,13 @@ class ContactWalker:
             rates = [s1 * by["swing_thigh_rate"], s1 * by["swing_shank_rate"],
                      s2 * by["stance_rate"], s2 * by["stance_rate"]]
         elif st.foot == "flat":
-            # the swing foot at its spring's rest (massless in the rigid view), the stance
-            # foot at the rigid view's ankle angle (0 after heel strike, at rest)
-            f1, f2 = flat_foot_numbers(self.data)
-            a, da = by.get("stance_ankle_angle", 0.0), by.get("stance_ankle_rate", 0.0)
+            # the swing foot at its spring's rest, turning with its leg (massless in the rigid
+            # view); the stance foot at the rigid view's ankle angle and rate (its sole
+            # angle is stance + ankle); the scale multiplies the legs' rates
+            r1 = flat_foot_numbers(self.data)[0]["r"]
+            a, da = by["stance_ankle_angle"], by["stance_ankle_rate"]
             w1, w2 = s1 * by["swing_rate"], s2 * by["stance_rate"]
-            ang = [by["swing_angle"], by["stance_angle"], by["swing_angle"] + f1["r"],
+            ang = [by["swing_angle"], by["stance_angle"], by["swing_angle"] + r1,
                    by["stance_angle"] + a]
             rates = [w1, w2, w1, w2 + da]
         elif st.coordinates == "absolute":
