@@ -24,13 +24,14 @@ def total_mass_kg(walker) -> float:
     return float(walker.total_mass_kg)
 
 
-def _phase_of(seg, times: np.ndarray) -> np.ndarray:
-    """Index of the phase (piece of the segment) each sample time falls in, as
-    :meth:`Segment.sample` assigns it (a boundary time belongs to the earlier phase)."""
+def _phase_of(seg, times: np.ndarray, names: list[str]) -> np.ndarray:
+    """Index in ``names`` (the walker's phase names) of the phase each sample time falls
+    in, as :meth:`Segment.sample` assigns it (a boundary time belongs to the earlier
+    phase; a step's phases may skip some of the walker's, e.g. a flat foot's modes)."""
     idx = np.full(times.size, -1, dtype=int)
-    for j, (_ph, _sol, (_ta, tb)) in enumerate(seg.pieces):
+    for j, (ph, _sol, (_ta, tb)) in enumerate(seg.pieces):
         last = j == len(seg.pieces) - 1
-        idx[(idx < 0) & ((times <= tb) | last)] = j
+        idx[(idx < 0) & ((times <= tb) | last)] = names.index(ph.name)
     return idx
 
 
@@ -90,7 +91,7 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         chunks["pe"].append(np.broadcast_to(pe, times.shape))
         chunks["stance"].append(np.full(times.size, legs.index(seg.stance_leg)))
         chunks["step"].append(np.full(times.size, seg.index))
-        chunks["phase"].append(_phase_of(seg, times))
+        chunks["phase"].append(_phase_of(seg, times, [p.name for p in w.phases]))
         for name, xy in sw.points(X).items():
             key = _leg_point_name(name, r2l)
             pts.setdefault(key, []).append(np.asarray(xy) + seg.stance_foot_world[:, None])
