@@ -52,7 +52,7 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.models import codegen
-from walkerlab.models.codegen import IND, _PY, _cse_lines, _flow, _numpy_fn, _reset
+from walkerlab.models.codegen import _PY, IND, _cse_lines, _flow, _numpy_fn, _reset
 from walkerlab.models.description import ROLE_TAG, Structure
 from walkerlab.models.symbolic import _dot_terms, _pos, _velocity_terms
 
@@ -256,7 +256,7 @@ def derive_flat(structure: Structure) -> FlatEquations:
         # next step's reference point (the swing heel)
         points["stance_foot"] = points["stance_ankle"]
         points["swing_foot"] = heel_sw
-        for mass, lin, _i, _p, name in bodies:
+        for _m, lin, _i, _p, name in bodies:
             if name != "hip":
                 points[name] = at(lin)
         T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
