@@ -168,6 +168,11 @@ def test_each_mode_s_flow_matches_the_independent_reference(fns, ref):
         for x in _random_states(5, seed=1):
             got = fns[f"flow_{mode}"](0.0, x)[3:]
             np.testing.assert_allclose(got, ref.qdd(rmode, x), rtol=1e-10, atol=1e-10)
+    for mode, rmode in (("heel", "heel"), ("toe", "toe")):  # energies: same zero of height
+        for x in _random_states(3, seed=6):
+            e = fns[f"energies_{mode}"](x)
+            assert e["kinetic"] + e["potential"] == pytest.approx(ref.energy(rmode, x),
+                                                                  rel=1e-12)
     for x in _random_states(5, flat=True, seed=2):
         got = fns["flow_foot_flat"](0.0, x)[3:]
         np.testing.assert_allclose(got[:2], ref.qdd("flat", x[[0, 1, 3, 4]]), rtol=1e-10,
@@ -310,3 +315,26 @@ def test_a_heel_strike_before_heel_off_is_a_step_from_foot_flat(scene):
     f = functions(walker_data(scene_from_dict(data, "soft.yaml").walker, w.slope_rad))
     np.testing.assert_allclose(seg.x_next, f["reset_heel_strike_heel"](seg.x_end), atol=1e-14)
     assert traj.segments[1].termination in ("heel_strike", "fall")
+
+
+@pytest.mark.slow  # derives the per-role structure (~2 s) and solves a stride
+def test_legs_with_different_feet_walk_a_stride(scene):
+    """Legs whose feet differ (leg2: toe 0.11 m, ankle 95 N m/rad): each step carries its own
+    stance and swing feet's numbers, the Poincaré map is a stride, and its fixed point is
+    found from the symmetric gait with variational multipliers equal to finite differences."""
+    data = scene.model_dump()
+    leg = data["walker"].pop("leg")
+    other = copy.deepcopy(leg)
+    other["foot"]["ankle"]["stiffness_n_m_per_rad"] = 95.0
+    other["foot"]["toe_m"] = 0.11
+    data["walker"]["leg"], data["walker"]["legs"] = None, [leg, other]
+    w = build_walker(scene_from_dict(data, "legs.yaml"))
+    assert w.steps_per_map == 2
+    assert (w.params["k_sw_ankle"], w.params["k_st_ankle"]) == (90.0, 95.0)
+    assert (w.mirror.params["k_sw_ankle"], w.mirror.params["toe_st_m"]) == (95.0, 0.10)
+    guess = scene.fixedpoint.initial_guess.as_array(w.state_names())
+    res = find_fixed_point(w, guess, Solver(method="DOP853", rtol=1e-11, atol=1e-11),
+                           xtol=1e-10)
+    assert len(res.step_periods_s) == 2 and res.step_periods_s[0] != res.step_periods_s[1]
+    np.testing.assert_allclose(np.sort_complex(res.multipliers_variational),
+                               np.sort_complex(res.multipliers_fd), atol=1e-5)
