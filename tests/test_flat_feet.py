@@ -338,3 +338,15 @@ def test_legs_with_different_feet_walk_a_stride(scene):
     assert len(res.step_periods_s) == 2 and res.step_periods_s[0] != res.step_periods_s[1]
     np.testing.assert_allclose(np.sort_complex(res.multipliers_variational),
                                np.sort_complex(res.multipliers_fd), atol=1e-5)
+
+
+def test_the_simulate_table_records_each_step_s_phases(walker, gait):
+    """The per-step table (written to simulate.h5 ``steps/phases``) names each phase of a
+    step and the guard that ended it, as found at run time."""
+    from walkerlab.analysis.metrics import step_table
+
+    traj = simulate_steps(walker, gait.x, 2, FINE)
+    phases = step_table(traj)["phases"]
+    assert list(phases) == ["heel_contact:early_swing (foot_slap) > foot_flat:early_swing "
+                            "(midstance) > foot_flat:late_swing (heel_off) > "
+                            "heel_off:late_swing (heel_strike)"] * 2

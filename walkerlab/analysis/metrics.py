@@ -110,12 +110,14 @@ def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
     """Per-step metrics: period [s], step length [m], hip speed [m/s], impact loss [J], ...
 
     Step length is the distance between the stance foot and the swing foot at heel strike;
-    hip speed is the horizontal hip displacement over the step divided by its period.
+    hip speed is the horizontal hip displacement over the step divided by its period;
+    ``phases`` lists the step's phases, each with the guard that ended it
+    (``"early_swing (midstance) > late_swing (heel_strike)"``).
     """
     w = traj.walker
     rows = {k: [] for k in ("index", "stance_leg", "swing_leg", "t_start", "t_end", "period",
                             "termination", "event", "step_length", "hip_speed",
-                            "impact_energy_loss", "nfev", "midstance_time")}
+                            "impact_energy_loss", "nfev", "midstance_time", "phases")}
     for seg in traj.segments:
         r2l = w.role_to_leg(seg.stance_leg)
         rows["index"].append(seg.index)
@@ -126,6 +128,10 @@ def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
         rows["period"].append(seg.period)
         rows["termination"].append(seg.termination)
         rows["event"].append(seg.event)
+        # the phases met, each with the guard that ended it (a flat foot's modes, a knee's
+        # lock ...), found by events at run time
+        rows["phases"].append(" > ".join(f"{name} ({end or 'cut'})"
+                                         for name, _ta, _tb, end in seg.phase_log))
         rows["nfev"].append(seg.nfev)
         rows["midstance_time"].append(seg.phase_times.get("midstance", np.nan))
         sw = w.for_stance(seg.stance_leg)  # legs that differ: that step's own numbers
