@@ -125,6 +125,7 @@ def relabel_artifact(f, units: Units) -> None:
 
 #: SI unit of a config field, by the suffix of its name (longest suffix first)
 FIELD_SUFFIX_UNITS = (
+    ("_n_m_s_per_rad", "N m s/rad"), ("_n_m_per_rad", "N m/rad"),
     ("_rad_per_s", "rad/s"), ("_m_per_s2", "m/s^2"), ("_m_per_s", "m/s"),
     ("_kg_m2", "kg m^2"), ("_deg", "deg"), ("_rad", "rad"), ("_kg", "kg"), ("_mm", "mm"),
     ("_hz", "Hz"), ("_m", "m"), ("_s", "s"),

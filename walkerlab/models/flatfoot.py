@@ -23,8 +23,8 @@ the ankle damper, ``G`` from gravity and the ankle spring ``k (a - r)^2 / 2``):
 - ``heel_off``: the stance toe pinned at ``O + (heel + toe) t`` (``t`` the downhill slope
   direction); the foot turns about it (``phi < 0``, heel up).
 
-The kinematics of a state follow from the sign of ``phi`` (both maps agree at ``phi = 0``), so
-``points`` and ``energies`` need no mode.
+The kinematics of a state follow from the sign of ``phi`` (both maps give the same positions at
+``phi = 0``), so ``points`` and ``energies`` need no mode (see :data:`HEEL_OFF_PHI_RAD`).
 
 Resets (plastic impulses; the impulse acts only where a contact is made):
 
@@ -52,7 +52,7 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.models import codegen
-from walkerlab.models.codegen import IND, _PY, _cse_lines, _flow, _numpy_fn, _reset
+from walkerlab.models.codegen import _PY, IND, _cse_lines, _flow, _numpy_fn, _reset
 from walkerlab.models.description import ROLE_TAG, Structure
 from walkerlab.models.symbolic import _dot_terms, _pos, _velocity_terms
 
@@ -60,6 +60,14 @@ from walkerlab.models.symbolic import _dot_terms, _pos, _velocity_terms
 MODES = ("heel_contact", "foot_flat", "heel_off")
 #: Index of the stance ankle's angle in ``q``.
 ANKLE = 2
+#: ``points``/``energies`` read a state as heel off (toe pinned) once ``phi`` is below minus
+#: this [rad].  Both kinematics give the same positions at ``phi = 0`` but not the same
+#: velocities while the foot turns: at the foot slap (``phi = 0`` to round-off, the foot
+#: turning at ~20 rad/s) the state is still heel contact; just after heel off (``phi`` ~
+#: ``-phi_dd t^2 / 2``) the foot's rate is ``sqrt(2 |phi_dd| |phi|)`` < 2e-5 rad/s at this
+#: threshold (``|phi_dd|`` < 100 rad/s^2), so the kinetic energy read there is off by < 1e-4 J
+#: for a microsecond.
+HEEL_OFF_PHI_RAD = 1e-12
 
 
 @dataclass(frozen=True)
@@ -248,7 +256,7 @@ def derive_flat(structure: Structure) -> FlatEquations:
         # next step's reference point (the swing heel)
         points["stance_foot"] = points["stance_ankle"]
         points["swing_foot"] = heel_sw
-        for mass, lin, _i, _p, name in bodies:
+        for _m, lin, _i, _p, name in bodies:
             if name != "hip":
                 points[name] = at(lin)
         T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
@@ -325,7 +333,8 @@ def generate_flat(structure: Structure, key: str) -> str:
     modes; ``reset_<name>`` and ``reset_<name>_jacobian`` for ``foot_slap``,
     ``heel_strike_heel``, ``heel_strike_toe``; ``guard_<name>``/``grad_<name>``;
     ``ground_heel(x, qdd) -> (N, N_toe)`` and ``ground_toe(x, qdd) -> (N,)`` [N];
-    ``section``/``from_section``; ``energies``; ``points``; ``leg_angles``)."""
+    ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
+    ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
     eq = derive_flat(structure)
     codegen._HOISTED.clear()
     codegen._PARAMS.clear()
@@ -356,18 +365,18 @@ def generate_flat(structure: Structure, key: str) -> str:
     numpy = [
         *_numpy_fn("_points_heel", eq, kin["heel"]["points"]),
         *_numpy_fn("_points_toe", eq, kin["toe"]["points"]),
-        *_numpy_fn("_energies_heel", eq, {"kinetic": kin["heel"]["kinetic"],
+        *_numpy_fn("energies_heel", eq, {"kinetic": kin["heel"]["kinetic"],
                                           "potential": kin["heel"]["potential"]}),
-        *_numpy_fn("_energies_toe", eq, {"kinetic": kin["toe"]["kinetic"],
+        *_numpy_fn("energies_toe", eq, {"kinetic": kin["toe"]["kinetic"],
                                          "potential": kin["toe"]["potential"]}),
         "    def _on_toe(x):  # heel off: the foot turned heel up (phi < 0)",
         f"{IND}x = np.asarray(x)",
-        f"{IND}return x[1] + x[2] + gamma < 0.0",
+        f"{IND}return x[1] + x[2] + gamma < {-HEEL_OFF_PHI_RAD!r}",
         "    def points(x):",
         f"{IND}toe, h, o = _on_toe(x), _points_heel(x), _points_toe(x)",
         f"{IND}return {{k: np.where(toe, o[k], h[k]) for k in h}}",
         "    def energies(x):",
-        f"{IND}toe, h, o = _on_toe(x), _energies_heel(x), _energies_toe(x)",
+        f"{IND}toe, h, o = _on_toe(x), energies_heel(x), energies_toe(x)",
         f"{IND}return (np.where(toe, o['kinetic'], h['kinetic']),",
         f"{IND}        np.where(toe, o['potential'], h['potential']))",
         *_numpy_fn("leg_angles", eq, eq.leg_angles),
