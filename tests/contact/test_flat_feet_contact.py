@@ -265,3 +265,50 @@ def test_point_feet_keep_one_contact_point_per_leg():
     x[1] = 1.0
     assert tuple(w.contact_quantities(x[None])) == ("leg1", "leg2")
     assert w.foot_quantities(x[None]).keys() == w.contact_quantities(x[None]).keys()
+
+
+def test_floating_view_matches_pinocchio():
+    """The flat-footed floating view's mass matrix and bias against Pinocchio's CRBA and RNEA
+    on a model built here (hip sliding in x and z, legs and feet on revolute joints about -y,
+    the feet's joints relative to their legs: ``q_pin = [x, z, th1, d1, th2, d2]``, ours
+    ``T q_pin`` with ``psi = th + d``; so ``M_pin = T^T M T`` and ``rnea = T^T (M T a + h)``
+    minus the ankle springs, which Pinocchio does not model).  Round-off agreement: 1e-10."""
+    pin = pytest.importorskip("pinocchio")
+    sc = _scene()
+    view = floating_view(walker_data(sc.walker, sc.slope.phi_rad), MF, IF)
+    p = _ref_params(None)
+    model = pin.Model()
+    model.gravity.linear = np.array([0.0, 0.0, -p["g"]])
+    axis = np.array([0.0, -1.0, 0.0])  # a positive angle puts the foot ahead (+x)
+
+    def inertia(m, c, I_y=0.0):
+        return pin.Inertia(m, np.asarray(c, float), np.diag([0.0, I_y, 0.0]))
+
+    jx = model.addJoint(0, pin.JointModelPX(), pin.SE3.Identity(), "hip_x")
+    jz = model.addJoint(jx, pin.JointModelPZ(), pin.SE3.Identity(), "hip_z")
+    model.appendBodyToJoint(jz, inertia(p["MH"], [0, 0, 0]), pin.SE3.Identity())
+    for leg in ("leg1", "leg2"):
+        jl = model.addJoint(jz, pin.JointModelRevoluteUnaligned(axis), pin.SE3.Identity(), leg)
+        model.appendBodyToJoint(jl, inertia(p["m"], [0, 0, -p["d"]]), pin.SE3.Identity())
+        ja = model.addJoint(jl, pin.JointModelRevoluteUnaligned(axis),
+                            pin.SE3(np.eye(3), np.array([0.0, 0.0, -p["L"]])), f"{leg}_ankle")
+        model.appendBodyToJoint(ja, inertia(p["mf"], [0, 0, 0], p["If"]), pin.SE3.Identity())
+    data = model.createData()
+    T = np.zeros((6, 6))  # ours = T pin; pin order [x, z, th1, d1, th2, d2]
+    T[0, 0] = T[1, 1] = 1.0
+    T[2, 2] = T[3, 4] = 1.0
+    T[4, 2] = T[4, 3] = 1.0
+    T[5, 4] = T[5, 5] = 1.0
+    rng = np.random.default_rng(7)
+    for _ in range(4):
+        qp, vp, ap = rng.normal(size=(3, 6)) * 0.5
+        q, dq = T @ qp, T @ vp
+        M = view.mass_matrix(q)
+        np.testing.assert_allclose(pin.crba(model, data, qp), T.T @ M @ T, atol=1e-10)
+        spring = np.zeros(6)
+        for th, ps in ((2, 4), (3, 5)):
+            tau = p["k"] * (q[ps] - q[th] - p["r"])
+            spring[ps] += tau
+            spring[th] -= tau
+        rhs = T.T @ (M @ (T @ ap) + view.bias(q, dq) - spring)
+        np.testing.assert_allclose(pin.rnea(model, data, qp, vp, ap), rhs, atol=1e-10)
