@@ -111,14 +111,14 @@ def test_free_flight_conserves_the_reference_energy():
 
 # --------------------------------------------------------------------------- contact run
 def test_contact_run_energy_balance():
-    """A contact run from heel contact through the foot slap (0.1 s): the walker's mechanical
+    """A contact run from heel contact through the foot slap (0.05 s): the walker's mechanical
     energy (kinetic + gravity + ankle springs, ``walker.energies``) changes by exactly the
     work of the contact forces at the heel and toe points (``power`` = F . v of each material
     point from the contact table: elastic + damping + friction) minus the ankle dampers'
     dissipation ``c ddelta^2``.  The work is integrated as an extra state beside the walker's
     (LSODA, rtol 1e-10), so the balance is exact up to the integrator: measured residual
-    6e-10 J at rtol 1e-10 (4e-7 J at 1e-8: it follows rtol) on ~5 J exchanged with the ground
-    and the damper; 1e-7 J is 150x that and far below the damper's own share (> 1e-3 J), which
+    1.3e-9 J at rtol 1e-10 (4e-7 J at 1e-8: it follows rtol) on 5.1 J given to the ground and
+    0.18 J to the dampers; 1e-7 J is ~75x that and far below the damper's own share, which
     the balance must contain."""
     from walkerlab.analysis.contact_sim import initial_state_from_ideal
 
@@ -144,7 +144,7 @@ def test_contact_run_energy_balance():
         J[:2 * n, :2 * n] = w.jac(t, y[:2 * n])
         return J
 
-    sol = solve_ivp(rates, (0.0, 0.1), np.concatenate([x0, [0.0, 0.0]]), method="LSODA",
+    sol = solve_ivp(rates, (0.0, 0.05), np.concatenate([x0, [0.0, 0.0]]), method="LSODA",
                     jac=jac, rtol=1e-10, atol=1e-12)
     assert sol.status == 0
     X = sol.y[:2 * n].T
@@ -152,7 +152,7 @@ def test_contact_run_energy_balance():
     E = w.energies(X)["total"]
     work, damped = sol.y[2 * n, -1], sol.y[2 * n + 1, -1]
     assert abs((E[-1] - E[0]) - work) < 1e-7
-    assert damped > 1e-3
+    assert damped > 0.1
     assert abs(work) > 1.0
 
 
