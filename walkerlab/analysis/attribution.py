@@ -111,7 +111,11 @@ def energy_by_sink(walker, z, n_samples: int = 20000) -> dict[str, float]:
     # spring's energy is then lost to the clipping, counted with the damping)
     loaded = [q["on_ground"] * (q["penetration"] > 0) for q in cq.values()]
     pressed = [on * (q["normal_force"] > 0) for on, q in zip(loaded, cq.values())]
-    both = (pressed[0] > 0) & (pressed[1] > 0)
+    # double support: both legs loaded (a flat foot's leg by any of its points)
+    leg_pressed = {leg: np.zeros(len(t), dtype=bool) for leg in ("leg1", "leg2")}
+    for name, pr in zip(cq, pressed):
+        leg_pressed[w.contact_leg(name) if name not in leg_pressed else name] |= pr > 0
+    both = leg_pressed["leg1"] & leg_pressed["leg2"]
     damp, fr_imp, fr_st = np.zeros(len(t)), np.zeros(len(t)), np.zeros(len(t))
     for q, on in zip(cq.values(), loaded):
         d = np.maximum(q["penetration"], 0.0)
