@@ -619,11 +619,11 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     guess = np.asarray(guess, float)
     if guess.size == len(P.names):
         z = guess.copy()
-    elif guess.size == 2 * len(walker.structure.roles):
+    elif guess.size == walker.rigid_layout().size:
         z = section_guess_from_ideal(PC, guess, rate_scale)
     else:
         raise ValueError(f"guess must be a section state ({len(P.names)},) or an ideal state "
-                         f"({2 * len(walker.structure.roles)},)")
+                         f"({walker.rigid_layout().size},)")
     hist = []
     for _ in range(warmup_steps):
         z1 = PC(z)[0]

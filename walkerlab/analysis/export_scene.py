@@ -123,9 +123,7 @@ def joint_state(mb, walker, x) -> tuple[np.ndarray, np.ndarray]:
     qpos, qvel : ndarray (2 + len(mb.links),)
         ``hip_x``, ``hip_z`` [m, m/s], then each link's joint [rad, rad/s].
     """
-    names = walker.coordinate_names()
-    nq = len(names)
-    q, v = dict(zip(names, x[:nq])), dict(zip(names, x[nq:]))
+    q, v = walker.layout().coordinate_values(x)
 
     def joint(vals, ln):
         own = vals[f"{ln.name}_angle"]
