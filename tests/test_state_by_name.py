@@ -1,8 +1,7 @@
 """Nothing outside the model layer reads a state by row or tests a walker's size against a
 number (STYLE: "state by name, sized by the walker").
 
-An AST scan of every module of walkerlab/ outside the model layer (walkerlab/models,
-walkerlab/contact) for
+An AST scan of every module of walkerlab/ outside the model layer (:data:`MODEL_LAYER`) for
 
 - a subscript of a single-state variable (``x``, ``x0``, ``x_ideal``, ``fp``, ``z``, ``q``,
   ``qd``, ...) by an integer literal, a slice with a literal bound, or a literal offset from
@@ -21,7 +20,8 @@ import re
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "walkerlab"
-MODEL_LAYER = ("models", "contact")
+#: the model layer, before and after the package move (walker/, codegen/, models/)
+MODEL_LAYER = ("models", "contact", "walker", "codegen")
 SINGLE_STATE = re.compile(r"^(x|x0|x1|xp|xe|xa|xk|x_\w+|fp|state|z|z0|zp|q|qd|dq)$")
 #: names of a walker's counts: any of them in a row offset (``x[n + 2]``); the unambiguous
 #: ones (not a loop's ``n``) also compared with a literal (``walker.nq == 4``)
