@@ -242,7 +242,7 @@ class StepMap:
         val[self._angle[0]] = val[self._angle[1]]
         ix = self.idx
         cols = [ix[c] for c in ix.names[ix.coordinates] if c not in ("hip_x", "hip_y")]
-        zp = np.array([val[c] for c in cols] + [val[c + ix.n // 2] for c in cols])
+        zp = np.array([val[c] for c in cols] + [val[ix.rate_of(ix.names[c])] for c in cols])
         # stance foot at p and at rest, then the whole walker translated at v
         x = self.walker.pinned_to_full(zp, p)
         x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] += v
