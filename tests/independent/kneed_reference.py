@@ -16,6 +16,15 @@ Step: three-link swing (knee free) until the knee straightens (``q3 = q2``): pla
 strike that locks the knee; two-link swing until heel strike (``q1 + q2 = -2 gamma``, swing
 foot ahead); plastic heel strike with the knee still locked, legs swap, the new swing knee
 unlocks.
+
+Parts beyond Hsu Chen's walker (issue 22), all optional (``p`` keys, default off): the swing
+leg's masses ``mt_sw``, ``ms_sw`` differing from the stance leg's ``mt``, ``ms`` (legs that
+differ: the step with the other leg swinging swaps them); a torsional hip spring-damper
+between the stance leg and the swing thigh, ``k_hip``, ``rest_hip``, ``c_hip`` on
+``delta = q1 - q2`` (stance minus swing thigh angle: potential ``k (delta - rest)^2 / 2``,
+generalised force ``-(k (delta - rest) + c d(delta)/dt) d(delta)/dq``); a torsional spring-
+damper at the swing knee, ``k_knee``, ``rest_knee``, ``c_knee`` on the knee angle
+``q3 - q2`` (the stance knee is straight: its spring holds a constant energy, left out).
 """
 
 from __future__ import annotations
@@ -57,6 +66,8 @@ def _symbolic():
     dq = sp.symbols("dq1 dq2 dq3", real=True)
     g, lt, ls, mh, mt, ms, a1, b1, a2, b2 = sp.symbols("g lt ls mh mt ms a1 b1 a2 b2",
                                                        positive=True)
+    mt_sw, ms_sw = sp.symbols("mt_sw ms_sw", positive=True)
+    springs = sp.symbols("k_hip rest_hip c_hip k_knee rest_knee c_knee", real=True)
     q1, q2, q3 = q
     up = lambda th: sp.Matrix([-sp.sin(th), sp.cos(th)])  # noqa: E731
     hip = (ls + lt) * up(q1)
@@ -72,9 +83,16 @@ def _symbolic():
         "stance_knee": ls * up(q1),
     }
     bodies = [(ms, 0, pts["stance_shank"], q1), (mt, 0, pts["stance_thigh"], q1),
-              (mh, 0, hip, q1), (mt, 0, pts["swing_thigh"], q2),
-              (ms, 0, pts["swing_shank"], q3)]
+              (mh, 0, hip, q1), (mt_sw, 0, pts["swing_thigh"], q2),
+              (ms_sw, 0, pts["swing_shank"], q3)]
     M, h, T, V = lagrange(q, dq, bodies, g)
+    k_hip, rest_hip, c_hip, k_knee, rest_knee, c_knee = springs
+    for k, rest, c, delta in ((k_hip, rest_hip, c_hip, q1 - q2),
+                              (k_knee, rest_knee, c_knee, q3 - q2)):
+        grad = sp.Matrix([sp.diff(delta, qi) for qi in q])
+        rate = sum(gi * dqi for gi, dqi in zip(grad, dq))
+        V = V + k * (delta - rest) ** 2 / 2
+        h = h + (k * (delta - rest) + c * rate) * grad
     # extended coordinates for heel strike: the stance foot free at (xf, yf)
     xf, yf, dxf, dyf = sp.symbols("xf yf dxf dyf", real=True)
     qe, dqe = (*q, xf, yf), (*dq, dxf, dyf)
@@ -82,9 +100,9 @@ def _symbolic():
     Me, _, _, _ = lagrange(qe, dqe, [(m, 0, p + off, a) for m, _, p, a in bodies], g,
                            mass_matrix_only=True)
     E = (pts["swing_foot"] + off).jacobian(sp.Matrix(qe))
-    par = (g, lt, ls, mh, mt, ms, a1, b1, a2, b2)
-    masses = {"stance_shank": ms, "stance_thigh": mt, "hip": mh, "swing_thigh": mt,
-              "swing_shank": ms}
+    par = (g, lt, ls, mh, mt, ms, a1, b1, a2, b2, mt_sw, ms_sw, *springs)
+    masses = {"stance_shank": ms, "stance_thigh": mt, "hip": mh, "swing_thigh": mt_sw,
+              "swing_shank": ms_sw}
     return q, dq, par, M, h, T, V, Me, E, pts, masses
 
 
@@ -116,7 +134,9 @@ class KneedReference:
     def _par(self):
         p = self.p
         return (p["g"], p["lt"], p["ls"], p["mh"], p["mt"], p["ms"], p["a1"], p["b1"],
-                p["a2"], p["b2"])
+                p["a2"], p["b2"], p.get("mt_sw", p["mt"]), p.get("ms_sw", p["ms"]),
+                *(p.get(k, 0.0) for k in ("k_hip", "rest_hip", "c_hip", "k_knee",
+                                          "rest_knee", "c_knee")))
 
     # ------------------------------------------------------------------ flows
     J_KNEE = np.array([0.0, -1.0, 1.0])   # knee constraint q3 - q2 = 0 (row)

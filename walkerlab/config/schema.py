@@ -341,8 +341,10 @@ class BipedParams(_Strict):
                                ("springs", self.springs)) if on]
         if new and self.coordinates != "absolute":
             raise ValueError(f"coordinates: {new[0]} needs 'absolute'")
-        if new and pair[0].knee is not None:
-            raise ValueError(f"{new[0]}: not available with a knee yet (straight legs only)")
+        if self.torso is not None and pair[0].knee is not None:
+            # the upper body's bisecting hip on a kneed walker is not derived (its coupling
+            # would act on the thighs; neither the rigid nor the contact view has it yet)
+            raise ValueError("torso: not available with a knee yet (straight legs only)")
         if self.springs and any(b.mass_kg == 0 for leg in pair for b in leg.bodies):
             raise ValueError("springs: not with massless bodies (a sprung massless leg has "
                              "no flow in the limit m -> 0)")
@@ -750,8 +752,9 @@ class Scene(_Strict):
         c = self.contact
         if c is None or not c.knee_stop.latch:
             return self
-        leg = getattr(self.walker, "leg", None)
-        if leg is None or getattr(leg, "knee", None) is None:
+        pair = getattr(self.walker, "leg_pair", None)  # a biped's legs (or its leg, twice)
+        leg = pair()[0] if pair is not None else None
+        if leg is None or leg.knee is None:
             raise ValueError("contact.knee_stop.latch: the walker's legs are straight (no "
                              "walker.leg.knee), so there is no knee to latch: remove it or "
                              "give the leg a knee")
