@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from tests.independent import floating_reference as ref
 from walkerlab.config import load_scene
@@ -302,8 +303,6 @@ def test_feet_where_the_walker_puts_them(name, tmp_path):
 
 # ---- issue 22: springs as tendons, the bisecting hip as an equality, off-axis bodies
 def _edited_scene(tmp_path, base, edit):
-    import yaml
-
     d = yaml.safe_load((ROOT / "configs" / f"{base}.yaml").read_text())
     edit(d)
     d.pop("fixedpoint")  # another walker: the file without the scene's gait keyframe
@@ -319,9 +318,12 @@ def _sprung_variants():
     def torso_spring(d):  # a spring between the torso and one leg, with a rest angle
         d["walker"]["springs"] = [{"between": ["torso", "leg1"], "stiffness_n_m_per_rad": 5.0,
                                    "rest_angle_rad": 0.1, "damping_n_m_s_per_rad": 0.3}]
+    def kneed_spring(d):  # a hip spring on a kneed walker acts on the thighs' hip joints
+        d["walker"]["springs"] = [{"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 2.0,
+                                   "rest_angle_rad": 0.2, "damping_n_m_s_per_rad": 0.3}]
     return {"hip_spring": ("hip_spring", None), "rest_and_damping": ("hip_spring",
                                                                      rest_and_damping),
-            "torso_spring": ("torso_bhm", torso_spring)}
+            "torso_spring": ("torso_bhm", torso_spring), "kneed_spring": ("kneed", kneed_spring)}
 
 
 @pytest.mark.parametrize("variant", list(_sprung_variants()))
@@ -393,16 +395,27 @@ def _torso_off_axis(d):
                                            "inertia_about_com_kg_m2": 0.04})
 
 
+def _kneed_legs_differ(d):
+    """kneed with leg2's thigh mass 0.55 kg and its shank mass 2 cm lower."""
+    leg = d["walker"].pop("leg")
+    other = yaml.safe_load(yaml.safe_dump(leg))
+    other["bodies"][0]["mass_kg"] = 0.55
+    other["bodies"][1]["from_hip_m"] = 0.67
+    d["walker"]["legs"] = [leg, other]
+
+
 @pytest.mark.parametrize("base, edit", [("asymmetric_legs", _off_axis),
-                                        ("torso_bhm", _torso_off_axis)])
+                                        ("torso_bhm", _torso_off_axis),
+                                        ("kneed", _kneed_legs_differ)])
 def test_off_axis_bodies_exported_in_place(base, edit, tmp_path):
     """Bodies off a link's axis (legs and torso) are exported in place (the link's inertial
-    origin off its axis, the parallel-axis inertia about it): Pinocchio and MuJoCo give the
-    independent reference's mass matrix and bias (body by body) to 1e-10 relative."""
+    origin off its axis, the parallel-axis inertia about it), and kneed legs that differ
+    carry each leg's numbers: Pinocchio and MuJoCo give the independent reference's mass
+    matrix and bias (body by body) to 1e-10 relative."""
     scene = _edited_scene(tmp_path, base, edit)
     data = _data(scene)
     s = data.structure
-    assert any(b.off_axis for b in (*s.bodies, *s.torso))
+    assert any(b.off_axis for b in (*s.bodies, *s.torso)) or s.asymmetric
     names = ref.coordinate_names(data)
     torso = bool(s.torso)
     libs = {"pinocchio": Pinocchio(export_stage.run(scene, tmp_path, "urdf"), names,
