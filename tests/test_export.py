@@ -318,9 +318,13 @@ def _sprung_variants():
     def torso_spring(d):  # a spring between the torso and one leg, with a rest angle
         d["walker"]["springs"] = [{"between": ["torso", "leg1"], "stiffness_n_m_per_rad": 5.0,
                                    "rest_angle_rad": 0.1, "damping_n_m_s_per_rad": 0.3}]
-    def kneed_spring(d):  # a hip spring on a kneed walker acts on the thighs' hip joints
+    def kneed_spring(d):  # a hip spring on a kneed walker acts on the thighs' hip joints;
+        # a knee spring (joint stiffness, springref, damping) on each knee
         d["walker"]["springs"] = [{"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 2.0,
                                    "rest_angle_rad": 0.2, "damping_n_m_s_per_rad": 0.3}]
+        d["walker"]["leg"]["knee"]["spring"] = {"stiffness_n_m_per_rad": 1.5,
+                                                "rest_angle_rad": -0.3,
+                                                "damping_n_m_s_per_rad": 0.2}
     return {"hip_spring": ("hip_spring", None), "rest_and_damping": ("hip_spring",
                                                                      rest_and_damping),
             "torso_spring": ("torso_bhm", torso_spring), "kneed_spring": ("kneed", kneed_spring)}

@@ -34,27 +34,36 @@ ROOT = Path(__file__).resolve().parents[1]
 SOLVER = Solver("DOP853", 1e-12, 1e-12)
 #: A hip spring light enough for the 1.6 kg walker to keep its gait (0.2 N m/rad loses it).
 HIP_SPRING = {"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 0.1}
-#: Every part variant: walker section overrides of configs/kneed.yaml.
+#: A knee spring pulling the knee straight (0.05 N m/rad keeps the gait: 0.5609 s).
+KNEE_SPRING = {"stiffness_n_m_per_rad": 0.05}
+#: Every part variant of configs/kneed.yaml: springs, a knee spring, legs that differ.
 VARIANTS = {
     "hip_spring": {"springs": [HIP_SPRING]},
     # rest angle and damping: not a mirror-symmetric walker (a stride map), dissipative
     "spring_rest_damping": {"springs": [{**HIP_SPRING, "rest_angle_rad": 0.2,
                                          "damping_n_m_s_per_rad": 0.05}]},
-    "legs_differ": "legs",
+    "legs_differ": {"legs_differ": True},
+    "knee_spring": {"knee_spring": KNEE_SPRING},
+    # all at once, the knee spring with a flexed rest angle and damping
+    "all_parts": {"legs_differ": True, "springs": [{**HIP_SPRING, "rest_angle_rad": -0.1}],
+                  "knee_spring": {"stiffness_n_m_per_rad": 0.2, "rest_angle_rad": -0.3,
+                                  "damping_n_m_s_per_rad": 0.02}},
 }
 
 
 def _cfg(variant):
     d = yaml.safe_load((ROOT / "configs" / "kneed.yaml").read_text())
-    extra = VARIANTS[variant]
-    if extra == "legs":  # leg B's thigh 10 % heavier, its shank mass 2 cm lower
+    v = VARIANTS[variant]
+    if "knee_spring" in v:
+        d["walker"]["leg"]["knee"]["spring"] = v["knee_spring"]
+    if "springs" in v:
+        d["walker"]["springs"] = v["springs"]
+    if v.get("legs_differ"):  # leg B's thigh 10 % heavier, its shank mass 2 cm lower
         leg = d["walker"].pop("leg")
         other = yaml.safe_load(yaml.safe_dump(leg))
         other["bodies"][0]["mass_kg"] = 0.55
         other["bodies"][1]["from_hip_m"] = 0.67
         d["walker"]["legs"] = [leg, other]
-    else:
-        d["walker"].update(extra)
     return d
 
 
@@ -65,7 +74,8 @@ def _scene(variant):
 def _reference(variant, stance_leg):
     """The prototype for the step with ``stance_leg`` in stance (role numbers of that step)."""
     p = dict(HSU_CHEN)
-    if variant == "legs_differ":
+    v = VARIANTS[variant]
+    if v.get("legs_differ"):
         thigh = {"leg1": 0.5, "leg2": 0.55}
         b1 = {"leg1": 0.15, "leg2": 0.17}
         swing = "leg1" if stance_leg == "leg2" else "leg2"
@@ -73,8 +83,12 @@ def _reference(variant, stance_leg):
         # the foot on the stance leg: the two legs' own distances, by role
         p.update(mt=thigh[stance_leg], mt_sw=thigh[swing], a1=0.5 - b1[stance_leg],
                  b1=b1[swing])
-    else:
-        s = VARIANTS[variant]["springs"][0]
+    if "knee_spring" in v:
+        ks = v["knee_spring"]
+        p.update(k_knee=ks["stiffness_n_m_per_rad"], rest_knee=ks.get("rest_angle_rad", 0.0),
+                 c_knee=ks.get("damping_n_m_s_per_rad", 0.0))
+    if "springs" in v:
+        s = v["springs"][0]
         # config delta = leg2 - leg1; the prototype's = stance - swing thigh
         sign = 1.0 if stance_leg == "leg2" else -1.0
         p.update(k_hip=s["stiffness_n_m_per_rad"], rest_hip=sign * s.get("rest_angle_rad", 0),
@@ -92,7 +106,8 @@ def _order(walker):
 @pytest.fixture(scope="module")
 def gaits():
     guess = {"hip_spring": [-0.2866, -0.2866, 0.1859, -0.188, -0.188, -1.160],
-             "legs_differ": [-0.29, -0.29, 0.189, -0.11, -0.11, -1.13]}
+             "legs_differ": [-0.29, -0.29, 0.189, -0.11, -0.11, -1.13],
+             "knee_spring": [-0.2912, -0.2912, 0.1905, -0.028, -0.028, -1.111]}
     out = {}
     for name, x0 in guess.items():
         w = build_walker(_scene(name))
@@ -147,7 +162,7 @@ def test_flows_and_impacts_match_the_kneed_prototype(variant):
             assert sum(w.energies(x)) == pytest.approx(sum(ref.energies(xr)), rel=1e-12)
 
 
-@pytest.mark.parametrize("name", ["hip_spring", "legs_differ"])
+@pytest.mark.parametrize("name", ["hip_spring", "legs_differ", "knee_spring"])
 def test_fixed_point_maps_to_itself_under_the_prototype(name, gaits):
     w, fp = gaits[name]
     x = fp.x.copy()
@@ -164,25 +179,30 @@ def test_fixed_point_maps_to_itself_under_the_prototype(name, gaits):
     # (max |multiplier| 0.821); legs that differ a stride of two steps
     if name == "hip_spring":
         assert w.steps_per_map == 1 and fp.period_s == pytest.approx(0.5216252366, abs=1e-8)
+    elif name == "knee_spring":  # the knee straightens sooner; 0.5609 s, max |mu| 0.653
+        assert w.steps_per_map == 1 and fp.period_s == pytest.approx(0.5609225352, abs=1e-8)
     else:
         assert w.steps_per_map == 2 and len(fp.step_periods_s) == 2
 
 
-def test_energy_with_spring_potential_is_conserved_unlocked_and_locked(gaits):
-    """The hip spring's potential is part of the energy: conserved in the unlocked and the
-    locked swing (to 1e-11 relative), and the total without it is not (the check can
-    fail)."""
-    w, fp = gaits["hip_spring"]
+@pytest.mark.parametrize("name", ["hip_spring", "knee_spring"])
+def test_energy_with_spring_potential_is_conserved_unlocked_and_locked(name, gaits):
+    """A spring's potential is part of the energy: conserved in the unlocked and the locked
+    swing (to 1e-11 relative), and the total without it is not (the check can fail; the
+    knee spring's share moves only while the knee is free)."""
+    w, fp = gaits[name]
     seg = integrate_step(w, fp.x, SOLVER)
     t_knee = seg.phase_times["knee_strike"]
     names = w.state_names()
-    th, st = names.index("swing_thigh_angle"), names.index("stance_angle")
+    th, sh, st = (names.index(f"{r}_angle") for r in ("swing_thigh", "swing_shank", "stance"))
     for a, b in ((seg.t_start, t_knee), (t_knee, seg.t_end)):
         X = seg.sample(np.linspace(a, b, 80)[1:-1])
         E = np.sum(w.energies(X), axis=0)
         assert np.ptp(E) < 1e-11 * abs(E[0])
-        spring = 0.1 * (X[st] - X[th]) ** 2 / 2
-        assert np.ptp(E - spring) > 1e-5  # the spring's share moves
+        spring = (0.1 * (X[st] - X[th]) ** 2 / 2 if name == "hip_spring"
+                  else 0.05 * (X[sh] - X[th]) ** 2 / 2)
+        if a == seg.t_start or name == "hip_spring":
+            assert np.ptp(E - spring) > 1e-5  # the spring's share moves
     # the knee strike loses kinetic energy, the spring's potential is continuous
     xm = seg.sample(np.array([t_knee]))[:, 0]
     knee = next(g for g in w.phases[0].guards if g.name == "knee_strike")

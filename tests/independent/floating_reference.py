@@ -25,7 +25,8 @@ external forces; gravity along -y).
 
 Springs (``walker.springs``, first step: swing = leg1, stance = leg2): ``delta = angle(second)
 - angle(first)``, potential ``k (delta - r)^2 / 2``, generalised force
-``-(k (delta - r) + c d(delta)/dt) d(delta)/dq``.
+``-(k (delta - r) + c d(delta)/dt) d(delta)/dq``; a knee spring (``knee.spring``) the same on
+each knee's angle ``delta = shank - thigh``.
 """
 
 from __future__ import annotations
@@ -137,8 +138,16 @@ def _springs(data):
     s = data.structure
     p = dict(zip(s.param_names, data.params))
     rows = _leg_angle_rows(data)
-    return [(p[f"k_s{i}"], p[f"r_s{i}"], p[f"c_s{i}"], rows[second] - rows[first])
-            for i, (first, second) in enumerate(s.springs)]
+    out = [(p[f"k_s{i}"], p[f"r_s{i}"], p[f"c_s{i}"], rows[second] - rows[first])
+           for i, (first, second) in enumerate(s.springs)]
+    if "k_knee" in p:  # a spring-damper at each knee on its angle shank - thigh
+        names = coordinate_names(data)
+        for leg in ("leg1", "leg2"):
+            row = np.zeros(len(names))
+            row[names.index(f"{leg}_shank_angle")] = 1.0
+            row[names.index(f"{leg}_thigh_angle")] = -1.0
+            out.append((p["k_knee"], p["r_knee"], p["c_knee"], row))
+    return out
 
 
 def spring_force(data, q, dq):

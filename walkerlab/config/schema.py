@@ -156,6 +156,20 @@ class ArcFoot(_Strict):
 Foot = Annotated[PointFoot | ArcFoot, Field(discriminator="kind")]
 
 
+class KneeSpringSpec(_Strict):
+    """A linear torsional spring and viscous damper at the knee: torque ``-k (knee - rest) -
+    c d(knee)/dt`` on the shank and the opposite on the thigh, ``knee`` = shank angle - thigh
+    angle (0 straight, negative flexed)."""
+
+    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
+                                         "[N m/rad]")
+    rest_angle_rad: float = Field(0.0, ge=-3.2, le=3.2, description="knee angle (shank - "
+                                  "thigh, negative flexed) at which the spring is relaxed "
+                                  "[rad]")
+    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
+                                         "[N m s/rad]")
+
+
 class KneeSpec(_Strict):
     """A knee joint splitting the leg into thigh (hip to knee) and shank (knee to foot).
 
@@ -166,6 +180,9 @@ class KneeSpec(_Strict):
     thigh_length_m: float = Field(gt=0, le=100, description="hip to knee [m]")
     lock: Literal["plastic"] = Field("plastic", description="knee strike: plastic impact, then "
                                      "the knee stays locked until heel strike")
+    spring: KneeSpringSpec | None = Field(None, description="torsional spring-damper at the "
+                                          "knee (null: none); in the rigid view it acts on "
+                                          "the free swing knee (a locked knee holds it)")
 
 
 class LegSpec(_Strict):

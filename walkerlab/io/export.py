@@ -31,6 +31,8 @@ Springs and couplings (issue 22):
   then ``-k (delta - rest) - c d(delta)/dt`` and its potential energy (``mjData.energy``
   with the energy flag) includes ``k (delta - rest)^2 / 2``.  URDF has no spring element
   (``dynamics`` carries damping only, of one joint): the springs are stated in comments.
+- a **knee spring** (``walker.leg.knee.spring``) acts on the knee joint's own angle: MJCF
+  joint ``stiffness``, ``springref`` (the rest angle) and ``damping`` on ``leg<i>_knee``.
 - the **bisecting hip mechanism** (``walker.torso.coupling``) is a fixed tendon
   ``bisecting_hip = torso_hip - (leg1_hip + leg2_hip) / 2`` held at 0 by an equality
   constraint (MJCF ``<equality><tendon tendon1=.../>``; MuJoCo's ``<joint>`` equality couples
@@ -305,12 +307,21 @@ def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     return out
 
 
+def _joint_springs(mb: Multibody) -> dict:
+    """Springs on one joint's own angle (a knee spring): ``{joint: Spring}``, written as the
+    joint's ``stiffness``, ``springref`` and ``damping``."""
+    return {sp.terms[0][0]: sp for sp in mb.springs
+            if len(sp.terms) == 1 and sp.terms[0][1] == 1.0}
+
+
 def _tendons(mb: Multibody) -> list[str]:
     """Fixed tendons: each spring on its ``delta``, each coupling on its residual."""
-    if not (mb.springs or mb.couplings):
+    on_joint = _joint_springs(mb).values()
+    springs = [sp for sp in mb.springs if sp not in on_joint]
+    if not (springs or mb.couplings):
         return []
     out = ["  <tendon>"]
-    for sp in mb.springs:
+    for sp in springs:
         # oriented so that springlength >= 0: MuJoCo reads a springlength of -1 as "the
         # tendon's length at qpos0"; k (delta - r)^2 = k (-delta + r)^2, the same spring
         sign = -1.0 if sp.rest_angle_rad < 0 else 1.0
@@ -378,10 +389,16 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     children: dict[str, list[Link]] = {}
     for ln in mb.links:
         children.setdefault(ln.parent, []).append(ln)
+    joint_springs = _joint_springs(mb)
 
     def body(ln: Link, indent: str) -> list[str]:
         inertia = max(ln.inertia_kg_m2, lo)
         rng = f' range="{_v(-math.pi, 0)}"' if ln.joint.endswith("_knee") else ""
+        if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
+            sp = joint_springs[ln.joint]
+            rng += (f' stiffness="{_f(sp.stiffness_n_m_per_rad)}" '
+                    f'springref="{_f(sp.rest_angle_rad)}" '
+                    f'damping="{_f(sp.damping_n_m_s_per_rad)}"')
         reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
         lines = [f'{indent}<body name="{ln.name}" pos="{_v(0, 0, -ln.joint_from_parent_m)}">',
                  f'{indent}  <joint name="{ln.joint}" type="hinge" axis="{AXIS}"{rng}/>',

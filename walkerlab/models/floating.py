@@ -244,6 +244,12 @@ def derive_floating(structure: Structure) -> FloatingEquations:
         V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
         Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
         damping += P[f"c_s{i}"] * Jd.T * Jd
+    if structure.knee_spring:  # a spring-damper at each knee on shank - thigh
+        for leg in LEGS:
+            knee_angle = q[names.index(f"{leg}_shank_angle")] - q[names.index(f"{leg}_thigh_angle")]
+            V += P["k_knee"] * (knee_angle - P["r_knee"]) ** 2 / 2
+            Jd = sp.Matrix([[sp.diff(knee_angle, s) for s in q]])
+            damping += P["c_knee"] * Jd.T * Jd
     h = (M * dqv).jacobian(qv) * dqv - sp.Matrix([sp.diff(T, s) for s in q]) \
         + sp.Matrix([sp.diff(V, s) for s in q]) + damping * dqv
     h = h.applyfunc(sp.expand)

@@ -106,12 +106,12 @@ class Spring:
     Attributes
     ----------
     name : str
-        ``spring<i>`` (the walker's ``springs`` order).
+        ``spring<i>`` (the walker's ``springs`` order) or ``leg<i>_knee_spring``.
     between : tuple of str
         The two links (first, second): ``delta = angle(second) - angle(first)``.
     terms : tuple of (str, float)
         ``(joint, coef)``: the hip joints are absolute link angles, so ``+1`` on the second
-        link's hip joint and ``-1`` on the first's.
+        link's hip joint and ``-1`` on the first's; a knee spring ``((leg<i>_knee, 1),)``.
     stiffness_n_m_per_rad, rest_angle_rad, damping_n_m_s_per_rad : float
     """
 
@@ -274,5 +274,10 @@ def multibody(data: WalkerData) -> Multibody:
             continue
         springs.append(Spring(f"spring{len(springs)}", (link_of[first], link_of[second]),
                               ((joint[second], 1.0), (joint[first], -1.0)), k, r, c))
+    if s.knee_spring:  # on each knee joint (the knee angle shank - thigh itself)
+        for leg in LEGS:
+            springs.append(Spring(f"{leg}_knee_spring", (f"{leg}_thigh", f"{leg}_shank"),
+                                  ((f"{leg}_knee", 1.0),), p["k_knee"], p["r_knee"],
+                                  p["c_knee"]))
     return Multibody(p.get("M_hip", 0.0), tuple(links), L, s.foot, R, s.knee, p["g"],
                      data.slope_rad, tuple(springs), couplings)

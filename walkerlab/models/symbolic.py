@@ -333,6 +333,12 @@ def derive(structure: Structure) -> Equations:
         V += k_ * (delta - r_) ** 2 / 2
         Jd = sp.Matrix([[sp.diff(delta, s) for s in psv]])
         D += c_ * Jd.T * Jd
+    if structure.knee_spring:  # the swing knee's (the stance knee is straight, locked: its
+        # spring holds a constant energy and no torque the lock does not take, left out)
+        knee_angle = ps_shank - ps_sw
+        V += P["k_knee"] * (knee_angle - P["r_knee"]) ** 2 / 2
+        Jd = sp.Matrix([[sp.diff(knee_angle, s) for s in psv]])
+        D += P["c_knee"] * Jd.T * Jd
     G = sp.Matrix([sp.diff(V, s) for s in psv])
     C = sp.zeros(n, n)
     for i in range(n):
