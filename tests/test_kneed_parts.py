@@ -229,3 +229,23 @@ def test_floating_view_matches_the_floating_reference(variant):
         assert view.bias(q, dq) == pytest.approx(h, rel=1e-11, abs=1e-12)
         V = view.energies(np.concatenate([q, dq]))[1]
         assert float(V) == pytest.approx(fref.potential(data, q), rel=1e-12)
+
+
+def test_elastic_knee_lock_is_refused_in_one_line(tmp_path):
+    """``knee.lock: elastic``: one line naming the field and saying why (a rigid elastic stop
+    is Zeno) and where an elastic stop exists (the contact view's compliant knee stop); exit
+    code 1, nothing written."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = _cfg("knee_spring")
+    d["walker"]["leg"]["knee"]["lock"] = "elastic"
+    path = tmp_path / "elastic.yaml"
+    path.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["simulate", str(path), "--runs-dir", str(tmp_path / "runs")])
+    assert r.exit_code == 1
+    out = r.output.strip()
+    assert out.count("\n") == 0 and "walker.leg.knee.lock" in out
+    assert "contact view only" in out and "contact.knee_stop" in out
+    assert not (tmp_path / "runs").exists() or not any((tmp_path / "runs").rglob("*.h5"))

@@ -184,6 +184,19 @@ class KneeSpec(_Strict):
                                           "knee (null: none); in the rigid view it acts on "
                                           "the free swing knee (a locked knee holds it)")
 
+    @field_validator("lock", mode="before")
+    @classmethod
+    def _elastic_is_contact_only(cls, v):
+        # an elastic stop (restitution e > 0) in a rigid model rebounds, returns and strikes
+        # again: infinitely many knee impacts in finite time (Zeno, as a bouncing ball), no
+        # honest step to hand on; the contact view's stop is compliant (IMPACT law) instead
+        if v == "elastic":
+            raise ValueError("'elastic' is available in the contact view only, as its "
+                             "compliant knee stop (contact.knee_stop with latch: false); in "
+                             "the rigid view an elastic stop chatters (infinitely many knee "
+                             "impacts in finite time): keep lock: plastic")
+        return v
+
 
 class LegSpec(_Strict):
     """One leg (both legs are identical): hip to foot, straight or with a knee."""
