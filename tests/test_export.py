@@ -408,9 +408,17 @@ def _kneed_legs_differ(d):
     d["walker"]["legs"] = [leg, other]
 
 
+def _kneed_torso(d):
+    """kneed with an upper body on the thighs' bisector, a rigid body off its axis."""
+    d["walker"]["torso"] = {"bodies": [{"kind": "rigid_body", "name": "box", "mass_kg": 0.2,
+                                        "com_from_hip_m": 0.2, "com_off_axis_m": 0.03,
+                                        "inertia_about_com_kg_m2": 0.004}]}
+
+
 @pytest.mark.parametrize("base, edit", [("asymmetric_legs", _off_axis),
                                         ("torso_bhm", _torso_off_axis),
-                                        ("kneed", _kneed_legs_differ)])
+                                        ("kneed", _kneed_legs_differ),
+                                        ("kneed", _kneed_torso)])
 def test_off_axis_bodies_exported_in_place(base, edit, tmp_path):
     """Bodies off a link's axis (legs and torso) are exported in place (the link's inertial
     origin off its axis, the parallel-axis inertia about it), and kneed legs that differ

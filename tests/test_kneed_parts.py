@@ -1,13 +1,15 @@
-"""Parts on a kneed walker (issue 22): a hip spring between the legs and legs that differ on the
-Hsu Chen (2007) kneed walker, in both views.
+"""Parts on a kneed walker (issue 22): a hip spring between the legs, a knee spring, legs that
+differ and an upper body on a bisecting hip mechanism on the Hsu Chen (2007) kneed walker, in
+both views.
 
 Rigid view: the generated flows (knee free, knee locked), the plastic knee strike and the heel
 strike against the independent kneed prototype (``tests/independent/kneed_reference.py``:
-Lagrange in its own coordinates, the locked knee and the impacts as multiplier systems, no code
-shared with the generator), for both steps of a stride; energy including the spring potential
-conserved in the unlocked and in the locked swing; the fixed point mapping to itself under the
-prototype's own integration.  Contact view: the floating equations against the independent
-floating reference (``tests/independent/floating_reference.py``).
+Lagrange in its own coordinates, the locked knee, the torso's coupling and the impacts as
+multiplier systems, no code shared with the generator), for both steps of a stride; energy
+including the spring potential conserved in the unlocked and in the locked swing; the fixed
+point mapping to itself under the prototype's own integration.  Contact view: the floating
+equations against the independent floating reference
+(``tests/independent/floating_reference.py``).
 
 Tolerances: flows and resets are closed-form algebra on both sides, compared at 1e-11 relative
 (round-off of two formulations); energy drift of DOP853 at rtol = atol = 1e-12 over a 0.5 s
@@ -21,7 +23,7 @@ import numpy as np
 import pytest
 import yaml
 from independent import floating_reference as fref
-from independent.kneed_reference import HSU_CHEN, KneedReference
+from independent.kneed_reference import HSU_CHEN, KneedReference, KneedTorsoReference
 
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import scene_from_dict
@@ -44,6 +46,9 @@ VARIANTS = {
                                          "damping_n_m_s_per_rad": 0.05}]},
     "legs_differ": {"legs_differ": True},
     "knee_spring": {"knee_spring": KNEE_SPRING},
+    # an upper body on the bisecting hip (the thighs' bisector): 0.2 kg, 0.2 m up
+    "torso": {"torso": {"bodies": [{"kind": "point_mass", "name": "mass", "mass_kg": 0.2,
+                                    "from_hip_m": 0.2}]}},
     # all at once, the knee spring with a flexed rest angle and damping
     "all_parts": {"legs_differ": True, "springs": [{**HIP_SPRING, "rest_angle_rad": -0.1}],
                   "knee_spring": {"stiffness_n_m_per_rad": 0.2, "rest_angle_rad": -0.3,
@@ -58,6 +63,8 @@ def _cfg(variant):
         d["walker"]["leg"]["knee"]["spring"] = v["knee_spring"]
     if "springs" in v:
         d["walker"]["springs"] = v["springs"]
+    if "torso" in v:
+        d["walker"]["torso"] = v["torso"]
     if v.get("legs_differ"):  # leg B's thigh 10 % heavier, its shank mass 2 cm lower
         leg = d["walker"].pop("leg")
         other = yaml.safe_load(yaml.safe_dump(leg))
@@ -93,6 +100,9 @@ def _reference(variant, stance_leg):
         sign = 1.0 if stance_leg == "leg2" else -1.0
         p.update(k_hip=s["stiffness_n_m_per_rad"], rest_hip=sign * s.get("rest_angle_rad", 0),
                  c_hip=s.get("damping_n_m_s_per_rad", 0.0))
+    if "torso" in v:
+        body = v["torso"]["bodies"][0]
+        return KneedTorsoReference({**p, "m_tor": body["mass_kg"], "d_tor": body["from_hip_m"]})
     return KneedReference(p)
 
 
@@ -107,7 +117,8 @@ def _order(walker):
 def gaits():
     guess = {"hip_spring": [-0.2866, -0.2866, 0.1859, -0.188, -0.188, -1.160],
              "legs_differ": [-0.29, -0.29, 0.189, -0.11, -0.11, -1.13],
-             "knee_spring": [-0.2912, -0.2912, 0.1905, -0.028, -0.028, -1.111]}
+             "knee_spring": [-0.2912, -0.2912, 0.1905, -0.028, -0.028, -1.111],
+             "torso": [-0.3198, -0.3198, 0.2190, -0.235, -0.235, -1.104]}
     out = {}
     for name, x0 in guess.items():
         w = build_walker(_scene(name))
@@ -115,19 +126,25 @@ def gaits():
     return out
 
 
-def test_the_parts_are_accepted_with_a_knee_and_a_torso_is_not():
-    from walkerlab.config import SceneError
-
+def test_the_parts_are_accepted_with_a_knee():
     for variant in VARIANTS:
         s = _scene(variant)
         assert s.walker.leg_pair()[0].knee is not None
-    d = _cfg("hip_spring")
-    d["walker"]["torso"] = {"bodies": [{"kind": "point_mass", "name": "m", "mass_kg": 1.0,
-                                        "from_hip_m": 0.2}]}
-    with pytest.raises(SceneError) as e:
-        scene_from_dict(d, origin="kneed_torso.yaml")
-    assert "torso: not available with a knee" in str(e.value)
-    assert str(e.value).count("\n") == 0
+
+
+def test_torso_on_a_kneed_walker_bisects_the_thighs(gaits):
+    """The upper body's angle (from the upward vertical) is the mean of the stance leg's and
+    the swing thigh's angles along a step, through the knee strike (to round-off)."""
+    w, fp = gaits["torso"]
+    seg = integrate_step(w, fp.x, SOLVER)
+    X = seg.sample(np.linspace(seg.t_start, seg.t_end, 60))
+    P = w.points(X)
+    hip, torso = P["hip"], P["torso_mass"]
+    angle = np.arctan2(-(torso[0] - hip[0]), torso[1] - hip[1])
+    names = w.state_names()
+    mean = 0.5 * (X[names.index("swing_thigh_angle")] + X[names.index("stance_angle")])
+    assert np.max(np.abs(angle - mean)) < 1e-12
+    assert np.ptp(mean) > 0.05  # it moves
 
 
 @pytest.mark.parametrize("variant", list(VARIANTS))
@@ -162,7 +179,7 @@ def test_flows_and_impacts_match_the_kneed_prototype(variant):
             assert sum(w.energies(x)) == pytest.approx(sum(ref.energies(xr)), rel=1e-12)
 
 
-@pytest.mark.parametrize("name", ["hip_spring", "legs_differ", "knee_spring"])
+@pytest.mark.parametrize("name", ["hip_spring", "legs_differ", "knee_spring", "torso"])
 def test_fixed_point_maps_to_itself_under_the_prototype(name, gaits):
     w, fp = gaits[name]
     x = fp.x.copy()
@@ -181,11 +198,13 @@ def test_fixed_point_maps_to_itself_under_the_prototype(name, gaits):
         assert w.steps_per_map == 1 and fp.period_s == pytest.approx(0.5216252366, abs=1e-8)
     elif name == "knee_spring":  # the knee straightens sooner; 0.5609 s, max |mu| 0.653
         assert w.steps_per_map == 1 and fp.period_s == pytest.approx(0.5609225352, abs=1e-8)
+    elif name == "torso":  # longer, slower steps; 0.6437 s, max |mu| 0.605
+        assert w.steps_per_map == 1 and fp.period_s == pytest.approx(0.6436584121, abs=1e-8)
     else:
         assert w.steps_per_map == 2 and len(fp.step_periods_s) == 2
 
 
-@pytest.mark.parametrize("name", ["hip_spring", "knee_spring"])
+@pytest.mark.parametrize("name", ["hip_spring", "knee_spring", "torso"])
 def test_energy_with_spring_potential_is_conserved_unlocked_and_locked(name, gaits):
     """A spring's potential is part of the energy: conserved in the unlocked and the locked
     swing (to 1e-11 relative), and the total without it is not (the check can fail; the
@@ -199,11 +218,13 @@ def test_energy_with_spring_potential_is_conserved_unlocked_and_locked(name, gai
         X = seg.sample(np.linspace(a, b, 80)[1:-1])
         E = np.sum(w.energies(X), axis=0)
         assert np.ptp(E) < 1e-11 * abs(E[0])
+        if name == "torso":
+            continue
         spring = (0.1 * (X[st] - X[th]) ** 2 / 2 if name == "hip_spring"
                   else 0.05 * (X[sh] - X[th]) ** 2 / 2)
         if a == seg.t_start or name == "hip_spring":
             assert np.ptp(E - spring) > 1e-5  # the spring's share moves
-    # the knee strike loses kinetic energy, the spring's potential is continuous
+    # the knee strike loses kinetic energy, the potential is continuous
     xm = seg.sample(np.array([t_knee]))[:, 0]
     knee = next(g for g in w.phases[0].guards if g.name == "knee_strike")
     assert w.energies(knee.reset(xm))[1] == pytest.approx(w.energies(xm)[1], rel=1e-13)

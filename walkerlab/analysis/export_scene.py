@@ -131,10 +131,11 @@ def joint_state(mb, walker, x) -> tuple[np.ndarray, np.ndarray]:
     q, v = dict(zip(names, x[:nq])), dict(zip(names, x[nq:]))
 
     coupled = {cp.joint: cp.terms for cp in mb.couplings}  # e.g. the torso's bisecting hip
+    link_of = {ln.joint: ln.name for ln in mb.links}
 
     def joint(vals, ln):
-        if ln.joint in coupled:  # hip joints are absolute link angles: <leg>_hip -> <leg>
-            return sum(c * vals[f"{j.removesuffix('_hip')}_angle"] for j, c in coupled[ln.joint])
+        if ln.joint in coupled:  # of hip joints: absolute link (leg or thigh) angles
+            return sum(c * vals[f"{link_of[j]}_angle"] for j, c in coupled[ln.joint])
         own = vals[f"{ln.name}_angle"]
         return own - vals[f"{ln.parent}_angle"] if ln.joint.endswith("_knee") else own
 

@@ -371,10 +371,6 @@ class BipedParams(_Strict):
                                ("springs", self.springs)) if on]
         if new and self.coordinates != "absolute":
             raise ValueError(f"coordinates: {new[0]} needs 'absolute'")
-        if self.torso is not None and pair[0].knee is not None:
-            # the upper body's bisecting hip on a kneed walker is not derived (its coupling
-            # would act on the thighs; neither the rigid nor the contact view has it yet)
-            raise ValueError("torso: not available with a knee yet (straight legs only)")
         if self.springs and any(b.mass_kg == 0 for leg in pair for b in leg.bodies):
             raise ValueError("springs: not with massless bodies (a sprung massless leg has "
                              "no flow in the limit m -> 0)")

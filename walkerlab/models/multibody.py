@@ -216,13 +216,9 @@ def multibody(data: WalkerData) -> Multibody:
     Raises
     ------
     ValueError
-        A link carries no mass (one line, naming the link), or an upper body on a kneed
-        walker (not described by the rigid view either).
+        A link carries no mass (one line, naming the link).
     """
     s = data.structure
-    if s.torso and s.knee:
-        raise ValueError("export: an upper body on a kneed walker cannot be exported (the "
-                         "walker description has no such walker)")
     p = dict(zip(s.param_names, data.params))
     L = p["L"]
     lt = p["L_thigh"] if s.knee else 0.0

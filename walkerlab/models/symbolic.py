@@ -402,14 +402,14 @@ def derive(structure: Structure) -> Equations:
               "hip_height": (hip.T * normal)[0],
               "swing_clearance": (swing_contact.T * normal)[0]}
     leg_angles = {"stance": psi_st, "swing": psi_sw}
-    if structure.torso:
-        leg_angles["torso"] = psi_t.subs(sub)
     tied = {}
     if knee:
         guards["knee_extension"] = q[1] - q[0]  # zero when straight, > 0 hyperextended
         leg_angles = {"stance_thigh": psi_st, "stance_shank": psi_st, "swing_thigh": q[0],
                       "swing_shank": q[1]}
         tied = {1: 0, n + 1: n}
+    if structure.torso:  # on a kneed walker the bisector of the thighs
+        leg_angles["torso"] = psi_t.subs(sub)
 
     if knee or arc:  # the printed-equation variants exist for the point-foot compass gait only
         return Equations(
