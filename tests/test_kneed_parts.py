@@ -13,7 +13,7 @@ equations against the independent floating reference
 
 Tolerances: flows and resets are closed-form algebra on both sides, compared at 1e-11 relative
 (round-off of two formulations); energy drift of DOP853 at rtol = atol = 1e-12 over a 0.5 s
-phase of a ~12.7 J walker stays below 1e-11 relative (measured a few 1e-13); the fixed point
+phase of a ~13 J walker stays below 1e-11 relative (measured <= 1.4e-13); the fixed point
 through the prototype's integration (DOP853 at 1e-12 over a 0.5 s step) at 1e-9.
 """
 
