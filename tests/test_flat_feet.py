@@ -87,9 +87,9 @@ def test_legs_with_different_flat_feet_get_per_role_numbers_and_a_stride():
         (0.12, 0.10, 30.0, 20.0)
 
 
-def test_existing_structures_keep_their_cache_keys():
-    """A flat foot is a new part: a point-footed walker's structure key (part of the
-    generated-code cache key) does not mention it."""
+def test_existing_structures_keep_their_structure_keys():
+    """A flat foot is a new part: a point-footed walker's structure key (the structure's
+    part of the generated-code cache key) does not mention it and is what it was."""
     d = _scene(leg={**LEG, "foot": {"kind": "point"}})
     w = walker_data(scene_from_dict(d, "s.yaml").walker, 0.02)
     assert "flat" not in w.structure.key() and "ankle" not in w.structure.key()
