@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.analysis.gaits import state_from_legs
 from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
@@ -88,9 +87,9 @@ def test_legs_with_different_flat_feet_get_per_role_numbers_and_a_stride():
         (0.12, 0.10, 30.0, 20.0)
 
 
-def test_existing_structures_keep_their_cache_keys():
-    """A flat foot is a new part: a point-footed walker's structure key (part of the
-    generated-code cache key) does not mention it."""
+def test_existing_structures_keep_their_structure_keys():
+    """A flat foot is a new part: a point-footed walker's structure key (the structure's
+    part of the generated-code cache key) does not mention it and is what it was."""
     d = _scene(leg={**LEG, "foot": {"kind": "point"}})
     w = walker_data(scene_from_dict(d, "s.yaml").walker, 0.02)
     assert "flat" not in w.structure.key() and "ankle" not in w.structure.key()
@@ -129,12 +128,19 @@ def ref(scene):
 
     w, leg = scene.walker, scene.walker.leg
     ankle = leg.foot.ankle
-    assert ankle.damping_n_m_s_per_rad == 0.0 and len(leg.bodies) == 1
+    assert len(leg.bodies) == 1
     return FlatFeetReference(dict(
         M=w.hip_mass_kg, m=leg.bodies[0].mass_kg, b=leg.bodies[0].from_hip_m,
         L=leg.length_m, h=leg.foot.heel_m, t=leg.foot.toe_m,
         k=ankle.stiffness_n_m_per_rad, r=ankle.rest_angle_rad,
-        gamma=scene.slope.angle_rad, g=w.gravity_m_per_s2))
+        c=ankle.damping_n_m_s_per_rad, gamma=scene.slope.angle_rad, g=w.gravity_m_per_s2))
+
+
+def _variant(scene, **ankle) -> dict:
+    """The scene's mapping with other ankle numbers (``stiffness_n_m_per_rad=...``)."""
+    data = scene.model_dump()
+    data["walker"]["leg"]["foot"]["ankle"].update(ankle)
+    return data
 
 
 @pytest.fixture(scope="module")
@@ -255,22 +261,48 @@ def test_one_step_goes_heel_contact_foot_flat_heel_off_then_heel_strike(step, re
     np.testing.assert_allclose(step.x_next, r["x_plus"], atol=1e-9)
 
 
-def test_energy_is_conserved_in_each_undamped_mode(step, fns):
-    """Kinetic + gravity + ankle spring is constant along each mode of a step (the mode's
-    own kinematics: heel- or toe-pinned).  DOP853 at rtol = atol = 1e-12 over < 0.6 s keeps
-    the state to ~1e-11; the energy (~160 J, |dE/dx| ~ 100 J) then drifts < 1e-8 J (observed
-    ~1e-10 J): a wrong term of the flow would show at the J level."""
+def _energy_and_dissipation(fns, c, mode, x0, duration):
+    """Integrate ``mode``'s generated flow from ``x0`` with the damper's dissipated energy
+    ``D = int c (d ankle/dt)^2 dt`` as an extra state (rtol = atol = 1e-12); returns the
+    mode's energy (kinetic + gravity + ankle spring) and ``D`` at 40 times [J]."""
+    from scipy.integrate import solve_ivp
+
+    flow = fns[f"flow_{mode}"]
+
+    def rhs(t, y):
+        return np.append(flow(t, y[:6]), c * y[5] ** 2)
+    sol = solve_ivp(rhs, (0, duration), np.append(x0, 0.0), method="DOP853", rtol=1e-12,
+                    atol=1e-12, t_eval=np.linspace(0, duration, 40))
+    e = fns[f"energies_{MODE_PIN[mode]}"](sol.y[:6])
+    return e["kinetic"] + e["potential"], sol.y[6]
+
+
+def test_energy_is_conserved_in_each_undamped_mode_and_the_damper_takes_its_work(
+        scene, step, fns):
+    """From the entry state of each mode of the gait's step, over that mode's duration:
+    without the ankle damper, kinetic + gravity + ankle spring is constant; with the scene's
+    damper it falls by exactly the damper's integral of ``c (d ankle/dt)^2``.  DOP853 at
+    rtol = atol = 1e-12 over < 0.4 s keeps the state to ~1e-11; the energy (~170 J,
+    |dE/dx| ~ 100 J) then drifts < 1e-8 J (observed ~1e-10 J): a wrong term of the flow
+    would show at the J level."""
+    c = scene.walker.leg.foot.ankle.damping_n_m_s_per_rad
+    assert c > 0
+    undamped = functions(walker_data(scene_from_dict(_variant(
+        scene, damping_n_m_s_per_rad=0.0), "undamped.yaml").walker, scene.slope.angle_rad))
     for phase, dense, (ta, tb) in step.pieces:
         mode = mode_of(phase.name)
-        X = np.asarray(dense(np.linspace(ta, tb, 40)))[:6]
-        e = fns[f"energies_{MODE_PIN[mode]}"](X)
-        total = e["kinetic"] + e["potential"]
-        assert np.ptp(total) < 1e-8, (phase.name, np.ptp(total))
+        x0 = np.ravel(dense(ta))[:6]
+        energy, _ = _energy_and_dissipation(undamped, 0.0, mode, x0, tb - ta)
+        assert np.ptp(energy) < 1e-8, (phase.name, np.ptp(energy))
+        energy, dissipated = _energy_and_dissipation(fns, c, mode, x0, tb - ta)
+        assert np.ptp(energy + dissipated) < 1e-8, (phase.name, np.ptp(energy + dissipated))
+        assert dissipated[-1] > 1e-3  # the damper does work in every mode
 
 
-def test_the_step_s_energy_losses_add_up_to_the_work_of_gravity(step, walker, gait):
+def test_the_step_s_energy_losses_add_up_to_the_work_of_gravity(step, walker, gait, fns):
     """Per step on the gait, foot slap + heel strike (kinetic) + the trailing ankle
-    spring's energy lost at heel strike = M g (step length) sin(gamma) (1e-8 relative)."""
+    spring's energy lost at heel strike + the ankle damper's integral of
+    ``c (d ankle/dt)^2`` = M g (step length) sin(gamma) (1e-8 relative)."""
     slap = next(g for g in walker.phases[0].guards if g.name == "foot_slap")
     _ph, dense, (_ta, tb) = step.pieces[0]
     x_slap = np.ravel(dense(tb))[:6]
@@ -279,10 +311,15 @@ def test_the_step_s_energy_losses_add_up_to_the_work_of_gravity(step, walker, ga
     k, r = walker.params["k_ankle"], walker.params["r_ankle"]
     strike_loss = e(step.x_end)[0] - e(step.x_next)[0]
     spring_loss = k / 2 * (step.x_end[2] - r) ** 2
-    assert slap_loss > 0 and strike_loss > 0 and spring_loss > 0
+    c = walker.params["c_ankle"]
+    damper_loss = 0.0
+    for ph, dense, (ta, tb) in step.pieces:
+        x0 = np.ravel(dense(ta))[:6]
+        damper_loss += _energy_and_dissipation(fns, c, mode_of(ph.name), x0, tb - ta)[1][-1]
+    assert slap_loss > 0 and strike_loss > 0 and spring_loss > 0 and damper_loss > 0
     work = (walker.total_mass_kg * walker.params["gravity_m_per_s2"]
             * gait.step_lengths_m[0] * math.sin(walker.slope_rad))
-    assert slap_loss + strike_loss + spring_loss == pytest.approx(work, rel=1e-8)
+    assert slap_loss + strike_loss + spring_loss + damper_loss == pytest.approx(work, rel=1e-8)
 
 
 def test_fixed_point_is_stable_and_its_multipliers_match_finite_differences(gait):
@@ -300,38 +337,74 @@ def test_fixed_point_is_stable_and_its_multipliers_match_finite_differences(gait
 
 
 def test_a_heel_strike_before_heel_off_is_a_step_from_foot_flat(scene):
-    """A softer ankle (60 N m/rad) keeps the foot flat until the swing heel lands: the step
-    ends in a heel strike from foot flat, through that mode's own heel-strike map (heel
-    pinned), and the next step goes on."""
-    data = scene.model_dump()
-    data["walker"]["leg"]["foot"]["ankle"]["stiffness_n_m_per_rad"] = 60.0
+    """A softer ankle (80 N m/rad) keeps the foot flat until the swing heel lands: on that
+    walker's gait the step ends in a heel strike from foot flat, through that mode's own
+    heel-strike map (heel pinned), and the next step is the same."""
+    data = _variant(scene, stiffness_n_m_per_rad=80.0)
     w = build_walker(scene_from_dict(data, "soft.yaml"))
-    x = state_from_legs(w, 0.2 - w.slope_rad, -0.2 - w.slope_rad, -1.2 * 0.2 * 3.13, 0.0)
-    traj = simulate_steps(w, x, 3, Solver(method="DOP853", rtol=1e-10, atol=1e-10))
+    guess = np.array([-0.213, 0.19, 0.0, -0.933, -0.849, -6.31])  # near its gait
+    x = find_fixed_point(w, guess, FINE, xtol=1e-10, fd_check=False).x
+    traj = simulate_steps(w, x, 2, FINE)
+    for seg in traj.segments:
+        assert seg.termination == "heel_strike"
+        assert mode_sequence(seg.phase_log) == ["heel_contact", "foot_flat"]
+        assert seg.phase_log[-1][0] == "foot_flat:late_swing"
     seg = traj.segments[0]
-    assert seg.termination == "heel_strike"
-    assert mode_sequence(seg.phase_log) == ["heel_contact", "foot_flat"]
-    assert seg.phase_log[-1][0] == "foot_flat:late_swing"
     f = functions(walker_data(scene_from_dict(data, "soft.yaml").walker, w.slope_rad))
     np.testing.assert_allclose(seg.x_next, f["reset_heel_strike_heel"](seg.x_end), atol=1e-14)
-    assert traj.segments[1].termination in ("heel_strike", "fall")
+
+
+def test_a_contact_that_pulls_as_its_mode_begins_is_a_fall(scene, gait):
+    """Without the ankle damper the massless foot's heel contact begins with a pulling
+    (negative) normal force - no zero crossing to find - and the step is reported as
+    ``stance_foot_lifts`` at its start, not walked through."""
+    w = build_walker(scene_from_dict(_variant(scene, damping_n_m_s_per_rad=0.0), "c0.yaml"))
+    seg = integrate_step(w, gait.x, FINE)
+    lifts = next(g for g in w.phases[0].guards if g.name == "stance_foot_lifts")
+    assert lifts.function(0.0, gait.x) < 0
+    assert (seg.termination, seg.event, seg.t_end) == ("fall", "stance_foot_lifts", 0.0)
+    assert seg.phase_log == [("heel_contact:early_swing", 0.0, 0.0, "stance_foot_lifts")]
+
+
+@pytest.mark.slow
+def test_every_contact_pushes_along_the_gait_s_step(step, fns, ref):
+    """The unilateral contacts hold along the whole step (sampled every ~2 ms): the heel in
+    heel contact, heel and toe in foot flat (the heel's share reaches 0 only at heel off),
+    the toe in heel off; the foot-flat forces equal the reference's own (Newton plus the
+    moment about the heel in its two-coordinate model) to 1e-8 N."""
+    for phase, dense, (ta, tb) in step.pieces:
+        mode = mode_of(phase.name)
+        for t in np.linspace(ta, tb, max(int((tb - ta) / 2e-3), 5)):
+            x = np.ravel(dense(t))[:6]
+            qdd = fns[f"flow_{mode}"](0.0, x)[3:]
+            if mode == "heel_off":
+                assert fns["ground_toe"](x, qdd)[0] > 100.0
+                continue
+            n, n_toe = fns["ground_heel"](x, qdd)
+            if mode == "heel_contact":
+                assert n > 100.0
+                continue
+            assert n_toe > 10.0 and n - n_toe > -1e-6
+            n_ref, n_toe_ref = ref.ground("flat", x[[0, 1, 3, 4]])
+            assert (n, n_toe) == (pytest.approx(n_ref, abs=1e-8),
+                                  pytest.approx(n_toe_ref, abs=1e-8))
 
 
 @pytest.mark.slow  # derives the per-role structure (~2 s) and solves a stride
 def test_legs_with_different_feet_walk_a_stride(scene):
-    """Legs whose feet differ (leg2: toe 0.11 m, ankle 95 N m/rad): each step carries its own
-    stance and swing feet's numbers, the Poincaré map is a stride, and its fixed point is
+    """Legs whose feet differ (leg2: toe 0.11 m, ankle 130 N m/rad): each step carries its
+    own stance and swing feet's numbers, the Poincaré map is a stride, and its fixed point is
     found from the symmetric gait with variational multipliers equal to finite differences."""
     data = scene.model_dump()
     leg = data["walker"].pop("leg")
     other = copy.deepcopy(leg)
-    other["foot"]["ankle"]["stiffness_n_m_per_rad"] = 95.0
+    other["foot"]["ankle"]["stiffness_n_m_per_rad"] = 130.0
     other["foot"]["toe_m"] = 0.11
     data["walker"]["leg"], data["walker"]["legs"] = None, [leg, other]
     w = build_walker(scene_from_dict(data, "legs.yaml"))
     assert w.steps_per_map == 2
-    assert (w.params["k_sw_ankle"], w.params["k_st_ankle"]) == (90.0, 95.0)
-    assert (w.mirror.params["k_sw_ankle"], w.mirror.params["toe_st_m"]) == (95.0, 0.10)
+    assert (w.params["k_sw_ankle"], w.params["k_st_ankle"]) == (120.0, 130.0)
+    assert (w.mirror.params["k_sw_ankle"], w.mirror.params["toe_st_m"]) == (130.0, 0.10)
     guess = scene.fixedpoint.initial_guess.as_array(w.state_names())
     res = find_fixed_point(w, guess, Solver(method="DOP853", rtol=1e-11, atol=1e-11),
                            xtol=1e-10)
@@ -350,3 +423,36 @@ def test_the_simulate_table_records_each_step_s_phases(walker, gait):
     assert list(phases) == ["heel_contact:early_swing (foot_slap) > foot_flat:early_swing "
                             "(midstance) > foot_flat:late_swing (heel_off) > "
                             "heel_off:late_swing (heel_strike)"] * 2
+
+
+def test_the_guards_the_walker_calls_have_the_right_sign_along_a_step(walker, step):
+    """Each guard of the phases actually run, at its situations of the gait's step: after
+    heel strike the toe is up and the foot loaded; after the foot slap heel and toe both
+    carry load; at heel off the heel's force is 0 and falling; in heel off the heel is up;
+    at heel strike the swing heel is on the slope and moving down."""
+    def guard(phase_name, name):
+        ph = next(p for p in walker.phases if p.name == phase_name)
+        return next(g for g in ph.guards if g.name == name)
+
+    def state(j, end=False):
+        _ph, dense, (ta, tb) = step.pieces[j]
+        return np.ravel(dense(tb if end else ta))[:6]
+
+    x0 = state(0)
+    assert guard("heel_contact:early_swing", "foot_slap").function(0, x0) > 0.2  # toe up
+    assert guard("heel_contact:early_swing", "stance_foot_lifts").function(0, x0) > 0
+    x1 = state(1)  # just after the foot slap
+    assert guard("foot_flat:early_swing", "heel_off").function(0, x1) > 0
+    assert guard("foot_flat:early_swing", "stance_toe_lifts").function(0, x1) > 0
+    xo = state(2, end=True)  # heel off
+    heel_off = guard("foot_flat:late_swing", "heel_off")
+    assert abs(heel_off.function(0, xo)) < 1e-6 * walker.total_mass_kg * 9.81
+    before = state(2)  # mid-stance: the heel's force is falling towards 0 from above
+    assert heel_off.function(0, before) > heel_off.function(0, xo)
+    _ph, dense, (ta, tb) = step.pieces[3]
+    inside = np.ravel(dense(0.5 * (ta + tb)))[:6]
+    assert guard("heel_off:late_swing", "stance_heel_touches_down").function(0, inside) < 0
+    hs = guard("heel_off:late_swing", "heel_strike")
+    assert abs(hs.function(0, step.x_end)) < 1e-12
+    flow = walker.phases[[p.name for p in walker.phases].index("heel_off:late_swing")].flow
+    assert hs.gradient(step.x_end) @ flow(0, step.x_end) < 0  # the heel comes down

@@ -4,7 +4,7 @@ code with walkerlab's generator (:mod:`walkerlab.models.flatfoot`).
 Written from scratch for the point-mass walker of ``configs/flat_feet.yaml`` (hip mass ``M``,
 one point mass ``m`` per leg at ``b`` from the hip, leg ``L`` hip to ankle; massless flat
 feet, heel ``h`` behind and toe ``t`` ahead of the ankle on the sole line; ankle spring ``k``,
-rest angle ``r``; slope ``gamma``), with its OWN coordinates per mode:
+rest angle ``r``, damper ``c``; slope ``gamma``), with its OWN coordinates per mode:
 
 - ``heel``  (heel contact): ``(swing, stance, ankle)``, the heel pinned at the origin;
 - ``toe``   (heel off): ``(swing, stance, ankle)``, the toe pinned at ``(h + t)`` down the slope;
@@ -12,7 +12,8 @@ rest angle ``r``; slope ``gamma``), with its OWN coordinates per mode:
   (the locked foot angle eliminated, not enforced by a multiplier as the generator does).
 
 Each mode's equations come from its own Lagrangian (``T - V``, ``V`` gravity plus
-``k (ankle - r)^2 / 2``) through the small sympy helper of this folder.  Impacts are momentum
+``k (ankle - r)^2 / 2``) through the small sympy helper of this folder, plus the damper's
+generalised force ``-c (d ankle/dt) d ankle/dq``.  Impacts are momentum
 projections written here: foot slap ``M_flat dq+ = sum J_flat^T m v-`` (both heel and toe
 pinned after the slap), heel strike ``M_heel(new) dq+ = sum J_heel(new)^T m v-`` in the new
 labelling (new heel at the origin, new ankle at the rest angle).  The ground reaction in foot
@@ -29,12 +30,12 @@ from tests.independent._lagrange import lagrange, lam
 
 
 class FlatFeetReference:
-    """The reference walker; ``p``: ``M, m, b, L, h, t, k, r, gamma, g`` (SI)."""
+    """The reference walker; ``p``: ``M, m, b, L, h, t, k, r, c, gamma, g`` (SI)."""
 
     def __init__(self, p: dict):
         self.p = dict(p)
         M, m, b, L, h, t = (p[k] for k in ("M", "m", "b", "L", "h", "t"))
-        k, r, gamma, g = (p[k] for k in ("k", "r", "gamma", "g"))
+        k, r, c, gamma, g = (p[k] for k in ("k", "r", "c", "gamma", "g"))
         sw, st, an = sp.symbols("sw st an", real=True)
         dsw, dst, dan = sp.symbols("dsw dst dan", real=True)
         slope = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
@@ -60,7 +61,9 @@ class FlatFeetReference:
             Mm, hvec, T, V = lagrange(q, dq, bodies, g)
             a_spring = (-gamma - st) if mode == "flat" else an
             Vs = k * (a_spring - r) ** 2 / 2
-            hvec = hvec + sp.Matrix([sp.diff(Vs, qi) for qi in q])
+            da = sum(sp.diff(a_spring, qi) * dqi for qi, dqi in zip(q, dq))
+            hvec = hvec + sp.Matrix([sp.diff(Vs, qi) + c * da * sp.diff(a_spring, qi)
+                                     for qi in q])
             qdd = sp.symbols(f"qdd0:{len(q)}", real=True)
             qv, dqv, ddv = sp.Matrix(q), sp.Matrix(dq), sp.Matrix(qdd)
             ground = sp.zeros(2, 1)

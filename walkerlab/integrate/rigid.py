@@ -239,6 +239,28 @@ class Segment:
         return out
 
 
+class _Held:
+    """Dense output of a phase that ended as it began: the state ``x`` at every time."""
+
+    def __init__(self, x: np.ndarray):
+        self._x = np.asarray(x, float)
+
+    def __call__(self, t):
+        if np.ndim(t) == 0:
+            return self._x.copy()
+        return np.repeat(self._x[:, None], np.size(t), axis=1)
+
+
+def _violated_at_entry(phase: Phase, t: float, x: np.ndarray):
+    """The first fall guard of ``phase`` marked ``at_entry`` whose function starts on its
+    firing side at ``(t, x)``, or None."""
+    for g in phase.guards:
+        if getattr(g, "at_entry", False) and g.outcome == "fall":
+            if g.direction * float(g.function(t, x)) > 0:
+                return g
+    return None
+
+
 def _grad(guard, x):
     """Gradient (2n,) of a guard function: the model's own, else numerical."""
     gradient = getattr(guard, "gradient", None)
@@ -324,6 +346,13 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
             rhs = phase.flow
             y0 = x
         if t >= t_stop:
+            break
+        broken = _violated_at_entry(phase, t, x)
+        if broken is not None:  # e.g. a unilateral contact already pulling as its mode begins
+            termination, event = RunEnd.FALL, broken.name
+            message = f"{broken.name}: already violated as {phase.name} begins"
+            pieces.append((phase, _Held(x), (t, t)))
+            phase_log.append((phase.name, t, t, broken.name))
             break
         # the model's analytic Jacobian for scipy's implicit methods (not a numerical one:
         # those methods approximate it themselves)

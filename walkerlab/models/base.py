@@ -83,6 +83,11 @@ class Guard:
         For ``next_phase`` guards: the name of the phase that follows (the phases of a step
         then form a graph, e.g. a flat foot's modes crossed with early / late swing); None:
         the next phase in :attr:`HybridWalker.phases`.
+    at_entry : bool
+        Also fire when the phase begins on the guard's firing side (``function < 0`` for
+        ``direction = -1``, ``> 0`` for ``+1``), which no zero crossing would report: a
+        contact force that is already pulling when its contact mode begins (a flat foot's
+        unilateral contacts).  False: crossings only.
     """
 
     name: str
@@ -93,6 +98,7 @@ class Guard:
     reset: Callable[[np.ndarray], np.ndarray] | None = None
     reset_jacobian: Callable[[np.ndarray], np.ndarray] | None = None
     next_phase: str | None = None
+    at_entry: bool = False
 
 
 @dataclass(frozen=True)

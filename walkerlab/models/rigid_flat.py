@@ -20,7 +20,9 @@ Guards (``direction`` as ``solve_ivp``'s events):
 - ``heel_strike`` (late swing, any mode): the swing heel's height above the slope decreasing
   through 0; the mode's own heel-strike map (heel- or toe-pinned kinematics);
 - falls: ``stance_foot_lifts`` (the total normal force decreasing through 0),
-  ``stance_toe_lifts`` (foot flat: the toe's force), ``stance_heel_touches_down`` (heel off:
+  ``stance_toe_lifts`` (foot flat: the toe's force) - both also when a mode begins with the
+  force already pulling (``Guard.at_entry``: a unilateral contact cannot hold the foot down),
+  ``stance_heel_touches_down`` (heel off:
   ``phi`` increasing through 0 - a second heel contact, reported rather than modelled),
   ``swing_leg_falls_back`` (late swing), ``fall`` (the hip reaches the slope).
 """
@@ -96,17 +98,20 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
                                 f["grad_foot_angle"], f["reset_foot_slap"],
                                 f["reset_foot_slap_jacobian"], next_phase=f"foot_flat:{part}"))
             guards.append(Guard("stance_foot_lifts",
-                                partial(_normal_force, f["ground_heel"], fl, 0), -1, "fall"))
+                                partial(_normal_force, f["ground_heel"], fl, 0), -1, "fall",
+                                at_entry=True))
         elif mode == "foot_flat":
             guards.append(Guard("heel_off", partial(_heel_force, f["ground_heel"], fl), -1,
                                 "next_phase", next_phase=f"heel_off:{part}"))
             guards.append(Guard("stance_toe_lifts",
-                                partial(_normal_force, f["ground_heel"], fl, 1), -1, "fall"))
+                                partial(_normal_force, f["ground_heel"], fl, 1), -1, "fall",
+                                at_entry=True))
         else:
             guards.append(Guard("stance_heel_touches_down", f["guard_foot_angle"], +1, "fall",
                                 f["grad_foot_angle"]))
             guards.append(Guard("stance_foot_lifts",
-                                partial(_normal_force, f["ground_toe"], fl, 0), -1, "fall"))
+                                partial(_normal_force, f["ground_toe"], fl, 0), -1, "fall",
+                                at_entry=True))
         if late:
             guards.append(Guard("swing_leg_falls_back", f["guard_swing_foot_ahead"], -1, "fall",
                                 f["grad_swing_foot_ahead"]))

@@ -70,16 +70,12 @@ def _param_key(path: str) -> str:
     return path.replace("/", "_")
 
 
-#: unit suffixes of scene field names (units live in the names, ``slope.angle_deg``)
-_UNIT_SUFFIXES = (("_kg_m2", "kg m^2"), ("_m_per_s2", "m/s^2"), ("_m_per_s", "m/s"),
-                  ("_rad_per_s", "rad/s"), ("_deg", "deg"), ("_rad", "rad"), ("_kg", "kg"),
-                  ("_mm", "mm"), ("_m", "m"), ("_hz", "Hz"), ("_s", "s"))
-
-
 def field_unit(path: str) -> str:
-    """Unit of a scene field from its name (``slope.angle_deg`` -> ``deg``; ``"-"``: none)."""
-    leaf = path.rsplit(".", 1)[-1].lower()
-    return next((u for suf, u in _UNIT_SUFFIXES if leaf.endswith(suf)), "-")
+    """Unit of a scene field from its name (``slope.angle_deg`` -> ``deg``; ``"-"``: none),
+    by the one suffix table (:data:`walkerlab.units.FIELD_SUFFIX_UNITS`)."""
+    from walkerlab.units import field_unit as unit_of_name
+
+    return unit_of_name(path.lower()) or "-"
 
 
 _BOOKKEEPING = ("row_hash",)
