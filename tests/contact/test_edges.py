@@ -21,7 +21,7 @@ PKG = Path(__file__).resolve().parents[2] / "walkerlab"
 
 
 def _walker(k=1e5, width=0.10, family="paper"):
-    c = ContactSettings(stiffness=k, stiffness_family=family)
+    c = ContactSettings(stiffness_n_per_mm_pow_e=k, stiffness_family=family)
     return ContactWalker.from_settings(c, TerrainSettings(patch_width_m=width),
                                        step_length=STEP_LENGTH, n_steps=12)
 

@@ -73,7 +73,8 @@ def drop_restitution(contact: ContactSettings, mass_kg: float = 20.0, v_in_m_per
 
 
 def restitution_curve(base: ContactSettings, stiffness, families=FAMILIES, **kw) -> dict:
-    """Restitution of the drop test for each stiffness (scene units) in each family.
+    """Restitution of the drop test for each stiffness in each family, the stiffnesses in
+    the unit ``base`` writes its stiffness in (``N/mm^e`` or ``N/m^e``).
 
     Returns
     -------
@@ -83,9 +84,10 @@ def restitution_curve(base: ContactSettings, stiffness, families=FAMILIES, **kw)
     """
     ks = np.asarray(stiffness, float)
     out: dict = {"stiffness": ks}
+    unit = base.written("stiffness")[1]
     for fam in families:
-        rows = [drop_restitution(base.model_copy(update={"stiffness": float(k),
-                                                         "stiffness_family": fam}), **kw)
+        family = base.model_copy(update={"stiffness_family": fam})
+        rows = [drop_restitution(family.with_written("stiffness", float(k), unit), **kw)
                 for k in ks]
         out[fam] = {key: np.array([r[key] for r in rows]) for key in rows[0]}
     return out

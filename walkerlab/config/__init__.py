@@ -24,7 +24,6 @@ SceneError
 
 from walkerlab.config.contact import (
     MAX_CONTACT_STRIDES,
-    ContactParamsSI,
     ContactSettings,
     ContactSimSettings,
     ContactSolverSettings,
@@ -98,7 +97,6 @@ __all__ = [
     "Body",
     "CommandOptions",
     "CompassGaitParams",
-    "ContactParamsSI",
     "ContactSettings",
     "ContactSimSettings",
     "ContactSolverSettings",

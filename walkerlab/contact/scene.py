@@ -96,9 +96,9 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
         check_masses(data.structure)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
-    si, knee = contact_si(contact)
+    si, knee = contact_si(contact)  # the contact law in SI: once per run
     probe = ContactWalker(contact=si, data=data, knee_stop=knee)
     step_length = ideal_step_length(probe, x_ideal)
-    return ContactWalker.from_settings(contact, terrain, step_length=step_length_m or step_length,
-                                       n_steps=n_steps + 4, data=data), step_length
+    return probe.on_terrain(terrain, step_length=step_length_m or step_length,
+                            n_steps=n_steps + 4), step_length
 

@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
+from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
 from walkerlab.sweep.bifurcation import fall_onset, onset_value, parameter_values
@@ -159,14 +160,7 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
     a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     im = a2.pcolormesh(xi, yi, wall, shading="nearest", cmap="viridis")
     fig.colorbar(im, ax=a2, label="wall time per point [s]")
-    import json
-
-    try:
-        unit_sys = (json.loads(sweep["attrs"]["scene_json"]).get("contact") or {}).get(
-            "unit_system", "mm-kg-s")
-    except (KeyError, ValueError, AttributeError):
-        unit_sys = "mm-kg-s"
-    ylab = _label(y_path).replace("len", "mm" if unit_sys == "mm-kg-s" else "m")
+    ylab = _label(y_path)
     for ax in (a1, a2):
         ax.set_xticks(xi, [f"{v:g}" for v in xv], fontsize=7)
         ax.set_yticks(yi, [f"{v:.3g}" for v in yv], fontsize=7)
@@ -179,7 +173,8 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
 
 
 _UNITS = {"slope.angle_deg": "slope φ [deg]", "slope.angle_rad": "slope φ [rad]",
-          "contact.stiffness": "contact stiffness k [N/len^e]",
+          **{f"contact.{name}": f"contact stiffness k [{unit}]"
+             for name, unit in CONTACT_QUANTITIES["stiffness"].values()},
           "contact.mu_static": "static friction μs [-]",
           "contact.mu_dynamic": "dynamic friction μd [-]"}
 
@@ -249,13 +244,9 @@ def gait_map_figure(data: dict):
         code[i, j] = (0 if st[i, j] else 1) if e else _REASON_CLASS.get(str(reason[i, j]), 6)
     attrs = data.attrs
     kind = str(attrs.get("kind", ""))
-    unit_sys = str(attrs.get("unit_system", "mm-kg-s"))
-    ylab = str(attrs.get("y_label", attrs.get("y_path", "y")))
-    units = Units(str(attrs.get("scene_units", "SI")))
-    if units.nondimensional and unit_sys != "mm-kg-s":  # the scene's lengths are in l
-        ylab = ylab.replace("[N/len^e]", f"[{units('N')}/{units('m')}^e]").replace(
-            "[m]", f"[{units('m')}]")
-    ylab = ylab.replace("len", "mm" if unit_sys == "mm-kg-s" else "m")
+    # the label names its unit (the field's); a nondimensional scene's SI units read in l, M, g
+    ylab = Units(str(attrs.get("scene_units", "SI")))(
+        str(attrs.get("y_label", attrs.get("y_path", "y"))))
     if kind == "stiffness":
         ylab += f", {attrs.get('stiffness_family', 'paper')} family"
     cmap = ListedColormap(GAIT_COLORS)
