@@ -30,11 +30,11 @@ from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.execution.workers import process_alive
 from walkerlab.io.artifacts import ArtifactError, atomic_write, open_artifact, write_artifact
 from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock
+from walkerlab.io.sweep_store import load_sweep, partial_path
 from walkerlab.stages import common
 from walkerlab.sweep import runner
 from walkerlab.sweep.outcomes import empty_row
 from walkerlab.sweep.params import SweepError, parse_param
-from walkerlab.sweep.store import load_sweep, partial_path
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())

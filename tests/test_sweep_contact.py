@@ -15,8 +15,8 @@ SCENE = Path(__file__).resolve().parents[1] / "configs" / "goswami1996.yaml"
 
 def test_contact_point_gives_a_typed_outcome():
     base = load_scene(SCENE).model_dump(mode="json")
-    row, x = evaluate("contact-sim", base, ["slope.angle_deg", "contact.stiffness_n_per_mm_pow_e"], (1.0, 1e5),
-                      0, None, {})
+    row, x = evaluate("contact-sim", base, ["slope.angle_deg", "contact.stiffness_n_per_mm_pow_e"],
+                      (1.0, 1e5), 0, None, {})
     assert row["outcome"] in OUTCOMES and row["outcome"] not in ("error", "invalid_config"), \
         row["message"]
     assert row["steps_expected"] == 10 and row["heel_strikes"] >= 0

@@ -18,11 +18,11 @@ from scipy.integrate import solve_ivp
 
 from walkerlab.config import load_scene
 from walkerlab.config.contact import ContactSettings
+from walkerlab.contact.laws import contact_params_si, knee_stop_si
 from walkerlab.contact.model import ContactWalker
 from walkerlab.models.description import walker_data
 from walkerlab.models.floating import MASSLESS_MESSAGE, floating_view
 from walkerlab.models.rigid import functions
-from walkerlab.contact.laws import contact_params_si, knee_stop_si
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 WALKERS = ("paper", "paper_rods", "kneed", "round_feet", "goswami1996")
@@ -35,8 +35,8 @@ def _data(name):
 
 def _walker(data, **kw):
     """Contact walker of ``data`` with no ground under either foot (free flight)."""
-    return ContactWalker(contact=contact_params_si(ContactSettings()), data=data, lane1=np.array([1e3]),
-                         lane2=np.array([-1e3]), continuous=False, **kw)
+    return ContactWalker(contact=contact_params_si(ContactSettings()), data=data,
+                         lane1=np.array([1e3]), lane2=np.array([-1e3]), continuous=False, **kw)
 
 
 def _link_map(structure):
@@ -235,9 +235,9 @@ def _kneed_on_one_leg(knee_stop=None):
     leg1 hanging over a gap, at rest."""
     data = _data("kneed")
     cs = ContactSettings() if knee_stop is None else ContactSettings(knee_stop=knee_stop)
-    w = ContactWalker(contact=contact_params_si(cs), data=data, knee_stop=knee_stop_si(cs.knee_stop),
-                      lane1=np.array([1e3]), lane2=np.array([0.0]), patch_half_width=0.5,
-                      continuous=False)
+    w = ContactWalker(contact=contact_params_si(cs), data=data,
+                      knee_stop=knee_stop_si(cs.knee_stop), lane1=np.array([1e3]),
+                      lane2=np.array([0.0]), patch_half_width=0.5, continuous=False)
     x0 = w.pinned_to_full(np.zeros(8), -w.static_penetration() * w.normal)
     sol = solve_ivp(w.rhs, (0, 0.3), x0, method="Radau", jac=w.jac, rtol=1e-8, atol=1e-10,
                     dense_output=True)

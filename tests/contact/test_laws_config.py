@@ -120,9 +120,9 @@ OLD_PAPER_CONTACT = """contact:
 def test_old_contact_names_get_one_line_naming_the_new_ones(tmp_path, system, new):
     """A scene written before units were in every contact name (unit_system + stiffness)
     is refused in one line that names the file and the fields to write instead."""
-    from walkerlab.config import SceneError, load_scene
-
     from pathlib import Path
+
+    from walkerlab.config import SceneError, load_scene
 
     text = Path("configs/paper.yaml").read_text()
     head = text[:text.index("contact:")]

@@ -5,8 +5,8 @@ import pytest
 
 from walkerlab.config.contact import ContactSettings
 from walkerlab.contact import ContactWalker
-from walkerlab.contact.model import checkerboard_lanes
 from walkerlab.contact.laws import contact_params_si
+from walkerlab.contact.model import checkerboard_lanes
 
 
 def _walker(**kw):

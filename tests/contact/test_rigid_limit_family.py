@@ -4,8 +4,8 @@
 import pytest
 
 from walkerlab.config.contact import ContactSettings, KneeStopSettings
-from walkerlab.contact.rigid_limit import contact_si, expected_order, scale
 from walkerlab.contact.laws import contact_params_si, knee_stop_si
+from walkerlab.contact.rigid_limit import contact_si, expected_order, scale
 
 
 def test_family_exponents():

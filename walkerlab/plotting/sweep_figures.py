@@ -111,7 +111,7 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
     Parameters
     ----------
     sweep : dict
-        :func:`walkerlab.sweep.store.load_sweep` output; 2 axes.
+        :func:`walkerlab.io.sweep_store.load_sweep` output; 2 axes.
     x_path, y_path : str, optional
         Which axis is drawn along x / y (default: second axis on x, first on y).
     log_y : bool, optional
@@ -334,7 +334,7 @@ _COLUMN_LABELS = {"max_abs_multiplier": "max |Floquet multiplier|\n(dashed: 1)",
 
 def sweep_figure(data: dict, title: str = ""):
     """The main results of a sweep against its first swept field, from a loaded sweep
-    (:func:`walkerlab.sweep.store.load_sweep`).
+    (:func:`walkerlab.io.sweep_store.load_sweep`).
 
     One panel per main result column (:data:`walkerlab.report.sweep_text.MAIN_COLUMNS`);
     points that walk (outcome ``ok``) joined by a line, one line per value of the other
@@ -346,7 +346,7 @@ def sweep_figure(data: dict, title: str = ""):
     matplotlib.figure.Figure
     """
     from walkerlab.report.sweep_text import column_unit, main_columns
-    from walkerlab.sweep.store import field_unit
+    from walkerlab.units import field_unit
 
     units = Units(str(data["attrs"].get("scene_units", "SI")))
     pts = data["points"]
@@ -362,7 +362,7 @@ def sweep_figure(data: dict, title: str = ""):
     cols = main_columns(data)
     fig, axes = plt.subplots(max(len(cols), 1), 1, figsize=(6.4, 1.2 + 1.9 * max(len(cols), 1)),
                              sharex=True, constrained_layout=True, squeeze=False)
-    xunit = units(field_unit(xpath))
+    xunit = units(field_unit(xpath) or "-")
     xlabel = _label(xpath) if xpath in _UNITS else f"{xpath} [{xunit}]"
     for ax, c in zip(axes[:, 0], cols):
         y = np.asarray(pts[c], float)

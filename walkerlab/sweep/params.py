@@ -311,7 +311,8 @@ def takes_whole_numbers(scene: Scene, axis: ParamAxis) -> bool:
 
 def axis_unit(scene: Scene, axis: ParamAxis) -> str:
     """Unit of the field an axis sweeps: the field's ``unit`` metadata (contact fields:
-    ``stiffness_n_per_mm_pow_e`` -> ``N/mm^e``), else the suffix of its name (:func:`walkerlab.units.field_unit`: ``mass_kg`` -> ``kg``), else ``"-"``.
+    ``stiffness_n_per_mm_pow_e`` -> ``N/mm^e``), else the suffix of its name
+    (:func:`walkerlab.units.field_unit`: ``mass_kg`` -> ``kg``), else ``"-"``.
 
     Raises
     ------
