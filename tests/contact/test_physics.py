@@ -7,7 +7,7 @@ from scipy.optimize import brentq
 
 from walkerlab.analysis.contact_bench import leg_angle_columns
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
-from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.contact import ContactWalker
 from walkerlab.contact.laws import contact_params_si, coulomb_friction_coefficient
 
@@ -26,7 +26,7 @@ def _standing(phi, settings=None, both_feet=False, t_final=0.5):
                       patch_half_width=1.0, continuous=False)
     x0 = initial_state_from_ideal(w, 0.0, 0.0, 0.0, 0.0)
     x0[1] += 1e-5  # start 10 µm higher: it has to settle, not just sit
-    return w, simulate_contact(w, x0, t_final, ContactSolverSettings(rtol=1e-10, atol=1e-13))
+    return w, simulate_contact(w, x0, t_final, SolverSettings.for_contact(rtol=1e-10, atol=1e-13))
 
 
 @pytest.mark.parametrize("both_feet", [False, True])
@@ -113,7 +113,7 @@ def test_rigid_limit_as_stiffness_grows():
                              stiction_velocity_mm_per_s=0.01, friction_velocity_mm_per_s=0.1)
         w = ContactWalker.from_settings(cs, TerrainSettings(), step_length=0.372, n_steps=4)
         r = simulate_contact(w, initial_state_from_ideal(w, *PAPER_FP), 0.6,
-                             ContactSolverSettings(rtol=1e-10, atol=1e-13))
+                             SolverSettings.for_contact(rtol=1e-10, atol=1e-13))
         errs.append(np.abs(r.x[:, leg_angle_columns(w)] - ideal[:, :2]).max())
     errs = np.array(errs)
     assert np.all(np.diff(errs) < 0), errs  # monotone decrease

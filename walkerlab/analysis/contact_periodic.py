@@ -691,7 +691,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
 
 
 def simulate_from_periodic_gait(scene, x_ideal: np.ndarray, strides: int | None = None,
-                                solver=None):  # scene: Scene, solver: ContactSolverSettings
+                                solver=None):  # scene: Scene, solver: SolverSettings
     """Run the contact walker of ``scene`` from its own periodic gait (``contact_sim.start:
     periodic_gait``): steady state, no start-up transient.
 

@@ -13,8 +13,9 @@ description; validation always runs and unknown keys are rejected (``extra="forb
 Modules: :mod:`~walkerlab.config.schema` (the pydantic sections and :class:`Scene`),
 :mod:`~walkerlab.config.loader` (YAML reading, validation, error lines),
 :mod:`~walkerlab.config.limits` (caps and unit-mistake warnings),
-:mod:`~walkerlab.config.contact` (compliant-contact sections).  This module only re-exports
-their public names.
+:mod:`~walkerlab.config.contact` (compliant-contact sections),
+:mod:`~walkerlab.config.solver` (the one solver section, ``solver`` and
+``contact_solver``).  This module only re-exports their public names.
 
 Raises
 ------
@@ -26,7 +27,6 @@ from walkerlab.config.contact import (
     MAX_CONTACT_STRIDES,
     ContactSettings,
     ContactSimSettings,
-    ContactSolverSettings,
     PerStepTerrain,
     TerrainSettings,
 )
@@ -78,7 +78,6 @@ from walkerlab.config.schema import (
     SceneError,
     SimulateSettings,
     SlopeSettings,
-    SolverSettings,
     SpringSpec,
     StateSpec,
     TorsoBody,
@@ -88,6 +87,7 @@ from walkerlab.config.schema import (
     WalkerParams,
     WorkPrecisionSettings,
 )
+from walkerlab.config.solver import SolverSettings
 
 __all__ = [
     "ArcFoot",
@@ -99,7 +99,6 @@ __all__ = [
     "CompassGaitParams",
     "ContactSettings",
     "ContactSimSettings",
-    "ContactSolverSettings",
     "FixedPointSettings",
     "Foot",
     "GuessFromArtifact",

@@ -1,7 +1,8 @@
 """Validated settings of the compliant-contact model and its runs (pydantic v2).
 
-The scene sections ``contact``, ``terrain``, ``contact_sim`` and ``contact_solver`` (read
-through :mod:`walkerlab.config`).  The contact model package imports its settings from here;
+The scene sections ``contact``, ``terrain`` and ``contact_sim`` (read through
+:mod:`walkerlab.config`; ``contact_solver`` is a :class:`walkerlab.config.solver.SolverSettings`
+as ``solver`` is).  The contact model package imports its settings from here;
 this module imports no model (settings lie under the models, not beside them).
 
 Every dimensional number of :class:`ContactSettings` carries its unit in its name, in
@@ -25,7 +26,7 @@ from pydantic import (
 )
 
 __all__ = ["CONTACT_QUANTITIES", "LENGTH_UNITS", "MAX_CONTACT_STRIDES", "ContactSettings",
-           "ContactSimSettings", "ContactSolverSettings", "KneeStopSettings", "PerStepTerrain",
+           "ContactSimSettings", "KneeStopSettings", "PerStepTerrain",
            "TerrainSettings", "renamed_contact_field"]
 
 
@@ -397,25 +398,3 @@ class ContactSimSettings(BaseModel):
         if isinstance(d, dict) and d.get("start") == "ideal":
             d.pop("start", None)
         return d
-
-
-class ContactSolverSettings(BaseModel):
-    """Integrator of the stiff contact model: ``cyrk_bdf`` (CyRK's BDF from compiled code,
-    the default), ``odeint`` (LSODA, low overhead), numbalsoda or solve_ivp.
-
-    The one object that carries the solver to every contact integration
-    (:func:`walkerlab.analysis.contact_sim.simulate_contact`), as
-    becomes :class:`walkerlab.integrate.solver.Solver`, as the rigid side's settings do."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
-
-    method: Literal["odeint", "cyrk_bdf", "numbalsoda", "LSODA", "Radau", "BDF", "RK45",
-                    "DOP853"] = Field(
-        "cyrk_bdf", description="cyrk_bdf (CyRK's BDF from compiled code), "
-        "scipy.integrate.odeint, numbalsoda (LSODA from compiled code; optional extra "
-        "'walkerlab[numbalsoda]') or a solve_ivp method")
-    rtol: float = Field(1e-8, ge=1e-13, lt=1,
-                        description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
-                        "cannot meet a tighter one in double precision)")
-    atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
-    max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")

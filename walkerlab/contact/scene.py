@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.config import ContactSimSettings, ContactSolverSettings, Scene, TerrainSettings
+from walkerlab.config import ContactSimSettings, Scene, SolverSettings, TerrainSettings
 
 from .model import ContactWalker
 from .rigid_limit import contact_si
@@ -27,7 +27,7 @@ def settings(scene: Scene):
 
     Returns
     -------
-    (ContactSettings, TerrainSettings, ContactSimSettings, ContactSolverSettings)
+    (ContactSettings, TerrainSettings, ContactSimSettings, SolverSettings)
 
     Raises
     ------
@@ -39,7 +39,7 @@ def settings(scene: Scene):
                                 "contact model needs")
     return (scene.contact, scene.terrain or TerrainSettings(),
             scene.contact_sim or ContactSimSettings(),
-            scene.contact_solver or ContactSolverSettings())
+            scene.contact_solver or SolverSettings.for_contact())
 
 
 def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
