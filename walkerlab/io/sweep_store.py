@@ -150,6 +150,66 @@ def _chain_check(chain: int, done: int, guess: str, key: str) -> str:
     return hashlib.sha256(f"{key}|{chain}|{done}|{guess}".encode()).hexdigest()
 
 
+def _checkpoints(f: h5py.File, n_chains: int) -> tuple[np.ndarray, list[str], list[str]]:
+    """Points done, continuation JSON and check of each chain of an open partial file
+    (rewritten as chains advance); unreadable ones are replaced: every chain restarts."""
+    try:
+        return (f["plan/done"][()],
+                [x.decode() if isinstance(x, bytes) else str(x) for x in f["plan/guess"][()]],
+                [x.decode() if isinstance(x, bytes) else str(x) for x in f["plan/check"][()]])
+    except (KeyError, ValueError, OSError):
+        for name in ("plan/done", "plan/guess", "plan/check"):
+            if name in f:
+                del f[name]
+        f.create_dataset("plan/done", data=np.zeros(n_chains, np.int64))
+        f.create_dataset("plan/guess", data=np.array(["null"] * n_chains, dtype=object),
+                         dtype=STR)
+        f.create_dataset("plan/check", data=np.array(["?"] * n_chains, dtype=object),
+                         dtype=STR)
+        return np.zeros(n_chains, np.int64), [], []
+
+
+def _intact_chains(plan: list[list[int]], checkpoints: tuple, valid: set[int],
+                   present: set[int], input_hash: str, parse_guess):
+    """The chains that continue from their checkpoint: ``(start, keep, restarted)`` with
+    ``start`` chain -> (points done, continuation), ``keep`` the grid indices of their rows
+    and ``restarted`` the number of chains with rows that start again."""
+    ndone, guesses, checks = checkpoints
+    start: dict = {}
+    keep_idx: set[int] = set()
+    restarted = 0
+    for c, chain in enumerate(plan):
+        n = int(ndone[c]) if c < len(ndone) else 0
+        ok = (c < len(checks) and 0 <= n <= len(chain)
+              and checks[c] == _chain_check(c, n, guesses[c], input_hash)
+              and all(i in valid for i in chain[:n]))
+        if ok and n > 0:
+            try:
+                start[c] = (n, parse_guess(guesses[c]))
+            except (ValueError, KeyError, TypeError):
+                ok = False
+        if ok:
+            keep_idx.update(chain[:n])
+        elif any(i in present for i in chain):
+            restarted += 1
+    return start, keep_idx, restarted
+
+
+def _drop_rows(f: h5py.File, dsets: dict, cols: dict, keep: np.ndarray, restart: list[int],
+               input_hash: str) -> None:
+    """Keep only the rows ``keep`` of every column and reset the checkpoints of the chains
+    ``restart`` (they are computed again from their start)."""
+    for name, ds in dsets.items():
+        v = cols[name][keep]
+        ds.resize((int(keep.sum()),))
+        ds[...] = v
+    for c in restart:
+        f["plan/done"][c] = 0
+        f["plan/guess"][c] = "null"
+        f["plan/check"][c] = _chain_check(c, 0, "null", input_hash)
+    f.flush()
+
+
 class SweepStore:
     """An open in-progress sweep file (use :meth:`create` or :meth:`resume`).
 
@@ -289,44 +349,13 @@ class SweepStore:
             f.close()
             raise SweepFileError(f"{part}: damaged partial sweep file; rerun without --resume") \
                 from None
-        try:  # checkpoints (rewritten as chains advance): unreadable = every chain restarts
-            ndone = f["plan/done"][()]
-            guesses = [x.decode() if isinstance(x, bytes) else str(x)
-                       for x in f["plan/guess"][()]]
-            checks = [x.decode() if isinstance(x, bytes) else str(x)
-                      for x in f["plan/check"][()]]
-        except (KeyError, ValueError, OSError):
-            ndone, guesses, checks = np.zeros(len(plan), np.int64), [], []
-            for name in ("plan/done", "plan/guess", "plan/check"):
-                if name in f:
-                    del f[name]
-            f.create_dataset("plan/done", data=np.zeros(len(plan), np.int64))
-            f.create_dataset("plan/guess", data=np.array(["null"] * len(plan), dtype=object),
-                             dtype=STR)
-            f.create_dataset("plan/check", data=np.array(["?"] * len(plan), dtype=object),
-                             dtype=STR)
+        ndone, guesses, checks = _checkpoints(f, len(plan))
         stored = [x.decode() if isinstance(x, bytes) else str(x) for x in cols["row_hash"]]
         good_row = np.array([a == b for a, b in zip(row_hashes(cols, input_hash), stored)],
                             bool)
         valid = {int(i) for i, ok in zip(idx, good_row) if ok}
-        start: dict = {}
-        keep_idx: set[int] = set()
-        restarted = 0
-        present = set(idx.tolist())
-        for c, chain in enumerate(plan):
-            n = int(ndone[c]) if c < len(ndone) else 0
-            ok = (c < len(checks) and 0 <= n <= len(chain)
-                  and checks[c] == _chain_check(c, n, guesses[c], input_hash)
-                  and all(i in valid for i in chain[:n]))
-            if ok and n > 0:
-                try:
-                    start[c] = (n, parse_guess(guesses[c]))
-                except (ValueError, KeyError, TypeError):
-                    ok = False
-            if ok:
-                keep_idx.update(chain[:n])
-            elif any(i in present for i in chain):
-                restarted += 1
+        start, keep_idx, restarted = _intact_chains(
+            plan, (ndone, guesses, checks), valid, set(idx.tolist()), input_hash, parse_guess)
         keep = np.array([int(i) in keep_idx for i in idx], bool)
         # one row per index: a chain's rows past its checkpoint are computed again
         _, first = np.unique(idx, return_index=True)
@@ -342,16 +371,8 @@ class SweepStore:
             if tell is not None:
                 tell(msg)
         if not keep.all():
-            for name, ds in dsets.items():
-                v = cols[name][keep]
-                ds.resize((int(keep.sum()),))
-                ds[...] = v
-            for c in range(len(plan)):
-                if c not in start:
-                    f["plan/done"][c] = 0
-                    f["plan/guess"][c] = "null"
-                    f["plan/check"][c] = _chain_check(c, 0, "null", input_hash)
-            f.flush()
+            _drop_rows(f, dsets, cols, keep, [c for c in range(len(plan)) if c not in start],
+                       input_hash)
         return cls(final, f, axes, columns), plan, start
 
     def checkpoint(self, chain: int, done: int, text: str, key: str) -> None:

@@ -334,6 +334,30 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
                            chunk_size, progress, on_chunk, pool, n_total)
 
 
+def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_chains):
+    """The sweep's partial file: resumed (its plan and each chain's checkpoint) or created
+    with a new plan of ``n_chains`` chains.
+
+    Raises
+    ------
+    SweepError
+        A partial file that cannot be resumed (one line).
+    """
+    columns = SweepColumns(STRING_COLUMNS, walker_columns(stage, scene), OUTCOMES)
+    if resume and partial_path(out_path).is_file():
+        # the chunk plan of the interrupted run (not re-planned from what is left: a point's
+        # continuation guess, hence its row, depends on the chain it is in, issue 19 item 13)
+        try:
+            return SweepStore.resume(out_path, axes, columns, key, guess_from_json,
+                                     tell=_progress.note)
+        except SweepFileError as exc:
+            raise SweepError(str(exc)) from None
+    base = scene.model_dump(mode="json")
+    plan = [[i for i, _ in c] for c in plan_chunks(axes, base, frozenset(), chunk_size,
+                                                   n_chains)]
+    return SweepStore.create(out_path, scene, stage, axes, columns, opts, key, plan), plan, {}
+
+
 def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, chunk_size,
                 progress, on_chunk, pool, n_total) -> Path:
     paths = [a.path for a in axes]
@@ -343,21 +367,9 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
     if resume and out_path.is_file() and not partial_path(out_path).is_file():
         if complete_sweep(out_path, key):
             return out_path
-    start: dict = {}
-    columns = SweepColumns(STRING_COLUMNS, walker_columns(stage, scene), OUTCOMES)
-    if resume and partial_path(out_path).is_file():
-        # the chunk plan of the interrupted run (not re-planned from what is left: a point's
-        # continuation guess, hence its row, depends on the chain it is in, issue 19 item 13)
-        try:
-            store, plan, start = SweepStore.resume(out_path, axes, columns, key,
-                                                   guess_from_json, tell=_progress.note)
-        except SweepFileError as exc:
-            raise SweepError(str(exc)) from None
-    else:
-        plan = [[i for i, _ in c] for c in
-                plan_chunks(axes, base, frozenset(), chunk_size,
-                            1 if scheduler is None and workers <= 1 else max(2, workers))]
-        store = SweepStore.create(out_path, scene, stage, axes, columns, opts, key, plan)
+    store, plan, start = _open_store(scene, axes, stage, out_path, resume, opts, key,
+                                     chunk_size, 1 if scheduler is None and workers <= 1
+                                     else max(2, workers))
     values_of = dict(enumerate(grid_points(axes)))
     origin = scene.name or "<scene>"
     offset = [start.get(c, (0, None))[0] for c in range(len(plan))]
