@@ -169,9 +169,9 @@ def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: floa
     from scipy.optimize import least_squares
 
     stance_leg = walker.legs[-1]
-    n = 2 * walker.n_coordinates
+    x0 = walker.layout().zeros()
     # leg links only: an ankle's angle (a flat foot's) is not a leg's and starts at 0
-    keys = [k for k in walker.leg_coordinates(np.zeros(n), stance_leg) if "_ankle_" not in k]
+    keys = [k for k in walker.leg_coordinates(x0, stance_leg) if "_ankle_" not in k]
 
     def target(k: str) -> float:
         stance = k.startswith(stance_leg + "_")
@@ -185,7 +185,7 @@ def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: floa
         d = walker.leg_coordinates(x, stance_leg)
         return np.array([float(d[k]) for k in keys]) - tgt
 
-    sol = least_squares(residual, np.zeros(n), xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    sol = least_squares(residual, x0, xtol=1e-15, ftol=1e-15, gtol=1e-15)
     return walker.from_section(walker.section(sol.x))
 
 
