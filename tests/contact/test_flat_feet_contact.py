@@ -275,6 +275,15 @@ def test_flat_feet_need_their_mass_in_the_contact_section():
     assert FLAT_FOOT_MESSAGE in msg
 
 
+def test_a_flat_stance_foot_cannot_be_pinned():
+    d = copy.deepcopy(SCENE)
+    d["contact_sim"] = {"pin_stance_until": "first_touchdown"}
+    with pytest.raises(ContactSceneError, match="pin_stance_until: pinning the stance foot "
+                       "needs point feet") as exc:
+        build(scene_from_dict(d, "f.yaml"), np.array([-0.35, 0.26, 0.0, -1.3, -1.2, -11.3]), 4)
+    assert "\n" not in str(exc.value)
+
+
 def test_point_feet_keep_one_contact_point_per_leg():
     """The paper walker's contact table keeps its rows ``leg1``, ``leg2``."""
     w = ContactWalker()

@@ -99,14 +99,19 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, a walker with a massless body, or flat feet without
-        ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2`` (one line).
+        No ``contact`` section, a walker with a massless body, flat feet without
+        ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
+        that is not a point (one line).
     """
     from walkerlab.models.description import walker_data
     from walkerlab.models.floating import FLAT_FOOT_MESSAGE, check_masses
 
-    contact, terrain, _, _ = settings(scene)
+    contact, terrain, cs, _ = settings(scene)
     data = walker_data(scene.walker, scene.slope.phi_rad)
+    if cs.pin_stance_until != "none" and data.structure.foot != "point":
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: pinning "
+                                f"the stance foot needs point feet (this walker's are "
+                                f"{data.structure.foot})")
     try:
         check_masses(data.structure)
     except ValueError as err:

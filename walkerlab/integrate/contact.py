@@ -319,7 +319,7 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline
 
     def touch(t, z):
         x = walker.pinned_to_full(z, foot2)
-        cq = walker.contact_quantities(x)["leg1"]
+        cq = walker.foot_quantities(x)["leg1"]
         return -cq["penetration"][0] if cq["on_ground"][0] > 0 else 1.0
 
     touch.terminal = True
