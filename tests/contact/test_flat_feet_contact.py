@@ -193,6 +193,9 @@ def test_step_modes_match_the_rigid_view():
     modes = [(m, a) for m, a, b in foot_modes(run.t, ev["points"], "leg2", 0.0, t_hs)
              if b - a > 2e-3]  # a toe's first millisecond on the ground is not a mode
     assert [m for m, _ in modes] == ["heel_contact", "foot_flat", "heel_off"]
+    # the step's record (contact_sim.h5 steps/stance_foot_modes) says the same
+    assert [p.split(" (")[0] for p in ev["steps"][0].foot_modes.split(" > ")] == \
+        ["heel_contact", "foot_flat", "heel_off"]
     contact_switches = [a for _, a in modes[1:]] + [t_hs]
     assert len(switches) == 2
     np.testing.assert_allclose(contact_switches, switches + [seg.t_end], atol=0.025)

@@ -129,6 +129,11 @@ class StepSummary:
         Largest penetration of either foot within the step [m].
     liftoff_time : float
         Lift-off of the stance foot ending its stance [s] (nan if none).
+    foot_modes : str
+        Flat feet: the stance foot's modes over the step with their start times
+        (``"heel_contact (0.7736 s) > foot_flat (1.0382 s) > heel_off (1.3785 s)"``, from the
+        contact table, :func:`foot_modes`; modes shorter than two samples left out); "" for
+        other feet.
     """
 
     index: int
@@ -142,6 +147,7 @@ class StepSummary:
     scuff_count: int
     peak_penetration_m: float
     liftoff_time: float = float("nan")
+    foot_modes: str = ""
 
 
 @dataclass
@@ -386,6 +392,15 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
                                  float(lo_mine[-1]) if lo_mine.size else np.nan))
     points = feet if tuple(walker.contact_names()) == tuple(feet) else \
         _foot_traces(walker, t, X, points=True)
+    if all(f"{st.stance_leg}_heel" in points and f"{st.stance_leg}_toe" in points
+           for st in steps):  # flat feet: each step's mode sequence from the contact table
+        dt = 2.0 * float(np.median(np.diff(t))) if t.size > 1 else 0.0
+        for st in steps:
+            tb = st.t_end if np.isfinite(st.t_end) else float(t[-1])
+            segs = [(m, a) for m, a, b in foot_modes(t, points, st.stance_leg, st.t_start, tb)
+                    if b - a >= dt]
+            merged = [s_ for k, s_ in enumerate(segs) if k == 0 or s_[0] != segs[k - 1][0]]
+            st.foot_modes = " > ".join(f"{m} ({a:.4f} s)" for m, a in merged)
     return {"feet": feet, "hs_t": np.array(hs_t), "hs_leg": hs_leg, "steps": steps,
             "points": points}
 

@@ -13,9 +13,9 @@ centres [m] per lane); ``initial_state`` (named by ``contact_state``),
 heel and toe combined); ``contact_points/<point>/`` (flat feet only: the same per contact
 point, ``leg1_heel``, ``leg1_toe``, ...: which points are loaded when); ``events/``
 (heel-strike times [s] and legs); ``steps/`` (per step: times [s], stance slip and creep
-[mm], bounces, scuffs, peak penetration [m]); ``summary/``; optional ``periodic_gait/``
-(the contact model's own gait: period [s], step length [m], Floquet multipliers) and
-``adjust/`` (``--adjust``'s search).
+[mm], bounces, scuffs, peak penetration [m]; flat feet: the stance foot's mode sequence);
+``summary/``; optional ``periodic_gait/`` (the contact model's own gait: period [s], step
+length [m], Floquet multipliers) and ``adjust/`` (``--adjust``'s search).
 """
 
 from __future__ import annotations
@@ -205,6 +205,10 @@ def _write_feet_events_steps(f, run: ContactSimRun) -> None:
             dims=s_dim if steps else None)
     put(g, "stance_leg", [s.stance_leg for s in steps] or [""], "-", "stance leg",
         dims=s_dim)
+    if any(getattr(s, "foot_modes", "") for s in steps):  # flat feet
+        put(g, "stance_foot_modes", [s.foot_modes for s in steps], "-", "the stance foot's "
+            "modes over the step (heel_contact, foot_flat, heel_off, off: which of its heel "
+            "and toe carry load, from the contact table) with their start times", dims=s_dim)
 
 
 def _write_periodic_and_adjust(f, run: ContactSimRun) -> None:
