@@ -649,8 +649,9 @@ class MfptSettings(_Strict):
                            description="Monte Carlo step cap per walk (censoring) [steps]")
     seed: int = Field(0, ge=0, description="Monte Carlo seed [-] (terrain.per_step.seed "
                       "when that is given)")
-    quadrature_nodes: int = Field(21, ge=3, le=61, description="Gauss-Hermite nodes of the "
-                                  "slope distribution in the mesh [-] (they integrate a fall "
+    quadrature_nodes: int = Field(21, ge=3, le=61, description="quadrature nodes of the "
+                                  "slope distribution in the mesh (Gauss-Hermite; "
+                                  "Gauss-Legendre for a uniform) [-] (they integrate a fall "
                                   "indicator, whose tails 9 nodes resolve too coarsely: +20 % "
                                   "MFPT for the paper walker at 0.004 rad)")
     mesh_cells: int = Field(2000, ge=10, le=1_000_000, description="nodes of the first "

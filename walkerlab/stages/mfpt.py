@@ -140,8 +140,7 @@ def compute(scene: Scene, x_star: np.ndarray, st: MfptSettings, workers: int = 1
     Raises
     ------
     ValueError
-        The walker cannot walk on per-step slopes, or the mesh is asked for a uniform
-        slope distribution (its quadrature is Gauss-Hermite).
+        The walker cannot walk on per-step slopes.
     """
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
     from walkerlab.models.registry import build_walker
@@ -150,10 +149,6 @@ def compute(scene: Scene, x_star: np.ndarray, st: MfptSettings, workers: int = 1
     per = scene.terrain.per_step if scene.terrain is not None else None
     dist = per.slope_distribution if per is not None else "normal"
     seed = per.seed if per is not None else st.seed
-    if st.method in ("mesh", "both") and dist != "normal":
-        raise ValueError("mfpt.method: the mesh integrates a normal slope distribution "
-                         "(Gauss-Hermite); use --method montecarlo for "
-                         "terrain.per_step.slope_distribution: uniform")
     walker = build_walker(scene)
     work.step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
     sig = np.asarray(st.sigma_rad, float)
@@ -173,7 +168,7 @@ def compute(scene: Scene, x_star: np.ndarray, st: MfptSettings, workers: int = 1
             vals["montecarlo_wall_time_s"][i] = time.perf_counter() - t
         if st.method in ("mesh", "both"):
             t = time.perf_counter()
-            last, all_meshes = work.mesh(scene, x_star, sd, st, workers, scheduler)
+            last, all_meshes = work.mesh(scene, x_star, sd, st, workers, scheduler, dist)
             vals["mfpt_steps_mesh"][i] = last.mfpt_steps
             vals["mfpt_steps_mesh_quasi_stationary"][i] = last.mfpt_quasi_stationary_steps
             vals["mesh_cells"][i] = last.cells

@@ -131,18 +131,22 @@ def image_evaluator(scene, ex):
     return evaluate
 
 
-def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler=None):
+def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler=None,
+         distribution: str = "normal"):
     """Converged (or capped) mesh MFPT at one sigma: ``(last MeshResult, all meshes)``.
 
     The nodes are the post-impact states visited by noisy walks from the gait at ``sd`` and
     at ``1.5 sd`` (so the tails, where the falls start, are meshed too; a fallen walk starts
-    again on the gait); the images of the nodes are computed over the executor."""
+    again on the gait); the images of the nodes are computed over the executor.
+    ``distribution`` (normal or uniform) is the per-step slope's: the walks draw from it
+    and the transitions integrate it (:func:`walkerlab.analysis.mfpt.slope_quadrature`)."""
     base = scene.model_dump(mode="json")
     sm = step_map_for(base)
     n = settings.mesh_max_cells
     walks = 100
     steps = max(20, math.ceil(n / walks) + 2)  # a pool of ~2 max_cells
-    pool = M.visited_states(sm, x0, (sd, 1.5 * sd), walks, steps, settings.seed)
+    pool = M.visited_states(sm, x0, (sd, 1.5 * sd), walks, steps, settings.seed,
+                            distribution=distribution)
     if len(pool) < 10 * len(x0):
         raise ValueError(f"mfpt: sigma {sd:g} rad: the walks fall too soon to shape a mesh "
                          "(fewer post-impact states than needed)")
@@ -153,7 +157,8 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
                                      refine=settings.mesh_refine,
                                      rel_change=settings.mesh_rel_change, max_cells=n,
                                      quadrature=settings.quadrature_nodes,
-                                     evaluate=image_evaluator(scene, ex))
+                                     evaluate=image_evaluator(scene, ex),
+                                     distribution=distribution)
 
 
 def _finite(v: float) -> float:
