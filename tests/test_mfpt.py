@@ -254,6 +254,7 @@ def test_mfpt_stage_artifact_and_figure(tmp_path):
     assert 0 <= m < 60 and data["montecarlo_falls"][0] > 0
     assert np.isnan(data["mfpt_steps_mesh"][0])
     assert stage.figure_path(sc, tmp_path / "runs").is_file()
+    assert not out.path.with_name("mfpt.h5.partial").exists()  # the resume file is gone
     again = pipeline.run("mfpt", sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
     assert again.reused
 

@@ -427,11 +427,15 @@ def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndar
 def mesh_mfpt_converged(step_map: BatchStepMap, pool: np.ndarray, x0: np.ndarray, sd: float,
                         cells: int = 1000, refine: float = 2.0, rel_change: float = 0.05,
                         max_cells: int = 16_000, quadrature: int = 21, evaluate=None,
-                        distribution: str = "normal"
-                        ) -> tuple[MeshResult, list[MeshResult]]:
+                        distribution: str = "normal", cache: dict | None = None,
+                        on_mesh=None) -> tuple[MeshResult, list[MeshResult]]:
     """Refine the mesh (``cells <- refine cells``: smaller voxels of the visited states
     ``pool`` (k, 2n) plus the gait ``x0``, :func:`voxel_nodes`) until the MFPT changes by
     less than ``rel_change`` between two meshes, or the pool or ``max_cells`` is exhausted.
+
+    ``cache`` (see :func:`mesh_mfpt`; rows of ``[x0, *pool]``) carries images computed
+    before, e.g. by an interrupted run; ``on_mesh(result, cache)`` is called after each mesh
+    (to store the images so far).
 
     Returns
     -------
@@ -441,7 +445,7 @@ def mesh_mfpt_converged(step_map: BatchStepMap, pool: np.ndarray, x0: np.ndarray
     P = np.concatenate([np.asarray(x0, float)[None], np.asarray(pool, float)])
     W = whitening(P)
     Z = (P - P[0]) @ W
-    cache: dict = {}
+    cache = {} if cache is None else cache
     results: list[MeshResult] = []
     n = min(cells, len(P))
     while True:
@@ -449,6 +453,8 @@ def mesh_mfpt_converged(step_map: BatchStepMap, pool: np.ndarray, x0: np.ndarray
         res = mesh_mfpt(step_map, P, idx, W, sd, quadrature, evaluate, cache, distribution)
         res.h = r
         results.append(res)
+        if on_mesh is not None:
+            on_mesh(res, cache)
         if len(results) >= 2:
             a, b = results[-2].mfpt_steps, res.mfpt_steps
             res.change = abs(b - a) / max(abs(b), 1e-300)
