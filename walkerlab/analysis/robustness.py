@@ -244,12 +244,36 @@ def largest_by_bisection(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
     (lo, hi) : floats [rad or m]
         ``hi = inf`` when ``max_value`` survives (nothing falls up to it).
     """
-    if survives(sm, x_star, disturbance, [sign * max_value], steps)[0]:
+    return bracket_flip(lambda v: survives(sm, x_star, disturbance, sign * v, steps),
+                        max_value, tol, sections)
+
+
+def bracket_flip(survive, max_value: float, tol: float, sections: int = 8
+                 ) -> tuple[float, float]:
+    """Bracket ``(lo, hi)`` of the first survival flip of ``survive`` on ``[0, max_value]``
+    (the multisection of :func:`largest_by_bisection`, for any model).
+
+    Parameters
+    ----------
+    survive : callable ``(values (k,)) -> (k,) bool``
+        Survival of each disturbance size (all of one round at once: a batch, or tasks on
+        an executor).
+    max_value, tol : float
+        Search cap and bracket width (same unit as the values).
+    sections : int
+        Sub-intervals per round (``sections - 1`` interior points).
+
+    Returns
+    -------
+    (lo, hi) : floats
+        ``lo`` survives, ``hi`` falls; ``hi = inf`` when ``max_value`` survives.
+    """
+    if survive(np.array([float(max_value)]))[0]:
         return float(max_value), float("inf")
     lo, hi = 0.0, float(max_value)
     while hi - lo > tol:
         v = np.linspace(lo, hi, sections + 1)[1:-1]
-        alive = survives(sm, x_star, disturbance, sign * v, steps)
+        alive = np.asarray(survive(v), bool)
         dead = np.flatnonzero(~alive)
         if dead.size:
             j = dead[0]

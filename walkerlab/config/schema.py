@@ -644,6 +644,12 @@ class MfptSettings(_Strict):
         description="standard deviations of the per-step slope [rad]")
     method: Literal["mesh", "montecarlo", "both"] = Field(
         "both", description="mesh (rigid model), Monte Carlo, or both side by side")
+    model: Literal["rigid", "contact"] = Field(
+        "rigid", description="rigid: the hybrid model (mesh and Monte Carlo); contact: the "
+        "compliant-contact model on checkerboard patches at the heights where each step's "
+        "slope puts the next footfall, from its periodic gait (Monte Carlo only: set "
+        "method montecarlo, and few walks and a short step cap - each walk is a contact "
+        "simulation)")
     walks: int = Field(400, ge=1, le=1_000_000, description="Monte Carlo walks per sigma")
     max_steps: int = Field(2000, ge=1, le=1_000_000,
                            description="Monte Carlo step cap per walk (censoring) [steps]")

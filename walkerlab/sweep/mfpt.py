@@ -216,11 +216,15 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): the finished
     pieces (Monte Carlo chunks, mesh images) of an interrupted run are reused and the new
     ones stored, so a killed study resumes where it stopped and gives the same numbers.
+    ``st.model == "contact"``: Monte Carlo of the compliant-contact model on patches at the
+    drawn heights (:func:`walkerlab.sweep.contact_rough.contact_monte_carlo`), from its
+    periodic gait.
 
     Raises
     ------
     ValueError
-        The walker cannot walk on per-step slopes.
+        The walker cannot walk on per-step slopes; the contact model asked for the mesh,
+        without patches or without a periodic gait (one line).
     """
     import time
 
@@ -231,15 +235,26 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     dist = per.slope_distribution if per is not None else "normal"
     seed = per.seed if per is not None else st.seed
     walker = build_walker(scene)
-    step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
+    contact = getattr(st, "model", "rigid") == "contact"
+    if contact:
+        start = _contact_start(scene, x_star, st)
+    else:
+        step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
     sig = np.asarray(st.sigma_rad, float)
     vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}
     hist = []
     for i, sd in enumerate(sig):
-        if st.method in ("montecarlo", "both"):
+        if contact:
+            from walkerlab.sweep.contact_rough import contact_monte_carlo
+
+            t = time.perf_counter()
+            mc, _ = contact_monte_carlo(start, sd, st.walks, st.max_steps, seed, dist,
+                                        workers, scheduler, partial)
+        elif st.method in ("montecarlo", "both"):
             t = time.perf_counter()
             mc = monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist, workers,
                              scheduler, partial)
+        if contact or st.method in ("montecarlo", "both"):
             m, se = mc.mfpt
             vals["mfpt_steps_montecarlo"][i] = m
             vals["mfpt_steps_montecarlo_stderr"][i] = se
@@ -262,6 +277,24 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
                       "change": r.change if math.isfinite(r.change) else math.nan}
                      for r in all_meshes]
     return MfptData(sig, vals, st.method, walker.state_names(), hist)
+
+
+def _contact_start(scene, x_star: np.ndarray, st):
+    """The contact model's periodic gait for ``mfpt.model: contact`` (one-line errors)."""
+    from walkerlab.analysis.contact_periodic import PeriodicGaitError
+    from walkerlab.analysis.contact_rough import contact_start
+    from walkerlab.contact.scene import ContactSceneError
+
+    if st.method != "montecarlo":
+        raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "
+                         "model's); set mfpt.method: montecarlo")
+    if scene.terrain is None or scene.terrain.kind != "checkerboard":
+        raise ValueError("mfpt.model: contact puts the rough ground on patches: the scene "
+                         "needs terrain.kind: checkerboard")
+    try:
+        return contact_start(scene, x_star)
+    except (ContactSceneError, PeriodicGaitError) as exc:
+        raise ValueError(f"mfpt.model: contact: {exc}") from None
 
 
 def _finite(v: float) -> float:
