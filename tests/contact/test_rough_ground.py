@@ -141,3 +141,18 @@ def test_contact_monte_carlo_same_on_dask_as_in_process(paper_start):
     np.testing.assert_array_equal(here.steps, there.steps)
     np.testing.assert_array_equal(here.fell, there.fell)
     assert kinds == kinds2
+
+
+def test_robustness_contact_steps_only_when_asked_and_on_patches(paper_scene):
+    """robustness.contact off: the contact brackets are NaN (nothing runs); on, with
+    continuous ground: one line naming terrain.kind."""
+    import math
+
+    from walkerlab.analysis.robustness import contact_steps
+    from walkerlab.config import RobustnessSettings, TerrainSettings
+
+    off = contact_steps(paper_scene, None, RobustnessSettings(), 0.05)
+    assert len(off) == 4 and all(math.isnan(v) for v in off.values())
+    flat = paper_scene.model_copy(update={"terrain": TerrainSettings(kind="continuous")})
+    with pytest.raises(ValueError, match="terrain.kind: checkerboard"):
+        contact_steps(flat, None, RobustnessSettings(contact=True), 0.05)

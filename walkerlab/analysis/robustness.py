@@ -35,6 +35,7 @@ stance leg (``relative_coordinates``).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -342,6 +343,7 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
           "push_backward_m_per_s/hi": back[1], "sigma_rad": st.sigma_rad, "mfpt_steps": m,
           "mfpt_steps_stderr": se, "montecarlo_walks": mc.steps.size,
           "montecarlo_falls": int(mc.fell.sum())}
+    sc.update(contact_steps(scene, x_star, st, 0.2 * cap, workers, scheduler))
     return RobustnessData(list(st.disturbances), {d: UNITS[d] for d in st.disturbances}, lam,
                           gsn, gnl, norm, sc, names)
 
@@ -462,4 +464,42 @@ def pushed_step(walker, x0: np.ndarray, dv_mps: np.ndarray, solver=None,
             out.outcome[i] = HEEL_STRIKE
             out.x_pre[i], out.x_next[i] = s2.x_end, s2.x_next
             out.step_time_s[i] = tm - seg.t_start + s2.period
+    return out
+
+
+def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
+                  scheduler=None) -> dict:
+    """The contact model's largest single step-down and step-up (``robustness.contact``):
+    bisection brackets [m] (search cap ``cap_m``; the stage uses a twentieth of the leg
+    length) of the step at the first heel strike, from the contact model's
+    periodic gait, surviving ``robustness.contact_survival_steps`` heel strikes
+    (:func:`walkerlab.sweep.contact_rough.contact_largest_step`, walks on the executor);
+    NaN when not asked for.
+
+    Raises
+    ------
+    ValueError
+        Asked for without a ``contact`` section, patches or periodic gait (one line).
+    """
+    keys = ("contact_step_down_m/lo", "contact_step_down_m/hi", "contact_step_up_m/lo",
+            "contact_step_up_m/hi")
+    if not getattr(st, "contact", False):
+        return dict.fromkeys(keys, math.nan)
+    from walkerlab.analysis.contact_periodic import PeriodicGaitError
+    from walkerlab.analysis.contact_rough import contact_start
+    from walkerlab.contact.scene import ContactSceneError
+    from walkerlab.sweep.contact_rough import contact_largest_step
+
+    if scene.terrain is None or scene.terrain.kind != "checkerboard":
+        raise ValueError("robustness.contact: the contact model's steps are patches at "
+                         "heights: the scene needs terrain.kind: checkerboard")
+    try:
+        start = contact_start(scene, x_star)
+    except (ContactSceneError, PeriodicGaitError) as exc:
+        raise ValueError(f"robustness.contact: {exc}") from None
+    out = {}
+    for sign, name in ((1.0, "down"), (-1.0, "up")):
+        lo, hi = contact_largest_step(start, sign, cap_m, st.resolution_m,
+                                      st.contact_survival_steps, workers, scheduler)
+        out[f"contact_step_{name}_m/lo"], out[f"contact_step_{name}_m/hi"] = lo, hi
     return out

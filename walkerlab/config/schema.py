@@ -700,6 +700,12 @@ class RobustnessSettings(_Strict):
                                     "(hip velocity change) [m/s]")
     survival_steps: int = Field(40, ge=1, le=1000, description="undisturbed steps a walker "
                                 "must take after a disturbance to survive it [steps]")
+    contact: bool = Field(False, description="also the contact model's largest step-down "
+                          "and step-up (patches at heights, from its periodic gait; each "
+                          "bisection round is a few contact walks: minutes)")
+    contact_survival_steps: int = Field(10, ge=1, le=200, description="heel strikes the "
+                                        "contact model must make after the step to survive "
+                                        "it [steps]")
 
 
 class Scene(_Strict):

@@ -1,5 +1,6 @@
 """The report's robustness section, from a loaded ``robustness.h5``
-(:class:`walkerlab.io.schemas.robustness.RobustnessData`) only."""
+(:class:`walkerlab.io.schemas.robustness.RobustnessData`) and, when the scene ran it, a loaded
+``basin.h5`` (the basin's area, :mod:`walkerlab.analysis.basin_area`) only."""
 
 from __future__ import annotations
 
@@ -16,6 +17,16 @@ def _mm(lo: float, hi: float, scale: float = 1000) -> str:
     if not math.isfinite(hi):
         return f"≥ {num(scale * lo, 3)} (none falls up to the search cap)"
     return f"{num(scale * lo, 3)} (falls at {num(scale * hi, 3)})"
+
+
+def _contact_steps(r) -> list[str]:
+    """The contact model's step-down/up beside the rigid model's (when asked for)."""
+    if not math.isfinite(r.scalars.get("contact_step_down_m/lo", math.nan)):
+        return []
+    return ["- the same for the contact model (patches at the step's height, from its own "
+            "periodic gait): step-down "
+            f"{_mm(r['contact_step_down_m/lo'], r['contact_step_down_m/hi'])} mm; step-up "
+            f"{_mm(r['contact_step_up_m/lo'], r['contact_step_up_m/hi'])} mm."]
 
 
 def _basin_line(b) -> list[str]:
@@ -51,7 +62,7 @@ def robustness_section(arts: dict) -> list[str]:
     m, se = r["mfpt_steps"], r["mfpt_steps_stderr"]
     mfpt = (f"≥ {num(r['montecarlo_walks'])} walks reached the step cap (no fall)"
             if not math.isfinite(m) else f"{num(m)} ± {num(se)} steps (standard error)")
-    return ["## Robustness (rigid model)", "",
+    return ["## Robustness (rigid model; the contact model where it says so)", "",
             f"- largest |Floquet multiplier|: {num(lam['absolute'])} in absolute leg angles, "
             f"{num(lam['relative'])} in angles relative to the stance leg (the Jacobians "
             "are similar matrices: the multipliers do not depend on the coordinates).",
@@ -59,6 +70,7 @@ def robustness_section(arts: dict) -> list[str]:
             f"{num(r['montecarlo_walks'])} walks, {num(r['montecarlo_falls'])} fell): {mfpt}.",
             f"- largest single step-down survived: {_mm(r['step_down_m/lo'], r['step_down_m/hi'])}"
             f" mm; step-up: {_mm(r['step_up_m/lo'], r['step_up_m/hi'])} mm (bisection).",
+            *_contact_steps(r),
             "- largest mid-stance push survived (an impulsive horizontal push at the hip when "
             "the stance leg is vertical, the stance foot pinned; as the hip's velocity change): "
             f"forward {_mm(r['push_forward_m_per_s/lo'], r['push_forward_m_per_s/hi'], 1)} "
