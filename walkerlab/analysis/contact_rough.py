@@ -138,16 +138,18 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
                         float(gait.period_s), float(scene.slope.phi_rad))
 
 
-#: wall-time limit of one walk [s]: this plus this per step (a foot caught below a patch's
-#: top at its edge makes the stiff solver grind until the limit: that walk has tripped)
-WALK_TIME_LIMIT_S = 20.0
+#: wall-time limit of one walk [s]: WALK_TIME_LIMIT_S + WALK_TIME_PER_STEP_S per step (a
+#: foot caught below a patch's top at its edge makes the stiff solver grind until the
+#: limit: that walk has tripped; a step takes ~0.05 s on a quiet core)
+WALK_TIME_LIMIT_S = 10.0
+WALK_TIME_PER_STEP_S = 2.0
 
 
 def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
                  ) -> tuple[int, bool, str]:
     """Walk the contact walker from ``start`` on footfalls at ``heights_m`` [m] until it
     makes ``max_steps`` heel strikes or stops otherwise (wall-time limit
-    ``WALK_TIME_LIMIT_S (1 + max_steps)``, or the scene's if smaller).
+    ``WALK_TIME_LIMIT_S + WALK_TIME_PER_STEP_S max_steps``, or the scene's if smaller).
 
     Returns
     -------
@@ -163,7 +165,7 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
     sv = settings(scene)[3]
     x_ideal = np.asarray(start.x_ideal, float)
     _, _, limits, _ = scene_start(scene, x_ideal, 2)
-    cap = WALK_TIME_LIMIT_S * (1 + max_steps)
+    cap = WALK_TIME_LIMIT_S + WALK_TIME_PER_STEP_S * max_steps
     limits = replace(limits, wall_time_limit_s=min(limits.wall_time_limit_s or cap, cap))
     walker, _ = build(scene, x_ideal, max_steps + 2, step_length_m=start.step_length_m)
     walker = footfall_lanes(walker, heights_m)
