@@ -103,8 +103,15 @@ def test_heights_are_checked_and_footfalls_map_to_lanes():
     np.testing.assert_allclose(h, [0.0, 0.0, -0.4 * np.tan(0.01), -0.4 * np.tan(0.01)
                                    + 0.4 * np.tan(0.01)], rtol=0, atol=1e-15)
     np.testing.assert_array_equal(C.step_heights(4, -0.005), [0.0, -0.005, -0.005, -0.005])
-    with pytest.raises(ValueError, match="checkerboard"):
+    with pytest.raises(ValueError, match="lanes of footfalls"):
         C.footfall_lanes(ContactWalker(contact=ContactSettings().to_si()), h)
+    cont = ContactWalker(contact=ContactSettings().to_si(), lane1=np.array([-0.4, 0.4, 1.2]),
+                         lane2=np.array([-0.8, 0.0, 0.8]))  # continuous: contiguous patches
+    steps = C.footfall_lanes(cont, np.zeros(6))
+    assert not steps.continuous and steps.patch_half_width == pytest.approx(0.4)
+    x = _states(cont, 6)
+    for xx in x:
+        np.testing.assert_allclose(steps.rhs(0, xx), cont.rhs(0, xx), rtol=0, atol=0)
 
 
 @pytest.fixture(scope="module")
@@ -143,16 +150,17 @@ def test_contact_monte_carlo_same_on_dask_as_in_process(paper_start):
     assert kinds == kinds2
 
 
-def test_robustness_contact_steps_only_when_asked_and_on_patches(paper_scene):
-    """robustness.contact off: the contact brackets are NaN (nothing runs); on, with
-    continuous ground: one line naming terrain.kind."""
+def test_robustness_contact_steps_only_when_asked(paper_scene):
+    """robustness.contact off: the contact brackets are NaN (nothing runs); on, for a scene
+    without a contact section: one line naming it."""
     import math
 
     from walkerlab.analysis.robustness import contact_steps
-    from walkerlab.config import RobustnessSettings, TerrainSettings
+    from walkerlab.config import RobustnessSettings
 
     off = contact_steps(paper_scene, None, RobustnessSettings(), 0.05)
     assert len(off) == 4 and all(math.isnan(v) for v in off.values())
-    flat = paper_scene.model_copy(update={"terrain": TerrainSettings(kind="continuous")})
-    with pytest.raises(ValueError, match="terrain.kind: checkerboard"):
-        contact_steps(flat, None, RobustnessSettings(contact=True), 0.05)
+    bare = paper_scene.model_copy(update={"contact": None})
+    with pytest.raises(ValueError, match="robustness.contact: .*'contact' section"):
+        contact_steps(bare, paper_scene.fixedpoint and np.zeros(4),
+                      RobustnessSettings(contact=True), 0.05)

@@ -62,19 +62,28 @@ def footfall_lanes(walker, heights_m: np.ndarray):
         leg2's patches are footfalls 0, 2, 4, ..., leg1's 1, 3, ....
     heights_m : ndarray (k,)
 
+    Continuous ground (``terrain.kind: continuous``, the kneed walker's) becomes contiguous
+    patches: each lane's patches widen to twice the step length, so every lane is ground
+    everywhere (from its first footfall's patch on) and a height changes half-way between
+    that lane's footfalls.
+
     Raises
     ------
     ValueError
-        Continuous ground (no patches to raise or lower).
+        Lanes without patches.
     """
-    if walker.continuous:
-        raise ValueError("terrain: rough ground for the contact model needs patches "
-                         "(terrain.kind: checkerboard), not continuous ground")
+    if walker.lane1.size == 0 or walker.lane2.size == 0:
+        raise ValueError("terrain: rough ground for the contact model needs the lanes of "
+                         "footfalls (ContactWalker.from_settings)")
     h = np.asarray(heights_m, float)
     n = 2 * max(walker.lane1.size, walker.lane2.size)
     h = np.concatenate([h, np.full(max(0, n - h.size), h[-1] if h.size else 0.0)])
+    ground = {}
+    if walker.continuous:
+        ground = {"continuous": False,
+                  "patch_half_width": float(walker.lane1[0] - walker.lane2[0])}
     return replace(walker, heights2=h[0:2 * walker.lane2.size:2],
-                   heights1=h[1:2 * walker.lane1.size:2])
+                   heights1=h[1:2 * walker.lane1.size:2], **ground)
 
 
 @dataclass(frozen=True)

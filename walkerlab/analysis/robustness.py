@@ -490,9 +490,6 @@ def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
     from walkerlab.contact.scene import ContactSceneError
     from walkerlab.sweep.contact_rough import contact_largest_step
 
-    if scene.terrain is None or scene.terrain.kind != "checkerboard":
-        raise ValueError("robustness.contact: the contact model's steps are patches at "
-                         "heights: the scene needs terrain.kind: checkerboard")
     try:
         start = contact_start(scene, x_star)
     except (ContactSceneError, PeriodicGaitError) as exc:

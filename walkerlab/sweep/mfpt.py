@@ -288,9 +288,6 @@ def _contact_start(scene, x_star: np.ndarray, st):
     if st.method != "montecarlo":
         raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "
                          "model's); set mfpt.method: montecarlo")
-    if scene.terrain is None or scene.terrain.kind != "checkerboard":
-        raise ValueError("mfpt.model: contact puts the rough ground on patches: the scene "
-                         "needs terrain.kind: checkerboard")
     try:
         return contact_start(scene, x_star)
     except (ContactSceneError, PeriodicGaitError) as exc:
