@@ -126,7 +126,8 @@ def _run_locked(scene, runs_root, force, st, workers, scheduler, up, path) -> St
     partial = MfptPartial(path.with_name(path.name + ".partial"), key, resume=not force)
     try:
         data = compute(scene, x_star, st, workers, scheduler, partial)
-    except ValueError as exc:
+    except ValueError as exc:  # bad input: nothing to resume
+        partial.remove()
         raise StageError(str(exc)) from None
     finally:
         partial.close()
