@@ -40,6 +40,8 @@ def row(name: str) -> str:
     except ValueError as exc:
         return f"| {name} | not supported: {exc} |"
     w, s = solve_scene(sc, fd_check=False)
+    if w.steps_per_map != 1:
+        return f"| {name} | not supported: legs that differ (a stride map) |"
     g = s.gait.result
     A, x = g.jacobian_variational, g.x
     T = R.relative_coordinates(w.state_names())

@@ -6,8 +6,10 @@ and seed) and the gait from ``fixedpoint.h5``; the walks and mesh cells run on l
 processes or Dask (:mod:`walkerlab.sweep.mfpt`).  Skipped when the scene sections, the sigma
 list, the method, the upstream gait and the code are unchanged.  An interrupted run resumes
 where it stopped: its finished Monte Carlo chunks and mesh images are kept in
-``mfpt.h5.partial`` (:mod:`walkerlab.io.mfpt_partial`) while the inputs are the same
-(``--force`` starts afresh); the file is removed once ``mfpt.h5`` is written.
+``mfpt.h5.partial`` (:mod:`walkerlab.io.mfpt_partial`) while the scene sections and the
+gait are the same (pieces are named by sigma: a rerun with other ``--sigma-rad`` or
+``--method`` keeps those it shares; ``--force`` starts afresh); the file is removed once
+``mfpt.h5`` is written.
 """
 
 from __future__ import annotations
@@ -122,8 +124,12 @@ def _run_locked(scene, runs_root, force, st, workers, scheduler, up, path) -> St
 
     x_star = load_fixedpoint(up).x
     t0 = time.perf_counter()
-    # finished pieces of an interrupted run with the same inputs are kept (--force: none)
-    partial = MfptPartial(path.with_name(path.name + ".partial"), key, resume=not force)
+    # finished pieces of an interrupted run with the same scene sections and gait are kept
+    # (--force: none); pieces are named by sigma, so another --sigma-rad list or --method
+    # reuses the pieces it shares
+    partial = MfptPartial(path.with_name(path.name + ".partial"),
+                          input_hash("mfpt", scene, SECTIONS, (up,), extra="resume"),
+                          resume=not force)
     try:
         data = compute(scene, x_star, st, workers, scheduler, partial)
     except ValueError as exc:  # bad input: nothing to resume
