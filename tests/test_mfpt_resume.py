@@ -3,6 +3,8 @@ finished Monte Carlo chunks and mesh images in ``mfpt.h5.partial`` are kept, an 
 piece is computed again, and the resumed study gives the same numbers, bit for bit, as an
 uninterrupted one."""
 
+from pathlib import Path
+
 import h5py
 import numpy as np
 import pytest
@@ -124,3 +126,40 @@ def test_killed_mesh_resumes_at_the_mesh_under_way(tmp_path, paper_scene, paper_
     assert small_chunks["images"] == full - first
     _same(got, ref)
     assert np.all(np.isfinite(got["mfpt_steps_mesh"]))
+
+
+@pytest.mark.slow
+def test_killed_mfpt_stage_resumes_and_keeps_pieces_across_sigma_lists(tmp_path,
+                                                                        small_chunks):
+    """walkerlab mfpt killed after 3 of its 4 Monte Carlo chunks (sigma 0.008, 10 walks in
+    chunks of 3): mfpt.h5.partial holds them, and a rerun asking for sigma 0.008 and 0.01
+    computes only the 1 chunk left at 0.008 and the 4 at 0.01; the partial file is gone
+    once mfpt.h5 is written, and the numbers at 0.008 equal an uninterrupted run's."""
+    import yaml
+
+    from walkerlab.config import load_scene
+    from walkerlab.io.schemas.mfpt import load
+    from walkerlab.stages import pipeline
+
+    d = yaml.safe_load((Path(__file__).resolve().parents[1] / "configs" / "paper.yaml")
+                       .read_text())
+    for k in ("contact", "terrain", "contact_sim", "contact_solver", "workprecision",
+              "simulate"):
+        d.pop(k, None)
+    d["mfpt"] = {"walks": 10, "max_steps": 15, "method": "montecarlo"}
+    p = tmp_path / "paper_mfpt.yaml"
+    p.write_text(yaml.safe_dump(d))
+    sc = load_scene(p)
+    ref = load(pipeline.run("mfpt", sc, tmp_path / "ref", sigma_rad=[0.008], workers=1).path)
+    small_chunks.update(walks=0, stop_walks=3)
+    with pytest.raises(KeyboardInterrupt):
+        pipeline.run("mfpt", sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
+    part = tmp_path / "runs" / sc.name / "mfpt.h5.partial"
+    assert part.is_file()
+    small_chunks.update(walks=0, stop_walks=None)
+    out = pipeline.run("mfpt", sc, tmp_path / "runs", sigma_rad=[0.008, 0.01], workers=1)
+    assert small_chunks["walks"] == 1 + 4
+    assert not part.exists()
+    got = load(out.path)
+    for k in ("mfpt_steps_montecarlo", "montecarlo_heel_strikes", "montecarlo_falls"):
+        assert got[k][0] == ref[k][0], k
