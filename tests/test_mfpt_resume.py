@@ -107,6 +107,7 @@ def test_killed_montecarlo_resumes_with_the_finished_chunks(tmp_path, paper_scen
     assert small_chunks["walks"] == 8
 
 
+@pytest.mark.slow
 def test_killed_mesh_resumes_at_the_mesh_under_way(tmp_path, paper_scene, paper_fixed_point,
                                                    small_chunks, few_nodes):
     """The mesh refinement (40 then 80 nodes, 5 slope nodes, one sigma) killed during the
