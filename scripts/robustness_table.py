@@ -85,7 +85,8 @@ def contact_row(name: str) -> str:
     cells = [name, f"{st.period_s:.6f} ({start})"]
     for sign in (1.0, -1.0):
         lo, hi = contact_largest_step(st, sign, 0.05, 0.001, 10, workers=2)
-        cells.append(f"{1000 * lo:.4g}-{1000 * hi:.4g}")
+        cells.append(f"{1000 * lo:.4g}-{1000 * hi:.4g}" if lo == lo else
+                     "falls without a step")
     cells.append(f"{time.perf_counter() - t:.0f}")
     return "| " + " | ".join(cells) + " |"
 

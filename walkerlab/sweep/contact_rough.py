@@ -112,7 +112,8 @@ def contact_largest_step(start: C.ContactStart, sign: float, max_value_m: float,
     """Bracket ``(lo, hi)`` [m] of the largest single step-down (``sign`` +1) or step-up
     (-1) at the first heel strike that the contact model survives for ``steps`` heel
     strikes (:func:`walkerlab.analysis.robustness.bracket_flip`; the ``sections - 1``
-    walks of a round run as tasks at once)."""
+    walks of a round run as tasks at once).  ``(nan, 0.0)``: the walker does not make
+    ``steps`` heel strikes even without a step (its gait does not fit the lanes)."""
     from walkerlab.analysis.robustness import bracket_flip
 
     n = steps + 6
@@ -122,4 +123,6 @@ def contact_largest_step(start: C.ContactStart, sign: float, max_value_m: float,
                  for i, v in enumerate(values)]
         out = _walk_all(tasks, workers, scheduler)
         return np.array([not out[i][1] for i in range(len(values))])
+    if not survive(np.zeros(1))[0]:
+        return float("nan"), 0.0
     return bracket_flip(survive, max_value_m, tol_m, sections)
