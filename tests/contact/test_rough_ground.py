@@ -10,13 +10,14 @@ import pytest
 
 from walkerlab.analysis import contact_rough as C
 from walkerlab.config import ContactSettings
+from walkerlab.contact.laws import contact_params_si
 from walkerlab.contact.model import ContactWalker
 
 SPACING = 0.372
 
 
 def _walker(**kw):
-    return ContactWalker(contact=ContactSettings().to_si(), continuous=False,
+    return ContactWalker(contact=contact_params_si(ContactSettings()), continuous=False,
                          lane1=np.array([SPACING, 3 * SPACING]),
                          lane2=np.array([0.0, 2 * SPACING]), **kw)
 
@@ -104,8 +105,9 @@ def test_heights_are_checked_and_footfalls_map_to_lanes():
                                    + 0.4 * np.tan(0.01)], rtol=0, atol=1e-15)
     np.testing.assert_array_equal(C.step_heights(4, -0.005), [0.0, -0.005, -0.005, -0.005])
     with pytest.raises(ValueError, match="lanes of footfalls"):
-        C.footfall_lanes(ContactWalker(contact=ContactSettings().to_si()), h)
-    cont = ContactWalker(contact=ContactSettings().to_si(), lane1=np.array([-0.4, 0.4, 1.2]),
+        C.footfall_lanes(ContactWalker(contact=contact_params_si(ContactSettings())), h)
+    cont = ContactWalker(contact=contact_params_si(ContactSettings()),
+                         lane1=np.array([-0.4, 0.4, 1.2]),
                          lane2=np.array([-0.8, 0.0, 0.8]))  # continuous: contiguous patches
     steps = C.footfall_lanes(cont, np.zeros(6))
     assert not steps.continuous and steps.patch_half_width == pytest.approx(0.4)
