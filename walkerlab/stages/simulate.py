@@ -39,7 +39,7 @@ def _longer_run(scene: Scene, runs_root, upstream: tuple[Path, ...]) -> StageOut
     the result the user asked for is kept rather than replaced (``StageOutcome.note`` says
     so; the CLI and the report print it)."""
     from walkerlab.io.artifacts import verified_hash
-    from walkerlab.stages.common import input_hash
+    from walkerlab.io.freshness import input_hash
 
     path = artifact_path(scene, runs_root, "simulate")
     n = strides_of(path)
