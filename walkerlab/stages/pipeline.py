@@ -3,9 +3,8 @@
 A stage reads the artifacts of the stages it depends on and never runs them itself;
 :func:`run` runs the upstream stages a stage needs for the scene (each with its default
 options, reusing an up-to-date artifact), then the stage.  :func:`report_plan` is the
-report's DAG: the stages the report runs for a scene, in order, and :func:`run_report` runs
-them (the work-precision study in a background thread, figures drawn as their artifacts are
-ready).
+report's DAG: the stages the report runs for a scene, in order
+(:mod:`walkerlab.stages.report_dag` runs them).
 
 ==============  ====================================================================
 stage           needs (for this scene)
@@ -122,68 +121,3 @@ NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' s
            "basin": "no 'basin' section (or no 'fixedpoint')",
            "robustness": "no 'robustness' section (or no 'fixedpoint')",
            "attribution": "no 'contact' or 'fixedpoint' section"}
-
-
-def _study(scene: Scene, runs_root, force: bool):
-    """The work-precision stage in a thread of the report, overlapping the untimed stages
-    (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
-    the contact model's kernels are compiled."""
-    from walkerlab.analysis.workprecision import start_worker
-    from walkerlab.execution.background import BackgroundStudy
-    from walkerlab.io.runpaths import stage_artifact
-
-    wp = stage_module("workprecision")
-    first_run = not stage_artifact(scene, runs_root, "workprecision").is_file()
-    return BackgroundStudy(lambda lanes: wp.run(scene, runs_root, force, lanes=lanes),
-                           start_worker, first_run,
-                           ("contact",) if scene.contact is not None else ())
-
-
-def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
-               on_done=lambda outcome: None) -> tuple[list, list[str]]:
-    """Run the stages of :func:`report_plan` and draw their figures
-    (:func:`walkerlab.stages.plot.draw_if_changed`); ``on_done(outcome)`` after each stage.
-
-    Returns
-    -------
-    (list of StageOutcome, list of str)
-        What each stage did, in order, and one line per figure group drawn or reused.
-    """
-    from walkerlab.stages.plot import draw_if_changed
-
-    plan = report_plan(scene, full)
-    done: list = []
-
-    def add(o) -> None:
-        done.append(o)
-        on_done(o)
-    drawn: list[str] = []
-    study = _study(scene, runs_root, force) if "workprecision" in plan else None
-    try:
-        if "fixedpoint" in plan:
-            add(stage_module("fixedpoint").run(scene, runs_root, force, compare_variants=True))
-        if study is not None:
-            study.start()
-        if study is not None and study.needs("contact"):
-            # numba compiles here, once
-            stage_module("workprecision").warm_up(scene, runs_root, "contact")
-            study.ready("contact")
-        for name in ("simulate", "contact-sim", "compare"):
-            if name in plan:
-                add(stage_module(name).run(scene, runs_root, force))
-        if any(o.stage in ("simulate", "contact-sim") for o in done):
-            drawn.append(draw_if_changed(scene, runs_root, force, "trajectories"))
-    except BaseException:
-        if study is not None:
-            study.cancel()
-        raise
-    if study is not None:
-        study.release()
-        add(study.join())
-        drawn.append(draw_if_changed(scene, runs_root, force, "workprecision"))
-    # after the study: the basin's worker processes and the attribution's timed cases would
-    # share the timed cases' cores
-    for name in ("basin", "robustness", "attribution"):
-        if name in plan:
-            add(stage_module(name).run(scene, runs_root, force))
-    return done, drawn

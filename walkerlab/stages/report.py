@@ -1,6 +1,6 @@
 """Stage ``report``: run the stages of the scene's plan and write the report.
 
-The stages and their figures run through :func:`walkerlab.stages.pipeline.run_report`
+The stages and their figures run through :func:`walkerlab.stages.report_dag.run_report`
 (reusing up-to-date artifacts; the work-precision study in a background thread); the
 artifacts are loaded through :mod:`walkerlab.io.schemas` and what the report states is
 computed from them (Table 3, energy drift, swing-foot clearance: :func:`load_inputs`), then
@@ -9,7 +9,8 @@ computed from them (Table 3, energy drift, swing-foot clearance: :func:`load_inp
 
 Sections appear only when the scene produces their data: an ideal-only scene gets an
 ideal-only report, with no empty contact panels.  Artifacts an earlier standalone command
-left in the run folder are left out, in one line (:func:`report_artifacts`).
+left in the run folder are left out, in one line
+(:func:`walkerlab.stages.report_dag.report_artifacts`).
 """
 
 from __future__ import annotations
@@ -18,54 +19,10 @@ from collections.abc import Callable
 from pathlib import Path
 
 from walkerlab.config import Scene
-from walkerlab.io.artifacts import stored_content_hash_matches
-from walkerlab.io.freshness import changed_fields
-from walkerlab.io.runpaths import bifurcation_artifacts, figures_dir, report_dir
+from walkerlab.io.runpaths import figures_dir, report_dir
 from walkerlab.report.build import ReportInputs, write_report
-from walkerlab.stages.common import StageOutcome, artifact_path
-from walkerlab.stages.pipeline import NOT_RUN, report_plan, run_report, stage_module
-
-REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation", "basin", "robustness", "attribution")
-#: artifacts shown although this report did not compute them, when computed for the
-#: scene's current sections: (their stage, why one is left out)
-EARLIER = {"workprecision": "measured for other settings; `walkerlab report --full` "
-                            "measures it again",
-           "attribution": "computed for other settings; `walkerlab report --full` computes "
-                          "it again",
-           "bifurcation": "computed for another walker, slope or solver"}
-
-
-def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
-    """``{stage: path}`` of the report's stages whose artifact exists for ``scene``, and
-    ``{bifurcation_<field>: path}`` of bifurcations over other fields (``--param``)."""
-    out = {s: p for s in REPORT_STAGES if (p := artifact_path(scene, runs_root, s)).is_file()}
-    return out | bifurcation_artifacts(scene, runs_root)
-
-
-def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
-    """'' when the artifact ``p`` the report did not produce is shown all the same."""
-    kind = "bifurcation" if stage.startswith("bifurcation") else stage
-    if kind not in EARLIER or (kind == "workprecision" and (scene.workprecision is None or full)
-                               ) or (kind == "attribution" and (scene.contact is None or full)):
-        return f"an earlier standalone run: the scene has {NOT_RUN.get(stage, 'no section for it')}"
-    if kind == "bifurcation" and not stored_content_hash_matches(p):  # edited by hand (26)
-        return "changed after it was written: rerun 'walkerlab bifurcation'"
-    return EARLIER[kind] if changed_fields(p, scene, stage_module(kind).SECTIONS) else ""
-
-
-def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
-                     ) -> tuple[dict[str, Path], str]:
-    """The artifacts the report shows (those this report produced, ``done``, and those of
-    :data:`EARLIER` computed for the current scene) and one line on what it leaves out."""
-    produced, paths, left = {o.stage for o in done}, {}, []
-    for stage, p in existing_artifacts(scene, runs_root).items():
-        why = "" if stage in produced else _why_left_out(scene, stage, p, full)
-        if why:
-            left.append(f"{p.name} ({why})")
-        else:
-            paths[stage] = p
-    return paths, ("report: leaves out " + "; ".join(left)) if left else ""
+from walkerlab.stages.pipeline import report_plan
+from walkerlab.stages.report_dag import report_artifacts, run_report
 
 
 def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportInputs:
