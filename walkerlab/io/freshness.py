@@ -2,7 +2,9 @@
 
 A stage's artifact stores the hash of everything its content depends on
 (:func:`input_hash`); :func:`recompute_reason` says in one line why an existing artifact no
-longer matches (the scene fields that changed, another walkerlab version, ...).
+longer matches (the scene fields that changed, another walkerlab version, ...).  ``scene``
+is a :class:`walkerlab.config.Scene`, taken as it comes (``config`` imports ``io``, never
+the other way round; as :func:`walkerlab.io.artifacts.write_artifact` takes it).
 """
 
 from __future__ import annotations
@@ -12,11 +14,10 @@ import json
 from pathlib import Path
 
 import walkerlab
-from walkerlab.config import Scene
 from walkerlab.io.artifacts import code_hash, content_hash, root_attrs
 
 
-def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
+def input_hash(stage: str, scene, sections: tuple[str, ...],
                upstream: tuple[Path, ...] = (), extra: str = "") -> str:
     """Content hash of everything a stage's output depends on.
 
@@ -45,7 +46,7 @@ def _leaves(d, prefix: str = "") -> dict[str, object]:
     return {prefix.rstrip("."): d}
 
 
-def changed_fields(path: Path, scene: Scene, sections: tuple[str, ...]) -> list[str]:
+def changed_fields(path: Path, scene, sections: tuple[str, ...]) -> list[str]:
     """``"simulate.strides 20 -> 5"`` for each scene field (of ``sections``) whose value in the
     artifact's stored scene differs from ``scene``'s; [] when none or unreadable."""
     try:
@@ -59,7 +60,7 @@ def changed_fields(path: Path, scene: Scene, sections: tuple[str, ...]) -> list[
             if was.get(k) != now.get(k)]
 
 
-def recompute_reason(path: Path, scene: Scene, sections: tuple[str, ...],
+def recompute_reason(path: Path, scene, sections: tuple[str, ...],
                      have: str | None) -> str:
     """One line saying why an existing artifact ``path`` is out of date (``have``: its
     verified input hash, None when its content does not match its stored hash)."""
