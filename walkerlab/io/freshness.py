@@ -15,6 +15,7 @@ from pathlib import Path
 
 import walkerlab
 from walkerlab.io.artifacts import code_hash, content_hash, root_attrs
+from walkerlab.safefs import NotARegularFile, read_regular
 
 
 def input_hash(stage: str, scene, sections: tuple[str, ...],
@@ -74,3 +75,20 @@ def recompute_reason(path: Path, scene, sections: tuple[str, ...],
     if old_code is not None and str(old_code) != code_hash():
         return "walkerlab's code changed"
     return "an upstream artifact or a stage option changed"
+
+
+def drawing_key(artifacts: dict[str, Path]) -> str:
+    """Key of figures drawn from ``artifacts`` (``{stage: path}`` of those that exist): their
+    *recomputed* content hashes and walkerlab's code (a hand edit, or a recompute after one,
+    changes the key; issue 26)."""
+    arts = {s: str(content_hash(p)) for s, p in artifacts.items()}
+    return json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True)
+
+
+def stamp_matches(stamp: Path, key: str) -> bool:
+    """Whether the stamp file ``stamp`` holds ``key`` (read bounded and non-blocking: a FIFO
+    or a huge file in its place is no match)."""
+    try:
+        return read_regular(stamp, 1 << 16, "figure stamp").decode() == key
+    except (OSError, NotARegularFile, UnicodeDecodeError):
+        return False

@@ -8,12 +8,12 @@ when that changes (:func:`draw_if_changed`).
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io import runpaths
-from walkerlab.io.artifacts import code_hash, content_hash, stored_content_hash_matches
+from walkerlab.io.artifacts import stored_content_hash_matches
+from walkerlab.io.freshness import drawing_key, stamp_matches
 from walkerlab.io.schemas.compare import load_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
@@ -40,13 +40,10 @@ def check_unedited(path: Path) -> Path:
 
 
 def figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
-    """Stamp file of a drawn figure group (:data:`PARTS`) and its key: the *recomputed*
-    content hashes of the artifacts it is drawn from and walkerlab's code (a hand edit, or a
-    recompute after one, changes the key; issue 26)."""
-    arts = {s: str(content_hash(p)) for s in PARTS[part]
-            if (p := artifact_path(scene, runs_root, s)).is_file()}
-    return (runpaths.figures_dir(scene, runs_root) / f".drawn_from_{part}",
-            json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True))
+    """Stamp file of a drawn figure group (:data:`PARTS`) and its key
+    (:func:`walkerlab.io.freshness.drawing_key` of the artifacts it is drawn from)."""
+    arts = {s: p for s in PARTS[part] if (p := artifact_path(scene, runs_root, s)).is_file()}
+    return (runpaths.figures_dir(scene, runs_root) / f".drawn_from_{part}", drawing_key(arts))
 
 
 def _load(scene: Scene, runs_root, stage: str, load):
@@ -100,14 +97,7 @@ def draw_if_changed(scene: Scene, runs_root, force: bool, part: str) -> str:
     """Draw one figure group unless it was drawn from the same artifact content by the same
     code (:func:`figures_key`: matplotlib and ~16 PNG/SVG files are most of a rerun's time);
     returns the line to print."""
-    from walkerlab.safefs import NotARegularFile, read_regular
-
-    stamp, key = figures_key(scene, runs_root, part)
-    try:  # bounded, non-blocking: a FIFO or a huge file in its place is no match
-        same = read_regular(stamp, 1 << 16, "figure stamp").decode() == key
-    except (OSError, NotARegularFile, UnicodeDecodeError):
-        same = False
-    if not force and same:
+    if not force and stamp_matches(*figures_key(scene, runs_root, part)):
         return f"{'plot':>13s}: {part} figures reused (drawn from these artifacts' content)"
     figs = run(scene, runs_root, parts=(part,))  # writes the stamp
     return f"{'plot':>13s}: {part}, {len([p for p in figs if p.suffix == '.png'])} figures"
