@@ -40,8 +40,7 @@ class StageOutcome:
     failure: str = ""
 
 
-def tell(msg: str) -> None:
-    """A notice on stderr (a recomputed artifact, a lock waited for)."""
+def _tell(msg: str) -> None:
     print(msg, file=sys.stderr)
 
 
@@ -62,7 +61,7 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
     """
     path = artifact_path(scene, runs_root, artifact or stage, claim=True)
     # one writer per artifact: a second identical run waits, then finds the result up to date
-    with artifact_lock(path, wait=True, on_wait=tell):
+    with artifact_lock(path, wait=True, on_wait=_tell):
         key = input_hash(stage, scene, sections, upstream, extra_key)
         note = ""
         if path.is_file():
@@ -74,7 +73,7 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
             # never replace a result silently: say what is recomputed and why (one line)
             note = "--force" if force else recompute_reason(path, scene, sections, have)
             if not force:
-                tell(f"{stage}: recomputing {path} ({note})")
+                _tell(f"{stage}: recomputing {path} ({note})")
         t0 = time.perf_counter()
         writer, summary = compute()
         wall = time.perf_counter() - t0

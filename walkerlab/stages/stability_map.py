@@ -8,13 +8,24 @@ scene's physics sections, the code and the grid), and its figure
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from walkerlab.config import CommandOptions, Scene, validate_option
-from walkerlab.io.runpaths import figures_dir
-from walkerlab.io.schemas.stability_map import load_stability_map, write_stability_map
+from walkerlab.io.schemas.stability_map import (
+    StabilityMapRun,
+    load_stability_map,
+    write_stability_map,
+)
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
-from walkerlab.sweep.stability import MapSpec, default_spec, gait_map, map_run
+from walkerlab.sweep.stability import (
+    CELL_FIELDS,
+    MAP_KINDS,
+    MapSpec,
+    default_spec,
+    gait_map,
+    stable_fraction,
+)
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
 
@@ -37,8 +48,15 @@ def not_applicable(scene: Scene, kind: str) -> str:
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         kind: str = "stiffness", n: int = 8, workers: int = 2, time_limit_s: float = 60.0,
         spec: MapSpec | None = None, progress=None) -> StageOutcome:
-    """Compute (or reuse) one stability map and draw its figure.  Raises StageError (no
-    ``contact`` or ``fixedpoint`` section) or ValueError (unknown ``kind``), one line."""
+    """Compute (or reuse) one stability map and draw its figure.
+
+    Raises
+    ------
+    StageError
+        The scene has no ``contact`` or ``fixedpoint`` section.
+    ValueError
+        Unknown ``kind``.
+    """
     require(scene, "contact", "stability-map")
     require(scene, "fixedpoint", "stability-map")
     why = not_applicable(scene, kind)
@@ -65,13 +83,34 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                     progress(done, total)
 
             cells = gait_map(scene, spec, workers=workers, progress=tick)
-        run, summary = map_run(scene, spec, cells)
+        frac = stable_fraction(cells)
+        reasons = [str(r) for r in cells["reason"].ravel() if r]
+        summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
+
+        run = StabilityMapRun(spec, cells, frac, scene.contact.stiffness_family,
+                              scene.contact.unit_system, CELL_FIELDS, MAP_KINDS[spec.kind][1],
+                              (math.degrees(scene.slope.phi_rad),
+                               _scene_value(scene, spec.y_path)))
         return (lambda f: write_stability_map(f, run)), summary
 
     out = run_cached(stage_name(spec.kind), scene, runs_root, SECTIONS, (), compute, force,
                      extra_key=spec.key())
+    from walkerlab.io.runpaths import figures_dir
+
     draw(out.path, figures_dir(scene, runs_root, claim=True))
     return out
+
+
+def _scene_value(scene: Scene, path: str) -> float:
+    """The scene's value of a map's y field (``contact.stiffness``; a missing optional
+    section at its default: ``terrain.patch_width_m`` 0.10); NaN if it has none."""
+    from walkerlab.config import TerrainSettings
+
+    d = scene.model_dump()
+    d["terrain"] = d.get("terrain") or TerrainSettings().model_dump()
+    for k in path.split("."):
+        d = d.get(k) if isinstance(d, dict) else None
+    return float(d) if isinstance(d, int | float) else float("nan")
 
 
 def draw(path: Path | str, out_dir: Path | str | None = None) -> list[Path]:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -159,57 +158,3 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
 
 def _finite(v: float) -> float:
     return v if math.isfinite(v) else math.nan
-
-
-def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None):
-    """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` (``st``: the scene's
-    :class:`walkerlab.config.MfptSettings`) from the gait ``x_star`` -> ``MfptData``.
-
-    Raises
-    ------
-    ValueError
-        The walker cannot walk on per-step slopes, or the mesh is asked for a uniform
-        slope distribution (its quadrature is Gauss-Hermite).
-    """
-    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
-    from walkerlab.models.registry import build_walker
-
-    per = scene.terrain.per_step if scene.terrain is not None else None
-    dist = per.slope_distribution if per is not None else "normal"
-    seed = per.seed if per is not None else st.seed
-    if st.method in ("mesh", "both") and dist != "normal":
-        raise ValueError("mfpt.method: the mesh integrates a normal slope distribution "
-                         "(Gauss-Hermite); use --method montecarlo for "
-                         "terrain.per_step.slope_distribution: uniform")
-    walker = build_walker(scene)
-    step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
-    sig = np.asarray(st.sigma_rad, float)
-    vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}
-    hist = []
-    for i, sd in enumerate(sig):
-        if st.method in ("montecarlo", "both"):
-            t = time.perf_counter()
-            mc = monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist, workers,
-                             scheduler)
-            m, se = mc.mfpt
-            vals["mfpt_steps_montecarlo"][i] = m
-            vals["mfpt_steps_montecarlo_stderr"][i] = se
-            vals["montecarlo_walks"][i] = mc.steps.size
-            vals["montecarlo_falls"][i] = int(mc.fell.sum())
-            vals["montecarlo_heel_strikes"][i] = int(mc.steps.sum())
-            vals["montecarlo_wall_time_s"][i] = time.perf_counter() - t
-        if st.method in ("mesh", "both"):
-            t = time.perf_counter()
-            last, all_meshes = mesh(scene, x_star, sd, st, workers, scheduler)
-            vals["mfpt_steps_mesh"][i] = last.mfpt_steps
-            vals["mfpt_steps_mesh_quasi_stationary"][i] = last.mfpt_quasi_stationary_steps
-            vals["mesh_cells"][i] = last.cells
-            vals["mesh_change"][i] = last.change
-            vals["mesh_converged"][i] = float(last.converged)
-            vals["mesh_escaped"][i] = last.escaped
-            vals["mesh_wall_time_s"][i] = time.perf_counter() - t
-            hist += [{"sigma_rad": float(sd), "h": r.h, "cells": r.cells,
-                      "mfpt_steps": r.mfpt_steps,
-                      "change": r.change if math.isfinite(r.change) else math.nan}
-                     for r in all_meshes]
-    return MfptData(sig, vals, st.method, walker.state_names(), hist)

@@ -21,7 +21,6 @@ The cached stage is :mod:`walkerlab.stages.stability_map`; the figure
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -29,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["MAP_KINDS", "CELL_FIELDS", "REASONS", "MapSpec", "default_spec", "gait_row",
-           "gait_map", "stable_fraction", "map_run", "MAP_GAIT_OPTIONS"]
+           "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS"]
 
 #: map kind -> (dotted scene path of the y axis, label)
 MAP_KINDS = {
@@ -243,34 +242,3 @@ def stable_fraction(cells: dict) -> dict:
     n = ex.size
     return {"cells": int(n), "exists_fraction": float(ex.sum() / n),
             "stable_fraction": float(st.sum() / n)}
-
-
-def map_run(scene, spec: MapSpec, cells: dict):
-    """What the stability-map artifact holds for ``cells`` (:func:`gait_map`) and a summary:
-    the stable fractions and the count of each reason a cell has no gait.
-
-    Returns
-    -------
-    (walkerlab.io.schemas.stability_map.StabilityMapRun, dict)
-    """
-    from walkerlab.io.schemas.stability_map import StabilityMapRun
-
-    frac = stable_fraction(cells)
-    reasons = [str(r) for r in cells["reason"].ravel() if r]
-    summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
-    run = StabilityMapRun(spec, cells, frac, scene.contact.stiffness_family,
-                          scene.contact.unit_system, CELL_FIELDS, MAP_KINDS[spec.kind][1],
-                          (math.degrees(scene.slope.phi_rad), _scene_value(scene, spec.y_path)))
-    return run, summary
-
-
-def _scene_value(scene, path: str) -> float:
-    """The scene's value of a map's y field (``contact.stiffness``; a missing optional
-    section at its default: ``terrain.patch_width_m`` 0.10); NaN if it has none."""
-    from walkerlab.config import TerrainSettings
-
-    d = scene.model_dump()
-    d["terrain"] = d.get("terrain") or TerrainSettings().model_dump()
-    for k in path.split("."):
-        d = d.get(k) if isinstance(d, dict) else None
-    return float(d) if isinstance(d, int | float) else float("nan")
