@@ -19,14 +19,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from walkerlab.config import Scene, SlopeSettings
-from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
-from walkerlab.io.freshness import input_hash
 from walkerlab.io.runpaths import figures_dir
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.io.terrain import load_terrain
 from walkerlab.plotting import CONTACT_LABEL, IDEAL_LABEL
 from walkerlab.stages.common import artifact_path
+from walkerlab.stages.pipeline import computed_for
 
 #: Frames per second, and the most frames one animation gets (a 5-stride compass gait,
 #: 7 s, is 141 frames at 20 fps; longer runs play faster).
@@ -42,21 +41,6 @@ class AnimateOutcome:
     note: str = ""
 
 
-def contact_left_out(scene: Scene, runs_root, path: Path) -> str:
-    """Why ``contact_sim.h5`` must not be drawn beside the current rigid walker ('' if it
-    may): changed after it was written, or written for other inputs than the scene's
-    current ones (any of the contact stage's variants: plain, ``--adjust``, ``--periodic``)."""
-    from walkerlab.stages.contact_sim import SECTIONS
-
-    if not stored_content_hash_matches(path):
-        return f"{path.name} was changed after it was written"
-    up, have = (artifact_path(scene, runs_root, "fixedpoint"),), stored_hash(path)
-    for extra in ((), ("adjust",), ("periodic",), ("adjust", "periodic")):
-        if have == input_hash("contact-sim", scene, SECTIONS + extra, up):
-            return ""
-    return f"{path.name} was computed for another scene or fixed point"
-
-
 def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
         max_frames: int = MAX_FRAMES) -> AnimateOutcome:
     """Write ``runs/<scene>/report/figures/animation.gif`` (and ``.mp4`` with ffmpeg) at
@@ -70,7 +54,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
     sim = load_simulate(artifact_path(scene, runs_root, "simulate"))
     trajs, ground, notes = {IDEAL_LABEL: sim.samples}, {}, []
     contact = artifact_path(scene, runs_root, "contact-sim")
-    why = contact_left_out(scene, runs_root, contact) if contact.is_file() else ""
+    # any of the contact stage's variants: plain, --adjust, --periodic
+    why = computed_for(scene, runs_root, "contact-sim", ("adjust", "periodic")) \
+        if contact.is_file() else ""
     if why:
         notes.append(f"animated the rigid walker only: {why} (rerun 'walkerlab contact-sim' "
                      "to animate the contact walker beside it)")

@@ -68,6 +68,28 @@ def stage_module(stage: str):
     return importlib.import_module(f"walkerlab.stages.{MODULES[stage]}")
 
 
+def computed_for(scene: Scene, runs_root, stage: str, variants: tuple[str, ...] = ()) -> str:
+    """Why the existing artifact of ``stage`` must not be used beside the scene's current
+    results ('' if it may): changed after it was written, or written for other inputs than
+    the scene's current ones (with any subset of the stage's ``variants``, e.g. contact-sim's
+    ``adjust`` and ``periodic``, in its input hash)."""
+    from itertools import combinations
+
+    from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
+    from walkerlab.io.freshness import input_hash
+    from walkerlab.io.runpaths import stage_artifact
+
+    path = stage_artifact(scene, runs_root, stage)
+    if not stored_content_hash_matches(path):
+        return f"{path.name} was changed after it was written"
+    up = tuple(stage_artifact(scene, runs_root, s) for s in needs(stage, scene))
+    have, sections = stored_hash(path), stage_module(stage).SECTIONS
+    for extra in (c for k in range(len(variants) + 1) for c in combinations(variants, k)):
+        if have == input_hash(stage, scene, sections + extra, up):
+            return ""
+    return f"{path.name} was computed for another scene or fixed point"
+
+
 def run_upstream(stage: str, scene: Scene, runs_root: Path | str = "runs") -> None:
     """Run (or reuse) every stage upstream of ``stage``, with default options."""
     for s in order(stage, scene)[:-1]:
