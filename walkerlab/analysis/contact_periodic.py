@@ -242,7 +242,7 @@ class StepMap:
         val[self._angle[0]] = val[self._angle[1]]
         ix = self.idx
         cols = [ix[c] for c in ix.names[ix.coordinates] if c not in ("hip_x", "hip_y")]
-        zp = np.array([val[c] for c in cols] + [val[c + ix.n // 2] for c in cols])
+        zp = np.array([val[c] for c in cols] + [val[ix.rate_of(ix.names[c])] for c in cols])
         # stance foot at p and at rest, then the whole walker translated at v
         x = self.walker.pinned_to_full(zp, p)
         x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] += v
@@ -619,11 +619,11 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     guess = np.asarray(guess, float)
     if guess.size == len(P.names):
         z = guess.copy()
-    elif guess.size == 2 * len(walker.structure.roles):
+    elif guess.size == walker.rigid_layout().size:
         z = section_guess_from_ideal(PC, guess, rate_scale)
     else:
         raise ValueError(f"guess must be a section state ({len(P.names)},) or an ideal state "
-                         f"({2 * len(walker.structure.roles)},)")
+                         f"({walker.rigid_layout().size},)")
     hist = []
     for _ in range(warmup_steps):
         z1 = PC(z)[0]

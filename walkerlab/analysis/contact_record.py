@@ -43,9 +43,8 @@ def drop_test(scene: Scene, mass_kg: float) -> dict:
 def rate_states(walker, leg: str) -> list[str]:
     """Names of the rate states of ``leg``'s links (what one entry of
     ``initial_rate_scale`` multiplies): ``dtheta1``; kneed ``dtheta1_thigh dtheta1_shank``."""
-    idx = walker.state_names()
-    n = walker.nq
-    return [idx[idx.index(s) + n] for s in walker.leg_angle_states(leg)]
+    lay = walker.layout()
+    return [lay.rate_of(s) for s in walker.leg_angle_states(leg)]
 
 
 def run_summary(res) -> dict:

@@ -156,6 +156,20 @@ class ArcFoot(_Strict):
 Foot = Annotated[PointFoot | ArcFoot, Field(discriminator="kind")]
 
 
+class KneeSpringSpec(_Strict):
+    """A linear torsional spring and viscous damper at the knee: torque ``-k (knee - rest) -
+    c d(knee)/dt`` on the shank and the opposite on the thigh, ``knee`` = shank angle - thigh
+    angle (0 straight, negative flexed)."""
+
+    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
+                                         "[N m/rad]")
+    rest_angle_rad: float = Field(0.0, ge=-3.2, le=3.2, description="knee angle (shank - "
+                                  "thigh, negative flexed) at which the spring is relaxed "
+                                  "[rad]")
+    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
+                                         "[N m s/rad]")
+
+
 class KneeSpec(_Strict):
     """A knee joint splitting the leg into thigh (hip to knee) and shank (knee to foot).
 
@@ -166,6 +180,22 @@ class KneeSpec(_Strict):
     thigh_length_m: float = Field(gt=0, le=100, description="hip to knee [m]")
     lock: Literal["plastic"] = Field("plastic", description="knee strike: plastic impact, then "
                                      "the knee stays locked until heel strike")
+    spring: KneeSpringSpec | None = Field(None, description="torsional spring-damper at the "
+                                          "knee (null: none); in the rigid view it acts on "
+                                          "the free swing knee (a locked knee holds it)")
+
+    @field_validator("lock", mode="before")
+    @classmethod
+    def _elastic_is_contact_only(cls, v):
+        # an elastic stop (restitution e > 0) in a rigid model rebounds, returns and strikes
+        # again: infinitely many knee impacts in finite time (Zeno, as a bouncing ball), no
+        # honest step to hand on; the contact view's stop is compliant (IMPACT law) instead
+        if v == "elastic":
+            raise ValueError("'elastic' is available in the contact view only, as its "
+                             "compliant knee stop (contact.knee_stop with latch: false); in "
+                             "the rigid view an elastic stop chatters (infinitely many knee "
+                             "impacts in finite time): keep lock: plastic")
+        return v
 
 
 class LegSpec(_Strict):
@@ -341,8 +371,6 @@ class BipedParams(_Strict):
                                ("springs", self.springs)) if on]
         if new and self.coordinates != "absolute":
             raise ValueError(f"coordinates: {new[0]} needs 'absolute'")
-        if new and pair[0].knee is not None:
-            raise ValueError(f"{new[0]}: not available with a knee yet (straight legs only)")
         if self.springs and any(b.mass_kg == 0 for leg in pair for b in leg.bodies):
             raise ValueError("springs: not with massless bodies (a sprung massless leg has "
                              "no flow in the limit m -> 0)")
@@ -750,8 +778,9 @@ class Scene(_Strict):
         c = self.contact
         if c is None or not c.knee_stop.latch:
             return self
-        leg = getattr(self.walker, "leg", None)
-        if leg is None or getattr(leg, "knee", None) is None:
+        pair = getattr(self.walker, "leg_pair", None)  # a biped's legs (or its leg, twice)
+        leg = pair()[0] if pair is not None else None
+        if leg is None or leg.knee is None:
             raise ValueError("contact.knee_stop.latch: the walker's legs are straight (no "
                              "walker.leg.knee), so there is no knee to latch: remove it or "
                              "give the leg a knee")

@@ -251,6 +251,18 @@ class ContactWalker:
         u = ("m", "m") + ("rad",) * (self.nq - 2)
         return u + tuple(f"{s}/s" for s in u)
 
+    def layout(self):
+        """The floating state layout (:class:`walkerlab.models.layout.StateLayout`)."""
+        from walkerlab.models.layout import StateLayout
+
+        return StateLayout.floating(self._coords, self.state_names(), self.state_units())
+
+    def rigid_layout(self):
+        """The layout of the rigid hybrid view of the same walker (its ideal states)."""
+        from walkerlab.models.layout import StateLayout
+
+        return StateLayout.rigid(self.structure.roles)
+
     def leg_angle_states(self, leg: str) -> tuple[str, ...]:
         """State names of ``leg``'s link angles, proximal first (``theta1`` or
         ``theta1_thigh``, ``theta1_shank``)."""
@@ -312,27 +324,17 @@ class ContactWalker:
         ``[th_swing_thigh, th_swing_shank, th_stance, rates]`` (the stance knee straight);
         other coordinate schemes through the rigid model's leg angles.
         """
+        from walkerlab.models.layout import floating_links_from_rigid
+
         x = np.asarray(x_ideal, float)
         st = self.structure
-        s1, s2 = float(rate_scale[0]), float(rate_scale[1])
-        roles = st.roles  # the rigid walker's state, by name (<role>_angle, <role>_rate)
-        by = {f"{r}_angle": x[i] for i, r in enumerate(roles)}
-        by.update({f"{r}_rate": x[len(roles) + i] for i, r in enumerate(roles)})
-        if st.knee:
-            ang = [by["swing_thigh_angle"], by["swing_shank_angle"], by["stance_angle"],
-                   by["stance_angle"]]
-            rates = [s1 * by["swing_thigh_rate"], s1 * by["swing_shank_rate"],
-                     s2 * by["stance_rate"], s2 * by["stance_rate"]]
-        elif st.coordinates == "absolute":
-            ang = [by["swing_angle"], by["stance_angle"]]
-            rates = [s1 * by["swing_rate"], s2 * by["stance_rate"]]
+        if st.coordinates == "absolute" or st.knee:
+            values = self.rigid_layout().named(x)  # the rigid state, by name
         else:
             from walkerlab.models.rigid import functions
 
-            la = functions(self.data)["leg_angles"](x)
-            ang = [la["swing_angle"], la["stance_angle"]]
-            rates = [s1 * la["swing_rate"], s2 * la["stance_rate"]]
-        return np.array(ang + rates, dtype=float)
+            values = functions(self.data)["leg_angles"](x)
+        return floating_links_from_rigid(values, self.layout(), rate_scale)
 
     # ------------------------------------------------------------------ post-processing
     def _rows(self, X) -> np.ndarray:
