@@ -102,9 +102,9 @@ def energy_by_sink(walker, z, n_samples: int = 20000) -> dict[str, float]:
     from walkerlab.analysis.contact_periodic import StepMap
 
     sm = StepMap(walker)
-    sol = sm.integrate(sm.to_state(z), stance_to_come=0, dense=True)
-    t = np.linspace(sol.t[0], sol.t[-1], n_samples)
-    X = sol.sol(t).T
+    run = sm.integrate(sm.to_state(z), stance_to_come=0, dense=True)
+    t = np.linspace(run.t[0], run.t[-1], n_samples)
+    X = run.dense(t).T
     w, c = sm.walker, sm.walker.contact
     cq = w.contact_quantities(X)
     # in contact: on a patch and below its top (the force may be clipped at 0 there: the

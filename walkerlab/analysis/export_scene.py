@@ -34,7 +34,8 @@ import math
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import ContactParamsSI, ContactSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.contact.laws import ContactParamsSI
 from walkerlab.io.export import MJCF_MIN_LENGTH_M, MJCF_MIN_MASS_KG, MjcfScene, point_foot_radius
 
 __all__ = ["EXPORT_STEPS", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]

@@ -31,7 +31,6 @@ from pydantic import (
 from walkerlab.config.contact import (
     ContactSettings,
     ContactSimSettings,
-    ContactSolverSettings,
     TerrainSettings,
 )
 from walkerlab.config.errors import format_error
@@ -45,6 +44,12 @@ from walkerlab.config.limits import (
     MAX_STEP_TIME_S,
     MAX_STEPS_PER_WALKING_STEP,
     MAX_WORKERS,
+)
+from walkerlab.config.solver import (
+    SolverSettings,
+    check_contact,
+    check_rigid,
+    with_contact_defaults,
 )
 
 
@@ -423,21 +428,6 @@ class IdealModelSettings(_Strict):
     )
 
 
-class SolverSettings(_Strict):
-    """One integrator setting fed to ``scipy.integrate.solve_ivp``."""
-
-    method: Literal["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"] = Field(
-        "DOP853", description="scipy solve_ivp method"
-    )
-    rtol: float = Field(1e-10, gt=0, lt=1, description="relative tolerance [-]")
-    atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
-    max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
-    backend: Literal["auto", "scipy", "cyrk", "cyrk_compiled"] = Field(
-        "auto", description="library that integrates: auto (cyrk for RK23/RK45/DOP853, else "
-        "scipy), scipy, cyrk, or cyrk_compiled (CyRK with the flow compiled by numba: no "
-        "Python callbacks, ~1 s numba import per process; for many-point studies)")
-
-
 class GuessFromArtifact(_Strict):
     """A starting state read from a continuation artifact (issue 23): the state of a branch
     at a parameter value, instead of digits copied by hand."""
@@ -748,7 +738,8 @@ class Scene(_Strict):
     contact: ContactSettings | None = None
     terrain: TerrainSettings | None = None
     contact_sim: ContactSimSettings | None = None
-    contact_solver: ContactSolverSettings | None = None
+    contact_solver: Annotated[SolverSettings | None,
+                              BeforeValidator(with_contact_defaults)] = None
     workprecision: WorkPrecisionSettings | None = None
     # Resolved path of the YAML file the scene was read from (None when built in code);
     # not part of the scene's content: it decides which file owns runs/<name>/.
@@ -768,6 +759,14 @@ class Scene(_Strict):
             raise ValueError("units: a nondimensional scene measures accelerations in g, so "
                              "walker.gravity_m_per_s2 must be 1 (got "
                              f"{self.walker.gravity_m_per_s2:g})")
+        return self
+
+    @model_validator(mode="after")
+    def _solvers_fit_their_models(self) -> Scene:
+        why = check_rigid(self.solver) or (self.contact_solver is not None
+                                           and check_contact(self.contact_solver))
+        if why:
+            raise ValueError(why)
         return self
 
     @model_validator(mode="after")

@@ -73,7 +73,7 @@ def _draw(scene: Scene, runs_root, part: str) -> list[Path]:
         trajs, runpaths.figures_dir(scene, runs_root, claim=True), title, scene.slope.phi_rad,
         u, load_terrain(artifact_path(scene, runs_root, "contact-sim")) if contact else None,
         _load(scene, runs_root, "compare", load_compare), contact.drop if has_drop else None,
-        float(scene.contact.stiffness) if has_drop else None)
+        float(scene.contact.written("stiffness")[0]) if has_drop else None)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs",

@@ -116,8 +116,8 @@ def draw(scene: Scene, path: Path, runs_root: str | Path = "runs") -> list[Path]
     """Draw the sweep's main results against its first swept field (PNG + SVG) from the
     artifact ``path`` (:func:`walkerlab.plotting.sweep_figures.sweep_figure`)."""
     from walkerlab.io.runpaths import figures_dir
+    from walkerlab.io.sweep_store import load_sweep
     from walkerlab.plotting.sweep_figures import save, sweep_figure
-    from walkerlab.sweep.store import load_sweep
 
     fig = sweep_figure(load_sweep(path), f"scene '{scene.name}'")
     return save(fig, figures_dir(scene, runs_root, claim=True), Path(path).stem)
