@@ -21,10 +21,10 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import load_scene
+from walkerlab.io.sweep_store import load_sweep
 from walkerlab.stages.sweep import run
 from walkerlab.sweep.outcomes import COLUMNS
 from walkerlab.sweep.points import warm_up
-from walkerlab.sweep.store import load_sweep
 
 PARAMS = ["slope.angle_deg=1:4:0.125", "walker.hip_mass_kg=8,10,12,14"]
 

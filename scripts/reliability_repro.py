@@ -174,7 +174,7 @@ def _contact(d, **kw):
 
 @case
 def d3_contact_inf_stiffness(d):
-    s = _contact(d, contact__stiffness=float("inf"))
+    s = _contact(d, contact__stiffness_n_per_mm_pow_e=float("inf"))
     rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 
@@ -188,7 +188,7 @@ def d3_contact_inf_rate_scale(d):
 
 @case
 def d3_contact_inf_damping(d):
-    s = _contact(d, contact__max_damping=float("inf"))
+    s = _contact(d, contact__max_damping_n_s_per_mm=float("inf"))
     rc, msg, _ = cli(d / "cfg", "contact-sim", str(s), "--runs-dir", "runs", timeout=400)
     return rc, msg, ""
 

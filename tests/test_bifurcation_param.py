@@ -127,5 +127,7 @@ def test_field_units_from_metadata_or_name():
     assert unit(paper, "walker.hip_mass_kg") == "kg"
     assert unit(paper, "slope.angle_rad") == "rad"
     assert unit(paper, "walker.gravity_m_per_s2") == "m/s^2"
-    assert unit(paper, "contact.stiffness") == "N/mm^e"  # metadata, mm-kg-s numbers
+    assert unit(paper, "contact.stiffness_n_per_mm_pow_e") == "N/mm^e"  # the name says it
+    assert unit(paper, "contact.stiffness_n_per_m_pow_e") == "N/m^e"
+    assert unit(paper, "contact.stiction_velocity_mm_per_s") == "mm/s"
     assert unit(paper, "contact.mu_static") == "-"

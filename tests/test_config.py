@@ -70,3 +70,31 @@ def test_sections_not_used_are_absent():
     """schwab_wisse2001 declares no contact sections: they stay None, not dummies."""
     scene = load_scene(ROOT / "configs" / "schwab_wisse2001.yaml")
     assert scene.contact is None and scene.terrain is None and scene.contact_sim is None
+
+
+@pytest.mark.parametrize("section, value, line", [
+    ("solver", {"method": "odeint"}, "solver.method: odeint integrates the contact model"),
+    ("contact_solver", {"method": "RK23"}, "contact_solver.method: the contact model takes"),
+    ("contact_solver", {"rtol": 1e-14}, "contact_solver.rtol: at least 1e-13"),
+    ("contact_solver", {"backend": "cyrk"}, "contact_solver.backend: the contact model's "
+                                            "library is its method"),
+])
+def test_solver_and_contact_solver_are_one_type_each_checked_for_its_model(tmp_path, section,
+                                                                            value, line):
+    """solver: and contact_solver: are one settings type (walkerlab.config.SolverSettings,
+    mapping onto walkerlab.integrate.Solver); a contact_solver: is completed with the contact
+    defaults (CyRK BDF at rtol 1e-8), and a method or setting the other model's integrator
+    takes is one line naming the key."""
+    from walkerlab.config import SolverSettings
+    from walkerlab.integrate.solver import Solver
+
+    base = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    base.pop("contact_solver", None)
+    ok = load_scene(_write(tmp_path, {**base, "contact_solver": {"rtol": 1e-9}}, "ok.yaml"))
+    assert type(ok.contact_solver) is type(ok.solver) is SolverSettings
+    assert Solver.from_settings(ok.contact_solver) == Solver("cyrk_bdf", 1e-9, 1e-10)
+    assert Solver.from_settings(ok.solver) == Solver("DOP853", 1e-12, 1e-12)
+    with pytest.raises(SceneError) as err:
+        load_scene(_write(tmp_path, {**base, section: value}))
+    msg = str(err.value)
+    assert "\n" not in msg and line in msg

@@ -71,18 +71,18 @@ def test_patch_width_map_on_continuous_ground_says_it_does_not_apply(tmp_path):
 
 
 def test_stability_map_figure_names_scene_units_and_unsupported_cells():
-    """round_feet.yaml is nondimensional (contact.unit_system SI reads metres as l): before,
+    """round_feet.yaml is nondimensional (its SI contact fields read metres as l): before,
     its patch-width map's axis read 'patch width [m]'; a kneed cell whose periodic-gait
     search has no section read '?'."""
     from walkerlab.io.schemas.stability_map import StabilityMap
     from walkerlab.plotting.sweep_figures import gait_map_figure, plt
-    from walkerlab.sweep.stability import MAP_KINDS, REASONS
+    from walkerlab.sweep.stability import MAP_KINDS, REASONS, MapSpec
 
     assert "unsupported" in REASONS
     reason = np.array([["", "unsupported"]], dtype=object)
     d = StabilityMap(
         attrs={"kind": "patch_width", "y_label": MAP_KINDS["patch_width"][1],
-               "unit_system": "SI", "scene_units": "nondimensional"},
+               "scene_units": "nondimensional"},
         y_values=np.array([0.2]), slopes_deg=np.array([1.0, 2.0]),
         cells={"exists": np.array([[1, 0]]), "stable": np.array([[1, 0]]),
                "max_abs_multiplier": np.array([[0.5, np.nan]]), "reason": reason,
@@ -93,13 +93,14 @@ def test_stability_map_figure_names_scene_units_and_unsupported_cells():
         assert "not sup-\nported" in [t.get_text() for t in fig.axes[0].texts]
     finally:
         plt.close(fig)
-    d.attrs = {**d.attrs, "kind": "stiffness", "y_label": MAP_KINDS["stiffness"][1]}
+    si_map = MapSpec("stiffness", (4e9,), (1.0,), y_field="stiffness_n_per_m_pow_e")
+    d.attrs = {**d.attrs, "kind": "stiffness", "y_label": si_map.y_label}
     fig = gait_map_figure(d)
     try:
         assert fig.axes[0].get_ylabel().startswith("contact stiffness k [M g/l^e]")
     finally:
         plt.close(fig)
-    d.attrs = {**d.attrs, "scene_units": "SI", "unit_system": "mm-kg-s"}
+    d.attrs = {**d.attrs, "scene_units": "SI", "y_label": MAP_KINDS["stiffness"][1]}
     fig = gait_map_figure(d)
     try:
         assert fig.axes[0].get_ylabel().startswith("contact stiffness k [N/mm^e]")
@@ -143,7 +144,8 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
 
     rf = load_scene("configs/round_feet.yaml")
     d = drop_test(rf, 2.0)
-    k = rf.contact.stiffness
+    k = rf.contact.stiffness_n_per_m_pow_e
+    assert d["unit"] == "N/m^e"
     assert d["stiffness"][0] < k < d["stiffness"][-1]
     i = int(np.argmin(abs(d["stiffness"] - k)))
     own = drop_restitution(settings(rf)[0], mass_kg=2.0, v_in_m_per_s=0.3)["restitution"]
@@ -156,8 +158,8 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     from walkerlab.analysis.contact_record import DROP_STIFFNESS_RATIO
 
     paper = load_scene("configs/paper.yaml").contact
-    assert paper.stiffness == paper.reference_stiffness == 1e5
-    np.testing.assert_allclose(np.multiply(DROP_STIFFNESS_RATIO, paper.stiffness),
+    assert paper.stiffness_n_per_mm_pow_e == paper.reference_stiffness_n_per_mm_pow_e == 1e5
+    np.testing.assert_allclose(np.multiply(DROP_STIFFNESS_RATIO, paper.stiffness_n_per_mm_pow_e),
                                [1e4, 3e4, 1e5, 3e5, 1e6, 3e6, 1e7, 3e7, 1e8, 3e8, 1e9],
                                rtol=1e-15)
 

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from tests.independent import floating_reference as ref
 from walkerlab.config import load_scene
@@ -27,7 +28,8 @@ from walkerlab.stages import export as export_stage
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Every shipped walker with masses (simplest.yaml and schwab_wisse2001.yaml: massless legs).
-SCENES = ("paper", "paper_rods", "kneed", "round_feet", "goswami1996")
+SCENES = ("paper", "paper_rods", "kneed", "round_feet", "goswami1996", "hip_spring",
+          "torso_bhm", "asymmetric_legs")
 #: Compass-gait scenes the hand-written contact kernel describes.
 TOL = 1e-10
 N_STATES = 5
@@ -49,8 +51,9 @@ def _states(n_q, seed):
         yield q, rng.uniform(-3, 3, n_q)
 
 
-def _joint_map(names):
-    """``T`` as {joint name: row over our coordinates}: q_joint = row . q."""
+def _joint_map(names, torso=False):
+    """``T`` as {joint name: row over our coordinates}: q_joint = row . q (the torso's joint,
+    eliminated in our coordinates, is the mean of the leg angles: the bisecting hip)."""
     rows = {}
     for j, c in enumerate(names):
         row = np.zeros(len(names))
@@ -64,19 +67,21 @@ def _joint_map(names):
         else:  # leg<i>_angle or leg<i>_thigh_angle
             row[j] = 1.0
             rows[c.split("_")[0] + "_hip"] = row
+    if torso:
+        rows["torso_hip"] = (rows["leg1_hip"] + rows["leg2_hip"]) / 2
     return rows
 
 
 class Pinocchio:
     """The exported URDF in Pinocchio: CRBA mass matrix and RNEA bias in our coordinates."""
 
-    def __init__(self, path, names, g):
+    def __init__(self, path, names, g, torso=False):
         pin = pytest.importorskip("pinocchio")
         self.pin = pin
         self.model = pin.buildModelFromUrdf(str(path))
         self.model.gravity.linear = np.array([0.0, 0.0, -g])
         self.data = self.model.createData()
-        rows = _joint_map(names)
+        rows = _joint_map(names, torso)
         assert set(rows) == set(self.model.names[1:])
         self.T = np.zeros((self.model.nv, len(names)))
         self.joints = []
@@ -103,12 +108,12 @@ class MuJoCo:
     """The exported MJCF in MuJoCo: ``mj_fullM`` (dense ``qM``) and ``qfrc_bias`` in our
     coordinates."""
 
-    def __init__(self, path, names):
+    def __init__(self, path, names, torso=False):
         mujoco = pytest.importorskip("mujoco")
         self.mj = mujoco
         self.model = mujoco.MjModel.from_xml_path(str(path))
         self.data = mujoco.MjData(self.model)
-        rows = _joint_map(names)
+        rows = _joint_map(names, torso)
         assert set(rows) == {self.model.joint(i).name for i in range(self.model.njnt)}
         self.T = np.zeros((self.model.nv, len(names)))
         self.Tq = np.zeros((self.model.nq, len(names)))
@@ -135,8 +140,9 @@ def _libraries(scene, tmp_path):
     names = ref.coordinate_names(data)
     urdf = export_stage.run(scene, tmp_path, "urdf")
     mjcf = export_stage.run(scene, tmp_path, "mjcf")
-    return data, names, {"pinocchio": Pinocchio(urdf, names, data.gravity_m_per_s2),
-                         "mujoco": MuJoCo(mjcf, names)}
+    torso = bool(data.structure.torso)
+    return data, names, {"pinocchio": Pinocchio(urdf, names, data.gravity_m_per_s2, torso),
+                         "mujoco": MuJoCo(mjcf, names, torso)}
 
 
 def agreement(scene_name, tmp_path, other=None):
@@ -205,8 +211,10 @@ def test_libraries_match_floating_view(name, tmp_path):
     view = floating.floating_view(_data(scene))
     assert tuple(view.coordinate_names()) == ref.coordinate_names(_data(scene))
 
-    def generated(q, dq):
-        return np.asarray(view.mass_matrix(q), float), np.asarray(view.bias(q, dq), float)
+    def generated(q, dq):  # without its springs (URDF has none; MuJoCo's are passive forces,
+        # checked by test_mujoco_springs_are_ours)
+        return (np.asarray(view.mass_matrix(q), float),
+                np.asarray(view.bias(q, dq), float) + ref.spring_force(_data(scene), q, dq))
 
     for lib, (_, rel_m, _, rel_b) in agreement(name, tmp_path, generated).items():
         assert rel_m <= TOL and rel_b <= TOL, (lib, rel_m, rel_b)
@@ -291,3 +299,164 @@ def test_feet_where_the_walker_puts_them(name, tmp_path):
             np.testing.assert_allclose(frame, [x, 0.0, y], atol=1e-13)
             np.testing.assert_allclose(mj.data.site(f"{leg}_foot").xpos, [x, 0.0, y],
                                        atol=1e-13)
+
+
+# ---- issue 22: springs as tendons, the bisecting hip as an equality, off-axis bodies
+def _edited_scene(tmp_path, base, edit):
+    d = yaml.safe_load((ROOT / "configs" / f"{base}.yaml").read_text())
+    edit(d)
+    d.pop("fixedpoint")  # another walker: the file without the scene's gait keyframe
+    path = tmp_path / f"{base}_edited.yaml"
+    path.write_text(yaml.safe_dump(d))
+    return load_scene(path)
+
+
+def _sprung_variants():
+    def rest_and_damping(d):  # rest angle -1: MuJoCo reads springlength="-1" as "qpos0"
+        d["walker"]["springs"][0].update(rest_angle_rad=-1.0, damping_n_m_s_per_rad=0.7)
+
+    def torso_spring(d):  # a spring between the torso and one leg, with a rest angle
+        d["walker"]["springs"] = [{"between": ["torso", "leg1"], "stiffness_n_m_per_rad": 5.0,
+                                   "rest_angle_rad": 0.1, "damping_n_m_s_per_rad": 0.3}]
+    def kneed_spring(d):  # a hip spring on a kneed walker acts on the thighs' hip joints;
+        # a knee spring (joint stiffness, springref, damping) on each knee
+        d["walker"]["springs"] = [{"between": ["leg1", "leg2"], "stiffness_n_m_per_rad": 2.0,
+                                   "rest_angle_rad": 0.2, "damping_n_m_s_per_rad": 0.3}]
+        d["walker"]["leg"]["knee"]["spring"] = {"stiffness_n_m_per_rad": 1.5,
+                                                "rest_angle_rad": -0.3,
+                                                "damping_n_m_s_per_rad": 0.2}
+    return {"hip_spring": ("hip_spring", None), "rest_and_damping": ("hip_spring",
+                                                                     rest_and_damping),
+            "torso_spring": ("torso_bhm", torso_spring), "kneed_spring": ("kneed", kneed_spring)}
+
+
+@pytest.mark.parametrize("variant", list(_sprung_variants()))
+def test_mujoco_springs_are_ours(variant, tmp_path):
+    """A spring exported as a MuJoCo fixed tendon (stiffness, springlength, damping) is ours:
+    at random states MuJoCo's potential energy (``mjData.energy[0]`` with the energy flag:
+    gravity + tendon springs) equals the independent reference's (gravity + ``k (delta -
+    r)^2 / 2``), MuJoCo's passive force ``qfrc_passive`` (mapped to our coordinates) equals
+    the reference's spring-damper force, and the generated floating view's full bias
+    ``h`` (springs included) equals MuJoCo's ``qfrc_bias - qfrc_passive``.  Tolerance 1e-10
+    relative: 17-digit numbers in the file, round-off only.  The rest angle -1 checks the
+    writer's orientation of the tendon (MuJoCo reads springlength -1 as "the length at
+    qpos0", which would silently give rest 0)."""
+    mujoco = pytest.importorskip("mujoco")
+    floating = pytest.importorskip("walkerlab.models.floating")
+    base, edit = _sprung_variants()[variant]
+    scene = _scene(base) if edit is None else _edited_scene(tmp_path, base, edit)
+    data = _data(scene)
+    names = ref.coordinate_names(data)
+    mj = MuJoCo(export_stage.run(scene, tmp_path, "mjcf"), names, bool(data.structure.torso))
+    mj.model.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
+    view = floating.floating_view(data)
+    assert data.structure.springs
+    for q, dq in _states(len(names), seed=11):
+        mj(q, dq)
+        V = ref.potential(data, q)
+        assert mj.data.energy[0] == pytest.approx(V, rel=1e-10, abs=1e-10)
+        Q = ref.spring_force(data, q, dq)
+        assert np.abs(Q).max() > 0.1  # the springs act at these states
+        np.testing.assert_allclose(mj.T.T @ mj.data.qfrc_passive, Q, rtol=0,
+                                   atol=1e-10 * np.abs(Q).max())
+        h = view.bias(q, dq)
+        np.testing.assert_allclose(mj.T.T @ (mj.data.qfrc_bias - mj.data.qfrc_passive), h,
+                                   rtol=0, atol=1e-10 * np.abs(h).max())
+
+
+def test_spring_check_can_fail(tmp_path):
+    """The spring check is not vacuous: the hip spring's tendon with its coefficients'
+    signs swapped on one joint (delta = leg1 + leg2) has another passive force."""
+    mujoco = pytest.importorskip("mujoco")
+    scene = _scene("hip_spring")
+    data = _data(scene)
+    names = ref.coordinate_names(data)
+    path = export_stage.run(scene, tmp_path, "mjcf")
+    text = path.read_text()
+    assert '<joint joint="leg1_hip" coef="-1.0"/>' in text
+    path.write_text(text.replace('<joint joint="leg1_hip" coef="-1.0"/>',
+                                 '<joint joint="leg1_hip" coef="1.0"/>'))
+    mj = MuJoCo(path, names)
+    q, dq = next(_states(len(names), seed=11))
+    mj(q, dq)
+    assert mujoco is mj.mj
+    assert np.abs(mj.T.T @ mj.data.qfrc_passive - ref.spring_force(data, q, dq)).max() > 1.0
+
+
+def _off_axis(d):
+    """asymmetric_legs with each leg's mass off the axis (+-3 cm) and a rod ahead of it."""
+    for leg, e in zip(d["walker"]["legs"], (0.03, -0.02)):
+        leg["bodies"][0]["off_axis_m"] = e
+        leg["bodies"].append({"kind": "rod", "name": "rod", "mass_kg": 1.0,
+                              "com_from_hip_m": 0.4, "inertia_about_com_kg_m2": 0.02,
+                              "com_off_axis_m": 0.01})
+
+
+def _torso_off_axis(d):
+    """torso_bhm with a rigid body ahead of the torso's axis beside its point mass."""
+    d["walker"]["torso"]["bodies"].append({"kind": "rigid_body", "name": "box", "mass_kg": 2.0,
+                                           "com_from_hip_m": 0.3, "com_off_axis_m": 0.05,
+                                           "inertia_about_com_kg_m2": 0.04})
+
+
+def _kneed_legs_differ(d):
+    """kneed with leg2's thigh mass 0.55 kg and its shank mass 2 cm lower."""
+    leg = d["walker"].pop("leg")
+    other = yaml.safe_load(yaml.safe_dump(leg))
+    other["bodies"][0]["mass_kg"] = 0.55
+    other["bodies"][1]["from_hip_m"] = 0.67
+    d["walker"]["legs"] = [leg, other]
+
+
+def _kneed_torso(d):
+    """kneed with an upper body on the thighs' bisector, a rigid body off its axis."""
+    d["walker"]["torso"] = {"bodies": [{"kind": "rigid_body", "name": "box", "mass_kg": 0.2,
+                                        "com_from_hip_m": 0.2, "com_off_axis_m": 0.03,
+                                        "inertia_about_com_kg_m2": 0.004}]}
+
+
+@pytest.mark.parametrize("base, edit", [("asymmetric_legs", _off_axis),
+                                        ("torso_bhm", _torso_off_axis),
+                                        ("kneed", _kneed_legs_differ),
+                                        ("kneed", _kneed_torso)])
+def test_off_axis_bodies_exported_in_place(base, edit, tmp_path):
+    """Bodies off a link's axis (legs and torso) are exported in place (the link's inertial
+    origin off its axis, the parallel-axis inertia about it), and kneed legs that differ
+    carry each leg's numbers: Pinocchio and MuJoCo give the independent reference's mass
+    matrix and bias (body by body) to 1e-10 relative."""
+    scene = _edited_scene(tmp_path, base, edit)
+    data = _data(scene)
+    s = data.structure
+    assert any(b.off_axis for b in (*s.bodies, *s.torso)) or s.asymmetric
+    names = ref.coordinate_names(data)
+    torso = bool(s.torso)
+    libs = {"pinocchio": Pinocchio(export_stage.run(scene, tmp_path, "urdf"), names,
+                                   data.gravity_m_per_s2, torso),
+            "mujoco": MuJoCo(export_stage.run(scene, tmp_path, "mjcf"), names, torso)}
+    for lib, f in libs.items():
+        for q, dq in _states(len(names), seed=19):
+            M, b = f(q, dq)
+            Mr, br = ref.mass_matrix_and_bias(data, q, dq)
+            assert np.abs(M - Mr).max() <= TOL * np.abs(Mr).max(), lib
+            assert np.abs(b - br).max() <= TOL * np.abs(br).max(), lib
+
+
+def test_bisecting_hip_holds_in_a_mujoco_run(tmp_path):
+    """The bisecting hip mechanism (tendon equality ``torso_hip - (leg1_hip + leg2_hip)/2 =
+    0``) holds along 1 s of MuJoCo walking from the gait keyframe (contact, heel strikes) to
+    1e-6 rad: MuJoCo's constraints are soft, the export makes this one as stiff as MuJoCo
+    allows (measured: 2e-8 rad over 2 s)."""
+    mujoco = pytest.importorskip("mujoco")
+    m = mujoco.MjModel.from_xml_path(str(export_stage.run(_scene("torso_bhm"), tmp_path,
+                                                          "mjcf")))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, m.key("gait").id)
+    torso, leg1, leg2 = (m.joint(j).qposadr[0] for j in ("torso_hip", "leg1_hip", "leg2_hip"))
+    assert d.qpos[torso] == pytest.approx((d.qpos[leg1] + d.qpos[leg2]) / 2, abs=1e-15)
+    worst, contacts = 0.0, 0
+    while d.time < 1.0:
+        mujoco.mj_step(m, d)
+        worst = max(worst, abs(d.qpos[torso] - (d.qpos[leg1] + d.qpos[leg2]) / 2))
+        contacts += d.ncon > 0
+    assert contacts > 0 and abs(d.qpos[leg1] - d.qpos[leg2]) > 0.1  # it moved, on the ground
+    assert worst < 1e-6, worst

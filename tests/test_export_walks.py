@@ -9,7 +9,11 @@ ground at the wrong height or a contact too soft makes the walker fall or change
 Measured (12 s): paper 17 alternating heel strikes, mean step period 0.70342 s against the
 rigid 0.70360 s (-0.03 %), step length 0.3722 m against 0.3714 m; kneed 22 strikes,
 0.5434 s against 0.54585 s (-0.4 %, the 2 mm latch release; a step-to-step oscillation of
-+-0.5 %).  Tolerance 1 % (issue 25): MuJoCo's contact is soft and linear.
++-0.5 %).  Tolerance 1 % (issue 25): MuJoCo's contact is soft and linear.  Issue 22:
+hip_spring (spring as a tendon) 12 strikes in 6.5 s, 0.52184 s against 0.522193 s; torso_bhm
+(bisecting hip as a tendon equality) 11 strikes in 9.5 s, 0.85055 s against 0.850906 s;
+asymmetric_legs 17 strikes in 12 s, leg A's / leg B's steps 0.71420 / 0.67823 s against
+0.71442 / 0.67839 s (the checkerboard laid out with both step lengths).
 """
 
 from __future__ import annotations
@@ -34,7 +38,9 @@ def _scene(name):
 
 
 @pytest.mark.parametrize("name, t_final, rigid_period", [("paper", 8.5, 0.703597),
-                                                        ("kneed", 6.5, 0.545846)])
+                                                        ("kneed", 6.5, 0.545846),
+                                                        ("hip_spring", 6.5, 0.522193),
+                                                        ("torso_bhm", 9.5, 0.850906)])
 def test_exported_walker_walks_in_mujoco_at_the_rigid_period(name, t_final, rigid_period,
                                                              tmp_path):
     from walkerlab.analysis.mujoco_walk import walk
@@ -119,3 +125,22 @@ def test_tiny_mass_or_length_refused_in_one_line(base, edit, field, tmp_path):
     assert r.exit_code == 1, r.output
     assert r.output.strip().count("\n") == 0 and field in r.output, r.output
     assert not list((tmp_path / "runs").rglob("walker.*"))
+
+
+def test_asymmetric_legs_walk_both_steps_in_mujoco(tmp_path):
+    """Legs that differ: MuJoCo walks the stride's two steps at the rigid stride's step
+    periods (1 %), on a checkerboard laid out with both step lengths (one length for both
+    lets footfalls drift 8.6 mm per stride off the 10 cm patches: a fall after 10 strikes)."""
+    from walkerlab.analysis.contact_periodic import ideal_gait
+    from walkerlab.analysis.mujoco_walk import walk
+
+    scene = _scene("asymmetric_legs")
+    rigid = ideal_gait(scene)
+    run = walk(export_stage.run(scene, tmp_path, "mjcf"), 12.0)
+    assert not run.fell and len(run.times_s) >= 12 and run.alternating
+    # strike i -> i + 1 after a leg1 strike is leg2's step (rigid step 2), and vice versa
+    by_leg = {leg: run.step_periods_s[[i for i, x in enumerate(run.legs[:-1]) if x == leg]]
+              for leg in ("leg1", "leg2")}
+    assert by_leg["leg1"].mean() == pytest.approx(rigid.step_periods_s[1], rel=0.01)
+    assert by_leg["leg2"].mean() == pytest.approx(rigid.step_periods_s[0], rel=0.01)
+    assert abs(rigid.step_periods_s[1] - rigid.step_periods_s[0]) > 0.02  # they differ

@@ -134,7 +134,7 @@ def test_stability_map_marks_the_scenes_point_with_three_cells_a_side():
 
     n = 3
     data = StabilityMap(
-        attrs={"kind": "stiffness", "y_label": "contact stiffness k [N/len^e]",
+        attrs={"kind": "stiffness", "y_label": "contact stiffness k [N/mm^e]",
                "scene_slope_deg": 0.997, "scene_y": 1e5},
         y_values=np.array([1e3, 1e6, 1e9]), slopes_deg=np.array([0.5, 2.25, 4.0]),
         cells={"exists": np.ones((n, n)), "stable": np.ones((n, n)),

@@ -23,11 +23,11 @@ from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.io.sweep_store import load_sweep
 from walkerlab.models.registry import build_walker
 from walkerlab.stages import sweep as sweep_stage
 from walkerlab.sweep.params import SweepError, check_axes, parse_param
 from walkerlab.sweep.points import evaluate
-from walkerlab.sweep.store import load_sweep
 
 ROOT = Path(__file__).resolve().parents[1]
 

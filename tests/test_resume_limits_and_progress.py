@@ -31,11 +31,11 @@ from walkerlab.config import (
     scene_from_dict,
 )
 from walkerlab.io.artifacts import content_hash, write_artifact
+from walkerlab.io.sweep_store import complete_sweep, load_sweep, partial_path
 from walkerlab.stages import common
 from walkerlab.sweep import basin as basin_mod
 from walkerlab.sweep import runner
 from walkerlab.sweep.outcomes import empty_row
-from walkerlab.sweep.store import complete_sweep, load_sweep, partial_path
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())

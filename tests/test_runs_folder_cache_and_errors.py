@@ -30,11 +30,11 @@ from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.execution.workers import process_alive
 from walkerlab.io.artifacts import ArtifactError, atomic_write, open_artifact, write_artifact
 from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock
+from walkerlab.io.sweep_store import load_sweep, partial_path
 from walkerlab.stages import common
 from walkerlab.sweep import runner
 from walkerlab.sweep.outcomes import empty_row
 from walkerlab.sweep.params import SweepError, parse_param
-from walkerlab.sweep.store import load_sweep, partial_path
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
@@ -128,8 +128,8 @@ def test_d2_two_scene_files_with_one_name_do_not_share_a_run_folder(tmp_path):
                                 "swing_rate_rad_per_s": -0.6, "stance_rate_rad_per_s": -0.8},
      "simulate.initial_state.swing_angle_rad"),
     ("simulate.strides", 10_000, "simulate.strides"),
-    ("contact.stiffness", float("inf"), "contact.stiffness"),
-    ("contact.max_damping", float("inf"), "contact.max_damping"),
+    ("contact.stiffness_n_per_mm_pow_e", float("inf"), "contact.stiffness_n_per_mm_pow_e"),
+    ("contact.max_damping_n_s_per_mm", float("inf"), "contact.max_damping_n_s_per_mm"),
     ("contact.mu_static", float("inf"), "contact.mu_static"),
     ("contact.mu_static", True, "contact.mu_static"),
     ("terrain.patch_width_m", float("inf"), "terrain.patch_width_m"),
@@ -149,7 +149,7 @@ def test_d10_strict_finite_numbers_name_the_field(tmp_path, path, value, field):
 
 def test_strict_still_accepts_yaml_ints_and_nested_mappings(tmp_path):
     d = _with(_with(PAPER, "walker.leg_length_m", 1), "walker.hip_mass_kg", 10)
-    sc = load_scene(_write(tmp_path / "s.yaml", _with(d, "contact.max_damping", 90)))
+    sc = load_scene(_write(tmp_path / "s.yaml", _with(d, "contact.max_damping_n_s_per_mm", 90)))
     assert isinstance(sc.walker.leg_length_m, float) and sc.walker.leg_length_m == 1.0
     assert sc.contact_sim.initial_rate_scale == (1.0, 1.1)  # a YAML list -> tuple
     assert sc.fixedpoint.initial_guess.stance_rate_rad_per_s == -0.84  # nested from a dict

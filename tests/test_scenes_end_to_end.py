@@ -88,9 +88,9 @@ def png_only(monkeypatch):
 @pytest.mark.slow  # end to end: a whole report
 @pytest.mark.parametrize("scene_path", SCENES, ids=[p.stem for p in SCENES])
 def test_scene_end_to_end(scene_path, tmp_path, png_only):
+    from walkerlab.io.sweep_store import load_sweep
     from walkerlab.stages import fixedpoint, report, simulate
     from walkerlab.stages import sweep as sweep_stage
-    from walkerlab.sweep.store import load_sweep
 
     scene = reduced(scene_path, tmp_path)
     runs = tmp_path / "runs"

@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene
+from walkerlab.io.sweep_store import load_sweep, partial_path
 from walkerlab.stages import sweep as sweep_stage
 from walkerlab.sweep import points as points_mod
 from walkerlab.sweep.outcomes import COLUMNS, OUTCOMES
 from walkerlab.sweep.params import SweepError, apply_point, parse_param
 from walkerlab.sweep.points import evaluate
 from walkerlab.sweep.runner import plan_chunks
-from walkerlab.sweep.store import load_sweep, partial_path
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "configs" / "goswami1996.yaml"

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from walkerlab.config import load_scene
 from walkerlab.sweep.outcomes import OUTCOMES
 from walkerlab.sweep.points import _CONTACT_OUTCOME, evaluate
@@ -13,8 +15,8 @@ SCENE = Path(__file__).resolve().parents[1] / "configs" / "goswami1996.yaml"
 
 def test_contact_point_gives_a_typed_outcome():
     base = load_scene(SCENE).model_dump(mode="json")
-    row, x = evaluate("contact-sim", base, ["slope.angle_deg", "contact.stiffness"], (1.0, 1e5),
-                      0, None, {})
+    row, x = evaluate("contact-sim", base, ["slope.angle_deg", "contact.stiffness_n_per_mm_pow_e"],
+                      (1.0, 1e5), 0, None, {})
     assert row["outcome"] in OUTCOMES and row["outcome"] not in ("error", "invalid_config"), \
         row["message"]
     assert row["steps_expected"] == 10 and row["heel_strikes"] >= 0
@@ -36,3 +38,23 @@ def test_contact_outcomes_map_onto_sweep_outcomes():
     assert set(_CONTACT_OUTCOME.values()) <= set(OUTCOMES)
     assert _CONTACT_OUTCOME["heel_strike"] == _CONTACT_OUTCOME["t_final"] == "ok"
     assert len(set(_CONTACT_OUTCOME.values())) == len(CONTACT_OUTCOMES) - 1
+
+
+def test_contact_fields_are_swept_by_their_unit_bearing_names():
+    """An old contact name in a sweep spec is one line naming the new ones; the SI name of a
+    quantity the scene writes in mm-kg-s replaces the scene's value (the pair excludes each
+    other, as slope.angle_deg / angle_rad)."""
+    from walkerlab.contact.laws import contact_params_si
+    from walkerlab.sweep.params import SweepError, apply_point, check_axes, parse_param
+
+    scene = load_scene(SCENE)
+    with pytest.raises(SweepError, match=r"contact\.stiffness is now "
+                       r"contact\.stiffness_n_per_mm_pow_e \(mm-kg-s\) or "
+                       r"contact\.stiffness_n_per_m_pow_e \(SI\)"):
+        check_axes(scene, [parse_param("contact.stiffness=1e5,1e6")])
+    k_si = contact_params_si(scene.contact).k
+    check_axes(scene, [parse_param(f"contact.stiffness_n_per_m_pow_e={k_si!r}")])
+    point = apply_point(scene.model_dump(mode="json"), ["contact.stiffness_n_per_m_pow_e"],
+                        (k_si,))
+    assert point.contact.stiffness_n_per_mm_pow_e is None
+    assert contact_params_si(point.contact) == contact_params_si(scene.contact)

@@ -105,7 +105,9 @@ def with_changes(scene: Scene | str | Path | dict, changes: dict[str, Any]) -> S
         Dotted scene field -> value, as ``walkerlab sweep --param`` names fields:
         ``{"slope.angle_deg": 2, "walker.leg.bodies.thigh_mass.mass_kg": 0.4}`` (a list
         item by its ``name`` or index).  Setting ``slope.angle_deg`` replaces
-        ``slope.angle_rad`` and vice versa; a missing section is created with its defaults.
+        ``slope.angle_rad`` and vice versa, and a contact quantity's SI name its mm-kg-s
+        name (``contact.stiffness_n_per_m_pow_e`` / ``_n_per_mm_pow_e``); a missing section
+        is created with its defaults.
 
     Returns
     -------

@@ -123,8 +123,12 @@ def relabel_artifact(f, units: Units) -> None:
     f.visititems(visit)
 
 
-#: SI unit of a config field, by the suffix of its name (longest suffix first)
+#: Unit of a config field, by the suffix of its name (longer suffixes first); the contact
+#: law's fields name mm-kg-s or SI units (``stiffness_n_per_mm_pow_e``)
 FIELD_SUFFIX_UNITS = (
+    ("_n_m_per_rad_pow_e", "N m/rad^e"), ("_n_m_s_per_rad", "N m s/rad"),
+    ("_n_m_per_rad", "N m/rad"), ("_n_per_mm_pow_e", "N/mm^e"), ("_n_per_m_pow_e", "N/m^e"),
+    ("_n_s_per_mm", "N s/mm"), ("_n_s_per_m", "N s/m"), ("_mm_per_s", "mm/s"),
     ("_rad_per_s", "rad/s"), ("_m_per_s2", "m/s^2"), ("_m_per_s", "m/s"),
     ("_kg_m2", "kg m^2"), ("_deg", "deg"), ("_rad", "rad"), ("_kg", "kg"), ("_mm", "mm"),
     ("_hz", "Hz"), ("_m", "m"), ("_s", "s"),
@@ -134,8 +138,8 @@ FIELD_SUFFIX_UNITS = (
 def field_unit(name: str) -> str | None:
     """SI unit of a config field from the suffix of its name (``mass_kg`` -> ``"kg"``,
     ``leg_length_m`` -> ``"m"``, ``angle_deg`` -> ``"deg"``, ``gravity_m_per_s2`` ->
-    ``"m/s^2"``); a dotted path is read by its last part.  None when the name carries no
-    unit (``contact.stiffness``: the unit is then in the field's metadata)."""
+    ``"m/s^2"``, ``stiffness_n_per_mm_pow_e`` -> ``"N/mm^e"``); a dotted path is read by
+    its last part.  None when the name carries no unit (``contact.exponent``)."""
     leaf = name.rsplit(".", 1)[-1]
     for suffix, unit in FIELD_SUFFIX_UNITS:
         if leaf.endswith(suffix):

@@ -5,7 +5,7 @@ import numpy as np
 from tests.contact.test_numbalsoda import _bench_case
 from walkerlab.analysis.contact_bench import leg_angle_columns
 from walkerlab.analysis.contact_sim import simulate_contact
-from walkerlab.config import ContactSolverSettings
+from walkerlab.config import SolverSettings
 from walkerlab.integrate import _cyrk
 from walkerlab.integrate.contact import sample_grid as _grid
 
@@ -16,9 +16,10 @@ def test_cyrk_bdf_five_strides_match_odeint():
     the leg angles (margin ~10x for the machine-dependent step sequence) and to 1e-6 s in
     every heel-strike time (measured 4.5e-9 s)."""
     w, x0, tf = _bench_case()
-    a = simulate_contact(w, x0, tf, ContactSolverSettings(method="odeint", rtol=1e-10, atol=1e-13))
+    a = simulate_contact(w, x0, tf,
+                         SolverSettings.for_contact(method="odeint", rtol=1e-10, atol=1e-13))
     b = simulate_contact(w, x0, tf,
-                         ContactSolverSettings(method="cyrk_bdf", rtol=1e-10, atol=1e-13))
+                         SolverSettings.for_contact(method="cyrk_bdf", rtol=1e-10, atol=1e-13))
     assert b.method == "cyrk_bdf" and b.termination == a.termination == "t_final"
     assert b.nfev > 0 and b.njev == 0  # no odeint fallback on this run
     assert b.walked_steps == a.walked_steps == 10
@@ -44,8 +45,9 @@ def test_cyrk_bdf_failure_is_finished_by_odeint(monkeypatch):
 
     monkeypatch.setattr(_cyrk, "solve_chunk", stops_halfway)
     b = simulate_contact(w, x0, 0.5,
-                         ContactSolverSettings(method="cyrk_bdf", rtol=1e-10, atol=1e-13))
-    a = simulate_contact(w, x0, 0.5, ContactSolverSettings(method="odeint", rtol=1e-10, atol=1e-13))
+                         SolverSettings.for_contact(method="cyrk_bdf", rtol=1e-10, atol=1e-13))
+    a = simulate_contact(w, x0, 0.5,
+                         SolverSettings.for_contact(method="odeint", rtol=1e-10, atol=1e-13))
     assert b.termination == "t_final"
     np.testing.assert_array_equal(b.t, _grid(0.0, 0.5, 1000.0))
     assert b.njev > 0 and b.nfev > sum(nbdf) > 0

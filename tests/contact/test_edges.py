@@ -13,7 +13,7 @@ from walkerlab.analysis.contact_drop import restitution_curve
 from walkerlab.analysis.contact_gait import CONTACT_OUTCOMES as OUTCOME_KINDS
 from walkerlab.analysis.contact_gait import phase_slip as _phase_slip
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
-from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.contact import ContactWalker
 from walkerlab.integrate.contact import ContactLimits
 
@@ -21,7 +21,7 @@ PKG = Path(__file__).resolve().parents[2] / "walkerlab"
 
 
 def _walker(k=1e5, width=0.10, family="paper"):
-    c = ContactSettings(stiffness=k, stiffness_family=family)
+    c = ContactSettings(stiffness_n_per_mm_pow_e=k, stiffness_family=family)
     return ContactWalker.from_settings(c, TerrainSettings(patch_width_m=width),
                                        step_length=STEP_LENGTH, n_steps=12)
 
@@ -34,7 +34,7 @@ def test_stiff_heel_strike_bounce_does_not_tunnel_into_a_trip():
     (~0.58 s with the +10 % stance rate)."""
     w = _walker(k=1e7)
     x0 = initial_state_from_ideal(w, *FP, rate_scale=(1.0, 1.1))
-    r = simulate_contact(w, x0, 0.75, ContactSolverSettings(rtol=1e-8, atol=1e-11))
+    r = simulate_contact(w, x0, 0.75, SolverSettings.for_contact(rtol=1e-8, atol=1e-11))
     assert r.outcome.kind in ("t_final", "scuff"), r.outcome
     assert r.termination == "t_final"
     assert r.walked_steps >= 1
@@ -54,7 +54,7 @@ def test_trip_is_a_foot_hitting_a_patch_side():
     x[0] -= 0.002 * w.normal[0]
     x[1] -= 0.002 * w.normal[1]  # 2 mm below the top, in the gap uphill of the patch
     x[4:6] = 1.0 * w.tangent  # moving downhill towards the patch side at 1 m/s
-    r = simulate_contact(w, x, 0.2, ContactSolverSettings(rtol=1e-8, atol=1e-11))
+    r = simulate_contact(w, x, 0.2, SolverSettings.for_contact(rtol=1e-8, atol=1e-11))
     assert r.outcome.kind == "trip", r.outcome
     assert r.termination == "trip"
     assert r.outcome.foot == "leg2"
@@ -74,7 +74,7 @@ def test_typed_outcomes_fall_time_limit_and_slip():
     assert r.outcome.kind == "fall" and r.outcome.hip_height_m == pytest.approx(0.5, abs=1e-3)
     # wall-time limit (tiny) -> time_limit after the first chunk
     r = simulate_contact(w, x0, 3.0,
-                         ContactSolverSettings(),
+                         SolverSettings.for_contact(),
                          ContactLimits(wall_time_limit_s=1e-6, chunk_s=0.05))
     assert r.outcome.kind == "time_limit" and r.t[-1] < 3.0
     # slip limit below the ~0.5 mm creep of the regularized friction -> slip
@@ -98,7 +98,7 @@ def test_slip_window_is_one_stance_phase():
     # a run cut in double support is NaN, not hundreds of mm of creep
     w = _walker(width=0.10)
     r = simulate_contact(w, initial_state_from_ideal(w, *FP, rate_scale=(1.0, 1.1)), 1.45,
-                         ContactSolverSettings(rtol=1e-8, atol=1e-11))
+                         SolverSettings.for_contact(rtol=1e-8, atol=1e-11))
     ended = [st for st in r.steps if np.isfinite(st.stance_slip_mm)]
     assert ended and all(abs(st.stance_slip_mm) < 2.0 for st in ended)
     assert np.isnan(r.steps[-1].stance_slip_mm)

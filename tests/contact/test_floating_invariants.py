@@ -18,6 +18,7 @@ from scipy.integrate import solve_ivp
 
 from walkerlab.config import load_scene
 from walkerlab.config.contact import ContactSettings
+from walkerlab.contact.laws import contact_params_si, knee_stop_si
 from walkerlab.contact.model import ContactWalker
 from walkerlab.models.description import walker_data
 from walkerlab.models.floating import MASSLESS_MESSAGE, floating_view
@@ -34,8 +35,8 @@ def _data(name):
 
 def _walker(data, **kw):
     """Contact walker of ``data`` with no ground under either foot (free flight)."""
-    return ContactWalker(contact=ContactSettings().to_si(), data=data, lane1=np.array([1e3]),
-                         lane2=np.array([-1e3]), continuous=False, **kw)
+    return ContactWalker(contact=contact_params_si(ContactSettings()), data=data,
+                         lane1=np.array([1e3]), lane2=np.array([-1e3]), continuous=False, **kw)
 
 
 def _link_map(structure):
@@ -234,9 +235,9 @@ def _kneed_on_one_leg(knee_stop=None):
     leg1 hanging over a gap, at rest."""
     data = _data("kneed")
     cs = ContactSettings() if knee_stop is None else ContactSettings(knee_stop=knee_stop)
-    w = ContactWalker(contact=cs.to_si(), data=data, knee_stop=cs.knee_stop.to_si(),
-                      lane1=np.array([1e3]), lane2=np.array([0.0]), patch_half_width=0.5,
-                      continuous=False)
+    w = ContactWalker(contact=contact_params_si(cs), data=data,
+                      knee_stop=knee_stop_si(cs.knee_stop), lane1=np.array([1e3]),
+                      lane2=np.array([0.0]), patch_half_width=0.5, continuous=False)
     x0 = w.pinned_to_full(np.zeros(8), -w.static_penetration() * w.normal)
     sol = solve_ivp(w.rhs, (0, 0.3), x0, method="Radau", jac=w.jac, rtol=1e-8, atol=1e-10,
                     dense_output=True)
@@ -262,8 +263,8 @@ def test_kneed_walker_standing_holds_its_knee_straight_with_the_stop():
     for x in X[10::30]:
         a_stop, a_free = w.rhs(0, x), free.rhs(0, x)
         assert (a_stop[11] - a_stop[10]) < (a_free[11] - a_free[10])
-    wf, Xf = _kneed_on_one_leg({"stiffness_N_m_per_rad": 1e-12,
-                                "max_damping_N_m_s_per_rad": 0.0})
+    wf, Xf = _kneed_on_one_leg({"stiffness_n_m_per_rad_pow_e": 1e-12,
+                                "max_damping_n_m_s_per_rad": 0.0})
     assert wf.knee_stop_quantities(Xf)["leg2"]["extension"].max() > 10 * kq["extension"].max()
 
 
@@ -394,8 +395,8 @@ def test_kneed_rigid_gait_pulls_on_the_stance_knee_early_in_stance():
 def _latched(data, **kw):
     from walkerlab.config.contact import KneeStopSettings
 
-    ks = KneeStopSettings(latch=True, **kw).to_si()
-    return ContactWalker(contact=ContactSettings().to_si(), data=data, knee_stop=ks)
+    ks = knee_stop_si(KneeStopSettings(latch=True, **kw))
+    return ContactWalker(contact=contact_params_si(ContactSettings()), data=data, knee_stop=ks)
 
 
 def test_straight_line_rhs_is_the_array_assembly_with_contact_and_latch():

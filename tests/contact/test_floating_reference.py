@@ -13,6 +13,7 @@ import pytest
 from independent.contact_reference import rhs_ref
 
 from walkerlab.config.contact import ContactSettings
+from walkerlab.contact.laws import contact_params_si
 from walkerlab.contact.model import ContactWalker
 
 
@@ -35,7 +36,7 @@ def _states(w, n, rng):
 @pytest.mark.parametrize("continuous", [True, False])
 def test_generated_rhs_equals_independent_reference(continuous):
     rng = np.random.default_rng(17)
-    w = ContactWalker(contact=ContactSettings().to_si(), lane1=np.array([0.372]),
+    w = ContactWalker(contact=contact_params_si(ContactSettings()), lane1=np.array([0.372]),
                       lane2=np.array([0.0]), continuous=continuous)
     worst, n_contact = 0.0, 0
     for x in _states(w, 100, rng):
@@ -56,7 +57,7 @@ def test_generated_jacobian_equals_central_differences():
     round-off eps |f| / h ~ 1e-8 of the largest entry; 1e-5 relative leaves margin and
     still catches a wrong term."""
     rng = np.random.default_rng(5)
-    w = ContactWalker(contact=ContactSettings().to_si(), continuous=True)
+    w = ContactWalker(contact=contact_params_si(ContactSettings()), continuous=True)
     for x in _states(w, 20, rng):
         J = w.jac(0.0, x)
         Jfd = np.empty_like(J)

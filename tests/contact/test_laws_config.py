@@ -9,6 +9,7 @@ from walkerlab.contact import _kernels as K
 from walkerlab.contact.laws import (
     adams_step,
     adams_step_derivative,
+    contact_params_si,
     coulomb_friction_coefficient,
     impact_normal_force,
 )
@@ -57,25 +58,37 @@ def test_friction_coefficient():
             float(coulomb_friction_coefficient(vi, *args)), abs=1e-14)
 
 
-def test_to_si_pins_units():
-    si = ContactSettings(stiffness=1e5, exponent=2.2, max_damping=90).to_si()
+def test_si_conversion_pins_units():
+    """Each field converts from the unit its name says: the paper's mm-kg-s numbers and the
+    same contact written in SI give the same SI law (an error of 1000^2.2 otherwise)."""
+    si = contact_params_si(ContactSettings(stiffness_n_per_mm_pow_e=1e5, exponent=2.2,
+                                           max_damping_n_s_per_mm=90))
     assert si.k == pytest.approx(1e5 * 1000**2.2, rel=1e-12)  # N/mm^2.2 -> N/m^2.2
     assert si.cmax == pytest.approx(9e4)  # N s/mm -> N s/m
     assert si.dmax == pytest.approx(1e-4)  # 0.1 mm
     assert si.v_s == pytest.approx(0.1) and si.v_d == pytest.approx(1.0)
     assert (si.mu_s, si.mu_d, si.e) == (0.9, 0.7, 2.2)
-    same = ContactSettings(unit_system="SI", stiffness=si.k, max_damping=si.cmax,
-                           penetration_at_max_damping=si.dmax, stiction_velocity=si.v_s,
-                           friction_velocity=si.v_d).to_si()
+    same = contact_params_si(ContactSettings(
+        stiffness_n_per_m_pow_e=si.k, max_damping_n_s_per_m=si.cmax,
+        penetration_at_max_damping_m=si.dmax, stiction_velocity_m_per_s=si.v_s,
+        friction_velocity_m_per_s=si.v_d))
     assert same == si
+    # units may be mixed field by field: each name says its own
+    mixed = contact_params_si(ContactSettings(stiffness_n_per_m_pow_e=si.k,
+                                              max_damping_n_s_per_mm=90.0))
+    assert (mixed.k, mixed.cmax, mixed.dmax) == (si.k, si.cmax, si.dmax)
 
 
 @pytest.mark.parametrize("kw, field", [
-    ({"stiffness": -1.0}, "stiffness"),
+    ({"stiffness_n_per_mm_pow_e": -1.0}, "stiffness_n_per_mm_pow_e"),
+    ({"stiffness_n_per_m_pow_e": 2e12}, "stiffness_n_per_m_pow_e"),
     ({"mu_static": 0.5, "mu_dynamic": 0.7}, "mu_dynamic"),
     ({"exponent": 0.5}, "exponent"),
-    ({"unit_system": "cgs"}, "unit_system"),
-    ({"stiction_velocity": 2000.0}, "stiction_velocity"),
+    ({"stiction_velocity_mm_per_s": 2000.0}, "stiction_velocity_mm_per_s"),
+    # vs 0.5 m/s against the default vd 1000 mm/s = 1 m/s: fine; 2 m/s is not below it
+    ({"stiction_velocity_m_per_s": 2.0}, "friction_velocity_mm_per_s"),
+    ({"stiffness_n_per_mm_pow_e": 1e5, "stiffness_n_per_m_pow_e": 4e9},
+     "give stiffness_n_per_mm_pow_e (mm-kg-s) or stiffness_n_per_m_pow_e (SI), not both"),
     ({"stifness": 1.0}, "stifness"),  # extra fields are forbidden
 ])
 def test_bad_inputs_name_the_field(kw, field):
@@ -91,3 +104,72 @@ def test_other_settings():
     with pytest.raises(ValidationError, match="pin_stance_until"):
         ContactSimSettings(pin_stance_until="forever")
     assert ContactSimSettings().initial_rate_scale == (1.0, 1.0)
+
+
+OLD_PAPER_CONTACT = """contact:
+  unit_system: {system}
+  stiffness: 1.0e+5
+  max_damping: 90.0
+"""
+
+
+@pytest.mark.parametrize("system, new", [
+    ("mm-kg-s", "stiffness_n_per_mm_pow_e, max_damping_n_s_per_mm (mm-kg-s"),
+    ("SI", "stiffness_n_per_m_pow_e, max_damping_n_s_per_m (SI"),
+])
+def test_old_contact_names_get_one_line_naming_the_new_ones(tmp_path, system, new):
+    """A scene written before units were in every contact name (unit_system + stiffness)
+    is refused in one line that names the file and the fields to write instead."""
+    from pathlib import Path
+
+    from walkerlab.config import SceneError, load_scene
+
+    text = Path("configs/paper.yaml").read_text()
+    head = text[:text.index("contact:")]
+    rest = text[text.index("terrain:"):]
+    p = tmp_path / "old.yaml"
+    p.write_text(head + OLD_PAPER_CONTACT.format(system=system) + rest)
+    with pytest.raises(SceneError) as err:
+        load_scene(p)
+    msg = str(err.value)
+    assert "\n" not in msg and str(p.name) in msg
+    assert "unit_system, stiffness, max_damping" in msg and new in msg
+
+
+def test_old_knee_stop_names_get_the_new_names():
+    from walkerlab.config.contact import KneeStopSettings
+
+    with pytest.raises(ValidationError, match="stiffness_N_m_per_rad is now "
+                       "stiffness_n_m_per_rad_pow_e"):
+        KneeStopSettings(stiffness_N_m_per_rad=1e5)
+
+
+def test_paper_scene_writes_table_2_as_printed():
+    """configs/paper.yaml writes the paper's contact numbers (Sec. 4 / Fig. 4b, "1e5, 90,
+    0.9 and 0.7") exactly as printed, under their mm-kg-s names, and its dumped contact
+    section (what the content hash and the artifacts store) names only those fields."""
+    from walkerlab.config import load_scene
+    from walkerlab.published.paper import CONTACT
+
+    c = load_scene("configs/paper.yaml").contact
+    assert {k: getattr(c, k) for k in CONTACT} == CONTACT
+    dumped = c.model_dump()
+    assert "stiffness_n_per_m_pow_e" not in dumped and "unit_system" not in dumped
+    assert dumped["stiffness_n_per_mm_pow_e"] == 1e5
+
+
+def test_a_run_converts_its_contact_law_to_si_once(monkeypatch):
+    """The contact model of a run is built with the law converted once (it was converted
+    twice: once for the probe walker that measures the step length, once for the run's)."""
+    from walkerlab.config import load_scene
+    from walkerlab.contact import laws, rigid_limit
+    from walkerlab.contact.scene import build
+
+    calls = []
+    real = laws.contact_params_si
+    monkeypatch.setattr(rigid_limit, "contact_params_si",
+                        lambda s: calls.append(s) or real(s))
+    scene = load_scene("configs/paper.yaml")
+    walker, step_length = build(scene, np.array([0.19, -0.19, -1.1, -0.4]), 10)
+    assert len(calls) == 1
+    assert walker.contact == real(scene.contact) and 0.3 < step_length < 0.45

@@ -5,12 +5,13 @@ import pytest
 
 from walkerlab.config.contact import ContactSettings
 from walkerlab.contact import ContactWalker
+from walkerlab.contact.laws import contact_params_si
 from walkerlab.contact.model import checkerboard_lanes
 
 
 def _walker(**kw):
     c1, c2 = checkerboard_lanes(0.372, 10)
-    return ContactWalker(contact=ContactSettings(**kw).to_si(), lane1=c1, lane2=c2,
+    return ContactWalker(contact=contact_params_si(ContactSettings(**kw)), lane1=c1, lane2=c2,
                          continuous=False)
 
 

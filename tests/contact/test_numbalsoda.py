@@ -5,7 +5,7 @@ import pytest
 
 from walkerlab.analysis.contact_bench import EXAMPLE_IDEAL, leg_angle_columns
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
-from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.contact import ContactWalker
 from walkerlab.integrate import _lsoda
 
@@ -27,9 +27,10 @@ def test_numbalsoda_five_strides_match_odeint():
     if not _lsoda.available():  # not importorskip: `import numbalsoda` compiles for ~7 s
         pytest.skip("numbalsoda (optional extra) not installed")
     w, x0, tf = _bench_case()
-    a = simulate_contact(w, x0, tf, ContactSolverSettings(method="odeint", rtol=1e-10, atol=1e-13))
+    a = simulate_contact(w, x0, tf,
+                         SolverSettings.for_contact(method="odeint", rtol=1e-10, atol=1e-13))
     b = simulate_contact(w, x0, tf,
-                         ContactSolverSettings(method="numbalsoda", rtol=1e-10, atol=1e-13))
+                         SolverSettings.for_contact(method="numbalsoda", rtol=1e-10, atol=1e-13))
     assert b.method == "numbalsoda" and b.termination == a.termination == "t_final"
     assert b.nfev > 0 and b.walked_steps == a.walked_steps == 10
     assert b.heel_strike_legs == a.heel_strike_legs
@@ -41,7 +42,8 @@ def test_numbalsoda_five_strides_match_odeint():
 def test_numbalsoda_missing_or_unsupported_is_one_clear_error(monkeypatch):
     w, x0, _ = _bench_case()
     with pytest.raises(ValueError, match="max_step_s"):
-        simulate_contact(w, x0, 0.01, ContactSolverSettings(method="numbalsoda", max_step_s=1e-3))
+        simulate_contact(w, x0, 0.01,
+                         SolverSettings.for_contact(method="numbalsoda", max_step_s=1e-3))
     monkeypatch.setattr(_lsoda, "lsoda", None)
     with pytest.raises(ValueError, match=r"pip install 'walkerlab\[numbalsoda\]'"):
-        simulate_contact(w, x0, 0.01, ContactSolverSettings(method="numbalsoda"))
+        simulate_contact(w, x0, 0.01, SolverSettings.for_contact(method="numbalsoda"))

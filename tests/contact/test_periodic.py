@@ -14,7 +14,7 @@ from walkerlab.analysis.contact_periodic import (
 from walkerlab.analysis.contact_sim import simulate_contact
 from walkerlab.analysis.rigid_limit import convergence, observed_order
 from walkerlab.analysis.scene_gaits import solve_variant
-from walkerlab.config import ContactSolverSettings, load_scene
+from walkerlab.config import SolverSettings, load_scene
 from walkerlab.contact.model import checkerboard_lanes
 from walkerlab.contact.rigid_limit import expected_order
 from walkerlab.contact.scene import build
@@ -70,7 +70,7 @@ def test_period_close_to_ideal(setup, paper_gait):
     c1, c2 = checkerboard_lanes(g.step_length_m, 8)
     w = dataclasses.replace(walker, lane1=c1, lane2=c2, continuous=False)
     x0 = StepMap(walker).to_state(g.z)
-    r = simulate_contact(w, x0, 6 * g.period_s, ContactSolverSettings(rtol=1e-10, atol=1e-13))
+    r = simulate_contact(w, x0, 6 * g.period_s, SolverSettings.for_contact(rtol=1e-10, atol=1e-13))
     assert r.termination == "t_final"
     T = np.diff(r.heel_strike_times)
     assert len(T) >= 4

@@ -9,7 +9,7 @@ import pytest
 from walkerlab.analysis.contact_periodic import StepMap, find_contact_periodic_gait
 from walkerlab.analysis.contact_sim import simulate_contact
 from walkerlab.analysis.scene_gaits import solve_variant
-from walkerlab.config import ContactSolverSettings, load_scene
+from walkerlab.config import SolverSettings, load_scene
 from walkerlab.contact.scene import build
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "kneed.yaml"
@@ -60,7 +60,7 @@ def test_kneed_section_is_named_and_the_fixed_point_maps_to_itself(kneed):
     assert walker.contact_quantities(x[None])["leg1"]["penetration"][0] < -0.02
     # an independent check of the map: a plain contact run (heel strikes found on 1 kHz
     # samples, not by the map's section) started on the fixed point repeats the period
-    r = simulate_contact(walker, x, 4.2 * T, ContactSolverSettings(rtol=1e-10, atol=1e-12))
+    r = simulate_contact(walker, x, 4.2 * T, SolverSettings.for_contact(rtol=1e-10, atol=1e-12))
     assert r.termination == "t_final"
     dT = np.diff(r.heel_strike_times)
     assert len(dT) >= 3 and np.all(np.abs(dT - T) < 2e-3)

@@ -7,9 +7,9 @@ from scipy.optimize import brentq
 
 from walkerlab.analysis.contact_bench import leg_angle_columns
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
-from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.contact import ContactWalker
-from walkerlab.contact.laws import coulomb_friction_coefficient
+from walkerlab.contact.laws import contact_params_si, coulomb_friction_coefficient
 
 PAPER_FP = (-0.2042, 0.1694, -0.6058, -0.8610)  # ideal fixed point after heel strike
 L, m, MH, a, g = 1.0, 5.0, 10.0, 0.5, 9.81
@@ -22,11 +22,11 @@ def _standing(phi, settings=None, both_feet=False, t_final=0.5):
     """
     cs = settings or ContactSettings()
     lane1 = np.array([0.0]) if both_feet else np.array([100.0])
-    w = ContactWalker(phi=phi, contact=cs.to_si(), lane1=lane1, lane2=np.array([0.0]),
+    w = ContactWalker(phi=phi, contact=contact_params_si(cs), lane1=lane1, lane2=np.array([0.0]),
                       patch_half_width=1.0, continuous=False)
     x0 = initial_state_from_ideal(w, 0.0, 0.0, 0.0, 0.0)
     x0[1] += 1e-5  # start 10 µm higher: it has to settle, not just sit
-    return w, simulate_contact(w, x0, t_final, ContactSolverSettings(rtol=1e-10, atol=1e-13))
+    return w, simulate_contact(w, x0, t_final, SolverSettings.for_contact(rtol=1e-10, atol=1e-13))
 
 
 @pytest.mark.parametrize("both_feet", [False, True])
@@ -109,11 +109,11 @@ def test_rigid_limit_as_stiffness_grows():
                       rtol=1e-12, atol=1e-12).y.T
     errs = []
     for k in (1e1, 1e2, 1e3, 1e4, 1e5):  # N/mm^2.2
-        cs = ContactSettings(stiffness=k, mu_static=5, mu_dynamic=5, stiction_velocity=0.01,
-                             friction_velocity=0.1)
+        cs = ContactSettings(stiffness_n_per_mm_pow_e=k, mu_static=5, mu_dynamic=5,
+                             stiction_velocity_mm_per_s=0.01, friction_velocity_mm_per_s=0.1)
         w = ContactWalker.from_settings(cs, TerrainSettings(), step_length=0.372, n_steps=4)
         r = simulate_contact(w, initial_state_from_ideal(w, *PAPER_FP), 0.6,
-                             ContactSolverSettings(rtol=1e-10, atol=1e-13))
+                             SolverSettings.for_contact(rtol=1e-10, atol=1e-13))
         errs.append(np.abs(r.x[:, leg_angle_columns(w)] - ideal[:, :2]).max())
     errs = np.array(errs)
     assert np.all(np.diff(errs) < 0), errs  # monotone decrease

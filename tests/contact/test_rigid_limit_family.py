@@ -4,11 +4,12 @@
 import pytest
 
 from walkerlab.config.contact import ContactSettings, KneeStopSettings
+from walkerlab.contact.laws import contact_params_si, knee_stop_si
 from walkerlab.contact.rigid_limit import contact_si, expected_order, scale
 
 
 def test_family_exponents():
-    c, k = ContactSettings().to_si(), KneeStopSettings().to_si()
+    c, k = contact_params_si(ContactSettings()), knee_stop_si(KneeStopSettings())
     kappa = 1e4
     c2, k2 = scale(c, k, kappa)
     p = 1 / (c.e + 1)  # 1/3.2
@@ -30,12 +31,17 @@ def test_scene_family_is_the_one_family():
     """stiffness 1e7 N/mm^2.2 in the rigid_limit family = the reference contact scaled by
     kappa = 100, friction velocities included (the old config family left them)."""
     ref = ContactSettings()
-    stiff = ref.model_copy(update={"stiffness": 1e7, "stiffness_family": "rigid_limit"})
+    stiff = ContactSettings(stiffness_n_per_mm_pow_e=1e7, stiffness_family="rigid_limit")
     got, knee = contact_si(stiff)
     want, want_knee = scale(*contact_si(ref), 100.0)
     for f in ("k", "cmax", "dmax", "v_s", "v_d"):
         assert getattr(got, f) == pytest.approx(getattr(want, f), rel=1e-12), f
     assert knee.latch_height == pytest.approx(want_knee.latch_height, rel=1e-12)
     # the paper family keeps the numbers as written
-    paper = ref.model_copy(update={"stiffness": 1e7})
-    assert contact_si(paper)[0].v_s == ref.to_si().v_s
+    paper = ContactSettings(stiffness_n_per_mm_pow_e=1e7)
+    assert contact_si(paper)[0].v_s == contact_params_si(ref).v_s
+    # the reference written in SI is the same reference (kappa from the SI values)
+    mixed = ContactSettings(stiffness_n_per_mm_pow_e=1e7, stiffness_family="rigid_limit",
+                            reference_stiffness_n_per_m_pow_e=contact_params_si(ref).k)
+    for f in ("k", "cmax", "dmax", "v_s", "v_d"):
+        assert getattr(contact_si(mixed)[0], f) == pytest.approx(getattr(got, f), rel=1e-12), f

@@ -15,7 +15,7 @@ from walkerlab.analysis.contact_sim import (
     simulate_contact,
 )
 from walkerlab.cli import app
-from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.contact import ContactWalker
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.ends import CONTACT_WALKED, RUN_END_NAMES
@@ -56,7 +56,7 @@ def test_a_one_sample_run_maps_onto_the_named_layout():
     sample (here by a wall-time limit already spent) maps onto the named layout."""
     w = _paper()
     x0 = initial_state_from_ideal(w, *FP)
-    r = simulate_contact(w, x0, 1.0, ContactSolverSettings(method="odeint"),
+    r = simulate_contact(w, x0, 1.0, SolverSettings.for_contact(method="odeint"),
                          ContactLimits(wall_time_limit_s=1e-9))
     assert r.t.size == 1 and r.outcome.kind == "time_limit"
     tr = named_trajectory(w, r)
@@ -73,7 +73,7 @@ def test_wall_time_limit_holds_inside_a_chunk(method):
     limit = 2.0
     w = _paper()
     x0 = initial_state_from_ideal(w, *FP, rate_scale=(1e6, 1e6))
-    r = simulate_contact(w, x0, 1.0, ContactSolverSettings(method=method),
+    r = simulate_contact(w, x0, 1.0, SolverSettings.for_contact(method=method),
                          ContactLimits(wall_time_limit_s=limit, airborne_hip_height_m=np.inf))
     assert r.outcome.kind == "time_limit", r.outcome
     assert r.wall_time_s < limit + 3.0  # "a few seconds": the chunk is cut, not finished

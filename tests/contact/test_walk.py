@@ -8,7 +8,7 @@ import pytest
 from tests.contact.conftest import FP, STEP_LENGTH
 from walkerlab.analysis.contact_bench import BAND_FACTORS, run_benchmark, run_scene_benchmark
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
-from walkerlab.config import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.contact import ContactWalker
 from walkerlab.integrate.contact import ContactLimits, StateIndex
 
@@ -21,7 +21,7 @@ def _paper(width, n_steps=12):
 def _walk(width, scale=(1.0, 1.0), t_final=7.5, **kw):
     w = _paper(width)
     return w, simulate_contact(w, initial_state_from_ideal(w, *FP, rate_scale=scale), t_final,
-                               ContactSolverSettings(rtol=1e-9, atol=1e-12), **kw)
+                               SolverSettings.for_contact(rtol=1e-9, atol=1e-12), **kw)
 
 
 def test_paper_walker_walks_five_strides_on_checkerboard():
@@ -60,13 +60,15 @@ def test_pinned_first_step_and_odeint_vs_radau():
     w = _paper(0.3)
     x0 = initial_state_from_ideal(w, *FP)
     r = simulate_contact(w, x0, 1.0,
-                         ContactSolverSettings(rtol=1e-9, atol=1e-12),
+                         SolverSettings.for_contact(rtol=1e-9, atol=1e-12),
                          ContactLimits(pin_stance_until="first_touchdown"))
     assert 0.6 < r.pin_end_time < 0.8 and r.walked_steps == 1
     foot2 = w.foot_positions(r.x[r.t <= r.pin_end_time])[:, 1]
     assert np.ptp(foot2, axis=0).max() < 1e-12  # pinned
-    a = simulate_contact(w, x0, 1.0, ContactSolverSettings(method="odeint", rtol=1e-10, atol=1e-13))
-    b = simulate_contact(w, x0, 1.0, ContactSolverSettings(method="Radau", rtol=1e-10, atol=1e-13))
+    a = simulate_contact(w, x0, 1.0,
+                         SolverSettings.for_contact(method="odeint", rtol=1e-10, atol=1e-13))
+    b = simulate_contact(w, x0, 1.0,
+                         SolverSettings.for_contact(method="Radau", rtol=1e-10, atol=1e-13))
     q = StateIndex(w).coordinates  # hip position and leg angles
     assert np.abs(a.x[:, q] - b.x[:, q]).max() < 1e-7  # two independent integrators agree
 
@@ -76,7 +78,7 @@ def test_fall_is_detected():
     x0 = initial_state_from_ideal(w, *FP, rate_scale=(1.0, 0.3))  # too slow: falls back
     for method in ("odeint", "cyrk_bdf", "LSODA"):
         r = simulate_contact(w, x0, 5.0,
-                             ContactSolverSettings(method=method, rtol=1e-8, atol=1e-11))
+                             SolverSettings.for_contact(method=method, rtol=1e-8, atol=1e-11))
         assert r.termination == "fall" and r.fall_time is not None
         assert w.hip_height(r.x)[-1] == pytest.approx(0.5, abs=0.02)
 

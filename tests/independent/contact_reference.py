@@ -35,7 +35,7 @@ def mass_matrix_ref(q, L, m, MH, a):
 def contact_forces_ref(x, L, phi, params, lanes, half_width, continuous):
     """World-frame contact force on each foot, (2, 2) [N] (row i = foot i+1).
 
-    ``params`` is a :class:`~walkerlab.config.contact.ContactParamsSI`; ``lanes`` = (c1, c2)
+    ``params`` is a :class:`~walkerlab.contact.laws.ContactParamsSI`; ``lanes`` = (c1, c2)
     patch-centre arrays [m].
     """
     n = np.array([np.sin(phi), np.cos(phi)])

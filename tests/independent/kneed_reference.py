@@ -16,6 +16,15 @@ Step: three-link swing (knee free) until the knee straightens (``q3 = q2``): pla
 strike that locks the knee; two-link swing until heel strike (``q1 + q2 = -2 gamma``, swing
 foot ahead); plastic heel strike with the knee still locked, legs swap, the new swing knee
 unlocks.
+
+Parts beyond Hsu Chen's walker (issue 22), all optional (``p`` keys, default off): the swing
+leg's masses ``mt_sw``, ``ms_sw`` differing from the stance leg's ``mt``, ``ms`` (legs that
+differ: the step with the other leg swinging swaps them); a torsional hip spring-damper
+between the stance leg and the swing thigh, ``k_hip``, ``rest_hip``, ``c_hip`` on
+``delta = q1 - q2`` (stance minus swing thigh angle: potential ``k (delta - rest)^2 / 2``,
+generalised force ``-(k (delta - rest) + c d(delta)/dt) d(delta)/dq``); a torsional spring-
+damper at the swing knee, ``k_knee``, ``rest_knee``, ``c_knee`` on the knee angle
+``q3 - q2`` (the stance knee is straight: its spring holds a constant energy, left out).
 """
 
 from __future__ import annotations
@@ -52,12 +61,14 @@ TEDRAKE_X0 = np.array([0.187700106303669, -0.288437140111164, -0.288437140111164
 
 
 @cache
-def _symbolic():
-    q = sp.symbols("q1 q2 q3", real=True)
-    dq = sp.symbols("dq1 dq2 dq3", real=True)
+def _symbolic(torso=False):
+    q = sp.symbols("q1 q2 q3" + (" q4" if torso else ""), real=True)
+    dq = sp.symbols("dq1 dq2 dq3" + (" dq4" if torso else ""), real=True)
     g, lt, ls, mh, mt, ms, a1, b1, a2, b2 = sp.symbols("g lt ls mh mt ms a1 b1 a2 b2",
                                                        positive=True)
-    q1, q2, q3 = q
+    mt_sw, ms_sw = sp.symbols("mt_sw ms_sw", positive=True)
+    springs = sp.symbols("k_hip rest_hip c_hip k_knee rest_knee c_knee", real=True)
+    q1, q2, q3 = q[:3]
     up = lambda th: sp.Matrix([-sp.sin(th), sp.cos(th)])  # noqa: E731
     hip = (ls + lt) * up(q1)
     knee = hip - lt * up(q2)
@@ -72,9 +83,22 @@ def _symbolic():
         "stance_knee": ls * up(q1),
     }
     bodies = [(ms, 0, pts["stance_shank"], q1), (mt, 0, pts["stance_thigh"], q1),
-              (mh, 0, hip, q1), (mt, 0, pts["swing_thigh"], q2),
-              (ms, 0, pts["swing_shank"], q3)]
+              (mh, 0, hip, q1), (mt_sw, 0, pts["swing_thigh"], q2),
+              (ms_sw, 0, pts["swing_shank"], q3)]
+    extra = ()
+    if torso:  # a point mass d up the torso (angle q4 from the upward vertical)
+        m_tor, d_tor = sp.symbols("m_tor d_tor", positive=True)
+        pts["torso"] = hip + d_tor * up(q[3])
+        bodies.append((m_tor, 0, pts["torso"], q[3]))
+        extra = (m_tor, d_tor)
     M, h, T, V = lagrange(q, dq, bodies, g)
+    k_hip, rest_hip, c_hip, k_knee, rest_knee, c_knee = springs
+    for k, rest, c, delta in ((k_hip, rest_hip, c_hip, q1 - q2),
+                              (k_knee, rest_knee, c_knee, q3 - q2)):
+        grad = sp.Matrix([sp.diff(delta, qi) for qi in q])
+        rate = sum(gi * dqi for gi, dqi in zip(grad, dq))
+        V = V + k * (delta - rest) ** 2 / 2
+        h = h + (k * (delta - rest) + c * rate) * grad
     # extended coordinates for heel strike: the stance foot free at (xf, yf)
     xf, yf, dxf, dyf = sp.symbols("xf yf dxf dyf", real=True)
     qe, dqe = (*q, xf, yf), (*dq, dxf, dyf)
@@ -82,15 +106,15 @@ def _symbolic():
     Me, _, _, _ = lagrange(qe, dqe, [(m, 0, p + off, a) for m, _, p, a in bodies], g,
                            mass_matrix_only=True)
     E = (pts["swing_foot"] + off).jacobian(sp.Matrix(qe))
-    par = (g, lt, ls, mh, mt, ms, a1, b1, a2, b2)
-    masses = {"stance_shank": ms, "stance_thigh": mt, "hip": mh, "swing_thigh": mt,
-              "swing_shank": ms}
+    par = (g, lt, ls, mh, mt, ms, a1, b1, a2, b2, mt_sw, ms_sw, *springs, *extra)
+    masses = {"stance_shank": ms, "stance_thigh": mt, "hip": mh, "swing_thigh": mt_sw,
+              "swing_shank": ms_sw}
     return q, dq, par, M, h, T, V, Me, E, pts, masses
 
 
 @cache
-def _lambdified():
-    q, dq, par, M, h, T, V, Me, E, pts, masses = _symbolic()
+def _lambdified(torso=False):
+    q, dq, par, M, h, T, V, Me, E, pts, masses = _symbolic(torso)
     a = (q, dq, par)
     return {"M": lam((q, par), M), "h": lam(a, h), "T": lam(a, T), "V": lam((q, par), V),
             "Me": lam((q, par), Me), "E": lam((q, par), E),
@@ -116,7 +140,9 @@ class KneedReference:
     def _par(self):
         p = self.p
         return (p["g"], p["lt"], p["ls"], p["mh"], p["mt"], p["ms"], p["a1"], p["b1"],
-                p["a2"], p["b2"])
+                p["a2"], p["b2"], p.get("mt_sw", p["mt"]), p.get("ms_sw", p["ms"]),
+                *(p.get(k, 0.0) for k in ("k_hip", "rest_hip", "c_hip", "k_knee",
+                                          "rest_knee", "c_knee")))
 
     # ------------------------------------------------------------------ flows
     J_KNEE = np.array([0.0, -1.0, 1.0])   # knee constraint q3 - q2 = 0 (row)
@@ -297,3 +323,76 @@ if __name__ == "__main__":  # pragma: no cover - prints the reference numbers
     s = w.step(xs)
     print("period", s["t_heel"], "knee strike at", s["t_knee"])
     print("multipliers", w.multipliers(xs), np.abs(w.multipliers(xs)))
+
+
+@dataclass
+class KneedTorsoReference(KneedReference):
+    """The kneed walker with an upper body on a bisecting hip mechanism (Wisse, Hobbelen &
+    Schwab 2007): a point mass ``m_tor`` at ``d_tor`` up a torso whose angle ``q4`` from the
+    upward vertical (positive leaning back) is a fourth coordinate, held at ``(q1 + q2) / 2``
+    (the mean of the stance leg's and the swing thigh's angles) by a Lagrange multiplier in
+    every flow and impact - not eliminated as in walkerlab.  States stay ``[q1, q2, q3,
+    rates]``; ``q4`` and its rate follow from the coupling."""
+
+    #: the coupling row q4 - (q1 + q2) / 2 = 0
+    A_TORSO = np.array([-0.5, -0.5, 0.0, 1.0])
+    J_KNEE4 = np.array([0.0, -1.0, 1.0, 0.0])
+
+    @cached_property
+    def _f(self):
+        return dict(_lambdified(True))
+
+    def _par(self):
+        return (*super()._par(), self.p["m_tor"], self.p["d_tor"])
+
+    @staticmethod
+    def _full(x):
+        q, dq = np.asarray(x[:3]), np.asarray(x[3:])
+        return (np.append(q, 0.5 * (q[0] + q[1])), np.append(dq, 0.5 * (dq[0] + dq[1])))
+
+    def _solve(self, M, rhs, rows):
+        """``M a - C^T lam = rhs``, ``C a = 0``: (a, lam)."""
+        C = np.atleast_2d(rows)
+        n, k = M.shape[0], C.shape[0]
+        A = np.zeros((n + k, n + k))
+        A[:n, :n], A[:n, n:], A[n:, :n] = M, -C.T, C
+        sol = np.linalg.solve(A, np.concatenate([rhs, np.zeros(k)]))
+        return sol[:n], sol[n:]
+
+    def flow_unlocked(self, t, x):
+        q, dq = self._full(x)
+        M = self._f["M"](q, self._par())
+        h = self._f["h"](q, dq, self._par()).ravel()
+        a, _ = self._solve(M, -h, self.A_TORSO)
+        return np.concatenate([x[3:], a[:3]])
+
+    def locked_accel(self, x):
+        q, dq = self._full(x)
+        M = self._f["M"](q, self._par())
+        h = self._f["h"](q, dq, self._par()).ravel()
+        a, lam_ = self._solve(M, -h, np.vstack([self.J_KNEE4, self.A_TORSO]))
+        return a[:3], lam_[0]
+
+    def knee_strike(self, x):
+        q, dq = self._full(x)
+        M = self._f["M"](q, self._par())
+        v, _ = self._solve(M, M @ dq, np.vstack([self.J_KNEE4, self.A_TORSO]))
+        q_new = np.asarray(x[:3], float).copy()
+        q_new[2] = q_new[1]
+        return np.concatenate([q_new, v[:3]])
+
+    def heel_strike(self, x, return_extra=False):
+        q, dq = self._full(x)
+        Me = self._f["Me"](q, self._par())
+        E = self._f["E"](q, self._par())
+        rows = np.vstack([E, np.append(self.J_KNEE4, [0.0, 0.0]),
+                          np.append(self.A_TORSO, [0.0, 0.0])])
+        v, _ = self._solve(Me, Me @ np.concatenate([dq, [0.0, 0.0]]), rows)
+        return np.array([q[1], q[0], q[0], v[1], v[0], v[0]])
+
+    def energies(self, x):
+        q, dq = self._full(x)
+        return (float(self._f["T"](q, dq, self._par())), float(self._f["V"](q, self._par())))
+
+    def point(self, name, x):
+        return self._f["pts"][name](self._full(x)[0], self._par()).ravel()

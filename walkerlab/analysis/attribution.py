@@ -102,9 +102,9 @@ def energy_by_sink(walker, z, n_samples: int = 20000) -> dict[str, float]:
     from walkerlab.analysis.contact_periodic import StepMap
 
     sm = StepMap(walker)
-    sol = sm.integrate(sm.to_state(z), stance_to_come=0, dense=True)
-    t = np.linspace(sol.t[0], sol.t[-1], n_samples)
-    X = sol.sol(t).T
+    run = sm.integrate(sm.to_state(z), stance_to_come=0, dense=True)
+    t = np.linspace(run.t[0], run.t[-1], n_samples)
+    X = run.dense(t).T
     w, c = sm.walker, sm.walker.contact
     cq = w.contact_quantities(X)
     # in contact: on a patch and below its top (the force may be clipped at 0 there: the
@@ -188,10 +188,8 @@ def adjustment_effect(scene, ideal, strides: int = 5) -> dict:
                                                                      "heel_strike") \
             else float("nan")
     iw = build_walker(scene)
-    x = np.array(ideal.x, float)
-    n = len(x) // 2  # role order: swing link(s), then the stance leg; rates likewise
-    x[n:-1] *= scale[0]
-    x[-1] *= scale[1]
+    # leg1 swings first (paper Eq. 11): its rates take scale[0], the stance leg's scale[1]
+    x = iw.layout().scale_rates(ideal.x, {"swing": scale[0], "stance": scale[1]})
     run = simulate_steps(iw, x, 2 * strides, Solver.from_settings(scene.solver))
     out["rigid_from_adjusted"] = run.termination
     out["rigid_heel_strikes"] = sum(s.termination == "heel_strike" for s in run.segments)

@@ -145,7 +145,7 @@ class BatchStepMap:
 
         self.walker, self.walker_at = walker, walker_at
         self.rtol, self.atol, self.max_step_time_s = rtol, atol, max_step_time_s
-        self.n = 2 * walker.n_coordinates
+        self.n = walker.layout().size
         self.phases = []
         for ph in walker.phases:
             cf = ph.compiled

@@ -11,7 +11,8 @@ import time
 
 import numpy as np
 
-from walkerlab.config.contact import ContactSettings, ContactSolverSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.config.solver import SolverSettings
 from walkerlab.contact.model import ContactWalker
 from walkerlab.integrate.contact import StateIndex
 
@@ -114,7 +115,7 @@ def run_benchmark(n_strides: int = 5, methods=None,
                                   ideal["dtheta2"], rate_scale=rate_scale)
     t_final = 1.03 * n_steps * ideal["step_period"]  # the contact gait is ~1% slower
     ref = simulate_contact(walker, x0, t_final,
-                           ContactSolverSettings(method="odeint", rtol=1e-12, atol=1e-15))
+                           SolverSettings.for_contact(method="odeint", rtol=1e-12, atol=1e-15))
     angles = leg_angle_columns(walker)
 
     def error(r):
@@ -125,7 +126,7 @@ def run_benchmark(n_strides: int = 5, methods=None,
         best = None
         for _ in range(repeats):
             r = simulate_contact(walker, x0, t_final,
-                                 ContactSolverSettings(method=method, rtol=rtol, atol=atol))
+                                 SolverSettings.for_contact(method=method, rtol=rtol, atol=atol))
             if best is None or r.wall_time_s < best.wall_time_s:
                 best = r
         return best, error(best)
@@ -145,7 +146,7 @@ def run_benchmark(n_strides: int = 5, methods=None,
         for rtol in rtols:
             best = None
             for _ in range(repeats):
-                r = simulate_contact(walker, x0, t_final, ContactSolverSettings(
+                r = simulate_contact(walker, x0, t_final, SolverSettings.for_contact(
                     method=method, rtol=rtol, atol=1e-3 * rtol))
                 if best is None or r.wall_time_s < best.wall_time_s:
                     best = r
@@ -191,7 +192,7 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
     n_strides : int
         Strides (2 steps each) [-].
     methods : sequence of str
-        Contact integrators (:class:`ContactSolverSettings` ``method``).
+        Contact integrators (:class:`SolverSettings` ``method``).
     target_error_rad : float
         Worst leg-angle error allowed [rad].
     repeats : int
@@ -220,7 +221,7 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
     ideal = ideal_gait(scene)
     walker, x0, limits, _ = scene_start(scene, ideal.x, n_strides + 1)
     t_final = 1.03 * 2 * n_strides * ideal.period_s
-    ref = simulate_contact(walker, x0, t_final, ContactSolverSettings(
+    ref = simulate_contact(walker, x0, t_final, SolverSettings.for_contact(
         method="odeint", rtol=reference_rtol, atol=1e-3 * reference_rtol), limits)
     angles = leg_angle_columns(walker)
 
@@ -229,7 +230,7 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
         return float(np.abs(r.x[:n, angles] - ref.x[:n, angles]).max())
 
     def timed(method, rtol):
-        rs = [simulate_contact(walker, x0, t_final, ContactSolverSettings(
+        rs = [simulate_contact(walker, x0, t_final, SolverSettings.for_contact(
             method=method, rtol=rtol, atol=0.1 * rtol), limits) for _ in range(repeats)]
         return (float(np.median([r.wall_time_s for r in rs])), error(rs[0]), rs[0].nfev,
                 rs[0].termination)

@@ -11,11 +11,12 @@ fixed) and in the rigid-limit family (:mod:`walkerlab.contact.rigid_limit`).
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from walkerlab.config.contact import ContactSettings
 from walkerlab.contact.laws import impact_normal_force
 from walkerlab.contact.rigid_limit import contact_si
+from walkerlab.integrate.events import Event, run_to_event
+from walkerlab.integrate.solver import Solver
 
 __all__ = ["FAMILIES", "drop_restitution", "restitution_curve"]
 
@@ -56,24 +57,21 @@ def drop_restitution(contact: ContactSettings, mass_kg: float = 20.0, v_in_m_per
         fn = float(impact_normal_force(d, dd, c.k, c.e, c.cmax, c.dmax))
         return [dd, g - fn / mass_kg]
 
-    def sep(t, y):
-        return y[0] if t > 0 else 1.0
-
-    sep.terminal = True
-    sep.direction = -1
-    sol = solve_ivp(f, (0.0, 50 * tc), [0.0, vin], method="Radau", rtol=rtol,
-                    atol=[1e-6 * dstar, 1e-6 * vin], events=sep, max_step=tc / 10)
-    penetration, _rate = sol.y  # the point mass's state [delta (m), d delta/dt (m/s)]
+    separation = Event("separation", lambda t, y: y[0] if t > 0 else 1.0, -1)
+    solver = Solver("Radau", rtol, [1e-6 * dstar, 1e-6 * vin], max_step_s=tc / 10)
+    run = run_to_event(f, [0.0, vin], 50 * tc, solver, [separation])
+    penetration, _rate = run.y  # the point mass's state [delta (m), d delta/dt (m/s)]
     dmax = float(np.max(penetration))
-    if sol.t_events[0].size:
-        vout = -float(sol.y_events[0][0][1])
+    if run.event == "separation":
+        vout = -float(run.y_event[1])
         return {"restitution": max(vout, 0.0) / vin, "max_penetration_m": dmax,
-                "contact_time_s": float(sol.t_events[0][0])}
+                "contact_time_s": run.t_event}
     return {"restitution": 0.0, "max_penetration_m": dmax, "contact_time_s": float("nan")}
 
 
 def restitution_curve(base: ContactSettings, stiffness, families=FAMILIES, **kw) -> dict:
-    """Restitution of the drop test for each stiffness (scene units) in each family.
+    """Restitution of the drop test for each stiffness in each family, the stiffnesses in
+    the unit ``base`` writes its stiffness in (``N/mm^e`` or ``N/m^e``).
 
     Returns
     -------
@@ -83,9 +81,10 @@ def restitution_curve(base: ContactSettings, stiffness, families=FAMILIES, **kw)
     """
     ks = np.asarray(stiffness, float)
     out: dict = {"stiffness": ks}
+    unit = base.written("stiffness")[1]
     for fam in families:
-        rows = [drop_restitution(base.model_copy(update={"stiffness": float(k),
-                                                         "stiffness_family": fam}), **kw)
+        family = base.model_copy(update={"stiffness_family": fam})
+        rows = [drop_restitution(family.with_written("stiffness", float(k), unit), **kw)
                 for k in ks]
         out[fam] = {key: np.array([r[key] for r in rows]) for key in rows[0]}
     return out

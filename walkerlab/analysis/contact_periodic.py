@@ -26,7 +26,9 @@ Step map
 --------
 ``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 = stance,
 leg1 = swing: the legs are identical, so one orientation suffices), integrate with
-``solve_ivp`` (LSODA or Radau with the analytic numba Jacobian) until the next upward zero
+``solve_ivp`` (LSODA or Radau with the analytic numba Jacobian; through
+:func:`walkerlab.integrate.events.run_to_event`, or odeint on a grid with
+:func:`~walkerlab.integrate.events.odeint_grid`) until the next upward zero
 of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), located by
 ``solve_ivp``'s event root-finding on the dense output; swap the leg roles and express the
 state relative to the new stance foot (leg1).  Outputs besides ``P(z)``: the step period
@@ -80,15 +82,16 @@ from __future__ import annotations
 
 import dataclasses
 import time
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
 from walkerlab.contact.model import ContactWalker
 from walkerlab.integrate.contact import StateIndex
+from walkerlab.integrate.ends import RunEnd
+from walkerlab.integrate.events import Event, EventRun, odeint_grid, run_to_event
+from walkerlab.integrate.solver import Solver
 
 __all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait", "PeriodicGaitError",
            "find_contact_periodic_gait", "section_guess_from_ideal"]
@@ -206,7 +209,8 @@ class StepMap:
         keep_ground = walker.continuous and walker.structure.knee
         self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing]),
                                           lane2=np.array([0.0]), continuous=keep_ground)
-        self.method, self.rtol, self.atol, self.t_max = method, rtol, atol, t_max
+        self.method, self.t_max = method, t_max
+        self.solver = Solver(method, rtol, atol)  # the step map's integrator
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
         w = self.walker
@@ -242,7 +246,7 @@ class StepMap:
         val[self._angle[0]] = val[self._angle[1]]
         ix = self.idx
         cols = [ix[c] for c in ix.names[ix.coordinates] if c not in ("hip_x", "hip_y")]
-        zp = np.array([val[c] for c in cols] + [val[c + ix.n // 2] for c in cols])
+        zp = np.array([val[c] for c in cols] + [val[ix.rate_of(ix.names[c])] for c in cols])
         # stance foot at p and at rest, then the whole walker translated at v
         x = self.walker.pinned_to_full(zp, p)
         x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] += v
@@ -267,30 +271,19 @@ class StepMap:
     def _jac(self, t, x):
         return self._fj(x)
 
-    def integrate(self, x0, stance_to_come: int = 0, dense: bool = False):
+    def integrate(self, x0, stance_to_come: int = 0, dense: bool = False) -> EventRun:
         """Integrate from ``x0`` to the next upward zero of theta_sw - theta_st where the
-        new stance leg is ``stance_to_come`` (0 = leg1).  Returns the solve_ivp solution."""
+        new stance leg is ``stance_to_come`` (0 = leg1): event ``mid_stance``, or ``fall``
+        (hip below L/2; :func:`walkerlab.integrate.events.run_to_event`)."""
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
-
-        def mid(t, x):
-            return x[isw] - x[ist]
-
-        mid.terminal = True
-        mid.direction = 1.0
-
         hth = 0.5 * self.walker.L
-
-        def fall(t, x):
-            return self.walker.fall_margin(x, hth)
-
-        fall.terminal = True
-        fall.direction = -1.0
-        sol = solve_ivp(self._rhs, (0.0, self.t_max), np.asarray(x0, float),
-                        method="LSODA" if self.method == "odeint" else self.method,
-                        jac=self._jac, rtol=self.rtol, atol=self.atol,
-                        events=[mid, fall], dense_output=dense)
+        events = [Event("mid_stance", lambda t, x: x[isw] - x[ist], 1.0),
+                  Event("fall", lambda t, x: self.walker.fall_margin(x, hth), -1.0,
+                        RunEnd.FALL)]
+        run = run_to_event(self._rhs, x0, self.t_max, self.solver, events, jac=self._jac,
+                           dense=dense)
         self.nfev += 1
-        return sol
+        return run
 
     def _step_odeint(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
                      chunk_s: float = 0.25):
@@ -301,8 +294,6 @@ class StepMap:
         on short odeint integrations from the sample before it, so the section state
         carries the integrator's accuracy, not an interpolant's.
         """
-        from scipy.integrate import ODEintWarning, odeint
-
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
         hth = 0.5 * self.walker.L
         frhs, fjac = self._f, self._fj
@@ -314,12 +305,9 @@ class StepMap:
             return fjac(x)
 
         def run(x, tg):
-            with warnings.catch_warnings():  # the message is checked below
-                warnings.simplefilter("ignore", ODEintWarning)
-                X, info = odeint(f, x, tg, Dfun=jf, tfirst=True, rtol=self.rtol,
-                                 atol=self.atol, full_output=True, mxstep=500000)
-            if info["message"] != "Integration successful.":
-                raise PeriodicGaitError("solver_failure", f"step map: {info['message']}")
+            X, end, message = odeint_grid(f, x, tg, self.solver, jac=jf)
+            if end is RunEnd.SOLVER_FAILURE:
+                raise PeriodicGaitError("solver_failure", f"step map: {message}")
             return X
 
         ta, xa = 0.0, np.asarray(x0, float)
@@ -366,34 +354,30 @@ class StepMap:
             te, xe = self._step_odeint(self.to_state(z))
             z1, s1 = self.to_section(xe, 0)
             return z1, te, s1
-        sol = self.integrate(self.to_state(z))
-        if sol.status != 1 or sol.t_events[0].size == 0:
-            if sol.t_events[1].size:
+        run = self.integrate(self.to_state(z))
+        if run.event != "mid_stance":
+            if run.end is RunEnd.FALL:
                 raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
-            if sol.status < 0:
-                raise PeriodicGaitError("solver_failure", f"step map: {sol.message}")
+            if run.end is RunEnd.SOLVER_FAILURE:
+                raise PeriodicGaitError("solver_failure", f"step map: {run.message}")
             raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
                                     f"{self.t_max:g} s")
-        xe = sol.y_events[0][0]
-        z1, s1 = self.to_section(xe, 0)
-        return z1, float(sol.t_events[0][0]), s1
+        z1, s1 = self.to_section(run.y_event, 0)
+        return z1, run.t_event, s1
 
     def patch_margin(self, z) -> float:
         """Smallest distance [m] of a loaded foot to its patch edge over one step."""
         if self.method == "odeint":
-            from scipy.integrate import odeint
-
             x0 = self.to_state(z)
             te = self._step_odeint(x0)[0]
             tt = np.linspace(0.0, te, 2001)
-            X = odeint(lambda t, x: self._f(x), x0, tt,
-                       Dfun=lambda t, x: self._fj(x), tfirst=True,
-                       rtol=self.rtol, atol=self.atol, mxstep=500000)
+            X = odeint_grid(lambda t, x: self._f(x), x0, tt, self.solver,
+                            jac=lambda t, x: self._fj(x))[0]
         else:
-            sol = self.integrate(self.to_state(z), dense=True)
-            te = sol.t_events[0][0] if sol.t_events[0].size else sol.t[-1]
+            run = self.integrate(self.to_state(z), dense=True)
+            te = run.t_event if run.event == "mid_stance" else run.t[-1]
             tt = np.linspace(0.0, te, 2001)
-            X = sol.sol(tt).T
+            X = run.dense(tt).T
         if self.walker.continuous:
             return np.inf  # continuous ground: no patch edges
         cq = self.walker.contact_quantities(X)
@@ -461,11 +445,11 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
 
     w = step_map.walker
     x0 = initial_state_from_ideal(w, *np.asarray(x_ideal, float), rate_scale=rate_scale)
-    sol = step_map.integrate(x0, stance_to_come=1)
-    if sol.status != 1 or sol.t_events[0].size == 0:
-        raise PeriodicGaitError("fall" if sol.t_events[1].size else "no_mid_stance",
+    run = step_map.integrate(x0, stance_to_come=1)
+    if run.event != "mid_stance":
+        raise PeriodicGaitError("fall" if run.end is RunEnd.FALL else "no_mid_stance",
                                 "the ideal state does not reach mid-stance on the contact model")
-    return step_map.to_section(sol.y_events[0][0], 1)[0]
+    return step_map.to_section(run.y_event, 1)[0]
 
 
 def ideal_gait(scene):
@@ -619,11 +603,11 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     guess = np.asarray(guess, float)
     if guess.size == len(P.names):
         z = guess.copy()
-    elif guess.size == 2 * len(walker.structure.roles):
+    elif guess.size == walker.rigid_layout().size:
         z = section_guess_from_ideal(PC, guess, rate_scale)
     else:
         raise ValueError(f"guess must be a section state ({len(P.names)},) or an ideal state "
-                         f"({2 * len(walker.structure.roles)},)")
+                         f"({walker.rigid_layout().size},)")
     hist = []
     for _ in range(warmup_steps):
         z1 = PC(z)[0]
@@ -691,7 +675,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
 
 
 def simulate_from_periodic_gait(scene, x_ideal: np.ndarray, strides: int | None = None,
-                                solver=None):  # scene: Scene, solver: ContactSolverSettings
+                                solver=None):  # scene: Scene, solver: SolverSettings
     """Run the contact walker of ``scene`` from its own periodic gait (``contact_sim.start:
     periodic_gait``): steady state, no start-up transient.
 

@@ -26,26 +26,30 @@ def drop_test(scene: Scene, mass_kg: float) -> dict:
     restitution_curve`): the walker's total mass ``mass_kg`` [kg] meeting flat ground at
     :data:`DROP_SPEED`, at the stiffnesses :data:`DROP_STIFFNESS_RATIO` x the scene's.
 
-    The rigid-limit family starts from the scene's own contact (its stiffness is the
-    reference) when the scene follows the paper family, so both curves pass through the
-    scene's contact whatever its unit system (``reference_stiffness`` defaults to the
-    paper's 1e5 N/mm^2.2, which means nothing in SI units, e.g. round_feet.yaml's 4e9 N/m^2.2).
+    The stiffnesses are in the unit the scene writes its stiffness in (``unit`` of the
+    result, ``N/mm^e`` for ``stiffness_n_per_mm_pow_e``).  The rigid-limit family starts
+    from the scene's own contact (its stiffness is the reference) when the scene follows the
+    paper family, so both curves pass through the scene's contact whatever its units (the
+    reference stiffness defaults to the paper's 1e5 N/mm^2.2, far from e.g.
+    round_feet.yaml's 4e9 N/m^2.2).
     """
     from walkerlab.analysis.contact_drop import restitution_curve
+    from walkerlab.config.contact import CONTACT_QUANTITIES
 
     base = settings(scene)[0]
+    k, unit, _ = base.written("stiffness")
     if base.stiffness_family == "paper":
-        base = base.model_copy(update={"reference_stiffness": base.stiffness})
-    ks = [base.stiffness * r for r in DROP_STIFFNESS_RATIO]
-    return restitution_curve(base, ks, mass_kg=float(mass_kg), v_in_m_per_s=DROP_SPEED)
+        base = base.with_written("reference_stiffness", k, unit)
+    ks = [k * r for r in DROP_STIFFNESS_RATIO]
+    out = restitution_curve(base, ks, mass_kg=float(mass_kg), v_in_m_per_s=DROP_SPEED)
+    return {**out, "unit": CONTACT_QUANTITIES["stiffness"][unit][1]}
 
 
 def rate_states(walker, leg: str) -> list[str]:
     """Names of the rate states of ``leg``'s links (what one entry of
     ``initial_rate_scale`` multiplies): ``dtheta1``; kneed ``dtheta1_thigh dtheta1_shank``."""
-    idx = walker.state_names()
-    n = walker.nq
-    return [idx[idx.index(s) + n] for s in walker.leg_angle_states(leg)]
+    lay = walker.layout()
+    return [lay.rate_of(s) for s in walker.leg_angle_states(leg)]
 
 
 def run_summary(res) -> dict:

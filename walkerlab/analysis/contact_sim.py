@@ -16,7 +16,7 @@ from dataclasses import replace
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import ContactSolverSettings
+from walkerlab.config.solver import SolverSettings
 from walkerlab.contact.scene import build, settings
 from walkerlab.integrate.contact import ContactLimits, StateIndex, integrate_contact
 from walkerlab.integrate.solver import Solver
@@ -59,7 +59,7 @@ def initial_state_from_ideal(walker, *x_ideal, rate_scale=(1.0, 1.0)) -> np.ndar
 
 
 def simulate_contact(walker, x0: np.ndarray, t_final: float,
-                     solver: Solver | ContactSolverSettings | None = None,
+                     solver: Solver | SolverSettings | None = None,
                      limits: ContactLimits | None = None, *,
                      max_heel_strikes: int | None = None, slip_limit_mm: float | None = None,
                      min_step_m: float = 0.05, initial_stance: str = "leg2") -> ContactResult:
@@ -72,8 +72,8 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         Initial state, named by ``walker.state_names()`` (SI).
     t_final : float
         End time [s].
-    solver : Solver or ContactSolverSettings, optional
-        The integrator, as one object (default: ``ContactSolverSettings()``, cyrk_bdf at
+    solver : Solver or SolverSettings, optional
+        The integrator, as one object (default: ``SolverSettings.for_contact()``, cyrk_bdf at
         rtol 1e-8, atol 1e-10); the scene's settings become a :class:`Solver` here.
     limits : ContactLimits, optional
         Sampling, pinning, event heights, wall-time limit, chunking.  A
@@ -99,7 +99,7 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
     ValueError
         Unknown method; ``max_step_s`` with numbalsoda; numbalsoda not installed.
     """
-    solver = Solver.from_settings(solver or ContactSolverSettings())
+    solver = Solver.from_settings(solver or SolverSettings.for_contact())
     limits = _with_heights(walker, limits or ContactLimits())
     stop = None
     if max_heel_strikes is not None:
@@ -162,7 +162,7 @@ def scene_start(scene: Scene, x_ideal: np.ndarray, n_strides: int, rate_scale=No
 
 
 def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=None,
-                  solver: ContactSolverSettings | None = None, strides: int | None = None):
+                  solver: SolverSettings | None = None, strides: int | None = None):
     """Run the contact walker of ``scene`` from the ideal fixed point ``x_ideal``.
 
     Parameters
@@ -174,7 +174,7 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
         Ideal step period [s] (sets the default simulated time).
     rate_scale : (float, float), optional
         Multipliers on the initial rates (default ``contact_sim.initial_rate_scale``).
-    solver : ContactSolverSettings, optional
+    solver : SolverSettings, optional
         Default: the scene's ``contact_solver``.
     strides : int, optional
         Strides to simulate (default ``contact_sim.n_strides``).

@@ -574,7 +574,7 @@ def _mass_points(w: HybridWalker) -> dict | None:
     ``m_<body>``), or None when they do not add up to the walker's total mass (a model whose
     points this convention does not cover)."""
     p = w.params
-    names = w.points(np.zeros(2 * w.n_coordinates))
+    names = w.points(w.layout().zeros())
     out = {"hip": float(p.get("M_hip", 0.0))}
     for name in names:
         for role in ("stance_", "swing_"):
@@ -611,7 +611,7 @@ def normal_force_ratio(w: HybridWalker, segs, n: int = 200) -> float:
             if tb - ta <= 1e-6:
                 continue
             ts = np.linspace(ta, tb, n)
-            X = np.atleast_2d(dense(ts))[:2 * w.n_coordinates]
+            X = w.layout().state_rows(np.atleast_2d(dense(ts)))
             pts = w.points(X)
             com = sum(m * np.asarray(pts[k], float) for k, m in masses.items()) / M
             dt = ts[1] - ts[0]

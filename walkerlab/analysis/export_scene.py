@@ -10,9 +10,11 @@
 - **terrain**: the scene's (``terrain`` section, default checkerboard): checkerboard patches
   centred on the rigid gait's footfalls as boxes, one lane per leg (contact bits
   :data:`walkerlab.io.export.LANE_BITS`), leg2 at ``s = 0, 2l, ...``, leg1 at
-  ``s = -l, l, 3l, ...``; continuous: one plane.  The ground's surface is lowered by the
-  point foot's sphere radius, so the sphere touches it where walkerlab's point foot touches
-  the ground line (arc feet: the cylinder is the foot, no offset).
+  ``s = -l, l, 3l, ...`` (legs that differ: leg1's step ``l1``, leg2's ``l2``, leg2 at
+  ``k (l1 + l2)``, leg1 at ``l1 + (k - 1)(l1 + l2)``); continuous: one plane.  The ground's
+  surface is lowered by the point foot's sphere radius, so the sphere touches it where
+  walkerlab's point foot touches the ground line (arc feet: the cylinder is the foot, no
+  offset).
 - **contact** (:func:`mujoco_contact`): MuJoCo's soft contact is a linear spring-damper on
   the penetration (``solref`` = time constant, damping ratio), walkerlab's IMPACT law is
   ``k d^e + STEP(d, 0, 0, dmax, cmax) d'``.  The mapping linearises IMPACT at the static
@@ -32,7 +34,8 @@ import math
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.config.contact import ContactParamsSI, ContactSettings, TerrainSettings
+from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.contact.laws import ContactParamsSI
 from walkerlab.io.export import MJCF_MIN_LENGTH_M, MJCF_MIN_MASS_KG, MjcfScene, point_foot_radius
 
 __all__ = ["EXPORT_STEPS", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]
@@ -121,13 +124,17 @@ def joint_state(mb, walker, x) -> tuple[np.ndarray, np.ndarray]:
     Returns
     -------
     qpos, qvel : ndarray (2 + len(mb.links),)
-        ``hip_x``, ``hip_z`` [m, m/s], then each link's joint [rad, rad/s].
+        ``hip_x``, ``hip_z`` [m, m/s], then each link's joint [rad, rad/s]; a coupled joint
+        (the torso's) from its coupling.
     """
-    names = walker.coordinate_names()
-    nq = len(names)
-    q, v = dict(zip(names, x[:nq])), dict(zip(names, x[nq:]))
+    q, v = walker.layout().coordinate_values(x)
+
+    coupled = {cp.joint: cp.terms for cp in mb.couplings}  # e.g. the torso's bisecting hip
+    link_of = {ln.joint: ln.name for ln in mb.links}
 
     def joint(vals, ln):
+        if ln.joint in coupled:  # of hip joints: absolute link (leg or thigh) angles
+            return sum(c * vals[f"{link_of[j]}_angle"] for j, c in coupled[ln.joint])
         own = vals[f"{ln.name}_angle"]
         return own - vals[f"{ln.parent}_angle"] if ln.joint.endswith("_knee") else own
 
@@ -170,9 +177,17 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
     dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)
     lanes = None
     if terrain.kind == "checkerboard":
-        ell = ideal_step_length(walker, ideal.x)
+        # the keyframe's feet are one step apart: leg2's step, the last of the gait's map
+        ell2 = ideal_step_length(walker, ideal.x)
+        ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
+        # legs that differ: leg1's step differs from leg2's by the rigid steps' difference
+        # (exact for point feet), else footfalls drift off the patches stride by stride
         k = np.arange(EXPORT_STEPS // 2 + 1)
-        lanes = (tuple(ell * (2 * k - 1)), tuple(2 * ell * k))
+        if len(ells) == 2:
+            ell1 = ell2 + (ells[0] - ells[1])
+            lanes = (tuple(ell1 + (k - 1) * (ell1 + ell2)), tuple((ell1 + ell2) * k))
+        else:
+            lanes = (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
     latch = (knee.latch_height, knee.latch_capture) if mb.knee else None
     notes = (f"Keyframe 'gait': the rigid walker's fixed point (step period "
              f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "

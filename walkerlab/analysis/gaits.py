@@ -164,8 +164,8 @@ def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: floa
     from scipy.optimize import least_squares
 
     stance_leg = walker.legs[-1]
-    n = 2 * walker.n_coordinates
-    keys = list(walker.leg_coordinates(np.zeros(n), stance_leg))
+    x0 = walker.layout().zeros()
+    keys = list(walker.leg_coordinates(x0, stance_leg))
 
     def target(k: str) -> float:
         stance = k.startswith(stance_leg + "_")
@@ -179,7 +179,7 @@ def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: floa
         d = walker.leg_coordinates(x, stance_leg)
         return np.array([float(d[k]) for k in keys]) - tgt
 
-    sol = least_squares(residual, np.zeros(n), xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    sol = least_squares(residual, x0, xtol=1e-15, ftol=1e-15, gtol=1e-15)
     return walker.from_section(walker.section(sol.x))
 
 

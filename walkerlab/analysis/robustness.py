@@ -327,11 +327,12 @@ def mass_matrix(walker, x: np.ndarray) -> np.ndarray:
     """``M(q)`` (n, n) of a rigid walker at state ``x`` (2n,), from its kinetic energy
     ``T = 1/2 qd^T M(q) qd`` (``walker.energies``) by polarisation: ``M_ii = 2 T(e_i)``,
     ``M_ij = T(e_i + e_j) - T(e_i) - T(e_j)`` (exact: ``T`` is quadratic in the rates)."""
-    n = walker.n_coordinates
-    q = np.asarray(x, float)[:n]
+    lay = walker.layout()
+    n = lay.n_coordinates
+    q = lay.q(np.asarray(x, float))
 
     def T(qd):
-        return float(np.asarray(walker.energies(np.concatenate([q, qd])))[0])
+        return float(np.asarray(walker.energies(lay.join(q, qd)))[0])
 
     E = np.eye(n)
     Ti = [T(E[i]) for i in range(n)]
@@ -345,12 +346,12 @@ def mass_matrix(walker, x: np.ndarray) -> np.ndarray:
 def hip_jacobian(walker, x: np.ndarray, h: float = 1e-6) -> np.ndarray:
     """``J`` (2, n): d(hip position, world x forward / y up) / dq, central differences
     (``walker.points``; error O(h^2) ~ 1e-12 m/rad)."""
-    n = walker.n_coordinates
+    lay = walker.layout()
+    n = lay.n_coordinates
     x = np.asarray(x, float)
     J = np.empty((2, n))
     for i in range(n):
-        e = np.zeros(x.size)
-        e[i] = h
+        e = lay.join(h * np.eye(n)[i], np.zeros(n))  # coordinate i moved by h
         J[:, i] = (np.asarray(walker.points(x + e)["hip"])
                    - np.asarray(walker.points(x - e)["hip"])) / (2 * h)
     return J
@@ -372,13 +373,12 @@ def apply_push(walker, x: np.ndarray, dv_mps: float) -> tuple[np.ndarray, float]
     x_plus : ndarray (2n,)
     impulse_Ns : float
     """
-    n = walker.n_coordinates
     M = mass_matrix(walker, x)
     jx = hip_jacobian(walker, x)[0]
     w = np.linalg.solve(M, jx)
     P = float(dv_mps) / float(jx @ w)
     xp = np.array(x, float)
-    xp[n:] += P * w
+    xp[walker.layout().qd_slice] += P * w
     return xp, P
 
 

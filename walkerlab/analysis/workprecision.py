@@ -139,7 +139,7 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
     """
     from walkerlab.analysis.contact_bench import leg_angle_columns
     from walkerlab.analysis.contact_sim import scene_start, settings, simulate_contact
-    from walkerlab.config import ContactSolverSettings
+    from walkerlab.config import SolverSettings
     from walkerlab.integrate.contact import StateIndex
 
     cs = settings(scene)[2]
@@ -151,7 +151,7 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
     rates = [idx.rate_of(idx.names[i]) for i in legs]
 
     def run(method, rtol, atol):
-        sv = ContactSolverSettings(method=method, rtol=rtol, atol=atol)
+        sv = SolverSettings.for_contact(method=method, rtol=rtol, atol=atol)
         c0 = time.thread_time()
         res = simulate_contact(walker, z0, t_final, sv, limits, max_heel_strikes=max_hs)
         cpu = time.thread_time() - c0

@@ -13,8 +13,9 @@ description; validation always runs and unknown keys are rejected (``extra="forb
 Modules: :mod:`~walkerlab.config.schema` (the pydantic sections and :class:`Scene`),
 :mod:`~walkerlab.config.loader` (YAML reading, validation, error lines),
 :mod:`~walkerlab.config.limits` (caps and unit-mistake warnings),
-:mod:`~walkerlab.config.contact` (compliant-contact sections).  This module only re-exports
-their public names.
+:mod:`~walkerlab.config.contact` (compliant-contact sections),
+:mod:`~walkerlab.config.solver` (the one solver section, ``solver`` and
+``contact_solver``).  This module only re-exports their public names.
 
 Raises
 ------
@@ -24,10 +25,8 @@ SceneError
 
 from walkerlab.config.contact import (
     MAX_CONTACT_STRIDES,
-    ContactParamsSI,
     ContactSettings,
     ContactSimSettings,
-    ContactSolverSettings,
     PerStepTerrain,
     TerrainSettings,
 )
@@ -69,6 +68,7 @@ from walkerlab.config.schema import (
     GuessFromArtifact,
     IdealModelSettings,
     KneeSpec,
+    KneeSpringSpec,
     LegSpec,
     MfptSettings,
     PointFoot,
@@ -79,7 +79,6 @@ from walkerlab.config.schema import (
     SceneError,
     SimulateSettings,
     SlopeSettings,
-    SolverSettings,
     SpringSpec,
     StateSpec,
     TorsoBody,
@@ -89,6 +88,7 @@ from walkerlab.config.schema import (
     WalkerParams,
     WorkPrecisionSettings,
 )
+from walkerlab.config.solver import SolverSettings
 
 __all__ = [
     "ArcFoot",
@@ -98,15 +98,14 @@ __all__ = [
     "Body",
     "CommandOptions",
     "CompassGaitParams",
-    "ContactParamsSI",
     "ContactSettings",
     "ContactSimSettings",
-    "ContactSolverSettings",
     "FixedPointSettings",
     "Foot",
     "GuessFromArtifact",
     "IdealModelSettings",
     "KneeSpec",
+    "KneeSpringSpec",
     "LegSpec",
     "MAX_BASIN_CELLS_PER_AXIS",
     "MAX_BIFURCATION_KEEP",

@@ -1,17 +1,19 @@
 """Validated settings of the compliant-contact model and its runs (pydantic v2).
 
-The scene sections ``contact``, ``terrain``, ``contact_sim`` and ``contact_solver`` (read
-through :mod:`walkerlab.config`).  The contact model package imports its settings from here;
+The scene sections ``contact``, ``terrain`` and ``contact_sim`` (read through
+:mod:`walkerlab.config`; ``contact_solver`` is a :class:`walkerlab.config.solver.SolverSettings`
+as ``solver`` is).  The contact model package imports its settings from here;
 this module imports no model (settings lie under the models, not beside them).
 
-Numbers in :class:`ContactSettings` are written in the unit system named by
-``unit_system`` (ADAMS's default is mm-kg-s); :meth:`ContactSettings.to_si` converts them
-explicitly to SI (NOTES.md: "a wrong unit here changes the answer by 10^6").
+Every dimensional number of :class:`ContactSettings` carries its unit in its name, in
+ADAMS's default mm-kg-s units (``stiffness_n_per_mm_pow_e``) or in SI
+(``stiffness_n_per_m_pow_e``); the contact model converts them to SI once per run
+(:func:`walkerlab.contact.laws.contact_params_si`; NOTES.md: "a wrong unit here changes the
+answer by 10^6").
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Annotated, Literal
 
 from pydantic import (
@@ -23,70 +25,9 @@ from pydantic import (
     model_validator,
 )
 
-__all__ = ["MAX_CONTACT_STRIDES", "ContactParamsSI", "ContactSettings", "ContactSimSettings",
-           "ContactSolverSettings", "KneeStopSI", "KneeStopSettings", "PerStepTerrain",
-           "TerrainSettings"]
-
-
-@dataclass(frozen=True)
-class ContactParamsSI:
-    """Contact parameters in SI units (what the model kernels use).
-
-    Attributes
-    ----------
-    k : float
-        Stiffness ``[N/m**e]``.
-    e : float
-        Force exponent ``[-]``.
-    cmax : float
-        Maximum damping ``[N s/m]``.
-    dmax : float
-        Penetration at full damping ``[m]``.
-    mu_s, mu_d : float
-        Static / dynamic friction coefficients ``[-]``.
-    v_s, v_d : float
-        Stiction / friction transition velocities ``[m/s]``.
-    """
-
-    k: float
-    e: float
-    cmax: float
-    dmax: float
-    mu_s: float
-    mu_d: float
-    v_s: float
-    v_d: float
-
-
-@dataclass(frozen=True)
-class KneeStopSI:
-    """Knee-stop parameters in SI (the IMPACT law on the knee's hyperextension angle).
-
-    Attributes
-    ----------
-    k : float
-        Stiffness ``[N m/rad**e]``.
-    e : float
-        Exponent ``[-]``.
-    cmax : float
-        Maximum damping ``[N m s/rad]``.
-    dmax : float
-        Hyperextension at full damping ``[rad]``.
-    latch : bool
-        The stop also holds a loaded leg's knee against flexion (knee latch).
-    latch_height : float
-        Height of the foot above the ground at which the latch has released ``[m]``.
-    latch_capture : float
-        Flexion beyond which the latch does not hold ``[rad]``.
-    """
-
-    k: float
-    e: float
-    cmax: float
-    dmax: float
-    latch: bool = False
-    latch_height: float = 0.002
-    latch_capture: float = 0.01
+__all__ = ["CONTACT_QUANTITIES", "LENGTH_UNITS", "MAX_CONTACT_STRIDES", "ContactSettings",
+           "ContactSimSettings", "KneeStopSettings", "PerStepTerrain",
+           "TerrainSettings", "renamed_contact_field"]
 
 
 # Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
@@ -101,9 +42,77 @@ def _list_to_tuple(v):
     return tuple(v) if isinstance(v, list) else v
 
 
-def _len_factor(unit_system: str) -> float:
-    """Metres per length unit of ``unit_system``."""
-    return {"mm-kg-s": 1e-3, "SI": 1.0}[unit_system]
+#: Metres per length unit of a contact field's name (``..._mm``: ADAMS's default mm-kg-s
+#: units, as the paper's numbers are read; ``..._m``: SI).
+LENGTH_UNITS = {"mm": 1e-3, "m": 1.0}
+
+#: The dimensional quantities of :class:`ContactSettings`: each is written in exactly one of
+#: two fields, its mm-kg-s name or its SI name, ``{quantity: {length unit: (field, unit)}}``.
+CONTACT_QUANTITIES = {
+    "stiffness": {"mm": ("stiffness_n_per_mm_pow_e", "N/mm^e"),
+                  "m": ("stiffness_n_per_m_pow_e", "N/m^e")},
+    "max_damping": {"mm": ("max_damping_n_s_per_mm", "N s/mm"),
+                    "m": ("max_damping_n_s_per_m", "N s/m")},
+    "penetration_at_max_damping": {"mm": ("penetration_at_max_damping_mm", "mm"),
+                                   "m": ("penetration_at_max_damping_m", "m")},
+    "stiction_velocity": {"mm": ("stiction_velocity_mm_per_s", "mm/s"),
+                          "m": ("stiction_velocity_m_per_s", "m/s")},
+    "friction_velocity": {"mm": ("friction_velocity_mm_per_s", "mm/s"),
+                          "m": ("friction_velocity_m_per_s", "m/s")},
+    "reference_stiffness": {"mm": ("reference_stiffness_n_per_mm_pow_e", "N/mm^e"),
+                            "m": ("reference_stiffness_n_per_m_pow_e", "N/m^e")},
+}
+
+#: Default of each quantity (the paper's values read in mm-kg-s, ADAMS View defaults for the
+#: rest), used when neither of its two fields is given.
+_CONTACT_DEFAULTS_MM = {"stiffness": 1e5, "max_damping": 90.0,
+                        "penetration_at_max_damping": 0.1, "stiction_velocity": 100.0,
+                        "friction_velocity": 1000.0, "reference_stiffness": 1e5}
+
+#: Field names of the knee stop before its units were in every name -> today's names.
+_KNEE_STOP_RENAMED = {"stiffness_N_m_per_rad": "stiffness_n_m_per_rad_pow_e",
+                      "max_damping_N_m_s_per_rad": "max_damping_n_m_s_per_rad"}
+
+
+def renamed_contact_field(path: str) -> str | None:
+    """Migration hint for a contact field name used before units were in every name
+    (``contact.stiffness`` -> ``"contact.stiffness_n_per_mm_pow_e (mm-kg-s) or
+    contact.stiffness_n_per_m_pow_e (SI)"``); None for any other path."""
+    head, _, leaf = path.rpartition(".")
+    prefix = head + "." if head else ""
+    if head.endswith("knee_stop") and leaf in _KNEE_STOP_RENAMED:
+        return prefix + _KNEE_STOP_RENAMED[leaf]
+    if head.endswith("contact") and leaf in CONTACT_QUANTITIES:
+        mm, si = (CONTACT_QUANTITIES[leaf][u][0] for u in ("mm", "m"))
+        return f"{prefix}{mm} (mm-kg-s) or {prefix}{si} (SI)"
+    if head.endswith("contact") and leaf == "unit_system":
+        return f"the unit in each field's name ({prefix}stiffness_n_per_mm_pow_e, ...)"
+    return None
+
+
+def _written_field(quantity: str, length_unit: str):
+    """The pydantic field of ``quantity`` written in ``length_unit`` ("mm" or "m")."""
+    _name, unit = CONTACT_QUANTITIES[quantity][length_unit]
+    bounds = {"ge": 0} if quantity == "max_damping" else {"gt": 0}
+    if quantity == "stiffness":
+        bounds["le"] = 1e12
+    return Field(None, **bounds, json_schema_extra={"unit": unit},
+                 description=f"{_DESCRIPTIONS[quantity]} [{unit}]; give this or "
+                 f"{CONTACT_QUANTITIES[quantity]['m' if length_unit == 'mm' else 'mm'][0]}, "
+                 f"not both (neither: {_CONTACT_DEFAULTS_MM[quantity]:g} "
+                 f"{CONTACT_QUANTITIES[quantity]['mm'][1]}).")
+
+
+_DESCRIPTIONS = {
+    "stiffness": "IMPACT stiffness k (paper: 'stiffness 1e5'; at most 1e12 as written)",
+    "max_damping": "IMPACT maximum damping cmax (paper: 'damping 90')",
+    "penetration_at_max_damping": "IMPACT penetration dmax at which full damping is "
+                                  "reached (ADAMS default 0.1 mm)",
+    "stiction_velocity": "Stiction transition velocity vs (ADAMS default 100 mm/s)",
+    "friction_velocity": "Friction transition velocity vd, > vs (ADAMS default 1000 mm/s)",
+    "reference_stiffness": "Stiffness at which the damping, dmax and transition velocities "
+                           "hold in the 'rigid_limit' family (paper: 1e5 N/mm^2.2)",
+}
 
 
 class KneeStopSettings(BaseModel):
@@ -122,12 +131,12 @@ class KneeStopSettings(BaseModel):
 
     model_config = _STRICT
 
-    stiffness_N_m_per_rad: float = Field(
+    stiffness_n_m_per_rad_pow_e: float = Field(
         1e5, gt=0, le=1e12, description="Stop stiffness k [N m/rad^e].",
         json_schema_extra={"unit": "N m/rad^e"})
     exponent: float = Field(1.5, ge=1.0, le=10.0, description="Stop force exponent e [-].",
                             json_schema_extra={"unit": "-"})
-    max_damping_N_m_s_per_rad: float = Field(
+    max_damping_n_m_s_per_rad: float = Field(
         200.0, ge=0, description="Stop maximum damping cmax [N m s/rad].",
         json_schema_extra={"unit": "N m s/rad"})
     penetration_at_max_damping_rad: float = Field(
@@ -149,73 +158,94 @@ class KneeStopSettings(BaseModel):
         "(full hold within half of it) [rad]: a knee bent farther when its foot touches down "
         "is not snapped straight.", json_schema_extra={"unit": "rad"})
 
-    def to_si(self) -> KneeStopSI:
-        """The same numbers as a :class:`KneeStopSI`."""
-        return KneeStopSI(self.stiffness_N_m_per_rad, self.exponent,
-                          self.max_damping_N_m_s_per_rad, self.penetration_at_max_damping_rad,
-                          self.latch, self.latch_release_height_m,
-                          self.latch_capture_rad)
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed(cls, data):
+        old = [k for k in _KNEE_STOP_RENAMED if isinstance(data, dict) and k in data]
+        if old:
+            raise ValueError("knee_stop: " + "; ".join(
+                f"{k} is now {_KNEE_STOP_RENAMED[k]} (the exponent's unit in the name)"
+                for k in old))
+        return data
 
 
 class ContactSettings(BaseModel):
-    """IMPACT normal force + Coulomb friction, numbers in ``unit_system``.
+    """IMPACT normal force + Coulomb friction of the feet.
 
+    Every dimensional quantity is written with its unit in its name, in ADAMS's default
+    mm-kg-s units (``stiffness_n_per_mm_pow_e``, as the paper's numbers are read) or in SI
+    (``stiffness_n_per_m_pow_e``): exactly one of the two names per quantity
+    (:data:`CONTACT_QUANTITIES`; neither: the paper's value in mm-kg-s).  The contact model
+    converts them to SI once per run (:func:`walkerlab.contact.laws.contact_params_si`).
     Defaults are the paper's values (k = 1e5, damping 90, mu_s = 0.9, mu_d = 0.7) read in
-    ADAMS's default mm-kg-s units, with the ADAMS View defaults for the rest (NOTES.md).
+    mm-kg-s, with the ADAMS View defaults for the rest (NOTES.md).
     """
 
     model_config = _STRICT
 
-    unit_system: Literal["mm-kg-s", "SI"] = Field(
-        "mm-kg-s",
-        description="Unit system of the numbers below: 'mm-kg-s' (ADAMS default) or 'SI'."
-    )
-    stiffness: float = Field(
-        1e5, gt=0, le=1e12, description="IMPACT stiffness k (at most 1e12).",
-        json_schema_extra={"unit": "N/<len>^e"},
-    )
+    stiffness_n_per_mm_pow_e: float | None = _written_field("stiffness", "mm")
+    stiffness_n_per_m_pow_e: float | None = _written_field("stiffness", "m")
     exponent: float = Field(
-        2.2, ge=1.0, le=10.0, description="IMPACT force exponent e (ADAMS default 2.2).",
+        2.2, ge=1.0, le=10.0, description="IMPACT force exponent e (ADAMS default 2.2) [-].",
         json_schema_extra={"unit": "-"},
     )
-    max_damping: float = Field(
-        90.0, ge=0, description="IMPACT maximum damping cmax (paper: 'damping 90').",
-        json_schema_extra={"unit": "N s/<len>"},
-    )
-    penetration_at_max_damping: float = Field(
-        0.1, gt=0, description="IMPACT penetration dmax at which full damping is reached.",
-        json_schema_extra={"unit": "<len>"},
-    )
-    mu_static: float = Field(0.9, ge=0, description="Static friction coefficient.",
+    max_damping_n_s_per_mm: float | None = _written_field("max_damping", "mm")
+    max_damping_n_s_per_m: float | None = _written_field("max_damping", "m")
+    penetration_at_max_damping_mm: float | None = _written_field(
+        "penetration_at_max_damping", "mm")
+    penetration_at_max_damping_m: float | None = _written_field(
+        "penetration_at_max_damping", "m")
+    mu_static: float = Field(0.9, ge=0, description="Static friction coefficient [-].",
                              json_schema_extra={"unit": "-"})
-    mu_dynamic: float = Field(0.7, ge=0, description="Dynamic friction coefficient.",
+    mu_dynamic: float = Field(0.7, ge=0, description="Dynamic friction coefficient [-].",
                               json_schema_extra={"unit": "-"})
-    stiction_velocity: float = Field(
-        100.0, gt=0, description="Stiction transition velocity vs.",
-        json_schema_extra={"unit": "<len>/s"},
-    )
-    friction_velocity: float = Field(
-        1000.0, gt=0, description="Friction transition velocity vd (> vs).",
-        json_schema_extra={"unit": "<len>/s"},
-    )
+    stiction_velocity_mm_per_s: float | None = _written_field("stiction_velocity", "mm")
+    stiction_velocity_m_per_s: float | None = _written_field("stiction_velocity", "m")
+    friction_velocity_mm_per_s: float | None = _written_field("friction_velocity", "mm")
+    friction_velocity_m_per_s: float | None = _written_field("friction_velocity", "m")
 
     stiffness_family: Literal["paper", "rigid_limit"] = Field(
         "paper", description="How damping and dmax follow the stiffness: 'paper' keeps "
-        "max_damping and penetration_at_max_damping as given (a stiffer contact is then more "
-        "elastic); 'rigid_limit' reads them, the transition velocities and the knee latch's "
-        "release height as holding at reference_stiffness and follows the one rigid-limit "
-        "family (walkerlab.contact.rigid_limit) with kappa = stiffness / reference_stiffness: "
-        "cmax * kappa^(1/(e+1)), dmax and latch height * kappa^(-1/(e+1)), vs and vd * "
-        "kappa^(-1/2), so a drop impact keeps its (near-plastic) restitution and the periodic "
-        "gait converges to the rigid one as k grows.")
-    reference_stiffness: float = Field(
-        1e5, gt=0, description="Stiffness at which max_damping and penetration_at_max_damping "
-        "hold in the 'rigid_limit' family (paper: 1e5 N/mm^2.2).",
-        json_schema_extra={"unit": "N/<len>^e"})
+        "the maximum damping and the penetration at maximum damping as given (a stiffer "
+        "contact is then more elastic); 'rigid_limit' reads them, the transition velocities "
+        "and the knee latch's release height as holding at the reference stiffness and "
+        "follows the one rigid-limit family (walkerlab.contact.rigid_limit) with kappa = "
+        "stiffness / reference stiffness: cmax * kappa^(1/(e+1)), dmax and latch height * "
+        "kappa^(-1/(e+1)), vs and vd * kappa^(-1/2), so a drop impact keeps its "
+        "(near-plastic) restitution and the periodic gait converges to the rigid one as k "
+        "grows.")
+    reference_stiffness_n_per_mm_pow_e: float | None = _written_field(
+        "reference_stiffness", "mm")
+    reference_stiffness_n_per_m_pow_e: float | None = _written_field(
+        "reference_stiffness", "m")
     knee_stop: KneeStopSettings = Field(
-        default_factory=KneeStopSettings, description="Knee stops of a kneed walker (SI, "
-        "unit_system does not apply): stiffness_N_m_per_rad, exponent, "
-        "max_damping_N_m_s_per_rad, penetration_at_max_damping_rad.")
+        default_factory=KneeStopSettings, description="Knee stops of a kneed walker (SI): "
+        "stiffness_n_m_per_rad_pow_e, exponent, max_damping_n_m_s_per_rad, "
+        "penetration_at_max_damping_rad, latch, latch_release_height_m, latch_capture_rad.")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _one_name_per_quantity(cls, data):
+        if not isinstance(data, dict):
+            return data
+        old = [k for k in ("unit_system", *CONTACT_QUANTITIES) if k in data]
+        if old:
+            u = "m" if data.get("unit_system") == "SI" else "mm"
+            new = [CONTACT_QUANTITIES[k][u][0] for k in old if k != "unit_system"]
+            raise ValueError(
+                f"contact: {', '.join(old)}: each contact field now carries its unit in its "
+                f"name and unit_system is gone: write {', '.join(new) or 'the fields'} "
+                f"({'SI' if u == 'm' else 'mm-kg-s'}; the other system: "
+                f"{'..._mm, ..._n_per_mm_pow_e' if u == 'm' else '..._m, ..._n_per_m_pow_e'})")
+        data = dict(data)
+        for q, names in CONTACT_QUANTITIES.items():
+            mm, si = names["mm"][0], names["m"][0]
+            given = [n for n in (mm, si) if data.get(n) is not None]
+            if len(given) == 2:
+                raise ValueError(f"contact: give {mm} (mm-kg-s) or {si} (SI), not both")
+            if not given:
+                data[mm] = _CONTACT_DEFAULTS_MM[q]
+        return data
 
     @model_validator(mode="after")
     def _check_relations(self) -> ContactSettings:
@@ -223,37 +253,49 @@ class ContactSettings(BaseModel):
             raise ValueError(
                 f"mu_dynamic ({self.mu_dynamic}) must be <= mu_static ({self.mu_static})"
             )
-        if not self.stiction_velocity < self.friction_velocity:
-            raise ValueError(
-                f"stiction_velocity ({self.stiction_velocity}) must be < "
-                f"friction_velocity ({self.friction_velocity})"
-            )
+        vs, vd = self.written("stiction_velocity"), self.written("friction_velocity")
+        if not vs[0] * LENGTH_UNITS[vs[1]] < vd[0] * LENGTH_UNITS[vd[1]]:
+            raise ValueError(f"{vs[2]} ({vs[0]:g}) must be < {vd[2]} ({vd[0]:g})")
         return self
 
-    def to_si(self) -> ContactParamsSI:
-        """Convert to SI: ``k_SI = k * f**-e``, ``c_SI = c / f``, lengths and velocities ``* f``.
+    @model_serializer(mode="wrap")
+    def _written_names_only(self, handler):
+        # the name not used of each pair is not part of the scene (nor of its content hash)
+        d = handler(self)
+        if isinstance(d, dict):
+            for names in CONTACT_QUANTITIES.values():
+                for name, _unit in names.values():
+                    if d.get(name, 0) is None:
+                        d.pop(name)
+        return d
 
-        ``f`` = metres per length unit (1e-3 for mm-kg-s).  E.g. ``k = 1e5 N/mm^2.2`` becomes
-        ``1e5 * 1000**2.2 N/m^2.2``.  The numbers as written: the ``stiffness_family`` is
-        applied by :func:`walkerlab.contact.rigid_limit.contact_si`.
+    def written(self, quantity: str) -> tuple[float, str, str]:
+        """A dimensional quantity as the scene writes it.
+
+        Parameters
+        ----------
+        quantity : str
+            A key of :data:`CONTACT_QUANTITIES` (``"stiffness"``, ``"max_damping"``, ...).
 
         Returns
         -------
-        ContactParamsSI
+        (value, length_unit, field)
+            The number, its length unit (``"mm"`` or ``"m"``, :data:`LENGTH_UNITS`) and the
+            name of the field that holds it.
         """
-        f = _len_factor(self.unit_system)
-        e = self.exponent
-        cmax, dmax = self.max_damping, self.penetration_at_max_damping
-        return ContactParamsSI(
-            k=self.stiffness * f ** (-e),
-            e=e,
-            cmax=cmax / f,
-            dmax=dmax * f,
-            mu_s=self.mu_static,
-            mu_d=self.mu_dynamic,
-            v_s=self.stiction_velocity * f,
-            v_d=self.friction_velocity * f,
-        )
+        for u, (name, _unit) in CONTACT_QUANTITIES[quantity].items():
+            v = getattr(self, name)
+            if v is not None:
+                return v, u, name
+        raise AssertionError(f"contact.{quantity}: no value (validation fills a default)")
+
+    def with_written(self, quantity: str, value: float, length_unit: str) -> ContactSettings:
+        """A copy with ``quantity`` set to ``value`` in ``length_unit`` ("mm" or "m"; the
+        other field of the pair cleared).  Not validated again, as pydantic's
+        ``model_copy``: the drop test's stiffnesses go past a scene's caps."""
+        return self.model_copy(update={
+            name: float(value) if u == length_unit else None
+            for u, (name, _unit) in CONTACT_QUANTITIES[quantity].items()})
 
 
 class PerStepTerrain(BaseModel):
@@ -356,25 +398,3 @@ class ContactSimSettings(BaseModel):
         if isinstance(d, dict) and d.get("start") == "ideal":
             d.pop("start", None)
         return d
-
-
-class ContactSolverSettings(BaseModel):
-    """Integrator of the stiff contact model: ``cyrk_bdf`` (CyRK's BDF from compiled code,
-    the default), ``odeint`` (LSODA, low overhead), numbalsoda or solve_ivp.
-
-    The one object that carries the solver to every contact integration
-    (:func:`walkerlab.analysis.contact_sim.simulate_contact`), as
-    becomes :class:`walkerlab.integrate.solver.Solver`, as the rigid side's settings do."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
-
-    method: Literal["odeint", "cyrk_bdf", "numbalsoda", "LSODA", "Radau", "BDF", "RK45",
-                    "DOP853"] = Field(
-        "cyrk_bdf", description="cyrk_bdf (CyRK's BDF from compiled code), "
-        "scipy.integrate.odeint, numbalsoda (LSODA from compiled code; optional extra "
-        "'walkerlab[numbalsoda]') or a solve_ivp method")
-    rtol: float = Field(1e-8, ge=1e-13, lt=1,
-                        description="relative tolerance [-]; at least 1e-13 (LSODA/odeint "
-                        "cannot meet a tighter one in double precision)")
-    atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
-    max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")

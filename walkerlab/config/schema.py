@@ -31,7 +31,6 @@ from pydantic import (
 from walkerlab.config.contact import (
     ContactSettings,
     ContactSimSettings,
-    ContactSolverSettings,
     TerrainSettings,
 )
 from walkerlab.config.errors import format_error
@@ -45,6 +44,12 @@ from walkerlab.config.limits import (
     MAX_STEP_TIME_S,
     MAX_STEPS_PER_WALKING_STEP,
     MAX_WORKERS,
+)
+from walkerlab.config.solver import (
+    SolverSettings,
+    check_contact,
+    check_rigid,
+    with_contact_defaults,
 )
 
 
@@ -156,6 +161,20 @@ class ArcFoot(_Strict):
 Foot = Annotated[PointFoot | ArcFoot, Field(discriminator="kind")]
 
 
+class KneeSpringSpec(_Strict):
+    """A linear torsional spring and viscous damper at the knee: torque ``-k (knee - rest) -
+    c d(knee)/dt`` on the shank and the opposite on the thigh, ``knee`` = shank angle - thigh
+    angle (0 straight, negative flexed)."""
+
+    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
+                                         "[N m/rad]")
+    rest_angle_rad: float = Field(0.0, ge=-3.2, le=3.2, description="knee angle (shank - "
+                                  "thigh, negative flexed) at which the spring is relaxed "
+                                  "[rad]")
+    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
+                                         "[N m s/rad]")
+
+
 class KneeSpec(_Strict):
     """A knee joint splitting the leg into thigh (hip to knee) and shank (knee to foot).
 
@@ -166,6 +185,22 @@ class KneeSpec(_Strict):
     thigh_length_m: float = Field(gt=0, le=100, description="hip to knee [m]")
     lock: Literal["plastic"] = Field("plastic", description="knee strike: plastic impact, then "
                                      "the knee stays locked until heel strike")
+    spring: KneeSpringSpec | None = Field(None, description="torsional spring-damper at the "
+                                          "knee (null: none); in the rigid view it acts on "
+                                          "the free swing knee (a locked knee holds it)")
+
+    @field_validator("lock", mode="before")
+    @classmethod
+    def _elastic_is_contact_only(cls, v):
+        # an elastic stop (restitution e > 0) in a rigid model rebounds, returns and strikes
+        # again: infinitely many knee impacts in finite time (Zeno, as a bouncing ball), no
+        # honest step to hand on; the contact view's stop is compliant (IMPACT law) instead
+        if v == "elastic":
+            raise ValueError("'elastic' is available in the contact view only, as its "
+                             "compliant knee stop (contact.knee_stop with latch: false); in "
+                             "the rigid view an elastic stop chatters (infinitely many knee "
+                             "impacts in finite time): keep lock: plastic")
+        return v
 
 
 class LegSpec(_Strict):
@@ -341,8 +376,6 @@ class BipedParams(_Strict):
                                ("springs", self.springs)) if on]
         if new and self.coordinates != "absolute":
             raise ValueError(f"coordinates: {new[0]} needs 'absolute'")
-        if new and pair[0].knee is not None:
-            raise ValueError(f"{new[0]}: not available with a knee yet (straight legs only)")
         if self.springs and any(b.mass_kg == 0 for leg in pair for b in leg.bodies):
             raise ValueError("springs: not with massless bodies (a sprung massless leg has "
                              "no flow in the limit m -> 0)")
@@ -393,21 +426,6 @@ class IdealModelSettings(_Strict):
         description="'derived': equations derived with sympy (default, energy-consistent); "
         "'appendix_a': the paper's printed Appendix A, signs included (reproduces Eq. 11)",
     )
-
-
-class SolverSettings(_Strict):
-    """One integrator setting fed to ``scipy.integrate.solve_ivp``."""
-
-    method: Literal["RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA"] = Field(
-        "DOP853", description="scipy solve_ivp method"
-    )
-    rtol: float = Field(1e-10, gt=0, lt=1, description="relative tolerance [-]")
-    atol: float = Field(1e-10, gt=0, lt=1, description="absolute tolerance [state units]")
-    max_step_s: float | None = Field(None, gt=0, description="largest step [s]; null = unbounded")
-    backend: Literal["auto", "scipy", "cyrk", "cyrk_compiled"] = Field(
-        "auto", description="library that integrates: auto (cyrk for RK23/RK45/DOP853, else "
-        "scipy), scipy, cyrk, or cyrk_compiled (CyRK with the flow compiled by numba: no "
-        "Python callbacks, ~1 s numba import per process; for many-point studies)")
 
 
 class GuessFromArtifact(_Strict):
@@ -720,7 +738,8 @@ class Scene(_Strict):
     contact: ContactSettings | None = None
     terrain: TerrainSettings | None = None
     contact_sim: ContactSimSettings | None = None
-    contact_solver: ContactSolverSettings | None = None
+    contact_solver: Annotated[SolverSettings | None,
+                              BeforeValidator(with_contact_defaults)] = None
     workprecision: WorkPrecisionSettings | None = None
     # Resolved path of the YAML file the scene was read from (None when built in code);
     # not part of the scene's content: it decides which file owns runs/<name>/.
@@ -743,6 +762,14 @@ class Scene(_Strict):
         return self
 
     @model_validator(mode="after")
+    def _solvers_fit_their_models(self) -> Scene:
+        why = check_rigid(self.solver) or (self.contact_solver is not None
+                                           and check_contact(self.contact_solver))
+        if why:
+            raise ValueError(why)
+        return self
+
+    @model_validator(mode="after")
     def _knee_stop_needs_a_knee(self) -> Scene:
         # a latch that cannot act is a mistake, as an unknown key is (issue 26): an error,
         # not a warning, so a latch the user counts on is never silently absent (the stop's
@@ -750,8 +777,9 @@ class Scene(_Strict):
         c = self.contact
         if c is None or not c.knee_stop.latch:
             return self
-        leg = getattr(self.walker, "leg", None)
-        if leg is None or getattr(leg, "knee", None) is None:
+        pair = getattr(self.walker, "leg_pair", None)  # a biped's legs (or its leg, twice)
+        leg = pair()[0] if pair is not None else None
+        if leg is None or leg.knee is None:
             raise ValueError("contact.knee_stop.latch: the walker's legs are straight (no "
                              "walker.leg.knee), so there is no knee to latch: remove it or "
                              "give the leg a knee")

@@ -2,7 +2,10 @@
 
 All functions are pure and vectorized (numpy broadcasting).  They are unit-agnostic: the
 caller must pass every argument in one consistent unit system (``walkerlab.contact`` uses SI
-internally, see :meth:`walkerlab.config.contact.ContactSettings.to_si`).
+internally).  The contact model's parameters in SI (:class:`ContactParamsSI`,
+:class:`KneeStopSI`) come from a scene's settings, each number converted from the unit its
+field names, by :func:`contact_params_si` and :func:`knee_stop_si`; the stiffness family is
+applied on top by :func:`walkerlab.contact.rigid_limit.contact_si`, once per run.
 
 Sources
 -------
@@ -17,14 +20,127 @@ Scalar, numba-compiled twins of these functions live in :mod:`walkerlab.contact.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from walkerlab.config.contact import LENGTH_UNITS, ContactSettings, KneeStopSettings
+
 __all__ = [
+    "ContactParamsSI",
+    "KneeStopSI",
+    "contact_params_si",
+    "knee_stop_si",
     "adams_step",
     "adams_step_derivative",
     "coulomb_friction_coefficient",
     "impact_normal_force",
 ]
+
+
+@dataclass(frozen=True)
+class ContactParamsSI:
+    """Contact parameters in SI units (what the model kernels use).
+
+    Attributes
+    ----------
+    k : float
+        Stiffness ``[N/m**e]``.
+    e : float
+        Force exponent ``[-]``.
+    cmax : float
+        Maximum damping ``[N s/m]``.
+    dmax : float
+        Penetration at full damping ``[m]``.
+    mu_s, mu_d : float
+        Static / dynamic friction coefficients ``[-]``.
+    v_s, v_d : float
+        Stiction / friction transition velocities ``[m/s]``.
+    """
+
+    k: float
+    e: float
+    cmax: float
+    dmax: float
+    mu_s: float
+    mu_d: float
+    v_s: float
+    v_d: float
+
+
+@dataclass(frozen=True)
+class KneeStopSI:
+    """Knee-stop parameters in SI (the IMPACT law on the knee's hyperextension angle).
+
+    Attributes
+    ----------
+    k : float
+        Stiffness ``[N m/rad**e]``.
+    e : float
+        Exponent ``[-]``.
+    cmax : float
+        Maximum damping ``[N m s/rad]``.
+    dmax : float
+        Hyperextension at full damping ``[rad]``.
+    latch : bool
+        The stop also holds a loaded leg's knee against flexion (knee latch).
+    latch_height : float
+        Height of the foot above the ground at which the latch has released ``[m]``.
+    latch_capture : float
+        Flexion beyond which the latch does not hold ``[rad]``.
+    """
+
+    k: float
+    e: float
+    cmax: float
+    dmax: float
+    latch: bool = False
+    latch_height: float = 0.002
+    latch_capture: float = 0.01
+
+
+
+def contact_params_si(settings: ContactSettings) -> ContactParamsSI:
+    """The contact law of ``settings`` in SI, each number converted from the unit its field
+    names (the stiffness family not applied: :func:`walkerlab.contact.rigid_limit.contact_si`).
+
+    With ``f`` the metres per length unit of a field's name (1e-3 for ``..._mm``, 1 for
+    ``..._m``): ``k_SI = k * f**-e``, ``c_SI = c / f``, lengths and velocities ``* f``.  E.g.
+    ``stiffness_n_per_mm_pow_e: 1e5`` is ``1e5 * 1000**2.2 N/m^2.2``.
+
+    Parameters
+    ----------
+    settings : ContactSettings
+
+    Returns
+    -------
+    ContactParamsSI
+    """
+    def length(quantity: str) -> float:  # a length or a velocity [m, m/s]
+        value, unit, _ = settings.written(quantity)
+        return value * LENGTH_UNITS[unit]
+
+    e = settings.exponent
+    k, ku, _ = settings.written("stiffness")
+    cmax, cu, _ = settings.written("max_damping")
+    return ContactParamsSI(
+        k=k * LENGTH_UNITS[ku] ** (-e),
+        e=e,
+        cmax=cmax / LENGTH_UNITS[cu],
+        dmax=length("penetration_at_max_damping"),
+        mu_s=settings.mu_static,
+        mu_d=settings.mu_dynamic,
+        v_s=length("stiction_velocity"),
+        v_d=length("friction_velocity"),
+    )
+
+
+def knee_stop_si(settings: KneeStopSettings) -> KneeStopSI:
+    """The knee stop of ``settings`` (already SI) as a :class:`KneeStopSI`."""
+    return KneeStopSI(settings.stiffness_n_m_per_rad_pow_e, settings.exponent,
+                      settings.max_damping_n_m_s_per_rad, settings.penetration_at_max_damping_rad,
+                      settings.latch, settings.latch_release_height_m,
+                      settings.latch_capture_rad)
 
 
 def _unit_interval(x, x0, x1):

@@ -31,17 +31,14 @@ dtheta1, dtheta2]``.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.config.contact import (
-    ContactParamsSI,
-    ContactSettings,
-    KneeStopSettings,
-    KneeStopSI,
-    TerrainSettings,
-)
+from walkerlab.config.contact import ContactSettings, KneeStopSettings, TerrainSettings
+
+from .laws import ContactParamsSI, KneeStopSI, contact_params_si, knee_stop_si
 
 __all__ = ["FOOT_NAMES", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
            "compass_gait_data", "state_name"]
@@ -131,7 +128,7 @@ class ContactWalker:
     a: float = 0.5
     g: float = 9.81
     phi: float = 0.0174
-    contact: ContactParamsSI = field(default_factory=lambda: ContactSettings().to_si())
+    contact: ContactParamsSI = field(default_factory=lambda: contact_params_si(ContactSettings()))
     lane1: np.ndarray = field(default_factory=lambda: np.zeros(0))
     lane2: np.ndarray = field(default_factory=lambda: np.zeros(0))
     patch_half_width: float = 0.05
@@ -158,7 +155,7 @@ class ContactWalker:
                           ("a", "leg_mass_from_foot_m")):
             set_(self, name, float(ex.get(key, np.nan)))
         if self.knee_stop is None:
-            set_(self, "knee_stop", KneeStopSettings().to_si())
+            set_(self, "knee_stop", knee_stop_si(KneeStopSettings()))
         c, ks = self.contact, self.knee_stop
         mod = contact_module(d.structure)
         PC = np.empty(NPC)
@@ -185,11 +182,18 @@ class ContactWalker:
         (patch spacing).  ``data`` (a WalkerData) replaces the compass-gait shorthand."""
         from .rigid_limit import contact_si
 
-        c1, c2 = checkerboard_lanes(step_length, n_steps)
         si, knee = contact_si(contact)  # the scene's stiffness family applied
-        return cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=si, lane1=c1,
-                   lane2=c2, patch_half_width=0.5 * terrain.patch_width_m,
-                   continuous=terrain.kind == "continuous", data=data, knee_stop=knee)
+        walker = cls(L=L, m=m, MH=MH, a=a, g=g, phi=phi, contact=si, data=data, knee_stop=knee)
+        return walker.on_terrain(terrain, step_length=step_length, n_steps=n_steps)
+
+    def on_terrain(self, terrain: TerrainSettings, *, step_length: float,
+                   n_steps: int) -> ContactWalker:
+        """The same walker and contact law on ``terrain``: checkerboard patches spaced by
+        ``step_length`` [m] for ``n_steps`` steps, or continuous ground."""
+        c1, c2 = checkerboard_lanes(step_length, n_steps)
+        return dataclasses.replace(self, lane1=c1, lane2=c2,
+                                   patch_half_width=0.5 * terrain.patch_width_m,
+                                   continuous=terrain.kind == "continuous")
 
     @property
     def structure(self):
@@ -250,6 +254,18 @@ class ContactWalker:
         """Units of :meth:`state_names`."""
         u = ("m", "m") + ("rad",) * (self.nq - 2)
         return u + tuple(f"{s}/s" for s in u)
+
+    def layout(self):
+        """The floating state layout (:class:`walkerlab.models.layout.StateLayout`)."""
+        from walkerlab.models.layout import StateLayout
+
+        return StateLayout.floating(self._coords, self.state_names(), self.state_units())
+
+    def rigid_layout(self):
+        """The layout of the rigid hybrid view of the same walker (its ideal states)."""
+        from walkerlab.models.layout import StateLayout
+
+        return StateLayout.rigid(self.structure.roles)
 
     def leg_angle_states(self, leg: str) -> tuple[str, ...]:
         """State names of ``leg``'s link angles, proximal first (``theta1`` or
@@ -312,27 +328,17 @@ class ContactWalker:
         ``[th_swing_thigh, th_swing_shank, th_stance, rates]`` (the stance knee straight);
         other coordinate schemes through the rigid model's leg angles.
         """
+        from walkerlab.models.layout import floating_links_from_rigid
+
         x = np.asarray(x_ideal, float)
         st = self.structure
-        s1, s2 = float(rate_scale[0]), float(rate_scale[1])
-        roles = st.roles  # the rigid walker's state, by name (<role>_angle, <role>_rate)
-        by = {f"{r}_angle": x[i] for i, r in enumerate(roles)}
-        by.update({f"{r}_rate": x[len(roles) + i] for i, r in enumerate(roles)})
-        if st.knee:
-            ang = [by["swing_thigh_angle"], by["swing_shank_angle"], by["stance_angle"],
-                   by["stance_angle"]]
-            rates = [s1 * by["swing_thigh_rate"], s1 * by["swing_shank_rate"],
-                     s2 * by["stance_rate"], s2 * by["stance_rate"]]
-        elif st.coordinates == "absolute":
-            ang = [by["swing_angle"], by["stance_angle"]]
-            rates = [s1 * by["swing_rate"], s2 * by["stance_rate"]]
+        if st.coordinates == "absolute" or st.knee:
+            values = self.rigid_layout().named(x)  # the rigid state, by name
         else:
             from walkerlab.models.rigid import functions
 
-            la = functions(self.data)["leg_angles"](x)
-            ang = [la["swing_angle"], la["stance_angle"]]
-            rates = [s1 * la["swing_rate"], s2 * la["stance_rate"]]
-        return np.array(ang + rates, dtype=float)
+            values = functions(self.data)["leg_angles"](x)
+        return floating_links_from_rigid(values, self.layout(), rate_scale)
 
     # ------------------------------------------------------------------ post-processing
     def _rows(self, X) -> np.ndarray:

@@ -53,7 +53,9 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from walkerlab.config.contact import ContactParamsSI, ContactSettings, KneeStopSI
+from walkerlab.config.contact import ContactSettings
+
+from .laws import ContactParamsSI, KneeStopSI, contact_params_si, knee_stop_si
 
 __all__ = ["FRICTION_EXPONENT", "contact_si", "expected_order", "scale", "scale_walker"]
 
@@ -106,21 +108,30 @@ def scale(contact: ContactParamsSI, knee: KneeStopSI, kappa: float
 
 
 def contact_si(settings: ContactSettings) -> tuple[ContactParamsSI, KneeStopSI]:
-    """The scene's contact and knee stop in SI, with its ``stiffness_family`` applied.
+    """The scene's contact and knee stop in SI, with its ``stiffness_family`` applied: the
+    contact model's parameters of a run (built once per run, :func:`walkerlab.contact.scene.
+    build`).
 
-    ``stiffness_family: paper`` returns the numbers as written.  ``rigid_limit`` reads
-    ``max_damping``, ``penetration_at_max_damping``, the transition velocities and the latch
-    height as holding at ``reference_stiffness`` and applies :func:`scale` with
-    ``kappa = stiffness / reference_stiffness``.
+    ``stiffness_family: paper`` returns the numbers as written, converted to SI
+    (:func:`walkerlab.contact.laws.contact_params_si`).  ``rigid_limit`` reads the maximum
+    damping, the penetration at maximum damping, the transition velocities and the latch
+    height as holding at the reference stiffness and applies :func:`scale` with
+    ``kappa = stiffness / reference stiffness`` (the ratio of the numbers as written when
+    both are written in the same unit, else of their SI values).
 
     Returns
     -------
     (ContactParamsSI, KneeStopSI)
     """
-    si, knee = settings.to_si(), settings.knee_stop.to_si()
+    si, knee = contact_params_si(settings), knee_stop_si(settings.knee_stop)
     if settings.stiffness_family != "rigid_limit":
         return si, knee
-    kappa = settings.stiffness / settings.reference_stiffness
+    (k, ku, _), (kr, kru, _) = (settings.written(q) for q in ("stiffness",
+                                                              "reference_stiffness"))
+    if ku == kru:
+        kappa = k / kr
+    else:
+        kappa = si.k / contact_params_si(settings.with_written("stiffness", kr, kru)).k
     return scale(dataclasses.replace(si, k=si.k / kappa), knee, kappa)
 
 

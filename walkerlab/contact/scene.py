@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.config import ContactSimSettings, ContactSolverSettings, Scene, TerrainSettings
+from walkerlab.config import ContactSimSettings, Scene, SolverSettings, TerrainSettings
 
 from .model import ContactWalker
 from .rigid_limit import contact_si
@@ -27,7 +27,7 @@ def settings(scene: Scene):
 
     Returns
     -------
-    (ContactSettings, TerrainSettings, ContactSimSettings, ContactSolverSettings)
+    (ContactSettings, TerrainSettings, ContactSimSettings, SolverSettings)
 
     Raises
     ------
@@ -39,7 +39,7 @@ def settings(scene: Scene):
                                 "contact model needs")
     return (scene.contact, scene.terrain or TerrainSettings(),
             scene.contact_sim or ContactSimSettings(),
-            scene.contact_solver or ContactSolverSettings())
+            scene.contact_solver or SolverSettings.for_contact())
 
 
 def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
@@ -96,9 +96,9 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
         check_masses(data.structure)
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
-    si, knee = contact_si(contact)
+    si, knee = contact_si(contact)  # the contact law in SI: once per run
     probe = ContactWalker(contact=si, data=data, knee_stop=knee)
     step_length = ideal_step_length(probe, x_ideal)
-    return ContactWalker.from_settings(contact, terrain, step_length=step_length_m or step_length,
-                                       n_steps=n_steps + 4, data=data), step_length
+    return probe.on_terrain(terrain, step_length=step_length_m or step_length,
+                            n_steps=n_steps + 4), step_length
 

@@ -74,33 +74,35 @@ CYRK_STEPS_PER_CALL = 100_000
 
 
 class StateIndex:
-    """Columns of a walker's state by name (``walker.state_names()``), never by number.
+    """Columns of a walker's state by name, never by number: a view of the walker's
+    :class:`~walkerlab.models.layout.StateLayout` (``walker.layout()``).
 
-    ``idx["hip_x"]`` is a column; :meth:`rates_of` the rate columns of a set of coordinates;
-    :meth:`coordinates` the first half (positions), :meth:`rates` the second.
+    ``idx["hip_x"]`` is a column; :meth:`rate_of` the column of a coordinate's rate;
+    :attr:`coordinates` the columns of the coordinates q, :attr:`rates` of their rates.
     """
 
     def __init__(self, walker):
-        self.names = tuple(walker.state_names())
+        self.layout = walker.layout()
+        self.names = self.layout.names
         self._col = {n: i for i, n in enumerate(self.names)}
-        self.n = len(self.names)
+        self.n = self.layout.size
 
     def __getitem__(self, name: str) -> int:
         return self._col[name]
 
     @property
     def coordinates(self) -> slice:
-        """Columns of the generalised coordinates q (the first half of the state)."""
-        return slice(0, self.n // 2)
+        """Columns of the generalised coordinates q."""
+        return self.layout.q_slice
 
     @property
     def rates(self) -> slice:
-        """Columns of the rates (the second half of the state)."""
-        return slice(self.n // 2, self.n)
+        """Columns of the rates."""
+        return self.layout.qd_slice
 
     def rate_of(self, name: str) -> int:
-        """Column of the rate of coordinate ``name`` (same position in the second half)."""
-        return self._col[name] + self.n // 2
+        """Column of the rate of coordinate state ``name``."""
+        return self._col[self.layout.rate_of(name)]
 
     def hip_velocity(self, X) -> np.ndarray:
         """Hip velocity (n, 2) [m/s] of states X (n, N): the rates of ``hip_x``, ``hip_y``."""

@@ -248,6 +248,100 @@ def _saltation(f_prev: np.ndarray, f_next: np.ndarray, dg: np.ndarray,
     return DR + np.outer(f_next - DR @ f_prev, dg) / (dg @ f_prev)
 
 
+@dataclass
+class _StepState:
+    """What :func:`integrate_step` carries from one phase of a step to the next."""
+
+    t: float
+    x: np.ndarray                     # role-ordered state (2n,)
+    Phi: np.ndarray                   # variational state (2n, 2n): d x / d x0 so far
+    nfev: int = 0
+    pieces: list = field(default_factory=list)
+    phase_times: dict = field(default_factory=dict)
+    termination: RunEnd = RunEnd.T_FINAL
+    event: str = ""
+    message: str = ""
+    x_next: np.ndarray | None = None
+
+
+def _phase_rhs(walker: HybridWalker, phase: Phase, n: int, variational: bool):
+    """Right-hand side of one phase, and the Jacobian handed to scipy's implicit methods.
+
+    Without ``variational``: the phase's flow and the model's analytic Jacobian (not a
+    numerical one: those methods approximate it themselves).  With it: the flow and
+    ``dPhi/dt = A(x) Phi`` on ``y = [x, Phi.ravel()]`` (the model's own in one call when it
+    has one), and no Jacobian."""
+    if not variational:
+        return phase.flow, (phase.jacobian if phase.jacobian is not None
+                            else walker.variational)
+    if phase.variational is not None:
+        return phase.variational, None
+    jac = _phase_jacobian(walker, phase)
+
+    def rhs(tt, y, _f=phase.flow, _A=jac):
+        xs = y[:n]
+        out = np.empty(n + n * n)
+        out[:n] = _f(tt, xs)
+        out[n:] = (_A(tt, xs) @ y[n:].reshape(n, n)).ravel()
+        return out
+    return rhs, None
+
+
+def _integrate_phase(phase: Phase, st: _StepState, t_stop: float, n: int, solver: Solver,
+                     backend: str, rhs, jac, variational: bool) -> _PhaseRun:
+    """One phase from ``st`` until its first guard fires or ``t_stop``, on ``backend``
+    (``cyrk_compiled`` runs the phase's compiled flow; a phase without one runs on CyRK)."""
+    y0 = np.concatenate([st.x, st.Phi.ravel()]) if variational else st.x
+    if backend == "cyrk_compiled" and phase.compiled is not None:
+        from walkerlab.integrate._compiled import solve_phase
+
+        return _PhaseRun(*solve_phase(phase.compiled, variational, st.t, t_stop, y0,
+                                      phase.guards, n, solver))
+    return _solve_phase(rhs, st.t, t_stop, y0, phase.guards, n, solver,
+                        "cyrk" if backend == "cyrk_compiled" else backend, jac)
+
+
+def _next_phase(walker: HybridWalker, k: int, guard, st: _StepState,
+                variational: bool) -> None:
+    """Phase ``k``'s guard hands the step to phase ``k + 1`` (``midstance``; a knee strike
+    applies its reset), with the saltation matrix of the crossing."""
+    phase = walker.phases[k]
+    st.phase_times[guard.name] = st.t
+    x_minus = st.x
+    g_reset = getattr(guard, "reset", None)
+    if g_reset is not None:  # intra-step impact (e.g. knee strike)
+        st.x = np.asarray(g_reset(x_minus), dtype=float)
+    if k + 1 < len(walker.phases) and variational:
+        nxt = walker.phases[k + 1]
+        DR = None if g_reset is None else np.asarray(guard.reset_jacobian(x_minus))
+        st.Phi = _saltation(np.asarray(phase.flow(st.t, x_minus)),
+                            np.asarray(nxt.flow(st.t, st.x)),
+                            _grad(guard, x_minus), DR) @ st.Phi
+
+
+def _end_step(walker: HybridWalker, phase: Phase, guard, st: _StepState, t0: float,
+              variational: bool) -> None:
+    """A guard that ends the step: a fall, a heel strike at the step's very start (no step),
+    or a heel strike: the reset, and on the variational state the saltation matrix and the
+    reset's Jacobian (so ``Phi`` becomes the Poincaré map's Jacobian)."""
+    if guard.outcome == "fall":
+        st.termination = RunEnd.FALL
+        return
+    if st.t - t0 <= MIN_STEP_TIME_S:
+        st.termination = RunEnd.NO_HEEL_STRIKE
+        st.message = (f"no step: the heel-strike guard fired at the step's start "
+                      f"(t = {t0:.4g} s); the walker does not move")
+        return
+    st.termination = RunEnd.HEEL_STRIKE
+    st.x_next = np.asarray(walker.reset(st.x), dtype=float)
+    if variational:
+        f_prev = np.asarray(phase.flow(st.t, st.x))
+        S = _saltation(f_prev, np.zeros_like(f_prev), _grad(guard, st.x))
+        RJ = (walker.reset_jacobian(st.x) if walker.reset_jacobian is not None
+              else numeric_jacobian(walker.reset, st.x))
+        st.Phi = RJ @ S @ st.Phi
+
+
 def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: float = 0.0,
                    max_step_time: float = 5.0, t_final: float | None = None,
                    variational: bool = False, index: int = 0, stance_leg: str = "leg2",
@@ -286,94 +380,39 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     t_stop = t0 + max_step_time
     if t_final is not None:
         t_stop = min(t_stop, t_final)
-    x = np.asarray(x0, dtype=float)
-    Phi = np.eye(n)
-    t = t0
-    nfev = 0
-    pieces = []
-    phase_times = {}
-    termination, event, message = RunEnd.T_FINAL, "", ""
-    x_next = None
+    st = _StepState(t0, np.asarray(x0, dtype=float), np.eye(n))
     for k, phase in enumerate(walker.phases):
-        if variational:
-            jac = _phase_jacobian(walker, phase)
-
-            def rhs(tt, y, _f=phase.flow, _A=jac):
-                xs = y[:n]
-                out = np.empty(n + n * n)
-                out[:n] = _f(tt, xs)
-                out[n:] = (_A(tt, xs) @ y[n:].reshape(n, n)).ravel()
-                return out
-            if phase.variational is not None:  # the model's own, in one call
-                rhs = phase.variational
-            y0 = np.concatenate([x, Phi.ravel()])
-        else:
-            rhs = phase.flow
-            y0 = x
-        if t >= t_stop:
+        if st.t >= t_stop:
             break
-        # the model's analytic Jacobian for scipy's implicit methods (not a numerical one:
-        # those methods approximate it themselves)
-        jac = (None if variational else phase.jacobian if phase.jacobian is not None
-               else walker.variational)
-        if backend == "cyrk_compiled" and phase.compiled is not None:
-            from walkerlab.integrate._compiled import solve_phase
-
-            run = _PhaseRun(*solve_phase(phase.compiled, variational, t, t_stop, y0,
-                                         phase.guards, n, solver))
-        else:
-            run = _solve_phase(rhs, t, t_stop, y0, phase.guards, n, solver,
-                               "cyrk" if backend == "cyrk_compiled" else backend, jac)
-        nfev += run.nfev
-        message = run.message
-        pieces.append((phase, run.dense, (t, run.t_last)))
-        t, x = run.t_last, run.y_last[:n].copy()
+        rhs, jac = _phase_rhs(walker, phase, n, variational)
+        run = _integrate_phase(phase, st, t_stop, n, solver, backend, rhs, jac, variational)
+        st.nfev += run.nfev
+        st.message = run.message
+        st.pieces.append((phase, run.dense, (st.t, run.t_last)))
+        st.t, st.x = run.t_last, run.y_last[:n].copy()
         if run.failed:
-            termination = RunEnd.SOLVER_FAILURE
+            st.termination = RunEnd.SOLVER_FAILURE
             break
         if run.event is None:
-            termination = RunEnd.T_FINAL
+            st.termination = RunEnd.T_FINAL
             break
         guard = phase.guards[run.event]
         if variational:
-            Phi = run.y_last[n:].reshape(n, n)
-        event = guard.name
+            st.Phi = run.y_last[n:].reshape(n, n)
+        st.event = guard.name
         if guard.outcome == "next_phase":
-            phase_times[guard.name] = t
-            x_minus = x
-            g_reset = getattr(guard, "reset", None)
-            if g_reset is not None:  # intra-step impact (e.g. knee strike)
-                x = np.asarray(g_reset(x_minus), dtype=float)
-            if k + 1 < len(walker.phases) and variational:
-                nxt = walker.phases[k + 1]
-                DR = None if g_reset is None else np.asarray(guard.reset_jacobian(x_minus))
-                Phi = _saltation(np.asarray(phase.flow(t, x_minus)), np.asarray(nxt.flow(t, x)),
-                                 _grad(guard, x_minus), DR) @ Phi
+            _next_phase(walker, k, guard, st, variational)
             continue
-        if guard.outcome == "fall":
-            termination = RunEnd.FALL
-            break
-        if t - t0 <= MIN_STEP_TIME_S:
-            termination = RunEnd.NO_HEEL_STRIKE
-            message = (f"no step: the heel-strike guard fired at the step's start "
-                       f"(t = {t0:.4g} s); the walker does not move")
-            break
-        termination = RunEnd.HEEL_STRIKE
-        x_next = np.asarray(walker.reset(x), dtype=float)
-        if variational:
-            f_prev = np.asarray(phase.flow(t, x))
-            S = _saltation(f_prev, np.zeros_like(f_prev), _grad(guard, x))
-            RJ = (walker.reset_jacobian(x) if walker.reset_jacobian is not None
-                  else numeric_jacobian(walker.reset, x))
-            Phi = RJ @ S @ Phi
+        _end_step(walker, phase, guard, st, t0, variational)
         break
     return Segment(
-        index=index, stance_leg=stance_leg, t_start=t0, t_end=t, x_start=np.asarray(x0, float),
-        x_end=x, x_next=x_next, termination=termination.value, event=event,
-        phase_times=phase_times,
-        nfev=nfev, message=message, pieces=pieces,
+        index=index, stance_leg=stance_leg, t_start=t0, t_end=st.t,
+        x_start=np.asarray(x0, float), x_end=st.x, x_next=st.x_next,
+        termination=st.termination.value, event=st.event, phase_times=st.phase_times,
+        nfev=st.nfev, message=st.message, pieces=st.pieces,
         stance_foot_world=np.zeros(2) if stance_foot_world is None else stance_foot_world,
-        monodromy=Phi if (variational and termination is RunEnd.HEEL_STRIKE) else None,
+        monodromy=(st.Phi if (variational and st.termination is RunEnd.HEEL_STRIKE)
+                   else None),
     )
 
 

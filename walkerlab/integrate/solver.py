@@ -3,7 +3,7 @@
 :class:`Solver` carries an integrator choice (method, tolerances, largest step, library) to
 every integration: the rigid hybrid walker's steps (:mod:`walkerlab.integrate.rigid`) and the
 compliant-contact walker's runs (:mod:`walkerlab.integrate.contact`).  The scene's typed
-settings (:class:`walkerlab.config.SolverSettings`, :class:`walkerlab.config.ContactSolverSettings`)
+settings (:class:`walkerlab.config.SolverSettings` of ``solver:`` and ``contact_solver:``)
 become a :class:`Solver` in one place, :meth:`Solver.from_settings`.
 
 Rigid backends (``backend``):
@@ -76,13 +76,13 @@ class Solver:
 
         Parameters
         ----------
-        s : walkerlab.config.SolverSettings or walkerlab.config.ContactSolverSettings or Solver
-            Settings with ``method``, ``rtol``, ``atol``, ``max_step_s`` (and ``backend``,
-            ``"auto"`` when absent, as in the contact settings).
+        s : walkerlab.config.SolverSettings or Solver
+            A scene's ``solver:`` or ``contact_solver:`` section (or a Solver, returned
+            as it is).
         """
         if isinstance(s, Solver):
             return s
-        return cls(s.method, s.rtol, s.atol, s.max_step_s, getattr(s, "backend", "auto"))
+        return cls(s.method, s.rtol, s.atol, s.max_step_s, s.backend)
 
     def kwargs(self) -> dict:
         """``solve_ivp`` keyword arguments (method, rtol, atol and max_step when bounded)."""

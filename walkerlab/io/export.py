@@ -15,7 +15,34 @@ hip_z         prismatic   ``hip_y`` [m] (along world z, up; named by its axis)
 leg<i>_hip    revolute    ``leg<i>_angle`` (kneed: ``leg<i>_thigh_angle``) [rad]
 leg<i>_knee   revolute    ``leg<i>_shank_angle - leg<i>_thigh_angle`` [rad]; limit [-pi, 0]:
                           0 is the straight-leg stop (positive = hyperextended)
+torso_hip     revolute    the upper body's angle from the upward vertical, positive leaning
+                          back [rad]; coupled: ``(leg1_hip + leg2_hip) / 2`` (eliminated in
+                          walkerlab's coordinates, a constraint here)
 ============  ==========  ================================================================
+
+Springs and couplings (issue 22):
+
+- a torsional **spring**-damper between two links at the hip (``walker.springs``) acts on
+  ``delta = angle(second) - angle(first)``, a linear combination of hip joints: in MJCF a
+  fixed tendon ``spring<i>`` (coef +1 on the second link's hip joint, -1 on the first's) with
+  ``stiffness`` = k [N m/rad], ``springlength`` = the rest angle [rad], ``damping`` = c
+  [N m s/rad] (a negative rest angle flips both coefficients and the rest angle's sign:
+  MuJoCo reads ``springlength="-1"`` as "the length at qpos0"); MuJoCo's passive force is
+  then ``-k (delta - rest) - c d(delta)/dt`` and its potential energy (``mjData.energy``
+  with the energy flag) includes ``k (delta - rest)^2 / 2``.  URDF has no spring element
+  (``dynamics`` carries damping only, of one joint): the springs are stated in comments.
+- a **knee spring** (``walker.leg.knee.spring``) acts on the knee joint's own angle: MJCF
+  joint ``stiffness``, ``springref`` (the rest angle) and ``damping`` on ``leg<i>_knee``.
+- the **bisecting hip mechanism** (``walker.torso.coupling``) is a fixed tendon
+  ``bisecting_hip = torso_hip - (leg1_hip + leg2_hip) / 2`` held at 0 by an equality
+  constraint (MJCF ``<equality><tendon tendon1=.../>``; MuJoCo's ``<joint>`` equality couples
+  two joints only).  MuJoCo's constraints are soft: the export makes this one as stiff as
+  MuJoCo allows (``solimp`` 0.9999, ``solref`` time constant two timesteps).  URDF's
+  ``mimic`` follows one joint only: the coupling is stated in a comment (a URDF library sees
+  a free torso joint).
+
+Bodies off a link's axis sit in place: a link's ``inertial`` origin is its centre of mass
+``(off-axis, 0, -along)`` in the link frame.
 
 Gravity ``g`` acts along world -z.  The slope is the ground's tilt, not gravity's: the ground
 falls towards +x at the slope angle (MJCF: a plane rotated about y; URDF has no world, the
@@ -62,6 +89,10 @@ MJCF_MIN_MASS_KG = 1e-12
 #: Shortest link or foot radius [m] an export accepts: the point foot's sphere is L/1000 and
 #: MuJoCo refuses geometry below mjMINVAL (1e-15), e.g. "fromto points too close".
 MJCF_MIN_LENGTH_M = 1e-9
+#: MuJoCo's default timestep [s] (an export without a scene keeps it).
+MJCF_DEFAULT_TIMESTEP_S = 0.002
+#: ``solimp`` of a coupling's equality: the largest impedance MuJoCo accepts (mjMAXIMP).
+COUPLING_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 #: Joint-axis of every hinge: world -y, so that a positive angle moves the foot ahead.
 AXIS = "0 -1 0"
 
@@ -80,7 +111,7 @@ def _header(mb: Multibody, name: str, fmt: str, version: str) -> list[str]:
             if mb.knee else "")
     foot = (f"arc feet, radius R = {_f(mb.foot_radius_m)} m, centre at L - R from the hip"
             if _arc(mb) else "point feet")
-    return [_comment(f"walker {name!s} exported by walkerlab {version} ({fmt})."),
+    parts = [_comment(f"walker {name!s} exported by walkerlab {version} ({fmt})."),
             _comment("Floating planar walker in the x-z plane: x downhill (horizontal), z up; "
                      "joint axes along -y (positive angle = foot ahead)."),
             _comment("Joints: hip_x, hip_z (prismatic, the hip's position along world x and z "
@@ -89,6 +120,18 @@ def _header(mb: Multibody, name: str, fmt: str, version: str) -> list[str]:
                      f"{_f(mb.slope_rad)} rad, falling towards +x (the ground is tilted, not "
                      "gravity)."),
             _comment(f"Leg length L = {_f(mb.leg_length_m)} m; {foot}.")]
+    for sp in mb.springs:
+        terms = " ".join(f"{c:+g} {j}" for j, c in sp.terms)
+        parts.append(_comment(
+            f"Spring {sp.name} between {sp.between[0]} and {sp.between[1]}: delta = {terms} "
+            f"[rad], torque -k (delta - rest) - c d(delta)/dt with k = "
+            f"{_f(sp.stiffness_n_m_per_rad)} N m/rad, rest = {_f(sp.rest_angle_rad)} rad, c = "
+            f"{_f(sp.damping_n_m_s_per_rad)} N m s/rad."))
+    for cp in mb.couplings:
+        terms = " + ".join(f"{c:g} {j}" for j, c in cp.terms)
+        parts.append(_comment(f"Coupling {cp.name} (bisecting hip mechanism): {cp.joint} = "
+                              f"{terms} [rad]."))
+    return parts
 
 
 def _comment(text: str) -> str:
@@ -138,9 +181,9 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
     return "\n".join(out)
 
 
-def _urdf_inertial(mass: float, com: float, inertia: float) -> list[str]:
+def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) -> list[str]:
     # a line along the link's z axis: inertia about x and y, none about z
-    return ["    <inertial>", f'      <origin xyz="{_v(0, 0, -com)}" rpy="0 0 0"/>',
+    return ["    <inertial>", f'      <origin xyz="{_v(off, 0, -com)}" rpy="0 0 0"/>',
             f'      <mass value="{_f(mass)}"/>',
             f'      <inertia ixx="{_f(inertia)}" ixy="0" ixz="0" iyy="{_f(inertia)}" iyz="0" '
             'izz="0"/>', "    </inertial>"]
@@ -149,6 +192,7 @@ def _urdf_inertial(mass: float, com: float, inertia: float) -> list[str]:
 def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
     knee = ln.joint.endswith("_knee")
     jtype = "revolute" if knee else "continuous"
+    reach = -ln.length_m if ln.up else ln.length_m  # the visual runs up the torso
     out = [f'  <joint name="{ln.joint}" type="{jtype}">', f'    <parent link="{ln.parent}"/>',
            f'    <child link="{ln.name}"/>',
            f'    <origin xyz="{_v(0, 0, -ln.joint_from_parent_m)}" rpy="0 0 0"/>',
@@ -156,8 +200,8 @@ def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
     if knee:  # straight-leg stop at 0, flexion down to -pi
         out.append(f'    <limit lower="{_f(-math.pi)}" upper="0" effort="0" velocity="1e9"/>')
     out += ["  </joint>", f'  <link name="{ln.name}">',
-            *_urdf_inertial(ln.mass_kg, ln.com_m, ln.inertia_kg_m2),
-            f'    <visual><origin xyz="{_v(0, 0, -ln.length_m / 2)}" rpy="0 0 0"/>'
+            *_urdf_inertial(ln.mass_kg, ln.com_m, ln.inertia_kg_m2, ln.com_off_axis_m),
+            f'    <visual><origin xyz="{_v(0, 0, -reach / 2)}" rpy="0 0 0"/>'
             f'<geometry><cylinder radius="{_f(width / 2)}" length="{_f(ln.length_m)}"/>'
             "</geometry></visual>", "  </link>"]
     if ln.foot_m is not None:
@@ -263,6 +307,37 @@ def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     return out
 
 
+def _joint_springs(mb: Multibody) -> dict:
+    """Springs on one joint's own angle (a knee spring): ``{joint: Spring}``, written as the
+    joint's ``stiffness``, ``springref`` and ``damping``."""
+    return {sp.terms[0][0]: sp for sp in mb.springs
+            if len(sp.terms) == 1 and sp.terms[0][1] == 1.0}
+
+
+def _tendons(mb: Multibody) -> list[str]:
+    """Fixed tendons: each spring on its ``delta``, each coupling on its residual."""
+    on_joint = _joint_springs(mb).values()
+    springs = [sp for sp in mb.springs if sp not in on_joint]
+    if not (springs or mb.couplings):
+        return []
+    out = ["  <tendon>"]
+    for sp in springs:
+        # oriented so that springlength >= 0: MuJoCo reads a springlength of -1 as "the
+        # tendon's length at qpos0"; k (delta - r)^2 = k (-delta + r)^2, the same spring
+        sign = -1.0 if sp.rest_angle_rad < 0 else 1.0
+        out.append(f'    <fixed name="{sp.name}" stiffness="{_f(sp.stiffness_n_m_per_rad)}" '
+                   f'springlength="{_f(sign * sp.rest_angle_rad)}" '
+                   f'damping="{_f(sp.damping_n_m_s_per_rad)}">')
+        out += [f'      <joint joint="{j}" coef="{_f(sign * c)}"/>' for j, c in sp.terms]
+        out.append("    </fixed>")
+    for cp in mb.couplings:  # residual = joint - sum coef * other joints, held at 0
+        out.append(f'    <fixed name="{cp.name}">')
+        out.append(f'      <joint joint="{cp.joint}" coef="1.0"/>')
+        out += [f'      <joint joint="{j}" coef="{_f(-c)}"/>' for j, c in cp.terms]
+        out.append("    </fixed>")
+    return out + ["  </tendon>"]
+
+
 def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | None = None
               ) -> str:
     """The walker as a MuJoCo model (MJCF; MuJoCo XML Reference,
@@ -314,15 +389,22 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     children: dict[str, list[Link]] = {}
     for ln in mb.links:
         children.setdefault(ln.parent, []).append(ln)
+    joint_springs = _joint_springs(mb)
 
     def body(ln: Link, indent: str) -> list[str]:
         inertia = max(ln.inertia_kg_m2, lo)
         rng = f' range="{_v(-math.pi, 0)}"' if ln.joint.endswith("_knee") else ""
+        if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
+            sp = joint_springs[ln.joint]
+            rng += (f' stiffness="{_f(sp.stiffness_n_m_per_rad)}" '
+                    f'springref="{_f(sp.rest_angle_rad)}" '
+                    f'damping="{_f(sp.damping_n_m_s_per_rad)}"')
+        reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
         lines = [f'{indent}<body name="{ln.name}" pos="{_v(0, 0, -ln.joint_from_parent_m)}">',
                  f'{indent}  <joint name="{ln.joint}" type="hinge" axis="{AXIS}"{rng}/>',
-                 f'{indent}  <inertial pos="{_v(0, 0, -ln.com_m)}" mass="{_f(ln.mass_kg)}" '
-                 f'diaginertia="{_v(inertia, inertia, lo)}"/>',
-                 f'{indent}  <geom type="capsule" fromto="{_v(0, 0, 0, 0, 0, -ln.length_m)}" '
+                 f'{indent}  <inertial pos="{_v(ln.com_off_axis_m, 0, -ln.com_m)}" '
+                 f'mass="{_f(ln.mass_kg)}" diaginertia="{_v(inertia, inertia, lo)}"/>',
+                 f'{indent}  <geom type="capsule" fromto="{_v(0, 0, 0, 0, 0, -reach)}" '
                  f'size="{_f(width / 2)}"/>']
         if ln.foot_m is not None:
             leg = ln.name.split("_")[0]
@@ -345,16 +427,21 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     for ln in children["hip"]:
         out += body(ln, "      ")
     standing = [0.0, mb.leg_length_m] + [0.0] * len(mb.links)
-    out += ["    </body>", "  </worldbody>"]
+    out += ["    </body>", "  </worldbody>", *_tendons(mb)]
     keys = [f'    <key name="standing" qpos="{_v(*standing)}"/>']
+    equality = [f'    <tendon name="{cp.name}" tendon1="{cp.name}" '
+                f'solref="{_v(2 * (extra.timestep_s if extra else MJCF_DEFAULT_TIMESTEP_S), 1)}" '
+                f'solimp="{_v(*COUPLING_SOLIMP)}"/>' for cp in mb.couplings]
     if extra is not None:
         keys.append(f'    <key name="gait" qpos="{_v(*extra.qpos)}" qvel="{_v(*extra.qvel)}"/>')
         knees = [ln.joint for ln in mb.links if ln.joint.endswith("_knee")]
         if knees and extra.latch is not None:
             # the gait keyframe starts with leg2 in stance: its latch holds, leg1's is free
-            out += ["  <equality>", *(f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
-                                      f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"'
-                                      '/>' for k in knees), "  </equality>"]
+            equality += [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
+                         f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>'
+                         for k in knees]
+    if equality:
+        out += ["  <equality>", *equality, "  </equality>"]
     if extra is not None:  # what a stepping loop needs (walkerlab.analysis.mujoco_walk)
         arc = mb.foot_radius_m if _arc(mb) else 0.0
         custom = {"slope_rad": mb.slope_rad, "foot_height_offset_m": arc}

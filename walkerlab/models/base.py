@@ -191,6 +191,13 @@ class HybridWalker:
     def n_coordinates(self) -> int:
         return len(self.roles)
 
+    def layout(self):
+        """The state layout (:class:`walkerlab.models.layout.StateLayout`): names, units,
+        q / qd slices and legs of the role-ordered state (2n,)."""
+        from walkerlab.models.layout import StateLayout
+
+        return StateLayout.rigid(self.roles)
+
     def state_names(self) -> list[str]:
         """Role-ordered state names, e.g. ``['swing_angle', 'stance_angle', 'swing_rate', ...]``."""
         from walkerlab.models.description import state_names

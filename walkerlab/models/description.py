@@ -75,6 +75,9 @@ class Structure:
     springs : tuple of (str, str)
         Torsional spring-dampers, each between two of :data:`SPRING_LINKS` (in that order);
         ``delta = angle(second) - angle(first)``; parameters ``k_s<i>, r_s<i>, c_s<i>``.
+    knee_spring : bool
+        A torsional spring-damper at each knee on the knee angle ``shank - thigh``;
+        parameters ``k_knee, r_knee, c_knee`` (last in :attr:`param_names`).
     """
 
     coordinates: str
@@ -86,6 +89,7 @@ class Structure:
     asymmetric: bool = False
     torso: tuple[BodySpec, ...] = ()
     springs: tuple[tuple[str, str], ...] = ()
+    knee_spring: bool = False
 
     @property
     def roles(self) -> tuple[str, ...]:
@@ -117,6 +121,8 @@ class Structure:
                 names.append(f"I_torso_{b.name}")
         for i in range(len(self.springs)):
             names += [f"k_s{i}", f"r_s{i}", f"c_s{i}"]
+        if self.knee_spring:
+            names += ["k_knee", "r_knee", "c_knee"]
         return tuple(names)
 
     def key(self) -> str:
@@ -131,6 +137,8 @@ class Structure:
             d["torso"] = [b.key() for b in self.torso]
         if self.springs:
             d["springs"] = [list(s) for s in self.springs]
+        if self.knee_spring:
+            d["knee_spring"] = True
         return json.dumps(d)
 
 
@@ -282,14 +290,18 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     head = [walker_cfg.gravity_m_per_s2, leg.length_m, slope_rad]
     if hip:
         head.append(walker_cfg.hip_mass_kg)
+    knee_spring = leg.knee.spring if leg.knee is not None else None
     structure = Structure(walker_cfg.coordinates, tuple(bodies), hip, leg.foot.kind,
                           knee=leg.knee is not None, asymmetric=asym, torso=tuple(torso),
-                          springs=tuple(pairs))
+                          springs=tuple(pairs), knee_spring=knee_spring is not None)
 
     def params(swing_vals, stance_vals, springs) -> tuple[float, ...]:
         vals = head + leg_block(swing_vals, stance_vals) + tail
         for k in springs:
             vals += k
+        if knee_spring is not None:
+            vals += [knee_spring.stiffness_n_m_per_rad, knee_spring.rest_angle_rad,
+                     knee_spring.damping_n_m_s_per_rad]
         return tuple(float(v) for v in vals)
 
     p1 = params(v1, v2, steps[0])

@@ -197,7 +197,8 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     # the upper body on the bisecting hip mechanism: eliminated as in the rigid view (its
     # angle from the upward vertical is the mean of the leg angles; both legs are free here,
     # the mechanism couples them); a point d up its axis at hip - d e(t)
-    psi_t = (q[2] + q[3]) / 2 if structure.torso else None
+    hip_links = (q[2], q[4]) if knee else (q[2], q[3])  # leg1's and leg2's links at the hip
+    psi_t = (hip_links[0] + hip_links[1]) / 2 if structure.torso else None
     for b in structure.torso:
         lin = {psi_t: -P[f"d_torso_{b.name}"]}
         if b.off_axis:
@@ -234,14 +235,21 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     dqv, qv = sp.Matrix(dq), sp.Matrix(q)
     T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
     # torsional spring-dampers (roles of the rigid view's first step: swing = leg1, stance =
-    # leg2): V_s = k (delta - r)^2 / 2 joins V; the damper's -c J^T J dq joins the bias
-    angle = {"swing": q[2], "stance": q[3], "torso": psi_t}
+    # leg2; a kneed leg's spring acts on its thigh): V_s = k (delta - r)^2 / 2 joins V; the
+    # damper's -c J^T J dq joins the bias
+    angle = {"swing": hip_links[0], "stance": hip_links[1], "torso": psi_t}
     damping = sp.zeros(nq, nq)
     for i, (first, second) in enumerate(structure.springs):
         delta = angle[second] - angle[first]
         V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
         Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
         damping += P[f"c_s{i}"] * Jd.T * Jd
+    if structure.knee_spring:  # a spring-damper at each knee on shank - thigh
+        for leg in LEGS:
+            knee_angle = q[names.index(f"{leg}_shank_angle")] - q[names.index(f"{leg}_thigh_angle")]
+            V += P["k_knee"] * (knee_angle - P["r_knee"]) ** 2 / 2
+            Jd = sp.Matrix([[sp.diff(knee_angle, s) for s in q]])
+            damping += P["c_knee"] * Jd.T * Jd
     h = (M * dqv).jacobian(qv) * dqv - sp.Matrix([sp.diff(T, s) for s in q]) \
         + sp.Matrix([sp.diff(V, s) for s in q]) + damping * dqv
     h = h.applyfunc(sp.expand)

@@ -13,7 +13,16 @@ module builds the floating planar multibody walker that Drake, Pinocchio or MuJo
   not rotate) and, with a knee, the knee joints (relative angle ``shank - thigh``; the knee is
   free, its straight-leg stop ``shank - thigh <= 0`` is a joint limit);
 - **feet**: a point at the end of the leg, or an arc of radius ``R`` centred on the leg axis
-  at ``L - R`` from the hip (McGeer 1990).
+  at ``L - R`` from the hip (McGeer 1990);
+- an **upper body** (``torso``): one link hinged at the hip, its axis pointing up; the
+  bisecting hip mechanism (Wisse, Hobbelen & Schwab 2007) is a :class:`Coupling` of its
+  joint to the two hip joints (torso angle = mean of the leg angles), which the rigid and
+  floating views eliminate and a multibody library enforces as a constraint;
+- **springs**: torsional spring-dampers between links at the hip, as a :class:`Spring` on a
+  linear combination of joint angles (``delta = angle(second) - angle(first)``).
+
+Bodies may lie off a link's axis (``off_axis_m``, positive ahead of the axis when the link
+hangs straight down): a link's centre of mass then has an off-axis component.
 
 Sign convention (walkerlab's, paper Eq. 1): a point at distance ``s`` along a link of
 absolute angle ``psi`` from the vertical lies at ``joint + s (sin psi, -cos psi)`` in
@@ -32,7 +41,7 @@ from dataclasses import dataclass
 
 from walkerlab.models.description import WalkerData
 
-__all__ = ["Link", "Multibody", "multibody"]
+__all__ = ["Coupling", "Link", "Multibody", "Spring", "multibody"]
 
 #: The two legs of the floating walker, in coordinate order.
 LEGS = ("leg1", "leg2")
@@ -46,26 +55,34 @@ class Link:
     Attributes
     ----------
     name : str
-        ``leg<i>`` (straight leg), ``leg<i>_thigh`` or ``leg<i>_shank``.
+        ``leg<i>`` (straight leg), ``leg<i>_thigh``, ``leg<i>_shank`` or ``torso``.
     parent : str
         ``hip`` or the thigh's name.
     joint : str
-        Name of the joint to the parent: ``leg<i>_hip`` or ``leg<i>_knee``.
+        Name of the joint to the parent: ``leg<i>_hip``, ``leg<i>_knee`` or ``torso_hip``
+        (the torso's absolute angle, from the upward vertical, positive leaning back: the
+        same joint axis as the legs').
     joint_from_parent_m : float
         Distance of the joint from the parent's origin along the parent's axis [m] (0 at
         the hip, the thigh length at the knee).
     length_m : float
-        Joint to the far end (knee, or the foot point) [m].
+        Joint to the far end (knee, the foot point, or the torso's farthest body) [m].
     mass_kg : float
         Sum of the masses of the bodies on the link [kg] (> 0).
     com_m : float
-        Centre of mass from the joint, along the link [m].
+        Centre of mass from the joint along the link's downward axis [m] (the torso's is
+        negative: its bodies lie above the hip).
     inertia_kg_m2 : float
         Moment of inertia about the centre of mass, about the joint axis [kg m^2]
-        (rods' own inertia plus ``m (s - com)^2`` for every body).
+        (rods' own inertia plus ``m |r - com|^2`` for every body).
     foot_m : float or None
         Distance of the foot point (point foot) or the arc's centre (arc foot) from the
-        joint [m]; None for a thigh.
+        joint [m]; None for a thigh or the torso.
+    com_off_axis_m : float
+        Centre of mass off the link's axis [m], positive ahead of it when the link hangs
+        straight down (``e(psi + pi/2) = (cos psi, sin psi)``).
+    up : bool
+        The link points up from its joint (the torso); for drawing only.
     """
 
     name: str
@@ -77,6 +94,52 @@ class Link:
     com_m: float
     inertia_kg_m2: float
     foot_m: float | None
+    com_off_axis_m: float = 0.0
+    up: bool = False
+
+
+@dataclass(frozen=True)
+class Spring:
+    """A linear torsional spring-damper on ``delta = sum coef * joint angle``: torque
+    ``-k (delta - rest) - c d(delta)/dt`` along ``delta``, potential ``k (delta - rest)^2 / 2``.
+
+    Attributes
+    ----------
+    name : str
+        ``spring<i>`` (the walker's ``springs`` order) or ``leg<i>_knee_spring``.
+    between : tuple of str
+        The two links (first, second): ``delta = angle(second) - angle(first)``.
+    terms : tuple of (str, float)
+        ``(joint, coef)``: the hip joints are absolute link angles, so ``+1`` on the second
+        link's hip joint and ``-1`` on the first's; a knee spring ``((leg<i>_knee, 1),)``.
+    stiffness_n_m_per_rad, rest_angle_rad, damping_n_m_s_per_rad : float
+    """
+
+    name: str
+    between: tuple[str, str]
+    terms: tuple[tuple[str, float], ...]
+    stiffness_n_m_per_rad: float
+    rest_angle_rad: float
+    damping_n_m_s_per_rad: float
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """A linear holonomic constraint ``angle(joint) = sum coef * angle(other joint)``.
+
+    Attributes
+    ----------
+    name : str
+        ``bisecting_hip``.
+    joint : str
+        The coupled joint (``torso_hip``).
+    terms : tuple of (str, float)
+        ``(("leg1_hip", 0.5), ("leg2_hip", 0.5))`` for the bisecting hip mechanism.
+    """
+
+    name: str
+    joint: str
+    terms: tuple[tuple[str, float], ...]
 
 
 @dataclass(frozen=True)
@@ -99,6 +162,11 @@ class Multibody:
         Gravity ``g`` along world -y (up is +y) [m/s^2].
     slope_rad : float
         The ground's tilt: it falls towards +x at this angle [rad].
+    springs : tuple of Spring
+        Torsional spring-dampers between links at the hip (springs with no stiffness and no
+        damping in the first step are left out).
+    couplings : tuple of Coupling
+        Linear constraints between joint angles (the bisecting hip mechanism).
     """
 
     hip_mass_kg: float
@@ -109,10 +177,14 @@ class Multibody:
     knee: bool
     gravity_m_per_s2: float
     slope_rad: float
+    springs: tuple[Spring, ...] = ()
+    couplings: tuple[Coupling, ...] = ()
 
 
-def _combine(name: str, parts: list[tuple[float, float, float, str]]) -> tuple[float, ...]:
-    """Mass, centre of mass and inertia about it of ``(mass, s, own inertia, body)`` parts."""
+def _combine(name: str, parts: list[tuple[float, float, float, str, float]]
+             ) -> tuple[float, ...]:
+    """Mass, centre of mass (along, off the axis) and inertia about it of ``(mass, s, own
+    inertia, body, e)`` parts (``s`` along the link's axis, ``e`` off it)."""
     m = sum(p[0] for p in parts)
     if not m > 0:
         bodies = ", ".join(f"{p[3]} ({p[0]:g} kg)" for p in parts) or "none"
@@ -120,12 +192,17 @@ def _combine(name: str, parts: list[tuple[float, float, float, str]]) -> tuple[f
                          "multibody model needs positive masses on every link (massless legs, "
                          "as in the simplest walker, have no multibody form)")
     c = sum(p[0] * p[1] for p in parts) / m
-    inertia = sum(p[2] + p[0] * (p[1] - c) ** 2 for p in parts)
-    return m, c, inertia
+    ce = sum(p[0] * p[4] for p in parts) / m
+    inertia = sum(p[2] + p[0] * ((p[1] - c) ** 2 + (p[4] - ce) ** 2) for p in parts)
+    return m, c, inertia, ce
 
 
 def multibody(data: WalkerData) -> Multibody:
     """The walker of ``data`` as a floating planar tree of rigid links.
+
+    The numbers are the first step's (``leg1`` swinging, paper Eq. 11): with legs that differ
+    ``leg1`` carries the swing role's numbers, ``leg2`` the stance role's; a spring's link
+    roles map to ``swing -> leg1``, ``stance -> leg2``.
 
     Parameters
     ----------
@@ -142,14 +219,6 @@ def multibody(data: WalkerData) -> Multibody:
         A link carries no mass (one line, naming the link).
     """
     s = data.structure
-    missing = [what for what, on in (("an upper body and its coupling (MJCF equality)",
-                                      s.torso),
-                                     ("springs (joint stiffness / tendons)", s.springs),
-                                     ("bodies off a link's axis",
-                                      any(b.off_axis for b in s.bodies))) if on]
-    if missing:
-        raise ValueError(f"export: {missing[0]} cannot be exported yet (URDF/MJCF writers "
-                         "know straight links with on-axis bodies)")
     p = dict(zip(s.param_names, data.params))
     L = p["L"]
     lt = p["L_thigh"] if s.knee else 0.0
@@ -164,21 +233,47 @@ def multibody(data: WalkerData) -> Multibody:
             start = lt if b.link == "shank" else 0.0  # mass 0 adds nothing; a link without
             per_segment[b.link].append((0.0 if b.massless else p[f"m_{tag}{b.name}"],
                                         p[f"d_{tag}{b.name}"] - start,  # mass is refused
-                                        p.get(f"I_{tag}{b.name}", 0.0), b.name))
+                                        p.get(f"I_{tag}{b.name}", 0.0), b.name,
+                                        p.get(f"e_{tag}{b.name}", 0.0)))
         per_leg.append(per_segment)
     foot_from_hip = L - R  # the foot point, or the arc's centre
     links = []
     for leg, per_segment in zip(LEGS, per_leg):
         for seg in segments:
             name = leg if seg == "leg" else f"{leg}_{seg}"
-            m, c, inertia = _combine(f"{seg} ({name})", per_segment[seg])
+            m, c, inertia, ce = _combine(f"{seg} ({name})", per_segment[seg])
             if seg == "thigh":
-                links.append(Link(name, "hip", f"{leg}_hip", 0.0, lt, m, c, inertia, None))
+                links.append(Link(name, "hip", f"{leg}_hip", 0.0, lt, m, c, inertia, None, ce))
             elif seg == "shank":
                 links.append(Link(name, f"{leg}_thigh", f"{leg}_knee", lt, L - lt, m, c,
-                                  inertia, foot_from_hip - lt))
+                                  inertia, foot_from_hip - lt, ce))
             else:
                 links.append(Link(name, "hip", f"{leg}_hip", 0.0, L, m, c, inertia,
-                                  foot_from_hip))
+                                  foot_from_hip, ce))
+    couplings = ()
+    if s.torso:  # bodies d up the torso's axis: -d along the link's downward axis
+        parts = [(p[f"m_torso_{b.name}"], -p[f"d_torso_{b.name}"],
+                  p.get(f"I_torso_{b.name}", 0.0), b.name, p.get(f"e_torso_{b.name}", 0.0))
+                 for b in s.torso]
+        m, c, inertia, ce = _combine("torso", parts)
+        height = max(max(-x[1] for x in parts), L / 10)
+        links.append(Link("torso", "hip", "torso_hip", 0.0, height, m, c, inertia, None, ce,
+                          up=True))
+        couplings = (Coupling("bisecting_hip", "torso_hip",
+                              tuple((f"{leg}_hip", 0.5) for leg in LEGS)),)
+    joint = {"swing": "leg1_hip", "stance": "leg2_hip", "torso": "torso_hip"}
+    link_of = {"swing": "leg1", "stance": "leg2", "torso": "torso"}
+    springs = []
+    for i, (first, second) in enumerate(s.springs):
+        k, r, c = p[f"k_s{i}"], p[f"r_s{i}"], p[f"c_s{i}"]
+        if k == 0 and c == 0:  # a torso spring's entry for the other leg's role
+            continue
+        springs.append(Spring(f"spring{len(springs)}", (link_of[first], link_of[second]),
+                              ((joint[second], 1.0), (joint[first], -1.0)), k, r, c))
+    if s.knee_spring:  # on each knee joint (the knee angle shank - thigh itself)
+        for leg in LEGS:
+            springs.append(Spring(f"{leg}_knee_spring", (f"{leg}_thigh", f"{leg}_shank"),
+                                  ((f"{leg}_knee", 1.0),), p["k_knee"], p["r_knee"],
+                                  p["c_knee"]))
     return Multibody(p.get("M_hip", 0.0), tuple(links), L, s.foot, R, s.knee, p["g"],
-                     data.slope_rad)
+                     data.slope_rad, tuple(springs), couplings)

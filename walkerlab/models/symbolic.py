@@ -333,6 +333,12 @@ def derive(structure: Structure) -> Equations:
         V += k_ * (delta - r_) ** 2 / 2
         Jd = sp.Matrix([[sp.diff(delta, s) for s in psv]])
         D += c_ * Jd.T * Jd
+    if structure.knee_spring:  # the swing knee's (the stance knee is straight, locked: its
+        # spring holds a constant energy and no torque the lock does not take, left out)
+        knee_angle = ps_shank - ps_sw
+        V += P["k_knee"] * (knee_angle - P["r_knee"]) ** 2 / 2
+        Jd = sp.Matrix([[sp.diff(knee_angle, s) for s in psv]])
+        D += P["c_knee"] * Jd.T * Jd
     G = sp.Matrix([sp.diff(V, s) for s in psv])
     C = sp.zeros(n, n)
     for i in range(n):
@@ -396,14 +402,14 @@ def derive(structure: Structure) -> Equations:
               "hip_height": (hip.T * normal)[0],
               "swing_clearance": (swing_contact.T * normal)[0]}
     leg_angles = {"stance": psi_st, "swing": psi_sw}
-    if structure.torso:
-        leg_angles["torso"] = psi_t.subs(sub)
     tied = {}
     if knee:
         guards["knee_extension"] = q[1] - q[0]  # zero when straight, > 0 hyperextended
         leg_angles = {"stance_thigh": psi_st, "stance_shank": psi_st, "swing_thigh": q[0],
                       "swing_shank": q[1]}
         tied = {1: 0, n + 1: n}
+    if structure.torso:  # on a kneed walker the bisector of the thighs
+        leg_angles["torso"] = psi_t.subs(sub)
 
     if knee or arc:  # the printed-equation variants exist for the point-foot compass gait only
         return Equations(

@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import BoundaryNorm, ListedColormap
 
+from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
 from walkerlab.sweep.bifurcation import fall_onset, onset_value, parameter_values
@@ -110,7 +111,7 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
     Parameters
     ----------
     sweep : dict
-        :func:`walkerlab.sweep.store.load_sweep` output; 2 axes.
+        :func:`walkerlab.io.sweep_store.load_sweep` output; 2 axes.
     x_path, y_path : str, optional
         Which axis is drawn along x / y (default: second axis on x, first on y).
     log_y : bool, optional
@@ -159,14 +160,7 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
     a1.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     im = a2.pcolormesh(xi, yi, wall, shading="nearest", cmap="viridis")
     fig.colorbar(im, ax=a2, label="wall time per point [s]")
-    import json
-
-    try:
-        unit_sys = (json.loads(sweep["attrs"]["scene_json"]).get("contact") or {}).get(
-            "unit_system", "mm-kg-s")
-    except (KeyError, ValueError, AttributeError):
-        unit_sys = "mm-kg-s"
-    ylab = _label(y_path).replace("len", "mm" if unit_sys == "mm-kg-s" else "m")
+    ylab = _label(y_path)
     for ax in (a1, a2):
         ax.set_xticks(xi, [f"{v:g}" for v in xv], fontsize=7)
         ax.set_yticks(yi, [f"{v:.3g}" for v in yv], fontsize=7)
@@ -179,7 +173,8 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
 
 
 _UNITS = {"slope.angle_deg": "slope φ [deg]", "slope.angle_rad": "slope φ [rad]",
-          "contact.stiffness": "contact stiffness k [N/len^e]",
+          **{f"contact.{name}": f"contact stiffness k [{unit}]"
+             for name, unit in CONTACT_QUANTITIES["stiffness"].values()},
           "contact.mu_static": "static friction μs [-]",
           "contact.mu_dynamic": "dynamic friction μd [-]"}
 
@@ -249,13 +244,9 @@ def gait_map_figure(data: dict):
         code[i, j] = (0 if st[i, j] else 1) if e else _REASON_CLASS.get(str(reason[i, j]), 6)
     attrs = data.attrs
     kind = str(attrs.get("kind", ""))
-    unit_sys = str(attrs.get("unit_system", "mm-kg-s"))
-    ylab = str(attrs.get("y_label", attrs.get("y_path", "y")))
-    units = Units(str(attrs.get("scene_units", "SI")))
-    if units.nondimensional and unit_sys != "mm-kg-s":  # the scene's lengths are in l
-        ylab = ylab.replace("[N/len^e]", f"[{units('N')}/{units('m')}^e]").replace(
-            "[m]", f"[{units('m')}]")
-    ylab = ylab.replace("len", "mm" if unit_sys == "mm-kg-s" else "m")
+    # the label names its unit (the field's); a nondimensional scene's SI units read in l, M, g
+    ylab = Units(str(attrs.get("scene_units", "SI")))(
+        str(attrs.get("y_label", attrs.get("y_path", "y"))))
     if kind == "stiffness":
         ylab += f", {attrs.get('stiffness_family', 'paper')} family"
     cmap = ListedColormap(GAIT_COLORS)
@@ -343,7 +334,7 @@ _COLUMN_LABELS = {"max_abs_multiplier": "max |Floquet multiplier|\n(dashed: 1)",
 
 def sweep_figure(data: dict, title: str = ""):
     """The main results of a sweep against its first swept field, from a loaded sweep
-    (:func:`walkerlab.sweep.store.load_sweep`).
+    (:func:`walkerlab.io.sweep_store.load_sweep`).
 
     One panel per main result column (:data:`walkerlab.report.sweep_text.MAIN_COLUMNS`);
     points that walk (outcome ``ok``) joined by a line, one line per value of the other
@@ -355,7 +346,7 @@ def sweep_figure(data: dict, title: str = ""):
     matplotlib.figure.Figure
     """
     from walkerlab.report.sweep_text import column_unit, main_columns
-    from walkerlab.sweep.store import field_unit
+    from walkerlab.units import field_unit
 
     units = Units(str(data["attrs"].get("scene_units", "SI")))
     pts = data["points"]
@@ -371,7 +362,7 @@ def sweep_figure(data: dict, title: str = ""):
     cols = main_columns(data)
     fig, axes = plt.subplots(max(len(cols), 1), 1, figsize=(6.4, 1.2 + 1.9 * max(len(cols), 1)),
                              sharex=True, constrained_layout=True, squeeze=False)
-    xunit = units(field_unit(xpath))
+    xunit = units(field_unit(xpath) or "-")
     xlabel = _label(xpath) if xpath in _UNITS else f"{xpath} [{xunit}]"
     for ax, c in zip(axes[:, 0], cols):
         y = np.asarray(pts[c], float)

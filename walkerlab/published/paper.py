@@ -74,6 +74,8 @@ STEP_LENGTH_M = 0.0342
 # Sec. 5 on Fig. 8: "the maximum error is around 10^-4" (angles and rates, MATLAB vs ADAMS).
 FIG8_MAX_ERROR = 1e-4
 # Sec. 4 / Fig. 4b: contact stiffness, damping, static and dynamic friction as printed
-# (no units printed; read in ADAMS's default mm-kg-s system by configs/paper.yaml).
-CONTACT = {"stiffness": 1e5, "max_damping": 90.0, "mu_static": 0.9, "mu_dynamic": 0.7}
+# (no units printed; read in ADAMS's default mm-kg-s system, the names configs/paper.yaml
+# writes them under).
+CONTACT = {"stiffness_n_per_mm_pow_e": 1e5, "max_damping_n_s_per_mm": 90.0, "mu_static": 0.9,
+           "mu_dynamic": 0.7}
 

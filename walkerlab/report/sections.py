@@ -342,9 +342,10 @@ def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
 
 # --------------------------------------------------------------------------- work-precision
 def _solver_text(scene, model: str) -> str:
-    from walkerlab.config import ContactSolverSettings
+    from walkerlab.config import SolverSettings
 
-    sv = scene.solver if model == "ideal" else (scene.contact_solver or ContactSolverSettings())
+    sv = (scene.solver if model == "ideal"
+          else scene.contact_solver or SolverSettings.for_contact())
     return f"{sv.method} rtol {sv.rtol:.0e}."
 
 

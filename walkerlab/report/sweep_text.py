@@ -38,7 +38,8 @@ def main_columns(data: dict) -> list[str]:
 def sweep_text(path: Path) -> str:
     """``5 points: ok 5``, then for each main result its range over the points that walk
     (``step_period_s 0.7036 .. 0.7343 s over slope.angle_deg 1 .. 3 deg``)."""
-    from walkerlab.sweep.store import field_unit, load_sweep
+    from walkerlab.io.sweep_store import load_sweep
+    from walkerlab.units import field_unit
 
     data = load_sweep(path)
     units = Units(str(data["attrs"].get("scene_units", "SI")))
@@ -50,7 +51,7 @@ def sweep_text(path: Path) -> str:
     for path_, _values in data["axes"]:
         v = np.asarray(data["points"][f"param/{path_}"])
         if v.dtype.kind in "fi" and v.size:
-            u = units(field_unit(path_) or "")
+            u = units(field_unit(path_) or "-")
             lines.append(f"  {path_:<28s} {num(np.min(v))} .. {num(np.max(v))}"
                          + (f" {u}" if u not in ("", "-") else ""))
     for c in main_columns(data):

@@ -135,8 +135,8 @@ def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True
     reported: Poincare maps per point (plain and variational, from the artifact) and, with
     ``cpu``, the CPU time per point of the same sweep run in this process (one worker).
     """
+    from walkerlab.io.sweep_store import load_sweep
     from walkerlab.stages.sweep import run
-    from walkerlab.sweep.store import load_sweep
 
     scene = _paper_scene()
     param = [f"slope.angle_deg={slopes}"]

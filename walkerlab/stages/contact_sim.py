@@ -87,7 +87,7 @@ def _compute(scene: Scene, fixedpoint: Path, adjust: bool, periodic: bool):
         fixed_point_names=fp.state_names, legs=LEGS,
         rate_names=[" ".join(rate_states(walker, leg)) for leg in LEGS],
         initial_rate_scale=np.asarray(scale if scale is not None else cs.initial_rate_scale),
-        stiffness_family=law.stiffness_family, unit_system=law.unit_system,
+        stiffness_family=law.stiffness_family,
         drop=drop_test(scene, walker.total_mass), drop_speed_m_per_s=DROP_SPEED,
         summary=run_summary(res), gait=gait, gait_error=gait_error, adjust=adj)
     return (lambda f: write_contact_sim(f, run)), run.summary

@@ -167,7 +167,8 @@ def _drop_figure(scene: Scene, runs_root, out_dir: Path, F) -> list[Path]:
     from walkerlab.plotting.sweep_figures import restitution_figure
 
     fig = restitution_figure(drop.stiffness, drop.restitution, unit=drop.unit,
-                             k_paper=float(scene.contact.stiffness), mass_kg=drop.mass_kg,
+                             k_paper=float(scene.contact.written("stiffness")[0]),
+                             mass_kg=drop.mass_kg,
                              units=for_scene(scene))
     return F.save(fig, out_dir, "drop_restitution")
 

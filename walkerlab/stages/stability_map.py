@@ -20,7 +20,6 @@ from walkerlab.io.schemas.stability_map import (
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 from walkerlab.sweep.stability import (
     CELL_FIELDS,
-    MAP_KINDS,
     MapSpec,
     default_spec,
     gait_map,
@@ -67,7 +66,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     time_limit_s = validate_option(CommandOptions, "stability_map_time_limit_s",
                                    float(time_limit_s), "--time-limit")
     terrain = scene.terrain
-    spec = spec or default_spec(kind, n, time_limit_s, stiffness=scene.contact.stiffness,
+    k, _, k_field = scene.contact.written("stiffness")
+    spec = spec or default_spec(kind, n, time_limit_s, stiffness=k, stiffness_field=k_field,
                                 patch_width_m=terrain.patch_width_m if terrain is not None
                                 else 0.10)
 
@@ -88,7 +88,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
 
         run = StabilityMapRun(spec, cells, frac, scene.contact.stiffness_family,
-                              scene.contact.unit_system, CELL_FIELDS, MAP_KINDS[spec.kind][1],
+                              CELL_FIELDS, spec.y_label,
                               (math.degrees(scene.slope.phi_rad),
                                _scene_value(scene, spec.y_path)))
         return (lambda f: write_stability_map(f, run)), summary
@@ -102,7 +102,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
 
 def _scene_value(scene: Scene, path: str) -> float:
-    """The scene's value of a map's y field (``contact.stiffness``; a missing optional
+    """The scene's value of a map's y field (``contact.mu_static``; a missing optional
     section at its default: ``terrain.patch_width_m`` 0.10); NaN if it has none."""
     from walkerlab.config import TerrainSettings
 

@@ -4,7 +4,6 @@
 - :mod:`walkerlab.sweep.outcomes`   typed outcomes and result columns per stage
 - :mod:`walkerlab.sweep.points`     point functions (fixedpoint, simulate, contact-sim)
 - :mod:`walkerlab.sweep.runner`     chunk planning (continuation), local / Dask executors
-- :mod:`walkerlab.sweep.store`      incremental HDF5 artifact (append, resume, finalize)
 - :mod:`walkerlab.sweep.bifurcation` period-doubling diagram of the ideal walker over the slope
 - :mod:`walkerlab.sweep.stability`  stability maps of the contact model
 

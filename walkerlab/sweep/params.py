@@ -1,7 +1,7 @@
 """Sweep parameters: parsing ``--param`` strings, building the grid, applying a point.
 
 A parameter is a dotted path into the scene mapping (``slope.angle_deg``,
-``contact.stiffness``, ``solver.rtol``; an item of a list by its ``name`` or index:
+``contact.stiffness_n_per_mm_pow_e``, ``solver.rtol``; an item of a list by its ``name`` or index:
 ``walker.leg.bodies.thigh_mass.mass_kg``, ``walker.leg.bodies.1.mass_kg``) and a list of
 values, given either as an inclusive range ``start:stop:step`` or as a comma list ``a,b,c``.
 A grid point is applied to the plain ``dict`` of the base scene and validated again through
@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from walkerlab.config import Scene, SceneError, scene_from_dict
+from walkerlab.config.contact import CONTACT_QUANTITIES, renamed_contact_field
 
 __all__ = ["SweepError", "ParamAxis", "parse_param", "grid_points", "apply_point",
            "check_axes", "axis_unit", "list_item", "params_hash", "EXCLUSIVE_FIELDS"]
@@ -31,8 +32,11 @@ class SweepError(ValueError):
     """A sweep cannot be set up (bad ``--param``, mismatched resume file); one-line message."""
 
 
-# Fields that exclude each other in the scene schema: setting one removes the other.
-EXCLUSIVE_FIELDS = {"slope.angle_deg": "slope.angle_rad", "slope.angle_rad": "slope.angle_deg"}
+# Fields that exclude each other in the scene schema: setting one removes the other (a
+# slope in degrees or radians; a contact quantity in mm-kg-s or SI, as its name says).
+EXCLUSIVE_FIELDS = {"slope.angle_deg": "slope.angle_rad", "slope.angle_rad": "slope.angle_deg",
+                    **{f"contact.{q[u][0]}": f"contact.{q[v][0]}"
+                       for q in CONTACT_QUANTITIES.values() for u, v in (("mm", "m"), ("m", "mm"))}}
 
 
 @dataclass(frozen=True)
@@ -270,6 +274,9 @@ def _check_path(scene: Scene, axis: ParamAxis):
         if cls.model_config.get("extra") == "allow":  # a state given by name
             return None
         fields = cls.model_fields
+        if k not in fields and renamed_contact_field(here):
+            raise SweepError(f"--param {axis.spec!r}: {here} is now "
+                             f"{renamed_contact_field(here)} (units in every field name)")
         if k not in fields:
             close = difflib.get_close_matches(k, list(fields), 1, 0.6)
             raise SweepError(f"--param {axis.spec!r}: unknown field {here}"
@@ -303,9 +310,9 @@ def takes_whole_numbers(scene: Scene, axis: ParamAxis) -> bool:
 
 
 def axis_unit(scene: Scene, axis: ParamAxis) -> str:
-    """SI unit of the field an axis sweeps: the field's ``unit`` metadata (contact
-    fields: ``<len>`` read in the scene's ``contact.unit_system``), else the suffix of its
-    name (:func:`walkerlab.units.field_unit`: ``mass_kg`` -> ``kg``), else ``"-"``.
+    """Unit of the field an axis sweeps: the field's ``unit`` metadata (contact fields:
+    ``stiffness_n_per_mm_pow_e`` -> ``N/mm^e``), else the suffix of its name
+    (:func:`walkerlab.units.field_unit`: ``mass_kg`` -> ``kg``), else ``"-"``.
 
     Raises
     ------
@@ -317,9 +324,6 @@ def axis_unit(scene: Scene, axis: ParamAxis) -> str:
     info = _check_path(scene, axis)
     extra = getattr(info, "json_schema_extra", None)
     unit = extra.get("unit") if isinstance(extra, dict) else None
-    if unit and "<len>" in unit:
-        system = getattr(getattr(scene, "contact", None), "unit_system", "SI")
-        unit = unit.replace("<len>", "mm" if system == "mm-kg-s" else "m")
     return unit or field_unit(axis.path) or "-"
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import json
 import math
 import threading
 import time
@@ -31,9 +32,9 @@ from walkerlab.integrate.ends import RUN_END_NAMES
 from walkerlab.sweep.outcomes import empty_row, state_column
 from walkerlab.sweep.params import apply_point
 
-__all__ = ["Task", "Continuation", "run_chunk", "fixedpoint_point", "simulate_point",
-           "contact_point", "contact_adapter", "ideal_fixed_point", "DEFAULT_OPTIONS",
-           "POINT_FUNCTIONS"]
+__all__ = ["Task", "Continuation", "guess_from_json", "guess_to_json", "run_chunk",
+           "fixedpoint_point", "simulate_point", "contact_point", "contact_adapter",
+           "ideal_fixed_point", "DEFAULT_OPTIONS", "POINT_FUNCTIONS"]
 
 DEFAULT_OPTIONS: dict[str, Any] = {
     "scuff_limit_m": None,   # rigid model: report 'scuff' if the swing foot dips deeper [m]
@@ -140,6 +141,31 @@ class Continuation:
         (v0, v1), (x0, x1), (J0, J1) = self.values, self.states, self.jacobians
         s = (v - v1) / (v1 - v0)
         return x1 + s * (x1 - x0), J1 + s * (J1 - J0)
+
+
+def guess_to_json(guess) -> str:
+    """JSON of a continuation state (:class:`Continuation` or None), as a sweep's partial
+    file stores it per chain; floats are written with ``repr`` precision, so it reads back
+    bit for bit."""
+    if guess is None:
+        return "null"
+    if isinstance(guess, np.ndarray):  # a bare state (the continuation of a state guess)
+        return json.dumps({"array": guess.tolist(), "dtype": guess.dtype.str})
+    return json.dumps({"values": list(guess.values),
+                       "states": [np.asarray(x, float).tolist() for x in guess.states],
+                       "jacobians": [np.asarray(j, float).tolist() for j in guess.jacobians],
+                       "target": guess.target})
+
+
+def guess_from_json(text: str):
+    """Inverse of :func:`guess_to_json` (data only: nothing in the file is executed)."""
+    d = json.loads(text)
+    if d is None:
+        return None
+    if "array" in d:
+        return np.asarray(d["array"], dtype=np.dtype(str(d["dtype"])))
+    return Continuation(tuple(d["values"]), tuple(np.asarray(x, float) for x in d["states"]),
+                        tuple(np.asarray(j, float) for j in d["jacobians"]), d["target"])
 
 
 def _real(value) -> float | None:

@@ -50,7 +50,7 @@ interleaving, so 785 of 1053 resumed rows differed by up to 2.8e-13 and 6 in
 a checkpoint per chain (points written, continuation state as exact JSON, hashed); a resumed
 chain continues from its checkpoint, so its rows are bit-identical to an uninterrupted run's
 with the same plan (the plan depends on the ``workers`` the sweep *started* with).  Every row
-is hashed as written (:func:`walkerlab.sweep.store.row_hashes`); a row or checkpoint that
+is hashed as written (:func:`walkerlab.io.sweep_store.row_hashes`); a row or checkpoint that
 does not match on resume drops its chain's rows and the chain is computed again.
 """
 
@@ -73,10 +73,23 @@ from walkerlab.config import MAX_SWEEP_POINTS, Scene
 from walkerlab.execution.executor import make_executor, run_chains
 from walkerlab.execution.workers import mp_context
 from walkerlab.io.artifacts import code_hash
-from walkerlab.sweep.outcomes import OUTCOMES, STAGES
+from walkerlab.io.sweep_store import (
+    SweepColumns,
+    SweepFileError,
+    SweepStore,
+    complete_sweep,
+    partial_path,
+)
+from walkerlab.sweep.outcomes import OUTCOMES, STAGES, STRING_COLUMNS, walker_columns
 from walkerlab.sweep.params import ParamAxis, SweepError, grid_points
-from walkerlab.sweep.points import DEFAULT_OPTIONS, Task, evaluate, warm_up
-from walkerlab.sweep.store import SweepStore, complete_sweep, partial_path
+from walkerlab.sweep.points import (
+    DEFAULT_OPTIONS,
+    Task,
+    evaluate,
+    guess_from_json,
+    guess_to_json,
+    warm_up,
+)
 
 __all__ = ["base_value", "plan_chunks", "run_sweep", "iter_piece_results", "run_piece",
            "sweep_executor", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
@@ -254,7 +267,7 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
               progress: bool = True,
               on_chunk: Callable[[int, int], None] | None = None,
               pool: bool | None = None) -> Path:
-    """Run a sweep and write its artifact (see :mod:`walkerlab.sweep.store`).
+    """Run a sweep and write its artifact (see :mod:`walkerlab.io.sweep_store`).
 
     Parameters
     ----------
@@ -321,6 +334,30 @@ def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
                            chunk_size, progress, on_chunk, pool, n_total)
 
 
+def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_chains):
+    """The sweep's partial file: resumed (its plan and each chain's checkpoint) or created
+    with a new plan of ``n_chains`` chains.
+
+    Raises
+    ------
+    SweepError
+        A partial file that cannot be resumed (one line).
+    """
+    columns = SweepColumns(STRING_COLUMNS, walker_columns(stage, scene), OUTCOMES)
+    if resume and partial_path(out_path).is_file():
+        # the chunk plan of the interrupted run (not re-planned from what is left: a point's
+        # continuation guess, hence its row, depends on the chain it is in, issue 19 item 13)
+        try:
+            return SweepStore.resume(out_path, axes, columns, key, guess_from_json,
+                                     tell=_progress.note)
+        except SweepFileError as exc:
+            raise SweepError(str(exc)) from None
+    base = scene.model_dump(mode="json")
+    plan = [[i for i, _ in c] for c in plan_chunks(axes, base, frozenset(), chunk_size,
+                                                   n_chains)]
+    return SweepStore.create(out_path, scene, stage, axes, columns, opts, key, plan), plan, {}
+
+
 def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, chunk_size,
                 progress, on_chunk, pool, n_total) -> Path:
     paths = [a.path for a in axes]
@@ -330,16 +367,9 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
     if resume and out_path.is_file() and not partial_path(out_path).is_file():
         if complete_sweep(out_path, key):
             return out_path
-    start: dict = {}
-    if resume and partial_path(out_path).is_file():
-        # the chunk plan of the interrupted run (not re-planned from what is left: a point's
-        # continuation guess, hence its row, depends on the chain it is in, issue 19 item 13)
-        store, plan, start = SweepStore.resume(out_path, stage, axes, key, tell=_progress.note)
-    else:
-        plan = [[i for i, _ in c] for c in
-                plan_chunks(axes, base, frozenset(), chunk_size,
-                            1 if scheduler is None and workers <= 1 else max(2, workers))]
-        store = SweepStore.create(out_path, scene, stage, axes, opts, key, plan)
+    store, plan, start = _open_store(scene, axes, stage, out_path, resume, opts, key,
+                                     chunk_size, 1 if scheduler is None and workers <= 1
+                                     else max(2, workers))
     values_of = dict(enumerate(grid_points(axes)))
     origin = scene.name or "<scene>"
     offset = [start.get(c, (0, None))[0] for c in range(len(plan))]
@@ -362,7 +392,7 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
         # rows and checkpoints, then one flush: the file is consistent between writes
         store.append(pending, values_of, flush=False)
         for c, (n, g) in marks.items():
-            store.checkpoint(c, n, g, key)
+            store.checkpoint(c, n, guess_to_json(g), key)
         store.flush()
         marks.clear()
         n_written += len(pending)
@@ -387,7 +417,7 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
                     if on_chunk is not None:
                         on_chunk(n_written, n_total)
     except BaseException:
-        if pending and store.f.id.valid:
+        if pending and store.is_open:
             try:
                 write()  # rows computed before the interruption are kept for --resume
             except Exception:  # noqa: BLE001 - the original error is the one to report
@@ -398,4 +428,7 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
     if pending:  # an executor that stopped early (the rows it gave are kept)
         write()
     store.add_wall_time(time.perf_counter() - t0)
-    return store.finalize(n_total)
+    try:
+        return store.finalize(n_total)
+    except SweepFileError as exc:
+        raise SweepError(str(exc)) from None

@@ -30,9 +30,10 @@ import numpy as np
 __all__ = ["MAP_KINDS", "CELL_FIELDS", "REASONS", "MapSpec", "default_spec", "gait_row",
            "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS"]
 
-#: map kind -> (dotted scene path of the y axis, label)
+#: map kind -> (dotted scene path of the y axis, label); the stiffness map varies the field
+#: the scene writes its stiffness in (:attr:`MapSpec.y_field`; this one by default)
 MAP_KINDS = {
-    "stiffness": ("contact.stiffness", "contact stiffness k [N/len^e]"),
+    "stiffness": ("contact.stiffness_n_per_mm_pow_e", "contact stiffness k [N/mm^e]"),
     "friction": ("contact.mu_static", "static friction mu_s [-] (mu_d = 7/9 mu_s)"),
     "patch_width": ("terrain.patch_width_m", "patch width [m]"),
 }
@@ -65,16 +66,31 @@ class MapSpec:
         Slopes [deg] (x axis).
     time_limit_s : float
         Wall-time limit per cell [s].
+    y_field : str, optional
+        Contact field of a stiffness map (``stiffness_n_per_mm_pow_e`` or
+        ``stiffness_n_per_m_pow_e``: the one the scene writes; None: the first).
     """
 
     kind: str
     y_values: tuple
     slopes_deg: tuple
     time_limit_s: float = 60.0
+    y_field: str | None = None
 
     @property
     def y_path(self) -> str:
-        return MAP_KINDS[self.kind][0]
+        """Dotted scene path of the y axis."""
+        return f"contact.{self.y_field}" if self.y_field else MAP_KINDS[self.kind][0]
+
+    @property
+    def y_label(self) -> str:
+        """Axis label of the y parameter, with its unit."""
+        if self.kind == "stiffness" and self.y_field:
+            from walkerlab.config.contact import CONTACT_QUANTITIES
+
+            unit = dict(CONTACT_QUANTITIES["stiffness"].values())[self.y_field]
+            return f"contact stiffness k [{unit}]"
+        return MAP_KINDS[self.kind][1]
 
     def key(self) -> str:
         """Text that identifies the spec (part of the stage's input hash)."""
@@ -84,7 +100,8 @@ class MapSpec:
 
 
 def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0,
-                 stiffness: float = 1e5, patch_width_m: float = 0.10) -> MapSpec:
+                 stiffness: float = 1e5, patch_width_m: float = 0.10,
+                 stiffness_field: str | None = None) -> MapSpec:
     """The default ``n x n`` grid of a map kind (slopes 0.5-4 deg), its y axis around the
     scene's own value: stiffness ``stiffness`` x 1e-2 ... 1e4 (log), patch width
     ``patch_width_m`` x 0.2 ... 2, static friction 0.1 ... 0.9.  The paper's scene (k = 1e5
@@ -93,9 +110,11 @@ def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0,
     Parameters
     ----------
     stiffness : float
-        The scene's contact stiffness (scene units, ``contact.stiffness``).
+        The scene's contact stiffness as written (in the unit of its field).
     patch_width_m : float
         The scene's patch width (scene length unit, ``terrain.patch_width_m``).
+    stiffness_field : str, optional
+        The contact field the scene writes its stiffness in (:attr:`MapSpec.y_field`).
 
     Raises
     ------
@@ -108,7 +127,8 @@ def default_spec(kind: str, n: int = 8, time_limit_s: float = 60.0,
     lk = np.log10(stiffness)
     ys = {"stiffness": np.logspace(lk - 2, lk + 4, n), "friction": np.linspace(0.1, 0.9, n),
           "patch_width": np.linspace(0.2 * patch_width_m, 2.0 * patch_width_m, n)}[kind]
-    return MapSpec(kind, tuple(float(v) for v in np.round(ys, 6)), slopes, time_limit_s)
+    return MapSpec(kind, tuple(float(v) for v in np.round(ys, 6)), slopes, time_limit_s,
+                   stiffness_field if kind == "stiffness" else None)
 
 
 def _cell_scene(base: dict, spec: MapSpec, y: float, slope_deg: float):

@@ -61,10 +61,9 @@ class ContactSimRun:
     initial_rate_scale : ndarray (2,)
         Multipliers used (the scene's or ``--adjust``'s).
     stiffness_family : str
-    unit_system : str
-        The contact section's unit system ("mm-kg-s" or SI).
     drop : dict
-        Drop test (:func:`walkerlab.analysis.contact_drop.restitution_curve`).
+        Drop test (:func:`walkerlab.analysis.contact_record.drop_test`; stiffnesses in its
+        ``unit``, the unit the scene writes its stiffness in).
     drop_speed_m_per_s : float
     summary : dict
     gait, gait_error : periodic contact gait or its error (or None)
@@ -83,7 +82,6 @@ class ContactSimRun:
     rate_names: list
     initial_rate_scale: np.ndarray
     stiffness_family: str
-    unit_system: str
     drop: dict
     drop_speed_m_per_s: float
     summary: dict
@@ -118,8 +116,7 @@ def _write_outcome_and_drop(f, run: ContactSimRun) -> None:
                          f"flat ground at {run.drop_speed_m_per_s} m/s, no gravity "
                          "(walkerlab.analysis.contact_drop); restitution = v_out / v_in")
     g.attrs["mass_kg"] = float(walker.total_mass)
-    lu = "mm" if run.unit_system == "mm-kg-s" else "m"
-    coordinate(g, "stiffness", drop["stiffness"], f"N/{lu}^e",
+    coordinate(g, "stiffness", drop["stiffness"], drop["unit"],
                "IMPACT stiffness in the scene's unit system")
     k = ("stiffness",)
     for fam in ("paper", "rigid_limit"):

@@ -2,7 +2,7 @@
 contact parameter × the slope (writer and loader side by side).
 
 Layout: root attributes ``kind``, ``y_path`` (the scene field varied), ``y_label``,
-``stiffness_family``, ``unit_system``, ``time_limit_s``, ``method``; ``y_values`` (ny,)
+``stiffness_family``, ``time_limit_s``, ``method``; ``y_values`` (ny,)
 and ``slopes_deg`` (nx,) [deg]; one (ny, nx) array per cell field
 (:data:`walkerlab.sweep.stability.CELL_FIELDS`: ``exists``, ``stable``,
 ``max_abs_multiplier``, ``step_period_s`` [s], ``patch_margin_m`` [m], ``residual``,
@@ -35,10 +35,10 @@ class StabilityMapRun:
     cell_fields : tuple of str
         The per-cell arrays written, in order (:data:`walkerlab.sweep.stability.CELL_FIELDS`).
     y_label : str
-        Axis label of the varied parameter.
+        Axis label of the varied parameter, with its unit.
     fractions : dict[str, float]
         :func:`walkerlab.sweep.stability.stable_fraction` of the cells.
-    stiffness_family, unit_system : str
+    stiffness_family : str
         Of the scene's contact law.
     scene_point : (float, float), optional
         The scene's own slope [deg] and y value (``scene_slope_deg``, ``scene_y``).
@@ -48,7 +48,6 @@ class StabilityMapRun:
     cells: dict
     fractions: dict
     stiffness_family: str
-    unit_system: str
     cell_fields: tuple = ()
     y_label: str = ""
     #: the scene's own point (slope [deg], y in the map's unit), marked on the map
@@ -61,7 +60,6 @@ def write_stability_map(f, run: StabilityMapRun) -> None:
     f.attrs["y_path"] = run.spec.y_path
     f.attrs["y_label"] = run.y_label
     f.attrs["stiffness_family"] = run.stiffness_family
-    f.attrs["unit_system"] = run.unit_system
     f.attrs["time_limit_s"] = run.spec.time_limit_s
     if run.scene_point is not None:  # marked on the map wherever the grid lies
         f.attrs["scene_slope_deg"], f.attrs["scene_y"] = (float(v) for v in run.scene_point)

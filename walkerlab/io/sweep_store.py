@@ -1,5 +1,9 @@
 """Incremental HDF5 store of a sweep: rows appended as points finish, finalized at the end.
 
+The sweep package (:mod:`walkerlab.sweep.runner`) decides what a row holds
+(:class:`SweepColumns`) and what a continuation is; this module only reads and writes the
+file (no ``h5py`` outside :mod:`walkerlab.io`).
+
 Layout (``stage`` attribute ``"sweep"``; every dataset has ``unit`` and ``description``)::
 
     /                      attrs: stage, walkerlab_version, scene_name, scene_json, input_hash,
@@ -45,6 +49,7 @@ import datetime as _dt
 import hashlib
 import json
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -52,12 +57,36 @@ import numpy as np
 
 import walkerlab
 from walkerlab.io import netcdf
-from walkerlab.sweep.outcomes import OUTCOMES, STRING_COLUMNS, walker_columns
-from walkerlab.sweep.params import ParamAxis, SweepError
+from walkerlab.units import field_unit
 
-__all__ = ["SweepStore", "partial_path", "load_sweep", "complete_sweep"]
+__all__ = ["SweepColumns", "SweepFileError", "SweepStore", "complete_sweep", "load_sweep",
+           "partial_path", "row_hashes"]
 
 STR = h5py.string_dtype()
+
+
+class SweepFileError(ValueError):
+    """A partial sweep file cannot be resumed or finalized (one-line message)."""
+
+
+@dataclass(frozen=True)
+class SweepColumns:
+    """The row layout of a sweep file, as the sweep package defines it
+    (:mod:`walkerlab.sweep.outcomes`).
+
+    Attributes
+    ----------
+    strings : dict
+        String column name -> description (``outcome``, ``message``, ...).
+    floats : dict
+        Float column name -> ``(unit, description)`` (the stage's result columns).
+    outcomes : tuple of str
+        Outcome kinds counted in ``/summary/outcome_counts``.
+    """
+
+    strings: dict
+    floats: dict
+    outcomes: tuple
 
 
 def partial_path(final: Path) -> Path:
@@ -70,16 +99,9 @@ def _param_key(path: str) -> str:
     return path.replace("/", "_")
 
 
-#: unit suffixes of scene field names (units live in the names, ``slope.angle_deg``)
-_UNIT_SUFFIXES = (("_kg_m2", "kg m^2"), ("_m_per_s2", "m/s^2"), ("_m_per_s", "m/s"),
-                  ("_rad_per_s", "rad/s"), ("_deg", "deg"), ("_rad", "rad"), ("_kg", "kg"),
-                  ("_mm", "mm"), ("_m", "m"), ("_hz", "Hz"), ("_s", "s"))
-
-
-def field_unit(path: str) -> str:
-    """Unit of a scene field from its name (``slope.angle_deg`` -> ``deg``; ``"-"``: none)."""
-    leaf = path.rsplit(".", 1)[-1].lower()
-    return next((u for suf, u in _UNIT_SUFFIXES if leaf.endswith(suf)), "-")
+def _unit(path: str) -> str:
+    """Unit of a swept scene field from its name (``slope.angle_deg`` -> ``deg``; ``-``)."""
+    return field_unit(path) or "-"
 
 
 _BOOKKEEPING = ("row_hash",)
@@ -124,52 +146,97 @@ def row_hashes(columns: dict[str, np.ndarray], key: str) -> list[str]:
     return out
 
 
-def guess_to_json(guess) -> str:
-    """JSON of a continuation state (:class:`walkerlab.sweep.points.Continuation` or None);
-    floats are written with ``repr`` precision, so it reads back bit for bit."""
-    if guess is None:
-        return "null"
-    if isinstance(guess, np.ndarray):  # a bare state (the continuation of a state guess)
-        return json.dumps({"array": guess.tolist(), "dtype": guess.dtype.str})
-    return json.dumps({"values": list(guess.values),
-                       "states": [np.asarray(x, float).tolist() for x in guess.states],
-                       "jacobians": [np.asarray(j, float).tolist() for j in guess.jacobians],
-                       "target": guess.target})
-
-
-def guess_from_json(text: str):
-    """Inverse of :func:`guess_to_json` (data only: nothing in the file is executed)."""
-    d = json.loads(text)
-    if d is None:
-        return None
-    if "array" in d:
-        return np.asarray(d["array"], dtype=np.dtype(str(d["dtype"])))
-    from walkerlab.sweep.points import Continuation
-
-    return Continuation(tuple(d["values"]), tuple(np.asarray(x, float) for x in d["states"]),
-                        tuple(np.asarray(j, float) for j in d["jacobians"]), d["target"])
-
-
 def _chain_check(chain: int, done: int, guess: str, key: str) -> str:
     return hashlib.sha256(f"{key}|{chain}|{done}|{guess}".encode()).hexdigest()
 
 
-class SweepStore:
-    """An open in-progress sweep file (use :meth:`create` or :meth:`resume`)."""
+def _checkpoints(f: h5py.File, n_chains: int) -> tuple[np.ndarray, list[str], list[str]]:
+    """Points done, continuation JSON and check of each chain of an open partial file
+    (rewritten as chains advance); unreadable ones are replaced: every chain restarts."""
+    try:
+        return (f["plan/done"][()],
+                [x.decode() if isinstance(x, bytes) else str(x) for x in f["plan/guess"][()]],
+                [x.decode() if isinstance(x, bytes) else str(x) for x in f["plan/check"][()]])
+    except (KeyError, ValueError, OSError):
+        for name in ("plan/done", "plan/guess", "plan/check"):
+            if name in f:
+                del f[name]
+        f.create_dataset("plan/done", data=np.zeros(n_chains, np.int64))
+        f.create_dataset("plan/guess", data=np.array(["null"] * n_chains, dtype=object),
+                         dtype=STR)
+        f.create_dataset("plan/check", data=np.array(["?"] * n_chains, dtype=object),
+                         dtype=STR)
+        return np.zeros(n_chains, np.int64), [], []
 
-    def __init__(self, final: Path, f: h5py.File, stage: str, axes: list[ParamAxis]):
+
+def _intact_chains(plan: list[list[int]], checkpoints: tuple, valid: set[int],
+                   present: set[int], input_hash: str, parse_guess):
+    """The chains that continue from their checkpoint: ``(start, keep, restarted)`` with
+    ``start`` chain -> (points done, continuation), ``keep`` the grid indices of their rows
+    and ``restarted`` the number of chains with rows that start again."""
+    ndone, guesses, checks = checkpoints
+    start: dict = {}
+    keep_idx: set[int] = set()
+    restarted = 0
+    for c, chain in enumerate(plan):
+        n = int(ndone[c]) if c < len(ndone) else 0
+        ok = (c < len(checks) and 0 <= n <= len(chain)
+              and checks[c] == _chain_check(c, n, guesses[c], input_hash)
+              and all(i in valid for i in chain[:n]))
+        if ok and n > 0:
+            try:
+                start[c] = (n, parse_guess(guesses[c]))
+            except (ValueError, KeyError, TypeError):
+                ok = False
+        if ok:
+            keep_idx.update(chain[:n])
+        elif any(i in present for i in chain):
+            restarted += 1
+    return start, keep_idx, restarted
+
+
+def _drop_rows(f: h5py.File, dsets: dict, cols: dict, keep: np.ndarray, restart: list[int],
+               input_hash: str) -> None:
+    """Keep only the rows ``keep`` of every column and reset the checkpoints of the chains
+    ``restart`` (they are computed again from their start)."""
+    for name, ds in dsets.items():
+        v = cols[name][keep]
+        ds.resize((int(keep.sum()),))
+        ds[...] = v
+    for c in restart:
+        f["plan/done"][c] = 0
+        f["plan/guess"][c] = "null"
+        f["plan/check"][c] = _chain_check(c, 0, "null", input_hash)
+    f.flush()
+
+
+class SweepStore:
+    """An open in-progress sweep file (use :meth:`create` or :meth:`resume`).
+
+    ``axes`` are the sweep's axes (:class:`walkerlab.sweep.params.ParamAxis`: ``path``,
+    ``values``, ``spec``, ``numeric``, ``len``); ``columns`` its row layout."""
+
+    def __init__(self, final: Path, f: h5py.File, axes: list, columns: SweepColumns):
         self.final = Path(final)
         self.f = f
-        self.stage = stage
         self.axes = axes
+        self.columns = columns
 
     # ------------------------------------------------------------------ open
     @classmethod
-    def create(cls, final: Path, scene, stage: str, axes: list[ParamAxis], options: dict,
-               input_hash: str, plan: list[list[int]] | None = None) -> SweepStore:
+    def create(cls, final: Path, scene, stage: str, axes: list, columns: SweepColumns,
+               options: dict, input_hash: str,
+               plan: list[list[int]] | None = None) -> SweepStore:
         """Start a new partial file (an old one is overwritten).
 
-        ``plan``: the chains of grid indices, in evaluation order (stored for resume).
+        ``scene`` (a :class:`walkerlab.config.Scene`) is stored as JSON; ``stage`` names the
+        stage each point runs; ``plan``: the chains of grid indices, in evaluation order
+        (stored for resume).
+
+        Raises
+        ------
+        walkerlab.io.artifacts.ArtifactError
+            The partial file cannot be created (one line).
         """
         from walkerlab.io.artifacts import ArtifactError
 
@@ -198,7 +265,7 @@ class SweepStore:
             data = np.asarray(a.values, float) if a.numeric else \
                 np.asarray([str(v) for v in a.values], dtype=STR)
             ds = f.create_dataset(f"grid/{_param_key(a.path)}", data=data)
-            ds.attrs.update(axis=i, path=a.path, spec=a.spec, unit=field_unit(a.path),
+            ds.attrs.update(axis=i, path=a.path, spec=a.spec, unit=_unit(a.path),
                             description=f"values of {a.path}")
         g = f.create_group("points")
 
@@ -209,13 +276,13 @@ class SweepStore:
         mk("index", np.int64, "-", "flat grid index (C order, first axis slowest)")
         for a in axes:
             mk(f"param/{_param_key(a.path)}", np.float64 if a.numeric else STR,
-               field_unit(a.path) if a.numeric else "-",
+               _unit(a.path) if a.numeric else "-",
                f"value of {a.path}")
             g[f"param/{_param_key(a.path)}"].attrs["path"] = a.path
-        for name, desc in STRING_COLUMNS.items():
+        for name, desc in columns.strings.items():
             mk(name, STR, "-", desc)
         mk("wall_time_s", np.float64, "s", "wall time of the point on its worker")
-        for name, (unit, desc) in walker_columns(stage, scene).items():
+        for name, (unit, desc) in columns.floats.items():
             mk(name, np.float64, unit, desc)
         mk("row_hash", STR, "-", "SHA-256 of the row and the input hash (resume check)")
         from walkerlab.units import for_scene, relabel_artifact
@@ -233,12 +300,15 @@ class SweepStore:
             [_chain_check(c, 0, "null", input_hash) for c in range(len(plan))], dtype=object),
             dtype=STR)
         f.flush()
-        return cls(final, f, stage, axes)
+        return cls(final, f, axes, columns)
 
     @classmethod
-    def resume(cls, final: Path, stage: str, axes: list[ParamAxis],
-               input_hash: str, tell=None) -> tuple[SweepStore, list[list[int]], dict]:
+    def resume(cls, final: Path, axes: list, columns: SweepColumns, input_hash: str,
+               parse_guess, tell=None) -> tuple[SweepStore, list[list[int]], dict]:
         """Reopen a partial file after checking every row and chain checkpoint.
+
+        ``parse_guess`` reads a checkpoint's continuation JSON (a chain whose continuation
+        does not parse starts again); ``tell`` receives a one-line note of dropped rows.
 
         Returns
         -------
@@ -251,7 +321,7 @@ class SweepStore:
 
         Raises
         ------
-        SweepError
+        SweepFileError
             Unreadable partial file, or one written for another sweep (other scene,
             parameters, stage, options or code).
         """
@@ -261,11 +331,11 @@ class SweepStore:
         try:
             f = h5py.File(part, "a")
         except OSError:
-            raise SweepError(f"{part}: damaged partial sweep file; rerun without --resume") \
+            raise SweepFileError(f"{part}: damaged partial sweep file; rerun without --resume") \
                 from None
         if f.attrs.get("input_hash") != input_hash:
             f.close()
-            raise SweepError(f"{part}: partial file of a different sweep (scene, parameters, "
+            raise SweepFileError(f"{part}: partial file of a different sweep (scene, parameters, "
                              "stage, options or code changed); rerun without --resume")
         try:
             g = f["points"]
@@ -277,46 +347,15 @@ class SweepStore:
             plan = [[int(i) for i in order[a:b]] for a, b in zip(starts[:-1], starts[1:])]
         except (KeyError, ValueError, OSError):
             f.close()
-            raise SweepError(f"{part}: damaged partial sweep file; rerun without --resume") \
+            raise SweepFileError(f"{part}: damaged partial sweep file; rerun without --resume") \
                 from None
-        try:  # checkpoints (rewritten as chains advance): unreadable = every chain restarts
-            ndone = f["plan/done"][()]
-            guesses = [x.decode() if isinstance(x, bytes) else str(x)
-                       for x in f["plan/guess"][()]]
-            checks = [x.decode() if isinstance(x, bytes) else str(x)
-                      for x in f["plan/check"][()]]
-        except (KeyError, ValueError, OSError):
-            ndone, guesses, checks = np.zeros(len(plan), np.int64), [], []
-            for name in ("plan/done", "plan/guess", "plan/check"):
-                if name in f:
-                    del f[name]
-            f.create_dataset("plan/done", data=np.zeros(len(plan), np.int64))
-            f.create_dataset("plan/guess", data=np.array(["null"] * len(plan), dtype=object),
-                             dtype=STR)
-            f.create_dataset("plan/check", data=np.array(["?"] * len(plan), dtype=object),
-                             dtype=STR)
+        ndone, guesses, checks = _checkpoints(f, len(plan))
         stored = [x.decode() if isinstance(x, bytes) else str(x) for x in cols["row_hash"]]
         good_row = np.array([a == b for a, b in zip(row_hashes(cols, input_hash), stored)],
                             bool)
         valid = {int(i) for i, ok in zip(idx, good_row) if ok}
-        start: dict = {}
-        keep_idx: set[int] = set()
-        restarted = 0
-        present = set(idx.tolist())
-        for c, chain in enumerate(plan):
-            n = int(ndone[c]) if c < len(ndone) else 0
-            ok = (c < len(checks) and 0 <= n <= len(chain)
-                  and checks[c] == _chain_check(c, n, guesses[c], input_hash)
-                  and all(i in valid for i in chain[:n]))
-            if ok and n > 0:
-                try:
-                    start[c] = (n, guess_from_json(guesses[c]))
-                except (ValueError, KeyError, TypeError):
-                    ok = False
-            if ok:
-                keep_idx.update(chain[:n])
-            elif any(i in present for i in chain):
-                restarted += 1
+        start, keep_idx, restarted = _intact_chains(
+            plan, (ndone, guesses, checks), valid, set(idx.tolist()), input_hash, parse_guess)
         keep = np.array([int(i) in keep_idx for i in idx], bool)
         # one row per index: a chain's rows past its checkpoint are computed again
         _, first = np.unique(idx, return_index=True)
@@ -332,22 +371,13 @@ class SweepStore:
             if tell is not None:
                 tell(msg)
         if not keep.all():
-            for name, ds in dsets.items():
-                v = cols[name][keep]
-                ds.resize((int(keep.sum()),))
-                ds[...] = v
-            for c in range(len(plan)):
-                if c not in start:
-                    f["plan/done"][c] = 0
-                    f["plan/guess"][c] = "null"
-                    f["plan/check"][c] = _chain_check(c, 0, "null", input_hash)
-            f.flush()
-        return cls(final, f, stage, axes), plan, start
+            _drop_rows(f, dsets, cols, keep, [c for c in range(len(plan)) if c not in start],
+                       input_hash)
+        return cls(final, f, axes, columns), plan, start
 
-    def checkpoint(self, chain: int, done: int, guess, key: str) -> None:
+    def checkpoint(self, chain: int, done: int, text: str, key: str) -> None:
         """Record that the first ``done`` points of ``chain`` are written and the
-        continuation after them (call after :meth:`append` of those rows)."""
-        text = guess_to_json(guess)
+        continuation after them as JSON ``text`` (call after :meth:`append` of those rows)."""
         self.f["plan/done"][chain] = done
         self.f["plan/guess"][chain] = text
         self.f["plan/check"][chain] = _chain_check(chain, done, text, key)
@@ -358,7 +388,8 @@ class SweepStore:
 
     # ------------------------------------------------------------------ write
     def append(self, rows: list[dict], values_of: dict[int, tuple], flush: bool = True) -> None:
-        """Append rows (dicts from :func:`walkerlab.sweep.points.evaluate`) and flush."""
+        """Append rows (dicts from :func:`walkerlab.sweep.points.evaluate`; ``values_of``:
+        grid index -> the point's axis values) and flush."""
         if not rows:
             return
         g = self.f["points"]
@@ -375,10 +406,10 @@ class SweepStore:
             vals = [values_of[r["index"]][k] for r in rows]
             put(f"param/{_param_key(a.path)}", np.asarray(vals, float) if a.numeric
                 else np.asarray([str(v) for v in vals], dtype=object))
-        for name in STRING_COLUMNS:
+        for name in self.columns.strings:
             put(name, np.asarray([str(r.get(name, "")) for r in rows], dtype=object))
         put("wall_time_s", np.array([r["wall_time_s"] for r in rows], float))
-        fixed = {"index", "wall_time_s", "row_hash", *STRING_COLUMNS}
+        fixed = {"index", "wall_time_s", "row_hash", *self.columns.strings}
         for name, ds in g.items():  # the stage's float columns, as created for this walker
             if isinstance(ds, h5py.Dataset) and name not in fixed:
                 put(name, np.array([r.get(name, np.nan) for r in rows], float))
@@ -395,6 +426,11 @@ class SweepStore:
         self.f.attrs["wall_time_s"] = float(self.f.attrs["wall_time_s"]) + float(seconds)
         self.f.flush()
 
+    @property
+    def is_open(self) -> bool:
+        """Whether the partial file is still open."""
+        return bool(self.f.id.valid)
+
     def close(self) -> None:
         """Close without finalizing (the partial file stays for ``resume``)."""
         if self.f.id.valid:
@@ -405,7 +441,7 @@ class SweepStore:
 
         Raises
         ------
-        SweepError
+        SweepFileError
             Fewer distinct rows than ``n_expected`` grid points (the partial file is kept
             for ``--resume``; a half-done sweep is never reported as done).
         """
@@ -415,7 +451,7 @@ class SweepStore:
             n_rows = np.unique(g["index"][()]).size
             if n_rows != n_expected:
                 f.close()
-                raise SweepError(f"{partial_path(self.final)}: only {n_rows} of {n_expected} "
+                raise SweepFileError(f"{partial_path(self.final)}: only {n_rows} of {n_expected} "
                                  "grid points have a row; rerun with --resume")
         order = np.argsort(g["index"][()], kind="stable")
 
@@ -425,13 +461,14 @@ class SweepStore:
 
         g.visititems(visit)
         outc = [o.decode() if isinstance(o, bytes) else str(o) for o in g["outcome"][()]]
-        counts = np.array([outc.count(o) for o in OUTCOMES], np.int64)
+        outcomes = list(self.columns.outcomes)
+        counts = np.array([outc.count(o) for o in outcomes], np.int64)
         if "summary" in f:
             del f["summary"]
-        netcdf.coordinate(f.create_group("summary"), "outcome_kind", list(OUTCOMES), "-",
+        netcdf.coordinate(f.create_group("summary"), "outcome_kind", outcomes, "-",
                           "outcome of a point (walkerlab.sweep.outcomes)")
         ds = f.create_dataset("summary/outcome_counts", data=counts)
-        ds.attrs.update(outcomes=list(OUTCOMES), unit="-", description="points per outcome")
+        ds.attrs.update(outcomes=outcomes, unit="-", description="points per outcome")
         netcdf.attach(ds, ("outcome_kind",))
         f.attrs["complete"] = True
         for name in ("plan", "points/row_hash"):  # resume bookkeeping

@@ -1,0 +1,178 @@
+"""Integrate a plain ODE until an event, or on a time grid, with the one :class:`Solver`.
+
+The analyses that integrate something other than a rigid step or a contact run (the contact
+model's step map between two mid-stances, :mod:`walkerlab.analysis.contact_periodic`; the
+drop test of a contact law, :mod:`walkerlab.analysis.contact_drop`) call these two functions
+instead of scipy's integrators, so every integration goes through this package with a
+:class:`~walkerlab.integrate.solver.Solver` and says how it ended with a
+:class:`~walkerlab.integrate.ends.RunEnd`:
+
+- :func:`run_to_event`: ``scipy.integrate.solve_ivp`` with terminal events located by its
+  root finder (``method="odeint"`` runs LSODA there);
+- :func:`odeint_grid`: ``scipy.integrate.odeint`` (LSODA with little per-step overhead) on a
+  time grid.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.integrate.ends import RunEnd
+from walkerlab.integrate.solver import Solver
+
+__all__ = ["Event", "EventRun", "MXSTEP", "odeint_grid", "run_to_event"]
+
+#: Most internal steps odeint may take between two grid times.
+MXSTEP = 500000
+
+
+@dataclass(frozen=True)
+class Event:
+    """A terminal event of :func:`run_to_event`.
+
+    Attributes
+    ----------
+    name : str
+        What the crossing is (``"mid_stance"``, ``"fall"``, ``"separation"``).
+    function : callable
+        ``(t, y) -> float``; the event is its zero crossing.
+    direction : float
+        Crossing direction as in ``solve_ivp`` (+1 rising, -1 falling, 0 both).
+    end : RunEnd
+        How the run ended when this event stops it (default ``T_FINAL``: the run reached
+        the end it was asked for, e.g. the next mid-stance of a step map).
+    """
+
+    name: str
+    function: Callable
+    direction: float
+    end: RunEnd = RunEnd.T_FINAL
+
+
+@dataclass
+class EventRun:
+    """What :func:`run_to_event` returned.
+
+    Attributes
+    ----------
+    end : RunEnd
+        The event's ``end`` when one stopped the run, ``T_FINAL`` at the end time,
+        ``SOLVER_FAILURE`` when the integrator stopped.
+    event : str
+        Name of the event that stopped the run ('' for none).
+    t : ndarray (k,)
+        Times of the integrator's steps [s].
+    y : ndarray (m, k)
+        States at those times.
+    t_event : float
+        Time of the event (NaN for none).
+    y_event : ndarray (m,) or None
+        State at the event.
+    dense : callable or None
+        Dense output ``t -> (m,)`` or ``(m, len(t))`` when asked for.
+    message : str
+        The integrator's message.
+    nfev : int
+        Right-hand-side evaluations.
+    """
+
+    end: RunEnd
+    event: str
+    t: np.ndarray
+    y: np.ndarray
+    t_event: float
+    y_event: np.ndarray | None
+    dense: object
+    message: str
+    nfev: int
+
+
+def run_to_event(rhs, x0, t_end: float, solver: Solver, events: list[Event], *,
+                 jac=None, dense: bool = False, t0: float = 0.0) -> EventRun:
+    """Integrate ``dy/dt = rhs(t, y)`` from ``(t0, x0)`` until the first event or ``t_end``.
+
+    Parameters
+    ----------
+    rhs : callable
+        ``(t, y) -> (m,)``.
+    x0 : array_like (m,)
+    t_end : float
+        End time [s].
+    solver : Solver
+        ``method`` a ``solve_ivp`` method (``"odeint"`` runs LSODA), ``rtol``, ``atol``
+        (float or (m,)), ``max_step_s``.
+    events : list of Event
+        All terminal.
+    jac : callable, optional
+        ``(t, y) -> (m, m)`` for the implicit methods.
+    dense : bool
+        Keep the dense output.
+
+    Returns
+    -------
+    EventRun
+    """
+    from scipy.integrate import solve_ivp
+
+    fns = []
+    for ev in events:
+        def fn(t, y, _f=ev.function):
+            return _f(t, y)
+        fn.terminal = True
+        fn.direction = ev.direction
+        fns.append(fn)
+    kw = solver.kwargs()
+    if kw["method"] == "odeint":
+        kw["method"] = "LSODA"
+    if jac is not None:
+        kw["jac"] = jac
+    sol = solve_ivp(rhs, (t0, t_end), np.asarray(x0, float), events=fns or None,
+                    dense_output=dense, **kw)
+    fired = [(float(te[0]), i) for i, te in enumerate(sol.t_events or []) if len(te)]
+    dense_out = sol.sol if dense else None
+    if sol.status == 1 and fired:
+        te, i = min(fired)
+        return EventRun(events[i].end, events[i].name, sol.t, sol.y, te,
+                        np.asarray(sol.y_events[i][0]), dense_out, sol.message, sol.nfev)
+    end = RunEnd.SOLVER_FAILURE if sol.status < 0 else RunEnd.T_FINAL
+    return EventRun(end, "", sol.t, sol.y, float("nan"), None, dense_out, sol.message,
+                    sol.nfev)
+
+
+def odeint_grid(rhs, x0, t_grid, solver: Solver, jac=None) -> tuple[np.ndarray, RunEnd, str]:
+    """``scipy.integrate.odeint`` of ``dy/dt = rhs(t, y)`` on a time grid.
+
+    Parameters
+    ----------
+    rhs : callable
+        ``(t, y) -> (m,)``.
+    x0 : array_like (m,)
+        State at ``t_grid[0]``.
+    t_grid : ndarray (k,)
+        Output times [s], increasing.
+    solver : Solver
+        Its ``rtol`` and ``atol`` (LSODA; ``method`` is not read).
+    jac : callable, optional
+        ``(t, y) -> (m, m)``.
+
+    Returns
+    -------
+    X : ndarray (k, m)
+        The state at each grid time.
+    end : RunEnd
+        ``T_FINAL`` when odeint reached the last time, else ``SOLVER_FAILURE``.
+    message : str
+        odeint's message.
+    """
+    from scipy.integrate import ODEintWarning, odeint
+
+    with warnings.catch_warnings():  # the message is returned instead
+        warnings.simplefilter("ignore", ODEintWarning)
+        X, info = odeint(rhs, x0, t_grid, Dfun=jac, tfirst=True, rtol=solver.rtol,
+                         atol=solver.atol, full_output=True, mxstep=MXSTEP)
+    ok = info["message"] == "Integration successful."
+    return X, (RunEnd.T_FINAL if ok else RunEnd.SOLVER_FAILURE), info["message"]
