@@ -62,6 +62,11 @@ SEED_STANCE_RATE = (0.8, 1.1, 1.4)
 SEED_SWING_RATIO = (0.0, 0.4, 0.8)
 #: seeds the root finder is started from (best first by the coarse residual)
 ROOT_STARTS = 6
+#: Coarse steps walked from a seed before its last post-impact state starts the root finder
+#: (second round, when no seed converged as it is: a walker whose post-impact states the
+#: seeds do not reach - a flat foot's ankle rate follows from the heel strike - walks onto
+#: its post-impact set in one step, and near a stable gait in a few).
+WALK_STEPS = 20
 #: relative offset of the deflated starts from the gait already found
 DEFLATION_OFFSET = 0.05
 #: two fixed points closer than this (max |x1 - x2|, rad and rad/s) are the same gait
@@ -165,7 +170,8 @@ def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: floa
 
     stance_leg = walker.legs[-1]
     x0 = walker.layout().zeros()
-    keys = list(walker.leg_coordinates(x0, stance_leg))
+    # leg links only: an ankle's angle (a flat foot's) is not a leg's and starts at 0
+    keys = [k for k in walker.leg_coordinates(x0, stance_leg) if "_ankle_" not in k]
 
     def target(k: str) -> float:
         stance = k.startswith(stance_leg + "_")
@@ -241,6 +247,19 @@ def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
                        desc, x))
     ranked.sort(key=lambda t: t[0])
     return ranked, len(seeds)
+
+
+def walked_start(walker: HybridWalker, x: np.ndarray, solver: Solver,
+                 max_step_time: float) -> np.ndarray | None:
+    """The post-impact state after a coarse walk of :data:`WALK_STEPS` maps from ``x`` (a
+    stride at a time for a walker whose map is a stride), or None when it falls before."""
+    coarse = _coarse(solver)
+    for _ in range(WALK_STEPS):
+        try:
+            x, _, _ = poincare_map(walker, x, coarse, max_step_time)
+        except StepFailed:
+            return None
+    return x
 
 
 # ----------------------------------------------------------------------------- search
@@ -370,6 +389,22 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
                 break
         tried.append(f"{n_started} of {n_seeds} scale-free seeds "
                      f"({n_seeds - len(ranked)} fell within the first step)")
+        if not found and ranked:  # second round: from where the seeds walk to
+            n_walked = n_started = 0
+            for _err, _desc, x in ranked:
+                n_walked += 1
+                end = walked_start(walker, x, solver, max_step_time)
+                if end is None:  # fell before WALK_STEPS steps: not near a stable gait
+                    continue
+                n_started += 1
+                g = attempt(end, "walked seed")
+                if g is not None:
+                    found.append(g)
+                    break
+                if n_started == ROOT_STARTS:
+                    break
+            tried.append(f"{n_walked} seeds walked {WALK_STEPS} steps "
+                         f"({n_started} root-finder starts)")
     if not found:
         raise GaitNotFound(_failure(walker, tried, best, last_msg, guess is not None), best)
     need_other = other_gait or policy in ("long_period", "short_period") or (

@@ -24,13 +24,14 @@ def total_mass_kg(walker) -> float:
     return float(walker.total_mass_kg)
 
 
-def _phase_of(seg, times: np.ndarray) -> np.ndarray:
-    """Index of the phase (piece of the segment) each sample time falls in, as
-    :meth:`Segment.sample` assigns it (a boundary time belongs to the earlier phase)."""
+def _phase_of(seg, times: np.ndarray, names: list[str]) -> np.ndarray:
+    """Index in ``names`` (the walker's phase names) of the phase each sample time falls
+    in, as :meth:`Segment.sample` assigns it (a boundary time belongs to the earlier
+    phase; a step's phases may skip some of the walker's, e.g. a flat foot's modes)."""
     idx = np.full(times.size, -1, dtype=int)
-    for j, (_ph, _sol, (_ta, tb)) in enumerate(seg.pieces):
+    for j, (ph, _sol, (_ta, tb)) in enumerate(seg.pieces):
         last = j == len(seg.pieces) - 1
-        idx[(idx < 0) & ((times <= tb) | last)] = j
+        idx[(idx < 0) & ((times <= tb) | last)] = names.index(ph.name)
     return idx
 
 
@@ -90,7 +91,7 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
         chunks["pe"].append(np.broadcast_to(pe, times.shape))
         chunks["stance"].append(np.full(times.size, legs.index(seg.stance_leg)))
         chunks["step"].append(np.full(times.size, seg.index))
-        chunks["phase"].append(_phase_of(seg, times))
+        chunks["phase"].append(_phase_of(seg, times, [p.name for p in w.phases]))
         for name, xy in sw.points(X).items():
             key = _leg_point_name(name, r2l)
             pts.setdefault(key, []).append(np.asarray(xy) + seg.stance_foot_world[:, None])
@@ -109,12 +110,14 @@ def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
     """Per-step metrics: period [s], step length [m], hip speed [m/s], impact loss [J], ...
 
     Step length is the distance between the stance foot and the swing foot at heel strike;
-    hip speed is the horizontal hip displacement over the step divided by its period.
+    hip speed is the horizontal hip displacement over the step divided by its period;
+    ``phases`` lists the step's phases, each with the guard that ended it
+    (``"early_swing (midstance) > late_swing (heel_strike)"``).
     """
     w = traj.walker
     rows = {k: [] for k in ("index", "stance_leg", "swing_leg", "t_start", "t_end", "period",
                             "termination", "event", "step_length", "hip_speed",
-                            "impact_energy_loss", "nfev", "midstance_time")}
+                            "impact_energy_loss", "nfev", "midstance_time", "phases")}
     for seg in traj.segments:
         r2l = w.role_to_leg(seg.stance_leg)
         rows["index"].append(seg.index)
@@ -125,6 +128,10 @@ def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
         rows["period"].append(seg.period)
         rows["termination"].append(seg.termination)
         rows["event"].append(seg.event)
+        # the phases met, each with the guard that ended it (a flat foot's modes, a knee's
+        # lock ...), found by events at run time
+        rows["phases"].append(" > ".join(f"{name} ({end or 'cut'})"
+                                         for name, _ta, _tb, end in seg.phase_log))
         rows["nfev"].append(seg.nfev)
         rows["midstance_time"].append(seg.phase_times.get("midstance", np.nan))
         sw = w.for_stance(seg.stance_leg)  # legs that differ: that step's own numbers

@@ -56,6 +56,7 @@ from walkerlab.config.loader import (
     validate_option,
 )
 from walkerlab.config.schema import (
+    AnkleSpec,
     ArcFoot,
     AsTuple,
     BasinSettings,
@@ -64,6 +65,7 @@ from walkerlab.config.schema import (
     CommandOptions,
     CompassGaitParams,
     FixedPointSettings,
+    FlatFoot,
     Foot,
     GuessFromArtifact,
     IdealModelSettings,
@@ -91,6 +93,7 @@ from walkerlab.config.schema import (
 from walkerlab.config.solver import SolverSettings
 
 __all__ = [
+    "AnkleSpec",
     "ArcFoot",
     "AsTuple",
     "BasinSettings",
@@ -101,6 +104,7 @@ __all__ = [
     "ContactSettings",
     "ContactSimSettings",
     "FixedPointSettings",
+    "FlatFoot",
     "Foot",
     "GuessFromArtifact",
     "IdealModelSettings",

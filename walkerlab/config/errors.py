@@ -12,7 +12,7 @@ from pathlib import Path
 from pydantic import BaseModel, ValidationError
 
 # discriminator tags of walker models and bodies: not part of a field's path
-_TAGS = {"compass_gait", "biped", "point_mass", "rod", "point", "arc"}
+_TAGS = {"compass_gait", "biped", "point_mass", "rod", "point", "arc", "flat"}
 
 
 def _loc_part(p) -> bool:
@@ -79,9 +79,9 @@ WALKER_VOCABULARY = (
     "a walker today is planar and passive: model compass_gait (hip mass, one point mass per "
     "leg) or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
     "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee, "
-    "foot kind point or arc; springs: torsional springs and dampers between links at the "
-    "hip; torso: an upper body on a bisecting hip mechanism); no ankles, flat feet, elastic "
-    "knees or actuation yet")
+    "foot kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "
+    "dampers between links at the hip; torso: an upper body on a bisecting hip mechanism); "
+    "no elastic knees or actuation yet")
 
 
 def _walker_vocabulary_applies(root: type[BaseModel], e: dict) -> bool:

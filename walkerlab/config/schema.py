@@ -158,7 +158,33 @@ class ArcFoot(_Strict):
     radius_m: float = Field(ge=0, le=100, description="arc radius R [m]")
 
 
-Foot = Annotated[PointFoot | ArcFoot, Field(discriminator="kind")]
+class AnkleSpec(_Strict):
+    """A revolute ankle between the leg's end and a flat foot, with a linear torsional spring
+    and viscous damper: torque ``-k (delta - rest) - c d(delta)/dt`` on the foot, ``delta``
+    the foot's angle from the leg's perpendicular (positive toe up; Wisse et al. 2006,
+    "Ankle springs instead of arc-shaped feet for passive dynamic walkers")."""
+
+    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
+                                         "[N m/rad]")
+    rest_angle_rad: float = Field(0.0, ge=-1.5, le=1.5, description="foot angle at which the "
+                                  "spring is relaxed [rad]; 0 = sole perpendicular to the leg")
+    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
+                                         "[N m s/rad]")
+
+
+class FlatFoot(_Strict):
+    """A massless flat foot on an ankle spring: a sole segment through the leg's end (the
+    ankle lies on the sole line, ankle height 0) from the heel, ``heel_m`` behind the ankle,
+    to the toe, ``toe_m`` ahead of it (Wisse et al. 2006).  A stance step rolls through heel
+    contact, foot flat and heel off (toe contact)."""
+
+    kind: Literal["flat"] = Field(description="foot shape")
+    heel_m: float = Field(ge=0, le=10, description="heel behind the ankle along the sole [m]")
+    toe_m: float = Field(gt=0, le=10, description="toe ahead of the ankle along the sole [m]")
+    ankle: AnkleSpec = Field(description="the ankle joint's spring and damper")
+
+
+Foot = Annotated[PointFoot | ArcFoot | FlatFoot, Field(discriminator="kind")]
 
 
 class KneeSpringSpec(_Strict):
@@ -240,6 +266,9 @@ class LegSpec(_Strict):
                 if (b.link == "thigh") != (d <= lt) and d != lt:
                     raise ValueError(f"bodies.{b.name}: {d} m from the hip is not "
                                      f"on the {b.link} (knee at {lt} m)")
+        if self.foot.kind == "flat" and self.knee is not None:
+            raise ValueError("foot.kind: flat feet are not available with a knee yet "
+                             "(straight legs only)")
         if self.foot.kind == "arc" and self.foot.radius_m > self.length_m - (
                 self.knee.thigh_length_m if self.knee else 0.0):
             raise ValueError("foot.radius_m: the arc's centre must lie on the "
@@ -357,8 +386,13 @@ class BipedParams(_Strict):
         pair = self.leg_pair()
         if self.legs is not None:
             a, b = pair
+            if a.foot.kind != b.foot.kind:
+                raise ValueError(f"legs: both legs need the same foot kind (leg1 "
+                                 f"{a.foot.kind!r}, leg2 {b.foot.kind!r})")
+            # flat feet may differ in their numbers (per-leg heel, toe, ankle spring)
+            fa, fb = (None, None) if a.foot.kind == "flat" else (a.foot, b.foot)
             for what, va, vb in (("length_m", a.length_m, b.length_m),
-                                 ("foot", a.foot, b.foot), ("knee", a.knee, b.knee),
+                                 ("foot", fa, fb), ("knee", a.knee, b.knee),
                                  ("bodies (kind, name, link)",
                                   [(x.kind, x.name, x.link) for x in a.bodies],
                                   [(x.kind, x.name, x.link) for x in b.bodies])):
@@ -370,6 +404,8 @@ class BipedParams(_Strict):
                     raise ValueError(f"legs: body {x.name!r} is massless on one leg only")
         if self.hip_mass_kg + sum(b.mass_kg for leg in pair for b in leg.bodies) <= 0:
             raise ValueError("the walker has no mass (hip_mass_kg and all bodies are 0)")
+        if self.coordinates != "absolute" and pair[0].foot.kind == "flat":
+            raise ValueError("coordinates: flat feet need 'absolute'")
         if self.coordinates != "absolute" and (pair[0].knee or pair[0].foot.kind != "point"):
             raise ValueError("coordinates: a knee or arc feet need 'absolute'")
         new = [n for n, on in (("legs", self.legs is not None), ("torso", self.torso),

@@ -42,6 +42,9 @@ from .solver import Solver
 #: heel-strike surface and never moved (slope 0, all-zero state; a passive step lasts
 #: tenths of a second or more).
 MIN_STEP_TIME_S = 1e-9
+#: Phase switches allowed in one step (a phase graph with a cycle must not loop for ever;
+#: a flat-footed step has at most five).
+MAX_PHASE_SWITCHES = 64
 
 
 def numeric_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
@@ -185,7 +188,11 @@ class Segment:
     event : str
         Name of the guard that fired (or ``""``).
     phase_times : dict[str, float]
-        Time at which each phase after the first began (e.g. ``midstance``).
+        Time at which each phase after the first began (e.g. ``midstance``), by the name of
+        the guard that began it.
+    phase_log : list of (str, float, float, str)
+        Each phase of the step in order: ``(phase name, t_start, t_end, guard that ended
+        it)`` (the guard is ``""`` when the step was cut or the solver failed).
     nfev : int
         Right-hand-side evaluations.
     message : str
@@ -211,6 +218,7 @@ class Segment:
     pieces: list = field(default_factory=list, repr=False)
     stance_foot_world: np.ndarray = field(default_factory=lambda: np.zeros(2))
     monodromy: np.ndarray | None = None
+    phase_log: list = field(default_factory=list)
 
     @property
     def period(self) -> float:
@@ -229,6 +237,28 @@ class Segment:
                 out[:, m] = np.atleast_2d(sol(np.clip(times[m], ta, tb)))[:n]
                 done |= m
         return out
+
+
+class _Held:
+    """Dense output of a phase that ended as it began: the state ``x`` at every time."""
+
+    def __init__(self, x: np.ndarray):
+        self._x = np.asarray(x, float)
+
+    def __call__(self, t):
+        if np.ndim(t) == 0:
+            return self._x.copy()
+        return np.repeat(self._x[:, None], np.size(t), axis=1)
+
+
+def _violated_at_entry(phase: Phase, t: float, x: np.ndarray):
+    """The first fall guard of ``phase`` marked ``at_entry`` whose function starts on its
+    firing side at ``(t, x)``, or None."""
+    for g in phase.guards:
+        if getattr(g, "at_entry", False) and g.outcome == "fall":
+            if g.direction * float(g.function(t, x)) > 0:
+                return g
+    return None
 
 
 def _grad(guard, x):
@@ -258,6 +288,7 @@ class _StepState:
     nfev: int = 0
     pieces: list = field(default_factory=list)
     phase_times: dict = field(default_factory=dict)
+    phase_log: list = field(default_factory=list)
     termination: RunEnd = RunEnd.T_FINAL
     event: str = ""
     message: str = ""
@@ -302,21 +333,26 @@ def _integrate_phase(phase: Phase, st: _StepState, t_stop: float, n: int, solver
 
 
 def _next_phase(walker: HybridWalker, k: int, guard, st: _StepState,
-                variational: bool) -> None:
-    """Phase ``k``'s guard hands the step to phase ``k + 1`` (``midstance``; a knee strike
-    applies its reset), with the saltation matrix of the crossing."""
+                variational: bool) -> int:
+    """Phase ``k``'s guard hands the step to the next phase (``k + 1``, or the phase the
+    guard names: a flat foot's phase graph) - ``midstance``; a knee strike or a foot slap
+    applies its reset - with the saltation matrix of the crossing.  Returns the next
+    phase's index."""
     phase = walker.phases[k]
     st.phase_times[guard.name] = st.t
+    target = getattr(guard, "next_phase", None)
+    k_next = k + 1 if target is None else [p.name for p in walker.phases].index(target)
     x_minus = st.x
     g_reset = getattr(guard, "reset", None)
     if g_reset is not None:  # intra-step impact (e.g. knee strike)
         st.x = np.asarray(g_reset(x_minus), dtype=float)
-    if k + 1 < len(walker.phases) and variational:
-        nxt = walker.phases[k + 1]
+    if k_next < len(walker.phases) and variational:
+        nxt = walker.phases[k_next]
         DR = None if g_reset is None else np.asarray(guard.reset_jacobian(x_minus))
         st.Phi = _saltation(np.asarray(phase.flow(st.t, x_minus)),
                             np.asarray(nxt.flow(st.t, st.x)),
                             _grad(guard, x_minus), DR) @ st.Phi
+    return k_next
 
 
 def _end_step(walker: HybridWalker, phase: Phase, guard, st: _StepState, t0: float,
@@ -333,12 +369,15 @@ def _end_step(walker: HybridWalker, phase: Phase, guard, st: _StepState, t0: flo
                       f"(t = {t0:.4g} s); the walker does not move")
         return
     st.termination = RunEnd.HEEL_STRIKE
-    st.x_next = np.asarray(walker.reset(st.x), dtype=float)
+    # a phase's own heel-strike map (a flat foot's depends on its mode), else the walker's
+    reset, reset_jac = ((guard.reset, guard.reset_jacobian)
+                        if getattr(guard, "reset", None) is not None
+                        else (walker.reset, walker.reset_jacobian))
+    st.x_next = np.asarray(reset(st.x), dtype=float)
     if variational:
         f_prev = np.asarray(phase.flow(st.t, st.x))
         S = _saltation(f_prev, np.zeros_like(f_prev), _grad(guard, st.x))
-        RJ = (walker.reset_jacobian(st.x) if walker.reset_jacobian is not None
-              else numeric_jacobian(walker.reset, st.x))
+        RJ = reset_jac(st.x) if reset_jac is not None else numeric_jacobian(reset, st.x)
         st.Phi = RJ @ S @ st.Phi
 
 
@@ -381,14 +420,26 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     if t_final is not None:
         t_stop = min(t_stop, t_final)
     st = _StepState(t0, np.asarray(x0, dtype=float), np.eye(n))
-    for k, phase in enumerate(walker.phases):
+    k, switches = 0, 0
+    while k < len(walker.phases) and switches <= MAX_PHASE_SWITCHES:
+        phase = walker.phases[k]
+        switches += 1
         if st.t >= t_stop:
+            break
+        broken = _violated_at_entry(phase, st.t, st.x)
+        if broken is not None:  # e.g. a unilateral contact already pulling as its mode begins
+            st.termination, st.event = RunEnd.FALL, broken.name
+            st.message = f"{broken.name}: already violated as {phase.name} begins"
+            st.pieces.append((phase, _Held(st.x), (st.t, st.t)))
+            st.phase_log.append((phase.name, st.t, st.t, broken.name))
             break
         rhs, jac = _phase_rhs(walker, phase, n, variational)
         run = _integrate_phase(phase, st, t_stop, n, solver, backend, rhs, jac, variational)
         st.nfev += run.nfev
         st.message = run.message
         st.pieces.append((phase, run.dense, (st.t, run.t_last)))
+        st.phase_log.append((phase.name, st.t, run.t_last, "" if run.event is None
+                             or run.failed else phase.guards[run.event].name))
         st.t, st.x = run.t_last, run.y_last[:n].copy()
         if run.failed:
             st.termination = RunEnd.SOLVER_FAILURE
@@ -401,7 +452,7 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
             st.Phi = run.y_last[n:].reshape(n, n)
         st.event = guard.name
         if guard.outcome == "next_phase":
-            _next_phase(walker, k, guard, st, variational)
+            k = _next_phase(walker, k, guard, st, variational)
             continue
         _end_step(walker, phase, guard, st, t0, variational)
         break
@@ -409,7 +460,7 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         index=index, stance_leg=stance_leg, t_start=t0, t_end=st.t,
         x_start=np.asarray(x0, float), x_end=st.x, x_next=st.x_next,
         termination=st.termination.value, event=st.event, phase_times=st.phase_times,
-        nfev=st.nfev, message=st.message, pieces=st.pieces,
+        phase_log=st.phase_log, nfev=st.nfev, message=st.message, pieces=st.pieces,
         stance_foot_world=np.zeros(2) if stance_foot_world is None else stance_foot_world,
         monodromy=(st.Phi if (variational and st.termination is RunEnd.HEEL_STRIKE)
                    else None),

@@ -3,7 +3,8 @@ relies on.
 
 A step of a hybrid walker is a sequence of continuous *phases* (compass gait: early swing
 until the swing leg passes the stance leg, then late swing until heel strike; a kneed
-walker adds a knee-locked phase).  Each phase has a flow ``f(t, x)`` and named guards;
+walker adds a knee-locked phase; flat feet cross the stance foot's modes with early / late
+swing, a guard naming the phase it leads to).  Each phase has a flow ``f(t, x)`` and named guards;
 a guard either moves to the next phase (optionally through its own reset map, e.g. a knee
 strike), ends the step with the reset map (heel strike), or ends the run (fall).  The analysis
 layer (:mod:`walkerlab.integrate.rigid`) integrates any model described this way.
@@ -14,7 +15,8 @@ Contract of :class:`HybridWalker` (nothing outside the model layer may assume mo
     Role-ordered generalised coordinates, prefixed ``swing``/``stance`` where they belong to
     a leg: ``("swing", "stance")`` for the compass gait, ``("stance", "hip")`` for the
     simplest walker (``hip`` = angle between the legs), e.g. ``("stance", "swing_thigh",
-    "swing_shank")`` for a kneed walker.  ``n = len(roles)``; the state is ``x = [n angles,
+    "swing_shank")`` for a kneed walker, ``("swing", "stance", "stance_ankle")`` for flat
+    feet on ankle springs.  ``n = len(roles)``; the state is ``x = [n angles,
     n rates]`` and its dimension is the same in every phase of a step (a locked knee is a
     constraint on the same coordinates, not fewer states).
 ``state_names()``, ``state_units()``
@@ -74,6 +76,18 @@ class Guard:
     reset, reset_jacobian : callable, optional
         For ``next_phase`` guards: a map applied to the state when the guard fires (an
         intra-step impact such as a knee strike, state dimension unchanged) and its Jacobian.
+        For a ``heel_strike`` guard: the heel-strike map of this phase (role swap included)
+        in place of the walker's :attr:`HybridWalker.reset` (a flat foot's depends on the
+        stance foot's mode).
+    next_phase : str, optional
+        For ``next_phase`` guards: the name of the phase that follows (the phases of a step
+        then form a graph, e.g. a flat foot's modes crossed with early / late swing); None:
+        the next phase in :attr:`HybridWalker.phases`.
+    at_entry : bool
+        Also fire when the phase begins on the guard's firing side (``function < 0`` for
+        ``direction = -1``, ``> 0`` for ``+1``), which no zero crossing would report: a
+        contact force that is already pulling when its contact mode begins (a flat foot's
+        unilateral contacts).  False: crossings only.
     """
 
     name: str
@@ -83,6 +97,8 @@ class Guard:
     gradient: Callable[[np.ndarray], np.ndarray] | None = None
     reset: Callable[[np.ndarray], np.ndarray] | None = None
     reset_jacobian: Callable[[np.ndarray], np.ndarray] | None = None
+    next_phase: str | None = None
+    at_entry: bool = False
 
 
 @dataclass(frozen=True)

@@ -50,10 +50,20 @@ def _generator_hash() -> str:
     return h.hexdigest()
 
 
+@cache
+def _flat_generator_hash() -> str:
+    """sha256 of the flat-foot generator's source (once per process)."""
+    return hashlib.sha256((Path(__file__).parent / "flatfoot.py").read_bytes()).hexdigest()
+
+
 def cache_key(structure) -> str:
-    """Cache key (hex, 24 characters) of a structure for the current generator."""
+    """Cache key (hex, 24 characters) of a structure for the current generator (a
+    flat-footed walker's also covers :mod:`walkerlab.models.flatfoot`, which no other
+    structure's key reads)."""
     h = hashlib.sha256(structure.key().encode())
     h.update(_generator_hash().encode())
+    if structure.foot == "flat":
+        h.update(_flat_generator_hash().encode())
     return h.hexdigest()[:24]
 
 
@@ -108,6 +118,13 @@ def generated_module(structure) -> dict:
     folder = cache_dir()
     path = folder / f"{key}.py" if folder is not None else None
     ns = _read(path) if path is not None else None
+    if ns is None and structure.foot == "flat":
+        from walkerlab.models import flatfoot
+
+        body = flatfoot.generate_flat(structure, key)
+        ns = _exec(body, str(path or f"<walkerlab model {key}>"))
+        if path is not None:
+            write_source(path, body)
     if ns is None:
         from walkerlab.models import codegen, symbolic
 

@@ -19,6 +19,9 @@ from dataclasses import dataclass
 ROLES = {"absolute": ("swing", "stance"), "slope_relative": ("stance", "hip")}
 #: Roles with a knee: swing thigh and shank free, the stance leg straight (absolute angles).
 KNEED_ROLES = ("swing_thigh", "swing_shank", "stance")
+#: Roles with flat feet: the absolute leg angles and the stance ankle's angle (the swing
+#: foot is massless and sits at its spring's rest angle: no coordinate).
+FLAT_ROLES = ("swing", "stance", "stance_ankle")
 
 
 @dataclass(frozen=True)
@@ -59,7 +62,11 @@ class Structure:
     hip_mass : bool
         True if there is a hip point mass.
     foot : str
-        ``"point"`` or ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip).
+        ``"point"``, ``"arc"`` (circular arc of radius ``R_foot``, rolling without slip) or
+        ``"flat"`` (a massless flat foot on an ankle spring: heel ``heel_m`` behind and toe
+        ``toe_m`` ahead of the ankle along the sole, ankle spring ``k_ankle`` [N m/rad],
+        rest angle ``r_ankle`` [rad], damper ``c_ankle`` [N m s/rad]; per role
+        ``heel_sw_m``, ``heel_st_m``, ``k_sw_ankle`` ... when the legs differ).
     variant : str
         ``"derived"``; ``"appendix_a"`` only for the paper's compass gait: the flow with the
         Coriolis matrix as printed in the paper (A.5, sign of ``C[1, 0]`` flipped).
@@ -93,6 +100,8 @@ class Structure:
 
     @property
     def roles(self) -> tuple[str, ...]:
+        if self.foot == "flat":
+            return FLAT_ROLES
         return KNEED_ROLES if self.knee else ROLES[self.coordinates]
 
     @property
@@ -113,6 +122,10 @@ class Structure:
             names.append("L_thigh")
         if self.foot == "arc":
             names.append("R_foot")
+        if self.foot == "flat":
+            for t in tags:
+                names += [f"heel_{t}m", f"toe_{t}m", f"k_{t}ankle", f"r_{t}ankle",
+                          f"c_{t}ankle"]
         for b in self.torso:
             names += [f"m_torso_{b.name}", f"d_torso_{b.name}"]
             if b.off_axis:
@@ -206,6 +219,14 @@ def _leg_values(leg) -> list[tuple[list[float], float]]:
     return out
 
 
+def _flat_foot_values(foot) -> list[float]:
+    """A flat foot's numbers in :attr:`Structure.param_names` order: heel, toe [m], ankle
+    stiffness [N m/rad], rest angle [rad], damping [N m s/rad]."""
+    a = foot.ankle
+    return [foot.heel_m, foot.toe_m, a.stiffness_n_m_per_rad, a.rest_angle_rad,
+            a.damping_n_m_s_per_rad]
+
+
 def _spring_roles(between, stance_leg: str) -> tuple[tuple[str, str], float]:
     """A config spring's link pair in role terms for the step with ``stance_leg`` in stance,
     ordered as :data:`SPRING_LINKS`, and the sign of its ``delta`` in that order."""
@@ -264,6 +285,11 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
         tail.append(leg.knee.thigh_length_m)
     if leg.foot.kind == "arc":
         tail.append(leg.foot.radius_m)
+    flat = leg.foot.kind == "flat"
+    f1 = _flat_foot_values(leg1.foot) if flat else []
+    f2 = _flat_foot_values(leg2.foot) if flat else []
+    asym = asym or f1 != f2
+    n_foot_tail = len(tail)  # the flat foot's numbers (per role) go here, before the torso's
     torso = []
     if walker_cfg.torso is not None:
         for b in walker_cfg.torso.bodies:
@@ -296,7 +322,9 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
                           springs=tuple(pairs), knee_spring=knee_spring is not None)
 
     def params(swing_vals, stance_vals, springs) -> tuple[float, ...]:
-        vals = head + leg_block(swing_vals, stance_vals) + tail
+        feet = ((f1, f2) if swing_vals is v1 else (f2, f1)) if asym else (f1,)
+        vals = (head + leg_block(swing_vals, stance_vals) + tail[:n_foot_tail]
+                + [x for f in feet for x in f] + tail[n_foot_tail:])
         for k in springs:
             vals += k
         if knee_spring is not None:

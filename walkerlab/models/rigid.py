@@ -14,6 +14,8 @@ Phases of a step (point feet, straight legs):
   zero: the swing foot reaches the slope), or a fall: the swing leg falls back behind the
   stance leg, or the hip reaches the slope.
 
+Flat feet on ankle springs have their own phase graph (:mod:`walkerlab.models.rigid_flat`).
+
 Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen 2007):
 
 - ``unlocked_swing`` (three links) until ``knee_extension`` (shank minus thigh angle) crosses
@@ -86,6 +88,10 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     -------
     HybridWalker
     """
+    if data.structure.foot == "flat":  # modes of a flat foot: their own phase graph
+        from walkerlab.models.rigid_flat import make_flat_walker
+
+        return make_flat_walker(data, name, variant)
     f = functions(data)
     # the compiled flow is the generated one: none when the flow is replaced
     generated_flow = flow is None and flow_jacobian is None

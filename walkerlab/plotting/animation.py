@@ -46,18 +46,22 @@ def leg_parts(tr: NamedTrajectory, leg: str) -> dict:
     Returns
     -------
     dict
-        ``chain``: point names from the hip to the leg's end (knee if any, then the foot or
-        the arc's centre); ``arc``: ``(centre, contact)`` names or None; ``bodies``: the
-        leg's other points (masses), drawn as dots.
+        ``chain``: point names from the hip to the leg's end (knee if any, then the foot,
+        the arc's centre or a flat foot's ankle); ``arc``: ``(centre, contact)`` names or
+        None; ``sole``: a flat foot's ``(heel, toe)`` names or None; ``bodies``: the leg's
+        other points (masses), drawn as dots.
     """
     p = tr.points
     knee, foot = f"{leg}_knee", f"{leg}_foot"
     centre, contact = f"{leg}_foot_centre", f"{leg}_contact"
+    heel, toe, ankle = f"{leg}_heel", f"{leg}_toe", f"{leg}_ankle"
     arc = (centre, contact) if centre in p and contact in p else None
-    chain = ["hip"] + ([knee] if knee in p else []) + [centre if arc else foot]
-    skip = {knee, foot, centre, contact}
+    sole = (heel, toe) if heel in p and toe in p and ankle in p else None
+    end = centre if arc else ankle if sole else foot
+    chain = ["hip"] + ([knee] if knee in p else []) + [end]
+    skip = {knee, foot, centre, contact, heel, toe, ankle}
     bodies = [n for n in p if n.startswith(leg + "_") and n not in skip]
-    return {"chain": chain, "arc": arc, "bodies": bodies}
+    return {"chain": chain, "arc": arc, "sole": sole, "bodies": bodies}
 
 
 def frame_times(trajs: dict[str, NamedTrajectory], fps: float, max_frames: int) -> np.ndarray:
@@ -206,6 +210,7 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
                 "line": ax.plot([], [], color=c, lw=3, solid_capstyle="round")[0],
                 "arc": ax.plot([], [], color=c, lw=3)[0] if parts["arc"] else None,
                 "contact": ax.plot([], [], "o", color=c, ms=3)[0] if parts["arc"] else None,
+                "sole": ax.plot([], [], color=c, lw=3)[0] if parts["sole"] else None,
                 "dots": ax.plot([], [], "o", color=c, ms=6)[0],
             })
         hip = ax.plot([], [], "o", color="k", ms=9)[0]
@@ -229,6 +234,9 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
                     lg["contact"].set_data([k[0]], [k[1]])
                     xy = np.vstack([xy, c + r * u])  # the leg runs on to its arc
                 lg["line"].set_data(xy[:, 0], xy[:, 1])
+                if parts["sole"]:  # a flat foot: heel to toe through the ankle
+                    sole = np.array([P[n] for n in parts["sole"]])
+                    lg["sole"].set_data(sole[:, 0], sole[:, 1])
                 b = np.array([P[n] for n in parts["bodies"]]).reshape(-1, 2)
                 lg["dots"].set_data(b[:, 0], b[:, 1])
             hx, hy = P["hip"]

@@ -23,14 +23,16 @@ def _fmt_mult(re, im) -> str:
 def zero_multipliers_text(re, im) -> str:
     """Why some Floquet multipliers are 0: the map lands on the heel-strike surface (and, for a
     kneed walker, on the straight-knee surface; for the simplest walker, whose swing leg has
-    no mass, the post-impact swing rate is a function of the stance-leg state)."""
+    no mass, the post-impact swing rate is a function of the stance-leg state; a flat foot
+    lands at its ankle's rest angle and its foot slap locks it flat)."""
     n0 = int(np.sum(np.hypot(re, im) < 1e-9))
     if n0 <= 1:
         return "one multiplier is 0 by construction: the map lands on the heel-strike surface"
     return (f"{n0} multipliers are 0 by construction: the map lands on the heel-strike surface "
-            f"and the impact fixes {n0 - 1} more combination(s) of the state (e.g. a kneed "
+            f"and the impacts fix {n0 - 1} more combination(s) of the state (e.g. a kneed "
             "walker's straight, locked swing knee; the simplest walker's massless swing leg, "
-            "whose rate after heel strike follows from the stance leg's)")
+            "whose rate after heel strike follows from the stance leg's; a flat foot's ankle "
+            "angle after heel strike and its foot slap, which stops the foot turning)")
 
 
 def fixedpoint_text(fp: FixedPointArtifact) -> str:

@@ -4,7 +4,8 @@ Layout: root attributes ``model``, ``variant``, ``legs``, ``termination``,
 ``strides_requested``, ``total_mass_kg``, ``gravity_m_per_s2``; ``state`` (dimension scale,
 role-ordered state names); ``samples/`` (:mod:`walkerlab.io.trajectory`); ``steps/`` (one
 row per step on dimension ``step``: ``t_start``, ``t_end``, ``period`` [s], ``step_length``
-[m], ``hip_speed`` [m/s], ``impact_energy_loss`` [J], ``stance_leg``, ``termination`` ...;
+[m], ``hip_speed`` [m/s], ``impact_energy_loss`` [J], ``stance_leg``, ``termination``,
+``phases`` (each phase of the step and the guard that ended it) ...;
 ``steps/states/<i>`` start/end state of each segment as attributes); ``initial_state``
 [rad, rad/s]; ``summary/<name>`` (mean step period [s], step length [m], hip speed [m/s],
 total energy [J], RHS evaluations, integration wall time [s]).

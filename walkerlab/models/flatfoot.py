@@ -1,0 +1,398 @@
+"""Flat feet on ankle springs: the rigid hybrid view's modes, derived with sympy from a
+:class:`~walkerlab.models.description.Structure` (``foot == "flat"``) and written as Python
+source (the same ``make(p)`` module form as :mod:`walkerlab.models.codegen`, through its
+printers and solvers).
+
+Coordinates ``q = (swing, stance, stance_ankle)``: the absolute leg angles (from the
+vertical, positive foot ahead of the hip) and the stance ankle's angle ``a``: the sole's
+angle from the stance leg's perpendicular, positive toe up (the ankle spring's deflection
+plus its rest angle).  The sole angle from the horizontal is ``theta_f = stance + a``; on a
+slope ``gamma`` the foot lies flat when ``phi = stance + a + gamma = 0``.  Feet are massless
+(Wisse et al. 2006, "Ankle springs instead of arc-shaped feet for passive dynamic walkers",
+IEEE-RAS Humanoids); the ankle lies on the sole line, ``heel`` behind and ``toe`` ahead of it.
+The swing foot carries no load and sits at its spring's rest angle ``r_sw`` (no coordinate).
+
+A *mode* is a pinned contact point plus locked coordinates; each is derived from the same
+bodies with Lagrange's equations ``M qdd + C dq + G = 0`` (``C`` in Christoffel form plus
+the ankle damper, ``G`` from gravity and the ankle spring ``k (a - r)^2 / 2``):
+
+- ``heel_contact``: the stance heel pinned at the step's reference point ``O`` (the heel's
+  touchdown point); the foot turns about it (``phi > 0``, toe up);
+- ``foot_flat``: heel pinned and the foot's angle locked (``J = d phi / dq = [0, 1, 1]``,
+  ``S`` a basis of its null space): ``[S^T M; J] qdd = [S^T (-C dq - G); 0]``;
+- ``heel_off``: the stance toe pinned at ``O + (heel + toe) t`` (``t`` the downhill slope
+  direction); the foot turns about it (``phi < 0``, heel up).
+
+The kinematics of a state follow from the sign of ``phi`` (both maps give the same positions at
+``phi = 0``), so ``points`` and ``energies`` need no mode (see :data:`HEEL_OFF_PHI_RAD`).
+
+Resets (plastic impulses; the impulse acts only where a contact is made):
+
+- foot slap (``phi`` reaches 0 in heel contact): ``[S^T M; J] dq+ = [S^T M; 0] dq-`` (the toe
+  impulse's generalised force lies along ``J^T``: the knee lock's projection);
+- heel strike (the swing heel reaches the slope, in any stance mode): the post-impact
+  velocities project the pre-impact momenta onto the coordinates with the swing heel pinned
+  and the new stance ankle at the swing foot's rest angle, ``Mi dq+ = sum_i J_i+^T m_i v_i-``
+  (``Mi = sum_i J_i+^T m_i J_i+`` plus rotational terms), then the leg roles swap; the
+  trailing foot leaves the ground and, massless, snaps to its rest angle (its spring energy
+  is lost).
+
+Ground reaction (for the heel-off and lift-off guards): the total force from Newton,
+``F = sum m_i (a_i - g)`` over the bodies (the feet are massless), normal part ``N = F . n``;
+in foot flat the toe's share from the moment balance about the heel,
+``N_toe (heel + toe) = sum (r_i x m_i (a_i - g)) + I_i alpha_i`` (friction along the slope
+has no moment about the heel), and the heel's ``N - N_toe``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+
+import sympy as sp
+
+from walkerlab.models import codegen
+from walkerlab.models.codegen import _PY, IND, _cse_lines, _flow, _numpy_fn, _reset
+from walkerlab.models.description import ROLE_TAG, Structure
+from walkerlab.models.symbolic import _dot_terms, _pos, _velocity_terms
+
+#: Modes of the stance foot, in the order of a step.
+MODES = ("heel_contact", "foot_flat", "heel_off")
+#: Index of the stance ankle's angle in ``q``.
+ANKLE = 2
+#: ``points``/``energies`` read a state as heel off (toe pinned) once ``phi`` is below minus
+#: this [rad].  Both kinematics give the same positions at ``phi = 0`` but not the same
+#: velocities while the foot turns: at the foot slap (``phi = 0`` to round-off, the foot
+#: turning at ~20 rad/s) the state is still heel contact; just after heel off (``phi`` ~
+#: ``-phi_dd t^2 / 2``) the foot's rate is ``sqrt(2 |phi_dd| |phi|)`` < 2e-5 rad/s at this
+#: threshold (``|phi_dd|`` < 100 rad/s^2), so the kinetic energy read there is off by < 1e-4 J
+#: for a microsecond.
+HEEL_OFF_PHI_RAD = 1e-12
+
+
+@dataclass(frozen=True)
+class _System:
+    """What :func:`codegen._flow` / :func:`codegen._reset` read (duck-typed Equations)."""
+
+    q: tuple
+    dq: tuple
+    M: sp.Matrix = None
+    C: sp.Matrix = None
+    G: sp.Matrix = None
+    Mi: sp.Matrix = None
+    B: sp.Matrix = None
+    relabel_q: sp.Matrix = None
+    relabel_rate: sp.Matrix = None
+
+
+@dataclass(frozen=True)
+class FlatEquations:
+    """Symbolic results of :func:`derive_flat` (``n = 3``).
+
+    Attributes
+    ----------
+    q, dq, qdd, params : tuple of Symbol
+    flows : dict[str, _System]
+        ``heel_contact``, ``foot_flat``, ``heel_off``: ``M, C, G`` (3 x 3, 3 x 3, 3 x 1).
+    resets : dict[str, _System]
+        ``foot_slap``, ``heel_strike_heel`` (from heel contact or foot flat: heel-pinned
+        kinematics), ``heel_strike_toe`` (from heel off): ``Mi, B, relabel_q, relabel_rate``.
+    guards : dict[str, Expr]
+        Scalar functions of the state.
+    ground : dict[str, list of Expr]
+        ``heel``: ``[N, N_toe]``, ``toe``: ``[N]`` [N], functions of ``q, dq, qdd``.
+    kinematics : dict[str, dict]
+        Per pinned point (``heel``, ``toe``): ``points``, ``kinetic``, ``potential``.
+    leg_angles : dict[str, Expr]
+    """
+
+    q: tuple
+    dq: tuple
+    qdd: tuple
+    params: tuple
+    flows: dict
+    resets: dict
+    guards: dict
+    ground: dict
+    kinematics: dict
+    leg_angles: dict
+
+
+def _add(lin: dict, angle, length) -> dict:
+    out = dict(lin)
+    out[angle] = out.get(angle, 0) + length
+    return out
+
+
+@cache
+def derive_flat(structure: Structure) -> FlatEquations:
+    """Derive the modes, resets, guards, ground reactions and points of a flat-footed biped.
+
+    Returns
+    -------
+    FlatEquations
+
+    Raises
+    ------
+    ValueError
+        Not a flat-footed straight-legged walker in absolute coordinates, or massless bodies.
+    """
+    if structure.foot != "flat" or structure.knee or structure.coordinates != "absolute":
+        raise ValueError("walker.leg.foot: the flat-foot derivation needs straight legs, "
+                         "flat feet and absolute coordinates")
+    if any(b.massless for b in structure.bodies):
+        raise ValueError("walker.leg.bodies: flat feet need massive bodies (mass_kg > 0)")
+    q = sp.symbols("q_swing q_stance q_stance_ankle", real=True)
+    dq = sp.symbols("dq_swing dq_stance dq_stance_ankle", real=True)
+    qdd = sp.symbols("ddq_swing ddq_stance ddq_stance_ankle", real=True)
+    par = sp.symbols(structure.param_names, real=True)
+    P = dict(zip(structure.param_names, par))
+    g, L, gamma = P["g"], P["L"], P["gamma"]
+    ps_sw, ps_st, a = q
+    b_new = sp.Symbol("b_new_ankle", real=True)  # the swing ankle, once it is the stance one
+
+    def fp(kind, role):  # a foot's number (per role when the legs differ)
+        t = f"{ROLE_TAG[role]}_" if structure.asymmetric else ""
+        return P[{"heel": f"heel_{t}m", "toe": f"toe_{t}m", "k": f"k_{t}ankle",
+                  "r": f"r_{t}ankle", "c": f"c_{t}ankle"}[kind]]
+
+    def bp(kind, name, role):
+        return P[f"{kind}_{ROLE_TAG[role]}_{name}" if structure.asymmetric else f"{kind}_{name}"]
+
+    hs, ts = fp("heel", "stance"), fp("toe", "stance")
+    hw, tw, rw = fp("heel", "swing"), fp("toe", "swing"), fp("r", "swing")
+    k_a, r_a, c_a = fp("k", "stance"), fp("r", "stance"), fp("c", "stance")
+    half = sp.pi / 2
+    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
+    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])  # along the slope, downhill
+    theta_f = ps_st + a
+    swap = {"stance": "swing", "swing": "stance"}
+    # positions = sum of {angle: length} e(angle) + a constant offset (e(angle + pi/2) is
+    # the unit vector at ``angle`` from the x axis)
+    anchors = {"heel": ({theta_f + half: hs}, sp.zeros(2, 1)),
+               "toe": ({theta_f + half: -ts}, (hs + ts) * tangent)}
+
+    def bodies_from(ankle_lin: dict, pinned: str = "stance"):
+        """(mass, lin, inertia, link angle, name) of every body, the hip's lin and the
+        other leg's ankle's lin, for the ``pinned`` leg's ankle at ``ankle_lin``; names
+        and numbers by the pre-impact roles (``pinned="swing"``: after a heel strike)."""
+        other = swap[pinned]
+        leg_psi = {"stance": ps_st, "swing": ps_sw}
+        hip = _add(ankle_lin, leg_psi[pinned], -L)
+        out = []
+        if structure.hip_mass:
+            out.append((P["M_hip"], hip, 0, leg_psi[pinned], "hip"))
+        for b in structure.bodies:
+            for role in (pinned, other):
+                psi = leg_psi[role]
+                lin = _add(hip, psi, bp("d", b.name, role))
+                if b.off_axis:
+                    lin = _add(lin, psi + half, bp("e", b.name, role))
+                inertia = bp("I", b.name, role) if b.kind == "rod" else 0
+                out.append((bp("m", b.name, role), lin, inertia, psi, f"{role}_{b.name}"))
+        psi_t = (ps_sw + ps_st) / 2
+        for b in structure.torso:
+            lin = _add(hip, psi_t, -P[f"d_torso_{b.name}"])
+            if b.off_axis:
+                lin = _add(lin, psi_t + half, P[f"e_torso_{b.name}"])
+            inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
+            out.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t, f"torso_{b.name}"))
+        return out, hip, _add(hip, leg_psi[other], L)
+
+    qv, dqv, ddv = sp.Matrix(q), sp.Matrix(dq), sp.Matrix(qdd)
+    link_angle = {"swing": ps_sw, "stance": ps_st, "torso": (ps_sw + ps_st) / 2}
+    flows, kin, ground, guards = {}, {}, {}, {}
+    for pin, (ankle_lin, off) in anchors.items():
+        bodies, hip, sw_ankle = bodies_from(ankle_lin)
+
+        def at(lin, _off=off):
+            return _pos(lin) + _off
+        M = sp.zeros(3, 3)
+        V = k_a * (a - r_a) ** 2 / 2
+        F = sp.zeros(2, 1)
+        mom = sp.Integer(0)
+        for mass, lin, inertia, psi, _name in bodies:
+            d = _velocity_terms(lin, q)
+            w = sp.Matrix([[sp.diff(psi, s) for s in q]])
+            for i in range(3):
+                for j in range(3):
+                    M[i, j] += mass * _dot_terms(d[i], d[j])
+            M += inertia * w.T * w
+            pos = at(lin)
+            V += mass * g * pos[1]
+            vel = pos.jacobian(qv) * dqv
+            acc = vel.jacobian(qv) * dqv + vel.jacobian(dqv) * ddv
+            f = mass * (acc + sp.Matrix([0, g]))
+            F += f
+            mom += pos[0] * f[1] - pos[1] * f[0] + inertia * (w * ddv)[0]
+        for i, (first, second) in enumerate(structure.springs):  # springs between links
+            delta = link_angle[second] - link_angle[first]
+            V += P[f"k_s{i}"] * (delta - P[f"r_s{i}"]) ** 2 / 2
+        M = M.applyfunc(sp.factor_terms)
+        G = sp.Matrix([sp.diff(V, s) for s in q])
+        C = sp.zeros(3, 3)
+        for i in range(3):
+            for j in range(3):
+                C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(M[i, j], q[k]) + sp.diff(M[i, k], q[j])
+                                                   - sp.diff(M[j, k], q[i])) * dq[k]
+                              for k in range(3))
+        C[ANKLE, ANKLE] += c_a  # the ankle damper: torque -c da/dt on the ankle coordinate
+        for i, (first, second) in enumerate(structure.springs):
+            delta = link_angle[second] - link_angle[first]
+            Jd = sp.Matrix([[sp.diff(delta, s) for s in q]])
+            C += P[f"c_s{i}"] * Jd.T * Jd
+        mode = "heel_contact" if pin == "heel" else "heel_off"
+        flows[mode] = _System(q, dq, M=M, C=C, G=G)
+        N = (F.T * normal)[0]
+        # moment balance about the pinned heel: the toe's normal force (see module docstring)
+        ground[pin] = [N, mom / (hs + ts)] if pin == "heel" else [N]
+        heel_sw = at(_add(sw_ankle, ps_sw + rw + half, -hw))
+        toe_sw = at(_add(sw_ankle, ps_sw + rw + half, tw))
+        points = {"stance_heel": at(_add(ankle_lin, theta_f + half, -hs)),
+                  "stance_toe": at(_add(ankle_lin, theta_f + half, ts)),
+                  "stance_ankle": at(ankle_lin), "hip": at(hip),
+                  "swing_ankle": at(sw_ankle), "swing_heel": heel_sw, "swing_toe": toe_sw}
+        # the contract's names: the stance foot is the stance leg's end, the swing foot the
+        # next step's reference point (the swing heel)
+        points["stance_foot"] = points["stance_ankle"]
+        points["swing_foot"] = heel_sw
+        for _m, lin, _i, _p, name in bodies:
+            if name != "hip":
+                points[name] = at(lin)
+        T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
+        kin[pin] = {"points": points, "kinetic": T, "potential": V}
+        guards[f"swing_heel_height_{pin}"] = (heel_sw.T * normal)[0]
+        guards[f"hip_height_{pin}"] = (at(hip).T * normal)[0]
+    guards["swing_foot_ahead"] = ps_sw - ps_st
+    guards["foot_angle"] = ps_st + a + gamma
+    # foot flat: the heel-contact flow with the foot's angle locked
+    Jl = sp.Matrix([[0, 1, 1]])
+    S = sp.Matrix([[1, 0], [0, 1], [0, -1]])
+    hc = flows["heel_contact"]
+    flows["foot_flat"] = _System(q, dq, M=(S.T * hc.M).col_join(Jl),
+                                 C=(S.T * hc.C).col_join(sp.zeros(1, 3)),
+                                 G=(S.T * hc.G).col_join(sp.zeros(1, 1)))
+    resets = {"foot_slap": _System(q, dq, Mi=(S.T * hc.M).col_join(Jl),
+                                   B=(S.T * hc.M).col_join(sp.zeros(1, 3)),
+                                   relabel_q=qv, relabel_rate=sp.eye(3))}
+    # heel strike: post-impact coordinates (swing, stance, b) with the swing heel pinned and
+    # the swing foot at angle swing + b (b = its rest angle at impact), in the pre-impact
+    # labelling; then the roles swap (new swing = old stance, new stance = old swing)
+    post_q = (ps_sw, ps_st, b_new)
+    post_bodies, _h, _a = bodies_from({ps_sw + b_new + half: hw}, "swing")
+    post = {b[4]: b for b in post_bodies}
+    relabel_q = sp.Matrix([ps_st, ps_sw, rw])
+    relabel_rate = sp.Matrix([[0, 1, 0], [1, 0, 0], [0, 0, 1]])
+    for pin, (ankle_lin, _off) in anchors.items():
+        pre_bodies, _h, _a = bodies_from(ankle_lin)
+        Mi, Bm = sp.zeros(3, 3), sp.zeros(3, 3)
+        for mass, lin, inertia, psi, name in pre_bodies:
+            pmass, plin, pinertia, ppsi, _n = post[name]
+            dn, dl = _velocity_terms(plin, post_q), _velocity_terms(lin, q)
+            wn = sp.Matrix([[sp.diff(ppsi, s) for s in post_q]])
+            wl = sp.Matrix([[sp.diff(psi, s) for s in q]])
+            for i in range(3):
+                for j in range(3):
+                    Mi[i, j] += mass * _dot_terms(dn[i], dn[j])
+                    Bm[i, j] += mass * _dot_terms(dn[i], dl[j])
+            Mi += inertia * wn.T * wn
+            Bm += inertia * wn.T * wl
+        Mi, Bm = (X.subs(b_new, rw).applyfunc(sp.factor_terms) for X in (Mi, Bm))
+        resets[f"heel_strike_{pin}"] = _System(q, dq, Mi=Mi, B=Bm, relabel_q=relabel_q,
+                                               relabel_rate=relabel_rate)
+    leg_angles = {"swing_angle": ps_sw, "stance_angle": ps_st, "stance_ankle_angle": a,
+                  "swing_ankle_angle": rw + 0 * ps_sw,
+                  "swing_rate": dq[0], "stance_rate": dq[1], "stance_ankle_rate": dq[2],
+                  "swing_ankle_rate": 0 * dq[0]}
+    return FlatEquations(q=q, dq=dq, qdd=qdd, params=tuple(par), flows=flows, resets=resets,
+                         guards=guards, ground=ground, kinematics=kin, leg_angles=leg_angles)
+
+
+def _scalar_fn(name: str, eq: FlatEquations, exprs: list, with_acc: bool) -> list[str]:
+    """A Python function ``(t, x)`` or ``(x, qdd)`` returning a float or a tuple."""
+    lines, red = _cse_lines(exprs, _PY)
+    unpack = codegen._unpack(eq)
+    head = [f"    def {name}(x, qdd):" if with_acc else f"    def {name}(t, x):", unpack]
+    if with_acc:
+        head.append(f"{IND}{', '.join(str(s) for s in eq.qdd)}, = qdd")
+    vals = [_PY.doprint(e) for e in red]
+    ret = vals[0] if len(vals) == 1 and not with_acc else f"({', '.join(vals)},)"
+    return head + lines + [f"{IND}return {ret}"]
+
+
+def _grad_fn(name: str, eq: FlatEquations, expr) -> list[str]:
+    x = [*eq.q, *eq.dq]
+    lines, red = _cse_lines([sp.diff(expr, s) for s in x], _PY)
+    return [f"    def {name}(x):", codegen._unpack(eq), *lines,
+            f"{IND}return np.array(({', '.join(_PY.doprint(e) for e in red)},))"]
+
+
+def generate_flat(structure: Structure, key: str) -> str:
+    """Source text of a flat-footed walker's generated module (``make(p)`` returns, by name:
+    ``flow_<mode>``, ``flow_<mode>_jacobian``, ``flow_<mode>_variational`` for the three
+    modes; ``reset_<name>`` and ``reset_<name>_jacobian`` for ``foot_slap``,
+    ``heel_strike_heel``, ``heel_strike_toe``; ``guard_<name>``/``grad_<name>``;
+    ``ground_heel(x, qdd) -> (N, N_toe)`` and ``ground_toe(x, qdd) -> (N,)`` [N];
+    ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
+    ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
+    eq = derive_flat(structure)
+    codegen._HOISTED.clear()
+    codegen._PARAMS.clear()
+    codegen._PARAMS.update(eq.params)
+    codegen._COUNT[0] = 0
+    fast = []
+    for mode, system in eq.flows.items():
+        fast += _flow(system, False, f"flow_{mode}")
+        fast += _flow(system, True, f"flow_{mode}_jacobian",
+                      variational=f"flow_{mode}_variational")
+    for name, system in eq.resets.items():
+        fast += _reset(system, False, f"reset_{name}")
+        fast += _reset(system, True, f"reset_{name}_jacobian")
+    for name, expr in eq.guards.items():
+        fast += _scalar_fn(f"guard_{name}", eq, [expr], False)
+        fast += _grad_fn(f"grad_{name}", eq, expr)
+    for pin, exprs in eq.ground.items():
+        fast += _scalar_fn(f"ground_{pin}", eq, exprs, True)
+    rest = "r_st_ankle" if structure.asymmetric else "r_ankle"
+    section = [
+        "    def section(x):",
+        f"{IND}return np.asarray(x)[[0, 1, 3, 4, 5]]",
+        "    def from_section(z):",
+        f"{IND}z0, z1, z2, z3, z4, = z",
+        f"{IND}return np.array((z0, z1, {rest} + 0.0 * z0, z2, z3, z4))",
+    ]
+    kin = eq.kinematics
+    numpy = [
+        *_numpy_fn("_points_heel", eq, kin["heel"]["points"]),
+        *_numpy_fn("_points_toe", eq, kin["toe"]["points"]),
+        *_numpy_fn("energies_heel", eq, {"kinetic": kin["heel"]["kinetic"],
+                                          "potential": kin["heel"]["potential"]}),
+        *_numpy_fn("energies_toe", eq, {"kinetic": kin["toe"]["kinetic"],
+                                         "potential": kin["toe"]["potential"]}),
+        "    def _on_toe(x):  # heel off: the foot turned heel up (phi < 0)",
+        f"{IND}x = np.asarray(x)",
+        f"{IND}return x[1] + x[2] + gamma < {-HEEL_OFF_PHI_RAD!r}",
+        "    def points(x):",
+        f"{IND}toe, h, o = _on_toe(x), _points_heel(x), _points_toe(x)",
+        f"{IND}return {{k: np.where(toe, o[k], h[k]) for k in h}}",
+        "    def energies(x):",
+        f"{IND}toe, h, o = _on_toe(x), energies_heel(x), energies_toe(x)",
+        f"{IND}return (np.where(toe, o['kinetic'], h['kinetic']),",
+        f"{IND}        np.where(toe, o['potential'], h['potential']))",
+        *_numpy_fn("leg_angles", eq, eq.leg_angles),
+    ]
+    body = [
+        "def make(p):",
+        f"    {', '.join(structure.param_names)}, = p",
+        *codegen._HOISTED, *fast, *section, *numpy,
+        "    return {k: v for k, v in locals().items() if callable(v) and not k.startswith('_')}",
+    ]
+    head = [
+        f"# walkerlab generated model code (walkerlab.models.flatfoot); key {key}",
+        "# Do not edit: regenerated when the walker description or the generator changes.",
+        "from math import sin, cos, tan, sqrt, pi  # noqa: F401",
+        "import numpy  # noqa: F401",
+        "import numpy as np",
+        "",
+    ]
+    return "\n".join(head + body) + "\n"
