@@ -14,9 +14,9 @@ from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.cache import functions
 from walkerlab.models.description import walker_data
 from walkerlab.models.registry import build_walker
-from walkerlab.models.rigid import functions
 from walkerlab.models.rigid_flat import mode_of, mode_sequence
 
 FOOT = {"kind": "flat", "heel_m": 0.05, "toe_m": 0.10,

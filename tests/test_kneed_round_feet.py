@@ -18,8 +18,9 @@ from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import BipedParams
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.cache import functions
 from walkerlab.models.description import walker_data
-from walkerlab.models.rigid import functions, make_rigid_walker
+from walkerlab.models.rigid import make_rigid_walker
 from walkerlab.published import bhounsule2009, hsu_chen2007
 
 ROOT = Path(__file__).resolve().parents[1]

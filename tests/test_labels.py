@@ -104,7 +104,8 @@ def test_nondimensional_report_and_figures_follow_the_scene(simplest_run):
     from walkerlab.io.schemas.simulate import load_simulate
     from walkerlab.plotting import figures as F
     from walkerlab.report import sections
-    from walkerlab.stages.report import existing_artifacts, load_inputs
+    from walkerlab.stages.report import load_inputs
+    from walkerlab.stages.report_dag import existing_artifacts
     from walkerlab.units import for_scene
 
     sc, root, _ = simplest_run

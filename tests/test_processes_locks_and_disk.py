@@ -23,7 +23,8 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from walkerlab.cli import _one_line, app
+from walkerlab.cli import app
+from walkerlab.cli.errors import one_line as _one_line
 from walkerlab.config import scene_from_dict
 from walkerlab.io import runpaths
 from walkerlab.io.artifacts import ArtifactError, atomic_write, write_artifact

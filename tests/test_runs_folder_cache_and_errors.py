@@ -317,7 +317,7 @@ def test_d5_report_is_written_atomically(tmp_path, monkeypatch):
         return real(path, write, mode)
 
     monkeypatch.setattr("walkerlab.io.artifacts.atomic_write", spy)
-    monkeypatch.setattr(report, "_run_stages", lambda *a, **k: [])
+    monkeypatch.setattr(report, "run_report", lambda *a, **k: ([], []))
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     out = report.run(sc, tmp_path, echo=lambda s: None)
     assert out.is_file() and {"report.md", "report.html"} <= set(calls)

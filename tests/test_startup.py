@@ -14,7 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from walkerlab.cli import BLAS_THREADS_ENV, _single_threaded_blas
+from walkerlab.cli.process import BLAS_THREADS_ENV
+from walkerlab.cli.process import single_threaded_blas as _single_threaded_blas
 
 ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("numba", "llvmlite", "sympy", "matplotlib", "CyRK.nb", "dask", "scipy.integrate")

@@ -10,7 +10,8 @@ the product):
 - :mod:`walkerlab.io`       HDF5 artifacts (atomic writes, content hashes)
 - :mod:`walkerlab.stages`   one function per stage: config + upstream artifacts -> one artifact
 - :mod:`walkerlab.plotting` figures drawn from loaded artifacts only
-- :mod:`walkerlab.cli`      thin typer front end
+- :mod:`walkerlab.cli`      thin typer front end (parse, run a stage, print)
+- :mod:`walkerlab.bench`    ``walkerlab bench``: the benchmarks by name
 - :mod:`walkerlab.api`      the Python front door: ``walkerlab.load_scene``,
   ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``,
   ``compare``, ``basin`` and ``api.sweep`` (each returns an ``xarray.Dataset`` read from the

@@ -20,9 +20,9 @@ from walkerlab.config import load_scene
 from walkerlab.config.contact import ContactSettings
 from walkerlab.contact.laws import contact_params_si, knee_stop_si
 from walkerlab.contact.model import ContactWalker
+from walkerlab.models.cache import functions
 from walkerlab.models.description import walker_data
 from walkerlab.models.floating import MASSLESS_MESSAGE, floating_view
-from walkerlab.models.rigid import functions
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 WALKERS = ("paper", "paper_rods", "kneed", "round_feet", "goswami1996")

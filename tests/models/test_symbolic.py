@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from walkerlab.models.cache import functions
 from walkerlab.models.description import BodySpec, Structure, WalkerData
-from walkerlab.models.rigid import functions
 from walkerlab.models.symbolic import derive
 
 COMPASS = Structure("absolute", (BodySpec("mass", "point_mass"),))

@@ -1,8 +1,8 @@
 """What a contact run records beside its trajectory: the drop test of the scene's contact
 law, the rates an initial rate scale multiplies, and the run's headline numbers.
 
-Used by the ``contact-sim`` stage (:mod:`walkerlab.stages.contact_sim`), which writes them
-through :mod:`walkerlab.io.schemas.contact_sim`.
+:func:`contact_sim_run` is the ``contact-sim`` stage's whole run (start, periodic gait, drop
+test, headline numbers); the stage writes it through :mod:`walkerlab.io.schemas.contact_sim`.
 """
 
 from __future__ import annotations
@@ -74,3 +74,75 @@ def run_summary(res) -> dict:
         "total_scuffs": int(sum(s.scuff_count for s in steps)),
         "nfev": int(res.nfev), "njev": int(res.njev), "wall_time_s": float(res.wall_time_s),
     }
+
+
+def contact_sim_run(scene: Scene, fp, adjust: bool = False, periodic: bool = False):
+    """The ``contact-sim`` stage's run: the contact walker started from the ideal fixed point
+    ``fp`` (a loaded ``fixedpoint.h5``) with the scene's rate scale, the rates ``adjust``
+    searches (kept only when they walk at least as well as the scene's own), or the contact
+    model's own periodic gait (``contact_sim.start: periodic_gait``); with ``periodic`` (or
+    that start) its periodic gait and Floquet multipliers; the drop test and the headline
+    numbers.
+
+    Returns
+    -------
+    walkerlab.io.schemas.contact_sim.ContactSimRun
+
+    Raises
+    ------
+    walkerlab.analysis.contact_periodic.PeriodicGaitError
+        ``start: periodic_gait`` and the gait was not found (one line naming the field).
+    """
+    from walkerlab.analysis import contact_sim as contact_run
+    from walkerlab.io.schemas.contact_sim import ContactSimRun
+
+    law, _terrain, cs = settings(scene)[:3]
+    adj = scale = None
+    gait = gait_error = None
+    adjust = adjust or cs.start == "adjusted"
+    if adjust:
+        from walkerlab.analysis.contact_adjust import adjust_rates, better_start
+
+        adj = adjust_rates(scene, fp.x, fp.step_period_s)
+        scale = adj["scale"]
+    if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
+        from walkerlab.analysis.contact_periodic import (
+            PeriodicGaitError,
+            simulate_from_periodic_gait,
+        )
+
+        try:
+            walker, res, x0, step_length, gait = simulate_from_periodic_gait(
+                scene, fp.x)
+        except PeriodicGaitError as exc:
+            raise PeriodicGaitError(f"scene '{scene.name}': contact_sim.start: periodic_gait: "
+                                    f"the contact walker's periodic gait was not found ({exc})"
+                                    ) from None
+        scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
+    else:
+        run = contact_run.simulate_from(scene, fp.x, fp.step_period_s, scale)
+        if adjust:  # the adjusted start must walk at least as well as the scene's own
+            plain = contact_run.simulate_from(scene, fp.x, fp.step_period_s, None)
+            adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
+            if adj["kept"] == "scene":
+                run, scale = plain, None
+        walker, res, x0, step_length = run
+    if periodic and gait is None:
+        from walkerlab.analysis.contact_periodic import (
+            PeriodicGaitError,
+            find_contact_periodic_gait,
+        )
+
+        try:
+            gait = find_contact_periodic_gait(walker, fp.x, time_limit_s=cs.periodic_time_limit_s)
+        except PeriodicGaitError as exc:
+            gait_error = exc
+    return ContactSimRun(
+        walker=walker, result=res, samples=contact_run.named_trajectory(walker, res, LEGS),
+        initial_state=x0, step_length_m=step_length, fixed_point=fp.x,
+        fixed_point_names=fp.state_names, legs=LEGS,
+        rate_names=[" ".join(rate_states(walker, leg)) for leg in LEGS],
+        initial_rate_scale=np.asarray(scale if scale is not None else cs.initial_rate_scale),
+        stiffness_family=law.stiffness_family,
+        drop=drop_test(scene, walker.total_mass), drop_speed_m_per_s=DROP_SPEED,
+        summary=run_summary(res), gait=gait, gait_error=gait_error, adjust=adj)

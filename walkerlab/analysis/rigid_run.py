@@ -65,3 +65,46 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
         "mean_total_energy_J": float(np.mean(samples.total)),
     }
     return RigidRun(traj, samples, steps, summary)
+
+
+def simulate_run(scene: Scene, fixed_point=None):
+    """The ``simulate`` stage's run: the scene's walker from the fixed point ``fixed_point``
+    (a loaded ``fixedpoint.h5``, when ``simulate.initial_state`` is ``fixed_point``) or from
+    the scene's explicit initial state, simulated and sampled (:func:`simulate_scene`).
+
+    Returns
+    -------
+    walkerlab.io.schemas.simulate.SimulateRun
+
+    Raises
+    ------
+    ValueError
+        More samples than :data:`walkerlab.config.MAX_SIMULATE_SAMPLES` (said before
+        integrating when the period is known); an initial state that does not fit the
+        walker (one line naming the field).
+    """
+    from walkerlab.analysis.metrics import total_mass_kg
+    from walkerlab.config import MAX_SIMULATE_SAMPLES
+    from walkerlab.io.schemas.simulate import SimulateRun
+    from walkerlab.models.registry import build_walker
+
+    sim = scene.simulate
+    walker = build_walker(scene)
+    if sim.initial_state == "fixed_point":
+        x0, period = fixed_point.x, fixed_point.step_period_s
+        # refuse before integrating what could not be sampled (sample_trajectory checks
+        # the exact count afterwards for any initial state)
+        n = 2 * sim.strides * period * sim.sample_rate_hz
+        if n > MAX_SIMULATE_SAMPLES:
+            raise ValueError(f"simulate.sample_rate_hz: {sim.sample_rate_hz:g} Hz over "
+                             f"{sim.strides} strides of {2 * period:.3g} s "
+                             f"gives {n:.3g} samples; at most {MAX_SIMULATE_SAMPLES:,} "
+                             "are kept (lower simulate.sample_rate_hz or simulate.strides)")
+    else:
+        try:
+            x0 = sim.initial_state.as_array(walker.state_names())
+        except ValueError as exc:
+            raise ValueError(f"simulate.initial_state: {exc}") from None
+    r = simulate_scene(scene, walker, x0)
+    return SimulateRun(walker, r.trajectory, r.samples, r.steps, x0, sim.strides,
+                       total_mass_kg(walker), r.summary)

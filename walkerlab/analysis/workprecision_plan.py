@@ -1,7 +1,7 @@
 """The cases of a work-precision study planned from a scene: models, methods, tolerances,
 references, target errors, warm-up cases, and the key under which a measured case is kept
-(its inputs and the sources it runs).  Measured by :mod:`walkerlab.analysis.workprecision`
-for the ``workprecision`` stage.
+(its inputs and the sources it runs).  :func:`run_study` measures them
+(:mod:`walkerlab.analysis.workprecision`) for the ``workprecision`` stage.
 """
 
 from __future__ import annotations
@@ -10,7 +10,13 @@ import hashlib
 import json
 from pathlib import Path
 
-from walkerlab.analysis.workprecision import CYRK_PREFIX
+from walkerlab.analysis.workprecision import (
+    CYRK_PREFIX,
+    Case,
+    rows_from_cases,
+    run_cases,
+    summarize,
+)
 from walkerlab.config import Scene
 
 #: the sources a case's result depends on (a change elsewhere - report text, plots, other
@@ -86,3 +92,55 @@ def warm_cases(model_plan) -> tuple:
     methods, rtols, af = model_plan[:3]
     r = max(rtols)
     return tuple((m, r, af * r) for m in methods)
+
+
+def run_study(scene: Scene, wp, x0, step_period_s: float, cache: Path, workers: int = 2,
+              lanes=None) -> tuple[dict, int, int]:
+    """Measure every case of the scene's plan (:func:`plan`) from the gait ``x0`` (its step
+    period [s]), keeping each measured case in ``cache`` (a case found there is not timed
+    again), and turn them into work-precision rows.
+
+    Parameters
+    ----------
+    wp : walkerlab.config.WorkPrecisionSettings
+        The scene's ``workprecision`` section (strides, repeats).
+    workers : int
+        Processes measuring cases side by side, one pinned core each (1 = in this process).
+    lanes : walkerlab.execution.lanes.Lanes, optional
+        Explicit cores/gates for the measuring processes
+        (:func:`walkerlab.analysis.workprecision.run_cases`).
+
+    Returns
+    -------
+    (dict, int, int)
+        ``{model: (rows, summary, reference)}``, the cases found in the cache, all cases.
+    """
+    import numpy as np
+
+    from walkerlab import progress
+
+    x0t = tuple(float(v) for v in x0)
+    sj = json.dumps(scene.model_dump(mode="json"), sort_keys=True)
+    period = float(step_period_s)
+    models = plan(scene)
+    tasks, keys = [], {}
+    for model, mp_ in models.items():
+        methods, rtols, af, ref, _, secs = mp_
+        warm = warm_cases(mp_)
+        cases = [(ref[0], ref[1], ref[2], 1)] + [(m, r, af * r, wp.repeats)
+                                                 for m in methods for r in rtols]
+        for m, r, a, rep in cases:
+            k = case_key(model, secs, x0t, wp.strides, m, r, a, rep)
+            keys[(model, m, r, rep)] = k
+            tasks.append(Case(k, model, sj, period, x0t, wp.strides, m, r, a, rep, warm))
+    with progress.task(f"work-precision: timing {len(tasks)} cases (uncached)") as bar:
+        done = run_cases(tasks, cache, workers, lanes,
+                         on_case=lambda k, n: bar.update(k, total=n))
+    results = {}
+    for model, (methods, rtols, _, ref, target, _) in models.items():
+        refvec = done[keys[(model, ref[0], ref[1], 1)]]["vec"]
+        cases = {(m, r): done[keys[(model, m, r, wp.repeats)]] for m in methods
+                 for r in rtols}
+        rows = rows_from_cases(cases, methods, rtols, np.asarray(refvec))
+        results[model] = (rows, summarize(rows, target), ref)
+    return results, sum(1 for v in done.values() if v.get("cached")), len(done)

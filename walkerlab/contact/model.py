@@ -335,7 +335,7 @@ class ContactWalker:
         if st.coordinates == "absolute" or st.knee:
             values = self.rigid_layout().named(x)  # the rigid state, by name
         else:
-            from walkerlab.models.rigid import functions
+            from walkerlab.models.cache import functions
 
             values = functions(self.data)["leg_angles"](x)
         return floating_links_from_rigid(values, self.layout(), rate_scale)

@@ -122,8 +122,14 @@ def _lost(client) -> DaskLost:
 
 
 def _n_workers(client) -> int | None:
+    """Workers the scheduler has now, asked over the wire; None when it does not answer.
+
+    ``client.scheduler_info()`` is not used: it swallows a connection error and returns the
+    cached worker list, so a dead scheduler looked alive (the session-6/7 flake of
+    ``test_h1_dask_scheduler_killed``)."""
     try:
-        return len(client.scheduler_info().get("workers", {}))
+        ident = client.sync(client.scheduler.identity, callback_timeout=CHECK_S + 2.0)
+        return len(ident.get("workers", {}))
     except Exception:  # noqa: BLE001 - the scheduler is unreachable: reported as lost
         return None
 

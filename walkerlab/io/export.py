@@ -68,7 +68,9 @@ Formats:
 
 from __future__ import annotations
 
+import json
 import math
+import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
@@ -77,10 +79,13 @@ if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not bu
     from walkerlab.models.multibody import Link, Multibody
 
 __all__ = ["FORMATS", "LANE_BITS", "MJCF_MIN_INERTIA_KG_M2", "MJCF_MIN_LENGTH_M",
-           "MJCF_MIN_MASS_KG", "MjcfScene", "mjcf_text", "point_foot_radius", "urdf_text"]
+           "MJCF_MIN_MASS_KG", "MjcfScene", "SIDECAR", "comments_in_scene_units", "keyframe_json",
+           "mjcf_text", "point_foot_radius", "urdf_text"]
 
 #: Export formats and their file names in ``runs/<scene>/``.
 FORMATS = {"urdf": "walker.urdf", "mjcf": "walker.xml"}
+#: The URDF's keyframe sidecar in ``runs/<scene>/``.
+SIDECAR = "walker.gait.json"
 #: Floor of a MuJoCo principal inertia [kg m^2] (MuJoCo's mjMINVAL is 1e-15).
 MJCF_MIN_INERTIA_KG_M2 = 1e-12
 #: Floor of the MuJoCo hip body's mass [kg] (only for a walker without a hip mass); a link
@@ -451,3 +456,26 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
                                 for k, v in custom.items()), "  </custom>"]
     out += ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>", ""]
     return "\n".join(out)
+
+
+def keyframe_json(mb: Multibody, extra: MjcfScene) -> str:
+    """The ``gait`` keyframe as JSON: ``{"joints": [...], "qpos": [...], "qvel": [...],
+    "units": [...]}`` in the URDF's joint names and order (the sidecar of ``walker.urdf``)."""
+    joints = ["hip_x", "hip_z", *(ln.joint for ln in mb.links)]
+    units = ["m", "m", *("rad" for _ in mb.links)]
+    return json.dumps({"keyframe": "gait", "description": "rigid fixed point just after heel "
+                       "strike, leg2 in stance, its foot at the origin on the ground line",
+                       "joints": joints, "units": units, "qpos": list(extra.qpos),
+                       "qvel": list(extra.qvel)}, indent=1) + "\n"
+
+
+def comments_in_scene_units(text: str, units) -> str:
+    """The header comments' unit labels in the scene's unit system (``units``: a
+    :class:`walkerlab.units.Units`; a nondimensional scene: ``l``, ``g``, not ``m``,
+    ``m/s^2``); the XML itself carries numbers only."""
+    if not units.nondimensional:
+        return text
+    # a unit follows a number ("1.2 m") or stands in brackets ("[m]"); prose is left alone
+    unit = re.compile(r"(?:(?<=\d )|(?<=\[))(m/s\^2|kg m\^2|kg|m|s)(?=[\];.,) ])")
+    return "\n".join(unit.sub(lambda m: units(m.group(1)), ln)
+                     if ln.lstrip().startswith("<!--") else ln for ln in text.split("\n"))

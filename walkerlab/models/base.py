@@ -57,6 +57,22 @@ Flow = Callable[[float, np.ndarray], np.ndarray]
 GuardOutcome = Literal["next_phase", "heel_strike", "fall"]
 
 
+#: Physical legs; ``leg1`` swings first (paper Eq. 11).
+LEGS = ("leg1", "leg2")
+
+
+def role_to_leg(stance_leg: str) -> dict[str, str]:
+    """``{"stance": stance_leg, "swing": other leg}``.
+
+    Raises
+    ------
+    KeyError
+        ``stance_leg`` is not ``leg1`` or ``leg2``.
+    """
+    other = {"leg1": "leg2", "leg2": "leg1"}[stance_leg]
+    return {"stance": stance_leg, "swing": other}
+
+
 @dataclass(frozen=True)
 class Guard:
     """A scalar guard function whose zero crossing (in ``direction``) triggers ``outcome``.

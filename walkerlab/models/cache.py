@@ -181,3 +181,8 @@ def import_generated(filename: str, module_name: str, build):
 def clear_memo() -> None:
     """Forget modules loaded in this process (tests)."""
     _memo.clear()
+
+
+def functions(data) -> dict:
+    """Generated functions of ``data`` with its parameters bound (see codegen's table)."""
+    return generated_module(data.structure)["make"](data.params)

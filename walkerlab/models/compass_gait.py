@@ -198,7 +198,7 @@ def _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_fro
 @cache
 def _generated(p: tuple) -> dict:
     """Generated functions for ``p = (m, M_H, L, a, g)`` (slope 0: flow, impact, energies)."""
-    from walkerlab.models.rigid import functions
+    from walkerlab.models.cache import functions
 
     m, mh, L, a, g = p
     return functions(_data(L, m, mh, g, a, 0.0))

@@ -38,12 +38,12 @@ from __future__ import annotations
 from dataclasses import replace
 from functools import partial
 
-from walkerlab.models.base import Guard, HybridWalker, Phase
-from walkerlab.models.cache import generated_module
+from walkerlab.models.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
+from walkerlab.models.cache import functions
 from walkerlab.models.compiled import CompiledFlow
 from walkerlab.models.description import WalkerData
+from walkerlab.models.rigid_flat import make_flat_walker
 
-LEGS = ("leg1", "leg2")
 #: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
 SCUFF_DEPTH = 1e-9
 
@@ -51,23 +51,6 @@ SCUFF_DEPTH = 1e-9
 def _below(clearance, depth, t, x):
     """``clearance + depth``: crosses zero downward when the foot is ``depth`` deep."""
     return clearance(t, x) + depth
-
-
-def role_to_leg(stance_leg: str) -> dict[str, str]:
-    """``{"stance": stance_leg, "swing": other leg}``.
-
-    Raises
-    ------
-    KeyError
-        ``stance_leg`` is not ``leg1`` or ``leg2``.
-    """
-    other = {"leg1": "leg2", "leg2": "leg1"}[stance_leg]
-    return {"stance": stance_leg, "swing": other}
-
-
-def functions(data: WalkerData) -> dict:
-    """Generated functions of ``data`` with its parameters bound (see codegen's table)."""
-    return generated_module(data.structure)["make"](data.params)
 
 
 def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "derived",
@@ -89,8 +72,6 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     HybridWalker
     """
     if data.structure.foot == "flat":  # modes of a flat foot: their own phase graph
-        from walkerlab.models.rigid_flat import make_flat_walker
-
         return make_flat_walker(data, name, variant)
     f = functions(data)
     # the compiled flow is the generated one: none when the flow is replaced

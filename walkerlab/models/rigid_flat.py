@@ -32,10 +32,9 @@ from __future__ import annotations
 from dataclasses import replace
 from functools import partial
 
-from walkerlab.models.base import Guard, HybridWalker, Phase
+from walkerlab.models.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
+from walkerlab.models.cache import functions
 from walkerlab.models.description import WalkerData
-from walkerlab.models.flatfoot import MODES
-from walkerlab.models.rigid import LEGS, functions, role_to_leg
 
 #: The swing leg's parts of a step: before and after the legs pass each other.
 SWING_PARTS = ("early_swing", "late_swing")
@@ -80,6 +79,10 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     HybridWalker
         Roles ``(swing, stance, stance_ankle)``; six phases ``<mode>:<swing part>``.
     """
+    # here, not at the top: flatfoot imports sympy, and models.rigid imports this module for
+    # every walker (issue 27: sympy on the path of `walkerlab fixedpoint`, ~0.2 s)
+    from walkerlab.models.flatfoot import MODES
+
     f = functions(data)
     flows = {m: f[f"flow_{m}"] for m in MODES}
     pin = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}

@@ -30,7 +30,7 @@ import numpy as np
 from walkerlab.io.trajectory import NamedTrajectory
 
 __all__ = ["ARC_HALF_ANGLE_RAD", "WalkerFrames", "frame_times", "gif_writer", "leg_parts",
-           "walker_animation", "write_frames"]
+           "save_frames", "walker_animation", "write_frames"]
 
 #: Half the angle the drawn foot arc spans about the leg axis [rad] (the stance arc's contact
 #: stays within about 0.3 rad of the axis for the shipped walkers).
@@ -181,64 +181,20 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
     fig, axes = plt.subplots(1, n, figsize=(width, 0.92 * width / n), dpi=dpi,
                              squeeze=False)
     fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=0.88, wspace=0.03)
-    axes = axes[0]
     xmin = min(float(tr.points["hip"][0].min()) for tr in trajs.values()) - 3 * L
     xmax = max(float(tr.points["hip"][0].max()) for tr in trajs.values()) + 3 * L
     gx = np.array([xmin, xmax])
-    gy = -np.tan(slope_rad) * gx
     panels = []
-    for ax, (title, tr) in zip(axes, trajs.items()):
-        ground = (terrain or {}).get(title)
-        if ground is not None and not ground["continuous"]:  # patches over gaps
-            from walkerlab.plotting.figures import draw_patches
-
-            draw_patches(ax, ground, slope_rad, 0.12 * L)
-            ax.plot(gx, gy, color="0.6", lw=0.8, ls=":")
-        else:
-            ax.fill_between(gx, gy, gy - 3 * L, color="0.85", lw=0)
-            ax.plot(gx, gy, color="k", lw=1)
-        ax.set_aspect("equal")
-        ax.set_xticks([])
-        ax.set_yticks([])
-        idx = np.clip(np.searchsorted(tr.time, times), 0, tr.time.size - 1)
-        legs = []
-        for k, leg in enumerate(tr.legs):
-            c = LEG_COLOURS[k % len(LEG_COLOURS)]
-            parts = leg_parts(tr, leg)
-            legs.append({
-                "parts": parts,
-                "line": ax.plot([], [], color=c, lw=3, solid_capstyle="round")[0],
-                "arc": ax.plot([], [], color=c, lw=3)[0] if parts["arc"] else None,
-                "contact": ax.plot([], [], "o", color=c, ms=3)[0] if parts["arc"] else None,
-                "sole": ax.plot([], [], color=c, lw=3)[0] if parts["sole"] else None,
-                "dots": ax.plot([], [], "o", color=c, ms=6)[0],
-            })
-        hip = ax.plot([], [], "o", color="k", ms=9)[0]
-        label = ax.set_title(title, fontsize=13)
-        panels.append((ax, tr, idx, legs, hip, label, title))
+    for ax, (title, tr) in zip(axes[0], trajs.items()):
+        _draw_ground(ax, gx, slope_rad, L, (terrain or {}).get(title))
+        panels.append(_panel(ax, title, tr, times))
 
     def draw(j: int) -> None:
         for ax, tr, idx, legs, hip, label, title in panels:
             i = idx[j]
             P = {n: tr.points[n][:, i] for n in tr.points}
             for lg in legs:
-                parts = lg["parts"]
-                xy = np.array([P[n] for n in parts["chain"]])
-                if parts["arc"]:
-                    c, k = (P[n] for n in parts["arc"])
-                    r = float(np.hypot(*(k - c)))
-                    u = (c - xy[-2]) / np.hypot(*(c - xy[-2]))  # the leg's (shank's) axis
-                    a = np.arctan2(u[1], u[0]) + np.linspace(-ARC_HALF_ANGLE_RAD,
-                                                             ARC_HALF_ANGLE_RAD, ARC_POINTS)
-                    lg["arc"].set_data(c[0] + r * np.cos(a), c[1] + r * np.sin(a))
-                    lg["contact"].set_data([k[0]], [k[1]])
-                    xy = np.vstack([xy, c + r * u])  # the leg runs on to its arc
-                lg["line"].set_data(xy[:, 0], xy[:, 1])
-                if parts["sole"]:  # a flat foot: heel to toe through the ankle
-                    sole = np.array([P[n] for n in parts["sole"]])
-                    lg["sole"].set_data(sole[:, 0], sole[:, 1])
-                b = np.array([P[n] for n in parts["bodies"]]).reshape(-1, 2)
-                lg["dots"].set_data(b[:, 0], b[:, 1])
+                _draw_leg(lg, P)
             hx, hy = P["hip"]
             hip.set_data([hx], [hy])
             ax.set_xlim(hx - 1.1 * L, hx + 1.1 * L)
@@ -246,3 +202,85 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
             label.set_text(f"{title}\nt = {times[j]:.2f} {time_unit}")
 
     return WalkerFrames(fig, times, draw, dpi)
+
+
+def _draw_ground(ax, gx: np.ndarray, slope_rad: float, L: float, ground: dict | None) -> None:
+    """The slope line ``y = -x tan(phi)`` over ``gx`` (shaded below), or the contact walker's
+    patches over gaps (``ground``: :func:`walkerlab.io.terrain.load_terrain`)."""
+    gy = -np.tan(slope_rad) * gx
+    if ground is not None and not ground["continuous"]:  # patches over gaps
+        from walkerlab.plotting.figures import draw_patches
+
+        draw_patches(ax, ground, slope_rad, 0.12 * L)
+        ax.plot(gx, gy, color="0.6", lw=0.8, ls=":")
+    else:
+        ax.fill_between(gx, gy, gy - 3 * L, color="0.85", lw=0)
+        ax.plot(gx, gy, color="k", lw=1)
+    ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+
+
+def _panel(ax, title: str, tr: NamedTrajectory, times: np.ndarray) -> tuple:
+    """One panel's artists: ``(ax, tr, sample index per frame, legs, hip, title, text)``."""
+    idx = np.clip(np.searchsorted(tr.time, times), 0, tr.time.size - 1)
+    legs = []
+    for k, leg in enumerate(tr.legs):
+        c = LEG_COLOURS[k % len(LEG_COLOURS)]
+        parts = leg_parts(tr, leg)
+        legs.append({
+            "parts": parts,
+            "line": ax.plot([], [], color=c, lw=3, solid_capstyle="round")[0],
+            "arc": ax.plot([], [], color=c, lw=3)[0] if parts["arc"] else None,
+            "contact": ax.plot([], [], "o", color=c, ms=3)[0] if parts["arc"] else None,
+            "sole": ax.plot([], [], color=c, lw=3)[0] if parts["sole"] else None,
+            "dots": ax.plot([], [], "o", color=c, ms=6)[0],
+        })
+    hip = ax.plot([], [], "o", color="k", ms=9)[0]
+    label = ax.set_title(title, fontsize=13)
+    return ax, tr, idx, legs, hip, label, title
+
+
+def _draw_leg(lg: dict, P: dict[str, np.ndarray]) -> None:
+    """Move one leg's artists (``lg``, from :func:`_panel`) to the points ``P`` of a frame."""
+    parts = lg["parts"]
+    xy = np.array([P[n] for n in parts["chain"]])
+    if parts["arc"]:
+        c, k = (P[n] for n in parts["arc"])
+        r = float(np.hypot(*(k - c)))
+        u = (c - xy[-2]) / np.hypot(*(c - xy[-2]))  # the leg's (shank's) axis
+        a = np.arctan2(u[1], u[0]) + np.linspace(-ARC_HALF_ANGLE_RAD,
+                                                 ARC_HALF_ANGLE_RAD, ARC_POINTS)
+        lg["arc"].set_data(c[0] + r * np.cos(a), c[1] + r * np.sin(a))
+        lg["contact"].set_data([k[0]], [k[1]])
+        xy = np.vstack([xy, c + r * u])  # the leg runs on to its arc
+    lg["line"].set_data(xy[:, 0], xy[:, 1])
+    if parts["sole"]:  # a flat foot: heel to toe through the ankle
+        sole = np.array([P[n] for n in parts["sole"]])
+        lg["sole"].set_data(sole[:, 0], sole[:, 1])
+    b = np.array([P[n] for n in parts["bodies"]]).reshape(-1, 2)
+    lg["dots"].set_data(b[:, 0], b[:, 1])
+
+
+def save_frames(frames: WalkerFrames, path: Path, writer) -> Path:
+    """Write the frames to a temporary file of the same suffix in the same folder, then rename
+    (matplotlib's writers pick the format from the file name), mode 0644.  ``path`` must not
+    be a symbolic link (RunPathError, one line); temporary files of a killed earlier run
+    (``.animation.<pid>.*.gif``) are removed first."""
+    import os
+    import tempfile
+
+    from walkerlab.safefs import refuse_link, remove_stale_temps, temp_prefix
+
+    refuse_link(path)
+    remove_stale_temps(path.parent, path.stem, (path.suffix,))
+    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.stem), suffix=path.suffix,
+                               dir=path.parent)
+    os.close(fd)
+    try:
+        write_frames(frames, tmp, writer)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    finally:
+        Path(tmp).unlink(missing_ok=True)
+    return path

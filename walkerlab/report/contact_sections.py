@@ -34,8 +34,6 @@ def contact_section(scene, arts) -> list[str]:
         return []
     pub = for_scene(scene)
     table2 = getattr(pub, "TABLE2", {})
-    scale = c.initial_rate_scale
-    scaled = c.rate_names or ["leg1", "leg2"]
     summ, stage_wall, cp = c.summary, c.stage_wall_time_s, c.contact_params_si
     term = c.termination
     outcome = (c.outcome, c.outcome_message)
@@ -43,42 +41,13 @@ def contact_section(scene, arts) -> list[str]:
     creep = c.steps.get("double_support_creep_mm")
     drop = c.drop
     periods = c.steps["period"]
-    adj = dict(c.adjust) if c.adjust is not None else None
-    if adj is not None:
-        adj.update(kept=str(adj.get("kept", "adjusted")), why=str(adj.get("kept_reason", "")))
     per = per_fail = None
     if c.periodic is not None and not c.periodic.found:
         per_fail = (c.periodic.outcome, c.periodic.message)
     elif c.periodic is not None:
         g = c.periodic
         per = (g.step_period_s, g.step_length_m, g.multipliers, g.stable)
-    # initial states by name: the first sample of each trajectory artifact
-    c0 = {n: float(v[0]) for n, v in c.samples.coordinates.items()}
-    i0 = {}
-    if "simulate" in arts:
-        i0 = {n: float(v[0]) for n, v in arts["simulate"].samples.coordinates.items()}
-    rows = []
-    for key in [k for k in table2 if k in c0] + [k for k in c0 if k not in table2]:
-        sym, pm, pa = table2.get(key, (key, np.nan, np.nan))
-        oi = i0.get(key, np.nan)
-        pd = f"{100 * (abs(pa) - abs(pm)) / abs(pm):+.1f}%" if key in table2 else "—"
-        rows.append([sym, printed(pm), printed(pa), pd, oi, c0[key],
-                     f"{100 * (abs(c0[key]) - abs(oi)) / abs(oi):+.1f}%"])
-    head = ["state", "paper MATLAB", "paper ADAMS", "paper diff.", "ours ideal",
-            "ours contact", "ours diff."]
-    if not table2:
-        head, rows = [head[0], *head[4:]], [[r[0], *r[4:]] for r in rows]
-    out = [("## Table 2 — " if table2 else "## ") + "initial states (ideal vs contact model)", "",
-           _table(head, rows), "",
-           f"Our contact walker starts from our ideal fixed point with the initial rates scaled "
-           f"by [{', '.join(num(v, 3) for v in np.atleast_1d(scale))}] ("
-           + "; ".join(f"{n} × {num(v, 3)}" for n, v in zip(scaled, np.atleast_1d(scale)))
-           + ")"
-           + (f" (found by `--adjust`: objective {num(adj['objective'], 3)} after "
-              f"{int(adj['evaluations'])} simulations)" if adj and adj["kept"] != "scene"
-              else f" (the scene's own: `--adjust` found a scale that walks worse; {adj['why']})"
-              if adj else "")
-           + "." + _table2_note(pub), "",
+    out = _initial_state_lines(c, arts, pub, table2) + [
            "## Contact walker (MSC ADAMS-style model)", "",
            _table(["quantity", "value", "unit"], _summary_rows(summ, stage_wall)
                   + [["termination", term, ""]]),
@@ -109,6 +78,44 @@ def contact_section(scene, arts) -> list[str]:
                 + ", ".join(f"{m:.4f}" for m in per[2][:3])
                 + " and three fast contact/creep modes ≈ 0.", ""]
     return out
+
+
+def _initial_state_lines(c, arts, pub, table2: dict) -> list[str]:
+    """Table 2 (initial states: the paper's MATLAB and ADAMS columns where the scene has
+    published ones, ours ideal and contact) and the sentence on the contact walker's start
+    (its rate scale, and what ``--adjust`` found)."""
+    scale = c.initial_rate_scale
+    scaled = c.rate_names or ["leg1", "leg2"]
+    adj = dict(c.adjust) if c.adjust is not None else None
+    if adj is not None:
+        adj.update(kept=str(adj.get("kept", "adjusted")), why=str(adj.get("kept_reason", "")))
+    # initial states by name: the first sample of each trajectory artifact
+    c0 = {n: float(v[0]) for n, v in c.samples.coordinates.items()}
+    i0 = {}
+    if "simulate" in arts:
+        i0 = {n: float(v[0]) for n, v in arts["simulate"].samples.coordinates.items()}
+    rows = []
+    for key in [k for k in table2 if k in c0] + [k for k in c0 if k not in table2]:
+        sym, pm, pa = table2.get(key, (key, np.nan, np.nan))
+        oi = i0.get(key, np.nan)
+        pd = f"{100 * (abs(pa) - abs(pm)) / abs(pm):+.1f}%" if key in table2 else "—"
+        rows.append([sym, printed(pm), printed(pa), pd, oi, c0[key],
+                     f"{100 * (abs(c0[key]) - abs(oi)) / abs(oi):+.1f}%"])
+    head = ["state", "paper MATLAB", "paper ADAMS", "paper diff.", "ours ideal",
+            "ours contact", "ours diff."]
+    if not table2:
+        head, rows = [head[0], *head[4:]], [[r[0], *r[4:]] for r in rows]
+    return [("## Table 2 — " if table2 else "## ") + "initial states (ideal vs contact model)",
+            "", _table(head, rows), "",
+            f"Our contact walker starts from our ideal fixed point with the initial rates scaled "
+            f"by [{', '.join(num(v, 3) for v in np.atleast_1d(scale))}] ("
+            + "; ".join(f"{n} × {num(v, 3)}" for n, v in zip(scaled, np.atleast_1d(scale)))
+            + ")"
+            + (f" (found by `--adjust`: objective {num(adj['objective'], 3)} after "
+               f"{int(adj['evaluations'])} simulations)" if adj and adj["kept"] != "scene"
+               else f" (the scene's own: `--adjust` found a scale that walks worse; {adj['why']})"
+               if adj else "")
+            + "." + _table2_note(pub), ""]
 
 
 def _summary_rows(summ: dict, stage_wall_s: float) -> list[list]:

@@ -15,16 +15,17 @@ name in the same folder, then rename).
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from walkerlab.config import Scene, SlopeSettings
+from walkerlab.io.runpaths import figures_dir
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
+from walkerlab.io.terrain import load_terrain
+from walkerlab.plotting import CONTACT_LABEL, IDEAL_LABEL
 from walkerlab.stages.common import artifact_path
-from walkerlab.stages.plot import CONTACT_LABEL, IDEAL_LABEL, figures_dir
+from walkerlab.stages.pipeline import computed_for
 
 #: Frames per second, and the most frames one animation gets (a 5-stride compass gait,
 #: 7 s, is 141 frames at 20 fps; longer runs play faster).
@@ -40,97 +41,37 @@ class AnimateOutcome:
     note: str = ""
 
 
-def _atomic_save(frames, path: Path, writer) -> Path:
-    """Write the frames to a temporary file of the same suffix in the same folder, then rename
-    (matplotlib's writers pick the format from the file name).  ``path`` must not be a
-    symbolic link (RunPathError, one line); temporary files of a killed earlier run
-    (``.animation.<pid>.*.gif``) are removed first."""
-    from walkerlab.plotting.animation import write_frames
-    from walkerlab.safefs import refuse_link, remove_stale_temps, temp_prefix
-
-    refuse_link(path)
-    remove_stale_temps(path.parent, path.stem, (path.suffix,))
-    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.stem), suffix=path.suffix,
-                               dir=path.parent)
-    os.close(fd)
-    try:
-        write_frames(frames, tmp, writer)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    finally:
-        Path(tmp).unlink(missing_ok=True)
-    return path
-
-
-def contact_left_out(scene: Scene, runs_root, path: Path) -> str:
-    """Why ``contact_sim.h5`` must not be drawn beside the current rigid walker ('' if it
-    may): changed after it was written, or written for other inputs than the scene's
-    current ones (any of the contact stage's variants: plain, ``--adjust``, ``--periodic``)."""
-    from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
-    from walkerlab.stages import contact_sim
-    from walkerlab.stages.common import input_hash
-
-    if not stored_content_hash_matches(path):
-        return f"{path.name} was changed after it was written"
-    up = (artifact_path(scene, runs_root, "fixedpoint"),)
-    have = stored_hash(path)
-    for extra in ((), ("adjust",), ("periodic",), ("adjust", "periodic")):
-        if have == input_hash("contact-sim", scene, contact_sim.SECTIONS + extra, up):
-            return ""
-    return f"{path.name} was computed for another scene or fixed point"
-
-
 def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
         max_frames: int = MAX_FRAMES) -> AnimateOutcome:
-    """Write ``runs/<scene>/report/figures/animation.gif`` (and ``.mp4`` with ffmpeg).
-
-    Parameters
-    ----------
-    scene : Scene
-    runs_root : Path or str
-    fps : float
-        Frames per second [1/s].
-    max_frames : int
-        Most frames (see :func:`walkerlab.plotting.animation.frame_times`).
-
-    Returns
-    -------
-    AnimateOutcome
-
-    Raises
-    ------
-    StageError
-        The rigid simulation cannot run (no ``simulate`` section, no fixed point, ...).
-    """
+    """Write ``runs/<scene>/report/figures/animation.gif`` (and ``.mp4`` with ffmpeg) at
+    ``fps`` frames per second [1/s], at most ``max_frames``
+    (:func:`walkerlab.plotting.animation.frame_times`)."""
     from matplotlib import pyplot as plt
     from matplotlib.animation import FFMpegWriter, writers
 
-    from walkerlab.plotting.animation import gif_writer, walker_animation
+    from walkerlab.plotting.animation import gif_writer, save_frames, walker_animation
 
     sim = load_simulate(artifact_path(scene, runs_root, "simulate"))
-    trajs, notes = {IDEAL_LABEL: sim.samples}, []
+    trajs, ground, notes = {IDEAL_LABEL: sim.samples}, {}, []
     contact = artifact_path(scene, runs_root, "contact-sim")
-    why = contact_left_out(scene, runs_root, contact) if contact.is_file() else ""
+    # any of the contact stage's variants: plain, --adjust, --periodic
+    why = computed_for(scene, runs_root, "contact-sim", ("adjust", "periodic")) \
+        if contact.is_file() else ""
     if why:
         notes.append(f"animated the rigid walker only: {why} (rerun 'walkerlab contact-sim' "
                      "to animate the contact walker beside it)")
-    elif contact.is_file():
+    elif contact.is_file():  # with the checkerboard it walks on
         trajs[CONTACT_LABEL] = load_contact_sim(contact).samples
-    unit = sim.units.time
+        ground[CONTACT_LABEL] = load_terrain(contact)
     slope = SlopeSettings.model_validate(json.loads(sim.scene_json)["slope"]).phi_rad
     folder = figures_dir(scene, runs_root, claim=True)
-    ground = {}
-    if CONTACT_LABEL in trajs:  # the checkerboard the contact walker walks on
-        from walkerlab.io.terrain import load_terrain
-
-        ground[CONTACT_LABEL] = load_terrain(artifact_path(scene, runs_root, "contact-sim"))
-    frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames, time_unit=unit,
-                              terrain=ground)
+    frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames,
+                              time_unit=sim.units.time, terrain=ground)
     out = AnimateOutcome(note="; ".join(notes))
     try:
-        out.paths.append(_atomic_save(frames, folder / "animation.gif", gif_writer(fps)))
+        out.paths.append(save_frames(frames, folder / "animation.gif", gif_writer(fps)))
         if writers.is_available("ffmpeg"):
-            out.paths.append(_atomic_save(frames, folder / "animation.mp4", FFMpegWriter(fps=fps)))
+            out.paths.append(save_frames(frames, folder / "animation.mp4", FFMpegWriter(fps=fps)))
         else:
             out.note = "; ".join(notes + ["ffmpeg not found: wrote the GIF only (install "
                                           "ffmpeg for the MP4)"])

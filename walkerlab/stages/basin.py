@@ -8,24 +8,16 @@ upstream fixed point and the code are unchanged.
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
 
 from walkerlab.config import BasinSettings, CommandOptions, Scene, validate_option
-from walkerlab.io.artifacts import write_artifact
-from walkerlab.io.runpaths import artifact_lock, stage_artifact
+from walkerlab.io import runpaths
+from walkerlab.io.freshness import input_hash
 from walkerlab.io.schemas.basin import BasinRun, load_basin, write_basin
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.stages.common import (
-    StageError,
-    StageOutcome,
-    _tell,
-    artifact_path,
-    input_hash,
-    require,
-)
+from walkerlab.stages.common import StageError, StageOutcome, artifact_path, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "basin")
 
@@ -41,9 +33,7 @@ def stem(scene: Scene, grid: tuple[int, int] | None = None) -> str:
 def figure_path(scene: Scene, runs_root: Path | str, grid: tuple[int, int] | None = None
                 ) -> Path:
     """``runs/<scene>/report/figures/<stem>.png`` (:func:`stem`)."""
-    from walkerlab.stages.plot import figures_dir
-
-    return figures_dir(scene, runs_root) / f"{stem(scene, grid)}.png"
+    return runpaths.figures_dir(scene, runs_root) / f"{stem(scene, grid)}.png"
 
 
 def draw(scene: Scene, runs_root: Path | str = "runs",
@@ -62,13 +52,8 @@ def draw(scene: Scene, runs_root: Path | str = "runs",
 def check(scene: Scene, grid: tuple[int, int] | None = None, workers: int = 2,
           **_options) -> tuple[tuple[int, int], int]:
     """The grid and worker count to use, checked before anything runs (the scene's cap on
-    ``basin.grid`` holds for ``--grid`` too).
-
-    Raises
-    ------
-    StageError
-        No ``fixedpoint`` section, or a grid or worker count out of bounds (one line).
-    """
+    ``basin.grid`` holds for ``--grid`` too).  Raises StageError (one line): no
+    ``fixedpoint`` section, a grid or worker count out of bounds."""
     require(scene, "fixedpoint", "basin")
     st = scene.basin or BasinSettings()
     if grid is not None:
@@ -80,65 +65,36 @@ def check(scene: Scene, grid: tuple[int, int] | None = None, workers: int = 2,
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
         resume: bool = True, on_chunk=None) -> StageOutcome:
-    """Compute (or reuse) the basin map of the scene's rigid walker.
-
-    Parameters
-    ----------
-    grid : (nx, ny), optional
-        Cells along x and y; overrides ``basin.grid``.
-    workers : int
-        Local worker processes (1 = in this process).
-    scheduler : str, optional
-        Dask scheduler address.
-    resume : bool
-        Continue from the partial file of an interrupted run with the same inputs.
-
-    Raises
-    ------
-    StageError
-        No ``fixedpoint`` section, or bad basin settings.
-    """
-    st = scene.basin or BasinSettings()
-    grid, workers = check(scene, grid, workers)
-    up = artifact_path(scene, runs_root, "fixedpoint")
-    path = stage_artifact(scene, runs_root, stem(scene, grid), claim=True)
-    # one writer per artifact (as run_cached): a second identical run waits, then reuses
-    with artifact_lock(path, wait=True, on_wait=_tell):
-        return _run_locked(scene, runs_root, force, grid, workers, scheduler, resume,
-                           on_chunk, st, up, path)
-
-
-def _run_locked(scene, runs_root, force, grid, workers, scheduler, resume, on_chunk, st, up,
-                path) -> StageOutcome:
+    """Compute (or reuse) the basin map of the scene's rigid walker on ``grid`` (nx, ny)
+    cells (default ``basin.grid``) with ``workers`` local processes (1 = this one) or a Dask
+    ``scheduler``; ``resume`` continues from the partial file of an interrupted run with the
+    same inputs.  Raises StageError: no ``fixedpoint`` section, bad basin settings."""
     from walkerlab.sweep.basin import OUTCOMES, BasinError, compute_basin
 
-    key = input_hash("basin", scene, SECTIONS, (up,), extra=f"grid={grid[0]}x{grid[1]}")
-    from walkerlab.io.artifacts import verified_hash
+    st = scene.basin or BasinSettings()
+    grid, workers = check(scene, grid, workers)
+    up, name = artifact_path(scene, runs_root, "fixedpoint"), stem(scene, grid)
+    extra = f"grid={grid[0]}x{grid[1]}"
+    partial = []
 
-    if not force and path.is_file() and verified_hash(path) == key:  # content still matches
-        if not figure_path(scene, runs_root, grid).is_file():
-            draw(scene, runs_root, grid)
-        return StageOutcome("basin", path, True, 0.0, {})
-    note = ""
-    if not force and path.is_file():  # never replaced silently (as run_cached)
-        from walkerlab.stages.common import recompute_reason
+    def compute():
+        x_star = load_fixedpoint(up).x
+        try:  # the partial file is keyed on run_cached's own input hash
+            res = compute_basin(scene, x_star, input_hash("basin", scene, SECTIONS, (up,), extra),
+                                artifact_path(scene, runs_root, name), grid, workers, scheduler,
+                                resume=resume and not force, on_chunk=on_chunk)
+        except BasinError as exc:
+            raise StageError(str(exc)) from None
+        partial.append(res["partial"])
+        counts = {o: int(np.sum(res["outcome"] == i)) for i, o in enumerate(OUTCOMES)}
+        basin = BasinRun(res["walker"], res, x_star, st, list(OUTCOMES), counts)
+        return (lambda f: write_basin(f, basin)), {"counts": counts, "grid": grid}
 
-        note = recompute_reason(path, scene, SECTIONS, verified_hash(path))
-        _tell(f"basin: recomputing {path} ({note})")
-    x_star = load_fixedpoint(up).x
-    t0 = time.perf_counter()
-    try:
-        res = compute_basin(scene, x_star, key, path, grid, workers, scheduler,
-                            resume=resume and not force, on_chunk=on_chunk)
-    except BasinError as exc:
-        raise StageError(str(exc)) from None
-    walker = res["walker"]
-    counts = {o: int(np.sum(res["outcome"] == i)) for i, o in enumerate(OUTCOMES)}
-    run = BasinRun(walker, res, x_star, st, list(OUTCOMES), counts)
-    wall = time.perf_counter() - t0
-    write_artifact(path, "basin", scene, key, lambda f: write_basin(f, run), wall,
-                   {"workers": workers if scheduler is None else 0,
-                    "scheduler": str(scheduler or "")})
-    res["partial"].unlink(missing_ok=True)
-    draw(scene, runs_root, grid)
-    return StageOutcome("basin", path, False, wall, {"counts": counts, "grid": grid}, note)
+    out = run_cached("basin", scene, runs_root, SECTIONS, (up,), compute, force,
+                     {"workers": workers if scheduler is None else 0,
+                      "scheduler": str(scheduler or "")}, extra_key=extra, artifact=name)
+    for p in partial:  # after the artifact is written
+        p.unlink(missing_ok=True)
+    if not out.reused or not figure_path(scene, runs_root, grid).is_file():
+        draw(scene, runs_root, grid)
+    return out

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from walkerlab.config import CommandOptions, Scene, validate_option
+from walkerlab.io.runpaths import figures_dir
 from walkerlab.stages.common import StageOutcome, run_cached, with_defaults
-from walkerlab.stages.plot import figures_dir
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
 

@@ -1,28 +1,23 @@
-"""Shared stage plumbing: artifact paths, input hashes, skip-if-up-to-date, locking.
+"""Shared stage plumbing: the outcome of a stage, skip-if-up-to-date, required sections.
 
 Run paths come from :mod:`walkerlab.io.runpaths` (the one place that builds
-``runs/<scene>/...``; names checked, every output inside the runs folder).
+``runs/<scene>/...``); whether an artifact is up to date from :mod:`walkerlab.io.freshness`.
 """
 
 from __future__ import annotations
 
-import hashlib
 import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import walkerlab
 from walkerlab.config import Scene
-from walkerlab.io.artifacts import (
-    code_hash,
-    content_hash,
-    root_attrs,
-    verified_hash,
-    write_artifact,
-)
-from walkerlab.io.runpaths import artifact_lock, stage_artifact
+from walkerlab.config.sections import default_section
+from walkerlab.io.artifacts import code_hash, verified_hash, write_artifact
+from walkerlab.io.freshness import input_hash, recompute_reason
+from walkerlab.io.runpaths import artifact_lock
+from walkerlab.io.runpaths import stage_artifact as artifact_path
 
 
 class StageError(RuntimeError):
@@ -45,81 +40,8 @@ class StageOutcome:
     failure: str = ""
 
 
-def artifact_path(scene: Scene, runs_root: Path | str, stage: str) -> Path:
-    """``runs/<scene name>/<stage>.h5`` (checked by :func:`walkerlab.io.runpaths.stage_artifact`).
-
-    Raises
-    ------
-    walkerlab.io.runpaths.RunPathError
-        Unsafe scene name, a path outside the runs folder, or a run folder owned by another
-        scene file of the same name.
-    """
-    return stage_artifact(scene, runs_root, stage)
-
-
-def input_hash(stage: str, scene: Scene, sections: tuple[str, ...],
-               upstream: tuple[Path, ...] = (), extra: str = "") -> str:
-    """Content hash of everything a stage's output depends on.
-
-    ``extra``: stage options that are not scene sections (e.g. a bifurcation grid).
-    Includes the upstream artifacts' *recomputed* content hashes
-    (:func:`walkerlab.io.artifacts.content_hash`), not the hashes they store: an upstream
-    artifact edited by hand changes the key.
-    """
-    h = hashlib.sha256()
-    h.update(stage.encode())
-    h.update(extra.encode())
-    h.update(scene.section_json(*sections).encode())
-    h.update(walkerlab.__version__.encode())
-    h.update(code_hash().encode())
-    for p in upstream:
-        h.update(str(content_hash(p)).encode())
-    return h.hexdigest()
-
-
 def _tell(msg: str) -> None:
     print(msg, file=sys.stderr)
-
-
-def _leaves(d, prefix: str = "") -> dict[str, object]:
-    if isinstance(d, dict):
-        out: dict[str, object] = {}
-        for k, v in d.items():
-            out.update(_leaves(v, f"{prefix}{k}."))
-        return out
-    return {prefix.rstrip("."): d}
-
-
-def changed_fields(path: Path, scene: Scene, sections: tuple[str, ...]) -> list[str]:
-    """``"simulate.strides 20 -> 5"`` for each scene field (of ``sections``) whose value in the
-    artifact's stored scene differs from ``scene``'s; [] when none or unreadable."""
-    import json
-
-    try:
-        old = json.loads(str(root_attrs(path, "scene_json")["scene_json"]))
-    except (KeyError, ValueError):
-        return []
-    new = json.loads(scene.model_dump_json())
-    was = _leaves({k: old.get(k) for k in sections})
-    now = _leaves({k: new.get(k) for k in sections})
-    return [f"{k} {was.get(k, '-')} -> {now.get(k, '-')}" for k in sorted(set(was) | set(now))
-            if was.get(k) != now.get(k)]
-
-
-def recompute_reason(path: Path, scene: Scene, sections: tuple[str, ...],
-                     have: str | None) -> str:
-    """One line saying why an existing artifact ``path`` is out of date (``have``: its
-    verified input hash, None when its content does not match its stored hash)."""
-    if have is None:
-        return "it was written by another walkerlab version or changed after it was written"
-    diff = changed_fields(path, scene, sections)
-    if diff:
-        more = f" (+{len(diff) - 3} more fields)" if len(diff) > 3 else ""
-        return "scene changed: " + ", ".join(diff[:3]) + more
-    old_code = root_attrs(path, "code_hash").get("code_hash")
-    if old_code is not None and str(old_code) != code_hash():
-        return "walkerlab's code changed"
-    return "an upstream artifact or a stage option changed"
 
 
 def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[str, ...],
@@ -137,7 +59,7 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
     ``artifact``: the file stem when it is not the stage's name (``bifurcation_<field>``;
     from :mod:`walkerlab.io.runpaths`).
     """
-    path = stage_artifact(scene, runs_root, artifact or stage, claim=True)
+    path = artifact_path(scene, runs_root, artifact or stage, claim=True)
     # one writer per artifact: a second identical run waits, then finds the result up to date
     with artifact_lock(path, wait=True, on_wait=_tell):
         key = input_hash(stage, scene, sections, upstream, extra_key)
@@ -160,31 +82,13 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
     return StageOutcome(stage, path, False, wall, summary, note)
 
 
-def _default_section(scene: Scene, section: str):
-    """The section's settings with every field at its default, or None when the section has
-    a required field (``contact``: a contact law must be chosen)."""
-    import typing
-
-    from pydantic import BaseModel, ValidationError
-
-    ann = type(scene).model_fields[section].annotation  # ``FixedPointSettings | None``
-    models = [m for m in typing.get_args(ann) or (ann,)
-              if isinstance(m, type) and issubclass(m, BaseModel)]
-    if len(models) != 1:
-        return None
-    try:
-        return models[0]()
-    except ValidationError:
-        return None
-
-
 def require(scene: Scene, section: str, stage: str):
     """Return the scene section a stage needs; a missing section whose fields are all
     optional is its defaults (``fixedpoint:`` left out runs as ``fixedpoint: {}``); a missing
     section with a required field raises a one-line StageError."""
     val = getattr(scene, section)
     if val is None:
-        val = _default_section(scene, section)
+        val = default_section(scene, section)
     if val is None:
         raise StageError(f"scene '{scene.name}' has no '{section}' section, which stage "
                          f"'{stage}' needs")

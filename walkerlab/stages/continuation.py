@@ -9,8 +9,8 @@ import json
 from pathlib import Path
 
 from walkerlab.config import Scene
+from walkerlab.io.runpaths import figures_dir
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
-from walkerlab.stages.plot import figures_dir
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
 

@@ -8,20 +8,23 @@ upstream artifact), atomically (temporary name, then rename).  Formats and conve
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import walkerlab
 from walkerlab.analysis.export_scene import check_exportable, mjcf_scene
 from walkerlab.config import Scene
 from walkerlab.io import runpaths
-from walkerlab.io.export import FORMATS, mjcf_text, urdf_text
+from walkerlab.io.export import (
+    FORMATS,
+    SIDECAR,
+    comments_in_scene_units,
+    keyframe_json,
+    mjcf_text,
+    urdf_text,
+)
 from walkerlab.models.description import walker_data
 from walkerlab.models.multibody import multibody
 from walkerlab.units import for_scene
-
-#: The URDF's keyframe sidecar in ``runs/<scene>/``.
-SIDECAR = "walker.gait.json"
 
 
 def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = False) -> Path:
@@ -38,18 +41,8 @@ def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = Fal
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path:
-    """Write the scene's walker as ``fmt`` and return the file's path.
-
-    Parameters
-    ----------
-    scene : Scene
-    runs_root : Path or str
-        Runs folder (the file goes to ``<runs_root>/<scene name>/``).
-    fmt : {"urdf", "mjcf"}
-
-    Returns
-    -------
-    Path
+    """Write the scene's walker as ``fmt`` ("urdf" or "mjcf") into
+    ``<runs_root>/<scene name>/`` and return the file's path.
 
     Raises
     ------
@@ -73,28 +66,4 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path
     if fmt == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
         runpaths.atomic_text(runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
                              keyframe_json(mb, extra))
-    return runpaths.atomic_text(path, _comments_in_scene_units(text, for_scene(scene)))
-
-
-def keyframe_json(mb, extra) -> str:
-    """The ``gait`` keyframe as JSON: ``{"joints": [...], "qpos": [...], "qvel": [...],
-    "units": [...]}`` in the URDF's joint names and order (the sidecar of ``walker.urdf``)."""
-    joints = ["hip_x", "hip_z", *(ln.joint for ln in mb.links)]
-    units = ["m", "m", *("rad" for _ in mb.links)]
-    return json.dumps({"keyframe": "gait", "description": "rigid fixed point just after heel "
-                       "strike, leg2 in stance, its foot at the origin on the ground line",
-                       "joints": joints, "units": units, "qpos": list(extra.qpos),
-                       "qvel": list(extra.qvel)}, indent=1) + "\n"
-
-
-def _comments_in_scene_units(text: str, units) -> str:
-    """The header comments' unit labels in the scene's unit system (a nondimensional scene:
-    ``l``, ``g``, not ``m``, ``m/s^2``); the XML itself carries numbers only."""
-    if not units.nondimensional:
-        return text
-    import re
-
-    # a unit follows a number ("1.2 m") or stands in brackets ("[m]"); prose is left alone
-    unit = re.compile(r"(?:(?<=\d )|(?<=\[))(m/s\^2|kg m\^2|kg|m|s)(?=[\];.,) ])")
-    return "\n".join(unit.sub(lambda m: units(m.group(1)), ln)
-                     if ln.lstrip().startswith("<!--") else ln for ln in text.split("\n"))
+    return runpaths.atomic_text(path, comments_in_scene_units(text, for_scene(scene)))

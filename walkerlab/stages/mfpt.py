@@ -32,7 +32,7 @@ SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt")
 
 def figure_path(scene: Scene, runs_root: Path | str) -> Path:
     """``runs/<scene>/report/figures/mfpt.png``."""
-    from walkerlab.stages.plot import figures_dir
+    from walkerlab.io.runpaths import figures_dir
 
     return figures_dir(scene, runs_root) / "mfpt.png"
 

@@ -3,7 +3,8 @@
 A stage reads the artifacts of the stages it depends on and never runs them itself;
 :func:`run` runs the upstream stages a stage needs for the scene (each with its default
 options, reusing an up-to-date artifact), then the stage.  :func:`report_plan` is the
-report's DAG: the stages the report runs for a scene, in order.
+report's DAG: the stages the report runs for a scene, in order
+(:mod:`walkerlab.stages.report_dag` runs them).
 
 ==============  ====================================================================
 stage           needs (for this scene)
@@ -32,7 +33,8 @@ from walkerlab.config import Scene
 MODULES = {"fixedpoint": "fixedpoint", "simulate": "simulate", "contact-sim": "contact_sim",
            "compare": "compare", "workprecision": "workprecision", "basin": "basin",
            "animate": "animate", "mfpt": "mfpt",
-           "robustness": "robustness", "attribution": "attribution"}
+           "robustness": "robustness", "attribution": "attribution",
+           "bifurcation": "bifurcation"}
 
 
 def needs(stage: str, scene: Scene) -> tuple[str, ...]:
@@ -64,6 +66,28 @@ def order(stage: str, scene: Scene) -> list[str]:
 def stage_module(stage: str):
     """The module of ``stage`` (imported on first use: the CLI stays light)."""
     return importlib.import_module(f"walkerlab.stages.{MODULES[stage]}")
+
+
+def computed_for(scene: Scene, runs_root, stage: str, variants: tuple[str, ...] = ()) -> str:
+    """Why the existing artifact of ``stage`` must not be used beside the scene's current
+    results ('' if it may): changed after it was written, or written for other inputs than
+    the scene's current ones (with any subset of the stage's ``variants``, e.g. contact-sim's
+    ``adjust`` and ``periodic``, in its input hash)."""
+    from itertools import combinations
+
+    from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
+    from walkerlab.io.freshness import input_hash
+    from walkerlab.io.runpaths import stage_artifact
+
+    path = stage_artifact(scene, runs_root, stage)
+    if not stored_content_hash_matches(path):
+        return f"{path.name} was changed after it was written"
+    up = tuple(stage_artifact(scene, runs_root, s) for s in needs(stage, scene))
+    have, sections = stored_hash(path), stage_module(stage).SECTIONS
+    for extra in (c for k in range(len(variants) + 1) for c in combinations(variants, k)):
+        if have == input_hash(stage, scene, sections + extra, up):
+            return ""
+    return f"{path.name} was computed for another scene or fixed point"
 
 
 def run_upstream(stage: str, scene: Scene, runs_root: Path | str = "runs") -> None:
@@ -109,3 +133,13 @@ def report_plan(scene: Scene, full: bool = False) -> list[str]:
                              and scene.fixedpoint is not None),
                             ("attribution", full and contact and scene.fixedpoint is not None))
             if on]
+
+
+#: why a report leaves out an artifact of a stage the scene does not run
+NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' section",
+           "contact-sim": "no 'contact' section",
+           "compare": "needs both a 'simulate' and a 'contact' section",
+           "workprecision": "no 'workprecision' section",
+           "basin": "no 'basin' section (or no 'fixedpoint')",
+           "robustness": "no 'robustness' section (or no 'fixedpoint')",
+           "attribution": "no 'contact' or 'fixedpoint' section"}

@@ -9,20 +9,12 @@ sections, the upstream gait and the code are unchanged.
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 from walkerlab.config import CommandOptions, Scene, validate_option
-from walkerlab.io.runpaths import artifact_lock, stage_artifact
+from walkerlab.io.schemas import robustness as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.stages.common import (
-    StageError,
-    StageOutcome,
-    _tell,
-    artifact_path,
-    input_hash,
-    require,
-)
+from walkerlab.stages.common import StageError, StageOutcome, artifact_path, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt", "robustness")
 
@@ -50,30 +42,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False, worke
     StageError
         Missing sections, or a walker the batched step map cannot carry (one line).
     """
+    from walkerlab.analysis.robustness import scene_robustness
+
     workers = check(scene, workers)
     up = artifact_path(scene, runs_root, "fixedpoint")
-    path = stage_artifact(scene, runs_root, "robustness", claim=True)
-    with artifact_lock(path, wait=True, on_wait=_tell):
-        from walkerlab.io.artifacts import verified_hash, write_artifact
-        from walkerlab.io.schemas import robustness as schema
 
-        key = input_hash("robustness", scene, SECTIONS, (up,))
-        if not force and path.is_file() and verified_hash(path) == key:
-            return StageOutcome("robustness", path, True, 0.0, {})
-        note = ""
-        if not force and path.is_file():
-            from walkerlab.stages.common import recompute_reason
-
-            note = recompute_reason(path, scene, SECTIONS, verified_hash(path))
-            _tell(f"robustness: recomputing {path} ({note})")
-        from walkerlab.analysis.robustness import scene_robustness
-
-        t0 = time.perf_counter()
+    def compute():
         try:
             data = scene_robustness(scene, load_fixedpoint(up).x, workers, scheduler)
         except ValueError as exc:
             raise StageError(str(exc)) from None
-        wall = time.perf_counter() - t0
-        write_artifact(path, "robustness", scene, key, lambda f: schema.write(f, data), wall,
-                       {"workers": workers if scheduler is None else 0})
-        return StageOutcome("robustness", path, False, wall, {"data": data}, note)
+        return (lambda f: schema.write(f, data)), {"data": data}
+
+    return run_cached("robustness", scene, runs_root, SECTIONS, (up,), compute, force,
+                      {"workers": workers if scheduler is None else 0})

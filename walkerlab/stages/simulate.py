@@ -1,6 +1,6 @@
 """Stage ``simulate``: N strides of the rigid hybrid walker -> ``simulate.h5``.
 
-The run is :func:`walkerlab.analysis.rigid_run.simulate_scene`; the layout
+The run is :func:`walkerlab.analysis.rigid_run.simulate_run`; the layout
 :mod:`walkerlab.io.schemas.simulate`.
 """
 
@@ -8,12 +8,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from walkerlab.analysis.metrics import total_mass_kg
-from walkerlab.analysis.rigid_run import simulate_scene
-from walkerlab.config import MAX_SIMULATE_SAMPLES, Scene, SimulateSettings
+from walkerlab.analysis.rigid_run import simulate_run
+from walkerlab.config import Scene, SimulateSettings
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.io.schemas.simulate import SimulateRun, run_end, strides_of, write_simulate
-from walkerlab.models.registry import build_walker
+from walkerlab.io.schemas.simulate import run_end, strides_of, write_simulate
 from walkerlab.stages.common import StageError, StageOutcome, artifact_path, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
@@ -39,7 +37,7 @@ def _longer_run(scene: Scene, runs_root, upstream: tuple[Path, ...]) -> StageOut
     the result the user asked for is kept rather than replaced (``StageOutcome.note`` says
     so; the CLI and the report print it)."""
     from walkerlab.io.artifacts import verified_hash
-    from walkerlab.stages.common import input_hash
+    from walkerlab.io.freshness import input_hash
 
     path = artifact_path(scene, runs_root, "simulate")
     n = strides_of(path)
@@ -86,25 +84,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
 
 def _compute(scene: Scene, upstream: tuple[Path, ...]):
-    sim = scene.simulate
-    walker = build_walker(scene)
-    if sim.initial_state == "fixed_point":
-        fp = load_fixedpoint(upstream[0])
-        x0, period = fp.x, fp.step_period_s
-        # refuse before integrating what could not be sampled (sample_trajectory checks
-        # the exact count afterwards for any initial state)
-        n = 2 * sim.strides * period * sim.sample_rate_hz
-        if n > MAX_SIMULATE_SAMPLES:
-            raise StageError(f"simulate.sample_rate_hz: {sim.sample_rate_hz:g} Hz over "
-                             f"{sim.strides} strides of {2 * period:.3g} s "
-                             f"gives {n:.3g} samples; at most {MAX_SIMULATE_SAMPLES:,} "
-                             "are kept (lower simulate.sample_rate_hz or simulate.strides)")
-    else:
-        try:
-            x0 = sim.initial_state.as_array(walker.state_names())
-        except ValueError as exc:
-            raise StageError(f"simulate.initial_state: {exc}") from None
-    r = simulate_scene(scene, walker, x0)
-    run = SimulateRun(walker, r.trajectory, r.samples, r.steps, x0, sim.strides,
-                      total_mass_kg(walker), r.summary)
-    return (lambda f: write_simulate(f, run)), r.summary
+    fp = load_fixedpoint(upstream[0]) if scene.simulate.initial_state == "fixed_point" else None
+    try:
+        run = simulate_run(scene, fp)
+    except ValueError as exc:
+        raise StageError(str(exc)) from None
+    return (lambda f: write_simulate(f, run)), run.summary

@@ -107,7 +107,7 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
 
 def figure_path(scene: Scene, path: Path, runs_root: str | Path = "runs") -> Path:
     """``runs/<scene>/report/figures/<sweep artifact stem>.png``."""
-    from walkerlab.stages.plot import figures_dir
+    from walkerlab.io.runpaths import figures_dir
 
     return figures_dir(scene, runs_root) / f"{Path(path).stem}.png"
 
@@ -115,9 +115,9 @@ def figure_path(scene: Scene, path: Path, runs_root: str | Path = "runs") -> Pat
 def draw(scene: Scene, path: Path, runs_root: str | Path = "runs") -> list[Path]:
     """Draw the sweep's main results against its first swept field (PNG + SVG) from the
     artifact ``path`` (:func:`walkerlab.plotting.sweep_figures.sweep_figure`)."""
+    from walkerlab.io.runpaths import figures_dir
     from walkerlab.io.sweep_store import load_sweep
     from walkerlab.plotting.sweep_figures import save, sweep_figure
-    from walkerlab.stages.plot import figures_dir
 
     fig = sweep_figure(load_sweep(path), f"scene '{scene.name}'")
     return save(fig, figures_dir(scene, runs_root, claim=True), Path(path).stem)

@@ -28,17 +28,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
-
-from walkerlab.analysis.workprecision import (
-    SINGLE_RUN_S,
-    Case,
-    rows_from_cases,
-    run_cases,
-    runner_for,
-    summarize,
-)
-from walkerlab.analysis.workprecision_plan import case_key, plan, warm_cases
+from walkerlab.analysis.workprecision import SINGLE_RUN_S, runner_for
+from walkerlab.analysis.workprecision_plan import plan, run_study, warm_cases
 from walkerlab.config import Scene
 from walkerlab.execution.lanes import Lanes
 from walkerlab.io.runpaths import run_cache_dir
@@ -66,57 +57,23 @@ def warm_up(scene: Scene, runs_root: Path | str, model: str) -> None:
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         workers: int = 2, lanes: Lanes | None = None) -> StageOutcome:
-    """Run the work-precision study of the scene's ``workprecision`` section.
-
-    Parameters
-    ----------
-    workers : int
-        Processes measuring cases side by side, one pinned core each (1 = in this process).
-        ``force`` also re-measures cached cases.
-    lanes : Lanes, optional
-        Explicit cores/gates for the measuring processes (see
-        :func:`walkerlab.analysis.workprecision.run_cases`).
-    """
-
+    """Run the work-precision study of the scene's ``workprecision`` section with
+    ``workers`` measuring processes or explicit ``lanes``
+    (:func:`walkerlab.analysis.workprecision_plan.run_study`); ``force`` also re-measures
+    cached cases."""
     wp = require(scene, "workprecision", "workprecision")
     up = (artifact_path(scene, runs_root, "fixedpoint"),)
 
     def compute():
         fp = load_fixedpoint(up[0])
-        x0t = tuple(float(v) for v in fp.x)
-        sj = json.dumps(scene.model_dump(mode="json"), sort_keys=True)
-        period = float(fp.step_period_s)
         cache = run_cache_dir(scene, runs_root, "workprecision")
         if force and cache.is_dir():
             for f in cache.glob("*.json"):
                 f.unlink()
-        models = plan(scene)
-        tasks, keys = [], {}
-        for model, mp_ in models.items():
-            methods, rtols, af, ref, _, secs = mp_
-            warm = warm_cases(mp_)
-            cases = [(ref[0], ref[1], ref[2], 1)] + [(m, r, af * r, wp.repeats)
-                                                     for m in methods for r in rtols]
-            for m, r, a, rep in cases:
-                k = case_key(model, secs, x0t, wp.strides, m, r, a, rep)
-                keys[(model, m, r, rep)] = k
-                tasks.append(Case(k, model, sj, period, x0t, wp.strides, m, r, a, rep, warm))
-        from walkerlab import progress
-
-        with progress.task(f"work-precision: timing {len(tasks)} cases (uncached)") as bar:
-            done = run_cases(tasks, cache, workers, lanes,
-                             on_case=lambda k, n: bar.update(k, total=n))
-        results = {}
-        for model, (methods, rtols, _, ref, target, _) in models.items():
-            refvec = done[keys[(model, ref[0], ref[1], 1)]]["vec"]
-            cases = {(m, r): done[keys[(model, m, r, wp.repeats)]] for m in methods
-                     for r in rtols}
-            rows = rows_from_cases(cases, methods, rtols, np.asarray(refvec))
-            results[model] = (rows, summarize(rows, target), ref)
-        n_cached = sum(1 for v in done.values() if v.get("cached"))
-
-        run = WorkPrecisionRun(results, n_cached, len(done), wp.target_error,
-                               wp.contact_target_error, SINGLE_RUN_S)
+        results, n_cached, n = run_study(scene, wp, fp.x, fp.step_period_s, cache, workers,
+                                          lanes)
+        run = WorkPrecisionRun(results, n_cached, n, wp.target_error, wp.contact_target_error,
+                               SINGLE_RUN_S)
         return (lambda f: write_workprecision(f, run)), {k: v[1] for k, v in results.items()}
 
     return run_cached("workprecision", scene, runs_root, SECTIONS, up, compute, force)

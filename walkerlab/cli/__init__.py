@@ -1,0 +1,77 @@
+"""Command-line interface (typer). Thin: parse arguments, call one stage, print a summary.
+
+Every command takes an optional scene path (default: ``configs/paper.yaml``).
+
+========================  ===========================================================
+module                    what
+========================  ===========================================================
+``commands_runs``         fixedpoint, simulate, contact-sim, compare, workprecision
+``commands_output``       plot, report, animate, export, bench
+``commands_families``     sweep, bifurcation, continuation
+``commands_robustness``   basin, mfpt, robustness, stability-map
+``options``               the shared arguments, loading the scene, the status line
+``errors``                the exit policy (:func:`walkerlab.cli.errors.guard`)
+``process``               process settings (OpenBLAS threads, numba cache) and --version
+``typer_flags``           the help shows on/off flags without a value type
+========================  ===========================================================
+
+Errors and exit codes
+---------------------
+A traceback shown to a user is a bug.  Every command runs inside
+:func:`walkerlab.cli.errors.guard`: one line ``error: ...`` on stderr and exit code 1 for
+bad input or a walker that falls (the stage's ``StageOutcome.failure``), ``interrupted`` and
+130 on Ctrl-C.  typer's own usage errors (unknown option, a value out of an option's range)
+keep typer's message and exit code 2.
+"""
+
+from __future__ import annotations
+
+import typer
+
+from walkerlab.cli import (
+    commands_families,
+    commands_output,
+    commands_robustness,
+    commands_runs,
+)
+from walkerlab.cli.process import process_settings, single_threaded_blas, version_callback
+from walkerlab.cli.typer_flags import flags_take_no_value
+
+flags_take_no_value()
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
+                  help="walkerlab: passive-dynamic biped walkers, from fixed point to report.")
+
+
+@app.callback()
+def _main(version: bool = typer.Option(False, "--version", callback=version_callback,
+                                       is_eager=True,
+                                       help="print walkerlab, Python, numpy, scipy, numba "
+                                       "and h5py versions and exit"),
+          quiet: bool = typer.Option(False, "--quiet", "-q",
+                                     help="no progress display and no notices on stderr "
+                                     "(errors are still shown); progress is also off when "
+                                     "stderr is not a terminal")) -> None:
+    """walkerlab: passive-dynamic biped walkers, from fixed point to report."""
+    single_threaded_blas()
+    process_settings()
+    from walkerlab import progress
+
+    progress.install(progress.sink_for_terminal(quiet))
+
+
+#: every command in the order ``--help`` lists them: (command name, function)
+COMMANDS = (
+    ("fixedpoint", commands_runs.fixedpoint), ("simulate", commands_runs.simulate),
+    ("contact-sim", commands_runs.contact_sim), ("compare", commands_runs.compare),
+    ("workprecision", commands_runs.workprecision), ("plot", commands_output.plot),
+    ("report", commands_output.report), ("sweep", commands_families.sweep),
+    ("bifurcation", commands_families.bifurcation),
+    ("continuation", commands_families.continuation), ("basin", commands_robustness.basin),
+    ("mfpt", commands_robustness.mfpt), ("robustness", commands_robustness.robustness),
+    ("stability-map", commands_robustness.stability_map),
+    ("animate", commands_output.animate), ("export", commands_output.export),
+    ("bench", commands_output.bench),
+)
+for _name, _command in COMMANDS:
+    app.command(_name)(_command)

@@ -1,0 +1,147 @@
+"""Commands over a family of scenes: sweeps, bifurcation diagrams, continuation."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from walkerlab.cli.errors import fail, guard
+from walkerlab.cli.options import ForceOpt, RunsOpt, SceneArg, load, status
+
+
+@guard
+def sweep(scene: Path | None = SceneArg,
+          param: list[str] = typer.Option(..., "--param", help="dotted scene field and values, "
+                                          "e.g. slope.angle_deg=0.5:5:0.05 or a,b,c"),
+          stage: str = typer.Option("fixedpoint", "--stage",
+                                    help="fixedpoint | simulate | contact-sim"),
+          workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+          scheduler: str | None = typer.Option(None, "--scheduler",
+                                                  help="Dask scheduler address (tcp://host:port)"),
+          resume: bool = typer.Option(False, "--resume", help="continue an interrupted sweep"),
+          name: str | None = typer.Option(None, "--name", help="artifact name"),
+          runs_dir: Path = RunsOpt) -> None:
+    """Run a stage over a grid of scene fields; one row per point, failures recorded."""
+    from walkerlab.report.sweep_text import sweep_text
+    from walkerlab.stages import sweep as stage_mod
+
+    sc = load(scene)
+    path = stage_mod.run(sc, param, stage=stage, workers=workers,
+                         scheduler=scheduler, resume=resume, runs_root=runs_dir, name=name)
+    typer.echo(sweep_text(path))
+    typer.echo(f"wrote {path}")
+    typer.echo(f"figure: {stage_mod.figure_path(sc, path, runs_dir)}")
+
+
+@guard
+def bifurcation(scene: Path | None = SceneArg,
+                slopes: str | None = typer.Option(None, "--slopes",
+                                                  help="slope grid in degrees: start:stop:step "
+                                                  "or a,b,c (default 1:5.5:0.05)",
+                                                  show_default=False),
+                param: str | None = typer.Option(None, "--param",
+                                                 help="continue over another numeric scene "
+                                                 "field instead of the slope, in the field's "
+                                                 "unit: FIELD=start:stop:step or FIELD=a,b,c "
+                                                 "(e.g. walker.leg.bodies.thigh_mass.mass_kg"
+                                                 "=0.3:0.7:0.05); writes "
+                                                 "bifurcation_<FIELD>.h5"),
+                transient: int = typer.Option(100, "--transient", min=1,
+                                              help="steps discarded before sampling"),
+                keep: int = typer.Option(30, "--keep", min=1,
+                                         help="heel strikes kept per grid value"),
+                workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
+                runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Bifurcation diagram over the slope (or any numeric scene field, --param): fixed
+    points, multipliers, period-doubling onset."""
+    from walkerlab.stages import bifurcation as stage
+    from walkerlab.sweep.params import (
+        SweepError,
+        check_axes,
+        parse_param,
+        takes_whole_numbers,
+    )
+
+    if slopes is not None and param is not None:
+        fail(SweepError("--slopes and --param exclude each other (--slopes S is "
+                         "--param slope.angle_deg=S)"))
+    try:
+        axis = parse_param(param if param is not None
+                           else f"slope.angle_deg={slopes or '1:5.5:0.05'}")
+    except SweepError as exc:  # name the option the user typed
+        if param is not None:
+            raise
+        fail(SweepError(str(exc).replace(f"--param 'slope.angle_deg={slopes}'",
+                                          f"--slopes {slopes!r}")))
+    sc = load(scene)
+    if param is not None:
+        check_axes(sc, [axis], values=not takes_whole_numbers(sc, axis))
+        if not axis.numeric:
+            fail(SweepError(f"--param {axis.spec!r}: a bifurcation needs numbers"))
+        if takes_whole_numbers(sc, axis):
+            fail(SweepError(f"--param {axis.spec!r}: {axis.path} takes whole numbers; a "
+                             "bifurcation continues over a real-valued field (e.g. "
+                             "slope.angle_deg or a body's mass_kg)"))
+    out = stage.run(sc, axis.values, runs_dir, transient, keep, workers, force=force,
+                    param=axis.path)
+    onset, unit = out.summary["onset"], out.summary["unit"]
+    where = (f"{onset:.4f} deg" if axis.path == "slope.angle_deg"
+             else f"{axis.path} = {onset:.6g} {unit}".removesuffix(" -"))
+    typer.echo(f"period-doubling onset: {where}" if onset == onset
+               else "period-doubling onset: none on the grid")
+    typer.echo(status(out))
+    typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
+
+
+def _range_spec(text: str, opt: str) -> tuple[str, float, float]:
+    """``FIELD=START:STOP`` -> (field, start, stop); one-line error otherwise."""
+    from walkerlab.sweep.params import SweepError
+
+    path, _, rhs = text.partition("=")
+    parts = rhs.split(":")
+    try:
+        if not path.strip() or len(parts) != 2:
+            raise ValueError
+        a, b = float(parts[0]), float(parts[1])
+        if not (a == a and b == b) or a == b:
+            raise ValueError
+    except ValueError:
+        raise SweepError(f"{opt} {text!r}: expected FIELD=START:STOP (two different "
+                         "numbers in the field's unit)") from None
+    return path.strip(), a, b
+
+
+@guard
+def continuation(scene: Path | None = SceneArg,
+                 param: str = typer.Option(..., "--param", help="FIELD=START:STOP, any "
+                                           "numeric scene field in its unit (e.g. "
+                                           "slope.angle_deg=0.5:5.2)"),
+                 switch: bool = typer.Option(False, "--switch", help="switch at period "
+                                             "doublings to the period-2 and period-4 "
+                                             "branches"),
+                 param2: str | None = typer.Option(None, "--param2", help="FIELD2=START:STOP: "
+                                                   "continue each fold and period doubling "
+                                                   "in the plane of both fields"),
+                 runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Pseudo-arclength continuation of the scene's gait over a field: folds, period
+    doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5."""
+    from walkerlab.stages import continuation as stage
+
+    path, a, b = _range_spec(param, "--param")
+    p2 = _range_spec(param2, "--param2") if param2 else None
+    out = stage.run(load(scene), path, a, b, 2 if switch else 0,
+                    p2[0] if p2 else None, p2[1:] if p2 else None, runs_dir, force)
+    data = out.summary["data"]
+    sp = data.special
+    unit = "" if data.unit == "-" else f" {data.unit}"
+    for i, kind in enumerate(sp["kind"]):
+        cause = f" ({sp['cause'][i]})" if kind == "branch_end" else ""
+        typer.echo(f"{kind:16s} period {int(sp['period'][i])}  {path} = "
+                   f"{float(sp['param'][i]):.10g}{unit}{cause}")
+    if not len(sp["kind"]):
+        typer.echo("no special point in the range")
+    for c in data.curves:
+        typer.echo(f"{c['kind']} curve over {c['path2']}: {len(c['param2'])} points")
+    typer.echo(status(out))
+    typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))

@@ -1,0 +1,76 @@
+"""Commands that write what is read: figures, the report, the animation, exported models,
+benchmarks."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from walkerlab.cli.errors import guard
+from walkerlab.cli.options import ForceOpt, RunsOpt, SceneArg, load
+
+
+@guard
+def plot(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
+    """Draw the figures (PNG + SVG) from the scene's existing artifacts."""
+    from walkerlab.stages import plot as stage
+
+    for p in stage.run(load(scene), runs_dir):
+        typer.echo(f"wrote {p}")
+
+
+@guard
+def report(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
+           force: bool = ForceOpt,
+           full: bool = typer.Option(False, "--full", help="also measure the work-precision "
+                                     "diagram (times every solver setting; ~30 s) and compute "
+                                     "the Section-5 attribution (contact scenes; ~17 s CPU)"),
+           ) -> None:
+    """Run every stage the scene needs (skipping up-to-date ones) and write the report."""
+    from walkerlab.stages import report as stage
+
+    out = stage.run(load(scene), runs_dir, force, echo=typer.echo, full=full)
+    typer.echo(f"report: {out}")
+
+
+
+
+@guard
+def animate(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
+    """The walker walking (rigid, and contact beside it where contact_sim.h5 exists):
+    report/figures/animation.gif, and .mp4 if ffmpeg is installed."""
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("animate", load(scene), runs_dir)
+    for p in out.paths:
+        typer.echo(f"wrote {p}")
+    if out.note:
+        typer.echo(out.note)
+
+
+@guard
+def export(scene: Path | None = SceneArg,
+           fmt: str = typer.Option("urdf", "--format", help="urdf (Drake, Pinocchio) or mjcf "
+                                   "(MuJoCo)"),
+           runs_dir: Path = RunsOpt) -> None:
+    """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf or
+    walker.xml."""
+    from walkerlab.stages import export as stage
+
+    typer.echo(f"wrote {stage.run(load(scene), runs_dir, fmt)}")
+
+
+@guard
+def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
+                                     " | all (all but basin)"),
+          scenes: list[Path] | None = typer.Argument(
+              None, help="contact only: scene YAML files whose walkers are timed (5 contact "
+              "strides at <= 1e-6 rad against a tight reference), e.g. configs/kneed.yaml "
+              "configs/paper.yaml", show_default=False),
+          out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
+    """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
+    from walkerlab.bench import run_bench
+
+    for line in run_bench(what, out, scenes=scenes or None):
+        typer.echo(line)

@@ -1,0 +1,135 @@
+"""Commands that measure how robust the gait is: basin of attraction, mean first-passage
+time, robustness measures, contact stability maps."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from walkerlab.cli.errors import fail, guard
+from walkerlab.cli.options import ForceOpt, RunsOpt, SceneArg, load, status
+
+
+@guard
+def basin(scene: Path | None = SceneArg,
+          grid: str | None = typer.Option(None, "--grid", help="cells NXxNY, e.g. 200x200 "
+                                          "(default: basin.grid of the scene, 200x200)"),
+          workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+          scheduler: str | None = typer.Option(None, "--scheduler",
+                                                help="Dask scheduler address (tcp://host:port)"),
+          resume: bool = typer.Option(True, "--resume/--no-resume",
+                                      help="continue an interrupted map with the same inputs"),
+          runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section."""
+
+    g = None
+    if grid is not None:
+        try:
+            nx, ny = (int(v) for v in grid.lower().split("x"))
+            if nx < 2 or ny < 2:
+                raise ValueError
+        except ValueError:
+            fail(ValueError(f"--grid: expected NXxNY with NX, NY >= 2 (e.g. 200x200), "
+                             f"got {grid!r}"))
+        g = (nx, ny)
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("basin", load(scene), runs_dir, force, grid=g, workers=workers,
+                       scheduler=scheduler, resume=resume)
+    if out.summary:
+        typer.echo(", ".join(f"{k}: {v}" for k, v in out.summary["counts"].items()))
+    typer.echo(status(out))
+    from walkerlab.stages.basin import figure_path
+
+    typer.echo(f"figure: {figure_path(load(scene), runs_dir, g)}")
+
+
+@guard
+def mfpt(scene: Path | None = SceneArg,
+         sigma_rad: str | None = typer.Option(None, "--sigma-rad", help="per-step slope "
+                                              "standard deviations in rad, e.g. "
+                                              "0.002,0.003,0.004 (default: mfpt.sigma_rad)"),
+         method: str | None = typer.Option(None, "--method", help="mesh | montecarlo | both "
+                                           "(default: mfpt.method, both)"),
+         workers: int = typer.Option(2, "--workers", min=1, help="local worker processes"),
+         scheduler: str | None = typer.Option(None, "--scheduler",
+                                               help="Dask scheduler address (tcp://host:port)"),
+         runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Mean first-passage time (steps before the fall) on per-step random slopes."""
+    from walkerlab.stages import mfpt as stage
+
+    sig = None
+    if sigma_rad is not None:
+        try:
+            sig = [float(v) for v in sigma_rad.split(",") if v.strip()]
+        except ValueError:
+            fail(ValueError(f"--sigma-rad: expected numbers separated by commas, got "
+                             f"{sigma_rad!r}"))
+    from walkerlab.stages import pipeline
+
+    sc = load(scene)
+    out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
+                       workers=workers, scheduler=scheduler)
+    if out.summary:
+        for s, m, me in zip(out.summary["sigma_rad"], out.summary["mfpt_steps_montecarlo"],
+                            out.summary["mfpt_steps_mesh"]):
+            typer.echo(f"sigma {s:.4g} rad: MFPT Monte Carlo {m:.4g}, mesh {me:.4g} steps")
+    typer.echo(status(out))
+    typer.echo(f"figure: {stage.figure_path(sc, runs_dir)}")
+
+
+@guard
+def robustness(scene: Path | None = SceneArg,
+               workers: int = typer.Option(2, "--workers", min=1,
+                                           help="local worker processes (Monte Carlo)"),
+               scheduler: str | None = typer.Option(None, "--scheduler",
+                                                     help="Dask scheduler address"),
+               runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Gait sensitivity norms, largest step-down/up and MFPT at the scene's sigma
+    (the scene's robustness section); writes robustness.h5."""
+    from walkerlab.io.schemas.robustness import per_unit
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("robustness", load(scene), runs_dir, force, workers=workers,
+                       scheduler=scheduler)
+    d = out.summary.get("data")
+    if d is not None:
+        for k in d.disturbances:
+            typer.echo(f"GSN {k}: {d.gsn[k]:.4g} {per_unit(d.units[k])}")
+        typer.echo(f"step-down {1000 * d['step_down_m/lo']:.0f} mm, step-up "
+                   f"{1000 * d['step_up_m/lo']:.0f} mm; MFPT {d['mfpt_steps']:.4g} "
+                   f"± {d['mfpt_steps_stderr']:.2g} steps at sigma {d['sigma_rad']:g} rad")
+        typer.echo(f"largest mid-stance push {d['push_forward_m_per_s/lo']:.3f} m/s forward, "
+                   f"{d['push_backward_m_per_s/lo']:.3f} m/s backward (hip velocity change)")
+    typer.echo(status(out))
+
+
+@guard
+def stability_map(scene: Path | None = SceneArg,
+                  kind: str = typer.Option("all", "--kind", help="stiffness | friction | "
+                                           "patch_width | all (each against the slope)"),
+                  n: int = typer.Option(8, "--n", min=2, help="grid size n x n"),
+                  time_limit: float = typer.Option(60.0, "--time-limit", min=1.0,
+                                                   help="wall-time limit per cell, in seconds"),
+                  workers: int = typer.Option(2, "--workers", min=1, help="worker processes"),
+                  runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Stability maps of the contact gait: does a periodic gait exist, is it stable, max
+    |Floquet multiplier|, or why not (cached stage)."""
+    from walkerlab.stages import stability_map as stage
+    from walkerlab.sweep.stability import MAP_KINDS
+
+    sc = load(scene)
+    kinds = list(MAP_KINDS) if kind == "all" else [kind]
+    for k in kinds:
+        if k not in MAP_KINDS:
+            fail(ValueError(f"--kind: unknown map {k!r} (stiffness, friction, patch_width, all)"))
+        if kind == "all" and stage.not_applicable(sc, k):
+            typer.echo(f"{k}: skipped ({stage.not_applicable(sc, k).split(': ', 1)[1]})")
+            continue
+        out = stage.run(sc, runs_dir, force, kind=k, n=n, workers=workers,
+                        time_limit_s=time_limit)
+        s = out.summary
+        typer.echo(f"{k}: " + (", ".join(f"{a}: {b:.3g}" if isinstance(b, float) else
+                                         f"{a}: {b}" for a, b in s.items()) or "cached"))
+        typer.echo(f"wrote {out.path}")

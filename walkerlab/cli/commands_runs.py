@@ -1,0 +1,114 @@
+"""Commands that run the walker once: fixed point, rigid and contact runs, their comparison,
+the work-precision study."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from walkerlab.cli.errors import fail, guard
+from walkerlab.cli.options import ForceOpt, RunsOpt, SceneArg, load, status
+
+
+@guard
+def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
+               force: bool = ForceOpt,
+               known: Path | None = typer.Option(None, "--from", help="a scene whose gait is "
+                                                 "known: continue it along the straight line "
+                                                 "between the two scenes' numeric fields to "
+                                                 "this walker (homotopy)")) -> None:
+    """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.report.text import fixedpoint_text
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("fixedpoint", load(scene), runs_dir, force, known=known)
+    typer.echo(fixedpoint_text(load_fixedpoint(out.path)))
+    typer.echo(status(out))
+
+
+@guard
+def simulate(scene: Path | None = SceneArg,
+             strides: int | None = typer.Option(
+                 None, "--strides", help="strides to simulate (1 stride = 2 steps) "
+                 "(default: simulate.strides of the scene)"),
+             runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
+    """Simulate N strides of the rigid walker from its fixed point (or from the state given
+    as simulate.initial_state in the scene)."""
+    from walkerlab.io.schemas.simulate import load_simulate
+    from walkerlab.report.text import simulate_ending, simulate_text
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("simulate", load(scene), runs_dir, force, strides=strides)
+    sim = load_simulate(out.path)
+    ending = simulate_ending(sim)  # a fall: no success-style summary (issue 26, item 5)
+    if ending is None:
+        typer.echo(simulate_text(sim))
+    typer.echo(status(out))
+    if out.failure:  # recorded in the artifact, and an error: one line, exit 1
+        fail(RuntimeError(f"the walker {ending}" if ending else out.failure))
+
+
+@guard
+def contact_sim(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
+                force: bool = ForceOpt,
+                adjust: bool = typer.Option(False, "--adjust", help="search the initial rates "
+                                            "that make the contact walker match the ideal gait"),
+                periodic: bool = typer.Option(False, "--periodic", help="also find the contact "
+                                              "walker's own periodic gait and its Floquet "
+                                              "multipliers (about 10 s)")
+                ) -> None:
+    """Simulate the compliant-contact (MSC ADAMS style) walker on the scene's terrain."""
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
+    from walkerlab.report.text import contact_text
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("contact-sim", load(scene), runs_dir, force, adjust=adjust,
+                       periodic=periodic)
+    typer.echo(contact_text(load_contact_sim(out.path)))
+    typer.echo(status(out))
+    if out.failure:
+        fail(RuntimeError(out.failure))
+
+
+@guard
+def compare(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
+            force: bool = ForceOpt,
+            rigid_limit: bool = typer.Option(
+                False, "--rigid-limit", help="instead: the contact periodic gait along the "
+                "rigid-limit family (rigid_limit.h5 and its figure)")) -> None:
+    """Compare the ideal and contact trajectories (errors, periods, speed, energy)."""
+    from walkerlab.io.schemas.compare import load_compare
+    from walkerlab.report.text import compare_text
+    from walkerlab.stages import pipeline
+
+    if rigid_limit:
+        from walkerlab.io.schemas.rigid_limit import load_rigid_limit
+        from walkerlab.report.text import rigid_limit_text
+        from walkerlab.stages import rigid_limit as rl
+
+        sc = load(scene)
+        out = rl.run(sc, runs_dir, force)
+        for line in rigid_limit_text(load_rigid_limit(out.path)):
+            typer.echo(line)
+        for p in rl.draw(sc, runs_dir, out.path):
+            typer.echo(f"wrote {p}")
+        typer.echo(status(out))
+        return
+    out = pipeline.run("compare", load(scene), runs_dir, force)
+    typer.echo(compare_text(load_compare(out.path)))
+    typer.echo(status(out))
+
+
+@guard
+def workprecision(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
+                  force: bool = ForceOpt) -> None:
+    """Work-precision study: error vs wall time for every solver and tolerance."""
+    from walkerlab.io.schemas.workprecision import load_workprecision
+    from walkerlab.report.text import workprecision_text
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("workprecision", load(scene), runs_dir, force)
+    typer.echo(workprecision_text(load_workprecision(out.path)))
+    typer.echo(status(out))

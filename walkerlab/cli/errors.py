@@ -1,0 +1,119 @@
+"""Exit policy of every command: one line on stderr and exit code 1 for a failure.
+
+- a scene that does not validate: every error on its own line ``error: <file>: <field>:
+  <message>``, unknown keys first (with the closest field name), exit code 1;
+- bad input (scene, names, paths, artifacts, a busy artifact, a read-only runs folder) and
+  a walker that falls (``simulate``, ``contact-sim``: the stage's ``StageOutcome.failure``):
+  one line ``error: ...`` on stderr, exit code 1;
+- an unexpected exception: one line ``error: internal error (<type>): <message>`` and a hint
+  to rerun with ``WALKERLAB_DEBUG=1``, which shows the traceback instead; exit code 1;
+- Ctrl-C: ``interrupted``, exit code 130.
+"""
+
+from __future__ import annotations
+
+import os
+
+import typer
+
+
+def fail(exc: Exception) -> None:
+    """Print ``error: <exc>`` on stderr and exit with code 1."""
+    typer.echo(f"error: {exc}", err=True)
+    raise typer.Exit(code=1)
+
+
+DEBUG_ENV = "WALKERLAB_DEBUG"
+#: values of ``WALKERLAB_DEBUG`` that show tracebacks (case-insensitive); anything else
+#: (``0``, ``false``, ``no``, empty) keeps errors to one line
+DEBUG_ON = ("1", "true", "yes")
+#: longest error line; a longer message is cut at a sentence or field boundary
+MAX_ERROR_CHARS = 300
+
+
+def _debug() -> bool:
+    return os.environ.get(DEBUG_ENV, "").strip().lower() in DEBUG_ON
+
+
+def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
+    """A message as one line: its lines joined (a sentence wrapped over two lines stays
+    whole); longer than ``limit``, it is cut after the last sentence or field boundary
+    (``.``, ``;``, ``:``, ``,`` followed by a space) and says how to see the rest."""
+    line = " ".join(ln.strip() for ln in str(text).strip().splitlines() if ln.strip())
+    if len(line) <= limit:
+        return line
+    # a trailing "[detail]" (a solver's report) is cut first: the advice before it stays whole
+    start = line.rfind(" [")
+    if line.endswith("]") and 0 < start <= limit:
+        more = f" ... rerun with {DEBUG_ENV}=1 for the rest]"
+        detail = line[start:-1]
+        # up to 80 characters past the limit for the detail's start (what was tried)
+        cut = detail[:max(limit + 80 - start - len(more), 2)].rfind(" ")
+        return line[:start] + (detail[:cut].rstrip(",;:( ") if cut > 2 else " [") + more
+    head = line[:limit]
+    cut = max(head.rfind(sep) for sep in (". ", "; ", ": ", ", "))
+    head = head[:cut + 1] if cut > limit // 3 else head[:head.rfind(" ")].rstrip()
+    return (f"{head} ... [{len(line) - len(head)} more characters: rerun with "
+            f"{DEBUG_ENV}=1 for the full message]")
+
+
+def _disk_full_line(exc: BaseException) -> str:
+    where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+    return (f"error: disk full: cannot write{where}; free some space (or raise the file-size "
+            "limit) and rerun")
+
+
+def guard(fn):
+    """Run a command so that every failure is one line on stderr and a non-zero exit code."""
+    import functools
+
+    @functools.wraps(fn)
+    def wrapper(*a, **k):
+        from walkerlab import progress
+        from walkerlab.analysis.poincare import FixedPointNotFound
+        from walkerlab.config import SceneError
+        from walkerlab.io.artifacts import ArtifactError, is_disk_full
+        from walkerlab.io.runpaths import ArtifactBusy
+        from walkerlab.stages.common import StageError
+
+        debug = _debug()
+        try:
+            # a spinner with the elapsed time on a terminal: never silent while it works
+            with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
+                return fn(*a, **k)
+        except (typer.Exit, typer.Abort, SystemExit):
+            raise
+        except KeyboardInterrupt:
+            typer.echo("interrupted", err=True)
+            raise typer.Exit(code=130) from None
+        except SceneError as exc:  # every config error, one line each
+            if debug:
+                raise
+            for line in str(exc).splitlines() or [""]:
+                typer.echo(f"error: {line.strip()}", err=True)
+            raise typer.Exit(code=1) from None
+        except (ArtifactError, ArtifactBusy, StageError, FixedPointNotFound,
+                ValueError) as exc:
+            if debug:
+                raise
+            typer.echo(f"error: {one_line(exc)}", err=True)
+            raise typer.Exit(code=1) from None
+        except OSError as exc:  # read-only runs folder, disk full, ...
+            if debug:
+                raise
+            if is_disk_full(exc):
+                typer.echo(_disk_full_line(exc), err=True)
+                raise typer.Exit(code=1) from None
+            where = f"{exc.filename}: " if exc.filename else ""
+            typer.echo(f"error: {where}{exc.strerror or one_line(exc)}", err=True)
+            raise typer.Exit(code=1) from None
+        except Exception as exc:  # noqa: BLE001 - a traceback shown to a user is a bug
+            if debug:
+                raise
+            if is_disk_full(exc):  # HDF5 reports a full disk as a RuntimeError too
+                typer.echo(_disk_full_line(exc), err=True)
+                raise typer.Exit(code=1) from None
+            typer.echo(f"error: internal error ({type(exc).__name__}): {one_line(exc)} "
+                       f"[rerun with {DEBUG_ENV}=1 for the traceback]", err=True)
+            raise typer.Exit(code=1) from None
+    return wrapper

@@ -1,0 +1,45 @@
+"""Arguments and options shared by the commands, loading the scene, the status line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+SceneArg = typer.Argument(None, help="scene YAML file (default: configs/paper.yaml, "
+                          "the paper's walker)",
+                          show_default=False)
+
+
+def _runs_dir(value) -> Path:
+    """``--runs-dir``: a folder name; an empty one (which would be the current folder) is
+    refused."""
+    if not str(value).strip():
+        raise typer.BadParameter("empty folder name (it would write into the current folder); "
+                                 "give a folder, e.g. --runs-dir runs")
+    return Path(value)
+
+
+RunsOpt = typer.Option("runs", "--runs-dir", parser=_runs_dir, metavar="PATH",
+                       help="folder for artifacts (runs/<scene>/)")
+ForceOpt = typer.Option(False, "--force", help="recompute even if the artifact is up to date")
+
+
+def default_scene() -> Path:
+    """``configs/paper.yaml`` (see :func:`walkerlab.config.default_scene_path`)."""
+    from walkerlab.config import default_scene_path
+
+    return default_scene_path()
+
+
+def load(scene: Path | None):
+    """The scene at ``scene`` (default :func:`default_scene`), validated (SceneError)."""
+    from walkerlab.config import load_scene
+
+    return load_scene(scene or default_scene())
+
+
+def status(o) -> str:
+    """The line saying what a stage did: ``wrote <path> (compute ...)`` or ``reused ...``."""
+    return (f"reused {o.path} ({o.note or 'inputs unchanged'})" if o.reused
+            else f"wrote {o.path} (compute {o.wall_time_s:.3f} s)")

@@ -1,0 +1,76 @@
+"""Settings of the process every command runs in, and ``--version``."""
+
+from __future__ import annotations
+
+import os
+
+import typer
+
+
+def versions() -> str:
+    """walkerlab, Python and the numeric libraries' versions (for bug reports)."""
+    import platform
+    from importlib import metadata
+
+    import walkerlab
+
+    parts = [f"walkerlab {walkerlab.__version__}", f"python {platform.python_version()}"]
+    for dist in ("numpy", "scipy", "numba", "h5py", "pydantic", "matplotlib"):
+        try:
+            parts.append(f"{dist} {metadata.version(dist)}")
+        except metadata.PackageNotFoundError:
+            parts.append(f"{dist} not installed")
+    return ", ".join(parts) + f" ({platform.system()} {platform.machine()})"
+
+
+def version_callback(value: bool) -> None:
+    """``--version``: print :func:`versions` and exit."""
+    if value:
+        typer.echo(versions())
+        raise typer.Exit()
+
+
+#: OpenBLAS thread pools (numpy's and scipy's each start one when loaded)
+BLAS_THREADS_ENV = "OPENBLAS_NUM_THREADS"
+
+
+def single_threaded_blas() -> None:
+    """Ask OpenBLAS for one thread unless the user chose a number (``OPENBLAS_NUM_THREADS``).
+
+    walkerlab's matrices have at most a few dozen rows, which OpenBLAS never splits across
+    threads, but starting the thread pools of numpy's and scipy's OpenBLAS costs every
+    command ~50-100 ms of start-up on the 2-core machine (issue 10: 3 OS threads -> 1).  Must
+    run before numpy is imported; worker processes (sweeps, basin) inherit it, as the
+    work-precision workers already set it for themselves.
+    """
+    os.environ.setdefault(BLAS_THREADS_ENV, "1")
+
+
+#: cyclic garbage collector thresholds of a command's process (generation 0 allocations,
+#: generation 1 and 2 collections; Python's are (700, 10, 10))
+GC_THRESHOLDS = (20_000, 20, 20)
+
+
+def process_settings() -> None:
+    """Settings every command (and every worker it starts) runs with:
+
+    - numba's on-disk cache in the per-user cache (``NUMBA_CACHE_DIR``, unless set), never
+      in the installed package (:func:`walkerlab.usercache.use_for_numba`); before numba is
+      imported, and inherited by worker processes;
+    - ``SIGXFSZ`` ignored (a file-size limit, ``ulimit -f``, then makes a write fail with
+      EFBIG, reported as "disk full" in one line, instead of killing the process);
+    - the cyclic garbage collector's thresholds raised to :data:`GC_THRESHOLDS` (this
+      process only; its workers keep Python's): a command imports scipy, h5py, pydantic and
+      its own schema after this point, and with Python's (700, 10, 10) the collector walks
+      those long-lived objects again and again (issue 27: ~5 % of ``walkerlab fixedpoint``'s
+      CPU time).  Reference counting still frees everything without cycles at once.
+    """
+    import gc
+    import signal
+
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()
+    if hasattr(signal, "SIGXFSZ"):
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    gc.set_threshold(*GC_THRESHOLDS)

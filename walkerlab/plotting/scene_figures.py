@@ -1,0 +1,76 @@
+"""A scene's figure groups, drawn from loaded artifacts and saved as PNG + SVG.
+
+``trajectories``: stick diagrams (Figs. 2, 6), angles and rates (Fig. 7), errors (Fig. 8),
+limit cycles (Fig. 9), energy (Fig. 10) and the drop test's restitution;
+``workprecision``: one work-precision diagram per model.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from walkerlab.io.trajectory import NamedTrajectory
+from walkerlab.plotting import IDEAL_LABEL
+from walkerlab.plotting import figures as F
+from walkerlab.units import Units
+
+
+def trajectory_figures(trajs: dict[str, NamedTrajectory], out_dir: Path, title: str,
+                       slope_rad: float, units: Units, terrain: dict | None = None,
+                       compare=None, drop=None, k_paper: float | None = None) -> list[Path]:
+    """Draw and save the trajectory figures (paper order: Figs. 2, 6, then 7-10).
+
+    Parameters
+    ----------
+    trajs : dict
+        ``{model label: NamedTrajectory}`` (:data:`walkerlab.plotting.IDEAL_LABEL`, ...).
+    terrain : dict, optional
+        The contact walker's ground (:func:`walkerlab.io.terrain.load_terrain`).
+    compare : CompareArtifact, optional
+        Loaded ``compare.h5`` (Fig. 8).
+    drop : optional
+        The drop test of ``contact_sim.h5`` (restitution against stiffness, with the scene's
+        stiffness ``k_paper`` marked).
+
+    Returns
+    -------
+    list of Path
+        Written files.
+    """
+    written: list[Path] = []
+    for label, tr in trajs.items():
+        stem = "fig2_stick_ideal" if label == IDEAL_LABEL else "fig6_stick_contact"
+        ground = None if label == IDEAL_LABEL else terrain  # the contact walker's checkerboard
+        written += F.save(F.stick_diagram(tr, label, slope_rad=slope_rad, units=units,
+                                          terrain=ground), out_dir, stem)
+    written += F.save(F.fig7_angles_rates(trajs, title, units=units), out_dir,
+                      "fig7_angles_rates")
+    written += F.save(F.fig9_limit_cycle(trajs, units=units), out_dir, "fig9_limit_cycles")
+    written += F.save(F.fig10_energy(trajs, units=units), out_dir, "fig10_energy")
+    if compare is not None:
+        c = compare
+        phase = (c.step_phase, c.phase_errors) if c.phase_errors is not None else None
+        written += F.save(F.fig8_errors(c.time, c.errors, c.error_units, "contact - ideal",
+                                        scene_units=units, phase=phase), out_dir, "fig8_errors")
+    if drop is not None:
+        from walkerlab.plotting.sweep_figures import restitution_figure
+
+        fig = restitution_figure(drop.stiffness, drop.restitution, unit=drop.unit,
+                                 k_paper=k_paper, mass_kg=drop.mass_kg, units=units)
+        written += F.save(fig, out_dir, "drop_restitution")
+    return written
+
+
+def workprecision_figures(wp, out_dir: Path, units: Units) -> list[Path]:
+    """One work-precision diagram per model of a loaded ``workprecision.h5`` (``wp``), with
+    its Pareto front; returns the written files."""
+    from walkerlab.io.schemas.workprecision import pareto
+
+    written: list[Path] = []
+    for model, m in wp.models.items():
+        rows = {meth: {k: v for k, v in cols.items() if k != "repeats"}
+                for meth, cols in m.rows.items()}
+        written += F.save(F.work_precision(rows, f"work-precision, {model} model",
+                                           pareto(m.choice), units=units),
+                          out_dir, f"work_precision_{model}")
+    return written
