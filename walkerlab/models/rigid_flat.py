@@ -80,10 +80,6 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     HybridWalker
         Roles ``(swing, stance, stance_ankle)``; six phases ``<mode>:<swing part>``.
     """
-    # here, not at the top: flatfoot imports sympy, and models.rigid imports this module for
-    # every walker (issue 27: sympy on the path of `walkerlab fixedpoint`, ~0.2 s)
-    from walkerlab.models.flatfoot import MODES
-
     f = functions(data)
     flows = {m: f[f"flow_{m}"] for m in MODES}
     pin = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
