@@ -527,3 +527,21 @@ def test_d6_memoised_content_hash_sees_an_edit(tmp_path, monkeypatch):
     monkeypatch.setattr(A.time, "time_ns", lambda: now + 20_000_000_000)
     assert A.content_hash(path) != first
     assert A.verified_hash(path) is None
+
+
+def test_force_replaces_an_artifact_without_hashing_it(tmp_path, monkeypatch):
+    """``--force`` recomputes whatever the existing artifact holds, so its content is not
+    hashed first (issue 27: that hash was ~10 % of ``walkerlab fixedpoint --force``); without
+    ``--force`` the same artifact is verified and reused."""
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(1.0))
+    verified = []
+    real = common.verified_hash
+    monkeypatch.setattr(common, "verified_hash", lambda p: verified.append(p) or real(p))
+    out = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(2.0),
+                            force=True)
+    assert verified == [] and not out.reused and out.note == "--force"
+    with h5py.File(out.path, "r") as f:
+        assert float(f["fixed_point/stance_rate"][()]) == 2.0
+    again = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(3.0))
+    assert verified == [out.path] and again.reused

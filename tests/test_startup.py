@@ -49,8 +49,9 @@ def test_cli_import_loads_no_numeric_library():
 
 @pytest.mark.usefixtures("paper_walker")  # generated model code in the shared cache
 def test_fixedpoint_command_loads_cyrk_without_numba(tmp_path):
-    """The whole ``walkerlab fixedpoint --force``: CyRK integrates, numba is not loaded, and
-    OpenBLAS started no thread pool (one OS thread in the process)."""
+    """The whole ``walkerlab fixedpoint --force``: CyRK integrates, numba is not loaded, no
+    process-pool machinery (``multiprocessing``) is loaded, and OpenBLAS started no thread
+    pool (one OS thread in the process)."""
     code = ("import os, sys\n"
             "from walkerlab.cli import app\n"
             "try:\n"
@@ -59,7 +60,7 @@ def test_fixedpoint_command_loads_cyrk_without_numba(tmp_path):
             "    assert not exc.code, exc.code\n"
             "tasks = '/proc/self/task'\n"
             "threads = len(os.listdir(tasks)) if os.path.isdir(tasks) else 1\n"
-            + _loaded(HEAVY + ("CyRK",),
+            + _loaded(HEAVY + ("CyRK", "multiprocessing"),
                       f"{{'blas': os.environ.get({BLAS_THREADS_ENV!r}), 'threads': threads}}"))
     # a first run fills the shared cache (the rigid module AND the compiled flow: a cold
     # cache compiles with sympy/numba, which is not what this test is about); the second is
@@ -128,3 +129,12 @@ def test_cyrk_loader_runs_cyrk_cpu_check_before_any_compiled_module():
     got = _run(code)
     assert "AVX2" in got["msg"]
     assert got["cy"] == [] and got["pkg"] is False
+
+
+def test_sweep_figure_loads_no_root_finder():
+    """``walkerlab sweep`` draws its figure in the main process after its points ran in
+    worker processes: the sweep stage and the figure module load neither scipy's root
+    finders nor an integrator (issue 27: ``scipy.optimize`` alone cost that process ~0.3 s)."""
+    got = _run("import walkerlab.stages.sweep, walkerlab.plotting.sweep_figures\n"
+               + _loaded(("scipy.optimize", "scipy.integrate", "CyRK", "numba")))
+    assert not any(got.values()), got

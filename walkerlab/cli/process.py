@@ -46,6 +46,11 @@ def single_threaded_blas() -> None:
     os.environ.setdefault(BLAS_THREADS_ENV, "1")
 
 
+#: cyclic garbage collector thresholds of a command's process (generation 0 allocations,
+#: generation 1 and 2 collections; Python's are (700, 10, 10))
+GC_THRESHOLDS = (20_000, 20, 20)
+
+
 def process_settings() -> None:
     """Settings every command (and every worker it starts) runs with:
 
@@ -53,8 +58,14 @@ def process_settings() -> None:
       in the installed package (:func:`walkerlab.usercache.use_for_numba`); before numba is
       imported, and inherited by worker processes;
     - ``SIGXFSZ`` ignored (a file-size limit, ``ulimit -f``, then makes a write fail with
-      EFBIG, reported as "disk full" in one line, instead of killing the process).
+      EFBIG, reported as "disk full" in one line, instead of killing the process);
+    - the cyclic garbage collector's thresholds raised to :data:`GC_THRESHOLDS` (this
+      process only; its workers keep Python's): a command imports scipy, h5py, pydantic and
+      its own schema after this point, and with Python's (700, 10, 10) the collector walks
+      those long-lived objects again and again (issue 27: ~5 % of ``walkerlab fixedpoint``'s
+      CPU time).  Reference counting still frees everything without cycles at once.
     """
+    import gc
     import signal
 
     from walkerlab.usercache import use_for_numba
@@ -62,3 +73,4 @@ def process_settings() -> None:
     use_for_numba()
     if hasattr(signal, "SIGXFSZ"):
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    gc.set_threshold(*GC_THRESHOLDS)

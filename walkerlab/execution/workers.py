@@ -20,7 +20,6 @@ Importing this module loads nothing heavy.
 
 from __future__ import annotations
 
-import multiprocessing as mp
 import os
 import sys
 import threading
@@ -77,6 +76,8 @@ def mp_context(method: str | None = None, preload: tuple[str, ...] = ()):
         method = "forkserver" if sys.platform.startswith("linux") else "spawn"
     if method == "fork":
         raise ValueError("walkerlab pools do not fork (a forked worker inherits open locks)")
+    import multiprocessing as mp
+
     ctx = mp.get_context(method)
     if method == "forkserver" and preload:
         ctx.set_forkserver_preload(list(preload))

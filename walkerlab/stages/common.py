@@ -64,16 +64,16 @@ def run_cached(stage: str, scene: Scene, runs_root: Path | str, sections: tuple[
     with artifact_lock(path, wait=True, on_wait=_tell):
         key = input_hash(stage, scene, sections, upstream, extra_key)
         note = ""
-        if path.is_file():
+        if path.is_file() and force:
+            note = "--force"  # recomputed whatever it holds: its content is not hashed
+        elif path.is_file():
             have = verified_hash(path)
-            if not force and (have == key or any(
-                    have == input_hash(stage, scene, sections, upstream, a)
-                    for a in also_accept)):
+            if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
+                                  for a in also_accept):
                 return StageOutcome(stage, path, True, 0.0, {})
             # never replace a result silently: say what is recomputed and why (one line)
-            note = "--force" if force else recompute_reason(path, scene, sections, have)
-            if not force:
-                _tell(f"{stage}: recomputing {path} ({note})")
+            note = recompute_reason(path, scene, sections, have)
+            _tell(f"{stage}: recomputing {path} ({note})")
         t0 = time.perf_counter()
         writer, summary = compute()
         wall = time.perf_counter() - t0

@@ -33,7 +33,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from walkerlab.config import Scene
 from walkerlab.execution.executor import run_each
@@ -254,6 +253,8 @@ def locate_period_doubling(base: dict, slopes_deg: np.ndarray, mult: np.ndarray,
         if g[k + 1 if rising else k] == 0:
             onset = hi if rising else lo
         else:
+            from scipy.optimize import brentq  # here: the sweep figure imports this module
+
             onset = brentq(f, lo, hi, xtol=xtol_deg)
         return _onset_dict(onset, [lo, hi], f(onset) - 1.0, state["n"], path)
     return _onset_dict(math.nan, [math.nan, math.nan], math.nan, 0, path)
