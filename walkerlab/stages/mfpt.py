@@ -143,6 +143,7 @@ def compute(scene: Scene, x_star: np.ndarray, st: MfptSettings, workers: int = 1
         The walker cannot walk on per-step slopes, or the mesh is asked for a uniform
         slope distribution (its quadrature is Gauss-Hermite).
     """
+    from walkerlab.analysis.python_step import needs_python_path
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
     from walkerlab.models.registry import build_walker
     from walkerlab.sweep import mfpt as work
@@ -155,6 +156,10 @@ def compute(scene: Scene, x_star: np.ndarray, st: MfptSettings, workers: int = 1
                          "(Gauss-Hermite); use --method montecarlo for "
                          "terrain.per_step.slope_distribution: uniform")
     walker = build_walker(scene)
+    if st.method in ("mesh", "both") and needs_python_path(walker):
+        raise ValueError("mfpt.method: the mesh needs the compiled batched step map (its "
+                         "~10^6 step images); this walker has no compiled flows (flat feet): "
+                         "use --method montecarlo")
     work.step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
     sig = np.asarray(st.sigma_rad, float)
     vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}

@@ -37,7 +37,10 @@ def scene_walker_at(scene):
 
 
 def step_map_for(base: dict) -> BatchStepMap:
-    """The batched step map of a scene mapping (built once per process)."""
+    """The batched step map of a scene mapping (built once per process; a walker without
+    compiled flows, e.g. flat feet, gets the row-by-row
+    :class:`~walkerlab.analysis.python_step.PythonStepMap`)."""
+    from walkerlab.analysis.python_step import make_step_map
     from walkerlab.config import MfptSettings, scene_from_dict
     from walkerlab.models.registry import build_walker
 
@@ -46,8 +49,8 @@ def step_map_for(base: dict) -> BatchStepMap:
         scene = scene_from_dict(base)
         st = scene.mfpt or MfptSettings()
         _MAPS.clear()
-        _MAPS[key] = BatchStepMap(build_walker(scene), scene_walker_at(scene), st.rtol,
-                                  st.atol, st.max_step_time_s)
+        _MAPS[key] = make_step_map(build_walker(scene), scene_walker_at(scene), st.rtol,
+                                   st.atol, st.max_step_time_s)
     return _MAPS[key]
 
 
