@@ -5,6 +5,12 @@ floor height step and mid-stance push, and the largest tolerable single step-dow
 (bisection brackets, 1 mm) and mid-stance push forward/backward (1 mm/s).
 
     python scripts/robustness_table.py [paper kneed ...]
+    python scripts/robustness_table.py --contact [paper kneed ...]
+
+``--contact``: the contact model's largest single step-down and step-up instead (patches at
+the step's height, from the contact model's periodic gait - or from the contact run's own
+start when none is found within contact_sim.periodic_time_limit_s - surviving 10 heel strikes;
+bisection brackets to 1 mm, walks on 2 local worker processes).
 """
 
 from __future__ import annotations
@@ -17,7 +23,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 WALKERS = ("paper", "goswami1996", "paper_rods", "round_feet", "kneed", "simplest",
-           "schwab_wisse2001")
+           "schwab_wisse2001", "hip_spring", "torso_bhm", "asymmetric_legs")
 
 
 def row(name: str) -> str:
@@ -35,6 +41,8 @@ def row(name: str) -> str:
     except ValueError as exc:
         return f"| {name} | not supported: {exc} |"
     w, s = solve_scene(sc, fd_check=False)
+    if w.steps_per_map != 1:
+        return f"| {name} | not supported: legs that differ (a stride map) |"
     g = s.gait.result
     A, x = g.jacobian_variational, g.x
     T = R.relative_coordinates(w.state_names())
@@ -57,8 +65,41 @@ def row(name: str) -> str:
     return "| " + " | ".join(cells) + " |"
 
 
+def contact_row(name: str) -> str:
+    from walkerlab.analysis.contact_rough import contact_start
+    from walkerlab.analysis.scene_gaits import solve_scene
+    from walkerlab.config import load_scene
+    from walkerlab.sweep.contact_rough import contact_largest_step
+
+    t = time.perf_counter()
+    sc = load_scene(ROOT / "configs" / f"{name}.yaml")
+    if sc.contact is None:
+        return f"| {name} | no contact section |"
+    _, s = solve_scene(sc, fd_check=False)
+    start = "periodic gait"
+    try:
+        st = contact_start(sc, s.gait.result.x)
+    except Exception:  # no periodic gait in time: the contact run's own start (a transient)
+        st = contact_start(sc, s.gait.result.x, periodic=False)
+        start = "contact-sim start (no periodic gait found in time)"
+    cells = [name, f"{st.period_s:.6f} ({start})"]
+    for sign in (1.0, -1.0):
+        lo, hi = contact_largest_step(st, sign, 0.05, 0.001, 10, workers=2)
+        cells.append(f"{1000 * lo:.4g}-{1000 * hi:.4g}" if lo == lo else
+                     "falls without a step")
+    cells.append(f"{time.perf_counter() - t:.0f}")
+    return "| " + " | ".join(cells) + " |"
+
+
 def main() -> None:
-    names = sys.argv[1:] or WALKERS
+    args = sys.argv[1:]
+    if args and args[0] == "--contact":
+        print("| walker | contact gait period [s] | step-down [mm] | step-up [mm] | s |")
+        print("|---|---|---|---|---|")
+        for n in args[1:] or WALKERS:
+            print(contact_row(n), flush=True)
+        return
+    names = args or WALKERS
     print("| walker | abs lambda max (abs / rel angles) | GSN slope [1/rad] (lin vs nonlin) "
           "| state norm slope (abs / rel) | GSN floor height [1/m] (lin vs nonlin) "
           "| state norm height (abs / rel) | GSN push [s/m] (lin vs nonlin) "

@@ -118,16 +118,19 @@ def test_no_noise_no_fall_and_unstable_gait_falls(paper_scene, paper_map):
     assert np.median(r.steps[r.fell]) < 20
 
 
-def _ar1_chain(a, sd, c, walks, steps, seed):
-    """An AR(1) map x' = a x + gamma (gamma ~ N(0, sd^2)), falling when |x'| > c, carried
-    as the 2-D state (x, x / 2) (a linear constraint, like a locked knee's, that the
-    mesh's metric must drop).  Returns the evaluator of the map, the states visited by
-    ``walks`` walks of ``steps`` steps from 0, and the Monte Carlo MFPT of those walks."""
+def _ar1_chain(a, sd, c, walks, steps, seed, distribution="normal"):
+    """An AR(1) map x' = a x + gamma (gamma ~ N(0, sd^2), or uniform with standard deviation
+    sd), falling when |x'| > c, carried as the 2-D state (x, x / 2) (a linear constraint,
+    like a locked knee's, that the mesh's metric must drop).  Returns the evaluator of the
+    map, the states visited by ``walks`` walks of ``steps`` steps from 0, and the Monte
+    Carlo MFPT of those walks."""
     rng = np.random.default_rng(seed)
     x, alive, n = np.zeros(walks), np.ones(walks, bool), np.zeros(walks, int)
     seen = []
     for _ in range(steps):
-        x = a * x + sd * rng.standard_normal(walks)
+        z = (rng.uniform(-math.sqrt(3), math.sqrt(3), walks) if distribution == "uniform"
+             else rng.standard_normal(walks))
+        x = a * x + sd * z
         ok = alive & (np.abs(x) <= c)
         n += ok
         alive = ok
@@ -161,6 +164,34 @@ def test_mesh_converges_to_monte_carlo_on_a_known_chain():
     assert abs(last.mfpt_steps - m) < 2 * se + 0.05 * last.mfpt_steps
     assert abs(meshes[0].mfpt_steps - m) > 0.05 * m
     assert abs(last.mfpt_quasi_stationary_steps - last.mfpt_steps) < 0.05 * m
+
+
+def test_uniform_slope_quadrature_mesh_agrees_with_monte_carlo():
+    """Uniform per-step noise (support -/+ sqrt(3) sd): Gauss-Legendre nodes on the support
+    integrate polynomials exactly (the 2nd and 4th moments 1 and 9/5 sd^4 to 1e-12), and the
+    converged mesh of the AR(1) chain (a = 0.6, boundary at 2.2 stationary sd's) agrees
+    with 40,000 Monte Carlo walks with uniform noise within 2 standard errors + the 5 %
+    refinement change.  The normal quadrature (Gauss-Hermite) on the same chain is off by
+    more than that (the uniform's bounded support makes falls rarer here), so the check
+    sees which distribution the mesh integrates."""
+    import types
+
+    g, w = M.slope_quadrature(21, 0.0, 1.0, "uniform")
+    assert abs(w.sum() - 1) < 1e-13 and np.all(np.abs(g) < math.sqrt(3))
+    assert abs(w @ g**2 - 1) < 1e-12 and abs(w @ g**4 - 9 / 5) < 1e-12
+    with pytest.raises(ValueError, match="normal or uniform"):
+        M.slope_quadrature(5, 0.0, 1.0, "lognormal")
+    a, sd = 0.6, 1.0
+    c = 2.2 * sd / math.sqrt(1 - a * a)
+    evaluate, seen, (m, se) = _ar1_chain(a, sd, c, 40000, 400, 0, "uniform")
+    fake = types.SimpleNamespace(slope_rad=0.0)
+    kw = dict(cells=20, max_cells=2000, quadrature=41, evaluate=evaluate)
+    last, _ = M.mesh_mfpt_converged(fake, seen[::200], np.zeros(2), sd,
+                                    distribution="uniform", **kw)
+    assert last.converged
+    assert abs(last.mfpt_steps - m) < 2 * se + 0.05 * last.mfpt_steps, (last.mfpt_steps, m)
+    normal, _ = M.mesh_mfpt_converged(fake, seen[::200], np.zeros(2), sd, **kw)
+    assert abs(normal.mfpt_steps - m) > 2 * se + 0.05 * normal.mfpt_steps, (normal, m)
 
 
 @pytest.mark.slow
@@ -223,6 +254,7 @@ def test_mfpt_stage_artifact_and_figure(tmp_path):
     assert 0 <= m < 60 and data["montecarlo_falls"][0] > 0
     assert np.isnan(data["mfpt_steps_mesh"][0])
     assert stage.figure_path(sc, tmp_path / "runs").is_file()
+    assert not out.path.with_name("mfpt.h5.partial").exists()  # the resume file is gone
     again = pipeline.run("mfpt", sc, tmp_path / "runs", sigma_rad=[0.008], workers=1)
     assert again.reused
 

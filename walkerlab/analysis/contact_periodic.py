@@ -215,7 +215,7 @@ class StepMap:
         self.nfev = 0
         w = self.walker
         kern = w.kernels
-        args = (w.contact_params, w.walker_params, w.lane1, w.lane2)
+        args = (w.contact_params, w.walker_params, *w.kernel_lanes)
         self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
         self._fj = lambda x: kern.jac(x, *args)  # noqa: E731
         self.n, self.t = w.normal, w.tangent

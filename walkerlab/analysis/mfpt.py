@@ -28,9 +28,11 @@ Mesh (:func:`mesh_mfpt`)
     step's slope: ``2n`` coordinates, ``d = 4`` for a compass walker; directions without
     spread, such as a locked knee's, drop out of the metric).  Each node is a Voronoi cell
     (nearest node, :class:`scipy.spatial.cKDTree`); from each node the step map is taken at
-    the Gauss-Hermite nodes of the slope distribution, an image goes to its nearest node,
-    and only a genuine fall (no heel strike) goes to the absorbing state; images farther
-    from every node than 99 % of the nodes are from their neighbour are reported
+    the quadrature nodes of the slope distribution (Gauss-Hermite for the normal,
+    Gauss-Legendre on the support for the uniform, :func:`slope_quadrature`), an image
+    goes to its nearest node, and only a genuine fall (no heel strike) goes to the
+    absorbing state; images farther from every node than 99 % of the nodes are from their
+    neighbour are reported
     (``escaped``: their probability per step from the quasi-stationary distribution).
     With ``Q`` the transition matrix among nodes (``scipy.sparse``), the quasi-stationary
     MFPT is ``1 / (1 - lambda_2) - 1`` (``lambda_2`` the largest eigenvalue of ``Q``,
@@ -160,7 +162,7 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
 # -- the mesh ------------------------------------------------------------------------------
 
 def visited_states(step_map: BatchStepMap, x0: np.ndarray, sds, walks: int, steps: int,
-                   seed: int, burn_in: int = 1) -> np.ndarray:
+                   seed: int, burn_in: int = 1, distribution: str = "normal") -> np.ndarray:
     """Post-impact states visited by noisy walks from ``x0`` (the mesh's nodes).
 
     Parameters
@@ -171,6 +173,8 @@ def visited_states(step_map: BatchStepMap, x0: np.ndarray, sds, walks: int, step
         that falls starts again from ``x0``, so about ``walks * steps`` states per sd).
     burn_in : int
         Steps of each walk not recorded.
+    distribution : {"normal", "uniform"}
+        Of the slopes (uniform: on ``mean -/+ sqrt(3) sd``).
 
     Returns
     -------
@@ -185,7 +189,9 @@ def visited_states(step_map: BatchStepMap, x0: np.ndarray, sds, walks: int, step
         rng = np.random.default_rng([int(seed), 24, i])
         X = np.tile(np.asarray(x0, float), (walks, 1))
         for k in range(steps):
-            r = step_map.step(X, step_map.slope_rad + sd * rng.standard_normal(len(X)))
+            z = (rng.uniform(-math.sqrt(3.0), math.sqrt(3.0), len(X))
+                 if distribution == "uniform" else rng.standard_normal(len(X)))
+            r = step_map.step(X, step_map.slope_rad + sd * z)
             ok = r.outcome == HEEL_STRIKE
             if k >= burn_in:
                 pts.append(r.x_next[ok])
@@ -247,6 +253,38 @@ def gauss_hermite(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarra
 
     z, w = hermegauss(n)
     return mean + sd * z, w / w.sum()
+
+
+def gauss_legendre_uniform(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes [rad] and weights (sum 1) of the uniform distribution on
+    ``mean -/+ sqrt(3) sd`` (standard deviation ``sd``; :func:`draw_slopes`'s uniform),
+    Gauss-Legendre (``numpy.polynomial.legendre.leggauss``) mapped to that interval."""
+    from numpy.polynomial.legendre import leggauss
+
+    z, w = leggauss(n)
+    return mean + math.sqrt(3.0) * sd * z, w / w.sum()
+
+
+def slope_quadrature(n: int, mean: float, sd: float, distribution: str = "normal"
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` nodes [rad] and weights (sum 1) of the per-step slope distribution.
+
+    Parameters
+    ----------
+    distribution : {"normal", "uniform"}
+        Gauss-Hermite (:func:`gauss_hermite`) or Gauss-Legendre on the uniform's support
+        (:func:`gauss_legendre_uniform`).
+
+    Raises
+    ------
+    ValueError
+        Another distribution.
+    """
+    if distribution == "normal":
+        return gauss_hermite(n, mean, sd)
+    if distribution == "uniform":
+        return gauss_legendre_uniform(n, mean, sd)
+    raise ValueError(f"slope distribution {distribution!r}: normal or uniform")
 
 
 def transition_matrix(images: np.ndarray, ok: np.ndarray, weights: np.ndarray,
@@ -338,8 +376,8 @@ def voxel_nodes(Z: np.ndarray, cells: int) -> tuple[np.ndarray, float]:
 
 
 def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndarray,
-              sd: float, quadrature: int = 21, evaluate=None, cache: dict | None = None
-              ) -> MeshResult:
+              sd: float, quadrature: int = 21, evaluate=None, cache: dict | None = None,
+              distribution: str = "normal") -> MeshResult:
     """MFPT on the Voronoi mesh of the nodes ``P[idx]`` (see the module docstring).
 
     Parameters
@@ -353,13 +391,15 @@ def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndar
     sd : float
         Slope standard deviation [rad].
     quadrature : int
-        Gauss-Hermite nodes of the slope distribution.
+        Quadrature nodes of the slope distribution (:func:`slope_quadrature`).
     evaluate : callable ``(X (k, 2n), gamma (k,)) -> (x_next (k, 2n), ok (k,))``, optional
         How the images are computed (e.g. on worker processes); default ``step_map.step``.
     cache : dict, optional
         Images of candidates computed by earlier meshes (reused and extended).
+    distribution : {"normal", "uniform"}
+        Of the per-step slope.
     """
-    g, w = gauss_hermite(quadrature, step_map.slope_rad, sd)
+    g, w = slope_quadrature(quadrature, step_map.slope_rad, sd, distribution)
     q = len(g)
     cache = {} if cache is None else cache
     if "x" not in cache:
@@ -386,11 +426,16 @@ def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndar
 
 def mesh_mfpt_converged(step_map: BatchStepMap, pool: np.ndarray, x0: np.ndarray, sd: float,
                         cells: int = 1000, refine: float = 2.0, rel_change: float = 0.05,
-                        max_cells: int = 16_000, quadrature: int = 21, evaluate=None
-                        ) -> tuple[MeshResult, list[MeshResult]]:
+                        max_cells: int = 16_000, quadrature: int = 21, evaluate=None,
+                        distribution: str = "normal", cache: dict | None = None,
+                        on_mesh=None) -> tuple[MeshResult, list[MeshResult]]:
     """Refine the mesh (``cells <- refine cells``: smaller voxels of the visited states
     ``pool`` (k, 2n) plus the gait ``x0``, :func:`voxel_nodes`) until the MFPT changes by
     less than ``rel_change`` between two meshes, or the pool or ``max_cells`` is exhausted.
+
+    ``cache`` (see :func:`mesh_mfpt`; rows of ``[x0, *pool]``) carries images computed
+    before, e.g. by an interrupted run; ``on_mesh(result, cache)`` is called after each mesh
+    (to store the images so far).
 
     Returns
     -------
@@ -400,14 +445,16 @@ def mesh_mfpt_converged(step_map: BatchStepMap, pool: np.ndarray, x0: np.ndarray
     P = np.concatenate([np.asarray(x0, float)[None], np.asarray(pool, float)])
     W = whitening(P)
     Z = (P - P[0]) @ W
-    cache: dict = {}
+    cache = {} if cache is None else cache
     results: list[MeshResult] = []
     n = min(cells, len(P))
     while True:
         idx, r = voxel_nodes(Z, n)
-        res = mesh_mfpt(step_map, P, idx, W, sd, quadrature, evaluate, cache)
+        res = mesh_mfpt(step_map, P, idx, W, sd, quadrature, evaluate, cache, distribution)
         res.h = r
         results.append(res)
+        if on_mesh is not None:
+            on_mesh(res, cache)
         if len(results) >= 2:
             a, b = results[-2].mfpt_steps, res.mfpt_steps
             res.change = abs(b - a) / max(abs(b), 1e-300)

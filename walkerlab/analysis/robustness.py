@@ -35,6 +35,7 @@ stance leg (``relative_coordinates``).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -244,12 +245,36 @@ def largest_by_bisection(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
     (lo, hi) : floats [rad or m]
         ``hi = inf`` when ``max_value`` survives (nothing falls up to it).
     """
-    if survives(sm, x_star, disturbance, [sign * max_value], steps)[0]:
+    return bracket_flip(lambda v: survives(sm, x_star, disturbance, sign * v, steps),
+                        max_value, tol, sections)
+
+
+def bracket_flip(survive, max_value: float, tol: float, sections: int = 8
+                 ) -> tuple[float, float]:
+    """Bracket ``(lo, hi)`` of the first survival flip of ``survive`` on ``[0, max_value]``
+    (the multisection of :func:`largest_by_bisection`, for any model).
+
+    Parameters
+    ----------
+    survive : callable ``(values (k,)) -> (k,) bool``
+        Survival of each disturbance size (all of one round at once: a batch, or tasks on
+        an executor).
+    max_value, tol : float
+        Search cap and bracket width (same unit as the values).
+    sections : int
+        Sub-intervals per round (``sections - 1`` interior points).
+
+    Returns
+    -------
+    (lo, hi) : floats
+        ``lo`` survives, ``hi`` falls; ``hi = inf`` when ``max_value`` survives.
+    """
+    if survive(np.array([float(max_value)]))[0]:
         return float(max_value), float("inf")
     lo, hi = 0.0, float(max_value)
     while hi - lo > tol:
         v = np.linspace(lo, hi, sections + 1)[1:-1]
-        alive = survives(sm, x_star, disturbance, sign * v, steps)
+        alive = np.asarray(survive(v), bool)
         dead = np.flatnonzero(~alive)
         if dead.size:
             j = dead[0]
@@ -275,7 +300,9 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     Raises
     ------
     ValueError
-        A walker the batched step map cannot carry (one line).
+        A walker no step map can carry (slope-relative coordinates, legs that differ; one
+        line).  A walker without compiled flows (flat feet) runs on the row-by-row
+        :class:`~walkerlab.analysis.python_step.PythonStepMap` (~5-10 ms a step).
     """
     from walkerlab.analysis.poincare import poincare_map
     from walkerlab.analysis.python_step import make_step_map
@@ -319,6 +346,7 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
           "push_backward_m_per_s/hi": back[1], "sigma_rad": st.sigma_rad, "mfpt_steps": m,
           "mfpt_steps_stderr": se, "montecarlo_walks": mc.steps.size,
           "montecarlo_falls": int(mc.fell.sum())}
+    sc.update(contact_steps(scene, x_star, st, 0.2 * cap, workers, scheduler))
     return RobustnessData(list(st.disturbances), {d: UNITS[d] for d in st.disturbances}, lam,
                           gsn, gnl, norm, sc, names)
 
@@ -472,4 +500,39 @@ def pushed_step(walker, x0: np.ndarray, dv_mps: np.ndarray, solver=None,
             out.outcome[i] = HEEL_STRIKE
             out.x_pre[i], out.x_next[i] = s2.x_end, s2.x_next
             out.step_time_s[i] = tm - seg.t_start + s2.period
+    return out
+
+
+def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
+                  scheduler=None) -> dict:
+    """The contact model's largest single step-down and step-up (``robustness.contact``):
+    bisection brackets [m] (search cap ``cap_m``; the stage uses a twentieth of the leg
+    length) of the step at the first heel strike, from the contact model's
+    periodic gait, surviving ``robustness.contact_survival_steps`` heel strikes
+    (:func:`walkerlab.sweep.contact_rough.contact_largest_step`, walks on the executor);
+    NaN when not asked for.
+
+    Raises
+    ------
+    ValueError
+        Asked for without a ``contact`` section, patches or periodic gait (one line).
+    """
+    keys = ("contact_step_down_m/lo", "contact_step_down_m/hi", "contact_step_up_m/lo",
+            "contact_step_up_m/hi")
+    if not getattr(st, "contact", False):
+        return dict.fromkeys(keys, math.nan)
+    from walkerlab.analysis.contact_periodic import PeriodicGaitError
+    from walkerlab.analysis.contact_rough import contact_start
+    from walkerlab.contact.scene import ContactSceneError
+    from walkerlab.sweep.contact_rough import contact_largest_step
+
+    try:
+        start = contact_start(scene, x_star)
+    except (ContactSceneError, PeriodicGaitError) as exc:
+        raise ValueError(f"robustness.contact: {exc}") from None
+    out = {}
+    for sign, name in ((1.0, "down"), (-1.0, "up")):
+        lo, hi = contact_largest_step(start, sign, cap_m, st.resolution_m,
+                                      st.contact_survival_steps, workers, scheduler)
+        out[f"contact_step_{name}_m/lo"], out[f"contact_step_{name}_m/hi"] = lo, hi
     return out

@@ -698,13 +698,20 @@ class MfptSettings(_Strict):
         description="standard deviations of the per-step slope [rad]")
     method: Literal["mesh", "montecarlo", "both"] = Field(
         "both", description="mesh (rigid model), Monte Carlo, or both side by side")
+    model: Literal["rigid", "contact"] = Field(
+        "rigid", description="rigid: the hybrid model (mesh and Monte Carlo); contact: the "
+        "compliant-contact model on checkerboard patches at the heights where each step's "
+        "slope puts the next footfall, from its periodic gait (Monte Carlo only: set "
+        "method montecarlo, and few walks and a short step cap - each walk is a contact "
+        "simulation)")
     walks: int = Field(400, ge=1, le=1_000_000, description="Monte Carlo walks per sigma")
     max_steps: int = Field(2000, ge=1, le=1_000_000,
                            description="Monte Carlo step cap per walk (censoring) [steps]")
     seed: int = Field(0, ge=0, description="Monte Carlo seed [-] (terrain.per_step.seed "
                       "when that is given)")
-    quadrature_nodes: int = Field(21, ge=3, le=61, description="Gauss-Hermite nodes of the "
-                                  "slope distribution in the mesh [-] (they integrate a fall "
+    quadrature_nodes: int = Field(21, ge=3, le=61, description="quadrature nodes of the "
+                                  "slope distribution in the mesh (Gauss-Hermite; "
+                                  "Gauss-Legendre for a uniform) [-] (they integrate a fall "
                                   "indicator, whose tails 9 nodes resolve too coarsely: +20 % "
                                   "MFPT for the paper walker at 0.004 rad)")
     mesh_cells: int = Field(2000, ge=10, le=1_000_000, description="nodes of the first "
@@ -747,6 +754,12 @@ class RobustnessSettings(_Strict):
                                     "(hip velocity change) [m/s]")
     survival_steps: int = Field(40, ge=1, le=1000, description="undisturbed steps a walker "
                                 "must take after a disturbance to survive it [steps]")
+    contact: bool = Field(False, description="also the contact model's largest step-down "
+                          "and step-up (patches at heights, from its periodic gait; each "
+                          "bisection round is a few contact walks: minutes)")
+    contact_survival_steps: int = Field(10, ge=1, le=200, description="heel strikes the "
+                                        "contact model must make after the step to survive "
+                                        "it [steps]")
 
 
 class Scene(_Strict):

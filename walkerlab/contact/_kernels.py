@@ -1,5 +1,5 @@
 """Numba-compiled scalar contact laws of the compliant-contact walker (ADAMS STEP, IMPACT,
-Coulomb friction with stiction, patch membership).
+Coulomb friction with stiction, patch membership and height).
 
 Internal module.  Everything is SI.  These are the scalar twins of the vectorised laws in
 :mod:`walkerlab.contact.laws` (``tests/contact/test_laws_config.py`` checks both agree); the
@@ -16,6 +16,7 @@ from walkerlab.usercache import use_for_numba
 
 use_for_numba()  # cache=True below: numba's cache in the user cache, not in the package
 
+import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
 
 
@@ -56,11 +57,24 @@ def friction_mu(v, mus, mud, vs, vd):
 
 
 @njit(cache=True)
-def in_patch(s, centres, hw, continuous):
-    """True when along-slope coordinate ``s`` [m] lies on ground of the lane."""
+def patch_height(s, lane, hw, continuous):
+    """Height [m] (along the slope's outward normal, > 0 raised) of the ground of the lane
+    at along-slope coordinate ``s`` [m]; NaN in a gap.
+
+    ``lane`` (2 n + 1,): the centres [m] of the lane's n patches, their heights [m], and
+    their largest height [m] (the kernel lane of
+    :meth:`walkerlab.contact.model.ContactWalker.kernel_lanes`).  Continuous ground: 0."""
     if continuous:
-        return True
-    for j in range(centres.shape[0]):
-        if abs(s - centres[j]) <= hw:
-            return True
-    return False
+        return 0.0
+    n = (lane.shape[0] - 1) // 2
+    for j in range(n):
+        if abs(s - lane[j]) <= hw:
+            return lane[n + j]
+    return np.nan
+
+
+@njit(cache=True)
+def in_patch(s, lane, hw, continuous):
+    """True when along-slope coordinate ``s`` [m] lies on ground of the lane (layout as
+    :func:`patch_height`)."""
+    return not np.isnan(patch_height(s, lane, hw, continuous))

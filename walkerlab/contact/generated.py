@@ -46,7 +46,10 @@ weight constant (left out: its dependence on the foot's height; Newton direction
 
 Packed data vector of the compiled integrators (``_cyrk``, ``_lsoda``):
 ``[n1, n2, PC (NPC), p (NP), c1 (n1), c2 (n2), nfev]`` (``p`` the walker's parameter vector,
-``c1``/``c2`` the patch centres of leg1's / leg2's lane [m]).
+``c1``/``c2`` the kernel lanes of leg1's / leg2's patches: their centres [m], their heights
+[m] along the outward normal and the largest height [m], ``n = 2 patches + 1``;
+:meth:`walkerlab.contact.model.ContactWalker.kernel_lanes`).  A foot's penetration is
+measured below the top of the patch under it (all heights 0: the flat ground, bit for bit).
 
 Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.models.floating` for ``q``):
 
@@ -81,7 +84,7 @@ ASSEMBLY = '''
 # ---------------------------------------------------------------- contact assembly
 # (walkerlab.contact.generated.ASSEMBLY: walker-independent; laws from contact._kernels)
 from math import sin as _sin, cos as _cos
-from walkerlab.contact._kernels import normal_force, friction_mu, in_patch, step
+from walkerlab.contact._kernels import normal_force, friction_mu, in_patch, patch_height, step
 
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
@@ -141,7 +144,12 @@ def _foot(P, V, i, PC, cen):
     vt = vx * cp - vy * sp
     s = px * cp - py * sp
     fn, dfd, dfdd, mu, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
-    if delta > 0.0 and in_patch(s, cen, PC[I_HW], PC[I_CONT] > 0.5):
+    # a patch at height hp: penetration below its top (cen[-1], the lane's highest patch,
+    # skips the lookup for a foot above every patch; all heights 0: the flat ground)
+    hp = patch_height(s, cen, PC[I_HW], PC[I_CONT] > 0.5) if delta + cen[-1] > 0.0 else np.nan
+    if hp == hp:
+        delta += hp
+    if delta > 0.0 and hp == hp:
         fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
         if fn > 0.0:
             mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
@@ -214,9 +222,13 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
 def _foot_force(px, py, vx, vy, sp, cp, PC, cen):
     """World-frame contact force (Fx, Fy) [N] on a foot at (px, py) moving at (vx, vy)."""
     delta = -(px * sp + py * cp)
-    if delta <= 0.0:
+    if delta + cen[-1] <= 0.0:
         return 0.0, 0.0
-    if not in_patch(px * cp - py * sp, cen, PC[I_HW], PC[I_CONT] > 0.5):
+    hp = patch_height(px * cp - py * sp, cen, PC[I_HW], PC[I_CONT] > 0.5)
+    if not hp == hp:
+        return 0.0, 0.0
+    delta += hp
+    if delta <= 0.0:
         return 0.0, 0.0
     fn = normal_force(delta, -(vx * sp + vy * cp), PC[I_K], PC[I_E], PC[I_CMAX],
                       PC[I_DMAX])[0]

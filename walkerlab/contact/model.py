@@ -107,6 +107,10 @@ class ContactWalker:
         IMPACT and friction parameters of the feet in SI.
     lane1, lane2 : ndarray
         Patch centres [m] of leg1's / leg2's lane (ignored if ``continuous``).
+    heights1, heights2 : ndarray, optional
+        Height [m] of each patch of leg1's / leg2's lane along the slope's outward normal
+        (> 0 raised; a step-down is a patch at -h), same length as the lane; default 0
+        (the flat checkerboard).  Rough ground as geometry (issue 24).
     patch_half_width : float
         Half width of each patch [m].
     continuous : bool
@@ -135,6 +139,8 @@ class ContactWalker:
     continuous: bool = True
     data: object = None
     knee_stop: KneeStopSI | None = None
+    heights1: np.ndarray | None = None
+    heights2: np.ndarray | None = None
 
     def __post_init__(self):
         from walkerlab.models.floating import check_masses, coordinate_names
@@ -168,6 +174,17 @@ class ContactWalker:
         PC[mod.I_KA] = ks.latch_capture
         set_(self, "lane1", np.ascontiguousarray(self.lane1, dtype=float))
         set_(self, "lane2", np.ascontiguousarray(self.lane2, dtype=float))
+        for k in ("1", "2"):
+            lane, h = getattr(self, "lane" + k), getattr(self, "heights" + k)
+            if h is not None:  # (None stays None: dataclasses.replace with new lanes works)
+                h = np.ascontiguousarray(h, dtype=float)
+                if h.shape != lane.shape or not np.all(np.isfinite(h)):
+                    raise ValueError(f"heights{k}: one finite height [m] per patch of "
+                                     f"lane{k} ({lane.size}), got shape {h.shape}")
+                set_(self, "heights" + k, h)
+            h = np.zeros(lane.size) if h is None else h
+            set_(self, "_kernel_lane" + k, np.ascontiguousarray(
+                np.concatenate([lane, h, [h.max(initial=0.0)]])))
         set_(self, "kernels", mod)
         set_(self, "contact_params", PC)
         set_(self, "walker_params", np.asarray(d.params, dtype=float))
@@ -274,8 +291,14 @@ class ContactWalker:
         return tuple(s for s in self.state_names()[:self.nq] if s.startswith(f"theta{i}"))
 
     # ------------------------------------------------------------------ dynamics
+    @property
+    def kernel_lanes(self) -> tuple[np.ndarray, np.ndarray]:
+        """The lanes as the kernels read them (:mod:`walkerlab.contact.generated`): leg1's
+        and leg2's ``[centres (n), heights (n), largest height]`` (2 n + 1,) [m]."""
+        return self._kernel_lane1, self._kernel_lane2
+
     def _args(self):
-        return self.contact_params, self.walker_params, self.lane1, self.lane2
+        return self.contact_params, self.walker_params, *self.kernel_lanes
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q) (nq, nq) [kg, kg m, kg m^2]."""
@@ -420,6 +443,7 @@ class ContactWalker:
     def pack(self) -> np.ndarray:
         """Data vector ``[n1, n2, PC, p, c1, c2, nfev=0]`` of the compiled right-hand side
         (:mod:`walkerlab.contact.generated`)."""
-        return np.concatenate([[len(self.lane1), len(self.lane2)], self.contact_params,
-                               self.walker_params, self.lane1, self.lane2, [0.0]]
+        k1, k2 = self.kernel_lanes
+        return np.concatenate([[len(k1), len(k2)], self.contact_params,
+                               self.walker_params, k1, k2, [0.0]]
                               ).astype(np.float64)

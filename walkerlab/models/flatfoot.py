@@ -56,8 +56,6 @@ from walkerlab.models.codegen import _PY, IND, _cse_lines, _flow, _numpy_fn, _re
 from walkerlab.models.description import ROLE_TAG, Structure
 from walkerlab.models.symbolic import _dot_terms, _pos, _velocity_terms
 
-#: Modes of the stance foot, in the order of a step.
-MODES = ("heel_contact", "foot_flat", "heel_off")
 #: Index of the stance ankle's angle in ``q``.
 ANKLE = 2
 #: ``points``/``energies`` read a state as heel off (toe pinned) once ``phi`` is below minus

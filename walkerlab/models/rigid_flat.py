@@ -34,8 +34,8 @@ from functools import partial
 
 from walkerlab.models.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
 from walkerlab.models.cache import functions
+from walkerlab.models.description import FLAT_FOOT_MODES as MODES
 from walkerlab.models.description import WalkerData
-from walkerlab.models.flatfoot import MODES
 
 #: The swing leg's parts of a step: before and after the legs pass each other.
 SWING_PARTS = ("early_swing", "late_swing")

@@ -1,5 +1,6 @@
 """The report's robustness section, from a loaded ``robustness.h5``
-(:class:`walkerlab.io.schemas.robustness.RobustnessData`) only."""
+(:class:`walkerlab.io.schemas.robustness.RobustnessData`) and, when the scene ran it, a loaded
+``basin.h5`` (the basin's area, :mod:`walkerlab.analysis.basin_area`) only."""
 
 from __future__ import annotations
 
@@ -18,6 +19,36 @@ def _mm(lo: float, hi: float, scale: float = 1000) -> str:
     return f"{num(scale * lo, 3)} (falls at {num(scale * hi, 3)})"
 
 
+def _contact_steps(r) -> list[str]:
+    """The contact model's step-down/up beside the rigid model's (when asked for)."""
+    if not math.isfinite(r.scalars.get("contact_step_down_m/lo", math.nan)):
+        return []
+    return ["- the same for the contact model (patches at the step's height, from its own "
+            "periodic gait): step-down "
+            f"{_mm(r['contact_step_down_m/lo'], r['contact_step_down_m/hi'])} mm; step-up "
+            f"{_mm(r['contact_step_up_m/lo'], r['contact_step_up_m/hi'])} mm."]
+
+
+def _basin_line(b) -> list[str]:
+    """The basin's area in the basin map's slice (when the scene ran ``basin``)."""
+    if b is None:
+        return []
+    from walkerlab.analysis.basin_area import basin_area
+
+    a = basin_area(b)
+    x0, x1, y0, y1 = a.box
+    where = (f"the box {a.x_axis} {num(x0)}…{num(x1)} {a.x_unit} × {a.y_axis} {num(y0)}…"
+             f"{num(y1)} {a.y_unit} of the basin map ({a.cells} cells)")
+    if not a.exists:
+        return [f"- basin of attraction: the gait's cell of {where} does not reach the gait "
+                f"(no basin around it in this slice; {num(100 * a.fraction, 3)} % of the "
+                "cells reach it)."]
+    return [f"- basin of attraction: {num(100 * a.fraction, 3)} % of {where} reaches the "
+            f"period-1 gait, an area of {num(a.area, 3)} {a.x_unit}·{a.y_unit}.  An area in "
+            "the section depends on its coordinates: compare walkers only on the same axes "
+            "and box."]
+
+
 def robustness_section(arts: dict) -> list[str]:
     """|lambda|max and GSN in two state coordinates, the MFPT at the scene's sigma, the
     largest step-down/up (rigid model; empty when the scene ran no robustness stage)."""
@@ -31,7 +62,7 @@ def robustness_section(arts: dict) -> list[str]:
     m, se = r["mfpt_steps"], r["mfpt_steps_stderr"]
     mfpt = (f"≥ {num(r['montecarlo_walks'])} walks reached the step cap (no fall)"
             if not math.isfinite(m) else f"{num(m)} ± {num(se)} steps (standard error)")
-    return ["## Robustness (rigid model)", "",
+    return ["## Robustness (rigid model; the contact model where it says so)", "",
             f"- largest |Floquet multiplier|: {num(lam['absolute'])} in absolute leg angles, "
             f"{num(lam['relative'])} in angles relative to the stance leg (the Jacobians "
             "are similar matrices: the multipliers do not depend on the coordinates).",
@@ -39,11 +70,12 @@ def robustness_section(arts: dict) -> list[str]:
             f"{num(r['montecarlo_walks'])} walks, {num(r['montecarlo_falls'])} fell): {mfpt}.",
             f"- largest single step-down survived: {_mm(r['step_down_m/lo'], r['step_down_m/hi'])}"
             f" mm; step-up: {_mm(r['step_up_m/lo'], r['step_up_m/hi'])} mm (bisection).",
+            *_contact_steps(r),
             "- largest mid-stance push survived (an impulsive horizontal push at the hip when "
             "the stance leg is vertical, the stance foot pinned; as the hip's velocity change): "
             f"forward {_mm(r['push_forward_m_per_s/lo'], r['push_forward_m_per_s/hi'], 1)} "
             f"m/s, backward {_mm(r['push_backward_m_per_s/lo'], r['push_backward_m_per_s/hi'], 1)}"
-            " m/s.", "",
+            " m/s.", *_basin_line(arts.get("basin")), "",
             "Gait sensitivity norm (Hobbelen & Wisse 2007; indicators step time, step length, "
             "stance angle at heel strike), with the relative difference to the nonlinear "
             "response to a small impulse, and the norm with the post-impact state as "

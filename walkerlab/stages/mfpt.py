@@ -4,12 +4,16 @@ Reads (after the pipeline has run ``fixedpoint``, :mod:`walkerlab.stages.pipelin
 scene's ``mfpt`` section (defaults when absent), ``terrain.per_step`` (distribution
 and seed) and the gait from ``fixedpoint.h5``; the walks and mesh cells run on local
 processes or Dask (:mod:`walkerlab.sweep.mfpt`).  Skipped when the scene sections, the sigma
-list, the method, the upstream gait and the code are unchanged.
+list, the method, the upstream gait and the code are unchanged.  An interrupted run resumes
+where it stopped: its finished Monte Carlo chunks and mesh images are kept in
+``mfpt.h5.partial`` (:mod:`walkerlab.io.mfpt_partial`) while the scene sections and the
+gait are the same (pieces are named by sigma: a rerun with other ``--sigma-rad`` or
+``--method`` keeps those it shares; ``--force`` starts afresh); the file is removed once
+``mfpt.h5`` is written.
 """
 
 from __future__ import annotations
 
-import math
 import time
 from pathlib import Path
 
@@ -116,16 +120,28 @@ def _run_locked(scene, runs_root, force, st, workers, scheduler, up, path) -> St
 
         note = recompute_reason(path, scene, SECTIONS, verified_hash(path))
         _tell(f"mfpt: recomputing {path} ({note})")
+    from walkerlab.io.mfpt_partial import MfptPartial
+
     x_star = load_fixedpoint(up).x
     t0 = time.perf_counter()
+    # finished pieces of an interrupted run with the same scene sections and gait are kept
+    # (--force: none); pieces are named by sigma, so another --sigma-rad list or --method
+    # reuses the pieces it shares
+    partial = MfptPartial(path.with_name(path.name + ".partial"),
+                          input_hash("mfpt", scene, SECTIONS, (up,), extra="resume"),
+                          resume=not force)
     try:
-        data = compute(scene, x_star, st, workers, scheduler)
-    except ValueError as exc:
+        data = compute(scene, x_star, st, workers, scheduler, partial)
+    except ValueError as exc:  # bad input: nothing to resume
+        partial.remove()
         raise StageError(str(exc)) from None
+    finally:
+        partial.close()
     wall = time.perf_counter() - t0
     write_artifact(path, "mfpt", scene, key, lambda f: schema.write(f, data), wall,
                    {"workers": workers if scheduler is None else 0,
                     "scheduler": str(scheduler or "")})
+    partial.remove()
     draw(scene, runs_root)
     summary = {"sigma_rad": list(map(float, data.sigma_rad)),
                "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
@@ -134,60 +150,9 @@ def _run_locked(scene, runs_root, force, st, workers, scheduler, up, path) -> St
 
 
 def compute(scene: Scene, x_star: np.ndarray, st: MfptSettings, workers: int = 1,
-            scheduler=None):
-    """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` -> ``MfptData``.
+            scheduler=None, partial=None):
+    """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` -> ``MfptData``
+    (:func:`walkerlab.sweep.mfpt.mfpt_study`; ``partial``: the resume file)."""
+    from walkerlab.sweep.mfpt import mfpt_study
 
-    Raises
-    ------
-    ValueError
-        The walker cannot walk on per-step slopes, or the mesh is asked for a uniform
-        slope distribution (its quadrature is Gauss-Hermite).
-    """
-    from walkerlab.analysis.python_step import needs_python_path
-    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
-    from walkerlab.models.registry import build_walker
-    from walkerlab.sweep import mfpt as work
-
-    per = scene.terrain.per_step if scene.terrain is not None else None
-    dist = per.slope_distribution if per is not None else "normal"
-    seed = per.seed if per is not None else st.seed
-    if st.method in ("mesh", "both") and dist != "normal":
-        raise ValueError("mfpt.method: the mesh integrates a normal slope distribution "
-                         "(Gauss-Hermite); use --method montecarlo for "
-                         "terrain.per_step.slope_distribution: uniform")
-    walker = build_walker(scene)
-    if st.method in ("mesh", "both") and needs_python_path(walker):
-        raise ValueError("mfpt.method: the mesh needs the compiled batched step map (its "
-                         "~10^6 step images); this walker has no compiled flows (flat feet): "
-                         "use --method montecarlo")
-    work.step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
-    sig = np.asarray(st.sigma_rad, float)
-    vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}
-    hist = []
-    for i, sd in enumerate(sig):
-        if st.method in ("montecarlo", "both"):
-            t = time.perf_counter()
-            mc = work.monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist,
-                                  workers, scheduler)
-            m, se = mc.mfpt
-            vals["mfpt_steps_montecarlo"][i] = m
-            vals["mfpt_steps_montecarlo_stderr"][i] = se
-            vals["montecarlo_walks"][i] = mc.steps.size
-            vals["montecarlo_falls"][i] = int(mc.fell.sum())
-            vals["montecarlo_heel_strikes"][i] = int(mc.steps.sum())
-            vals["montecarlo_wall_time_s"][i] = time.perf_counter() - t
-        if st.method in ("mesh", "both"):
-            t = time.perf_counter()
-            last, all_meshes = work.mesh(scene, x_star, sd, st, workers, scheduler)
-            vals["mfpt_steps_mesh"][i] = last.mfpt_steps
-            vals["mfpt_steps_mesh_quasi_stationary"][i] = last.mfpt_quasi_stationary_steps
-            vals["mesh_cells"][i] = last.cells
-            vals["mesh_change"][i] = last.change
-            vals["mesh_converged"][i] = float(last.converged)
-            vals["mesh_escaped"][i] = last.escaped
-            vals["mesh_wall_time_s"][i] = time.perf_counter() - t
-            hist += [{"sigma_rad": float(sd), "h": r.h, "cells": r.cells,
-                      "mfpt_steps": r.mfpt_steps,
-                      "change": r.change if math.isfinite(r.change) else math.nan}
-                     for r in all_meshes]
-    return MfptData(sig, vals, st.method, walker.state_names(), hist)
+    return mfpt_study(scene, x_star, st, workers, scheduler, partial)

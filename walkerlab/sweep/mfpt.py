@@ -94,10 +94,14 @@ def run_images(task: ImageTask):
 
 
 def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, seed: int,
-                distribution: str = "normal", workers: int = 1, scheduler=None
-                ) -> M.MonteCarloResult:
+                distribution: str = "normal", workers: int = 1, scheduler=None,
+                partial=None) -> M.MonteCarloResult:
     """Monte Carlo MFPT walks of a scene at one sigma [rad] (see
-    :func:`walkerlab.analysis.mfpt.monte_carlo`), chunked over the executor."""
+    :func:`walkerlab.analysis.mfpt.monte_carlo`), chunked over the executor.
+
+    ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): chunks stored
+    there by an interrupted run are taken as they are (a chunk's walks do not depend on
+    when or where they ran), and every chunk that finishes is stored."""
     from walkerlab.execution.executor import run_each
     from walkerlab.sweep.runner import sweep_executor
 
@@ -108,10 +112,28 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
              for i, a in enumerate(range(0, walks, WALKS_PER_TASK))]
     steps = np.zeros(walks, dtype=np.int64)
     fell = np.zeros(walks, dtype=bool)
-    with sweep_executor(workers, scheduler) as ex:
-        for _, (i, s, f) in run_each(ex, run_walks, [(t,) for t in tasks]):
-            a = i * WALKS_PER_TASK
-            steps[a:a + s.size], fell[a:a + f.size] = s, f
+
+    def name(i: int) -> str:
+        return f"montecarlo/sigma={float(sd)!r}/chunk={i}"
+
+    def put(i, s, f):
+        a = i * WALKS_PER_TASK
+        steps[a:a + s.size], fell[a:a + f.size] = s, f
+
+    todo = []
+    for t in tasks:
+        got = partial.get(name(t.index)) if partial is not None else None
+        if got is not None and got["steps"].size == len(t.walks):
+            put(t.index, got["steps"], got["fell"].astype(bool))
+        else:
+            todo.append(t)
+    if todo:
+        with sweep_executor(workers, scheduler) as ex:
+            for _, (i, s, f) in run_each(ex, run_walks, [(t,) for t in todo]):
+                put(i, s, f)
+                if partial is not None:
+                    partial.put(name(i), {"steps": np.asarray(s, np.int64),
+                                          "fell": np.asarray(f, np.int8)})
     return M.MonteCarloResult(steps, fell)
 
 
@@ -134,29 +156,151 @@ def image_evaluator(scene, ex):
     return evaluate
 
 
-def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler=None):
+def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler=None,
+         distribution: str = "normal", partial=None):
     """Converged (or capped) mesh MFPT at one sigma: ``(last MeshResult, all meshes)``.
 
     The nodes are the post-impact states visited by noisy walks from the gait at ``sd`` and
     at ``1.5 sd`` (so the tails, where the falls start, are meshed too; a fallen walk starts
-    again on the gait); the images of the nodes are computed over the executor."""
+    again on the gait); the images of the nodes are computed over the executor.
+    ``distribution`` (normal or uniform) is the per-step slope's: the walks draw from it
+    and the transitions integrate it (:func:`walkerlab.analysis.mfpt.slope_quadrature`).
+    ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): the images of
+    the nodes are stored there after every mesh, and a rerun takes those of an interrupted
+    run (when its visited states are the same, bit for bit), so it resumes at the mesh
+    under way."""
+    import hashlib
+
     base = scene.model_dump(mode="json")
     sm = step_map_for(base)
     n = settings.mesh_max_cells
     walks = 100
     steps = max(20, math.ceil(n / walks) + 2)  # a pool of ~2 max_cells
-    pool = M.visited_states(sm, x0, (sd, 1.5 * sd), walks, steps, settings.seed)
+    pool = M.visited_states(sm, x0, (sd, 1.5 * sd), walks, steps, settings.seed,
+                            distribution=distribution)
     if len(pool) < 10 * len(x0):
         raise ValueError(f"mfpt: sigma {sd:g} rad: the walks fall too soon to shape a mesh "
                          "(fewer post-impact states than needed)")
+    name = f"mesh/sigma={float(sd)!r}"
+    pool_sha = np.frombuffer(hashlib.sha256(np.ascontiguousarray(
+        np.concatenate([np.asarray(x0, float)[None], pool])).tobytes()).digest(), np.uint8)
+    q = settings.quadrature_nodes
+    cache: dict = {}
+    got = partial.get(name) if partial is not None else None
+    if got is not None and np.array_equal(got["pool_sha256"], pool_sha) \
+            and got["x_next"].shape[1:] == (q, len(x0)):
+        k = len(pool) + 1
+        cache = {"x": np.full((k, q, len(x0)), np.nan), "ok": np.zeros((k, q), dtype=bool),
+                 "done": np.zeros(k, dtype=bool)}
+        done = got["done_rows"]
+        cache["x"][done], cache["ok"][done], cache["done"][done] = \
+            got["x_next"], got["ok"].astype(bool), True
+
+    def store(_res, c):
+        if partial is not None:
+            done = np.flatnonzero(c["done"])
+            partial.put(name, {"pool_sha256": pool_sha, "done_rows": done,
+                               "x_next": c["x"][done], "ok": c["ok"][done].astype(np.int8)})
     from walkerlab.sweep.runner import sweep_executor
 
     with sweep_executor(workers, scheduler) as ex:
         return M.mesh_mfpt_converged(sm, pool, x0, sd, cells=settings.mesh_cells,
                                      refine=settings.mesh_refine,
                                      rel_change=settings.mesh_rel_change, max_cells=n,
-                                     quadrature=settings.quadrature_nodes,
-                                     evaluate=image_evaluator(scene, ex))
+                                     quadrature=q, evaluate=image_evaluator(scene, ex),
+                                     distribution=distribution, cache=cache, on_mesh=store)
+
+
+def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
+               partial=None):
+    """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` (``st``: the scene's
+    :class:`walkerlab.config.MfptSettings`) from the gait ``x_star`` -> ``MfptData``.
+
+    ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): the finished
+    pieces (Monte Carlo chunks, mesh images) of an interrupted run are reused and the new
+    ones stored, so a killed study resumes where it stopped and gives the same numbers.
+    ``st.model == "contact"``: Monte Carlo of the compliant-contact model on patches at the
+    drawn heights (:func:`walkerlab.sweep.contact_rough.contact_monte_carlo`), from its
+    periodic gait.
+
+    Raises
+    ------
+    ValueError
+        The walker cannot walk on per-step slopes; the contact model asked for the mesh,
+        without patches or without a periodic gait (one line).
+    """
+    import time
+
+    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
+    from walkerlab.models.registry import build_walker
+
+    per = scene.terrain.per_step if scene.terrain is not None else None
+    dist = per.slope_distribution if per is not None else "normal"
+    seed = per.seed if per is not None else st.seed
+    walker = build_walker(scene)
+    contact = getattr(st, "model", "rigid") == "contact"
+    if contact:
+        start = _contact_start(scene, x_star, st)
+    else:
+        from walkerlab.analysis.python_step import needs_python_path
+
+        if st.method in ("mesh", "both") and needs_python_path(walker):
+            raise ValueError("mfpt.method: the mesh needs the compiled batched step map (its "
+                             "~10^6 step images); this walker has no compiled flows (flat "
+                             "feet): use --method montecarlo")
+        step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
+    sig = np.asarray(st.sigma_rad, float)
+    vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}
+    hist = []
+    for i, sd in enumerate(sig):
+        if contact:
+            from walkerlab.sweep.contact_rough import contact_monte_carlo
+
+            t = time.perf_counter()
+            mc, _ = contact_monte_carlo(start, sd, st.walks, st.max_steps, seed, dist,
+                                        workers, scheduler, partial)
+        elif st.method in ("montecarlo", "both"):
+            t = time.perf_counter()
+            mc = monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist, workers,
+                             scheduler, partial)
+        if contact or st.method in ("montecarlo", "both"):
+            m, se = mc.mfpt
+            vals["mfpt_steps_montecarlo"][i] = m
+            vals["mfpt_steps_montecarlo_stderr"][i] = se
+            vals["montecarlo_walks"][i] = mc.steps.size
+            vals["montecarlo_falls"][i] = int(mc.fell.sum())
+            vals["montecarlo_heel_strikes"][i] = int(mc.steps.sum())
+            vals["montecarlo_wall_time_s"][i] = time.perf_counter() - t
+        if st.method in ("mesh", "both"):
+            t = time.perf_counter()
+            last, all_meshes = mesh(scene, x_star, sd, st, workers, scheduler, dist, partial)
+            vals["mfpt_steps_mesh"][i] = last.mfpt_steps
+            vals["mfpt_steps_mesh_quasi_stationary"][i] = last.mfpt_quasi_stationary_steps
+            vals["mesh_cells"][i] = last.cells
+            vals["mesh_change"][i] = last.change
+            vals["mesh_converged"][i] = float(last.converged)
+            vals["mesh_escaped"][i] = last.escaped
+            vals["mesh_wall_time_s"][i] = time.perf_counter() - t
+            hist += [{"sigma_rad": float(sd), "h": r.h, "cells": r.cells,
+                      "mfpt_steps": r.mfpt_steps,
+                      "change": r.change if math.isfinite(r.change) else math.nan}
+                     for r in all_meshes]
+    return MfptData(sig, vals, st.method, walker.state_names(), hist)
+
+
+def _contact_start(scene, x_star: np.ndarray, st):
+    """The contact model's periodic gait for ``mfpt.model: contact`` (one-line errors)."""
+    from walkerlab.analysis.contact_periodic import PeriodicGaitError
+    from walkerlab.analysis.contact_rough import contact_start
+    from walkerlab.contact.scene import ContactSceneError
+
+    if st.method != "montecarlo":
+        raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "
+                         "model's); set mfpt.method: montecarlo")
+    try:
+        return contact_start(scene, x_star)
+    except (ContactSceneError, PeriodicGaitError) as exc:
+        raise ValueError(f"mfpt.model: contact: {exc}") from None
 
 
 def _finite(v: float) -> float:

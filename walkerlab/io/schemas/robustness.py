@@ -7,6 +7,8 @@ Layout (every value a scalar dataset with its unit)::
     gsn_nonlinear/<disturbance>                       1/unit GSN, small nonlinear impulse
     state_norm/{absolute,relative}/<disturbance>      1/unit state-indicator norm (Jin et al.)
     step_down_m/{lo,hi}, step_up_m/{lo,hi}            m      bisection bracket (lo survives)
+    contact_step_{down,up}_m/{lo,hi}                  m      the same, contact model (NaN:
+                                                             not asked for)
     push_{forward,backward}_m_per_s/{lo,hi}           m/s    mid-stance push bracket
     sigma_rad                                         rad    per-step slope sigma of the MFPT
     mfpt_steps, mfpt_steps_stderr                     steps  Monte Carlo MFPT (censored MLE)
@@ -43,6 +45,11 @@ SCALARS = {
     "mfpt_steps_stderr": ("steps", "standard error of mfpt_steps"),
     "montecarlo_walks": ("-", "Monte Carlo walks"),
     "montecarlo_falls": ("-", "walks that fell (the rest reached the step cap)"),
+    "contact_step_down_m/lo": ("m", "contact model: largest step-down survived (lower end; "
+                               "NaN: robustness.contact not asked for)"),
+    "contact_step_down_m/hi": ("m", "contact model: smallest step-down that falls"),
+    "contact_step_up_m/lo": ("m", "contact model: largest step-up survived (lower end)"),
+    "contact_step_up_m/hi": ("m", "contact model: smallest step-up that falls"),
 }
 
 
@@ -120,5 +127,5 @@ def load(path: Path) -> RobustnessData:
             {k: float(f[f"gsn/{k}"][()]) for k in dists},
             {k: float(f[f"gsn_nonlinear/{k}"][()]) for k in dists},
             {c: {k: float(f[f"state_norm/{c}/{k}"][()]) for k in dists} for c in COORDINATES},
-            {k: float(f[k][()]) for k in SCALARS},
+            {k: float(f[k][()]) if k in f else float("nan") for k in SCALARS},
             [str(s) for s in f.attrs["state_names"]])
