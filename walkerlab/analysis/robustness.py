@@ -300,9 +300,12 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     Raises
     ------
     ValueError
-        A walker the batched step map cannot carry (one line).
+        A walker no step map can carry (slope-relative coordinates, legs that differ; one
+        line).  A walker without compiled flows (flat feet) runs on the row-by-row
+        :class:`~walkerlab.analysis.python_step.PythonStepMap` (~5-10 ms a step).
     """
     from walkerlab.analysis.poincare import poincare_map
+    from walkerlab.analysis.python_step import make_step_map
     from walkerlab.config import RobustnessSettings
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.robustness import RobustnessData
@@ -311,7 +314,7 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
 
     st = scene.robustness or RobustnessSettings()
     walker = build_walker(scene)
-    sm = BatchStepMap(walker, work.scene_walker_at(scene), 1e-12, 1e-12)
+    sm = make_step_map(walker, work.scene_walker_at(scene), 1e-12, 1e-12)
     if walker.steps_per_map != 1:
         raise ValueError("robustness: legs that differ (a stride map) are not supported")
     A = poincare_map(walker, x_star, Solver("DOP853", 1e-12, 1e-12, None, "scipy"),
@@ -383,9 +386,12 @@ def hip_jacobian(walker, x: np.ndarray, h: float = 1e-6) -> np.ndarray:
     return J
 
 
-def apply_push(walker, x: np.ndarray, dv_mps: float) -> tuple[np.ndarray, float]:
+def apply_push(walker, x: np.ndarray, dv_mps: float, lock=None) -> tuple[np.ndarray, float]:
     """An impulsive horizontal push at the hip that changes the hip's horizontal velocity by
-    ``dv_mps`` [m/s] (positive forward), the stance foot pinned.
+    ``dv_mps`` [m/s] (positive forward), the stance foot pinned; ``lock`` (optional): the
+    plastic projection onto a locked mode's rates (a flat foot's foot slap, ``[S^T M; J]
+    dqd+ = [S^T M; 0] dqd-``), applied when the push comes while that mode holds a
+    coordinate locked: the lock's impulse (the ground's on the flat foot) keeps it locked.
 
     The push is a physical impulse ``P`` [N s] along world x at the hip: the generalised
     impulse is ``J_x^T P`` (``J_x`` the hip's horizontal Jacobian row), so the rates jump by
@@ -402,6 +408,9 @@ def apply_push(walker, x: np.ndarray, dv_mps: float) -> tuple[np.ndarray, float]
     M = mass_matrix(walker, x)
     jx = hip_jacobian(walker, x)[0]
     w = np.linalg.solve(M, jx)
+    if lock is not None:  # linear in the rates: the locked rate change per unit impulse
+        lay = walker.layout()
+        w = lay.qd(np.asarray(lock(lay.join(lay.q(np.asarray(x, float)), w)), float))
     P = float(dv_mps) / float(jx @ w)
     xp = np.array(x, float)
     xp[walker.layout().qd_slice] += P * w
@@ -415,12 +424,40 @@ def _stance_angle(walker, X: np.ndarray) -> np.ndarray:
     return np.asarray(c[f"{s}_angle"] if f"{s}_angle" in c else c[f"{s}_thigh_angle"])
 
 
+def starting_at(walker, phase_name: str):
+    """``walker`` whose step begins in the phase ``phase_name``: its phases rotated so that
+    phase comes first (``phases[k:] + phases[:k]``).  A step goes on by the guards' named
+    next phases (a flat foot's phase graph, :attr:`Guard.next_phase`) or, unnamed, to the
+    next phase in order - the same phases as the walker's own step from ``phase_name`` on
+    (slicing ``phases[k:]`` would drop the graph's earlier phases, which a later phase may
+    still lead to, e.g. ``heel_contact:late_swing`` after a mid-stance in heel contact)."""
+    import dataclasses
+
+    names = [p.name for p in walker.phases]
+    k = names.index(phase_name)
+    return dataclasses.replace(walker, phases=walker.phases[k:] + walker.phases[:k])
+
+
+def entry_lock(walker, phase_name: str):
+    """The reset of a guard that leads into the phase ``phase_name`` by name (an intra-step
+    impact that locks a coordinate, e.g. a flat foot's foot slap into ``foot_flat``), or
+    None.  Only named graph edges are searched (walkers whose phases follow in order keep the
+    free push)."""
+    for ph in walker.phases:
+        for g in ph.guards:
+            if g.next_phase == phase_name and g.reset is not None:
+                return g.reset
+    return None
+
+
 def pushed_step(walker, x0: np.ndarray, dv_mps: np.ndarray, solver=None,
                 max_step_time: float = 5.0):
     """One step from the post-impact state ``x0`` with a mid-stance push ``dv_mps[i]``
     (:func:`apply_push`) for each value: mid-stance is where the stance leg is vertical
     (its absolute angle crosses 0, located by :func:`scipy.optimize.brentq` on the step's
-    dense output); the step goes on from the pushed state in the phase active there.
+    dense output); the step goes on from the pushed state in the phase active there and
+    through the walker's phase graph from it (:func:`starting_at`); in a locked mode the
+    push keeps the lock (:func:`entry_lock`).
 
     Returns
     -------
@@ -431,8 +468,6 @@ def pushed_step(walker, x0: np.ndarray, dv_mps: np.ndarray, solver=None,
     ValueError
         The gait's stance leg never passes the vertical in the step.
     """
-    import dataclasses
-
     from scipy.optimize import brentq
 
     from walkerlab.analysis.batch_step import FALL, BatchStep
@@ -450,15 +485,16 @@ def pushed_step(walker, x0: np.ndarray, dv_mps: np.ndarray, solver=None,
     tm = brentq(lambda t: float(_stance_angle(walker, seg.sample([t]))[0]), ts[j], ts[j + 1],
                 xtol=1e-14)
     xm = seg.sample([tm])[:, 0]
-    k = next(i for i, (_ph, _s, (ta, tb)) in enumerate(seg.pieces) if tm <= tb or
+    j = next(i for i, (_ph, _s, (ta, tb)) in enumerate(seg.pieces) if tm <= tb or
              i == len(seg.pieces) - 1)
-    rest = dataclasses.replace(walker, phases=walker.phases[k:])
+    rest = starting_at(walker, seg.pieces[j][0].name)
+    lock = entry_lock(walker, seg.pieces[j][0].name)
     dv = np.atleast_1d(np.asarray(dv_mps, float))
     N, m = dv.size, xm.size
     out = BatchStep(np.full(N, FALL, np.int8), np.full((N, m), np.nan),
                     np.full((N, m), np.nan), np.full(N, np.nan))
     for i, v in enumerate(dv):
-        s2 = integrate_step(rest, apply_push(walker, xm, v)[0], solver,
+        s2 = integrate_step(rest, apply_push(walker, xm, v, lock)[0], solver,
                             max_step_time=max_step_time)
         if s2.termination == "heel_strike" and s2.x_next is not None:
             out.outcome[i] = HEEL_STRIKE

@@ -37,7 +37,10 @@ def scene_walker_at(scene):
 
 
 def step_map_for(base: dict) -> BatchStepMap:
-    """The batched step map of a scene mapping (built once per process)."""
+    """The batched step map of a scene mapping (built once per process; a walker without
+    compiled flows, e.g. flat feet, gets the row-by-row
+    :class:`~walkerlab.analysis.python_step.PythonStepMap`)."""
+    from walkerlab.analysis.python_step import make_step_map
     from walkerlab.config import MfptSettings, scene_from_dict
     from walkerlab.models.registry import build_walker
 
@@ -46,8 +49,8 @@ def step_map_for(base: dict) -> BatchStepMap:
         scene = scene_from_dict(base)
         st = scene.mfpt or MfptSettings()
         _MAPS.clear()
-        _MAPS[key] = BatchStepMap(build_walker(scene), scene_walker_at(scene), st.rtol,
-                                  st.atol, st.max_step_time_s)
+        _MAPS[key] = make_step_map(build_walker(scene), scene_walker_at(scene), st.rtol,
+                                   st.atol, st.max_step_time_s)
     return _MAPS[key]
 
 
@@ -239,6 +242,12 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     if contact:
         start = _contact_start(scene, x_star, st)
     else:
+        from walkerlab.analysis.python_step import needs_python_path
+
+        if st.method in ("mesh", "both") and needs_python_path(walker):
+            raise ValueError("mfpt.method: the mesh needs the compiled batched step map (its "
+                             "~10^6 step images); this walker has no compiled flows (flat "
+                             "feet): use --method montecarlo")
         step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
     sig = np.asarray(st.sigma_rad, float)
     vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}
