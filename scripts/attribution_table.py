@@ -10,7 +10,7 @@ import sys
 from walkerlab.analysis.attribution import adjustment_effect, attribute
 from walkerlab.analysis.contact_periodic import ideal_gait
 from walkerlab.config import load_scene
-from walkerlab.contact.scene import build
+from walkerlab.models.contact.scene import build
 
 
 def main(paths):

@@ -614,7 +614,7 @@ def i19_14_numba_cache_location(d):
     before = {p: p.stat().st_mtime_ns for p in pkg.glob("*.nb*")} if pkg.is_dir() else {}
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     env.update(_uc(d))
-    p = subprocess.run([PY, "-c", "from walkerlab.contact import _kernels as K; "
+    p = subprocess.run([PY, "-c", "from walkerlab.models.contact import _kernels as K; "
                         "K.friction_mu(0.1, 0.9, 0.7, 0.01, 0.02)"], env=env,
                        capture_output=True, text=True)
     after = {q: q.stat().st_mtime_ns for q in pkg.glob("*.nb*")} if pkg.is_dir() else {}
@@ -723,8 +723,8 @@ def i19_7_cache_write_full_disk(d):
 
     def pre():
         resource.setrlimit(resource.RLIMIT_FSIZE, (2048, 2048))
-    code = ("from walkerlab.models import cache\n"
-            "from walkerlab.models.description import BodySpec, Structure\n"
+    code = ("from walkerlab.codegen import cache\n"
+            "from walkerlab.walker.description import BodySpec, Structure\n"
             "cache.generated_module(Structure('absolute', (BodySpec('mass', 'point_mass'),)))\n")
     for _ in range(2):
         p = subprocess.run([PY, "-c", code], cwd=d, capture_output=True, text=True,

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.models.base import Guard, HybridWalker, Phase
+from walkerlab.models.hybrid.base import Guard, HybridWalker, Phase
 
 ROOT = Path(__file__).resolve().parents[1]
 K, C, TORSO_M = 40.0, 8.0, 0.3  # spring [1/s^2], damping [1/s], drawn torso length [m]

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from walkerlab.models.compass_gait import (
+from walkerlab.codegen.symbolic import derive
+from walkerlab.models.hybrid.compass_gait import (
     compass_gait_structure,
     energies,
     flow,
@@ -12,7 +13,6 @@ from walkerlab.models.compass_gait import (
     make_compass_gait,
     swing_foot_height,
 )
-from walkerlab.models.symbolic import derive
 
 P = (5.0, 10.0, 1.0, 0.5, 9.81)  # m, M_H, L, a, g (Table 1)
 PHI = 0.0174

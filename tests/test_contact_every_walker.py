@@ -140,7 +140,7 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     from walkerlab.analysis.contact_drop import drop_restitution
     from walkerlab.analysis.contact_record import drop_test
     from walkerlab.config import load_scene
-    from walkerlab.contact.scene import settings
+    from walkerlab.models.contact.scene import settings
 
     rf = load_scene("configs/round_feet.yaml")
     d = drop_test(rf, 2.0)

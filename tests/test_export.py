@@ -23,8 +23,8 @@ import yaml
 from tests.independent import floating_reference as ref
 from walkerlab.config import load_scene
 from walkerlab.io.export import MJCF_MIN_INERTIA_KG_M2
-from walkerlab.models.description import walker_data
 from walkerlab.stages import export as export_stage
+from walkerlab.walker.description import walker_data
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Every shipped walker with masses (simplest.yaml and schwab_wisse2001.yaml: massless legs).
@@ -201,12 +201,12 @@ def test_reference_is_not_trivially_equal(tmp_path):
     assert np.abs(M - Mr).max() > 1e-4
 
 
-# ---- the generated floating view (walkerlab.models.floating, issue 17 part 1)
+# ---- the generated floating view (walkerlab.codegen.floating, issue 17 part 1)
 @pytest.mark.parametrize("name", SCENES)
 def test_libraries_match_floating_view(name, tmp_path):
     """Pinocchio and MuJoCo equal the generated floating view: same coordinate names, mass
     matrix and bias at random states."""
-    floating = pytest.importorskip("walkerlab.models.floating")
+    floating = pytest.importorskip("walkerlab.codegen.floating")
     scene = _scene(name)
     view = floating.floating_view(_data(scene))
     assert tuple(view.coordinate_names()) == ref.coordinate_names(_data(scene))
@@ -342,7 +342,7 @@ def test_mujoco_springs_are_ours(variant, tmp_path):
     writer's orientation of the tendon (MuJoCo reads springlength -1 as "the length at
     qpos0", which would silently give rest 0)."""
     mujoco = pytest.importorskip("mujoco")
-    floating = pytest.importorskip("walkerlab.models.floating")
+    floating = pytest.importorskip("walkerlab.codegen.floating")
     base, edit = _sprung_variants()[variant]
     scene = _scene(base) if edit is None else _edited_scene(tmp_path, base, edit)
     data = _data(scene)

@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.codegen.cache import functions
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.cache import functions
-from walkerlab.models.description import walker_data
+from walkerlab.models.hybrid.rigid_flat import mode_of, mode_sequence
 from walkerlab.models.registry import build_walker
-from walkerlab.models.rigid_flat import mode_of, mode_sequence
+from walkerlab.walker.description import walker_data
 
 FOOT = {"kind": "flat", "heel_m": 0.05, "toe_m": 0.10,
         "ankle": {"stiffness_n_m_per_rad": 20.0, "rest_angle_rad": 0.0,

@@ -162,7 +162,7 @@ def test_h2_fifos_in_the_user_cache_do_not_hang_fixedpoint(tmp_path):
     assert not any(p.is_fifo() for p in (cache / "models").iterdir())  # rebuilt in place
 
 
-_KERNEL = ("from walkerlab.contact import _kernels as k; "
+_KERNEL = ("from walkerlab.models.contact import _kernels as k; "
            "print(k.step(0.25, 0.0, 0.0, 1.0, 1.0)[0], k.friction_mu(0.5, 0.9, 0.7, 0.1, 1.0)[0])")
 
 

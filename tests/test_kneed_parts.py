@@ -29,8 +29,8 @@ from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import scene_from_dict
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.description import walker_data
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.description import walker_data
 
 ROOT = Path(__file__).resolve().parents[1]
 SOLVER = Solver("DOP853", 1e-12, 1e-12)
@@ -234,7 +234,7 @@ def test_energy_with_spring_potential_is_conserved_unlocked_and_locked(name, gai
 def test_floating_view_matches_the_floating_reference(variant):
     """The contact view's equations (floating base, both knees free): mass matrix and bias,
     springs included, against the independent floating reference."""
-    from walkerlab.models.floating import floating_view
+    from walkerlab.codegen.floating import floating_view
 
     sc = _scene(variant)
     data = walker_data(sc.walker, sc.slope.phi_rad)

@@ -15,13 +15,13 @@ from independent.kneed_reference import KneedReference
 from independent.round_feet_reference import RoundFeetReference
 
 from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.codegen.cache import functions
 from walkerlab.config import BipedParams
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.cache import functions
-from walkerlab.models.description import walker_data
-from walkerlab.models.rigid import make_rigid_walker
+from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.published import bhounsule2009, hsu_chen2007
+from walkerlab.walker.description import walker_data
 
 ROOT = Path(__file__).resolve().parents[1]
 TIGHT = Solver("DOP853", 1e-12, 1e-12)

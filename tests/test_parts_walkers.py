@@ -17,8 +17,8 @@ from walkerlab.analysis.poincare import find_fixed_point
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.description import walker_data
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.description import walker_data
 
 SOLVER = Solver("DOP853", 1e-12, 1e-12)
 GUESS = np.array([-0.2022, 0.1674, -0.60, -0.84])
@@ -98,7 +98,7 @@ def test_off_axis_rigid_upper_body_matches_the_reference():
 @pytest.mark.parametrize("name", list(REFS))
 def test_floating_view_matches_the_reference(name):
     # the compliant-contact model's mass matrix and bias (floating base, no foot pinned)
-    from walkerlab.models.floating import floating_view
+    from walkerlab.codegen.floating import floating_view
 
     sc = load_scene(f"configs/{name}.yaml")
     view = floating_view(walker_data(sc.walker, sc.slope.phi_rad))

@@ -215,14 +215,14 @@ def test_i1_only_a_dead_holder_of_this_host_is_taken_over(tmp_path, host, taken_
 
 # ------------------------------------------------------------------ 2: the user cache
 def _simple_structure():
-    from walkerlab.models.description import BodySpec, Structure
+    from walkerlab.walker.description import BodySpec, Structure
 
     return Structure("absolute", (BodySpec("mass", "point_mass"),))
 
 
 @pytest.fixture
 def user_cache(tmp_path, monkeypatch):
-    from walkerlab.models import cache
+    from walkerlab.codegen import cache
 
     monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path / "uc"))
     cache.clear_memo()
@@ -231,7 +231,7 @@ def user_cache(tmp_path, monkeypatch):
 
 
 def test_i2_generated_code_lives_in_a_private_user_cache(user_cache, tmp_path):
-    from walkerlab.models import cache
+    from walkerlab.codegen import cache
 
     cache.generated_module(_simple_structure())
     folder = user_cache / "models"
@@ -245,7 +245,7 @@ def test_i2_generated_code_lives_in_a_private_user_cache(user_cache, tmp_path):
 def test_i2_untrusted_cache_file_is_regenerated_never_executed(user_cache, tmp_path, how):
     import hashlib
 
-    from walkerlab.models import cache
+    from walkerlab.codegen import cache
 
     s = _simple_structure()
     cache.generated_module(s)
@@ -276,7 +276,7 @@ def test_i2_untrusted_cache_file_is_regenerated_never_executed(user_cache, tmp_p
 
 def test_i2_nothing_from_a_runs_folder_is_executed(user_cache, tmp_path):
     """A runs folder unpacked from someone else carries ``.cache/models``: never read."""
-    from walkerlab.models import cache
+    from walkerlab.codegen import cache
 
     s = _simple_structure()
     key = cache.cache_key(s)
@@ -298,7 +298,7 @@ def test_i14_numba_cache_is_written_to_the_user_cache(tmp_path):
     env["WALKERLAB_CACHE_DIR"] = str(tmp_path / "uc")
     out = subprocess.run([sys.executable, "-c", textwrap.dedent("""
         import os
-        from walkerlab.contact import _kernels as K
+        from walkerlab.models.contact import _kernels as K
         K.friction_mu(0.1, 0.9, 0.7, 0.01, 0.02)
         print(os.environ.get("NUMBA_CACHE_DIR"))
         """)], env=env, capture_output=True, text=True, timeout=300)
@@ -400,8 +400,8 @@ def test_i7_full_disk_is_one_line_and_keeps_the_old_artifact(tmp_path):
 
 def test_i7_cache_write_on_a_full_disk_leaves_nothing(tmp_path):
     r = _limited("""
-        from walkerlab.models import cache
-        from walkerlab.models.description import BodySpec, Structure
+        from walkerlab.codegen import cache
+        from walkerlab.walker.description import BodySpec, Structure
         ns = cache.generated_module(Structure("absolute", (BodySpec("mass", "point_mass"),)))
         assert callable(ns["make"])  # the code is still usable (kept in memory)
         """, 2048, tmp_path, env={"WALKERLAB_CACHE_DIR": str(tmp_path / "uc")})

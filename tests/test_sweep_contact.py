@@ -44,7 +44,7 @@ def test_contact_fields_are_swept_by_their_unit_bearing_names():
     """An old contact name in a sweep spec is one line naming the new ones; the SI name of a
     quantity the scene writes in mm-kg-s replaces the scene's value (the pair excludes each
     other, as slope.angle_deg / angle_rad)."""
-    from walkerlab.contact.laws import contact_params_si
+    from walkerlab.models.contact.laws import contact_params_si
     from walkerlab.sweep.params import SweepError, apply_point, check_axes, parse_param
 
     scene = load_scene(SCENE)

@@ -5,7 +5,7 @@ the product):
 
 - :mod:`walkerlab.config`   typed YAML scenes (pydantic, ``extra="forbid"``)
 - :mod:`walkerlab.models`   walker models (flow, guard, reset as pure functions)
-- :mod:`walkerlab.contact`  the compliant-contact (MSC ADAMS style) walker
+- :mod:`walkerlab.models.contact`  the compliant-contact (MSC ADAMS style) walker
 - :mod:`walkerlab.analysis` hybrid integration, Poincaré map, fixed points, gait metrics
 - :mod:`walkerlab.io`       HDF5 artifacts (atomic writes, content hashes)
 - :mod:`walkerlab.stages`   one function per stage: config + upstream artifacts -> one artifact

@@ -2,7 +2,7 @@
 
 What the cache trusts
 ---------------------
-walkerlab executes generated model code (:mod:`walkerlab.models.cache`) and lets numba load
+walkerlab executes generated model code (:mod:`walkerlab.codegen.cache`) and lets numba load
 machine code it compiled earlier.  Both live in one folder per user, never in a runs folder
 (runs folders are shared and unpacked from others; nothing in them is ever executed):
 

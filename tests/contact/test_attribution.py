@@ -14,7 +14,7 @@ from walkerlab.analysis.attribution import energy_by_sink
 from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
 from walkerlab.analysis.scene_gaits import solve_variant
 from walkerlab.config import load_scene
-from walkerlab.contact.scene import build
+from walkerlab.models.contact.scene import build
 
 
 def test_sinks_add_up_to_gravity_work_over_the_step():

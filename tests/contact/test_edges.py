@@ -14,8 +14,8 @@ from walkerlab.analysis.contact_gait import CONTACT_OUTCOMES as OUTCOME_KINDS
 from walkerlab.analysis.contact_gait import phase_slip as _phase_slip
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
-from walkerlab.contact import ContactWalker
 from walkerlab.integrate.contact import ContactLimits
+from walkerlab.models.contact import ContactWalker
 
 PKG = Path(__file__).resolve().parents[2] / "walkerlab"
 
@@ -122,9 +122,9 @@ def test_drop_restitution_monotone_per_family_rigid_limit_near_plastic():
 
 
 def test_kernels_read_parameters_through_named_indices():
-    from walkerlab.contact.generated import ASSEMBLY
+    from walkerlab.models.contact.generated import ASSEMBLY
 
-    for src in ((PKG / "contact" / "_kernels.py").read_text(), ASSEMBLY):
+    for src in ((PKG / "models" / "contact" / "_kernels.py").read_text(), ASSEMBLY):
         assert not re.findall(r"\bPC?\[\d+\]", src), "bare P[number] in the contact kernels"
 
 
@@ -144,10 +144,18 @@ def _imports(path):
 
 @pytest.mark.parametrize("package,never", [
     # the model holds the model only: no integration, analysis, sweep or stage above it
-    ("contact", ("walkerlab.stages", "walkerlab.analysis", "walkerlab.integrate",
-                 "walkerlab.sweep", "walkerlab.report")),
+    ("models/contact", ("walkerlab.stages", "walkerlab.analysis", "walkerlab.integrate",
+                        "walkerlab.sweep", "walkerlab.report")),
+    # the rigid view knows no contact model; neither view imports anything above them
+    ("models/hybrid", ("walkerlab.models.contact", "walkerlab.stages", "walkerlab.analysis",
+                       "walkerlab.integrate", "walkerlab.sweep", "walkerlab.report")),
+    # generated code sits under both views, the description under the generator
+    ("codegen", ("walkerlab.models", "walkerlab.stages", "walkerlab.analysis",
+                 "walkerlab.integrate", "walkerlab.sweep", "walkerlab.report")),
+    ("walker", ("walkerlab.codegen", "walkerlab.models", "walkerlab.stages",
+                "walkerlab.analysis", "walkerlab.integrate", "walkerlab.sweep")),
     # settings lie under every model (no config <-> contact cycle)
-    ("config", ("walkerlab.contact", "walkerlab.models", "walkerlab.analysis",
+    ("config", ("walkerlab.models.contact", "walkerlab.models", "walkerlab.analysis",
                 "walkerlab.integrate", "walkerlab.stages")),
     # integration knows no gait analysis and no stage
     ("integrate", ("walkerlab.analysis", "walkerlab.stages", "walkerlab.sweep")),

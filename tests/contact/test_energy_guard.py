@@ -1,7 +1,7 @@
 """Energy as a guard on contact runs (issue 25 item 6).
 
 paper_rods with ``mu_static: 0, mu_dynamic: 0`` ended "airborne (the hip rose 1.5 m)" with a
-last sample of 1.25e10 J (150 J at the start).  Cause (walkerlab.contact.energy): the
+last sample of 1.25e10 J (150 J at the start).  Cause (walkerlab.models.contact.energy): the
 frictionless stance foot slides off its patch, both feet sink into the gaps, and leg2's foot
 enters the next patch from its side 0.27 m below its top, which the IMPACT law reads as a
 0.27 m penetration.  Now the run ends as that trip, at the last trustworthy sample, and no
@@ -15,7 +15,7 @@ from tests.contact.test_periodic import SCENE
 from walkerlab.analysis.contact_sim import simulate_from
 from walkerlab.analysis.scene_gaits import solve_variant
 from walkerlab.config import load_scene
-from walkerlab.contact.energy import energy_rise_bound, total_energy
+from walkerlab.models.contact.energy import energy_rise_bound, total_energy
 
 RODS = SCENE.parent / "paper_rods.yaml"
 
@@ -40,7 +40,7 @@ def test_frictionless_rods_end_as_a_trip_without_blown_up_samples():
 def test_total_energy_counts_the_stored_elastic_energy():
     """A point foot pressed into its patch by d stores k d^(e+1)/(e+1) (IMPACT's spring):
     total_energy exceeds kinetic + potential by exactly that (rtol 1e-12)."""
-    from walkerlab.contact.scene import build
+    from walkerlab.models.contact.scene import build
 
     sc = load_scene(SCENE)
     ideal = solve_variant(sc, "derived")[1]

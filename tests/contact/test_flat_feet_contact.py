@@ -11,12 +11,12 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from tests.independent import flat_feet_floating_reference as ref
+from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, floating_view
 from walkerlab.config import scene_from_dict
-from walkerlab.contact.model import ContactWalker
-from walkerlab.contact.scene import ContactSceneError, build
 from walkerlab.integrate.contact import StateIndex
-from walkerlab.models.description import walker_data
-from walkerlab.models.floating import FLAT_FOOT_MESSAGE, floating_view
+from walkerlab.models.contact.model import ContactWalker
+from walkerlab.models.contact.scene import ContactSceneError, build
+from walkerlab.walker.description import walker_data
 
 FOOT = {"kind": "flat", "heel_m": 0.05, "toe_m": 0.10,
         "ankle": {"stiffness_n_m_per_rad": 90.0, "rest_angle_rad": 0.03,
@@ -169,7 +169,7 @@ def test_step_modes_match_the_rigid_view():
     from walkerlab.integrate.contact import ContactLimits, integrate_contact
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.rigid_flat import make_flat_walker, mode_of, mode_sequence
+    from walkerlab.models.hybrid.rigid_flat import make_flat_walker, mode_of, mode_sequence
 
     d = copy.deepcopy(SCENE)
     d["walker"]["leg"]["foot"]["ankle"].update(

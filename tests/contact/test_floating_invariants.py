@@ -1,8 +1,8 @@
 """The rigid hybrid view and the floating (contact) view of every shipped walker with masses
 are one walker (issue 17, part 6): both are generated from the same description, by two
 different derivations (the rigid one with the stance foot pinned from the start,
-:mod:`walkerlab.models.symbolic`; the floating one with hip coordinates,
-:mod:`walkerlab.models.floating`).
+:mod:`walkerlab.codegen.symbolic`; the floating one with hip coordinates,
+:mod:`walkerlab.codegen.floating`).
 
 Tolerances: the exact identities (pinned mass matrix, impact projections) compare the same
 closed forms reached by different algebra, in double precision: 1e-12 relative leaves ~1e3 x
@@ -16,13 +16,13 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from walkerlab.codegen.cache import functions
+from walkerlab.codegen.floating import MASSLESS_MESSAGE, floating_view
 from walkerlab.config import load_scene
 from walkerlab.config.contact import ContactSettings
-from walkerlab.contact.laws import contact_params_si, knee_stop_si
-from walkerlab.contact.model import ContactWalker
-from walkerlab.models.cache import functions
-from walkerlab.models.description import walker_data
-from walkerlab.models.floating import MASSLESS_MESSAGE, floating_view
+from walkerlab.models.contact.laws import contact_params_si, knee_stop_si
+from walkerlab.models.contact.model import ContactWalker
+from walkerlab.walker.description import walker_data
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 WALKERS = ("paper", "paper_rods", "kneed", "round_feet", "goswami1996")

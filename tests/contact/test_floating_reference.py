@@ -13,8 +13,8 @@ import pytest
 from independent.contact_reference import rhs_ref
 
 from walkerlab.config.contact import ContactSettings
-from walkerlab.contact.laws import contact_params_si
-from walkerlab.contact.model import ContactWalker
+from walkerlab.models.contact.laws import contact_params_si
+from walkerlab.models.contact.model import ContactWalker
 
 
 def _states(w, n, rng):

@@ -9,7 +9,7 @@ import yaml
 
 from walkerlab.analysis.contact_sim import initial_state_from_ideal
 from walkerlab.config import scene_from_dict
-from walkerlab.contact.scene import ContactSceneError, build
+from walkerlab.models.contact.scene import ContactSceneError, build
 from walkerlab.models.registry import build_walker
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"

@@ -5,8 +5,8 @@ import pytest
 from pydantic import ValidationError
 
 from walkerlab.config import ContactSettings, ContactSimSettings, TerrainSettings
-from walkerlab.contact import _kernels as K
-from walkerlab.contact.laws import (
+from walkerlab.models.contact import _kernels as K
+from walkerlab.models.contact.laws import (
     adams_step,
     adams_step_derivative,
     contact_params_si,
@@ -162,8 +162,8 @@ def test_a_run_converts_its_contact_law_to_si_once(monkeypatch):
     """The contact model of a run is built with the law converted once (it was converted
     twice: once for the probe walker that measures the step length, once for the run's)."""
     from walkerlab.config import load_scene
-    from walkerlab.contact import laws, rigid_limit
-    from walkerlab.contact.scene import build
+    from walkerlab.models.contact import laws, rigid_limit
+    from walkerlab.models.contact.scene import build
 
     calls = []
     real = laws.contact_params_si

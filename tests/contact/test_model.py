@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from walkerlab.config.contact import ContactSettings
-from walkerlab.contact import ContactWalker
-from walkerlab.contact.laws import contact_params_si
-from walkerlab.contact.model import checkerboard_lanes
+from walkerlab.models.contact import ContactWalker
+from walkerlab.models.contact.laws import contact_params_si
+from walkerlab.models.contact.model import checkerboard_lanes
 
 
 def _walker(**kw):

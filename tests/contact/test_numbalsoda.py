@@ -6,8 +6,8 @@ import pytest
 from walkerlab.analysis.contact_bench import EXAMPLE_IDEAL, leg_angle_columns
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
-from walkerlab.contact import ContactWalker
 from walkerlab.integrate import _lsoda
+from walkerlab.models.contact import ContactWalker
 
 
 def _bench_case():

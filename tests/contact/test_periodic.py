@@ -15,9 +15,9 @@ from walkerlab.analysis.contact_sim import simulate_contact
 from walkerlab.analysis.rigid_limit import convergence, observed_order
 from walkerlab.analysis.scene_gaits import solve_variant
 from walkerlab.config import SolverSettings, load_scene
-from walkerlab.contact.model import checkerboard_lanes
-from walkerlab.contact.rigid_limit import expected_order
-from walkerlab.contact.scene import build
+from walkerlab.models.contact.model import checkerboard_lanes
+from walkerlab.models.contact.rigid_limit import expected_order
+from walkerlab.models.contact.scene import build
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "paper.yaml"
 
@@ -79,7 +79,7 @@ def test_period_close_to_ideal(setup, paper_gait):
 
 
 def test_periodic_gait_converges_to_rigid_along_the_family_with_observed_order(setup):
-    """(c) Along the one rigid-limit family (walkerlab.contact.rigid_limit) the contact
+    """(c) Along the one rigid-limit family (walkerlab.models.contact.rigid_limit) the contact
     periodic gait's step period and step length reach the rigid ones at an observed order
     between the impact duration's 1/(e+1) = 0.3125 and the stance creep's 1/2 (measured on
     kappa = 1, 10, 100: period 0.47, 0.44; step length 0.505, 0.505; down to 0.37 / 0.56 at

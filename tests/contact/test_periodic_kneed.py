@@ -10,7 +10,7 @@ from walkerlab.analysis.contact_periodic import StepMap, find_contact_periodic_g
 from walkerlab.analysis.contact_sim import simulate_contact
 from walkerlab.analysis.scene_gaits import solve_variant
 from walkerlab.config import SolverSettings, load_scene
-from walkerlab.contact.scene import build
+from walkerlab.models.contact.scene import build
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "kneed.yaml"
 

@@ -8,8 +8,8 @@ from scipy.optimize import brentq
 from walkerlab.analysis.contact_bench import leg_angle_columns
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
-from walkerlab.contact import ContactWalker
-from walkerlab.contact.laws import contact_params_si, coulomb_friction_coefficient
+from walkerlab.models.contact import ContactWalker
+from walkerlab.models.contact.laws import contact_params_si, coulomb_friction_coefficient
 
 PAPER_FP = (-0.2042, 0.1694, -0.6058, -0.8610)  # ideal fixed point after heel strike
 L, m, MH, a, g = 1.0, 5.0, 10.0, 0.5, 9.81

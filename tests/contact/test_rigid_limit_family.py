@@ -1,11 +1,11 @@
-"""The one rigid-limit family (walkerlab.contact.rigid_limit): its exponents, and the scene's
+"""The one rigid-limit family (walkerlab.models.contact.rigid_limit): its exponents, and the scene's
 ``stiffness_family: rigid_limit`` is the same family (not a second definition)."""
 
 import pytest
 
 from walkerlab.config.contact import ContactSettings, KneeStopSettings
-from walkerlab.contact.laws import contact_params_si, knee_stop_si
-from walkerlab.contact.rigid_limit import contact_si, expected_order, scale
+from walkerlab.models.contact.laws import contact_params_si, knee_stop_si
+from walkerlab.models.contact.rigid_limit import contact_si, expected_order, scale
 
 
 def test_family_exponents():

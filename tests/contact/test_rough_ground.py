@@ -10,8 +10,8 @@ import pytest
 
 from walkerlab.analysis import contact_rough as C
 from walkerlab.config import ContactSettings
-from walkerlab.contact.laws import contact_params_si
-from walkerlab.contact.model import ContactWalker
+from walkerlab.models.contact.laws import contact_params_si
+from walkerlab.models.contact.model import ContactWalker
 
 SPACING = 0.372
 

@@ -16,9 +16,9 @@ from walkerlab.analysis.contact_sim import (
 )
 from walkerlab.cli import app
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
-from walkerlab.contact import ContactWalker
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.ends import CONTACT_WALKED, RUN_END_NAMES
+from walkerlab.models.contact import ContactWalker
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -9,8 +9,8 @@ from tests.contact.conftest import FP, STEP_LENGTH
 from walkerlab.analysis.contact_bench import BAND_FACTORS, run_benchmark, run_scene_benchmark
 from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
-from walkerlab.contact import ContactWalker
 from walkerlab.integrate.contact import ContactLimits, StateIndex
+from walkerlab.models.contact import ContactWalker
 
 
 def _paper(width, n_steps=12):

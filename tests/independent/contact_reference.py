@@ -1,8 +1,8 @@
 """Pure-numpy reference implementation of the contact walker's equations of motion.
 
 Slow (~tens of µs per call) but written directly from the Lagrangian, independently of the
-generated kernels (:mod:`walkerlab.contact.generated`); tests check the two agree.  Test-only
-(it moved here from ``walkerlab/contact/reference.py`` when the hand-written numba kernel
+generated kernels (:mod:`walkerlab.models.contact.generated`); tests check the two agree.  Test-only
+(it moved here from ``walkerlab/models/contact/reference.py`` when the hand-written numba kernel
 retired, issue 17).
 
 Lagrangian of the floating walker, q = [hip_x, hip_y, theta1, theta2] (SI):
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.contact.laws import coulomb_friction_coefficient, impact_normal_force
+from walkerlab.models.contact.laws import coulomb_friction_coefficient, impact_normal_force
 
 __all__ = ["contact_forces_ref", "mass_matrix_ref", "rhs_ref"]
 
@@ -35,7 +35,7 @@ def mass_matrix_ref(q, L, m, MH, a):
 def contact_forces_ref(x, L, phi, params, lanes, half_width, continuous):
     """World-frame contact force on each foot, (2, 2) [N] (row i = foot i+1).
 
-    ``params`` is a :class:`~walkerlab.contact.laws.ContactParamsSI`; ``lanes`` = (c1, c2)
+    ``params`` is a :class:`~walkerlab.models.contact.laws.ContactParamsSI`; ``lanes`` = (c1, c2)
     patch-centre arrays [m].
     """
     n = np.array([np.sin(phi), np.cos(phi)])

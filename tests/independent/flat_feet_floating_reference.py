@@ -1,6 +1,6 @@
 """Independent reference of the floating (contact) view of a flat-footed walker: kinetic and
 potential energy and the heel/toe positions and velocities, written by hand in numpy from the
-geometry (no sympy, no code shared with :mod:`walkerlab.models.floating`).
+geometry (no sympy, no code shared with :mod:`walkerlab.codegen.floating`).
 
 Walker: hip point mass ``MH``, one point mass ``m`` per leg at ``d`` from the hip, legs of
 length ``L`` (hip to ankle), a foot per leg with mass ``mf`` at the ankle and inertia ``If``

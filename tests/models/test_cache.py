@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from walkerlab.models import cache, symbolic
-from walkerlab.models.description import BodySpec, Structure
+from walkerlab.codegen import cache, symbolic
+from walkerlab.walker.description import BodySpec, Structure
 
 S = Structure("absolute", (BodySpec("mass", "point_mass"),))
 P = (9.81, 1.0, 0.0174, 10.0, 5.0, 0.5)

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from walkerlab.models.cache import functions
-from walkerlab.models.description import BodySpec, Structure, WalkerData
+from walkerlab.codegen.cache import functions
+from walkerlab.walker.description import BodySpec, Structure, WalkerData
 
 CASES = {
     "compass": (Structure("absolute", (BodySpec("mass", "point_mass"),)),

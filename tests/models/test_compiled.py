@@ -14,10 +14,10 @@ import pytest
 
 from tests.conftest import ROOT
 from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.codegen.compiled import compiled_module
 from walkerlab.config import load_scene
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.compiled import compiled_module
 from walkerlab.models.registry import build_walker
 from walkerlab.published import paper
 

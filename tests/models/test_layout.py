@@ -1,11 +1,11 @@
-"""The state layout (walkerlab.models.layout): names, units and slices of a walker view's
+"""The state layout (walkerlab.walker.layout): names, units and slices of a walker view's
 state, its legs, and the rigid -> floating link map the contact model starts from."""
 
 import numpy as np
 import pytest
 
-from walkerlab.contact.model import state_name
-from walkerlab.models.layout import StateLayout, floating_links_from_rigid
+from walkerlab.models.contact.model import state_name
+from walkerlab.walker.layout import StateLayout, floating_links_from_rigid
 
 
 def floating(coords):
@@ -45,7 +45,7 @@ def test_floating_layout_rates_and_legs():
 
 
 def test_built_rigid_walker_layout_is_its_state_names():
-    from walkerlab.models.compass_gait import make_compass_gait
+    from walkerlab.models.hybrid.compass_gait import make_compass_gait
 
     w = make_compass_gait(1.0, 5.0, 10.0, 9.81, 0.5, 0.0174, "derived")
     assert list(w.layout().names) == w.state_names()

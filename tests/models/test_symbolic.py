@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from walkerlab.models.cache import functions
-from walkerlab.models.description import BodySpec, Structure, WalkerData
-from walkerlab.models.symbolic import derive
+from walkerlab.codegen.cache import functions
+from walkerlab.codegen.symbolic import derive
+from walkerlab.walker.description import BodySpec, Structure, WalkerData
 
 COMPASS = Structure("absolute", (BodySpec("mass", "point_mass"),))
 RODS = Structure("absolute", (BodySpec("rod", "rod"),))

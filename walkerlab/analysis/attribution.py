@@ -9,7 +9,7 @@ contact walker's own periodic gait (:mod:`walkerlab.analysis.contact_periodic`):
   :data:`CREEP_OFF` (the creep vanishes with ``v_s``);
 - **compliance**: the finite stiffness (impact duration, sinking): the creep-free gap less
   the gap :data:`COMPLIANCE_OFF` times stiffer along the rigid-limit family
-  (:mod:`walkerlab.contact.rigid_limit`, whose ``v_s ~ kappa^(-1/2)`` takes the creep down
+  (:mod:`walkerlab.models.contact.rigid_limit`, whose ``v_s ~ kappa^(-1/2)`` takes the creep down
   too; a creep-free contact that stiff is too stiff for the step map's integrator);
 - **residual**: what remains at that stiffness (the family's gap there).
 
@@ -141,8 +141,8 @@ def attribute(walker, ideal, **search) -> Attribution:
         Passed to :func:`~walkerlab.analysis.contact_periodic.find_contact_periodic_gait`.
     """
     from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
-    from walkerlab.contact.rigid_limit import scale_walker
-    from walkerlab.contact.scene import ideal_step_length
+    from walkerlab.models.contact.rigid_limit import scale_walker
+    from walkerlab.models.contact.scene import ideal_step_length
 
     search.setdefault("check_fd", False)
     T0, L0 = float(ideal.period_s), ideal_step_length(walker, ideal.x)

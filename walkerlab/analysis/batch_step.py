@@ -3,7 +3,7 @@ own slope: the workhorse of the metastability studies (:mod:`walkerlab.analysis.
 
 One step of ``N`` walkers is integrated as one stacked system (``N x 2n`` states) by scipy's
 DOP853 (``scipy.integrate.DOP853``, stepped one step at a time); its right-hand side calls the
-walker's compiled flow (the numba ``cfunc`` of :class:`walkerlab.models.compiled.CompiledFlow`,
+walker's compiled flow (the numba ``cfunc`` of :class:`walkerlab.codegen.compiled.CompiledFlow`,
 the same generated equations as every other rigid integration) once per walker, in one
 compiled loop (:func:`_stacked`), so the per-step Python cost of the integrator is shared by
 all ``N`` walkers.  Guards are the cfunc's extra outputs; after each integrator step the
@@ -141,7 +141,7 @@ class BatchStepMap:
 
     def __init__(self, walker, walker_at, rtol: float = 1e-9, atol: float = 1e-9,
                  max_step_time_s: float = 5.0):
-        from walkerlab.models.compiled import compiled_module
+        from walkerlab.codegen.compiled import compiled_module
 
         self.walker, self.walker_at = walker, walker_at
         self.rtol, self.atol, self.max_step_time_s = rtol, atol, max_step_time_s

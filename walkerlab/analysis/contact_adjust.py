@@ -25,7 +25,7 @@ def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
     dict
         ``scale`` (2,), ``objective``, ``evaluations``, ``grid_best`` (2,).
     """
-    from walkerlab.contact.scene import settings
+    from walkerlab.models.contact.scene import settings
 
     from .contact_sim import simulate_from
 

@@ -13,8 +13,8 @@ import numpy as np
 
 from walkerlab.config.contact import ContactSettings, TerrainSettings
 from walkerlab.config.solver import SolverSettings
-from walkerlab.contact.model import ContactWalker
 from walkerlab.integrate.contact import StateIndex
+from walkerlab.models.contact.model import ContactWalker
 
 from .contact_sim import initial_state_from_ideal, simulate_contact
 

@@ -1,11 +1,11 @@
 """Drop test of the IMPACT contact: coefficient of restitution against stiffness.
 
 A point mass ``m`` moving down at ``v_in`` meets flat ground governed by the IMPACT law
-(:func:`walkerlab.contact.laws.impact_normal_force`, the law the walker's kernel compiles) under
-gravity; the coefficient of restitution is ``e = v_out / v_in`` with ``v_out`` the upward
+(:func:`walkerlab.models.contact.laws.impact_normal_force`, the law the walker's kernel compiles)
+under gravity; the coefficient of restitution is ``e = v_out / v_in`` with ``v_out`` the upward
 speed at separation (force back to zero).  A plastic impact (the rigid model's heel strike)
 has ``e = 0``.  :func:`restitution_curve` sweeps the stiffness in the paper's family (damping
-fixed) and in the rigid-limit family (:mod:`walkerlab.contact.rigid_limit`).
+fixed) and in the rigid-limit family (:mod:`walkerlab.models.contact.rigid_limit`).
 """
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.config.contact import ContactSettings
-from walkerlab.contact.laws import impact_normal_force
-from walkerlab.contact.rigid_limit import contact_si
 from walkerlab.integrate.events import Event, run_to_event
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.laws import impact_normal_force
+from walkerlab.models.contact.rigid_limit import contact_si
 
 __all__ = ["FAMILIES", "drop_restitution", "restitution_curve"]
 

@@ -73,8 +73,8 @@ three slow ones (0.469 +- 0.498j, 0.113; rigid 0.548 +- 0.499j, 0.108), the seve
 
 Rigid limit
 -----------
-The one rigid-limit family of the contact is :mod:`walkerlab.contact.rigid_limit`
-(:func:`~walkerlab.contact.rigid_limit.scale_walker`);
+The one rigid-limit family of the contact is :mod:`walkerlab.models.contact.rigid_limit`
+(:func:`~walkerlab.models.contact.rigid_limit.scale_walker`);
 :func:`walkerlab.analysis.rigid_limit.convergence` follows this gait along it.
 """
 
@@ -87,11 +87,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq, root
 
-from walkerlab.contact.model import ContactWalker, footprint_offsets
 from walkerlab.integrate.contact import StateIndex
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, odeint_grid, run_to_event
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.model import ContactWalker, footprint_offsets
 
 __all__ = ["SECTION_NAMES", "SECTION_UNITS", "StepMap", "ContactPeriodicGait", "PeriodicGaitError",
            "find_contact_periodic_gait", "section_guess_from_ideal"]
@@ -486,7 +486,7 @@ def ideal_gait(scene):
 def _walker_and_guess(walker_or_scene, guess):
     if isinstance(walker_or_scene, ContactWalker):
         return walker_or_scene, guess, None
-    from walkerlab.contact.scene import build
+    from walkerlab.models.contact.scene import build
 
     scene = walker_or_scene
     ideal = ideal_gait(scene)
@@ -545,7 +545,7 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     Parameters
     ----------
     walker_or_scene : ContactWalker or walkerlab.config.Scene
-        A scene is built into a walker with :func:`walkerlab.contact.scene.build`; then
+        A scene is built into a walker with :func:`walkerlab.models.contact.scene.build`; then
         the default guess is its ideal (derived) fixed point.
     guess : array_like, optional
         Either a section state (n,) (:func:`section_coordinates`) or an ideal post-impact
@@ -699,7 +699,7 @@ def simulate_from_periodic_gait(scene, x_ideal: np.ndarray, strides: int | None 
         The periodic gait was not found (fell, no mid-stance, solver failure, time limit).
     """
     from walkerlab.analysis.contact_sim import scene_start, simulate_contact
-    from walkerlab.contact.scene import build, settings
+    from walkerlab.models.contact.scene import build, settings
 
     _, _, cs, sv = settings(scene)
     sv = solver or sv

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.config import Scene
-from walkerlab.contact.scene import settings
+from walkerlab.models.contact.scene import settings
 
 #: stiffness values of the drop test stored with every contact run, relative to the scene's
 #: own stiffness (the paper's k = 1e5 N/mm^2.2: 1e4 ... 1e9 N/mm^2.2)

@@ -1,10 +1,10 @@
 """The compliant-contact walker on rough ground: the terrain as geometry (issue 24).
 
-The contact model walks on the checkerboard lanes of :mod:`walkerlab.contact.model`: footfall
+The contact model walks on the checkerboard lanes of :mod:`walkerlab.models.contact.model`: footfall
 ``k`` of the gait lands on a patch centred at ``s = k l`` (``l`` the gait's step length;
 leg2's lane holds the even footfalls, leg1's the odd ones; footfall 0 is the stance foot the
 walk starts on).  Rough ground gives each patch a height ``h_k`` along the slope's outward
-normal (:attr:`walkerlab.contact.model.ContactWalker.heights1`), so
+normal (:attr:`walkerlab.models.contact.model.ContactWalker.heights1`), so
 
 * a single step-down of ``h`` at the first heel strike is ``h_k = -h`` for every ``k >= 1``
   (a step-up: ``+h``), as the rigid model's swing-foot clearance guard meets the ground
@@ -58,7 +58,7 @@ def footfall_lanes(walker, heights_m: np.ndarray):
     Parameters
     ----------
     walker : ContactWalker
-        With checkerboard lanes (:func:`walkerlab.contact.model.checkerboard_lanes`):
+        With checkerboard lanes (:func:`walkerlab.models.contact.model.checkerboard_lanes`):
         leg2's patches are footfalls 0, 2, 4, ..., leg1's 1, 3, ....
     heights_m : ndarray (k,)
 
@@ -123,12 +123,12 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
     ------
     walkerlab.analysis.contact_periodic.PeriodicGaitError
         No periodic gait.
-    walkerlab.contact.scene.ContactSceneError
+    walkerlab.models.contact.scene.ContactSceneError
         No ``contact`` section.
     """
     from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
     from walkerlab.analysis.contact_sim import scene_start
-    from walkerlab.contact.scene import settings
+    from walkerlab.models.contact.scene import settings
 
     cs = settings(scene)[2]
     probe, x0, _, step_length = scene_start(scene, x_ideal, 2)
@@ -168,7 +168,7 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
     """
     from walkerlab.analysis.contact_sim import scene_start, simulate_contact
     from walkerlab.config import scene_from_dict
-    from walkerlab.contact.scene import build, settings
+    from walkerlab.models.contact.scene import build, settings
 
     scene = scene_from_dict(start.scene)
     sv = settings(scene)[3]

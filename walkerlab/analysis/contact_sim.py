@@ -17,9 +17,9 @@ import numpy as np
 
 from walkerlab.config import Scene
 from walkerlab.config.solver import SolverSettings
-from walkerlab.contact.scene import build, settings
 from walkerlab.integrate.contact import ContactLimits, StateIndex, integrate_contact
 from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.scene import build, settings
 
 from .contact_gait import ContactResult, classify, gait_events, heel_strike_count
 

@@ -69,7 +69,7 @@ import numpy as np
 
 from walkerlab.integrate.rigid import integrate_step, numeric_jacobian
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.base import HybridWalker
+from walkerlab.models.hybrid.base import HybridWalker
 
 __all__ = ["VALIDITY", "normal_force_ratio", "WalkerFamily", "BranchPoint", "SpecialPoint",
            "Branch", "ContinuationResult",

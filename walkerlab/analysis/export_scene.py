@@ -21,7 +21,7 @@
   penetration of the whole walker standing on one foot.
 - **knee latch** (kneed walkers): MuJoCo has no contact-switched joint lock, so each knee has
   a joint equality constraint ``leg<i>_latch`` (knee angle = 0) that a stepping loop switches
-  by walkerlab's rule (:mod:`walkerlab.contact.generated`): on while the leg's foot is less
+  by walkerlab's rule (:mod:`walkerlab.models.contact.generated`): on while the leg's foot is less
   than the release height above the ground and its knee within the capture flexion of
   straight; the numbers are in the file's ``custom`` section and the rule is
   :func:`walkerlab.analysis.mujoco_walk.latch_rule`.
@@ -35,8 +35,8 @@ import numpy as np
 
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings, TerrainSettings
-from walkerlab.contact.laws import ContactParamsSI
 from walkerlab.io.export import MJCF_MIN_LENGTH_M, MJCF_MIN_MASS_KG, MjcfScene, point_foot_radius
+from walkerlab.models.contact.laws import ContactParamsSI
 
 __all__ = ["EXPORT_STEPS", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]
 
@@ -163,9 +163,9 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
         No ``fixedpoint`` section (one line).
     """
     from walkerlab.analysis.contact_periodic import ideal_gait
-    from walkerlab.contact.model import ContactWalker
-    from walkerlab.contact.rigid_limit import contact_si
-    from walkerlab.contact.scene import ideal_step_length
+    from walkerlab.models.contact.model import ContactWalker
+    from walkerlab.models.contact.rigid_limit import contact_si
+    from walkerlab.models.contact.scene import ideal_step_length
 
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain or TerrainSettings()

@@ -47,7 +47,7 @@ from walkerlab.analysis.poincare import (
     poincare_map,
 )
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.base import HybridWalker
+from walkerlab.models.hybrid.base import HybridWalker
 
 __all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "seed_states", "state_from_legs",
            "deflation_starts", "step_length",

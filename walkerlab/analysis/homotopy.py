@@ -18,7 +18,7 @@ from walkerlab.analysis.continuation import (
     first_point,
 )
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.base import HybridWalker
+from walkerlab.models.hybrid.base import HybridWalker
 
 __all__ = ["HomotopyResult", "homotopy"]
 

@@ -74,7 +74,7 @@ def latch_rule(foot_height_m: float, knee_rad: float, release_height_m: float,
     """walkerlab's knee latch as an on/off rule: hold the knee straight while the foot is
     less than ``release_height_m`` above the ground and the knee is flexed less than
     ``capture_rad`` (the contact model weights the same two conditions by cubic steps,
-    :mod:`walkerlab.contact.generated`)."""
+    :mod:`walkerlab.models.contact.generated`)."""
     return foot_height_m < release_height_m and knee_rad > -capture_rad
 
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from walkerlab.integrate.rigid import integrate_step, numeric_jacobian
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.base import HybridWalker
+from walkerlab.models.hybrid.base import HybridWalker
 
 
 class StepFailed(RuntimeError):

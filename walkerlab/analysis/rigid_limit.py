@@ -1,13 +1,13 @@
 """The contact walker's periodic gait along the rigid-limit family, against the rigid gait.
 
 For each stiffness factor ``kappa`` the contact is scaled along the one family
-(:mod:`walkerlab.contact.rigid_limit`), the contact walker's own periodic gait is found
+(:mod:`walkerlab.models.contact.rigid_limit`), the contact walker's own periodic gait is found
 (:func:`walkerlab.analysis.contact_periodic.find_contact_periodic_gait`, warm-started from
 the previous ``kappa``'s fixed point) and its step period, step length and slow Floquet
 multipliers are set beside the rigid walker's.  The observed order of convergence between
 successive factors is ``log(gap_i / gap_{i+1}) / log(kappa_{i+1} / kappa_i)`` (as PyBaMM's
 convergence tests take log2 of successive error ratios); the family's expected order is
-:func:`walkerlab.contact.rigid_limit.expected_order` (``1/(e+1)``).
+:func:`walkerlab.models.contact.rigid_limit.expected_order` (``1/(e+1)``).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from walkerlab.contact.rigid_limit import scale_walker
+from walkerlab.models.contact.rigid_limit import scale_walker
 
 __all__ = ["RigidLimitTable", "convergence", "match_multipliers", "observed_order"]
 
@@ -130,7 +130,7 @@ def convergence(walker, ideal, kappas, *, min_multiplier: float = 1e-6,
     RigidLimitTable
     """
     from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
-    from walkerlab.contact.scene import ideal_step_length
+    from walkerlab.models.contact.scene import ideal_step_length
 
     lam_r = np.asarray(ideal.multipliers_variational, complex)
     lam_r = lam_r[np.abs(lam_r) > min_multiplier]

@@ -523,7 +523,7 @@ def contact_steps(scene, x_star: np.ndarray, st, cap_m: float, workers: int = 1,
         return dict.fromkeys(keys, math.nan)
     from walkerlab.analysis.contact_periodic import PeriodicGaitError
     from walkerlab.analysis.contact_rough import contact_start
-    from walkerlab.contact.scene import ContactSceneError
+    from walkerlab.models.contact.scene import ContactSceneError
     from walkerlab.sweep.contact_rough import contact_largest_step
 
     try:

@@ -27,7 +27,7 @@ def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
     with published numbers) the other variants: they explain the difference from Eq. 11."""
     own = (scene.ideal.variant,)
     if compare and scene.walker.model == "compass_gait" and scene.published is not None:
-        from walkerlab.models.compass_gait import VARIANTS
+        from walkerlab.models.hybrid.compass_gait import VARIANTS
 
         return own + tuple(v for v in VARIANTS if v != scene.ideal.variant)
     return own

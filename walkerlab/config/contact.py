@@ -8,7 +8,7 @@ this module imports no model (settings lie under the models, not beside them).
 Every dimensional number of :class:`ContactSettings` carries its unit in its name, in
 ADAMS's default mm-kg-s units (``stiffness_n_per_mm_pow_e``) or in SI
 (``stiffness_n_per_m_pow_e``); the contact model converts them to SI once per run
-(:func:`walkerlab.contact.laws.contact_params_si`; NOTES.md: "a wrong unit here changes the
+(:func:`walkerlab.models.contact.laws.contact_params_si`; NOTES.md: "a wrong unit here changes the
 answer by 10^6").
 """
 
@@ -176,7 +176,7 @@ class ContactSettings(BaseModel):
     mm-kg-s units (``stiffness_n_per_mm_pow_e``, as the paper's numbers are read) or in SI
     (``stiffness_n_per_m_pow_e``): exactly one of the two names per quantity
     (:data:`CONTACT_QUANTITIES`; neither: the paper's value in mm-kg-s).  The contact model
-    converts them to SI once per run (:func:`walkerlab.contact.laws.contact_params_si`).
+    converts them to SI once per run (:func:`walkerlab.models.contact.laws.contact_params_si`).
     Defaults are the paper's values (k = 1e5, damping 90, mu_s = 0.9, mu_d = 0.7) read in
     mm-kg-s, with the ADAMS View defaults for the rest (NOTES.md).
     """
@@ -209,7 +209,7 @@ class ContactSettings(BaseModel):
         "the maximum damping and the penetration at maximum damping as given (a stiffer "
         "contact is then more elastic); 'rigid_limit' reads them, the transition velocities "
         "and the knee latch's release height as holding at the reference stiffness and "
-        "follows the one rigid-limit family (walkerlab.contact.rigid_limit) with kappa = "
+        "follows the one rigid-limit family (walkerlab.models.contact.rigid_limit) with kappa = "
         "stiffness / reference stiffness: cmax * kappa^(1/(e+1)), dmax and latch height * "
         "kappa^(-1/(e+1)), vs and vd * kappa^(-1/2), so a drop impact keeps its "
         "(near-plastic) restitution and the periodic gait converges to the rigid one as k "

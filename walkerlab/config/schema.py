@@ -357,7 +357,7 @@ class SpringSpec(_Strict):
 
 class BipedParams(_Strict):
     """A planar passive biped described as data (``model: biped``); its equations of motion,
-    guards and impact are derived symbolically (:mod:`walkerlab.models.symbolic`).
+    guards and impact are derived symbolically (:mod:`walkerlab.codegen.symbolic`).
 
     Give ``leg`` (both legs identical, the shorthand) or ``legs`` (a pair: ``leg1``, which
     starts as the swing leg, then ``leg2``; same length, foot and body names, the numbers
@@ -425,7 +425,7 @@ class BipedParams(_Strict):
 
 
 # ``model`` is the discriminator; "compass_gait" is the paper's shorthand for a biped with a
-# hip mass and one point mass per leg (expanded by walkerlab.models.description).
+# hip mass and one point mass per leg (expanded by walkerlab.walker.description).
 def _walker_tag(v: Any) -> str:
     return (v.get("model", "compass_gait") if isinstance(v, dict)
             else getattr(v, "model", "compass_gait"))

@@ -1,6 +1,6 @@
 """Advancing the models in time: the one solver layer of the rigid and the contact model.
 
-Above the models (:mod:`walkerlab.models`, :mod:`walkerlab.contact`), below the analyses.
+Above the models (:mod:`walkerlab.models`, :mod:`walkerlab.models.contact`), below the analyses.
 :mod:`walkerlab.integrate.solver` holds the one settings object (:class:`Solver`: method,
 tolerances, largest step, backend) and :func:`available_backends`;
 :mod:`walkerlab.integrate.rigid` integrates the rigid hybrid walker step by step (scipy,

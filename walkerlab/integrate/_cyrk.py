@@ -4,7 +4,7 @@ Internal module, imported by :mod:`walkerlab.integrate.contact`; CyRK itself is 
 on the first chunk of a ``cyrk_*`` method.  CyRK (a main dependency, binary wheels, no
 Fortran) takes the right-hand side as a C function pointer (its numba bridge,
 ``CyRK.nb.numba_solver``: ``cyjit_sig``, ``c_numba_cysolve_ivp``).  The walker's
-generated RHS (:mod:`walkerlab.contact.generated`) is wrapped in a numba ``cfunc`` (compiled
+generated RHS (:mod:`walkerlab.models.contact.generated`) is wrapped in a numba ``cfunc`` (compiled
 once per walker structure, cached on disk), so CyRK integrates a whole chunk of samples
 without re-entering Python.
 The physics is not repeated here: the cfunc only unpacks its data vector and calls the
@@ -58,7 +58,7 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     t_eval : ndarray (n,)
         Increasing sample times [s]; the first is the start time.
     data : ndarray
-        From :meth:`walkerlab.contact.model.ContactWalker.pack`.
+        From :meth:`walkerlab.models.contact.model.ContactWalker.pack`.
     rtol : float
     atol : float or ndarray (2 nq,)
         [m, rad, m/s, rad/s].

@@ -3,7 +3,7 @@
 Internal module, imported only when ``method="numbalsoda"`` is selected (numbalsoda is an
 optional extra: ``pip install 'walkerlab[numbalsoda]'``; building it from source needs a C++
 and a Fortran compiler and cmake).  The walker's generated right-hand side
-(:mod:`walkerlab.contact.generated`) is wrapped in a numba ``cfunc`` so that LSODA
+(:mod:`walkerlab.models.contact.generated`) is wrapped in a numba ``cfunc`` so that LSODA
 (numbalsoda's C++ port) integrates a whole chunk of samples without re-entering Python.
 numbalsoda's LSODA takes a scalar ``atol``, no largest step and no user Jacobian (it forms the
 stiff-phase Jacobian by finite differences;

@@ -1,6 +1,6 @@
 """Time integration of the compliant-contact walker: backends, chunks and event location.
 
-Where this sits: :mod:`walkerlab.contact` is the model (laws, geometry, terrain, the floating
+Where this sits: :mod:`walkerlab.models.contact` is the model (laws, geometry, terrain, the floating
 walker); this module advances a model's state and finds where its run-ending events are;
 :mod:`walkerlab.analysis.contact_gait` says what the samples mean (touchdowns, heel strikes,
 steps, the run's outcome) and :mod:`walkerlab.analysis.contact_sim` puts the two together
@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
-from walkerlab.contact.energy import (
+from walkerlab.models.contact.energy import (
     energy_rise_bound,
     first_energy_violation,
     side_entry,
@@ -75,7 +75,7 @@ CYRK_STEPS_PER_CALL = 100_000
 
 class StateIndex:
     """Columns of a walker's state by name, never by number: a view of the walker's
-    :class:`~walkerlab.models.layout.StateLayout` (``walker.layout()``).
+    :class:`~walkerlab.walker.layout.StateLayout` (``walker.layout()``).
 
     ``idx["hip_x"]`` is a column; :meth:`rate_of` the column of a coordinate's rate;
     :attr:`coordinates` the columns of the coordinates q, :attr:`rates` of their rates.
@@ -428,7 +428,7 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
     ta, xa = t0, x0
     term, msg, event = RunEnd.T_FINAL, "Integration successful.", None
     n_checked = 1
-    # the energy guard (walkerlab.contact.energy): no sample above the start's energy + bound
+    # the energy guard (walkerlab.models.contact.energy): no sample above the start's energy + bound
     e_start = float(total_energy(walker, x0)[0])
     e_bound = energy_rise_bound(walker, x0, solver.rtol)
     guarded = False  # the energy guard ended the run (no event state to interpolate)

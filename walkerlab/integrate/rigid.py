@@ -1,4 +1,4 @@
-"""Integrate a :class:`~walkerlab.models.base.HybridWalker` step by step.
+"""Integrate a :class:`~walkerlab.models.hybrid.base.HybridWalker` step by step.
 
 A trajectory is a list of :class:`Segment` (one per step), each with its termination reason
 (``heel_strike``, ``fall``, ``t_final``, ``solver_failure``) and the event time and state, as
@@ -14,7 +14,7 @@ Integrators come from libraries, chosen by :class:`~walkerlab.integrate.solver.S
   On the compass gait it takes exactly scipy's steps (same time and state at heel strike to
   round-off) 25-60 times faster: ``scripts/bench_integrators.py`` and the note of issue 10.
 - ``"cyrk_compiled"``: the same CyRK pairs with the phase's flow (and variational equations)
-  compiled by numba (:mod:`walkerlab.models.compiled`, cached on disk), so each phase runs in
+  compiled by numba (:mod:`walkerlab.codegen.compiled`, cached on disk), so each phase runs in
   C++ without Python callbacks; guards are located on the step points and by Brent's method
   on the dense output (:mod:`walkerlab.integrate._compiled`).  Imports numba (about 1 s per
   process): meant for many-point studies.  A phase without a compiled flow (a replaced flow)
@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.models.base import HybridWalker, Phase, complex_step_jacobian
+from walkerlab.models.hybrid.base import HybridWalker, Phase, complex_step_jacobian
 
 from .ends import RunEnd
 from .solver import Solver

@@ -1,6 +1,6 @@
 """The walker in the exchange formats of multibody libraries: URDF and MJCF.
 
-Both files describe the floating planar walker of :func:`walkerlab.models.multibody.multibody`
+Both files describe the floating planar walker of :func:`walkerlab.walker.multibody.multibody`
 in 3-D, in the **x-z plane**: x horizontal (downhill), z up (walkerlab's y), every joint axis
 along world **-y**, so that a positive joint angle moves the foot ahead (+x): a point at
 distance ``s`` along a link of angle ``psi`` lies at ``joint + s (sin psi, 0, -cos psi)``.
@@ -76,7 +76,7 @@ from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
-    from walkerlab.models.multibody import Link, Multibody
+    from walkerlab.walker.multibody import Link, Multibody
 
 __all__ = ["FORMATS", "LANE_BITS", "MJCF_MIN_INERTIA_KG_M2", "MJCF_MIN_LENGTH_M",
            "MJCF_MIN_MASS_KG", "MjcfScene", "SIDECAR", "comments_in_scene_units", "keyframe_json",
@@ -153,7 +153,7 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
     Parameters
     ----------
     mb : Multibody
-        From :func:`walkerlab.models.multibody.multibody`.
+        From :func:`walkerlab.walker.multibody.multibody`.
     name : str
         Robot name (the scene's name).
     version : str
@@ -351,7 +351,7 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     Parameters
     ----------
     mb : Multibody
-        From :func:`walkerlab.models.multibody.multibody`.
+        From :func:`walkerlab.walker.multibody.multibody`.
     name : str
         Model name (the scene's name).
     version : str

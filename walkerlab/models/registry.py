@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from walkerlab.models.base import HybridWalker
+from walkerlab.models.hybrid.base import HybridWalker
 
 
 def state_layout(scene) -> tuple[list[str], list[str]]:
@@ -14,7 +14,7 @@ def state_layout(scene) -> tuple[list[str], list[str]]:
     -------
     names, units : list of str, length 2n
     """
-    from walkerlab.models.description import state_names, state_units, walker_data
+    from walkerlab.walker.description import state_names, state_units, walker_data
 
     roles = walker_data(scene.walker, scene.slope.phi_rad).structure.roles
     return state_names(roles), state_units(roles)
@@ -34,15 +34,15 @@ def build_walker(scene) -> HybridWalker:
     """
     w = scene.walker
     if w.model == "compass_gait":
-        from walkerlab.models.compass_gait import make_compass_gait
+        from walkerlab.models.hybrid.compass_gait import make_compass_gait
 
         return make_compass_gait(
             w.leg_length_m, w.leg_mass_kg, w.hip_mass_kg, w.gravity_m_per_s2,
             w.leg_mass_from_foot_m, scene.slope.phi_rad, scene.ideal.variant,
         )
     if w.model == "biped":
-        from walkerlab.models.description import walker_data
-        from walkerlab.models.rigid import make_rigid_walker
+        from walkerlab.models.hybrid.rigid import make_rigid_walker
+        from walkerlab.walker.description import walker_data
 
         if scene.ideal.variant != "derived":
             raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "

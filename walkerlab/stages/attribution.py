@@ -39,7 +39,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
 
     def compute():
         from walkerlab.analysis.attribution import adjustment_effect, attribute
-        from walkerlab.contact.scene import build
+        from walkerlab.models.contact.scene import build
 
         fp = load_fixedpoint(up[0])
         ideal = SimpleNamespace(x=fp.x, period_s=float(fp.step_period_s))

@@ -15,10 +15,10 @@ from pathlib import Path
 
 from walkerlab.analysis.contact_record import contact_sim_run
 from walkerlab.config import Scene
-from walkerlab.contact import scene as contact_scene
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.schemas.contact_sim import run_end, write_contact_sim
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.models.contact import scene as contact_scene
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,

@@ -22,9 +22,9 @@ from walkerlab.io.export import (
     mjcf_text,
     urdf_text,
 )
-from walkerlab.models.description import walker_data
-from walkerlab.models.multibody import multibody
 from walkerlab.units import for_scene
+from walkerlab.walker.description import walker_data
+from walkerlab.walker.multibody import multibody
 
 
 def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = False) -> Path:

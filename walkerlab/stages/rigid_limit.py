@@ -2,7 +2,7 @@
 -> ``rigid_limit.h5`` (``walkerlab compare --rigid-limit``).
 
 For each stiffness factor ``kappa`` (default :data:`KAPPAS`) the scene's contact is scaled by
-:mod:`walkerlab.contact.rigid_limit` and the contact walker's own periodic gait is found
+:mod:`walkerlab.models.contact.rigid_limit` and the contact walker's own periodic gait is found
 (:func:`walkerlab.analysis.rigid_limit.convergence`); the artifact holds its step period, step
 length and slow Floquet multipliers against ``kappa``, the rigid gait's as scalars, and the
 observed orders of convergence (layout: :mod:`walkerlab.io.schemas.rigid_limit`).  Any
@@ -38,8 +38,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     def compute():
         from walkerlab.analysis.contact_periodic import ideal_gait
         from walkerlab.analysis.rigid_limit import convergence, observed_order
-        from walkerlab.contact.rigid_limit import expected_order
-        from walkerlab.contact.scene import build
+        from walkerlab.models.contact.rigid_limit import expected_order
+        from walkerlab.models.contact.scene import build
 
         ideal = ideal_gait(scene)
         walker, _ = build(scene, ideal.x, 2)

@@ -292,7 +292,7 @@ def _contact_start(scene, x_star: np.ndarray, st):
     """The contact model's periodic gait for ``mfpt.model: contact`` (one-line errors)."""
     from walkerlab.analysis.contact_periodic import PeriodicGaitError
     from walkerlab.analysis.contact_rough import contact_start
-    from walkerlab.contact.scene import ContactSceneError
+    from walkerlab.models.contact.scene import ContactSceneError
 
     if st.method != "montecarlo":
         raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "

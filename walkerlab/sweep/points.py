@@ -385,7 +385,7 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
                     step_length_m: float):
     """Run the compliant-contact simulation of ``scene`` from an ideal-model state.
 
-    The only place that calls :mod:`walkerlab.contact`; keep it in step with that module.
+    The only place that calls :mod:`walkerlab.models.contact`; keep it in step with that module.
 
     Parameters
     ----------

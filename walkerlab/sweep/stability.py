@@ -155,7 +155,7 @@ def gait_row(base: dict, spec: MapSpec, iy: int) -> list[dict]:
     """
     from walkerlab.analysis.contact_periodic import PeriodicGaitError, find_contact_periodic_gait
     from walkerlab.config import SceneError
-    from walkerlab.contact.scene import build
+    from walkerlab.models.contact.scene import build
     from walkerlab.sweep.points import _Outcome, ideal_fixed_point
 
     y = spec.y_values[iy]

@@ -43,7 +43,7 @@ class ContactSimRun:
 
     Attributes
     ----------
-    walker : walkerlab.contact.generated walker
+    walker : walkerlab.models.contact.generated walker
         The floating contact walker (state names/units, lanes, contact law in SI).
     result : ContactResult
         The run (feet, events, steps, outcome).

@@ -21,7 +21,7 @@ from walkerlab.io.artifacts import open_artifact, put
 from walkerlab.io.netcdf import coordinate
 
 STAGE = "rigid-limit"
-FAMILY = ("walkerlab.contact.rigid_limit: k*kappa, cmax*kappa^(1/(e+1)), dmax and latch "
+FAMILY = ("walkerlab.models.contact.rigid_limit: k*kappa, cmax*kappa^(1/(e+1)), dmax and latch "
           "height*kappa^(-1/(e+1)), vs, vd*kappa^(-1/2), knee stop along the same family")
 
 

@@ -38,7 +38,7 @@ class SimulateRun:
 
     Attributes
     ----------
-    walker : walkerlab.models.base.HybridWalker
+    walker : walkerlab.models.hybrid.base.HybridWalker
         The walker simulated (name, variant, legs, state names, parameters).
     trajectory : walkerlab.integrate.rigid.HybridTrajectory
         Segments of the run (termination, start/end states).

@@ -1,12 +1,12 @@
 """The compliant-contact walker's compiled kernels, generated per walker structure.
 
-The generated module is the floating view of the walker (:mod:`walkerlab.models.floating`:
+The generated module is the floating view of the walker (:mod:`walkerlab.codegen.floating`:
 ``dyn``, ``dyn_jac``, ``feet``, ``feet_jac``, numba) followed by :data:`ASSEMBLY`, the
 walker-independent code that turns contact geometry into forces with the laws of
-:mod:`walkerlab.contact._kernels` (IMPACT normal force, ADAMS Coulomb friction, patch
+:mod:`walkerlab.models.contact._kernels` (IMPACT normal force, ADAMS Coulomb friction, patch
 membership) and solves ``M qdd = Q - h`` (no mechanics is written by hand here: every
 position, velocity, Jacobian, mass matrix and bias comes from the generator).  It is cached
-on disk next to the rigid models' code (:func:`walkerlab.models.cache.cache_dir`), keyed on
+on disk next to the rigid models' code (:func:`walkerlab.codegen.cache.cache_dir`), keyed on
 the structure, the generators and this file.
 
 Contact parameter vector ``PC`` (float64, (NPC,)), read through named indices:
@@ -46,10 +46,10 @@ weight constant (left out: its dependence on the foot's height; Newton direction
 
 Packed data vector of the compiled integrators (``_cyrk``, ``_lsoda``):
 ``[n1, n2, PC (NPC), p (NP), c1 (n1), c2 (n2), nfev]`` (``p`` the floating view's parameter
-vector, :func:`walkerlab.models.floating.param_names`; ``c1``/``c2`` the kernel lanes of
+vector, :func:`walkerlab.codegen.floating.param_names`; ``c1``/``c2`` the kernel lanes of
 leg1's / leg2's patches: their centres [m], their heights [m] along the outward normal and the
 largest height [m], ``n = 2 patches + 1``;
-:meth:`walkerlab.contact.model.ContactWalker.kernel_lanes`).  A foot's penetration is
+:meth:`walkerlab.models.contact.model.ContactWalker.kernel_lanes`).  A foot's penetration is
 measured below the top of the patch under it (all heights 0: the flat ground, bit for bit).
 
 Contact points: ``NF`` of them, named ``CONTACTS`` (``('leg1', 'leg2')`` for point and arc
@@ -57,7 +57,7 @@ feet, ``('leg1_heel', 'leg1_toe', 'leg2_heel', 'leg2_toe')`` for flat feet), eac
 IMPACT and Coulomb laws on its leg's lane (``POINT_LEG``); ``PIN`` is leg2's first point
 (the point a pinned stance foot holds).
 
-Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.models.floating` for ``q``):
+Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.floating` for ``q``):
 
 =======================================  =================================================
 ``rhs(x, PC, p, c1, c2)``                dx/dt (NX,)
@@ -79,7 +79,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from walkerlab.models.description import Structure
+from walkerlab.walker.description import Structure
 
 __all__ = ["ASSEMBLY", "NPC", "contact_module", "contact_source", "rhs_source"]
 
@@ -88,9 +88,10 @@ NPC = 18
 
 ASSEMBLY = '''
 # ---------------------------------------------------------------- contact assembly
-# (walkerlab.contact.generated.ASSEMBLY: walker-independent; laws from contact._kernels)
+# (walkerlab.models.contact.generated.ASSEMBLY: walker-independent; laws from contact._kernels)
 from math import sin as _sin, cos as _cos
-from walkerlab.contact._kernels import normal_force, friction_mu, in_patch, patch_height, step
+from walkerlab.models.contact._kernels import normal_force, friction_mu, in_patch, patch_height,
+step
 
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
@@ -508,7 +509,7 @@ def build_lsoda(sig):
 
 def rhs_source(eq) -> str:
     """Straight-line numba source of ``rhs(x, PC, p, c1, c2)`` for the floating equations
-    ``eq`` (:class:`walkerlab.models.floating.FloatingEquations`): the feet's contact points
+    ``eq`` (:class:`walkerlab.codegen.floating.FloatingEquations`): the feet's contact points
     and material velocities, the contact forces and knee-stop torques from the laws, then
     ``M`` and ``Q - h`` (common subexpressions shared) and an unrolled Cholesky solve that
     skips the structural zeros of ``M`` (fill-in tracked).  Same equations as the array
@@ -588,7 +589,7 @@ def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
     constants ``NP``, ``KNEE``, ``NF``, ``POINT_LEG``, ``PIN``, ``CONTACTS``, then
     :data:`ASSEMBLY` and the straight-line ``rhs``)."""
-    from walkerlab.models import floating
+    from walkerlab.codegen import floating
 
     eq = floating.derive_floating(structure)
     if structure.knee and len(eq.feet) != 2:
@@ -609,7 +610,7 @@ def contact_module(structure: Structure):
     ValueError
         Massless bodies (a floating model needs positive leg masses).
     """
-    from walkerlab.models import floating
+    from walkerlab.codegen import floating
 
     floating.check_masses(structure)
     return floating.load_generated(structure, "contact",

@@ -1,18 +1,18 @@
 """Floating walker with compliant ADAMS-style feet (:class:`ContactWalker`), for any walker
 with positive leg masses (compass gait, rods, knees, arc feet).
 
-Conventions (shared with the rigid model, :mod:`walkerlab.models.floating`): x downhill, y up,
+Conventions (shared with the rigid model, :mod:`walkerlab.codegen.floating`): x downhill, y up,
 gravity (0, -g); ground line y = -x tan(phi), outward normal n = (sin phi, cos phi),
 down-slope tangent t = (cos phi, -sin phi).  The mechanics (mass matrix, bias, contact points,
 Jacobians) are generated from the walker description; the contact forces use the laws of
-:mod:`walkerlab.contact.laws` (numba twins in :mod:`walkerlab.contact._kernels`); the knees
-of a kneed walker are free, each held by a compliant stop
+:mod:`walkerlab.models.contact.laws` (numba twins in :mod:`walkerlab.models.contact._kernels`); the
+knees of a kneed walker are free, each held by a compliant stop
 (:class:`~walkerlab.config.contact.KneeStopSettings`).
 
 State names
 -----------
 ``x = [q, dq]``.  The floating coordinates are named by
-:func:`walkerlab.models.floating.coordinate_names` (``hip_x``, ``hip_y``, ``leg1_angle``, ...);
+:func:`walkerlab.codegen.floating.coordinate_names` (``hip_x``, ``hip_y``, ``leg1_angle``, ...);
 the contact model keeps its established state vocabulary, mapped one to one
 (:data:`STATE_OF_COORDINATE`):
 
@@ -112,10 +112,10 @@ def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np
 
 
 def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
-    """:class:`~walkerlab.models.description.WalkerData` of the paper's compass gait (Table 1):
+    """:class:`~walkerlab.walker.description.WalkerData` of the paper's compass gait (Table 1):
     leg length L [m], leg mass m [kg] at ``a`` [m] from the foot, hip mass MH [kg]."""
-    from walkerlab.models.compass_gait import compass_gait_structure
-    from walkerlab.models.description import WalkerData
+    from walkerlab.models.hybrid.compass_gait import compass_gait_structure
+    from walkerlab.walker.description import WalkerData
 
     st = compass_gait_structure()
     vals = {"g": g, "L": L, "gamma": phi, "M_hip": MH, "m_mass": m, "d_mass": L - a}
@@ -147,7 +147,7 @@ class ContactWalker:
     continuous : bool
         Ground everywhere (no lanes/gaps).
     data : WalkerData, optional
-        Any walker description (:func:`walkerlab.models.description.walker_data`).
+        Any walker description (:func:`walkerlab.walker.description.walker_data`).
     knee_stop : KneeStopSI, optional
         Knee-stop law (kneed walkers; default :class:`KneeStopSettings` ()).
     flat_foot : (float, float), optional
@@ -160,7 +160,7 @@ class ContactWalker:
     ValueError
         A body of the walker has mass 0 (a floating (contact) model needs positive leg
         masses); flat feet without ``flat_foot``
-        (:data:`walkerlab.models.floating.FLAT_FOOT_MESSAGE`).
+        (:data:`walkerlab.codegen.floating.FLAT_FOOT_MESSAGE`).
     """
 
     L: float = 1.0
@@ -181,7 +181,7 @@ class ContactWalker:
     flat_foot: tuple[float, float] | None = None
 
     def __post_init__(self):
-        from walkerlab.models.floating import check_masses, coordinate_names, floating_params
+        from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params
 
         from .generated import NPC, contact_module
 
@@ -259,7 +259,7 @@ class ContactWalker:
 
     @property
     def structure(self):
-        """The walker's :class:`~walkerlab.models.description.Structure`."""
+        """The walker's :class:`~walkerlab.walker.description.Structure`."""
         return self.data.structure
 
     @property
@@ -304,7 +304,7 @@ class ContactWalker:
         return len(self._coords)
 
     def coordinate_names(self) -> tuple[str, ...]:
-        """Floating coordinates (:func:`walkerlab.models.floating.coordinate_names`)."""
+        """Floating coordinates (:func:`walkerlab.codegen.floating.coordinate_names`)."""
         return self._coords
 
     def state_names(self) -> tuple[str, ...]:
@@ -318,14 +318,14 @@ class ContactWalker:
         return u + tuple(f"{s}/s" for s in u)
 
     def layout(self):
-        """The floating state layout (:class:`walkerlab.models.layout.StateLayout`)."""
-        from walkerlab.models.layout import StateLayout
+        """The floating state layout (:class:`walkerlab.walker.layout.StateLayout`)."""
+        from walkerlab.walker.layout import StateLayout
 
         return StateLayout.floating(self._coords, self.state_names(), self.state_units())
 
     def rigid_layout(self):
         """The layout of the rigid hybrid view of the same walker (its ideal states)."""
-        from walkerlab.models.layout import StateLayout
+        from walkerlab.walker.layout import StateLayout
 
         return StateLayout.rigid(self.structure.roles)
 
@@ -338,7 +338,7 @@ class ContactWalker:
     # ------------------------------------------------------------------ dynamics
     @property
     def kernel_lanes(self) -> tuple[np.ndarray, np.ndarray]:
-        """The lanes as the kernels read them (:mod:`walkerlab.contact.generated`): leg1's
+        """The lanes as the kernels read them (:mod:`walkerlab.models.contact.generated`): leg1's
         and leg2's ``[centres (n), heights (n), largest height]`` (2 n + 1,) [m]."""
         return self._kernel_lane1, self._kernel_lane2
 
@@ -399,7 +399,7 @@ class ContactWalker:
         leg's scale multiplies its foot's rate too);
         other coordinate schemes through the rigid model's leg angles.
         """
-        from walkerlab.models.layout import floating_links_from_rigid
+        from walkerlab.walker.layout import floating_links_from_rigid
 
         x = np.asarray(x_ideal, float)
         st = self.structure
@@ -416,7 +416,7 @@ class ContactWalker:
                                                + values["stance_ankle_angle"])
                 values["stance_foot_rate"] = values["stance_rate"] + values["stance_ankle_rate"]
         else:
-            from walkerlab.models.cache import functions
+            from walkerlab.codegen.cache import functions
 
             values = functions(self.data)["leg_angles"](x)
         return floating_links_from_rigid(values, self.layout(), rate_scale)
@@ -545,7 +545,7 @@ class ContactWalker:
     # ------------------------------------------------------------------ compiled integrators
     def pack(self) -> np.ndarray:
         """Data vector ``[n1, n2, PC, p, c1, c2, nfev=0]`` of the compiled right-hand side
-        (:mod:`walkerlab.contact.generated`)."""
+        (:mod:`walkerlab.models.contact.generated`)."""
         k1, k2 = self.kernel_lanes
         return np.concatenate([[len(k1), len(k2)], self.contact_params,
                                self.walker_params, k1, k2, [0.0]]

@@ -1,7 +1,7 @@
 """Compiled right-hand sides of a walker's flow: numba ``cfunc``s for CyRK's C++ integrators.
 
-The source comes from :func:`walkerlab.models.codegen.generate_compiled` (the same symbolic
-equations as the Python module of :mod:`walkerlab.models.cache`) and is cached next to it as
+The source comes from :func:`walkerlab.codegen.source.generate_compiled` (the same symbolic
+equations as the Python module of :mod:`walkerlab.codegen.cache`) and is cached next to it as
 ``<key>_nb.py`` in the per-user cache (same key, same ownership/mode and sha256 checks,
 atomic write).  It is imported as a real module so that numba's own disk cache
 (``cache=True``, in ``<user cache>/numba``, :func:`walkerlab.usercache.use_for_numba`) keeps
@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.models import cache
+from walkerlab.codegen import cache
 
 
 def compiled_module(structure):
@@ -31,7 +31,8 @@ def compiled_module(structure):
     key = cache.cache_key(structure)
 
     def build() -> str:
-        from walkerlab.models import codegen, symbolic
+        from walkerlab.codegen import source as codegen
+        from walkerlab.codegen import symbolic
 
         return codegen.generate_compiled(symbolic.derive(structure), structure.param_names, key)
 

@@ -1,11 +1,11 @@
 """Compliant-contact force laws of MSC ADAMS (STEP, IMPACT, Coulomb friction).
 
 All functions are pure and vectorized (numpy broadcasting).  They are unit-agnostic: the
-caller must pass every argument in one consistent unit system (``walkerlab.contact`` uses SI
+caller must pass every argument in one consistent unit system (``walkerlab.models.contact`` uses SI
 internally).  The contact model's parameters in SI (:class:`ContactParamsSI`,
 :class:`KneeStopSI`) come from a scene's settings, each number converted from the unit its
 field names, by :func:`contact_params_si` and :func:`knee_stop_si`; the stiffness family is
-applied on top by :func:`walkerlab.contact.rigid_limit.contact_si`, once per run.
+applied on top by :func:`walkerlab.models.contact.rigid_limit.contact_si`, once per run.
 
 Sources
 -------
@@ -14,7 +14,7 @@ Sources
   and friction transition velocities.
 * /work/shared/NOTES.md, section "The MSC ADAMS model", which restates these laws.
 
-Scalar, numba-compiled twins of these functions live in :mod:`walkerlab.contact._kernels`;
+Scalar, numba-compiled twins of these functions live in :mod:`walkerlab.models.contact._kernels`;
 ``tests/contact/test_laws.py`` checks that both agree.
 """
 
@@ -102,7 +102,8 @@ class KneeStopSI:
 
 def contact_params_si(settings: ContactSettings) -> ContactParamsSI:
     """The contact law of ``settings`` in SI, each number converted from the unit its field
-    names (the stiffness family not applied: :func:`walkerlab.contact.rigid_limit.contact_si`).
+    names (the stiffness family not applied:
+    :func:`walkerlab.models.contact.rigid_limit.contact_si`).
 
     With ``f`` the metres per length unit of a field's name (1e-3 for ``..._mm``, 1 for
     ``..._m``): ``k_SI = k * f**-e``, ``c_SI = c / f``, lengths and velocities ``* f``.  E.g.

@@ -1,8 +1,8 @@
 """The floating view of a walker: the same bodies, links and feet as the rigid hybrid model
-(:mod:`walkerlab.models.symbolic`), with no foot pinned (what the compliant-contact model
+(:mod:`walkerlab.codegen.symbolic`), with no foot pinned (what the compliant-contact model
 integrates).  Derived symbolically (sympy) from the
-:class:`~walkerlab.models.description.Structure`, emitted as numba-compiled code, cached on
-disk through :mod:`walkerlab.models.cache`.
+:class:`~walkerlab.walker.description.Structure`, emitted as numba-compiled code, cached on
+disk through :mod:`walkerlab.codegen.cache`.
 
 Conventions (shared with the rigid view and the contact model)
 --------------------------------------------------------------
@@ -70,7 +70,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.models.description import Structure, WalkerData
+from walkerlab.walker.description import Structure, WalkerData
 
 __all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "MASSLESS_MESSAGE", "FloatingEquations",
            "FloatingView", "check_masses", "contact_names", "coordinate_names",
@@ -457,7 +457,7 @@ def generate_floating(eq: FloatingEquations, key: str) -> str:
     body += ["def energies(X, p):", "    d = _energies(X, p)",
              "    return d['kinetic'], d['potential']", ""]
     body += _numpy_fn("points", eq, eq.points)
-    head = [f"# walkerlab generated floating model code (walkerlab.models.floating); key {key}",
+    head = [f"# walkerlab generated floating model code (walkerlab.codegen.floating); key {key}",
             "# Do not edit: regenerated when the walker description or the generator changes.",
             "from math import sin, cos, tan, sqrt  # noqa: F401",
             "import numpy  # noqa: F401", "import numpy as np", "from numba import njit", "",
@@ -478,7 +478,7 @@ def _source_hash(paths) -> str:
 def module_key(structure: Structure, tag: str, sources=()) -> str:
     """Cache key: the rigid generator's key of ``structure`` (structure + generator + sympy),
     this file and ``sources`` (files whose text is part of the module), and ``tag``."""
-    from walkerlab.models import cache
+    from walkerlab.codegen import cache
 
     h = hashlib.sha256(cache.cache_key(structure).encode())
     h.update(tag.encode())
@@ -489,8 +489,8 @@ def module_key(structure: Structure, tag: str, sources=()) -> str:
 def load_generated(structure: Structure, tag: str, build, sources=()):
     """Import the generated module ``<key>_<tag>.py`` of the cache folder, writing it with
     ``build(key) -> str`` on a miss (or a damaged or untrusted file): one mechanism with the
-    rigid compiled flows, :func:`walkerlab.models.cache.import_generated`."""
-    from walkerlab.models import cache
+    rigid compiled flows, :func:`walkerlab.codegen.cache.import_generated`."""
+    from walkerlab.codegen import cache
 
     key = module_key(structure, tag, sources)
     return cache.import_generated(f"{key}_{tag}.py", f"walkerlab_{tag}_{key}",

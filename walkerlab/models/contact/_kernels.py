@@ -2,10 +2,10 @@
 Coulomb friction with stiction, patch membership and height).
 
 Internal module.  Everything is SI.  These are the scalar twins of the vectorised laws in
-:mod:`walkerlab.contact.laws` (``tests/contact/test_laws_config.py`` checks both agree); the
+:mod:`walkerlab.models.contact.laws` (``tests/contact/test_laws_config.py`` checks both agree); the
 walker's mechanics (mass matrix, bias, contact points and Jacobians) is generated from the
-walker description (:mod:`walkerlab.models.floating`) and assembled with these laws in
-:mod:`walkerlab.contact.generated`.  The hand-written floating compass gait that lived here
+walker description (:mod:`walkerlab.codegen.floating`) and assembled with these laws in
+:mod:`walkerlab.models.contact.generated`.  The hand-written floating compass gait that lived here
 retired after the generated one was shown equal to it (rhs 5e-16, Jacobian 1.8e-14 relative,
 issue 17); the independent numpy check is ``tests/independent/contact_reference.py``.
 """
@@ -63,7 +63,7 @@ def patch_height(s, lane, hw, continuous):
 
     ``lane`` (2 n + 1,): the centres [m] of the lane's n patches, their heights [m], and
     their largest height [m] (the kernel lane of
-    :meth:`walkerlab.contact.model.ContactWalker.kernel_lanes`).  Continuous ground: 0."""
+    :meth:`walkerlab.models.contact.model.ContactWalker.kernel_lanes`).  Continuous ground: 0."""
     if continuous:
         return 0.0
     n = (lane.shape[0] - 1) // 2

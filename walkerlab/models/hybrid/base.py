@@ -126,7 +126,7 @@ class Phase:
     ``(t, [x, Phi.ravel()]) -> [flow(t, x), (jacobian(t, x) @ Phi).ravel()]`` (2n + 4n^2,).
 
     ``compiled`` (optional) is a handle on the same flow compiled for CyRK's C++ integrators
-    (:class:`walkerlab.models.compiled.CompiledFlow`: ``address(variational)``, ``data()``),
+    (:class:`walkerlab.codegen.compiled.CompiledFlow`: ``address(variational)``, ``data()``),
     used by the ``cyrk_compiled`` solver backend.
     """
 
@@ -224,21 +224,21 @@ class HybridWalker:
         return len(self.roles)
 
     def layout(self):
-        """The state layout (:class:`walkerlab.models.layout.StateLayout`): names, units,
+        """The state layout (:class:`walkerlab.walker.layout.StateLayout`): names, units,
         q / qd slices and legs of the role-ordered state (2n,)."""
-        from walkerlab.models.layout import StateLayout
+        from walkerlab.walker.layout import StateLayout
 
         return StateLayout.rigid(self.roles)
 
     def state_names(self) -> list[str]:
         """Role-ordered state names, e.g. ``['swing_angle', 'stance_angle', 'swing_rate', ...]``."""
-        from walkerlab.models.description import state_names
+        from walkerlab.walker.description import state_names
 
         return state_names(self.roles)
 
     def state_units(self) -> list[str]:
         """Units of :meth:`state_names` (every coordinate is an angle)."""
-        from walkerlab.models.description import state_units
+        from walkerlab.walker.description import state_units
 
         return state_units(self.roles)
 

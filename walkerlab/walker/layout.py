@@ -82,7 +82,7 @@ class StateLayout:
     @classmethod
     def floating(cls, coordinates, names, units) -> StateLayout:
         """Layout of a floating (contact) view: ``coordinates`` as
-        :func:`walkerlab.models.floating.coordinate_names`, ``names`` and ``units`` (2n,) as
+        :func:`walkerlab.codegen.floating.coordinate_names`, ``names`` and ``units`` (2n,) as
         the contact walker's ``state_names()`` / ``state_units()``."""
         return cls(tuple(coordinates), tuple(names), tuple(units))
 

@@ -1,5 +1,5 @@
 """Python source of a walker's equations, generated from
-:class:`~walkerlab.models.symbolic.Equations`.
+:class:`~walkerlab.codegen.symbolic.Equations`.
 
 The generated module defines one function, ``make(p) -> dict[str, callable]``, that binds the
 parameter vector ``p`` (``Structure.param_names`` order) in closures.  The hot functions
@@ -36,7 +36,7 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
-from walkerlab.models.symbolic import Equations
+from walkerlab.codegen.symbolic import Equations
 
 _PY = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
 _NP = NumPyPrinter({"fully_qualified_modules": True})
@@ -380,7 +380,7 @@ def generate(eq: Equations, param_names, key: str) -> str:
         "    return {k: v for k, v in locals().items() if callable(v) and not k.startswith('_')}",
     ]
     head = [
-        f"# walkerlab generated model code (walkerlab.models.codegen); key {key}",
+        f"# walkerlab generated model code (walkerlab.codegen.source); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
         "from math import sin, cos, tan, sqrt  # noqa: F401",
         "import numpy  # noqa: F401",
@@ -458,7 +458,7 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
         body += _cfunc(k, e, consts, parts[k], False, guards) + [""]
         body += _cfunc(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
     head = [
-        f"# walkerlab compiled model code (walkerlab.models.codegen); key {key}",
+        f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
         "from math import sin, cos, tan, sqrt  # noqa: F401",
         "import numpy as np",

@@ -1,5 +1,5 @@
 """The compliant-contact (MSC ADAMS-style) walker model of any walker description with positive
-leg masses (generated from its floating view, :mod:`walkerlab.models.floating`): contact laws,
+leg masses (generated from its floating view, :mod:`walkerlab.codegen.floating`): contact laws,
 geometry, terrain, knee stops and the floating walker.  Only the model: integrating it is
 :mod:`walkerlab.integrate.contact`, reading its gait :mod:`walkerlab.analysis.contact_gait` /
 :mod:`walkerlab.analysis.contact_sim`, its settings live in :mod:`walkerlab.config.contact`.

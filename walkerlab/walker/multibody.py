@@ -1,6 +1,6 @@
 """The walker as a tree of rigid links (for multibody libraries: URDF, MJCF).
 
-From the one walker description (:func:`walkerlab.models.description.walker_data`) this
+From the one walker description (:func:`walkerlab.walker.description.walker_data`) this
 module builds the floating planar multibody walker that Drake, Pinocchio or MuJoCo load:
 
 - a **base**, the hip: it translates in x (downhill, horizontal) and y (up) and never rotates;
@@ -39,7 +39,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from walkerlab.models.description import WalkerData
+from walkerlab.walker.description import WalkerData
 
 __all__ = ["Coupling", "Link", "Multibody", "Spring", "multibody"]
 
@@ -207,7 +207,7 @@ def multibody(data: WalkerData) -> Multibody:
     Parameters
     ----------
     data : WalkerData
-        From :func:`walkerlab.models.description.walker_data`.
+        From :func:`walkerlab.walker.description.walker_data`.
 
     Returns
     -------

@@ -9,14 +9,14 @@ cos theta2)`` (A.1-A.3).  The walker walks in +x down a slope of angle ``phi``.
 Three pure pieces (as in Drake's ``examples/compass_gait``):
 
 - flow   :func:`flow`        ``M(q) qdd + C(q, dq) dq + G(q) = 0`` (Eq. 3-4)
-- guard  generated with the flow (:func:`walkerlab.models.rigid.make_rigid_walker`:
+- guard  generated with the flow (:func:`walkerlab.models.hybrid.rigid.make_rigid_walker`:
          ``heel_strike`` armed in late swing, after ``midstance``); :func:`swing_foot_height`
          is the geometry both factors of it come from
 - reset  :func:`impact`       plastic impact and role swap (Eq. 6-8, A.41-A.57)
 
 The ``derived`` equations are not written here: the compass gait is the generic biped of
-:mod:`walkerlab.models.description` (hip point mass, one point mass per leg) and its code is
-generated and cached (:mod:`walkerlab.models.symbolic`, :mod:`walkerlab.models.codegen`).
+:mod:`walkerlab.walker.description` (hip point mass, one point mass per leg) and its code is
+generated and cached (:mod:`walkerlab.codegen.symbolic`, :mod:`walkerlab.codegen.source`).
 This module keeps the paper's *printed* equations (Appendix A) for comparison.
 
 Equation variants
@@ -36,7 +36,7 @@ from functools import cache, partial
 
 import numpy as np
 
-from walkerlab.models.base import HybridWalker, complex_step_jacobian
+from walkerlab.models.hybrid.base import HybridWalker, complex_step_jacobian
 
 VARIANTS = ("derived", "appendix_a", "appendix_a_literal")
 
@@ -178,8 +178,8 @@ def points(x: np.ndarray, p: tuple) -> dict[str, np.ndarray]:
 # --------------------------------------------------------------------------- builder
 def compass_gait_structure():
     """The compass gait (paper A.1-A.3) as a generic biped structure: a hip point mass and one
-    point mass per leg (:class:`~walkerlab.models.description.Structure`)."""
-    from walkerlab.models.description import BodySpec, Structure
+    point mass per leg (:class:`~walkerlab.walker.description.Structure`)."""
+    from walkerlab.walker.description import BodySpec, Structure
 
     return Structure("absolute", (BodySpec("mass", "point_mass"),))
 
@@ -187,7 +187,7 @@ def compass_gait_structure():
 def _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_from_foot_m,
           slope_rad):
     from walkerlab.config import CompassGaitParams
-    from walkerlab.models.description import walker_data
+    from walkerlab.walker.description import walker_data
 
     w = CompassGaitParams(leg_length_m=leg_length_m, leg_mass_kg=leg_mass_kg,
                           hip_mass_kg=hip_mass_kg, gravity_m_per_s2=gravity_m_per_s2,
@@ -198,7 +198,7 @@ def _data(leg_length_m, leg_mass_kg, hip_mass_kg, gravity_m_per_s2, leg_mass_fro
 @cache
 def _generated(p: tuple) -> dict:
     """Generated functions for ``p = (m, M_H, L, a, g)`` (slope 0: flow, impact, energies)."""
-    from walkerlab.models.cache import functions
+    from walkerlab.codegen.cache import functions
 
     m, mh, L, a, g = p
     return functions(_data(L, m, mh, g, a, 0.0))
@@ -210,7 +210,7 @@ def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: floa
     """Build the compass-gait :class:`HybridWalker` (all arguments SI).
 
     ``derived`` is the generic biped (generated code); the ``appendix_a`` variants use the
-    printed flow A.4-A.6 (generated too, see :class:`~walkerlab.models.description.Structure`)
+    printed flow A.4-A.6 (generated too, see :class:`~walkerlab.walker.description.Structure`)
     and, for ``appendix_a_literal``, the impact with A.55 as printed (Jacobian by complex
     step).
 
@@ -219,7 +219,7 @@ def make_compass_gait(leg_length_m: float, leg_mass_kg: float, hip_mass_kg: floa
     ValueError
         Unknown ``variant``.
     """
-    from walkerlab.models.rigid import make_rigid_walker
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     if variant not in VARIANTS:
         raise ValueError(f"ideal.variant: unknown variant {variant!r}; choose from {VARIANTS}")

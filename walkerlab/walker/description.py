@@ -40,7 +40,7 @@ class BodySpec:
         return out + ["off_axis"] if self.off_axis else out
 
 
-#: Stance-foot modes of a flat foot, in the order a step meets them (models/flatfoot.py).
+#: Stance-foot modes of a flat foot, in the order a step meets them (codegen/flatfoot.py).
 FLAT_FOOT_MODES = ("heel_contact", "foot_flat", "heel_off")
 #: Short role tags of per-leg parameters (``m_sw_<body>``) when the legs differ.
 ROLE_TAG = {"swing": "sw", "stance": "st"}

@@ -48,7 +48,7 @@ from functools import cache
 
 import sympy as sp
 
-from walkerlab.models.description import ROLE_TAG, Structure
+from walkerlab.walker.description import ROLE_TAG, Structure
 
 #: coordinate of ``q`` eliminated on the heel-strike surface (the rest parametrise the section)
 SECTION_DROP = {"absolute": 0, "slope_relative": 1}

@@ -1,9 +1,9 @@
-"""Build a :class:`~walkerlab.models.base.HybridWalker` from generated model code.
+"""Build a :class:`~walkerlab.models.hybrid.base.HybridWalker` from generated model code.
 
-Any biped described as data (:mod:`walkerlab.models.description`) becomes a walker here: the
+Any biped described as data (:mod:`walkerlab.walker.description`) becomes a walker here: the
 flow, its Jacobian, guards and their gradients, the heel-strike reset and its Jacobian,
 energies, points and leg angles all come from the generated module
-(:mod:`walkerlab.models.codegen`, cached by :mod:`walkerlab.models.cache`).
+(:mod:`walkerlab.codegen.source`, cached by :mod:`walkerlab.codegen.cache`).
 
 Phases of a step (point feet, straight legs):
 
@@ -14,7 +14,7 @@ Phases of a step (point feet, straight legs):
   zero: the swing foot reaches the slope), or a fall: the swing leg falls back behind the
   stance leg, or the hip reaches the slope.
 
-Flat feet on ankle springs have their own phase graph (:mod:`walkerlab.models.rigid_flat`).
+Flat feet on ankle springs have their own phase graph (:mod:`walkerlab.models.hybrid.rigid_flat`).
 
 Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen 2007):
 
@@ -38,11 +38,11 @@ from __future__ import annotations
 from dataclasses import replace
 from functools import partial
 
-from walkerlab.models.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
-from walkerlab.models.cache import functions
-from walkerlab.models.compiled import CompiledFlow
-from walkerlab.models.description import WalkerData
-from walkerlab.models.rigid_flat import make_flat_walker
+from walkerlab.codegen.cache import functions
+from walkerlab.codegen.compiled import CompiledFlow
+from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
+from walkerlab.models.hybrid.rigid_flat import make_flat_walker
+from walkerlab.walker.description import WalkerData
 
 #: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
 SCUFF_DEPTH = 1e-9

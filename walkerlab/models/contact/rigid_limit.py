@@ -42,7 +42,7 @@ impact's duration: expected order ``1/(e+1)`` per factor of ``kappa`` (0.3125 fo
 i.e. a factor ``10^0.3125 = 2.05`` per decade, issue 25's measured +3.62 / +1.46 / +0.80 /
 +0.42 / +0.20 / +0.098 / +0.048 ms for kappa = 1 ... 1e6).
 
-The knee latch of kneed walkers (:mod:`walkerlab.contact.generated`) releases when the
+The knee latch of kneed walkers (:mod:`walkerlab.models.contact.generated`) releases when the
 foot rises ``latch_height`` above the ground; a fixed height (2 mm) leaves a
 stiffness-independent gap (kneed: 0.548518 s at any stiffness, 0.546596 s at 0.5 mm, rigid
 0.54642 s), so it follows the contact's length scale ``d*`` too.
@@ -109,11 +109,11 @@ def scale(contact: ContactParamsSI, knee: KneeStopSI, kappa: float
 
 def contact_si(settings: ContactSettings) -> tuple[ContactParamsSI, KneeStopSI]:
     """The scene's contact and knee stop in SI, with its ``stiffness_family`` applied: the
-    contact model's parameters of a run (built once per run, :func:`walkerlab.contact.scene.
+    contact model's parameters of a run (built once per run, :func:`walkerlab.models.contact.scene.
     build`).
 
     ``stiffness_family: paper`` returns the numbers as written, converted to SI
-    (:func:`walkerlab.contact.laws.contact_params_si`).  ``rigid_limit`` reads the maximum
+    (:func:`walkerlab.models.contact.laws.contact_params_si`).  ``rigid_limit`` reads the maximum
     damping, the penetration at maximum damping, the transition velocities and the latch
     height as holding at the reference stiffness and applies :func:`scale` with
     ``kappa = stiffness / reference stiffness`` (the ratio of the numbers as written when
@@ -136,7 +136,7 @@ def contact_si(settings: ContactSettings) -> tuple[ContactParamsSI, KneeStopSI]:
 
 
 def scale_walker(walker, kappa: float):
-    """Copy of a :class:`~walkerlab.contact.model.ContactWalker` whose contact (and knee
+    """Copy of a :class:`~walkerlab.models.contact.model.ContactWalker` whose contact (and knee
     latch) is ``kappa`` times stiffer along the family (:func:`scale`)."""
     contact, knee = scale(walker.contact, walker.knee_stop, kappa)
     return dataclasses.replace(walker, contact=contact, knee_stop=knee)

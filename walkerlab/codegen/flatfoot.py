@@ -1,6 +1,6 @@
 """Flat feet on ankle springs: the rigid hybrid view's modes, derived with sympy from a
-:class:`~walkerlab.models.description.Structure` (``foot == "flat"``) and written as Python
-source (the same ``make(p)`` module form as :mod:`walkerlab.models.codegen`, through its
+:class:`~walkerlab.walker.description.Structure` (``foot == "flat"``) and written as Python
+source (the same ``make(p)`` module form as :mod:`walkerlab.codegen.source`, through its
 printers and solvers).
 
 Coordinates ``q = (swing, stance, stance_ankle)``: the absolute leg angles (from the
@@ -51,10 +51,10 @@ from functools import cache
 
 import sympy as sp
 
-from walkerlab.models import codegen
-from walkerlab.models.codegen import _PY, IND, _cse_lines, _flow, _numpy_fn, _reset
-from walkerlab.models.description import ROLE_TAG, Structure
-from walkerlab.models.symbolic import _dot_terms, _pos, _velocity_terms
+from walkerlab.codegen import source as codegen
+from walkerlab.codegen.source import _PY, IND, _cse_lines, _flow, _numpy_fn, _reset
+from walkerlab.codegen.symbolic import _dot_terms, _pos, _velocity_terms
+from walkerlab.walker.description import ROLE_TAG, Structure
 
 #: Index of the stance ankle's angle in ``q``.
 ANKLE = 2
@@ -386,7 +386,7 @@ def generate_flat(structure: Structure, key: str) -> str:
         "    return {k: v for k, v in locals().items() if callable(v) and not k.startswith('_')}",
     ]
     head = [
-        f"# walkerlab generated model code (walkerlab.models.flatfoot); key {key}",
+        f"# walkerlab generated model code (walkerlab.codegen.flatfoot); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
         "from math import sin, cos, tan, sqrt, pi  # noqa: F401",
         "import numpy  # noqa: F401",

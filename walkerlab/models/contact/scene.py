@@ -103,8 +103,8 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).
     """
-    from walkerlab.models.description import walker_data
-    from walkerlab.models.floating import FLAT_FOOT_MESSAGE, check_masses
+    from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, check_masses
+    from walkerlab.walker.description import walker_data
 
     contact, terrain, cs, _ = settings(scene)
     data = walker_data(scene.walker, scene.slope.phi_rad)
