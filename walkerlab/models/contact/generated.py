@@ -90,8 +90,8 @@ ASSEMBLY = '''
 # ---------------------------------------------------------------- contact assembly
 # (walkerlab.models.contact.generated.ASSEMBLY: walker-independent; laws from contact._kernels)
 from math import sin as _sin, cos as _cos
-from walkerlab.models.contact._kernels import normal_force, friction_mu, in_patch, patch_height,
-step
+from walkerlab.models.contact._kernels import (normal_force, friction_mu, in_patch,
+                                               patch_height, step)
 
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
