@@ -157,8 +157,8 @@ def test_robustness_contact_steps_only_when_asked(paper_scene):
     without a contact section: one line naming it."""
     import math
 
-    from walkerlab.analysis.robustness import contact_steps
     from walkerlab.config import RobustnessSettings
+    from walkerlab.sweep.robustness_study import contact_steps
 
     off = contact_steps(paper_scene, None, RobustnessSettings(), 0.05)
     assert len(off) == 4 and all(math.isnan(v) for v in off.values())
