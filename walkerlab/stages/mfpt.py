@@ -14,21 +14,19 @@ gait are the same (pieces are named by sigma: a rerun with other ``--sigma-rad``
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
 
 from walkerlab.config import CommandOptions, MfptSettings, Scene, validate_option
-from walkerlab.io.runpaths import artifact_lock, stage_artifact
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,
-    _tell,
     artifact_path,
     input_hash,
     require,
+    run_cached,
 )
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt")
@@ -99,54 +97,42 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     st, workers = check(scene, sigma_rad, method, workers)
     up = artifact_path(scene, runs_root, "fixedpoint")
-    path = stage_artifact(scene, runs_root, "mfpt", claim=True)
-    with artifact_lock(path, wait=True, on_wait=_tell):
-        return _run_locked(scene, runs_root, force, st, workers, scheduler, up, path)
+    path = artifact_path(scene, runs_root, "mfpt")
+    done = []  # the resume file, removed once the artifact is written
 
+    def work():
+        from walkerlab.io.mfpt_partial import MfptPartial
+        from walkerlab.io.schemas import mfpt as schema
 
-def _run_locked(scene, runs_root, force, st, workers, scheduler, up, path) -> StageOutcome:
-    from walkerlab.io.artifacts import verified_hash, write_artifact
-    from walkerlab.io.schemas import mfpt as schema
+        x_star = load_fixedpoint(up).x
+        # finished pieces of an interrupted run with the same scene sections and gait are
+        # kept (--force: none); pieces are named by sigma, so another --sigma-rad list or
+        # --method reuses the pieces it shares
+        partial = MfptPartial(path.with_name(path.name + ".partial"),
+                              input_hash("mfpt", scene, SECTIONS, (up,), extra="resume"),
+                              resume=not force)
+        try:
+            data = compute(scene, x_star, st, workers, scheduler, partial)
+        except ValueError as exc:  # bad input: nothing to resume
+            partial.remove()
+            raise StageError(str(exc)) from None
+        finally:
+            partial.close()
+        done.append(partial)
+        summary = {"sigma_rad": list(map(float, data.sigma_rad)),
+                   "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
+                   "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"]))}
+        return (lambda f: schema.write(f, data)), summary
 
-    key = input_hash("mfpt", scene, SECTIONS, (up,),
-                     extra=f"sigma={st.sigma_rad};method={st.method}")
-    if not force and path.is_file() and verified_hash(path) == key:
-        if not figure_path(scene, runs_root).is_file():
-            draw(scene, runs_root)
-        return StageOutcome("mfpt", path, True, 0.0, {})
-    note = ""
-    if not force and path.is_file():
-        from walkerlab.stages.common import recompute_reason
-
-        note = recompute_reason(path, scene, SECTIONS, verified_hash(path))
-        _tell(f"mfpt: recomputing {path} ({note})")
-    from walkerlab.io.mfpt_partial import MfptPartial
-
-    x_star = load_fixedpoint(up).x
-    t0 = time.perf_counter()
-    # finished pieces of an interrupted run with the same scene sections and gait are kept
-    # (--force: none); pieces are named by sigma, so another --sigma-rad list or --method
-    # reuses the pieces it shares
-    partial = MfptPartial(path.with_name(path.name + ".partial"),
-                          input_hash("mfpt", scene, SECTIONS, (up,), extra="resume"),
-                          resume=not force)
-    try:
-        data = compute(scene, x_star, st, workers, scheduler, partial)
-    except ValueError as exc:  # bad input: nothing to resume
+    out = run_cached("mfpt", scene, runs_root, SECTIONS, (up,), work, force,
+                     {"workers": workers if scheduler is None else 0,
+                      "scheduler": str(scheduler or "")},
+                     extra_key=f"sigma={st.sigma_rad};method={st.method}")
+    for partial in done:
         partial.remove()
-        raise StageError(str(exc)) from None
-    finally:
-        partial.close()
-    wall = time.perf_counter() - t0
-    write_artifact(path, "mfpt", scene, key, lambda f: schema.write(f, data), wall,
-                   {"workers": workers if scheduler is None else 0,
-                    "scheduler": str(scheduler or "")})
-    partial.remove()
-    draw(scene, runs_root)
-    summary = {"sigma_rad": list(map(float, data.sigma_rad)),
-               "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
-               "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"]))}
-    return StageOutcome("mfpt", path, False, wall, summary, note)
+    if not out.reused or not figure_path(scene, runs_root).is_file():
+        draw(scene, runs_root)
+    return out
 
 
 def compute(scene: Scene, x_star: np.ndarray, st: MfptSettings, workers: int = 1,
