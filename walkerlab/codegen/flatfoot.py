@@ -52,8 +52,8 @@ from functools import cache
 import sympy as sp
 
 from walkerlab.codegen import source as codegen
-from walkerlab.codegen.source import _PY, IND, _cse_lines, _flow, _numpy_fn, _reset
-from walkerlab.codegen.symbolic import _dot_terms, _pos, _velocity_terms
+from walkerlab.codegen.source import IND, PRINTER, cse_lines, flow_lines, numpy_fn, reset_lines
+from walkerlab.codegen.symbolic import dot_terms, position_of, velocity_terms
 from walkerlab.walker.description import ROLE_TAG, Structure
 
 #: Index of the stance ankle's angle in ``q``.
@@ -70,7 +70,8 @@ HEEL_OFF_PHI_RAD = 1e-12
 
 @dataclass(frozen=True)
 class _System:
-    """What :func:`codegen._flow` / :func:`codegen._reset` read (duck-typed Equations)."""
+    """What :func:`~walkerlab.codegen.source.flow_lines` and
+    :func:`~walkerlab.codegen.source.reset_lines` read (duck-typed Equations)."""
 
     q: tuple
     dq: tuple
@@ -204,17 +205,17 @@ def derive_flat(structure: Structure) -> FlatEquations:
         bodies, hip, sw_ankle = bodies_from(ankle_lin)
 
         def at(lin, _off=off):
-            return _pos(lin) + _off
+            return position_of(lin) + _off
         M = sp.zeros(3, 3)
         V = k_a * (a - r_a) ** 2 / 2
         F = sp.zeros(2, 1)
         mom = sp.Integer(0)
         for mass, lin, inertia, psi, _name in bodies:
-            d = _velocity_terms(lin, q)
+            d = velocity_terms(lin, q)
             w = sp.Matrix([[sp.diff(psi, s) for s in q]])
             for i in range(3):
                 for j in range(3):
-                    M[i, j] += mass * _dot_terms(d[i], d[j])
+                    M[i, j] += mass * dot_terms(d[i], d[j])
             M += inertia * w.T * w
             pos = at(lin)
             V += mass * g * pos[1]
@@ -286,13 +287,13 @@ def derive_flat(structure: Structure) -> FlatEquations:
         Mi, Bm = sp.zeros(3, 3), sp.zeros(3, 3)
         for mass, lin, inertia, psi, name in pre_bodies:
             pmass, plin, pinertia, ppsi, _n = post[name]
-            dn, dl = _velocity_terms(plin, post_q), _velocity_terms(lin, q)
+            dn, dl = velocity_terms(plin, post_q), velocity_terms(lin, q)
             wn = sp.Matrix([[sp.diff(ppsi, s) for s in post_q]])
             wl = sp.Matrix([[sp.diff(psi, s) for s in q]])
             for i in range(3):
                 for j in range(3):
-                    Mi[i, j] += mass * _dot_terms(dn[i], dn[j])
-                    Bm[i, j] += mass * _dot_terms(dn[i], dl[j])
+                    Mi[i, j] += mass * dot_terms(dn[i], dn[j])
+                    Bm[i, j] += mass * dot_terms(dn[i], dl[j])
             Mi += inertia * wn.T * wn
             Bm += inertia * wn.T * wl
         Mi, Bm = (X.subs(b_new, rw).applyfunc(sp.factor_terms) for X in (Mi, Bm))
@@ -308,21 +309,21 @@ def derive_flat(structure: Structure) -> FlatEquations:
 
 def _scalar_fn(name: str, eq: FlatEquations, exprs: list, with_acc: bool) -> list[str]:
     """A Python function ``(t, x)`` or ``(x, qdd)`` returning a float or a tuple."""
-    lines, red = _cse_lines(exprs, _PY)
-    unpack = codegen._unpack(eq)
+    lines, red = cse_lines(exprs, PRINTER)
+    unpack = codegen.unpack(eq)
     head = [f"    def {name}(x, qdd):" if with_acc else f"    def {name}(t, x):", unpack]
     if with_acc:
         head.append(f"{IND}{', '.join(str(s) for s in eq.qdd)}, = qdd")
-    vals = [_PY.doprint(e) for e in red]
+    vals = [PRINTER.doprint(e) for e in red]
     ret = vals[0] if len(vals) == 1 and not with_acc else f"({', '.join(vals)},)"
     return head + lines + [f"{IND}return {ret}"]
 
 
 def _grad_fn(name: str, eq: FlatEquations, expr) -> list[str]:
     x = [*eq.q, *eq.dq]
-    lines, red = _cse_lines([sp.diff(expr, s) for s in x], _PY)
-    return [f"    def {name}(x):", codegen._unpack(eq), *lines,
-            f"{IND}return np.array(({', '.join(_PY.doprint(e) for e in red)},))"]
+    lines, red = cse_lines([sp.diff(expr, s) for s in x], PRINTER)
+    return [f"    def {name}(x):", codegen.unpack(eq), *lines,
+            f"{IND}return np.array(({', '.join(PRINTER.doprint(e) for e in red)},))"]
 
 
 def generate_flat(structure: Structure, key: str) -> str:
@@ -334,18 +335,15 @@ def generate_flat(structure: Structure, key: str) -> str:
     ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
     ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
     eq = derive_flat(structure)
-    codegen._HOISTED.clear()
-    codegen._PARAMS.clear()
-    codegen._PARAMS.update(eq.params)
-    codegen._COUNT[0] = 0
+    hoisted = codegen.start_module(eq.params)
     fast = []
     for mode, system in eq.flows.items():
-        fast += _flow(system, False, f"flow_{mode}")
-        fast += _flow(system, True, f"flow_{mode}_jacobian",
+        fast += flow_lines(system, False, f"flow_{mode}")
+        fast += flow_lines(system, True, f"flow_{mode}_jacobian",
                       variational=f"flow_{mode}_variational")
     for name, system in eq.resets.items():
-        fast += _reset(system, False, f"reset_{name}")
-        fast += _reset(system, True, f"reset_{name}_jacobian")
+        fast += reset_lines(system, False, f"reset_{name}")
+        fast += reset_lines(system, True, f"reset_{name}_jacobian")
     for name, expr in eq.guards.items():
         fast += _scalar_fn(f"guard_{name}", eq, [expr], False)
         fast += _grad_fn(f"grad_{name}", eq, expr)
@@ -361,11 +359,11 @@ def generate_flat(structure: Structure, key: str) -> str:
     ]
     kin = eq.kinematics
     numpy = [
-        *_numpy_fn("_points_heel", eq, kin["heel"]["points"]),
-        *_numpy_fn("_points_toe", eq, kin["toe"]["points"]),
-        *_numpy_fn("energies_heel", eq, {"kinetic": kin["heel"]["kinetic"],
+        *numpy_fn("_points_heel", eq, kin["heel"]["points"]),
+        *numpy_fn("_points_toe", eq, kin["toe"]["points"]),
+        *numpy_fn("energies_heel", eq, {"kinetic": kin["heel"]["kinetic"],
                                           "potential": kin["heel"]["potential"]}),
-        *_numpy_fn("energies_toe", eq, {"kinetic": kin["toe"]["kinetic"],
+        *numpy_fn("energies_toe", eq, {"kinetic": kin["toe"]["kinetic"],
                                          "potential": kin["toe"]["potential"]}),
         "    def _on_toe(x):  # heel off: the foot turned heel up (phi < 0)",
         f"{IND}x = np.asarray(x)",
@@ -377,12 +375,12 @@ def generate_flat(structure: Structure, key: str) -> str:
         f"{IND}toe, h, o = _on_toe(x), energies_heel(x), energies_toe(x)",
         f"{IND}return (np.where(toe, o['kinetic'], h['kinetic']),",
         f"{IND}        np.where(toe, o['potential'], h['potential']))",
-        *_numpy_fn("leg_angles", eq, eq.leg_angles),
+        *numpy_fn("leg_angles", eq, eq.leg_angles),
     ]
     body = [
         "def make(p):",
         f"    {', '.join(structure.param_names)}, = p",
-        *codegen._HOISTED, *fast, *section, *numpy,
+        *hoisted, *fast, *section, *numpy,
         "    return {k: v for k, v in locals().items() if callable(v) and not k.startswith('_')}",
     ]
     head = [

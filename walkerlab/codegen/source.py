@@ -38,7 +38,7 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from walkerlab.codegen.symbolic import Equations
 
-_PY = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
+PRINTER = PythonCodePrinter({"fully_qualified_modules": False, "standard": "python3"})
 _NP = NumPyPrinter({"fully_qualified_modules": True})
 IND = "        "
 
@@ -48,7 +48,19 @@ _PARAMS: set = set()  # the parameters and every hoisted symbol
 _COUNT = [0]
 
 
-def _cse_lines(exprs, printer):
+def start_module(params) -> list[str]:
+    """Start the source of one generated module: no hoisted lines yet, ``params`` (symbols)
+    the only parameter-only names, numbering of the common subexpressions from 0.  Returns
+    the list of hoisted lines (parameter-only subexpressions computed once in ``make(p)``),
+    filled as the module's functions are generated."""
+    _HOISTED.clear()
+    _PARAMS.clear()
+    _PARAMS.update(params)
+    _COUNT[0] = 0
+    return _HOISTED
+
+
+def cse_lines(exprs, printer):
     """``(lines, reduced)``: common subexpressions as assignments, and the reduced exprs.
 
     Subexpressions of the parameters only are moved to ``make(p)`` (closure constants)."""
@@ -65,7 +77,7 @@ def _cse_lines(exprs, printer):
     return lines, reduced
 
 
-def _unpack(eq: Equations) -> str:
+def unpack(eq: Equations) -> str:
     """Unpack ``x`` into Python floats (``tolist``: float arithmetic is faster than numpy's)."""
     names = ", ".join(str(s) for s in (*eq.q, *eq.dq))
     return (f"{IND}try:\n{IND}    {names}, = x.tolist()\n{IND}except AttributeError:\n"
@@ -84,11 +96,11 @@ def _bind(names, exprs) -> tuple[list[str], list[str]]:
             out.append("0")
         elif e.free_symbols <= _PARAMS:
             h = f"_k{_COUNT[0]}{a}"
-            _HOISTED.append(f"    {h} = {_PY.doprint(e)}")
+            _HOISTED.append(f"    {h} = {PRINTER.doprint(e)}")
             _PARAMS.add(sp.Symbol(h))
             out.append(h)
         else:
-            lines.append(f"{IND}{a} = {_PY.doprint(e)}")
+            lines.append(f"{IND}{a} = {PRINTER.doprint(e)}")
             out.append(a)
     return lines, out
 
@@ -99,13 +111,13 @@ def _solve_lines(n: int, mnames, prefix: str) -> tuple[list[str], list[list[str]
     S = sp.Matrix(n, n, lambda i, j: 0 if mnames[i][j] == "0" else sp.Symbol(mnames[i][j]))
     det = S.det(method="berkowitz")
     adj = S.adjugate()
-    lines = [f"{IND}{prefix}id = 1.0 / ({_PY.doprint(det)})"]
+    lines = [f"{IND}{prefix}id = 1.0 / ({PRINTER.doprint(det)})"]
     inv = [["0"] * n for _ in range(n)]
     for i in range(n):
         for j in range(n):
             if adj[i, j] != 0:
                 inv[i][j] = f"{prefix}{i}{j}"
-                lines.append(f"{IND}{inv[i][j]} = ({_PY.doprint(adj[i, j])}) * {prefix}id")
+                lines.append(f"{IND}{inv[i][j]} = ({PRINTER.doprint(adj[i, j])}) * {prefix}id")
     return lines, inv
 
 
@@ -124,7 +136,7 @@ def _array(rows) -> str:
     return "np.array((" + ", ".join(rows) + ",))"
 
 
-def _flow(eq: Equations, jac: bool, name: str | None = None,
+def flow_lines(eq: Equations, jac: bool, name: str | None = None,
           variational: str | None = None, parts: bool = False):
     """``flow``, or with ``jac`` its Jacobian; with ``variational`` (a name) also the
     right-hand side of the variational equations from the same lines,
@@ -140,7 +152,7 @@ def _flow(eq: Equations, jac: bool, name: str | None = None,
         exprs += [sp.diff(eq.M[i, j], q[k]) for k in range(n) for i in range(n) for j in range(n)]
         exprs += [sp.diff(r[i], q[k]) for k in range(n) for i in range(n)]
         exprs += [sp.diff(r[i], dq[k]) for k in range(n) for i in range(n)]
-    lines, red = _cse_lines(exprs, _PY)
+    lines, red = cse_lines(exprs, PRINTER)
     bound, names = _bind([f"_M{i}{j}" for i in range(n) for j in range(n)]
                          + [f"_r{i}" for i in range(n)], red[:n * n + n])
     lines += bound
@@ -151,7 +163,7 @@ def _flow(eq: Equations, jac: bool, name: str | None = None,
     qdd = [f"_a{i}" for i in range(n)]
     lines += [f"{IND}{a} = {e}" for a, e in zip(qdd, _matvec(inv, rn))]
     name = name or ("flow_jacobian" if jac else "flow")
-    head = [f"    def {name}(t, x):", _unpack(eq)]
+    head = [f"    def {name}(t, x):", unpack(eq)]
     if not jac:
         if parts:
             return lines, [str(s) for s in dq] + qdd
@@ -168,7 +180,7 @@ def _flow(eq: Equations, jac: bool, name: str | None = None,
                                       for j in range(n))
             w.append("0" if e == 0 else f"_w{k}_{i}")
             if e != 0:
-                lines.append(f"{IND}_w{k}_{i} = {_PY.doprint(e)}")
+                lines.append(f"{IND}_w{k}_{i} = {PRINTER.doprint(e)}")
         cols.append(_matvec(inv, w))
     for k in range(n):  # d qdd / d dq_k = Minv dr/d dq_k
         bound, w = _bind([f"_v{k}_{i}" for i in range(n)], dr_dq[k * n:(k + 1) * n])
@@ -200,7 +212,7 @@ def _flow(eq: Equations, jac: bool, name: str | None = None,
     return out
 
 
-def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
+def reset_lines(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     """``Mi dq+ = B dq-`` then the role swap ``q_new = relabel_q(q)``, ``dq_new = R dq+``."""
     n = len(eq.q)
     q, dq = eq.q, eq.dq
@@ -208,7 +220,7 @@ def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     if jac:
         exprs += [sp.diff(eq.Mi[i, j], q[k]) for k in range(n) for i in range(n) for j in range(n)]
         exprs += [sp.diff(eq.B[i, j], q[k]) for k in range(n) for i in range(n) for j in range(n)]
-    lines, red = _cse_lines(exprs, _PY)
+    lines, red = cse_lines(exprs, PRINTER)
     bound, names = _bind([f"_M{i}{j}" for i in range(n) for j in range(n)]
                          + [f"_B{i}{j}" for i in range(n) for j in range(n)], red[:2 * n * n])
     lines += bound
@@ -221,10 +233,10 @@ def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
     post = [f"_p{i}" for i in range(n)]
     lines += [f"{IND}{a} = {e}" for a, e in zip(post, _matvec(inv, [f"_h{i}" for i in range(n)]))]
     R = eq.relabel_rate
-    qn = [_PY.doprint(e) for e in eq.relabel_q]
-    dqn = [_PY.doprint(e) for e in R * sp.Matrix([sp.Symbol(p) for p in post])]
+    qn = [PRINTER.doprint(e) for e in eq.relabel_q]
+    dqn = [PRINTER.doprint(e) for e in R * sp.Matrix([sp.Symbol(p) for p in post])]
     name = name or ("reset_jacobian" if jac else "reset")
-    head = [f"    def {name}(x):", _unpack(eq)]
+    head = [f"    def {name}(x):", unpack(eq)]
     if not jac:
         return head + lines + [f"{IND}return {_array(qn + dqn)}"]
     k0 = 2 * n * n
@@ -235,7 +247,7 @@ def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
         for i in range(n):
             w = sum(dB[k * n * n + i * n + j] * dq[j]
                     - dMi[k * n * n + i * n + j] * sp.Symbol(post[j]) for j in range(n))
-            lines.append(f"{IND}_w{k}_{i} = {_PY.doprint(w)}")
+            lines.append(f"{IND}_w{k}_{i} = {PRINTER.doprint(w)}")
         col = _matvec(inv, [f"_w{k}_{i}" for i in range(n)])
         for i in range(n):
             lines.append(f"{IND}_D{i}_{k} = {col[i]}")
@@ -246,9 +258,9 @@ def _reset(eq: Equations, jac: bool, name: str | None = None) -> list[str]:
             lines.append(f"{IND}_D{i}_{n + k} = {col[i]}")
             D[i, n + k] = sp.Symbol(f"_D{i}_{n + k}")
     Jq = eq.relabel_q.jacobian(sp.Matrix(q))
-    rows = [[_PY.doprint(Jq[i, j]) for j in range(n)] + ["0.0"] * n for i in range(n)]
+    rows = [[PRINTER.doprint(Jq[i, j]) for j in range(n)] + ["0.0"] * n for i in range(n)]
     RD = R * D
-    rows += [[_PY.doprint(RD[i, j]) for j in range(2 * n)] for i in range(n)]
+    rows += [[PRINTER.doprint(RD[i, j]) for j in range(2 * n)] for i in range(n)]
     return head + lines + [f"{IND}return {_array(rows)}"]
 
 
@@ -256,13 +268,13 @@ def _guards(eq: Equations) -> list[str]:
     x = sp.Matrix([*eq.q, *eq.dq])
     out = []
     for name, g in eq.guards.items():
-        lines, red = _cse_lines([g], _PY)
-        out += [f"    def guard_{name}(t, x):", _unpack(eq), *lines,
-                f"{IND}return {_PY.doprint(red[0])}"]
+        lines, red = cse_lines([g], PRINTER)
+        out += [f"    def guard_{name}(t, x):", unpack(eq), *lines,
+                f"{IND}return {PRINTER.doprint(red[0])}"]
         grad = [sp.diff(g, s) for s in x]
-        lines, red = _cse_lines(grad, _PY)
-        out += [f"    def grad_{name}(x):", _unpack(eq), *lines,
-                f"{IND}return {_array([_PY.doprint(e) for e in red])}"]
+        lines, red = cse_lines(grad, PRINTER)
+        out += [f"    def grad_{name}(x):", unpack(eq), *lines,
+                f"{IND}return {_array([PRINTER.doprint(e) for e in red])}"]
     return out
 
 
@@ -274,7 +286,7 @@ def _section(eq: Equations) -> list[str]:
     z = sp.symbols(f"z0:{len(keep)}")
     full = sp.Matrix([*eq.q, *eq.dq])
     sub = {full[i]: z[k] for k, i in enumerate(keep)}
-    xs = [str(z[keep.index(i)]) if i in keep else _PY.doprint(eq.drop_solution.subs(sub))
+    xs = [str(z[keep.index(i)]) if i in keep else PRINTER.doprint(eq.drop_solution.subs(sub))
           for i in range(2 * n)]
     for i, j in tied.items():
         xs[i] = xs[j]
@@ -287,7 +299,7 @@ def _section(eq: Equations) -> list[str]:
     ]
 
 
-def _numpy_fn(name: str, eq: Equations, named: dict, args: str = "x") -> list[str]:
+def numpy_fn(name: str, eq: Equations, named: dict, args: str = "x") -> list[str]:
     """A numpy function returning ``{key: expr or Matrix}`` for states (2n,) or (2n, k)."""
     keys = list(named)
     flat, shapes = [], []
@@ -344,36 +356,35 @@ def generate(eq: Equations, param_names, key: str) -> str:
     """
     la = eq.leg_angles
     rates = {k: sum(sp.diff(v, qi) * dqi for qi, dqi in zip(eq.q, eq.dq)) for k, v in la.items()}
-    _HOISTED.clear()
-    _PARAMS.clear()
-    _PARAMS.update(eq.params)
-    _COUNT[0] = 0
-    fast = [*_flow(eq, False), *_flow(eq, True, variational="flow_variational"),
-            *_reset(eq, False), *_reset(eq, True), *_guards(eq)]
+    start_module(eq.params)
+    fast = [*flow_lines(eq, False), *flow_lines(eq, True, variational="flow_variational"),
+            *reset_lines(eq, False), *reset_lines(eq, True), *_guards(eq)]
     if eq.locked is not None:  # kneed walker: knee-locked flow and the knee strike
         lk = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
         q_lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, len(eq.q)))])
         kn = replace(eq, Mi=eq.knee_impact[0], B=eq.knee_impact[1], relabel_q=q_lock,
                      relabel_rate=sp.eye(len(eq.q)))
-        fast += [*_flow(lk, False, "flow_locked"),
-                 *_flow(lk, True, "flow_locked_jacobian", variational="flow_locked_variational"),
-                 *_reset(kn, False, "knee_reset"), *_reset(kn, True, "knee_reset_jacobian")]
+        fast += [*flow_lines(lk, False, "flow_locked"),
+                 *flow_lines(lk, True, "flow_locked_jacobian",
+                             variational="flow_locked_variational"),
+                 *reset_lines(kn, False, "knee_reset"),
+                 *reset_lines(kn, True, "knee_reset_jacobian")]
     body = [
         "def make(p):",
         f"    {', '.join(param_names)}, = p",
         *_HOISTED, *fast, *_section(eq),
-        *_numpy_fn("_energies", eq, {"kinetic": eq.kinetic, "potential": eq.potential}),
+        *numpy_fn("_energies", eq, {"kinetic": eq.kinetic, "potential": eq.potential}),
         "    def energies(x):",
         f"{IND}d = _energies(x)",
         f"{IND}return d['kinetic'], d['potential']",
-        *_numpy_fn("points", eq, eq.points),
-        *_numpy_fn("leg_angles", eq, {**{f"{k}_angle": v for k, v in la.items()},
+        *numpy_fn("points", eq, eq.points),
+        *numpy_fn("leg_angles", eq, {**{f"{k}_angle": v for k, v in la.items()},
                                       **{f"{k}_rate": v for k, v in rates.items()}}),
-        *_numpy_fn("_matrices", eq, {"M": eq.M, "C": eq.C, "G": eq.G}),
+        *numpy_fn("_matrices", eq, {"M": eq.M, "C": eq.C, "G": eq.G}),
         "    def matrices(x):",
         f"{IND}d = _matrices(x)",
         f"{IND}return d['M'], d['C'], np.reshape(d['G'], (len(d['M']),) + np.shape(d['G'])[1:])",
-        *_numpy_fn("_impact_matrices", eq, {"De": eq.De, "E": eq.E}, args="q"),
+        *numpy_fn("_impact_matrices", eq, {"De": eq.De, "E": eq.E}, args="q"),
         "    def impact_matrices(q):",
         f"{IND}d = _impact_matrices(q)",
         f"{IND}return d['De'], d['E']",
@@ -420,7 +431,7 @@ def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational
                 out.append(f"    dy[{m + i * m + j}] = {' + '.join(terms) or '0.0'}")
     k0 = m + m * m if variational else m
     out += [ln[4:] for ln in guards[0]]
-    out += [f"    dy[{k0 + j}] = {_PY.doprint(e)}" for j, e in enumerate(guards[1])]
+    out += [f"    dy[{k0 + j}] = {PRINTER.doprint(e)}" for j, e in enumerate(guards[1])]
     out.append(f"    d[{len(consts)}] += 1.0")
     return out
 
@@ -437,16 +448,13 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  The
     equations are those of :func:`generate` (same expressions, same key).
     """
-    _HOISTED.clear()
-    _PARAMS.clear()
-    _PARAMS.update(eq.params)
-    _COUNT[0] = 0
+    start_module(eq.params)
     flows = {"flow": eq}
     if eq.locked is not None:
         flows["flow_locked"] = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
-    parts = {k: (_flow(e, False, parts=True), _flow(e, True, parts=True))
+    parts = {k: (flow_lines(e, False, parts=True), flow_lines(e, True, parts=True))
              for k, e in flows.items()}
-    guards = _cse_lines(list(eq.guards.values()), _PY)
+    guards = cse_lines(list(eq.guards.values()), PRINTER)
     consts = list(param_names) + [h.split("=")[0].strip() for h in _HOISTED]
     body = ["def constants(p):",
             f"    {', '.join(param_names)}, = p",

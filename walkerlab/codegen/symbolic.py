@@ -132,7 +132,7 @@ def _leg_angles(structure: Structure, q, gamma):
     return theta - gamma, theta - phi - gamma
 
 
-def _pos(lin: dict) -> sp.Matrix:
+def position_of(lin: dict) -> sp.Matrix:
     """Position ``sum(length * e(angle))`` of a ``{angle: length}`` leg-vector sum."""
     out = sp.zeros(2, 1)
     for psi, length in lin.items():
@@ -140,7 +140,7 @@ def _pos(lin: dict) -> sp.Matrix:
     return out
 
 
-def _velocity_terms(lin: dict, psv) -> list[list[tuple]]:
+def velocity_terms(lin: dict, psv) -> list[list[tuple]]:
     """For each ``psi_k``: the ``(angle, coefficient)`` terms of ``d position / d psi_k =
     sum coefficient * e'(angle)`` of a ``{angle: length}`` leg-vector sum."""
     out = []
@@ -154,7 +154,7 @@ def _velocity_terms(lin: dict, psv) -> list[list[tuple]]:
     return out
 
 
-def _dot_terms(u: list, v: list):
+def dot_terms(u: list, v: list):
     """``(sum cu e'(a)) . (sum cv e'(b)) = sum cu cv cos(a - b)``."""
     return sum((cu * cv * sp.cos(a - b) for a, cu in u for b, cv in v), sp.Integer(0))
 
@@ -230,7 +230,7 @@ def derive(structure: Structure) -> Equations:
     offset = (-R * (ps_st + gamma) * tangent + R * normal) if arc else sp.zeros(2, 1)
 
     def at(lin):
-        return _pos(lin) + offset
+        return position_of(lin) + offset
 
     def add(lin, psi, length):
         out = dict(lin)
@@ -311,12 +311,12 @@ def derive(structure: Structure) -> Equations:
             # trigonometric simplifier (a = psi_k for a body on a leg's axis)
             new = {k: lin.get(k, 0) - foot_lin.get(k, 0)
                    for k in {**lin, **foot_lin}}  # swing foot at rest
-            dl, dn = _velocity_terms(lin, psv), _velocity_terms(new, psv)
+            dl, dn = velocity_terms(lin, psv), velocity_terms(new, psv)
             for i in range(n):
                 for j in range(n):
-                    Mp[i, j] += mass * _dot_terms(dl[i], dl[j])
-                    Mi[i, j] += mass * _dot_terms(dn[i], dn[j])
-                    Bm[i, j] += mass * _dot_terms(dn[i], dl[j])
+                    Mp[i, j] += mass * dot_terms(dl[i], dl[j])
+                    Mi[i, j] += mass * dot_terms(dn[i], dn[j])
+                    Bm[i, j] += mass * dot_terms(dn[i], dl[j])
         Mp += inertia * a.T * a
         Mi += inertia * a.T * a
         Bm += inertia * a.T * a

@@ -158,18 +158,26 @@ class ArcFoot(_Strict):
     radius_m: float = Field(ge=0, le=100, description="arc radius R [m]")
 
 
-class AnkleSpec(_Strict):
+class TorsionalSpring(_Strict):
+    """A linear torsional spring and viscous damper: stiffness, rest angle, damping (each
+    joint below says what its angle is and narrows the rest angle's range)."""
+
+    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
+                                         "[N m/rad]")
+    rest_angle_rad: float = Field(0.0, ge=-3.2, le=3.2, description="angle at which the "
+                                  "spring is relaxed [rad]")
+    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
+                                         "[N m s/rad]")
+
+
+class AnkleSpec(TorsionalSpring):
     """A revolute ankle between the leg's end and a flat foot, with a linear torsional spring
     and viscous damper: torque ``-k (delta - rest) - c d(delta)/dt`` on the foot, ``delta``
     the foot's angle from the leg's perpendicular (positive toe up; Wisse et al. 2006,
     "Ankle springs instead of arc-shaped feet for passive dynamic walkers")."""
 
-    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
-                                         "[N m/rad]")
     rest_angle_rad: float = Field(0.0, ge=-1.5, le=1.5, description="foot angle at which the "
                                   "spring is relaxed [rad]; 0 = sole perpendicular to the leg")
-    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
-                                         "[N m s/rad]")
 
 
 class FlatFoot(_Strict):
@@ -187,18 +195,14 @@ class FlatFoot(_Strict):
 Foot = Annotated[PointFoot | ArcFoot | FlatFoot, Field(discriminator="kind")]
 
 
-class KneeSpringSpec(_Strict):
+class KneeSpringSpec(TorsionalSpring):
     """A linear torsional spring and viscous damper at the knee: torque ``-k (knee - rest) -
     c d(knee)/dt`` on the shank and the opposite on the thigh, ``knee`` = shank angle - thigh
     angle (0 straight, negative flexed)."""
 
-    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
-                                         "[N m/rad]")
     rest_angle_rad: float = Field(0.0, ge=-3.2, le=3.2, description="knee angle (shank - "
                                   "thigh, negative flexed) at which the spring is relaxed "
                                   "[rad]")
-    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
-                                         "[N m s/rad]")
 
 
 class KneeSpec(_Strict):
@@ -330,7 +334,7 @@ class TorsoSpec(_Strict):
         return self
 
 
-class SpringSpec(_Strict):
+class SpringSpec(TorsionalSpring):
     """A linear torsional spring and viscous damper between two links sharing a joint point
     (the hip): torque ``-k (delta - rest) - c d(delta)/dt`` on the second link and the
     opposite on the first, ``delta`` = angle(second) - angle(first) (leg angles from the
@@ -341,12 +345,8 @@ class SpringSpec(_Strict):
     between: list[Literal["leg1", "leg2", "torso"]] = Field(
         min_length=2, max_length=2,
         description="the two links the spring joins (leg1 starts as the swing leg)")
-    stiffness_n_m_per_rad: float = Field(ge=0, le=1e6, description="torsional stiffness k "
-                                         "[N m/rad]")
     rest_angle_rad: float = Field(0.0, ge=-3.2, le=3.2, description="relative angle at which "
                                   "the spring is relaxed [rad]")
-    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="viscous damping c "
-                                         "[N m s/rad]")
 
     @model_validator(mode="after")
     def _two_links(self) -> SpringSpec:
