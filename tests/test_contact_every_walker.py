@@ -143,7 +143,7 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     from walkerlab.models.contact.scene import settings
 
     rf = load_scene("configs/round_feet.yaml")
-    d = drop_test(rf, 2.0)
+    d = drop_test(rf.contact, 2.0)
     k = rf.contact.stiffness_n_per_m_pow_e
     assert d["unit"] == "N/m^e"
     assert d["stiffness"][0] < k < d["stiffness"][-1]

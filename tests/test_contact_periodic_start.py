@@ -19,10 +19,12 @@ def test_run_from_the_periodic_gait_has_constant_step_periods():
     over 6 steps.  The start from the ideal fixed point (x 1.1 rates) has a first step of
     0.58 s against 0.71 s: 10^4 times that tolerance."""
     from walkerlab.analysis.contact_periodic import ideal_gait, simulate_from_periodic_gait
+    from walkerlab.models.contact.scene import contact_setup
 
     scene = load_scene("configs/paper.yaml")
     ideal = ideal_gait(scene)
-    _, res, _, _, gait = simulate_from_periodic_gait(scene, ideal.x, strides=2)
+    _, res, _, _, gait = simulate_from_periodic_gait(contact_setup(scene), ideal.x,
+                                                     strides=2)
     assert gait.converged and gait.residual < 1e-8
     hs = np.asarray(res.heel_strike_times)
     assert hs.size == 5 and res.heel_strike_legs[:2] == ["leg1", "leg2"]

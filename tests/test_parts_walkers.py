@@ -323,10 +323,11 @@ def test_contact_view_walks_the_hip_spring_walker_near_its_rigid_gait(fixed_poin
     # floating equations): 2 strides from the rigid fixed point, step periods within 2 %
     # of the rigid 0.5222 s (measured: 0.5245, 0.5281, 0.5290, 0.5284 s)
     from walkerlab.analysis.contact_sim import simulate_from
+    from walkerlab.models.contact.scene import contact_setup
 
     w, fp = fixed_points["hip_spring"]
     sc = load_scene("configs/hip_spring.yaml")
-    _cw, res, _x0, _d = simulate_from(sc, fp.x, fp.period_s, strides=2)
+    _cw, res, _x0, _d = simulate_from(contact_setup(sc), fp.x, fp.period_s, strides=2)
     periods = np.diff(np.concatenate([[0.0], res.heel_strike_times]))
     assert len(periods) >= 3
     assert np.all(np.abs(periods / fp.period_s - 1) < 0.02)

@@ -506,18 +506,19 @@ def test_progress_adjust_counts_contact_runs(monkeypatch):
 
     from walkerlab.analysis import contact_adjust as adjust
     from walkerlab.analysis import contact_sim
+    from walkerlab.models.contact.scene import contact_setup
 
     calls = []
 
-    def fake_simulate_from(scene, x_fp, period, rate_scale=None):
+    def fake_simulate_from(setup, x_fp, period, rate_scale=None):
         calls.append(rate_scale)
         return None, SimpleNamespace(heel_strike_times=[], termination="fall"), None, None
 
     monkeypatch.setattr(contact_sim, "simulate_from", fake_simulate_from)
     rec = Recorder()
     with progress.use(rec):
-        out = adjust.adjust_rates(scene_from_dict({**PAPER, "name": "paper"}), X_GUESS, 0.7,
-                                  grid=(0.8, 1.5, 3))
+        out = adjust.adjust_rates(contact_setup(scene_from_dict({**PAPER, "name": "paper"})),
+                                  X_GUESS, 0.7, grid=(0.8, 1.5, 3))
     t = rec.one("adjust")
     c = t["counts"]
     assert all(b > a for a, b in zip(c, c[1:])) and c[-1] == len(calls) == out["evaluations"]

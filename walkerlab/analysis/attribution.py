@@ -180,12 +180,14 @@ def adjustment_effect(scene, ideal, strides: int = 5) -> dict:
     from walkerlab.analysis.contact_sim import simulate_from
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
+    from walkerlab.models.contact.scene import contact_setup
     from walkerlab.models.registry import build_walker
 
     scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)
     out = {"rate_scale": scale}
+    setup = contact_setup(scene)
     for key, rs in (("adjusted_s", scale), ("unadjusted_s", (1.0, 1.0))):
-        _, r, _, _ = simulate_from(scene, ideal.x, ideal.period_s, rate_scale=rs,
+        _, r, _, _ = simulate_from(setup, ideal.x, ideal.period_s, rate_scale=rs,
                                    strides=strides)
         T = np.diff(r.heel_strike_times)
         out[key] = float(np.mean(T)) if T.size and r.termination in ("t_final",

@@ -17,25 +17,34 @@ import numpy as np
 from scipy.optimize import brute, minimize
 
 
-def adjust_rates(scene, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> dict:
+def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> dict:
     """Find initial-rate scale factors that make the contact gait match the ideal one.
+
+    Parameters
+    ----------
+    setup : walkerlab.models.contact.scene.ContactSetup
+        The scene's contact model (runs ``contact_sim.n_strides`` strides).
+    x_fp : ndarray (n,)
+        Ideal fixed point (rigid walker's ``state_names()`` order) [rad, rad/s].
+    period : float
+        Ideal step period [s].
+    grid : (float, float, int)
+        Lower and upper scale and points per axis of the coarse grid.
 
     Returns
     -------
     dict
         ``scale`` (2,), ``objective``, ``evaluations``, ``grid_best`` (2,).
     """
-    from walkerlab.models.contact.scene import settings
-
     from .contact_sim import simulate_from
 
-    n_strides = settings(scene)[2].n_strides
+    n_strides = setup.sim.n_strides
     count = {"n": 0}
 
     def J(s):
         count["n"] += 1
         s = np.clip(np.asarray(s, float), 0.2, 5.0)
-        walker, res, _, l_star = simulate_from(scene, x_fp, period, rate_scale=tuple(s))
+        walker, res, _, l_star = simulate_from(setup, x_fp, period, rate_scale=tuple(s))
         n_hs = len(res.heel_strike_times)
         want = 2 * n_strides
         if n_hs < want or res.termination in ("fall", "trip", "airborne"):

@@ -215,11 +215,13 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
     ContactSceneError
         The scene has no ``contact`` section or a massless body.
     """
+    from walkerlab.models.contact.scene import contact_setup
+
     from .contact_periodic import ideal_gait
     from .contact_sim import scene_start
 
     ideal = ideal_gait(scene)
-    walker, x0, limits, _ = scene_start(scene, ideal.x, n_strides + 1)
+    walker, x0, limits, _ = scene_start(contact_setup(scene), ideal.x, n_strides + 1)
     t_final = 1.03 * 2 * n_strides * ideal.period_s
     ref = simulate_contact(walker, x0, t_final, SolverSettings.for_contact(
         method="odeint", rtol=reference_rtol, atol=1e-3 * reference_rtol), limits)

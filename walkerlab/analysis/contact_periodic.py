@@ -483,17 +483,6 @@ def ideal_gait(scene):
                       fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
 
 
-def _walker_and_guess(walker_or_scene, guess):
-    if isinstance(walker_or_scene, ContactWalker):
-        return walker_or_scene, guess, None
-    from walkerlab.models.contact.scene import build
-
-    scene = walker_or_scene
-    ideal = ideal_gait(scene)
-    walker, _ = build(scene, ideal.x, 2)
-    return walker, (ideal.x if guess is None else guess), ideal
-
-
 def fd_jacobian(F, z, scale, h, central: bool = True, F0=None):
     """Finite-difference Jacobian dF/dz (SI) with steps ``h * scale``: central, or forward
     from ``F0 = F(z)`` (n calls instead of 2n; used only for the root finder's Newton
@@ -530,7 +519,7 @@ def _sorted_eig(J):
     return ev[np.argsort(-np.abs(ev), kind="stable")]
 
 
-def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 1.0),
+def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0, 1.0),
                                warmup_steps: int = 8, xtol: float = 1e-8,
                                residual_tol: float = 1e-8, fd_step: float = 1e-4,
                                check_fd: bool = True, method: str = "odeint",
@@ -544,10 +533,9 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
 
     Parameters
     ----------
-    walker_or_scene : ContactWalker or walkerlab.config.Scene
-        A scene is built into a walker with :func:`walkerlab.models.contact.scene.build`; then
-        the default guess is its ideal (derived) fixed point.
-    guess : array_like, optional
+    walker : ContactWalker
+        The contact walker (:meth:`walkerlab.models.contact.scene.ContactSetup.build`).
+    guess : array_like
         Either a section state (n,) (:func:`section_coordinates`) or an ideal post-impact
         state (role order of the rigid walker, as ``solve_variant``; compass gait
         ``[th_swing, th_stance, w_swing, w_stance]``).
@@ -595,7 +583,6 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
     """
     wall = time.perf_counter()
     deadline = None if time_limit_s is None else wall + time_limit_s
-    walker, guess, ideal = _walker_and_guess(walker_or_scene, guess)
     P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol, deadline=deadline)
     scale = P.scale
     coarse = coarse_rtol is not None and coarse_rtol > rtol
@@ -662,9 +649,6 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
             "fd_step": fd_step, "scales": scale, "method": method, "rtol": rtol, "atol": atol,
             "coarse_rtol": coarse_rtol if coarse else None, "coarse_map_evaluations": PC.nfev
             if coarse else 0, "patch_spacing_m": P.spacing}
-    if ideal is not None:
-        info["ideal_period_s"] = ideal.period_s
-        info["ideal_multipliers"] = ideal.multipliers_variational
     resid = float(np.max(np.abs(res_si / scale)))
     return ContactPeriodicGait(
         z=zs, fixed_point=dict(zip(P.names, map(float, zs))), period_s=T,
@@ -676,10 +660,11 @@ def find_contact_periodic_gait(walker_or_scene, guess=None, *, rate_scale=(1.0, 
         wall_time_s=time.perf_counter() - wall, info=info)
 
 
-def simulate_from_periodic_gait(scene, x_ideal: np.ndarray, strides: int | None = None,
-                                solver=None):  # scene: Scene, solver: SolverSettings
-    """Run the contact walker of ``scene`` from its own periodic gait (``contact_sim.start:
-    periodic_gait``): steady state, no start-up transient.
+def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None = None,
+                                solver=None):  # setup: ContactSetup, solver: SolverSettings
+    """Run the contact walker of a scene (its ``setup``,
+    :func:`walkerlab.models.contact.scene.contact_setup`) from its own periodic gait
+    (``contact_sim.start: periodic_gait``): steady state, no start-up transient.
 
     The gait is found from the ideal fixed point ``x_ideal``
     (:func:`walkerlab.analysis.contact_periodic.find_contact_periodic_gait`, within
@@ -699,14 +684,12 @@ def simulate_from_periodic_gait(scene, x_ideal: np.ndarray, strides: int | None 
         The periodic gait was not found (fell, no mid-stance, solver failure, time limit).
     """
     from walkerlab.analysis.contact_sim import scene_start, simulate_contact
-    from walkerlab.models.contact.scene import build, settings
 
-    _, _, cs, sv = settings(scene)
-    sv = solver or sv
+    cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
-    probe, _, limits, _ = scene_start(scene, x_ideal, n_strides)
+    probe, _, limits, _ = scene_start(setup, x_ideal, n_strides)
     gait = find_contact_periodic_gait(probe, x_ideal, time_limit_s=cs.periodic_time_limit_s)
-    walker, step_length = build(scene, x_ideal, 2 * n_strides, step_length_m=gait.step_length_m)
+    walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m=gait.step_length_m)
     x0 = np.asarray(gait.full_state, float)
     t_final = cs.t_final_s or (2 * n_strides + 1) * gait.period_s
     res = simulate_contact(walker, x0, t_final, sv, limits,

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.config import Scene
-from walkerlab.models.contact.scene import settings
+from walkerlab.config import ContactSettings
+from walkerlab.models.contact.scene import ContactSetup
 
 #: stiffness values of the drop test stored with every contact run, relative to the scene's
 #: own stiffness (the paper's k = 1e5 N/mm^2.2: 1e4 ... 1e9 N/mm^2.2)
@@ -21,10 +21,11 @@ DROP_SPEED = 0.3
 LEGS = ["leg1", "leg2"]
 
 
-def drop_test(scene: Scene, mass_kg: float) -> dict:
-    """The drop test of the scene's contact law (:func:`walkerlab.analysis.contact_drop.
-    restitution_curve`): the walker's total mass ``mass_kg`` [kg] meeting flat ground at
-    :data:`DROP_SPEED`, at the stiffnesses :data:`DROP_STIFFNESS_RATIO` x the scene's.
+def drop_test(law: ContactSettings, mass_kg: float) -> dict:
+    """The drop test of the scene's contact law ``law`` (its ``contact`` section as written;
+    :func:`walkerlab.analysis.contact_drop.restitution_curve`): the walker's total mass
+    ``mass_kg`` [kg] meeting flat ground at :data:`DROP_SPEED`, at the stiffnesses
+    :data:`DROP_STIFFNESS_RATIO` x the scene's.
 
     The stiffnesses are in the unit the scene writes its stiffness in (``unit`` of the
     result, ``N/mm^e`` for ``stiffness_n_per_mm_pow_e``).  The rigid-limit family starts
@@ -36,12 +37,11 @@ def drop_test(scene: Scene, mass_kg: float) -> dict:
     from walkerlab.analysis.contact_drop import restitution_curve
     from walkerlab.config.contact import CONTACT_QUANTITIES
 
-    base = settings(scene)[0]
-    k, unit, _ = base.written("stiffness")
-    if base.stiffness_family == "paper":
-        base = base.with_written("reference_stiffness", k, unit)
+    k, unit, _ = law.written("stiffness")
+    if law.stiffness_family == "paper":
+        law = law.with_written("reference_stiffness", k, unit)
     ks = [k * r for r in DROP_STIFFNESS_RATIO]
-    out = restitution_curve(base, ks, mass_kg=float(mass_kg), v_in_m_per_s=DROP_SPEED)
+    out = restitution_curve(law, ks, mass_kg=float(mass_kg), v_in_m_per_s=DROP_SPEED)
     return {**out, "unit": CONTACT_QUANTITIES["stiffness"][unit][1]}
 
 
@@ -76,8 +76,9 @@ def run_summary(res) -> dict:
     }
 
 
-def contact_sim_run(scene: Scene, fp, adjust: bool = False, periodic: bool = False):
-    """The ``contact-sim`` stage's run: the contact walker started from the ideal fixed point
+def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: bool = False):
+    """The ``contact-sim`` stage's run: the contact walker of a scene (its ``setup``,
+    :func:`walkerlab.models.contact.scene.contact_setup`) started from the ideal fixed point
     ``fp`` (a loaded ``fixedpoint.h5``) with the scene's rate scale, the rates ``adjust``
     searches (kept only when they walk at least as well as the scene's own), or the contact
     model's own periodic gait (``contact_sim.start: periodic_gait``); with ``periodic`` (or
@@ -96,14 +97,14 @@ def contact_sim_run(scene: Scene, fp, adjust: bool = False, periodic: bool = Fal
     from walkerlab.analysis import contact_sim as contact_run
     from walkerlab.io.schemas.contact_sim import ContactSimRun
 
-    law, _terrain, cs = settings(scene)[:3]
+    cs = setup.sim
     adj = scale = None
     gait = gait_error = None
     adjust = adjust or cs.start == "adjusted"
     if adjust:
         from walkerlab.analysis.contact_adjust import adjust_rates, better_start
 
-        adj = adjust_rates(scene, fp.x, fp.step_period_s)
+        adj = adjust_rates(setup, fp.x, fp.step_period_s)
         scale = adj["scale"]
     if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
         from walkerlab.analysis.contact_periodic import (
@@ -113,16 +114,16 @@ def contact_sim_run(scene: Scene, fp, adjust: bool = False, periodic: bool = Fal
 
         try:
             walker, res, x0, step_length, gait = simulate_from_periodic_gait(
-                scene, fp.x)
+                setup, fp.x)
         except PeriodicGaitError as exc:
-            raise PeriodicGaitError(f"scene '{scene.name}': contact_sim.start: periodic_gait: "
+            raise PeriodicGaitError(f"scene '{setup.name}': contact_sim.start: periodic_gait: "
                                     f"the contact walker's periodic gait was not found ({exc})"
                                     ) from None
         scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
     else:
-        run = contact_run.simulate_from(scene, fp.x, fp.step_period_s, scale)
+        run = contact_run.simulate_from(setup, fp.x, fp.step_period_s, scale)
         if adjust:  # the adjusted start must walk at least as well as the scene's own
-            plain = contact_run.simulate_from(scene, fp.x, fp.step_period_s, None)
+            plain = contact_run.simulate_from(setup, fp.x, fp.step_period_s, None)
             adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
             if adj["kept"] == "scene":
                 run, scale = plain, None
@@ -143,6 +144,6 @@ def contact_sim_run(scene: Scene, fp, adjust: bool = False, periodic: bool = Fal
         fixed_point_names=fp.state_names, legs=LEGS,
         rate_names=[" ".join(rate_states(walker, leg)) for leg in LEGS],
         initial_rate_scale=np.asarray(scale if scale is not None else cs.initial_rate_scale),
-        stiffness_family=law.stiffness_family,
-        drop=drop_test(scene, walker.total_mass), drop_speed_m_per_s=DROP_SPEED,
+        stiffness_family=setup.law.stiffness_family,
+        drop=drop_test(setup.law, walker.total_mass), drop_speed_m_per_s=DROP_SPEED,
         summary=run_summary(res), gait=gait, gait_error=gait_error, adjust=adj)

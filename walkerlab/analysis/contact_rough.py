@@ -128,10 +128,11 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
     """
     from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
     from walkerlab.analysis.contact_sim import scene_start
-    from walkerlab.models.contact.scene import settings
+    from walkerlab.models.contact.scene import contact_setup
 
-    cs = settings(scene)[2]
-    probe, x0, _, step_length = scene_start(scene, x_ideal, 2)
+    setup = contact_setup(scene)
+    cs = setup.sim
+    probe, x0, _, step_length = scene_start(setup, x_ideal, 2)
     if not periodic:
         from walkerlab.integrate.rigid import Solver, integrate_step
         from walkerlab.models.registry import build_walker
@@ -168,15 +169,15 @@ def contact_walk(start: ContactStart, heights_m: np.ndarray, max_steps: int
     """
     from walkerlab.analysis.contact_sim import scene_start, simulate_contact
     from walkerlab.config import scene_from_dict
-    from walkerlab.models.contact.scene import build, settings
+    from walkerlab.models.contact.scene import contact_setup
 
-    scene = scene_from_dict(start.scene)
-    sv = settings(scene)[3]
+    setup = contact_setup(scene_from_dict(start.scene))
+    sv = setup.solver
     x_ideal = np.asarray(start.x_ideal, float)
-    _, _, limits, _ = scene_start(scene, x_ideal, 2)
+    _, _, limits, _ = scene_start(setup, x_ideal, 2)
     cap = WALK_TIME_LIMIT_S + WALK_TIME_PER_STEP_S * max_steps
     limits = replace(limits, wall_time_limit_s=min(limits.wall_time_limit_s or cap, cap))
-    walker, _ = build(scene, x_ideal, max_steps + 2, step_length_m=start.step_length_m)
+    walker, _ = setup.build(x_ideal, max_steps + 2, step_length_m=start.step_length_m)
     walker = footfall_lanes(walker, heights_m)
     res = simulate_contact(walker, np.asarray(start.x0, float),
                            (max_steps + 1.5) * start.period_s, sv, limits,

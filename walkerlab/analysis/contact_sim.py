@@ -2,8 +2,9 @@
 
 :func:`simulate_contact` = :func:`walkerlab.integrate.contact.integrate_contact` (samples,
 events) + :func:`walkerlab.analysis.contact_gait.gait_events` (heel strikes, steps) + the
-typed outcome.  :func:`simulate_from` runs the contact walker of a scene from the ideal
-gait, the one code path of the ``contact-sim`` stage, the adjustment
+typed outcome.  :func:`simulate_from` runs the contact walker of a scene (its
+:class:`~walkerlab.models.contact.scene.ContactSetup`) from the ideal gait, the one code
+path of the ``contact-sim`` stage, the adjustment
 (:mod:`walkerlab.analysis.contact_adjust`), the sweeps and the work-precision study, so a
 scene means the same contact run everywhere.  States are read by name
 (``walker.state_names()``), never by row.
@@ -15,11 +16,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.config import Scene
 from walkerlab.config.solver import SolverSettings
 from walkerlab.integrate.contact import ContactLimits, StateIndex, integrate_contact
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.contact.scene import build, settings
+from walkerlab.models.contact.scene import ContactSetup
 
 from .contact_gait import ContactResult, classify, gait_events, heel_strike_count
 
@@ -130,12 +130,14 @@ def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
     return replace(limits, **upd)
 
 
-def scene_start(scene: Scene, x_ideal: np.ndarray, n_strides: int, rate_scale=None):
-    """The contact walker of ``scene``, its initial state and run limits (the start of
+def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_scale=None):
+    """The contact walker of a scene, its initial state and run limits (the start of
     :func:`simulate_from`, shared with the benchmark).
 
     Parameters
     ----------
+    setup : ContactSetup
+        The scene's contact model (:func:`walkerlab.models.contact.scene.contact_setup`).
     x_ideal : ndarray (n,)
         Ideal post-impact state (rigid walker's ``state_names()`` order) [rad, rad/s].
     n_strides : int
@@ -149,8 +151,8 @@ def scene_start(scene: Scene, x_ideal: np.ndarray, n_strides: int, rate_scale=No
         :class:`ContactWalker`, the initial state (N,), :class:`ContactLimits` from the
         scene's ``contact_sim`` section, the ideal step length [m].
     """
-    cs = settings(scene)[2]
-    walker, step_length = build(scene, x_ideal, 2 * n_strides)
+    cs = setup.sim
+    walker, step_length = setup.build(x_ideal, 2 * n_strides)
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
     x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
     limits = ContactLimits(
@@ -161,12 +163,14 @@ def scene_start(scene: Scene, x_ideal: np.ndarray, n_strides: int, rate_scale=No
     return walker, x0, limits, step_length
 
 
-def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=None,
+def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_scale=None,
                   solver: SolverSettings | None = None, strides: int | None = None):
-    """Run the contact walker of ``scene`` from the ideal fixed point ``x_ideal``.
+    """Run the contact walker of a scene from the ideal fixed point ``x_ideal``.
 
     Parameters
     ----------
+    setup : ContactSetup
+        The scene's contact model (:func:`walkerlab.models.contact.scene.contact_setup`).
     x_ideal : ndarray (n,)
         Ideal post-impact state in the rigid walker's ``state_names()`` order (leg1 = swing,
         leg2 = stance) [rad, rad/s].
@@ -185,10 +189,9 @@ def simulate_from(scene: Scene, x_ideal: np.ndarray, period: float, rate_scale=N
         :class:`ContactWalker`, :class:`ContactResult`, the initial state (N,), the ideal
         step length [m].
     """
-    _, _, cs, sv = settings(scene)
-    sv = solver or sv
+    cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
-    walker, x0, limits, step_length = scene_start(scene, x_ideal, n_strides, rate_scale)
+    walker, x0, limits, step_length = scene_start(setup, x_ideal, n_strides, rate_scale)
     t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
     res = simulate_contact(walker, x0, t_final, sv, limits,
                            max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)

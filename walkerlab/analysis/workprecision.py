@@ -138,12 +138,14 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
     around :func:`walkerlab.analysis.contact_sim.simulate_contact` alone.
     """
     from walkerlab.analysis.contact_bench import leg_angle_columns
-    from walkerlab.analysis.contact_sim import scene_start, settings, simulate_contact
+    from walkerlab.analysis.contact_sim import scene_start, simulate_contact
     from walkerlab.config import SolverSettings
     from walkerlab.integrate.contact import StateIndex
+    from walkerlab.models.contact.scene import contact_setup
 
-    cs = settings(scene)[2]
-    walker, z0, limits, _ = scene_start(scene, x0, strides)
+    setup = contact_setup(scene)
+    cs = setup.sim
+    walker, z0, limits, _ = scene_start(setup, x0, strides)
     t_final = cs.t_final_s or (2 * strides + 0.5) * step_period
     max_hs = 2 * strides + 1 if cs.stop_after_strides else None
     idx = StateIndex(walker)

@@ -18,23 +18,22 @@ from walkerlab.config import Scene
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.schemas.contact_sim import run_end, write_contact_sim
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.models.contact import scene as contact_scene
+from walkerlab.models.contact.scene import ContactSetup, contact_setup
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,
     artifact_path,
-    require,
     run_cached,
 )
 
 SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_solver")
 
 
-def _compute(scene: Scene, fixedpoint: Path, adjust: bool, periodic: bool):
+def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool):
     from walkerlab.analysis.contact_periodic import PeriodicGaitError
 
     try:
-        run = contact_sim_run(scene, load_fixedpoint(fixedpoint), adjust, periodic)
+        run = contact_sim_run(setup, load_fixedpoint(fixedpoint), adjust, periodic)
     except PeriodicGaitError as exc:  # the start asked for a gait that was not found
         raise StageError(str(exc)) from None
     return (lambda f: write_contact_sim(f, run)), run.summary
@@ -49,17 +48,18 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
 
     Raises
     ------
-    StageError
-        The scene has no ``contact`` section.
+    walkerlab.models.contact.scene.ContactSceneError
+        The scene has no ``contact`` section, or its walker cannot stand on contacts
+        (:func:`walkerlab.models.contact.scene.contact_setup`; one line).
     walkerlab.io.artifacts.ArtifactError
         ``fixedpoint.h5`` is missing or unreadable.
     """
-    require(scene, "contact", "contact-sim")
-    periodic = periodic or contact_scene.settings(scene)[2].periodic_gait
+    setup = contact_setup(scene)  # the scene read once: all the run needs, typed
+    periodic = periodic or setup.sim.periodic_gait
     up = (artifact_path(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())
     out = run_cached("contact-sim", scene, runs_root, sections, up,
-                     lambda: _compute(scene, up[0], adjust, periodic), force)
+                     lambda: _compute(setup, up[0], adjust, periodic), force)
     kind, why = run_end(out.path)
     # like simulate: a walker that does not walk fails the run (the shared run ends,
     # walkerlab.integrate.ends: trip, fall, airborne, no_heel_strike, ...)

@@ -407,12 +407,12 @@ def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
         Steps requested (2 * ``contact_sim.n_strides``).
     """
     from walkerlab.analysis.contact_sim import simulate_from
-    from walkerlab.config import ContactSimSettings
+    from walkerlab.models.contact.scene import contact_setup
 
     # one code path with the contact-sim stage (terrain, initial state, solver, end time)
-    cs = scene.contact_sim or ContactSimSettings()
-    cw, res, _, _ = simulate_from(scene, np.asarray(x_ideal, float), ideal_period_s)
-    return cw, res, 2 * cs.n_strides
+    setup = contact_setup(scene)
+    cw, res, _, _ = simulate_from(setup, np.asarray(x_ideal, float), ideal_period_s)
+    return cw, res, 2 * setup.sim.n_strides
 
 
 #: contact outcome kind (walkerlab.analysis.contact_gait.CONTACT_OUTCOMES, the shared run

@@ -1,5 +1,6 @@
-"""Build the contact walker of a validated scene (its model; running it is
-:mod:`walkerlab.analysis.contact_sim`).
+"""The contact model of a validated scene: :func:`contact_setup` turns the scene once into
+the typed objects a contact run needs (:class:`ContactSetup`), which builds the walker
+(running it is :mod:`walkerlab.analysis.contact_sim`).
 
 The ``contact-sim`` stage, the adjustment, :mod:`walkerlab.analysis.contact_periodic`, the
 stability maps and the sweep points all build their walker here, so a scene means the same
@@ -8,14 +9,28 @@ contact model everywhere.  This module imports settings only (:mod:`walkerlab.co
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from walkerlab.config import ContactSimSettings, Scene, SolverSettings, TerrainSettings
+from walkerlab.config import (
+    ContactSettings,
+    ContactSimSettings,
+    Scene,
+    SolverSettings,
+    TerrainSettings,
+)
 
+from .laws import ContactParamsSI, KneeStopSI
 from .model import ContactWalker, flat_foot_numbers
 from .rigid_limit import contact_si
 
-__all__ = ["ContactSceneError", "build", "ideal_step_length", "settings"]
+if TYPE_CHECKING:
+    from walkerlab.walker.description import WalkerData
+
+__all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal_step_length",
+           "settings"]
 
 
 class ContactSceneError(ValueError):
@@ -75,9 +90,100 @@ def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
     return chord + R * (z[m - 1] - z[m // 2 - 1])
 
 
+@dataclass(frozen=True)
+class ContactSetup:
+    """A scene read once for the contact model (:func:`contact_setup`): everything a contact
+    run needs, typed; the contact law is in SI (its conversion runs here only).
+
+    Attributes
+    ----------
+    name : str
+        The scene's name (for one-line messages).
+    law : ContactSettings
+        The contact section as written (units of the scene; the drop test and the stiffness
+        family read it).
+    law_si : ContactParamsSI
+        The contact law in SI with its ``stiffness_family`` applied.
+    knee_stop : KneeStopSI
+        The knee stop in SI.
+    walker : WalkerData
+        The walker's structure and parameters on the scene's slope.
+    terrain : TerrainSettings
+    sim : ContactSimSettings
+        Run options (``contact_sim``; defaults when the scene has none).
+    solver : SolverSettings
+        ``contact_solver`` (default :meth:`SolverSettings.for_contact`).
+    """
+
+    name: str
+    law: ContactSettings
+    law_si: ContactParamsSI
+    knee_stop: KneeStopSI
+    walker: WalkerData
+    terrain: TerrainSettings
+    sim: ContactSimSettings
+    solver: SolverSettings
+
+    def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
+        """ContactWalker of the setup with checkerboard patches from the ideal step length.
+
+        Parameters
+        ----------
+        x_ideal : ndarray (2n,)
+            Ideal fixed point (role order of the rigid walker, leg2 = stance) [rad, rad/s].
+        n_steps : int
+            Steps the run may take (sets how many patches are laid out).
+        step_length_m : float, optional
+            Patch spacing [m] instead of the ideal step length (a run started on the contact
+            model's own periodic gait lays its patches at that gait's footfalls).
+
+        Returns
+        -------
+        walker : ContactWalker
+        step_length : float
+            Ideal step length [m] (the patch spacing unless ``step_length_m`` is given).
+        """
+        probe = ContactWalker(contact=self.law_si, data=self.walker, knee_stop=self.knee_stop,
+                              flat_foot=self.law.flat_foot())
+        step_length = ideal_step_length(probe, x_ideal)
+        return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
+                                n_steps=n_steps + 4), step_length
+
+
+def contact_setup(scene: Scene) -> ContactSetup:
+    """The scene turned once into what a contact run needs (any walker with positive leg
+    masses): its walker data, the contact law and knee stop in SI, terrain, run options and
+    solver settings.
+
+    Raises
+    ------
+    ContactSceneError
+        No ``contact`` section, a walker with a massless body, flat feet without
+        ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
+        that is not a point (one line).
+    """
+    from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, check_masses
+    from walkerlab.walker.description import walker_data
+
+    contact, terrain, cs, sv = settings(scene)
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    if cs.pin_stance_until != "none" and data.structure.foot != "point":
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: pinning "
+                                f"the stance foot needs point feet (this walker's are "
+                                f"{data.structure.foot})")
+    try:
+        check_masses(data.structure)
+    except ValueError as err:
+        raise ContactSceneError(f"scene '{scene.name}': {err}") from None
+    if data.structure.foot == "flat" and contact.flat_foot() is None:
+        raise ContactSceneError(f"scene '{scene.name}': {FLAT_FOOT_MESSAGE}")
+    si, knee = contact_si(contact)  # the contact law in SI: once per run
+    return ContactSetup(scene.name, contact, si, knee, data, terrain, cs, sv)
+
+
 def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
-    """ContactWalker of the scene (any walker with positive leg masses) with checkerboard
-    patches from the ideal step length.
+    """ContactWalker of the scene (:func:`contact_setup`, then :meth:`ContactSetup.build`)
+    with checkerboard patches from the ideal step length.
 
     Parameters
     ----------
@@ -103,25 +209,4 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).
     """
-    from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, check_masses
-    from walkerlab.walker.description import walker_data
-
-    contact, terrain, cs, _ = settings(scene)
-    data = walker_data(scene.walker, scene.slope.phi_rad)
-    if cs.pin_stance_until != "none" and data.structure.foot != "point":
-        raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: pinning "
-                                f"the stance foot needs point feet (this walker's are "
-                                f"{data.structure.foot})")
-    try:
-        check_masses(data.structure)
-    except ValueError as err:
-        raise ContactSceneError(f"scene '{scene.name}': {err}") from None
-    if data.structure.foot == "flat" and contact.flat_foot() is None:
-        raise ContactSceneError(f"scene '{scene.name}': {FLAT_FOOT_MESSAGE}")
-    si, knee = contact_si(contact)  # the contact law in SI: once per run
-    probe = ContactWalker(contact=si, data=data, knee_stop=knee,
-                          flat_foot=contact.flat_foot())
-    step_length = ideal_step_length(probe, x_ideal)
-    return probe.on_terrain(terrain, step_length=step_length_m or step_length,
-                            n_steps=n_steps + 4), step_length
-
+    return contact_setup(scene).build(x_ideal, n_steps, step_length_m)
