@@ -140,7 +140,6 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     from walkerlab.analysis.contact_drop import drop_restitution
     from walkerlab.analysis.contact_record import drop_test
     from walkerlab.config import load_scene
-    from walkerlab.models.contact.scene import settings
 
     rf = load_scene("configs/round_feet.yaml")
     d = drop_test(rf.contact, 2.0)
@@ -148,7 +147,7 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     assert d["unit"] == "N/m^e"
     assert d["stiffness"][0] < k < d["stiffness"][-1]
     i = int(np.argmin(abs(d["stiffness"] - k)))
-    own = drop_restitution(settings(rf)[0], mass_kg=2.0, v_in_m_per_s=0.3)["restitution"]
+    own = drop_restitution(rf.contact, mass_kg=2.0, v_in_m_per_s=0.3)["restitution"]
     assert 0 < own < 0.2  # near-plastic, as the scene's comment intends
     assert d["paper"]["restitution"][i] == own
     # the rigid-limit family keeps the scene contact's restitution at every k (self-similar

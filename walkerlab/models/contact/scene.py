@@ -29,32 +29,11 @@ from .rigid_limit import contact_si
 if TYPE_CHECKING:
     from walkerlab.walker.description import WalkerData
 
-__all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal_step_length",
-           "settings"]
+__all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal_step_length"]
 
 
 class ContactSceneError(ValueError):
     """The scene lacks a section the contact model needs (one-line message)."""
-
-
-def settings(scene: Scene):
-    """Contact sections of ``scene`` with defaults for the optional ones.
-
-    Returns
-    -------
-    (ContactSettings, TerrainSettings, ContactSimSettings, SolverSettings)
-
-    Raises
-    ------
-    ContactSceneError
-        The scene has no ``contact`` section.
-    """
-    if scene.contact is None:
-        raise ContactSceneError(f"scene '{scene.name}' has no 'contact' section, which the "
-                                "contact model needs")
-    return (scene.contact, scene.terrain or TerrainSettings(),
-            scene.contact_sim or ContactSimSettings(),
-            scene.contact_solver or SolverSettings.for_contact())
 
 
 def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
@@ -165,7 +144,11 @@ def contact_setup(scene: Scene) -> ContactSetup:
     from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, check_masses
     from walkerlab.walker.description import walker_data
 
-    contact, terrain, cs, sv = settings(scene)
+    if scene.contact is None:
+        raise ContactSceneError(f"scene '{scene.name}' has no 'contact' section, which the "
+                                "contact model needs")
+    contact = scene.contact
+    cs = scene.contact_sim or ContactSimSettings()
     data = walker_data(scene.walker, scene.slope.phi_rad)
     if cs.pin_stance_until != "none" and data.structure.foot != "point":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: pinning "
@@ -178,7 +161,8 @@ def contact_setup(scene: Scene) -> ContactSetup:
     if data.structure.foot == "flat" and contact.flat_foot() is None:
         raise ContactSceneError(f"scene '{scene.name}': {FLAT_FOOT_MESSAGE}")
     si, knee = contact_si(contact)  # the contact law in SI: once per run
-    return ContactSetup(scene.name, contact, si, knee, data, terrain, cs, sv)
+    return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
+                        cs, scene.contact_solver or SolverSettings.for_contact())
 
 
 def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
