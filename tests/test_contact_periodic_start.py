@@ -75,3 +75,32 @@ def test_contact_sim_stage_starts_from_the_periodic_gait(tmp_path):
     hs = cs.heel_strike_times
     assert hs.size == 3 and hs[0] < 0.6 * cs.periodic.step_period_s  # started mid-stance
     assert np.all(np.abs(np.diff(hs) - cs.periodic.step_period_s) < 2e-5)
+
+
+@pytest.mark.slow  # fixedpoint, a periodic-gait search (~3 s CPU) and a 2-stride contact run
+def test_contact_sim_reads_the_scene_once(tmp_path, monkeypatch):
+    """Issue 27: ``contact-sim`` turns the scene into its typed contact setup once
+    (:func:`walkerlab.models.contact.scene.contact_setup`: walker data, the contact law in
+    SI, terrain, run options, solver) and hands that on.  The start from the periodic gait
+    builds two walkers (the search's probe, then the run's on the gait's patch spacing);
+    each build used to read the scene and convert the contact law to SI again."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.models.contact import scene as contact_scene
+
+    root = Path(__file__).resolve().parents[1]
+    d = yaml.safe_load((root / "configs" / "paper.yaml").read_text())
+    d = {k: v for k, v in d.items() if k not in ("workprecision", "basin")}
+    d["name"] = "once"
+    d["contact_sim"] = {**d["contact_sim"], "n_strides": 2, "periodic_gait": False,
+                        "start": "periodic_gait"}
+    path = tmp_path / "once.yaml"
+    path.write_text(yaml.safe_dump(d))
+    calls = []
+    real = contact_scene.contact_si
+    monkeypatch.setattr(contact_scene, "contact_si", lambda c: calls.append(c) or real(c))
+    r = CliRunner().invoke(app, ["contact-sim", str(path), "--runs-dir", str(tmp_path / "r")])
+    assert r.exit_code == 0, r.stderr
+    assert len(calls) == 1
