@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.rigid import integrate_step, numeric_jacobian
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
@@ -209,7 +210,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     FixedPointNotFound
         The root finder did not converge, or the map failed (fall) near the guess.
     """
-    from scipy.optimize import root
+    root = import_on_fresh_stack("scipy.optimize").root  # see walkerlab.freshstack
 
     t0 = time.perf_counter()
     counter = {"nfev": 0, "calls": 0, "jacobians": 0}
