@@ -13,12 +13,15 @@ with every frame added or removed anywhere between the CLI and the solver.
 :func:`import_on_fresh_stack` imports the module in a short-lived thread, whose data stack
 starts empty, so the cost of the import no longer depends on the caller's depth (a thread
 start, ~0.1 ms).  Python's import lock makes this an ordinary import: the module lands in
-``sys.modules`` for every thread; if the thread's import failed, the caller imports again\nand the error is raised in the caller.
+``sys.modules`` for every thread, and an error raised by the import (ImportError or any
+error of the module's own code) is raised again in the caller.  The thread body calls
+``__import__`` directly: the frames between the thread's start and the import are fixed
+here (``scipy.optimize``: ~500 16 KiB ``munmap`` calls per process against ~1,900 from
+the pre-renovation code's depth and ~10,000 from the root finder's).
 """
 
 from __future__ import annotations
 
-import importlib
 import sys
 import threading
 from types import ModuleType
@@ -43,10 +46,22 @@ def import_on_fresh_stack(name: str) -> ModuleType:
     ------
     ImportError
         As ``importlib.import_module(name)`` would (raised in the calling thread).
+    Exception
+        Whatever the module's own code raises while it is imported.
     """
     if name not in sys.modules:
-        worker = threading.Thread(target=importlib.import_module, args=(name,), daemon=True)
+        errors: list[BaseException] = []
+        worker = threading.Thread(target=_load, args=(name, errors), daemon=True)
         worker.start()
         worker.join()
-    # imported by the thread; else import here, which raises the import's error
-    return importlib.import_module(name)
+        if errors:
+            raise errors[0]
+    return sys.modules[name]
+
+
+def _load(name: str, errors: list) -> None:
+    """Thread body: ``__import__`` (no Python frame of importlib's own in between)."""
+    try:
+        __import__(name)
+    except BaseException as exc:  # noqa: BLE001 - raised again in the caller
+        errors.append(exc)
