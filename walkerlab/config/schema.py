@@ -3,10 +3,11 @@ slope and model-variant sections, and the sizes typed on the command line.
 
 The walker sections live in :mod:`walkerlab.config.walker`, the analyses' sections in
 :mod:`walkerlab.config.studies`, the compliant-contact ones in
-:mod:`walkerlab.config.contact`.  Every numeric field carries its unit in its name (``leg_length_m``) and a description;
-unknown keys are rejected (``extra="forbid"``).  The caps the fields use live in
-:mod:`walkerlab.config.limits`, the file reading and error lines in
-:mod:`walkerlab.config.loader`; everything is importable from :mod:`walkerlab.config`.
+:mod:`walkerlab.config.contact`.  Every numeric field carries its unit in its name
+(``leg_length_m``) and a description; unknown keys are rejected (``extra="forbid"``).  The
+caps the fields use live in :mod:`walkerlab.config.limits`, the file reading and error
+lines in :mod:`walkerlab.config.loader`; everything is importable from
+:mod:`walkerlab.config`.
 """
 
 from __future__ import annotations
