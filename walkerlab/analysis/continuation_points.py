@@ -37,6 +37,7 @@ __all__ = ["BranchPoint", "SpecialPoint", "bordered_jacobian", "branch_point", "
            "switch_period_doubling"]
 
 
+@dataclass
 class BranchPoint:
     """One point of a branch (a fixed point of the ``k``-step map).
 
