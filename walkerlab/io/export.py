@@ -394,45 +394,56 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     children: dict[str, list[Link]] = {}
     for ln in mb.links:
         children.setdefault(ln.parent, []).append(ln)
-    joint_springs = _joint_springs(mb)
-
-    def body(ln: Link, indent: str) -> list[str]:
-        inertia = max(ln.inertia_kg_m2, lo)
-        rng = f' range="{_v(-math.pi, 0)}"' if ln.joint.endswith("_knee") else ""
-        if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
-            sp = joint_springs[ln.joint]
-            rng += (f' stiffness="{_f(sp.stiffness_n_m_per_rad)}" '
-                    f'springref="{_f(sp.rest_angle_rad)}" '
-                    f'damping="{_f(sp.damping_n_m_s_per_rad)}"')
-        reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
-        lines = [f'{indent}<body name="{ln.name}" pos="{_v(0, 0, -ln.joint_from_parent_m)}">',
-                 f'{indent}  <joint name="{ln.joint}" type="hinge" axis="{AXIS}"{rng}/>',
-                 f'{indent}  <inertial pos="{_v(ln.com_off_axis_m, 0, -ln.com_m)}" '
-                 f'mass="{_f(ln.mass_kg)}" diaginertia="{_v(inertia, inertia, lo)}"/>',
-                 f'{indent}  <geom type="capsule" fromto="{_v(0, 0, 0, 0, 0, -reach)}" '
-                 f'size="{_f(width / 2)}"/>']
-        if ln.foot_m is not None:
-            leg = ln.name.split("_")[0]
-            foot = leg + "_foot"
-            z = -ln.foot_m
-            y = 0.0 if extra is None or extra.lanes is None else (
-                0.05 if leg == "leg1" else -0.05) * mb.leg_length_m
-            if _arc(mb):
-                geom = (f'type="cylinder" fromto="{_v(0, y - width, z, 0, y + width, z)}" '
-                        f'size="{_f(mb.foot_radius_m)}"')
-            else:
-                geom = f'type="sphere" pos="{_v(0, y, z)}" size="{_f(point_foot_radius(mb))}"'
-            lines += [f'{indent}  <site name="{foot}" pos="{_v(0, 0, z)}"/>',
-                      f'{indent}  <geom name="{foot}" {geom} contype="0" '
-                      f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
-        for child in children.get(ln.name, []):
-            lines += body(child, indent + "  ")
-        return lines + [f"{indent}</body>"]
-
     for ln in children["hip"]:
-        out += body(ln, "      ")
+        out += _mjcf_body(ln, "      ", mb, extra, children, _joint_springs(mb))
+    out += ["    </body>", "  </worldbody>", *_tendons(mb), *_mjcf_tail(mb, extra), ""]
+    return "\n".join(out)
+
+
+def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
+               children: dict, joint_springs: dict) -> list[str]:
+    """The MJCF body of link ``ln`` with its hinge, inertia, capsule, foot (a site and a
+    contact geom) and its child links' bodies nested inside."""
+    lo = MJCF_MIN_INERTIA_KG_M2
+    width = mb.leg_length_m / 50
+    inertia = max(ln.inertia_kg_m2, lo)
+    rng = f' range="{_v(-math.pi, 0)}"' if ln.joint.endswith("_knee") else ""
+    if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
+        sp = joint_springs[ln.joint]
+        rng += (f' stiffness="{_f(sp.stiffness_n_m_per_rad)}" '
+                f'springref="{_f(sp.rest_angle_rad)}" '
+                f'damping="{_f(sp.damping_n_m_s_per_rad)}"')
+    reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
+    lines = [f'{indent}<body name="{ln.name}" pos="{_v(0, 0, -ln.joint_from_parent_m)}">',
+             f'{indent}  <joint name="{ln.joint}" type="hinge" axis="{AXIS}"{rng}/>',
+             f'{indent}  <inertial pos="{_v(ln.com_off_axis_m, 0, -ln.com_m)}" '
+             f'mass="{_f(ln.mass_kg)}" diaginertia="{_v(inertia, inertia, lo)}"/>',
+             f'{indent}  <geom type="capsule" fromto="{_v(0, 0, 0, 0, 0, -reach)}" '
+             f'size="{_f(width / 2)}"/>']
+    if ln.foot_m is not None:
+        leg = ln.name.split("_")[0]
+        foot = leg + "_foot"
+        z = -ln.foot_m
+        y = 0.0 if extra is None or extra.lanes is None else (
+            0.05 if leg == "leg1" else -0.05) * mb.leg_length_m
+        if _arc(mb):
+            geom = (f'type="cylinder" fromto="{_v(0, y - width, z, 0, y + width, z)}" '
+                    f'size="{_f(mb.foot_radius_m)}"')
+        else:
+            geom = f'type="sphere" pos="{_v(0, y, z)}" size="{_f(point_foot_radius(mb))}"'
+        lines += [f'{indent}  <site name="{foot}" pos="{_v(0, 0, z)}"/>',
+                  f'{indent}  <geom name="{foot}" {geom} contype="0" '
+                  f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
+    for child in children.get(ln.name, []):
+        lines += _mjcf_body(child, indent + "  ", mb, extra, children, joint_springs)
+    return lines + [f"{indent}</body>"]
+
+
+def _mjcf_tail(mb: Multibody, extra: MjcfScene | None) -> list[str]:
+    """After the world: the equality constraints (couplings, knee latches), the numbers a
+    stepping loop reads (``custom``) and the keyframes (``standing``; ``gait`` with
+    ``extra``), through ``</mujoco>``."""
     standing = [0.0, mb.leg_length_m] + [0.0] * len(mb.links)
-    out += ["    </body>", "  </worldbody>", *_tendons(mb)]
     keys = [f'    <key name="standing" qpos="{_v(*standing)}"/>']
     equality = [f'    <tendon name="{cp.name}" tendon1="{cp.name}" '
                 f'solref="{_v(2 * (extra.timestep_s if extra else MJCF_DEFAULT_TIMESTEP_S), 1)}" '
@@ -445,8 +456,7 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
             equality += [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
                          f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>'
                          for k in knees]
-    if equality:
-        out += ["  <equality>", *equality, "  </equality>"]
+    out = ["  <equality>", *equality, "  </equality>"] if equality else []
     if extra is not None:  # what a stepping loop needs (walkerlab.analysis.mujoco_walk)
         arc = mb.foot_radius_m if _arc(mb) else 0.0
         custom = {"slope_rad": mb.slope_rad, "foot_height_offset_m": arc}
@@ -454,8 +464,7 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
             custom.update(latch_release_height_m=extra.latch[0], latch_capture_rad=extra.latch[1])
         out += ["  <custom>", *(f'    <numeric name="{k}" data="{_f(v)}"/>'
                                 for k, v in custom.items()), "  </custom>"]
-    out += ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>", ""]
-    return "\n".join(out)
+    return out + ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>"]
 
 
 def keyframe_json(mb: Multibody, extra: MjcfScene) -> str:
