@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.integrate.rigid import integrate_step, numeric_jacobian
+from walkerlab.integrate.rigid import integrate_step
+from walkerlab.integrate.rigid_phase import numeric_jacobian
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 
