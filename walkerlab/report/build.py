@@ -19,7 +19,7 @@ import numpy as np
 import walkerlab
 from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
-from walkerlab.report import contact_sections, sections
+from walkerlab.report import contact_sections, sections, study_sections
 from walkerlab.report.markdown import details, num, table, text, to_html
 from walkerlab.report.robustness_section import robustness_section
 from walkerlab.units import for_scene as units_for_scene
@@ -44,12 +44,25 @@ class ReportInputs:
         (:func:`walkerlab.analysis.gait_checks.energy_drift_in_swing`).
     swing_clearance : float
         Lowest swing-foot height above the slope [m] (NaN: none).
+    basin_area : BasinArea or None
+        The basin's area in the basin map's slice
+        (:func:`walkerlab.analysis.basin_area.basin_area`; None: no basin).
+    bifurcation_onsets : dict[str, (float, float)]
+        Period-doubling onset and fall onset (NaN: none on the grid) in the grid's unit by
+        bifurcation artifact key (:func:`walkerlab.sweep.bifurcation.onset_value`,
+        :func:`walkerlab.sweep.bifurcation.fall_onset`).
+
+    The stage computes them before the report is written
+    (:func:`walkerlab.stages.report.load_inputs`), mostly through
+    :func:`walkerlab.analysis.report_numbers.report_numbers`.
     """
 
     artifacts: dict
     gait_columns: dict = field(default_factory=dict)
     energy_drift: tuple = (float("nan"), float("nan"))
     swing_clearance: float = float("nan")
+    basin_area: object = None
+    bifurcation_onsets: dict = field(default_factory=dict)
 
 
 def _header(scene) -> list[str]:
@@ -111,9 +124,9 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     md += contact_sections.sections(scene, arts)
     md += attribution_section(scene, arts)
     md += sections.workprecision_summary(scene, arts)
-    md += sections.bifurcation_section(arts, pub)
-    md += sections.basin_section(arts)
-    md += robustness_section(arts)
+    md += study_sections.bifurcation_section(arts, inputs.bifurcation_onsets, pub)
+    md += study_sections.basin_section(arts)
+    md += robustness_section(arts, inputs.basin_area)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
     md += sections.figures_section(Path(figures_dir), str(rel), arts)

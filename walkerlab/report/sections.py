@@ -16,10 +16,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from walkerlab.analysis.tables import TABLE3_ROWS
 from walkerlab.report.markdown import details, num, printed, sig_digits, table
 from walkerlab.report.text import workprecision_choice, zero_multipliers_text
 from walkerlab.units import Units, for_scene
+
+#: Table 3 rows (keys of :func:`walkerlab.analysis.tables.gait_metrics`): name, symbol, unit
+TABLE3_ROWS = {
+    "t_left_s": ("Left step period", "t_left", "s"),
+    "t_right_s": ("Right step period", "t_right", "s"),
+    "t_cycle_s": ("One cycle period", "t_cycle = t_left + t_right", "s"),
+    "v_com_m_per_s": ("Average velocity of robot", "v_com", "m/s"),
+    "E_avg_J": ("Average mechanical energy (5 steps)", "E_avg = KE + PE", "J"),
+}
 
 if TYPE_CHECKING:  # loaded artifacts (walkerlab.io.schemas)
     from walkerlab.io.schemas.simulate import SimulateArtifact
@@ -367,75 +375,3 @@ def workprecision_summary(scene, arts: dict) -> list[str]:
                 "only the more accurate is kept): "
                 + ", ".join(f"{a} {r:.0e}" for a, r in zip(pm, pr)) + ".", ""]
     return out
-
-
-# --------------------------------------------------------------------------- bifurcation
-def bifurcation_section(arts: dict, pub: ModuleType | None = None) -> list[str]:
-    """Period-doubling onset from ``bifurcation.h5`` (when the scene ran that stage) and from
-    each ``bifurcation_<field>.h5`` (``bifurcation --param``), the grid named by its field
-    and unit (``arts``: loaded :class:`walkerlab.io.schemas.bifurcation.BifurcationSummary`
-    by artifact key)."""
-    out = []
-    b = arts.get("bifurcation")
-    if b is not None:
-        out += _bifurcation_lines(b, pub)
-    for key in sorted(k for k in arts if k.startswith("bifurcation_")):
-        out += _bifurcation_lines(arts[key], None)
-    return out
-
-
-def _bifurcation_lines(b, pub: ModuleType | None) -> list[str]:
-    from walkerlab.io.schemas.bifurcation import SLOPE_PATH
-    from walkerlab.sweep.bifurcation import fall_onset, onset_value
-
-    p, data, values, per = b.path, b.data, b.values, b.attractor_period
-    path, unit = data["parameter_path"], data["parameter_unit"]
-    onset = onset_value(data)
-    falls = fall_onset(data)
-    periods = sorted(set(int(v) for v in per if v > 0))
-    if path == SLOPE_PATH:
-        text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
-                "where the most negative real Floquet multiplier crosses −1"
-                if np.isfinite(onset) else "no period doubling on the grid")
-        out = ["## Bifurcation over the slope", "",
-               f"Grid {printed(values[0])}–{printed(values[-1])}° ({values.size} slopes): "
-               f"{text}; steady-state periods seen: {periods}"
-               + (f"; from {num(falls)}° on the walker falls (no steady gait)."
-                  if np.isfinite(falls) else "; the walker walks up to the largest slope.")]
-        rng = getattr(pub, "STABLE_SLOPE_RANGE_RAD", None)
-        if rng is not None:
-            out.append(f"Published ({pub.SHORT}): the period-1 gait is stable for "
-                       f"{printed(rng[0])} < γ < {printed(rng[1])} rad "
-                       f"({printed(round(np.degrees(rng[1]), 4))}°).")
-        return out + [""]
-    u = "" if unit in ("", "-") else f" {unit}"
-    text = (f"period-doubling onset at {path} = {num(onset)}{u}, where the most negative "
-            "real Floquet multiplier crosses −1" if np.isfinite(onset)
-            else "no period doubling on the grid")
-    return [f"## Bifurcation over `{path}`", "",
-            f"Grid {printed(values[0])}–{printed(values[-1])}{u} ({values.size} values, "
-            f"`{p.name}`): {text}; steady-state periods seen: {periods}"
-            + (f"; from {num(falls)}{u} on the walker falls (no steady gait)."
-               if np.isfinite(falls) else "; the walker walks up to the largest value."), ""]
-
-
-# --------------------------------------------------------------------------- basin
-def basin_section(arts: dict) -> list[str]:
-    """Outcome shares of ``basin.h5`` (when the scene ran that stage)."""
-    b = arts.get("basin")
-    if b is None:
-        return []
-    counts, xa, ya, xc, yc = b.counts, b.x_axis, b.y_axis, b.x, b.y
-    xu, yu, start, max_steps = b.x_unit, b.y_unit, b.start, b.max_steps
-    n = sum(counts.values())
-    how = ("each cell a state just after a heel strike (the heel-strike image of a pre-impact "
-           "state on the guard)" if start == "heel_strike"
-           else "the other coordinates from the fixed point, projected on the heel-strike "
-           "surface")
-    rows = [[o.replace("_", " "), str(c), num(100 * c / n, 3)] for o, c in counts.items() if c]
-    return ["## Basin of attraction", "",
-            f"{xc.size} × {yc.size} cells over {xa} {printed(xc.min())}…{printed(xc.max())} {xu} × "
-            f"{ya} {printed(yc.min())}…{printed(yc.max())} {yu} (cell centres), {how}; at most "
-            f"{max_steps} steps a cell.  {num(100 * counts.get('converged', 0) / n, 3)} % of "
-            "the cells reach the period-1 gait.", "",
-            table(["outcome", "cells", "share [%]"], rows), ""]
