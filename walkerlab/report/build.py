@@ -47,6 +47,13 @@ class ReportInputs:
     basin_area : BasinArea or None
         The basin's area in the basin map's slice
         (:func:`walkerlab.analysis.basin_area.basin_area`; None: no basin).
+    published_step_length_m : float
+        Step length the published fixed point (Eq. (11)) implies [m] (NaN: none printed).
+    phase_error : (float, float, int) or None
+        Largest phase-aligned angle error of the comparison [rad], over its last step, and
+        that step's number (None: no comparison).
+    mean_stance_slip_mm : float
+        Mean stance-foot slip per step of the contact run [mm] (NaN: none).
     bifurcation_onsets : dict[str, (float, float)]
         Period-doubling onset and fall onset (NaN: none on the grid) in the grid's unit by
         bifurcation artifact key (:func:`walkerlab.sweep.bifurcation.onset_value`,
@@ -62,6 +69,9 @@ class ReportInputs:
     energy_drift: tuple = (float("nan"), float("nan"))
     swing_clearance: float = float("nan")
     basin_area: object = None
+    published_step_length_m: float = float("nan")
+    phase_error: tuple | None = None
+    mean_stance_slip_mm: float = float("nan")
     bifurcation_onsets: dict = field(default_factory=dict)
 
 
@@ -121,7 +131,7 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     if "fixedpoint" in arts:
         md += sections.fixedpoint_section(arts["fixedpoint"], pub)
     md += sections.gait_section(scene, inputs, pub)
-    md += contact_sections.sections(scene, arts)
+    md += contact_sections.sections(scene, inputs)
     md += attribution_section(scene, arts)
     md += sections.workprecision_summary(scene, arts)
     md += study_sections.bifurcation_section(arts, inputs.bifurcation_onsets, pub)

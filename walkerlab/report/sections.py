@@ -232,9 +232,7 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     ideal = cols.get("ours, ideal")
     eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
     if ideal and t3 and eq is not None and step_pub is not None:
-        L = float(scene.walker.leg_length_m)
-        eqd = dict(zip(pub.EQ11_NAMES, eq))
-        dx_eq11 = 2 * L * np.sin((eqd["stance_angle"] - eqd["swing_angle"]) / 2)
+        dx_eq11 = inputs.published_step_length_m
         e_pub = t3["E_avg_J"][0]
         e_st = ideal.get("E_avg_stance_frame_J", np.nan)
         out += ["", "**Differences from the published Table 3, measured:**", "",
