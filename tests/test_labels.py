@@ -213,10 +213,10 @@ def test_report_cites_the_paper_not_a_path(tmp_path):
 
 # --------------------------------------------------------------------------- figures
 def test_figures_in_paper_order(tmp_path, monkeypatch):
-    from walkerlab.report import sections
-    from walkerlab.report.sections import CAPTIONS, figures_section
+    from walkerlab.report import figures_section as module
+    from walkerlab.report.figures_section import CAPTIONS, figures_section
 
-    monkeypatch.setattr(sections, "steps_table", lambda path: "")  # no artifact read here
+    monkeypatch.setattr(module, "steps_table", lambda path: "")  # no artifact read here
 
     stems = [s for s, _ in CAPTIONS]
     assert stems[:6] == ["fig2_stick_ideal", "fig6_stick_contact", "fig7_angles_rates",

@@ -20,8 +20,10 @@ import walkerlab
 from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections, study_sections
+from walkerlab.report.figures_section import figures_section
 from walkerlab.report.markdown import details, num, table, text, to_html
 from walkerlab.report.robustness_section import robustness_section
+from walkerlab.report.workprecision_section import workprecision_summary
 from walkerlab.units import for_scene as units_for_scene
 
 
@@ -133,13 +135,13 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     md += sections.gait_section(scene, inputs, pub)
     md += contact_sections.sections(scene, inputs)
     md += attribution_section(scene, arts)
-    md += sections.workprecision_summary(scene, arts)
+    md += workprecision_summary(scene, arts)
     md += study_sections.bifurcation_section(arts, inputs.bifurcation_onsets, pub)
     md += study_sections.basin_section(arts)
     md += robustness_section(arts, inputs.basin_area)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
-    md += sections.figures_section(Path(figures_dir), str(rel), arts)
+    md += figures_section(Path(figures_dir), str(rel), arts)
     md += ["## Scene", ""]
     md += details("Resolved scene (JSON)", "\n".join(
         ["```json", json.dumps(scene.model_dump(mode="json", exclude_none=True), indent=1),
