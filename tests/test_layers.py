@@ -6,7 +6,10 @@ also those inside functions), never by running it: dependencies point down.
 - a stage never imports another stage: only the pipeline (and the report's DAG run, which
   the pipeline's plan drives) reach other stages;
 - ``h5py`` is imported only under ``walkerlab/io/`` (the artifact schemas);
-- the CLI opens no artifact itself (no ``h5py``, no ``open_artifact``).
+- the CLI opens no artifact itself (no ``h5py``, no ``open_artifact``);
+- ``report/`` writes text from loaded schema objects and numbers computed before it: no
+  ``h5py``, no matplotlib or ``plotting``, no ``analysis``, ``sweep``, ``models``,
+  ``integrate`` (its run-end names aside), no loader.
 """
 
 from __future__ import annotations
