@@ -332,7 +332,7 @@ def test_work_precision_labels_do_not_overlap():
 
 def _wp_rows(times: dict) -> dict:
     """{method: (rtols, [[repeat times] per rtol], errors)} -> rows_from_cases output."""
-    from walkerlab.analysis.workprecision import rows_from_cases
+    from walkerlab.analysis.workprecision_results import rows_from_cases
 
     cases, methods, rtols = {}, list(times), [1e-6, 1e-8]
     for m, per in times.items():
@@ -345,7 +345,7 @@ def _wp_rows(times: dict) -> dict:
 def test_work_precision_choice_respects_timing_noise():
     """Overlapping repeat ranges: no setting is named fastest, the tied ones are listed;
     clearly separated: the fastest is named with its spread."""
-    from walkerlab.analysis.workprecision import summarize
+    from walkerlab.analysis.workprecision_results import summarize
     from walkerlab.report.text import workprecision_choice
 
     noisy = summarize(_wp_rows({"DOP853": [[1.0, 1.4, 2.0], [0.9, 1.3, 1.8]],

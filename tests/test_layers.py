@@ -16,7 +16,7 @@ from pathlib import Path
 
 PKG = Path(__file__).resolve().parents[1] / "walkerlab"
 #: the top floor: may import stages
-FRONT = ("cli", "api.py", "bench.py")
+FRONT = ("cli", "api", "bench.py")
 #: stage modules that chain stages (the one place that decides order, and the report's run)
 CHAINS = ("pipeline.py", "report_dag.py", "report.py")
 
