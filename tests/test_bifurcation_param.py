@@ -36,7 +36,7 @@ def test_bifurcation_over_a_body_mass_by_name(tmp_path):
     from walkerlab.plotting.sweep_figures import bifurcation_figure, plt
     from walkerlab.report.sections import bifurcation_section
     from walkerlab.stages.report import load_inputs
-    from walkerlab.stages.report_dag import existing_artifacts
+    from walkerlab.stages.report_inputs import existing_artifacts
 
     scene = load_scene(ROOT / "configs" / "kneed.yaml")
     grid = parse_param(f"{SHANK}=0.03:0.07:0.02").values

@@ -105,7 +105,7 @@ def test_nondimensional_report_and_figures_follow_the_scene(simplest_run):
     from walkerlab.plotting import figures as F
     from walkerlab.report import sections
     from walkerlab.stages.report import load_inputs
-    from walkerlab.stages.report_dag import existing_artifacts
+    from walkerlab.stages.report_inputs import existing_artifacts
     from walkerlab.units import for_scene
 
     sc, root, _ = simplest_run

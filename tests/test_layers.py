@@ -69,7 +69,7 @@ def test_library_modules_never_import_stages_or_the_front_doors():
 
 
 def test_a_stage_never_imports_another_stage():
-    shared = ("common", "pipeline")  # the plumbing, and the one place that knows stages
+    shared = ("common", "pipeline", "report_inputs")  # plumbing; the place that knows stages
     bad = {}
     for path in sorted((PKG / "stages").glob("*.py")):
         if path.name in CHAINS:

@@ -25,7 +25,7 @@ from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.io.terrain import load_terrain
 from walkerlab.plotting import CONTACT_LABEL, IDEAL_LABEL
 from walkerlab.stages.common import artifact_path
-from walkerlab.stages.pipeline import computed_for
+from walkerlab.stages.report_inputs import computed_for
 
 #: Frames per second, and the most frames one animation gets (a 5-stride compass gait,
 #: 7 s, is 141 frames at 20 fps; longer runs play faster).

@@ -10,7 +10,7 @@ computed from them (Table 3, energy drift, swing-foot clearance: :func:`load_inp
 Sections appear only when the scene produces their data: an ideal-only scene gets an
 ideal-only report, with no empty contact panels.  Artifacts an earlier standalone command
 left in the run folder are left out, in one line
-(:func:`walkerlab.stages.report_dag.report_artifacts`).
+(:func:`walkerlab.stages.report_inputs.report_artifacts`).
 """
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ from walkerlab.config import Scene
 from walkerlab.io.runpaths import figures_dir, report_dir
 from walkerlab.report.build import ReportInputs, write_report
 from walkerlab.stages.pipeline import report_plan
-from walkerlab.stages.report_dag import report_artifacts, run_report
+from walkerlab.stages.report_dag import run_report
+from walkerlab.stages.report_inputs import report_artifacts
 
 
 def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportInputs:
