@@ -28,6 +28,7 @@ from typer.testing import CliRunner
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.execution.workers import process_alive
+from walkerlab.io import freshness
 from walkerlab.io.artifacts import ArtifactError, atomic_write, open_artifact, write_artifact
 from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock
 from walkerlab.io.sweep_store import load_sweep, partial_path
@@ -273,10 +274,10 @@ def test_d6_edited_artifact_and_edited_upstream_are_detected(tmp_path):
     assert common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (),
                              _fake_compute(-0.8)).reused
     up = (first.path,)
-    key_before = common.input_hash("simulate", sc, ("walker",), up)
+    key_before = freshness.input_hash("simulate", sc, ("walker",), up)
     with h5py.File(first.path, "a") as f:  # a user edits the output by hand
         f["fixed_point/stance_rate"][()] = -3.0
-    assert common.input_hash("simulate", sc, ("walker",), up) != key_before  # downstream
+    assert freshness.input_hash("simulate", sc, ("walker",), up) != key_before  # downstream
     again = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(-0.8))
     assert not again.reused  # the edited output is not trusted
     with open_artifact(again.path, "fixedpoint") as f:
@@ -536,8 +537,8 @@ def test_force_replaces_an_artifact_without_hashing_it(tmp_path, monkeypatch):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(1.0))
     verified = []
-    real = common.verified_hash
-    monkeypatch.setattr(common, "verified_hash", lambda p: verified.append(p) or real(p))
+    real = freshness.verified_hash
+    monkeypatch.setattr(freshness, "verified_hash", lambda p: verified.append(p) or real(p))
     out = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(2.0),
                             force=True)
     assert verified == [] and not out.reused and out.note == "--force"
