@@ -30,7 +30,7 @@ from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.execution.workers import process_alive
 from walkerlab.io import freshness
 from walkerlab.io.artifacts import ArtifactError, atomic_write, open_artifact, write_artifact
-from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock
+from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock, stage_artifact
 from walkerlab.io.sweep_store import load_sweep, partial_path
 from walkerlab.stages import common
 from walkerlab.sweep import runner
@@ -91,7 +91,7 @@ def test_d1_symlinked_run_folder_leaving_runs_rejected(tmp_path):
     (tmp_path / "runs" / "paper").symlink_to(tmp_path / "elsewhere")
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     with pytest.raises(RunPathError, match="outside the runs folder"):
-        common.artifact_path(sc, tmp_path / "runs", "fixedpoint")
+        stage_artifact(sc, tmp_path / "runs", "fixedpoint")
 
 
 @pytest.mark.parametrize("name", ["fixedpoint", "simulate.h5", "contact_sim", "compare",
@@ -222,7 +222,7 @@ def test_d3_read_only_runs_folder_is_one_line(tmp_path, monkeypatch):
 
 def test_d3_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
-    path = common.artifact_path(sc, tmp_path, "simulate")
+    path = stage_artifact(sc, tmp_path, "simulate")
     write_artifact(path, "simulate", sc, "k", lambda f: None, 0.0)  # no samples/ inside
     from walkerlab.stages import plot
 
@@ -234,7 +234,7 @@ def test_d3_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
                                               ("t_final", 0)])
 def test_d11_contact_sim_fall_exits_non_zero(tmp_path, monkeypatch, termination, code):
     sc = scene_from_dict({**PAPER, "name": "paper"})
-    path = common.artifact_path(sc, tmp_path, "contact-sim")
+    path = stage_artifact(sc, tmp_path, "contact-sim")
 
     def fake_run_cached(stage, scene, runs_root, *a, **k):  # the run, not its physics
         write_artifact(path, "contact-sim", sc, "k",
@@ -486,7 +486,7 @@ def test_d7_sigkill_of_the_main_process_leaves_no_workers(tmp_path):
 
 def test_d4_a_second_stage_run_waits_for_the_first_writer(tmp_path, capfd):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
-    target = common.artifact_path(sc, tmp_path, "fixedpoint")
+    target = stage_artifact(sc, tmp_path, "fixedpoint")
     target.parent.mkdir(parents=True)
     holder = subprocess.Popen([sys.executable, "-c", textwrap.dedent(f"""
         import time

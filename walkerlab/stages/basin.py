@@ -11,11 +11,11 @@ from pathlib import Path
 from walkerlab.config import BasinSettings, Scene
 from walkerlab.config.options import basin_options
 from walkerlab.io.freshness import input_hash
-from walkerlab.io.runpaths import figures_dir
+from walkerlab.io.runpaths import figures_dir, stage_artifact
 from walkerlab.io.schemas.basin import load_basin, write_basin
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.plotting.artifact_figures import save_basin_figure
-from walkerlab.stages.common import StageError, StageOutcome, artifact_path, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "basin")
 
@@ -37,7 +37,7 @@ def draw(scene: Scene, runs_root: Path | str = "runs",
          grid: tuple[int, int] | None = None) -> list[Path]:
     """Draw the basin figure (PNG + SVG) from ``<stem>.h5``."""
     name = stem(scene, grid)
-    d = load_basin(artifact_path(scene, runs_root, name))
+    d = load_basin(stage_artifact(scene, runs_root, name))
     return save_basin_figure(d, scene.name, figures_dir(scene, runs_root), name)
 
 
@@ -57,14 +57,14 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     from walkerlab.sweep.basin import BasinError, basin_run
 
     grid, workers = check(scene, grid, workers)
-    up, name = artifact_path(scene, runs_root, "fixedpoint"), stem(scene, grid)
+    up, name = stage_artifact(scene, runs_root, "fixedpoint"), stem(scene, grid)
     extra, partial = f"grid={grid[0]}x{grid[1]}", []
 
     def compute():
         x_star = load_fixedpoint(up).x
         key = input_hash("basin", scene, SECTIONS, (up,), extra)  # run_cached's own key
         try:
-            basin, part = basin_run(scene, x_star, key, artifact_path(scene, runs_root, name),
+            basin, part = basin_run(scene, x_star, key, stage_artifact(scene, runs_root, name),
                                     grid, workers, scheduler, resume and not force, on_chunk)
         except BasinError as exc:
             raise StageError(str(exc)) from None

@@ -1,8 +1,8 @@
 """Shared stage plumbing: the outcome of a stage, its cache, the sections it needs.
 
 The cache is :func:`walkerlab.io.freshness.write_if_stale`; run paths come from
-:mod:`walkerlab.io.runpaths` (``artifact_path`` is its ``stage_artifact``); a section left
-out as its defaults from :mod:`walkerlab.config.sections`.
+:mod:`walkerlab.io.runpaths` (:func:`~walkerlab.io.runpaths.stage_artifact`); a section
+left out as its defaults from :mod:`walkerlab.config.sections`.
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ from pathlib import Path
 from walkerlab.config import Scene
 from walkerlab.config.sections import section_or_default, with_default_section
 from walkerlab.io.freshness import write_if_stale
-from walkerlab.io.runpaths import stage_artifact as artifact_path  # noqa: F401 (stages use it)
 
 
 class StageError(RuntimeError):

@@ -12,11 +12,11 @@ from pathlib import Path
 from walkerlab.config import Scene
 from walkerlab.config.options import mfpt_options
 from walkerlab.io.freshness import input_hash
-from walkerlab.io.runpaths import figures_dir
+from walkerlab.io.runpaths import figures_dir, stage_artifact
 from walkerlab.io.schemas import mfpt as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.plotting.artifact_figures import save_mfpt_figure
-from walkerlab.stages.common import StageError, StageOutcome, artifact_path, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt")
 
@@ -28,7 +28,7 @@ def figure_path(scene: Scene, runs_root: Path | str) -> Path:
 
 def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     """Draw log MFPT against sigma (PNG + SVG) from ``mfpt.h5``."""
-    d = schema.load(artifact_path(scene, runs_root, "mfpt"))
+    d = schema.load(stage_artifact(scene, runs_root, "mfpt"))
     return save_mfpt_figure(d, scene.name, figure_path(scene, runs_root).parent)
 
 
@@ -51,7 +51,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     from walkerlab.sweep.mfpt import MfptStudyError, mfpt_summary, resumable_mfpt_study
 
     st, workers = check(scene, sigma_rad, method, workers)
-    up, path = (artifact_path(scene, runs_root, s) for s in ("fixedpoint", "mfpt"))
+    up, path = (stage_artifact(scene, runs_root, s) for s in ("fixedpoint", "mfpt"))
     done = []  # the resume file, removed once the artifact is written
 
     def work():

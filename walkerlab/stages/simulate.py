@@ -12,9 +12,10 @@ from walkerlab.analysis.rigid_run import simulate_run
 from walkerlab.config import Scene, SceneError
 from walkerlab.config.options import with_strides
 from walkerlab.io.freshness import input_hash
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.schemas.simulate import longer_run_note, run_end, write_simulate
-from walkerlab.stages.common import StageError, StageOutcome, artifact_path, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
 
@@ -41,8 +42,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         raise StageError(str(exc)) from None
     upstream: tuple[Path, ...] = ()
     if scene.simulate.initial_state == "fixed_point":
-        upstream = (artifact_path(scene, runs_root, "fixedpoint"),)
-    path, note = artifact_path(scene, runs_root, "simulate"), ""
+        upstream = (stage_artifact(scene, runs_root, "fixedpoint"),)
+    path, note = stage_artifact(scene, runs_root, "simulate"), ""
     if strides is None and not force:
         note = longer_run_note(path, scene.simulate.strides, lambda n: input_hash(
             "simulate", with_strides(scene, n), SECTIONS, upstream))
