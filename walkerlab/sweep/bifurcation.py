@@ -169,7 +169,8 @@ def _arclength_step(fam, prev, value: float):
     at 3 kg, issue 23).  None when there is no previous point or the branch does not reach
     ``value`` (a fold in between): the caller falls back to the root finder.
     """
-    from walkerlab.analysis.continuation import MapFailed, continue_branch, first_point
+    from walkerlab.analysis.continuation import continue_branch, first_point
+    from walkerlab.analysis.continuation_map import MapFailed
 
     if prev is None:
         return None
