@@ -79,10 +79,10 @@ def simplest_run(tmp_path_factory):
 def test_nondimensional_artifact_units_and_cli_text(simplest_run):
     """The artifact's unit attributes follow the scene (clock times stay seconds) and the
     CLI summary prints no SI unit for a nondimensional scene."""
+    from walkerlab.io.runpaths import stage_artifact
     from walkerlab.io.schemas.fixedpoint import load_fixedpoint
     from walkerlab.io.schemas.simulate import load_simulate
     from walkerlab.report.text import fixedpoint_text, simulate_text
-    from walkerlab.stages.common import artifact_path
 
     sc, root, path = simplest_run
     with h5py.File(path, "r") as f:
@@ -93,7 +93,7 @@ def test_nondimensional_artifact_units_and_cli_text(simplest_run):
     text = simulate_text(load_simulate(path))
     assert "√(l/g)" in text and "M g l" in text and "nondimensional" in text
     assert not re.search(r"\d (s|m|m/s|J)\b(?! \(wall)", text), text
-    fp = fixedpoint_text(load_fixedpoint(artifact_path(sc, root, "fixedpoint")))
+    fp = fixedpoint_text(load_fixedpoint(stage_artifact(sc, root, "fixedpoint")))
     assert "step period" in fp and "√(l/g)" in fp and "rad/√(l/g)" in fp
     assert not re.search(r"\d (s|rad/s)$", fp, re.M), fp
 

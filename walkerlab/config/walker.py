@@ -44,6 +44,16 @@ class CompassGaitParams(Strict):
         """Distance b of the leg mass from the hip [m]."""
         return self.leg_length_m - self.leg_mass_from_foot_m
 
+    def as_biped(self) -> BipedParams:
+        """The same walker as a ``model: biped`` section: a hip mass and one point mass per
+        leg at b = L - a from the hip (paper Table 1, Eqs. A.1-A.3)."""
+        return BipedParams.model_validate({
+            "model": "biped", "coordinates": "absolute",
+            "gravity_m_per_s2": self.gravity_m_per_s2, "hip_mass_kg": self.hip_mass_kg,
+            "leg": {"length_m": self.leg_length_m, "bodies": [{
+                "kind": "point_mass", "name": "mass", "mass_kg": self.leg_mass_kg,
+                "from_hip_m": self.leg_length_m - self.leg_mass_from_foot_m}]}})
+
 
 # ---- generic walker description (``model: biped``): bodies, joints, feet as data.
 # A kneed leg (``knee``) and round feet (``foot.kind: arc``) extend these classes.

@@ -14,12 +14,13 @@ from walkerlab.config import Scene
 from walkerlab.io import runpaths
 from walkerlab.io.artifacts import require_unedited
 from walkerlab.io.freshness import drawing_key, stamp_matches
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.compare import load_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.io.schemas.workprecision import load_workprecision
 from walkerlab.io.terrain import load_terrain
-from walkerlab.stages.common import StageError, artifact_path
+from walkerlab.stages.common import StageError
 from walkerlab.units import for_scene
 
 #: figure groups and the stage artifacts each is drawn from
@@ -30,7 +31,7 @@ PARTS = {"trajectories": ("simulate", "contact-sim", "compare"),
 def figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
     """Stamp file of a drawn figure group (:data:`PARTS`) and its key
     (:func:`walkerlab.io.freshness.drawing_key` of the artifacts it is drawn from)."""
-    arts = {s: p for s in PARTS[part] if (p := artifact_path(scene, runs_root, s)).is_file()}
+    arts = {s: p for s in PARTS[part] if (p := stage_artifact(scene, runs_root, s)).is_file()}
     return (runpaths.figures_dir(scene, runs_root) / f".drawn_from_{part}", drawing_key(arts))
 
 
@@ -38,7 +39,7 @@ def _draw(scene: Scene, runs_root, part: str) -> list[Path]:
     from walkerlab.plotting import scene_figures  # matplotlib: only when drawing
 
     def load(stage, loader):
-        p = artifact_path(scene, runs_root, stage)
+        p = stage_artifact(scene, runs_root, stage)
         return loader(require_unedited(p)) if p.is_file() else None
 
     folder = runpaths.figures_dir(scene, runs_root, claim=True)
