@@ -17,8 +17,8 @@ from walkerlab.config import Scene
 #: the sources a case's result depends on (a change elsewhere - report text, plots, other
 #: stages - keeps the measured cases)
 CASE_SOURCES = {
-    "ideal": ("analysis", "models", "integrate", "config"),
-    "contact": ("analysis", "models", "contact", "integrate", "config"),
+    "ideal": ("analysis", "models", "integrate", "config", "walker", "codegen"),
+    "contact": ("analysis", "models", "integrate", "config", "walker", "codegen"),
 }
 
 
