@@ -141,8 +141,8 @@ def test_animate_cli_one_line_error(tmp_path):
 def test_report_embeds_the_gif(tmp_path):
     """The report's figures section shows animation.gif when it exists, and the HTML embeds
     it as a GIF."""
+    from walkerlab.report.figures_section import figures_section
     from walkerlab.report.markdown import to_html
-    from walkerlab.report.sections import figures_section
 
     figs = tmp_path / "figures"
     figs.mkdir()

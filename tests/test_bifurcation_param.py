@@ -34,9 +34,9 @@ def test_bifurcation_over_a_body_mass_by_name(tmp_path):
 
     from walkerlab.io.schemas.bifurcation import load_bifurcation
     from walkerlab.plotting.sweep_figures import bifurcation_figure, plt
-    from walkerlab.report.sections import bifurcation_section
+    from walkerlab.report.study_sections import bifurcation_section
     from walkerlab.stages.report import load_inputs
-    from walkerlab.stages.report_dag import existing_artifacts
+    from walkerlab.stages.report_inputs import existing_artifacts
 
     scene = load_scene(ROOT / "configs" / "kneed.yaml")
     grid = parse_param(f"{SHANK}=0.03:0.07:0.02").values
@@ -64,7 +64,7 @@ def test_bifurcation_over_a_body_mass_by_name(tmp_path):
     assert (tmp_path / "kneed" / "report" / "figures" / f"bifurcation_{SHANK}.png").is_file()
     # the report finds the artifact and names the grid by field and unit
     inputs = load_inputs(scene, existing_artifacts(scene, tmp_path), tmp_path)
-    text = "\n".join(bifurcation_section(inputs.artifacts))
+    text = "\n".join(bifurcation_section(inputs.artifacts, inputs.bifurcation_onsets))
     assert f"## Bifurcation over `{SHANK}`" in text and "0.03–0.07 kg (3 values" in text
     # a rerun with the same grid reuses the artifact
     assert bif_stage.run(scene, grid, tmp_path, n_transient=6, n_keep=3, workers=1,

@@ -57,6 +57,7 @@ def test_patch_width_map_on_continuous_ground_says_it_does_not_apply(tmp_path):
     import pytest
 
     from walkerlab.config import load_scene
+    from walkerlab.config.options import map_not_applicable
     from walkerlab.stages import stability_map
     from walkerlab.stages.common import StageError
 
@@ -65,9 +66,8 @@ def test_patch_width_map_on_continuous_ground_says_it_does_not_apply(tmp_path):
         stability_map.run(scene, tmp_path, kind="patch_width", n=2)
     assert "\n" not in str(e.value)
     assert not list(tmp_path.rglob("*.h5"))
-    assert stability_map.not_applicable(scene, "friction") == ""
-    assert stability_map.not_applicable(load_scene("configs/paper_rods.yaml"),
-                                        "patch_width") == ""
+    assert map_not_applicable(scene, "friction") == ""
+    assert map_not_applicable(load_scene("configs/paper_rods.yaml"), "patch_width") == ""
 
 
 def test_stability_map_figure_names_scene_units_and_unsupported_cells():

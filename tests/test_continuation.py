@@ -288,7 +288,8 @@ def test_stance_foot_normal_force_from_the_equations_of_motion():
     n + g cos phi) with n the slope normal.  The smallest N / (M g) over the step agrees to
     1e-5 (the second difference on 200 points a phase errs by ~h^2 |d^4 com/dt^4| / 12,
     measured 3e-6 here; at a branch end this moves the located parameter by 1e-5 / |dN/dp|)."""
-    from walkerlab.analysis.continuation import normal_force_ratio, step_map
+    from walkerlab.analysis.continuation_map import step_map
+    from walkerlab.analysis.continuation_validity import normal_force_ratio
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
     w = build_walker(scene)

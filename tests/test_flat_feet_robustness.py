@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from walkerlab.analysis import push
 from walkerlab.analysis import robustness as R
 from walkerlab.analysis.batch_step import HEEL_STRIKE
 from walkerlab.analysis.python_step import PythonStepMap, make_step_map
@@ -81,7 +82,7 @@ def test_push_restart_follows_the_phase_graph(flat):
     rotated to the mid-stance phase, so a restart from any phase's state finishes the step as
     the walker's own step does."""
     walker, _ = flat
-    p = R.pushed_step(walker, X_STAR, np.array([0.0]), solver=SOLVER)
+    p = push.pushed_step(walker, X_STAR, np.array([0.0]), solver=SOLVER)
     seg = integrate_step(walker, X_STAR, SOLVER)
     assert p.outcome[0] == HEEL_STRIKE
     assert p.step_time_s[0] == pytest.approx(seg.period, abs=1e-9)
@@ -90,7 +91,7 @@ def test_push_restart_follows_the_phase_graph(flat):
     # phases[k:] with the piece's index started in heel_off:early_swing)
     for j, (ph, dense, (ta, tb)) in enumerate(seg.pieces):
         tm = 0.5 * (ta + tb)
-        rest = R.starting_at(walker, ph.name)
+        rest = push.starting_at(walker, ph.name)
         s2 = integrate_step(rest, np.asarray(dense(tm), float)[:X_STAR.size], SOLVER, t0=tm)
         assert s2.termination == "heel_strike", ph.name
         assert [e[0] for e in s2.phase_log] == [e[0] for e in seg.phase_log[j:]]
@@ -105,19 +106,19 @@ def test_push_in_foot_flat_keeps_the_foot_locked(flat):
     seg = integrate_step(walker, X_STAR, SOLVER)
     ph, dense, (ta, tb) = next(pc for pc in seg.pieces if pc[0].name == "foot_flat:late_swing")
     x = np.asarray(dense(0.5 * (ta + tb)), float)
-    lock = R.entry_lock(walker, ph.name)
+    lock = push.entry_lock(walker, ph.name)
     assert lock is not None
-    assert R.entry_lock(walker, "heel_off:late_swing") is None  # heel off: no impact
+    assert push.entry_lock(walker, "heel_off:late_swing") is None  # heel off: no impact
     names = walker.state_names()
     i_s, i_a = names.index("stance_rate"), names.index("stance_ankle_rate")
     dv = 0.1
-    xp, P = R.apply_push(walker, x, dv, lock)
+    xp, P = push.apply_push(walker, x, dv, lock)
     assert abs(xp[i_s] + xp[i_a]) < 1e-12
     lay = walker.layout()
-    J = R.hip_jacobian(walker, x)
+    J = push.hip_jacobian(walker, x)
     v0, v1 = J @ lay.qd(x), J @ lay.qd(xp)
     assert v1[0] - v0[0] == pytest.approx(dv, abs=1e-8)
     assert P > 0
     # without the lock the foot would start turning
-    free, _ = R.apply_push(walker, x, dv)
+    free, _ = push.apply_push(walker, x, dv)
     assert abs(free[i_s] + free[i_a]) > 1e-3

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.analysis.gaits import deflation_starts, find_gaits, step_length
+from walkerlab.analysis.gait_starts import deflation_starts, step_length
+from walkerlab.analysis.gaits import find_gaits
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker

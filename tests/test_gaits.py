@@ -18,7 +18,8 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from walkerlab.analysis.gaits import GaitNotFound, find_gaits, state_from_legs
+from walkerlab.analysis.gait_starts import state_from_legs
+from walkerlab.analysis.gaits import GaitNotFound, find_gaits
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.solver import Solver

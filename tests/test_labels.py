@@ -79,10 +79,10 @@ def simplest_run(tmp_path_factory):
 def test_nondimensional_artifact_units_and_cli_text(simplest_run):
     """The artifact's unit attributes follow the scene (clock times stay seconds) and the
     CLI summary prints no SI unit for a nondimensional scene."""
+    from walkerlab.io.runpaths import stage_artifact
     from walkerlab.io.schemas.fixedpoint import load_fixedpoint
     from walkerlab.io.schemas.simulate import load_simulate
     from walkerlab.report.text import fixedpoint_text, simulate_text
-    from walkerlab.stages.common import artifact_path
 
     sc, root, path = simplest_run
     with h5py.File(path, "r") as f:
@@ -93,7 +93,7 @@ def test_nondimensional_artifact_units_and_cli_text(simplest_run):
     text = simulate_text(load_simulate(path))
     assert "√(l/g)" in text and "M g l" in text and "nondimensional" in text
     assert not re.search(r"\d (s|m|m/s|J)\b(?! \(wall)", text), text
-    fp = fixedpoint_text(load_fixedpoint(artifact_path(sc, root, "fixedpoint")))
+    fp = fixedpoint_text(load_fixedpoint(stage_artifact(sc, root, "fixedpoint")))
     assert "step period" in fp and "√(l/g)" in fp and "rad/√(l/g)" in fp
     assert not re.search(r"\d (s|rad/s)$", fp, re.M), fp
 
@@ -105,7 +105,7 @@ def test_nondimensional_report_and_figures_follow_the_scene(simplest_run):
     from walkerlab.plotting import figures as F
     from walkerlab.report import sections
     from walkerlab.stages.report import load_inputs
-    from walkerlab.stages.report_dag import existing_artifacts
+    from walkerlab.stages.report_inputs import existing_artifacts
     from walkerlab.units import for_scene
 
     sc, root, _ = simplest_run
@@ -213,10 +213,10 @@ def test_report_cites_the_paper_not_a_path(tmp_path):
 
 # --------------------------------------------------------------------------- figures
 def test_figures_in_paper_order(tmp_path, monkeypatch):
-    from walkerlab.report import sections
-    from walkerlab.report.sections import CAPTIONS, figures_section
+    from walkerlab.report import figures_section as module
+    from walkerlab.report.figures_section import CAPTIONS, figures_section
 
-    monkeypatch.setattr(sections, "steps_table", lambda path: "")  # no artifact read here
+    monkeypatch.setattr(module, "steps_table", lambda path: "")  # no artifact read here
 
     stems = [s for s, _ in CAPTIONS]
     assert stems[:6] == ["fig2_stick_ideal", "fig6_stick_contact", "fig7_angles_rates",
@@ -332,7 +332,7 @@ def test_work_precision_labels_do_not_overlap():
 
 def _wp_rows(times: dict) -> dict:
     """{method: (rtols, [[repeat times] per rtol], errors)} -> rows_from_cases output."""
-    from walkerlab.analysis.workprecision import rows_from_cases
+    from walkerlab.analysis.workprecision_results import rows_from_cases
 
     cases, methods, rtols = {}, list(times), [1e-6, 1e-8]
     for m, per in times.items():
@@ -345,7 +345,7 @@ def _wp_rows(times: dict) -> dict:
 def test_work_precision_choice_respects_timing_noise():
     """Overlapping repeat ranges: no setting is named fastest, the tied ones are listed;
     clearly separated: the fastest is named with its spread."""
-    from walkerlab.analysis.workprecision import summarize
+    from walkerlab.analysis.workprecision_results import summarize
     from walkerlab.report.text import workprecision_choice
 
     noisy = summarize(_wp_rows({"DOP853": [[1.0, 1.4, 2.0], [0.9, 1.3, 1.8]],

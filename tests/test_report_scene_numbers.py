@@ -7,9 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from walkerlab.analysis.report_numbers import report_numbers
 from walkerlab.config import load_scene
 from walkerlab.io.schemas.compare import load_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
+from walkerlab.report.build import ReportInputs
 from walkerlab.report.contact_sections import compare_section
 from walkerlab.report.markdown import num
 from walkerlab.stages import pipeline
@@ -25,11 +27,11 @@ def test_fig8_prose_from_artifacts_and_paper_sentence_only_for_published_paper(t
             "contact-sim": load_contact_sim(out.path.with_name("contact_sim.h5"))}
     slip_mm = float(np.nanmean(np.abs(arts["contact-sim"].steps["stance_slip_mm"])))
     stride = float(arts["compare"].metrics["contact"]["t_cycle_s"])
-    text = "\n".join(compare_section(scene, arts))
+    text = "\n".join(compare_section(scene, ReportInputs(arts, **report_numbers(scene, arts))))
     assert f"creeps {num(slip_mm, 3)} mm per step" in text
     assert f"stride lasts {num(stride, 4)} s" in text
     assert "Phase-aligned" in text
     assert "The paper reports" in text
     other = scene.model_copy(update={"published": None})
-    text = "\n".join(compare_section(other, arts))
+    text = "\n".join(compare_section(other, ReportInputs(arts, **report_numbers(other, arts))))
     assert "paper" not in text.lower() and "0.5 mm" not in text

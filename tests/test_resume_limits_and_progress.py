@@ -31,6 +31,7 @@ from walkerlab.config import (
     scene_from_dict,
 )
 from walkerlab.io.artifacts import content_hash, write_artifact
+from walkerlab.io.freshness import input_hash
 from walkerlab.io.sweep_store import complete_sweep, load_sweep, partial_path
 from walkerlab.stages import common
 from walkerlab.sweep import basin as basin_mod
@@ -260,14 +261,14 @@ def _fake_fixedpoint(wall: float, value: float = -0.8):
 def test_item11_content_hash_covers_results_not_timings(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     first = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_fixedpoint(1.2))
-    key = common.input_hash("simulate", sc, ("walker",), (first.path,))
+    key = input_hash("simulate", sc, ("walker",), (first.path,))
     again = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_fixedpoint(3.4),
                               force=True)  # same result, other timing
     assert not again.reused
-    assert common.input_hash("simulate", sc, ("walker",), (again.path,)) == key
+    assert input_hash("simulate", sc, ("walker",), (again.path,)) == key
     changed = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (),
                                 _fake_fixedpoint(3.4, -0.81), force=True)
-    assert common.input_hash("simulate", sc, ("walker",), (changed.path,)) != key
+    assert input_hash("simulate", sc, ("walker",), (changed.path,)) != key
 
 
 def test_item11_run_records_are_not_hashed(tmp_path):

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import yaml
 
+from walkerlab.analysis import push
 from walkerlab.analysis import robustness as R
 from walkerlab.analysis.batch_step import BatchStepMap
 from walkerlab.config import load_scene
@@ -50,11 +51,11 @@ def test_push_is_a_physical_impulse(paper_walker, paper_fixed_point):
     x[w.state_names().index("stance_angle")] = 0.05  # a state of the swing, not the section
     masses = {"hip": 10.0, "stance_mass": 5.0, "swing_mass": 5.0}
     dv = 0.2
-    xp, P = R.apply_push(w, x, dv)
+    xp, P = push.apply_push(w, x, dv)
     dH = _angular_momentum(w, xp, masses) - _angular_momentum(w, x, masses)
     y_hip = float(np.asarray(w.points(x)["hip"])[1])
     assert abs(dH - (-y_hip * P)) < 1e-7 * abs(y_hip * P)
-    J = R.hip_jacobian(w, x)
+    J = push.hip_jacobian(w, x)
     n = w.n_coordinates
     v0, v1 = J @ x[n:], J @ xp[n:]
     assert abs((v1[0] - v0[0]) - dv) < 1e-9

@@ -28,8 +28,9 @@ from typer.testing import CliRunner
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.execution.workers import process_alive
+from walkerlab.io import freshness
 from walkerlab.io.artifacts import ArtifactError, atomic_write, open_artifact, write_artifact
-from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock
+from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock, stage_artifact
 from walkerlab.io.sweep_store import load_sweep, partial_path
 from walkerlab.stages import common
 from walkerlab.sweep import runner
@@ -90,7 +91,7 @@ def test_d1_symlinked_run_folder_leaving_runs_rejected(tmp_path):
     (tmp_path / "runs" / "paper").symlink_to(tmp_path / "elsewhere")
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     with pytest.raises(RunPathError, match="outside the runs folder"):
-        common.artifact_path(sc, tmp_path / "runs", "fixedpoint")
+        stage_artifact(sc, tmp_path / "runs", "fixedpoint")
 
 
 @pytest.mark.parametrize("name", ["fixedpoint", "simulate.h5", "contact_sim", "compare",
@@ -221,7 +222,7 @@ def test_d3_read_only_runs_folder_is_one_line(tmp_path, monkeypatch):
 
 def test_d3_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
-    path = common.artifact_path(sc, tmp_path, "simulate")
+    path = stage_artifact(sc, tmp_path, "simulate")
     write_artifact(path, "simulate", sc, "k", lambda f: None, 0.0)  # no samples/ inside
     from walkerlab.stages import plot
 
@@ -233,7 +234,7 @@ def test_d3_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
                                               ("t_final", 0)])
 def test_d11_contact_sim_fall_exits_non_zero(tmp_path, monkeypatch, termination, code):
     sc = scene_from_dict({**PAPER, "name": "paper"})
-    path = common.artifact_path(sc, tmp_path, "contact-sim")
+    path = stage_artifact(sc, tmp_path, "contact-sim")
 
     def fake_run_cached(stage, scene, runs_root, *a, **k):  # the run, not its physics
         write_artifact(path, "contact-sim", sc, "k",
@@ -273,10 +274,10 @@ def test_d6_edited_artifact_and_edited_upstream_are_detected(tmp_path):
     assert common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (),
                              _fake_compute(-0.8)).reused
     up = (first.path,)
-    key_before = common.input_hash("simulate", sc, ("walker",), up)
+    key_before = freshness.input_hash("simulate", sc, ("walker",), up)
     with h5py.File(first.path, "a") as f:  # a user edits the output by hand
         f["fixed_point/stance_rate"][()] = -3.0
-    assert common.input_hash("simulate", sc, ("walker",), up) != key_before  # downstream
+    assert freshness.input_hash("simulate", sc, ("walker",), up) != key_before  # downstream
     again = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(-0.8))
     assert not again.reused  # the edited output is not trusted
     with open_artifact(again.path, "fixedpoint") as f:
@@ -485,7 +486,7 @@ def test_d7_sigkill_of_the_main_process_leaves_no_workers(tmp_path):
 
 def test_d4_a_second_stage_run_waits_for_the_first_writer(tmp_path, capfd):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
-    target = common.artifact_path(sc, tmp_path, "fixedpoint")
+    target = stage_artifact(sc, tmp_path, "fixedpoint")
     target.parent.mkdir(parents=True)
     holder = subprocess.Popen([sys.executable, "-c", textwrap.dedent(f"""
         import time
@@ -536,8 +537,8 @@ def test_force_replaces_an_artifact_without_hashing_it(tmp_path, monkeypatch):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(1.0))
     verified = []
-    real = common.verified_hash
-    monkeypatch.setattr(common, "verified_hash", lambda p: verified.append(p) or real(p))
+    real = freshness.verified_hash
+    monkeypatch.setattr(freshness, "verified_hash", lambda p: verified.append(p) or real(p))
     out = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(2.0),
                             force=True)
     assert verified == [] and not out.reused and out.note == "--force"

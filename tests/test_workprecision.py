@@ -67,3 +67,18 @@ def test_report_study_measures_every_case_once_and_reuses_it(tmp_path):
     report.run(_scene(tmp_path, target_error=1e-6), runs, echo=lambda s: None, full=True)
     with open_artifact(wp, "workprecision") as f:
         assert f.attrs["cases_reused_from_cache"] == f.attrs["cases_total"]
+
+
+def test_every_case_source_exists():
+    """A measured case is kept until the sources it runs change: each folder or file the
+    key hashes must exist (a folder renamed away made every study crash)."""
+    from pathlib import Path
+
+    import walkerlab
+    from walkerlab.analysis.workprecision_plan import CASE_SOURCES, sources_hash
+
+    root = Path(walkerlab.__file__).parent
+    for model, parts in CASE_SOURCES.items():
+        missing = [p for p in parts if not (root / p).exists()]
+        assert not missing, (model, missing)
+        assert len(sources_hash(parts)) == 64

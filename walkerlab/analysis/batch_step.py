@@ -5,14 +5,15 @@ One step of ``N`` walkers is integrated as one stacked system (``N x 2n`` states
 DOP853 (``scipy.integrate.DOP853``, stepped one step at a time); its right-hand side calls the
 walker's compiled flow (the numba ``cfunc`` of :class:`walkerlab.codegen.compiled.CompiledFlow`,
 the same generated equations as every other rigid integration) once per walker, in one
-compiled loop (:func:`_stacked`), so the per-step Python cost of the integrator is shared by
-all ``N`` walkers.  Guards are the cfunc's extra outputs; after each integrator step the
-walkers whose guard changed sign in its direction (``solve_ivp``'s rule) are located on the
-step's dense output (DOP853's 7th-order interpolant, evaluated row-wise for those walkers) by
-``scipy.optimize.elementwise.find_root`` (Chandrupatla's bracketing method, vectorised) and
-leave the stacked system; the others go on (the system is restarted with the remaining rows
-and the last step size).  The phases of a step (early/late swing, unlocked/locked knee) are
-run one after the other, each from the phase-local time 0 (the flows are autonomous).
+compiled loop (:func:`walkerlab.analysis.batch_rows.kernel`), so the per-step Python cost of
+the integrator is shared by all ``N`` walkers.  Guards are the cfunc's extra outputs; after
+each integrator step the walkers whose guard changed sign in its direction (``solve_ivp``'s
+rule) are located on the step's dense output (DOP853's 7th-order interpolant, evaluated
+row-wise for those walkers) by ``scipy.optimize.elementwise.find_root`` (Chandrupatla's
+bracketing method, vectorised) and leave the stacked system; the others go on (the system
+is restarted with the remaining rows and the last step size).  The phases of a step
+(early/late swing, unlocked/locked knee) are run one after the other, each from the
+phase-local time 0 (the flows are autonomous).
 
 Per-step slope (a walker on rough terrain, Byl & Tedrake 2009): each row has its own slope
 ``gamma``: the parameter vector of the compiled functions (``Structure.param_names``) with
@@ -31,54 +32,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.analysis.batch_rows import StackedRows, dense_rows
+
 #: How a step of one row ended (``outcome`` codes are indices into this tuple).
 STEP_OUTCOMES = ("heel_strike", "fall", "timeout", "solver_failure")
 HEEL_STRIKE, FALL, TIMEOUT, SOLVER_FAILURE = range(4)
-EPS = np.finfo(float).eps
-
-_KERNEL = None
-
-
-def _kernel():
-    """The compiled loop ``(f, Y, D, dY, G) -> None``: ``f`` a flow cfunc (first-class
-    function argument), ``Y`` (N, m) states, ``D`` (N, c) data vectors, ``dY`` (N, m) flows,
-    ``G`` (N, g) guard values (the cfunc's extra outputs)."""
-    global _KERNEL
-    if _KERNEL is None:
-        from walkerlab.usercache import use_for_numba
-
-        use_for_numba()
-        from numba import njit
-
-        @njit(cache=True)
-        def _stacked(f, Y, D, dY, G):  # pragma: no cover - compiled
-            m = Y.shape[1]
-            g = G.shape[1]
-            buf = np.empty(m + g)
-            for i in range(Y.shape[0]):
-                f(buf.ctypes, 0.0, Y[i].ctypes, D[i].ctypes)
-                dY[i, :] = buf[:m]
-                G[i, :] = buf[m:]
-        _KERNEL = _stacked
-    return _KERNEL
-
-
-def _entry(kern, f, Y, D, dY, G) -> None:
-    """Call the kernel; after its first compilation through the compiled entry point of its
-    one signature (the dispatcher's typing of a first-class function argument costs about
-    twice the call itself on a few hundred rows)."""
-    ep = _ENTRY.get(id(kern))
-    if ep is None:
-        kern(f, Y, D, dY, G)
-        sigs = kern.signatures
-        if len(sigs) == 1 and hasattr(kern.overloads.get(sigs[0]), "entry_point"):
-            _ENTRY[id(kern)] = kern.overloads[sigs[0]].entry_point
-        return
-    ep(f, Y, D, dY, G)
-
-
-_ENTRY: dict = {}
-
 
 @dataclass
 class BatchStep:
@@ -101,20 +59,6 @@ class BatchStep:
     x_pre: np.ndarray
     x_next: np.ndarray
     step_time_s: np.ndarray
-
-
-def _dense_rows(dense, cols: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """DOP853 dense output of some components at per-row times.
-
-    ``cols`` (k, m) component indices of the stacked state, ``t`` (k,) times in the step;
-    returns (k, m).  Same arithmetic as ``scipy.integrate._ivp.rk.Dop853DenseOutput``
-    (``F``, ``t_old``, ``h``, ``y_old``), restricted to the rows asked for."""
-    x = ((t - dense.t_old) / dense.h)[:, None]
-    y = np.zeros(cols.shape)
-    for i, f in enumerate(reversed(dense.F)):
-        y += f[cols]
-        y *= x if i % 2 == 0 else (1 - x)
-    return y + dense.y_old[cols]
 
 
 class BatchStepMap:
@@ -263,9 +207,6 @@ class BatchStepMap:
         """Integrate rows through phase ``k``; returns the rows that go on to phase k + 1
         (their entry states and times).  ``D[:, :nc]`` are the data vectors; a column
         after them is the per-row drop of the footfall [m] (last phase only)."""
-        from scipy.integrate import DOP853
-        from scipy.optimize.elementwise import find_root
-
         ph, cfunc, n_extra, gcols, goffs, dirs = phase
         # a step-down/up (rows with a nonzero drop, last phase): the heel strike is the
         # swing foot's clearance reaching -drop, armed once the foot has risen above both
@@ -273,10 +214,9 @@ class BatchStepMap:
         # scuffing the ideal model ignores, which must not count as the landing)
         drop = D.shape[1] > nc and k == len(self.phases) - 1
         hs = self._hs[0] if self._hs else None
-        kern = _kernel()
         m = self.n
         last = k == len(self.phases) - 1
-        nxt_rows, nxt_Y, nxt_T = [], [], []
+        nxt: tuple[list, list, list] = ([], [], [])
         cap = self.max_step_time_s - T  # remaining time of each row [s]
         ok = cap > 0
         out.outcome[rows[~ok]] = TIMEOUT
@@ -284,32 +224,9 @@ class BatchStepMap:
         Dk = D[rows]
         if drop:  # one more column: armed (1) or not (0)
             Dk = np.hstack([Dk, np.zeros((rows.size, 1))])
-
-        def guards(Yr, Dr):
-            dY = np.empty_like(Yr)
-            G = np.empty((Yr.shape[0], n_extra))
-            _entry(kern, cfunc, np.ascontiguousarray(Yr), np.ascontiguousarray(Dr[:, :nc]), dY,
-                   G)
-            vals = G[:, gcols] + goffs
-            if drop:
-                dr = Dr[:, nc] != 0
-                vals[dr, hs] = G[dr, self._clear] + Dr[dr, nc]
-            return vals
-
-        def make_solver(Y0, Dr, t0, h):
-            def fun(t, y, _D=np.ascontiguousarray(Dr[:, :nc])):
-                Yr = y.reshape(-1, m)
-                dY = np.empty_like(Yr)
-                G = np.empty((Yr.shape[0], n_extra))
-                _entry(kern, cfunc, Yr, _D, dY, G)
-                return dY.ravel()
-            scale = np.sqrt(Y0.size)
-            return DOP853(fun, t0, Y0.ravel().copy(), t_bound=t0 + float(cap.max()) + 1.0,
-                          rtol=max(self.rtol / scale, 1e-13), atol=self.atol / scale,
-                          first_step=h)
-
-        solver = make_solver(Y, Dk, 0.0, None)
-        G_old = guards(Y, Dk)
+        stk = StackedRows(cfunc, n_extra, gcols, goffs, nc, m, drop, hs, self._clear)
+        solver = stk.solver(Y, Dk, 0.0, None, float(cap.max()), self.rtol, self.atol)
+        G_old = stk.guards(Y, Dk)
         while rows.size:
             solver.step()
             if solver.status == "failed":
@@ -317,7 +234,7 @@ class BatchStepMap:
                 break
             t_new = solver.t
             Yn = solver.y.reshape(-1, m)
-            G_new = guards(Yn, Dk)
+            G_new = stk.guards(Yn, Dk)
             up = (G_old <= 0) & (G_new >= 0) & (dirs >= 0)
             down = (G_old >= 0) & (G_new <= 0) & (dirs <= 0)
             hit = up | down
@@ -331,59 +248,15 @@ class BatchStepMap:
             which = np.full(rows.size, -1)
             if done.any():
                 dense = solver.dense_output()
-                for j in np.flatnonzero(hit.any(axis=0)):
-                    r = np.flatnonzero(hit[:, j])
-                    cols = r[:, None] * m + np.arange(m)[None, :]
-                    Dr = Dk[r]
-                    g0, g1 = G_old[r, j], G_new[r, j]
-
-                    a = np.full(r.size, dense.t_old)
-                    b = np.full(r.size, t_new)
-                    tj = np.where(g1 == 0, b, np.where(g0 == 0, a, np.nan))
-                    todo = np.isnan(tj)
-                    if todo.any():
-                        cols_t, D_t = cols[todo], Dr[todo]
-
-                        def ft(t, idx, _c=cols_t, _D=D_t, _j=j, _d=dense):
-                            # find_root passes only its unconverged elements (and their idx)
-                            i = idx.astype(int)
-                            return guards(_dense_rows(_d, _c[i], t), _D[i])[:, _j]
-                        res = find_root(ft, (a[todo], b[todo]),
-                                        args=(np.arange(cols_t.shape[0], dtype=float),),
-                                        tolerances={"xatol": 1e-15, "xrtol": 4 * EPS})
-                        tj[todo] = res.x
-                    better = tj < te[r]
-                    te[r[better]] = tj[better]
-                    which[r[better]] = j
+                stk.locate(hit, G_old, G_new, dense, t_new, Dk, te, which)
             late = ~done & (t_new >= cap)
             # rows that ended (guard or time cap) leave the stacked system
             idone = np.flatnonzero(done)
-            Y_ev = (_dense_rows(dense, idone[:, None] * m + np.arange(m)[None, :], te[idone])
+            Y_ev = (dense_rows(dense, idone[:, None] * m + np.arange(m)[None, :], te[idone])
                     if idone.size else None)
             for y_ev, i in zip(Y_ev if idone.size else (), idone):
-                g = ph.guards[which[i]]
-                r0 = rows[i]
-                t_end = T[i] + te[i]
-                if g.outcome == "fall":
-                    out.outcome[r0] = FALL
-                    out.x_pre[r0] = y_ev
-                    out.step_time_s[r0] = t_end
-                elif g.outcome == "heel_strike":
-                    w = self._walker(float(gamma[r0]))
-                    out.outcome[r0] = HEEL_STRIKE
-                    out.x_pre[r0] = y_ev
-                    out.x_next[r0] = np.asarray(w.reset(y_ev), dtype=float)
-                    out.step_time_s[r0] = t_end
-                else:  # next phase (with its intra-step reset, e.g. a knee strike)
-                    if last:  # pragma: no cover - a model whose last phase has no heel strike
-                        out.outcome[r0] = SOLVER_FAILURE
-                        continue
-                    w = self._walker(float(gamma[r0]))
-                    gw = w.phases[k].guards[which[i]]
-                    y1 = np.asarray(gw.reset(y_ev), float) if gw.reset is not None else y_ev
-                    nxt_rows.append(r0)
-                    nxt_Y.append(y1)
-                    nxt_T.append(t_end)
+                self._leave(k, ph.guards[which[i]], which[i], rows[i], T[i] + te[i], y_ev,
+                            gamma, out, nxt, last)
             out.outcome[rows[late]] = TIMEOUT
             keep = ~(done | late)
             if solver.status == "finished" and keep.any():  # pragma: no cover - t_bound > cap
@@ -395,9 +268,35 @@ class BatchStepMap:
                 G_old = G_new[keep]
                 if rows.size:
                     h = solver.step_size
-                    solver = make_solver(Yk, Dk, t_new, h)
+                    solver = stk.solver(Yk, Dk, t_new, h, float(cap.max()), self.rtol,
+                                        self.atol)
             else:
                 G_old = G_new
-        if nxt_rows:
-            return np.array(nxt_rows), np.array(nxt_Y), np.array(nxt_T)
+        if nxt[0]:
+            return np.array(nxt[0]), np.array(nxt[1]), np.array(nxt[2])
         return np.empty(0, int), np.empty((0, m)), np.empty(0)
+
+    def _leave(self, k, g, j, r0, t_end, y_ev, gamma, out, nxt, last) -> None:
+        """Row ``r0`` met guard ``g`` (index ``j`` of phase ``k``) at ``t_end`` [s] in state
+        ``y_ev``: a fall or a heel strike ends its step in ``out``; a next-phase guard
+        (with its intra-step reset, e.g. a knee strike) appends its entry to ``nxt`` (rows,
+        states, times)."""
+        if g.outcome == "fall":
+            out.outcome[r0] = FALL
+            out.x_pre[r0] = y_ev
+            out.step_time_s[r0] = t_end
+        elif g.outcome == "heel_strike":
+            w = self._walker(float(gamma[r0]))
+            out.outcome[r0] = HEEL_STRIKE
+            out.x_pre[r0] = y_ev
+            out.x_next[r0] = np.asarray(w.reset(y_ev), dtype=float)
+            out.step_time_s[r0] = t_end
+        elif last:  # pragma: no cover - a model whose last phase has no heel strike
+            out.outcome[r0] = SOLVER_FAILURE
+        else:
+            w = self._walker(float(gamma[r0]))
+            gw = w.phases[k].guards[j]
+            y1 = np.asarray(gw.reset(y_ev), float) if gw.reset is not None else y_ev
+            nxt[0].append(r0)
+            nxt[1].append(y1)
+            nxt[2].append(t_end)

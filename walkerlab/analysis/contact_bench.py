@@ -114,27 +114,11 @@ def run_benchmark(n_strides: int = 5, methods=None,
     x0 = initial_state_from_ideal(walker, ideal["theta1"], ideal["theta2"], ideal["dtheta1"],
                                   ideal["dtheta2"], rate_scale=rate_scale)
     t_final = 1.03 * n_steps * ideal["step_period"]  # the contact gait is ~1% slower
-    ref = simulate_contact(walker, x0, t_final,
-                           SolverSettings.for_contact(method="odeint", rtol=1e-12, atol=1e-15))
-    angles = leg_angle_columns(walker)
-
-    def error(r):
-        n = min(len(r.t), len(ref.t))
-        return float(np.abs(r.x[:n, angles] - ref.x[:n, angles]).max())
-
-    def one(method, rtol, atol):
-        best = None
-        for _ in range(repeats):
-            r = simulate_contact(walker, x0, t_final,
-                                 SolverSettings.for_contact(method=method, rtol=rtol, atol=atol))
-            if best is None or r.wall_time_s < best.wall_time_s:
-                best = r
-        return best, error(best)
-
+    case = _Case(walker, x0, t_final, None, 1e-12, 1e-15)
     target = {}
     bands = TARGET_RTOLS if target_rtols is None else target_rtols
     for method in [m for m in bands if m in methods]:
-        rs = [one(method, rt, 0.1 * rt) for rt in bands[method]]
+        rs = [case.fastest(method, rt, 0.1 * rt, repeats) for rt in bands[method]]
         target[method] = {"rtols": list(bands[method]), "atol_over_rtol": 0.1,
                           "wall_time_s": [r.wall_time_s for r, _ in rs],
                           "max_angle_error_rad": [e for _, e in rs],
@@ -144,16 +128,11 @@ def run_benchmark(n_strides: int = 5, methods=None,
     runs = []
     for method in methods:
         for rtol in rtols:
-            best = None
-            for _ in range(repeats):
-                r = simulate_contact(walker, x0, t_final, SolverSettings.for_contact(
-                    method=method, rtol=rtol, atol=1e-3 * rtol))
-                if best is None or r.wall_time_s < best.wall_time_s:
-                    best = r
+            best, err = case.fastest(method, rtol, 1e-3 * rtol, repeats)
             runs.append({"method": method, "rtol": rtol, "wall_time_s": best.wall_time_s,
-                         "nfev": best.nfev, "njev": best.njev,
-                         "max_angle_error_rad": error(best),
+                         "nfev": best.nfev, "njev": best.njev, "max_angle_error_rad": err,
                          "heel_strikes": best.walked_steps, "termination": best.termination})
+    ref = case.ref
     return {"t_final_s": t_final,
             "reference": {"method": "odeint", "rtol": 1e-12, "wall_time_s": ref.wall_time_s,
                           "nfev": ref.nfev, "heel_strikes": ref.walked_steps,
@@ -161,6 +140,44 @@ def run_benchmark(n_strides: int = 5, methods=None,
             "rhs_cost": rhs_cost(walker, x0),
             "issue10_target": target,
             "runs": runs}
+
+
+class _Case:
+    """One benchmark case: the walker's contact run from ``x0`` to ``t_final`` (with
+    ``limits``), its odeint reference at ``ref_rtol``/``ref_atol`` (run on creation) and
+    the leg-angle error of a run against it [rad]."""
+
+    def __init__(self, walker: ContactWalker, x0: np.ndarray, t_final: float, limits,
+                 ref_rtol: float, ref_atol: float):
+        self.walker, self.x0, self.t_final, self.limits = walker, x0, t_final, limits
+        self.ref = self.run("odeint", ref_rtol, ref_atol)
+        self.angles = leg_angle_columns(walker)
+
+    def run(self, method: str, rtol: float, atol: float):
+        """One contact run (:func:`~walkerlab.analysis.contact_sim.simulate_contact`)."""
+        return simulate_contact(self.walker, self.x0, self.t_final, SolverSettings.for_contact(
+            method=method, rtol=rtol, atol=atol), self.limits)
+
+    def error(self, r) -> float:
+        """Largest leg-angle difference from the reference on the common samples [rad]."""
+        n = min(len(r.t), len(self.ref.t))
+        return float(np.abs(r.x[:n, self.angles] - self.ref.x[:n, self.angles]).max())
+
+    def fastest(self, method: str, rtol: float, atol: float, repeats: int):
+        """``(run, error)`` of the fastest of ``repeats`` runs."""
+        best = None
+        for _ in range(repeats):
+            r = self.run(method, rtol, atol)
+            if best is None or r.wall_time_s < best.wall_time_s:
+                best = r
+        return best, self.error(best)
+
+    def median(self, method: str, rtol: float, repeats: int) -> tuple:
+        """``(median wall time [s], error, nfev, termination)`` of ``repeats`` runs at
+        ``atol = 0.1 rtol`` (error, nfev and termination of the first run)."""
+        rs = [self.run(method, rtol, 0.1 * rtol) for _ in range(repeats)]
+        return (float(np.median([r.wall_time_s for r in rs])), self.error(rs[0]), rs[0].nfev,
+                rs[0].termination)
 
 
 #: rtols scanned (loose to tight) for the band reaching the target error; each band is
@@ -223,37 +240,10 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
     ideal = ideal_gait(scene)
     walker, x0, limits, _ = scene_start(contact_setup(scene), ideal.x, n_strides + 1)
     t_final = 1.03 * 2 * n_strides * ideal.period_s
-    ref = simulate_contact(walker, x0, t_final, SolverSettings.for_contact(
-        method="odeint", rtol=reference_rtol, atol=1e-3 * reference_rtol), limits)
-    angles = leg_angle_columns(walker)
-
-    def error(r):
-        n = min(len(r.t), len(ref.t))
-        return float(np.abs(r.x[:n, angles] - ref.x[:n, angles]).max())
-
-    def timed(method, rtol):
-        rs = [simulate_contact(walker, x0, t_final, SolverSettings.for_contact(
-            method=method, rtol=rtol, atol=0.1 * rtol), limits) for _ in range(repeats)]
-        return (float(np.median([r.wall_time_s for r in rs])), error(rs[0]), rs[0].nfev,
-                rs[0].termination)
-
+    case = _Case(walker, x0, t_final, limits, reference_rtol, 1e-3 * reference_rtol)
     target, scan = {}, {}
     for method in methods:
-        scan[method] = []
-        best = None
-        for r0 in SCAN_RTOLS:
-            band = [r0 * f for f in BAND_FACTORS]
-            rows = []
-            for rt in band:
-                t, e, nf, term = timed(method, rt)
-                rows.append({"rtol": rt, "error": e, "wall_time_s": t, "nfev": nf,
-                             "termination": term})
-                if e > target_error_rad:
-                    break  # this band misses the target: the next tighter one
-            scan[method] += rows
-            if len(rows) == len(band) and all(r["error"] <= target_error_rad for r in rows):
-                best = rows
-                break
+        scan[method], best = _scan(case, method, target_error_rad, repeats)
         target[method] = {"reached": best is not None}
         if best is not None:
             target[method].update(
@@ -262,9 +252,31 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
                 wall_time_s=[r["wall_time_s"] for r in best], nfev=[r["nfev"] for r in best],
                 median_wall_time_s=float(np.median([r["wall_time_s"] for r in best])),
                 worst_error_rad=float(max(r["error"] for r in best)))
+    ref = case.ref
     return {"scene": scene.name, "n_strides": n_strides, "t_final_s": t_final,
             "reference": {"method": "odeint", "rtol": reference_rtol,
                           "wall_time_s": ref.wall_time_s, "nfev": ref.nfev,
                           "heel_strikes": len(ref.heel_strike_times),
                           "termination": ref.termination},
             "rhs_cost": rhs_cost(walker, x0), "target": target, "scan": scan}
+
+
+def _scan(case: _Case, method: str, target_error_rad: float, repeats: int
+          ) -> tuple[list[dict], list[dict] | None]:
+    """Bands ``r * BAND_FACTORS`` from loose to tight (:data:`SCAN_RTOLS`) until one's every
+    run reaches ``target_error_rad``: ``(rows run, that band's rows or None)`` (a band stops
+    at its first run that misses the target)."""
+    scan: list[dict] = []
+    for r0 in SCAN_RTOLS:
+        band = [r0 * f for f in BAND_FACTORS]
+        rows = []
+        for rt in band:
+            t, e, nf, term = case.median(method, rt, repeats)
+            rows.append({"rtol": rt, "error": e, "wall_time_s": t, "nfev": nf,
+                         "termination": term})
+            if e > target_error_rad:
+                break  # this band misses the target: the next tighter one
+        scan += rows
+        if len(rows) == len(band) and all(r["error"] <= target_error_rad for r in rows):
+            return scan, rows
+    return scan, None

@@ -1,6 +1,6 @@
 """What an exported MuJoCo walker needs to walk: its gait, its terrain, its contact, its latch.
 
-:func:`mjcf_scene` turns a validated scene into :class:`walkerlab.io.export.MjcfScene`
+:func:`mjcf_scene` turns a validated scene into :class:`walkerlab.io.mjcf_scene.MjcfScene`
 (written by :func:`walkerlab.io.export.mjcf_text`):
 
 - **gait keyframe**: the rigid walker's fixed point (just after heel strike, leg2 in stance,
@@ -9,7 +9,7 @@
   link angle, ``leg<i>_knee`` = shank - thigh; rates likewise.
 - **terrain**: the scene's (``terrain`` section, default checkerboard): checkerboard patches
   centred on the rigid gait's footfalls as boxes, one lane per leg (contact bits
-  :data:`walkerlab.io.export.LANE_BITS`), leg2 at ``s = 0, 2l, ...``, leg1 at
+  :data:`walkerlab.io.mjcf_scene.LANE_BITS`), leg2 at ``s = 0, 2l, ...``, leg1 at
   ``s = -l, l, 3l, ...`` (legs that differ: leg1's step ``l1``, leg2's ``l2``, leg2 at
   ``k (l1 + l2)``, leg1 at ``l1 + (k - 1)(l1 + l2)``); continuous: one plane.  The ground's
   surface is lowered by the point foot's sphere radius, so the sphere touches it where
@@ -35,7 +35,12 @@ import numpy as np
 
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings, TerrainSettings
-from walkerlab.io.export import MJCF_MIN_LENGTH_M, MJCF_MIN_MASS_KG, MjcfScene, point_foot_radius
+from walkerlab.io.mjcf_scene import (
+    MJCF_MIN_LENGTH_M,
+    MJCF_MIN_MASS_KG,
+    MjcfScene,
+    point_foot_radius,
+)
 from walkerlab.models.contact.laws import ContactParamsSI
 
 __all__ = ["EXPORT_STEPS", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]

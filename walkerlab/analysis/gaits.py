@@ -13,16 +13,17 @@ swing leg's rate), so a root finder started between them lands on either.  This 
    ``theta_dot ~ -theta``), a swing-leg rate ``r`` times the stance rate, knees straight -
    turns each into a state just after heel strike through the walker's own
    ``leg_coordinates`` (by name, any coordinates), ranks them by one coarse step of the
-   Poincaré map (``|P(z) - z| / |z|`` on the heel-strike section) and roots from the best;
+   Poincaré map (``|P(z) - z| / |z|`` on the heel-strike section) and roots from the best
+   (the starts: :mod:`walkerlab.analysis.gait_starts`);
 3. looks for the other gait of the pair by *deflation* (Farrell, Birkisson & Funke 2015,
    SIAM J. Sci. Comput. 37(4)): the root finder, on the residual divided by the distance to
    the gait already found, from starts a few percent off it along each section coordinate
-   (:func:`deflation_starts`: along each coordinate the start towards the partner's expected
-   step length first - shorter when the first gait is stable, the long-period gait of the
-   pair on shallow slopes).  The deflated search runs at the screening tolerance
-   (:func:`_coarse`, cheaper maps, loose ``xtol``); the root it finds is then polished at
-   the scene's tolerance without deflation, MINPACK ``hybrj`` starting from the coarse
-   root's own variational Jacobian (a few maps);
+   (along each coordinate the start towards the partner's expected step length first -
+   shorter when the first gait is stable, the long-period gait of the pair on shallow
+   slopes).  The deflated search runs at the screening tolerance (cheaper maps, loose
+   ``xtol``); the root it finds is then polished at the scene's tolerance without
+   deflation, MINPACK ``hybrj`` starting from the coarse root's own variational Jacobian (a
+   few maps);
 4. labels the gaits (``long_period`` / ``short_period`` by step period) and picks one by the
    scene's policy (``stable``, ``long_period``, ``short_period``, ``nearest_guess``).
 
@@ -33,42 +34,29 @@ Every root is found by :func:`walkerlab.analysis.poincare.find_fixed_point` (MIN
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.analysis.poincare import (
-    FixedPointNotFound,
-    FixedPointResult,
-    StepFailed,
-    find_fixed_point,
-    poincare_map,
+from walkerlab.analysis.gait_starts import (
+    WALK_STEPS,
+    coarse_solver,
+    deflation_starts,
+    screen_seeds,
+    walked_start,
 )
+from walkerlab.analysis.poincare import FixedPointNotFound, FixedPointResult, find_fixed_point
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 
-__all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "seed_states", "state_from_legs",
-           "deflation_starts", "step_length",
-           "find_gaits", "select_gait"]
+__all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "find_gaits", "select_gait"]
 
 #: gait choices of ``fixedpoint.gait``
 POLICIES = ("stable", "long_period", "short_period", "nearest_guess")
 
-#: seed grid: step angle / gamma^(1/3), stance rate / (alpha sqrt(g/l)), swing / stance rate
-SEED_STEP = (0.5, 0.7, 0.9, 1.1, 1.3)
-SEED_STANCE_RATE = (0.8, 1.1, 1.4)
-SEED_SWING_RATIO = (0.0, 0.4, 0.8)
 #: seeds the root finder is started from (best first by the coarse residual)
 ROOT_STARTS = 6
-#: Coarse steps walked from a seed before its last post-impact state starts the root finder
-#: (second round, when no seed converged as it is: a walker whose post-impact states the
-#: seeds do not reach - a flat foot's ankle rate follows from the heel strike - walks onto
-#: its post-impact set in one step, and near a stable gait in a few).
-WALK_STEPS = 20
-#: relative offset of the deflated starts from the gait already found
-DEFLATION_OFFSET = 0.05
 #: two fixed points closer than this (max |x1 - x2|, rad and rad/s) are the same gait
 SAME_GAIT = 1e-6
 #: root-finder xtol of the deflated search at the screening tolerance (then polished)
@@ -149,159 +137,6 @@ class GaitSearch:
         return self.gait.result
 
 
-# ----------------------------------------------------------------------------- seeds
-def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: float,
-                    stance_rate: float, swing_rate: float) -> np.ndarray:
-    """Walker state (2n,) whose legs have the given absolute angles and rates.
-
-    Every link of the stance leg gets ``stance_angle`` [rad, from the vertical, positive with
-    the foot ahead of the hip] and ``stance_rate`` [rad/s], every link of the swing leg the
-    swing values (knees straight).  The state is found by least squares
-    (``scipy.optimize.least_squares``) on the walker's own ``leg_coordinates`` - so it works
-    for any coordinates (absolute, slope-relative) and any number of links - and projected on
-    the heel-strike surface (``from_section(section(x))``).
-
-    Returns
-    -------
-    ndarray, shape (2n,)
-        Role-ordered state, leg ``walker.legs[-1]`` in stance.
-    """
-    from scipy.optimize import least_squares
-
-    stance_leg = walker.legs[-1]
-    x0 = walker.layout().zeros()
-    # leg links only: an ankle's angle (a flat foot's) is not a leg's and starts at 0
-    keys = [k for k in walker.leg_coordinates(x0, stance_leg) if "_ankle_" not in k]
-
-    def target(k: str) -> float:
-        stance = k.startswith(stance_leg + "_")
-        if k.endswith("_angle"):
-            return stance_angle if stance else swing_angle
-        return stance_rate if stance else swing_rate
-
-    tgt = np.array([target(k) for k in keys])
-
-    def residual(x):
-        d = walker.leg_coordinates(x, stance_leg)
-        return np.array([float(d[k]) for k in keys]) - tgt
-
-    sol = least_squares(residual, x0, xtol=1e-15, ftol=1e-15, gtol=1e-15)
-    return walker.from_section(walker.section(sol.x))
-
-
-def seed_states(walker: HybridWalker) -> list[tuple[str, np.ndarray]]:
-    """Scale-free seeds just after heel strike, from the slope and the walker's size.
-
-    Step half-angle ``alpha = c gamma^(1/3)`` (``c`` in :data:`SEED_STEP`; Garcia et al.
-    1998: the step angle of both gaits scales as gamma^(1/3) on small slopes), stance leg at
-    ``alpha - gamma`` and swing leg at ``-alpha - gamma`` from the vertical (so the feet lie on
-    the slope), stance rate ``-k alpha sqrt(g/l)`` (``k`` in :data:`SEED_STANCE_RATE`; their
-    ``theta_dot ~ -theta``), swing rate ``r`` times the stance rate (``r`` in
-    :data:`SEED_SWING_RATIO`).
-
-    Returns
-    -------
-    list of (str, ndarray (2n,))
-        A description and the state, for each seed.
-    """
-    gamma = max(float(walker.slope_rad), 1e-4)
-    omega = math.sqrt(float(walker.params["gravity_m_per_s2"])
-                      / float(walker.params["leg_length_m"]))
-    out = []
-    for c, k, r in itertools.product(SEED_STEP, SEED_STANCE_RATE, SEED_SWING_RATIO):
-        alpha = min(c * gamma ** (1.0 / 3.0), 0.6)
-        rate = -k * alpha * omega
-        x = state_from_legs(walker, alpha - gamma, -alpha - gamma, rate, r * rate)
-        out.append((f"step angle {c:g} gamma^(1/3), stance rate {k:g} alpha sqrt(g/l), "
-                    f"swing/stance rate {r:g}", x))
-    return out
-
-
-def _coarse(solver: Solver) -> Solver:
-    """The solver at a screening tolerance (1e-7, or the scene's if looser)."""
-    return dataclasses.replace(solver, rtol=max(solver.rtol, 1e-7), atol=max(solver.atol, 1e-9))
-
-
-def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
-                 ) -> tuple[list[tuple[float, str, np.ndarray]], int]:
-    """Seeds ranked by one coarse Poincaré-map step: ``|section(P(x)) - section(x)| /
-    |section(x)|`` (seeds that fall within the step are dropped).
-
-    Returns
-    -------
-    ranked : list of (float, str, ndarray (2n,))
-        Relative residual, description, state; smallest residual first.
-    n_seeds : int
-        Seeds tried.
-    """
-    coarse = _coarse(solver)
-    seeds = seed_states(walker)
-    ranked = []
-    for desc, x in seeds:
-        try:
-            xn, _, _ = poincare_map(walker, x, coarse, max_step_time)
-        except StepFailed:
-            continue
-        z = walker.section(x)
-        ranked.append((float(np.linalg.norm(walker.section(xn) - z) / np.linalg.norm(z)),
-                       desc, x))
-    ranked.sort(key=lambda t: t[0])
-    return ranked, len(seeds)
-
-
-def walked_start(walker: HybridWalker, x: np.ndarray, solver: Solver,
-                 max_step_time: float) -> np.ndarray | None:
-    """The post-impact state after a coarse walk of :data:`WALK_STEPS` maps from ``x`` (a
-    stride at a time for a walker whose map is a stride), or None when it falls before."""
-    coarse = _coarse(solver)
-    for _ in range(WALK_STEPS):
-        try:
-            x, _, _ = poincare_map(walker, x, coarse, max_step_time)
-        except StepFailed:
-            return None
-    return x
-
-
-# ----------------------------------------------------------------------------- search
-def step_length(walker: HybridWalker, x: np.ndarray) -> float:
-    """Length of the step of a state just after heel strike [m] (the swing foot's offset
-    from the stance foot; NaN for a walker without a ``swing_foot`` point)."""
-    foot = walker.points(x).get("swing_foot")
-    return float(np.linalg.norm(foot)) if foot is not None else math.nan
-
-
-def deflation_starts(walker: HybridWalker, first: FixedPointResult) -> list[np.ndarray]:
-    """Starts of the deflated search for the other gait of the pair (states (2n,)).
-
-    ``first``'s section coordinates offset by :data:`DEFLATION_OFFSET` (relative, at least
-    0.1 absolute) one at a time, both ways.  Along each coordinate the way that moves the
-    step length towards the partner's comes first: shorter when ``first`` is stable (on
-    shallow slopes the stable gait of the pair is the long-period one with the longer step,
-    Goswami et al. 1996, Garcia et al. 1998), longer when it is unstable; a coordinate that
-    does not change the step (a rate) keeps ``+`` first.
-
-    Returns
-    -------
-    list of ndarray (2n,)
-        ``2 * (2n - 1)`` states on the heel-strike section.
-    """
-    z1 = walker.section(first.x)
-    shorter_first = bool(first.stable)
-    out = []
-    for j in range(z1.size):
-        pair = []
-        for sign in (1.0, -1.0):
-            dz = np.zeros(z1.size)
-            dz[j] = sign * DEFLATION_OFFSET * max(abs(float(z1[j])), 0.1)
-            x = walker.from_section(z1 + dz)
-            pair.append((step_length(walker, x), x))
-        (l_plus, x_plus), (l_minus, x_minus) = pair
-        flip = math.isfinite(l_plus) and math.isfinite(l_minus) and \
-            abs(l_plus - l_minus) > 1e-12 and ((l_minus < l_plus) == shorter_first)
-        out += [x_minus, x_plus] if flip else [x_plus, x_minus]
-    return out
-
-
 def _is_new(res: FixedPointResult, found: list[Gait]) -> bool:
     return all(float(np.max(np.abs(res.x - g.result.x))) > SAME_GAIT for g in found)
 
@@ -318,7 +153,8 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     solver : Solver
     guess : ndarray (2n,), optional
         Initial guess (role-ordered state just after heel strike); without it the root
-        finder starts from the best scale-free seeds (:func:`seed_states`).
+        finder starts from the best scale-free seeds
+        (:func:`~walkerlab.analysis.gait_starts.seed_states`).
     policy : {"stable", "long_period", "short_period", "nearest_guess"}
         Which gait to choose (:func:`select_gait`).
     other_gait : bool
@@ -349,100 +185,123 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         raise ValueError(f"fixedpoint.gait: {policy!r} is not one of {', '.join(POLICIES)}")
     if policy == "nearest_guess" and guess is None:
         raise ValueError("fixedpoint.gait: nearest_guess needs fixedpoint.initial_guess")
-    kw = {"xtol": xtol, "fd_step": fd_step, "max_step_time": max_step_time,
-          "fd_check": fd_check}
-    found: list[Gait] = []
-    tried: list[str] = []
-    notes: list[str] = []
-    best = math.inf
-    last_msg = ""
+    s = _RootStarts(walker, solver, {"xtol": xtol, "fd_step": fd_step,
+                                     "max_step_time": max_step_time, "fd_check": fd_check})
+    if guess is not None:
+        s.tried.append("the initial guess")
+        g = s.attempt(np.asarray(guess, float), "initial_guess")
+        if g is not None:
+            s.found.append(g)
+        else:
+            s.notes.append(f"the initial guess did not converge ({_short(s.last_msg)})")
+    if not s.found and (seeds or guess is None):
+        s.from_seeds()
+    if not s.found:
+        raise GaitNotFound(_failure(walker, s.tried, s.best, s.last_msg, guess is not None),
+                           s.best)
+    if other_gait or policy in ("long_period", "short_period") or (
+            policy == "stable" and not s.found[0].result.stable):
+        s.other_gait()
+    found = s.found
+    found.sort(key=lambda g: -g.result.period_s)
+    if len(found) == 2:
+        found[0].label, found[1].label = "long_period", "short_period"
+    search = GaitSearch(found, 0, policy, s.notes, s.tried)
+    search.selected = select_gait(search, guess, time_unit)
+    return search
 
-    def attempt(x0, source: str, deflate=(), jacobian_guess=None) -> Gait | None:
-        nonlocal best, last_msg
+
+class _RootStarts:
+    """The root-finder starts of one gait search (:func:`find_gaits`) and what they found:
+    the gaits (``found``), every start tried (``tried``), notes, the best residual of a
+    failed start and the last failure's message."""
+
+    def __init__(self, walker: HybridWalker, solver: Solver, kw: dict):
+        self.walker, self.solver, self.kw = walker, solver, kw
+        self.found: list[Gait] = []
+        self.tried: list[str] = []
+        self.notes: list[str] = []
+        self.best = math.inf
+        self.last_msg = ""
+
+    def attempt(self, x0, source: str, deflate=(), jacobian_guess=None) -> Gait | None:
+        """The gait the root finder reaches from ``x0``, or None (no root, or a gait already
+        found)."""
         try:
-            res = find_fixed_point(walker, x0, solver, deflate=deflate,
-                                   jacobian_guess=jacobian_guess, **kw)
+            res = find_fixed_point(self.walker, x0, self.solver, deflate=deflate,
+                                   jacobian_guess=jacobian_guess, **self.kw)
         except FixedPointNotFound as exc:
             if math.isfinite(exc.residual) and "standing" not in str(exc):
-                best = min(best, exc.residual)
-            last_msg = str(exc)
+                self.best = min(self.best, exc.residual)
+            self.last_msg = str(exc)
             return None
-        if not _is_new(res, found):
+        if not _is_new(res, self.found):
             return None
         return Gait("period_1", res, source, np.asarray(x0, float))
 
-    if guess is not None:
-        tried.append("the initial guess")
-        g = attempt(np.asarray(guess, float), "initial_guess")
-        if g is not None:
-            found.append(g)
-        else:
-            notes.append(f"the initial guess did not converge ({_short(last_msg)})")
-    n_seeds = n_started = 0
-    if not found and (seeds or guess is None):
+    def from_seeds(self) -> None:
+        """Root from the best-ranked scale-free seeds; none converging, from where the seeds
+        walk to in :data:`~walkerlab.analysis.gait_starts.WALK_STEPS` steps."""
+        walker, solver, max_step_time = self.walker, self.solver, self.kw["max_step_time"]
+        n_started = 0
         ranked, n_seeds = screen_seeds(walker, solver, max_step_time)
         for _err, _desc, x in ranked[:ROOT_STARTS]:
             n_started += 1
-            g = attempt(x, "seed")
+            g = self.attempt(x, "seed")
             if g is not None:
-                found.append(g)
+                self.found.append(g)
                 break
-        tried.append(f"{n_started} of {n_seeds} scale-free seeds "
-                     f"({n_seeds - len(ranked)} fell within the first step)")
-        if not found and ranked:  # second round: from where the seeds walk to
-            n_walked = n_started = 0
-            for _err, _desc, x in ranked:
-                n_walked += 1
-                end = walked_start(walker, x, solver, max_step_time)
-                if end is None:  # fell before WALK_STEPS steps: not near a stable gait
-                    continue
-                n_started += 1
-                g = attempt(end, "walked seed")
-                if g is not None:
-                    found.append(g)
-                    break
-                if n_started == ROOT_STARTS:
-                    break
-            tried.append(f"{n_walked} seeds walked {WALK_STEPS} steps "
-                         f"({n_started} root-finder starts)")
-    if not found:
-        raise GaitNotFound(_failure(walker, tried, best, last_msg, guess is not None), best)
-    need_other = other_gait or policy in ("long_period", "short_period") or (
-        policy == "stable" and not found[0].result.stable)
-    if need_other:
-        first = found[0].result
-        coarse = _coarse(solver)
+        self.tried.append(f"{n_started} of {n_seeds} scale-free seeds "
+                          f"({n_seeds - len(ranked)} fell within the first step)")
+        if self.found or not ranked:
+            return
+        n_walked = n_started = 0  # second round: from where the seeds walk to
+        for _err, _desc, x in ranked:
+            n_walked += 1
+            end = walked_start(walker, x, solver, max_step_time)
+            if end is None:  # fell before WALK_STEPS steps: not near a stable gait
+                continue
+            n_started += 1
+            g = self.attempt(end, "walked seed")
+            if g is not None:
+                self.found.append(g)
+                break
+            if n_started == ROOT_STARTS:
+                break
+        self.tried.append(f"{n_walked} seeds walked {WALK_STEPS} steps "
+                          f"({n_started} root-finder starts)")
+
+    def other_gait(self) -> None:
+        """The other gait of the pair by deflation from starts near the first one, at the
+        screening tolerance, then polished at the scene's."""
+        first = self.found[0].result
+        coarse = coarse_solver(self.solver)
         n_defl = 0
-        for x0 in deflation_starts(walker, first):
+        for x0 in deflation_starts(self.walker, first):
             n_defl += 1
             try:  # cheap maps and a loose xtol to find the partner ...
-                rough = find_fixed_point(walker, x0, coarse, xtol=COARSE_XTOL, fd_step=fd_step,
-                                         max_step_time=max_step_time, fd_check=False,
-                                         deflate=(first.x,))
+                rough = find_fixed_point(self.walker, x0, coarse, xtol=COARSE_XTOL,
+                                         fd_step=self.kw["fd_step"],
+                                         max_step_time=self.kw["max_step_time"],
+                                         fd_check=False, deflate=(first.x,))
             except FixedPointNotFound as exc:
-                last_msg = str(exc)
+                self.last_msg = str(exc)
                 continue
-            if not _is_new(rough, found):
+            if not _is_new(rough, self.found):
                 continue
             # ... then polished at the scene's tolerance (no deflation): MINPACK hybrj from
             # the coarse root's own Jacobian, or, should its updates stall, hybrd
-            g = attempt(rough.x, "deflation", jacobian_guess=rough.jacobian_variational) \
-                or attempt(rough.x, "deflation")
+            g = self.attempt(rough.x, "deflation", jacobian_guess=rough.jacobian_variational) \
+                or self.attempt(rough.x, "deflation")
             if g is not None:  # the gait's start and costs include the coarse pass
                 g.start = np.asarray(x0, float)
                 g.result = dataclasses.replace(
                     g.result, nfev=g.result.nfev + rough.nfev,
                     iterations=g.result.iterations + rough.iterations,
                     wall_time_s=g.result.wall_time_s + rough.wall_time_s)
-                found.append(g)
+                self.found.append(g)
                 break
-        tried.append(f"{n_defl} deflated starts near the first gait")
-    found.sort(key=lambda g: -g.result.period_s)
-    if len(found) == 2:
-        found[0].label, found[1].label = "long_period", "short_period"
-    search = GaitSearch(found, 0, policy, notes, tried)
-    search.selected = select_gait(search, guess, time_unit)
-    return search
+        self.tried.append(f"{n_defl} deflated starts near the first gait")
 
 
 def select_gait(search: GaitSearch, guess: np.ndarray | None = None,

@@ -15,7 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.integrate.rigid import integrate_step, numeric_jacobian
+from walkerlab.freshstack import import_on_fresh_stack
+from walkerlab.integrate.rigid import integrate_step
+from walkerlab.integrate.rigid_phase import numeric_jacobian
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 
@@ -163,19 +165,9 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     """Find the period-1 fixed point of the Poincaré map and its Floquet multipliers.
 
     The root finder is MINPACK (``scipy.optimize.root``, method ``hybr``) on the map reduced
-    to the section, ``F(z) = section(P(from_section(z))) - z``:
-
-    - without ``jacobian_guess``: ``hybrd``, with its own finite-difference start
-      (``2n - 1`` extra maps) and rank-1 (Broyden) updates;
-    - with ``jacobian_guess`` (``DP`` of a nearby fixed point, e.g. the previous point of a
-      continuation): ``hybrj`` starts from it and updates it by Broyden steps; only when
-      MINPACK asks for a Jacobian again (its updates stopped helping) is the true one
-      computed, by the variational equations at the current iterate.  One variational map
-      costs about five plain maps, so a stale Jacobian is never recomputed up front.
-
-    ``DP`` is then computed once, by the variational equations, at the fixed point.
-    Repeated evaluations at the same iterate (scipy evaluates ``F(z0)`` once to check its
-    shape, then MINPACK again) cost one map.
+    to the section, ``F(z) = section(P(from_section(z))) - z`` (:class:`_ReducedMap`: hybrd
+    with its own finite-difference start, or hybrj from ``jacobian_guess``).  ``DP`` is then
+    computed once, by the variational equations, at the fixed point.
 
     Parameters
     ----------
@@ -209,82 +201,23 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     FixedPointNotFound
         The root finder did not converge, or the map failed (fall) near the guess.
     """
-    from scipy.optimize import root
+    root = import_on_fresh_stack("scipy.optimize").root  # see walkerlab.freshstack
 
     t0 = time.perf_counter()
-    counter = {"nfev": 0, "calls": 0, "jacobians": 0}
-    last: dict = {}  # the last iterate's residual (z bytes -> F(z))
-    variational: dict = {}  # the last variational map asked as a Jacobian (z bytes -> map)
-
-    def residual(z):
-        key = z.tobytes()
-        if key in last:
-            return last[key].copy()
-        x = walker.from_section(z)
-        counter["calls"] += 1
-        try:
-            xn, _, nf = poincare_map(walker, x, solver, max_step_time)
-        except StepFailed:
-            r = np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
-        else:
-            counter["nfev"] += nf
-            r = walker.section(xn) - z
-            for zk in known:
-                r = r * (1.0 / max(float(np.sum((z - zk) ** 2)), 1e-300) + 1.0)
-        last.clear()
-        last[key] = r
-        return r.copy()
-
     known = [walker.section(np.asarray(xk, float)) for xk in deflate]
     if known and jacobian_guess is not None:
         raise ValueError("find_fixed_point: deflate and jacobian_guess exclude each other")
+    F = _ReducedMap(walker, solver, max_step_time, known)
     z0 = walker.section(np.asarray(guess, float))
     if jacobian_guess is None:
-        sol = root(residual, z0, method="hybr", options={"xtol": xtol})
+        sol = root(F.residual, z0, method="hybr", options={"xtol": xtol})
     else:
-        start = {z0.tobytes(): _section_jacobian(walker, np.asarray(jacobian_guess, float),
-                                                 z0)}
-
-        def jacobian(z):
-            key = z.tobytes()
-            if key in start:  # the start: asked by scipy's shape check and by MINPACK
-                return start[key]
-            segs: list = []
-            try:  # asked again: the updated guess stopped helping; the true one here
-                out = poincare_map(walker, walker.from_section(z), solver, max_step_time,
-                                   jacobian=True, steps=segs)
-            except StepFailed:
-                return next(iter(start.values()))
-            counter["nfev"] += out[3]
-            counter["jacobians"] += 1
-            variational.clear()
-            variational[key] = (*out, segs)  # MINPACK often stops at this iterate: reused
-            return _section_jacobian(walker, out[2], z)
-
-        sol = root(residual, z0, method="hybr", jac=jacobian, options={"xtol": xtol})
-    x = walker.from_section(sol.x)
-    if sol.x.tobytes() in variational:  # the Jacobian was last computed at the solution
-        xn, period, DP, _, segs = variational[sol.x.tobytes()]
-        counter["jacobians"] -= 1
-    else:
-        segs = []
-        try:
-            xn, period, DP, nf = poincare_map(walker, x, solver, max_step_time, jacobian=True,
-                                              steps=segs)
-        except StepFailed as exc:
-            raise FixedPointNotFound(f"{sol.message}; the map fails at the last iterate "
-                                     f"({exc})", float("nan")) from None
-        counter["nfev"] += nf
+        F.start[z0.tobytes()] = _section_jacobian(walker, np.asarray(jacobian_guess, float),
+                                                  z0)
+        sol = root(F.residual, z0, method="hybr", jac=F.jacobian, options={"xtol": xtol})
+    x, xn, period, DP, segs = F.variational_at(sol.x, sol.message)
     res = float(np.max(np.abs(xn - x)))
-    message = " ".join(str(sol.message).split())
-    step = walker.points(x).get("swing_foot")
-    L = walker.params.get("leg_length_m", 1.0)
-    if step is not None and float(np.linalg.norm(step)) < 1e-3 * L:
-        raise FixedPointNotFound("the root finder went to the trivial standing solution "
-                                 f"(step length {1e3 * float(np.linalg.norm(step)):.2f} mm), "
-                                 "not to a walking gait", res)
-    if not sol.success or res > 1e-6:
-        raise FixedPointNotFound(message, res)
+    _check_walking(walker, x, sol, res)
     if fd_check:
         Jfd, nf2 = fd_jacobian(walker, x, solver, fd_step, max_step_time)
         mult_fd = sort_multipliers(np.linalg.eigvals(Jfd))
@@ -295,13 +228,118 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         x=x, period_s=period, residual=res,
         multipliers_variational=sort_multipliers(np.linalg.eigvals(DP)),
         multipliers_fd=mult_fd, jacobian_variational=DP, jacobian_fd=Jfd,
-        nfev=counter["nfev"] + nf2, iterations=counter["calls"],
-        wall_time_s=time.perf_counter() - t0, variational_maps=counter["jacobians"] + 1,
+        nfev=F.counter["nfev"] + nf2, iterations=F.counter["calls"],
+        wall_time_s=time.perf_counter() - t0, variational_maps=F.counter["jacobians"] + 1,
         step_periods_s=tuple(float(sg.period) for sg in segs),
         step_lengths_m=tuple(
             float(np.linalg.norm(walker.for_stance(sg.stance_leg).points(sg.x_end)["swing_foot"]))
             for sg in segs),
     )
+
+
+class _ReducedMap:
+    """``F(z) = section(P(from_section(z))) - z`` for MINPACK, deflated by the ``known``
+    section points, with its evaluations counted (``counter``: RHS evaluations, maps, maps
+    with the variational equations asked as a Jacobian).
+
+    - without a Jacobian start: ``hybrd``, with its own finite-difference start (``2n - 1``
+      extra maps) and rank-1 (Broyden) updates;
+    - with one (``start``: ``DP`` of a nearby fixed point, e.g. the previous point of a
+      continuation, reduced to the section): ``hybrj`` starts from it and updates it by
+      Broyden steps; only when MINPACK asks for a Jacobian again (its updates stopped
+      helping) is the true one computed, by the variational equations at the current
+      iterate.  One variational map costs about five plain maps, so a stale Jacobian is
+      never recomputed up front.
+
+    Repeated evaluations at the same iterate (scipy evaluates ``F(z0)`` once to check its
+    shape, then MINPACK again) cost one map.
+    """
+
+    def __init__(self, walker: HybridWalker, solver: Solver, max_step_time: float,
+                 known: list):
+        self.walker, self.solver, self.max_step_time = walker, solver, max_step_time
+        self.known = known
+        self.counter = {"nfev": 0, "calls": 0, "jacobians": 0}
+        self.start: dict = {}  # the Jacobian start (z0 bytes -> section Jacobian)
+        self._last: dict = {}  # the last iterate's residual (z bytes -> F(z))
+        self._variational: dict = {}  # the last variational map asked as a Jacobian
+
+    def residual(self, z: np.ndarray) -> np.ndarray:
+        """``F(z)`` (2n-1,), deflated; a failed step pushes the root finder away."""
+        key = z.tobytes()
+        if key in self._last:
+            return self._last[key].copy()
+        walker = self.walker
+        x = walker.from_section(z)
+        self.counter["calls"] += 1
+        try:
+            xn, _, nf = poincare_map(walker, x, self.solver, self.max_step_time)
+        except StepFailed:
+            r = np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
+        else:
+            self.counter["nfev"] += nf
+            r = walker.section(xn) - z
+            for zk in self.known:
+                r = r * (1.0 / max(float(np.sum((z - zk) ** 2)), 1e-300) + 1.0)
+        self._last.clear()
+        self._last[key] = r
+        return r.copy()
+
+    def jacobian(self, z: np.ndarray) -> np.ndarray:
+        """``F_z`` (2n-1, 2n-1): the start at ``z0``, else from the variational equations."""
+        key = z.tobytes()
+        if key in self.start:  # the start: asked by scipy's shape check and by MINPACK
+            return self.start[key]
+        walker, segs = self.walker, []
+        try:  # asked again: the updated guess stopped helping; the true one here
+            out = poincare_map(walker, walker.from_section(z), self.solver,
+                               self.max_step_time, jacobian=True, steps=segs)
+        except StepFailed:
+            return next(iter(self.start.values()))
+        self.counter["nfev"] += out[3]
+        self.counter["jacobians"] += 1
+        self._variational.clear()
+        self._variational[key] = (*out, segs)  # MINPACK often stops at this iterate: reused
+        return _section_jacobian(walker, out[2], z)
+
+    def variational_at(self, z: np.ndarray, message: str):
+        """``(x, P(x), period, DP, steps)`` at the root finder's last iterate ``z``: the
+        variational map there (reused when MINPACK last asked for its Jacobian there).
+
+        Raises
+        ------
+        FixedPointNotFound
+            The map fails at ``z`` (``message``: the root finder's).
+        """
+        x = self.walker.from_section(z)
+        if z.tobytes() in self._variational:  # the Jacobian was last computed at the solution
+            xn, period, DP, _, segs = self._variational[z.tobytes()]
+            self.counter["jacobians"] -= 1
+            return x, xn, period, DP, segs
+        segs = []
+        try:
+            xn, period, DP, nf = poincare_map(self.walker, x, self.solver, self.max_step_time,
+                                              jacobian=True, steps=segs)
+        except StepFailed as exc:
+            raise FixedPointNotFound(f"{message}; the map fails at the last iterate "
+                                     f"({exc})", float("nan")) from None
+        self.counter["nfev"] += nf
+        return x, xn, period, DP, segs
+
+
+def _check_walking(walker: HybridWalker, x: np.ndarray, sol, res: float) -> None:
+    """Raise :class:`FixedPointNotFound` unless the root finder converged (``sol``) to a
+    walking gait ``x`` with residual ``res`` below 1e-6 (not the trivial standing solution,
+    a step shorter than 1e-3 leg lengths)."""
+    message = " ".join(str(sol.message).split())
+    step = walker.points(x).get("swing_foot")
+    L = walker.params.get("leg_length_m", 1.0)
+    if step is not None and float(np.linalg.norm(step)) < 1e-3 * L:
+        raise FixedPointNotFound("the root finder went to the trivial standing solution "
+                                 f"(step length {1e3 * float(np.linalg.norm(step)):.2f} mm), "
+                                 "not to a walking gait", res)
+    if not sol.success or res > 1e-6:
+        raise FixedPointNotFound(message, res)
 
 
 def _section_jacobian(walker: HybridWalker, DP: np.ndarray, z: np.ndarray) -> np.ndarray:

@@ -116,7 +116,7 @@ def convergence(walker, ideal, kappas, *, min_multiplier: float = 1e-6,
         The scene's contact walker (``kappa = 1``).
     ideal : fixed-point result of the rigid walker
         With ``x`` (post-impact state, role order), ``period_s`` and
-        ``multipliers_variational`` (as :func:`walkerlab.stages.fixedpoint.solve_variant`).
+        ``multipliers_variational`` (as :func:`walkerlab.analysis.scene_gaits.solve_variant`).
     kappas : array_like (n,)
         Increasing stiffness factors [-].
     min_multiplier : float

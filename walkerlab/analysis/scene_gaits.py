@@ -139,3 +139,52 @@ def solve_variant(scene: Scene, variant: str, guess=None):
     res = find_fixed_point(walker, g, Solver.from_settings(scene.solver),
                            xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
     return walker, res
+
+
+def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
+                    note: str | None = None):
+    """The period-1 gait of the scene's own equation variant and, with ``compare_variants``
+    (a compass gait compared with published numbers), the fixed points of the other
+    variants from the same start - what the ``fixedpoint`` artifact stores.
+
+    Parameters
+    ----------
+    guess : ndarray (2n,), optional
+        Start of the root finder (a known gait carried here by homotopy,
+        :func:`walkerlab.sweep.continuation.homotopy_start`); default the scene's initial
+        guess or the scale-free seeds.
+    note : str, optional
+        How ``guess`` was found, added to the search's notes.
+
+    Returns
+    -------
+    run : walkerlab.io.schemas.fixedpoint.FixedPointRun
+        The writer's input; a variant without a fixed point holds its
+        :class:`~walkerlab.analysis.poincare.FixedPointNotFound`.
+    summary : dict
+        ``walker``, ``result`` (the selected gait), ``gaits`` (the search), ``variants``.
+
+    Raises
+    ------
+    GaitNotFound
+        No gait for the scene's own variant (one line).
+    ValueError
+        A malformed initial guess or gait choice (one line).
+    """
+    from walkerlab.io.schemas.fixedpoint import FixedPointRun
+
+    walker, search = solve_scene(scene, guess=guess)
+    if note:
+        search.notes.append(note)
+    main = search.result
+    results = {scene.ideal.variant: (walker, main)}
+    init = initial_guess(scene, walker)
+    other_guess = main.x if init is None else init
+    for variant in variants_for(scene, compare_variants)[1:]:
+        try:
+            results[variant] = solve_variant(scene, variant, other_guess)
+        except FixedPointNotFound as exc:
+            results[variant] = exc
+    run = FixedPointRun(walker, search, results, scene.ideal.variant, other_guess)
+    summary = {"walker": walker, "result": main, "gaits": search, "variants": dict(results)}
+    return run, summary

@@ -9,14 +9,6 @@ import numpy as np
 
 from walkerlab.io.trajectory import NamedTrajectory
 
-TABLE3_ROWS = {
-    "t_left_s": ("Left step period", "t_left", "s"),
-    "t_right_s": ("Right step period", "t_right", "s"),
-    "t_cycle_s": ("One cycle period", "t_cycle = t_left + t_right", "s"),
-    "v_com_m_per_s": ("Average velocity of robot", "v_com", "m/s"),
-    "E_avg_J": ("Average mechanical energy (5 steps)", "E_avg = KE + PE", "J"),
-}
-
 
 def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_steps: int = 5,
                  mass_kg: float | None = None, g: float = 9.81) -> dict[str, float]:

@@ -2,7 +2,7 @@
 
 The augmented system ``[F(z, p1, p2); psi(z, p1, p2)] = 0`` (``F`` the ``k``-step map's
 fixed-point residual on the heel-strike section, ``psi`` the fold or period-doubling test
-function of :mod:`walkerlab.analysis.continuation`) is solved for ``(z, p1)`` at each
+function of :mod:`walkerlab.analysis.continuation_map`) is solved for ``(z, p1)`` at each
 ``p2`` by ``scipy.optimize.root`` (``hybr``; the rows of ``F`` analytic from the
 variational equations, the row of ``psi`` by central differences), with a secant predictor
 in ``p2``: the stability boundary in the plane of two scene fields (Goswami, Thuilot &
@@ -15,17 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.analysis.continuation import (
+from walkerlab.analysis.continuation_map import (
     RESIDUAL_TOL,
-    BranchPoint,
+    BranchSystem,
     MapFailed,
-    SpecialPoint,
     WalkerFamily,
-    _critical_vector,
-    _point,
-    _System,
-    _test_functions,
+    critical_vector,
+    test_functions,
 )
+from walkerlab.analysis.continuation_points import BranchPoint, SpecialPoint, branch_point
 
 __all__ = ["TwoParameterCurve", "special_point_at", "two_parameter"]
 
@@ -70,12 +68,12 @@ def special_point_at(family: WalkerFamily, kind: str, k: int, p_guess: float,
     """
     from scipy.optimize import root
 
-    sys = _System(family, k, p_scale)
+    sys = BranchSystem(family, k, p_scale)
     target = 1.0 if kind == "fold" else -1.0
 
     def psi(u):
         info = sys.full(u[:-1], u[-1] * p_scale)
-        return _test_functions(info["M"])[kind], info
+        return test_functions(info["M"])[kind], info
 
     def G(u):
         try:
@@ -107,8 +105,8 @@ def special_point_at(family: WalkerFamily, kind: str, k: int, p_guess: float,
         raise MapFailed("no special point", str(exc)) from None
     if float(np.max(np.abs(info["F"]))) > RESIDUAL_TOL or not sol.success:
         raise MapFailed("no special point", " ".join(str(sol.message).split()))
-    q = _point(sys, u, info, None)
-    _v, mu = _critical_vector(q.M, target)
+    q = branch_point(sys, u, info, None)
+    _v, mu = critical_vector(q.M, target)
     if abs(mu - target) > 1e-5:
         raise MapFailed("no special point", f"critical multiplier {mu:.6g}")
     return float(u[-1] * p_scale), q
@@ -142,7 +140,7 @@ def two_parameter(family: WalkerFamily, sp: SpecialPoint, path2: str, p2_start: 
                 p, q = special_point_at(fam, sp.kind, sp.period, pg, zg, p_scale)
             except MapFailed:
                 break
-            mu = _critical_vector(q.M, 1.0 if sp.kind == "fold" else -1.0)[1]
+            mu = critical_vector(q.M, 1.0 if sp.kind == "fold" else -1.0)[1]
             rows.append((float(p2), p, q.x, q.z, mu))
             hist.append((float(p2), p, q.z))
     rows.sort(key=lambda r: r[0])

@@ -15,8 +15,8 @@ plans the cases from the scene, caches them and writes the artifact):
   timed case never shares its core with another case; each worker runs every method once,
   untimed, over one stride before timing (compiled code is loaded from the on-disk caches,
   not timed), then freezes its heap for the garbage collector;
-- the Pareto front and the fastest setting (:func:`pareto_front`, :func:`summarize`), both
-  only where the settings' CPU times differ by more than the spread of their repeats.
+- the rows of the study, its Pareto front and the fastest setting:
+  :mod:`walkerlab.analysis.workprecision_results`.
 """
 
 from __future__ import annotations
@@ -64,40 +64,6 @@ def ideal_runner(scene, x0: np.ndarray, strides: int):
             return None, tr.nfev, cpu
         return np.concatenate([seg.x_end, [seg.t_end]]), tr.nfev, cpu
     return run
-
-
-def pareto_front(times: np.ndarray, errors: np.ndarray, time_min: np.ndarray | None = None,
-                 time_max: np.ndarray | None = None) -> np.ndarray:
-    """Indices of the non-dominated points, ordered by time.
-
-    Without a spread: a point stays unless another is at most as slow and at least as
-    accurate (one of the two strictly).  With the spread of the repeats (``time_min``,
-    ``time_max``, shape like ``times`` [s]), times are compared only beyond it: point ``j``
-    dominates ``i`` when it is at least as accurate and either clearly faster
-    (``time_max[j] < time_min[i]``) or indistinguishable in time (the ranges overlap) and
-    strictly more accurate.  So the front never holds two settings whose time ranges
-    overlap (the less accurate of them is dominated), and a point is not dropped for a
-    difference in time that lies inside the timing noise.
-    """
-    t = np.asarray(times, float)
-    e = np.asarray(errors, float)
-    lo = t if time_min is None else np.asarray(time_min, float)
-    hi = t if time_max is None else np.asarray(time_max, float)
-    keep = []
-    for i in np.argsort(t, kind="stable"):
-        if not np.isfinite(e[i]):
-            continue
-        if time_min is None and time_max is None:
-            dominated = any(np.isfinite(e[j]) and e[j] <= e[i] and t[j] <= t[i]
-                            and (e[j] < e[i] or t[j] < t[i]) for j in range(t.size) if j != i)
-        else:
-            dominated = any(
-                np.isfinite(e[j]) and e[j] <= e[i]
-                and (hi[j] < lo[i] or (e[j] < e[i] and lo[j] <= hi[i] and lo[i] <= hi[j]))
-                for j in range(t.size) if j != i)
-        if not dominated:
-            keep.append(int(i))
-    return np.asarray(keep, dtype=int)
 
 
 #: a run longer than this [s] is timed once: the timer's resolution and start-up jitter are
@@ -161,39 +127,6 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
             return None, res.nfev, cpu
         return np.concatenate([res.x[-1, legs], res.x[-1, rates]]), res.nfev, cpu
     return run
-
-
-def rows_from_cases(cases: dict, methods, rtols, reference) -> dict:
-    """``{method: {rtol, time, time_min, time_max, wall_time, error, nfev, repeats}}``
-    (arrays over ``rtols``; ``time`` is the median CPU time of the integration over the
-    repeats, ``time_min``/``time_max`` their spread, ``wall_time`` the median wall time)
-    from ``{(method, rtol): time_case result}``; the error is the max-norm distance of the
-    final vector from ``reference`` (inf where the run failed)."""
-    out = {}
-    for m in methods:
-        rows = {"rtol": [], "time": [], "time_min": [], "time_max": [], "wall_time": [],
-                "error": [], "nfev": [], "repeats": []}
-        for rtol in rtols:
-            c = cases[(m, rtol)]
-            vec = c["vec"]
-            rows["rtol"].append(rtol)
-            rows["time"].append(float(np.median(c["cpu_times"])))
-            rows["time_min"].append(float(np.min(c["cpu_times"])))
-            rows["time_max"].append(float(np.max(c["cpu_times"])))
-            rows["wall_time"].append(float(np.median(c["times"])))
-            rows["error"].append(np.inf if vec is None
-                                 else float(np.max(np.abs(np.asarray(vec) - reference))))
-            rows["nfev"].append(c["nfev"])
-            rows["repeats"].append(len(c["times"]))
-        out[m] = {k: np.asarray(v) for k, v in rows.items()}
-    return out
-
-
-def study(runner, methods, rtols, atol_factor, repeats, reference) -> dict:
-    """Run every (method, rtol) here; returns :func:`rows_from_cases`'s rows."""
-    cases = {(m, r): time_case(runner, m, r, atol_factor * r, repeats)
-             for m in methods for r in rtols}
-    return rows_from_cases(cases, methods, rtols, reference)
 
 
 # ------------------------------------------------------------------ cached, parallel cases
@@ -383,55 +316,3 @@ def run_cases(tasks: list[Case], cache_dir: Path, workers: int = 2,
     run_on_lanes(lanes, todo, _run_case, lambda kr: store(*kr, len(lanes.cores)),
                  group=lambda t: t.model, warm=load_libraries, name="workprecision")
     return out
-
-
-def summarize(rows: dict, target: float) -> dict:
-    """Pareto front, and the fastest setting reaching ``target`` when the timings can tell.
-
-    Parameters
-    ----------
-    rows : dict
-        :func:`rows_from_cases` output (``time`` the median, ``time_min``/``time_max`` the
-        spread of the repeats; rows without a spread count as one run).
-    target : float
-        Error a setting must reach [rad, rad/s].
-
-    Returns
-    -------
-    dict
-        ``pareto``: ``[(method, rtol, median time, error)]``; ``best``: the setting with the
-        smallest median time among those reaching ``target`` (None if none does);
-        ``separated``: whether that choice exceeds the timing noise: its slowest run is
-        faster than the fastest run of every other setting reaching the target, each
-        measured at least twice (or it is the only one reaching it); ``tied``: the settings
-        the timings cannot separate from ``best`` (``best`` first), each
-        ``(method, rtol, min, median, max time, repeats)``.
-    """
-    meth = [m for m in rows for _ in rows[m]["rtol"]]
-    cat = {k: np.concatenate([np.asarray(rows[m].get(k, rows[m]["time"]), float)
-                              for m in rows]) for k in ("rtol", "time", "time_min",
-                                                        "time_max", "error")}
-    reps = np.concatenate([np.asarray(rows[m].get("repeats", np.ones(len(rows[m]["rtol"]))))
-                           for m in rows])
-    rt, tt, ee = cat["rtol"], cat["time"], cat["error"]
-    lo, hi = cat["time_min"], cat["time_max"]
-    idx = pareto_front(tt, ee, lo, hi)
-    ok = np.flatnonzero(ee <= target)
-    best = int(ok[np.argmin(tt[ok])]) if ok.size else None
-    tied, separated = [], False
-    if best is not None:
-        others = [int(j) for j in ok[np.argsort(tt[ok], kind="stable")] if j != best]
-        overlap = [j for j in others if lo[j] <= hi[best]]
-        measured = reps[best] >= 2 and (not others or reps[others[0]] >= 2)
-        separated = not overlap and measured
-        if not separated:
-            tied = [best, *(overlap or others[:1])]
-
-    def case(i):
-        return (meth[i], float(rt[i]), float(lo[i]), float(tt[i]), float(hi[i]), int(reps[i]))
-    return {"pareto": [(meth[i], float(rt[i]), float(tt[i]), float(ee[i])) for i in idx],
-            "best": None if best is None else (meth[best], float(rt[best]), float(tt[best]),
-                                               float(ee[best])),
-            "separated": bool(separated),
-            "best_spread": None if best is None else case(best),
-            "tied": [case(i) for i in tied]}

@@ -10,20 +10,15 @@ import hashlib
 import json
 from pathlib import Path
 
-from walkerlab.analysis.workprecision import (
-    CYRK_PREFIX,
-    Case,
-    rows_from_cases,
-    run_cases,
-    summarize,
-)
+from walkerlab.analysis.workprecision import CYRK_PREFIX, Case, run_cases
+from walkerlab.analysis.workprecision_results import rows_from_cases, summarize
 from walkerlab.config import Scene
 
 #: the sources a case's result depends on (a change elsewhere - report text, plots, other
 #: stages - keeps the measured cases)
 CASE_SOURCES = {
-    "ideal": ("analysis", "models", "integrate", "config"),
-    "contact": ("analysis", "models", "contact", "integrate", "config"),
+    "ideal": ("analysis", "models", "integrate", "config", "walker", "codegen"),
+    "contact": ("analysis", "models", "integrate", "config", "walker", "codegen"),
 }
 
 

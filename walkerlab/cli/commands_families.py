@@ -23,13 +23,14 @@ def sweep(scene: Path | None = SceneArg,
           name: str | None = typer.Option(None, "--name", help="artifact name"),
           runs_dir: Path = RunsOpt) -> None:
     """Run a stage over a grid of scene fields; one row per point, failures recorded."""
+    from walkerlab.io.sweep_store import load_sweep
     from walkerlab.report.sweep_text import sweep_text
     from walkerlab.stages import sweep as stage_mod
 
     sc = load(scene)
     path = stage_mod.run(sc, param, stage=stage, workers=workers,
                          scheduler=scheduler, resume=resume, runs_root=runs_dir, name=name)
-    typer.echo(sweep_text(path))
+    typer.echo(sweep_text(load_sweep(path)))
     typer.echo(f"wrote {path}")
     typer.echo(f"figure: {stage_mod.figure_path(sc, path, runs_dir)}")
 

@@ -116,6 +116,7 @@ def stability_map(scene: Path | None = SceneArg,
                   runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Stability maps of the contact gait: does a periodic gait exist, is it stable, max
     |Floquet multiplier|, or why not (cached stage)."""
+    from walkerlab.config.options import map_not_applicable
     from walkerlab.stages import stability_map as stage
     from walkerlab.sweep.stability import MAP_KINDS
 
@@ -124,8 +125,8 @@ def stability_map(scene: Path | None = SceneArg,
     for k in kinds:
         if k not in MAP_KINDS:
             fail(ValueError(f"--kind: unknown map {k!r} (stiffness, friction, patch_width, all)"))
-        if kind == "all" and stage.not_applicable(sc, k):
-            typer.echo(f"{k}: skipped ({stage.not_applicable(sc, k).split(': ', 1)[1]})")
+        if kind == "all" and map_not_applicable(sc, k):
+            typer.echo(f"{k}: skipped ({map_not_applicable(sc, k).split(': ', 1)[1]})")
             continue
         out = stage.run(sc, runs_dir, force, kind=k, n=n, workers=workers,
                         time_limit_s=time_limit)

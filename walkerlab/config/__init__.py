@@ -1,16 +1,22 @@
 """Typed scene configuration (YAML -> pydantic v2).
 
-The package is the bottom of the settings: :mod:`walkerlab.config.contact` holds the
-compliant-contact sections (contact law, terrain, run, solver) and
-:mod:`walkerlab.config.schema` the scene and the rigid model's sections; every section is
-importable from ``walkerlab.config``.  Nothing here imports a model package (the model
+The package is the bottom of the settings: :mod:`walkerlab.config.walker` holds the walker
+sections, :mod:`walkerlab.config.studies` the sections of the analyses,
+:mod:`walkerlab.config.contact` the compliant-contact sections (contact law, terrain, run)
+and :mod:`walkerlab.config.schema` the scene that holds them; every section is importable
+from ``walkerlab.config``.  Nothing here imports a model package (the model
 packages import their settings from here).
 
 A *scene* declares only the sections it uses; every section is optional except the walker
 and the slope.  Every numeric field carries its unit in its name (``leg_length_m``) and a
 description; validation always runs and unknown keys are rejected (``extra="forbid"``).
 
-Modules: :mod:`~walkerlab.config.schema` (the pydantic sections and :class:`Scene`),
+Modules: :mod:`~walkerlab.config.schema` (:class:`Scene`, the slope, the model variant and
+the command-line sizes), :mod:`~walkerlab.config.walker` (compass gait, biped: legs, bodies,
+feet, knee, torso, springs), :mod:`~walkerlab.config.studies` (fixed point, simulation,
+work-precision, basin, MFPT, robustness; a state by name), :mod:`~walkerlab.config.base`
+(the strict base of every section), :mod:`~walkerlab.config.errors` (error lines,
+:class:`SceneError`),
 :mod:`~walkerlab.config.loader` (YAML reading, validation, error lines),
 :mod:`~walkerlab.config.limits` (caps and unit-mistake warnings),
 :mod:`~walkerlab.config.contact` (compliant-contact sections),
@@ -23,6 +29,7 @@ SceneError
     One line naming the file and the offending field, for every bad input.
 """
 
+from walkerlab.config.base import AsTuple
 from walkerlab.config.contact import (
     MAX_CONTACT_STRIDES,
     ContactSettings,
@@ -30,7 +37,7 @@ from walkerlab.config.contact import (
     PerStepTerrain,
     TerrainSettings,
 )
-from walkerlab.config.errors import WALKER_VOCABULARY
+from walkerlab.config.errors import WALKER_VOCABULARY, SceneError
 from walkerlab.config.limits import (
     MAX_BASIN_CELLS_PER_AXIS,
     MAX_BIFURCATION_KEEP,
@@ -56,41 +63,43 @@ from walkerlab.config.loader import (
     validate_option,
 )
 from walkerlab.config.schema import (
+    CommandOptions,
+    IdealModelSettings,
+    Scene,
+    SlopeSettings,
+)
+from walkerlab.config.solver import SolverSettings
+from walkerlab.config.studies import (
+    BasinSettings,
+    FixedPointSettings,
+    GuessFromArtifact,
+    MfptSettings,
+    RobustnessSettings,
+    SimulateSettings,
+    StateSpec,
+    WorkPrecisionSettings,
+)
+from walkerlab.config.walker import (
     AnkleSpec,
     ArcFoot,
-    AsTuple,
-    BasinSettings,
     BipedParams,
     Body,
-    CommandOptions,
     CompassGaitParams,
-    FixedPointSettings,
     FlatFoot,
     Foot,
-    GuessFromArtifact,
-    IdealModelSettings,
     KneeSpec,
     KneeSpringSpec,
     LegSpec,
-    MfptSettings,
     PointFoot,
     PointMassBody,
-    RobustnessSettings,
     RodBody,
-    Scene,
-    SceneError,
-    SimulateSettings,
-    SlopeSettings,
     SpringSpec,
-    StateSpec,
     TorsoBody,
     TorsoPointMass,
     TorsoRigidBody,
     TorsoSpec,
     WalkerParams,
-    WorkPrecisionSettings,
 )
-from walkerlab.config.solver import SolverSettings
 
 __all__ = [
     "AnkleSpec",

@@ -31,7 +31,7 @@ __all__ = ["CONTACT_QUANTITIES", "LENGTH_UNITS", "MAX_CONTACT_STRIDES", "Contact
 
 
 # Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
-# a YAML int still validates as a float.  Same rules as walkerlab.config.schema._Strict.
+# a YAML int still validates as a float.  Same rules as walkerlab.config.base.Strict.
 _STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 
 # Longest contact run (D8): 100 strides is ~20x the paper's 5 and keeps the artifact < 100 MB.

@@ -1,7 +1,8 @@
 """One error line per validation mistake, naming the file and the field (``<file>: <field
 path>: <message>``), with the likely meant field for an unknown key and a unit hint for a
-bound that looks like a unit mistake.  The root model is a parameter, so this module sits
-below the schema it describes."""
+bound that looks like a unit mistake, and :class:`SceneError`, the exception those lines
+travel in.  The root model is a parameter, so this module sits below the schema it
+describes."""
 
 from __future__ import annotations
 
@@ -10,6 +11,12 @@ import re
 from pathlib import Path
 
 from pydantic import BaseModel, ValidationError
+
+
+class SceneError(ValueError):
+    """A scene file cannot be read or does not validate (one line per error, each naming
+    the file and the field)."""
+
 
 # discriminator tags of walker models and bodies: not part of a field's path
 _TAGS = {"compass_gait", "biped", "point_mass", "rod", "point", "arc", "flat"}

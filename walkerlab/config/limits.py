@@ -1,8 +1,8 @@
 """Caps and bounds of a scene and the command line, and unit-mistake warnings.
 
 Each size a user can type has one cap, defined here; the scene's fields
-(:mod:`walkerlab.config.schema`) and the CLI's options (:func:`walkerlab.config.validate_option`)
-validate through them.
+(:mod:`~walkerlab.config.schema`, :mod:`~walkerlab.config.studies`) and the CLI's options
+(:func:`walkerlab.config.validate_option`) validate through them.
 """
 
 from __future__ import annotations

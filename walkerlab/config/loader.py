@@ -16,9 +16,9 @@ from typing import Annotated, Any
 import yaml
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from walkerlab.config.errors import format_error
+from walkerlab.config.errors import SceneError, format_error
 from walkerlab.config.limits import MAX_SCENE_BYTES, MAX_YAML_DEPTH, SMALL_SLOPE_DEG
-from walkerlab.config.schema import SCENE_NAME_RE, Scene, SceneError
+from walkerlab.config.schema import SCENE_NAME_RE, Scene
 
 
 def default_scene_path() -> Path:

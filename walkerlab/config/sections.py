@@ -19,3 +19,22 @@ def default_section(scene: BaseModel, section: str) -> BaseModel | None:
         return models[0]()
     except ValidationError:
         return None
+
+
+def section_or_default(scene: BaseModel, section: str) -> BaseModel | None:
+    """The scene's ``section``; left out, its defaults when every field of it is optional
+    (``fixedpoint:`` left out runs as ``fixedpoint: {}``); None when it is left out and has
+    a required field."""
+    val = getattr(scene, section)
+    return val if val is not None else default_section(scene, section)
+
+
+def with_default_section(scene, section: str):
+    """``scene`` (a :class:`walkerlab.config.Scene`) with ``section`` filled with its
+    defaults when it is left out (:func:`section_or_default`); the scene's file
+    (``origin``) is kept.  A section with a required field stays None."""
+    if getattr(scene, section) is not None:
+        return scene
+    out = scene.model_copy(update={section: default_section(scene, section)})
+    out._origin = scene.origin
+    return out

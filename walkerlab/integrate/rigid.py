@@ -4,23 +4,10 @@ A trajectory is a list of :class:`Segment` (one per step), each with its termina
 (``heel_strike``, ``fall``, ``t_final``, ``solver_failure``) and the event time and state, as
 PyBaMM's solutions record why they stopped.
 
-Integrators come from libraries, chosen by :class:`~walkerlab.integrate.solver.Solver`
-``backend``:
-
-- ``"scipy"``: ``scipy.integrate.solve_ivp`` (any of its methods); guards are its events.
-- ``"cyrk"``: ``CyRK.pysolve_ivp`` (Renaud, CyRK: the same explicit Runge-Kutta pairs as
-  scipy - RK23, RK45, DOP853 - with the adaptive stepping written in C++).  Guards are its
-  events, located like scipy's by Brent's method on the dense output (xtol = 4 eps).
-  On the compass gait it takes exactly scipy's steps (same time and state at heel strike to
-  round-off) 25-60 times faster: ``scripts/bench_integrators.py`` and the note of issue 10.
-- ``"cyrk_compiled"``: the same CyRK pairs with the phase's flow (and variational equations)
-  compiled by numba (:mod:`walkerlab.codegen.compiled`, cached on disk), so each phase runs in
-  C++ without Python callbacks; guards are located on the step points and by Brent's method
-  on the dense output (:mod:`walkerlab.integrate._compiled`).  Imports numba (about 1 s per
-  process): meant for many-point studies.  A phase without a compiled flow (a replaced flow)
-  falls back to ``cyrk``.
-- ``"auto"`` (default): ``cyrk`` for the methods it shares with scipy when it is installed,
-  else ``scipy``.
+Each phase runs on a library's integrator, chosen by
+:class:`~walkerlab.integrate.solver.Solver` ``backend`` (:mod:`walkerlab.integrate.rigid_phase`);
+at each guard crossing the reset and, with the variational equations, the saltation matrix
+are applied here.
 
 Nothing here knows the walker's size: states are ``(2n,)`` arrays, guards and resets come
 from the walker's phases.
@@ -33,9 +20,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.models.hybrid.base import HybridWalker, Phase, complex_step_jacobian
+from walkerlab.models.hybrid.base import HybridWalker, Phase
 
 from .ends import RunEnd
+from .rigid_phase import integrate_phase, numeric_jacobian, phase_rhs
 from .solver import Solver
 
 #: A heel strike this soon after the step began [s] is no step: the state sat on the
@@ -45,122 +33,6 @@ MIN_STEP_TIME_S = 1e-9
 #: Phase switches allowed in one step (a phase graph with a cycle must not loop for ever;
 #: a flat-footed step has at most five).
 MAX_PHASE_SWITCHES = 64
-
-
-def numeric_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
-    """Jacobian of ``fun`` at ``x``: complex step where ``fun`` takes complex input, else
-    central differences (step ``1e-6 (1 + |x_k|)``; for compiled functions of real input).
-
-    Returns
-    -------
-    ndarray, shape (p, m)
-    """
-    try:
-        return complex_step_jacobian(fun, x, h)
-    except (TypeError, ValueError):
-        x = np.asarray(x, dtype=float)
-        cols = []
-        for k in range(x.size):
-            e = np.zeros_like(x)
-            e[k] = 1e-6 * (1.0 + abs(x[k]))
-            cols.append((np.asarray(fun(x + e), float) - np.asarray(fun(x - e), float))
-                        / (2 * e[k]))
-        return np.stack(cols, axis=1)
-
-
-@dataclass
-class _PhaseRun:
-    """What one phase's integration returned, whatever the backend."""
-
-    t_last: float          # time at the end (event time when a guard fired)
-    y_last: np.ndarray     # state at the end (event state when a guard fired)
-    failed: bool
-    message: str
-    event: int | None      # index of the guard that ended the phase
-    dense: object          # callable t -> (m,) or (m, k)
-    nfev: int
-
-
-class _CyDense:
-    """Dense output of a CyRK solution with scipy's ``OdeSolution`` calling convention."""
-
-    def __init__(self, res):
-        self._res = res
-
-    def __call__(self, t):
-        t = np.asarray(t, dtype=float)
-        if t.ndim == 0:
-            return self._res.call(float(t))
-        return np.asarray(self._res.call_vectorize(np.ascontiguousarray(t))).reshape(-1, t.size)
-
-
-IMPLICIT_METHODS = ("Radau", "BDF", "LSODA")
-
-
-def _solve_phase(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
-                 solver: Solver, backend: str, jac=None) -> _PhaseRun:
-    """Integrate ``rhs`` from ``t0`` until the first guard (state rows ``:n``) fires or ``t1``.
-
-    ``jac`` (``(t, y) -> (m, m)``) is handed to scipy's implicit methods."""
-    evs = []
-    whole = len(y0) == n  # no variational rows: the guard sees y itself (no slicing)
-    for gd in guards:
-        if whole:
-            def ev(t, y, _g=gd.function):
-                return _g(t, y)
-        else:
-            def ev(t, y, _g=gd.function):
-                return _g(t, y[:n])
-        ev.terminal = True
-        ev.direction = gd.direction
-        evs.append(ev)
-    y0 = np.ascontiguousarray(y0, dtype=float)
-    if backend == "cyrk":
-        from walkerlab.integrate.cyrk_loader import pysolve_ivp as cyrk_solver
-
-        pysolve_ivp = cyrk_solver()  # CyRK without its numba solvers (see cyrk_loader)
-        count = [0]
-
-        def counted(t, y):
-            count[0] += 1
-            return rhs(t, y)
-        res = pysolve_ivp(counted, (float(t0), float(t1)), y0, method=solver.method,
-                          dense_output=True, events=evs or None, rtol=solver.rtol,
-                          atol=solver.atol,
-                          max_step=solver.max_step_s if solver.max_step_s else np.inf)
-        t_events = res.t_events if evs else []
-        y_events = [np.asarray(ye).T for ye in res.y_events] if evs else []  # (k, m)
-        ts = res.t
-        failed = not res.success and not res.event_terminated
-        t_last = float(ts[-1]) if ts.size else float(t0)
-        y_last = res.y[:, -1] if ts.size else y0
-        msg, dense, nfev = res.message, _CyDense(res), count[0]
-    else:
-        from scipy.integrate import solve_ivp
-
-        kw = solver.kwargs()
-        if jac is not None and solver.method in IMPLICIT_METHODS:
-            kw["jac"] = jac
-        sol = solve_ivp(rhs, (t0, t1), y0, events=evs or None, dense_output=True, **kw)
-        t_events, y_events = (sol.t_events, sol.y_events) if evs else ([], [])
-        failed = sol.status == -1
-        t_last, y_last, msg = float(sol.t[-1]), sol.y[:, -1], sol.message
-        dense, nfev = sol.sol, sol.nfev
-    fired = [(te[0], i) for i, te in enumerate(t_events) if len(te)]
-    if fired and not failed:
-        te, i = min(fired)
-        return _PhaseRun(float(te), np.array(y_events[i][0], float), False, msg, i, dense, nfev)
-    return _PhaseRun(t_last, np.array(y_last, float), failed, msg, None, dense, nfev)
-
-
-def _phase_jacobian(walker: HybridWalker, phase: Phase):
-    """``(t, x) -> (2n, 2n)`` Jacobian of the phase's flow: the phase's own, the walker's,
-    or (last resort) a numerical one."""
-    if phase.jacobian is not None:
-        return phase.jacobian
-    if walker.variational is not None:
-        return walker.variational
-    return lambda t, x, _f=phase.flow: numeric_jacobian(lambda z: _f(t, z), x)
 
 
 @dataclass
@@ -295,43 +167,6 @@ class _StepState:
     x_next: np.ndarray | None = None
 
 
-def _phase_rhs(walker: HybridWalker, phase: Phase, n: int, variational: bool):
-    """Right-hand side of one phase, and the Jacobian handed to scipy's implicit methods.
-
-    Without ``variational``: the phase's flow and the model's analytic Jacobian (not a
-    numerical one: those methods approximate it themselves).  With it: the flow and
-    ``dPhi/dt = A(x) Phi`` on ``y = [x, Phi.ravel()]`` (the model's own in one call when it
-    has one), and no Jacobian."""
-    if not variational:
-        return phase.flow, (phase.jacobian if phase.jacobian is not None
-                            else walker.variational)
-    if phase.variational is not None:
-        return phase.variational, None
-    jac = _phase_jacobian(walker, phase)
-
-    def rhs(tt, y, _f=phase.flow, _A=jac):
-        xs = y[:n]
-        out = np.empty(n + n * n)
-        out[:n] = _f(tt, xs)
-        out[n:] = (_A(tt, xs) @ y[n:].reshape(n, n)).ravel()
-        return out
-    return rhs, None
-
-
-def _integrate_phase(phase: Phase, st: _StepState, t_stop: float, n: int, solver: Solver,
-                     backend: str, rhs, jac, variational: bool) -> _PhaseRun:
-    """One phase from ``st`` until its first guard fires or ``t_stop``, on ``backend``
-    (``cyrk_compiled`` runs the phase's compiled flow; a phase without one runs on CyRK)."""
-    y0 = np.concatenate([st.x, st.Phi.ravel()]) if variational else st.x
-    if backend == "cyrk_compiled" and phase.compiled is not None:
-        from walkerlab.integrate._compiled import solve_phase
-
-        return _PhaseRun(*solve_phase(phase.compiled, variational, st.t, t_stop, y0,
-                                      phase.guards, n, solver))
-    return _solve_phase(rhs, st.t, t_stop, y0, phase.guards, n, solver,
-                        "cyrk" if backend == "cyrk_compiled" else backend, jac)
-
-
 def _next_phase(walker: HybridWalker, k: int, guard, st: _StepState,
                 variational: bool) -> int:
     """Phase ``k``'s guard hands the step to the next phase (``k + 1``, or the phase the
@@ -381,6 +216,40 @@ def _end_step(walker: HybridWalker, phase: Phase, guard, st: _StepState, t0: flo
         st.Phi = RJ @ S @ st.Phi
 
 
+def _advance(walker: HybridWalker, phase: Phase, st: _StepState, t_stop: float, n: int,
+             solver: Solver, backend: str, variational: bool):
+    """Run ``phase`` from ``st`` and record it (its dense output and log line, the state, the
+    variational state); returns the guard that ended it, or None when the step ends without
+    one (a fall guard violated as the phase begins, a solver failure, ``t_stop``)."""
+    broken = _violated_at_entry(phase, st.t, st.x)
+    if broken is not None:  # e.g. a unilateral contact already pulling as its mode begins
+        st.termination, st.event = RunEnd.FALL, broken.name
+        st.message = f"{broken.name}: already violated as {phase.name} begins"
+        st.pieces.append((phase, _Held(st.x), (st.t, st.t)))
+        st.phase_log.append((phase.name, st.t, st.t, broken.name))
+        return None
+    rhs, jac = phase_rhs(walker, phase, n, variational)
+    run = integrate_phase(phase, st.t, st.x, st.Phi, t_stop, n, solver, backend, rhs, jac,
+                          variational)
+    st.nfev += run.nfev
+    st.message = run.message
+    st.pieces.append((phase, run.dense, (st.t, run.t_last)))
+    st.phase_log.append((phase.name, st.t, run.t_last, "" if run.event is None
+                         or run.failed else phase.guards[run.event].name))
+    st.t, st.x = run.t_last, run.y_last[:n].copy()
+    if run.failed:
+        st.termination = RunEnd.SOLVER_FAILURE
+        return None
+    if run.event is None:
+        st.termination = RunEnd.T_FINAL
+        return None
+    guard = phase.guards[run.event]
+    if variational:
+        st.Phi = run.y_last[n:].reshape(n, n)
+    st.event = guard.name
+    return guard
+
+
 def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: float = 0.0,
                    max_step_time: float = 5.0, t_final: float | None = None,
                    variational: bool = False, index: int = 0, stance_leg: str = "leg2",
@@ -426,31 +295,9 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         switches += 1
         if st.t >= t_stop:
             break
-        broken = _violated_at_entry(phase, st.t, st.x)
-        if broken is not None:  # e.g. a unilateral contact already pulling as its mode begins
-            st.termination, st.event = RunEnd.FALL, broken.name
-            st.message = f"{broken.name}: already violated as {phase.name} begins"
-            st.pieces.append((phase, _Held(st.x), (st.t, st.t)))
-            st.phase_log.append((phase.name, st.t, st.t, broken.name))
+        guard = _advance(walker, phase, st, t_stop, n, solver, backend, variational)
+        if guard is None:
             break
-        rhs, jac = _phase_rhs(walker, phase, n, variational)
-        run = _integrate_phase(phase, st, t_stop, n, solver, backend, rhs, jac, variational)
-        st.nfev += run.nfev
-        st.message = run.message
-        st.pieces.append((phase, run.dense, (st.t, run.t_last)))
-        st.phase_log.append((phase.name, st.t, run.t_last, "" if run.event is None
-                             or run.failed else phase.guards[run.event].name))
-        st.t, st.x = run.t_last, run.y_last[:n].copy()
-        if run.failed:
-            st.termination = RunEnd.SOLVER_FAILURE
-            break
-        if run.event is None:
-            st.termination = RunEnd.T_FINAL
-            break
-        guard = phase.guards[run.event]
-        if variational:
-            st.Phi = run.y_last[n:].reshape(n, n)
-        st.event = guard.name
         if guard.outcome == "next_phase":
             k = _next_phase(walker, k, guard, st, variational)
             continue

@@ -210,6 +210,24 @@ def content_hash(path: Path) -> str | None:
         return None
 
 
+def require_unedited(path: Path) -> Path:
+    """``path`` if its content still matches the content hash stored when it was written.
+
+    Raises
+    ------
+    ArtifactError
+        It was changed afterwards (one line naming it and the command that rewrites it):
+        figures and reports are drawn only from what a stage wrote.
+    """
+    if not stored_content_hash_matches(path):
+        stage = Path(path).stem.replace("_", "-")
+        raise ArtifactError(f"{path}: changed after it was written (its content no longer "
+                            f"matches its stored content hash); figures are drawn only from "
+                            f"what a stage wrote: rerun 'walkerlab {stage} --force' (or "
+                            "'walkerlab report')")
+    return path
+
+
 def stored_content_hash_matches(path: Path) -> bool:
     """True when the artifact's content equals the content hash stored when it was written
     (False: changed afterwards - edited by hand or with h5py - or unreadable)."""

@@ -62,8 +62,9 @@ Formats:
   mass or with a zero principal inertia, so: both slide joints sit in the hip body (no
   massless carriage), and principal inertias that never enter the planar dynamics (the hip
   never rotates; the links rotate about y only) or are zero (point masses on a line) get a
-  floor of :data:`MJCF_MIN_INERTIA_KG_M2`; the hip mass gets :data:`MJCF_MIN_MASS_KG` if
-  the walker has none.  Their effect on the mass matrix is at most that floor.
+  floor of :data:`~walkerlab.io.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`; the hip mass gets
+  :data:`~walkerlab.io.mjcf_scene.MJCF_MIN_MASS_KG` if the walker has none.  Their effect on
+  the mass matrix is at most that floor.
 """
 
 from __future__ import annotations
@@ -71,80 +72,33 @@ from __future__ import annotations
 import json
 import math
 import re
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 from xml.sax.saxutils import quoteattr
+
+from walkerlab.io.export_text import arc_feet, comment, header, num, nums
+from walkerlab.io.mjcf_scene import (
+    LANE_BITS,
+    MJCF_DEFAULT_TIMESTEP_S,
+    MJCF_MIN_INERTIA_KG_M2,
+    MJCF_MIN_MASS_KG,
+    MjcfScene,
+    point_foot_radius,
+)
 
 if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
     from walkerlab.walker.multibody import Link, Multibody
 
-__all__ = ["FORMATS", "LANE_BITS", "MJCF_MIN_INERTIA_KG_M2", "MJCF_MIN_LENGTH_M",
-           "MJCF_MIN_MASS_KG", "MjcfScene", "SIDECAR", "comments_in_scene_units", "keyframe_json",
-           "mjcf_text", "point_foot_radius", "urdf_text"]
+__all__ = ["FORMATS", "SIDECAR", "comments_in_scene_units", "keyframe_json", "mjcf_text",
+           "urdf_text"]
 
 #: Export formats and their file names in ``runs/<scene>/``.
 FORMATS = {"urdf": "walker.urdf", "mjcf": "walker.xml"}
 #: The URDF's keyframe sidecar in ``runs/<scene>/``.
 SIDECAR = "walker.gait.json"
-#: Floor of a MuJoCo principal inertia [kg m^2] (MuJoCo's mjMINVAL is 1e-15).
-MJCF_MIN_INERTIA_KG_M2 = 1e-12
-#: Floor of the MuJoCo hip body's mass [kg] (only for a walker without a hip mass); a link
-#: lighter than this is refused (MuJoCo refuses bodies below mjMINVAL = 1e-15 kg).
-MJCF_MIN_MASS_KG = 1e-12
-#: Shortest link or foot radius [m] an export accepts: the point foot's sphere is L/1000 and
-#: MuJoCo refuses geometry below mjMINVAL (1e-15), e.g. "fromto points too close".
-MJCF_MIN_LENGTH_M = 1e-9
-#: MuJoCo's default timestep [s] (an export without a scene keeps it).
-MJCF_DEFAULT_TIMESTEP_S = 0.002
 #: ``solimp`` of a coupling's equality: the largest impedance MuJoCo accepts (mjMAXIMP).
 COUPLING_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 #: Joint-axis of every hinge: world -y, so that a positive angle moves the foot ahead.
 AXIS = "0 -1 0"
-
-
-def _f(x: float) -> str:
-    """A float that reads back exactly (shortest round-trip repr)."""
-    return repr(float(x) + 0.0)  # + 0.0: no "-0.0"
-
-
-def _v(*xs: float) -> str:
-    return " ".join(_f(x) for x in xs)
-
-
-def _header(mb: Multibody, name: str, fmt: str, version: str) -> list[str]:
-    knee = ("; leg<i>_knee = shank - thigh angle, limit [-pi, 0], 0 = straight-leg stop"
-            if mb.knee else "")
-    foot = (f"arc feet, radius R = {_f(mb.foot_radius_m)} m, centre at L - R from the hip"
-            if _arc(mb) else "point feet")
-    parts = [_comment(f"walker {name!s} exported by walkerlab {version} ({fmt})."),
-            _comment("Floating planar walker in the x-z plane: x downhill (horizontal), z up; "
-                     "joint axes along -y (positive angle = foot ahead)."),
-            _comment("Joints: hip_x, hip_z (prismatic, the hip's position along world x and z "
-                     f"[m]); leg<i>_hip = absolute link angle from the vertical [rad]{knee}."),
-            _comment(f"Gravity g = {_f(mb.gravity_m_per_s2)} m/s^2 along -z. Ground: slope "
-                     f"{_f(mb.slope_rad)} rad, falling towards +x (the ground is tilted, not "
-                     "gravity)."),
-            _comment(f"Leg length L = {_f(mb.leg_length_m)} m; {foot}.")]
-    for sp in mb.springs:
-        terms = " ".join(f"{c:+g} {j}" for j, c in sp.terms)
-        parts.append(_comment(
-            f"Spring {sp.name} between {sp.between[0]} and {sp.between[1]}: delta = {terms} "
-            f"[rad], torque -k (delta - rest) - c d(delta)/dt with k = "
-            f"{_f(sp.stiffness_n_m_per_rad)} N m/rad, rest = {_f(sp.rest_angle_rad)} rad, c = "
-            f"{_f(sp.damping_n_m_s_per_rad)} N m s/rad."))
-    for cp in mb.couplings:
-        terms = " + ".join(f"{c:g} {j}" for j, c in cp.terms)
-        parts.append(_comment(f"Coupling {cp.name} (bisecting hip mechanism): {cp.joint} = "
-                              f"{terms} [rad]."))
-    return parts
-
-
-def _comment(text: str) -> str:
-    """An XML comment holding ``text``: "--" may not occur inside one (XML 1.0, section
-    2.5), nor may it end in "-", so each "-" that follows a "-" gets a space before it."""
-    while "--" in text:
-        text = text.replace("--", "- -")
-    return f"<!-- {text} -->"
 
 
 def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
@@ -166,7 +120,7 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
         through a massless ``hip_slider`` link; hip joints are ``continuous``.
     """
     width = mb.leg_length_m / 50  # visual thickness of the links
-    out = ['<?xml version="1.0"?>', *_header(mb, name, "URDF", version),
+    out = ['<?xml version="1.0"?>', *header(mb, name, "URDF", version),
            f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
            '  <link name="hip_slider"/>']
     for joint, parent, child, axis in (("hip_x", "world", "hip_slider", "1 0 0"),
@@ -178,7 +132,7 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
     out.append('  <link name="hip">')
     if mb.hip_mass_kg > 0:
         out += _urdf_inertial(mb.hip_mass_kg, 0.0, 0.0)
-    out += ['    <visual><geometry><sphere radius="' + _f(2 * width) + '"/></geometry></visual>',
+    out += ['    <visual><geometry><sphere radius="' + num(2 * width) + '"/></geometry></visual>',
             "  </link>"]
     for ln in mb.links:
         out += _urdf_link(ln, mb, width)
@@ -188,9 +142,9 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
 
 def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) -> list[str]:
     # a line along the link's z axis: inertia about x and y, none about z
-    return ["    <inertial>", f'      <origin xyz="{_v(off, 0, -com)}" rpy="0 0 0"/>',
-            f'      <mass value="{_f(mass)}"/>',
-            f'      <inertia ixx="{_f(inertia)}" ixy="0" ixz="0" iyy="{_f(inertia)}" iyz="0" '
+    return ["    <inertial>", f'      <origin xyz="{nums(off, 0, -com)}" rpy="0 0 0"/>',
+            f'      <mass value="{num(mass)}"/>',
+            f'      <inertia ixx="{num(inertia)}" ixy="0" ixz="0" iyy="{num(inertia)}" iyz="0" '
             'izz="0"/>', "    </inertial>"]
 
 
@@ -200,114 +154,51 @@ def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
     reach = -ln.length_m if ln.up else ln.length_m  # the visual runs up the torso
     out = [f'  <joint name="{ln.joint}" type="{jtype}">', f'    <parent link="{ln.parent}"/>',
            f'    <child link="{ln.name}"/>',
-           f'    <origin xyz="{_v(0, 0, -ln.joint_from_parent_m)}" rpy="0 0 0"/>',
+           f'    <origin xyz="{nums(0, 0, -ln.joint_from_parent_m)}" rpy="0 0 0"/>',
            f'    <axis xyz="{AXIS}"/>']
     if knee:  # straight-leg stop at 0, flexion down to -pi
-        out.append(f'    <limit lower="{_f(-math.pi)}" upper="0" effort="0" velocity="1e9"/>')
+        out.append(f'    <limit lower="{num(-math.pi)}" upper="0" effort="0" velocity="1e9"/>')
     out += ["  </joint>", f'  <link name="{ln.name}">',
             *_urdf_inertial(ln.mass_kg, ln.com_m, ln.inertia_kg_m2, ln.com_off_axis_m),
-            f'    <visual><origin xyz="{_v(0, 0, -reach / 2)}" rpy="0 0 0"/>'
-            f'<geometry><cylinder radius="{_f(width / 2)}" length="{_f(ln.length_m)}"/>'
+            f'    <visual><origin xyz="{nums(0, 0, -reach / 2)}" rpy="0 0 0"/>'
+            f'<geometry><cylinder radius="{num(width / 2)}" length="{num(ln.length_m)}"/>'
             "</geometry></visual>", "  </link>"]
     if ln.foot_m is not None:
         foot = ln.name.split("_")[0] + "_foot"
-        if _arc(mb):  # cylinder axis (z) turned onto y
-            geom = (f'<origin xyz="{_v(0, 0, 0)}" rpy="{_v(math.pi / 2, 0, 0)}"/><geometry>'
-                    f'<cylinder radius="{_f(mb.foot_radius_m)}" length="{_f(2 * width)}"/>'
+        if arc_feet(mb):  # cylinder axis (z) turned onto y
+            geom = (f'<origin xyz="{nums(0, 0, 0)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
+                    f'<cylinder radius="{num(mb.foot_radius_m)}" length="{num(2 * width)}"/>'
                     "</geometry>")
         else:
-            geom = f'<geometry><sphere radius="{_f(point_foot_radius(mb))}"/></geometry>'
+            geom = f'<geometry><sphere radius="{num(point_foot_radius(mb))}"/></geometry>'
         out += [f'  <joint name="{foot}" type="fixed">', f'    <parent link="{ln.name}"/>',
                 f'    <child link="{foot}"/>',
-                f'    <origin xyz="{_v(0, 0, -ln.foot_m)}" rpy="0 0 0"/>', "  </joint>",
+                f'    <origin xyz="{nums(0, 0, -ln.foot_m)}" rpy="0 0 0"/>', "  </joint>",
                 f'  <link name="{foot}">', f"    <collision>{geom}</collision>", "  </link>"]
     return out
-
-
-@dataclass(frozen=True)
-class MjcfScene:
-    """What the MJCF carries beyond the walker: the gait, the terrain, the contact.
-
-    Computed from the scene by :mod:`walkerlab.analysis.export_scene`; this module only
-    writes it.
-
-    Attributes
-    ----------
-    qpos, qvel : tuple of float
-        The ``gait`` keyframe in the export's joint order (``hip_x``, ``hip_z``, then the
-        link joints as in :attr:`Multibody.links`) [m, rad; m/s, rad/s].
-    lanes : tuple of (tuple of float, tuple of float) or None
-        Checkerboard patch centres along the slope [m] of leg1's and leg2's lane; None: a
-        continuous plane.
-    patch_width_m : float
-        Patch width along the slope [m].
-    ground_offset_m : float
-        The ground's surface lies this far below the feet's reference points along the slope
-        normal [m] (the point foot's sphere radius; 0 for arc feet).
-    timestep_s : float
-        MuJoCo ``option timestep`` [s].
-    solref : (float, float)
-        Contact ``solref`` (time constant [s], damping ratio [-]).
-    solimp : tuple of float
-        Contact ``solimp`` (d0, dwidth, width [m], midpoint, power).
-    friction : float
-        Sliding friction coefficient [-].
-    latch : (float, float) or None
-        Knee latch (release height above the ground [m], capture flexion [rad]); None without.
-    notes : tuple of str
-        Comments written into the file (how the numbers were derived).
-    """
-
-    qpos: tuple
-    qvel: tuple
-    lanes: tuple | None
-    patch_width_m: float
-    ground_offset_m: float
-    timestep_s: float
-    solref: tuple
-    solimp: tuple
-    friction: float
-    latch: tuple | None = None
-    notes: tuple = ()
-
-
-#: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot
-#: touches only its own lane (the paper's checkerboard, NOTES.md); continuous: both bits.
-LANE_BITS = {"leg1": 2, "leg2": 4}
-
-
-def point_foot_radius(mb: Multibody) -> float:
-    """Radius [m] of the sphere that stands for a point foot: ``L / 1000`` (the paper's ADAMS
-    feet carry a 1 mm bevel on a 1 m leg)."""
-    return mb.leg_length_m / 1000
-
-
-def _arc(mb: Multibody) -> bool:
-    """Arc feet with a radius (``R = 0`` is the point foot, as in the models)."""
-    return mb.foot == "arc" and mb.foot_radius_m > 0
 
 
 def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     phi = mb.slope_rad
     if extra is None:
-        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{_v(0, phi, 0)}"'
+        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
                 ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>']
     n = (math.sin(phi), math.cos(phi))  # slope normal in (x, z)
     t = (math.cos(phi), -math.sin(phi))  # downhill along the slope
     off = extra.ground_offset_m
     if extra.lanes is None:
-        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{_v(0, phi, 0)}" '
-                f'pos="{_v(-off * n[0], 0, -off * n[1])}" contype="6" conaffinity="0" '
+        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}" '
+                f'pos="{nums(-off * n[0], 0, -off * n[1])}" contype="6" conaffinity="0" '
                 'rgba="0.8 0.8 0.8 1"/>']
     half, depth = extra.patch_width_m / 2, extra.patch_width_m / 10
     out = []
     for leg, (y, centres) in zip(LANE_BITS, ((0.05, extra.lanes[0]), (-0.05, extra.lanes[1]))):
         for i, s in enumerate(centres):
             d = off + depth  # box centre below the surface
-            size = _v(half, 0.04 * mb.leg_length_m, depth)
-            pos = _v(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])
+            size = nums(half, 0.04 * mb.leg_length_m, depth)
+            pos = nums(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])
             out.append(f'    <geom name="{leg}_patch{i}" type="box" size="{size}" pos="{pos}"'
-                       f' euler="{_v(0, phi, 0)}" contype="{LANE_BITS[leg]}" conaffinity="0"'
+                       f' euler="{nums(0, phi, 0)}" contype="{LANE_BITS[leg]}" conaffinity="0"'
                        ' rgba="0.8 0.8 0.8 1"/>')
     return out
 
@@ -330,15 +221,15 @@ def _tendons(mb: Multibody) -> list[str]:
         # oriented so that springlength >= 0: MuJoCo reads a springlength of -1 as "the
         # tendon's length at qpos0"; k (delta - r)^2 = k (-delta + r)^2, the same spring
         sign = -1.0 if sp.rest_angle_rad < 0 else 1.0
-        out.append(f'    <fixed name="{sp.name}" stiffness="{_f(sp.stiffness_n_m_per_rad)}" '
-                   f'springlength="{_f(sign * sp.rest_angle_rad)}" '
-                   f'damping="{_f(sp.damping_n_m_s_per_rad)}">')
-        out += [f'      <joint joint="{j}" coef="{_f(sign * c)}"/>' for j, c in sp.terms]
+        out.append(f'    <fixed name="{sp.name}" stiffness="{num(sp.stiffness_n_m_per_rad)}" '
+                   f'springlength="{num(sign * sp.rest_angle_rad)}" '
+                   f'damping="{num(sp.damping_n_m_s_per_rad)}">')
+        out += [f'      <joint joint="{j}" coef="{num(sign * c)}"/>' for j, c in sp.terms]
         out.append("    </fixed>")
     for cp in mb.couplings:  # residual = joint - sum coef * other joints, held at 0
         out.append(f'    <fixed name="{cp.name}">')
         out.append(f'      <joint joint="{cp.joint}" coef="1.0"/>')
-        out += [f'      <joint joint="{j}" coef="{_f(-c)}"/>' for j, c in cp.terms]
+        out += [f'      <joint joint="{j}" coef="{num(-c)}"/>' for j, c in cp.terms]
         out.append("    </fixed>")
     return out + ["  </tendon>"]
 
@@ -372,90 +263,100 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     width = mb.leg_length_m / 50
     lo = MJCF_MIN_INERTIA_KG_M2
     hip_mass = mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG
-    out = [*_header(mb, name, "MJCF", version), f"<mujoco model={quoteattr(name)}>",
-           *(_comment(note) for note in (extra.notes if extra else ())),
+    out = [*header(mb, name, "MJCF", version), f"<mujoco model={quoteattr(name)}>",
+           *(comment(note) for note in (extra.notes if extra else ())),
            '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
     if extra is None:
-        out.append(f'  <option gravity="{_v(0, 0, -mb.gravity_m_per_s2)}"/>')
+        out.append(f'  <option gravity="{nums(0, 0, -mb.gravity_m_per_s2)}"/>')
         out.append('  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/>'
                    '</default>')
     else:
-        out.append(f'  <option gravity="{_v(0, 0, -mb.gravity_m_per_s2)}" '
-                   f'timestep="{_f(extra.timestep_s)}" integrator="implicitfast"/>')
+        out.append(f'  <option gravity="{nums(0, 0, -mb.gravity_m_per_s2)}" '
+                   f'timestep="{num(extra.timestep_s)}" integrator="implicitfast"/>')
         out.append(f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
-                   f'solref="{_v(*extra.solref)}" solimp="{_v(*extra.solimp)}" '
-                   f'friction="{_v(extra.friction, 0, 0)}" condim="3"/></default>')
+                   f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
+                   f'friction="{nums(extra.friction, 0, 0)}" condim="3"/></default>')
     out += ["  <worldbody>", *_ground(mb, extra),
             '    <body name="hip" pos="0 0 0">',
             '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
             '      <joint name="hip_z" type="slide" axis="0 0 1"/>',
-            f'      <inertial pos="0 0 0" mass="{_f(hip_mass)}" diaginertia="{_v(lo, lo, lo)}"/>',
-            f'      <geom type="sphere" size="{_f(2 * width)}"/>']
+            f'      <inertial pos="0 0 0" mass="{num(hip_mass)}" '
+            f'diaginertia="{nums(lo, lo, lo)}"/>',
+            f'      <geom type="sphere" size="{num(2 * width)}"/>']
     children: dict[str, list[Link]] = {}
     for ln in mb.links:
         children.setdefault(ln.parent, []).append(ln)
-    joint_springs = _joint_springs(mb)
-
-    def body(ln: Link, indent: str) -> list[str]:
-        inertia = max(ln.inertia_kg_m2, lo)
-        rng = f' range="{_v(-math.pi, 0)}"' if ln.joint.endswith("_knee") else ""
-        if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
-            sp = joint_springs[ln.joint]
-            rng += (f' stiffness="{_f(sp.stiffness_n_m_per_rad)}" '
-                    f'springref="{_f(sp.rest_angle_rad)}" '
-                    f'damping="{_f(sp.damping_n_m_s_per_rad)}"')
-        reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
-        lines = [f'{indent}<body name="{ln.name}" pos="{_v(0, 0, -ln.joint_from_parent_m)}">',
-                 f'{indent}  <joint name="{ln.joint}" type="hinge" axis="{AXIS}"{rng}/>',
-                 f'{indent}  <inertial pos="{_v(ln.com_off_axis_m, 0, -ln.com_m)}" '
-                 f'mass="{_f(ln.mass_kg)}" diaginertia="{_v(inertia, inertia, lo)}"/>',
-                 f'{indent}  <geom type="capsule" fromto="{_v(0, 0, 0, 0, 0, -reach)}" '
-                 f'size="{_f(width / 2)}"/>']
-        if ln.foot_m is not None:
-            leg = ln.name.split("_")[0]
-            foot = leg + "_foot"
-            z = -ln.foot_m
-            y = 0.0 if extra is None or extra.lanes is None else (
-                0.05 if leg == "leg1" else -0.05) * mb.leg_length_m
-            if _arc(mb):
-                geom = (f'type="cylinder" fromto="{_v(0, y - width, z, 0, y + width, z)}" '
-                        f'size="{_f(mb.foot_radius_m)}"')
-            else:
-                geom = f'type="sphere" pos="{_v(0, y, z)}" size="{_f(point_foot_radius(mb))}"'
-            lines += [f'{indent}  <site name="{foot}" pos="{_v(0, 0, z)}"/>',
-                      f'{indent}  <geom name="{foot}" {geom} contype="0" '
-                      f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
-        for child in children.get(ln.name, []):
-            lines += body(child, indent + "  ")
-        return lines + [f"{indent}</body>"]
-
     for ln in children["hip"]:
-        out += body(ln, "      ")
+        out += _mjcf_body(ln, "      ", mb, extra, children, _joint_springs(mb))
+    out += ["    </body>", "  </worldbody>", *_tendons(mb), *_mjcf_tail(mb, extra), ""]
+    return "\n".join(out)
+
+
+def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
+               children: dict, joint_springs: dict) -> list[str]:
+    """The MJCF body of link ``ln`` with its hinge, inertia, capsule, foot (a site and a
+    contact geom) and its child links' bodies nested inside."""
+    lo = MJCF_MIN_INERTIA_KG_M2
+    width = mb.leg_length_m / 50
+    inertia = max(ln.inertia_kg_m2, lo)
+    rng = f' range="{nums(-math.pi, 0)}"' if ln.joint.endswith("_knee") else ""
+    if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
+        sp = joint_springs[ln.joint]
+        rng += (f' stiffness="{num(sp.stiffness_n_m_per_rad)}" '
+                f'springref="{num(sp.rest_angle_rad)}" '
+                f'damping="{num(sp.damping_n_m_s_per_rad)}"')
+    reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
+    lines = [f'{indent}<body name="{ln.name}" pos="{nums(0, 0, -ln.joint_from_parent_m)}">',
+             f'{indent}  <joint name="{ln.joint}" type="hinge" axis="{AXIS}"{rng}/>',
+             f'{indent}  <inertial pos="{nums(ln.com_off_axis_m, 0, -ln.com_m)}" '
+             f'mass="{num(ln.mass_kg)}" diaginertia="{nums(inertia, inertia, lo)}"/>',
+             f'{indent}  <geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -reach)}" '
+             f'size="{num(width / 2)}"/>']
+    if ln.foot_m is not None:
+        leg = ln.name.split("_")[0]
+        foot = leg + "_foot"
+        z = -ln.foot_m
+        y = 0.0 if extra is None or extra.lanes is None else (
+            0.05 if leg == "leg1" else -0.05) * mb.leg_length_m
+        if arc_feet(mb):
+            geom = (f'type="cylinder" fromto="{nums(0, y - width, z, 0, y + width, z)}" '
+                    f'size="{num(mb.foot_radius_m)}"')
+        else:
+            geom = f'type="sphere" pos="{nums(0, y, z)}" size="{num(point_foot_radius(mb))}"'
+        lines += [f'{indent}  <site name="{foot}" pos="{nums(0, 0, z)}"/>',
+                  f'{indent}  <geom name="{foot}" {geom} contype="0" '
+                  f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
+    for child in children.get(ln.name, []):
+        lines += _mjcf_body(child, indent + "  ", mb, extra, children, joint_springs)
+    return lines + [f"{indent}</body>"]
+
+
+def _mjcf_tail(mb: Multibody, extra: MjcfScene | None) -> list[str]:
+    """After the world: the equality constraints (couplings, knee latches), the numbers a
+    stepping loop reads (``custom``) and the keyframes (``standing``; ``gait`` with
+    ``extra``), through ``</mujoco>``."""
     standing = [0.0, mb.leg_length_m] + [0.0] * len(mb.links)
-    out += ["    </body>", "  </worldbody>", *_tendons(mb)]
-    keys = [f'    <key name="standing" qpos="{_v(*standing)}"/>']
+    keys = [f'    <key name="standing" qpos="{nums(*standing)}"/>']
     equality = [f'    <tendon name="{cp.name}" tendon1="{cp.name}" '
-                f'solref="{_v(2 * (extra.timestep_s if extra else MJCF_DEFAULT_TIMESTEP_S), 1)}" '
-                f'solimp="{_v(*COUPLING_SOLIMP)}"/>' for cp in mb.couplings]
+                f'solref="{nums(2 * (extra.timestep_s if extra else MJCF_DEFAULT_TIMESTEP_S), 1)}" '
+                f'solimp="{nums(*COUPLING_SOLIMP)}"/>' for cp in mb.couplings]
     if extra is not None:
-        keys.append(f'    <key name="gait" qpos="{_v(*extra.qpos)}" qvel="{_v(*extra.qvel)}"/>')
+        keys.append(f'    <key name="gait" qpos="{nums(*extra.qpos)}" qvel="{nums(*extra.qvel)}"/>')
         knees = [ln.joint for ln in mb.links if ln.joint.endswith("_knee")]
         if knees and extra.latch is not None:
             # the gait keyframe starts with leg2 in stance: its latch holds, leg1's is free
             equality += [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
                          f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>'
                          for k in knees]
-    if equality:
-        out += ["  <equality>", *equality, "  </equality>"]
+    out = ["  <equality>", *equality, "  </equality>"] if equality else []
     if extra is not None:  # what a stepping loop needs (walkerlab.analysis.mujoco_walk)
-        arc = mb.foot_radius_m if _arc(mb) else 0.0
+        arc = mb.foot_radius_m if arc_feet(mb) else 0.0
         custom = {"slope_rad": mb.slope_rad, "foot_height_offset_m": arc}
         if extra.latch is not None and mb.knee:
             custom.update(latch_release_height_m=extra.latch[0], latch_capture_rad=extra.latch[1])
-        out += ["  <custom>", *(f'    <numeric name="{k}" data="{_f(v)}"/>'
+        out += ["  <custom>", *(f'    <numeric name="{k}" data="{num(v)}"/>'
                                 for k, v in custom.items()), "  </custom>"]
-    out += ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>", ""]
-    return "\n".join(out)
+    return out + ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>"]
 
 
 def keyframe_json(mb: Multibody, extra: MjcfScene) -> str:

@@ -2,7 +2,9 @@
 
 A stage's artifact stores the hash of everything its content depends on
 (:func:`input_hash`); :func:`recompute_reason` says in one line why an existing artifact no
-longer matches (the scene fields that changed, another walkerlab version, ...).  ``scene``
+longer matches (the scene fields that changed, another walkerlab version, ...);
+:func:`write_if_stale` is the cache every stage runs through (one writer per artifact, reuse
+when up to date, atomic write otherwise).  ``scene``
 is a :class:`walkerlab.config.Scene`, taken as it comes (``config`` imports ``io``, never
 the other way round; as :func:`walkerlab.io.artifacts.write_artifact` takes it).
 """
@@ -11,10 +13,21 @@ from __future__ import annotations
 
 import hashlib
 import json
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import walkerlab
-from walkerlab.io.artifacts import code_hash, content_hash, root_attrs
+from walkerlab.io.artifacts import (
+    code_hash,
+    content_hash,
+    root_attrs,
+    verified_hash,
+    write_artifact,
+)
+from walkerlab.io.runpaths import artifact_lock, stage_artifact
 from walkerlab.safefs import NotARegularFile, read_regular
 
 
@@ -92,3 +105,90 @@ def stamp_matches(stamp: Path, key: str) -> bool:
         return read_regular(stamp, 1 << 16, "figure stamp").decode() == key
     except (OSError, NotARegularFile, UnicodeDecodeError):
         return False
+
+
+def _tell(msg: str) -> None:
+    print(msg, file=sys.stderr)
+
+
+@dataclass
+class CachedArtifact:
+    """An artifact :func:`write_if_stale` reused or wrote."""
+
+    path: Path
+    reused: bool
+    wall_time_s: float
+    #: what ``compute`` returned beside its writer ({} when reused)
+    summary: dict = field(default_factory=dict)
+    #: why an existing artifact was recomputed (one line), "" otherwise
+    note: str = ""
+
+
+def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str, ...],
+                   upstream: tuple[Path, ...], compute: Callable[[], tuple[Callable, dict]],
+                   force: bool = False, extra_attrs: dict | None = None, extra_key: str = "",
+                   also_accept: tuple[str, ...] = (), artifact: str | None = None,
+                   tell: Callable[[str], None] = _tell) -> CachedArtifact:
+    """Run ``compute`` unless the stage's artifact is up to date, then write it atomically.
+
+    Parameters
+    ----------
+    stage : str
+        The stage (its name enters the input hash and the artifact's ``stage`` attribute).
+    scene : walkerlab.config.Scene
+    runs_root : path
+        The runs folder (:mod:`walkerlab.io.runpaths`).
+    sections : tuple of str
+        The scene sections the artifact depends on (:func:`input_hash`).
+    upstream : tuple of Path
+        Artifacts read by ``compute`` (their recomputed content hashes enter the key).
+    compute : callable
+        ``compute() -> (writer, summary)``; ``writer(h5file)`` fills the artifact.
+    force : bool
+        Recompute whatever the existing artifact holds (its content is not hashed).
+    extra_attrs : dict, optional
+        Root attributes written beside ``code_hash``.
+    extra_key : str
+        Stage options that enter the input hash (a grid, a sigma list).
+    also_accept : tuple of str
+        Other ``extra_key`` values whose artifact counts as up to date too (a superset of
+        what is asked for).
+    artifact : str, optional
+        The file stem when it is not the stage's name (``bifurcation_<field>``).
+    tell : callable
+        Where the waiting and recompute lines go (stderr).
+
+    Returns
+    -------
+    CachedArtifact
+        Reused (``wall_time_s`` 0, empty summary) or written; an existing artifact that is
+        recomputed is never replaced silently: one line through ``tell`` says which and
+        why (the scene fields that changed, ``--force``, ...), also kept in ``note``.
+
+    Raises
+    ------
+    walkerlab.io.runpaths.RunPathError, walkerlab.io.artifacts.ArtifactError
+        A bad run path, an artifact that cannot be written (one line); and whatever
+        ``compute`` raises (nothing is written then).
+    """
+    path = stage_artifact(scene, runs_root, artifact or stage, claim=True)
+    # one writer per artifact: a second identical run waits, then finds the result up to date
+    with artifact_lock(path, wait=True, on_wait=tell):
+        key = input_hash(stage, scene, sections, upstream, extra_key)
+        note = ""
+        if path.is_file() and force:
+            note = "--force"  # recomputed whatever it holds: its content is not hashed
+        elif path.is_file():
+            have = verified_hash(path)
+            if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
+                                  for a in also_accept):
+                return CachedArtifact(path, True, 0.0, {})
+            # never replace a result silently: say what is recomputed and why (one line)
+            note = recompute_reason(path, scene, sections, have)
+            tell(f"{stage}: recomputing {path} ({note})")
+        t0 = time.perf_counter()
+        writer, summary = compute()
+        wall = time.perf_counter() - t0
+        write_artifact(path, stage, scene, key, writer, wall,
+                       {"code_hash": code_hash(), **(extra_attrs or {})})
+    return CachedArtifact(path, False, wall, summary, note)

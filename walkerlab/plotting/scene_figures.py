@@ -61,6 +61,35 @@ def trajectory_figures(trajs: dict[str, NamedTrajectory], out_dir: Path, title: 
     return written
 
 
+def scene_trajectory_figures(scene, sim, contact, terrain, compare, out_dir: Path
+                             ) -> list[Path]:
+    """:func:`trajectory_figures` of a scene's loaded artifacts, titled by its walker model.
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+    sim, contact : SimulateArtifact or ContactSimArtifact, optional
+        Loaded ``simulate.h5`` and ``contact_sim.h5`` (at least one).
+    terrain : dict, optional
+        The contact walker's ground (:func:`walkerlab.io.terrain.load_terrain`).
+    compare : CompareArtifact, optional
+        Loaded ``compare.h5``.
+    out_dir : Path
+        The report's figures folder.
+    """
+    from walkerlab.plotting import CONTACT_LABEL
+    from walkerlab.units import for_scene
+
+    trajs = {label: a.samples for label, a in ((IDEAL_LABEL, sim), (CONTACT_LABEL, contact))
+             if a is not None}
+    title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
+    has_drop = contact is not None and scene.contact is not None and contact.drop is not None
+    return trajectory_figures(
+        trajs, out_dir, title, scene.slope.phi_rad, for_scene(scene), terrain, compare,
+        contact.drop if has_drop else None,
+        float(scene.contact.written("stiffness")[0]) if has_drop else None)
+
+
 def workprecision_figures(wp, out_dir: Path, units: Units) -> list[Path]:
     """One work-precision diagram per model of a loaded ``workprecision.h5`` (``wp``), with
     its Pareto front; returns the written files."""

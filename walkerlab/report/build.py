@@ -19,9 +19,11 @@ import numpy as np
 import walkerlab
 from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
-from walkerlab.report import contact_sections, sections
+from walkerlab.report import contact_sections, sections, study_sections
+from walkerlab.report.figures_section import figures_section
 from walkerlab.report.markdown import details, num, table, text, to_html
 from walkerlab.report.robustness_section import robustness_section
+from walkerlab.report.workprecision_section import workprecision_summary
 from walkerlab.units import for_scene as units_for_scene
 
 
@@ -44,12 +46,35 @@ class ReportInputs:
         (:func:`walkerlab.analysis.gait_checks.energy_drift_in_swing`).
     swing_clearance : float
         Lowest swing-foot height above the slope [m] (NaN: none).
+    basin_area : BasinArea or None
+        The basin's area in the basin map's slice
+        (:func:`walkerlab.analysis.basin_area.basin_area`; None: no basin).
+    published_step_length_m : float
+        Step length the published fixed point (Eq. (11)) implies [m] (NaN: none printed).
+    phase_error : (float, float, int) or None
+        Largest phase-aligned angle error of the comparison [rad], over its last step, and
+        that step's number (None: no comparison).
+    mean_stance_slip_mm : float
+        Mean stance-foot slip per step of the contact run [mm] (NaN: none).
+    bifurcation_onsets : dict[str, (float, float)]
+        Period-doubling onset and fall onset (NaN: none on the grid) in the grid's unit by
+        bifurcation artifact key (:func:`walkerlab.sweep.bifurcation.onset_value`,
+        :func:`walkerlab.sweep.bifurcation.fall_onset`).
+
+    The stage computes them before the report is written
+    (:func:`walkerlab.stages.report.load_inputs`), mostly through
+    :func:`walkerlab.analysis.report_numbers.report_numbers`.
     """
 
     artifacts: dict
     gait_columns: dict = field(default_factory=dict)
     energy_drift: tuple = (float("nan"), float("nan"))
     swing_clearance: float = float("nan")
+    basin_area: object = None
+    published_step_length_m: float = float("nan")
+    phase_error: tuple | None = None
+    mean_stance_slip_mm: float = float("nan")
+    bifurcation_onsets: dict = field(default_factory=dict)
 
 
 def _header(scene) -> list[str]:
@@ -108,15 +133,15 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     if "fixedpoint" in arts:
         md += sections.fixedpoint_section(arts["fixedpoint"], pub)
     md += sections.gait_section(scene, inputs, pub)
-    md += contact_sections.sections(scene, arts)
+    md += contact_sections.sections(scene, inputs)
     md += attribution_section(scene, arts)
-    md += sections.workprecision_summary(scene, arts)
-    md += sections.bifurcation_section(arts, pub)
-    md += sections.basin_section(arts)
-    md += robustness_section(arts)
+    md += workprecision_summary(scene, arts)
+    md += study_sections.bifurcation_section(arts, inputs.bifurcation_onsets, pub)
+    md += study_sections.basin_section(arts)
+    md += robustness_section(arts, inputs.basin_area)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
-    md += sections.figures_section(Path(figures_dir), str(rel), arts)
+    md += figures_section(Path(figures_dir), str(rel), arts)
     md += ["## Scene", ""]
     md += details("Resolved scene (JSON)", "\n".join(
         ["```json", json.dumps(scene.model_dump(mode="json", exclude_none=True), indent=1),

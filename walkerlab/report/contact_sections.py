@@ -182,11 +182,12 @@ def _map_lines(arts) -> list[str]:
     return out
 
 
-def compare_section(scene, arts) -> list[str]:
+def compare_section(scene, inputs) -> list[str]:
     """Fig. 8's numbers, every one read from the loaded ``compare`` / ``contact-sim``
-    artifacts in the scene's units; the sentence on the paper's printed error only with
-    ``published: paper``."""
-    c = arts.get("compare")
+    artifacts or computed from them before (``inputs``:
+    :class:`walkerlab.report.build.ReportInputs`) in the scene's units; the sentence on the
+    paper's printed error only with ``published: paper``."""
+    c = inputs.artifacts.get("compare")
     if c is None:
         return []
     u = units_for(scene)
@@ -197,18 +198,10 @@ def compare_section(scene, arts) -> list[str]:
     t_end = float(c.time[-1])
     cyc = {m: float(c.metrics[m]["t_cycle_s"]) for m in ("ideal", "contact")
            if "t_cycle_s" in c.metrics.get(m, {})}
-    phase = None
-    if c.phase_errors is not None and c.step_phase is not None and c.step_phase.size:
-        ang = [e for n, e in c.phase_errors.items() if c.error_units.get(n) == "rad"]
-        if ang:
-            sp = c.step_phase
-            a = np.max(np.abs(np.vstack(ang)), axis=0)
-            last = sp >= np.floor(sp[-1])
-            phase = (float(a.max()), float(a[last].max()), int(np.floor(sp[-1])))
+    phase = inputs.phase_error
     slip = None
-    cs = arts.get("contact-sim")
-    if cs is not None and np.isfinite(cs.steps["stance_slip_mm"]).any():
-        slip = float(np.nanmean(np.abs(cs.steps["stance_slip_mm"]))) * 1e-3 * u.small_scale
+    if np.isfinite(inputs.mean_stance_slip_mm):
+        slip = inputs.mean_stance_slip_mm * 1e-3 * u.small_scale
     prose = []
     if len(cyc) == 2:
         prose.append(f"The contact walker's stride lasts {num(cyc['contact'], 4)} "
@@ -235,12 +228,7 @@ def compare_section(scene, arts) -> list[str]:
             " ".join(prose), ""]
 
 
-def sections(scene, arts) -> list[str]:
-    """All contact sections, in report order (``arts``: loaded artifacts by stage name)."""
-    out: list[str] = []
-    for fn in _SECTION_FUNCS:
-        out += fn(scene, arts)
-    return out
-
-
-_SECTION_FUNCS = [contact_section, compare_section]
+def sections(scene, inputs) -> list[str]:
+    """All contact sections, in report order (``inputs``:
+    :class:`walkerlab.report.build.ReportInputs`)."""
+    return contact_section(scene, inputs.artifacts) + compare_section(scene, inputs)

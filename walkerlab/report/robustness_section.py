@@ -29,13 +29,11 @@ def _contact_steps(r) -> list[str]:
             f"{_mm(r['contact_step_up_m/lo'], r['contact_step_up_m/hi'])} mm."]
 
 
-def _basin_line(b) -> list[str]:
-    """The basin's area in the basin map's slice (when the scene ran ``basin``)."""
-    if b is None:
+def _basin_line(a) -> list[str]:
+    """The basin's area ``a`` (:class:`walkerlab.analysis.basin_area.BasinArea`) in the basin
+    map's slice (when the scene ran ``basin``)."""
+    if a is None:
         return []
-    from walkerlab.analysis.basin_area import basin_area
-
-    a = basin_area(b)
     x0, x1, y0, y1 = a.box
     where = (f"the box {a.x_axis} {num(x0)}…{num(x1)} {a.x_unit} × {a.y_axis} {num(y0)}…"
              f"{num(y1)} {a.y_unit} of the basin map ({a.cells} cells)")
@@ -49,9 +47,10 @@ def _basin_line(b) -> list[str]:
             "and box."]
 
 
-def robustness_section(arts: dict) -> list[str]:
+def robustness_section(arts: dict, basin_area=None) -> list[str]:
     """|lambda|max and GSN in two state coordinates, the MFPT at the scene's sigma, the
-    largest step-down/up (rigid model; empty when the scene ran no robustness stage)."""
+    largest step-down/up (rigid model; empty when the scene ran no robustness stage), and
+    the basin's area ``basin_area`` when the scene ran ``basin``."""
     r = arts.get("robustness")
     if r is None:
         return []
@@ -75,7 +74,7 @@ def robustness_section(arts: dict) -> list[str]:
             "the stance leg is vertical, the stance foot pinned; as the hip's velocity change): "
             f"forward {_mm(r['push_forward_m_per_s/lo'], r['push_forward_m_per_s/hi'], 1)} "
             f"m/s, backward {_mm(r['push_backward_m_per_s/lo'], r['push_backward_m_per_s/hi'], 1)}"
-            " m/s.", *_basin_line(arts.get("basin")), "",
+            " m/s.", *_basin_line(basin_area), "",
             "Gait sensitivity norm (Hobbelen & Wisse 2007; indicators step time, step length, "
             "stance angle at heel strike), with the relative difference to the nonlinear "
             "response to a small impulse, and the norm with the post-impact state as "

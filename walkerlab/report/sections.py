@@ -1,5 +1,5 @@
-"""Report sections of the rigid walker (summary, fixed point, gait table, figures), from
-loaded artifacts.
+"""Report sections of the rigid walker (summary, fixed point, gait table), from loaded
+artifacts and the numbers computed from them.
 
 Every function takes the scene, the report's inputs (:class:`walkerlab.report.build.
 ReportInputs`: the loaded artifacts by stage name and the numbers computed from them) and
@@ -10,20 +10,22 @@ values come from :mod:`walkerlab.published`, never from literals here.
 
 from __future__ import annotations
 
-from pathlib import Path
 from types import ModuleType
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from walkerlab.analysis.tables import TABLE3_ROWS
-from walkerlab.report.markdown import details, num, printed, sig_digits, table
-from walkerlab.report.text import workprecision_choice, zero_multipliers_text
+from walkerlab.report.markdown import num, printed, sig_digits, table
+from walkerlab.report.text import zero_multipliers_text
 from walkerlab.units import Units, for_scene
 
-if TYPE_CHECKING:  # loaded artifacts (walkerlab.io.schemas)
-    from walkerlab.io.schemas.simulate import SimulateArtifact
-    from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
+#: Table 3 rows (keys of :func:`walkerlab.analysis.tables.gait_metrics`): name, symbol, unit
+TABLE3_ROWS = {
+    "t_left_s": ("Left step period", "t_left", "s"),
+    "t_right_s": ("Right step period", "t_right", "s"),
+    "t_cycle_s": ("One cycle period", "t_cycle = t_left + t_right", "s"),
+    "v_com_m_per_s": ("Average velocity of robot", "v_com", "m/s"),
+    "E_avg_J": ("Average mechanical energy (5 steps)", "E_avg = KE + PE", "J"),
+}
 
 
 # --------------------------------------------------------------------------- data
@@ -224,9 +226,7 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     ideal = cols.get("ours, ideal")
     eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
     if ideal and t3 and eq is not None and step_pub is not None:
-        L = float(scene.walker.leg_length_m)
-        eqd = dict(zip(pub.EQ11_NAMES, eq))
-        dx_eq11 = 2 * L * np.sin((eqd["stance_angle"] - eqd["swing_angle"]) / 2)
+        dx_eq11 = inputs.published_step_length_m
         e_pub = t3["E_avg_J"][0]
         e_st = ideal.get("E_avg_stance_frame_J", np.nan)
         out += ["", "**Differences from the published Table 3, measured:**", "",
@@ -251,191 +251,3 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
                 f"the {num(scene.slope.phi_rad)} rad slope by Δx sin φ per step."]
     out.append("")
     return out
-
-
-# --------------------------------------------------------------------------- figures
-CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond the paper
-    ("fig2_stick_ideal", "Fig. 2 — stick diagram of one gait cycle, ideal model."),
-    ("fig6_stick_contact", "Fig. 6 — stick diagram of one gait cycle, contact model."),
-    ("fig7_angles_rates", "Fig. 7 — angles and angular rates over the simulated strides."),
-    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates: left time-aligned "
-     "(both at the same time since the start, so a different step period shows as a growing "
-     "phase drift), right phase-aligned (both at the same fraction of the same step: the "
-     "difference of the gaits themselves)."),
-    ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, one "
-                          "panel per link, both legs in it)."),
-    ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),
-    ("work_precision_ideal", "Work-precision diagram, ideal model."),
-    ("work_precision_contact", "Work-precision diagram, contact model."),
-    ("bifurcation", "Bifurcation diagram over the slope."),
-    ("basin", "Basin of attraction: where each cell of the Poincaré-section slice goes "
-              "(left) and how many steps the converged cells take (right)."),
-]
-
-
-def steps_table(sim: SimulateArtifact) -> str:
-    """Per-step table of ``simulate.h5`` (period, step length, hip speed, impact loss)."""
-    u, s = sim.units, sim.steps
-    cols = ("period", "step_length", "hip_speed", "impact_energy_loss")
-    rows = [[int(i), str(leg), *[num(s[c][k]) for c in cols], str(term)]
-            for k, (i, leg, term) in enumerate(zip(s["step"], s["stance_leg"],
-                                                   s["termination"]))]
-    return table(["step", "stance leg", f"period [{u.time}]", f"step length [{u.length}]",
-                  f"hip speed [{u.speed}]", f"impact loss [{u.energy}]", "ended by"], rows)
-
-
-def workprecision_table(wp: WorkPrecisionArtifact, model: str) -> str:
-    """Every (method, rtol) point of one model of ``workprecision.h5``."""
-    rows, clock = [], "wall"
-    for m, d in wp.models[model].rows.items():
-        if "wall_time" in d:  # times are the integration's CPU time (older artifacts: wall)
-            clock = "CPU"
-        lo = d.get("time_min", d["time"])
-        hi = d.get("time_max", d["time"])
-        reps = d["repeats"] if "repeats" in d else np.ones(len(lo), int)
-        for rt, t, a, b, k, e, n in zip(d["rtol"], d["time"], lo, hi, reps, d["error"],
-                                        d["nfev"]):
-            rows.append([m, num(rt, 1), num(t * 1e3, 3), f"{num(a * 1e3, 3)}–"
-                         f"{num(b * 1e3, 3)}", int(k), num(e, 2), int(n)])
-    return table(["method", "rtol", f"median {clock} [ms]", f"min–max {clock} [ms]", "runs",
-                  "error vs reference", "RHS evals"], rows)
-
-
-def _drawn_from(stem: str, arts: dict) -> bool:
-    """Whether a figure's artifacts are among the report's (a figure an earlier ``walkerlab
-    plot`` drew from an artifact the report leaves out is not shown)."""
-    for prefix, stages in (("fig2_", ("simulate",)), ("fig6_", ("contact-sim",)),
-                           ("fig8_", ("compare",)), ("fig", ("simulate", "contact-sim")),
-                           ("work_precision", ("workprecision",)),
-                           ("bifurcation", ("bifurcation",)), ("basin", ("basin",))):
-        if stem.startswith(prefix):
-            return any(s in arts for s in stages)
-    return True
-
-
-def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
-    """Every figure that exists, with its raw data folded underneath where it is long
-    (``arts``: the loaded artifacts by stage name)."""
-    out = []
-    gif = fig_dir / "animation.gif"  # written by `walkerlab animate`, embedded when present
-    if gif.is_file():
-        cap = ("The walker walking (`walkerlab animate`; rigid model, and the contact model "
-               "beside it where it was simulated).")
-        out += [f"![{cap}]({rel}/{gif.name})", "", f"*{cap}*", ""]
-    extra = [(png.stem, f"Bifurcation diagram over {png.stem.removeprefix('bifurcation_')} "
-                        "(`walkerlab bifurcation --param`).")
-             for png in sorted(fig_dir.glob("bifurcation_*.png"))]
-    for stem, cap in CAPTIONS + extra:
-        png = fig_dir / f"{stem}.png"
-        if not png.is_file() or not _drawn_from(stem, arts):
-            continue
-        out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
-        if stem == "fig7_angles_rates" and "simulate" in arts:
-            out += details("Per-step data of the rigid walker (simulate.h5)",
-                           steps_table(arts["simulate"]))
-        if stem.startswith("work_precision_") and "workprecision" in arts:
-            out += details("All (method, tolerance) points",
-                           workprecision_table(arts["workprecision"],
-                                               stem.removeprefix("work_precision_")))
-    return ["## Figures", "", *out] if out else []
-
-
-# --------------------------------------------------------------------------- work-precision
-def _solver_text(scene, model: str) -> str:
-    from walkerlab.config import SolverSettings
-
-    sv = (scene.solver if model == "ideal"
-          else scene.contact_solver or SolverSettings.for_contact())
-    return f"{sv.method} rtol {sv.rtol:.0e}."
-
-
-def workprecision_summary(scene, arts: dict) -> list[str]:
-    """The fastest setting reaching the target error, only where the timing noise allows
-    naming one, and the Pareto front per model (raw points fold under the figure)."""
-    wp = arts.get("workprecision")
-    if wp is None:
-        return []
-    out = ["## Error against run time (work-precision)", ""]
-    for model, m in wp.models.items():
-        out += [f"### {model} model", ""]
-        out.append("Choice: " + workprecision_choice(m.choice) + " Scene default: "
-                   + _solver_text(scene, model))
-        pm = [str(s) for s in m.choice.get("pareto_methods", [])]
-        pr = list(m.choice.get("pareto_rtol", []))
-        out += ["", "Pareto front (no setting is both more accurate and faster by more than "
-                "the spread of the repeats' CPU times; of two settings whose times overlap "
-                "only the more accurate is kept): "
-                + ", ".join(f"{a} {r:.0e}" for a, r in zip(pm, pr)) + ".", ""]
-    return out
-
-
-# --------------------------------------------------------------------------- bifurcation
-def bifurcation_section(arts: dict, pub: ModuleType | None = None) -> list[str]:
-    """Period-doubling onset from ``bifurcation.h5`` (when the scene ran that stage) and from
-    each ``bifurcation_<field>.h5`` (``bifurcation --param``), the grid named by its field
-    and unit (``arts``: loaded :class:`walkerlab.io.schemas.bifurcation.BifurcationSummary`
-    by artifact key)."""
-    out = []
-    b = arts.get("bifurcation")
-    if b is not None:
-        out += _bifurcation_lines(b, pub)
-    for key in sorted(k for k in arts if k.startswith("bifurcation_")):
-        out += _bifurcation_lines(arts[key], None)
-    return out
-
-
-def _bifurcation_lines(b, pub: ModuleType | None) -> list[str]:
-    from walkerlab.io.schemas.bifurcation import SLOPE_PATH
-    from walkerlab.sweep.bifurcation import fall_onset, onset_value
-
-    p, data, values, per = b.path, b.data, b.values, b.attractor_period
-    path, unit = data["parameter_path"], data["parameter_unit"]
-    onset = onset_value(data)
-    falls = fall_onset(data)
-    periods = sorted(set(int(v) for v in per if v > 0))
-    if path == SLOPE_PATH:
-        text = (f"period-doubling onset at slope {num(onset)}° ({num(np.radians(onset))} rad), "
-                "where the most negative real Floquet multiplier crosses −1"
-                if np.isfinite(onset) else "no period doubling on the grid")
-        out = ["## Bifurcation over the slope", "",
-               f"Grid {printed(values[0])}–{printed(values[-1])}° ({values.size} slopes): "
-               f"{text}; steady-state periods seen: {periods}"
-               + (f"; from {num(falls)}° on the walker falls (no steady gait)."
-                  if np.isfinite(falls) else "; the walker walks up to the largest slope.")]
-        rng = getattr(pub, "STABLE_SLOPE_RANGE_RAD", None)
-        if rng is not None:
-            out.append(f"Published ({pub.SHORT}): the period-1 gait is stable for "
-                       f"{printed(rng[0])} < γ < {printed(rng[1])} rad "
-                       f"({printed(round(np.degrees(rng[1]), 4))}°).")
-        return out + [""]
-    u = "" if unit in ("", "-") else f" {unit}"
-    text = (f"period-doubling onset at {path} = {num(onset)}{u}, where the most negative "
-            "real Floquet multiplier crosses −1" if np.isfinite(onset)
-            else "no period doubling on the grid")
-    return [f"## Bifurcation over `{path}`", "",
-            f"Grid {printed(values[0])}–{printed(values[-1])}{u} ({values.size} values, "
-            f"`{p.name}`): {text}; steady-state periods seen: {periods}"
-            + (f"; from {num(falls)}{u} on the walker falls (no steady gait)."
-               if np.isfinite(falls) else "; the walker walks up to the largest value."), ""]
-
-
-# --------------------------------------------------------------------------- basin
-def basin_section(arts: dict) -> list[str]:
-    """Outcome shares of ``basin.h5`` (when the scene ran that stage)."""
-    b = arts.get("basin")
-    if b is None:
-        return []
-    counts, xa, ya, xc, yc = b.counts, b.x_axis, b.y_axis, b.x, b.y
-    xu, yu, start, max_steps = b.x_unit, b.y_unit, b.start, b.max_steps
-    n = sum(counts.values())
-    how = ("each cell a state just after a heel strike (the heel-strike image of a pre-impact "
-           "state on the guard)" if start == "heel_strike"
-           else "the other coordinates from the fixed point, projected on the heel-strike "
-           "surface")
-    rows = [[o.replace("_", " "), str(c), num(100 * c / n, 3)] for o, c in counts.items() if c]
-    return ["## Basin of attraction", "",
-            f"{xc.size} × {yc.size} cells over {xa} {printed(xc.min())}…{printed(xc.max())} {xu} × "
-            f"{ya} {printed(yc.min())}…{printed(yc.max())} {yu} (cell centres), {how}; at most "
-            f"{max_steps} steps a cell.  {num(100 * counts.get('converged', 0) / n, 3)} % of "
-            "the cells reach the period-1 gait.", "",
-            table(["outcome", "cells", "share [%]"], rows), ""]

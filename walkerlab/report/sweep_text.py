@@ -3,8 +3,6 @@ outcome and the range of the stage's main results over the points that walk."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from walkerlab.report.markdown import num
@@ -35,13 +33,12 @@ def main_columns(data: dict) -> list[str]:
     return [c for c in MAIN_COLUMNS.get(stage, ()) if c in data["points"]]
 
 
-def sweep_text(path: Path) -> str:
+def sweep_text(data: dict) -> str:
     """``5 points: ok 5``, then for each main result its range over the points that walk
-    (``step_period_s 0.7036 .. 0.7343 s over slope.angle_deg 1 .. 3 deg``)."""
-    from walkerlab.io.sweep_store import load_sweep
+    (``step_period_s 0.7036 .. 0.7343 s over slope.angle_deg 1 .. 3 deg``), of a loaded
+    sweep (:func:`walkerlab.io.sweep_store.load_sweep`)."""
     from walkerlab.units import field_unit
 
-    data = load_sweep(path)
     units = Units(str(data["attrs"].get("scene_units", "SI")))
     outcome = np.asarray(data["points"]["outcome"]).astype(str)
     kinds, counts = np.unique(outcome, return_counts=True)

@@ -19,13 +19,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from walkerlab.config import Scene, SlopeSettings
-from walkerlab.io.runpaths import figures_dir
+from walkerlab.io.runpaths import figures_dir, stage_artifact
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.io.terrain import load_terrain
 from walkerlab.plotting import CONTACT_LABEL, IDEAL_LABEL
-from walkerlab.stages.common import artifact_path
-from walkerlab.stages.pipeline import computed_for
+from walkerlab.stages.report_inputs import computed_for
 
 #: Frames per second, and the most frames one animation gets (a 5-stride compass gait,
 #: 7 s, is 141 frames at 20 fps; longer runs play faster).
@@ -51,9 +50,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
 
     from walkerlab.plotting.animation import gif_writer, save_frames, walker_animation
 
-    sim = load_simulate(artifact_path(scene, runs_root, "simulate"))
+    sim = load_simulate(stage_artifact(scene, runs_root, "simulate"))
     trajs, ground, notes = {IDEAL_LABEL: sim.samples}, {}, []
-    contact = artifact_path(scene, runs_root, "contact-sim")
+    contact = stage_artifact(scene, runs_root, "contact-sim")
     # any of the contact stage's variants: plain, --adjust, --periodic
     why = computed_for(scene, runs_root, "contact-sim", ("adjust", "periodic")) \
         if contact.is_file() else ""

@@ -15,9 +15,10 @@ from pathlib import Path
 from types import SimpleNamespace
 
 from walkerlab.config import Scene
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.attribution import AttributionRun, write_attribution
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
+from walkerlab.stages.common import StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "contact", "terrain", "contact_sim",
             "contact_solver")
@@ -35,7 +36,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         ``fixedpoint.h5`` is missing or unreadable.
     """
     require(scene, "contact", "attribution")
-    up = (artifact_path(scene, runs_root, "fixedpoint"),)
+    up = (stage_artifact(scene, runs_root, "fixedpoint"),)
 
     def compute():
         from walkerlab.analysis.attribution import adjustment_effect, attribute

@@ -12,10 +12,11 @@ import numpy as np
 from walkerlab.analysis.compare import aligned_errors, limit_cycle_distance, phase_aligned_errors
 from walkerlab.analysis.tables import gait_metrics
 from walkerlab.config import Scene
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.compare import METRIC_UNITS, Comparison, write_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
-from walkerlab.stages.common import StageOutcome, artifact_path, run_cached
+from walkerlab.stages.common import StageOutcome, run_cached
 
 
 def compare_files(ideal_path: Path, contact_path: Path) -> Comparison:
@@ -45,8 +46,8 @@ def compare_files(ideal_path: Path, contact_path: Path) -> Comparison:
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
     """Compare ``simulate.h5`` with ``contact_sim.h5`` (both must exist:
     :mod:`walkerlab.stages.pipeline` runs them first)."""
-    up = (artifact_path(scene, runs_root, "simulate"),
-          artifact_path(scene, runs_root, "contact-sim"))
+    up = (stage_artifact(scene, runs_root, "simulate"),
+          stage_artifact(scene, runs_root, "contact-sim"))
 
     def compute():
         c = compare_files(*up)

@@ -16,13 +16,13 @@ from pathlib import Path
 from walkerlab.analysis.contact_record import contact_sim_run
 from walkerlab.config import Scene
 from walkerlab.integrate.ends import CONTACT_WALKED
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.contact_sim import run_end, write_contact_sim
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.models.contact.scene import ContactSetup, contact_setup
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,
-    artifact_path,
     run_cached,
 )
 
@@ -56,7 +56,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     setup = contact_setup(scene)  # the scene read once: all the run needs, typed
     periodic = periodic or setup.sim.periodic_gait
-    up = (artifact_path(scene, runs_root, "fixedpoint"),)
+    up = (stage_artifact(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())
     out = run_cached("contact-sim", scene, runs_root, sections, up,
                      lambda: _compute(setup, up[0], adjust, periodic), force)

@@ -27,7 +27,7 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     walkerlab.sweep.params.SweepError
         A field that does not exist (one line).
     """
-    from walkerlab.analysis.continuation import MapFailed
+    from walkerlab.analysis.continuation_map import MapFailed
     from walkerlab.io.runpaths import bifurcation_artifacts, check_name
     from walkerlab.io.schemas.bifurcation import load_bifurcation
     from walkerlab.io.schemas.continuation import continuation_writer, load_continuation

@@ -1,49 +1,21 @@
 """Stage ``fixedpoint``: period-1 gait of the rigid hybrid walker -> ``fixedpoint.h5``.
 
-The search is :mod:`walkerlab.analysis.scene_gaits`; the layout
+The search is :func:`walkerlab.analysis.scene_gaits.fixed_point_run`; the layout
 :mod:`walkerlab.io.schemas.fixedpoint`.
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 from walkerlab.analysis.gaits import GaitNotFound
-from walkerlab.analysis.poincare import FixedPointNotFound
-from walkerlab.analysis.scene_gaits import (
-    initial_guess,
-    solve_scene,
-    solve_variant,
-    variants_for,
-)
-from walkerlab.config import Scene
-from walkerlab.io.schemas.fixedpoint import FixedPointRun, write_fixedpoint
+from walkerlab.analysis.scene_gaits import fixed_point_run
+from walkerlab.config import Scene, SceneError
+from walkerlab.io.schemas.fixedpoint import write_fixedpoint
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
-
-
-def _compute(scene: Scene, compare_variants: bool, known: Scene | None = None):
-    guess = note = None
-    if known is not None:  # the known gait carried here (walkerlab.sweep.continuation)
-        from walkerlab.sweep.continuation import homotopy_start
-
-        guess, note = homotopy_start(scene, known)
-    walker, search = solve_scene(scene, guess=guess)
-    if note:
-        search.notes.append(note)
-    main = search.result
-    results = {scene.ideal.variant: (walker, main)}
-    init = initial_guess(scene, walker)
-    other_guess = main.x if init is None else init
-    for variant in variants_for(scene, compare_variants)[1:]:
-        try:
-            results[variant] = solve_variant(scene, variant, other_guess)
-        except FixedPointNotFound as exc:
-            results[variant] = exc
-    run = FixedPointRun(walker, search, results, scene.ideal.variant, other_guess)
-    summary = {"walker": walker, "result": main, "gaits": search, "variants": dict(results)}
-    return (lambda f: write_fixedpoint(f, run)), summary
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
@@ -54,8 +26,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     With ``compare_variants`` (the default) the other equation variants (printed Appendix A,
     ...) of a compass gait compared with published numbers are solved too (~0.1 s), for the
     report's comparison with Eq. (11): ``walkerlab fixedpoint`` then writes the very artifact
-    the report needs, so the report does not recompute it (nor the contact simulation, which
-    keys on its content).  ``compare_variants=False`` reuses such an artifact (a superset).
+    the report needs.  ``compare_variants=False`` reuses such an artifact (a superset).
     ``known`` (or the scene's ``fixedpoint.from``): a scene whose gait is carried to this
     walker by homotopy and used as the initial guess (``walkerlab fixedpoint --from``).
 
@@ -64,10 +35,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     StageError
         No ``fixedpoint`` section, or no fixed point for the scene's own variant.
     """
-    import json
-
-    from walkerlab.config import SceneError
-
     require(scene, "fixedpoint", "fixedpoint")
     src = None
     if known is not None or getattr(scene.fixedpoint, "from_", None) is not None:
@@ -81,12 +48,18 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                                                           sort_keys=True)
 
     def compute():
+        guess = note = None
         try:
-            return _compute(scene, compare_variants, src)
+            if src is not None:  # the known gait carried here
+                from walkerlab.sweep.continuation import homotopy_start
+
+                guess, note = homotopy_start(scene, src)
+            run, summary = fixed_point_run(scene, compare_variants, guess, note)
         except GaitNotFound as exc:
             raise StageError(f"fixedpoint: {exc}") from None
         except ValueError as exc:  # a malformed initial guess or gait choice (one line)
             raise StageError(str(exc)) from None
+        return (lambda f: write_fixedpoint(f, run)), summary
 
     return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force,
                       extra_key=("variants" if compare_variants else "") + from_key,

@@ -1,128 +1,70 @@
 """Stage ``mfpt``: mean first-passage time on per-step random slopes -> ``mfpt.h5`` (+ figure).
 
-Reads (after the pipeline has run ``fixedpoint``, :mod:`walkerlab.stages.pipeline`) the
-scene's ``mfpt`` section (defaults when absent), ``terrain.per_step`` (distribution
-and seed) and the gait from ``fixedpoint.h5``; the walks and mesh cells run on local
-processes or Dask (:mod:`walkerlab.sweep.mfpt`).  Skipped when the scene sections, the sigma
-list, the method, the upstream gait and the code are unchanged.  An interrupted run resumes
-where it stopped: its finished Monte Carlo chunks and mesh images are kept in
-``mfpt.h5.partial`` (:mod:`walkerlab.io.mfpt_partial`) while the scene sections and the
-gait are the same (pieces are named by sigma: a rerun with other ``--sigma-rad`` or
-``--method`` keeps those it shares; ``--force`` starts afresh); the file is removed once
-``mfpt.h5`` is written.
+Reads the ``mfpt`` section (defaults when absent), ``terrain.per_step`` and the gait from
+``fixedpoint.h5``; the study, resumable from ``mfpt.h5.partial``, is
+:func:`walkerlab.sweep.mfpt.resumable_mfpt_study`; the layout :mod:`walkerlab.io.schemas.mfpt`.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
-from walkerlab.config import CommandOptions, MfptSettings, Scene, validate_option
+from walkerlab.config import Scene
+from walkerlab.config.options import mfpt_options
+from walkerlab.io.freshness import input_hash
+from walkerlab.io.runpaths import figures_dir, stage_artifact
+from walkerlab.io.schemas import mfpt as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.stages.common import (
-    StageError,
-    StageOutcome,
-    artifact_path,
-    input_hash,
-    require,
-    run_cached,
-)
+from walkerlab.plotting.artifact_figures import save_mfpt_figure
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt")
 
 
 def figure_path(scene: Scene, runs_root: Path | str) -> Path:
     """``runs/<scene>/report/figures/mfpt.png``."""
-    from walkerlab.io.runpaths import figures_dir
-
     return figures_dir(scene, runs_root) / "mfpt.png"
 
 
 def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     """Draw log MFPT against sigma (PNG + SVG) from ``mfpt.h5``."""
-    from walkerlab.io.schemas.mfpt import load
-    from walkerlab.plotting.figures import save
-    from walkerlab.plotting.mfpt_figures import mfpt_figure
-
-    d = load(artifact_path(scene, runs_root, "mfpt"))
-    fig = mfpt_figure(d, f"Mean first-passage time - scene '{scene.name}'")
-    return save(fig, figure_path(scene, runs_root).parent, "mfpt")
+    d = schema.load(stage_artifact(scene, runs_root, "mfpt"))
+    return save_mfpt_figure(d, scene.name, figure_path(scene, runs_root).parent)
 
 
 def check(scene: Scene, sigma_rad: list[float] | None = None, method: str | None = None,
-          workers: int = 2, **_options) -> tuple[MfptSettings, int]:
-    """The settings (``mfpt`` section with the command-line overrides) and worker count,
-    checked before anything runs.
-
-    Raises
-    ------
-    StageError
-        No ``fixedpoint`` section, or an option out of bounds (one line).
-    """
+          workers: int = 2, **_options):
+    """``(MfptSettings, workers)`` with the command-line overrides, checked before anything
+    runs (:func:`walkerlab.config.options.mfpt_options`).  Raises StageError: no
+    ``fixedpoint`` section; SceneError: an option out of bounds (one line)."""
     require(scene, "fixedpoint", "mfpt")
-    st = scene.mfpt or MfptSettings()
-    if sigma_rad is not None:
-        sigma_rad = validate_option(MfptSettings, "sigma_rad", list(sigma_rad), "--sigma-rad",
-                                    "mfpt.sigma_rad")
-    if method is not None:
-        method = validate_option(MfptSettings, "method", method, "--method", "mfpt.method")
-    workers = validate_option(CommandOptions, "workers", workers, "--workers")
-    st = st.model_copy(update={k: v for k, v in (("sigma_rad", sigma_rad), ("method", method))
-                               if v is not None})
-    return st, workers
+    return mfpt_options(scene, sigma_rad, method, workers)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         sigma_rad: list[float] | None = None, method: str | None = None, workers: int = 2,
         scheduler=None) -> StageOutcome:
-    """Compute (or reuse) the MFPT of the scene's rigid walker at each sigma.
+    """Compute (or reuse) the MFPT at each sigma [rad] (``--sigma-rad``; ``method``: mesh,
+    montecarlo or both) on ``workers`` local processes or a Dask ``scheduler``, and draw it.
+    Raises StageError (one line): no ``fixedpoint`` section, or a walker the study cannot
+    carry (:class:`walkerlab.sweep.mfpt.MfptStudyError`)."""
+    from walkerlab.sweep.mfpt import MfptStudyError, mfpt_summary, resumable_mfpt_study
 
-    Parameters
-    ----------
-    sigma_rad : list of float, optional
-        Per-step slope standard deviations [rad]; overrides ``mfpt.sigma_rad``.
-    method : {"mesh", "montecarlo", "both"}, optional
-        Overrides ``mfpt.method``.
-    workers : int
-        Local worker processes (1 = in this process).
-    scheduler : str, optional
-        Dask scheduler address.
-
-    Raises
-    ------
-    StageError
-        No ``fixedpoint`` section, bad settings, or a walker the per-step terrain cannot
-        carry (one line).
-    """
     st, workers = check(scene, sigma_rad, method, workers)
-    up = artifact_path(scene, runs_root, "fixedpoint")
-    path = artifact_path(scene, runs_root, "mfpt")
+    up, path = (stage_artifact(scene, runs_root, s) for s in ("fixedpoint", "mfpt"))
     done = []  # the resume file, removed once the artifact is written
 
     def work():
-        from walkerlab.io.mfpt_partial import MfptPartial
-        from walkerlab.io.schemas import mfpt as schema
-
         x_star = load_fixedpoint(up).x
-        # finished pieces of an interrupted run with the same scene sections and gait are
-        # kept (--force: none); pieces are named by sigma, so another --sigma-rad list or
-        # --method reuses the pieces it shares
-        partial = MfptPartial(path.with_name(path.name + ".partial"),
-                              input_hash("mfpt", scene, SECTIONS, (up,), extra="resume"),
-                              resume=not force)
         try:
-            data = compute(scene, x_star, st, workers, scheduler, partial)
-        except ValueError as exc:  # bad input: nothing to resume
-            partial.remove()
+            data, partial = resumable_mfpt_study(
+                scene, x_star, st, path.with_name(path.name + ".partial"),
+                input_hash("mfpt", scene, SECTIONS, (up,), extra="resume"), not force,
+                workers, scheduler)
+        except MfptStudyError as exc:
             raise StageError(str(exc)) from None
-        finally:
-            partial.close()
         done.append(partial)
-        summary = {"sigma_rad": list(map(float, data.sigma_rad)),
-                   "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
-                   "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"]))}
-        return (lambda f: schema.write(f, data)), summary
+        return (lambda f: schema.write(f, data)), mfpt_summary(data)
 
     out = run_cached("mfpt", scene, runs_root, SECTIONS, (up,), work, force,
                      {"workers": workers if scheduler is None else 0,
@@ -133,12 +75,3 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     if not out.reused or not figure_path(scene, runs_root).is_file():
         draw(scene, runs_root)
     return out
-
-
-def compute(scene: Scene, x_star: np.ndarray, st: MfptSettings, workers: int = 1,
-            scheduler=None, partial=None):
-    """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` -> ``MfptData``
-    (:func:`walkerlab.sweep.mfpt.mfpt_study`; ``partial``: the resume file)."""
-    from walkerlab.sweep.mfpt import mfpt_study
-
-    return mfpt_study(scene, x_star, st, workers, scheduler, partial)

@@ -12,15 +12,15 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io import runpaths
-from walkerlab.io.artifacts import stored_content_hash_matches
+from walkerlab.io.artifacts import require_unedited
 from walkerlab.io.freshness import drawing_key, stamp_matches
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.compare import load_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
 from walkerlab.io.schemas.workprecision import load_workprecision
 from walkerlab.io.terrain import load_terrain
-from walkerlab.plotting import CONTACT_LABEL, IDEAL_LABEL
-from walkerlab.stages.common import StageError, artifact_path
+from walkerlab.stages.common import StageError
 from walkerlab.units import for_scene
 
 #: figure groups and the stage artifacts each is drawn from
@@ -28,60 +28,41 @@ PARTS = {"trajectories": ("simulate", "contact-sim", "compare"),
          "workprecision": ("workprecision",)}
 
 
-def check_unedited(path: Path) -> Path:
-    """``path`` if its content still matches the content hash stored when it was written;
-    else StageError (one line naming it and the command that rewrites it)."""
-    if not stored_content_hash_matches(path):
-        stage = path.stem.replace("_", "-")
-        raise StageError(f"{path}: changed after it was written (its content no longer matches "
-                         f"its stored content hash); figures are drawn only from what a stage "
-                         f"wrote: rerun 'walkerlab {stage} --force' (or 'walkerlab report')")
-    return path
-
-
 def figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
     """Stamp file of a drawn figure group (:data:`PARTS`) and its key
     (:func:`walkerlab.io.freshness.drawing_key` of the artifacts it is drawn from)."""
-    arts = {s: p for s in PARTS[part] if (p := artifact_path(scene, runs_root, s)).is_file()}
+    arts = {s: p for s in PARTS[part] if (p := stage_artifact(scene, runs_root, s)).is_file()}
     return (runpaths.figures_dir(scene, runs_root) / f".drawn_from_{part}", drawing_key(arts))
 
 
-def _load(scene: Scene, runs_root, stage: str, load):
-    p = artifact_path(scene, runs_root, stage)
-    return load(check_unedited(p)) if p.is_file() else None
-
-
 def _draw(scene: Scene, runs_root, part: str) -> list[Path]:
-    from walkerlab.plotting import scene_figures as draw  # matplotlib: only when drawing
+    from walkerlab.plotting import scene_figures  # matplotlib: only when drawing
 
-    u = for_scene(scene)
+    def load(stage, loader):
+        p = stage_artifact(scene, runs_root, stage)
+        return loader(require_unedited(p)) if p.is_file() else None
+
+    folder = runpaths.figures_dir(scene, runs_root, claim=True)
     if part == "workprecision":
-        wp = _load(scene, runs_root, "workprecision", load_workprecision)
-        return [] if wp is None else draw.workprecision_figures(
-            wp, runpaths.figures_dir(scene, runs_root, claim=True), u)
-    sim, contact = (_load(scene, runs_root, s, f) for s, f in
-                    (("simulate", load_simulate), ("contact-sim", load_contact_sim)))
-    trajs = {label: a.samples for label, a in ((IDEAL_LABEL, sim), (CONTACT_LABEL, contact))
-             if a is not None}
-    if not trajs:
+        wp = load("workprecision", load_workprecision)
+        return [] if wp is None else scene_figures.workprecision_figures(wp, folder,
+                                                                         for_scene(scene))
+    sim, contact = load("simulate", load_simulate), load("contact-sim", load_contact_sim)
+    if sim is None and contact is None:
         raise StageError(f"plot: no simulate.h5 or contact_sim.h5 under "
                          f"{runpaths.scene_dir(scene, runs_root)}; run 'walkerlab simulate' "
                          "first")
-    title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
-    has_drop = contact is not None and scene.contact is not None and contact.drop is not None
-    return draw.trajectory_figures(
-        trajs, runpaths.figures_dir(scene, runs_root, claim=True), title, scene.slope.phi_rad,
-        u, load_terrain(artifact_path(scene, runs_root, "contact-sim")) if contact else None,
-        _load(scene, runs_root, "compare", load_compare), contact.drop if has_drop else None,
-        float(scene.contact.written("stiffness")[0]) if has_drop else None)
+    terrain = load("contact-sim", load_terrain) if contact is not None else None
+    return scene_figures.scene_trajectory_figures(scene, sim, contact, terrain,
+                                                  load("compare", load_compare), folder)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs",
         parts: tuple[str, ...] = tuple(PARTS)) -> list[Path]:
     """Draw every figure the scene's artifacts support, in the groups ``parts``
     (:data:`PARTS`); returns the written files (PNG and SVG).  Raises StageError: trajectory
-    figures asked for and no trajectory artifact exists yet; an artifact was changed after
-    it was written."""
+    figures asked for and no trajectory artifact exists yet; ArtifactError: an artifact was
+    changed after it was written."""
     written: list[Path] = []
     for part in (p for p in PARTS if p in parts):
         stamp, key = figures_key(scene, runs_root, part)

@@ -3,14 +3,14 @@
 The stages and their figures run through :func:`walkerlab.stages.report_dag.run_report`
 (reusing up-to-date artifacts; the work-precision study in a background thread); the
 artifacts are loaded through :mod:`walkerlab.io.schemas` and what the report states is
-computed from them (Table 3, energy drift, swing-foot clearance: :func:`load_inputs`), then
+computed from them (:func:`load_inputs`), then
 :func:`walkerlab.report.build.write_report` writes ``runs/<scene>/report/report.html``
 (self-contained) and ``report.md``.
 
 Sections appear only when the scene produces their data: an ideal-only scene gets an
 ideal-only report, with no empty contact panels.  Artifacts an earlier standalone command
 left in the run folder are left out, in one line
-(:func:`walkerlab.stages.report_dag.report_artifacts`).
+(:func:`walkerlab.stages.report_inputs.report_artifacts`).
 """
 
 from __future__ import annotations
@@ -22,32 +22,28 @@ from walkerlab.config import Scene
 from walkerlab.io.runpaths import figures_dir, report_dir
 from walkerlab.report.build import ReportInputs, write_report
 from walkerlab.stages.pipeline import report_plan
-from walkerlab.stages.report_dag import report_artifacts, run_report
+from walkerlab.stages.report_dag import run_report
+from walkerlab.stages.report_inputs import report_artifacts
 
 
 def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportInputs:
-    """Load the report's artifacts (``paths``: ``{stage: Path}``) through
-    :mod:`walkerlab.io.schemas` and compute what the report states from them: Table 3
-    columns, the rigid run's energy drift and swing-foot clearance.  Stability maps whose
-    figure is in ``figures`` are loaded too (``stability_map_<kind>``)."""
-    from walkerlab.analysis.gait_checks import energy_drift_in_swing, swing_foot_clearance
-    from walkerlab.analysis.tables import table3
+    """Load the report's artifacts (``paths``: ``{stage: Path}``, and the stability maps
+    whose figure is in ``figures``) through :mod:`walkerlab.io.schemas`, with the numbers
+    computed from them (:func:`walkerlab.analysis.report_numbers.report_numbers`; the
+    bifurcation diagrams' onsets: :mod:`walkerlab.sweep.bifurcation`)."""
+    from walkerlab.analysis.report_numbers import report_numbers
     from walkerlab.io.schemas.loaders import load_artifact
+    from walkerlab.sweep.bifurcation import fall_onset, onset_value
 
     if "contact-sim" in paths:
         maps = (paths["contact-sim"].parent / f"stability_map_{k}.h5"
                 for k in ("stiffness", "friction", "patch_width"))
         paths = paths | {p.stem: p for p in maps
                          if p.is_file() and (figures / f"{p.stem}.png").is_file()}
-    inputs = ReportInputs({key: load_artifact(key, p) for key, p in paths.items()})
-    sim, contact = inputs.artifacts.get("simulate"), inputs.artifacts.get("contact-sim")
-    if sim is not None:
-        inputs.energy_drift = energy_drift_in_swing(sim.samples)
-        inputs.swing_clearance = swing_foot_clearance(sim.samples, scene.slope.phi_rad)
-        trajs = {"ours, ideal": sim.samples} | (
-            {"ours, contact": contact.samples} if contact is not None else {})
-        inputs.gait_columns = table3(trajs, sim.total_mass_kg, sim.gravity_m_per_s2)
-    return inputs
+    arts = {key: load_artifact(key, p) for key, p in paths.items()}
+    onsets = {k: (onset_value(a.data), fall_onset(a.data)) for k, a in arts.items()
+              if k.startswith("bifurcation")}
+    return ReportInputs(arts, **report_numbers(scene, arts), bifurcation_onsets=onsets)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,

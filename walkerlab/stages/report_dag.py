@@ -1,65 +1,17 @@
-"""The report's DAG run: its stages in order, their figures, and the artifacts it shows.
+"""The report's DAG run: its stages in order and their figures.
 
 :func:`run_report` runs the stages of :func:`walkerlab.stages.pipeline.report_plan`
 (reusing up-to-date artifacts), with the work-precision study in a background thread on
 cores of its own (:class:`walkerlab.execution.background.BackgroundStudy`) overlapping the
 untimed stages, and draws each figure group once its artifacts are ready.  The basin of
 attraction and the attribution run after the study: their worker processes and timed cases
-must not share the study's cores.  :func:`report_artifacts` picks what the report shows.
+must not share the study's cores.  What the report shows: :mod:`walkerlab.stages.report_inputs`.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from walkerlab.config import Scene
-from walkerlab.io.artifacts import stored_content_hash_matches
-from walkerlab.io.freshness import changed_fields
-from walkerlab.io.runpaths import bifurcation_artifacts
-from walkerlab.stages.common import StageOutcome, artifact_path
-from walkerlab.stages.pipeline import NOT_RUN, report_plan, stage_module
-
-REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation", "basin", "robustness", "attribution")
-#: artifacts shown although this report did not compute them, when computed for the
-#: scene's current sections: (their stage, why one is left out)
-EARLIER = {"workprecision": "measured for other settings; `walkerlab report --full` "
-                            "measures it again",
-           "attribution": "computed for other settings; `walkerlab report --full` computes "
-                          "it again",
-           "bifurcation": "computed for another walker, slope or solver"}
-
-
-def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
-    """``{stage: path}`` of the report's stages whose artifact exists for ``scene``, and
-    ``{bifurcation_<field>: path}`` of bifurcations over other fields (``--param``)."""
-    out = {s: p for s in REPORT_STAGES if (p := artifact_path(scene, runs_root, s)).is_file()}
-    return out | bifurcation_artifacts(scene, runs_root)
-
-
-def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
-    """'' when the artifact ``p`` the report did not produce is shown all the same."""
-    kind = "bifurcation" if stage.startswith("bifurcation") else stage
-    if kind not in EARLIER or (kind == "workprecision" and (scene.workprecision is None or full)
-                               ) or (kind == "attribution" and (scene.contact is None or full)):
-        return f"an earlier standalone run: the scene has {NOT_RUN.get(stage, 'no section for it')}"
-    if kind == "bifurcation" and not stored_content_hash_matches(p):  # edited by hand (26)
-        return "changed after it was written: rerun 'walkerlab bifurcation'"
-    return EARLIER[kind] if changed_fields(p, scene, stage_module(kind).SECTIONS) else ""
-
-
-def report_artifacts(scene: Scene, runs_root, done: list[StageOutcome], full: bool = False
-                     ) -> tuple[dict[str, Path], str]:
-    """The artifacts the report shows (those this report produced, ``done``, and those of
-    :data:`EARLIER` computed for the current scene) and one line on what it leaves out."""
-    produced, paths, left = {o.stage for o in done}, {}, []
-    for stage, p in existing_artifacts(scene, runs_root).items():
-        why = "" if stage in produced else _why_left_out(scene, stage, p, full)
-        if why:
-            left.append(f"{p.name} ({why})")
-        else:
-            paths[stage] = p
-    return paths, ("report: leaves out " + "; ".join(left)) if left else ""
+from walkerlab.stages.pipeline import report_plan, stage_module
 
 
 def _study(scene: Scene, runs_root, force: bool):

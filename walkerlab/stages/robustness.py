@@ -12,9 +12,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from walkerlab.config import CommandOptions, Scene, validate_option
+from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas import robustness as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.stages.common import StageError, StageOutcome, artifact_path, require, run_cached
+from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt", "robustness")
 
@@ -45,7 +46,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False, worke
     from walkerlab.sweep.robustness_study import scene_robustness
 
     workers = check(scene, workers)
-    up = artifact_path(scene, runs_root, "fixedpoint")
+    up = stage_artifact(scene, runs_root, "fixedpoint")
 
     def compute():
         try:

@@ -1,21 +1,20 @@
 """Stage ``sweep``: run a stage over a grid of scene fields -> ``sweep_<stage>_<hash>.h5``.
 
 ``walkerlab sweep SCENE --param slope.angle_deg=0.5:5:0.05 [--param ...] --stage fixedpoint``
-calls :func:`run`.  One row per grid point: the parameters, the typed outcome
-(:mod:`walkerlab.sweep.outcomes`), the stage's key results and the point's wall time.
-Rows are appended to ``<name>.h5.partial`` as chunks finish; an interrupted sweep keeps them
-and ``resume=True`` computes only the rest.
+calls :func:`run`: one row per grid point (:func:`walkerlab.sweep.runner.run_sweep`: the
+parameters, the typed outcome, the stage's key results, the point's wall time), appended to
+``<name>.h5.partial`` as chunks finish (``resume=True`` computes only the rest), and a figure
+of the results against the first swept field.
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 from walkerlab.config import CommandOptions, Scene, load_scene, validate_option
-from walkerlab.io.runpaths import named_artifact
-from walkerlab.sweep.params import ParamAxis, SweepError, check_axes, params_hash, parse_param
-from walkerlab.sweep.runner import MAX_GRID_POINTS, run_sweep
+from walkerlab.io.runpaths import figures_dir, named_artifact
+from walkerlab.sweep.params import ParamAxis, SweepError, params_hash, parse_param, sweep_axes
+from walkerlab.sweep.runner import run_sweep
 
 __all__ = ["run", "parse_param", "sweep_path", "SweepError", "STAGE_NAMES"]
 
@@ -24,14 +23,9 @@ STAGE_NAMES = ("fixedpoint", "simulate", "contact-sim")
 
 def sweep_path(scene: Scene, axes: list[ParamAxis], stage: str, runs_root: Path | str = "runs",
                name: str | None = None, claim: bool = False) -> Path:
-    """``runs/<scene>/sweep_<stage>_<short hash of params>.h5`` (or ``<name>.h5``).
-
-    Raises
-    ------
-    walkerlab.io.runpaths.RunPathError
-        ``name`` is not a plain file name (path separators, ``..``), leaves the runs
-        folder, or is a stage artifact's name (``fixedpoint``, ``simulate``, ...).
-    """
+    """``runs/<scene>/sweep_<stage>_<short hash of params>.h5`` (or ``<name>.h5``); raises
+    RunPathError for a ``name`` that is not a plain file name, leaves the runs folder or is
+    a stage artifact's name."""
     stem = name if name else f"sweep_{stage.replace('-', '_')}_{params_hash(axes, stage)}"
     return named_artifact(scene, runs_root, stem, "--name", claim=claim)
 
@@ -41,38 +35,11 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
         runs_root: str | Path = "runs", name: str | None = None, *,
         options: dict | None = None, chunk_size: int | None = None, progress: bool = True,
         on_chunk=None, pool: bool | None = None, figure: bool = True) -> Path:
-    """Sweep ``stage`` over the grid of ``params`` and write one HDF5 artifact.
-
-    Parameters
-    ----------
-    scene_path_or_scene : str, Path or Scene
-        Scene YAML file or a validated scene.
-    params : list of str
-        ``--param`` strings, e.g. ``["slope.angle_deg=0.5:5:0.05", "walker.hip_mass_kg=5,10"]``;
-        continuation runs along the first one.
-    stage : {"fixedpoint", "simulate", "contact-sim"}
-    workers : int
-        Local processes (1 = in this process).
-    scheduler : str, optional
-        Dask distributed scheduler address; the chunks run on that cluster.
-    resume : bool
-        Continue from ``<artifact>.h5.partial`` (rows already there are not recomputed).
-    runs_root : str or Path
-    name : str, optional
-        Artifact file name (without folder); default ``sweep_<stage>_<hash>.h5``.
-    options : dict, optional
-        Point options, see :data:`walkerlab.sweep.points.DEFAULT_OPTIONS`.
-    chunk_size : int, optional
-        Longest chunk of consecutive points given to one worker.
-    progress : bool
-        Show the rich progress bar.
-    on_chunk : callable(done, total), optional
-        Hook after each chunk is written.
-    pool : bool, optional
-        Force a process pool even with one worker (benchmarks) or forbid it.
-    figure : bool
-        Draw the results against the first swept field (:func:`draw`) into the report's
-        figures folder.
+    """Sweep ``stage`` over the grid of ``params`` (``--param`` strings, e.g.
+    ``["slope.angle_deg=0.5:5:0.05", "walker.hip_mass_kg=5,10"]``; continuation runs along
+    the first) and write one HDF5 artifact; ``figure``: draw it (:func:`draw`).  The other
+    parameters are :func:`walkerlab.sweep.runner.run_sweep`'s; ``name``: the artifact's file
+    name (default ``sweep_<stage>_<hash>``).
 
     Returns
     -------
@@ -90,12 +57,7 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     scene = scene_path_or_scene if isinstance(scene_path_or_scene, Scene) \
         else load_scene(scene_path_or_scene)
     workers = validate_option(CommandOptions, "workers", workers, "--workers")
-    if stage not in STAGE_NAMES:
-        raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(STAGE_NAMES)}")
-    axes = [parse_param(p) if isinstance(p, str) else p for p in params]
-    # an unknown field or a bad value: refused before anything runs (the values of a grid
-    # too large to run are left to run_sweep's refusal)
-    check_axes(scene, axes, values=math.prod(len(a) for a in axes) <= MAX_GRID_POINTS)
+    axes = sweep_axes(scene, params, stage, STAGE_NAMES)
     out = sweep_path(scene, axes, stage, runs_root, name, claim=True)
     path = run_sweep(scene, axes, stage, out, workers=workers, scheduler=scheduler,
                      resume=resume, options=options, chunk_size=chunk_size, progress=progress,
@@ -107,15 +69,12 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
 
 def figure_path(scene: Scene, path: Path, runs_root: str | Path = "runs") -> Path:
     """``runs/<scene>/report/figures/<sweep artifact stem>.png``."""
-    from walkerlab.io.runpaths import figures_dir
-
     return figures_dir(scene, runs_root) / f"{Path(path).stem}.png"
 
 
 def draw(scene: Scene, path: Path, runs_root: str | Path = "runs") -> list[Path]:
     """Draw the sweep's main results against its first swept field (PNG + SVG) from the
     artifact ``path`` (:func:`walkerlab.plotting.sweep_figures.sweep_figure`)."""
-    from walkerlab.io.runpaths import figures_dir
     from walkerlab.io.sweep_store import load_sweep
     from walkerlab.plotting.sweep_figures import save, sweep_figure
 

@@ -32,10 +32,10 @@ from walkerlab.analysis.workprecision import SINGLE_RUN_S, runner_for
 from walkerlab.analysis.workprecision_plan import plan, run_study, warm_cases
 from walkerlab.config import Scene
 from walkerlab.execution.lanes import Lanes
-from walkerlab.io.runpaths import run_cache_dir
+from walkerlab.io.runpaths import run_cache_dir, stage_artifact
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.schemas.workprecision import WorkPrecisionRun, write_workprecision
-from walkerlab.stages.common import StageOutcome, artifact_path, require, run_cached
+from walkerlab.stages.common import StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "fixedpoint", "workprecision", "contact", "terrain",
             "contact_sim")
@@ -49,7 +49,7 @@ def warm_up(scene: Scene, runs_root: Path | str, model: str) -> None:
     p = plan(scene)
     if model not in p:
         return
-    fp = load_fixedpoint(artifact_path(scene, runs_root, "fixedpoint"))
+    fp = load_fixedpoint(stage_artifact(scene, runs_root, "fixedpoint"))
     runner_for(model, json.dumps(scene.model_dump(mode="json"), sort_keys=True),
                float(fp.step_period_s), tuple(float(v) for v in fp.x), wp.strides,
                warm_cases(p[model]))
@@ -62,7 +62,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     (:func:`walkerlab.analysis.workprecision_plan.run_study`); ``force`` also re-measures
     cached cases."""
     wp = require(scene, "workprecision", "workprecision")
-    up = (artifact_path(scene, runs_root, "fixedpoint"),)
+    up = (stage_artifact(scene, runs_root, "fixedpoint"),)
 
     def compute():
         fp = load_fixedpoint(up[0])

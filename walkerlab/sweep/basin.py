@@ -52,7 +52,7 @@ NOT_DONE = -1
 
 __all__ = ["OUTCOMES", "CODE", "NOT_DONE", "BasinTask", "slice_state", "HeelStrikeSlice",
            "heel_strike_slice", "axis_values", "classify_cell", "run_basin_chunk",
-           "compute_basin"]
+           "compute_basin", "basin_run"]
 
 
 class BasinError(ValueError):
@@ -477,3 +477,32 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
                     on_chunk(done, total)
     return {"x": xs, "y": ys, **arrays, "wall_time_s": time.perf_counter() - t0,
             "cells_computed": computed, "partial": part, "settings": st, "walker": walker}
+
+
+def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
+              grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
+              resume: bool = True, on_chunk: Callable[[int, int], None] | None = None):
+    """:func:`compute_basin` (same arguments) packed for the basin artifact.
+
+    Returns
+    -------
+    run : walkerlab.io.schemas.basin.BasinRun
+        The cells, the fixed point, the scene's ``basin`` settings (defaults when absent)
+        and the cells per outcome (``run.counts``, in :data:`OUTCOMES` order).
+    partial : Path
+        The resume file; the caller removes it once the artifact is written.
+
+    Raises
+    ------
+    BasinError
+        Bad axes or ranges (one line).
+    """
+    from walkerlab.config import BasinSettings
+    from walkerlab.io.schemas.basin import BasinRun
+
+    res = compute_basin(scene, x_star, key, out_path, grid, workers, scheduler, resume=resume,
+                        on_chunk=on_chunk)
+    counts = {o: int(np.sum(res["outcome"] == i)) for i, o in enumerate(OUTCOMES)}
+    run = BasinRun(res["walker"], res, x_star, scene.basin or BasinSettings(), list(OUTCOMES),
+                   counts)
+    return run, res["partial"]

@@ -41,7 +41,8 @@ from walkerlab.sweep.params import ParamAxis
 from walkerlab.sweep.runner import plan_chunks, sweep_executor
 
 __all__ = ["BifurcationResult", "bifurcation_diagram", "locate_period_doubling",
-           "min_real_multiplier", "parameter_values", "onset_value", "fall_onset"]
+           "min_real_multiplier", "parameter_values", "onset_value", "fall_onset", "grid_key",
+           "diagram_summary"]
 
 @dataclass(frozen=True)
 class _BifTask:
@@ -168,7 +169,8 @@ def _arclength_step(fam, prev, value: float):
     at 3 kg, issue 23).  None when there is no previous point or the branch does not reach
     ``value`` (a fold in between): the caller falls back to the root finder.
     """
-    from walkerlab.analysis.continuation import MapFailed, continue_branch, first_point
+    from walkerlab.analysis.continuation import continue_branch, first_point
+    from walkerlab.analysis.continuation_map import MapFailed
 
     if prev is None:
         return None
@@ -446,3 +448,47 @@ def fall_onset(data: dict) -> float:
     last_walk = np.flatnonzero(walks)
     i = int(last_walk[-1]) + 1 if last_walk.size else 0
     return float(s[i])
+
+
+def grid_key(scene: Scene, values: list[float], n_transient: int, n_keep: int,
+             steady_state: bool, param: str = SLOPE_PATH) -> tuple[str, str]:
+    """The cache key of a bifurcation diagram over ``values`` of ``param`` and the
+    parameter's unit, checked before anything runs.
+
+    The slope's key is the one it always had (``slopes_deg``); another field's names it.
+
+    Returns
+    -------
+    key : str
+        JSON of the grid and the options (enters the artifact's input hash).
+    unit : str
+        Of ``param`` (``deg`` for the slope; :func:`walkerlab.sweep.params.axis_unit`).
+
+    Raises
+    ------
+    walkerlab.sweep.params.SweepError
+        ``param`` names no field of the scene or a grid value does not validate (one line).
+    """
+    import json
+
+    from walkerlab.sweep.params import axis_unit, check_axes
+
+    if param == SLOPE_PATH:
+        key = json.dumps({"slopes_deg": values, "n_transient": n_transient, "n_keep": n_keep,
+                          "steady_state": steady_state})
+    else:
+        check_axes(scene, [ParamAxis(param, tuple(values), f"{param}=<grid>")])
+        key = json.dumps({"param": param, "values": values, "n_transient": n_transient,
+                          "n_keep": n_keep, "steady_state": steady_state})
+    return key, axis_unit(scene, ParamAxis(param, tuple(values), param))
+
+
+def diagram_summary(data: dict, param: str, summary: dict) -> dict:
+    """``summary`` (the run's, or {} when the artifact was reused) completed from the loaded
+    diagram ``data`` over ``param``: ``onset`` (in the parameter's unit, NaN when none),
+    ``param``, ``unit``, and ``onset_deg`` for the slope."""
+    summary.setdefault("onset", onset_value(data))
+    summary.update(param=param, unit=data["parameter_unit"])
+    if param == SLOPE_PATH:
+        summary["onset_deg"] = summary["onset"]
+    return summary

@@ -16,12 +16,8 @@ import math
 
 import numpy as np
 
-from walkerlab.analysis.continuation import (
-    ContinuationResult,
-    MapFailed,
-    WalkerFamily,
-    continuation,
-)
+from walkerlab.analysis.continuation import ContinuationResult, continuation
+from walkerlab.analysis.continuation_map import MapFailed, WalkerFamily
 from walkerlab.analysis.homotopy import homotopy
 from walkerlab.analysis.two_parameter import two_parameter
 from walkerlab.config import Scene, SceneError

@@ -305,3 +305,62 @@ def _contact_start(scene, x_star: np.ndarray, st):
 
 def _finite(v: float) -> float:
     return v if math.isfinite(v) else math.nan
+
+
+class MfptStudyError(ValueError):
+    """The study cannot run on this scene (one line; nothing is kept to resume)."""
+
+
+def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
+                         resume: bool = True, workers: int = 1, scheduler=None):
+    """:func:`mfpt_study` that resumes an interrupted run of the same inputs.
+
+    The finished pieces (Monte Carlo chunks, mesh images) are kept in ``partial_path``
+    (``mfpt.h5.partial``, :class:`walkerlab.io.mfpt_partial.MfptPartial`) while ``key``
+    (the input hash of the scene sections and the gait) is the same; pieces are named by
+    sigma, so another sigma list or method reuses the pieces it shares.  The caller removes
+    the file (``partial.remove()``) once the artifact is written.
+
+    Parameters
+    ----------
+    x_star : ndarray (2n,)
+        The period-1 gait just after heel strike [rad, rad/s].
+    st : walkerlab.config.MfptSettings
+    partial_path : Path
+    key : str
+        Input hash the partial file is kept under.
+    resume : bool
+        False (``--force``): start afresh.
+
+    Returns
+    -------
+    data : walkerlab.io.schemas.mfpt.MfptData
+    partial : walkerlab.io.mfpt_partial.MfptPartial
+        Closed.
+
+    Raises
+    ------
+    walkerlab.safefs.RunPathError
+        ``partial_path`` is a symbolic link.
+    MfptStudyError
+        As :func:`mfpt_study`'s ValueError (bad input: the partial file is removed).
+    """
+    from walkerlab.io.mfpt_partial import MfptPartial
+
+    partial = MfptPartial(partial_path, key, resume=resume)
+    try:
+        data = mfpt_study(scene, x_star, st, workers, scheduler, partial)
+    except ValueError as exc:  # bad input: nothing to resume
+        partial.remove()
+        raise MfptStudyError(str(exc)) from None
+    finally:
+        partial.close()
+    return data, partial
+
+
+def mfpt_summary(data) -> dict:
+    """The printable summary of an ``MfptData``: ``sigma_rad`` [rad] and the Monte Carlo and
+    mesh MFPT [steps] at each sigma (lists of float)."""
+    return {"sigma_rad": list(map(float, data.sigma_rad)),
+            "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
+            "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"]))}

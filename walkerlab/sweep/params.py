@@ -21,7 +21,7 @@ import typing
 from dataclasses import dataclass
 from typing import Any
 
-from walkerlab.config import Scene, SceneError, scene_from_dict
+from walkerlab.config import MAX_SWEEP_POINTS, Scene, SceneError, scene_from_dict
 from walkerlab.config.contact import CONTACT_QUANTITIES, renamed_contact_field
 
 __all__ = ["SweepError", "ParamAxis", "parse_param", "grid_points", "apply_point",
@@ -383,3 +383,23 @@ def params_hash(axes: list[ParamAxis], stage: str) -> str:
     """Short (10 hex digits) hash of the stage and the axes' paths and values."""
     blob = json.dumps([stage, [[a.path, list(a.values)] for a in axes]], sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:10]
+
+
+def sweep_axes(scene: Scene, params: list, stage: str,
+               stages: tuple[str, ...] = ("fixedpoint", "simulate", "contact-sim")
+               ) -> list[ParamAxis]:
+    """The axes of a sweep of ``stage`` over ``params`` (``--param`` strings or ParamAxis),
+    checked against the scene before anything runs (:func:`check_axes`; the values of a grid
+    of more than ``MAX_SWEEP_POINTS`` points are left to the runner's refusal).
+
+    Raises
+    ------
+    SweepError
+        An unknown stage, a malformed ``--param``, a field the scene does not have or a value
+        that does not validate (one line).
+    """
+    if stage not in stages:
+        raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(stages)}")
+    axes = [parse_param(p) if isinstance(p, str) else p for p in params]
+    check_axes(scene, axes, values=math.prod(len(a) for a in axes) <= MAX_SWEEP_POINTS)
+    return axes

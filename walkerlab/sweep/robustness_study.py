@@ -25,8 +25,8 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     gait ``x_star`` (2n,): ``|lambda|max`` and the state norms in absolute and relative leg
     angles, the GSN of each disturbance (linearised, and the nonlinear check at an impulse
     of 1e-5), the step-down/up brackets (search cap a quarter leg length), the largest
-    forward and backward mid-stance pushes (:func:`apply_push`) and the Monte Carlo
-    MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.sweep.mfpt.monte_carlo`).
+    forward and backward mid-stance pushes (:func:`walkerlab.analysis.push.apply_push`) and
+    the Monte Carlo MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.sweep.mfpt.monte_carlo`).
 
     Returns
     -------

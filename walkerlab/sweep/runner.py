@@ -50,7 +50,7 @@ interleaving, so 785 of 1053 resumed rows differed by up to 2.8e-13 and 6 in
 a checkpoint per chain (points written, continuation state as exact JSON, hashed); a resumed
 chain continues from its checkpoint, so its rows are bit-identical to an uninterrupted run's
 with the same plan (the plan depends on the ``workers`` the sweep *started* with).  Every row
-is hashed as written (:func:`walkerlab.io.sweep_store.row_hashes`); a row or checkpoint that
+is hashed as written (:func:`walkerlab.io.sweep_resume.row_hashes`); a row or checkpoint that
 does not match on resume drops its chain's rows and the chain is computed again.
 """
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["MAP_KINDS", "CELL_FIELDS", "REASONS", "MapSpec", "default_spec", "gait_row",
-           "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS"]
+           "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS", "stability_map_run"]
 
 #: map kind -> (dotted scene path of the y axis, label); the stiffness map varies the field
 #: the scene writes its stiffness in (:attr:`MapSpec.y_field`; this one by default)
@@ -262,3 +262,49 @@ def stable_fraction(cells: dict) -> dict:
     n = ex.size
     return {"cells": int(n), "exists_fraction": float(ex.sum() / n),
             "stable_fraction": float(st.sum() / n)}
+
+
+def stability_map_run(scene, spec: MapSpec, workers: int = 2,
+                      progress: Callable[[int, int], None] | None = None):
+    """:func:`gait_map` with a progress bar, packed for the stability-map artifact.
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+        Base scene (needs ``contact`` and ``fixedpoint``).
+    spec : MapSpec
+    workers : int
+        Worker processes (1 = in this process).
+    progress : callable, optional
+        ``progress(rows_done, rows_total)``, beside the terminal's progress bar.
+
+    Returns
+    -------
+    run : walkerlab.io.schemas.stability_map.StabilityMapRun
+        The cells, their :func:`stable_fraction`, and the scene's own point (slope [deg],
+        y value: :func:`walkerlab.config.options.map_axis_value`).
+    summary : dict
+        The fractions and ``reason_<why>``: cells without a gait, per reason.
+    """
+    import math
+
+    from walkerlab import progress as _progress
+    from walkerlab.config.options import map_axis_value
+    from walkerlab.io.schemas.stability_map import StabilityMapRun
+
+    ny = len(spec.y_values)
+    with _progress.task(f"stability map {spec.kind}: {ny}x{len(spec.slopes_deg)} cells "
+                        "(rows)", ny) as bar:
+        def tick(done, total):
+            bar.update(done)
+            if progress is not None:
+                progress(done, total)
+
+        cells = gait_map(scene, spec, workers=workers, progress=tick)
+    frac = stable_fraction(cells)
+    reasons = [str(r) for r in cells["reason"].ravel() if r]
+    summary = {**frac, **{f"reason_{r}": reasons.count(r) for r in sorted(set(reasons))}}
+    run = StabilityMapRun(spec, cells, frac, scene.contact.stiffness_family, CELL_FIELDS,
+                          spec.y_label, (math.degrees(scene.slope.phi_rad),
+                                         map_axis_value(scene, spec.y_path)))
+    return run, summary

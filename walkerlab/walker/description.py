@@ -192,17 +192,6 @@ class WalkerData:
                           self.leg_length_m, self.gravity_m_per_s2, self.slope_rad, self.extra)
 
 
-def compass_gait_as_biped(w) -> dict:
-    """The ``compass_gait`` shorthand as a ``model: biped`` mapping (paper Table 1, A.1-A.3)."""
-    return {
-        "model": "biped", "coordinates": "absolute", "gravity_m_per_s2": w.gravity_m_per_s2,
-        "hip_mass_kg": w.hip_mass_kg,
-        "leg": {"length_m": w.leg_length_m, "bodies": [{
-            "kind": "point_mass", "name": "mass", "mass_kg": w.leg_mass_kg,
-            "from_hip_m": w.leg_length_m - w.leg_mass_from_foot_m}]},
-    }
-
-
 def _leg_values(leg) -> list[tuple[list[float], float]]:
     """Per-body ``(numbers, off-axis distance)`` of one leg (:attr:`Structure.param_names`
     order: mass unless massless, distance, inertia for a rod)."""
@@ -260,13 +249,11 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     -------
     WalkerData
     """
-    from walkerlab.config import BipedParams
-
     extra = {}
     if walker_cfg.model == "compass_gait":
         extra = {"leg_mass_kg": walker_cfg.leg_mass_kg, "hip_mass_kg": walker_cfg.hip_mass_kg,
                  "leg_mass_from_foot_m": walker_cfg.leg_mass_from_foot_m}
-        walker_cfg = BipedParams.model_validate(compass_gait_as_biped(walker_cfg))
+        walker_cfg = walker_cfg.as_biped()
     leg1, leg2 = walker_cfg.leg_pair()
     leg = leg1
     v1, v2 = _leg_values(leg1), _leg_values(leg2)

@@ -191,3 +191,24 @@ def run_end(path: Path) -> str:
     """
     with open_artifact(path, STAGE) as f:
         return str(f.attrs["termination"])
+
+
+def longer_run_note(path: Path, asked: int, key_of) -> str:
+    """Why the existing ``simulate.h5`` at ``path`` is kept for a scene asking ``asked``
+    strides, or "" when it is not: it holds *more* strides of the same run (an earlier
+    ``simulate --strides N``), so it contains the scene's strides and the result the user
+    asked for is kept rather than replaced.
+
+    ``key_of(n)``: the input hash of the same scene with ``n`` strides; the artifact must
+    have it (verified against its content).
+    """
+    from walkerlab.io.artifacts import verified_hash
+
+    n = strides_of(path)
+    if n is None or n <= asked:
+        return ""
+    have = verified_hash(path)
+    if have is None or have != key_of(n):
+        return ""
+    return (f"kept {n} strides of an earlier 'simulate --strides {n}'; the scene asks for "
+            f"{asked}, the first {asked} are the same run")

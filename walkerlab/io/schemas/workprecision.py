@@ -31,8 +31,8 @@ class WorkPrecisionRun:
     ----------
     results : dict[str, (rows, summary, reference)]
         Per model: ``rows`` ``{method: {column: ndarray (n_rtol,)}}``
-        (:func:`walkerlab.analysis.workprecision.rows_from_cases`), ``summary``
-        (:func:`walkerlab.analysis.workprecision.summarize`), the reference setting.
+        (:func:`walkerlab.analysis.workprecision_results.rows_from_cases`), ``summary``
+        (:func:`walkerlab.analysis.workprecision_results.summarize`), the reference setting.
     cases_reused, cases_total : int
     target_error, contact_target_error : float
     single_run_s : float

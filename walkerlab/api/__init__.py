@@ -1,0 +1,40 @@
+"""walkerlab's Python front door: scenes in, ``xarray.Dataset`` out.
+
+Every function runs the *same* stage as the command line (:mod:`walkerlab.stages`): it
+writes (or reuses, when up to date) the stage's HDF5 artifact in the runs folder
+(``runs_dir``, default ``runs/``, as ``--runs-dir``), then reads the artifact back with
+:func:`walkerlab.io.datasets.load_dataset`, through its netCDF-4 view.  So a notebook and
+``walkerlab report`` share one code path, one cache and one set of files, and a dataset holds
+exactly what the artifact holds: named dimensions (``time``, ``state``, ``step``,
+``multiplier``, the swept field ``slope.angle_deg``, ``x``/``y`` of a basin ...), coordinate
+variables, and ``units``/``long_name`` on every variable.
+
+``walkerlab.sweep`` is the package :mod:`walkerlab.sweep` (sweeps, basins, maps); the sweep
+of the front door is :func:`walkerlab.api.sweep` (``wl.api.sweep(scene, param, values)``).
+
+Modules: :mod:`~walkerlab.api.scenes` (:func:`load_scene`, :func:`with_changes`),
+:mod:`~walkerlab.api.runs` (one scene: :func:`fixed_point`, :func:`fixed_points`,
+:func:`simulate`, :func:`contact_simulate`, :func:`compare`),
+:mod:`~walkerlab.api.studies` (many points: :func:`sweep`, :func:`basin`,
+:func:`continuation`, :func:`mfpt`); this module only gathers their public names.
+
+Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
+Importing this module loads neither them nor the numeric stack: each function imports what
+it uses.
+
+Example
+-------
+>>> import walkerlab as wl
+>>> scene = wl.load_scene("configs/kneed.yaml")
+>>> gait = wl.fixed_point(scene, runs_dir="runs")        # doctest: +SKIP
+>>> float(gait.step_period), gait.multipliers.values      # doctest: +SKIP
+>>> run = wl.simulate(scene, strides=2)                   # doctest: +SKIP
+>>> run.leg1_angle.plot()                                 # doctest: +SKIP
+"""
+
+from walkerlab.api.runs import compare, contact_simulate, fixed_point, fixed_points, simulate
+from walkerlab.api.scenes import DEFAULT_RUNS, load_scene, with_changes
+from walkerlab.api.studies import basin, continuation, mfpt, sweep
+
+__all__ = ["DEFAULT_RUNS", "load_scene", "with_changes", "fixed_point", "fixed_points",
+           "simulate", "contact_simulate", "compare", "sweep", "basin", "continuation", "mfpt"]

@@ -1,0 +1,83 @@
+"""Report section of the figures: every figure the run folder holds, in the paper's order,
+with its caption and, where it is long, its raw data folded underneath (the rigid walker's
+per-step table, every work-precision point); from loaded artifacts only."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from walkerlab.report.markdown import details, num, table
+from walkerlab.report.workprecision_section import workprecision_table
+
+if TYPE_CHECKING:  # loaded artifacts (walkerlab.io.schemas)
+    from walkerlab.io.schemas.simulate import SimulateArtifact
+
+
+CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond the paper
+    ("fig2_stick_ideal", "Fig. 2 — stick diagram of one gait cycle, ideal model."),
+    ("fig6_stick_contact", "Fig. 6 — stick diagram of one gait cycle, contact model."),
+    ("fig7_angles_rates", "Fig. 7 — angles and angular rates over the simulated strides."),
+    ("fig8_errors", "Fig. 8 — error contact − ideal, angles and rates: left time-aligned "
+     "(both at the same time since the start, so a different step period shows as a growing "
+     "phase drift), right phase-aligned (both at the same fraction of the same step: the "
+     "difference of the gaits themselves)."),
+    ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, one "
+                          "panel per link, both legs in it)."),
+    ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),
+    ("work_precision_ideal", "Work-precision diagram, ideal model."),
+    ("work_precision_contact", "Work-precision diagram, contact model."),
+    ("bifurcation", "Bifurcation diagram over the slope."),
+    ("basin", "Basin of attraction: where each cell of the Poincaré-section slice goes "
+              "(left) and how many steps the converged cells take (right)."),
+]
+
+
+def steps_table(sim: SimulateArtifact) -> str:
+    """Per-step table of ``simulate.h5`` (period, step length, hip speed, impact loss)."""
+    u, s = sim.units, sim.steps
+    cols = ("period", "step_length", "hip_speed", "impact_energy_loss")
+    rows = [[int(i), str(leg), *[num(s[c][k]) for c in cols], str(term)]
+            for k, (i, leg, term) in enumerate(zip(s["step"], s["stance_leg"],
+                                                   s["termination"]))]
+    return table(["step", "stance leg", f"period [{u.time}]", f"step length [{u.length}]",
+                  f"hip speed [{u.speed}]", f"impact loss [{u.energy}]", "ended by"], rows)
+
+
+def _drawn_from(stem: str, arts: dict) -> bool:
+    """Whether a figure's artifacts are among the report's (a figure an earlier ``walkerlab
+    plot`` drew from an artifact the report leaves out is not shown)."""
+    for prefix, stages in (("fig2_", ("simulate",)), ("fig6_", ("contact-sim",)),
+                           ("fig8_", ("compare",)), ("fig", ("simulate", "contact-sim")),
+                           ("work_precision", ("workprecision",)),
+                           ("bifurcation", ("bifurcation",)), ("basin", ("basin",))):
+        if stem.startswith(prefix):
+            return any(s in arts for s in stages)
+    return True
+
+
+def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
+    """Every figure that exists, with its raw data folded underneath where it is long
+    (``arts``: the loaded artifacts by stage name)."""
+    out = []
+    gif = fig_dir / "animation.gif"  # written by `walkerlab animate`, embedded when present
+    if gif.is_file():
+        cap = ("The walker walking (`walkerlab animate`; rigid model, and the contact model "
+               "beside it where it was simulated).")
+        out += [f"![{cap}]({rel}/{gif.name})", "", f"*{cap}*", ""]
+    extra = [(png.stem, f"Bifurcation diagram over {png.stem.removeprefix('bifurcation_')} "
+                        "(`walkerlab bifurcation --param`).")
+             for png in sorted(fig_dir.glob("bifurcation_*.png"))]
+    for stem, cap in CAPTIONS + extra:
+        png = fig_dir / f"{stem}.png"
+        if not png.is_file() or not _drawn_from(stem, arts):
+            continue
+        out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
+        if stem == "fig7_angles_rates" and "simulate" in arts:
+            out += details("Per-step data of the rigid walker (simulate.h5)",
+                           steps_table(arts["simulate"]))
+        if stem.startswith("work_precision_") and "workprecision" in arts:
+            out += details("All (method, tolerance) points",
+                           workprecision_table(arts["workprecision"],
+                                               stem.removeprefix("work_precision_")))
+    return ["## Figures", "", *out] if out else []

@@ -1,0 +1,60 @@
+"""Report section of the work-precision study (``workprecision.h5``): the fastest setting
+reaching the target error, the Pareto front per model, and the table of every (method,
+tolerance) point; from the loaded artifact only."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from walkerlab.report.markdown import num, table
+from walkerlab.report.text import workprecision_choice
+
+if TYPE_CHECKING:  # loaded artifacts (walkerlab.io.schemas)
+    from walkerlab.io.schemas.workprecision import WorkPrecisionArtifact
+
+
+def workprecision_table(wp: WorkPrecisionArtifact, model: str) -> str:
+    """Every (method, rtol) point of one model of ``workprecision.h5``."""
+    rows, clock = [], "wall"
+    for m, d in wp.models[model].rows.items():
+        if "wall_time" in d:  # times are the integration's CPU time (older artifacts: wall)
+            clock = "CPU"
+        lo = d.get("time_min", d["time"])
+        hi = d.get("time_max", d["time"])
+        reps = d["repeats"] if "repeats" in d else np.ones(len(lo), int)
+        for rt, t, a, b, k, e, n in zip(d["rtol"], d["time"], lo, hi, reps, d["error"],
+                                        d["nfev"]):
+            rows.append([m, num(rt, 1), num(t * 1e3, 3), f"{num(a * 1e3, 3)}–"
+                         f"{num(b * 1e3, 3)}", int(k), num(e, 2), int(n)])
+    return table(["method", "rtol", f"median {clock} [ms]", f"min–max {clock} [ms]", "runs",
+                  "error vs reference", "RHS evals"], rows)
+
+
+def _solver_text(scene, model: str) -> str:
+    from walkerlab.config import SolverSettings
+
+    sv = (scene.solver if model == "ideal"
+          else scene.contact_solver or SolverSettings.for_contact())
+    return f"{sv.method} rtol {sv.rtol:.0e}."
+
+
+def workprecision_summary(scene, arts: dict) -> list[str]:
+    """The fastest setting reaching the target error, only where the timing noise allows
+    naming one, and the Pareto front per model (raw points fold under the figure)."""
+    wp = arts.get("workprecision")
+    if wp is None:
+        return []
+    out = ["## Error against run time (work-precision)", ""]
+    for model, m in wp.models.items():
+        out += [f"### {model} model", ""]
+        out.append("Choice: " + workprecision_choice(m.choice) + " Scene default: "
+                   + _solver_text(scene, model))
+        pm = [str(s) for s in m.choice.get("pareto_methods", [])]
+        pr = list(m.choice.get("pareto_rtol", []))
+        out += ["", "Pareto front (no setting is both more accurate and faster by more than "
+                "the spread of the repeats' CPU times; of two settings whose times overlap "
+                "only the more accurate is kept): "
+                + ", ".join(f"{a} {r:.0e}" for a, r in zip(pm, pr)) + ".", ""]
+    return out

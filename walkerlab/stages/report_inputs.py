@@ -1,0 +1,84 @@
+"""What the report shows: the artifacts of its stages that exist, and which are current.
+
+An artifact the report produced is shown; one it did not produce (an earlier standalone run)
+is shown only when :data:`EARLIER` allows it and it was computed for the scene's current
+sections (:func:`computed_for`); everything left out is named in one line.
+"""
+
+from __future__ import annotations
+
+from itertools import combinations
+from pathlib import Path
+
+from walkerlab.config import Scene
+from walkerlab.io.artifacts import stored_content_hash_matches, stored_hash
+from walkerlab.io.freshness import changed_fields, input_hash
+from walkerlab.io.runpaths import bifurcation_artifacts, stage_artifact
+from walkerlab.stages.pipeline import needs, stage_module
+
+REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
+                 "bifurcation", "basin", "robustness", "attribution")
+#: why a report leaves out an artifact of a stage the scene does not run
+NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' section",
+           "contact-sim": "no 'contact' section",
+           "compare": "needs both a 'simulate' and a 'contact' section",
+           "workprecision": "no 'workprecision' section",
+           "basin": "no 'basin' section (or no 'fixedpoint')",
+           "robustness": "no 'robustness' section (or no 'fixedpoint')",
+           "attribution": "no 'contact' or 'fixedpoint' section"}
+#: artifacts shown although this report did not compute them, when computed for the
+#: scene's current sections: (their stage, why one is left out)
+EARLIER = {"workprecision": "measured for other settings; `walkerlab report --full` "
+                            "measures it again",
+           "attribution": "computed for other settings; `walkerlab report --full` computes "
+                          "it again",
+           "bifurcation": "computed for another walker, slope or solver"}
+
+
+def computed_for(scene: Scene, runs_root, stage: str, variants: tuple[str, ...] = ()) -> str:
+    """Why the existing artifact of ``stage`` must not be used beside the scene's current
+    results ('' if it may): changed after it was written, or written for other inputs than
+    the scene's current ones (with any subset of the stage's ``variants``, e.g. contact-sim's
+    ``adjust`` and ``periodic``, in its input hash)."""
+    path = stage_artifact(scene, runs_root, stage)
+    if not stored_content_hash_matches(path):
+        return f"{path.name} was changed after it was written"
+    up = tuple(stage_artifact(scene, runs_root, s) for s in needs(stage, scene))
+    have, sections = stored_hash(path), stage_module(stage).SECTIONS
+    for extra in (c for k in range(len(variants) + 1) for c in combinations(variants, k)):
+        if have == input_hash(stage, scene, sections + extra, up):
+            return ""
+    return f"{path.name} was computed for another scene or fixed point"
+
+
+def existing_artifacts(scene: Scene, runs_root) -> dict[str, Path]:
+    """``{stage: path}`` of the report's stages whose artifact exists for ``scene``, and
+    ``{bifurcation_<field>: path}`` of bifurcations over other fields (``--param``)."""
+    out = {s: p for s in REPORT_STAGES if (p := stage_artifact(scene, runs_root, s)).is_file()}
+    return out | bifurcation_artifacts(scene, runs_root)
+
+
+def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
+    """'' when the artifact ``p`` the report did not produce is shown all the same."""
+    kind = "bifurcation" if stage.startswith("bifurcation") else stage
+    if kind not in EARLIER or (kind == "workprecision" and (scene.workprecision is None or full)
+                               ) or (kind == "attribution" and (scene.contact is None or full)):
+        return f"an earlier standalone run: the scene has {NOT_RUN.get(stage, 'no section for it')}"
+    if kind == "bifurcation" and not stored_content_hash_matches(p):  # edited by hand (26)
+        return "changed after it was written: rerun 'walkerlab bifurcation'"
+    return EARLIER[kind] if changed_fields(p, scene, stage_module(kind).SECTIONS) else ""
+
+
+def report_artifacts(scene: Scene, runs_root, done: list, full: bool = False
+                     ) -> tuple[dict[str, Path], str]:
+    """The artifacts the report shows (those this report produced, ``done``: its
+    ``StageOutcome`` list, and those of :data:`EARLIER` computed for the current scene) and
+    one line on what it leaves out ('' when nothing)."""
+    produced, paths, left = {o.stage for o in done}, {}, []
+    for stage, p in existing_artifacts(scene, runs_root).items():
+        why = "" if stage in produced else _why_left_out(scene, stage, p, full)
+        if why:
+            left.append(f"{p.name} ({why})")
+        else:
+            paths[stage] = p
+    return paths, ("report: leaves out " + "; ".join(left)) if left else ""
