@@ -3,13 +3,20 @@
 The package is split by role (lower layers first; the README describes
 the product):
 
+- :mod:`walkerlab.walker`   the walker as data: description, state layout, link tree
 - :mod:`walkerlab.config`   typed YAML scenes (pydantic, ``extra="forbid"``)
-- :mod:`walkerlab.models`   walker models (flow, guard, reset as pure functions)
-- :mod:`walkerlab.models.contact`  the compliant-contact (MSC ADAMS style) walker
-- :mod:`walkerlab.analysis` hybrid integration, Poincaré map, fixed points, gait metrics
-- :mod:`walkerlab.io`       HDF5 artifacts (atomic writes, content hashes)
-- :mod:`walkerlab.stages`   one function per stage: config + upstream artifacts -> one artifact
+- :mod:`walkerlab.codegen`  the generated code of a walker's rigid and floating views (sympy)
+- :mod:`walkerlab.models`   walker models: ``models.hybrid`` (rigid) and ``models.contact``
+  (the compliant-contact, MSC ADAMS style, walker)
+- :mod:`walkerlab.integrate` the one solver layer of both models (settings, run ends, events)
+- :mod:`walkerlab.analysis` Poincaré map, fixed points, gait metrics, robustness measures
+- :mod:`walkerlab.sweep`    many-point studies: sweeps, bifurcation, basins, maps, MFPT
+- :mod:`walkerlab.execution` the one executor protocol (inline, process pool, Dask)
+- :mod:`walkerlab.io`       HDF5 artifacts (one schema module per artifact, atomic writes)
+- :mod:`walkerlab.report`   markdown/HTML from loaded artifacts only
 - :mod:`walkerlab.plotting` figures drawn from loaded artifacts only
+- :mod:`walkerlab.stages`   one module per stage: config + upstream artifacts -> one artifact;
+  ``stages.pipeline`` chains them
 - :mod:`walkerlab.cli`      thin typer front end (parse, run a stage, print)
 - :mod:`walkerlab.bench`    ``walkerlab bench``: the benchmarks by name
 - :mod:`walkerlab.api`      the Python front door: ``walkerlab.load_scene``,
