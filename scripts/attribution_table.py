@@ -1,14 +1,14 @@
 """Section-5 attribution table per walker: the contact-vs-rigid gap of the periodic gait split
 by cause, the energy per step by sink, the initial-rate adjustment's effect and whether the
-adjusted start lies in the rigid walker's basin (walkerlab.analysis.attribution).
+adjusted start lies in the rigid walker's basin (walkerlab.analysis.contact.attribution).
 
     python scripts/attribution_table.py configs/paper.yaml configs/kneed.yaml ...
 """
 
 import sys
 
-from walkerlab.analysis.attribution import adjustment_effect, attribute
-from walkerlab.analysis.contact_periodic import ideal_gait
+from walkerlab.analysis.contact.attribution import adjustment_effect, attribute
+from walkerlab.analysis.contact.periodic import ideal_gait
 from walkerlab.config import load_scene
 from walkerlab.models.contact.scene import build
 

@@ -23,7 +23,7 @@ import time; t0 = time.perf_counter()
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
 from walkerlab.integrate.solver import Solver
-from walkerlab.analysis.poincare import poincare_map
+from walkerlab.analysis.gait.poincare import poincare_map
 sc = load_scene({path!r}); w = build_walker(sc)
 x = sc.fixedpoint.initial_guess.as_array(w.state_names())
 poincare_map(w, x, Solver('DOP853', sc.solver.rtol, sc.solver.atol, None, {backend!r}))
@@ -32,7 +32,7 @@ print(time.perf_counter() - t0)
 
 
 def main(path: str = "configs/paper.yaml", repeats: int = 30) -> None:
-    from walkerlab.analysis.poincare import poincare_map
+    from walkerlab.analysis.gait.poincare import poincare_map
     from walkerlab.config import load_scene
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
@@ -58,7 +58,7 @@ def main(path: str = "configs/paper.yaml", repeats: int = 30) -> None:
         print(f"{'variational' if jac else 'plain'} map: cyrk {a * 1e3:.3f} ms, cyrk_compiled "
               f"{c * 1e3:.3f} ms (median CPU of {repeats}x{batch}), ratio {a / c:.1f}x; "
               f"max |x_A - x_B| {diff:.1e}{extra}")
-    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.analysis.gait.poincare import find_fixed_point
 
     times = {b: [] for b in sv}
     fps = {}

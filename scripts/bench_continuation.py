@@ -41,7 +41,7 @@ def main() -> None:
 
     from walkerlab.config import load_scene
     from walkerlab.models.registry import build_walker
-    from walkerlab.sweep.continuation import run_continuation
+    from walkerlab.studies.continuation import run_continuation
 
     warnings.simplefilter("ignore")
     out = {"load_average": os.getloadavg(), "cpus": os.cpu_count(), "cases": {}}

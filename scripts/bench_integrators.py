@@ -45,7 +45,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--rtol", type=float, default=1e-10)
     args = ap.parse_args()
-    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.analysis.gait.poincare import find_fixed_point
     from walkerlab.config import default_scene_path as default_scene
     from walkerlab.config import load_scene
     from walkerlab.integrate.rigid import integrate_step

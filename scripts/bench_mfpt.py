@@ -38,9 +38,9 @@ def main() -> None:
     ap.add_argument("--skip-mesh", action="store_true")
     a = ap.parse_args()
 
-    from walkerlab.analysis.scene_gaits import solve_scene
+    from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.config import MfptSettings, load_scene
-    from walkerlab.sweep import mfpt as work
+    from walkerlab.studies import mfpt as work
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
     _, search = solve_scene(scene, fd_check=False)

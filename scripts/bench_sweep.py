@@ -23,8 +23,8 @@ import numpy as np
 from walkerlab.config import load_scene
 from walkerlab.io.sweep_store import load_sweep
 from walkerlab.stages.sweep import run
-from walkerlab.sweep.outcomes import COLUMNS
-from walkerlab.sweep.points import warm_up
+from walkerlab.studies.outcomes import COLUMNS
+from walkerlab.studies.points import warm_up
 
 PARAMS = ["slope.angle_deg=1:4:0.125", "walker.hip_mass_kg=8,10,12,14"]
 

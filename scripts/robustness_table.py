@@ -27,12 +27,12 @@ WALKERS = ("paper", "goswami1996", "paper_rods", "round_feet", "kneed", "simples
 
 
 def row(name: str) -> str:
-    from walkerlab.analysis import robustness as R
-    from walkerlab.analysis.batch_step import BatchStepMap
-    from walkerlab.analysis.scene_gaits import solve_scene
+    from walkerlab.analysis.gait.batch_step import BatchStepMap
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.analysis.robustness import measures as R
     from walkerlab.config import load_scene
     from walkerlab.models.registry import build_walker
-    from walkerlab.sweep.mfpt import scene_walker_at
+    from walkerlab.studies.mfpt import scene_walker_at
 
     t = time.perf_counter()
     sc = load_scene(ROOT / "configs" / f"{name}.yaml")
@@ -66,10 +66,10 @@ def row(name: str) -> str:
 
 
 def contact_row(name: str) -> str:
-    from walkerlab.analysis.contact_rough import contact_start
-    from walkerlab.analysis.scene_gaits import solve_scene
+    from walkerlab.analysis.contact.rough import contact_start
+    from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.config import load_scene
-    from walkerlab.sweep.contact_rough import contact_largest_step
+    from walkerlab.studies.contact_rough import contact_largest_step
 
     t = time.perf_counter()
     sc = load_scene(ROOT / "configs" / f"{name}.yaml")

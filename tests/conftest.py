@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker

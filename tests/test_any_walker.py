@@ -97,7 +97,7 @@ def walker(scene):
 
 @pytest.fixture(scope="module")
 def fixed_point(walker, scene):
-    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.analysis.gait.poincare import find_fixed_point
     from walkerlab.integrate.solver import Solver
 
     g = dict(zip(["swing_angle", "stance_angle", "swing_rate", "stance_rate"],
@@ -120,7 +120,7 @@ def test_samples_artifact_and_figures_name_the_torso(walker, fixed_point, scene,
     import h5py
 
     import walkerlab.io.artifacts as A
-    from walkerlab.analysis.metrics import sample_trajectory
+    from walkerlab.analysis.gait.metrics import sample_trajectory
     from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.trajectory import read_samples, write_samples
@@ -165,9 +165,9 @@ def test_sweep_columns_and_bifurcation_arrays_follow_the_walker(walker, fixed_po
 
     import walkerlab.io.artifacts as A
     from walkerlab.io.schemas.bifurcation import bifurcation_writer
-    from walkerlab.sweep.bifurcation import BifurcationResult
-    from walkerlab.sweep.outcomes import columns
-    from walkerlab.sweep.points import _fp_columns, interleg_angle
+    from walkerlab.studies.bifurcation import BifurcationResult
+    from walkerlab.studies.outcomes import columns
+    from walkerlab.studies.points import _fp_columns, interleg_angle
 
     cols = columns("fixedpoint", walker.state_names(), walker.state_units())
     assert "torso_angle_rad" in cols and "torso_rate_rad_per_s" in cols

@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _fake_run():
-    from walkerlab.analysis.attribution import Attribution
+    from walkerlab.analysis.contact.attribution import Attribution
     from walkerlab.io.schemas.attribution import AttributionRun
 
     a = Attribution(7.37e-3, -10.94e-3, 6.57e-3, -10.29e-3, 0.467e-3, -0.325e-3, 0.338e-3,
@@ -62,7 +62,7 @@ def test_attribution_stage_writes_and_reuses(tmp_path, monkeypatch):
     """The stage runs the analysis once from fixedpoint.h5 and reuses its artifact (the
     analysis itself, ~17 s CPU on the paper scene, is replaced by its recorded numbers:
     scripts/attribution_table.py runs it for real)."""
-    from walkerlab.analysis import attribution as A
+    from walkerlab.analysis.contact import attribution as A
     from walkerlab.stages import pipeline
 
     calls = []

@@ -7,7 +7,7 @@ import pytest
 import yaml
 
 from walkerlab.config import BasinSettings, load_scene
-from walkerlab.sweep.basin import CODE, NOT_DONE, BasinError, classify_cell, slice_state
+from walkerlab.studies.basin import CODE, NOT_DONE, BasinError, classify_cell, slice_state
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -101,10 +101,10 @@ def test_heel_strike_cells_of_the_simplest_walker(tmp_path):
     post-impact states satisfy phi = 2 theta and phi-dot = (1 - cos 2 theta) theta-dot
     (Garcia et al. 1998, heel-strike equations, written here independently of the model's
     generated reset), and the cell at the fixed point's values is the fixed point."""
-    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.analysis.gait.poincare import find_fixed_point
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
-    from walkerlab.sweep.basin import heel_strike_slice, pre_impact_fixed_point
+    from walkerlab.studies.basin import heel_strike_slice, pre_impact_fixed_point
 
     sc = _simplest(tmp_path)
     w = build_walker(sc)

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from walkerlab.analysis.basin_area import basin_area
+from walkerlab.analysis.robustness.basin_area import basin_area
 from walkerlab.io.schemas.basin import BasinArtifact
 
 OUTCOMES = ["converged", "other_attractor", "fell_forward", "fell_backward", "max_steps",

@@ -18,7 +18,7 @@ from typer.testing import CliRunner
 from walkerlab.cli import app
 from walkerlab.config import load_scene
 from walkerlab.stages import bifurcation as bif_stage
-from walkerlab.sweep.params import SweepError, axis_unit, parse_param
+from walkerlab.studies.params import SweepError, axis_unit, parse_param
 
 ROOT = Path(__file__).resolve().parents[1]
 SHANK = "walker.leg.bodies.shank_mass.mass_kg"

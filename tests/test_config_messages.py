@@ -141,7 +141,7 @@ def test_help_shows_flags_without_a_value():
 
 
 def test_an_integer_field_over_a_range_of_whole_numbers(tmp_path):
-    from walkerlab.sweep.params import check_axes, parse_param
+    from walkerlab.studies.params import check_axes, parse_param
 
     axis = parse_param("simulate.strides=1:3:1")
     assert axis.values == (1, 2, 3) and all(type(v) is int for v in axis.values)

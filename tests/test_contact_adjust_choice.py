@@ -12,7 +12,7 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from walkerlab.analysis import contact_adjust
+from walkerlab.analysis.contact import adjust as contact_adjust
 from walkerlab.cli import app
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -76,7 +76,7 @@ def test_stability_map_figure_names_scene_units_and_unsupported_cells():
     search has no section read '?'."""
     from walkerlab.io.schemas.stability_map import StabilityMap
     from walkerlab.plotting.sweep_figures import gait_map_figure, plt
-    from walkerlab.sweep.stability import MAP_KINDS, REASONS, MapSpec
+    from walkerlab.studies.stability import MAP_KINDS, REASONS, MapSpec
 
     assert "unsupported" in REASONS
     reason = np.array([["", "unsupported"]], dtype=object)
@@ -137,8 +137,8 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     N/m^2.2 (restitution 0 throughout).  Now the grid is the scene's k x 0.1 ... 1e4 and
     both families pass through the scene's own contact; the paper scene's numbers do not
     move."""
-    from walkerlab.analysis.contact_drop import drop_restitution
-    from walkerlab.analysis.contact_record import drop_test
+    from walkerlab.analysis.contact.drop import drop_restitution
+    from walkerlab.analysis.contact.record import drop_test
     from walkerlab.config import load_scene
 
     rf = load_scene("configs/round_feet.yaml")
@@ -154,7 +154,7 @@ def test_drop_test_uses_the_walkers_mass_and_brackets_its_own_stiffness():
     # drop without gravity; Radau rtol 1e-10 -> ~1e-6 between the k)
     np.testing.assert_allclose(d["rigid_limit"]["restitution"], own, atol=1e-5)
     # the paper scene (k = 1e5 N/mm^2.2, 20 kg, reference_stiffness = its k) keeps its grid
-    from walkerlab.analysis.contact_record import DROP_STIFFNESS_RATIO
+    from walkerlab.analysis.contact.record import DROP_STIFFNESS_RATIO
 
     paper = load_scene("configs/paper.yaml").contact
     assert paper.stiffness_n_per_mm_pow_e == paper.reference_stiffness_n_per_mm_pow_e == 1e5
@@ -197,8 +197,8 @@ def test_work_precision_contact_runner_reads_a_kneed_walkers_legs_by_name():
     """The work-precision study's contact series on the kneed walker: the final vector is
     the four link angles [rad] and their four rates, read by name (no hip position: |angle|
     < 1 rad, where hip_x is ~0.95 m after a stride), and it converges with the tolerance."""
-    from walkerlab.analysis.poincare import find_fixed_point
-    from walkerlab.analysis.workprecision import contact_runner
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.bench.workprecision import contact_runner
     from walkerlab.config import load_scene
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
@@ -223,7 +223,7 @@ def test_stability_map_default_axes_bracket_the_scenes_own_contact():
     for every scene: round_feet.yaml (k = 4e9 N/m^2.2, patches 0.30 l) lay outside both.
     Now the axes are the scene's own value x 1e-2 ... 1e4 and x 0.2 ... 2; the paper
     scene's grids are unchanged (bit for bit: its cached maps stay valid)."""
-    from walkerlab.sweep.stability import default_spec
+    from walkerlab.studies.stability import default_spec
 
     k = default_spec("stiffness", 3, stiffness=4e9).y_values
     w = default_spec("patch_width", 3, patch_width_m=0.30).y_values

@@ -18,7 +18,7 @@ def test_run_from_the_periodic_gait_has_constant_step_periods():
     heel-strike location, measured as a steady offset of 6-7 us with a spread of ~1.5 us
     over 6 steps.  The start from the ideal fixed point (x 1.1 rates) has a first step of
     0.58 s against 0.71 s: 10^4 times that tolerance."""
-    from walkerlab.analysis.contact_periodic import ideal_gait, simulate_from_periodic_gait
+    from walkerlab.analysis.contact.periodic import ideal_gait, simulate_from_periodic_gait
     from walkerlab.models.contact.scene import contact_setup
 
     scene = load_scene("configs/paper.yaml")

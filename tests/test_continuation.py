@@ -1,7 +1,7 @@
 """Pseudo-arclength continuation of gaits (issue 23): special points against independent
 computations.
 
-The independent checks share no code with :mod:`walkerlab.analysis.continuation`: fixed
+The independent checks share no code with :mod:`walkerlab.analysis.continuation.branch`: fixed
 points by :func:`scipy.optimize.root` on the (k-step) Poincaré map with MINPACK's own
 finite-difference Jacobian, multipliers from a central finite-difference Jacobian of the
 map (not the variational equations), and the onset by :func:`scipy.optimize.brentq` in the
@@ -18,13 +18,13 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, root
 
-from walkerlab.analysis.continuation import SPECIAL_KINDS
-from walkerlab.analysis.poincare import poincare_map
+from walkerlab.analysis.continuation.branch import SPECIAL_KINDS
+from walkerlab.analysis.gait.poincare import poincare_map
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
-from walkerlab.sweep.continuation import run_continuation
-from walkerlab.sweep.params import apply_point
+from walkerlab.studies.continuation import run_continuation
+from walkerlab.studies.params import apply_point
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -147,7 +147,7 @@ def test_kneed_gait_ends_in_a_fold_where_a_scan_loses_it():
     reported ``no_fixed_point`` near 0.268 m): a fold, multiplier +1 to 1e-6; a natural-
     parameter scan with the root finder (independent of the continuation) finds gaits above
     the fold and none 2 mm below it."""
-    from walkerlab.analysis.poincare import FixedPointNotFound, find_fixed_point
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
 
     scene = load_scene(ROOT / "configs" / "kneed.yaml")
     path = "walker.leg.bodies.thigh_mass.from_hip_m"
@@ -171,7 +171,7 @@ def test_paper_rods_bifurcation_chain_keeps_the_stable_long_gait():
     reported the unstable short-period gait at 3 kg (T 0.8227 s, |mu| 3.23).  The chains
     start at the scene's value (5 kg) and follow the branch by pseudo-arclength: at 3 kg the
     stable long gait (T 1.0223 s, |mu| 0.778, as ``fixedpoint`` and ``sweep`` there)."""
-    from walkerlab.sweep.bifurcation import bifurcation_diagram
+    from walkerlab.studies.bifurcation import bifurcation_diagram
 
     scene = load_scene(ROOT / "configs" / "paper_rods.yaml")
     r = bifurcation_diagram(scene, np.arange(3.0, 7.01, 0.5), steady_state=False, workers=1,
@@ -270,7 +270,7 @@ def test_homotopy_and_initial_guess_from_an_artifact(tmp_path):
     rod = scene.model_dump(mode="json")
     rod["fixedpoint"]["initial_guess"] = {"from": str(out.path), "at": 3.5}
     rod["walker"]["leg"]["bodies"][0]["mass_kg"] = 3.5
-    from walkerlab.analysis.scene_gaits import solve_scene
+    from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.config import scene_from_dict
 
     _w, search = solve_scene(scene_from_dict(rod), fd_check=False)
@@ -288,8 +288,8 @@ def test_stance_foot_normal_force_from_the_equations_of_motion():
     n + g cos phi) with n the slope normal.  The smallest N / (M g) over the step agrees to
     1e-5 (the second difference on 200 points a phase errs by ~h^2 |d^4 com/dt^4| / 12,
     measured 3e-6 here; at a branch end this moves the located parameter by 1e-5 / |dN/dp|)."""
-    from walkerlab.analysis.continuation_map import step_map
-    from walkerlab.analysis.continuation_validity import normal_force_ratio
+    from walkerlab.analysis.continuation.gait_map import step_map
+    from walkerlab.analysis.continuation.validity import normal_force_ratio
 
     scene = load_scene(ROOT / "configs" / "paper.yaml")
     w = build_walker(scene)

@@ -22,7 +22,7 @@ import yaml
 
 from tests.independent import floating_reference as ref
 from walkerlab.config import load_scene
-from walkerlab.io.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
+from walkerlab.export.mjcf_scene import MJCF_MIN_INERTIA_KG_M2
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
 

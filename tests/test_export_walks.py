@@ -3,7 +3,7 @@ export refuses or handles inputs MuJoCo cannot take (issue 26).
 
 MuJoCo runs the exported file with its own soft contact (solref/solimp mapped from the
 scene's IMPACT law), the scene's terrain and, for the kneed walker, the knee latch switched by
-:func:`walkerlab.analysis.mujoco_walk.latch_rule`.  A MuJoCo run is an outside check of the
+:func:`walkerlab.export.mujoco_walk.latch_rule`.  A MuJoCo run is an outside check of the
 whole export (masses, geometry, keyframe, ground placement, contact): a wrong keyframe sign, a
 ground at the wrong height or a contact too soft makes the walker fall or change its gait.
 Measured (12 s): paper 17 alternating heel strikes, mean step period 0.70342 s against the
@@ -43,7 +43,7 @@ def _scene(name):
                                                         ("torso_bhm", 9.5, 0.850906)])
 def test_exported_walker_walks_in_mujoco_at_the_rigid_period(name, t_final, rigid_period,
                                                              tmp_path):
-    from walkerlab.analysis.mujoco_walk import walk
+    from walkerlab.export.mujoco_walk import walk
 
     scene = _scene(name)
     run = walk(export_stage.run(scene, tmp_path, "mjcf"), t_final)
@@ -58,7 +58,7 @@ def test_gait_keyframe_is_the_rigid_fixed_point_and_urdf_sidecar_carries_it(tmp_
     """The keyframe's hip_x/hip_z put the stance foot (leg2) at the origin; the URDF's sidecar
     has the same numbers under the URDF's joint names; the rates of the legs are the fixed
     point's (paper Eq. (11) neighbourhood: stance rate ~ -0.84 rad/s)."""
-    from walkerlab.analysis.contact_periodic import ideal_gait
+    from walkerlab.analysis.contact.periodic import ideal_gait
 
     scene = _scene("paper")
     m = mujoco.MjModel.from_xml_path(str(export_stage.run(scene, tmp_path, "mjcf")))
@@ -131,8 +131,8 @@ def test_asymmetric_legs_walk_both_steps_in_mujoco(tmp_path):
     """Legs that differ: MuJoCo walks the stride's two steps at the rigid stride's step
     periods (1 %), on a checkerboard laid out with both step lengths (one length for both
     lets footfalls drift 8.6 mm per stride off the 10 cm patches: a fall after 10 strikes)."""
-    from walkerlab.analysis.contact_periodic import ideal_gait
-    from walkerlab.analysis.mujoco_walk import walk
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.export.mujoco_walk import walk
 
     scene = _scene("asymmetric_legs")
     rigid = ideal_gait(scene)

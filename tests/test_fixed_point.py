@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import TIGHT
-from walkerlab.analysis.poincare import find_fixed_point, poincare_map
+from walkerlab.analysis.gait.poincare import find_fixed_point, poincare_map
 from walkerlab.models.hybrid.compass_gait import make_compass_gait
 from walkerlab.published import paper
 
@@ -47,7 +47,7 @@ def test_derived_fixed_point_differs_from_eq11(paper_fixed_point):
 
 
 def test_flat_ground_has_no_passive_gait():
-    from walkerlab.analysis.poincare import FixedPointNotFound
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound
 
     w = make_compass_gait(1.0, 5.0, 10.0, 9.81, 0.5, 0.0, "derived")
     with pytest.raises(FixedPointNotFound):

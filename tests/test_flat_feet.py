@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.codegen.cache import functions
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
@@ -416,7 +416,7 @@ def test_legs_with_different_feet_walk_a_stride(scene):
 def test_the_simulate_table_records_each_step_s_phases(walker, gait):
     """The per-step table (written to simulate.h5 ``steps/phases``) names each phase of a
     step and the guard that ended it, as found at run time."""
-    from walkerlab.analysis.metrics import step_table
+    from walkerlab.analysis.gait.metrics import step_table
 
     traj = simulate_steps(walker, gait.x, 2, FINE)
     phases = step_table(traj)["phases"]

@@ -7,15 +7,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from walkerlab.analysis import push
-from walkerlab.analysis import robustness as R
-from walkerlab.analysis.batch_step import HEEL_STRIKE
-from walkerlab.analysis.python_step import PythonStepMap, make_step_map
+from walkerlab.analysis.gait.batch_step import HEEL_STRIKE
+from walkerlab.analysis.gait.python_step import PythonStepMap, make_step_map
+from walkerlab.analysis.robustness import measures as R
+from walkerlab.analysis.robustness import push
 from walkerlab.config import load_scene
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
-from walkerlab.sweep.mfpt import scene_walker_at
+from walkerlab.studies.mfpt import scene_walker_at
 
 #: the gait of configs/flat_feet.yaml (reports/22a.md; 10 digits on the angles, 8 on rates)
 X_STAR = np.array([-0.3473790834, 0.2559008258, 0.0, -1.3354750, -1.1909763, -11.3443774])

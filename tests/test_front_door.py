@@ -131,7 +131,7 @@ def test_api_reuses_the_cli_artifact_and_fixed_points_stack_the_variants(tmp_pat
 
 
 def test_sweep_package_is_a_plain_package_and_the_api_sweep_lives_in_api(tmp_path):
-    import walkerlab.sweep as package
+    import walkerlab.studies as package
 
     assert not callable(package) and type(package) is type(wl)
     sw = wl.api.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)

@@ -1,6 +1,6 @@
 """The second period-1 gait (the partner of the long/short-period pair) found cheaply and
 exactly: a deflated search at the screening tolerance, then a polish at the scene's
-tolerance (walkerlab.analysis.gaits.find_gaits)."""
+tolerance (walkerlab.analysis.gait.search.find_gaits)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.analysis.gait_starts import deflation_starts, step_length
-from walkerlab.analysis.gaits import find_gaits
+from walkerlab.analysis.gait.search import find_gaits
+from walkerlab.analysis.gait.starts import deflation_starts, step_length
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker

@@ -18,8 +18,8 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from walkerlab.analysis.gait_starts import state_from_legs
-from walkerlab.analysis.gaits import GaitNotFound, find_gaits
+from walkerlab.analysis.gait.search import GaitNotFound, find_gaits
+from walkerlab.analysis.gait.starts import state_from_legs
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.solver import Solver
@@ -27,8 +27,8 @@ from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.io.sweep_store import load_sweep
 from walkerlab.models.registry import build_walker
 from walkerlab.stages import sweep as sweep_stage
-from walkerlab.sweep.params import SweepError, check_axes, parse_param
-from walkerlab.sweep.points import evaluate
+from walkerlab.studies.params import SweepError, check_axes, parse_param
+from walkerlab.studies.points import evaluate
 
 ROOT = Path(__file__).resolve().parents[1]
 

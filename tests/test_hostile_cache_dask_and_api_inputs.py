@@ -262,7 +262,7 @@ def test_m5_api_runs_dir_empty_is_refused_not_the_current_folder(tmp_path, monke
 
 def test_m5_api_sweep_values_must_be_a_sequence(tmp_path):
     import walkerlab.api as wl
-    from walkerlab.sweep.params import SweepError
+    from walkerlab.studies.params import SweepError
 
     scene = wl.load_scene(PAPER)
     for bad in ("10", "1,2", b"10", 10):
@@ -314,7 +314,7 @@ def test_m6_a_spinning_initial_guess_fails_fast_in_one_line(tmp_path):
 
 
 def test_m6_every_shipped_initial_guess_is_within_the_walking_bound():
-    from walkerlab.analysis.scene_gaits import initial_guess
+    from walkerlab.analysis.gait.scene import initial_guess
     from walkerlab.config import load_scene
     from walkerlab.models.registry import build_walker
 

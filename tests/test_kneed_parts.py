@@ -25,7 +25,7 @@ import yaml
 from independent import floating_reference as fref
 from independent.kneed_reference import HSU_CHEN, KneedReference, KneedTorsoReference
 
-from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config import scene_from_dict
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.solver import Solver

@@ -14,7 +14,7 @@ import yaml
 from independent.kneed_reference import KneedReference
 from independent.round_feet_reference import RoundFeetReference
 
-from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.codegen.cache import functions
 from walkerlab.config import BipedParams
 from walkerlab.integrate.rigid import integrate_step, simulate_steps

@@ -332,7 +332,7 @@ def test_work_precision_labels_do_not_overlap():
 
 def _wp_rows(times: dict) -> dict:
     """{method: (rtols, [[repeat times] per rtol], errors)} -> rows_from_cases output."""
-    from walkerlab.analysis.workprecision_results import rows_from_cases
+    from walkerlab.bench.workprecision_results import rows_from_cases
 
     cases, methods, rtols = {}, list(times), [1e-6, 1e-8]
     for m, per in times.items():
@@ -345,7 +345,7 @@ def _wp_rows(times: dict) -> dict:
 def test_work_precision_choice_respects_timing_noise():
     """Overlapping repeat ranges: no setting is named fastest, the tied ones are listed;
     clearly separated: the fastest is named with its spread."""
-    from walkerlab.analysis.workprecision_results import summarize
+    from walkerlab.bench.workprecision_results import summarize
     from walkerlab.report.text import workprecision_choice
 
     noisy = summarize(_wp_rows({"DOP853": [[1.0, 1.4, 2.0], [0.9, 1.3, 1.8]],
@@ -376,7 +376,7 @@ def test_work_precision_choice_respects_timing_noise():
 
 def test_bifurcation_figure_marks_falls_and_keeps_labels_inside():
     from walkerlab.plotting.sweep_figures import bifurcation_figure, plt
-    from walkerlab.sweep.bifurcation import fall_onset
+    from walkerlab.studies.bifurcation import fall_onset
 
     s = np.linspace(1.0, 5.0, 9)
     walks = s < 4.2

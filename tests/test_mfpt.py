@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 import yaml
 
-from walkerlab.analysis import mfpt as M
-from walkerlab.analysis.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.analysis.gait.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.analysis.robustness import mfpt as M
 from walkerlab.config import load_scene
 from walkerlab.integrate.rigid import Solver, integrate_step
 from walkerlab.models.registry import build_walker
-from walkerlab.sweep.mfpt import scene_walker_at
+from walkerlab.studies.mfpt import scene_walker_at
 
 ROOT = Path(__file__).resolve().parents[1]
 TIGHT = Solver("DOP853", 1e-12, 1e-12)
@@ -64,7 +64,7 @@ def test_kneed_walker_two_phases_and_knee_strike(paper_scene):
     map equals integrate_step on two slopes."""
     sc = load_scene(ROOT / "configs" / "kneed.yaml")
     w = build_walker(sc)
-    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.analysis.gait.poincare import find_fixed_point
 
     g = sc.fixedpoint.initial_guess.as_array(w.state_names())
     x = find_fixed_point(w, g, TIGHT, fd_check=False).x
@@ -104,7 +104,7 @@ def test_no_noise_no_fall_and_unstable_gait_falls(paper_scene, paper_map):
     """sigma -> 0: walks on the stable long-period gait (|lambda| 0.586) never fall (MFPT
     infinite); from the unstable short-period gait (|lambda| 2.44) the same noise makes
     walks fall within a few steps (those that do not fall drift to the stable gait)."""
-    from walkerlab.analysis.scene_gaits import solve_scene
+    from walkerlab.analysis.gait.scene import solve_scene
 
     _, search = solve_scene(paper_scene, fd_check=False)
     gaits = {g.label: g.result for g in search.gaits}
@@ -281,7 +281,7 @@ def test_gait_sensitivity_norm_linear_equals_nonlinear(paper_scene, paper_fixed_
     """Hobbelen & Wisse's GSN from the linearised step-to-step map (A from the variational
     equations) equals the nonlinear map's response to a 1e-5 impulse to 1e-3 relative
     (measured ~1e-6: central differences with steps 1e-6, impulse response O(e^2))."""
-    from walkerlab.analysis import robustness as R
+    from walkerlab.analysis.robustness import measures as R
 
     sm = BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-12, 1e-12)
     lin = R.linearise(sm, paper_fixed_point.x, paper_fixed_point.jacobian_variational,
@@ -295,7 +295,7 @@ def test_gait_sensitivity_norm_linear_equals_nonlinear(paper_scene, paper_fixed_
 def test_state_norm_depends_on_coordinates_multipliers_do_not(paper_fixed_point, paper_scene):
     """Jin et al. 2021: the multipliers are the same in absolute and relative angles
     (similar Jacobians, to 1e-12), a state-indicator norm is not (differs by > 0.1 %)."""
-    from walkerlab.analysis import robustness as R
+    from walkerlab.analysis.robustness import measures as R
 
     A = paper_fixed_point.jacobian_variational
     names = build_walker(paper_scene).state_names()
@@ -313,7 +313,7 @@ def test_largest_step_down_and_up_of_the_paper_walker(paper_map, paper_fixed_poi
     """The paper walker survives a single step-down of a few millimetres only (measured 5 mm
     down, 3 mm up on a 1 mm grid): survival is monotone on the grid (every value below the
     answer survives 40 steps, the next one falls), and the answer is between 1 and 20 mm."""
-    from walkerlab.analysis import robustness as R
+    from walkerlab.analysis.robustness import measures as R
 
     for sign in (1.0, -1.0):
         h = R.largest_tolerable(paper_map, paper_fixed_point.x, "floor_height", 0.02, 0.001,

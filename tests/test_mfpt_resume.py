@@ -11,7 +11,7 @@ import pytest
 
 from walkerlab.config import MfptSettings
 from walkerlab.io.mfpt_partial import MfptPartial
-from walkerlab.sweep import mfpt as work
+from walkerlab.studies import mfpt as work
 
 SIGMA = [0.008, 0.006]
 
@@ -44,7 +44,7 @@ def small_chunks(monkeypatch):
 @pytest.fixture
 def few_nodes(monkeypatch):
     """The mesh's candidate nodes from 10 walks of 10 steps per sigma (not 100 of 20)."""
-    from walkerlab.analysis import mfpt as M
+    from walkerlab.analysis.robustness import mfpt as M
 
     visited = M.visited_states
     monkeypatch.setattr(M, "visited_states", lambda sm, x0, sds, walks, steps, seed, **kw:

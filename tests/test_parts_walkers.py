@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from independent.parts_reference import Parts, PartsReference
 
-from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
@@ -281,8 +281,8 @@ def test_export_writes_the_parts(name, element, tmp_path):
 
 
 def test_table3_gives_each_legs_step_where_legs_differ(fixed_points):
-    from walkerlab.analysis.metrics import sample_trajectory, step_table
-    from walkerlab.analysis.tables import gait_metrics
+    from walkerlab.analysis.gait.metrics import sample_trajectory, step_table
+    from walkerlab.analysis.gait.tables import gait_metrics
 
     w, fp = fixed_points["asymmetric_legs"]
     traj = simulate_steps(w, fp.x, 4, SOLVER)
@@ -297,7 +297,7 @@ def test_table3_gives_each_legs_step_where_legs_differ(fixed_points):
 
 def test_basin_iterates_strides_where_legs_differ(fixed_points):
     from walkerlab.config import BasinSettings
-    from walkerlab.sweep.basin import CODE, classify_cell
+    from walkerlab.studies.basin import CODE, classify_cell
 
     w, fp = fixed_points["asymmetric_legs"]
     st = BasinSettings()
@@ -309,7 +309,7 @@ def test_basin_iterates_strides_where_legs_differ(fixed_points):
 
 
 def test_gait_search_without_a_guess_finds_the_stride_fixed_point(fixed_points):
-    from walkerlab.analysis.gaits import find_gaits
+    from walkerlab.analysis.gait.search import find_gaits
 
     w, fp = fixed_points["asymmetric_legs"]
     search = find_gaits(w, SOLVER, None, other_gait=False, fd_check=False)
@@ -322,7 +322,7 @@ def test_contact_view_walks_the_hip_spring_walker_near_its_rigid_gait(fixed_poin
     # the compliant-contact walker generated from the same description (spring in the
     # floating equations): 2 strides from the rigid fixed point, step periods within 2 %
     # of the rigid 0.5222 s (measured: 0.5245, 0.5281, 0.5290, 0.5284 s)
-    from walkerlab.analysis.contact_sim import simulate_from
+    from walkerlab.analysis.contact.sim import simulate_from
     from walkerlab.models.contact.scene import contact_setup
 
     w, fp = fixed_points["hip_spring"]

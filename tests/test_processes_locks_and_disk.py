@@ -122,7 +122,7 @@ def test_i1_stability_map_workers_end_with_their_parent_and_free_the_lock(tmp_pa
 def test_i1_work_precision_lane_worker_ends_with_its_parent():
     script = textwrap.dedent("""
         import time
-        from walkerlab.analysis.workprecision import start_worker
+        from walkerlab.bench.workprecision import start_worker
         ex = start_worker(0)
         ex.submit(time.sleep, 120)
         time.sleep(120)
@@ -330,7 +330,7 @@ def test_i3_writers_refuse_a_symlink_in_place(tmp_path, name):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     with pytest.raises(RunPathError, match="symbolic link"):
         if name.endswith(".partial"):
-            from walkerlab.sweep import basin
+            from walkerlab.studies import basin
 
             monkey_fp = np.zeros(4)
             basin.compute_basin(sc, monkey_fp, "k", link.with_name("basin.h5"), grid=(2, 2),
@@ -428,7 +428,7 @@ def test_i7_disk_full_errors_map_to_one_line(tmp_path):
                                     '{"vec": [1.0], "nfev": 3, "times": [0.1], '
                                     '"cpu_times": [0.1]}'])
 def test_i10_damaged_work_precision_case_is_measured_again(tmp_path, monkeypatch, damage):
-    from walkerlab.analysis import workprecision as W
+    from walkerlab.bench import workprecision as W
 
     good = {"vec": [1.0, 2.0], "nfev": 10, "times": [0.01], "cpu_times": [0.01],
             "clock": "thread_cpu_integration"}

@@ -34,9 +34,9 @@ from walkerlab.io.artifacts import content_hash, write_artifact
 from walkerlab.io.freshness import input_hash
 from walkerlab.io.sweep_store import complete_sweep, load_sweep, partial_path
 from walkerlab.stages import common
-from walkerlab.sweep import basin as basin_mod
-from walkerlab.sweep import runner
-from walkerlab.sweep.outcomes import empty_row
+from walkerlab.studies import basin as basin_mod
+from walkerlab.studies import runner
+from walkerlab.studies.outcomes import empty_row
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
@@ -235,7 +235,7 @@ def test_item4_unreadable_checkpoints_restart_every_chain(tmp_path, fake_points)
 
 def test_item4_finished_sweep_carries_a_content_hash(tmp_path, fake_points):
     out = _sweep(tmp_path, "fin")
-    from walkerlab.sweep.runner import sweep_input_hash
+    from walkerlab.studies.runner import sweep_input_hash
 
     with h5py.File(out, "r") as f:
         key = str(f.attrs["input_hash"])
@@ -367,7 +367,7 @@ def test_item5_sample_count_is_capped_before_memory_runs_out(tmp_path):
 
 
 def test_item5_sample_trajectory_checks_the_count_first():
-    from walkerlab.analysis.metrics import sample_trajectory
+    from walkerlab.analysis.gait.metrics import sample_trajectory
 
     class Seg:
         t_start, t_end = 0.0, 1e4
@@ -418,7 +418,7 @@ def test_progress_basin_counts_are_monotone_and_end_at_the_total(tmp_path, monke
 
 
 def test_progress_bifurcation_counts_are_monotone_and_end_at_the_total(tmp_path):
-    from walkerlab.sweep.bifurcation import bifurcation_diagram
+    from walkerlab.studies.bifurcation import bifurcation_diagram
 
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     rec = Recorder()
@@ -444,8 +444,8 @@ def test_progress_sweep_counts_are_monotone_and_end_at_the_total(tmp_path, fake_
 
 
 def test_progress_module_and_libraries_do_not_load_rich():
-    code = ("import sys, walkerlab.progress, walkerlab.sweep.basin, walkerlab.sweep.runner, "
-            "walkerlab.sweep.bifurcation; print('rich' in sys.modules)")
+    code = ("import sys, walkerlab.progress, walkerlab.studies.basin, walkerlab.studies.runner, "
+            "walkerlab.studies.bifurcation; print('rich' in sys.modules)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                        env=dict(os.environ, PYTHONPATH=str(ROOT)), timeout=120)
     assert r.stdout.strip() == "False", r.stderr
@@ -505,8 +505,8 @@ def test_progress_adjust_counts_contact_runs(monkeypatch):
     """contact-sim --adjust: one count per contact run, up to the most there can be."""
     from types import SimpleNamespace
 
-    from walkerlab.analysis import contact_adjust as adjust
-    from walkerlab.analysis import contact_sim
+    from walkerlab.analysis.contact import adjust
+    from walkerlab.analysis.contact import sim as contact_sim
     from walkerlab.models.contact.scene import contact_setup
 
     calls = []

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 import yaml
 
-from walkerlab.analysis import push
-from walkerlab.analysis import robustness as R
-from walkerlab.analysis.batch_step import BatchStepMap
+from walkerlab.analysis.gait.batch_step import BatchStepMap
+from walkerlab.analysis.robustness import measures as R
+from walkerlab.analysis.robustness import push
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
-from walkerlab.sweep.mfpt import scene_walker_at
+from walkerlab.studies.mfpt import scene_walker_at
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -27,15 +27,15 @@ from typer.testing import CliRunner
 
 from walkerlab.cli import app
 from walkerlab.config import SceneError, load_scene, scene_from_dict
-from walkerlab.execution.workers import process_alive
 from walkerlab.io import freshness
 from walkerlab.io.artifacts import ArtifactError, atomic_write, open_artifact, write_artifact
 from walkerlab.io.runpaths import ArtifactBusy, RunPathError, artifact_lock, stage_artifact
 from walkerlab.io.sweep_store import load_sweep, partial_path
+from walkerlab.safefs import process_alive
 from walkerlab.stages import common
-from walkerlab.sweep import runner
-from walkerlab.sweep.outcomes import empty_row
-from walkerlab.sweep.params import SweepError, parse_param
+from walkerlab.studies import runner
+from walkerlab.studies.outcomes import empty_row
+from walkerlab.studies.params import SweepError, parse_param
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
@@ -449,7 +449,7 @@ def test_d7_sigkill_of_the_main_process_leaves_no_workers(tmp_path):
         import multiprocessing as mp
         from walkerlab.config import load_scene
         from walkerlab.stages import sweep
-        from walkerlab.sweep import runner
+        from walkerlab.studies import runner
         runner._mp_context = lambda: mp.get_context("forkserver")
         sc = load_scene({str(ROOT / 'configs' / 'goswami1996.yaml')!r})
         sweep.run(sc, ["slope.angle_deg=1:4:0.02"], "fixedpoint", workers=2,

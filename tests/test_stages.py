@@ -114,7 +114,7 @@ def test_figures_are_drawn_from_a_hand_built_artifact(tmp_path, ideal_scene):
 
 
 def test_compare_of_a_trajectory_with_itself_is_zero():
-    from walkerlab.analysis.compare import aligned_errors, limit_cycle_distance
+    from walkerlab.analysis.contact.compare import aligned_errors, limit_cycle_distance
 
     tr = _fake_trajectory()
     t, err = aligned_errors(tr, tr)
@@ -124,7 +124,7 @@ def test_compare_of_a_trajectory_with_itself_is_zero():
 
 
 def test_table3_is_recomputed_from_the_artifact(tmp_path, ideal_scene):
-    from walkerlab.analysis.tables import gait_metrics
+    from walkerlab.analysis.gait.tables import gait_metrics
 
     tr = _fake_trajectory()
     m = gait_metrics(tr)

@@ -11,11 +11,11 @@ import pytest
 from walkerlab.config import load_scene
 from walkerlab.io.sweep_store import load_sweep, partial_path
 from walkerlab.stages import sweep as sweep_stage
-from walkerlab.sweep import points as points_mod
-from walkerlab.sweep.outcomes import COLUMNS, OUTCOMES
-from walkerlab.sweep.params import SweepError, apply_point, parse_param
-from walkerlab.sweep.points import evaluate
-from walkerlab.sweep.runner import plan_chunks
+from walkerlab.studies import points as points_mod
+from walkerlab.studies.outcomes import COLUMNS, OUTCOMES
+from walkerlab.studies.params import SweepError, apply_point, parse_param
+from walkerlab.studies.points import evaluate
+from walkerlab.studies.runner import plan_chunks
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "configs" / "goswami1996.yaml"
@@ -88,10 +88,10 @@ def test_continuation_matches_independent_fixed_points(scene, tmp_path):
     """Secant predictor + the previous point's Jacobian (MINPACK hybrj) converge to the
     fixed points and Floquet multipliers of independent searches from the scene's guess,
     to well below the sweep's use (1e-9 rad, 1e-7), with fewer Poincare maps."""
-    from walkerlab.analysis.poincare import find_fixed_point
+    from walkerlab.analysis.gait.poincare import find_fixed_point
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.registry import build_walker
-    from walkerlab.sweep.outcomes import state_column
+    from walkerlab.studies.outcomes import state_column
 
     slopes = np.round(np.arange(3.0, 3.31, 0.05), 10)
     rows = _rows(sweep_stage.run(scene, ["slope.angle_deg=3:3.3:0.05"], "fixedpoint",
@@ -118,7 +118,7 @@ def test_continuation_matches_independent_fixed_points(scene, tmp_path):
 
 
 def test_failed_point_and_bad_jacobian_do_not_poison_the_continuation(base):
-    from walkerlab.sweep.points import Continuation
+    from walkerlab.studies.points import Continuation
 
     cont = None
     for v in (2.9, 3.0):
@@ -305,7 +305,7 @@ def test_dask_cluster_matches_local_runner_and_survives_a_lost_worker(scene, tmp
     import os
     import signal
 
-    from walkerlab.sweep import runner
+    from walkerlab.studies import runner
 
     addr, workers = dask_cluster
     monkeypatch.setattr(runner, "PIECE_POINTS", 1)  # 4 pieces: work left after the kill
@@ -330,7 +330,7 @@ def test_dask_cluster_matches_local_runner_and_survives_a_lost_worker(scene, tmp
 
 # ----------------------------------------------------------------------------- bifurcation
 def test_bifurcation_onset_where_multiplier_crosses_minus_one(scene):
-    from walkerlab.sweep.bifurcation import bifurcation_diagram, min_real_multiplier
+    from walkerlab.studies.bifurcation import bifurcation_diagram, min_real_multiplier
 
     res = bifurcation_diagram(scene, [3.5, 4.0, 4.5, 5.0], workers=1, steady_state=False,
                               xtol_deg=1e-3)

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from walkerlab.config import load_scene
-from walkerlab.sweep.outcomes import OUTCOMES
-from walkerlab.sweep.points import _CONTACT_OUTCOME, evaluate
+from walkerlab.studies.outcomes import OUTCOMES
+from walkerlab.studies.points import _CONTACT_OUTCOME, evaluate
 
 SCENE = Path(__file__).resolve().parents[1] / "configs" / "goswami1996.yaml"
 
@@ -32,7 +32,7 @@ def test_contact_outcomes_map_onto_sweep_outcomes():
     """Every typed outcome of a contact run has a sweep outcome of its own (trip and fall
     apart, time limit apart from solver failure); the two ends of a run that walked
     (heel_strike: strides cap, t_final: end time) are both 'ok'."""
-    from walkerlab.analysis.contact_gait import CONTACT_OUTCOMES
+    from walkerlab.analysis.contact.gait import CONTACT_OUTCOMES
 
     assert set(_CONTACT_OUTCOME) == set(CONTACT_OUTCOMES)
     assert set(_CONTACT_OUTCOME.values()) <= set(OUTCOMES)
@@ -45,7 +45,7 @@ def test_contact_fields_are_swept_by_their_unit_bearing_names():
     quantity the scene writes in mm-kg-s replaces the scene's value (the pair excludes each
     other, as slope.angle_deg / angle_rad)."""
     from walkerlab.models.contact.laws import contact_params_si
-    from walkerlab.sweep.params import SweepError, apply_point, check_axes, parse_param
+    from walkerlab.studies.params import SweepError, apply_point, check_axes, parse_param
 
     scene = load_scene(SCENE)
     with pytest.raises(SweepError, match=r"contact\.stiffness is now "

@@ -75,7 +75,7 @@ def test_every_case_source_exists():
     from pathlib import Path
 
     import walkerlab
-    from walkerlab.analysis.workprecision_plan import CASE_SOURCES, sources_hash
+    from walkerlab.bench.workprecision_plan import CASE_SOURCES, sources_hash
 
     root = Path(walkerlab.__file__).parent
     for model, parts in CASE_SOURCES.items():

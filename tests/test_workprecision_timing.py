@@ -5,8 +5,8 @@ import time
 
 import numpy as np
 
-from walkerlab.analysis.workprecision import time_case
-from walkerlab.analysis.workprecision_results import pareto_front
+from walkerlab.bench.workprecision import time_case
+from walkerlab.bench.workprecision_results import pareto_front
 
 
 def test_time_case_ranks_by_the_integrations_cpu_time_not_wall_time():

@@ -10,7 +10,7 @@ the product):
   (the compliant-contact, MSC ADAMS style, walker)
 - :mod:`walkerlab.integrate` the one solver layer of both models (settings, run ends, events)
 - :mod:`walkerlab.analysis` Poincaré map, fixed points, gait metrics, robustness measures
-- :mod:`walkerlab.sweep`    many-point studies: sweeps, bifurcation, basins, maps, MFPT
+- :mod:`walkerlab.studies`    many-point studies: sweeps, bifurcation, basins, maps, MFPT
 - :mod:`walkerlab.execution` the one executor protocol (inline, process pool, Dask)
 - :mod:`walkerlab.io`       HDF5 artifacts (one schema module per artifact, atomic writes)
 - :mod:`walkerlab.report`   markdown/HTML from loaded artifacts only
@@ -18,11 +18,11 @@ the product):
 - :mod:`walkerlab.stages`   one module per stage: config + upstream artifacts -> one artifact;
   ``stages.pipeline`` chains them
 - :mod:`walkerlab.cli`      thin typer front end (parse, run a stage, print)
-- :mod:`walkerlab.bench`    ``walkerlab bench``: the benchmarks by name
+- :mod:`walkerlab.cli.bench`    ``walkerlab bench``: the benchmarks by name
 - :mod:`walkerlab.api`      the Python front door: ``walkerlab.load_scene``,
   ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``,
   ``compare``, ``basin`` and ``api.sweep`` (each returns an ``xarray.Dataset`` read from the
-  stage's artifact; ``walkerlab.sweep`` is the package of sweeps, basins and maps),
+  stage's artifact; ``walkerlab.studies`` is the package of sweeps, basins and maps),
   ``continuation`` (the loaded continuation artifact)
 
 Importing the package has no side effects and loads no heavy optional package: the API's

@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 __all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link", "temp_prefix",
-           "remove_stale_temps"]
+           "remove_stale_temps", "process_alive"]
 
 #: when this process started (wall clock) [s]; a temporary file older than this whose
 #: writer is gone is stale
@@ -64,7 +64,6 @@ def remove_stale_temps(folder: Path | str, name: str | None = None,
     characters><suffix>`` (:func:`temp_prefix` + ``mkstemp``) whose pid is not alive and
     which are older than this process.  ``name`` None: any name.  Another name, a live
     writer, a newer file, a folder: left alone.  Returns the number removed."""
-    from walkerlab.execution.workers import process_alive  # light; imported when first needed
 
     try:
         entries = list(os.scandir(folder))
@@ -89,6 +88,23 @@ def remove_stale_temps(folder: Path | str, name: str | None = None,
         except OSError:
             continue
     return n
+
+
+def process_alive(pid: int) -> bool:
+    """True while process ``pid`` exists and is not a zombie (Linux: /proc state 'Z')."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return True
 
 
 class NotARegularFile(ValueError):

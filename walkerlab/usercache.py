@@ -114,7 +114,7 @@ def _remove_stale_tmp(base: Path) -> None:
     """Remove ``walkerlab_gen_<pid>_*`` folders of this user whose process is gone."""
     import shutil
 
-    from walkerlab.execution.workers import process_alive
+    from walkerlab.safefs import process_alive
 
     try:
         entries = list(os.scandir(base))

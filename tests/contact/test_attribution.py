@@ -1,4 +1,4 @@
-"""Energy per step by sink (issue 25 item 2, walkerlab.analysis.attribution.energy_by_sink).
+"""Energy per step by sink (issue 25 item 2, walkerlab.analysis.contact.attribution.energy_by_sink).
 
 Independent check: on a periodic gait the walker returns to the same state one step further
 down the slope, so everything its sinks dissipate in a step is the work of gravity over the
@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from tests.contact.test_periodic import SCENE
-from walkerlab.analysis.attribution import energy_by_sink
-from walkerlab.analysis.contact_periodic import find_contact_periodic_gait
-from walkerlab.analysis.scene_gaits import solve_variant
+from walkerlab.analysis.contact.attribution import energy_by_sink
+from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+from walkerlab.analysis.gait.scene import solve_variant
 from walkerlab.config import load_scene
 from walkerlab.models.contact.scene import build
 

@@ -3,8 +3,8 @@
 import numpy as np
 
 from tests.contact.test_numbalsoda import _bench_case
-from walkerlab.analysis.contact_bench import leg_angle_columns
-from walkerlab.analysis.contact_sim import simulate_contact
+from walkerlab.analysis.contact.sim import simulate_contact
+from walkerlab.bench.contact import leg_angle_columns
 from walkerlab.config import SolverSettings
 from walkerlab.integrate import _cyrk
 from walkerlab.integrate.contact import sample_grid as _grid

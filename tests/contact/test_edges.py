@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from tests.contact.conftest import FP, STEP_LENGTH
-from walkerlab.analysis.contact_drop import restitution_curve
-from walkerlab.analysis.contact_gait import CONTACT_OUTCOMES as OUTCOME_KINDS
-from walkerlab.analysis.contact_gait import phase_slip as _phase_slip
-from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
+from walkerlab.analysis.contact.drop import restitution_curve
+from walkerlab.analysis.contact.gait import CONTACT_OUTCOMES as OUTCOME_KINDS
+from walkerlab.analysis.contact.gait import phase_slip as _phase_slip
+from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.models.contact import ContactWalker
@@ -145,20 +145,20 @@ def _imports(path):
 @pytest.mark.parametrize("package,never", [
     # the model holds the model only: no integration, analysis, sweep or stage above it
     ("models/contact", ("walkerlab.stages", "walkerlab.analysis", "walkerlab.integrate",
-                        "walkerlab.sweep", "walkerlab.report")),
+                        "walkerlab.studies", "walkerlab.report")),
     # the rigid view knows no contact model; neither view imports anything above them
     ("models/hybrid", ("walkerlab.models.contact", "walkerlab.stages", "walkerlab.analysis",
-                       "walkerlab.integrate", "walkerlab.sweep", "walkerlab.report")),
+                       "walkerlab.integrate", "walkerlab.studies", "walkerlab.report")),
     # generated code sits under both views, the description under the generator
     ("codegen", ("walkerlab.models", "walkerlab.stages", "walkerlab.analysis",
-                 "walkerlab.integrate", "walkerlab.sweep", "walkerlab.report")),
+                 "walkerlab.integrate", "walkerlab.studies", "walkerlab.report")),
     ("walker", ("walkerlab.codegen", "walkerlab.models", "walkerlab.stages",
-                "walkerlab.analysis", "walkerlab.integrate", "walkerlab.sweep")),
+                "walkerlab.analysis", "walkerlab.integrate", "walkerlab.studies")),
     # settings lie under every model (no config <-> contact cycle)
     ("config", ("walkerlab.models.contact", "walkerlab.models", "walkerlab.analysis",
                 "walkerlab.integrate", "walkerlab.stages")),
     # integration knows no gait analysis and no stage
-    ("integrate", ("walkerlab.analysis", "walkerlab.stages", "walkerlab.sweep")),
+    ("integrate", ("walkerlab.analysis", "walkerlab.stages", "walkerlab.studies")),
 ])
 def test_package_imports_point_down(package, never):
     paths = list((PKG / package).glob("*.py"))

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from tests.contact.test_periodic import SCENE
-from walkerlab.analysis.contact_sim import simulate_from
-from walkerlab.analysis.scene_gaits import solve_variant
+from walkerlab.analysis.contact.sim import simulate_from
+from walkerlab.analysis.gait.scene import solve_variant
 from walkerlab.config import load_scene
 from walkerlab.models.contact.energy import energy_rise_bound, total_energy
 from walkerlab.models.contact.scene import contact_setup

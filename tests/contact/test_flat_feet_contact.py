@@ -13,10 +13,10 @@ from scipy.integrate import solve_ivp
 from tests.independent import flat_feet_floating_reference as ref
 from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, floating_view
 from walkerlab.config import scene_from_dict
-from walkerlab.integrate.contact import StateIndex
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.models.contact.scene import ContactSceneError, build
 from walkerlab.walker.description import walker_data
+from walkerlab.walker.layout import StateIndex
 
 FOOT = {"kind": "flat", "heel_m": 0.05, "toe_m": 0.10,
         "ankle": {"stiffness_n_m_per_rad": 90.0, "rest_angle_rad": 0.03,
@@ -120,7 +120,7 @@ def test_contact_run_energy_balance():
     1.3e-9 J at rtol 1e-10 (4e-7 J at 1e-8: it follows rtol) on 5.1 J given to the ground and
     0.18 J to the dampers; 1e-7 J is ~75x that and far below the damper's own share, which
     the balance must contain."""
-    from walkerlab.analysis.contact_sim import initial_state_from_ideal
+    from walkerlab.analysis.contact.sim import initial_state_from_ideal
 
     c = 0.02  # N m s/rad: I_foot / c = 25 ms, the foot still slaps at ~0.02 s
     # the trailing foot (leg1) at its rest angle reaches below the slope (the rigid view's
@@ -164,8 +164,8 @@ def test_step_modes_match_the_rigid_view():
     heel strike, each switch within 25 ms of the rigid one (measured 3, 17 and 16 ms: the
     compliant heel and toe and the regularised foot delay the switches; a wrong lever arm or
     spring sign moves them by 100 ms or changes the order)."""
-    from walkerlab.analysis.contact_gait import foot_modes, gait_events
-    from walkerlab.analysis.contact_sim import initial_state_from_ideal
+    from walkerlab.analysis.contact.gait import foot_modes, gait_events
+    from walkerlab.analysis.contact.sim import initial_state_from_ideal
     from walkerlab.integrate.contact import ContactLimits, integrate_contact
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import yaml
 
-from walkerlab.analysis.contact_sim import initial_state_from_ideal
+from walkerlab.analysis.contact.sim import initial_state_from_ideal
 from walkerlab.config import scene_from_dict
 from walkerlab.models.contact.scene import ContactSceneError, build
 from walkerlab.models.registry import build_walker

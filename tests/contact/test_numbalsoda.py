@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from walkerlab.analysis.contact_bench import EXAMPLE_IDEAL, leg_angle_columns
-from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
+from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
+from walkerlab.bench.contact import EXAMPLE_IDEAL, leg_angle_columns
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
-from walkerlab.integrate import _lsoda
+from walkerlab.integrate import numbalsoda_backend
 from walkerlab.models.contact import ContactWalker
 
 
@@ -24,7 +24,7 @@ def test_numbalsoda_five_strides_match_odeint():
     """Same run, rtol 1e-10: both integrators are within ~6e-9 rad of the rtol-1e-12
     reference (bench), so they must agree to 1e-7 rad in the leg angles (margin ~10x for
     the machine-dependent step sequence) and to 1e-6 s in every heel-strike time."""
-    if not _lsoda.available():  # not importorskip: `import numbalsoda` compiles for ~7 s
+    if not numbalsoda_backend.available():  # not importorskip: `import numbalsoda` compiles for ~7 s
         pytest.skip("numbalsoda (optional extra) not installed")
     w, x0, tf = _bench_case()
     a = simulate_contact(w, x0, tf,
@@ -44,6 +44,6 @@ def test_numbalsoda_missing_or_unsupported_is_one_clear_error(monkeypatch):
     with pytest.raises(ValueError, match="max_step_s"):
         simulate_contact(w, x0, 0.01,
                          SolverSettings.for_contact(method="numbalsoda", max_step_s=1e-3))
-    monkeypatch.setattr(_lsoda, "lsoda", None)
+    monkeypatch.setattr(numbalsoda_backend, "lsoda", None)
     with pytest.raises(ValueError, match=r"pip install 'walkerlab\[numbalsoda\]'"):
         simulate_contact(w, x0, 0.01, SolverSettings.for_contact(method="numbalsoda"))

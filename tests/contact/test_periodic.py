@@ -6,14 +6,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.analysis.contact_periodic import (
-    SECTION_NAMES,
-    StepMap,
-    find_contact_periodic_gait,
-)
-from walkerlab.analysis.contact_sim import simulate_contact
-from walkerlab.analysis.rigid_limit import convergence, observed_order
-from walkerlab.analysis.scene_gaits import solve_variant
+from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+from walkerlab.analysis.contact.rigid_limit import convergence, observed_order
+from walkerlab.analysis.contact.sim import simulate_contact
+from walkerlab.analysis.contact.step_map import SECTION_NAMES, StepMap
+from walkerlab.analysis.gait.scene import solve_variant
 from walkerlab.config import SolverSettings, load_scene
 from walkerlab.models.contact.model import checkerboard_lanes
 from walkerlab.models.contact.rigid_limit import expected_order

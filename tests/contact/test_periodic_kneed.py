@@ -6,9 +6,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.analysis.contact_periodic import StepMap, find_contact_periodic_gait
-from walkerlab.analysis.contact_sim import simulate_contact
-from walkerlab.analysis.scene_gaits import solve_variant
+from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+from walkerlab.analysis.contact.sim import simulate_contact
+from walkerlab.analysis.contact.step_map import StepMap
+from walkerlab.analysis.gait.scene import solve_variant
 from walkerlab.config import SolverSettings, load_scene
 from walkerlab.models.contact.scene import build
 

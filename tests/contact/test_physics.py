@@ -5,8 +5,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from walkerlab.analysis.contact_bench import leg_angle_columns
-from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
+from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
+from walkerlab.bench.contact import leg_angle_columns
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
 from walkerlab.models.contact import ContactWalker
 from walkerlab.models.contact.laws import contact_params_si, coulomb_friction_coefficient

@@ -8,7 +8,7 @@ the height, not a rerun of the same formula)."""
 import numpy as np
 import pytest
 
-from walkerlab.analysis import contact_rough as C
+from walkerlab.analysis.contact import rough as C
 from walkerlab.config import ContactSettings
 from walkerlab.models.contact.laws import contact_params_si
 from walkerlab.models.contact.model import ContactWalker
@@ -139,7 +139,7 @@ def test_contact_monte_carlo_same_on_dask_as_in_process(paper_start):
     give the walks run in this process, walk by walk (each walk's terrain is its own random
     stream)."""
     distributed = pytest.importorskip("distributed")
-    from walkerlab.sweep.contact_rough import contact_monte_carlo
+    from walkerlab.studies.contact_rough import contact_monte_carlo
 
     here, kinds = contact_monte_carlo(paper_start, 0.01, 3, 2, seed=7, workers=1)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
@@ -158,7 +158,7 @@ def test_robustness_contact_steps_only_when_asked(paper_scene):
     import math
 
     from walkerlab.config import RobustnessSettings
-    from walkerlab.sweep.robustness_study import contact_steps
+    from walkerlab.studies.robustness_study import contact_steps
 
     off = contact_steps(paper_scene, None, RobustnessSettings(), 0.05)
     assert len(off) == 4 and all(math.isnan(v) for v in off.values())

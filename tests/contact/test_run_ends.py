@@ -9,7 +9,7 @@ import yaml
 from typer.testing import CliRunner
 
 from tests.contact.conftest import FP, STEP_LENGTH
-from walkerlab.analysis.contact_sim import (
+from walkerlab.analysis.contact.sim import (
     initial_state_from_ideal,
     named_trajectory,
     simulate_contact,
@@ -81,9 +81,9 @@ def test_wall_time_limit_holds_inside_a_chunk(method):
 
 def test_one_vocabulary():
     """Contact outcomes, rigid terminations and the walked set are names of one tuple."""
-    from walkerlab.analysis.contact_gait import CONTACT_OUTCOMES
+    from walkerlab.analysis.contact.gait import CONTACT_OUTCOMES
     from walkerlab.integrate.ends import RIGID_ENDS
-    from walkerlab.sweep.outcomes import OUTCOMES
+    from walkerlab.studies.outcomes import OUTCOMES
 
     assert set(CONTACT_OUTCOMES) <= set(RUN_END_NAMES)
     assert set(RIGID_ENDS) <= set(RUN_END_NAMES)

@@ -6,11 +6,12 @@ import numpy as np
 import pytest
 
 from tests.contact.conftest import FP, STEP_LENGTH
-from walkerlab.analysis.contact_bench import BAND_FACTORS, run_benchmark, run_scene_benchmark
-from walkerlab.analysis.contact_sim import initial_state_from_ideal, simulate_contact
+from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
+from walkerlab.bench.contact import BAND_FACTORS, run_benchmark, run_scene_benchmark
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
-from walkerlab.integrate.contact import ContactLimits, StateIndex
+from walkerlab.integrate.contact import ContactLimits
 from walkerlab.models.contact import ContactWalker
+from walkerlab.walker.layout import StateIndex
 
 
 def _paper(width, n_steps=12):

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import ROOT
-from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.codegen.compiled import compiled_module
 from walkerlab.config import load_scene
 from walkerlab.integrate.rigid import simulate_steps
@@ -86,7 +86,7 @@ def test_a_fall_is_found_like_cyrk(paper_walker, paper_fixed_point):
     span rounded below twice its first step, CyRK refused the step, and the cell came out
     ``stalled`` instead of ``fell_backward``."""
     from walkerlab.integrate.rigid import integrate_step
-    from walkerlab.sweep.basin import slice_state
+    from walkerlab.studies.basin import slice_state
 
     x_star = np.asarray(paper_fixed_point.x, dtype=float)
     x = slice_state(paper_walker, x_star, ("stance_angle", "stance_rate"),

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import TIGHT
-from walkerlab.analysis.poincare import find_fixed_point
+from walkerlab.analysis.gait.poincare import find_fixed_point
 from walkerlab.config import load_scene
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.models.registry import build_walker

@@ -21,14 +21,14 @@ def report_numbers(scene, arts: dict) -> dict:
     -------
     dict
         With ``simulate`` loaded: ``gait_columns`` (Table 3 columns by label,
-        :func:`walkerlab.analysis.tables.table3`), ``energy_drift`` ([J] and relative,
-        :func:`walkerlab.analysis.gait_checks.energy_drift_in_swing`), ``swing_clearance``
+        :func:`walkerlab.analysis.gait.tables.table3`), ``energy_drift`` ([J] and relative,
+        :func:`walkerlab.analysis.gait.checks.energy_drift_in_swing`), ``swing_clearance``
         (lowest swing-foot height above the slope [m]) and, where the scene's published
         module prints Eq. (11) and Table 3, ``published_step_length_m``
         (:func:`published_step_length`); with ``compare``: ``phase_error``
         (:func:`phase_aligned_angle_error`); with ``contact-sim``: ``mean_stance_slip_mm``
         (:func:`mean_stance_slip`); with ``basin``: ``basin_area``
-        (:class:`walkerlab.analysis.basin_area.BasinArea`).
+        (:class:`walkerlab.analysis.robustness.basin_area.BasinArea`).
 
     Raises
     ------
@@ -40,8 +40,8 @@ def report_numbers(scene, arts: dict) -> dict:
     out: dict = {}
     sim, contact = arts.get("simulate"), arts.get("contact-sim")
     if sim is not None:
-        from walkerlab.analysis.gait_checks import energy_drift_in_swing, swing_foot_clearance
-        from walkerlab.analysis.tables import table3
+        from walkerlab.analysis.gait.checks import energy_drift_in_swing, swing_foot_clearance
+        from walkerlab.analysis.gait.tables import table3
 
         out["energy_drift"] = energy_drift_in_swing(sim.samples)
         out["swing_clearance"] = swing_foot_clearance(sim.samples, scene.slope.phi_rad)
@@ -58,7 +58,7 @@ def report_numbers(scene, arts: dict) -> dict:
     if contact is not None:
         out["mean_stance_slip_mm"] = mean_stance_slip(contact)
     if arts.get("basin") is not None:
-        from walkerlab.analysis.basin_area import basin_area
+        from walkerlab.analysis.robustness.basin_area import basin_area
 
         out["basin_area"] = basin_area(arts["basin"])
     return out

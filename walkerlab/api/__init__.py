@@ -9,7 +9,7 @@ exactly what the artifact holds: named dimensions (``time``, ``state``, ``step``
 ``multiplier``, the swept field ``slope.angle_deg``, ``x``/``y`` of a basin ...), coordinate
 variables, and ``units``/``long_name`` on every variable.
 
-``walkerlab.sweep`` is the package :mod:`walkerlab.sweep` (sweeps, basins, maps); the sweep
+``walkerlab.studies`` is the package :mod:`walkerlab.studies` (sweeps, basins, maps); the sweep
 of the front door is :func:`walkerlab.api.sweep` (``wl.api.sweep(scene, param, values)``).
 
 Modules: :mod:`~walkerlab.api.scenes` (:func:`load_scene`, :func:`with_changes`),

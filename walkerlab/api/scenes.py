@@ -102,7 +102,7 @@ def with_changes(scene: Scene | str | Path | dict, changes: dict[str, Any]) -> S
     ...                           {"slope.angle_deg": 2})          # doctest: +SKIP
     """
     from walkerlab.config import SceneError
-    from walkerlab.sweep.params import ParamAxis, SweepError, apply_point, check_axes
+    from walkerlab.studies.params import ParamAxis, SweepError, apply_point, check_axes
 
     base = as_scene(scene)
     if not isinstance(changes, dict) or not all(isinstance(k, str) for k in changes):

@@ -27,7 +27,7 @@ def _axis_spec(param: str, values: Sequence) -> str:
             return str(v)
         return str(int(v)) if isinstance(v, numbers.Integral) else repr(float(v))
 
-    from walkerlab.sweep.params import SweepError
+    from walkerlab.studies.params import SweepError
 
     if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
         raise SweepError(f"sweep {param}: values={values!r}: give a sequence of values, e.g. "
@@ -66,14 +66,14 @@ def sweep(scene: Scene | str | Path | dict, param: str, values: Sequence, *,
     xarray.Dataset
         One dimension named by the swept field (``slope.angle_deg``, its coordinate with the
         field's unit); per point: ``outcome`` (``ok``, ``no_fixed_point``, ``fell`` ... see
-        :mod:`walkerlab.sweep.outcomes`), ``message``, the stage's columns (fixed point
+        :mod:`walkerlab.studies.outcomes`), ``message``, the stage's columns (fixed point
         ``<role>_angle_rad`` ..., ``step_period_s`` [s], ``max_abs_multiplier``, ``stable``
         ...) and ``wall_time_s``.  A failed point is a row with its outcome, never an
         exception.
 
     Raises
     ------
-    walkerlab.sweep.params.SweepError
+    walkerlab.studies.params.SweepError
         Unknown field, values the field refuses, ``values`` a string or a single number
         instead of a sequence, or an unknown stage.
     SceneError, ImportError
@@ -163,7 +163,7 @@ def continuation(scene: Scene | str | Path | dict, param: str, start: float, sto
     ------
     walkerlab.stages.common.StageError
         No ``fixedpoint`` section or no gait at the scene's own value (one line).
-    walkerlab.sweep.params.SweepError
+    walkerlab.studies.params.SweepError
         ``param`` names no field of the scene.
     """
     from walkerlab.io.schemas.continuation import load_continuation

@@ -57,7 +57,7 @@ def bifurcation(scene: Path | None = SceneArg,
     """Bifurcation diagram over the slope (or any numeric scene field, --param): fixed
     points, multipliers, period-doubling onset."""
     from walkerlab.stages import bifurcation as stage
-    from walkerlab.sweep.params import (
+    from walkerlab.studies.params import (
         SweepError,
         check_axes,
         parse_param,
@@ -97,7 +97,7 @@ def bifurcation(scene: Path | None = SceneArg,
 
 def _range_spec(text: str, opt: str) -> tuple[str, float, float]:
     """``FIELD=START:STOP`` -> (field, start, stop); one-line error otherwise."""
-    from walkerlab.sweep.params import SweepError
+    from walkerlab.studies.params import SweepError
 
     path, _, rhs = text.partition("=")
     parts = rhs.split(":")

@@ -70,7 +70,7 @@ def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | b
               "configs/paper.yaml", show_default=False),
           out: Path = typer.Option(Path("runs/bench"), "--out", help="output folder")) -> None:
     """Benchmarks (wall time, RHS evaluations); results printed and stored as JSON."""
-    from walkerlab.bench import run_bench
+    from walkerlab.cli.bench import run_bench
 
     for line in run_bench(what, out, scenes=scenes or None):
         typer.echo(line)

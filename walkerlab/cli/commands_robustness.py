@@ -118,7 +118,7 @@ def stability_map(scene: Path | None = SceneArg,
     |Floquet multiplier|, or why not (cached stage)."""
     from walkerlab.config.options import map_not_applicable
     from walkerlab.stages import stability_map as stage
-    from walkerlab.sweep.stability import MAP_KINDS
+    from walkerlab.studies.stability import MAP_KINDS
 
     sc = load(scene)
     kinds = list(MAP_KINDS) if kind == "all" else [kind]

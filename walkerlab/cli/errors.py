@@ -70,7 +70,7 @@ def guard(fn):
     @functools.wraps(fn)
     def wrapper(*a, **k):
         from walkerlab import progress
-        from walkerlab.analysis.poincare import FixedPointNotFound
+        from walkerlab.analysis.gait.poincare import FixedPointNotFound
         from walkerlab.config import SceneError
         from walkerlab.io.artifacts import ArtifactError, is_disk_full
         from walkerlab.io.runpaths import ArtifactBusy

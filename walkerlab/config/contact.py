@@ -390,7 +390,7 @@ class ContactSimSettings(BaseModel):
     sample_rate_hz: float = Field(1000.0, gt=0, le=1e5, description="Output sample rate [Hz].")
     periodic_gait: bool = Field(
         False, description="Also find the contact walker's own periodic gait and its Floquet "
-        "multipliers (walkerlab.analysis.contact_periodic; about 5-10 s)."
+        "multipliers (walkerlab.analysis.contact.periodic; about 5-10 s)."
     )
     initial_rate_scale: Annotated[tuple[float, float], BeforeValidator(_list_to_tuple)] = Field(
         (1.0, 1.0), description="Multipliers [-] on dtheta1, dtheta2 of the initial state."

@@ -133,7 +133,7 @@ class FixedPointSettings(Strict):
         None, description="starting point of the root finder, by state name or "
         "{from: <continuation artifact>, at: <parameter value>}; null: found automatically "
         "(scale-free seeds from the slope and the walker's size, ranked on the heel-strike "
-        "section; walkerlab.analysis.gaits)")
+        "section; walkerlab.analysis.gait.search)")
     from_: str | None = Field(
         None, alias="from", description="a scene YAML whose gait is known: its gait is "
         "continued along the straight line between the two scenes' numeric walker and slope "

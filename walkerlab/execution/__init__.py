@@ -10,7 +10,7 @@ Dask) and the worker processes behind it.
 - :mod:`walkerlab.execution.background` a timed study in a thread beside untimed work
   (``walkerlab report``)
 - :mod:`walkerlab.execution.workers`   worker processes that end with their parent
-  (forkserver/spawn, parent watch), :func:`process_alive`
+  (forkserver/spawn, parent watch)
 
 Importing this package loads nothing heavy.
 """

@@ -33,7 +33,7 @@ class BackgroundStudy:
         The study; ``lanes`` is None when it runs in this process.
     start_worker : callable(core) -> executor
         Starts a measuring worker process pinned to ``core``
-        (:func:`walkerlab.analysis.workprecision.start_worker`).
+        (:func:`walkerlab.bench.workprecision.start_worker`).
     first_run : bool
         Start the worker processes now (nothing is cached yet).
     pending : tuple of str

@@ -1,6 +1,6 @@
 """Pinned lanes: one single-threaded worker process per core, for timing work side by side.
 
-A timed job (a work-precision case, :mod:`walkerlab.analysis.workprecision`) must not share
+A timed job (a work-precision case, :mod:`walkerlab.bench.workprecision`) must not share
 its core with another timed job or with the caller's own work.  :func:`run_on_lanes` runs a
 list of jobs on :class:`Lanes`: one thread per core, each feeding one worker process pinned
 to that core (``os.sched_setaffinity``) and started with single-threaded BLAS/OpenMP, one

@@ -12,8 +12,8 @@ pinned lanes: :mod:`walkerlab.execution.lanes`) is built by :func:`process_pool`
   worker (``os._exit``) when it does not - after SIGKILL or SIGTERM of the parent as well as
   after a crash.  The forkserver and multiprocessing's resource tracker end on their own once
   the parent and the workers are gone (their pipes close);
-- :func:`process_alive` (pid exists and is not a zombie) is also what the artifact lock uses
-  to take over a lock whose recorded holder is dead (:func:`walkerlab.io.runpaths.artifact_lock`).
+- the parent watch asks :func:`walkerlab.safefs.process_alive`, the PID check the artifact
+  locks and stale temporary files use (:func:`walkerlab.io.runpaths.artifact_lock`).
 
 Importing this module loads nothing heavy.
 """
@@ -26,27 +26,12 @@ import threading
 import time
 from collections.abc import Callable
 
-__all__ = ["process_alive", "watch_parent", "mp_context", "process_pool", "WATCH_PERIOD_S"]
+from walkerlab.safefs import process_alive
+
+__all__ = ["watch_parent", "mp_context", "process_pool", "WATCH_PERIOD_S"]
 
 #: how often a worker checks that its parent is alive [s]
 WATCH_PERIOD_S = 0.5
-
-
-def process_alive(pid: int) -> bool:
-    """True while process ``pid`` exists and is not a zombie (Linux: /proc state 'Z')."""
-    if pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return True
 
 
 def _watch(pid: int, period_s: float) -> None:

@@ -2,15 +2,15 @@
 
 Where this sits: :mod:`walkerlab.models.contact` is the model (laws, geometry, terrain, the floating
 walker); this module advances a model's state and finds where its run-ending events are;
-:mod:`walkerlab.analysis.contact_gait` says what the samples mean (touchdowns, heel strikes,
-steps, the run's outcome) and :mod:`walkerlab.analysis.contact_sim` puts the two together
+:mod:`walkerlab.analysis.contact.gait` says what the samples mean (touchdowns, heel strikes,
+steps, the run's outcome) and :mod:`walkerlab.analysis.contact.sim` puts the two together
 (``simulate_contact``, a scene's contact run).  This module knows no gait: the strides cap
 reaches it as a ``stop`` predicate over the samples.
 
 Backends (:class:`~walkerlab.integrate.solver.Solver` ``method``): ``"odeint"``
 (scipy.integrate.odeint = LSODA with little overhead), ``"cyrk_bdf"`` (CyRK's BDF over a
 compiled RHS, no Python per evaluation; :mod:`walkerlab.integrate._cyrk`), ``"numbalsoda"``
-(numbalsoda's LSODA from compiled code; optional extra, :mod:`walkerlab.integrate._lsoda`)
+(numbalsoda's LSODA from compiled code; optional extra, :mod:`walkerlab.integrate.numbalsoda_backend`)
 or a ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``, ...), these given the
 model's analytic Jacobian.  All run in chunks so a fall, a trip, a flight, the wall-time
 limit or the strides cap stops the run.
@@ -52,13 +52,14 @@ from walkerlab.models.contact.energy import (
     side_entry,
     total_energy,
 )
+from walkerlab.walker.layout import StateIndex
 
 from . import _cyrk
 from .ends import RunEnd
 from .solver import Solver
 
 __all__ = ["CHUNK_WALL_S", "CYRK_STEPS_PER_CALL", "METHODS", "ContactIntegration",
-           "ContactLimits", "StateIndex", "first_event", "hermite_root", "hermite_state",
+           "ContactLimits", "first_event", "hermite_root", "hermite_state",
            "integrate_contact", "sample_grid"]
 
 #: Solver methods this module runs.
@@ -71,43 +72,6 @@ CHUNK_WALL_S = 0.5
 #: Most CyRK BDF steps in one chunk call (a 1 s chunk of the paper's walk takes a few
 #: thousand): past it the chunk continues in odeint, whose RHS checks the wall-time limit.
 CYRK_STEPS_PER_CALL = 100_000
-
-
-class StateIndex:
-    """Columns of a walker's state by name, never by number: a view of the walker's
-    :class:`~walkerlab.walker.layout.StateLayout` (``walker.layout()``).
-
-    ``idx["hip_x"]`` is a column; :meth:`rate_of` the column of a coordinate's rate;
-    :attr:`coordinates` the columns of the coordinates q, :attr:`rates` of their rates.
-    """
-
-    def __init__(self, walker):
-        self.layout = walker.layout()
-        self.names = self.layout.names
-        self._col = {n: i for i, n in enumerate(self.names)}
-        self.n = self.layout.size
-
-    def __getitem__(self, name: str) -> int:
-        return self._col[name]
-
-    @property
-    def coordinates(self) -> slice:
-        """Columns of the generalised coordinates q."""
-        return self.layout.q_slice
-
-    @property
-    def rates(self) -> slice:
-        """Columns of the rates."""
-        return self.layout.qd_slice
-
-    def rate_of(self, name: str) -> int:
-        """Column of the rate of coordinate state ``name``."""
-        return self._col[self.layout.rate_of(name)]
-
-    def hip_velocity(self, X) -> np.ndarray:
-        """Hip velocity (n, 2) [m/s] of states X (n, N): the rates of ``hip_x``, ``hip_y``."""
-        X = np.atleast_2d(X)
-        return X[:, [self.rate_of("hip_x"), self.rate_of("hip_y")]]
 
 
 @dataclass(frozen=True)
@@ -392,9 +356,9 @@ class _Backend:
         if self.method == "odeint":
             return self.odeint_chunk(xa, tg)
         if self.method == "numbalsoda":  # whole chunk in compiled code (FD Jacobian)
-            from . import _lsoda
+            from . import numbalsoda_backend as lsoda
 
-            X, ok, nf = _lsoda.solve_chunk(xa, tg, self.data, s.rtol, s.atol,
+            X, ok, nf = lsoda.solve_chunk(xa, tg, self.data, s.rtol, s.atol,
                                             kernels=self.walker.kernels)
             nk = len(tg) if ok else 1  # rows after a failure are undefined: drop the chunk
             m = "Integration successful." if ok else "numbalsoda LSODA failed in this chunk"
@@ -527,7 +491,7 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
     limits : ContactLimits
     stop : callable, optional
         ``stop(t (n,), X (n, N)) -> bool``, asked after each chunk; True ends the run with
-        termination ``heel_strike`` (the strides cap of :mod:`walkerlab.analysis.contact_sim`).
+        termination ``heel_strike`` (the strides cap of :mod:`walkerlab.analysis.contact.sim`).
 
     Returns
     -------
@@ -537,7 +501,7 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
     ------
     ValueError
         Unknown method; ``max_step_s`` with numbalsoda; numbalsoda not installed
-        (:class:`walkerlab.integrate._lsoda.MissingNumbalsoda`, also an ImportError).
+        (:class:`walkerlab.integrate.numbalsoda_backend.MissingNumbalsoda`, also an ImportError).
     """
     if solver.method not in METHODS:
         raise ValueError(f"contact_solver.method must be one of {', '.join(METHODS)}, "

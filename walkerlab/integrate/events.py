@@ -1,8 +1,8 @@
 """Integrate a plain ODE until an event, or on a time grid, with the one :class:`Solver`.
 
 The analyses that integrate something other than a rigid step or a contact run (the contact
-model's step map between two mid-stances, :mod:`walkerlab.analysis.contact_periodic`; the
-drop test of a contact law, :mod:`walkerlab.analysis.contact_drop`) call these two functions
+model's step map between two mid-stances, :mod:`walkerlab.analysis.contact.periodic`; the
+drop test of a contact law, :mod:`walkerlab.analysis.contact.drop`) call these two functions
 instead of scipy's integrators, so every integration goes through this package with a
 :class:`~walkerlab.integrate.solver.Solver` and says how it ended with a
 :class:`~walkerlab.integrate.ends.RunEnd`:

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.models.hybrid.base import HybridWalker, Phase, complex_step_jacobian
+from walkerlab.models.hybrid.base import HybridWalker, Phase
+from walkerlab.numerics import complex_step_jacobian, fd_jacobian
 
 from .solver import Solver
 
@@ -45,13 +46,7 @@ def numeric_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
         return complex_step_jacobian(fun, x, h)
     except (TypeError, ValueError):
         x = np.asarray(x, dtype=float)
-        cols = []
-        for k in range(x.size):
-            e = np.zeros_like(x)
-            e[k] = 1e-6 * (1.0 + abs(x[k]))
-            cols.append((np.asarray(fun(x + e), float) - np.asarray(fun(x - e), float))
-                        / (2 * e[k]))
-        return np.stack(cols, axis=1)
+        return fd_jacobian(fun, x, 1e-6 * (1.0 + np.abs(x)))
 
 
 @dataclass

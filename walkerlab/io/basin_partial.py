@@ -1,6 +1,6 @@
 """The in-progress file of a basin map (``basin.h5.partial``): the grid's cell arrays, the
 input hash they belong to and one SHA-256 per finished grid row, rewritten after every chunk
-so an interrupted ``basin`` run resumes (:func:`walkerlab.sweep.basin.compute_basin`).
+so an interrupted ``basin`` run resumes (:func:`walkerlab.studies.basin.compute_basin`).
 
 Layout: root attribute ``input_hash``; datasets ``outcome``, ``steps``, ``period``
 (shape (ny, nx)) and ``row_hash`` (ny strings, ``""``: row not finished or not checked).

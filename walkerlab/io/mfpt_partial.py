@@ -1,5 +1,5 @@
 """The in-progress file of an MFPT study (``mfpt.h5.partial``): finished pieces of work kept
-so an interrupted ``mfpt`` run resumes where it stopped (:mod:`walkerlab.sweep.mfpt`).
+so an interrupted ``mfpt`` run resumes where it stopped (:mod:`walkerlab.studies.mfpt`).
 
 Layout: root attribute ``input_hash``; one group per finished piece, named by the study
 (``montecarlo/sigma=0.004/chunk=3``: the heel strikes and falls of one chunk of walks;

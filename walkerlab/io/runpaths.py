@@ -316,7 +316,7 @@ def _take_over(fd: int, lock: Path) -> bool:
     """Remove a lock file whose recorded holder process is dead, though its lock is held
     (by a descendant that inherited it).  True when the name was removed (the caller then
     starts over on a new file)."""
-    from walkerlab.execution.workers import process_alive
+    from walkerlab.safefs import process_alive
 
     with _folder_locked(lock.parent):
         pid = _holder(fd, local_only=True)

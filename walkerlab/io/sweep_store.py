@@ -1,6 +1,6 @@
 """Incremental HDF5 store of a sweep: rows appended as points finish, finalized at the end.
 
-The sweep package (:mod:`walkerlab.sweep.runner`) decides what a row holds
+The sweep package (:mod:`walkerlab.studies.runner`) decides what a row holds
 (:class:`SweepColumns`) and what a continuation is; this module only reads and writes the
 file (no ``h5py`` outside :mod:`walkerlab.io`).
 
@@ -15,7 +15,7 @@ Layout (``stage`` attribute ``"sweep"``; every dataset has ``unit`` and ``descri
     /points/index          (n,) int64 flat grid index, C order (first axis slowest):
                            grid position = numpy.unravel_index(index, grid_shape)
     /points/param/<path>   (n,) value of each swept field at the row
-    /points/outcome        (n,) str, see walkerlab.sweep.outcomes
+    /points/outcome        (n,) str, see walkerlab.studies.outcomes
     /points/message, fall_leg, guess_source  (n,) str
     /points/wall_time_s    (n,) float64 [s], wall time of the point (worker side)
     /points/<column>       (n,) float64, the stage's result columns (NaN = not applicable)
@@ -66,7 +66,7 @@ class SweepFileError(ValueError):
 @dataclass(frozen=True)
 class SweepColumns:
     """The row layout of a sweep file, as the sweep package defines it
-    (:mod:`walkerlab.sweep.outcomes`).
+    (:mod:`walkerlab.studies.outcomes`).
 
     Attributes
     ----------
@@ -101,7 +101,7 @@ def _unit(path: str) -> str:
 class SweepStore:
     """An open in-progress sweep file (use :meth:`create` or :meth:`resume`).
 
-    ``axes`` are the sweep's axes (:class:`walkerlab.sweep.params.ParamAxis`: ``path``,
+    ``axes`` are the sweep's axes (:class:`walkerlab.studies.params.ParamAxis`: ``path``,
     ``values``, ``spec``, ``numeric``, ``len``); ``columns`` its row layout."""
 
     def __init__(self, final: Path, f: h5py.File, axes: list, columns: SweepColumns):
@@ -237,7 +237,7 @@ class SweepStore:
 
     # ------------------------------------------------------------------ write
     def append(self, rows: list[dict], values_of: dict[int, tuple], flush: bool = True) -> None:
-        """Append rows (dicts from :func:`walkerlab.sweep.points.evaluate`; ``values_of``:
+        """Append rows (dicts from :func:`walkerlab.studies.points.evaluate`; ``values_of``:
         grid index -> the point's axis values) and flush."""
         if not rows:
             return
@@ -315,7 +315,7 @@ class SweepStore:
         if "summary" in f:
             del f["summary"]
         netcdf.coordinate(f.create_group("summary"), "outcome_kind", outcomes, "-",
-                          "outcome of a point (walkerlab.sweep.outcomes)")
+                          "outcome of a point (walkerlab.studies.outcomes)")
         ds = f.create_dataset("summary/outcome_counts", data=counts)
         ds.attrs.update(outcomes=outcomes, unit="-", description="points per outcome")
         netcdf.attach(ds, ("outcome_kind",))

@@ -23,8 +23,8 @@ from matplotlib.colors import BoundaryNorm, ListedColormap
 from walkerlab.config.contact import CONTACT_QUANTITIES
 from walkerlab.io.schemas.bifurcation import SLOPE_PATH
 from walkerlab.plotting.figures import save  # noqa: F401  (re-exported for callers)
-from walkerlab.sweep.bifurcation import fall_onset, onset_value, parameter_values
-from walkerlab.sweep.outcomes import OUTCOMES
+from walkerlab.studies.bifurcation import fall_onset, onset_value, parameter_values
+from walkerlab.studies.outcomes import OUTCOMES
 from walkerlab.units import Units
 
 OUTCOME_COLORS = {

@@ -39,16 +39,16 @@ class ReportInputs:
         ``bifurcation`` and ``bifurcation_<field>``, ``stability_map_<kind>``; an absent
         stage gives no section.
     gait_columns : dict[str, dict[str, float]]
-        Table 3 columns (:func:`walkerlab.analysis.tables.table3`) by label ("ours, ideal",
+        Table 3 columns (:func:`walkerlab.analysis.gait.tables.table3`) by label ("ours, ideal",
         "ours, contact").
     energy_drift : (float, float)
         Largest energy change within a phase of the rigid run [J] and relative [-]
-        (:func:`walkerlab.analysis.gait_checks.energy_drift_in_swing`).
+        (:func:`walkerlab.analysis.gait.checks.energy_drift_in_swing`).
     swing_clearance : float
         Lowest swing-foot height above the slope [m] (NaN: none).
     basin_area : BasinArea or None
         The basin's area in the basin map's slice
-        (:func:`walkerlab.analysis.basin_area.basin_area`; None: no basin).
+        (:func:`walkerlab.analysis.robustness.basin_area.basin_area`; None: no basin).
     published_step_length_m : float
         Step length the published fixed point (Eq. (11)) implies [m] (NaN: none printed).
     phase_error : (float, float, int) or None
@@ -58,8 +58,8 @@ class ReportInputs:
         Mean stance-foot slip per step of the contact run [mm] (NaN: none).
     bifurcation_onsets : dict[str, (float, float)]
         Period-doubling onset and fall onset (NaN: none on the grid) in the grid's unit by
-        bifurcation artifact key (:func:`walkerlab.sweep.bifurcation.onset_value`,
-        :func:`walkerlab.sweep.bifurcation.fall_onset`).
+        bifurcation artifact key (:func:`walkerlab.studies.bifurcation.onset_value`,
+        :func:`walkerlab.studies.bifurcation.fall_onset`).
 
     The stage computes them before the report is written
     (:func:`walkerlab.stages.report.load_inputs`), mostly through

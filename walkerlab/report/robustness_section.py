@@ -1,6 +1,6 @@
 """The report's robustness section, from a loaded ``robustness.h5``
 (:class:`walkerlab.io.schemas.robustness.RobustnessData`) and, when the scene ran it, a loaded
-``basin.h5`` (the basin's area, :mod:`walkerlab.analysis.basin_area`) only."""
+``basin.h5`` (the basin's area, :mod:`walkerlab.analysis.robustness.basin_area`) only."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def _contact_steps(r) -> list[str]:
 
 
 def _basin_line(a) -> list[str]:
-    """The basin's area ``a`` (:class:`walkerlab.analysis.basin_area.BasinArea`) in the basin
+    """The basin's area ``a`` (:class:`walkerlab.analysis.robustness.basin_area.BasinArea`) in the basin
     map's slice (when the scene ran ``basin``)."""
     if a is None:
         return []

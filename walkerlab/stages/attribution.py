@@ -3,7 +3,7 @@
 The contact-vs-rigid gap of the contact model's periodic gait split by cause (friction
 creep, compliance, residual), the energy per step by sink and the initial-rate adjustment's
 effect with whether the adjusted start lies in the rigid walker's basin
-(:mod:`walkerlab.analysis.attribution`).  Reads ``fixedpoint.h5``; any walker with a
+(:mod:`walkerlab.analysis.contact.attribution`).  Reads ``fixedpoint.h5``; any walker with a
 ``contact`` section.  Cost: about 17 s CPU on the paper scene (seven periodic-gait searches
 and three short runs), so ``walkerlab report`` runs it only with ``--full``.
 Layout: :mod:`walkerlab.io.schemas.attribution`.
@@ -39,7 +39,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
 
     def compute():
-        from walkerlab.analysis.attribution import adjustment_effect, attribute
+        from walkerlab.analysis.contact.attribution import adjustment_effect, attribute
         from walkerlab.models.contact.scene import build
 
         fp = load_fixedpoint(up[0])

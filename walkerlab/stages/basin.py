@@ -1,7 +1,7 @@
 """Stage ``basin``: basin of attraction of the period-1 gait -> ``basin.h5`` (+ figure).
 
 Reads the ``basin`` section (defaults when absent) and ``fixedpoint.h5``; the cells are
-classified by :func:`walkerlab.sweep.basin.basin_run`; layout :mod:`walkerlab.io.schemas.basin`.
+classified by :func:`walkerlab.studies.basin.basin_run`; layout :mod:`walkerlab.io.schemas.basin`.
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """Compute (or reuse) the basin map on ``grid`` (nx, ny) cells (default ``basin.grid``)
     with ``workers`` local processes or a Dask ``scheduler``; ``resume`` continues an
     interrupted run.  Raises StageError: no ``fixedpoint`` section, bad basin settings."""
-    from walkerlab.sweep.basin import BasinError, basin_run
+    from walkerlab.studies.basin import BasinError, basin_run
 
     grid, workers = check(scene, grid, workers)
     up, name = stage_artifact(scene, runs_root, "fixedpoint"), stem(scene, grid)

@@ -2,7 +2,7 @@
 -> ``bifurcation.h5``, or over any numeric scene field -> ``bifurcation_<field>.h5``
 (:func:`walkerlab.io.runpaths.bifurcation_stem`; rerun only when the scene's walker, slope,
 solver or fixed-point settings, the grid, the options or the code change).  The diagram is
-:func:`walkerlab.sweep.bifurcation.bifurcation_diagram`; its figure (``<artifact
+:func:`walkerlab.studies.bifurcation.bifurcation_diagram`; its figure (``<artifact
 stem>.png/.svg``) is drawn from the artifact into the report's figures folder.
 """
 
@@ -34,13 +34,13 @@ def run(scene: Scene, slopes_deg, runs_root: Path | str = "runs", n_transient: i
     ------
     StageError
         The scene has no ``fixedpoint`` section.
-    walkerlab.sweep.params.SweepError
+    walkerlab.studies.params.SweepError
         ``param`` names no field of the scene or a grid value does not validate (one line,
-        before anything runs; :func:`walkerlab.sweep.bifurcation.grid_key`).
+        before anything runs; :func:`walkerlab.studies.bifurcation.grid_key`).
     """
     from walkerlab.io.schemas.bifurcation import bifurcation_writer, load_bifurcation
     from walkerlab.plotting.artifact_figures import save_bifurcation_figure
-    from walkerlab.sweep.bifurcation import bifurcation_diagram, diagram_summary, grid_key
+    from walkerlab.studies.bifurcation import bifurcation_diagram, diagram_summary, grid_key
 
     scene = with_defaults(scene, "fixedpoint", "bifurcation")
     n_transient, n_keep, workers = bifurcation_options(n_transient, n_keep, workers)

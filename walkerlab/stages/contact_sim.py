@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from walkerlab.analysis.contact_record import contact_sim_run
+from walkerlab.analysis.contact.record import contact_sim_run
 from walkerlab.config import Scene
 from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.runpaths import stage_artifact
@@ -30,7 +30,7 @@ SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_sol
 
 
 def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool):
-    from walkerlab.analysis.contact_periodic import PeriodicGaitError
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError
 
     try:
         run = contact_sim_run(setup, load_fixedpoint(fixedpoint), adjust, periodic)

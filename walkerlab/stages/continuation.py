@@ -1,7 +1,7 @@
 """Stage ``continuation``: the scene's gait continued over a scene field, special points,
 period-doubling switches, optional two-parameter curves -> ``continuation_<field>.h5``
 (:mod:`walkerlab.io.schemas.continuation`) and its figure(s) in the report's figures folder.
-The computation is :func:`walkerlab.sweep.continuation.run_continuation`."""
+The computation is :func:`walkerlab.studies.continuation.run_continuation`."""
 
 from __future__ import annotations
 
@@ -24,10 +24,10 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     ------
     StageError
         No ``fixedpoint`` section, no gait at the scene's own value, or a bad ``switch``.
-    walkerlab.sweep.params.SweepError
+    walkerlab.studies.params.SweepError
         A field that does not exist (one line).
     """
-    from walkerlab.analysis.continuation_map import MapFailed
+    from walkerlab.analysis.continuation.gait_map import MapFailed
     from walkerlab.io.runpaths import bifurcation_artifacts, check_name
     from walkerlab.io.schemas.bifurcation import load_bifurcation
     from walkerlab.io.schemas.continuation import continuation_writer, load_continuation
@@ -36,8 +36,8 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
         two_parameter_figure,
     )
     from walkerlab.plotting.figures import save
-    from walkerlab.sweep.continuation import run_continuation, scene_family
-    from walkerlab.sweep.params import SweepError
+    from walkerlab.studies.continuation import run_continuation, scene_family
+    from walkerlab.studies.params import SweepError
 
     require(scene, "fixedpoint", "continuation")
     if switch not in (0, 1, 2):

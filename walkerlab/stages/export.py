@@ -3,7 +3,7 @@
 Not an HDF5 artifact: an exchange file for multibody libraries (Drake, Pinocchio read URDF;
 MuJoCo reads MJCF), written from the scene's ``walker`` and ``slope`` sections only (no
 upstream artifact), atomically (temporary name, then rename).  Formats and conventions:
-:mod:`walkerlab.io.export`.
+:mod:`walkerlab.export.multibody`.
 """
 
 from __future__ import annotations
@@ -11,10 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import walkerlab
-from walkerlab.analysis.export_scene import check_exportable, mjcf_scene
 from walkerlab.config import Scene
-from walkerlab.io import runpaths
-from walkerlab.io.export import (
+from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
     comments_in_scene_units,
@@ -22,6 +20,8 @@ from walkerlab.io.export import (
     mjcf_text,
     urdf_text,
 )
+from walkerlab.export.scene import check_exportable, mjcf_scene
+from walkerlab.io import runpaths
 from walkerlab.units import for_scene
 from walkerlab.walker.description import walker_data
 from walkerlab.walker.multibody import multibody

@@ -1,6 +1,6 @@
 """Stage ``fixedpoint``: period-1 gait of the rigid hybrid walker -> ``fixedpoint.h5``.
 
-The search is :func:`walkerlab.analysis.scene_gaits.fixed_point_run`; the layout
+The search is :func:`walkerlab.analysis.gait.scene.fixed_point_run`; the layout
 :mod:`walkerlab.io.schemas.fixedpoint`.
 """
 
@@ -9,8 +9,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from walkerlab.analysis.gaits import GaitNotFound
-from walkerlab.analysis.scene_gaits import fixed_point_run
+from walkerlab.analysis.gait.scene import fixed_point_run
+from walkerlab.analysis.gait.search import GaitNotFound
 from walkerlab.config import Scene, SceneError
 from walkerlab.io.schemas.fixedpoint import write_fixedpoint
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
@@ -38,7 +38,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     require(scene, "fixedpoint", "fixedpoint")
     src = None
     if known is not None or getattr(scene.fixedpoint, "from_", None) is not None:
-        from walkerlab.sweep.continuation import known_scene  # only for a homotopy start
+        from walkerlab.studies.continuation import known_scene  # only for a homotopy start
 
         try:
             src = known_scene(scene, known)
@@ -51,7 +51,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         guess = note = None
         try:
             if src is not None:  # the known gait carried here
-                from walkerlab.sweep.continuation import homotopy_start
+                from walkerlab.studies.continuation import homotopy_start
 
                 guess, note = homotopy_start(scene, src)
             run, summary = fixed_point_run(scene, compare_variants, guess, note)

@@ -2,7 +2,7 @@
 
 Reads the ``mfpt`` section (defaults when absent), ``terrain.per_step`` and the gait from
 ``fixedpoint.h5``; the study, resumable from ``mfpt.h5.partial``, is
-:func:`walkerlab.sweep.mfpt.resumable_mfpt_study`; the layout :mod:`walkerlab.io.schemas.mfpt`.
+:func:`walkerlab.studies.mfpt.resumable_mfpt_study`; the layout :mod:`walkerlab.io.schemas.mfpt`.
 """
 
 from __future__ import annotations
@@ -47,8 +47,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """Compute (or reuse) the MFPT at each sigma [rad] (``--sigma-rad``; ``method``: mesh,
     montecarlo or both) on ``workers`` local processes or a Dask ``scheduler``, and draw it.
     Raises StageError (one line): no ``fixedpoint`` section, or a walker the study cannot
-    carry (:class:`walkerlab.sweep.mfpt.MfptStudyError`)."""
-    from walkerlab.sweep.mfpt import MfptStudyError, mfpt_summary, resumable_mfpt_study
+    carry (:class:`walkerlab.studies.mfpt.MfptStudyError`)."""
+    from walkerlab.studies.mfpt import MfptStudyError, mfpt_summary, resumable_mfpt_study
 
     st, workers = check(scene, sigma_rad, method, workers)
     up, path = (stage_artifact(scene, runs_root, s) for s in ("fixedpoint", "mfpt"))

@@ -30,10 +30,10 @@ def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportIn
     """Load the report's artifacts (``paths``: ``{stage: Path}``, and the stability maps
     whose figure is in ``figures``) through :mod:`walkerlab.io.schemas`, with the numbers
     computed from them (:func:`walkerlab.analysis.report_numbers.report_numbers`; the
-    bifurcation diagrams' onsets: :mod:`walkerlab.sweep.bifurcation`)."""
+    bifurcation diagrams' onsets: :mod:`walkerlab.studies.bifurcation`)."""
     from walkerlab.analysis.report_numbers import report_numbers
     from walkerlab.io.schemas.loaders import load_artifact
-    from walkerlab.sweep.bifurcation import fall_onset, onset_value
+    from walkerlab.studies.bifurcation import fall_onset, onset_value
 
     if "contact-sim" in paths:
         maps = (paths["contact-sim"].parent / f"stability_map_{k}.h5"

@@ -18,7 +18,7 @@ def _study(scene: Scene, runs_root, force: bool):
     """The work-precision stage in a thread of the report, overlapping the untimed stages
     (:class:`walkerlab.execution.background.BackgroundStudy`); its contact cases wait until
     the contact model's kernels are compiled."""
-    from walkerlab.analysis.workprecision import start_worker
+    from walkerlab.bench.workprecision import start_worker
     from walkerlab.execution.background import BackgroundStudy
     from walkerlab.io.runpaths import stage_artifact
 

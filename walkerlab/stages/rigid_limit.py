@@ -3,7 +3,7 @@
 
 For each stiffness factor ``kappa`` (default :data:`KAPPAS`) the scene's contact is scaled by
 :mod:`walkerlab.models.contact.rigid_limit` and the contact walker's own periodic gait is found
-(:func:`walkerlab.analysis.rigid_limit.convergence`); the artifact holds its step period, step
+(:func:`walkerlab.analysis.contact.rigid_limit.convergence`); the artifact holds its step period, step
 length and slow Floquet multipliers against ``kappa``, the rigid gait's as scalars, and the
 observed orders of convergence (layout: :mod:`walkerlab.io.schemas.rigid_limit`).  Any
 walker with a ``contact`` and a ``fixedpoint`` section.
@@ -36,8 +36,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     kappas = tuple(float(k) for k in kappas)
 
     def compute():
-        from walkerlab.analysis.contact_periodic import ideal_gait
-        from walkerlab.analysis.rigid_limit import convergence, observed_order
+        from walkerlab.analysis.contact.periodic import ideal_gait
+        from walkerlab.analysis.contact.rigid_limit import convergence, observed_order
         from walkerlab.models.contact.rigid_limit import expected_order
         from walkerlab.models.contact.scene import build
 

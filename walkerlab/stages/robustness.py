@@ -2,7 +2,7 @@
 
 Reads the scene's ``robustness`` section and the gait from ``fixedpoint.h5`` (the pipeline
 runs ``fixedpoint`` first, :mod:`walkerlab.stages.pipeline`); computes by
-:func:`walkerlab.sweep.robustness_study.scene_robustness` the gait sensitivity norms, the
+:func:`walkerlab.studies.robustness_study.scene_robustness` the gait sensitivity norms, the
 largest step-down/up and the Monte Carlo MFPT at the scene's sigma.  Skipped when the scene
 sections, the upstream gait and the code are unchanged.
 """
@@ -43,7 +43,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False, worke
     StageError
         Missing sections, or a walker the batched step map cannot carry (one line).
     """
-    from walkerlab.sweep.robustness_study import scene_robustness
+    from walkerlab.studies.robustness_study import scene_robustness
 
     workers = check(scene, workers)
     up = stage_artifact(scene, runs_root, "fixedpoint")

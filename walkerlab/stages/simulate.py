@@ -1,6 +1,6 @@
 """Stage ``simulate``: N strides of the rigid hybrid walker -> ``simulate.h5``.
 
-The run is :func:`walkerlab.analysis.rigid_run.simulate_run`; the layout
+The run is :func:`walkerlab.analysis.gait.rigid_run.simulate_run`; the layout
 :mod:`walkerlab.io.schemas.simulate`.
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from walkerlab.analysis.rigid_run import simulate_run
+from walkerlab.analysis.gait.rigid_run import simulate_run
 from walkerlab.config import Scene, SceneError
 from walkerlab.config.options import with_strides
 from walkerlab.io.freshness import input_hash

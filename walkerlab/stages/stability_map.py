@@ -3,7 +3,7 @@
 One cached artifact per map kind, ``runs/<scene>/stability_map_<kind>.h5`` (input hash: the
 scene's physics sections, the code and the grid), and its figure
 ``report/figures/stability_map_<kind>.png/.svg``, drawn from the artifact.  The computation is
-:func:`walkerlab.sweep.stability.stability_map_run`; the layout
+:func:`walkerlab.studies.stability.stability_map_run`; the layout
 :mod:`walkerlab.io.schemas.stability_map`.
 """
 
@@ -17,7 +17,7 @@ from walkerlab.io.runpaths import figures_dir
 from walkerlab.io.schemas.stability_map import load_stability_map, write_stability_map
 from walkerlab.plotting.artifact_figures import save_gait_map_figure
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
-from walkerlab.sweep.stability import MapSpec, default_spec, stability_map_run
+from walkerlab.studies.stability import MapSpec, default_spec, stability_map_run
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "contact", "terrain")
 

@@ -1,7 +1,7 @@
 """Stage ``sweep``: run a stage over a grid of scene fields -> ``sweep_<stage>_<hash>.h5``.
 
 ``walkerlab sweep SCENE --param slope.angle_deg=0.5:5:0.05 [--param ...] --stage fixedpoint``
-calls :func:`run`: one row per grid point (:func:`walkerlab.sweep.runner.run_sweep`: the
+calls :func:`run`: one row per grid point (:func:`walkerlab.studies.runner.run_sweep`: the
 parameters, the typed outcome, the stage's key results, the point's wall time), appended to
 ``<name>.h5.partial`` as chunks finish (``resume=True`` computes only the rest), and a figure
 of the results against the first swept field.
@@ -13,8 +13,8 @@ from pathlib import Path
 
 from walkerlab.config import CommandOptions, Scene, load_scene, validate_option
 from walkerlab.io.runpaths import figures_dir, named_artifact
-from walkerlab.sweep.params import ParamAxis, SweepError, params_hash, parse_param, sweep_axes
-from walkerlab.sweep.runner import run_sweep
+from walkerlab.studies.params import ParamAxis, SweepError, params_hash, parse_param, sweep_axes
+from walkerlab.studies.runner import run_sweep
 
 __all__ = ["run", "parse_param", "sweep_path", "SweepError", "STAGE_NAMES"]
 
@@ -38,7 +38,7 @@ def run(scene_path_or_scene: str | Path | Scene, params: list[str], stage: str =
     """Sweep ``stage`` over the grid of ``params`` (``--param`` strings, e.g.
     ``["slope.angle_deg=0.5:5:0.05", "walker.hip_mass_kg=5,10"]``; continuation runs along
     the first) and write one HDF5 artifact; ``figure``: draw it (:func:`draw`).  The other
-    parameters are :func:`walkerlab.sweep.runner.run_sweep`'s; ``name``: the artifact's file
+    parameters are :func:`walkerlab.studies.runner.run_sweep`'s; ``name``: the artifact's file
     name (default ``sweep_<stage>_<hash>``).
 
     Returns

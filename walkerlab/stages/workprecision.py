@@ -12,12 +12,12 @@ accurate) and the Pareto-best setting: the fastest one whose error is below
 ``target_error``.
 
 The cases (model, method, tolerance) are planned by
-:mod:`walkerlab.analysis.workprecision_plan` and measured by
-:mod:`walkerlab.analysis.workprecision` (worker processes pinned to their own cores, untimed
+:mod:`walkerlab.bench.workprecision_plan` and measured by
+:mod:`walkerlab.bench.workprecision` (worker processes pinned to their own cores, untimed
 warm-up, wall and CPU time).  This stage keeps each measured case under
 ``runs/<scene>/.cache/workprecision/`` (key: the model's scene sections, the fixed point by
 value, the case and the sources it runs,
-:data:`walkerlab.analysis.workprecision_plan.CASE_SOURCES`), so a rerun after an unrelated
+:data:`walkerlab.bench.workprecision_plan.CASE_SOURCES`), so a rerun after an unrelated
 change (another target error, a new tolerance, the contact section only, report code)
 measures only what is new, and writes the artifact.  The ideal model is also integrated with
 CyRK's DOP853/RK45 (group ``CyRK <method>``), next to scipy's ``solve_ivp`` methods.
@@ -28,8 +28,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from walkerlab.analysis.workprecision import SINGLE_RUN_S, runner_for
-from walkerlab.analysis.workprecision_plan import plan, run_study, warm_cases
+from walkerlab.bench.workprecision import SINGLE_RUN_S, runner_for
+from walkerlab.bench.workprecision_plan import plan, run_study, warm_cases
 from walkerlab.config import Scene
 from walkerlab.execution.lanes import Lanes
 from walkerlab.io.runpaths import run_cache_dir, stage_artifact
@@ -59,7 +59,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         workers: int = 2, lanes: Lanes | None = None) -> StageOutcome:
     """Run the work-precision study of the scene's ``workprecision`` section with
     ``workers`` measuring processes or explicit ``lanes``
-    (:func:`walkerlab.analysis.workprecision_plan.run_study`); ``force`` also re-measures
+    (:func:`walkerlab.bench.workprecision_plan.run_study`); ``force`` also re-measures
     cached cases."""
     wp = require(scene, "workprecision", "workprecision")
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)

@@ -249,3 +249,40 @@ def floating_links_from_rigid(values: Mapping[str, float], floating: StateLayout
         angles.append(values[f"{src}angle"])
         rates.append(scale[leg] * values[f"{src}rate"])
     return np.array(angles + rates, dtype=float)
+
+
+class StateIndex:
+    """Columns of a walker's state by name, never by number: a view of the walker's
+    :class:`~walkerlab.walker.layout.StateLayout` (``walker.layout()``).
+
+    ``idx["hip_x"]`` is a column; :meth:`rate_of` the column of a coordinate's rate;
+    :attr:`coordinates` the columns of the coordinates q, :attr:`rates` of their rates.
+    """
+
+    def __init__(self, walker):
+        self.layout = walker.layout()
+        self.names = self.layout.names
+        self._col = {n: i for i, n in enumerate(self.names)}
+        self.n = self.layout.size
+
+    def __getitem__(self, name: str) -> int:
+        return self._col[name]
+
+    @property
+    def coordinates(self) -> slice:
+        """Columns of the generalised coordinates q."""
+        return self.layout.q_slice
+
+    @property
+    def rates(self) -> slice:
+        """Columns of the rates."""
+        return self.layout.qd_slice
+
+    def rate_of(self, name: str) -> int:
+        """Column of the rate of coordinate state ``name``."""
+        return self._col[self.layout.rate_of(name)]
+
+    def hip_velocity(self, X) -> np.ndarray:
+        """Hip velocity (n, 2) [m/s] of states X (n, N): the rates of ``hip_x``, ``hip_y``."""
+        X = np.atleast_2d(X)
+        return X[:, [self.rate_of("hip_x"), self.rate_of("hip_y")]]

@@ -4,7 +4,7 @@ energy per step by sink and the initial-rate adjustment's effect (writer and loa
 Layout (scalars, each with unit and description): ``gap/period``, ``gap/step_length`` (the
 scene's contact periodic gait - the rigid gait [s, m]); ``creep/period``,
 ``creep/step_length``, ``compliance/...``, ``residual/...`` (the split,
-:class:`walkerlab.analysis.attribution.Attribution`; NaN where a search failed);
+:class:`walkerlab.analysis.contact.attribution.Attribution`; NaN where a search failed);
 ``energy/<sink>`` [J] per step (``normal_damping``, ``friction_impact``, ``friction_stance``);
 ``adjustment/adjusted_period``, ``adjustment/unadjusted_period`` [s] (mean step period of
 the contact run from the scene's start and from the unscaled ideal start),
@@ -33,9 +33,9 @@ class AttributionRun:
 
     Attributes
     ----------
-    attribution : walkerlab.analysis.attribution.Attribution
+    attribution : walkerlab.analysis.contact.attribution.Attribution
     adjustment : dict
-        :func:`walkerlab.analysis.attribution.adjustment_effect`'s result.
+        :func:`walkerlab.analysis.contact.attribution.adjustment_effect`'s result.
     rigid_period_s : float
         The rigid gait's step period [s].
     """

@@ -30,7 +30,7 @@ class BasinRun:
     ----------
     walker : HybridWalker
     result : dict
-        :func:`walkerlab.sweep.basin.compute_basin`'s result (``x``, ``y`` cell centres,
+        :func:`walkerlab.studies.basin.compute_basin`'s result (``x``, ``y`` cell centres,
         ``outcome``, ``steps``, ``period`` arrays (ny, nx), ``cells_computed``).
     fixed_point : ndarray (2n,)
         The period-1 gait [rad, rad/s].

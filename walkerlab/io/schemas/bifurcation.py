@@ -1,6 +1,6 @@
 """``bifurcation.h5`` / ``bifurcation_<field>.h5``: what the report reads of a bifurcation
 diagram (:func:`load_bifurcation_summary`), its writer (:func:`bifurcation_writer`, filled
-from a :class:`walkerlab.sweep.bifurcation.BifurcationResult`) and its full reader
+from a :class:`walkerlab.studies.bifurcation.BifurcationResult`) and its full reader
 (:func:`load_bifurcation`).
 
 Layout read here: root attribute ``parameter_path`` (the scene field of the grid; the slope
@@ -50,7 +50,7 @@ class BifurcationSummary:
         ``parameter_path``, ``parameter_unit``, the grid (ndarray (n,), under its coordinate
         name), ``onset/onset_slope`` or ``onset/onset_value`` where stored, and
         ``steady_state/outcome`` (list of str, or None in an artifact without it): the
-        input of :func:`walkerlab.sweep.bifurcation.onset_value` and ``fall_onset``.
+        input of :func:`walkerlab.studies.bifurcation.onset_value` and ``fall_onset``.
     values : ndarray (n,)
         The grid, in ``data["parameter_unit"]``.
     attractor_period : ndarray (n,)
@@ -87,7 +87,7 @@ def load_bifurcation_summary(path: Path) -> BifurcationSummary:
                                   f["steady_state/attractor_period"][()])
 
 
-def bifurcation_writer(res):  # res: walkerlab.sweep.bifurcation.BifurcationResult
+def bifurcation_writer(res):  # res: walkerlab.studies.bifurcation.BifurcationResult
     """``writer(h5file)`` filling a ``bifurcation`` artifact (netCDF dimensions: the
     parameter (:func:`parameter_dim`: ``slope`` or the field's dotted path; attributes
     ``unit``, ``path``), ``multiplier``, ``heel_strike``; units on every dataset; the onset

@@ -64,7 +64,7 @@ class ContactSimRun:
         Multipliers used (the scene's or ``--adjust``'s).
     stiffness_family : str
     drop : dict
-        Drop test (:func:`walkerlab.analysis.contact_record.drop_test`; stiffnesses in its
+        Drop test (:func:`walkerlab.analysis.contact.record.drop_test`; stiffnesses in its
         ``unit``, the unit the scene writes its stiffness in).
     drop_speed_m_per_s : float
     summary : dict
@@ -116,7 +116,7 @@ def _write_outcome_and_drop(f, run: ContactSimRun) -> None:
     g = f.create_group("drop_test")
     g.attrs["method"] = (f"point mass {walker.total_mass:.6g} kg (the walker's) meeting "
                          f"flat ground at {run.drop_speed_m_per_s} m/s, no gravity "
-                         "(walkerlab.analysis.contact_drop); restitution = v_out / v_in")
+                         "(walkerlab.analysis.contact.drop); restitution = v_out / v_in")
     g.attrs["mass_kg"] = float(walker.total_mass)
     coordinate(g, "stiffness", drop["stiffness"], drop["unit"],
                "IMPACT stiffness in the scene's unit system")

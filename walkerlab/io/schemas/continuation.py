@@ -33,8 +33,8 @@ STAGE = "continuation"
 
 
 def continuation_writer(res, curves=()):
-    """``writer(h5file)`` for a :class:`walkerlab.analysis.continuation.ContinuationResult`
-    and optional :class:`~walkerlab.analysis.two_parameter.TwoParameterCurve` s."""
+    """``writer(h5file)`` for a :class:`walkerlab.analysis.continuation.branch.ContinuationResult`
+    and optional :class:`~walkerlab.analysis.continuation.two_parameter.TwoParameterCurve` s."""
     from walkerlab.io.artifacts import put
 
     names, units = list(res.state_names), list(res.state_units)

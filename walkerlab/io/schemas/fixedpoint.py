@@ -35,7 +35,7 @@ class FixedPointRun:
     Attributes
     ----------
     walker : HybridWalker
-    search : walkerlab.analysis.gaits.GaitSearch
+    search : walkerlab.analysis.gait.search.GaitSearch
         Every period-1 gait found and the one selected.
     variants : dict[str, (HybridWalker, FixedPointResult) or Exception]
         The scene's own equation variant first, then the others solved for comparison.

@@ -28,7 +28,7 @@ FAMILY = ("walkerlab.models.contact.rigid_limit: k*kappa, cmax*kappa^(1/(e+1)), 
 @dataclass
 class RigidLimitRun:
     """What the rigid-limit stage computed (the writer's input): ``table``
-    (:func:`walkerlab.analysis.rigid_limit.convergence`), the observed ``orders``
+    (:func:`walkerlab.analysis.contact.rigid_limit.convergence`), the observed ``orders``
     ({"period", "step_length"}: ndarray (n - 1,)) and the ``expected_order``."""
 
     table: object

@@ -45,7 +45,7 @@ class SimulateRun:
     samples : NamedTrajectory
         Sampled trajectory.
     steps : dict[str, ndarray (n_steps,)]
-        Per-step table (:func:`walkerlab.analysis.metrics.step_table`).
+        Per-step table (:func:`walkerlab.analysis.gait.metrics.step_table`).
     initial_state : ndarray (2n,)
         Role-ordered initial state [rad, rad/s].
     strides_requested : int

@@ -4,7 +4,7 @@ contact parameter × the slope (writer and loader side by side).
 Layout: root attributes ``kind``, ``y_path`` (the scene field varied), ``y_label``,
 ``stiffness_family``, ``time_limit_s``, ``method``; ``y_values`` (ny,)
 and ``slopes_deg`` (nx,) [deg]; one (ny, nx) array per cell field
-(:data:`walkerlab.sweep.stability.CELL_FIELDS`: ``exists``, ``stable``,
+(:data:`walkerlab.studies.stability.CELL_FIELDS`: ``exists``, ``stable``,
 ``max_abs_multiplier``, ``step_period_s`` [s], ``patch_margin_m`` [m], ``residual``,
 ``reason`` (why no gait, text), ``wall_time_s`` [s] ...); ``summary/<fraction>``.
 """
@@ -29,15 +29,15 @@ class StabilityMapRun:
 
     Attributes
     ----------
-    spec : walkerlab.sweep.stability.MapSpec
+    spec : walkerlab.studies.stability.MapSpec
     cells : dict[str, ndarray]
-        :func:`walkerlab.sweep.stability.gait_map`'s result.
+        :func:`walkerlab.studies.stability.gait_map`'s result.
     cell_fields : tuple of str
-        The per-cell arrays written, in order (:data:`walkerlab.sweep.stability.CELL_FIELDS`).
+        The per-cell arrays written, in order (:data:`walkerlab.studies.stability.CELL_FIELDS`).
     y_label : str
         Axis label of the varied parameter, with its unit.
     fractions : dict[str, float]
-        :func:`walkerlab.sweep.stability.stable_fraction` of the cells.
+        :func:`walkerlab.studies.stability.stable_fraction` of the cells.
     stiffness_family : str
         Of the scene's contact law.
     scene_point : (float, float), optional

@@ -31,13 +31,13 @@ class WorkPrecisionRun:
     ----------
     results : dict[str, (rows, summary, reference)]
         Per model: ``rows`` ``{method: {column: ndarray (n_rtol,)}}``
-        (:func:`walkerlab.analysis.workprecision_results.rows_from_cases`), ``summary``
-        (:func:`walkerlab.analysis.workprecision_results.summarize`), the reference setting.
+        (:func:`walkerlab.bench.workprecision_results.rows_from_cases`), ``summary``
+        (:func:`walkerlab.bench.workprecision_results.summarize`), the reference setting.
     cases_reused, cases_total : int
     target_error, contact_target_error : float
     single_run_s : float
         A case slower than this [s] is timed once
-        (:data:`walkerlab.analysis.workprecision.SINGLE_RUN_S`).
+        (:data:`walkerlab.bench.workprecision.SINGLE_RUN_S`).
     """
 
     results: dict

@@ -1,8 +1,8 @@
 """The compliant-contact (MSC ADAMS-style) walker model of any walker description with positive
 leg masses (generated from its floating view, :mod:`walkerlab.codegen.floating`): contact laws,
 geometry, terrain, knee stops and the floating walker.  Only the model: integrating it is
-:mod:`walkerlab.integrate.contact`, reading its gait :mod:`walkerlab.analysis.contact_gait` /
-:mod:`walkerlab.analysis.contact_sim`, its settings live in :mod:`walkerlab.config.contact`.
+:mod:`walkerlab.integrate.contact`, reading its gait :mod:`walkerlab.analysis.contact.gait` /
+:mod:`walkerlab.analysis.contact.sim`, its settings live in :mod:`walkerlab.config.contact`.
 
 The names below are loaded on first use (PEP 562 ``__getattr__``), so importing a settings
 or law module does not load numba, which the model needs.

@@ -44,7 +44,7 @@ near straight: a bent knee whose foot touches down is not snapped straight).  A 
 stance foot (``rhs_pinned``) counts as on the ground.  The analytic Jacobian holds the
 weight constant (left out: its dependence on the foot's height; Newton directions only).
 
-Packed data vector of the compiled integrators (``_cyrk``, ``_lsoda``):
+Packed data vector of the compiled integrators (``_cyrk``, ``numbalsoda_backend``):
 ``[n1, n2, PC (NPC), p (NP), c1 (n1), c2 (n2), nfev]`` (``p`` the floating view's parameter
 vector, :func:`walkerlab.codegen.floating.param_names`; ``c1``/``c2`` the kernel lanes of
 leg1's / leg2's patches: their centres [m], their heights [m] along the outward normal and the

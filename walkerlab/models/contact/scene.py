@@ -1,8 +1,8 @@
 """The contact model of a validated scene: :func:`contact_setup` turns the scene once into
 the typed objects a contact run needs (:class:`ContactSetup`), which builds the walker
-(running it is :mod:`walkerlab.analysis.contact_sim`).
+(running it is :mod:`walkerlab.analysis.contact.sim`).
 
-The ``contact-sim`` stage, the adjustment, :mod:`walkerlab.analysis.contact_periodic`, the
+The ``contact-sim`` stage, the adjustment, :mod:`walkerlab.analysis.contact.periodic`, the
 stability maps and the sweep points all build their walker here, so a scene means the same
 contact model everywhere.  This module imports settings only (:mod:`walkerlab.config`).
 """

@@ -281,27 +281,3 @@ class HybridWalker:
             # a coordinate on no leg (a torso) keeps its own name
             out[key if role is None else r2l[role] + key[len(role):]] = np.asarray(val)
         return out
-
-
-def complex_step_jacobian(fun, x: np.ndarray, h: float = 1e-30) -> np.ndarray:
-    """Jacobian of an analytic function by the complex-step method (exact to round-off).
-
-    Squire & Trapp (1998), SIAM Review 40(1): ``df/dx_k = Im f(x + i h e_k) / h``.
-
-    Parameters
-    ----------
-    fun : callable ``(m,) -> (p,)``
-        Must accept complex input.
-    x : ndarray, shape (m,)
-
-    Returns
-    -------
-    ndarray, shape (p, m)
-    """
-    x = np.asarray(x, dtype=float)
-    cols = []
-    for k in range(x.size):
-        xc = x.astype(complex)
-        xc[k] += 1j * h
-        cols.append(np.imag(fun(xc)) / h)
-    return np.stack(cols, axis=1)

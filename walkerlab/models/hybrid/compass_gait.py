@@ -36,7 +36,8 @@ from functools import cache, partial
 
 import numpy as np
 
-from walkerlab.models.hybrid.base import HybridWalker, complex_step_jacobian
+from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.numerics import complex_step_jacobian
 
 VARIANTS = ("derived", "appendix_a", "appendix_a_literal")
 

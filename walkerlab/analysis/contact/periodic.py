@@ -1,0 +1,335 @@
+"""The compliant-contact walker's own periodic gait: fixed point of a mid-stance step map.
+
+The step map, its section coordinates and the footfall-relative terrain live in
+:mod:`walkerlab.analysis.contact.step_map`.
+
+Floquet multipliers
+-------------------
+Eigenvalues of the n x n Jacobian of ``P`` (n = 6, kneed 10) at the fixed point, by central
+finite differences in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the
+coordinate scale (:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1
+mm/s, 1 mm/s; kneed: every angle 1 rad, every rate 1 rad/s), with the map integrated at rtol
+1e-12 / atol 1e-14.  Measured on the paper's contact: the map's noise (adaptive-step jitter)
+is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD noise is ~1e-10 / h ~ 1e-6,
+and the truncation error O(h^2) is ~1e-8; the multipliers agree to ~1e-5 between h = 1e-3,
+1e-4 and 1e-5 (``multiplier_fd_spread`` reports the change for h*3 and h/3).  The three
+"fast" multipliers (normal contact mode, tangential creep of the stance foot, both damped
+within milliseconds) are ~1e-5..1e-8, i.e. zero within the FD noise; the three slow ones
+belong to the swing dynamics and correspond to the ideal model's nonzero multipliers
+(section-independent for a periodic orbit).  Kneed walker (``configs/kneed.yaml``): the same
+three slow ones (0.469 +- 0.498j, 0.113; rigid 0.548 +- 0.499j, 0.108), the seven others
+(contact and knee-stop modes) < 1e-4.
+
+Rigid limit
+-----------
+The one rigid-limit family of the contact is :mod:`walkerlab.models.contact.rigid_limit`
+(:func:`~walkerlab.models.contact.rigid_limit.scale_walker`);
+:func:`walkerlab.analysis.contact.rigid_limit.convergence` follows this gait along it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import root
+
+from walkerlab.analysis.contact.step_map import (
+    StepMap,
+    section_guess_from_ideal,
+)
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.model import ContactWalker
+from walkerlab.numerics import fd_jacobian, sort_multipliers
+
+__all__ = ["ContactPeriodicGait", "find_contact_periodic_gait", "ideal_gait",
+           "simulate_from_periodic_gait"]
+
+
+@dataclass
+class ContactPeriodicGait:
+    """Periodic gait of the contact walker (fixed point of the mid-stance step map).
+
+    Attributes
+    ----------
+    z : ndarray (n,)
+        Fixed point in the section's order (:func:`section_coordinates`; straight legs
+        :data:`SECTION_NAMES`, units :data:`SECTION_UNITS`; n = 6, kneed 10).
+    fixed_point : dict[str, float]
+        The same, named.
+    period_s : float
+        Step period [s] (mid-stance to mid-stance; equals the heel-strike-to-heel-strike
+        period on a periodic orbit).
+    step_length_m : float
+        Along-slope advance of the stance foot per step [m].
+    residual : float
+        max |(P(z) - z) / scale| (scaled, see :data:`SCALES`) [-].
+    residual_si : ndarray (n,)
+        P(z) - z in SI units.
+    jacobian : ndarray (n, n)
+        dP/dz in SI (rows/cols in the section's order).
+    multipliers : ndarray (n,) complex
+        Floquet multipliers, sorted by decreasing modulus.
+    multiplier_fd_spread : float
+        max change of the slow (|lambda| > 1e-3) sorted multipliers when the FD step is
+        multiplied or divided by 3.
+    stable : bool
+        All |multipliers| < 1.
+    converged : bool
+    message : str
+    nfev : int
+        Step-map evaluations (root finding + Jacobian).
+    patch_margin_m : float
+        Smallest distance [m] of a loaded foot to the edge of its patch on the orbit (inf on
+        continuous ground).
+    full_state : ndarray (2 nq,)
+        Full state at the section (leg2 stance at s = 0).
+    wall_time_s : float
+    info : dict
+        Extra diagnostics (warm-up history, solver settings).
+    """
+
+    z: np.ndarray
+    fixed_point: dict
+    period_s: float
+    step_length_m: float
+    residual: float
+    residual_si: np.ndarray
+    jacobian: np.ndarray
+    multipliers: np.ndarray
+    multiplier_fd_spread: float
+    stable: bool
+    converged: bool
+    message: str
+    nfev: int
+    patch_margin_m: float
+    full_state: np.ndarray
+    wall_time_s: float
+    info: dict = field(default_factory=dict)
+
+    @property
+    def max_multiplier(self) -> float:
+        """Largest |multiplier| [-]."""
+        return float(np.max(np.abs(self.multipliers)))
+
+
+def ideal_gait(scene):
+    """The rigid (derived) periodic gait of ``scene`` from its ``fixedpoint`` section.
+
+    Returns
+    -------
+    walkerlab.analysis.gait.search result (``x`` role-order post-impact state, ``period_s``, ...)
+
+    Raises
+    ------
+    GaitNotFound
+        No ideal gait (a scene without a ``fixedpoint`` section searches from scale-free
+        seeds).
+    """
+    from walkerlab.analysis.gait.search import find_gaits
+    from walkerlab.models.registry import build_walker
+
+    sc = scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": "derived"})})
+    from walkerlab.config import FixedPointSettings
+
+    fp = sc.fixedpoint or FixedPointSettings()  # every field optional: the defaults
+    iw = build_walker(sc)
+    return find_gaits(iw, Solver.from_settings(sc.solver),
+                      None if fp.initial_guess is None
+                      else fp.initial_guess.as_array(iw.state_names()),
+                      policy=fp.gait, other_gait=False, xtol=fp.tolerance,
+                      fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
+
+
+def _last_call_memo(f):
+    """``f`` that returns its previous result when called again with the same array
+    (``scipy.optimize.root`` evaluates the function and the Jacobian at the starting point
+    twice, a shape check and MINPACK's own call: here each is one step map or six).  The
+    last result is also kept as ``.last``."""
+    def g(u):
+        key = np.asarray(u, float).tobytes()
+        if g.key != key:
+            g.key, g.last = key, f(u)
+        return g.last
+
+    g.key, g.last = None, None
+    return g
+
+
+def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0, 1.0),
+                               warmup_steps: int = 8, xtol: float = 1e-8,
+                               residual_tol: float = 1e-8, fd_step: float = 1e-4,
+                               check_fd: bool = True, method: str = "odeint",
+                               rtol: float = 1e-12, atol: float = 1e-14,
+                               jac_rtol: float = 1e-12, jac_atol: float = 1e-14,
+                               coarse_rtol: float | None = 1e-10, coarse_atol: float = 1e-12,
+                               coarse_xtol: float = 1e-6,
+                               patch_spacing: float | None = None,
+                               time_limit_s: float | None = None) -> ContactPeriodicGait:
+    """Periodic gait of the compliant-contact walker and its Floquet multipliers.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        The contact walker (:meth:`walkerlab.models.contact.scene.ContactSetup.build`).
+    guess : array_like
+        Either a section state (n,) (:func:`section_coordinates`) or an ideal post-impact
+        state (role order of the rigid walker, as ``solve_variant``; compass gait
+        ``[th_swing, th_stance, w_swing, w_stance]``).
+    rate_scale : (float, float)
+        Multipliers on the swing and stance legs' rates of an ideal-state guess.
+    warmup_steps : int
+        Steps of the map iterated from the guess before root finding (the gait is stable,
+        so this brings the guess into the Newton basin).
+    xtol : float
+        Relative tolerance of ``scipy.optimize.root`` (hybr) in scaled coordinates.
+    residual_tol : float
+        ``converged`` means the scaled residual is below this [-] (hybr may stop with "not
+        making good progress" once it reaches the map's noise floor: ~2e-8 at rtol 1e-11,
+        ~2e-10 at rtol 1e-12, measured on the paper's contact).
+    fd_step : float
+        Relative central-difference step (times :data:`SCALES`) of the final Jacobian [-]
+        (the root finder's own Jacobians use ``10 * fd_step`` on the cheaper map).
+    check_fd : bool
+        Also compute the multipliers with ``fd_step * 3`` and ``/ 3`` (``multiplier_fd_spread``).
+    method, rtol, atol : integrator settings of the map while root finding (``"odeint"``:
+        scipy odeint with the section crossing found by brentq, 3-10x faster than the
+        ``solve_ivp`` methods "LSODA", "Radau", "BDF", which locate it as an event).
+    jac_rtol, jac_atol : tolerances of the map for the final FD Jacobian.
+    coarse_rtol, coarse_atol, coarse_xtol : two-fidelity search (used only when
+        ``coarse_rtol`` is looser than ``rtol``; None: off).  The warm-up and a first hybr
+        solve (``xtol = coarse_xtol``, forward-difference Jacobian) run on the map at
+        ``coarse_rtol``; the final hybr solve at ``rtol`` starts from that fixed point with
+        its Jacobian (a Newton direction accurate to the FD step, ~1e-3), so it needs only
+        a few map evaluations at the tight tolerance.  Measured on the paper's contact
+        (odeint, median CPU per map): 31 ms at rtol 1e-10, 130 ms at 1e-11, 114 ms at 1e-12.
+    patch_spacing : float, optional
+        Swing-patch distance ahead of the stance foot [m]; default the walker's lane spacing.
+    time_limit_s : float, optional
+        Wall-time limit of the whole search [s].
+
+    Returns
+    -------
+    ContactPeriodicGait
+
+    Raises
+    ------
+    PeriodicGaitError
+        A step of the map fell, found no mid-stance, the solver failed, or the wall-time
+        limit ran out (``kind`` says which).
+    """
+    wall = time.perf_counter()
+    deadline = None if time_limit_s is None else wall + time_limit_s
+    P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol, deadline=deadline)
+    scale = P.scale
+    coarse = coarse_rtol is not None and coarse_rtol > rtol
+    # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
+    PC = StepMap(walker, patch_spacing, method=method, rtol=coarse_rtol, atol=coarse_atol,
+                 deadline=deadline) if coarse else P
+    guess = np.asarray(guess, float)
+    if guess.size == len(P.names):
+        z = guess.copy()
+    elif guess.size == walker.rigid_layout().size:
+        z = section_guess_from_ideal(PC, guess, rate_scale)
+    else:
+        raise ValueError(f"guess must be a section state ({len(P.names)},) or an ideal state "
+                         f"({walker.rigid_layout().size},)")
+    hist = []
+    for _ in range(warmup_steps):
+        z1 = PC(z)[0]
+        hist.append(float(np.max(np.abs((z1 - z) / scale))))
+        z = z1
+
+    def G_of(M):
+        return _last_call_memo(lambda u: (M(u * scale)[0] - u * scale) / scale)
+
+    def dG_of(M):
+        return _last_call_memo(
+            lambda u: fd_jacobian(lambda v: M(v)[0], u * scale, 10 * fd_step * scale,
+                                  central=method != "odeint")
+            * scale[None, :] / scale[:, None] - np.eye(len(scale)))
+
+    root_nfev = 0
+    jac = dG_of(P)
+    if coarse:
+        dGc = dG_of(PC)
+        solc = root(G_of(PC), z / scale, jac=dGc, method="hybr", options={"xtol": coarse_xtol})
+        root_nfev += solc.nfev
+        z = solc.x * scale
+        # the last Jacobian hybr asked for (near the coarse fixed point; the tight one is
+        # ~1e-7 from it) steers every step of the tight solve: a Newton step then lands at
+        # the tight map's noise floor, with no Jacobian at the tight tolerance
+        Jc = dGc.last
+        jac = lambda u: Jc  # noqa: E731
+
+    sol = root(G_of(P), z / scale, jac=jac, method="hybr", options={"xtol": xtol})
+    root_nfev += sol.nfev
+    zs = sol.x * scale
+    z1, T, ell = P(zs)
+    res_si = z1 - zs
+    PJ = P if (jac_rtol, jac_atol) == (rtol, atol) else \
+        StepMap(walker, patch_spacing, method=method, rtol=jac_rtol, atol=jac_atol,
+                deadline=deadline)
+    FJ = lambda v: PJ(v)[0]  # noqa: E731
+    J = fd_jacobian(FJ, zs, fd_step * scale)
+    ev = sort_multipliers(np.linalg.eigvals(J))
+    spread = np.nan
+    if check_fd:
+        ev_lo = sort_multipliers(np.linalg.eigvals(fd_jacobian(FJ, zs, fd_step / 3 * scale)))
+        ev_hi = sort_multipliers(np.linalg.eigvals(fd_jacobian(FJ, zs, fd_step * 3 * scale)))
+        # compare the slow (|lambda| > 1e-3) multipliers; the fast ones are FD noise
+        slow = np.abs(ev) > 1e-3
+        spread = float(max(np.max(np.abs(ev_lo - ev)[slow], initial=0.0),
+                           np.max(np.abs(ev_hi - ev)[slow], initial=0.0)))
+    margin = P.patch_margin(zs)
+    info = {"warmup_history": hist, "root_message": sol.message, "root_nfev": root_nfev,
+            "fd_step": fd_step, "scales": scale, "method": method, "rtol": rtol, "atol": atol,
+            "coarse_rtol": coarse_rtol if coarse else None, "coarse_map_evaluations": PC.nfev
+            if coarse else 0, "patch_spacing_m": P.spacing}
+    resid = float(np.max(np.abs(res_si / scale)))
+    return ContactPeriodicGait(
+        z=zs, fixed_point=dict(zip(P.names, map(float, zs))), period_s=T,
+        step_length_m=ell, residual=resid, residual_si=res_si, jacobian=J, multipliers=ev,
+        multiplier_fd_spread=spread, stable=bool(np.all(np.abs(ev) < 1)),
+        converged=bool(resid < residual_tol), message=sol.message,
+        nfev=P.nfev + (PJ.nfev if PJ is not P else 0) + (PC.nfev if coarse else 0),
+        patch_margin_m=margin, full_state=P.to_state(zs),
+        wall_time_s=time.perf_counter() - wall, info=info)
+
+
+def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None = None,
+                                solver=None):  # setup: ContactSetup, solver: SolverSettings
+    """Run the contact walker of a scene (its ``setup``,
+    :func:`walkerlab.models.contact.scene.contact_setup`) from its own periodic gait
+    (``contact_sim.start: periodic_gait``): steady state, no start-up transient.
+
+    The gait is found from the ideal fixed point ``x_ideal``
+    (:func:`walkerlab.analysis.contact.periodic.find_contact_periodic_gait`, within
+    ``contact_sim.periodic_time_limit_s``); the run starts at its mid-stance section (leg2
+    stance, stance foot at s = 0) on patches spaced by the gait's step length, so every
+    footfall lands where the gait's does, and runs ``(2 strides + 1)`` gait periods.
+
+    Returns
+    -------
+    walker, result, x0, step_length, gait
+        As :func:`walkerlab.analysis.contact.sim.simulate_from`, plus the
+        :class:`ContactPeriodicGait` started from.
+
+    Raises
+    ------
+    walkerlab.analysis.contact.periodic.PeriodicGaitError
+        The periodic gait was not found (fell, no mid-stance, solver failure, time limit).
+    """
+    from walkerlab.analysis.contact.sim import scene_start, simulate_contact
+
+    cs, sv = setup.sim, solver or setup.solver
+    n_strides = strides or cs.n_strides
+    probe, _, limits, _ = scene_start(setup, x_ideal, n_strides)
+    gait = find_contact_periodic_gait(probe, x_ideal, time_limit_s=cs.periodic_time_limit_s)
+    walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m=gait.step_length_m)
+    x0 = np.asarray(gait.full_state, float)
+    t_final = cs.t_final_s or (2 * n_strides + 1) * gait.period_s
+    res = simulate_contact(walker, x0, t_final, sv, limits,
+                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
+    return walker, res, x0, step_length, gait

@@ -1,0 +1,145 @@
+"""What a contact run records beside its trajectory: the drop test of the scene's contact
+law, the rates an initial rate scale multiplies, and the run's headline numbers.
+
+:func:`contact_sim_run` is the ``contact-sim`` stage's whole run (start, periodic gait, drop
+test, headline numbers); the stage writes it through :mod:`walkerlab.io.schemas.contact_sim`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from walkerlab.config import ContactSettings
+from walkerlab.models.contact.scene import ContactSetup
+
+#: stiffness values of the drop test stored with every contact run, relative to the scene's
+#: own stiffness (the paper's k = 1e5 N/mm^2.2: 1e4 ... 1e9 N/mm^2.2)
+DROP_STIFFNESS_RATIO = (0.1, 0.3, 1.0, 3.0, 1e1, 3e1, 1e2, 3e2, 1e3, 3e3, 1e4)
+#: downward speed of the drop test at first contact [m/s, or the scene's speed unit]
+DROP_SPEED = 0.3
+#: the legs of a contact run, in the order of ``initial_rate_scale`` (swing, stance)
+LEGS = ["leg1", "leg2"]
+
+
+def drop_test(law: ContactSettings, mass_kg: float) -> dict:
+    """The drop test of the scene's contact law ``law`` (its ``contact`` section as written;
+    :func:`walkerlab.analysis.contact.drop.restitution_curve`): the walker's total mass
+    ``mass_kg`` [kg] meeting flat ground at :data:`DROP_SPEED`, at the stiffnesses
+    :data:`DROP_STIFFNESS_RATIO` x the scene's.
+
+    The stiffnesses are in the unit the scene writes its stiffness in (``unit`` of the
+    result, ``N/mm^e`` for ``stiffness_n_per_mm_pow_e``).  The rigid-limit family starts
+    from the scene's own contact (its stiffness is the reference) when the scene follows the
+    paper family, so both curves pass through the scene's contact whatever its units (the
+    reference stiffness defaults to the paper's 1e5 N/mm^2.2, far from e.g.
+    round_feet.yaml's 4e9 N/m^2.2).
+    """
+    from walkerlab.analysis.contact.drop import restitution_curve
+    from walkerlab.config.contact import CONTACT_QUANTITIES
+
+    k, unit, _ = law.written("stiffness")
+    if law.stiffness_family == "paper":
+        law = law.with_written("reference_stiffness", k, unit)
+    ks = [k * r for r in DROP_STIFFNESS_RATIO]
+    out = restitution_curve(law, ks, mass_kg=float(mass_kg), v_in_m_per_s=DROP_SPEED)
+    return {**out, "unit": CONTACT_QUANTITIES["stiffness"][unit][1]}
+
+
+def rate_states(walker, leg: str) -> list[str]:
+    """Names of the rate states of ``leg``'s links (what one entry of
+    ``initial_rate_scale`` multiplies): ``dtheta1``; kneed ``dtheta1_thigh dtheta1_shank``."""
+    lay = walker.layout()
+    return [lay.rate_of(s) for s in walker.leg_angle_states(leg)]
+
+
+def run_summary(res) -> dict:
+    """Headline numbers of a contact run ``res`` (ContactResult): how it ended, heel strikes,
+    strides, stance slip and double-support creep [mm], peak penetration [mm], bounces,
+    scuffs, RHS/Jacobian evaluations and the integration's wall time [s]."""
+    steps = res.steps
+    slips = np.array([s.stance_slip_mm for s in steps])
+    creep = np.array([s.double_support_creep_mm for s in steps])
+    return {
+        "termination": res.termination,
+        "outcome": res.outcome.kind,
+        "heel_strikes": int(res.walked_steps),
+        "strides_completed": int(res.walked_steps // 2),
+        "mean_abs_stance_slip_mm": float(np.nanmean(np.abs(slips)))
+        if np.isfinite(slips).any() else np.nan,
+        "max_abs_stance_slip_mm": float(res.max_stance_slip_mm),
+        "total_double_support_creep_mm": float(np.sum(creep)) if creep.size else 0.0,
+        "peak_penetration_mm": float(max((s.peak_penetration_m for s in steps),
+                                         default=np.nan) * 1e3),
+        "total_bounces": int(sum(s.bounce_count for s in steps)),
+        "total_scuffs": int(sum(s.scuff_count for s in steps)),
+        "nfev": int(res.nfev), "njev": int(res.njev), "wall_time_s": float(res.wall_time_s),
+    }
+
+
+def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: bool = False):
+    """The ``contact-sim`` stage's run: the contact walker of a scene (its ``setup``,
+    :func:`walkerlab.models.contact.scene.contact_setup`) started from the ideal fixed point
+    ``fp`` (a loaded ``fixedpoint.h5``) with the scene's rate scale, the rates ``adjust``
+    searches (kept only when they walk at least as well as the scene's own), or the contact
+    model's own periodic gait (``contact_sim.start: periodic_gait``); with ``periodic`` (or
+    that start) its periodic gait and Floquet multipliers; the drop test and the headline
+    numbers.
+
+    Returns
+    -------
+    walkerlab.io.schemas.contact_sim.ContactSimRun
+
+    Raises
+    ------
+    walkerlab.analysis.contact.step_map.PeriodicGaitError
+        ``start: periodic_gait`` and the gait was not found (one line naming the field).
+    """
+    from walkerlab.analysis.contact import sim as contact_run
+    from walkerlab.io.schemas.contact_sim import ContactSimRun
+
+    cs = setup.sim
+    adj = scale = None
+    gait = gait_error = None
+    adjust = adjust or cs.start == "adjusted"
+    if adjust:
+        from walkerlab.analysis.contact.adjust import adjust_rates, better_start
+
+        adj = adjust_rates(setup, fp.x, fp.step_period_s)
+        scale = adj["scale"]
+    if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
+        from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
+        from walkerlab.analysis.contact.step_map import PeriodicGaitError
+
+        try:
+            walker, res, x0, step_length, gait = simulate_from_periodic_gait(
+                setup, fp.x)
+        except PeriodicGaitError as exc:
+            raise PeriodicGaitError(f"scene '{setup.name}': contact_sim.start: periodic_gait: "
+                                    f"the contact walker's periodic gait was not found ({exc})"
+                                    ) from None
+        scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
+    else:
+        run = contact_run.simulate_from(setup, fp.x, fp.step_period_s, scale)
+        if adjust:  # the adjusted start must walk at least as well as the scene's own
+            plain = contact_run.simulate_from(setup, fp.x, fp.step_period_s, None)
+            adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
+            if adj["kept"] == "scene":
+                run, scale = plain, None
+        walker, res, x0, step_length = run
+    if periodic and gait is None:
+        from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+        from walkerlab.analysis.contact.step_map import PeriodicGaitError
+
+        try:
+            gait = find_contact_periodic_gait(walker, fp.x, time_limit_s=cs.periodic_time_limit_s)
+        except PeriodicGaitError as exc:
+            gait_error = exc
+    return ContactSimRun(
+        walker=walker, result=res, samples=contact_run.named_trajectory(walker, res, LEGS),
+        initial_state=x0, step_length_m=step_length, fixed_point=fp.x,
+        fixed_point_names=fp.state_names, legs=LEGS,
+        rate_names=[" ".join(rate_states(walker, leg)) for leg in LEGS],
+        initial_rate_scale=np.asarray(scale if scale is not None else cs.initial_rate_scale),
+        stiffness_family=setup.law.stiffness_family,
+        drop=drop_test(setup.law, walker.total_mass), drop_speed_m_per_s=DROP_SPEED,
+        summary=run_summary(res), gait=gait, gait_error=gait_error, adjust=adj)

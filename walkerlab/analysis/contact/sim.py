@@ -1,0 +1,244 @@
+"""A contact run: integrate the compliant-contact walker, then read its gait (``contact-sim``).
+
+:func:`simulate_contact` = :func:`walkerlab.integrate.contact.integrate_contact` (samples,
+events) + :func:`walkerlab.analysis.contact.gait.gait_events` (heel strikes, steps) + the
+typed outcome.  :func:`simulate_from` runs the contact walker of a scene (its
+:class:`~walkerlab.models.contact.scene.ContactSetup`) from the ideal gait, the one code
+path of the ``contact-sim`` stage, the adjustment
+(:mod:`walkerlab.analysis.contact.adjust`), the sweeps and the work-precision study, so a
+scene means the same contact run everywhere.  States are read by name
+(``walker.state_names()``), never by row.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from walkerlab.analysis.contact.gait import ContactResult, classify, gait_events, heel_strike_count
+from walkerlab.config.solver import SolverSettings
+from walkerlab.integrate.contact import ContactLimits, integrate_contact
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.scene import ContactSetup
+from walkerlab.walker.layout import StateIndex
+
+__all__ = ["AIRBORNE_HEIGHT_FACTOR", "initial_state_from_ideal", "named_trajectory",
+           "scene_start", "simulate_contact", "simulate_from", "trajectory_names"]
+
+#: A walker whose hip rises above this many leg lengths has left the ground for good
+#: (a foot can touch the ground only while the hip is within one leg length of it).
+AIRBORNE_HEIGHT_FACTOR = 1.5
+
+
+def initial_state_from_ideal(walker, *x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
+    """Floating-walker state from an ideal-model state (leg1 = swing, leg2 = stance).
+
+    The stance foot (leg2) is placed at s = 0 at its static penetration
+    ``(M g cos phi / k)^(1/e)`` [m] (along -n) and held at rest there: the hip follows from
+    the stance leg's links (``walker.pinned_to_full``).  ``rate_scale`` multiplies leg1's
+    and leg2's rates first.
+
+    Parameters
+    ----------
+    *x_ideal : float
+        The rigid model's state in the order of its ``state_names()``, e.g. ``theta1,
+        theta2, dtheta1, dtheta2`` (swing / stance leg angles [rad] and rates [rad/s]) for
+        the compass gait (``walker.link_state_from_ideal``).
+    rate_scale : (float, float)
+        Multipliers [-] on leg1's (swing) and leg2's (stance) rates.
+
+    Returns
+    -------
+    ndarray (N,)
+        Named by ``walker.state_names()``.
+    """
+    foot2 = -walker.static_penetration() * walker.normal
+    z = walker.link_state_from_ideal(np.asarray(x_ideal, float).ravel(), rate_scale)
+    return walker.pinned_to_full(z, foot2)
+
+
+def simulate_contact(walker, x0: np.ndarray, t_final: float,
+                     solver: Solver | SolverSettings | None = None,
+                     limits: ContactLimits | None = None, *,
+                     max_heel_strikes: int | None = None, slip_limit_mm: float | None = None,
+                     min_step_m: float = 0.05, initial_stance: str = "leg2") -> ContactResult:
+    """Simulate the floating walker with compliant feet and classify its gait.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    x0 : ndarray (N,)
+        Initial state, named by ``walker.state_names()`` (SI).
+    t_final : float
+        End time [s].
+    solver : Solver or SolverSettings, optional
+        The integrator, as one object (default: ``SolverSettings.for_contact()``, cyrk_bdf at
+        rtol 1e-8, atol 1e-10); the scene's settings become a :class:`Solver` here.
+    limits : ContactLimits, optional
+        Sampling, pinning, event heights, wall-time limit, chunking.  A
+        ``fall_hip_height_m`` / ``airborne_hip_height_m`` left at its default is set to 0.5
+        / :data:`AIRBORNE_HEIGHT_FACTOR` leg lengths.
+    max_heel_strikes : int, optional
+        Strides cap: stop (termination and outcome ``heel_strike``) at the end of the chunk
+        in which this many heel strikes have happened.
+    slip_limit_mm : float, optional
+        A stance phase sliding farther than this [mm] makes the outcome ``slip``.
+    min_step_m : float
+        A touchdown of the swing foot counts as a heel strike only if it lands at least this
+        far [m] downhill of the stance foot's touchdown point (else it is a scuff).
+    initial_stance : str
+        The foot in stance at the start.
+
+    Returns
+    -------
+    ContactResult
+
+    Raises
+    ------
+    ValueError
+        Unknown method; ``max_step_s`` with numbalsoda; numbalsoda not installed.
+    """
+    solver = Solver.from_settings(solver or SolverSettings.for_contact())
+    limits = _with_heights(walker, limits or ContactLimits())
+    stop = None
+    if max_heel_strikes is not None:
+        def stop(t, X):
+            return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
+                >= max_heel_strikes
+    run = integrate_contact(walker, x0, 0.0, t_final, solver, limits, stop)
+    ev = gait_events(walker, run.t, run.X, min_step_m, initial_stance)
+    hh = float(walker.hip_height(run.X[-1:])[0])
+    out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
+                   slip_limit_mm, limits.wall_time_limit_s)
+    return ContactResult(t=run.t, x=run.X, state_names=tuple(walker.state_names()),
+                         feet=ev["feet"], heel_strike_times=ev["hs_t"],
+                         heel_strike_legs=ev["hs_leg"], steps=ev["steps"],
+                         termination=run.termination, message=run.message, nfev=run.nfev,
+                         njev=run.njev, wall_time_s=run.wall_time_s, method=solver.method,
+                         pin_end_time=run.pin_end_time, outcome=out, points=ev["points"])
+
+
+def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
+    """``limits`` with default event heights taken from the walker's leg length."""
+    d = ContactLimits()
+    upd = {}
+    if limits.fall_hip_height_m == d.fall_hip_height_m:
+        upd["fall_hip_height_m"] = 0.5 * walker.L
+    if limits.airborne_hip_height_m == d.airborne_hip_height_m:
+        upd["airborne_hip_height_m"] = AIRBORNE_HEIGHT_FACTOR * walker.L
+    return replace(limits, **upd)
+
+
+def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_scale=None):
+    """The contact walker of a scene, its initial state and run limits (the start of
+    :func:`simulate_from`, shared with the benchmark).
+
+    Parameters
+    ----------
+    setup : ContactSetup
+        The scene's contact model (:func:`walkerlab.models.contact.scene.contact_setup`).
+    x_ideal : ndarray (n,)
+        Ideal post-impact state (rigid walker's ``state_names()`` order) [rad, rad/s].
+    n_strides : int
+        Strides the run may take (patches are laid out for them).
+    rate_scale : (float, float), optional
+        Multipliers on the initial rates (default ``contact_sim.initial_rate_scale``).
+
+    Returns
+    -------
+    walker, x0, limits, step_length
+        :class:`ContactWalker`, the initial state (N,), :class:`ContactLimits` from the
+        scene's ``contact_sim`` section, the ideal step length [m].
+    """
+    cs = setup.sim
+    walker, step_length = setup.build(x_ideal, 2 * n_strides)
+    scale = cs.initial_rate_scale if rate_scale is None else rate_scale
+    x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
+    limits = ContactLimits(
+        sample_rate_hz=cs.sample_rate_hz, pin_stance_until=cs.pin_stance_until,
+        pin_time_s=cs.pin_time_s,
+        fall_hip_height_m=cs.fall_hip_height_m or ContactLimits().fall_hip_height_m,
+        wall_time_limit_s=cs.wall_time_limit_s)
+    return walker, x0, limits, step_length
+
+
+def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_scale=None,
+                  solver: SolverSettings | None = None, strides: int | None = None):
+    """Run the contact walker of a scene from the ideal fixed point ``x_ideal``.
+
+    Parameters
+    ----------
+    setup : ContactSetup
+        The scene's contact model (:func:`walkerlab.models.contact.scene.contact_setup`).
+    x_ideal : ndarray (n,)
+        Ideal post-impact state in the rigid walker's ``state_names()`` order (leg1 = swing,
+        leg2 = stance) [rad, rad/s].
+    period : float
+        Ideal step period [s] (sets the default simulated time).
+    rate_scale : (float, float), optional
+        Multipliers on the initial rates (default ``contact_sim.initial_rate_scale``).
+    solver : SolverSettings, optional
+        Default: the scene's ``contact_solver``.
+    strides : int, optional
+        Strides to simulate (default ``contact_sim.n_strides``).
+
+    Returns
+    -------
+    walker, result, x0, step_length
+        :class:`ContactWalker`, :class:`ContactResult`, the initial state (N,), the ideal
+        step length [m].
+    """
+    cs, sv = setup.sim, solver or setup.solver
+    n_strides = strides or cs.n_strides
+    walker, x0, limits, step_length = scene_start(setup, x_ideal, n_strides, rate_scale)
+    t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
+    res = simulate_contact(walker, x0, t_final, sv, limits,
+                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
+    return walker, res, x0, step_length
+
+
+def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
+    """State name -> name in the shared trajectory layout for every leg coordinate of the
+    walker (the hip position and velocity are points): the floating coordinate's name
+    (``<leg>_angle``, kneed ``<leg>_thigh_angle``, ``<leg>_shank_angle``; the same names as
+    the rigid walker's ``leg_coordinates``) and ``..._rate`` for its rate.
+    """
+    idx = StateIndex(walker)
+    n = idx.coordinates.stop
+    out = {}
+    for i, coord in enumerate(walker.coordinate_names()):
+        if coord in ("hip_x", "hip_y"):
+            continue
+        leg = coord.split("_", 1)[0]
+        new = coord if leg not in ("leg1", "leg2") else legs[int(leg[-1]) - 1] + coord[4:]
+        out[idx.names[i]] = new
+        out[idx.names[n + i]] = new.removesuffix("_angle") + "_rate"
+    return out
+
+
+def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
+    """A :class:`ContactResult` in the shared named layout of
+    :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes;
+    coordinates by :func:`trajectory_names`, points from the generated floating view: hip,
+    each body ``<leg>_<body>``, feet, knees)."""
+    from walkerlab.io.trajectory import NamedTrajectory
+
+    legs = list(legs)
+    t = res.t
+    stance = np.full(t.size, legs.index("leg2"))
+    step = np.zeros(t.size, dtype=int)
+    for k, (ths, leg) in enumerate(zip(res.heel_strike_times, res.heel_strike_legs)):
+        m = t >= ths
+        stance[m] = legs.index(leg)
+        step[m] = k + 1
+    X = res.x
+    en = walker.energies(X)
+    pts = {k: np.asarray(v, float).reshape(2, -1) for k, v in walker.points(X).items()}
+    names = trajectory_names(walker, legs)
+    units = dict(zip(walker.state_names(), walker.state_units()))
+    coords = {new: res.column(old) for old, new in names.items()}
+    return NamedTrajectory(
+        time=t, legs=legs, coordinates=coords, units={names[o]: units[o] for o in names},
+        stance_leg=stance, step_index=step, kinetic=en["kinetic"], potential=en["potential"],
+        points=pts)

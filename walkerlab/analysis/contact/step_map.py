@@ -1,0 +1,365 @@
+"""The compliant-contact walker's mid-stance step map: its Poincaré section, section
+coordinates and the footfall-relative terrain it integrates on.
+
+Poincaré section
+----------------
+Mid-stance single support: the legs' proximal links are aligned (straight legs: the legs;
+kneed legs: the thighs), ``theta_swing - theta_stance`` of those links crosses zero upward
+(the links are found by name, ``walker.leg_angle_states(leg)[0]``).  In the compliant
+model a heel strike is not an instant but a double-support phase
+(both feet loaded for ~10 ms), so a touchdown section would cut through an impact transient;
+at mid-stance only the stance foot is loaded and the state is smooth.
+
+Section coordinates (all states - section constraint - translation along the slope, by
+name, :func:`section_coordinates`); straight legs (6 = 8 - 2)::
+
+    z = [theta_stance, dtheta_swing, dtheta_stance,
+         delta_stance, v_t_stance, ddelta_stance]
+
+kneed legs (10 = 12 - 2): ``theta_stance_thigh, theta_stance_shank, theta_swing_shank``, the
+four link rates (swing leg first), then the three stance-foot coordinates.
+``theta_swing = theta_stance`` on the section [rad]; rates [rad/s]; ``delta_stance`` is the
+stance foot's penetration [m] (along -n), ``v_t_stance`` its down-slope slip velocity [m/s],
+``ddelta_stance`` its penetration rate [m/s].  The along-slope position of the stance foot is
+dropped (the dynamics are invariant under translation along the slope, see *Terrain*).
+
+Step map
+--------
+``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 = stance,
+leg1 = swing: the legs are identical, so one orientation suffices), integrate with
+``solve_ivp`` (LSODA or Radau with the analytic numba Jacobian; through
+:func:`walkerlab.integrate.events.run_to_event`, or odeint on a grid with
+:func:`~walkerlab.integrate.events.odeint_grid`) until the next upward zero
+of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), located by
+``solve_ivp``'s event root-finding on the dense output; swap the leg roles and express the
+state relative to the new stance foot (leg1).  Outputs besides ``P(z)``: the step period
+``T`` [s] and the step length (along-slope displacement of the stance foot from one
+mid-stance to the next) [m].
+
+Terrain (the choice made here, and why)
+---------------------------------------
+Kneed walkers keep their scene's *continuous ground*: at the section the swing knee is
+flexed (~0.5 rad on ``configs/kneed.yaml``) and the swing foot ~5 cm above the ground.
+For straight legs, *continuous ground* is not usable at this section: with rigid legs of
+equal length the swing foot is exactly at stance-foot depth when the legs are aligned, i.e.
+it penetrates the ground (foot scuffing) precisely on the section.  *Checkerboard at fixed
+positions* breaks the translation invariance (the gait's steps are ~12 mm shorter than the
+ideal ones, so footfalls drift across the patches).  We therefore use **checkerboard lanes
+placed relative to the current footfall**: during each step the stance lane has one patch
+centred on the stance foot's section position (s = 0) and the swing lane one patch centred
+one *ideal* step length ``l`` ahead (the paper's rule: patches around the footfalls of the
+ideal gait).  The swing foot passes over a gap at mid-stance exactly as in the ADAMS model.
+The re-centring is physically invisible as long as each foot stays inside its patch during
+its stance (the IMPACT force only depends on the patch membership, not on the distance to
+the centre): :func:`find_contact_periodic_gait` reports the worst margin to a patch edge
+(``patch_margin_m``), and the fixed point is then a true periodic gait of a checkerboard
+whose patches are spaced by the gait's own step length.
+
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+from scipy.optimize import brentq
+
+from walkerlab.integrate.ends import RunEnd
+from walkerlab.integrate.events import Event, EventRun, odeint_grid, run_to_event
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.contact.model import ContactWalker, footprint_offsets
+from walkerlab.walker.layout import StateIndex
+
+__all__ = ["SCALES", "SECTION_NAMES", "SECTION_UNITS", "PeriodicGaitError", "StepMap",
+           "section_coordinates", "section_guess_from_ideal"]
+
+SECTION_NAMES = ("theta_stance", "dtheta_swing", "dtheta_stance", "delta_stance",
+                 "v_t_stance", "ddelta_stance")
+SECTION_UNITS = ("rad", "rad/s", "rad/s", "m", "m/s", "m/s")
+
+
+class PeriodicGaitError(RuntimeError):
+    """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
+    "time_limit", "solver_failure"."""
+
+    def __init__(self, kind: str, message: str):
+        super().__init__(message)
+        self.kind = kind
+
+
+class StepMap:
+    """Mid-stance-to-mid-stance step map of a :class:`ContactWalker`.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        Parameters and contact law; its lanes are replaced by footfall-relative lanes
+        (kneed walkers on continuous ground keep it).  Any walker the contact model builds.
+    patch_spacing : float, optional
+        Distance [m] ahead of the stance foot of the swing lane's patch (default: the
+        walker's lane spacing ``lane1[0] - lane2[0]`` if it has lanes, else 0.372 m).
+    method : {"LSODA", "Radau", "BDF"}
+    rtol, atol : float
+        Integrator tolerances (``atol`` well below the penetration ~6e-5 m).
+    t_max : float
+        Give up a step after this time [s].
+    """
+
+    def __init__(self, walker: ContactWalker, patch_spacing: float | None = None,
+                 method: str = "LSODA", rtol: float = 1e-11, atol: float = 1e-13,
+                 t_max: float = 3.0, deadline: float | None = None):
+        if patch_spacing is None:
+            if walker.lane1.size and walker.lane2.size:
+                patch_spacing = float(walker.lane1[0] - walker.lane2[0])
+            else:
+                patch_spacing = 0.372
+        self.spacing = float(patch_spacing)
+        # straight legs scuff the ground at mid-stance: footfall-relative lanes (module doc);
+        # a kneed swing leg is flexed there, so its continuous ground is kept
+        keep_ground = walker.continuous and walker.structure.knee
+        # each patch centred on its foot's footprint (a flat foot's lies ahead of its heel)
+        o2 = footprint_offsets(walker.data)[1]
+        self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing + o2]),
+                                          lane2=np.array([o2]), continuous=keep_ground)
+        self.method, self.t_max = method, t_max
+        self.solver = Solver(method, rtol, atol)  # the step map's integrator
+        self.deadline = np.inf if deadline is None else deadline
+        self.nfev = 0
+        w = self.walker
+        kern = w.kernels
+        args = (w.contact_params, w.walker_params, *w.kernel_lanes)
+        self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
+        self._fj = lambda x: kern.jac(x, *args)  # noqa: E731
+        self.n, self.t = w.normal, w.tangent
+        self.idx = StateIndex(w)
+        # every column by name (leg1 = 0, leg2 = 1), never by row: each leg's link angles,
+        # proximal first (the section is the crossing of the two proximal links)
+        self._links = [w.leg_angle_states("leg1"), w.leg_angle_states("leg2")]
+        self._angle = [self.idx[a[0]] for a in self._links]
+        self._rate = [self.idx.rate_of(a[0]) for a in self._links]
+        self.names, self.units, self.scale = section_coordinates(w)
+
+    def _columns(self, stance: int) -> list[int]:
+        """State columns of the link coordinates in section order, with foot ``stance``."""
+        ix, st, sw = self.idx, self._links[stance], self._links[1 - stance]
+        return ([ix[a] for a in st] + [ix[a] for a in sw[1:]]
+                + [ix.rate_of(a) for a in sw] + [ix.rate_of(a) for a in st])
+
+    # ------------------------------------------------------------------ coordinates
+    def to_state(self, z) -> np.ndarray:
+        """Full state (2 nq,) from section coordinates (leg2 stance, stance foot at s = 0)."""
+        z = np.asarray(z, float)
+        nl = len(z) - 3
+        d, vt, dd = z[nl:]
+        p = -d * self.n
+        v = vt * self.t - dd * self.n
+        # link state by name: the swing leg's proximal link aligned with the stance one's
+        val = dict(zip(self._columns(1), z[:nl]))
+        val[self._angle[0]] = val[self._angle[1]]
+        ix = self.idx
+        cols = [ix[c] for c in ix.names[ix.coordinates] if c not in ("hip_x", "hip_y")]
+        zp = np.array([val[c] for c in cols] + [val[ix.rate_of(ix.names[c])] for c in cols])
+        # stance foot at p and at rest, then the whole walker translated at v
+        x = self.walker.pinned_to_full(zp, p)
+        x[[ix.rate_of("hip_x"), ix.rate_of("hip_y")]] += v
+        return x
+
+    def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
+        """Section coordinates (:attr:`names`) and along-slope position s [m] of foot
+        ``stance`` (0/1)."""
+        x = np.asarray(x, float)
+        px, py, vx, vy = self.walker.foot_state(x, stance)
+        p, v = np.array([px, py]), np.array([vx, vy])
+        z = np.concatenate([x[self._columns(stance)], [-p @ self.n, v @ self.t, -v @ self.n]])
+        return z, float(p @ self.t)
+
+    # ------------------------------------------------------------------ the map
+    def _rhs(self, t, x):
+        if time.perf_counter() > self.deadline:
+            raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
+                                    "reached")
+        return self._f(x)
+
+    def _jac(self, t, x):
+        return self._fj(x)
+
+    def integrate(self, x0, stance_to_come: int = 0, dense: bool = False) -> EventRun:
+        """Integrate from ``x0`` to the next upward zero of theta_sw - theta_st where the
+        new stance leg is ``stance_to_come`` (0 = leg1): event ``mid_stance``, or ``fall``
+        (hip below L/2; :func:`walkerlab.integrate.events.run_to_event`)."""
+        ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
+        hth = 0.5 * self.walker.L
+        events = [Event("mid_stance", lambda t, x: x[isw] - x[ist], 1.0),
+                  Event("fall", lambda t, x: self.walker.fall_margin(x, hth), -1.0,
+                        RunEnd.FALL)]
+        run = run_to_event(self._rhs, x0, self.t_max, self.solver, events, jac=self._jac,
+                           dense=dense)
+        self.nfev += 1
+        return run
+
+    def _step_odeint(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
+                     chunk_s: float = 0.25):
+        """``method="odeint"``: (t_e, x_e) of the next upward zero of theta_sw - theta_st.
+
+        scipy's odeint (LSODA without per-step Python overhead) on a ``dt`` grid in chunks;
+        the crossing is bracketed on the samples and located by ``scipy.optimize.brentq``
+        on short odeint integrations from the sample before it, so the section state
+        carries the integrator's accuracy, not an interpolant's.
+        """
+        ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
+        hth = 0.5 * self.walker.L
+        frhs, fjac = self._f, self._fj
+
+        def f(t, x):
+            return frhs(x)
+
+        def jf(t, x):
+            return fjac(x)
+
+        def run(x, tg):
+            X, end, message = odeint_grid(f, x, tg, self.solver, jac=jf)
+            if end is RunEnd.SOLVER_FAILURE:
+                raise PeriodicGaitError("solver_failure", f"step map: {message}")
+            return X
+
+        ta, xa = 0.0, np.asarray(x0, float)
+        self.nfev += 1
+        while ta < self.t_max:
+            if time.perf_counter() > self.deadline:
+                raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
+                                        "reached")
+            tg = ta + dt * np.arange(int(round(chunk_s / dt)) + 1)
+            X = run(xa, tg)
+            g = X[:, isw] - X[:, ist]
+            hh = self.walker.hip_height(X)
+            up = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0)) + 1
+            down = np.flatnonzero(hh < hth)
+            if down.size and (not up.size or down[0] <= up[0]):
+                raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+            if up.size:
+                k = int(up[0])
+                xk = X[k - 1]
+
+                def gap(t, k=k, xk=xk, tg=tg, g=g):
+                    if t <= tg[k - 1]:
+                        return g[k - 1]
+                    x = run(xk, np.array([tg[k - 1], t]))[-1]
+                    return x[isw] - x[ist]
+
+                te = brentq(gap, tg[k - 1], tg[k], xtol=1e-13, rtol=1e-14)
+                xe = run(xk, np.array([tg[k - 1], te]))[-1] if te > tg[k - 1] else xk
+                return float(te), xe
+            ta, xa = tg[-1], X[-1]
+        raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
+                                f"{self.t_max:g} s")
+
+    def __call__(self, z):
+        """One step: returns (P(z) (n,), period [s], step length [m]).
+
+        Raises
+        ------
+        PeriodicGaitError
+            The walker fell, did not reach the next mid-stance within ``t_max``, the solver
+            failed or the wall-time limit ran out.
+        """
+        if self.method == "odeint":
+            te, xe = self._step_odeint(self.to_state(z))
+            z1, s1 = self.to_section(xe, 0)
+            return z1, te, s1
+        run = self.integrate(self.to_state(z))
+        if run.event != "mid_stance":
+            if run.end is RunEnd.FALL:
+                raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+            if run.end is RunEnd.SOLVER_FAILURE:
+                raise PeriodicGaitError("solver_failure", f"step map: {run.message}")
+            raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
+                                    f"{self.t_max:g} s")
+        z1, s1 = self.to_section(run.y_event, 0)
+        return z1, run.t_event, s1
+
+    def patch_margin(self, z) -> float:
+        """Smallest distance [m] of a loaded foot to its patch edge over one step."""
+        if self.method == "odeint":
+            x0 = self.to_state(z)
+            te = self._step_odeint(x0)[0]
+            tt = np.linspace(0.0, te, 2001)
+            X = odeint_grid(lambda t, x: self._f(x), x0, tt, self.solver,
+                            jac=lambda t, x: self._fj(x))[0]
+        else:
+            run = self.integrate(self.to_state(z), dense=True)
+            te = run.t_event if run.event == "mid_stance" else run.t[-1]
+            tt = np.linspace(0.0, te, 2001)
+            X = run.dense(tt).T
+        if self.walker.continuous:
+            return np.inf  # continuous ground: no patch edges
+        cq = self.walker.contact_quantities(X)
+        hw = self.walker.patch_half_width
+        margin = np.inf
+        for name, q in cq.items():  # every contact point on its leg's patch
+            c = float(self.walker.lane(name)[0])
+            loaded = q["penetration"] > 0
+            near = np.abs(q["s"] - c) <= 2 * hw  # in or next to this leg's patch
+            sel = loaded & near
+            if sel.any():
+                margin = min(margin, float(np.min(hw - np.abs(q["s"][sel] - c))))
+        return margin
+
+
+#: coordinate scales (SI) of the straight-legged section (:data:`SECTION_NAMES`) used for
+#: the root finder, the residual and the FD steps; the penetration scale is replaced by the
+#: walker's static penetration at run time (:func:`section_coordinates` for any walker).
+SCALES = np.array([1.0, 1.0, 1.0, 6e-5, 1e-3, 1e-3])
+
+
+def _role_name(state: str, role: str) -> str:
+    """``theta1_thigh`` -> ``theta_<role>_thigh``, ``dtheta2`` -> ``dtheta_<role>``."""
+    head, _, tail = state.partition("_")
+    return head.rstrip("12") + f"_{role}" + (f"_{tail}" if tail else "")
+
+
+def section_coordinates(walker: ContactWalker) -> tuple[tuple, tuple, np.ndarray]:
+    """Names, units and scales of the mid-stance section coordinates of ``walker``.
+
+    All states minus the section constraint (the swing leg's proximal link aligned with the
+    stance leg's) minus the along-slope translation, the hip position replaced by the stance
+    foot's contact: the stance leg's link angles, the swing leg's other link angles, the
+    swing leg's link rates, the stance leg's link rates, then ``delta_stance`` [m],
+    ``v_t_stance`` [m/s], ``ddelta_stance`` [m/s].  Straight legs: :data:`SECTION_NAMES`
+    (6); kneed legs: 10.
+
+    Returns
+    -------
+    names : tuple of str
+    units : tuple of str
+    scale : ndarray (n,)
+        1 rad, 1 rad/s, the static penetration, 1 mm/s, 1 mm/s (:data:`SCALES`).
+    """
+    st, sw = walker.leg_angle_states("leg2"), walker.leg_angle_states("leg1")
+    angles = [_role_name(a, "stance") for a in st] + [_role_name(a, "swing") for a in sw[1:]]
+    rates = ([_role_name("d" + a, "swing") for a in sw]
+             + [_role_name("d" + a, "stance") for a in st])
+    names = tuple(angles + rates) + SECTION_NAMES[-3:]
+    units = ("rad",) * len(angles) + ("rad/s",) * len(rates) + SECTION_UNITS[-3:]
+    scale = np.array([1.0] * (len(angles) + len(rates))
+                     + [walker.static_penetration(), 1e-3, 1e-3])
+    return names, units, scale
+
+
+def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) -> np.ndarray:
+    """Section state from an ideal-model post-impact state (the rigid walkers
+    ``state_names()`` order, e.g. ``[th_sw, th_st, w_sw, w_st]``).
+
+    The ideal state is placed as :func:`initial_state_from_ideal` does (stance foot leg2 at
+    its static penetration, ``rate_scale`` on the rates) and integrated to the first
+    mid-stance of leg2, where the section coordinates are read.
+    """
+    from walkerlab.analysis.contact.sim import initial_state_from_ideal
+
+    w = step_map.walker
+    x0 = initial_state_from_ideal(w, *np.asarray(x_ideal, float), rate_scale=rate_scale)
+    run = step_map.integrate(x0, stance_to_come=1)
+    if run.event != "mid_stance":
+        raise PeriodicGaitError("fall" if run.end is RunEnd.FALL else "no_mid_stance",
+                                "the ideal state does not reach mid-stance on the contact model")
+    return step_map.to_section(run.y_event, 1)[0]

@@ -1,0 +1,302 @@
+"""The Poincaré (step-to-step) map of a rigid walker for many states at once, each state on its
+own slope: the workhorse of the metastability studies (:mod:`walkerlab.analysis.robustness.mfpt`).
+
+One step of ``N`` walkers is integrated as one stacked system (``N x 2n`` states) by scipy's
+DOP853 (``scipy.integrate.DOP853``, stepped one step at a time); its right-hand side calls the
+walker's compiled flow (the numba ``cfunc`` of :class:`walkerlab.codegen.compiled.CompiledFlow`,
+the same generated equations as every other rigid integration) once per walker, in one
+compiled loop (:func:`walkerlab.integrate.batch_rows.kernel`), so the per-step Python cost of
+the integrator is shared by all ``N`` walkers.  Guards are the cfunc's extra outputs; after
+each integrator step the walkers whose guard changed sign in its direction (``solve_ivp``'s
+rule) are located on the step's dense output (DOP853's 7th-order interpolant, evaluated
+row-wise for those walkers) by ``scipy.optimize.elementwise.find_root`` (Chandrupatla's
+bracketing method, vectorised) and leave the stacked system; the others go on (the system
+is restarted with the remaining rows and the last step size).  The phases of a step
+(early/late swing, unlocked/locked knee) are run one after the other, each from the
+phase-local time 0 (the flows are autonomous).
+
+Per-step slope (a walker on rough terrain, Byl & Tedrake 2009): each row has its own slope
+``gamma``: the parameter vector of the compiled functions (``Structure.param_names``) with
+``gamma`` replaced, so the heel-strike guard of a compass walker becomes
+``theta_swing + theta_stance = -2 gamma_n`` (the ground of step ``n`` is the line through the
+stance foot at slope ``gamma_n``); the model generator is untouched.
+
+Accuracy: scipy's error norm is the RMS over all components, so the tolerances handed to
+DOP853 are the requested ones divided by ``sqrt(N 2n)``: a single walker's error estimate
+then stays below the requested tolerance, as if it were integrated alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.integrate.batch_rows import StackedRows, dense_rows
+
+#: How a step of one row ended (``outcome`` codes are indices into this tuple).
+STEP_OUTCOMES = ("heel_strike", "fall", "timeout", "solver_failure")
+HEEL_STRIKE, FALL, TIMEOUT, SOLVER_FAILURE = range(4)
+
+@dataclass
+class BatchStep:
+    """One step of ``N`` rows.
+
+    Attributes
+    ----------
+    outcome : ndarray of int8, shape (N,)
+        Index into :data:`STEP_OUTCOMES`.
+    x_pre : ndarray, shape (N, 2n)
+        State at the step's end (just before heel strike; at the fall guard for a fall;
+        NaN for a timeout or solver failure).
+    x_next : ndarray, shape (N, 2n)
+        State just after heel strike (role-ordered, the next step's start); NaN otherwise.
+    step_time_s : ndarray, shape (N,)
+        Duration of the step [s] (NaN for a timeout or failure).
+    """
+
+    outcome: np.ndarray
+    x_pre: np.ndarray
+    x_next: np.ndarray
+    step_time_s: np.ndarray
+
+
+class BatchStepMap:
+    """The step map ``x_{k+1} = P(x_k; gamma_k)`` of a rigid walker, for many rows at once.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+        Built from generated code (every phase has a compiled flow).
+    walker_at : callable ``gamma [rad] -> HybridWalker``
+        The same walker on another slope (its reset maps, where they depend on the slope).
+    rtol, atol : float
+        Per-walker tolerances of DOP853 (see the module docstring).
+    max_step_time_s : float
+        A step longer than this ends as ``timeout`` (a fall: no heel strike) [s].
+
+    Raises
+    ------
+    ValueError
+        A phase without a compiled flow (e.g. ``ideal.variant: appendix_a``), or a walker
+        whose state coordinates depend on the slope (``coordinates: slope_relative``): a
+        state could not be carried from one step's slope to the next.
+    """
+
+    def __init__(self, walker, walker_at, rtol: float = 1e-9, atol: float = 1e-9,
+                 max_step_time_s: float = 5.0):
+        from walkerlab.codegen.compiled import compiled_module
+
+        self.walker, self.walker_at = walker, walker_at
+        self.rtol, self.atol, self.max_step_time_s = rtol, atol, max_step_time_s
+        self.n = walker.layout().size
+        self.phases = []
+        for ph in walker.phases:
+            cf = ph.compiled
+            if cf is None or cf.guard_columns() is None:
+                raise ValueError(f"{walker.name} ({walker.variant}): phase {ph.name!r} has no "
+                                 "compiled flow; per-step terrain needs the generated model "
+                                 "(ideal.variant: derived; flat feet are not compiled yet)")
+            mod = compiled_module(cf.structure)
+            n_extra, cols, offs = cf.guard_columns()
+            self.phases.append((ph, getattr(mod, cf.name), n_extra, cols, offs,
+                                np.array([g.direction for g in ph.guards])))
+        # a step-down (or up) of the ground at the footfall: the last phase's heel strike
+        # becomes the swing foot's clearance above the slope line reaching -drop
+        lastc = walker.phases[-1].compiled
+        names = compiled_module(lastc.structure).GUARDS
+        self._hs = [j for j, g in enumerate(walker.phases[-1].guards)
+                    if g.outcome == "heel_strike"]
+        self._clear = names.index("swing_clearance") if "swing_clearance" in names else None
+        first = walker.phases[0].compiled
+        self._constants = compiled_module(first.structure).constants
+        self._params = np.array(first.params, dtype=float)
+        self._ig = list(first.structure.param_names).index("gamma")
+        self.slope_rad = float(walker.slope_rad)
+        self._resets_depend_on_slope = self._probe_slope_dependence()
+        self._walkers: dict[float, object] = {}
+
+    # -- slope handling -------------------------------------------------------------------
+    def _probe_slope_dependence(self) -> bool:
+        """Check the state coordinates are slope-independent; return whether the reset maps
+        are (probe: a generic state on two slopes)."""
+        w2 = self.walker_at(self.slope_rad + 0.01)
+        probe = np.linspace(0.11, 0.37, self.n) * np.array([1, -1] * (self.n // 2))
+        a = self.walker.leg_coordinates(probe, self.walker.legs[-1])
+        b = w2.leg_coordinates(probe, w2.legs[-1])
+        if any(not np.allclose(a[k], b[k], rtol=0, atol=1e-14) for k in a):
+            raise ValueError("terrain.per_step: the walker's state coordinates are measured "
+                             "from the slope (walker.coordinates: slope_relative); per-step "
+                             "slopes need absolute coordinates")
+        same = np.array_equal(np.asarray(self.walker.reset(probe)), np.asarray(w2.reset(probe)))
+        for p1, p2 in zip(self.walker.phases, w2.phases):
+            for g1, g2 in zip(p1.guards, p2.guards):
+                if g1.reset is not None:
+                    same &= np.array_equal(np.asarray(g1.reset(probe)), np.asarray(g2.reset(probe)))
+        return not same
+
+    def _walker(self, gamma: float):
+        if not self._resets_depend_on_slope or gamma == self.slope_rad:
+            return self.walker
+        w = self._walkers.get(gamma)
+        if w is None:
+            if len(self._walkers) > 4096:
+                self._walkers.clear()
+            w = self._walkers[gamma] = self.walker_at(gamma)
+        return w
+
+    def data(self, gamma: np.ndarray) -> np.ndarray:
+        """Data vectors (N, c) of the compiled functions, one per slope [rad]."""
+        uniq, inv = np.unique(np.asarray(gamma, dtype=float), return_inverse=True)
+        rows = []
+        for g in uniq:
+            p = self._params.copy()
+            p[self._ig] = g
+            rows.append(self._constants(p))
+        return np.ascontiguousarray(np.stack(rows)[inv.ravel()])
+
+    # -- the map --------------------------------------------------------------------------
+    def step(self, X: np.ndarray, gamma: np.ndarray | float | None = None,
+             drop_m: np.ndarray | float | None = None) -> BatchStep:
+        """One step of every row.
+
+        Parameters
+        ----------
+        X : ndarray, shape (N, 2n)
+            Role-ordered states just after a heel strike.
+        gamma : ndarray (N,) or float, optional
+            Slope of this step [rad] for each row; default the walker's slope.
+        drop_m : ndarray (N,) or float, optional
+            The ground at this step's footfall lies ``drop_m`` [m] below the slope line
+            through the stance foot (a step-down; negative: a step-up), measured as the
+            model's swing-foot clearance above that line: the heel strike is the clearance
+            reaching ``-drop_m`` after the foot has risen above both ground levels (rows
+            with ``drop_m = 0`` keep the ordinary heel-strike guard).
+
+        Raises
+        ------
+        ValueError
+            ``drop_m`` for a walker whose generated model has no swing-foot clearance.
+
+        Returns
+        -------
+        BatchStep
+        """
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        N, m = X.shape
+        gamma = np.broadcast_to(self.slope_rad if gamma is None else
+                                np.asarray(gamma, dtype=float), (N,)).copy()
+        D = self.data(gamma)
+        nc = D.shape[1]
+        if drop_m is not None:
+            if self._clear is None:
+                raise ValueError(f"{self.walker.name}: no swing-foot clearance in the model; "
+                                 "a step-down cannot be located")
+            drop = np.broadcast_to(np.asarray(drop_m, dtype=float), (N,))
+            D = np.hstack([D, drop[:, None]])
+        out = BatchStep(np.full(N, TIMEOUT, np.int8), np.full((N, m), np.nan),
+                        np.full((N, m), np.nan), np.full(N, np.nan))
+        rows, Y, T = np.arange(N), X.copy(), np.zeros(N)
+        for k, phase in enumerate(self.phases):
+            if rows.size == 0:
+                break
+            rows, Y, T = self._phase(k, phase, rows, Y, T, D, nc, gamma, out)
+        return out
+
+    def _phase(self, k, phase, rows, Y, T, D, nc, gamma, out):
+        """Integrate rows through phase ``k``; returns the rows that go on to phase k + 1
+        (their entry states and times).  ``D[:, :nc]`` are the data vectors; a column
+        after them is the per-row drop of the footfall [m] (last phase only)."""
+        ph, cfunc, n_extra, gcols, goffs, dirs = phase
+        # a step-down/up (rows with a nonzero drop, last phase): the heel strike is the
+        # swing foot's clearance reaching -drop, armed once the foot has risen above both
+        # ground levels (just after mid-stance a point foot is below the slope line: the
+        # scuffing the ideal model ignores, which must not count as the landing)
+        drop = D.shape[1] > nc and k == len(self.phases) - 1
+        hs = self._hs[0] if self._hs else None
+        m = self.n
+        last = k == len(self.phases) - 1
+        nxt: tuple[list, list, list] = ([], [], [])
+        cap = self.max_step_time_s - T  # remaining time of each row [s]
+        ok = cap > 0
+        out.outcome[rows[~ok]] = TIMEOUT
+        rows, Y, T, cap = rows[ok], Y[ok], T[ok], cap[ok]
+        Dk = D[rows]
+        if drop:  # one more column: armed (1) or not (0)
+            Dk = np.hstack([Dk, np.zeros((rows.size, 1))])
+        stk = StackedRows(cfunc, n_extra, gcols, goffs, nc, m, drop, hs, self._clear)
+        solver = stk.solver(Y, Dk, 0.0, None, float(cap.max()), self.rtol, self.atol)
+        G_old = stk.guards(Y, Dk)
+        while rows.size:
+            solver.step()
+            if solver.status == "failed":
+                out.outcome[rows] = SOLVER_FAILURE
+                break
+            t_new = solver.t
+            Yn = solver.y.reshape(-1, m)
+            G_new = stk.guards(Yn, Dk)
+            up = (G_old <= 0) & (G_new >= 0) & (dirs >= 0)
+            down = (G_old >= 0) & (G_new <= 0) & (dirs <= 0)
+            hit = up | down
+            if drop:
+                dr = Dk[:, nc] != 0
+                hit[dr, hs] &= Dk[dr, nc + 1] > 0
+                clearance = G_new[:, hs] - Dk[:, nc]
+                Dk[dr & (clearance > np.maximum(0.0, -Dk[:, nc])), nc + 1] = 1.0
+            done = hit.any(axis=1)
+            te = np.full(rows.size, np.inf)
+            which = np.full(rows.size, -1)
+            if done.any():
+                dense = solver.dense_output()
+                stk.locate(hit, G_old, G_new, dense, t_new, Dk, te, which)
+            late = ~done & (t_new >= cap)
+            # rows that ended (guard or time cap) leave the stacked system
+            idone = np.flatnonzero(done)
+            Y_ev = (dense_rows(dense, idone[:, None] * m + np.arange(m)[None, :], te[idone])
+                    if idone.size else None)
+            for y_ev, i in zip(Y_ev if idone.size else (), idone):
+                self._leave(k, ph.guards[which[i]], which[i], rows[i], T[i] + te[i], y_ev,
+                            gamma, out, nxt, last)
+            out.outcome[rows[late]] = TIMEOUT
+            keep = ~(done | late)
+            if solver.status == "finished" and keep.any():  # pragma: no cover - t_bound > cap
+                out.outcome[rows[keep]] = TIMEOUT
+                break
+            if not keep.all():
+                rows, T, cap, Dk = rows[keep], T[keep], cap[keep], Dk[keep]
+                Yk = Yn[keep]
+                G_old = G_new[keep]
+                if rows.size:
+                    h = solver.step_size
+                    solver = stk.solver(Yk, Dk, t_new, h, float(cap.max()), self.rtol,
+                                        self.atol)
+            else:
+                G_old = G_new
+        if nxt[0]:
+            return np.array(nxt[0]), np.array(nxt[1]), np.array(nxt[2])
+        return np.empty(0, int), np.empty((0, m)), np.empty(0)
+
+    def _leave(self, k, g, j, r0, t_end, y_ev, gamma, out, nxt, last) -> None:
+        """Row ``r0`` met guard ``g`` (index ``j`` of phase ``k``) at ``t_end`` [s] in state
+        ``y_ev``: a fall or a heel strike ends its step in ``out``; a next-phase guard
+        (with its intra-step reset, e.g. a knee strike) appends its entry to ``nxt`` (rows,
+        states, times)."""
+        if g.outcome == "fall":
+            out.outcome[r0] = FALL
+            out.x_pre[r0] = y_ev
+            out.step_time_s[r0] = t_end
+        elif g.outcome == "heel_strike":
+            w = self._walker(float(gamma[r0]))
+            out.outcome[r0] = HEEL_STRIKE
+            out.x_pre[r0] = y_ev
+            out.x_next[r0] = np.asarray(w.reset(y_ev), dtype=float)
+            out.step_time_s[r0] = t_end
+        elif last:  # pragma: no cover - a model whose last phase has no heel strike
+            out.outcome[r0] = SOLVER_FAILURE
+        else:
+            w = self._walker(float(gamma[r0]))
+            gw = w.phases[k].guards[j]
+            y1 = np.asarray(gw.reset(y_ev), float) if gw.reset is not None else y_ev
+            nxt[0].append(r0)
+            nxt[1].append(y1)
+            nxt[2].append(t_end)

@@ -1,0 +1,369 @@
+"""Poincaré map, period-1 fixed point and Floquet multipliers (paper Sec. 3.3, Eq. 10).
+
+The Poincaré section is the state just after heel strike.  The map ``P`` integrates one
+step and applies the impact; its fixed point is found with ``scipy.optimize.root`` on the
+map reduced to the guard surface (``walker.section`` coordinates).  Floquet multipliers are
+the eigenvalues of ``DP`` at the fixed point, computed (a) by central finite differences of
+``P`` and (b) from the variational equations with saltation matrices at the guards; one
+multiplier is zero by construction because ``P`` lands on the guard surface.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab import numerics
+from walkerlab.freshstack import import_on_fresh_stack
+from walkerlab.integrate.rigid import integrate_step
+from walkerlab.integrate.rigid_phase import numeric_jacobian
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.numerics import sort_multipliers
+
+
+class StepFailed(RuntimeError):
+    """One step did not end in heel strike (``termination`` says how it ended)."""
+
+    def __init__(self, termination: str, t: float, x: np.ndarray, message: str = ""):
+        super().__init__(f"step ended by {termination} at t = {t:.4g} s {message}".strip())
+        self.termination, self.t, self.x = termination, t, x
+
+
+class FixedPointNotFound(RuntimeError):
+    """The root finder stopped without a fixed point; ``residual`` is the best reached."""
+
+    def __init__(self, message: str, residual: float):
+        super().__init__(f"no fixed point found: {message} (residual {residual:.3g})")
+        self.residual = residual
+
+
+def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
+                 max_step_time: float = 5.0, jacobian: bool = False,
+                 steps: list | None = None):
+    """The Poincaré map ``x_{n+1} = P(x_n)`` (Eq. 10): one step, or one stride (two steps,
+    ``legs[0]`` swinging first) for a walker whose legs differ (``walker.mirror``).
+
+    Parameters
+    ----------
+    x : ndarray, shape (2n,)
+        State just after heel strike (role-ordered), ``legs[0]`` about to swing.
+    jacobian : bool
+        Also return ``DP`` (2n x 2n) from the variational equations (with saltation at every
+        guard; for a stride the product of the two steps' Jacobians).
+    steps : list, optional
+        The steps' :class:`~walkerlab.integrate.rigid.Segment` are appended to it.
+
+    Returns
+    -------
+    x_next : ndarray, shape (2n,)
+    period : float
+        Period of the map [s]: the step period, or the stride period.
+    DP : ndarray (2n, 2n), only if ``jacobian``.
+    nfev : int
+
+    Raises
+    ------
+    StepFailed
+        A step ended in a fall, a solver failure or ran past ``max_step_time``.
+    """
+    legs = walker.legs
+    period, nfev, DP = 0.0, 0, np.eye(np.size(x))
+    for k in range(walker.steps_per_map):
+        stance = legs[1] if k == 0 else legs[0]
+        seg = integrate_step(walker.for_stance(stance), x, solver, t0=period,
+                             max_step_time=max_step_time, variational=jacobian, index=k,
+                             stance_leg=stance)
+        if steps is not None:
+            steps.append(seg)
+        nfev += seg.nfev
+        if seg.termination != "heel_strike":
+            raise StepFailed(seg.termination, seg.t_end, seg.x_end, seg.message)
+        x, period = seg.x_next, seg.t_end
+        if jacobian:
+            DP = seg.monodromy @ DP
+    if jacobian:
+        return x, period, DP, nfev
+    return x, period, nfev
+
+
+def map_fd_jacobian(walker: HybridWalker, x: np.ndarray, solver: Solver, h: float = 1e-7,
+                max_step_time: float = 5.0) -> tuple[np.ndarray, int]:
+    """Central finite-difference Jacobian of the Poincaré map and its RHS count.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    x : ndarray, shape (2n,)
+        Post-impact state (role order) [rad, rad/s].
+    solver : Solver
+    h : float
+        Step in every coordinate [rad or rad/s].
+    max_step_time : float
+        Give up a step after this time [s].
+
+    Returns
+    -------
+    J : ndarray, shape (2n, 2n)
+    nfev : int
+        Right-hand-side evaluations of the 2 * 2n maps.
+
+    Raises
+    ------
+    StepFailed
+        A perturbed step fell or timed out (as :func:`poincare_map`).
+    """
+    nfev = 0
+
+    def P(z):
+        nonlocal nfev
+        xz, _, f = poincare_map(walker, z, solver, max_step_time)
+        nfev += f
+        return xz
+
+    return numerics.fd_jacobian(P, x, h), nfev
+
+
+@dataclass
+class FixedPointResult:
+    """Period-1 gait: fixed point, period, multipliers and bookkeeping.
+
+    Attributes
+    ----------
+    x : ndarray (2n,)  fixed point just after heel strike (role-ordered)
+    period_s : float   step period [s]
+    residual : float   ``max |P(x) - x|``
+    multipliers_variational, multipliers_fd : ndarray (2n,) complex
+        Eigenvalues of ``DP`` (variational equations / finite differences), sorted.
+    jacobian_variational, jacobian_fd : ndarray (2n, 2n)
+    nfev : int         RHS evaluations in total (search + Jacobians)
+    iterations : int   map evaluations by the root finder
+    wall_time_s : float
+    variational_maps : int
+        Maps with the variational equations: the one at the fixed point, plus any the root
+        finder asked for as a Jacobian
+    stable : bool      all multipliers (variational) strictly inside the unit circle
+    step_periods_s, step_lengths_m : tuple of float
+        Each step of the map [s], [m] (one step; two, ``legs[0]`` swinging first, when the
+        map is a stride); a step's length is the distance from its stance foot to the
+        swing foot at heel strike
+    """
+
+    x: np.ndarray
+    period_s: float
+    residual: float
+    multipliers_variational: np.ndarray
+    multipliers_fd: np.ndarray
+    jacobian_variational: np.ndarray
+    jacobian_fd: np.ndarray
+    nfev: int
+    iterations: int
+    wall_time_s: float
+    variational_maps: int = 1
+    step_periods_s: tuple = ()
+    step_lengths_m: tuple = ()
+
+    @property
+    def stable(self) -> bool:
+        return bool(np.max(np.abs(self.multipliers_variational)) < 1.0)
+
+    @property
+    def multiplier_difference(self) -> float:
+        return float(np.max(np.abs(self.multipliers_variational - self.multipliers_fd)))
+
+
+def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xtol: float = 1e-12,
+                     fd_step: float = 1e-7, max_step_time: float = 5.0,
+                     fd_check: bool = True,
+                     jacobian_guess: np.ndarray | None = None,
+                     deflate: tuple | list = ()) -> FixedPointResult:
+    """Find the period-1 fixed point of the Poincaré map and its Floquet multipliers.
+
+    The root finder is MINPACK (``scipy.optimize.root``, method ``hybr``) on the map reduced
+    to the section, ``F(z) = section(P(from_section(z))) - z`` (:class:`_ReducedMap`: hybrd
+    with its own finite-difference start, or hybrj from ``jacobian_guess``).  ``DP`` is then
+    computed once, by the variational equations, at the fixed point.
+
+    Parameters
+    ----------
+    guess : ndarray, shape (2n,)
+        Initial guess (projected on the guard surface through ``walker.section``).
+    xtol : float
+        ``scipy.optimize.root`` (MINPACK hybrd/hybrj) relative tolerance.
+    fd_step : float
+        Step of the central finite-difference check of ``DP``.
+    fd_check : bool
+        Also compute ``DP`` by finite differences (``2 * 2n`` more map evaluations) and
+        its multipliers, as an independent check of the variational equations.  Without it
+        ``multipliers_fd``/``jacobian_fd`` are NaN.
+    jacobian_guess : ndarray, shape (2n, 2n), optional
+        Approximate Jacobian ``DP`` of the Poincaré map near the fixed point (full state,
+        as :attr:`FixedPointResult.jacobian_variational`).
+    deflate : sequence of ndarray, shape (2n,) each
+        Fixed points already known (full states): the root finder solves the *deflated*
+        residual ``F(z) * prod_k (1 / |z - z_k|^2 + 1)`` instead (Farrell, Birkisson & Funke
+        2015, "Deflation techniques for finding distinct solutions of nonlinear PDEs", SIAM
+        J. Sci. Comput. 37(4)), whose roots are the roots of ``F`` other than the ``z_k``:
+        from a start near a known gait it converges to another one.  Not with
+        ``jacobian_guess``.
+
+    Returns
+    -------
+    FixedPointResult
+
+    Raises
+    ------
+    FixedPointNotFound
+        The root finder did not converge, or the map failed (fall) near the guess.
+    """
+    root = import_on_fresh_stack("scipy.optimize").root  # see walkerlab.freshstack
+
+    t0 = time.perf_counter()
+    known = [walker.section(np.asarray(xk, float)) for xk in deflate]
+    if known and jacobian_guess is not None:
+        raise ValueError("find_fixed_point: deflate and jacobian_guess exclude each other")
+    F = _ReducedMap(walker, solver, max_step_time, known)
+    z0 = walker.section(np.asarray(guess, float))
+    if jacobian_guess is None:
+        sol = root(F.residual, z0, method="hybr", options={"xtol": xtol})
+    else:
+        F.start[z0.tobytes()] = _section_jacobian(walker, np.asarray(jacobian_guess, float),
+                                                  z0)
+        sol = root(F.residual, z0, method="hybr", jac=F.jacobian, options={"xtol": xtol})
+    x, xn, period, DP, segs = F.variational_at(sol.x, sol.message)
+    res = float(np.max(np.abs(xn - x)))
+    _check_walking(walker, x, sol, res)
+    if fd_check:
+        Jfd, nf2 = map_fd_jacobian(walker, x, solver, fd_step, max_step_time)
+        mult_fd = sort_multipliers(np.linalg.eigvals(Jfd))
+    else:
+        Jfd, nf2 = np.full_like(DP, np.nan), 0
+        mult_fd = np.full(DP.shape[0], np.nan + 0j)
+    return FixedPointResult(
+        x=x, period_s=period, residual=res,
+        multipliers_variational=sort_multipliers(np.linalg.eigvals(DP)),
+        multipliers_fd=mult_fd, jacobian_variational=DP, jacobian_fd=Jfd,
+        nfev=F.counter["nfev"] + nf2, iterations=F.counter["calls"],
+        wall_time_s=time.perf_counter() - t0, variational_maps=F.counter["jacobians"] + 1,
+        step_periods_s=tuple(float(sg.period) for sg in segs),
+        step_lengths_m=tuple(
+            float(np.linalg.norm(walker.for_stance(sg.stance_leg).points(sg.x_end)["swing_foot"]))
+            for sg in segs),
+    )
+
+
+class _ReducedMap:
+    """``F(z) = section(P(from_section(z))) - z`` for MINPACK, deflated by the ``known``
+    section points, with its evaluations counted (``counter``: RHS evaluations, maps, maps
+    with the variational equations asked as a Jacobian).
+
+    - without a Jacobian start: ``hybrd``, with its own finite-difference start (``2n - 1``
+      extra maps) and rank-1 (Broyden) updates;
+    - with one (``start``: ``DP`` of a nearby fixed point, e.g. the previous point of a
+      continuation, reduced to the section): ``hybrj`` starts from it and updates it by
+      Broyden steps; only when MINPACK asks for a Jacobian again (its updates stopped
+      helping) is the true one computed, by the variational equations at the current
+      iterate.  One variational map costs about five plain maps, so a stale Jacobian is
+      never recomputed up front.
+
+    Repeated evaluations at the same iterate (scipy evaluates ``F(z0)`` once to check its
+    shape, then MINPACK again) cost one map.
+    """
+
+    def __init__(self, walker: HybridWalker, solver: Solver, max_step_time: float,
+                 known: list):
+        self.walker, self.solver, self.max_step_time = walker, solver, max_step_time
+        self.known = known
+        self.counter = {"nfev": 0, "calls": 0, "jacobians": 0}
+        self.start: dict = {}  # the Jacobian start (z0 bytes -> section Jacobian)
+        self._last: dict = {}  # the last iterate's residual (z bytes -> F(z))
+        self._variational: dict = {}  # the last variational map asked as a Jacobian
+
+    def residual(self, z: np.ndarray) -> np.ndarray:
+        """``F(z)`` (2n-1,), deflated; a failed step pushes the root finder away."""
+        key = z.tobytes()
+        if key in self._last:
+            return self._last[key].copy()
+        walker = self.walker
+        x = walker.from_section(z)
+        self.counter["calls"] += 1
+        try:
+            xn, _, nf = poincare_map(walker, x, self.solver, self.max_step_time)
+        except StepFailed:
+            r = np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
+        else:
+            self.counter["nfev"] += nf
+            r = walker.section(xn) - z
+            for zk in self.known:
+                r = r * (1.0 / max(float(np.sum((z - zk) ** 2)), 1e-300) + 1.0)
+        self._last.clear()
+        self._last[key] = r
+        return r.copy()
+
+    def jacobian(self, z: np.ndarray) -> np.ndarray:
+        """``F_z`` (2n-1, 2n-1): the start at ``z0``, else from the variational equations."""
+        key = z.tobytes()
+        if key in self.start:  # the start: asked by scipy's shape check and by MINPACK
+            return self.start[key]
+        walker, segs = self.walker, []
+        try:  # asked again: the updated guess stopped helping; the true one here
+            out = poincare_map(walker, walker.from_section(z), self.solver,
+                               self.max_step_time, jacobian=True, steps=segs)
+        except StepFailed:
+            return next(iter(self.start.values()))
+        self.counter["nfev"] += out[3]
+        self.counter["jacobians"] += 1
+        self._variational.clear()
+        self._variational[key] = (*out, segs)  # MINPACK often stops at this iterate: reused
+        return _section_jacobian(walker, out[2], z)
+
+    def variational_at(self, z: np.ndarray, message: str):
+        """``(x, P(x), period, DP, steps)`` at the root finder's last iterate ``z``: the
+        variational map there (reused when MINPACK last asked for its Jacobian there).
+
+        Raises
+        ------
+        FixedPointNotFound
+            The map fails at ``z`` (``message``: the root finder's).
+        """
+        x = self.walker.from_section(z)
+        if z.tobytes() in self._variational:  # the Jacobian was last computed at the solution
+            xn, period, DP, _, segs = self._variational[z.tobytes()]
+            self.counter["jacobians"] -= 1
+            return x, xn, period, DP, segs
+        segs = []
+        try:
+            xn, period, DP, nf = poincare_map(self.walker, x, self.solver, self.max_step_time,
+                                              jacobian=True, steps=segs)
+        except StepFailed as exc:
+            raise FixedPointNotFound(f"{message}; the map fails at the last iterate "
+                                     f"({exc})", float("nan")) from None
+        self.counter["nfev"] += nf
+        return x, xn, period, DP, segs
+
+
+def _check_walking(walker: HybridWalker, x: np.ndarray, sol, res: float) -> None:
+    """Raise :class:`FixedPointNotFound` unless the root finder converged (``sol``) to a
+    walking gait ``x`` with residual ``res`` below 1e-6 (not the trivial standing solution,
+    a step shorter than 1e-3 leg lengths)."""
+    message = " ".join(str(sol.message).split())
+    step = walker.points(x).get("swing_foot")
+    L = walker.params.get("leg_length_m", 1.0)
+    if step is not None and float(np.linalg.norm(step)) < 1e-3 * L:
+        raise FixedPointNotFound("the root finder went to the trivial standing solution "
+                                 f"(step length {1e3 * float(np.linalg.norm(step)):.2f} mm), "
+                                 "not to a walking gait", res)
+    if not sol.success or res > 1e-6:
+        raise FixedPointNotFound(message, res)
+
+
+def _section_jacobian(walker: HybridWalker, DP: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Jacobian (2n-1, 2n-1) of ``F(z) = section(P(from_section(z))) - z`` from ``DP``
+    (2n, 2n), the section maps' Jacobians taken at ``from_section(z)`` (near a fixed point
+    ``P(x) = x``)."""
+    x = walker.from_section(z)
+    D_from = numeric_jacobian(walker.from_section, np.asarray(z, float))
+    D_sec = numeric_jacobian(walker.section, np.asarray(x, float))
+    return D_sec @ DP @ D_from - np.eye(z.size)

@@ -1,0 +1,190 @@
+"""The period-1 gait of a scene's rigid walker: the scene's solver and fixed-point settings
+applied to :func:`walkerlab.analysis.gait.search.find_gaits`, and the other equation variants
+of a compass gait compared with published numbers (what the ``fixedpoint`` stage stores).
+"""
+
+from __future__ import annotations
+
+import math
+
+from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
+from walkerlab.analysis.gait.search import find_gaits
+from walkerlab.config import Scene
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.registry import build_walker
+
+
+def _settings(scene: Scene):
+    """The scene's ``fixedpoint`` section; left out, its defaults (every field is optional:
+    the gait is then found from scale-free seeds)."""
+    from walkerlab.config import FixedPointSettings
+
+    return scene.fixedpoint if scene.fixedpoint is not None else FixedPointSettings()
+
+
+def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
+    """The scene's own equation variant first, then (``compare``, for a compass gait compared
+    with published numbers) the other variants: they explain the difference from Eq. 11."""
+    own = (scene.ideal.variant,)
+    if compare and scene.walker.model == "compass_gait" and scene.published is not None:
+        from walkerlab.models.hybrid.compass_gait import VARIANTS
+
+        return own + tuple(v for v in VARIANTS if v != scene.ideal.variant)
+    return own
+
+
+def initial_guess(scene: Scene, walker):
+    """The scene's initial guess by state name, or None (found automatically).
+
+    Raises
+    ------
+    ValueError
+        The guess does not name the walker's states, or is no walking state
+        (:func:`check_walking_state`) (one line naming the field).
+    """
+    fp = _settings(scene)
+    if fp.initial_guess is None:
+        return None
+    try:
+        guess = fp.initial_guess.as_array(walker.state_names())
+    except ValueError as exc:
+        raise ValueError(f"fixedpoint.initial_guess: {exc}") from None
+    check_walking_state(guess, walker, scene)
+    return guess
+
+
+#: largest leg angular rate of an initial guess, in units of sqrt(g/l)
+MAX_GUESS_RATE = 20.0
+
+
+def check_walking_state(x, walker, scene: Scene) -> None:
+    """Refuse a guess no walking gait is near, before the root finder spends minutes on it.
+
+    A leg turning at ``omega`` needs a centripetal acceleration ``omega^2 l`` at its far end;
+    above ``g`` the stance foot would leave the ground, so a walking gait has rates of the
+    order of ``sqrt(g/l)`` (paper walker: 3.1 rad/s; its fixed point 0.86 rad/s).  Rates above
+    :data:`MAX_GUESS_RATE` ``sqrt(g/l)`` (or angles beyond pi) send the map's integration
+    into spinning legs (issue 26: 1e6 rad/s ran 74 s, then ``OverflowError``).
+
+    Raises
+    ------
+    ValueError
+        One line naming the field, its value and the bound.
+    """
+    from walkerlab.units import for_scene
+
+    g = walker.params.get("gravity_m_per_s2")
+    length = walker.params.get("leg_length_m")
+    if not g or not length:
+        return
+    max_rate = MAX_GUESS_RATE * math.sqrt(g / length)
+    for name, v in zip(walker.state_names(), x, strict=True):
+        if name.endswith("_rate") and abs(v) > max_rate:
+            raise ValueError(
+                f"fixedpoint.initial_guess.{name}_rad_per_s: {v:g} is not a walking state: "
+                f"give at most {max_rate:.3g} {for_scene(scene).rate} ({MAX_GUESS_RATE:g} "
+                "sqrt(g/l); a leg this fast would leave the ground)")
+        if name.endswith("_angle") and abs(v) > math.pi:
+            raise ValueError(f"fixedpoint.initial_guess.{name}_rad: {v:g} rad is more than "
+                             "half a turn: give an angle within [-pi, pi]")
+
+
+def with_variant(scene: Scene, variant: str) -> Scene:
+    """The scene with ``ideal.variant`` set to ``variant``."""
+    return scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
+
+
+def solve_scene(scene: Scene, fd_check: bool = True, guess=None):
+    """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
+    ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
+    scene's initial guess.
+
+    Returns
+    -------
+    walker : HybridWalker
+    search : walkerlab.analysis.gait.search.GaitSearch
+
+    Raises
+    ------
+    GaitNotFound
+        No gait (one line: what was tried, what to try next).
+    ValueError
+        A malformed initial guess or gait choice, or no ``fixedpoint`` section (one line).
+    """
+    fp = _settings(scene)
+    walker = build_walker(scene)
+    start = initial_guess(scene, walker) if guess is None else guess
+    search = find_gaits(walker, Solver.from_settings(scene.solver), start,
+                        policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
+                        fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
+                        fd_check=fd_check)
+    return walker, search
+
+
+def solve_variant(scene: Scene, variant: str, guess=None):
+    """Fixed point of one equation variant of the scene's walker, from ``guess`` (default:
+    the scene's initial guess) - for the comparison of printed equations.
+
+    Raises
+    ------
+    FixedPointNotFound
+        No fixed point from the guess (or no guess).
+    """
+    sc = with_variant(scene, variant)
+    walker = build_walker(sc)
+    fp = _settings(scene)
+    g = initial_guess(scene, walker) if guess is None else guess
+    if g is None:
+        raise FixedPointNotFound("no initial guess for this equation variant", math.nan)
+    res = find_fixed_point(walker, g, Solver.from_settings(scene.solver),
+                           xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s)
+    return walker, res
+
+
+def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
+                    note: str | None = None):
+    """The period-1 gait of the scene's own equation variant and, with ``compare_variants``
+    (a compass gait compared with published numbers), the fixed points of the other
+    variants from the same start - what the ``fixedpoint`` artifact stores.
+
+    Parameters
+    ----------
+    guess : ndarray (2n,), optional
+        Start of the root finder (a known gait carried here by homotopy,
+        :func:`walkerlab.studies.continuation.homotopy_start`); default the scene's initial
+        guess or the scale-free seeds.
+    note : str, optional
+        How ``guess`` was found, added to the search's notes.
+
+    Returns
+    -------
+    run : walkerlab.io.schemas.fixedpoint.FixedPointRun
+        The writer's input; a variant without a fixed point holds its
+        :class:`~walkerlab.analysis.gait.poincare.FixedPointNotFound`.
+    summary : dict
+        ``walker``, ``result`` (the selected gait), ``gaits`` (the search), ``variants``.
+
+    Raises
+    ------
+    GaitNotFound
+        No gait for the scene's own variant (one line).
+    ValueError
+        A malformed initial guess or gait choice (one line).
+    """
+    from walkerlab.io.schemas.fixedpoint import FixedPointRun
+
+    walker, search = solve_scene(scene, guess=guess)
+    if note:
+        search.notes.append(note)
+    main = search.result
+    results = {scene.ideal.variant: (walker, main)}
+    init = initial_guess(scene, walker)
+    other_guess = main.x if init is None else init
+    for variant in variants_for(scene, compare_variants)[1:]:
+        try:
+            results[variant] = solve_variant(scene, variant, other_guess)
+        except FixedPointNotFound as exc:
+            results[variant] = exc
+    run = FixedPointRun(walker, search, results, scene.ideal.variant, other_guess)
+    summary = {"walker": walker, "result": main, "gaits": search, "variants": dict(results)}
+    return run, summary

@@ -1,0 +1,384 @@
+"""Finding a walker's period-1 gaits without being told where they are, and choosing one.
+
+A passive walker on a shallow slope usually has *two* period-1 gaits: a long-period and a
+short-period one (Goswami, Thuilot & Espiau 1996, INRIA RR-2996; Garcia, Chatterjee, Ruina &
+Coleman 1998, J. Biomech. Eng. 120:281-288 - for the simplest walker the long-period gait is
+the stable one).  They lie close together on the Poincaré section (they differ mostly in the
+swing leg's rate), so a root finder started between them lands on either.  This module
+
+1. starts the root finder from the scene's initial guess, if there is one;
+2. otherwise (or when that fails) makes *scale-free seeds* from the walker's own data - a
+   step angle ``alpha = c * gamma^(1/3)`` (the small-slope scaling of the step angle,
+   Garcia et al. 1998), a stance-leg rate ``-k * alpha * sqrt(g / l)`` (their
+   ``theta_dot ~ -theta``), a swing-leg rate ``r`` times the stance rate, knees straight -
+   turns each into a state just after heel strike through the walker's own
+   ``leg_coordinates`` (by name, any coordinates), ranks them by one coarse step of the
+   Poincaré map (``|P(z) - z| / |z|`` on the heel-strike section) and roots from the best
+   (the starts: :mod:`walkerlab.analysis.gait.starts`);
+3. looks for the other gait of the pair by *deflation* (Farrell, Birkisson & Funke 2015,
+   SIAM J. Sci. Comput. 37(4)): the root finder, on the residual divided by the distance to
+   the gait already found, from starts a few percent off it along each section coordinate
+   (along each coordinate the start towards the partner's expected step length first -
+   shorter when the first gait is stable, the long-period gait of the pair on shallow
+   slopes).  The deflated search runs at the screening tolerance (cheaper maps, loose
+   ``xtol``); the root it finds is then polished at the scene's tolerance without
+   deflation, MINPACK ``hybrj`` starting from the coarse root's own variational Jacobian (a
+   few maps);
+4. labels the gaits (``long_period`` / ``short_period`` by step period) and picks one by the
+   scene's policy (``stable``, ``long_period``, ``short_period``, ``nearest_guess``).
+
+Every root is found by :func:`walkerlab.analysis.gait.poincare.find_fixed_point` (MINPACK through
+``scipy.optimize.root``); nothing here knows a state's row.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from walkerlab.analysis.gait.poincare import FixedPointNotFound, FixedPointResult, find_fixed_point
+from walkerlab.analysis.gait.starts import (
+    WALK_STEPS,
+    coarse_solver,
+    deflation_starts,
+    screen_seeds,
+    walked_start,
+)
+from walkerlab.integrate.solver import Solver
+from walkerlab.models.hybrid.base import HybridWalker
+
+__all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "find_gaits", "select_gait"]
+
+#: gait choices of ``fixedpoint.gait``
+POLICIES = ("stable", "long_period", "short_period", "nearest_guess")
+
+#: seeds the root finder is started from (best first by the coarse residual)
+ROOT_STARTS = 6
+#: two fixed points closer than this (max |x1 - x2|, rad and rad/s) are the same gait
+SAME_GAIT = 1e-6
+#: root-finder xtol of the deflated search at the screening tolerance (then polished)
+COARSE_XTOL = 1e-7
+
+
+class GaitNotFound(FixedPointNotFound):
+    """No period-1 gait: the message (one line) says what was tried and what to try next."""
+
+    def __init__(self, message: str, residual: float):
+        RuntimeError.__init__(self, message)
+        self.residual = residual
+
+
+@dataclass
+class Gait:
+    """One period-1 gait.
+
+    Attributes
+    ----------
+    label : str
+        ``"long_period"``/``"short_period"`` (two gaits found) or ``"period_1"`` (one).
+    result : FixedPointResult
+    source : str
+        Where the root finder started: ``"initial_guess"``, ``"seed"`` (scale-free seed) or
+        ``"deflation"`` (near the other gait, deflated).
+    start : ndarray (2n,)
+        The root finder's starting state.
+    """
+
+    label: str
+    result: FixedPointResult
+    source: str
+    start: np.ndarray
+
+    @property
+    def max_multiplier(self) -> float:
+        """Largest |Floquet multiplier| (variational) [-]."""
+        return float(np.max(np.abs(self.result.multipliers_variational)))
+
+    def describe(self, time_unit: str = "s") -> str:
+        """``long-period gait (step period 0.9398 s, max |multiplier| 0.593, stable)``."""
+        return (f"{self.label.replace('_', '-')} gait (step period {self.result.period_s:.4f} "
+                f"{time_unit}, max |multiplier| {self.max_multiplier:.3g}, "
+                f"{'stable' if self.result.stable else 'UNSTABLE'})")
+
+
+@dataclass
+class GaitSearch:
+    """The period-1 gaits found and the one chosen.
+
+    Attributes
+    ----------
+    gaits : list of Gait
+        Longest step period first.
+    selected : int
+        Index of the chosen gait in ``gaits``.
+    policy : str
+        One of :data:`POLICIES`.
+    notes : list of str
+        What happened on the way (an initial guess that failed, a policy that fell back).
+    tried : list of str
+        Every start of the root finder, for failure messages.
+    """
+
+    gaits: list[Gait]
+    selected: int
+    policy: str
+    notes: list[str] = field(default_factory=list)
+    tried: list[str] = field(default_factory=list)
+
+    @property
+    def gait(self) -> Gait:
+        return self.gaits[self.selected]
+
+    @property
+    def result(self) -> FixedPointResult:
+        return self.gait.result
+
+
+def _is_new(res: FixedPointResult, found: list[Gait]) -> bool:
+    return all(float(np.max(np.abs(res.x - g.result.x))) > SAME_GAIT for g in found)
+
+
+def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = None,
+               policy: str = "stable", other_gait: bool = True, xtol: float = 1e-12,
+               fd_step: float = 1e-7, max_step_time: float = 5.0, fd_check: bool = True,
+               time_unit: str = "s", seeds: bool = True) -> GaitSearch:
+    """Find the walker's period-1 gait(s) and choose one.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    solver : Solver
+    guess : ndarray (2n,), optional
+        Initial guess (role-ordered state just after heel strike); without it the root
+        finder starts from the best scale-free seeds
+        (:func:`~walkerlab.analysis.gait.starts.seed_states`).
+    policy : {"stable", "long_period", "short_period", "nearest_guess"}
+        Which gait to choose (:func:`select_gait`).
+    other_gait : bool
+        Also look for the other gait of the long/short-period pair (deflation; a few
+        root-finder runs, about 0.05-0.4 s).  Needed by the ``long_period``/``short_period``
+        policies and by ``stable`` when the first gait found is unstable.
+    xtol, fd_step, max_step_time, fd_check
+        As :func:`walkerlab.analysis.gait.poincare.find_fixed_point`.
+    time_unit : str
+        Unit of the step period in messages (``s``, or ``sqrt(l/g)`` for a nondimensional
+        scene).
+    seeds : bool
+        Try the scale-free seeds when the guess does not converge (always without a guess).
+
+    Returns
+    -------
+    GaitSearch
+
+    Raises
+    ------
+    GaitNotFound
+        No gait from the guess nor from the seeds, or the policy's gait was not found; the
+        one-line message says what was tried and what to try next.
+    ValueError
+        Unknown ``policy``, or ``nearest_guess`` without a guess.
+    """
+    if policy not in POLICIES:
+        raise ValueError(f"fixedpoint.gait: {policy!r} is not one of {', '.join(POLICIES)}")
+    if policy == "nearest_guess" and guess is None:
+        raise ValueError("fixedpoint.gait: nearest_guess needs fixedpoint.initial_guess")
+    s = _RootStarts(walker, solver, {"xtol": xtol, "fd_step": fd_step,
+                                     "max_step_time": max_step_time, "fd_check": fd_check})
+    if guess is not None:
+        s.tried.append("the initial guess")
+        g = s.attempt(np.asarray(guess, float), "initial_guess")
+        if g is not None:
+            s.found.append(g)
+        else:
+            s.notes.append(f"the initial guess did not converge ({_short(s.last_msg)})")
+    if not s.found and (seeds or guess is None):
+        s.from_seeds()
+    if not s.found:
+        raise GaitNotFound(_failure(walker, s.tried, s.best, s.last_msg, guess is not None),
+                           s.best)
+    if other_gait or policy in ("long_period", "short_period") or (
+            policy == "stable" and not s.found[0].result.stable):
+        s.other_gait()
+    found = s.found
+    found.sort(key=lambda g: -g.result.period_s)
+    if len(found) == 2:
+        found[0].label, found[1].label = "long_period", "short_period"
+    search = GaitSearch(found, 0, policy, s.notes, s.tried)
+    search.selected = select_gait(search, guess, time_unit)
+    return search
+
+
+class _RootStarts:
+    """The root-finder starts of one gait search (:func:`find_gaits`) and what they found:
+    the gaits (``found``), every start tried (``tried``), notes, the best residual of a
+    failed start and the last failure's message."""
+
+    def __init__(self, walker: HybridWalker, solver: Solver, kw: dict):
+        self.walker, self.solver, self.kw = walker, solver, kw
+        self.found: list[Gait] = []
+        self.tried: list[str] = []
+        self.notes: list[str] = []
+        self.best = math.inf
+        self.last_msg = ""
+
+    def attempt(self, x0, source: str, deflate=(), jacobian_guess=None) -> Gait | None:
+        """The gait the root finder reaches from ``x0``, or None (no root, or a gait already
+        found)."""
+        try:
+            res = find_fixed_point(self.walker, x0, self.solver, deflate=deflate,
+                                   jacobian_guess=jacobian_guess, **self.kw)
+        except FixedPointNotFound as exc:
+            if math.isfinite(exc.residual) and "standing" not in str(exc):
+                self.best = min(self.best, exc.residual)
+            self.last_msg = str(exc)
+            return None
+        if not _is_new(res, self.found):
+            return None
+        return Gait("period_1", res, source, np.asarray(x0, float))
+
+    def from_seeds(self) -> None:
+        """Root from the best-ranked scale-free seeds; none converging, from where the seeds
+        walk to in :data:`~walkerlab.analysis.gait.starts.WALK_STEPS` steps."""
+        walker, solver, max_step_time = self.walker, self.solver, self.kw["max_step_time"]
+        n_started = 0
+        ranked, n_seeds = screen_seeds(walker, solver, max_step_time)
+        for _err, _desc, x in ranked[:ROOT_STARTS]:
+            n_started += 1
+            g = self.attempt(x, "seed")
+            if g is not None:
+                self.found.append(g)
+                break
+        self.tried.append(f"{n_started} of {n_seeds} scale-free seeds "
+                          f"({n_seeds - len(ranked)} fell within the first step)")
+        if self.found or not ranked:
+            return
+        n_walked = n_started = 0  # second round: from where the seeds walk to
+        for _err, _desc, x in ranked:
+            n_walked += 1
+            end = walked_start(walker, x, solver, max_step_time)
+            if end is None:  # fell before WALK_STEPS steps: not near a stable gait
+                continue
+            n_started += 1
+            g = self.attempt(end, "walked seed")
+            if g is not None:
+                self.found.append(g)
+                break
+            if n_started == ROOT_STARTS:
+                break
+        self.tried.append(f"{n_walked} seeds walked {WALK_STEPS} steps "
+                          f"({n_started} root-finder starts)")
+
+    def other_gait(self) -> None:
+        """The other gait of the pair by deflation from starts near the first one, at the
+        screening tolerance, then polished at the scene's."""
+        first = self.found[0].result
+        coarse = coarse_solver(self.solver)
+        n_defl = 0
+        for x0 in deflation_starts(self.walker, first):
+            n_defl += 1
+            try:  # cheap maps and a loose xtol to find the partner ...
+                rough = find_fixed_point(self.walker, x0, coarse, xtol=COARSE_XTOL,
+                                         fd_step=self.kw["fd_step"],
+                                         max_step_time=self.kw["max_step_time"],
+                                         fd_check=False, deflate=(first.x,))
+            except FixedPointNotFound as exc:
+                self.last_msg = str(exc)
+                continue
+            if not _is_new(rough, self.found):
+                continue
+            # ... then polished at the scene's tolerance (no deflation): MINPACK hybrj from
+            # the coarse root's own Jacobian, or, should its updates stall, hybrd
+            g = self.attempt(rough.x, "deflation", jacobian_guess=rough.jacobian_variational) \
+                or self.attempt(rough.x, "deflation")
+            if g is not None:  # the gait's start and costs include the coarse pass
+                g.start = np.asarray(x0, float)
+                g.result = dataclasses.replace(
+                    g.result, nfev=g.result.nfev + rough.nfev,
+                    iterations=g.result.iterations + rough.iterations,
+                    wall_time_s=g.result.wall_time_s + rough.wall_time_s)
+                self.found.append(g)
+                break
+        self.tried.append(f"{n_defl} deflated starts near the first gait")
+
+
+def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
+                time_unit: str = "s") -> int:
+    """Index of the gait ``search.policy`` chooses (notes on the choice go to
+    ``search.notes``).
+
+    - ``stable``: the stable gait (nearest the guess if several); none stable: the gait
+      nearest the guess (or, without a guess, the least unstable one), with a note;
+    - ``long_period``/``short_period``: by label (both gaits must have been found);
+    - ``nearest_guess``: the gait the root finder reached from the initial guess (else the
+      one nearest it, max-norm over the state).
+
+    Raises
+    ------
+    GaitNotFound
+        ``long_period``/``short_period`` asked but only one gait was found.
+    """
+    gaits, policy = search.gaits, search.policy
+
+    def nearest(cands):
+        cands = list(cands)
+        if guess is None:
+            return min(cands, key=lambda k: gaits[k].max_multiplier)
+        # the gait the root finder reached from the guess; else the closest (max-norm)
+        return min(cands, key=lambda k: (gaits[k].source != "initial_guess",
+                                         float(np.max(np.abs(gaits[k].result.x - guess)))))
+
+    if policy in ("long_period", "short_period"):
+        k = next((k for k, g in enumerate(gaits) if g.label == policy), None)
+        if k is None:
+            raise GaitNotFound(
+                f"fixedpoint.gait: {policy}: only one period-1 gait was found "
+                f"({gaits[0].describe(time_unit)}; tried {', '.join(search.tried)}); use "
+                "gait: stable or nearest_guess, or give an initial_guess near the other gait",
+                0.0)
+        return k
+    if policy == "nearest_guess":
+        return nearest(range(len(gaits)))
+    stable = [k for k, g in enumerate(gaits) if g.result.stable]
+    if stable:
+        k = nearest(stable)
+        if guess is not None:
+            near = nearest(range(len(gaits)))
+            if near != k:
+                other = gaits[near].label.replace("_", "-")
+                search.notes.append(
+                    f"the gait nearest the initial guess is the {other} one, UNSTABLE "
+                    f"(max |multiplier| {gaits[near].max_multiplier:.3g}); "
+                    "fixedpoint.gait: nearest_guess selects it")
+        return k
+    search.notes.append("no stable period-1 gait found: "
+                        + ("the one nearest the initial guess" if guess is not None
+                           else "the least unstable one"))
+    return nearest(range(len(gaits)))
+
+
+def _short(msg: str) -> str:
+    """scipy's message, one line, without the prefix and the residual (given apart)."""
+    import re
+
+    text = " ".join(str(msg).removeprefix("no fixed point found: ").split())
+    return re.sub(r" \(residual [^)]*\)$", "", text)
+
+
+def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
+             had_guess: bool) -> str:
+    res = f", best residual {best:.2g}" if math.isfinite(best) else ""
+    last = _short(last)
+    if last and "standing" not in last:
+        last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
+    why = ("a passive walker needs a downhill slope (slope > 0)"
+           if walker.slope_rad <= 0 else "the walker may have no period-1 gait here")
+    # the advice first, the solver's detail last: a one-line display that must shorten the
+    # message cuts the detail, never the advice (issue 26, item 2)
+    return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "
+            "from a walker whose gait is known (walkerlab sweep SCENE --param "
+            "FIELD=KNOWN:THIS:STEP, e.g. slope.angle_deg), or "
+            + ("an initial_guess nearer a gait" if had_guess else "give fixedpoint.initial_guess")
+            + f" [tried {' and '.join(tried)}{res}; last: {last or 'every start fell'}]")

@@ -1,0 +1,285 @@
+"""Robustness of a gait beyond its Floquet multipliers: the gait sensitivity norm and the largest
+tolerable single disturbance.
+
+Gait sensitivity norm (Hobbelen & Wisse 2007, IEEE T-RO 23(6), Eq. 5-8): linearise the
+step-to-step map about the gait, with a disturbance ``e_k`` acting on step ``k`` and gait
+indicators ``y_k`` of that step::
+
+    dx_{k+1} = A dx_k + B e_k,        dy_k = C dx_k + D e_k
+
+(``x_k`` the post-impact state).  The GSN of a disturbance is the 2-norm of the indicators'
+response to a unit impulse ``e_0 = 1``, summed over all steps: the H2 norm
+``sqrt(|D|^2 + trace(C W C^T))`` with ``W = sum_k A^k B B^T (A^T)^k``
+(:func:`scipy.linalg.solve_discrete_lyapunov`).  ``A`` is the Poincaré-map Jacobian from the
+variational equations with saltation matrices (:func:`walkerlab.analysis.gait.poincare.poincare_map`,
+exact to ~1e-12); ``B``, ``C`` and ``D`` are central differences (step ``1e-6`` of the state
+scale) of the one-step map of :class:`walkerlab.analysis.gait.batch_step.BatchStepMap` at
+tolerance 1e-12, i.e. ~1e-6 relative.  :func:`gsn_nonlinear` checks it: the response of the
+nonlinear map to a small impulse, divided by its size.
+
+Disturbances (scalar, one step): ``slope`` (that step's slope changes by ``e`` [rad]),
+``floor_height`` (the ground at that step's footfall lies ``e`` [m] lower: a step-down),
+``push`` (an impulsive horizontal push at the hip at mid-stance changing the hip's forward
+velocity by ``e`` [m/s], :func:`walkerlab.analysis.robustness.push.apply_push`; those rows are
+integrated one by one by scipy's DOP853 at 1e-12, :func:`walkerlab.analysis.robustness.push.pushed_step`).
+Indicators: ``step_time_s``, ``step_length_m`` (distance from stance foot to swing foot at
+heel strike), ``stance_angle_rad`` (the stance leg's absolute angle from the vertical at
+heel strike).
+
+Jin et al. (2021, R. Soc. Open Sci. 8: 201122) show that local measures can rank walkers
+differently in different state coordinates.  The multipliers do not change (the Jacobians in
+two coordinate systems are similar matrices); a sensitivity norm whose indicators are the
+*states* does: :func:`state_gsn` gives it in absolute angles and in angles relative to the
+stance leg (``relative_coordinates``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.analysis.gait.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.analysis.robustness.push import pushed_step
+
+DISTURBANCES = ("slope", "floor_height", "push")
+INDICATORS = ("step_time_s", "step_length_m", "stance_angle_rad")
+#: disturbance units
+UNITS = {"slope": "rad", "floor_height": "m", "push": "m/s"}
+
+
+def _indicators(sm: BatchStepMap, res) -> np.ndarray:
+    """Indicators (N, 3) of a batch step (NaN where no heel strike)."""
+    w = sm.walker
+    out = np.full((res.outcome.size, len(INDICATORS)), np.nan)
+    ok = res.outcome == HEEL_STRIKE
+    if ok.any():
+        Xp = res.x_pre[ok].T
+        foot = np.asarray(w.points(Xp)["swing_foot"])
+        stance = w.legs[-1]
+        coords = w.leg_coordinates(Xp, stance)
+        # the stance leg is straight: its angle, or (kneed walker) its thigh's
+        key = f"{stance}_angle" if f"{stance}_angle" in coords else f"{stance}_thigh_angle"
+        ang = np.asarray(coords[key])
+        out[ok] = np.column_stack([res.step_time_s[ok], np.hypot(foot[0], foot[1]), ang])
+    return out
+
+
+def one_step(sm: BatchStepMap, X: np.ndarray, disturbance: str, e: np.ndarray):
+    """One step of rows ``X`` (N, 2n) with disturbance values ``e`` (N,).
+
+    Returns ``(x_next (N, 2n), indicators (N, 3), ok (N,))``."""
+    e = np.asarray(e, dtype=float)
+    if disturbance == "push":  # pushed rows one by one (scipy), the others batched
+        e = np.broadcast_to(e, (X.shape[0],))
+        r = sm.step(X, None)
+        for i in np.flatnonzero(e != 0):
+            p = pushed_step(sm.walker, X[i], e[i:i + 1])
+            for name in ("outcome", "x_pre", "x_next", "step_time_s"):
+                getattr(r, name)[i] = getattr(p, name)[0]
+    elif disturbance == "slope":
+        r = sm.step(X, sm.slope_rad + e)
+    elif disturbance == "floor_height":
+        r = sm.step(X, None, drop_m=e)
+    else:
+        raise ValueError(f"disturbance: unknown {disturbance!r}; choose from "
+                         f"{', '.join(DISTURBANCES)}")
+    return r.x_next, _indicators(sm, r), r.outcome == HEEL_STRIKE
+
+
+@dataclass
+class Linearisation:
+    """``dx' = A dx + B e``, ``dy = C dx + D e`` at the gait for one disturbance."""
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+
+    def gsn(self) -> float:
+        """H2 norm from the disturbance to the indicators (Hobbelen & Wisse 2007)."""
+        from scipy.linalg import solve_discrete_lyapunov
+
+        W = solve_discrete_lyapunov(self.A, np.outer(self.B, self.B))
+        return float(np.sqrt(self.D @ self.D + np.trace(self.C @ W @ self.C.T)))
+
+
+def linearise(sm: BatchStepMap, x_star: np.ndarray, A: np.ndarray, disturbance: str,
+              h_rel: float = 1e-6) -> Linearisation:
+    """``B, C, D`` by central differences of the one-step map (``A`` given: the variational
+    Jacobian, shape (2n, 2n)); state steps ``h_rel (1 + |x_i|)``, disturbance step
+    ``h_rel`` (rad or m)."""
+    n = x_star.size
+    hx = h_rel * (1 + np.abs(x_star))
+    X = np.tile(x_star, (2 * n + 2, 1))
+    e = np.zeros(2 * n + 2)
+    for i in range(n):
+        X[2 * i, i] += hx[i]
+        X[2 * i + 1, i] -= hx[i]
+    e[2 * n], e[2 * n + 1] = h_rel, -h_rel
+    xn, y, ok = one_step(sm, X, disturbance, e)
+    if not ok.all():
+        raise ValueError("linearise: a neighbouring step of the gait did not end in heel "
+                         "strike")
+    C = np.column_stack([(y[2 * i] - y[2 * i + 1]) / (2 * hx[i]) for i in range(n)])
+    B = (xn[2 * n] - xn[2 * n + 1]) / (2 * h_rel)
+    D = (y[2 * n] - y[2 * n + 1]) / (2 * h_rel)
+    return Linearisation(np.asarray(A, float), B, C, D)
+
+
+def gsn_nonlinear(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, e: float,
+                  steps: int = 80) -> float:
+    """The GSN from the nonlinear map: impulse ``e`` on step 0, then the undisturbed map for
+    ``steps`` steps; ``sqrt(sum_k |y_k - y*|^2) / |e|``.  Uses the same ``+e`` and ``-e``
+    impulses and halves their difference (central), so the error is O(e^2) relative."""
+    X = np.tile(x_star, (3, 1))
+    ee = np.array([0.0, e, -e])
+    acc = 0.0
+    for k in range(steps):
+        xn, y, ok = one_step(sm, X, disturbance, ee if k == 0 else np.zeros(3))
+        if not ok.all():
+            raise ValueError("gsn_nonlinear: the disturbed walker fell; use a smaller e")
+        dy = (y[1] - y[2]) / 2
+        acc += float(dy @ dy)
+        X = xn
+    return float(np.sqrt(acc)) / abs(e)
+
+
+def relative_coordinates(names: list[str]) -> np.ndarray:
+    """``T`` (2n, 2n): absolute angles -> angles relative to the stance leg (each other
+    coordinate minus ``stance_angle``, its rate minus ``stance_rate``; the stance leg's
+    own stay absolute), by state name.
+
+    Raises
+    ------
+    ValueError
+        No ``stance_angle``/``stance_rate`` state.
+    """
+    if "stance_angle" not in names or "stance_rate" not in names:
+        raise ValueError("relative coordinates need the states stance_angle and stance_rate")
+    T = np.eye(len(names))
+    ia, ir = names.index("stance_angle"), names.index("stance_rate")
+    for i, nm in enumerate(names):
+        if nm.endswith("_angle") and i != ia:
+            T[i, ia] = -1.0
+        elif nm.endswith("_rate") and i != ir:
+            T[i, ir] = -1.0
+    return T
+
+
+def state_gsn(lin: Linearisation, T: np.ndarray | None = None) -> float:
+    """The sensitivity norm with the post-impact *state* as the indicator, in coordinates
+    ``z = T x`` (Jin et al. 2021: such a norm depends on the coordinates):
+    ``sqrt(trace(T W T^T))`` with ``W`` as in :meth:`Linearisation.gsn`, including the
+    first step's ``B``."""
+    from scipy.linalg import solve_discrete_lyapunov
+
+    T = np.eye(lin.A.shape[0]) if T is None else T
+    W = solve_discrete_lyapunov(lin.A, np.outer(lin.B, lin.B))
+    return float(np.sqrt(np.trace(T @ W @ T.T)))
+
+
+def largest_tolerable(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
+                      max_value: float, resolution: float, steps: int = 40,
+                      sign: float = 1.0) -> float:
+    """Largest single disturbance of one sign that the gait survives.
+
+    One impulse ``sign * v`` on step 0, then ``steps`` undisturbed steps; survival = no
+    fall.  Every value of the grid ``0, resolution, 2 resolution, ... max_value`` is walked
+    (one batch), and the answer is the largest value below the first that falls (so a
+    survivable value above a fatal one is not counted).
+
+    Returns
+    -------
+    float
+        [rad or m]; ``max_value`` if none falls.
+    """
+    v = np.arange(0.0, max_value + 0.5 * resolution, resolution)
+    X = np.tile(x_star, (v.size, 1))
+    alive = np.ones(v.size, bool)
+    for k in range(steps):
+        idx = np.flatnonzero(alive)
+        if idx.size == 0:
+            break
+        xn, _, ok = one_step(sm, X[idx], disturbance,
+                             sign * v[idx] if k == 0 else np.zeros(idx.size))
+        alive[idx[~ok]] = False
+        X[idx[ok]] = xn[ok]
+    dead = np.flatnonzero(~alive)
+    return float(v[dead[0] - 1]) if dead.size and dead[0] > 0 else (
+        0.0 if dead.size else float(v[-1]))
+
+
+def survives(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, values: np.ndarray,
+             steps: int = 40) -> np.ndarray:
+    """Survival (N,) bool of the single disturbances ``values`` (N,) [rad or m] on step 0,
+    followed by ``steps`` undisturbed steps (one batch; a fall or timeout on any step is
+    death)."""
+    v = np.asarray(values, float)
+    X = np.tile(x_star, (v.size, 1))
+    alive = np.ones(v.size, bool)
+    for k in range(steps + 1):
+        idx = np.flatnonzero(alive)
+        if idx.size == 0:
+            break
+        xn, _, ok = one_step(sm, X[idx], disturbance, v[idx] if k == 0 else np.zeros(idx.size))
+        alive[idx[~ok]] = False
+        X[idx[ok]] = xn[ok]
+    return alive
+
+
+def largest_by_bisection(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
+                         max_value: float, tol: float, steps: int = 40, sign: float = 1.0,
+                         sections: int = 8) -> tuple[float, float]:
+    """Bracket ``(lo, hi)`` of the largest single disturbance ``sign * v`` the gait survives.
+
+    A bracketing multisection (bisection with ``sections - 1`` interior points walked in one
+    batch per round): the invariant is "``lo`` survives, ``hi`` falls"; each round replaces
+    the bracket by the sub-interval between the last survivor before the first fall and that
+    fall.  Stops when ``hi - lo <= tol``: the bracket then holds a survival flip to ``tol``
+    (``ceil(log(max_value / tol) / log(sections))`` rounds).  Survival need not be monotone
+    in ``v``; the bracket holds the lowest flip the grids saw.
+
+    Returns
+    -------
+    (lo, hi) : floats [rad or m]
+        ``hi = inf`` when ``max_value`` survives (nothing falls up to it).
+    """
+    return bracket_flip(lambda v: survives(sm, x_star, disturbance, sign * v, steps),
+                        max_value, tol, sections)
+
+
+def bracket_flip(survive, max_value: float, tol: float, sections: int = 8
+                 ) -> tuple[float, float]:
+    """Bracket ``(lo, hi)`` of the first survival flip of ``survive`` on ``[0, max_value]``
+    (the multisection of :func:`largest_by_bisection`, for any model).
+
+    Parameters
+    ----------
+    survive : callable ``(values (k,)) -> (k,) bool``
+        Survival of each disturbance size (all of one round at once: a batch, or tasks on
+        an executor).
+    max_value, tol : float
+        Search cap and bracket width (same unit as the values).
+    sections : int
+        Sub-intervals per round (``sections - 1`` interior points).
+
+    Returns
+    -------
+    (lo, hi) : floats
+        ``lo`` survives, ``hi`` falls; ``hi = inf`` when ``max_value`` survives.
+    """
+    if survive(np.array([float(max_value)]))[0]:
+        return float(max_value), float("inf")
+    lo, hi = 0.0, float(max_value)
+    while hi - lo > tol:
+        v = np.linspace(lo, hi, sections + 1)[1:-1]
+        alive = np.asarray(survive(v), bool)
+        dead = np.flatnonzero(~alive)
+        if dead.size:
+            j = dead[0]
+            hi = float(v[j])
+            lo = float(v[j - 1]) if j > 0 else lo
+        else:
+            lo = float(v[-1])
+    return lo, hi

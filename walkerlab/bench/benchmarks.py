@@ -1,0 +1,140 @@
+"""The benchmarks behind ``walkerlab bench`` that time the library or a whole command.
+
+Each returns a JSON-able dict of timings (the table of benchmarks and targets is in
+:mod:`walkerlab.cli.bench`); whole-command benchmarks run ``python -m walkerlab.cli`` as a
+separate process.  Speed goals are checked here, never in tests.
+"""
+
+from __future__ import annotations
+
+import gc
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def machine() -> dict:
+    return {"machine": platform.machine(), "processor": platform.processor(),
+            "cpus": os.cpu_count(), "python": platform.python_version(),
+            "loadavg_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
+
+
+def paper_scene():
+    from walkerlab.config import default_scene_path as default_scene
+    from walkerlab.config import load_scene
+
+    return load_scene(default_scene())
+
+
+def bench_ideal(repeats: int = 7) -> dict:
+    """5 ideal strides at rtol 1e-10 per integrator backend, and the fixed-point search."""
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+
+    scene = paper_scene()
+    t0 = time.perf_counter()
+    w = build_walker(scene)
+    build_s = time.perf_counter() - t0
+    guess = np.asarray(scene.fixedpoint.initial_guess.as_array(w.state_names()))
+    sv = Solver.from_settings(scene.solver)
+    fp = find_fixed_point(w, guess, sv)
+    out = {"build_walker_s": build_s}
+    for backend in ("cyrk", "scipy"):
+        s = Solver("DOP853", 1e-10, 1e-10, None, backend)
+        simulate_steps(w, fp.x, 10, s)  # warm (imports)
+        # as the sweep/work-precision workers do: the loaded libraries' objects are not
+        # traversed by the cyclic GC in every timed run (without this the first dozen runs
+        # of a process take ~1.8x longer, which a 7-run median sees)
+        gc.collect()
+        gc.freeze()
+        t, c = [], []
+        for _ in range(repeats):
+            t0, c0 = time.perf_counter(), time.process_time()
+            tr = simulate_steps(w, fp.x, 10, s)
+            t.append(time.perf_counter() - t0)
+            c.append(time.process_time() - c0)
+        out[f"simulate_5_strides_{backend}_median_s"] = float(np.median(t))
+        out[f"simulate_5_strides_{backend}_cpu_median_s"] = float(np.median(c))
+        out[f"simulate_5_strides_{backend}_nfev"] = tr.nfev
+    t = []
+    for _ in range(3):
+        t0 = time.perf_counter()
+        fp = find_fixed_point(w, guess, sv)
+        t.append(time.perf_counter() - t0)
+    out.update({"fixedpoint_compute_median_s": float(np.median(t)), "fixedpoint_nfev": fp.nfev,
+                "fixedpoint_solver": f"{sv.method} rtol={sv.rtol:g} backend={sv.backend}",
+                "target_simulate_5_strides_s": 0.010})
+    return out
+
+
+def _cli(*args: str) -> list[str]:
+    return [sys.executable, "-m", "walkerlab.cli", *args]
+
+
+def _time_process(cmd: list[str], runs: int, cwd: Path | None = None) -> dict:
+    walls = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        subprocess.run(cmd, check=True, capture_output=True, cwd=cwd)
+        walls.append(time.perf_counter() - t0)
+    return {"wall_median_s": float(np.median(walls)), "wall_min_s": float(np.min(walls)),
+            "wall_max_s": float(np.max(walls)), "runs": runs}
+
+
+def bench_fixedpoint(runs: int = 5) -> dict:
+    """``walkerlab fixedpoint --force`` on the paper scene, whole process."""
+    with tempfile.TemporaryDirectory() as d:
+        cmd = _cli("fixedpoint", "--force", "--runs-dir", d)
+        subprocess.run(cmd, check=True, capture_output=True)  # warm the model code cache
+        return {**_time_process(cmd, runs), "command": " ".join(cmd[2:]), "target_s": 1.0}
+
+
+def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
+    """``walkerlab basin --grid 200x200 --force`` on the paper scene, whole process."""
+    with tempfile.TemporaryDirectory() as d:
+        subprocess.run(_cli("fixedpoint", "--runs-dir", d), check=True, capture_output=True)
+        cmd = _cli("basin", "--grid", grid, "--workers", str(workers), "--force",
+                   "--runs-dir", d)
+        res = _time_process(cmd, 1)
+        from walkerlab.io.runpaths import stage_artifact
+        from walkerlab.io.schemas.basin import load_basin
+
+        b = load_basin(stage_artifact(paper_scene(), d, "basin"))
+    out = b.outcome
+    return {**res, "grid": grid, "workers": workers, "target_s": 120.0,
+            "outcomes": {o: int(np.sum(out == i)) for i, o in enumerate(b.outcomes)}}
+
+
+def scene_line(res: dict) -> str:
+    parts = []
+    for method, t in res["target"].items():
+        if t["reached"]:
+            parts.append(f"{method} {t['median_wall_time_s']:.4f} s (rtol {t['rtols'][-1]:.2g}"
+                         f"..{t['rtols'][0]:.2g}, worst error {t['worst_error_rad']:.2g} rad)")
+        else:
+            parts.append(f"{method} did not reach the target")
+    return (f"contact {res['scene']}: {res['n_strides']} strides at <= 1e-6 rad: "
+            + "; ".join(parts) + f" [reference {res['reference']['wall_time_s']:.3f} s]")
+
+
+def bench_contact_scenes(scenes) -> dict:
+    """:func:`~walkerlab.bench.contact.run_scene_benchmark` for each scene file.
+
+    Raises
+    ------
+    ConfigError
+        A scene file is missing or invalid (one line, from :func:`load_scene`).
+    """
+    from walkerlab.bench.contact import run_scene_benchmark
+    from walkerlab.config import load_scene
+
+    loaded = [load_scene(p) for p in scenes]  # every file checked before the first run
+    return {"scenes": [run_scene_benchmark(sc) for sc in loaded]}

@@ -1,0 +1,143 @@
+"""``walkerlab bench``: the benchmarks, run by name, results printed and stored as JSON.
+
+Speed goals are checked here, never in tests.  This is a front end beside :mod:`walkerlab.cli`
+and :mod:`walkerlab.api` (the sweep benchmark times the ``sweep`` stage as the command runs it);
+the other benchmarks live in :mod:`walkerlab.bench.benchmarks`.
+
+=============  ===============================================================  ==========
+benchmark      what is timed                                                    target
+=============  ===============================================================  ==========
+``ideal``      5 strides (10 steps) of the paper walker from its fixed point,   <= 10 ms
+               DOP853 rtol = atol = 1e-10, compute only (median); per backend
+``fixedpoint`` ``walkerlab fixedpoint --force`` on the paper scene, whole       <= 1.0 s
+               process (median of runs, model code cache warm)
+``sweep``      fixed-point sweep over the slope (0.5-4.5 deg, 201 points), 2    >= 50 pt/s
+               worker processes, pool start included (model code cache warm),
+               to the finished artifact; the figure drawn after it timed apart
+``basin``      ``walkerlab basin --grid 200x200 --force``, paper walker,        <= 120 s
+               50 steps a cell at most, 2 workers, whole process
+``contact``    the contact walker's work-precision benchmark
+               (:func:`walkerlab.bench.contact.run_benchmark`); with scene
+               files (``walkerlab bench contact configs/kneed.yaml ...``): each
+               scene's walker, 5 contact strides at <= 1e-6 rad against a tight     kneed:
+               reference, median time of the loosest tolerance band reaching it     <= 0.1 s
+               (:func:`walkerlab.bench.contact.run_scene_benchmark`)
+=============  ===============================================================  ==========
+
+The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
+Results are printed and written as JSON to ``OUT/<what>.json`` with the machine and its load
+noted (the machine may be shared: compare code trees side by side, in alternating runs).
+"""
+from __future__ import annotations
+
+import json
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.bench import benchmarks as B
+from walkerlab.io.artifacts import atomic_write
+
+BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact")
+
+
+def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
+    """Fixed-point sweep over the slope with ``workers`` local processes (points/s).
+
+    Timed from the call to the finished artifact (process pool start included), with the
+    generated model code already in the runs folder's cache (as ``fixedpoint``'s benchmark:
+    the one-off symbolic derivation of a fresh runs folder is not sweep throughput).  The
+    figure ``walkerlab sweep`` draws after the artifact (a fixed cost, not throughput) is
+    timed apart (``figure_wall_s``).  Also reported: Poincare maps per point (plain and
+    variational, from the artifact) and, with ``cpu``, the CPU time per point of the same
+    sweep run in this process (one worker).
+    """
+    from walkerlab.io.sweep_store import load_sweep
+    from walkerlab.stages.sweep import draw, run
+
+    scene = B.paper_scene()
+    param = [f"slope.angle_deg={slopes}"]
+    with tempfile.TemporaryDirectory() as d:
+        run(scene, ["slope.angle_deg=1"], "fixedpoint", workers=1, runs_root=d,
+            name="warm", progress=False, figure=False)  # model code cache of this runs folder
+        t0 = time.perf_counter()
+        p = run(scene, param, "fixedpoint", workers=workers, runs_root=d, name="bench",
+                progress=False, figure=False)
+        wall = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        draw(scene, p, d)
+        figure_wall = time.perf_counter() - t0
+        pts = load_sweep(p)["points"]
+        cpu_pt = None
+        if cpu:
+            c0 = time.process_time()
+            p1 = run(scene, param, "fixedpoint", workers=1, pool=False, runs_root=d,
+                     name="bench_cpu", progress=False, figure=False)
+            cpu_pt = (time.process_time() - c0) / load_sweep(p1)["points"]["index"].size
+    outcomes = pts["outcome"].astype(str)
+    n = int(outcomes.size)
+    kinds, counts = np.unique(outcomes, return_counts=True)
+    return {"points": n, "workers": workers, "wall_s": wall, "points_per_s": n / wall,
+            "figure_wall_s": figure_wall,
+            "maps_per_point": float(np.mean(pts["map_evaluations"])),
+            "variational_maps_per_point": float(np.mean(pts["variational_maps"])),
+            "point_wall_median_ms": 1e3 * float(np.median(pts["wall_time_s"])),
+            "cpu_per_point_ms_in_process": None if cpu_pt is None else 1e3 * cpu_pt,
+            "outcomes": {str(k): int(c) for k, c in zip(kinds, counts)},
+            "note": "wall includes starting the process pool, not the figure drawn after "
+                    "the artifact (figure_wall_s); model code cache warm",
+            "target_points_per_s": 50}
+
+
+def run_bench(what: str, out: Path, scenes=None) -> list[str]:
+    """Run the named benchmarks; return printable lines.
+
+    Parameters
+    ----------
+    what : str
+        A name of :data:`BENCHMARKS` or "all".
+    out : Path
+        Folder of the JSON results.
+    scenes : sequence of Path, optional
+        Contact benchmark only: scene files timed by
+        :func:`walkerlab.bench.contact.run_scene_benchmark` instead of the paper
+        walker's work-precision study.
+
+    Raises
+    ------
+    ValueError
+        Unknown benchmark name; scene files given for another benchmark than contact.
+    """
+    if scenes and what != "contact":
+        raise ValueError(f"bench {what}: scene files apply to 'bench contact' only")
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"bench --out {out}: is a file; --out names a folder (results go to "
+                         f"<folder>/<benchmark>.json): give a folder or remove the file")
+    lines = []
+    todo = ["ideal", "fixedpoint", "sweep", "contact"] if what == "all" else [what]
+    unknown = [n for n in todo if n not in BENCHMARKS]
+    if unknown:
+        raise ValueError(f"bench: unknown benchmark {unknown[0]!r} "
+                         f"({' | '.join(BENCHMARKS)} | all)")
+    out.mkdir(parents=True, exist_ok=True)
+    for name in todo:
+        res = {"benchmark": name, **B.machine(), "result": _run_one(name, scenes)}
+        text = json.dumps(res, indent=1, default=str).encode()
+        atomic_write(out / f"{name}.json", lambda fh, text=text: fh.write(text))
+        if name == "contact" and scenes:
+            lines += [B.scene_line(r) for r in res["result"]["scenes"]]
+        lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
+    return lines
+
+
+def _run_one(name: str, scenes) -> dict:
+    if name == "contact" and not scenes:
+        from walkerlab.bench.contact import run_benchmark
+
+        return run_benchmark()
+    return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint, "sweep": bench_sweep,
+            "basin": B.bench_basin,
+            "contact": lambda: B.bench_contact_scenes(scenes)}[name]()

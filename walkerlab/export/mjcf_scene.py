@@ -1,0 +1,86 @@
+"""What an MJCF export of a scene carries beyond the walker (:class:`MjcfScene`: the gait
+keyframe, the terrain, the contact, the knee latch; computed by
+:mod:`walkerlab.export.scene`, written by :func:`walkerlab.export.multibody.mjcf_text`), and
+the limits MuJoCo sets on it (its floors of mass, inertia and length, its default timestep,
+the contact bits of the checkerboard lanes, the point foot's sphere).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
+    from walkerlab.walker.multibody import Multibody
+
+__all__ = ["LANE_BITS", "MJCF_DEFAULT_TIMESTEP_S", "MJCF_MIN_INERTIA_KG_M2",
+           "MJCF_MIN_LENGTH_M", "MJCF_MIN_MASS_KG", "MjcfScene", "point_foot_radius"]
+
+#: Floor of a MuJoCo principal inertia [kg m^2] (MuJoCo's mjMINVAL is 1e-15).
+MJCF_MIN_INERTIA_KG_M2 = 1e-12
+#: Floor of the MuJoCo hip body's mass [kg] (only for a walker without a hip mass); a link
+#: lighter than this is refused (MuJoCo refuses bodies below mjMINVAL = 1e-15 kg).
+MJCF_MIN_MASS_KG = 1e-12
+#: Shortest link or foot radius [m] an export accepts: the point foot's sphere is L/1000 and
+#: MuJoCo refuses geometry below mjMINVAL (1e-15), e.g. "fromto points too close".
+MJCF_MIN_LENGTH_M = 1e-9
+#: MuJoCo's default timestep [s] (an export without a scene keeps it).
+MJCF_DEFAULT_TIMESTEP_S = 0.002
+
+
+@dataclass(frozen=True)
+class MjcfScene:
+    """What the MJCF carries beyond the walker: the gait, the terrain, the contact.
+
+    Computed from the scene by :mod:`walkerlab.export.scene`; this module only
+    writes it.
+
+    Attributes
+    ----------
+    qpos, qvel : tuple of float
+        The ``gait`` keyframe in the export's joint order (``hip_x``, ``hip_z``, then the
+        link joints as in :attr:`Multibody.links`) [m, rad; m/s, rad/s].
+    lanes : tuple of (tuple of float, tuple of float) or None
+        Checkerboard patch centres along the slope [m] of leg1's and leg2's lane; None: a
+        continuous plane.
+    patch_width_m : float
+        Patch width along the slope [m].
+    ground_offset_m : float
+        The ground's surface lies this far below the feet's reference points along the slope
+        normal [m] (the point foot's sphere radius; 0 for arc feet).
+    timestep_s : float
+        MuJoCo ``option timestep`` [s].
+    solref : (float, float)
+        Contact ``solref`` (time constant [s], damping ratio [-]).
+    solimp : tuple of float
+        Contact ``solimp`` (d0, dwidth, width [m], midpoint, power).
+    friction : float
+        Sliding friction coefficient [-].
+    latch : (float, float) or None
+        Knee latch (release height above the ground [m], capture flexion [rad]); None without.
+    notes : tuple of str
+        Comments written into the file (how the numbers were derived).
+    """
+
+    qpos: tuple
+    qvel: tuple
+    lanes: tuple | None
+    patch_width_m: float
+    ground_offset_m: float
+    timestep_s: float
+    solref: tuple
+    solimp: tuple
+    friction: float
+    latch: tuple | None = None
+    notes: tuple = ()
+
+
+#: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot
+#: touches only its own lane (the paper's checkerboard, NOTES.md); continuous: both bits.
+LANE_BITS = {"leg1": 2, "leg2": 4}
+
+
+def point_foot_radius(mb: Multibody) -> float:
+    """Radius [m] of the sphere that stands for a point foot: ``L / 1000`` (the paper's ADAMS
+    feet carry a 1 mm bevel on a 1 m leg)."""
+    return mb.leg_length_m / 1000

@@ -1,0 +1,382 @@
+"""The walker in the exchange formats of multibody libraries: URDF and MJCF.
+
+Both files describe the floating planar walker of :func:`walkerlab.walker.multibody.multibody`
+in 3-D, in the **x-z plane**: x horizontal (downhill), z up (walkerlab's y), every joint axis
+along world **-y**, so that a positive joint angle moves the foot ahead (+x): a point at
+distance ``s`` along a link of angle ``psi`` lies at ``joint + s (sin psi, 0, -cos psi)``.
+
+Coordinates and names (both formats):
+
+============  ==========  ================================================================
+joint         type        walkerlab floating coordinate
+============  ==========  ================================================================
+hip_x         prismatic   ``hip_x`` [m] (the base translates along world x)
+hip_z         prismatic   ``hip_y`` [m] (along world z, up; named by its axis)
+leg<i>_hip    revolute    ``leg<i>_angle`` (kneed: ``leg<i>_thigh_angle``) [rad]
+leg<i>_knee   revolute    ``leg<i>_shank_angle - leg<i>_thigh_angle`` [rad]; limit [-pi, 0]:
+                          0 is the straight-leg stop (positive = hyperextended)
+torso_hip     revolute    the upper body's angle from the upward vertical, positive leaning
+                          back [rad]; coupled: ``(leg1_hip + leg2_hip) / 2`` (eliminated in
+                          walkerlab's coordinates, a constraint here)
+============  ==========  ================================================================
+
+Springs and couplings (issue 22):
+
+- a torsional **spring**-damper between two links at the hip (``walker.springs``) acts on
+  ``delta = angle(second) - angle(first)``, a linear combination of hip joints: in MJCF a
+  fixed tendon ``spring<i>`` (coef +1 on the second link's hip joint, -1 on the first's) with
+  ``stiffness`` = k [N m/rad], ``springlength`` = the rest angle [rad], ``damping`` = c
+  [N m s/rad] (a negative rest angle flips both coefficients and the rest angle's sign:
+  MuJoCo reads ``springlength="-1"`` as "the length at qpos0"); MuJoCo's passive force is
+  then ``-k (delta - rest) - c d(delta)/dt`` and its potential energy (``mjData.energy``
+  with the energy flag) includes ``k (delta - rest)^2 / 2``.  URDF has no spring element
+  (``dynamics`` carries damping only, of one joint): the springs are stated in comments.
+- a **knee spring** (``walker.leg.knee.spring``) acts on the knee joint's own angle: MJCF
+  joint ``stiffness``, ``springref`` (the rest angle) and ``damping`` on ``leg<i>_knee``.
+- the **bisecting hip mechanism** (``walker.torso.coupling``) is a fixed tendon
+  ``bisecting_hip = torso_hip - (leg1_hip + leg2_hip) / 2`` held at 0 by an equality
+  constraint (MJCF ``<equality><tendon tendon1=.../>``; MuJoCo's ``<joint>`` equality couples
+  two joints only).  MuJoCo's constraints are soft: the export makes this one as stiff as
+  MuJoCo allows (``solimp`` 0.9999, ``solref`` time constant two timesteps).  URDF's
+  ``mimic`` follows one joint only: the coupling is stated in a comment (a URDF library sees
+  a free torso joint).
+
+Bodies off a link's axis sit in place: a link's ``inertial`` origin is its centre of mass
+``(off-axis, 0, -along)`` in the link frame.
+
+Gravity ``g`` acts along world -z.  The slope is the ground's tilt, not gravity's: the ground
+falls towards +x at the slope angle (MJCF: a plane rotated about y; URDF has no world, the
+slope is stated in a comment).  Feet: a point foot is a sphere of radius ``L/1000`` (the
+paper's ADAMS feet carry a 1 mm bevel on a 1 m leg) so that contact engines have a geometry;
+an arc foot is a cylinder of radius ``R`` about the y axis at the arc's centre.  A link of
+the ``leg<i>_foot`` name marks the foot point or arc centre.
+
+Formats:
+
+- URDF: ROS "URDF XML specification", http://wiki.ros.org/urdf/XML (``robot``, ``link``,
+  ``inertial``, ``joint`` of type ``prismatic``/``continuous``/``revolute``/``fixed``).
+  Links without ``inertial`` are massless (Pinocchio and Drake accept them).
+- MJCF: MuJoCo "XML Reference", https://mujoco.readthedocs.io/en/stable/XMLreference.html
+  (``compiler``, ``option``, ``worldbody``, ``body``, ``joint`` of type ``slide``/``hinge``,
+  ``inertial``, ``geom``, ``site``, ``keyframe``).  MuJoCo refuses moving bodies without
+  mass or with a zero principal inertia, so: both slide joints sit in the hip body (no
+  massless carriage), and principal inertias that never enter the planar dynamics (the hip
+  never rotates; the links rotate about y only) or are zero (point masses on a line) get a
+  floor of :data:`~walkerlab.export.mjcf_scene.MJCF_MIN_INERTIA_KG_M2`; the hip mass gets
+  :data:`~walkerlab.export.mjcf_scene.MJCF_MIN_MASS_KG` if the walker has none.  Their effect on
+  the mass matrix is at most that floor.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from typing import TYPE_CHECKING
+from xml.sax.saxutils import quoteattr
+
+from walkerlab.export.mjcf_scene import (
+    LANE_BITS,
+    MJCF_DEFAULT_TIMESTEP_S,
+    MJCF_MIN_INERTIA_KG_M2,
+    MJCF_MIN_MASS_KG,
+    MjcfScene,
+    point_foot_radius,
+)
+from walkerlab.export.text import arc_feet, comment, header, num, nums
+
+if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not build them
+    from walkerlab.walker.multibody import Link, Multibody
+
+__all__ = ["FORMATS", "SIDECAR", "comments_in_scene_units", "keyframe_json", "mjcf_text",
+           "urdf_text"]
+
+#: Export formats and their file names in ``runs/<scene>/``.
+FORMATS = {"urdf": "walker.urdf", "mjcf": "walker.xml"}
+#: The URDF's keyframe sidecar in ``runs/<scene>/``.
+SIDECAR = "walker.gait.json"
+#: ``solimp`` of a coupling's equality: the largest impedance MuJoCo accepts (mjMAXIMP).
+COUPLING_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
+#: Joint-axis of every hinge: world -y, so that a positive angle moves the foot ahead.
+AXIS = "0 -1 0"
+
+
+def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
+    """The walker as a URDF robot (ROS URDF XML specification, http://wiki.ros.org/urdf/XML).
+
+    Parameters
+    ----------
+    mb : Multibody
+        From :func:`walkerlab.walker.multibody.multibody`.
+    name : str
+        Robot name (the scene's name).
+    version : str
+        walkerlab version, for the header comment.
+
+    Returns
+    -------
+    str
+        URDF XML; the base is ``world -> hip_x (prismatic x) -> hip_z (prismatic z) -> hip``
+        through a massless ``hip_slider`` link; hip joints are ``continuous``.
+    """
+    width = mb.leg_length_m / 50  # visual thickness of the links
+    out = ['<?xml version="1.0"?>', *header(mb, name, "URDF", version),
+           f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
+           '  <link name="hip_slider"/>']
+    for joint, parent, child, axis in (("hip_x", "world", "hip_slider", "1 0 0"),
+                                       ("hip_z", "hip_slider", "hip", "0 0 1")):
+        out += [f'  <joint name="{joint}" type="prismatic">', f'    <parent link="{parent}"/>',
+                f'    <child link="{child}"/>', '    <origin xyz="0 0 0" rpy="0 0 0"/>',
+                f'    <axis xyz="{axis}"/>',
+                '    <limit lower="-1e9" upper="1e9" effort="0" velocity="1e9"/>', "  </joint>"]
+    out.append('  <link name="hip">')
+    if mb.hip_mass_kg > 0:
+        out += _urdf_inertial(mb.hip_mass_kg, 0.0, 0.0)
+    out += ['    <visual><geometry><sphere radius="' + num(2 * width) + '"/></geometry></visual>',
+            "  </link>"]
+    for ln in mb.links:
+        out += _urdf_link(ln, mb, width)
+    out += ["</robot>", ""]
+    return "\n".join(out)
+
+
+def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) -> list[str]:
+    # a line along the link's z axis: inertia about x and y, none about z
+    return ["    <inertial>", f'      <origin xyz="{nums(off, 0, -com)}" rpy="0 0 0"/>',
+            f'      <mass value="{num(mass)}"/>',
+            f'      <inertia ixx="{num(inertia)}" ixy="0" ixz="0" iyy="{num(inertia)}" iyz="0" '
+            'izz="0"/>', "    </inertial>"]
+
+
+def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
+    knee = ln.joint.endswith("_knee")
+    jtype = "revolute" if knee else "continuous"
+    reach = -ln.length_m if ln.up else ln.length_m  # the visual runs up the torso
+    out = [f'  <joint name="{ln.joint}" type="{jtype}">', f'    <parent link="{ln.parent}"/>',
+           f'    <child link="{ln.name}"/>',
+           f'    <origin xyz="{nums(0, 0, -ln.joint_from_parent_m)}" rpy="0 0 0"/>',
+           f'    <axis xyz="{AXIS}"/>']
+    if knee:  # straight-leg stop at 0, flexion down to -pi
+        out.append(f'    <limit lower="{num(-math.pi)}" upper="0" effort="0" velocity="1e9"/>')
+    out += ["  </joint>", f'  <link name="{ln.name}">',
+            *_urdf_inertial(ln.mass_kg, ln.com_m, ln.inertia_kg_m2, ln.com_off_axis_m),
+            f'    <visual><origin xyz="{nums(0, 0, -reach / 2)}" rpy="0 0 0"/>'
+            f'<geometry><cylinder radius="{num(width / 2)}" length="{num(ln.length_m)}"/>'
+            "</geometry></visual>", "  </link>"]
+    if ln.foot_m is not None:
+        foot = ln.name.split("_")[0] + "_foot"
+        if arc_feet(mb):  # cylinder axis (z) turned onto y
+            geom = (f'<origin xyz="{nums(0, 0, 0)}" rpy="{nums(math.pi / 2, 0, 0)}"/><geometry>'
+                    f'<cylinder radius="{num(mb.foot_radius_m)}" length="{num(2 * width)}"/>'
+                    "</geometry>")
+        else:
+            geom = f'<geometry><sphere radius="{num(point_foot_radius(mb))}"/></geometry>'
+        out += [f'  <joint name="{foot}" type="fixed">', f'    <parent link="{ln.name}"/>',
+                f'    <child link="{foot}"/>',
+                f'    <origin xyz="{nums(0, 0, -ln.foot_m)}" rpy="0 0 0"/>', "  </joint>",
+                f'  <link name="{foot}">', f"    <collision>{geom}</collision>", "  </link>"]
+    return out
+
+
+def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
+    phi = mb.slope_rad
+    if extra is None:
+        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}"'
+                ' contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>']
+    n = (math.sin(phi), math.cos(phi))  # slope normal in (x, z)
+    t = (math.cos(phi), -math.sin(phi))  # downhill along the slope
+    off = extra.ground_offset_m
+    if extra.lanes is None:
+        return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}" '
+                f'pos="{nums(-off * n[0], 0, -off * n[1])}" contype="6" conaffinity="0" '
+                'rgba="0.8 0.8 0.8 1"/>']
+    half, depth = extra.patch_width_m / 2, extra.patch_width_m / 10
+    out = []
+    for leg, (y, centres) in zip(LANE_BITS, ((0.05, extra.lanes[0]), (-0.05, extra.lanes[1]))):
+        for i, s in enumerate(centres):
+            d = off + depth  # box centre below the surface
+            size = nums(half, 0.04 * mb.leg_length_m, depth)
+            pos = nums(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])
+            out.append(f'    <geom name="{leg}_patch{i}" type="box" size="{size}" pos="{pos}"'
+                       f' euler="{nums(0, phi, 0)}" contype="{LANE_BITS[leg]}" conaffinity="0"'
+                       ' rgba="0.8 0.8 0.8 1"/>')
+    return out
+
+
+def _joint_springs(mb: Multibody) -> dict:
+    """Springs on one joint's own angle (a knee spring): ``{joint: Spring}``, written as the
+    joint's ``stiffness``, ``springref`` and ``damping``."""
+    return {sp.terms[0][0]: sp for sp in mb.springs
+            if len(sp.terms) == 1 and sp.terms[0][1] == 1.0}
+
+
+def _tendons(mb: Multibody) -> list[str]:
+    """Fixed tendons: each spring on its ``delta``, each coupling on its residual."""
+    on_joint = _joint_springs(mb).values()
+    springs = [sp for sp in mb.springs if sp not in on_joint]
+    if not (springs or mb.couplings):
+        return []
+    out = ["  <tendon>"]
+    for sp in springs:
+        # oriented so that springlength >= 0: MuJoCo reads a springlength of -1 as "the
+        # tendon's length at qpos0"; k (delta - r)^2 = k (-delta + r)^2, the same spring
+        sign = -1.0 if sp.rest_angle_rad < 0 else 1.0
+        out.append(f'    <fixed name="{sp.name}" stiffness="{num(sp.stiffness_n_m_per_rad)}" '
+                   f'springlength="{num(sign * sp.rest_angle_rad)}" '
+                   f'damping="{num(sp.damping_n_m_s_per_rad)}">')
+        out += [f'      <joint joint="{j}" coef="{num(sign * c)}"/>' for j, c in sp.terms]
+        out.append("    </fixed>")
+    for cp in mb.couplings:  # residual = joint - sum coef * other joints, held at 0
+        out.append(f'    <fixed name="{cp.name}">')
+        out.append(f'      <joint joint="{cp.joint}" coef="1.0"/>')
+        out += [f'      <joint joint="{j}" coef="{num(-c)}"/>' for j, c in cp.terms]
+        out.append("    </fixed>")
+    return out + ["  </tendon>"]
+
+
+def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | None = None
+              ) -> str:
+    """The walker as a MuJoCo model (MJCF; MuJoCo XML Reference,
+    https://mujoco.readthedocs.io/en/stable/XMLreference.html).
+
+    Parameters
+    ----------
+    mb : Multibody
+        From :func:`walkerlab.walker.multibody.multibody`.
+    name : str
+        Model name (the scene's name).
+    version : str
+        walkerlab version, for the header comment.
+    extra : MjcfScene, optional
+        The gait keyframe, terrain, contact setting and knee latch of the scene; without it
+        a plane through the feet and MuJoCo's default contact.
+
+    Returns
+    -------
+    str
+        MJCF XML: the ground, the hip body with both slide joints, the links as nested
+        bodies with hinges, feet as contact geoms (only feet touch the ground), a keyframe
+        ``standing`` (legs vertical, the feet at the ground line at x = 0) and, with
+        ``extra``, a keyframe ``gait`` and the knee latches as joint equality constraints
+        named ``leg<i>_latch``.
+    """
+    width = mb.leg_length_m / 50
+    lo = MJCF_MIN_INERTIA_KG_M2
+    hip_mass = mb.hip_mass_kg if mb.hip_mass_kg > 0 else MJCF_MIN_MASS_KG
+    out = [*header(mb, name, "MJCF", version), f"<mujoco model={quoteattr(name)}>",
+           *(comment(note) for note in (extra.notes if extra else ())),
+           '  <compiler angle="radian" inertiafromgeom="false" autolimits="true"/>']
+    if extra is None:
+        out.append(f'  <option gravity="{nums(0, 0, -mb.gravity_m_per_s2)}"/>')
+        out.append('  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1"/>'
+                   '</default>')
+    else:
+        out.append(f'  <option gravity="{nums(0, 0, -mb.gravity_m_per_s2)}" '
+                   f'timestep="{num(extra.timestep_s)}" integrator="implicitfast"/>')
+        out.append(f'  <default><geom contype="0" conaffinity="0" rgba="0.3 0.4 0.8 1" '
+                   f'solref="{nums(*extra.solref)}" solimp="{nums(*extra.solimp)}" '
+                   f'friction="{nums(extra.friction, 0, 0)}" condim="3"/></default>')
+    out += ["  <worldbody>", *_ground(mb, extra),
+            '    <body name="hip" pos="0 0 0">',
+            '      <joint name="hip_x" type="slide" axis="1 0 0"/>',
+            '      <joint name="hip_z" type="slide" axis="0 0 1"/>',
+            f'      <inertial pos="0 0 0" mass="{num(hip_mass)}" '
+            f'diaginertia="{nums(lo, lo, lo)}"/>',
+            f'      <geom type="sphere" size="{num(2 * width)}"/>']
+    children: dict[str, list[Link]] = {}
+    for ln in mb.links:
+        children.setdefault(ln.parent, []).append(ln)
+    for ln in children["hip"]:
+        out += _mjcf_body(ln, "      ", mb, extra, children, _joint_springs(mb))
+    out += ["    </body>", "  </worldbody>", *_tendons(mb), *_mjcf_tail(mb, extra), ""]
+    return "\n".join(out)
+
+
+def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
+               children: dict, joint_springs: dict) -> list[str]:
+    """The MJCF body of link ``ln`` with its hinge, inertia, capsule, foot (a site and a
+    contact geom) and its child links' bodies nested inside."""
+    lo = MJCF_MIN_INERTIA_KG_M2
+    width = mb.leg_length_m / 50
+    inertia = max(ln.inertia_kg_m2, lo)
+    rng = f' range="{nums(-math.pi, 0)}"' if ln.joint.endswith("_knee") else ""
+    if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
+        sp = joint_springs[ln.joint]
+        rng += (f' stiffness="{num(sp.stiffness_n_m_per_rad)}" '
+                f'springref="{num(sp.rest_angle_rad)}" '
+                f'damping="{num(sp.damping_n_m_s_per_rad)}"')
+    reach = -ln.length_m if ln.up else ln.length_m  # the torso's capsule runs up
+    lines = [f'{indent}<body name="{ln.name}" pos="{nums(0, 0, -ln.joint_from_parent_m)}">',
+             f'{indent}  <joint name="{ln.joint}" type="hinge" axis="{AXIS}"{rng}/>',
+             f'{indent}  <inertial pos="{nums(ln.com_off_axis_m, 0, -ln.com_m)}" '
+             f'mass="{num(ln.mass_kg)}" diaginertia="{nums(inertia, inertia, lo)}"/>',
+             f'{indent}  <geom type="capsule" fromto="{nums(0, 0, 0, 0, 0, -reach)}" '
+             f'size="{num(width / 2)}"/>']
+    if ln.foot_m is not None:
+        leg = ln.name.split("_")[0]
+        foot = leg + "_foot"
+        z = -ln.foot_m
+        y = 0.0 if extra is None or extra.lanes is None else (
+            0.05 if leg == "leg1" else -0.05) * mb.leg_length_m
+        if arc_feet(mb):
+            geom = (f'type="cylinder" fromto="{nums(0, y - width, z, 0, y + width, z)}" '
+                    f'size="{num(mb.foot_radius_m)}"')
+        else:
+            geom = f'type="sphere" pos="{nums(0, y, z)}" size="{num(point_foot_radius(mb))}"'
+        lines += [f'{indent}  <site name="{foot}" pos="{nums(0, 0, z)}"/>',
+                  f'{indent}  <geom name="{foot}" {geom} contype="0" '
+                  f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
+    for child in children.get(ln.name, []):
+        lines += _mjcf_body(child, indent + "  ", mb, extra, children, joint_springs)
+    return lines + [f"{indent}</body>"]
+
+
+def _mjcf_tail(mb: Multibody, extra: MjcfScene | None) -> list[str]:
+    """After the world: the equality constraints (couplings, knee latches), the numbers a
+    stepping loop reads (``custom``) and the keyframes (``standing``; ``gait`` with
+    ``extra``), through ``</mujoco>``."""
+    standing = [0.0, mb.leg_length_m] + [0.0] * len(mb.links)
+    keys = [f'    <key name="standing" qpos="{nums(*standing)}"/>']
+    equality = [f'    <tendon name="{cp.name}" tendon1="{cp.name}" '
+                f'solref="{nums(2 * (extra.timestep_s if extra else MJCF_DEFAULT_TIMESTEP_S), 1)}" '
+                f'solimp="{nums(*COUPLING_SOLIMP)}"/>' for cp in mb.couplings]
+    if extra is not None:
+        keys.append(f'    <key name="gait" qpos="{nums(*extra.qpos)}" qvel="{nums(*extra.qvel)}"/>')
+        knees = [ln.joint for ln in mb.links if ln.joint.endswith("_knee")]
+        if knees and extra.latch is not None:
+            # the gait keyframe starts with leg2 in stance: its latch holds, leg1's is free
+            equality += [f'    <joint name="{k.split("_")[0]}_latch" joint1="{k}" '
+                         f'polycoef="0 1 0 0 0" active="{str("leg2" in k).lower()}"/>'
+                         for k in knees]
+    out = ["  <equality>", *equality, "  </equality>"] if equality else []
+    if extra is not None:  # what a stepping loop needs (walkerlab.export.mujoco_walk)
+        arc = mb.foot_radius_m if arc_feet(mb) else 0.0
+        custom = {"slope_rad": mb.slope_rad, "foot_height_offset_m": arc}
+        if extra.latch is not None and mb.knee:
+            custom.update(latch_release_height_m=extra.latch[0], latch_capture_rad=extra.latch[1])
+        out += ["  <custom>", *(f'    <numeric name="{k}" data="{num(v)}"/>'
+                                for k, v in custom.items()), "  </custom>"]
+    return out + ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>"]
+
+
+def keyframe_json(mb: Multibody, extra: MjcfScene) -> str:
+    """The ``gait`` keyframe as JSON: ``{"joints": [...], "qpos": [...], "qvel": [...],
+    "units": [...]}`` in the URDF's joint names and order (the sidecar of ``walker.urdf``)."""
+    joints = ["hip_x", "hip_z", *(ln.joint for ln in mb.links)]
+    units = ["m", "m", *("rad" for _ in mb.links)]
+    return json.dumps({"keyframe": "gait", "description": "rigid fixed point just after heel "
+                       "strike, leg2 in stance, its foot at the origin on the ground line",
+                       "joints": joints, "units": units, "qpos": list(extra.qpos),
+                       "qvel": list(extra.qvel)}, indent=1) + "\n"
+
+
+def comments_in_scene_units(text: str, units) -> str:
+    """The header comments' unit labels in the scene's unit system (``units``: a
+    :class:`walkerlab.units.Units`; a nondimensional scene: ``l``, ``g``, not ``m``,
+    ``m/s^2``); the XML itself carries numbers only."""
+    if not units.nondimensional:
+        return text
+    # a unit follows a number ("1.2 m") or stands in brackets ("[m]"); prose is left alone
+    unit = re.compile(r"(?:(?<=\d )|(?<=\[))(m/s\^2|kg m\^2|kg|m|s)(?=[\];.,) ])")
+    return "\n".join(unit.sub(lambda m: units(m.group(1)), ln)
+                     if ln.lstrip().startswith("<!--") else ln for ln in text.split("\n"))

@@ -1,0 +1,208 @@
+"""What an exported MuJoCo walker needs to walk: its gait, its terrain, its contact, its latch.
+
+:func:`mjcf_scene` turns a validated scene into :class:`walkerlab.export.mjcf_scene.MjcfScene`
+(written by :func:`walkerlab.export.multibody.mjcf_text`):
+
+- **gait keyframe**: the rigid walker's fixed point (just after heel strike, leg2 in stance,
+  its foot's contact point at the origin on the ground line) as the export's joint
+  coordinates: ``hip_x``, ``hip_z`` = the hip's world position, ``leg<i>_hip`` = absolute
+  link angle, ``leg<i>_knee`` = shank - thigh; rates likewise.
+- **terrain**: the scene's (``terrain`` section, default checkerboard): checkerboard patches
+  centred on the rigid gait's footfalls as boxes, one lane per leg (contact bits
+  :data:`walkerlab.export.mjcf_scene.LANE_BITS`), leg2 at ``s = 0, 2l, ...``, leg1 at
+  ``s = -l, l, 3l, ...`` (legs that differ: leg1's step ``l1``, leg2's ``l2``, leg2 at
+  ``k (l1 + l2)``, leg1 at ``l1 + (k - 1)(l1 + l2)``); continuous: one plane.  The ground's
+  surface is lowered by the point foot's sphere radius, so the sphere touches it where
+  walkerlab's point foot touches the ground line (arc feet: the cylinder is the foot, no
+  offset).
+- **contact** (:func:`mujoco_contact`): MuJoCo's soft contact is a linear spring-damper on
+  the penetration (``solref`` = time constant, damping ratio), walkerlab's IMPACT law is
+  ``k d^e + STEP(d, 0, 0, dmax, cmax) d'``.  The mapping linearises IMPACT at the static
+  penetration of the whole walker standing on one foot.
+- **knee latch** (kneed walkers): MuJoCo has no contact-switched joint lock, so each knee has
+  a joint equality constraint ``leg<i>_latch`` (knee angle = 0) that a stepping loop switches
+  by walkerlab's rule (:mod:`walkerlab.models.contact.generated`): on while the leg's foot is less
+  than the release height above the ground and its knee within the capture flexion of
+  straight; the numbers are in the file's ``custom`` section and the rule is
+  :func:`walkerlab.export.mujoco_walk.latch_rule`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from walkerlab.config import Scene
+from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.export.mjcf_scene import (
+    MJCF_MIN_LENGTH_M,
+    MJCF_MIN_MASS_KG,
+    MjcfScene,
+    point_foot_radius,
+)
+from walkerlab.models.contact.laws import ContactParamsSI
+
+__all__ = ["EXPORT_STEPS", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]
+
+#: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
+EXPORT_STEPS = 40
+
+
+def check_exportable(scene: Scene) -> None:
+    """Refuse walkers whose numbers MuJoCo cannot represent.
+
+    Raises
+    ------
+    ValueError
+        One line naming the field: a mass below :data:`MJCF_MIN_MASS_KG` (but > 0; 0 is
+        refused by the multibody model) or a length / foot radius below
+        :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot).
+    """
+    def walk(obj, path):
+        if isinstance(obj, dict):
+            for k, v in obj.items():
+                yield from walk(v, f"{path}.{k}")
+        elif isinstance(obj, list | tuple):
+            for i, v in enumerate(obj):
+                yield from walk(v, f"{path}[{i}]")
+        elif isinstance(obj, float | int) and not isinstance(obj, bool):
+            yield path, float(obj)
+
+    for path, val in walk(scene.walker.model_dump(), "walker"):
+        field = path.rsplit(".", 1)[-1]
+        if field.endswith("mass_kg") and 0 < val < MJCF_MIN_MASS_KG:
+            raise ValueError(f"{path} = {val:g} kg is below the {MJCF_MIN_MASS_KG:g} kg an "
+                             "MJCF export can carry (MuJoCo refuses lighter bodies)")
+        if (field.endswith("length_m") or field == "radius_m") and 0 < val < MJCF_MIN_LENGTH_M:
+            raise ValueError(f"{path} = {val:g} m is below the {MJCF_MIN_LENGTH_M:g} m an "
+                             "MJCF export can carry (MuJoCo refuses smaller geometry)")
+
+
+def mujoco_contact(c: ContactParamsSI, mass_kg: float, g: float, phi: float,
+                   ) -> tuple[float, tuple, tuple, float, tuple]:
+    """MuJoCo contact parameters equivalent to the IMPACT law near the static penetration.
+
+    The walker of mass ``M`` standing on one foot sinks to ``d_s = (M g cos phi / k)^(1/e)``;
+    there IMPACT has the tangent stiffness ``k_l = e M g cos phi / d_s`` and the damping
+    ``c_s = cmax STEP(d_s, 0, 0, dmax, 1)``: natural frequency ``w = sqrt(k_l / M)``, damping
+    ratio ``z = c_s / (2 sqrt(k_l M))``.  MuJoCo's reference acceleration
+    ``-b v - k r`` with ``solref = (tau, z)`` has ``k = 1 / (tau z)^2``, ``b = 2 / tau``
+    (per unit mass, impedance ~1 with ``solimp = (0.99, 0.99, ...)``), so ``tau = 1 / (z w)``
+    gives the same ``w`` and ``z`` (``z = 1`` if IMPACT has no damping there).  The timestep
+    is ``tau / 4`` (MuJoCo needs ``tau >= 2 dt``), at most 1 ms.
+
+    Limits: MuJoCo's spring is linear in the penetration (IMPACT's ``d^e`` is exact only at
+    ``d_s``: an impact penetrates less deeply and rebounds differently), the load on a foot
+    is not always ``M g`` (double support, a swing foot's touchdown), MuJoCo's friction has
+    one coefficient (``mu_static`` is used: the stance foot is in stiction) and no
+    stiction/creep regularisation (its soft cone lets a foot creep instead).
+
+    Returns
+    -------
+    timestep_s, solref, solimp, friction, notes
+    """
+    W = mass_kg * g * math.cos(phi)
+    ds = (W / c.k) ** (1.0 / c.e)
+    kl = c.e * W / ds
+    s = min(ds / c.dmax, 1.0)
+    cs = c.cmax * s * s * (3 - 2 * s)
+    w = math.sqrt(kl / mass_kg)
+    z = cs / (2 * math.sqrt(kl * mass_kg)) if cs > 0 else 1.0
+    tau = 1.0 / (z * w)
+    dt = min(tau / 4, 1e-3)
+    notes = (f"Contact from the scene's IMPACT law (walkerlab.export.scene."
+             f"mujoco_contact): k = {c.k:.6g} N/m^{c.e:g}, cmax = {c.cmax:.6g} N s/m, dmax = "
+             f"{c.dmax:.6g} m linearised at the static penetration d_s = {ds:.4g} m of the "
+             f"{mass_kg:.6g} kg walker on one foot: stiffness {kl:.4g} N/m, damping "
+             f"{cs:.4g} N s/m, i.e. w = {w:.4g} rad/s, damping ratio z = {z:.4g}; MuJoCo "
+             f"solref = (tau, z) with tau = 1/(z w) = {tau:.4g} s, timestep tau/4. Limits: "
+             "linear spring (exact only at d_s), one friction coefficient (mu_static), no "
+             "stiction regularisation.",)
+    return dt, (tau, z), (0.99, 0.99, 0.001, 0.5, 2.0), float(c.mu_s), notes
+
+
+def joint_state(mb, walker, x) -> tuple[np.ndarray, np.ndarray]:
+    """The export's joint coordinates and rates from a floating state ``x`` (2 nq,) of the
+    contact walker (state names of :meth:`ContactWalker.state_names`).
+
+    Returns
+    -------
+    qpos, qvel : ndarray (2 + len(mb.links),)
+        ``hip_x``, ``hip_z`` [m, m/s], then each link's joint [rad, rad/s]; a coupled joint
+        (the torso's) from its coupling.
+    """
+    q, v = walker.layout().coordinate_values(x)
+
+    coupled = {cp.joint: cp.terms for cp in mb.couplings}  # e.g. the torso's bisecting hip
+    link_of = {ln.joint: ln.name for ln in mb.links}
+
+    def joint(vals, ln):
+        if ln.joint in coupled:  # of hip joints: absolute link (leg or thigh) angles
+            return sum(c * vals[f"{link_of[j]}_angle"] for j, c in coupled[ln.joint])
+        own = vals[f"{ln.name}_angle"]
+        return own - vals[f"{ln.parent}_angle"] if ln.joint.endswith("_knee") else own
+
+    return (np.array([q["hip_x"], q["hip_y"], *(joint(q, ln) for ln in mb.links)]),
+            np.array([v["hip_x"], v["hip_y"], *(joint(v, ln) for ln in mb.links)]))
+
+
+def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
+    """The gait keyframe, terrain, contact and latch of ``scene`` for the MJCF export.
+
+    Parameters
+    ----------
+    scene : Scene
+        With a ``fixedpoint`` section (the rigid gait); ``contact`` and ``terrain`` default
+        to the paper's law and a checkerboard of 0.1 m patches.
+    mb : Multibody
+    data : WalkerData
+
+    Returns
+    -------
+    MjcfScene
+
+    Raises
+    ------
+    ValueError
+        No ``fixedpoint`` section (one line).
+    """
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.models.contact.model import ContactWalker
+    from walkerlab.models.contact.rigid_limit import contact_si
+    from walkerlab.models.contact.scene import ideal_step_length
+
+    settings = scene.contact or ContactSettings()
+    terrain = scene.terrain or TerrainSettings()
+    c, knee = contact_si(settings)
+    walker = ContactWalker(contact=c, data=data, knee_stop=knee)
+    ideal = ideal_gait(scene)
+    z = walker.link_state_from_ideal(ideal.x)
+    qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
+    dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)
+    lanes = None
+    if terrain.kind == "checkerboard":
+        # the keyframe's feet are one step apart: leg2's step, the last of the gait's map
+        ell2 = ideal_step_length(walker, ideal.x)
+        ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
+        # legs that differ: leg1's step differs from leg2's by the rigid steps' difference
+        # (exact for point feet), else footfalls drift off the patches stride by stride
+        k = np.arange(EXPORT_STEPS // 2 + 1)
+        if len(ells) == 2:
+            ell1 = ell2 + (ells[0] - ells[1])
+            lanes = (tuple(ell1 + (k - 1) * (ell1 + ell2)), tuple((ell1 + ell2) * k))
+        else:
+            lanes = (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
+    latch = (knee.latch_height, knee.latch_capture) if mb.knee else None
+    notes = (f"Keyframe 'gait': the rigid walker's fixed point (step period "
+             f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "
+             "origin.",) + notes
+    if latch:
+        notes += (f"Knee latch (walkerlab.export.mujoco_walk.latch_rule): equality "
+                  f"leg<i>_latch holds knee = 0 while the leg's foot is less than "
+                  f"{knee.latch_height:.4g} m above the ground and its knee within "
+                  f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
+                  "(data.eq_active), MuJoCo has no contact-switched lock.",)
+    return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
+                     0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
+                     dt, solref, solimp, mu, latch, notes)

@@ -1,0 +1,510 @@
+"""Basin of attraction of the period-1 gait over a 2-D slice of the Poincaré section.
+
+Schwab & Wisse (2001), "Basin of attraction of the simplest walking model", ASME DETC 2001:
+start the walker from every cell of a grid of post-heel-strike states, iterate the Poincaré
+map and record where each cell goes.  Here a cell's state takes its two axis coordinates
+(named by ``walker.state_names()``) from the grid, and either (``basin.start``)
+
+``fixed_point``  the coordinate fixed by the heel-strike surface from that constraint
+                 (``walker.from_section(walker.section(x))``) and every other coordinate from
+                 the fixed point ``x*`` (:func:`slice_state`), or
+``heel_strike``  the cell is a state just after a heel strike, as Schwab & Wisse's: the image
+                 ``walker.reset(x-)`` of a pre-impact state ``x-`` on the guard that equals
+                 the fixed point's pre-impact state but in the two section coordinates the
+                 axis values depend on most (:func:`heel_strike_slice`).  For the simplest
+                 walker the post-impact states form a 2-D set (the massless swing leg's rate
+                 follows from the stance leg's), so this cell is the only one there is.
+
+Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
+
+``converged``        ``max|x_k - x*| < converge_tol`` after ``k`` steps (the period-1 gait)
+``other_attractor``  ``max|x_k - x_{k-p}| < period_tol`` for some ``1 <= p <= max_period``
+                     away from ``x*`` (a period-``p`` gait; ``p`` is stored)
+``fell_forward``     a fall guard fired with the hip ahead of the stance foot (x > 0)
+``fell_backward``    ... with the hip behind it
+``max_steps``        none of the above within ``max_steps`` steps
+``stalled``          a step longer than ``max_step_time_s``, or a solver failure
+``unreachable``      (``start: heel_strike``) no pre-impact state on the guard has a heel
+                     strike that lands on the cell
+
+Cells are evaluated in chunks (one grid row each) by
+:func:`walkerlab.studies.runner.sweep_executor` - in this process, on a local process pool
+or on a Dask cluster - and written to a partial HDF5 file after every chunk, so an
+interrupted map resumes where it stopped.  Each finished grid row is stored with its hash
+(:func:`row_digest`, ``/row_hash``); on resume a row whose cells no longer match it (edited,
+damaged) is computed again (issue 19, item 4).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.numerics import fd_jacobian
+
+OUTCOMES = ("converged", "other_attractor", "fell_forward", "fell_backward", "max_steps",
+            "stalled", "unreachable")
+CODE = {name: i for i, name in enumerate(OUTCOMES)}
+NOT_DONE = -1
+
+__all__ = ["OUTCOMES", "CODE", "NOT_DONE", "BasinTask", "slice_state", "HeelStrikeSlice",
+           "heel_strike_slice", "axis_values", "classify_cell", "run_basin_chunk",
+           "compute_basin", "basin_run"]
+
+
+class BasinError(ValueError):
+    """Bad basin settings (message names the field)."""
+
+
+def _index(names: list[str], name: str, field: str) -> int:
+    if name not in names:
+        raise BasinError(f"basin.{field}: unknown state {name!r}; choose from "
+                         f"{', '.join(names)}")
+    return names.index(name)
+
+
+def slice_state(walker, x_star: np.ndarray, axes: tuple[str, str],
+                values: tuple[float, float]) -> np.ndarray:
+    """Post-heel-strike state of one cell.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    x_star : ndarray, shape (2n,)
+        Period-1 fixed point (role-ordered, just after heel strike).
+    axes : (str, str)
+        State names of the two grid axes.
+    values : (float, float)
+        Their values [rad or rad/s].
+
+    Returns
+    -------
+    ndarray, shape (2n,)
+        ``x*`` with the two axis coordinates replaced, projected on the heel-strike surface.
+
+    Raises
+    ------
+    BasinError
+        An unknown state name, or an axis that the heel-strike constraint fixes.
+    """
+    names = walker.state_names()
+    ix = _index(names, axes[0], "x_axis")
+    iy = _index(names, axes[1], "y_axis")
+    if ix == iy:
+        raise BasinError("basin: x_axis and y_axis name the same state")
+    x = np.array(x_star, dtype=float)
+    x[ix], x[iy] = values
+    x = np.asarray(walker.from_section(walker.section(x)), dtype=float)
+    for i, field, v in ((ix, "x_axis", values[0]), (iy, "y_axis", values[1])):
+        if abs(x[i] - v) > 1e-12 * (1 + abs(v)):
+            raise BasinError(f"basin.{field}: {names[i]!r} is fixed by the heel-strike "
+                             "constraint; choose another state")
+    return x
+
+
+@dataclass(frozen=True)
+class HeelStrikeSlice:
+    """Cells as states just after a heel strike (``basin.start: heel_strike``).
+
+    Attributes
+    ----------
+    z_pre : ndarray, shape (2n - 1,)
+        Section coordinates (``walker.section``) of the fixed point's pre-impact state.
+    free : ndarray of int, shape (2,)
+        Which of them vary from cell to cell: the two the post-impact axis values depend on
+        most (column-pivoted QR of that 2 x (2n - 1) Jacobian at ``z_pre``).
+    axes : ndarray of int, shape (2,)
+        State indices of the x and y axes.
+    """
+
+    z_pre: np.ndarray
+    free: np.ndarray
+    axes: np.ndarray
+
+    def post(self, walker, u: np.ndarray) -> np.ndarray:
+        """Post-impact state ``walker.reset(x-)`` of the pre-impact state with ``free = u``
+        (legs that differ: the heel strike that closes a stride, leg2 swinging)."""
+        z = self.z_pre.copy()
+        z[self.free] = u
+        last = walker.for_stance(walker.legs[0])
+        return np.asarray(last.reset(np.asarray(last.from_section(z), dtype=float)),
+                          dtype=float)
+
+    def state(self, walker, values: tuple[float, float]) -> np.ndarray | None:
+        """The cell's post-impact state, or None where no heel strike lands on it.
+
+        The two free pre-impact coordinates are found by ``scipy.optimize.root`` (MINPACK
+        hybrd) from the fixed point's; the cell is unreachable unless the axis values are
+        matched to 1e-10 (relative) and the pre-impact state is finite.
+        """
+        from scipy.optimize import root
+
+        target = np.asarray(values, dtype=float)
+
+        def residual(u):
+            return self.post(walker, u)[self.axes] - target
+
+        with np.errstate(all="ignore"):
+            sol = root(residual, self.z_pre[self.free], method="hybr", options={"xtol": 1e-13})
+            x = self.post(walker, sol.x)
+        if not (np.all(np.isfinite(x)) and
+                np.max(np.abs(x[self.axes] - target)) <= 1e-10 * (1 + np.max(np.abs(target)))):
+            return None
+        return x
+
+
+def heel_strike_slice(walker, x_pre: np.ndarray, axes: tuple[str, str]) -> HeelStrikeSlice:
+    """Set up :class:`HeelStrikeSlice` from the fixed point's pre-impact state ``x_pre``
+    (shape (2n,), on the heel-strike guard).
+
+    Raises
+    ------
+    BasinError
+        An unknown axis name, or axes the heel strike leaves fixed (the 2 x (2n - 1)
+        Jacobian has rank < 2).
+    """
+    names = walker.state_names()
+    ax = np.array([_index(names, axes[0], "x_axis"), _index(names, axes[1], "y_axis")])
+    if ax[0] == ax[1]:
+        raise BasinError("basin: x_axis and y_axis name the same state")
+    from scipy.linalg import qr
+
+    z = np.asarray(walker.section(np.asarray(x_pre, dtype=float)), dtype=float)
+    base = HeelStrikeSlice(z, np.arange(z.size), ax)
+    # forward differences are enough: only the pivot order (and the rank) is taken from it
+    jac = np.atleast_2d(fd_jacobian(lambda zz: base.post(walker, zz)[ax], z, 1e-7,
+                                     central=False))
+    _, r, piv = qr(jac, pivoting=True)
+    if abs(r[1, 1]) <= 1e-9 * max(abs(r[0, 0]), 1e-300):
+        raise BasinError(f"basin: the heel strike fixes a relation between {axes[0]!r} and "
+                         f"{axes[1]!r}; choose other axes or basin.start: fixed_point")
+    return HeelStrikeSlice(z, np.sort(piv[:2]), ax)
+
+
+def axis_values(settings, walker, x_star: np.ndarray,
+                grid: tuple[int, int] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Cell-centre values of the x and y axes [rad or rad/s].
+
+    Default ranges: the fixed point -/+ 0.3 rad for an angle, -/+ 1.2 rad/s for a rate.
+    """
+    names = walker.state_names()
+    nx, ny = grid or settings.grid
+    out = []
+    for name, rng, n, field in ((settings.x_axis, settings.x_range, nx, "x_axis"),
+                                (settings.y_axis, settings.y_range, ny, "y_axis")):
+        c = float(x_star[_index(names, name, field)])
+        if rng is None:
+            half = 1.2 if name.endswith("_rate") else 0.3
+            rng = (c - half, c + half)
+        lo, hi = float(rng[0]), float(rng[1])
+        if not hi > lo:
+            raise BasinError(f"basin.{field[0]}_range: the upper end must exceed the lower")
+        edges = np.linspace(lo, hi, n + 1)
+        out.append(0.5 * (edges[:-1] + edges[1:]))
+    return out[0], out[1]
+
+
+def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
+                  max_step_time: float = 5.0) -> tuple[int, int, int]:
+    """Iterate the Poincaré map from ``x0`` and classify where it goes.
+
+    ``max_step_time`` [s]: a longer step ends the cell as ``stalled``.
+
+    Returns
+    -------
+    code : int
+        Index into :data:`OUTCOMES`.
+    steps : int
+        Steps taken until the outcome was decided.
+    period : int
+        Period of the attractor reached, in Poincare maps (strides when the legs differ;
+        1 for the fixed point, 0 if none).
+    """
+    from walkerlab.integrate.rigid import integrate_step
+
+    x = np.asarray(x0, dtype=float)
+    hist = [x]
+    per_map = walker.steps_per_map  # legs that differ: the section is reached every stride
+    for k in range(1, settings.max_steps + 1):
+        stance = walker.legs[1] if (k - 1) % per_map == 0 else walker.legs[0]
+        step_walker = walker.for_stance(stance)
+        seg = integrate_step(step_walker, x, solver, max_step_time=max_step_time)
+        if seg.termination == "fall":
+            hip = step_walker.points(seg.x_end)["hip"]
+            return CODE["fell_forward" if float(hip[0]) > 0 else "fell_backward"], k, 0
+        if seg.termination != "heel_strike":
+            return CODE["stalled"], k, 0
+        x = seg.x_next
+        if not np.all(np.isfinite(x)):
+            return CODE["stalled"], k, 0
+        if k % per_map:  # mid-stride: not on the Poincare section of a stride map
+            continue
+        if float(np.max(np.abs(x - x_star))) < settings.converge_tol:
+            return CODE["converged"], k, 1
+        for p in range(1, min(settings.max_period, len(hist)) + 1):
+            if float(np.max(np.abs(x - hist[-p]))) < settings.period_tol:
+                return CODE["other_attractor"], k, p
+        hist.append(x)
+    return CODE["max_steps"], settings.max_steps, 0
+
+
+@dataclass(frozen=True)
+class BasinTask:
+    """A chunk of cells evaluated by one worker (picklable).
+
+    Attributes
+    ----------
+    base : dict
+        Scene mapping (``Scene.model_dump(mode="json")``).
+    x_star : tuple of float
+        Fixed point (role-ordered).
+    cells : tuple of (int, float, float)
+        ``(flat index, x value, y value)``.
+    """
+
+    base: dict
+    x_star: tuple
+    cells: tuple
+    #: the fixed point's pre-impact state (``basin.start: heel_strike``), else empty
+    x_pre: tuple = ()
+
+
+_WALKERS: dict[str, object] = {}
+
+
+def _walker_and_settings(base: dict):
+    from walkerlab.config import BasinSettings, scene_from_dict
+    from walkerlab.models.registry import build_walker
+
+    key = json.dumps(base, sort_keys=True)
+    if key not in _WALKERS:
+        scene = scene_from_dict(base)
+        _WALKERS.clear()
+        st = scene.basin or BasinSettings()
+        mst = st.max_step_time_s or (scene.fixedpoint.max_step_time_s if scene.fixedpoint
+                                     else 5.0)
+        _WALKERS[key] = (build_walker(scene), st, mst)
+    return _WALKERS[key]
+
+
+def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
+    """Classify every cell of a chunk: ``[(flat index, code, steps, period), ...]``."""
+    from walkerlab.integrate.solver import Solver
+
+    walker, st, max_step_time = _walker_and_settings(task.base)
+    solver = Solver("DOP853", st.rtol, st.atol, backend=st.backend)
+    x_star = np.asarray(task.x_star, dtype=float)
+    axes = (st.x_axis, st.y_axis)
+    hs = heel_strike_slice(walker, np.asarray(task.x_pre), axes) if task.x_pre else None
+    out = []
+    for idx, vx, vy in task.cells:
+        x0 = (slice_state(walker, x_star, axes, (vx, vy)) if hs is None
+              else hs.state(walker, (vx, vy)))
+        if x0 is None:
+            out.append((int(idx), CODE["unreachable"], 0, 0))
+            continue
+        out.append((int(idx), *classify_cell(walker, x0, x_star, solver, st, max_step_time)))
+    return out
+
+
+def pre_impact_fixed_point(walker, x_star: np.ndarray, settings, max_step_time: float
+                           ) -> np.ndarray:
+    """The fixed point's state just before its heel strike, shape (2n,) (one step of the
+    basin's integrator from ``x_star``).
+
+    Raises
+    ------
+    BasinError
+        The step from ``x_star`` does not end in a heel strike.
+    """
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
+
+    solver = Solver("DOP853", settings.rtol, settings.atol, backend=settings.backend)
+    x = np.asarray(x_star, dtype=float)
+    for k in range(walker.steps_per_map):  # legs that differ: the stride's closing step
+        seg = integrate_step(walker.for_stance(walker.legs[1 - k % 2]), x, solver,
+                             max_step_time=max_step_time)
+        if seg.termination != "heel_strike":
+            break
+        x = seg.x_next
+    if seg.termination != "heel_strike":
+        raise BasinError(f"basin.start: the step from the fixed point ended in "
+                         f"{seg.termination!r}, not a heel strike")
+    return np.asarray(seg.x_end, dtype=float)
+
+
+def _partial(path: Path) -> Path:
+    return path.with_name(path.name + ".partial")
+
+
+def row_digest(arrays: dict, j: int, key: str) -> str:
+    """SHA-256 of grid row ``j`` (outcome, steps, period) and the input hash ``key``: the
+    integrity check of a partial basin file (a row that does not match is computed again)."""
+    import hashlib
+
+    h = hashlib.sha256(f"{key}|{j}".encode())
+    for k in ("outcome", "steps", "period"):
+        a = np.ascontiguousarray(arrays[k][j])
+        h.update(k.encode() + a.dtype.str.encode() + a.tobytes())
+    return h.hexdigest()
+
+
+def _resumed_cells(part: Path, key: str, nx: int, ny: int):
+    """``(arrays, row_hash)`` of a partial basin file of input hash ``key`` and grid
+    ``(ny, nx)``, keeping only grid rows whose cells still match the hash written with them
+    (the others are set back to not done); ``(None, None)`` without a usable file."""
+    from walkerlab.io.basin_partial import read_basin_partial
+
+    arrays, stored = read_basin_partial(part, key, (ny, nx))
+    if arrays is None:
+        return None, None
+    row_hash = np.array([""] * ny, dtype=object)
+    bad = 0
+    for j in range(ny):
+        done_row = bool(np.any(arrays["outcome"][j] != NOT_DONE))
+        if stored[j] and stored[j] == row_digest(arrays, j, key) and \
+                bool(np.all(arrays["outcome"][j] != NOT_DONE)):
+            row_hash[j] = stored[j]
+            continue
+        bad += done_row
+        arrays["outcome"][j] = NOT_DONE
+        arrays["steps"][j] = 0
+        arrays["period"][j] = 0
+    if bad:
+        from walkerlab import progress
+
+        progress.note(f"{part}: {bad} grid row(s) failed their integrity check; "
+                      "computing them again")
+    return arrays, row_hash
+
+
+def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
+                  grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
+                  resume: bool = True, on_chunk: Callable[[int, int], None] | None = None
+                  ) -> dict:
+    """Classify every cell of the basin grid; resumable through ``<out_path>.partial``.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``basin`` section (or the defaults) sets axes, ranges and tolerances.
+    x_star : ndarray, shape (2n,)
+        Period-1 fixed point.
+    key : str
+        Input hash; a partial file with another key is discarded.
+    out_path : Path
+        Final artifact (the partial file lives next to it).
+    grid : (nx, ny), optional
+        Overrides ``basin.grid``.
+    workers, scheduler
+        As for :func:`walkerlab.studies.runner.sweep_executor`.
+    resume : bool
+        Keep the cells of a matching partial file.
+    on_chunk : callable(done, total), optional
+        Called after each chunk is stored.
+
+    Returns
+    -------
+    dict
+        ``x``, ``y`` (cell centres), ``outcome``, ``steps``, ``period`` (shape (ny, nx)),
+        ``wall_time_s`` (this call), ``cells_computed``.
+
+    Raises
+    ------
+    BasinError
+        Bad axes or ranges.
+    """
+    from walkerlab.execution.executor import run_each
+    from walkerlab.io.basin_partial import basin_partial_writer
+    from walkerlab.studies.runner import sweep_executor
+
+    base = scene.model_dump(mode="json")
+    walker, st, mst = _walker_and_settings(base)
+    xs, ys = axis_values(st, walker, x_star, grid)
+    x_pre: tuple = ()
+    if st.start == "heel_strike":  # validates the axes too
+        pre = pre_impact_fixed_point(walker, x_star, st, mst)
+        heel_strike_slice(walker, pre, (st.x_axis, st.y_axis))
+        x_pre = tuple(float(v) for v in pre)
+    else:
+        slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]))  # validate axes
+    nx, ny = xs.size, ys.size
+    from walkerlab.io.runpaths import refuse_link
+
+    part = refuse_link(_partial(Path(out_path)))  # never written through a link
+    part.parent.mkdir(parents=True, exist_ok=True)
+    arrays, row_hash = _resumed_cells(part, key, nx, ny) if resume else (None, None)
+    if arrays is None:
+        arrays = {"outcome": np.full((ny, nx), NOT_DONE, np.int8),
+                  "steps": np.zeros((ny, nx), np.int16), "period": np.zeros((ny, nx), np.int8)}
+        row_hash = np.array([""] * ny, dtype=object)
+    tasks = []
+    for j in range(ny):
+        cells = tuple((j * nx + i, float(xs[i]), float(ys[j])) for i in range(nx)
+                      if arrays["outcome"][j, i] == NOT_DONE)
+        if cells:
+            tasks.append(BasinTask(base, tuple(float(v) for v in x_star), cells, x_pre))
+    # rows through the fixed point converge slowly: start them first for load balance
+    jc = int(np.argmin(np.abs(ys - x_star[walker.state_names().index(st.y_axis)])))
+    tasks.sort(key=lambda t: abs(t.cells[0][0] // nx - jc))
+    total, done = nx * ny, int(np.sum(arrays["outcome"] != NOT_DONE))
+    t0 = time.perf_counter()
+    computed = 0
+    from walkerlab import progress
+
+    part.unlink(missing_ok=True)
+    with basin_partial_writer(part, key, arrays, row_hash) as write, \
+            progress.task(f"basin {nx}x{ny} cells", total, done) as bar:
+        with sweep_executor(workers, scheduler) as ex:
+            for _, rows in run_each(ex, run_basin_chunk, [(t,) for t in tasks]):
+                for idx, code, steps, period in rows:
+                    j, i = divmod(idx, nx)
+                    arrays["outcome"][j, i] = code
+                    arrays["steps"][j, i] = steps
+                    arrays["period"][j, i] = period
+                for j in sorted({idx // nx for idx, *_ in rows}):
+                    if np.all(arrays["outcome"][j] != NOT_DONE):
+                        row_hash[j] = row_digest(arrays, j, key)
+                write(arrays, row_hash)
+                computed += len(rows)
+                done += len(rows)
+                bar.update(done)
+                if on_chunk is not None:
+                    on_chunk(done, total)
+    return {"x": xs, "y": ys, **arrays, "wall_time_s": time.perf_counter() - t0,
+            "cells_computed": computed, "partial": part, "settings": st, "walker": walker}
+
+
+def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
+              grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
+              resume: bool = True, on_chunk: Callable[[int, int], None] | None = None):
+    """:func:`compute_basin` (same arguments) packed for the basin artifact.
+
+    Returns
+    -------
+    run : walkerlab.io.schemas.basin.BasinRun
+        The cells, the fixed point, the scene's ``basin`` settings (defaults when absent)
+        and the cells per outcome (``run.counts``, in :data:`OUTCOMES` order).
+    partial : Path
+        The resume file; the caller removes it once the artifact is written.
+
+    Raises
+    ------
+    BasinError
+        Bad axes or ranges (one line).
+    """
+    from walkerlab.config import BasinSettings
+    from walkerlab.io.schemas.basin import BasinRun
+
+    res = compute_basin(scene, x_star, key, out_path, grid, workers, scheduler, resume=resume,
+                        on_chunk=on_chunk)
+    counts = {o: int(np.sum(res["outcome"] == i)) for i, o in enumerate(OUTCOMES)}
+    run = BasinRun(res["walker"], res, x_star, scene.basin or BasinSettings(), list(OUTCOMES),
+                   counts)
+    return run, res["partial"]

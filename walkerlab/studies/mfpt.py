@@ -1,0 +1,366 @@
+"""The many-walk and many-cell work of the MFPT study, on local processes or Dask.
+
+Monte Carlo walks are dealt out in chunks of walk numbers (each walk's slopes come from its
+own random stream, so a chunk's result does not depend on the chunking or the executor);
+the mesh's step-map images are dealt out in chunks of (state, slope) rows.  Both go through
+:func:`walkerlab.execution.executor.run_each` on :func:`walkerlab.studies.runner.sweep_executor`
+(in this process, a local process pool or a Dask cluster, unchanged).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.analysis.gait.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.analysis.robustness import mfpt as M
+
+#: walks per Monte Carlo task, rows per mesh task
+WALKS_PER_TASK = 500
+ROWS_PER_TASK = 4000
+
+_MAPS: dict[str, BatchStepMap] = {}
+
+
+def scene_walker_at(scene):
+    """``gamma -> HybridWalker``: the scene's rigid walker on another slope."""
+    from walkerlab.models.registry import build_walker
+
+    def at(gamma: float):
+        return build_walker(scene.model_copy(update={
+            "slope": scene.slope.model_copy(update={"angle_rad": float(gamma),
+                                                    "angle_deg": None})}))
+    return at
+
+
+def step_map_for(base: dict) -> BatchStepMap:
+    """The batched step map of a scene mapping (built once per process; a walker without
+    compiled flows, e.g. flat feet, gets the row-by-row
+    :class:`~walkerlab.analysis.gait.python_step.PythonStepMap`)."""
+    from walkerlab.analysis.gait.python_step import make_step_map
+    from walkerlab.config import MfptSettings, scene_from_dict
+    from walkerlab.models.registry import build_walker
+
+    key = json.dumps(base, sort_keys=True)
+    if key not in _MAPS:
+        scene = scene_from_dict(base)
+        st = scene.mfpt or MfptSettings()
+        _MAPS.clear()
+        _MAPS[key] = make_step_map(build_walker(scene), scene_walker_at(scene), st.rtol,
+                                   st.atol, st.max_step_time_s)
+    return _MAPS[key]
+
+
+@dataclass(frozen=True)
+class WalkTask:
+    """Monte Carlo walks ``walks`` at one sigma (picklable)."""
+
+    base: dict
+    x0: tuple
+    sd: float
+    walks: tuple
+    max_steps: int
+    seed: int
+    distribution: str
+    index: int
+
+
+@dataclass(frozen=True)
+class ImageTask:
+    """Step-map images of ``X`` on slopes ``gamma`` (picklable)."""
+
+    base: dict
+    X: np.ndarray
+    gamma: np.ndarray
+    start: int
+
+
+def run_walks(task: WalkTask):
+    """``(index, steps, fell)`` of a chunk of walks."""
+    sm = step_map_for(task.base)
+    res = M.monte_carlo(sm, np.asarray(task.x0), task.sd, task.walks, task.max_steps,
+                        task.seed, distribution=task.distribution)
+    return task.index, res.steps, res.fell
+
+
+def run_images(task: ImageTask):
+    """``(start, x_next, ok)`` of a chunk of mesh rows."""
+    sm = step_map_for(task.base)
+    r = sm.step(task.X, task.gamma)
+    return task.start, r.x_next, r.outcome == HEEL_STRIKE
+
+
+def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, seed: int,
+                distribution: str = "normal", workers: int = 1, scheduler=None,
+                partial=None) -> M.MonteCarloResult:
+    """Monte Carlo MFPT walks of a scene at one sigma [rad] (see
+    :func:`walkerlab.analysis.robustness.mfpt.monte_carlo`), chunked over the executor.
+
+    ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): chunks stored
+    there by an interrupted run are taken as they are (a chunk's walks do not depend on
+    when or where they ran), and every chunk that finishes is stored."""
+    from walkerlab.execution.executor import run_each
+    from walkerlab.studies.runner import sweep_executor
+
+    base = scene.model_dump(mode="json")
+    tasks = [WalkTask(base, tuple(float(v) for v in x0), float(sd),
+                      tuple(range(a, min(a + WALKS_PER_TASK, walks))), max_steps, seed,
+                      distribution, i)
+             for i, a in enumerate(range(0, walks, WALKS_PER_TASK))]
+    steps = np.zeros(walks, dtype=np.int64)
+    fell = np.zeros(walks, dtype=bool)
+
+    def name(i: int) -> str:
+        return f"montecarlo/sigma={float(sd)!r}/chunk={i}"
+
+    def put(i, s, f):
+        a = i * WALKS_PER_TASK
+        steps[a:a + s.size], fell[a:a + f.size] = s, f
+
+    todo = []
+    for t in tasks:
+        got = partial.get(name(t.index)) if partial is not None else None
+        if got is not None and got["steps"].size == len(t.walks):
+            put(t.index, got["steps"], got["fell"].astype(bool))
+        else:
+            todo.append(t)
+    if todo:
+        with sweep_executor(workers, scheduler) as ex:
+            for _, (i, s, f) in run_each(ex, run_walks, [(t,) for t in todo]):
+                put(i, s, f)
+                if partial is not None:
+                    partial.put(name(i), {"steps": np.asarray(s, np.int64),
+                                          "fell": np.asarray(f, np.int8)})
+    return M.MonteCarloResult(steps, fell)
+
+
+def image_evaluator(scene, ex):
+    """``(X, gamma) -> (x_next, ok)`` on the open executor ``ex`` (for
+    :func:`M.mesh_mfpt`; one worker pool serves every mesh of a refinement)."""
+    from walkerlab.execution.executor import run_each
+
+    base = scene.model_dump(mode="json")
+
+    def evaluate(X, gamma):
+        n = X.shape[0]
+        tasks = [ImageTask(base, X[a:a + ROWS_PER_TASK], gamma[a:a + ROWS_PER_TASK], a)
+                 for a in range(0, n, ROWS_PER_TASK)]
+        xn = np.full_like(X, np.nan)
+        ok = np.zeros(n, dtype=bool)
+        for _, (a, x, o) in run_each(ex, run_images, [(t,) for t in tasks]):
+            xn[a:a + x.shape[0]], ok[a:a + o.size] = x, o
+        return xn, ok
+    return evaluate
+
+
+def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler=None,
+         distribution: str = "normal", partial=None):
+    """Converged (or capped) mesh MFPT at one sigma: ``(last MeshResult, all meshes)``.
+
+    The nodes are the post-impact states visited by noisy walks from the gait at ``sd`` and
+    at ``1.5 sd`` (so the tails, where the falls start, are meshed too; a fallen walk starts
+    again on the gait); the images of the nodes are computed over the executor.
+    ``distribution`` (normal or uniform) is the per-step slope's: the walks draw from it
+    and the transitions integrate it (:func:`walkerlab.analysis.robustness.mfpt.slope_quadrature`).
+    ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): the images of
+    the nodes are stored there after every mesh, and a rerun takes those of an interrupted
+    run (when its visited states are the same, bit for bit), so it resumes at the mesh
+    under way."""
+    import hashlib
+
+    base = scene.model_dump(mode="json")
+    sm = step_map_for(base)
+    n = settings.mesh_max_cells
+    walks = 100
+    steps = max(20, math.ceil(n / walks) + 2)  # a pool of ~2 max_cells
+    pool = M.visited_states(sm, x0, (sd, 1.5 * sd), walks, steps, settings.seed,
+                            distribution=distribution)
+    if len(pool) < 10 * len(x0):
+        raise ValueError(f"mfpt: sigma {sd:g} rad: the walks fall too soon to shape a mesh "
+                         "(fewer post-impact states than needed)")
+    name = f"mesh/sigma={float(sd)!r}"
+    pool_sha = np.frombuffer(hashlib.sha256(np.ascontiguousarray(
+        np.concatenate([np.asarray(x0, float)[None], pool])).tobytes()).digest(), np.uint8)
+    q = settings.quadrature_nodes
+    cache: dict = {}
+    got = partial.get(name) if partial is not None else None
+    if got is not None and np.array_equal(got["pool_sha256"], pool_sha) \
+            and got["x_next"].shape[1:] == (q, len(x0)):
+        k = len(pool) + 1
+        cache = {"x": np.full((k, q, len(x0)), np.nan), "ok": np.zeros((k, q), dtype=bool),
+                 "done": np.zeros(k, dtype=bool)}
+        done = got["done_rows"]
+        cache["x"][done], cache["ok"][done], cache["done"][done] = \
+            got["x_next"], got["ok"].astype(bool), True
+
+    def store(_res, c):
+        if partial is not None:
+            done = np.flatnonzero(c["done"])
+            partial.put(name, {"pool_sha256": pool_sha, "done_rows": done,
+                               "x_next": c["x"][done], "ok": c["ok"][done].astype(np.int8)})
+    from walkerlab.studies.runner import sweep_executor
+
+    with sweep_executor(workers, scheduler) as ex:
+        return M.mesh_mfpt_converged(sm, pool, x0, sd, cells=settings.mesh_cells,
+                                     refine=settings.mesh_refine,
+                                     rel_change=settings.mesh_rel_change, max_cells=n,
+                                     quadrature=q, evaluate=image_evaluator(scene, ex),
+                                     distribution=distribution, cache=cache, on_mesh=store)
+
+
+def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
+               partial=None):
+    """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` (``st``: the scene's
+    :class:`walkerlab.config.MfptSettings`) from the gait ``x_star`` -> ``MfptData``.
+
+    ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): the finished
+    pieces (Monte Carlo chunks, mesh images) of an interrupted run are reused and the new
+    ones stored, so a killed study resumes where it stopped and gives the same numbers.
+    ``st.model == "contact"``: Monte Carlo of the compliant-contact model on patches at the
+    drawn heights (:func:`walkerlab.studies.contact_rough.contact_monte_carlo`), from its
+    periodic gait.
+
+    Raises
+    ------
+    ValueError
+        The walker cannot walk on per-step slopes; the contact model asked for the mesh,
+        without patches or without a periodic gait (one line).
+    """
+    import time
+
+    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
+    from walkerlab.models.registry import build_walker
+
+    per = scene.terrain.per_step if scene.terrain is not None else None
+    dist = per.slope_distribution if per is not None else "normal"
+    seed = per.seed if per is not None else st.seed
+    walker = build_walker(scene)
+    contact = getattr(st, "model", "rigid") == "contact"
+    if contact:
+        start = _contact_start(scene, x_star, st)
+    else:
+        from walkerlab.analysis.gait.python_step import needs_python_path
+
+        if st.method in ("mesh", "both") and needs_python_path(walker):
+            raise ValueError("mfpt.method: the mesh needs the compiled batched step map (its "
+                             "~10^6 step images); this walker has no compiled flows (flat "
+                             "feet): use --method montecarlo")
+        step_map_for(scene.model_dump(mode="json"))  # validates the walker in this process
+    sig = np.asarray(st.sigma_rad, float)
+    vals = {k: np.full(sig.size, np.nan) for k in VARIABLES}
+    hist = []
+    for i, sd in enumerate(sig):
+        if contact:
+            from walkerlab.studies.contact_rough import contact_monte_carlo
+
+            t = time.perf_counter()
+            mc, _ = contact_monte_carlo(start, sd, st.walks, st.max_steps, seed, dist,
+                                        workers, scheduler, partial)
+        elif st.method in ("montecarlo", "both"):
+            t = time.perf_counter()
+            mc = monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist, workers,
+                             scheduler, partial)
+        if contact or st.method in ("montecarlo", "both"):
+            m, se = mc.mfpt
+            vals["mfpt_steps_montecarlo"][i] = m
+            vals["mfpt_steps_montecarlo_stderr"][i] = se
+            vals["montecarlo_walks"][i] = mc.steps.size
+            vals["montecarlo_falls"][i] = int(mc.fell.sum())
+            vals["montecarlo_heel_strikes"][i] = int(mc.steps.sum())
+            vals["montecarlo_wall_time_s"][i] = time.perf_counter() - t
+        if st.method in ("mesh", "both"):
+            t = time.perf_counter()
+            last, all_meshes = mesh(scene, x_star, sd, st, workers, scheduler, dist, partial)
+            vals["mfpt_steps_mesh"][i] = last.mfpt_steps
+            vals["mfpt_steps_mesh_quasi_stationary"][i] = last.mfpt_quasi_stationary_steps
+            vals["mesh_cells"][i] = last.cells
+            vals["mesh_change"][i] = last.change
+            vals["mesh_converged"][i] = float(last.converged)
+            vals["mesh_escaped"][i] = last.escaped
+            vals["mesh_wall_time_s"][i] = time.perf_counter() - t
+            hist += [{"sigma_rad": float(sd), "h": r.h, "cells": r.cells,
+                      "mfpt_steps": r.mfpt_steps,
+                      "change": r.change if math.isfinite(r.change) else math.nan}
+                     for r in all_meshes]
+    return MfptData(sig, vals, st.method, walker.state_names(), hist)
+
+
+def _contact_start(scene, x_star: np.ndarray, st):
+    """The contact model's periodic gait for ``mfpt.model: contact`` (one-line errors)."""
+    from walkerlab.analysis.contact.rough import contact_start
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+    from walkerlab.models.contact.scene import ContactSceneError
+
+    if st.method != "montecarlo":
+        raise ValueError("mfpt.model: contact runs Monte Carlo only (the mesh is the rigid "
+                         "model's); set mfpt.method: montecarlo")
+    try:
+        return contact_start(scene, x_star)
+    except (ContactSceneError, PeriodicGaitError) as exc:
+        raise ValueError(f"mfpt.model: contact: {exc}") from None
+
+
+def _finite(v: float) -> float:
+    return v if math.isfinite(v) else math.nan
+
+
+class MfptStudyError(ValueError):
+    """The study cannot run on this scene (one line; nothing is kept to resume)."""
+
+
+def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
+                         resume: bool = True, workers: int = 1, scheduler=None):
+    """:func:`mfpt_study` that resumes an interrupted run of the same inputs.
+
+    The finished pieces (Monte Carlo chunks, mesh images) are kept in ``partial_path``
+    (``mfpt.h5.partial``, :class:`walkerlab.io.mfpt_partial.MfptPartial`) while ``key``
+    (the input hash of the scene sections and the gait) is the same; pieces are named by
+    sigma, so another sigma list or method reuses the pieces it shares.  The caller removes
+    the file (``partial.remove()``) once the artifact is written.
+
+    Parameters
+    ----------
+    x_star : ndarray (2n,)
+        The period-1 gait just after heel strike [rad, rad/s].
+    st : walkerlab.config.MfptSettings
+    partial_path : Path
+    key : str
+        Input hash the partial file is kept under.
+    resume : bool
+        False (``--force``): start afresh.
+
+    Returns
+    -------
+    data : walkerlab.io.schemas.mfpt.MfptData
+    partial : walkerlab.io.mfpt_partial.MfptPartial
+        Closed.
+
+    Raises
+    ------
+    walkerlab.safefs.RunPathError
+        ``partial_path`` is a symbolic link.
+    MfptStudyError
+        As :func:`mfpt_study`'s ValueError (bad input: the partial file is removed).
+    """
+    from walkerlab.io.mfpt_partial import MfptPartial
+
+    partial = MfptPartial(partial_path, key, resume=resume)
+    try:
+        data = mfpt_study(scene, x_star, st, workers, scheduler, partial)
+    except ValueError as exc:  # bad input: nothing to resume
+        partial.remove()
+        raise MfptStudyError(str(exc)) from None
+    finally:
+        partial.close()
+    return data, partial
+
+
+def mfpt_summary(data) -> dict:
+    """The printable summary of an ``MfptData``: ``sigma_rad`` [rad] and the Monte Carlo and
+    mesh MFPT [steps] at each sigma (lists of float)."""
+    return {"sigma_rad": list(map(float, data.sigma_rad)),
+            "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
+            "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"]))}

@@ -1,0 +1,582 @@
+"""Evaluate sweep points: one function per swept stage, and the chunk runner workers call.
+
+Each point function takes a validated :class:`~walkerlab.config.Scene`, the fixed points of
+the previous points of the same chunk (a :class:`Continuation`, or ``None``) and the sweep
+options, and returns ``(columns, fixed point result or None)``.  :func:`run_chunk` wraps
+them so that every point ends in a typed outcome (:mod:`walkerlab.studies.outcomes`),
+whatever happens.
+
+The contact-sim point goes through :func:`contact_adapter`, the only place that knows the
+calling convention of :func:`walkerlab.analysis.contact.sim.simulate_from` (adjust the
+adapter, nothing else, when its interface changes).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import json
+import math
+import threading
+import time
+import traceback
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from walkerlab.config import Scene, SceneError
+from walkerlab.integrate.ends import RUN_END_NAMES
+from walkerlab.studies.outcomes import empty_row, state_column
+from walkerlab.studies.params import apply_point
+
+__all__ = ["Task", "Continuation", "guess_from_json", "guess_to_json", "run_chunk",
+           "fixedpoint_point", "simulate_point", "contact_point", "contact_adapter",
+           "ideal_fixed_point", "DEFAULT_OPTIONS", "POINT_FUNCTIONS"]
+
+DEFAULT_OPTIONS: dict[str, Any] = {
+    "scuff_limit_m": None,   # rigid model: report 'scuff' if the swing foot dips deeper [m]
+    "slip_limit_mm": 5.0,    # contact model: 'slip' if a stance foot slides farther [mm]
+    "min_interleg_angle_rad": 1e-3,  # smaller fixed-point inter-leg angle = degenerate gait
+}
+
+
+class PointOutcome(Exception):
+    """Internal: end a point with a typed outcome and extra columns."""
+
+    def __init__(self, outcome: str, message: str = "", **cols):
+        super().__init__(message)
+        self.outcome, self.message, self.cols = outcome, message, cols
+
+
+@dataclass(frozen=True)
+class Task:
+    """A chunk of sweep points evaluated in order by one worker (picklable).
+
+    Attributes
+    ----------
+    stage : str
+        ``"fixedpoint"``, ``"simulate"`` or ``"contact-sim"``.
+    base : dict
+        Base scene as a plain mapping (``Scene.model_dump(mode="json")``).
+    paths : tuple of str
+        Dotted parameter paths, one per axis.
+    points : tuple of (int, tuple)
+        ``(row index, parameter values)`` in evaluation (continuation) order.
+    options : dict
+        Sweep options (see :data:`DEFAULT_OPTIONS`).
+    origin : str
+        Scene origin for error messages.
+    """
+
+    stage: str
+    base: dict
+    paths: tuple
+    points: tuple
+    options: dict = field(default_factory=dict)
+    origin: str = "<sweep>"
+
+
+# ----------------------------------------------------------------------------- helpers
+def _solver(scene: Scene):
+    from walkerlab.integrate.solver import Solver
+
+    return Solver.from_settings(scene.solver)
+
+
+@dataclass(frozen=True)
+class Continuation:
+    """What a chunk's next point takes from the fixed points before it (picklable, small).
+
+    Attributes
+    ----------
+    values : tuple of float or None
+        Continuation-axis value of each kept fixed point, oldest first (at most two; ``None``
+        when the axis is not numeric, and then no extrapolation is done).
+    states : tuple of ndarray (2n,)
+        The fixed points (role-ordered state just after heel strike).
+    jacobians : tuple of ndarray (2n, 2n)
+        ``DP`` at each fixed point (variational equations).
+    target : float or None
+        Continuation-axis value of the point to predict (set by :meth:`aimed`).
+    """
+
+    values: tuple = ()
+    states: tuple = ()
+    jacobians: tuple = ()
+    target: float | None = None
+
+    def aimed(self, value) -> Continuation:
+        """This continuation, set to predict the point at ``value`` (``target``)."""
+        return Continuation(self.values, self.states, self.jacobians, _real(value))
+
+    @property
+    def x(self) -> np.ndarray:
+        """The last fixed point (2n,)."""
+        return self.states[-1]
+
+    def then(self, value, res) -> Continuation:
+        """This continuation with the fixed point ``res`` (a FixedPointResult) at ``value``
+        appended (only the last two are kept)."""
+        v = _real(value)
+        keep = slice(-1, None) if self.values and self.values[-1] is not None \
+            and v is not None else slice(0, 0)
+        return Continuation(self.values[keep] + (v,), self.states[keep] + (np.asarray(res.x),),
+                            self.jacobians[keep] + (np.asarray(res.jacobian_variational),))
+
+    def predict(self) -> tuple[np.ndarray, np.ndarray]:
+        """Guess of the fixed point and of ``DP`` at ``target``: secant (linear)
+        extrapolation from the last two fixed points of the chunk, or the last one.
+
+        Returns
+        -------
+        x : ndarray (2n,)
+        DP : ndarray (2n, 2n)
+        """
+        v = self.target
+        if len(self.values) < 2 or v is None or self.values[0] == self.values[1]:
+            return self.states[-1], self.jacobians[-1]
+        (v0, v1), (x0, x1), (J0, J1) = self.values, self.states, self.jacobians
+        s = (v - v1) / (v1 - v0)
+        return x1 + s * (x1 - x0), J1 + s * (J1 - J0)
+
+
+def guess_to_json(guess) -> str:
+    """JSON of a continuation state (:class:`Continuation` or None), as a sweep's partial
+    file stores it per chain; floats are written with ``repr`` precision, so it reads back
+    bit for bit."""
+    if guess is None:
+        return "null"
+    if isinstance(guess, np.ndarray):  # a bare state (the continuation of a state guess)
+        return json.dumps({"array": guess.tolist(), "dtype": guess.dtype.str})
+    return json.dumps({"values": list(guess.values),
+                       "states": [np.asarray(x, float).tolist() for x in guess.states],
+                       "jacobians": [np.asarray(j, float).tolist() for j in guess.jacobians],
+                       "target": guess.target})
+
+
+def guess_from_json(text: str):
+    """Inverse of :func:`guess_to_json` (data only: nothing in the file is executed)."""
+    d = json.loads(text)
+    if d is None:
+        return None
+    if "array" in d:
+        return np.asarray(d["array"], dtype=np.dtype(str(d["dtype"])))
+    return Continuation(tuple(d["values"]), tuple(np.asarray(x, float) for x in d["states"]),
+                        tuple(np.asarray(j, float) for j in d["jacobians"]), d["target"])
+
+
+def _real(value) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        return None
+    v = float(value)
+    return v if math.isfinite(v) else None
+
+
+_FP_CACHE: dict[tuple, Any] = {}
+
+
+def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
+    """Period-1 fixed point of the scene's rigid walker, trying the continuation guess first.
+
+    Tries, in order: the continuation's predicted fixed point and Jacobian (MINPACK hybrj
+    from the extrapolated ``DP``), the previous fixed point itself (hybrd), the scene's
+    ``fixedpoint.initial_guess`` (hybrd) or, without one, the automatic search
+    (:func:`walkerlab.analysis.gait.search.find_gaits`, choosing by ``fixedpoint.gait``); the
+    first that converges to a walking gait wins.
+
+    Parameters
+    ----------
+    scene : Scene
+        Needs a ``fixedpoint`` section (its ``initial_guess`` is the fallback guess).
+    guess : Continuation, ndarray (2n,) or None
+        The chunk's previous fixed points (aimed at this point, see
+        :meth:`Continuation.aimed`), or a neighbour's fixed point (role-ordered state just
+        after heel strike).
+
+    Returns
+    -------
+    walker : HybridWalker
+    result : FixedPointResult
+    source : str
+        ``"neighbour"``, ``"scene"`` or ``"search"``.
+
+    Raises
+    ------
+    PointOutcome
+        ``no_fixed_point`` (with the best residual) or ``invalid_config`` (no section).
+    """
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_point
+    from walkerlab.models.registry import build_walker
+
+    opts = {**DEFAULT_OPTIONS, **(options or {})}
+    from walkerlab.config import FixedPointSettings
+
+    fp = scene.fixedpoint or FixedPointSettings()  # every field optional: the defaults
+    walker = build_walker(scene)
+    solver = _solver(scene)
+    tries = []
+    if isinstance(guess, Continuation) and guess.states:
+        x_pred, J_pred = guess.predict()
+        if x_pred.shape == guess.x.shape == (len(walker.state_names()),):
+            tries += [("neighbour", x_pred, J_pred), ("neighbour", guess.x, None)]
+    elif guess is not None:
+        tries.append(("neighbour", np.asarray(guess, float), None))
+    if fp.initial_guess is not None:
+        tries.append(("scene", fp.initial_guess.as_array(walker.state_names()), None))
+    else:
+        tries.append(("search", None, None))
+    best, msg = math.inf, ""
+    for source, g, J in tries:
+        try:
+            if source in ("scene", "search"):  # the scene's guess or seeds, its gait choice
+                res = _searched_gait(walker, solver, fp, g)
+            else:
+                # the sweep keeps the variational multipliers only: no finite-difference check
+                res = find_fixed_point(walker, g, solver, xtol=fp.tolerance, fd_step=fp.fd_step,
+                                       max_step_time=fp.max_step_time_s, fd_check=False,
+                                       jacobian_guess=J)
+        except FixedPointNotFound as exc:
+            if not (exc.residual >= best):  # keeps NaN out unless nothing better
+                best = exc.residual if math.isfinite(exc.residual) else best
+            msg = str(exc)
+            continue
+        if interleg_angle(walker, res.x) < opts["min_interleg_angle_rad"]:
+            il = interleg_angle(walker, res.x)
+            msg = (f"degenerate fixed point (inter-leg angle {il:.2e} rad "
+                   f"< {opts['min_interleg_angle_rad']:g}): no step")
+            best = min(best, res.residual)
+            continue
+        return walker, res, source
+    raise PointOutcome("no_fixed_point", msg, residual=best if math.isfinite(best) else math.nan)
+
+
+def _searched_gait(walker, solver, fp, guess):
+    """The scene's period-1 gait as the fixedpoint stage chooses it (``fixedpoint.gait``):
+    from the scene's initial guess (no seeds when it fails: a sweep point stays cheap), or
+    without one from the scale-free seeds; the other gait of the pair is looked for only
+    when the choice needs it (``stable`` and the first gait unstable, ``long_period``...)."""
+    from walkerlab.analysis.gait.search import find_gaits
+
+    return find_gaits(walker, solver, guess, policy=fp.gait, other_gait=False,
+                      xtol=fp.tolerance, fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
+                      fd_check=False, seeds=False).result
+
+
+def interleg_angle(walker, x: np.ndarray) -> float:
+    """Angle [rad] between the legs, from the foot-to-foot distance ``d`` of state ``x``.
+
+    ``2 asin(d / 2L)`` with ``L = walker.params["leg_length_m"]``: for straight legs this is
+    ``|theta_swing - theta_stance|`` exactly; for any walker it is the angle of the isosceles
+    triangle hip-feet with the same step, so it needs no state row.
+    """
+    d = float(np.hypot(*walker.points(x)["swing_foot"]))
+    L = float(walker.params["leg_length_m"])
+    return float(2.0 * np.arcsin(min(1.0, d / (2.0 * L))))
+
+
+def _state_columns(walker, x, prefix: str = "") -> dict:
+    return {prefix + state_column(n, u): float(v)
+            for n, u, v in zip(walker.state_names(), walker.state_units(), x)}
+
+
+def _fp_columns(walker, res) -> dict:
+    cols = _state_columns(walker, res.x)
+    mult = np.asarray(res.multipliers_variational, complex)
+    for k in range(len(walker.state_names())):
+        z = mult[k] if k < mult.size else complex(math.nan, math.nan)
+        cols[f"multiplier_{k}_re"], cols[f"multiplier_{k}_im"] = float(z.real), float(z.imag)
+    # per step: a stride map's period (legs that differ) is two steps'
+    cols.update(step_period_s=float(res.period_s) / walker.steps_per_map,
+                residual=float(res.residual),
+                max_abs_multiplier=float(np.max(np.abs(mult))), stable=float(res.stable),
+                map_evaluations=float(res.iterations),
+                variational_maps=float(res.variational_maps), nfev=float(res.nfev))
+    return cols
+
+
+# ----------------------------------------------------------------------------- stages
+def fixedpoint_point(scene: Scene, guess, options: dict):
+    """Fixed point and Floquet multipliers at one point (stage ``fixedpoint``).
+
+    Returns
+    -------
+    cols : dict
+        Columns of :data:`walkerlab.studies.outcomes.COLUMNS` ``["fixedpoint"]``, ``outcome``
+        ``ok`` and ``guess_source``.
+    fixed_point : FixedPointResult
+        For the next point of the chunk (continuation).
+    """
+    walker, res, source = ideal_fixed_point(scene, guess, options)
+    cols = _fp_columns(walker, res)
+    cols.update(outcome="ok", guess_source=source,
+                message="" if res.stable else "unstable period-1 gait (|multiplier| >= 1)")
+    return cols, res
+
+
+def _scuff_depth(walker, seg, n: int = 64) -> float:
+    """Largest depth [m] of the swing foot below the slope strictly inside a step."""
+    if seg.t_end <= seg.t_start:
+        return 0.0
+    ts = np.linspace(seg.t_start, seg.t_end, n + 2)[1:-1]
+    X = seg.sample(ts)
+    foot = walker.points(X)["swing_foot"]
+    phi = walker.slope_rad
+    h = foot[1] * math.cos(phi) + foot[0] * math.sin(phi)
+    return float(max(0.0, -np.min(h)))
+
+
+def simulate_point(scene: Scene, guess, options: dict):
+    """Forward simulation of ``2 * simulate.strides`` steps (stage ``simulate``).
+
+    The initial state is the scene's explicit state, or (``initial_state: fixed_point``)
+    the fixed point found at this point (continuation from ``guess``).
+    """
+    from walkerlab.config import SimulateSettings
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.models.registry import build_walker
+
+    opts = {**DEFAULT_OPTIONS, **options}
+    sim = scene.simulate or SimulateSettings()
+    cols: dict = {}
+    next_guess = None
+    if sim.initial_state == "fixed_point":
+        walker, res, source = ideal_fixed_point(scene, guess, options)
+        x0, next_guess = res.x, res
+        cols["guess_source"] = source
+    else:
+        walker = build_walker(scene)
+        x0 = sim.initial_state.as_array(walker.state_names())
+    cols.update(_state_columns(walker, x0, "x0_"))
+    traj = simulate_steps(walker, x0, 2 * sim.strides, _solver(scene),
+                          max_step_time=sim.max_step_time_s)
+    segs = traj.segments
+    done = [s for s in segs if s.termination == "heel_strike"]
+    last = segs[-1]
+    cols.update(steps_completed=float(len(done)), t_end_s=float(last.t_end), nfev=float(traj.nfev))
+    if done:
+        per = np.array([s.period for s in done])
+        lengths = np.array([float(np.hypot(*walker.points(s.x_end)["swing_foot"])) for s in done])
+        cols.update(mean_step_period_s=float(per.mean()), mean_step_length_m=float(lengths.mean()),
+                    mean_hip_speed_m_per_s=float(lengths.mean() / per.mean()),
+                    interleg_angle_last_rad=interleg_angle(walker, done[-1].x_end))
+        depth = max(_scuff_depth(walker, s) for s in done)
+        cols["scuff_depth_m"] = depth
+    if last.termination == "fall":
+        raise PointOutcome("fall", f"guard '{last.event}' at t = {last.t_end:.4g} s in step "
+                       f"{last.index}", fall_time_s=float(last.t_end), fall_leg=last.stance_leg,
+                       **cols)
+    if last.termination == "solver_failure":
+        raise PointOutcome("solver_failure", last.message, **cols)
+    if last.termination == "t_final":
+        raise PointOutcome("max_steps", f"step {last.index} lasted longer than max_step_time_s = "
+                       f"{sim.max_step_time_s:g} s (walker stalled)", **cols)
+    lim = opts.get("scuff_limit_m")
+    if lim is not None and cols.get("scuff_depth_m", 0.0) > lim:
+        raise PointOutcome("scuff", f"swing foot {1e3 * cols['scuff_depth_m']:.3g} mm below the "
+                       f"slope before heel strike (limit {1e3 * lim:g} mm)", **cols)
+    cols["outcome"] = "ok"
+    return cols, next_guess
+
+
+def contact_adapter(scene: Scene, x_ideal: np.ndarray, ideal_period_s: float,
+                    step_length_m: float):
+    """Run the compliant-contact simulation of ``scene`` from an ideal-model state.
+
+    The only place that calls :mod:`walkerlab.models.contact`; keep it in step with that module.
+
+    Parameters
+    ----------
+    scene : Scene
+        Uses ``walker``, ``slope``, ``contact``, ``terrain``, ``contact_sim``,
+        ``contact_solver`` (defaults when absent).
+    x_ideal : ndarray (4,)
+        Ideal-model state just after heel strike (role-ordered: swing, stance).
+    ideal_period_s : float
+        Step period of the ideal gait [s] (sets the default simulated time).
+    step_length_m : float
+        Step length of the ideal gait [m] (checkerboard patch spacing).
+
+    Returns
+    -------
+    walker : ContactWalker
+    result : ContactResult
+    n_steps : int
+        Steps requested (2 * ``contact_sim.n_strides``).
+    """
+    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.models.contact.scene import contact_setup
+
+    # one code path with the contact-sim stage (terrain, initial state, solver, end time)
+    setup = contact_setup(scene)
+    cw, res, _, _ = simulate_from(setup, np.asarray(x_ideal, float), ideal_period_s)
+    return cw, res, 2 * setup.sim.n_strides
+
+
+#: contact outcome kind (walkerlab.analysis.contact.gait.CONTACT_OUTCOMES, the shared run
+#: ends) -> sweep outcome: a run that walked is "ok", every other end keeps its name
+_CONTACT_OUTCOME = {k: ("ok" if k in ("heel_strike", "t_final") else k)
+                    for k in RUN_END_NAMES}
+
+
+def contact_point(scene: Scene, guess, options: dict):
+    """Compliant-contact simulation started from the ideal gait at this point (``contact-sim``).
+
+    The ideal fixed point (continuation from ``guess``) gives the initial state, the step
+    period and the checkerboard spacing; see :func:`contact_adapter`.  The point's outcome
+    is the contact run's typed outcome (trip, fall, scuff, slip beyond
+    ``options["slip_limit_mm"]``, solver failure, time limit), then ``bounce`` (a stance
+    foot left the ground and came back) and ``max_steps`` (stalled).
+    """
+    from walkerlab.analysis.contact.gait import classify_complete
+    from walkerlab.config import FixedPointSettings
+    from walkerlab.integrate.rigid import integrate_step
+
+    opts = {**DEFAULT_OPTIONS, **options}
+    walker, fp, source = ideal_fixed_point(scene, guess, options)
+    seg = integrate_step(walker, fp.x, _solver(scene),
+                         max_step_time=(scene.fixedpoint
+                                        or FixedPointSettings()).max_step_time_s)
+    step_length = float(np.hypot(*walker.points(seg.x_end)["swing_foot"]))
+    cols = {"guess_source": source, "ideal_step_length_m": step_length,
+            "ideal_step_period_s": float(fp.period_s)}
+    _cw, res, n_steps = contact_adapter(scene, fp.x, fp.period_s, step_length)
+    out = res.outcome
+    if out.ok:
+        out = classify_complete(res.steps, opts["slip_limit_mm"], out.hip_height_m, out.kind)
+    bounces = sum(s.bounce_count for s in res.steps)
+    scuffs = sum(s.scuff_count for s in res.steps)
+    periods = [s.period for s in res.steps if math.isfinite(s.period)]
+    peak = max((float(np.max(np.where(ft.on_ground, ft.penetration, 0.0))) for ft in
+                res.feet.values()), default=0.0)
+    cols.update(heel_strikes=float(res.walked_steps), steps_expected=float(n_steps),
+                t_end_s=float(res.t[-1]), max_slip_mm=res.max_stance_slip_mm,
+                double_support_creep_mm=float(sum(s.double_support_creep_mm
+                                                  for s in res.steps)),
+                bounces=float(bounces), scuffs=float(scuffs),
+                peak_penetration_mm=1e3 * max(peak, 0.0),
+                mean_step_period_s=float(np.mean(periods)) if periods else math.nan,
+                integration_wall_time_s=float(res.wall_time_s), nfev=float(res.nfev),
+                hip_height_end_m=float(out.hip_height_m), trip_edge_m=float(out.patch_edge_m))
+    kind = _CONTACT_OUTCOME[out.kind]
+    if kind in ("trip", "fall"):
+        raise PointOutcome(kind, out.message, fall_time_s=float(out.time_s),
+                       fall_leg=out.foot or (res.steps[-1].stance_leg if res.steps else ""),
+                       **cols)
+    if kind != "ok":
+        raise PointOutcome(kind, out.message, **cols)
+    if bounces:
+        raise PointOutcome("bounce", f"{bounces} stance-foot bounce(s)", **cols)
+    if res.walked_steps < n_steps - 1:
+        raise PointOutcome("max_steps", f"stalled: {res.walked_steps} of {n_steps} heel strikes by "
+                       f"t = {res.t[-1]:.4g} s", **cols)
+    cols["outcome"] = "ok"
+    return cols, fp
+
+
+POINT_FUNCTIONS: dict[str, Callable] = {
+    "fixedpoint": fixedpoint_point, "simulate": simulate_point, "contact-sim": contact_point,
+}
+
+
+# ----------------------------------------------------------------------------- chunk runner
+def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: dict,
+             origin: str = "<sweep>") -> tuple[dict, Any]:
+    """Evaluate one point; never raises (except KeyboardInterrupt / SystemExit).
+
+    Returns
+    -------
+    row : dict
+        All columns of the stage (NaN / ``""`` where not applicable), ``index``,
+        ``outcome``, ``message``, ``wall_time_s``.
+    next_guess : Continuation or None
+        ``guess`` (a :class:`Continuation`) with this point's fixed point appended, for the
+        next point of the chunk (``None`` after a failure or without a fixed point: the
+        caller keeps the previous one, so a failed point never enters the extrapolation).
+    """
+    row = empty_row(stage, index)
+    t0 = time.perf_counter()
+    next_guess = None
+    # warnings.catch_warnings is process-global: only capture in the main thread (Dask
+    # workers with processes=False run points in threads; np.errstate is thread-local).
+    main = threading.current_thread() is threading.main_thread()
+    with (warnings.catch_warnings(record=True) if main else contextlib.nullcontext([])) \
+            as caught, np.errstate(all="ignore"):
+        if main:
+            warnings.simplefilter("always")
+        try:
+            scene = apply_point(base, list(paths), tuple(values), origin)
+            cont = guess if isinstance(guess, Continuation) else None
+            start = cont.aimed(values[0]) if cont is not None and cont.states else guess
+            cols, fp = POINT_FUNCTIONS[stage](scene, start, options)
+            row.update(cols)
+            if fp is not None:
+                next_guess = (cont or Continuation()).then(values[0], fp)
+        except SceneError as exc:
+            row.update(outcome="invalid_config", message=str(exc))
+        except PointOutcome as exc:
+            row.update(exc.cols)
+            row.update(outcome=exc.outcome, message=exc.message)
+        except (KeyboardInterrupt, SystemExit):
+            raise
+        except Exception as exc:  # noqa: BLE001 - a sweep point must never crash the sweep
+            tb = traceback.extract_tb(exc.__traceback__)
+            where = f" ({tb[-1].filename.rsplit('/', 1)[-1]}:{tb[-1].lineno})" if tb else ""
+            kind = "solver_failure" if _from_solver(exc) else "error"
+            row.update(outcome=kind, message=f"{type(exc).__name__}: {exc}{where}")
+    if caught and row["outcome"] != "ok":
+        uniq = list(dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught))[:3]
+        row["message"] = (row["message"] + " [warnings: " + "; ".join(uniq) + "]")[:2000]
+    row["wall_time_s"] = time.perf_counter() - t0
+    row["message"] = str(row["message"]).replace("\n", " ")
+    return row, next_guess
+
+
+def _from_solver(exc: BaseException) -> bool:
+    tb = traceback.extract_tb(exc.__traceback__)
+    return any("scipy/integrate" in f.filename for f in tb)
+
+
+def run_chunk(task: Task) -> list[dict]:
+    """Evaluate a chunk of points in order, passing each fixed point to the next as its guess.
+
+    Top-level and picklable, so it runs the same in a process pool and on Dask workers.
+
+    Returns
+    -------
+    list of dict
+        One row per point, in the chunk's order.
+    """
+    rows, guess = [], None
+    for index, values in task.points:
+        row, nxt = evaluate(task.stage, task.base, task.paths, values, index, guess,
+                            task.options, task.origin)
+        rows.append(row)
+        guess = nxt if nxt is not None else guess
+    return rows
+
+
+def warm_up() -> None:
+    """Import the root-finding and integration libraries once (called in fresh worker
+    processes and in the forkserver), so that processes forked from the forkserver start
+    warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise).  CyRK comes through
+    :mod:`walkerlab.integrate.cyrk_loader` (its ``pysolve_ivp`` without numba, ~0.2 s less);
+    the model code is built per scene by the points themselves (cached on disk)."""
+    try:
+        import scipy.optimize  # noqa: F401
+
+        from walkerlab.integrate.solver import available_backends
+
+        if "cyrk" in available_backends():
+            from walkerlab.integrate.cyrk_loader import pysolve_ivp
+
+            pysolve_ivp()
+    except Exception:  # noqa: BLE001 - warming is an optimisation only
+        pass
+    # the imported libraries' objects live as long as the process: keep the cyclic garbage
+    # collector from traversing them again and again (a full collection over them made the
+    # first dozen 5-stride runs of a process ~1.8x slower; see `walkerlab bench ideal`)
+    gc.collect()
+    gc.freeze()

@@ -1,0 +1,434 @@
+"""Run a sweep: plan chunks, evaluate them locally or on Dask, append rows as they finish.
+
+Chunks are *runs along the first axis*: for every combination of the other axes the points
+of the first axis are evaluated in order by one worker, so each point can start its
+fixed-point search from its neighbours' fixed points (continuation: secant predictor and
+the previous Jacobian, :class:`walkerlab.studies.points.Continuation`).  When the base
+scene's own value of the first parameter lies inside the axis, a line is split there into
+an upward run and a downward run, both starting next to the scene's initial guess.
+
+Balance: all chains run at once (each has one piece in flight), so the workers stay busy
+while there are at least as many unfinished chains as workers; the sweep's wall time is
+then about ``max(total / workers, longest chain)``.  A run longer than ``total / workers``
+is therefore dealt out *interleaved* into ``k`` chains (points ``0, k, 2k, ...``,
+``1, k+1, ...``): each still starts next to the scene's guess and continues in steps of
+``k`` grid points, so no chain needs a guess far from the anchor.
+
+Executors
+---------
+The chains run on the one executor protocol of :mod:`walkerlab.execution`
+(:func:`sweep_executor`):
+
+- ``workers == 1`` and no scheduler: in this process (no start-up cost).
+- ``workers >= 2`` and no scheduler: a local process pool (forkserver processes on Linux,
+  with the model functions built once in the server).
+- ``scheduler`` given: a Dask ``distributed`` cluster at that address (or a ``Client``);
+  the same :func:`run_piece` runs on its workers.
+
+Progress and robustness (issue 12)
+----------------------------------
+- A chunk is cut into *pieces* of at most :data:`PIECE_POINTS` points; the next piece of a
+  chunk is submitted when the previous one returns, with its continuation state, so
+  continuation is unchanged while rows come back every few points (D12).  They are written
+  to the file after the first piece and then at least every :data:`FLUSH_EVERY_S` seconds
+  (one HDF5 append of every column costs the main process ~25 ms of CPU, taken from the
+  workers on a 2-core machine), and on an interruption.
+- Local pool workers watch the main process and exit within about a second when it dies,
+  even by SIGKILL (D7); the forkserver and resource tracker then exit on their own (one
+  mechanism for every pool of walkerlab: :mod:`walkerlab.execution.workers`).
+- The grid is capped at :data:`MAX_GRID_POINTS` points (product of the axes, D3).
+- One sweep per artifact at a time: a second identical sweep fails with one line (D4), and
+  an artifact is finalized only when every grid point has its row.
+
+Resume (issue 19, items 4 and 13)
+---------------------------------
+A point's fixed point depends, to round-off (~1e-13, within the root finder's xtol), on the
+predictor it started from, i.e. on its chain.  Re-planning the chains from the points left
+(as before) restarted them from the scene's guess at a different point and changed the
+interleaving, so 785 of 1053 resumed rows differed by up to 2.8e-13 and 6 in
+``guess_source``.  Now the plan made when the sweep starts is stored in the partial file with
+a checkpoint per chain (points written, continuation state as exact JSON, hashed); a resumed
+chain continues from its checkpoint, so its rows are bit-identical to an uninterrupted run's
+with the same plan (the plan depends on the ``workers`` the sweep *started* with).  Every row
+is hashed as written (:func:`walkerlab.io.sweep_resume.row_hashes`); a row or checkpoint that
+does not match on resume drops its chain's rows and the chain is computed again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from collections.abc import Callable, Iterator
+from contextlib import nullcontext
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import walkerlab
+from walkerlab import progress as _progress
+from walkerlab.config import MAX_SWEEP_POINTS, Scene
+from walkerlab.execution.executor import make_executor, run_chains
+from walkerlab.execution.workers import mp_context
+from walkerlab.io.artifacts import code_hash
+from walkerlab.io.sweep_store import (
+    SweepColumns,
+    SweepFileError,
+    SweepStore,
+    complete_sweep,
+    partial_path,
+)
+from walkerlab.studies.outcomes import OUTCOMES, STAGES, STRING_COLUMNS, walker_columns
+from walkerlab.studies.params import ParamAxis, SweepError, grid_points
+from walkerlab.studies.points import (
+    DEFAULT_OPTIONS,
+    Task,
+    evaluate,
+    guess_from_json,
+    guess_to_json,
+    warm_up,
+)
+
+__all__ = ["base_value", "plan_chunks", "run_sweep", "iter_piece_results", "run_piece",
+           "sweep_executor", "sweep_input_hash", "MAX_GRID_POINTS", "PIECE_POINTS", "FLUSH_EVERY_S"]
+
+MAX_GRID_POINTS = MAX_SWEEP_POINTS  # a larger grid is refused (product of the axes' lengths)
+PIECE_POINTS = 4              # rows come back from a worker every this many points per chunk
+FLUSH_EVERY_S = 0.5           # rows are written to the partial file at least this often [s]
+
+
+def _dotted_get(d: dict, path: str):
+    """Value at a dotted path of a scene mapping (list items by name or index); None if
+    absent."""
+    from walkerlab.config import SceneError
+    from walkerlab.studies.params import list_item
+
+    node: Any = d
+    for k in path.split("."):
+        if isinstance(node, list):
+            try:
+                node = list_item(node, k, path)
+            except SceneError:
+                return None
+            continue
+        if not isinstance(node, dict) or k not in node:
+            return None
+        node = node[k]
+    return node
+
+
+def base_value(base: dict, path: str):
+    """The value of a dotted field in a scene dump ``base`` (the slope in either unit:
+    ``slope.angle_deg`` of a scene given in radians, and the other way round); None if
+    absent."""
+    v = _dotted_get(base, path)
+    if v is None and path == "slope.angle_deg" and _dotted_get(base, "slope.angle_rad") is not None:
+        v = math.degrees(_dotted_get(base, "slope.angle_rad"))
+    if v is None and path == "slope.angle_rad" and _dotted_get(base, "slope.angle_deg") is not None:
+        v = math.radians(_dotted_get(base, "slope.angle_deg"))
+    return v
+
+
+def plan_chunks(axes: list[ParamAxis], base: dict, done: set[int] | frozenset = frozenset(),
+                chunk_size: int | None = None, workers: int = 1) -> list[list[tuple[int, tuple]]]:
+    """Split the grid into ordered chunks of ``(index, values)``.
+
+    Parameters
+    ----------
+    axes : list of ParamAxis
+    base : dict
+        Base scene mapping (its value of the first parameter anchors the runs).
+    done : set of int
+        Indices already computed (resume); they are left out.
+    chunk_size : int, optional
+        Longest chunk (consecutive points); default: whole runs, a run of ``m`` points
+        longer than ``t = ceil(total / workers)`` dealt out interleaved into
+        ``ceil(m / t)`` chains.
+    workers : int
+
+    Returns
+    -------
+    list of list of (int, tuple)
+        Chunks in submission order (longest first, for load balance).
+    """
+    shape = tuple(len(a) for a in axes)
+    pts = grid_points(axes)
+    a0 = axes[0]
+    anchor = None
+    bv = base_value(base, a0.path)
+    if a0.numeric and isinstance(bv, (int, float)) and not isinstance(bv, bool) and len(a0) > 1:
+        vals = np.asarray(a0.values, float)
+        anchor = int(np.argmin(np.abs(vals - float(bv))))
+    runs: list[list[int]] = []
+    for rest in np.ndindex(*shape[1:]) if len(shape) > 1 else [()]:
+        line = [int(np.ravel_multi_index((i0, *rest), shape)) for i0 in range(shape[0])]
+        if anchor is None or anchor == 0:
+            cand = [line]
+        else:
+            cand = [line[anchor:], line[:anchor][::-1]]
+        for r in cand:
+            r = [i for i in r if i not in done]
+            if r:
+                runs.append(r)
+    if chunk_size is not None:
+        runs = [r[k:k + chunk_size] for r in runs for k in range(0, len(r), max(1, chunk_size))]
+    elif workers > 1 and runs:
+        target = math.ceil(sum(len(r) for r in runs) / workers)
+        runs = [r[j::k] for r in runs for k in [math.ceil(len(r) / target)] for j in range(k)]
+    runs.sort(key=len, reverse=True)
+    return [[(i, pts[i]) for i in r] for r in runs]
+
+
+def sweep_input_hash(scene: Scene, stage: str, axes: list[ParamAxis], options: dict) -> str:
+    """Content hash of a sweep (scene, stage, axes, options, walkerlab version and code)."""
+    h = hashlib.sha256()
+    h.update(json.dumps([scene.model_dump(mode="json"), stage,
+                         [[a.path, list(a.values)] for a in axes], options],
+                        sort_keys=True, default=str).encode())
+    h.update(walkerlab.__version__.encode())
+    h.update(code_hash().encode())
+    return h.hexdigest()
+
+
+def _worker_init() -> None:
+    """Pool worker start-up (after its parent watch started): warm the model functions."""
+    warm_up()
+
+
+def run_piece(task: Task, guess: Any = None) -> tuple[list[dict], Any]:
+    """Evaluate a piece of a chunk in order, starting from the continuation ``guess``.
+
+    Returns
+    -------
+    rows : list of dict
+        One row per point (as :func:`walkerlab.studies.points.run_chunk`).
+    guess : ndarray or None
+        Continuation guess for the chunk's next piece.
+    """
+    rows = []
+    for index, values in task.points:
+        row, nxt = evaluate(task.stage, task.base, task.paths, values, index, guess,
+                            task.options, task.origin)
+        rows.append(row)
+        guess = nxt if nxt is not None else guess
+    return rows, guess
+
+
+def _mp_context():
+    """The sweep pools' process context: forkserver with the model functions built once in
+    the server (:mod:`walkerlab.studies._preload`)."""
+    return mp_context(preload=("walkerlab.studies._preload",))
+
+
+def sweep_executor(workers: int = 2, scheduler=None, pool: bool | None = None):
+    """The executor of a sweep, a basin map or a bifurcation diagram
+    (:func:`walkerlab.execution.make_executor`): workers warmed with the model functions.
+
+    Parameters
+    ----------
+    workers : int
+        Local processes (ignored with a scheduler).
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address or client; a worker lost mid-study is replaced by Dask (its
+        job is recomputed elsewhere).
+    pool : bool, optional
+        Force (True) or forbid (False) a process pool; default: pool when ``workers > 1``.
+    """
+    return make_executor(workers, scheduler, pool, initializer=_worker_init,
+                         context=_mp_context)
+
+
+def iter_piece_results(chains: list[list[Task]], workers: int = 2, scheduler=None,
+                       pool: bool | None = None, guesses: list | None = None
+                       ) -> Iterator[tuple[int, int, list[dict], Any]]:
+    """Evaluate chains of pieces; yield ``(chain, piece, rows, continuation after them)``
+    for each piece as soon as it returns (:func:`walkerlab.execution.run_chains` of
+    :func:`run_piece` on :func:`sweep_executor`).
+
+    Parameters
+    ----------
+    chains : list of list of Task
+    guesses : list, optional
+        Continuation each chain starts from (a resumed chain's checkpoint); default None.
+    workers, scheduler, pool
+        As for :func:`sweep_executor`.
+    """
+    if not any(chains):
+        return
+    with sweep_executor(workers, scheduler, pool) as ex:
+        yield from run_chains(ex, run_piece, chains, guesses)
+
+
+def run_sweep(scene: Scene, axes: list[ParamAxis], stage: str, out_path: Path,
+              workers: int = 2, scheduler=None, resume: bool = False,
+              options: dict | None = None, chunk_size: int | None = None,
+              progress: bool = True,
+              on_chunk: Callable[[int, int], None] | None = None,
+              pool: bool | None = None) -> Path:
+    """Run a sweep and write its artifact (see :mod:`walkerlab.io.sweep_store`).
+
+    Parameters
+    ----------
+    scene : Scene
+        Base scene.
+    axes : list of ParamAxis
+        Sweep axes (at least one).
+    stage : {"fixedpoint", "simulate", "contact-sim"}
+    out_path : Path
+        Final artifact path (``.h5``); ``<out_path>.partial`` while running.
+    workers : int
+        Local worker processes (1 = in this process).
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address: run the chunks there instead.
+    resume : bool
+        Continue an interrupted sweep from its partial file (finished rows are kept).
+    options : dict, optional
+        Point options (:data:`walkerlab.studies.points.DEFAULT_OPTIONS`).
+    chunk_size : int, optional
+        Longest chunk (continuation restarts from the scene's guess at each chunk start).
+    progress : bool
+        Show a rich progress bar.
+    on_chunk : callable(done_points, total_points), optional
+        Called after rows are written: after the first piece, then at least every
+        :data:`FLUSH_EVERY_S` (raising ``KeyboardInterrupt`` there simulates an interruption).
+    pool : bool, optional
+        Force a process pool even for one worker (True) or run in this process (False);
+        default: a pool when ``workers > 1``.
+
+    Returns
+    -------
+    Path
+        The finished artifact.
+
+    Raises
+    ------
+    SweepError
+        Unknown stage, no axes, a grid of more than :data:`MAX_GRID_POINTS` points, or a
+        partial file of another sweep with ``resume``.
+    walkerlab.io.runpaths.ArtifactBusy
+        Another process is running a sweep into the same artifact.
+    KeyboardInterrupt
+        Propagated after the finished rows are flushed to the partial file.
+    """
+    if stage not in STAGES:
+        raise SweepError(f"sweep: unknown stage {stage!r}; choose from {', '.join(STAGES)}")
+    if not axes:
+        raise SweepError("sweep: give at least one --param")
+    paths = [a.path for a in axes]
+    if len(set(paths)) != len(paths):
+        raise SweepError("sweep: a parameter is given twice")
+    n_total = math.prod(len(a) for a in axes)
+    if n_total > MAX_GRID_POINTS:
+        raise SweepError(f"sweep: the grid has {n_total:,} points "
+                         f"({' x '.join(str(len(a)) for a in axes)}); at most "
+                         f"{MAX_GRID_POINTS:,} are allowed")
+    opts = {**DEFAULT_OPTIONS, **(options or {})}
+    from walkerlab.io.runpaths import artifact_lock, refuse_link
+
+    out_path = refuse_link(Path(out_path))  # the artifact is never written through a link
+
+    with artifact_lock(out_path, wait=False):
+        return _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts,
+                           chunk_size, progress, on_chunk, pool, n_total)
+
+
+def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_chains):
+    """The sweep's partial file: resumed (its plan and each chain's checkpoint) or created
+    with a new plan of ``n_chains`` chains.
+
+    Raises
+    ------
+    SweepError
+        A partial file that cannot be resumed (one line).
+    """
+    columns = SweepColumns(STRING_COLUMNS, walker_columns(stage, scene), OUTCOMES)
+    if resume and partial_path(out_path).is_file():
+        # the chunk plan of the interrupted run (not re-planned from what is left: a point's
+        # continuation guess, hence its row, depends on the chain it is in, issue 19 item 13)
+        try:
+            return SweepStore.resume(out_path, axes, columns, key, guess_from_json,
+                                     tell=_progress.note)
+        except SweepFileError as exc:
+            raise SweepError(str(exc)) from None
+    base = scene.model_dump(mode="json")
+    plan = [[i for i, _ in c] for c in plan_chunks(axes, base, frozenset(), chunk_size,
+                                                   n_chains)]
+    return SweepStore.create(out_path, scene, stage, axes, columns, opts, key, plan), plan, {}
+
+
+def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, chunk_size,
+                progress, on_chunk, pool, n_total) -> Path:
+    paths = [a.path for a in axes]
+    key = sweep_input_hash(scene, stage, axes, opts)
+    base = scene.model_dump(mode="json")
+    done: set[int] = set()
+    if resume and out_path.is_file() and not partial_path(out_path).is_file():
+        if complete_sweep(out_path, key):
+            return out_path
+    store, plan, start = _open_store(scene, axes, stage, out_path, resume, opts, key,
+                                     chunk_size, 1 if scheduler is None and workers <= 1
+                                     else max(2, workers))
+    values_of = dict(enumerate(grid_points(axes)))
+    origin = scene.name or "<scene>"
+    offset = [start.get(c, (0, None))[0] for c in range(len(plan))]
+    done = {i for c, chain in enumerate(plan) for i in chain[:offset[c]]}
+    chains = [[Task(stage, base, tuple(paths),
+                    tuple((i, values_of[i]) for i in chain[offset[c]:][k:k + PIECE_POINTS]),
+                    opts, origin)
+               for k in range(0, len(chain) - offset[c], PIECE_POINTS)]
+              for c, chain in enumerate(plan)]
+    guesses = [start.get(c, (0, None))[1] for c in range(len(plan))]
+    t0 = time.perf_counter()
+    counts = {o: 0 for o in OUTCOMES}
+    n_done = n_written = len(done)
+    pending: list[dict] = []
+    marks: dict[int, tuple[int, Any]] = {}  # chain -> (points done, continuation) pending
+    last_write = -math.inf
+
+    def write() -> None:
+        nonlocal pending, last_write, n_written
+        # rows and checkpoints, then one flush: the file is consistent between writes
+        store.append(pending, values_of, flush=False)
+        for c, (n, g) in marks.items():
+            store.checkpoint(c, n, guess_to_json(g), key)
+        store.flush()
+        marks.clear()
+        n_written += len(pending)
+        pending, last_write = [], time.perf_counter()
+
+    try:
+        with (_progress.task(f"sweep {stage} ({n_total} points)", n_total, n_done)
+              if progress else nullcontext()) as bar:
+            for ci, k, rows, guess in iter_piece_results(chains, workers, scheduler, pool=pool,
+                                                         guesses=guesses):
+                pending += rows
+                marks[ci] = (offset[ci] + min((k + 1) * PIECE_POINTS,
+                                              len(plan[ci]) - offset[ci]), guess)
+                n_done += len(rows)
+                for r in rows:
+                    counts[r["outcome"]] = counts.get(r["outcome"], 0) + 1
+                if bar is not None:
+                    bar.update(n_done, info=" ".join(f"{o}:{v}" for o, v in counts.items()
+                                                     if v))
+                if n_done == n_total or time.perf_counter() - last_write >= FLUSH_EVERY_S:
+                    write()
+                    if on_chunk is not None:
+                        on_chunk(n_written, n_total)
+    except BaseException:
+        if pending and store.is_open:
+            try:
+                write()  # rows computed before the interruption are kept for --resume
+            except Exception:  # noqa: BLE001 - the original error is the one to report
+                pass
+        store.add_wall_time(time.perf_counter() - t0)
+        store.close()
+        raise
+    if pending:  # an executor that stopped early (the rows it gave are kept)
+        write()
+    store.add_wall_time(time.perf_counter() - t0)
+    try:
+        return store.finalize(n_total)
+    except SweepFileError as exc:
+        raise SweepError(str(exc)) from None

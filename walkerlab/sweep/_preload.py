@@ -1,5 +1,0 @@
-"""Imported once in the forkserver process: builds the model functions so workers start warm."""
-
-from walkerlab.sweep.points import warm_up
-
-warm_up()
