@@ -27,10 +27,10 @@ WALKERS = ("paper", "goswami1996", "paper_rods", "round_feet", "kneed", "simples
 
 
 def row(name: str) -> str:
-    from walkerlab.analysis.gait.batch_step import BatchStepMap
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.analysis.robustness import measures as R
     from walkerlab.config import load_scene
+    from walkerlab.integrate.batch_step import BatchStepMap
     from walkerlab.models.registry import build_walker
     from walkerlab.studies.mfpt import scene_walker_at
 

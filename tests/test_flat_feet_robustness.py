@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from walkerlab.analysis.gait.batch_step import HEEL_STRIKE
-from walkerlab.analysis.gait.python_step import PythonStepMap, make_step_map
 from walkerlab.analysis.robustness import measures as R
 from walkerlab.analysis.robustness import push
 from walkerlab.config import load_scene
+from walkerlab.integrate.batch_step import HEEL_STRIKE
+from walkerlab.integrate.python_step import PythonStepMap, make_step_map
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker

@@ -8,8 +8,16 @@ also those inside functions), never by running it: dependencies point down.
 - ``h5py`` is imported only under ``walkerlab/io/`` (the artifact schemas);
 - the CLI opens no artifact itself (no ``h5py``, no ``open_artifact``);
 - ``report/`` writes text from loaded schema objects and numbers computed before it: no
-  ``h5py``, no matplotlib or ``plotting``, no ``analysis``, ``sweep``, ``models``,
-  ``integrate`` (its run-end names aside), no loader.
+  ``h5py``, no matplotlib or ``plotting``, no ``analysis``, ``studies``, ``models``,
+  ``integrate`` (its run-end names aside), no loader;
+- the middle floor: ``analysis/`` never imports ``studies/``, ``bench/`` or ``export/``;
+  ``models/``, ``integrate/``, ``codegen/`` and ``walker/`` never import ``analysis/``;
+  ``config/`` never imports ``io/`` (a scene opens no artifact);
+- no name private to a module (``_name``) is imported by another package, and no private
+  module is imported from outside its package;
+- one formula, one place: one finite-difference and one complex-step Jacobian
+  (:mod:`walkerlab.numerics`), no ``approx_fprime``;
+- package docstrings tell what the code does, not its issue history (no "issue N").
 """
 
 from __future__ import annotations
@@ -141,3 +149,94 @@ def test_the_report_only_writes_text_from_loaded_objects():
     assert len(mods) > 5
     bad = {p.name: v for p in mods if (v := _report_violations(p))}
     assert not bad, bad
+
+
+#: (importing packages, packages they must never import)
+MIDDLE_FLOOR_RULES = [
+    (("analysis",), ("walkerlab.studies", "walkerlab.bench", "walkerlab.export")),
+    (("models", "integrate", "codegen", "walker"), ("walkerlab.analysis",)),
+    (("config",), ("walkerlab.io",)),
+]
+
+
+def _floor_violations(paths, banned) -> dict:
+    return {str(p): v for p in paths
+            if (v := [m for m in _imports(p) if m.startswith(banned)])}
+
+
+def test_the_middle_floor_rules_catch_a_violation(tmp_path):
+    bad = tmp_path / "x.py"
+    bad.write_text("def f():\n    from walkerlab.studies.mfpt import run\n")
+    assert _floor_violations([bad], MIDDLE_FLOOR_RULES[0][1])
+
+
+def test_the_middle_floor_points_down():
+    bad = {}
+    for packages, banned in MIDDLE_FLOOR_RULES:
+        for pkg in packages:
+            paths = sorted((PKG / pkg).rglob("*.py"))
+            assert paths, pkg
+            bad.update(_floor_violations(paths, banned))
+    assert not bad, bad
+
+
+def _private_crossings(path: Path) -> list[str]:
+    """Imports in ``path`` of a ``_name`` from a module of another package, or of a private
+    module (``pkg._mod``) from outside ``pkg``."""
+    here = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1]) \
+        if path.is_relative_to(PKG.parent) else ""
+    out = []
+    for m in _imports(path):
+        if not m.startswith("walkerlab."):
+            continue
+        parts = m.split(".")
+        for i, part in enumerate(parts):
+            if part.startswith("_") and not part.startswith("__"):
+                owner = ".".join(parts[:i - 1]) if i == len(parts) - 1 else ".".join(parts[:i])
+                if not here.startswith(owner) or not owner:
+                    out.append(m)
+                break
+    return out
+
+
+def test_the_private_name_rule_catches_a_crossing(tmp_path):
+    bad = tmp_path / "x.py"
+    bad.write_text("from walkerlab.studies.points import _Outcome\n"
+                   "from walkerlab.integrate import _lsoda\n")
+    assert len(_private_crossings(bad)) == 2
+
+
+def test_no_private_names_cross_packages():
+    bad = {_rel(p): v for p in _modules() if (v := _private_crossings(p))}
+    assert not bad, bad
+
+
+def test_one_finite_difference_jacobian():
+    import re
+
+    defs = {}
+    for p in _modules():
+        text = p.read_text()
+        for name in re.findall(r"^def ((?:fd|complex_step)_jacobian)\b", text, re.M):
+            defs.setdefault(name, []).append(_rel(p))
+        assert "approx_fprime" not in text, _rel(p)
+    assert defs == {"fd_jacobian": ["numerics.py"], "complex_step_jacobian": ["numerics.py"]}
+
+
+def test_no_issue_numbers_in_package_docstrings():
+    import re
+
+    bad = [f"{_rel(p)}:{n}" for p in _modules()
+           for n, line in enumerate(p.read_text().splitlines(), 1)
+           if re.search(r"\b[Ii]ssues? \d+", line)]
+    assert not bad, bad
+
+
+def test_no_top_level_package_holds_more_than_18_percent_of_the_lines():
+    sizes = {}
+    for p in _modules():
+        top = _rel(p).split("/")[0]
+        sizes[top] = sizes.get(top, 0) + len(p.read_text().splitlines())
+    total = sum(sizes.values())
+    big = {k: round(v / total, 3) for k, v in sizes.items() if v > 0.18 * total}
+    assert not big, big

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import yaml
 
-from walkerlab.analysis.gait.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.analysis.robustness import mfpt as M
 from walkerlab.config import load_scene
+from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.integrate.rigid import Solver, integrate_step
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.mfpt import scene_walker_at

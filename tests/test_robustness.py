@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 import yaml
 
-from walkerlab.analysis.gait.batch_step import BatchStepMap
 from walkerlab.analysis.robustness import measures as R
 from walkerlab.analysis.robustness import push
 from walkerlab.config import load_scene
+from walkerlab.integrate.batch_step import BatchStepMap
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.mfpt import scene_walker_at
 

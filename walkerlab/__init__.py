@@ -32,7 +32,7 @@ names are looked up on first use (PEP 562).
 __version__ = "0.1.0"
 
 _API = ("load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
-        "contact_simulate", "compare", "basin", "continuation")
+        "contact_simulate", "compare", "basin", "continuation", "Walker")
 __all__ = ["__version__", "api", *_API]
 
 

@@ -6,7 +6,7 @@ chunk is unmapped again as soon as the frame at its base returns.  A loop that c
 function whose frame lands exactly on a chunk boundary therefore maps and unmaps 16 KiB on
 every call.  ``scipy.optimize``'s first import runs ``scipy.special``'s module-level loops
 about 60 frames below the importer (nested imports), so whether it churns depends on how
-deep the first importer sits: from ``walkerlab fixedpoint``'s root finder (issue 27) it did,
+deep the first importer sits: from ``walkerlab fixedpoint``'s root finder it did,
 ~8,000 ``mmap``/``munmap`` pairs and +50 ms of system time per process, and the count moved
 with every frame added or removed anywhere between the CLI and the solver.
 

@@ -15,7 +15,7 @@ Every file walkerlab reads from a runs folder or a scene path (the scene YAML, t
 ``runs/<name>/.scene`` marker, cache entries) goes through :func:`read_regular`: it is
 opened without blocking (a FIFO in its place cannot hang the open), must be a regular file
 (``S_ISREG`` of the *opened* file: a symlink to ``/dev/zero`` is refused, not read forever)
-and no larger than the caller's cap, which is checked before a byte is read (issue 19, item 5).
+and no larger than the caller's cap, which is checked before a byte is read.
 """
 
 from __future__ import annotations

@@ -24,7 +24,8 @@ def test_numbalsoda_five_strides_match_odeint():
     """Same run, rtol 1e-10: both integrators are within ~6e-9 rad of the rtol-1e-12
     reference (bench), so they must agree to 1e-7 rad in the leg angles (margin ~10x for
     the machine-dependent step sequence) and to 1e-6 s in every heel-strike time."""
-    if not numbalsoda_backend.available():  # not importorskip: `import numbalsoda` compiles for ~7 s
+    # not importorskip: `import numbalsoda` compiles for ~7 s
+    if not numbalsoda_backend.available():
         pytest.skip("numbalsoda (optional extra) not installed")
     w, x0, tf = _bench_case()
     a = simulate_contact(w, x0, tf,

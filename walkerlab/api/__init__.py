@@ -16,7 +16,9 @@ Modules: :mod:`~walkerlab.api.scenes` (:func:`load_scene`, :func:`with_changes`)
 :mod:`~walkerlab.api.runs` (one scene: :func:`fixed_point`, :func:`fixed_points`,
 :func:`simulate`, :func:`contact_simulate`, :func:`compare`),
 :mod:`~walkerlab.api.studies` (many points: :func:`sweep`, :func:`basin`,
-:func:`continuation`, :func:`mfpt`); this module only gathers their public names.
+:func:`continuation`, :func:`mfpt`) and :mod:`~walkerlab.api.walker` (:class:`Walker`: the
+walker in memory, its map, Jacobian, fixed point and walks, no artifact); this module only
+gathers their public names.
 
 Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what
@@ -35,6 +37,8 @@ Example
 from walkerlab.api.runs import compare, contact_simulate, fixed_point, fixed_points, simulate
 from walkerlab.api.scenes import DEFAULT_RUNS, load_scene, with_changes
 from walkerlab.api.studies import basin, continuation, mfpt, sweep
+from walkerlab.api.walker import Walker
 
 __all__ = ["DEFAULT_RUNS", "load_scene", "with_changes", "fixed_point", "fixed_points",
-           "simulate", "contact_simulate", "compare", "sweep", "basin", "continuation", "mfpt"]
+           "simulate", "contact_simulate", "compare", "sweep", "basin", "continuation", "mfpt",
+           "Walker"]

@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.io.schemas.continuation import initial_state
+
 
 def machine() -> dict:
     return {"machine": platform.machine(), "processor": platform.processor(),
@@ -43,7 +45,7 @@ def bench_ideal(repeats: int = 7) -> dict:
     t0 = time.perf_counter()
     w = build_walker(scene)
     build_s = time.perf_counter() - t0
-    guess = np.asarray(scene.fixedpoint.initial_guess.as_array(w.state_names()))
+    guess = np.asarray(initial_state(scene.fixedpoint.initial_guess, w.state_names()))
     sv = Solver.from_settings(scene.solver)
     fp = find_fixed_point(w, guess, sv)
     out = {"build_walker_s": build_s}

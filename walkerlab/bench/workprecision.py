@@ -234,7 +234,7 @@ def _numbers(v, n: int | None = None) -> bool:
 def read_cached_case(path: Path) -> dict | None:
     """A cached case result (:func:`time_case`) if the file holds a complete one, else None
     (missing, unreadable, not JSON, or lacking/mistyping a field: the case is measured
-    again, issue 19)."""
+    again)."""
     from walkerlab.safefs import read_regular
 
     try:

@@ -42,7 +42,7 @@ def simulate(scene: Path | None = SceneArg,
 
     out = pipeline.run("simulate", load(scene), runs_dir, force, strides=strides)
     sim = load_simulate(out.path)
-    ending = simulate_ending(sim)  # a fall: no success-style summary (issue 26, item 5)
+    ending = simulate_ending(sim)  # a fall: no success-style summary
     if ending is None:
         typer.echo(simulate_text(sim))
     typer.echo(status(out))

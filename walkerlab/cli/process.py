@@ -39,7 +39,7 @@ def single_threaded_blas() -> None:
 
     walkerlab's matrices have at most a few dozen rows, which OpenBLAS never splits across
     threads, but starting the thread pools of numpy's and scipy's OpenBLAS costs every
-    command ~50-100 ms of start-up on the 2-core machine (issue 10: 3 OS threads -> 1).  Must
+    command ~50-100 ms of start-up on the 2-core machine (3 OS threads -> 1).  Must
     run before numpy is imported; worker processes (sweeps, basin) inherit it, as the
     work-precision workers already set it for themselves.
     """
@@ -62,7 +62,7 @@ def process_settings() -> None:
     - the cyclic garbage collector's thresholds raised to :data:`GC_THRESHOLDS` (this
       process only; its workers keep Python's): a command imports scipy, h5py, pydantic and
       its own schema after this point, and with Python's (700, 10, 10) the collector walks
-      those long-lived objects again and again (issue 27: ~5 % of ``walkerlab fixedpoint``'s
+      those long-lived objects again and again (~5 % of ``walkerlab fixedpoint``'s
       CPU time).  Reference counting still frees everything without cycles at once.
     """
     import gc

@@ -1,7 +1,7 @@
 """A patch of typer's help: an on/off flag is listed without a value type.
 
 typer 0.29 with click 8.2+ shows ``<bool>`` beside ``--force`` and ``--help`` in ``--help``,
-as if they took a value (issue 26); :func:`flags_take_no_value` makes them show none.
+as if they took a value; :func:`flags_take_no_value` makes them show none.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 def flags_take_no_value() -> None:
     """``--help`` lists an on/off flag (``--force``, ``--help``) without a value type: typer
-    0.29 with click 8.2+ shows ``<bool>`` beside it, as if it took a value (issue 26)."""
+    0.29 with click 8.2+ shows ``<bool>`` beside it, as if it took a value."""
     from typer.core import TyperOption
 
     shown = TyperOption.display_type_rich

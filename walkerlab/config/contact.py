@@ -30,7 +30,7 @@ __all__ = ["CONTACT_QUANTITIES", "LENGTH_UNITS", "MAX_CONTACT_STRIDES", "Contact
            "TerrainSettings", "renamed_contact_field"]
 
 
-# Numbers are strict and finite (issue 12, D10): no bool or string as a number, no inf/NaN;
+# Numbers are strict and finite: no bool or string as a number, no inf/NaN;
 # a YAML int still validates as a float.  Same rules as walkerlab.config.base.Strict.
 _STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 

@@ -104,7 +104,7 @@ _BOUND_ERRORS = ("less_than", "less_than_equal", "greater_than", "greater_than_e
 
 
 def _unit_hint(root: type[BaseModel], e: dict, parts: list) -> str:
-    """A likely unit mistake behind a bound error (issue 26, item 9): an angle in degrees
+    """A likely unit mistake behind a bound error: an angle in degrees
     given to a ``*_rad`` field (``3 rad = 172°; did you mean angle_deg?``), a length in
     millimetres given to a ``*_m`` field (``1000 m: a length in mm? 1000 mm = 1 m``)."""
     v = e.get("input")

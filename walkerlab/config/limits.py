@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import os
 
-# Caps that keep a run bounded (issue 12, D8; issue 19, item 5): a bigger request is a
+# Caps that keep a run bounded: a bigger request is a
 # one-line error.  Each size a user can type has one cap, defined here; the CLI validates its
 # options through the same pydantic fields (:func:`validate_option`).
 MAX_SIMULATE_STRIDES = 1000

@@ -148,7 +148,7 @@ class Scene(Strict):
 
     @model_validator(mode="after")
     def _knee_stop_needs_a_knee(self) -> Scene:
-        # a latch that cannot act is a mistake, as an unknown key is (issue 26): an error,
+        # a latch that cannot act is a mistake, as an unknown key is: an error,
         # not a warning, so a latch the user counts on is never silently absent (the stop's
         # other numbers have defaults and are dumped with every scene: not checked)
         c = self.contact
@@ -175,7 +175,7 @@ class Scene(Strict):
     @model_validator(mode="after")
     def _bounded_integrator_steps(self) -> Scene:
         # a tiny max_step_s runs for minutes without output: bound the steps it implies for
-        # the longest walking step the scene allows (issue 19, item 5)
+        # the longest walking step the scene allows
         if self.solver.max_step_s is None:
             return self
         longest = max([5.0] + [s.max_step_time_s for s in (self.fixedpoint, self.simulate,

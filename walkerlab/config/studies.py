@@ -10,7 +10,6 @@ Every numeric field carries its unit in its name and a description; the caps com
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Annotated, Literal
 
 from pydantic import ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -24,7 +23,7 @@ from walkerlab.config.limits import (
 
 
 class GuessFromArtifact(Strict):
-    """A starting state read from a continuation artifact (issue 23): the state of a branch
+    """A starting state read from a continuation artifact: the state of a branch
     at a parameter value, instead of digits copied by hand."""
 
     model_config = ConfigDict(populate_by_name=True)
@@ -37,24 +36,20 @@ class GuessFromArtifact(Strict):
     branch: int = Field(0, ge=0, le=1000, description="branch index in the artifact (0: the "
                         "period-1 branch through the scene's own gait)")
 
-    def as_array(self, state_names: list[str] | None = None):
-        """State (2n,) of the branch at ``at`` (linear interpolation between its two nearest
-        points), in the order of ``state_names``.
+    def pick(self, data, state_names: list[str] | None = None):
+        """State (2n,) of the loaded continuation ``data`` (a
+        :class:`walkerlab.io.schemas.continuation.ContinuationData`) on branch
+        :attr:`branch` at ``at`` (linear interpolation between its two nearest points), in
+        the order of ``state_names``.  Reading the file is the caller's
+        (:func:`walkerlab.io.schemas.continuation.initial_state`): config opens no artifact.
 
         Raises
         ------
         ValueError
-            Artifact missing or damaged, ``at`` off the branch, or other state names.
+            ``at`` off the branch, no such branch, or other state names.
         """
         import numpy as np
 
-        from walkerlab.io.artifacts import ArtifactError
-        from walkerlab.io.schemas.continuation import load_continuation
-
-        try:
-            data = load_continuation(Path(self.from_))
-        except ArtifactError as exc:
-            raise ValueError(str(exc)) from None
         if self.branch >= len(data.branches):
             raise ValueError(f"branch {self.branch}: {self.from_} has "
                              f"{len(data.branches)} branches")
@@ -81,7 +76,7 @@ class StateSpec(Strict):
         import re
 
         extra = self.model_extra or {}
-        if "from" in extra:  # a state read from a continuation artifact (issue 23)
+        if "from" in extra:  # a state read from a continuation artifact
             try:
                 GuessFromArtifact.model_validate(extra)
             except ValidationError as exc:
@@ -99,6 +94,12 @@ class StateSpec(Strict):
             raise ValueError("give the state by name (<role>_angle_rad, <role>_rate_rad_per_s)")
         return self
 
+    @property
+    def artifact(self) -> GuessFromArtifact | None:
+        """The continuation artifact this state is read from, or None (a state by name)."""
+        extra = self.model_extra or {}
+        return GuessFromArtifact.model_validate(extra) if "from" in extra else None
+
     def as_array(self, state_names: list[str] | None = None):
         """State (2n,) in the order of ``state_names`` (a walker's ``state_names()``; default:
         the compass gait's ``swing_angle, stance_angle, swing_rate, stance_rate``).
@@ -110,8 +111,9 @@ class StateSpec(Strict):
         """
         import numpy as np
 
-        if "from" in (self.model_extra or {}):
-            return GuessFromArtifact.model_validate(self.model_extra).as_array(state_names)
+        if self.artifact is not None:
+            raise ValueError(f"the state is read from {self.artifact.from_}: use "
+                             "walkerlab.io.schemas.continuation.initial_state")
         names = state_names or ["swing_angle", "stance_angle", "swing_rate", "stance_rate"]
         keys = [n + ("_rad" if n.endswith("_angle") else "_rad_per_s") for n in names]
         given = dict(self.model_extra or {})
@@ -291,7 +293,7 @@ class MfptSettings(Strict):
 
 
 class RobustnessSettings(Strict):
-    """Robustness of the gait beyond |lambda| (``walkerlab robustness``; issue 24): gait
+    """Robustness of the gait beyond |lambda| (``walkerlab robustness``): gait
     sensitivity norms (Hobbelen & Wisse 2007), the largest single step-down and step-up
     (bisection), and the MFPT at one per-step slope sigma by Monte Carlo (Byl & Tedrake 2009)."""
 

@@ -1,5 +1,5 @@
 """Dask client helpers of :class:`walkerlab.execution.executor.DaskExecutor`: never wait
-forever, fail in one line (issue 26, reliability).
+forever, fail in one line (reliability).
 
 Dask's scheduler keeps a task whose worker died and waits - silently, for ever - until
 another worker joins; a scheduler that dies cancels every future and its client logs

@@ -6,7 +6,7 @@ pinned lanes: :mod:`walkerlab.execution.lanes`) is built by :func:`process_pool`
 
 - workers are started by ``forkserver`` (Linux) or ``spawn``, never by ``fork``: a forked
   worker would inherit the parent's open files, among them the artifact lock (it then held
-  the lock after the parent died, issue 19);
+  the lock after the parent died);
 - each worker runs :func:`watch_parent` first: a daemon thread that checks every
   :data:`WATCH_PERIOD_S` whether the process that built the pool still exists and ends the
   worker (``os._exit``) when it does not - after SIGKILL or SIGTERM of the parent as well as

@@ -20,7 +20,7 @@ torso_hip     revolute    the upper body's angle from the upward vertical, posit
                           walkerlab's coordinates, a constraint here)
 ============  ==========  ================================================================
 
-Springs and couplings (issue 22):
+Springs and couplings:
 
 - a torsional **spring**-damper between two links at the hip (``walker.springs``) acts on
   ``delta = angle(second) - angle(first)``, a linear combination of hip joints: in MJCF a

@@ -1,4 +1,4 @@
-"""The stacked system of many rows of one phase (:mod:`walkerlab.analysis.gait.batch_step`): the
+"""The stacked system of many rows of one phase (:mod:`walkerlab.integrate.batch_step`): the
 compiled loop that evaluates every row's flow and guards in one call (:func:`kernel`), the
 DOP853 integrator on the stacked state, and the location of the rows' guard crossings on
 its dense output (``scipy.optimize.elementwise.find_root``, vectorised).

@@ -10,7 +10,8 @@ reaches it as a ``stop`` predicate over the samples.
 Backends (:class:`~walkerlab.integrate.solver.Solver` ``method``): ``"odeint"``
 (scipy.integrate.odeint = LSODA with little overhead), ``"cyrk_bdf"`` (CyRK's BDF over a
 compiled RHS, no Python per evaluation; :mod:`walkerlab.integrate._cyrk`), ``"numbalsoda"``
-(numbalsoda's LSODA from compiled code; optional extra, :mod:`walkerlab.integrate.numbalsoda_backend`)
+(numbalsoda's LSODA from compiled code; optional extra,
+:mod:`walkerlab.integrate.numbalsoda_backend`)
 or a ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``, ...), these given the
 model's analytic Jacobian.  All run in chunks so a fall, a trip, a flight, the wall-time
 limit or the strides cap stops the run.

@@ -21,7 +21,7 @@ sees the complete package, numba solvers included, with ``CyRK.cy`` the modules 
 loaded (a compiled module cannot be loaded twice, so the package must not be re-created).
 If ``CyRK`` is already imported, or any step of the shortcut fails (a CyRK release that moved
 these modules), the plain ``from CyRK import pysolve_ivp`` is used: the shortcut can only
-cost speed, never correctness.  Measured (issue 10, whole ``walkerlab fixedpoint --force``
+cost speed, never correctness.  Measured (whole ``walkerlab fixedpoint --force``
 process, paired with the plain import): 1068 -> 859 modules, peak memory 162 -> 104 MiB,
 14-20 % less CPU.  No upstream issue found; remove this module when CyRK imports its numba
 solvers lazily.

@@ -9,7 +9,8 @@ Integrators come from libraries, chosen by :class:`~walkerlab.integrate.solver.S
   scipy - RK23, RK45, DOP853 - with the adaptive stepping written in C++).  Guards are its
   events, located like scipy's by Brent's method on the dense output (xtol = 4 eps).
   On the compass gait it takes exactly scipy's steps (same time and state at heel strike to
-  round-off) 25-60 times faster: ``scripts/bench_integrators.py`` and the note of issue 10.
+  round-off) 25-60 times faster: ``scripts/bench_integrators.py`` (its docstring gives the
+  measurements).
 - ``"cyrk_compiled"``: the same CyRK pairs with the phase's flow (and variational equations)
   compiled by numba (:mod:`walkerlab.codegen.compiled`, cached on disk), so each phase runs in
   C++ without Python callbacks; guards are located on the step points and by Brent's method

@@ -15,7 +15,7 @@ Layout conventions
   exclusively; a link in place of the target is a one-line error).  Every output file is
   mode 0644.
 - ``content_hash`` (root attribute): SHA-256 over every dataset and attribute of the file
-  that holds a *result*: run-dependent records are left out (issue 19, item 11), i.e. the
+  that holds a *result*: run-dependent records are left out, i.e. the
   root attributes in :data:`VOLATILE_ATTRS` (``content_hash``, ``created_utc``,
   ``wall_time_s``, ``workers``, ``scheduler``, ``hostname``) and every dataset or attribute
   whose own name is in :data:`VOLATILE_NAMES` (wall times such as ``stats/wall_time``,

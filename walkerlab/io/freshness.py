@@ -93,7 +93,7 @@ def recompute_reason(path: Path, scene, sections: tuple[str, ...],
 def drawing_key(artifacts: dict[str, Path]) -> str:
     """Key of figures drawn from ``artifacts`` (``{stage: path}`` of those that exist): their
     *recomputed* content hashes and walkerlab's code (a hand edit, or a recompute after one,
-    changes the key; issue 26)."""
+    changes the key)."""
     arts = {s: str(content_hash(p)) for s, p in artifacts.items()}
     return json.dumps({"artifacts": arts, "code": code_hash()}, sort_keys=True)
 

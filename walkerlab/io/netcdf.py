@@ -158,7 +158,7 @@ def finish_sweep(f: h5py.File) -> None:
         if not len(ds.dims[0]):
             ds.dims[0].attach_scale(g["point"])
     # the swept values as coordinates of the rows (CF ``coordinates``): opened alone, the
-    # ``points`` group shows each row's slope.angle_deg beside its results (issue 26, item 7)
+    # ``points`` group shows each row's slope.angle_deg beside its results
     swept = []
     for ds in (g["param"].values() if "param" in g else ()):
         path = str(ds.attrs.get("path", ds.name.rsplit("/", 1)[-1]))

@@ -1,7 +1,7 @@
 """Resume bookkeeping of a partial sweep file (:mod:`walkerlab.io.sweep_store`): the rows'
 and the chain checkpoints' hashes, and which rows a resumed sweep keeps.
 
-Resume bookkeeping of the partial file (issue 19, items 4 and 13)::
+Resume bookkeeping of the partial file::
 
     /points/row_hash       (n,) str, SHA-256 of the row's columns and the input hash
     /plan/index            (n_points,) int64, grid indices in chain order (the chunk plan

@@ -87,7 +87,7 @@ def bifurcation_figure(data: dict, title: str = ""):
             ax.axvspan(falls - half, s.max() + half, color="0.85", hatch="//", ec="0.6", lw=0,
                        zorder=0, label=f"walker falls (no steady gait) from {at(falls, '.3g')}"
                        if k == 0 else None)
-    # legends outside the axes: they never cover data (issue 23)
+    # legends outside the axes: they never cover data
     ax1.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     if title:
         ax1.set_title(title)

@@ -30,8 +30,8 @@ def _contact_steps(r) -> list[str]:
 
 
 def _basin_line(a) -> list[str]:
-    """The basin's area ``a`` (:class:`walkerlab.analysis.robustness.basin_area.BasinArea`) in the basin
-    map's slice (when the scene ran ``basin``)."""
+    """The basin's area ``a`` (:class:`walkerlab.analysis.robustness.basin_area.BasinArea`) in the
+    basin map's slice (when the scene ran ``basin``)."""
     if a is None:
         return []
     x0, x1, y0, y1 = a.box

@@ -143,7 +143,7 @@ def contact_text(c: ContactSimArtifact) -> str:
         names = c.rate_names or ["leg1 rates", "leg2 rates"]
         kept, why = str(c.adjust.get("kept", "adjusted")), str(c.adjust.get("kept_reason", ""))
         found = np.atleast_1d(c.adjust.get("scale", s))
-        if kept == "scene":  # the adjusted start walked worse (issue 26, item 3)
+        if kept == "scene":  # the adjusted start walked worse
             lines.append("--adjust: kept the scene's initial rate scale ("
                          + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
                          + "), which walks better than the adjusted one ("

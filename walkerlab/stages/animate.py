@@ -5,7 +5,7 @@ Not an HDF5 artifact (a figure, like ``walkerlab plot``'s); always redrawn (a fe
 Drawn from the artifacts only: ``simulate.h5`` (run or reused first, as ``compare`` does) and,
 where it exists and is current, ``contact_sim.h5`` beside it (rigid and contact side by side,
 same times).  A ``contact_sim.h5`` of another scene (or of an earlier fixed point) or one
-changed after it was written is left out, and a one-line note says why (issue 26).
+changed after it was written is left out, and a one-line note says why.
 The slope comes from the resolved scene stored in ``simulate.h5``.  GIF through matplotlib's
 Pillow writer (one shared palette, :func:`walkerlab.plotting.animation.gif_writer`); MP4
 through its ffmpeg writer only when ffmpeg is installed.  Both written atomically (temporary

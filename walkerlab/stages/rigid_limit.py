@@ -3,8 +3,8 @@
 
 For each stiffness factor ``kappa`` (default :data:`KAPPAS`) the scene's contact is scaled by
 :mod:`walkerlab.models.contact.rigid_limit` and the contact walker's own periodic gait is found
-(:func:`walkerlab.analysis.contact.rigid_limit.convergence`); the artifact holds its step period, step
-length and slow Floquet multipliers against ``kappa``, the rigid gait's as scalars, and the
+(:func:`walkerlab.analysis.contact.rigid_limit.convergence`); the artifact holds its step period,
+step length and slow Floquet multipliers against ``kappa``, the rigid gait's as scalars, and the
 observed orders of convergence (layout: :mod:`walkerlab.io.schemas.rigid_limit`).  Any
 walker with a ``contact`` and a ``fixedpoint`` section.
 """

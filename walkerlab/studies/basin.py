@@ -32,7 +32,7 @@ Cells are evaluated in chunks (one grid row each) by
 or on a Dask cluster - and written to a partial HDF5 file after every chunk, so an
 interrupted map resumes where it stopped.  Each finished grid row is stored with its hash
 (:func:`row_digest`, ``/row_hash``); on resume a row whose cells no longer match it (edited,
-damaged) is computed again (issue 19, item 4).
+damaged) is computed again.
 """
 
 from __future__ import annotations

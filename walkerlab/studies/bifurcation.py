@@ -166,7 +166,7 @@ def _arclength_step(fam, prev, value: float):
     (``prev = (value, BranchPoint or state)``), by pseudo-arclength continuation
     (:func:`walkerlab.analysis.continuation.branch.continue_branch`), which does not jump to the
     other gait of a long/short-period pair as a large natural-parameter step can (paper_rods
-    at 3 kg, issue 23).  None when there is no previous point or the branch does not reach
+    at 3 kg).  None when there is no previous point or the branch does not reach
     ``value`` (a fold in between): the caller falls back to the root finder.
     """
     from walkerlab.analysis.continuation.branch import continue_branch, first_point

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.analysis.gait.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.analysis.robustness import mfpt as M
+from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 
 #: walks per Monte Carlo task, rows per mesh task
 WALKS_PER_TASK = 500
@@ -39,9 +39,9 @@ def scene_walker_at(scene):
 def step_map_for(base: dict) -> BatchStepMap:
     """The batched step map of a scene mapping (built once per process; a walker without
     compiled flows, e.g. flat feet, gets the row-by-row
-    :class:`~walkerlab.analysis.gait.python_step.PythonStepMap`)."""
-    from walkerlab.analysis.gait.python_step import make_step_map
+    :class:`~walkerlab.integrate.python_step.PythonStepMap`)."""
     from walkerlab.config import MfptSettings, scene_from_dict
+    from walkerlab.integrate.python_step import make_step_map
     from walkerlab.models.registry import build_walker
 
     key = json.dumps(base, sort_keys=True)
@@ -242,7 +242,7 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     if contact:
         start = _contact_start(scene, x_star, st)
     else:
-        from walkerlab.analysis.gait.python_step import needs_python_path
+        from walkerlab.integrate.python_step import needs_python_path
 
         if st.method in ("mesh", "both") and needs_python_path(walker):
             raise ValueError("mfpt.method: the mesh needs the compiled batched step map (its "

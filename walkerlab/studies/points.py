@@ -29,6 +29,7 @@ import numpy as np
 
 from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.ends import RUN_END_NAMES
+from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.studies.outcomes import empty_row, state_column
 from walkerlab.studies.params import apply_point
 
@@ -225,7 +226,7 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     elif guess is not None:
         tries.append(("neighbour", np.asarray(guess, float), None))
     if fp.initial_guess is not None:
-        tries.append(("scene", fp.initial_guess.as_array(walker.state_names()), None))
+        tries.append(("scene", initial_state(fp.initial_guess, walker.state_names()), None))
     else:
         tries.append(("search", None, None))
     best, msg = math.inf, ""
@@ -348,7 +349,7 @@ def simulate_point(scene: Scene, guess, options: dict):
         cols["guess_source"] = source
     else:
         walker = build_walker(scene)
-        x0 = sim.initial_state.as_array(walker.state_names())
+        x0 = initial_state(sim.initial_state, walker.state_names())
     cols.update(_state_columns(walker, x0, "x0_"))
     traj = simulate_steps(walker, x0, 2 * sim.strides, _solver(scene),
                           max_step_time=sim.max_step_time_s)

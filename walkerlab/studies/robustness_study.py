@@ -1,6 +1,6 @@
-"""A scene's robustness study on the executor (issue 24): the rigid model's gait sensitivity
-norms, largest tolerable step and push (:mod:`walkerlab.analysis.robustness.measures`), its Monte Carlo
-MFPT (:mod:`walkerlab.studies.mfpt`) and, when asked, the contact model's largest step
+"""A scene's robustness study on the executor: the rigid model's gait sensitivity
+norms, largest tolerable step and push (:mod:`walkerlab.analysis.robustness.measures`), its Monte
+Carlo MFPT (:mod:`walkerlab.studies.mfpt`) and, when asked, the contact model's largest step
 (:mod:`walkerlab.studies.contact_rough`).  It lives above ``analysis`` because it schedules walks
 on the executor; the measures themselves are in ``analysis``."""
 
@@ -25,7 +25,8 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     gait ``x_star`` (2n,): ``|lambda|max`` and the state norms in absolute and relative leg
     angles, the GSN of each disturbance (linearised, and the nonlinear check at an impulse
     of 1e-5), the step-down/up brackets (search cap a quarter leg length), the largest
-    forward and backward mid-stance pushes (:func:`walkerlab.analysis.robustness.push.apply_push`) and
+    forward and backward mid-stance pushes (:func:`walkerlab.analysis.robustness.push.apply_push`)
+    and
     the Monte Carlo MFPT at ``robustness.sigma_rad`` (:func:`walkerlab.studies.mfpt.monte_carlo`).
 
     Returns
@@ -37,11 +38,11 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     ValueError
         A walker no step map can carry (slope-relative coordinates, legs that differ; one
         line).  A walker without compiled flows (flat feet) runs on the row-by-row
-        :class:`~walkerlab.analysis.gait.python_step.PythonStepMap` (~5-10 ms a step).
+        :class:`~walkerlab.integrate.python_step.PythonStepMap` (~5-10 ms a step).
     """
     from walkerlab.analysis.gait.poincare import poincare_map
-    from walkerlab.analysis.gait.python_step import make_step_map
     from walkerlab.config import RobustnessSettings
+    from walkerlab.integrate.python_step import make_step_map
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.robustness import RobustnessData
     from walkerlab.models.registry import build_walker

@@ -25,7 +25,7 @@ The chains run on the one executor protocol of :mod:`walkerlab.execution`
 - ``scheduler`` given: a Dask ``distributed`` cluster at that address (or a ``Client``);
   the same :func:`run_piece` runs on its workers.
 
-Progress and robustness (issue 12)
+Progress and robustness
 ----------------------------------
 - A chunk is cut into *pieces* of at most :data:`PIECE_POINTS` points; the next piece of a
   chunk is submitted when the previous one returns, with its continuation state, so
@@ -40,7 +40,7 @@ Progress and robustness (issue 12)
 - One sweep per artifact at a time: a second identical sweep fails with one line (D4), and
   an artifact is finalized only when every grid point has its row.
 
-Resume (issue 19, items 4 and 13)
+Resume
 ---------------------------------
 A point's fixed point depends, to round-off (~1e-13, within the root finder's xtol), on the
 predictor it started from, i.e. on its chain.  Re-planning the chains from the points left
@@ -346,7 +346,7 @@ def _open_store(scene, axes, stage, out_path, resume, opts, key, chunk_size, n_c
     columns = SweepColumns(STRING_COLUMNS, walker_columns(stage, scene), OUTCOMES)
     if resume and partial_path(out_path).is_file():
         # the chunk plan of the interrupted run (not re-planned from what is left: a point's
-        # continuation guess, hence its row, depends on the chain it is in, issue 19 item 13)
+        # continuation guess, hence its row, depends on the chain it is in)
         try:
             return SweepStore.resume(out_path, axes, columns, key, guess_from_json,
                                      tell=_progress.note)

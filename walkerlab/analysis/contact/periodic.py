@@ -40,6 +40,7 @@ from walkerlab.analysis.contact.step_map import (
     section_guess_from_ideal,
 )
 from walkerlab.integrate.solver import Solver
+from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.numerics import fd_jacobian, sort_multipliers
 
@@ -137,7 +138,7 @@ def ideal_gait(scene):
     iw = build_walker(sc)
     return find_gaits(iw, Solver.from_settings(sc.solver),
                       None if fp.initial_guess is None
-                      else fp.initial_guess.as_array(iw.state_names()),
+                      else initial_state(fp.initial_guess, iw.state_names()),
                       policy=fp.gait, other_gait=False, xtol=fp.tolerance,
                       fd_step=fp.fd_step, max_step_time=fp.max_step_time_s).result
 

@@ -1,4 +1,4 @@
-"""The compliant-contact walker on rough ground: the terrain as geometry (issue 24).
+"""The compliant-contact walker on rough ground: the terrain as geometry.
 
 The contact model walks on the checkerboard lanes of :mod:`walkerlab.models.contact.model`: footfall
 ``k`` of the gait lands on a patch centred at ``s = k l`` (``l`` the gait's step length;
@@ -9,7 +9,7 @@ normal (:attr:`walkerlab.models.contact.model.ContactWalker.heights1`), so
 * a single step-down of ``h`` at the first heel strike is ``h_k = -h`` for every ``k >= 1``
   (a step-up: ``+h``), as the rigid model's swing-foot clearance guard meets the ground
   ``h`` below the slope line through the stance foot
-  (:meth:`walkerlab.analysis.gait.batch_step.BatchStepMap.step`, ``drop_m``);
+  (:meth:`walkerlab.integrate.batch_step.BatchStepMap.step`, ``drop_m``);
 * per-step slopes ``gamma_k`` (Byl & Tedrake 2009) are the heights at which the line
   through footfall ``k`` at slope ``gamma_k`` meets the next footfall,
   ``h_{k+1} = h_k - l tan(gamma_k - gamma)`` (``gamma`` the scene's slope): the swing foot

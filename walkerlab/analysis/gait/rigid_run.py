@@ -11,6 +11,7 @@ from walkerlab.analysis.gait.metrics import sample_trajectory, step_table
 from walkerlab.config import Scene
 from walkerlab.integrate.rigid import simulate_steps
 from walkerlab.integrate.solver import Solver
+from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.io.trajectory import NamedTrajectory
 
 
@@ -102,7 +103,7 @@ def simulate_run(scene: Scene, fixed_point=None):
                              "are kept (lower simulate.sample_rate_hz or simulate.strides)")
     else:
         try:
-            x0 = sim.initial_state.as_array(walker.state_names())
+            x0 = initial_state(sim.initial_state, walker.state_names())
         except ValueError as exc:
             raise ValueError(f"simulate.initial_state: {exc}") from None
     r = simulate_scene(scene, walker, x0)

@@ -11,6 +11,7 @@ from walkerlab.analysis.gait.poincare import FixedPointNotFound, find_fixed_poin
 from walkerlab.analysis.gait.search import find_gaits
 from walkerlab.config import Scene
 from walkerlab.integrate.solver import Solver
+from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.models.registry import build_walker
 
 
@@ -46,7 +47,7 @@ def initial_guess(scene: Scene, walker):
     if fp.initial_guess is None:
         return None
     try:
-        guess = fp.initial_guess.as_array(walker.state_names())
+        guess = initial_state(fp.initial_guess, walker.state_names())
     except ValueError as exc:
         raise ValueError(f"fixedpoint.initial_guess: {exc}") from None
     check_walking_state(guess, walker, scene)
@@ -64,7 +65,7 @@ def check_walking_state(x, walker, scene: Scene) -> None:
     above ``g`` the stance foot would leave the ground, so a walking gait has rates of the
     order of ``sqrt(g/l)`` (paper walker: 3.1 rad/s; its fixed point 0.86 rad/s).  Rates above
     :data:`MAX_GUESS_RATE` ``sqrt(g/l)`` (or angles beyond pi) send the map's integration
-    into spinning legs (issue 26: 1e6 rad/s ran 74 s, then ``OverflowError``).
+    into spinning legs (1e6 rad/s ran 74 s, then ``OverflowError``).
 
     Raises
     ------

@@ -376,7 +376,7 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
     why = ("a passive walker needs a downhill slope (slope > 0)"
            if walker.slope_rad <= 0 else "the walker may have no period-1 gait here")
     # the advice first, the solver's detail last: a one-line display that must shorten the
-    # message cuts the detail, never the advice (issue 26, item 2)
+    # message cuts the detail, never the advice
     return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "
             "from a walker whose gait is known (walkerlab sweep SCENE --param "
             "FIELD=KNOWN:THIS:STEP, e.g. slope.angle_deg), or "

@@ -1,4 +1,4 @@
-"""The basin of attraction's area in a 2-D slice of the Poincaré section (issue 24).
+"""The basin of attraction's area in a 2-D slice of the Poincaré section.
 
 An area in the section depends on the coordinates it is measured in (Jin et al. 2021, R.
 Soc. Open Sci. 8: 201122): this module states it as the *fraction of a stated box* - the

@@ -11,9 +11,10 @@ indicators ``y_k`` of that step::
 response to a unit impulse ``e_0 = 1``, summed over all steps: the H2 norm
 ``sqrt(|D|^2 + trace(C W C^T))`` with ``W = sum_k A^k B B^T (A^T)^k``
 (:func:`scipy.linalg.solve_discrete_lyapunov`).  ``A`` is the Poincaré-map Jacobian from the
-variational equations with saltation matrices (:func:`walkerlab.analysis.gait.poincare.poincare_map`,
+variational equations with saltation matrices
+(:func:`walkerlab.analysis.gait.poincare.poincare_map`,
 exact to ~1e-12); ``B``, ``C`` and ``D`` are central differences (step ``1e-6`` of the state
-scale) of the one-step map of :class:`walkerlab.analysis.gait.batch_step.BatchStepMap` at
+scale) of the one-step map of :class:`walkerlab.integrate.batch_step.BatchStepMap` at
 tolerance 1e-12, i.e. ~1e-6 relative.  :func:`gsn_nonlinear` checks it: the response of the
 nonlinear map to a small impulse, divided by its size.
 
@@ -21,7 +22,8 @@ Disturbances (scalar, one step): ``slope`` (that step's slope changes by ``e`` [
 ``floor_height`` (the ground at that step's footfall lies ``e`` [m] lower: a step-down),
 ``push`` (an impulsive horizontal push at the hip at mid-stance changing the hip's forward
 velocity by ``e`` [m/s], :func:`walkerlab.analysis.robustness.push.apply_push`; those rows are
-integrated one by one by scipy's DOP853 at 1e-12, :func:`walkerlab.analysis.robustness.push.pushed_step`).
+integrated one by one by scipy's DOP853 at 1e-12,
+:func:`walkerlab.analysis.robustness.push.pushed_step`).
 Indicators: ``step_time_s``, ``step_length_m`` (distance from stance foot to swing foot at
 heel strike), ``stance_angle_rad`` (the stance leg's absolute angle from the vertical at
 heel strike).
@@ -39,8 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.analysis.gait.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.analysis.robustness.push import pushed_step
+from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 
 DISTURBANCES = ("slope", "floor_height", "push")
 INDICATORS = ("step_time_s", "step_length_m", "stance_angle_rad")

@@ -9,7 +9,7 @@ Monte Carlo (:func:`monte_carlo`)
     Many walks from the gait, slopes ``gamma_k ~ N(mean, sd)`` (or uniform) drawn from a
     per-walk random stream (``SeedSequence(seed, spawn_key=(walk,))``, so a walk's slopes do
     not depend on how walks are grouped), stepped together by
-    :class:`walkerlab.analysis.gait.batch_step.BatchStepMap`.  A fall is any step that does not
+    :class:`walkerlab.integrate.batch_step.BatchStepMap`.  A fall is any step that does not
     end in heel strike (the hip reaches the ground, the swing leg falls back, scuffing, no
     heel strike within ``max_step_time_s``).  A walk that reaches the step cap is *censored*,
     not a fall: with ``S`` heel strikes in all and ``F`` falls, the censored geometric
@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.analysis.gait.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 
 
 def geometric_mle(heel_strikes: int, falls: int) -> tuple[float, float]:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.analysis.gait.batch_step import FALL, HEEL_STRIKE, BatchStep
+from walkerlab.integrate.batch_step import FALL, HEEL_STRIKE, BatchStep
 from walkerlab.numerics import fd_jacobian
 
 __all__ = ["apply_push", "entry_lock", "hip_jacobian", "mass_matrix", "pushed_step",

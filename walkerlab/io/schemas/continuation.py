@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["continuation_writer", "load_continuation", "ContinuationData", "STAGE"]
+__all__ = ["continuation_writer", "load_continuation", "initial_state", "ContinuationData", "STAGE"]
 
 STAGE = "continuation"
 
@@ -192,3 +192,36 @@ def load_continuation(path: Path) -> ContinuationData:
                 "multiplier": h["critical_multiplier/real"][()]
                 + 1j * h["critical_multiplier/imag"][()]})
     return out
+
+
+def initial_state(spec, state_names: list[str] | None = None):
+    """The state (2n,) a scene's ``StateSpec`` names, in the order of ``state_names``: by
+    name, or read from a continuation artifact (``{from: runs/x/continuation_<field>.h5,
+    at: 0.27, branch: 0}``, :class:`walkerlab.config.studies.GuessFromArtifact`).
+
+    Parameters
+    ----------
+    spec : walkerlab.config.studies.StateSpec
+    state_names : list of str, optional
+        The walker's ``state_names()``.
+
+    Returns
+    -------
+    ndarray, shape (2n,)
+        [rad, rad/s].
+
+    Raises
+    ------
+    ValueError
+        Artifact missing or damaged, ``at`` off the branch, or other state names (one line).
+    """
+    from walkerlab.io.artifacts import ArtifactError
+
+    source = spec.artifact
+    if source is None:
+        return spec.as_array(state_names)
+    try:
+        data = load_continuation(Path(source.from_))
+    except ArtifactError as exc:
+        raise ValueError(str(exc)) from None
+    return source.pick(data, state_names)

@@ -7,7 +7,7 @@ walker's mechanics (mass matrix, bias, contact points and Jacobians) is generate
 walker description (:mod:`walkerlab.codegen.floating`) and assembled with these laws in
 :mod:`walkerlab.models.contact.generated`.  The hand-written floating compass gait that lived here
 retired after the generated one was shown equal to it (rhs 5e-16, Jacobian 1.8e-14 relative,
-issue 17); the independent numpy check is ``tests/independent/contact_reference.py``.
+measured); the independent numpy check is ``tests/independent/contact_reference.py``.
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ penetration, so a latch holding a slightly flexed knee can exchange ~1e-6 J; the
 integrator's own error (relative ``rtol`` per step) moves the energy by ~``rtol`` of its
 scale per step.
 
-What makes a frictionless run blow up (issue 25, paper_rods with mu = 0): with no friction
+What makes a frictionless run blow up (paper_rods with mu = 0): with no friction
 the stance foot slides off its patch into the gap and the walker sinks with both feet below
 the patch tops (0.43 m and 0.27 m at 0.409 s) while its hip is still above the fall height;
 then a foot enters the next patch *from its side*, 0.27 m below the top.  The IMPACT law

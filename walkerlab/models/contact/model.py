@@ -141,7 +141,7 @@ class ContactWalker:
     heights1, heights2 : ndarray, optional
         Height [m] of each patch of leg1's / leg2's lane along the slope's outward normal
         (> 0 raised; a step-down is a patch at -h), same length as the lane; default 0
-        (the flat checkerboard).  Rough ground as geometry (issue 24).
+        (the flat checkerboard).  Rough ground as geometry.
     patch_half_width : float
         Half width of each patch [m].
     continuous : bool

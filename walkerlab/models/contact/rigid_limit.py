@@ -32,14 +32,14 @@ Friction (tangential direction).  The regularised Coulomb law has no true sticti
 ``v_s`` the friction coefficient is ``~ 1.5 mu_s v / v_s`` (slope of ADAMS's STEP at 0), so
 a stance foot that must carry the tangential load ``F_t`` creeps at
 ``v ~ v_s F_t / (1.5 mu_s F_n)``: a gap proportional to ``v_s`` that no stiffness removes
-(issue 25: 13 mm/s, 0.71087 s against the rigid 0.70360 s whatever ``k``).  Scaling
+(measured: 13 mm/s, 0.71087 s against the rigid 0.70360 s whatever ``k``).  Scaling
 ``v_s ~ kappa^(-1/2)`` makes the creep's share vanish faster than the impact's duration
 (exponent 1/2 > 1/(e+1) for e >= 1).  The transition velocity ``v_d`` keeps its ratio to
 ``v_s``.
 
 Observed order.  The period and step-length gaps to the rigid gait are then dominated by the
 impact's duration: expected order ``1/(e+1)`` per factor of ``kappa`` (0.3125 for e = 2.2,
-i.e. a factor ``10^0.3125 = 2.05`` per decade, issue 25's measured +3.62 / +1.46 / +0.80 /
+i.e. a factor ``10^0.3125 = 2.05`` per decade, the measured +3.62 / +1.46 / +0.80 /
 +0.42 / +0.20 / +0.098 / +0.048 ms for kappa = 1 ... 1e6).
 
 The knee latch of kneed walkers (:mod:`walkerlab.models.contact.generated`) releases when the

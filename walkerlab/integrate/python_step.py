@@ -1,5 +1,5 @@
 """The step map of a rigid walker without compiled flows, row by row: the fallback of
-:class:`walkerlab.analysis.gait.batch_step.BatchStepMap` for walkers the batched stepper cannot
+:class:`walkerlab.integrate.batch_step.BatchStepMap` for walkers the batched stepper cannot
 carry (flat feet: a phase graph whose guards are ground reactions, not compiled yet; a
 replaced flow such as ``ideal.variant: appendix_a``).
 
@@ -8,7 +8,8 @@ Not a second integrator: each row is one :func:`walkerlab.integrate.rigid.integr
 backend ``auto`` (CyRK's DOP853, which takes scipy's steps, or scipy's ``solve_ivp``).  Same
 interface as the batched map (``step(X, gamma, drop_m) -> BatchStep``, ``walker``,
 ``slope_rad``), so the gait sensitivity norm, the largest step-down/up and push
-(:mod:`walkerlab.analysis.robustness.measures`) and the Monte Carlo MFPT (:mod:`walkerlab.analysis.robustness.mfpt`)
+(:mod:`walkerlab.analysis.robustness.measures`) and the Monte Carlo MFPT
+(:mod:`walkerlab.analysis.robustness.mfpt`)
 run on it unchanged, about 10-40 ms per step instead of a fraction of a millisecond.
 
 A step-down of height ``drop`` [m] at the footfall: every heel-strike guard ``g`` (the swing
@@ -26,7 +27,7 @@ import dataclasses
 
 import numpy as np
 
-from walkerlab.analysis.gait.batch_step import FALL, HEEL_STRIKE, SOLVER_FAILURE, TIMEOUT, BatchStep
+from walkerlab.integrate.batch_step import FALL, HEEL_STRIKE, SOLVER_FAILURE, TIMEOUT, BatchStep
 
 
 def needs_python_path(walker) -> bool:
@@ -41,11 +42,11 @@ def make_step_map(walker, walker_at, rtol: float = 1e-9, atol: float = 1e-9,
     Raises
     ------
     ValueError
-        As :class:`~walkerlab.analysis.gait.batch_step.BatchStepMap` (slope-relative coordinates).
+        As :class:`~walkerlab.integrate.batch_step.BatchStepMap` (slope-relative coordinates).
     """
     if needs_python_path(walker):
         return PythonStepMap(walker, walker_at, rtol, atol, max_step_time_s)
-    from walkerlab.analysis.gait.batch_step import BatchStepMap
+    from walkerlab.integrate.batch_step import BatchStepMap
 
     return BatchStepMap(walker, walker_at, rtol, atol, max_step_time_s)
 
