@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 __all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link", "temp_prefix",
-           "remove_stale_temps", "process_alive"]
+           "remove_stale_temps", "process_alive", "atomic_replace"]
 
 #: when this process started (wall clock) [s]; a temporary file older than this whose
 #: writer is gone is stale
@@ -88,6 +88,58 @@ def remove_stale_temps(folder: Path | str, name: str | None = None,
         except OSError:
             continue
     return n
+
+
+def atomic_replace(path: Path | str, fill, *, mode: int = 0o644, suffix: str = ".tmp",
+                   name: str | None = None) -> Path:
+    """Write ``path`` atomically: a temporary file in the same folder (``mkstemp``:
+    ``O_CREAT | O_EXCL``, never through a symbolic link; named ``.<name>.<pid>.*<suffix>``,
+    those of a killed earlier writer removed first) is filled by ``fill(fd, tmp_path)``,
+    given ``mode`` and renamed over ``path`` (a crash leaves the old file or none, never a
+    truncated one).  ``fill`` writes the open descriptor ``fd`` (and closes it, e.g. with
+    ``os.fdopen``) or closes it and writes the file by name.  On any error the temporary file
+    is removed and the error raised.
+
+    Parameters
+    ----------
+    path : Path or str
+        The file to replace; the caller refuses a symbolic link (:func:`refuse_link`).
+    fill : callable ``(int, str) -> None``
+    mode : int
+        Permission bits of the new file.
+    suffix : str
+        Suffix of the temporary file (writers that choose a format by name need the real
+        one).
+    name : str, optional
+        Name in the temporary file's prefix (default ``path``'s name).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    OSError
+        The folder cannot be written, the disk is full, ... (nothing is left behind).
+    """
+    import tempfile
+
+    path = Path(path)
+    name = path.name if name is None else name
+    remove_stale_temps(path.parent, name, (suffix,))
+    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(name), suffix=suffix, dir=path.parent)
+    try:
+        fill(fd, tmp)
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
 
 
 def process_alive(pid: int) -> bool:

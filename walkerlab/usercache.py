@@ -180,26 +180,16 @@ def read_private(path: Path) -> str | None:
 def write_private(path: Path, text: str) -> bool:
     """Write ``path`` atomically with mode 0600; False (and nothing left behind) when the
     folder cannot be written (read-only, disk full, ...)."""
-    import tempfile
+    from walkerlab.safefs import atomic_replace
 
-    from walkerlab.safefs import remove_stale_temps, temp_prefix
-
-    tmp = None
-    try:
-        remove_stale_temps(path.parent, path.stem)  # of a killed earlier run
-        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.stem), suffix=".tmp",
-                                   dir=path.parent)
+    def fill(fd, _tmp):
         with os.fdopen(fd, "wb") as fh:
             fh.write(text.encode())
-        os.chmod(tmp, 0o600)
-        os.replace(tmp, path)
+
+    try:
+        atomic_replace(path, fill, mode=0o600, name=path.stem)
         return True
     except OSError:
-        if tmp is not None:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
         return False
 
 

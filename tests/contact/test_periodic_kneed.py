@@ -11,6 +11,7 @@ from walkerlab.analysis.contact.sim import simulate_contact
 from walkerlab.analysis.contact.step_map import StepMap
 from walkerlab.analysis.gait.scene import solve_variant
 from walkerlab.config import SolverSettings, load_scene
+from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import build
 
 SCENE = Path(__file__).resolve().parents[2] / "configs" / "kneed.yaml"
@@ -44,7 +45,7 @@ def test_kneed_section_is_named_and_the_fixed_point_maps_to_itself(kneed):
     read at the same tolerance: 1e-6 s / m is 30x their measured change from rtol 1e-12.
     """
     _, walker = kneed
-    P = StepMap(walker, method="odeint", rtol=1e-10, atol=1e-12)
+    P = StepMap(walker, solver=Solver("odeint", 1e-10, 1e-12))
     assert P.names == tuple(FIXED_POINT)
     assert P.walker.continuous  # the scene's continuous ground is kept (no footfall lanes)
     z = np.array(list(FIXED_POINT.values()))

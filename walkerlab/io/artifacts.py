@@ -34,7 +34,6 @@ import errno
 import hashlib
 import itertools
 import os
-import tempfile
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -111,29 +110,25 @@ def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
     walkerlab.io.runpaths.RunPathError
         ``path`` is a symbolic link.
     """
-    from walkerlab.safefs import refuse_link, remove_stale_temps, temp_prefix
+    from walkerlab.safefs import atomic_replace, refuse_link
 
     path = refuse_link(Path(path))
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        remove_stale_temps(path.parent, path.name)  # of a killed earlier run
-        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.name), suffix=".tmp",
-                                   dir=path.parent)
+        os.close(os.open(path.parent, os.O_RDONLY))  # a folder that cannot be opened: below
     except OSError as exc:
         if is_disk_full(exc):
             raise disk_full_error(path, exc) from None
         raise ArtifactError(f"{path.parent}: cannot write there ({exc.strerror})") from None
-    try:
+
+    def fill(fd, _tmp):
         with os.fdopen(fd, "wb") as fh:
             write(fh)
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
+
+    try:
+        atomic_replace(path, fill, mode=mode)
     except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
         raise _write_error(path, exc) from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path
 
 

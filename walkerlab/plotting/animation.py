@@ -268,19 +268,13 @@ def save_frames(frames: WalkerFrames, path: Path, writer) -> Path:
     be a symbolic link (RunPathError, one line); temporary files of a killed earlier run
     (``.animation.<pid>.*.gif``) are removed first."""
     import os
-    import tempfile
 
-    from walkerlab.safefs import refuse_link, remove_stale_temps, temp_prefix
+    from walkerlab.safefs import atomic_replace, refuse_link
+
+    def fill(fd, tmp):
+        os.close(fd)
+        write_frames(frames, tmp, writer)
 
     refuse_link(path)
-    remove_stale_temps(path.parent, path.stem, (path.suffix,))
-    fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.stem), suffix=path.suffix,
-                               dir=path.parent)
-    os.close(fd)
-    try:
-        write_frames(frames, tmp, writer)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    finally:
-        Path(tmp).unlink(missing_ok=True)
+    atomic_replace(path, fill, mode=0o644, suffix=path.suffix, name=path.stem)
     return path

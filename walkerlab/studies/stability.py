@@ -27,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.integrate.solver import Solver
+
 __all__ = ["MAP_KINDS", "CELL_FIELDS", "REASONS", "MapSpec", "default_spec", "gait_row",
            "gait_map", "stable_fraction", "MAP_GAIT_OPTIONS", "stability_map_run"]
 
@@ -47,9 +49,9 @@ CELL_FIELDS = ("exists", "stable", "max_abs_multiplier", "step_period_s", "patch
 #: settings of the periodic-gait search in a map cell (odeint step map, rtol 1e-9; FD
 #: Jacobian at rtol 1e-10 with step 1e-3 x scale): looser than the contact-sim stage's, the
 #: map noise is then ~1e-8 (scaled) and the multipliers carry ~1e-4 absolute error.
-MAP_GAIT_OPTIONS = dict(method="odeint", check_fd=False, rtol=1e-9, atol=1e-12,
-                        jac_rtol=1e-10, jac_atol=1e-13, fd_step=1e-3, residual_tol=1e-6,
-                        xtol=1e-7)
+MAP_GAIT_OPTIONS = dict(solver=Solver("odeint", 1e-9, 1e-12),
+                        jacobian_solver=Solver("odeint", 1e-10, 1e-13), check_fd=False,
+                        fd_step=1e-3, residual_tol=1e-6, xtol=1e-7)
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ The one rigid-limit family of the contact is :mod:`walkerlab.models.contact.rigi
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
@@ -44,8 +45,13 @@ from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.numerics import fd_jacobian, sort_multipliers
 
-__all__ = ["ContactPeriodicGait", "find_contact_periodic_gait", "ideal_gait",
-           "simulate_from_periodic_gait"]
+#: the step map's integrator while root finding and for the final Jacobian (odeint)
+MAP_SOLVER = Solver("odeint", 1e-12, 1e-14)
+#: the cheap map of the two-fidelity search
+COARSE_SOLVER = Solver("odeint", 1e-10, 1e-12)
+
+__all__ = ["COARSE_SOLVER", "MAP_SOLVER", "ContactPeriodicGait", "find_contact_periodic_gait",
+           "ideal_gait", "simulate_from_periodic_gait"]
 
 
 @dataclass
@@ -161,10 +167,9 @@ def _last_call_memo(f):
 def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0, 1.0),
                                warmup_steps: int = 8, xtol: float = 1e-8,
                                residual_tol: float = 1e-8, fd_step: float = 1e-4,
-                               check_fd: bool = True, method: str = "odeint",
-                               rtol: float = 1e-12, atol: float = 1e-14,
-                               jac_rtol: float = 1e-12, jac_atol: float = 1e-14,
-                               coarse_rtol: float | None = 1e-10, coarse_atol: float = 1e-12,
+                               check_fd: bool = True, solver: Solver = MAP_SOLVER,
+                               jacobian_solver: Solver = MAP_SOLVER,
+                               coarse_solver: Solver | None = COARSE_SOLVER,
                                coarse_xtol: float = 1e-6,
                                patch_spacing: float | None = None,
                                time_limit_s: float | None = None) -> ContactPeriodicGait:
@@ -194,14 +199,17 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         (the root finder's own Jacobians use ``10 * fd_step`` on the cheaper map).
     check_fd : bool
         Also compute the multipliers with ``fd_step * 3`` and ``/ 3`` (``multiplier_fd_spread``).
-    method, rtol, atol : integrator settings of the map while root finding (``"odeint"``:
-        scipy odeint with the section crossing found by brentq, 3-10x faster than the
+    solver : walkerlab.integrate.solver.Solver
+        The map's integrator while root finding (:data:`MAP_SOLVER`: ``"odeint"``, scipy
+        odeint with the section crossing found by brentq, 3-10x faster than the
         ``solve_ivp`` methods "LSODA", "Radau", "BDF", which locate it as an event).
-    jac_rtol, jac_atol : tolerances of the map for the final FD Jacobian.
-    coarse_rtol, coarse_atol, coarse_xtol : two-fidelity search (used only when
-        ``coarse_rtol`` is looser than ``rtol``; None: off).  The warm-up and a first hybr
-        solve (``xtol = coarse_xtol``, forward-difference Jacobian) run on the map at
-        ``coarse_rtol``; the final hybr solve at ``rtol`` starts from that fixed point with
+    jacobian_solver : walkerlab.integrate.solver.Solver
+        The map's integrator for the final FD Jacobian (same method as ``solver``).
+    coarse_solver : walkerlab.integrate.solver.Solver or None
+        Two-fidelity search (used only when its ``rtol`` is looser than ``solver``'s; None:
+        off).  The warm-up and a first hybr solve (``xtol = coarse_xtol``,
+        forward-difference Jacobian) run on the map at its tolerances; the final hybr
+        solve at ``solver.rtol`` starts from that fixed point with
         its Jacobian (a Newton direction accurate to the FD step, ~1e-3), so it needs only
         a few map evaluations at the tight tolerance.  Measured on the paper's contact
         (odeint, median CPU per map): 31 ms at rtol 1e-10, 130 ms at 1e-11, 114 ms at 1e-12.
@@ -222,11 +230,12 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     """
     wall = time.perf_counter()
     deadline = None if time_limit_s is None else wall + time_limit_s
-    P = StepMap(walker, patch_spacing, method=method, rtol=rtol, atol=atol, deadline=deadline)
+    method = solver.method
+    P = StepMap(walker, patch_spacing, solver, deadline=deadline)
     scale = P.scale
-    coarse = coarse_rtol is not None and coarse_rtol > rtol
+    coarse = coarse_solver is not None and coarse_solver.rtol > solver.rtol
     # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
-    PC = StepMap(walker, patch_spacing, method=method, rtol=coarse_rtol, atol=coarse_atol,
+    PC = StepMap(walker, patch_spacing, dataclasses.replace(coarse_solver, method=method),
                  deadline=deadline) if coarse else P
     guess = np.asarray(guess, float)
     if guess.size == len(P.names):
@@ -269,9 +278,9 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     zs = sol.x * scale
     z1, T, ell = P(zs)
     res_si = z1 - zs
-    PJ = P if (jac_rtol, jac_atol) == (rtol, atol) else \
-        StepMap(walker, patch_spacing, method=method, rtol=jac_rtol, atol=jac_atol,
-                deadline=deadline)
+    jac_solver = dataclasses.replace(jacobian_solver, method=method)
+    PJ = P if (jac_solver.rtol, jac_solver.atol) == (solver.rtol, solver.atol) else \
+        StepMap(walker, patch_spacing, jac_solver, deadline=deadline)
     FJ = lambda v: PJ(v)[0]  # noqa: E731
     J = fd_jacobian(FJ, zs, fd_step * scale)
     ev = sort_multipliers(np.linalg.eigvals(J))
@@ -285,9 +294,9 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
                            np.max(np.abs(ev_hi - ev)[slow], initial=0.0)))
     margin = P.patch_margin(zs)
     info = {"warmup_history": hist, "root_message": sol.message, "root_nfev": root_nfev,
-            "fd_step": fd_step, "scales": scale, "method": method, "rtol": rtol, "atol": atol,
-            "coarse_rtol": coarse_rtol if coarse else None, "coarse_map_evaluations": PC.nfev
-            if coarse else 0, "patch_spacing_m": P.spacing}
+            "fd_step": fd_step, "scales": scale, "method": method, "rtol": solver.rtol,
+            "atol": solver.atol, "coarse_rtol": coarse_solver.rtol if coarse else None,
+            "coarse_map_evaluations": PC.nfev if coarse else 0, "patch_spacing_m": P.spacing}
     resid = float(np.max(np.abs(res_si / scale)))
     return ContactPeriodicGait(
         z=zs, fixed_point=dict(zip(P.names, map(float, zs))), period_s=T,

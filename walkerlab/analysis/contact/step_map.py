@@ -88,6 +88,10 @@ class PeriodicGaitError(RuntimeError):
         self.kind = kind
 
 
+#: the step map's default integrator (LSODA with the analytic Jacobian)
+DEFAULT_SOLVER = Solver("LSODA", 1e-11, 1e-13)
+
+
 class StepMap:
     """Mid-stance-to-mid-stance step map of a :class:`ContactWalker`.
 
@@ -99,16 +103,17 @@ class StepMap:
     patch_spacing : float, optional
         Distance [m] ahead of the stance foot of the swing lane's patch (default: the
         walker's lane spacing ``lane1[0] - lane2[0]`` if it has lanes, else 0.372 m).
-    method : {"LSODA", "Radau", "BDF"}
-    rtol, atol : float
-        Integrator tolerances (``atol`` well below the penetration ~6e-5 m).
+    solver : walkerlab.integrate.solver.Solver
+        The map's integrator: ``"odeint"`` (scipy's odeint on a grid, the crossing found
+        by brentq) or a ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``; the
+        crossing located as an event); ``atol`` well below the penetration ~6e-5 m.
     t_max : float
         Give up a step after this time [s].
     """
 
     def __init__(self, walker: ContactWalker, patch_spacing: float | None = None,
-                 method: str = "LSODA", rtol: float = 1e-11, atol: float = 1e-13,
-                 t_max: float = 3.0, deadline: float | None = None):
+                 solver: Solver = DEFAULT_SOLVER, t_max: float = 3.0,
+                 deadline: float | None = None):
         if patch_spacing is None:
             if walker.lane1.size and walker.lane2.size:
                 patch_spacing = float(walker.lane1[0] - walker.lane2[0])
@@ -122,8 +127,8 @@ class StepMap:
         o2 = footprint_offsets(walker.data)[1]
         self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing + o2]),
                                           lane2=np.array([o2]), continuous=keep_ground)
-        self.method, self.t_max = method, t_max
-        self.solver = Solver(method, rtol, atol)  # the step map's integrator
+        self.method, self.t_max = solver.method, t_max
+        self.solver = solver  # the step map's integrator
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
         w = self.walker
@@ -200,7 +205,7 @@ class StepMap:
 
     def _step_odeint(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
                      chunk_s: float = 0.25):
-        """``method="odeint"``: (t_e, x_e) of the next upward zero of theta_sw - theta_st.
+        """``solver.method == "odeint"``: (t_e, x_e) of the next upward zero of theta_sw - theta_st.
 
         scipy's odeint (LSODA without per-step Python overhead) on a ``dt`` grid in chunks;
         the crossing is bracketed on the samples and located by ``scipy.optimize.brentq``
