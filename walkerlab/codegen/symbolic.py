@@ -174,42 +174,109 @@ def _row_limit(rows: sp.Matrix, beta) -> tuple[sp.Matrix, bool]:
     return out, scaled
 
 
-@cache
-def derive(structure: Structure) -> Equations:
-    """Derive flow, impact, guards, energies and points of ``structure`` (memoised per process).
+@dataclass(frozen=True)
+class _Symbols:
+    """Symbols and link angles of a derivation (set up by :func:`_symbols`).
 
-    Returns
-    -------
-    Equations
-
-    Raises
-    ------
-    ValueError
-        A foot kind this derivation does not handle, or a knee / arc feet with coordinates
-        other than ``absolute``.
+    ``q, dq, par`` are the scene's coordinates, rates and parameters (``P`` by name);
+    ``psi_sw, psi_st`` the absolute swing (thigh) and stance leg angles as functions of ``q``
+    and ``psi_q`` every link angle so; ``psv, dps`` the absolute link angles the derivation
+    works in (``ps_sw, ps_shank, ps_st``; ``ps_shank`` is ``ps_sw`` without a knee) and their
+    rates, ``psi_t`` the torso's angle; ``normal, tangent`` the slope's unit vectors, ``lt``
+    the thigh length and ``R`` the foot radius (0 when there is none).
     """
+
+    structure: Structure
+    knee: bool
+    arc: bool
+    n: int
+    q: list
+    dq: list
+    par: list
+    P: dict
+    beta: sp.Symbol
+    qv: sp.Matrix
+    dqv: sp.Matrix
+    psi_sw: sp.Expr
+    psi_st: sp.Expr
+    psi_q: list
+    ps_sw: sp.Symbol
+    ps_shank: sp.Symbol
+    ps_st: sp.Symbol
+    psi_t: sp.Expr
+    psv: sp.Matrix
+    dps: sp.Matrix
+    normal: sp.Matrix
+    tangent: sp.Matrix
+    lt: sp.Expr
+    R: sp.Expr
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """Leg-vector sums ``{link angle: length}`` of the hip, the swing knee and the swing foot
+    (or arc centre), the stance arc's rolling ``offset`` added to every position, the named
+    points, the swing foot's contact point and its arc's centre (None for point feet)."""
+
+    hip_lin: dict
+    knee_lin: dict
+    foot_lin: dict
+    offset: sp.Matrix
+    points: dict
+    swing_contact: sp.Matrix
+    centre_sw: sp.Matrix | None
+
+    def at(self, lin: dict) -> sp.Matrix:
+        """Position of a leg-vector sum, relative to the stance foot."""
+        return position_of(lin) + self.offset
+
+
+@dataclass(frozen=True)
+class _Dynamics:
+    """Flow ``M, C, G``, impact ``Mi, Bm``, energies ``T, V``, whether the massless limit was
+    taken (``lim``) and the knee-locked flow and knee strike (``locked``, ``knee_impact``, or
+    None) - in link angles, then (:func:`_to_scene`) in the scene's coordinates."""
+
+    M: sp.Matrix
+    C: sp.Matrix
+    G: sp.Matrix
+    Mi: sp.Matrix
+    Bm: sp.Matrix
+    T: sp.Expr
+    V: sp.Expr
+    lim: bool
+    locked: tuple | None
+    knee_impact: tuple | None
+
+
+def _add(lin: dict, psi, length) -> dict:
+    """Copy of the leg-vector sum ``lin`` with ``length`` more along the angle ``psi``."""
+    out = dict(lin)
+    out[psi] = out.get(psi, 0) + length
+    return out
+
+
+def _symbols(structure: Structure) -> _Symbols:
+    """Check the structure is one this derivation handles and set up its symbols: the scene's
+    coordinates, rates and parameters, the absolute leg angles they give, and the absolute link
+    angles the derivation works in.  Each massless body then moves with one link angle only,
+    so the row limit is exact; :func:`_to_scene` maps to ``q`` at the end."""
     if structure.foot not in ("point", "arc"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
     knee, arc = structure.knee, structure.foot == "arc"
     if (knee or arc) and structure.coordinates != "absolute":
         raise ValueError("walker.coordinates: a knee or arc feet need 'absolute'")
-    n = len(structure.roles)
     q = sp.symbols([f"q_{r}" for r in structure.roles], real=True)
     dq = sp.symbols([f"dq_{r}" for r in structure.roles], real=True)
     par = sp.symbols(structure.param_names, real=True)
     P = dict(zip(structure.param_names, par))
-    beta = sp.Symbol("beta", positive=True)
-    g, L, gamma = P["g"], P["L"], P["gamma"]
-    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
+    gamma = P["gamma"]
     if knee:  # absolute angles (KNEED_ROLES): swing thigh, swing shank, stance
         psi_q = list(q)
         psi_sw, psi_st = q[0], q[2]
     else:
         psi_st, psi_sw = _leg_angles(structure, q, gamma)
         psi_q = [psi_sw, psi_st]
-
-    # derive in absolute link angles psi (swing link(s), stance): each massless body then moves
-    # with one coordinate only, so the row limit below is exact; map to q at the end
     if knee:
         ps_sw, ps_shank, ps_st = sp.symbols("psi_swing psi_swing_shank psi_stance", real=True)
         dps = sp.Matrix(sp.symbols("dpsi_swing dpsi_swing_shank dpsi_stance", real=True))
@@ -219,96 +286,128 @@ def derive(structure: Structure) -> Equations:
         dps = sp.Matrix(sp.symbols("dpsi_swing dpsi_stance", real=True))
         psv = sp.Matrix([ps_sw, ps_st])
         ps_shank = ps_sw
-    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
-    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])  # along the slope, downhill
-    lt = P["L_thigh"] if knee else 0
-    R = P["R_foot"] if arc else 0
-    # every position is a sum of leg vectors {link angle: length along it} times e(angle),
-    # plus, with arc feet, the rolling offset of the stance arc (contact + R n) - (L - R) stays
-    # on the leg: the stance arc's centre is at L - R from the hip
-    hip_lin = {ps_st: -(L - R)} if arc else {ps_st: -L}  # stance foot at the origin (A.2)
-    offset = (-R * (ps_st + gamma) * tangent + R * normal) if arc else sp.zeros(2, 1)
+    return _Symbols(
+        structure=structure, knee=knee, arc=arc, n=len(structure.roles), q=q, dq=dq, par=par,
+        P=P, beta=sp.Symbol("beta", positive=True), qv=sp.Matrix(q), dqv=sp.Matrix(dq),
+        psi_sw=psi_sw, psi_st=psi_st, psi_q=psi_q, ps_sw=ps_sw, ps_shank=ps_shank, ps_st=ps_st,
+        psi_t=(ps_sw + ps_st) / 2, psv=psv, dps=dps,
+        normal=sp.Matrix([sp.sin(gamma), sp.cos(gamma)]),
+        tangent=sp.Matrix([sp.cos(gamma), -sp.sin(gamma)]),  # along the slope, downhill
+        lt=P["L_thigh"] if knee else 0, R=P["R_foot"] if arc else 0,
+    )
+
+
+def _geometry(s: _Symbols) -> _Geometry:
+    """Positions of the hip, the knees and the feet (and, with arc feet, the contact points
+    and arc centres) relative to the stance foot.  Every position is a sum of leg vectors
+    ``{link angle: length along it}`` times ``e(angle)`` plus, with arc feet, the rolling
+    offset of the stance arc (contact + R n), whose centre stays on the leg at ``L - R`` from
+    the hip; the stance foot is at the origin (paper A.2)."""
+    L, R, gamma, ps_st = s.P["L"], s.R, s.P["gamma"], s.ps_st
+    hip_lin = {ps_st: -(L - R)} if s.arc else {ps_st: -L}
+    offset = (-R * (ps_st + gamma) * s.tangent + R * s.normal) if s.arc else sp.zeros(2, 1)
 
     def at(lin):
         return position_of(lin) + offset
 
-    def add(lin, psi, length):
-        out = dict(lin)
-        out[psi] = out.get(psi, 0) + length
-        return out
-
-    knee_lin = add(hip_lin, ps_sw, lt) if knee else hip_lin
-    foot_lin = add(knee_lin, ps_shank, L - lt - R)   # point foot, or the swing arc's centre
-    if arc:
+    knee_lin = _add(hip_lin, s.ps_sw, s.lt) if s.knee else hip_lin
+    foot_lin = _add(knee_lin, s.ps_shank, L - s.lt - R)  # point foot, or the swing arc's centre
+    centre_sw = None
+    if s.arc:
         centre_sw = at(foot_lin)
-        swing_contact = centre_sw - R * normal
-        swing_foot = swing_contact + R * (ps_shank + gamma) * tangent  # next reference point
+        swing_contact = centre_sw - R * s.normal
+        swing_foot = swing_contact + R * (s.ps_shank + gamma) * s.tangent  # next reference
     else:
         swing_foot = swing_contact = at(foot_lin)
     points = {"stance_foot": sp.zeros(2, 1), "hip": at(hip_lin), "swing_foot": swing_foot}
-    if knee:
+    if s.knee:
         points["swing_knee"] = at(knee_lin)
-        points["stance_knee"] = at(add(hip_lin, ps_st, lt))
-    if arc:
-        points["stance_contact"] = offset - R * normal
+        points["stance_knee"] = at(_add(hip_lin, ps_st, s.lt))
+    if s.arc:
+        points["stance_contact"] = offset - R * s.normal
         points["stance_foot_centre"] = offset
         points["swing_contact"] = swing_contact
         points["swing_foot_centre"] = centre_sw
-    bodies = []  # (mass, {angle: length}, inertia, link angle)
+    return _Geometry(hip_lin, knee_lin, foot_lin, offset, points, swing_contact, centre_sw)
+
+
+def _bodies(s: _Symbols, geo: _Geometry) -> tuple[list, dict]:
+    """The bodies ``(mass, {angle: length}, inertia, link angle)`` - hip mass, each leg body
+    for the stance and the swing role (mass ``beta`` when massless), torso bodies - and the
+    named points with each body's position added.  The upper body sits on the bisecting hip
+    mechanism: its angle from the upward vertical, positive leaning back, is the mean of the
+    leg angles; a point ``d`` up its axis lies at ``hip - d e(psi_t)``, one ``e`` ahead of the
+    axis at ``+ e e(psi_t + pi/2)``."""
+    structure, P, hip_lin = s.structure, s.P, geo.hip_lin
+    points = dict(geo.points)
+    bodies = []
     if structure.hip_mass:
-        bodies.append((P["M_hip"], hip_lin, 0, ps_st))
+        bodies.append((P["M_hip"], hip_lin, 0, s.ps_st))
 
     def bp(kind, name, role):  # a leg body's parameter (per role when the legs differ)
         return P[f"{kind}_{ROLE_TAG[role]}_{name}" if structure.asymmetric else f"{kind}_{name}"]
 
     for b in structure.bodies:
         for role in ("stance", "swing"):
-            mass = beta if b.massless else bp("m", b.name, role)
+            mass = s.beta if b.massless else bp("m", b.name, role)
             inertia = bp("I", b.name, role) if b.kind == "rod" else 0
             d = bp("d", b.name, role)
             if role == "stance":
-                lin, psi = add(hip_lin, ps_st, d), ps_st
+                lin, psi = _add(hip_lin, s.ps_st, d), s.ps_st
             elif b.link == "shank":
-                lin, psi = add(knee_lin, ps_shank, d - lt), ps_shank
+                lin, psi = _add(geo.knee_lin, s.ps_shank, d - s.lt), s.ps_shank
             else:
-                lin, psi = add(hip_lin, ps_sw, d), ps_sw
+                lin, psi = _add(hip_lin, s.ps_sw, d), s.ps_sw
             if b.off_axis:  # ahead of the link's axis: e(psi + pi/2) = (cos psi, sin psi)
-                lin = add(lin, psi + sp.pi / 2, bp("e", b.name, role))
+                lin = _add(lin, psi + sp.pi / 2, bp("e", b.name, role))
             if f"{role}_{b.name}" in points:
                 raise ValueError(f"walker.leg.bodies: body name {b.name!r} is reserved")
-            points[f"{role}_{b.name}"] = at(lin)
+            points[f"{role}_{b.name}"] = geo.at(lin)
             bodies.append((mass, lin, inertia, psi))
-    # upper body on the bisecting hip mechanism (the coupling eliminated): its angle from the
-    # upward vertical, positive leaning back, is the mean of the leg angles; a point d up its
-    # axis lies at hip - d e(psi_t), one e ahead of the axis at + e e(psi_t + pi/2)
-    psi_t = (ps_sw + ps_st) / 2
+    psi_t = s.psi_t
     for b in structure.torso:
-        lin = add(hip_lin, psi_t, -P[f"d_torso_{b.name}"])
+        lin = _add(hip_lin, psi_t, -P[f"d_torso_{b.name}"])
         if b.off_axis:
-            lin = add(lin, psi_t + sp.pi / 2, P[f"e_torso_{b.name}"])
-        points[f"torso_{b.name}"] = at(lin)
+            lin = _add(lin, psi_t + sp.pi / 2, P[f"e_torso_{b.name}"])
+        points[f"torso_{b.name}"] = geo.at(lin)
         inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
         bodies.append((P[f"m_torso_{b.name}"], lin, inertia, psi_t))
+    return bodies, points
 
+
+def _inertia(s: _Symbols, geo: _Geometry, bodies: list):
+    """Mass matrix ``Mp``, impact matrices ``Mi`` (velocities with the swing foot's contact
+    point at rest) and ``Bm`` (momentum of the pre-impact velocities on the same directions),
+    all in link angles, and the gravitational potential ``V``.  With point feet the matrices
+    are built from ``e'(a) . e'(b) = cos(a - b)`` and come out simplified without a
+    trigonometric simplifier; with arc feet (the rolling offset moves with ``psi_st``) from
+    plain Jacobians, the swing arc's material contact point moving at ``v_centre + w x (-R n)``.
+
+    Returns
+    -------
+    Mp, Mi, Bm : Matrix (n, n)
+    V : Expr
+    """
+    n, psv = s.n, s.psv
     V = sp.Integer(0)
     Mi = sp.zeros(n, n)
     Bm = sp.zeros(n, n)
     Mp = sp.zeros(n, n)
-    if arc:  # material point of the swing arc at the contact: v_centre + w x (-R n)
-        Jf = centre_sw.jacobian(psv) + R * tangent * sp.Matrix([[sp.diff(ps_shank, s)
-                                                                for s in psv]])
+    if s.arc:  # material point of the swing arc at the contact: v_centre + w x (-R n)
+        Jf = geo.centre_sw.jacobian(psv) + s.R * s.tangent * sp.Matrix(
+            [[sp.diff(s.ps_shank, k) for k in psv]])
     for mass, lin, inertia, psi in bodies:
         a = sp.Matrix([[sp.diff(psi, k) for k in psv]])
-        if arc:  # the rolling offset moves with psi_st: plain Jacobians
-            J = at(lin).jacobian(psv)
+        if s.arc:
+            J = geo.at(lin).jacobian(psv)
             Jn = J - Jf  # velocity Jacobian with the swing arc's contact point at rest
             Mp += mass * J.T * J
             Mi += mass * Jn.T * Jn
             Bm += mass * Jn.T * J
         else:
-            # d(position)/d(psi_k) = sum over the angles a of lin[a] da/dpsi_k e'(a), and
-            # e'(a) . e'(b) = cos(a - b): the inertia matrices come out simplified without a
-            # trigonometric simplifier (a = psi_k for a body on a leg's axis)
+            # d(position)/d(psi_k) = sum over the angles a of lin[a] da/dpsi_k e'(a)
+            # (a = psi_k for a body on a leg's axis)
+            foot_lin = geo.foot_lin
             new = {k: lin.get(k, 0) - foot_lin.get(k, 0)
                    for k in {**lin, **foot_lin}}  # swing foot at rest
             dl, dn = velocity_terms(lin, psv), velocity_terms(new, psv)
@@ -320,26 +419,50 @@ def derive(structure: Structure) -> Equations:
         Mp += inertia * a.T * a
         Mi += inertia * a.T * a
         Bm += inertia * a.T * a
-        V += mass * g * at(lin)[1]
+        V += mass * s.P["g"] * geo.at(lin)[1]
     Mp, Mi, Bm = (X.applyfunc(sp.factor_terms) for X in (Mp, Mi, Bm))
-    T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
-    # torsional spring-dampers: V_s = k (delta - r)^2 / 2 joins the potential (so G and the
-    # energy include it); the damper's generalised force -c J^T J dpsi joins C dq
-    link_angle = {"swing": ps_sw, "stance": ps_st, "torso": psi_t}
-    D = sp.zeros(n, n)
-    for i, (first, second) in enumerate(structure.springs):
+    return Mp, Mi, Bm, V
+
+
+def _springs(s: _Symbols, V):
+    """Torsional spring-dampers: each spring's ``V_s = k (delta - r)^2 / 2`` joins the
+    potential ``V`` (so ``G`` and the energy include it) and its damper's generalised force
+    ``-c J^T J dpsi`` the damping matrix ``D`` (added to ``C``).  The swing knee's spring acts
+    on ``shank - thigh``; the stance knee is straight and locked, so its spring holds a
+    constant energy and no torque the lock does not take, and is left out.
+
+    Returns
+    -------
+    V : Expr
+    D : Matrix (n, n)
+    """
+    psv, P = s.psv, s.P
+    link_angle = {"swing": s.ps_sw, "stance": s.ps_st, "torso": s.psi_t}
+    D = sp.zeros(s.n, s.n)
+    for i, (first, second) in enumerate(s.structure.springs):
         delta = link_angle[second] - link_angle[first]
         k_, r_, c_ = P[f"k_s{i}"], P[f"r_s{i}"], P[f"c_s{i}"]
         V += k_ * (delta - r_) ** 2 / 2
-        Jd = sp.Matrix([[sp.diff(delta, s) for s in psv]])
+        Jd = sp.Matrix([[sp.diff(delta, k) for k in psv]])
         D += c_ * Jd.T * Jd
-    if structure.knee_spring:  # the swing knee's (the stance knee is straight, locked: its
-        # spring holds a constant energy and no torque the lock does not take, left out)
-        knee_angle = ps_shank - ps_sw
+    if s.structure.knee_spring:
+        knee_angle = s.ps_shank - s.ps_sw
         V += P["k_knee"] * (knee_angle - P["r_knee"]) ** 2 / 2
-        Jd = sp.Matrix([[sp.diff(knee_angle, s) for s in psv]])
+        Jd = sp.Matrix([[sp.diff(knee_angle, k) for k in psv]])
         D += P["c_knee"] * Jd.T * Jd
-    G = sp.Matrix([sp.diff(V, s) for s in psv])
+    return V, D
+
+
+def _lagrange(s: _Symbols, Mp, Mi, Bm, V, D) -> _Dynamics:
+    """Lagrange's equations in link angles: ``G = dV/dpsi``, ``C`` from the Christoffel
+    symbols of the first kind of ``Mp`` plus the dampers ``D`` (the printed A.5's sign flip of
+    ``C[1, 0]`` for the ``appendix_a`` variant), the kinetic energy; then the exact massless
+    limit of flow and impact (see the module docstring) and, with a knee, the knee lock
+    ``J_k dpsi = 0`` (``S`` spans its null space: thigh and shank together): locked flow,
+    knee strike and heel strike with the knee locked as square systems."""
+    n, psv, dps, beta = s.n, s.psv, s.dps, s.beta
+    T = sp.Rational(1, 2) * (dps.T * Mp * dps)[0]
+    G = sp.Matrix([sp.diff(V, k) for k in psv])
     C = sp.zeros(n, n)
     for i in range(n):
         for j in range(n):
@@ -347,8 +470,10 @@ def derive(structure: Structure) -> Equations:
                                                - sp.diff(Mp[j, k], psv[i])) * dps[k]
                           for k in range(n))  # Christoffel symbols of the first kind
     C += D
+    structure = s.structure
     if structure.variant == "appendix_a":  # the paper's printed A.5: C[1, 0] sign flipped
-        if structure.coordinates != "absolute" or len(structure.bodies) != 1 or knee or arc:
+        if (structure.coordinates != "absolute" or len(structure.bodies) != 1 or s.knee
+                or s.arc):
             raise ValueError("ideal.variant: appendix_a exists only for the compass gait")
         C[1, 0] = -C[1, 0]
     lim = any(b.massless for b in structure.bodies)
@@ -360,80 +485,152 @@ def derive(structure: Structure) -> Equations:
         Mi, Bm = imp[:, :n], imp[:, n:]
         T, V = T.subs(beta, 0), V.subs(beta, 0)
     locked = knee_impact = None
-    if knee:  # knee lock J_k dpsi = 0; S spans its null space (thigh and shank together)
+    if s.knee:
         Jk = sp.Matrix([[-1, 1, 0]])
         S = sp.Matrix([[1, 0], [1, 0], [0, 1]])
         z = sp.zeros(1, n)
         locked = (S.T * M).col_join(Jk), (S.T * C).col_join(z), (S.T * G).col_join(sp.zeros(1, 1))
         knee_impact = (S.T * M).col_join(Jk), (S.T * M).col_join(z)
         Mi, Bm = (S.T * Mi).col_join(Jk), (S.T * Bm).col_join(z)
-    # to the scene's coordinates: psi = A q + c, dpsi = A dq
-    psi_q = sp.Matrix(psi_q)
-    A = psi_q.jacobian(qv)
-    sub = {s: e for s, e in zip(psv, psi_q)}
-    sub.update({dps[i]: (A * dqv)[i] for i in range(n)})
-    W = sp.eye(n) if lim else A.T  # keep psi rows in the limit; else Lagrange's rows in q
-    M, C, G = (W * M * A).subs(sub), (W * C * A).subs(sub), (W * G).subs(sub)
-    Mi, Bm = (W * Mi * A).subs(sub), (W * Bm * A).subs(sub)
-    if knee:  # absolute coordinates: A = I, the systems are already in q
+    return _Dynamics(M, C, G, Mi, Bm, T, V, lim, locked, knee_impact)
+
+
+def _to_scene(s: _Symbols, dyn: _Dynamics, geo: _Geometry, points: dict, bodies: list):
+    """Map everything from link angles to the scene's coordinates, ``psi = A q + c`` and
+    ``dpsi = A dq``: the equations' rows stay link-angle rows in the massless limit (each
+    moves one body), else they become Lagrange's rows in ``q`` (``A^T``).  A kneed walker's
+    coordinates are absolute (``A = I``): its locked systems only need the substitution.
+
+    Returns
+    -------
+    dyn : _Dynamics
+        In ``q``.
+    points : dict[str, Matrix (2, 1)]
+    swing_contact : Matrix (2, 1)
+    bodies : list of (mass, position, inertia, link angle)
+        Positions and link angles in ``q``.
+    sub : dict
+        The substitution of link angles and rates.
+    """
+    n = s.n
+    psi_q = sp.Matrix(s.psi_q)
+    A = psi_q.jacobian(s.qv)
+    sub = {k: e for k, e in zip(s.psv, psi_q)}
+    sub.update({s.dps[i]: (A * s.dqv)[i] for i in range(n)})
+    W = sp.eye(n) if dyn.lim else A.T  # keep psi rows in the limit; else Lagrange's rows in q
+    locked, knee_impact = dyn.locked, dyn.knee_impact
+    if s.knee:
         locked = tuple(m_.subs(sub) for m_ in locked)
         knee_impact = tuple(m_.subs(sub) for m_ in knee_impact)
-    T, V = T.subs(sub), V.subs(sub)
+    out = _Dynamics(
+        M=(W * dyn.M * A).subs(sub), C=(W * dyn.C * A).subs(sub), G=(W * dyn.G).subs(sub),
+        Mi=(W * dyn.Mi * A).subs(sub), Bm=(W * dyn.Bm * A).subs(sub), T=dyn.T.subs(sub),
+        V=dyn.V.subs(sub), lim=dyn.lim, locked=locked, knee_impact=knee_impact,
+    )
     points = {k: v.subs(sub) for k, v in points.items()}
-    hip, foot = points["hip"], points["swing_foot"]
-    swing_contact = swing_contact.subs(sub)
-    bodies = [(m_, at(lin).subs(sub), i_, psi.subs(sub)) for m_, lin, i_, psi in bodies]
+    bodies = [(m_, geo.at(lin).subs(sub), i_, psi.subs(sub)) for m_, lin, i_, psi in bodies]
+    return out, points, geo.swing_contact.subs(sub), bodies, sub
 
-    # role swap: new stance leg = old swing leg (absolute angles), solved for the new q
+
+def _swap_and_guards(s: _Symbols, points: dict, swing_contact, sub: dict) -> dict:
+    """Role swap at heel strike (the new stance leg is the old swing leg, absolute angles,
+    solved for the new ``q``; a kneed walker's swing knee is locked at heel strike and the new
+    swing knee starts straight), the guards, the heel-strike section (the coordinate solved
+    from its guard; kneed: the shank's angle and rate tied to the thigh's) and the named
+    absolute leg angles.  Returns the matching :class:`Equations` fields by name."""
+    structure, q, n, gamma = s.structure, s.q, s.n, s.P["gamma"]
+    psi_sw, psi_st = s.psi_sw, s.psi_st
     qn = sp.symbols([f"qn_{r}" for r in structure.roles], real=True)
-    if knee:  # the swing knee is locked at heel strike; the new swing knee starts straight
+    if s.knee:
         eqs = [qn[2] - psi_sw, qn[0] - psi_st, qn[1] - psi_st]
     else:
         nst, nsw = _leg_angles(structure, qn, gamma)
         eqs = [nst - psi_sw, nsw - psi_st]
     sol = sp.solve(eqs, qn, dict=True)[0]
-    relabel_q = sp.Matrix([sp.expand(sol[s]) for s in qn])
-    relabel_rate = relabel_q.jacobian(qv)
+    relabel_q = sp.Matrix([sp.expand(sol[k]) for k in qn])
+    relabel_rate = relabel_q.jacobian(s.qv)
 
     sigma = sp.expand(psi_sw + psi_st + 2 * gamma)
     drop = SECTION_DROP[structure.coordinates]
     drop_solution = sp.solve(sigma, q[drop])[0]
     guards = {"heel_strike": sigma, "swing_foot_ahead": sp.expand(psi_sw - psi_st),
-              "hip_height": (hip.T * normal)[0],
-              "swing_clearance": (swing_contact.T * normal)[0]}
+              "hip_height": (points["hip"].T * s.normal)[0],
+              "swing_clearance": (swing_contact.T * s.normal)[0]}
     leg_angles = {"stance": psi_st, "swing": psi_sw}
     tied = {}
-    if knee:
+    if s.knee:
         guards["knee_extension"] = q[1] - q[0]  # zero when straight, > 0 hyperextended
         leg_angles = {"stance_thigh": psi_st, "stance_shank": psi_st, "swing_thigh": q[0],
                       "swing_shank": q[1]}
         tied = {1: 0, n + 1: n}
     if structure.torso:  # on a kneed walker the bisector of the thighs
-        leg_angles["torso"] = psi_t.subs(sub)
+        leg_angles["torso"] = s.psi_t.subs(sub)
+    return {"relabel_q": relabel_q, "relabel_rate": relabel_rate, "guards": guards,
+            "leg_angles": leg_angles, "section_drop": drop, "drop_solution": drop_solution,
+            "section_tied": tied}
 
-    if knee or arc:  # the printed-equation variants exist for the point-foot compass gait only
-        return Equations(
-            q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=Bm,
-            relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=T, potential=V,
-            guards=guards, points=points, leg_angles=leg_angles, section_drop=drop,
-            drop_solution=drop_solution, De=sp.zeros(n + 2, n + 2), E=sp.zeros(2, n + 2),
-            limit=lim, section_tied=tied, locked=locked, knee_impact=knee_impact,
-        )
-    # extended coordinates (stance foot free at (x_f, y_f)) for the printed-equation variants
+
+def _extended(s: _Symbols, bodies: list, foot, lim: bool):
+    """Extended impact matrices of the printed-equation variants (point-foot compass gait
+    only): with the stance foot free at ``(x_f, y_f)``, ``De`` is the Hessian of the kinetic
+    energy in the rates of ``[q, x_f, y_f]`` (massless bodies carry none) and ``E`` the
+    Jacobian of the swing foot's position (paper Eq. 6-7, A.7-A.24).
+
+    Returns
+    -------
+    De : Matrix (n + 2, n + 2)
+    E : Matrix (2, n + 2)
+    """
     xf, yf, dxf, dyf = sp.symbols("x_f y_f dx_f dy_f", real=True)
-    qe, dqe = sp.Matrix([*q, xf, yf]), sp.Matrix([*dq, dxf, dyf])
+    qe, dqe = sp.Matrix([*s.q, xf, yf]), sp.Matrix([*s.dq, dxf, dyf])
     Te = sp.Integer(0)
     for mass, pos, inertia, psi in bodies:
         ve = (pos + sp.Matrix([xf, yf])).jacobian(qe) * dqe
         a = sp.Matrix([[sp.diff(psi, qi) for qi in qe]])
         Te += (sp.Rational(1, 2) * mass * (ve.T * ve)[0]
                + sp.Rational(1, 2) * inertia * (a * dqe)[0] ** 2)
-    Te = Te.subs(beta, 0) if lim else Te
+    Te = Te.subs(s.beta, 0) if lim else Te
     De = sp.hessian(Te, dqe)
     E = (foot + sp.Matrix([xf, yf])).jacobian(qe)
+    return De, E
+
+
+@cache
+def derive(structure: Structure) -> Equations:
+    """Derive flow, impact, guards, energies and points of ``structure`` (memoised per process).
+
+    Parameters
+    ----------
+    structure : Structure
+        The walker's form (no numbers).
+
+    Returns
+    -------
+    Equations
+
+    Raises
+    ------
+    ValueError
+        A foot kind this derivation does not handle, or a knee / arc feet with coordinates
+        other than ``absolute``.
+    """
+    s = _symbols(structure)
+    geo = _geometry(s)
+    bodies, points = _bodies(s, geo)
+    Mp, Mi, Bm, V = _inertia(s, geo, bodies)
+    V, D = _springs(s, V)
+    dyn, points, swing_contact, bodies, sub = _to_scene(
+        s, _lagrange(s, Mp, Mi, Bm, V, D), geo, points, bodies)
+    swap = _swap_and_guards(s, points, swing_contact, sub)
+    n = s.n
+    if s.knee or s.arc:  # the printed-equation variants exist for the point-foot compass gait
+        De, E = sp.zeros(n + 2, n + 2), sp.zeros(2, n + 2)
+        extra = {"locked": dyn.locked, "knee_impact": dyn.knee_impact}
+    else:
+        De, E = _extended(s, bodies, points["swing_foot"], dyn.lim)
+        extra = {"section_tied": None}
     return Equations(
-        q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=Bm,
-        relabel_q=relabel_q, relabel_rate=relabel_rate, kinetic=T, potential=V, guards=guards,
-        points=points, leg_angles=leg_angles, section_drop=drop,
-        drop_solution=drop_solution, De=De, E=E, limit=lim,
+        q=tuple(s.q), dq=tuple(s.dq), params=tuple(s.par), M=dyn.M, C=dyn.C, G=dyn.G,
+        Mi=dyn.Mi, B=dyn.Bm, kinetic=dyn.T, potential=dyn.V, points=points, De=De, E=E,
+        limit=dyn.lim, **{**swap, **extra},
     )
