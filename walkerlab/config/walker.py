@@ -10,12 +10,28 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import Discriminator, Field, Tag, field_validator, model_validator
+from pydantic import Discriminator, Field, Tag, field_validator, model_serializer, model_validator
 
+from walkerlab.config.actuation import Actuation
 from walkerlab.config.base import Strict
 
 
-class CompassGaitParams(Strict):
+class _Actuated(Strict):
+    """A walker section with optional actuators; a passive walker serialises as before (no
+    ``actuation`` key), so its scene JSON, input hashes and artifacts are unchanged."""
+
+    actuation: Actuation | None = Field(None, description="actuators: push-off impulse, joint "
+                                        "torques (null: a passive walker)")
+
+    @model_serializer(mode="wrap")
+    def _passive_as_before(self, handler):
+        out = handler(self)
+        if isinstance(out, dict) and out.get("actuation", 0) is None:
+            out.pop("actuation")
+        return out
+
+
+class CompassGaitParams(_Actuated):
     """Rigid-legged compass-gait walker (paper Table 1; Goswami et al. 1996, Fig. 1).
 
     Point masses: hip ``hip_mass_kg`` and one ``leg_mass_kg`` per leg at distance
@@ -52,7 +68,9 @@ class CompassGaitParams(Strict):
             "gravity_m_per_s2": self.gravity_m_per_s2, "hip_mass_kg": self.hip_mass_kg,
             "leg": {"length_m": self.leg_length_m, "bodies": [{
                 "kind": "point_mass", "name": "mass", "mass_kg": self.leg_mass_kg,
-                "from_hip_m": self.leg_length_m - self.leg_mass_from_foot_m}]}})
+                "from_hip_m": self.leg_length_m - self.leg_mass_from_foot_m}]},
+            **({} if self.actuation is None
+               else {"actuation": self.actuation.model_dump(mode="json")})})
 
 
 # ---- generic walker description (``model: biped``): bodies, joints, feet as data.
@@ -301,7 +319,7 @@ class SpringSpec(TorsionalSpring):
         return self
 
 
-class BipedParams(Strict):
+class BipedParams(_Actuated):
     """A planar passive biped described as data (``model: biped``); its equations of motion,
     guards and impact are derived symbolically (:mod:`walkerlab.codegen.symbolic`).
 

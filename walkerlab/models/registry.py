@@ -27,11 +27,30 @@ def build_walker(scene) -> HybridWalker:
     (``ideal.variant``); ``model: biped`` is any walker described as data, derived
     symbolically (variant ``derived`` only).
 
+    A ``walker.actuation`` section adds its actuators (:func:`walkerlab.models.hybrid.
+    actuated.actuate`).
+
     Raises
     ------
     ValueError
-        The scene names a walker model or variant that has no rigid hybrid implementation.
+        The scene names a walker model or variant that has no rigid hybrid implementation,
+        or actuators the walker cannot carry (one line).
     """
+    walker = _passive(scene)
+    act = getattr(scene.walker, "actuation", None)
+    if act is None:
+        return walker
+    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.walker.description import walker_data
+
+    if scene.ideal.variant != "derived":
+        raise ValueError("walker.actuation: only with ideal.variant: derived (the printed "
+                         "Appendix A equations are passive)")
+    return actuate(walker, walker_data(scene.walker, scene.slope.phi_rad), act)
+
+
+def _passive(scene) -> HybridWalker:
+    """The passive walker of the scene (its actuators left out)."""
     w = scene.walker
     if w.model == "compass_gait":
         from walkerlab.models.hybrid.compass_gait import make_compass_gait

@@ -186,6 +186,11 @@ class HybridWalker:
         (legs that differ: same roles and state, other numbers); None when the legs are
         mirror images.  This walker takes the steps with ``legs[1]`` in stance (``legs[0]``
         swings first, paper Eq. 11); with a mirror the Poincaré map is a stride (two steps).
+    actuators : walkerlab.models.hybrid.actuated.Actuators or None
+        The walker's actuators (joint torques, push-off) bound to its model; None: passive.
+    matrices : callable or None
+        ``x (2n,) -> (M (n, n), C (n, n), G (n,))`` of the generated flow (the energy
+        ledger's damper power); None for hand-written models.
     """
 
     name: str
@@ -207,6 +212,8 @@ class HybridWalker:
     heel_strike_guard: Callable[[float, np.ndarray], float] | None = None
     leg_angles: Callable[[np.ndarray], dict[str, np.ndarray]] | None = None
     mirror: HybridWalker | None = None
+    actuators: object | None = None
+    matrices: Callable[[np.ndarray], tuple] | None = None
 
     def for_stance(self, stance_leg: str) -> HybridWalker:
         """The walker of a step with ``stance_leg`` in stance (this one or :attr:`mirror`)."""

@@ -134,4 +134,5 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
         variational=flow_jacobian or f["flow_jacobian"],
         reset_jacobian=reset_jacobian or f["reset_jacobian"],
         heel_strike_guard=f["guard_heel_strike"], leg_angles=coords, mirror=mirror,
+        matrices=f["matrices"],
     )

@@ -1,0 +1,155 @@
+"""Where a rigid walker's energy goes, step by step: the energy ledger and the cost of
+transport.
+
+For each step (heel strike to heel strike) the change of the total mechanical energy
+``E = T + V`` (``V``: gravity, measured in the world from the first stance foot, and the
+springs) is the sum of
+
+- ``actuator_work_positive`` / ``actuator_work_negative`` [J]: the joint torques' work,
+  ``int max(tau ddelta, 0) dt`` and ``int min(tau ddelta, 0) dt``, by adaptive quadrature on
+  the step's dense output (independent of ``E``: the ledger's closure checks the flow);
+- ``damper_work`` [J] (<= 0): ``int dq . (Mdot dq / 2 - C dq) dt``, the part of ``-C dq``
+  that is not Christoffel's (zero without dampers: the Christoffel part does no work);
+- ``push_off_work`` [J]: kinetic energy after the push-off impulse minus before
+  (:meth:`walkerlab.models.hybrid.actuated.Actuators.transition`);
+- ``-heel_strike_loss`` [J]: kinetic energy lost in the plastic heel strike;
+- ``-internal_collision_loss`` [J]: knee strikes and foot slaps within the step;
+
+``closure = dE - (sum of the above)`` [J] is round-off and quadrature error (<= 1e-9 of the
+step's kinetic energy).  ``potential_work = -dV`` [J] is gravity's (and the springs') work.
+
+Cost of transport (Kuo 2002; Collins et al. 2005): ``(positive actuator work + push-off
+work + M g d sin(phi)^+) / (M g d)`` with ``M`` the walker's mass, ``d`` the step's length
+along the ground and ``M g d sin(phi)`` the potential energy the slope releases over it
+(nothing uphill).  A passive gait's is ``sin(phi)``; a powered gait on level ground's is the
+actuators' share alone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["LEDGER_NAMES", "LEDGER_UNITS", "step_ledger", "trajectory_ledger"]
+
+#: the ledger's columns, each (step,)
+LEDGER_NAMES = ("actuator_work_positive", "actuator_work_negative", "push_off_work",
+                "push_off_impulse", "heel_strike_loss", "internal_collision_loss",
+                "damper_work", "potential_work", "energy_change", "closure",
+                "slope_energy", "cost_of_transport")
+#: unit of each column
+LEDGER_UNITS = {**{k: "J" for k in LEDGER_NAMES}, "push_off_impulse": "N s",
+                "cost_of_transport": "-"}
+
+
+def _quad(f, a: float, b: float, scale: float) -> float:
+    from scipy.integrate import quad
+
+    if b <= a:
+        return 0.0
+    val, _ = quad(f, a, b, limit=400, epsabs=1e-13 * scale, epsrel=1e-12)
+    return float(val)
+
+
+def _damped(walker) -> bool:
+    """The walker has a damper (a spring-damper with c > 0 at the hip, a knee or an ankle)."""
+    return any(k.startswith(("c_s", "c_knee", "c_ankle")) and float(v) != 0.0
+               for k, v in walker.params.items())
+
+
+def _damper_power(walker, x) -> float:
+    """``dq . (Mdot dq / 2 - C dq)`` [W] at ``x`` (generated ``matrices``; ``Mdot dq`` by
+    the complex step along ``dq``)."""
+    fns = walker.matrices
+    if fns is None:
+        return 0.0
+    n = x.size // 2
+    q, dq = x[:n], x[n:]
+    M, C, _ = fns(x)
+    h = 1e-30
+    Mc = fns(np.concatenate([q + 1j * h * dq, dq]))[0]
+    Mdot = np.imag(Mc) / h
+    return float(dq @ (0.5 * Mdot @ dq - C @ dq))
+
+
+def step_ledger(walker, seg) -> dict[str, float]:
+    """The energy ledger of one step.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+        The walker of this step (legs that differ: ``walker.for_stance(seg.stance_leg)``).
+    seg : walkerlab.integrate.rigid.Segment
+        The step, ended by a heel strike (other ends: every entry NaN).
+
+    Returns
+    -------
+    dict[str, float]
+        :data:`LEDGER_NAMES` [J; ``push_off_impulse`` N s; ``cost_of_transport`` -].
+    """
+    out = dict.fromkeys(LEDGER_NAMES, np.nan)
+    if seg.termination != "heel_strike":
+        return out
+    acts = walker.actuators
+    g = float(walker.params["gravity_m_per_s2"])
+    m = float(walker.total_mass_kg)
+    ke0, pe0 = (float(v) for v in walker.energies(seg.x_start))
+    scale = max(ke0, 1e-12)
+    wpos = wneg = wdamp = internal = 0.0
+    damped = _damped(walker)
+    torques = acts is not None and bool(acts.spec.torques) and not acts.limit
+    prev_ke = None
+    n2 = seg.x_start.size
+    for _ph, sol, (ta, tb) in seg.pieces:
+        def x_at(t, sol=sol):
+            y = np.asarray(sol(np.atleast_1d(float(t))), float)
+            return (y[:, 0] if y.ndim == 2 else y)[:n2]
+
+        ke_a = float(walker.energies(x_at(ta))[0])
+        if prev_ke is not None:  # a reset inside the step: knee strike, foot slap
+            internal += prev_ke - ke_a
+        prev_ke = float(walker.energies(x_at(tb))[0])
+        if tb <= ta:
+            continue
+
+        if torques:
+            wpos += _quad(lambda t: max(acts.power(t, x_at(t)), 0.0), ta, tb, scale)
+            wneg += _quad(lambda t: min(acts.power(t, x_at(t)), 0.0), ta, tb, scale)
+        if damped:
+            wdamp += _quad(lambda t: _damper_power(walker, x_at(t)), ta, tb, scale)
+    ke_end, pe_end = (float(v) for v in walker.energies(seg.x_end))
+    pts = walker.points(seg.x_end)
+    step = np.asarray(pts["swing_foot"], float)
+    nxt = walker.for_stance(walker.role_to_leg(seg.stance_leg).get("swing", seg.stance_leg))
+    if acts is not None and acts.spec.push_off is not None:
+        tr = acts.transition(seg.x_end)
+        push, loss, impulse = tr["ke_push_off"] - tr["ke_minus"], \
+            tr["ke_push_off"] - tr["ke_plus"], float(tr["impulse"])
+        ke_plus = float(tr["ke_plus"])
+    else:
+        ke_plus = float(nxt.energies(seg.x_next)[0])
+        push, loss, impulse = 0.0, ke_end - ke_plus, 0.0
+    # the next stance foot (this step's swing foot) is step[1] higher in the world
+    pe_plus = float(nxt.energies(seg.x_next)[1]) + m * g * float(step[1])
+    d_e = (ke_plus + pe_plus) - (ke0 + pe0)
+    closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
+    d = float(np.hypot(*step))
+    slope_energy = m * g * d * np.sin(float(walker.slope_rad))
+    cot = (wpos + push + max(slope_energy, 0.0)) / (m * g * d)
+    out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
+               push_off_impulse=impulse, heel_strike_loss=loss,
+               internal_collision_loss=internal, damper_work=wdamp,
+               potential_work=-(pe_plus - pe0), energy_change=d_e, closure=closure,
+               slope_energy=slope_energy, cost_of_transport=cot)
+    return out
+
+
+def trajectory_ledger(traj) -> dict[str, np.ndarray]:
+    """:func:`step_ledger` of every step of a :class:`~walkerlab.integrate.rigid.
+    HybridTrajectory`, each column (steps,)."""
+    w = traj.walker
+    rows = {k: [] for k in LEDGER_NAMES}
+    for seg in traj.segments:
+        led = step_ledger(w.for_stance(seg.stance_leg), seg)
+        for k in LEDGER_NAMES:
+            rows[k].append(led[k])
+    return {k: np.asarray(v, float) for k, v in rows.items()}

@@ -1,0 +1,102 @@
+"""Actuators as parts of the walker (``walker.actuation``): a push-off impulse along the
+trailing leg before heel strike (Kuo 2002) and joint torques at the hip, each a law given
+as data.  A walker without the section is passive and its numbers are those of before.
+
+Units: N s for impulses, N m for torques, rad for angles (a ``units: nondimensional`` scene
+reads them as M √(g l) and M g l).  Sources: Kuo (2002), "Energetics of actively powered
+locomotion using the simplest walking model", J. Biomech. Eng. 124:113-120 (push-off,
+swing-hip torque); Westervelt, Grizzle & Koditschek (2003), IEEE TAC 48(1):42-56 (virtual
+constraints: PD tracking of a reference of a monotonic phase variable).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field, model_validator
+
+from walkerlab.config.base import Strict
+
+
+class PushOff(Strict):
+    """An impulse along the trailing (stance) leg, from its foot towards the hip, applied
+    immediately before heel strike (Kuo 2002's pre-emptive push-off: the step-to-step
+    transition is a push-off impulse, then the heel-strike collision).
+
+    ``P = impulse_n_s + speed_gain_n_s2_per_m * (reference_speed_m_per_s - v)``, ``v`` the
+    hip's speed just before heel strike; never negative (a foot can only push)."""
+
+    impulse_n_s: float = Field(ge=0, le=1e4, description="push-off impulse P [N s] (with a "
+                               "speed law: its value at the reference speed)")
+    speed_gain_n_s2_per_m: float = Field(0.0, ge=0, le=1e4, description="gain of the push-off "
+                                         "on the pre-impact hip speed's shortfall [N s^2/m]")
+    reference_speed_m_per_s: float = Field(0.0, ge=0, le=100, description="hip speed at which "
+                                           "the law gives impulse_n_s [m/s]")
+
+
+class PhaseReference(Strict):
+    """A reference of the hip angle (swing minus stance leg angle) as a function of a
+    monotonic phase variable of the step, the stance leg's absolute angle (Westervelt et al.
+    2003): a piecewise-linear or cubic-spline table, held at its end values outside."""
+
+    phase_rad: list[float] = Field(min_length=2, max_length=200, description="stance-leg "
+                                   "angles of the table, increasing [rad]")
+    hip_angle_rad: list[float] = Field(min_length=2, max_length=200, description="reference "
+                                       "swing minus stance angle at each phase [rad]")
+    interpolation: Literal["linear", "cubic"] = Field("cubic", description="piecewise-linear "
+                                                      "or not-a-knot cubic spline")
+
+    @model_validator(mode="after")
+    def _table(self) -> PhaseReference:
+        if len(self.phase_rad) != len(self.hip_angle_rad):
+            raise ValueError("phase_rad and hip_angle_rad need the same length")
+        if any(b <= a for a, b in zip(self.phase_rad, self.phase_rad[1:])):
+            raise ValueError("phase_rad must increase")
+        return self
+
+
+class TorqueLaw(Strict):
+    """A torque law of the joint angle ``delta`` and rate (hip: swing minus stance leg
+    angle): ``tau = constant_n_m - stiffness (delta - rest_angle_rad) - damping ddelta``
+    (constant, or spring-like as Kuo's swing-hip torque), or with ``reference`` a PD
+    tracking ``tau = -stiffness (delta - h_d(s)) - damping (ddelta - h_d'(s) ds)`` of a
+    reference of the phase variable ``s`` (a virtual constraint)."""
+
+    constant_n_m: float = Field(0.0, ge=-1e5, le=1e5, description="constant torque [N m]")
+    stiffness_n_m_per_rad: float = Field(0.0, ge=0, le=1e7, description="proportional gain "
+                                         "[N m/rad]")
+    damping_n_m_s_per_rad: float = Field(0.0, ge=0, le=1e6, description="derivative gain "
+                                         "[N m s/rad]")
+    rest_angle_rad: float = Field(0.0, ge=-3.2, le=3.2, description="angle where the "
+                                  "spring-like torque vanishes [rad]")
+    reference: PhaseReference | None = Field(None, description="track this reference of the "
+                                             "phase variable instead of rest_angle_rad")
+
+
+class JointTorque(Strict):
+    """A torque actuator at a joint shared by two links.  ``joint: hip``: between the legs,
+    ``+tau`` on the swing leg (positive moves its foot forward) and ``-tau`` on the stance
+    leg."""
+
+    joint: Literal["hip"] = Field(description="the joint (hip: between the two legs)")
+    law: TorqueLaw = Field(description="the torque law")
+    max_torque_n_m: float | None = Field(None, gt=0, le=1e6, description="saturation |tau| <= "
+                                         "max [N m] (null: none)")
+    scaled_by: Literal["none", "foot_mass"] = Field(
+        "none", description="'foot_mass' on a walker whose legs are massless (the simplest "
+        "walker, the limit m_foot -> 0): the law gives tau / m_foot [N m/kg], which stays "
+        "finite in the limit and acts on the swing leg only (Kuo 2002)")
+
+
+class Actuation(Strict):
+    """The walker's actuators (``walker.actuation``)."""
+
+    push_off: PushOff | None = Field(None, description="push-off impulse before heel strike")
+    torques: list[JointTorque] = Field(default_factory=list, max_length=8,
+                                       description="joint torque actuators")
+
+    @model_validator(mode="after")
+    def _something(self) -> Actuation:
+        if self.push_off is None and not self.torques:
+            raise ValueError("give push_off or torques (or leave actuation out)")
+        return self

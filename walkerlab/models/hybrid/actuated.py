@@ -1,0 +1,376 @@
+"""Actuators on a rigid hybrid walker: ``B(q) u`` in the flow (paper Eq. 3 with u != 0) and a
+push-off impulse in the reset (Kuo 2002's two-impulse step-to-step transition).
+
+Flow
+----
+``M(q) qdd + C(q, dq) dq + G(q) = B(q) tau``: each hip actuator's torque acts on the swing leg
+(``+tau``) and on the stance leg (``-tau``), so its generalised force is ``tau d(delta)/dq``
+with ``delta = psi_swing - psi_stance`` (the absolute leg angles; exact, from the generated
+leg angles' rates).  The generated passive flow is kept and the actuation added:
+``qdd = qdd_passive + M^-1 B tau``.  On a walker whose legs are massless (the limit
+``m_foot -> 0`` of the simplest walker, whose equations are the rows of the absolute leg
+angles divided by the foot mass), a torque ``scaled_by: foot_mass`` gives ``tau / m_foot``
+and acts on the swing row only (Kuo 2002: it stays finite there and does no work).
+
+Reset
+-----
+Push-off, then heel strike, then the roles swap.  The push-off is an impulse ``P`` at the
+trailing (stance) foot along the trailing leg, from the foot towards the hip, the foot being
+free for it; then the plastic heel strike pins the leading foot.  In the extended
+coordinates ``qe = (q, x_f, y_f)`` (stance foot free, :func:`impact_matrices` of the
+generated model: ``De`` its mass matrix, ``E`` the leading foot's Jacobian)::
+
+    De (dqe_po - dqe-) = E_f^T P e,        E_f = d(x_f, y_f)/dqe,  e = (hip - foot)/|.|
+    [De  -E^T] [dqe+]   [De dqe_po]
+    [E     0 ] [ F  ] = [    0    ]
+
+With ``P = 0`` this is the generated impact (tests show both to round-off).  A walker with
+massless legs (only the hip carries mass) has a singular ``De``: its transition is written
+for the hip mass directly: ``v_po = v- + (P / M) e``, the heel strike removes the velocity
+along the new stance leg, the trailing foot keeps no velocity across its leg (Kuo 2002,
+Eq. 2 and its appendix; ``tests/independent/actuated_compass.py`` derives both).
+
+States stay the walker's own (role-ordered ``(2n,)``): nothing here knows their number.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from walkerlab.models.hybrid.base import HybridWalker, Phase
+from walkerlab.numerics import complex_step_jacobian
+
+__all__ = ["Actuators", "actuate"]
+
+
+def _spline(table):
+    """``(h, dh)`` of a phase reference table (complex-safe to first order: a complex
+    argument ``s + i e`` gives ``h(s) + i e h'(s)``, what the complex step needs)."""
+    from scipy.interpolate import CubicSpline
+
+    s, y = np.asarray(table.phase_rad, float), np.asarray(table.hip_angle_rad, float)
+    if table.interpolation == "cubic" and len(s) >= 3:
+        cs = CubicSpline(s, y, bc_type="not-a-knot", extrapolate=False)
+        d1, d2 = cs.derivative(), cs.derivative(2)
+
+        def val(u, f, df):
+            r = np.clip(np.real(u), s[0], s[-1])
+            inside = (np.real(u) > s[0]) & (np.real(u) < s[-1])
+            return f(r) + (1j * np.imag(u) * df(r) * inside if np.iscomplexobj(u) else 0.0)
+
+        return (lambda u: val(u, cs, d1)), (lambda u: val(u, d1, d2) * (
+            (np.real(u) > s[0]) & (np.real(u) < s[-1])))
+    slope = np.diff(y) / np.diff(s)
+
+    def lin(u):
+        r = np.clip(np.real(u), s[0], s[-1])
+        k = np.clip(np.searchsorted(s, r) - 1, 0, len(s) - 2)
+        out = y[k] + slope[k] * (r - s[k])
+        inside = (np.real(u) > s[0]) & (np.real(u) < s[-1])
+        return out + (1j * np.imag(u) * slope[k] * inside if np.iscomplexobj(u) else 0.0)
+
+    def dlin(u):
+        r = np.real(u)
+        k = np.clip(np.searchsorted(s, r) - 1, 0, len(s) - 2)
+        return slope[k] * ((r > s[0]) & (r < s[-1]))
+
+    return lin, dlin
+
+
+def _saturate(tau, limit):
+    if limit is None:
+        return tau
+    re = np.real(tau)
+    return np.where(re > limit, limit, np.where(re < -limit, -limit, tau))
+
+
+@dataclass
+class Actuators:
+    """The actuators of one walker, bound to its generated model.
+
+    Attributes
+    ----------
+    spec : walkerlab.config.actuation.Actuation
+    fns : dict
+        The generated model's functions (``matrices``, ``impact_matrices``, ``points``,
+        ``leg_angles``, ``reset``, ``energies``).
+    n : int
+        Number of generalised coordinates.
+    limit : bool
+        The legs are massless (the walker's equations are the limit ``m_foot -> 0``).
+    hip_mass_kg : float
+    """
+
+    spec: object
+    fns: dict
+    n: int
+    limit: bool
+    hip_mass_kg: float
+
+    def __post_init__(self):
+        eye = np.eye(self.n)
+        la = self.fns["leg_angles"]
+        z = np.zeros(self.n)
+        # d(delta)/dq and the absolute leg angles' Jacobian A = d(psi_sw, psi_st)/dq, exact:
+        # the generated leg angles' rates are linear in dq
+        rows = [la(np.concatenate([z, eye[k]])) for k in range(self.n)]
+        self.A = np.array([[float(r["swing_rate"]) for r in rows],
+                           [float(r["stance_rate"]) for r in rows]])
+        self.ddelta_dq = self.A[0] - self.A[1]
+        self._refs = [(_spline(t.law.reference) if t.law.reference is not None else None)
+                      for t in self.spec.torques]
+
+    # ---------------------------------------------------------------- joint torques
+    def hip_angles(self, x):
+        """``(delta, ddelta, s, ds)``: hip angle (swing minus stance) [rad], its rate
+        [rad/s], the phase variable (stance angle) [rad] and its rate [rad/s]."""
+        d = self.fns["leg_angles"](x)
+        return (d["swing_angle"] - d["stance_angle"], d["swing_rate"] - d["stance_rate"],
+                d["stance_angle"], d["stance_rate"])
+
+    def torques(self, t, x) -> np.ndarray:
+        """Torque of each actuator (k,) [N m; N m/kg when ``scaled_by: foot_mass``] at the
+        state ``x`` (2n,) (complex-safe: the complex step differentiates through it)."""
+        delta, ddelta, s, ds = self.hip_angles(x)
+        out = []
+        for act, ref in zip(self.spec.torques, self._refs):
+            law = act.law
+            if ref is None:
+                err, derr = delta - law.rest_angle_rad, ddelta
+            else:
+                h, dh = ref
+                err, derr = delta - h(s), ddelta - dh(s) * ds
+            tau = law.constant_n_m - law.stiffness_n_m_per_rad * err \
+                - law.damping_n_m_s_per_rad * derr
+            out.append(_saturate(tau, act.max_torque_n_m))
+        return np.array(out)
+
+    def generalised_force(self, t, x):
+        """``B(q) tau`` (n,) in the rows of the generated ``M`` [N m]."""
+        tau = self.torques(t, x)
+        if self.limit:  # rows of the absolute leg angles, swing row first, / m_foot
+            col = np.zeros(self.n)
+            col[0] = 1.0
+        else:
+            col = self.ddelta_dq
+        return col * np.sum(tau)
+
+    def power(self, t, x) -> float:
+        """Mechanical power of the joint torques [W]: ``tau * ddelta`` (0 for torques scaled
+        by a massless foot's mass: they do no work in the limit)."""
+        if self.limit or not self.spec.torques:
+            return 0.0
+        return float(np.real(np.sum(self.torques(t, x)) * self.hip_angles(x)[1]))
+
+    def added_acceleration(self, t, x):
+        """``M^-1 B tau`` (n,) [rad/s^2]."""
+        M = self.fns["matrices"](x)[0]
+        return np.linalg.solve(M, self.generalised_force(t, x))
+
+    # ---------------------------------------------------------------- push-off
+    def hip_velocity(self, x) -> np.ndarray:
+        """Hip velocity (2,) [m/s] (world x forward, y up) of a pinned-stance state."""
+        n = self.n
+        q, dq = np.asarray(x[:n]), np.asarray(x[n:])
+        J = complex_step_jacobian(lambda qq: self.fns["points"](
+            np.concatenate([qq, np.zeros(n)]))["hip"], np.real(q)) if not np.iscomplexobj(x) \
+            else self._hip_jac_complex(q)
+        return J @ dq
+
+    def _hip_jac_complex(self, q):
+        n, h = self.n, 1e-7
+        cols = []
+        for k in range(n):
+            e = np.zeros(n)
+            e[k] = h
+            a = self.fns["points"](np.concatenate([q + e, np.zeros(n)]))["hip"]
+            b = self.fns["points"](np.concatenate([q - e, np.zeros(n)]))["hip"]
+            cols.append((np.asarray(a) - np.asarray(b)) / (2 * h))
+        return np.stack(cols, axis=1)
+
+    def impulse(self, x) -> float:
+        """Push-off impulse ``P`` [N s] for the pre-impact state ``x`` (>= 0)."""
+        po = self.spec.push_off
+        if po is None:
+            return 0.0
+        if po.speed_gain_n_s2_per_m == 0.0:
+            return po.impulse_n_s
+        v = self.hip_velocity(x)
+        speed = np.sqrt(v @ v)
+        p = po.impulse_n_s + po.speed_gain_n_s2_per_m * (po.reference_speed_m_per_s - speed)
+        return np.where(np.real(p) > 0.0, p, 0.0 * p)
+
+    def _relabel(self, q):
+        """New coordinates (n,) after the role swap and the rate map ``R`` (n, n) (exact:
+        ``A^-1 S A`` with ``S`` the swap of the two legs' absolute angles)."""
+        qn = np.real(self.fns["reset"](np.concatenate([np.real(q), np.zeros(self.n)]))[:self.n])
+        S = np.array([[0.0, 1.0], [1.0, 0.0]])
+        R = np.linalg.pinv(self.A) @ S @ self.A
+        return qn, R
+
+    def transition(self, x) -> dict:
+        """Push-off and heel strike from the pre-impact state ``x`` (2n,).
+
+        Returns
+        -------
+        dict
+            ``x_plus`` (2n,) the post-impact state, roles swapped; ``impulse`` P [N s];
+            ``ke_minus``, ``ke_push_off``, ``ke_plus`` kinetic energies [J] before the
+            push-off, after it and after the heel strike.
+        """
+        n = self.n
+        x = np.asarray(x)
+        q, dq = x[:n], x[n:]
+        P = self.impulse(x)
+        if self.limit:
+            return self._transition_point_hip(x, P)
+        De, E = self.fns["impact_matrices"](q)
+        De, E = np.asarray(De), np.asarray(E)
+        r = np.asarray(self.fns["points"](x)["hip"])  # from the stance foot at the origin
+        e = r / np.sqrt(r @ r)
+        dqe = np.concatenate([dq, np.zeros(2)])
+        Ef = np.zeros((2, n + 2))
+        Ef[:, n:] = np.eye(2)
+        dqe_po = dqe + np.linalg.solve(De, Ef.T @ (P * e))
+        K = np.block([[De, -E.T], [E, np.zeros((2, 2))]])
+        sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(2)]))
+        dq_plus = sol[:n]
+        qn, R = self._relabel(np.real(q))
+        qn = qn + R @ (q - np.real(q))  # the swap is affine: exact for a complex step too
+        ke = (0.5 * dqe @ De @ dqe, 0.5 * dqe_po @ De @ dqe_po, 0.5 * sol[:n + 2] @ De
+              @ sol[:n + 2])
+        return {"x_plus": np.concatenate([qn, R @ dq_plus]),
+                "impulse": P, "ke_minus": ke[0], "ke_push_off": ke[1], "ke_plus": ke[2]}
+
+    def _transition_point_hip(self, x, P):
+        n, M = self.n, self.hip_mass_kg
+        q, dq = x[:n], x[n:]
+        pts = self.fns["points"](x)
+        J = self._hip_jac_complex(np.real(q)) if np.iscomplexobj(x) else \
+            complex_step_jacobian(lambda qq: self.fns["points"](
+                np.concatenate([qq, np.zeros(n)]))["hip"], q)
+        v = J @ dq
+        hip, lead = np.asarray(pts["hip"]), np.asarray(pts["swing_foot"])
+        et = hip / np.sqrt(hip @ hip)          # trailing leg: stance foot at the origin
+        el = (hip - lead) / np.sqrt((hip - lead) @ (hip - lead))
+        v_po = v + (P / M) * et
+        v_plus = v_po - (v_po @ el) * el
+        v_foot = (v_plus @ et) * et            # the trailing foot: no velocity across its leg
+        qn, R = self._relabel(np.real(q))
+        qn_real = qn
+        qn = qn + R @ (q - np.real(q))
+        zero = np.zeros(n)
+
+        def jac(name):
+            return complex_step_jacobian(lambda qq: self.fns["points"](
+                np.concatenate([qq, zero]))[name], qn_real)
+        Jn = np.vstack([jac("hip"), jac("swing_foot")])
+        dq_plus = np.linalg.lstsq(Jn, np.concatenate([v_plus, v_foot]), rcond=None)[0] \
+            if not np.iscomplexobj(x) else np.linalg.pinv(Jn) @ np.concatenate([v_plus, v_foot])
+        ke = (0.5 * M * (v @ v), 0.5 * M * (v_po @ v_po), 0.5 * M * (v_plus @ v_plus))
+        return {"x_plus": np.concatenate([qn, dq_plus]), "impulse": P, "ke_minus": ke[0],
+                "ke_push_off": ke[1], "ke_plus": ke[2]}
+
+    def reset(self, x) -> np.ndarray:
+        """Post-impact state (2n,) after push-off and heel strike (roles swapped)."""
+        return self.transition(x)["x_plus"]
+
+
+def _structure_check(data, spec) -> bool:
+    """Refuse what this actuation does not handle (one line); True for massless legs."""
+    st = data.structure
+    if st.knee or st.foot != "point":
+        raise ValueError("walker.actuation: actuators need straight legs with point feet "
+                         "today (knees, arc and flat feet: not yet)")
+    massless = [b.massless for b in st.bodies]
+    limit = bool(massless) and all(massless)
+    if any(massless) and not limit:
+        raise ValueError("walker.actuation: legs with some massless bodies are not supported")
+    if limit and (st.torso or not st.hip_mass):
+        raise ValueError("walker.actuation: massless legs need a hip mass and no torso")
+    for i, t in enumerate(spec.torques):
+        if limit and t.scaled_by != "foot_mass":
+            raise ValueError(f"walker.actuation.torques.{i}.scaled_by: the legs are massless "
+                             "(a torque on them needs infinite acceleration): give the torque "
+                             "per foot mass, scaled_by: foot_mass (Kuo 2002)")
+        if not limit and t.scaled_by != "none":
+            raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
+                             "walkers whose legs are massless")
+    return limit
+
+
+def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
+    """The walker with its actuators: every phase's flow gains ``M^-1 B tau`` (and its
+    Jacobian the derivative of it, by the complex step), the heel-strike reset becomes
+    push-off + heel strike (:meth:`Actuators.transition`; its Jacobian by the complex step).
+
+    Parameters
+    ----------
+    walker : HybridWalker
+        The passive walker built from ``data`` (legs that differ: its ``mirror`` too).
+    data : walkerlab.walker.description.WalkerData
+    spec : walkerlab.config.actuation.Actuation
+
+    Returns
+    -------
+    HybridWalker
+        With ``actuators`` set; no compiled flows (the actuation is evaluated in Python).
+
+    Raises
+    ------
+    ValueError
+        A walker this actuation does not handle (knees, arc or flat feet, partly massless
+        legs) or a torque scaling that does not fit the legs (one line).
+    """
+    from walkerlab.codegen.cache import functions
+
+    limit = _structure_check(data, spec)
+    fns = functions(data)
+    acts = Actuators(spec, fns, len(walker.roles), limit, float(walker.total_mass_kg))
+    base_jac = walker.variational
+    has_torque = bool(spec.torques)
+
+    def flow_of(flow):
+        if not has_torque:
+            return flow
+
+        def f(t, x):
+            out = np.array(flow(t, x), dtype=complex if np.iscomplexobj(x) else float)
+            out[acts.n:] += acts.added_acceleration(t, x)
+            return out
+        return f
+
+    def jac_of(flow, jac):
+        if not has_torque:
+            return jac
+
+        def J(t, x):
+            base = np.array(jac(t, x), float)
+            base[acts.n:] += complex_step_jacobian(
+                lambda z: acts.added_acceleration(t, z), np.asarray(x, float))
+            return base
+        return J
+
+    phases = []
+    for ph in walker.phases:
+        jac = ph.jacobian or base_jac
+        guards = tuple(replace(g) for g in ph.guards)
+        phases.append(Phase(ph.name, flow_of(ph.flow), guards, jacobian=jac_of(ph.flow, jac),
+                            variational=None if has_torque else ph.variational,
+                            compiled=None if has_torque else ph.compiled))
+    reset = walker.reset
+    reset_jac = walker.reset_jacobian
+    if spec.push_off is not None:
+        reset = acts.reset
+
+        def reset_jac(x):
+            return complex_step_jacobian(acts.reset, x)
+    mirror = walker.mirror
+    if mirror is not None:
+        mirror = actuate(mirror, data.mirror, spec)
+    return replace(walker, phases=tuple(phases), reset=reset, reset_jacobian=reset_jac,
+                   variational=jac_of(None, base_jac) if has_torque else base_jac,
+                   mirror=mirror, actuators=acts)
+
