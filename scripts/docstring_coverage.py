@@ -58,7 +58,8 @@ UNIT_RE = re.compile(
 RAISES_RE = re.compile(r"^\s*Raises\s*\n\s*-{3,}", re.M)
 SOURCE_RE = re.compile(
     r"\bEqs?\.|\bet al\.|\bpaper\b|\b[A-Z][a-z]+(?: & [A-Z][a-z]+)? \(?(19|20)\d\d\b|"
-    r"\bSection \d|\bsec\. \d|\bTable \d|\bFig\. \d|\bTedrake|\bStrogatz|\bHairer", re.I)
+    r"\bSection \d|\bsec\. \d|\bTable \d|\bFig\. \d|\bTedrake|\bStrogatz|\bHairer|"
+    r"MSC Adams|Adams/(Solver|View)|NOTES\.md|module docstring", re.I)
 
 ARRAY_ANN_RE = re.compile(r"ndarray|ArrayLike|NDArray|np\.array")
 ARRAY_NAMES = {
