@@ -48,9 +48,10 @@ from pathlib import Path
 FRONT = ("cli", "api", "stages")
 QUALITIES = ("docstring", "shapes", "units", "errors", "source")
 
+_DIM = r"\d*\s*[a-zA-Z_]*(?:\s*[-+*/]\s*\d*\s*[a-zA-Z_]*)*"  # n, 2n, 2 nq, n - 1, 2 n + 1
 SHAPE_RE = re.compile(
-    r"shape|\(\s*\d*[a-zA-Z_]*\s*,\s*\)|ndarray\s*\(|\(\s*\d*[a-zA-Z_]+\s*,\s*\d*[a-zA-Z_]+"
-    r"(\s*,\s*\d*[a-zA-Z_]+)*\s*\)|\bscalar\b|\bn[_ ]?(rows|points|steps)\b")
+    r"shape|ndarray\s*\(|\bscalar\b|\bn[_ ]?(rows|points|steps)\b|"
+    rf"\(\s*{_DIM}\s*,\s*\)|\(\s*{_DIM}\s*,\s*{_DIM}(\s*,\s*{_DIM})*\s*\)")
 UNIT_RE = re.compile(
     r"\[(-|1|rad|deg|m|mm|s|ms|kg|N|J|W|Hz|rad/s|m/s|N m|N s/m|kg m\^?2|[^\]\n]{0,20}"
     r"(rad|m|s|kg|N|J|W|Hz|g|l)\b[^\]\n]{0,12})\]|\bunits?\b|\bSI\b|dimensionless|"
