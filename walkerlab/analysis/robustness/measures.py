@@ -70,11 +70,9 @@ def _indicators(sm: BatchStepMap, res) -> np.ndarray:
 def one_step(sm: BatchStepMap, X: np.ndarray, disturbance: str, e: np.ndarray):
     """One step of rows ``X`` (N, 2n) with disturbance values ``e`` (N,).
 
-    Returns ``(x_next (N, 2n), indicators (N, 3), ok (N,))``.
-
-    ``X`` are post-impact states in the walker's ``state_names()`` order [rad, rad/s]; ``e``
-    is in the disturbance's unit (:data:`UNITS`: [rad], [m] or [m/s]); the indicators are
-    :data:`INDICATORS` ([s], [m], [rad]; NaN where ``ok`` is False).
+    Returns ``(x_next (N, 2n), indicators (N, 3), ok (N,))``.  ``X``: post-impact states
+    (``state_names()``, [rad, rad/s]); ``e`` in :data:`UNITS` ([rad], [m] or [m/s]);
+    indicators :data:`INDICATORS` ([s], [m], [rad]; NaN where not ``ok``).
 
     Raises
     ------
@@ -104,16 +102,8 @@ class Linearisation:
     """``dx' = A dx + B e``, ``dy = C dx + D e`` at the gait for one disturbance
     (Hobbelen & Wisse 2007, Eq. 5-8).
 
-    Attributes
-    ----------
-    A : ndarray, shape (2n, 2n)
-        Poincaré-map Jacobian (post-impact to post-impact) [state unit / state unit].
-    B : ndarray, shape (2n,)
-        Response of the next post-impact state to the disturbance [state unit / :data:`UNITS`].
-    C : ndarray, shape (3, 2n)
-        Response of the :data:`INDICATORS` ([s], [m], [rad]) to the state.
-    D : ndarray, shape (3,)
-        Response of the indicators to the disturbance.
+    Shapes: ``A`` (2n, 2n) the Poincaré-map Jacobian; ``B`` (2n,) per unit of disturbance
+    (:data:`UNITS`); ``C`` (3, 2n) and ``D`` (3,) of the :data:`INDICATORS` ([s], [m], [rad]).
     """
 
     A: np.ndarray
@@ -133,22 +123,8 @@ def linearise(sm: BatchStepMap, x_star: np.ndarray, A: np.ndarray, disturbance: 
               h_rel: float = 1e-6) -> Linearisation:
     """``B, C, D`` by central differences of the one-step map (``A`` given: the variational
     Jacobian, shape (2n, 2n)); state steps ``h_rel (1 + |x_i|)``, disturbance step
-    ``h_rel`` (in the disturbance's unit, :data:`UNITS`).
-
-    Parameters
-    ----------
-    sm : BatchStepMap
-    x_star : ndarray, shape (2n,)
-        The gait's post-impact fixed point (``state_names()`` order, [rad, rad/s]).
-    A : ndarray, shape (2n, 2n)
-        The Poincaré-map Jacobian at ``x_star``.
-    disturbance : {"slope", "floor_height", "push"}
-    h_rel : float
-        Relative difference step [-].
-
-    Returns
-    -------
-    Linearisation
+    ``h_rel`` [-] (in the disturbance's unit, :data:`UNITS`); ``x_star`` (2n,) the gait's
+    post-impact fixed point (``state_names()``, [rad, rad/s]).
 
     Raises
     ------
@@ -179,23 +155,9 @@ def gsn_nonlinear(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, e: flo
     """The GSN from the nonlinear map: impulse ``e`` on step 0, then the undisturbed map for
     ``steps`` steps; ``sqrt(sum_k |y_k - y*|^2) / |e|``.  Uses the same ``+e`` and ``-e``
     impulses and halves their difference (central), so the error is O(e^2) relative.
-    (Hobbelen & Wisse 2007's GSN as the nonlinear response; module docstring.)
-
-    Parameters
-    ----------
-    sm : BatchStepMap
-    x_star : ndarray, shape (2n,)
-        The gait's post-impact fixed point [rad, rad/s].
-    disturbance : {"slope", "floor_height", "push"}
-    e : float
-        Impulse size in the disturbance's unit (:data:`UNITS`: [rad], [m], [m/s]).
-    steps : int
-        Steps summed.
-
-    Returns
-    -------
-    float
-        The GSN [indicator units (s, m, rad) per disturbance unit].
+    (Hobbelen & Wisse 2007's GSN as the nonlinear response.)  ``x_star`` (2n,) [rad,
+    rad/s]; ``e`` in :data:`UNITS`; the GSN in indicator units ([s], [m], [rad]) per unit
+    of ``e``.
 
     Raises
     ------
@@ -242,18 +204,8 @@ def state_gsn(lin: Linearisation, T: np.ndarray | None = None) -> float:
     """The sensitivity norm with the post-impact *state* as the indicator, in coordinates
     ``z = T x`` (Jin et al. 2021: such a norm depends on the coordinates):
     ``sqrt(trace(T W T^T))`` with ``W`` as in :meth:`Linearisation.gsn`, including the
-    first step's ``B``.
-
-    Parameters
-    ----------
-    lin : Linearisation
-    T : ndarray, shape (2n, 2n), optional
-        Coordinate change (:func:`relative_coordinates`); default the identity.
-
-    Returns
-    -------
-    float
-        The norm [state units ([rad], [rad/s]) per disturbance unit, :data:`UNITS`].
+    first step's ``B``.  ``T`` (2n, 2n): :func:`relative_coordinates` or None (identity);
+    the norm is in state units ([rad], [rad/s]) per disturbance unit (:data:`UNITS`).
     """
     from scipy.linalg import solve_discrete_lyapunov
 
@@ -272,18 +224,8 @@ def largest_tolerable(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
     (one batch), and the answer is the largest value below the first that falls (so a
     survivable value above a fatal one is not counted).
 
-    Parameters
-    ----------
-    sm : BatchStepMap
-    x_star : ndarray, shape (2n,)
-        The gait's post-impact fixed point [rad, rad/s].
-    disturbance : {"slope", "floor_height", "push"}
-    max_value, resolution : float
-        Grid end and spacing, in the disturbance's unit (:data:`UNITS`).
-    steps : int
-        Undisturbed steps after the disturbed one.
-    sign : float
-        +1 or -1: the disturbance's direction.
+    ``x_star`` (2n,): the gait's post-impact fixed point [rad, rad/s]; ``max_value`` and
+    ``resolution`` in the disturbance's unit (:data:`UNITS`); ``sign`` +1 or -1.
 
     Returns
     -------

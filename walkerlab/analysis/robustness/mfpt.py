@@ -81,25 +81,8 @@ def draw_slopes(seed: int, walk: int, n: int, mean: float, sd: float,
     """The slopes [rad] of the first ``n`` steps of walk number ``walk`` (reproducible).
 
     ``distribution``: ``normal`` (mean, standard deviation ``sd``) or ``uniform`` (on
-    ``mean -/+ sqrt(3) sd``, the same standard deviation); the stream is
-    ``SeedSequence(seed, spawn_key=(walk,))``, so a walk's slopes do not depend on how walks
-    are grouped.
-
-    Parameters
-    ----------
-    seed, walk : int
-        The run's seed and the walk's number.
-    n : int
-        Number of steps.
-    mean, sd : float
-        Mean and standard deviation of the slope [rad].
-    distribution : {"normal", "uniform"}
-        Any other value draws from the normal.
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        Slopes [rad].
+    ``mean -/+ sqrt(3) sd``, the same standard deviation; any other value: normal); stream
+    ``SeedSequence(seed, spawn_key=(walk,))``.  ``mean``, ``sd`` [rad]; returns shape (n,).
     """
     rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(int(walk),)))
     if distribution == "uniform":
@@ -228,21 +211,9 @@ def whitening(P: np.ndarray, rank_tol: float = 1e-10) -> np.ndarray:
     knee's equal thigh and shank angles) drop out, so ``d`` is the dimension of the set the
     post-impact states fill (4 for a compass walker on per-step slopes).
 
-    The whitening (PCA) transform: ``W = V diag(w)^(-1/2)`` over the eigenpairs ``(w, V)``
-    of the cloud's covariance with ``w`` above ``rank_tol`` times the largest.
-
-    Parameters
-    ----------
-    P : ndarray, shape (k, 2n)
-        Post-impact states in the walker's ``state_names()`` order [rad, rad/s].
-    rank_tol : float
-        Relative eigenvalue below which a direction counts as without spread [-].
-
-    Returns
-    -------
-    ndarray, shape (2n, d)
-        Each column in [1 / unit of the state]: the whitened coordinates are dimensionless
-        (standard deviations).
+    PCA whitening, ``W = V diag(w)^(-1/2)`` over the covariance's eigenpairs with ``w >
+    rank_tol max(w)``; ``P`` in ``state_names()`` order [rad, rad/s], ``W`` in [1 / state
+    unit], so the whitened coordinates are dimensionless [standard deviations].
     """
     w, V = np.linalg.eigh(np.cov(np.asarray(P, float).T))
     keep = w > rank_tol * w.max()
@@ -274,10 +245,8 @@ class MeshResult:
         Step-map evaluations this mesh computed (the cached images not counted).
     expected_steps : ndarray, shape (cells,)
         Expected heel strikes before the fall from each node [steps].
-    change : float
-        Relative change [-] of ``mfpt_steps`` from the previous (coarser) mesh.
-    converged : bool
-        The refinement criterion of :func:`mesh_mfpt_converged` was met.
+    change, converged : float, bool
+        Relative change [-] from the coarser mesh; :func:`mesh_mfpt_converged` criterion met.
     """
 
     mfpt_steps: float
@@ -295,13 +264,7 @@ class MeshResult:
 
 def gauss_hermite(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarray]:
     """Nodes [rad] and weights (sum 1) of the normal distribution N(mean, sd^2)
-    (``numpy.polynomial.hermite_e.hermegauss``).
-
-    Returns
-    -------
-    (nodes, weights) : ndarray, shape (n,) each
-        Slopes [rad] and probabilities [-].
-    """
+    (``numpy.polynomial.hermite_e.hermegauss``); each of shape (n,)."""
     from numpy.polynomial.hermite_e import hermegauss
 
     z, w = hermegauss(n)
@@ -311,13 +274,8 @@ def gauss_hermite(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarra
 def gauss_legendre_uniform(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarray]:
     """Nodes [rad] and weights (sum 1) of the uniform distribution on
     ``mean -/+ sqrt(3) sd`` (standard deviation ``sd``; :func:`draw_slopes`'s uniform),
-    Gauss-Legendre (``numpy.polynomial.legendre.leggauss``) mapped to that interval.
-
-    Returns
-    -------
-    (nodes, weights) : ndarray, shape (n,) each
-        Slopes [rad] and probabilities [-].
-    """
+    Gauss-Legendre (``numpy.polynomial.legendre.leggauss``) mapped to that interval; each
+    of shape (n,)."""
     from numpy.polynomial.legendre import leggauss
 
     z, w = leggauss(n)
@@ -330,10 +288,8 @@ def slope_quadrature(n: int, mean: float, sd: float, distribution: str = "normal
 
     Parameters
     ----------
-    n : int
-        Number of nodes.
-    mean, sd : float
-        Mean and standard deviation of the slope [rad].
+    n, mean, sd : int, float, float
+        Number of nodes; mean and standard deviation of the slope [rad].
     distribution : {"normal", "uniform"}
         Gauss-Hermite (:func:`gauss_hermite`) or Gauss-Legendre on the uniform's support
         (:func:`gauss_legendre_uniform`).
@@ -404,18 +360,8 @@ def solve_mesh(Q, start: int):
     quasi-stationary distribution (k,))`` of the absorbing chain with transient block ``Q``
     (k, k) (heel strikes = transitions - 1): ``(I - Q) m = 1``
     (:func:`scipy.sparse.linalg.spsolve`) and the largest eigenvalue of ``Q`` with its left
-    eigenvector (:func:`scipy.sparse.linalg.eigs`).
-
-    The absorbing Markov chain's expected time to absorption (Byl & Tedrake 2009; module
-    docstring, "Mesh"); every count is in heel strikes [steps], ``lambda_2`` [-].
-
-    Parameters
-    ----------
-    Q : scipy.sparse matrix, shape (k, k)
-        Transient block (:func:`transition_matrix`).
-    start : int
-        Row of the start node (the gait).
-    """
+    eigenvector (:func:`scipy.sparse.linalg.eigs`): the absorbing chain's expected time to
+    absorption (Byl & Tedrake 2009); counts in heel strikes [steps], ``lambda_2`` [-]."""
     from scipy.sparse import identity
     from scipy.sparse.linalg import ArpackNoConvergence, eigs, spsolve
 
@@ -438,14 +384,8 @@ def voxel_nodes(Z: np.ndarray, cells: int) -> tuple[np.ndarray, float]:
     bisected so that about ``cells`` voxels are occupied (row 0, the gait, always in).
 
     ``Z`` (k, d): the states in the whitened chart.  Nodes spread evenly over the visited
-    region, so the tails (where the falls start) are meshed as finely as the core.
-
-    Returns
-    -------
-    (indices, r) : ndarray of int (c,), float
-        Rows of ``Z`` chosen (sorted, 0 among them) and the voxel side ``r`` in the whitened
-        chart's unit [standard deviations; dimensionless].
-    """
+    region, so the tails (where the falls start) are meshed as finely as the core.  The
+    indices have shape (c,); ``r`` is in standard deviations (dimensionless)."""
     lo, hi = 1e-3, 10.0
     best = None
     for _ in range(40):
