@@ -19,7 +19,8 @@ def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], x, steps, *, central: b
 
     Column ``k`` is ``(fun(x + h_k e_k) - fun(x - h_k e_k)) / (2 h_k)`` (central, error
     O(h²)) or ``(fun(x + h_k e_k) - f0) / h_k`` (forward, error O(h), ``n`` calls instead
-    of ``2n``); ``fun(x + h e)`` is always called before ``fun(x - h e)``.
+    of ``2n``); ``fun(x + h e)`` is always called before ``fun(x - h e)`` (Nocedal & Wright,
+    "Numerical Optimization", 2nd ed. 2006, sec. 8.1).
 
     Parameters
     ----------
@@ -69,7 +70,8 @@ def complex_step_jacobian(fun: Callable[[np.ndarray], np.ndarray], x,
     Parameters
     ----------
     fun : callable ``(m,) -> (p,)``
-        Must accept complex input.
+        Must accept complex input (units of its output per unit of ``x``, as
+        :func:`fd_jacobian`).
     x : array_like, shape (m,)
     h : float
         Imaginary step (any tiny value: no subtraction, no cancellation).

@@ -39,6 +39,7 @@ class Units:
 
     @property
     def nondimensional(self) -> bool:
+        """True for the nondimensional system (g = 1; Garcia et al. 1998's units)."""
         return self.system == NONDIMENSIONAL
 
     def __call__(self, si: str) -> str:
@@ -51,10 +52,12 @@ class Units:
     # the dimensions the report and the figures name most often
     @property
     def time(self) -> str:
+        """Label of a time: ``s`` in SI, ``√(l/g)`` nondimensional."""
         return self("s")
 
     @property
     def length(self) -> str:
+        """Label of a length: ``m`` in SI, ``l`` nondimensional."""
         return self("m")
 
     @property
@@ -70,14 +73,17 @@ class Units:
 
     @property
     def speed(self) -> str:
+        """Label of a speed: ``m/s`` in SI, ``√(g l)`` nondimensional."""
         return self("m/s")
 
     @property
     def rate(self) -> str:
+        """Label of an angular rate: ``rad/s`` in SI, ``rad/√(l/g)`` nondimensional."""
         return self("rad/s")
 
     @property
     def energy(self) -> str:
+        """Label of an energy: ``J`` in SI, ``M g l`` nondimensional."""
         return self("J")
 
     def sentence(self) -> str:

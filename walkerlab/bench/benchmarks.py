@@ -22,12 +22,21 @@ from walkerlab.io.schemas.continuation import initial_state
 
 
 def machine() -> dict:
+    """The machine a benchmark ran on: architecture, processor, CPU count, Python version and
+    the 1-minute load average (None where the platform has none)."""
     return {"machine": platform.machine(), "processor": platform.processor(),
             "cpus": os.cpu_count(), "python": platform.python_version(),
             "loadavg_1min": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
 
 
 def paper_scene():
+    """The default scene (``configs/paper.yaml``), loaded and validated.
+
+    Raises
+    ------
+    SceneError
+        The scene file is missing or does not validate (:func:`load_scene`).
+    """
     from walkerlab.config import default_scene_path as default_scene
     from walkerlab.config import load_scene
 
@@ -100,7 +109,11 @@ def bench_fixedpoint(runs: int = 5) -> dict:
 
 
 def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
-    """``walkerlab basin --grid 200x200 --force`` on the paper scene, whole process."""
+    """``walkerlab basin --grid 200x200 --force`` on the paper scene, whole process.
+
+    ``grid``: ``"<nx>x<ny>"`` cells; the result carries the wall time [s] against a
+    ``target_s`` of 120 s and the cells per outcome.
+    """
     with tempfile.TemporaryDirectory() as d:
         subprocess.run(_cli("fixedpoint", "--runs-dir", d), check=True, capture_output=True)
         cmd = _cli("basin", "--grid", grid, "--workers", str(workers), "--force",
@@ -116,6 +129,8 @@ def bench_basin(grid: str = "200x200", workers: int = 2) -> dict:
 
 
 def scene_line(res: dict) -> str:
+    """One line of a scene's result ``res`` in :func:`bench_contact_scenes`: per method the
+    median wall time [s] that reached the target error [rad], or that it did not."""
     parts = []
     for method, t in res["target"].items():
         if t["reached"]:

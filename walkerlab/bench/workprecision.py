@@ -131,7 +131,11 @@ def contact_runner(scene, x0: np.ndarray, step_period: float, strides: int):
 
 # ------------------------------------------------------------------ cached, parallel cases
 class Case(NamedTuple):
-    """One timed case (picklable: it travels to a worker process)."""
+    """One timed case (picklable: it travels to a worker process).
+
+    ``x0`` is the start state as a tuple of 2n floats (the rigid walker's ``state_names()``,
+    [rad, rad/s]); ``rtol`` [-] and ``atol`` [rad, rad/s] the integrator's tolerances.
+    """
 
     key: str
     model: str

@@ -61,7 +61,13 @@ def reference_method() -> str:
 
 def plan(scene: Scene) -> dict:
     """``{model: (methods, rtols, atol_factor, reference (method, rtol, atol), target error,
-    scene sections of the model)}`` of the scene's ``workprecision`` section."""
+    scene sections of the model)}`` of the scene's ``workprecision`` section.
+
+    Raises
+    ------
+    ValueError
+        The scene has no ``workprecision`` section.
+    """
     wp = scene.workprecision
     if wp is None:
         raise ValueError(f"scene '{scene.name}' has no 'workprecision' section")

@@ -59,9 +59,10 @@ _ENTRY: dict = {}
 def dense_rows(dense, cols: np.ndarray, t: np.ndarray) -> np.ndarray:
     """DOP853 dense output of some components at per-row times.
 
-    ``cols`` (k, m) component indices of the stacked state, ``t`` (k,) times in the step;
-    returns (k, m).  Same arithmetic as ``scipy.integrate._ivp.rk.Dop853DenseOutput``
-    (``F``, ``t_old``, ``h``, ``y_old``), restricted to the rows asked for."""
+    ``cols`` (k, m) component indices of the stacked state, ``t`` (k,) times [s] in the step;
+    returns (k, m), each component in its state's unit ([rad], [rad/s]).  Same arithmetic as
+    ``scipy.integrate._ivp.rk.Dop853DenseOutput`` (``F``, ``t_old``, ``h``, ``y_old``),
+    restricted to the rows asked for."""
     x = ((t - dense.t_old) / dense.h)[:, None]
     y = np.zeros(cols.shape)
     for i, f in enumerate(reversed(dense.F)):
@@ -73,7 +74,9 @@ def dense_rows(dense, cols: np.ndarray, t: np.ndarray) -> np.ndarray:
 class StackedRows:
     """The stacked system of one phase's rows: every row's compiled flow in one kernel call,
     the guard values (a footfall drop's heel strike on the swing foot's clearance), the
-    DOP853 integrator and the location of the guards' crossings."""
+    DOP853 integrator (Hairer, Nørsett & Wanner, "Solving Ordinary Differential Equations
+    I", 2nd ed. 1993, sec. II.10; scipy's ``DOP853``) and the location of the guards'
+    crossings."""
 
     def __init__(self, cfunc, n_extra: int, gcols, goffs, nc: int, m: int, drop: bool,
                  hs: int | None, clear: int | None):
@@ -82,7 +85,8 @@ class StackedRows:
         self.drop, self.hs, self.clear = drop, hs, clear
 
     def guards(self, Yr: np.ndarray, Dr: np.ndarray) -> np.ndarray:
-        """Guard values (k, g) of the rows ``Yr`` (k, m) with data ``Dr``."""
+        """Guard values (k, g) of the rows ``Yr`` (k, m) with data ``Dr`` (k, c); a guard is
+        in its own unit (a clearance [m] or an angle [rad]), its sign is what counts."""
         dY = np.empty_like(Yr)
         G = np.empty((Yr.shape[0], self.n_extra))
         _entry(self.kern, self.cfunc, np.ascontiguousarray(Yr),
@@ -96,7 +100,12 @@ class StackedRows:
     def solver(self, Y0: np.ndarray, Dr: np.ndarray, t0: float, h: float | None,
                t_span: float, rtol: float, atol: float):
         """DOP853 on the stacked rows ``Y0`` from ``t0`` (first step ``h``) up to ``t_span``
-        [s] past it, at the per-walker tolerances (module docstring)."""
+        [s] past it, at the per-walker tolerances (module docstring).
+
+        ``Y0`` (k, m): the rows' states ([rad], [rad/s]); ``Dr`` (k, c): their data vectors;
+        ``t0`` and ``h`` [s]; ``rtol``, ``atol`` [-] and [state unit].  The integrator's
+        state is ``Y0`` flattened, shape (k m,).
+        """
         from scipy.integrate import DOP853
 
         m, kern, cfunc, n_extra = self.m, self.kern, self.cfunc, self.n_extra
@@ -114,7 +123,8 @@ class StackedRows:
     def locate(self, hit, G_old, G_new, dense, t_new: float, Dk, te, which) -> None:
         """The first crossing of each row whose guards changed sign in the step (``hit``
         (k, g)): its time in the step into ``te`` (k,) and its guard into ``which``, located
-        on the dense output by Chandrupatla's method (``find_root``, vectorised)."""
+        on the dense output by Chandrupatla's method (``find_root``, vectorised).  ``t_new``
+        and the located times ``te`` are in [s]; ``G_old``, ``G_new`` (k, g) guard values."""
         from scipy.optimize.elementwise import find_root
 
         m = self.m

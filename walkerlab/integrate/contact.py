@@ -147,7 +147,13 @@ class ContactIntegration:
 
 
 def sample_grid(t0: float, t1: float, rate: float) -> np.ndarray:
-    """Sample times from ``t0`` to ``t1`` [s] at ``rate`` [Hz], ``t1`` always included."""
+    """Sample times from ``t0`` to ``t1`` [s] at ``rate`` [Hz], ``t1`` always included.
+
+    Returns
+    -------
+    ndarray, shape (k,)
+        Increasing times [s].
+    """
     n = int(np.floor((t1 - t0) * rate + 1e-9))
     t = t0 + np.arange(n + 1) / rate
     if t1 - t[-1] > 1e-9:
@@ -232,6 +238,9 @@ def first_event(walker, t, X, limits: ContactLimits, k0=1):
     the patch's top (penetration > 0 at the crossing, on the Hermite interpolant); a fall
     is the hip height crossing ``limits.fall_hip_height_m`` downward, a flight
     (``airborne``) ``limits.airborne_hip_height_m`` upward.
+
+    ``t`` (n,) [s] and ``X`` (n, 2 nq) (``walker.state_names()``) are the samples; the
+    returned ``time`` is in [s] and ``edge`` the patch edge's along-slope position [m].
     """
     if len(t) <= k0:
         return None

@@ -39,6 +39,9 @@ def make_step_map(walker, walker_at, rtol: float = 1e-9, atol: float = 1e-9,
                   max_step_time_s: float = 5.0):
     """The batched map of ``walker`` when its phases are compiled, else :class:`PythonStepMap`.
 
+    ``rtol`` [-], ``atol`` [state unit: rad, rad/s] and ``max_step_time_s`` [s] (a longer
+    step is a timeout) are the integration's.
+
     Raises
     ------
     ValueError

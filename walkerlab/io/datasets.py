@@ -51,7 +51,14 @@ _SHORT = (("samples/coordinates/", ""), ("samples/points/", ""), ("samples/", ""
 
 
 def xarray():
-    """Import xarray (and check h5netcdf), or raise ImportError with the install hint."""
+    """Import xarray (and check h5netcdf), or raise ImportError with the install hint.
+
+    Raises
+    ------
+    ImportError
+        xarray or h5netcdf is not installed (the message names the missing one and how to
+        install it).
+    """
     try:
         import h5netcdf  # noqa: F401
         import xarray as xr

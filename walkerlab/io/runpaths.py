@@ -77,6 +77,12 @@ def check_name(name: str, what: str) -> str:
         Candidate file or folder name.
     what : str
         What the name is, for the message (``"scene name"``, ``"--name"``).
+
+    Raises
+    ------
+    RunPathError
+        ``name`` is empty or is not a single safe path component (letters, digits and
+        ``. _ + -`` only).
     """
     if not isinstance(name, str) or not name:
         raise RunPathError(f"{what}: empty name")
@@ -237,7 +243,14 @@ def figures_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
 
 def run_cache_dir(scene, runs_root: Path | str, name: str) -> Path:
     """``<runs>/<scene>/.cache/<name>`` (measured data such as work-precision cases; never
-    code), which must resolve inside the runs folder."""
+    code), which must resolve inside the runs folder.
+
+    Raises
+    ------
+    RunPathError
+        ``name`` is not a safe single path component (:func:`check_name`), or the folder
+        resolves outside the runs folder (a symbolic link).
+    """
     d = scene_dir(scene, runs_root) / ".cache" / check_name(name, "cache name")
     return _inside(Path(runs_root), d, f"cache folder {name!r}")
 

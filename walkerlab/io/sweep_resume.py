@@ -75,12 +75,20 @@ def row_hashes(columns: dict[str, np.ndarray], key: str) -> list[str]:
 
 
 def chain_check(chain: int, done: int, guess: str, key: str) -> str:
+    """SHA-256 (hex) of a chain's checkpoint: the input hash ``key``, the chain number, the
+    points done and the continuation's JSON ``guess``."""
     return hashlib.sha256(f"{key}|{chain}|{done}|{guess}".encode()).hexdigest()
 
 
 def read_checkpoints(f: h5py.File, n_chains: int) -> tuple[np.ndarray, list[str], list[str]]:
     """Points done, continuation JSON and check of each chain of an open partial file
-    (rewritten as chains advance); unreadable ones are replaced: every chain restarts."""
+    (rewritten as chains advance); unreadable ones are replaced: every chain restarts.
+
+    Returns
+    -------
+    (done, guesses, checks) : ndarray of int64 shape (n_chains,), list of str, list of str
+        Empty lists (and zeros) when the checkpoints are missing or unreadable.
+    """
     try:
         return (f["plan/done"][()],
                 [x.decode() if isinstance(x, bytes) else str(x) for x in f["plan/guess"][()]],
@@ -126,7 +134,11 @@ def intact_chains(plan: list[list[int]], checkpoints: tuple, valid: set[int],
 def drop_rows(f: h5py.File, dsets: dict, cols: dict, keep: np.ndarray, restart: list[int],
                input_hash: str) -> None:
     """Keep only the rows ``keep`` of every column and reset the checkpoints of the chains
-    ``restart`` (they are computed again from their start)."""
+    ``restart`` (they are computed again from their start).
+
+    ``keep``: bool mask of shape (n,) over the rows of the columns ``cols`` (each (n,));
+    ``restart``: chain numbers.
+    """
     for name, ds in dsets.items():
         v = cols[name][keep]
         ds.resize((int(keep.sum()),))

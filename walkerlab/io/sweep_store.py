@@ -355,7 +355,14 @@ def load_sweep(path: Path) -> dict:
     dict
         ``attrs`` (dict of root attributes, ``params`` parsed), ``axes`` (list of
         ``(path, values ndarray)``), ``grid_shape`` (tuple), and ``points``: column name ->
-        (n,) array (strings as ``str`` object arrays; params under ``param/<path>``).
+        (n,) array (strings as ``str`` object arrays; params under ``param/<path>``).  Each
+        value is in the unit its column's name ends in (``_s``, ``_m``, ``_rad``, ...) or its
+        parameter path names.
+
+    Raises
+    ------
+    ArtifactError
+        ``path`` is not a readable sweep artifact, or it is an artifact of another kind.
     """
     from walkerlab.io.artifacts import ArtifactError
 

@@ -68,6 +68,7 @@ class NamedTrajectory:
 
     @property
     def total(self) -> np.ndarray:
+        """Total mechanical energy ``kinetic + potential`` (k,) [J]."""
         return self.kinetic + self.potential
 
     def angle_names(self) -> list[str]:

@@ -123,6 +123,11 @@ def stability_map_figure(sweep: dict, x_path: str | None = None, y_path: str | N
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    ValueError
+        The sweep does not have 2 axes.
     """
     axes = dict(sweep["axes"])
     paths = [p for p, _ in sweep["axes"]]

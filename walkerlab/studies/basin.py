@@ -70,7 +70,8 @@ def _index(names: list[str], name: str, field: str) -> int:
 
 def slice_state(walker, x_star: np.ndarray, axes: tuple[str, str],
                 values: tuple[float, float]) -> np.ndarray:
-    """Post-heel-strike state of one cell.
+    """Post-heel-strike state of one cell (``basin.start: fixed_point``; Schwab & Wisse
+    2001's grid of post-heel-strike states).
 
     Parameters
     ----------
@@ -114,12 +115,16 @@ class HeelStrikeSlice:
     Attributes
     ----------
     z_pre : ndarray, shape (2n - 1,)
-        Section coordinates (``walker.section``) of the fixed point's pre-impact state.
+        Section coordinates (``walker.section``) of the fixed point's pre-impact state
+        [rad, rad/s].
     free : ndarray of int, shape (2,)
         Which of them vary from cell to cell: the two the post-impact axis values depend on
         most (column-pivoted QR of that 2 x (2n - 1) Jacobian at ``z_pre``).
     axes : ndarray of int, shape (2,)
         State indices of the x and y axes.
+
+    The cell is Schwab & Wisse (2001)'s: a state just after a heel strike (module
+    docstring, ``heel_strike``).
     """
 
     z_pre: np.ndarray
@@ -128,7 +133,12 @@ class HeelStrikeSlice:
 
     def post(self, walker, u: np.ndarray) -> np.ndarray:
         """Post-impact state ``walker.reset(x-)`` of the pre-impact state with ``free = u``
-        (legs that differ: the heel strike that closes a stride, leg2 swinging)."""
+        (legs that differ: the heel strike that closes a stride, leg2 swinging).
+
+        ``u`` (2,) are the two free section coordinates [rad or rad/s]; returns the
+        post-impact state (2n,) in ``walker.state_names()`` order [rad, rad/s] (the heel
+        strike's impact map, ``walker.reset``).
+        """
         z = self.z_pre.copy()
         z[self.free] = u
         last = walker.for_stance(walker.legs[0])
@@ -141,6 +151,18 @@ class HeelStrikeSlice:
         The two free pre-impact coordinates are found by ``scipy.optimize.root`` (MINPACK
         hybrd) from the fixed point's; the cell is unreachable unless the axis values are
         matched to 1e-10 (relative) and the pre-impact state is finite.
+
+        Parameters
+        ----------
+        walker : HybridWalker
+        values : (float, float)
+            The x and y axis values [rad or rad/s].
+
+        Returns
+        -------
+        ndarray, shape (2n,) or None
+            Post-impact state (``walker.state_names()``, [rad, rad/s]) through the heel
+            strike's impact map ``walker.reset`` (Schwab & Wisse 2001's cell).
         """
         from scipy.optimize import root
 
@@ -160,7 +182,9 @@ class HeelStrikeSlice:
 
 def heel_strike_slice(walker, x_pre: np.ndarray, axes: tuple[str, str]) -> HeelStrikeSlice:
     """Set up :class:`HeelStrikeSlice` from the fixed point's pre-impact state ``x_pre``
-    (shape (2n,), on the heel-strike guard).
+    (shape (2n,), on the heel-strike guard; ``walker.state_names()`` order, [rad, rad/s]).
+    ``axes`` are two state names; the free coordinates are chosen by column-pivoted QR of the
+    axis values' finite-difference Jacobian (Schwab & Wisse 2001's post-impact cells).
 
     Raises
     ------
@@ -191,6 +215,26 @@ def axis_values(settings, walker, x_star: np.ndarray,
     """Cell-centre values of the x and y axes [rad or rad/s].
 
     Default ranges: the fixed point -/+ 0.3 rad for an angle, -/+ 1.2 rad/s for a rate.
+
+    Parameters
+    ----------
+    settings : BasinSettings
+        Axes (state names), ranges and grid.
+    walker : HybridWalker
+    x_star : ndarray, shape (2n,)
+        Period-1 fixed point (``walker.state_names()``).
+    grid : (nx, ny), optional
+        Overrides ``settings.grid``.
+
+    Returns
+    -------
+    (x, y) : ndarray, shapes (nx,) and (ny,)
+        Cell centres [rad or rad/s].
+
+    Raises
+    ------
+    BasinError
+        An unknown axis name, or a range whose upper end does not exceed its lower.
     """
     names = walker.state_names()
     nx, ny = grid or settings.grid
@@ -211,9 +255,11 @@ def axis_values(settings, walker, x_star: np.ndarray,
 
 def classify_cell(walker, x0: np.ndarray, x_star: np.ndarray, solver, settings,
                   max_step_time: float = 5.0) -> tuple[int, int, int]:
-    """Iterate the Poincaré map from ``x0`` and classify where it goes.
+    """Iterate the Poincaré map from ``x0`` and classify where it goes (Schwab & Wisse
+    2001; outcomes in the module docstring).
 
-    ``max_step_time`` [s]: a longer step ends the cell as ``stalled``.
+    ``x0`` and ``x_star`` are post-impact states of shape (2n,) (``walker.state_names()``,
+    [rad, rad/s]); ``max_step_time`` [s]: a longer step ends the cell as ``stalled``.
 
     Returns
     -------
@@ -315,7 +361,8 @@ def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
 def pre_impact_fixed_point(walker, x_star: np.ndarray, settings, max_step_time: float
                            ) -> np.ndarray:
     """The fixed point's state just before its heel strike, shape (2n,) (one step of the
-    basin's integrator from ``x_star``).
+    basin's integrator from ``x_star``); ``walker.state_names()`` order, [rad, rad/s].
+    ``max_step_time`` [s] caps the step.
 
     Raises
     ------
@@ -395,7 +442,7 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     scene : Scene
         Its ``basin`` section (or the defaults) sets axes, ranges and tolerances.
     x_star : ndarray, shape (2n,)
-        Period-1 fixed point.
+        Period-1 fixed point (``walker.state_names()``, [rad, rad/s]).
     key : str
         Input hash; a partial file with another key is discarded.
     out_path : Path
@@ -412,8 +459,9 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     Returns
     -------
     dict
-        ``x``, ``y`` (cell centres), ``outcome``, ``steps``, ``period`` (shape (ny, nx)),
-        ``wall_time_s`` (this call), ``cells_computed``.
+        ``x``, ``y`` (cell centres [rad or rad/s], shapes (nx,), (ny,)), ``outcome``,
+        ``steps``, ``period`` (shape (ny, nx)), ``wall_time_s`` [s] (this call),
+        ``cells_computed``.
 
     Raises
     ------
@@ -484,7 +532,8 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
 def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
               grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,
               resume: bool = True, on_chunk: Callable[[int, int], None] | None = None):
-    """:func:`compute_basin` (same arguments) packed for the basin artifact.
+    """:func:`compute_basin` (same arguments; ``x_star`` of shape (2n,) [rad, rad/s]) packed
+    for the basin artifact.
 
     Returns
     -------

@@ -56,7 +56,23 @@ def step_map_for(base: dict) -> BatchStepMap:
 
 @dataclass(frozen=True)
 class WalkTask:
-    """Monte Carlo walks ``walks`` at one sigma (picklable)."""
+    """Monte Carlo walks ``walks`` at one sigma (picklable).
+
+    Attributes
+    ----------
+    base : dict
+        What :func:`step_map_for` rebuilds the batched step map from.
+    x0 : tuple of float, length 2n
+        The gait's post-impact state (``state_names()``, [rad, rad/s]).
+    sd : float
+        Slope standard deviation [rad].
+    walks : tuple of int
+        Walk numbers of the chunk.
+    max_steps, seed, index : int
+        Step cap, the run's seed, the chunk's index.
+    distribution : str
+        ``normal`` or ``uniform``.
+    """
 
     base: dict
     x0: tuple
@@ -70,7 +86,19 @@ class WalkTask:
 
 @dataclass(frozen=True)
 class ImageTask:
-    """Step-map images of ``X`` on slopes ``gamma`` (picklable)."""
+    """Step-map images of ``X`` on slopes ``gamma`` (picklable).
+
+    Attributes
+    ----------
+    base : dict
+        What :func:`step_map_for` rebuilds the batched step map from.
+    X : ndarray, shape (k, 2n)
+        Post-impact states [rad, rad/s].
+    gamma : ndarray, shape (k,)
+        Slope of each row's step [rad].
+    start : int
+        Row of the chunk's first state in the whole list.
+    """
 
     base: dict
     X: np.ndarray
@@ -101,7 +129,12 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
 
     ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): chunks stored
     there by an interrupted run are taken as they are (a chunk's walks do not depend on
-    when or where they ran), and every chunk that finishes is stored."""
+    when or where they ran), and every chunk that finishes is stored.
+
+    ``x0`` (2n,): the gait's post-impact state (``state_names()``, [rad, rad/s]).  The
+    censored geometric estimate of Byl & Tedrake (2009) is
+    :attr:`~walkerlab.analysis.robustness.mfpt.MonteCarloResult.mfpt` [steps].
+    """
     from walkerlab.execution.executor import run_each
     from walkerlab.studies.runner import sweep_executor
 
@@ -139,7 +172,9 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
 
 def image_evaluator(scene, ex):
     """``(X, gamma) -> (x_next, ok)`` on the open executor ``ex`` (for
-    :func:`M.mesh_mfpt`; one worker pool serves every mesh of a refinement)."""
+    :func:`M.mesh_mfpt`; one worker pool serves every mesh of a refinement): ``X`` (k, 2n)
+    post-impact states [rad, rad/s], ``gamma`` (k,) slopes [rad] -> ``x_next`` (k, 2n),
+    ``ok`` (k,) bool (heel strike)."""
     from walkerlab.execution.executor import run_each
 
     base = scene.model_dump(mode="json")
@@ -168,7 +203,27 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
     ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): the images of
     the nodes are stored there after every mesh, and a rerun takes those of an interrupted
     run (when its visited states are the same, bit for bit), so it resumes at the mesh
-    under way."""
+    under way.  (Byl & Tedrake 2009's mesh; :mod:`walkerlab.analysis.robustness.mfpt`.)
+
+    Parameters
+    ----------
+    x0 : ndarray, shape (2n,)
+        The gait's post-impact state (``state_names()``, [rad, rad/s]).
+    sd : float
+        Slope standard deviation [rad].
+    settings : MfptSettings
+
+    Returns
+    -------
+    (MeshResult, list of MeshResult)
+        MFPTs in heel strikes [steps].
+
+    Raises
+    ------
+    ValueError
+        The walks fall too soon to visit ``10 * 2n`` states (no mesh can be shaped), or an
+        unknown ``distribution``.
+    """
     import hashlib
 
     base = scene.model_dump(mode="json")
@@ -214,7 +269,10 @@ def mesh(scene, x0: np.ndarray, sd: float, settings, workers: int = 1, scheduler
 def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
                partial=None):
     """Monte Carlo and/or mesh MFPT at every ``st.sigma_rad`` (``st``: the scene's
-    :class:`walkerlab.config.MfptSettings`) from the gait ``x_star`` -> ``MfptData``.
+    :class:`walkerlab.config.MfptSettings`) from the gait ``x_star`` -> ``MfptData``
+    (Byl & Tedrake 2009; :mod:`walkerlab.analysis.robustness.mfpt`).  ``x_star`` (2n,): the
+    period-1 gait just after heel strike (``state_names()``, [rad, rad/s]); MFPTs in heel
+    strikes [steps], sigmas [rad].
 
     ``partial`` (:class:`walkerlab.io.mfpt_partial.MfptPartial`, optional): the finished
     pieces (Monte Carlo chunks, mesh images) of an interrupted run are reused and the new

@@ -65,7 +65,8 @@ class Task:
     paths : tuple of str
         Dotted parameter paths, one per axis.
     points : tuple of (int, tuple)
-        ``(row index, parameter values)`` in evaluation (continuation) order.
+        ``(row index, parameter values)`` in evaluation (continuation) order; each value in
+        its field's unit (the unit the dotted path names, e.g. ``slope.angle_deg`` [deg]).
     options : dict
         Sweep options (see :data:`DEFAULT_OPTIONS`).
     origin : str
@@ -97,9 +98,11 @@ class Continuation:
         Continuation-axis value of each kept fixed point, oldest first (at most two; ``None``
         when the axis is not numeric, and then no extrapolation is done).
     states : tuple of ndarray (2n,)
-        The fixed points (role-ordered state just after heel strike).
+        The fixed points (role-ordered state just after heel strike, ``state_names()``;
+        [rad], [rad/s]).
     jacobians : tuple of ndarray (2n, 2n)
-        ``DP`` at each fixed point (variational equations).
+        ``DP`` at each fixed point (Poincaré-map Jacobian from the variational equations
+        with saltation matrices; [state unit / state unit]).
     target : float or None
         Continuation-axis value of the point to predict (set by :meth:`aimed`).
     """
@@ -115,7 +118,7 @@ class Continuation:
 
     @property
     def x(self) -> np.ndarray:
-        """The last fixed point (2n,)."""
+        """The last fixed point (2n,) (``state_names()``, [rad, rad/s])."""
         return self.states[-1]
 
     def then(self, value, res) -> Continuation:
@@ -134,7 +137,9 @@ class Continuation:
         Returns
         -------
         x : ndarray (2n,)
+            Post-impact state (``state_names()``, [rad, rad/s]).
         DP : ndarray (2n, 2n)
+            Poincaré-map Jacobian [state unit / state unit].
         """
         v = self.target
         if len(self.values) < 2 or v is None or self.values[0] == self.values[1]:
@@ -195,7 +200,7 @@ def ideal_fixed_point(scene: Scene, guess, options: dict | None = None):
     guess : Continuation, ndarray (2n,) or None
         The chunk's previous fixed points (aimed at this point, see
         :meth:`Continuation.aimed`), or a neighbour's fixed point (role-ordered state just
-        after heel strike).
+        after heel strike, ``state_names()``; [rad, rad/s]).
 
     Returns
     -------
@@ -272,6 +277,12 @@ def interleg_angle(walker, x: np.ndarray) -> float:
     ``2 asin(d / 2L)`` with ``L = walker.params["leg_length_m"]``: for straight legs this is
     ``|theta_swing - theta_stance|`` exactly; for any walker it is the angle of the isosceles
     triangle hip-feet with the same step, so it needs no state row.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    x : ndarray, shape (2n,)
+        State (``walker.state_names()``, [rad, rad/s]); only the feet's positions are read.
     """
     d = float(np.hypot(*walker.points(x)["swing_foot"]))
     L = float(walker.params["leg_length_m"])
@@ -334,6 +345,21 @@ def simulate_point(scene: Scene, guess, options: dict):
 
     The initial state is the scene's explicit state, or (``initial_state: fixed_point``)
     the fixed point found at this point (continuation from ``guess``).
+
+    Returns
+    -------
+    cols : dict
+        Columns of :data:`walkerlab.studies.outcomes.COLUMNS` ``["simulate"]``.
+    next_guess : FixedPointResult or None
+        The fixed point found here (``initial_state: fixed_point``), for the next point of
+        the chunk; None with an explicit initial state.
+
+    Raises
+    ------
+    PointOutcome
+        ``fall`` (a fall guard fired), ``solver_failure``, ``max_steps`` (a step longer than
+        ``max_step_time_s``), ``scuff`` (the swing foot below the ground), or as
+        :func:`ideal_fixed_point` when the start is the fixed point.
     """
     from walkerlab.config import SimulateSettings
     from walkerlab.integrate.rigid import simulate_steps
@@ -430,6 +456,12 @@ def contact_point(scene: Scene, guess, options: dict):
     is the contact run's typed outcome (trip, fall, scuff, slip beyond
     ``options["slip_limit_mm"]``, solver failure, time limit), then ``bounce`` (a stance
     foot left the ground and came back) and ``max_steps`` (stalled).
+
+    Raises
+    ------
+    PointOutcome
+        The outcomes above (each with the columns computed so far), or as
+        :func:`ideal_fixed_point`.
     """
     from walkerlab.analysis.contact.gait import classify_complete
     from walkerlab.config import FixedPointSettings
@@ -490,8 +522,9 @@ def evaluate(stage: str, base: dict, paths, values, index: int, guess, options: 
     Returns
     -------
     row : dict
-        All columns of the stage (NaN / ``""`` where not applicable), ``index``,
-        ``outcome``, ``message``, ``wall_time_s``.
+        All columns of the stage (NaN / ``""`` where not applicable; units as the columns'
+        names say, :data:`walkerlab.studies.outcomes.COLUMNS`), ``index``, ``outcome``,
+        ``message``, ``wall_time_s`` [s].
     next_guess : Continuation or None
         ``guess`` (a :class:`Continuation`) with this point's fixed point appended, for the
         next point of the chunk (``None`` after a failure or without a fixed point: the

@@ -209,7 +209,14 @@ class ContactResult:
     points: dict = field(default_factory=dict)
 
     def column(self, name: str) -> np.ndarray:
-        """Samples (n,) of the state ``name``."""
+        """Samples (n,) of the state ``name``, in its unit (the walker's
+        ``state_units()``: [m], [rad], [m/s] or [rad/s]).
+
+        Raises
+        ------
+        ValueError
+            ``name`` is not one of :attr:`state_names`.
+        """
         return self.x[:, list(self.state_names).index(name)]
 
     @property
@@ -321,7 +328,9 @@ def _heel_strikes(t, feet, min_step_m, initial_stance):
 
 def heel_strike_count(walker, t, X, min_step_m: float = 0.05,
                       initial_stance: str = "leg2") -> int:
-    """Heel strikes in the samples ``t`` (n,), ``X`` (n, N) (the strides cap's count)."""
+    """Heel strikes in the samples ``t`` (n,) [s], ``X`` (n, N) (``walker.state_names()``)
+    (the strides cap's count); a touchdown counts only ``min_step_m`` [m] downhill of the
+    stance foot (as :func:`gait_events`)."""
     feet = _foot_traces(walker, t, X)
     return len(_heel_strikes(t, feet, min_step_m, initial_stance)[0])
 

@@ -320,6 +320,10 @@ def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None 
     stance, stance foot at s = 0) on patches spaced by the gait's step length, so every
     footfall lands where the gait's does, and runs ``(2 strides + 1)`` gait periods.
 
+    ``x_ideal`` (2n,): the rigid walker's post-impact fixed point (its ``state_names()``,
+    [rad, rad/s]); the returned ``x0`` is the contact walker's full state (2 nq,)
+    (``ContactWalker.state_names()``, [m, rad, m/s, rad/s]), ``step_length`` in [m].
+
     Returns
     -------
     walker, result, x0, step_length, gait

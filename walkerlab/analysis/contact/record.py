@@ -47,7 +47,8 @@ def drop_test(law: ContactSettings, mass_kg: float) -> dict:
 
 def rate_states(walker, leg: str) -> list[str]:
     """Names of the rate states of ``leg``'s links (what one entry of
-    ``initial_rate_scale`` multiplies): ``dtheta1``; kneed ``dtheta1_thigh dtheta1_shank``."""
+    ``initial_rate_scale`` multiplies): ``dtheta1``; kneed ``dtheta1_thigh dtheta1_shank``
+    (each in [rad/s])."""
     lay = walker.layout()
     return [lay.rate_of(s) for s in walker.leg_angle_states(leg)]
 

@@ -94,14 +94,16 @@ class ContactStart:
     ----------
     scene : dict
         The scene (``model_dump(mode="json")``).
-    x_ideal : tuple
-        The rigid gait's post-impact state (sets the contact walker's parts).
-    x0 : tuple
-        The contact periodic gait's full state at mid-stance on footfall 0.
+    x_ideal : tuple of float, length 2n
+        The rigid gait's post-impact state (``state_names()`` of the rigid walker, [rad,
+        rad/s]; sets the contact walker's parts).
+    x0 : tuple of float, length 2 nq
+        The contact periodic gait's full state at mid-stance on footfall 0
+        (``ContactWalker.state_names()``, [m, rad, m/s, rad/s]).
     step_length_m, period_s : float
-        Of the contact periodic gait (the patch spacing; the time per step).
+        Of the contact periodic gait (the patch spacing [m]; the time per step [s]).
     slope_rad : float
-        The scene's slope (the mean of per-step slopes).
+        The scene's slope [rad] (the mean of per-step slopes).
     """
 
     scene: dict
@@ -118,6 +120,9 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
     own start instead (:func:`walkerlab.analysis.contact.sim.scene_start`: the rigid gait
     with ``contact_sim.initial_rate_scale``, the ideal step length, the rigid gait's step
     period; no periodic-gait search, so walks start with a transient).
+
+    ``x_ideal`` (2n,): the rigid gait's post-impact state (the rigid walker's
+    ``state_names()``, [rad, rad/s]).
 
     Raises
     ------
@@ -190,7 +195,24 @@ def walk_heights(start: ContactStart, seed: int, walk: int, max_steps: int, sd: 
                  distribution: str = "normal") -> np.ndarray:
     """Footfall heights [m] of Monte Carlo walk number ``walk``: its per-step slopes
     (:func:`walkerlab.analysis.robustness.mfpt.draw_slopes`, the same streams as the rigid walks)
-    turned into heights (:func:`slope_heights`)."""
+    turned into heights (:func:`slope_heights`).
+
+    Parameters
+    ----------
+    start : ContactStart
+    seed, walk : int
+        The run's seed and the walk's number (the rigid walks' streams).
+    max_steps : int
+        Step cap: ``max_steps + 2`` slopes are drawn.
+    sd : float
+        Slope standard deviation [rad].
+    distribution : {"normal", "uniform"}
+
+    Returns
+    -------
+    ndarray, shape (max_steps + 3,)
+        Footfall heights [m], footfall 0 at 0.
+    """
     from walkerlab.analysis.robustness.mfpt import draw_slopes
 
     g = draw_slopes(seed, walk, max_steps + 2, start.slope_rad, sd, distribution)

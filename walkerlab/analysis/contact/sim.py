@@ -202,7 +202,8 @@ def trajectory_names(walker, legs=("leg1", "leg2")) -> dict[str, str]:
     """State name -> name in the shared trajectory layout for every leg coordinate of the
     walker (the hip position and velocity are points): the floating coordinate's name
     (``<leg>_angle``, kneed ``<leg>_thigh_angle``, ``<leg>_shank_angle``; the same names as
-    the rigid walker's ``leg_coordinates``) and ``..._rate`` for its rate.
+    the rigid walker's ``leg_coordinates``) and ``..._rate`` for its rate (angles [rad],
+    rates [rad/s]).
     """
     idx = StateIndex(walker)
     n = idx.coordinates.stop
@@ -221,7 +222,8 @@ def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
     """A :class:`ContactResult` in the shared named layout of
     :class:`walkerlab.io.trajectory.NamedTrajectory` (stance leg from the heel strikes;
     coordinates by :func:`trajectory_names`, points from the generated floating view: hip,
-    each body ``<leg>_<body>``, feet, knees)."""
+    each body ``<leg>_<body>``, feet, knees; points in [m], angles [rad], rates [rad/s],
+    times [s])."""
     from walkerlab.io.trajectory import NamedTrajectory
 
     legs = list(legs)

@@ -153,7 +153,12 @@ class StepMap:
 
     # ------------------------------------------------------------------ coordinates
     def to_state(self, z) -> np.ndarray:
-        """Full state (2 nq,) from section coordinates (leg2 stance, stance foot at s = 0)."""
+        """Full state (2 nq,) from section coordinates (leg2 stance, stance foot at s = 0).
+
+        ``z`` has shape (m,) in :attr:`names` order (units :attr:`units`: link angles [rad],
+        rates [rad/s], the stance foot's penetration [m] and velocities [m/s]); the state
+        follows ``walker.state_names()`` [m, rad, m/s, rad/s].
+        """
         z = np.asarray(z, float)
         nl = len(z) - 3
         d, vt, dd = z[nl:]
@@ -172,7 +177,11 @@ class StepMap:
 
     def to_section(self, x, stance: int) -> tuple[np.ndarray, float]:
         """Section coordinates (:attr:`names`) and along-slope position s [m] of foot
-        ``stance`` (0/1)."""
+        ``stance`` (0/1).
+
+        ``x`` (2 nq,): full state (``walker.state_names()``); returns ``(z, s)`` with ``z``
+        of shape (m,) (units :attr:`units`).
+        """
         x = np.asarray(x, float)
         px, py, vx, vy = self.walker.foot_state(x, stance)
         p, v = np.array([px, py]), np.array([vx, vy])
@@ -192,7 +201,16 @@ class StepMap:
     def integrate(self, x0, stance_to_come: int = 0, dense: bool = False) -> EventRun:
         """Integrate from ``x0`` to the next upward zero of theta_sw - theta_st where the
         new stance leg is ``stance_to_come`` (0 = leg1): event ``mid_stance``, or ``fall``
-        (hip below L/2; :func:`walkerlab.integrate.events.run_to_event`)."""
+        (hip below L/2; :func:`walkerlab.integrate.events.run_to_event`).
+
+        ``x0`` (2 nq,): full state (``walker.state_names()``, [m, rad, m/s, rad/s]); the
+        run's times are in [s].
+
+        Raises
+        ------
+        PeriodicGaitError
+            ``time_limit``: the search's wall-time deadline passed during the integration.
+        """
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
         hth = 0.5 * self.walker.L
         events = [Event("mid_stance", lambda t, x: x[isw] - x[ist], 1.0),
@@ -284,7 +302,8 @@ class StepMap:
         return z1, run.t_event, s1
 
     def patch_margin(self, z) -> float:
-        """Smallest distance [m] of a loaded foot to its patch edge over one step."""
+        """Smallest distance [m] of a loaded foot to its patch edge over one step from the
+        section coordinates ``z`` (m,) (:attr:`names`); inf on continuous ground."""
         if self.method == "odeint":
             x0 = self.to_state(z)
             te = self._step_odeint(x0)[0]
@@ -358,6 +377,26 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
     The ideal state is placed as :func:`initial_state_from_ideal` does (stance foot leg2 at
     its static penetration, ``rate_scale`` on the rates) and integrated to the first
     mid-stance of leg2, where the section coordinates are read.
+
+    Parameters
+    ----------
+    step_map : StepMap
+    x_ideal : array_like, shape (2n,)
+        The rigid walker's post-impact state [rad, rad/s].
+    rate_scale : (float, float)
+        Multipliers [-] on leg1's and leg2's rates.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        Section coordinates (``step_map.names``, units ``step_map.units``; m = 6 for
+        straight legs).
+
+    Raises
+    ------
+    PeriodicGaitError
+        ``fall`` or ``no_mid_stance``: the placed state does not reach mid-stance;
+        ``time_limit`` when the step map's wall-time deadline passes.
     """
     from walkerlab.analysis.contact.sim import initial_state_from_ideal
 

@@ -85,7 +85,17 @@ SPECIAL_KINDS = ("fold", "period_doubling", "neimark_sacker", "branch_end")
 
 @dataclass
 class Branch:
-    """A continued branch: points in order of arclength, the branch's period ``k``."""
+    """A continued branch: points in order of arclength, the branch's period ``k``.
+
+    Attributes
+    ----------
+    period : int
+        Steps per period (1, 2, 4, ...).
+    points : list of BranchPoint
+    specials : list of SpecialPoint
+    direction : int
+        +1 or -1: the direction of increasing arclength from the start.
+    """
 
     period: int
     points: list[BranchPoint]
@@ -93,6 +103,7 @@ class Branch:
     direction: int = 1
 
     def params(self) -> np.ndarray:
+        """The points' parameter values, shape (len(points),) [the field's unit]."""
         return np.array([q.p for q in self.points])
 
 
@@ -279,7 +290,8 @@ def _specials_between(sys: BranchSystem, a: BranchPoint, b: BranchPoint, u: np.n
 def first_point(family: WalkerFamily, p: float, x: np.ndarray, k: int, p_scale: float
                 ) -> BranchPoint:
     """The corrected point of the period-``k`` branch at ``p`` from the state ``x`` (natural
-    parameter: ``p`` held).
+    parameter: ``p`` held).  ``x`` (2n,): the walker's ``state_names()`` [rad, rad/s];
+    ``p`` and ``p_scale`` in the parameter's unit.
 
     Raises
     ------
@@ -298,7 +310,15 @@ def first_point(family: WalkerFamily, p: float, x: np.ndarray, k: int, p_scale: 
 
 
 def fixed_point_at(family: WalkerFamily, p: float, x: np.ndarray, k: int = 1) -> BranchPoint:
-    """Fixed point of the ``k``-step map at ``p`` from a guess ``x`` (2n,)."""
+    """Fixed point of the ``k``-step map at ``p`` from a guess ``x`` (2n,) (the walker's
+    ``state_names()``, [rad, rad/s]; ``p`` in its field's unit); :func:`first_point` with
+    ``p_scale = max(1, |p|)``.
+
+    Raises
+    ------
+    MapFailed
+        No fixed point near ``x``.
+    """
     return first_point(family, p, x, k, max(1.0, abs(p)))
 
 

@@ -114,12 +114,14 @@ def _cause(walker: HybridWalker, seg) -> str:
 
 def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,
              jacobian: bool = False, max_step_time: float = 5.0, segments: bool = False):
-    """The ``k``-step Poincaré map ``P^k`` and (optionally) its Jacobian.
+    """The ``k``-step Poincaré map ``P^k`` and (optionally) its Jacobian (variational
+    equations with saltation matrices at every guard; :mod:`walkerlab.integrate.rigid`).
 
     Parameters
     ----------
     x : ndarray (2n,)
-        State just after heel strike (role-ordered).
+        State just after heel strike (role-ordered, ``walker.state_names()``; [rad],
+        [rad/s]).
     k : int
         Maps composed (1: the Poincaré map, 2: its square, ...); a map is one step, or one
         stride (two steps) for a walker whose legs differ (``walker.steps_per_map``).
@@ -164,7 +166,8 @@ def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,
 
 
 def state_from_section(walker: HybridWalker, z: np.ndarray) -> np.ndarray:
-    """The state (2n,) of the section coordinates ``z`` (m,).
+    """The state (2n,) of the section coordinates ``z`` (m,) (``walker.from_section``; the
+    state in ``walker.state_names()`` order, [rad] and [rad/s]).
 
     Raises
     ------
@@ -183,7 +186,14 @@ def state_from_section(walker: HybridWalker, z: np.ndarray) -> np.ndarray:
 
 class BranchSystem:
     """``F(z, p)`` of the period-``k`` branch with memoised maps (one per iterate);
-    ``p_scale`` is the parameter's scale in the arclength (``u = (z, p / p_scale)``)."""
+    ``p_scale`` is the parameter's scale in the arclength (``u = (z, p / p_scale)``), in the
+    parameter's unit; ``z`` (m,) are section coordinates [rad, rad/s].
+
+    Attributes
+    ----------
+    n_maps, n_variational : int
+        Steps integrated so far without / with the variational equations.
+    """
 
     def __init__(self, family: WalkerFamily, k: int, p_scale: float):
         self.family, self.k, self.p_scale = family, k, p_scale
@@ -192,6 +202,14 @@ class BranchSystem:
         self._last: dict = {}
 
     def residual(self, z: np.ndarray, p: float) -> np.ndarray:
+        """``F(z, p) = section(P^k(from_section(z); p)) - z`` (m,) [rad, rad/s] (module
+        docstring); the last one is memoised.
+
+        Raises
+        ------
+        MapFailed
+            A step did not end in heel strike, or ``z`` leaves the section's domain.
+        """
         key = (np.asarray(z, float).tobytes(), float(p))
         if key in self._last:
             return self._last[key].copy()
@@ -207,7 +225,8 @@ class BranchSystem:
 
     def dp(self, z: np.ndarray, p: float) -> np.ndarray:
         """``dF/dp`` (m,) by central differences (step ``1e-6 (1 + |p|)``); one-sided next
-        to a branch end, where the map fails on one side.
+        to a branch end, where the map fails on one side.  Unit: the section's [rad, rad/s]
+        per unit of ``p``.
 
         Raises
         ------
@@ -225,7 +244,20 @@ class BranchSystem:
             return (up - self.residual(z, p)) / h
 
     def full(self, z: np.ndarray, p: float) -> dict:
-        """Everything at ``(z, p)``: state, period, ``D(P^k)``, ``F_z``, reduced ``M``."""
+        """Everything at ``(z, p)``: state, period, ``D(P^k)``, ``F_z``, reduced ``M``.
+
+        Returns
+        -------
+        dict
+            ``x`` (2n,) [rad, rad/s], ``period`` [s], ``J`` = ``D(P^k)`` (2n, 2n), ``M`` =
+            ``D section . J . D from_section`` (m, m), ``Fz`` = ``M - I``, ``orbit`` (k, 2n)
+            the post-impact states of the ``k`` steps, ``F`` (m,) the residual, ``walker``.
+
+        Raises
+        ------
+        MapFailed
+            As :meth:`residual`.
+        """
         w = self.family.walker(p)
         x = state_from_section(w, z)
         xk, T, J, segs = step_map(w, x, self.family.solver, self.k, jacobian=True,
@@ -240,7 +272,23 @@ class BranchSystem:
 
 
 def test_functions(M: np.ndarray) -> dict:
-    """Fold, period-doubling and Neimark-Sacker test functions of the reduced Jacobian."""
+    """Fold, period-doubling and Neimark-Sacker test functions of the reduced Jacobian.
+
+    ``det(M - I)``, ``det(M + I)`` and the bialternate product ``prod_{i<j} (mu_i mu_j -
+    1)`` (Kuznetsov, "Elements of Applied Bifurcation Theory", 3rd ed. 2004, ch. 10;
+    module docstring).
+
+    Parameters
+    ----------
+    M : ndarray, shape (m, m)
+        Reduced Jacobian ``F_z + I`` (dimensionless in the section's coordinates).
+
+    Returns
+    -------
+    dict
+        ``fold``, ``period_doubling``, ``neimark_sacker`` (float, [-]) and ``mu`` (the
+        eigenvalues, complex ndarray of shape (m,)).
+    """
     mu = np.linalg.eigvals(M)
     m = mu.size
     pairs = [(i, j) for i in range(m) for j in range(i + 1, m)]
@@ -254,7 +302,18 @@ def test_functions(M: np.ndarray) -> dict:
 
 def critical_vector(M: np.ndarray, target: complex) -> tuple[np.ndarray, complex]:
     """The unit eigenvector of ``M`` whose eigenvalue lies nearest ``target`` (real when the
-    eigenvalue is), and that eigenvalue."""
+    eigenvalue is), and that eigenvalue.
+
+    Parameters
+    ----------
+    M : ndarray, shape (m, m)
+    target : complex
+        E.g. -1 for a period doubling, +1 for a fold (Floquet multipliers).
+
+    Returns
+    -------
+    (v, mu) : ndarray of shape (m,) (real or complex), complex
+    """
     mu, V = np.linalg.eig(M)
     i = int(np.argmin(np.abs(mu - target)))
     v = V[:, i].real if abs(mu[i].imag) < 1e-12 else V[:, i]

@@ -39,7 +39,8 @@ __all__ = ["BranchPoint", "SpecialPoint", "bordered_jacobian", "branch_point", "
 
 @dataclass
 class BranchPoint:
-    """One point of a branch (a fixed point of the ``k``-step map).
+    """One point of a branch (a fixed point of the ``k``-step map; pseudo-arclength
+    continuation, Allgower & Georg 2003, ch. 2).
 
     Attributes
     ----------
@@ -52,6 +53,12 @@ class BranchPoint:
     tangent : ndarray (m + 1,)   unit tangent in scaled ``(z, p / p_scale)``
     residual : float   ``max |F|``
     orbit : ndarray (k, 2n)   the states just after each of the orbit's ``k`` heel strikes
+    M : ndarray (m, m)        reduced Jacobian ``F_z + I`` (Floquet multipliers without the
+                              zero one)
+    Fp : ndarray (m,)         ``dF/dp`` [section unit per parameter unit]
+
+    Angles are in [rad], rates in [rad/s]; ``x`` and ``orbit`` rows follow the walker's
+    ``state_names()``.
     """
 
     p: float
@@ -68,6 +75,7 @@ class BranchPoint:
 
     @property
     def stable(self) -> bool:
+        """All Floquet multipliers strictly inside the unit circle (``max |mu| < 1``)."""
         return bool(np.max(np.abs(self.multipliers)) < 1.0)
 
 
@@ -116,10 +124,28 @@ def correct(sys: BranchSystem, u0: np.ndarray, row: np.ndarray, target: float,
     """Solve ``[F(z, p); row . u - target] = 0`` from ``u0`` (scaled ``u = (z, p/p_scale)``)
     with ``scipy.optimize.root`` (``hybr``, analytic bordered Jacobian).
 
+    The bordered corrector of pseudo-arclength continuation (Allgower & Georg 2003, ch. 2;
+    module docstring).
+
+    Parameters
+    ----------
+    sys : BranchSystem
+    u0 : ndarray (m + 1,)
+        Start: section coordinates [rad, rad/s] and ``p / p_scale`` [-].
+    row : ndarray (m + 1,)
+        The constraint's row (the tangent, or the parameter's unit row).
+    target : float
+        The constraint's right-hand side.
+    J0 : ndarray (m + 1, m + 1), optional
+        Start Jacobian (:func:`bordered_jacobian`); default the exact one at ``u0``.
+    xtol : float
+        MINPACK's relative tolerance [-].
+
     Returns
     -------
     u : ndarray (m + 1,) or None (no convergence)
-    info : dict or None   :meth:`BranchSystem.full` at the solution
+    info : dict or None   :meth:`BranchSystem.full` at the solution; on failure the
+                          :class:`MapFailed` met, or None
     """
     from scipy.optimize import root
 
@@ -172,7 +198,12 @@ def correct(sys: BranchSystem, u0: np.ndarray, row: np.ndarray, target: float,
 def branch_point(sys: BranchSystem, u: np.ndarray, info: dict,
                  t_prev: np.ndarray | None) -> BranchPoint:
     """The branch point at the corrected ``u`` (m + 1,) with ``info`` (:func:`correct`): its
-    tangent (oriented along ``t_prev`` when given), multipliers and test functions.
+    tangent (oriented along ``t_prev`` when given), multipliers and test functions
+    (:func:`~walkerlab.analysis.continuation.gait_map.test_functions`; the tangent spans the
+    null space of ``[F_z  F_p p_scale]``, Allgower & Georg 2003, ch. 2).
+
+    ``u`` holds the section coordinates [rad, rad/s] and ``p / p_scale`` [-]; ``t_prev``
+    has the same shape (m + 1,).
 
     Raises
     ------
@@ -196,20 +227,41 @@ def branch_point(sys: BranchSystem, u: np.ndarray, info: dict,
 
 def bordered_jacobian(a: BranchPoint, row: np.ndarray, s: float) -> np.ndarray | None:
     """The bordered Jacobian at ``a`` with the constraint ``row`` (a start for MINPACK's
-    Broyden updates near ``a``: no variational map spent up front)."""
+    Broyden updates near ``a``: no variational map spent up front).
+
+    Returns
+    -------
+    ndarray (m + 1, m + 1) or None
+        ``[[F_z, F_p s], [row]]`` in the scaled coordinates ``u = (z, p / s)``; None when
+        ``a`` carries no ``M`` or ``Fp``.
+    """
     if a.M is None or a.Fp is None:
         return None
     return np.vstack([np.column_stack([a.M - np.eye(a.z.size), a.Fp * s]), row])
 
 
 def scaled_point(q: BranchPoint, s: float) -> np.ndarray:
-    """``u = (z, p / s)`` (m + 1,): the point in the arclength's scaled coordinates."""
+    """``u = (z, p / s)`` (m + 1,): the point in the arclength's scaled coordinates
+    (``z`` [rad, rad/s], ``p / s`` dimensionless)."""
     return np.append(q.z, q.p / s)
 
 
 def locate_special(sys: BranchSystem, a: BranchPoint, b_s: float, kind: str, guess_b: np.ndarray,
             period: int) -> SpecialPoint | None:
-    """brentq along the branch between ``a`` (s = 0) and the point at ``s = b_s``."""
+    """brentq along the branch between ``a`` (s = 0) and the point at ``s = b_s``.
+
+    ``s`` is the arclength in the scaled coordinates ``u = (z, p / p_scale)``
+    (dimensionless); ``guess_b`` (m + 1,) is the point at ``b_s`` in them.  A sign change of
+    the ``kind``'s test function (fold, period doubling, Neimark-Sacker; module docstring)
+    or validity check (:data:`~walkerlab.analysis.continuation.validity.VALIDITY`, then a
+    ``branch_end``) is located to ``xtol = 1e-12`` in ``s``.
+
+    Returns
+    -------
+    SpecialPoint or None
+        None when a correction on a trial hyperplane fails (:class:`MapFailed` is caught) or
+        the sign change is not confirmed (a Neimark-Sacker change of a real pair).
+    """
     from scipy.optimize import brentq
 
     sc = sys.p_scale
@@ -291,7 +343,7 @@ def locate_end(sys: BranchSystem, a: BranchPoint, ds: float, exc, period: int,
 
 def locate_on_bound(sys, a, b, kind, k):
     """A special point between ``a`` and the bound point ``b``: along ``a``'s tangent to
-    the arclength of ``b``."""
+    the arclength of ``b`` (scaled, dimensionless: ``u = (z, p / p_scale)``)."""
     ua, ub = scaled_point(a, sys.p_scale), scaled_point(b, sys.p_scale)
     s_b = float(a.tangent @ (ub - ua))
     if s_b <= 0:
@@ -303,7 +355,9 @@ def switch_period_doubling(family: WalkerFamily, sp: SpecialPoint, p_scale: floa
                            eps: float = 1e-3) -> BranchPoint:
     """First point of the period-``2k`` branch born at the period doubling ``sp`` (on the
     period-``k`` branch): the fixed point of the ``2k``-step map with ``v . (z - z*) = eps``
-    (``v`` the eigenvector of the multiplier -1), the parameter free.
+    (``v`` the eigenvector of the multiplier -1), the parameter free (branch switching at a
+    flip bifurcation; Kuznetsov, "Elements of Applied Bifurcation Theory", 3rd ed. 2004,
+    ch. 10).
 
     Raises
     ------

@@ -95,7 +95,8 @@ def seed_states(walker: HybridWalker) -> list[tuple[str, np.ndarray]]:
     Returns
     -------
     list of (str, ndarray (2n,))
-        A description and the state, for each seed.
+        A description and the state (``walker.state_names()``; angles [rad], rates
+        [rad/s]), for each seed.
     """
     gamma = max(float(walker.slope_rad), 1e-4)
     omega = math.sqrt(float(walker.params["gravity_m_per_s2"])
@@ -118,12 +119,14 @@ def coarse_solver(solver: Solver) -> Solver:
 def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
                  ) -> tuple[list[tuple[float, str, np.ndarray]], int]:
     """Seeds ranked by one coarse Poincaré-map step: ``|section(P(x)) - section(x)| /
-    |section(x)|`` (seeds that fall within the step are dropped).
+    |section(x)|`` (seeds that fall within the step are dropped).  The seeds are
+    :func:`seed_states` (Garcia et al. 1998's gamma^(1/3) scaling); ``max_step_time`` [s]
+    caps a step.
 
     Returns
     -------
     ranked : list of (float, str, ndarray (2n,))
-        Relative residual, description, state; smallest residual first.
+        Relative residual [-], description, state ([rad, rad/s]); smallest residual first.
     n_seeds : int
         Seeds tried.
     """
@@ -145,7 +148,24 @@ def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
 def walked_start(walker: HybridWalker, x: np.ndarray, solver: Solver,
                  max_step_time: float) -> np.ndarray | None:
     """The post-impact state after a coarse walk of :data:`WALK_STEPS` maps from ``x`` (a
-    stride at a time for a walker whose map is a stride), or None when it falls before."""
+    stride at a time for a walker whose map is a stride), or None when it falls before.
+
+    Iterating the Poincaré map towards a stable gait (Garcia et al. 1998: the stable gait
+    of the pair attracts nearby starts).
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    x : ndarray, shape (2n,)
+        Post-impact state (``walker.state_names()``, [rad, rad/s]).
+    solver : Solver
+    max_step_time : float
+        A step longer than this [s] counts as a fall.
+
+    Returns
+    -------
+    ndarray, shape (2n,) or None
+    """
     coarse = coarse_solver(solver)
     for _ in range(WALK_STEPS):
         try:
@@ -157,13 +177,19 @@ def walked_start(walker: HybridWalker, x: np.ndarray, solver: Solver,
 
 def step_length(walker: HybridWalker, x: np.ndarray) -> float:
     """Length of the step of a state just after heel strike [m] (the swing foot's offset
-    from the stance foot; NaN for a walker without a ``swing_foot`` point)."""
+    from the stance foot; NaN for a walker without a ``swing_foot`` point).
+
+    ``x`` (2n,): ``walker.state_names()`` order [rad, rad/s].  The distance the pair of
+    gaits differs in (Goswami et al. 1996, Garcia et al. 1998: the stable gait has the
+    longer step on shallow slopes).
+    """
     foot = walker.points(x).get("swing_foot")
     return float(np.linalg.norm(foot)) if foot is not None else math.nan
 
 
 def deflation_starts(walker: HybridWalker, first: FixedPointResult) -> list[np.ndarray]:
-    """Starts of the deflated search for the other gait of the pair (states (2n,)).
+    """Starts of the deflated search for the other gait of the pair (states (2n,),
+    ``walker.state_names()`` order, [rad, rad/s]).
 
     ``first``'s section coordinates offset by :data:`DEFLATION_OFFSET` (relative, at least
     0.1 absolute) one at a time, both ways.  Along each coordinate the way that moves the

@@ -70,7 +70,15 @@ def _indicators(sm: BatchStepMap, res) -> np.ndarray:
 def one_step(sm: BatchStepMap, X: np.ndarray, disturbance: str, e: np.ndarray):
     """One step of rows ``X`` (N, 2n) with disturbance values ``e`` (N,).
 
-    Returns ``(x_next (N, 2n), indicators (N, 3), ok (N,))``."""
+    Returns ``(x_next (N, 2n), indicators (N, 3), ok (N,))``.  ``X``: post-impact states
+    (``state_names()``, [rad, rad/s]); ``e`` in :data:`UNITS` ([rad], [m] or [m/s]);
+    indicators :data:`INDICATORS` ([s], [m], [rad]; NaN where not ``ok``).
+
+    Raises
+    ------
+    ValueError
+        ``disturbance`` is not one of :data:`DISTURBANCES`.
+    """
     e = np.asarray(e, dtype=float)
     if disturbance == "push":  # pushed rows one by one (scipy), the others batched
         e = np.broadcast_to(e, (X.shape[0],))
@@ -91,7 +99,12 @@ def one_step(sm: BatchStepMap, X: np.ndarray, disturbance: str, e: np.ndarray):
 
 @dataclass
 class Linearisation:
-    """``dx' = A dx + B e``, ``dy = C dx + D e`` at the gait for one disturbance."""
+    """``dx' = A dx + B e``, ``dy = C dx + D e`` at the gait for one disturbance
+    (Hobbelen & Wisse 2007, Eq. 5-8).
+
+    Shapes: ``A`` (2n, 2n) the Poincaré-map Jacobian; ``B`` (2n,) per unit of disturbance
+    (:data:`UNITS`); ``C`` (3, 2n) and ``D`` (3,) of the :data:`INDICATORS` ([s], [m], [rad]).
+    """
 
     A: np.ndarray
     B: np.ndarray
@@ -110,7 +123,15 @@ def linearise(sm: BatchStepMap, x_star: np.ndarray, A: np.ndarray, disturbance: 
               h_rel: float = 1e-6) -> Linearisation:
     """``B, C, D`` by central differences of the one-step map (``A`` given: the variational
     Jacobian, shape (2n, 2n)); state steps ``h_rel (1 + |x_i|)``, disturbance step
-    ``h_rel`` (rad or m)."""
+    ``h_rel`` [-] (in the disturbance's unit, :data:`UNITS`); ``x_star`` (2n,) the gait's
+    post-impact fixed point (``state_names()``, [rad, rad/s]).
+
+    Raises
+    ------
+    ValueError
+        A neighbouring step of the gait did not end in heel strike, or an unknown
+        ``disturbance`` (:func:`one_step`).
+    """
     n = x_star.size
     hx = h_rel * (1 + np.abs(x_star))
     X = np.tile(x_star, (2 * n + 2, 1))
@@ -133,7 +154,16 @@ def gsn_nonlinear(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, e: flo
                   steps: int = 80) -> float:
     """The GSN from the nonlinear map: impulse ``e`` on step 0, then the undisturbed map for
     ``steps`` steps; ``sqrt(sum_k |y_k - y*|^2) / |e|``.  Uses the same ``+e`` and ``-e``
-    impulses and halves their difference (central), so the error is O(e^2) relative."""
+    impulses and halves their difference (central), so the error is O(e^2) relative.
+    (Hobbelen & Wisse 2007's GSN as the nonlinear response.)  ``x_star`` (2n,) [rad,
+    rad/s]; ``e`` in :data:`UNITS`; the GSN in indicator units ([s], [m], [rad]) per unit
+    of ``e``.
+
+    Raises
+    ------
+    ValueError
+        The disturbed walker fell within ``steps``, or an unknown ``disturbance``.
+    """
     X = np.tile(x_star, (3, 1))
     ee = np.array([0.0, e, -e])
     acc = 0.0
@@ -150,7 +180,8 @@ def gsn_nonlinear(sm: BatchStepMap, x_star: np.ndarray, disturbance: str, e: flo
 def relative_coordinates(names: list[str]) -> np.ndarray:
     """``T`` (2n, 2n): absolute angles -> angles relative to the stance leg (each other
     coordinate minus ``stance_angle``, its rate minus ``stance_rate``; the stance leg's
-    own stay absolute), by state name.
+    own stay absolute), by state name.  ``T`` is dimensionless ([-]: entries 0, 1, -1), so
+    ``z = T x`` keeps the units of ``x`` ([rad], [rad/s]).
 
     Raises
     ------
@@ -173,7 +204,9 @@ def state_gsn(lin: Linearisation, T: np.ndarray | None = None) -> float:
     """The sensitivity norm with the post-impact *state* as the indicator, in coordinates
     ``z = T x`` (Jin et al. 2021: such a norm depends on the coordinates):
     ``sqrt(trace(T W T^T))`` with ``W`` as in :meth:`Linearisation.gsn`, including the
-    first step's ``B``."""
+    first step's ``B``.  ``T`` (2n, 2n): :func:`relative_coordinates` or None (identity);
+    the norm is in state units ([rad], [rad/s]) per disturbance unit (:data:`UNITS`).
+    """
     from scipy.linalg import solve_discrete_lyapunov
 
     T = np.eye(lin.A.shape[0]) if T is None else T
@@ -191,10 +224,18 @@ def largest_tolerable(sm: BatchStepMap, x_star: np.ndarray, disturbance: str,
     (one batch), and the answer is the largest value below the first that falls (so a
     survivable value above a fatal one is not counted).
 
+    ``x_star`` (2n,): the gait's post-impact fixed point [rad, rad/s]; ``max_value`` and
+    ``resolution`` in the disturbance's unit (:data:`UNITS`); ``sign`` +1 or -1.
+
     Returns
     -------
     float
-        [rad or m]; ``max_value`` if none falls.
+        [rad, m or m/s] (:data:`UNITS`); ``max_value`` if none falls.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``disturbance`` (:func:`one_step`).
     """
     v = np.arange(0.0, max_value + 0.5 * resolution, resolution)
     X = np.tile(x_star, (v.size, 1))

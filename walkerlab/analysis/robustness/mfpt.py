@@ -54,7 +54,9 @@ from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 
 
 def geometric_mle(heel_strikes: int, falls: int) -> tuple[float, float]:
-    """Censored geometric MLE of the MFPT and its standard error.
+    """Censored geometric MLE of the MFPT and its standard error (module docstring;
+    ``MFPT = S / F``, ``stderr = sqrt(MFPT (MFPT + 1) / F)``, Fisher information and delta
+    method).
 
     Parameters
     ----------
@@ -79,7 +81,8 @@ def draw_slopes(seed: int, walk: int, n: int, mean: float, sd: float,
     """The slopes [rad] of the first ``n`` steps of walk number ``walk`` (reproducible).
 
     ``distribution``: ``normal`` (mean, standard deviation ``sd``) or ``uniform`` (on
-    ``mean -/+ sqrt(3) sd``, the same standard deviation).
+    ``mean -/+ sqrt(3) sd``, the same standard deviation; any other value: normal); stream
+    ``SeedSequence(seed, spawn_key=(walk,))``.  ``mean``, ``sd`` [rad]; returns shape (n,).
     """
     rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(int(walk),)))
     if distribution == "uniform":
@@ -95,7 +98,7 @@ class MonteCarloResult:
     Attributes
     ----------
     steps : ndarray of int, shape (walks,)
-        Heel strikes of each walk.
+        Heel strikes of each walk [steps].
     fell : ndarray of bool, shape (walks,)
         Whether the walk fell (False: censored at the step cap).
     """
@@ -113,7 +116,8 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
                 max_steps: int, seed: int, mean: float | None = None,
                 distribution: str = "normal", block: int = 64) -> MonteCarloResult:
     """Walk ``len(walks)`` walkers from ``x0`` on random per-step slopes until each falls or
-    reaches ``max_steps`` heel strikes.
+    reaches ``max_steps`` heel strikes (Byl & Tedrake 2009; module docstring, "Monte
+    Carlo").
 
     Parameters
     ----------
@@ -163,7 +167,8 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
 
 def visited_states(step_map: BatchStepMap, x0: np.ndarray, sds, walks: int, steps: int,
                    seed: int, burn_in: int = 1, distribution: str = "normal") -> np.ndarray:
-    """Post-impact states visited by noisy walks from ``x0`` (the mesh's nodes).
+    """Post-impact states visited by noisy walks from ``x0`` (the mesh's nodes; Byl &
+    Tedrake 2009's "reachable" mesh).
 
     Parameters
     ----------
@@ -204,7 +209,12 @@ def whitening(P: np.ndarray, rank_tol: float = 1e-10) -> np.ndarray:
     """``W`` (2n, d): ``(x - x') @ W`` measures distances in standard deviations of the
     cloud ``P`` (k, 2n) along its principal axes; directions without spread (a locked
     knee's equal thigh and shank angles) drop out, so ``d`` is the dimension of the set the
-    post-impact states fill (4 for a compass walker on per-step slopes)."""
+    post-impact states fill (4 for a compass walker on per-step slopes).
+
+    PCA whitening, ``W = V diag(w)^(-1/2)`` over the covariance's eigenpairs with ``w >
+    rank_tol max(w)``; ``P`` in ``state_names()`` order [rad, rad/s], ``W`` in [1 / state
+    unit], so the whitened coordinates are dimensionless [standard deviations].
+    """
     w, V = np.linalg.eigh(np.cov(np.asarray(P, float).T))
     keep = w > rank_tol * w.max()
     return V[:, keep] / np.sqrt(w[keep])
@@ -221,6 +231,7 @@ class MeshResult:
     mfpt_quasi_stationary_steps : float
         ``1 / (1 - lambda_2) - 1``.
     lambda2 : float
+        Largest eigenvalue of the transient block ``Q`` [-].
     cells : int
         Nodes (Voronoi cells) of the mesh.
     h : float
@@ -231,6 +242,11 @@ class MeshResult:
         lands off the mesh (farther from every node than 99 % of the nodes are from their
         nearest neighbour); such images go to their nearest node.
     steps_evaluated : int
+        Step-map evaluations this mesh computed (the cached images not counted).
+    expected_steps : ndarray, shape (cells,)
+        Expected heel strikes before the fall from each node [steps].
+    change, converged : float, bool
+        Relative change [-] from the coarser mesh; :func:`mesh_mfpt_converged` criterion met.
     """
 
     mfpt_steps: float
@@ -248,7 +264,7 @@ class MeshResult:
 
 def gauss_hermite(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarray]:
     """Nodes [rad] and weights (sum 1) of the normal distribution N(mean, sd^2)
-    (``numpy.polynomial.hermite_e.hermegauss``)."""
+    (``numpy.polynomial.hermite_e.hermegauss``); each of shape (n,)."""
     from numpy.polynomial.hermite_e import hermegauss
 
     z, w = hermegauss(n)
@@ -258,7 +274,8 @@ def gauss_hermite(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarra
 def gauss_legendre_uniform(n: int, mean: float, sd: float) -> tuple[np.ndarray, np.ndarray]:
     """Nodes [rad] and weights (sum 1) of the uniform distribution on
     ``mean -/+ sqrt(3) sd`` (standard deviation ``sd``; :func:`draw_slopes`'s uniform),
-    Gauss-Legendre (``numpy.polynomial.legendre.leggauss``) mapped to that interval."""
+    Gauss-Legendre (``numpy.polynomial.legendre.leggauss``) mapped to that interval; each
+    of shape (n,)."""
     from numpy.polynomial.legendre import leggauss
 
     z, w = leggauss(n)
@@ -271,9 +288,16 @@ def slope_quadrature(n: int, mean: float, sd: float, distribution: str = "normal
 
     Parameters
     ----------
+    n, mean, sd : int, float, float
+        Number of nodes; mean and standard deviation of the slope [rad].
     distribution : {"normal", "uniform"}
         Gauss-Hermite (:func:`gauss_hermite`) or Gauss-Legendre on the uniform's support
         (:func:`gauss_legendre_uniform`).
+
+    Returns
+    -------
+    (nodes, weights) : ndarray, shape (n,) each
+        Slopes [rad] and probabilities [-].
 
     Raises
     ------
@@ -294,7 +318,8 @@ def transition_matrix(images: np.ndarray, ok: np.ndarray, weights: np.ndarray,
     Parameters
     ----------
     images : ndarray (k, q, 2n)
-        Post-impact state from node ``i`` on slope node ``j``.
+        Post-impact state from node ``i`` on slope node ``j`` (``state_names()`` order,
+        [rad, rad/s]).
     ok : ndarray of bool (k, q)
         Heel strike (else a fall: the absorbing state).
     weights : ndarray (q,)
@@ -310,7 +335,8 @@ def transition_matrix(images: np.ndarray, ok: np.ndarray, weights: np.ndarray,
     off : ndarray (k,)
         Probability from each node of landing off the mesh (see ``MeshResult.escaped``).
     h : float
-        Median nearest-neighbour distance of the nodes.
+        Median nearest-neighbour distance of the nodes, in the whitened chart [standard
+        deviations].
     """
     from scipy.sparse import coo_matrix
     from scipy.spatial import cKDTree
@@ -334,7 +360,8 @@ def solve_mesh(Q, start: int):
     quasi-stationary distribution (k,))`` of the absorbing chain with transient block ``Q``
     (k, k) (heel strikes = transitions - 1): ``(I - Q) m = 1``
     (:func:`scipy.sparse.linalg.spsolve`) and the largest eigenvalue of ``Q`` with its left
-    eigenvector (:func:`scipy.sparse.linalg.eigs`)."""
+    eigenvector (:func:`scipy.sparse.linalg.eigs`): the absorbing chain's expected time to
+    absorption (Byl & Tedrake 2009); counts in heel strikes [steps], ``lambda_2`` [-]."""
     from scipy.sparse import identity
     from scipy.sparse.linalg import ArpackNoConvergence, eigs, spsolve
 
@@ -357,7 +384,8 @@ def voxel_nodes(Z: np.ndarray, cells: int) -> tuple[np.ndarray, float]:
     bisected so that about ``cells`` voxels are occupied (row 0, the gait, always in).
 
     ``Z`` (k, d): the states in the whitened chart.  Nodes spread evenly over the visited
-    region, so the tails (where the falls start) are meshed as finely as the core."""
+    region, so the tails (where the falls start) are meshed as finely as the core.  The
+    indices have shape (c,); ``r`` is in standard deviations (dimensionless)."""
     lo, hi = 1e-3, 10.0
     best = None
     for _ in range(40):
@@ -378,7 +406,8 @@ def voxel_nodes(Z: np.ndarray, cells: int) -> tuple[np.ndarray, float]:
 def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndarray,
               sd: float, quadrature: int = 21, evaluate=None, cache: dict | None = None,
               distribution: str = "normal") -> MeshResult:
-    """MFPT on the Voronoi mesh of the nodes ``P[idx]`` (see the module docstring).
+    """MFPT on the Voronoi mesh of the nodes ``P[idx]`` (see the module docstring; Byl &
+    Tedrake 2009).
 
     Parameters
     ----------
@@ -398,6 +427,16 @@ def mesh_mfpt(step_map: BatchStepMap, P: np.ndarray, idx: np.ndarray, W: np.ndar
         Images of candidates computed by earlier meshes (reused and extended).
     distribution : {"normal", "uniform"}
         Of the per-step slope.
+
+    Returns
+    -------
+    MeshResult
+        MFPTs in heel strikes [steps].
+
+    Raises
+    ------
+    ValueError
+        ``distribution`` is neither ``"normal"`` nor ``"uniform"`` (:func:`slope_quadrature`).
     """
     g, w = slope_quadrature(quadrature, step_map.slope_rad, sd, distribution)
     q = len(g)
@@ -431,7 +470,8 @@ def mesh_mfpt_converged(step_map: BatchStepMap, pool: np.ndarray, x0: np.ndarray
                         on_mesh=None) -> tuple[MeshResult, list[MeshResult]]:
     """Refine the mesh (``cells <- refine cells``: smaller voxels of the visited states
     ``pool`` (k, 2n) plus the gait ``x0``, :func:`voxel_nodes`) until the MFPT changes by
-    less than ``rel_change`` between two meshes, or the pool or ``max_cells`` is exhausted.
+    less than ``rel_change`` between two meshes, or the pool or ``max_cells`` is exhausted
+    (module docstring: a coarse mesh is biased, so its change is the stated error).
 
     ``cache`` (see :func:`mesh_mfpt`; rows of ``[x0, *pool]``) carries images computed
     before, e.g. by an interrupted run; ``on_mesh(result, cache)`` is called after each mesh

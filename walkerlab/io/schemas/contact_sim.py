@@ -284,7 +284,12 @@ class DropTest:
 @dataclass
 class PeriodicGait:
     """The contact model's own periodic gait (or why it was not found: ``found`` False,
-    ``outcome`` and ``message``).  Period [s], step length [m], multipliers complex."""
+    ``outcome`` and ``message``).  Period [s], step length [m], multipliers complex.
+
+    ``multipliers`` is an ndarray of shape (m,) (the section's dimension: 6 for straight
+    legs, 10 kneed; shape (0,) when not found), Floquet multipliers [-] by decreasing
+    modulus.
+    """
 
     found: bool
     outcome: str

@@ -118,7 +118,8 @@ class ContinuationData:
     curves: list = field(default_factory=list)
 
     def state_at(self, value: float, branch: int = 0) -> np.ndarray:
-        """The state (2n,) of branch ``branch`` at the parameter ``value`` (linear
+        """The state (2n,) [rad, rad/s] of branch ``branch`` at the parameter ``value`` (in
+        :attr:`unit`; linear
         interpolation between the two nearest points along the branch; a guess for a root
         finder).
 

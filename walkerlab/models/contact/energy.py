@@ -40,7 +40,19 @@ def total_energy(walker, X) -> np.ndarray:
     """Kinetic + gravitational + stored elastic energy [J] of states ``X`` (n, 2 nq).
 
     Elastic: ``k d^(e+1) / (e+1)`` of each foot on a patch with penetration ``d > 0``, and
-    ``k_k x^(e_k+1) / (e_k+1)`` of each knee stop at hyperextension ``x > 0``.
+    ``k_k x^(e_k+1) / (e_k+1)`` of each knee stop at hyperextension ``x > 0`` (the integral
+    of the IMPACT spring force ``k d^e``; MSC Adams/Solver IMPACT, NOTES.md).
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    X : array_like, shape (n, 2 nq) or (2 nq,)
+        States in ``walker.state_names()`` order [m, rad, m/s, rad/s].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Total energy [J] (potential relative to y = 0).
     """
     X = np.atleast_2d(np.asarray(X, float))
     E = walker.energies(X)["total"].astype(float)
@@ -63,6 +75,19 @@ def energy_rise_bound(walker, x0, rtol: float) -> float:
     ``rtol`` relative per step and the energy of a walking run at the shipped tolerances
     (rtol 1e-8) stays within ~1e-7 of that scale (measured), so 1e-4 of it is far above the
     integration error and far below any blow-up (1e10 J on 150 J).
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    x0 : array_like, shape (2 nq,)
+        The run's first state (``walker.state_names()``).
+    rtol : float
+        The integrator's relative tolerance [-].
+
+    Returns
+    -------
+    float
+        The bound [J] (module docstring: the energy never rises without a source).
     """
     E = walker.energies(np.atleast_2d(x0))
     scale = float(E["kinetic"][0]) + walker.total_mass * walker.g * walker.L
@@ -71,7 +96,18 @@ def energy_rise_bound(walker, x0, rtol: float) -> float:
 
 def first_energy_violation(walker, X, e_start: float, bound: float) -> int | None:
     """Index of the first state in ``X`` whose total energy exceeds ``e_start + bound``
-    (None if none)."""
+    (None if none); a NaN energy counts as exceeding.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    X : array_like, shape (n, 2 nq)
+        Samples of a run (``walker.state_names()``).
+    e_start : float
+        :func:`total_energy` of the run's start [J].
+    bound : float
+        Allowed rise [J] (:func:`energy_rise_bound`).
+    """
     E = total_energy(walker, X)
     bad = np.flatnonzero(~(E <= e_start + bound))  # NaN counts as a violation
     return int(bad[0]) if bad.size else None

@@ -514,7 +514,12 @@ def rhs_source(eq) -> str:
     ``M`` and ``Q - h`` (common subexpressions shared) and an unrolled Cholesky solve that
     skips the structural zeros of ``M`` (fill-in tracked).  Same equations as the array
     functions ``dyn``/``feet`` (tests check the two agree), ~2x faster per call, which is
-    what CyRK's BDF pays per step."""
+    what CyRK's BDF pays per step.
+
+    The generated ``rhs`` takes the state ``x`` of shape (2 nq,) [m, rad, m/s, rad/s], the
+    contact parameters ``PC`` (SI), the walker's parameters ``p`` (SI) and the kernel lanes
+    ``c1``, ``c2`` [m], and returns dx/dt of shape (2 nq,).
+    """
     import sympy as sp
     from sympy.printing.pycode import PythonCodePrinter
 
@@ -588,7 +593,13 @@ def rhs_source(eq) -> str:
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
     constants ``NP``, ``KNEE``, ``NF``, ``POINT_LEG``, ``PIN``, ``CONTACTS``, then
-    :data:`ASSEMBLY` and the straight-line ``rhs``)."""
+    :data:`ASSEMBLY` and the straight-line ``rhs``).
+
+    Raises
+    ------
+    ValueError
+        A kneed walker with more than one contact point per leg (flat feet).
+    """
     from walkerlab.codegen import floating
 
     eq = floating.derive_floating(structure)

@@ -75,7 +75,20 @@ STATE_OF_COORDINATE = {c: state_name(c) for c in
 
 def flat_foot_numbers(data) -> list[dict]:
     """Per leg (leg1, leg2) a flat foot's numbers ``heel``, ``toe`` [m], ``r`` [rad] from the
-    parameter vector (leg1 the swing role's when the legs differ); [] for other feet."""
+    parameter vector (leg1 the swing role's when the legs differ); [] for other feet.
+
+    Parameters
+    ----------
+    data : WalkerData
+        The walker; read are ``data.structure`` and ``data.params`` (shape
+        ``(len(structure.param_names),)``, named by ``structure.param_names``).
+
+    Returns
+    -------
+    list of dict
+        Two dicts (leg1, leg2) with float values ``heel`` [m], ``toe`` [m], ``r`` [rad]; an
+        empty list unless ``data.structure.foot == "flat"``.
+    """
     st = data.structure
     if st.foot != "flat":
         return []
@@ -250,7 +263,20 @@ class ContactWalker:
                    n_steps: int) -> ContactWalker:
         """The same walker and contact law on ``terrain``: checkerboard patches spaced by
         ``step_length`` [m] for ``n_steps`` steps (each lane shifted by its leg's
-        :func:`footprint_offsets`), or continuous ground."""
+        :func:`footprint_offsets`), or continuous ground.
+
+        Returns
+        -------
+        ContactWalker
+            A copy (:func:`dataclasses.replace`) with lanes of ``n_steps // 2 + 2`` patch
+            centres [m] each and ``patch_half_width = terrain.patch_width_m / 2`` [m].
+
+        Raises
+        ------
+        ValueError
+            From the copy's ``__post_init__``: ``heights1``/``heights2`` are set and no longer
+            have one value per patch of the new lanes.
+        """
         c1, c2 = checkerboard_lanes(step_length, n_steps)
         o1, o2 = footprint_offsets(self.data)
         return dataclasses.replace(self, lane1=c1 + o1, lane2=c2 + o2,
@@ -274,16 +300,20 @@ class ContactWalker:
 
     @property
     def normal(self) -> np.ndarray:
-        """Outward ground normal n (2,)."""
+        """Outward ground normal n = (sin phi, cos phi), shape (2,), unit vector [-]."""
         return np.array([np.sin(self.phi), np.cos(self.phi)])
 
     @property
     def tangent(self) -> np.ndarray:
-        """Down-slope tangent t (2,)."""
+        """Down-slope tangent t = (cos phi, -sin phi), shape (2,), unit vector [-]."""
         return np.array([np.cos(self.phi), -np.sin(self.phi)])
 
     def static_penetration(self, load: float | None = None) -> float:
-        """IMPACT static penetration (F / k)^(1/e) [m] under ``load`` [N] (default M g cos phi)."""
+        """IMPACT static penetration (F / k)^(1/e) [m] under ``load`` [N] (default M g cos phi).
+
+        The damping-free equilibrium of :func:`~walkerlab.models.contact.laws.impact_normal_force`
+        (MSC Adams/Solver IMPACT; NOTES.md): ``k delta^e = F``.
+        """
         if load is None:
             load = self.total_mass * self.g * np.cos(self.phi)
         return (load / self.contact.k) ** (1.0 / self.contact.e)
@@ -331,7 +361,14 @@ class ContactWalker:
 
     def leg_angle_states(self, leg: str) -> tuple[str, ...]:
         """State names of ``leg``'s link angles, proximal first (``theta1`` or
-        ``theta1_thigh``, ``theta1_shank``)."""
+        ``theta1_thigh``, ``theta1_shank``); their unit is [rad], their rates' (``d`` +
+        name) [rad/s].
+
+        Raises
+        ------
+        ValueError
+            ``leg`` is not ``"leg1"`` or ``"leg2"``.
+        """
         i = FOOT_NAMES.index(leg) + 1
         return tuple(s for s in self.state_names()[:self.nq] if s.startswith(f"theta{i}"))
 
@@ -339,14 +376,28 @@ class ContactWalker:
     @property
     def kernel_lanes(self) -> tuple[np.ndarray, np.ndarray]:
         """The lanes as the kernels read them (:mod:`walkerlab.models.contact.generated`): leg1's
-        and leg2's ``[centres (n), heights (n), largest height]`` (2 n + 1,) [m]."""
+        and leg2's ``[centres (n), heights (n), largest height]``, each of shape (2 n + 1,)
+        [m] for a lane of n patches."""
         return self._kernel_lane1, self._kernel_lane2
 
     def _args(self):
         return self.contact_params, self.walker_params, *self.kernel_lanes
 
     def mass_matrix(self, q) -> np.ndarray:
-        """M(q) (nq, nq) [kg, kg m, kg m^2]."""
+        """Mass matrix M(q) of the floating equations of motion M(q) q'' = h(q, q'), generated
+        from the walker description (:mod:`walkerlab.codegen.floating`; Lagrange's equations).
+
+        Parameters
+        ----------
+        q : array_like, shape (nq,) or longer
+            Coordinates [m, m, rad, ...] in :meth:`coordinate_names` order (only the first
+            ``nq`` entries are read, so a full state (2 nq,) works too).
+
+        Returns
+        -------
+        ndarray, shape (nq, nq)
+            Entries in [kg] (hip translations), [kg m] (coupling) and [kg m^2] (angles).
+        """
         x = np.zeros(2 * self.nq)
         x[:self.nq] = np.asarray(q, float)[:self.nq]
         M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
@@ -354,11 +405,38 @@ class ContactWalker:
         return M
 
     def rhs(self, t, x) -> np.ndarray:
-        """dx/dt (2 nq,) (numba).  ``t`` [s] unused (autonomous)."""
+        """dx/dt (numba).  ``t`` [s] unused (autonomous).
+
+        Parameters
+        ----------
+        t : float
+            Time [s] (ignored).
+        x : array_like, shape (2 nq,)
+            State in :meth:`state_names` order, units :meth:`state_units`.
+
+        Returns
+        -------
+        ndarray, shape (2 nq,)
+            ``[dq, ddq]`` in [m/s, rad/s] and [m/s^2, rad/s^2].
+        """
         return self.kernels.rhs(np.asarray(x, dtype=float), *self._args())
 
     def jac(self, t, x) -> np.ndarray:
-        """Analytic Jacobian d(rhs)/dx (2 nq, 2 nq) (numba)."""
+        """Analytic Jacobian d(rhs)/dx (numba; :func:`walkerlab.models.contact.generated.jac`,
+        with each contact point's patch membership held locally constant).
+
+        Parameters
+        ----------
+        t : float
+            Time [s] (ignored).
+        x : array_like, shape (2 nq,)
+            State in :meth:`state_names` order, units :meth:`state_units`.
+
+        Returns
+        -------
+        ndarray, shape (2 nq, 2 nq)
+            Row i, column j is d(dx_i/dt)/dx_j, in [unit of dx_i/dt / unit of x_j].
+        """
         return self.kernels.jac(np.asarray(x, dtype=float), *self._args())
 
     def _check_pin(self):
@@ -367,7 +445,19 @@ class ContactWalker:
                              "point feet")
 
     def pinned_state(self, x) -> np.ndarray:
-        """Pinned state ``z = [link angles, their rates]`` (2 nq - 4,) of a full state."""
+        """Pinned state ``z = [link angles, their rates]`` of a full state.
+
+        Parameters
+        ----------
+        x : array_like, shape (2 nq,)
+            Full state (:meth:`state_names`).
+
+        Returns
+        -------
+        ndarray, shape (2 nq - 4,)
+            The link angles [rad] and their rates [rad/s] (the hip's position and velocity
+            dropped).
+        """
         x = np.asarray(x, float)
         n = self.nq
         return np.concatenate([x[2:n], x[n + 2:]])
@@ -377,13 +467,46 @@ class ContactWalker:
 
         ``z = [link angles, their rates]`` (:meth:`pinned_state`); leg1's foot still feels
         its contact, the knees their stops.
+
+        Parameters
+        ----------
+        t : float
+            Time [s] (ignored).
+        z : array_like, shape (2 nq - 4,)
+            Link angles [rad] and rates [rad/s].
+        foot2 : array_like, shape (2,)
+            Position (x, y) [m] of leg2's pinned foot.
+
+        Returns
+        -------
+        ndarray, shape (2 nq - 4,)
+            dz/dt [rad/s, rad/s^2].
+
+        Raises
+        ------
+        ValueError
+            The walker's feet are not point feet.
         """
         self._check_pin()
         return self.kernels.rhs_pinned(np.asarray(z, float), *self._args(),
                                        np.asarray(foot2, float))
 
     def pinned_to_full(self, z, foot2) -> np.ndarray:
-        """Full state (2 nq,) from the pinned state z and the pinned foot position [m]."""
+        """Full state from the pinned state z and the pinned foot position.
+
+        Parameters
+        ----------
+        z : array_like, shape (2 nq - 4,)
+            Link angles [rad] and rates [rad/s] (:meth:`pinned_state`).
+        foot2 : array_like, shape (2,)
+            Position (x, y) [m] of leg2's pinned foot.
+
+        Returns
+        -------
+        ndarray, shape (2 nq,)
+            State in :meth:`state_names` order (hip position and velocity from the pinned
+            foot's kinematics), units :meth:`state_units`.
+        """
         return self.kernels.pinned_to_full(np.asarray(z, float), self.walker_params,
                                            np.asarray(foot2, float))
 
@@ -398,6 +521,19 @@ class ContactWalker:
         its spring's rest angle ``r``, the stance foot at the rigid view's ankle angle; a
         leg's scale multiplies its foot's rate too);
         other coordinate schemes through the rigid model's leg angles.
+
+        Parameters
+        ----------
+        x_ideal : array_like, shape (2n,)
+            The rigid model's state in its role order (``rigid_layout().state_names()``),
+            angles [rad] and rates [rad/s].
+        rate_scale : (float, float)
+            Multipliers [-] on leg1's and leg2's rates.
+
+        Returns
+        -------
+        ndarray, shape (2 nq - 4,)
+            The pinned state z (:meth:`pinned_state`), [rad] and [rad/s].
         """
         from walkerlab.walker.layout import floating_links_from_rigid
 
@@ -435,7 +571,14 @@ class ContactWalker:
         return FOOT_NAMES[self._point_legs[self._contacts.index(name)]]
 
     def lane(self, name: str) -> np.ndarray:
-        """Patch centres [m] of the lane of contact point (or leg) ``name``."""
+        """Patch centres [m] of the lane of contact point (or leg) ``name``: ``lane1`` or
+        ``lane2``, shape (number of patches,).
+
+        Raises
+        ------
+        ValueError
+            ``name`` is neither a leg nor one of :meth:`contact_names`.
+        """
         leg = name if name in FOOT_NAMES else self.contact_leg(name)
         return self.lane1 if leg == "leg1" else self.lane2
 
@@ -468,7 +611,15 @@ class ContactWalker:
 
     def fall_margin(self, x, threshold: float) -> float:
         """The one fall test: hip height of state ``x`` minus ``threshold`` [m]
-        (negative = fallen).  Used as the fall event of every integration."""
+        (negative = fallen).  Used as the fall event of every integration.
+
+        Parameters
+        ----------
+        x : array_like, shape (2 nq,)
+            State (:meth:`state_names`).
+        threshold : float
+            Hip height [m] below which the walker has fallen.
+        """
         return float(self.hip_height(x)[0]) - threshold
 
     def contact_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
@@ -491,7 +642,8 @@ class ContactWalker:
                 for i, foot in enumerate(self._contacts)}
 
     def foot_quantities(self, X) -> dict[str, dict[str, np.ndarray]]:
-        """Per-leg contact quantities (``leg1``, ``leg2``) for states X (n, 2 nq): the
+        """Per-leg contact quantities (``leg1``, ``leg2``) for states X (n, 2 nq) [m, rad, m/s,
+        rad/s] (or one state (2 nq,)): the
         contact table itself for one point per leg; a flat foot's points combined: forces
         and power summed, the deepest point's penetration, its rate, slip velocity, ``s``
         and ``on_ground`` (the point that touches down first and lifts off last).
@@ -538,14 +690,38 @@ class ContactWalker:
                 for i, leg in enumerate(FOOT_NAMES)}
 
     def energies(self, X) -> dict[str, np.ndarray]:
-        """Kinetic, potential (relative to y = 0) and total energy [J] for X (n, 2 nq)."""
+        """Kinetic, potential (relative to y = 0) and total energy [J] for X (n, 2 nq).
+
+        ``T = 1/2 dq^T M(q) dq`` and ``V = g sum(m_i y_i)`` of the generated mechanics
+        (:mod:`walkerlab.codegen.floating`), the contact and knee-stop springs' energy not
+        included.
+
+        Parameters
+        ----------
+        X : array_like, shape (n, 2 nq) or (2 nq,)
+            States (:meth:`state_names`).
+
+        Returns
+        -------
+        dict[str, ndarray]
+            ``kinetic``, ``potential``, ``total``, each of shape (n,) [J].
+        """
         T, V = self.kernels.energies(self._rows(X).T, self.walker_params)
         return {"kinetic": T, "potential": V, "total": T + V}
 
     # ------------------------------------------------------------------ compiled integrators
     def pack(self) -> np.ndarray:
         """Data vector ``[n1, n2, PC, p, c1, c2, nfev=0]`` of the compiled right-hand side
-        (:mod:`walkerlab.models.contact.generated`)."""
+        (:mod:`walkerlab.models.contact.generated`).
+
+        Returns
+        -------
+        ndarray, shape (2 + NPC + len(walker_params) + n1 + n2 + 1,), float64
+            ``n1``, ``n2`` the kernel lanes' lengths (:attr:`kernel_lanes`), ``PC`` the contact
+            parameters (SI: [N/m^e], [-], [N s/m], [m], [-], [m/s], ...), ``p`` the walker's
+            parameters (SI), ``c1``, ``c2`` the kernel lanes [m], and a zero slot the compiled
+            code counts right-hand-side evaluations in.
+        """
         k1, k2 = self.kernel_lanes
         return np.concatenate([[len(k1), len(k2)], self.contact_params,
                                self.walker_params, k1, k2, [0.0]]

@@ -65,7 +65,14 @@ FRICTION_EXPONENT = 0.5
 
 def expected_order(e: float) -> float:
     """Observed order of the period / step-length gaps in ``kappa`` along the family [-]:
-    ``min(1/(e+1), FRICTION_EXPONENT)`` (impact duration vs. stance creep)."""
+    ``min(1/(e+1), FRICTION_EXPONENT)`` (impact duration vs. stance creep; derived in the
+    module docstring, "Observed order").
+
+    Parameters
+    ----------
+    e : float
+        The IMPACT force exponent [-].
+    """
     return min(1.0 / (e + 1.0), FRICTION_EXPONENT)
 
 
