@@ -22,12 +22,16 @@ RUN_RECORDS = re.compile(r"(wall|cpu|elapsed|time_s$|timing|hash|created|generat
                          r"|seconds|_s_per_|duration|host|machine|load)", re.I)
 
 
+#: netCDF dimension-scale bookkeeping: object references that depend on the open file
+REFERENCES = frozenset({"DIMENSION_LIST", "REFERENCE_LIST"})
+
+
 def _items(f: h5py.File) -> dict:
     out = {}
 
     def visit(name, obj):
         for k, v in obj.attrs.items():
-            if not RUN_RECORDS.search(k):
+            if not RUN_RECORDS.search(k) and k not in REFERENCES:
                 out[f"{name}@{k}"] = v
         if isinstance(obj, h5py.Dataset) and not RUN_RECORDS.search(name.rsplit("/", 1)[-1]):
             out[name] = obj[()]
@@ -40,7 +44,7 @@ def _items(f: h5py.File) -> dict:
 
 
 def _same(a, b) -> bool:
-    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+    if isinstance(a, np.ndarray | np.generic) or isinstance(b, np.ndarray | np.generic):
         a, b = np.asarray(a), np.asarray(b)
         if a.shape != b.shape or a.dtype != b.dtype:
             return False

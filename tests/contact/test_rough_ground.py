@@ -10,6 +10,7 @@ import pytest
 
 from walkerlab.analysis.contact import rough as C
 from walkerlab.config import ContactSettings
+from walkerlab.models.contact import terrain as T
 from walkerlab.models.contact.laws import contact_params_si
 from walkerlab.models.contact.model import ContactWalker
 
@@ -96,20 +97,20 @@ def test_heights_are_checked_and_footfalls_map_to_lanes():
     through each footfall."""
     with pytest.raises(ValueError, match="heights1: one finite height"):
         _walker(heights1=np.zeros(3))
-    w = C.footfall_lanes(_walker(), np.array([0.0, -1.0, -2.0, -3.0, -4.0]))
+    w = T.footfall_lanes(_walker(), np.array([0.0, -1.0, -2.0, -3.0, -4.0]))
     np.testing.assert_array_equal(w.heights2, [0.0, -2.0])
     np.testing.assert_array_equal(w.heights1, [-1.0, -3.0])
     g = np.array([0.01, 0.02, 0.0])
-    h = C.slope_heights(g, 0.01, 0.4)
+    h = T.slope_heights(g, 0.01, 0.4)
     np.testing.assert_allclose(h, [0.0, 0.0, -0.4 * np.tan(0.01), -0.4 * np.tan(0.01)
                                    + 0.4 * np.tan(0.01)], rtol=0, atol=1e-15)
-    np.testing.assert_array_equal(C.step_heights(4, -0.005), [0.0, -0.005, -0.005, -0.005])
+    np.testing.assert_array_equal(T.step_heights(4, -0.005), [0.0, -0.005, -0.005, -0.005])
     with pytest.raises(ValueError, match="lanes of footfalls"):
-        C.footfall_lanes(ContactWalker(contact=contact_params_si(ContactSettings())), h)
+        T.footfall_lanes(ContactWalker(contact=contact_params_si(ContactSettings())), h)
     cont = ContactWalker(contact=contact_params_si(ContactSettings()),
                          lane1=np.array([-0.4, 0.4, 1.2]),
                          lane2=np.array([-0.8, 0.0, 0.8]))  # continuous: contiguous patches
-    steps = C.footfall_lanes(cont, np.zeros(6))
+    steps = T.footfall_lanes(cont, np.zeros(6))
     assert not steps.continuous and steps.patch_half_width == pytest.approx(0.4)
     x = _states(cont, 6)
     for xx in x:
@@ -127,9 +128,9 @@ def test_contact_walker_survives_flat_ground_and_falls_off_a_deep_step(paper_sta
     """From the contact run's start the paper walker makes 3 heel strikes on the flat
     checkerboard and on a 1 mm step-down, and does not on a 40 mm step-down (the rigid
     model survives about 5 mm)."""
-    assert C.contact_walk(paper_start, C.step_heights(10, 0.0), 3)[:2] == (3, False)
-    assert C.contact_walk(paper_start, C.step_heights(10, -0.001), 3)[:2] == (3, False)
-    n, fell, kind = C.contact_walk(paper_start, C.step_heights(10, -0.04), 3)
+    assert C.contact_walk(paper_start, T.step_heights(10, 0.0), 3)[:2] == (3, False)
+    assert C.contact_walk(paper_start, T.step_heights(10, -0.001), 3)[:2] == (3, False)
+    n, fell, kind = C.contact_walk(paper_start, T.step_heights(10, -0.04), 3)
     assert fell and n < 3, kind
 
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from walkerlab.analysis.contact import rough as C
 from walkerlab.analysis.robustness.mfpt import MonteCarloResult
+from walkerlab.models.contact import terrain as T
 
 __all__ = ["ContactWalkTask", "contact_monte_carlo", "contact_largest_step", "run_contact_walk"]
 
@@ -119,7 +120,7 @@ def contact_largest_step(start: C.ContactStart, sign: float, max_value_m: float,
     n = steps + 6
 
     def survive(values):
-        tasks = [ContactWalkTask(start, tuple(C.step_heights(n, -sign * float(v))), steps, i)
+        tasks = [ContactWalkTask(start, tuple(T.step_heights(n, -sign * float(v))), steps, i)
                  for i, v in enumerate(values)]
         out = _walk_all(tasks, workers, scheduler)
         return np.array([not out[i][1] for i in range(len(values))])

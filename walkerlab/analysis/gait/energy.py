@@ -29,16 +29,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["LEDGER_NAMES", "LEDGER_UNITS", "step_ledger", "trajectory_ledger"]
+from walkerlab.io.schemas.simulate import LEDGER_UNITS
 
-#: the ledger's columns, each (step,)
-LEDGER_NAMES = ("actuator_work_positive", "actuator_work_negative", "push_off_work",
-                "push_off_impulse", "heel_strike_loss", "internal_collision_loss",
-                "damper_work", "potential_work", "energy_change", "closure",
-                "slope_energy", "cost_of_transport")
-#: unit of each column
-LEDGER_UNITS = {**{k: "J" for k in LEDGER_NAMES}, "push_off_impulse": "N s",
-                "cost_of_transport": "-"}
+__all__ = ["LEDGER_NAMES", "step_ledger", "trajectory_ledger"]
+
+#: the ledger's columns, each (step,) (units: the artifact's, ``LEDGER_UNITS``)
+LEDGER_NAMES = tuple(LEDGER_UNITS)
 
 
 def _quad(f, a: float, b: float, scale: float) -> float:

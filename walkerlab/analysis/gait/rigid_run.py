@@ -107,5 +107,7 @@ def simulate_run(scene: Scene, fixed_point=None):
         except ValueError as exc:
             raise ValueError(f"simulate.initial_state: {exc}") from None
     r = simulate_scene(scene, walker, x0)
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+
     return SimulateRun(walker, r.trajectory, r.samples, r.steps, x0, sim.strides,
-                       total_mass_kg(walker), r.summary)
+                       total_mass_kg(walker), r.summary, trajectory_ledger(r.trajectory))

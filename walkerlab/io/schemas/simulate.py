@@ -8,7 +8,10 @@ row per step on dimension ``step``: ``t_start``, ``t_end``, ``period`` [s], ``st
 ``phases`` (each phase of the step and the guard that ended it) ...;
 ``steps/states/<i>`` start/end state of each segment as attributes); ``initial_state``
 [rad, rad/s]; ``summary/<name>`` (mean step period [s], step length [m], hip speed [m/s],
-total energy [J], RHS evaluations, integration wall time [s]).
+total energy [J], RHS evaluations, integration wall time [s]); ``ledger/<name>`` (the
+energy ledger on dimension ``step``: actuator work, push-off work, collision losses, damper
+and potential work, closure [J], push-off impulse [N s], ``cost_of_transport`` [-];
+:mod:`walkerlab.analysis.gait.energy`).
 """
 
 from __future__ import annotations
@@ -27,6 +30,27 @@ STAGE = "simulate"
 #: unit of each ``steps/`` column
 STEP_UNITS = {"t_start": "s", "t_end": "s", "period": "s", "step_length": "m",
               "hip_speed": "m/s", "impact_energy_loss": "J", "midstance_time": "s"}
+#: unit of each ``ledger/`` column (the energy ledger, :mod:`walkerlab.analysis.gait.energy`)
+LEDGER_UNITS = {**{k: "J" for k in (
+    "actuator_work_positive", "actuator_work_negative", "push_off_work", "heel_strike_loss",
+    "internal_collision_loss", "damper_work", "potential_work", "energy_change", "closure",
+    "slope_energy")}, "push_off_impulse": "N s", "cost_of_transport": "-"}
+#: what each ``ledger/`` column is
+LEDGER_DESCRIPTIONS = {
+    "actuator_work_positive": "positive work of the joint torques over the step",
+    "actuator_work_negative": "negative work of the joint torques over the step",
+    "push_off_work": "work of the push-off impulse (kinetic energy gained)",
+    "push_off_impulse": "push-off impulse along the trailing leg",
+    "heel_strike_loss": "kinetic energy lost in the heel-strike collision",
+    "internal_collision_loss": "kinetic energy lost in knee strikes and foot slaps",
+    "damper_work": "work of the dampers (<= 0)",
+    "potential_work": "work of gravity and the springs (minus the potential's change)",
+    "energy_change": "change of the total mechanical energy over the step",
+    "closure": "energy change minus the sum of the ledger's terms (round-off)",
+    "slope_energy": "potential energy the slope releases over the step, M g d sin(slope)",
+    "cost_of_transport": "(positive actuator work + push-off work + slope energy if > 0) "
+                         "/ (M g d), d the step length along the ground",
+}
 #: unit of each ``summary/`` entry (others: "-")
 SUMMARY_UNITS = {"wall_time_s": "s", "mean_period_s": "s", "mean_step_length_m": "m",
                  "mean_hip_speed_m_per_s": "m/s", "mean_total_energy_J": "J"}
@@ -53,6 +77,9 @@ class SimulateRun:
     summary : dict
         Headline numbers (``termination`` plus :data:`SUMMARY_UNITS` keys, ``nfev``,
         ``steps_completed``).
+    ledger : dict[str, ndarray (n_steps,)]
+        The energy ledger per step (:func:`walkerlab.analysis.gait.energy.trajectory_ledger`;
+        units :data:`LEDGER_UNITS`).
     """
 
     walker: object
@@ -63,6 +90,7 @@ class SimulateRun:
     strides_requested: int
     total_mass_kg: float
     summary: dict
+    ledger: dict = field(default_factory=dict)
 
 
 def write_simulate(f, run: SimulateRun) -> None:
@@ -97,6 +125,12 @@ def write_simulate(f, run: SimulateRun) -> None:
     for k, v in run.summary.items():
         if k != "termination":
             put(f, f"summary/{k}", v, SUMMARY_UNITS.get(k, "-"), k)
+    if run.ledger:
+        lg = f.create_group("ledger")
+        coordinate(lg, "step", steps["index"], "-", "step number")
+        for k, v in run.ledger.items():
+            put(lg, k, np.asarray(v, float), LEDGER_UNITS[k], LEDGER_DESCRIPTIONS[k],
+                dims=("step",))
 
 
 @dataclass
@@ -121,6 +155,9 @@ class SimulateArtifact:
         (units in :data:`STEP_UNITS`).
     summary : dict[str, float]
         ``summary/`` entries.
+    ledger : dict[str, ndarray (n_steps,)]
+        The energy ledger per step (``ledger/``, units :data:`LEDGER_UNITS`); empty for an
+        artifact written before it existed.
     scene_json : str
         The resolved scene the artifact was written for.
     """
@@ -134,6 +171,7 @@ class SimulateArtifact:
     samples: NamedTrajectory
     steps: dict = field(default_factory=dict)
     summary: dict = field(default_factory=dict)
+    ledger: dict = field(default_factory=dict)
     scene_json: str = "{}"
 
     def heel_strike_count(self) -> int:
@@ -165,6 +203,8 @@ def load_simulate(path: Path) -> SimulateArtifact:
             gravity_m_per_s2=float(a.get("gravity_m_per_s2", np.nan)),
             samples=read_samples(f), steps=steps,
             summary={k: f["summary"][k][()] for k in f["summary"]} if "summary" in f else {},
+            ledger={k: f["ledger"][k][()] for k in f["ledger"] if k != "step"}
+            if "ledger" in f else {},
             scene_json=str(a["scene_json"]))
 
 
