@@ -84,7 +84,9 @@ def scene_trajectory_figures(scene, sim, contact, terrain, compare, out_dir: Pat
              if a is not None}
     title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
     has_drop = contact is not None and scene.contact is not None and contact.drop is not None
-    return trajectory_figures(
+    ledger = [] if sim is None or not sim.ledger else energy_ledger_figure(sim, out_dir,
+                                                                           for_scene(scene))
+    return ledger + trajectory_figures(
         trajs, out_dir, title, scene.slope.phi_rad, for_scene(scene), terrain, compare,
         contact.drop if has_drop else None,
         float(scene.contact.written("stiffness")[0]) if has_drop else None)
@@ -103,3 +105,56 @@ def workprecision_figures(wp, out_dir: Path, units: Units) -> list[Path]:
                                            pareto(m.choice), units=units),
                           out_dir, f"work_precision_{model}")
     return written
+
+
+#: the ledger's sources (above zero) and sinks (below), in stacking order
+_SOURCES = (("push_off_work", "push-off"), ("actuator_work_positive", "actuators (+)"),
+            ("potential_work", "gravity and springs"))
+_SINKS = (("heel_strike_loss", "heel-strike collision"), ("actuator_work_negative",
+                                                           "actuators (-)"),
+          ("internal_collision_loss", "knee strikes, foot slaps"), ("damper_work", "dampers"))
+
+
+def energy_ledger_figure(sim, out_dir: Path, units: Units) -> list[Path]:
+    """Sources and sinks of mechanical energy per step (stacked bars, from ``simulate.h5``'s
+    ``ledger/``) and the cost of transport per step; returns the written files."""
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    led = sim.ledger
+    steps = np.arange(len(led["closure"]))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(10, 4), gridspec_kw={"width_ratios": [3, 1]})
+    up = np.zeros(steps.size)
+    down = np.zeros(steps.size)
+    scale = max(float(np.nanmax(np.abs(np.asarray(led[k], float)))) for k, _ in _SOURCES + _SINKS)
+    tiny = 1e-9 * max(scale, 1e-300)  # round-off (the closure's size) is not drawn
+    for key, label in _SOURCES:
+        v = np.nan_to_num(np.asarray(led[key], float))
+        pos, neg = np.clip(v, 0, None), np.clip(v, None, 0)
+        if np.any(pos > tiny):
+            ax.bar(steps, pos, bottom=up, label=label)
+            up += pos
+        if np.any(neg < -tiny):
+            ax.bar(steps, neg, bottom=down, label=f"{label} (stored)")
+            down += neg
+    for key, label in _SINKS:
+        v = np.nan_to_num(np.asarray(led[key], float))
+        v = -np.abs(v)
+        if np.any(v < -tiny):
+            ax.bar(steps, v, bottom=down, label=label)
+            down += v
+    ax.axhline(0.0, color="k", lw=0.8)
+    ax.set_xlabel("step")
+    ax.set_ylabel(f"energy per step [{units.energy}]")
+    ax.set_title("where the energy goes: sources (+) and sinks (-) per step")
+    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.0, 0.5))
+    cot = np.asarray(led["cost_of_transport"], float)
+    ax2.plot(steps, cot, "o-")
+    top = float(np.nanmax(cot)) if np.isfinite(cot).any() else 1.0
+    ax2.set_ylim(0.0, 1.25 * top if top > 0 else 1.0)
+    ax2.ticklabel_format(axis="y", useOffset=False)
+    ax2.set_xlabel("step")
+    ax2.set_ylabel("cost of transport [-]")
+    ax2.set_title("cost of transport")
+    fig.tight_layout()
+    return F.save(fig, out_dir, "energy_ledger")

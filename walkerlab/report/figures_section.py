@@ -25,6 +25,10 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
     ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, one "
                           "panel per link, both legs in it)."),
     ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),
+    ("energy_ledger", "Energy ledger of the rigid walker: the sources (push-off, actuators' "
+                      "positive work, gravity) and sinks (heel-strike and knee-strike "
+                      "collisions, actuators' negative work, dampers) of each step, and the "
+                      "cost of transport per step."),
     ("work_precision_ideal", "Work-precision diagram, ideal model."),
     ("work_precision_contact", "Work-precision diagram, contact model."),
     ("bifurcation", "Bifurcation diagram over the slope."),
@@ -44,10 +48,34 @@ def steps_table(sim: SimulateArtifact) -> str:
                   f"hip speed [{u.speed}]", f"impact loss [{u.energy}]", "ended by"], rows)
 
 
+def energy_section(sim: SimulateArtifact) -> list[str]:
+    """The energy ledger of ``simulate.h5`` per step, and its closure."""
+    import math
+
+    led, u = sim.ledger, sim.units
+    if not led:
+        return []
+    keys = ("push_off_work", "actuator_work_positive", "actuator_work_negative",
+            "heel_strike_loss", "internal_collision_loss", "damper_work", "potential_work",
+            "closure", "cost_of_transport")
+    head = ["step", "push-off", "actuators +", "actuators -", "heel strike", "knee/foot",
+            "dampers", "gravity+springs", "closure", "cost of transport"]
+    rows = [[k, *[num(led[c][k]) for c in keys]] for k in range(len(led["closure"]))]
+    cot = [v for v in led["cost_of_transport"] if math.isfinite(v)]
+    mean = sum(cot) / len(cot) if cot else math.nan
+    return [f"Cost of transport (positive actuator and push-off work + the potential energy "
+            f"the slope releases, per weight and distance along the ground), mean over the "
+            f"steps: **{num(mean)}**. Energies in {u.energy}; the collisions, dampers and "
+            "negative actuator work are the sinks; closure = the energy change minus the "
+            "sum of the terms.", "",
+            *details("Energy ledger per step (simulate.h5, ledger/)", table(head, rows))]
+
+
 def _drawn_from(stem: str, arts: dict) -> bool:
     """Whether a figure's artifacts are among the report's (a figure an earlier ``walkerlab
     plot`` drew from an artifact the report leaves out is not shown)."""
-    for prefix, stages in (("fig2_", ("simulate",)), ("fig6_", ("contact-sim",)),
+    for prefix, stages in (("fig2_", ("simulate",)), ("energy_ledger", ("simulate",)),
+                           ("fig6_", ("contact-sim",)),
                            ("fig8_", ("compare",)), ("fig", ("simulate", "contact-sim")),
                            ("work_precision", ("workprecision",)),
                            ("bifurcation", ("bifurcation",)), ("basin", ("basin",))):
@@ -73,6 +101,8 @@ def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
         if not png.is_file() or not _drawn_from(stem, arts):
             continue
         out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
+        if stem == "energy_ledger" and "simulate" in arts:
+            out += energy_section(arts["simulate"])
         if stem == "fig7_angles_rates" and "simulate" in arts:
             out += details("Per-step data of the rigid walker (simulate.h5)",
                            steps_table(arts["simulate"]))
