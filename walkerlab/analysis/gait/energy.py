@@ -67,7 +67,7 @@ def _damper_power(walker, x) -> float:
     return float(dq @ (0.5 * Mdot @ dq - C @ dq))
 
 
-def step_ledger(walker, seg) -> dict[str, float]:
+def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     """The energy ledger of one step.
 
     Parameters
@@ -76,6 +76,9 @@ def step_ledger(walker, seg) -> dict[str, float]:
         The walker of this step (legs that differ: ``walker.for_stance(seg.stance_leg)``).
     seg : walkerlab.integrate.rigid.Segment
         The step, ended by a heel strike (other ends: every entry NaN).
+    next_walker : HybridWalker, optional
+        The walker of the next step (legs that differ: the other leg's numbers); default
+        ``walker``.
 
     Returns
     -------
@@ -115,7 +118,7 @@ def step_ledger(walker, seg) -> dict[str, float]:
     ke_end, pe_end = (float(v) for v in walker.energies(seg.x_end))
     pts = walker.points(seg.x_end)
     step = np.asarray(pts["swing_foot"], float)
-    nxt = walker.for_stance(walker.role_to_leg(seg.stance_leg).get("swing", seg.stance_leg))
+    nxt = walker if next_walker is None else next_walker
     if acts is not None and acts.spec.push_off is not None:
         tr = acts.transition(seg.x_end)
         push, loss, impulse = tr["ke_push_off"] - tr["ke_minus"], \
@@ -141,11 +144,18 @@ def step_ledger(walker, seg) -> dict[str, float]:
 
 def trajectory_ledger(traj) -> dict[str, np.ndarray]:
     """:func:`step_ledger` of every step of a :class:`~walkerlab.integrate.rigid.
-    HybridTrajectory`, each column (steps,)."""
+    HybridTrajectory`, each column (steps,); empty for a walker without generated flow
+    matrices (flat feet: their energies are read per pinned point, heel or toe, and the
+    ankle damper's work is not yet in the ledger)."""
+    from walkerlab.integrate.rigid import other_leg
+
     w = traj.walker
+    if w.matrices is None:
+        return {}
     rows = {k: [] for k in LEDGER_NAMES}
     for seg in traj.segments:
-        led = step_ledger(w.for_stance(seg.stance_leg), seg)
+        led = step_ledger(w.for_stance(seg.stance_leg), seg,
+                          w.for_stance(other_leg(w, seg.stance_leg)))
         for k in LEDGER_NAMES:
             rows[k].append(led[k])
     return {k: np.asarray(v, float) for k, v in rows.items()}

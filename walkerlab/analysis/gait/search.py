@@ -373,8 +373,15 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
     last = _short(last)
     if last and "standing" not in last:
         last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
-    why = ("a passive walker needs a downhill slope (slope > 0)"
-           if walker.slope_rad <= 0 else "the walker may have no period-1 gait here")
+    if walker.slope_rad <= 0 and walker.actuators is None:
+        why = ("a passive walker needs a downhill slope (slope > 0); on level ground or "
+               "uphill give it actuators (walker.actuation: push_off, torques)")
+    elif walker.actuators is not None:
+        why = ("the scale-free seeds are a passive walker's: give fixedpoint.initial_guess "
+               "from a gait of this walker with a nearby push-off or slope (e.g. "
+               "walkerlab continuation --param walker.actuation.push_off.impulse_n_s=...)")
+    else:
+        why = "the walker may have no period-1 gait here"
     # the advice first, the solver's detail last: a one-line display that must shorten the
     # message cuts the detail, never the advice
     return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "

@@ -1,0 +1,230 @@
+"""Powered walking on the rigid model (``walker.actuation``), against numbers that share no
+code with the generator: the independent actuated compass gait
+(``tests/independent/actuated_compass.py``: Lagrange by hand, push-off and heel strike in
+floating coordinates) and Kuo's (2002) closed forms for the simplest walker; the energy
+ledger's closure and the cost of transport of every shipped scene."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import walkerlab as wl
+from tests.independent import actuated_compass as ref
+from walkerlab.analysis.gait.energy import trajectory_ledger
+from walkerlab.config import SceneError, load_scene, scene_from_dict
+from walkerlab.integrate.rigid import simulate_steps
+from walkerlab.models.registry import build_walker
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+PASSIVE = sorted(p.stem for p in CONFIGS.glob("*.yaml")
+                 if load_scene(p).walker.actuation is None)
+POWERED = sorted(p.stem for p in CONFIGS.glob("*.yaml")
+                 if load_scene(p).walker.actuation is not None)
+
+
+def _compass(actuation: dict, slope: float = 0.0) -> dict:
+    return {"name": "t", "walker": {"model": "compass_gait", "leg_length_m": 1.0,
+                                    "leg_mass_kg": 5.0, "hip_mass_kg": 10.0,
+                                    "gravity_m_per_s2": 9.81, "leg_mass_from_foot_m": 0.5,
+                                    "actuation": actuation},
+            "slope": {"angle_rad": slope},
+            "solver": {"method": "DOP853", "rtol": 1e-12, "atol": 1e-12},
+            "fixedpoint": {"tolerance": 1e-12}}
+
+
+LAW = {"constant_n_m": 1.5, "stiffness_n_m_per_rad": 20.0, "damping_n_m_s_per_rad": 0.5,
+       "rest_angle_rad": 0.1}
+
+
+@pytest.mark.parametrize("slope", [0.0, 0.0174, -0.01])
+def test_actuated_flow_equals_the_independent_derivation(slope):
+    w = build_walker(scene_from_dict(_compass({"torques": [{"joint": "hip", "law": LAW,
+                                                            "max_torque_n_m": 2.0}]}, slope)))
+    law = ref.spring_torque(1.5, 20.0, 0.5, 0.1, tau_max=2.0)
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        x = rng.normal(0.0, [0.2, 0.2, 1.0, 1.0])
+        got = w.phases[0].flow(0.0, x)
+        want = ref.flow(x, ref.PAPER, slope, tau=law(0.0, x))
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+        # the flow's Jacobian (the variational equations') against central differences
+        J = w.phases[0].jacobian(0.0, x)
+        h = 1e-6
+        Jfd = np.stack([(w.phases[0].flow(0, x + h * e) - w.phases[0].flow(0, x - h * e))
+                        / (2 * h) for e in np.eye(4)], axis=1)
+        np.testing.assert_allclose(J, Jfd, rtol=0, atol=1e-6 * (1 + np.abs(J).max()))
+
+
+@pytest.mark.parametrize("P", [0.0, 1.0, 3.0])
+def test_push_off_and_heel_strike_equal_the_independent_derivation(P):
+    w = build_walker(scene_from_dict(_compass({"push_off": {"impulse_n_s": P}})))
+    for xm in ([-0.17, 0.17, -0.77, -0.87], [-0.2, 0.2, -0.5, -0.9], [-0.1, 0.1, -0.9, -0.6]):
+        xm = np.array(xm)
+        want, info = ref.push_off_heel_strike(xm, ref.PAPER, 0.0, P)
+        tr = w.actuators.transition(xm)
+        np.testing.assert_allclose(tr["x_plus"], want, rtol=0, atol=1e-12)
+        assert tr["ke_push_off"] - tr["ke_minus"] == pytest.approx(info["pushoff_work"],
+                                                                  abs=1e-12)
+        assert tr["ke_push_off"] - tr["ke_plus"] == pytest.approx(info["collision_loss"],
+                                                                 abs=1e-12)
+    if P == 0.0:  # the push-off form with P = 0 is the generated passive impact
+        passive = build_walker(load_scene(CONFIGS / "paper.yaml"))
+        xm = np.array([-0.2, 0.1652, -0.6, -0.85])
+        np.testing.assert_allclose(w.reset(xm), passive.reset(xm), rtol=0, atol=1e-13)
+
+
+def test_powered_compass_fixed_point_equals_the_independent_one():
+    """configs/powered_compass.yaml: level ground, push-off 3 N s; and the same walker with a
+    spring-like hip torque: fixed point, step period and multipliers to <= 1e-9."""
+    gait = wl.Walker.from_scene(CONFIGS / "powered_compass.yaml").fixed_point()
+    x, T, mu = ref.fixed_point(ref.PAPER, 0.0, P=3.0, guess=gait.x)
+    np.testing.assert_allclose(gait.x, x, rtol=0, atol=1e-9)
+    assert gait.step_period == pytest.approx(T, abs=1e-9)
+    np.testing.assert_allclose(np.sort(np.abs(gait.multipliers))[1:],
+                               np.sort(np.abs(mu))[1:], atol=1e-6)  # reference: FD Jacobian
+    assert gait.stable and 0.69 < gait.step_period < 0.70
+    sc = _compass({"push_off": {"impulse_n_s": 3.0},
+                   "torques": [{"joint": "hip", "law": {"constant_n_m": 0.5,
+                                                        "stiffness_n_m_per_rad": 1.0,
+                                                        "damping_n_m_s_per_rad": 0.2}}]})
+    sc["fixedpoint"]["initial_guess"] = dict(zip(
+        ["swing_angle_rad", "stance_angle_rad", "swing_rate_rad_per_s",
+         "stance_rate_rad_per_s"], [-0.181, 0.181, -0.72, -0.88]))
+    g2 = wl.Walker.from_scene(sc).fixed_point()
+    x2, T2, _ = ref.fixed_point(ref.PAPER, 0.0, P=3.0, guess=g2.x,
+                                torque_law=ref.spring_torque(0.5, 1.0, 0.2))
+    np.testing.assert_allclose(g2.x, x2, rtol=0, atol=1e-9)
+    assert g2.step_period == pytest.approx(T2, abs=1e-9)
+
+
+@pytest.fixture(scope="module")
+def kuo():
+    return wl.Walker.from_scene(CONFIGS / "kuo2002.yaml")
+
+
+@pytest.mark.parametrize("alpha", [0.15, 0.2, 0.35])
+def test_kuo_closed_forms_on_the_generated_reset(kuo, alpha):
+    """Kuo (2002): theta+ = -theta, dtheta+ = cos 2a dtheta + sin 2a P (the generated
+    transition's sign: forward rates are negative); the steady push-off P = v tan(a) keeps
+    the speed; the collision loss of stance-torque powering (P = 0, same pre-transition
+    speed) is 4 cos^4(a) times that of push-off."""
+    v = 0.4
+    x = np.array([-alpha, -2 * alpha, -v, -0.05])  # on the heel-strike surface phi = 2 theta
+    P = v * math.tan(alpha)
+    w = kuo.with_changes({"walker.actuation.push_off.impulse_n_s": P}).model
+    tr = w.actuators.transition(x)
+    th, dth, ph, dph = ref.kuo_transition(-alpha, -v, P)
+    np.testing.assert_allclose(tr["x_plus"], [th, ph, -dth if dth > 0 else dth, dph],
+                               atol=1e-14)
+    assert tr["x_plus"][2] == pytest.approx(-v, abs=1e-14)  # the speed is kept
+    loss_push = tr["ke_push_off"] - tr["ke_plus"]
+    w0 = kuo.with_changes({"walker.actuation.push_off.impulse_n_s": 0.0}).model
+    tr0 = w0.actuators.transition(x)
+    loss_stance = tr0["ke_minus"] - tr0["ke_plus"]
+    assert loss_stance / loss_push == pytest.approx(4 * math.cos(alpha) ** 4, rel=1e-12)
+    assert loss_push == pytest.approx(0.5 * v ** 2 * math.tan(alpha) ** 2, rel=1e-12)
+
+
+def test_kuo_hip_torque_is_the_swing_equation_term(kuo):
+    """The per-foot-mass hip torque adds -k (psi_sw - psi_st) to the swing leg's equation
+    (Kuo 2002: phi'' = ... - k phi), nothing to the stance leg's (the hip mass's)."""
+    passive = build_walker(load_scene(CONFIGS / "simplest.yaml").model_copy(
+        update={"slope": load_scene(CONFIGS / "kuo2002.yaml").slope}))
+    x = np.array([0.1, 0.3, -0.2, 0.05])
+    d = kuo.model.phases[0].flow(0, x) - passive.phases[0].flow(0, x)
+    # coordinates (theta, phi = theta - psi_sw): theta'' unchanged, phi'' gains -k phi
+    assert d[2] == pytest.approx(0.0, abs=1e-15)
+    assert d[3] == pytest.approx(-0.08 * x[1], rel=1e-12)
+
+
+def _ledger(name: str):
+    w = wl.Walker.from_scene(CONFIGS / f"{name}.yaml")
+    g = w.fixed_point()
+    traj = simulate_steps(w.model, g.x, 2 * w.model.steps_per_map, w.solver,
+                          max_step_time=w.max_step_time)
+    ke = np.array([w.model.for_stance(s_.stance_leg).energies(s_.x_start)[0]
+                   for s_ in traj.segments])
+    return w, trajectory_ledger(traj), ke
+
+
+def test_flat_feet_have_no_ledger_yet():
+    """Flat feet: energies per pinned point and the ankle damper are not in the ledger; it
+    is left out (no numbers that do not close)."""
+    w, led, _ = _ledger("flat_feet")
+    assert led == {}
+
+
+@pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED if n != "flat_feet"])
+def test_the_energy_ledger_closes_and_cost_of_transport(name):
+    w, led, ke = _ledger(name)
+    assert np.all(np.isfinite(led["closure"]))
+    assert np.max(np.abs(led["closure"]) / ke) <= 1e-9
+    phi = w.model.slope_rad
+    if name in PASSIVE:
+        # a passive gait: the collisions (and dampers) take what the slope releases, so the
+        # cost of transport is sin(slope)
+        np.testing.assert_allclose(led["cost_of_transport"], math.sin(phi), rtol=1e-12)
+        sinks = led["heel_strike_loss"] + led["internal_collision_loss"] - led["damper_work"]
+        np.testing.assert_allclose(sinks.sum(), led["slope_energy"].sum(),
+                                   rtol=1e-7 if w.model.steps_per_map == 1 else 1e-6)
+        assert not np.any(led["push_off_work"]) and not np.any(led["actuator_work_positive"])
+    else:  # level ground: the actuators' share alone
+        assert phi == 0.0 and np.all(led["slope_energy"] == 0.0)
+        m, g = w.model.total_mass_kg, w.model.params["gravity_m_per_s2"]
+        steps = np.array([np.hypot(*w.model.points(s.x_end)["swing_foot"])
+                          for s in simulate_steps(w.model, w.fixed_point().x, 2, w.solver,
+                                                  max_step_time=w.max_step_time).segments])
+        np.testing.assert_allclose(led["cost_of_transport"],
+                                   (led["push_off_work"] + led["actuator_work_positive"])
+                                   / (m * g * steps), rtol=1e-12)
+
+
+def test_a_passive_scene_is_serialised_as_before():
+    """No ``actuation`` key in a passive scene's JSON: its input hashes, hence its
+    artifacts, are those of before actuation existed."""
+    for name in PASSIVE:
+        assert '"actuation"' not in load_scene(CONFIGS / f"{name}.yaml").model_dump_json()
+        assert build_walker(load_scene(CONFIGS / f"{name}.yaml")).actuators is None
+
+
+@pytest.mark.parametrize("bad, msg", [
+    ({"push_off": {}}, "impulse_n_s"),
+    ({}, "give push_off or torques"),
+    ({"torques": [{"joint": "knee", "law": {}}]}, "joint"),
+    ({"push_off": {"impulse_n_s": -1.0}}, "impulse_n_s"),
+])
+def test_bad_actuation_is_one_clear_line(bad, msg):
+    with pytest.raises(SceneError, match=msg) as e:
+        scene_from_dict(_compass(bad))
+    assert "actuation" in str(e.value)
+
+
+def test_actuators_the_walker_cannot_carry_are_refused():
+    kneed = load_scene(CONFIGS / "kneed.yaml").model_dump(mode="json", exclude_none=True)
+    kneed["walker"]["actuation"] = {"push_off": {"impulse_n_s": 1.0}}
+    with pytest.raises(ValueError, match="straight legs with point feet"):
+        build_walker(scene_from_dict(kneed))
+    simplest = load_scene(CONFIGS / "simplest.yaml").model_dump(mode="json", exclude_none=True)
+    simplest["walker"]["actuation"] = {"torques": [{"joint": "hip", "law": {}}]}
+    with pytest.raises(ValueError, match="scaled_by: foot_mass"):
+        build_walker(scene_from_dict(simplest))
+
+
+def test_the_ledger_names_the_dampers_work():
+    """A damped hip spring (hip_spring.yaml with 0.5 N m s/rad): the damper's work is
+    negative and the ledger still closes; the cost of transport stays sin(slope) (passive)."""
+    d = load_scene(CONFIGS / "hip_spring.yaml").model_dump(mode="json", exclude_none=True)
+    d["walker"]["springs"][0]["damping_n_m_s_per_rad"] = 0.5
+    w = wl.Walker.from_scene(d)
+    g = w.fixed_point()
+    traj = simulate_steps(w.model, g.x, 2, w.solver)
+    led = trajectory_ledger(traj)
+    ke = w.model.energies(g.x)[0]
+    assert np.all(led["damper_work"] < -1e-3)
+    assert np.max(np.abs(led["closure"])) / ke <= 1e-9
+    sinks = led["heel_strike_loss"] - led["damper_work"]
+    np.testing.assert_allclose(sinks, led["slope_energy"], rtol=1e-7)
