@@ -25,6 +25,9 @@ NONDIMENSIONAL_LABELS = {
     "m/s^2": "g", "rad/s": "rad/√(l/g)", "m/s": "√(g l)", "kg m^2": "M l²", "mm": "10⁻³ l",
     "Hz": "√(g/l)", "J": "M g l", "kg": "M", "N": "M g", "m": "l", "s": "√(l/g)",
     "N/m^e": "M g/l^e", "N s/m": "M √(g/l)",  # IMPACT stiffness and damping
+    "N s": "M √(g l)", "N m": "M g l",  # impulse (push-off), torque
+    "N m/rad": "M g l/rad", "N m s/rad": "M l √(g l)/rad", "N s^2/m": "M",  # actuator laws
+    "N m/kg": "g l",  # a torque per foot mass (massless legs)
 }
 _TOKEN = re.compile(r"(?<![\w/^])(" + "|".join(
     re.escape(k) for k in sorted(NONDIMENSIONAL_LABELS, key=len, reverse=True))
@@ -134,7 +137,8 @@ def relabel_artifact(f, units: Units) -> None:
 FIELD_SUFFIX_UNITS = (
     ("_n_m_per_rad_pow_e", "N m/rad^e"), ("_n_m_s_per_rad", "N m s/rad"),
     ("_n_m_per_rad", "N m/rad"), ("_n_per_mm_pow_e", "N/mm^e"), ("_n_per_m_pow_e", "N/m^e"),
-    ("_n_s_per_mm", "N s/mm"), ("_n_s_per_m", "N s/m"), ("_mm_per_s", "mm/s"),
+    ("_n_s2_per_m", "N s^2/m"), ("_n_s_per_mm", "N s/mm"), ("_n_s_per_m", "N s/m"),
+    ("_n_m_per_kg", "N m/kg"), ("_n_m", "N m"), ("_n_s", "N s"), ("_mm_per_s", "mm/s"),
     ("_rad_per_s", "rad/s"), ("_m_per_s2", "m/s^2"), ("_m_per_s", "m/s"),
     ("_kg_m2", "kg m^2"), ("_deg", "deg"), ("_rad", "rad"), ("_kg", "kg"), ("_mm", "mm"),
     ("_hz", "Hz"), ("_m", "m"), ("_s", "s"),

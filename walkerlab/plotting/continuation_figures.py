@@ -148,3 +148,32 @@ def two_parameter_figure(data, title: str = ""):
         ax.set_title(title, fontsize=10)
     fig.tight_layout()
     return fig
+
+
+def cost_of_transport_figure(data, title: str = ""):
+    """Cost of transport against speed along every branch of a loaded continuation artifact
+    that holds gait measures (``branches[i]["gait"]``), coloured by the continued field;
+    stable points solid, unstable hollow.  None when no branch has them."""
+    import matplotlib.pyplot as plt
+
+    branches = [b for b in data.branches if b.get("gait")]
+    if not branches:
+        return None
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    sc = None
+    for b in branches:
+        v, c, st = b["gait"]["speed"], b["gait"]["cost_of_transport"], b["stable"]
+        ax.plot(v, c, "-", color="0.6", lw=0.8)
+        sc = ax.scatter(v[st], c[st], c=b["param"][st], s=18, cmap="viridis",
+                        label=f"period {b['period']}, stable")
+        if (~st).any():
+            ax.scatter(v[~st], c[~st], facecolors="none", edgecolors="k", s=18,
+                       label=f"period {b['period']}, unstable")
+    if sc is not None:
+        fig.colorbar(sc, ax=ax, label=f"{data.path} [{data.unit}]")
+    ax.set_xlabel("speed [m/s]")
+    ax.set_ylabel("cost of transport [-]")
+    ax.set_title(title or "cost of transport along the branch")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig

@@ -33,6 +33,7 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     from walkerlab.io.schemas.continuation import continuation_writer, load_continuation
     from walkerlab.plotting.continuation_figures import (
         continuation_figure,
+        cost_of_transport_figure,
         two_parameter_figure,
     )
     from walkerlab.plotting.figures import save
@@ -75,5 +76,8 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     if data.curves:
         figs += save(two_parameter_figure(data, f"{model}, scene {scene.name}"), figdir,
                      stem + "_two_parameter")
+    cot = cost_of_transport_figure(data, f"{model}, scene {scene.name}: cost of transport")
+    if cot is not None:
+        figs += save(cot, figdir, stem + "_cost_of_transport")
     out.summary.update(figures=figs, data=data)
     return out

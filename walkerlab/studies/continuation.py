@@ -102,6 +102,7 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
     MapFailed
         No gait at the scene's own value.
     """
+    from walkerlab.analysis.continuation.branch import add_gait_measures
     from walkerlab.studies.points import PointOutcome, ideal_fixed_point
 
     unit = axis_unit(scene, ParamAxis(path, (), path))
@@ -116,6 +117,7 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
         raise MapFailed("no gait at the scene's own value", exc.message) from None
     res = continuation(fam, min(max(p0, lo), hi), gait.x, (lo, hi), unit, switch=switch,
                        ds=min(0.02, ds_max), ds_max=ds_max)
+    add_gait_measures(fam, res)
     curves = []
     if path2 is not None:
         unit2 = axis_unit(scene, ParamAxis(path2, (), path2))

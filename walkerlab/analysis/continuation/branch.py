@@ -54,7 +54,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -95,12 +95,17 @@ class Branch:
     specials : list of SpecialPoint
     direction : int
         +1 or -1: the direction of increasing arclength from the start.
+    measures : dict[str, ndarray (len(points),)]
+        Gait measures at each point (``step_length`` [m], ``speed`` [m/s],
+        ``cost_of_transport`` [-]; :func:`walkerlab.analysis.gait.energy.gait_measures`),
+        empty until :func:`add_gait_measures`.
     """
 
     period: int
     points: list[BranchPoint]
     specials: list[SpecialPoint]
     direction: int = 1
+    measures: dict = field(default_factory=dict)
 
     def params(self) -> np.ndarray:
         """The points' parameter values, shape (len(points),) [the field's unit]."""
@@ -412,3 +417,23 @@ def _join(down: Branch, up: Branch) -> Branch:
     """One branch from the two halves (the start point once), in arclength order."""
     pts = down.points[:0:-1] + up.points
     return Branch(up.period, pts, down.specials + up.specials, 1)
+
+
+def add_gait_measures(family: WalkerFamily, res: ContinuationResult) -> None:
+    """Fill every branch's :attr:`Branch.measures`: step length, speed and cost of transport
+    of the gait at each point (one period simulated per point)."""
+    from walkerlab.analysis.gait.energy import gait_measures
+
+    for br in res.branches:
+        rows = []
+        for q in br.points:
+            try:
+                w = family.walker(q.p)
+            except MapFailed:
+                rows.append({"step_length": np.nan, "speed": np.nan,
+                             "cost_of_transport": np.nan})
+                continue
+            rows.append(gait_measures(w, q.x, br.period * w.steps_per_map, family.solver,
+                                      family.max_step_time))
+        br.measures = {k: np.array([r[k] for r in rows], float)
+                       for k in ("step_length", "speed", "cost_of_transport")}

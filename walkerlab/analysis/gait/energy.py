@@ -31,7 +31,7 @@ import numpy as np
 
 from walkerlab.io.schemas.simulate import LEDGER_UNITS
 
-__all__ = ["LEDGER_NAMES", "step_ledger", "trajectory_ledger"]
+__all__ = ["LEDGER_NAMES", "gait_measures", "step_ledger", "trajectory_ledger"]
 
 #: the ledger's columns, each (step,) (units: the artifact's, ``LEDGER_UNITS``)
 LEDGER_NAMES = tuple(LEDGER_UNITS)
@@ -159,3 +159,41 @@ def trajectory_ledger(traj) -> dict[str, np.ndarray]:
         for k in LEDGER_NAMES:
             rows[k].append(led[k])
     return {k: np.asarray(v, float) for k, v in rows.items()}
+
+
+def gait_measures(walker, x, steps: int, solver, max_step_time: float = 5.0
+                  ) -> dict[str, float]:
+    """Step length, speed and cost of transport of a periodic gait through ``x``.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    x : ndarray, shape (2n,)
+        A post-impact state of the gait (``legs[0]`` about to swing).
+    steps : int
+        Steps of the gait's period (1, 2, 4, ...; legs that differ: a stride).
+    solver : walkerlab.integrate.solver.Solver
+    max_step_time : float
+        [s]
+
+    Returns
+    -------
+    dict[str, float]
+        ``step_length`` [m] (mean), ``speed`` [m/s] (distance along the ground over the
+        period's time), ``cost_of_transport`` [-] (mean over the steps; NaN without a
+        ledger); all NaN when a step does not end by a heel strike.
+    """
+    from walkerlab.integrate.rigid import simulate_steps
+
+    traj = simulate_steps(walker, np.asarray(x, float), int(steps), solver,
+                          max_step_time=max_step_time)
+    segs = traj.segments
+    if len(segs) < steps or any(s.termination != "heel_strike" for s in segs):
+        return {"step_length": np.nan, "speed": np.nan, "cost_of_transport": np.nan}
+    lengths = [float(np.hypot(*walker.for_stance(s.stance_leg).points(s.x_end)["swing_foot"]))
+               for s in segs]
+    led = trajectory_ledger(traj)
+    cot = float(np.mean(led["cost_of_transport"])) if led else np.nan
+    return {"step_length": float(np.mean(lengths)),
+            "speed": float(np.sum(lengths) / (segs[-1].t_end - segs[0].t_start)),
+            "cost_of_transport": cot}

@@ -30,6 +30,13 @@ import numpy as np
 __all__ = ["continuation_writer", "load_continuation", "initial_state", "ContinuationData", "STAGE"]
 
 STAGE = "continuation"
+#: the gait measures stored at each branch point (``branches/<i>/gait/``): unit, meaning
+GAIT_MEASURES = {
+    "step_length": ("m", "mean step length of the gait (stance foot to swing foot)"),
+    "speed": ("m/s", "distance along the ground over the period's time"),
+    "cost_of_transport": ("-", "mean cost of transport of the gait's steps "
+                               "(walkerlab.analysis.gait.energy)"),
+}
 
 
 def continuation_writer(res, curves=()):
@@ -68,6 +75,9 @@ def continuation_writer(res, curves=()):
             mults(g, [q.multipliers for q in br.points], f"the {br.period}-step map")
             put(g, "stable", [int(q.stable) for q in br.points], "-",
                 "1 if every multiplier is inside the unit circle")
+            for k, (u, what) in GAIT_MEASURES.items():
+                if k in br.measures:
+                    put(g, f"gait/{k}", br.measures[k], u, what)
         sp = res.specials
         g = f.create_group("special_points")
         put(g, "kind", [s.kind for s in sp] or np.zeros(0, "S1"), "-",
@@ -103,7 +113,8 @@ class ContinuationData:
 
     ``branches``: list of dicts with ``period`` (int), ``param`` (N,), ``states`` (name ->
     (N,)), ``orbit`` (name -> (N, k)), ``step_period`` (N,) [s], ``multipliers`` (N, 2n)
-    complex, ``stable`` (N,) bool.
+    complex, ``stable`` (N,) bool, ``gait`` (name -> (N,): ``step_length`` [m], ``speed``
+    [m/s], ``cost_of_transport`` [-]; empty in artifacts written before).
     ``special``: dict of arrays ``kind``, ``param``, ``period``, ``branch``, ``cause``,
     ``states`` (name -> (S,)), ``multipliers`` (S, 2n).  ``curves``: list of dicts ``kind``,
     ``period``, ``param``, ``param2``, ``path2``, ``unit2``, ``multiplier``.
@@ -176,7 +187,9 @@ def load_continuation(path: Path) -> ContinuationData:
                 "states": {n: g[f"state/{n}"][()] for n in names},
                 "orbit": {n: g[f"orbit/{n}"][()] for n in names},
                 "step_period": g["period"][()], "multipliers": mult(g),
-                "stable": g["stable"][()].astype(bool)})
+                "stable": g["stable"][()].astype(bool),
+                "gait": {k: g[f"gait/{k}"][()] for k in GAIT_MEASURES
+                         if f"gait/{k}" in g}})
         g = f["special_points"]
         out.special = {k: np.asarray(read_named(g, k)) for k in
                        ("kind", "param", "period", "branch", "cause")}
