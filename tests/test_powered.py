@@ -228,3 +228,41 @@ def test_the_ledger_names_the_dampers_work():
     assert np.max(np.abs(led["closure"])) / ke <= 1e-9
     sinks = led["heel_strike_loss"] - led["damper_work"]
     np.testing.assert_allclose(sinks, led["slope_energy"], rtol=1e-7)
+
+
+def test_gait_target_recovers_the_push_off_of_a_known_gait():
+    """Kuo's findgait(target=speed, varying=P): the speed of the gait at P = 2 N s, asked as
+    a target from the scene's P = 3 N s, gives back P = 2 N s; and a step-period target."""
+    from walkerlab.analysis.gait.energy import gait_measures
+
+    w = wl.Walker.from_scene(CONFIGS / "powered_compass.yaml")
+    at2 = w.with_changes({"walker.actuation.push_off.impulse_n_s": 2.0})
+    g2 = gait_measures(at2.model, at2.fixed_point().x, 1, at2.solver)
+    found, gait = w.find_gait_for("walker.actuation.push_off.impulse_n_s",
+                                  speed_m_per_s=g2["speed"])
+    assert found.scene.walker.actuation.push_off.impulse_n_s == pytest.approx(2.0, abs=1e-8)
+    assert gait_measures(found.model, gait.x, 1, found.solver)["speed"] == pytest.approx(
+        g2["speed"], rel=1e-10)
+    _, g3 = w.find_gait_for("walker.actuation.push_off.impulse_n_s", step_period_s=0.69)
+    assert g3.step_period == pytest.approx(0.69, abs=1e-9)
+    with pytest.raises(ValueError, match="exactly one"):
+        w.find_gait_for("walker.actuation.push_off.impulse_n_s", speed_m_per_s=0.4,
+                        step_period_s=0.7)
+
+
+def test_target_command_prints_the_value_or_one_line():
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    scene = str(CONFIGS / "powered_compass.yaml")
+    r = CliRunner().invoke(app, ["target", scene, "--vary",
+                                 "walker.actuation.push_off.impulse_n_s",
+                                 "--speed-m-per-s", "0.45"])
+    assert r.exit_code == 0, r.output
+    assert "impulse_n_s = 2.4434" in r.output and "N s gives speed = 0.45 m/s" in r.output
+    r = CliRunner().invoke(app, ["target", scene, "--vary",
+                                 "walker.actuation.push_off.impulse_n_s",
+                                 "--speed-m-per-s", "3"])
+    assert r.exit_code == 1 and "Traceback" not in r.output
+    assert "error: target: no gait with speed = 3" in r.output

@@ -243,6 +243,51 @@ class Walker:
                     np.asarray(r.multipliers_variational),
                     np.asarray(r.jacobian_variational), float(r.residual), chosen.label)
 
+    def find_gait_for(self, vary: str, **target: float) -> tuple[Walker, Gait]:
+        """The walker whose period-1 gait meets a target, one field freed (Kuo's
+        ``findgait(target=speed, varying=P)``): ``w.find_gait_for(
+        "walker.actuation.push_off.impulse_n_s", speed_m_per_s=0.45)``.
+
+        Parameters
+        ----------
+        vary : str
+            The dotted numeric scene field to solve for (started from its own value).
+        **target : float
+            Exactly one of ``speed_m_per_s``, ``step_length_m``, ``step_period_s``.
+
+        Returns
+        -------
+        walker : Walker
+            This walker with ``vary`` set to the value found.
+        gait : Gait
+            Its gait (as :meth:`fixed_point` finds it, from the solution).
+
+        Raises
+        ------
+        ValueError
+            Not exactly one known target.
+        walkerlab.studies.params.SweepError
+            ``vary`` names no numeric field.
+        walkerlab.analysis.continuation.target.TargetNotReached
+            No gait meets the target near the start (one line).
+        """
+        from walkerlab.analysis.continuation.target import MEASURES, solve_target
+        from walkerlab.studies.continuation import scene_family, scene_value
+
+        if len(target) != 1 or next(iter(target)) not in MEASURES:
+            raise ValueError(f"give exactly one target of {', '.join(MEASURES)}")
+        (name, value), = target.items()
+        fam = scene_family(self.scene, vary)
+        res = solve_target(fam, scene_value(self.scene, vary), self.fixed_point().x,
+                           MEASURES[name][0], float(value))
+        found = self.with_changes({vary: res.p})
+        fp = self.scene.fixedpoint
+        if fp is not None and fp.initial_guess is not None:  # start from the solution
+            found = found.with_changes({
+                f"fixedpoint.initial_guess.{n}_{'rad' if n.endswith('_angle') else 'rad_per_s'}":
+                float(v) for n, v in zip(found.state_names(), res.x)})
+        return found, found.fixed_point()
+
     def simulate(self, x0, strides: int, sample_rate_hz: float = 500.0) -> Walk:
         """Walk ``strides`` strides (2 * strides heel strikes) from ``x0``.
 

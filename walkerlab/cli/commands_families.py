@@ -146,3 +146,45 @@ def continuation(scene: Path | None = SceneArg,
         typer.echo(f"{c['kind']} curve over {c['path2']}: {len(c['param2'])} points")
     typer.echo(status(out))
     typer.echo("figures: " + ", ".join(str(p) for p in out.summary["figures"]))
+
+
+@guard
+def target(scene: Path | None = SceneArg,
+           vary: str = typer.Option(..., "--vary", help="the numeric scene field to solve for "
+                                    "(e.g. walker.actuation.push_off.impulse_n_s)"),
+           speed: float | None = typer.Option(None, "--speed-m-per-s", help="target speed "
+                                              "[m/s]"),
+           step_length: float | None = typer.Option(None, "--step-length-m",
+                                                    help="target step length [m]"),
+           step_period: float | None = typer.Option(None, "--step-period-s",
+                                                    help="target step period [s]")) -> None:
+    """Find the value of one field (an actuation parameter) whose period-1 gait has a target
+    speed, step length or step period (solved with the fixed point); prints it and the gait.
+    Writes nothing: set the value in the scene (or pass it to sweep/continuation)."""
+    import walkerlab as wl
+
+    given = {k: v for k, v in (("speed_m_per_s", speed), ("step_length_m", step_length),
+                               ("step_period_s", step_period)) if v is not None}
+    if len(given) != 1:
+        raise typer.BadParameter("give exactly one of --speed-m-per-s, --step-length-m, "
+                                 "--step-period-s")
+    from walkerlab.analysis.continuation.target import TargetNotReached
+    from walkerlab.analysis.gait.search import GaitNotFound
+
+    try:
+        w, gait = wl.Walker.from_scene(load(scene)).find_gait_for(vary, **given)
+    except (TargetNotReached, GaitNotFound) as exc:
+        raise ValueError(f"target: {exc}; try a target nearer the scene's own gait, or "
+                         f"follow it with walkerlab continuation --param {vary}=...") from None
+    (name, value), = given.items()
+    from walkerlab.studies.continuation import scene_value
+    from walkerlab.units import field_unit, for_scene
+
+    u = for_scene(w.scene)
+    typer.echo(f"{vary} = {scene_value(w.scene, vary):.10g} {u(field_unit(vary) or '-')} "
+               f"gives {name.rsplit('_', 1)[0].rsplit('_m', 1)[0]} = {value:g} "
+               f"{u(field_unit(name) or '-')}")
+    typer.echo(f"  step period {gait.step_period:.6g} {u.time}, max |Floquet multiplier| "
+               f"{max(abs(gait.multipliers)):.4g} ({'stable' if gait.stable else 'unstable'})")
+    for n, v in gait.state.items():
+        typer.echo(f"  {n:14s} {v:+.8f}")

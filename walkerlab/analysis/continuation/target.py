@@ -1,0 +1,132 @@
+"""Gait targets: the value of one walker parameter (an actuation parameter, typically the
+push-off impulse) that gives a period-1 gait with a target speed, step length or step period,
+solved together with the fixed point (as Kuo's DynLoco ``findgait(target=speed, varying=P)``).
+
+Unknowns ``u = (z, p)``: the section coordinates ``z`` (2n - 1) of the post-impact state and
+the parameter ``p``; equations ``section(P(from_section(z); p)) - z = 0`` and
+``measure(z, p) - target = 0`` (one step map gives both), solved by ``scipy.optimize.root``
+(MINPACK hybr) from the gait at the parameter's own value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.analysis.continuation.gait_map import MapFailed, WalkerFamily
+from walkerlab.analysis.gait.poincare import StepFailed
+
+__all__ = ["MEASURES", "TargetNotReached", "TargetResult", "solve_target"]
+
+#: the measures a target can name: scene-style name -> (measure, unit)
+MEASURES = {"speed_m_per_s": ("speed", "m/s"), "step_length_m": ("step_length", "m"),
+            "step_period_s": ("step_period", "s")}
+
+
+class TargetNotReached(RuntimeError):
+    """No gait of the family meets the target from the start (one line: why)."""
+
+
+@dataclass(frozen=True)
+class TargetResult:
+    """The parameter value and gait that meet a target.
+
+    Attributes
+    ----------
+    p : float
+        The varied parameter's value [its field's unit].
+    x : ndarray, shape (2n,)
+        The gait's post-impact state [rad, rad/s].
+    measures : dict[str, float]
+        ``speed`` [m/s], ``step_length`` [m], ``step_period`` [s] of the gait.
+    residual : float
+        max |F| at the solution (state part [rad, rad/s] and target part [its unit]).
+    maps : int
+        Step maps integrated.
+    """
+
+    p: float
+    x: np.ndarray
+    measures: dict
+    residual: float
+    maps: int
+
+
+def _measures(walker, x, solver, max_step_time):
+    """``(P(x), {speed [m/s], step_length [m], step_period [s]})`` of one map from ``x``."""
+    from walkerlab.analysis.gait.poincare import poincare_map
+
+    steps: list = []
+    x1, period, _ = poincare_map(walker, x, solver, max_step_time, steps=steps)
+    lengths = [float(np.hypot(*walker.for_stance(s.stance_leg).points(s.x_end)["swing_foot"]))
+               for s in steps]
+    return x1, {"speed": sum(lengths) / period, "step_length": float(np.mean(lengths)),
+                "step_period": period / len(steps)}
+
+
+def solve_target(family: WalkerFamily, p0: float, x0, measure: str, value: float, *,
+                 xtol: float = 1e-11) -> TargetResult:
+    """The parameter value near ``p0`` whose period-1 gait has ``measure`` = ``value``.
+
+    Parameters
+    ----------
+    family : WalkerFamily
+        The walker as a function of the varied field (:func:`walkerlab.studies.continuation.
+        scene_family`).
+    p0 : float
+        Start value of the varied field [its unit].
+    x0 : array_like, shape (2n,)
+        A gait's post-impact state at (or near) ``p0``.
+    measure : {"speed", "step_length", "step_period"}
+    value : float
+        The target [m/s, m or s].
+    xtol : float
+        Relative tolerance of the root finder.
+
+    Returns
+    -------
+    TargetResult
+
+    Raises
+    ------
+    TargetNotReached
+        The root finder did not converge, or the gait fell on the way (one line).
+    ValueError
+        An unknown measure.
+    """
+    from scipy.optimize import root
+
+    if measure not in {m for m, _ in MEASURES.values()}:
+        raise ValueError(f"target: {measure!r} is not one of speed, step_length, step_period")
+    w0 = family.walker(p0)
+    z0 = np.asarray(w0.section(np.asarray(x0, float)), float)
+    scale_p = max(abs(p0), 1e-3)
+    maps = 0
+
+    def F(u):
+        nonlocal maps
+        z, p = u[:-1], u[-1] * scale_p
+        try:
+            w = family.walker(float(p))
+            x = w.from_section(z)
+            x1, m = _measures(w, x, family.solver, family.max_step_time)
+        except (MapFailed, StepFailed, ValueError):  # a fall, a value off the domain: away
+            return np.full(u.size, 1e3 * (1.0 + np.linalg.norm(u)))
+        maps += 1
+        return np.concatenate([w.section(x1) - z, [(m[measure] - value) / abs(value)]])
+
+    sol = root(F, np.concatenate([z0, [p0 / scale_p]]), method="hybr",
+               options={"xtol": xtol})
+    res = float(np.max(np.abs(F(sol.x))))
+    if not sol.success or res > 1e-8:
+        raise TargetNotReached(f"no gait with {measure} = {value:g} near the start "
+                               f"(residual {res:.2g}; {' '.join(str(sol.message).split())})")
+    p = float(sol.x[-1] * scale_p)
+    w = family.walker(p)
+    x = w.from_section(sol.x[:-1])
+    try:
+        _, m = _measures(w, x, family.solver, family.max_step_time)
+    except (MapFailed, StepFailed) as exc:  # pragma: no cover - its last map walked
+        raise TargetNotReached(str(exc)) from None
+    return TargetResult(p, np.asarray(x, float), m, res, maps)
