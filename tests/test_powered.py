@@ -266,3 +266,24 @@ def test_target_command_prints_the_value_or_one_line():
                                  "--speed-m-per-s", "3"])
     assert r.exit_code == 1 and "Traceback" not in r.output
     assert "error: target: no gait with speed = 3" in r.output
+
+
+def test_the_contact_view_and_export_refuse_actuators_in_one_line(tmp_path):
+    """Not silently passive: the contact model and the URDF/MJCF export do not carry
+    actuators yet, and say so."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = load_scene(CONFIGS / "paper.yaml").model_dump(mode="json", exclude_none=True)
+    d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 1.0}}
+    d["name"] = "powered_paper"
+    scene = tmp_path / "powered_paper.yaml"
+    import yaml
+
+    scene.write_text(yaml.safe_dump(d))
+    for args, msg in ((["contact-sim"], "contact view does not carry them"),
+                      (["export", "--format", "mjcf"], "not exported yet")):
+        r = CliRunner().invoke(app, [*args, str(scene), "--runs-dir", str(tmp_path / "runs")])
+        assert r.exit_code == 1 and "Traceback" not in r.output, r.output
+        assert msg in r.output and r.output.count("error:") == 1, r.output

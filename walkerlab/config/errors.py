@@ -87,8 +87,9 @@ WALKER_VOCABULARY = (
     "leg) or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
     "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee, "
     "foot kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "
-    "dampers between links at the hip; torso: an upper body on a bisecting hip mechanism); "
-    "no elastic knees or actuation yet")
+    "dampers between links at the hip; torso: an upper body on a bisecting hip mechanism; "
+    "actuation: a push-off impulse and hip torques on straight, point-footed legs, rigid "
+    "model); no elastic knees, knee or ankle actuators yet")
 
 
 def _walker_vocabulary_applies(root: type[BaseModel], e: dict) -> bool:

@@ -57,8 +57,12 @@ def check_exportable(scene: Scene) -> None:
     ValueError
         One line naming the field: a mass below :data:`MJCF_MIN_MASS_KG` (but > 0; 0 is
         refused by the multibody model) or a length / foot radius below
-        :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot).
+        :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot); a walker
+        with actuators (not exported yet: the file would walk passively).
     """
+    if getattr(scene.walker, "actuation", None) is not None:
+        raise ValueError("walker.actuation: actuators are not exported yet (the URDF/MJCF "
+                         "would hold a passive walker); export the scene without them")
     def walk(obj, path):
         if isinstance(obj, dict):
             for k, v in obj.items():

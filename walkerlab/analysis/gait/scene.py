@@ -27,6 +27,8 @@ def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
     """The scene's own equation variant first, then (``compare``, for a compass gait compared
     with published numbers) the other variants: they explain the difference from Eq. 11."""
     own = (scene.ideal.variant,)
+    if getattr(scene.walker, "actuation", None) is not None:  # the printed ones are passive
+        return own
     if compare and scene.walker.model == "compass_gait" and scene.published is not None:
         from walkerlab.models.hybrid.compass_gait import VARIANTS
 

@@ -137,7 +137,8 @@ def contact_setup(scene: Scene) -> ContactSetup:
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, a walker with a massless body, flat feet without
+        No ``contact`` section, a walker with actuators (not in the contact view yet), a
+        walker with a massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).
     """
@@ -147,6 +148,10 @@ def contact_setup(scene: Scene) -> ContactSetup:
     if scene.contact is None:
         raise ContactSceneError(f"scene '{scene.name}' has no 'contact' section, which the "
                                 "contact model needs")
+    if getattr(scene.walker, "actuation", None) is not None:
+        raise ContactSceneError(f"scene '{scene.name}': walker.actuation: actuators are in "
+                                "the rigid model only; the contact view does not carry them "
+                                "yet (leave out the 'contact' section)")
     contact = scene.contact
     cs = scene.contact_sim or ContactSimSettings()
     data = walker_data(scene.walker, scene.slope.phi_rad)
@@ -189,7 +194,8 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, a walker with a massless body, flat feet without
+        No ``contact`` section, a walker with actuators (not in the contact view yet), a
+        walker with a massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).
     """
