@@ -22,9 +22,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 if TYPE_CHECKING:  # pragma: no cover
+    import numpy as np
+
     from walkerlab.config import Scene
 
 __all__ = ["Gait", "Step", "Walk", "Walker"]
@@ -72,6 +72,8 @@ class Gait:
     @property
     def stable(self) -> bool:
         """All |Floquet multipliers| < 1."""
+        import numpy as np
+
         return bool(np.max(np.abs(self.multipliers)) < 1.0)
 
 
@@ -181,6 +183,8 @@ class Walker:
         return list(self.model.state_units())
 
     def _map(self, x, jacobian: bool = False, steps: list | None = None):
+        import numpy as np
+
         from walkerlab.analysis.gait.poincare import poincare_map
 
         return poincare_map(self.model, np.asarray(x, dtype=float), self.solver,
@@ -218,6 +222,8 @@ class Walker:
     def floquet(self, x) -> np.ndarray:
         """Floquet multipliers (2n,) at ``x`` (eigenvalues of :meth:`jacobian`), by
         decreasing modulus; meaningful at a fixed point."""
+        import numpy as np
+
         from walkerlab.numerics import sort_multipliers
 
         return sort_multipliers(np.linalg.eigvals(self.jacobian(x)))
@@ -233,6 +239,8 @@ class Walker:
         ValueError
             A malformed initial guess or gait choice (one line naming the field).
         """
+        import numpy as np
+
         from walkerlab.analysis.gait.scene import solve_scene
 
         _, search = solve_scene(self.scene)
@@ -305,6 +313,8 @@ class Walker:
         ValueError
             ``strides`` < 1 or ``sample_rate_hz`` <= 0.
         """
+        import numpy as np
+
         from walkerlab.integrate.rigid import simulate_steps
 
         if strides < 1 or not sample_rate_hz > 0:
