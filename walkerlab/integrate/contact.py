@@ -440,19 +440,8 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             event = None  # a fall or flight seen only on a blown-up sample is not one
         if event is None and bad is not None:  # blown-up samples are not data
             ts[-1], Xs[-1] = tn[:bad], Xn[:bad]
-            last = Xn[bad - 1] if bad else xa
-            trip = side_entry(walker, last, 2.0 / rate)
-            msg = (f"total energy rose above its start by more than {e_bound:.3g} J at "
-                   f"t = {tn[bad]:.6g} s (a contact walker cannot gain energy): the run ends "
-                   "at the last trustworthy sample")
-            term = RunEnd.SOLVER_FAILURE
-            if trip is not None:  # the cause: a foot in a gap entered a patch's side
-                foot, edge, ahead, depth = trip
-                t_last = float(tn[bad - 1]) if bad else float(ta)
-                event = ("trip", n_prev + bad - 1, t_last + ahead, foot, edge)
-                term = RunEnd.TRIP
-                msg = (f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
-                       f"entered a patch from its side; {msg}")
+            event, term, msg = _energy_guard_end(walker, ta, xa, tn, Xn, bad, n_prev, e_bound,
+                                                 rate)
             guarded = True
             break
         if event is not None:
@@ -470,16 +459,51 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
         ta, xa = t_all[-1], X_all[-1]
     t_all, X_all = np.concatenate(ts), np.vstack(Xs)
     if event is not None and not guarded:  # cut at the event and append the event state
-        _, k, te, _, _ = event
-        k = max(k, 1)
-        xe = hermite_state(walker, t_all[k - 1], t_all[k], X_all[k - 1], X_all[k], te) \
-            if te > t_all[k - 1] else X_all[k - 1]
-        t_all = np.append(t_all[:k], te) if te > t_all[k - 1] else t_all[:k]
-        X_all = np.vstack([X_all[:k], xe[None]]) if len(t_all) > k else X_all[:k]
-        msg = {RunEnd.TRIP: "trip: a foot hit the side of a patch below its top",
-               RunEnd.FALL: "fall: hip below the fall height",
-               RunEnd.AIRBORNE: "airborne: hip above the airborne height"}[term]
+        t_all, X_all, msg = _cut_at_event(walker, t_all, X_all, event, term)
     return t_all, X_all, nfev, njev, term, msg, event
+
+
+def _energy_guard_end(walker, ta, xa, tn, Xn, bad: int, n_prev: int, e_bound: float,
+                      rate: float):
+    """How a run of :func:`_run_free` ends when the energy guard fires at sample ``bad`` of
+    the chunk ``(tn, Xn)`` (started at ``ta``, ``xa``; ``n_prev`` samples before it): a
+    solver failure at the last trustworthy sample (energy above the start's by more than
+    ``e_bound`` [J]), or a trip when :func:`~walkerlab.models.contact.energy.side_entry`
+    finds the cause, a foot below the patch tops in a gap that reaches a patch's side within
+    ``2 / rate`` s of that sample.  Returns ``(event, termination, message)``, ``event``
+    None but for a trip."""
+    event = None
+    last = Xn[bad - 1] if bad else xa
+    trip = side_entry(walker, last, 2.0 / rate)
+    msg = (f"total energy rose above its start by more than {e_bound:.3g} J at "
+           f"t = {tn[bad]:.6g} s (a contact walker cannot gain energy): the run ends "
+           "at the last trustworthy sample")
+    term = RunEnd.SOLVER_FAILURE
+    if trip is not None:  # the cause: a foot in a gap entered a patch's side
+        foot, edge, ahead, depth = trip
+        t_last = float(tn[bad - 1]) if bad else float(ta)
+        event = ("trip", n_prev + bad - 1, t_last + ahead, foot, edge)
+        term = RunEnd.TRIP
+        msg = (f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
+               f"entered a patch from its side; {msg}")
+    return event, term, msg
+
+
+def _cut_at_event(walker, t_all: np.ndarray, X_all: np.ndarray, event: tuple, term: RunEnd):
+    """The samples of a :func:`_run_free` run cut at its ``event`` (a trip, fall or flight:
+    ``(kind, k, time, foot, edge)`` of :func:`first_event`), with the event's state on the
+    Hermite interpolant appended as the last sample when the event lies after sample
+    ``k - 1``; returns ``(t, X, message)``, the message naming the termination ``term``."""
+    _, k, te, _, _ = event
+    k = max(k, 1)
+    xe = hermite_state(walker, t_all[k - 1], t_all[k], X_all[k - 1], X_all[k], te) \
+        if te > t_all[k - 1] else X_all[k - 1]
+    t_all = np.append(t_all[:k], te) if te > t_all[k - 1] else t_all[:k]
+    X_all = np.vstack([X_all[:k], xe[None]]) if len(t_all) > k else X_all[:k]
+    msg = {RunEnd.TRIP: "trip: a foot hit the side of a patch below its top",
+           RunEnd.FALL: "fall: hip below the fall height",
+           RunEnd.AIRBORNE: "airborne: hip above the airborne height"}[term]
+    return t_all, X_all, msg
 
 
 def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,

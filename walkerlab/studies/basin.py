@@ -468,20 +468,10 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     BasinError
         Bad axes or ranges.
     """
-    from walkerlab.execution.executor import run_each
-    from walkerlab.io.basin_partial import basin_partial_writer
-    from walkerlab.studies.runner import sweep_executor
-
     base = scene.model_dump(mode="json")
     walker, st, mst = _walker_and_settings(base)
     xs, ys = axis_values(st, walker, x_star, grid)
-    x_pre: tuple = ()
-    if st.start == "heel_strike":  # validates the axes too
-        pre = pre_impact_fixed_point(walker, x_star, st, mst)
-        heel_strike_slice(walker, pre, (st.x_axis, st.y_axis))
-        x_pre = tuple(float(v) for v in pre)
-    else:
-        slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]))  # validate axes
+    x_pre = _start_pre_impact(walker, x_star, st, mst, xs, ys)
     nx, ny = xs.size, ys.size
     from walkerlab.io.runpaths import refuse_link
 
@@ -492,6 +482,39 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
         arrays = {"outcome": np.full((ny, nx), NOT_DONE, np.int8),
                   "steps": np.zeros((ny, nx), np.int16), "period": np.zeros((ny, nx), np.int8)}
         row_hash = np.array([""] * ny, dtype=object)
+    tasks = _basin_tasks(base, walker, st, x_star, xs, ys, arrays, x_pre)
+    t0 = time.perf_counter()
+    part.unlink(missing_ok=True)
+    computed = _run_basin_tasks(tasks, part, key, arrays, row_hash, nx, ny, workers, scheduler,
+                                on_chunk)
+    return {"x": xs, "y": ys, **arrays, "wall_time_s": time.perf_counter() - t0,
+            "cells_computed": computed, "partial": part, "settings": st, "walker": walker}
+
+
+def _start_pre_impact(walker, x_star: np.ndarray, st, mst: float, xs: np.ndarray,
+                      ys: np.ndarray) -> tuple:
+    """The start of the basin's cells, for :func:`compute_basin`: with ``basin.start:
+    heel_strike`` the fixed point's pre-impact state (:func:`pre_impact_fixed_point`, ``mst``
+    [s] capping the step) as a tuple of floats, once :func:`heel_strike_slice` has accepted
+    the axes; with ``fixed_point`` an empty tuple, once :func:`slice_state` has accepted the
+    axes at the first cell ``(xs[0], ys[0])``.  Raises :class:`BasinError` for bad axes or a
+    step from the fixed point that ends in no heel strike."""
+    x_pre: tuple = ()
+    if st.start == "heel_strike":  # validates the axes too
+        pre = pre_impact_fixed_point(walker, x_star, st, mst)
+        heel_strike_slice(walker, pre, (st.x_axis, st.y_axis))
+        x_pre = tuple(float(v) for v in pre)
+    else:
+        slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]))  # validate axes
+    return x_pre
+
+
+def _basin_tasks(base: dict, walker, st, x_star: np.ndarray, xs: np.ndarray, ys: np.ndarray,
+                 arrays: dict, x_pre: tuple) -> list[BasinTask]:
+    """The chunks of :func:`compute_basin`: one :class:`BasinTask` per grid row with cells
+    still not done in ``arrays`` (those cells only), the rows nearest the fixed point's
+    ``y`` value first (they converge slowly: started first for load balance)."""
+    nx, ny = xs.size, ys.size
     tasks = []
     for j in range(ny):
         cells = tuple((j * nx + i, float(xs[i]), float(ys[j])) for i in range(nx)
@@ -501,12 +524,23 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
     # rows through the fixed point converge slowly: start them first for load balance
     jc = int(np.argmin(np.abs(ys - x_star[walker.state_names().index(st.y_axis)])))
     tasks.sort(key=lambda t: abs(t.cells[0][0] // nx - jc))
-    total, done = nx * ny, int(np.sum(arrays["outcome"] != NOT_DONE))
-    t0 = time.perf_counter()
-    computed = 0
-    from walkerlab import progress
+    return tasks
 
-    part.unlink(missing_ok=True)
+
+def _run_basin_tasks(tasks: list[BasinTask], part: Path, key: str, arrays: dict,
+                     row_hash: np.ndarray, nx: int, ny: int, workers: int, scheduler,
+                     on_chunk: Callable[[int, int], None] | None) -> int:
+    """Run the chunks of :func:`compute_basin` on
+    :func:`walkerlab.studies.runner.sweep_executor`, storing each chunk's cells in
+    ``arrays`` (and the hash of every grid row it completes in ``row_hash``), writing the
+    partial file ``part`` and reporting progress after each; returns the cells computed."""
+    from walkerlab import progress
+    from walkerlab.execution.executor import run_each
+    from walkerlab.io.basin_partial import basin_partial_writer
+    from walkerlab.studies.runner import sweep_executor
+
+    total, done = nx * ny, int(np.sum(arrays["outcome"] != NOT_DONE))
+    computed = 0
     with basin_partial_writer(part, key, arrays, row_hash) as write, \
             progress.task(f"basin {nx}x{ny} cells", total, done) as bar:
         with sweep_executor(workers, scheduler) as ex:
@@ -525,9 +559,7 @@ def compute_basin(scene, x_star: np.ndarray, key: str, out_path: Path,
                 bar.update(done)
                 if on_chunk is not None:
                     on_chunk(done, total)
-    return {"x": xs, "y": ys, **arrays, "wall_time_s": time.perf_counter() - t0,
-            "cells_computed": computed, "partial": part, "settings": st, "walker": walker}
-
+    return computed
 
 def basin_run(scene, x_star: np.ndarray, key: str, out_path: Path,
               grid: tuple[int, int] | None = None, workers: int = 2, scheduler=None,

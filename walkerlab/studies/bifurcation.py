@@ -384,25 +384,48 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         span = float(np.ptp(slopes)) if slopes.size > 1 else 1.0
         xtol_deg = 1e-4 if param == SLOPE_PATH else 1e-5 * (span or 1.0)
     base = scene.model_dump(mode="json")
+    rows = _grid_rows(base, axis, n_transient, n_keep, steady_state, workers, scheduler)
+    x = np.array([r["x"] for r in rows])
+    mult = np.array([r["multipliers"] for r in rows])
+    onset = locate_period_doubling(base, slopes, mult, x, xtol_deg, param)
+    return _diagram_result(scene, slopes, rows, x, mult, onset, n_transient, n_keep, param,
+                           unit)
+
+
+def _grid_rows(base: dict, axis: ParamAxis, n_transient: int, n_keep: int, steady_state: bool,
+               workers: int, scheduler) -> list[dict]:
+    """The per-value rows of :func:`bifurcation_diagram` (fixed point, multipliers, steady
+    state; :func:`_bif_chunk`), in grid order: the grid of ``axis`` is cut into runs
+    (:func:`walkerlab.studies.runner.plan_chunks`) evaluated on
+    :func:`walkerlab.studies.runner.sweep_executor`, with a progress bar."""
+    from walkerlab import progress
+
+    param, n = axis.path, len(axis.values)
     chunks = plan_chunks([axis], base, workers=max(1, workers))
     tasks = [_BifTask(base, tuple(c), n_transient, n_keep, steady_state, param)
              for c in chunks]
-    from walkerlab import progress
-
     rows = []
-    with progress.task(f"bifurcation: {slopes.size} values of {param}", slopes.size) as bar:
+    with progress.task(f"bifurcation: {n} values of {param}", n) as bar:
         with sweep_executor(workers, scheduler) as ex:
             for _, rs in run_each(ex, _bif_chunk, [(t,) for t in tasks]):
                 rows += rs
                 bar.update(len(rows))
     rows.sort(key=lambda r: r["index"])
-    x = np.array([r["x"] for r in rows])
-    mult = np.array([r["multipliers"] for r in rows])
-    onset = locate_period_doubling(base, slopes, mult, x, xtol_deg, param)
-    il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
+    return rows
+
+
+def _diagram_result(scene: Scene, slopes: np.ndarray, rows: list[dict], x: np.ndarray,
+                    mult: np.ndarray, onset: dict, n_transient: int, n_keep: int, param: str,
+                    unit: str) -> BifurcationResult:
+    """:func:`bifurcation_diagram`'s rows packed as a :class:`BifurcationResult`: the fixed
+    points ``x`` and multipliers ``mult`` with the fixed points' inter-leg angles (from the
+    scene's walker; NaN where no fixed point was found), the steady state's heel strikes in
+    degrees and the attractor period (distinct inter-leg angles among them), the grid
+    ``slopes`` of ``param`` [``unit``] and the period-doubling ``onset``."""
     from walkerlab.models.registry import build_walker
     from walkerlab.studies.points import interleg_angle
 
+    il = np.degrees(np.array([r["hs_interleg"] for r in rows]))
     walker = build_walker(scene)
     fp_il = np.degrees([interleg_angle(walker, xi) if np.all(np.isfinite(xi)) else math.nan
                         for xi in x])
@@ -416,7 +439,6 @@ def bifurcation_diagram(scene: Scene, slopes_deg, n_transient: int = 100, n_keep
         attractor_period=np.array([_distinct(np.radians(v)) for v in il]),
         onset=onset, wall_time_s=np.array([r["wall_time_s"] for r in rows]),
         n_transient=n_transient, n_keep=n_keep, param=param, unit=unit)
-
 
 def parameter_values(data: dict) -> tuple[np.ndarray, str, str]:
     """The grid of loaded bifurcation data

@@ -232,11 +232,27 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     deadline = None if time_limit_s is None else wall + time_limit_s
     method = solver.method
     P = StepMap(walker, patch_spacing, solver, deadline=deadline)
-    scale = P.scale
     coarse = coarse_solver is not None and coarse_solver.rtol > solver.rtol
     # the cheap map (coarse) brings the guess to ~its noise floor; the tight map polishes it
     PC = StepMap(walker, patch_spacing, dataclasses.replace(coarse_solver, method=method),
                  deadline=deadline) if coarse else P
+    z, hist = _warm_up_guess(walker, P, PC, guess, rate_scale, warmup_steps)
+    sol, root_nfev = _solve_fixed_point(P, PC, coarse, z, method, fd_step, xtol, coarse_xtol)
+    return _periodic_gait_result(
+        walker, P, PC, coarse, sol, root_nfev, hist, solver=solver,
+        coarse_solver=coarse_solver, jacobian_solver=jacobian_solver,
+        patch_spacing=patch_spacing, deadline=deadline, fd_step=fd_step, check_fd=check_fd,
+        residual_tol=residual_tol, wall=wall)
+
+
+def _warm_up_guess(walker: ContactWalker, P: StepMap, PC: StepMap, guess, rate_scale,
+                   warmup_steps: int) -> tuple[np.ndarray, list[float]]:
+    """The warm-up of :func:`find_contact_periodic_gait`: the guess as a section state (a
+    section state as given, an ideal post-impact state through
+    :func:`section_guess_from_ideal` on the cheap map ``PC``), then ``warmup_steps`` steps of
+    ``PC`` from it; returns the state reached and the scaled change of each step (the
+    ``warmup_history``).  Raises ValueError for a guess of neither size."""
+    scale = P.scale
     guess = np.asarray(guess, float)
     if guess.size == len(P.names):
         z = guess.copy()
@@ -250,21 +266,42 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         z1 = PC(z)[0]
         hist.append(float(np.max(np.abs((z1 - z) / scale))))
         z = z1
+    return z, hist
 
-    def G_of(M):
-        return _last_call_memo(lambda u: (M(u * scale)[0] - u * scale) / scale)
 
-    def dG_of(M):
-        return _last_call_memo(
-            lambda u: fd_jacobian(lambda v: M(v)[0], u * scale, 10 * fd_step * scale,
-                                  central=method != "odeint")
-            * scale[None, :] / scale[:, None] - np.eye(len(scale)))
+def _scaled_residual(M: StepMap, scale: np.ndarray):
+    """``G(u) = (M(u * scale) - u * scale) / scale``, the scaled fixed-point residual of the
+    step map ``M`` that ``scipy.optimize.root`` zeroes (memoised on its last argument, see
+    :func:`_last_call_memo`)."""
+    return _last_call_memo(lambda u: (M(u * scale)[0] - u * scale) / scale)
 
+
+def _scaled_residual_jacobian(M: StepMap, scale: np.ndarray, fd_step: float, method: str):
+    """dG/du of :func:`_scaled_residual` by finite differences of step ``10 * fd_step`` times
+    ``scale`` (forward differences when ``method`` is odeint, central otherwise), the root
+    finder's Jacobian; memoised on its last argument, its last value kept as ``.last``."""
+    return _last_call_memo(
+        lambda u: fd_jacobian(lambda v: M(v)[0], u * scale, 10 * fd_step * scale,
+                              central=method != "odeint")
+        * scale[None, :] / scale[:, None] - np.eye(len(scale)))
+
+
+def _solve_fixed_point(P: StepMap, PC: StepMap, coarse: bool, z: np.ndarray, method: str,
+                       fd_step: float, xtol: float, coarse_xtol: float):
+    """The two-fidelity root solve of :func:`find_contact_periodic_gait` from the warmed-up
+    state ``z``: with ``coarse``, a hybr solve on the cheap map ``PC`` to ``coarse_xtol``
+    whose last Jacobian then steers every step of the tight solve on ``P`` (a Newton step
+    lands at the tight map's noise floor with no Jacobian at the tight tolerance); without
+    it, one hybr solve on ``P`` with its own FD Jacobians.  Returns the tight solve's
+    ``OptimizeResult`` (``x`` in scaled coordinates) and the function evaluations of both
+    (``method``: the maps' integrator, which picks the FD Jacobians' differences)."""
+    scale = P.scale
     root_nfev = 0
-    jac = dG_of(P)
+    jac = _scaled_residual_jacobian(P, scale, fd_step, method)
     if coarse:
-        dGc = dG_of(PC)
-        solc = root(G_of(PC), z / scale, jac=dGc, method="hybr", options={"xtol": coarse_xtol})
+        dGc = _scaled_residual_jacobian(PC, scale, fd_step, method)
+        solc = root(_scaled_residual(PC, scale), z / scale, jac=dGc, method="hybr",
+                    options={"xtol": coarse_xtol})
         root_nfev += solc.nfev
         z = solc.x * scale
         # the last Jacobian hybr asked for (near the coarse fixed point; the tight one is
@@ -273,12 +310,23 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         Jc = dGc.last
         jac = lambda u: Jc  # noqa: E731
 
-    sol = root(G_of(P), z / scale, jac=jac, method="hybr", options={"xtol": xtol})
+    sol = root(_scaled_residual(P, scale), z / scale, jac=jac, method="hybr",
+               options={"xtol": xtol})
     root_nfev += sol.nfev
-    zs = sol.x * scale
-    z1, T, ell = P(zs)
-    res_si = z1 - zs
-    jac_solver = dataclasses.replace(jacobian_solver, method=method)
+    return sol, root_nfev
+
+
+def _floquet_multipliers(walker: ContactWalker, P: StepMap, zs: np.ndarray, solver: Solver,
+                         jacobian_solver: Solver, patch_spacing, deadline, fd_step: float,
+                         check_fd: bool):
+    """The final Jacobian of :func:`find_contact_periodic_gait` at the fixed point ``zs``:
+    central differences of step ``fd_step * scale`` on the map at ``jacobian_solver``'s
+    tolerances (``P`` itself when they equal ``solver``'s), its sorted eigenvalues (the
+    Floquet multipliers) and, with ``check_fd``, the largest change of the slow (|lambda| >
+    1e-3) multipliers for the step times 3 and over 3 (NaN without).  Returns
+    ``(PJ, J, multipliers, spread)``, ``PJ`` the map the Jacobian used."""
+    scale = P.scale
+    jac_solver = dataclasses.replace(jacobian_solver, method=solver.method)
     PJ = P if (jac_solver.rtol, jac_solver.atol) == (solver.rtol, solver.atol) else \
         StepMap(walker, patch_spacing, jac_solver, deadline=deadline)
     FJ = lambda v: PJ(v)[0]  # noqa: E731
@@ -292,6 +340,25 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         slow = np.abs(ev) > 1e-3
         spread = float(max(np.max(np.abs(ev_lo - ev)[slow], initial=0.0),
                            np.max(np.abs(ev_hi - ev)[slow], initial=0.0)))
+    return PJ, J, ev, spread
+
+
+def _periodic_gait_result(walker: ContactWalker, P: StepMap, PC: StepMap, coarse: bool, sol,
+                          root_nfev: int, hist: list[float], *, solver: Solver,
+                          coarse_solver: Solver | None, jacobian_solver: Solver,
+                          patch_spacing, deadline, fd_step: float, check_fd: bool,
+                          residual_tol: float, wall: float) -> ContactPeriodicGait:
+    """The result of :func:`find_contact_periodic_gait` from its root solve ``sol``: one step
+    of the tight map from the fixed point (period, step length, residual), the Floquet
+    multipliers (:func:`_floquet_multipliers`), the patch margin and the diagnostics
+    (``info``), packed as a :class:`ContactPeriodicGait` (``wall`` is the search's start on
+    ``time.perf_counter``; the keywords are the search's own arguments)."""
+    scale, method = P.scale, solver.method
+    zs = sol.x * scale
+    z1, T, ell = P(zs)
+    res_si = z1 - zs
+    PJ, J, ev, spread = _floquet_multipliers(walker, P, zs, solver, jacobian_solver,
+                                             patch_spacing, deadline, fd_step, check_fd)
     margin = P.patch_margin(zs)
     info = {"warmup_history": hist, "root_message": sol.message, "root_nfev": root_nfev,
             "fd_step": fd_step, "scales": scale, "method": method, "rtol": solver.rtol,
@@ -306,7 +373,6 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         nfev=P.nfev + (PJ.nfev if PJ is not P else 0) + (PC.nfev if coarse else 0),
         patch_margin_m=margin, full_state=P.to_state(zs),
         wall_time_s=time.perf_counter() - wall, info=info)
-
 
 def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None = None,
                                 solver=None):  # setup: ContactSetup, solver: SolverSettings

@@ -53,6 +53,55 @@ def _below(clearance, depth, t, x):
     return clearance(t, x) + depth
 
 
+def _kneed_phases(data: WalkerData, f: dict, flow, var, compiled, heel: Guard,
+                  falls_back: Guard, fall: Guard) -> tuple[Phase, Phase]:
+    """The two phases of a kneed walker for :func:`make_rigid_walker`: ``unlocked_swing``
+    (the free knee, ended by the knee strike, its reset leading to the next phase, or by a
+    swing foot scuffing more than :data:`SCUFF_DEPTH` times the leg length below the ground)
+    and ``locked_swing`` (the locked knee, ended by the heel strike), each also by a fall;
+    ``f`` are the generated functions, ``flow`` the unlocked flow, ``var`` its variational
+    right-hand side and ``compiled(name, *guards)`` the compiled flow (or None)."""
+    ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
+    return (
+        Phase("unlocked_swing", flow, (
+            Guard("knee_strike", f["guard_knee_extension"], +1, "next_phase",
+                  f["grad_knee_extension"], f["knee_reset"], f["knee_reset_jacobian"]),
+            Guard("swing_foot_scuffs", partial(_below, f["guard_swing_clearance"],
+                                               SCUFF_DEPTH * data.leg_length_m), -1, "fall",
+                  f["grad_swing_clearance"]), fall),
+            jacobian=f["flow_jacobian"], variational=var,
+            compiled=compiled("flow", ("knee_extension", 0.0),
+                              ("swing_clearance", SCUFF_DEPTH * data.leg_length_m),
+                              ("hip_height", 0.0))),
+        Phase("locked_swing", f["flow_locked"], (
+            heel, falls_back, Guard("swing_foot_scuffs", ahead, +1, "fall", dahead), fall),
+            jacobian=f["flow_locked_jacobian"],
+            variational=f.get("flow_locked_variational"),
+            compiled=compiled("flow_locked", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
+                              ("swing_foot_ahead", 0.0), ("hip_height", 0.0))),
+    )
+
+
+def _straight_leg_phases(f: dict, flow, flow_jacobian, var, compiled, heel: Guard,
+                         falls_back: Guard, fall: Guard) -> tuple[Phase, Phase]:
+    """The two phases of a straight-leg walker for :func:`make_rigid_walker`:
+    ``early_swing`` until mid-stance (the swing foot passing the stance foot) and
+    ``late_swing`` until the heel strike or the swing leg falling back, each also ended by a
+    fall; ``f`` are the generated functions, ``flow``/``flow_jacobian`` the flow and its
+    Jacobian (``flow_jacobian`` None: the generated one), ``var`` the variational
+    right-hand side and ``compiled(name, *guards)`` the compiled flow (or None)."""
+    ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
+    early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead),
+                                        fall), jacobian=flow_jacobian or f["flow_jacobian"],
+                  variational=var,
+                  compiled=compiled("flow", ("swing_foot_ahead", 0.0), ("hip_height", 0.0)))
+    late = Phase("late_swing", flow, (heel, falls_back, fall),
+                 jacobian=flow_jacobian or f["flow_jacobian"], variational=var,
+                 compiled=compiled("flow", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
+                                   ("hip_height", 0.0)))
+    return early, late
+
+
 def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "derived",
                       flow=None, flow_jacobian=None, reset=None, reset_jacobian=None
                       ) -> HybridWalker:
@@ -88,35 +137,10 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     ahead, dahead = f["guard_swing_foot_ahead"], f["grad_swing_foot_ahead"]
     heel = Guard("heel_strike", f["guard_heel_strike"], -1, "heel_strike", f["grad_heel_strike"])
     falls_back = Guard("swing_leg_falls_back", ahead, -1, "fall", dahead)
-    if data.structure.knee:
-        phases = (
-            Phase("unlocked_swing", flow, (
-                Guard("knee_strike", f["guard_knee_extension"], +1, "next_phase",
-                      f["grad_knee_extension"], f["knee_reset"], f["knee_reset_jacobian"]),
-                Guard("swing_foot_scuffs", partial(_below, f["guard_swing_clearance"],
-                                                   SCUFF_DEPTH * data.leg_length_m), -1, "fall",
-                      f["grad_swing_clearance"]), fall),
-                jacobian=f["flow_jacobian"], variational=var,
-                compiled=compiled("flow", ("knee_extension", 0.0),
-                                  ("swing_clearance", SCUFF_DEPTH * data.leg_length_m),
-                                  ("hip_height", 0.0))),
-            Phase("locked_swing", f["flow_locked"], (
-                heel, falls_back, Guard("swing_foot_scuffs", ahead, +1, "fall", dahead), fall),
-                jacobian=f["flow_locked_jacobian"],
-                variational=f.get("flow_locked_variational"),
-                compiled=compiled("flow_locked", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
-                                  ("swing_foot_ahead", 0.0), ("hip_height", 0.0))),
-        )
-    else:
-        early = Phase("early_swing", flow, (Guard("midstance", ahead, +1, "next_phase", dahead),
-                                            fall), jacobian=flow_jacobian or f["flow_jacobian"],
-                      variational=var,
-                      compiled=compiled("flow", ("swing_foot_ahead", 0.0), ("hip_height", 0.0)))
-        late = Phase("late_swing", flow, (heel, falls_back, fall),
-                     jacobian=flow_jacobian or f["flow_jacobian"], variational=var,
-                     compiled=compiled("flow", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
-                                       ("hip_height", 0.0)))
-        phases = (early, late)
+    phases = (_kneed_phases(data, f, flow, var, compiled, heel, falls_back, fall)
+              if data.structure.knee else
+              _straight_leg_phases(f, flow, flow_jacobian, var, compiled, heel, falls_back,
+                                   fall))
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
               "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
