@@ -7,7 +7,7 @@ the full swing amplitude, phase-aligned they agree to the interpolation error.
 
 import numpy as np
 
-from walkerlab.analysis.contact.compare import aligned_errors, phase_aligned_errors
+from walkerlab.comparison.errors import aligned_errors, phase_aligned_errors
 from walkerlab.io.trajectory import NamedTrajectory
 
 

@@ -10,7 +10,8 @@ also those inside functions), never by running it: dependencies point down.
 - ``report/`` writes text from loaded schema objects and numbers computed before it: no
   ``h5py``, no matplotlib or ``plotting``, no ``analysis``, ``studies``, ``models``,
   ``integrate`` (its run-end names aside), no loader;
-- the middle floor: ``analysis/`` never imports ``studies/``, ``bench/`` or ``export/``;
+- the middle floor: ``analysis/`` never imports ``studies/``, ``bench/``, ``export/`` or
+  ``comparison/``;
   ``models/``, ``integrate/``, ``codegen/`` and ``walker/`` never import ``analysis/``;
   ``config/`` never imports ``io/`` (a scene opens no artifact);
 - no name private to a module (``_name``) is imported by another package, and no private
@@ -115,7 +116,8 @@ def test_the_cli_opens_no_artifact():
 #: no HDF5, no drawing, no computation, and loads no artifact (the run-end names of
 #: walkerlab.integrate.ends are vocabulary, allowed)
 REPORT_BANNED = ("h5py", "matplotlib", "walkerlab.plotting", "walkerlab.analysis",
-                 "walkerlab.studies", "walkerlab.models", "walkerlab.codegen",
+                 "walkerlab.studies", "walkerlab.comparison", "walkerlab.models",
+                 "walkerlab.codegen",
                  "walkerlab.execution", "walkerlab.io.sweep_store", "walkerlab.io.schemas.loaders")
 
 
@@ -153,7 +155,8 @@ def test_the_report_only_writes_text_from_loaded_objects():
 
 #: (importing packages, packages they must never import)
 MIDDLE_FLOOR_RULES = [
-    (("analysis",), ("walkerlab.studies", "walkerlab.bench", "walkerlab.export")),
+    (("analysis",), ("walkerlab.studies", "walkerlab.bench", "walkerlab.export",
+                     "walkerlab.comparison")),
     (("models", "integrate", "codegen", "walker"), ("walkerlab.analysis",)),
     (("config",), ("walkerlab.io",)),
 ]

@@ -282,7 +282,7 @@ def test_export_writes_the_parts(name, element, tmp_path):
 
 def test_table3_gives_each_legs_step_where_legs_differ(fixed_points):
     from walkerlab.analysis.gait.metrics import sample_trajectory, step_table
-    from walkerlab.analysis.gait.tables import gait_metrics
+    from walkerlab.comparison.tables import gait_metrics
 
     w, fp = fixed_points["asymmetric_legs"]
     traj = simulate_steps(w, fp.x, 4, SOLVER)

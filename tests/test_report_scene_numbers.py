@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.analysis.report_numbers import report_numbers
+from walkerlab.comparison.report_numbers import report_numbers
 from walkerlab.config import load_scene
 from walkerlab.io.schemas.compare import load_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim

@@ -77,8 +77,8 @@ def test_report_of_ideal_only_scene_has_no_contact_sections(ideal_scene, tmp_pat
     for word in ("contact", "Fig. 8", "Table 2", "work-precision"):
         assert word not in md.replace("ours, ideal", "")
     figs = sorted(p.name for p in (html.parent / "figures").glob("*.png"))
-    assert figs == ["fig10_energy.png", "fig2_stick_ideal.png", "fig7_angles_rates.png",
-                    "fig9_limit_cycles.png"]
+    assert figs == ["energy_ledger.png", "fig10_energy.png", "fig2_stick_ideal.png",
+                    "fig7_angles_rates.png", "fig9_limit_cycles.png"]
     assert "data:image/png;base64" in html.read_text()
 
 
@@ -114,7 +114,7 @@ def test_figures_are_drawn_from_a_hand_built_artifact(tmp_path, ideal_scene):
 
 
 def test_compare_of_a_trajectory_with_itself_is_zero():
-    from walkerlab.analysis.contact.compare import aligned_errors, limit_cycle_distance
+    from walkerlab.comparison.errors import aligned_errors, limit_cycle_distance
 
     tr = _fake_trajectory()
     t, err = aligned_errors(tr, tr)
@@ -124,7 +124,7 @@ def test_compare_of_a_trajectory_with_itself_is_zero():
 
 
 def test_table3_is_recomputed_from_the_artifact(tmp_path, ideal_scene):
-    from walkerlab.analysis.gait.tables import gait_metrics
+    from walkerlab.comparison.tables import gait_metrics
 
     tr = _fake_trajectory()
     m = gait_metrics(tr)

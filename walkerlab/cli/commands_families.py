@@ -152,12 +152,11 @@ def continuation(scene: Path | None = SceneArg,
 def target(scene: Path | None = SceneArg,
            vary: str = typer.Option(..., "--vary", help="the numeric scene field to solve for "
                                     "(e.g. walker.actuation.push_off.impulse_n_s)"),
-           speed: float | None = typer.Option(None, "--speed-m-per-s", help="target speed "
-                                              "[m/s]"),
+           speed: float | None = typer.Option(None, "--speed-m-per-s", help="target speed, m/s"),
            step_length: float | None = typer.Option(None, "--step-length-m",
-                                                    help="target step length [m]"),
+                                                    help="target step length, m"),
            step_period: float | None = typer.Option(None, "--step-period-s",
-                                                    help="target step period [s]")) -> None:
+                                                    help="target step period, s")) -> None:
     """Find the value of one field (an actuation parameter) whose period-1 gait has a target
     speed, step length or step period (solved with the fixed point); prints it and the gait.
     Writes nothing: set the value in the scene (or pass it to sweep/continuation)."""

@@ -83,7 +83,7 @@ def _suggestion(root: type[BaseModel], e: dict) -> list[str]:
 #: What a walker can be today, said by an error on an unknown walker field or kind and by
 #: the README (one place: update it as the walker vocabulary grows)
 WALKER_VOCABULARY = (
-    "a walker today is planar and passive: model compass_gait (hip mass, one point mass per "
+    "a walker today is planar: model compass_gait (hip mass, one point mass per "
     "leg) or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
     "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee, "
     "foot kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "

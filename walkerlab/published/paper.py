@@ -61,7 +61,7 @@ TABLE2 = {
 TABLE2_RATE_INCREASE_PERCENT = (41.0, 74.0)
 
 # Table 3: gait characteristics (MATLAB, MSC ADAMS) for the row keys of
-# walkerlab.analysis.gait.tables.gait_metrics.
+# walkerlab.comparison.tables.gait_metrics.
 TABLE3 = {
     "t_left_s": (0.60, 0.59),
     "t_right_s": (0.79, 0.77),

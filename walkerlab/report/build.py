@@ -39,7 +39,7 @@ class ReportInputs:
         ``bifurcation`` and ``bifurcation_<field>``, ``stability_map_<kind>``; an absent
         stage gives no section.
     gait_columns : dict[str, dict[str, float]]
-        Table 3 columns (:func:`walkerlab.analysis.gait.tables.table3`) by label ("ours, ideal",
+        Table 3 columns (:func:`walkerlab.comparison.tables.table3`) by label ("ours, ideal",
         "ours, contact").
     energy_drift : (float, float)
         Largest energy change within a phase of the rigid run [J] and relative [-]
@@ -63,7 +63,7 @@ class ReportInputs:
 
     The stage computes them before the report is written
     (:func:`walkerlab.stages.report.load_inputs`), mostly through
-    :func:`walkerlab.analysis.report_numbers.report_numbers`.
+    :func:`walkerlab.comparison.report_numbers.report_numbers`.
     """
 
     artifacts: dict

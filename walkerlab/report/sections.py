@@ -18,7 +18,7 @@ from walkerlab.report.markdown import num, printed, sig_digits, table
 from walkerlab.report.text import zero_multipliers_text
 from walkerlab.units import Units, for_scene
 
-#: Table 3 rows (keys of :func:`walkerlab.analysis.gait.tables.gait_metrics`): name, symbol, unit
+#: Table 3 rows (keys of :func:`walkerlab.comparison.tables.gait_metrics`): name, symbol, unit
 TABLE3_ROWS = {
     "t_left_s": ("Left step period", "t_left", "s"),
     "t_right_s": ("Right step period", "t_right", "s"),

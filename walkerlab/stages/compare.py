@@ -9,12 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.analysis.contact.compare import (
+from walkerlab.comparison.errors import (
     aligned_errors,
     limit_cycle_distance,
     phase_aligned_errors,
 )
-from walkerlab.analysis.gait.tables import gait_metrics
+from walkerlab.comparison.tables import gait_metrics
 from walkerlab.config import Scene
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.compare import METRIC_UNITS, Comparison, write_compare

@@ -29,9 +29,9 @@ from walkerlab.stages.report_inputs import report_artifacts
 def load_inputs(scene: Scene, paths: dict[str, Path], figures: Path) -> ReportInputs:
     """Load the report's artifacts (``paths``: ``{stage: Path}``, and the stability maps
     whose figure is in ``figures``) through :mod:`walkerlab.io.schemas`, with the numbers
-    computed from them (:func:`walkerlab.analysis.report_numbers.report_numbers`; the
+    computed from them (:func:`walkerlab.comparison.report_numbers.report_numbers`; the
     bifurcation diagrams' onsets: :mod:`walkerlab.studies.bifurcation`)."""
-    from walkerlab.analysis.report_numbers import report_numbers
+    from walkerlab.comparison.report_numbers import report_numbers
     from walkerlab.io.schemas.loaders import load_artifact
     from walkerlab.studies.bifurcation import fall_onset, onset_value
 

@@ -374,12 +374,10 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
     if last and "standing" not in last:
         last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
     if walker.slope_rad <= 0 and walker.actuators is None:
-        why = ("a passive walker needs a downhill slope (slope > 0); on level ground or "
-               "uphill give it actuators (walker.actuation: push_off, torques)")
+        why = "a passive walker needs a downhill slope (slope > 0) or walker.actuation"
     elif walker.actuators is not None:
-        why = ("the scale-free seeds are a passive walker's: give fixedpoint.initial_guess "
-               "from a gait of this walker with a nearby push-off or slope (e.g. "
-               "walkerlab continuation --param walker.actuation.push_off.impulse_n_s=...)")
+        why = ("the seeds are a passive walker's: give fixedpoint.initial_guess (a gait "
+               "at a nearby push-off or slope)")
     else:
         why = "the walker may have no period-1 gait here"
     # the advice first, the solver's detail last: a one-line display that must shorten the

@@ -6,7 +6,7 @@ contact - ideal of each named coordinate, in its unit; ``limit_cycle_distance/<c
 mean distance between the two phase curves; ``max_abs_angle`` [rad], ``max_abs_rate``
 [rad/s]); ``errors_phase_aligned/`` (dimension ``step_phase``: step number + fraction of
 the step [-]; ``coordinates/<name>``: error contact - ideal at the same fraction of the same
-step, :func:`walkerlab.analysis.contact.compare.phase_aligned_errors`); ``metrics/{ideal,contact}/
+step, :func:`walkerlab.comparison.errors.phase_aligned_errors`); ``metrics/{ideal,contact}/
 <name>``: the gait metrics of paper Table 3 (units in :data:`METRIC_UNITS`).
 """
 

@@ -21,7 +21,7 @@ def report_numbers(scene, arts: dict) -> dict:
     -------
     dict
         With ``simulate`` loaded: ``gait_columns`` (Table 3 columns by label,
-        :func:`walkerlab.analysis.gait.tables.table3`), ``energy_drift`` ([J] and relative,
+        :func:`walkerlab.comparison.tables.table3`), ``energy_drift`` ([J] and relative,
         :func:`walkerlab.analysis.gait.checks.energy_drift_in_swing`), ``swing_clearance``
         (lowest swing-foot height above the slope [m]) and, where the scene's published
         module prints Eq. (11) and Table 3, ``published_step_length_m``
@@ -41,7 +41,7 @@ def report_numbers(scene, arts: dict) -> dict:
     sim, contact = arts.get("simulate"), arts.get("contact-sim")
     if sim is not None:
         from walkerlab.analysis.gait.checks import energy_drift_in_swing, swing_foot_clearance
-        from walkerlab.analysis.gait.tables import table3
+        from walkerlab.comparison.tables import table3
 
         out["energy_drift"] = energy_drift_in_swing(sim.samples)
         out["swing_clearance"] = swing_foot_clearance(sim.samples, scene.slope.phi_rad)
