@@ -82,13 +82,28 @@ def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: floa
     return walker.from_section(walker.section(sol.x))
 
 
+def powered_slope(walker: HybridWalker) -> float:
+    """The slope [rad] whose passive gait would take, per step, what the push-off gives: a
+    push-off ``P`` loses ``P^2 / (2 M)`` in the collision (Kuo 2002), a slope ``gamma``
+    releases ``M g d gamma`` with ``d ~ 2 l alpha`` and ``alpha ~ gamma^(1/3)``, so
+    ``gamma = (P^2 / (4 M^2 g l))^(3/4)``; 0 without a push-off.  Only the seeds' size."""
+    acts = walker.actuators
+    if acts is None or acts.spec.push_off is None:
+        return 0.0
+    m, g = float(walker.total_mass_kg), float(walker.params["gravity_m_per_s2"])
+    length = float(walker.params["leg_length_m"])
+    p = float(acts.spec.push_off.impulse_n_s)
+    return (p * p / (4.0 * m * m * g * length)) ** 0.75
+
+
 def seed_states(walker: HybridWalker) -> list[tuple[str, np.ndarray]]:
     """Scale-free seeds just after heel strike, from the slope and the walker's size.
 
     Step half-angle ``alpha = c gamma^(1/3)`` (``c`` in :data:`SEED_STEP`; Garcia et al.
-    1998: the step angle of both gaits scales as gamma^(1/3) on small slopes), stance leg at
-    ``alpha - gamma`` and swing leg at ``-alpha - gamma`` from the vertical (so the feet lie on
-    the slope), stance rate ``-k alpha sqrt(g/l)`` (``k`` in :data:`SEED_STANCE_RATE`; their
+    1998: the step angle of both gaits scales as gamma^(1/3) on small slopes; a powered
+    walker's ``gamma`` adds :func:`powered_slope`), stance leg at ``alpha - phi`` and swing
+    leg at ``-alpha - phi`` from the vertical (``phi`` the slope: the feet lie on it),
+    stance rate ``-k alpha sqrt(g/l)`` (``k`` in :data:`SEED_STANCE_RATE`; their
     ``theta_dot ~ -theta``), swing rate ``r`` times the stance rate (``r`` in
     :data:`SEED_SWING_RATIO`).
 
@@ -98,14 +113,15 @@ def seed_states(walker: HybridWalker) -> list[tuple[str, np.ndarray]]:
         A description and the state (``walker.state_names()``; angles [rad], rates
         [rad/s]), for each seed.
     """
-    gamma = max(float(walker.slope_rad), 1e-4)
+    phi = float(walker.slope_rad)
+    gamma = max(phi, 1e-4) + powered_slope(walker)
     omega = math.sqrt(float(walker.params["gravity_m_per_s2"])
                       / float(walker.params["leg_length_m"]))
     out = []
     for c, k, r in itertools.product(SEED_STEP, SEED_STANCE_RATE, SEED_SWING_RATIO):
         alpha = min(c * gamma ** (1.0 / 3.0), 0.6)
         rate = -k * alpha * omega
-        x = state_from_legs(walker, alpha - gamma, -alpha - gamma, rate, r * rate)
+        x = state_from_legs(walker, alpha - phi, -alpha - phi, rate, r * rate)
         out.append((f"step angle {c:g} gamma^(1/3), stance rate {k:g} alpha sqrt(g/l), "
                     f"swing/stance rate {r:g}", x))
     return out
