@@ -303,3 +303,29 @@ def test_the_automatic_gait_search_walks_on_level_ground(name):
         assert ok and found.stable
     else:  # Kuo's numbers: two unstable gaits; the search reports one of them
         assert not found.stable and 3.0 < found.step_period < 3.7
+
+
+def test_a_push_off_law_of_the_pre_impact_speed():
+    """P = P0 + k (v_ref - v), v the hip's speed before heel strike, never negative; the
+    hip speed from the compass gait's own kinematics, hip = foot + L (-sin th2, cos th2)."""
+    law = {"impulse_n_s": 3.0, "speed_gain_n_s2_per_m": 10.0, "reference_speed_m_per_s": 0.5}
+    w = build_walker(scene_from_dict(_compass({"push_off": law})))
+    for xm in ([-0.17, 0.17, -0.77, -0.87], [-0.2, 0.2, -0.5, -0.6], [-0.1, 0.1, -2.0, -2.0]):
+        xm = np.array(xm)
+        v = abs(xm[3]) * 1.0  # |d hip / dt| = L |dtheta2|
+        want = max(0.0, 3.0 + 10.0 * (0.5 - v))
+        tr = w.actuators.transition(xm)
+        assert tr["impulse"] == pytest.approx(want, abs=1e-12)
+        ref_plus, _ = ref.push_off_heel_strike(xm, ref.PAPER, 0.0, want)
+        np.testing.assert_allclose(tr["x_plus"], ref_plus, atol=1e-12)
+    # a speed-regulated gait: the same fixed point as the fixed push-off it settles to
+    sc = _compass({"push_off": law})
+    sc["fixedpoint"]["initial_guess"] = dict(zip(
+        ["swing_angle_rad", "stance_angle_rad", "swing_rate_rad_per_s",
+         "stance_rate_rad_per_s"], [-0.1735, 0.1735, -0.7654, -0.8690]))
+    walker = wl.Walker.from_scene(sc)
+    g = walker.fixed_point()
+    pre = simulate_steps(walker.model, g.x, 1, walker.solver).segments[0].x_end
+    P = max(0.0, 3.0 + 10.0 * (0.5 - abs(pre[3])))  # the impulse the law gives on the gait
+    x, T, _ = ref.fixed_point(ref.PAPER, 0.0, P=P, guess=g.x)
+    np.testing.assert_allclose(g.x, x, atol=1e-8)

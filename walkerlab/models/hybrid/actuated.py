@@ -40,7 +40,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from walkerlab.models.hybrid.base import HybridWalker, Phase
-from walkerlab.numerics import complex_step_jacobian
+from walkerlab.numerics import complex_step_jacobian, fd_jacobian
 
 __all__ = ["Actuators", "actuate"]
 
@@ -183,15 +183,11 @@ class Actuators:
         return J @ dq
 
     def _hip_jac_complex(self, q):
-        n, h = self.n, 1e-7
-        cols = []
-        for k in range(n):
-            e = np.zeros(n)
-            e[k] = h
-            a = self.fns["points"](np.concatenate([q + e, np.zeros(n)]))["hip"]
-            b = self.fns["points"](np.concatenate([q - e, np.zeros(n)]))["hip"]
-            cols.append((np.asarray(a) - np.asarray(b)) / (2 * h))
-        return np.stack(cols, axis=1)
+        """The hip's position Jacobian (2, n) by central differences (for a state that is
+        already complex: a complex step cannot be nested)."""
+        n = self.n
+        return fd_jacobian(lambda qq: np.asarray(self.fns["points"](
+            np.concatenate([qq, np.zeros(n)]))["hip"]), np.real(q), 1e-7)
 
     def impulse(self, x) -> float:
         """Push-off impulse ``P`` [N s] for the pre-impact state ``x`` (>= 0)."""
