@@ -83,6 +83,7 @@ def _sweep_files(folder: Path) -> set[str]:
     return {p.name for p in folder.iterdir()} if folder.is_dir() else set()
 
 
+@pytest.mark.xdist_group("timing")  # wall-clock bound: not beside another of them
 @pytest.mark.slow
 def test_h1_dask_only_worker_killed_bounded_wait_one_line_resume(tmp_path, one_worker_cluster):
     addr, wpid, _ = one_worker_cluster
@@ -297,6 +298,7 @@ def test_m5_a_5000_digit_integer_is_one_line_naming_the_field():
 
 
 # ----------------------------------------------------------------------------- guess (Medium)
+@pytest.mark.xdist_group("timing")  # wall-clock bound: not beside another of them
 def test_m6_a_spinning_initial_guess_fails_fast_in_one_line(tmp_path):
     import yaml
 
@@ -495,6 +497,7 @@ def test_m4_animate_leaves_out_a_stale_or_edited_contact_sim(tmp_path):
     assert "contact_sim.h5 was changed after it was written" in " ".join(r.stdout.split())
 
 
+@pytest.mark.xdist_group("timing")  # wall-clock bound: not beside another of them
 def test_h1_dask_garbage_scheduler_address_is_one_line_at_once(tmp_path):
     pytest.importorskip("distributed")
     for addr in ("not an address", "tcp://host", "inproc://x"):

@@ -26,6 +26,7 @@ def _scene(tmp_path, **wp):
     return load_scene(p)
 
 
+@pytest.mark.xdist_group("timing")  # times every solver setting (pins the CPUs it uses)
 @pytest.mark.slow  # end to end: a whole report
 def test_report_study_measures_every_case_once_and_reuses_it(tmp_path):
     from walkerlab.stages import report

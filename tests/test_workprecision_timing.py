@@ -4,11 +4,13 @@ front and the fastest setting only beyond the spread of the repeats."""
 import time
 
 import numpy as np
+import pytest
 
 from walkerlab.bench.workprecision import time_case
 from walkerlab.bench.workprecision_results import pareto_front
 
 
+@pytest.mark.xdist_group("timing")  # CPU and wall-clock bounds
 def test_time_case_ranks_by_the_integrations_cpu_time_not_wall_time():
     """A runner that waits 50 ms (wall, no CPU) outside its timed integration and spins
     ~20 ms of CPU inside: the stored CPU times are the inner ones, the wall times include
