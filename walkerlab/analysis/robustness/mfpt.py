@@ -368,7 +368,10 @@ def solve_mesh(Q, start: int):
     k = Q.shape[0]
     m = spsolve((identity(k, format="csc") - Q.tocsc()), np.ones(k))
     try:  # the quasi-stationary distribution: left eigenvector of lambda_2
-        lam, vec = eigs(Q.T.tocsr(), k=1, which="LM", maxiter=5000, tol=1e-10)
+        # a fixed start vector: ARPACK's default is a random one (scipy >= 1.17 seeds it from
+        # the OS), which made the eigenpair differ in the 10th digit from run to run
+        lam, vec = eigs(Q.T.tocsr(), k=1, which="LM", maxiter=5000, tol=1e-10,
+                        v0=np.full(k, 1.0 / math.sqrt(k)))
         lam2, pi = float(np.real(lam[0])), np.abs(np.real(vec[:, 0]))
     except ArpackNoConvergence:
         w, V = np.linalg.eig(Q.toarray().T)
