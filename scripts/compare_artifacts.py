@@ -4,8 +4,9 @@ hash, timestamps).  For restructurings that must keep every number bit-identical
 
     python scripts/compare_artifacts.py runs_before runs_after
 
-Prints one line per artifact (identical / which datasets or attributes differ) and exits 1
-when anything differs.
+Prints one line per artifact (identical / which datasets or attributes differ; datasets
+only the second has are listed apart, as additions) and exits 1 when anything that both
+have differs or the first has something the second lacks.
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ def compare(a: Path, b: Path) -> list[str]:
 
 def main(before: str, after: str) -> int:
     A, B = Path(before), Path(after)
-    bad = n = 0
+    bad = n = added = 0
     for a in sorted(A.rglob("*.h5")):
         b = B / a.relative_to(A)
         n += 1
@@ -75,10 +76,18 @@ def main(before: str, after: str) -> int:
             bad += 1
             continue
         d = compare(a, b)
+        new = [x for x in d if x.startswith("only after: ")]
+        d = [x for x in d if not x.startswith("only after: ")]
+        groups = sorted({x.removeprefix("only after: ").split("/")[0].split("@")[0]
+                         for x in new})
         print(f"{a.relative_to(A)}: " + ("identical" if not d else f"{len(d)} differ: "
-                                           + "; ".join(d[:6])))
+                                           + "; ".join(d[:6]))
+              + (f" (+ {len(new)} new datasets/attributes in {', '.join(groups)})"
+                 if new else ""))
         bad += bool(d)
-    print(f"{n} artifacts, {n - bad} identical, {bad} differ")
+        added += bool(new)
+    print(f"{n} artifacts, {n - bad} identical in everything they had before ({added} with "
+          f"new datasets), {bad} differ")
     return 1 if bad else 0
 
 
