@@ -416,7 +416,8 @@ if __name__ == "__main__":
     print(f"  W_act = {info['actuator_work']:+.6f} J, W_po = {info['pushoff_work']:+.6f} J, "
           f"loss = {info['collision_loss']:+.6f} J")
     print(f"  E_end - E_start = {info['E_end'] - info['E_start']:+.6f} J, residual = "
-          f"{info['energy_balance_residual']:.2e} J (rel {abs(info['energy_balance_residual'])/scale:.1e}),"
+          f"{info['energy_balance_residual']:.2e} J "
+          f"(rel {abs(info['energy_balance_residual']) / scale:.1e}),"
           f" swing drift {info['energy_drift']:.1e} J")
     assert abs(info["energy_balance_residual"]) / scale <= 1e-9
 
@@ -446,7 +447,8 @@ if __name__ == "__main__":
         assert abs(dthp + v) < 1e-14 and abs(loss_tq / loss_po - 4 * np.cos(alpha) ** 4) < 1e-12
 
     print("== level ground (phi = 0), push-off only (100 steps from the passive gait, then Newton)")
-    print("  P[Ns]  x* (post-impact)                      T[s]   step[m] v[m/s] max|mu| CoT     lift")
+    print("  P[Ns]  x* (post-impact)                      T[s]   step[m] v[m/s] max|mu| "
+          "CoT     lift")
     x_pass = x
 
     def scan(P, law, label):
