@@ -189,3 +189,21 @@ def _ref(w, x):
 
     return rhs_ref(np.asarray(x, float), w.L, w.m, w.MH, w.a, w.g, w.phi, w.contact,
                    (w.lane1, w.lane2), w.patch_half_width, w.continuous)
+
+
+def test_the_drop_test_is_computed_once_per_law_and_a_damaged_entry_is_a_miss(tmp_path,
+                                                                              monkeypatch):
+    """The second drop of the same law reads the user cache, bit for bit; garbage in the
+    cache file is recomputed, not trusted."""
+    from walkerlab.analysis.contact import drop
+
+    monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path / "cache"))
+    calls = []
+    real = drop._drop
+    monkeypatch.setattr(drop, "_drop", lambda *a: calls.append(a) or real(*a))
+    a = drop.drop_restitution(ContactSettings())
+    b = drop.drop_restitution(ContactSettings())
+    assert len(calls) == 1 and a == b
+    (entry,) = (tmp_path / "cache" / "drop").glob("*.json")
+    entry.write_text("{not json")
+    assert drop.drop_restitution(ContactSettings()) == a and len(calls) == 2

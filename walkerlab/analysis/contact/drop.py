@@ -6,9 +6,15 @@ under gravity; the coefficient of restitution is ``e = v_out / v_in`` with ``v_o
 speed at separation (force back to zero).  A plastic impact (the rigid model's heel strike)
 has ``e = 0``.  :func:`restitution_curve` sweeps the stiffness in the paper's family (damping
 fixed) and in the rigid-limit family (:mod:`walkerlab.models.contact.rigid_limit`).
+
+A drop is computed once per contact law, mass, speed, gravity and tolerance and kept in the
+private user cache (``drop/<key>.json``; the key also hashes the sources that decide the
+numbers and scipy's version); a damaged or foreign entry is a miss.
 """
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 
@@ -48,7 +54,67 @@ def drop_restitution(contact: ContactSettings, mass_kg: float = 20.0, v_in_m_per
         times), ``max_penetration_m`` [m], ``contact_time_s`` [s].
     """
     c = contact_si(contact)[0]
-    vin = float(v_in_m_per_s)
+    key = _cache_key(c, mass_kg, v_in_m_per_s, g, rtol)
+    cached = _cached(key)
+    if cached is not None:
+        return cached
+    out = _drop(c, float(mass_kg), float(v_in_m_per_s), float(g), float(rtol))
+    _store(key, out)
+    return out
+
+
+#: the sources whose code decides a drop's numbers (part of the cache key)
+_SOURCES = ("analysis/contact/drop.py", "models/contact/laws.py", "models/contact/_kernels.py",
+            "integrate/events.py", "integrate/solver.py")
+
+
+def _cache_key(c, mass_kg, v_in, g, rtol) -> str:
+    """sha256 of the drop's numbers (exact reprs), the deciding sources and scipy's version."""
+    import hashlib
+
+    import scipy
+
+    root = Path(__file__).resolve().parents[2]
+    h = hashlib.sha256(repr((float(c.k), float(c.e), float(c.cmax), float(c.dmax),
+                             float(mass_kg), float(v_in), float(g), float(rtol),
+                             scipy.__version__)).encode())
+    for rel in _SOURCES:
+        h.update((root / rel).read_bytes())
+    return h.hexdigest()[:32]
+
+
+def _cached(key: str) -> dict | None:
+    """A drop computed before with the same key, from the private user cache (``drop/``)."""
+    import json
+
+    from walkerlab.usercache import private_dir, read_private
+
+    d = private_dir("drop")
+    text = None if d is None else read_private(d / f"{key}.json")
+    if text is None:
+        return None
+    try:
+        out = json.loads(text)
+    except ValueError:
+        return None
+    return out if isinstance(out, dict) and set(out) == set(_KEYS) else None
+
+
+def _store(key: str, out: dict) -> None:
+    import json
+
+    from walkerlab.usercache import private_dir, write_private
+
+    d = private_dir("drop", writable=True)
+    if d is not None:  # a cache that cannot be written: computed again next time
+        write_private(d / f"{key}.json", json.dumps(out))
+
+
+_KEYS = ("restitution", "max_penetration_m", "contact_time_s")
+
+
+def _drop(c, mass_kg: float, vin: float, g: float, rtol: float) -> dict:
+    """One drop of the point mass on the SI law ``c`` (:func:`drop_restitution`)."""
     dstar = ((c.e + 1) * mass_kg * vin**2 / (2 * c.k)) ** (1 / (c.e + 1))
     tc = dstar / vin
 
