@@ -329,3 +329,42 @@ def test_a_push_off_law_of_the_pre_impact_speed():
     P = max(0.0, 3.0 + 10.0 * (0.5 - abs(pre[3])))  # the impulse the law gives on the gait
     x, T, _ = ref.fixed_point(ref.PAPER, 0.0, P=P, guess=g.x)
     np.testing.assert_allclose(g.x, x, atol=1e-8)
+
+
+@pytest.mark.parametrize("interpolation", ["linear", "cubic"])
+def test_pd_tracking_of_a_phase_reference(interpolation):
+    """A virtual constraint: tau = -k (delta - h(s)) - c (ddelta - h'(s) ds), s the stance
+    angle, delta = swing - stance angle; against the independent flow with the torque
+    computed here (numpy's interp / scipy's spline), and the flow's Jacobian (complex step
+    through the table) against central differences."""
+    from scipy.interpolate import CubicSpline
+
+    phase = [-0.3, -0.1, 0.1, 0.3]
+    hip = [0.35, 0.1, -0.15, -0.3]
+    law = {"stiffness_n_m_per_rad": 40.0, "damping_n_m_s_per_rad": 2.0,
+           "reference": {"phase_rad": phase, "hip_angle_rad": hip,
+                         "interpolation": interpolation}}
+    w = build_walker(scene_from_dict(_compass({"torques": [{"joint": "hip", "law": law}]})))
+    if interpolation == "linear":
+        def h(s):
+            return np.interp(s, phase, hip)
+
+        def dh(s):
+            k = np.clip(np.searchsorted(phase, s) - 1, 0, 2)
+            return (hip[k + 1] - hip[k]) / (phase[k + 1] - phase[k])
+    else:
+        cs = CubicSpline(phase, hip, bc_type="not-a-knot")
+        h, dh = cs, cs.derivative()
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        x = np.array([rng.uniform(-0.25, 0.25), rng.uniform(-0.25, 0.25),
+                      rng.normal(0, 1), rng.normal(0, 1)])
+        s, ds = x[1], x[3]
+        tau = -40.0 * ((x[0] - x[1]) - h(s)) - 2.0 * ((x[2] - x[3]) - dh(s) * ds)
+        np.testing.assert_allclose(w.phases[0].flow(0.0, x), ref.flow(x, ref.PAPER, 0.0, tau),
+                                   rtol=0, atol=1e-11)
+        J = w.phases[0].jacobian(0.0, x)
+        hh = 1e-6
+        Jfd = np.stack([(w.phases[0].flow(0, x + hh * e) - w.phases[0].flow(0, x - hh * e))
+                        / (2 * hh) for e in np.eye(4)], axis=1)
+        np.testing.assert_allclose(J, Jfd, rtol=0, atol=1e-5 * (1 + np.abs(J).max()))
