@@ -55,12 +55,12 @@ class TargetResult:
 
 def _measures(walker, x, solver, max_step_time):
     """``(P(x), {speed [m/s], step_length [m], step_period [s]})`` of one map from ``x``."""
+    from walkerlab.analysis.gait.metrics import step_length
     from walkerlab.analysis.gait.poincare import poincare_map
 
     steps: list = []
     x1, period, _ = poincare_map(walker, x, solver, max_step_time, steps=steps)
-    lengths = [float(np.hypot(*walker.for_stance(s.stance_leg).points(s.x_end)["swing_foot"]))
-               for s in steps]
+    lengths = [step_length(walker, s) for s in steps]
     return x1, {"speed": sum(lengths) / period, "step_length": float(np.mean(lengths)),
                 "step_period": period / len(steps)}
 

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.analysis.gait.metrics import step_length
 from walkerlab.io.schemas.simulate import LEDGER_UNITS
 
 __all__ = ["LEDGER_NAMES", "gait_measures", "step_ledger", "trajectory_ledger"]
@@ -131,7 +132,7 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     pe_plus = float(nxt.energies(seg.x_next)[1]) + m * g * float(step[1])
     d_e = (ke_plus + pe_plus) - (ke0 + pe0)
     closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
-    d = float(np.hypot(*step))
+    d = step_length(walker, seg)
     slope_energy = m * g * d * np.sin(float(walker.slope_rad))
     cot = (wpos + push + max(slope_energy, 0.0)) / (m * g * d)
     out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
@@ -190,8 +191,7 @@ def gait_measures(walker, x, steps: int, solver, max_step_time: float = 5.0
     segs = traj.segments
     if len(segs) < steps or any(s.termination != "heel_strike" for s in segs):
         return {"step_length": np.nan, "speed": np.nan, "cost_of_transport": np.nan}
-    lengths = [float(np.hypot(*walker.for_stance(s.stance_leg).points(s.x_end)["swing_foot"]))
-               for s in segs]
+    lengths = [step_length(walker, s) for s in segs]
     led = trajectory_ledger(traj)
     cot = float(np.mean(led["cost_of_transport"])) if led else np.nan
     return {"step_length": float(np.mean(lengths)),

@@ -106,6 +106,24 @@ def sample_trajectory(traj: HybridTrajectory, rate_hz: float) -> NamedTrajectory
     )
 
 
+def step_length(walker, seg) -> float:
+    """Length of a step that ended by a heel strike [m]: the distance from the stance foot
+    to the swing foot at heel strike, with the step's own numbers (legs that differ:
+    ``walker.for_stance(seg.stance_leg)``).
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    seg : walkerlab.integrate.rigid.Segment
+
+    Returns
+    -------
+    float
+        [m] (the walker's length unit).
+    """
+    return float(np.linalg.norm(walker.for_stance(seg.stance_leg).points(seg.x_end)["swing_foot"]))
+
+
 def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
     """Per-step metrics: period [s], step length [m], hip speed [m/s], impact loss [J], ...
 
@@ -137,7 +155,7 @@ def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
         sw = w.for_stance(seg.stance_leg)  # legs that differ: that step's own numbers
         p0, p1 = sw.points(seg.x_start), sw.points(seg.x_end)
         if seg.termination == "heel_strike":
-            rows["step_length"].append(float(np.linalg.norm(p1["swing_foot"])))
+            rows["step_length"].append(step_length(w, seg))
             rows["hip_speed"].append(float((p1["hip"][0] - p0["hip"][0]) / seg.period))
             ke_m, _ = sw.energies(seg.x_end)
             ke_p, _ = w.for_stance(r2l.get("swing", seg.stance_leg)).energies(seg.x_next)

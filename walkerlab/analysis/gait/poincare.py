@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab import numerics
+from walkerlab.analysis.gait.metrics import step_length
 from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.rigid_phase import numeric_jacobian
@@ -248,9 +249,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         nfev=F.counter["nfev"] + nf2, iterations=F.counter["calls"],
         wall_time_s=time.perf_counter() - t0, variational_maps=F.counter["jacobians"] + 1,
         step_periods_s=tuple(float(sg.period) for sg in segs),
-        step_lengths_m=tuple(
-            float(np.linalg.norm(walker.for_stance(sg.stance_leg).points(sg.x_end)["swing_foot"]))
-            for sg in segs),
+        step_lengths_m=tuple(step_length(walker, sg) for sg in segs),
     )
 
 

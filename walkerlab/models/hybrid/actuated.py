@@ -351,7 +351,7 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
             return out
         return f
 
-    def jac_of(flow, jac):
+    def jac_of(jac):
         if not has_torque:
             return jac
 
@@ -364,9 +364,8 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
 
     phases = []
     for ph in walker.phases:
-        jac = ph.jacobian or base_jac
-        guards = tuple(replace(g) for g in ph.guards)
-        phases.append(Phase(ph.name, flow_of(ph.flow), guards, jacobian=jac_of(ph.flow, jac),
+        phases.append(Phase(ph.name, flow_of(ph.flow), ph.guards,
+                            jacobian=jac_of(ph.jacobian or base_jac),
                             variational=None if has_torque else ph.variational,
                             compiled=None if has_torque else ph.compiled))
     reset = walker.reset
@@ -380,6 +379,6 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     if mirror is not None:
         mirror = actuate(mirror, data.mirror, spec)
     return replace(walker, phases=tuple(phases), reset=reset, reset_jacobian=reset_jac,
-                   variational=jac_of(None, base_jac) if has_torque else base_jac,
+                   variational=jac_of(base_jac),
                    mirror=mirror, actuators=acts)
 
