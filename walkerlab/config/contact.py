@@ -259,6 +259,18 @@ class ContactSettings(BaseModel):
         "about its ankle [kg m^2] (regularisation, see flat_foot_mass_kg).",
         json_schema_extra={"unit": "kg m^2"})
 
+    push_off_duration_s: float | None = Field(
+        None, ge=0, le=0.5, description="Powered walkers only: the duration [s] of the "
+        "push-off pulse, a constant force P / duration along the trailing leg (from its foot "
+        "towards the hip) at its foot, starting at the leading foot's touchdown; 0 applies "
+        "the impulse P at once (the rigid model's push-off).  Default "
+        "(null) 0.005 s.  As it shortens the pulse converges to the impulse (first order).",
+        json_schema_extra={"unit": "s"})
+
+    def push_off_pulse_s(self) -> float:
+        """The push-off pulse's duration [s] (``push_off_duration_s``, default 0.005 s)."""
+        return 0.005 if self.push_off_duration_s is None else float(self.push_off_duration_s)
+
     def flat_foot(self) -> tuple[float, float] | None:
         """``(flat_foot_mass_kg, flat_foot_inertia_kg_m2)`` or None if either is unset."""
         if self.flat_foot_mass_kg is None or self.flat_foot_inertia_kg_m2 is None:
@@ -286,7 +298,7 @@ class ContactSettings(BaseModel):
                     if d.get(name, 0) is None:
                         d.pop(name)
             # a scene without flat feet serialises as before (same content hashes)
-            for k in ("flat_foot_mass_kg", "flat_foot_inertia_kg_m2"):
+            for k in ("flat_foot_mass_kg", "flat_foot_inertia_kg_m2", "push_off_duration_s"):
                 if d.get(k, 0) is None:
                     d.pop(k)
         return d

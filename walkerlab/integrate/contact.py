@@ -133,6 +133,9 @@ class ContactIntegration:
         [s].
     pin_end_time : float
         End of the pinned phase [s] (= t0 if none).
+    work : ndarray (n, 4) or None
+        A powered walker's work integrals at the samples [J]
+        (:data:`walkerlab.models.contact.actuation.WORK_NAMES`); None for a passive one.
     """
 
     t: np.ndarray
@@ -144,6 +147,7 @@ class ContactIntegration:
     njev: int
     wall_time_s: float
     pin_end_time: float
+    work: np.ndarray | None = None
 
 
 def sample_grid(t0: float, t1: float, rate: float) -> np.ndarray:
@@ -559,9 +563,16 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
         t_pin, x0 = tp[-1], Xp[-1]
         if term is RunEnd.FALL:
             event = (RunEnd.FALL.value, len(tp) - 1, float(tp[-1]), "", np.nan)
+    work = None
     if term is RunEnd.T_FINAL and t_pin < t_final - 1e-12:
-        tf, Xf, nf, nj, term, msg, event = _run_free(walker, x0, t_pin, t_final, solver,
-                                                     limits, deadline, stop)
+        if getattr(walker, "actuators", None) is not None:  # (never pinned: the scene refuses)
+            from .contact_powered import run_powered
+
+            tf, Xf, nf, nj, term, msg, event, work = run_powered(
+                walker, x0, t_pin, t_final, solver, limits, deadline, stop)
+        else:
+            tf, Xf, nf, nj, term, msg, event = _run_free(walker, x0, t_pin, t_final, solver,
+                                                         limits, deadline, stop)
         if ts:
             tf, Xf = tf[1:], Xf[1:]
         ts.append(tf)
@@ -571,4 +582,4 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
     return ContactIntegration(t=np.concatenate(ts), X=np.vstack(Xs), termination=term.value,
                               message=str(msg), event=event, nfev=int(nfev), njev=int(njev),
                               wall_time_s=time.perf_counter() - wall,
-                              pin_end_time=float(t_pin))
+                              pin_end_time=float(t_pin), work=work)

@@ -167,6 +167,10 @@ class ContactWalker:
         A flat foot's regularising mass [kg] (at the ankle) and inertia about the ankle
         [kg m^2] (``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``);
         required for flat feet, ignored otherwise.
+    actuators : ContactActuators, optional
+        The walker's actuators (:mod:`walkerlab.models.contact.actuation`): hip torques and
+        the push-off pulse; a walker with them runs on
+        :mod:`walkerlab.integrate.contact_powered` (its stance leg is a discrete state).
 
     Raises
     ------
@@ -192,6 +196,7 @@ class ContactWalker:
     heights1: np.ndarray | None = None
     heights2: np.ndarray | None = None
     flat_foot: tuple[float, float] | None = None
+    actuators: object = None
 
     def __post_init__(self):
         from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params

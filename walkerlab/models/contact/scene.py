@@ -22,6 +22,7 @@ from walkerlab.config import (
     TerrainSettings,
 )
 
+from .actuation import ContactActuators
 from .laws import ContactParamsSI, KneeStopSI
 from .model import ContactWalker, flat_foot_numbers
 from .rigid_limit import contact_si
@@ -92,6 +93,9 @@ class ContactSetup:
         Run options (``contact_sim``; defaults when the scene has none).
     solver : SolverSettings
         ``contact_solver`` (default :meth:`SolverSettings.for_contact`).
+    actuators : ContactActuators or None
+        The walker's actuators as forces (:mod:`walkerlab.models.contact.actuation`);
+        None for a passive walker.
     """
 
     name: str
@@ -102,6 +106,7 @@ class ContactSetup:
     terrain: TerrainSettings
     sim: ContactSimSettings
     solver: SolverSettings
+    actuators: ContactActuators | None = None
 
     def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
         """ContactWalker of the setup with checkerboard patches from the ideal step length.
@@ -123,7 +128,7 @@ class ContactSetup:
             Ideal step length [m] (the patch spacing unless ``step_length_m`` is given).
         """
         probe = ContactWalker(contact=self.law_si, data=self.walker, knee_stop=self.knee_stop,
-                              flat_foot=self.law.flat_foot())
+                              flat_foot=self.law.flat_foot(), actuators=self.actuators)
         step_length = ideal_step_length(probe, x_ideal)
         return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
                                 n_steps=n_steps + 4), step_length
@@ -137,7 +142,8 @@ def contact_setup(scene: Scene) -> ContactSetup:
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, a walker with actuators (not in the contact view yet), a
+        No ``contact`` section, a walker with actuators the contact view does not carry
+        (knees, arc or flat feet, a torso; a pinned or non-ideal start), a
         walker with a massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).
@@ -148,13 +154,10 @@ def contact_setup(scene: Scene) -> ContactSetup:
     if scene.contact is None:
         raise ContactSceneError(f"scene '{scene.name}' has no 'contact' section, which the "
                                 "contact model needs")
-    if getattr(scene.walker, "actuation", None) is not None:
-        raise ContactSceneError(f"scene '{scene.name}': walker.actuation: actuators are in "
-                                "the rigid model only; the contact view does not carry them "
-                                "yet (leave out the 'contact' section)")
     contact = scene.contact
     cs = scene.contact_sim or ContactSimSettings()
     data = walker_data(scene.walker, scene.slope.phi_rad)
+    actuators = _actuators(scene, data, cs)
     if cs.pin_stance_until != "none" and data.structure.foot != "point":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: pinning "
                                 f"the stance foot needs point feet (this walker's are "
@@ -167,7 +170,29 @@ def contact_setup(scene: Scene) -> ContactSetup:
         raise ContactSceneError(f"scene '{scene.name}': {FLAT_FOOT_MESSAGE}")
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
-                        cs, scene.contact_solver or SolverSettings.for_contact())
+                        cs, scene.contact_solver or SolverSettings.for_contact(), actuators)
+
+
+def _actuators(scene: Scene, data, cs: ContactSimSettings) -> ContactActuators | None:
+    """The scene's actuators in the contact view, or None; one-line refusals."""
+    spec = getattr(scene.walker, "actuation", None)
+    if spec is None:
+        return None
+    from walkerlab.codegen.floating import coordinate_names
+
+    st = data.structure
+    if st.knee or st.foot != "point" or st.torso:
+        raise ContactSceneError(f"scene '{scene.name}': walker.actuation: the contact view "
+                                "carries actuators on straight legs with point feet and no "
+                                "torso only (the rigid view has them too)")
+    if cs.pin_stance_until != "none":
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
+                                "pinned start phase carries no actuators: leave it 'none'")
+    if cs.start != "ideal":
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: {cs.start}: a "
+                                "powered walker's contact run starts from the rigid gait "
+                                "(start: ideal) today")
+    return ContactActuators(spec, coordinate_names(st), scene.contact.push_off_pulse_s())
 
 
 def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
@@ -194,7 +219,8 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, a walker with actuators (not in the contact view yet), a
+        No ``contact`` section, a walker with actuators the contact view does not carry
+        (knees, arc or flat feet, a torso; a pinned or non-ideal start), a
         walker with a massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).

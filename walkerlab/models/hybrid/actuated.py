@@ -39,51 +39,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian, fd_jacobian
 
 __all__ = ["Actuators", "actuate"]
-
-
-def _spline(table):
-    """``(h, dh)`` of a phase reference table (complex-safe to first order: a complex
-    argument ``s + i e`` gives ``h(s) + i e h'(s)``, what the complex step needs)."""
-    from scipy.interpolate import CubicSpline
-
-    s, y = np.asarray(table.phase_rad, float), np.asarray(table.hip_angle_rad, float)
-    if table.interpolation == "cubic" and len(s) >= 3:
-        cs = CubicSpline(s, y, bc_type="not-a-knot", extrapolate=False)
-        d1, d2 = cs.derivative(), cs.derivative(2)
-
-        def val(u, f, df):
-            r = np.clip(np.real(u), s[0], s[-1])
-            inside = (np.real(u) > s[0]) & (np.real(u) < s[-1])
-            return f(r) + (1j * np.imag(u) * df(r) * inside if np.iscomplexobj(u) else 0.0)
-
-        return (lambda u: val(u, cs, d1)), (lambda u: val(u, d1, d2) * (
-            (np.real(u) > s[0]) & (np.real(u) < s[-1])))
-    slope = np.diff(y) / np.diff(s)
-
-    def lin(u):
-        r = np.clip(np.real(u), s[0], s[-1])
-        k = np.clip(np.searchsorted(s, r) - 1, 0, len(s) - 2)
-        out = y[k] + slope[k] * (r - s[k])
-        inside = (np.real(u) > s[0]) & (np.real(u) < s[-1])
-        return out + (1j * np.imag(u) * slope[k] * inside if np.iscomplexobj(u) else 0.0)
-
-    def dlin(u):
-        r = np.real(u)
-        k = np.clip(np.searchsorted(s, r) - 1, 0, len(s) - 2)
-        return slope[k] * ((r > s[0]) & (r < s[-1]))
-
-    return lin, dlin
-
-
-def _saturate(tau, limit):
-    if limit is None:
-        return tau
-    re = np.real(tau)
-    return np.where(re > limit, limit, np.where(re < -limit, -limit, tau))
 
 
 @dataclass
@@ -121,8 +81,7 @@ class Actuators:
         self.ddelta_dq = self.A[0] - self.A[1]
         swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # the legs' absolute angles trade places
         self.R = np.linalg.pinv(self.A) @ swap @ self.A
-        self._refs = [(_spline(t.law.reference) if t.law.reference is not None else None)
-                      for t in self.spec.torques]
+        self.laws = TorqueLaws(self.spec.torques)
         self._memo: dict = {}  # recent transitions (pre-impact state bytes -> result)
 
     # ---------------------------------------------------------------- joint torques
@@ -136,19 +95,7 @@ class Actuators:
     def torques(self, t, x) -> np.ndarray:
         """Torque of each actuator (k,) [N m; N m/kg when ``scaled_by: foot_mass``] at the
         state ``x`` (2n,) (complex-safe: the complex step differentiates through it)."""
-        delta, ddelta, s, ds = self.hip_angles(x)
-        out = []
-        for act, ref in zip(self.spec.torques, self._refs):
-            law = act.law
-            if ref is None:
-                err, derr = delta - law.rest_angle_rad, ddelta
-            else:
-                h, dh = ref
-                err, derr = delta - h(s), ddelta - dh(s) * ds
-            tau = law.constant_n_m - law.stiffness_n_m_per_rad * err \
-                - law.damping_n_m_s_per_rad * derr
-            out.append(_saturate(tau, act.max_torque_n_m))
-        return np.array(out)
+        return self.laws(*self.hip_angles(x))
 
     def generalised_force(self, t, x):
         """``B(q) tau`` (n,) in the rows of the generated ``M`` [N m]."""
@@ -192,14 +139,10 @@ class Actuators:
     def impulse(self, x) -> float:
         """Push-off impulse ``P`` [N s] for the pre-impact state ``x`` (>= 0)."""
         po = self.spec.push_off
-        if po is None:
-            return 0.0
-        if po.speed_gain_n_s2_per_m == 0.0:
-            return po.impulse_n_s
+        if po is None or po.speed_gain_n_s2_per_m == 0.0:
+            return push_off_impulse(po, 0.0)
         v = self.hip_velocity(x)
-        speed = np.sqrt(v @ v)
-        p = po.impulse_n_s + po.speed_gain_n_s2_per_m * (po.reference_speed_m_per_s - speed)
-        return np.where(np.real(p) > 0.0, p, 0.0 * p)
+        return push_off_impulse(po, np.sqrt(v @ v))
 
     def _relabel(self, q):
         """New coordinates (n,) after the role swap and the rate map ``R`` (n, n) (exact:

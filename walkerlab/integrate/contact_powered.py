@@ -1,0 +1,273 @@
+"""Time integration of a powered compliant-contact walker (one with ``actuators``).
+
+A powered walker's right-hand side depends on two discrete states the passive one does not
+have: which leg is in stance (the hip torques act +tau on the swing leg) and whether a
+push-off pulse is running (:mod:`walkerlab.models.contact.actuation`).  So the run goes in
+segments, on :func:`scipy.integrate.solve_ivp` with event location:
+
+1. from the step's start until the swing foot touches the ground on a patch at least
+   ``ContactActuators.min_step_m`` ahead of the stance foot (a heel strike), or a fall;
+2. at the touchdown the roles swap and the push-off starts at the (old) stance foot: for
+   ``pulse_s`` seconds a force ``P / pulse_s`` along that leg (or, with ``pulse_s = 0``, the
+   impulse at once: ``dq += M^-1 J^T P e``);
+3. repeat until the end time, the ``stop`` predicate (strides cap) or an event.
+
+The state carries four work integrals beside the walker's (``WORK_NAMES`` [J]: the hip
+torques' positive and negative work, the push-off's, the contact forces'), so the energy
+ledger of a run closes to the integrator's tolerance: ``E(t) - E(0) = sum of the works``
+with ``E`` the walker's kinetic + gravitational energy (the contact springs' energy is in
+the contact term).  Samples are on the run's grid (``sample_rate_hz`` from ``t0``); trips and
+flights are found on them as in the passive run (:func:`walkerlab.integrate.contact.first_event`).
+
+Methods: a :func:`~scipy.integrate.solve_ivp` method of the settings (``LSODA``, ``Radau``,
+``BDF``, ...); the compiled backends (``cyrk_bdf``, ``numbalsoda``) and ``odeint`` have no
+event location and run as ``LSODA`` here.  The analytic Jacobian of the passive walker is
+passed (the actuation's derivatives left out: Newton directions only).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from walkerlab.models.contact.actuation import WORK_NAMES, powered_rhs
+
+from .ends import RunEnd
+
+__all__ = ["IVP_METHODS", "run_powered"]
+
+#: solve_ivp methods a powered run uses as given (others run as LSODA).
+IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
+
+
+#: RHS calls without the time advancing by more than 1e-9 s after which a segment ends (a
+#: force jump the solver cannot step over, e.g. a foot entering a patch from its side).
+STALL_CALLS = 20_000
+
+
+class _Deadline(Exception):
+    pass
+
+
+class _Stall(Exception):
+    pass
+
+
+def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, events):
+    """One segment on solve_ivp; returns the solution (``t_eval`` the grid inside)."""
+    import time
+
+    n, nw = 2 * walker.nq, len(WORK_NAMES)
+    method = solver.method if solver.method in IVP_METHODS else "LSODA"
+
+    mark = [t0, 0]
+
+    def f(t, y):
+        if time.perf_counter() > deadline:
+            raise _Deadline
+        if t > mark[0] + 1e-9:
+            mark[0], mark[1] = t, 0
+        mark[1] += 1
+        if mark[1] > STALL_CALLS:
+            raise _Stall(y)
+        dx, p = powered_rhs(walker, y[:n], stance, push)
+        return np.concatenate([dx, p])
+
+    def jac(t, y):
+        J = np.zeros((n + nw, n + nw))
+        J[:n, :n] = walker.jac(t, y[:n])
+        return J
+
+    kw = {} if method in ("RK45", "DOP853", "RK23") else {"jac": jac}
+    inside = grid[(grid > t0 + 1e-12) & (grid < t1 - 1e-12)]
+    return solve_ivp(f, (t0, t1), y0, method=method, rtol=solver.rtol, atol=solver.atol,
+                     max_step=solver.max_step_s or np.inf, t_eval=np.append(inside, t1),
+                     events=events, dense_output=False, **kw)
+
+
+def _touchdown_event(walker, stance_of):
+    """Event: the swing foot's penetration crosses 0 on ground, ahead of the stance foot."""
+    acts = walker.actuators
+    n = 2 * walker.nq
+
+    def touch(t, y):
+        stance = stance_of()
+        x = y[:n]
+        fq = walker.foot_quantities(x)
+        sw, st = fq[f"leg{2 - stance}"], fq[f"leg{stance + 1}"]
+        if sw["on_ground"][0] < 0.5 or sw["s"][0] - st["s"][0] < acts.min_step_m:
+            return 1.0
+        return -float(sw["penetration"][0])
+
+    touch.terminal = True
+    touch.direction = -1
+    return touch
+
+
+def _fall_event(walker, limits):
+    n = 2 * walker.nq
+
+    def fall(t, y):
+        return walker.fall_margin(y[:n], limits.fall_hip_height_m)
+
+    fall.terminal = True
+    fall.direction = -1
+    return fall
+
+
+def _failure(walker, t_last, x_last, message):
+    """How a run ends when a segment fails at ``(t_last, x_last)``: a trip when a foot in a
+    gap below the patch tops is about to enter a patch's side
+    (:func:`walkerlab.models.contact.energy.side_entry`), else a solver failure.
+    Returns ``(termination, message, event or None)``; the event's sample index is filled
+    in by the caller."""
+    from walkerlab.models.contact.energy import side_entry
+
+    hit = side_entry(walker, x_last, 0.01)
+    if hit is None:
+        return RunEnd.SOLVER_FAILURE, message, None
+    foot, edge, ahead, depth = hit
+    return (RunEnd.TRIP, f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
+            "entered a patch from its side",
+            (RunEnd.TRIP.value, -1, float(t_last) + ahead, foot, edge))
+
+
+def _impulse_jump(walker, x, trailing, P):
+    """The state after the push-off impulse ``P`` [N s] at once, and its work [J]."""
+    n = walker.nq
+    nf = len(walker.contact_names())
+    Pp, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
+    walker.kernels.feet(np.asarray(x, float), walker.walker_params, Pp, V, J)
+    r = x[:2] - Pp[trailing]
+    M = walker.mass_matrix(x)
+    dq = x[n:] + np.linalg.solve(M, J[trailing].T @ (P * r / np.sqrt(r @ r)))
+    work = 0.5 * dq @ M @ dq - 0.5 * x[n:] @ M @ x[n:]
+    return np.concatenate([x[:n], dq]), float(work)
+
+
+def run_powered(walker, x0, t0, t1, solver, limits, deadline, stop):
+    """Integrate the powered free walker until ``t1``, an event, the deadline or ``stop``.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        With ``actuators``; leg2 in stance at the start.
+    x0 : ndarray, shape (2 nq,)
+    t0, t1 : float
+        [s].
+    solver : Solver
+    limits : ContactLimits
+    deadline : float
+        ``time.perf_counter()`` value past which the run stops (``time_limit``).
+    stop : callable or None
+        ``stop(t, X) -> bool``, asked after each touchdown (strides cap).
+
+    Returns
+    -------
+    tuple
+        ``(t (n,), X (n, 2 nq), nfev, njev, termination, message, event, work)`` as
+        :func:`walkerlab.integrate.contact.integrate_contact`'s free run, plus ``work``
+        (n, 4) [J], the integrals of :data:`WORK_NAMES` at the samples.
+    """
+    from .contact import first_event, sample_grid
+
+    run = _PoweredRun(walker, solver, limits, deadline, sample_grid(t0, t1, limits.sample_rate_hz))
+    run.go(x0, t0, t1, stop)
+    n = 2 * walker.nq
+    Y = np.vstack(run.Ys)
+    t = np.concatenate(run.ts)
+    if run.term is not RunEnd.FALL and run.term is not RunEnd.TRIP:
+        ev = first_event(walker, t, Y[:, :n], limits, k0=1)
+        if ev is not None:  # a trip or flight seen on the samples: the run ends there
+            k = max(ev[1], 1)
+            t, Y = t[:k], Y[:k]
+            run.event, run.term = ev, RunEnd(ev[0])
+            run.msg = f"{ev[0]}: on the samples of the powered run at t = {ev[2]:.4g} s"
+    if run.event is not None and run.event[1] == -1:
+        run.event = (*run.event[:1], len(t) - 1, *run.event[2:])
+    return t, Y[:, :n], run.nfev, run.njev, run.term, run.msg, run.event, Y[:, n:]
+
+
+class _PoweredRun:
+    """The segments of one powered run (:func:`run_powered`)."""
+
+    def __init__(self, walker, solver, limits, deadline, grid):
+        self.walker, self.solver, self.limits = walker, solver, limits
+        self.deadline, self.grid = deadline, grid
+        self.stance = 1  # leg2 carries the first stance (the contact model's convention)
+        self.touch = _touchdown_event(walker, lambda: self.stance)
+        self.fall = _fall_event(walker, limits)
+        self.ts, self.Ys, self.nfev, self.njev = [], [], 0, 0
+        self.term, self.msg, self.event = RunEnd.T_FINAL, "Integration successful.", None
+
+    def _run(self, y, t, tb, push, events):
+        """One segment; returns the solution, or None when the run ends here."""
+        try:
+            sol = _segment(self.walker, y, t, tb, self.grid, self.stance, push, self.solver,
+                           self.limits, self.deadline, events)
+        except _Deadline:
+            self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
+            return None
+        except _Stall as stall:
+            x = np.asarray(stall.args[0])
+            self.term, self.msg, self.event = _failure(
+                self.walker, t, x[:2 * self.walker.nq],
+                f"the solver stalled after t = {t:.6g} s (a force jump it cannot step over)")
+            return None
+        self.nfev, self.njev = self.nfev + sol.nfev, self.njev + sol.njev
+        if sol.status < 0:
+            self.term, self.msg = RunEnd.SOLVER_FAILURE, str(sol.message)
+            return None
+        return sol
+
+    def _keep(self, sol, t_end, y_end=None):
+        """Store the samples before ``t_end`` (and ``(t_end, y_end)`` itself if given)."""
+        keep = sol.t < t_end - 1e-12
+        self.ts.append(sol.t[keep] if y_end is None else np.append(sol.t[keep], t_end))
+        self.Ys.append(sol.y.T[keep] if y_end is None else np.vstack([sol.y.T[keep],
+                                                                     y_end[None]]))
+
+    def go(self, x0, t, t1, stop):
+        n, nw = 2 * self.walker.nq, len(WORK_NAMES)
+        acts = self.walker.actuators
+        y = np.concatenate([x0, np.zeros(nw)])
+        self.ts, self.Ys = [np.array([t])], [y[None]]
+        while t < t1 - 1e-12:
+            tb = min(t + self.limits.chunk_s, t1)
+            sol = self._run(y, t, tb, None, [self.fall, self.touch])
+            if sol is None:
+                return
+            if sol.t_events[0].size:  # a fall
+                self._keep(sol, sol.t_events[0][0], sol.y_events[0][0])
+                self.term, self.msg = RunEnd.FALL, "fall: hip below the fall height"
+                k = sum(len(a) for a in self.ts) - 1
+                self.event = (RunEnd.FALL.value, k, float(sol.t_events[0][0]), "", np.nan)
+                return
+            if not sol.t_events[1].size:  # the chunk's end
+                self._keep(sol, np.inf)
+                t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+                continue
+            t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+            self._keep(sol, t)
+            trailing, self.stance = self.stance, 1 - self.stance  # heel strike: roles swap
+            P = acts.impulse(y[:n])
+            if P > 0.0 and acts.pulse_s == 0.0:
+                y[:n], w = _impulse_jump(self.walker, y[:n], trailing, P)
+                y[n + 2] += w
+            elif P > 0.0:
+                tp = min(t + acts.pulse_s, t1)
+                sol = self._run(y, t, tp, (trailing, P / acts.pulse_s), [self.fall])
+                if sol is None:
+                    return
+                self._keep(sol, tp)
+                t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+            if stop is not None and stop(np.concatenate(self.ts),
+                                         np.vstack(self.Ys)[:, :n]):
+                self._keep_last(t, y)
+                self.term, self.msg = RunEnd.HEEL_STRIKE, "the heel strikes asked for were made"
+                return
+
+    def _keep_last(self, t, y):
+        if t > self.ts[-1][-1] + 1e-12 if len(self.ts[-1]) else True:
+            self.ts.append(np.array([t]))
+            self.Ys.append(y[None])

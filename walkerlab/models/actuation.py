@@ -1,0 +1,118 @@
+"""Joint-torque laws of ``walker.actuation`` evaluated the same way in both views of a walker
+(the rigid hybrid model, :mod:`walkerlab.models.hybrid.actuated`, and the compliant-contact
+model, :mod:`walkerlab.models.contact.actuation`): one formula, one place.
+
+A law is data (:class:`walkerlab.config.actuation.TorqueLaw`): ``tau = constant - K (delta -
+rest) - D ddelta``, or with a reference ``h_d(s)`` of the phase variable ``s`` (the stance
+leg's absolute angle) the PD tracking ``tau = -K (delta - h_d(s)) - D (ddelta - h_d'(s) ds)``
+(a virtual constraint, Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56), each
+saturated at ``max_torque_n_m``.  ``delta`` is the hip angle, swing minus stance leg angle
+[rad]; ``+tau`` acts on the swing leg, ``-tau`` on the stance leg (Kuo 2002).
+
+Everything is complex-safe to first order (a complex argument ``u + i e`` gives ``f(u) + i e
+f'(u)``), which the rigid model's complex-step Jacobians need.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["TorqueLaws", "phase_reference", "push_off_impulse", "saturate"]
+
+
+def phase_reference(table):
+    """``(h, dh)``: the reference ``h_d(s)`` [rad] and its slope ``h_d'(s)`` [rad/rad] of a
+    phase table (:class:`walkerlab.config.actuation.PhaseReference`), piecewise linear or a
+    not-a-knot cubic spline (:class:`scipy.interpolate.CubicSpline`), held at its end values
+    outside the table (slope 0 there)."""
+    from scipy.interpolate import CubicSpline
+
+    s, y = np.asarray(table.phase_rad, float), np.asarray(table.hip_angle_rad, float)
+    if table.interpolation == "cubic" and len(s) >= 3:
+        cs = CubicSpline(s, y, bc_type="not-a-knot", extrapolate=False)
+        d1, d2 = cs.derivative(), cs.derivative(2)
+
+        def val(u, f, df):
+            r = np.clip(np.real(u), s[0], s[-1])
+            inside = (np.real(u) > s[0]) & (np.real(u) < s[-1])
+            return f(r) + (1j * np.imag(u) * df(r) * inside if np.iscomplexobj(u) else 0.0)
+
+        return (lambda u: val(u, cs, d1)), (lambda u: val(u, d1, d2) * (
+            (np.real(u) > s[0]) & (np.real(u) < s[-1])))
+    slope = np.diff(y) / np.diff(s)
+
+    def lin(u):
+        r = np.clip(np.real(u), s[0], s[-1])
+        k = np.clip(np.searchsorted(s, r) - 1, 0, len(s) - 2)
+        out = y[k] + slope[k] * (r - s[k])
+        inside = (np.real(u) > s[0]) & (np.real(u) < s[-1])
+        return out + (1j * np.imag(u) * slope[k] * inside if np.iscomplexobj(u) else 0.0)
+
+    def dlin(u):
+        r = np.real(u)
+        k = np.clip(np.searchsorted(s, r) - 1, 0, len(s) - 2)
+        return slope[k] * ((r > s[0]) & (r < s[-1]))
+
+    return lin, dlin
+
+
+def saturate(tau, limit):
+    """``tau`` clipped to ``[-limit, limit]`` [N m] (None: unchanged); complex-safe."""
+    if limit is None:
+        return tau
+    re = np.real(tau)
+    return np.where(re > limit, limit, np.where(re < -limit, -limit, tau))
+
+
+class TorqueLaws:
+    """The hip-torque laws of one walker's ``walker.actuation.torques``.
+
+    Parameters
+    ----------
+    torques : list of walkerlab.config.actuation.JointTorque
+    """
+
+    def __init__(self, torques):
+        self.torques = list(torques)
+        self.refs = [(phase_reference(t.law.reference) if t.law.reference is not None
+                      else None) for t in self.torques]
+
+    def __bool__(self) -> bool:
+        return bool(self.torques)
+
+    def __call__(self, delta, ddelta, s, ds) -> np.ndarray:
+        """Torque of each actuator, shape (k,) [N m; N m/kg when ``scaled_by: foot_mass``].
+
+        Parameters
+        ----------
+        delta, ddelta : float or complex
+            Hip angle (swing minus stance leg angle) [rad] and its rate [rad/s].
+        s, ds : float or complex
+            Phase variable (the stance leg's absolute angle) [rad] and its rate [rad/s].
+        """
+        out = []
+        for act, ref in zip(self.torques, self.refs):
+            law = act.law
+            if ref is None:
+                err, derr = delta - law.rest_angle_rad, ddelta
+            else:
+                h, dh = ref
+                err, derr = delta - h(s), ddelta - dh(s) * ds
+            tau = law.constant_n_m - law.stiffness_n_m_per_rad * err \
+                - law.damping_n_m_s_per_rad * derr
+            out.append(saturate(tau, act.max_torque_n_m))
+        return np.array(out)
+
+
+def push_off_impulse(push_off, hip_speed):
+    """Push-off impulse ``P`` [N s] (>= 0: a foot can only push) of the law
+    :class:`walkerlab.config.actuation.PushOff` at the pre-impact hip speed [m/s]:
+    ``P = impulse_n_s + speed_gain_n_s2_per_m (reference_speed_m_per_s - v)`` (complex-safe).
+    None: 0."""
+    if push_off is None:
+        return 0.0
+    if push_off.speed_gain_n_s2_per_m == 0.0:
+        return push_off.impulse_n_s
+    p = push_off.impulse_n_s + push_off.speed_gain_n_s2_per_m * (
+        push_off.reference_speed_m_per_s - hip_speed)
+    return np.where(np.real(p) > 0.0, p, 0.0 * p)

@@ -1,0 +1,149 @@
+"""Actuators in the compliant-contact view of a walker: the same ``walker.actuation`` as the
+rigid model (:mod:`walkerlab.models.hybrid.actuated`), as forces.
+
+Hip torques
+-----------
+A hip actuator's torque ``tau`` (:class:`walkerlab.models.actuation.TorqueLaws`, the rigid
+view's laws) acts ``+tau`` on the swing leg and ``-tau`` on the stance leg: on the floating
+coordinates (``hip_x, hip_y, leg1_angle, leg2_angle``, absolute leg angles) its generalised
+force is ``tau (e_swing - e_stance)`` and its power ``tau (dtheta_swing - dtheta_stance)``.
+Which leg is the stance leg is a discrete state of the run, as in the rigid model: leg2 at
+the start, then the leg whose foot touched down last (the integrator switches it at each
+touchdown, :mod:`walkerlab.integrate.contact_powered`).
+
+Push-off
+--------
+The rigid model's push-off is an impulse ``P`` at the trailing foot along the trailing leg
+(from the foot towards the hip) just before heel strike.  Here it is a pulse: a constant
+force ``(P / T) e`` at the trailing foot for ``T = contact.push_off_duration_s`` from the
+leading foot's touchdown, with ``e`` the unit vector from that foot to the hip, recomputed as
+the leg turns; its generalised force is ``J_foot^T F``.  ``T = 0`` applies the impulse at
+once (``M dq+ = M dq- + J_foot^T P e``).  Since a plastic heel strike and a given push-off
+impulse are both linear in the velocities, their order does not matter in the impulsive
+limit (push-off then heel strike = both at once), so a pulse starting at the touchdown
+converges to the rigid transition as ``T -> 0`` (first order in ``T``).  ``P`` follows the
+same law as in the rigid view (:func:`walkerlab.models.actuation.push_off_impulse`) at the
+touchdown state's hip speed.
+
+Source: Kuo (2002), J. Biomech. Eng. 124:113-120 (push-off, swing-hip torque); Westervelt,
+Grizzle & Koditschek (2003), IEEE TAC 48(1):42-56 (phase-variable references).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from walkerlab.models.actuation import TorqueLaws, push_off_impulse
+
+__all__ = ["WORK_NAMES", "ContactActuators", "powered_rhs"]
+
+
+class ContactActuators:
+    """The actuators of one contact walker (straight legs, point feet).
+
+    Parameters
+    ----------
+    spec : walkerlab.config.actuation.Actuation
+    coordinates : tuple of str
+        The floating coordinates (``hip_x, hip_y, leg1_angle, leg2_angle``).
+    pulse_s : float
+        Push-off pulse duration [s] (0: an impulse).
+
+    Raises
+    ------
+    ValueError
+        The walker's legs are not two straight legs with point feet (one line).
+    """
+
+    #: A touchdown is a heel strike only this far [m] ahead of the stance foot (a scuff
+    #: near mid-stance is not one; the contact gait analysis' ``min_step_m`` default).
+    min_step_m = 0.05
+
+    def __init__(self, spec, coordinates, pulse_s: float):
+        names = tuple(coordinates)
+        if "leg1_angle" not in names or "leg2_angle" not in names:
+            raise ValueError("walker.actuation: the contact view carries actuators on "
+                             "straight legs with point feet only (knees, arc and flat feet: "
+                             "not yet)")
+        self.spec = spec
+        self.nq = len(names)
+        self.pulse_s = float(pulse_s)
+        self.leg = (names.index("leg1_angle"), names.index("leg2_angle"))
+        self.laws = TorqueLaws(spec.torques)
+
+    def hip_angles(self, x, stance: int):
+        """``(delta, ddelta, s, ds)`` with leg ``stance`` (0: leg1, 1: leg2) in stance:
+        hip angle (swing minus stance) [rad], its rate [rad/s], the phase variable (the
+        stance leg's angle) [rad] and its rate [rad/s]."""
+        n = self.nq
+        i_sw, i_st = self.leg[1 - stance], self.leg[stance]
+        return (x[i_sw] - x[i_st], x[n + i_sw] - x[n + i_st], x[i_st], x[n + i_st])
+
+    def hip_torque(self, x, stance: int) -> tuple[np.ndarray, float]:
+        """Generalised force of the hip torques (nq,) [N, N m] and their power [W]."""
+        Q = np.zeros(self.nq)
+        if not self.laws:
+            return Q, 0.0
+        delta, ddelta, s, ds = self.hip_angles(x, stance)
+        tau = float(np.sum(self.laws(delta, ddelta, s, ds)))
+        Q[self.leg[1 - stance]] += tau
+        Q[self.leg[stance]] -= tau
+        return Q, tau * ddelta
+
+    def impulse(self, x) -> float:
+        """Push-off impulse ``P`` [N s] for the touchdown state ``x`` (its hip speed)."""
+        n = self.nq
+        return float(push_off_impulse(self.spec.push_off, np.hypot(x[n], x[n + 1])))
+
+    def push_off_force(self, walker, x, trailing: int, force: float):
+        """Generalised force (nq,) of a force ``force`` [N] at leg ``trailing``'s foot
+        along that leg towards the hip, and its power [W]."""
+        n = self.nq
+        nf = len(walker.contact_names())
+        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
+        walker.kernels.feet(np.asarray(x, float), walker.walker_params, P, V, J)
+        r = np.asarray(x[:2], float) - P[trailing]
+        e = r / np.sqrt(r @ r)
+        F = force * e
+        return J[trailing].T @ F, float(F @ V[trailing])
+
+
+#: Names of the work integrals a powered contact run carries beside the state [J].
+WORK_NAMES = ("hip_torque_positive", "hip_torque_negative", "push_off", "contact")
+
+
+def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None):
+    """dx/dt of the contact walker with its actuators, and the powers of the ledger.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        With ``actuators`` set.
+    x : ndarray, shape (2 nq,)
+        State (``walker.state_names()``), SI.
+    stance : int
+        The stance leg (0: leg1, 1: leg2).
+    push : (int, float), optional
+        A push-off pulse in progress: the trailing leg and the force [N].
+
+    Returns
+    -------
+    dx : ndarray, shape (2 nq,)
+        ``[dq, ddq]`` [m/s, rad/s, m/s^2, rad/s^2].
+    powers : ndarray, shape (4,)
+        [W]: the hip torques' positive and negative power, the push-off's, and the contact
+        forces' (normal + friction, all points; negative while they dissipate or store).
+    """
+    acts = walker.actuators
+    n = walker.nq
+    dx = np.array(walker.rhs(0.0, x), float)
+    Q, p_tau = acts.hip_torque(x, stance)
+    p_po = 0.0
+    if push is not None:
+        Qp, p_po = acts.push_off_force(walker, x, push[0], push[1])
+        Q = Q + Qp
+    if np.any(Q):
+        dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
+    p_contact = float(np.sum(walker.kernels.contact_table(
+        np.ascontiguousarray(x[None], dtype=float), *walker._args())[0, :, 6]))
+    return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact])
