@@ -268,9 +268,9 @@ def test_target_command_prints_the_value_or_one_line():
     assert "error: target: no gait with speed = 3" in r.output
 
 
-def test_the_contact_view_and_export_refuse_actuators_in_one_line(tmp_path):
-    """Not silently passive: the contact model and the URDF/MJCF export do not carry
-    actuators yet, and say so."""
+def test_the_contact_periodic_gait_and_export_refuse_actuators_in_one_line(tmp_path):
+    """Not silently passive: the contact model's periodic gait (its step map) and the
+    URDF/MJCF export do not carry actuators yet, and say so."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
@@ -282,7 +282,7 @@ def test_the_contact_view_and_export_refuse_actuators_in_one_line(tmp_path):
     import yaml
 
     scene.write_text(yaml.safe_dump(d))
-    for args, msg in ((["contact-sim"], "contact view does not carry them"),
+    for args, msg in ((["contact-sim"], "contact periodic gait of a powered walker"),
                       (["export", "--format", "mjcf"], "not exported yet")):
         r = CliRunner().invoke(app, [*args, str(scene), "--runs-dir", str(tmp_path / "runs")])
         assert r.exit_code == 1 and "Traceback" not in r.output, r.output

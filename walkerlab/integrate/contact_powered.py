@@ -34,7 +34,7 @@ from walkerlab.models.contact.actuation import WORK_NAMES, powered_rhs
 
 from .ends import RunEnd
 
-__all__ = ["IVP_METHODS", "run_powered"]
+__all__ = ["IVP_METHODS", "STALL_CALLS", "impulse_jump", "run_powered"]
 
 #: solve_ivp methods a powered run uses as given (others run as LSODA).
 IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
@@ -132,8 +132,25 @@ def _failure(walker, t_last, x_last, message):
             (RunEnd.TRIP.value, -1, float(t_last) + ahead, foot, edge))
 
 
-def _impulse_jump(walker, x, trailing, P):
-    """The state after the push-off impulse ``P`` [N s] at once, and its work [J]."""
+def impulse_jump(walker, x, trailing, P):
+    """The state after a push-off impulse ``P`` [N s] at leg ``trailing``'s foot along that
+    leg towards the hip, applied at once: ``M dq+ = M dq- + J_foot^T P e``.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    x : ndarray, shape (2 nq,)
+    trailing : int
+        0: leg1, 1: leg2.
+    P : float
+        [N s].
+
+    Returns
+    -------
+    x_plus : ndarray, shape (2 nq,)
+    work : float
+        Its work, the kinetic energy it adds [J].
+    """
     n = walker.nq
     nf = len(walker.contact_names())
     Pp, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
@@ -252,7 +269,7 @@ class _PoweredRun:
             trailing, self.stance = self.stance, 1 - self.stance  # heel strike: roles swap
             P = acts.impulse(y[:n])
             if P > 0.0 and acts.pulse_s == 0.0:
-                y[:n], w = _impulse_jump(self.walker, y[:n], trailing, P)
+                y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
                 y[n + 2] += w
             elif P > 0.0:
                 tp = min(t + acts.pulse_s, t1)

@@ -189,6 +189,9 @@ class ContactResult:
         Per contact point (``walker.contact_names()``; a flat foot's ``leg1_heel``,
         ``leg1_toe``, ...): its trace and touchdown / lift-off times; ``feet`` again
         when each leg has one point.
+    work : ndarray (n, 4) or None
+        A powered walker's work integrals at the samples [J]
+        (:data:`walkerlab.models.contact.actuation.WORK_NAMES`); None when passive.
     """
 
     t: np.ndarray
@@ -207,6 +210,7 @@ class ContactResult:
     pin_end_time: float = 0.0
     outcome: Outcome = field(default_factory=lambda: Outcome("t_final"))
     points: dict = field(default_factory=dict)
+    work: np.ndarray | None = None
 
     def column(self, name: str) -> np.ndarray:
         """Samples (n,) of the state ``name``, in its unit (the walker's

@@ -116,7 +116,8 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
                          heel_strike_legs=ev["hs_leg"], steps=ev["steps"],
                          termination=run.termination, message=run.message, nfev=run.nfev,
                          njev=run.njev, wall_time_s=run.wall_time_s, method=solver.method,
-                         pin_end_time=run.pin_end_time, outcome=out, points=ev["points"])
+                         pin_end_time=run.pin_end_time, outcome=out, points=ev["points"],
+                         work=run.work)
 
 
 def _with_heights(walker, limits: ContactLimits) -> ContactLimits:

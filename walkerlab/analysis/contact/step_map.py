@@ -114,6 +114,10 @@ class StepMap:
     def __init__(self, walker: ContactWalker, patch_spacing: float | None = None,
                  solver: Solver = DEFAULT_SOLVER, t_max: float = 3.0,
                  deadline: float | None = None):
+        if getattr(walker, "actuators", None) is not None:
+            raise ValueError("the contact step map carries no actuators (a powered walker's "
+                             "stance leg and push-off pulse are states of its run): its "
+                             "contact periodic gait is not computed yet")
         if patch_spacing is None:
             if walker.lane1.size and walker.lane2.size:
                 patch_spacing = float(walker.lane1[0] - walker.lane2[0])

@@ -258,6 +258,29 @@ def write_contact_sim(f, run: ContactSimRun) -> None:
         if k not in ("termination", "outcome"):
             put(f, f"summary/{k}", v, SUMMARY_UNITS.get(k, "-"), k)
     _write_periodic_and_adjust(f, run)
+    _write_work(f, run)
+
+
+def _write_work(f, run: ContactSimRun) -> None:
+    """A powered walker's energy ledger: ``ledger/work/<name>`` [J] on ``time`` (the work
+    integrals the run carried, :data:`walkerlab.models.contact.actuation.WORK_NAMES`) and
+    ``ledger/residual`` [J], ``E(t) - E(0)`` minus their sum (the ledger's closure)."""
+    work = getattr(run.result, "work", None)
+    if work is None:
+        return
+    from walkerlab.models.contact.actuation import WORK_NAMES
+
+    what = {"hip_torque_positive": "positive work of the hip torques",
+            "hip_torque_negative": "negative work of the hip torques",
+            "push_off": "work of the push-off pulse at the trailing foot",
+            "contact": "work of the contact forces (normal + friction, every point): their "
+                       "dissipation and the energy their springs hold"}
+    for k, name in enumerate(WORK_NAMES):
+        put(f, f"ledger/work/{name}", work[:, k], "J", what[name] + " since the start",
+            dims=("time",))
+    E = run.walker.energies(run.result.x)["total"]
+    put(f, "ledger/residual", (E - E[0]) - work.sum(axis=1), "J", "kinetic + potential "
+        "energy change minus the works: the ledger's closure", dims=("time",))
 
 
 @dataclass
