@@ -368,3 +368,49 @@ def test_pd_tracking_of_a_phase_reference(interpolation):
         Jfd = np.stack([(w.phases[0].flow(0, x + hh * e) - w.phases[0].flow(0, x - hh * e))
                         / (2 * hh) for e in np.eye(4)], axis=1)
         np.testing.assert_allclose(J, Jfd, rtol=0, atol=1e-5 * (1 + np.abs(J).max()))
+
+
+@pytest.mark.parametrize("interpolation", ["linear", "cubic"])
+def test_pd_tracking_of_a_time_table_counts_from_each_step(interpolation):
+    """``time_reference``: tau = -k (delta - h(t)) - c (ddelta - h'(t)), t the time since
+    the step's heel strike; two steps of the rigid model (the second starts at the first's
+    end, so the table must restart) against the independent step with the law computed here
+    (numpy's interp / scipy's spline, t from 0 each step)."""
+    from scipy.interpolate import CubicSpline
+
+    times = [0.0, 0.2, 0.4, 0.6]
+    hip = [-0.35, -0.1, 0.15, 0.35]
+    law = {"stiffness_n_m_per_rad": 30.0, "damping_n_m_s_per_rad": 1.0,
+           "time_reference": {"time_s": times, "hip_angle_rad": hip,
+                              "interpolation": interpolation}}
+    sc = _compass({"push_off": {"impulse_n_s": 3.0},
+                   "torques": [{"joint": "hip", "law": law}]})
+    w = build_walker(scene_from_dict(sc))
+    if interpolation == "linear":
+        slopes = np.diff(hip) / np.diff(times)
+
+        def h(t):
+            return np.interp(t, times, hip)
+
+        def dh(t):
+            return slopes[min(max(np.searchsorted(times, t) - 1, 0), 2)] if t < times[-1] \
+                else 0.0
+    else:
+        cs = CubicSpline(times, hip, bc_type="not-a-knot")
+
+        def h(t):
+            return cs(min(t, times[-1]))
+
+        def dh(t):
+            return cs(t, 1) if t < times[-1] else 0.0
+
+    def torque(t, x):
+        return -30.0 * ((x[0] - x[1]) - h(t)) - 1.0 * ((x[2] - x[3]) - dh(t))
+
+    x0 = np.array([-0.1735, 0.1735, -0.7654, -0.869])
+    traj = simulate_steps(w, x0, 2, wl.Walker.from_scene(sc).solver)
+    x = x0
+    for seg in traj.segments:
+        x, T, _ = ref.step(x, ref.PAPER, 0.0, P=3.0, torque_law=torque)
+        assert seg.t_end - seg.t_start == pytest.approx(T, abs=1e-8)
+        np.testing.assert_allclose(seg.x_next, x, rtol=0, atol=1e-8)

@@ -55,12 +55,43 @@ class PhaseReference(Strict):
         return self
 
 
+class TimeReference(Strict):
+    """A reference of the hip angle (swing minus stance leg angle) as a function of the time
+    since the step began (its heel strike): a piecewise-linear or cubic-spline table, held at
+    its end values outside (a time-based feed-forward pattern, the alternative to a phase
+    variable, Westervelt et al. 2003 Sec. II)."""
+
+    time_s: list[float] = Field(min_length=2, max_length=200, description="times since the "
+                                "step's heel strike, increasing [s]")
+    hip_angle_rad: list[float] = Field(min_length=2, max_length=200, description="reference "
+                                       "swing minus stance angle at each time [rad]")
+    interpolation: Literal["linear", "cubic"] = Field("cubic", description="piecewise-linear "
+                                                      "or not-a-knot cubic spline")
+
+    @model_validator(mode="after")
+    def _table(self) -> TimeReference:
+        if len(self.time_s) != len(self.hip_angle_rad):
+            raise ValueError("time_s and hip_angle_rad need the same length")
+        if any(b <= a for a, b in zip(self.time_s, self.time_s[1:])):
+            raise ValueError("time_s must increase")
+        if self.time_s[0] < 0:
+            raise ValueError("time_s starts at the step's heel strike: no negative times")
+        return self
+
+    @property
+    def phase_rad(self) -> list[float]:
+        """The table's abscissa (times [s]; the name the interpolation reads)."""
+        return self.time_s
+
+
 class TorqueLaw(Strict):
     """A torque law of the joint angle ``delta`` and rate (hip: swing minus stance leg
     angle): ``tau = constant_n_m - stiffness (delta - rest_angle_rad) - damping ddelta``
     (constant, or spring-like as Kuo's swing-hip torque), or with ``reference`` a PD
     tracking ``tau = -stiffness (delta - h_d(s)) - damping (ddelta - h_d'(s) ds)`` of a
-    reference of the phase variable ``s`` (a virtual constraint)."""
+    reference of the phase variable ``s`` (a virtual constraint), or with
+    ``time_reference`` the same tracking of ``h_d(t)``, ``t`` the time since the step's heel
+    strike (``ds`` = 1)."""
 
     constant_n_m: float = Field(0.0, ge=-1e5, le=1e5, description="constant torque [N m]")
     stiffness_n_m_per_rad: float = Field(0.0, ge=0, le=1e7, description="proportional gain "
@@ -71,6 +102,15 @@ class TorqueLaw(Strict):
                                   "spring-like torque vanishes [rad]")
     reference: PhaseReference | None = Field(None, description="track this reference of the "
                                              "phase variable instead of rest_angle_rad")
+    time_reference: TimeReference | None = Field(
+        None, description="track this reference of the time since the step's heel strike "
+        "instead of rest_angle_rad")
+
+    @model_validator(mode="after")
+    def _one_reference(self) -> TorqueLaw:
+        if self.reference is not None and self.time_reference is not None:
+            raise ValueError("give reference (phase) or time_reference, not both")
+        return self
 
 
 class JointTorque(Strict):

@@ -53,8 +53,10 @@ class _Stall(Exception):
     pass
 
 
-def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, events):
-    """One segment on solve_ivp; returns the solution (``t_eval`` the grid inside)."""
+def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, events,
+             t_origin=0.0):
+    """One segment on solve_ivp; returns the solution (``t_eval`` the grid inside);
+    ``t_origin`` [s] is when the present step began (time-based torque laws)."""
     import time
 
     n, nw = 2 * walker.nq, len(WORK_NAMES)
@@ -70,7 +72,7 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
         mark[1] += 1
         if mark[1] > STALL_CALLS:
             raise _Stall(y)
-        dx, p = powered_rhs(walker, y[:n], stance, push)
+        dx, p = powered_rhs(walker, y[:n], stance, push, t - t_origin)
         return np.concatenate([dx, p])
 
     def jac(t, y):
@@ -212,6 +214,7 @@ class _PoweredRun:
         self.walker, self.solver, self.limits = walker, solver, limits
         self.deadline, self.grid = deadline, grid
         self.stance = 1  # leg2 carries the first stance (the contact model's convention)
+        self.t_origin = float(grid[0])  # when the present step began [s]
         self.touch = _touchdown_event(walker, lambda: self.stance)
         self.fall = _fall_event(walker, limits)
         self.ts, self.Ys, self.nfev, self.njev = [], [], 0, 0
@@ -221,7 +224,7 @@ class _PoweredRun:
         """One segment; returns the solution, or None when the run ends here."""
         try:
             sol = _segment(self.walker, y, t, tb, self.grid, self.stance, push, self.solver,
-                           self.limits, self.deadline, events)
+                           self.limits, self.deadline, events, self.t_origin)
         except _Deadline:
             self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
             return None
@@ -267,6 +270,7 @@ class _PoweredRun:
             t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
             self._keep(sol, t)
             trailing, self.stance = self.stance, 1 - self.stance  # heel strike: roles swap
+            self.t_origin = t
             P = acts.impulse(y[:n])
             if P > 0.0 and acts.pulse_s == 0.0:
                 y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)

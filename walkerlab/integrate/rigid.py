@@ -285,6 +285,8 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     """
     backend = solver.resolved_backend()
     n = x0.size
+    if walker.actuators is not None:  # a time-based torque law counts from the step's start
+        walker.actuators.begin_step(t0)
     t_stop = t0 + max_step_time
     if t_final is not None:
         t_stop = min(t_stop, t_final)

@@ -76,11 +76,19 @@ class TorqueLaws:
         self.torques = list(torques)
         self.refs = [(phase_reference(t.law.reference) if t.law.reference is not None
                       else None) for t in self.torques]
+        self.time_refs = [(phase_reference(t.law.time_reference)
+                           if t.law.time_reference is not None else None)
+                          for t in self.torques]
+
+    @property
+    def timed(self) -> bool:
+        """Some law reads the time since the step began."""
+        return any(r is not None for r in self.time_refs)
 
     def __bool__(self) -> bool:
         return bool(self.torques)
 
-    def __call__(self, delta, ddelta, s, ds) -> np.ndarray:
+    def __call__(self, delta, ddelta, s, ds, t_step=0.0) -> np.ndarray:
         """Torque of each actuator, shape (k,) [N m; N m/kg when ``scaled_by: foot_mass``].
 
         Parameters
@@ -89,15 +97,20 @@ class TorqueLaws:
             Hip angle (swing minus stance leg angle) [rad] and its rate [rad/s].
         s, ds : float or complex
             Phase variable (the stance leg's absolute angle) [rad] and its rate [rad/s].
+        t_step : float
+            Time since the step's heel strike [s] (read by ``time_reference`` laws).
         """
         out = []
-        for act, ref in zip(self.torques, self.refs):
+        for act, ref, tref in zip(self.torques, self.refs, self.time_refs):
             law = act.law
-            if ref is None:
-                err, derr = delta - law.rest_angle_rad, ddelta
-            else:
+            if ref is not None:
                 h, dh = ref
                 err, derr = delta - h(s), ddelta - dh(s) * ds
+            elif tref is not None:
+                h, dh = tref
+                err, derr = delta - h(t_step), ddelta - dh(t_step)
+            else:
+                err, derr = delta - law.rest_angle_rad, ddelta
             tau = law.constant_n_m - law.stiffness_n_m_per_rad * err \
                 - law.damping_n_m_s_per_rad * derr
             out.append(saturate(tau, act.max_torque_n_m))

@@ -79,13 +79,14 @@ class ContactActuators:
         i_sw, i_st = self.leg[1 - stance], self.leg[stance]
         return (x[i_sw] - x[i_st], x[n + i_sw] - x[n + i_st], x[i_st], x[n + i_st])
 
-    def hip_torque(self, x, stance: int) -> tuple[np.ndarray, float]:
-        """Generalised force of the hip torques (nq,) [N, N m] and their power [W]."""
+    def hip_torque(self, x, stance: int, t_step: float = 0.0) -> tuple[np.ndarray, float]:
+        """Generalised force of the hip torques (nq,) [N, N m] and their power [W];
+        ``t_step`` the time since the step's heel strike [s] (``time_reference`` laws)."""
         Q = np.zeros(self.nq)
         if not self.laws:
             return Q, 0.0
         delta, ddelta, s, ds = self.hip_angles(x, stance)
-        tau = float(np.sum(self.laws(delta, ddelta, s, ds)))
+        tau = float(np.sum(self.laws(delta, ddelta, s, ds, t_step)))
         Q[self.leg[1 - stance]] += tau
         Q[self.leg[stance]] -= tau
         return Q, tau * ddelta
@@ -112,7 +113,8 @@ class ContactActuators:
 WORK_NAMES = ("hip_torque_positive", "hip_torque_negative", "push_off", "contact")
 
 
-def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None):
+def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
+                t_step: float = 0.0):
     """dx/dt of the contact walker with its actuators, and the powers of the ledger.
 
     Parameters
@@ -125,6 +127,8 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None):
         The stance leg (0: leg1, 1: leg2).
     push : (int, float), optional
         A push-off pulse in progress: the trailing leg and the force [N].
+    t_step : float
+        Time since the step's heel strike (the last touchdown, or the run's start) [s].
 
     Returns
     -------
@@ -137,7 +141,7 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None):
     acts = walker.actuators
     n = walker.nq
     dx = np.array(walker.rhs(0.0, x), float)
-    Q, p_tau = acts.hip_torque(x, stance)
+    Q, p_tau = acts.hip_torque(x, stance, t_step)
     p_po = 0.0
     if push is not None:
         Qp, p_po = acts.push_off_force(walker, x, push[0], push[1])

@@ -82,6 +82,7 @@ class Actuators:
         swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # the legs' absolute angles trade places
         self.R = np.linalg.pinv(self.A) @ swap @ self.A
         self.laws = TorqueLaws(self.spec.torques)
+        self.t_origin = 0.0  # the time [s] the present step began (time_reference laws)
         self._memo: dict = {}  # recent transitions (pre-impact state bytes -> result)
 
     # ---------------------------------------------------------------- joint torques
@@ -95,7 +96,12 @@ class Actuators:
     def torques(self, t, x) -> np.ndarray:
         """Torque of each actuator (k,) [N m; N m/kg when ``scaled_by: foot_mass``] at the
         state ``x`` (2n,) (complex-safe: the complex step differentiates through it)."""
-        return self.laws(*self.hip_angles(x))
+        return self.laws(*self.hip_angles(x), t - self.t_origin)
+
+    def begin_step(self, t0: float) -> None:
+        """A step begins at ``t0`` [s]: the origin of the time a ``time_reference`` law
+        reads (the integrator calls it at every step's start)."""
+        self.t_origin = float(t0)
 
     def generalised_force(self, t, x):
         """``B(q) tau`` (n,) in the rows of the generated ``M`` [N m]."""
