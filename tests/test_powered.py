@@ -193,7 +193,7 @@ def test_a_passive_scene_is_serialised_as_before():
 
 @pytest.mark.parametrize("bad, msg", [
     ({"push_off": {}}, "impulse_n_s"),
-    ({}, "give push_off or torques"),
+    ({}, "give push_off, torques or ankle_push_off"),
     ({"torques": [{"joint": "knee", "law": {}}]}, "joint"),
     ({"push_off": {"impulse_n_s": -1.0}}, "impulse_n_s"),
 ])
@@ -269,21 +269,25 @@ def test_target_command_prints_the_value_or_one_line():
 
 
 def test_the_contact_periodic_gait_and_export_refuse_actuators_in_one_line(tmp_path):
-    """Not silently passive: the contact model's periodic gait (its step map) and the
-    URDF/MJCF export do not carry actuators yet, and say so."""
+    """Not silently passive: the contact model's periodic gait (its step map) does not
+    carry actuators, nor does the URDF/MJCF export carry an ankle push-off; both say so."""
+    import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
 
+    cases = []
     d = load_scene(CONFIGS / "paper.yaml").model_dump(mode="json", exclude_none=True)
     d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 1.0}}
     d["name"] = "powered_paper"
-    scene = tmp_path / "powered_paper.yaml"
-    import yaml
-
-    scene.write_text(yaml.safe_dump(d))
-    for args, msg in ((["contact-sim"], "contact periodic gait of a powered walker"),
-                      (["export", "--format", "mjcf"], "not exported yet")):
+    cases.append((d, ["contact-sim"], "contact periodic gait of a powered walker"))
+    f = load_scene(CONFIGS / "flat_feet.yaml").model_dump(mode="json", exclude_none=True)
+    f["walker"]["actuation"] = {"ankle_push_off": {"constant_n_m": 5.0}}
+    f["name"] = "ankle_flat"
+    cases.append((f, ["export", "--format", "mjcf"], "not exported yet"))
+    for d, args, msg in cases:
+        scene = tmp_path / f"{d['name']}.yaml"
+        scene.write_text(yaml.safe_dump(d))
         r = CliRunner().invoke(app, [*args, str(scene), "--runs-dir", str(tmp_path / "runs")])
         assert r.exit_code == 1 and "Traceback" not in r.output, r.output
         assert msg in r.output and r.output.count("error:") == 1, r.output

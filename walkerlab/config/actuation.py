@@ -128,15 +128,44 @@ class JointTorque(Strict):
         "finite in the limit and acts on the swing leg only (Kuo 2002)")
 
 
+class AnklePushOff(Strict):
+    """Ankle push-off of a walker on flat feet: from heel off (the stance heel's normal
+    force reaches 0) until heel strike, a pre-loaded ankle spring is released and/or a
+    constant ankle torque acts, as Mizani et al. (2018, the paper's ref. [32]) power the
+    walker in ADAMS.  On the stance ankle angle ``a`` (the sole's angle from the leg's
+    perpendicular, positive toe up) the added torque is ``-stiffness (a - rest_angle_rad) -
+    constant_n_m``: a positive constant plantarflexes (pushes the toe down, the heel and the
+    walker up and forward); a spring relaxed at a ``rest_angle_rad`` below the ankle's angle
+    at heel off is pre-loaded, and releases ``stiffness (a_off - rest)^2 / 2`` as the toe
+    rolls."""
+
+    stiffness_n_m_per_rad: float = Field(0.0, ge=0, le=1e6, description="the released "
+                                         "spring's stiffness [N m/rad]")
+    rest_angle_rad: float = Field(0.0, ge=-1.6, le=1.6, description="its rest angle (ankle "
+                                  "angle, positive toe up) [rad]")
+    constant_n_m: float = Field(0.0, ge=-1e5, le=1e5, description="constant plantarflexion "
+                                "torque [N m]")
+
+    @model_validator(mode="after")
+    def _something(self) -> AnklePushOff:
+        if self.stiffness_n_m_per_rad == 0.0 and self.constant_n_m == 0.0:
+            raise ValueError("give stiffness_n_m_per_rad or constant_n_m")
+        return self
+
+
 class Actuation(Strict):
     """The walker's actuators (``walker.actuation``)."""
 
     push_off: PushOff | None = Field(None, description="push-off impulse before heel strike")
+    ankle_push_off: AnklePushOff | None = Field(
+        None, description="flat feet: an ankle spring released / an ankle torque from heel "
+        "off to heel strike")
     torques: list[JointTorque] = Field(default_factory=list, max_length=8,
                                        description="joint torque actuators")
 
     @model_validator(mode="after")
     def _something(self) -> Actuation:
-        if self.push_off is None and not self.torques:
-            raise ValueError("give push_off or torques (or leave actuation out)")
+        if self.push_off is None and not self.torques and self.ankle_push_off is None:
+            raise ValueError("give push_off, torques or ankle_push_off (or leave actuation "
+                             "out)")
         return self

@@ -58,6 +58,12 @@ class MjcfScene:
         Sliding friction coefficient [-].
     latch : (float, float) or None
         Knee latch (release height above the ground [m], capture flexion [rad]); None without.
+    actuation_json : str or None
+        The scene's ``walker.actuation`` as JSON (a powered walker): the hip-torque laws a
+        stepping loop evaluates into the ``hip`` motor and the push-off it applies at each
+        heel strike (:mod:`walkerlab.export.mujoco_walk`); None for a passive walker.
+    push_off_duration_s : float
+        The push-off pulse's duration [s] (``contact.push_off_duration_s``).
     notes : tuple of str
         Comments written into the file (how the numbers were derived).
     """
@@ -73,6 +79,8 @@ class MjcfScene:
     friction: float
     latch: tuple | None = None
     notes: tuple = ()
+    actuation_json: str | None = None
+    push_off_duration_s: float = 0.005
 
 
 #: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot

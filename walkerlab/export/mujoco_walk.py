@@ -6,6 +6,16 @@ A heel strike of leg i is the first contact of its foot geom (``leg<i>_foot``) w
 ground after the foot has been off the ground for at least ``min_air_s`` (shorter gaps are
 bounces of the soft contact, not steps).  The knee latch of a kneed export (equality
 constraints ``leg<i>_latch``) is switched before every step by :func:`latch_rule`.
+
+A powered export (custom text ``walkerlab_actuation``: the scene's ``walker.actuation``) is
+driven by :class:`PoweredLoop`: before every MuJoCo step the hip motor's control is the swing
+leg's hip torque of the laws (:class:`walkerlab.models.actuation.TorqueLaws`, the rigid and
+contact views' own), its sign flipped while leg2 swings (the motor drives ``leg1_hip -
+leg2_hip``); at each heel strike the roles swap and the push-off
+(:func:`walkerlab.models.actuation.push_off_impulse` at the hip's speed) acts as a force
+``P / T`` along the trailing leg at its foot for ``T = push_off_duration_s``
+(``data.xfrc_applied`` on the leg's body, with the moment of the force about its centre of
+mass).
 """
 
 from __future__ import annotations
@@ -15,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["MujocoWalk", "latch_rule", "walk"]
+__all__ = ["MujocoWalk", "PoweredLoop", "latch_rule", "walk"]
 
 LEGS = ("leg1", "leg2")
 
@@ -78,6 +88,72 @@ def latch_rule(foot_height_m: float, knee_rad: float, release_height_m: float,
     return foot_height_m < release_height_m and knee_rad > -capture_rad
 
 
+class PoweredLoop:
+    """The controller of a powered export (module docstring).
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        With the custom text ``walkerlab_actuation``.
+    """
+
+    def __init__(self, model):
+        import json
+
+        import mujoco
+
+        from walkerlab.config.actuation import Actuation
+        from walkerlab.models.actuation import TorqueLaws
+
+        i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation")
+        adr, size = int(model.text_adr[i]), int(model.text_size[i])
+        self.spec = Actuation.model_validate(json.loads(
+            bytes(model.text_data[adr:adr + size - 1]).decode()))
+        self.laws = TorqueLaws(self.spec.torques)
+        self.pulse_s = _numeric(model, "push_off_duration_s", 0.005)
+        self.motor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "hip")
+        joints = [model.joint(f"{g}_hip") for g in LEGS]
+        self.qadr = [int(j.qposadr[0]) for j in joints]
+        self.vadr = [int(j.dofadr[0]) for j in joints]
+        self.body = [int(model.body(g).id) for g in LEGS]
+        self.hip = int(model.joint("hip_x").dofadr[0])
+        self.stance, self.t_step, self.push = 1, 0.0, None  # leg2 stands at the keyframe
+
+    def control(self, data) -> None:
+        """Set the hip motor and the push-off force for the coming step."""
+        st, sw = self.stance, 1 - self.stance
+        q, v = data.qpos, data.qvel
+        tau = 0.0
+        if self.laws:
+            tau = float(np.sum(self.laws(q[self.qadr[sw]] - q[self.qadr[st]],
+                                         v[self.vadr[sw]] - v[self.vadr[st]],
+                                         q[self.qadr[st]], v[self.vadr[st]],
+                                         data.time - self.t_step)))
+        data.ctrl[self.motor] = tau if sw == 0 else -tau
+        data.xfrc_applied[:] = 0.0
+        if self.push is not None and data.time < self.push[1]:
+            leg, force = self.push[0], self.push[2]
+            foot = data.site_xpos[self._site[leg]]
+            e = data.xpos[self._hip_body] - foot
+            F = force * e / np.sqrt(e @ e)
+            data.xfrc_applied[self.body[leg], :3] = F
+            data.xfrc_applied[self.body[leg], 3:] = np.cross(foot - data.xipos[self.body[leg]], F)
+
+    def heel_strike(self, data, leg: int) -> None:
+        """Leg ``leg`` (0, 1) struck: roles swap, the push-off starts at the other foot."""
+        from walkerlab.models.actuation import push_off_impulse
+
+        self.stance, self.t_step = leg, float(data.time)
+        vx, vz = data.qvel[self.hip], data.qvel[self.hip + 1]
+        P = float(push_off_impulse(self.spec.push_off, float(np.hypot(vx, vz))))
+        self.push = ((1 - leg, data.time + self.pulse_s, P / self.pulse_s) if P > 0 else None)
+
+    def bind(self, model, site: list) -> None:
+        """The foot sites and the hip body (ids)."""
+        self._site = site
+        self._hip_body = int(model.body("hip").id)
+
+
 def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     """Run the MJCF at ``xml_path`` from its ``gait`` keyframe for ``t_final_s`` [s].
 
@@ -109,6 +185,10 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     knee = [model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{g}_knee")]
             if latch[0] >= 0 else -1 for g in LEGS]
     hip = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")]
+    powered = None
+    if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation") >= 0:
+        powered = PoweredLoop(model)
+        powered.bind(model, site)
     mujoco.mj_forward(model, data)
     L = float(np.hypot(*(data.site_xpos[site[1]][[0, 2]] - data.qpos[[hip, hip + 1]])))
     last_contact = [data.time, data.time]  # both feet at the ground at the keyframe
@@ -120,6 +200,8 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
                 p = data.site_xpos[site[i]][[0, 2]]
                 data.eq_active[latch[i]] = latch_rule(float(p @ n) - off,
                                                       float(data.qpos[knee[i]]), h_rel, cap)
+        if powered is not None:
+            powered.control(data)
         mujoco.mj_step(model, data)
         geoms = data.contact.geom[:data.ncon]
         for i in range(2):
@@ -128,6 +210,8 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
                     times.append(data.time)
                     legs.append(LEGS[i])
                     pos.append(float(data.site_xpos[site[i]][[0, 2]] @ t))
+                    if powered is not None:
+                        powered.heel_strike(data, i)
                 last_contact[i] = data.time
         if float(data.qpos[[hip, hip + 1]] @ n) < 0.5 * L:
             fell = True

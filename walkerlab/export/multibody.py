@@ -210,13 +210,23 @@ def _joint_springs(mb: Multibody) -> dict:
             if len(sp.terms) == 1 and sp.terms[0][1] == 1.0}
 
 
-def _tendons(mb: Multibody) -> list[str]:
-    """Fixed tendons: each spring on its ``delta``, each coupling on its residual."""
+#: The fixed tendon a powered export's hip motor drives: ``leg1_hip - leg2_hip``, so a control
+#: ``u`` acts ``+u`` on leg1 and ``-u`` on leg2 (the swing leg's torque when leg1 swings).
+HIP_ACTUATION_TENDON = "hip_actuation"
+
+
+def _tendons(mb: Multibody, powered: bool = False) -> list[str]:
+    """Fixed tendons: each spring on its ``delta``, each coupling on its residual; a powered
+    walker's hip actuation (:data:`HIP_ACTUATION_TENDON`)."""
     on_joint = _joint_springs(mb).values()
     springs = [sp for sp in mb.springs if sp not in on_joint]
-    if not (springs or mb.couplings):
+    if not (springs or mb.couplings or powered):
         return []
     out = ["  <tendon>"]
+    if powered:
+        out += [f'    <fixed name="{HIP_ACTUATION_TENDON}">',
+                '      <joint joint="leg1_hip" coef="1.0"/>',
+                '      <joint joint="leg2_hip" coef="-1.0"/>', "    </fixed>"]
     for sp in springs:
         # oriented so that springlength >= 0: MuJoCo reads a springlength of -1 as "the
         # tendon's length at qpos0"; k (delta - r)^2 = k (-delta + r)^2, the same spring
@@ -288,7 +298,12 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
         children.setdefault(ln.parent, []).append(ln)
     for ln in children["hip"]:
         out += _mjcf_body(ln, "      ", mb, extra, children, _joint_springs(mb))
-    out += ["    </body>", "  </worldbody>", *_tendons(mb), *_mjcf_tail(mb, extra), ""]
+    powered = extra is not None and extra.actuation_json is not None
+    out += ["    </body>", "  </worldbody>", *_tendons(mb, powered)]
+    if powered:  # one motor for the sum of the hip torques; the laws live in the custom text
+        out += ["  <actuator>", f'    <motor name="hip" tendon="{HIP_ACTUATION_TENDON}" '
+                'gear="1"/>', "  </actuator>"]
+    out += [*_mjcf_tail(mb, extra), ""]
     return "\n".join(out)
 
 
@@ -354,8 +369,13 @@ def _mjcf_tail(mb: Multibody, extra: MjcfScene | None) -> list[str]:
         custom = {"slope_rad": mb.slope_rad, "foot_height_offset_m": arc}
         if extra.latch is not None and mb.knee:
             custom.update(latch_release_height_m=extra.latch[0], latch_capture_rad=extra.latch[1])
+        if extra.actuation_json is not None:
+            custom["push_off_duration_s"] = extra.push_off_duration_s
+        texts = ([f'    <text name="walkerlab_actuation" '
+                  f'data={quoteattr(extra.actuation_json)}/>']
+                 if extra.actuation_json is not None else [])
         out += ["  <custom>", *(f'    <numeric name="{k}" data="{num(v)}"/>'
-                                for k, v in custom.items()), "  </custom>"]
+                                for k, v in custom.items()), *texts, "  </custom>"]
     return out + ["  <keyframe>", *keys, "  </keyframe>", "</mujoco>"]
 
 
@@ -364,10 +384,16 @@ def keyframe_json(mb: Multibody, extra: MjcfScene) -> str:
     "units": [...]}`` in the URDF's joint names and order (the sidecar of ``walker.urdf``)."""
     joints = ["hip_x", "hip_z", *(ln.joint for ln in mb.links)]
     units = ["m", "m", *("rad" for _ in mb.links)]
-    return json.dumps({"keyframe": "gait", "description": "rigid fixed point just after heel "
-                       "strike, leg2 in stance, its foot at the origin on the ground line",
-                       "joints": joints, "units": units, "qpos": list(extra.qpos),
-                       "qvel": list(extra.qvel)}, indent=1) + "\n"
+    out = {"keyframe": "gait", "description": "rigid fixed point just after heel strike, "
+           "leg2 in stance, its foot at the origin on the ground line",
+           "joints": joints, "units": units, "qpos": list(extra.qpos),
+           "qvel": list(extra.qvel)}
+    if extra.actuation_json is not None:  # a powered walker: its actuators, as the scene
+        out["actuation"] = json.loads(extra.actuation_json)
+        out["actuation_note"] = ("hip torques act +tau on the swing leg's hip joint and -tau "
+                                 "on the stance leg's; the push-off is an impulse along the "
+                                 "trailing leg at its foot at each heel strike")
+    return json.dumps(out, indent=1) + "\n"
 
 
 def comments_in_scene_units(text: str, units) -> str:

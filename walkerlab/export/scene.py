@@ -57,12 +57,13 @@ def check_exportable(scene: Scene) -> None:
     ValueError
         One line naming the field: a mass below :data:`MJCF_MIN_MASS_KG` (but > 0; 0 is
         refused by the multibody model) or a length / foot radius below
-        :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot); a walker
-        with actuators (not exported yet: the file would walk passively).
+        :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot); an ankle
+        push-off (flat feet: not exported yet, the file would walk passively).
     """
-    if getattr(scene.walker, "actuation", None) is not None:
-        raise ValueError("walker.actuation: actuators are not exported yet (the URDF/MJCF "
-                         "would hold a passive walker); export the scene without them")
+    act = getattr(scene.walker, "actuation", None)
+    if act is not None and act.ankle_push_off is not None:
+        raise ValueError("walker.actuation.ankle_push_off: not exported yet (the URDF/MJCF "
+                         "would hold a passive walker); export the scene without it")
     def walk(obj, path):
         if isinstance(obj, dict):
             for k, v in obj.items():
@@ -207,6 +208,18 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
                   f"{knee.latch_height:.4g} m above the ground and its knee within "
                   f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
                   "(data.eq_active), MuJoCo has no contact-switched lock.",)
+    act = getattr(scene.walker, "actuation", None)
+    actuation = None
+    if act is not None:
+        import json
+
+        actuation = json.dumps(act.model_dump(mode="json", exclude_none=True))
+        notes += ("Actuators (walker.actuation, in the custom text walkerlab_actuation): one "
+                  "motor 'hip' on the tendon leg1_hip - leg2_hip; a stepping loop sets its "
+                  "control to the swing leg's hip torque (its sign flipped when leg2 swings) "
+                  "and applies the push-off as a force along the trailing leg at its foot for "
+                  "push_off_duration_s from each heel strike (walkerlab.export.mujoco_walk).",)
     return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
-                     dt, solref, solimp, mu, latch, notes)
+                     dt, solref, solimp, mu, latch, notes, actuation,
+                     settings.push_off_pulse_s())

@@ -239,6 +239,9 @@ class Actuators:
 def _structure_check(data, spec) -> bool:
     """Refuse what this actuation does not handle (one line); True for massless legs."""
     st = data.structure
+    if spec.ankle_push_off is not None:
+        raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
+                         "flat); point feet take push_off, the impulse along the leg")
     if st.knee or st.foot != "point":
         raise ValueError("walker.actuation: actuators need straight legs with point feet "
                          "today (knees, arc and flat feet: not yet)")
@@ -284,6 +287,10 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     """
     from walkerlab.codegen.cache import functions
 
+    if data.structure.foot == "flat":
+        from walkerlab.models.hybrid.ankle_push_off import actuate_flat
+
+        return actuate_flat(walker, data, spec)
     limit = _structure_check(data, spec)
     fns = functions(data)
     acts = Actuators(spec, fns, len(walker.roles), limit, float(walker.total_mass_kg))

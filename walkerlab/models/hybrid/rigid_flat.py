@@ -72,7 +72,8 @@ def _heel_force(ground, flow, t, x) -> float:
 
 
 def make_flat_walker(data: WalkerData, name: str = "biped",
-                     variant: str = "derived") -> HybridWalker:
+                     variant: str = "derived",
+                     heel_off_data: WalkerData | None = None) -> HybridWalker:
     """A :class:`HybridWalker` for a flat-footed ``data`` (``structure.foot == "flat"``).
 
     Returns
@@ -80,19 +81,23 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     HybridWalker
         Roles ``(swing, stance, stance_ankle)``; six phases ``<mode>:<swing part>``.
     """
-    f = functions(data)
-    flows = {m: f[f"flow_{m}"] for m in MODES}
+    base = functions(data)
+    off = base if heel_off_data is None else functions(heel_off_data)
     pin = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
 
     def phase(mode: str, part: str) -> Phase:
-        fl, p = flows[mode], pin[mode]
+        # an ankle push-off acts in heel off: its flow (and the ground forces, read through
+        # it) from the released spring's numbers; guards and resets are the walker's own
+        # (the new stance ankle lands at the walker's rest angle)
+        f, g = (off if mode == "heel_off" else base), base
+        fl, p = f[f"flow_{mode}"], pin[mode]
         late = part == "late_swing"
         guards = []
         if late:
-            guards.append(Guard("heel_strike", f[f"guard_swing_heel_height_{p}"], -1,
-                                "heel_strike", f[f"grad_swing_heel_height_{p}"],
-                                f[f"reset_heel_strike_{p}"],
-                                f[f"reset_heel_strike_{p}_jacobian"]))
+            guards.append(Guard("heel_strike", g[f"guard_swing_heel_height_{p}"], -1,
+                                "heel_strike", g[f"grad_swing_heel_height_{p}"],
+                                g[f"reset_heel_strike_{p}"],
+                                g[f"reset_heel_strike_{p}_jacobian"]))
         if mode == "heel_contact":
             guards.append(Guard("foot_slap", f["guard_foot_angle"], -1, "next_phase",
                                 f["grad_foot_angle"], f["reset_foot_slap"],
@@ -124,6 +129,7 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
                      variational=f[f"flow_{mode}_variational"])
 
     phases = tuple(phase(m, part) for part in SWING_PARTS for m in MODES)
+    f = base
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
               "total_mass_kg": data.total_mass_kg, "slope_rad": data.slope_rad, **data.extra,
