@@ -329,7 +329,9 @@ class ContactSimArtifact:
 
     ``summary`` maps each ``summary/`` name to ``(value, unit)``; ``initial_rate_scale``
     multiplies the rates named in ``rate_names`` (None in artifacts without them);
-    ``stage_wall_time_s``: the whole stage's compute time [s].
+    ``stage_wall_time_s``: the whole stage's compute time [s]; ``ledger`` (a powered run)
+    maps each work integral's name (:data:`walkerlab.models.contact.actuation.WORK_NAMES`)
+    and ``residual`` to its samples (n,) [J].
     """
 
     path: Path
@@ -349,6 +351,7 @@ class ContactSimArtifact:
     drop: DropTest | None = None
     periodic: PeriodicGait | None = None
     adjust: dict | None = None
+    ledger: dict | None = None
 
 
 def _periodic(f) -> PeriodicGait | None:
@@ -405,7 +408,9 @@ def load_contact_sim(path: Path) -> ContactSimArtifact:
             steps=steps, drop=drop, periodic=_periodic(f),
             adjust={**{k: f["adjust"][k][()] for k in f["adjust"]},
                     **{k: str(v) for k, v in f["adjust"].attrs.items()}}
-            if "adjust" in f else None)
+            if "adjust" in f else None,
+            ledger=({**{k: f["ledger/work"][k][()] for k in f["ledger/work"] if k != "time"},
+                     "residual": f["ledger/residual"][()]} if "ledger" in f else None))
 
 
 def run_end(path: Path) -> tuple[str, str]:
