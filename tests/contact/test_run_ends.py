@@ -111,3 +111,22 @@ def test_rigid_walker_that_never_moves_exits_1_in_one_line(tmp_path):
     assert "no_heel_strike" in err and "\n" not in err
     # a run that did not walk: its count is in the error line, no summary (issue 26, item 5)
     assert "0 heel strikes" in err and "simulated" not in r.stdout
+
+
+def test_a_run_asked_for_n_strides_makes_them_when_its_steps_are_slower():
+    """configs/asymmetric_legs.yaml: the contact model's steps are slower than the rigid
+    ones the end time is sized by (5 rigid strides' time).  Before: the run ended at that
+    time after 9 heel strikes (4 strides) with outcome 't_final'.  Now it goes on until the
+    strides cap (11 heel strikes) and says so."""
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.config import load_scene
+    from walkerlab.models.contact.scene import contact_setup
+
+    scene = load_scene(ROOT / "configs" / "asymmetric_legs.yaml")
+    ideal = ideal_gait(scene)
+    step = float(np.mean(ideal.step_periods_s))  # the stride map's two steps
+    _, res, _, _ = simulate_from(contact_setup(scene), ideal.x, step)
+    assert res.outcome.kind == "heel_strike", res.outcome
+    assert len(res.heel_strike_times) >= 2 * scene.contact_sim.n_strides
+    assert res.t[-1] > (2 * scene.contact_sim.n_strides + 0.5) * step

@@ -62,7 +62,8 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
                      solver: Solver | SolverSettings | None = None,
                      limits: ContactLimits | None = None, *,
                      max_heel_strikes: int | None = None, slip_limit_mm: float | None = None,
-                     min_step_m: float = 0.05, initial_stance: str = "leg2") -> ContactResult:
+                     min_step_m: float = 0.05, initial_stance: str = "leg2",
+                     t_more: float | None = None) -> ContactResult:
     """Simulate the floating walker with compliant feet and classify its gait.
 
     Parameters
@@ -89,6 +90,12 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         far [m] downhill of the stance foot's touchdown point (else it is a scuff).
     initial_stance : str
         The foot in stance at the start.
+    t_more : float, optional
+        With ``max_heel_strikes``: a run that reaches ``t_final`` [s] short of the heel
+        strikes asked for (contact steps slower than the rigid ones the end time was sized
+        by) goes on from there until the cap or ``t_more`` [s] (the samples up to
+        ``t_final`` are those of the run without it).  Not for a powered walker (its stance
+        leg is a state of one run): it gets ``t_more`` as its end time at once.
 
     Returns
     -------
@@ -106,7 +113,18 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         def stop(t, X):
             return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
                 >= max_heel_strikes
+    powered = getattr(walker, "actuators", None) is not None
+    if powered and t_more is not None and stop is not None:
+        t_final = max(t_final, t_more)
     run = integrate_contact(walker, x0, 0.0, t_final, solver, limits, stop)
+    if (t_more is not None and stop is not None and not powered
+            and run.termination == "t_final" and t_more > t_final):
+        run = _go_on(walker, run, t_more, solver, limits, stop)
+    if stop is not None and run.event is not None:
+        # the strides asked for (2 N heel strikes; the cap stops at the one after) were made
+        # before the event: the run made its promise, the event comes after it
+        run = _made_before_event(run, lambda t, X: heel_strike_count(
+            walker, t, X, min_step_m, initial_stance) >= max_heel_strikes - 1)
     ev = gait_events(walker, run.t, run.X, min_step_m, initial_stance)
     hh = float(walker.hip_height(run.X[-1:])[0])
     out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
@@ -118,6 +136,37 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
                          njev=run.njev, wall_time_s=run.wall_time_s, method=solver.method,
                          pin_end_time=run.pin_end_time, outcome=out, points=ev["points"],
                          work=run.work)
+
+
+def _made_before_event(run, stop):
+    """A run whose strides cap was met before the event (trip, fall, flight) that ended the
+    chunk it was met in: cut before the event, ended by the cap (the event is named in the
+    message)."""
+    k = max(int(run.event[1]), 1)
+    if not stop(run.t[:k], run.X[:k]):
+        return run
+    msg = (f"the heel strikes asked for were made; a {run.event[0]} followed at "
+           f"t = {float(run.event[2]):.4g} s (after the last of them: not part of the run)")
+    return replace(run, t=run.t[:k], X=run.X[:k], event=None, termination="heel_strike",
+                   message=msg, work=None if run.work is None else run.work[:k])
+
+
+def _go_on(walker, run, t_more: float, solver, limits, stop):
+    """``run`` (ended at its end time short of the strides cap) continued from its last
+    sample until the cap or ``t_more`` [s]; the cap counts the heel strikes of both parts."""
+    t0, X0 = run.t, run.X
+
+    def stop_all(t, X):
+        return stop(np.concatenate([t0, t[1:]]), np.vstack([X0, X[1:]]))
+
+    more = integrate_contact(walker, X0[-1], float(t0[-1]), t_more, solver, limits, stop_all)
+    event = more.event
+    if event is not None:  # sample indices of the combined run
+        event = (event[0], event[1] + len(t0) - 1, *event[2:])
+    return replace(more, t=np.concatenate([t0, more.t[1:]]), X=np.vstack([X0, more.X[1:]]),
+                   nfev=run.nfev + more.nfev, njev=run.njev + more.njev, event=event,
+                   wall_time_s=run.wall_time_s + more.wall_time_s,
+                   pin_end_time=run.pin_end_time)
 
 
 def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
@@ -194,8 +243,12 @@ def simulate_from(setup: ContactSetup, x_ideal: np.ndarray, period: float, rate_
     n_strides = strides or cs.n_strides
     walker, x0, limits, step_length = scene_start(setup, x_ideal, n_strides, rate_scale)
     t_final = cs.t_final_s or (2 * n_strides + 0.5) * period
+    # without an end time of its own, a run whose contact steps are slower than the rigid
+    # ones goes on until its strides are made (or twice the rigid strides' time)
+    t_more = 2.0 * t_final if cs.t_final_s is None else None
     res = simulate_contact(walker, x0, t_final, sv, limits,
-                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None)
+                           max_heel_strikes=2 * n_strides + 1 if cs.stop_after_strides else None,
+                           t_more=t_more)
     return walker, res, x0, step_length
 
 
