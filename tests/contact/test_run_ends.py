@@ -130,3 +130,22 @@ def test_a_run_asked_for_n_strides_makes_them_when_its_steps_are_slower():
     assert res.outcome.kind == "heel_strike", res.outcome
     assert len(res.heel_strike_times) >= 2 * scene.contact_sim.n_strides
     assert res.t[-1] > (2 * scene.contact_sim.n_strides + 0.5) * step
+
+
+def test_a_fall_on_continuous_ground_names_the_scuffs_and_the_checkerboard():
+    """The paper walker on continuous ground: its swing foot scuffs at mid-stance and it
+    falls within the first step.  Before: "fall: hip 0.500 m above ground ... after 0 heel
+    strikes" only; now the message names the scuffs its own table counts and the remedy."""
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.api.scenes import with_changes
+    from walkerlab.config import load_scene
+    from walkerlab.models.contact.scene import contact_setup
+
+    scene = with_changes(load_scene(ROOT / "configs" / "paper.yaml"),
+                         {"terrain.kind": "continuous"})
+    ideal = ideal_gait(scene)
+    _, res, _, _ = simulate_from(contact_setup(scene), ideal.x, ideal.period_s)
+    assert res.outcome.kind == "fall"
+    assert "scuffed the ground" in res.outcome.message
+    assert "terrain.kind: checkerboard" in res.outcome.message

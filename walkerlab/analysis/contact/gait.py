@@ -496,7 +496,7 @@ def _other(steps, leg: str) -> str:
 
 def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps: list,
              message: str, limits, slip_limit_mm: float | None,
-             wall_time_limit_s: float | None) -> Outcome:
+             wall_time_limit_s: float | None, continuous: bool = False) -> Outcome:
     """The typed outcome of a contact run from how its integration stopped.
 
     Parameters
@@ -514,6 +514,8 @@ def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps:
         The solver's message.
     limits : ContactLimits
     slip_limit_mm, wall_time_limit_s : float or None
+    continuous : bool
+        The ground is continuous (a fall after swing-foot scuffs suggests the checkerboard).
     """
     n_hs = max(len(steps) - 1, 0)
     te = float(t[-1])
@@ -523,10 +525,17 @@ def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps:
                        f"trip: {foot} hit the side of the patch edge at s = {edge:.4f} m at "
                        f"t = {te:.4g} s after {n_hs} heel strikes")
     if termination == "fall":
+        scuffs = sum(st.scuff_count for st in steps)
+        why = ""
+        if scuffs:  # the run's own table counts them: name the likely cause
+            why = (f"; the swing foot scuffed the ground {scuffs} time(s) before (a straight "
+                   "leg's swing foot passes below the ground line near mid-stance"
+                   + ("; terrain.kind: checkerboard gives it a gap there)"
+                      if continuous else ")"))
         return Outcome("fall", te, "", np.nan, hip_height_m,
                        f"fall: hip {hip_height_m:.3f} m above ground "
                        f"(< {limits.fall_hip_height_m:g} m) at t = {te:.4g} s after {n_hs} "
-                       "heel strikes")
+                       f"heel strikes{why}")
     if termination == "airborne":
         return Outcome("airborne", te, "", np.nan, hip_height_m,
                        f"airborne: the hip rose {hip_height_m:.3g} m above the ground "

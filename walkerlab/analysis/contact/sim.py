@@ -128,7 +128,7 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
     ev = gait_events(walker, run.t, run.X, min_step_m, initial_stance)
     hh = float(walker.hip_height(run.X[-1:])[0])
     out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
-                   slip_limit_mm, limits.wall_time_limit_s)
+                   slip_limit_mm, limits.wall_time_limit_s, bool(walker.continuous))
     return ContactResult(t=run.t, x=run.X, state_names=tuple(walker.state_names()),
                          feet=ev["feet"], heel_strike_times=ev["hs_t"],
                          heel_strike_legs=ev["hs_leg"], steps=ev["steps"],
