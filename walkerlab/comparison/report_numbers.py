@@ -48,6 +48,9 @@ def report_numbers(scene, arts: dict) -> dict:
         trajs = {"ours, ideal": sim.samples} | (
             {"ours, contact": contact.samples} if contact is not None else {})
         out["gait_columns"] = table3(trajs, sim.total_mass_kg, sim.gravity_m_per_s2)
+        per = getattr(contact, "periodic", None)
+        if per is not None and per.found:  # the contact model's own gait: no start-up steps
+            out["gait_columns"]["ours, contact periodic gait"] = periodic_gait_column(per)
         pub = for_scene(scene)
         if getattr(pub, "TABLE3", None) and getattr(pub, "EQ11_STATE", None) is not None \
                 and getattr(pub, "STEP_LENGTH_M", None) is not None:
@@ -62,6 +65,17 @@ def report_numbers(scene, arts: dict) -> dict:
 
         out["basin_area"] = basin_area(arts["basin"])
     return out
+
+
+def periodic_gait_column(per) -> dict[str, float]:
+    """Table 3 entries of the contact model's periodic gait (``per``: a loaded
+    :class:`walkerlab.io.schemas.contact_sim.PeriodicGait`): both steps its step period
+    [s], the cycle two of them, the speed step length / step period [m/s]; energies NaN (the
+    gait is a fixed point, not a run)."""
+    T, L = float(per.step_period_s), float(per.step_length_m)
+    return {"t_left_s": T, "t_right_s": T, "t_cycle_s": 2 * T, "v_com_m_per_s": L / T,
+            "E_avg_J": np.nan, "E_avg_stance_frame_J": np.nan, "step_length_m": L,
+            "step_length_left_m": L, "step_length_right_m": L, "n_steps": np.nan}
 
 
 def published_step_length(state: dict, leg_length_m: float) -> float:

@@ -223,6 +223,14 @@ def gait_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     out = [title, "", "Recomputed from the trajectory artifacts ("
            + ", ".join(f"`{arts[s].path.name}`" for s in ("simulate", "contact-sim") if s in arts)
            + ").", "", table(header, rows)]
+    if "ours, contact" in cols:
+        out += ["", "*ours, contact* averages every complete step of the contact run, which "
+                "starts from the rigid gait, so its start-up steps are included"
+                + ("; *ours, contact periodic gait* is the contact model's own periodic gait "
+                   "(the fixed point of its step-to-step map: no start-up, energies not "
+                   "defined)." if "ours, contact periodic gait" in cols else
+                   " (the scene computes no contact periodic gait: contact_sim.periodic_gait)."
+                   )]
     ideal = cols.get("ours, ideal")
     eq = getattr(pub, "EQ11_STATE", None)  # the paper's Eq. (11) specifically
     if ideal and t3 and eq is not None and step_pub is not None:
