@@ -35,3 +35,17 @@ def test_fig8_prose_from_artifacts_and_paper_sentence_only_for_published_paper(t
     other = scene.model_copy(update={"published": None})
     text = "\n".join(compare_section(other, ReportInputs(arts, **report_numbers(other, arts))))
     assert "paper" not in text.lower() and "0.5 mm" not in text
+
+
+def test_table3_shows_the_contact_periodic_gait_beside_the_run():
+    """Table 3's contact column averages the run's start-up steps; the contact model's own
+    periodic gait gets its column (both steps its period, speed = step length / period)."""
+    from walkerlab.comparison.report_numbers import periodic_gait_column
+    from walkerlab.io.schemas.contact_sim import PeriodicGait
+
+    col = periodic_gait_column(PeriodicGait(True, "found", step_period_s=0.711,
+                                            step_length_m=0.3605))
+    assert col["t_left_s"] == col["t_right_s"] == 0.711
+    assert col["t_cycle_s"] == 2 * 0.711
+    assert col["v_com_m_per_s"] == pytest.approx(0.3605 / 0.711)
+    assert np.isnan(col["E_avg_J"])
