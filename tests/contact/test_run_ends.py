@@ -149,3 +149,21 @@ def test_a_fall_on_continuous_ground_names_the_scuffs_and_the_checkerboard():
     assert res.outcome.kind == "fall"
     assert "scuffed the ground" in res.outcome.message
     assert "terrain.kind: checkerboard" in res.outcome.message
+
+
+def test_a_benchmark_never_reports_a_target_on_a_run_that_stopped_early():
+    """``walkerlab bench contact``: a run (or the reference) that stops before the end time
+    ("Excess work done", a fall) has no error over the span: infinite, never "reached"."""
+    from types import SimpleNamespace
+
+    from walkerlab.bench.contact import _Case
+
+    case = _Case.__new__(_Case)
+    case.t_final, case.limits, case.angles = 1.0, SimpleNamespace(sample_rate_hz=1000.0), [0]
+    full = SimpleNamespace(t=np.linspace(0, 1.0, 1001), x=np.zeros((1001, 1)))
+    short = SimpleNamespace(t=np.linspace(0, 0.8, 801), x=np.zeros((801, 1)))
+    case.ref = full
+    assert case.error(full) == 0.0
+    assert case.error(short) == np.inf
+    case.ref = short
+    assert case.error(full) == np.inf

@@ -138,8 +138,13 @@ def scene_line(res: dict) -> str:
                          f"..{t['rtols'][0]:.2g}, worst error {t['worst_error_rad']:.2g} rad)")
         else:
             parts.append(f"{method} did not reach the target")
+    ref = res["reference"]
+    short = ("" if ref.get("complete", True) else
+             f"; the reference stopped at t = {ref['end_time_s']:.4g} s of "
+             f"{res['t_final_s']:.4g} s ({ref['termination']}: {ref['message']}): no method "
+             "can be judged over the span")
     return (f"contact {res['scene']}: {res['n_strides']} strides at <= 1e-6 rad: "
-            + "; ".join(parts) + f" [reference {res['reference']['wall_time_s']:.3f} s]")
+            + "; ".join(parts) + f" [reference {ref['wall_time_s']:.3f} s]" + short)
 
 
 def bench_contact_scenes(scenes) -> dict:

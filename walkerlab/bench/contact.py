@@ -157,8 +157,19 @@ class _Case:
         return simulate_contact(self.walker, self.x0, self.t_final, SolverSettings.for_contact(
             method=method, rtol=rtol, atol=atol), self.limits)
 
+    def complete(self, r) -> bool:
+        """The run covered the whole span (its last sample within two sample intervals of
+        the end time): a run that stopped early ("Excess work done", a fall) is compared
+        with nothing past its end, so its error says nothing about the span."""
+        dt = 2.0 / self.limits.sample_rate_hz
+        return bool(len(r.t)) and float(r.t[-1]) >= self.t_final - dt
+
     def error(self, r) -> float:
-        """Largest leg-angle difference from the reference on the common samples [rad]."""
+        """Largest leg-angle difference from the reference on the common samples [rad];
+        infinite when the run or the reference stopped before the end time (a target is
+        never reached on part of the span)."""
+        if not (self.complete(r) and self.complete(self.ref)):
+            return float("inf")
         n = min(len(r.t), len(self.ref.t))
         return float(np.abs(r.x[:n, self.angles] - self.ref.x[:n, self.angles]).max())
 
@@ -255,7 +266,9 @@ def run_scene_benchmark(scene, n_strides: int = 5, methods=("cyrk_bdf", "odeint"
             "reference": {"method": "odeint", "rtol": reference_rtol,
                           "wall_time_s": ref.wall_time_s, "nfev": ref.nfev,
                           "heel_strikes": len(ref.heel_strike_times),
-                          "termination": ref.termination},
+                          "termination": ref.termination,
+                          "end_time_s": float(ref.t[-1]) if len(ref.t) else 0.0,
+                          "complete": case.complete(ref), "message": ref.message},
             "rhs_cost": rhs_cost(walker, x0), "target": target, "scan": scan}
 
 
