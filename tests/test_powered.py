@@ -158,7 +158,8 @@ def test_flat_feet_have_no_ledger_yet():
     assert led == {}
 
 
-@pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED if n != "flat_feet"])
+@pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED
+                                  if n not in ("flat_feet", "flat_feet_push_off")])
 def test_the_energy_ledger_closes_and_cost_of_transport(name):
     w, led, ke = _ledger(name)
     assert np.all(np.isfinite(led["closure"]))
@@ -418,3 +419,42 @@ def test_pd_tracking_of_a_time_table_counts_from_each_step(interpolation):
         x, T, _ = ref.step(x, ref.PAPER, 0.0, P=3.0, torque_law=torque)
         assert seg.t_end - seg.t_start == pytest.approx(T, abs=1e-8)
         np.testing.assert_allclose(seg.x_next, x, rtol=0, atol=1e-8)
+
+
+def test_ankle_push_off_on_flat_feet_is_the_released_spring_in_heel_off():
+    """``ankle_push_off`` on flat feet: the heel-off mode runs on the walker's own generated
+    equations with the ankle numbers (k + k_po, r_eff); its flow equals the passive flow
+    plus the push-off torque on the ankle coordinate, -k_po (a - r_po) - tau_0, through
+    M^-1 (checked against the passive heel-off flow, the other modes unchanged); the shipped
+    scene's gait puts the push-off's work into the ledger (~11.1 J a step, cost of
+    transport ~0.097)."""
+    from walkerlab.models.hybrid.ankle_push_off import ankle_push_off_work
+
+    d = load_scene(CONFIGS / "flat_feet.yaml").model_dump(mode="json", exclude_none=True)
+    passive = build_walker(scene_from_dict(d))
+    d["walker"]["actuation"] = {"ankle_push_off": {"stiffness_n_m_per_rad": 40.0,
+                                                   "rest_angle_rad": -0.2,
+                                                   "constant_n_m": 7.0}}
+    powered = build_walker(scene_from_dict(d))
+    x = np.array([-0.3, 0.2, 0.05, -1.2, -1.1, -3.0])
+    a = x[2]
+    for ph0, ph1 in zip(passive.phases, powered.phases):
+        f0, f1 = np.asarray(ph0.flow(0.0, x)), np.asarray(ph1.flow(0.0, x))
+        if not ph0.name.startswith("heel_off"):
+            np.testing.assert_array_equal(f0, f1)
+            continue
+        tau = -40.0 * (a + 0.2) - 7.0
+        # the added acceleration is linear in the torque: tau times the response to a unit
+        # torque, which two spring settings give (the ankle row of M^-1 scaled)
+        d2 = dict(d, walker=dict(d["walker"], actuation={"ankle_push_off": {
+            "constant_n_m": -1.0}}))
+        unit = np.asarray(build_walker(scene_from_dict(d2)).phases[
+            [p.name for p in powered.phases].index(ph1.name)].flow(0.0, x)) - f0
+        np.testing.assert_allclose(f1 - f0, tau * unit, rtol=1e-10, atol=1e-10)
+    w = wl.Walker.from_scene(CONFIGS / "flat_feet_push_off.yaml")
+    g = w.fixed_point()
+    assert g.stable
+    seg = simulate_steps(w.model, g.x, 1, w.solver).segments[0]
+    assert ankle_push_off_work(w.model, seg) == pytest.approx(11.11, rel=1e-3)
+    led = trajectory_ledger(simulate_steps(w.model, g.x, 2, w.solver))
+    assert np.allclose(led["cost_of_transport"], 0.0966, rtol=1e-3)

@@ -126,7 +126,8 @@ def energy_ledger_figure(sim, out_dir: Path, units: Units) -> list[Path]:
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(10, 4), gridspec_kw={"width_ratios": [3, 1]})
     up = np.zeros(steps.size)
     down = np.zeros(steps.size)
-    scale = max(float(np.nanmax(np.abs(np.asarray(led[k], float)))) for k, _ in _SOURCES + _SINKS)
+    scale = max(float(np.max(np.abs(np.nan_to_num(np.asarray(led[k], float)))))
+                for k, _ in _SOURCES + _SINKS)
     tiny = 1e-9 * max(scale, 1e-300)  # round-off (the closure's size) is not drawn
     for key, label in _SOURCES:
         v = np.nan_to_num(np.asarray(led[key], float))

@@ -152,13 +152,38 @@ def trajectory_ledger(traj) -> dict[str, np.ndarray]:
 
     w = traj.walker
     if w.matrices is None:
-        return {}
+        return _ankle_push_off_ledger(traj)
     rows = {k: [] for k in LEDGER_NAMES}
     for seg in traj.segments:
         led = step_ledger(w.for_stance(seg.stance_leg), seg,
                           w.for_stance(other_leg(w, seg.stance_leg)))
         for k in LEDGER_NAMES:
             rows[k].append(led[k])
+    return {k: np.asarray(v, float) for k, v in rows.items()}
+
+
+def _ankle_push_off_ledger(traj) -> dict[str, np.ndarray]:
+    """Flat feet with an ankle push-off: the push-off's work per step
+    (:func:`walkerlab.models.hybrid.ankle_push_off.ankle_push_off_work`) and the cost of
+    transport (push-off work + the energy the slope releases) / (m g d); the other terms
+    NaN (the flat foot's full ledger is not written yet); empty for a passive flat foot."""
+    from walkerlab.models.hybrid.ankle_push_off import AnklePushOffActuator, ankle_push_off_work
+
+    w = traj.walker
+    if not isinstance(w.actuators, AnklePushOffActuator):
+        return {}
+    g, m = float(w.params["gravity_m_per_s2"]), float(w.total_mass_kg)
+    rows = {k: [] for k in LEDGER_NAMES}
+    for seg in traj.segments:
+        out = dict.fromkeys(LEDGER_NAMES, np.nan)
+        if seg.termination == "heel_strike":
+            work = ankle_push_off_work(w, seg)
+            d = step_length(w, seg)
+            slope = m * g * d * np.sin(float(w.slope_rad))
+            out.update(push_off_work=work, push_off_impulse=0.0, slope_energy=slope,
+                       cost_of_transport=(max(work, 0.0) + max(slope, 0.0)) / (m * g * d))
+        for k in LEDGER_NAMES:
+            rows[k].append(out[k])
     return {k: np.asarray(v, float) for k, v in rows.items()}
 
 
