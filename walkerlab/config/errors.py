@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections import Counter
 from pathlib import Path
 
 from pydantic import BaseModel, ValidationError
@@ -73,11 +74,29 @@ def _input_text(value) -> str:
     return repr(value)
 
 
-def _suggestion(root: type[BaseModel], e: dict) -> list[str]:
-    """The field an unknown key most likely meant ([] when none is close)."""
-    import difflib
+#: At most this many error lines for one scene; the rest are counted ("… and N more errors")
+MAX_ERROR_LINES = 20
 
-    return difflib.get_close_matches(str(e["loc"][-1]), _fields_at(root, tuple(e["loc"][:-1])), n=1)
+
+class _Suggester:
+    """The field an unknown key most likely meant ([] when none is close), the allowed
+    fields looked up once per location: thousands of unknown keys in one mapping cost one
+    lookup, not thousands."""
+
+    def __init__(self, root: type[BaseModel]) -> None:
+        self.root = root
+        self.fields: dict[tuple, list[str]] = {}
+        self.said: dict[tuple, list[str]] = {}
+
+    def __call__(self, e: dict) -> list[str]:
+        import difflib
+
+        at, key = tuple(e["loc"][:-1]), str(e["loc"][-1])
+        if at not in self.fields:
+            self.fields[at] = _fields_at(self.root, at)
+        if (at, key) not in self.said:
+            self.said[at, key] = difflib.get_close_matches(key, self.fields[at], n=1)
+        return self.said[at, key]
 
 
 #: What a walker can be today, said by an error on an unknown walker field or kind and by
@@ -92,13 +111,14 @@ WALKER_VOCABULARY = (
     "model); no elastic knees, knee or ankle actuators yet")
 
 
-def _walker_vocabulary_applies(root: type[BaseModel], e: dict) -> bool:
+def _walker_vocabulary_applies(root: type[BaseModel], e: dict, suggest=None) -> bool:
     """An unknown kind, or an unknown key close to no field, inside ``walker``: the
     vocabulary's end rather than a typo."""
     if not e["loc"] or e["loc"][0] != "walker":
         return False
+    suggest = suggest or _Suggester(root)
     return e["type"] == "union_tag_invalid" or (e["type"] == "extra_forbidden"
-                                                 and not _suggestion(root, e))
+                                                 and not suggest(e))
 
 
 _BOUND_ERRORS = ("less_than", "less_than_equal", "greater_than", "greater_than_equal")
@@ -122,12 +142,12 @@ def _unit_hint(root: type[BaseModel], e: dict, parts: list) -> str:
         return f" ({v:g} m: a length in mm? {v:g} mm = {v / 1000:g} m)"
     return ""
 
-def _error_line(root: type[BaseModel], e: dict) -> str:
+def _error_line(root: type[BaseModel], e: dict, suggest=None) -> str:
     """One error as ``<field path>: <message>`` (an unknown key names the likely field)."""
     parts = [p for p in e["loc"] if _loc_part(p)]
     loc = ".".join(str(p) for p in parts)
     if e["type"] == "extra_forbidden":
-        close = _suggestion(root, e)
+        close = (suggest or _Suggester(root))(e)
         return f"{loc}: unknown field" + (f" (did you mean {close[0]}?)" if close else "")
     msg = e["msg"].removeprefix("Value error, ").replace(
         " found using _walker_tag() ", " (walker.model) ") + _unit_hint(root, e, parts)
@@ -163,22 +183,34 @@ def format_error(path: Path, err: ValidationError, root: type[BaseModel]) -> str
     """
     errs = err.errors()
     locs = [tuple(p for p in x["loc"] if _loc_part(p)) for x in errs]
-    keep = []
-    for i, x in enumerate(errs):
-        deeper = any(len(o) > len(locs[i]) and o[:len(locs[i])] == locs[i] for o in locs)
-        if deeper or (x["type"] in ("literal_error", "none_required")
-                      and sum(o == locs[i] for o in locs) > 1):
-            continue
-        keep.append(x)
-    keep = keep or errs[:1]
+    # linear in the number of errors: the strict prefixes of every location, once
+    prefixes = {o[:k] for o in locs for k in range(len(o))}
+    count = Counter(locs)
+    keep = [i for i, x in enumerate(errs)
+            if not (locs[i] in prefixes or (x["type"] in ("literal_error", "none_required")
+                                            and count[locs[i]] > 1))] or [0]
+    suggest = _Suggester(root)
     # a misspelt required key is one mistake: "unknown field (did you mean X?)" says it, so
     # the "X: Field required" it causes is left out
-    meant = {(*locs[errs.index(x)][:-1], m) for x in keep if x["type"] == "extra_forbidden"
-             for m in _suggestion(root, x)}
-    keep = [x for x in keep if not (x["type"] == "missing" and locs[errs.index(x)] in meant)]
-    keep.sort(key=lambda x: x["type"] != "extra_forbidden")  # stable: file order otherwise
-    said = next((x for x in keep if _walker_vocabulary_applies(root, x)), None)
-    lines = list(dict.fromkeys(_error_line(root, x)
-                               + (f"; {WALKER_VOCABULARY}" if x is said else "")
-                               for x in keep))  # the vocabulary once, on the first such line
-    return "\n".join(f"{path}: {ln}" for ln in lines)
+    missing = {locs[i][:-1] for i in keep if errs[i]["type"] == "missing"}
+    meant = {(*locs[i][:-1], m) for i in keep if errs[i]["type"] == "extra_forbidden"
+             and locs[i][:-1] in missing for m in suggest(errs[i])}
+    keep = [i for i in keep if not (errs[i]["type"] == "missing" and locs[i] in meant)]
+    keep.sort(key=lambda i: errs[i]["type"] != "extra_forbidden")  # stable: file order
+    return "\n".join(f"{path}: {ln}" for ln in _capped_lines(root, errs, keep, suggest))
+
+
+def _capped_lines(root: type[BaseModel], errs: list[dict], keep: list[int],
+                  suggest: _Suggester) -> list[str]:
+    """The kept errors' lines, repeats once, at most :data:`MAX_ERROR_LINES` (the rest
+    counted in a last line, not rendered: thousands of unknown keys cost no suggestions)."""
+    said = False  # the walker vocabulary once, on the first line it applies to
+    lines: dict[str, None] = {}
+    for n, i in enumerate(keep):
+        if len(lines) == MAX_ERROR_LINES - 1 and len(keep) - n > 1:
+            return [*lines, f"… and {len(keep) - n} more errors"]
+        line = _error_line(root, errs[i], suggest)
+        if not said and _walker_vocabulary_applies(root, errs[i], suggest):
+            line, said = f"{line}; {WALKER_VOCABULARY}", True
+        lines[line] = None
+    return list(lines)
