@@ -47,3 +47,16 @@ def test_a_few_unknown_keys_are_all_listed_with_their_suggestion():
     lines = str(pytest.raises(SceneError, scene_from_dict, data, "s.yaml").value).splitlines()
     assert lines == ["s.yaml: slop: unknown field (did you mean slope?)",
                      "s.yaml: zzz: unknown field"]
+
+
+# ------------------------------------------------------------- 2: a NUL byte in a scene
+def test_a_nul_byte_in_a_scene_is_one_line_naming_the_file_and_line(tmp_path):
+    f = tmp_path / "nul.yaml"
+    f.write_bytes((ROOT / "configs" / "simplest.yaml").read_bytes() + b"\nextra: 1\x00\n")
+    code, err, _ = _cli("fixedpoint", f, "--runs-dir", tmp_path / "runs")
+    assert code == 1
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"error: {f}: line ") and "0x00" in lines[0]
+    with pytest.raises(SceneError, match=r"nul.yaml: line \d+: character 0x00 "):
+        load_scene(f)
