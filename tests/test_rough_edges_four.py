@@ -60,3 +60,64 @@ def test_a_nul_byte_in_a_scene_is_one_line_naming_the_file_and_line(tmp_path):
     assert lines[0].startswith(f"error: {f}: line ") and "0x00" in lines[0]
     with pytest.raises(SceneError, match=r"nul.yaml: line \d+: character 0x00 "):
         load_scene(f)
+
+
+# ------------------------------------------------------- 3: --param of a continuation
+def _one_line(*args) -> str:
+    code, err, _ = _cli(*args)
+    assert code == 1, (code, err)
+    assert len(err.splitlines()) == 1, err
+    return err
+
+
+@pytest.mark.filterwarnings("error")
+def test_a_continuation_to_infinity_is_one_line_and_no_numpy_warning(tmp_path):
+    err = _one_line("continuation", ROOT / "configs" / "paper.yaml", "--param",
+                    "slope.angle_deg=1:inf", "--runs-dir", tmp_path)
+    assert err == "error: --param slope.angle_deg: stop inf is not a finite number"
+
+
+@pytest.mark.parametrize("param2", ["slope.angle_deg=1:2", "slope.angle_rad=0.01:0.02"])
+def test_param2_the_same_field_as_param_is_refused(tmp_path, param2):
+    err = _one_line("continuation", ROOT / "configs" / "paper.yaml", "--param",
+                    "slope.angle_deg=1:2", "--param2", param2, "--runs-dir", tmp_path)
+    assert "the same field as --param slope.angle_deg" in err
+
+
+def test_an_index_past_an_unnamed_list_says_its_indices(tmp_path):
+    err = _one_line("continuation", ROOT / "configs" / "asymmetric_legs.yaml", "--param",
+                    "walker.legs.5.length_m=0.9:1", "--runs-dir", tmp_path)
+    assert err.endswith("index 5 is out of range (the list has 2 items, indices 0-1)")
+    assert "None" not in err
+
+
+def test_a_continuation_over_a_whole_number_field_is_refused_as_typed(tmp_path):
+    err = _one_line("continuation", ROOT / "configs" / "paper.yaml", "--param",
+                    "simulate.strides=1:2", "--runs-dir", tmp_path)
+    assert err.startswith("error: --param simulate.strides: the field takes whole numbers")
+    assert "<sweep>" not in err and "2.0" not in err
+
+
+def test_a_fall_is_named_once():
+    from types import SimpleNamespace
+
+    from walkerlab.analysis.continuation.gait_map import _cause
+
+    walker = SimpleNamespace(phases=[])
+    seg = SimpleNamespace(termination="event", event="fall", phase_times={})
+    assert _cause(walker, seg) == "fall"
+    seg.event = "stance_heel_touches_down"
+    assert _cause(walker, seg) == "fall (stance_heel_touches_down)"
+
+
+def test_an_initial_guess_from_a_fifo_is_not_a_regular_file(tmp_path):
+    import os
+
+    fifo = tmp_path / "branch.h5"
+    os.mkfifo(fifo)
+    data = yaml.safe_load((ROOT / "configs" / "simplest.yaml").read_text())
+    data["fixedpoint"]["initial_guess"] = {"from": str(fifo), "at": 0.5}
+    scene = tmp_path / "s.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    err = _one_line("fixedpoint", scene, "--runs-dir", tmp_path / "runs")
+    assert err.endswith(f"{fifo}: not a regular file; give an HDF5 artifact")

@@ -24,6 +24,9 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     ------
     StageError
         No ``fixedpoint`` section, no gait at the scene's own value, or a bad ``switch``.
+    walkerlab.config.SceneError
+        A range or field the continuation cannot follow
+        (:func:`walkerlab.studies.continuation.check_continuation`; one line).
     walkerlab.studies.params.SweepError
         A field that does not exist (one line).
     """
@@ -37,18 +40,12 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
         two_parameter_figure,
     )
     from walkerlab.plotting.figures import save
-    from walkerlab.studies.continuation import run_continuation, scene_family
-    from walkerlab.studies.params import SweepError
+    from walkerlab.studies.continuation import check_continuation, run_continuation
 
     require(scene, "fixedpoint", "continuation")
     if switch not in (0, 1, 2):
         raise StageError(f"--switch: {switch} is not 0, 1 or 2 (period doublings to follow)")
-    scene_family(scene, path)  # an unknown field: one line before anything runs
-    if path2 is not None:
-        try:
-            scene_family(scene, path2)
-        except SweepError as exc:
-            raise SweepError(str(exc).replace("--param ", "--param2 ", 1)) from None
+    start, stop, range2 = check_continuation(scene, path, start, stop, path2, range2)
     stem = check_name(f"continuation_{path}", "--param field")
     key = json.dumps({"param": path, "range": [start, stop], "switch": switch,
                       "param2": path2, "range2": list(range2) if range2 else None})
