@@ -164,3 +164,25 @@ def test_the_api_refuses_what_the_command_refuses_in_one_line(tmp_path, call, sa
         call(wl, tmp_path)
     assert says in str(exc.value) and "\n" not in str(exc.value)
     assert not list(tmp_path.rglob("*.h5"))  # refused before anything ran
+
+
+# ------------------------------------------------ 5: an uphill no-gait message, whole
+def test_an_uphill_no_gait_message_ends_its_clauses(tmp_path):
+    d = yaml.safe_load(PAPER.read_text())
+    d["slope"] = {"angle_rad": -0.0174}
+    scene = tmp_path / "uphill.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    err = _one_line("fixedpoint", scene, "--runs-dir", tmp_path / "runs")
+    assert "downhill slope" in err and "try a continuation" in err
+    # what was tried is printed whole: no sentence or parenthesis left open
+    assert "scale-free seeds (45 fell within the first step)" in err
+    assert "[tried the initial guess and 0 of 45" in err
+
+
+def test_a_long_detail_is_cut_between_clauses():
+    from walkerlab.cli.errors import one_line
+
+    advice = "no gait; " + "advice " * 38
+    detail = "[tried a and b (3 fell within the first step); last: " + "word " * 40 + "]"
+    line = one_line(advice + detail)
+    assert line.startswith(advice + "[tried a and b (3 fell within the first step) ... rerun")
