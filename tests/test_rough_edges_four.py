@@ -186,3 +186,13 @@ def test_a_long_detail_is_cut_between_clauses():
     detail = "[tried a and b (3 fell within the first step); last: " + "word " * 40 + "]"
     line = one_line(advice + detail)
     assert line.startswith(advice + "[tried a and b (3 fell within the first step) ... rerun")
+
+
+# --------------------------------------- 6: a knee at the walker's level, not the leg's
+@pytest.mark.parametrize("scene, meant", [("asymmetric_legs.yaml", "legs.N.knee"),
+                                          ("paper_rods.yaml", "leg.knee")])
+def test_a_knee_given_to_the_walker_points_to_the_leg(scene, meant):
+    d = yaml.safe_load((ROOT / "configs" / scene).read_text())
+    d["walker"]["knee"] = {"thigh_length_m": 0.5}
+    lines = str(pytest.raises(SceneError, scene_from_dict, d, "s.yaml").value).splitlines()
+    assert lines == [f"s.yaml: walker.knee: unknown field (did you mean {meant}?)"]

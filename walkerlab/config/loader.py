@@ -166,7 +166,7 @@ def scene_from_dict(data: dict[str, Any], origin: str | Path = "<scene>") -> Sce
     try:
         return Scene.model_validate(data)
     except ValidationError as err:
-        raise SceneError(format_error(Path(str(origin)), err, Scene)) from None
+        raise SceneError(format_error(Path(str(origin)), err, Scene, data)) from None
 
 def validate_option(model: type[BaseModel], field: str, value: Any, option: str,
                     yaml_field: str | None = None) -> Any:
