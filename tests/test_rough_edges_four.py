@@ -196,3 +196,30 @@ def test_a_knee_given_to_the_walker_points_to_the_leg(scene, meant):
     d["walker"]["knee"] = {"thigh_length_m": 0.5}
     lines = str(pytest.raises(SceneError, scene_from_dict, d, "s.yaml").value).splitlines()
     assert lines == [f"s.yaml: walker.knee: unknown field (did you mean {meant}?)"]
+
+
+# ------------------------------------ 7: the zero multipliers of this walker, not all
+@pytest.mark.parametrize("scene, names, says, not_said", [
+    ("kneed.yaml", ["swing_thigh_angle", "swing_shank_angle", "stance_angle"],
+     "swing knee is straight and locked", ("flat foot", "no mass")),
+    ("flat_feet.yaml", ["swing_angle", "stance_angle", "stance_ankle_angle"],
+     "flat foot lands", ("knee", "no mass")),
+    ("simplest.yaml", ["stance_angle", "hip_angle"], "swing leg has no mass",
+     ("knee", "flat foot")),
+])
+def test_the_verdict_names_only_the_zero_multipliers_that_apply(scene, names, says, not_said):
+    import json
+
+    import numpy as np
+
+    from walkerlab.config import load_scene
+    from walkerlab.report.text import zero_multipliers_text
+
+    sc = load_scene(ROOT / "configs" / scene)
+    n0 = 1 + (1 if scene == "simplest.yaml" else 2)
+    re = np.r_[np.zeros(n0), 0.5, 0.4]
+    text = zero_multipliers_text(re, np.zeros_like(re), names,
+                                 json.dumps(sc.model_dump(mode="json")))
+    assert text.startswith(f"{n0} multipliers are 0 by construction")
+    assert says in text and not any(w in text for w in not_said)
+    assert "e.g." not in text
