@@ -240,3 +240,81 @@ def test_the_readme_names_every_api_function_and_the_basin_file_a_grid_writes():
     row = next(ln for ln in (ROOT / "README.md").read_text().splitlines()
                if ln.startswith("| `walkerlab basin"))
     assert "`basin_<NX>x<NY>.h5`" in row and "`basin_40x40.h5`" in row
+
+
+# ------------------------------------------------------------------- 9: figure nits
+def test_fig9_caption_does_not_promise_a_panel_per_link_of_a_straight_leg():
+    from walkerlab.report.figures_section import CAPTIONS
+
+    cap = dict(CAPTIONS)["fig9_limit_cycles"]
+    assert "one panel per link" not in cap and "both legs in each panel" in cap
+
+
+def test_mfpt_log_axis_ticks_are_plain_numbers():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import numpy as np
+
+    from walkerlab.plotting.mfpt_figures import mfpt_figure
+
+    class D(dict):
+        sigma_rad = np.array([0.002, 0.003, 0.004])
+
+    d = D(mfpt_steps_montecarlo=np.array([5.5, 4.2, 3.1]),
+          mfpt_steps_montecarlo_stderr=np.array([0.2, 0.2, 0.1]),
+          mfpt_steps_mesh=np.array([5.4, 4.1, 3.2]), mesh_converged=np.ones(3))
+    fig = mfpt_figure(d)
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_yticklabels(minor=True) + ax.get_yticklabels()]
+    shown = [s for s in labels if s]
+    assert shown and not any("10^" in s or "times" in s or "×" in s for s in shown), shown
+    assert {"3", "4", "5"} <= set(shown)
+
+
+def test_table_2_comes_before_table_3_and_headings_are_capitalised(tmp_path, monkeypatch):
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from walkerlab.report import build, contact_sections, sections
+
+    monkeypatch.setattr(contact_sections, "initial_states_section",
+                        lambda scene, arts: ["## Table 2 — initial states", ""])
+    monkeypatch.setattr(sections, "gait_section",
+                        lambda scene, inputs, pub: ["## Table 3 — gait characteristics", ""])
+    scene = load_scene(PAPER)
+    build.write_report(scene, build.ReportInputs({}), tmp_path, tmp_path)
+    md = (tmp_path / "report.md").read_text()
+    assert md.index("## Table 2") < md.index("## Table 3")
+    c = SimpleNamespace(initial_rate_scale=np.array([1.0, 1.0]), rate_names=["leg1", "leg2"],
+                        adjust=None, samples=SimpleNamespace(coordinates={"leg1_angle": [0.2]}))
+    lines = contact_sections._initial_state_lines(c, {}, None, {})
+    assert lines[0] == "## Initial states (ideal vs contact model)"
+
+
+def test_limit_cycle_distance_column_has_a_unit():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from walkerlab.report.build import ReportInputs
+    from walkerlab.report.contact_sections import compare_section
+
+    c = SimpleNamespace(errors={"leg1_angle": np.array([0.01]), "leg1_rate": np.array([0.1])},
+                        limit_cycle_distance={"leg1": 0.02}, time=np.array([0.0, 1.0]),
+                        metrics={})
+    scene = load_scene(PAPER).model_copy(update={"published": None})
+    text = "\n".join(compare_section(scene, ReportInputs({"compare": c})))
+    assert "mean limit-cycle distance [rad, rad/s: in the (angle, rate) plane]" in text
+
+
+def test_the_notebook_basin_panel_names_its_axes_and_colours():
+    import json
+
+    nb = json.loads((ROOT / "examples" / "walkerlab_tour.ipynb").read_text())
+    cell = next("".join(c["source"]) for c in nb["cells"]
+                if "basin.outcome.plot" in "".join(c["source"]))
+    assert "ax[2].set_xlabel(" in cell and "ax[2].set_ylabel(" in cell  # not "cell centres"
+    assert "OUTCOME_COLORS" in cell and "ax[2].legend(" in cell  # each colour named

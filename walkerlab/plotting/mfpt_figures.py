@@ -6,6 +6,24 @@ from __future__ import annotations
 import numpy as np
 
 
+def plain_log_ticks(axis) -> None:
+    """Label a log axis's ticks as plain numbers (``3``, ``40``, ``1000``), not
+    ``3×10^0``: a step count reads as a count.  Minor ticks are labelled only where the
+    axis spans few decades (matplotlib's own thresholds), as by default."""
+    from matplotlib.ticker import FuncFormatter, LogFormatter
+
+    minor = LogFormatter(labelOnlyBase=False, minor_thresholds=(1, 0.4))
+
+    def plain(v, pos=None, _minor=False):
+        if _minor and not minor(v, pos):  # a minor tick matplotlib leaves unlabelled
+            return ""
+        return f"{v:,.0f}" if v >= 1 else f"{v:.3g}"
+
+    axis.set_major_formatter(FuncFormatter(plain))
+    axis.set_minor_formatter(FuncFormatter(lambda v, pos=None: plain(v, pos, True)))
+    minor.set_axis(axis)
+
+
 def mfpt_figure(d, title: str = ""):
     """log10 MFPT [steps] against sigma [rad]: Monte Carlo with 2 standard errors, mesh.
 
@@ -38,6 +56,7 @@ def mfpt_figure(d, title: str = ""):
             ax.plot(s[okm & conv], me[okm & conv], "s", color="#d62728",
                     label="mesh, converged (< 5 % on refinement)")
     ax.set_yscale("log")
+    plain_log_ticks(ax.yaxis)
     ax.set_xlabel("per-step slope standard deviation sigma [rad]")
     ax.set_ylabel("MFPT [steps before the fall]")
     ax.grid(True, which="both", alpha=0.3)
