@@ -7,21 +7,17 @@ import numpy as np
 
 
 def plain_log_ticks(axis) -> None:
-    """Label a log axis's ticks as plain numbers (``3``, ``40``, ``1000``), not
-    ``3×10^0``: a step count reads as a count.  Minor ticks are labelled only where the
-    axis spans few decades (matplotlib's own thresholds), as by default."""
-    from matplotlib.ticker import FuncFormatter, LogFormatter
+    """Label a log axis's ticks as plain numbers (``3``, ``40``, ``1,000``), not
+    ``3×10^0``: a step count reads as a count.  Which ticks carry a label is matplotlib's
+    own choice (minor ticks only where the axis spans few decades)."""
+    from matplotlib.ticker import LogFormatter
 
-    minor = LogFormatter(labelOnlyBase=False, minor_thresholds=(1, 0.4))
+    class Plain(LogFormatter):
+        def _num_to_string(self, x, vmin, vmax):
+            return f"{x:,.0f}" if x >= 1 else f"{x:.3g}"
 
-    def plain(v, pos=None, _minor=False):
-        if _minor and not minor(v, pos):  # a minor tick matplotlib leaves unlabelled
-            return ""
-        return f"{v:,.0f}" if v >= 1 else f"{v:.3g}"
-
-    axis.set_major_formatter(FuncFormatter(plain))
-    axis.set_minor_formatter(FuncFormatter(lambda v, pos=None: plain(v, pos, True)))
-    minor.set_axis(axis)
+    axis.set_major_formatter(Plain(labelOnlyBase=True))
+    axis.set_minor_formatter(Plain(labelOnlyBase=False, minor_thresholds=(1, 0.4)))
 
 
 def mfpt_figure(d, title: str = ""):
