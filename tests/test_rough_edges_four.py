@@ -318,3 +318,59 @@ def test_the_notebook_basin_panel_names_its_axes_and_colours():
                 if "basin.outcome.plot" in "".join(c["source"]))
     assert "ax[2].set_xlabel(" in cell and "ax[2].set_ylabel(" in cell  # not "cell centres"
     assert "OUTCOME_COLORS" in cell and "ax[2].legend(" in cell  # each colour named
+
+
+# --------------------------------- 10: a continuation figure's stability is max|λ| < 1
+def _branch_data(mmax, special=None):
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    p = np.arange(len(mmax), dtype=float)
+    mult = np.c_[np.asarray(mmax, float), 0.1 * np.ones(len(mmax))].astype(complex)
+    b = {"period": 1, "param": p, "states": {"stance_angle": 0.2 + 0.01 * p},
+         "multipliers": mult, "stable": np.asarray(mmax) < 1}
+    return SimpleNamespace(branches=[b], special=special or {}, state_names=["stance_angle"],
+                           unit="deg", path="slope.angle_deg", start=0.0)
+
+
+def test_a_branch_is_drawn_stable_only_where_its_largest_multiplier_is_below_one():
+    import numpy as np
+
+    from walkerlab.plotting.continuation_figures import continuation_figure, stability_pieces
+
+    mmax = np.array([0.8, 0.9, 1.2, 1.1, 0.95])
+    pieces = stability_pieces(np.arange(5.0), np.zeros((5, 1)), mmax)
+    assert [st for *_x, st in pieces] == [True, False, True]
+    assert pieces[0][0][-1] == pytest.approx(1 + 0.1 / 0.3)  # |λ| = 1, linearly between
+    assert pieces[1][0][0] == pieces[0][0][-1] and pieces[1][2][0] == 1.0
+    fig = continuation_figure(_branch_data(mmax))
+    ax2 = fig.axes[1]
+    for line in ax2.get_lines():
+        y = np.asarray(line.get_ydata(), float)
+        if line.get_linestyle() == "-" and y.size > 1:
+            assert np.all(y <= 1.0 + 1e-12), y  # solid: stable
+        if line.get_linestyle() == "--":
+            assert np.all(y >= 1.0 - 1e-12), y
+
+
+def test_special_point_labels_stay_inside_the_axes_clear_of_their_markers():
+    import numpy as np
+
+    from walkerlab.plotting.continuation_figures import continuation_figure
+
+    sp = {"kind": np.array(["period_doubling", "branch_end"]), "param": np.array([1.0, 4.0]),
+          "period": np.array([1, 1]),
+          "states": {"stance_angle": np.array([0.21, 0.24])}}
+    fig = continuation_figure(_branch_data([0.8, 0.9, 1.2, 1.1, 1.3], sp))
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    box = ax.get_window_extent()
+    from matplotlib.text import Text
+
+    for t in ax.texts:
+        bb = Text.get_window_extent(t)  # the label itself, without its leader line
+        assert box.y0 - 1 <= bb.y0 and bb.y1 <= box.y1 + 1, t.get_text()  # not clipped
+        assert box.x0 - 1 <= bb.x0 and bb.x1 <= box.x1 + 1, t.get_text()
+        x, y = ax.transData.transform((float(t.xy[0]), float(t.xy[1])))
+        assert not (bb.x0 - 4 <= x <= bb.x1 + 4 and bb.y0 - 4 <= y <= bb.y1 + 4), t.get_text()
