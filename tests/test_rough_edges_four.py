@@ -359,9 +359,10 @@ def test_special_point_labels_stay_inside_the_axes_clear_of_their_markers():
 
     from walkerlab.plotting.continuation_figures import continuation_figure
 
-    sp = {"kind": np.array(["period_doubling", "branch_end"]), "param": np.array([1.0, 4.0]),
-          "period": np.array([1, 1]),
-          "states": {"stance_angle": np.array([0.21, 0.24])}}
+    # the third label of a point at the top: stacked highest, where it left the axes
+    sp = {"kind": np.array(["period_doubling", "fold", "branch_end"]),
+          "param": np.array([1.0, 2.0, 4.0]), "period": np.array([1, 1, 1]),
+          "states": {"stance_angle": np.array([0.21, 0.22, 0.24])}}
     fig = continuation_figure(_branch_data([0.8, 0.9, 1.2, 1.1, 1.3], sp))
     fig.canvas.draw()
     ax = fig.axes[0]
