@@ -375,3 +375,35 @@ def test_special_point_labels_stay_inside_the_axes_clear_of_their_markers():
         assert box.x0 - 1 <= bb.x0 and bb.x1 <= box.x1 + 1, t.get_text()
         x, y = ax.transData.transform((float(t.xy[0]), float(t.xy[1])))
         assert not (bb.x0 - 4 <= x <= bb.x1 + 4 and bb.y0 - 4 <= y <= bb.y1 + 4), t.get_text()
+
+
+# ------------------------------ 11: a two-parameter run keeps the one-parameter artifact
+def test_a_two_parameter_continuation_has_its_own_artifact_name():
+    from walkerlab.io.runpaths import continuation_stem
+
+    one = continuation_stem("walker.leg.bodies.rod.mass_kg")
+    two = continuation_stem("walker.leg.bodies.rod.mass_kg", "walker.hip_mass_kg")
+    assert one == "continuation_walker.leg.bodies.rod.mass_kg"
+    assert two == "continuation_walker.leg.bodies.rod.mass_kg+walker.hip_mass_kg"
+
+
+@pytest.mark.slow
+def test_switch_and_param2_runs_are_both_kept(tmp_path):
+    from walkerlab.io.schemas.continuation import load_continuation
+
+    scene, runs = ROOT / "configs" / "simplest.yaml", tmp_path / "runs"
+    base = ["continuation", scene, "--param", "slope.angle_rad=0.0085:0.0095", "--runs-dir",
+            runs]
+    code, err, out = _cli(*base, "--switch")
+    assert code == 0, err
+    code, err, out2 = _cli(*base, "--param2", "walker.leg.length_m=0.95:1.05")
+    assert code == 0, err
+    d = runs / "simplest"
+    one = load_continuation(d / "continuation_slope.angle_rad.h5")
+    two = load_continuation(d / "continuation_slope.angle_rad+walker.leg.length_m.h5")
+    assert not one.curves and {b["period"] for b in one.branches} >= {1}
+    assert len(one.branches) >= len(two.branches)
+    figs = d / "report" / "figures"
+    assert (figs / "continuation_slope.angle_rad.png").is_file()
+    assert (figs / "continuation_slope.angle_rad+walker.leg.length_m.png").is_file()
+    assert "continuation_slope.angle_rad+walker.leg.length_m.h5" in out2

@@ -160,7 +160,8 @@ def continuation(scene: Scene | str | Path | dict, param: str, start: float, sto
     walkerlab.io.schemas.continuation.ContinuationData
         ``branches`` (list: ``period``, ``param`` (N,) [unit], ``states`` by name, ``step_period``
         [s], ``multipliers`` (N, 2n), ``stable``), ``special`` (``kind``, ``param``,
-        ``period``, ``cause`` ...), ``curves``; read from ``continuation_<param>.h5``.
+        ``period``, ``cause`` ...), ``curves``; read from ``continuation_<param>.h5``
+        (``continuation_<param>+<param2>.h5`` with ``param2``).
 
     Raises
     ------

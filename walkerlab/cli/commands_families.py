@@ -125,7 +125,8 @@ def continuation(scene: Path | None = SceneArg,
                                                    "in the plane of both fields"),
                  runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Pseudo-arclength continuation of the scene's gait over a field: folds, period
-    doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5."""
+    doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5
+    (continuation_<FIELD>+<FIELD2>.h5 with --param2)."""
     from walkerlab.stages import continuation as stage
 
     path, a, b = _range_spec(param, "--param")
