@@ -407,3 +407,38 @@ def test_switch_and_param2_runs_are_both_kept(tmp_path):
     assert (figs / "continuation_slope.angle_rad.png").is_file()
     assert (figs / "continuation_slope.angle_rad+walker.leg.length_m.png").is_file()
     assert "continuation_slope.angle_rad+walker.leg.length_m.h5" in out2
+
+
+# ------------------------------------------- 12: demanding a stable gait (--require-stable)
+def test_require_stable_refuses_an_unstable_gait_in_one_line_and_keeps_the_artifact(tmp_path):
+    d = yaml.safe_load(PAPER.read_text())
+    d["slope"] = {"angle_deg": 12.0}
+    scene = tmp_path / "steep.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    runs = tmp_path / "runs"
+    code, err, out = _cli("fixedpoint", scene, "--runs-dir", runs)
+    assert code == 0 and "verdict: UNSTABLE" in out  # as before: the gait found, exit 0
+    code, err, out = _cli("fixedpoint", scene, "--runs-dir", runs, "--require-stable")
+    assert code == 1 and "verdict: UNSTABLE" in out
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("error: --require-stable: the gait found is unstable (largest "
+                          "|Floquet multiplier| ")
+    assert "no stable period-1 gait was found" in err
+    assert (runs / "steep" / "fixedpoint.h5").is_file()
+    code, err, _ = _cli("fixedpoint", PAPER, "--runs-dir", runs, "--require-stable")
+    assert code == 0, err
+
+
+def test_require_stable_names_a_stable_gait_the_policy_passed_over():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from walkerlab.report.text import unstable_gait_line
+
+    fp = SimpleNamespace(multipliers=np.array([2.4, 0.1]), step_period_s=0.61,
+                         units=SimpleNamespace(time="s"), gait_policy="short_period",
+                         gaits={"long_period": SimpleNamespace(stable=True),
+                                "short_period": SimpleNamespace(stable=False)})
+    line = unstable_gait_line(fp)
+    assert "the long-period gait is stable: set fixedpoint.gait: stable" in line

@@ -93,6 +93,21 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     return "\n".join(lines)
 
 
+def unstable_gait_line(fp: FixedPointArtifact) -> str:
+    """One line on an unstable selected gait: its largest |Floquet multiplier| and whether
+    any stable period-1 gait was found (``walkerlab fixedpoint --require-stable``)."""
+    mod = float(np.max(np.abs(fp.multipliers)))
+    n = max(len(fp.gaits), 1)
+    head = (f"the gait found is unstable (largest |Floquet multiplier| {mod:.4g} > 1, step "
+            f"period {fp.step_period_s:.6g} {fp.units.time}); ")
+    stable = [lab.replace("_", "-") for lab, g in fp.gaits.items() if g.stable]
+    if stable:  # the scene's policy chose another: say so
+        return head + (f"the {stable[0]} gait is stable: set fixedpoint.gait: stable (the "
+                       f"scene's {fp.gait_policy or 'policy'} chose the unstable one)")
+    return head + (f"no stable period-1 gait was found ({n} gait{'s' if n > 1 else ''} "
+                   "found, all unstable)")
+
+
 _GAIT_SOURCES = {"initial_guess": "root finder from the initial guess",
                  "seed": "root finder from a scale-free seed",
                  "deflation": "deflated root finder near the other gait"}
