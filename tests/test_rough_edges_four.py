@@ -442,3 +442,9 @@ def test_require_stable_names_a_stable_gait_the_policy_passed_over():
                                 "short_period": SimpleNamespace(stable=False)})
     line = unstable_gait_line(fp)
     assert "the long-period gait is stable: set fixedpoint.gait: stable" in line
+
+
+def test_a_field_given_one_section_too_high_points_to_its_section():
+    d = dict(SIMPLEST, angle_deg=2.0)
+    lines = str(pytest.raises(SceneError, scene_from_dict, d, "s.yaml").value).splitlines()
+    assert lines == ["s.yaml: angle_deg: unknown field (did you mean slope.angle_deg?)"]

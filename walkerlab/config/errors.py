@@ -146,7 +146,7 @@ class _Suggester:
             return close
         down = _one_level_down(self.root, at, key)
         given = _given_at(self.data, at) or {}
-        return [p for p in down if p.split(".")[0] in given] or down
+        return ([p for p in down if p.split(".")[0] in given] or down)[:3]
 
 
 #: What a walker can be today, said by an error on an unknown walker field or kind and by
