@@ -23,7 +23,7 @@ the product):
   ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``,
   ``compare``, ``basin`` and ``api.sweep`` (each returns an ``xarray.Dataset`` read from the
   stage's artifact; ``walkerlab.studies`` is the package of sweeps, basins and maps),
-  ``continuation`` (the loaded continuation artifact)
+  ``continuation`` (the loaded continuation artifact), ``mfpt`` (mean first-passage time)
 
 Importing the package has no side effects and loads no heavy optional package: the API's
 names are looked up on first use (PEP 562).
@@ -32,7 +32,7 @@ names are looked up on first use (PEP 562).
 __version__ = "0.1.0"
 
 _API = ("load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
-        "contact_simulate", "compare", "basin", "continuation", "Walker")
+        "contact_simulate", "compare", "basin", "continuation", "mfpt", "Walker")
 __all__ = ["__version__", "api", *_API]
 
 

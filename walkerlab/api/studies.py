@@ -118,13 +118,16 @@ def basin(scene: Scene | str | Path | dict, grid: tuple[int, int] | None = None,
     ------
     StageError
         No ``fixedpoint`` section or bad basin settings.
-    SceneError, ImportError
+    SceneError
+        ``grid`` not two whole numbers (a string such as ``"10x10"``, a single number) or
+        out of bounds, or as :func:`fixed_point`.
+    ImportError
         As :func:`fixed_point`.
     """
     from walkerlab.stages import pipeline
 
     out = pipeline.run("basin", as_scene(scene), runs_folder(runs_dir), force,
-                       grid=tuple(grid) if grid else None, workers=workers)
+                       grid=grid, workers=workers)
     return read_dataset(out.path)
 
 
@@ -157,21 +160,27 @@ def continuation(scene: Scene | str | Path | dict, param: str, start: float, sto
     walkerlab.io.schemas.continuation.ContinuationData
         ``branches`` (list: ``period``, ``param`` (N,) [unit], ``states`` by name, ``step_period``
         [s], ``multipliers`` (N, 2n), ``stable``), ``special`` (``kind``, ``param``,
-        ``period``, ``cause`` ...), ``curves``; read from ``continuation_<param>.h5``.
+        ``period``, ``cause`` ...), ``curves``; read from ``continuation_<param>.h5``
+        (``continuation_<param>+<param2>.h5`` with ``param2``).
 
     Raises
     ------
     walkerlab.stages.common.StageError
         No ``fixedpoint`` section or no gait at the scene's own value (one line).
+    SceneError
+        The checks of ``walkerlab continuation``
+        (:func:`walkerlab.studies.continuation.check_continuation`): ``param`` not a field
+        name, a bound not a finite number, ``start == stop``, a whole-number field,
+        ``param2`` without ``range2`` (or the reverse), ``range2`` not two numbers,
+        ``param2`` the same field as ``param`` (one line).
     walkerlab.studies.params.SweepError
         ``param`` names no field of the scene.
     """
     from walkerlab.io.schemas.continuation import load_continuation
     from walkerlab.stages import continuation as stage
 
-    out = stage.run(as_scene(scene), param, float(start), float(stop), 2 if switch else 0,
-                    param2, tuple(range2) if range2 is not None else None, runs_folder(runs_dir),
-                    force)
+    out = stage.run(as_scene(scene), param, start, stop, 2 if switch else 0, param2, range2,
+                    runs_folder(runs_dir), force)
     return load_continuation(out.path)
 
 
@@ -207,7 +216,10 @@ def mfpt(scene: Scene | str | Path | dict, sigma_rad: list[float] | None = None,
     StageError
         No ``fixedpoint`` section, bad settings, or a walker whose state coordinates are
         measured from the slope.
-    SceneError, ImportError
+    SceneError
+        ``sigma_rad`` not a list of positive numbers (a string, a single number), or as
+        :func:`fixed_point`.
+    ImportError
         As :func:`fixed_point`.
     """
     from walkerlab.stages import pipeline

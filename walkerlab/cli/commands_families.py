@@ -96,7 +96,8 @@ def bifurcation(scene: Path | None = SceneArg,
 
 
 def _range_spec(text: str, opt: str) -> tuple[str, float, float]:
-    """``FIELD=START:STOP`` -> (field, start, stop); one-line error otherwise."""
+    """``FIELD=START:STOP`` -> (field, start, stop); one-line error otherwise (the numbers
+    are checked by the stage, as for a call from Python)."""
     from walkerlab.studies.params import SweepError
 
     path, _, rhs = text.partition("=")
@@ -105,8 +106,6 @@ def _range_spec(text: str, opt: str) -> tuple[str, float, float]:
         if not path.strip() or len(parts) != 2:
             raise ValueError
         a, b = float(parts[0]), float(parts[1])
-        if not (a == a and b == b) or a == b:
-            raise ValueError
     except ValueError:
         raise SweepError(f"{opt} {text!r}: expected FIELD=START:STOP (two different "
                          "numbers in the field's unit)") from None
@@ -126,7 +125,8 @@ def continuation(scene: Path | None = SceneArg,
                                                    "in the plane of both fields"),
                  runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Pseudo-arclength continuation of the scene's gait over a field: folds, period
-    doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5."""
+    doublings, Neimark-Sacker points, branch ends; writes continuation_<FIELD>.h5
+    (continuation_<FIELD>+<FIELD2>.h5 with --param2)."""
     from walkerlab.stages import continuation as stage
 
     path, a, b = _range_spec(param, "--param")

@@ -17,15 +17,22 @@ def fixedpoint(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                known: Path | None = typer.Option(None, "--from", help="a scene whose gait is "
                                                  "known: continue it along the straight line "
                                                  "between the two scenes' numeric fields to "
-                                                 "this walker (homotopy)")) -> None:
+                                                 "this walker (homotopy)"),
+               require_stable: bool = typer.Option(False, "--require-stable",
+                                                   help="exit non-zero (one line) when the "
+                                                   "gait found is unstable: no stable "
+                                                   "period-1 gait was found")) -> None:
     """Find the period-1 gait: fixed point of the Poincaré map, step period, Floquet multipliers."""
     from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-    from walkerlab.report.text import fixedpoint_text
+    from walkerlab.report.text import fixedpoint_text, unstable_gait_line
     from walkerlab.stages import pipeline
 
     out = pipeline.run("fixedpoint", load(scene), runs_dir, force, known=known)
-    typer.echo(fixedpoint_text(load_fixedpoint(out.path)))
+    fp = load_fixedpoint(out.path)
+    typer.echo(fixedpoint_text(fp))
     typer.echo(status(out))
+    if require_stable and not fp.stable:  # the artifact stays: it holds what was found
+        fail(RuntimeError(f"--require-stable: {unstable_gait_line(fp)}"))
 
 
 @guard

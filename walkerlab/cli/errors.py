@@ -35,6 +35,16 @@ def _debug() -> bool:
     return os.environ.get(DEBUG_ENV, "").strip().lower() in DEBUG_ON
 
 
+def _word_end(text: str) -> int:
+    """Where to cut ``text`` at a space outside parentheses (-1: nowhere)."""
+    depth, cut = 0, -1
+    for i, c in enumerate(text):
+        depth += (c == "(") - (c == ")")
+        if c == " " and depth <= 0:
+            cut = i
+    return cut
+
+
 def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
     """A message as one line: its lines joined (a sentence wrapped over two lines stays
     whole); longer than ``limit``, it is cut after the last sentence or field boundary
@@ -47,9 +57,19 @@ def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
     if line.endswith("]") and 0 < start <= limit:
         more = f" ... rerun with {DEBUG_ENV}=1 for the rest]"
         detail = line[start:-1]
-        # up to 80 characters past the limit for the detail's start (what was tried)
-        cut = detail[:max(limit + 80 - start - len(more), 2)].rfind(" ")
-        return line[:start] + (detail[:cut].rstrip(",;:( ") if cut > 2 else " [") + more
+        # the detail's first clause (what was tried) whole, unless longer than a line of
+        # its own; further clauses ("; ") while they fit 80 characters past the limit:
+        # never cut inside a clause, a parenthesis or a sentence
+        clauses = detail.split("; ")
+        keep = clauses[0] if len(clauses[0]) <= 160 else ""
+        for c in clauses[1:] if keep else ():
+            if start + len(keep) + 2 + len(c) + len(more) > limit + 80:
+                break
+            keep += "; " + c
+        if not keep:  # one long clause: at a space outside parentheses
+            cut = _word_end(detail[:max(limit + 80 - start - len(more), 2)])
+            keep = detail[:cut].rstrip(",;:( ") if cut > 2 else " ["
+        return line[:start] + keep + more
     head = line[:limit]
     cut = max(head.rfind(sep) for sep in (". ", "; ", ": ", ", "))
     head = head[:cut + 1] if cut > limit // 3 else head[:head.rfind(" ")].rstrip()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections import Counter
 from pathlib import Path
 
 from pydantic import BaseModel, ValidationError
@@ -44,9 +45,9 @@ def _models_in(tp) -> list[type[BaseModel]]:
     return out
 
 
-def _fields_at(root: type[BaseModel], loc: tuple) -> list[str]:
-    """Field names allowed at a validation-error location (the union of the candidate
-    models' fields where a union leaves the model open); [] when it cannot be told."""
+def _models_at(root: type[BaseModel], loc: tuple) -> list[type[BaseModel]]:
+    """The models a validation-error location can be (several where a union leaves the
+    model open)."""
     import typing
 
     current: list[type[BaseModel]] = [root]
@@ -62,7 +63,47 @@ def _fields_at(root: type[BaseModel], loc: tuple) -> list[str]:
         tagged = [m for m in current if m.__name__ == p or any(
             typing.get_args(f.annotation) == (p,) for f in m.model_fields.values())]
         current = tagged or current
-    return sorted({k for m in current for k in m.model_fields})
+    return current
+
+
+def _fields_at(root: type[BaseModel], loc: tuple) -> list[str]:
+    """Field names allowed at a validation-error location (the union of the candidate
+    models' fields where a union leaves the model open); [] when it cannot be told."""
+    return sorted({k for m in _models_at(root, loc) for k in m.model_fields})
+
+
+def _is_list(tp) -> bool:
+    """Whether a field annotation holds a list or tuple (through Optional and Annotated)."""
+    import typing
+
+    return typing.get_origin(tp) in (list, tuple) or any(_is_list(a)
+                                                         for a in typing.get_args(tp))
+
+
+def _one_level_down(root: type[BaseModel], loc: tuple, key: str) -> list[str]:
+    """Where an unknown key is a field one section further down (``walker.knee`` ->
+    ``leg.knee``, ``legs.N.knee``): the dotted paths from ``loc``."""
+    out: list[str] = []
+    for m in _models_at(root, loc):
+        for name, f in m.model_fields.items():
+            if any(key in sub.model_fields for sub in _models_in(f.annotation)):
+                path = f"{name}.N.{key}" if _is_list(f.annotation) else f"{name}.{key}"
+                out += [path] if path not in out else []
+    return out
+
+
+def _given_at(data, loc: tuple):
+    """The mapping the user gave at a location (None when it cannot be followed)."""
+    for p in loc:
+        if isinstance(data, dict) and p in data:
+            data = data[p]
+        elif isinstance(data, list) and isinstance(p, int) and 0 <= p < len(data):
+            data = data[p]
+        elif not _loc_part(p):  # a union member's class name or a discriminator tag
+            continue
+        else:
+            return None
+    return data if isinstance(data, dict) else None
 
 
 def _input_text(value) -> str:
@@ -73,11 +114,39 @@ def _input_text(value) -> str:
     return repr(value)
 
 
-def _suggestion(root: type[BaseModel], e: dict) -> list[str]:
-    """The field an unknown key most likely meant ([] when none is close)."""
-    import difflib
+#: At most this many error lines for one scene; the rest are counted ("… and N more errors")
+MAX_ERROR_LINES = 20
 
-    return difflib.get_close_matches(str(e["loc"][-1]), _fields_at(root, tuple(e["loc"][:-1])), n=1)
+
+class _Suggester:
+    """The field an unknown key most likely meant ([] when none is close): a close name
+    at the same place, else the same name one section further down (``walker.knee`` on a
+    ``legs:`` walker -> ``legs.N.knee``; the sections the scene gives first).  The allowed
+    fields are looked up once per location: thousands of unknown keys in one mapping cost
+    one lookup, not thousands."""
+
+    def __init__(self, root: type[BaseModel], data=None) -> None:
+        self.root, self.data = root, data
+        self.fields: dict[tuple, list[str]] = {}
+        self.said: dict[tuple, list[str]] = {}
+
+    def __call__(self, e: dict) -> list[str]:
+        at, key = tuple(e["loc"][:-1]), str(e["loc"][-1])
+        if at not in self.fields:
+            self.fields[at] = _fields_at(self.root, at)
+        if (at, key) not in self.said:
+            self.said[at, key] = self._close(at, key)
+        return self.said[at, key]
+
+    def _close(self, at: tuple, key: str) -> list[str]:
+        import difflib
+
+        close = difflib.get_close_matches(key, self.fields[at], n=1)
+        if close:
+            return close
+        down = _one_level_down(self.root, at, key)
+        given = _given_at(self.data, at) or {}
+        return ([p for p in down if p.split(".")[0] in given] or down)[:3]
 
 
 #: What a walker can be today, said by an error on an unknown walker field or kind and by
@@ -85,20 +154,22 @@ def _suggestion(root: type[BaseModel], e: dict) -> list[str]:
 WALKER_VOCABULARY = (
     "a walker today is planar: model compass_gait (hip mass, one point mass per "
     "leg) or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
-    "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee, "
+    "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee "
+    "(with an optional spring-damper), "
     "foot kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "
     "dampers between links at the hip; torso: an upper body on a bisecting hip mechanism; "
     "actuation: a push-off impulse and hip torques on straight, point-footed legs, rigid "
-    "model); no elastic knees, knee or ankle actuators yet")
+    "model); no knee or ankle actuators yet")
 
 
-def _walker_vocabulary_applies(root: type[BaseModel], e: dict) -> bool:
+def _walker_vocabulary_applies(root: type[BaseModel], e: dict, suggest=None) -> bool:
     """An unknown kind, or an unknown key close to no field, inside ``walker``: the
     vocabulary's end rather than a typo."""
     if not e["loc"] or e["loc"][0] != "walker":
         return False
+    suggest = suggest or _Suggester(root)
     return e["type"] == "union_tag_invalid" or (e["type"] == "extra_forbidden"
-                                                 and not _suggestion(root, e))
+                                                 and not suggest(e))
 
 
 _BOUND_ERRORS = ("less_than", "less_than_equal", "greater_than", "greater_than_equal")
@@ -122,13 +193,14 @@ def _unit_hint(root: type[BaseModel], e: dict, parts: list) -> str:
         return f" ({v:g} m: a length in mm? {v:g} mm = {v / 1000:g} m)"
     return ""
 
-def _error_line(root: type[BaseModel], e: dict) -> str:
+def _error_line(root: type[BaseModel], e: dict, suggest=None) -> str:
     """One error as ``<field path>: <message>`` (an unknown key names the likely field)."""
     parts = [p for p in e["loc"] if _loc_part(p)]
     loc = ".".join(str(p) for p in parts)
     if e["type"] == "extra_forbidden":
-        close = _suggestion(root, e)
-        return f"{loc}: unknown field" + (f" (did you mean {close[0]}?)" if close else "")
+        close = (suggest or _Suggester(root))(e)
+        return f"{loc}: unknown field" + (f" (did you mean {' or '.join(close)}?)"
+                                          if close else "")
     msg = e["msg"].removeprefix("Value error, ").replace(
         " found using _walker_tag() ", " (walker.model) ") + _unit_hint(root, e, parts)
     if "input" in e and isinstance(e["input"], (bool, str, float, int)) \
@@ -152,33 +224,46 @@ def _error_line(root: type[BaseModel], e: dict) -> str:
     return f"{loc or '<scene>'}: {msg}"
 
 
-def format_error(path: Path, err: ValidationError, root: type[BaseModel]) -> str:
+def format_error(path: Path, err: ValidationError, root: type[BaseModel], data=None) -> str:
     """Every validation error, one line each, ``<file>: <field path>: <message>``.
 
     Unknown keys (pydantic's ``extra_forbidden``, at their own location) come first, with
     the closest allowed field name (``walker.hip_mas_kg: unknown field (did you mean
     hip_mass_kg?)``); a union (``'fixed_point' | StateSpec``) reports one error per member:
     only the members that went deepest into the mapping are kept, they name the offending
-    field; the other members are alternatives, not further errors.
+    field; the other members are alternatives, not further errors.  ``data``, the mapping
+    that failed (optional), narrows a suggestion to the sections it gives.
     """
     errs = err.errors()
     locs = [tuple(p for p in x["loc"] if _loc_part(p)) for x in errs]
-    keep = []
-    for i, x in enumerate(errs):
-        deeper = any(len(o) > len(locs[i]) and o[:len(locs[i])] == locs[i] for o in locs)
-        if deeper or (x["type"] in ("literal_error", "none_required")
-                      and sum(o == locs[i] for o in locs) > 1):
-            continue
-        keep.append(x)
-    keep = keep or errs[:1]
+    # linear in the number of errors: the strict prefixes of every location, once
+    prefixes = {o[:k] for o in locs for k in range(len(o))}
+    count = Counter(locs)
+    keep = [i for i, x in enumerate(errs)
+            if not (locs[i] in prefixes or (x["type"] in ("literal_error", "none_required")
+                                            and count[locs[i]] > 1))] or [0]
+    suggest = _Suggester(root, data)
     # a misspelt required key is one mistake: "unknown field (did you mean X?)" says it, so
     # the "X: Field required" it causes is left out
-    meant = {(*locs[errs.index(x)][:-1], m) for x in keep if x["type"] == "extra_forbidden"
-             for m in _suggestion(root, x)}
-    keep = [x for x in keep if not (x["type"] == "missing" and locs[errs.index(x)] in meant)]
-    keep.sort(key=lambda x: x["type"] != "extra_forbidden")  # stable: file order otherwise
-    said = next((x for x in keep if _walker_vocabulary_applies(root, x)), None)
-    lines = list(dict.fromkeys(_error_line(root, x)
-                               + (f"; {WALKER_VOCABULARY}" if x is said else "")
-                               for x in keep))  # the vocabulary once, on the first such line
-    return "\n".join(f"{path}: {ln}" for ln in lines)
+    missing = {locs[i][:-1] for i in keep if errs[i]["type"] == "missing"}
+    meant = {(*locs[i][:-1], m) for i in keep if errs[i]["type"] == "extra_forbidden"
+             and locs[i][:-1] in missing for m in suggest(errs[i])}
+    keep = [i for i in keep if not (errs[i]["type"] == "missing" and locs[i] in meant)]
+    keep.sort(key=lambda i: errs[i]["type"] != "extra_forbidden")  # stable: file order
+    return "\n".join(f"{path}: {ln}" for ln in _capped_lines(root, errs, keep, suggest))
+
+
+def _capped_lines(root: type[BaseModel], errs: list[dict], keep: list[int],
+                  suggest: _Suggester) -> list[str]:
+    """The kept errors' lines, repeats once, at most :data:`MAX_ERROR_LINES` (the rest
+    counted in a last line, not rendered: thousands of unknown keys cost no suggestions)."""
+    said = False  # the walker vocabulary once, on the first line it applies to
+    lines: dict[str, None] = {}
+    for n, i in enumerate(keep):
+        if len(lines) == MAX_ERROR_LINES - 1 and len(keep) - n > 1:
+            return [*lines, f"… and {len(keep) - n} more errors"]
+        line = _error_line(root, errs[i], suggest)
+        if not said and _walker_vocabulary_applies(root, errs[i], suggest):
+            line, said = f"{line}; {WALKER_VOCABULARY}", True
+        lines[line] = None
+    return list(lines)

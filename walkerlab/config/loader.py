@@ -131,6 +131,11 @@ def load_scene(path: str | Path) -> Scene:
     except RecursionError:
         raise SceneError(f"{path}: nesting too deep (at most {MAX_YAML_DEPTH} levels)") \
             from None
+    except yaml.reader.ReaderError as exc:  # a control character: say where, in one line
+        line = text.count("\n", 0, exc.position) + 1
+        code = exc.character if isinstance(exc.character, int) else ord(exc.character)
+        raise SceneError(f"{path}: line {line}: character 0x{code:02x} is not allowed in a "
+                         "YAML file (a binary or damaged file?)") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" line {mark.line + 1}" if mark is not None else ""
@@ -161,7 +166,7 @@ def scene_from_dict(data: dict[str, Any], origin: str | Path = "<scene>") -> Sce
     try:
         return Scene.model_validate(data)
     except ValidationError as err:
-        raise SceneError(format_error(Path(str(origin)), err, Scene)) from None
+        raise SceneError(format_error(Path(str(origin)), err, Scene, data)) from None
 
 def validate_option(model: type[BaseModel], field: str, value: Any, option: str,
                     yaml_field: str | None = None) -> Any:

@@ -39,6 +39,23 @@ def checked_workers(workers: int) -> int:
     return validate_option(CommandOptions, "workers", workers, "--workers")
 
 
+def _sequence(value, option: str, example: str) -> list:
+    """An option given as a sequence of values (a list from Python, parsed text from the
+    command line) as a list; a string or a single value refused in one line rather than
+    iterated character by character.
+
+    Raises
+    ------
+    SceneError
+        ``value`` is a string, bytes or not iterable.
+    """
+    from collections.abc import Iterable
+
+    if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
+        raise SceneError(f"{option} {value!r}: give a sequence of values, e.g. {example}")
+    return list(value)
+
+
 def mfpt_options(scene: Scene, sigma_rad: list[float] | None = None,
                  method: str | None = None, workers: int = 2) -> tuple[MfptSettings, int]:
     """The scene's ``mfpt`` section (defaults when absent) with ``--sigma-rad`` [rad] and
@@ -47,12 +64,14 @@ def mfpt_options(scene: Scene, sigma_rad: list[float] | None = None,
     Raises
     ------
     SceneError
-        An option out of bounds (one line, naming ``mfpt.sigma_rad`` / ``mfpt.method``).
+        An option out of bounds or ``sigma_rad`` not a sequence of numbers (one line, naming
+        ``mfpt.sigma_rad`` / ``mfpt.method``).
     """
     st = scene.mfpt or MfptSettings()
     if sigma_rad is not None:
-        sigma_rad = validate_option(MfptSettings, "sigma_rad", list(sigma_rad), "--sigma-rad",
-                                    "mfpt.sigma_rad")
+        sigma_rad = validate_option(MfptSettings, "sigma_rad",
+                                    _sequence(sigma_rad, "--sigma-rad", "[0.002, 0.004]"),
+                                    "--sigma-rad", "mfpt.sigma_rad")
     if method is not None:
         method = validate_option(MfptSettings, "method", method, "--method", "mfpt.method")
     workers = checked_workers(workers)
@@ -69,11 +88,13 @@ def basin_options(scene: Scene, grid: tuple[int, int] | None = None, workers: in
     Raises
     ------
     SceneError
-        A grid or worker count out of bounds (one line).
+        A grid that is not two whole numbers (a string, a single number), or a grid or
+        worker count out of bounds (one line).
     """
     st = scene.basin or BasinSettings()
     if grid is not None:
-        grid = validate_option(BasinSettings, "grid", tuple(grid), "--grid", "basin.grid")
+        grid = validate_option(BasinSettings, "grid", tuple(_sequence(grid, "--grid", "(40, 40)")),
+                               "--grid", "basin.grid")
     workers = checked_workers(workers)
     return tuple(grid or st.grid), workers
 

@@ -369,6 +369,10 @@ def open_artifact(path: Path, stage: str | None = None,
     """
     path = Path(path)
     if not path.is_file():
+        if path.is_dir():
+            raise ArtifactError(f"{path}: is a directory, not an artifact")
+        if path.exists():  # a FIFO, socket or device: opening it could block or read forever
+            raise ArtifactError(f"{path}: not a regular file; give an HDF5 artifact")
         raise ArtifactError(f"{path}: artifact not found (run its stage first)")
     try:
         f = h5py.File(path, "r")

@@ -183,6 +183,20 @@ def bifurcation_stem(path: str) -> str:
     return check_name(f"bifurcation_{path}", "--param field")
 
 
+def continuation_stem(path: str, path2: str | None = None) -> str:
+    """File stem of a continuation artifact: ``continuation_<path>`` over one field (with
+    or without period-doubling switches), ``continuation_<path>+<path2>`` for a run with
+    the two-parameter curves over ``path2``, so neither replaces the other.
+
+    Raises
+    ------
+    RunPathError
+        The fields do not make a safe file name (at most 100 characters).
+    """
+    return check_name(f"continuation_{path}" + (f"+{path2}" if path2 else ""),
+                      "--param field" + (" and --param2 field" if path2 else ""))
+
+
 def bifurcation_artifacts(scene, runs_root: Path | str) -> dict[str, Path]:
     """``{stem: path}`` of the scene's bifurcation artifacts over fields other than the
     slope (``bifurcation_<field>.h5``), sorted by name."""

@@ -2,11 +2,13 @@
 the loaded data only.
 
 - :func:`continuation_figure`: the branches (stance-leg angle just after each of the ``k``
-  heel strikes of a period-``k`` orbit) against the parameter, stable solid, unstable
-  dashed, period 1/2/4 in colours; special points marked and labelled; a branch of one
-  point drawn as a marker; the steady states of a brute-force ``bifurcation`` artifact over
-  the same field overlaid as dots; below, the largest |Floquet multiplier| of each branch.
-  Legends sit outside the axes, so they never cover data.
+  heel strikes of a period-``k`` orbit) against the parameter, stable (max |Floquet
+  multiplier| < 1, the line cut where it crosses 1) solid, unstable dashed, period 1/2/4 in
+  colours; special points marked and labelled (inside the axes, clear of the markers); a
+  branch of one point drawn as a marker; the steady states of a brute-force
+  ``bifurcation`` artifact over the same field overlaid as dots; below, the largest
+  |Floquet multiplier| of each branch.  Legends sit outside the axes, so they never cover
+  data.
 - :func:`two_parameter_figure`: fold / period-doubling curves in the plane of two fields.
 """
 
@@ -18,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-__all__ = ["continuation_figure", "two_parameter_figure"]
+__all__ = ["continuation_figure", "two_parameter_figure", "stability_pieces"]
 
 PERIOD_COLORS = {1: "tab:blue", 2: "tab:orange", 4: "tab:green", 8: "tab:purple"}
 MARKERS = {"fold": ("s", "tab:red", "F"), "period_doubling": ("o", "tab:red", "PD"),
@@ -31,16 +33,49 @@ def _y(data, states: dict) -> tuple[np.ndarray, str]:
         "after heel strike [deg]"
 
 
-def _runs(mask: np.ndarray):
-    """Index runs where ``mask`` is constant: (start, stop_inclusive, value)."""
-    out, i = [], 0
-    while i < mask.size:
-        j = i
-        while j + 1 < mask.size and mask[j + 1] == mask[i]:
-            j += 1
-        out.append((i, j, bool(mask[i])))
-        i = j + 1
-    return out
+def stability_pieces(p: np.ndarray, ys: np.ndarray, mmax: np.ndarray):
+    """A branch cut where its largest |Floquet multiplier| crosses 1: pieces ``(p, ys, mmax,
+    stable)``, stable exactly where ``mmax < 1``; the crossing (linear in ``mmax`` between
+    the two points that straddle it) ends one piece and starts the next, so the pieces
+    meet and no stable line is drawn where |multiplier| > 1.
+
+    Parameters
+    ----------
+    p : ndarray (N,)
+        Parameter along the branch.
+    ys : ndarray (N, k)
+        The plotted state at each of the ``k`` heel strikes.
+    mmax : ndarray (N,)
+        Largest |Floquet multiplier| [-].
+    """
+    stable = mmax < 1.0
+    pieces, start = [], (p[:1], ys[:1], mmax[:1])
+    for i in range(1, p.size):
+        if stable[i] == stable[i - 1]:
+            start = tuple(np.concatenate([a, b[i:i + 1]]) for a, b in zip(start, (p, ys, mmax)))
+            continue
+        t = (1.0 - mmax[i - 1]) / (mmax[i] - mmax[i - 1]) if mmax[i] != mmax[i - 1] else 0.5
+        t = float(np.clip(t, 0.0, 1.0))
+        cross = (p[i - 1:i] + t * (p[i:i + 1] - p[i - 1:i]),
+                 ys[i - 1:i] + t * (ys[i:i + 1] - ys[i - 1:i]), np.ones(1))
+        pieces.append((*(np.concatenate([a, b]) for a, b in zip(start, cross)),
+                       bool(stable[i - 1])))
+        start = tuple(np.concatenate([c, b[i:i + 1]]) for c, b in zip(cross, (p, ys, mmax)))
+    pieces.append((*start, bool(stable[-1])))
+    return pieces
+
+
+def _label_offset(ax, x: float, y: float, i: int) -> tuple[tuple[float, float], str, str]:
+    """Where a special point's label goes (offset points, vertical and horizontal
+    alignment): above a point in the lower half of the axes and below one in the upper
+    half, right of a point in the left half and left of one in the right half, so it stays
+    inside the axes; staggered by ``i`` so neighbouring labels do not overlap; clear of the
+    marker."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    up, right = y < 0.5 * (y0 + y1), x < 0.5 * (x0 + x1)
+    d = 9 + 11 * (i % 3)
+    return ((7 if right else -7, d if up else -d), "bottom" if up else "top",
+            "left" if right else "right")
 
 
 def continuation_figure(data, title: str = "", brute: dict | None = None):
@@ -78,21 +113,22 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
         y = ys[:, 0]
         mmax = np.max(np.abs(b["multipliers"]), axis=1)
         c = PERIOD_COLORS.get(k, "tab:gray")
-        for i, j, st in _runs(np.asarray(b["stable"], bool)):
-            sl = slice(i, j + 2)  # join to the next point, so runs meet
-            lab = f"period {k}, {'stable' if st else 'unstable'}"
-            lab = None if lab in seen else lab
-            seen.add(f"period {k}, {'stable' if st else 'unstable'}")
+        for pp, yy, mm, st in stability_pieces(p, ys, mmax):
+            key = f"period {k}, {'stable' if st else 'unstable'}"
+            lab = None if key in seen else key
+            seen.add(key)
             ls = "-" if st else "--"
-            if p.size == 1:
-                ax1.plot(p, y, "o", color=c, mfc=c if st else "w", label=lab)
-                ax2.plot(p, mmax, "o", color=c, mfc=c if st else "w")
+            if pp.size == 1:
+                ax1.plot(pp, yy[:, 0], "o", color=c, mfc=c if st else "w", label=lab)
+                ax2.plot(pp, mm, "o", color=c, mfc=c if st else "w")
             else:  # every heel strike of the period-k orbit: k curves
-                for h in range(ys.shape[1]):
-                    ax1.plot(p[sl], ys[sl, h], ls, color=c, lw=1.4,
+                for h in range(yy.shape[1]):
+                    ax1.plot(pp, yy[:, h], ls, color=c, lw=1.4,
                              label=lab if h == 0 else None, zorder=3)
-                ax2.plot(p[sl], mmax[sl], ls, color=c, lw=1.2, zorder=3)
+                ax2.plot(pp, mm, ls, color=c, lw=1.2, zorder=3)
     sp = data.special
+    ax1.margins(x=0.04, y=0.15)
+    labels = []
     for i, kind in enumerate(sp.get("kind", [])):
         mk, col, short = MARKERS.get(str(kind), ("*", "k", str(kind)))
         y, _ = _y(data, {n: np.atleast_1d(v)[i:i + 1] for n, v in sp["states"].items()})
@@ -104,12 +140,15 @@ def continuation_figure(data, title: str = "", brute: dict | None = None):
                  label=None if lab in seen else lab)
         seen.add(lab)
         if np.isfinite(y[0]):
-            ax1.annotate(f"{short}{int(sp['period'][i])} {pv:.5g}", (pv, y[0]),
-                         textcoords="offset points", xytext=(6, 8 + 12 * (i % 3)),
-                         fontsize=7, color=col, annotation_clip=True,
-                         ha="right" if i % 2 else "left")
+            labels.append((f"{short}{int(sp['period'][i])} {pv:.5g}", pv, y[0], col))
         ax2.axvline(pv, color=col, lw=0.5, ls=":")
-    ax1.margins(x=0.04, y=0.12)
+    for i, (text, pv, y0, col) in enumerate(labels):  # after the limits are known
+        off, va, ha = _label_offset(ax1, pv, y0, i)
+        ax1.annotate(text, (pv, y0), textcoords="offset points", xytext=off, fontsize=7,
+                     color=col, va=va, ha=ha, zorder=6, annotation_clip=True,
+                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none",
+                           "alpha": 0.85},
+                     arrowprops={"arrowstyle": "-", "color": col, "lw": 0.5})
     ax1.axvline(data.start, color="0.5", lw=0.6, ls="-.", label="start (the scene's gait)")
     ax1.set_ylabel(ylabel if data.branches else "")
     ax2.axhline(1.0, color="0.5", lw=0.8)

@@ -6,6 +6,20 @@ from __future__ import annotations
 import numpy as np
 
 
+def plain_log_ticks(axis) -> None:
+    """Label a log axis's ticks as plain numbers (``3``, ``40``, ``1,000``), not
+    ``3×10^0``: a step count reads as a count.  Which ticks carry a label is matplotlib's
+    own choice (minor ticks only where the axis spans few decades)."""
+    from matplotlib.ticker import LogFormatter
+
+    class Plain(LogFormatter):
+        def _num_to_string(self, x, vmin, vmax):
+            return f"{x:,.0f}" if x >= 1 else f"{x:.3g}"
+
+    axis.set_major_formatter(Plain(labelOnlyBase=True))
+    axis.set_minor_formatter(Plain(labelOnlyBase=False, minor_thresholds=(1, 0.4)))
+
+
 def mfpt_figure(d, title: str = ""):
     """log10 MFPT [steps] against sigma [rad]: Monte Carlo with 2 standard errors, mesh.
 
@@ -38,6 +52,7 @@ def mfpt_figure(d, title: str = ""):
             ax.plot(s[okm & conv], me[okm & conv], "s", color="#d62728",
                     label="mesh, converged (< 5 % on refinement)")
     ax.set_yscale("log")
+    plain_log_ticks(ax.yaxis)
     ax.set_xlabel("per-step slope standard deviation sigma [rad]")
     ax.set_ylabel("MFPT [steps before the fall]")
     ax.grid(True, which="both", alpha=0.3)

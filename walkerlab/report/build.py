@@ -132,6 +132,7 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
                               num(float(o.wall_time_s), 3)] for o in done]))
     if "fixedpoint" in arts:
         md += sections.fixedpoint_section(arts["fixedpoint"], pub)
+    md += contact_sections.initial_states_section(scene, arts)  # Table 2, then Table 3
     md += sections.gait_section(scene, inputs, pub)
     md += contact_sections.sections(scene, inputs)
     md += attribution_section(scene, arts)

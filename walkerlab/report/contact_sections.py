@@ -28,12 +28,27 @@ def _table2_note(pub) -> str:
                            for (_s, pm, pa), g in zip(rates, got)) + ".")
 
 
-def contact_section(scene, arts) -> list[str]:
+def initial_states_section(scene, arts) -> list[str]:
+    """The initial states of the ideal and contact walkers (the paper's Table 2 where the
+    scene has published ones): before the gait characteristics (Table 3), in the paper's
+    order."""
     c = arts.get("contact-sim")
     if c is None:
         return []
     pub = for_scene(scene)
     table2 = getattr(pub, "TABLE2", {})
+    return _initial_state_lines(c, arts, pub, table2)[:-1] + [
+        "", "(% columns: change of magnitude relative to the ideal value: ours, or the "
+        "published MATLAB one.)" if table2 else
+        "(% column: change of magnitude relative to our ideal value.)", ""]
+
+
+def contact_section(scene, arts) -> list[str]:
+    """The contact walker's run: its summary, parameters, outcome, slips, periodic gait,
+    drop test and stability maps (the initial states: :func:`initial_states_section`)."""
+    c = arts.get("contact-sim")
+    if c is None:
+        return []
     summ, stage_wall, cp = c.summary, c.stage_wall_time_s, c.contact_params_si
     term = c.termination
     outcome = (c.outcome, c.outcome_message)
@@ -47,7 +62,7 @@ def contact_section(scene, arts) -> list[str]:
     elif c.periodic is not None:
         g = c.periodic
         per = (g.step_period_s, g.step_length_m, g.multipliers, g.stable)
-    out = _initial_state_lines(c, arts, pub, table2) + [
+    out = [
            "## Contact walker (MSC ADAMS-style model)", "",
            _table(["quantity", "value", "unit"], _summary_rows(summ, stage_wall)
                   + [["termination", term, ""]]),
@@ -60,10 +75,7 @@ def contact_section(scene, arts) -> list[str]:
            "phase had not ended when the run did): " + ", ".join(num(v, 3) for v in slips)
            + (("; creep of both feet during double support [mm]: "
                + ", ".join(num(v, 3) for v in creep)) if creep is not None else "")
-           + "; step periods [s]: " + ", ".join(num(v, 4) for v in periods) + ".",
-           ("(% columns: change of magnitude relative to the ideal value: ours, or the "
-            "published MATLAB one.)" if table2 else
-            "(% column: change of magnitude relative to our ideal value.)"), ""]
+           + "; step periods [s]: " + ", ".join(num(v, 4) for v in periods) + ".", ""]
     if c.ledger is not None:
         w = c.ledger
         out += ["**Energy ledger of the powered contact run** (work integrals carried with the "
@@ -114,7 +126,8 @@ def _initial_state_lines(c, arts, pub, table2: dict) -> list[str]:
             "ours contact", "ours diff."]
     if not table2:
         head, rows = [head[0], *head[4:]], [[r[0], *r[4:]] for r in rows]
-    return [("## Table 2 — " if table2 else "## ") + "initial states (ideal vs contact model)",
+    return [("## Table 2 — initial states" if table2 else "## Initial states")
+            + " (ideal vs contact model)",
             "", _table(head, rows), "",
             f"Our contact walker starts from our ideal fixed point with the initial rates scaled "
             f"by [{', '.join(num(v, 3) for v in np.atleast_1d(scale))}] ("
@@ -233,11 +246,14 @@ def compare_section(scene, inputs) -> list[str]:
     return ["## Comparison ideal vs contact (Fig. 8)", "",
             f"Errors contact − ideal over the common span 0–{t_end:.2f} {u.time}:", "",
             _table(["leg", "max abs angle error [rad]",
-                    f"max abs rate error [{u.rate}]", "mean limit-cycle distance"], rows), "",
+                    f"max abs rate error [{u.rate}]",
+                    f"mean limit-cycle distance [rad, {u.rate}: in the (angle, rate) plane]"],
+                   rows), "",
             " ".join(prose), ""]
 
 
 def sections(scene, inputs) -> list[str]:
-    """All contact sections, in report order (``inputs``:
-    :class:`walkerlab.report.build.ReportInputs`)."""
+    """The contact sections after the gait characteristics, in report order (``inputs``:
+    :class:`walkerlab.report.build.ReportInputs`; the initial states come before them,
+    :func:`initial_states_section`)."""
     return contact_section(scene, inputs.artifacts) + compare_section(scene, inputs)

@@ -22,8 +22,9 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
      "(both at the same time since the start, so a different step period shows as a growing "
      "phase drift), right phase-aligned (both at the same fraction of the same step: the "
      "difference of the gaits themselves)."),
-    ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle, one "
-                          "panel per link, both legs in it)."),
+    ("fig9_limit_cycles", "Fig. 9 — limit cycles in the phase plane (rate vs angle; both "
+                          "legs in each panel: one panel for straight legs, thigh and shank "
+                          "panels for a kneed walker)."),
     ("fig10_energy", "Fig. 10 — kinetic, potential and total mechanical energy."),
     ("energy_ledger", "Energy ledger of the rigid walker: the sources (push-off, actuators' "
                       "positive work, gravity) and sinks (heel-strike and knee-strike "

@@ -187,7 +187,7 @@ def fixedpoint_section(fp, pub: ModuleType | None) -> list[str]:
                    for i, (a, b, c, d) in enumerate(zip(re, im, re2, im2))]),
             "", f"Max difference between the two: {num(fp.max_difference, 2)}. "
             f"Verdict: **{'stable' if fp.stable else 'unstable'}** "
-            f"({zero_multipliers_text(re, im)}).", ""]
+            f"({zero_multipliers_text(re, im, fp.state_names, fp.scene_json)}).", ""]
     return out
 
 

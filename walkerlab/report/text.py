@@ -20,19 +20,45 @@ def _fmt_mult(re, im) -> str:
     return ", ".join(f"{a:+.6f}{b:+.6f}j" if abs(b) > 0 else f"{a:+.6f}" for a, b in zip(re, im))
 
 
-def zero_multipliers_text(re, im) -> str:
-    """Why some Floquet multipliers are 0: the map lands on the heel-strike surface (and, for a
-    kneed walker, on the straight-knee surface; for the simplest walker, whose swing leg has
-    no mass, the post-impact swing rate is a function of the stance-leg state; a flat foot
-    lands at its ankle's rest angle and its foot slap locks it flat)."""
+def _massless_leg(walker: dict) -> bool:
+    """Whether a walker (a scene's ``walker`` mapping) has a leg that carries no mass."""
+    legs = walker.get("legs") or ([walker["leg"]] if walker.get("leg") else [])
+    return any(sum(float(b.get("mass_kg", 0.0)) for b in leg.get("bodies", ())) == 0.0
+               for leg in legs)
+
+
+def _fixed_by_impacts(state_names: list[str], walker: dict) -> list[tuple[int, str]]:
+    """The state combinations the impacts of this walker fix, as (how many, why)."""
+    out = []
+    if any("shank" in n for n in state_names):
+        out.append((2, "the swing knee is straight and locked after heel strike, its angle "
+                       "and rate fixed"))
+    if any("ankle" in n for n in state_names):
+        out.append((2, "the flat foot lands at its ankle's angle and its foot slap stops "
+                       "the foot turning"))
+    if _massless_leg(walker):
+        out.append((1, "the swing leg has no mass: its rate after heel strike follows from "
+                       "the stance leg's"))
+    return out
+
+
+def zero_multipliers_text(re, im, state_names: list[str] | None = None,
+                          scene_json: str = "{}") -> str:
+    """Why some Floquet multipliers are 0: the map lands on the heel-strike surface, and the
+    impacts of this walker fix more combinations of the state (a kneed walker's locked
+    swing knee, a flat foot's ankle, a massless swing leg's rate): only the reasons that
+    apply to the walker (its ``state_names`` and the scene of ``scene_json``) are named."""
+    import json
+
     n0 = int(np.sum(np.hypot(re, im) < 1e-9))
     if n0 <= 1:
         return "one multiplier is 0 by construction: the map lands on the heel-strike surface"
+    walker = json.loads(scene_json or "{}").get("walker") or {}
+    why = _fixed_by_impacts(list(state_names or []), walker)
+    said = ("; ".join(w for _n, w in why) if sum(n for n, _w in why) == n0 - 1 else "")
     return (f"{n0} multipliers are 0 by construction: the map lands on the heel-strike surface "
-            f"and the impacts fix {n0 - 1} more combination(s) of the state (e.g. a kneed "
-            "walker's straight, locked swing knee; the simplest walker's massless swing leg, "
-            "whose rate after heel strike follows from the stance leg's; a flat foot's ankle "
-            "angle after heel strike and its foot slap, which stops the foot turning)")
+            f"and the impacts fix {n0 - 1} more combination{'s' if n0 > 2 else ''} of the "
+            "state" + (f" ({said})" if said else ""))
 
 
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
@@ -62,9 +88,24 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     mod = float(np.max(np.hypot(re, im)))
     verdict = "STABLE" if fp.stable else "UNSTABLE"
     lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; "
-                 f"{zero_multipliers_text(re, im)})")
+                 f"{zero_multipliers_text(re, im, fp.state_names, fp.scene_json)})")
     lines += gaits_text(fp)
     return "\n".join(lines)
+
+
+def unstable_gait_line(fp: FixedPointArtifact) -> str:
+    """One line on an unstable selected gait: its largest |Floquet multiplier| and whether
+    any stable period-1 gait was found (``walkerlab fixedpoint --require-stable``)."""
+    mod = float(np.max(np.abs(fp.multipliers)))
+    n = max(len(fp.gaits), 1)
+    head = (f"the gait found is unstable (largest |Floquet multiplier| {mod:.4g} > 1, step "
+            f"period {fp.step_period_s:.6g} {fp.units.time}); ")
+    stable = [lab.replace("_", "-") for lab, g in fp.gaits.items() if g.stable]
+    if stable:  # the scene's policy chose another: say so
+        return head + (f"the {stable[0]} gait is stable: set fixedpoint.gait: stable (the "
+                       f"scene's {fp.gait_policy or 'policy'} chose the unstable one)")
+    return head + (f"no stable period-1 gait was found ({n} gait{'s' if n > 1 else ''} "
+                   "found, all unstable)")
 
 
 _GAIT_SOURCES = {"initial_guess": "root finder from the initial guess",

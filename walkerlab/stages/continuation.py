@@ -1,6 +1,8 @@
 """Stage ``continuation``: the scene's gait continued over a scene field, special points,
 period-doubling switches, optional two-parameter curves -> ``continuation_<field>.h5``
-(:mod:`walkerlab.io.schemas.continuation`) and its figure(s) in the report's figures folder.
+(``continuation_<field>+<field2>.h5`` with the curves over a second field, so a
+two-parameter run keeps the one-parameter run's artifact;
+:mod:`walkerlab.io.schemas.continuation`) and its figure(s) in the report's figures folder.
 The computation is :func:`walkerlab.studies.continuation.run_continuation`."""
 
 from __future__ import annotations
@@ -18,17 +20,21 @@ SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
 def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
         path2: str | None = None, range2: tuple | None = None, runs_root: Path | str = "runs",
         force: bool = False) -> StageOutcome:
-    """Compute (or reuse) ``continuation_<path>.h5`` and draw ``continuation_<path>.png``.
+    """Compute (or reuse) ``continuation_<path>.h5`` (``continuation_<path>+<path2>.h5``
+    with ``path2``) and draw its figures under the same name.
 
     Raises
     ------
     StageError
         No ``fixedpoint`` section, no gait at the scene's own value, or a bad ``switch``.
+    walkerlab.config.SceneError
+        A range or field the continuation cannot follow
+        (:func:`walkerlab.studies.continuation.check_continuation`; one line).
     walkerlab.studies.params.SweepError
         A field that does not exist (one line).
     """
     from walkerlab.analysis.continuation.gait_map import MapFailed
-    from walkerlab.io.runpaths import bifurcation_artifacts, check_name
+    from walkerlab.io.runpaths import bifurcation_artifacts, continuation_stem
     from walkerlab.io.schemas.bifurcation import load_bifurcation
     from walkerlab.io.schemas.continuation import continuation_writer, load_continuation
     from walkerlab.plotting.continuation_figures import (
@@ -37,19 +43,13 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
         two_parameter_figure,
     )
     from walkerlab.plotting.figures import save
-    from walkerlab.studies.continuation import run_continuation, scene_family
-    from walkerlab.studies.params import SweepError
+    from walkerlab.studies.continuation import check_continuation, run_continuation
 
     require(scene, "fixedpoint", "continuation")
     if switch not in (0, 1, 2):
         raise StageError(f"--switch: {switch} is not 0, 1 or 2 (period doublings to follow)")
-    scene_family(scene, path)  # an unknown field: one line before anything runs
-    if path2 is not None:
-        try:
-            scene_family(scene, path2)
-        except SweepError as exc:
-            raise SweepError(str(exc).replace("--param ", "--param2 ", 1)) from None
-    stem = check_name(f"continuation_{path}", "--param field")
+    start, stop, range2 = check_continuation(scene, path, start, stop, path2, range2)
+    stem = continuation_stem(path, path2)
     key = json.dumps({"param": path, "range": [start, stop], "switch": switch,
                       "param2": path2, "range2": list(range2) if range2 else None})
 

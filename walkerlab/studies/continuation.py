@@ -24,8 +24,9 @@ from walkerlab.config import Scene, SceneError
 from walkerlab.integrate.solver import Solver
 from walkerlab.studies.params import ParamAxis, apply_point, axis_unit, check_axes
 
-__all__ = ["scene_family", "scene_value", "run_continuation", "numeric_fields",
-           "homotopy_family", "homotopy_gait", "known_scene", "homotopy_start"]
+__all__ = ["scene_family", "scene_value", "check_continuation", "run_continuation",
+           "numeric_fields", "homotopy_family", "homotopy_gait", "known_scene",
+           "homotopy_start"]
 
 #: top-level sections that do not describe the rigid walker (left out of a homotopy)
 NOT_WALKER = ("name", "source", "published", "fixedpoint", "simulate", "contact", "units",
@@ -66,6 +67,84 @@ def scene_value(scene: Scene, path: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise SceneError(f"{path}: the scene's value {v!r} is not a number")
     return float(v)
+
+
+def _finite(value, what: str) -> float:
+    """A range bound as a float; one line when it is not a finite real number."""
+    import numbers
+
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) \
+            or not math.isfinite(value):
+        raise SceneError(f"{what} {value!r} is not a finite number")
+    return float(value)
+
+
+def _field_range(scene: Scene, opt: str, path, start, stop) -> tuple[float, float]:
+    """One field and its range checked (as :func:`check_continuation`)."""
+    from walkerlab.studies.params import SweepError, takes_whole_numbers
+
+    if not isinstance(path, str) or not path:
+        raise SceneError(f"{opt}: give a dotted numeric scene field (e.g. slope.angle_deg), "
+                         f"got {path!r}")
+    a, b = _finite(start, f"{opt} {path}: start"), _finite(stop, f"{opt} {path}: stop")
+    if a == b:
+        raise SceneError(f"{opt} {path}: start and stop are both {a:g}; a continuation "
+                         "needs a range: FIELD=START:STOP with two different numbers")
+    try:
+        scene_family(scene, path)  # an unknown field: one line before anything runs
+        whole = takes_whole_numbers(scene, ParamAxis(path, (), path))
+    except SweepError as exc:
+        raise SweepError(str(exc).replace("--param ", f"{opt} ", 1)) from None
+    if whole:
+        raise SceneError(f"{opt} {path}: the field takes whole numbers; a continuation "
+                         "follows a real-valued field (e.g. slope.angle_deg or a body's "
+                         "mass_kg)")
+    return a, b
+
+
+def check_continuation(scene: Scene, path, start, stop, path2=None, range2=None
+                       ) -> tuple[float, float, tuple[float, float] | None]:
+    """The fields and ranges of a continuation checked before anything runs (the command
+    line's ``--param`` / ``--param2`` and the Python front door's arguments alike).
+
+    Parameters
+    ----------
+    path, start, stop
+        The continued field and its range [the field's unit].
+    path2, range2
+        The second field of the two-parameter curves and its (start, stop), both or neither.
+
+    Returns
+    -------
+    start, stop : float
+    range2 : (float, float) or None
+
+    Raises
+    ------
+    SceneError
+        A field that is not a string, a bound that is not a finite number, equal bounds, an
+        integer field, ``path2`` without ``range2`` (or the reverse), ``range2`` not two
+        numbers, or ``path2`` the same field as ``path`` (one line).
+    walkerlab.studies.params.SweepError
+        A field the scene does not have (one line, with the closest name).
+    """
+    a, b = _field_range(scene, "--param", path, start, stop)
+    if path2 is None:
+        if range2 is not None:
+            raise SceneError("--param2: range2 given without param2 (the second field)")
+        return a, b, None
+    if range2 is None:
+        raise SceneError(f"--param2 {path2}: no range; give FIELD2=START:STOP "
+                         "(param2 with range2=(start, stop) in Python)")
+    if isinstance(range2, (str, bytes)) or not hasattr(range2, "__len__") or len(range2) != 2:
+        raise SceneError(f"--param2 {path2}: range2 must be two numbers (start, stop), "
+                         f"got {range2!r}")
+    from walkerlab.studies.params import EXCLUSIVE_FIELDS
+
+    if path2 in (path, EXCLUSIVE_FIELDS.get(path)):
+        raise SceneError(f"--param2 {path2}: the same field as --param {path}; the "
+                         "two-parameter curves need a second field")
+    return a, b, _field_range(scene, "--param2", path2, *range2)
 
 
 def run_continuation(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
@@ -110,7 +189,7 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
     p0 = scene_value(scene, path)
     lo, hi = min(start, stop), max(start, stop)
     at = scene if lo <= p0 <= hi else apply_point(scene.model_dump(mode="json"), [path],
-                                                  (min(max(p0, lo), hi),))
+                                                  (min(max(p0, lo), hi),), "<continuation>")
     try:
         _w, gait, _src = ideal_fixed_point(at, None)
     except PointOutcome as exc:

@@ -181,18 +181,20 @@ def list_item(items: list, key: str, path: str):
         No such item (the message lists the names and the index range).
     """
     names = [it.get("name") for it in items if isinstance(it, dict)]
+    named = ", ".join(str(n) for n in names if n is not None)
     if key.isdigit():
         if int(key) < len(items):
             return items[int(key)]
         raise SceneError(f"{path}: index {key} is out of range (the list has {len(items)} "
-                         f"items: {', '.join(map(str, names)) or 'none'})")
+                         + (f"items, indices 0-{len(items) - 1}" if items else "items")
+                         + (f": {named})" if named else ")"))
     hits = [it for it in items if isinstance(it, dict) and it.get("name") == key]
     if len(hits) == 1:
         return hits[0]
     close = difflib.get_close_matches(key, [str(n) for n in names], 1)
     raise SceneError(f"{path}: no item named {key!r}"
                      + (f" (did you mean {close[0]!r}?)" if close else "")
-                     + f"; items: {', '.join(map(str, names)) or 'none'} "
+                     + f"; items: {named or 'none named'} "
                      f"(or by index 0-{max(len(items) - 1, 0)})")
 
 

@@ -109,7 +109,7 @@ def _cause(walker: HybridWalker, seg) -> str:
         return "swing foot scuffing"
     if seg.event == "swing_leg_falls_back":
         return "no heel strike (the swing leg falls back)"
-    return f"fall ({seg.event})" if seg.event else "fall"
+    return f"fall ({seg.event})" if seg.event not in ("", None, "fall") else "fall"
 
 
 def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,

@@ -211,6 +211,8 @@ class FixedPointArtifact(GaitResult):
         Every gait found, by label.
     variants : dict[str, GaitResult]
         Every equation variant solved, by name (``error`` set where none was found).
+    scene_json : str
+        The resolved scene the gait was computed for (JSON).
     """
 
     path: Path = Path()
@@ -225,6 +227,7 @@ class FixedPointArtifact(GaitResult):
     gait_notes: list = field(default_factory=list)
     gaits: dict = field(default_factory=dict)
     variants: dict = field(default_factory=dict)
+    scene_json: str = "{}"
 
 
 def load_fixedpoint(path: Path) -> FixedPointArtifact:
@@ -249,4 +252,4 @@ def load_fixedpoint(path: Path) -> FixedPointArtifact:
             gaits={str(lab): _gait(f[f"gaits/{lab}"], names)
                    for lab in f.attrs.get("gaits", [])} if "gaits" in f else {},
             variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
-            if "variants" in f else {})
+            if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")))
