@@ -167,3 +167,19 @@ def test_a_benchmark_never_reports_a_target_on_a_run_that_stopped_early():
     assert case.error(short) == np.inf
     case.ref = short
     assert case.error(full) == np.inf
+
+
+def test_the_upper_body_walker_makes_five_strides_from_its_contact_periodic_gait():
+    """configs/torso_bhm.yaml: from the adjusted rigid start the footfalls drift off the
+    0.1 m patches and a foot in a gap enters a patch's side at 8.69 s, where the solver
+    stops (before: reported as a solver failure, "Excess work done"; now a trip).  From the
+    contact model's own periodic gait (patches at its footfalls) it makes 5 strides."""
+    from walkerlab.analysis.contact.periodic import ideal_gait, simulate_from_periodic_gait
+    from walkerlab.config import load_scene
+    from walkerlab.models.contact.scene import contact_setup
+
+    scene = load_scene(ROOT / "configs" / "torso_bhm.yaml")
+    assert scene.contact_sim.n_strides == 5 and scene.contact_sim.start == "periodic_gait"
+    _, res, *_ = simulate_from_periodic_gait(contact_setup(scene), ideal_gait(scene).x)
+    assert res.outcome.kind == "heel_strike", res.outcome
+    assert len(res.heel_strike_times) >= 10

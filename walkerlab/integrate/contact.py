@@ -61,7 +61,7 @@ from .solver import Solver
 
 __all__ = ["CHUNK_WALL_S", "CYRK_STEPS_PER_CALL", "METHODS", "ContactIntegration",
            "ContactLimits", "first_event", "hermite_root", "hermite_state",
-           "integrate_contact", "sample_grid"]
+           "integrate_contact", "sample_grid", "trip_or_failure"]
 
 #: Solver methods this module runs.
 METHODS = ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853",
@@ -452,7 +452,9 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             term = RunEnd(event[0])
             break
         if not ok:
-            term, msg = RunEnd.SOLVER_FAILURE, str(m)
+            term, msg, event = trip_or_failure(walker, float(t_all[-1]), X_all[-1], str(m),
+                                               len(t_all) - 1, 2.0 / rate)
+            guarded = True  # the last sample is the run's end (no event state to interpolate)
             break
         if time.perf_counter() > deadline and t_all[-1] < t1 - 1e-12:
             term, msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
@@ -465,6 +467,22 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
     if event is not None and not guarded:  # cut at the event and append the event state
         t_all, X_all, msg = _cut_at_event(walker, t_all, X_all, event, term)
     return t_all, X_all, nfev, njev, term, msg, event
+
+
+def trip_or_failure(walker, t_last: float, x_last, message: str, k_last: int,
+                    ahead_s: float) -> tuple[RunEnd, str, tuple | None]:
+    """How a run ends when its solver fails at the sample ``k_last`` (time ``t_last`` [s],
+    state ``x_last``): a trip when a foot below the patch tops in a gap reaches a patch's
+    side within ``ahead_s`` [s] (:func:`~walkerlab.models.contact.energy.side_entry`: the
+    force jump no step can cross, a walker whose footfalls drifted off the patches), else a
+    solver failure with ``message``.  Returns ``(termination, message, event or None)``."""
+    hit = side_entry(walker, x_last, ahead_s)
+    if hit is None:
+        return RunEnd.SOLVER_FAILURE, message, None
+    foot, edge, ahead, depth = hit
+    return (RunEnd.TRIP, f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
+            f"entered a patch from its side (the solver stopped there: {message})",
+            (RunEnd.TRIP.value, k_last, float(t_last) + ahead, foot, edge))
 
 
 def _energy_guard_end(walker, ta, xa, tn, Xn, bad: int, n_prev: int, e_bound: float,

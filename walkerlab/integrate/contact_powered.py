@@ -117,23 +117,6 @@ def _fall_event(walker, limits):
     return fall
 
 
-def _failure(walker, t_last, x_last, message):
-    """How a run ends when a segment fails at ``(t_last, x_last)``: a trip when a foot in a
-    gap below the patch tops is about to enter a patch's side
-    (:func:`walkerlab.models.contact.energy.side_entry`), else a solver failure.
-    Returns ``(termination, message, event or None)``; the event's sample index is filled
-    in by the caller."""
-    from walkerlab.models.contact.energy import side_entry
-
-    hit = side_entry(walker, x_last, 0.01)
-    if hit is None:
-        return RunEnd.SOLVER_FAILURE, message, None
-    foot, edge, ahead, depth = hit
-    return (RunEnd.TRIP, f"trip: {foot}'s foot, {depth:.3g} m below the patch tops in a gap, "
-            "entered a patch from its side",
-            (RunEnd.TRIP.value, -1, float(t_last) + ahead, foot, edge))
-
-
 def impulse_jump(walker, x, trailing, P):
     """The state after a push-off impulse ``P`` [N s] at leg ``trailing``'s foot along that
     leg towards the hip, applied at once: ``M dq+ = M dq- + J_foot^T P e``.
@@ -230,9 +213,12 @@ class _PoweredRun:
             return None
         except _Stall as stall:
             x = np.asarray(stall.args[0])
-            self.term, self.msg, self.event = _failure(
+            from .contact import trip_or_failure
+
+            self.term, self.msg, self.event = trip_or_failure(
                 self.walker, t, x[:2 * self.walker.nq],
-                f"the solver stalled after t = {t:.6g} s (a force jump it cannot step over)")
+                f"the solver stalled after t = {t:.6g} s (a force jump it cannot step over)",
+                -1, 0.01)
             return None
         self.nfev, self.njev = self.nfev + sol.nfev, self.njev + sol.njev
         if sol.status < 0:
