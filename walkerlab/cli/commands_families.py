@@ -187,3 +187,27 @@ def target(scene: Path | None = SceneArg,
                f"{max(abs(gait.multipliers)):.4g} ({'stable' if gait.stable else 'unstable'})")
     for n, v in gait.state.items():
         typer.echo(f"  {n:14s} {v:+.8f}")
+
+
+@guard
+def optimize(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
+             force: bool = ForceOpt) -> None:
+    """A periodic gait of a walker with a hip torque by direct collocation (CasADi +
+    IPOPT; the scene's optimize section): least int u^2 dt, the targets and limits given,
+    replayed on the rigid model; writes optimize.h5."""
+    from walkerlab.stages import pipeline
+
+    out = pipeline.run("optimize", load(scene), runs_dir, force)
+    d = out.summary.get("data")
+    if d is not None:
+        mu = max(abs(d.multipliers)) if len(d.multipliers) else float("nan")
+        typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s)")
+        typer.echo(f"  step period {d.step_period_s:.6g} s, step length {d.step_length_m:.5g} m,"
+                   f" speed {d.step_length_m / d.step_period_s:.5g} m/s, push-off "
+                   f"{d.push_off_n_s:.5g} N s, peak |torque| {max(abs(d.torque)):.4g} N m")
+        typer.echo(f"  objective int u^2 dt = {d.objective:.6g} N^2 m^2 s; replay return "
+                   f"error {d.replay_error:.2g}; max |Floquet multiplier| {mu:.4g}")
+        typer.echo("  a gait (the replay closes)" if d.gait else
+                   "  NOT a gait: the replay does not return to its start within "
+                   "optimize.replay_tolerance (or IPOPT did not converge)")
+    typer.echo(status(out))

@@ -26,6 +26,7 @@ from pydantic import (
     PrivateAttr,
     ValidationError,
     field_validator,
+    model_serializer,
     model_validator,
 )
 
@@ -44,6 +45,7 @@ from walkerlab.config.limits import (
     MAX_STEPS_PER_WALKING_STEP,
     MAX_WORKERS,
 )
+from walkerlab.config.optimize import OptimizeSettings
 from walkerlab.config.solver import (
     SolverSettings,
     check_contact,
@@ -129,6 +131,15 @@ class Scene(Strict):
     basin: BasinSettings | None = None
     mfpt: MfptSettings | None = None
     robustness: RobustnessSettings | None = None
+    optimize: OptimizeSettings | None = None
+
+    @model_serializer(mode="wrap")
+    def _drop_unused_optimize(self, handler):
+        # a scene without an optimize section serialises as before (same scene JSON)
+        d = handler(self)
+        if isinstance(d, dict) and d.get("optimize", 0) is None:
+            d.pop("optimize")
+        return d
 
     @model_validator(mode="after")
     def _units_consistent(self) -> Scene:

@@ -17,13 +17,15 @@ from walkerlab.config import Scene
 MODULES = {"fixedpoint": "fixedpoint", "simulate": "simulate", "contact-sim": "contact_sim",
            "compare": "compare", "workprecision": "workprecision", "basin": "basin",
            "animate": "animate", "mfpt": "mfpt", "robustness": "robustness",
-           "attribution": "attribution", "bifurcation": "bifurcation"}
+           "attribution": "attribution", "bifurcation": "bifurcation",
+           "optimize": "optimize"}
 #: the stages each stage reads the artifacts of (``simulate`` reads ``fixedpoint.h5`` only
 #: when ``simulate.initial_state`` is the fixed point)
 NEEDS = {"simulate": ("fixedpoint",), "contact-sim": ("fixedpoint",),
          "compare": ("simulate", "contact-sim"), "workprecision": ("fixedpoint",),
          "basin": ("fixedpoint",), "mfpt": ("fixedpoint",), "robustness": ("fixedpoint",),
-         "attribution": ("fixedpoint",), "animate": ("simulate",)}
+         "attribution": ("fixedpoint",), "animate": ("simulate",),
+         "optimize": ("fixedpoint",)}
 
 
 def needs(stage: str, scene: Scene) -> tuple[str, ...]:

@@ -1,0 +1,103 @@
+"""``optimize.h5``: a periodic gait by direct collocation, writer and reader side by side.
+
+Layout (netCDF conventions: every array on the ``time`` dimension of the collocation
+points)::
+
+    time                          s        collocation points (2N + 1) on [0, step_period]
+    states/<state name>           rad, rad/s   the walker's states there (role order)
+    torque/hip                    N m      the hip torque there (+ on the swing leg)
+    step_period, step_length      s, m
+    speed                         m/s      step length / step period
+    push_off                      N s      the push-off impulse
+    objective                     N^2 m^2 s   int u^2 dt (+ the free push-off's weighted P^2)
+    replay/max_state_error        rad, rad/s  the rigid model's return error (gait if
+                                           <= the scene's replay_tolerance)
+    replay/multipliers/{real,imag} -       Floquet multipliers of the replayed gait
+    ipopt                         attributes: status, iterations, wall_time_s
+
+attributes: ``gait`` (the replay closed), ``state_names``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+STAGE = "optimize"
+
+__all__ = ["OptimizeData", "STAGE", "load", "write"]
+
+
+@dataclass
+class OptimizeData:
+    """The contents of ``optimize.h5`` (units in the module docstring)."""
+
+    time: np.ndarray
+    states: dict
+    torque: np.ndarray
+    step_period_s: float
+    step_length_m: float
+    push_off_n_s: float
+    objective: float
+    replay_error: float
+    multipliers: np.ndarray
+    gait: bool
+    status: str
+    iterations: int
+    wall_time_s: float
+    state_units: dict
+
+
+def write(f, d: OptimizeData) -> None:
+    """Fill an open artifact (``write_artifact``'s writer) with ``d``."""
+    from walkerlab.io.artifacts import put
+    from walkerlab.io.netcdf import coordinate
+
+    coordinate(f, "time", d.time, "s", "collocation point time since the heel strike")
+    for name, v in d.states.items():
+        put(f, f"states/{name}", v, d.state_units[name], f"{name} at the collocation points",
+            dims=("time",))
+    put(f, "torque/hip", d.torque, "N m", "hip torque (+ on the swing leg, - on the stance "
+        "leg)", dims=("time",))
+    put(f, "step_period", float(d.step_period_s), "s", "step period")
+    put(f, "step_length", float(d.step_length_m), "m", "distance between the feet at heel "
+        "strike")
+    put(f, "speed", float(d.step_length_m / d.step_period_s), "m/s", "step length / period")
+    put(f, "push_off", float(d.push_off_n_s), "N s", "push-off impulse")
+    put(f, "objective", float(d.objective), "N^2 m^2 s", "int u^2 dt (+ the free push-off's "
+        "weighted P^2)")
+    put(f, "replay/max_state_error", float(d.replay_error), "-", "max-norm return error of "
+        "the rigid model's replay [rad, rad/s]")
+    mu = np.asarray(d.multipliers, complex)
+    put(f, "replay/multipliers/real", mu.real, "-", "Floquet multipliers of the replay")
+    put(f, "replay/multipliers/imag", mu.imag, "-", "Floquet multipliers of the replay")
+    f.attrs["gait"] = bool(d.gait)
+    f.attrs["state_names"] = list(d.states)
+    f.attrs["ipopt_status"] = d.status
+    f.attrs["ipopt_iterations"] = int(d.iterations)
+    f.attrs["ipopt_wall_time_s"] = float(d.wall_time_s)
+
+
+def load(path: Path) -> OptimizeData:
+    """Read ``optimize.h5``.
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Missing, damaged or another stage's file (one line).
+    """
+    from walkerlab.io.artifacts import open_artifact
+
+    with open_artifact(path, STAGE) as f:
+        names = [str(s) for s in f.attrs["state_names"]]
+        return OptimizeData(
+            f["time"][()], {n: f[f"states/{n}"][()] for n in names}, f["torque/hip"][()],
+            float(f["step_period"][()]), float(f["step_length"][()]),
+            float(f["push_off"][()]), float(f["objective"][()]),
+            float(f["replay/max_state_error"][()]),
+            f["replay/multipliers/real"][()] + 1j * f["replay/multipliers/imag"][()],
+            bool(f.attrs["gait"]), str(f.attrs["ipopt_status"]),
+            int(f.attrs["ipopt_iterations"]), float(f.attrs["ipopt_wall_time_s"]),
+            {n: str(f[f"states/{n}"].attrs["unit"]) for n in names})

@@ -1,0 +1,52 @@
+"""Stage ``optimize``: a periodic gait by direct collocation -> ``optimize.h5``.
+
+Reads the scene's ``optimize`` section and its gait from ``fixedpoint.h5`` (the pipeline
+runs ``fixedpoint`` first, :mod:`walkerlab.stages.pipeline`; the collocation starts from
+one step of it), optimises by :func:`walkerlab.optimal.scene.optimize_scene`
+(CasADi + IPOPT) and replays the result on the rigid model.  Skipped when the scene
+sections, the upstream gait and the code are unchanged.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from walkerlab.config import Scene
+from walkerlab.io.runpaths import stage_artifact
+from walkerlab.io.schemas import optimize as schema
+from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.stages.common import (
+    StageError,
+    StageOutcome,
+    require,
+    run_cached,
+    with_defaults,
+)
+
+SECTIONS = ("walker", "slope", "ideal", "solver", "optimize")
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
+    """Compute (or reuse) ``optimize.h5``.
+
+    Raises
+    ------
+    StageError
+        A walker the collocation does not handle (one line); a missing ``optimize`` or
+        ``fixedpoint`` section runs with its defaults.
+    """
+    from walkerlab.optimal.scene import optimize_scene
+
+    require(scene, "fixedpoint", "optimize")
+    scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
+    up = stage_artifact(scene, runs_root, "fixedpoint")
+
+    def compute():
+        fp = load_fixedpoint(up)
+        try:
+            data = optimize_scene(scene, fp.x, fp.step_period_s)
+        except ValueError as exc:
+            raise StageError(str(exc)) from None
+        return (lambda f: schema.write(f, data)), {"data": data}
+
+    return run_cached("optimize", scene, runs_root, SECTIONS, (up,), compute, force)
