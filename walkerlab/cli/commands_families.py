@@ -211,3 +211,6 @@ def optimize(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
                    "  NOT a gait: the replay does not return to its start within "
                    "optimize.replay_tolerance (or IPOPT did not converge)")
     typer.echo(status(out))
+    from walkerlab.stages.optimize import draw
+
+    typer.echo(f"figure: {draw(load(scene), runs_dir)[0]}")

@@ -17,8 +17,7 @@ swing foot ahead); the step's start is the end mapped by push-off + heel strike 
 (the extended-coordinate impact of :mod:`walkerlab.models.hybrid.actuated`, symbolic here):
 ``x_0 = reset(x_2N)``.  Objective: the effort ``int u^2 dt`` (Simpson's rule on the same
 points), with the push-off's weighted square ``w P^2`` added when it is free.  Constraints:
-optional target speed,
-step length or step period, a torque limit.
+optional target speed, step length or step period, a torque limit.
 
 A result is called a gait only after its **replay**: the rigid model integrated (scipy's
 DOP853 at 1e-12) from ``x_0`` with the optimised torque as a function of time (piecewise

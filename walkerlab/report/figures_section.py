@@ -35,6 +35,9 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
     ("bifurcation", "Bifurcation diagram over the slope."),
     ("basin", "Basin of attraction: where each cell of the Poincaré-section slice goes "
               "(left) and how many steps the converged cells take (right)."),
+    ("optimize", "Optimised step (direct collocation, `walkerlab optimize`): the hip torque "
+                 "at the collocation points (left) and the leg angles over the step "
+                 "(right)."),
 ]
 
 
@@ -76,6 +79,22 @@ def energy_section(sim: SimulateArtifact) -> list[str]:
             *details("Energy ledger per step (simulate.h5, ledger/)", table(head, rows))]
 
 
+def optimize_lines(d) -> list[str]:
+    """The optimised step of a loaded ``optimize.h5`` in words."""
+    import numpy as np
+
+    mu = float(np.max(np.abs(d.multipliers))) if len(d.multipliers) else float("nan")
+    return [f"IPOPT: {d.status} ({d.iterations} iterations, {num(d.wall_time_s, 3)} s). Step "
+            f"period {num(d.step_period_s)} s, step length {num(d.step_length_m)} m, speed "
+            f"{num(d.step_length_m / d.step_period_s)} m/s, push-off {num(d.push_off_n_s)} N s, "
+            f"peak hip torque {num(float(np.max(np.abs(d.torque))))} N m; objective int u^2 dt "
+            f"= {num(d.objective)} N^2 m^2 s. Replayed on the rigid model (the torque as a "
+            f"function of time): return error {num(d.replay_error, 2)}, largest |Floquet "
+            f"multiplier| {num(mu)}: "
+            + ("**a gait**." if d.gait else "**not a gait** (the replay does not close)."),
+            ""]
+
+
 def _drawn_from(stem: str, arts: dict) -> bool:
     """Whether a figure's artifacts are among the report's (a figure an earlier ``walkerlab
     plot`` drew from an artifact the report leaves out is not shown)."""
@@ -83,7 +102,8 @@ def _drawn_from(stem: str, arts: dict) -> bool:
                            ("fig6_", ("contact-sim",)),
                            ("fig8_", ("compare",)), ("fig", ("simulate", "contact-sim")),
                            ("work_precision", ("workprecision",)),
-                           ("bifurcation", ("bifurcation",)), ("basin", ("basin",))):
+                           ("bifurcation", ("bifurcation",)), ("basin", ("basin",)),
+                           ("optimize", ("optimize",))):
         if stem.startswith(prefix):
             return any(s in arts for s in stages)
     return True
@@ -106,6 +126,8 @@ def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
         if not png.is_file() or not _drawn_from(stem, arts):
             continue
         out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
+        if stem == "optimize" and "optimize" in arts:
+            out += optimize_lines(arts["optimize"])
         if stem == "energy_ledger" and "simulate" in arts:
             out += energy_section(arts["simulate"])
         if stem == "fig7_angles_rates" and "simulate" in arts:

@@ -50,3 +50,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         return (lambda f: schema.write(f, data)), {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, (up,), compute, force)
+
+
+def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
+    """Draw ``optimize.png`` (PNG + SVG) from ``optimize.h5``."""
+    from walkerlab.io.runpaths import figures_dir
+    from walkerlab.plotting.optimize_figure import save_optimize_figure
+
+    d = schema.load(stage_artifact(scene, runs_root, "optimize"))
+    return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root))

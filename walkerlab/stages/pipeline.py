@@ -83,5 +83,6 @@ def report_plan(scene: Scene, full: bool = False) -> list[str]:
             "compare": contact and sim, "workprecision": full and scene.workprecision is not None,
             "basin": scene.basin is not None and fp,
             "robustness": scene.robustness is not None and fp,
+            "optimize": getattr(scene, "optimize", None) is not None and fp,
             "attribution": full and contact and fp}
     return [s for s, on in plan.items() if on]

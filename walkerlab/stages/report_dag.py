@@ -73,7 +73,9 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
         drawn.append(draw_if_changed(scene, runs_root, force, "workprecision"))
     # after the study: the basin's worker processes and the attribution's timed cases would
     # share the timed cases' cores
-    for name in ("basin", "robustness", "attribution"):
+    for name in ("basin", "robustness", "attribution", "optimize"):
         if name in plan:
             add(stage_module(name).run(scene, runs_root, force))
+    if "optimize" in plan:
+        stage_module("optimize").draw(scene, runs_root)
     return done, drawn

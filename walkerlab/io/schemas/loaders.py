@@ -14,6 +14,7 @@ LOADERS = {"fixedpoint": ("fixedpoint", "load_fixedpoint"),
            "workprecision": ("workprecision", "load_workprecision"),
            "basin": ("basin", "load_basin"), "robustness": ("robustness", "load"),
            "mfpt": ("mfpt", "load"), "attribution": ("attribution", "load_attribution"),
+           "optimize": ("optimize", "load"),
            "bifurcation": ("bifurcation", "load_bifurcation_summary"),
            "stability_map": ("stability_map", "load_stability_map")}
 
