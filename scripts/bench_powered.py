@@ -37,8 +37,8 @@ def _scenes():
 
 
 def _fixed_point_time(scene: dict, repeats: int) -> tuple[float, int]:
-    from walkerlab.analysis.gait.poincare import find_fixed_point
     import walkerlab as wl
+    from walkerlab.analysis.gait.poincare import find_fixed_point
 
     w = wl.Walker.from_scene(scene)
     guess = {"swing_angle_rad": -0.181, "stance_angle_rad": 0.181,
@@ -57,21 +57,33 @@ def _fixed_point_time(scene: dict, repeats: int) -> tuple[float, int]:
     return float(np.median(times)), int(nfev)
 
 
-def _simulate_time(scene: dict, repeats: int, ledger: bool) -> float:
+def _simulate_stage_and_ledger(scene: dict, repeats: int) -> tuple[float, float]:
+    """Median wall time [s] of the ``simulate`` stage (5 strides, artifact written; its
+    ledger included) and of the ledger alone on the same trajectory."""
+    import tempfile
+
     import walkerlab as wl
     from walkerlab.analysis.gait.energy import trajectory_ledger
+    from walkerlab.config import scene_from_dict
     from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.stages import pipeline
+    from walkerlab.stages import simulate as stage
 
+    sc = scene_from_dict(scene)
     w = wl.Walker.from_scene(scene)
     g = w.fixed_point()
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        traj = simulate_steps(w.model, g.x, 10, w.solver)
-        if ledger:
-            trajectory_ledger(w.model, traj)
-        times.append(time.perf_counter() - t)
-    return float(np.median(times))
+    stage_t, ledger_t = [], []
+    with tempfile.TemporaryDirectory() as d:
+        pipeline.run("fixedpoint", sc, d)
+        for _ in range(repeats):
+            t = time.perf_counter()
+            stage.run(sc, d, force=True)
+            stage_t.append(time.perf_counter() - t)
+            traj = simulate_steps(w.model, g.x, 2 * sc.simulate.strides, w.solver)
+            t = time.perf_counter()
+            trajectory_ledger(traj)
+            ledger_t.append(time.perf_counter() - t)
+    return float(np.median(stage_t)), float(np.median(ledger_t))
 
 
 def main() -> None:
@@ -81,14 +93,13 @@ def main() -> None:
     sc = _scenes()
     rows = {k: _fixed_point_time(v, a.repeats) for k, v in sc.items()}
     base = rows["passive (paper, slope)"][0]
-    print(f"{'fixed point from a 1e-3 perturbed start':42s} {'median s':>9s} {'maps':>5s} "
+    print(f"{'fixed point from a 1e-3 perturbed start':42s} {'median s':>9s} {'nfev':>7s} "
           f"{'/ passive':>9s}")
     for k, (t, n) in rows.items():
-        print(f"{k:42s} {t:9.3f} {n:5d} {t / base:9.2f}")
-    push = sc["push-off (level)"]
-    plain, led = (_simulate_time(push, a.repeats, flag) for flag in (False, True))
-    print(f"simulate 10 steps (push-off): {plain:.3f} s, with the ledger {led:.3f} s "
-          f"(+{100 * (led / plain - 1):.1f} %)")
+        print(f"{k:42s} {t:9.3f} {n:7d} {t / base:9.2f}")
+    stage_s, ledger_s = _simulate_stage_and_ledger(sc["push-off (level)"], a.repeats)
+    print(f"simulate stage (push-off, 5 strides): {stage_s:.3f} s; its energy ledger "
+          f"{ledger_s:.4f} s ({100 * ledger_s / stage_s:.1f} % of the stage)")
 
 
 if __name__ == "__main__":

@@ -458,3 +458,28 @@ def test_ankle_push_off_on_flat_feet_is_the_released_spring_in_heel_off():
     assert ankle_push_off_work(w.model, seg) == pytest.approx(11.11, rel=1e-3)
     led = trajectory_ledger(simulate_steps(w.model, g.x, 2, w.solver))
     assert np.allclose(led["cost_of_transport"], 0.0966, rtol=1e-3)
+
+
+def test_linear_hip_torques_run_on_the_compiled_flows():
+    """A hip torque linear in the hip angle and rate is a generated hip spring-damper (with
+    its rest angle shifted by the constant): its flows are the compiled ones (the powered
+    fixed point at the passive one's cost, scripts/bench_powered.py) and equal the Python
+    flow of the same law; a phase-reference law stays on the Python flow."""
+    from walkerlab.models.hybrid.actuated import Actuators
+
+    sc = scene_from_dict(_compass({"torques": [{"joint": "hip", "law": LAW}]}))
+    w = build_walker(sc)
+    assert all(ph.compiled is not None for ph in w.phases)
+    acts = w.actuators
+    assert isinstance(acts, Actuators)
+    rng = np.random.default_rng(7)
+    passive = build_walker(scene_from_dict(_compass({"push_off": {"impulse_n_s": 0.0}})))
+    for _ in range(5):
+        x = rng.normal(0, 0.3, 4)
+        expect = np.asarray(passive.phases[0].flow(0.0, x), float)
+        expect[2:] += acts.added_acceleration(0.0, x)
+        np.testing.assert_allclose(w.phases[0].flow(0.0, x), expect, rtol=1e-12, atol=1e-12)
+    ref = {"stiffness_n_m_per_rad": 40.0, "reference": {"phase_rad": [-0.3, 0.3],
+                                                        "hip_angle_rad": [0.3, -0.3]}}
+    sc2 = scene_from_dict(_compass({"torques": [{"joint": "hip", "law": ref}]}))
+    assert all(ph.compiled is None for ph in build_walker(sc2).phases)

@@ -262,6 +262,37 @@ def _structure_check(data, spec) -> bool:
     return limit
 
 
+def spring_equivalent(data, spec):
+    """The walker's data with its hip torques as one more generated hip spring-damper, when
+    every law is linear in the hip angle and rate (no reference, no saturation, not scaled
+    by a massless foot's mass): ``sum_i (c_i - K_i (delta - r_i) - D_i ddelta) = -K (delta -
+    r) - D ddelta`` with ``K = sum K_i > 0``, ``r = (sum K_i r_i + sum c_i) / K``, ``D = sum
+    D_i`` (or ``K = 0`` and no constant torque: a damper), on the pair (swing, stance) of
+    :data:`walkerlab.walker.description.SPRING_LINKS` (its ``delta`` is stance - swing: rest
+    angle ``-r``).  Its flows are then the generated, compiled ones; None otherwise."""
+    from walkerlab.walker.description import WalkerData
+
+    st = data.structure
+    laws = [t for t in spec.torques]
+    if not laws or st.knee_spring or st.torso or any(
+            t.scaled_by != "none" or t.max_torque_n_m is not None or t.law.reference is not None
+            or t.law.time_reference is not None for t in laws):
+        return None
+    K = sum(t.law.stiffness_n_m_per_rad for t in laws)
+    D = sum(t.law.damping_n_m_s_per_rad for t in laws)
+    C = sum(t.law.constant_n_m for t in laws)
+    if K <= 0.0 and C != 0.0:
+        return None
+    r = (sum(t.law.stiffness_n_m_per_rad * t.law.rest_angle_rad for t in laws) + C) / K \
+        if K > 0.0 else 0.0
+    structure = replace(st, springs=st.springs + (("swing", "stance"),))
+    extra = (float(K), float(-r), float(D))
+    mirror = None if data.mirror_params is None else tuple(data.mirror_params) + extra
+    return WalkerData(structure, tuple(data.params) + extra, data.total_mass_kg,
+                      data.leg_length_m, data.gravity_m_per_s2, data.slope_rad, data.extra,
+                      mirror)
+
+
 def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     """The walker with its actuators: every phase's flow gains ``M^-1 B tau`` (and its
     Jacobian the derivative of it, by the complex step), the heel-strike reset becomes
@@ -319,7 +350,16 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         return J
 
     phases = []
-    for ph in walker.phases:
+    sprung = spring_equivalent(data, spec) if has_torque and not limit else None
+    if sprung is not None:  # the torques as a generated (compiled) hip spring-damper
+        from walkerlab.models.hybrid.rigid import make_rigid_walker
+
+        fast = make_rigid_walker(sprung, walker.name, walker.variant)
+        base_jac = fast.variational
+        phases = [Phase(ph.name, ph.flow, ph.guards, jacobian=ph.jacobian,
+                        variational=ph.variational, compiled=ph.compiled)
+                  for ph in fast.phases]
+    for ph in walker.phases if sprung is None else ():
         phases.append(Phase(ph.name, flow_of(ph.flow), ph.guards,
                             jacobian=jac_of(ph.jacobian or base_jac),
                             variational=None if has_torque else ph.variational,
@@ -335,6 +375,6 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     if mirror is not None:
         mirror = actuate(mirror, data.mirror, spec)
     return replace(walker, phases=tuple(phases), reset=reset, reset_jacobian=reset_jac,
-                   variational=jac_of(base_jac),
+                   variational=base_jac if sprung is not None else jac_of(base_jac),
                    mirror=mirror, actuators=acts)
 
