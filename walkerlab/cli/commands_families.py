@@ -190,12 +190,28 @@ def target(scene: Path | None = SceneArg,
 
 
 @guard
-def optimize(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
-             force: bool = ForceOpt) -> None:
+def optimize(scene: Path | None = SceneArg,
+             design: list[str] = typer.Option(None, "--design", help="a numeric scene field "
+                                              "and its bounds, FIELD=LO:HI (repeatable): "
+                                              "optimise the design instead of the gait"),
+             objective: str = typer.Option("max_abs_multiplier", "--objective",
+                                           help="with --design: step_period | step_length "
+                                           "| speed | cost_of_transport | "
+                                           "max_abs_multiplier"),
+             maximize: bool = typer.Option(False, "--maximize", help="with --design: "
+                                           "maximise the objective"),
+             runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """A periodic gait of a walker with a hip torque by direct collocation (CasADi +
     IPOPT; the scene's optimize section): least int u^2 dt, the targets and limits given,
-    replayed on the rigid model; writes optimize.h5."""
+    replayed on the rigid model; writes optimize.h5.  With --design: the fields within
+    their bounds that minimise (--maximize: maximise) a measure of the scene's own gait,
+    followed from the scene's values, gradients through the fixed point; writes
+    optimize_design.h5."""
     from walkerlab.stages import pipeline
+
+    if design:
+        _optimize_design(scene, design, objective, maximize, runs_dir, force)
+        return
 
     out = pipeline.run("optimize", load(scene), runs_dir, force)
     d = out.summary.get("data")
@@ -214,3 +230,35 @@ def optimize(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt,
     from walkerlab.stages.optimize import draw
 
     typer.echo(f"figure: {draw(load(scene), runs_dir)[0]}")
+
+
+def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> None:
+    """``walkerlab optimize --design``: parse FIELD=LO:HI, run, print the optimum."""
+    from walkerlab.stages import optimize as stage
+    from walkerlab.stages import pipeline
+
+    bounds = {}
+    for item in design:
+        field, _, rng = item.partition("=")
+        lo, _, hi = rng.partition(":")
+        try:
+            lo_v, hi_v = float(lo), float(hi)
+        except ValueError:
+            raise ValueError(f"--design {item!r}: write FIELD=LO:HI with numbers") from None
+        if not (lo_v < hi_v) or not all(abs(v) < float("inf") for v in (lo_v, hi_v)):
+            raise ValueError(f"--design {item!r}: LO < HI, both finite")
+        bounds[field.strip()] = (lo_v, hi_v)
+    from walkerlab.optimal.design import MEASURES
+
+    if objective not in MEASURES:
+        raise ValueError(f"--objective: one of {', '.join(MEASURES)}, not {objective!r}")
+    sc = load(scene)
+    pipeline.run_upstream("optimize", sc, runs_dir)
+    out = stage.run_design(sc, runs_dir, force, bounds, objective, maximize)
+    r = out.summary.get("design")
+    if r is not None:
+        typer.echo(f"{'maximised' if maximize else 'minimised'} {r.objective}: "
+                   f"{r.value:.8g} after {r.evaluations} fixed points ({r.message})")
+        for f, v, g in zip(r.fields, r.values, r.gradient):
+            typer.echo(f"  {f} = {v:.8g}   d{r.objective}/d field = {g:.4g}")
+    typer.echo(status(out))

@@ -52,6 +52,36 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     return run_cached("optimize", scene, runs_root, SECTIONS, (up,), compute, force)
 
 
+def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
+               objective: str, maximize: bool = False) -> StageOutcome:
+    """Compute (or reuse) ``optimize_design.h5``: the fields within ``bounds``
+    (``{field: (lo, hi)}``) that minimise (``maximize``: maximise) the gait measure
+    ``objective`` (:func:`walkerlab.optimal.design.design_optimize`).
+
+    Raises
+    ------
+    StageError
+        An unknown objective or field, or no gait along the way (one line).
+    """
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound
+    from walkerlab.optimal.design import design_optimize
+
+    require(scene, "fixedpoint", "optimize")
+    up = stage_artifact(scene, runs_root, "fixedpoint")
+
+    def compute():
+        try:
+            r = design_optimize(scene, bounds, objective, load_fixedpoint(up).x, maximize)
+        except (ValueError, FixedPointNotFound) as exc:
+            raise StageError(f"optimize --design: {exc}") from None
+        return (lambda f: schema.write_design(f, r)), {"design": r}
+
+    key = repr((sorted(bounds.items()), objective, maximize))
+    return run_cached(schema.DESIGN_STAGE, scene, runs_root, ("walker", "slope", "ideal",
+                                                              "solver"), (up,), compute,
+                      force, extra_key=key, artifact=schema.DESIGN_STAGE)
+
+
 def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     """Draw ``optimize.png`` (PNG + SVG) from ``optimize.h5``."""
     from walkerlab.io.runpaths import figures_dir

@@ -27,7 +27,7 @@ import numpy as np
 
 STAGE = "optimize"
 
-__all__ = ["OptimizeData", "STAGE", "load", "write"]
+__all__ = ["DESIGN_STAGE", "OptimizeData", "STAGE", "load", "write", "write_design"]
 
 
 @dataclass
@@ -101,3 +101,32 @@ def load(path: Path) -> OptimizeData:
             bool(f.attrs["gait"]), str(f.attrs["ipopt_status"]),
             int(f.attrs["ipopt_iterations"]), float(f.attrs["ipopt_wall_time_s"]),
             {n: str(f[f"states/{n}"].attrs["unit"]) for n in names})
+
+
+#: the design optimisation's artifact (``walkerlab optimize --design``)
+DESIGN_STAGE = "optimize_design"
+
+
+def write_design(f, r) -> None:
+    """Fill an open artifact with a design optimisation ``r``
+    (:class:`walkerlab.optimal.design.DesignResult`): ``fields`` (attribute), ``values`` (k,)
+    in the fields' units, ``objective_value``, ``gradient`` (k,) [measure unit per field
+    unit; NaN where the measure is not smooth], ``history/values`` (m, k) and
+    ``history/objective`` (m,); attributes ``objective``, ``success``, ``message``,
+    ``evaluations``."""
+    from walkerlab.io.artifacts import put
+
+    put(f, "values", np.asarray(r.values, float), "-", "optimal values of the fields "
+        "(attribute 'fields'), each in its field's unit")
+    put(f, "objective_value", float(r.value), "-", f"{r.objective} at the optimum")
+    put(f, "gradient", np.asarray(r.gradient, float), "-", f"d {r.objective} / d field at "
+        "the optimum (through the fixed point)")
+    hv = np.array([h[0] for h in r.history], float).reshape(len(r.history), len(r.fields))
+    put(f, "history/values", hv, "-", "each evaluation's field values")
+    put(f, "history/objective", np.array([h[1] for h in r.history], float), "-",
+        f"each evaluation's {r.objective}")
+    f.attrs["fields"] = list(r.fields)
+    f.attrs["objective"] = r.objective
+    f.attrs["success"] = bool(r.success)
+    f.attrs["message"] = str(r.message)
+    f.attrs["evaluations"] = int(r.evaluations)

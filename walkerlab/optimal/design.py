@@ -1,0 +1,207 @@
+"""Design optimisation: the numeric scene fields (within bounds) that minimise or maximise a
+measure of the scene's own gait, followed from the scene's value (every evaluation starts
+the root finder at the last gait found, so the optimiser never jumps to another branch).
+
+Measures (of the period-1 gait ``x*(p)`` of the rigid model): ``step_period`` [s],
+``step_length`` [m], ``speed`` [m/s], ``cost_of_transport`` [-] (the energy ledger's,
+:mod:`walkerlab.analysis.gait.energy`) and ``max_abs_multiplier`` [-].
+
+Gradients of the smooth measures are exact through the fixed point (the implicit function
+theorem on the Poincaré map ``P``): ``x* = P(x*, p)`` gives ``dx*/dp = (I - DP)^-1 dP/dp``,
+with ``DP`` the map's Jacobian from the variational equations at the fixed point and
+``dP/dp``, ``dm/dx``, ``dm/dp`` central differences of single steps; SLSQP
+(:func:`scipy.optimize.minimize`) uses them.  ``max_abs_multiplier`` is not smooth where two
+multipliers cross: Nelder-Mead (derivative-free, within the bounds).  Hobbelen & Wisse
+(2007) and Byl & Tedrake (2009) optimise designs over such gait measures.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["MEASURES", "DesignResult", "design_optimize", "measure_gradient"]
+
+#: Measures of a gait a design can optimise, with their units.
+MEASURES = {"step_period": "s", "step_length": "m", "speed": "m/s", "cost_of_transport": "-",
+            "max_abs_multiplier": "-"}
+SMOOTH = ("step_period", "step_length", "speed", "cost_of_transport")
+
+
+@dataclass
+class DesignResult:
+    """An optimised design.
+
+    Attributes
+    ----------
+    fields : list of str
+        The scene fields varied (dotted paths).
+    values : ndarray (k,)
+        Their optimal values (the fields' units).
+    objective : str
+        The measure (:data:`MEASURES`).
+    value : float
+        The measure there (its unit).
+    gradient : ndarray (k,)
+        d measure / d field there (NaN for ``max_abs_multiplier``).
+    success : bool
+    message : str
+        Why the optimiser stopped.
+    evaluations : int
+        Fixed points solved.
+    history : list of (ndarray, float)
+        Each evaluation's field values and measure.
+    """
+
+    fields: list
+    values: np.ndarray
+    objective: str
+    value: float
+    gradient: np.ndarray
+    success: bool
+    message: str
+    evaluations: int
+    history: list = field(default_factory=list)
+
+
+class _Gaits:
+    """Walkers and their gaits over the design, each solve started at the last gait."""
+
+    def __init__(self, scene, fields, x0):
+        from walkerlab.integrate.solver import Solver
+
+        self.scene, self.fields = scene, list(fields)
+        self.solver = Solver.from_settings(scene.solver)
+        self.last = np.asarray(x0, float)
+        self.count = 0
+
+    def walker(self, p):
+        from walkerlab.models.registry import build_walker
+        from walkerlab.studies.params import apply_point
+
+        return build_walker(apply_point(self.scene.model_dump(mode="json"), self.fields,
+                                        tuple(map(float, p)), "optimize --design"))
+
+    def gait(self, p):
+        from walkerlab.analysis.gait.poincare import find_fixed_point
+
+        w = self.walker(p)
+        fp = find_fixed_point(w, self.last, self.solver, fd_check=False)
+        self.last = np.asarray(fp.x, float)
+        self.count += 1
+        return w, fp
+
+
+def _measures(walker, x, solver) -> dict[str, float]:
+    """The smooth measures of one map from ``x`` (not only at a fixed point)."""
+    from walkerlab.analysis.gait.energy import gait_measures
+    from walkerlab.analysis.gait.poincare import poincare_map
+
+    steps = walker.steps_per_map
+    _, period, _ = poincare_map(walker, np.asarray(x, float), solver)
+    g = gait_measures(walker, x, steps, solver)
+    return {"step_period": float(period) / steps, "step_length": g["step_length"],
+            "speed": g["speed"], "cost_of_transport": g["cost_of_transport"]}
+
+
+def measure_gradient(gaits: _Gaits, p, name: str, h_x: float = 1e-6,
+                     h_p: float = 1e-6) -> tuple[float, np.ndarray]:
+    """The measure ``name`` of the gait at ``p`` and its gradient (k,) through the fixed
+    point (module docstring).
+
+    Raises
+    ------
+    walkerlab.analysis.gait.poincare.FixedPointNotFound
+        No gait at ``p`` near the last one.
+    """
+    from walkerlab.analysis.gait.poincare import poincare_map
+
+    p = np.asarray(p, float)
+    w, fp = gaits.gait(p)
+    x = np.asarray(fp.x, float)
+    value = _measures(w, x, gaits.solver)[name]
+    J = np.asarray(fp.jacobian_variational, float)
+    n2 = x.size
+    dm_dx = np.array([(_measures(w, x + h_x * e, gaits.solver)[name]
+                       - _measures(w, x - h_x * e, gaits.solver)[name]) / (2 * h_x)
+                      for e in np.eye(n2)])
+    grad = np.empty(p.size)
+    for j in range(p.size):
+        dp = np.zeros(p.size)
+        dp[j] = h_p * max(1.0, abs(p[j]))
+        wp, wm = gaits.walker(p + dp), gaits.walker(p - dp)
+        dP = (poincare_map(wp, x, gaits.solver)[0] - poincare_map(wm, x, gaits.solver)[0]) \
+            / (2 * dp[j])
+        dm = (_measures(wp, x, gaits.solver)[name]
+              - _measures(wm, x, gaits.solver)[name]) / (2 * dp[j])
+        dx = np.linalg.solve(np.eye(n2) - J, dP)
+        grad[j] = dm_dx @ dx + dm
+    return value, grad
+
+
+def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool = False,
+                    max_evaluations: int = 60) -> DesignResult:
+    """Optimise the scene's fields within ``bounds`` for the gait measure ``objective``.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its gait (``x_gait``) at the fields' present values starts everything.
+    bounds : dict
+        ``{field: (lo, hi)}`` in the fields' units; the start is the scene's value (clipped).
+    objective : str
+        A key of :data:`MEASURES`.
+    x_gait : ndarray (2n,)
+        The scene's gait just after heel strike (``fixedpoint.h5``).
+    maximize : bool
+    max_evaluations : int
+        Cap on the optimiser's iterations.
+
+    Returns
+    -------
+    DesignResult
+
+    Raises
+    ------
+    ValueError
+        An unknown objective (one line).
+    """
+    from scipy.optimize import minimize
+
+    from walkerlab.studies.continuation import scene_value
+
+    if objective not in MEASURES:
+        raise ValueError(f"optimize --objective: one of {', '.join(MEASURES)}, not "
+                         f"{objective!r}")
+    fields = list(bounds)
+    lo = np.array([bounds[f][0] for f in fields], float)
+    hi = np.array([bounds[f][1] for f in fields], float)
+    p0 = np.clip([float(scene_value(scene, f)) for f in fields], lo, hi)
+    gaits = _Gaits(scene, fields, x_gait)
+    sign = -1.0 if maximize else 1.0
+    history: list = []
+    if objective in SMOOTH:
+        def fun(p):
+            v, g = measure_gradient(gaits, p, objective)
+            history.append((np.array(p, float), v))
+            return sign * v, sign * g
+
+        res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
+                       options={"maxiter": max_evaluations, "ftol": 1e-12})
+        value, grad = measure_gradient(gaits, res.x, objective)
+    else:
+        def fun(p):
+            _, fp = gaits.gait(p)
+            v = float(np.max(np.abs(fp.multipliers_variational)))
+            history.append((np.array(p, float), v))
+            return sign * v
+
+        res = minimize(fun, p0, method="Nelder-Mead", bounds=list(zip(lo, hi)),
+                       options={"maxfev": max_evaluations, "xatol": 1e-6, "fatol": 1e-9})
+        _, fp = gaits.gait(res.x)
+        value, grad = float(np.max(np.abs(fp.multipliers_variational))), np.full(len(fields),
+                                                                                 np.nan)
+    return DesignResult(fields, np.asarray(res.x, float), objective, float(value),
+                        np.asarray(grad, float), bool(res.success), str(res.message),
+                        gaits.count, history)
