@@ -376,7 +376,7 @@ def _contacts(mb, ids: dict, lanes: bool, n_patches: tuple, law: dict) -> list[s
     feet = [ln for ln in mb.links if ln.foot_m is not None]
     gid, cid = 1001, 1
     groups = list(zip(feet, n_patches)) if lanes else [(f, n_patches[0]) for f in feet]
-    for k, (ln, count) in enumerate(groups):
+    for ln, count in groups:
         first = gid if lanes else 1001
         for g in range(first, first + count):
             out += _stmt(f"CONTACT/{cid}, IGEOM={marker_id(ids[ln.name], 'foot')}, JGEOM={g}",
@@ -490,11 +490,16 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     ids = part_ids(mb)
     out = [f"walker {name} exported by walkerlab {version} (Adams Solver dataset)",
            "! The walker of the paper's Section 4, planar in the ground's x-y plane:",
-           "! x downhill, y up, parts turning about z; the ground is tilted, gravity is not.", f"! Start: the rigid gait (step period {start.period_s:.6g} s), leg2 in "
+           "! x downhill, y up, parts turning about z; the ground is tilted, gravity is not.",
+           f"! Start: the rigid gait (step period {start.period_s:.6g} s), leg2 in "
            "stance, its foot at", f"! the origin, rates x initial_rate_scale "
            f"{start.rate_scale[0]:g}, {start.rate_scale[1]:g} (paper Table 2).",
            "! Contact law in mm-kg-s (the paper's numbers as written; SI values converted).",
            "UNITS/FORCE=NEWTON, MASS=KILOGRAM, LENGTH=MILLIMETER, TIME=SECOND"]
+    if scene.contact_sim is not None and scene.contact_sim.start != "ideal":
+        out += [f"! contact_sim.start is {scene.contact_sim.start!r}: this file starts from "
+                "the rigid", "! gait x initial_rate_scale (the adjusted or periodic start "
+                "is not written)"]
     act = getattr(scene.walker, "actuation", None)
     if act is not None:
         out += ["! walker.actuation: the hip torques and the push-off are NOT exported",
