@@ -164,14 +164,51 @@ def test_kneed_round_trip(kneed):
     assert "latch" in adm and "SENSOR" in adm  # the latch is stated, not modelled
 
 
+def test_hip_spring_round_trip(tmp_path_factory):
+    """The hip spring (Kuo 2002, 20 N m/rad, rest 0) as a rotational SPRINGDAMPER between
+    the legs' hip markers: I on leg2, J on leg1 (delta = leg2 - leg1), KT in N mm/rad, no
+    CT (its damping is 0; CT > 0 when given)."""
+    scene, mb, adm, _ = _export("hip_spring", tmp_path_factory)
+    model, _ = _round_trip(scene, mb, adm)
+    (sd,) = model.by_kind["SPRINGDAMPER"].values()
+    assert "ROTATIONAL" in sd.flags and "CT" not in sd.args
+    assert sd.number("KT") == 20.0 * 1000 and sd.number("ANGLE") == 0.0
+    ids = part_ids(mb)
+    assert (sd.integer("I"), sd.integer("J")) == (marker_id(ids["leg2"], "joint"),
+                                                  marker_id(ids["leg1"], "joint"))
+
+
+def test_cli_writes_adm_and_acf(tmp_path):
+    """``walkerlab export configs/powered_compass.yaml --format adm``: both files, the
+    actuators stated as not exported, no temporary file left."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, ["export", str(ROOT / "configs" / "powered_compass.yaml"),
+                                 "--format", "adm", "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    folder = tmp_path / "powered_compass"
+    assert f"wrote {folder / 'walker.adm'}" in r.output
+    adm = (folder / "walker.adm").read_text()
+    assert "NOT exported" in adm and parse_acf((folder / "walker.acf").read_text())
+    assert not list(folder.glob(".*.tmp"))
+
+
 @pytest.mark.parametrize("name,word", [("round_feet", "arc feet"),
+                                       ("flat_feet", "flat feet"),
                                        ("torso_bhm", "walker.torso")])
 def test_refused_in_one_line(name, word, tmp_path):
-    scene = load_scene(ROOT / "configs" / f"{name}.yaml")
-    with pytest.raises(ValueError, match=word) as exc:
-        export_stage.run(scene, tmp_path, "adm")
-    assert "\n" not in str(exc.value)
-    assert not list(tmp_path.rglob("walker.adm"))
+    """Arc and flat feet, upper bodies: one line naming the field, exit 1, no file."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, ["export", str(ROOT / "configs" / f"{name}.yaml"),
+                                 "--format", "adm", "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 1
+    assert r.output.strip().count("\n") == 0 and word in r.output
+    assert not list(tmp_path.rglob("walker.a*"))
 
 
 def test_reader_refuses_outside_subset():
@@ -226,8 +263,8 @@ def test_pendulum_period_closed_form():
     t_true = 2 * math.pi * math.sqrt((0.02 + 2.0 * 0.25) / (2.0 * 9.81 * 0.5))
     up = lambda t, y: y[1]  # noqa: E731 - the rate crosses zero going down once a period
     up.direction = -1
-    sol = solve_ivp(rhs, (0, 3.2 * t_true), [0.0, w0 @ n], rtol=1e-11, atol=1e-14,
-                    events=up)
+    sol = solve_ivp(rhs, (0, 3.2 * t_true), [0.0, w0 @ n], method="DOP853", rtol=1e-11,
+                    atol=1e-14, events=up)
     crossings = sol.t_events[0]
     period = crossings[-1] - crossings[-2]
     assert abs(period / t_true - 1) < 1e-6

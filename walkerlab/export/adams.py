@@ -4,7 +4,7 @@ built as the paper's Section 4 built it in ADAMS.
 Statements (Adams Solver statement and command reference, adams_solver/state_*.html and
 com_*.html): ``UNITS``, ``PART`` (``MASS``, ``CM``, ``IP``, ``QG``, ``REULER``, ``VX``,
 ``VY``, ``WZ``, ``GROUND``), ``MARKER`` (``PART``, ``QP``, ``REULER``), ``JOINT``
-(``REVOLUTE``, ``FIXED``, ``PLANAR``; ``I``, ``J``), ``SPRINGDAMPER`` (``ROTATION``, ``KT``,
+(``REVOLUTE``, ``FIXED``, ``PLANAR``; ``I``, ``J``), ``SPRINGDAMPER`` (``ROTATIONAL``, ``KT``,
 ``CT``, ``ANGLE``), ``SFORCE`` (``ROTATION``, ``FUNCTION=IMPACT(...)``), ``ACCGRAV``
 (``JGRAVITY``), ``GRAPHICS`` (``ELLIPSOID``, ``BOX``), ``CONTACT`` (``IGEOM``, ``JGEOM``,
 ``IMPACT``, ``STIFFNESS``, ``DAMPING``, ``DMAX``, ``EXPONENT``, ``COULOMB_FRICTION``,
@@ -47,7 +47,7 @@ hip / knee joints                      JOINT/REVOLUTE I (child), J (parent)   -
 ``contact.mu_static`` / ``mu_dynamic`` CONTACT MU_STATIC / MU_DYNAMIC         -
 ``contact.stiction_velocity_*``        CONTACT STICTION_TRANSITION_VELOCITY   mm/s
 ``contact.friction_velocity_*``        CONTACT FRICTION_TRANSITION_VELOCITY   mm/s
-``walker.springs`` (hip)               SPRINGDAMPER/ROTATION KT, CT, ANGLE    N mm/rad, rad
+``walker.springs`` (hip)               SPRINGDAMPER/ROTATIONAL KT, CT, ANGLE  N mm/rad, rad
 ``contact.knee_stop`` (kneed)          SFORCE/ROTATION FUNCTION=-IMPACT(..)   N mm, rad
 rigid gait start (x ``contact_sim.     PART QG, REULER, VX, VY (CM), WZ       mm, deg, mm/s,
 initial_rate_scale``)                                                         rad/s
@@ -410,9 +410,11 @@ def _forces(mb, scene: Scene, ids: dict) -> list[str]:
             jm = marker_id(b, "joint")
         out += [f"! {sp.name}: torque -k (delta - rest) - c d(delta)/dt, delta = "
                 f"{sp.between[1]} - {sp.between[0]}"]
-        out += _stmt(f"SPRINGDAMPER/{i + 1}, ROTATION, I={marker_id(a, 'joint')}, J={jm}",
-                     f"KT={_f(sp.stiffness_n_m_per_rad * MM)}, "
-                     f"CT={_f(sp.damping_n_m_s_per_rad * MM)}, ANGLE={_f(sp.rest_angle_rad)}")
+        coefs = [f"{key}={_f(val * MM)}" for key, val in
+                 (("KT", sp.stiffness_n_m_per_rad), ("CT", sp.damping_n_m_s_per_rad))
+                 if val > 0]  # KT, CT > 0 when given (default 0)
+        out += _stmt(f"SPRINGDAMPER/{i + 1}, ROTATIONAL, I={marker_id(a, 'joint')}, J={jm}",
+                     *coefs, f"ANGLE={_f(sp.rest_angle_rad)}")
     if mb.knee:
         from walkerlab.models.contact.rigid_limit import contact_si
 
