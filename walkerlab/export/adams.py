@@ -78,6 +78,7 @@ import numpy as np
 from walkerlab.config import Scene
 from walkerlab.config.contact import LENGTH_UNITS, ContactSettings, TerrainSettings
 from walkerlab.export.mjcf_scene import point_foot_radius
+from walkerlab.units import for_scene
 
 __all__ = ["ADAMS_FILES", "PIN_JOINT", "AdamsStart", "acf_text", "adams_start", "adm_text",
            "check_adams_exportable", "contact_mm", "marker_id", "part_ids"]
@@ -190,7 +191,23 @@ class AdamsStart:
 def adams_start(scene: Scene, mb, data) -> AdamsStart:
     """The rigid gait's post-impact state (leg2 in stance, its foot at the origin), its rates
     times ``contact_sim.initial_rate_scale`` (the paper's Table 2 adjustment), and the
-    checkerboard of :func:`walkerlab.export.scene.mjcf_scene` cut to the run's strides."""
+    checkerboard of :func:`walkerlab.export.scene.mjcf_scene` cut to the run's strides.
+
+    Parameters
+    ----------
+    scene : Scene
+    mb : Multibody
+    data : WalkerData
+
+    Returns
+    -------
+    AdamsStart
+
+    Raises
+    ------
+    walkerlab.analysis.gait.search.GaitNotFound
+        No rigid gait (:func:`walkerlab.analysis.contact.periodic.ideal_gait`).
+    """
     from walkerlab.analysis.contact.periodic import ideal_gait
     from walkerlab.export.scene import mjcf_scene
     from walkerlab.models.contact.model import ContactWalker
@@ -498,6 +515,9 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
            f"{start.rate_scale[0]:g}, {start.rate_scale[1]:g} (paper Table 2).",
            "! Contact law in mm-kg-s (the paper's numbers as written; SI values converted).",
            "UNITS/FORCE=NEWTON, MASS=KILOGRAM, LENGTH=MILLIMETER, TIME=SECOND"]
+    if for_scene(scene).nondimensional:
+        out += ["! nondimensional scene (g = 1): its numbers are written as if in SI "
+                "(l = 1 m,", "! M = 1 kg, g = 1 m/s^2), then in mm-kg-s"]
     if scene.contact_sim is not None and scene.contact_sim.start != "ideal":
         out += [f"! contact_sim.start is {scene.contact_sim.start!r}: this file starts from "
                 "the rigid", "! gait x initial_rate_scale (the adjusted or periodic start "
@@ -519,7 +539,19 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
 def acf_text(scene: Scene, start: AdamsStart) -> str:
     """The command file: the initial-conditions analysis with the stance-foot pin, the pin
     deactivated, a dynamic run over the scene's strides (``2 n_strides`` rigid step
-    periods), STOP.  Its first two lines name the dataset and the output files."""
+    periods, :data:`STEPS_PER_S` output steps a second), STOP.
+
+    Parameters
+    ----------
+    scene : Scene
+    start : AdamsStart
+
+    Returns
+    -------
+    str
+        The .acf text; its first two lines name the dataset (``walker``) and the output
+        files' base name.
+    """
     t = 2 * _strides(scene) * start.period_s
     steps = max(1, round(t * STEPS_PER_S))
     return "\n".join(["walker", "walker", "SIMULATE/INITIAL_CONDITIONS",

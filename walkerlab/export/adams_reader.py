@@ -91,9 +91,11 @@ class Statement:
                                "is not a number") from None
 
     def number(self, key: str, default: float | None = None) -> float:
+        """The first number of ``key`` (``default`` if absent; none: :class:`AdmReadError`)."""
         return self.numbers(key, None if default is None else (default,))[0]
 
     def integer(self, key: str) -> int:
+        """An id argument (``CM=301``) as an int."""
         return int(self.number(key))
 
 
