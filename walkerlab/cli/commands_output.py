@@ -51,11 +51,11 @@ def animate(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
 
 @guard
 def export(scene: Path | None = SceneArg,
-           fmt: str = typer.Option("urdf", "--format", help="urdf (Drake, Pinocchio) or mjcf "
-                                   "(MuJoCo)"),
+           fmt: str = typer.Option("urdf", "--format", help="urdf (Drake, Pinocchio), mjcf "
+                                   "(MuJoCo) or adm (MSC Adams Solver .adm + .acf)"),
            runs_dir: Path = RunsOpt) -> None:
-    """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf or
-    walker.xml."""
+    """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf,
+    walker.xml, or walker.adm + walker.acf (Adams Solver)."""
     from walkerlab.stages import export as stage
 
     typer.echo(f"wrote {stage.run(load(scene), runs_dir, fmt)}")

@@ -1,4 +1,5 @@
-"""Stage ``export``: the scene's walker as a URDF or MJCF file in ``runs/<scene>/``.
+"""Stage ``export``: the scene's walker as a URDF or MJCF file, or an Adams Solver dataset and
+command file (``--format adm``: :mod:`walkerlab.export.adams`), in ``runs/<scene>/``.
 
 Not an HDF5 artifact: an exchange file for multibody libraries (Drake, Pinocchio read URDF;
 MuJoCo reads MJCF), written from the scene's ``walker`` and ``slope`` sections only (no
@@ -12,6 +13,13 @@ from pathlib import Path
 
 import walkerlab
 from walkerlab.config import Scene
+from walkerlab.export.adams import (
+    ADAMS_FILES,
+    acf_text,
+    adams_start,
+    adm_text,
+    check_adams_exportable,
+)
 from walkerlab.export.multibody import (
     FORMATS,
     SIDECAR,
@@ -35,13 +43,29 @@ def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = Fal
     ValueError
         Unknown format (one line).
     """
+    if fmt == "adm":
+        return runpaths.scene_file(scene, runs_root, ADAMS_FILES["adm"], claim)
     if fmt not in FORMATS:
-        raise ValueError(f"--format: unknown format {fmt!r} (choose {' or '.join(FORMATS)})")
+        raise ValueError(f"--format: unknown format {fmt!r} (choose "
+                         f"{', '.join(FORMATS)} or adm)")
     return runpaths.scene_file(scene, runs_root, FORMATS[fmt], claim)
 
 
+def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
+    """``walker.adm`` and ``walker.acf`` (both built before either is written)."""
+    check_adams_exportable(mb)  # before the gait search
+    start = adams_start(scene, mb, data)
+    adm = adm_text(scene, mb, data, name, walkerlab.__version__, start)
+    acf = acf_text(scene, start)
+    path = runpaths.atomic_text(export_path(scene, runs_root, "adm", claim=True), adm)
+    runpaths.atomic_text(runpaths.scene_file(scene, runs_root, ADAMS_FILES["acf"], claim=True),
+                         acf)
+    return path
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path:
-    """Write the scene's walker as ``fmt`` ("urdf" or "mjcf") into
+    """Write the scene's walker as ``fmt`` ("urdf", "mjcf" or "adm": ``walker.adm`` and
+    ``walker.acf``, returning the .adm's path) into
     ``<runs_root>/<scene name>/`` and return the file's path.
 
     Raises
@@ -53,10 +77,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path
         The run folder is not allowed.
     """
     path = export_path(scene, runs_root, fmt)  # check the format before building anything
-    check_exportable(scene)
     data = walker_data(scene.walker, scene.slope.phi_rad)
     mb = multibody(data)
     name = scene.name or "walker"
+    if fmt == "adm":
+        return _run_adams(scene, runs_root, mb, data, name)
+    check_exportable(scene)
     extra = mjcf_scene(scene, mb, data) if scene.fixedpoint is not None else None
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__)
