@@ -67,7 +67,7 @@ def test_adjust_keeps_the_scenes_start_when_the_adjusted_one_walks_worse(tmp_pat
     line = next(ln for ln in r.stdout.splitlines() if ln.startswith("--adjust:"))
     assert line.startswith("--adjust: kept the scene's initial rate scale")
     assert "adjusted start: fall after" in line
-    assert re.search(r"the scene's start: (t_final|heel_strike) after 10 heel strikes", line)
+    assert re.search(r"the scene's start: (t_final|heel_strike) after 1[01] heel strikes", line)
     with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:
         assert f["initial_rate_scale"][()].tolist() == [1.0, 1.1]
         assert f["adjust"].attrs["kept"] == "scene"

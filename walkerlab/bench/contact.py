@@ -161,7 +161,8 @@ class _Case:
         """The run covered the whole span (its last sample within two sample intervals of
         the end time): a run that stopped early ("Excess work done", a fall) is compared
         with nothing past its end, so its error says nothing about the span."""
-        dt = 2.0 / self.limits.sample_rate_hz
+        rate = getattr(self.limits, "sample_rate_hz", None) or 1000.0
+        dt = 2.0 / rate
         return bool(len(r.t)) and float(r.t[-1]) >= self.t_final - dt
 
     def error(self, r) -> float:

@@ -158,8 +158,9 @@ WALKER_VOCABULARY = (
     "(with an optional spring-damper), "
     "foot kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "
     "dampers between links at the hip; torso: an upper body on a bisecting hip mechanism; "
-    "actuation: a push-off impulse and hip torques on straight, point-footed legs, rigid "
-    "model); no knee or ankle actuators yet")
+    "actuation: a push-off impulse and hip torques on straight, point-footed legs (rigid "
+    "and contact models), an ankle push-off on flat feet (rigid model)); no knee or torso "
+    "actuators yet")
 
 
 def _walker_vocabulary_applies(root: type[BaseModel], e: dict, suggest=None) -> bool:

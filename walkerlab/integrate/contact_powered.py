@@ -140,7 +140,7 @@ def impulse_jump(walker, x, trailing, P):
     nf = len(walker.contact_names())
     Pp, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
     walker.kernels.feet(np.asarray(x, float), walker.walker_params, Pp, V, J)
-    r = x[:2] - Pp[trailing]
+    r = np.asarray(walker.points(x)["hip"], float).ravel() - Pp[trailing]
     M = walker.mass_matrix(x)
     dq = x[n:] + np.linalg.solve(M, J[trailing].T @ (P * r / np.sqrt(r @ r)))
     work = 0.5 * dq @ M @ dq - 0.5 * x[n:] @ M @ x[n:]
@@ -212,11 +212,12 @@ class _PoweredRun:
             self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
             return None
         except _Stall as stall:
-            x = np.asarray(stall.args[0])
             from .contact import trip_or_failure
 
+            n2 = 2 * self.walker.nq  # the walker's state, without the work integrals
+            state = np.asarray(stall.args[0])[:n2]
             self.term, self.msg, self.event = trip_or_failure(
-                self.walker, t, x[:2 * self.walker.nq],
+                self.walker, t, state,
                 f"the solver stalled after t = {t:.6g} s (a force jump it cannot step over)",
                 -1, 0.01)
             return None

@@ -309,8 +309,10 @@ def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
+    # a saturated law is never a generated spring (models.hybrid.actuated.spring_equivalent):
+    # its torque is the Actuators' own, which is replaced by the optimised one below
     spec = Actuation(push_off=PushOff(impulse_n_s=max(res.push_off_n_s, 0.0)),
-                     torques=[JointTorque(joint="hip", law=TorqueLaw())])
+                     torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
     walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
     acts = walker.actuators
     tau = torque_of_time(res)

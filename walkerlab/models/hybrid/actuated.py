@@ -281,7 +281,7 @@ def spring_equivalent(data, spec):
     K = sum(t.law.stiffness_n_m_per_rad for t in laws)
     D = sum(t.law.damping_n_m_s_per_rad for t in laws)
     C = sum(t.law.constant_n_m for t in laws)
-    if K <= 0.0 and C != 0.0:
+    if (K <= 0.0 and C != 0.0) or K == D == C == 0.0:
         return None
     r = (sum(t.law.stiffness_n_m_per_rad * t.law.rest_angle_rad for t in laws) + C) / K \
         if K > 0.0 else 0.0
