@@ -27,7 +27,7 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["DaskLost", "connect", "quiet_distributed", "completed", "result",
+__all__ = ["DaskLost", "RERUN", "connect", "quiet_distributed", "completed", "result",
            "worker_wait_s", "WORKER_WAIT_S", "WAIT_ENV"]
 
 #: default time a sweep waits for a Dask worker while none is connected [s]
@@ -39,8 +39,29 @@ POLL_S = 0.02
 CHECK_S = 1.0
 
 
+#: how to continue after a lost cluster, unless the study says otherwise
+#: (:meth:`DaskLost.advising`)
+RERUN = "rerun with --resume"
+
+
 class DaskLost(ValueError):
-    """The Dask cluster cannot finish the work (no workers, scheduler gone); one line."""
+    """The Dask cluster cannot finish the work (no workers, scheduler gone); one line.
+
+    Not bad input: the work finished before the loss is kept.  The message's ``{rerun}``
+    is how to continue (default :data:`RERUN`); a study that continues some other way
+    names it with :meth:`advising`.
+    """
+
+    def __init__(self, message: str, rerun: str = RERUN):
+        super().__init__(message)
+        self.message, self.rerun = message, rerun
+
+    def __str__(self) -> str:
+        return self.message.replace("{rerun}", self.rerun)
+
+    def advising(self, rerun: str) -> DaskLost:
+        """The same loss, advising ``rerun`` (e.g. ``"rerun the same command"``)."""
+        return DaskLost(self.message, rerun)
 
 
 def worker_wait_s() -> float:
@@ -116,9 +137,8 @@ def connect(address: str):
 
 def _lost(client) -> DaskLost:
     where = getattr(client.scheduler, "address", None) or "the Dask scheduler"
-    return DaskLost(f"lost the connection to the Dask scheduler {where}; the rows finished so "
-                    "far are kept: restart the scheduler and its workers and rerun with "
-                    "--resume")
+    return DaskLost(f"lost the connection to the Dask scheduler {where}; the work finished so "
+                    "far is kept: restart the scheduler and its workers and {rerun}")
 
 
 def _n_workers(client) -> int | None:
@@ -195,8 +215,8 @@ class _Completed:
                 where = getattr(self.client.scheduler, "address", None) or "the scheduler"
                 raise DaskLost(f"Dask scheduler {where} has had no worker for "
                                f"{self.wait_s:g} s ({self.ac.count()} task(s) waiting); the "
-                               "rows finished so far are kept: start workers (or raise "
-                               f"{WAIT_ENV}) and rerun with --resume")
+                               "work finished so far is kept: start workers (or raise "
+                               f"{WAIT_ENV}) and {{rerun}}")
         raise StopIteration
 
 
@@ -210,9 +230,10 @@ def result(client, fut):
     try:
         return fut.result()
     except KilledWorker as exc:
-        raise DaskLost(f"a Dask task ended the worker running it, again and again ({exc}); the "
-                       "rows finished so far are kept: rerun with --resume (locally, without "
-                       "--scheduler, to see the error)") from None
+        raise DaskLost(f"a Dask task ended the worker running it, again and again "
+                       f"({str(exc).replace('{', '(').replace('}', ')')}); the work finished "
+                       "so far is kept: {rerun} (locally, without --scheduler, to see the "
+                       "error)") from None
     except FutureCancelledError:
         raise _lost(client) from None
     except Exception:  # noqa: BLE001 - re-raised unless the scheduler is gone
