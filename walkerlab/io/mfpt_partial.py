@@ -1,17 +1,18 @@
-"""The in-progress file of an MFPT study (``mfpt.h5.partial``): finished pieces of work kept
-so an interrupted ``mfpt`` run resumes where it stopped (:mod:`walkerlab.studies.mfpt`).
+"""The in-progress file of an MFPT study (``mfpt.h5.partial``): finished pieces of work kept so an
+interrupted ``mfpt`` run resumes where it stopped (:mod:`walkerlab.studies.mfpt`).
 
 Layout: root attribute ``input_hash``; one group per finished piece, named by the study
 (``montecarlo/sigma=0.004/chunk=3``: the heel strikes and falls of one chunk of walks;
-``mesh/sigma=0.004``: the step-map images of the mesh nodes evaluated so far), holding
-numeric datasets and the attribute ``digest`` (SHA-256 of the input hash, the piece's name
-and every dataset's dtype and bytes).  When the file is opened every piece is read and
-checked; the file is then written afresh with the intact pieces only, so a piece whose
-digest does not match (edited), or that cannot be read at all (a damaged group, link or
-heap), is dropped and computed again, and no damaged structure is ever written into.  A file
-of another input hash, or one that is not an HDF5 file at all, is started afresh.  The file is edited in memory and saved as one image after every
-piece (:class:`walkerlab.io.h5image.H5Image`), so a killed run loses at most the pieces
-under way, and a full disk is one line ("disk full") with the last saved file intact.
+``mesh/sigma=0.004``: the step-map images of the mesh nodes evaluated so far), holding numeric
+datasets and the attribute ``digest`` (SHA-256 of the input hash, the piece's name and every
+dataset's dtype and bytes). When the file is opened every piece is read and checked; the file
+is then written afresh with the intact pieces only, so a piece whose digest does not match
+(edited), or that cannot be read at all (a damaged group, link or heap), is dropped and
+computed again, and no damaged structure is ever written into. A file of another input hash, or
+one that is not an HDF5 file at all, is started afresh. The file is edited in memory and saved
+as one image after every piece (:class:`walkerlab.io.h5image.H5Image`), so a killed run loses
+at most the pieces under way, and a full disk is one line ("disk full") with the last saved
+file intact.
 """
 
 from __future__ import annotations

@@ -141,7 +141,8 @@ class SweepStore:
         except OSError as exc:
             raise ArtifactError(f"{part}: cannot create the sweep file ({exc.strerror})") \
                 from None
-        img = H5Image(part, kept=KEPT)  # edited in memory, saved as one image (a full disk: one line)
+        # edited in memory, saved as one image (a full disk: one line)
+        img = H5Image(part, kept=KEPT)
         f = img.f
         f.attrs.update({
             "stage": "sweep", "walkerlab_version": walkerlab.__version__,

@@ -410,9 +410,8 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
         The Dask cluster was lost (one line advising :data:`RERUN`; the partial file is
         kept).
     """
-    from walkerlab.io.mfpt_partial import MfptPartial
-
     from walkerlab.execution.dask import DaskLost
+    from walkerlab.io.mfpt_partial import MfptPartial
 
     partial = MfptPartial(partial_path, key, resume=resume)
     try:
