@@ -20,6 +20,7 @@ import yaml
 from typer.testing import CliRunner
 
 from walkerlab.cli import app
+from walkerlab.config import scene_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
@@ -149,3 +150,29 @@ def test_i3_damaged_mfpt_partial_pieces_are_dropped_and_computed_again(
     data, p = _mc(paper_scene, paper_fixed_point.x, part)
     assert p.dropped >= 1 and 1 <= chunked_walks["walks"] <= 4
     assert np.array_equal(data["mfpt_steps_montecarlo"], ref["mfpt_steps_montecarlo"])
+
+
+# ------------------------------------------------------------------ 5: a link, before computing
+@pytest.mark.parametrize("stage", ["continuation", "robustness"])
+def test_i5_link_in_place_of_an_artifact_is_refused_before_computing(tmp_path, monkeypatch,
+                                                                     stage):
+    from walkerlab.io.artifacts import write_artifact
+    from walkerlab.io.runpaths import RunPathError
+    from walkerlab.io.freshness import write_if_stale
+
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    runs = tmp_path / "runs"
+    elsewhere = tmp_path / "elsewhere.h5"  # a valid artifact of another run
+    write_artifact(elsewhere, stage, sc, "other inputs", lambda f: None, 0.0)
+    link = runs / "paper" / f"{stage}.h5"
+    link.parent.mkdir(parents=True)
+    link.symlink_to(elsewhere)
+    computed, told = [], []
+
+    def compute():
+        computed.append(1)
+        return (lambda f: None), {}
+
+    with pytest.raises(RunPathError, match="symbolic link"):
+        write_if_stale(stage, sc, runs, ("walker",), (), compute, tell=told.append)
+    assert not computed and not told  # before: "recomputing ... changed" and the computation
