@@ -157,8 +157,8 @@ def test_i3_damaged_mfpt_partial_pieces_are_dropped_and_computed_again(
 def test_i5_link_in_place_of_an_artifact_is_refused_before_computing(tmp_path, monkeypatch,
                                                                      stage):
     from walkerlab.io.artifacts import write_artifact
-    from walkerlab.io.runpaths import RunPathError
     from walkerlab.io.freshness import write_if_stale
+    from walkerlab.io.runpaths import RunPathError
 
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     runs = tmp_path / "runs"
@@ -176,3 +176,21 @@ def test_i5_link_in_place_of_an_artifact_is_refused_before_computing(tmp_path, m
     with pytest.raises(RunPathError, match="symbolic link"):
         write_if_stale(stage, sc, runs, ("walker",), (), compute, tell=told.append)
     assert not computed and not told  # before: "recomputing ... changed" and the computation
+
+
+# ------------------------------------------------------------------ 7: flat-foot edges
+FLAT = yaml.safe_load((ROOT / "configs" / "flat_feet.yaml").read_text())
+
+
+@pytest.mark.parametrize("field, value", [("heel_m", 0), ("toe_m", 1e-9)])
+def test_i7_flat_foot_without_a_heel_or_toe_is_one_line_naming_the_field(tmp_path, field,
+                                                                         value):
+    data = yaml.safe_load(yaml.safe_dump(FLAT))
+    data["walker"]["leg"]["foot"][field] = value
+    scene = tmp_path / "flat.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    # before: internal error (ZeroDivisionError) / (OverflowError, after 103 s)
+    code, err, _ = _cli("fixedpoint", scene, "--runs-dir", tmp_path / "runs")
+    lines = err.splitlines()
+    assert code == 1 and len(lines) == 1, lines
+    assert f"foot.{field}" in lines[0] and "internal error" not in lines[0], lines
