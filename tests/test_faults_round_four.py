@@ -194,3 +194,41 @@ def test_i7_flat_foot_without_a_heel_or_toe_is_one_line_naming_the_field(tmp_pat
     lines = err.splitlines()
     assert code == 1 and len(lines) == 1, lines
     assert f"foot.{field}" in lines[0] and "internal error" not in lines[0], lines
+
+
+# ------------------------------------------------------------------ 8: a bounded gait search
+@pytest.mark.parametrize("search", ["find_fixed_point", "find_gaits"])
+def test_i8_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
+        paper_walker, monkeypatch, search):
+    """A spring and damper at their caps (1e6) make one step map take ~40 s, and the search
+    went on for 12+ maps (459 s, silent) before "no gait found".  Here every step is made
+    0.25 s slower and the budget is 0.6 s: the search stops after a few maps (MINPACK alone
+    needs ~20), says why, and a slow map is said in one notice."""
+    import time as _time
+
+    from walkerlab import progress
+    from walkerlab.analysis.gait import poincare
+    from walkerlab.analysis.gait import search as gait_search
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.published import paper
+
+    monkeypatch.setattr(poincare, "ROOT_BUDGET_S", 0.6, raising=False)
+    monkeypatch.setattr(poincare, "SLOW_MAP_S", 0.2, raising=False)
+    steps, notes = [], []
+    real = poincare.integrate_step
+
+    def slow_step(*a, **k):
+        steps.append(1)
+        _time.sleep(0.25)
+        return real(*a, **k)
+
+    monkeypatch.setattr(poincare, "integrate_step", slow_step)
+    monkeypatch.setattr(progress, "note", notes.append)
+    solver, guess = Solver("DOP853", 1e-12, 1e-12), np.array(paper.EQ11_STATE)
+    with pytest.raises(poincare.FixedPointNotFound, match="gave up after [1-4] step map"):
+        if search == "find_fixed_point":
+            poincare.find_fixed_point(paper_walker, guess, solver)
+        else:
+            gait_search.find_gaits(paper_walker, solver, guess)
+    assert 1 <= len(steps) <= 4, len(steps)
+    assert len(notes) == 1 and "step map took" in notes[0], notes
