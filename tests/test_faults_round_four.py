@@ -232,3 +232,33 @@ def test_i8_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
             gait_search.find_gaits(paper_walker, solver, guess)
     assert 1 <= len(steps) <= 4, len(steps)
     assert len(notes) == 1 and "step map took" in notes[0], notes
+
+
+# ------------------------------------------------------------------ 9: an unconverged mesh
+def _mfpt_data(converged: float):
+    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
+
+    vals = {k: np.array([np.nan]) for k in VARIABLES}
+    vals.update(mfpt_steps_montecarlo=np.array([6.0]), mfpt_steps_mesh=np.array([5.606]),
+                mesh_cells=np.array([80.0]), mesh_change=np.array([0.106]),
+                mesh_converged=np.array([converged]))
+    return MfptData(np.array([0.008]), vals, "both", ["a", "b", "c", "d"], [])
+
+
+def test_i9_mesh_mfpt_that_did_not_converge_is_said_on_the_cli_and_in_the_report(
+        tmp_path, monkeypatch):
+    from walkerlab.report.robustness_section import mfpt_section
+    from walkerlab.stages import common, pipeline
+    from walkerlab.studies.mfpt import mfpt_summary
+
+    data = _mfpt_data(0.0)
+    summary = mfpt_summary(data)
+    out = common.StageOutcome("mfpt", tmp_path / "mfpt.h5", False, 1.0, summary)
+    monkeypatch.setattr(pipeline, "run", lambda *a, **k: out)
+    code, err, stdout = _cli("mfpt", _scene(tmp_path), "--runs-dir", tmp_path / "runs")
+    line = [ln for ln in stdout.splitlines() if ln.startswith("sigma 0.008")]
+    assert line and "mesh 5.606 steps" in line[0], stdout
+    assert "NOT converged" in line[0] and "10.6 %" in line[0], line  # before: not said
+    report = "\n".join(mfpt_section({"mfpt": data}))
+    assert "NOT converged" in report and "10.6 %" in report
+    assert "NOT converged" not in "\n".join(mfpt_section({"mfpt": _mfpt_data(1.0)}))

@@ -34,6 +34,8 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
     ("bifurcation", "Bifurcation diagram over the slope."),
     ("basin", "Basin of attraction: where each cell of the Poincaré-section slice goes "
               "(left) and how many steps the converged cells take (right)."),
+    ("mfpt", "Mean first-passage time against the per-step slope's σ (`walkerlab mfpt`); "
+             "open squares: mesh values whose refinement did not converge."),
 ]
 
 
@@ -78,7 +80,8 @@ def _drawn_from(stem: str, arts: dict) -> bool:
                            ("fig6_", ("contact-sim",)),
                            ("fig8_", ("compare",)), ("fig", ("simulate", "contact-sim")),
                            ("work_precision", ("workprecision",)),
-                           ("bifurcation", ("bifurcation",)), ("basin", ("basin",))):
+                           ("bifurcation", ("bifurcation",)), ("basin", ("basin",)),
+                           ("mfpt", ("mfpt",))):
         if stem.startswith(prefix):
             return any(s in arts for s in stages)
     return True

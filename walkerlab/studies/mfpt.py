@@ -426,9 +426,13 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
     return data, partial
 
 
-def mfpt_summary(data) -> dict:
-    """The printable summary of an ``MfptData``: ``sigma_rad`` [rad] and the Monte Carlo and
-    mesh MFPT [steps] at each sigma (lists of float)."""
+def mfpt_summary(data, rel_change: float | None = None) -> dict:
+    """The printable summary of an ``MfptData``: ``sigma_rad`` [rad], the Monte Carlo and
+    mesh MFPT [steps] at each sigma (lists of float), and ``mesh_note``: for each sigma ''
+    or, when the mesh's refinement did not converge, why
+    (:meth:`walkerlab.io.schemas.mfpt.MfptData.mesh_notes`; ``rel_change``:
+    ``mfpt.mesh_rel_change``)."""
     return {"sigma_rad": list(map(float, data.sigma_rad)),
             "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
-            "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"]))}
+            "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"])),
+            "mesh_note": data.mesh_notes(rel_change)}
