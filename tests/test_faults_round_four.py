@@ -262,3 +262,20 @@ def test_i9_mesh_mfpt_that_did_not_converge_is_said_on_the_cli_and_in_the_report
     report = "\n".join(mfpt_section({"mfpt": data}))
     assert "NOT converged" in report and "10.6 %" in report
     assert "NOT converged" not in "\n".join(mfpt_section({"mfpt": _mfpt_data(1.0)}))
+
+
+# ------------------------------------------------------------------ 10: the gait simulate starts from
+@pytest.mark.slow
+def test_i10_report_of_a_scene_without_fixedpoint_section_shows_the_gait_simulate_starts_from(
+        tmp_path):
+    scene = tmp_path / "nofp.yaml"
+    scene.write_text(yaml.safe_dump({k: v for k, v in IDEAL.items() if k != "fixedpoint"}))
+    runs = tmp_path / "runs"
+    code, err, _ = _cli("simulate", scene, "--runs-dir", runs)  # runs the fixed point first
+    assert code == 0, err
+    code, err, _ = _cli("report", scene, "--runs-dir", runs)
+    assert code == 0, err
+    md = (runs / "nofp" / "report" / "report.md").read_text()
+    # before: left out ("an earlier standalone run: the scene has no 'fixedpoint' section")
+    assert "## Fixed point of the Poincaré map" in md and "Floquet multipliers" in md
+    assert "fixedpoint.h5 (an earlier standalone run" not in md
