@@ -264,7 +264,7 @@ def test_i9_mesh_mfpt_that_did_not_converge_is_said_on_the_cli_and_in_the_report
     assert "NOT converged" not in "\n".join(mfpt_section({"mfpt": _mfpt_data(1.0)}))
 
 
-# ------------------------------------------------------------------ 10: the gait simulate starts from
+# ------------------------------------------------------------------ 10: the gait simulate uses
 @pytest.mark.slow
 def test_i10_report_of_a_scene_without_fixedpoint_section_shows_the_gait_simulate_starts_from(
         tmp_path):
@@ -279,3 +279,28 @@ def test_i10_report_of_a_scene_without_fixedpoint_section_shows_the_gait_simulat
     # before: left out ("an earlier standalone run: the scene has no 'fixedpoint' section")
     assert "## Fixed point of the Poincaré map" in md and "Floquet multipliers" in md
     assert "fixedpoint.h5 (an earlier standalone run" not in md
+
+
+# ------------------------------------------------------------------ 11: a damper is not drift
+def test_i11_a_dampers_loss_is_named_and_the_balance_checked_with_it():
+    """Hip spring 20 N m/rad with a 0.05 N m s/rad damper: the report called the damper's
+    0.026 J "energy drift between impacts" (3.7e-9 J without the damper).  The energy ledger
+    of the run (``simulate.h5``, ledger/) has the damper's work and the balance's closure."""
+    from types import SimpleNamespace
+
+    from walkerlab.report.sections import energy_check
+    from walkerlab.units import Units
+
+    def sim(damper):
+        n = 3
+        return SimpleNamespace(ledger={
+            "damper_work": np.full(n, damper), "actuator_work_positive": np.zeros(n),
+            "actuator_work_negative": np.zeros(n), "closure": np.array([-2e-13, 2.5e-13, 0])})
+
+    text, rows = energy_check(sim(-0.0527), (0.026, 1.7e-4), Units())
+    assert "drift" not in text and "dampers dissipate 0.0527 J per step" in text, text
+    assert "closes to 2.5e-13 J" in text, text
+    assert [r[0] for r in rows] == ["damper work per step (energy ledger)",
+                                    "energy balance closure, largest per step (ledger)"]
+    text, rows = energy_check(sim(0.0), (3.7e-9, 1e-11), Units())  # no damper: drift is the check
+    assert text.startswith("energy drift between impacts 3.7e-09 J"), text
