@@ -333,3 +333,23 @@ def test_i12_animation_draws_the_upper_body(tmp_path):
         import matplotlib.pyplot as plt
 
         plt.close(frames.fig)
+
+
+# ------------------------------------------------------------------ 6: a stride map on a branch
+@pytest.mark.slow
+def test_i6_continuation_where_the_legs_start_to_differ_writes_its_artifact(tmp_path):
+    """A hip spring's rest angle from 0 (legs alike: a one-step map) to 0.01 rad (legs that
+    differ: a stride) - before: 9-15 s of work, then "setting an array element with a
+    sequence" while writing (orbits of 1 and 2 heel strikes on one branch).  The branch has
+    one map, a stride, throughout; the fixed points at 0 are the gait's, as before."""
+    from walkerlab.io.schemas.continuation import load_continuation
+
+    code, err, _ = _cli("continuation", ROOT / "configs" / "hip_spring.yaml", "--param",
+                        "walker.springs.0.rest_angle_rad=0:0.01", "--runs-dir", tmp_path)
+    assert code == 0, err
+    path = tmp_path / "hip_spring" / "continuation_walker.springs.0.rest_angle_rad.h5"
+    with h5py.File(path, "r") as f:
+        orbit = f["branches/0/orbit/swing_angle"][()]
+    assert orbit.ndim == 2 and orbit.shape[1] == 2  # two heel strikes a map at every point
+    d = load_continuation(path)
+    assert np.all(np.isfinite(d.branches[0]["param"]))
