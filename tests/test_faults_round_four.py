@@ -395,3 +395,27 @@ def test_i4_waiting_for_a_dask_result_is_bounded_and_says_why(monkeypatch):
     with pytest.raises(D.DaskLost, match="has had no worker for 0.3 s") as info:
         D.result(_NoWorkerClient(), _LostDataFuture())
     assert "--resume" in str(info.value) and "{rerun}" not in str(info.value)
+
+
+def test_i8_search_budgets_nest_and_end_with_their_search():
+    """A fixed point inside a gait search keeps the search's earlier deadline and adds its
+    maps to the search's count; after the search no map is bounded (per thread)."""
+    import threading
+
+    from walkerlab.analysis.gait import poincare as P
+
+    with P.search_budget(1000.0):
+        outer = P._BUDGET.deadline
+        with P.search_budget(2000.0):
+            assert P._BUDGET.deadline == outer
+            P._map_started()
+        with P.search_budget(0.0):
+            with pytest.raises(P.SearchGaveUp, match="gave up after 1 step map"):
+                P._map_started()
+        assert P._BUDGET.deadline == outer
+        seen = []
+        t = threading.Thread(target=lambda: seen.append(P._BUDGET.deadline))
+        t.start()
+        t.join()
+        assert seen == [float("inf")]  # another thread's search has its own budget
+    assert P._BUDGET.deadline == float("inf")

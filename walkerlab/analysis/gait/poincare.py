@@ -11,6 +11,7 @@ multiplier is zero by construction because ``P`` lands on the guard surface.
 from __future__ import annotations
 
 import math
+import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -37,13 +38,17 @@ ROOT_BUDGET_S = 60.0
 SLOW_MAP_S = 5.0
 
 
-class _Budget:
-    """The wall-time budget of the search under way (:func:`search_budget`)."""
+class _Budget(threading.local):
+    """The wall-time budget of the search under way in this thread (:func:`search_budget`;
+    per thread: the report runs the work-precision study in a thread of its own)."""
 
     deadline = math.inf  # time.perf_counter() after which no step map starts
     maps = 0  # step maps started under the budget
     slowest = 0.0  # slowest of them [s]
     started = 0.0
+
+
+_BUDGET = _Budget()
 
 
 class SearchGaveUp(Exception):
@@ -58,39 +63,38 @@ def search_budget(seconds: float | None = None) -> Iterator[None]:
     :func:`poincare_map` raises :class:`SearchGaveUp` instead of starting a map.  A map
     slower than :data:`SLOW_MAP_S` is said once in a notice
     (:func:`walkerlab.progress.note`)."""
-    outer = (_Budget.deadline, _Budget.maps, _Budget.slowest, _Budget.started)
+    outer = _BUDGET.deadline
     now = time.perf_counter()
-    if not math.isfinite(_Budget.deadline):  # the outermost budget counts the maps
-        _Budget.maps, _Budget.slowest, _Budget.started = 0, 0.0, now
-    _Budget.deadline = min(_Budget.deadline,
-                           now + (ROOT_BUDGET_S if seconds is None else seconds))
+    if not math.isfinite(outer):  # the outermost budget counts the maps of all inside
+        _BUDGET.maps, _BUDGET.slowest, _BUDGET.started = 0, 0.0, now
+    _BUDGET.deadline = min(outer, now + (ROOT_BUDGET_S if seconds is None else seconds))
     try:
         yield
     finally:
-        _Budget.deadline, _Budget.maps, _Budget.slowest, _Budget.started = outer
+        _BUDGET.deadline = outer
 
 
 def _map_started() -> float:
     t = time.perf_counter()
-    if t > _Budget.deadline:
+    if t > _BUDGET.deadline:
         raise SearchGaveUp(
-            f"the search gave up after {_Budget.maps} step map(s) in "
-            f"{t - _Budget.started:.0f} s (its time budget; the slowest map took "
-            f"{_Budget.slowest:.1f} s - a very stiff or heavily damped spring makes the "
+            f"the search gave up after {_BUDGET.maps} step map(s) in "
+            f"{t - _BUDGET.started:.0f} s (its time budget; the slowest map took "
+            f"{_BUDGET.slowest:.1f} s - a very stiff or heavily damped spring makes the "
             "integrator crawl: soften it, or start nearer the gait)")
-    _Budget.maps += 1
+    _BUDGET.maps += 1
     return t
 
 
 def _map_ended(t: float) -> None:
     dt = time.perf_counter() - t
-    if dt > SLOW_MAP_S and _Budget.slowest <= SLOW_MAP_S and math.isfinite(_Budget.deadline):
+    if dt > SLOW_MAP_S and _BUDGET.slowest <= SLOW_MAP_S and math.isfinite(_BUDGET.deadline):
         from walkerlab import progress
 
         progress.note(f"gait search: one step map took {dt:.0f} s (a very stiff or heavily "
                       "damped spring makes every step slow); the search gives up after "
-                      f"{_Budget.deadline - _Budget.started:.0f} s")
-    _Budget.slowest = max(_Budget.slowest, dt)
+                      f"{_BUDGET.deadline - _BUDGET.started:.0f} s")
+    _BUDGET.slowest = max(_BUDGET.slowest, dt)
 
 
 class StepFailed(RuntimeError):
