@@ -72,9 +72,11 @@ def mfpt(scene: Path | None = SceneArg,
     out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
                        workers=workers, scheduler=scheduler)
     if out.summary:
-        for s, m, me in zip(out.summary["sigma_rad"], out.summary["mfpt_steps_montecarlo"],
-                            out.summary["mfpt_steps_mesh"]):
-            typer.echo(f"sigma {s:.4g} rad: MFPT Monte Carlo {m:.4g}, mesh {me:.4g} steps")
+        for s, m, me, why in zip(out.summary["sigma_rad"],
+                                 out.summary["mfpt_steps_montecarlo"],
+                                 out.summary["mfpt_steps_mesh"], out.summary["mesh_note"]):
+            typer.echo(f"sigma {s:.4g} rad: MFPT Monte Carlo {m:.4g}, mesh {me:.4g} steps"
+                       + (f" - mesh {why}" if why else ""))
     typer.echo(status(out))
     typer.echo(f"figure: {stage.figure_path(sc, runs_dir)}")
 

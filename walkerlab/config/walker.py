@@ -144,6 +144,13 @@ class AnkleSpec(TorsionalSpring):
                                   "spring is relaxed [rad]; 0 = sole perpendicular to the leg")
 
 
+#: shortest heel or toe of a flat foot, as a fraction of the leg length [-]: the stance
+#: foot rolls about its heel (heel contact) and its toe (heel off), so each must lie apart
+#: from the ankle; a heel at the ankle divides by zero in the heel-contact flow, a toe of
+#: 1e-9 m drives the heel-off flow to overflow
+MIN_SOLE_FRACTION = 1e-3
+
+
 class FlatFoot(Strict):
     """A massless flat foot on an ankle spring: a sole segment through the leg's end (the
     ankle lies on the sole line, ankle height 0) from the heel, ``heel_m`` behind the ankle,
@@ -151,8 +158,10 @@ class FlatFoot(Strict):
     contact, foot flat and heel off (toe contact)."""
 
     kind: Literal["flat"] = Field(description="foot shape")
-    heel_m: float = Field(ge=0, le=10, description="heel behind the ankle along the sole [m]")
-    toe_m: float = Field(gt=0, le=10, description="toe ahead of the ankle along the sole [m]")
+    heel_m: float = Field(ge=0, le=10, description="heel behind the ankle along the sole [m] "
+                          "(at least MIN_SOLE_FRACTION of the leg)")
+    toe_m: float = Field(gt=0, le=10, description="toe ahead of the ankle along the sole [m] "
+                         "(at least MIN_SOLE_FRACTION of the leg)")
     ankle: AnkleSpec = Field(description="the ankle joint's spring and damper")
 
 
@@ -237,6 +246,15 @@ class LegSpec(Strict):
         if self.foot.kind == "flat" and self.knee is not None:
             raise ValueError("foot.kind: flat feet are not available with a knee yet "
                              "(straight legs only)")
+        if self.foot.kind == "flat":
+            shortest = MIN_SOLE_FRACTION * self.length_m
+            for name in ("heel_m", "toe_m"):
+                if getattr(self.foot, name) < shortest:
+                    raise ValueError(
+                        f"foot.{name}: {getattr(self.foot, name):g} m is shorter than "
+                        f"{MIN_SOLE_FRACTION:g} of the leg ({shortest:g} m): the foot rolls "
+                        "about its heel and its toe, which must lie apart from the ankle "
+                        "(a foot without a sole is kind: point)")
         if self.foot.kind == "arc" and self.foot.radius_m > self.length_m - (
                 self.knee.thigh_length_m if self.knee else 0.0):
             raise ValueError("foot.radius_m: the arc's centre must lie on the "

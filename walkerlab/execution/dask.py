@@ -11,8 +11,10 @@ tracebacks while it tries to reconnect.  Here:
 - :func:`completed` yields futures as they finish, like ``distributed.as_completed``, but
   raises :class:`DaskLost` (a ``ValueError``, one line) when the scheduler has had no worker
   for :func:`worker_wait_s` seconds while work is pending, or when the connection to the
-  scheduler is lost (cancelled futures); :func:`result` turns a cancelled or killed task
-  into that line too.  A task that fails on its own raises its own error, unchanged.
+  scheduler is lost (cancelled futures); :func:`result` waits the same bounded way (a
+  finished future whose data died with its worker is computed again and waits for a
+  worker) and turns a cancelled or killed task into that line too.  Both share one wait,
+  ``_WorkerWatch``.  A task that fails on its own raises its own error, unchanged.
 
 The wait for workers is ``$WALKERLAB_DASK_WORKER_WAIT_S`` seconds (default
 :data:`WORKER_WAIT_S`): long enough for a worker to be restarted by its nanny or a batch
@@ -27,7 +29,7 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["DaskLost", "connect", "quiet_distributed", "completed", "result",
+__all__ = ["DaskLost", "RERUN", "connect", "quiet_distributed", "completed", "result",
            "worker_wait_s", "WORKER_WAIT_S", "WAIT_ENV"]
 
 #: default time a sweep waits for a Dask worker while none is connected [s]
@@ -39,8 +41,29 @@ POLL_S = 0.02
 CHECK_S = 1.0
 
 
+#: how to continue after a lost cluster, unless the study says otherwise
+#: (:meth:`DaskLost.advising`)
+RERUN = "rerun with --resume"
+
+
 class DaskLost(ValueError):
-    """The Dask cluster cannot finish the work (no workers, scheduler gone); one line."""
+    """The Dask cluster cannot finish the work (no workers, scheduler gone); one line.
+
+    Not bad input: the work finished before the loss is kept.  The message's ``{rerun}``
+    is how to continue (default :data:`RERUN`); a study that continues some other way
+    names it with :meth:`advising`.
+    """
+
+    def __init__(self, message: str, rerun: str = RERUN):
+        super().__init__(message)
+        self.message, self.rerun = message, rerun
+
+    def __str__(self) -> str:
+        return self.message.replace("{rerun}", self.rerun)
+
+    def advising(self, rerun: str) -> DaskLost:
+        """The same loss, advising ``rerun`` (e.g. ``"rerun the same command"``)."""
+        return DaskLost(self.message, rerun)
 
 
 def worker_wait_s() -> float:
@@ -116,9 +139,8 @@ def connect(address: str):
 
 def _lost(client) -> DaskLost:
     where = getattr(client.scheduler, "address", None) or "the Dask scheduler"
-    return DaskLost(f"lost the connection to the Dask scheduler {where}; the rows finished so "
-                    "far are kept: restart the scheduler and its workers and rerun with "
-                    "--resume")
+    return DaskLost(f"lost the connection to the Dask scheduler {where}; the work finished so "
+                    "far is kept: restart the scheduler and its workers and {rerun}")
 
 
 def _n_workers(client) -> int | None:
@@ -155,6 +177,39 @@ def completed(client, futures, wait_s: float | None = None) -> Iterator:
     return _Completed(client, futures, worker_wait_s() if wait_s is None else wait_s)
 
 
+class _WorkerWatch:
+    """The one bounded wait on Dask futures (:func:`completed`, :func:`result`): between
+    two looks for finished work, :meth:`check` asks the scheduler (at most every
+    :data:`CHECK_S`) for its workers and raises :class:`DaskLost` once it has had none for
+    ``wait_s`` seconds, or is gone."""
+
+    def __init__(self, client, wait_s: float):
+        self.client, self.wait_s = client, wait_s
+        self.no_workers_since: float | None = None
+        self.checked = time.monotonic()
+
+    def check(self, waiting: int) -> None:
+        """Raise :class:`DaskLost` when the wait must end (``waiting``: tasks waited for)."""
+        now = time.monotonic()
+        if now - self.checked < CHECK_S:
+            return
+        self.checked = now
+        if self.client.status not in ("running", "connecting"):
+            raise _lost(self.client)
+        n = _n_workers(self.client)
+        if n is None:
+            raise _lost(self.client)
+        if n:
+            self.no_workers_since = None
+        elif self.no_workers_since is None:
+            self.no_workers_since = now
+        elif now - self.no_workers_since >= self.wait_s:
+            where = getattr(self.client.scheduler, "address", None) or "the scheduler"
+            raise DaskLost(f"Dask scheduler {where} has had no worker for {self.wait_s:g} s "
+                           f"({waiting} task(s) waiting); the work finished so far is kept: "
+                           f"start workers (or raise {WAIT_ENV}) and {{rerun}}")
+
+
 class _Completed:
     def __init__(self, client, futures, wait_s: float):
         from distributed import as_completed
@@ -169,8 +224,7 @@ class _Completed:
         return self
 
     def __next__(self):
-        no_workers_since: float | None = None
-        checked = time.monotonic()
+        watch = _WorkerWatch(self.client, self.wait_s)
         while not self.ac.is_empty():
             if self.ac.has_ready():
                 fut = next(self.ac)
@@ -178,41 +232,32 @@ class _Completed:
                     raise _lost(self.client)
                 return fut
             time.sleep(POLL_S)
-            now = time.monotonic()
-            if now - checked < CHECK_S:
-                continue
-            checked = now
-            if self.client.status not in ("running", "connecting"):
-                raise _lost(self.client)
-            n = _n_workers(self.client)
-            if n is None:
-                raise _lost(self.client)
-            if n:
-                no_workers_since = None
-            elif no_workers_since is None:
-                no_workers_since = now
-            elif now - no_workers_since >= self.wait_s:
-                where = getattr(self.client.scheduler, "address", None) or "the scheduler"
-                raise DaskLost(f"Dask scheduler {where} has had no worker for "
-                               f"{self.wait_s:g} s ({self.ac.count()} task(s) waiting); the "
-                               "rows finished so far are kept: start workers (or raise "
-                               f"{WAIT_ENV}) and rerun with --resume")
+            watch.check(self.ac.count())
         raise StopIteration
 
 
-def result(client, fut):
-    """``fut.result()``; a task that killed its workers, or was cancelled or failed because
-    the scheduler was lost, raises :class:`DaskLost` (one line); an error of the task itself
-    (scheduler still there) propagates unchanged."""
+def result(client, fut, wait_s: float | None = None):
+    """``fut.result()``, waited for as :func:`completed` waits (a finished future whose data
+    died with its worker is computed again, and waits for a worker): no worker for
+    ``wait_s`` seconds (default :func:`worker_wait_s`), or the scheduler gone, raises
+    :class:`DaskLost`; so does a task that killed its workers, or was cancelled or failed
+    because the scheduler was lost (one line).  An error of the task itself (scheduler still
+    there) propagates unchanged."""
     from distributed.client import FutureCancelledError
     from distributed.scheduler import KilledWorker
 
+    watch = _WorkerWatch(client, worker_wait_s() if wait_s is None else wait_s)
     try:
-        return fut.result()
+        while True:
+            try:
+                return fut.result(timeout=CHECK_S)
+            except TimeoutError:  # still waiting (asyncio's and distributed's are this one)
+                watch.check(1)
     except KilledWorker as exc:
-        raise DaskLost(f"a Dask task ended the worker running it, again and again ({exc}); the "
-                       "rows finished so far are kept: rerun with --resume (locally, without "
-                       "--scheduler, to see the error)") from None
+        raise DaskLost(f"a Dask task ended the worker running it, again and again "
+                       f"({str(exc).replace('{', '(').replace('}', ')')}); the work finished "
+                       "so far is kept: {rerun} (locally, without --scheduler, to see the "
+                       "error)") from None
     except FutureCancelledError:
         raise _lost(client) from None
     except Exception:  # noqa: BLE001 - re-raised unless the scheduler is gone

@@ -79,10 +79,11 @@ def is_disk_full(exc: BaseException) -> bool:
         "No space left on device" in text or "File too large" in text
 
 
-def disk_full_error(path: Path, exc: OSError) -> ArtifactError:
-    """The one-line "disk full" error of a write to ``path``."""
+def disk_full_error(path: Path, exc: OSError,
+                    kept: str = "nothing was replaced") -> ArtifactError:
+    """The one-line "disk full" error of a write to ``path``; ``kept`` says what is left."""
     why = os.strerror(exc.errno) if exc.errno in DISK_FULL_ERRNOS else "no space left"
-    return ArtifactError(f"disk full: cannot write {path} ({why}); nothing was replaced - "
+    return ArtifactError(f"disk full: cannot write {path} ({why}); {kept} - "
                          "free some space (or raise the file-size limit) and rerun")
 
 

@@ -60,25 +60,37 @@ def read_basin_partial(part: Path, key: str, shape: tuple[int, int]
 def basin_partial_writer(part: Path, key: str, arrays: dict[str, np.ndarray],
                          row_hash: np.ndarray
                          ) -> Iterator[Callable[[dict[str, np.ndarray], np.ndarray], None]]:
-    """Create the partial file exclusively (it must not exist) with ``arrays`` and
-    ``row_hash``; yield ``write(arrays, row_hash)``, which stores their current values and
-    flushes the file.
+    """Create the partial file (it must not exist) with ``arrays`` and ``row_hash``; yield
+    ``write(arrays, row_hash)``, which stores their current values and saves the file.
+
+    The file is edited in memory and saved as one image (:class:`walkerlab.io.h5image.H5Image`):
+    a full disk is one line and the file saved before stays intact.
 
     Raises
     ------
     FileExistsError
         ``part`` exists.
+    walkerlab.io.artifacts.ArtifactError
+        The disk is full ("disk full", one line).
     """
-    with h5py.File(part, "x") as f:
+    from walkerlab.io.h5image import H5Image
+
+    if part.exists() or part.is_symlink():
+        raise FileExistsError(part)
+    img = H5Image(part)
+    try:
+        f = img.f
         f.attrs["input_hash"] = key
         dsets = {k: f.create_dataset(k, data=v) for k, v in arrays.items()}
         hashes = f.create_dataset("row_hash", data=row_hash, dtype=h5py.string_dtype())
-        f.flush()
+        img.save()
 
         def write(arrays: dict[str, np.ndarray], row_hash: np.ndarray) -> None:
             for k, d in dsets.items():
                 d[...] = arrays[k]
             hashes[...] = row_hash
-            f.flush()
+            img.save()
 
         yield write
+    finally:
+        img.close()

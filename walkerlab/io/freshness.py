@@ -28,7 +28,7 @@ from walkerlab.io.artifacts import (
     write_artifact,
 )
 from walkerlab.io.runpaths import artifact_lock, stage_artifact
-from walkerlab.safefs import NotARegularFile, read_regular
+from walkerlab.safefs import NotARegularFile, read_regular, refuse_link
 
 
 def input_hash(stage: str, scene, sections: tuple[str, ...],
@@ -168,10 +168,12 @@ def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str
     Raises
     ------
     walkerlab.io.runpaths.RunPathError, walkerlab.io.artifacts.ArtifactError
-        A bad run path, an artifact that cannot be written (one line); and whatever
+        A bad run path, a symbolic link in place of the artifact (both before anything
+        is computed), an artifact that cannot be written (one line); and whatever
         ``compute`` raises (nothing is written then).
     """
-    path = stage_artifact(scene, runs_root, artifact or stage, claim=True)
+    # a link in place of the artifact is refused now, not after the computation
+    path = refuse_link(stage_artifact(scene, runs_root, artifact or stage, claim=True))
     # one writer per artifact: a second identical run waits, then finds the result up to date
     with artifact_lock(path, wait=True, on_wait=tell):
         key = input_hash(stage, scene, sections, upstream, extra_key)

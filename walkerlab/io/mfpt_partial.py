@@ -1,13 +1,18 @@
-"""The in-progress file of an MFPT study (``mfpt.h5.partial``): finished pieces of work kept
-so an interrupted ``mfpt`` run resumes where it stopped (:mod:`walkerlab.studies.mfpt`).
+"""The in-progress file of an MFPT study (``mfpt.h5.partial``): finished pieces of work kept so an
+interrupted ``mfpt`` run resumes where it stopped (:mod:`walkerlab.studies.mfpt`).
 
 Layout: root attribute ``input_hash``; one group per finished piece, named by the study
 (``montecarlo/sigma=0.004/chunk=3``: the heel strikes and falls of one chunk of walks;
-``mesh/sigma=0.004``: the step-map images of the mesh nodes evaluated so far), holding
-numeric datasets and the attribute ``digest`` (SHA-256 of the input hash, the piece's name
-and every dataset's dtype and bytes).  A piece whose digest does not match (edited, damaged)
-is dropped and computed again; a file of another input hash is started afresh.  Pieces are
-flushed as they are stored, so a killed run loses at most the pieces under way.
+``mesh/sigma=0.004``: the step-map images of the mesh nodes evaluated so far), holding numeric
+datasets and the attribute ``digest`` (SHA-256 of the input hash, the piece's name and every
+dataset's dtype and bytes). When the file is opened every piece is read and checked; the file
+is then written afresh with the intact pieces only, so a piece whose digest does not match
+(edited), or that cannot be read at all (a damaged group, link or heap), is dropped and
+computed again, and no damaged structure is ever written into. A file of another input hash, or
+one that is not an HDF5 file at all, is started afresh. The file is edited in memory and saved
+as one image after every piece (:class:`walkerlab.io.h5image.H5Image`), so a killed run loses
+at most the pieces under way, and a full disk is one line ("disk full") with the last saved
+file intact.
 """
 
 from __future__ import annotations
@@ -31,6 +36,45 @@ def piece_digest(key: str, name: str, arrays: dict[str, np.ndarray]) -> str:
     return h.hexdigest()
 
 
+MEND_ERRORS = (OSError, KeyError, ValueError, RuntimeError, TypeError)
+
+
+def _intact_pieces(f: h5py.File, key: str) -> tuple[dict[str, dict[str, np.ndarray]], int]:
+    """``(pieces, dropped)``: the arrays of every piece of ``f`` whose digest matches, and
+    how many pieces (or unreadable groups) did not."""
+    pieces: dict[str, dict[str, np.ndarray]] = {}
+    dropped = 0
+
+    def walk(g: h5py.Group, prefix: str) -> None:
+        nonlocal dropped
+        try:
+            names = list(g.keys())
+        except MEND_ERRORS:
+            dropped += 1
+            return
+        for n in names:
+            name = f"{prefix}{n}"
+            try:
+                obj = g[n]
+                if not isinstance(obj, h5py.Group):
+                    continue
+                digest = obj.attrs.get("digest")
+                if digest is None:
+                    walk(obj, name + "/")
+                    continue
+                arrays = {k: obj[k][()] for k in obj if isinstance(obj[k], h5py.Dataset)}
+            except MEND_ERRORS:
+                dropped += 1
+                continue
+            if digest == piece_digest(key, name, arrays):
+                pieces[name] = arrays
+            else:
+                dropped += 1
+
+    walk(f, "")
+    return pieces, dropped
+
+
 class MfptPartial:
     """Finished pieces of an MFPT study in ``path`` (open while the study runs).
 
@@ -43,69 +87,89 @@ class MfptPartial:
     resume : bool
         False: start afresh even from a matching file.
 
+    Attributes
+    ----------
+    dropped : int
+        Pieces of the file that failed their digest or could not be read.
+
     Raises
     ------
     walkerlab.safefs.RunPathError
         ``path`` is a symbolic link (one line).
+    walkerlab.io.artifacts.ArtifactError
+        The disk is full ("disk full", one line).
     """
 
     def __init__(self, path: Path | str, key: str, resume: bool = True):
+        from walkerlab.io.h5image import H5Image
         from walkerlab.safefs import refuse_link
 
         self.path = refuse_link(Path(path))
         self.key = key
         self.dropped = 0
+        self._pieces: dict[str, dict[str, np.ndarray]] = {}
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        f = None
         if resume and self.path.is_file():
+            self._pieces, self.dropped = self._read()
+        self._img = H5Image(self.path)
+        self._img.f.attrs["input_hash"] = key
+        try:
+            for name, arrays in self._pieces.items():
+                self._write(name, arrays)
+            self._img.save()
+        except BaseException:
+            self._img.close()
+            raise
+
+    def _read(self) -> tuple[dict, int]:
+        from walkerlab.io.h5image import H5Image
+
+        try:
+            img = H5Image.load(self.path)
+        except (OSError, RuntimeError):  # not an HDF5 file, truncated, ...
+            return {}, 0
+        try:
+            if img.f.attrs.get("input_hash") != self.key:
+                return {}, 0
+            return _intact_pieces(img.f, self.key)
+        except MEND_ERRORS:  # the root itself is damaged
+            return {}, 0
+        finally:
             try:
-                f = h5py.File(self.path, "a")
-                if f.attrs.get("input_hash") != key:
-                    f.close()
-                    f = None
-            except OSError:
-                f = None
-        if f is None:
-            self.path.unlink(missing_ok=True)
-            f = h5py.File(self.path, "x")
-            f.attrs["input_hash"] = key
-            f.flush()
-        self._f = f
+                img.close()
+            except MEND_ERRORS:
+                pass
 
     def get(self, name: str) -> dict[str, np.ndarray] | None:
-        """The arrays of piece ``name``, or None when it is missing or fails its digest
-        (then it is removed, and counted in ``dropped``)."""
-        if name not in self._f:
-            return None
-        g = self._f[name]
-        try:
-            arrays = {k: g[k][()] for k in g if isinstance(g[k], h5py.Dataset)}
-            ok = g.attrs.get("digest") == piece_digest(self.key, name, arrays)
-        except (OSError, KeyError, ValueError):
-            ok = False
-        if not ok:
-            del self._f[name]
-            self._f.flush()
-            self.dropped += 1
-            return None
-        return arrays
+        """The arrays of piece ``name``, or None when the file had no intact piece of
+        that name (a damaged one is counted in ``dropped`` when the file is opened)."""
+        return self._pieces.get(name)
 
-    def put(self, name: str, arrays: dict[str, np.ndarray]) -> None:
-        """Store (or replace) piece ``name`` and flush the file."""
-        if name in self._f:
-            del self._f[name]
-        g = self._f.create_group(name)
-        arrays = {k: np.asarray(v) for k, v in arrays.items()}
+    def _write(self, name: str, arrays: dict[str, np.ndarray]) -> None:
+        f = self._img.f
+        if name in f:
+            del f[name]
+        g = f.create_group(name)
         for k, v in arrays.items():
             g.create_dataset(k, data=v)
         g.attrs["digest"] = piece_digest(self.key, name, arrays)
-        self._f.flush()
+
+    def put(self, name: str, arrays: dict[str, np.ndarray]) -> None:
+        """Store (or replace) piece ``name`` and save the file.
+
+        Raises
+        ------
+        walkerlab.io.artifacts.ArtifactError
+            The disk is full ("disk full", one line; the file saved before is kept).
+        """
+        arrays = {k: np.asarray(v) for k, v in arrays.items()}
+        self._pieces[name] = arrays
+        self._write(name, arrays)
+        self._img.save()
 
     def close(self) -> None:
         """Close the file (it stays on disk until :meth:`remove`)."""
-        if self._f is not None:
-            self._f.close()
-            self._f = None
+        self._img.close()
 
     def remove(self) -> None:
         """Close and delete the file (the study's artifact is written)."""

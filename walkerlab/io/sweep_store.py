@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -57,6 +56,10 @@ from walkerlab.units import field_unit
 
 __all__ = ["SweepColumns", "SweepFileError", "SweepStore", "complete_sweep", "load_sweep",
            "partial_path"]
+
+
+#: what a "disk full" error while the sweep runs says is left
+KEPT = "the rows saved before are kept for --resume"
 
 
 class SweepFileError(ValueError):
@@ -104,9 +107,10 @@ class SweepStore:
     ``axes`` are the sweep's axes (:class:`walkerlab.studies.params.ParamAxis`: ``path``,
     ``values``, ``spec``, ``numeric``, ``len``); ``columns`` its row layout."""
 
-    def __init__(self, final: Path, f: h5py.File, axes: list, columns: SweepColumns):
+    def __init__(self, final: Path, img, axes: list, columns: SweepColumns):
         self.final = Path(final)
-        self.f = f
+        self._img = img  # walkerlab.io.h5image.H5Image of the partial file
+        self.f = img.f
         self.axes = axes
         self.columns = columns
 
@@ -127,17 +131,19 @@ class SweepStore:
             The partial file cannot be created (one line).
         """
         from walkerlab.io.artifacts import ArtifactError
+        from walkerlab.io.h5image import H5Image
 
         final = Path(final)
         part = partial_path(final)
         try:
             final.parent.mkdir(parents=True, exist_ok=True)
             part.unlink(missing_ok=True)  # a link in its place is removed, not followed
-            f = h5py.File(part, "x")  # created exclusively (O_EXCL)
         except OSError as exc:
-            reason = exc.strerror or str(exc).rpartition("error message = ")[2].strip("' )")
-            raise ArtifactError(f"{part}: cannot create the sweep file ({reason})") from None
-        os.chmod(part, 0o644)
+            raise ArtifactError(f"{part}: cannot create the sweep file ({exc.strerror})") \
+                from None
+        # edited in memory, saved as one image (a full disk: one line)
+        img = H5Image(part, kept=KEPT)
+        f = img.f
         f.attrs.update({
             "stage": "sweep", "walkerlab_version": walkerlab.__version__,
             "scene_name": scene.name or "", "scene_json": scene.model_dump_json(),
@@ -177,8 +183,13 @@ class SweepStore:
 
         relabel_artifact(f, for_scene(scene))  # unit labels follow the scene's system
         write_plan(f, plan if plan is not None else [], input_hash)
-        f.flush()
-        return cls(final, f, axes, columns)
+        store = cls(final, img, axes, columns)
+        try:
+            store.flush()
+        except BaseException:
+            img.close()
+            raise
+        return store
 
     @classmethod
     def resume(cls, final: Path, axes: list, columns: SweepColumns, input_hash: str,
@@ -203,14 +214,16 @@ class SweepStore:
             Unreadable partial file, or one written for another sweep (other scene,
             parameters, stage, options or code).
         """
+        from walkerlab.io.h5image import H5Image
         from walkerlab.io.runpaths import refuse_link
 
         part = refuse_link(partial_path(final))  # never written through a link
         try:
-            f = h5py.File(part, "a")
-        except OSError:
+            img = H5Image.load(part, kept=KEPT)
+        except (OSError, RuntimeError):
             raise SweepFileError(f"{part}: damaged partial sweep file; rerun without --resume") \
                 from None
+        f = img.f
         if f.attrs.get("input_hash") != input_hash:
             f.close()
             raise SweepFileError(f"{part}: partial file of a different sweep (scene, parameters, "
@@ -222,7 +235,9 @@ class SweepStore:
             raise SweepFileError(f"{part}: damaged partial sweep file; rerun without --resume") \
                 from None
         start = keep_intact(f, dsets, cols, idx, plan, input_hash, parse_guess, part, tell)
-        return cls(final, f, axes, columns), plan, start
+        store = cls(final, img, axes, columns)
+        store.flush()
+        return store, plan, start
 
     def checkpoint(self, chain: int, done: int, text: str, key: str) -> None:
         """Record that the first ``done`` points of ``chain`` are written and the
@@ -232,8 +247,14 @@ class SweepStore:
         self.f["plan/check"][chain] = chain_check(chain, done, text, key)
 
     def flush(self) -> None:
-        """Write what is buffered to disk (rows and checkpoints together)."""
-        self.f.flush()
+        """Save the file (rows and checkpoints together) as one image.
+
+        Raises
+        ------
+        walkerlab.io.artifacts.ArtifactError
+            The disk is full ("disk full", one line; the file saved before is kept).
+        """
+        self._img.save()
 
     # ------------------------------------------------------------------ write
     def append(self, rows: list[dict], values_of: dict[int, tuple], flush: bool = True) -> None:
@@ -268,12 +289,12 @@ class SweepStore:
             put("row_hash", np.asarray(row_hashes(cols, str(self.f.attrs["input_hash"])),
                                        dtype=object))
         if flush:
-            self.f.flush()
+            self.flush()
 
     def add_wall_time(self, seconds: float) -> None:
         """Add elapsed sweep wall time [s] (accumulates over resumed sessions)."""
         self.f.attrs["wall_time_s"] = float(self.f.attrs["wall_time_s"]) + float(seconds)
-        self.f.flush()
+        self.flush()
 
     @property
     def is_open(self) -> bool:
@@ -281,9 +302,9 @@ class SweepStore:
         return bool(self.f.id.valid)
 
     def close(self) -> None:
-        """Close without finalizing (the partial file stays for ``resume``)."""
-        if self.f.id.valid:
-            self.f.close()
+        """Close without finalizing (the partial file, as last saved, stays for
+        ``resume``)."""
+        self._img.close()
 
     def finalize(self, n_expected: int | None = None) -> Path:
         """Sort rows by index, write the outcome summary, rename to the final name.
@@ -327,8 +348,13 @@ class SweepStore:
         from walkerlab.io.artifacts import content_hash_of
 
         f.attrs["content_hash"] = content_hash_of(f)
-        f.close()
-        os.replace(partial_path(self.final), self.final)
+        img = self._img
+        img.path, img.kept = self.final, "the partial file is kept for --resume"
+        try:
+            img.save()
+        finally:
+            img.close()
+        partial_path(self.final).unlink(missing_ok=True)
         return self.final
 
 

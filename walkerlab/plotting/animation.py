@@ -8,6 +8,8 @@ Everything is read from the trajectory's named points (``samples/points/<name>``
   on to the arc, drawn as a circular arc of radius ``R = |contact - centre|`` about the leg's
   axis (McGeer 1990), its contact point (lowest point relative to the slope) a small dot;
 - every other point of a leg (point masses, rods' centres) is a dot; the hip a larger dot;
+- an upper body (points ``torso_<body>``) is a line from the hip through its bodies to the
+  farthest one, each body a dot (:func:`torso_parts`);
 - the ground is the slope line ``y = -x tan(phi)`` through the first stance foot (world
   frame, x downhill, y up), shaded below.
 
@@ -30,7 +32,7 @@ import numpy as np
 from walkerlab.io.trajectory import NamedTrajectory
 
 __all__ = ["ARC_HALF_ANGLE_RAD", "WalkerFrames", "frame_times", "gif_writer", "leg_parts",
-           "save_frames", "walker_animation", "write_frames"]
+           "save_frames", "torso_parts", "walker_animation", "write_frames"]
 
 #: Half the angle the drawn foot arc spans about the leg axis [rad] (the stance arc's contact
 #: stays within about 0.3 rad of the axis for the shipped walkers).
@@ -62,6 +64,14 @@ def leg_parts(tr: NamedTrajectory, leg: str) -> dict:
     skip = {knee, foot, centre, contact, heel, toe, ankle}
     bodies = [n for n in p if n.startswith(leg + "_") and n not in skip]
     return {"chain": chain, "arc": arc, "sole": sole, "bodies": bodies}
+
+
+def torso_parts(tr: NamedTrajectory) -> list[str]:
+    """Names of the upper body's points (``torso_<body>``), nearest the hip first (empty:
+    no upper body)."""
+    hip = tr.points["hip"][:, 0]
+    names = [n for n in tr.points if n.startswith("torso_")]
+    return sorted(names, key=lambda n: float(np.hypot(*(tr.points[n][:, 0] - hip))))
 
 
 def frame_times(trajs: dict[str, NamedTrajectory], fps: float, max_frames: int) -> np.ndarray:
@@ -194,7 +204,7 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
             i = idx[j]
             P = {n: tr.points[n][:, i] for n in tr.points}
             for lg in legs:
-                _draw_leg(lg, P)
+                (_draw_torso if "torso" in lg else _draw_leg)(lg, P)
             hx, hy = P["hip"]
             hip.set_data([hx], [hy])
             ax.set_xlim(hx - 1.1 * L, hx + 1.1 * L)
@@ -236,9 +246,22 @@ def _panel(ax, title: str, tr: NamedTrajectory, times: np.ndarray) -> tuple:
             "sole": ax.plot([], [], color=c, lw=3)[0] if parts["sole"] else None,
             "dots": ax.plot([], [], "o", color=c, ms=6)[0],
         })
+    torso = torso_parts(tr)
+    if torso:  # drawn with the legs' artists (the last entry)
+        legs.append({"torso": torso,
+                     "line": ax.plot([], [], color="tab:green", lw=4,
+                                     solid_capstyle="round")[0],
+                     "dots": ax.plot([], [], "o", color="tab:green", ms=7)[0]})
     hip = ax.plot([], [], "o", color="k", ms=9)[0]
     label = ax.set_title(title, fontsize=13)
     return ax, tr, idx, legs, hip, label, title
+
+
+def _draw_torso(tb: dict, P: dict[str, np.ndarray]) -> None:
+    """Move the upper body's artists (``tb``, from :func:`_panel`) to the points ``P``."""
+    xy = np.array([P["hip"], *(P[n] for n in tb["torso"])])
+    tb["line"].set_data(xy[:, 0], xy[:, 1])
+    tb["dots"].set_data(xy[1:, 0], xy[1:, 1])
 
 
 def _draw_leg(lg: dict, P: dict[str, np.ndarray]) -> None:

@@ -22,7 +22,7 @@ from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections, study_sections
 from walkerlab.report.figures_section import figures_section
 from walkerlab.report.markdown import details, num, table, text, to_html
-from walkerlab.report.robustness_section import robustness_section
+from walkerlab.report.robustness_section import mfpt_section, robustness_section
 from walkerlab.report.workprecision_section import workprecision_summary
 from walkerlab.units import for_scene as units_for_scene
 
@@ -140,6 +140,7 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     md += study_sections.bifurcation_section(arts, inputs.bifurcation_onsets, pub)
     md += study_sections.basin_section(arts)
     md += robustness_section(arts, inputs.basin_area)
+    md += mfpt_section(arts)
     rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
         report_dir) else Path(figures_dir)
     md += figures_section(Path(figures_dir), str(rel), arts)

@@ -35,6 +35,8 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
     ("bifurcation", "Bifurcation diagram over the slope."),
     ("basin", "Basin of attraction: where each cell of the Poincaré-section slice goes "
               "(left) and how many steps the converged cells take (right)."),
+    ("mfpt", "Mean first-passage time against the per-step slope's σ (`walkerlab mfpt`); "
+             "open squares: mesh values whose refinement did not converge."),
     ("optimize", "Optimised step (direct collocation, `walkerlab optimize`): the hip torque "
                  "at the collocation points (left) and the leg angles over the step "
                  "(right)."),
@@ -103,7 +105,7 @@ def _drawn_from(stem: str, arts: dict) -> bool:
                            ("fig8_", ("compare",)), ("fig", ("simulate", "contact-sim")),
                            ("work_precision", ("workprecision",)),
                            ("bifurcation", ("bifurcation",)), ("basin", ("basin",)),
-                           ("optimize", ("optimize",))):
+                           ("mfpt", ("mfpt",)), ("optimize", ("optimize",))):
         if stem.startswith(prefix):
             return any(s in arts for s in stages)
     return True

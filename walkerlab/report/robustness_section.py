@@ -83,3 +83,27 @@ def robustness_section(arts: dict, basin_area=None) -> list[str]:
             "different state coordinates: compare walkers only in one stated choice.", "",
             table(["disturbance", "GSN", "linear vs nonlinear", "state norm (absolute)",
                    "state norm (relative)"], rows), ""]
+
+
+def mfpt_section(arts: dict) -> list[str]:
+    """The MFPT at each sigma of ``walkerlab mfpt`` (Monte Carlo and mesh), each mesh value
+    that did not converge on refinement said so (empty when the scene ran no mfpt)."""
+    d = arts.get("mfpt")
+    if d is None:
+        return []
+    notes = d.mesh_notes()
+    rows = [[num(float(s)), num(float(m)), num(float(me)), why or ("converged" if
+                                                                   math.isfinite(me) else "-")]
+            for s, m, me, why in zip(d.sigma_rad, d["mfpt_steps_montecarlo"],
+                                     d["mfpt_steps_mesh"], notes)]
+    out = ["## Mean first-passage time (`walkerlab mfpt`)", "",
+           "Steps before the fall on per-step random slopes of standard deviation σ "
+           "(Monte Carlo: censored geometric estimate; mesh: the step map's Markov chain "
+           "on a refined mesh of visited states, Byl & Tedrake 2009).", "",
+           table(["σ [rad]", "Monte Carlo [steps]", "mesh [steps]", "mesh refinement"], rows),
+           ""]
+    if any(notes):
+        out += ["**The mesh MFPT did not converge on refinement at σ = "
+                + ", ".join(num(float(s)) for s, w in zip(d.sigma_rad, notes) if w)
+                + " rad**: its values there are as uncertain as their last change.", ""]
+    return out

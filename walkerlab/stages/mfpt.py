@@ -64,7 +64,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         except MfptStudyError as exc:
             raise StageError(str(exc)) from None
         done.append(partial)
-        return (lambda f: schema.write(f, data)), mfpt_summary(data)
+        return (lambda f: schema.write(f, data)), mfpt_summary(data, st.mesh_rel_change)
 
     out = run_cached("mfpt", scene, runs_root, SECTIONS, (up,), work, force,
                      {"workers": workers if scheduler is None else 0,

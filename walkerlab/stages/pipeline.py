@@ -75,11 +75,15 @@ def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **optio
 
 def report_plan(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order: each only when the scene has its
-    sections; the work-precision study (it times every solver setting: most of a cold report)
-    and the Section-5 attribution (~15-17 s CPU on the paper scene) only with ``full``."""
+    sections (``fixedpoint`` also when ``simulate`` starts from the gait); the
+    work-precision study (it times every solver setting: most of a cold report) and the
+    Section-5 attribution (~15-17 s CPU on the paper scene) only with ``full``."""
     sim, contact, fp = (getattr(scene, s) is not None for s in ("simulate", "contact",
                                                                 "fixedpoint"))
-    plan = {"fixedpoint": fp, "simulate": sim, "contact-sim": contact,
+    # a simulation that starts from the gait runs (and shows) the fixed point it starts from,
+    # with the section's defaults when the scene has none
+    gait = fp or (sim and "fixedpoint" in needs("simulate", scene))
+    plan = {"fixedpoint": gait, "simulate": sim, "contact-sim": contact,
             "compare": contact and sim, "workprecision": full and scene.workprecision is not None,
             "basin": scene.basin is not None and fp,
             "robustness": scene.robustness is not None and fp,

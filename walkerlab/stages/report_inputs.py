@@ -17,7 +17,7 @@ from walkerlab.io.runpaths import bifurcation_artifacts, stage_artifact
 from walkerlab.stages.pipeline import needs, stage_module
 
 REPORT_STAGES = ("fixedpoint", "simulate", "contact-sim", "compare", "workprecision",
-                 "bifurcation", "basin", "robustness", "attribution", "optimize")
+                 "bifurcation", "basin", "robustness", "mfpt", "attribution", "optimize")
 #: why a report leaves out an artifact of a stage the scene does not run
 NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' section",
            "contact-sim": "no 'contact' section",
@@ -25,6 +25,7 @@ NOT_RUN = {"fixedpoint": "no 'fixedpoint' section", "simulate": "no 'simulate' s
            "workprecision": "no 'workprecision' section",
            "basin": "no 'basin' section (or no 'fixedpoint')",
            "robustness": "no 'robustness' section (or no 'fixedpoint')",
+           "mfpt": "no 'mfpt' section (or no 'fixedpoint')",
            "attribution": "no 'contact' or 'fixedpoint' section",
            "optimize": "no 'optimize' section (or no 'fixedpoint')"}
 #: artifacts shown although this report did not compute them, when computed for the
@@ -33,7 +34,8 @@ EARLIER = {"workprecision": "measured for other settings; `walkerlab report --fu
                             "measures it again",
            "attribution": "computed for other settings; `walkerlab report --full` computes "
                           "it again",
-           "bifurcation": "computed for another walker, slope or solver"}
+           "bifurcation": "computed for another walker, slope or solver",
+           "mfpt": "computed for other settings: rerun `walkerlab mfpt`"}
 
 
 def computed_for(scene: Scene, runs_root, stage: str, variants: tuple[str, ...] = ()) -> str:

@@ -185,9 +185,10 @@ def run_continuation(scene: Scene, path: str, start: float, stop: float, switch:
     from walkerlab.studies.points import PointOutcome, ideal_fixed_point
 
     unit = axis_unit(scene, ParamAxis(path, (), path))
-    fam = scene_family(scene, path)
     p0 = scene_value(scene, path)
     lo, hi = min(start, stop), max(start, stop)
+    # one map (step or stride) along the whole branch, even where the legs become equal
+    fam = scene_family(scene, path).sharing_map((lo, hi, min(max(p0, lo), hi)))
     at = scene if lo <= p0 <= hi else apply_point(scene.model_dump(mode="json"), [path],
                                                   (min(max(p0, lo), hi),), "<continuation>")
     try:

@@ -365,6 +365,10 @@ def _finite(v: float) -> float:
     return v if math.isfinite(v) else math.nan
 
 
+#: how an interrupted study continues: ``mfpt`` resumes from its partial file by itself
+RERUN = "rerun the same command (mfpt resumes from the finished pieces)"
+
+
 class MfptStudyError(ValueError):
     """The study cannot run on this scene (one line; nothing is kept to resume)."""
 
@@ -402,12 +406,18 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
         ``partial_path`` is a symbolic link.
     MfptStudyError
         As :func:`mfpt_study`'s ValueError (bad input: the partial file is removed).
+    walkerlab.execution.dask.DaskLost
+        The Dask cluster was lost (one line advising :data:`RERUN`; the partial file is
+        kept).
     """
+    from walkerlab.execution.dask import DaskLost
     from walkerlab.io.mfpt_partial import MfptPartial
 
     partial = MfptPartial(partial_path, key, resume=resume)
     try:
         data = mfpt_study(scene, x_star, st, workers, scheduler, partial)
+    except DaskLost as exc:  # not bad input: the finished pieces are kept for the rerun
+        raise exc.advising(RERUN) from None
     except ValueError as exc:  # bad input: nothing to resume
         partial.remove()
         raise MfptStudyError(str(exc)) from None
@@ -416,9 +426,13 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
     return data, partial
 
 
-def mfpt_summary(data) -> dict:
-    """The printable summary of an ``MfptData``: ``sigma_rad`` [rad] and the Monte Carlo and
-    mesh MFPT [steps] at each sigma (lists of float)."""
+def mfpt_summary(data, rel_change: float | None = None) -> dict:
+    """The printable summary of an ``MfptData``: ``sigma_rad`` [rad], the Monte Carlo and
+    mesh MFPT [steps] at each sigma (lists of float), and ``mesh_note``: for each sigma ''
+    or, when the mesh's refinement did not converge, why
+    (:meth:`walkerlab.io.schemas.mfpt.MfptData.mesh_notes`; ``rel_change``:
+    ``mfpt.mesh_rel_change``)."""
     return {"sigma_rad": list(map(float, data.sigma_rad)),
             "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
-            "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"]))}
+            "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"])),
+            "mesh_note": data.mesh_notes(rel_change)}

@@ -422,8 +422,12 @@ def _run_locked(scene, axes, stage, out_path, workers, scheduler, resume, opts, 
                 write()  # rows computed before the interruption are kept for --resume
             except Exception:  # noqa: BLE001 - the original error is the one to report
                 pass
-        store.add_wall_time(time.perf_counter() - t0)
-        store.close()
+        try:
+            store.add_wall_time(time.perf_counter() - t0)
+        except Exception:  # noqa: BLE001 - a full disk: the original error is reported
+            pass
+        finally:
+            store.close()
         raise
     if pending:  # an executor that stopped early (the rows it gave are kept)
         write()

@@ -433,7 +433,7 @@ def add_gait_measures(family: WalkerFamily, res: ContinuationResult) -> None:
                 rows.append({"step_length": np.nan, "speed": np.nan,
                              "cost_of_transport": np.nan})
                 continue
-            rows.append(gait_measures(w, q.x, br.period * w.steps_per_map, family.solver,
+            rows.append(gait_measures(w, q.x, br.period * family.steps(w), family.solver,
                                       family.max_step_time))
         br.measures = {k: np.array([r[k] for r in rows], float)
                        for k in ("step_length", "speed", "cost_of_transport")}

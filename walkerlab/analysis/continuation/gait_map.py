@@ -63,6 +63,12 @@ class WalkerFamily:
         A step longer than this is a failure [s].
     fixed : dict
         Other parameters held at a value (the second parameter of a two-parameter run).
+    steps_per_map : int, optional
+        Steps of every member's Poincaré map (None: each walker's own,
+        ``walker.steps_per_map``).  A field that makes the legs differ away from one value
+        (a hip spring's rest angle from 0, one leg's mass from the other's) would switch
+        the map from a step to a stride there; :meth:`sharing_map` fixes the stride for
+        the whole family.
     """
 
     make: Callable[[dict], HybridWalker]
@@ -70,7 +76,23 @@ class WalkerFamily:
     solver: Solver
     max_step_time: float = 5.0
     fixed: dict = field(default_factory=dict)
+    steps_per_map: int | None = None
     _cache: dict = field(default_factory=dict, repr=False)
+
+    def steps(self, walker: HybridWalker) -> int:
+        """Steps of the Poincaré map of the member ``walker``."""
+        return self.steps_per_map or walker.steps_per_map
+
+    def sharing_map(self, values) -> WalkerFamily:
+        """This family with one map for every member: a stride when the walker at any of
+        ``values`` (the range's ends and start) has legs that differ, else a step."""
+        steps = 1
+        for v in values:
+            try:
+                steps = max(steps, self.walker(v).steps_per_map)
+            except MapFailed:
+                continue
+        return dataclasses.replace(self, steps_per_map=steps, _cache={})
 
     def walker(self, p: float) -> HybridWalker:
         """The walker at ``p`` (built once per value).
@@ -113,7 +135,8 @@ def _cause(walker: HybridWalker, seg) -> str:
 
 
 def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,
-             jacobian: bool = False, max_step_time: float = 5.0, segments: bool = False):
+             jacobian: bool = False, max_step_time: float = 5.0, segments: bool = False,
+             steps_per_map: int | None = None):
     """The ``k``-step Poincaré map ``P^k`` and (optionally) its Jacobian (variational
     equations with saltation matrices at every guard; :mod:`walkerlab.integrate.rigid`).
 
@@ -128,6 +151,9 @@ def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,
     jacobian : bool
         Also ``D(P^k)`` (2n, 2n), the product of the steps' variational Jacobians (with
         saltation matrices).
+    steps_per_map : int, optional
+        Steps of one map (default ``walker.steps_per_map``; a family's common map,
+        :meth:`WalkerFamily.steps`).
 
     Returns
     -------
@@ -150,7 +176,7 @@ def step_map(walker: HybridWalker, x: np.ndarray, solver: Solver, k: int = 1,
     T = 0.0
     segs = []
     legs = walker.legs
-    for i in range(k * walker.steps_per_map):  # a walker whose legs differ: a map is a stride
+    for i in range(k * (steps_per_map or walker.steps_per_map)):  # legs that differ: a stride
         stance = legs[1] if i % 2 == 0 else legs[0]
         seg = integrate_step(walker.for_stance(stance), x, solver, max_step_time=max_step_time,
                              variational=jacobian, stance_leg=stance)
@@ -216,6 +242,7 @@ class BranchSystem:
         w = self.family.walker(p)
         x = state_from_section(w, z)
         xk, _, _ = step_map(w, x, self.family.solver, self.k,
+                            steps_per_map=self.family.steps(w),
                             max_step_time=self.family.max_step_time)
         self.n_maps += self.k
         r = np.asarray(w.section(xk), float) - z
@@ -261,6 +288,7 @@ class BranchSystem:
         w = self.family.walker(p)
         x = state_from_section(w, z)
         xk, T, J, segs = step_map(w, x, self.family.solver, self.k, jacobian=True,
+                                  steps_per_map=self.family.steps(w),
                                   max_step_time=self.family.max_step_time, segments=True)
         self.n_variational += self.k
         D_from = numeric_jacobian(w.from_section, np.asarray(z, float))

@@ -25,7 +25,8 @@ def _clearance(sys: BranchSystem, u: np.ndarray, sc: float, n: int = 200) -> flo
     w = sys.family.walker(u[-1] * sc)
     x = state_from_section(w, u[:-1])
     _xk, _T, _J, segs = step_map(w, x, sys.family.solver, sys.k,
-                                 max_step_time=sys.family.max_step_time, segments=True)
+                                 max_step_time=sys.family.max_step_time, segments=True,
+                                 steps_per_map=sys.family.steps(w))
     low = math.inf
     phi = w.slope_rad
     for seg in segs:
@@ -94,7 +95,7 @@ def _normal_force(sys: BranchSystem, u: np.ndarray, sc: float) -> float:
     w = sys.family.walker(u[-1] * sc)
     x = state_from_section(w, u[:-1])
     segs = step_map(w, x, sys.family.solver, sys.k, max_step_time=sys.family.max_step_time,
-                    segments=True)[3]
+                    segments=True, steps_per_map=sys.family.steps(w))[3]
     return normal_force_ratio(w, segs)
 
 

@@ -10,7 +10,11 @@ multiplier is zero by construction because ``P`` lands on the guard surface.
 
 from __future__ import annotations
 
+import math
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +27,74 @@ from walkerlab.integrate.rigid_phase import numeric_jacobian
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.numerics import sort_multipliers
+
+#: longest wall time of one search for a gait [s] (:func:`search_budget`; a fixed point, or
+#: every start of :func:`walkerlab.analysis.gait.search.find_gaits`): the shipped scenes need
+#: 0.1-3 s; a spring or damper at its cap (1e6) makes the integrator crawl (about 40 s per
+#: step map), and the search's starts and MINPACK's own cap of 200 (n + 1) maps would keep it
+#: busy, silent, for many minutes before it says "no gait found"
+ROOT_BUDGET_S = 60.0
+#: a step map slower than this [s] is said in one notice (the search is not silent)
+SLOW_MAP_S = 5.0
+
+
+class _Budget(threading.local):
+    """The wall-time budget of the search under way in this thread (:func:`search_budget`;
+    per thread: the report runs the work-precision study in a thread of its own)."""
+
+    deadline = math.inf  # time.perf_counter() after which no step map starts
+    maps = 0  # step maps started under the budget
+    slowest = 0.0  # slowest of them [s]
+    started = 0.0
+
+
+_BUDGET = _Budget()
+
+
+class SearchGaveUp(Exception):
+    """A search for a gait spent its wall-time budget (:func:`search_budget`); raised
+    before a step map would start.  The message says after how many maps and how slow."""
+
+
+@contextmanager
+def search_budget(seconds: float | None = None) -> Iterator[None]:
+    """Bound every step map started inside to ``seconds`` of wall time from now (default
+    :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline): past it,
+    :func:`poincare_map` raises :class:`SearchGaveUp` instead of starting a map.  A map
+    slower than :data:`SLOW_MAP_S` is said once in a notice
+    (:func:`walkerlab.progress.note`)."""
+    outer = _BUDGET.deadline
+    now = time.perf_counter()
+    if not math.isfinite(outer):  # the outermost budget counts the maps of all inside
+        _BUDGET.maps, _BUDGET.slowest, _BUDGET.started = 0, 0.0, now
+    _BUDGET.deadline = min(outer, now + (ROOT_BUDGET_S if seconds is None else seconds))
+    try:
+        yield
+    finally:
+        _BUDGET.deadline = outer
+
+
+def _map_started() -> float:
+    t = time.perf_counter()
+    if t > _BUDGET.deadline:
+        raise SearchGaveUp(
+            f"the search gave up after {_BUDGET.maps} step map(s) in "
+            f"{t - _BUDGET.started:.0f} s (its time budget; the slowest map took "
+            f"{_BUDGET.slowest:.1f} s - a very stiff or heavily damped spring makes the "
+            "integrator crawl: soften it, or start nearer the gait)")
+    _BUDGET.maps += 1
+    return t
+
+
+def _map_ended(t: float) -> None:
+    dt = time.perf_counter() - t
+    if dt > SLOW_MAP_S and _BUDGET.slowest <= SLOW_MAP_S and math.isfinite(_BUDGET.deadline):
+        from walkerlab import progress
+
+        progress.note(f"gait search: one step map took {dt:.0f} s (a very stiff or heavily "
+                      "damped spring makes every step slow); the search gives up after "
+                      f"{_BUDGET.deadline - _BUDGET.started:.0f} s")
+    _BUDGET.slowest = max(_BUDGET.slowest, dt)
 
 
 class StepFailed(RuntimeError):
@@ -39,6 +111,10 @@ class FixedPointNotFound(RuntimeError):
     def __init__(self, message: str, residual: float):
         super().__init__(f"no fixed point found: {message} (residual {residual:.3g})")
         self.residual = residual
+
+
+class FixedPointGaveUp(FixedPointNotFound):
+    """:func:`find_fixed_point` spent its (or its search's) time budget."""
 
 
 def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
@@ -69,7 +145,17 @@ def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
     ------
     StepFailed
         A step ended in a fall, a solver failure or ran past ``max_step_time``.
+    SearchGaveUp
+        Inside a :func:`search_budget` whose time is spent (no map is started).
     """
+    t = _map_started()
+    try:
+        return _step_map(walker, x, solver, max_step_time, jacobian, steps)
+    finally:
+        _map_ended(t)
+
+
+def _step_map(walker, x, solver, max_step_time, jacobian, steps):
     legs = walker.legs
     period, nfev, DP = 0.0, 0, np.eye(np.size(x))
     for k in range(walker.steps_per_map):
@@ -179,7 +265,8 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
                      fd_step: float = 1e-7, max_step_time: float = 5.0,
                      fd_check: bool = True,
                      jacobian_guess: np.ndarray | None = None,
-                     deflate: tuple | list = ()) -> FixedPointResult:
+                     deflate: tuple | list = (),
+                     budget_s: float | None = None) -> FixedPointResult:
     """Find the period-1 fixed point of the Poincaré map and its Floquet multipliers.
 
     The root finder is MINPACK (``scipy.optimize.root``, method ``hybr``) on the map reduced
@@ -209,6 +296,10 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         J. Sci. Comput. 37(4)), whose roots are the roots of ``F`` other than the ``z_k``:
         from a start near a known gait it converges to another one.  Not with
         ``jacobian_guess``.
+    budget_s : float, optional
+        Longest wall time of the search [s] (default :data:`ROOT_BUDGET_S`; an enclosing
+        :func:`search_budget` keeps its earlier deadline), checked before each step map:
+        once spent, the search gives up and says why.
 
     Returns
     -------
@@ -217,7 +308,8 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     Raises
     ------
     FixedPointNotFound
-        The root finder did not converge, or the map failed (fall) near the guess.
+        The root finder did not converge, the map failed (fall) near the guess, or the
+        budget was spent (the message says after how many maps and how long each took).
     """
     root = import_on_fresh_stack("scipy.optimize").root  # see walkerlab.freshstack
 
@@ -227,12 +319,17 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         raise ValueError("find_fixed_point: deflate and jacobian_guess exclude each other")
     F = _ReducedMap(walker, solver, max_step_time, known)
     z0 = walker.section(np.asarray(guess, float))
-    if jacobian_guess is None:
-        sol = root(F.residual, z0, method="hybr", options={"xtol": xtol})
-    else:
-        F.start[z0.tobytes()] = _section_jacobian(walker, np.asarray(jacobian_guess, float),
-                                                  z0)
-        sol = root(F.residual, z0, method="hybr", jac=F.jacobian, options={"xtol": xtol})
+    try:
+        with search_budget(budget_s):
+            if jacobian_guess is None:
+                sol = root(F.residual, z0, method="hybr", options={"xtol": xtol})
+            else:
+                F.start[z0.tobytes()] = _section_jacobian(
+                    walker, np.asarray(jacobian_guess, float), z0)
+                sol = root(F.residual, z0, method="hybr", jac=F.jacobian,
+                           options={"xtol": xtol})
+    except SearchGaveUp as exc:
+        raise FixedPointGaveUp(str(exc), math.nan) from None
     x, xn, period, DP, segs = F.variational_at(sol.x, sol.message)
     res = float(np.max(np.abs(xn - x)))
     _check_walking(walker, x, sol, res)

@@ -39,7 +39,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.analysis.gait.poincare import FixedPointNotFound, FixedPointResult, find_fixed_point
+from walkerlab.analysis.gait.poincare import (
+    FixedPointGaveUp,
+    FixedPointNotFound,
+    FixedPointResult,
+    SearchGaveUp,
+    find_fixed_point,
+    search_budget,
+)
 from walkerlab.analysis.gait.starts import (
     WALK_STEPS,
     coarse_solver,
@@ -177,7 +184,9 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     ------
     GaitNotFound
         No gait from the guess nor from the seeds, or the policy's gait was not found; the
-        one-line message says what was tried and what to try next.
+        one-line message says what was tried and what to try next.  The whole search has
+        one time budget (:func:`~walkerlab.analysis.gait.poincare.search_budget`): spent,
+        it gives up and says after how many step maps and how slow they were.
     ValueError
         Unknown ``policy``, or ``nearest_guess`` without a guess.
     """
@@ -185,6 +194,17 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         raise ValueError(f"fixedpoint.gait: {policy!r} is not one of {', '.join(POLICIES)}")
     if policy == "nearest_guess" and guess is None:
         raise ValueError("fixedpoint.gait: nearest_guess needs fixedpoint.initial_guess")
+    try:
+        with search_budget():  # every start, seed and root finder: one time budget
+            return _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step,
+                               max_step_time, fd_check, time_unit, seeds)
+    except (SearchGaveUp, FixedPointGaveUp) as exc:
+        why = str(exc).removeprefix("no fixed point found: ").removesuffix(" (residual nan)")
+        raise GaitNotFound(f"no period-1 gait found: {why}", math.nan) from None
+
+
+def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_step_time,
+                fd_check, time_unit, seeds) -> GaitSearch:
     s = _RootStarts(walker, solver, {"xtol": xtol, "fd_step": fd_step,
                                      "max_step_time": max_step_time, "fd_check": fd_check})
     if guess is not None:
@@ -230,6 +250,8 @@ class _RootStarts:
         try:
             res = find_fixed_point(self.walker, x0, self.solver, deflate=deflate,
                                    jacobian_guess=jacobian_guess, **self.kw)
+        except FixedPointGaveUp:
+            raise
         except FixedPointNotFound as exc:
             if math.isfinite(exc.residual) and "standing" not in str(exc):
                 self.best = min(self.best, exc.residual)
@@ -284,6 +306,8 @@ class _RootStarts:
                                          fd_step=self.kw["fd_step"],
                                          max_step_time=self.kw["max_step_time"],
                                          fd_check=False, deflate=(first.x,))
+            except FixedPointGaveUp:
+                raise
             except FixedPointNotFound as exc:
                 self.last_msg = str(exc)
                 continue

@@ -72,6 +72,26 @@ class MfptData:
     def __getitem__(self, name: str) -> np.ndarray:
         return self.values[name]
 
+    def mesh_notes(self, rel_change: float | None = None) -> list[str]:
+        """For each sigma: '' for a converged mesh MFPT (or none computed), else one clause
+        saying its refinement did not converge: the last relative change of the MFPT
+        (against ``rel_change`` [-], ``mfpt.mesh_rel_change``, when given) and the cells of
+        the finest mesh."""
+        out = []
+        for conv, change, cells in zip(self["mesh_converged"], self["mesh_change"],
+                                       self["mesh_cells"]):
+            if not np.isfinite(conv) or conv > 0.5:
+                out.append("")
+                continue
+            last = (f"last refinement changed it by {100 * change:.3g} %"
+                    if np.isfinite(change) else "one mesh only, no refinement to compare")
+            limit = (f" > {100 * rel_change:.3g} %"
+                     if rel_change is not None and np.isfinite(change) else "")
+            out.append(f"refinement NOT converged ({last}{limit} at {int(cells)} cells, the "
+                       "most mfpt.mesh_max_cells or the visited states allow): its error may "
+                       "be that large")
+        return out
+
 
 def write(f, data: MfptData) -> None:
     """Fill an open artifact (``write_artifact``'s writer) with ``data``."""
