@@ -401,6 +401,25 @@ def generate(eq: Equations, param_names, key: str) -> str:
     return "\n".join(head + body) + "\n"
 
 
+def _reset_rows(eq: Equations, consts: list[str], reset: list[str]) -> list[str]:
+    """``reset_rows(X, D, out)``: the heel-strike reset (``reset_lines``' equations, same
+    expressions) of every row of ``X`` (N, 2n) with its data vector ``D[r]`` into ``out``
+    (N, 2n) (numba, lazy)."""
+    names = [str(s) for s in (*eq.q, *eq.dq)]
+    ret = reset[-1].strip()
+    assert ret.startswith("return np.array((") and ret.endswith(",))")
+    out = ["@njit(cache=True, error_model='numpy')",
+           "def reset_rows(X, D, out):  # pragma: no cover - runs compiled",
+           '    """Heel-strike resets of the rows of X (N, 2n), data vectors D (N, c)."""',
+           "    for _r in range(X.shape[0]):"]
+    out += [f"        {c} = D[_r, {i}]" for i, c in enumerate(consts)]
+    out += [f"        {a} = X[_r, {i}]" for i, a in enumerate(names)]
+    out += reset[2:-1]
+    out += [f"        _res = ({ret[len('return np.array(('):-3]},)",
+            f"        for _k in range({len(names)}):", "            out[_r, _k] = _res[_k]"]
+    return out + [""]
+
+
 def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational: bool,
            guards: tuple[list[str], list]) -> list[str]:
     """A numba ``cfunc`` ``(dy, t, y, d)`` (CyRK's ``cyjit_sig``) writing the flow (and with
@@ -441,7 +460,9 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     C++ integrators (``CyRK.nb.numba_solver.cyjit_sig``), ``cache=True``.
 
     Defines ``constants(p) -> ndarray (NCONST + 1,)`` (the parameters, the parameter-only
-    subexpressions and a zeroed call counter: the data vector of every cfunc), ``NCONST``,
+    subexpressions and a zeroed call counter: the data vector of every cfunc), its compiled
+    twin for many parameter rows ``constants_rows(P (N, NP)) -> (N, NCONST + 1)`` (numba,
+    lazy), ``NCONST``, the compiled heel-strike reset of many rows ``reset_rows(X, D, out)``,
     ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
     ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
     ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
@@ -455,22 +476,32 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     parts = {k: (flow_lines(e, False, parts=True), flow_lines(e, True, parts=True))
              for k, e in flows.items()}
     guards = cse_lines(list(eq.guards.values()), PRINTER)
+    reset = reset_lines(eq, False)  # (its parameter-only subexpressions join the constants)
     consts = list(param_names) + [h.split("=")[0].strip() for h in _HOISTED]
     body = ["def constants(p):",
             f"    {', '.join(param_names)}, = p",
             *_HOISTED,
             f"    return np.array(({', '.join(consts)}, 0.0), dtype=np.float64)",
             "", f"NCONST = {len(consts)}",
-            f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", ""]
+            f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", "",
+            "_constants_jit = njit(cache=True)(constants)", "", "",
+            "@njit(cache=True)",
+            "def constants_rows(P):  # pragma: no cover - runs compiled",
+            '    """Data vectors (N, NCONST + 1) of the parameter rows P (N, NP)."""',
+            "    out = np.empty((P.shape[0], NCONST + 1))",
+            "    for i in range(P.shape[0]):",
+            "        out[i] = _constants_jit(P[i])",
+            "    return out", ""]
     for k, e in flows.items():
         body += _cfunc(k, e, consts, parts[k], False, guards) + [""]
         body += _cfunc(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
+    body += _reset_rows(eq, consts, reset)
     head = [
         f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
         "from math import sin, cos, tan, sqrt  # noqa: F401",
         "import numpy as np",
-        "from numba import cfunc, types",
+        "from numba import cfunc, njit, types",
         "",
         "SIG = types.void(types.CPointer(types.float64), types.float64,",
         "                 types.CPointer(types.float64), types.CPointer(types.float64))",
