@@ -141,6 +141,29 @@ def _locate(F, y_old, h, gamma, which, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
+def _dense_coeffs(y, ynew, h, K, F, ev, p):  # pragma: no cover - compiled
+    """The 3 extra stages and the interpolant's coefficients ``F`` of the step."""
+    n = y.size
+    for s in range(NS + 1, 16):
+        for k in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += A[s, j] * K[j, k]
+            ev[k] = y[k] + h * acc
+        flow(ev, p, K[s])
+    for k in range(n):
+        dy = ynew[k] - y[k]
+        F[0, k] = dy
+        F[1, k] = h * K[0, k] - dy
+        F[2, k] = 2.0 * dy - h * (K[NS, k] + K[0, k])
+        for r in range(4):
+            acc = 0.0
+            for j in range(16):
+                acc += D[r, j] * K[j, k]
+            F[3 + r, k] = h * acc
+
+
+@njit(cache=True)
 def step(x0, gamma, p, rtol, atol, max_time, out):  # pragma: no cover - compiled
     """One step from the post-impact state ``x0`` on slope ``gamma`` [rad]; the next
     post-impact state into ``out``.  Returns True for a heel strike, False for a fall."""
@@ -187,24 +210,6 @@ def step(x0, gamma, p, rtol, atol, max_time, out):  # pragma: no cover - compile
                 break
             h *= max(0.2, 0.9 * err ** (-1.0 / 8.0))
             rejected = True
-        # dense output (3 extra stages)
-        for s in range(NS + 1, 16):
-            for k in range(n):
-                acc = 0.0
-                for j in range(s):
-                    acc += A[s, j] * K[j, k]
-                ev[k] = y[k] + h * acc
-            flow(ev, p, K[s])
-        for k in range(n):
-            dy = ynew[k] - y[k]
-            F[0, k] = dy
-            F[1, k] = h * K[0, k] - dy
-            F[2, k] = 2.0 * dy - h * (K[NS, k] + K[0, k])
-            for r in range(4):
-                acc = 0.0
-                for j in range(16):
-                    acc += D[r, j] * K[j, k]
-                F[3 + r, k] = h * acc
         if abs(ynew[1]) >= 0.5 * math.pi:
             return False  # the hip reaches the ground
         if not armed and _guard(ynew, gamma, 0) > 0 >= _guard(y, gamma, 0):
@@ -212,6 +217,7 @@ def step(x0, gamma, p, rtol, atol, max_time, out):  # pragma: no cover - compile
         elif armed and _guard(ynew, gamma, 0) < 0:
             return False  # the swing leg falls back
         if armed and _guard(ynew, gamma, 1) <= 0 < _guard(y, gamma, 1):
+            _dense_coeffs(y, ynew, h, K, F, ev, p)
             _locate(F, y, h, gamma, 1, ev)
             impact(ev, p, out)
             return True

@@ -401,22 +401,20 @@ def generate(eq: Equations, param_names, key: str) -> str:
     return "\n".join(head + body) + "\n"
 
 
-def _reset_rows(eq: Equations, consts: list[str], reset: list[str]) -> list[str]:
-    """``reset_rows(X, D, out)``: the heel-strike reset (``reset_lines``' equations, same
-    expressions) of every row of ``X`` (N, 2n) with its data vector ``D[r]`` into ``out``
-    (N, 2n) (numba, lazy)."""
+def _reset_cfunc(eq: Equations, consts: list[str], reset: list[str]) -> list[str]:
+    """``reset_flow(dy, t, y, d)``: the heel-strike reset (``reset_lines``' equations, same
+    expressions) of the pre-impact state ``y`` into ``dy``, a numba ``cfunc`` of the flows'
+    signature (``d`` the data vector; ``t`` unused)."""
     names = [str(s) for s in (*eq.q, *eq.dq)]
     ret = reset[-1].strip()
     assert ret.startswith("return np.array((") and ret.endswith(",))")
-    out = ["@njit(cache=True, error_model='numpy')",
-           "def reset_rows(X, D, out):  # pragma: no cover - runs compiled",
-           '    """Heel-strike resets of the rows of X (N, 2n), data vectors D (N, c)."""',
-           "    for _r in range(X.shape[0]):"]
-    out += [f"        {c} = D[_r, {i}]" for i, c in enumerate(consts)]
-    out += [f"        {a} = X[_r, {i}]" for i, a in enumerate(names)]
-    out += reset[2:-1]
-    out += [f"        _res = ({ret[len('return np.array(('):-3]},)",
-            f"        for _k in range({len(names)}):", "            out[_r, _k] = _res[_k]"]
+    out = ["@cfunc(SIG, cache=True, error_model='numpy')",
+           "def reset_flow(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
+    out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
+    out += [ln[4:] for ln in reset[2:-1]]
+    out += [f"    _res = ({ret[len('return np.array(('):-3]},)",
+            f"    for _k in range({len(names)}):", "        dy[_k] = _res[_k]"]
     return out + [""]
 
 
@@ -462,7 +460,8 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     Defines ``constants(p) -> ndarray (NCONST + 1,)`` (the parameters, the parameter-only
     subexpressions and a zeroed call counter: the data vector of every cfunc), its compiled
     twin for many parameter rows ``constants_rows(P (N, NP)) -> (N, NCONST + 1)`` (numba,
-    lazy), ``NCONST``, the compiled heel-strike reset of many rows ``reset_rows(X, D, out)``,
+    lazy), ``NCONST``, the heel-strike reset as a cfunc of the flows' signature
+    ``reset_flow(dy, t, y, d)``,
     ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
     ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
     ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
@@ -495,7 +494,7 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     for k, e in flows.items():
         body += _cfunc(k, e, consts, parts[k], False, guards) + [""]
         body += _cfunc(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
-    body += _reset_rows(eq, consts, reset)
+    body += _reset_cfunc(eq, consts, reset)
     head = [
         f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",

@@ -127,7 +127,7 @@ class BatchStepMap:
         self._ig = list(first.structure.param_names).index("gamma")
         self.slope_rad = float(walker.slope_rad)
         self._resets_depend_on_slope = self._probe_slope_dependence()
-        self._reset_rows = self._probe_compiled_reset(compiled_module(lastc.structure))
+        self._reset_flow = self._probe_compiled_reset(compiled_module(lastc.structure))
         #: rows integrated by the compiled per-row integrator (phases), for the record
         self.integrated = 0
         self._walkers: dict[float, object] = {}
@@ -155,17 +155,82 @@ class BatchStepMap:
         """The generated module's compiled heel-strike reset if it gives the walker's own
         reset bit for bit on a probe state on two slopes (a walker built with another reset,
         e.g. an impulse at push-off, keeps its own), else None."""
-        fn = getattr(mod, "reset_rows", None)
-        if fn is None:  # pragma: no cover - a module generated before reset_rows
+        from walkerlab.integrate.rows_dop853 import reset_rows
+
+        fn = getattr(mod, "reset_flow", None)
+        if fn is None:  # pragma: no cover - a module generated before reset_flow
             return None
         probe = np.linspace(0.11, 0.37, self.n) * np.array([1, -1] * (self.n // 2))
         for g in (self.slope_rad, self.slope_rad + 0.01):
             out = np.empty((1, self.n))
-            fn(probe[None], self.data(np.array([g])), out)
+            reset_rows(fn, probe[None], self.data(np.array([g])), out)
             w = self.walker if g == self.slope_rad else self.walker_at(g)
             if not np.array_equal(out[0], np.asarray(w.reset(probe), dtype=float)):
                 return None
         return fn
+
+    @property
+    def can_walk(self) -> bool:
+        """Whether :meth:`walk` runs whole walks compiled: one compiled flow for every phase
+        of a step, no reset between phases, and the compiled heel-strike reset."""
+        cf = {id(p[1]) for p in self.phases}
+        no_mid_reset = all(g.reset is None for p in self.phases for g in p[0].guards
+                           if g.outcome == "next_phase")
+        return len(cf) == 1 and no_mid_reset and self._reset_flow is not None
+
+    def walk(self, X: np.ndarray, gamma: np.ndarray):
+        """Walk every row up to ``gamma.shape[1]`` steps, step ``s`` of row ``w`` on the
+        slope ``gamma[w, s]`` [rad], until it falls (any step that does not end in heel
+        strike), all in compiled code (:func:`walkerlab.integrate.rows_dop853.walk_rows`;
+        the same numbers as :meth:`step` step after step).
+
+        Parameters
+        ----------
+        X : ndarray, shape (W, 2n)
+            Post-impact states [rad, rad/s].
+        gamma : ndarray, shape (W, S)
+            Slopes [rad].
+
+        Returns
+        -------
+        steps : ndarray of int, shape (W,)
+            Heel strikes of each row.
+        fell : ndarray of bool, shape (W,)
+        X_end : ndarray, shape (W, 2n)
+            Each row's last post-impact state.
+
+        Raises
+        ------
+        ValueError
+            A walker :attr:`can_walk` says no to.
+        """
+        from walkerlab.integrate.rows_dop853 import walk_rows
+
+        if not self.can_walk:
+            raise ValueError(f"{self.walker.name}: compiled walks need one compiled flow for "
+                             "every phase, no intra-step reset and the compiled reset")
+        X = np.array(X, dtype=float, order="C", ndmin=2)
+        W, S = gamma.shape
+        P = np.tile(self._params, (W * S, 1))
+        P[:, self._ig] = np.asarray(gamma, dtype=float).ravel()
+        D = self._constants_rows(P).reshape(W, S, -1)  # (as data(): one row per slope)
+        g = self._guard_table()
+        steps = np.zeros(W, np.int64)
+        fell = np.zeros(W, np.bool_)
+        walk_rows(self.phases[0][1], self._reset_flow, X, D, S, float(self.max_step_time_s),
+                  *g, float(self.rtol), float(self.atol), self.n + self.phases[0][2], steps,
+                  fell)
+        return steps, fell, X
+
+    def _guard_table(self):
+        """``(gstart, gcols, goffs, dirs, gout)``: every phase's guards in flat arrays."""
+        if not hasattr(self, "_gtab"):
+            sizes = [len(p[0].guards) for p in self.phases]
+            gout = [GUARD_OUTCOME[gd.outcome] for p in self.phases for gd in p[0].guards]
+            self._gtab = (np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+                          np.concatenate(self._gcols), np.concatenate(self._goffs),
+                          np.concatenate(self._dirs), np.array(gout, dtype=np.int64))
+        return self._gtab
 
     def _walker(self, gamma: float):
         if not self._resets_depend_on_slope or gamma == self.slope_rad:
@@ -358,9 +423,11 @@ class BatchStepMap:
         row's slope ``gamma`` (k,) [rad] (data vectors ``D`` (k, c) of the last phase):
         compiled (``reset_rows`` of the generated module) when the walker's reset is the
         generated one, else the walker's reset row by row."""
-        if self._reset_rows is not None:
+        if self._reset_flow is not None:
+            from walkerlab.integrate.rows_dop853 import reset_rows
+
             out = np.empty_like(Y)
-            self._reset_rows(np.ascontiguousarray(Y), np.ascontiguousarray(D), out)
+            reset_rows(self._reset_flow, np.ascontiguousarray(Y), np.ascontiguousarray(D), out)
             return out
         if not self._resets_depend_on_slope:
             reset = self.walker.reset

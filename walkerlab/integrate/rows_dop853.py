@@ -32,7 +32,7 @@ import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
 from scipy.integrate import DOP853 as _SCIPY_DOP853  # noqa: E402
 
-__all__ = ["TIMEOUT", "FAILED", "phase_rows"]
+__all__ = ["TIMEOUT", "FAILED", "phase_rows", "reset_rows", "walk_rows"]
 
 #: ``which`` of a row that reached its time cap / whose step size collapsed
 TIMEOUT, FAILED = -1, -2
@@ -46,14 +46,6 @@ B = np.ascontiguousarray(_SCIPY_DOP853.B)
 E3 = np.ascontiguousarray(_SCIPY_DOP853.E3)
 E5 = np.ascontiguousarray(_SCIPY_DOP853.E5)
 DD = np.ascontiguousarray(_SCIPY_DOP853.D)
-
-
-@njit(cache=True, error_model="numpy")
-def _eval(f, t, y, d, buf, m, out):  # pragma: no cover - compiled
-    """``f`` at ``(t, y)`` into ``buf`` (flow and extra outputs); the flow also into ``out``."""
-    f(buf.ctypes, t, y.ctypes, d.ctypes)
-    for k in range(m):
-        out[k] = buf[k]
 
 
 @njit(cache=True, error_model="numpy")
@@ -78,7 +70,7 @@ def _dense_at(F, y_old, x, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def _dense_coeffs(f, t, h, y, ynew, K, d, buf, F, tmp):  # pragma: no cover - compiled
+def _dense_coeffs(f, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compiled
     """The 3 extra stages and the interpolant's coefficients ``F`` (7, m) of the step."""
     m = y.size
     for s in range(NS + 1, 16):
@@ -87,7 +79,7 @@ def _dense_coeffs(f, t, h, y, ynew, K, d, buf, F, tmp):  # pragma: no cover - co
             for j in range(s):
                 acc += A[s, j] * K[j, k]
             tmp[k] = y[k] + h * acc
-        _eval(f, t + C[s] * h, tmp, d, buf, m, K[s])
+        f(K[s].ctypes, t + C[s] * h, tmp.ctypes, d.ctypes)
     for k in range(m):
         dy = ynew[k] - y[k]
         F[0, k] = dy
@@ -101,7 +93,8 @@ def _dense_coeffs(f, t, h, y, ynew, K, d, buf, F, tmp):  # pragma: no cover - co
 
 
 @njit(cache=True, error_model="numpy")
-def _locate(f, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp, gv):  # pragma: no cover
+def _locate(f, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
+            gv):  # pragma: no cover - compiled
     """Time of guard ``j``'s crossing in the step ``[t_old, t_old + h]`` (values ``g0``,
     ``g1`` at its ends), by the Illinois method on the dense output."""
     if g1 == 0.0:
@@ -138,9 +131,9 @@ def _locate(f, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp, gv):  #
 
 
 @njit(cache=True, error_model="numpy")
-def _attempt(f, t, y, h, K, d, buf, ynew, rtol, atol):  # pragma: no cover - compiled
-    """One DOP853 step of size ``h`` from ``(t, y)`` (``K[0]`` = f(t, y)): ``ynew``, the
-    FSAL evaluation into ``K[NS]`` and ``buf``; returns the error norm."""
+def _attempt(f, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - compiled
+    """One DOP853 step of size ``h`` from ``(t, y)`` (``K[0]`` = f(t, y)): ``ynew`` and
+    the FSAL evaluation (flow and extra outputs) into ``K[NS]``; returns the error norm."""
     m = y.size
     for s in range(1, NS):
         for k in range(m):
@@ -148,13 +141,13 @@ def _attempt(f, t, y, h, K, d, buf, ynew, rtol, atol):  # pragma: no cover - com
             for j in range(s):
                 acc += A[s, j] * K[j, k]
             ynew[k] = y[k] + h * acc
-        _eval(f, t + C[s] * h, ynew, d, buf, m, K[s])
+        f(K[s].ctypes, t + C[s] * h, ynew.ctypes, d.ctypes)
     for k in range(m):
         acc = 0.0
         for j in range(NS):
             acc += B[j] * K[j, k]
         ynew[k] = y[k] + h * acc
-    _eval(f, t + h, ynew, d, buf, m, K[NS])
+    f(K[NS].ctypes, t + h, ynew.ctypes, d.ctypes)
     e5, e3 = 0.0, 0.0
     for k in range(m):
         sc = atol + rtol * max(abs(y[k]), abs(ynew[k]))
@@ -202,7 +195,7 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, n_out, yev, h_first):  # 
     into ``yev``; ``h_first`` > 0: the first step size [s] (else scipy's choice)."""
     m = y.size
     ng = gcols.size
-    K = np.empty((16, m))
+    K = np.empty((16, n_out))  # stages: flow (m) then the extra outputs
     F = np.empty((7, m))
     buf = np.empty(n_out)
     ynew = np.empty(m)
@@ -211,8 +204,8 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, n_out, yev, h_first):  # 
     g1 = np.empty(ng)
     gv = np.empty(ng)
     t, t_bound = 0.0, cap + 1.0
-    _eval(f, t, y, d, buf, m, K[0])
-    _guards(buf, m, gcols, goffs, g0)
+    f(K[0].ctypes, t, y.ctypes, d.ctypes)
+    _guards(K[0], m, gcols, goffs, g0)
     if h_first > 0.0:
         h_abs = min(h_first, t_bound)
     else:
@@ -225,7 +218,7 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, n_out, yev, h_first):  # 
                 return FAILED, t, h_abs
             t_new = min(t + h_abs, t_bound)
             h = t_new - t
-            err = _attempt(f, t, y, h, K, d, buf, ynew, rtol, atol)
+            err = _attempt(f, t, y, h, K, d, ynew, rtol, atol)
             if err < 1.0:
                 fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
                 if rejected:
@@ -234,7 +227,7 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, n_out, yev, h_first):  # 
                 break
             h_abs = h * max(0.2, 0.9 * err ** (-1.0 / 8.0))
             rejected = True
-        _guards(buf, m, gcols, goffs, g1)
+        _guards(K[NS], m, gcols, goffs, g1)
         best, te = -1, np.inf
         dense = False
         for j in range(ng):
@@ -243,7 +236,7 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, n_out, yev, h_first):  # 
             if not hit:
                 continue
             if not dense:
-                _dense_coeffs(f, t, h, y, ynew, K, d, buf, F, tmp)
+                _dense_coeffs(f, t, h, y, ynew, K, d, F, tmp)
                 dense = True
             tj = _locate(f, F, y, t, h, d, buf, gcols, goffs, j, g0[j], g1[j], tmp, gv)
             if tj < te:
@@ -255,7 +248,7 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, n_out, yev, h_first):  # 
             return TIMEOUT, t_new, h_abs
         for k in range(m):
             y[k] = ynew[k]
-            K[0, k] = K[NS, k]
+        K[0, :] = K[NS, :]
         for j in range(ng):
             g0[j] = g1[j]
         t = t_new
@@ -279,3 +272,59 @@ def phase_rows(f, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te, Y
         which[i] = w
         te[i] = t
         H[i] = h
+
+
+@njit(cache=True, error_model="numpy")
+def reset_rows(reset, X, D, out):  # pragma: no cover - compiled
+    """The reset cfunc ``reset`` (``(dy, t, y, d)``, the generated module's ``reset_flow``)
+    of every row of ``X`` (N, m) with its data vector ``D[i]`` into ``out`` (N, m)."""
+    for i in range(X.shape[0]):
+        x = np.ascontiguousarray(X[i])
+        d = np.ascontiguousarray(D[i])
+        o = np.empty(X.shape[1])
+        reset(o.ctypes, 0.0, x.ctypes, d.ctypes)
+        out[i] = o
+
+
+@njit(cache=True, error_model="numpy")
+def walk_rows(f, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, gout, rtol,
+              atol, n_out, steps, fell):  # pragma: no cover - compiled
+    """Walk every row of ``X`` (W, m) up to ``n_steps`` steps, step ``s`` of walk ``w`` on
+    the data vector ``D[w, s]`` (its slope): the phases of a step in turn (phase ``p``'s
+    guards ``gstart[p]:gstart[p + 1]`` of the flat arrays ``gcols``, ``goffs``, ``dirs``
+    and ``gout``: 0 heel strike, 1 fall, 9 next phase, guards without intra-step reset),
+    each integrated by :func:`_row` as :func:`phase_rows` does (the step size carried from
+    phase to phase), a heel strike reset by ``reset`` and counted in ``steps`` (W,); a fall,
+    a step longer than ``max_time`` [s] or a failed integration sets ``fell`` (W,) and ends
+    the walk.  ``X`` is overwritten with each walk's last post-impact state."""
+    W, m = X.shape
+    n_ph = gstart.size - 1
+    yev = np.empty(m)
+    for w in range(W):
+        x = X[w].copy()
+        for s in range(n_steps):
+            T, h, ended = 0.0, 0.0, False
+            d = np.ascontiguousarray(D[w, s])
+            y = x.copy()
+            for p in range(n_ph):
+                a, b = gstart[p], gstart[p + 1]
+                if max_time - T <= 0.0:
+                    ended = True
+                    break
+                which, te, h = _row(f, y, d, max_time - T, gcols[a:b], goffs[a:b],
+                                    dirs[a:b], rtol, atol, n_out, yev, h)
+                if which < 0 or gout[a + which] == 1:
+                    ended = True
+                    break
+                T += te
+                if gout[a + which] == 0:
+                    reset(x.ctypes, 0.0, yev.ctypes, d.ctypes)
+                    steps[w] += 1
+                    break
+                y[:] = yev
+                if p == n_ph - 1:
+                    ended = True  # a last phase that leads nowhere
+            if ended:
+                fell[w] = True
+                break
+        X[w] = x
