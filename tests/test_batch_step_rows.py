@@ -11,6 +11,7 @@ import pytest
 from walkerlab.codegen.compiled import compiled_module
 from walkerlab.config import load_scene
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
+from walkerlab.integrate.rows_dop853 import reset_rows
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.mfpt import scene_walker_at
 
@@ -40,8 +41,9 @@ def test_a_rows_step_does_not_depend_on_its_batch(paper_scene, paper_map, paper_
 
 @pytest.mark.parametrize("scene", ["paper.yaml", "kneed.yaml"])
 def test_compiled_reset_is_the_walkers_reset(scene):
-    """``reset_rows`` of the generated compiled module (same expressions as the Python
-    ``reset``) gives the walker's heel-strike reset bit for bit, on two slopes."""
+    """``reset_flow`` of the generated compiled module (a cfunc, same expressions as the
+    Python ``reset``), applied row by row by ``rows_dop853.reset_rows``, gives the walker's
+    heel-strike reset bit for bit, on two slopes."""
     sc = load_scene(ROOT / "configs" / scene)
     w = build_walker(sc)
     cf = w.phases[-1].compiled
@@ -52,5 +54,39 @@ def test_compiled_reset_is_the_walkers_reset(scene):
         wg = scene_walker_at(sc)(gamma)
         D = np.tile(wg.phases[-1].compiled.data(), (5, 1))
         out = np.empty_like(X)
-        mod.reset_rows(X, D, out)
+        reset_rows(mod.reset_flow, X, D, out)
         np.testing.assert_array_equal(out, np.array([wg.reset(x) for x in X]))
+
+
+def test_compiled_walks_equal_step_after_step(paper_scene, paper_map, paper_fixed_point):
+    """A whole walk in compiled code (``BatchStepMap.walk``) gives the same heel strikes,
+    falls and last states, bit for bit, as ``step`` called step after step on the same
+    slopes (sigma 0.01 rad: most walks fall within 12 steps, so both branches are met)."""
+    rng = np.random.default_rng(11)
+    W, S = 40, 12
+    gam = paper_scene.slope.phi_rad + 0.01 * rng.standard_normal((W, S))
+    assert paper_map.can_walk
+    steps, fell, X_end = paper_map.walk(np.tile(paper_fixed_point.x, (W, 1)), gam)
+    X = np.tile(paper_fixed_point.x, (W, 1))
+    alive = np.arange(W)
+    ref = np.zeros(W, int)
+    for s in range(S):
+        r = paper_map.step(X[alive], gam[alive, s])
+        ok = r.outcome == HEEL_STRIKE
+        ref[alive[ok]] += 1
+        X[alive[ok]] = r.x_next[ok]
+        alive = alive[ok]
+    np.testing.assert_array_equal(steps, ref)
+    np.testing.assert_array_equal(fell, ~np.isin(np.arange(W), alive))
+    np.testing.assert_array_equal(X_end, X)
+    assert 0 < fell.sum() < W
+
+
+def test_kneed_walker_keeps_the_step_by_step_walks():
+    """A kneed walker (two flows, the knee strike's reset between phases) is not walked in
+    one compiled call: ``can_walk`` is False and ``walk`` says why in one line."""
+    sc = load_scene(ROOT / "configs" / "kneed.yaml")
+    sm = BatchStepMap(build_walker(sc), scene_walker_at(sc), 1e-9, 1e-9)
+    assert not sm.can_walk
+    with pytest.raises(ValueError, match="compiled walks need"):
+        sm.walk(np.zeros((1, sm.n)), np.zeros((1, 1)))
