@@ -3,7 +3,8 @@ the private user cache (numba's ``cache=True``), compiles nothing and writes not
 
 The child runs the kernels the paper's main job runs - the contact walker's right-hand side,
 Jacobian, contact table, hip heights and CyRK cfunc, a short contact walk, the rigid
-walker's compiled flows (Poincare map on ``cyrk_compiled``), the batched step map - and
+walker's compiled flows (Poincare map on ``cyrk_compiled``), the batched step map and the
+compiled Monte Carlo walks - and
 reports numba's compile events (``numba:compile`` is broadcast only on a cache miss:
 ``numba.core.dispatcher.Dispatcher.compile``), the dispatchers with more than one
 specialisation, and the compiled walks' cache statistics.
@@ -53,6 +54,7 @@ xs = sc.fixedpoint.initial_guess.as_array(rw.state_names())
 poincare_map(rw, xs, Solver("DOP853", 1e-10, 1e-10, None, "cyrk_compiled"), jacobian=True)
 sm = step_map_for(sc.model_dump(mode="json"))
 sm.step(np.tile(xs, (3, 1)), np.array([0.017, 0.0174, 0.018]))
+sm.walk(np.tile(xs, (2, 1)), np.full((2, 3), 0.0174))
 multi = sorted(f"{v.py_func.__module__}.{v.py_func.__name__}"
                for m in (w.kernels,) for v in vars(m).values()
                if isinstance(v, CPUDispatcher) and len(v.signatures) > 1)
