@@ -54,7 +54,7 @@ def test_compiled_reset_is_the_walkers_reset(scene):
         wg = scene_walker_at(sc)(gamma)
         D = np.tile(wg.phases[-1].compiled.data(), (5, 1))
         out = np.empty_like(X)
-        reset_rows(mod.reset_flow, X, D, out)
+        reset_rows(mod.reset_flow(), X, D, out)
         np.testing.assert_array_equal(out, np.array([wg.reset(x) for x in X]))
 
 

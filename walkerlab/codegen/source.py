@@ -402,19 +402,26 @@ def generate(eq: Equations, param_names, key: str) -> str:
 
 
 def _reset_cfunc(eq: Equations, consts: list[str], reset: list[str]) -> list[str]:
-    """``reset_flow(dy, t, y, d)``: the heel-strike reset (``reset_lines``' equations, same
-    expressions) of the pre-impact state ``y`` into ``dy``, a numba ``cfunc`` of the flows'
-    signature (``d`` the data vector; ``t`` unused)."""
+    """``reset_flow()``: the heel-strike reset (``reset_lines``' equations, same
+    expressions) of the pre-impact state ``y`` into ``dy``, a numba ``cfunc`` ``(dy, t, y,
+    d)`` of the flows' signature (``d`` the data vector; ``t`` unused), compiled on the
+    first call of ``reset_flow()`` (cfuncs compile when made: lazily, as every njit)."""
     names = [str(s) for s in (*eq.q, *eq.dq)]
     ret = reset[-1].strip()
     assert ret.startswith("return np.array((") and ret.endswith(",))")
-    out = ["@cfunc(SIG, cache=True, error_model='numpy')",
-           "def reset_flow(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out = ["def _reset_flow(dy, t, y, d):  # pragma: no cover - runs compiled"]
     out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
     out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
     out += [ln[4:] for ln in reset[2:-1]]
     out += [f"    _res = ({ret[len('return np.array(('):-3]},)",
-            f"    for _k in range({len(names)}):", "        dy[_k] = _res[_k]"]
+            f"    for _k in range({len(names)}):", "        dy[_k] = _res[_k]", "", "",
+            "_RESET_FLOW = []", "", "",
+            "def reset_flow():",
+            '    """The heel-strike reset, a cfunc of the flows\' signature (compiled on first',
+            '    use: a walker that never walks on per-step slopes does not compile it)."""',
+            "    if not _RESET_FLOW:",
+            "        _RESET_FLOW.append(cfunc(SIG, cache=True, error_model='numpy')(_reset_flow))",
+            "    return _RESET_FLOW[0]"]
     return out + [""]
 
 
@@ -461,7 +468,7 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     subexpressions and a zeroed call counter: the data vector of every cfunc), its compiled
     twin for many parameter rows ``constants_rows(P (N, NP)) -> (N, NCONST + 1)`` (numba,
     lazy), ``NCONST``, the heel-strike reset as a cfunc of the flows' signature
-    ``reset_flow(dy, t, y, d)``,
+    (``reset_flow()`` makes it on first use),
     ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
     ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
     ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values

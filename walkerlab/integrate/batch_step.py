@@ -157,9 +157,10 @@ class BatchStepMap:
         e.g. an impulse at push-off, keeps its own), else None."""
         from walkerlab.integrate.rows_dop853 import reset_rows
 
-        fn = getattr(mod, "reset_flow", None)
-        if fn is None:  # pragma: no cover - a module generated before reset_flow
+        make = getattr(mod, "reset_flow", None)
+        if make is None:  # pragma: no cover - a module generated before reset_flow
             return None
+        fn = make()
         probe = np.linspace(0.11, 0.37, self.n) * np.array([1, -1] * (self.n // 2))
         for g in (self.slope_rad, self.slope_rad + 0.01):
             out = np.empty((1, self.n))
