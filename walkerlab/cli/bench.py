@@ -22,6 +22,11 @@ benchmark      what is timed                                                    
                scene's walker, 5 contact strides at <= 1e-6 rad against a tight     kneed:
                reference, median time of the loosest tolerance band reaching it     <= 0.1 s
                (:func:`walkerlab.bench.contact.run_scene_benchmark`)
+``main-job``   the paper's main job as a new user meets it: cold and warm       see
+               ``contact-sim``, cold first ``report``, MFPT Monte Carlo CPU per  module
+               heel strike against a minimal numba loop, mesh MFPT, robustness
+               (:mod:`walkerlab.bench.main_job`; ``scripts/bench_main_job.py
+               --vs DIR`` puts another code tree beside this one)
 =============  ===============================================================  ==========
 
 The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
@@ -40,7 +45,7 @@ import numpy as np
 from walkerlab.bench import benchmarks as B
 from walkerlab.io.artifacts import atomic_write
 
-BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact")
+BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact", "main-job")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
@@ -129,6 +134,11 @@ def run_bench(what: str, out: Path, scenes=None) -> list[str]:
         atomic_write(out / f"{name}.json", lambda fh, text=text: fh.write(text))
         if name == "contact" and scenes:
             lines += [B.scene_line(r) for r in res["result"]["scenes"]]
+        if name == "main-job":
+            from walkerlab.bench.main_job import lines as main_job_lines
+
+            lines += main_job_lines(res["result"])
+            continue
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines
 
@@ -138,6 +148,10 @@ def _run_one(name: str, scenes) -> dict:
         from walkerlab.bench.contact import run_benchmark
 
         return run_benchmark()
+    if name == "main-job":
+        from walkerlab.bench.main_job import run_main_job
+
+        return run_main_job()
     return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint, "sweep": bench_sweep,
             "basin": B.bench_basin,
             "contact": lambda: B.bench_contact_scenes(scenes)}[name]()

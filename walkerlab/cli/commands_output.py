@@ -63,7 +63,7 @@ def export(scene: Path | None = SceneArg,
 
 @guard
 def bench(what: str = typer.Argument("all", help="ideal | fixedpoint | sweep | basin | contact"
-                                     " | all (all but basin)"),
+                                     " | main-job | all (all but basin and main-job)"),
           scenes: list[Path] | None = typer.Argument(
               None, help="contact only: scene YAML files whose walkers are timed (5 contact "
               "strides at <= 1e-6 rad against a tight reference), e.g. configs/kneed.yaml "

@@ -401,6 +401,30 @@ def generate(eq: Equations, param_names, key: str) -> str:
     return "\n".join(head + body) + "\n"
 
 
+def _reset_cfunc(eq: Equations, consts: list[str], reset: list[str]) -> list[str]:
+    """``reset_flow()``: the heel-strike reset (``reset_lines``' equations, same
+    expressions) of the pre-impact state ``y`` into ``dy``, a numba ``cfunc`` ``(dy, t, y,
+    d)`` of the flows' signature (``d`` the data vector; ``t`` unused), compiled on the
+    first call of ``reset_flow()`` (cfuncs compile when made: lazily, as every njit)."""
+    names = [str(s) for s in (*eq.q, *eq.dq)]
+    ret = reset[-1].strip()
+    assert ret.startswith("return np.array((") and ret.endswith(",))")
+    out = ["def _reset_flow(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
+    out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
+    out += [ln[4:] for ln in reset[2:-1]]
+    out += [f"    _res = ({ret[len('return np.array(('):-3]},)",
+            f"    for _k in range({len(names)}):", "        dy[_k] = _res[_k]", "", "",
+            "_RESET_FLOW = []", "", "",
+            "def reset_flow():",
+            '    """The heel-strike reset, a cfunc of the flows\' signature (compiled on first',
+            '    use: a walker that never walks on per-step slopes does not compile it)."""',
+            "    if not _RESET_FLOW:",
+            "        _RESET_FLOW.append(cfunc(SIG, cache=True, error_model='numpy')(_reset_flow))",
+            "    return _RESET_FLOW[0]"]
+    return out + [""]
+
+
 def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational: bool,
            guards: tuple[list[str], list]) -> list[str]:
     """A numba ``cfunc`` ``(dy, t, y, d)`` (CyRK's ``cyjit_sig``) writing the flow (and with
@@ -441,7 +465,10 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     C++ integrators (``CyRK.nb.numba_solver.cyjit_sig``), ``cache=True``.
 
     Defines ``constants(p) -> ndarray (NCONST + 1,)`` (the parameters, the parameter-only
-    subexpressions and a zeroed call counter: the data vector of every cfunc), ``NCONST``,
+    subexpressions and a zeroed call counter: the data vector of every cfunc), its compiled
+    twin for many parameter rows ``constants_rows(P (N, NP)) -> (N, NCONST + 1)`` (numba,
+    lazy), ``NCONST``, the heel-strike reset as a cfunc of the flows' signature
+    (``reset_flow()`` makes it on first use),
     ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
     ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
     ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
@@ -455,22 +482,32 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     parts = {k: (flow_lines(e, False, parts=True), flow_lines(e, True, parts=True))
              for k, e in flows.items()}
     guards = cse_lines(list(eq.guards.values()), PRINTER)
+    reset = reset_lines(eq, False)  # (its parameter-only subexpressions join the constants)
     consts = list(param_names) + [h.split("=")[0].strip() for h in _HOISTED]
     body = ["def constants(p):",
             f"    {', '.join(param_names)}, = p",
             *_HOISTED,
             f"    return np.array(({', '.join(consts)}, 0.0), dtype=np.float64)",
             "", f"NCONST = {len(consts)}",
-            f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", ""]
+            f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", "",
+            "_constants_jit = njit(cache=True)(constants)", "", "",
+            "@njit(cache=True)",
+            "def constants_rows(P):  # pragma: no cover - runs compiled",
+            '    """Data vectors (N, NCONST + 1) of the parameter rows P (N, NP)."""',
+            "    out = np.empty((P.shape[0], NCONST + 1))",
+            "    for i in range(P.shape[0]):",
+            "        out[i] = _constants_jit(P[i])",
+            "    return out", ""]
     for k, e in flows.items():
         body += _cfunc(k, e, consts, parts[k], False, guards) + [""]
         body += _cfunc(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
+    body += _reset_cfunc(eq, consts, reset)
     head = [
         f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
         "from math import sin, cos, tan, sqrt  # noqa: F401",
         "import numpy as np",
-        "from numba import cfunc, types",
+        "from numba import cfunc, njit, types",
         "",
         "SIG = types.void(types.CPointer(types.float64), types.float64,",
         "                 types.CPointer(types.float64), types.CPointer(types.float64))",

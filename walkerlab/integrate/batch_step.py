@@ -1,19 +1,24 @@
 """The Poincaré (step-to-step) map of a rigid walker for many states at once, each state on its
 own slope: the workhorse of the metastability studies (:mod:`walkerlab.analysis.robustness.mfpt`).
 
-One step of ``N`` walkers is integrated as one stacked system (``N x 2n`` states) by scipy's
-DOP853 (``scipy.integrate.DOP853``, stepped one step at a time); its right-hand side calls the
-walker's compiled flow (the numba ``cfunc`` of :class:`walkerlab.codegen.compiled.CompiledFlow`,
-the same generated equations as every other rigid integration) once per walker, in one
-compiled loop (:func:`walkerlab.integrate.batch_rows.kernel`), so the per-step Python cost of
-the integrator is shared by all ``N`` walkers.  Guards are the cfunc's extra outputs; after
-each integrator step the walkers whose guard changed sign in its direction (``solve_ivp``'s
-rule) are located on the step's dense output (DOP853's 7th-order interpolant, evaluated
-row-wise for those walkers) by ``scipy.optimize.elementwise.find_root`` (Chandrupatla's
-bracketing method, vectorised) and leave the stacked system; the others go on (the system
-is restarted with the remaining rows and the last step size).  The phases of a step
-(early/late swing, unlocked/locked knee) are run one after the other, each from the
-phase-local time 0 (the flows are autonomous).
+One step of ``N`` walkers: each row is integrated on its own, phase after phase, by a
+compiled DOP853 calling the walker's compiled flow (the numba ``cfunc`` of
+:class:`walkerlab.codegen.compiled.CompiledFlow`, the same generated equations as every other
+rigid integration) to its first guard crossing, located on the step's dense output
+(:func:`walkerlab.integrate.rows_dop853.phase_rows`: one compiled call per phase for all
+rows, so a row's numbers do not depend on the other rows of its batch); heel strikes are
+reset by the generated module's compiled reset (``reset_rows``) when it is the walker's own
+(checked bit for bit on a probe), else row by row.  The phases of a step (early/late swing,
+unlocked/locked knee) are run one after the other, each from the phase-local time 0 (the
+flows are autonomous), a row starting each phase with the step size it would have taken
+next.  A footfall drop (``drop_m``, the robustness study's step-down) keeps the stacked
+system: all its rows integrated as one system by scipy's DOP853 (``scipy.integrate.DOP853``,
+stepped one step at a time), its right-hand side the walker's compiled flow for every row
+in one compiled loop (:func:`walkerlab.integrate.batch_rows.kernel`); guards are the
+cfunc's extra outputs; after each integrator step the rows whose guard changed sign in its
+direction (``solve_ivp``'s rule) are located on the step's dense output by
+``scipy.optimize.elementwise.find_root`` (Chandrupatla's method, vectorised) and leave the
+stacked system.
 
 Per-step slope (a walker on rough terrain, Byl & Tedrake 2009): each row has its own slope
 ``gamma``: the parameter vector of the compiled functions (``Structure.param_names``) with
@@ -21,9 +26,9 @@ Per-step slope (a walker on rough terrain, Byl & Tedrake 2009): each row has its
 ``theta_swing + theta_stance = -2 gamma_n`` (the ground of step ``n`` is the line through the
 stance foot at slope ``gamma_n``); the model generator is untouched.
 
-Accuracy: scipy's error norm is the RMS over all components, so the tolerances handed to
-DOP853 are the requested ones divided by ``sqrt(N 2n)``: a single walker's error estimate
-then stays below the requested tolerance, as if it were integrated alone.
+Accuracy: a row's error estimate (the 2-norm over its 2n components of the scaled error)
+stays below 1 at the requested tolerances, as if it were integrated alone; the stacked
+system divides them by ``sqrt(N 2n)`` (scipy's error norm is the RMS over all components).
 """
 
 from __future__ import annotations
@@ -37,6 +42,10 @@ from walkerlab.integrate.batch_rows import StackedRows, dense_rows
 #: How a step of one row ended (``outcome`` codes are indices into this tuple).
 STEP_OUTCOMES = ("heel_strike", "fall", "timeout", "solver_failure")
 HEEL_STRIKE, FALL, TIMEOUT, SOLVER_FAILURE = range(4)
+#: a guard that leads to the next phase of the step (its reset applied)
+NEXT_PHASE = 9
+#: a guard's ``outcome`` -> how its row's phase ends
+GUARD_OUTCOME = {"heel_strike": HEEL_STRIKE, "fall": FALL, "next_phase": NEXT_PHASE}
 
 @dataclass
 class BatchStep:
@@ -101,6 +110,10 @@ class BatchStepMap:
             n_extra, cols, offs = cf.guard_columns()
             self.phases.append((ph, getattr(mod, cf.name), n_extra, cols, offs,
                                 np.array([g.direction for g in ph.guards])))
+        # the compiled per-row integrator's arguments, one dtype each (one specialisation)
+        self._gcols = [np.ascontiguousarray(p[3], dtype=np.int64) for p in self.phases]
+        self._goffs = [np.ascontiguousarray(p[4], dtype=float) for p in self.phases]
+        self._dirs = [np.ascontiguousarray(p[5], dtype=np.int64) for p in self.phases]
         # a step-down (or up) of the ground at the footfall: the last phase's heel strike
         # becomes the swing foot's clearance above the slope line reaching -drop
         lastc = walker.phases[-1].compiled
@@ -109,11 +122,14 @@ class BatchStepMap:
                     if g.outcome == "heel_strike"]
         self._clear = names.index("swing_clearance") if "swing_clearance" in names else None
         first = walker.phases[0].compiled
-        self._constants = compiled_module(first.structure).constants
+        self._constants_rows = compiled_module(first.structure).constants_rows
         self._params = np.array(first.params, dtype=float)
         self._ig = list(first.structure.param_names).index("gamma")
         self.slope_rad = float(walker.slope_rad)
         self._resets_depend_on_slope = self._probe_slope_dependence()
+        self._reset_flow = self._probe_compiled_reset(compiled_module(lastc.structure))
+        #: rows integrated by the compiled per-row integrator (phases), for the record
+        self.integrated = 0
         self._walkers: dict[float, object] = {}
 
     # -- slope handling -------------------------------------------------------------------
@@ -135,6 +151,88 @@ class BatchStepMap:
                     same &= np.array_equal(np.asarray(g1.reset(probe)), np.asarray(g2.reset(probe)))
         return not same
 
+    def _probe_compiled_reset(self, mod):
+        """The generated module's compiled heel-strike reset if it gives the walker's own
+        reset bit for bit on a probe state on two slopes (a walker built with another reset,
+        e.g. an impulse at push-off, keeps its own), else None."""
+        from walkerlab.integrate.rows_dop853 import reset_rows
+
+        make = getattr(mod, "reset_flow", None)
+        if make is None:  # pragma: no cover - a module generated before reset_flow
+            return None
+        fn = make()
+        probe = np.linspace(0.11, 0.37, self.n) * np.array([1, -1] * (self.n // 2))
+        for g in (self.slope_rad, self.slope_rad + 0.01):
+            out = np.empty((1, self.n))
+            reset_rows(fn, probe[None], self.data(np.array([g])), out)
+            w = self.walker if g == self.slope_rad else self.walker_at(g)
+            if not np.array_equal(out[0], np.asarray(w.reset(probe), dtype=float)):
+                return None
+        return fn
+
+    @property
+    def can_walk(self) -> bool:
+        """Whether :meth:`walk` runs whole walks compiled: one compiled flow for every phase
+        of a step, no reset between phases, and the compiled heel-strike reset."""
+        cf = {id(p[1]) for p in self.phases}
+        no_mid_reset = all(g.reset is None for p in self.phases for g in p[0].guards
+                           if g.outcome == "next_phase")
+        return len(cf) == 1 and no_mid_reset and self._reset_flow is not None
+
+    def walk(self, X: np.ndarray, gamma: np.ndarray):
+        """Walk every row up to ``gamma.shape[1]`` steps, step ``s`` of row ``w`` on the
+        slope ``gamma[w, s]`` [rad], until it falls (any step that does not end in heel
+        strike), all in compiled code (:func:`walkerlab.integrate.rows_dop853.walk_rows`;
+        the same numbers as :meth:`step` step after step).
+
+        Parameters
+        ----------
+        X : ndarray, shape (W, 2n)
+            Post-impact states [rad, rad/s].
+        gamma : ndarray, shape (W, S)
+            Slopes [rad].
+
+        Returns
+        -------
+        steps : ndarray of int, shape (W,)
+            Heel strikes of each row.
+        fell : ndarray of bool, shape (W,)
+        X_end : ndarray, shape (W, 2n)
+            Each row's last post-impact state.
+
+        Raises
+        ------
+        ValueError
+            A walker :attr:`can_walk` says no to.
+        """
+        from walkerlab.integrate.rows_dop853 import walk_rows
+
+        if not self.can_walk:
+            raise ValueError(f"{self.walker.name}: compiled walks need one compiled flow for "
+                             "every phase, no intra-step reset and the compiled reset")
+        X = np.array(X, dtype=float, order="C", ndmin=2)
+        W, S = gamma.shape
+        P = np.tile(self._params, (W * S, 1))
+        P[:, self._ig] = np.asarray(gamma, dtype=float).ravel()
+        D = self._constants_rows(P).reshape(W, S, -1)  # (as data(): one row per slope)
+        g = self._guard_table()
+        steps = np.zeros(W, np.int64)
+        fell = np.zeros(W, np.bool_)
+        walk_rows(self.phases[0][1], self._reset_flow, X, D, S, float(self.max_step_time_s),
+                  *g, float(self.rtol), float(self.atol), self.n + self.phases[0][2], steps,
+                  fell)
+        return steps, fell, X
+
+    def _guard_table(self):
+        """``(gstart, gcols, goffs, dirs, gout)``: every phase's guards in flat arrays."""
+        if not hasattr(self, "_gtab"):
+            sizes = [len(p[0].guards) for p in self.phases]
+            gout = [GUARD_OUTCOME[gd.outcome] for p in self.phases for gd in p[0].guards]
+            self._gtab = (np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+                          np.concatenate(self._gcols), np.concatenate(self._goffs),
+                          np.concatenate(self._dirs), np.array(gout, dtype=np.int64))
+        return self._gtab
+
     def _walker(self, gamma: float):
         if not self._resets_depend_on_slope or gamma == self.slope_rad:
             return self.walker
@@ -148,12 +246,9 @@ class BatchStepMap:
     def data(self, gamma: np.ndarray) -> np.ndarray:
         """Data vectors (N, c) of the compiled functions, one per slope [rad]."""
         uniq, inv = np.unique(np.asarray(gamma, dtype=float), return_inverse=True)
-        rows = []
-        for g in uniq:
-            p = self._params.copy()
-            p[self._ig] = g
-            rows.append(self._constants(p))
-        return np.ascontiguousarray(np.stack(rows)[inv.ravel()])
+        P = np.tile(self._params, (uniq.size, 1))
+        P[:, self._ig] = uniq
+        return np.ascontiguousarray(self._constants_rows(P)[inv.ravel()])
 
     # -- the map --------------------------------------------------------------------------
     def step(self, X: np.ndarray, gamma: np.ndarray | float | None = None,
@@ -197,6 +292,7 @@ class BatchStepMap:
         out = BatchStep(np.full(N, TIMEOUT, np.int8), np.full((N, m), np.nan),
                         np.full((N, m), np.nan), np.full(N, np.nan))
         rows, Y, T = np.arange(N), X.copy(), np.zeros(N)
+        self._h_rows = np.zeros(N)  # step size carried from phase to phase [s]
         for k, phase in enumerate(self.phases):
             if rows.size == 0:
                 break
@@ -221,6 +317,8 @@ class BatchStepMap:
         ok = cap > 0
         out.outcome[rows[~ok]] = TIMEOUT
         rows, Y, T, cap = rows[ok], Y[ok], T[ok], cap[ok]
+        if not drop:
+            return self._phase_rows(k, phase, rows, Y, T, D[rows, :nc], cap, gamma, out)
         Dk = D[rows]
         if drop:  # one more column: armed (1) or not (0)
             Dk = np.hstack([Dk, np.zeros((rows.size, 1))])
@@ -275,6 +373,68 @@ class BatchStepMap:
         if nxt[0]:
             return np.array(nxt[0]), np.array(nxt[1]), np.array(nxt[2])
         return np.empty(0, int), np.empty((0, m)), np.empty(0)
+
+    def _phase_rows(self, k, phase, rows, Y, T, Dk, cap, gamma, out):
+        """Phase ``k`` of rows without a footfall drop, each row integrated alone by the
+        compiled DOP853 (:func:`walkerlab.integrate.rows_dop853.phase_rows`); returns the
+        rows that go on to phase k + 1 (their entry states and times)."""
+        from walkerlab.integrate.rows_dop853 import FAILED, phase_rows
+
+        ph, cfunc, n_extra, gcols, goffs, dirs = phase
+        N, m = Y.shape
+        which = np.empty(N, np.int64)
+        te = np.empty(N)
+        Yev = np.empty((N, m))
+        H = self._h_rows[rows]
+        phase_rows(cfunc, np.ascontiguousarray(Y, dtype=float), np.ascontiguousarray(Dk),
+                   np.ascontiguousarray(cap, dtype=float), self._gcols[k], self._goffs[k],
+                   self._dirs[k], float(self.rtol), float(self.atol), m + n_extra, which, te,
+                   Yev, H)
+        self._h_rows[rows] = H
+        out.outcome[rows[which == FAILED]] = SOLVER_FAILURE  # (TIMEOUT: already set)
+        self.integrated += N
+        outcome = np.array([GUARD_OUTCOME.get(g.outcome, -1) for g in ph.guards] + [-1, -1])
+        kind = outcome[which]  # which = -1 / -2 pick the trailing -1s
+        t_end = T + te
+        fell = kind == FALL
+        out.outcome[rows[fell]] = FALL
+        out.x_pre[rows[fell]] = Yev[fell]
+        out.step_time_s[rows[fell]] = t_end[fell]
+        hs = np.flatnonzero(kind == HEEL_STRIKE)
+        if hs.size:
+            r = rows[hs]
+            out.outcome[r] = HEEL_STRIKE
+            out.x_pre[r] = Yev[hs]
+            out.step_time_s[r] = t_end[hs]
+            out.x_next[r] = self._resets(Yev[hs], gamma[r], Dk[hs])
+        go = np.flatnonzero(kind == NEXT_PHASE)
+        if k == len(self.phases) - 1:  # pragma: no cover - a last phase without heel strike
+            out.outcome[rows[go]] = SOLVER_FAILURE
+            go = go[:0]
+        Y1 = Yev[go]
+        for j in np.unique(which[go]):  # the guard's reset (e.g. a knee strike), if any
+            if ph.guards[j].reset is not None:
+                for i in np.flatnonzero(which[go] == j):
+                    gw = self._walker(float(gamma[rows[go[i]]])).phases[k].guards[j]
+                    Y1[i] = np.asarray(gw.reset(Yev[go[i]]), float)
+        return rows[go], Y1, t_end[go]
+
+    def _resets(self, Y: np.ndarray, gamma: np.ndarray, D: np.ndarray) -> np.ndarray:
+        """Heel-strike resets (k, 2n) of the pre-impact states ``Y`` (k, 2n), each on its
+        row's slope ``gamma`` (k,) [rad] (data vectors ``D`` (k, c) of the last phase):
+        compiled (``reset_rows`` of the generated module) when the walker's reset is the
+        generated one, else the walker's reset row by row."""
+        if self._reset_flow is not None:
+            from walkerlab.integrate.rows_dop853 import reset_rows
+
+            out = np.empty_like(Y)
+            reset_rows(self._reset_flow, np.ascontiguousarray(Y), np.ascontiguousarray(D), out)
+            return out
+        if not self._resets_depend_on_slope:
+            reset = self.walker.reset
+            return np.array([reset(y) for y in Y], dtype=float).reshape(Y.shape)
+        return np.array([self._walker(float(g)).reset(y) for y, g in zip(Y, gamma)],
+                        dtype=float).reshape(Y.shape)
 
     def _leave(self, k, g, j, r0, t_end, y_ev, gamma, out, nxt, last) -> None:
         """Row ``r0`` met guard ``g`` (index ``j`` of phase ``k``) at ``t_end`` [s] in state

@@ -146,6 +146,19 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
     steps = np.zeros(W, dtype=np.int64)
     fell = np.zeros(W, dtype=bool)
     alive = np.arange(W)
+    if getattr(step_map, "can_walk", False):  # whole walks compiled, block after block
+        wb = max(block, 200_000 // max(W, 1))  # (slopes drawn once per walk and block)
+        for k in range(0, max_steps, wb):
+            if alive.size == 0:
+                break
+            nb = min(wb, max_steps - k)
+            slopes = np.stack([draw_slopes(seed, walks[i], k + nb, mean, sd, distribution)[k:]
+                               for i in alive])
+            s, f, X[alive] = step_map.walk(X[alive], slopes)
+            steps[alive] += s
+            fell[alive] = f
+            alive = alive[~f]
+        return MonteCarloResult(steps, fell)
     slopes = np.empty((W, 0))
     for k in range(max_steps):
         if alive.size == 0:

@@ -1,0 +1,330 @@
+"""One phase of many rows, each integrated on its own by a compiled DOP853 to its first guard
+crossing: the inner loop of :class:`walkerlab.integrate.batch_step.BatchStepMap`.
+
+Every row is integrated alone (its own step sizes; no stacked system), by Dormand & Prince's
+DOP853 (Hairer, Nørsett & Wanner, "Solving Ordinary Differential Equations I", 2nd ed. 1993,
+sec. II.10) with scipy's coefficients (``scipy.integrate.DOP853``'s class attributes) and
+scipy's step-size control (safety 0.9, factor in [0.2, 10], exponent -1/8, the first step
+by ``select_initial_step``'s rule).  The error norm is the 2-norm over the row's components of
+the scaled error (``atol + rtol max(|y|, |y_new|)``): the criterion
+:class:`~walkerlab.integrate.batch_step.BatchStepMap` has always asked of each row (the 2-norm
+equals scipy's RMS norm at tolerances divided by ``sqrt(2n)``).
+
+The flow is the walker's compiled ``cfunc`` ``(dy, t, y, d)``
+(:class:`walkerlab.codegen.compiled.CompiledFlow`), called as a first-class function; its
+extra outputs are the guards (``G[gcols] + goffs``).  A guard ends the phase when it changes
+sign in its direction over an accepted step (``up``: from <= 0 to >= 0, ``down``: from >= 0 to
+<= 0, ``solve_ivp``'s rule); the crossing is located on the step's 7th-order dense output by
+the Illinois method (bracketing regula falsi) to 1e-15 s, and the first crossing of all the
+row's guards wins (ties: the first guard).
+
+Row outcomes (``which``): the guard index, :data:`TIMEOUT` (``t`` reached the row's cap
+without a crossing) or :data:`FAILED` (the step size fell below 10 ulp of ``t``).
+"""
+
+from __future__ import annotations
+
+from walkerlab.usercache import use_for_numba
+
+use_for_numba()  # cache=True below: numba's cache in the user cache, not in the package
+
+import numpy as np  # noqa: E402
+from numba import njit  # noqa: E402
+from scipy.integrate import DOP853 as _SCIPY_DOP853  # noqa: E402
+
+__all__ = ["TIMEOUT", "FAILED", "phase_rows", "reset_rows", "walk_rows"]
+
+#: ``which`` of a row that reached its time cap / whose step size collapsed
+TIMEOUT, FAILED = -1, -2
+
+NS = _SCIPY_DOP853.n_stages  # 12
+A = np.zeros((16, 16))
+A[:NS, :NS] = _SCIPY_DOP853.A
+A[NS + 1:, :] = _SCIPY_DOP853.A_EXTRA
+C = np.concatenate([_SCIPY_DOP853.C, [1.0], _SCIPY_DOP853.C_EXTRA])
+B = np.ascontiguousarray(_SCIPY_DOP853.B)
+E3 = np.ascontiguousarray(_SCIPY_DOP853.E3)
+E5 = np.ascontiguousarray(_SCIPY_DOP853.E5)
+DD = np.ascontiguousarray(_SCIPY_DOP853.D)
+
+
+@njit(cache=True, error_model="numpy")
+def _guards(buf, m, gcols, goffs, g):  # pragma: no cover - compiled
+    for j in range(gcols.size):
+        g[j] = buf[m + gcols[j]] + goffs[j]
+
+
+@njit(cache=True, error_model="numpy")
+def _dense_at(F, y_old, x, out):  # pragma: no cover - compiled
+    """Dense output at the fraction ``x`` of the step (scipy's ``Dop853DenseOutput``)."""
+    m = out.size
+    for k in range(m):
+        out[k] = 0.0
+    nF = F.shape[0]
+    for i in range(nF):
+        for k in range(m):
+            out[k] += F[nF - 1 - i, k]
+            out[k] *= x if i % 2 == 0 else (1.0 - x)
+    for k in range(m):
+        out[k] += y_old[k]
+
+
+@njit(cache=True, error_model="numpy")
+def _dense_coeffs(f, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compiled
+    """The 3 extra stages and the interpolant's coefficients ``F`` (7, m) of the step."""
+    m = y.size
+    for s in range(NS + 1, 16):
+        for k in range(m):
+            acc = 0.0
+            for j in range(s):
+                acc += A[s, j] * K[j, k]
+            tmp[k] = y[k] + h * acc
+        f(K[s].ctypes, t + C[s] * h, tmp.ctypes, d.ctypes)
+    for k in range(m):
+        dy = ynew[k] - y[k]
+        F[0, k] = dy
+        F[1, k] = h * K[0, k] - dy
+        F[2, k] = 2.0 * dy - h * (K[NS, k] + K[0, k])
+        for r in range(4):
+            acc = 0.0
+            for j in range(16):
+                acc += DD[r, j] * K[j, k]
+            F[3 + r, k] = h * acc
+
+
+@njit(cache=True, error_model="numpy")
+def _locate(f, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
+            gv):  # pragma: no cover - compiled
+    """Time of guard ``j``'s crossing in the step ``[t_old, t_old + h]`` (values ``g0``,
+    ``g1`` at its ends), by the Illinois method on the dense output."""
+    if g1 == 0.0:
+        return t_old + h
+    if g0 == 0.0:
+        return t_old
+    m = y_old.size
+    a, b, fa, fb = 0.0, 1.0, g0, g1
+    x = 1.0
+    side = 0
+    for _ in range(200):
+        x = (a * fb - b * fa) / (fb - fa)
+        if not a < x < b:
+            x = 0.5 * (a + b)
+        _dense_at(F, y_old, x, tmp)
+        f(buf.ctypes, t_old + x * h, tmp.ctypes, d.ctypes)
+        _guards(buf, m, gcols, goffs, gv)
+        fx = gv[j]
+        if fx == 0.0:
+            break
+        if (fx > 0.0) == (fb > 0.0):
+            b, fb = x, fx
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            a, fa = x, fx
+            if side == 1:
+                fb *= 0.5
+            side = 1
+        if (b - a) * abs(h) <= 1e-15 + 4.4e-16 * abs(t_old):
+            break
+    return t_old + x * h
+
+
+@njit(cache=True, error_model="numpy")
+def _attempt(f, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - compiled
+    """One DOP853 step of size ``h`` from ``(t, y)`` (``K[0]`` = f(t, y)): ``ynew`` and
+    the FSAL evaluation (flow and extra outputs) into ``K[NS]``; returns the error norm."""
+    m = y.size
+    for s in range(1, NS):
+        for k in range(m):
+            acc = 0.0
+            for j in range(s):
+                acc += A[s, j] * K[j, k]
+            ynew[k] = y[k] + h * acc
+        f(K[s].ctypes, t + C[s] * h, ynew.ctypes, d.ctypes)
+    for k in range(m):
+        acc = 0.0
+        for j in range(NS):
+            acc += B[j] * K[j, k]
+        ynew[k] = y[k] + h * acc
+    f(K[NS].ctypes, t + h, ynew.ctypes, d.ctypes)
+    e5, e3 = 0.0, 0.0
+    for k in range(m):
+        sc = atol + rtol * max(abs(y[k]), abs(ynew[k]))
+        a5, a3 = 0.0, 0.0
+        for j in range(NS + 1):
+            a5 += E5[j] * K[j, k]
+            a3 += E3[j] * K[j, k]
+        e5 += (a5 / sc) ** 2
+        e3 += (a3 / sc) ** 2
+    if e5 == 0.0 and e3 == 0.0:
+        return 0.0
+    return abs(h) * e5 / np.sqrt(e5 + 0.01 * e3)
+
+
+@njit(cache=True, error_model="numpy")
+def _first_step(f, y, f0, d, buf, tmp, rtol, atol, span):  # pragma: no cover - compiled
+    """scipy's ``select_initial_step`` (order 7, RMS norms)."""
+    m = y.size
+    d0, d1 = 0.0, 0.0
+    for k in range(m):
+        sc = atol + abs(y[k]) * rtol
+        d0 += (y[k] / sc) ** 2
+        d1 += (f0[k] / sc) ** 2
+    d0, d1 = np.sqrt(d0 / m), np.sqrt(d1 / m)
+    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+    h0 = min(h0, span)
+    for k in range(m):
+        tmp[k] = y[k] + h0 * f0[k]
+    f(buf.ctypes, h0, tmp.ctypes, d.ctypes)
+    d2 = 0.0
+    for k in range(m):
+        sc = atol + abs(y[k]) * rtol
+        d2 += ((buf[k] - f0[k]) / sc) ** 2
+    d2 = np.sqrt(d2 / m) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, span)
+
+
+@njit(cache=True, error_model="numpy")
+def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, n_out, yev, h_first):  # pragma: no cover
+    """One row to its first guard crossing: ``(which, t_event, next step size)``, the state
+    into ``yev``; ``h_first`` > 0: the first step size [s] (else scipy's choice)."""
+    m = y.size
+    ng = gcols.size
+    K = np.empty((16, n_out))  # stages: flow (m) then the extra outputs
+    F = np.empty((7, m))
+    buf = np.empty(n_out)
+    ynew = np.empty(m)
+    tmp = np.empty(m)
+    g0 = np.empty(ng)
+    g1 = np.empty(ng)
+    gv = np.empty(ng)
+    t, t_bound = 0.0, cap + 1.0
+    f(K[0].ctypes, t, y.ctypes, d.ctypes)
+    _guards(K[0], m, gcols, goffs, g0)
+    if h_first > 0.0:
+        h_abs = min(h_first, t_bound)
+    else:
+        h_abs = _first_step(f, y, K[0], d, buf, tmp, rtol, atol, t_bound)
+    while True:
+        rejected = False
+        while True:
+            min_step = 10.0 * (np.nextafter(t, np.inf) - t)
+            if h_abs < min_step:
+                return FAILED, t, h_abs
+            t_new = min(t + h_abs, t_bound)
+            h = t_new - t
+            err = _attempt(f, t, y, h, K, d, ynew, rtol, atol)
+            if err < 1.0:
+                fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
+                if rejected:
+                    fac = min(1.0, fac)
+                h_abs = h * fac
+                break
+            h_abs = h * max(0.2, 0.9 * err ** (-1.0 / 8.0))
+            rejected = True
+        _guards(K[NS], m, gcols, goffs, g1)
+        best, te = -1, np.inf
+        dense = False
+        for j in range(ng):
+            hit = ((g0[j] <= 0.0 and g1[j] >= 0.0 and dirs[j] >= 0)
+                   or (g0[j] >= 0.0 and g1[j] <= 0.0 and dirs[j] <= 0))
+            if not hit:
+                continue
+            if not dense:
+                _dense_coeffs(f, t, h, y, ynew, K, d, F, tmp)
+                dense = True
+            tj = _locate(f, F, y, t, h, d, buf, gcols, goffs, j, g0[j], g1[j], tmp, gv)
+            if tj < te:
+                best, te = j, tj
+        if best >= 0:
+            _dense_at(F, y, (te - t) / h, yev)
+            return best, te, h_abs
+        if t_new >= cap:
+            return TIMEOUT, t_new, h_abs
+        for k in range(m):
+            y[k] = ynew[k]
+        K[0, :] = K[NS, :]
+        for j in range(ng):
+            g0[j] = g1[j]
+        t = t_new
+
+
+@njit(cache=True, error_model="numpy")
+def phase_rows(f, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te, Yev,
+               H):  # pragma: no cover - compiled
+    """Integrate every row of ``Y`` (N, m) [state units] with its data vector ``D[i]`` from
+    phase time 0 to its first guard crossing (module docstring): guard index or
+    :data:`TIMEOUT` / :data:`FAILED` into ``which`` (N,), the time [s] into ``te`` (N,) and
+    the state there into ``Yev`` (N, m).  ``cap`` (N,) [s]: time limits; ``gcols``, ``goffs``,
+    ``dirs`` (g,): guard columns among the cfunc's extra outputs, offsets, directions;
+    ``n_out``: outputs the cfunc writes (m + extra); ``H`` (N,) [s]: each row's first step
+    size (<= 0: scipy's choice), overwritten with the step size it would take next (a row
+    going on to the next phase starts with it)."""
+    for i in range(Y.shape[0]):
+        y = Y[i].copy()
+        w, t, h = _row(f, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol, n_out, Yev[i],
+                       H[i])
+        which[i] = w
+        te[i] = t
+        H[i] = h
+
+
+@njit(cache=True, error_model="numpy")
+def reset_rows(reset, X, D, out):  # pragma: no cover - compiled
+    """The reset cfunc ``reset`` (``(dy, t, y, d)``, the generated module's ``reset_flow``)
+    of every row of ``X`` (N, m) with its data vector ``D[i]`` into ``out`` (N, m)."""
+    for i in range(X.shape[0]):
+        x = np.ascontiguousarray(X[i])
+        d = np.ascontiguousarray(D[i])
+        o = np.empty(X.shape[1])
+        reset(o.ctypes, 0.0, x.ctypes, d.ctypes)
+        out[i] = o
+
+
+@njit(cache=True, error_model="numpy")
+def walk_rows(f, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, gout, rtol,
+              atol, n_out, steps, fell):  # pragma: no cover - compiled
+    """Walk every row of ``X`` (W, m) up to ``n_steps`` steps, step ``s`` of walk ``w`` on
+    the data vector ``D[w, s]`` (its slope): the phases of a step in turn (phase ``p``'s
+    guards ``gstart[p]:gstart[p + 1]`` of the flat arrays ``gcols``, ``goffs``, ``dirs``
+    and ``gout``: 0 heel strike, 1 fall, 9 next phase, guards without intra-step reset),
+    each integrated by :func:`_row` as :func:`phase_rows` does (the step size carried from
+    phase to phase), a heel strike reset by ``reset`` and counted in ``steps`` (W,); a fall,
+    a step longer than ``max_time`` [s] or a failed integration sets ``fell`` (W,) and ends
+    the walk.  ``X`` is overwritten with each walk's last post-impact state."""
+    W, m = X.shape
+    n_ph = gstart.size - 1
+    yev = np.empty(m)
+    for w in range(W):
+        x = X[w].copy()
+        for s in range(n_steps):
+            T, h, ended = 0.0, 0.0, False
+            d = np.ascontiguousarray(D[w, s])
+            y = x.copy()
+            for p in range(n_ph):
+                a, b = gstart[p], gstart[p + 1]
+                if max_time - T <= 0.0:
+                    ended = True
+                    break
+                which, te, h = _row(f, y, d, max_time - T, gcols[a:b], goffs[a:b],
+                                    dirs[a:b], rtol, atol, n_out, yev, h)
+                if which < 0 or gout[a + which] == 1:
+                    ended = True
+                    break
+                T += te
+                if gout[a + which] == 0:
+                    reset(x.ctypes, 0.0, yev.ctypes, d.ctypes)
+                    steps[w] += 1
+                    break
+                y[:] = yev
+                if p == n_ph - 1:
+                    ended = True  # a last phase that leads nowhere
+            if ended:
+                fell[w] = True
+                break
+        X[w] = x
