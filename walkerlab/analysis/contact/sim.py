@@ -91,9 +91,10 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
     initial_stance : str
         The foot in stance at the start.
     t_more : float, optional
-        With ``max_heel_strikes``: a run that reaches ``t_final`` [s] short of the heel
-        strikes asked for (contact steps slower than the rigid ones the end time was sized
-        by) goes on from there until the cap or ``t_more`` [s] (the samples up to
+        With ``max_heel_strikes``: a run that reaches ``t_final`` [s] short of the strides
+        asked for (fewer than ``max_heel_strikes - 1`` heel strikes: contact steps slower
+        than the rigid ones the end time was sized by) goes on from there until the cap or
+        ``t_more`` [s] (the samples up to
         ``t_final`` are those of the run without it).  Not for a powered walker (its stance
         leg is a state of one run): it gets ``t_more`` as its end time at once.
 
@@ -118,7 +119,9 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         t_final = max(t_final, t_more)
     run = integrate_contact(walker, x0, 0.0, t_final, solver, limits, stop)
     if (t_more is not None and stop is not None and not powered
-            and run.termination == "t_final" and t_more > t_final):
+            and run.termination == "t_final" and t_more > t_final
+            and heel_strike_count(walker, run.t, run.X, min_step_m, initial_stance)
+            < max_heel_strikes - 1):  # short of the strides asked for (2 N heel strikes)
         run = _go_on(walker, run, t_more, solver, limits, stop)
     if stop is not None and run.event is not None:
         # the strides asked for (2 N heel strikes; the cap stops at the one after) were made
