@@ -219,6 +219,9 @@ def multibody(data: WalkerData) -> Multibody:
         A link carries no mass (one line, naming the link).
     """
     s = data.structure
+    if s.free_knees:
+        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a rigid "
+                         "model only today (no contact view, no export)")
     p = dict(zip(s.param_names, data.params))
     L = p["L"]
     lt = p["L_thigh"] if s.knee else 0.0
