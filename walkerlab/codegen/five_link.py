@@ -33,7 +33,8 @@ symbolic` (whose helpers for sums of link vectors this module uses):
   ground; the swing shank's angle is solved from that (``-acos(..) - gamma``);
 - leg angles: every link's, and the virtual legs' (``stance``/``swing``: the angle of the line
   from the hip to the stance / swing foot, the straight legs' angles when the knees are
-  straight; ``stance`` is the phase variable of the joint-torque laws).
+  straight; ``stance`` is the phase variable of the joint-torque laws; written with
+  ``atan``, they hold while the hip is above the feet).
 """
 
 from __future__ import annotations
@@ -187,8 +188,10 @@ def derive_five_link(structure: Structure) -> Equations:
               "hip_height": (hip.T * normal)[0], "swing_clearance": clearance}
     relabel_q = sp.Matrix([ws, wt, st, ss, *q[4:]])  # legs swap, the torso keeps its angle
     reach = (ls * sp.cos(ss + gamma) + lt * sp.cos(st + gamma) - lt * sp.cos(wt + gamma)) / ls
-    leg_angles = {"stance": sp.atan2(-hip[0], hip[1]),
-                  "swing": sp.atan2(foot[0] - hip[0], hip[1] - foot[1]),
+    # atan, not atan2: complex-safe (the complex-step Jacobians of torque laws that read the
+    # phase variable), and exact while the hip is above both feet
+    leg_angles = {"stance": sp.atan(-hip[0] / hip[1]),
+                  "swing": sp.atan((foot[0] - hip[0]) / (hip[1] - foot[1])),
                   **{r: psi[r] for r in roles}}
     De, E = _extended(q, dq, bodies, foot)
     return Equations(

@@ -239,6 +239,11 @@ class Actuators:
 def _structure_check(data, spec) -> bool:
     """Refuse what this actuation does not handle (one line); True for massless legs."""
     st = data.structure
+    for i, t in enumerate(spec.torques):
+        if t.joint != "hip":
+            raise ValueError(f"walker.actuation.torques.{i}.joint: {t.joint} is a five-link "
+                             "biped's joint (knee.lock: free); a straight-legged walker's is "
+                             "hip")
     if st.knee or st.foot != "point":
         raise ValueError("walker.actuation: actuators need straight legs with point feet "
                          "today (knees, arc and flat feet: not yet)")
@@ -274,19 +279,27 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     Returns
     -------
     HybridWalker
-        With ``actuators`` set; no compiled flows (the actuation is evaluated in Python).
+        With ``actuators`` set (free knees: :class:`walkerlab.models.hybrid.
+        actuated_five_link.FiveLinkActuators`); no compiled flows (the actuation is
+        evaluated in Python).
 
     Raises
     ------
     ValueError
-        A walker this actuation does not handle (knees, arc or flat feet, partly massless
-        legs) or a torque scaling that does not fit the legs (one line).
+        A walker this actuation does not handle (locking knees, arc or flat feet, partly
+        massless legs), a joint the walker does not have, a push-off on free knees or a
+        torque scaling that does not fit the legs (one line).
     """
     from walkerlab.codegen.cache import functions
 
-    limit = _structure_check(data, spec)
-    fns = functions(data)
-    acts = Actuators(spec, fns, len(walker.roles), limit, float(walker.total_mass_kg))
+    if data.structure.free_knees:  # every joint free: hips and knees (five-link bipeds)
+        from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
+
+        acts = five_link_actuators(data, spec, walker.roles)
+    else:
+        limit = _structure_check(data, spec)
+        acts = Actuators(spec, functions(data), len(walker.roles), limit,
+                         float(walker.total_mass_kg))
     base_jac = walker.variational
     has_torque = bool(spec.torques)
 
