@@ -119,7 +119,7 @@ def _shared_phase_table(torques):
     memo: dict = {}
 
     def at(u):  # (h (k,), dh (k,)) at the phase u
-        key = (complex(u),)
+        key = (bool(np.iscomplexobj(u)), complex(u))  # a real call never reads a complex
         if key not in memo:
             memo.clear()
             r = min(max(float(np.real(u)), s[0]), s[-1])
