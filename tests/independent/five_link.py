@@ -24,7 +24,8 @@ x forward, y up, gravity (0, -g)::
 
 Flow: ``T = sum 1/2 m |dp/dt|^2 + 1/2 I w^2``, ``V = sum m g y``, Euler-Lagrange with
 ``D = d^2 T / dr' dr'`` and ``h = (d^2 L / dr' dr) r' - dL/dr`` (sympy differentiates the
-Lagrangian; nothing is assembled by hand): ``D r'' + h = 0``.
+Lagrangian; nothing is assembled by hand): ``D r'' + h = Q``, ``Q`` the joint torques (in
+relative coordinates each joint torque is its own coordinate's generalised force).
 
 Heel strike (Westervelt et al. 2003, Sec. III-B; Hurmuzlu & Marghitu 1994): extended
 coordinates ``(r, x_f, y_f)`` (stance foot free), ``De`` the Hessian of the extended kinetic
@@ -96,11 +97,16 @@ def _model():
             sp.lambdify(args, (foot2.subs(pinned), hip.subs(pinned)), "numpy"))
 
 
-def acceleration(r, dr, p: dict) -> np.ndarray:
-    """``r''`` (5,) [rad/s^2] of the passive flow at ``(r, r')``; ``p`` by :data:`PARAMS`."""
+def acceleration(r, dr, p: dict, Q=None) -> np.ndarray:
+    """``r''`` (5,) [rad/s^2] at ``(r, r')``; ``p`` by :data:`PARAMS`.  ``Q`` (5,): the
+    generalised forces [N m] of the relative coordinates - joint torques ARE those: a
+    torque ``tau`` at the stance hip (on the thigh, its reaction on the torso) does the
+    virtual work ``tau dh1``, so ``Q = (0, tau_stance_hip, tau_swing_hip, tau_stance_knee,
+    tau_swing_knee)``; None: passive."""
     D, h = _model()[:2]
     args = (list(r), list(dr), [p[k] for k in PARAMS])
-    return np.linalg.solve(np.asarray(D(*args), float), -np.asarray(h(*args), float).ravel())
+    rhs = -np.asarray(h(*args), float).ravel() + (0.0 if Q is None else np.asarray(Q, float))
+    return np.linalg.solve(np.asarray(D(*args), float), rhs)
 
 
 def heel_strike(r, dr, p: dict) -> tuple[np.ndarray, np.ndarray]:
