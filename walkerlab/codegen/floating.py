@@ -196,11 +196,14 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     Raises
     ------
     ValueError
-        Massless bodies (:func:`check_masses`) or a foot kind other than point / arc /
-        flat.
+        Massless bodies (:func:`check_masses`), a foot kind other than point / arc /
+        flat, or free knees (a five-link biped: rigid model only).
     """
     import sympy as sp
 
+    if structure.free_knees:  # the hinged torso is not the bisecting one derived below
+        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a rigid "
+                         "model only today (no contact view, no export)")
     check_masses(structure)
     if structure.foot not in ("point", "arc", "flat"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")

@@ -216,7 +216,8 @@ def multibody(data: WalkerData) -> Multibody:
     Raises
     ------
     ValueError
-        A link carries no mass (one line, naming the link).
+        A link carries no mass (one line, naming the link), or the walker has free knees
+        (a five-link biped: rigid model only today).
     """
     s = data.structure
     if s.free_knees:
