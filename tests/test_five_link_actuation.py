@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tests.independent import five_link as ref
-from tests.test_five_link import P, SCENE, from_ref, states, to_ref
+from tests.test_five_link import SCENE, P, from_ref, states, to_ref
 from walkerlab.config import scene_from_dict
 from walkerlab.models.actuation import TorqueLaws
 from walkerlab.models.registry import build_walker

@@ -70,7 +70,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.walker.description import Structure, WalkerData
+from walkerlab.walker.description import Structure, WalkerData, check_floating_view
 
 __all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "MASSLESS_MESSAGE", "FloatingEquations",
            "FloatingView", "check_masses", "contact_names", "coordinate_names",
@@ -201,9 +201,7 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     """
     import sympy as sp
 
-    if structure.free_knees:  # the hinged torso is not the bisecting one derived below
-        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a rigid "
-                         "model only today (no contact view, no export)")
+    check_floating_view(structure)  # a hinged torso is not the bisecting one derived below
     check_masses(structure)
     if structure.foot not in ("point", "arc", "flat"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")

@@ -1,6 +1,7 @@
 """Actuators as parts of the walker (``walker.actuation``): a push-off impulse along the
 trailing leg before heel strike (Kuo 2002) and joint torques at the hip (a five-link
-biped's: at its hips and knees), each a law given as data.  A walker without the section is passive and its numbers are those of before.
+biped's: at its hips and knees), each a law given as data.  A walker without the section is
+passive and its numbers are those of before.
 
 Units: N s for impulses, N m for torques, rad for angles (a ``units: nondimensional`` scene
 reads them as M √(g l) and M g l).  Sources: Kuo (2002), "Energetics of actively powered

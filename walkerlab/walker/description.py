@@ -176,6 +176,19 @@ class Structure:
         return json.dumps(d)
 
 
+def check_floating_view(structure: Structure) -> None:
+    """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
+    knees, whose hinged torso the floating derivation would eliminate as a bisecting one.
+
+    Raises
+    ------
+    ValueError
+    """
+    if structure.free_knees:
+        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a rigid "
+                         "model only today (no contact view, no export)")
+
+
 def state_names(roles) -> list[str]:
     """Role-ordered state names of a walker with coordinate ``roles``: every role's angle, then
     every role's rate (``['swing_angle', 'stance_angle', 'swing_rate', 'stance_rate']``)."""
