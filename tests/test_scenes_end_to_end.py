@@ -129,11 +129,13 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
     # within each phase of each step (relative bound far above the solver's rtol 1e-10);
     # with a damper (an ankle's, a spring's) it can only lose energy there
     damped = _has_damper(scene.walker.model_dump())
-    # an actuator inside a phase (a hip torque, an ankle push-off) adds energy there: its
-    # ledger checks it (tests/test_powered.py)
-    inside = scene.walker.actuation is not None and (
-        scene.walker.actuation.torques or scene.walker.actuation.ankle_push_off is not None)
-    for k in np.unique(step) if not inside else ():
+    act = scene.walker.actuation
+    # joint torques that do work (not Kuo's, per foot mass: none in his limit) and an ankle
+    # push-off change the energy between impacts: tests/test_powered.py and
+    # tests/test_rabbit.py close the ledger
+    working = act is not None and (any(t.scaled_by == "none" for t in act.torques)
+                                   or act.ankle_push_off is not None)
+    for k in np.unique(step) if not working else ():
         for ph in np.unique(phase[step == k]):
             e = tot[(step == k) & (phase == ph)]
             if damped:
@@ -160,6 +162,10 @@ def test_scene_end_to_end(scene_path, tmp_path, png_only):
         if has_basin:
             assert "6 × 5 cells" in md
 
+    if scene_path.stem == "rabbit":  # a fixed point takes ~2.5 min (ten states, high-gain
+        for p in (fp.path, sim.path):  # PD): its sweep would repeat it three times at slope 0
+            assert_netcdf(p)
+        return
     slope = scene.slope.angle_deg if scene.slope.angle_deg is not None else \
         float(np.degrees(scene.slope.angle_rad))
     grid = ",".join(f"{slope * f:.6g}" for f in (0.98, 1.0, 1.02))

@@ -70,7 +70,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.walker.description import Structure, WalkerData
+from walkerlab.walker.description import Structure, WalkerData, check_floating_view
 
 __all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "MASSLESS_MESSAGE", "FloatingEquations",
            "FloatingView", "check_masses", "contact_names", "coordinate_names",
@@ -196,11 +196,12 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     Raises
     ------
     ValueError
-        Massless bodies (:func:`check_masses`) or a foot kind other than point / arc /
-        flat.
+        Massless bodies (:func:`check_masses`), a foot kind other than point / arc /
+        flat, or free knees (a five-link biped: rigid model only).
     """
     import sympy as sp
 
+    check_floating_view(structure)  # a hinged torso is not the bisecting one derived below
     check_masses(structure)
     if structure.foot not in ("point", "arc", "flat"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")

@@ -1,6 +1,7 @@
 """Actuators as parts of the walker (``walker.actuation``): a push-off impulse along the
-trailing leg before heel strike (Kuo 2002) and joint torques at the hip, each a law given
-as data.  A walker without the section is passive and its numbers are those of before.
+trailing leg before heel strike (Kuo 2002) and joint torques at the hip (a five-link
+biped's: at its hips and knees), each a law given as data.  A walker without the section is
+passive and its numbers are those of before.
 
 Units: N s for impulses, N m for torques, rad for angles (a ``units: nondimensional`` scene
 reads them as M √(g l) and M g l).  Sources: Kuo (2002), "Energetics of actively powered
@@ -13,9 +14,43 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, model_serializer, model_validator
 
 from walkerlab.config.base import Strict
+
+
+class _JointTable(Strict):
+    """A reference table's values: ``hip_angle_rad`` (the straight-legged walkers' hip) or
+    ``angle_rad`` (any joint's angle, e.g. a five-link biped's knee); the one not given is
+    left out of the dump (a table as before serialises as before)."""
+
+    hip_angle_rad: list[float] | None = Field(None, min_length=2, max_length=200,
+                                              description="reference hip angle (swing minus "
+                                              "stance leg angle) at each abscissa [rad]")
+    angle_rad: list[float] | None = Field(None, min_length=2, max_length=200, description="the "
+                                          "reference of the joint's angle at each abscissa "
+                                          "(see JointTorque.joint) [rad]")
+
+    @property
+    def values_rad(self) -> list[float]:
+        """The reference values [rad] (whichever of the two fields is given)."""
+        return self.hip_angle_rad if self.hip_angle_rad is not None else self.angle_rad
+
+    def _one_of(self, abscissa: list[float], name: str) -> None:
+        if (self.hip_angle_rad is None) == (self.angle_rad is None):
+            raise ValueError("give hip_angle_rad or angle_rad (one of them)")
+        if len(abscissa) != len(self.values_rad):
+            field = "hip_angle_rad" if self.hip_angle_rad is not None else "angle_rad"
+            raise ValueError(f"{name} and {field} need the same length")
+
+    @model_serializer(mode="wrap")
+    def _as_given(self, handler):
+        out = handler(self)
+        if isinstance(out, dict):
+            for k in ("hip_angle_rad", "angle_rad"):
+                if k in out and out[k] is None:
+                    out.pop(k)
+        return out
 
 
 class PushOff(Strict):
@@ -34,44 +69,39 @@ class PushOff(Strict):
                                            "the law gives impulse_n_s [m/s]")
 
 
-class PhaseReference(Strict):
-    """A reference of the hip angle (swing minus stance leg angle) as a function of a
-    monotonic phase variable of the step, the stance leg's absolute angle (Westervelt et al.
-    2003): a piecewise-linear or cubic-spline table, held at its end values outside."""
+class PhaseReference(_JointTable):
+    """A reference of the joint's angle (hip: swing minus stance leg angle) as a function of
+    a monotonic phase variable of the step, the stance leg's absolute angle (Westervelt et
+    al. 2003; a kneed stance leg's: the line from the hip to the stance foot): a
+    piecewise-linear or cubic-spline table, held at its end values outside."""
 
     phase_rad: list[float] = Field(min_length=2, max_length=200, description="stance-leg "
                                    "angles of the table, increasing [rad]")
-    hip_angle_rad: list[float] = Field(min_length=2, max_length=200, description="reference "
-                                       "swing minus stance angle at each phase [rad]")
     interpolation: Literal["linear", "cubic"] = Field("cubic", description="piecewise-linear "
                                                       "or not-a-knot cubic spline")
 
     @model_validator(mode="after")
     def _table(self) -> PhaseReference:
-        if len(self.phase_rad) != len(self.hip_angle_rad):
-            raise ValueError("phase_rad and hip_angle_rad need the same length")
+        self._one_of(self.phase_rad, "phase_rad")
         if any(b <= a for a, b in zip(self.phase_rad, self.phase_rad[1:])):
             raise ValueError("phase_rad must increase")
         return self
 
 
-class TimeReference(Strict):
-    """A reference of the hip angle (swing minus stance leg angle) as a function of the time
-    since the step began (its heel strike): a piecewise-linear or cubic-spline table, held at
-    its end values outside (a time-based feed-forward pattern, the alternative to a phase
-    variable, Westervelt et al. 2003 Sec. II)."""
+class TimeReference(_JointTable):
+    """A reference of the joint's angle (hip: swing minus stance leg angle) as a function of
+    the time since the step began (its heel strike): a piecewise-linear or cubic-spline
+    table, held at its end values outside (a time-based feed-forward pattern, the
+    alternative to a phase variable, Westervelt et al. 2003 Sec. II)."""
 
     time_s: list[float] = Field(min_length=2, max_length=200, description="times since the "
                                 "step's heel strike, increasing [s]")
-    hip_angle_rad: list[float] = Field(min_length=2, max_length=200, description="reference "
-                                       "swing minus stance angle at each time [rad]")
     interpolation: Literal["linear", "cubic"] = Field("cubic", description="piecewise-linear "
                                                       "or not-a-knot cubic spline")
 
     @model_validator(mode="after")
     def _table(self) -> TimeReference:
-        if len(self.time_s) != len(self.hip_angle_rad):
-            raise ValueError("time_s and hip_angle_rad need the same length")
+        self._one_of(self.time_s, "time_s")
         if any(b <= a for a, b in zip(self.time_s, self.time_s[1:])):
             raise ValueError("time_s must increase")
         if self.time_s[0] < 0:
@@ -86,7 +116,8 @@ class TimeReference(Strict):
 
 class TorqueLaw(Strict):
     """A torque law of the joint angle ``delta`` and rate (hip: swing minus stance leg
-    angle): ``tau = constant_n_m - stiffness (delta - rest_angle_rad) - damping ddelta``
+    angle; the five-link joints: :class:`JointTorque`): ``tau = constant_n_m - stiffness
+    (delta - rest_angle_rad) - damping ddelta``
     (constant, or spring-like as Kuo's swing-hip torque), or with ``reference`` a PD
     tracking ``tau = -stiffness (delta - h_d(s)) - damping (ddelta - h_d'(s) ds)`` of a
     reference of the phase variable ``s`` (a virtual constraint), or with
@@ -113,12 +144,30 @@ class TorqueLaw(Strict):
         return self
 
 
+#: Joints of a five-link biped (free knees, hinged torso): (first link, second link); the
+#: joint's angle is ``angle(second) - angle(first)`` (absolute link angles, all
+#: counter-clockwise: legs from the downward vertical, the torso from the upward one), ``+tau``
+#: acts on the second link, ``-tau`` on the first.
+FIVE_LINK_JOINTS = {"stance_hip": ("torso", "stance_thigh"),
+                    "swing_hip": ("torso", "swing_thigh"),
+                    "stance_knee": ("stance_thigh", "stance_shank"),
+                    "swing_knee": ("swing_thigh", "swing_shank")}
+
+
 class JointTorque(Strict):
     """A torque actuator at a joint shared by two links.  ``joint: hip``: between the legs,
     ``+tau`` on the swing leg (positive moves its foot forward) and ``-tau`` on the stance
-    leg."""
+    leg.  On a five-link biped (``knee.lock: free``, ``torso.coupling: hinged``;
+    :data:`FIVE_LINK_JOINTS`): ``stance_hip`` / ``swing_hip`` between the torso and a thigh,
+    angle thigh minus torso (0 with the torso upright and the thigh hanging straight down,
+    positive flexed: the thigh ahead), ``+tau`` flexes (moves the thigh forward, the torso
+    back); ``stance_knee`` / ``swing_knee`` between a thigh and its shank, angle shank minus
+    thigh (0 straight, negative flexed), ``+tau`` extends the knee.  The joints follow the
+    roles (a leg's joint is ``swing_*`` while it swings)."""
 
-    joint: Literal["hip"] = Field(description="the joint (hip: between the two legs)")
+    joint: Literal["hip", "stance_hip", "swing_hip", "stance_knee", "swing_knee"] = Field(
+        description="the joint (hip: between the two legs; five-link bipeds: stance_hip, "
+        "swing_hip (torso to thigh), stance_knee, swing_knee (thigh to shank))")
     law: TorqueLaw = Field(description="the torque law")
     max_torque_n_m: float | None = Field(None, gt=0, le=1e6, description="saturation |tau| <= "
                                          "max [N m] (null: none)")

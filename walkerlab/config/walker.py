@@ -181,13 +181,19 @@ class KneeSpringSpec(TorsionalSpring):
 class KneeSpec(Strict):
     """A knee joint splitting the leg into thigh (hip to knee) and shank (knee to foot).
 
-    The stance knee stays straight.  The swing knee is free until it straightens against its
-    stop (knee strike: a plastic impact that locks it); it stays locked until heel strike and
-    unlocks when that leg leaves the ground (McGeer 1990 'Passive walking with knees')."""
+    ``lock: plastic``: the stance knee stays straight.  The swing knee is free until it
+    straightens against its stop (knee strike: a plastic impact that locks it); it stays
+    locked until heel strike and unlocks when that leg leaves the ground (McGeer 1990
+    'Passive walking with knees').  ``lock: free``: both knees are free joints that never
+    lock (no stop), the stance knee included: the legs of a five-link biped driven at its
+    knees (Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1):42-56); a passive walker
+    with free knees buckles, so such a walker is meant to carry knee torques."""
 
     thigh_length_m: float = Field(gt=0, le=100, description="hip to knee [m]")
-    lock: Literal["plastic"] = Field("plastic", description="knee strike: plastic impact, then "
-                                     "the knee stays locked until heel strike")
+    lock: Literal["plastic", "free"] = Field(
+        "plastic", description="'plastic': knee strike, a plastic impact, then the knee stays "
+        "locked until heel strike (the stance knee straight); 'free': both knees free, "
+        "never locking (five-link bipeds)")
     spring: KneeSpringSpec | None = Field(None, description="torsional spring-damper at the "
                                           "knee (null: none); in the rigid view it acts on "
                                           "the free swing knee (a locked knee holds it)")
@@ -300,12 +306,15 @@ class TorsoSpec(Strict):
     hip; with leg angles theta1, theta2 from the downward vertical (positive foot ahead), the
     torso's angle from the upward vertical is (theta1 + theta2) / 2, positive leaning back.
     The coupling is a holonomic linear constraint between link angles; the rigid model
-    eliminates it (the torso adds bodies, not coordinates)."""
+    eliminates it (the torso adds bodies, not coordinates).  ``coupling: hinged``: a free
+    revolute joint at the hip, the torso's angle its own coordinate (a five-link biped's
+    upper body, Westervelt et al. 2003)."""
 
-    coupling: Literal["bisecting_hip"] = Field(
+    coupling: Literal["bisecting_hip", "hinged"] = Field(
         "bisecting_hip", description="linear constraint between the torso's and the legs' "
         "angles: 'bisecting_hip' = torso angle (from the upward vertical, positive leaning "
-        "back) equals the mean of the two leg angles")
+        "back) equals the mean of the two leg angles; 'hinged': none, the torso is jointed "
+        "at the hip and has its own coordinate (held by hip torques; needs knee.lock: free)")
     bodies: list[TorsoBody] = Field(min_length=1, description="bodies on the upper body")
 
     @model_validator(mode="after")
@@ -399,7 +408,38 @@ class BipedParams(_Actuated):
                              "no flow in the limit m -> 0)")
         if any("torso" in s.between for s in self.springs) and self.torso is None:
             raise ValueError("springs: a spring on the torso needs a 'torso'")
+        self._free_joints_check(pair)
         return self
+
+    def _free_joints_check(self, pair) -> None:
+        """Free knees (``knee.lock: free``) and a hinged torso: the five-link biped's chain
+        of free joints, with what it supports today (one line otherwise)."""
+        free = pair[0].knee is not None and pair[0].knee.lock == "free"
+        hinged = self.torso is not None and self.torso.coupling == "hinged"
+        if hinged and not free:
+            raise ValueError("torso.coupling: 'hinged' needs free knees (leg.knee.lock: free;"
+                             " the five-link biped)")
+        if not free:
+            return
+        leg = pair[0]
+        for what, bad in (("legs: both legs identical (give 'leg')", self.legs is not None
+                           and pair[0] != pair[1]),
+                          ("leg.foot.kind: point", leg.foot.kind != "point"),
+                          ("no leg.knee.spring", leg.knee.spring is not None),
+                          ("no springs", bool(self.springs)),
+                          ("bodies on the leg axis (off_axis 0)", any(
+                              (b.off_axis_m if b.kind == "point_mass" else b.com_off_axis_m)
+                              != 0.0 for b in leg.bodies))):
+            if bad:
+                raise ValueError(f"leg.knee.lock: free knees need {what} today")
+        if self.torso is not None and not hinged:
+            raise ValueError("torso.coupling: free knees need a 'hinged' torso (the bisecting "
+                             "hip mechanism is for locking knees)")
+        if self.torso is not None and any(
+                (b.off_axis_m if b.kind == "point_mass" else b.com_off_axis_m) != 0.0
+                for b in self.torso.bodies):
+            raise ValueError("torso.bodies: a hinged torso's bodies lie on its axis today "
+                             "(off_axis 0)")
 
     def leg_pair(self) -> tuple[LegSpec, LegSpec]:
         """``(leg1, leg2)``: the ``legs`` pair, or ``leg`` twice."""

@@ -27,7 +27,7 @@ def phase_reference(table):
     outside the table (slope 0 there)."""
     from scipy.interpolate import CubicSpline
 
-    s, y = np.asarray(table.phase_rad, float), np.asarray(table.hip_angle_rad, float)
+    s, y = np.asarray(table.phase_rad, float), np.asarray(table.values_rad, float)
     if table.interpolation == "cubic" and len(s) >= 3:
         cs = CubicSpline(s, y, bc_type="not-a-knot", extrapolate=False)
         d1, d2 = cs.derivative(), cs.derivative(2)
@@ -100,8 +100,17 @@ class TorqueLaws:
         t_step : float
             Time since the step's heel strike [s] (read by ``time_reference`` laws).
         """
+        k = len(self.torques)
+        return self.each([delta] * k, [ddelta] * k, s, ds, t_step)
+
+    def each(self, deltas, ddeltas, s, ds, t_step=0.0) -> np.ndarray:
+        """Torque of each actuator (k,) [N m] with its own joint angle: ``deltas[i]``,
+        ``ddeltas[i]`` [rad, rad/s] are actuator ``i``'s joint angle and rate (a five-link
+        biped's joints, :data:`walkerlab.config.actuation.FIVE_LINK_JOINTS`); ``s, ds``,
+        ``t_step`` as in :meth:`__call__`."""
         out = []
-        for act, ref, tref in zip(self.torques, self.refs, self.time_refs):
+        for act, ref, tref, delta, ddelta in zip(self.torques, self.refs, self.time_refs,
+                                                 deltas, ddeltas):
             law = act.law
             if ref is not None:
                 h, dh = ref

@@ -19,6 +19,9 @@ from dataclasses import dataclass
 ROLES = {"absolute": ("swing", "stance"), "slope_relative": ("stance", "hip")}
 #: Roles with a knee: swing thigh and shank free, the stance leg straight (absolute angles).
 KNEED_ROLES = ("swing_thigh", "swing_shank", "stance")
+#: Roles with free knees (``knee.lock: free``): every link's absolute angle, from the stance
+#: foot up the chain and down to the swing foot; a hinged torso's angle is appended.
+FREE_KNEE_ROLES = ("stance_shank", "stance_thigh", "swing_thigh", "swing_shank")
 #: Roles with flat feet: the absolute leg angles and the stance ankle's angle (the swing
 #: foot is massless and sits at its spring's rest angle: no coordinate).
 FLAT_ROLES = ("swing", "stance", "stance_ankle")
@@ -87,6 +90,14 @@ class Structure:
     knee_spring : bool
         A torsional spring-damper at each knee on the knee angle ``shank - thigh``;
         parameters ``k_knee, r_knee, c_knee`` (last in :attr:`param_names`).
+    free_knees : bool
+        Both knees free, never locking (``knee.lock: free``; needs ``knee``): every link
+        angle is a coordinate (roles :data:`FREE_KNEE_ROLES`), derived by
+        :mod:`walkerlab.codegen.five_link`.
+    hinged_torso : bool
+        The torso (``torso`` bodies) is jointed at the hip with its own coordinate, role
+        ``torso`` (its angle from the upward vertical, positive leaning back); needs
+        ``free_knees``.
     """
 
     coordinates: str
@@ -99,9 +110,13 @@ class Structure:
     torso: tuple[BodySpec, ...] = ()
     springs: tuple[tuple[str, str], ...] = ()
     knee_spring: bool = False
+    free_knees: bool = False
+    hinged_torso: bool = False
 
     @property
     def roles(self) -> tuple[str, ...]:
+        if self.free_knees:
+            return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
         if self.foot == "flat":
             return FLAT_ROLES
         return KNEED_ROLES if self.knee else ROLES[self.coordinates]
@@ -154,7 +169,24 @@ class Structure:
             d["springs"] = [list(s) for s in self.springs]
         if self.knee_spring:
             d["knee_spring"] = True
+        if self.free_knees:
+            d["free_knees"] = True
+        if self.hinged_torso:
+            d["hinged_torso"] = True
         return json.dumps(d)
+
+
+def check_floating_view(structure: Structure) -> None:
+    """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
+    knees, whose hinged torso the floating derivation would eliminate as a bisecting one.
+
+    Raises
+    ------
+    ValueError
+    """
+    if structure.free_knees:
+        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a rigid "
+                         "model only today (no contact view, no export)")
 
 
 def state_names(roles) -> list[str]:
@@ -308,7 +340,10 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     knee_spring = leg.knee.spring if leg.knee is not None else None
     structure = Structure(walker_cfg.coordinates, tuple(bodies), hip, leg.foot.kind,
                           knee=leg.knee is not None, asymmetric=asym, torso=tuple(torso),
-                          springs=tuple(pairs), knee_spring=knee_spring is not None)
+                          springs=tuple(pairs), knee_spring=knee_spring is not None,
+                          free_knees=leg.knee is not None and leg.knee.lock == "free",
+                          hinged_torso=(walker_cfg.torso is not None
+                                        and walker_cfg.torso.coupling == "hinged"))
 
     def params(swing_vals, stance_vals, springs) -> tuple[float, ...]:
         feet = ((f1, f2) if swing_vals is v1 else (f2, f1)) if asym else (f1,)

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from walkerlab.walker.description import WalkerData
+from walkerlab.walker.description import WalkerData, check_floating_view
 
 __all__ = ["Coupling", "Link", "Multibody", "Spring", "multibody"]
 
@@ -216,13 +216,13 @@ def multibody(data: WalkerData) -> Multibody:
     Raises
     ------
     ValueError
-        A link carries no mass (one line, naming the link).
+        A link carries no mass (naming it), or free knees (one line, both).
     """
     s = data.structure
+    check_floating_view(s)
     p = dict(zip(s.param_names, data.params))
     L = p["L"]
-    lt = p["L_thigh"] if s.knee else 0.0
-    R = p["R_foot"] if s.foot == "arc" else 0.0
+    lt, R = p["L_thigh"] if s.knee else 0.0, p["R_foot"] if s.foot == "arc" else 0.0
     segments = ("thigh", "shank") if s.knee else ("leg",)
     # the first step's numbers: with legs that differ leg1's are the swing role's (``sw``)
     tags = ("sw_", "st_") if s.asymmetric else ("", "")

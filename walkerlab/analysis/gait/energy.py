@@ -39,11 +39,19 @@ LEDGER_NAMES = tuple(LEDGER_UNITS)
 
 
 def _quad(f, a: float, b: float, scale: float) -> float:
-    from scipy.integrate import quad
+    """``int_a^b f dt`` [J] by adaptive quadrature.  A kinked integrand (``max(p, 0)`` where
+    the power changes sign, a saturated torque law) can keep quad from certifying its 1e-12
+    tolerance (its IntegrationWarning); the value is kept: the ledger's ``closure``, an
+    independent check, states the accuracy actually reached."""
+    import warnings
+
+    from scipy.integrate import IntegrationWarning, quad
 
     if b <= a:
         return 0.0
-    val, _ = quad(f, a, b, limit=400, epsabs=1e-13 * scale, epsrel=1e-12)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IntegrationWarning)
+        val, _ = quad(f, a, b, limit=400, epsabs=1e-13 * scale, epsrel=1e-12)
     return float(val)
 
 

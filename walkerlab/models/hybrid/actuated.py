@@ -242,6 +242,11 @@ def _structure_check(data, spec) -> bool:
     if spec.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
                          "flat); point feet take push_off, the impulse along the leg")
+    for i, t in enumerate(spec.torques):
+        if t.joint != "hip":
+            raise ValueError(f"walker.actuation.torques.{i}.joint: {t.joint} is a five-link "
+                             "biped's joint (knee.lock: free); a straight-legged walker's is "
+                             "hip")
     if st.knee or st.foot != "point":
         raise ValueError("walker.actuation: actuators need straight legs with point feet "
                          "today (knees, arc and flat feet: not yet)")
@@ -308,13 +313,16 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     Returns
     -------
     HybridWalker
-        With ``actuators`` set; no compiled flows (the actuation is evaluated in Python).
+        With ``actuators`` set (free knees: :class:`walkerlab.models.hybrid.
+        actuated_five_link.FiveLinkActuators`); no compiled flows (the actuation is
+        evaluated in Python).
 
     Raises
     ------
     ValueError
-        A walker this actuation does not handle (knees, arc or flat feet, partly massless
-        legs) or a torque scaling that does not fit the legs (one line).
+        A walker this actuation does not handle (locking knees, arc or flat feet, partly
+        massless legs), a joint the walker does not have, a push-off on free knees or a
+        torque scaling that does not fit the legs (one line).
     """
     from walkerlab.codegen.cache import functions
 
@@ -322,9 +330,15 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         from walkerlab.models.hybrid.ankle_push_off import actuate_flat
 
         return actuate_flat(walker, data, spec)
-    limit = _structure_check(data, spec)
-    fns = functions(data)
-    acts = Actuators(spec, fns, len(walker.roles), limit, float(walker.total_mass_kg))
+    limit = False
+    if data.structure.free_knees:  # every joint free: hips and knees (five-link bipeds)
+        from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
+
+        acts = five_link_actuators(data, spec, walker.roles)
+    else:
+        limit = _structure_check(data, spec)
+        acts = Actuators(spec, functions(data), len(walker.roles), limit,
+                         float(walker.total_mass_kg))
     base_jac = walker.variational
     has_torque = bool(spec.torques)
 
@@ -350,7 +364,8 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         return J
 
     phases = []
-    sprung = spring_equivalent(data, spec) if has_torque and not limit else None
+    sprung = (spring_equivalent(data, spec) if has_torque and not limit
+              and not data.structure.free_knees else None)
     if sprung is not None:  # the torques as a generated (compiled) hip spring-damper
         from walkerlab.models.hybrid.rigid import make_rigid_walker
 

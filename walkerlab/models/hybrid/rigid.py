@@ -122,6 +122,10 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     """
     if data.structure.foot == "flat":  # modes of a flat foot: their own phase graph
         return make_flat_walker(data, name, variant)
+    if data.structure.free_knees:  # every joint free (five-link bipeds): one flow
+        from walkerlab.models.hybrid.rigid_five_link import make_five_link_walker
+
+        return make_five_link_walker(data, name, variant)
     f = functions(data)
     # the compiled flow is the generated one: none when the flow is replaced
     generated_flow = flow is None and flow_jacobian is None

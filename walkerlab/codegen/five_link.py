@@ -1,0 +1,213 @@
+"""Symbolic derivation of a planar biped whose joints are all free: two thighs and two shanks
+on free (never locking) knees and, optionally, a torso hinged at the hip with its own
+coordinate - the five-link biped of Westervelt, Grizzle & Koditschek (2003), "Hybrid zero
+dynamics of planar biped walkers", IEEE TAC 48(1):42-56 (their RABBIT), and without the
+torso a four-link biped.
+
+Coordinates (:data:`walkerlab.walker.description.FREE_KNEE_ROLES`, then ``torso``): every
+link's absolute angle, the legs' from the downward vertical (positive when the link's lower
+end is ahead of its upper end, as the straight legs' angles, paper Eq. 1), the torso's from
+the upward vertical (positive leaning back, as the bisecting torso's).  All are
+counter-clockwise rotations, so a joint's relative angle is a difference of two
+coordinates.  With ``e(a) = (sin a, -cos a)`` (world axes: x downhill, y up) and the stance
+foot at the origin::
+
+    stance knee = -l_s e(q_ss);  hip = stance knee - l_t e(q_st)
+    swing knee  = hip + l_t e(q_wt);  swing foot = swing knee + l_s e(q_ws)
+    torso point at d = hip - d e(q_t)
+
+(``l_t`` the thigh, ``l_s = L - l_t`` the shank).  Then, as in :mod:`walkerlab.codegen.
+symbolic` (whose helpers for sums of link vectors this module uses):
+
+- flow: Lagrange's equations ``M qdd + C dq + G = 0``, ``C`` from Christoffel symbols;
+- heel strike: plastic impact of the swing foot, the old stance foot leaving the ground
+  without impulse; with the post-impact velocities parametrised with the swing foot at rest
+  the impulse drops out, ``Mi dq+ = B dq-`` (Westervelt et al. 2003, Sec. III-B; the same
+  impact as the extended-coordinate one, ``impact_matrices``: stance foot free at
+  ``(x_f, y_f)``, ``De`` and the swing foot's Jacobian ``E``); then the legs' roles swap
+  (the torso keeps its angle);
+- guards: ``heel_strike`` = ``swing_clearance`` = the swing foot's height above the slope,
+  ``swing_foot_ahead`` = its distance ahead of the stance foot along the slope,
+  ``hip_height``;
+- Poincare section: the post-impact states, where the new swing foot (behind) is on the
+  ground; the swing shank's angle is solved from that (``-acos(..) - gamma``);
+- leg angles: every link's, and the virtual legs' (``stance``/``swing``: the angle of the line
+  from the hip to the stance / swing foot, the straight legs' angles when the knees are
+  straight; ``stance`` is the phase variable of the joint-torque laws; written with
+  ``atan``, they hold while the hip is above the feet).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from walkerlab.codegen.symbolic import Equations, dot_terms, position_of, velocity_terms
+from walkerlab.walker.description import Structure
+
+__all__ = ["derive_five_link", "generate_five_link"]
+
+#: index of the swing shank's angle in ``q`` (solved from the heel-strike surface)
+SECTION_DROP = 3
+
+
+def _plus(lin: dict, psi, length) -> dict:
+    """Copy of the link-vector sum ``lin`` with ``length`` more along the angle ``psi``."""
+    out = dict(lin)
+    out[psi] = out.get(psi, 0) + length
+    return out
+
+
+def _check(structure: Structure) -> None:
+    if not structure.free_knees or not structure.knee:
+        raise ValueError("walker.leg.knee.lock: the five-link generator needs free knees")
+    if (structure.foot != "point" or structure.asymmetric or structure.springs
+            or structure.knee_spring or any(b.off_axis or b.massless for b in structure.bodies)
+            or any(b.off_axis for b in structure.torso)
+            or (structure.torso and not structure.hinged_torso)):
+        raise ValueError("walker.leg.knee.lock: free knees need identical legs with point "
+                         "feet, massive bodies on the link axes, no springs and a hinged "
+                         "torso (if any) today")
+
+
+def _bodies(structure: Structure, P: dict, psi: dict, lin: dict) -> tuple[list, dict]:
+    """The bodies ``(mass, {angle: length}, inertia, link angle)`` and the named points'
+    link-vector sums (see the module docstring for the chain)."""
+    lt, L = P["L_thigh"], P["L"]
+    points = dict(lin)
+    bodies = []
+    if structure.hip_mass:
+        bodies.append((P["M_hip"], lin["hip"], 0, psi["stance_thigh"]))
+    for b in structure.bodies:
+        d = P[f"d_{b.name}"]
+        inertia = P[f"I_{b.name}"] if b.kind == "rod" else 0
+        for role in ("stance", "swing"):
+            if b.link == "thigh":
+                a = psi[f"{role}_thigh"]
+                where = _plus(lin["hip"], a, d)
+            elif role == "stance":  # d from the hip along the straightened leg
+                a = psi["stance_shank"]
+                where = {a: d - L}
+            else:
+                a = psi["swing_shank"]
+                where = _plus(lin["swing_knee"], a, d - lt)
+            points[f"{role}_{b.name}"] = where
+            bodies.append((P[f"m_{b.name}"], where, inertia, a))
+    for b in structure.torso:
+        a = psi["torso"]
+        where = _plus(lin["hip"], a, -P[f"d_torso_{b.name}"])
+        points[f"torso_{b.name}"] = where
+        inertia = P[f"I_torso_{b.name}"] if b.kind == "rigid_body" else 0
+        bodies.append((P[f"m_torso_{b.name}"], where, inertia, a))
+    return bodies, points
+
+
+def _matrices(q, bodies: list, foot_lin: dict, g):
+    """Mass matrix ``M``, impact matrices ``Mi`` (velocities with the swing foot at rest)
+    and ``B`` (momentum of the pre-impact velocities on those directions), potential ``V``."""
+    n = len(q)
+    M, Mi, B = sp.zeros(n, n), sp.zeros(n, n), sp.zeros(n, n)
+    V = sp.Integer(0)
+    for mass, lin, inertia, a in bodies:
+        rel = {k: lin.get(k, 0) - foot_lin.get(k, 0) for k in {**lin, **foot_lin}}
+        dl, dn = velocity_terms(lin, q), velocity_terms(rel, q)
+        w = sp.Matrix([[sp.diff(a, k) for k in q]])
+        for i in range(n):
+            for j in range(n):
+                M[i, j] += mass * dot_terms(dl[i], dl[j])
+                Mi[i, j] += mass * dot_terms(dn[i], dn[j])
+                B[i, j] += mass * dot_terms(dn[i], dl[j])
+        M += inertia * w.T * w
+        Mi += inertia * w.T * w
+        B += inertia * w.T * w
+        V += mass * g * position_of(lin)[1]
+    return [X.applyfunc(sp.factor_terms) for X in (M, Mi, B)] + [V]
+
+
+def _extended(q, dq, bodies: list, foot):
+    """``De`` (Hessian of the kinetic energy in the rates of ``[q, x_f, y_f]``, the stance
+    foot free) and ``E`` (Jacobian of the swing foot's position) of the extended impact."""
+    xf, yf, dxf, dyf = sp.symbols("x_f y_f dx_f dy_f", real=True)
+    qe, dqe = sp.Matrix([*q, xf, yf]), sp.Matrix([*dq, dxf, dyf])
+    Te = sp.Integer(0)
+    for mass, lin, inertia, a in bodies:
+        v = (position_of(lin) + sp.Matrix([xf, yf])).jacobian(qe) * dqe
+        w = sp.Matrix([[sp.diff(a, k) for k in qe]])
+        Te += sp.Rational(1, 2) * (mass * (v.T * v)[0] + inertia * (w * dqe)[0] ** 2)
+    return sp.hessian(Te, dqe), (foot + sp.Matrix([xf, yf])).jacobian(qe)
+
+
+def derive_five_link(structure: Structure) -> Equations:
+    """Flow, impact, guards, section, energies, points and leg angles of a free-jointed biped
+    (see the module docstring).
+
+    Parameters
+    ----------
+    structure : Structure
+        With ``free_knees`` (and optionally ``hinged_torso``).
+
+    Returns
+    -------
+    Equations
+        ``n = 4`` (no torso) or ``5``; no locked flow, no knee strike.
+
+    Raises
+    ------
+    ValueError
+        A structure this generator does not handle (one line).
+    """
+    _check(structure)
+    roles = structure.roles
+    q = sp.symbols([f"q_{r}" for r in roles], real=True)
+    dq = sp.symbols([f"dq_{r}" for r in roles], real=True)
+    par = sp.symbols(structure.param_names, real=True)
+    P = dict(zip(structure.param_names, par))
+    psi = dict(zip(roles, q))
+    g, gamma, lt = P["g"], P["gamma"], P["L_thigh"]
+    ls = P["L"] - lt
+    ss, st, wt, ws = (psi[r] for r in roles[:4])
+    lin = {"stance_foot": {}, "stance_knee": {ss: -ls}, "hip": {ss: -ls, st: -lt}}
+    lin["swing_knee"] = _plus(lin["hip"], wt, lt)
+    lin["swing_foot"] = _plus(lin["swing_knee"], ws, ls)
+    bodies, point_lin = _bodies(structure, P, psi, lin)
+    M, Mi, B, V = _matrices(q, bodies, lin["swing_foot"], g)
+    n = len(q)
+    qv, dqv = sp.Matrix(q), sp.Matrix(dq)
+    C = sp.zeros(n, n)
+    for i in range(n):
+        for j in range(n):
+            C[i, j] = sum(sp.Rational(1, 2) * (sp.diff(M[i, j], q[k]) + sp.diff(M[i, k], q[j])
+                                               - sp.diff(M[j, k], q[i])) * dq[k]
+                          for k in range(n))
+    G = sp.Matrix([sp.diff(V, k) for k in q])
+    points = {k: position_of(v) for k, v in point_lin.items()}
+    normal = sp.Matrix([sp.sin(gamma), sp.cos(gamma)])
+    tangent = sp.Matrix([sp.cos(gamma), -sp.sin(gamma)])
+    hip, foot = points["hip"], points["swing_foot"]
+    clearance = (foot.T * normal)[0]
+    guards = {"heel_strike": clearance, "swing_foot_ahead": (foot.T * tangent)[0],
+              "hip_height": (hip.T * normal)[0], "swing_clearance": clearance}
+    relabel_q = sp.Matrix([ws, wt, st, ss, *q[4:]])  # legs swap, the torso keeps its angle
+    reach = (ls * sp.cos(ss + gamma) + lt * sp.cos(st + gamma) - lt * sp.cos(wt + gamma)) / ls
+    # atan, not atan2: complex-safe (the complex-step Jacobians of torque laws that read the
+    # phase variable), and exact while the hip is above both feet
+    leg_angles = {"stance": sp.atan(-hip[0] / hip[1]),
+                  "swing": sp.atan((foot[0] - hip[0]) / (hip[1] - foot[1])),
+                  **{r: psi[r] for r in roles}}
+    De, E = _extended(q, dq, bodies, foot)
+    return Equations(
+        q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, C=C, G=G, Mi=Mi, B=B,
+        relabel_q=relabel_q, relabel_rate=relabel_q.jacobian(qv),
+        kinetic=sp.Rational(1, 2) * (dqv.T * M * dqv)[0], potential=V, guards=guards,
+        points=points, leg_angles=leg_angles, section_drop=SECTION_DROP,
+        drop_solution=-sp.acos(reach) - gamma, De=De, E=E, limit=False, section_tied={})
+
+
+def generate_five_link(structure: Structure, key: str) -> str:
+    """Source of the generated module of a free-jointed biped: :func:`walkerlab.codegen.
+    source.generate` of :func:`derive_five_link` (the same function table as every biped's),
+    with ``acos`` imported for the section."""
+    from walkerlab.codegen import source
+
+    body = source.generate(derive_five_link(structure), structure.param_names, key)
+    return body.replace("import numpy as np\n", "import numpy as np\nfrom math import acos  "
+                        "# noqa: F401  (the section's swing shank)\n", 1)
