@@ -320,3 +320,18 @@ def test_stance_foot_normal_force_from_the_equations_of_motion():
                 low = min(low, float((nrm @ a + g * np.cos(phi)) / g))
     assert 0.5 < low < 1.0
     assert abs(got - low) < 1e-5, (got, low)
+
+
+def test_no_cost_of_transport_figure_without_finite_measures():
+    """A branch whose gait measures are all NaN (a walker without a ledger) gets no cost-of-
+    transport figure, not an empty one."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from walkerlab.plotting.continuation_figures import cost_of_transport_figure
+
+    nan = np.full(3, np.nan)
+    b = {"gait": {"speed": nan, "cost_of_transport": nan}, "stable": np.ones(3, bool),
+         "param": np.arange(3.0), "period": 1}
+    assert cost_of_transport_figure(SimpleNamespace(branches=[b], path="x", unit="-")) is None

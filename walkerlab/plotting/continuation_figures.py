@@ -192,10 +192,15 @@ def two_parameter_figure(data, title: str = ""):
 def cost_of_transport_figure(data, title: str = ""):
     """Cost of transport against speed along every branch of a loaded continuation artifact
     that holds gait measures (``branches[i]["gait"]``), coloured by the continued field;
-    stable points solid, unstable hollow.  None when no branch has them."""
+    stable points solid, unstable hollow.  None when no branch has a finite pair of them
+    (a walker without a ledger: no empty figure)."""
     import matplotlib.pyplot as plt
 
-    branches = [b for b in data.branches if b.get("gait")]
+    def finite(b):
+        return np.any(np.isfinite(b["gait"]["speed"]) & np.isfinite(
+            b["gait"]["cost_of_transport"]))
+
+    branches = [b for b in data.branches if b.get("gait") and finite(b)]
     if not branches:
         return None
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
