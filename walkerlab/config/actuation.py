@@ -42,6 +42,8 @@ class _JointTable(Strict):
         if len(abscissa) != len(self.values_rad):
             field = "hip_angle_rad" if self.hip_angle_rad is not None else "angle_rad"
             raise ValueError(f"{name} and {field} need the same length")
+        if any(b <= a for a, b in zip(abscissa, abscissa[1:])):
+            raise ValueError(f"{name} must increase")
 
     @model_serializer(mode="wrap")
     def _as_given(self, handler):
@@ -83,8 +85,6 @@ class PhaseReference(_JointTable):
     @model_validator(mode="after")
     def _table(self) -> PhaseReference:
         self._one_of(self.phase_rad, "phase_rad")
-        if any(b <= a for a, b in zip(self.phase_rad, self.phase_rad[1:])):
-            raise ValueError("phase_rad must increase")
         return self
 
 
@@ -102,8 +102,6 @@ class TimeReference(_JointTable):
     @model_validator(mode="after")
     def _table(self) -> TimeReference:
         self._one_of(self.time_s, "time_s")
-        if any(b <= a for a, b in zip(self.time_s, self.time_s[1:])):
-            raise ValueError("time_s must increase")
         if self.time_s[0] < 0:
             raise ValueError("time_s starts at the step's heel strike: no negative times")
         return self

@@ -137,12 +137,9 @@ def impulse_jump(walker, x, trailing, P):
         Its work, the kinetic energy it adds [J].
     """
     n = walker.nq
-    nf = len(walker.contact_names())
-    Pp, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
-    walker.kernels.feet(np.asarray(x, float), walker.walker_params, Pp, V, J)
-    r = np.asarray(walker.points(x)["hip"], float).ravel() - Pp[trailing]
+    e, J, _ = walker.actuators.push_direction(walker, x, trailing)
     M = walker.mass_matrix(x)
-    dq = x[n:] + np.linalg.solve(M, J[trailing].T @ (P * r / np.sqrt(r @ r)))
+    dq = x[n:] + np.linalg.solve(M, J.T @ (P * e))
     work = 0.5 * dq @ M @ dq - 0.5 * x[n:] @ M @ x[n:]
     return np.concatenate([x[:n], dq]), float(work)
 

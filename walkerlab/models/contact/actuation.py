@@ -96,17 +96,22 @@ class ContactActuators:
         n = self.nq
         return float(push_off_impulse(self.spec.push_off, np.hypot(x[n], x[n + 1])))
 
-    def push_off_force(self, walker, x, trailing: int, force: float):
-        """Generalised force (nq,) of a force ``force`` [N] at leg ``trailing``'s foot
-        along that leg towards the hip, and its power [W]."""
+    def push_direction(self, walker, x, trailing: int):
+        """``(e, J, v)``: the unit vector (2,) from leg ``trailing``'s foot towards the hip
+        (the push-off's direction), that foot's Jacobian (2, nq) and velocity (2,) [m/s]."""
         n = self.nq
         nf = len(walker.contact_names())
         P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
         walker.kernels.feet(np.asarray(x, float), walker.walker_params, P, V, J)
-        r = np.asarray(x[:2], float) - P[trailing]
-        e = r / np.sqrt(r @ r)
+        r = np.asarray(walker.points(x)["hip"], float).ravel() - P[trailing]
+        return r / np.sqrt(r @ r), J[trailing], V[trailing]
+
+    def push_off_force(self, walker, x, trailing: int, force: float):
+        """Generalised force (nq,) of a force ``force`` [N] at leg ``trailing``'s foot
+        along that leg towards the hip, and its power [W]."""
+        e, J, v = self.push_direction(walker, x, trailing)
         F = force * e
-        return J[trailing].T @ F, float(F @ V[trailing])
+        return J.T @ F, float(F @ v)
 
 
 #: Names of the work integrals a powered contact run carries beside the state [J].
