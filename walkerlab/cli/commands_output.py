@@ -53,12 +53,16 @@ def animate(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
 def export(scene: Path | None = SceneArg,
            fmt: str = typer.Option("urdf", "--format", help="urdf (Drake, Pinocchio), mjcf "
                                    "(MuJoCo) or adm (MSC Adams Solver .adm + .acf)"),
-           runs_dir: Path = RunsOpt) -> None:
+           runs_dir: Path = RunsOpt,
+           walker_only: bool = typer.Option(
+               False, "--walker-only", help="urdf/mjcf: the walker alone, without the rigid "
+               "gait (no keyframe; the MJCF on a plane with MuJoCo's default contact)")) -> None:
     """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf,
-    walker.xml, or walker.adm + walker.acf (Adams Solver)."""
+    walker.xml, or walker.adm + walker.acf (Adams Solver).  The URDF and MJCF carry the rigid
+    gait (found as `walkerlab fixedpoint` finds it) as a keyframe."""
     from walkerlab.stages import export as stage
 
-    typer.echo(f"wrote {stage.run(load(scene), runs_dir, fmt)}")
+    typer.echo(f"wrote {stage.run(load(scene), runs_dir, fmt, walker_only=walker_only)}")
 
 
 @guard

@@ -57,9 +57,15 @@ def check_exportable(scene: Scene) -> None:
     ValueError
         One line naming the field: a mass below :data:`MJCF_MIN_MASS_KG` (but > 0; 0 is
         refused by the multibody model) or a length / foot radius below
-        :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot); an ankle
-        push-off (flat feet: not exported yet, the file would walk passively).
+        :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot); flat feet
+        (the multibody model has no foot link yet: the files would hold point feet); an
+        ankle push-off (the file would walk passively).
     """
+    foot = getattr(getattr(scene.walker, "leg", None), "foot", None)
+    if getattr(foot, "kind", None) == "flat":
+        raise ValueError("walker.leg.foot.kind: flat feet are not exported to URDF/MJCF yet "
+                         "(the files would hold point feet: no foot link, ankle spring or "
+                         "heel and toe contacts)")
     act = getattr(scene.walker, "actuation", None)
     if act is not None and act.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: not exported yet (the URDF/MJCF "

@@ -63,16 +63,37 @@ def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
     return path
 
 
-def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path:
+def _gait_scene(scene: Scene, mb, data):
+    """The MJCF's gait keyframe, terrain and contact; no rigid gait: one line."""
+    from walkerlab.analysis.gait.poincare import FixedPointNotFound
+
+    try:
+        return mjcf_scene(scene, mb, data)
+    except FixedPointNotFound as exc:
+        where = ("its fixedpoint section" if scene.fixedpoint is not None
+                 else "an automatic search (the scene has no fixedpoint section)")
+        raise ValueError(f"export: no rigid gait for the file's keyframe from {where}: "
+                         f"{' '.join(str(exc).split())}; give fixedpoint.initial_guess, or "
+                         "export --walker-only for the walker alone") from None
+
+
+def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
+        walker_only: bool = False) -> Path:
     """Write the scene's walker as ``fmt`` ("urdf", "mjcf" or "adm": ``walker.adm`` and
     ``walker.acf``, returning the .adm's path) into
     ``<runs_root>/<scene name>/`` and return the file's path.
 
+    The URDF and MJCF carry the rigid gait (the MJCF's ``gait`` keyframe, terrain and
+    contact; the URDF's keyframe sidecar), found as ``walkerlab fixedpoint`` finds it, from
+    the scene's ``fixedpoint`` section or, without one, from its defaults (an automatic
+    search).  ``walker_only``: the walker alone (no gait search; the MJCF on a plane with
+    MuJoCo's default contact, no sidecar).
+
     Raises
     ------
     ValueError
-        Unknown format, or a walker with a massless link (a multibody model needs positive
-        masses); one line.
+        Unknown format, a walker with a massless link (a multibody model needs positive
+        masses), feet the formats cannot carry, or no rigid gait to start from; one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
     """
@@ -83,7 +104,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf") -> Path
     if fmt == "adm":
         return _run_adams(scene, runs_root, mb, data, name)
     check_exportable(scene)
-    extra = mjcf_scene(scene, mb, data) if scene.fixedpoint is not None else None
+    extra = None if walker_only else _gait_scene(scene, mb, data)
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__)
     else:
