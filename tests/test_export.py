@@ -257,13 +257,14 @@ def test_export_refuses_in_one_line(args, message, tmp_path):
 
 
 def test_arc_feet_and_knee_limit_in_files(tmp_path):
-    """Arc feet are cylinders of radius R at the arc's centre (L - R from the hip); the knee's
-    straight-leg stop is the upper limit 0 of a [-pi, 0] range."""
+    """Arc feet are spheres of radius R at the arc's centre (L - R from the hip) in the MJCF
+    (in the x-z plane the arc; the URDF's are cylinders); the knee's straight-leg stop is the
+    upper limit 0 of a [-pi, 0] range."""
     mujoco = pytest.importorskip("mujoco")
     scene = _scene("round_feet")
     m = mujoco.MjModel.from_xml_path(str(export_stage.run(scene, tmp_path, "mjcf")))
     foot = m.geom("leg1_foot")
-    assert foot.type[0] == mujoco.mjtGeom.mjGEOM_CYLINDER and foot.size[0] == 0.2
+    assert foot.type[0] == mujoco.mjtGeom.mjGEOM_SPHERE and foot.size[0] == 0.2
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, m.key("standing").id)
     mujoco.mj_forward(m, d)
@@ -305,7 +306,7 @@ def test_feet_where_the_walker_puts_them(name, tmp_path):
 def _edited_scene(tmp_path, base, edit):
     d = yaml.safe_load((ROOT / "configs" / f"{base}.yaml").read_text())
     edit(d)
-    d.pop("fixedpoint")  # another walker: the file without the scene's gait keyframe
+    d.pop("fixedpoint")  # another walker: exported walker_only (no gait keyframe)
     path = tmp_path / f"{base}_edited.yaml"
     path.write_text(yaml.safe_dump(d))
     return load_scene(path)
@@ -347,7 +348,8 @@ def test_mujoco_springs_are_ours(variant, tmp_path):
     scene = _scene(base) if edit is None else _edited_scene(tmp_path, base, edit)
     data = _data(scene)
     names = ref.coordinate_names(data)
-    mj = MuJoCo(export_stage.run(scene, tmp_path, "mjcf"), names, bool(data.structure.torso))
+    mj = MuJoCo(export_stage.run(scene, tmp_path, "mjcf", walker_only=edit is not None), names,
+                bool(data.structure.torso))
     mj.model.opt.enableflags |= mujoco.mjtEnableBit.mjENBL_ENERGY
     view = floating.floating_view(data)
     assert data.structure.springs
@@ -430,9 +432,10 @@ def test_off_axis_bodies_exported_in_place(base, edit, tmp_path):
     assert any(b.off_axis for b in (*s.bodies, *s.torso)) or s.asymmetric
     names = ref.coordinate_names(data)
     torso = bool(s.torso)
-    libs = {"pinocchio": Pinocchio(export_stage.run(scene, tmp_path, "urdf"), names,
-                                   data.gravity_m_per_s2, torso),
-            "mujoco": MuJoCo(export_stage.run(scene, tmp_path, "mjcf"), names, torso)}
+    libs = {"pinocchio": Pinocchio(export_stage.run(scene, tmp_path, "urdf", walker_only=True),
+                                   names, data.gravity_m_per_s2, torso),
+            "mujoco": MuJoCo(export_stage.run(scene, tmp_path, "mjcf", walker_only=True), names,
+                             torso)}
     for lib, f in libs.items():
         for q, dq in _states(len(names), seed=19):
             M, b = f(q, dq)

@@ -44,7 +44,13 @@ class MjcfScene:
         Checkerboard patch centres along the slope [m] of leg1's and leg2's lane; None: a
         continuous plane.
     patch_width_m : float
-        Patch width along the slope [m].
+        Patch width along the slope [m] (the scene's ``terrain.patch_width_m``), centred on
+        the footfall.
+    patch_ahead_m : float
+        Ground added at each patch's downhill edge [m]: where an arc foot rolls its contact
+        point further ahead of the footfall than half a patch
+        (:func:`walkerlab.export.scene.arc_roll_m`), the patch is lengthened to the roll's
+        end plus half a patch; 0 otherwise.
     ground_offset_m : float
         The ground's surface lies this far below the feet's reference points along the slope
         normal [m] (the point foot's sphere radius; 0 for arc feet).
@@ -81,6 +87,7 @@ class MjcfScene:
     notes: tuple = ()
     actuation_json: str | None = None
     push_off_duration_s: float = 0.005
+    patch_ahead_m: float = 0.0
 
 
 #: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot

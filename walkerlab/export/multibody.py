@@ -48,7 +48,9 @@ Gravity ``g`` acts along world -z.  The slope is the ground's tilt, not gravity'
 falls towards +x at the slope angle (MJCF: a plane rotated about y; URDF has no world, the
 slope is stated in a comment).  Feet: a point foot is a sphere of radius ``L/1000`` (the
 paper's ADAMS feet carry a 1 mm bevel on a 1 m leg) so that contact engines have a geometry;
-an arc foot is a cylinder of radius ``R`` about the y axis at the arc's centre.  A link of
+an arc foot is a cylinder of radius ``R`` about the y axis at the arc's centre in the URDF and
+a sphere of radius ``R`` there in the MJCF (the same section in the x-z plane; MuJoCo's
+cylinder-box collision is a general convex one, too coarse for a rolling foot).  A link of
 the ``leg<i>_foot`` name marks the foot point or arc centre.
 
 Formats:
@@ -190,10 +192,11 @@ def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
         return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}" '
                 f'pos="{nums(-off * n[0], 0, -off * n[1])}" contype="6" conaffinity="0" '
                 'rgba="0.8 0.8 0.8 1"/>']
-    half, depth = extra.patch_width_m / 2, extra.patch_width_m / 10
+    half, depth = (extra.patch_width_m + extra.patch_ahead_m) / 2, extra.patch_width_m / 10
     out = []
     for leg, (y, centres) in zip(LANE_BITS, ((0.05, extra.lanes[0]), (-0.05, extra.lanes[1]))):
         for i, s in enumerate(centres):
+            s = s + extra.patch_ahead_m / 2  # from footfall - w/2 to footfall + w/2 + ahead
             d = off + depth  # box centre below the surface
             size = nums(half, 0.04 * mb.leg_length_m, depth)
             pos = nums(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])
@@ -333,11 +336,12 @@ def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
         z = -ln.foot_m
         y = 0.0 if extra is None or extra.lanes is None else (
             0.05 if leg == "leg1" else -0.05) * mb.leg_length_m
-        if arc_feet(mb):
-            geom = (f'type="cylinder" fromto="{nums(0, y - width, z, 0, y + width, z)}" '
-                    f'size="{num(mb.foot_radius_m)}"')
-        else:
-            geom = f'type="sphere" pos="{nums(0, y, z)}" size="{num(point_foot_radius(mb))}"'
+        # an arc foot is a sphere of radius R too: MuJoCo's cylinder-box collision is its
+        # general convex one, whose contact point wanders at these 1e-5 m penetrations
+        # (round_feet's steps came out 11 % short); sphere-box and sphere-plane are analytic,
+        # and in the x-z plane the sphere's section through its centre is the arc
+        r = mb.foot_radius_m if arc_feet(mb) else point_foot_radius(mb)
+        geom = f'type="sphere" pos="{nums(0, y, z)}" size="{num(r)}"'
         lines += [f'{indent}  <site name="{foot}" pos="{nums(0, 0, z)}"/>',
                   f'{indent}  <geom name="{foot}" {geom} contype="0" '
                   f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']

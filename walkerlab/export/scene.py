@@ -43,7 +43,7 @@ from walkerlab.export.mjcf_scene import (
 )
 from walkerlab.models.contact.laws import ContactParamsSI
 
-__all__ = ["EXPORT_STEPS", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]
+__all__ = ["EXPORT_STEPS", "arc_roll_m", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
@@ -158,6 +158,38 @@ def joint_state(mb, walker, x) -> tuple[np.ndarray, np.ndarray]:
             np.array([v["hip_x"], v["hip_y"], *(joint(v, ln) for ln in mb.links)]))
 
 
+def arc_roll_m(mb, qpos) -> float:
+    """How far an arc foot rolls its contact point ahead of its footfall during a stance [m]:
+    ``R (psi_start - psi_end)``, the stance shank's turn from heel strike to the next (rolling
+    without slip on the slope), from the ``gait`` keyframe ``qpos`` (joint order of
+    :func:`joint_state`): the stance leg (leg2) starts at its own angle and ends at the swing
+    leg's (a symmetric gait); 0 for point feet."""
+    if not (mb.foot == "arc" and mb.foot_radius_m > 0):
+        return 0.0
+    q = dict(zip(["hip_x", "hip_z", *(ln.joint for ln in mb.links)], qpos))
+
+    def shank(leg):
+        return q[f"{leg}_hip"] + q.get(f"{leg}_knee", 0.0)
+
+    return mb.foot_radius_m * abs(shank("leg2") - shank("leg1"))
+
+
+def _patch_ahead(scene: Scene, terrain: TerrainSettings, roll: float) -> tuple[float, tuple]:
+    """Ground to add ahead of each patch for an arc foot's roll, and the note saying so; a
+    warning on stderr where the scene's patch is narrower than the roll."""
+    half = terrain.patch_width_m / 2
+    if terrain.kind != "checkerboard" or roll <= half:
+        return 0.0, ()
+    from walkerlab import progress
+
+    ahead = roll  # the patch's downhill edge from footfall + w/2 to the roll's end + w/2
+    line = (f"terrain.patch_width_m = {terrain.patch_width_m:g} m: the arc feet roll their "
+            f"contact point {roll:.4g} m ahead of each footfall, beyond the patch's "
+            f"{half:g} m; the MJCF's patches run {ahead:.4g} m further downhill")
+    progress.note(f"warning: {scene.name or 'walker'}: {line}")
+    return ahead, (f"Terrain: {line} (walkerlab.export.scene.arc_roll_m).",)
+
+
 def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
     """The gait keyframe, terrain, contact and latch of ``scene`` for the MJCF export.
 
@@ -225,7 +257,8 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
                   "control to the swing leg's hip torque (its sign flipped when leg2 swings) "
                   "and applies the push-off as a force along the trailing leg at its foot for "
                   "push_off_duration_s from each heel strike (walkerlab.export.mujoco_walk).",)
+    ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
     return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
-                     dt, solref, solimp, mu, latch, notes, actuation,
-                     settings.push_off_pulse_s())
+                     dt, solref, solimp, mu, latch, notes + terrain_notes, actuation,
+                     settings.push_off_pulse_s(), ahead)
