@@ -4,7 +4,8 @@ MuJoCo is an optional (dev/test) dependency: imported inside the functions.
 
 A heel strike of leg i is the first contact of its foot geom (``leg<i>_foot``) with the
 ground after the foot has been off the ground for at least ``min_air_s`` (shorter gaps are
-bounces of the soft contact, not steps).  The knee latch of a kneed export (equality
+bounces of the soft contact, not steps); MuJoCo is stepped :data:`LOOK_EVERY` timesteps at a time
+where no stepping rule acts.  The knee latch of a kneed export (equality
 constraints ``leg<i>_latch``) is switched before every step by :func:`latch_rule`.
 
 A powered export (custom text ``walkerlab_actuation``: the scene's ``walker.actuation``) is
@@ -154,6 +155,14 @@ class PoweredLoop:
         self._hip_body = int(model.body("hip").id)
 
 
+#: MuJoCo steps a walk takes without looking (``mj_step``'s ``nstep``) when no stepping rule
+#: acts (no latch, no motor): heel-strike times are then known to 5 timesteps (an export's
+#: timestep is tau/4 of its contact, at most 1 ms; 0.18-0.25 ms for the shipped SI scenes),
+#: a mean step period over 10 steps to 5 dt / (10 T), ~1e-4; the latch and PoweredLoop act
+#: every step.
+LOOK_EVERY = 5
+
+
 def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     """Run the MJCF at ``xml_path`` from its ``gait`` keyframe for ``t_final_s`` [s].
 
@@ -178,10 +187,12 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     off = _numeric(model, "foot_height_offset_m", 0.0)
     h_rel = _numeric(model, "latch_release_height_m")
     cap = _numeric(model, "latch_capture_rad")
-    n, t = np.array([math.sin(phi), math.cos(phi)]), np.array([math.cos(phi), -math.sin(phi)])
+    n = np.array([math.sin(phi), 0.0, math.cos(phi)])  # slope normal and tangent, (x, y, z)
+    t = np.array([math.cos(phi), 0.0, -math.sin(phi)])
     foot_geom = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, f"{g}_foot") for g in LEGS]
     site = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, f"{g}_foot") for g in LEGS]
     latch = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, f"{g}_latch") for g in LEGS]
+    latched = latch[0] >= 0 and h_rel is not None
     knee = [model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{g}_knee")]
             if latch[0] >= 0 else -1 for g in LEGS]
     hip = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")]
@@ -189,31 +200,32 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation") >= 0:
         powered = PoweredLoop(model)
         powered.bind(model, site)
+    nstep = 1 if latched or powered else LOOK_EVERY
     mujoco.mj_forward(model, data)
     L = float(np.hypot(*(data.site_xpos[site[1]][[0, 2]] - data.qpos[[hip, hip + 1]])))
     last_contact = [data.time, data.time]  # both feet at the ground at the keyframe
     times, legs, pos = [], [], []
     fell = False
     while data.time < t_final_s:
-        if latch[0] >= 0 and h_rel is not None:
+        if latched:
             for i in range(2):
-                p = data.site_xpos[site[i]][[0, 2]]
-                data.eq_active[latch[i]] = latch_rule(float(p @ n) - off,
+                data.eq_active[latch[i]] = latch_rule(float(data.site_xpos[site[i]] @ n) - off,
                                                       float(data.qpos[knee[i]]), h_rel, cap)
         if powered is not None:
             powered.control(data)
-        mujoco.mj_step(model, data)
-        geoms = data.contact.geom[:data.ncon]
-        for i in range(2):
-            if data.ncon and (geoms == foot_geom[i]).any():
-                if data.time - last_contact[i] > min_air_s:
-                    times.append(data.time)
-                    legs.append(LEGS[i])
-                    pos.append(float(data.site_xpos[site[i]][[0, 2]] @ t))
-                    if powered is not None:
-                        powered.heel_strike(data, i)
-                last_contact[i] = data.time
-        if float(data.qpos[[hip, hip + 1]] @ n) < 0.5 * L:
+        mujoco.mj_step(model, data, nstep)
+        if data.ncon:
+            geoms = data.contact.geom[:data.ncon]
+            for i in range(2):
+                if (geoms == foot_geom[i]).any():
+                    if data.time - last_contact[i] > min_air_s:
+                        times.append(data.time)
+                        legs.append(LEGS[i])
+                        pos.append(float(data.site_xpos[site[i]] @ t))
+                        if powered is not None:
+                            powered.heel_strike(data, i)
+                    last_contact[i] = data.time
+        if data.qpos[hip] * n[0] + data.qpos[hip + 1] * n[2] < 0.5 * L:
             fell = True
             break
     return MujocoWalk(np.array(times), legs, np.array(pos), fell, float(data.time))
