@@ -43,7 +43,8 @@ from walkerlab.export.mjcf_scene import (
 )
 from walkerlab.models.contact.laws import ContactParamsSI
 
-__all__ = ["EXPORT_STEPS", "arc_roll_m", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]
+__all__ = ["EXPORT_STEPS", "arc_roll_m", "check_exportable", "joint_state", "mjcf_scene",
+           "mujoco_contact"]
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
@@ -63,9 +64,9 @@ def check_exportable(scene: Scene) -> None:
     """
     foot = getattr(getattr(scene.walker, "leg", None), "foot", None)
     if getattr(foot, "kind", None) == "flat":
-        raise ValueError("walker.leg.foot.kind: flat feet are not exported to URDF/MJCF yet "
-                         "(the files would hold point feet: no foot link, ankle spring or "
-                         "heel and toe contacts)")
+        raise ValueError("walker.leg.foot.kind: flat feet are not exported yet (a URDF/MJCF "
+                         "would hold point feet: no foot link, ankle spring or heel and toe "
+                         "contacts)")
     act = getattr(scene.walker, "actuation", None)
     if act is not None and act.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: not exported yet (the URDF/MJCF "
