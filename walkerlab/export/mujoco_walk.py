@@ -14,7 +14,8 @@ leg's hip torque of the laws (:class:`walkerlab.models.actuation.TorqueLaws`, th
 contact views' own), its sign flipped while leg2 swings (the motor drives ``leg1_hip -
 leg2_hip``); at each heel strike the roles swap and the push-off
 (:func:`walkerlab.models.actuation.push_off_impulse` at the hip's speed) acts as a force
-``P / T`` along the trailing leg at its foot for ``T = push_off_duration_s``
+``P / T`` along the trailing leg at its foot for ``T = push_off_duration_s`` (the pulse's
+last MuJoCo step carries only its share of the force, so the impulse is ``P`` exactly)
 (``data.xfrc_applied`` on the leg's body, with the moment of the force about its centre of
 mass).
 """
@@ -118,6 +119,7 @@ class PoweredLoop:
         self.vadr = [int(j.dofadr[0]) for j in joints]
         self.body = [int(model.body(g).id) for g in LEGS]
         self.hip = int(model.joint("hip_x").dofadr[0])
+        self.dt = float(model.opt.timestep)
         self.stance, self.t_step, self.push = 1, 0.0, None  # leg2 stands at the keyframe
 
     def control(self, data) -> None:
@@ -133,7 +135,10 @@ class PoweredLoop:
         data.ctrl[self.motor] = tau if sw == 0 else -tau
         data.xfrc_applied[:] = 0.0
         if self.push is not None and data.time < self.push[1]:
-            leg, force = self.push[0], self.push[2]
+            # the pulse's share of this step: the last step of a pulse that is not a whole
+            # number of steps carries only the rest, so the impulse is P exactly
+            share = min(1.0, (self.push[1] - data.time) / self.dt)
+            leg, force = self.push[0], self.push[2] * share
             foot = data.site_xpos[self._site[leg]]
             e = data.xpos[self._hip_body] - foot
             F = force * e / np.sqrt(e @ e)
