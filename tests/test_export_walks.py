@@ -310,3 +310,31 @@ def test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens(tmp_path):
     run = walk(path, 11.3 * step_s)
     assert not run.fell and len(run.times_s) >= 10 and run.alternating
     assert run.step_periods_s.mean() == pytest.approx(step_s, rel=0.01)
+
+
+@pytest.mark.slow
+def test_no_rigid_gait_refused_in_one_line_and_walker_only_writes_the_walker(tmp_path):
+    """The paper walker on level ground without a ``fixedpoint`` section: the automatic
+    search (its seeds: ~30 s wall under load, 3 s CPU) finds no passive gait, so the export refuses in one line saying how to go on and
+    writes nothing (before: a file without keyframe, terrain or contact, exit 0);
+    ``--walker-only`` writes the walker alone, as asked."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    for key in ("ideal", "published", "workprecision", "fixedpoint"):
+        d.pop(key)
+    d["slope"]["angle_rad"] = 0.0
+    d["name"] = "level"
+    (tmp_path / "level.yaml").write_text(yaml.safe_dump(d))
+    args = ["export", str(tmp_path / "level.yaml"), "--format", "mjcf",
+            "--runs-dir", str(tmp_path / "runs")]
+    r = CliRunner().invoke(app, args)
+    assert r.exit_code == 1 and r.output.strip().count("\n") == 0, r.output
+    assert "no rigid gait" in r.output and "--walker-only" in r.output
+    assert not list((tmp_path / "runs").rglob("walker.*"))
+    r = CliRunner().invoke(app, [*args, "--walker-only"])
+    assert r.exit_code == 0, r.output
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "runs" / "level" / "walker.xml"))
+    assert m.nkey == 1  # "standing" only

@@ -72,9 +72,9 @@ def _gait_scene(scene: Scene, mb, data):
     except FixedPointNotFound as exc:
         where = ("its fixedpoint section" if scene.fixedpoint is not None
                  else "an automatic search (the scene has no fixedpoint section)")
-        raise ValueError(f"export: no rigid gait for the file's keyframe from {where}: "
-                         f"{' '.join(str(exc).split())}; give fixedpoint.initial_guess, or "
-                         "export --walker-only for the walker alone") from None
+        raise ValueError(f"export: no rigid gait for the file's keyframe from {where} (give "
+                         "fixedpoint.initial_guess, or --walker-only for the walker alone): "
+                         f"{' '.join(str(exc).split())}") from None
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
