@@ -9,9 +9,9 @@ ground at the wrong height or a contact too soft makes the walker fall or change
 Measured: test_every_shipped_scene_walks_in_mujoco_or_is_refused's docstring (every shipped
 scene, 11.3 rigid steps).  Over 30.3 rigid steps: 30 alternating strikes for all but
 compass_optimal (17, then a foot misses its 10 cm patch: MuJoCo's steps are 3 mm longer than
-the rigid 0.536 m, the footfalls drift 4.9 cm; the scene keeps the default terrain) and
-powered_compass (25, its footfalls drift 15 cm off the 30 cm patches).  Tolerance 1 % (issue
-25): MuJoCo's contact is soft and linear.
+the rigid 0.536 m, the footfalls drift 4.9 cm; the scene keeps the default terrain);
+powered_compass -1.5 % over 30.  Tolerance 1 % (issue 25): MuJoCo's contact is soft and
+linear.
 """
 
 from __future__ import annotations
