@@ -40,15 +40,17 @@ from walkerlab.analysis.contact.step_map import (
     StepMap,
     section_guess_from_ideal,
 )
+from walkerlab.integrate.contact_grid import GRID_METHODS
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.numerics import fd_jacobian, sort_multipliers
 
-#: the step map's integrator while root finding and for the final Jacobian (odeint)
-MAP_SOLVER = Solver("odeint", 1e-12, 1e-14)
+#: the step map's integrator while root finding and for the final Jacobian (CyRK's BDF over
+#: the compiled right-hand side, :func:`walkerlab.integrate.contact_grid.contact_grid`)
+MAP_SOLVER = Solver("cyrk_bdf", 1e-12, 1e-14)
 #: the cheap map of the two-fidelity search
-COARSE_SOLVER = Solver("odeint", 1e-10, 1e-12)
+COARSE_SOLVER = Solver("cyrk_bdf", 1e-10, 1e-12)
 
 __all__ = ["COARSE_SOLVER", "MAP_SOLVER", "ContactPeriodicGait", "find_contact_periodic_gait",
            "ideal_gait", "simulate_from_periodic_gait"]
@@ -278,11 +280,12 @@ def _scaled_residual(M: StepMap, scale: np.ndarray):
 
 def _scaled_residual_jacobian(M: StepMap, scale: np.ndarray, fd_step: float, method: str):
     """dG/du of :func:`_scaled_residual` by finite differences of step ``10 * fd_step`` times
-    ``scale`` (forward differences when ``method`` is odeint, central otherwise), the root
-    finder's Jacobian; memoised on its last argument, its last value kept as ``.last``."""
+    ``scale`` (forward differences when ``method`` is a grid method, ``"cyrk_bdf"`` or
+    ``"odeint"``, central otherwise), the root finder's Jacobian; memoised on its last
+    argument, its last value kept as ``.last``."""
     return _last_call_memo(
         lambda u: fd_jacobian(lambda v: M(v)[0], u * scale, 10 * fd_step * scale,
-                              central=method != "odeint")
+                              central=method not in GRID_METHODS)
         * scale[None, :] / scale[:, None] - np.eye(len(scale)))
 
 

@@ -66,7 +66,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 from walkerlab.integrate.ends import RunEnd
-from walkerlab.integrate.events import Event, EventRun, odeint_grid, run_to_event
+from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
+from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
 from walkerlab.walker.layout import StateIndex
@@ -140,6 +141,7 @@ class StepMap:
         args = (w.contact_params, w.walker_params, *w.kernel_lanes)
         self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
         self._fj = lambda x: kern.jac(x, *args)  # noqa: E731
+        self._data = w.pack() if solver.method != "odeint" else None  # compiled RHS data
         self.n, self.t = w.normal, w.tangent
         self.idx = StateIndex(w)
         # every column by name (leg1 = 0, leg2 = 1), never by row: each leg's link angles,
@@ -225,27 +227,23 @@ class StepMap:
         self.nfev += 1
         return run
 
-    def _step_odeint(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
+    def next_section(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
                      chunk_s: float = 0.25):
-        """``solver.method == "odeint"``: (t_e, x_e) of the next upward zero of theta_sw - theta_st.
+        """(t_e [s], x_e (2 nq,)) of the next upward zero of theta_sw - theta_st from the
+        full state ``x0`` (2 nq,) at t = 0, the new stance leg ``stance_to_come`` (0 = leg1);
+        for a grid method (``"cyrk_bdf"``, ``"odeint"``).
 
-        scipy's odeint (LSODA without per-step Python overhead) on a ``dt`` grid in chunks;
-        the crossing is bracketed on the samples and located by ``scipy.optimize.brentq``
-        on short odeint integrations from the sample before it, so the section state
-        carries the integrator's accuracy, not an interpolant's.
+        The walker on a ``dt`` grid in chunks (:func:`walkerlab.integrate.contact_grid.
+        contact_grid`: CyRK's BDF over the compiled RHS, or scipy's odeint); the crossing is
+        bracketed on the samples and located by ``scipy.optimize.brentq`` on short
+        integrations from the sample before it, so the section state carries the
+        integrator's accuracy, not an interpolant's.
         """
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
         hth = 0.5 * self.walker.L
-        frhs, fjac = self._f, self._fj
-
-        def f(t, x):
-            return frhs(x)
-
-        def jf(t, x):
-            return fjac(x)
 
         def run(x, tg):
-            X, end, message = odeint_grid(f, x, tg, self.solver, jac=jf)
+            X, end, message, _ = contact_grid(self.walker, x, tg, self.solver, self._data)
             if end is RunEnd.SOLVER_FAILURE:
                 raise PeriodicGaitError("solver_failure", f"step map: {message}")
             return X
@@ -290,8 +288,8 @@ class StepMap:
             The walker fell, did not reach the next mid-stance within ``t_max``, the solver
             failed or the wall-time limit ran out.
         """
-        if self.method == "odeint":
-            te, xe = self._step_odeint(self.to_state(z))
+        if self.method in GRID_METHODS:
+            te, xe = self.next_section(self.to_state(z))
             z1, s1 = self.to_section(xe, 0)
             return z1, te, s1
         run = self.integrate(self.to_state(z))
@@ -308,12 +306,11 @@ class StepMap:
     def patch_margin(self, z) -> float:
         """Smallest distance [m] of a loaded foot to its patch edge over one step from the
         section coordinates ``z`` (m,) (:attr:`names`); inf on continuous ground."""
-        if self.method == "odeint":
+        if self.method in GRID_METHODS:
             x0 = self.to_state(z)
-            te = self._step_odeint(x0)[0]
+            te = self.next_section(x0)[0]
             tt = np.linspace(0.0, te, 2001)
-            X = odeint_grid(lambda t, x: self._f(x), x0, tt, self.solver,
-                            jac=lambda t, x: self._fj(x))[0]
+            X = contact_grid(self.walker, x0, tt, self.solver, self._data)[0]
         else:
             run = self.integrate(self.to_state(z), dense=True)
             te = run.t_event if run.event == "mid_stance" else run.t[-1]
@@ -406,6 +403,16 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
 
     w = step_map.walker
     x0 = initial_state_from_ideal(w, *np.asarray(x_ideal, float), rate_scale=rate_scale)
+    if step_map.method in GRID_METHODS:
+        try:
+            xe = step_map.next_section(x0, stance_to_come=1)[1]
+        except PeriodicGaitError as e:
+            if e.kind == "time_limit":
+                raise
+            raise PeriodicGaitError("fall" if e.kind == "fall" else "no_mid_stance",
+                                    "the ideal state does not reach mid-stance on the "
+                                    "contact model") from None
+        return step_map.to_section(xe, 1)[0]
     run = step_map.integrate(x0, stance_to_come=1)
     if run.event != "mid_stance":
         raise PeriodicGaitError("fall" if run.end is RunEnd.FALL else "no_mid_stance",
