@@ -52,7 +52,12 @@ MAP_SOLVER = Solver("cyrk_bdf", 1e-12, 1e-14)
 #: the cheap map of the two-fidelity search
 COARSE_SOLVER = Solver("cyrk_bdf", 1e-10, 1e-12)
 
-__all__ = ["COARSE_SOLVER", "MAP_SOLVER", "ContactPeriodicGait", "find_contact_periodic_gait",
+#: a powered walker's map (the powered contact integrator, solve_ivp with a Python
+#: right-hand side: looser than the passive map's) and its cheap map
+POWERED_MAP_SOLVER = Solver("LSODA", 1e-10, 1e-12)
+POWERED_COARSE_SOLVER = Solver("LSODA", 1e-8, 1e-10)
+
+__all__ = ["COARSE_SOLVER", "MAP_SOLVER", "POWERED_COARSE_SOLVER", "POWERED_MAP_SOLVER", "ContactPeriodicGait", "find_contact_periodic_gait",
            "ideal_gait", "simulate_from_periodic_gait"]
 
 
@@ -232,6 +237,11 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     """
     wall = time.perf_counter()
     deadline = None if time_limit_s is None else wall + time_limit_s
+    if getattr(walker, "actuators", None) is not None:  # the defaults of a powered walker
+        solver = POWERED_MAP_SOLVER if solver is MAP_SOLVER else solver
+        jacobian_solver = POWERED_MAP_SOLVER if jacobian_solver is MAP_SOLVER else jacobian_solver
+        coarse_solver = (POWERED_COARSE_SOLVER if coarse_solver is COARSE_SOLVER
+                         else coarse_solver)
     method = solver.method
     P = StepMap(walker, patch_spacing, solver, deadline=deadline)
     coarse = coarse_solver is not None and coarse_solver.rtol > solver.rtol

@@ -65,8 +65,10 @@ import time
 import numpy as np
 from scipy.optimize import brentq
 
-from walkerlab.integrate.ends import RunEnd
+from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
+from walkerlab.integrate.contact_powered import powered_to_section, run_powered
+from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
@@ -115,10 +117,13 @@ class StepMap:
     def __init__(self, walker: ContactWalker, patch_spacing: float | None = None,
                  solver: Solver = DEFAULT_SOLVER, t_max: float = 3.0,
                  deadline: float | None = None):
-        if getattr(walker, "actuators", None) is not None:
-            raise ValueError("the contact step map carries no actuators (a powered walker's "
-                             "stance leg and push-off pulse are states of its run): its "
-                             "contact periodic gait is not computed yet")
+        acts = getattr(walker, "actuators", None)
+        if acts is not None and any(r is not None for r in acts.laws.time_refs):
+            raise ValueError("walker.actuation: a torque law on time since the heel strike "
+                             "has no mid-stance step map (the time is not a state of the "
+                             "section): the contact periodic gait needs state-based laws")
+        #: a powered walker (actuators): its map runs on the powered contact integrator
+        self.powered = acts is not None
         if patch_spacing is None:
             if walker.lane1.size and walker.lane2.size:
                 patch_spacing = float(walker.lane1[0] - walker.lane2[0])
@@ -228,10 +233,12 @@ class StepMap:
         return run
 
     def next_section(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
-                     chunk_s: float = 0.25):
+                     chunk_s: float = 0.25, passive: bool = False):
         """(t_e [s], x_e (2 nq,)) of the next upward zero of theta_sw - theta_st from the
         full state ``x0`` (2 nq,) at t = 0, the new stance leg ``stance_to_come`` (0 = leg1);
-        for a grid method (``"cyrk_bdf"``, ``"odeint"``).
+        for a grid method (``"cyrk_bdf"``, ``"odeint"``), or a powered walker (through its
+        next heel strike, on the powered contact integrator; ``passive``: its actuators
+        left out, on CyRK's BDF at the map's tolerances).
 
         The walker on a ``dt`` grid in chunks (:func:`walkerlab.integrate.contact_grid.
         contact_grid`: CyRK's BDF over the compiled RHS, or scipy's odeint); the crossing is
@@ -241,9 +248,14 @@ class StepMap:
         """
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
         hth = 0.5 * self.walker.L
+        if self.powered and not passive:
+            return self._powered_section(x0, stance_to_come, ist, isw, hth)
+        solver = self.solver
+        if solver.method not in GRID_METHODS:
+            solver = dataclasses.replace(solver, method=GRID_METHODS[0])
 
         def run(x, tg):
-            X, end, message, _ = contact_grid(self.walker, x, tg, self.solver, self._data)
+            X, end, message, _ = contact_grid(self.walker, x, tg, solver, self._data)
             if end is RunEnd.SOLVER_FAILURE:
                 raise PeriodicGaitError("solver_failure", f"step map: {message}")
             return X
@@ -279,6 +291,27 @@ class StepMap:
         raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
                                 f"{self.t_max:g} s")
 
+    def _powered_section(self, x0, stance_to_come, ist, isw, hth):
+        """:meth:`next_section` of a powered walker: the heel strike, push-off and roles
+        swap on the powered contact integrator
+        (:func:`walkerlab.integrate.contact_powered.powered_to_section`)."""
+        self.nfev += 1
+        te, xe, end = powered_to_section(self.walker, np.asarray(x0, float),
+                                         1 - stance_to_come, lambda x: x[isw] - x[ist],
+                                         self.solver, self.t_max, self.deadline, hth)
+        if end is RunEnd.T_FINAL:
+            return float(te), xe
+        if end is RunEnd.FALL:
+            raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+        if end is RunEnd.TIME_LIMIT:
+            raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
+                                    "reached")
+        if end is RunEnd.SOLVER_FAILURE or end is RunEnd.TRIP:
+            raise PeriodicGaitError("solver_failure", f"step map: the powered run ended "
+                                    f"({end.value}) at t = {te:.4g} s")
+        raise PeriodicGaitError("no_mid_stance", f"step map: no heel strike and mid-stance "
+                                f"within {self.t_max:g} s")
+
     def __call__(self, z):
         """One step: returns (P(z) (n,), period [s], step length [m]).
 
@@ -288,7 +321,7 @@ class StepMap:
             The walker fell, did not reach the next mid-stance within ``t_max``, the solver
             failed or the wall-time limit ran out.
         """
-        if self.method in GRID_METHODS:
+        if self.method in GRID_METHODS or self.powered:
             te, xe = self.next_section(self.to_state(z))
             z1, s1 = self.to_section(xe, 0)
             return z1, te, s1
@@ -306,7 +339,12 @@ class StepMap:
     def patch_margin(self, z) -> float:
         """Smallest distance [m] of a loaded foot to its patch edge over one step from the
         section coordinates ``z`` (m,) (:attr:`names`); inf on continuous ground."""
-        if self.method in GRID_METHODS:
+        if self.powered:
+            x0 = self.to_state(z)
+            te = self.next_section(x0)[0]
+            X = run_powered(self.walker, x0, 0.0, te, self.solver,
+                            ContactLimits(sample_rate_hz=2000 / te), self.deadline, None)[1]
+        elif self.method in GRID_METHODS:
             x0 = self.to_state(z)
             te = self.next_section(x0)[0]
             tt = np.linspace(0.0, te, 2001)
@@ -403,9 +441,10 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
 
     w = step_map.walker
     x0 = initial_state_from_ideal(w, *np.asarray(x_ideal, float), rate_scale=rate_scale)
-    if step_map.method in GRID_METHODS:
+    if step_map.method in GRID_METHODS or step_map.powered:
         try:
-            xe = step_map.next_section(x0, stance_to_come=1)[1]
+            # from the post-impact state to the first mid-stance: no heel strike between
+            xe = step_map.next_section(x0, stance_to_come=1, passive=True)[1]
         except PeriodicGaitError as e:
             if e.kind == "time_limit":
                 raise

@@ -21,15 +21,16 @@ weight is held constant in the analytic Jacobian, so this check is for walkers w
 latch.
 
 This is a check, not the search's path: the augmented system ((2 nq)(2 nq + 1) states) runs
-through scipy's Radau with a Python right-hand side.
+through scipy's odeint (LSODA) with a Python right-hand side.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from walkerlab.analysis.contact.step_map import StepMap
+from walkerlab.integrate.events import odeint_grid
+from walkerlab.integrate.solver import Solver
 
 __all__ = ["variational_jacobian"]
 
@@ -55,7 +56,7 @@ def variational_jacobian(step_map: StepMap, z, rtol: float = 1e-10,
     z : array_like (m,)
         Section coordinates (``step_map.names``, units ``step_map.units``).
     rtol, atol : float
-        Radau's tolerances for the state and its sensitivity matrix.
+        odeint's tolerances for the state and its sensitivity matrix.
 
     Returns
     -------
@@ -77,9 +78,9 @@ def variational_jacobian(step_map: StepMap, z, rtol: float = 1e-10,
     def jac(t, y):  # the blocks of d/dy, the second derivative of f left out (Newton only)
         return np.kron(np.eye(n + 1), kern.jac(y[:n], *args))
 
-    sol = solve_ivp(rhs, (0.0, te), np.concatenate([x0, np.eye(n).ravel()]), method="Radau",
-                    jac=jac, rtol=rtol, atol=atol)
-    xe, phi = sol.y[:n, -1], sol.y[n:, -1].reshape(n, n)
+    y0 = np.concatenate([x0, np.eye(n).ravel()])
+    Y = odeint_grid(rhs, y0, np.array([0.0, te]), Solver("odeint", rtol, atol), jac=jac)[0]
+    xe, phi = Y[-1, :n], Y[-1, n:].reshape(n, n)
     grad = np.zeros(n)  # g = theta_swing(leg1) - theta_stance(leg2), proximal links
     grad[step_map.idx[w.leg_angle_states("leg1")[0]]] += 1.0
     grad[step_map.idx[w.leg_angle_states("leg2")[0]]] -= 1.0
