@@ -121,4 +121,4 @@ def test_refusals_are_one_line(tmp_path):
     with pytest.raises(ContactSceneError, match="pin_stance_until"):
         contact_setup(with_changes(base, {"contact_sim.pin_stance_until": "first_touchdown"}))
     with pytest.raises(ContactSceneError, match="contact_sim.start"):
-        contact_setup(with_changes(base, {"contact_sim.start": "periodic_gait"}))
+        contact_setup(with_changes(base, {"contact_sim.start": "adjusted"}))

@@ -34,7 +34,8 @@ from walkerlab.models.contact.actuation import WORK_NAMES, powered_rhs
 
 from .ends import RunEnd
 
-__all__ = ["IVP_METHODS", "STALL_CALLS", "impulse_jump", "powered_to_section", "run_powered"]
+__all__ = ["IVP_METHODS", "STALL_CALLS", "impulse_jump", "powered_to_section", "push_off",
+           "run_powered"]
 
 #: solve_ivp methods a powered run uses as given (others run as LSODA).
 IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
@@ -349,3 +350,54 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
                 return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
             t, y = float(sol.t[-1]), sol.y[:, -1].copy()
     return t, y[:n], RunEnd.NO_HEEL_STRIKE
+
+
+def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.inf,
+             fall_hip_height_m: float = 0.5):
+    """The push-off of a heel strike at ``(t, x)``: the pulse ``P / pulse_s`` along leg
+    ``trailing`` for ``pulse_s`` seconds on the powered contact integrator (the new stance
+    leg the other one), or with ``pulse_s = 0`` the impulse at once (:func:`impulse_jump`).
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        With ``actuators``.
+    x : ndarray, shape (2 nq,)
+        The state at the touchdown [m, rad, m/s, rad/s].
+    t : float
+        The touchdown's time [s].
+    trailing : int
+        The trailing leg (0: leg1, 1: leg2), the old stance leg.
+    solver : Solver
+        A :data:`IVP_METHODS` method (others run as ``LSODA``), ``rtol``, ``atol``.
+    deadline : float
+        ``time.perf_counter()`` value past which the run stops.
+    fall_hip_height_m : float
+        The fall height [m].
+
+    Returns
+    -------
+    (t_end, x_end, end) : (float, ndarray (2 nq,), RunEnd)
+        After the pulse (``T_FINAL``), or where a fall, the deadline or a solver failure
+        stopped it.
+    """
+    from .contact import ContactLimits
+
+    acts = walker.actuators
+    x = np.asarray(x, float)
+    P = acts.impulse(x)
+    if P <= 0.0:
+        return t, x, RunEnd.T_FINAL
+    if acts.pulse_s == 0.0:
+        return t, impulse_jump(walker, x, trailing, P)[0], RunEnd.T_FINAL
+    n, nw = 2 * walker.nq, len(WORK_NAMES)
+    run = _PoweredRun(walker, solver, ContactLimits(fall_hip_height_m=fall_hip_height_m),
+                      deadline, np.array([t, t + acts.pulse_s]))
+    run.stance, run.t_origin = 1 - trailing, t
+    sol = run._run(np.concatenate([x, np.zeros(nw)]), t, t + acts.pulse_s,
+                   (trailing, P / acts.pulse_s), [run.fall])
+    if sol is None:
+        return t, x, run.term
+    if sol.t_events[0].size:
+        return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
+    return float(sol.t[-1]), sol.y[:n, -1], RunEnd.T_FINAL

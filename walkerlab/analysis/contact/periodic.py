@@ -57,7 +57,8 @@ COARSE_SOLVER = Solver("cyrk_bdf", 1e-10, 1e-12)
 POWERED_MAP_SOLVER = Solver("LSODA", 1e-10, 1e-12)
 POWERED_COARSE_SOLVER = Solver("LSODA", 1e-8, 1e-10)
 
-__all__ = ["COARSE_SOLVER", "MAP_SOLVER", "POWERED_COARSE_SOLVER", "POWERED_MAP_SOLVER", "ContactPeriodicGait", "find_contact_periodic_gait",
+__all__ = ["COARSE_SOLVER", "MAP_SOLVER", "POWERED_COARSE_SOLVER", "POWERED_MAP_SOLVER",
+           "ContactPeriodicGait", "find_contact_periodic_gait",
            "ideal_gait", "simulate_from_periodic_gait"]
 
 
@@ -237,7 +238,8 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     """
     wall = time.perf_counter()
     deadline = None if time_limit_s is None else wall + time_limit_s
-    if getattr(walker, "actuators", None) is not None:  # the defaults of a powered walker
+    acts = getattr(walker, "actuators", None)
+    if acts is not None and acts.laws:  # hip torques: the whole map in Python, looser
         solver = POWERED_MAP_SOLVER if solver is MAP_SOLVER else solver
         jacobian_solver = POWERED_MAP_SOLVER if jacobian_solver is MAP_SOLVER else jacobian_solver
         coarse_solver = (POWERED_COARSE_SOLVER if coarse_solver is COARSE_SOLVER

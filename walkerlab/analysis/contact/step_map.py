@@ -67,7 +67,7 @@ from scipy.optimize import brentq
 
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
-from walkerlab.integrate.contact_powered import powered_to_section, run_powered
+from walkerlab.integrate.contact_powered import powered_to_section, push_off, run_powered
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
@@ -250,6 +250,15 @@ class StepMap:
         hth = 0.5 * self.walker.L
         if self.powered and not passive:
             return self._powered_section(x0, stance_to_come, ist, isw, hth)
+        return self._grid_crossing(x0, lambda X: X[:, isw] - X[:, ist], 0.0, dt, chunk_s,
+                                   hth, "no_mid_stance", "mid-stance")
+
+    def _grid_crossing(self, x0, gfun, t0: float, dt: float, chunk_s: float, hth: float,
+                       kind: str, what: str):
+        """(t_e, x_e) of the first upward zero of ``gfun`` (rows of states -> values) from
+        ``x0`` at ``t0`` on the passive flow, on the grid integrator (module doc of
+        :meth:`next_section`); a fall (hip below ``hth``) first raises ``fall``, no crossing
+        by ``t_max`` raises ``kind``."""
         solver = self.solver
         if solver.method not in GRID_METHODS:
             solver = dataclasses.replace(solver, method=GRID_METHODS[0])
@@ -260,7 +269,7 @@ class StepMap:
                 raise PeriodicGaitError("solver_failure", f"step map: {message}")
             return X
 
-        ta, xa = 0.0, np.asarray(x0, float)
+        ta, xa = t0, np.asarray(x0, float)
         self.nfev += 1
         while ta < self.t_max:
             if time.perf_counter() > self.deadline:
@@ -268,7 +277,7 @@ class StepMap:
                                         "reached")
             tg = ta + dt * np.arange(int(round(chunk_s / dt)) + 1)
             X = run(xa, tg)
-            g = X[:, isw] - X[:, ist]
+            g = gfun(X)
             hh = self.walker.hip_height(X)
             up = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0)) + 1
             down = np.flatnonzero(hh < hth)
@@ -281,24 +290,53 @@ class StepMap:
                 def gap(t, k=k, xk=xk, tg=tg, g=g):
                     if t <= tg[k - 1]:
                         return g[k - 1]
-                    x = run(xk, np.array([tg[k - 1], t]))[-1]
-                    return x[isw] - x[ist]
+                    return gfun(run(xk, np.array([tg[k - 1], t]))[-1:])[0]
 
                 te = brentq(gap, tg[k - 1], tg[k], xtol=1e-13, rtol=1e-14)
                 xe = run(xk, np.array([tg[k - 1], te]))[-1] if te > tg[k - 1] else xk
                 return float(te), xe
             ta, xa = tg[-1], X[-1]
-        raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
-                                f"{self.t_max:g} s")
+        raise PeriodicGaitError(kind, f"step map: no {what} within {self.t_max:g} s")
 
     def _powered_section(self, x0, stance_to_come, ist, isw, hth):
         """:meth:`next_section` of a powered walker: the heel strike, push-off and roles
-        swap on the powered contact integrator
+        swap.  Push-off alone: the passive flow (compiled, :meth:`_grid_crossing`) to the
+        touchdown of the swing foot on its patch ahead, the pulse on the powered contact
+        integrator (:func:`walkerlab.integrate.contact_powered.push_off`), the passive flow
+        to mid-stance; with hip torques the whole step on the powered contact integrator
         (:func:`walkerlab.integrate.contact_powered.powered_to_section`)."""
+        acts = self.walker.actuators
+        if not acts.laws:
+            return self._push_off_section(x0, stance_to_come, ist, isw, hth)
         self.nfev += 1
         te, xe, end = powered_to_section(self.walker, np.asarray(x0, float),
                                          1 - stance_to_come, lambda x: x[isw] - x[ist],
                                          self.solver, self.t_max, self.deadline, hth)
+        return self._powered_end(te, xe, end)
+
+    def _push_off_section(self, x0, stance_to_come, ist, isw, hth):
+        """:meth:`_powered_section` of a walker powered by push-off alone."""
+        w, acts = self.walker, self.walker.actuators
+        trailing = 1 - stance_to_come
+        sw, st = f"leg{stance_to_come + 1}", f"leg{trailing + 1}"
+
+        def touch(X):  # the swing foot's penetration on its patch ahead, else -1
+            fq = w.foot_quantities(X)
+            ok = (fq[sw]["on_ground"] > 0.5) & (fq[sw]["s"] - fq[st]["s"] >= acts.min_step_m)
+            return np.where(ok, fq[sw]["penetration"], -1.0)
+
+        t1, x1 = self._grid_crossing(x0, touch, 0.0, 2e-3, 0.25, hth, "no_mid_stance",
+                                     "heel strike")
+        t2, x2, end = push_off(w, x1, t1, trailing, self.solver, self.deadline, hth)
+        if end is not RunEnd.T_FINAL:
+            return self._powered_end(t2, x2, end)
+        self.nfev -= 1  # one map evaluation in three pieces
+        return self._grid_crossing(x2, lambda X: X[:, isw] - X[:, ist], t2, 2e-3, 0.25, hth,
+                                   "no_mid_stance", "mid-stance")
+
+    def _powered_end(self, te, xe, end):
+        """(t_e, x_e) of a powered section run that ended at the section, else the
+        :class:`PeriodicGaitError` its ``end`` (:class:`RunEnd`) means."""
         if end is RunEnd.T_FINAL:
             return float(te), xe
         if end is RunEnd.FALL:
