@@ -9,7 +9,8 @@ Eigenvalues of the n x n Jacobian of ``P`` (n = 6, kneed 10) at the fixed point,
 finite differences in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the
 coordinate scale (:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1
 mm/s, 1 mm/s; kneed: every angle 1 rad, every rate 1 rad/s), with the map integrated at rtol
-1e-12 / atol 1e-14.  Measured on the paper's contact: the map's noise (adaptive-step jitter)
+1e-12 / atol 1e-14 (CyRK's BDF over the compiled RHS; the step map's Jacobian from the
+variational equations agrees to ~1e-5 scaled, :mod:`walkerlab.analysis.contact.variational`).  Measured on the paper's contact: the map's noise (adaptive-step jitter)
 is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD noise is ~1e-10 / h ~ 1e-6,
 and the truncation error O(h^2) is ~1e-8; the multipliers agree to ~1e-5 between h = 1e-3,
 1e-4 and 1e-5 (``multiplier_fd_spread`` reports the change for h*3 and h/3).  The three
@@ -208,9 +209,12 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     check_fd : bool
         Also compute the multipliers with ``fd_step * 3`` and ``/ 3`` (``multiplier_fd_spread``).
     solver : walkerlab.integrate.solver.Solver
-        The map's integrator while root finding (:data:`MAP_SOLVER`: ``"odeint"``, scipy
-        odeint with the section crossing found by brentq, 3-10x faster than the
-        ``solve_ivp`` methods "LSODA", "Radau", "BDF", which locate it as an event).
+        The map's integrator while root finding (:data:`MAP_SOLVER`: ``"cyrk_bdf"``, CyRK's
+        BDF over the compiled right-hand side with the section crossing found by brentq;
+        ``"odeint"`` the same through scipy's odeint and a Python RHS, 30-80x slower;
+        the ``solve_ivp`` methods "LSODA", "Radau", "BDF" locate it as an event).  A
+        walker with hip torques defaults to :data:`POWERED_MAP_SOLVER` (its map is Python
+        throughout).
     jacobian_solver : walkerlab.integrate.solver.Solver
         The map's integrator for the final FD Jacobian (same method as ``solver``).
     coarse_solver : walkerlab.integrate.solver.Solver or None
@@ -220,7 +224,8 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         solve at ``solver.rtol`` starts from that fixed point with
         its Jacobian (a Newton direction accurate to the FD step, ~1e-3), so it needs only
         a few map evaluations at the tight tolerance.  Measured on the paper's contact
-        (odeint, median CPU per map): 31 ms at rtol 1e-10, 130 ms at 1e-11, 114 ms at 1e-12.
+        (odeint, median CPU per map): 31 ms at rtol 1e-10, 130 ms at 1e-11, 114 ms at 1e-12;
+        cyrk_bdf: ~3 ms at 1e-10, ~5 ms at 1e-12 (the whole search 0.4 s CPU).
     patch_spacing : float, optional
         Swing-patch distance ahead of the stance foot [m]; default the walker's lane spacing.
     time_limit_s : float, optional

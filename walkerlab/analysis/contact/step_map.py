@@ -26,15 +26,21 @@ dropped (the dynamics are invariant under translation along the slope, see *Terr
 Step map
 --------
 ``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 = stance,
-leg1 = swing: the legs are identical, so one orientation suffices), integrate with
-``solve_ivp`` (LSODA or Radau with the analytic numba Jacobian; through
-:func:`walkerlab.integrate.events.run_to_event`, or odeint on a grid with
-:func:`~walkerlab.integrate.events.odeint_grid`) until the next upward zero
-of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), located by
-``solve_ivp``'s event root-finding on the dense output; swap the leg roles and express the
-state relative to the new stance foot (leg1).  Outputs besides ``P(z)``: the step period
-``T`` [s] and the step length (along-slope displacement of the stance foot from one
-mid-stance to the next) [m].
+leg1 = swing: the legs are identical, so one orientation suffices), integrate until the next
+upward zero of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), swap the leg
+roles and express the state relative to the new stance foot (leg1).  The search's map runs
+on the compiled integrator (``"cyrk_bdf"``: CyRK's BDF over the generated right-hand side on
+a 2 ms grid, :func:`walkerlab.integrate.contact_grid.contact_grid`; no Python per RHS call),
+the crossing bracketed on the samples and located by brentq on short compiled runs from the
+sample before it; ``"odeint"`` does the same through scipy's odeint, a ``solve_ivp`` method
+locates it as an event (:func:`walkerlab.integrate.events.run_to_event`).  A powered walker
+(``actuators``: straight legs, point feet) passes its heel strike inside the step: the swing
+foot's touchdown on its patch ahead, the push-off pulse along the trailing leg on the powered
+contact integrator (:mod:`walkerlab.integrate.contact_powered`) and the roles swap; with
+push-off alone the flow between is passive and compiled, with hip torques the whole step
+runs on the powered integrator.  Outputs besides ``P(z)``: the step period ``T`` [s] and the
+step length (along-slope displacement of the stance foot from one mid-stance to the next)
+[m].
 
 Terrain (the choice made here, and why)
 ---------------------------------------
