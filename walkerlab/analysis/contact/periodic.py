@@ -10,7 +10,8 @@ finite differences in scaled coordinates: step ``h = fd_step`` (default 1e-4) ti
 coordinate scale (:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1
 mm/s, 1 mm/s; kneed: every angle 1 rad, every rate 1 rad/s), with the map integrated at rtol
 1e-12 / atol 1e-14 (CyRK's BDF over the compiled RHS; the step map's Jacobian from the
-variational equations agrees to ~1e-5 scaled, :mod:`walkerlab.analysis.contact.variational`).  Measured on the paper's contact: the map's noise (adaptive-step jitter)
+variational equations agrees to ~1e-5 scaled, :mod:`walkerlab.analysis.contact.variational`).
+Measured on the paper's contact: the map's noise (adaptive-step jitter)
 is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD noise is ~1e-10 / h ~ 1e-6,
 and the truncation error O(h^2) is ~1e-8; the multipliers agree to ~1e-5 between h = 1e-3,
 1e-4 and 1e-5 (``multiplier_fd_spread`` reports the change for h*3 and h/3).  The three
