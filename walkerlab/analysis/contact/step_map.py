@@ -113,9 +113,12 @@ class StepMap:
         Distance [m] ahead of the stance foot of the swing lane's patch (default: the
         walker's lane spacing ``lane1[0] - lane2[0]`` if it has lanes, else 0.372 m).
     solver : walkerlab.integrate.solver.Solver
-        The map's integrator: ``"odeint"`` (scipy's odeint on a grid, the crossing found
-        by brentq) or a ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``; the
-        crossing located as an event); ``atol`` well below the penetration ~6e-5 m.
+        The map's integrator: ``"cyrk_bdf"`` (CyRK's BDF over the compiled RHS on a grid,
+        the crossing found by brentq), ``"odeint"`` (the same through scipy's odeint) or a
+        ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``; the crossing located as
+        an event); ``atol`` well below the penetration ~6e-5 m.  A powered walker's pulse
+        (and, with hip torques, its whole step) runs on the powered contact integrator with
+        this method if it is a ``solve_ivp`` one, else LSODA.
     t_max : float
         Give up a step after this time [s].
     """
