@@ -122,6 +122,14 @@ def test_refusals_are_one_line(tmp_path):
         contact_setup(with_changes(base, {"contact_sim.pin_stance_until": "first_touchdown"}))
     with pytest.raises(ContactSceneError, match="contact_sim.start"):
         contact_setup(with_changes(base, {"contact_sim.start": "adjusted"}))
+    # the contact periodic gait needs state-based laws: time since the heel strike is not
+    # a state of the mid-stance section
+    law = {"stiffness_n_m_per_rad": 30.0, "damping_n_m_s_per_rad": 1.0,
+           "time_reference": {"time_s": [0.0, 0.3, 0.6], "hip_angle_rad": [-0.3, 0.0, 0.3]}}
+    timed = with_changes(base, {"walker.actuation.torques": [{"joint": "hip", "law": law}],
+                                "contact_sim.start": "periodic_gait"})
+    with pytest.raises(ContactSceneError, match="time since the heel strike"):
+        contact_setup(timed)
 
 
 @pytest.mark.slow  # ~10 s CPU: 40 step maps, each with a 5 ms pulse on solve_ivp
