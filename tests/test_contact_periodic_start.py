@@ -104,3 +104,24 @@ def test_contact_sim_reads_the_scene_once(tmp_path, monkeypatch):
     r = CliRunner().invoke(app, ["contact-sim", str(path), "--runs-dir", str(tmp_path / "r")])
     assert r.exit_code == 0, r.stderr
     assert len(calls) == 1
+
+
+def test_a_start_whose_periodic_gait_is_not_found_says_why_in_one_line(monkeypatch):
+    """``start: periodic_gait`` whose search fails (here: its wall-time limit, as on a
+    loaded machine) re-raises the search's error with its kind and the field named; it was
+    re-raised with the message in place of the kind (a TypeError: an internal error)."""
+    from types import SimpleNamespace
+
+    from walkerlab.analysis.contact import periodic
+    from walkerlab.analysis.contact.record import contact_sim_run
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+    from walkerlab.models.contact.scene import contact_setup
+
+    def fails(setup, x, strides=None, solver=None):
+        raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit reached")
+
+    monkeypatch.setattr(periodic, "simulate_from_periodic_gait", fails)
+    setup = contact_setup(load_scene("configs/torso_bhm.yaml"))
+    with pytest.raises(PeriodicGaitError, match="contact_sim.start: periodic_gait") as e:
+        contact_sim_run(setup, SimpleNamespace(x=np.zeros(4)))
+    assert e.value.kind == "time_limit" and "wall-time limit" in str(e.value)

@@ -272,19 +272,16 @@ def test_target_command_prints_the_value_or_one_line():
     assert "error: target: no gait with speed = 3" in r.output
 
 
-def test_the_contact_periodic_gait_and_export_refuse_actuators_in_one_line(tmp_path):
-    """Not silently passive: the contact model's periodic gait (its step map) does not
-    carry actuators, nor does the URDF/MJCF export carry an ankle push-off; both say so."""
+def test_the_export_refuses_an_ankle_push_off_in_one_line(tmp_path):
+    """Not silently passive: the URDF/MJCF export does not carry an ankle push-off and says
+    so (the contact periodic gait of a powered walker is computed:
+    tests/contact/test_powered_contact.py)."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
 
     cases = []
-    d = load_scene(CONFIGS / "paper.yaml").model_dump(mode="json", exclude_none=True)
-    d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 1.0}}
-    d["name"] = "powered_paper"
-    cases.append((d, ["contact-sim"], "contact periodic gait of a powered walker"))
     f = load_scene(CONFIGS / "flat_feet.yaml").model_dump(mode="json", exclude_none=True)
     f["walker"]["actuation"] = {"ankle_push_off": {"constant_n_m": 5.0}}
     f["name"] = "ankle_flat"

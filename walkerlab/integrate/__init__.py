@@ -8,7 +8,9 @@ CyRK, CyRK over a numba-compiled flow: :mod:`walkerlab.integrate._compiled`; CyR
 without numba by :mod:`walkerlab.integrate.cyrk_loader`), guards located as events;
 :mod:`walkerlab.integrate.contact` integrates the compliant-contact walker (odeint, CyRK's
 BDF over a compiled RHS, numbalsoda, solve_ivp; trips, falls and flights located on the
-Hermite interpolant); :mod:`walkerlab.integrate.ends` names how a run ends
+Hermite interpolant); :mod:`walkerlab.integrate.contact_grid` runs it on a time grid
+(CyRK's BDF over the compiled RHS: the contact step map's flow);
+:mod:`walkerlab.integrate.ends` names how a run ends
 (:class:`RunEnd`), for the rigid and the contact model alike.  Importing this package loads
 nothing heavy.
 """

@@ -34,7 +34,8 @@ from walkerlab.models.contact.actuation import WORK_NAMES, powered_rhs
 
 from .ends import RunEnd
 
-__all__ = ["IVP_METHODS", "STALL_CALLS", "impulse_jump", "run_powered"]
+__all__ = ["IVP_METHODS", "STALL_CALLS", "impulse_jump", "powered_to_section", "push_off",
+           "run_powered"]
 
 #: solve_ivp methods a powered run uses as given (others run as LSODA).
 IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
@@ -276,3 +277,127 @@ class _PoweredRun:
         if t > self.ts[-1][-1] + 1e-12 if len(self.ts[-1]) else True:
             self.ts.append(np.array([t]))
             self.Ys.append(y[None])
+
+
+def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
+                       deadline: float = np.inf, fall_hip_height_m: float = 0.5):
+    """Integrate a powered walker from ``x0`` (leg ``stance`` in stance) through the next heel
+    strike (touchdown of the other leg ahead, the roles swap, the push-off pulse or impulse
+    at the old stance foot) to the next upward zero of ``section(x)``: the powered
+    contact step map's flow (:mod:`walkerlab.analysis.contact.step_map`).
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        With ``actuators``.
+    x0 : ndarray, shape (2 nq,)
+        State at t = 0 [m, rad, m/s, rad/s].
+    stance : int
+        The stance leg at the start (0: leg1, 1: leg2); time-based torque laws count from
+        t = 0.
+    section : callable
+        ``section(x) -> float``, searched only after the heel strike (upward zero).
+    solver : Solver
+        A :data:`IVP_METHODS` method (others run as ``LSODA``), ``rtol``, ``atol``.
+    t_max : float
+        Give up after this time [s].
+    deadline : float
+        ``time.perf_counter()`` value past which the run stops.
+    fall_hip_height_m : float
+        The fall height [m].
+
+    Returns
+    -------
+    (t_e, x_e, end) : (float, ndarray (2 nq,), RunEnd)
+        ``end`` ``T_FINAL`` at the section; ``FALL``, ``TIME_LIMIT``, ``SOLVER_FAILURE``
+        (``t_e``, ``x_e`` then where the run stopped), or ``NO_HEEL_STRIKE`` when neither a
+        heel strike and the section came within ``t_max``.
+    """
+    from .contact import ContactLimits
+
+    limits = ContactLimits(fall_hip_height_m=fall_hip_height_m)
+    run = _PoweredRun(walker, solver, limits, deadline, np.array([0.0, t_max]))
+    run.stance, run.t_origin = stance, 0.0
+    n, nw = 2 * walker.nq, len(WORK_NAMES)
+    acts = walker.actuators
+
+    def cross(t, y):
+        return section(y[:n])
+
+    cross.terminal, cross.direction = True, 1.0
+    y, t, struck = np.concatenate([np.asarray(x0, float), np.zeros(nw)]), 0.0, False
+    while t < t_max - 1e-12:
+        sol = run._run(y, t, t_max, None, [run.fall, cross if struck else run.touch])
+        if sol is None:
+            return t, y[:n], run.term
+        if sol.t_events[0].size:
+            return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
+        if not sol.t_events[1].size:
+            return float(sol.t[-1]), sol.y[:n, -1], RunEnd.NO_HEEL_STRIKE
+        t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+        if struck:
+            return t, y[:n], RunEnd.T_FINAL
+        struck, trailing = True, run.stance
+        run.stance, run.t_origin = 1 - trailing, t  # heel strike: the roles swap
+        P = acts.impulse(y[:n])
+        if P > 0.0 and acts.pulse_s == 0.0:
+            y[:n] = impulse_jump(walker, y[:n], trailing, P)[0]
+        elif P > 0.0:
+            sol = run._run(y, t, t + acts.pulse_s, (trailing, P / acts.pulse_s), [run.fall])
+            if sol is None:
+                return t, y[:n], run.term
+            if sol.t_events[0].size:
+                return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
+            t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+    return t, y[:n], RunEnd.NO_HEEL_STRIKE
+
+
+def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.inf,
+             fall_hip_height_m: float = 0.5):
+    """The push-off of a heel strike at ``(t, x)``: the pulse ``P / pulse_s`` along leg
+    ``trailing`` for ``pulse_s`` seconds on the powered contact integrator (the new stance
+    leg the other one), or with ``pulse_s = 0`` the impulse at once (:func:`impulse_jump`).
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        With ``actuators``.
+    x : ndarray, shape (2 nq,)
+        The state at the touchdown [m, rad, m/s, rad/s].
+    t : float
+        The touchdown's time [s].
+    trailing : int
+        The trailing leg (0: leg1, 1: leg2), the old stance leg.
+    solver : Solver
+        A :data:`IVP_METHODS` method (others run as ``LSODA``), ``rtol``, ``atol``.
+    deadline : float
+        ``time.perf_counter()`` value past which the run stops.
+    fall_hip_height_m : float
+        The fall height [m].
+
+    Returns
+    -------
+    (t_end, x_end, end) : (float, ndarray (2 nq,), RunEnd)
+        After the pulse (``T_FINAL``), or where a fall, the deadline or a solver failure
+        stopped it.
+    """
+    from .contact import ContactLimits
+
+    acts = walker.actuators
+    x = np.asarray(x, float)
+    P = acts.impulse(x)
+    if P <= 0.0:
+        return t, x, RunEnd.T_FINAL
+    if acts.pulse_s == 0.0:
+        return t, impulse_jump(walker, x, trailing, P)[0], RunEnd.T_FINAL
+    n, nw = 2 * walker.nq, len(WORK_NAMES)
+    run = _PoweredRun(walker, solver, ContactLimits(fall_hip_height_m=fall_hip_height_m),
+                      deadline, np.array([t, t + acts.pulse_s]))
+    run.stance, run.t_origin = 1 - trailing, t
+    sol = run._run(np.concatenate([x, np.zeros(nw)]), t, t + acts.pulse_s,
+                   (trailing, P / acts.pulse_s), [run.fall])
+    if sol is None:
+        return t, x, run.term
+    if sol.t_events[0].size:
+        return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
+    return float(sol.t[-1]), sol.y[:n, -1], RunEnd.T_FINAL

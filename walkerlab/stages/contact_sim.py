@@ -19,7 +19,7 @@ from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.contact_sim import run_end, write_contact_sim
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-from walkerlab.models.contact.scene import ContactSceneError, ContactSetup, contact_setup
+from walkerlab.models.contact.scene import ContactSetup, contact_setup
 from walkerlab.stages.common import (
     StageError,
     StageOutcome,
@@ -56,10 +56,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """
     setup = contact_setup(scene)  # the scene read once: all the run needs, typed
     periodic = periodic or setup.sim.periodic_gait
-    if periodic and setup.actuators is not None:
-        raise ContactSceneError(f"scene '{scene.name}': the contact periodic gait of a powered "
-                                "walker is not computed yet (contact_sim.periodic_gait, "
-                                "--periodic): leave it out")
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())
     out = run_cached("contact-sim", scene, runs_root, sections, up,

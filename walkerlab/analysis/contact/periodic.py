@@ -9,7 +9,9 @@ Eigenvalues of the n x n Jacobian of ``P`` (n = 6, kneed 10) at the fixed point,
 finite differences in scaled coordinates: step ``h = fd_step`` (default 1e-4) times the
 coordinate scale (:data:`SCALES`: 1 rad, 1 rad/s, 1 rad/s, static penetration ~6e-5 m, 1
 mm/s, 1 mm/s; kneed: every angle 1 rad, every rate 1 rad/s), with the map integrated at rtol
-1e-12 / atol 1e-14.  Measured on the paper's contact: the map's noise (adaptive-step jitter)
+1e-12 / atol 1e-14 (CyRK's BDF over the compiled RHS; the step map's Jacobian from the
+variational equations agrees to ~1e-5 scaled, :mod:`walkerlab.analysis.contact.variational`).
+Measured on the paper's contact: the map's noise (adaptive-step jitter)
 is ~1e-9 (scaled) at rtol 1e-11 and ~1e-10 at 1e-12, so the FD noise is ~1e-10 / h ~ 1e-6,
 and the truncation error O(h^2) is ~1e-8; the multipliers agree to ~1e-5 between h = 1e-3,
 1e-4 and 1e-5 (``multiplier_fd_spread`` reports the change for h*3 and h/3).  The three
@@ -40,17 +42,25 @@ from walkerlab.analysis.contact.step_map import (
     StepMap,
     section_guess_from_ideal,
 )
+from walkerlab.integrate.contact_grid import GRID_METHODS
 from walkerlab.integrate.solver import Solver
 from walkerlab.io.schemas.continuation import initial_state
 from walkerlab.models.contact.model import ContactWalker
 from walkerlab.numerics import fd_jacobian, sort_multipliers
 
-#: the step map's integrator while root finding and for the final Jacobian (odeint)
-MAP_SOLVER = Solver("odeint", 1e-12, 1e-14)
+#: the step map's integrator while root finding and for the final Jacobian (CyRK's BDF over
+#: the compiled right-hand side, :func:`walkerlab.integrate.contact_grid.contact_grid`)
+MAP_SOLVER = Solver("cyrk_bdf", 1e-12, 1e-14)
 #: the cheap map of the two-fidelity search
-COARSE_SOLVER = Solver("odeint", 1e-10, 1e-12)
+COARSE_SOLVER = Solver("cyrk_bdf", 1e-10, 1e-12)
 
-__all__ = ["COARSE_SOLVER", "MAP_SOLVER", "ContactPeriodicGait", "find_contact_periodic_gait",
+#: a powered walker's map (the powered contact integrator, solve_ivp with a Python
+#: right-hand side: looser than the passive map's) and its cheap map
+POWERED_MAP_SOLVER = Solver("LSODA", 1e-10, 1e-12)
+POWERED_COARSE_SOLVER = Solver("LSODA", 1e-8, 1e-10)
+
+__all__ = ["COARSE_SOLVER", "MAP_SOLVER", "POWERED_COARSE_SOLVER", "POWERED_MAP_SOLVER",
+           "ContactPeriodicGait", "find_contact_periodic_gait",
            "ideal_gait", "simulate_from_periodic_gait"]
 
 
@@ -200,9 +210,12 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     check_fd : bool
         Also compute the multipliers with ``fd_step * 3`` and ``/ 3`` (``multiplier_fd_spread``).
     solver : walkerlab.integrate.solver.Solver
-        The map's integrator while root finding (:data:`MAP_SOLVER`: ``"odeint"``, scipy
-        odeint with the section crossing found by brentq, 3-10x faster than the
-        ``solve_ivp`` methods "LSODA", "Radau", "BDF", which locate it as an event).
+        The map's integrator while root finding (:data:`MAP_SOLVER`: ``"cyrk_bdf"``, CyRK's
+        BDF over the compiled right-hand side with the section crossing found by brentq;
+        ``"odeint"`` the same through scipy's odeint and a Python RHS, 30-80x slower;
+        the ``solve_ivp`` methods "LSODA", "Radau", "BDF" locate it as an event).  A
+        walker with hip torques defaults to :data:`POWERED_MAP_SOLVER` (its map is Python
+        throughout).
     jacobian_solver : walkerlab.integrate.solver.Solver
         The map's integrator for the final FD Jacobian (same method as ``solver``).
     coarse_solver : walkerlab.integrate.solver.Solver or None
@@ -212,7 +225,8 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         solve at ``solver.rtol`` starts from that fixed point with
         its Jacobian (a Newton direction accurate to the FD step, ~1e-3), so it needs only
         a few map evaluations at the tight tolerance.  Measured on the paper's contact
-        (odeint, median CPU per map): 31 ms at rtol 1e-10, 130 ms at 1e-11, 114 ms at 1e-12.
+        (odeint, median CPU per map): 31 ms at rtol 1e-10, 130 ms at 1e-11, 114 ms at 1e-12;
+        cyrk_bdf: ~3 ms at 1e-10, ~5 ms at 1e-12 (the whole search 0.4 s CPU).
     patch_spacing : float, optional
         Swing-patch distance ahead of the stance foot [m]; default the walker's lane spacing.
     time_limit_s : float, optional
@@ -230,6 +244,12 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     """
     wall = time.perf_counter()
     deadline = None if time_limit_s is None else wall + time_limit_s
+    acts = getattr(walker, "actuators", None)
+    if acts is not None and acts.laws:  # hip torques: the whole map in Python, looser
+        solver = POWERED_MAP_SOLVER if solver is MAP_SOLVER else solver
+        jacobian_solver = POWERED_MAP_SOLVER if jacobian_solver is MAP_SOLVER else jacobian_solver
+        coarse_solver = (POWERED_COARSE_SOLVER if coarse_solver is COARSE_SOLVER
+                         else coarse_solver)
     method = solver.method
     P = StepMap(walker, patch_spacing, solver, deadline=deadline)
     coarse = coarse_solver is not None and coarse_solver.rtol > solver.rtol
@@ -237,7 +257,8 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     PC = StepMap(walker, patch_spacing, dataclasses.replace(coarse_solver, method=method),
                  deadline=deadline) if coarse else P
     z, hist = _warm_up_guess(walker, P, PC, guess, rate_scale, warmup_steps)
-    sol, root_nfev = _solve_fixed_point(P, PC, coarse, z, method, fd_step, xtol, coarse_xtol)
+    sol, root_nfev = _solve_fixed_point(P, PC, coarse, z, method, fd_step, xtol, coarse_xtol,
+                                        residual_tol)
     return _periodic_gait_result(
         walker, P, PC, coarse, sol, root_nfev, hist, solver=solver,
         coarse_solver=coarse_solver, jacobian_solver=jacobian_solver,
@@ -278,23 +299,27 @@ def _scaled_residual(M: StepMap, scale: np.ndarray):
 
 def _scaled_residual_jacobian(M: StepMap, scale: np.ndarray, fd_step: float, method: str):
     """dG/du of :func:`_scaled_residual` by finite differences of step ``10 * fd_step`` times
-    ``scale`` (forward differences when ``method`` is odeint, central otherwise), the root
-    finder's Jacobian; memoised on its last argument, its last value kept as ``.last``."""
+    ``scale`` (forward differences when ``method`` is a grid method, ``"cyrk_bdf"`` or
+    ``"odeint"``, central otherwise), the root finder's Jacobian; memoised on its last
+    argument, its last value kept as ``.last``."""
     return _last_call_memo(
         lambda u: fd_jacobian(lambda v: M(v)[0], u * scale, 10 * fd_step * scale,
-                              central=method != "odeint")
+                              central=method not in GRID_METHODS)
         * scale[None, :] / scale[:, None] - np.eye(len(scale)))
 
 
 def _solve_fixed_point(P: StepMap, PC: StepMap, coarse: bool, z: np.ndarray, method: str,
-                       fd_step: float, xtol: float, coarse_xtol: float):
+                       fd_step: float, xtol: float, coarse_xtol: float,
+                       residual_tol: float = np.inf):
     """The two-fidelity root solve of :func:`find_contact_periodic_gait` from the warmed-up
     state ``z``: with ``coarse``, a hybr solve on the cheap map ``PC`` to ``coarse_xtol``
     whose last Jacobian then steers every step of the tight solve on ``P`` (a Newton step
     lands at the tight map's noise floor with no Jacobian at the tight tolerance); without
-    it, one hybr solve on ``P`` with its own FD Jacobians.  Returns the tight solve's
-    ``OptimizeResult`` (``x`` in scaled coordinates) and the function evaluations of both
-    (``method``: the maps' integrator, which picks the FD Jacobians' differences)."""
+    it, one hybr solve on ``P`` with its own FD Jacobians; then, while the scaled residual
+    is above ``residual_tol``, up to three Newton steps with the last Jacobian.  Returns
+    the tight solve's ``OptimizeResult`` (``x`` in scaled coordinates) and the function
+    evaluations of both (``method``: the maps' integrator, which picks the FD Jacobians'
+    differences)."""
     scale = P.scale
     root_nfev = 0
     jac = _scaled_residual_jacobian(P, scale, fd_step, method)
@@ -310,9 +335,20 @@ def _solve_fixed_point(P: StepMap, PC: StepMap, coarse: bool, z: np.ndarray, met
         Jc = dGc.last
         jac = lambda u: Jc  # noqa: E731
 
-    sol = root(_scaled_residual(P, scale), z / scale, jac=jac, method="hybr",
-               options={"xtol": xtol})
+    G = _scaled_residual(P, scale)
+    sol = root(G, z / scale, jac=jac, method="hybr", options={"xtol": xtol})
     root_nfev += sol.nfev
+    # hybr's step test (xtol) may stop above the residual asked for: up to three Newton
+    # steps with the same Jacobian, each kept only if it lowers the residual
+    for _ in range(3):
+        r = G(sol.x)
+        if np.max(np.abs(r)) < residual_tol:
+            break
+        u = sol.x - np.linalg.solve(jac(sol.x), r)
+        root_nfev += 1
+        if np.max(np.abs(G(u))) >= np.max(np.abs(r)):
+            break
+        sol.x = u
     return sol, root_nfev
 
 

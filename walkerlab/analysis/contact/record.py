@@ -115,7 +115,8 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
             walker, res, x0, step_length, gait = simulate_from_periodic_gait(
                 setup, fp.x)
         except PeriodicGaitError as exc:
-            raise PeriodicGaitError(f"scene '{setup.name}': contact_sim.start: periodic_gait: "
+            raise PeriodicGaitError(exc.kind, f"scene '{setup.name}': contact_sim.start: "
+                                    "periodic_gait: "
                                     f"the contact walker's periodic gait was not found ({exc})"
                                     ) from None
         scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates

@@ -26,15 +26,21 @@ dropped (the dynamics are invariant under translation along the slope, see *Terr
 Step map
 --------
 ``P(z)``: build the full state with the stance foot at along-slope ``s = 0`` (leg2 = stance,
-leg1 = swing: the legs are identical, so one orientation suffices), integrate with
-``solve_ivp`` (LSODA or Radau with the analytic numba Jacobian; through
-:func:`walkerlab.integrate.events.run_to_event`, or odeint on a grid with
-:func:`~walkerlab.integrate.events.odeint_grid`) until the next upward zero
-of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), located by
-``solve_ivp``'s event root-finding on the dense output; swap the leg roles and express the
-state relative to the new stance foot (leg1).  Outputs besides ``P(z)``: the step period
-``T`` [s] and the step length (along-slope displacement of the stance foot from one
-mid-stance to the next) [m].
+leg1 = swing: the legs are identical, so one orientation suffices), integrate until the next
+upward zero of ``theta2 - theta1`` (proximal links; mid-stance of the other leg), swap the leg
+roles and express the state relative to the new stance foot (leg1).  The search's map runs
+on the compiled integrator (``"cyrk_bdf"``: CyRK's BDF over the generated right-hand side on
+a 2 ms grid, :func:`walkerlab.integrate.contact_grid.contact_grid`; no Python per RHS call),
+the crossing bracketed on the samples and located by brentq on short compiled runs from the
+sample before it; ``"odeint"`` does the same through scipy's odeint, a ``solve_ivp`` method
+locates it as an event (:func:`walkerlab.integrate.events.run_to_event`).  A powered walker
+(``actuators``: straight legs, point feet) passes its heel strike inside the step: the swing
+foot's touchdown on its patch ahead, the push-off pulse along the trailing leg on the powered
+contact integrator (:mod:`walkerlab.integrate.contact_powered`) and the roles swap; with
+push-off alone the flow between is passive and compiled, with hip torques the whole step
+runs on the powered integrator.  Outputs besides ``P(z)``: the step period ``T`` [s] and the
+step length (along-slope displacement of the stance foot from one mid-stance to the next)
+[m].
 
 Terrain (the choice made here, and why)
 ---------------------------------------
@@ -65,8 +71,11 @@ import time
 import numpy as np
 from scipy.optimize import brentq
 
+from walkerlab.integrate.contact import ContactLimits
+from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
+from walkerlab.integrate.contact_powered import powered_to_section, push_off, run_powered
 from walkerlab.integrate.ends import RunEnd
-from walkerlab.integrate.events import Event, EventRun, odeint_grid, run_to_event
+from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
 from walkerlab.walker.layout import StateIndex
@@ -104,9 +113,12 @@ class StepMap:
         Distance [m] ahead of the stance foot of the swing lane's patch (default: the
         walker's lane spacing ``lane1[0] - lane2[0]`` if it has lanes, else 0.372 m).
     solver : walkerlab.integrate.solver.Solver
-        The map's integrator: ``"odeint"`` (scipy's odeint on a grid, the crossing found
-        by brentq) or a ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``; the
-        crossing located as an event); ``atol`` well below the penetration ~6e-5 m.
+        The map's integrator: ``"cyrk_bdf"`` (CyRK's BDF over the compiled RHS on a grid,
+        the crossing found by brentq), ``"odeint"`` (the same through scipy's odeint) or a
+        ``solve_ivp`` method (``"LSODA"``, ``"Radau"``, ``"BDF"``; the crossing located as
+        an event); ``atol`` well below the penetration ~6e-5 m.  A powered walker's pulse
+        (and, with hip torques, its whole step) runs on the powered contact integrator with
+        this method if it is a ``solve_ivp`` one, else LSODA.
     t_max : float
         Give up a step after this time [s].
     """
@@ -114,10 +126,13 @@ class StepMap:
     def __init__(self, walker: ContactWalker, patch_spacing: float | None = None,
                  solver: Solver = DEFAULT_SOLVER, t_max: float = 3.0,
                  deadline: float | None = None):
-        if getattr(walker, "actuators", None) is not None:
-            raise ValueError("the contact step map carries no actuators (a powered walker's "
-                             "stance leg and push-off pulse are states of its run): its "
-                             "contact periodic gait is not computed yet")
+        acts = getattr(walker, "actuators", None)
+        if acts is not None and any(r is not None for r in acts.laws.time_refs):
+            raise ValueError("walker.actuation: a torque law on time since the heel strike "
+                             "has no mid-stance step map (the time is not a state of the "
+                             "section): the contact periodic gait needs state-based laws")
+        #: a powered walker (actuators): its map runs on the powered contact integrator
+        self.powered = acts is not None
         if patch_spacing is None:
             if walker.lane1.size and walker.lane2.size:
                 patch_spacing = float(walker.lane1[0] - walker.lane2[0])
@@ -140,6 +155,7 @@ class StepMap:
         args = (w.contact_params, w.walker_params, *w.kernel_lanes)
         self._f = lambda x: kern.rhs(x, *args)  # noqa: E731
         self._fj = lambda x: kern.jac(x, *args)  # noqa: E731
+        self._data = w.pack() if solver.method != "odeint" else None  # compiled RHS data
         self.n, self.t = w.normal, w.tangent
         self.idx = StateIndex(w)
         # every column by name (leg1 = 0, leg2 = 1), never by row: each leg's link angles,
@@ -225,32 +241,44 @@ class StepMap:
         self.nfev += 1
         return run
 
-    def _step_odeint(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
-                     chunk_s: float = 0.25):
-        """``solver.method == "odeint"``: (t_e, x_e) of the next upward zero of theta_sw - theta_st.
+    def next_section(self, x0, stance_to_come: int = 0, dt: float = 2e-3,
+                     chunk_s: float = 0.25, passive: bool = False):
+        """(t_e [s], x_e (2 nq,)) of the next upward zero of theta_sw - theta_st from the
+        full state ``x0`` (2 nq,) at t = 0, the new stance leg ``stance_to_come`` (0 = leg1);
+        for a grid method (``"cyrk_bdf"``, ``"odeint"``), or a powered walker (through its
+        next heel strike, on the powered contact integrator; ``passive``: its actuators
+        left out, on CyRK's BDF at the map's tolerances).
 
-        scipy's odeint (LSODA without per-step Python overhead) on a ``dt`` grid in chunks;
-        the crossing is bracketed on the samples and located by ``scipy.optimize.brentq``
-        on short odeint integrations from the sample before it, so the section state
-        carries the integrator's accuracy, not an interpolant's.
+        The walker on a ``dt`` grid in chunks (:func:`walkerlab.integrate.contact_grid.
+        contact_grid`: CyRK's BDF over the compiled RHS, or scipy's odeint); the crossing is
+        bracketed on the samples and located by ``scipy.optimize.brentq`` on short
+        integrations from the sample before it, so the section state carries the
+        integrator's accuracy, not an interpolant's.
         """
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
         hth = 0.5 * self.walker.L
-        frhs, fjac = self._f, self._fj
+        if self.powered and not passive:
+            return self._powered_section(x0, stance_to_come, ist, isw, hth)
+        return self._grid_crossing(x0, lambda X: X[:, isw] - X[:, ist], 0.0, dt, chunk_s,
+                                   hth, "no_mid_stance", "mid-stance")
 
-        def f(t, x):
-            return frhs(x)
-
-        def jf(t, x):
-            return fjac(x)
+    def _grid_crossing(self, x0, gfun, t0: float, dt: float, chunk_s: float, hth: float,
+                       kind: str, what: str):
+        """(t_e, x_e) of the first upward zero of ``gfun`` (rows of states -> values) from
+        ``x0`` at ``t0`` on the passive flow, on the grid integrator (module doc of
+        :meth:`next_section`); a fall (hip below ``hth``) first raises ``fall``, no crossing
+        by ``t_max`` raises ``kind``."""
+        solver = self.solver
+        if solver.method not in GRID_METHODS:
+            solver = dataclasses.replace(solver, method=GRID_METHODS[0])
 
         def run(x, tg):
-            X, end, message = odeint_grid(f, x, tg, self.solver, jac=jf)
+            X, end, message, _ = contact_grid(self.walker, x, tg, solver, self._data)
             if end is RunEnd.SOLVER_FAILURE:
                 raise PeriodicGaitError("solver_failure", f"step map: {message}")
             return X
 
-        ta, xa = 0.0, np.asarray(x0, float)
+        ta, xa = t0, np.asarray(x0, float)
         self.nfev += 1
         while ta < self.t_max:
             if time.perf_counter() > self.deadline:
@@ -258,7 +286,7 @@ class StepMap:
                                         "reached")
             tg = ta + dt * np.arange(int(round(chunk_s / dt)) + 1)
             X = run(xa, tg)
-            g = X[:, isw] - X[:, ist]
+            g = gfun(X)
             hh = self.walker.hip_height(X)
             up = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0)) + 1
             down = np.flatnonzero(hh < hth)
@@ -271,15 +299,65 @@ class StepMap:
                 def gap(t, k=k, xk=xk, tg=tg, g=g):
                     if t <= tg[k - 1]:
                         return g[k - 1]
-                    x = run(xk, np.array([tg[k - 1], t]))[-1]
-                    return x[isw] - x[ist]
+                    return gfun(run(xk, np.array([tg[k - 1], t]))[-1:])[0]
 
                 te = brentq(gap, tg[k - 1], tg[k], xtol=1e-13, rtol=1e-14)
                 xe = run(xk, np.array([tg[k - 1], te]))[-1] if te > tg[k - 1] else xk
                 return float(te), xe
             ta, xa = tg[-1], X[-1]
-        raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
-                                f"{self.t_max:g} s")
+        raise PeriodicGaitError(kind, f"step map: no {what} within {self.t_max:g} s")
+
+    def _powered_section(self, x0, stance_to_come, ist, isw, hth):
+        """:meth:`next_section` of a powered walker: the heel strike, push-off and roles
+        swap.  Push-off alone: the passive flow (compiled, :meth:`_grid_crossing`) to the
+        touchdown of the swing foot on its patch ahead, the pulse on the powered contact
+        integrator (:func:`walkerlab.integrate.contact_powered.push_off`), the passive flow
+        to mid-stance; with hip torques the whole step on the powered contact integrator
+        (:func:`walkerlab.integrate.contact_powered.powered_to_section`)."""
+        acts = self.walker.actuators
+        if not acts.laws:
+            return self._push_off_section(x0, stance_to_come, ist, isw, hth)
+        self.nfev += 1
+        te, xe, end = powered_to_section(self.walker, np.asarray(x0, float),
+                                         1 - stance_to_come, lambda x: x[isw] - x[ist],
+                                         self.solver, self.t_max, self.deadline, hth)
+        return self._powered_end(te, xe, end)
+
+    def _push_off_section(self, x0, stance_to_come, ist, isw, hth):
+        """:meth:`_powered_section` of a walker powered by push-off alone."""
+        w, acts = self.walker, self.walker.actuators
+        trailing = 1 - stance_to_come
+        sw, st = f"leg{stance_to_come + 1}", f"leg{trailing + 1}"
+
+        def touch(X):  # the swing foot's penetration on its patch ahead, else -1
+            fq = w.foot_quantities(X)
+            ok = (fq[sw]["on_ground"] > 0.5) & (fq[sw]["s"] - fq[st]["s"] >= acts.min_step_m)
+            return np.where(ok, fq[sw]["penetration"], -1.0)
+
+        t1, x1 = self._grid_crossing(x0, touch, 0.0, 2e-3, 0.25, hth, "no_mid_stance",
+                                     "heel strike")
+        t2, x2, end = push_off(w, x1, t1, trailing, self.solver, self.deadline, hth)
+        if end is not RunEnd.T_FINAL:
+            return self._powered_end(t2, x2, end)
+        self.nfev -= 1  # one map evaluation in three pieces
+        return self._grid_crossing(x2, lambda X: X[:, isw] - X[:, ist], t2, 2e-3, 0.25, hth,
+                                   "no_mid_stance", "mid-stance")
+
+    def _powered_end(self, te, xe, end):
+        """(t_e, x_e) of a powered section run that ended at the section, else the
+        :class:`PeriodicGaitError` its ``end`` (:class:`RunEnd`) means."""
+        if end is RunEnd.T_FINAL:
+            return float(te), xe
+        if end is RunEnd.FALL:
+            raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+        if end is RunEnd.TIME_LIMIT:
+            raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
+                                    "reached")
+        if end is RunEnd.SOLVER_FAILURE or end is RunEnd.TRIP:
+            raise PeriodicGaitError("solver_failure", f"step map: the powered run ended "
+                                    f"({end.value}) at t = {te:.4g} s")
+        raise PeriodicGaitError("no_mid_stance", f"step map: no heel strike and mid-stance "
+                                f"within {self.t_max:g} s")
 
     def __call__(self, z):
         """One step: returns (P(z) (n,), period [s], step length [m]).
@@ -290,8 +368,8 @@ class StepMap:
             The walker fell, did not reach the next mid-stance within ``t_max``, the solver
             failed or the wall-time limit ran out.
         """
-        if self.method == "odeint":
-            te, xe = self._step_odeint(self.to_state(z))
+        if self.method in GRID_METHODS or self.powered:
+            te, xe = self.next_section(self.to_state(z))
             z1, s1 = self.to_section(xe, 0)
             return z1, te, s1
         run = self.integrate(self.to_state(z))
@@ -308,12 +386,16 @@ class StepMap:
     def patch_margin(self, z) -> float:
         """Smallest distance [m] of a loaded foot to its patch edge over one step from the
         section coordinates ``z`` (m,) (:attr:`names`); inf on continuous ground."""
-        if self.method == "odeint":
+        if self.powered:
             x0 = self.to_state(z)
-            te = self._step_odeint(x0)[0]
+            te = self.next_section(x0)[0]
+            X = run_powered(self.walker, x0, 0.0, te, self.solver,
+                            ContactLimits(sample_rate_hz=2000 / te), self.deadline, None)[1]
+        elif self.method in GRID_METHODS:
+            x0 = self.to_state(z)
+            te = self.next_section(x0)[0]
             tt = np.linspace(0.0, te, 2001)
-            X = odeint_grid(lambda t, x: self._f(x), x0, tt, self.solver,
-                            jac=lambda t, x: self._fj(x))[0]
+            X = contact_grid(self.walker, x0, tt, self.solver, self._data)[0]
         else:
             run = self.integrate(self.to_state(z), dense=True)
             te = run.t_event if run.event == "mid_stance" else run.t[-1]
@@ -406,6 +488,17 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
 
     w = step_map.walker
     x0 = initial_state_from_ideal(w, *np.asarray(x_ideal, float), rate_scale=rate_scale)
+    if step_map.method in GRID_METHODS or step_map.powered:
+        try:
+            # from the post-impact state to the first mid-stance: no heel strike between
+            xe = step_map.next_section(x0, stance_to_come=1, passive=True)[1]
+        except PeriodicGaitError as e:
+            if e.kind == "time_limit":
+                raise
+            raise PeriodicGaitError("fall" if e.kind == "fall" else "no_mid_stance",
+                                    "the ideal state does not reach mid-stance on the "
+                                    "contact model") from None
+        return step_map.to_section(xe, 1)[0]
     run = step_map.integrate(x0, stance_to_come=1)
     if run.event != "mid_stance":
         raise PeriodicGaitError("fall" if run.end is RunEnd.FALL else "no_mid_stance",

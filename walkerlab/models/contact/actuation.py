@@ -69,6 +69,8 @@ class ContactActuators:
         self.nq = len(names)
         self.pulse_s = float(pulse_s)
         self.leg = (names.index("leg1_angle"), names.index("leg2_angle"))
+        #: the hip's position columns (the floating base: the hip point itself)
+        self.hip = (names.index("hip_x"), names.index("hip_y"))
         self.laws = TorqueLaws(spec.torques)
 
     def hip_angles(self, x, stance: int):
@@ -102,8 +104,9 @@ class ContactActuators:
         n = self.nq
         nf = len(walker.contact_names())
         P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
-        walker.kernels.feet(np.asarray(x, float), walker.walker_params, P, V, J)
-        r = np.asarray(walker.points(x)["hip"], float).ravel() - P[trailing]
+        x = np.asarray(x, float)
+        walker.kernels.feet(x, walker.walker_params, P, V, J)
+        r = x[list(self.hip)] - P[trailing]  # the hip is the floating base's point
         return r / np.sqrt(r @ r), J[trailing], V[trailing]
 
     def push_off_force(self, walker, x, trailing: int, force: float):

@@ -188,10 +188,16 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings) -> ContactActuators |
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
                                 "pinned start phase carries no actuators: leave it 'none'")
-    if cs.start != "ideal":
+    if cs.start not in ("ideal", "periodic_gait"):
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: {cs.start}: a "
                                 "powered walker's contact run starts from the rigid gait "
-                                "(start: ideal) today")
+                                "(start: ideal) or its own periodic gait (periodic_gait)")
+    if cs.start == "periodic_gait" or cs.periodic_gait:
+        tr = [t.law.time_reference for t in getattr(spec, "torques", None) or ()]
+        if any(r is not None for r in tr):
+            raise ContactSceneError(f"scene '{scene.name}': walker.actuation: a torque law on "
+                                    "time since the heel strike has no contact periodic gait "
+                                    "(contact_sim.start / periodic_gait): use a phase law")
     return ContactActuators(spec, coordinate_names(st), scene.contact.push_off_pulse_s())
 
 
