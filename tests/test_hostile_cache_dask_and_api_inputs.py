@@ -150,6 +150,7 @@ def _fifo_all(folder: Path, suffixes=None) -> int:
     return n
 
 
+@pytest.mark.slow  # compiles the kernels into a fresh cache (~9 s CPU)
 def test_h2_fifos_in_the_user_cache_do_not_hang_fixedpoint(tmp_path):
     cache = tmp_path / "cache"
     env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(cache), TMPDIR=str(tmp_path / "tmp"))
@@ -201,6 +202,7 @@ def _package_pycache() -> set[Path]:
         {p for p in (ROOT / "walkerlab").rglob("*.nbc")}
 
 
+@pytest.mark.slow  # each case compiles the kernels into a fresh cache (~10 s CPU)
 @pytest.mark.parametrize("how", ["group_writable", "symlink", "not_creatable", "read_only"])
 def test_m2_unusable_numba_cache_never_writes_into_the_package(tmp_path, how):
     if how == "read_only" and os.geteuid() == 0:
