@@ -160,15 +160,3 @@ def test_passive_structures_keep_their_keys():
         assert "free_knees" not in key and "hinged_torso" not in key
         dumped = sc.model_dump(mode="json")
         assert "angle_rad" not in str(dumped.get("walker", {}).get("actuation", ""))
-
-
-def test_contact_view_and_export_refuse_in_one_line():
-    """The floating (contact) view would eliminate the torso as a bisecting one: refused,
-    as the export's multibody tree is."""
-    from walkerlab.codegen.floating import derive_floating
-    from walkerlab.walker.multibody import multibody
-
-    data = walker_data(scene_from_dict(SCENE).walker, 0.05)
-    for build in (multibody, lambda d: derive_floating(d.structure)):
-        with pytest.raises(ValueError, match=r"^walker\.leg\.knee\.lock: .*five-link[^\n]*$"):
-            build(data)

@@ -1,0 +1,194 @@
+"""``walkerlab export`` of a five-link biped (free knees, hinged torso): URDF in Pinocchio and
+MJCF in MuJoCo against walkerlab's floating view and the independent derivation
+(tests/independent/five_link.py) at random states; the motors on the actuated joints; and
+RABBIT (configs/rabbit.yaml) walking in MuJoCo from its gait keyframe under its own
+controller (slow)."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from tests.independent import five_link as ref
+from tests.test_five_link import SCENE, P
+from walkerlab.config import load_scene, scene_from_dict
+from walkerlab.codegen.floating import floating_view
+from walkerlab.stages import export as export_stage
+from walkerlab.walker.description import walker_data
+
+ROOT = Path(__file__).resolve().parents[1]
+#: joint of the export -> its row over walkerlab's floating coordinates (hip_x, hip_y,
+#: leg1_thigh, leg1_shank, leg2_thigh, leg2_shank, torso): q_joint = row . q
+JOINT_ROWS = {"hip_x": [1, 0, 0, 0, 0, 0, 0], "hip_z": [0, 1, 0, 0, 0, 0, 0],
+              "leg1_hip": [0, 0, 1, 0, 0, 0, 0], "leg1_knee": [0, 0, -1, 1, 0, 0, 0],
+              "leg2_hip": [0, 0, 0, 0, 1, 0, 0], "leg2_knee": [0, 0, 0, 0, -1, 1, 0],
+              "torso_hip": [0, 0, 0, 0, 0, 0, 1]}
+TOL = 1e-10
+
+
+def _states(seed, n=5):
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        q = np.concatenate([rng.uniform(-2, 2, 2), rng.uniform(-1, 1, 5)])
+        yield q, rng.uniform(-3, 3, 7)
+
+
+def _actuated_scene():
+    cfg = copy.deepcopy(SCENE)
+    cfg["name"] = "five_link"
+    cfg["walker"]["actuation"] = yaml.safe_load((ROOT / "configs" / "rabbit.yaml").read_text(
+        ))["walker"]["actuation"]
+    return scene_from_dict(cfg)
+
+
+def _known_gait(x, period_s):
+    """A stand-in for the rigid gait search (:func:`walkerlab.analysis.contact.periodic.
+    ideal_gait`), returning the post-impact state ``x`` (role order) and its period."""
+    from types import SimpleNamespace
+
+    return lambda scene: SimpleNamespace(x=np.asarray(x, float), period_s=period_s)
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    """The actuated test biped (hip mass, slope 0.05, RABBIT's laws) exported; its keyframe
+    from a stand-in gait (any state: the files' dynamics do not depend on it)."""
+    tmp = tmp_path_factory.mktemp("export")
+    scene = _actuated_scene().model_copy(update={"fixedpoint": load_scene(
+        ROOT / "configs" / "rabbit.yaml").fixedpoint})
+    x = scene.fixedpoint.initial_guess.as_array(tuple(
+        f"{r}_{k}" for k in ("angle", "rate") for r in ("stance_shank", "stance_thigh",
+                                                          "swing_thigh", "swing_shank", "torso")))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr("walkerlab.analysis.contact.periodic.ideal_gait", _known_gait(x, 0.4))
+        return (scene, export_stage.run(scene, tmp, "urdf"), export_stage.run(scene, tmp, "mjcf"))
+
+
+def _pinocchio(path, g):
+    pin = pytest.importorskip("pinocchio")
+    model = pin.buildModelFromUrdf(str(path))
+    model.gravity.linear = np.array([0.0, 0.0, -g])
+    data = model.createData()
+    assert set(model.names[1:]) == set(JOINT_ROWS)
+    T = np.zeros((model.nv, 7))
+    joints = []
+    for name, row in JOINT_ROWS.items():
+        jm = model.joints[model.getJointId(name)]
+        T[jm.idx_v] = row
+        joints.append((jm.idx_q, jm.nq, np.asarray(row, float)))
+
+    def f(q, dq):
+        ql = np.zeros(model.nq)
+        for iq, nq, row in joints:
+            a = row @ q
+            ql[iq:iq + nq] = (np.cos(a), np.sin(a)) if nq == 2 else (a,)
+        M = pin.crba(model, data, ql)
+        M = np.triu(M) + np.triu(M, 1).T
+        b = pin.rnea(model, data, ql, T @ dq, np.zeros(model.nv))
+        return T.T @ M @ T, T.T @ b
+
+    return f
+
+
+def _mujoco(path):
+    mujoco = pytest.importorskip("mujoco")
+    model = mujoco.MjModel.from_xml_path(str(path))
+    data = mujoco.MjData(model)
+    assert {model.joint(i).name for i in range(model.njnt)} == set(JOINT_ROWS)
+    T, Tq = np.zeros((model.nv, 7)), np.zeros((model.nq, 7))
+    for name, row in JOINT_ROWS.items():
+        jt = model.joint(name)
+        T[jt.dofadr[0]], Tq[jt.qposadr[0]] = row, row
+
+    def f(q, dq):
+        data.qpos[:], data.qvel[:] = Tq @ q, T @ dq
+        mujoco.mj_forward(model, data)
+        M = np.zeros((model.nv, model.nv))
+        try:
+            mujoco.mj_fullM(model, data, M)
+        except TypeError:
+            mujoco.mj_fullM(model, M, data.qM)
+        return T.T @ M @ T, T.T @ data.qfrc_bias
+
+    return f, model
+
+
+def test_urdf_and_mjcf_dynamics_are_the_floating_views(exported):
+    """Pinocchio (CRBA, RNEA) on the URDF and MuJoCo (qM, qfrc_bias) on the MJCF give
+    walkerlab's floating mass matrix and bias (the contact model's mechanics) at random
+    states, to 1e-10 of the largest entry (MuJoCo: plus its 1e-12 kg m^2 inertia floor)."""
+    scene, urdf, mjcf = exported
+    view = floating_view(walker_data(scene.walker, scene.slope.phi_rad))
+    assert view.coordinate_names()[-1] == "torso_angle"
+    libs = {"pinocchio": _pinocchio(urdf, 9.81), "mujoco": _mujoco(mjcf)[0]}
+    for lib, f in libs.items():
+        for q, dq in _states(17):
+            M, b = f(q, dq)
+            Mr, br = view.mass_matrix(q), view.bias(q, dq)
+            assert np.abs(M - Mr).max() <= TOL * np.abs(Mr).max() + 4e-12, lib
+            assert np.abs(b - br).max() <= TOL * np.abs(br).max(), lib
+
+
+def test_urdf_mass_matrix_is_the_independent_one(exported):
+    """The URDF in Pinocchio against the independent derivation (no walkerlab code): its
+    mass matrix, carried to the independent extended coordinates ``(th, h1, h2, k1, k2,
+    x_f, y_f)`` (leg2 the stance leg), is the independent ``De``."""
+    scene, urdf, _ = exported
+    f = _pinocchio(urdf, 9.81)
+    lt, ls = P["lt"], P["ls"]
+    A = np.array([[1, 0, 1, 0, 0], [1, 0, 1, 0, 1], [1, 1, 0, 0, 0], [1, 1, 0, 1, 0],
+                  [1, 0, 0, 0, 0]], float)  # (leg1_thigh, leg1_shank, leg2_..., torso)
+    rng = np.random.default_rng(4)
+    for _ in range(5):
+        r = np.array([0.1, 0.3, -0.2, -0.3, -0.5]) + rng.normal(0, 0.3, 5)
+        a = A @ r
+        hip = -ls * np.array([np.sin(a[3]), -np.cos(a[3])]) - lt * np.array(
+            [np.sin(a[2]), -np.cos(a[2])])
+        dhip = np.zeros((2, 5))
+        dhip[:, 3] = -ls * np.array([np.cos(a[3]), np.sin(a[3])])
+        dhip[:, 2] = -lt * np.array([np.cos(a[2]), np.sin(a[2])])
+        Jf = np.zeros((7, 7))
+        Jf[:2, :5], Jf[:2, 5:], Jf[2:, :5] = dhip @ A, np.eye(2), A
+        M, _ = f(np.concatenate([hip, a]), np.zeros(7))
+        De = np.asarray(ref._model()[2](list(r), [0.0] * 5, [P[k] for k in ref.PARAMS]),
+                        float)
+        np.testing.assert_allclose(Jf.T @ M @ Jf, De, rtol=0, atol=TOL * np.abs(De).max())
+
+
+def test_motors_on_the_actuated_joints(exported):
+    """Four motors on the physical joints (both legs' hips against the torso, both knees), no
+    knee limits (free knees), no coupling of the torso; a motor's control acts on the joint
+    as the law's torque (MuJoCo's actuator force mapped to walkerlab's coordinates is +u on
+    the thigh, -u on the torso; +u on the shank, -u on the thigh)."""
+    mujoco = pytest.importorskip("mujoco")
+    scene, urdf, mjcf = exported
+    text = Path(mjcf).read_text()
+    for leg in ("leg1", "leg2"):
+        assert f'<motor name="{leg}_hip_motor" tendon="{leg}_hip_torso" gear="1"/>' in text
+        assert f'<motor name="{leg}_knee_motor" joint="{leg}_knee" gear="1"/>' in text
+    assert "range=" not in text and "<equality>" not in text
+    assert 'name="hip_actuation"' not in text
+    assert "Motor leg1_hip_motor" in Path(urdf).read_text()
+    assert 'type="revolute"' not in Path(urdf).read_text()  # free knees: continuous
+    f, model = _mujoco(mjcf)
+    data = mujoco.MjData(model)
+    T = np.zeros((model.nv, 7))
+    for name, row in JOINT_ROWS.items():
+        T[model.joint(name).dofadr[0]] = row
+    coords = ("hip_x", "hip_y", "leg1_thigh", "leg1_shank", "leg2_thigh", "leg2_shank",
+              "torso")
+    want = {"leg1_hip_motor": ("leg1_thigh", "torso"), "leg2_knee_motor": ("leg2_shank",
+                                                                           "leg2_thigh")}
+    for motor, (plus, minus) in want.items():
+        data.ctrl[:] = 0.0
+        data.ctrl[model.actuator(motor).id] = 7.0
+        mujoco.mj_forward(model, data)
+        Q = T.T @ data.qfrc_actuator
+        expect = np.zeros(7)
+        expect[coords.index(plus)], expect[coords.index(minus)] = 7.0, -7.0
+        np.testing.assert_allclose(Q, expect, atol=1e-12)
