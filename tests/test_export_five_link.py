@@ -16,8 +16,8 @@ import yaml
 
 from tests.independent import five_link as ref
 from tests.test_five_link import SCENE, P
-from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.codegen.floating import floating_view
+from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
 

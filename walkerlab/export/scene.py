@@ -43,7 +43,8 @@ from walkerlab.export.mjcf_scene import (
 )
 from walkerlab.models.contact.laws import ContactParamsSI
 
-__all__ = ["EXPORT_STEPS", "actuation_json", "check_exportable", "joint_state", "mjcf_scene", "mujoco_contact"]
+__all__ = ["EXPORT_STEPS", "actuation_json", "check_exportable", "joint_state", "mjcf_scene",
+           "mujoco_contact"]
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40

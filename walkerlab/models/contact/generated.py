@@ -592,8 +592,9 @@ def rhs_source(eq) -> str:
 
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
-    constants ``NP``, ``KNEE`` (knee stops: kneed legs whose knees are not free), ``NF``, ``POINT_LEG``, ``PIN``, ``CONTACTS``, then
-    :data:`ASSEMBLY` and the straight-line ``rhs``).
+    constants ``NP``, ``KNEE`` (knee stops: kneed legs whose knees are not free), ``NF``,
+    ``POINT_LEG``, ``PIN``, ``CONTACTS``, then :data:`ASSEMBLY` and the straight-line
+    ``rhs``).
 
     Raises
     ------

@@ -170,9 +170,10 @@ class ContactWalker:
         A flat foot's regularising mass [kg] (at the ankle) and inertia about the ankle
         [kg m^2] (``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``);
         required for flat feet, ignored otherwise.
-    actuators : ContactActuators, optional
+    actuators : ContactActuators or JointTorqueActuators, optional
         The walker's actuators (:mod:`walkerlab.models.contact.actuation`): hip torques and
-        the push-off pulse; a walker with them runs on
+        the push-off pulse; a free-jointed (five-link) biped's joint torques
+        (:mod:`walkerlab.models.contact.joint_torques`); a walker with them runs on
         :mod:`walkerlab.integrate.contact_powered` (its stance leg is a discrete state).
 
     Raises
