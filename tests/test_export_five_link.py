@@ -21,6 +21,10 @@ from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.stages import export as export_stage
 from walkerlab.walker.description import walker_data
 
+#: every test here shares the independent sympy model (tests/independent/five_link.py, ~8 s
+#: of CPU to build): one worker builds it once
+pytestmark = pytest.mark.xdist_group("five_link_reference")
+
 ROOT = Path(__file__).resolve().parents[1]
 #: joint of the export -> its row over walkerlab's floating coordinates (hip_x, hip_y,
 #: leg1_thigh, leg1_shank, leg2_thigh, leg2_shank, torso): q_joint = row . q
@@ -210,12 +214,13 @@ def test_adams_export_refuses_a_five_link_biped_in_one_line(tmp_path):
     assert not list(tmp_path.rglob("walker.adm")) and not list(tmp_path.rglob("walker.acf"))
 
 
-@pytest.mark.slow  # ~45-90 s: 5 s of MuJoCo with the PD laws evaluated in Python every step
+@pytest.mark.slow  # 40-90 s: 4.3 s of MuJoCo (20000 steps of 0.22 ms), the PD laws evaluated
+#                   in Python at every step
 def test_rabbit_walks_in_mujoco_with_its_controller(tmp_path, monkeypatch):
     """configs/rabbit.yaml exported to MJCF (its keyframe the rigid fixed point: the scene's
     initial guess, the fixed point to 1e-8, tests/test_rabbit.py; the gait search itself is
     the export's, left out here for time) walks in MuJoCo from the ``gait`` keyframe under
-    JointTorqueLoop: >= 10 alternating heel strikes in 5 s, mean step period within 1 % of
+    JointTorqueLoop: 11 alternating heel strikes in 4.3 s, mean step period within 1 % of
     the rigid 0.37093 s (measured 0.3716 s, +0.2 %), steps 0.3385-0.3388 m against the rigid
     0.33847 m."""
     from walkerlab.export.mujoco_walk import walk
@@ -226,7 +231,7 @@ def test_rabbit_walks_in_mujoco_with_its_controller(tmp_path, monkeypatch):
     monkeypatch.setattr("walkerlab.analysis.contact.periodic.ideal_gait",
                         _known_gait(x, 0.37093))
     path = export_stage.run(scene, tmp_path, "mjcf")
-    run = walk(path, 5.0)
+    run = walk(path, 4.3)  # 11 heel strikes (the first at 0.37 s)
     assert not run.fell
     assert len(run.times_s) >= 11 and run.alternating, run.legs
     assert run.legs[0] == "leg1"

@@ -15,6 +15,10 @@ from walkerlab.config.loader import SceneError
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
 
+#: every test here shares the independent sympy model (tests/independent/five_link.py, ~8 s
+#: of CPU to build): one worker builds it once
+pytestmark = pytest.mark.xdist_group("five_link_reference")
+
 # RABBIT-like numbers (Westervelt et al. 2003, Table I) with a hip mass and a slope added so
 # that every term of the generator is exercised
 LT, LS, CT, CS = 0.4, 0.4, 0.11, 0.24
