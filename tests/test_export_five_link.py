@@ -241,3 +241,34 @@ def test_rabbit_walks_in_mujoco_with_its_controller(tmp_path, monkeypatch):
     note = json.loads((Path(side).parent / export_stage.SIDECAR).read_text())
     assert [t["joint"] for t in note["actuation"]["torques"]] == [
         "stance_hip", "swing_hip", "stance_knee", "swing_knee"]
+
+
+def test_gait_keyframe_is_the_rigid_state(exported):
+    """The ``gait`` keyframe of the MJCF and the URDF's sidecar: leg2's foot (stance) at the
+    origin, ``torso_hip`` the rigid torso angle, ``leg<i>_hip`` the absolute thigh angles,
+    ``leg<i>_knee`` shank - thigh, rates likewise (leg1 swinging)."""
+    mujoco = pytest.importorskip("mujoco")
+    scene, urdf, mjcf = exported
+    names = tuple(f"{r}_{k}" for k in ("angle", "rate") for r in (
+        "stance_shank", "stance_thigh", "swing_thigh", "swing_shank", "torso"))
+    x = dict(zip(names, scene.fixedpoint.initial_guess.as_array(names)))
+    m = mujoco.MjModel.from_xml_path(str(mjcf))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, m.key("gait").id)
+    mujoco.mj_forward(m, d)
+    np.testing.assert_allclose(d.site("leg2_foot").xpos, [0, 0, 0], atol=1e-12)
+    for k, kind in (("angle", d.qpos), ("rate", d.qvel)):
+        adr = "qposadr" if k == "angle" else "dofadr"
+
+        def at(j, kind=kind, adr=adr):
+            return kind[getattr(m.joint(j), adr)[0]]
+
+        assert at("torso_hip") == pytest.approx(x[f"torso_{k}"], abs=1e-12)
+        assert at("leg1_hip") == pytest.approx(x[f"swing_thigh_{k}"], abs=1e-12)
+        assert at("leg2_knee") == pytest.approx(x[f"stance_shank_{k}"]
+                                                - x[f"stance_thigh_{k}"], abs=1e-12)
+    side = json.loads((Path(urdf).parent / export_stage.SIDECAR).read_text())
+    assert side["joints"] == ["hip_x", "hip_z", "leg1_hip", "leg1_knee", "leg2_hip",
+                              "leg2_knee", "torso_hip"]
+    np.testing.assert_array_equal(side["qpos"], d.qpos)
+    assert "five-link" in side["actuation_note"]
