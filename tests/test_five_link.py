@@ -15,6 +15,10 @@ from walkerlab.config.loader import SceneError
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
 
+#: every test here shares the independent sympy model (tests/independent/five_link.py, ~8 s
+#: of CPU to build): one worker builds it once
+pytestmark = pytest.mark.xdist_group("five_link_reference")
+
 # RABBIT-like numbers (Westervelt et al. 2003, Table I) with a hip mass and a slope added so
 # that every term of the generator is exercised
 LT, LS, CT, CS = 0.4, 0.4, 0.11, 0.24
@@ -160,15 +164,3 @@ def test_passive_structures_keep_their_keys():
         assert "free_knees" not in key and "hinged_torso" not in key
         dumped = sc.model_dump(mode="json")
         assert "angle_rad" not in str(dumped.get("walker", {}).get("actuation", ""))
-
-
-def test_contact_view_and_export_refuse_in_one_line():
-    """The floating (contact) view would eliminate the torso as a bisecting one: refused,
-    as the export's multibody tree is."""
-    from walkerlab.codegen.floating import derive_floating
-    from walkerlab.walker.multibody import multibody
-
-    data = walker_data(scene_from_dict(SCENE).walker, 0.05)
-    for build in (multibody, lambda d: derive_floating(d.structure)):
-        with pytest.raises(ValueError, match=r"^walker\.leg\.knee\.lock: .*five-link[^\n]*$"):
-            build(data)

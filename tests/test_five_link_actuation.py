@@ -16,6 +16,10 @@ from walkerlab.config import scene_from_dict
 from walkerlab.models.actuation import TorqueLaws
 from walkerlab.models.registry import build_walker
 
+#: every test here shares the independent sympy model (tests/independent/five_link.py, ~8 s
+#: of CPU to build): one worker builds it once
+pytestmark = pytest.mark.xdist_group("five_link_reference")
+
 JOINTS = ("stance_hip", "swing_hip", "stance_knee", "swing_knee")
 CONSTANT = {"stance_hip": 7.0, "swing_hip": -3.0, "stance_knee": 11.0, "swing_knee": -5.0}
 

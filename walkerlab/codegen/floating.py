@@ -11,7 +11,12 @@ normal ``n = (sin phi, cos phi)`` and down-slope tangent ``t = (cos phi, -sin ph
 Generalised coordinates ``q = [hip_x, hip_y, angles of leg1's links, angles of leg2's links]``
 [m, m, rad...]: a straight leg has one link (``leg{i}_angle``), a kneed leg a thigh then a
 shank (``leg{i}_thigh_angle``, ``leg{i}_shank_angle``); each angle is absolute, from the
-vertical, positive when the foot is ahead of the hip.  A point at distance ``d`` along a link
+vertical, positive when the foot is ahead of the hip.  A torso hinged at the hip (the
+five-link biped of Westervelt, Grizzle & Koditschek 2003: free knees, ``torso.coupling:
+hinged``) adds its own coordinate ``torso_angle`` last (from the upward vertical, positive
+leaning back, as the rigid view's); its free knees have no stop (as in the rigid view,
+:mod:`walkerlab.codegen.five_link`); a bisecting torso is eliminated (its angle the mean of
+the legs').  A point at distance ``d`` along a link
 at angle ``psi`` from the link's proximal joint is at ``joint + d (sin psi, -cos psi)``.
 
 Equations
@@ -95,6 +100,8 @@ def coordinate_names(structure: Structure) -> tuple[str, ...]:
         ang = tuple(f"{leg}_angle" for leg in LEGS)
     if structure.foot == "flat":  # the feet's absolute angles after the legs'
         ang += tuple(f"{leg}_foot_angle" for leg in LEGS)
+    if structure.hinged_torso:  # its own coordinate, last (a five-link biped)
+        ang += ("torso_angle",)
     return ("hip_x", "hip_y") + ang
 
 
@@ -167,8 +174,9 @@ class FloatingEquations:
         kneed ``<leg>_knee``, flat feet ``<leg>_ankle`` (= ``<leg>_foot``),
         ``<leg>_heel``, ``<leg>_toe``.
     knees : tuple of (int, int)
-        Per leg with a knee, the indices in ``q`` of its thigh and shank angles (by
-        their names); empty for straight legs.
+        Per leg with a knee stop, the indices in ``q`` of its thigh and shank angles (by
+        their names); empty for straight legs and for free knees (``knee.lock: free``: no
+        stop, as in the rigid view, :mod:`walkerlab.codegen.five_link`).
     contacts : tuple of str
         Names of the contact points, in the order of ``feet`` (:func:`contact_names`).
     point_legs : tuple of int
@@ -197,11 +205,12 @@ def derive_floating(structure: Structure) -> FloatingEquations:
     ------
     ValueError
         Massless bodies (:func:`check_masses`), a foot kind other than point / arc /
-        flat, or free knees (a five-link biped: rigid model only).
+        flat, or free knees on feet other than points, legs that differ or with springs
+        (:func:`walkerlab.walker.description.check_floating_view`).
     """
     import sympy as sp
 
-    check_floating_view(structure)  # a hinged torso is not the bisecting one derived below
+    check_floating_view(structure)
     check_masses(structure)
     if structure.foot not in ("point", "arc", "flat"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
@@ -280,9 +289,12 @@ def derive_floating(structure: Structure) -> FloatingEquations:
 
     # the upper body on the bisecting hip mechanism: eliminated as in the rigid view (its
     # angle from the upward vertical is the mean of the leg angles; both legs are free here,
-    # the mechanism couples them); a point d up its axis at hip - d e(t)
+    # the mechanism couples them); a hinged torso (five-link biped): its own coordinate
+    # ``torso_angle``; a point d up its axis at hip - d e(t)
     hip_links = (q[2], q[4]) if knee else (q[2], q[3])  # leg1's and leg2's links at the hip
     psi_t = (hip_links[0] + hip_links[1]) / 2 if structure.torso else None
+    if structure.hinged_torso:
+        psi_t = q[names.index("torso_angle")]
     for b in structure.torso:
         lin = {psi_t: -P[f"d_torso_{b.name}"]}
         if b.off_axis:
@@ -347,7 +359,7 @@ def derive_floating(structure: Structure) -> FloatingEquations:
                              feet=tuple(feet), kinetic=T, potential=V, points=points,
                              knees=tuple((names.index(f"{leg}_thigh_angle"),
                                           names.index(f"{leg}_shank_angle"))
-                                         for leg in LEGS if knee),
+                                         for leg in LEGS if knee and not structure.free_knees),
                              contacts=contact_names(structure),
                              point_legs=tuple(int(c[3]) - 1 for c in contact_names(structure)))
 

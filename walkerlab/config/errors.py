@@ -155,12 +155,12 @@ WALKER_VOCABULARY = (
     "a walker today is planar: model compass_gait (hip mass, one point mass per "
     "leg) or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "
     "length_m, bodies (point_mass or rod, on or off the leg axis), an optional locking knee "
-    "(with an optional spring-damper) or free knees (knee.lock: free, rigid model), foot "
+    "(with an optional spring-damper) or free knees (knee.lock: free), foot "
     "kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "
     "dampers between links at the hip; torso: an upper body on a bisecting hip mechanism, or "
     "hinged at the hip with free knees (a five-link biped); actuation: a push-off impulse and "
-    "hip torques on straight, point-footed legs (rigid and contact models), hip and knee "
-    "torques on a five-link biped and an ankle push-off on flat feet (rigid model)); no knee "
+    "hip torques on straight, point-footed legs and hip and knee torques on a five-link "
+    "biped (rigid and contact models), an ankle push-off on flat feet (rigid model)); no knee "
     "or torso actuators outside the five-link biped yet")
 
 

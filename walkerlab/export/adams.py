@@ -115,11 +115,17 @@ def check_adams_exportable(mb) -> None:
     Raises
     ------
     ValueError
-        Arc or flat feet, an upper body (its bisecting-hip coupling is not written).
+        Arc or flat feet, free knees (a five-link biped: its controller has no dataset
+        form), an upper body (its bisecting-hip coupling is not written).
     """
     if mb.foot != "point" and not (mb.foot == "arc" and mb.foot_radius_m == 0):  # R = 0
         raise ValueError(f"walker.leg.foot: {mb.foot} feet are not exported to ADAMS yet "
                          "(--format adm writes point feet only)")
+    if mb.knee and not mb.knee_stop:
+        raise ValueError("walker.leg.knee.lock: free knees (five-link biped) are not exported "
+                         "to ADAMS: its torques follow a phase variable whose stance leg "
+                         "switches at each heel strike, which needs a user subroutine (use "
+                         "--format mjcf)")
     if mb.couplings or any(ln.name == "torso" for ln in mb.links):
         raise ValueError("walker.torso: an upper body is not exported to ADAMS yet (its "
                          "bisecting hip would need a COUPLER); export a walker without it")

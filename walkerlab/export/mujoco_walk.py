@@ -17,7 +17,8 @@ leg2_hip``); at each heel strike the roles swap and the push-off
 ``P / T`` along the trailing leg at its foot for ``T = push_off_duration_s`` (the pulse's
 last MuJoCo step carries only its share of the force, so the impulse is ``P`` exactly)
 (``data.xfrc_applied`` on the leg's body, with the moment of the force about its centre of
-mass).
+mass).  A five-link biped's joint torques are driven by :class:`JointTorqueLoop` (one motor
+per physical joint, the torque of its present role).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["MujocoWalk", "PoweredLoop", "latch_rule", "walk"]
+__all__ = ["JointTorqueLoop", "MujocoWalk", "PoweredLoop", "latch_rule", "powered_loop", "walk"]
 
 LEGS = ("leg1", "leg2")
 
@@ -168,6 +169,100 @@ class PoweredLoop:
 LOOK_EVERY = 5
 
 
+class JointTorqueLoop:
+    """The controller of a powered five-link export (motors ``leg<i>_hip_motor`` on the
+    tendons ``leg<i>_hip - torso_hip``, ``leg<i>_knee_motor`` on the knees): before every
+    MuJoCo step each motor's control is the torque of its joint's present role (leg2 stands
+    at the keyframe; the roles swap at each heel strike), from the laws of the custom text
+    ``walkerlab_actuation`` (:class:`walkerlab.models.actuation.TorqueLaws`, the rigid and
+    contact views' own) at the joints' angles (``stance_hip`` = stance thigh - torso,
+    ``swing_knee`` = the swing knee's angle, ...) and the phase variable of the rigid view:
+    the angle of the line from the hip to the stance foot from the downward vertical,
+    ``atan(u / w)`` with ``(u, w) = l_t (sin, cos)(thigh) + l_s (sin, cos)(shank)`` (absolute
+    angles; ``l_t``, ``l_s`` read from the model: the knee's and the foot site's offsets).
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        With the custom text ``walkerlab_actuation`` and the five-link motors.
+    spec : walkerlab.config.actuation.Actuation
+        The laws (read from that text).
+    """
+
+    def __init__(self, model, spec):
+        from walkerlab.models.actuation import TorqueLaws
+
+        self.spec, self.laws = spec, TorqueLaws(spec.torques)
+        self.joints = [t.joint for t in spec.torques]
+        self.hip = [(int(model.joint(f"{g}_hip").qposadr[0]),
+                     int(model.joint(f"{g}_hip").dofadr[0])) for g in LEGS]
+        self.knee = [(int(model.joint(f"{g}_knee").qposadr[0]),
+                      int(model.joint(f"{g}_knee").dofadr[0])) for g in LEGS]
+        self.torso = (int(model.joint("torso_hip").qposadr[0]),
+                      int(model.joint("torso_hip").dofadr[0]))
+        self.motor = {(kind, i): int(model.actuator(f"{g}_{kind}_motor").id)
+                      for kind in ("hip", "knee") for i, g in enumerate(LEGS)}
+        self.lt = -float(model.body("leg1_shank").pos[2])
+        self.ls = -float(model.site("leg1_foot").pos[2])
+        self.stance, self.t_step = 1, 0.0
+
+    def phase(self, q, v) -> tuple[float, float]:
+        """The phase variable [rad] and its rate [rad/s] (class docstring)."""
+        (qh, vh), (qk, vk) = self.hip[self.stance], self.knee[self.stance]
+        t, dt = q[qh], v[vh]
+        sh, dsh = t + q[qk], dt + v[vk]
+        u = self.lt * math.sin(t) + self.ls * math.sin(sh)
+        w = self.lt * math.cos(t) + self.ls * math.cos(sh)
+        du = self.lt * math.cos(t) * dt + self.ls * math.cos(sh) * dsh
+        dw = -self.lt * math.sin(t) * dt - self.ls * math.sin(sh) * dsh
+        return math.atan(u / w), (du * w - u * dw) / (u * u + w * w)
+
+    def control(self, data) -> None:
+        """Set every motor for the coming step."""
+        q, v = data.qpos, data.qvel
+        role = {"stance": self.stance, "swing": 1 - self.stance}
+        deltas, rates, targets = [], [], []
+        for j in self.joints:
+            r, kind = j.split("_")
+            i = role[r]
+            if kind == "hip":
+                deltas.append(q[self.hip[i][0]] - q[self.torso[0]])
+                rates.append(v[self.hip[i][1]] - v[self.torso[1]])
+            else:
+                deltas.append(q[self.knee[i][0]])
+                rates.append(v[self.knee[i][1]])
+            targets.append(self.motor[(kind, i)])
+        s, ds = self.phase(q, v)
+        data.ctrl[:] = 0.0
+        for m, tau in zip(targets, self.laws.each(deltas, rates, s, ds, data.time - self.t_step)):
+            data.ctrl[m] += float(tau)
+
+    def heel_strike(self, data, leg: int) -> None:
+        """Leg ``leg`` (0, 1) struck: it is the stance leg now."""
+        self.stance, self.t_step = leg, float(data.time)
+
+    def bind(self, model, site: list) -> None:
+        """Nothing to bind (the interface of :class:`PoweredLoop`)."""
+
+
+def powered_loop(model):
+    """The controller of a powered export: :class:`JointTorqueLoop` for a five-link biped's
+    joint torques, else :class:`PoweredLoop`."""
+    import json
+
+    import mujoco
+
+    from walkerlab.config.actuation import Actuation
+
+    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation")
+    adr, size = int(model.text_adr[i]), int(model.text_size[i])
+    spec = Actuation.model_validate(json.loads(
+        bytes(model.text_data[adr:adr + size - 1]).decode()))
+    if any(t.joint != "hip" for t in spec.torques):
+        return JointTorqueLoop(model, spec)
+    return PoweredLoop(model)
+
+
 def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     """Run the MJCF at ``xml_path`` from its ``gait`` keyframe for ``t_final_s`` [s].
 
@@ -203,7 +298,7 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     hip = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "hip_x")]
     powered = None
     if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation") >= 0:
-        powered = PoweredLoop(model)
+        powered = powered_loop(model)
         powered.bind(model, site)
     nstep = 1 if latched or powered else LOOK_EVERY
     mujoco.mj_forward(model, data)

@@ -14,10 +14,12 @@ hip_x         prismatic   ``hip_x`` [m] (the base translates along world x)
 hip_z         prismatic   ``hip_y`` [m] (along world z, up; named by its axis)
 leg<i>_hip    revolute    ``leg<i>_angle`` (kneed: ``leg<i>_thigh_angle``) [rad]
 leg<i>_knee   revolute    ``leg<i>_shank_angle - leg<i>_thigh_angle`` [rad]; limit [-pi, 0]:
-                          0 is the straight-leg stop (positive = hyperextended)
+                          0 is the straight-leg stop (positive = hyperextended); free knees
+                          (``knee.lock: free``): no limit
 torso_hip     revolute    the upper body's angle from the upward vertical, positive leaning
                           back [rad]; coupled: ``(leg1_hip + leg2_hip) / 2`` (eliminated in
-                          walkerlab's coordinates, a constraint here)
+                          walkerlab's coordinates, a constraint here); a hinged torso (the
+                          five-link biped): free, walkerlab's ``torso_angle``
 ============  ==========  ================================================================
 
 Springs and couplings:
@@ -40,6 +42,16 @@ Springs and couplings:
   MuJoCo allows (``solimp`` 0.9999, ``solref`` time constant two timesteps).  URDF's
   ``mimic`` follows one joint only: the coupling is stated in a comment (a URDF library sees
   a free torso joint).
+
+Motors (a powered walker, MJCF ``<actuator>``; the laws in the custom text
+``walkerlab_actuation``, evaluated by a stepping loop, :mod:`walkerlab.export.mujoco_walk`):
+``hip`` on the tendon ``hip_actuation = leg1_hip - leg2_hip`` (a hip torque between the legs);
+a five-link biped's joint torques on the physical joints: ``leg<i>_hip_motor`` on the tendon
+``leg<i>_hip_torso = leg<i>_hip - torso_hip`` (the thigh relative to the torso: ``+u`` on the
+thigh, ``-u`` on the torso) and ``leg<i>_knee_motor`` on the joint ``leg<i>_knee`` (``+u``
+extends it); the loop gives each the torque of its leg's present role (``stance_hip`` of the
+stance leg, ...).  URDF has no actuator element for a torque between two non-adjacent joints:
+the motors are stated in comments (and the laws in the keyframe sidecar).
 
 Bodies off a link's axis sit in place: a link's ``inertial`` origin is its centre of mass
 ``(off-axis, 0, -along)`` in the link frame.
@@ -91,7 +103,7 @@ if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not bu
     from walkerlab.walker.multibody import Link, Multibody
 
 __all__ = ["FORMATS", "SIDECAR", "comments_in_scene_units", "keyframe_json", "mjcf_text",
-           "urdf_text"]
+           "motors", "urdf_text"]
 
 #: Export formats and their file names in ``runs/<scene>/``.
 FORMATS = {"urdf": "walker.urdf", "mjcf": "walker.xml"}
@@ -103,7 +115,8 @@ COUPLING_SOLIMP = (0.9999, 0.9999, 0.001, 0.5, 2.0)
 AXIS = "0 -1 0"
 
 
-def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
+def urdf_text(mb: Multibody, name: str, version: str = "",
+              actuation_json: str | None = None) -> str:
     """The walker as a URDF robot (ROS URDF XML specification, http://wiki.ros.org/urdf/XML).
 
     Parameters
@@ -114,6 +127,9 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
         Robot name (the scene's name).
     version : str
         walkerlab version, for the header comment.
+    actuation_json : str, optional
+        The scene's ``walker.actuation`` as JSON: its motors (:func:`motors`) are stated in
+        comments (URDF has no element for them).
 
     Returns
     -------
@@ -123,6 +139,7 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
     """
     width = mb.leg_length_m / 50  # visual thickness of the links
     out = ['<?xml version="1.0"?>', *header(mb, name, "URDF", version),
+           *(comment(_motor_note(*m)) for m in motors(actuation_json)),
            f"<robot name={quoteattr(name)}>", '  <link name="world"/>',
            '  <link name="hip_slider"/>']
     for joint, parent, child, axis in (("hip_x", "world", "hip_slider", "1 0 0"),
@@ -142,6 +159,18 @@ def urdf_text(mb: Multibody, name: str, version: str = "") -> str:
     return "\n".join(out)
 
 
+def _motor_note(name: str, kind: str, target: str) -> str:
+    """A URDF comment's text for one motor of :func:`motors`."""
+    if kind == "joint":
+        what = f"the joint {target} (+u extends the knee)"
+    elif target == HIP_ACTUATION_TENDON:
+        what = "leg1_hip - leg2_hip (+u on leg1_hip, -u on leg2_hip)"
+    else:
+        what = f"{target[:-len('_torso')]} - torso_hip (+u on the thigh's joint, -u on torso_hip)"
+    return (f"Motor {name}: a torque u on {what}; its law is the scene's walker.actuation "
+            "(in the keyframe sidecar)")
+
+
 def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) -> list[str]:
     # a line along the link's z axis: inertia about x and y, none about z
     return ["    <inertial>", f'      <origin xyz="{nums(off, 0, -com)}" rpy="0 0 0"/>',
@@ -151,7 +180,7 @@ def _urdf_inertial(mass: float, com: float, inertia: float, off: float = 0.0) ->
 
 
 def _urdf_link(ln: Link, mb: Multibody, width: float) -> list[str]:
-    knee = ln.joint.endswith("_knee")
+    knee = ln.joint.endswith("_knee") and mb.knee_stop  # free knees: no stop
     jtype = "revolute" if knee else "continuous"
     reach = -ln.length_m if ln.up else ln.length_m  # the visual runs up the torso
     out = [f'  <joint name="{ln.joint}" type="{jtype}">', f'    <parent link="{ln.parent}"/>',
@@ -218,18 +247,40 @@ def _joint_springs(mb: Multibody) -> dict:
 HIP_ACTUATION_TENDON = "hip_actuation"
 
 
-def _tendons(mb: Multibody, powered: bool = False) -> list[str]:
+def motors(actuation_json: str | None) -> list[tuple[str, str, str]]:
+    """The motors of a powered export (module docstring): ``(name, kind, target)`` with
+    ``kind`` ``"tendon"`` or ``"joint"``; none without actuation or torques.  A five-link
+    biped's joints (``stance_hip``, ``swing_knee``, ...) become the physical joints' motors of
+    both legs (the roles swap at each heel strike)."""
+    if actuation_json is None:
+        return []
+    joints = {t["joint"] for t in json.loads(actuation_json).get("torques", [])}
+    out = []
+    if "hip" in joints or not joints:  # (a push-off alone: the hip motor, at 0)
+        out.append(("hip", "tendon", HIP_ACTUATION_TENDON))
+    for kind in ("hip", "knee"):
+        if joints & {f"stance_{kind}", f"swing_{kind}"}:
+            out += [(f"{leg}_{kind}_motor", "tendon" if kind == "hip" else "joint",
+                     f"{leg}_hip_torso" if kind == "hip" else f"{leg}_knee")
+                    for leg in ("leg1", "leg2")]
+    return out
+
+
+def _tendons(mb: Multibody, motor_list=()) -> list[str]:
     """Fixed tendons: each spring on its ``delta``, each coupling on its residual; a powered
-    walker's hip actuation (:data:`HIP_ACTUATION_TENDON`)."""
+    walker's actuated joint combinations (:data:`HIP_ACTUATION_TENDON`, a five-link biped's
+    ``leg<i>_hip_torso``; :func:`motors`)."""
     on_joint = _joint_springs(mb).values()
     springs = [sp for sp in mb.springs if sp not in on_joint]
-    if not (springs or mb.couplings or powered):
+    driven = [m[2] for m in motor_list if m[1] == "tendon"]
+    if not (springs or mb.couplings or driven):
         return []
     out = ["  <tendon>"]
-    if powered:
-        out += [f'    <fixed name="{HIP_ACTUATION_TENDON}">',
-                '      <joint joint="leg1_hip" coef="1.0"/>',
-                '      <joint joint="leg2_hip" coef="-1.0"/>', "    </fixed>"]
+    for name in driven:
+        second = "leg2_hip" if name == HIP_ACTUATION_TENDON else "torso_hip"
+        first = "leg1_hip" if name == HIP_ACTUATION_TENDON else name[:-len("_torso")]
+        out += [f'    <fixed name="{name}">', f'      <joint joint="{first}" coef="1.0"/>',
+                f'      <joint joint="{second}" coef="-1.0"/>', "    </fixed>"]
     for sp in springs:
         # oriented so that springlength >= 0: MuJoCo reads a springlength of -1 as "the
         # tendon's length at qpos0"; k (delta - r)^2 = k (-delta + r)^2, the same spring
@@ -301,11 +352,11 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
         children.setdefault(ln.parent, []).append(ln)
     for ln in children["hip"]:
         out += _mjcf_body(ln, "      ", mb, extra, children, _joint_springs(mb))
-    powered = extra is not None and extra.actuation_json is not None
-    out += ["    </body>", "  </worldbody>", *_tendons(mb, powered)]
-    if powered:  # one motor for the sum of the hip torques; the laws live in the custom text
-        out += ["  <actuator>", f'    <motor name="hip" tendon="{HIP_ACTUATION_TENDON}" '
-                'gear="1"/>', "  </actuator>"]
+    motor_list = motors(extra.actuation_json if extra is not None else None)
+    out += ["    </body>", "  </worldbody>", *_tendons(mb, motor_list)]
+    if motor_list:  # the laws live in the custom text, a stepping loop sets the controls
+        out += ["  <actuator>", *(f'    <motor name="{name}" {kind}="{target}" gear="1"/>'
+                                  for name, kind, target in motor_list), "  </actuator>"]
     out += [*_mjcf_tail(mb, extra), ""]
     return "\n".join(out)
 
@@ -317,7 +368,7 @@ def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
     lo = MJCF_MIN_INERTIA_KG_M2
     width = mb.leg_length_m / 50
     inertia = max(ln.inertia_kg_m2, lo)
-    rng = f' range="{nums(-math.pi, 0)}"' if ln.joint.endswith("_knee") else ""
+    rng = f' range="{nums(-math.pi, 0)}"' if ln.joint.endswith("_knee") and mb.knee_stop else ""
     if ln.joint in joint_springs:  # a knee spring: MuJoCo's joint spring-damper
         sp = joint_springs[ln.joint]
         rng += (f' stiffness="{num(sp.stiffness_n_m_per_rad)}" '
@@ -394,9 +445,14 @@ def keyframe_json(mb: Multibody, extra: MjcfScene) -> str:
            "qvel": list(extra.qvel)}
     if extra.actuation_json is not None:  # a powered walker: its actuators, as the scene
         out["actuation"] = json.loads(extra.actuation_json)
-        out["actuation_note"] = ("hip torques act +tau on the swing leg's hip joint and -tau "
-                                 "on the stance leg's; the push-off is an impulse along the "
-                                 "trailing leg at its foot at each heel strike")
+        out["actuation_note"] = (
+            "joint torques on a five-link biped: stance_hip / swing_hip act +tau on the "
+            "stance / swing leg's hip joint and -tau on torso_hip, stance_knee / swing_knee "
+            "+tau on that leg's knee; leg2 stands at the keyframe, the roles swap at each "
+            "heel strike; the phase variable is the angle of the line from the hip to the "
+            "stance foot from the downward vertical" if not mb.knee_stop else
+            "hip torques act +tau on the swing leg's hip joint and -tau on the stance leg's; "
+            "the push-off is an impulse along the trailing leg at its foot at each heel strike")
     return json.dumps(out, indent=1) + "\n"
 
 

@@ -43,8 +43,8 @@ from walkerlab.export.mjcf_scene import (
 )
 from walkerlab.models.contact.laws import ContactParamsSI
 
-__all__ = ["EXPORT_STEPS", "arc_roll_m", "check_exportable", "joint_state", "mjcf_scene",
-           "mujoco_contact"]
+__all__ = ["EXPORT_STEPS", "actuation_json", "arc_roll_m", "check_exportable", "joint_state",
+           "mjcf_scene", "mujoco_contact"]
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
@@ -191,6 +191,17 @@ def _patch_ahead(scene: Scene, terrain: TerrainSettings, roll: float) -> tuple[f
     return ahead, (f"Terrain: {line} (walkerlab.export.scene.arc_roll_m).",)
 
 
+def actuation_json(scene: Scene) -> str | None:
+    """The scene's ``walker.actuation`` as JSON (None for a passive walker): what the
+    exported files carry for a stepping loop (MJCF custom text, URDF keyframe sidecar)."""
+    act = getattr(scene.walker, "actuation", None)
+    if act is None:
+        return None
+    import json
+
+    return json.dumps(act.model_dump(mode="json", exclude_none=True))
+
+
 def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
     """The gait keyframe, terrain, contact and latch of ``scene`` for the MJCF export.
 
@@ -237,7 +248,7 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
             lanes = (tuple(ell1 + (k - 1) * (ell1 + ell2)), tuple((ell1 + ell2) * k))
         else:
             lanes = (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
-    latch = (knee.latch_height, knee.latch_capture) if mb.knee else None
+    latch = (knee.latch_height, knee.latch_capture) if mb.knee and mb.knee_stop else None
     notes = (f"Keyframe 'gait': the rigid walker's fixed point (step period "
              f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "
              "origin.",) + notes
@@ -247,12 +258,16 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
                   f"{knee.latch_height:.4g} m above the ground and its knee within "
                   f"{knee.latch_capture:.4g} rad of straight; a stepping loop switches it "
                   "(data.eq_active), MuJoCo has no contact-switched lock.",)
-    act = getattr(scene.walker, "actuation", None)
-    actuation = None
-    if act is not None:
-        import json
-
-        actuation = json.dumps(act.model_dump(mode="json", exclude_none=True))
+    actuation = actuation_json(scene)
+    if actuation is not None and data.structure.free_knees:
+        notes += ("Actuators (walker.actuation, in the custom text walkerlab_actuation): "
+                  "motors leg<i>_hip_motor on the tendons leg<i>_hip - torso_hip and "
+                  "leg<i>_knee_motor on the knees; a stepping loop sets each to the torque "
+                  "of its leg's present role (stance_hip, swing_knee, ...: leg2 stands at the "
+                  "keyframe, the roles swap at each heel strike), the phase variable the "
+                  "virtual stance leg's angle (hip to stance foot) "
+                  "(walkerlab.export.mujoco_walk).",)
+    elif actuation is not None:
         notes += ("Actuators (walker.actuation, in the custom text walkerlab_actuation): one "
                   "motor 'hip' on the tendon leg1_hip - leg2_hip; a stepping loop sets its "
                   "control to the swing leg's hip torque (its sign flipped when leg2 swings) "

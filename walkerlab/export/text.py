@@ -27,7 +27,11 @@ def header(mb: Multibody, name: str, fmt: str, version: str) -> list[str]:
     walkerlab's version, the axes and joints, gravity and the slope, the leg and its feet,
     each spring and coupling."""
     knee = ("; leg<i>_knee = shank - thigh angle, limit [-pi, 0], 0 = straight-leg stop"
-            if mb.knee else "")
+            if mb.knee and mb.knee_stop else "; leg<i>_knee = shank - thigh angle, free (no "
+            "stop)" if mb.knee else "")
+    if any(ln.name == "torso" for ln in mb.links) and not mb.couplings:
+        knee += ("; torso_hip = the torso's absolute angle from the upward vertical, positive "
+                 "leaning back (a free hinge)")
     foot = (f"arc feet, radius R = {num(mb.foot_radius_m)} m, centre at L - R from the hip"
             if arc_feet(mb) else "point feet")
     parts = [comment(f"walker {name!s} exported by walkerlab {version} ({fmt})."),

@@ -12,6 +12,10 @@ segments, on :func:`scipy.integrate.solve_ivp` with event location:
    impulse at once: ``dq += M^-1 J^T P e``);
 3. repeat until the end time, the ``stop`` predicate (strides cap) or an event.
 
+A free-jointed (five-link) biped's joint torques (:mod:`walkerlab.models.contact.joint_torques`)
+run the same way: the stance leg switched at the heel strike sets which leg's hip and knee
+carry the ``stance_*`` laws and which the ``swing_*`` ones; the time-based laws count from it.
+
 The state carries four work integrals beside the walker's (``WORK_NAMES`` [J]: the hip
 torques' positive and negative work, the push-off's, the contact forces'), so the energy
 ledger of a run closes to the integrator's tolerance: ``E(t) - E(0) = sum of the works``

@@ -80,8 +80,9 @@ def contact_section(scene, arts) -> list[str]:
         w = c.ledger
         out += ["**Energy ledger of the powered contact run** (work integrals carried with the "
                 "state; J over the whole run): push-off "
-                f"{num(w['push_off'][-1], 4)}, hip torques +{num(w['hip_torque_positive'][-1], 4)}"
-                f" / {num(w['hip_torque_negative'][-1], 4)}, contact forces (normal + friction, "
+                f"{num(w['push_off'][-1], 4)}, joint torques "
+                f"+{num(w['hip_torque_positive'][-1], 4)} / "
+                f"{num(w['hip_torque_negative'][-1], 4)}, contact forces (normal + friction, "
                 f"their dissipation and the energy their springs hold) "
                 f"{num(w['contact'][-1], 4)}; closure (kinetic + potential energy change minus "
                 f"these) at most {num(float(abs(w['residual']).max()), 2)} J.", ""]

@@ -28,7 +28,7 @@ from walkerlab.export.multibody import (
     mjcf_text,
     urdf_text,
 )
-from walkerlab.export.scene import check_exportable, mjcf_scene
+from walkerlab.export.scene import actuation_json, check_exportable, mjcf_scene
 from walkerlab.io import runpaths
 from walkerlab.units import for_scene
 from walkerlab.walker.description import walker_data
@@ -106,7 +106,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     check_exportable(scene)
     extra = None if walker_only else _gait_scene(scene, mb, data)
     if fmt == "urdf":
-        text = urdf_text(mb, name, walkerlab.__version__)
+        text = urdf_text(mb, name, walkerlab.__version__, actuation_json(scene))
     else:
         text = mjcf_text(mb, name, walkerlab.__version__, extra)
     path = export_path(scene, runs_root, fmt, claim=True)

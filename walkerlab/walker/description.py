@@ -178,15 +178,19 @@ class Structure:
 
 def check_floating_view(structure: Structure) -> None:
     """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
-    knees, whose hinged torso the floating derivation would eliminate as a bisecting one.
+    knees (the five-link biped) on legs that differ, on feet other than points, or with
+    springs (what the rigid view of free knees, :mod:`walkerlab.codegen.five_link`, refuses
+    too).
 
     Raises
     ------
     ValueError
     """
-    if structure.free_knees:
-        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a rigid "
-                         "model only today (no contact view, no export)")
+    if structure.free_knees and (structure.foot != "point" or structure.asymmetric
+                                 or structure.springs or structure.knee_spring):
+        raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "
+                         "floating view (contact model, export) with identical point-footed "
+                         "legs and no springs only")
 
 
 def state_names(roles) -> list[str]:

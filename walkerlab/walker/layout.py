@@ -24,7 +24,9 @@ floating base (``hip_x``, ``hip_y``) and a torso belong to no leg.
 The rigid -> floating map (:func:`floating_links_from_rigid`): the rigid model's step starts
 with ``leg1`` swinging (paper Eq. 11), so floating link ``leg1_<link>_angle`` takes the rigid
 ``swing_<link>`` angle, or the straight swing leg's ``swing`` angle when the rigid leg has no
-such link (a knee the rigid model holds straight); ``leg2`` likewise from ``stance``.
+such link (a knee the rigid model holds straight); ``leg2`` likewise from ``stance``; a
+hinged torso's ``torso_angle`` takes the rigid ``torso`` angle (no leg: no role swap, its rate
+not scaled).
 """
 
 from __future__ import annotations
@@ -213,7 +215,8 @@ class StateLayout:
 def floating_links_from_rigid(values: Mapping[str, float], floating: StateLayout,
                               rate_scale=(1.0, 1.0)) -> np.ndarray:
     """The floating view's link state ``z = [link angles, their rates]`` (the coordinates that
-    belong to a leg, in state order) from the rigid model's named values.
+    belong to a leg, and a hinged torso's, in state order) from the rigid model's named
+    values.
 
     Parameters
     ----------
@@ -240,6 +243,10 @@ def floating_links_from_rigid(values: Mapping[str, float], floating: StateLayout
     angles, rates = [], []
     for c in floating.coordinates:
         leg = floating.leg_of(c)
+        if c == "torso_angle":  # a hinged torso: the rigid view's own torso coordinate
+            angles.append(values["torso_angle"])
+            rates.append(values["torso_rate"])
+            continue
         if leg not in ROLE_OF_LEG:
             continue
         role = ROLE_OF_LEG[leg]

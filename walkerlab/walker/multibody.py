@@ -17,7 +17,8 @@ module builds the floating planar multibody walker that Drake, Pinocchio or MuJo
 - an **upper body** (``torso``): one link hinged at the hip, its axis pointing up; the
   bisecting hip mechanism (Wisse, Hobbelen & Schwab 2007) is a :class:`Coupling` of its
   joint to the two hip joints (torso angle = mean of the leg angles), which the rigid and
-  floating views eliminate and a multibody library enforces as a constraint;
+  floating views eliminate and a multibody library enforces as a constraint; a hinged torso
+  (the five-link biped, free knees) is a free joint (no coupling, no knee stops);
 - **springs**: torsional spring-dampers between links at the hip, as a :class:`Spring` on a
   linear combination of joint angles (``delta = angle(second) - angle(first)``).
 
@@ -167,6 +168,9 @@ class Multibody:
         damping in the first step are left out).
     couplings : tuple of Coupling
         Linear constraints between joint angles (the bisecting hip mechanism).
+    knee_stop : bool
+        The knees have the straight-leg stop (``shank - thigh <= 0``, a joint limit); False
+        for free knees (``knee.lock: free``, the five-link biped: no stop in any view).
     """
 
     hip_mass_kg: float
@@ -179,6 +183,7 @@ class Multibody:
     slope_rad: float
     springs: tuple[Spring, ...] = ()
     couplings: tuple[Coupling, ...] = ()
+    knee_stop: bool = True
 
 
 def _combine(name: str, parts: list[tuple[float, float, float, str, float]]
@@ -216,7 +221,8 @@ def multibody(data: WalkerData) -> Multibody:
     Raises
     ------
     ValueError
-        A link carries no mass (naming it), or free knees (one line, both).
+        A link carries no mass (naming it), or free knees the floating view does not carry
+        (:func:`walkerlab.walker.description.check_floating_view`; one line, both).
     """
     s = data.structure
     check_floating_view(s)
@@ -259,8 +265,9 @@ def multibody(data: WalkerData) -> Multibody:
         height = max(max(-x[1] for x in parts), L / 10)
         links.append(Link("torso", "hip", "torso_hip", 0.0, height, m, c, inertia, None, ce,
                           up=True))
-        couplings = (Coupling("bisecting_hip", "torso_hip",
-                              tuple((f"{leg}_hip", 0.5) for leg in LEGS)),)
+        if not s.hinged_torso:  # a hinged torso (five-link biped): a free joint of its own
+            couplings = (Coupling("bisecting_hip", "torso_hip",
+                                  tuple((f"{leg}_hip", 0.5) for leg in LEGS)),)
     joint = {"swing": "leg1_hip", "stance": "leg2_hip", "torso": "torso_hip"}
     link_of = {"swing": "leg1", "stance": "leg2", "torso": "torso"}
     springs = []
@@ -276,4 +283,4 @@ def multibody(data: WalkerData) -> Multibody:
                                   ((f"{leg}_knee", 1.0),), p["k_knee"], p["r_knee"],
                                   p["c_knee"]))
     return Multibody(p.get("M_hip", 0.0), tuple(links), L, s.foot, R, s.knee, p["g"],
-                     data.slope_rad, tuple(springs), couplings)
+                     data.slope_rad, tuple(springs), couplings, not s.free_knees)

@@ -275,6 +275,9 @@ def _write_work(f, run: ContactSimRun) -> None:
             "push_off": "work of the push-off pulse at the trailing foot",
             "contact": "work of the contact forces (normal + friction, every point): their "
                        "dissipation and the energy their springs hold"}
+    if run.walker.structure.free_knees:  # a five-link biped: every joint torque's work
+        what.update(hip_torque_positive="positive work of the joint torques (hips and knees)",
+                    hip_torque_negative="negative work of the joint torques (hips and knees)")
     for k, name in enumerate(WORK_NAMES):
         put(f, f"ledger/work/{name}", work[:, k], "J", what[name] + " since the start",
             dims=("time",))

@@ -592,8 +592,9 @@ def rhs_source(eq) -> str:
 
 def contact_source(structure: Structure, key: str) -> str:
     """Source of the generated contact module of ``structure`` (its floating view, the
-    constants ``NP``, ``KNEE``, ``NF``, ``POINT_LEG``, ``PIN``, ``CONTACTS``, then
-    :data:`ASSEMBLY` and the straight-line ``rhs``).
+    constants ``NP``, ``KNEE`` (knee stops: kneed legs whose knees are not free), ``NF``,
+    ``POINT_LEG``, ``PIN``, ``CONTACTS``, then :data:`ASSEMBLY` and the straight-line
+    ``rhs``).
 
     Raises
     ------
@@ -607,7 +608,7 @@ def contact_source(structure: Structure, key: str) -> str:
         raise ValueError("a kneed walker's contact model needs one contact point per leg")
     fl = floating.floating_source(structure, key)
     legs = tuple(eq.point_legs)
-    return (fl + f"\nNP = {len(eq.params)}\nKNEE = {bool(structure.knee)}\n"
+    return (fl + f"\nNP = {len(eq.params)}\nKNEE = {bool(eq.knees)}\n"
             f"NF = {len(eq.feet)}\nPOINT_LEG = {legs!r}\nPIN = {legs.index(1)}\n"
             f"CONTACTS = {tuple(eq.contacts)!r}\n" + ASSEMBLY + "\n\n" + rhs_source(eq))
 

@@ -26,7 +26,8 @@ coordinate                    state                        rate state
 ============================  ===========================  ==========================
 
 so the paper walker's states are unchanged: ``[hip_x, hip_y, theta1, theta2, vhip_x, vhip_y,
-dtheta1, dtheta2]``; a flat foot's absolute angle ``leg{i}_foot_angle`` is ``theta{i}_foot``.
+dtheta1, dtheta2]``; a flat foot's absolute angle ``leg{i}_foot_angle`` is ``theta{i}_foot``,
+a hinged torso's ``torso_angle`` (the five-link biped) ``theta_torso``.
 
 Contact points
 --------------
@@ -59,6 +60,8 @@ def state_name(coordinate: str, rate: bool = False) -> str:
     """State name of a floating coordinate (module docstring's table)."""
     if coordinate in ("hip_x", "hip_y"):
         return ("v" if rate else "") + coordinate
+    if coordinate == "torso_angle":  # a hinged torso (five-link biped)
+        return ("d" if rate else "") + "theta_torso"
     leg, rest = coordinate.split("_", 1)
     i = leg[-1]
     link = rest[:-len("_angle")]
@@ -70,7 +73,7 @@ def state_name(coordinate: str, rate: bool = False) -> str:
 STATE_OF_COORDINATE = {c: state_name(c) for c in
                        ("hip_x", "hip_y", "leg1_angle", "leg2_angle", "leg1_thigh_angle",
                         "leg1_shank_angle", "leg2_thigh_angle", "leg2_shank_angle",
-                        "leg1_foot_angle", "leg2_foot_angle")}
+                        "leg1_foot_angle", "leg2_foot_angle", "torso_angle")}
 
 
 def flat_foot_numbers(data) -> list[dict]:
@@ -167,9 +170,10 @@ class ContactWalker:
         A flat foot's regularising mass [kg] (at the ankle) and inertia about the ankle
         [kg m^2] (``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``);
         required for flat feet, ignored otherwise.
-    actuators : ContactActuators, optional
+    actuators : ContactActuators or JointTorqueActuators, optional
         The walker's actuators (:mod:`walkerlab.models.contact.actuation`): hip torques and
-        the push-off pulse; a walker with them runs on
+        the push-off pulse; a free-jointed (five-link) biped's joint torques
+        (:mod:`walkerlab.models.contact.joint_torques`); a walker with them runs on
         :mod:`walkerlab.integrate.contact_powered` (its stance leg is a discrete state).
 
     Raises
@@ -685,9 +689,9 @@ class ContactWalker:
             (shank - thigh angle, > 0 hyperextended), ``extension_rate`` [rad/s],
             ``torque`` [N m] (> 0: pushes the knee straight from hyperextension; < 0: the
             latch holds a loaded leg's knee against flexion), ``power`` [W] (of the stop on
-            the walker).
+            the walker).  Empty for straight legs and free knees (no stop).
         """
-        if not self.structure.knee:
+        if not self.kernels.KNEE:  # straight legs, free knees (no stop)
             return {}
         tab = self.kernels.knee_table(self._rows(X), *self._args())
         names = ("extension", "extension_rate", "torque", "power")

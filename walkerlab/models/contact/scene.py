@@ -23,6 +23,7 @@ from walkerlab.config import (
 )
 
 from .actuation import ContactActuators
+from .joint_torques import JointTorqueActuators
 from .laws import ContactParamsSI, KneeStopSI
 from .model import ContactWalker, flat_foot_numbers
 from .rigid_limit import contact_si
@@ -93,8 +94,9 @@ class ContactSetup:
         Run options (``contact_sim``; defaults when the scene has none).
     solver : SolverSettings
         ``contact_solver`` (default :meth:`SolverSettings.for_contact`).
-    actuators : ContactActuators or None
-        The walker's actuators as forces (:mod:`walkerlab.models.contact.actuation`);
+    actuators : ContactActuators or JointTorqueActuators or None
+        The walker's actuators as forces (:mod:`walkerlab.models.contact.actuation`; a
+        free-jointed biped's joint torques :mod:`walkerlab.models.contact.joint_torques`);
         None for a passive walker.
     """
 
@@ -106,7 +108,7 @@ class ContactSetup:
     terrain: TerrainSettings
     sim: ContactSimSettings
     solver: SolverSettings
-    actuators: ContactActuators | None = None
+    actuators: ContactActuators | JointTorqueActuators | None = None
 
     def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
         """ContactWalker of the setup with checkerboard patches from the ideal step length.
@@ -173,7 +175,8 @@ def contact_setup(scene: Scene) -> ContactSetup:
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators)
 
 
-def _actuators(scene: Scene, data, cs: ContactSimSettings) -> ContactActuators | None:
+def _actuators(scene: Scene, data, cs: ContactSimSettings
+               ) -> ContactActuators | JointTorqueActuators | None:
     """The scene's actuators in the contact view, or None; one-line refusals."""
     spec = getattr(scene.walker, "actuation", None)
     if spec is None:
@@ -181,10 +184,12 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings) -> ContactActuators |
     from walkerlab.codegen.floating import coordinate_names
 
     st = data.structure
-    if st.knee or st.foot != "point" or st.torso:
+    five_link = st.free_knees and st.foot == "point"
+    if not five_link and (st.knee or st.foot != "point" or st.torso):
         raise ContactSceneError(f"scene '{scene.name}': walker.actuation: the contact view "
                                 "carries actuators on straight legs with point feet and no "
-                                "torso only (the rigid view has them too)")
+                                "torso, and on free-jointed (five-link) bipeds, only (the "
+                                "rigid view has them too)")
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
                                 "pinned start phase carries no actuators: leave it 'none'")
@@ -198,6 +203,15 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings) -> ContactActuators |
             raise ContactSceneError(f"scene '{scene.name}': walker.actuation: a torque law on "
                                     "time since the heel strike has no contact periodic gait "
                                     "(contact_sim.start / periodic_gait): use a phase law")
+    if five_link and (cs.start == "periodic_gait" or cs.periodic_gait):
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: a five-link biped's "
+                                "contact periodic gait is not found yet: start it from the "
+                                "rigid gait (start: ideal, periodic_gait: false)")
+    if five_link:  # joint torques at the hips and knees (the rigid view's laws)
+        try:
+            return JointTorqueActuators(data, spec, coordinate_names(st))
+        except ValueError as err:
+            raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     return ContactActuators(spec, coordinate_names(st), scene.contact.push_off_pulse_s())
 
 
