@@ -316,7 +316,8 @@ def test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens(tmp_path):
 def test_no_rigid_gait_refused_in_one_line_and_walker_only_writes_the_walker(tmp_path):
     """The paper walker on level ground without a ``fixedpoint`` section: the automatic
     search (its seeds: ~30 s wall under load, 3 s CPU) finds no passive gait, so the export
-    refuses in one line saying how to go on and writes nothing (before: a file without keyframe, terrain or contact, exit 0);
+    refuses in one line saying how to go on and writes nothing (before: a file without
+    keyframe, terrain or contact, exit 0);
     ``--walker-only`` writes the walker alone, as asked."""
     from typer.testing import CliRunner
 
