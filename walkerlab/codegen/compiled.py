@@ -31,6 +31,10 @@ def compiled_module(structure):
     key = cache.cache_key(structure)
 
     def build() -> str:
+        if structure.foot == "flat":  # a flat foot's modes: their own generator
+            from walkerlab.codegen import flatfoot
+
+            return flatfoot.generate_flat_compiled(structure, key)
         from walkerlab.codegen import source as codegen
         from walkerlab.codegen import symbolic
 
@@ -50,17 +54,24 @@ class CompiledFlow:
     params : tuple of float
         Parameter vector (``structure.param_names`` order).
     name : str
-        ``"flow"`` or ``"flow_locked"`` (kneed walker, knee locked).
+        ``"flow"`` or ``"flow_locked"`` (kneed walker, knee locked); a flat foot's
+        ``"flow_<mode>"`` (:func:`walkerlab.codegen.flatfoot.generate_flat_compiled`).
     guards : tuple of (str, float), optional
         For each guard of the phase, in order: the generated guard it is and a constant added
         to it (``Guard.function = guard_<name> + offset``); the guards are then evaluated in
         the cfunc (extra outputs).  None: the integrator calls the Python guards.
+    first_chunk_steps : int
+        Steps of the first chunk the ``cyrk_compiled`` backend integrates before it looks
+        at the guards (:mod:`walkerlab.integrate._compiled`; the chunks then double): the
+        steps after a crossing in a chunk are wasted, so a phase that often ends within a
+        few steps wants a short first chunk (a flat foot's modes: 8).
     """
 
     structure: object
     params: tuple
     name: str = "flow"
     guards: tuple | None = None
+    first_chunk_steps: int = 24
     _memo: dict = field(default_factory=dict, repr=False, compare=False)
 
     def address(self, variational: bool = False) -> int:
