@@ -73,6 +73,12 @@ class CompiledFlow:
     guards: tuple | None = None
     first_chunk_steps: int = 24
     _memo: dict = field(default_factory=dict, repr=False, compare=False)
+    #: the batched step map may run this flow (its module's ``flow`` cfuncs and reset)
+    batchable = True
+
+    def module(self):
+        """The imported compiled module this flow's cfuncs live in."""
+        return compiled_module(self.structure)
 
     def address(self, variational: bool = False) -> int:
         """C address of the cfunc ``(dy, t, y, d)``: the flow (2n outputs) or, with
@@ -80,7 +86,7 @@ class CompiledFlow:
         row-major in ``y[2n:]``)."""
         k = (self.name, variational)
         if k not in self._memo:
-            mod = compiled_module(self.structure)
+            mod = self.module()
             fn = getattr(mod, f"{self.name}_variational" if variational else self.name)
             self._memo[k] = fn.address
         return self._memo[k]
@@ -88,7 +94,7 @@ class CompiledFlow:
     def data(self) -> np.ndarray:
         """A fresh data vector (constants, then a zeroed call counter as the last entry)."""
         if "data" not in self._memo:
-            self._memo["data"] = compiled_module(self.structure).constants(self.params)
+            self._memo["data"] = self.module().constants(self.params)
         return self._memo["data"].copy()
 
     def guard_columns(self) -> tuple[int, np.ndarray, np.ndarray] | None:
@@ -98,7 +104,7 @@ class CompiledFlow:
         if self.guards is None:
             return None
         if "guards" not in self._memo:
-            names = compiled_module(self.structure).GUARDS
+            names = self.module().GUARDS
             self._memo["guards"] = (len(names), np.array([names.index(g) for g, _ in self.guards]),
                                     np.array([float(o) for _, o in self.guards]))
         return self._memo["guards"]
