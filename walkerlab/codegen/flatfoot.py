@@ -377,6 +377,8 @@ def generate_flat(structure: Structure, key: str) -> str:
         f"{IND}x = np.asarray(x)",
         f"{IND}return x[1] + x[2] + gamma < {-HEEL_OFF_PHI_RAD!r}",
         "    def points(x):",
+        f"{IND}if np.ndim(x) == 1:  # one state: one kinematics",
+        f"{IND}    return _points_toe(x) if _on_toe(x) else _points_heel(x)",
         f"{IND}toe, h, o = _on_toe(x), _points_heel(x), _points_toe(x)",
         f"{IND}return {{k: np.where(toe, o[k], h[k]) for k in h}}",
         "    def energies(x):",

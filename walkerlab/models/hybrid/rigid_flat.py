@@ -40,9 +40,10 @@ from walkerlab.walker.description import WalkerData
 
 #: The swing leg's parts of a step: before and after the legs pass each other.
 SWING_PARTS = ("early_swing", "late_swing")
-#: First chunk of the compiled flows [steps] (``CompiledFlow.first_chunk_steps``): a foot
-#: flat before mid-stance lasts ~5 DOP853 steps, heel contact ~50 (8 + 16 + 32).
-FIRST_CHUNK_STEPS = 8
+#: First chunk of each mode's compiled flow [steps] (``CompiledFlow.first_chunk_steps``):
+#: heel contact lasts ~50 DOP853 steps at rtol 1e-10, a foot flat before mid-stance ~5
+#: (each CyRK call costs as much as ~20 wasted steps: one chunk for heel contact).
+FIRST_CHUNK_STEPS = {"heel_contact": 64, "foot_flat": 8, "heel_off": 24}
 #: Each guard's extra output of the compiled flows (``GUARDS`` of
 #: :func:`walkerlab.codegen.flatfoot.generate_flat_compiled`; ``{pin}`` the mode's pinned
 #: point): the same function of the state as the Python guard of that name.
@@ -104,7 +105,7 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
             return None
         return CompiledFlow(data.structure, tuple(data.params), f"flow_{mode}",
                             tuple((GUARD_OUTPUT[g.name].format(pin=pin[mode]), 0.0)
-                                  for g in guards), first_chunk_steps=FIRST_CHUNK_STEPS)
+                                  for g in guards), first_chunk_steps=FIRST_CHUNK_STEPS[mode])
 
     def phase(mode: str, part: str) -> Phase:
         # an ankle push-off acts in heel off: its flow (and the ground forces, read through
