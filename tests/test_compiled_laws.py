@@ -124,3 +124,31 @@ def test_steps_on_compiled_laws_agree_with_the_python_path(name):
         assert a.termination == c.termination == "heel_strike"
         assert abs(a.t_end - c.t_end) < 1e-9
         np.testing.assert_allclose(c.x_next, a.x_next, rtol=0, atol=1e-9)
+
+
+@pytest.mark.slow
+def test_rabbit_runs_its_virtual_constraints_on_compiled_flows():
+    """RABBIT (five links, four saturated PD virtual constraints on cubic phase tables): its
+    compiled flow is the Python one at states near its gait, and one step on DOP853 with
+    compiled laws lands where the scene's LSODA step lands (both at rtol 1e-11).  Slow: the
+    five-link cfuncs take minutes to compile on a cold cache (seconds from numba's cache)."""
+    pytest.importorskip("numba")
+    from walkerlab.config import load_scene
+
+    sc = load_scene("configs/rabbit.yaml")
+    w = build_walker(sc)
+    x0 = sc.fixedpoint.initial_guess.as_array(w.state_names())
+    cf = w.phases[0].compiled
+    mod = cf.module()
+    rng = np.random.default_rng(8)
+    for _ in range(3):
+        x = x0 + rng.normal(0, 0.02, x0.size)
+        out = _call(mod.flow, x, cf.data(), x0.size + len(mod.GUARDS))
+        want = np.asarray(w.phases[0].flow(0.3, x))
+        np.testing.assert_allclose(out[:x0.size], want, rtol=0, atol=1e-11 * np.abs(want).max())
+    lsoda = simulate_steps(w, x0, 1, Solver.from_settings(sc.solver)).segments[0]
+    comp = simulate_steps(w, x0, 1, Solver("DOP853", 1e-11, 1e-11, None, "cyrk_compiled"))
+    c = comp.segments[0]
+    assert c.termination == lsoda.termination == "heel_strike"
+    assert abs(c.t_end - lsoda.t_end) < 1e-8
+    np.testing.assert_allclose(c.x_next, lsoda.x_next, rtol=0, atol=1e-8)
