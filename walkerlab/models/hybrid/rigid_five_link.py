@@ -15,8 +15,9 @@ heel strike is looked for only once the swing foot is ahead:
   reaching the slope.
 
 The heel strike is plastic, the old stance foot leaves the ground without impulse, the legs
-swap roles (:mod:`walkerlab.codegen.five_link`).  No compiled flow (the ``cyrk_compiled``
-backend is not offered for these walkers).
+swap roles (:mod:`walkerlab.codegen.five_link`).  The passive walker has no compiled flow
+(``cyrk_compiled`` runs it on CyRK with the Python flow); one driven by joint torques does
+(:mod:`walkerlab.codegen.actuated`, its guards' outputs from :func:`guard_outputs`).
 """
 
 from __future__ import annotations
