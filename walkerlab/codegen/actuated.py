@@ -26,7 +26,6 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-import sympy as sp
 
 from walkerlab.codegen import cache
 from walkerlab.codegen.compiled import CompiledFlow
@@ -40,6 +39,8 @@ def _defined(lines: list[str]) -> set[str]:
 
 def _joint_exprs(eq, joints):
     """Per actuator ``(delta, ddelta, B (n,))``, and ``(s, ds)``, as sympy expressions."""
+    import sympy as sp
+
     la = eq.leg_angles
 
     def rate(e):
@@ -55,6 +56,8 @@ def _joint_exprs(eq, joints):
 def _law_lines(eq, joints, printer, cse_lines):
     """Lines that evaluate the laws (``_tau{k}`` and its partials ``_t{k}_0..3``) and the
     symbolic pieces the variational equations need: ``(lines, acts, grads)``."""
+    import sympy as sp
+
     acts, (s, ds) = _joint_exprs(eq, joints)
     exprs = [s, ds] + [e for d, dd, _B in acts for e in (d, dd)]
     lines, red = cse_lines(exprs, printer)
@@ -72,6 +75,8 @@ def _law_lines(eq, joints, printer, cse_lines):
 def _body(eq, joints, variational, guards, printer) -> list[str]:
     """The lines of one cfunc after its constants' unpacking (see the module docstring);
     ``NCONST`` is the module's constant count (a compile-time global for numba)."""
+    import sympy as sp
+
     from walkerlab.codegen.source import cse_lines, flow_lines
 
     n = len(eq.q)
