@@ -464,7 +464,8 @@ def test_linear_hip_torques_run_on_the_compiled_flows():
     """A hip torque linear in the hip angle and rate is a generated hip spring-damper (with
     its rest angle shifted by the constant): its flows are the compiled ones (the powered
     fixed point at the passive one's cost, scripts/bench_powered.py) and equal the Python
-    flow of the same law; a phase-reference law stays on the Python flow."""
+    flow of the same law; a phase-reference law runs the Python flow (the law in Python) or
+    its own compiled flows (the law in the cfunc)."""
     from walkerlab.models.hybrid.actuated import Actuators
 
     sc = scene_from_dict(_compass({"torques": [{"joint": "hip", "law": LAW}]}))
@@ -482,4 +483,7 @@ def test_linear_hip_torques_run_on_the_compiled_flows():
     ref = {"stiffness_n_m_per_rad": 40.0, "reference": {"phase_rad": [-0.3, 0.3],
                                                         "hip_angle_rad": [0.3, -0.3]}}
     sc2 = scene_from_dict(_compass({"torques": [{"joint": "hip", "law": ref}]}))
-    assert all(ph.compiled is None for ph in build_walker(sc2).phases)
+    # a phase-reference law: the Python flow, and compiled flows that evaluate the law
+    # (tests/test_compiled_laws.py)
+    assert all(ph.compiled is not None and not ph.compiled.batchable
+               for ph in build_walker(sc2).phases)

@@ -31,6 +31,10 @@ def compiled_module(structure):
     key = cache.cache_key(structure)
 
     def build() -> str:
+        if structure.foot == "flat":  # a flat foot's modes: their own generator
+            from walkerlab.codegen import flatfoot
+
+            return flatfoot.generate_flat_compiled(structure, key)
         from walkerlab.codegen import source as codegen
         from walkerlab.codegen import symbolic
 
@@ -50,18 +54,31 @@ class CompiledFlow:
     params : tuple of float
         Parameter vector (``structure.param_names`` order).
     name : str
-        ``"flow"`` or ``"flow_locked"`` (kneed walker, knee locked).
+        ``"flow"`` or ``"flow_locked"`` (kneed walker, knee locked); a flat foot's
+        ``"flow_<mode>"`` (:func:`walkerlab.codegen.flatfoot.generate_flat_compiled`).
     guards : tuple of (str, float), optional
         For each guard of the phase, in order: the generated guard it is and a constant added
         to it (``Guard.function = guard_<name> + offset``); the guards are then evaluated in
         the cfunc (extra outputs).  None: the integrator calls the Python guards.
+    first_chunk_steps : int
+        Steps of the first chunk the ``cyrk_compiled`` backend integrates before it looks
+        at the guards (:mod:`walkerlab.integrate._compiled`; the chunks then double): the
+        steps after a crossing in a chunk are wasted, so a phase that often ends within a
+        few steps wants a short first chunk (a flat foot's modes: 8).
     """
 
     structure: object
     params: tuple
     name: str = "flow"
     guards: tuple | None = None
+    first_chunk_steps: int = 24
     _memo: dict = field(default_factory=dict, repr=False, compare=False)
+    #: the batched step map may run this flow (its module's ``flow`` cfuncs and reset)
+    batchable = True
+
+    def module(self):
+        """The imported compiled module this flow's cfuncs live in."""
+        return compiled_module(self.structure)
 
     def address(self, variational: bool = False) -> int:
         """C address of the cfunc ``(dy, t, y, d)``: the flow (2n outputs) or, with
@@ -69,7 +86,7 @@ class CompiledFlow:
         row-major in ``y[2n:]``)."""
         k = (self.name, variational)
         if k not in self._memo:
-            mod = compiled_module(self.structure)
+            mod = self.module()
             fn = getattr(mod, f"{self.name}_variational" if variational else self.name)
             self._memo[k] = fn.address
         return self._memo[k]
@@ -77,7 +94,7 @@ class CompiledFlow:
     def data(self) -> np.ndarray:
         """A fresh data vector (constants, then a zeroed call counter as the last entry)."""
         if "data" not in self._memo:
-            self._memo["data"] = compiled_module(self.structure).constants(self.params)
+            self._memo["data"] = self.module().constants(self.params)
         return self._memo["data"].copy()
 
     def guard_columns(self) -> tuple[int, np.ndarray, np.ndarray] | None:
@@ -87,7 +104,7 @@ class CompiledFlow:
         if self.guards is None:
             return None
         if "guards" not in self._memo:
-            names = compiled_module(self.structure).GUARDS
+            names = self.module().GUARDS
             self._memo["guards"] = (len(names), np.array([names.index(g) for g, _ in self.guards]),
                                     np.array([float(o) for _, o in self.guards]))
         return self._memo["guards"]

@@ -7,7 +7,8 @@ as in :mod:`walkerlab.models.contact._cyrk`), so the Runge-Kutta steps run witho
 
 CyRK's numba bridge takes no events, so guards are located here with scipy's rules:
 
-1. integrate towards ``t1`` at most ``K`` steps at a time (``K = 32, 64, ...``; a chunk that
+1. integrate towards ``t1`` at most ``K`` steps at a time (``K = K0, 2 K0, ...``, ``K0`` the
+   flow's ``first_chunk_steps``, :data:`FIRST_CHUNK_STEPS` by default; a chunk that
    stops on the step limit continues from its last step, with that step's size as first step);
    the chunk boundaries depend on the step count only, so results do not depend on history;
 2. evaluate the phase's guards (Python functions) at the step points and find the first step
@@ -185,7 +186,8 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
         def values(T, Y):
             return np.array([[f(t, y[:n]) for f in fns] for t, y in zip(T, Y)])
     dense = CompiledDense(m + n_extra)
-    ta, ya, h0, K, nfev = float(t0), np.asarray(y0, float), 0.0, FIRST_CHUNK_STEPS, 0
+    ta, ya, h0, nfev = float(t0), np.asarray(y0, float), 0.0, 0
+    K = getattr(compiled, "first_chunk_steps", FIRST_CHUNK_STEPS)
     while True:
         res, T, Y, ok, msg, nf = _solve(addr, data, ta, t1, ya, method_int, rtol, atol, hmax,
                                         K, h0, False, n_extra)

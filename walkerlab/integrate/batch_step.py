@@ -105,7 +105,7 @@ class BatchStepMap:
             if cf is None or cf.guard_columns() is None:
                 raise ValueError(f"{walker.name} ({walker.variant}): phase {ph.name!r} has no "
                                  "compiled flow; per-step terrain needs the generated model "
-                                 "(ideal.variant: derived; flat feet are not compiled yet)")
+                                 "(ideal.variant: derived)")
             mod = compiled_module(cf.structure)
             n_extra, cols, offs = cf.guard_columns()
             self.phases.append((ph, getattr(mod, cf.name), n_extra, cols, offs,

@@ -1,6 +1,6 @@
 """The step map of a rigid walker without compiled flows, row by row: the fallback of
 :class:`walkerlab.integrate.batch_step.BatchStepMap` for walkers the batched stepper cannot
-carry (flat feet: a phase graph whose guards are ground reactions, not compiled yet; a
+carry (flat feet: a phase graph of contact modes, each with its own heel-strike map; a
 replaced flow such as ``ideal.variant: appendix_a``).
 
 Not a second integrator: each row is one :func:`walkerlab.integrate.rigid.integrate_step`
@@ -31,8 +31,12 @@ from walkerlab.integrate.batch_step import FALL, HEEL_STRIKE, SOLVER_FAILURE, TI
 
 
 def needs_python_path(walker) -> bool:
-    """True when some phase of ``walker`` has no compiled flow (the batched map refuses it)."""
-    return any(ph.compiled is None for ph in walker.phases)
+    """True when some phase of ``walker`` has no compiled flow (the batched map refuses it),
+    one the batched map cannot run (an actuated walker's: its laws are in its own cfuncs),
+    or its phases form a graph (a guard naming its next phase: a flat foot's modes, whose
+    heel-strike maps depend on the mode; the batched map runs the phases in order)."""
+    return any(ph.compiled is None or not ph.compiled.batchable
+               or any(g.next_phase is not None for g in ph.guards) for ph in walker.phases)
 
 
 def make_step_map(walker, walker_at, rtol: float = 1e-9, atol: float = 1e-9,

@@ -56,6 +56,18 @@ def phase_reference(table):
     return lin, dlin
 
 
+def _table_coefficients(table) -> tuple[np.ndarray, np.ndarray]:
+    """Knots (n,) and cubic coefficients (4, n - 1) of a table as :func:`phase_reference`
+    interpolates it (highest degree first; piecewise linear: ``0, 0, slope, value``)."""
+    s, y = np.asarray(table.phase_rad, float), np.asarray(table.values_rad, float)
+    if table.interpolation == "cubic" and len(s) >= 3:
+        from scipy.interpolate import CubicSpline
+
+        return s, CubicSpline(s, y, bc_type="not-a-knot").c
+    slope = np.diff(y) / np.diff(s)
+    return s, np.vstack([np.zeros_like(slope), np.zeros_like(slope), slope, y[:-1]])
+
+
 def saturate(tau, limit):
     """``tau`` clipped to ``[-limit, limit]`` [N m] (None: unchanged); complex-safe."""
     if limit is None:
@@ -87,6 +99,26 @@ class TorqueLaws:
 
     def __bool__(self) -> bool:
         return bool(self.torques)
+
+    def packed(self) -> np.ndarray:
+        """The laws as the law block of compiled flows
+        (:func:`walkerlab.codegen.torque_law.pack_laws`): the same tables (the not-a-knot
+        :class:`scipy.interpolate.CubicSpline`'s coefficients, or the piecewise-linear
+        slopes), gains and saturations as :meth:`each` evaluates."""
+        from walkerlab.codegen.torque_law import PHASE, PLAIN, TIME, pack_laws
+
+        rows = []
+        for act in self.torques:
+            law = act.law
+            table = law.reference if law.reference is not None else law.time_reference
+            kind = PLAIN if table is None else (PHASE if law.reference is not None else TIME)
+            knots = coefs = None
+            if table is not None:
+                knots, coefs = _table_coefficients(table)
+            rows.append((kind, law.constant_n_m, law.stiffness_n_m_per_rad,
+                         law.damping_n_m_s_per_rad, law.rest_angle_rad, act.max_torque_n_m,
+                         knots, coefs))
+        return pack_laws(rows)
 
     def __call__(self, delta, ddelta, s, ds, t_step=0.0) -> np.ndarray:
         """Torque of each actuator, shape (k,) [N m; N m/kg when ``scaled_by: foot_mass``].

@@ -298,6 +298,28 @@ def spring_equivalent(data, spec):
                       mirror)
 
 
+def _compiled_laws(phase: Phase, data, acts, limit: bool):
+    """The phase's flow with its torque laws compiled
+    (:class:`walkerlab.codegen.actuated.ActuatedFlow`: the laws evaluated in the cfunc, the
+    same guards as extra outputs), or None: torques scaled by a massless foot's mass (they
+    act on the swing row alone), or a phase whose guards have no compiled outputs."""
+    from walkerlab.codegen.actuated import ActuatedFlow
+
+    if limit:
+        return None
+    guards = phase.compiled.guards if phase.compiled is not None else None
+    if guards is None and data.structure.free_knees:
+        from walkerlab.models.hybrid.rigid_five_link import guard_outputs
+
+        guards = guard_outputs(phase, data)
+    if guards is None:
+        return None
+    links = getattr(acts, "links", None) or [("stance", "swing")] * len(acts.spec.torques)
+    return ActuatedFlow(data.structure, tuple(data.params), "flow", guards,
+                        joints=tuple(tuple(j) for j in links), laws=acts.laws.packed(),
+                        actuators=acts)
+
+
 def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     """The walker with its actuators: every phase's flow gains ``M^-1 B tau`` (and its
     Jacobian the derivative of it, by the complex step), the heel-strike reset becomes
@@ -314,8 +336,9 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     -------
     HybridWalker
         With ``actuators`` set (free knees: :class:`walkerlab.models.hybrid.
-        actuated_five_link.FiveLinkActuators`); no compiled flows (the actuation is
-        evaluated in Python).
+        actuated_five_link.FiveLinkActuators`); every phase's flow in Python (the
+        actuation added to the generated flow) and compiled with its laws
+        (``cyrk_compiled``: :class:`walkerlab.codegen.actuated.ActuatedFlow`).
 
     Raises
     ------
@@ -378,7 +401,8 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         phases.append(Phase(ph.name, flow_of(ph.flow), ph.guards,
                             jacobian=jac_of(ph.jacobian or base_jac),
                             variational=None if has_torque else ph.variational,
-                            compiled=None if has_torque else ph.compiled))
+                            compiled=(_compiled_laws(ph, data, acts, limit) if has_torque
+                                      else ph.compiled)))
     reset = walker.reset
     reset_jac = walker.reset_jacobian
     if spec.push_off is not None:

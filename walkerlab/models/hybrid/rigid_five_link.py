@@ -15,8 +15,9 @@ heel strike is looked for only once the swing foot is ahead:
   reaching the slope.
 
 The heel strike is plastic, the old stance foot leaves the ground without impulse, the legs
-swap roles (:mod:`walkerlab.codegen.five_link`).  No compiled flow (the ``cyrk_compiled``
-backend is not offered for these walkers).
+swap roles (:mod:`walkerlab.codegen.five_link`).  The passive walker has no compiled flow
+(``cyrk_compiled`` runs it on CyRK with the Python flow); one driven by joint torques does
+(:mod:`walkerlab.codegen.actuated`, its guards' outputs from :func:`guard_outputs`).
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
 from walkerlab.walker.description import WalkerData
 
-__all__ = ["make_five_link_walker"]
+__all__ = ["guard_outputs", "make_five_link_walker"]
 
 #: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
 SCUFF_DEPTH = 1e-9
@@ -36,6 +37,18 @@ SCUFF_DEPTH = 1e-9
 def _below(clearance, depth, t, x):
     """``clearance + depth``: crosses zero downward when the foot is ``depth`` deep."""
     return clearance(t, x) + depth
+
+
+def guard_outputs(phase, data: WalkerData) -> tuple:
+    """Each guard of ``phase`` as ``(generated guard, offset)``: the outputs of a compiled
+    flow (:class:`walkerlab.codegen.compiled.CompiledFlow` ``guards``) that are the same
+    functions of the state as the phase's Python guards."""
+    depth = SCUFF_DEPTH * data.leg_length_m
+    table = {"midstance": ("swing_foot_ahead", 0.0),
+             "swing_foot_scuffs": ("swing_clearance", depth), "fall": ("hip_height", 0.0),
+             "heel_strike": ("heel_strike", 0.0),
+             "swing_leg_falls_back": ("swing_foot_ahead", 0.0)}
+    return tuple(table[g.name] for g in phase.guards)
 
 
 def make_five_link_walker(data: WalkerData, name: str = "biped",

@@ -33,12 +33,25 @@ from dataclasses import replace
 from functools import partial
 
 from walkerlab.codegen.cache import functions
+from walkerlab.codegen.compiled import CompiledFlow
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
 from walkerlab.walker.description import FLAT_FOOT_MODES as MODES
 from walkerlab.walker.description import WalkerData
 
 #: The swing leg's parts of a step: before and after the legs pass each other.
 SWING_PARTS = ("early_swing", "late_swing")
+#: First chunk of each mode's compiled flow [steps] (``CompiledFlow.first_chunk_steps``):
+#: heel contact lasts ~50 DOP853 steps at rtol 1e-10, a foot flat before mid-stance ~5
+#: (each CyRK call costs as much as ~20 wasted steps: one chunk for heel contact).
+FIRST_CHUNK_STEPS = {"heel_contact": 64, "foot_flat": 8, "heel_off": 24}
+#: Each guard's extra output of the compiled flows (``GUARDS`` of
+#: :func:`walkerlab.codegen.flatfoot.generate_flat_compiled`; ``{pin}`` the mode's pinned
+#: point): the same function of the state as the Python guard of that name.
+GUARD_OUTPUT = {"heel_strike": "swing_heel_height_{pin}", "foot_slap": "foot_angle",
+                "stance_foot_lifts": "normal_force", "heel_off": "heel_force",
+                "stance_toe_lifts": "toe_force", "stance_heel_touches_down": "foot_angle",
+                "swing_leg_falls_back": "swing_foot_ahead", "midstance": "swing_foot_ahead",
+                "fall": "hip_height_{pin}"}
 
 
 def mode_of(phase_name: str) -> str:
@@ -85,6 +98,15 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     off = base if heel_off_data is None else functions(heel_off_data)
     pin = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
 
+    def compiled(mode: str, guards: list[Guard]):
+        # the phase's flow compiled, its guards the cfunc's extra outputs (GUARD_OUTPUT);
+        # an ankle push-off's heel off (other numbers than the guards') stays in Python
+        if heel_off_data is not None:
+            return None
+        return CompiledFlow(data.structure, tuple(data.params), f"flow_{mode}",
+                            tuple((GUARD_OUTPUT[g.name].format(pin=pin[mode]), 0.0)
+                                  for g in guards), first_chunk_steps=FIRST_CHUNK_STEPS[mode])
+
     def phase(mode: str, part: str) -> Phase:
         # an ankle push-off acts in heel off: its flow (and the ground forces, read through
         # it) from the released spring's numbers; guards and resets are the walker's own
@@ -126,7 +148,7 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
         guards.append(Guard("fall", f[f"guard_hip_height_{p}"], -1, "fall",
                             f[f"grad_hip_height_{p}"]))
         return Phase(f"{mode}:{part}", fl, tuple(guards), jacobian=f[f"flow_{mode}_jacobian"],
-                     variational=f[f"flow_{mode}_variational"])
+                     variational=f[f"flow_{mode}_variational"], compiled=compiled(mode, guards))
 
     phases = tuple(phase(m, part) for part in SWING_PARTS for m in MODES)
     f = base

@@ -1,0 +1,256 @@
+"""Compiled flows of a walker driven by joint-torque laws: numba ``cfunc`` right-hand sides
+(CyRK's signature, as :func:`walkerlab.codegen.source.generate_compiled`) in which the laws
+are evaluated (:mod:`walkerlab.codegen.torque_law`), so a phase-reference (virtual
+constraint), time-table or saturated law runs without a Python callback.
+
+Equations: ``M qdd + C dq + G = sum_k B_k tau_k`` with ``delta_k = leg_angles[second_k] -
+leg_angles[first_k]`` the joint angle of actuator ``k`` and ``B_k = d delta_k / dq`` its
+generalised-force direction (``+tau`` on the second link, ``-tau`` on the first: the hip of a
+straight-legged walker, ``(stance, swing)``; a five-link biped's joints), the phase variable
+``s = leg_angles["stance"]``; the torques are symbols ``_tau_k`` in the generated lines
+(:func:`walkerlab.codegen.source.flow_lines` on ``G - sum_k B_k _tau_k``) and take the law's
+values at run time.  The variational right-hand side adds the chain term
+``(M^-1 B_k) (d tau_k / dx)`` to the Jacobian at fixed torques, with ``d tau_k / dx`` from the
+law's partial derivatives and the symbolic gradients of ``delta_k``, its rate, ``s`` and
+``ds``.
+
+The data vector of each cfunc: ``constants(p)`` (``NCONST`` entries: parameters and
+parameter-only subexpressions), the law block (:func:`walkerlab.codegen.torque_law.pack_laws`,
+its length first), then the call counter (last, as every compiled flow's).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from walkerlab.codegen import cache
+from walkerlab.codegen.compiled import CompiledFlow
+
+__all__ = ["ActuatedFlow", "actuated_module", "generate_actuated"]
+
+
+def _defined(lines: list[str]) -> set[str]:
+    return {ln.split("=", 1)[0].strip() for ln in lines if "=" in ln}
+
+
+def _joint_exprs(eq, joints):
+    """Per actuator ``(delta, ddelta, B (n,))``, and ``(s, ds)``, as sympy expressions."""
+    import sympy as sp
+
+    la = eq.leg_angles
+
+    def rate(e):
+        return sum(sp.diff(e, qi) * dqi for qi, dqi in zip(eq.q, eq.dq))
+    out = []
+    for first, second in joints:
+        d = la[second] - la[first]
+        out.append((d, rate(d), [sp.diff(d, qi) for qi in eq.q]))
+    s = la["stance"]
+    return out, (s, rate(s))
+
+
+def _law_lines(eq, joints, printer, cse_lines):
+    """Lines that evaluate the laws (``_tau{k}`` and its partials ``_t{k}_0..3``) and the
+    symbolic pieces the variational equations need: ``(lines, acts, grads)``."""
+    import sympy as sp
+
+    acts, (s, ds) = _joint_exprs(eq, joints)
+    exprs = [s, ds] + [e for d, dd, _B in acts for e in (d, dd)]
+    lines, red = cse_lines(exprs, printer)
+    ind = "        "
+    lines += [f"{ind}_s = {printer.doprint(red[0])}", f"{ind}_ds = {printer.doprint(red[1])}"]
+    for k in range(len(acts)):
+        lines.append(f"{ind}_tau{k}, _t{k}_0, _t{k}_1, _t{k}_2, _t{k}_3 = law_torque("
+                     f"_law, {k}, {printer.doprint(red[2 + 2 * k])}, "
+                     f"{printer.doprint(red[3 + 2 * k])}, _s, _ds, t)")
+    x = [*eq.q, *eq.dq]
+    grads = [[sp.diff(e, v) for v in x] for e in exprs]  # rows: s, ds, delta_k, ddelta_k
+    return lines, acts, grads
+
+
+def _body(eq, joints, variational, guards, printer) -> list[str]:
+    """The lines of one cfunc after its constants' unpacking (see the module docstring);
+    ``NCONST`` is the module's constant count (a compile-time global for numba)."""
+    import sympy as sp
+
+    from walkerlab.codegen.source import cse_lines, flow_lines
+
+    n = len(eq.q)
+    m = 2 * n
+    law_lines, acts, grads = _law_lines(eq, joints, printer, cse_lines)
+    taus = [sp.Symbol(f"_tau{k}", real=True) for k in range(len(acts))]
+    G = eq.G - sum((sp.Matrix(B) * tau for (_d, _dd, B), tau in zip(acts, taus)),
+                   sp.zeros(n, 1))
+    fl, fo = flow_lines(replace(eq, G=G), variational, parts=True)
+    names = [str(v) for v in (*eq.q, *eq.dq)]
+    out = ["    _L = int(d[NCONST])",
+           "    _law = carray(d, (NCONST + _L + 1,))[NCONST:NCONST + _L]"]
+    out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
+    out += [ln[4:] for ln in law_lines] + [ln[4:] for ln in fl]
+    if not variational:
+        out += [f"    dy[{i}] = {e}" for i, e in enumerate(fo)]
+    else:
+        out += _variational_lines(eq, acts, grads, fl, fo, printer, cse_lines)
+    k0 = m + m * m if variational else m
+    out += [ln[4:] for ln in guards[0]]
+    out += [f"    dy[{k0 + j}] = {printer.doprint(e)}" for j, e in enumerate(guards[1])]
+    out.append("    d[NCONST + _L] += 1.0")
+    return out
+
+
+def _variational_lines(eq, acts, grads, fl, rows, printer, cse_lines) -> list[str]:
+    """The flow and ``(J + chain) Phi`` of the variational cfunc: ``rows`` the Jacobian at
+    fixed torques (``flow_lines``' parts), the chain ``(M^-1 B_k) (d tau_k / dx)``."""
+    n = len(eq.q)
+    m = 2 * n
+    names = [str(v) for v in (*eq.q, *eq.dq)]
+    defined = _defined(fl)
+    out = [f"    dy[{i}] = {v}" for i, v in enumerate(names[n:])]
+    out += [f"    dy[{n + i}] = _a{i}" for i in range(n)]
+    gl, gred = cse_lines([g for row in grads for g in row], printer)
+    out += [ln[4:] for ln in gl]
+    g = [[printer.doprint(gred[r * m + c]) for c in range(m)] for r in range(len(grads))]
+    for k in range(len(acts)):  # d tau_k / dx_c: the law's partials, the symbolic gradients
+        for c in range(m):
+            terms = [f"_t{k}_{j} * ({g[r][c]})" for j, r in ((2, 0), (3, 1), (0, 2 + 2 * k),
+                                                            (1, 3 + 2 * k)) if g[r][c] != "0"]
+            out.append(f"    _g{k}_{c} = {' + '.join(terms) or '0.0'}")
+    for k, (_d, _dd, B) in enumerate(acts):  # M^-1 B_k from the inverse's entries ``_i{i}{j}``
+        bl = [printer.doprint(b) for b in B]
+        for i in range(n):
+            terms = [f"_i{i}{j} * ({bl[j]})" for j in range(n)
+                     if f"_i{i}{j}" in defined and B[j] != 0]
+            out.append(f"    _mb{k}_{i} = {' + '.join(terms) or '0.0'}")
+    for i in range(m):
+        for c in range(m):
+            a = rows[i][c].strip("()")
+            if i >= n and acts:
+                chain = " + ".join(f"_mb{k}_{i - n} * _g{k}_{c}" for k in range(len(acts)))
+                a = chain if a in ("0", "0.0") else f"({a}) + {chain}"
+            out.append(f"    _J{i}_{c} = {a}")
+    for i in range(m):
+        for j in range(m):
+            terms = [f"_J{i}_{k} * y[{m + k * m + j}]" for k in range(m)]
+            out.append(f"    dy[{m + i * m + j}] = {' + '.join(terms)}")
+    return out
+
+
+def generate_actuated(eq, param_names, joints, key: str) -> str:
+    """Source of the compiled module of an actuated walker (module docstring): ``constants``,
+    ``NCONST``, ``GUARDS`` (``eq.guards``' names, written after the outputs as
+    :func:`walkerlab.codegen.source.generate_compiled` does) and the cfuncs ``flow`` (2n
+    outputs) and ``flow_variational`` (``2n + (2n)^2``).
+
+    Parameters
+    ----------
+    eq : walkerlab.codegen.symbolic.Equations
+    param_names : sequence of str
+    joints : tuple of (str, str)
+        Each actuator's (first, second) key of ``eq.leg_angles``.
+    key : str
+        Written into the header.
+    """
+    from walkerlab.codegen.source import PRINTER, cse_lines, start_module
+    from walkerlab.codegen.torque_law import kernel_source
+
+    hoisted = start_module(eq.params)  # filled as the bodies are generated
+    guards = cse_lines(list(eq.guards.values()), PRINTER)
+    bodies = {nm: _body(eq, joints, var, guards, PRINTER)
+              for nm, var in (("flow", False), ("flow_variational", True))}
+    consts = list(param_names) + [h.split("=")[0].strip() for h in hoisted]
+    text = []
+    for nm, lines in bodies.items():
+        text += ["@cfunc(SIG, cache=True, error_model='numpy')",
+                 f"def {nm}(dy, t, y, d):  # pragma: no cover - runs compiled",
+                 *[f"    {c} = d[{i}]" for i, c in enumerate(consts)], *lines, ""]
+    body = ["def constants(p):", f"    {', '.join(param_names)}, = p", *hoisted,
+            f"    return np.array(({', '.join(consts)},), dtype=np.float64)", "",
+            f"NCONST = {len(consts)}",
+            f"GUARDS = {tuple(eq.guards)!r}  # extra outputs, in this order", "",
+            *kernel_source(), *text]
+    head = [
+        f"# walkerlab compiled actuated model code (walkerlab.codegen.actuated); key {key}",
+        "# Do not edit: regenerated when the walker description or the generator changes.",
+        "from math import sin, cos, tan, sqrt, atan, acos  # noqa: F401",
+        "import numpy as np",
+        "from numba import carray, cfunc, njit, types",
+        "",
+        "SIG = types.void(types.CPointer(types.float64), types.float64,",
+        "                 types.CPointer(types.float64), types.CPointer(types.float64))",
+        "",
+    ]
+    return "\n".join(head + body) + "\n"
+
+
+def _source_hash() -> str:
+    here = Path(__file__).parent
+    h = hashlib.sha256()
+    for name in ("actuated.py", "torque_law.py"):
+        h.update((here / name).read_bytes())
+    return h.hexdigest()[:12]
+
+
+def actuated_module(structure, joints):
+    """The imported compiled module of ``structure`` driven at ``joints`` (generated on a
+    cache miss; file ``<key>_act_<hash>_nb.py``, the hash covering the joints and this
+    generator's sources).
+
+    Raises
+    ------
+    ImportError
+        numba is not installed.
+    """
+    key = cache.cache_key(structure)
+    tag = hashlib.sha256(f"{joints!r}{_source_hash()}".encode()).hexdigest()[:12]
+
+    def build() -> str:
+        if structure.free_knees:
+            from walkerlab.codegen.five_link import derive_five_link
+
+            eq = derive_five_link(structure)
+        else:
+            from walkerlab.codegen import symbolic
+
+            eq = symbolic.derive(structure)
+        return generate_actuated(eq, structure.param_names, tuple(joints), key)
+
+    return cache.import_generated(f"{key}_act_{tag}_nb.py", f"walkerlab_actuated_{key}_{tag}",
+                                  build)
+
+
+@dataclass(frozen=True, eq=False)
+class ActuatedFlow(CompiledFlow):
+    """Handle on an actuated walker's compiled flow (:class:`CompiledFlow` with laws).
+
+    Attributes
+    ----------
+    joints : tuple of (str, str)
+        Each actuator's (first, second) link (keys of the generated ``leg_angles``).
+    laws : ndarray
+        The law block (:func:`walkerlab.codegen.torque_law.pack_laws`).
+    actuators : object
+        Holds ``t_origin`` [s], the time the present step began (written into the law
+        block by :meth:`data`).
+    """
+
+    joints: tuple = ()
+    laws: np.ndarray | None = None
+    actuators: object = None
+    #: the batched step map runs the passive module's flows: not this one
+    batchable = False
+
+    def module(self):
+        return actuated_module(self.structure, self.joints)
+
+    def data(self) -> np.ndarray:
+        """Constants, the law block (with the present step's start time) and a zeroed
+        call counter."""
+        if "consts" not in self._memo:
+            self._memo["consts"] = self.module().constants(self.params)
+        laws = self.laws.copy()
+        laws[2] = float(getattr(self.actuators, "t_origin", 0.0))
+        return np.concatenate([self._memo["consts"], laws, [0.0]])
