@@ -221,8 +221,9 @@ def optimize(scene: Path | None = SceneArg,
         typer.echo(f"  step period {d.step_period_s:.6g} s, step length {d.step_length_m:.5g} m,"
                    f" speed {d.step_length_m / d.step_period_s:.5g} m/s, push-off "
                    f"{d.push_off_n_s:.5g} N s, peak |torque| {max(abs(d.torque)):.4g} N m")
-        typer.echo(f"  objective int u^2 dt = {d.objective:.6g} N^2 m^2 s; replay return "
-                   f"error {d.replay_error:.2g}; max |Floquet multiplier| {mu:.4g}")
+        typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}; "
+                   f"replay return error {d.replay_error:.2g}; max |Floquet multiplier| "
+                   f"{mu:.4g}")
         typer.echo("  a gait (the replay closes)" if d.gait else
                    "  NOT a gait: the replay does not return to its start within "
                    "optimize.replay_tolerance (or IPOPT did not converge)")
