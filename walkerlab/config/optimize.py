@@ -53,7 +53,7 @@ class OptimizeSettings(Strict):
                   float] | None = Field(None, description="objective: weighted: the terms' "
                                         "weights [1 / the term's unit]")
     smoothing_w: float = Field(1e-3, gt=0, le=1e3, description="eps of the positive part "
-                               "(p + sqrt(p^2 + eps^2) - eps) / 2 of the hip power in the "
+                               "(p + sqrt(p^2 + eps^2)) / 2 of the hip power in the "
                                "cost of transport [W]")
     intervals: int = Field(40, ge=4, le=400, description="Hermite-Simpson intervals [-]")
     push_off: Literal["fixed", "free"] = Field(

@@ -61,8 +61,8 @@ class CollocationSpec:
     weights : tuple of (str, float)
         The weighted sum's terms (names of :data:`OBJECTIVES`) and weights.
     smoothing_w : float
-        ``eps`` [W] of the positive part ``max(p, 0) ~ (p + sqrt(p^2 + eps^2) - eps) / 2``
-        in the cost of transport (within ``eps / 2`` of it).
+        ``eps`` [W] of the positive part ``max(p, 0) ~ (p + sqrt(p^2 + eps^2)) / 2`` in
+        the cost of transport (above it by at most ``eps / 2``, smooth and convex).
     min_clearance_m : float or None
         The swing foot at least this high above the slope [m] at every point but the first
         and the last (no scuffing).
@@ -451,7 +451,7 @@ def _terms(opti, fns, spec, X, U, T, P):
     h = T / ((K - 1) // 2)
     eps = spec.smoothing_w
     power = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(K)])
-    positive = 0.5 * (power + ca.sqrt(power ** 2 + eps ** 2) - eps)
+    positive = 0.5 * (power + ca.sqrt(power ** 2 + eps ** 2))
     work = fns["push_off_work"](X[:, -1], P)
     weight = fns["total_mass_kg"] * fns["gravity"]
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}

@@ -9,7 +9,31 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["optimize_scene"]
+__all__ = ["collocation_spec", "optimize_scene"]
+
+
+def collocation_spec(scene):
+    """The :class:`walkerlab.optimal.collocation.CollocationSpec` of the scene's
+    ``optimize`` section (the push-off's value, fixed or the free one's start, from the
+    scene's actuation)."""
+    from walkerlab.optimal.collocation import CollocationSpec
+
+    o = scene.optimize
+    act = getattr(scene.walker, "actuation", None)
+    push = float(act.push_off.impulse_n_s) if act is not None and act.push_off else 0.0
+    return CollocationSpec(intervals=o.intervals, push_off_n_s=push,
+                           push_off_free=o.push_off == "free",
+                           push_off_max_n_s=o.push_off_max_n_s,
+                           push_off_weight=o.push_off_weight_per_s,
+                           max_torque_n_m=o.max_torque_n_m,
+                           target_speed_m_per_s=o.target_speed_m_per_s,
+                           target_step_length_m=o.target_step_length_m,
+                           target_step_period_s=o.target_step_period_s,
+                           objective=o.objective, weights=tuple((o.weights or {}).items()),
+                           smoothing_w=o.smoothing_w, min_clearance_m=o.min_clearance_m,
+                           friction_coefficient=o.friction_coefficient,
+                           hip_angle_range_rad=o.hip_angle_range_rad,
+                           touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
 
 
 def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
@@ -40,7 +64,7 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.collocation import CollocationSpec, collocate_step, replay
+    from walkerlab.optimal.collocation import collocate_step, replay
     from walkerlab.optimal.guess import starting_step
     from walkerlab.walker.description import walker_data
 
@@ -49,22 +73,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     except ImportError:
         raise ValueError("optimize needs CasADi: pip install -e '.[optimize]'") from None
     o = scene.optimize
-    act = getattr(scene.walker, "actuation", None)
-    push = float(act.push_off.impulse_n_s) if act is not None and act.push_off else 0.0
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    spec = CollocationSpec(intervals=o.intervals, push_off_n_s=push,
-                           push_off_free=o.push_off == "free",
-                           push_off_max_n_s=o.push_off_max_n_s,
-                           push_off_weight=o.push_off_weight_per_s,
-                           max_torque_n_m=o.max_torque_n_m,
-                           target_speed_m_per_s=o.target_speed_m_per_s,
-                           target_step_length_m=o.target_step_length_m,
-                           target_step_period_s=o.target_step_period_s,
-                           objective=o.objective, weights=tuple((o.weights or {}).items()),
-                           smoothing_w=o.smoothing_w, min_clearance_m=o.min_clearance_m,
-                           friction_coefficient=o.friction_coefficient,
-                           hip_angle_range_rad=o.hip_angle_range_rad,
-                           touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
+    spec = collocation_spec(scene)
     walker = build_walker(scene)
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
     if guess_p is not None and spec.push_off_free:
