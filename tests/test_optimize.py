@@ -28,7 +28,7 @@ def _start(scene):
     return g, walk.t[first], walk.x[first]
 
 
-@pytest.mark.parametrize("slope", [0.0174, 0.0525])
+@pytest.mark.parametrize("slope", [0.0174, 0.035, 0.0525])
 def test_the_least_effort_gait_on_a_slope_is_the_passive_gait(slope):
     """int u^2 dt = 0 at the passive gait, so the optimum is it: objective <= 1e-10, step
     period within 1e-7 s of the shooting fixed point (Hermite-Simpson with 40 intervals:
