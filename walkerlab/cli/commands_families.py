@@ -224,6 +224,12 @@ def optimize(scene: Path | None = SceneArg,
         typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}; "
                    f"replay return error {d.replay_error:.2g}; max |Floquet multiplier| "
                    f"{mu:.4g}")
+        if d.contact_step_period_s == d.contact_step_period_s:  # not NaN: replayed
+            typer.echo(f"  contact model driven by the optimised torque: step period "
+                       f"{d.contact_step_period_s:.5g} s "
+                       f"({100 * (d.contact_step_period_s / d.step_period_s - 1):+.2f} %)")
+        else:
+            typer.echo(f"  contact model: {d.contact_outcome}")
         typer.echo("  a gait (the replay closes)" if d.gait else
                    "  NOT a gait: the replay does not return to its start within "
                    "optimize.replay_tolerance (or IPOPT did not converge)")

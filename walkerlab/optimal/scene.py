@@ -65,6 +65,7 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.collocation import collocate_step, replay
+    from walkerlab.optimal.contact_replay import contact_replay
     from walkerlab.optimal.guess import starting_step
     from walkerlab.walker.description import walker_data
 
@@ -89,6 +90,9 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
             mu = np.linalg.eigvals(DP).astype(complex)
         except Exception:  # noqa: BLE001 - the replay's multipliers are a report, not a gate
             pass
+    contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
+    if np.isfinite(err):
+        contact_period, contact_outcome = contact_replay(scene, res)
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
@@ -97,7 +101,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
                                                      and res.status == "Solve_Succeeded"),
                         res.status, res.iterations, res.wall_time_s, units,
                         objective_name=o.objective, objective_unit=_unit(o, data),
-                        terms=res.terms)
+                        terms=res.terms, contact_step_period_s=contact_period,
+                        contact_outcome=contact_outcome)
 
 
 def _unit(o, data) -> str:
