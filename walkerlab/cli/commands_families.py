@@ -197,7 +197,8 @@ def optimize(scene: Path | None = SceneArg,
              objective: str = typer.Option("max_abs_multiplier", "--objective",
                                            help="with --design: step_period | step_length "
                                            "| speed | cost_of_transport | "
-                                           "max_abs_multiplier"),
+                                           "max_abs_multiplier | gait_sensitivity_norm | "
+                                           "basin_share | mfpt"),
              maximize: bool = typer.Option(False, "--maximize", help="with --design: "
                                            "maximise the objective"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
