@@ -15,9 +15,17 @@ hip angle's gradient, so ``+u`` acts on the swing leg and ``-u`` on the stance l
 :mod:`walkerlab.models.actuation`).  The end is a heel strike (the generated guard = 0, the
 swing foot ahead); the step's start is the end mapped by push-off + heel strike + role swap
 (the extended-coordinate impact of :mod:`walkerlab.models.hybrid.actuated`, symbolic here):
-``x_0 = reset(x_2N)``.  Objective: the effort ``int u^2 dt`` (Simpson's rule on the same
-points), with the push-off's weighted square ``w P^2`` added when it is free.  Constraints:
-optional target speed, step length or step period, a torque limit.
+``x_0 = reset(x_2N)``; the swing foot comes down onto the ground at the end (the guard's
+rate below ``-touchdown_rate``, the rigid model's event direction).  Objectives
+(:data:`OBJECTIVES`, or a weighted sum of them): the effort ``int u^2 dt`` (Simpson's rule
+on the same points; with a free push-off its weighted square ``w P^2`` added), the
+push-off's work, the cost of transport (the hip's positive work, ``max(p, 0)`` smoothed
+as ``(p + sqrt(p^2 + eps^2)) / 2``, plus the push-off's work, per weight and step length)
+and the peak torque (epigraph form: ``-s <= u_k <= s``, minimise ``s``).  Constraints:
+optional target speed, step length or step period, a torque limit, no scuffing (the swing
+foot above a bound at every point but the ends), the stance foot's ground reaction
+``m (a_com + g)`` with a non-negative normal force inside the friction cone, the hip's
+joint limits.
 
 A result is called a gait only after its **replay**: the rigid model integrated (scipy's
 DOP853 at 1e-12) from ``x_0`` with the optimised torque as a function of time (piecewise
@@ -25,7 +33,8 @@ quadratic through the points, Hermite-Simpson's control), until its heel strike,
 same reset; the return error ``|x_0' - x_0|`` is stored.
 
 Straight legs with point feet (the walkers whose push-off the rigid view carries in
-extended coordinates); one hip torque.
+extended coordinates), or massless legs with a hip mass (Kuo's 2002 walker: the torque per
+foot mass on the swing leg's row, the point hip's transition); one hip torque.
 """
 
 from __future__ import annotations

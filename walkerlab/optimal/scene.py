@@ -42,10 +42,11 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     Parameters
     ----------
     scene : Scene
-        With ``optimize``; straight legs, point feet, massive legs.
+        With ``optimize``; straight legs, point feet, massive legs or massless ones with a
+        hip mass.
     x_gait : ndarray (2n,)
         The scene's gait just after heel strike (``fixedpoint.h5``): the initial guess is
-        one step of it.
+        one step of it (unless ``optimize.initial_guess`` names an artifact).
     period_s : float
         Its step period [s].
 
@@ -56,8 +57,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     Raises
     ------
     ValueError
-        A walker the transcription does not handle, or the scene's gait does not make a
-        step (one line).
+        A walker the transcription does not handle, the starting gait does not make a step,
+        or the initial guess's artifact is unusable (one line).
     """
     from walkerlab.analysis.gait.poincare import poincare_map
     from walkerlab.codegen import symbolic
