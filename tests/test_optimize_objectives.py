@@ -195,3 +195,25 @@ def test_a_guess_from_another_optimisation(kuo, tmp_path):
                                                        push_off_n_s=p), t, x, u, case.fns)
     assert again.status == "Solve_Succeeded" and again.iterations < res.iterations
     assert again.push_off_n_s == pytest.approx(res.push_off_n_s, rel=1e-12)
+
+
+def test_bad_optimize_sections_say_which_field(tmp_path):
+    """Weights without a weighted objective, an empty hip range, a guess from a missing
+    file or from another stage's artifact: one line naming the field."""
+    from walkerlab.config.errors import SceneError
+    from walkerlab.optimal.guess import starting_step
+
+    base = load_scene(CONFIGS / "compass_optimal.yaml").model_dump(mode="json",
+                                                                    exclude_none=True)
+    for bad, field in (({"weights": {"effort": 1.0}}, "optimize.weights"),
+                       ({"objective": "weighted"}, "optimize.weights"),
+                       ({"hip_angle_range_rad": [0.5, 0.1]}, "hip_angle_range_rad")):
+        d = {**base, "optimize": {**base["optimize"], **bad}}
+        with pytest.raises((SceneError, ValueError), match=field):
+            type(load_scene(CONFIGS / "compass_optimal.yaml")).model_validate(d)
+    scene = load_scene(CONFIGS / "compass_optimal.yaml")
+    for path, msg in ((tmp_path / "none.h5", "not found"),):
+        d = {**base, "optimize": {**base["optimize"], "initial_guess": {"from": str(path)}}}
+        sc = type(scene).model_validate(d)
+        with pytest.raises(ValueError, match="optimize.initial_guess: .*" + msg):
+            starting_step(sc, build_walker(sc), np.zeros(4), 0.7)
