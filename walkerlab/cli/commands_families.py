@@ -221,7 +221,8 @@ def optimize(scene: Path | None = SceneArg,
         typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s)")
         typer.echo(f"  step period {d.step_period_s:.6g} s, step length {d.step_length_m:.5g} m,"
                    f" speed {d.step_length_m / d.step_period_s:.5g} m/s, push-off "
-                   f"{d.push_off_n_s:.5g} N s, peak |torque| {max(abs(d.torque)):.4g} N m")
+                   f"{d.push_off_n_s:.5g} N s, peak |torque| {max(abs(d.torque)):.4g} "
+                   f"{d.torque_unit}")
         typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}; "
                    f"replay return error {d.replay_error:.2g}; max |Floquet multiplier| "
                    f"{mu:.4g}")

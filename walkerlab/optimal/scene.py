@@ -103,7 +103,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
                         res.status, res.iterations, res.wall_time_s, units,
                         objective_name=o.objective, objective_unit=_unit(o, data),
                         terms=res.terms, contact_step_period_s=contact_period,
-                        contact_outcome=contact_outcome)
+                        contact_outcome=contact_outcome,
+                        torque_unit="N m/kg" if _massless(data) else "N m")
 
 
 def _unit(o, data) -> str:
@@ -112,6 +113,11 @@ def _unit(o, data) -> str:
     from walkerlab.optimal.collocation import OBJECTIVES
 
     unit = OBJECTIVES.get(o.objective, "-")
-    if data.structure.bodies and all(b.massless for b in data.structure.bodies):
+    if _massless(data):
         unit = {"N^2 m^2 s": "N^2 m^2 s / kg^2", "N m": "N m/kg"}.get(unit, unit)
     return unit
+
+
+def _massless(data) -> bool:
+    """The legs are massless (the torque is per foot mass)."""
+    return bool(data.structure.bodies) and all(b.massless for b in data.structure.bodies)

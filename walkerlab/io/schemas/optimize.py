@@ -5,7 +5,8 @@ points)::
 
     time                          s        collocation points (2N + 1) on [0, step_period]
     states/<state name>           rad, rad/s   the walker's states there (role order)
-    torque/hip                    N m      the hip torque there (+ on the swing leg)
+    torque/hip                    N m      the hip torque there (+ on the swing leg; N m/kg:
+                                           per foot mass on massless legs)
     step_period, step_length      s, m
     speed                         m/s      step length / step period
     push_off                      N s      the push-off impulse
@@ -58,6 +59,7 @@ class OptimizeData:
     terms: dict = field(default_factory=dict)
     contact_step_period_s: float = float("nan")
     contact_outcome: str = ""
+    torque_unit: str = "N m"
 
 
 def write(f, d: OptimizeData) -> None:
@@ -69,7 +71,7 @@ def write(f, d: OptimizeData) -> None:
     for name, v in d.states.items():
         put(f, f"states/{name}", v, d.state_units[name], f"{name} at the collocation points",
             dims=("time",))
-    put(f, "torque/hip", d.torque, "N m", "hip torque (+ on the swing leg, - on the stance "
+    put(f, "torque/hip", d.torque, d.torque_unit, "hip torque (+ on the swing leg, - on the stance "
         "leg)", dims=("time",))
     put(f, "step_period", float(d.step_period_s), "s", "step period")
     put(f, "step_length", float(d.step_length_m), "m", "distance between the feet at heel "
@@ -123,7 +125,7 @@ def load(path: Path) -> OptimizeData:
             str(f.attrs["objective_name"]), str(f["objective"].attrs["unit"]),
             {k: float(v[()]) for k, v in f["terms"].items()} if "terms" in f else {},
             float(f["contact_replay/step_period"][()]),
-            str(f.attrs["contact_replay_outcome"]))
+            str(f.attrs["contact_replay_outcome"]), str(f["torque/hip"].attrs["unit"]))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)
