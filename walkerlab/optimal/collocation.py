@@ -173,8 +173,8 @@ def step_functions(data, eq):
     (> 0: the swing foot ahead), ``step(x)`` (the feet's distance [m]), ``reset(x, P)``
     (push-off ``P`` [N s] + heel strike + role swap), ``push_off_work(x, P)`` [J],
     ``guard_rate(x, u)`` (its time derivative), ``clearance(x)`` (the swing foot's
-    height above the slope [m]), ``hip_angle(x)`` (swing minus stance [rad]), ``power(x, u)`` (the hip torque's power [W]) and
-    ``grf(x, u)`` (the stance foot's ground reaction along the slope's normal and
+    height above the slope [m]), ``hip_angle(x)`` (swing minus stance [rad]),
+    ``power(x, u)`` (the hip torque's power [W]) and ``grf(x, u)`` (the stance foot's ground reaction along the slope's normal and
     tangent, forward positive [N]).
 
     On massless legs (the limit ``m_foot -> 0``, :mod:`walkerlab.codegen.symbolic`) ``u``
