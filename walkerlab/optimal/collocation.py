@@ -169,13 +169,13 @@ def _to_casadi(exprs, syms, values: dict):
 def step_functions(data, eq):
     """CasADi functions of one step of ``data`` (a WalkerData with straight legs and point
     feet, the legs massive or all massless with a hip mass) from its symbolic equations
-    ``eq``: ``flow(x, u)`` (2n,), ``guard(x)`` (the heel strike, 0 at it), ``ahead(x)``
-    (> 0: the swing foot ahead), ``step(x)`` (the feet's distance [m]), ``reset(x, P)``
-    (push-off ``P`` [N s] + heel strike + role swap), ``push_off_work(x, P)`` [J],
-    ``guard_rate(x, u)`` (its time derivative), ``clearance(x)`` (the swing foot's
+    ``eq``: ``flow(x, u)`` (2n,), ``guard(x)`` (the heel strike, 0 at it),
+    ``guard_rate(x, u)`` (its time derivative), ``ahead(x)`` (> 0: the swing foot ahead),
+    ``step(x)`` (the feet's distance [m]), ``reset(x, P)`` (push-off ``P`` [N s] + heel
+    strike + role swap), ``push_off_work(x, P)`` [J], ``clearance(x)`` (the swing foot's
     height above the slope [m]), ``hip_angle(x)`` (swing minus stance [rad]),
-    ``power(x, u)`` (the hip torque's power [W]) and ``grf(x, u)`` (the stance foot's ground reaction along the slope's normal and
-    tangent, forward positive [N]).
+    ``power(x, u)`` (the hip torque's power [W]) and ``grf(x, u)`` (the stance foot's
+    ground reaction along the slope's normal and tangent, forward positive [N]).
 
     On massless legs (the limit ``m_foot -> 0``, :mod:`walkerlab.codegen.symbolic`) ``u``
     is the torque per foot mass acting on the swing leg's row only and doing no work, and
