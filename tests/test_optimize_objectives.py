@@ -217,3 +217,56 @@ def test_bad_optimize_sections_say_which_field(tmp_path):
         sc = type(scene).model_validate(d)
         with pytest.raises(ValueError, match="optimize.initial_guess: .*" + msg):
             starting_step(sc, build_walker(sc), np.zeros(4), 0.7)
+
+
+def test_a_guess_from_a_continuation_branch(compass, tmp_path):
+    """optimize.initial_guess from a continuation artifact (a branch over the slope with
+    the gaits at 0.05 and 0.055 rad) at the scene's 0.0525: the branch's state there
+    (linear between its points) starts one simulated step, and the collocation ends at the
+    scene's passive gait all the same."""
+    import walkerlab as wl
+    from walkerlab.io.artifacts import put, write_artifact
+    from walkerlab.io.schemas.continuation import STAGE
+    from walkerlab.optimal.guess import starting_step
+
+    case, passive = compass
+    names = list(build_walker(case.scene).state_names())
+    slopes = [0.05, 0.055]
+    gaits = [wl.Walker.from_scene(case.scene).with_changes({"slope.angle_rad": s}
+                                                           ).fixed_point() for s in slopes]
+    X = np.array([g.x for g in gaits])
+
+    def writer(f):
+        f.attrs.update(parameter_path="slope.angle_rad", parameter_unit="rad",
+                       state_names=names, parameter_start=0.0525)
+        g = f.create_group("branches/0")
+        g.attrs["branch_period"] = 1
+        put(g, "param", np.array(slopes), "rad")
+        for k, n in enumerate(names):
+            put(g, f"state/{n}", X[:, k], "rad")
+            put(g, f"orbit/{n}", X[:, k:k + 1], "rad")
+        put(g, "period", np.array([g_.step_period for g_ in gaits]), "s")
+        put(g, "multipliers/real", np.zeros((2, 4)), "-")
+        put(g, "multipliers/imag", np.zeros((2, 4)), "-")
+        put(g, "stable", np.ones(2, int), "-")
+        s = f.create_group("special_points")
+        for k in ("kind", "cause"):
+            put(s, k, np.zeros(0, "S1"), "-")
+        for k in ("param", "period", "branch"):
+            put(s, k, np.zeros(0), "-")
+        for n in names:
+            put(s, f"state/{n}", np.zeros(0), "rad")
+        put(s, "multipliers/real", np.zeros((0, 4)), "-")
+        put(s, "multipliers/imag", np.zeros((0, 4)), "-")
+
+    path = tmp_path / "continuation_slope.h5"
+    write_artifact(path, STAGE, case.scene, "x", writer, 0.0)
+    d = case.scene.model_dump(mode="json", exclude_none=True)
+    d["optimize"]["initial_guess"] = {"from": str(path), "at": 0.0525}
+    scene = type(case.scene).model_validate(d)
+    t, x, u, p = starting_step(scene, build_walker(scene), np.zeros(4), 0.73)
+    np.testing.assert_allclose(x[0], X.mean(axis=0), rtol=0, atol=1e-14)
+    assert u is None and p is None
+    res = collocate_step(case.data, case.eq, CollocationSpec(intervals=40), t, x, fns=case.fns)
+    assert res.status == "Solve_Succeeded" and res.objective <= 1e-10
+    assert res.step_period_s == pytest.approx(passive.step_period_s, abs=1e-9)
