@@ -197,7 +197,8 @@ def optimize(scene: Path | None = SceneArg,
              objective: str = typer.Option("max_abs_multiplier", "--objective",
                                            help="with --design: step_period | step_length "
                                            "| speed | cost_of_transport | "
-                                           "max_abs_multiplier"),
+                                           "max_abs_multiplier | gait_sensitivity_norm | "
+                                           "basin_share | mfpt"),
              maximize: bool = typer.Option(False, "--maximize", help="with --design: "
                                            "maximise the objective"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
@@ -220,9 +221,17 @@ def optimize(scene: Path | None = SceneArg,
         typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s)")
         typer.echo(f"  step period {d.step_period_s:.6g} s, step length {d.step_length_m:.5g} m,"
                    f" speed {d.step_length_m / d.step_period_s:.5g} m/s, push-off "
-                   f"{d.push_off_n_s:.5g} N s, peak |torque| {max(abs(d.torque)):.4g} N m")
-        typer.echo(f"  objective int u^2 dt = {d.objective:.6g} N^2 m^2 s; replay return "
-                   f"error {d.replay_error:.2g}; max |Floquet multiplier| {mu:.4g}")
+                   f"{d.push_off_n_s:.5g} N s, peak |torque| {max(abs(d.torque)):.4g} "
+                   f"{d.torque_unit}")
+        typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}; "
+                   f"replay return error {d.replay_error:.2g}; max |Floquet multiplier| "
+                   f"{mu:.4g}")
+        if d.contact_step_period_s == d.contact_step_period_s:  # not NaN: replayed
+            typer.echo(f"  contact model driven by the optimised torque: step period "
+                       f"{d.contact_step_period_s:.5g} s "
+                       f"({100 * (d.contact_step_period_s / d.step_period_s - 1):+.2f} %)")
+        else:
+            typer.echo(f"  contact model: {d.contact_outcome}")
         typer.echo("  a gait (the replay closes)" if d.gait else
                    "  NOT a gait: the replay does not return to its start within "
                    "optimize.replay_tolerance (or IPOPT did not converge)")

@@ -10,22 +10,51 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import ConfigDict, Field, model_validator
 
 from walkerlab.config.base import Strict
 
-__all__ = ["OptimizeSettings"]
+__all__ = ["OptimizeGuess", "OptimizeSettings"]
+
+#: the objectives of one step (``weighted``: a sum of them with ``weights``)
+OBJECTIVE_NAMES = ("effort", "push_off_work", "cost_of_transport", "peak_torque")
+
+
+class OptimizeGuess(Strict):
+    """The collocation's starting step read from an artifact instead of the scene's gait:
+    another ``optimize.h5`` (its states, torque, period and push-off), or a continuation
+    artifact's branch at a parameter value (its gait there, one step of the scene's
+    walker simulated from it)."""
+
+    model_config = ConfigDict(populate_by_name=True)
+
+    from_: str = Field(alias="from", min_length=1, description="optimize.h5 or "
+                       "continuation_<field>.h5, relative to the current folder")
+    at: float | None = Field(None, description="continuation artifact: the parameter value "
+                             "on the branch [the artifact's field unit]")
+    branch: int = Field(0, ge=0, le=1000, description="continuation artifact: the branch")
 
 
 class OptimizeSettings(Strict):
     """One step of the walker with a hip torque ``u`` (and the scene's push-off) found by
-    Hermite-Simpson collocation: minimise ``int u^2 dt`` (objective ``effort``), with the
-    push-off's squared impulse added when it is ``free``; the result is replayed on the rigid
-    model and called a gait only if the replay returns to its start within
-    ``replay_tolerance``."""
+    Hermite-Simpson collocation: minimise the objective (``effort`` ``int u^2 dt`` by
+    default, with the push-off's squared impulse added when it is ``free``) within the
+    targets and constraints given; the result is replayed on the rigid model and called a
+    gait only if the replay returns to its start within ``replay_tolerance``.  On massless
+    legs (Kuo's walker) ``u`` is the torque per foot mass [N m/kg] on the swing leg."""
 
-    objective: Literal["effort"] = Field("effort", description="int u^2 dt [N^2 m^2 s] (plus "
-                                         "push_off_weight P^2 when the push-off is free)")
+    objective: Literal["effort", "push_off_work", "cost_of_transport", "peak_torque",
+                       "weighted"] = Field(
+        "effort", description="effort: int u^2 dt [N^2 m^2 s] (plus push_off_weight P^2 "
+        "when the push-off is free); push_off_work [J]; cost_of_transport: positive hip "
+        "work (smoothed) + push-off work per weight and step length [-]; peak_torque: max "
+        "|u| [N m] (epigraph form); weighted: sum of weights[name] * name")
+    weights: dict[Literal["effort", "push_off_work", "cost_of_transport", "peak_torque"],
+                  float] | None = Field(None, description="objective: weighted: the terms' "
+                                        "weights [1 / the term's unit]")
+    smoothing_w: float = Field(1e-3, gt=0, le=1e3, description="eps of the positive part "
+                               "(p + sqrt(p^2 + eps^2)) / 2 of the hip power in the "
+                               "cost of transport [W]")
     intervals: int = Field(40, ge=4, le=400, description="Hermite-Simpson intervals [-]")
     push_off: Literal["fixed", "free"] = Field(
         "fixed", description="the push-off impulse: the scene's (fixed) or a decision "
@@ -39,6 +68,20 @@ class OptimizeSettings(Strict):
                                                "/ step period [m/s]")
     target_step_length_m: float | None = Field(None, gt=0, le=10, description="[m]")
     target_step_period_s: float | None = Field(None, gt=0, le=20, description="[s]")
+    min_clearance_m: float | None = Field(None, ge=-1, le=1, description="the swing foot at "
+                                          "least this high above the slope at every point "
+                                          "but the first and the last (no scuffing) [m]")
+    friction_coefficient: float | None = Field(None, gt=0, le=10, description="the stance "
+                                               "foot's normal force >= 0 and |tangential| "
+                                               "<= this times it [-]")
+    hip_angle_range_rad: tuple[float, float] | None = Field(
+        None, description="the hip joint's limits on the swing - stance angle [rad]")
+    touchdown_rate_rad_per_s: float = Field(0.05, gt=0, le=100, description="the heel-"
+                                            "strike guard falls at least this fast at the "
+                                            "end (no grazing touchdown) [rad/s]")
+    initial_guess: OptimizeGuess | None = Field(None, description="start from another "
+                                                "optimize.h5 or a continuation branch "
+                                                "(default: the scene's gait)")
     replay_tolerance: float = Field(1e-6, gt=0, le=1.0, description="largest return error "
                                     "of the replay for a gait [rad, rad/s]")
 
@@ -49,4 +92,10 @@ class OptimizeSettings(Strict):
         if len(given) == 3:
             raise ValueError("optimize: speed, step length and step period together fix "
                              "one another: give at most two")
+        if (self.objective == "weighted") != bool(self.weights):
+            raise ValueError("optimize.weights: give them with objective: weighted (and "
+                             "only then)")
+        r = self.hip_angle_range_rad
+        if r is not None and not r[0] < r[1]:
+            raise ValueError("optimize.hip_angle_range_rad: [lo, hi] with lo < hi")
         return self

@@ -15,9 +15,17 @@ hip angle's gradient, so ``+u`` acts on the swing leg and ``-u`` on the stance l
 :mod:`walkerlab.models.actuation`).  The end is a heel strike (the generated guard = 0, the
 swing foot ahead); the step's start is the end mapped by push-off + heel strike + role swap
 (the extended-coordinate impact of :mod:`walkerlab.models.hybrid.actuated`, symbolic here):
-``x_0 = reset(x_2N)``.  Objective: the effort ``int u^2 dt`` (Simpson's rule on the same
-points), with the push-off's weighted square ``w P^2`` added when it is free.  Constraints:
-optional target speed, step length or step period, a torque limit.
+``x_0 = reset(x_2N)``; the swing foot comes down onto the ground at the end (the guard's
+rate below ``-touchdown_rate``, the rigid model's event direction).  Objectives
+(:data:`OBJECTIVES`, or a weighted sum of them): the effort ``int u^2 dt`` (Simpson's rule
+on the same points; with a free push-off its weighted square ``w P^2`` added), the
+push-off's work, the cost of transport (the hip's positive work, ``max(p, 0)`` smoothed
+as ``(p + sqrt(p^2 + eps^2)) / 2``, plus the push-off's work, per weight and step length)
+and the peak torque (epigraph form: ``-s <= u_k <= s``, minimise ``s``).  Constraints:
+optional target speed, step length or step period, a torque limit, no scuffing (the swing
+foot above a bound at every point but the ends), the stance foot's ground reaction
+``m (a_com + g)`` with a non-negative normal force inside the friction cone, the hip's
+joint limits.
 
 A result is called a gait only after its **replay**: the rigid model integrated (scipy's
 DOP853 at 1e-12) from ``x_0`` with the optimised torque as a function of time (piecewise
@@ -25,18 +33,19 @@ quadratic through the points, Hermite-Simpson's control), until its heel strike,
 same reset; the return error ``|x_0' - x_0|`` is stored.
 
 Straight legs with point feet (the walkers whose push-off the rigid view carries in
-extended coordinates); one hip torque.
+extended coordinates), or massless legs with a hip mass (Kuo's 2002 walker: the torque per
+foot mass on the swing leg's row, the point hip's transition); one hip torque.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["CollocationResult", "CollocationSpec", "collocate_step", "replay", "step_functions",
-           "torque_of_time"]
+__all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step", "replay",
+           "step_functions", "torque_of_time"]
 
 
 @dataclass(frozen=True)
@@ -56,6 +65,24 @@ class CollocationSpec:
         ``|u| <= max`` [N m].
     target_speed_m_per_s, target_step_length_m, target_step_period_s : float or None
         Equality targets (speed = step length / step period).
+    objective : str
+        A key of :data:`OBJECTIVES`, or ``weighted``: ``sum w_i J_i`` over ``weights``.
+    weights : tuple of (str, float)
+        The weighted sum's terms (names of :data:`OBJECTIVES`) and weights.
+    smoothing_w : float
+        ``eps`` [W] of the positive part ``max(p, 0) ~ (p + sqrt(p^2 + eps^2)) / 2`` in
+        the cost of transport (above it by at most ``eps / 2``, smooth and convex).
+    min_clearance_m : float or None
+        The swing foot at least this high above the slope [m] at every point but the first
+        and the last (no scuffing).
+    friction_coefficient : float or None
+        The stance foot's ground reaction: normal force >= 0 and ``|F_t| <= mu F_n``.
+    hip_angle_range_rad : tuple (lo, hi) or None
+        The hip joint's limits on ``swing - stance`` angle [rad].
+    touchdown_rate_rad_per_s : float
+        The heel-strike guard falls at least this fast at the end [rad/s]: the swing foot
+        comes down onto the ground, not grazing it (a grazing touchdown moves the replay's
+        event time by the state error / the rate).
     """
 
     intervals: int = 40
@@ -67,6 +94,18 @@ class CollocationSpec:
     target_speed_m_per_s: float | None = None
     target_step_length_m: float | None = None
     target_step_period_s: float | None = None
+    objective: str = "effort"
+    weights: tuple = ()
+    smoothing_w: float = 1e-3
+    min_clearance_m: float | None = None
+    friction_coefficient: float | None = None
+    hip_angle_range_rad: tuple | None = None
+    touchdown_rate_rad_per_s: float = 0.05
+
+
+#: Objectives of one step, with their units (``u`` per foot mass on massless legs).
+OBJECTIVES = {"effort": "N^2 m^2 s", "push_off_work": "J", "cost_of_transport": "-",
+              "peak_torque": "N m"}
 
 
 @dataclass
@@ -83,7 +122,11 @@ class CollocationResult:
         Hip torque [N m].
     step_period_s, step_length_m, push_off_n_s : float
     objective : float
-        ``int u^2 dt`` [N^2 m^2 s] (+ the push-off's weighted work when it is free).
+        The spec's objective at the optimum (its unit: :data:`OBJECTIVES`; ``effort``
+        with a free push-off adds ``push_off_weight P^2``).
+    terms : dict
+        Every objective of :data:`OBJECTIVES` evaluated there (the cost of transport
+        smoothed; ``peak_torque`` ``max |u|``).
     status : str
         IPOPT's return status.
     iterations : int
@@ -103,6 +146,7 @@ class CollocationResult:
     iterations: int
     wall_time_s: float
     replay_error: float = np.nan
+    terms: dict = field(default_factory=dict)
 
 
 def _to_casadi(exprs, syms, values: dict):
@@ -124,57 +168,156 @@ def _to_casadi(exprs, syms, values: dict):
 
 def step_functions(data, eq):
     """CasADi functions of one step of ``data`` (a WalkerData with straight legs and point
-    feet) from its symbolic equations ``eq``: ``flow(x, u)`` (2n,), ``guard(x)`` (the heel
-    strike, 0 at it), ``ahead(x)`` (> 0: the swing foot ahead), ``step(x)`` (the feet's
-    distance [m]) and ``reset(x, P)`` (push-off ``P`` [N s] + heel strike + role swap).
+    feet, the legs massive or all massless with a hip mass) from its symbolic equations
+    ``eq``: ``flow(x, u)`` (2n,), ``guard(x)`` (the heel strike, 0 at it),
+    ``guard_rate(x, u)`` (its time derivative), ``ahead(x)`` (> 0: the swing foot ahead),
+    ``step(x)`` (the feet's distance [m]), ``reset(x, P)`` (push-off ``P`` [N s] + heel
+    strike + role swap), ``push_off_work(x, P)`` [J], ``clearance(x)`` (the swing foot's
+    height above the slope [m]), ``hip_angle(x)`` (swing minus stance [rad]),
+    ``power(x, u)`` (the hip torque's power [W]) and ``grf(x, u)`` (the stance foot's
+    ground reaction along the slope's normal and tangent, forward positive [N]).
+
+    On massless legs (the limit ``m_foot -> 0``, :mod:`walkerlab.codegen.symbolic`) ``u``
+    is the torque per foot mass acting on the swing leg's row only and doing no work, and
+    the transition is the point hip's (Kuo 2002, as :mod:`walkerlab.models.hybrid.actuated`).
 
     Raises
     ------
     ValueError
-        Knees, arc or flat feet, massless legs (one line).
+        Knees, arc or flat feet, a torso, partly massless legs (one line).
     """
     import casadi as ca
     import sympy as sp
 
     st = data.structure
-    if st.knee or st.foot != "point" or any(b.massless for b in st.bodies) or st.torso:
-        raise ValueError("optimize: straight legs with point feet and massive legs only "
-                         "today (knees, arc and flat feet, a torso, massless legs: not yet)")
+    massless = [b.massless for b in st.bodies]
+    limit = bool(massless) and all(massless)
+    if (st.knee or st.foot != "point" or st.torso or (any(massless) and not limit)
+            or (limit and not st.hip_mass)):
+        raise ValueError("optimize: straight legs with point feet only today, their bodies "
+                         "massive or all massless with a hip mass (knees, arc and flat feet, "
+                         "a torso, partly massless legs: not yet)")
     n = len(eq.q)
     vals = dict(zip(eq.params, data.params))
-    q, dq = list(eq.q), list(eq.dq)
-    xs = q + dq
-    M = _to_casadi(eq.M, xs, vals)
-    C = _to_casadi(eq.C, xs, vals)
-    G = _to_casadi(eq.G, xs, vals)
+    xs = list(eq.q) + list(eq.dq)
+
+    def fn(name, exprs, *extra):
+        return ca.Function(name, [x, *extra], [_to_casadi(exprs, xs, vals)(x)])
+
+    x, u, P = ca.SX.sym("x", 2 * n), ca.SX.sym("u"), ca.SX.sym("P")
+    M, C, G = (_to_casadi(m, xs, vals)(x) for m in (eq.M, eq.C, eq.G))
     delta = eq.leg_angles["swing"] - eq.leg_angles["stance"]
-    B = _to_casadi(sp.Matrix([delta]).jacobian(q).T, xs, vals)
-    x = ca.SX.sym("x", 2 * n)
-    u = ca.SX.sym("u")
-    qdd = ca.solve(M(x), B(x) * u - C(x) @ x[n:] - G(x))
-    flow = ca.Function("flow", [x, u], [ca.vertcat(x[n:], qdd)])
-    guard = ca.Function("guard", [x], [_to_casadi([eq.guards["heel_strike"]], xs, vals)(x)])
-    ahead = ca.Function("ahead", [x], [_to_casadi([eq.guards["swing_foot_ahead"]], xs,
-                                                  vals)(x)])
+    if limit:  # the rows of the absolute leg angles / m_foot, the swing row first
+        B = ca.DM([1.0] + [0.0] * (n - 1))
+    else:
+        B = _to_casadi(sp.Matrix([delta]).jacobian(eq.q).T, xs, vals)(x)
+    qdd = ca.solve(M, B * u - C @ x[n:] - G)
     foot = _to_casadi(eq.points["swing_foot"], xs, vals)(x)
-    step = ca.Function("step", [x], [ca.sqrt(foot[0] ** 2 + foot[1] ** 2)])
-    # push-off + heel strike in extended coordinates [q, x_f, y_f]
-    qe = list(eq.q) + [sp.Symbol("x_f"), sp.Symbol("y_f")]
-    De = _to_casadi(eq.De.subs({qe[n]: 0, qe[n + 1]: 0}), xs, vals)(x)
-    E = _to_casadi(eq.E.subs({qe[n]: 0, qe[n + 1]: 0}), xs, vals)(x)
+    hip_angle = _to_casadi([delta], xs, vals)(x)
+    rate = ca.jacobian(hip_angle, x[:n]) @ x[n:]
+    reset, work = (_reset_point_hip if limit else _reset_extended)(eq, xs, vals, x, P,
+                                                                   data.total_mass_kg)
+    return {"flow": ca.Function("flow", [x, u], [ca.vertcat(x[n:], qdd)]),
+            "guard": fn("guard", [eq.guards["heel_strike"]]),
+            "guard_rate": ca.Function("guard_rate", [x, u], [ca.jacobian(
+                _to_casadi([eq.guards["heel_strike"]], xs, vals)(x), x) @ ca.vertcat(
+                    x[n:], qdd)]),
+            "ahead": fn("ahead", [eq.guards["swing_foot_ahead"]]),
+            "step": ca.Function("step", [x], [ca.sqrt(foot[0] ** 2 + foot[1] ** 2)]),
+            "reset": ca.Function("reset", [x, P], [reset]),
+            "push_off_work": ca.Function("push_off_work", [x, P], [work]),
+            "clearance": fn("clearance", [eq.guards["swing_clearance"]]),
+            "hip_angle": ca.Function("hip_angle", [x], [hip_angle]),
+            "power": ca.Function("power", [x, u], [0 * u if limit else u * rate]),
+            "grf": ca.Function("grf", [x, u], [_ground_reaction(data, eq, xs, vals, x,
+                                                               qdd)]),
+            "n": n, "limit": limit, "total_mass_kg": float(data.total_mass_kg),
+            "gravity": float(data.gravity_m_per_s2)}
+
+
+def _relabel(eq, xs, vals, x, dq_plus):
+    """The post-impact state with the roles swapped (CasADi)."""
+    import casadi as ca
+
+    qn = _to_casadi(eq.relabel_q, xs, vals)(x)
+    R = np.array(eq.relabel_rate.subs(vals), float)
+    return ca.vertcat(qn, ca.DM(R) @ dq_plus)
+
+
+def _reset_extended(eq, xs, vals, x, P, _mass):
+    """Push-off + heel strike in extended coordinates ``[q, x_f, y_f]``
+    (:mod:`walkerlab.models.hybrid.actuated`), and the push-off's work [J]."""
+    import casadi as ca
+    import sympy as sp
+
+    n = len(eq.q)
+    fs = {sp.Symbol("x_f"): 0, sp.Symbol("y_f"): 0}
+    De = _to_casadi(eq.De.subs(fs), xs, vals)(x)
+    E = _to_casadi(eq.E.subs(fs), xs, vals)(x)
     hip = _to_casadi(eq.points["hip"], xs, vals)(x)
     e = hip / ca.sqrt(hip[0] ** 2 + hip[1] ** 2)
-    P = ca.SX.sym("P")
     dqe = ca.vertcat(x[n:], 0, 0)
     Ef = ca.horzcat(ca.SX.zeros(2, n), ca.SX.eye(2))
     dqe_po = dqe + ca.solve(De, Ef.T @ (P * e))
     K = ca.vertcat(ca.horzcat(De, -E.T), ca.horzcat(E, ca.SX.zeros(2, 2)))
     sol = ca.solve(K, ca.vertcat(De @ dqe_po, 0, 0))
+    work = 0.5 * (dqe_po.T @ De @ dqe_po - dqe.T @ De @ dqe)
+    return _relabel(eq, xs, vals, x, sol[:n]), work
+
+
+def _reset_point_hip(eq, xs, vals, x, P, mass):
+    """Push-off + heel strike of a walker whose mass is all at the hip (Kuo 2002, Eq. 2):
+    ``v_po = v + (P / M) e_trail``, the heel strike removes the velocity along the leading
+    leg, the trailing foot keeps none across its leg; and the push-off's work [J]."""
+    import casadi as ca
+
+    n = len(eq.q)
+    q, dq = x[:n], x[n:]
+    hip = _to_casadi(eq.points["hip"], xs, vals)(x)
+    lead = _to_casadi(eq.points["swing_foot"], xs, vals)(x)
+    v = ca.jacobian(hip, q) @ dq
+    et = hip / ca.norm_2(hip)
+    el = (hip - lead) / ca.norm_2(hip - lead)
+    v_po = v + (P / mass) * et
+    v_plus = v_po - ca.dot(v_po, el) * el
+    v_foot = ca.dot(v_plus, et) * et
     qn = _to_casadi(eq.relabel_q, xs, vals)(x)
-    R = np.array(eq.relabel_rate.subs(vals), float)
-    reset = ca.Function("reset", [x, P], [ca.vertcat(qn, ca.DM(R) @ sol[:n])])
-    return {"flow": flow, "guard": guard, "ahead": ahead, "step": step, "reset": reset,
-            "n": n}
+    qs = ca.SX.sym("qs", n)  # the new coordinates: Jacobian of (hip, swing foot) there
+    where = ca.Function("where", [x], [ca.vertcat(hip, lead)])
+    Jn = ca.Function("Jn", [qs], [ca.jacobian(where(ca.vertcat(qs, ca.SX.zeros(n))),
+                                              qs)])(qn)
+    b = ca.vertcat(v_plus, v_foot)
+    dq_plus = ca.solve(Jn.T @ Jn, Jn.T @ b)
+    work = 0.5 * mass * (ca.dot(v_po, v_po) - ca.dot(v, v))
+    return ca.vertcat(qn, dq_plus), work
+
+
+def _ground_reaction(data, eq, xs, vals, x, qdd):
+    """The stance foot's ground reaction ``m_total (a_com + g y)`` [N] along the slope's
+    normal and tangent (forward positive), from the bodies' named points and masses."""
+    import casadi as ca
+
+    from walkerlab.walker.description import ROLE_TAG
+
+    st = data.structure
+    n = len(eq.q)
+    names = list(st.param_names)
+    pts = [(float(data.params[names.index("M_hip")]), "hip")] if st.hip_mass else []
+    for b in st.bodies:
+        for role in ("stance", "swing"):
+            if b.massless:
+                continue
+            tag = f"{ROLE_TAG[role]}_" if st.asymmetric else ""
+            pts.append((float(data.params[names.index(f"m_{tag}{b.name}")]),
+                        f"{role}_{b.name}"))
+    mtot = sum(m for m, _ in pts)
+    com = sum(m * _to_casadi(eq.points[p], xs, vals)(x) for m, p in pts) / mtot
+    vel = ca.jacobian(com, x[:n]) @ x[n:]
+    acc = ca.jacobian(vel, x) @ ca.vertcat(x[n:], qdd)
+    F = mtot * (acc + ca.vertcat(0, data.gravity_m_per_s2))
+    gam = data.slope_rad
+    return ca.vertcat(ca.sin(gam) * F[0] + ca.cos(gam) * F[1],
+                      ca.cos(gam) * F[0] - ca.sin(gam) * F[1])
 
 
 def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
@@ -212,43 +355,19 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     n2, N = 2 * fns["n"], int(spec.intervals)
     K = 2 * N + 1
     opti = ca.Opti()
-    X = opti.variable(n2, K)
-    U = opti.variable(1, K)
-    T = opti.variable()
+    X, U, T = opti.variable(n2, K), opti.variable(1, K), opti.variable()
     P = opti.variable() if spec.push_off_free else spec.push_off_n_s
-    h = T / N
-    f = [fns["flow"](X[:, k], U[k]) for k in range(K)]
-    for i in range(0, K - 1, 2):
-        m, j = i + 1, i + 2
-        opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (f[i] - f[j]))
-        opti.subject_to(X[:, j] == X[:, i] + h / 6 * (f[i] + 4 * f[m] + f[j]))
-    opti.subject_to(fns["guard"](X[:, -1]) == 0)
-    opti.subject_to(fns["ahead"](X[:, -1]) >= 1e-3)
-    opti.subject_to(X[:, 0] == fns["reset"](X[:, -1], P))
-    opti.subject_to(opti.bounded(0.05 * guess_t[-1], T, 5.0 * guess_t[-1]))
-    if spec.max_torque_n_m is not None:
-        opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
-    length = fns["step"](X[:, -1])
-    if spec.target_step_period_s is not None:
-        opti.subject_to(T == spec.target_step_period_s)
-    if spec.target_step_length_m is not None:
-        opti.subject_to(length == spec.target_step_length_m)
-    if spec.target_speed_m_per_s is not None:
-        opti.subject_to(length == spec.target_speed_m_per_s * T)
-    w = np.tile([4.0, 2.0], N)[:K - 2]
-    weights = np.concatenate([[1.0], w, [1.0]])  # Simpson on the 2N + 1 points
-    effort = h / 6 * ca.sum2(ca.DM(weights).T * U ** 2)
-    obj = effort
-    if spec.push_off_free:
-        opti.subject_to(opti.bounded(0.0, P, spec.push_off_max_n_s))
-        obj = obj + spec.push_off_weight * P ** 2
+    _transcribe(opti, fns, spec, X, U, T, P, guess_t[-1])
+    _path_constraints(opti, fns, spec, X, U)
+    terms = _terms(opti, fns, spec, X, U, T, P)
+    obj = _objective(spec, terms, P)
     opti.minimize(obj)
     tk = np.linspace(0.0, 1.0, K) * guess_t[-1]
     opti.set_initial(T, float(guess_t[-1]))
     opti.set_initial(X, np.stack([np.interp(tk, guess_t, guess_x[:, c])
                                   for c in range(n2)]))
-    opti.set_initial(U, np.interp(tk, guess_t, np.zeros_like(guess_t)
-                                  if guess_u is None else guess_u)[None])
+    ug = np.interp(tk, guess_t, np.zeros_like(guess_t) if guess_u is None else guess_u)
+    opti.set_initial(U, ug[None])
     if spec.push_off_free:
         opti.set_initial(P, spec.push_off_n_s)
     opti.solver("ipopt", {"print_time": False},
@@ -268,7 +387,113 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
         step_length_m=float(fns["step"](Xv[-1])),
         push_off_n_s=float(get(P)) if spec.push_off_free else float(spec.push_off_n_s),
         objective=float(get(obj)), status=status,
-        iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall)
+        iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall,
+        terms={k: float(get(v)) for k, v in terms.items()})
+
+
+def _transcribe(opti, fns, spec, X, U, T, P, period_guess):
+    """Hermite-Simpson defects, the heel strike at the end, the periodic reset and the
+    targets (module docstring)."""
+    K = X.shape[1]
+    h = T / ((K - 1) // 2)
+    f = [fns["flow"](X[:, k], U[k]) for k in range(K)]
+    for i in range(0, K - 1, 2):
+        m, j = i + 1, i + 2
+        opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (f[i] - f[j]))
+        opti.subject_to(X[:, j] == X[:, i] + h / 6 * (f[i] + 4 * f[m] + f[j]))
+    opti.subject_to(fns["guard"](X[:, -1]) == 0)
+    opti.subject_to(fns["ahead"](X[:, -1]) >= 1e-3)
+    # the swing foot comes down onto the ground (the rigid model's heel-strike direction)
+    opti.subject_to(fns["guard_rate"](X[:, -1], U[-1])
+                    <= -spec.touchdown_rate_rad_per_s)
+    opti.subject_to(X[:, 0] == fns["reset"](X[:, -1], P))
+    opti.subject_to(opti.bounded(0.05 * period_guess, T, 5.0 * period_guess))
+    if spec.push_off_free:
+        opti.subject_to(opti.bounded(0.0, P, spec.push_off_max_n_s))
+    if spec.max_torque_n_m is not None:
+        opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
+    length = fns["step"](X[:, -1])
+    if spec.target_step_period_s is not None:
+        opti.subject_to(T == spec.target_step_period_s)
+    if spec.target_step_length_m is not None:
+        opti.subject_to(length == spec.target_step_length_m)
+    if spec.target_speed_m_per_s is not None:
+        opti.subject_to(length == spec.target_speed_m_per_s * T)
+
+
+def _path_constraints(opti, fns, spec, X, U):
+    """No scuffing (every point but the first and the last), the stance foot's ground
+    reaction in its friction cone, the hip's joint limits."""
+    K = X.shape[1]
+    if spec.min_clearance_m is not None:
+        for k in range(1, K - 1):
+            opti.subject_to(fns["clearance"](X[:, k]) >= spec.min_clearance_m)
+    if spec.friction_coefficient is not None:
+        mu = spec.friction_coefficient
+        for k in range(K):
+            F = fns["grf"](X[:, k], U[k])
+            opti.subject_to(F[0] >= 0)
+            opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
+    if spec.hip_angle_range_rad is not None:
+        lo, hi = spec.hip_angle_range_rad
+        for k in range(K):
+            opti.subject_to(opti.bounded(lo, fns["hip_angle"](X[:, k]), hi))
+
+
+def _simpson(h, values):
+    """Simpson's rule on the 2N + 1 points (``values`` (1, 2N + 1))."""
+    import casadi as ca
+
+    K = values.shape[1]
+    w = np.concatenate([[1.0], np.tile([4.0, 2.0], (K - 1) // 2)[:K - 2], [1.0]])
+    return h / 6 * ca.sum2(ca.DM(w).T * values)
+
+
+def _terms(opti, fns, spec, X, U, T, P):
+    """The objectives used (:data:`OBJECTIVES`): effort ``int u^2 dt``, the push-off's work,
+    the cost of transport (positive hip work, smoothed, plus the push-off's work, per
+    weight and step length) and the peak torque (epigraph: ``-s <= u <= s``, minimise
+    ``s``; only when it is asked for, else ``max |u|`` afterwards)."""
+    import casadi as ca
+
+    K = X.shape[1]
+    h = T / ((K - 1) // 2)
+    eps = spec.smoothing_w
+    power = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(K)])
+    positive = 0.5 * (power + ca.sqrt(power ** 2 + eps ** 2))
+    work = fns["push_off_work"](X[:, -1], P)
+    weight = fns["total_mass_kg"] * fns["gravity"]
+    asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
+    if "peak_torque" in asked:
+        peak = opti.variable()
+        opti.subject_to(opti.bounded(-peak, U, peak))
+        opti.set_initial(peak, 1.0)
+    else:
+        peak = ca.mmax(ca.fabs(U))
+    return {"effort": _simpson(h, U ** 2), "push_off_work": work,
+            "cost_of_transport": (_simpson(h, positive) + work)
+            / (weight * fns["step"](X[:, -1])), "peak_torque": peak}
+
+
+def _objective(spec, terms, P):
+    """The spec's objective from the terms (``effort`` with a free push-off: + ``w P^2``).
+
+    Raises
+    ------
+    ValueError
+        An unknown objective or weighted term (one line).
+    """
+    if spec.objective == "weighted":
+        bad = [k for k, _ in spec.weights if k not in OBJECTIVES]
+        if bad or not spec.weights:
+            raise ValueError(f"optimize.weights: terms among {', '.join(OBJECTIVES)}")
+        return sum(w * terms[k] for k, w in spec.weights)
+    if spec.objective not in OBJECTIVES:
+        raise ValueError(f"optimize.objective: one of {', '.join(OBJECTIVES)} or weighted")
+    obj = terms[spec.objective]
+    if spec.objective == "effort" and spec.push_off_free:
+        obj = obj + spec.push_off_weight * P ** 2
+    return obj
 
 
 def torque_of_time(res: CollocationResult):
@@ -311,8 +536,11 @@ def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
 
     # a saturated law is never a generated spring (models.hybrid.actuated.spring_equivalent):
     # its torque is the Actuators' own, which is replaced by the optimised one below
+    st = data.structure
+    massless = bool(st.bodies) and all(b.massless for b in st.bodies)
     spec = Actuation(push_off=PushOff(impulse_n_s=max(res.push_off_n_s, 0.0)),
-                     torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
+                     torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
+                                          scaled_by="foot_mass" if massless else "none")])
     walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
     acts = walker.actuators
     tau = torque_of_time(res)

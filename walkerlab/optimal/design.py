@@ -4,14 +4,19 @@ the root finder at the last gait found, so the optimiser never jumps to another 
 
 Measures (of the period-1 gait ``x*(p)`` of the rigid model): ``step_period`` [s],
 ``step_length`` [m], ``speed`` [m/s], ``cost_of_transport`` [-] (the energy ledger's,
-:mod:`walkerlab.analysis.gait.energy`) and ``max_abs_multiplier`` [-].
+:mod:`walkerlab.analysis.gait.energy`), ``max_abs_multiplier`` [-] and the robustness
+measures of :mod:`walkerlab.optimal.design_measures` (``gait_sensitivity_norm``,
+``basin_share``, ``mfpt``).
 
 Gradients of the smooth measures are exact through the fixed point (the implicit function
 theorem on the Poincaré map ``P``): ``x* = P(x*, p)`` gives ``dx*/dp = (I - DP)^-1 dP/dp``,
 with ``DP`` the map's Jacobian from the variational equations at the fixed point and
 ``dP/dp``, ``dm/dx``, ``dm/dp`` central differences of single steps; SLSQP
 (:func:`scipy.optimize.minimize`) uses them.  ``max_abs_multiplier`` is not smooth where two
-multipliers cross: Nelder-Mead (derivative-free, within the bounds).  Hobbelen & Wisse
+multipliers cross, the basin share and the MFPT are piecewise constant in the design:
+Nelder-Mead (derivative-free, within the bounds).  The gait sensitivity norm is smooth but
+itself built from differences: its gradient is central differences of the re-solved gait
+(step ``1e-4`` of the field's scale), SLSQP.  Hobbelen & Wisse
 (2007) and Byl & Tedrake (2009) optimise designs over such gait measures.
 """
 
@@ -25,8 +30,12 @@ __all__ = ["MEASURES", "DesignResult", "design_optimize", "measure_gradient"]
 
 #: Measures of a gait a design can optimise, with their units.
 MEASURES = {"step_period": "s", "step_length": "m", "speed": "m/s", "cost_of_transport": "-",
-            "max_abs_multiplier": "-"}
+            "max_abs_multiplier": "-", "gait_sensitivity_norm": "-", "basin_share": "-",
+            "mfpt": "steps"}
+#: gradients through the fixed point (implicit function theorem)
 SMOOTH = ("step_period", "step_length", "speed", "cost_of_transport")
+#: smooth, gradients by central differences of the re-solved gait
+DIFFERENCED = ("gait_sensitivity_norm",)
 
 
 @dataclass
@@ -76,12 +85,42 @@ class _Gaits:
         self.last = np.asarray(x0, float)
         self.count = 0
 
-    def walker(self, p):
-        from walkerlab.models.registry import build_walker
+    def scene_at(self, p):
         from walkerlab.studies.params import apply_point
 
-        return build_walker(apply_point(self.scene.model_dump(mode="json"), self.fields,
-                                        tuple(map(float, p)), "optimize --design"))
+        return apply_point(self.scene.model_dump(mode="json"), self.fields,
+                           tuple(map(float, p)), "optimize --design")
+
+    def walker(self, p):
+        from walkerlab.models.registry import build_walker
+
+        return build_walker(self.scene_at(p))
+
+    def value(self, p, name: str) -> float:
+        """A measure that is not one map's (``max_abs_multiplier`` and
+        :data:`walkerlab.optimal.design_measures.ROBUSTNESS_MEASURES`) at ``p``."""
+        from walkerlab.optimal.design_measures import robustness_measure
+
+        w, fp = self.gait(p)
+        if name == "max_abs_multiplier":
+            return float(np.max(np.abs(fp.multipliers_variational)))
+        return robustness_measure(name, self.scene_at(p), w, fp.x, fp.jacobian_variational)
+
+    def differenced(self, p, name: str, h_rel: float = 1e-4):
+        """``(value, gradient (k,))``: central differences of the re-solved measure."""
+        p = np.asarray(p, float)
+        value = self.value(p, name)
+        start = self.last.copy()
+        grad = np.empty(p.size)
+        for j in range(p.size):
+            dp = np.zeros(p.size)
+            dp[j] = h_rel * max(1.0, abs(p[j]))
+            hi = self.value(p + dp, name)
+            self.last = start.copy()
+            lo = self.value(p - dp, name)
+            self.last = start.copy()
+            grad[j] = (hi - lo) / (2 * dp[j])
+        return value, grad
 
     def gait(self, p):
         from walkerlab.analysis.gait.poincare import find_fixed_point
@@ -190,18 +229,24 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
         res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
                        options={"maxiter": max_evaluations, "ftol": 1e-12})
         value, grad = measure_gradient(gaits, res.x, objective)
+    elif objective in DIFFERENCED:
+        def fun(p):
+            v, g = gaits.differenced(p, objective)
+            history.append((np.array(p, float), v))
+            return sign * v, sign * g
+
+        res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
+                       options={"maxiter": max_evaluations, "ftol": 1e-10})
+        value, grad = gaits.differenced(res.x, objective)
     else:
         def fun(p):
-            _, fp = gaits.gait(p)
-            v = float(np.max(np.abs(fp.multipliers_variational)))
+            v = gaits.value(p, objective)
             history.append((np.array(p, float), v))
             return sign * v
 
         res = minimize(fun, p0, method="Nelder-Mead", bounds=list(zip(lo, hi)),
                        options={"maxfev": max_evaluations, "xatol": 1e-6, "fatol": 1e-9})
-        _, fp = gaits.gait(res.x)
-        value, grad = float(np.max(np.abs(fp.multipliers_variational))), np.full(len(fields),
-                                                                                 np.nan)
+        value, grad = gaits.value(res.x, objective), np.full(len(fields), np.nan)
     return DesignResult(fields, np.asarray(res.x, float), objective, float(value),
                         np.asarray(grad, float), bool(res.success), str(res.message),
                         gaits.count, history)

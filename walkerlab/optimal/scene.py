@@ -5,9 +5,35 @@ model, its Floquet multipliers from the replay."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
-__all__ = ["optimize_scene"]
+__all__ = ["collocation_spec", "optimize_scene"]
+
+
+def collocation_spec(scene):
+    """The :class:`walkerlab.optimal.collocation.CollocationSpec` of the scene's
+    ``optimize`` section (the push-off's value, fixed or the free one's start, from the
+    scene's actuation)."""
+    from walkerlab.optimal.collocation import CollocationSpec
+
+    o = scene.optimize
+    act = getattr(scene.walker, "actuation", None)
+    push = float(act.push_off.impulse_n_s) if act is not None and act.push_off else 0.0
+    return CollocationSpec(intervals=o.intervals, push_off_n_s=push,
+                           push_off_free=o.push_off == "free",
+                           push_off_max_n_s=o.push_off_max_n_s,
+                           push_off_weight=o.push_off_weight_per_s,
+                           max_torque_n_m=o.max_torque_n_m,
+                           target_speed_m_per_s=o.target_speed_m_per_s,
+                           target_step_length_m=o.target_step_length_m,
+                           target_step_period_s=o.target_step_period_s,
+                           objective=o.objective, weights=tuple((o.weights or {}).items()),
+                           smoothing_w=o.smoothing_w, min_clearance_m=o.min_clearance_m,
+                           friction_coefficient=o.friction_coefficient,
+                           hip_angle_range_rad=o.hip_angle_range_rad,
+                           touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
 
 
 def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
@@ -16,10 +42,11 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     Parameters
     ----------
     scene : Scene
-        With ``optimize``; straight legs, point feet, massive legs.
+        With ``optimize``; straight legs, point feet, massive legs or massless ones with a
+        hip mass.
     x_gait : ndarray (2n,)
         The scene's gait just after heel strike (``fixedpoint.h5``): the initial guess is
-        one step of it.
+        one step of it (unless ``optimize.initial_guess`` names an artifact).
     period_s : float
         Its step period [s].
 
@@ -30,16 +57,17 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     Raises
     ------
     ValueError
-        A walker the transcription does not handle, or the scene's gait does not make a
-        step (one line).
+        A walker the transcription does not handle, the starting gait does not make a step,
+        or the initial guess's artifact is unusable (one line).
     """
-    from walkerlab.analysis.gait.poincare import find_fixed_point
+    from walkerlab.analysis.gait.poincare import poincare_map
     from walkerlab.codegen import symbolic
-    from walkerlab.integrate.rigid import simulate_steps
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.collocation import CollocationSpec, collocate_step, replay
+    from walkerlab.optimal.collocation import collocate_step, replay
+    from walkerlab.optimal.contact_replay import contact_replay
+    from walkerlab.optimal.guess import starting_step
     from walkerlab.walker.description import walker_data
 
     try:
@@ -47,43 +75,49 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     except ImportError:
         raise ValueError("optimize needs CasADi: pip install -e '.[optimize]'") from None
     o = scene.optimize
-    act = getattr(scene.walker, "actuation", None)
-    push = float(act.push_off.impulse_n_s) if act is not None and act.push_off else 0.0
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    spec = CollocationSpec(intervals=o.intervals, push_off_n_s=push,
-                           push_off_free=o.push_off == "free",
-                           push_off_max_n_s=o.push_off_max_n_s,
-                           push_off_weight=o.push_off_weight_per_s,
-                           max_torque_n_m=o.max_torque_n_m,
-                           target_speed_m_per_s=o.target_speed_m_per_s,
-                           target_step_length_m=o.target_step_length_m,
-                           target_step_period_s=o.target_step_period_s)
+    spec = collocation_spec(scene)
     walker = build_walker(scene)
-    solver = Solver.from_settings(scene.solver)
-    seg = simulate_steps(walker, np.asarray(x_gait, float), 1, solver,
-                         max_step_time=3.0 * period_s).segments[0]
-    if seg.termination != "heel_strike":
-        raise ValueError("optimize: the scene's gait does not make a step to start from")
-    t = np.linspace(seg.t_start, seg.t_end, 400)
-    guess = np.empty((t.size, x_gait.size))
-    for k, (_ph, sol, (a, b)) in enumerate(seg.pieces):  # each phase's dense output
-        last = k == len(seg.pieces) - 1
-        sel = (t >= a) & ((t <= b) if last else (t < b))
-        if sel.any():
-            guess[sel] = np.asarray(sol(t[sel]), float)[:x_gait.size].T
-    res = collocate_step(data, symbolic.derive(data.structure), spec, t - t[0], guess)
+    t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
+    if guess_p is not None and spec.push_off_free:
+        spec = replace(spec, push_off_n_s=guess_p)
+    res = collocate_step(data, symbolic.derive(data.structure), spec, t, guess, guess_u)
     err, replayed = replay(data, res)
     mu = np.full(res.x.shape[1], np.nan, complex)
     if np.isfinite(err):
-        try:
-            mu = find_fixed_point(replayed, res.x[0], Solver("DOP853", 1e-12, 1e-12),
-                                  max_step_time=3.0 * res.step_period_s).multipliers_variational
+        try:  # the replay map's Jacobian at the start (variational equations + saltation)
+            DP = poincare_map(replayed, res.x[0], Solver.from_settings(scene.solver),
+                              max_step_time=3.0 * res.step_period_s, jacobian=True)[2]
+            mu = np.linalg.eigvals(DP).astype(complex)
         except Exception:  # noqa: BLE001 - the replay's multipliers are a report, not a gate
             pass
+    contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
+    if np.isfinite(err):
+        contact_period, contact_outcome = contact_replay(scene, res)
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
                         res.step_period_s, res.step_length_m, res.push_off_n_s,
                         res.objective, err, mu, bool(err <= o.replay_tolerance
                                                      and res.status == "Solve_Succeeded"),
-                        res.status, res.iterations, res.wall_time_s, units)
+                        res.status, res.iterations, res.wall_time_s, units,
+                        objective_name=o.objective, objective_unit=_unit(o, data),
+                        terms=res.terms, contact_step_period_s=contact_period,
+                        contact_outcome=contact_outcome,
+                        torque_unit="N m/kg" if _massless(data) else "N m")
+
+
+def _unit(o, data) -> str:
+    """The objective's unit (a weighted sum's: ``-``; the torque per foot mass on massless
+    legs: N m/kg in place of N m)."""
+    from walkerlab.optimal.collocation import OBJECTIVES
+
+    unit = OBJECTIVES.get(o.objective, "-")
+    if _massless(data):
+        unit = {"N^2 m^2 s": "N^2 m^2 s / kg^2", "N m": "N m/kg"}.get(unit, unit)
+    return unit
+
+
+def _massless(data) -> bool:
+    """The legs are massless (the torque is per foot mass)."""
+    return bool(data.structure.bodies) and all(b.massless for b in data.structure.bodies)

@@ -22,8 +22,10 @@ def save_optimize_figure(d, title: str, folder: Path) -> list[Path]:
     ax.plot(d.time, d.torque, "o-", ms=3, color="tab:red")
     ax.axhline(0.0, color="0.5", lw=0.8)
     ax.set_xlabel("time since heel strike [s]")
-    ax.set_ylabel("hip torque [N m] (+ on the swing leg)")
-    ax.set_title(f"int u^2 dt = {d.objective:.3g} N^2 m^2 s")
+    ax.set_ylabel(f"hip torque [{d.torque_unit}] (+ on the swing leg)")
+    work = d.terms.get("push_off_work", 0.0)
+    ax.set_title(f"{d.objective_name} = {d.objective:.3g} {d.objective_unit}"
+                 + (f"; push-off work {work:.3g} J" if work > 0 else ""), fontsize=10)
     for name, v in d.states.items():
         if d.state_units.get(name) == "rad":
             ax2.plot(d.time, v, label=name)

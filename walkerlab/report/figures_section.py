@@ -89,11 +89,15 @@ def optimize_lines(d) -> list[str]:
     return [f"IPOPT: {d.status} ({d.iterations} iterations, {num(d.wall_time_s, 3)} s). Step "
             f"period {num(d.step_period_s)} s, step length {num(d.step_length_m)} m, speed "
             f"{num(d.step_length_m / d.step_period_s)} m/s, push-off {num(d.push_off_n_s)} N s, "
-            f"peak hip torque {num(float(np.max(np.abs(d.torque))))} N m; objective int u^2 dt "
-            f"= {num(d.objective)} N^2 m^2 s. Replayed on the rigid model (the torque as a "
-            f"function of time): return error {num(d.replay_error, 2)}, largest |Floquet "
-            f"multiplier| {num(mu)}: "
-            + ("**a gait**." if d.gait else "**not a gait** (the replay does not close)."),
+            f"peak hip torque {num(float(np.max(np.abs(d.torque))))} {d.torque_unit}; objective "
+            f"{d.objective_name} = {num(d.objective)} {d.objective_unit}. Replayed on the rigid "
+            f"model (the torque as a function of time): return error {num(d.replay_error, 2)}, "
+            f"largest |Floquet multiplier| {num(mu)}: "
+            + ("**a gait**." if d.gait else "**not a gait** (the replay does not close).")
+            + (f" In the contact model: step period {num(d.contact_step_period_s)} s "
+               f"({num(100 * (d.contact_step_period_s / d.step_period_s - 1), 2)} %)."
+               if d.contact_step_period_s == d.contact_step_period_s
+               else f" Contact model: {d.contact_outcome}."),
             ""]
 
 

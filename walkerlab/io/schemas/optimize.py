@@ -5,11 +5,17 @@ points)::
 
     time                          s        collocation points (2N + 1) on [0, step_period]
     states/<state name>           rad, rad/s   the walker's states there (role order)
-    torque/hip                    N m      the hip torque there (+ on the swing leg)
+    torque/hip                    N m      the hip torque there (+ on the swing leg; N m/kg:
+                                           per foot mass on massless legs)
     step_period, step_length      s, m
     speed                         m/s      step length / step period
     push_off                      N s      the push-off impulse
-    objective                     N^2 m^2 s   int u^2 dt (+ the free push-off's weighted P^2)
+    objective                     its unit  the objective (attribute objective_name; effort:
+                                           int u^2 dt + the free push-off's weighted P^2)
+    terms/<name>                  its unit every objective at the optimum (effort,
+                                           push_off_work, cost_of_transport, peak_torque)
+    contact_replay/step_period    s        the contact model driven by the optimised torque
+                                           (attribute contact_replay_outcome; NaN: none)
     replay/max_state_error        rad, rad/s  the rigid model's return error (gait if
                                            <= the scene's replay_tolerance)
     replay/multipliers/{real,imag} -       Floquet multipliers of the replayed gait
@@ -20,7 +26,7 @@ attributes: ``gait`` (the replay closed), ``state_names``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +54,12 @@ class OptimizeData:
     iterations: int
     wall_time_s: float
     state_units: dict
+    objective_name: str = "effort"
+    objective_unit: str = "N^2 m^2 s"
+    terms: dict = field(default_factory=dict)
+    contact_step_period_s: float = float("nan")
+    contact_outcome: str = ""
+    torque_unit: str = "N m"
 
 
 def write(f, d: OptimizeData) -> None:
@@ -59,15 +71,24 @@ def write(f, d: OptimizeData) -> None:
     for name, v in d.states.items():
         put(f, f"states/{name}", v, d.state_units[name], f"{name} at the collocation points",
             dims=("time",))
-    put(f, "torque/hip", d.torque, "N m", "hip torque (+ on the swing leg, - on the stance "
+    put(f, "torque/hip", d.torque, d.torque_unit, "hip torque (+ on the swing leg, - on the stance "
         "leg)", dims=("time",))
     put(f, "step_period", float(d.step_period_s), "s", "step period")
     put(f, "step_length", float(d.step_length_m), "m", "distance between the feet at heel "
         "strike")
     put(f, "speed", float(d.step_length_m / d.step_period_s), "m/s", "step length / period")
     put(f, "push_off", float(d.push_off_n_s), "N s", "push-off impulse")
-    put(f, "objective", float(d.objective), "N^2 m^2 s", "int u^2 dt (+ the free push-off's "
-        "weighted P^2)")
+    put(f, "objective", float(d.objective), d.objective_unit, f"objective {d.objective_name} "
+        "at the optimum (effort: int u^2 dt, + the free push-off's weighted P^2)")
+    units = {"effort": d.objective_unit if d.objective_name == "effort" else "N^2 m^2 s",
+             "push_off_work": "J", "cost_of_transport": "-", "peak_torque": "N m"}
+    for name, v in d.terms.items():
+        put(f, f"terms/{name}", float(v), units.get(name, "-"), f"{name} at the optimum "
+            "(cost_of_transport smoothed; torques per foot mass on massless legs)")
+    put(f, "contact_replay/step_period", float(d.contact_step_period_s), "s", "mean step "
+        "period of the contact model driven by the optimised torque (NaN: not replayed)")
+    f.attrs["contact_replay_outcome"] = d.contact_outcome
+    f.attrs["objective_name"] = d.objective_name
     put(f, "replay/max_state_error", float(d.replay_error), "-", "max-norm return error of "
         "the rigid model's replay [rad, rad/s]")
     mu = np.asarray(d.multipliers, complex)
@@ -100,7 +121,11 @@ def load(path: Path) -> OptimizeData:
             f["replay/multipliers/real"][()] + 1j * f["replay/multipliers/imag"][()],
             bool(f.attrs["gait"]), str(f.attrs["ipopt_status"]),
             int(f.attrs["ipopt_iterations"]), float(f.attrs["ipopt_wall_time_s"]),
-            {n: str(f[f"states/{n}"].attrs["unit"]) for n in names})
+            {n: str(f[f"states/{n}"].attrs["unit"]) for n in names},
+            str(f.attrs["objective_name"]), str(f["objective"].attrs["unit"]),
+            {k: float(v[()]) for k, v in f["terms"].items()} if "terms" in f else {},
+            float(f["contact_replay/step_period"][()]),
+            str(f.attrs["contact_replay_outcome"]), str(f["torque/hip"].attrs["unit"]))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)
