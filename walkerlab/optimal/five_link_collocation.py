@@ -188,7 +188,8 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
 def torques_of_time(t: np.ndarray, u: np.ndarray):
     """The optimised torques as a function of the time since the heel strike [s] -> (k,)
     [N m]: in each Hermite-Simpson interval the quadratic through its three points (the
-    transcription's own control), held outside ``[t_0, t_2N]``.
+    transcription's own control); before ``t_0`` held, after ``t_2N`` the last quadratic
+    extrapolated (a replayed step may end slightly later than the collocated one).
 
     Parameters
     ----------
@@ -201,7 +202,7 @@ def torques_of_time(t: np.ndarray, u: np.ndarray):
     nint = (len(t) - 1) // 2
 
     def tau(s: float) -> np.ndarray:
-        s = min(max(float(s), t[0]), t[-1])
+        s = max(float(s), t[0])
         i = 2 * min(int((s - t[0]) / (t[2] - t[0])), nint - 1)
         ti, tm, tj = t[i], t[i + 1], t[i + 2]
         return (u[i] * (s - tm) * (s - tj) / ((ti - tm) * (ti - tj))
