@@ -217,10 +217,19 @@ def optimize(scene: Path | None = SceneArg,
     d = out.summary.get("data")
     if d is not None:
         mu = max(abs(d.multipliers)) if len(d.multipliers) else float("nan")
-        typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s)")
+        cpu = "" if d.cpu_time_s != d.cpu_time_s else f", CPU {d.cpu_time_s:.2f} s"
+        typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s"
+                   f"{cpu})")
+        peak = ", ".join(f"{n} {v:.4g}" for n, v in zip(
+            d.torque_names, abs(d.torque.reshape(len(d.time), -1)).max(axis=0)))
         typer.echo(f"  step period {d.step_period_s:.6g} s, step length {d.step_length_m:.5g} m,"
                    f" speed {d.step_length_m / d.step_period_s:.5g} m/s, push-off "
-                   f"{d.push_off_n_s:.5g} N s, peak |torque| {max(abs(d.torque)):.4g} N m")
+                   f"{d.push_off_n_s:.5g} N s, peak |torque| [N m]: {peak}")
+        if d.start_shift == d.start_shift:  # closed by shooting (a five-link biped)
+            typer.echo(f"  open loop from the collocated start: return error "
+                       f"{d.collocated_start_error:.2g}; closed by shooting under the same "
+                       f"torques: start moved {d.start_shift:.2g}, step period "
+                       f"{d.replay_step_period_s:.9g} s")
         typer.echo(f"  objective int u^2 dt = {d.objective:.6g} N^2 m^2 s; replay return "
                    f"error {d.replay_error:.2g}; max |Floquet multiplier| {mu:.4g}")
         typer.echo("  a gait (the replay closes)" if d.gait else

@@ -211,15 +211,18 @@ def torques_of_time(t: np.ndarray, u: np.ndarray):
     return tau
 
 
-def replay_five_link(data, res: FiveLinkResult, solver=None):
+def replay_five_link(data, res: FiveLinkResult, x0: np.ndarray | None = None, solver=None):
     """One step of the rigid five-link model (its generated code, its own phases, guards and
     reset: not the CasADi expressions the optimisation used) from ``res.x[0]`` with the
-    torques :func:`torques_of_time` of ``res`` (open loop).
+    torques :func:`torques_of_time` of ``res`` (open loop), or from ``x0`` (the closed
+    start of :func:`walkerlab.optimal.five_link_shooting.close_step`).
 
     Parameters
     ----------
     data : WalkerData
     res : FiveLinkResult
+    x0 : ndarray (2n,), optional
+        The start (default ``res.x[0]``); the return error is measured against it.
     solver : walkerlab.integrate.solver.Solver, optional
         Default DOP853 at rtol = atol = 1e-12.
 
@@ -247,8 +250,8 @@ def replay_five_link(data, res: FiveLinkResult, solver=None):
     tau = torques_of_time(res.t, res.u)
     acts.torques = lambda t, x: tau(float(np.real(t)) - acts.t_origin)
     solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)
-    seg = integrate_step(walker, np.asarray(res.x[0], float), solver,
-                         max_step_time=3.0 * res.step_period_s)
+    start = np.asarray(res.x[0] if x0 is None else x0, float)
+    seg = integrate_step(walker, start, solver, max_step_time=3.0 * res.step_period_s)
     if seg.termination != "heel_strike":
         return float("inf"), walker, seg
-    return float(np.max(np.abs(seg.x_next - res.x[0]))), walker, seg
+    return float(np.max(np.abs(seg.x_next - start))), walker, seg

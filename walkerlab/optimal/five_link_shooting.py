@@ -45,6 +45,9 @@ class ClosedStep:
         ``max |x0 - x_col[0]|``: how far the collocated start was [rad, rad/s].
     multipliers : ndarray (2n,) complex
         Floquet multipliers of the open-loop step map (one ~0: the heel-strike surface).
+    open_loop_error : float
+        ``max |reset(Phi(x_col[0], t_2N)) - x_col[0]|``: the return error of the collocated
+        start itself under the same torques [rad, rad/s].
     converged : bool
     message : str
     """
@@ -54,6 +57,7 @@ class ClosedStep:
     residual: float
     shift: float
     multipliers: np.ndarray
+    open_loop_error: float
     converged: bool
     message: str
 
@@ -128,6 +132,7 @@ def close_step(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> Clos
         return np.asarray(G(v)[0]).ravel()
 
     z0 = np.concatenate([np.asarray(x[0], float), [float(t[-1])]])
+    open_loop = float(np.max(np.abs(fun(z0)[:n2])))
     # hybrd: its own finite-difference Jacobian, then Broyden updates (one G costs ~1/30
     # of its Jacobian by CVODES' sensitivities)
     sol = root(fun, z0, method="hybr", options={"xtol": 1e-12})
@@ -136,6 +141,7 @@ def close_step(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> Clos
     mu = _multipliers(fns, params, G, z, zs, t, u)
     return ClosedStep(x0=zs[:n2], period_s=float(zs[n2]), residual=resid,
                       shift=float(np.max(np.abs(zs[:n2] - x[0]))), multipliers=mu,
+                      open_loop_error=open_loop,
                       converged=bool(sol.success and resid < 1e-9), message=str(sol.message))
 
 

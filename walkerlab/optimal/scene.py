@@ -7,7 +7,15 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["optimize_scene"]
+__all__ = ["needs_gait", "optimize_scene"]
+
+
+def needs_gait(scene) -> bool:
+    """Whether the scene's optimisation starts from its own gait (``fixedpoint.h5``): every
+    walker but a five-link biped (``walker.leg.knee.lock: free``), whose guess is built from
+    the targets (:mod:`walkerlab.optimal.five_link_scene`)."""
+    knee = getattr(getattr(scene.walker, "leg", None), "knee", None)
+    return getattr(knee, "lock", None) != "free"
 
 
 def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
