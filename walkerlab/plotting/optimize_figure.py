@@ -20,7 +20,6 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
     import numpy as np
 
     from walkerlab.plotting.figures import save

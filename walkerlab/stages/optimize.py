@@ -3,8 +3,9 @@
 Reads the scene's ``optimize`` section and its gait from ``fixedpoint.h5`` (the pipeline
 runs ``fixedpoint`` first, :mod:`walkerlab.stages.pipeline`; the collocation starts from
 one step of it; a five-link biped's from its targets, no upstream gait), optimises by
-:func:`walkerlab.optimal.scene.optimize_scene` (CasADi + IPOPT) and replays the result on the rigid model.  Skipped when the scene
-sections, the upstream gait and the code are unchanged.
+:func:`walkerlab.optimal.scene.optimize_scene` (CasADi + IPOPT) and replays the result
+on the rigid model.  Skipped when the scene sections, the upstream gait and the code are
+unchanged.
 """
 
 from __future__ import annotations
