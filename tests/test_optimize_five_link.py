@@ -127,3 +127,15 @@ def test_the_closed_step_replays_on_the_rigid_model(optimised):
     assert d.replay_error <= 1e-6 and d.gait
     assert np.max(np.abs(d.multipliers)) > 1.0
     assert (runs / "rabbit_optimal" / "report" / "figures" / "optimize.png").is_file()
+
+
+@pytest.mark.slow  # shares the fixture above (the report reuses its optimize.h5: ~2 s)
+def test_the_report_shows_the_optimised_step(optimised):
+    """tests/test_scenes_end_to_end.py leaves this scene out (no gait for fixedpoint): its
+    report is built here, the optimised step its only section."""
+    from walkerlab.stages import report
+
+    _, _, runs = optimised
+    html = report.run(load_scene(CONFIGS / "rabbit_optimal.yaml"), runs, echo=lambda s: None)
+    md = (html.parent / "report.md").read_text()
+    assert "closed by shooting" in md and "**a gait**" in md and "optimize.png" in md
