@@ -201,9 +201,10 @@ def optimize(scene: Path | None = SceneArg,
              maximize: bool = typer.Option(False, "--maximize", help="with --design: "
                                            "maximise the objective"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
-    """A periodic gait of a walker with a hip torque by direct collocation (CasADi +
-    IPOPT; the scene's optimize section): least int u^2 dt, the targets and limits given,
-    replayed on the rigid model; writes optimize.h5.  With --design: the fields within
+    """A periodic gait of a walker with a hip torque (a five-link biped: hip and knee
+    torques) by direct collocation (CasADi + IPOPT; the scene's optimize section): least
+    int u^2 dt, the targets and limits given, replayed on the rigid model; writes
+    optimize.h5.  With --design: the fields within
     their bounds that minimise (--maximize: maximise) a measure of the scene's own gait,
     followed from the scene's values, gradients through the fixed point; writes
     optimize_design.h5."""
