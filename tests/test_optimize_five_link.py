@@ -63,6 +63,27 @@ def test_a_five_link_scene_optimises_without_an_upstream_gait():
         "fixedpoint", "optimize"]
 
 
+def test_a_five_link_walker_without_torso_is_refused_in_one_line(tmp_path):
+    """Its hips would have no torso to push against: one line naming the fields."""
+    import copy
+
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = copy.deepcopy(SCENE)
+    d.pop("torso", None)
+    d["walker"].pop("torso", None)
+    d["name"] = "no_torso"
+    d["optimize"] = {"target_step_length_m": 0.5}
+    (tmp_path / "no_torso.yaml").write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["optimize", str(tmp_path / "no_torso.yaml"), "--runs-dir",
+                                 str(tmp_path / "runs")])
+    assert r.exit_code == 1 and "Traceback" not in r.output
+    assert r.output.count("error:") == 1 and "walker.torso.coupling" in r.output, r.output
+
+
 def test_torques_of_time_is_the_intervals_quadratic():
     """Exact on a quadratic (Hermite-Simpson's control), extrapolated past the end."""
     from walkerlab.optimal.five_link_collocation import torques_of_time

@@ -119,11 +119,17 @@ def five_link_functions(structure) -> dict:
     Raises
     ------
     ValueError
-        A structure the five-link generator does not handle (one line).
+        A walker without free knees or without a hinged torso (the hips act between the
+        torso and the thighs), or one the five-link generator does not handle (one line).
     """
     import casadi as ca
 
     from walkerlab.codegen.cache import cache_dir, cache_key, read_source, write_source
+
+    if not (structure.free_knees and structure.hinged_torso):
+        raise ValueError("optimize: the five-link collocation drives the hips between a hinged "
+                         "torso and the thighs and the free knees (walker.torso.coupling: "
+                         "hinged, walker.leg.knee.lock: free)")
 
     key = f"{cache_key(structure)}-collocation-{_source_hash()}"
     if key in _memo:
