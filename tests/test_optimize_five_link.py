@@ -160,3 +160,29 @@ def test_the_report_shows_the_optimised_step(optimised):
     html = report.run(load_scene(CONFIGS / "rabbit_optimal.yaml"), runs, echo=lambda s: None)
     md = (html.parent / "report.md").read_text()
     assert "closed by shooting" in md and "**a gait**" in md and "optimize.png" in md
+
+
+@pytest.mark.slow  # one more collocation (25 intervals, ~2 s CPU) beside the fixture's 50
+def test_the_transcription_error_falls_at_hermite_simpsons_order(optimised):
+    """The open-loop return error of the collocated start (the transcription's error grown
+    over the step by the same linearised map at both meshes) falls by 2^p when the mesh is
+    halved: observed p >= 3.5 for Hermite-Simpson's 4 (measured 3.7: at 25 intervals the
+    error, 0.67, is large enough to be past the linear growth, which lowers p)."""
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.five_link import five_link_functions
+    from walkerlab.optimal.five_link_collocation import collocate_five_link
+    from walkerlab.optimal.five_link_shooting import open_loop_error
+
+    d, _, _ = optimised
+    assert len(d.time) == 101
+    scene = load_scene(CONFIGS / "rabbit_optimal.yaml")
+    data = walker_data(scene.walker, 0.0)
+    coarse = collocate_five_link(data, CollocationSpec(
+        intervals=25, max_torque_n_m=150.0, target_step_length_m=0.5,
+        target_step_period_s=0.7))
+    assert coarse.status == "Solve_Succeeded"
+    assert coarse.objective == pytest.approx(d.objective, rel=1e-4)
+    fns = five_link_functions(data.structure)
+    e25 = open_loop_error(fns, data.params, coarse.t, coarse.x, coarse.u)
+    e50 = d.collocated_start_error
+    assert np.log2(e25 / e50) >= 3.5, (e25, e50)

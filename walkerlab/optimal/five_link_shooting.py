@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ClosedStep", "close_step"]
+__all__ = ["ClosedStep", "close_step", "open_loop_error"]
 
 
 @dataclass
@@ -164,3 +164,12 @@ def _multipliers(fns, params, G, z, zs, t, u) -> np.ndarray:
     gx = (grad_c @ Phi_x).ravel()
     DP = DR @ (Phi_x - np.outer(f, gx) / float((grad_c @ f)[0]))
     return np.linalg.eigvals(DP)
+
+
+def open_loop_error(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> float:
+    """``max |reset(Phi(x[0], t[-1])) - x[0]|`` [rad, rad/s]: the return error of a
+    collocated step from its own start under its torques (CVODES, as :func:`close_step`;
+    arguments as there)."""
+    G, _ = _shooting(fns, list(params), np.asarray(t, float), np.asarray(u, float))
+    z0 = np.concatenate([np.asarray(x[0], float), [float(t[-1])]])
+    return float(np.max(np.abs(np.asarray(G(z0)[0]).ravel()[:2 * fns["n"]])))
