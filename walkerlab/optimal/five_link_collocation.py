@@ -104,6 +104,32 @@ def _guess_numbers(data, spec):
     return D, T
 
 
+def _constrain(opti, fns: dict, spec, X, U, T, p) -> None:
+    """The step's constraints (module docstring) on the decision variables ``X`` (2n, K),
+    ``U`` (4, K) and ``T``."""
+    import casadi as ca
+
+    K = X.shape[1]
+    h = T / ((K - 1) // 2)
+    F = fns["flow"].map(K)(X, U, ca.repmat(p, 1, K))
+    feet = fns["feet"].map(K)(X, ca.repmat(p, 1, K))  # clearance, ahead, rate, knees
+    i, m, j = np.arange(0, K - 1, 2), np.arange(1, K, 2), np.arange(2, K, 2)
+    opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (F[:, i] - F[:, j]))
+    opti.subject_to(X[:, j] == X[:, i] + h / 6 * (F[:, i] + 4 * F[:, m] + F[:, j]))
+    opti.subject_to(X[:, 0] == fns["reset"](X[:, -1], p))
+    opti.subject_to(feet[0, -1] == 0)                    # heel strike at the end
+    opti.subject_to(feet[2, -1] <= 0)                    # ... moving down
+    opti.subject_to(feet[2, 0] >= 0)                     # the trailing foot lifts off
+    opti.subject_to(feet[0, 1:-1] >= 0)                  # above the ground in between
+    opti.subject_to(ca.vec(feet[3:5, :]) <= 0)           # no knee hyper-extension
+    opti.subject_to(feet[1, -1] >= 1e-3)                 # the swing foot ahead
+    opti.subject_to(opti.bounded(-np.pi / 2, X[:fns["n"], :], np.pi / 2))
+    opti.subject_to(opti.bounded(0.1, T, 5.0))
+    if spec.max_torque_n_m is not None:
+        opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
+    _targets(opti, spec, T, feet[1, -1])
+
+
 def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     """Optimise one step of a five-link biped (module docstring).
 
@@ -140,23 +166,7 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     X, U = opti.variable(n2, K), opti.variable(4, K)
     T = opti.variable()
     h = T / N
-    F = fns["flow"].map(K)(X, U, ca.repmat(p, 1, K))
-    feet = fns["feet"].map(K)(X, ca.repmat(p, 1, K))  # clearance, ahead, rate, knees
-    i, m, j = np.arange(0, K - 1, 2), np.arange(1, K, 2), np.arange(2, K, 2)
-    opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (F[:, i] - F[:, j]))
-    opti.subject_to(X[:, j] == X[:, i] + h / 6 * (F[:, i] + 4 * F[:, m] + F[:, j]))
-    opti.subject_to(X[:, 0] == fns["reset"](X[:, -1], p))
-    opti.subject_to(feet[0, -1] == 0)                    # heel strike at the end
-    opti.subject_to(feet[2, -1] <= 0)                    # ... moving down
-    opti.subject_to(feet[2, 0] >= 0)                     # the trailing foot lifts off
-    opti.subject_to(feet[0, 1:-1] >= 0)                  # above the ground in between
-    opti.subject_to(ca.vec(feet[3:5, :]) <= 0)                # no knee hyper-extension
-    opti.subject_to(feet[1, -1] >= 1e-3)                 # the swing foot ahead
-    opti.subject_to(opti.bounded(-np.pi / 2, X[:fns["n"], :], np.pi / 2))
-    opti.subject_to(opti.bounded(0.1, T, 5.0))
-    if spec.max_torque_n_m is not None:
-        opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
-    _targets(opti, spec, T, feet[1, -1])
+    _constrain(opti, fns, spec, X, U, T, p)
     weights = np.concatenate([[1.0], np.tile([4.0, 2.0], N)[:K - 2], [1.0]])
     effort = h / 6 * ca.sum2(ca.DM(weights).T * ca.sum1(U ** 2))
     opti.minimize(effort)
