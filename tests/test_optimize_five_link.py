@@ -52,6 +52,33 @@ def test_casadi_step_matches_the_independent_derivation(fns_and_params):
         assert feet[1] == pytest.approx(foot[0], abs=1e-12)  # ahead of the stance foot
 
 
+def test_the_step_functions_are_built_once_and_cached(fns_and_params, tmp_path,
+                                                     monkeypatch):
+    """A miss derives (sympy) and writes the user cache; the next process reads it back
+    (no derivation) and computes the same; a damaged file is derived again."""
+    from walkerlab.optimal import five_link as fl
+
+    built = {k: v for k, v in fns_and_params[0].items() if k != "n"}
+    calls = []
+    monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(fl, "_build", lambda s: calls.append(s) or dict(built))
+    monkeypatch.setattr(fl, "_memo", {})
+    structure = walker_data(scene_from_dict(SCENE).walker, 0.0).structure
+    fl.five_link_functions(structure)
+    assert len(calls) == 1
+    fl._memo.clear()
+    got = fl.five_link_functions(structure)
+    assert len(calls) == 1 and got["n"] == 5
+    x, p = states()[0], fns_and_params[1]
+    np.testing.assert_array_equal(np.asarray(got["flow"](x, TAU, p)),
+                                  np.asarray(built["flow"](x, TAU, p)))
+    (path,) = (tmp_path / "models").glob("*-collocation-*.casadi")
+    path.write_text(path.read_text()[:-40])
+    fl._memo.clear()
+    fl.five_link_functions(structure)
+    assert len(calls) == 2
+
+
 def test_a_five_link_scene_optimises_without_an_upstream_gait():
     """rabbit_optimal has no passive gait on level ground: optimize needs no fixedpoint."""
     from walkerlab.stages import pipeline
