@@ -115,7 +115,7 @@ def close_step(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> Clos
     t : ndarray (2N + 1,)
         Collocation times [s].
     x : ndarray (2N + 1, 2n)
-        Collocated states (the start of the search: ``x[0]`` and ``t[-1]``).
+        Collocated states (the start of the search: the first row and ``t[-1]``).
     u : ndarray (2N + 1, k)
         Collocated torques [N m].
 
@@ -131,7 +131,7 @@ def close_step(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> Clos
     def fun(v):
         return np.asarray(G(v)[0]).ravel()
 
-    z0 = np.concatenate([np.asarray(x[0], float), [float(t[-1])]])
+    z0 = np.concatenate([np.asarray(x, float)[0, :], [float(t[-1])]])
     open_loop = float(np.max(np.abs(fun(z0)[:n2])))
     # hybrd: its own finite-difference Jacobian, then Broyden updates (one G costs ~1/30
     # of its Jacobian by CVODES' sensitivities)
@@ -140,7 +140,7 @@ def close_step(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> Clos
     resid = float(np.max(np.abs(fun(zs))))
     mu = _multipliers(fns, params, G, z, zs, t, u)
     return ClosedStep(x0=zs[:n2], period_s=float(zs[n2]), residual=resid,
-                      shift=float(np.max(np.abs(zs[:n2] - x[0]))), multipliers=mu,
+                      shift=float(np.max(np.abs(zs[:n2] - z0[:n2]))), multipliers=mu,
                       open_loop_error=open_loop,
                       converged=bool(sol.success and resid < 1e-9), message=str(sol.message))
 
@@ -167,9 +167,9 @@ def _multipliers(fns, params, G, z, zs, t, u) -> np.ndarray:
 
 
 def open_loop_error(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> float:
-    """``max |reset(Phi(x[0], t[-1])) - x[0]|`` [rad, rad/s]: the return error of a
-    collocated step from its own start under its torques (CVODES, as :func:`close_step`;
-    arguments as there)."""
+    """``max |reset(Phi(x_0, t_2N)) - x_0|`` (``x_0`` the first row) [rad, rad/s]: the
+    return error of a collocated step from its own start under its torques (CVODES, as
+    :func:`close_step`; arguments as there)."""
     G, _ = _shooting(fns, list(params), np.asarray(t, float), np.asarray(u, float))
-    z0 = np.concatenate([np.asarray(x[0], float), [float(t[-1])]])
+    z0 = np.concatenate([np.asarray(x, float)[0, :], [float(t[-1])]])
     return float(np.max(np.abs(np.asarray(G(z0)[0]).ravel()[:2 * fns["n"]])))
