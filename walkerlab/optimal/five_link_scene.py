@@ -61,8 +61,9 @@ def optimize_five_link_scene(scene):
     return OptimizeData(
         res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u, res.step_period_s,
         res.step_length_m, 0.0, res.objective, err, closed.multipliers, gait, res.status,
-        res.iterations, res.wall_time_s, units, JOINTS, closed.shift, closed.period_s,
-        closed.open_loop_error, res.cpu_time_s)
+        res.iterations, res.wall_time_s, units, torque_names=JOINTS,
+        start_shift=closed.shift, replay_step_period_s=closed.period_s,
+        collocated_start_error=closed.open_loop_error, cpu_time_s=res.cpu_time_s)
 
 
 
