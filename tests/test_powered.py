@@ -160,9 +160,11 @@ def test_flat_feet_have_no_ledger_yet():
 
 # rabbit: its fixed point takes ~2 min (ten coordinates, high-gain PD); tests/test_rabbit.py
 # closes its ledger on one step from the fixed point its scene stores; flat feet: no full
-# ledger yet
+# ledger yet; rabbit_optimal: no gait of its own (its step is optimised: tests/
+# test_optimize_five_link.py)
 @pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED
-                                  if n not in ("flat_feet", "flat_feet_push_off", "rabbit")])
+                                  if n not in ("flat_feet", "flat_feet_push_off", "rabbit",
+                                               "rabbit_optimal")])
 def test_the_energy_ledger_closes_and_cost_of_transport(name):
     w, led, ke = _ledger(name)
     assert np.all(np.isfinite(led["closure"]))

@@ -202,9 +202,10 @@ def optimize(scene: Path | None = SceneArg,
              maximize: bool = typer.Option(False, "--maximize", help="with --design: "
                                            "maximise the objective"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
-    """A periodic gait of a walker with a hip torque by direct collocation (CasADi +
-    IPOPT; the scene's optimize section): least int u^2 dt, the targets and limits given,
-    replayed on the rigid model; writes optimize.h5.  With --design: the fields within
+    """A periodic gait of a walker with a hip torque (a five-link biped: hip and knee
+    torques) by direct collocation (CasADi + IPOPT; the scene's optimize section): least
+    int u^2 dt, the targets and limits given, replayed on the rigid model; writes
+    optimize.h5.  With --design: the fields within
     their bounds that minimise (--maximize: maximise) a measure of the scene's own gait,
     followed from the scene's values, gradients through the fixed point; writes
     optimize_design.h5."""
@@ -218,11 +219,19 @@ def optimize(scene: Path | None = SceneArg,
     d = out.summary.get("data")
     if d is not None:
         mu = max(abs(d.multipliers)) if len(d.multipliers) else float("nan")
-        typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s)")
+        cpu = "" if d.cpu_time_s != d.cpu_time_s else f", CPU {d.cpu_time_s:.2f} s"
+        typer.echo(f"IPOPT: {d.status} after {d.iterations} iterations ({d.wall_time_s:.2f} s"
+                   f"{cpu})")
+        peak = ", ".join(f"{n} {v:.4g}" for n, v in zip(
+            d.torque_names, abs(d.torque.reshape(len(d.time), -1)).max(axis=0)))
         typer.echo(f"  step period {d.step_period_s:.6g} s, step length {d.step_length_m:.5g} m,"
                    f" speed {d.step_length_m / d.step_period_s:.5g} m/s, push-off "
-                   f"{d.push_off_n_s:.5g} N s, peak |torque| {max(abs(d.torque)):.4g} "
-                   f"{d.torque_unit}")
+                   f"{d.push_off_n_s:.5g} N s, peak |torque| [{d.torque_unit}]: {peak}")
+        if d.start_shift == d.start_shift:  # closed by shooting (a five-link biped)
+            typer.echo(f"  open loop from the collocated start: return error "
+                       f"{d.collocated_start_error:.2g}; closed by shooting under the same "
+                       f"torques: start moved {d.start_shift:.2g}, step period "
+                       f"{d.replay_step_period_s:.9g} s")
         typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}; "
                    f"replay return error {d.replay_error:.2g}; max |Floquet multiplier| "
                    f"{mu:.4g}")

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["collocation_spec", "optimize_scene"]
+__all__ = ["collocation_spec", "needs_gait", "optimize_scene"]
 
 
 def collocation_spec(scene):
@@ -34,6 +34,14 @@ def collocation_spec(scene):
                            friction_coefficient=o.friction_coefficient,
                            hip_angle_range_rad=o.hip_angle_range_rad,
                            touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
+
+
+def needs_gait(scene) -> bool:
+    """Whether the scene's optimisation starts from its own gait (``fixedpoint.h5``): every
+    walker but a five-link biped (``walker.leg.knee.lock: free``), whose guess is built from
+    the targets (:mod:`walkerlab.optimal.five_link_scene`)."""
+    knee = getattr(getattr(scene.walker, "leg", None), "knee", None)
+    return getattr(knee, "lock", None) != "free"
 
 
 def optimize_scene(scene, x_gait: np.ndarray, period_s: float):

@@ -1,4 +1,5 @@
-"""The figure of ``optimize.h5``: the optimised hip torque and the leg angles over the step."""
+"""The figure of ``optimize.h5``: the optimised torques and the link angles over the step
+(and, for a walker whose stick figure is given, the step as stop-action frames)."""
 
 from __future__ import annotations
 
@@ -7,22 +8,35 @@ from pathlib import Path
 __all__ = ["save_optimize_figure"]
 
 
-def save_optimize_figure(d, title: str, folder: Path) -> list[Path]:
+def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
+                         ) -> list[Path]:
     """Draw ``optimize.png`` / ``.svg`` from a loaded ``optimize.h5`` (``d``:
-    :class:`walkerlab.io.schemas.optimize.OptimizeData`): left the hip torque [N m] at the
-    collocation points, right every angle state [rad] over the step."""
+    :class:`walkerlab.io.schemas.optimize.OptimizeData`): left every torque [N m] at the
+    collocation points (by name), middle every angle state [rad] over the step, and with
+    ``sticks`` (a list of (m, 2) polylines [m], e.g. stance foot - knee - hip - torso / hip
+    - swing knee - swing foot at a few instants) a third panel with them drawn over each
+    other (stop action)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import numpy as np
 
     from walkerlab.plotting.figures import save
 
-    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(10, 3.8))
-    ax.plot(d.time, d.torque, "o-", ms=3, color="tab:red")
+    fig, axes = plt.subplots(1, 3 if sticks else 2, figsize=(15 if sticks else 10, 3.8))
+    ax, ax2 = axes[0], axes[1]
+    tq = d.torque.reshape(len(d.time), -1)
+    for k, name in enumerate(d.torque_names):
+        ax.plot(d.time, tq[:, k], "o-", ms=2, label=name,
+                color="tab:red" if len(d.torque_names) == 1 else None)
     ax.axhline(0.0, color="0.5", lw=0.8)
     ax.set_xlabel("time since heel strike [s]")
-    ax.set_ylabel(f"hip torque [{d.torque_unit}] (+ on the swing leg)")
+    if d.torque_names == ("hip",):
+        ax.set_ylabel(f"hip torque [{d.torque_unit}] (+ on the swing leg)")
+    else:
+        ax.set_ylabel(f"joint torque [{d.torque_unit}] (+ on the joint's second link)")
+        ax.legend(fontsize=8, loc="best")
     work = d.terms.get("push_off_work", 0.0)
     ax.set_title(f"{d.objective_name} = {d.objective:.3g} {d.objective_unit}"
                  + (f"; push-off work {work:.3g} J" if work > 0 else ""), fontsize=10)
@@ -35,6 +49,17 @@ def save_optimize_figure(d, title: str, folder: Path) -> list[Path]:
     speed = d.step_length_m / d.step_period_s
     ax2.set_title(f"step {d.step_period_s:.4g} s, {d.step_length_m:.4g} m, {speed:.3g} m/s; "
                   f"replay error {d.replay_error:.1g}", fontsize=9)
+    if sticks:
+        ax3 = axes[2]
+        for k, line in enumerate(sticks):
+            line = np.asarray(line, float)
+            ax3.plot(line[:, 0], line[:, 1], "-o", ms=2, lw=1.2,
+                     color=plt.cm.viridis(k / max(len(sticks) - 1, 1)))
+        ax3.axhline(0.0, color="0.4", lw=1)
+        ax3.set_aspect("equal")
+        ax3.set_xlabel("x [m] (stance foot at 0)")
+        ax3.set_ylabel("y [m]")
+        ax3.set_title("the step, stop action (early: dark, late: yellow)", fontsize=9)
     fig.suptitle(f"{title}: optimised step (direct collocation)"
                  + ("" if d.gait else " — NOT a gait: the replay does not close"), fontsize=10)
     fig.tight_layout()

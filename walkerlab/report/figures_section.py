@@ -37,9 +37,9 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
               "(left) and how many steps the converged cells take (right)."),
     ("mfpt", "Mean first-passage time against the per-step slope's σ (`walkerlab mfpt`); "
              "open squares: mesh values whose refinement did not converge."),
-    ("optimize", "Optimised step (direct collocation, `walkerlab optimize`): the hip torque "
-                 "at the collocation points (left) and the leg angles over the step "
-                 "(right)."),
+    ("optimize", "Optimised step (direct collocation, `walkerlab optimize`): the torques "
+                 "at the collocation points (left) and the link angles over the step "
+                 "(middle; a five-link biped: the step as stop action, right)."),
 ]
 
 
@@ -86,13 +86,21 @@ def optimize_lines(d) -> list[str]:
     import numpy as np
 
     mu = float(np.max(np.abs(d.multipliers))) if len(d.multipliers) else float("nan")
+    peaks = np.abs(np.asarray(d.torque).reshape(len(d.time), -1)).max(axis=0)
+    peak = ", ".join(f"{n} {num(float(v))}" for n, v in zip(d.torque_names, peaks))
+    closed = ("" if not np.isfinite(d.start_shift) else
+              f" The torques are open loop and the gait unstable under them: from the "
+              f"collocated start the step returns {num(d.collocated_start_error, 2)} away, so "
+              f"the step is first closed by shooting under the same torques (start moved "
+              f"{num(d.start_shift, 2)}, step period {num(d.replay_step_period_s, 9)} s), "
+              f"then replayed.")
     return [f"IPOPT: {d.status} ({d.iterations} iterations, {num(d.wall_time_s, 3)} s). Step "
             f"period {num(d.step_period_s)} s, step length {num(d.step_length_m)} m, speed "
             f"{num(d.step_length_m / d.step_period_s)} m/s, push-off {num(d.push_off_n_s)} N s, "
-            f"peak hip torque {num(float(np.max(np.abs(d.torque))))} {d.torque_unit}; objective "
-            f"{d.objective_name} = {num(d.objective)} {d.objective_unit}. Replayed on the rigid "
-            f"model (the torque as a function of time): return error {num(d.replay_error, 2)}, "
-            f"largest |Floquet multiplier| {num(mu)}: "
+            f"peak torque [{d.torque_unit}]: {peak}; objective {d.objective_name} = "
+            f"{num(d.objective)} {d.objective_unit}.{closed} Replayed on the rigid model (the "
+            f"torques as a function of time): return error {num(d.replay_error, 2)}, largest "
+            f"|Floquet multiplier| {num(mu)}: "
             + ("**a gait**." if d.gait else "**not a gait** (the replay does not close).")
             + (f" In the contact model: step period {num(d.contact_step_period_s)} s "
                f"({num(100 * (d.contact_step_period_s / d.step_period_s - 1), 2)} %)."

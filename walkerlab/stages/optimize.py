@@ -2,9 +2,10 @@
 
 Reads the scene's ``optimize`` section and its gait from ``fixedpoint.h5`` (the pipeline
 runs ``fixedpoint`` first, :mod:`walkerlab.stages.pipeline`; the collocation starts from
-one step of it), optimises by :func:`walkerlab.optimal.scene.optimize_scene`
-(CasADi + IPOPT) and replays the result on the rigid model.  Skipped when the scene
-sections, the upstream gait and the code are unchanged.
+one step of it; a five-link biped's from its targets, no upstream gait), optimises by
+:func:`walkerlab.optimal.scene.optimize_scene` (CasADi + IPOPT) and replays the result
+on the rigid model.  Skipped when the scene sections, the upstream gait and the code are
+unchanged.
 """
 
 from __future__ import annotations
@@ -35,10 +36,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         A walker the collocation does not handle (one line); a missing ``optimize`` or
         ``fixedpoint`` section runs with its defaults.
     """
-    from walkerlab.optimal.scene import optimize_scene
+    from walkerlab.optimal.scene import needs_gait, optimize_scene
 
-    require(scene, "fixedpoint", "optimize")
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
+    if not needs_gait(scene):
+        return _run_five_link(scene, runs_root, force)
+    require(scene, "fixedpoint", "optimize")
     up = stage_artifact(scene, runs_root, "fixedpoint")
 
     def compute():
@@ -50,6 +53,21 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         return (lambda f: schema.write(f, data)), {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, (up,), compute, force)
+
+
+def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
+    """``optimize.h5`` of a five-link biped (no upstream gait:
+    :func:`walkerlab.optimal.five_link_scene.optimize_five_link_scene`)."""
+    from walkerlab.optimal.five_link_scene import optimize_five_link_scene
+
+    def compute():
+        try:
+            data = optimize_five_link_scene(scene)
+        except ValueError as exc:
+            raise StageError(str(exc)) from None
+        return (lambda f: schema.write(f, data)), {"data": data}
+
+    return run_cached("optimize", scene, runs_root, SECTIONS, (), compute, force)
 
 
 def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
@@ -88,4 +106,9 @@ def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     from walkerlab.plotting.optimize_figure import save_optimize_figure
 
     d = schema.load(stage_artifact(scene, runs_root, "optimize"))
-    return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root))
+    sticks = None
+    if d.torque_names != ("hip",):  # a five-link biped: its step as stop action
+        from walkerlab.optimal.five_link_scene import stick_figures
+
+        sticks = stick_figures(scene, d)
+    return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks)

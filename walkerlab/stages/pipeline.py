@@ -33,6 +33,11 @@ def needs(stage: str, scene: Scene) -> tuple[str, ...]:
     if stage == "simulate" and scene.simulate is not None \
             and scene.simulate.initial_state != "fixed_point":
         return ()
+    if stage == "optimize":
+        from walkerlab.optimal.scene import needs_gait
+
+        if not needs_gait(scene):  # a five-link biped: its guess is built from the targets
+            return ()
     return NEEDS.get(stage, ())
 
 
@@ -87,6 +92,7 @@ def report_plan(scene: Scene, full: bool = False) -> list[str]:
             "compare": contact and sim, "workprecision": full and scene.workprecision is not None,
             "basin": scene.basin is not None and fp,
             "robustness": scene.robustness is not None and fp,
-            "optimize": getattr(scene, "optimize", None) is not None and fp,
+            "optimize": getattr(scene, "optimize", None) is not None
+            and (fp or not needs("optimize", scene)),
             "attribution": full and contact and fp}
     return [s for s, on in plan.items() if on]

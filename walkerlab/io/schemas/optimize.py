@@ -5,8 +5,10 @@ points)::
 
     time                          s        collocation points (2N + 1) on [0, step_period]
     states/<state name>           rad, rad/s   the walker's states there (role order)
-    torque/hip                    N m      the hip torque there (+ on the swing leg; N m/kg:
-                                           per foot mass on massless legs)
+    torque/<joint>                N m      each actuator's torque there (``hip``: + on the
+                                           swing leg; N m/kg: per foot mass on massless legs;
+                                           a five-link biped: stance_hip, swing_hip,
+                                           stance_knee, swing_knee)
     step_period, step_length      s, m
     speed                         m/s      step length / step period
     push_off                      N s      the push-off impulse
@@ -19,7 +21,13 @@ points)::
     replay/max_state_error        rad, rad/s  the rigid model's return error (gait if
                                            <= the scene's replay_tolerance)
     replay/multipliers/{real,imag} -       Floquet multipliers of the replayed gait
-    ipopt                         attributes: status, iterations, wall_time_s
+    replay/start_shift            rad, rad/s  (closed by shooting, a five-link biped) how
+                                           far the exactly periodic start is from the
+                                           collocated one (the transcription's error)
+    replay/step_period            s        (closed by shooting) the closed step's period
+    replay/collocated_start_error rad, rad/s  (closed by shooting) the open-loop return
+                                           error from the collocated start itself
+    ipopt                         attributes: status, iterations, wall_time_s, cpu_time_s
 
 attributes: ``gait`` (the replay closed), ``state_names``.
 """
@@ -60,6 +68,11 @@ class OptimizeData:
     contact_step_period_s: float = float("nan")
     contact_outcome: str = ""
     torque_unit: str = "N m"
+    torque_names: tuple = ("hip",)
+    start_shift: float = float("nan")
+    replay_step_period_s: float = float("nan")
+    collocated_start_error: float = float("nan")
+    cpu_time_s: float = float("nan")
 
 
 def write(f, d: OptimizeData) -> None:
@@ -71,8 +84,12 @@ def write(f, d: OptimizeData) -> None:
     for name, v in d.states.items():
         put(f, f"states/{name}", v, d.state_units[name], f"{name} at the collocation points",
             dims=("time",))
-    put(f, "torque/hip", d.torque, d.torque_unit, "hip torque (+ on the swing leg, - on the stance "
-        "leg)", dims=("time",))
+    tq = np.asarray(d.torque, float).reshape(len(d.time), -1)
+    for k, name in enumerate(d.torque_names):
+        put(f, f"torque/{name}", tq[:, k], d.torque_unit, "hip torque (+ on the swing leg, - on "
+            "the stance leg)" if name == "hip" else f"{name} torque (+ on the joint's second "
+            "link, - on its first)", dims=("time",))
+    f.attrs["torque_names"] = list(d.torque_names)
     put(f, "step_period", float(d.step_period_s), "s", "step period")
     put(f, "step_length", float(d.step_length_m), "m", "distance between the feet at heel "
         "strike")
@@ -99,6 +116,15 @@ def write(f, d: OptimizeData) -> None:
     f.attrs["ipopt_status"] = d.status
     f.attrs["ipopt_iterations"] = int(d.iterations)
     f.attrs["ipopt_wall_time_s"] = float(d.wall_time_s)
+    f.attrs["ipopt_cpu_time_s"] = float(d.cpu_time_s)
+    for key, v, unit, what in (
+            ("start_shift", d.start_shift, "-", "max |closed start - collocated start| "
+             "[rad, rad/s]: the transcription's error"),
+            ("step_period", d.replay_step_period_s, "s", "the closed step's period"),
+            ("collocated_start_error", d.collocated_start_error, "-", "open-loop return "
+             "error from the collocated start [rad, rad/s]")):
+        if np.isfinite(v):
+            put(f, f"replay/{key}", float(v), unit, what)
 
 
 def load(path: Path) -> OptimizeData:
@@ -113,8 +139,15 @@ def load(path: Path) -> OptimizeData:
 
     with open_artifact(path, STAGE) as f:
         names = [str(s) for s in f.attrs["state_names"]]
+        joints = tuple(str(s) for s in f.attrs.get("torque_names", ["hip"]))
+        tq = np.stack([f[f"torque/{j}"][()] for j in joints], axis=1)
+
+        def opt(key):
+            return float(f[f"replay/{key}"][()]) if f"replay/{key}" in f else float("nan")
+
         return OptimizeData(
-            f["time"][()], {n: f[f"states/{n}"][()] for n in names}, f["torque/hip"][()],
+            f["time"][()], {n: f[f"states/{n}"][()] for n in names},
+            tq[:, 0] if joints == ("hip",) else tq,
             float(f["step_period"][()]), float(f["step_length"][()]),
             float(f["push_off"][()]), float(f["objective"][()]),
             float(f["replay/max_state_error"][()]),
@@ -125,7 +158,9 @@ def load(path: Path) -> OptimizeData:
             str(f.attrs["objective_name"]), str(f["objective"].attrs["unit"]),
             {k: float(v[()]) for k, v in f["terms"].items()} if "terms" in f else {},
             float(f["contact_replay/step_period"][()]),
-            str(f.attrs["contact_replay_outcome"]), str(f["torque/hip"].attrs["unit"]))
+            str(f.attrs["contact_replay_outcome"]), str(f[f"torque/{joints[0]}"].attrs["unit"]),
+            joints, opt("start_shift"), opt("step_period"), opt("collocated_start_error"),
+            float(f.attrs.get("ipopt_cpu_time_s", float("nan"))))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)

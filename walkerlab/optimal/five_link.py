@@ -1,0 +1,152 @@
+"""CasADi functions of a free-jointed (five-link) biped's step, from its own symbolic model
+(:func:`walkerlab.codegen.five_link.derive_five_link`), built once per walker structure and
+cached on disk like the generated flows (:mod:`walkerlab.codegen.cache`).
+
+Every function takes the walker's parameter vector ``p`` (``structure.param_names`` order,
+``WalkerData.params``) as an input, so one cached file serves every set of masses and
+lengths, as one generated module does:
+
+``flow(x, u, p)``      ``[dq, M^-1 (B u - C dq - G)]`` (2n,): Lagrange's equations of the
+                       walker (Westervelt, Grizzle & Koditschek 2003, IEEE TAC 48(1), Eq. 3
+                       with ``B u``); ``u`` (4,) the joint torques [N m] in :data:`JOINTS`
+                       order, each ``+tau`` on its second link's row and ``-tau`` on its
+                       first's (:data:`walkerlab.config.actuation.FIVE_LINK_JOINTS`, the
+                       signs of :mod:`walkerlab.models.hybrid.actuated_five_link`)
+``feet(x, p)``         ``[clearance, ahead, clearance rate, stance knee, swing knee]``: the
+                       swing foot's height above the slope [m] (the heel-strike guard), its
+                       distance ahead of the stance foot along the slope [m], the height's
+                       rate [m/s], and the knees' angles (shank minus thigh, [rad], 0
+                       straight, negative flexed)
+``reset(x, p)``        heel strike and role swap (2n,): ``Mi dq+ = B dq-`` (Westervelt et
+                       al. 2003, Sec. III-B), ``q+ = relabel_q(q-)``, ``dq+ = R dq+``
+
+Cache: ``<user cache>/models/<cache_key(structure)>-collocation-<hash>.casadi`` (the
+walker's structure key, this module's source and CasADi's version in the name; the same
+private-folder, sha256-header rules as the generated code: a damaged or untrusted file is
+rebuilt).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from functools import cache
+from pathlib import Path
+
+__all__ = ["JOINTS", "five_link_functions"]
+
+#: the actuated joints, the order of ``u`` (hips then knees)
+JOINTS = ("stance_hip", "swing_hip", "stance_knee", "swing_knee")
+_memo: dict[str, dict] = {}
+
+
+def _lambdify(exprs, syms: list, args: list):
+    """The sympy matrix ``exprs`` as a CasADi SX matrix, ``syms`` replaced by ``args``."""
+    import casadi as ca
+    import sympy as sp
+
+    mat = sp.Matrix(exprs)
+    f = sp.lambdify(syms, mat, modules=[{"sin": ca.sin, "cos": ca.cos, "sqrt": ca.sqrt,
+                                         "atan": ca.atan, "acos": ca.acos, "Abs": ca.fabs,
+                                         "ImmutableDenseMatrix": list,
+                                         "MutableDenseMatrix": list}, "math"])
+    rows = f(*args)
+    return ca.vertcat(*[ca.horzcat(*[v if isinstance(v, ca.SX) else ca.SX(float(v))
+                                     for v in r]) for r in rows])
+
+
+def _build(structure) -> dict:
+    """Derive (sympy) and convert (CasADi SX) the step's functions (module docstring)."""
+    import casadi as ca
+    import numpy as np
+
+    from walkerlab.codegen.five_link import derive_five_link
+    from walkerlab.config.actuation import FIVE_LINK_JOINTS
+
+    eq = derive_five_link(structure)
+    n, roles = len(eq.q), list(structure.roles)
+    syms = [*eq.q, *eq.dq, *eq.params]
+    x, u, p = ca.SX.sym("x", 2 * n), ca.SX.sym("u", len(JOINTS)), ca.SX.sym("p", len(eq.params))
+    args = [*ca.vertsplit(x), *ca.vertsplit(p)]
+    B = np.zeros((n, len(JOINTS)))
+    for k, j in enumerate(JOINTS):
+        first, second = FIVE_LINK_JOINTS[j]
+        B[roles.index(first), k] -= 1.0
+        B[roles.index(second), k] += 1.0
+    M, C, G = (_lambdify(e, syms, args) for e in (eq.M, eq.C, eq.G))
+    dq = x[n:]
+    qdd = ca.solve(M, ca.DM(B) @ u - C @ dq - G)
+    flow = ca.Function("flow", [x, u, p], [ca.vertcat(dq, qdd)], ["x", "u", "p"], ["dx"])
+    clear = _lambdify([eq.guards["heel_strike"]], syms, args)
+    ahead = _lambdify([eq.guards["swing_foot_ahead"]], syms, args)
+    rate = ca.jtimes(clear, x, ca.vertcat(dq, ca.SX.zeros(n)))
+    knees = [x[roles.index(b)] - x[roles.index(a)]
+             for a, b in (FIVE_LINK_JOINTS["stance_knee"], FIVE_LINK_JOINTS["swing_knee"])]
+    feet = ca.Function("feet", [x, p], [ca.vertcat(clear, ahead, rate, *knees)], ["x", "p"],
+                       ["feet"])
+    Mi, Bi = _lambdify(eq.Mi, syms, args), _lambdify(eq.B, syms, args)
+    dq_post = ca.solve(Mi, Bi @ dq)
+    qn = _lambdify(eq.relabel_q, syms, args)
+    R = np.array(eq.relabel_rate, float)
+    reset = ca.Function("reset", [x, p], [ca.vertcat(qn, ca.DM(R) @ dq_post)], ["x", "p"],
+                        ["x_next"])
+    return {"flow": flow, "feet": feet, "reset": reset}
+
+
+@cache
+def _source_hash() -> str:
+    import casadi as ca
+
+    h = hashlib.sha256(Path(__file__).read_bytes())
+    h.update(ca.__version__.encode())
+    return h.hexdigest()[:12]
+
+
+def five_link_functions(structure) -> dict:
+    """The step's CasADi functions of a free-jointed biped (module docstring), from the
+    memo, the disk cache, or derived (sympy, ~2 s) and written there.
+
+    Parameters
+    ----------
+    structure : walkerlab.walker.description.Structure
+        ``free_knees`` set (the five-link generator's walkers).
+
+    Returns
+    -------
+    dict
+        ``flow``, ``feet``, ``reset`` (:class:`casadi.Function`) and ``n`` (coordinates).
+
+    Raises
+    ------
+    ValueError
+        A walker without free knees or without a hinged torso (the hips act between the
+        torso and the thighs), or one the five-link generator does not handle (one line).
+    """
+    import casadi as ca
+
+    from walkerlab.codegen.cache import cache_dir, cache_key, read_source, write_source
+
+    if not (structure.free_knees and structure.hinged_torso):
+        raise ValueError("optimize: the five-link collocation drives the hips between a hinged "
+                         "torso and the thighs and the free knees (walker.torso.coupling: "
+                         "hinged, walker.leg.knee.lock: free)")
+
+    key = f"{cache_key(structure)}-collocation-{_source_hash()}"
+    if key in _memo:
+        return _memo[key]
+    folder = cache_dir()
+    path = folder / f"{key}.casadi" if folder is not None else None
+    text = read_source(path) if path is not None else None
+    fns = None
+    if text is not None:
+        try:
+            fns = {k: ca.Function.deserialize(v) for k, v in json.loads(text).items()}
+        except (RuntimeError, ValueError, TypeError):
+            fns = None  # damaged: rebuilt below
+    if fns is None:
+        fns = _build(structure)
+        if path is not None:
+            write_source(path, json.dumps({k: f.serialize() for k, f in fns.items()}))
+    fns["n"] = len(structure.roles)
+    _memo[key] = fns
+    return fns

@@ -1,0 +1,90 @@
+"""A five-link biped scene's least-effort step (``walkerlab optimize`` on a walker with free
+knees): collocated (:mod:`walkerlab.optimal.five_link_collocation`), closed by shooting
+under its own torques (:mod:`walkerlab.optimal.five_link_shooting`), replayed on the rigid
+model's generated code, stored as ``optimize.h5``.  Needs no upstream gait: the guess is
+built from the targets (Kelly 2017's set-up)."""
+
+from __future__ import annotations
+
+__all__ = ["optimize_five_link_scene", "stick_figures"]
+
+
+def optimize_five_link_scene(scene):
+    """Optimise, close and replay one step of the scene's five-link walker.
+
+    Parameters
+    ----------
+    scene : Scene
+        A walker with free knees (``walker.leg.knee.lock: free``) and an ``optimize``
+        section (``intervals``, ``max_torque_n_m``, the targets).
+
+    Returns
+    -------
+    walkerlab.io.schemas.optimize.OptimizeData
+        The collocated states and torques by name; ``replay_error`` the rigid model's
+        return error from the closed start; ``gait`` when IPOPT converged, the shooting
+        closed and the replay returns within ``optimize.replay_tolerance``.
+
+    Raises
+    ------
+    ValueError
+        A push-off asked for, a walker the five-link generator does not handle (one line).
+    """
+    from walkerlab.io.schemas.optimize import OptimizeData
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.five_link import JOINTS, five_link_functions
+    from walkerlab.optimal.five_link_collocation import collocate_five_link, replay_five_link
+    from walkerlab.optimal.five_link_shooting import close_step
+    from walkerlab.walker.description import walker_data
+
+    o = scene.optimize
+    if o.push_off == "free":
+        raise ValueError("optimize.push_off: a five-link biped has no push-off (its hips and "
+                         "knees are driven)")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    fns = five_link_functions(data.structure)
+    spec = CollocationSpec(intervals=o.intervals, max_torque_n_m=o.max_torque_n_m,
+                           target_speed_m_per_s=o.target_speed_m_per_s,
+                           target_step_length_m=o.target_step_length_m,
+                           target_step_period_s=o.target_step_period_s)
+    res = collocate_five_link(data, spec, fns)
+    closed = close_step(fns, data.params, res.t, res.x, res.u)
+    err = float("inf")
+    if closed.converged:
+        err = replay_five_link(data, res, closed.x0)[0]
+    rigid = make_rigid_walker(data, "biped", "derived")
+    names = list(rigid.state_names())
+    units = dict(zip(names, rigid.state_units()))
+    gait = bool(res.status == "Solve_Succeeded" and closed.converged
+                and err <= o.replay_tolerance)
+    return OptimizeData(
+        res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u, res.step_period_s,
+        res.step_length_m, 0.0, res.objective, err, closed.multipliers, gait, res.status,
+        res.iterations, res.wall_time_s, units, torque_names=JOINTS,
+        start_shift=closed.shift, replay_step_period_s=closed.period_s,
+        collocated_start_error=closed.open_loop_error, cpu_time_s=res.cpu_time_s)
+
+
+
+#: the stick figure's polyline through the walker's named points
+STICK = ("stance_foot", "stance_knee", "hip", "torso_top", "hip", "swing_knee", "swing_foot")
+
+
+def stick_figures(scene, d, frames: int = 8) -> list:
+    """The five-link walker of ``scene`` at ``frames`` instants of the stored step ``d``
+    (a loaded ``optimize.h5``): polylines (7, 2) [m] through :data:`STICK` (the torso's
+    top: its centre of mass, the generated ``torso_*`` point)."""
+    import numpy as np
+
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.walker.description import walker_data
+
+    w = make_rigid_walker(walker_data(scene.walker, scene.slope.phi_rad), "biped", "derived")
+    names = w.state_names()
+    out = []
+    for k in np.linspace(0, len(d.time) - 1, frames).round().astype(int):
+        pts = w.points(np.array([d.states[n][k] for n in names]))
+        top = next(v for key, v in pts.items() if key.startswith("torso_"))
+        out.append(np.array([pts[n] if n != "torso_top" else top for n in STICK]))
+    return out
