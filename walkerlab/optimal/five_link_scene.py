@@ -63,8 +63,9 @@ def optimize_five_link_scene(scene):
         res.step_length_m, 0.0, res.objective, err, closed.multipliers, gait, res.status,
         res.iterations, res.wall_time_s, units, torque_names=JOINTS,
         start_shift=closed.shift, replay_step_period_s=closed.period_s,
-        collocated_start_error=closed.open_loop_error, cpu_time_s=res.cpu_time_s)
-
+        collocated_start_error=closed.open_loop_error, cpu_time_s=res.cpu_time_s,
+        contact_outcome="not replayed: a five-link biped's optimised torques are replayed on "
+        "the rigid model only")
 
 
 #: the stick figure's polyline through the walker's named points
