@@ -181,10 +181,12 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings) -> ContactActuators |
     from walkerlab.codegen.floating import coordinate_names
 
     st = data.structure
-    if st.knee or st.foot != "point" or st.torso:
+    flat_push_off = st.foot == "flat" and spec.ankle_push_off is not None
+    if st.knee or st.torso or not (st.foot == "point" or flat_push_off):
         raise ContactSceneError(f"scene '{scene.name}': walker.actuation: the contact view "
                                 "carries actuators on straight legs with point feet and no "
-                                "torso only (the rigid view has them too)")
+                                "torso, or an ankle push-off on flat feet, only (the rigid "
+                                "view has them too)")
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
                                 "pinned start phase carries no actuators: leave it 'none'")
