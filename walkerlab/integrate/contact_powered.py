@@ -100,12 +100,11 @@ def _touchdown_event(walker, stance_of):
 
     def touch(t, y):
         stance = stance_of()
-        x = y[:n]
-        fq = walker.foot_quantities(x)
-        sw, st = fq[f"leg{2 - stance}"], fq[f"leg{stance + 1}"]
-        if sw["on_ground"][0] < 0.5 or sw["s"][0] - st["s"][0] < acts.min_step_m:
+        rows = acts.leg_contacts(walker, y[:n])  # (penetration, ..., s, ..., on_ground)
+        sw, st = rows[1 - stance], rows[stance]
+        if sw[7] < 0.5 or sw[3] - st[3] < acts.min_step_m:
             return 1.0
-        return -float(sw["penetration"][0])
+        return -float(sw[0])
 
     touch.terminal = True
     touch.direction = -1
@@ -116,13 +115,16 @@ def _heel_off_event(walker, stance_of):
     """Event: the stance heel's penetration crosses 0 downwards (it leaves the ground) with
     the stance toe loaded (penetration > 0); the ankle push-off starts there."""
     n = 2 * walker.nq
+    names = walker.contact_names()
+    heel = [names.index(f"{leg}_heel") for leg in ("leg1", "leg2")]
+    toe = [names.index(f"{leg}_toe") for leg in ("leg1", "leg2")]
 
     def heel_off(t, y):
-        leg = f"leg{stance_of() + 1}"
-        cq = walker.contact_quantities(y[:n])
-        if cq[f"{leg}_toe"]["penetration"][0] <= 0.0:
+        stance = stance_of()
+        tab = walker.actuators.contact_rows(walker, y[:n])  # column 0: penetration [m]
+        if tab[toe[stance], 0] <= 0.0:
             return 1.0
-        return float(cq[f"{leg}_heel"]["penetration"][0])
+        return float(tab[heel[stance], 0])
 
     heel_off.terminal = True
     heel_off.direction = -1
