@@ -54,13 +54,15 @@ __all__ = ["ANKLE_WORK_NAMES", "WORK_NAMES", "ContactActuators", "powered_rhs"]
 
 
 class ContactActuators:
-    """The actuators of one contact walker (straight legs, point feet).
+    """The actuators of one contact walker (straight legs; point feet, or flat feet with an
+    ankle push-off).
 
     Parameters
     ----------
     spec : walkerlab.config.actuation.Actuation
     coordinates : tuple of str
-        The floating coordinates (``hip_x, hip_y, leg1_angle, leg2_angle``).
+        The floating coordinates (``hip_x, hip_y, leg1_angle, leg2_angle``; flat feet then
+        ``leg1_foot_angle, leg2_foot_angle``).
     pulse_s : float
         Push-off pulse duration [s] (0: an impulse).
 
