@@ -512,3 +512,20 @@ def test_the_flat_footed_ankle_push_off_walks_on_level_ground():
     np.testing.assert_allclose(led["cost_of_transport"],
                                led["actuator_work_positive"] / (m * gr * d), rtol=1e-12)
     assert led["cost_of_transport"][0] == pytest.approx(0.0637, abs=1e-4)
+
+
+def test_table3_step_length_of_flat_feet_is_heel_to_heel():
+    """Table 3's step length of a flat-footed walker: from the stance heel's touchdown point
+    to the swing heel's, the rigid step (walkerlab.analysis.gait.metrics.step_length,
+    0.4130 m for flat_feet_push_off.yaml); the stance ankle, heeled off at heel strike, read
+    0.361 m before."""
+    from walkerlab.analysis.gait.metrics import sample_trajectory, step_length
+    from walkerlab.comparison.tables import gait_metrics
+
+    w = wl.Walker.from_scene(CONFIGS / "flat_feet_push_off.yaml")
+    traj = simulate_steps(w.model, w.fixed_point().x, 3, w.solver)
+    m = gait_metrics(sample_trajectory(traj, 200.0))
+    d = step_length(w.model, traj.segments[0])
+    assert m["step_length_m"] == pytest.approx(d, abs=1e-9)
+    assert m["step_length_left_m"] == pytest.approx(d, abs=1e-9)
+    assert m["step_length_right_m"] == pytest.approx(d, abs=1e-9)
