@@ -80,7 +80,7 @@ def test_the_ledger_powers_add_up_to_the_energy_rate(contact_walker, ankle):
 
 @pytest.fixture(scope="module")
 def walk(rigid):
-    """The shipped scene's contact run: 12 heel strikes from the rigid gait."""
+    """The shipped scene's contact run: 11 heel strikes from the rigid gait."""
     from walkerlab.analysis.contact.sim import simulate_from
 
     _, gait = rigid
@@ -89,7 +89,8 @@ def walk(rigid):
     return walker, res
 
 
-@pytest.mark.slow  # one contact run of 12 heel strikes on solve_ivp: COST_NOTE
+@pytest.mark.slow  # one contact run of 11 heel strikes on solve_ivp: ~60 s CPU (4-8 min wall
+# on the shared 2-core machine)
 def test_contact_step_period_and_ledger_of_the_ankle_push_off(rigid, walk):
     """More than 10 heel strikes at the rigid gait's step period (within 3 %); E(t) - E(0)
     = ankle push-off + ankle dampers + contact work at every sample, to 1e-4 of the kinetic
