@@ -72,8 +72,8 @@ def energy_section(sim: SimulateArtifact) -> list[str]:
     note = (" Flat feet: the ankle push-off's torque is in the actuator columns; the heel "
             "strike's loss includes the trailing ankle spring's energy (its massless foot "
             "leaves the ground and snaps to its rest angle); knee/foot is the foot slaps."
-            if sim.samples is not None and "stance_ankle_angle" in sim.samples.coordinates
-            else "")
+            if sim.samples is not None
+            and any(c.endswith("_ankle_angle") for c in sim.samples.coordinates) else "")
     return [f"Cost of transport (positive actuator and push-off work + the potential energy "
             f"the slope releases, per weight and distance along the ground), mean over the "
             f"steps: **{num(mean)}**. Energies in {u.energy}; the collisions, dampers and "
