@@ -222,7 +222,8 @@ class _PoweredRun:
         self.t_origin = float(grid[0])  # when the present step began [s]
         self.touch = _touchdown_event(walker, lambda: self.stance)
         self.fall = _fall_event(walker, limits)
-        self.heel_off = _heel_off_event(walker, lambda: self.stance)
+        self.heel_off = (None if walker.actuators.ankle is None  # flat feet only
+                         else _heel_off_event(walker, lambda: self.stance))
         self.ankle_on = False  # the ankle push-off (flat feet), off until the heel lifts
         self.ts, self.Ys, self.nfev, self.njev = [], [], 0, 0
         self.term, self.msg, self.event = RunEnd.T_FINAL, "Integration successful.", None
