@@ -151,20 +151,11 @@ def _ledger(name: str):
     return w, trajectory_ledger(traj), ke
 
 
-def test_flat_feet_have_no_ledger_yet():
-    """Flat feet: energies per pinned point and the ankle damper are not in the ledger; it
-    is left out (no numbers that do not close)."""
-    w, led, _ = _ledger("flat_feet")
-    assert led == {}
-
-
 # rabbit: its fixed point takes ~2 min (ten coordinates, high-gain PD); tests/test_rabbit.py
-# closes its ledger on one step from the fixed point its scene stores; flat feet: no full
-# ledger yet; rabbit_optimal: no gait of its own (its step is optimised: tests/
-# test_optimize_five_link.py)
-@pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED
-                                  if n not in ("flat_feet", "flat_feet_push_off", "rabbit",
-                                               "rabbit_optimal")])
+# closes its ledger on one step from the fixed point its scene stores; flat feet (passive
+# and with an ankle push-off): walkerlab.analysis.gait.energy_flat; rabbit_optimal: no gait
+# of its own (its step is optimised: tests/test_optimize_five_link.py)
+@pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED if n not in ("rabbit", "rabbit_optimal")])
 def test_the_energy_ledger_closes_and_cost_of_transport(name):
     w, led, ke = _ledger(name)
     assert np.all(np.isfinite(led["closure"]))
@@ -428,8 +419,8 @@ def test_ankle_push_off_on_flat_feet_is_the_released_spring_in_heel_off():
     equations with the ankle numbers (k + k_po, r_eff); its flow equals the passive flow
     plus the push-off torque on the ankle coordinate, -k_po (a - r_po) - tau_0, through
     M^-1 (checked against the passive heel-off flow, the other modes unchanged); the shipped
-    scene's gait puts the push-off's work into the ledger (~11.1 J a step, cost of
-    transport ~0.097)."""
+    scene's gait puts the push-off's work into the ledger (its positive and negative parts
+    apart)."""
     from walkerlab.models.hybrid.ankle_push_off import ankle_push_off_work
 
     d = load_scene(CONFIGS / "flat_feet.yaml").model_dump(mode="json", exclude_none=True)
@@ -457,9 +448,11 @@ def test_ankle_push_off_on_flat_feet_is_the_released_spring_in_heel_off():
     g = w.fixed_point()
     assert g.stable
     seg = simulate_steps(w.model, g.x, 1, w.solver).segments[0]
-    assert ankle_push_off_work(w.model, seg) == pytest.approx(11.11, rel=1e-3)
     led = trajectory_ledger(simulate_steps(w.model, g.x, 2, w.solver))
-    assert np.allclose(led["cost_of_transport"], 0.0966, rtol=1e-3)
+    # the ledger's ankle torque work (positive and negative parts, adaptive quadrature) is
+    # the push-off's work (Gauss-Legendre on the heel-off pieces)
+    np.testing.assert_allclose(led["actuator_work_positive"] + led["actuator_work_negative"],
+                               ankle_push_off_work(w.model, seg), rtol=1e-9)
 
 
 def test_linear_hip_torques_run_on_the_compiled_flows():
@@ -489,3 +482,52 @@ def test_linear_hip_torques_run_on_the_compiled_flows():
     # (tests/test_compiled_laws.py)
     assert all(ph.compiled is not None and not ph.compiled.batchable
                for ph in build_walker(sc2).phases)
+
+
+def test_the_flat_footed_ankle_push_off_walks_on_level_ground():
+    """configs/flat_feet_push_off.yaml (short toes, 25 N m from heel off to heel strike): a
+    stable period-1 gait on level ground from the stored guess, with the numbers its header
+    states (step period 0.7524 s, step length 0.4130 m, cost of transport 0.0637); the flat
+    foot's ledger closes to 1e-9 of the step's kinetic energy (measured ~3e-11) and names
+    where the push-off's work goes: the ankle damper, the heel strike (with the trailing
+    ankle spring's release) and the foot slap; the cost of transport is the push-off's
+    positive work over m g d (level ground)."""
+    from walkerlab.analysis.gait.metrics import step_length
+
+    w = wl.Walker.from_scene(CONFIGS / "flat_feet_push_off.yaml")
+    assert w.model.slope_rad == 0.0
+    g = w.fixed_point()
+    assert g.residual < 1e-10 and g.stable
+    assert g.step_period == pytest.approx(0.75238, abs=1e-5)
+    assert max(abs(g.multipliers)) == pytest.approx(0.5234, abs=1e-3)
+    traj = simulate_steps(w.model, g.x, 2, w.solver)
+    led = trajectory_ledger(traj)
+    ke = w.model.energies(g.x)[0]
+    assert np.max(np.abs(led["closure"])) <= 1e-9 * ke
+    d = step_length(w.model, traj.segments[0])
+    assert d == pytest.approx(0.41298, abs=1e-5)
+    np.testing.assert_allclose(led["energy_change"], 0.0, atol=1e-9 * ke)  # periodic
+    assert np.all(led["damper_work"] < 0) and np.all(led["heel_strike_loss"] > 0)
+    assert np.all(led["internal_collision_loss"] > 0)
+    np.testing.assert_allclose(led["actuator_work_positive"], 5.164, rtol=1e-3)
+    m, gr = w.model.total_mass_kg, w.model.params["gravity_m_per_s2"]
+    np.testing.assert_allclose(led["cost_of_transport"],
+                               led["actuator_work_positive"] / (m * gr * d), rtol=1e-12)
+    assert led["cost_of_transport"][0] == pytest.approx(0.0637, abs=1e-4)
+
+
+def test_table3_step_length_of_flat_feet_is_heel_to_heel():
+    """Table 3's step length of a flat-footed walker: from the stance heel's touchdown point
+    to the swing heel's, the rigid step (walkerlab.analysis.gait.metrics.step_length,
+    0.4130 m for flat_feet_push_off.yaml); the stance ankle, heeled off at heel strike, read
+    0.361 m before."""
+    from walkerlab.analysis.gait.metrics import sample_trajectory, step_length
+    from walkerlab.comparison.tables import gait_metrics
+
+    w = wl.Walker.from_scene(CONFIGS / "flat_feet_push_off.yaml")
+    traj = simulate_steps(w.model, w.fixed_point().x, 3, w.solver)
+    m = gait_metrics(sample_trajectory(traj, 200.0))
+    d = step_length(w.model, traj.segments[0])
+    assert m["step_length_m"] == pytest.approx(d, abs=1e-9)
+    assert m["step_length_left_m"] == pytest.approx(d, abs=1e-9)
+    assert m["step_length_right_m"] == pytest.approx(d, abs=1e-9)

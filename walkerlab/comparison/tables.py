@@ -29,8 +29,10 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     -------
     dict
         ``t_left_s``, ``t_right_s``, ``t_cycle_s``, ``v_com_m_per_s``, ``E_avg_J``,
-        ``E_avg_stance_frame_J``, ``step_length_m`` (and per leg, ``step_length_left_m``,
-        ``step_length_right_m``: the steps the left / right leg's swing ends), ``n_steps``.
+        ``E_avg_stance_frame_J``, ``step_length_m`` (the feet's distance at heel strike; flat
+        feet: from the stance heel's touchdown point to the swing heel's; and per leg,
+        ``step_length_left_m``, ``step_length_right_m``: the steps the left / right leg's
+        swing ends), ``n_steps``.
     """
     left = left_leg or tr.legs[0]
     li = tr.legs.index(left)
@@ -54,11 +56,18 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
         i0, i1 = bounds[0], bounds[2 * n_cyc]
         out["v_com_m_per_s"] = float((hip[0, i1] - hip[0, i0]) / (tr.time[i1] - tr.time[i0]))
         feet = [tr.points.get(f"{leg}_foot") for leg in tr.legs]
+        # flat feet: heel to heel, from where the stance heel landed (the step's first
+        # sample) to where the swing heel lands (the stance foot is heeled off by then and
+        # its "foot" point, the ankle, is not on the ground)
+        heels = [tr.points.get(f"{leg}_heel") for leg in tr.legs]
+        flat = all(h is not None for h in heels)
         if all(f is not None for f in feet):
             lengths, left_step = [], []
             for k in range(1, int(done.sum()) + 1):
                 i = bounds[k] - 1 if k < len(bounds) - 1 else bounds[k]
-                d = feet[0][:, i] - feet[1][:, i]
+                st = int(stance[k - 1])
+                d = (heels[1 - st][:, i] - heels[st][:, bounds[k - 1]] if flat
+                     else feet[0][:, i] - feet[1][:, i])
                 lengths.append(np.hypot(*d))
                 left_step.append(stance[k - 1] != li)
             out["step_length_m"] = float(np.mean(lengths)) if lengths else np.nan

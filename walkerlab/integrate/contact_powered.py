@@ -16,8 +16,13 @@ A free-jointed (five-link) biped's joint torques (:mod:`walkerlab.models.contact
 run the same way: the stance leg switched at the heel strike sets which leg's hip and knee
 carry the ``stance_*`` laws and which the ``swing_*`` ones; the time-based laws count from it.
 
-The state carries four work integrals beside the walker's (``WORK_NAMES`` [J]: the hip
-torques' positive and negative work, the push-off's, the contact forces'), so the energy
+A flat-footed walker's ankle push-off is a third discrete state: off from the run's start
+and from each touchdown, on from the stance heel's lift-off with its toe loaded (an event:
+the heel's penetration crossing 0 downwards) until the next touchdown.
+
+The state carries four work integrals beside the walker's (``actuators.work_names`` [J]:
+the hip torques' positive and negative work, the push-off's, the contact forces'; flat feet:
+the ankle push-off's positive and negative work, the dampers', the contact forces'), so the energy
 ledger of a run closes to the integrator's tolerance: ``E(t) - E(0) = sum of the works``
 with ``E`` the walker's kinetic + gravitational energy (the contact springs' energy is in
 the contact term).  Samples are on the run's grid (``sample_rate_hz`` from ``t0``); trips and
@@ -34,7 +39,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from walkerlab.models.contact.actuation import WORK_NAMES, powered_rhs
+from walkerlab.models.contact.actuation import powered_rhs
 
 from .ends import RunEnd
 
@@ -59,12 +64,13 @@ class _Stall(Exception):
 
 
 def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, events,
-             t_origin=0.0):
+             t_origin=0.0, ankle=False):
     """One segment on solve_ivp; returns the solution (``t_eval`` the grid inside);
-    ``t_origin`` [s] is when the present step began (time-based torque laws)."""
+    ``t_origin`` [s] is when the present step began (time-based torque laws); ``ankle``:
+    the ankle push-off is on."""
     import time
 
-    n, nw = 2 * walker.nq, len(WORK_NAMES)
+    n, nw = 2 * walker.nq, len(walker.actuators.work_names)
     method = solver.method if solver.method in IVP_METHODS else "LSODA"
 
     mark = [t0, 0]
@@ -77,7 +83,7 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
         mark[1] += 1
         if mark[1] > STALL_CALLS:
             raise _Stall(y)
-        dx, p = powered_rhs(walker, y[:n], stance, push, t - t_origin)
+        dx, p = powered_rhs(walker, y[:n], stance, push, t - t_origin, ankle)
         return np.concatenate([dx, p])
 
     def jac(t, y):
@@ -99,16 +105,35 @@ def _touchdown_event(walker, stance_of):
 
     def touch(t, y):
         stance = stance_of()
-        x = y[:n]
-        fq = walker.foot_quantities(x)
-        sw, st = fq[f"leg{2 - stance}"], fq[f"leg{stance + 1}"]
-        if sw["on_ground"][0] < 0.5 or sw["s"][0] - st["s"][0] < acts.min_step_m:
+        rows = acts.leg_contacts(walker, y[:n])  # (penetration, ..., s, ..., on_ground)
+        sw, st = rows[1 - stance], rows[stance]
+        if sw[7] < 0.5 or sw[3] - st[3] < acts.min_step_m:
             return 1.0
-        return -float(sw["penetration"][0])
+        return -float(sw[0])
 
     touch.terminal = True
     touch.direction = -1
     return touch
+
+
+def _heel_off_event(walker, stance_of):
+    """Event: the stance heel's penetration crosses 0 downwards (it leaves the ground) with
+    the stance toe loaded (penetration > 0); the ankle push-off starts there."""
+    n = 2 * walker.nq
+    names = walker.contact_names()
+    heel = [names.index(f"{leg}_heel") for leg in ("leg1", "leg2")]
+    toe = [names.index(f"{leg}_toe") for leg in ("leg1", "leg2")]
+
+    def heel_off(t, y):
+        stance = stance_of()
+        tab = walker.actuators.contact_rows(walker, y[:n])  # column 0: penetration [m]
+        if tab[toe[stance], 0] <= 0.0:
+            return 1.0
+        return float(tab[heel[stance], 0])
+
+    heel_off.terminal = True
+    heel_off.direction = -1
+    return heel_off
 
 
 def _fall_event(walker, limits):
@@ -171,7 +196,7 @@ def run_powered(walker, x0, t0, t1, solver, limits, deadline, stop):
     tuple
         ``(t (n,), X (n, 2 nq), nfev, njev, termination, message, event, work)`` as
         :func:`walkerlab.integrate.contact.integrate_contact`'s free run, plus ``work``
-        (n, 4) [J], the integrals of :data:`WORK_NAMES` at the samples.
+        (n, 4) [J], the integrals of ``walker.actuators.work_names`` at the samples.
     """
     from .contact import first_event, sample_grid
 
@@ -202,6 +227,9 @@ class _PoweredRun:
         self.t_origin = float(grid[0])  # when the present step began [s]
         self.touch = _touchdown_event(walker, lambda: self.stance)
         self.fall = _fall_event(walker, limits)
+        self.heel_off = (None if walker.actuators.ankle is None  # flat feet only
+                         else _heel_off_event(walker, lambda: self.stance))
+        self.ankle_on = False  # the ankle push-off (flat feet), off until the heel lifts
         self.ts, self.Ys, self.nfev, self.njev = [], [], 0, 0
         self.term, self.msg, self.event = RunEnd.T_FINAL, "Integration successful.", None
 
@@ -209,7 +237,7 @@ class _PoweredRun:
         """One segment; returns the solution, or None when the run ends here."""
         try:
             sol = _segment(self.walker, y, t, tb, self.grid, self.stance, push, self.solver,
-                           self.limits, self.deadline, events, self.t_origin)
+                           self.limits, self.deadline, events, self.t_origin, self.ankle_on)
         except _Deadline:
             self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
             return None
@@ -237,13 +265,15 @@ class _PoweredRun:
                                                                      y_end[None]]))
 
     def go(self, x0, t, t1, stop):
-        n, nw = 2 * self.walker.nq, len(WORK_NAMES)
         acts = self.walker.actuators
+        n, nw = 2 * self.walker.nq, len(acts.work_names)
         y = np.concatenate([x0, np.zeros(nw)])
         self.ts, self.Ys = [np.array([t])], [y[None]]
         while t < t1 - 1e-12:
             tb = min(t + self.limits.chunk_s, t1)
-            sol = self._run(y, t, tb, None, [self.fall, self.touch])
+            watch = acts.ankle is not None and not self.ankle_on
+            sol = self._run(y, t, tb, None,
+                            [self.fall, self.touch] + ([self.heel_off] if watch else []))
             if sol is None:
                 return
             if sol.t_events[0].size:  # a fall
@@ -252,6 +282,11 @@ class _PoweredRun:
                 k = sum(len(a) for a in self.ts) - 1
                 self.event = (RunEnd.FALL.value, k, float(sol.t_events[0][0]), "", np.nan)
                 return
+            if watch and sol.t_events[2].size:  # heel off: the ankle push-off starts
+                t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
+                self._keep(sol, t)
+                self.ankle_on = True
+                continue
             if not sol.t_events[1].size:  # the chunk's end
                 self._keep(sol, np.inf)
                 t, y = float(sol.t[-1]), sol.y[:, -1].copy()
@@ -259,8 +294,8 @@ class _PoweredRun:
             t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
             self._keep(sol, t)
             trailing, self.stance = self.stance, 1 - self.stance  # heel strike: roles swap
-            self.t_origin = t
-            P = acts.impulse(y[:n])
+            self.t_origin, self.ankle_on = t, False
+            P = acts.impulse(y[:n]) if acts.ankle is None else 0.0
             if P > 0.0 and acts.pulse_s == 0.0:
                 y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
                 y[n + 2] += w

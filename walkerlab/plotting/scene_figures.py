@@ -154,6 +154,9 @@ def energy_ledger_figure(sim, out_dir: Path, units: Units) -> list[Path]:
     top = float(np.nanmax(cot)) if np.isfinite(cot).any() else 1.0
     ax2.set_ylim(0.0, 1.25 * top if top > 0 else 1.0)
     ax2.ticklabel_format(axis="y", useOffset=False)
+    from matplotlib.ticker import MaxNLocator
+
+    ax2.xaxis.set_major_locator(MaxNLocator(integer=True))  # steps, not fractions
     ax2.set_xlabel("step")
     ax2.set_ylabel("cost of transport [-]")
     ax2.set_title("cost of transport")

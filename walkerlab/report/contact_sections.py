@@ -78,11 +78,14 @@ def contact_section(scene, arts) -> list[str]:
            + "; step periods [s]: " + ", ".join(num(v, 4) for v in periods) + ".", ""]
     if c.ledger is not None:
         w = c.ledger
+        terms = (f"push-off {num(w['push_off'][-1], 4)}, joint torques "
+                 f"+{num(w['hip_torque_positive'][-1], 4)} / "
+                 f"{num(w['hip_torque_negative'][-1], 4)}" if "push_off" in w else
+                 f"ankle push-off +{num(w['ankle_torque_positive'][-1], 4)} / "
+                 f"{num(w['ankle_torque_negative'][-1], 4)}, ankle dampers "
+                 f"{num(w['damper'][-1], 4)}")
         out += ["**Energy ledger of the powered contact run** (work integrals carried with the "
-                "state; J over the whole run): push-off "
-                f"{num(w['push_off'][-1], 4)}, joint torques "
-                f"+{num(w['hip_torque_positive'][-1], 4)} / "
-                f"{num(w['hip_torque_negative'][-1], 4)}, contact forces (normal + friction, "
+                f"state; J over the whole run): {terms}, contact forces (normal + friction, "
                 f"their dissipation and the energy their springs hold) "
                 f"{num(w['contact'][-1], 4)}; closure (kinetic + potential energy change minus "
                 f"these) at most {num(float(abs(w['residual']).max()), 2)} J.", ""]

@@ -69,10 +69,11 @@ def energy_section(sim: SimulateArtifact) -> list[str]:
     rows = [[k, *[num(led[c][k]) for c in keys]] for k in range(len(led["closure"]))]
     cot = [v for v in led["cost_of_transport"] if math.isfinite(v)]
     mean = sum(cot) / len(cot) if cot else math.nan
-    partial = not any(math.isfinite(v) for v in led["closure"])
-    note = (" Flat feet: the ledger has the ankle push-off's work and the cost of transport "
-            "only (the heel-strike, foot-slap, ankle-spring and damper terms of a flat foot "
-            "are not in it yet, so it has no closure)." if partial else "")
+    note = (" Flat feet: the ankle push-off's torque is in the actuator columns; the heel "
+            "strike's loss includes the trailing ankle spring's energy (its massless foot "
+            "leaves the ground and snaps to its rest angle); knee/foot is the foot slaps."
+            if sim.samples is not None
+            and any(c.endswith("_ankle_angle") for c in sim.samples.coordinates) else "")
     return [f"Cost of transport (positive actuator and push-off work + the potential energy "
             f"the slope releases, per weight and distance along the ground), mean over the "
             f"steps: **{num(mean)}**. Energies in {u.energy}; the collisions, dampers and "

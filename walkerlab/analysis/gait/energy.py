@@ -32,13 +32,13 @@ import numpy as np
 from walkerlab.analysis.gait.metrics import step_length
 from walkerlab.io.schemas.simulate import LEDGER_UNITS
 
-__all__ = ["LEDGER_NAMES", "gait_measures", "step_ledger", "trajectory_ledger"]
+__all__ = ["LEDGER_NAMES", "gait_measures", "quad_work", "step_ledger", "trajectory_ledger"]
 
 #: the ledger's columns, each (step,) (units: the artifact's, ``LEDGER_UNITS``)
 LEDGER_NAMES = tuple(LEDGER_UNITS)
 
 
-def _quad(f, a: float, b: float, scale: float) -> float:
+def quad_work(f, a: float, b: float, scale: float) -> float:
     """``int_a^b f dt`` [J] by adaptive quadrature.  A kinked integrand (``max(p, 0)`` where
     the power changes sign, a saturated torque law) can keep quad from certifying its 1e-12
     tolerance (its IntegrationWarning); the value is kept: the ledger's ``closure``, an
@@ -120,10 +120,10 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
             continue
 
         if torques:
-            wpos += _quad(lambda t: max(acts.power(t, x_at(t)), 0.0), ta, tb, scale)
-            wneg += _quad(lambda t: min(acts.power(t, x_at(t)), 0.0), ta, tb, scale)
+            wpos += quad_work(lambda t: max(acts.power(t, x_at(t)), 0.0), ta, tb, scale)
+            wneg += quad_work(lambda t: min(acts.power(t, x_at(t)), 0.0), ta, tb, scale)
         if damped:
-            wdamp += _quad(lambda t: _damper_power(walker, x_at(t)), ta, tb, scale)
+            wdamp += quad_work(lambda t: _damper_power(walker, x_at(t)), ta, tb, scale)
     ke_end, pe_end = (float(v) for v in walker.energies(seg.x_end))
     pts = walker.points(seg.x_end)
     step = np.asarray(pts["swing_foot"], float)
@@ -153,45 +153,23 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
 
 def trajectory_ledger(traj) -> dict[str, np.ndarray]:
     """:func:`step_ledger` of every step of a :class:`~walkerlab.integrate.rigid.
-    HybridTrajectory`, each column (steps,); empty for a walker without generated flow
-    matrices (flat feet: their energies are read per pinned point, heel or toe, and the
-    ankle damper's work is not yet in the ledger)."""
+    HybridTrajectory`, each column (steps,); flat feet (no generated flow matrices: their
+    modes pin the heel or the toe) by
+    :func:`walkerlab.analysis.gait.energy_flat.flat_trajectory_ledger`, empty for flat
+    feet on legs that differ."""
     from walkerlab.integrate.rigid import other_leg
 
     w = traj.walker
     if w.matrices is None:
-        return _ankle_push_off_ledger(traj)
+        from walkerlab.analysis.gait.energy_flat import flat_trajectory_ledger
+
+        return {} if w.mirror is not None else flat_trajectory_ledger(traj)
     rows = {k: [] for k in LEDGER_NAMES}
     for seg in traj.segments:
         led = step_ledger(w.for_stance(seg.stance_leg), seg,
                           w.for_stance(other_leg(w, seg.stance_leg)))
         for k in LEDGER_NAMES:
             rows[k].append(led[k])
-    return {k: np.asarray(v, float) for k, v in rows.items()}
-
-
-def _ankle_push_off_ledger(traj) -> dict[str, np.ndarray]:
-    """Flat feet with an ankle push-off: the push-off's work per step
-    (:func:`walkerlab.models.hybrid.ankle_push_off.ankle_push_off_work`) and the cost of
-    transport (push-off work + the energy the slope releases) / (m g d); the other terms
-    NaN (the flat foot's full ledger is not written yet); empty for a passive flat foot."""
-    from walkerlab.models.hybrid.ankle_push_off import AnklePushOffActuator, ankle_push_off_work
-
-    w = traj.walker
-    if not isinstance(w.actuators, AnklePushOffActuator):
-        return {}
-    g, m = float(w.params["gravity_m_per_s2"]), float(w.total_mass_kg)
-    rows = {k: [] for k in LEDGER_NAMES}
-    for seg in traj.segments:
-        out = dict.fromkeys(LEDGER_NAMES, np.nan)
-        if seg.termination == "heel_strike":
-            work = ankle_push_off_work(w, seg)
-            d = step_length(w, seg)
-            slope = m * g * d * np.sin(float(w.slope_rad))
-            out.update(push_off_work=work, push_off_impulse=0.0, slope_energy=slope,
-                       cost_of_transport=(max(work, 0.0) + max(slope, 0.0)) / (m * g * d))
-        for k in LEDGER_NAMES:
-            rows[k].append(out[k])
     return {k: np.asarray(v, float) for k, v in rows.items()}
 
 

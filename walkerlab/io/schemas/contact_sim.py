@@ -263,22 +263,23 @@ def write_contact_sim(f, run: ContactSimRun) -> None:
 
 def _write_work(f, run: ContactSimRun) -> None:
     """A powered walker's energy ledger: ``ledger/work/<name>`` [J] on ``time`` (the work
-    integrals the run carried, :data:`walkerlab.models.contact.actuation.WORK_NAMES`) and
+    integrals the run carried, ``walker.actuators.work_names``) and
     ``ledger/residual`` [J], ``E(t) - E(0)`` minus their sum (the ledger's closure)."""
     work = getattr(run.result, "work", None)
     if work is None:
         return
-    from walkerlab.models.contact.actuation import WORK_NAMES
-
     what = {"hip_torque_positive": "positive work of the hip torques",
             "hip_torque_negative": "negative work of the hip torques",
             "push_off": "work of the push-off pulse at the trailing foot",
+            "ankle_torque_positive": "positive work of the ankle push-off torque",
+            "ankle_torque_negative": "negative work of the ankle push-off torque",
+            "damper": "work of the ankle (and hip) dampers",
             "contact": "work of the contact forces (normal + friction, every point): their "
                        "dissipation and the energy their springs hold"}
     if run.walker.structure.free_knees:  # a five-link biped: every joint torque's work
         what.update(hip_torque_positive="positive work of the joint torques (hips and knees)",
                     hip_torque_negative="negative work of the joint torques (hips and knees)")
-    for k, name in enumerate(WORK_NAMES):
+    for k, name in enumerate(run.walker.actuators.work_names):
         put(f, f"ledger/work/{name}", work[:, k], "J", what[name] + " since the start",
             dims=("time",))
     E = run.walker.energies(run.result.x)["total"]

@@ -25,8 +25,23 @@ converges to the rigid transition as ``T -> 0`` (first order in ``T``).  ``P`` f
 same law as in the rigid view (:func:`walkerlab.models.actuation.push_off_impulse`) at the
 touchdown state's hip speed.
 
+Ankle push-off on flat feet
+---------------------------
+The rigid view's ankle push-off (:mod:`walkerlab.models.hybrid.ankle_push_off`) acts on the
+stance ankle from heel off (the stance heel's normal force reaches 0 in foot flat) until
+heel strike: ``tau(a) = -k_po (a - r_po) - tau_0`` on the ankle angle ``a = psi_foot -
+psi_leg`` (toe up > 0).  Here it is the same torque as a force pair at the stance ankle:
+``+tau`` on the stance foot, ``-tau`` on the stance leg (generalised force ``tau (e_foot -
+e_leg)``, power ``tau da/dt``), switched on when the stance heel leaves the ground while
+its toe is loaded (the heel's penetration crossing 0 downwards with the toe's above 0: the
+contact terms of heel off, an event of the integrator) and off at the swing foot's
+touchdown (the rigid view's heel strike).  The ledger of such a walker
+(:attr:`ContactActuators.work_names`: :data:`ANKLE_WORK_NAMES`) carries the torque's
+positive and negative work apart, the ankle (and hip) dampers' work and the contact forces'.
+
 Source: Kuo (2002), J. Biomech. Eng. 124:113-120 (push-off, swing-hip torque); Westervelt,
-Grizzle & Koditschek (2003), IEEE TAC 48(1):42-56 (phase-variable references).
+Grizzle & Koditschek (2003), IEEE TAC 48(1):42-56 (phase-variable references); Mizani et al.
+(2018; the paper's ref. [32]) for the ankle push-off of a flat-footed walker.
 """
 
 from __future__ import annotations
@@ -35,24 +50,27 @@ import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
-__all__ = ["WORK_NAMES", "ContactActuators", "powered_rhs"]
+__all__ = ["ANKLE_WORK_NAMES", "WORK_NAMES", "ContactActuators", "powered_rhs"]
 
 
 class ContactActuators:
-    """The actuators of one contact walker (straight legs, point feet).
+    """The actuators of one contact walker (straight legs; point feet, or flat feet with an
+    ankle push-off).
 
     Parameters
     ----------
     spec : walkerlab.config.actuation.Actuation
     coordinates : tuple of str
-        The floating coordinates (``hip_x, hip_y, leg1_angle, leg2_angle``).
+        The floating coordinates (``hip_x, hip_y, leg1_angle, leg2_angle``; flat feet then
+        ``leg1_foot_angle, leg2_foot_angle``).
     pulse_s : float
         Push-off pulse duration [s] (0: an impulse).
 
     Raises
     ------
     ValueError
-        The walker's legs are not two straight legs with point feet (one line).
+        The walker's legs are not two straight legs with point feet, or flat feet with an
+        ankle push-off alone (one line).
     """
 
     #: A touchdown is a heel strike only this far [m] ahead of the stance foot (a scuff
@@ -65,6 +83,17 @@ class ContactActuators:
             raise ValueError("walker.actuation: the contact view carries actuators on "
                              "straight legs with point feet only (knees, arc and flat feet: "
                              "not yet)")
+        flat = "leg1_foot_angle" in names
+        ankle = getattr(spec, "ankle_push_off", None)
+        if flat and (ankle is None or spec.push_off is not None or spec.torques):
+            raise ValueError("walker.actuation: flat feet take ankle_push_off alone in the "
+                             "contact view")
+        if ankle is not None and not flat:
+            raise ValueError("walker.actuation.ankle_push_off: flat feet only")
+        self.ankle = ankle
+        self._points = self._dampers = None  # per-walker lookups, filled on first use
+        self.foot = ((names.index("leg1_foot_angle"), names.index("leg2_foot_angle"))
+                     if flat else None)
         self.spec = spec
         self.nq = len(names)
         self.pulse_s = float(pulse_s)
@@ -93,6 +122,65 @@ class ContactActuators:
         Q[self.leg[stance]] -= tau
         return Q, tau * ddelta
 
+    @property
+    def work_names(self) -> tuple[str, ...]:
+        """Names of the work integrals this walker's run carries (:data:`WORK_NAMES`, or
+        :data:`ANKLE_WORK_NAMES` for an ankle push-off)."""
+        return WORK_NAMES if self.ankle is None else ANKLE_WORK_NAMES
+
+    def ankle_torque(self, x, stance: int) -> tuple[np.ndarray, float]:
+        """Generalised force (nq,) of the ankle push-off at leg ``stance``'s ankle (0: leg1,
+        1: leg2) and its power [W] (module docstring)."""
+        n = self.nq
+        i_f, i_l = self.foot[stance], self.leg[stance]
+        po = self.ankle
+        a = x[i_f] - x[i_l]
+        tau = -po.stiffness_n_m_per_rad * (a - po.rest_angle_rad) - po.constant_n_m
+        Q = np.zeros(n)
+        Q[i_f] += tau
+        Q[i_l] -= tau
+        return Q, float(tau * (x[n + i_f] - x[n + i_l]))
+
+    def damper_power(self, walker, x) -> float:
+        """Power [W] (<= 0) of the ankle spring-dampers, ``-c (d delta/dt)^2`` at each
+        ankle (``delta`` = foot angle - leg angle), and of the springs' dampers between the
+        legs (on the legs' angle difference); the ledger's ``damper`` term."""
+        n = self.nq
+        if self._dampers is None:  # (ankle c, sum of the leg springs' c), once
+            p = dict(zip(walker.data.structure.param_names, walker.data.params))
+            self._dampers = (float(p.get("c_ankle", 0.0)),
+                             sum(float(p[f"c_s{i}"])
+                                 for i in range(len(walker.data.structure.springs))))
+        c_a, c_s = self._dampers
+        r1 = x[n + self.foot[0]] - x[n + self.leg[0]]
+        r2 = x[n + self.foot[1]] - x[n + self.leg[1]]
+        hip = x[n + self.leg[1]] - x[n + self.leg[0]]
+        return float(-c_a * (r1 * r1 + r2 * r2) - c_s * hip * hip)
+
+    def contact_rows(self, walker, x) -> np.ndarray:
+        """The contact table (points, 8) at one state ``x`` (points as
+        ``walker.contact_names()``; columns as :meth:`leg_contacts`)."""
+        return walker.kernels.contact_table(np.ascontiguousarray(np.atleast_2d(x), float),
+                                            *walker._args())[0]
+
+    def leg_contacts(self, walker, x) -> list[np.ndarray]:
+        """Per leg (leg1, leg2) the contact-table row (8,) of its deepest point on ground
+        (its only point for point feet; as :meth:`ContactWalker.foot_quantities` picks a
+        flat foot's, without building its dictionaries: the event functions' fast path):
+        ``penetration`` [m], its rate [m/s], slip velocity [m/s], ``s`` [m], normal and
+        friction force [N], power [W], ``on_ground``."""
+        tab = self.contact_rows(walker, x)
+        if self._points is None:  # each leg's rows of the table, once
+            names = walker.contact_names()
+            self._points = [[k for k, c in enumerate(names) if walker.contact_leg(c) == leg]
+                            for leg in ("leg1", "leg2")]
+        out = []
+        for idx in self._points:
+            rows = tab[idx]
+            on = rows[:, 7] > 0.5
+            out.append(rows[int(np.argmax(np.where(on, rows[:, 0], rows[:, 0] - 1e3)))])
+        return out
+
     def impulse(self, x) -> float:
         """Push-off impulse ``P`` [N s] for the touchdown state ``x`` (its hip speed)."""
         n = self.nq
@@ -119,10 +207,12 @@ class ContactActuators:
 
 #: Names of the work integrals a powered contact run carries beside the state [J].
 WORK_NAMES = ("hip_torque_positive", "hip_torque_negative", "push_off", "contact")
+#: ... and those of a flat-footed walker's ankle push-off run [J].
+ANKLE_WORK_NAMES = ("ankle_torque_positive", "ankle_torque_negative", "damper", "contact")
 
 
 def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
-                t_step: float = 0.0):
+                t_step: float = 0.0, ankle: bool = False):
     """dx/dt of the contact walker with its actuators, and the powers of the ledger.
 
     Parameters
@@ -137,18 +227,32 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
         A push-off pulse in progress: the trailing leg and the force [N].
     t_step : float
         Time since the step's heel strike (the last touchdown, or the run's start) [s].
+    ankle : bool
+        The ankle push-off is on (flat feet: from the stance heel's lift-off to the next
+        touchdown).
 
     Returns
     -------
     dx : ndarray, shape (2 nq,)
         ``[dq, ddq]`` [m/s, rad/s, m/s^2, rad/s^2].
     powers : ndarray, shape (4,)
-        [W]: the hip torques' positive and negative power, the push-off's, and the contact
-        forces' (normal + friction, all points; negative while they dissipate or store).
+        [W], in the order of ``walker.actuators.work_names``: the hip torques' positive and
+        negative power, the push-off's, and the contact forces' (normal + friction, all
+        points; negative while they dissipate or store); flat feet: the ankle push-off's
+        positive and negative power, the dampers', the contact forces'.
     """
     acts = walker.actuators
     n = walker.nq
     dx = np.array(walker.rhs(0.0, x), float)
+    p_contact = float(np.sum(walker.kernels.contact_table(
+        np.ascontiguousarray(x[None], dtype=float), *walker._args())[0, :, 6]))
+    if acts.ankle is not None:
+        p_tau = 0.0
+        if ankle:
+            Q, p_tau = acts.ankle_torque(x, stance)
+            dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
+        return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0),
+                             acts.damper_power(walker, x), p_contact])
     Q, p_tau = acts.hip_torque(x, stance, t_step)
     p_po = 0.0
     if push is not None:
@@ -156,6 +260,4 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
         Q = Q + Qp
     if np.any(Q):
         dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
-    p_contact = float(np.sum(walker.kernels.contact_table(
-        np.ascontiguousarray(x[None], dtype=float), *walker._args())[0, :, 6]))
     return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact])

@@ -70,6 +70,11 @@ class JointTorqueActuators:
     min_step_m = 0.05
     #: No push-off pulse (refused on these walkers).
     pulse_s = 0.0
+    #: No ankle push-off (point feet).
+    ankle = None
+    #: The work integrals a run carries (:data:`~walkerlab.models.contact.actuation.WORK_NAMES`:
+    #: the hip-torque names carry every joint torque's work).
+    work_names = ("hip_torque_positive", "hip_torque_negative", "push_off", "contact")
 
     def __init__(self, data, spec, coordinates):
         from walkerlab.models.hybrid.actuated_five_link import five_link_actuators

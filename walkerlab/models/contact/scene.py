@@ -185,11 +185,13 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
 
     st = data.structure
     five_link = st.free_knees and st.foot == "point"
-    if not five_link and (st.knee or st.foot != "point" or st.torso):
+    flat_push_off = st.foot == "flat" and spec.ankle_push_off is not None
+    if not five_link and (st.knee or st.torso or not (st.foot == "point" or flat_push_off)):
         raise ContactSceneError(f"scene '{scene.name}': walker.actuation: the contact view "
                                 "carries actuators on straight legs with point feet and no "
-                                "torso, and on free-jointed (five-link) bipeds, only (the "
-                                "rigid view has them too)")
+                                "torso, an ankle push-off on flat feet, and joint torques on "
+                                "free-jointed (five-link) bipeds, only (the rigid view has "
+                                "them too)")
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
                                 "pinned start phase carries no actuators: leave it 'none'")
