@@ -155,7 +155,8 @@ def _ledger(name: str):
 # closes its ledger on one step from the fixed point its scene stores; flat feet (passive
 # and with an ankle push-off): walkerlab.analysis.gait.energy_flat; rabbit_optimal: no gait
 # of its own (its step is optimised: tests/test_optimize_five_link.py)
-@pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED if n not in ("rabbit", "rabbit_optimal")])
+@pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED
+                                  if n not in ("rabbit", "rabbit_optimal")])
 def test_the_energy_ledger_closes_and_cost_of_transport(name):
     w, led, ke = _ledger(name)
     assert np.all(np.isfinite(led["closure"]))

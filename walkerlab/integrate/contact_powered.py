@@ -357,7 +357,7 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
     limits = ContactLimits(fall_hip_height_m=fall_hip_height_m)
     run = _PoweredRun(walker, solver, limits, deadline, np.array([0.0, t_max]))
     run.stance, run.t_origin = stance, 0.0
-    n, nw = 2 * walker.nq, len(WORK_NAMES)
+    n, nw = 2 * walker.nq, len(walker.actuators.work_names)
     acts = walker.actuators
 
     def cross(t, y):
@@ -429,7 +429,7 @@ def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.in
         return t, x, RunEnd.T_FINAL
     if acts.pulse_s == 0.0:
         return t, impulse_jump(walker, x, trailing, P)[0], RunEnd.T_FINAL
-    n, nw = 2 * walker.nq, len(WORK_NAMES)
+    n, nw = 2 * walker.nq, len(walker.actuators.work_names)
     run = _PoweredRun(walker, solver, ContactLimits(fall_hip_height_m=fall_hip_height_m),
                       deadline, np.array([t, t + acts.pulse_s]))
     run.stance, run.t_origin = 1 - trailing, t
