@@ -50,10 +50,41 @@ import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
-__all__ = ["ANKLE_WORK_NAMES", "WORK_NAMES", "ContactActuators", "powered_rhs"]
+__all__ = ["ANKLE_WORK_NAMES", "WORK_NAMES", "ContactActuators", "ContactRows", "powered_rhs"]
 
 
-class ContactActuators:
+class ContactRows:
+    """Readers of a contact walker's contact table at one state, shared by every kind of
+    contact actuators (the powered run's touchdown and heel-off events read them)."""
+
+    _points = None  # each leg's rows of the table, filled on first use
+
+    def contact_rows(self, walker, x) -> np.ndarray:
+        """The contact table (points, 8) at one state ``x`` (points as
+        ``walker.contact_names()``; columns as :meth:`leg_contacts`)."""
+        return walker.kernels.contact_table(np.ascontiguousarray(np.atleast_2d(x), float),
+                                            *walker._args())[0]
+
+    def leg_contacts(self, walker, x) -> list[np.ndarray]:
+        """Per leg (leg1, leg2) the contact-table row (8,) of its deepest point on ground
+        (its only point for point feet; as :meth:`ContactWalker.foot_quantities` picks a
+        flat foot's, without building its dictionaries: the event functions' fast path):
+        ``penetration`` [m], its rate [m/s], slip velocity [m/s], ``s`` [m], normal and
+        friction force [N], power [W], ``on_ground``."""
+        tab = self.contact_rows(walker, x)
+        if self._points is None:  # each leg's rows of the table, once
+            names = walker.contact_names()
+            self._points = [[k for k, c in enumerate(names) if walker.contact_leg(c) == leg]
+                            for leg in ("leg1", "leg2")]
+        out = []
+        for idx in self._points:
+            rows = tab[idx]
+            on = rows[:, 7] > 0.5
+            out.append(rows[int(np.argmax(np.where(on, rows[:, 0], rows[:, 0] - 1e3)))])
+        return out
+
+
+class ContactActuators(ContactRows):
     """The actuators of one contact walker (straight legs; point feet, or flat feet with an
     ankle push-off).
 
@@ -91,7 +122,7 @@ class ContactActuators:
         if ankle is not None and not flat:
             raise ValueError("walker.actuation.ankle_push_off: flat feet only")
         self.ankle = ankle
-        self._points = self._dampers = None  # per-walker lookups, filled on first use
+        self._dampers = None  # the walker's dampers, looked up on first use
         self.foot = ((names.index("leg1_foot_angle"), names.index("leg2_foot_angle"))
                      if flat else None)
         self.spec = spec
@@ -156,30 +187,6 @@ class ContactActuators:
         r2 = x[n + self.foot[1]] - x[n + self.leg[1]]
         hip = x[n + self.leg[1]] - x[n + self.leg[0]]
         return float(-c_a * (r1 * r1 + r2 * r2) - c_s * hip * hip)
-
-    def contact_rows(self, walker, x) -> np.ndarray:
-        """The contact table (points, 8) at one state ``x`` (points as
-        ``walker.contact_names()``; columns as :meth:`leg_contacts`)."""
-        return walker.kernels.contact_table(np.ascontiguousarray(np.atleast_2d(x), float),
-                                            *walker._args())[0]
-
-    def leg_contacts(self, walker, x) -> list[np.ndarray]:
-        """Per leg (leg1, leg2) the contact-table row (8,) of its deepest point on ground
-        (its only point for point feet; as :meth:`ContactWalker.foot_quantities` picks a
-        flat foot's, without building its dictionaries: the event functions' fast path):
-        ``penetration`` [m], its rate [m/s], slip velocity [m/s], ``s`` [m], normal and
-        friction force [N], power [W], ``on_ground``."""
-        tab = self.contact_rows(walker, x)
-        if self._points is None:  # each leg's rows of the table, once
-            names = walker.contact_names()
-            self._points = [[k for k, c in enumerate(names) if walker.contact_leg(c) == leg]
-                            for leg in ("leg1", "leg2")]
-        out = []
-        for idx in self._points:
-            rows = tab[idx]
-            on = rows[:, 7] > 0.5
-            out.append(rows[int(np.argmax(np.where(on, rows[:, 0], rows[:, 0] - 1e3)))])
-        return out
 
     def impulse(self, x) -> float:
         """Push-off impulse ``P`` [N s] for the touchdown state ``x`` (its hip speed)."""

@@ -40,10 +40,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.models.contact.actuation import WORK_NAMES, ContactRows
+
 __all__ = ["JointTorqueActuators"]
 
 
-class JointTorqueActuators:
+class JointTorqueActuators(ContactRows):
     """The joint torques of one free-jointed contact walker (the interface of
     :class:`walkerlab.models.contact.actuation.ContactActuators` that
     :func:`~walkerlab.models.contact.actuation.powered_rhs` and
@@ -74,7 +76,7 @@ class JointTorqueActuators:
     ankle = None
     #: The work integrals a run carries (:data:`~walkerlab.models.contact.actuation.WORK_NAMES`:
     #: the hip-torque names carry every joint torque's work).
-    work_names = ("hip_torque_positive", "hip_torque_negative", "push_off", "contact")
+    work_names = WORK_NAMES
 
     def __init__(self, data, spec, coordinates):
         from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
