@@ -17,6 +17,7 @@ linear.
 from __future__ import annotations
 
 import json
+import re
 import xml.dom.minidom
 from pathlib import Path
 
@@ -44,12 +45,10 @@ REFUSED = {"flat_feet": "walker.leg.foot.kind", "flat_feet_push_off": "walker.le
 SHIPPED = sorted(p.stem for p in (ROOT / "configs").glob("*.yaml") if p.stem != "rabbit")
 #: Step-period tolerance against the rigid gait: 1 % (MuJoCo's contact is soft and linear,
 #: walkerlab's own contact model differs from the rigid one by 0.1-1 % on these walkers).
-#: powered_compass 2.5 %: its scene gives the push-off as a 5 ms pulse from touchdown
-#: (contact.push_off_duration_s), the rigid model as an impulse with the heel strike; the two
-#: agree to first order in the pulse's length (walkerlab.models.contact.actuation): MuJoCo's
-#: walker steps 2.06 % faster with the 5 ms pulse, 0.39 % with 1 ms, +0.01 % with 0.2 ms
-#: (test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens).
-PERIOD_RTOL = {"powered_compass": 0.025}
+#: powered_compass too: the export applies the push-off over one MuJoCo timestep (the rigid
+#: model's impulse); with the contact model's 5 ms pulse MuJoCo's walker steps 2.06 % faster,
+#: 0.39 % with 1 ms (test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens).
+PERIOD_RTOL: dict[str, float] = {}
 
 
 @pytest.mark.slow
@@ -61,9 +60,10 @@ def test_every_shipped_scene_walks_in_mujoco_or_is_refused(name, tmp_path):
     in one line naming the field, writing nothing.  Measured (11.3 rigid steps each; step
     period against the rigid one): asymmetric_legs -0.05 %, compass_optimal +0.55 %,
     goswami1996 +0.85 %, hip_spring -0.07 %, kneed -0.50 %, paper -0.05 %, paper_rods -0.04 %,
-    powered_compass -2.06 % (its 5 ms push-off pulse; -3.2 % before the pulse's last step
-    carried only its share), round_feet +0.01 % (a cylinder foot: 7 strikes, legs out of
-    turn after 4, steps 11 % short), torso_bhm -0.04 %.  About 5-12 s each under load."""
+    powered_compass +0.012 % (its push-off over one timestep: see
+    test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens), round_feet +0.01 % (a
+    cylinder foot: 7 strikes, legs out of turn after 4, steps 11 % short), torso_bhm -0.04 %.
+    About 5-12 s each under load."""
     from walkerlab.analysis.contact.periodic import ideal_gait
     from walkerlab.export.mujoco_walk import walk
 
@@ -292,24 +292,33 @@ def test_arc_feet_get_ground_for_their_roll_with_a_warning(tmp_path, capsys):
 
 
 def test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens(tmp_path):
-    """The rigid model's push-off is an impulse with the heel strike, the scene's a 5 ms pulse
-    from touchdown; the two agree to first order in the pulse's length.  The exported file
-    with its ``push_off_duration_s`` set to 0.2 ms (~1 MuJoCo step; the pulse's last step
-    carries only its share, so the impulse is P exactly) walks the rigid gait's step period
-    to 1 % (measured +0.01 %; the scene's 5 ms: -2.06 %, 1 ms: -0.39 %)."""
+    """The rigid model's push-off is an impulse with the heel strike; the export applies it
+    over one MuJoCo timestep (its ``push_off_duration_s``; the pulse's last step carries only
+    its share, so the impulse is P exactly) and walks the rigid gait's step period to 1 %
+    (measured +0.01 %).  The contact model's 5 ms pulse agrees only to first order in its
+    length: the same file with 5 ms steps 2.06 % fast (-3.2 % before the last step carried
+    only its share), 1 ms 0.39 %."""
     from walkerlab.analysis.contact.periodic import ideal_gait
     from walkerlab.export.mujoco_walk import walk
 
     scene = _scene("powered_compass")
     path = Path(export_stage.run(scene, tmp_path, "mjcf"))
+    m = mujoco.MjModel.from_xml_path(str(path))
     text = path.read_text()
-    assert '<numeric name="push_off_duration_s" data="0.005"/>' in text
-    path.write_text(text.replace('<numeric name="push_off_duration_s" data="0.005"/>',
-                                 '<numeric name="push_off_duration_s" data="0.0002"/>'))
     step_s = ideal_gait(scene).period_s
+    assert m.numeric("push_off_duration_s").data[0] == pytest.approx(m.opt.timestep, rel=1e-9)
     run = walk(path, 11.3 * step_s)
     assert not run.fell and len(run.times_s) >= 10 and run.alternating
     assert run.step_periods_s.mean() == pytest.approx(step_s, rel=0.01)
+    ratio = []
+    for pulse in ("0.005", "0.001"):
+        p = tmp_path / f"pulse_{pulse}.xml"
+        p.write_text(re.sub(r'<numeric name="push_off_duration_s" data="[^"]*"/>',
+                            f'<numeric name="push_off_duration_s" data="{pulse}"/>', text))
+        r = walk(p, 11.3 * step_s)
+        assert not r.fell and len(r.times_s) >= 10
+        ratio.append(r.step_periods_s.mean() / step_s - 1)
+    assert ratio[0] < -0.015 and -0.01 < ratio[1] < 0  # first order in the pulse's length
 
 
 @pytest.mark.slow

@@ -69,7 +69,8 @@ class MjcfScene:
         stepping loop evaluates into the ``hip`` motor and the push-off it applies at each
         heel strike (:mod:`walkerlab.export.mujoco_walk`); None for a passive walker.
     push_off_duration_s : float
-        The push-off pulse's duration [s] (``contact.push_off_duration_s``).
+        The push-off pulse's duration [s]: one timestep (the rigid model's impulse as MuJoCo
+        applies it; :func:`walkerlab.export.scene.mjcf_scene`).
     notes : tuple of str
         Comments written into the file (how the numbers were derived).
     """

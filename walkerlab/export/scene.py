@@ -272,9 +272,12 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
                   "motor 'hip' on the tendon leg1_hip - leg2_hip; a stepping loop sets its "
                   "control to the swing leg's hip torque (its sign flipped when leg2 swings) "
                   "and applies the push-off as a force along the trailing leg at its foot for "
-                  "push_off_duration_s from each heel strike (walkerlab.export.mujoco_walk).",)
+                  "push_off_duration_s from each heel strike (walkerlab.export.mujoco_walk): "
+                  "one MuJoCo timestep, the rigid model's impulse as MuJoCo can apply it (the "
+                  "contact model's contact.push_off_duration_s pulse agrees with it only to "
+                  "first order in its length: -2.1 % step period with 5 ms).",)
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
     return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
                      dt, solref, solimp, mu, latch, notes + terrain_notes, actuation,
-                     settings.push_off_pulse_s(), ahead)
+                     dt, ahead)  # the push-off over one timestep: the rigid model's impulse
