@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 __all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step", "replay",
-           "step_functions", "torque_of_time"]
+           "step_functions", "target_constraints", "torque_of_time"]
 
 
 @dataclass(frozen=True)
@@ -412,7 +412,13 @@ def _transcribe(opti, fns, spec, X, U, T, P, period_guess):
         opti.subject_to(opti.bounded(0.0, P, spec.push_off_max_n_s))
     if spec.max_torque_n_m is not None:
         opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
-    length = fns["step"](X[:, -1])
+    target_constraints(opti, spec, T, fns["step"](X[:, -1]))
+
+
+def target_constraints(opti, spec, T, length) -> None:
+    """The gait targets of ``spec`` (step period [s], step length [m], speed [m/s]) as
+    equality constraints on the step's period ``T`` and length ``length`` (CasADi
+    expressions) of ``opti``; a target left ``None`` adds nothing."""
     if spec.target_step_period_s is not None:
         opti.subject_to(T == spec.target_step_period_s)
     if spec.target_step_length_m is not None:

@@ -32,6 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.optimal.collocation import target_constraints
+
 __all__ = ["FiveLinkResult", "collocate_five_link", "kelly_guess", "replay_five_link",
            "torques_of_time"]
 
@@ -83,15 +85,6 @@ def kelly_guess(leg_length_m: float, step_length_m: float, period_s: float, poin
     return t, np.hstack([q, dq])
 
 
-def _targets(opti, spec, T, length):
-    if spec.target_step_period_s is not None:
-        opti.subject_to(T == spec.target_step_period_s)
-    if spec.target_step_length_m is not None:
-        opti.subject_to(length == spec.target_step_length_m)
-    if spec.target_speed_m_per_s is not None:
-        opti.subject_to(length == spec.target_speed_m_per_s * T)
-
-
 def _guess_numbers(data, spec):
     """The guess's step length [m] and period [s]: the targets, else a 0.5 m step at 0.7 s."""
     T = spec.target_step_period_s
@@ -127,7 +120,7 @@ def _constrain(opti, fns: dict, spec, X, U, T, p) -> None:
     opti.subject_to(opti.bounded(0.1, T, 5.0))
     if spec.max_torque_n_m is not None:
         opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
-    _targets(opti, spec, T, feet[1, -1])
+    target_constraints(opti, spec, T, feet[1, -1])
 
 
 def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
