@@ -28,21 +28,24 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.numerics import sort_multipliers
 
-#: longest wall time of one search for a gait [s] (:func:`search_budget`; a fixed point, or
+#: longest CPU time of one search for a gait [s] (:func:`search_budget`; a fixed point, or
 #: every start of :func:`walkerlab.analysis.gait.search.find_gaits`): the shipped scenes need
 #: 0.1-3 s; a spring or damper at its cap (1e6) makes the integrator crawl (about 40 s per
 #: step map), and the search's starts and MINPACK's own cap of 200 (n + 1) maps would keep it
 #: busy, silent, for many minutes before it says "no gait found"
 ROOT_BUDGET_S = 60.0
+#: the budget's clock: this thread's CPU time, so that a loaded machine (other processes on
+#: the same cores) does not make a search give up that would finish on a quiet one
+_clock = time.thread_time
 #: a step map slower than this [s] is said in one notice (the search is not silent)
 SLOW_MAP_S = 5.0
 
 
 class _Budget(threading.local):
-    """The wall-time budget of the search under way in this thread (:func:`search_budget`;
+    """The CPU-time budget of the search under way in this thread (:func:`search_budget`;
     per thread: the report runs the work-precision study in a thread of its own)."""
 
-    deadline = math.inf  # time.perf_counter() after which no step map starts
+    deadline = math.inf  # _clock() after which no step map starts
     maps = 0  # step maps started under the budget
     slowest = 0.0  # slowest of them [s]
     started = 0.0
@@ -52,19 +55,19 @@ _BUDGET = _Budget()
 
 
 class SearchGaveUp(Exception):
-    """A search for a gait spent its wall-time budget (:func:`search_budget`); raised
+    """A search for a gait spent its CPU-time budget (:func:`search_budget`); raised
     before a step map would start.  The message says after how many maps and how slow."""
 
 
 @contextmanager
 def search_budget(seconds: float | None = None) -> Iterator[None]:
-    """Bound every step map started inside to ``seconds`` of wall time from now (default
+    """Bound every step map started inside to ``seconds`` of this thread's CPU time from now (default
     :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline): past it,
     :func:`poincare_map` raises :class:`SearchGaveUp` instead of starting a map.  A map
     slower than :data:`SLOW_MAP_S` is said once in a notice
     (:func:`walkerlab.progress.note`)."""
     outer = _BUDGET.deadline
-    now = time.perf_counter()
+    now = _clock()
     if not math.isfinite(outer):  # the outermost budget counts the maps of all inside
         _BUDGET.maps, _BUDGET.slowest, _BUDGET.started = 0, 0.0, now
     _BUDGET.deadline = min(outer, now + (ROOT_BUDGET_S if seconds is None else seconds))
@@ -75,11 +78,11 @@ def search_budget(seconds: float | None = None) -> Iterator[None]:
 
 
 def _map_started() -> float:
-    t = time.perf_counter()
+    t = _clock()
     if t > _BUDGET.deadline:
         raise SearchGaveUp(
             f"the search gave up after {_BUDGET.maps} step map(s) in "
-            f"{t - _BUDGET.started:.0f} s (its time budget; the slowest map took "
+            f"{t - _BUDGET.started:.0f} s of CPU (its time budget; the slowest map took "
             f"{_BUDGET.slowest:.1f} s - a very stiff or heavily damped spring makes the "
             "integrator crawl: soften it, or start nearer the gait)")
     _BUDGET.maps += 1
@@ -87,7 +90,7 @@ def _map_started() -> float:
 
 
 def _map_ended(t: float) -> None:
-    dt = time.perf_counter() - t
+    dt = _clock() - t
     if dt > SLOW_MAP_S and _BUDGET.slowest <= SLOW_MAP_S and math.isfinite(_BUDGET.deadline):
         from walkerlab import progress
 
@@ -297,7 +300,7 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         from a start near a known gait it converges to another one.  Not with
         ``jacobian_guess``.
     budget_s : float, optional
-        Longest wall time of the search [s] (default :data:`ROOT_BUDGET_S`; an enclosing
+        Longest CPU time of the search in this thread [s] (default :data:`ROOT_BUDGET_S`; an enclosing
         :func:`search_budget` keeps its earlier deadline), checked before each step map:
         once spent, the search gives up and says why.
 
