@@ -150,8 +150,8 @@ def test_design_optimisation_follows_the_gait_to_a_bounded_optimum():
 
 def test_design_command_prints_the_optimum_and_refuses_bad_input_in_one_line(tmp_path):
     """``walkerlab optimize --design``: the paper walker's hip mass within 5-20 kg that
-    minimises its largest Floquet multiplier (Nelder-Mead, derivative-free: |lambda|max is
-    not smooth) is the heaviest (0.574 at 20 kg against 0.580 at the scene's 10 kg)."""
+    minimises its largest Floquet multiplier (SLSQP with the eigenvalue-perturbation
+    gradient) is the heaviest (0.574 at 20 kg against 0.580 at the scene's 10 kg)."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app

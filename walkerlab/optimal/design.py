@@ -12,8 +12,13 @@ Gradients of the smooth measures are exact through the fixed point (the implicit
 theorem on the Poincaré map ``P``): ``x* = P(x*, p)`` gives ``dx*/dp = (I - DP)^-1 dP/dp``,
 with ``DP`` the map's Jacobian from the variational equations at the fixed point and
 ``dP/dp``, ``dm/dx``, ``dm/dp`` central differences of single steps; SLSQP
-(:func:`scipy.optimize.minimize`) uses them.  ``max_abs_multiplier`` is not smooth where two
-multipliers cross, the basin share and the MFPT are piecewise constant in the design:
+(:func:`scipy.optimize.minimize`) uses them.  ``max_abs_multiplier`` is smooth wherever the
+largest multiplier is simple (or one complex pair): its gradient is the eigenvalue
+perturbation ``dλ = wᴴ (dDP/dp) v / (wᴴ v)`` (``v``, ``w`` right and left eigenvectors) with
+``dDP/dp`` the total derivative of the variational Jacobian along ``(dx*/dp, 1)``, one central
+difference of two variational maps per field (:func:`multiplier_gradient`); SLSQP.  Where two
+multipliers of different moduli cross it is not differentiable (SLSQP then sees one side).
+The basin share and the MFPT are piecewise constant in the design:
 Nelder-Mead (derivative-free, within the bounds).  The gait sensitivity norm is smooth but
 itself built from differences: its gradient is central differences of the re-solved gait
 (step ``1e-4`` of the field's scale), SLSQP.  Hobbelen & Wisse
@@ -26,7 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["MEASURES", "DesignResult", "design_optimize", "measure_gradient"]
+__all__ = ["MEASURES", "DesignResult", "design_optimize", "measure_gradient",
+           "multiplier_gradient"]
 
 #: Measures of a gait a design can optimise, with their units.
 MEASURES = {"step_period": "s", "step_length": "m", "speed": "m/s", "cost_of_transport": "-",
@@ -36,6 +42,10 @@ MEASURES = {"step_period": "s", "step_length": "m", "speed": "m/s", "cost_of_tra
 SMOOTH = ("step_period", "step_length", "speed", "cost_of_transport")
 #: smooth, gradients by central differences of the re-solved gait
 DIFFERENCED = ("gait_sensitivity_norm",)
+#: longest design change solved in one go, as a share of each field's bound span
+MAX_STEP_SHARE = 0.05
+#: smooth where the largest multiplier is simple: eigenvalue perturbation through the gait
+SPECTRAL = ("max_abs_multiplier",)
 
 
 @dataclass
@@ -53,7 +63,8 @@ class DesignResult:
     value : float
         The measure there (its unit).
     gradient : ndarray (k,)
-        d measure / d field there (NaN for ``max_abs_multiplier``).
+        d measure / d field there (NaN for ``basin_share`` and ``mfpt``, piecewise
+        constant).
     success : bool
     message : str
         Why the optimiser stopped.
@@ -77,12 +88,18 @@ class DesignResult:
 class _Gaits:
     """Walkers and their gaits over the design, each solve started at the last gait."""
 
-    def __init__(self, scene, fields, x0):
+    def __init__(self, scene, fields, x0, max_step=None):
         from walkerlab.integrate.solver import Solver
+        from walkerlab.studies.continuation import scene_value
 
         self.scene, self.fields = scene, list(fields)
         self.solver = Solver.from_settings(scene.solver)
+        # the last gait and its design point: every solve is continued from there
         self.last = np.asarray(x0, float)
+        self.p_last = np.array([float(scene_value(scene, f)) for f in self.fields])
+        # longest design change solved in one go (field units); longer ones are walked in
+        # equal sub-steps, each started at the gait before (natural-parameter continuation)
+        self.max_step = None if max_step is None else np.asarray(max_step, float)
         self.count = 0
 
     def scene_at(self, p):
@@ -110,25 +127,36 @@ class _Gaits:
         """``(value, gradient (k,))``: central differences of the re-solved measure."""
         p = np.asarray(p, float)
         value = self.value(p, name)
-        start = self.last.copy()
+        start = self.last.copy(), self.p_last.copy()
         grad = np.empty(p.size)
         for j in range(p.size):
             dp = np.zeros(p.size)
             dp[j] = h_rel * max(1.0, abs(p[j]))
             hi = self.value(p + dp, name)
-            self.last = start.copy()
+            self.last, self.p_last = start[0].copy(), start[1].copy()
             lo = self.value(p - dp, name)
-            self.last = start.copy()
+            self.last, self.p_last = start[0].copy(), start[1].copy()
             grad[j] = (hi - lo) / (2 * dp[j])
         return value, grad
 
     def gait(self, p):
+        """The walker at ``p`` and its gait, continued from the last one: a change longer
+        than ``max_step`` is walked in equal sub-steps, so the root finder never jumps to
+        another gait of the same walker (the paper walker has an unstable one, |λ| 2.5,
+        a root-finder's jump away at 15 kg)."""
         from walkerlab.analysis.gait.poincare import find_fixed_point
 
-        w = self.walker(p)
-        fp = find_fixed_point(w, self.last, self.solver, fd_check=False)
-        self.last = np.asarray(fp.x, float)
-        self.count += 1
+        p = np.asarray(p, float)
+        n = 1
+        if self.max_step is not None:
+            n = max(1, int(np.ceil(np.max(np.abs(p - self.p_last) / self.max_step) - 1e-9)))
+        start = self.p_last.copy()
+        for k in range(1, n + 1):
+            pk = p if k == n else start + (p - start) * (k / n)
+            w = self.walker(pk)
+            fp = find_fixed_point(w, self.last, self.solver, fd_check=False)
+            self.last, self.p_last = np.asarray(fp.x, float), np.asarray(pk, float).copy()
+            self.count += 1
         return w, fp
 
 
@@ -179,6 +207,63 @@ def measure_gradient(gaits: _Gaits, p, name: str, h_x: float = 1e-6,
     return value, grad
 
 
+def multiplier_gradient(gaits: _Gaits, p, h: float = 1e-5) -> tuple[float, np.ndarray]:
+    """The largest Floquet multiplier's modulus ``|λ|max`` of the gait at ``p`` and its
+    gradient (k,) [1/field unit], exact through the fixed point.
+
+    ``x*(p)`` moves by ``dx*/dp_j = (I - DP)⁻¹ ∂P/∂p_j`` (implicit function theorem); the
+    variational Jacobian's total derivative ``dDP/dp_j`` is the central difference of
+    ``DP(x* ± ε dx*/dp_j, p ± ε e_j)`` (two variational maps, ``ε = h max(1, |p_j|)``), and
+    ``d|λ| = Re(conj(λ) wᴴ dDP v / wᴴ v) / |λ|`` (first-order eigenvalue perturbation; e.g.
+    Seyranian & Mailybaev 2003, Multiparameter Stability Theory, ch. 2).
+
+    Parameters
+    ----------
+    gaits : _Gaits
+        The design's walkers and gaits (the solve starts at the last gait).
+    p : array_like (k,)
+        The design fields' values (their units).
+    h : float
+        Relative step of the directional difference.
+
+    Returns
+    -------
+    value : float
+        ``|λ|max`` [-].
+    gradient : ndarray (k,)
+
+    Raises
+    ------
+    walkerlab.analysis.gait.poincare.FixedPointNotFound
+        No gait at ``p`` near the last one.
+    """
+    from scipy.linalg import eig
+
+    from walkerlab.analysis.gait.poincare import poincare_map
+
+    p = np.asarray(p, float)
+    w, fp = gaits.gait(p)
+    x = np.asarray(fp.x, float)
+    J = np.asarray(fp.jacobian_variational, float)
+    ev, W, V = eig(J, left=True, right=True)
+    i = int(np.argmax(np.abs(ev)))
+    lam, v, wl = ev[i], V[:, i], W[:, i]
+    grad = np.empty(p.size)
+    for j in range(p.size):
+        dp = np.zeros(p.size)
+        dp[j] = h * max(1.0, abs(p[j]))
+        wp, wm = gaits.walker(p + dp), gaits.walker(p - dp)
+        dP = (poincare_map(wp, x, gaits.solver)[0] - poincare_map(wm, x, gaits.solver)[0]) \
+            / (2 * dp[j])
+        dx = np.linalg.solve(np.eye(x.size) - J, dP) * dp[j]
+        Jp = poincare_map(wp, x + dx, gaits.solver, jacobian=True)[2]
+        Jm = poincare_map(wm, x - dx, gaits.solver, jacobian=True)[2]
+        dJ = (np.asarray(Jp, float) - np.asarray(Jm, float)) / (2 * dp[j])
+        dlam = (wl.conj() @ dJ @ v) / (wl.conj() @ v)
+        grad[j] = float(np.real(np.conj(lam) * dlam)) / abs(lam)
+    return float(abs(lam)), grad
+
+
 def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool = False,
                     max_evaluations: int = 60) -> DesignResult:
     """Optimise the scene's fields within ``bounds`` for the gait measure ``objective``.
@@ -217,7 +302,7 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
     lo = np.array([bounds[f][0] for f in fields], float)
     hi = np.array([bounds[f][1] for f in fields], float)
     p0 = np.clip([float(scene_value(scene, f)) for f in fields], lo, hi)
-    gaits = _Gaits(scene, fields, x_gait)
+    gaits = _Gaits(scene, fields, x_gait, max_step=MAX_STEP_SHARE * (hi - lo))
     sign = -1.0 if maximize else 1.0
     history: list = []
     if objective in SMOOTH:
@@ -229,15 +314,18 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
         res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
                        options={"maxiter": max_evaluations, "ftol": 1e-12})
         value, grad = measure_gradient(gaits, res.x, objective)
-    elif objective in DIFFERENCED:
+    elif objective in DIFFERENCED + SPECTRAL:
+        slope = multiplier_gradient if objective in SPECTRAL else \
+            (lambda g, p: g.differenced(p, objective))
+
         def fun(p):
-            v, g = gaits.differenced(p, objective)
+            v, g = slope(gaits, p)
             history.append((np.array(p, float), v))
             return sign * v, sign * g
 
         res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
                        options={"maxiter": max_evaluations, "ftol": 1e-10})
-        value, grad = gaits.differenced(res.x, objective)
+        value, grad = slope(gaits, res.x)
     else:
         def fun(p):
             v = gaits.value(p, objective)
