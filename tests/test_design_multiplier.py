@@ -71,3 +71,29 @@ def test_hip_mass_minimising_the_largest_multiplier_is_interior_with_zero_gradie
     assert res.values[0] == pytest.approx(20.64, abs=0.05)
     assert res.value == pytest.approx(0.57365, abs=2e-5) and res.value < 0.5858
     assert abs(res.gradient[0]) < 1e-6
+
+
+def test_design_artifact_loads_back_and_draws_its_figure(paper, tmp_path):
+    """``optimize_design.h5`` is read back by its loader beside its writer (values, unit,
+    gradient, history) and its figure is drawn from the loaded artifact."""
+    import h5py
+
+    from walkerlab.io.schemas.optimize import load_design, write_design
+    from walkerlab.optimal.design import DesignResult
+    from walkerlab.plotting.design_figure import save_design_figure
+
+    r = DesignResult(["walker.hip_mass_kg"], np.array([20.6]), "speed", 0.53,
+                     np.array([-1e-3]), True, "ok", 3,
+                     [(np.array([10.0]), 0.52), (np.array([20.6]), 0.53)], "m/s")
+    from walkerlab.io.artifacts import write_artifact
+
+    scene, _ = paper
+    path = write_artifact(tmp_path / "optimize_design.h5", "optimize_design", scene, "x",
+                          lambda f: write_design(f, r), 0.0)
+    d = load_design(path)
+    assert d.fields == ("walker.hip_mass_kg",) and d.objective_unit == "m/s"
+    assert d.values[0] == 20.6 and d.gradient[0] == -1e-3 and d.history_values.shape == (2, 1)
+    with h5py.File(path) as f:
+        assert f.attrs["objective"] == "speed"
+    paths = save_design_figure(d, "paper", tmp_path / "fig")
+    assert any(p.suffix == ".png" and p.stat().st_size > 1000 for p in paths)

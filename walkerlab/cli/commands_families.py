@@ -280,3 +280,5 @@ def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> Non
         for f, v, g in zip(r.fields, r.values, r.gradient):
             typer.echo(f"  {f} = {v:.8g}   d{r.objective}/d field = {g:.4g}")
     typer.echo(status(out))
+    for path in stage.draw_design(sc, runs_dir)[:1]:
+        typer.echo(f"figure: {path}")

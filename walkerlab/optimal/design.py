@@ -72,6 +72,8 @@ class DesignResult:
         Fixed points solved.
     history : list of (ndarray, float)
         Each evaluation's field values and measure.
+    unit : str
+        The measure's unit (:data:`MEASURES`).
     """
 
     fields: list
@@ -83,6 +85,7 @@ class DesignResult:
     message: str
     evaluations: int
     history: list = field(default_factory=list)
+    unit: str = "-"
 
 
 class _Gaits:
@@ -337,4 +340,4 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
         value, grad = gaits.value(res.x, objective), np.full(len(fields), np.nan)
     return DesignResult(fields, np.asarray(res.x, float), objective, float(value),
                         np.asarray(grad, float), bool(res.success), str(res.message),
-                        gaits.count, history)
+                        gaits.count, history, MEASURES[objective])

@@ -112,3 +112,12 @@ def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
 
         sticks = stick_figures(scene, d)
     return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks)
+
+
+def draw_design(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
+    """Draw ``optimize_design.png`` (PNG + SVG) from ``optimize_design.h5``."""
+    from walkerlab.io.runpaths import figures_dir
+    from walkerlab.plotting.design_figure import save_design_figure
+
+    d = schema.load_design(stage_artifact(scene, runs_root, schema.DESIGN_STAGE))
+    return save_design_figure(d, scene.name, figures_dir(scene, runs_root))

@@ -61,8 +61,8 @@ class SearchGaveUp(Exception):
 
 @contextmanager
 def search_budget(seconds: float | None = None) -> Iterator[None]:
-    """Bound every step map started inside to ``seconds`` of this thread's CPU time from now (default
-    :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline): past it,
+    """Bound every step map started inside to ``seconds`` of this thread's CPU time from now
+    (default :data:`ROOT_BUDGET_S`; nested budgets keep the earlier deadline): past it,
     :func:`poincare_map` raises :class:`SearchGaveUp` instead of starting a map.  A map
     slower than :data:`SLOW_MAP_S` is said once in a notice
     (:func:`walkerlab.progress.note`)."""
@@ -300,9 +300,9 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         from a start near a known gait it converges to another one.  Not with
         ``jacobian_guess``.
     budget_s : float, optional
-        Longest CPU time of the search in this thread [s] (default :data:`ROOT_BUDGET_S`; an enclosing
-        :func:`search_budget` keeps its earlier deadline), checked before each step map:
-        once spent, the search gives up and says why.
+        Longest CPU time of the search in this thread [s] (default :data:`ROOT_BUDGET_S`;
+        an enclosing :func:`search_budget` keeps its earlier deadline), checked before each
+        step map: once spent, the search gives up and says why.
 
     Returns
     -------

@@ -41,7 +41,8 @@ import numpy as np
 
 STAGE = "optimize"
 
-__all__ = ["DESIGN_STAGE", "OptimizeData", "STAGE", "load", "write", "write_design"]
+__all__ = ["DESIGN_STAGE", "DesignData", "OptimizeData", "STAGE", "load", "load_design",
+           "write", "write_design"]
 
 
 @dataclass
@@ -172,21 +173,59 @@ def write_design(f, r) -> None:
     (:class:`walkerlab.optimal.design.DesignResult`): ``fields`` (attribute), ``values`` (k,)
     in the fields' units, ``objective_value``, ``gradient`` (k,) [measure unit per field
     unit; NaN where the measure is not smooth], ``history/values`` (m, k) and
-    ``history/objective`` (m,); attributes ``objective``, ``success``, ``message``,
-    ``evaluations``."""
+    ``history/objective`` (m,); attributes ``objective``, ``objective_unit``, ``success``,
+    ``message``, ``evaluations``."""
     from walkerlab.io.artifacts import put
 
+    unit = str(getattr(r, "unit", "-"))
     put(f, "values", np.asarray(r.values, float), "-", "optimal values of the fields "
         "(attribute 'fields'), each in its field's unit")
-    put(f, "objective_value", float(r.value), "-", f"{r.objective} at the optimum")
-    put(f, "gradient", np.asarray(r.gradient, float), "-", f"d {r.objective} / d field at "
-        "the optimum (through the fixed point)")
+    put(f, "objective_value", float(r.value), unit, f"{r.objective} at the optimum")
+    put(f, "gradient", np.asarray(r.gradient, float), f"{unit} per field unit",
+        f"d {r.objective} / d field at the optimum (through the fixed point)")
     hv = np.array([h[0] for h in r.history], float).reshape(len(r.history), len(r.fields))
     put(f, "history/values", hv, "-", "each evaluation's field values")
-    put(f, "history/objective", np.array([h[1] for h in r.history], float), "-",
+    put(f, "history/objective", np.array([h[1] for h in r.history], float), unit,
         f"each evaluation's {r.objective}")
     f.attrs["fields"] = list(r.fields)
     f.attrs["objective"] = r.objective
+    f.attrs["objective_unit"] = unit
     f.attrs["success"] = bool(r.success)
     f.attrs["message"] = str(r.message)
     f.attrs["evaluations"] = int(r.evaluations)
+
+
+@dataclass
+class DesignData:
+    """The contents of ``optimize_design.h5`` (:func:`write_design`)."""
+
+    fields: tuple
+    values: np.ndarray  # (k,) the fields' units
+    objective: str
+    objective_unit: str
+    objective_value: float
+    gradient: np.ndarray  # (k,) objective unit per field unit
+    history_values: np.ndarray  # (m, k)
+    history_objective: np.ndarray  # (m,)
+    success: bool
+    message: str
+    evaluations: int
+
+
+def load_design(path: Path) -> DesignData:
+    """Read ``optimize_design.h5`` (:func:`write_design`).
+
+    Raises
+    ------
+    walkerlab.io.artifacts.ArtifactError
+        Not a readable design artifact (one line naming the file).
+    """
+    from walkerlab.io.artifacts import open_artifact
+
+    with open_artifact(path, DESIGN_STAGE) as f:
+        return DesignData(
+            tuple(str(x) for x in f.attrs["fields"]), f["values"][()],
+            str(f.attrs["objective"]), str(f.attrs.get("objective_unit", "-")),
+            float(f["objective_value"][()]), f["gradient"][()], f["history/values"][()],
+            f["history/objective"][()], bool(f.attrs["success"]), str(f.attrs["message"]),
+            int(f.attrs["evaluations"]))
