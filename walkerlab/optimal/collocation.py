@@ -44,6 +44,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.optimal.ipopt import iteration_history
+
 __all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step", "replay",
            "step_functions", "target_constraints", "torque_of_time"]
 
@@ -133,6 +135,8 @@ class CollocationResult:
     wall_time_s : float
     replay_error : float
         Max-norm return error of the replay (module docstring).
+    history : dict of str -> ndarray
+        IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
     """
 
     t: np.ndarray
@@ -147,6 +151,7 @@ class CollocationResult:
     wall_time_s: float
     replay_error: float = np.nan
     terms: dict = field(default_factory=dict)
+    history: dict = field(default_factory=dict)
 
 
 def _to_casadi(exprs, syms, values: dict):
@@ -388,7 +393,8 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
         push_off_n_s=float(get(P)) if spec.push_off_free else float(spec.push_off_n_s),
         objective=float(get(obj)), status=status,
         iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall,
-        terms={k: float(get(v)) for k, v in terms.items()})
+        terms={k: float(get(v)) for k, v in terms.items()},
+        history=iteration_history(opti.stats()))
 
 
 def _transcribe(opti, fns, spec, X, U, T, P, period_guess):

@@ -28,11 +28,12 @@ heel strike (:func:`torques_of_time`), one step from ``x_0`` (scipy's DOP853 at 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from walkerlab.optimal.collocation import target_constraints
+from walkerlab.optimal.ipopt import iteration_history
 
 __all__ = ["FiveLinkResult", "collocate_five_link", "kelly_guess", "replay_five_link",
            "torques_of_time"]
@@ -58,6 +59,8 @@ class FiveLinkResult:
     iterations : int
     wall_time_s, cpu_time_s : float
         The solve's (IPOPT and the function evaluations; not the set-up).
+    history : dict of str -> ndarray
+        IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
     """
 
     t: np.ndarray
@@ -70,6 +73,7 @@ class FiveLinkResult:
     iterations: int
     wall_time_s: float
     cpu_time_s: float
+    history: dict = field(default_factory=dict)
 
 
 def kelly_guess(leg_length_m: float, step_length_m: float, period_s: float, points: int):
@@ -185,7 +189,8 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
         t=np.linspace(0.0, Tv, K), x=Xv, u=Uv, step_period_s=Tv,
         step_length_m=float(np.asarray(fns["feet"](Xv[-1], p))[1, 0]),
         objective=float(get(effort)), status=status,
-        iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall, cpu_time_s=cpu)
+        iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall, cpu_time_s=cpu,
+        history=iteration_history(opti.stats()))
 
 
 def torques_of_time(t: np.ndarray, u: np.ndarray):

@@ -36,6 +36,7 @@ def optimize_five_link_scene(scene):
     from walkerlab.optimal.five_link import JOINTS, five_link_functions
     from walkerlab.optimal.five_link_collocation import collocate_five_link, replay_five_link
     from walkerlab.optimal.five_link_shooting import close_step
+    from walkerlab.optimal.scene import step_record
     from walkerlab.walker.description import walker_data
 
     o = scene.optimize
@@ -65,7 +66,7 @@ def optimize_five_link_scene(scene):
         start_shift=closed.shift, replay_step_period_s=closed.period_s,
         collocated_start_error=closed.open_loop_error, cpu_time_s=res.cpu_time_s,
         contact_outcome="not replayed: a five-link biped's optimised torques are replayed on "
-        "the rigid model only")
+        "the rigid model only", **step_record(scene, rigid, res))
 
 
 #: the stick figure's polyline through the walker's named points

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["collocation_spec", "needs_gait", "optimize_scene"]
+__all__ = ["collocation_spec", "needs_gait", "optimize_scene", "step_record"]
 
 
 def collocation_spec(scene):
@@ -112,7 +112,20 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
                         objective_name=o.objective, objective_unit=_unit(o, data),
                         terms=res.terms, contact_step_period_s=contact_period,
                         contact_outcome=contact_outcome,
-                        torque_unit="N m/kg" if _massless(data) else "N m")
+                        torque_unit="N m/kg" if _massless(data) else "N m",
+                        **step_record(scene, walker, res))
+
+
+def step_record(scene, walker, res) -> dict:
+    """IPOPT's iteration history and the walker's kinetic and potential energy at the
+    collocation points (``res``: a collocation result with ``x`` (2N + 1, 2n) in the
+    walker's state order and ``history``), as :class:`OptimizeData` keywords."""
+    from walkerlab.units import for_scene
+
+    ke, pe = walker.energies(np.asarray(res.x, float).T)
+    return {"ipopt_history": dict(res.history),
+            "energy": {"kinetic": np.asarray(ke, float), "potential": np.asarray(pe, float)},
+            "energy_unit": for_scene(scene).energy}
 
 
 def _unit(o, data) -> str:

@@ -1,5 +1,6 @@
 """The figure of ``optimize.h5``: the optimised torques and the link angles over the step
-(and, for a walker whose stick figure is given, the step as stop-action frames)."""
+(and, for a walker whose stick figure is given, the step as stop-action frames); below, the
+energies over the step and IPOPT's convergence, where the artifact holds them."""
 
 from __future__ import annotations
 
@@ -15,7 +16,10 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
     collocation points (by name), middle every angle state [rad] over the step, and with
     ``sticks`` (a list of (m, 2) polylines [m], e.g. stance foot - knee - hip - torso / hip
     - swing knee - swing foot at a few instants) a third panel with them drawn over each
-    other (stop action)."""
+    other (stop action).  A second row, where the artifact has them: the kinetic, potential
+    and total mechanical energy's change since the heel strike [J] (the total changes by the
+    actuators' work),
+    and IPOPT's primal and dual infeasibility per iteration (log scale)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -24,7 +28,10 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
 
     from walkerlab.plotting.figures import save
 
-    fig, axes = plt.subplots(1, 3 if sticks else 2, figsize=(15 if sticks else 10, 3.8))
+    rows = 2 if (d.energy or d.ipopt_history) else 1
+    cols = 3 if sticks else 2
+    fig, grid = plt.subplots(rows, cols, figsize=(5 * cols, 3.8 * rows), squeeze=False)
+    axes = grid[0]
     ax, ax2 = axes[0], axes[1]
     tq = d.torque.reshape(len(d.time), -1)
     for k, name in enumerate(d.torque_names):
@@ -60,7 +67,38 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
         ax3.set_xlabel("x [m] (stance foot at 0)")
         ax3.set_ylabel("y [m]")
         ax3.set_title("the step, stop action (early: dark, late: yellow)", fontsize=9)
+    if rows == 2:
+        _energy_and_convergence(d, grid[1])
     fig.suptitle(f"{title}: optimised step (direct collocation)"
                  + ("" if d.gait else " — NOT a gait: the replay does not close"), fontsize=10)
     fig.tight_layout()
     return save(fig, Path(folder), "optimize")
+
+
+def _energy_and_convergence(d, axes) -> None:
+    """Second row: energies over the step, IPOPT's infeasibilities per iteration."""
+    import numpy as np
+
+    ax = axes[0]
+    if d.energy:
+        ke, pe = d.energy["kinetic"], d.energy["potential"]
+        for v, name in ((ke, "kinetic"), (pe, "potential"), (ke + pe, "total")):
+            ax.plot(d.time, v - v[0], label=name, lw=2 if name == "total" else 1)
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.set_xlabel("time since heel strike [s]")
+        ax.set_ylabel(f"energy change since heel strike [{d.energy_unit}]")
+        ax.set_title(f"total rises by {(ke + pe)[-1] - (ke + pe)[0]:.3g} {d.energy_unit} "
+                     "over the step (the actuators' net work)", fontsize=9)
+        ax.legend(fontsize=8, loc="best")
+    ax = axes[1]
+    h = d.ipopt_history
+    if h and len(h.get("objective", ())):
+        it = np.arange(len(h["objective"]))
+        for key in ("primal_infeasibility", "dual_infeasibility"):
+            ax.semilogy(it, np.maximum(h[key], 1e-20), label=key.replace("_", " "))
+        ax.set_xlabel("IPOPT iteration")
+        ax.set_ylabel("infeasibility")
+        ax.set_title(f"IPOPT: {d.status}, {d.iterations} iterations", fontsize=9)
+        ax.legend(fontsize=8, loc="best")
+    for extra in axes[2:]:
+        extra.axis("off")

@@ -28,6 +28,10 @@ points)::
     replay/collocated_start_error rad, rad/s  (closed by shooting) the open-loop return
                                            error from the collocated start itself
     ipopt                         attributes: status, iterations, wall_time_s, cpu_time_s
+    ipopt/<series>                -        on the ``iteration`` dimension: objective,
+                                           primal_infeasibility, dual_infeasibility, barrier
+    energy/kinetic, energy/potential  J    the walker's energies at the collocation points
+                                           (their sum rises by the actuators' work)
 
 attributes: ``gait`` (the replay closed), ``state_names``.
 """
@@ -74,6 +78,9 @@ class OptimizeData:
     replay_step_period_s: float = float("nan")
     collocated_start_error: float = float("nan")
     cpu_time_s: float = float("nan")
+    ipopt_history: dict = field(default_factory=dict)  # walkerlab.optimal.ipopt.HISTORY
+    energy: dict = field(default_factory=dict)  # kinetic, potential (time,) [energy_unit]
+    energy_unit: str = "J"
 
 
 def write(f, d: OptimizeData) -> None:
@@ -126,6 +133,24 @@ def write(f, d: OptimizeData) -> None:
              "error from the collocated start [rad, rad/s]")):
         if np.isfinite(v):
             put(f, f"replay/{key}", float(v), unit, what)
+    _write_history_and_energy(f, d)
+
+
+def _write_history_and_energy(f, d: OptimizeData) -> None:
+    """``ipopt/<series>`` on the ``iteration`` dimension and ``energy/<kind>`` on ``time``."""
+    from walkerlab.io.artifacts import put
+    from walkerlab.io.netcdf import coordinate
+
+    n = len(d.ipopt_history.get("objective", ()))
+    if n:
+        coordinate(f, "iteration", np.arange(n), "-", "IPOPT iteration (0: the initial guess)")
+        for name, v in d.ipopt_history.items():
+            put(f, f"ipopt/{name}", np.asarray(v, float), "-", f"IPOPT's {name} at each "
+                "iteration (the NLP's own scaling)", dims=("iteration",))
+    for name, v in d.energy.items():
+        put(f, f"energy/{name}", np.asarray(v, float), d.energy_unit, f"{name} energy of the "
+            "collocated states (gravity's potential relative to the stance foot)",
+            dims=("time",))
 
 
 def load(path: Path) -> OptimizeData:
@@ -161,7 +186,10 @@ def load(path: Path) -> OptimizeData:
             float(f["contact_replay/step_period"][()]),
             str(f.attrs["contact_replay_outcome"]), str(f[f"torque/{joints[0]}"].attrs["unit"]),
             joints, opt("start_shift"), opt("step_period"), opt("collocated_start_error"),
-            float(f.attrs.get("ipopt_cpu_time_s", float("nan"))))
+            float(f.attrs.get("ipopt_cpu_time_s", float("nan"))),
+            {k: v[()] for k, v in f["ipopt"].items()} if "ipopt" in f else {},
+            {k: v[()] for k, v in f["energy"].items()} if "energy" in f else {},
+            str(next(iter(f["energy"].values())).attrs["unit"]) if "energy" in f else "J")
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)

@@ -1,0 +1,32 @@
+"""IPOPT's iteration history from CasADi's solver statistics (``Opti.stats()``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["HISTORY", "iteration_history"]
+
+#: the stored series and CasADi's names for them (IPOPT's iteration output: ``objective``,
+#: ``inf_pr`` the largest constraint violation, ``inf_du`` the dual infeasibility, ``mu`` the
+#: barrier parameter; Wächter & Biegler 2006, §3)
+HISTORY = {"objective": "obj", "primal_infeasibility": "inf_pr",
+           "dual_infeasibility": "inf_du", "barrier": "mu"}
+
+
+def iteration_history(stats: dict) -> dict[str, np.ndarray]:
+    """Every IPOPT iteration's objective, infeasibilities and barrier parameter.
+
+    Parameters
+    ----------
+    stats : dict
+        ``casadi.Opti.stats()`` after a solve (failed or not).
+
+    Returns
+    -------
+    dict of str -> ndarray (iterations + 1,)
+        Keys of :data:`HISTORY` (the objective in the NLP's own scaling and unit, the
+        infeasibilities in the constraints' and the Lagrangian's); empty arrays when CasADi
+        recorded none.
+    """
+    it = stats.get("iterations") or {}
+    return {name: np.asarray(it.get(key, []), float) for name, key in HISTORY.items()}
