@@ -81,3 +81,20 @@ def test_ipopt_history_is_recorded_and_the_artifact_reads_it_back(powered, tmp_p
                                   h["dual_infeasibility"])
     np.testing.assert_array_equal(back.energy["kinetic"], rec["energy"]["kinetic"])
     assert back.energy_unit == "J"
+
+
+def test_legs_that_differ_are_refused_in_one_line_not_optimised_as_one_step():
+    """A one-step transcription with its reset as the periodic condition is a gait only for
+    mirror-image legs: with legs that differ it closed on itself with the wrong leg in
+    stance every other step (and then the contact replay crashed on the scene's ``legs``).
+    It is refused in one line naming the reason."""
+    from walkerlab.codegen import symbolic
+
+    scene = load_scene(CONFIGS / "asymmetric_legs.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    assert data.mirror is not None
+    from walkerlab.optimal.collocation import step_functions
+
+    with pytest.raises(ValueError, match="legs that differ") as info:
+        step_functions(data, symbolic.derive(data.structure))
+    assert "\n" not in str(info.value)

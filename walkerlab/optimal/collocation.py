@@ -202,6 +202,10 @@ def step_functions(data, eq):
         raise ValueError("optimize: straight legs with point feet only today, their bodies "
                          "massive or all massless with a hip mass (knees, arc and flat feet, "
                          "a torso, partly massless legs: not yet)")
+    if getattr(data, "mirror", None) is not None:
+        raise ValueError("optimize: legs that differ take a stride of two different steps "
+                         "(a two-phase transcription: not yet); one step would be periodic "
+                         "only for mirror-image legs")
     n = len(eq.q)
     vals = dict(zip(eq.params, data.params))
     xs = list(eq.q) + list(eq.dq)

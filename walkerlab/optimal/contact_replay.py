@@ -36,7 +36,9 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup
     from walkerlab.optimal.collocation import torque_of_time
 
-    bodies = scene.walker.model_dump().get("leg", {}).get("bodies", [])
+    w = scene.walker.model_dump()
+    bodies = [b for leg in [w.get("leg")] + list(w.get("legs") or []) if leg
+              for b in leg.get("bodies", [])]
     if bodies and all(b.get("mass_kg", 1.0) == 0.0 for b in bodies):
         return float("nan"), "not replayed: massless legs (the contact view needs masses)"
     d = scene.model_dump(mode="json", exclude_none=True)
