@@ -182,11 +182,8 @@ class BatchStepMap:
     def walk(self, X: np.ndarray, gamma: np.ndarray):
         """Walk every row up to ``gamma.shape[1]`` steps, step ``s`` of row ``w`` on the
         slope ``gamma[w, s]`` [rad], until it falls (any step that does not end in heel
-        strike), all in compiled code (:func:`walkerlab.integrate.rows_dop853.walk_rows`).
-        Each step is one integration through its phases (no restart at a phase boundary:
-        the phases share the flow), so the states differ from :meth:`step` step after step
-        (which restarts every phase) within the tolerances; the heel strikes and falls are
-        the same but for a walk on the edge of a fall.
+        strike), all in compiled code (:func:`walkerlab.integrate.rows_dop853.walk_rows`;
+        the same numbers as :meth:`step` step after step).
 
         Parameters
         ----------
