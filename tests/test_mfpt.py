@@ -194,6 +194,43 @@ def test_uniform_slope_quadrature_mesh_agrees_with_monte_carlo():
     assert abs(normal.mfpt_steps - m) > 2 * se + 0.05 * normal.mfpt_steps, (normal, m)
 
 
+def test_voxel_rows_packed_as_one_key_equal_numpy_unique_rows():
+    """``first_of_each_row`` (rows packed into one int64 key, 1-D stable unique) gives the
+    indices of ``np.unique(V, axis=0, return_index=True)`` exactly, in its order: small and
+    negative voxel indices in 4 and 7 columns, repeats, one row, and ranges too wide for 62
+    bits (the ``axis=0`` fallback)."""
+    rng = np.random.default_rng(3)
+    cases = [rng.integers(-4, 4, (3000, 4)), rng.integers(-50, 3, (2000, 7)),
+             np.zeros((5, 3), np.int64), rng.integers(0, 9, (1, 4)),
+             rng.integers(-2**40, 2**40, (400, 3))]
+    for V in cases:
+        np.testing.assert_array_equal(M.first_of_each_row(V),
+                                      np.unique(V, axis=0, return_index=True)[1])
+
+
+def test_visited_states_of_all_sigmas_stepped_together_equal_one_sigma_at_a_time(
+        paper_map, paper_fixed_point):
+    """The walks of every sigma step in one batch; each sigma's states are those of its own
+    walks stepped alone (its own random stream ``[seed, 24, i]``; a row's step does not
+    depend on its batch), in the same order: the pool of (sd, 1.5 sd) is bit for bit the
+    one of sigmas walked one after the other (the shuffle of ``[seed, 25]`` after)."""
+    x0, sd, walks, steps, seed = paper_fixed_point.x, 0.004, 6, 5, 2
+    pts = []
+    for i, s in enumerate((sd, 1.5 * sd)):
+        rng = np.random.default_rng([seed, 24, i])
+        X = np.tile(x0, (walks, 1))
+        for k in range(steps):
+            r = paper_map.step(X, paper_map.slope_rad + s * rng.standard_normal(walks))
+            ok = r.outcome == HEEL_STRIKE
+            if k >= 1:
+                pts.append(r.x_next[ok])
+            X = np.where(ok[:, None], r.x_next, x0)
+    P = np.concatenate(pts)
+    ref = P[np.random.default_rng([seed, 25]).permutation(len(P))]
+    got = M.visited_states(paper_map, x0, (sd, 1.5 * sd), walks, steps, seed=seed)
+    np.testing.assert_array_equal(got, ref)
+
+
 @pytest.mark.slow
 def test_mesh_agrees_with_monte_carlo_on_the_paper_walker(paper_fixed_point, paper_map):
     """The paper walker at sigma = 0.004 rad (MFPT ~ 32 steps: 4,000 walks give 32.4 +- 0.5):

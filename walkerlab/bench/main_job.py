@@ -23,6 +23,8 @@ measurement            what is timed                                            
                        (:mod:`walkerlab.bench.minimal_compass`), interleaved
 ``mesh``               wall time of the mesh MFPT at ``sigma_mesh`` (2 workers,         15 s
                        :func:`walkerlab.studies.mfpt.mesh`, the scene's mfpt settings)
+                       and its CPU (``mesh_cpu_s``: the mesh alone, workers
+                       included; ``mesh_process_cpu_s``: the whole process)
 ``robustness``         ``walkerlab robustness SCENE --force``, whole process (the
                        fixed point done before)
 =====================  ==============================================================  =======
@@ -100,9 +102,14 @@ from walkerlab.studies import mfpt as work
 scene = load_scene(sys.argv[1]); sd = float(sys.argv[2]); workers = int(sys.argv[3])
 _, search = solve_scene(scene, fd_check=False)
 x = np.asarray(search.gait.result.x, float)
-t = time.perf_counter()
+import resource
+def cpu():
+    r = [resource.getrusage(k) for k in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)]
+    return sum(u.ru_utime + u.ru_stime for u in r)
+t, c = time.perf_counter(), cpu()
 last, meshes = work.mesh(scene, x, sd, scene.mfpt or MfptSettings(), workers)
-print(json.dumps({"wall_s": time.perf_counter() - t, "mfpt_steps": last.mfpt_steps,
+print(json.dumps({"wall_s": time.perf_counter() - t, "cpu_s": cpu() - c,
+    "mfpt_steps": last.mfpt_steps,
     "cells": last.cells, "meshes": len(meshes), "converged": bool(last.converged),
     "change": last.change, "sigma_rad": sd, "workers": workers}))
 """
@@ -161,9 +168,10 @@ def robustness(code: Path, scene: str, runs: str) -> tuple[float, float]:
 
 
 def child(code: Path, src: str, *args) -> dict:
-    """Run ``src`` (:data:`MC_CHILD` or :data:`MESH_CHILD`) in a fresh process; its JSON."""
-    out = _run([sys.executable, "-c", src, *map(str, args)], _env(code), code)[2]
-    return json.loads(out.strip().splitlines()[-1])
+    """Run ``src`` (:data:`MC_CHILD` or :data:`MESH_CHILD`) in a fresh process; its JSON,
+    with ``process_cpu_s``: the CPU [s] of the whole process tree (its workers included)."""
+    _, cpu, out = _run([sys.executable, "-c", src, *map(str, args)], _env(code), code)
+    return {**json.loads(out.strip().splitlines()[-1]), "process_cpu_s": cpu}
 
 
 def _median(rows: list, key: int) -> float:
@@ -260,6 +268,9 @@ def _summary(raw: list, mc: list, slow: dict) -> dict:
         out["montecarlo_detail"] = mc[-1]
     if slow["mesh"]:
         out["mesh_wall_s"] = float(np.median([m["wall_s"] for m in slow["mesh"]]))
+        out["mesh_cpu_s"] = float(np.median([m["cpu_s"] for m in slow["mesh"]]))
+        out["mesh_process_cpu_s"] = float(np.median([m["process_cpu_s"]
+                                                     for m in slow["mesh"]]))
         out["mesh_detail"] = slow["mesh"][-1]
     if slow["robustness"]:
         out["robustness_wall_s"] = _median(slow["robustness"], 0)

@@ -190,19 +190,25 @@ def _first_step(f, y, f0, d, buf, tmp, rtol, atol, span):  # pragma: no cover - 
 
 
 @njit(cache=True, error_model="numpy")
-def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, n_out, yev, h_first):  # pragma: no cover
+def _work(m, n_out, ng):  # pragma: no cover - compiled
+    """The scratch arrays of :func:`_row` for rows of ``m`` states, ``n_out`` cfunc outputs
+    and at most ``ng`` guards: ``K`` (16, n_out) stages (flow then extra outputs), ``F``
+    (7, m) interpolant, ``buf`` (n_out,), ``ynew``, ``tmp`` (m,), ``G`` (3, ng) guard
+    values (step start, step end, probe)."""
+    return (np.empty((16, n_out)), np.empty((7, m)), np.empty(n_out), np.empty(m),
+            np.empty(m), np.empty((3, ng)))
+
+
+@njit(cache=True, error_model="numpy")
+def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
+         work):  # pragma: no cover - compiled
     """One row to its first guard crossing: ``(which, t_event, next step size)``, the state
-    into ``yev``; ``h_first`` > 0: the first step size [s] (else scipy's choice)."""
+    into ``yev``; ``h_first`` > 0: the first step size [s] (else scipy's choice); ``work``:
+    :func:`_work`'s scratch arrays (allocated once per call of the caller, not per row)."""
     m = y.size
     ng = gcols.size
-    K = np.empty((16, n_out))  # stages: flow (m) then the extra outputs
-    F = np.empty((7, m))
-    buf = np.empty(n_out)
-    ynew = np.empty(m)
-    tmp = np.empty(m)
-    g0 = np.empty(ng)
-    g1 = np.empty(ng)
-    gv = np.empty(ng)
+    K, F, buf, ynew, tmp, G = work
+    g0, g1, gv = G[0], G[1], G[2]
     t, t_bound = 0.0, cap + 1.0
     f(K[0].ctypes, t, y.ctypes, d.ctypes)
     _guards(K[0], m, gcols, goffs, g0)
@@ -265,10 +271,12 @@ def phase_rows(f, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te, Y
     ``n_out``: outputs the cfunc writes (m + extra); ``H`` (N,) [s]: each row's first step
     size (<= 0: scipy's choice), overwritten with the step size it would take next (a row
     going on to the next phase starts with it)."""
+    work = _work(Y.shape[1], n_out, gcols.size)
+    y = np.empty(Y.shape[1])
     for i in range(Y.shape[0]):
-        y = Y[i].copy()
-        w, t, h = _row(f, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol, n_out, Yev[i],
-                       H[i])
+        y[:] = Y[i]
+        w, t, h = _row(f, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol, Yev[i], H[i],
+                       work)
         which[i] = w
         te[i] = t
         H[i] = h
@@ -300,19 +308,22 @@ def walk_rows(f, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, gou
     W, m = X.shape
     n_ph = gstart.size - 1
     yev = np.empty(m)
+    x = np.empty(m)
+    y = np.empty(m)
+    work = _work(m, n_out, np.max(gstart[1:] - gstart[:-1]))
     for w in range(W):
-        x = X[w].copy()
+        x[:] = X[w]
         for s in range(n_steps):
             T, h, ended = 0.0, 0.0, False
             d = np.ascontiguousarray(D[w, s])
-            y = x.copy()
+            y[:] = x
             for p in range(n_ph):
                 a, b = gstart[p], gstart[p + 1]
                 if max_time - T <= 0.0:
                     ended = True
                     break
                 which, te, h = _row(f, y, d, max_time - T, gcols[a:b], goffs[a:b],
-                                    dirs[a:b], rtol, atol, n_out, yev, h)
+                                    dirs[a:b], rtol, atol, yev, h, work)
                 if which < 0 or gout[a + which] == 1:
                     ended = True
                     break

@@ -201,20 +201,24 @@ def visited_states(step_map: BatchStepMap, x0: np.ndarray, sds, walks: int, step
         (so the first ``N`` rows are a fair sample of all, and meshes of growing ``N`` are
         nested).
     """
-    pts = []
     x0 = np.asarray(x0, float)
-    for i, sd in enumerate(sds):
-        rng = np.random.default_rng([int(seed), 24, i])
-        X = np.tile(np.asarray(x0, float), (walks, 1))
-        for k in range(steps):
-            z = (rng.uniform(-math.sqrt(3.0), math.sqrt(3.0), len(X))
-                 if distribution == "uniform" else rng.standard_normal(len(X)))
-            r = step_map.step(X, step_map.slope_rad + sd * z)
-            ok = r.outcome == HEEL_STRIKE
-            if k >= burn_in:
-                pts.append(r.x_next[ok])
-            X = np.where(ok[:, None], r.x_next, x0)  # a fallen walk starts again on the gait
-    P = np.concatenate(pts) if pts else np.empty((0, len(x0)))
+    sds = [float(sd) for sd in sds]
+    pts: list[list] = [[] for _ in sds]  # per sd (the walks of all sds step together)
+    rngs = [np.random.default_rng([int(seed), 24, i]) for i in range(len(sds))]
+    X = np.tile(x0, (len(sds) * walks, 1))
+    for k in range(steps):
+        z = [rng.uniform(-math.sqrt(3.0), math.sqrt(3.0), walks)
+             if distribution == "uniform" else rng.standard_normal(walks) for rng in rngs]
+        r = step_map.step(X, np.concatenate([step_map.slope_rad + sd * zi
+                                             for sd, zi in zip(sds, z)]))
+        ok = r.outcome == HEEL_STRIKE
+        if k >= burn_in:
+            for i in range(len(sds)):
+                rows = slice(i * walks, (i + 1) * walks)
+                pts[i].append(r.x_next[rows][ok[rows]])
+        X = np.where(ok[:, None], r.x_next, x0)  # a fallen walk starts again on the gait
+    flat = [p for per_sd in pts for p in per_sd]
+    P = np.concatenate(flat) if flat else np.empty((0, len(x0)))
     return P[np.random.default_rng([int(seed), 25]).permutation(len(P))]
 
 
@@ -395,6 +399,29 @@ def solve_mesh(Q, start: int):
     return float(m[start] - 1.0), qs, lam2, m - 1.0, pi
 
 
+def first_of_each_row(V: np.ndarray) -> np.ndarray:
+    """Index of the first occurrence of each distinct row of the integer array ``V`` (k, d)
+    (the ``index`` of ``np.unique(V, axis=0, return_index=True)``, in that order: the rows
+    sorted lexicographically).
+
+    Each row is packed into one int64 (mixed radix over the columns' ranges, the first
+    column most significant, so the order is the lexicographic one) and the 1-D keys go
+    through ``np.unique`` (a stable sort: first occurrences), much faster than the
+    structured sort of ``axis=0``; rows whose ranges do not fit in 62 bits take
+    ``axis=0``.  Returns shape (distinct rows,)."""
+    V = np.asarray(V, dtype=np.int64)
+    if V.ndim != 2 or V.shape[0] == 0:
+        return np.unique(V, axis=0, return_index=True)[1]
+    lo = V.min(axis=0)
+    span = V.max(axis=0) - lo + 1
+    if float(np.prod(span.astype(float))) >= 2.0 ** 62:
+        return np.unique(V, axis=0, return_index=True)[1]
+    key = np.zeros(V.shape[0], dtype=np.int64)
+    for j in range(V.shape[1]):
+        key = key * span[j] + (V[:, j] - lo[j])
+    return np.unique(key, return_index=True)[1]
+
+
 def voxel_nodes(Z: np.ndarray, cells: int) -> tuple[np.ndarray, float]:
     """One state per occupied voxel of side ``r``: ``(indices into Z, r)`` with ``r``
     bisected so that about ``cells`` voxels are occupied (row 0, the gait, always in).
@@ -406,7 +433,7 @@ def voxel_nodes(Z: np.ndarray, cells: int) -> tuple[np.ndarray, float]:
     best = None
     for _ in range(40):
         r = math.sqrt(lo * hi)
-        _, idx = np.unique(np.floor(Z / r).astype(np.int64), axis=0, return_index=True)
+        idx = first_of_each_row(np.floor(Z / r).astype(np.int64))
         best = (idx, r) if best is None or abs(len(idx) - cells) < abs(len(best[0]) - cells) \
             else best
         if len(idx) > cells:
