@@ -39,8 +39,7 @@ strike (each phase's piecewise quadratic): :func:`replay_phases`.
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
