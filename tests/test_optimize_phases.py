@@ -142,7 +142,8 @@ def test_what_the_phased_transcription_does_not_take_is_refused_in_one_line():
 
 def test_optimize_h5_keeps_the_phases(tmp_path, kneed):
     """The writer and the reader side by side: the phases' names, first points and
-    durations round-trip; a step without phases writes none."""
+    durations round-trip (and reach the report's line); a step without phases writes
+    none."""
     from walkerlab.io.artifacts import write_artifact
     from walkerlab.io.schemas import optimize as schema
 
@@ -159,6 +160,10 @@ def test_optimize_h5_keeps_the_phases(tmp_path, kneed):
     assert back.phase_names == d.phase_names and back.build_time_s == 0.5
     np.testing.assert_array_equal(back.phase_start, [0, 3])
     np.testing.assert_array_equal(back.phase_duration_s, [0.2, 0.2])
+    from walkerlab.report.figures_section import optimize_lines
+
+    assert "Phases (each with its own mesh and free duration): unlocked_swing 0.2 s, " \
+        "locked_swing 0.2 s." in optimize_lines(back)[0]
     d.phase_names = ()
     write_artifact(path, schema.STAGE, kneed[0], "x", lambda f: schema.write(f, d), 0.0)
     assert schema.load(path).phase_names == () and schema.load(path).phase_start is None
