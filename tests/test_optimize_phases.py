@@ -162,8 +162,8 @@ def test_optimize_h5_keeps_the_phases(tmp_path, kneed):
     np.testing.assert_array_equal(back.phase_duration_s, [0.2, 0.2])
     from walkerlab.report.figures_section import optimize_lines
 
-    assert "Phases (each with its own mesh and free duration): unlocked_swing 0.2 s, " \
-        "locked_swing 0.2 s." in optimize_lines(back)[0]
+    assert "Phases (each with its own mesh and free duration): unlocked_swing 0.200000 s, " \
+        "locked_swing 0.200000 s." in optimize_lines(back)[0]
     d.phase_names = ()
     write_artifact(path, schema.STAGE, kneed[0], "x", lambda f: schema.write(f, d), 0.0)
     assert schema.load(path).phase_names == () and schema.load(path).phase_start is None
