@@ -124,13 +124,14 @@ class Actuators:
             return 0.0
         return float(np.real(np.sum(self.torques(t, x)) * self.hip_angles(x)[1]))
 
-    def added_acceleration(self, t, x, constraint=None):
+    def added_acceleration(self, t, x, constraint=None, M=None):
         """``M^-1 B tau`` (n,) [rad/s^2]; in a phase holding a constraint with gradient
         ``a = constraint(x)`` (n,) (a locked knee), the constrained system's
         ``M^-1 (B tau + a lam)`` with ``a . qdd = 0`` (the lock's share: ``lam = -a M^-1
         B tau / (a M^-1 a)``; the same as ``[S^T M; a] qdd = [S^T B tau; 0]``, ``S`` a
-        basis of the constraint's null space, :mod:`walkerlab.codegen.symbolic`)."""
-        M = self.fns["matrices"](x)[0]
+        basis of the constraint's null space, :mod:`walkerlab.codegen.symbolic`).  ``M``
+        (n, n): the mass matrix of the phase (default: the generated ``matrices``')."""
+        M = self.fns["matrices"](x)[0] if M is None else M
         acc = np.linalg.solve(M, self.generalised_force(t, x))
         if constraint is None:
             return acc
