@@ -64,12 +64,19 @@ class PhasedResult:
 
 def phased_guess(walker, x0, period_s: float, solver, intervals: int):
     """One step of the rigid ``walker`` from the post-impact state ``x0`` (2n,), each
-    phase sampled on its own mesh: ``2 N_p + 1`` evenly spaced points, ``N_p`` the share
-    of ``intervals`` by the phase's duration (at least 3).
+    phase sampled on its own mesh of ``N_p`` intervals (their mid-points halfway), the
+    ``intervals`` shared among the phases and placed within each by
+    :func:`mesh_density` (at least 3 a phase): Hermite-Simpson's error per interval,
+    ``~ h^5 |x^(5)|``, is then about the same in every interval (de Boor's equidistribution;
+    Betts 2010, Ch. 4.7), so a fast transient (a flat foot's ankle after heel strike) gets
+    short intervals and a slow phase long ones.
 
     Returns
     -------
-    list of (name, t (2 N_p + 1,) [s from the phase's start], x (2 N_p + 1, 2n))
+    guess : list of (name, t (2 N_p + 1,) [s from the phase's start], x (2 N_p + 1, 2n))
+    phase_log : list
+        The step's :attr:`walkerlab.integrate.rigid.Segment.phase_log` (its phase
+        sequence: :func:`walkerlab.optimal.phases.phase_order`).
 
     Raises
     ------
@@ -82,48 +89,92 @@ def phased_guess(walker, x0, period_s: float, solver, intervals: int):
     seg = simulate_steps(walker, x0, 1, solver, max_step_time=3.0 * period_s).segments[0]
     if seg.termination != "heel_strike":
         raise ValueError(f"optimize: the starting gait does not make a step ({seg.termination})")
-    total = seg.t_end - seg.t_start
+    dens = [mesh_density(ph, sol, a, b, x0.size) for ph, sol, (a, b) in seg.pieces]
+    total = sum(c[-1] for _t, c in dens)
     out = []
-    for ph, sol, (a, b) in seg.pieces:
-        N = max(3, int(round(intervals * (b - a) / total)))
-        t = np.linspace(a, b, 2 * N + 1)
+    for (ph, sol, (a, b)), (tf, cum) in zip(seg.pieces, dens):
+        # half by the density, half by the duration (the density alone starves a slow phase
+        # whose errors the resets carry on: the kneed walker's locked swing)
+        cum = 0.5 * cum / total + 0.5 * (tf - tf[0]) / (seg.t_end - seg.t_start)
+        N = max(3, int(round(intervals * cum[-1])))
+        ends = np.interp(np.linspace(0.0, cum[-1], N + 1), cum, tf)
+        t = np.empty(2 * N + 1)
+        t[0::2], t[1::2] = ends, 0.5 * (ends[:-1] + ends[1:])
+        t[0], t[-1] = a, b
         out.append((ph.name, t - a, np.asarray(sol(t), float)[:x0.size].T))
-    return out
+    return out, seg.phase_log
 
 
-def _simpson(h, values):
-    """Simpson's rule on the 2N + 1 points of one phase (``values`` (1, 2N + 1))."""
+def mesh_density(phase, sol, a: float, b: float, n2: int, samples: int = 401):
+    """The cumulative mesh density of a phase on ``[a, b]`` [s]: ``int rho dt`` with
+    ``rho = max_i |x_i^(5)|^(1/5)`` (the fifth derivative from the phase's flow ``f``
+    along the dense output ``sol``, differentiated four times by finite differences on
+    ``samples`` points; within 1/40 of the ends, where the differences are one-sided, the
+    nearest value inside), floored at a tenth of its mean (no interval starves).
+
+    Returns
+    -------
+    t : ndarray (samples,) [s]
+    cum : ndarray (samples,)
+        ``int_a^t rho``, increasing, ``cum[0] = 0``.
+    """
+    from scipy.integrate import cumulative_trapezoid
+
+    t = np.linspace(a, b, samples)
+    x = np.asarray(sol(t), float)[:n2]
+    d = np.stack([np.asarray(phase.flow(tk, x[:, k]), float) for k, tk in enumerate(t)], 1)
+    for _ in range(4):
+        d = np.gradient(d, t, axis=1) if b > a else d
+    rho = np.max(np.abs(d), axis=0) ** 0.2
+    edge = max(1, samples // 40)  # one-sided differences at the ends: their nearest inside
+    rho[:edge], rho[-edge:] = rho[edge], rho[-edge - 1]
+    rho = np.maximum(rho, 0.1 * max(rho.mean(), 1e-300)) + 1e-300
+    return t, cumulative_trapezoid(rho, t, initial=0.0)
+
+
+def _simpson(T, tau, values):
+    """Simpson's rule on the 2N + 1 points ``T tau`` of one phase (``values`` (1, 2N + 1),
+    ``tau`` (2N + 1,) from 0 to 1, mid-points halfway)."""
     import casadi as ca
 
     K = values.shape[1]
-    w = np.concatenate([[1.0], np.tile([4.0, 2.0], (K - 1) // 2)[:K - 2], [1.0]])
-    return h / 6 * ca.sum2(ca.DM(w).T * values)
+    w = np.zeros(K)
+    for i in range(0, K - 1, 2):
+        dt = tau[i + 2] - tau[i]
+        w[i] += dt / 6
+        w[i + 1] += 4 * dt / 6
+        w[i + 2] += dt / 6
+    return T * ca.sum2(ca.DM(w).T * values)
 
 
-def _phase(opti, mp, spec, X, U, T, first: bool, last: bool, fns):
-    """One phase's defects, its guard at the end (transversal) and inside (its sign)."""
+def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
+    """One phase's defects (on the mesh ``T tau``), its guard at the end (transversal) and
+    inside (its sign), its unilateral contacts and the path constraints."""
     K = X.shape[1]
-    h = T / ((K - 1) // 2)
     f = [mp.flow(X[:, k], U[k]) for k in range(K)]
     for i in range(0, K - 1, 2):
         m, j = i + 1, i + 2
+        h = T * (tau[j] - tau[i])
         opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (f[i] - f[j]))
         opti.subject_to(X[:, j] == X[:, i] + h / 6 * (f[i] + 4 * f[m] + f[j]))
     d = mp.direction
-    opti.subject_to(mp.guard(X[:, -1]) == 0)
+    opti.subject_to(mp.guard(X[:, -1], U[-1]) == 0)
     opti.subject_to(d * mp.guard_rate(X[:, -1], U[-1]) >= spec.touchdown_rate_rad_per_s)
     for k in range(1, K - 1):  # the event has not happened inside the phase
-        opti.subject_to(d * mp.guard(X[:, k]) <= 0)
+        opti.subject_to(d * mp.guard(X[:, k], U[k]) <= 0)
+    if mp.keep is not None:  # unilateral contacts push
+        for k in range(K):
+            opti.subject_to(mp.keep(X[:, k], U[k]) >= 0)
     if spec.min_clearance_m is not None:
         for k in range(1 if first else 0, K - 1 if last else K):
-            opti.subject_to(fns["clearance"](X[:, k]) >= spec.min_clearance_m)
+            opti.subject_to(mp.clearance(X[:, k]) >= spec.min_clearance_m)
     if spec.hip_angle_range_rad is not None:
         lo, hi = spec.hip_angle_range_rad
         for k in range(K):
             opti.subject_to(opti.bounded(lo, fns["hip_angle"](X[:, k]), hi))
     if spec.max_torque_n_m is not None:
         opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
-    return _simpson(h, U ** 2)
+    return _simpson(T, tau, U ** 2)
 
 
 def _check(spec) -> None:
@@ -177,8 +228,10 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
     Us = [opti.variable(1, g[1].size) for g in guess]
     Ts = [opti.variable() for _ in guess]
     effort = 0
+    taus = [np.asarray(g[1], float) / float(g[1][-1]) for g in guess]
     for p, mp in enumerate(phases):
-        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], p == 0, p == P - 1, fns)
+        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], p == 0,
+                                 p == P - 1, fns)
         nxt = Xs[p + 1][:, 0] if p + 1 < P else Xs[0][:, 0]
         opti.subject_to(nxt == mp.reset(Xs[p][:, -1]))
         Tg = float(guess[p][1][-1])
@@ -188,7 +241,7 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
         opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)))
     opti.subject_to(fns["ahead"](Xs[-1][:, -1]) >= 1e-3)
     period = sum(Ts[1:], Ts[0])
-    target_constraints(opti, spec, period, fns["step"](Xs[-1][:, -1]))
+    target_constraints(opti, spec, period, phases[-1].step(Xs[-1][:, -1]))
     U = ca.horzcat(*Us)
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     if "peak_torque" in asked:
@@ -204,10 +257,10 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
                 {"print_level": 0, "tol": 1e-12, "acceptable_tol": 1e-10, "max_iter": 500,
                  "sb": "yes"})
     build = time.perf_counter() - t_build
-    return _solve(opti, Xs, Us, Ts, obj, terms, fns, [p.name for p in phases], build)
+    return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build)
 
 
-def _solve(opti, Xs, Us, Ts, obj, terms, fns, names, build) -> PhasedResult:
+def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResult:
     """Run IPOPT and read the phases back as one step."""
     t0, c0 = time.perf_counter(), os.times()
     try:
@@ -219,10 +272,10 @@ def _solve(opti, Xs, Us, Ts, obj, terms, fns, names, build) -> PhasedResult:
     wall, cpu = time.perf_counter() - t0, (c1.user - c0.user) + (c1.system - c0.system)
     n2 = Xs[0].shape[0]
     ts, xs, us, starts, durs, offset = [], [], [], [], [], 0.0
-    for X, U, T in zip(Xs, Us, Ts):
+    for X, U, T, tau in zip(Xs, Us, Ts, taus):
         Tv, K = float(get(T)), X.shape[1]
         starts.append(sum(len(a) for a in ts))
-        ts.append(offset + np.linspace(0.0, Tv, K))
+        ts.append(offset + Tv * tau)
         xs.append(np.asarray(get(X)).reshape(n2, K).T)
         us.append(np.asarray(get(U)).ravel())
         durs.append(Tv)
@@ -231,7 +284,7 @@ def _solve(opti, Xs, Us, Ts, obj, terms, fns, names, build) -> PhasedResult:
     return PhasedResult(
         t=np.concatenate(ts), x=x, u=np.concatenate(us), phase_names=tuple(names),
         phase_start=np.array(starts), phase_duration_s=np.array(durs), step_period_s=offset,
-        step_length_m=float(fns["step"](x[-1])), objective=float(get(obj)), status=status,
+        step_length_m=float(fns["phases"][-1].step(x[-1])), objective=float(get(obj)), status=status,
         iterations=int(opti.stats().get("iter_count", -1)), build_time_s=build,
         wall_time_s=wall, cpu_time_s=cpu, terms={k: float(get(v)) for k, v in terms.items()})
 
@@ -247,7 +300,8 @@ def phase_torque_of_time(res: PhasedResult):
         s = min(max(float(s), 0.0), float(ends[-1]))
         p = min(int(np.searchsorted(ends, s)), len(ends) - 1)
         t, u = res.t[bounds[p]:bounds[p + 1]], res.u[bounds[p]:bounds[p + 1]]
-        i = min(int((s - t[0]) / (t[2] - t[0])), (len(t) - 3) // 2) * 2
+        i = min(int(np.searchsorted(t[0::2], s, side="right")) - 1, (len(t) - 3) // 2) * 2
+        i = max(i, 0)
         ti, tm, tj = t[i], t[i + 1], t[i + 2]
         return float(u[i] * (s - tm) * (s - tj) / ((ti - tm) * (ti - tj))
                      + u[i + 1] * (s - ti) * (s - tj) / ((tm - ti) * (tm - tj))

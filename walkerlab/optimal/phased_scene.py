@@ -39,7 +39,6 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     """
     import time
 
-    from walkerlab.codegen import symbolic
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
@@ -48,18 +47,18 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
         phased_guess,
         replay_phases,
     )
-    from walkerlab.optimal.phases import mode_functions
+    from walkerlab.optimal.phases import mode_functions, phase_order
 
     o = scene.optimize
     if o.initial_guess is not None:
         raise ValueError("optimize.initial_guess: a walker with phases starts from its own "
                          "gait today")
     walker = make_rigid_walker(data)
+    guess, log = phased_guess(walker, x_gait, period_s, Solver.from_settings(scene.solver),
+                              spec.intervals)
     t0 = time.perf_counter()
-    fns = mode_functions(data, symbolic.derive(data.structure), walker)
+    fns = mode_functions(data, walker, phase_order(walker, log))
     build = time.perf_counter() - t0
-    guess = phased_guess(walker, x_gait, period_s, Solver.from_settings(scene.solver),
-                         spec.intervals)
     res = collocate_phases(fns, spec, guess)
     err, replayed = replay_phases(data, res)
     mu = _multipliers(replayed, res, scene, err)

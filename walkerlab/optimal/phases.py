@@ -43,19 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PHASE_FLOWS", "PHASE_GUARDS", "ModePhase", "mode_functions", "phase_order"]
-
-#: the symbolic flow of each rigid phase: ``(equations, lock)`` - ``free`` (``M, C, G``) or
-#: ``locked`` (``Equations.locked``), ``lock`` the generated guard whose gradient the lock
-#: holds (None: unconstrained)
-PHASE_FLOWS = {"unlocked_swing": ("free", None), "locked_swing": ("locked", "knee_extension"),
-               "early_swing": ("free", None), "late_swing": ("free", None)}
-#: the symbolic guard and reset of each rigid guard that ends a phase: ``(generated guard,
-#: reset)``, the reset ``knee`` (plastic knee strike), ``heel`` (heel strike + role swap) or
-#: None (no jump)
-PHASE_GUARDS = {"knee_strike": ("knee_extension", "knee"), "heel_strike": ("heel_strike", "heel"),
-                "midstance": ("swing_foot_ahead", None)}
-
+__all__ = ["ModePhase", "mode_functions", "phase_order"]
 
 @dataclass(frozen=True)
 class ModePhase:
@@ -76,6 +64,12 @@ class ModePhase:
     reset : casadi.Function
         ``x -> x+`` at the guard (identity when it has none; the last phase's: heel strike
         with the role swap).
+    keep : casadi.Function or None
+        ``(x, u) -> v``: kept ``>= 0`` at every point of the phase (a unilateral contact's
+        normal forces [N]: flat feet); None: nothing.
+    clearance, step : casadi.Function
+        ``x ->`` the swing foot's height above the slope [m] and its distance from the
+        stance reference point [m] in the phase's kinematics.
     """
 
     name: str
@@ -85,121 +79,269 @@ class ModePhase:
     guard: object
     guard_rate: object
     reset: object
+    keep: object = None
+    clearance: object = None
+    step: object = None
 
 
-def phase_order(walker) -> list[tuple[str, str, int]]:
+def phase_order(walker, phase_log=None) -> list[tuple[str, str, int]]:
     """The step's phases of a rigid walker in order: ``(phase, guard ending it, its
-    direction)``, following each phase's guard that does not end in a fall to the next
-    phase (its ``next_phase``, else the next in order) until the heel strike.
+    direction)``.  With ``phase_log`` (a step's
+    :attr:`walkerlab.integrate.rigid.Segment.phase_log`: a flat foot's modes form a graph,
+    its gait goes one way through it) the sequence that step met; else, following each
+    phase's one guard that does not end in a fall to the next phase (its ``next_phase``,
+    else the next in order) until the heel strike.
 
     Raises
     ------
     ValueError
-        A phase with no such guard, or one with several (the step's phase sequence is not
-        fixed: a flat foot's mode graph), or a loop (one line).
+        Without ``phase_log``, a phase with no such guard or several (no fixed sequence),
+        or a loop; a logged guard the phase does not have (one line).
     """
-    by_name = {ph.name: k for k, ph in enumerate(walker.phases)}
+    by_name = {ph.name: ph for ph in walker.phases}
+    if phase_log is not None:
+        out = []
+        for name, _t0, _t1, ended in phase_log:
+            g = next((g for g in by_name[name].guards if g.name == ended
+                      and g.outcome != "fall"), None)
+            if g is None:
+                raise ValueError(f"optimize: the starting step's phase {name} ended by "
+                                 f"{ended!r}, not a step of the gait")
+            out.append((name, g.name, int(g.direction)))
+        return out
     out, k = [], 0
     while len(out) <= len(walker.phases):
         ph = walker.phases[k]
         ends = [g for g in ph.guards if g.outcome != "fall"]
         if len(ends) != 1:
             raise ValueError(f"optimize: the phase {ph.name} ends {len(ends)} ways: the step "
-                             "has no fixed phase sequence (not yet)")
+                             "has no fixed phase sequence (give the gait's)")
         g = ends[0]
         out.append((ph.name, g.name, int(g.direction)))
         if g.outcome == "heel_strike":
             return out
-        k = by_name[g.next_phase] if g.next_phase else k + 1
+        k = [p.name for p in walker.phases].index(g.next_phase) if g.next_phase else k + 1
     raise ValueError("optimize: the step's phases loop without a heel strike")
 
 
-def _hip_gradient(eq):
-    """The hip angle (swing thigh minus stance thigh; straight legs: swing minus stance)."""
-    la = eq.leg_angles
-    sw, st = ("swing_thigh", "stance_thigh") if "swing_thigh" in la else ("swing", "stance")
-    return la[sw] - la[st]
-
-
-def mode_functions(data, eq, walker) -> dict:
+def mode_functions(data, walker, order=None) -> dict:
     """CasADi functions of the step of ``data``'s walker (module docstring) from its
-    symbolic equations ``eq``, in the phase order of its rigid model ``walker``:
-    ``phases`` (list of :class:`ModePhase`), ``step(x)`` (the feet's distance [m]),
-    ``ahead(x)`` (> 0: the swing foot ahead), ``clearance(x)`` (the swing foot above the
-    slope [m]), ``hip_angle(x)`` [rad], ``power(x, u)`` [W], ``n``.
+    symbolic equations, in the phase order ``order`` (:func:`phase_order`; default: the
+    rigid model ``walker``'s fixed one): ``phases`` (list of :class:`ModePhase`),
+    ``ahead(x)`` (> 0: the swing foot ahead), ``hip_angle(x)`` [rad], ``n``.
 
     Raises
     ------
     ValueError
-        A phase or guard this transcription has no symbolic form for, massless legs, a
-        torso (one line).
+        A walker or phase this transcription has no symbolic form for (massless legs, a
+        torso, arc feet, free knees; one line).
     """
     import casadi as ca
-    import sympy as sp
-
-    from walkerlab.optimal.collocation import _to_casadi
 
     st = data.structure
-    if eq.limit or st.torso or st.free_knees or st.foot != "point":
+    if st.torso or st.free_knees or st.foot == "arc" or any(b.massless for b in st.bodies):
         raise ValueError("optimize: the phased transcription takes massive legs with point "
-                         "feet and no torso today")
-    order = phase_order(walker)
-    n = len(eq.q)
-    vals = dict(zip(eq.params, data.params))
-    xs = list(eq.q) + list(eq.dq)
+                         "or flat feet and no torso today")
+    order = order if order is not None else phase_order(walker)
+    kind = _FlatModes(data) if st.foot == "flat" else _KneedModes(data)
+    n = kind.n
     x, u = ca.SX.sym("x", 2 * n), ca.SX.sym("u")
-
-    def cas(exprs):
-        return _to_casadi(exprs, xs, vals)(x)
-    hip = _hip_gradient(eq)
-    Bu = cas(sp.Matrix([hip]).jacobian(eq.q).T) * u
-    M = cas(eq.M)
-    acc = ca.solve(M, Bu)
     phases = []
     for name, gname, direction in order:
-        if name not in PHASE_FLOWS or gname not in PHASE_GUARDS:
-            raise ValueError(f"optimize: no symbolic form of the phase {name} / guard {gname}")
-        kind, lock = PHASE_FLOWS[name]
-        Mp, Cp, Gp = (eq.M, eq.C, eq.G) if kind == "free" else eq.locked
-        qdd = ca.solve(cas(Mp), -cas(Cp) @ x[n:] - cas(Gp))
-        if lock is None:
-            qdd = qdd + acc
-        else:  # the torque's share along the lock is taken by it
-            a = cas(sp.Matrix([eq.guards[lock]]).jacobian(eq.q).T)
-            Ma = ca.solve(M, a)
-            qdd = qdd + acc - Ma * (a.T @ acc) / (a.T @ Ma)
-        f = ca.vertcat(x[n:], qdd)
-        gkey, rkind = PHASE_GUARDS[gname]
-        g = cas([eq.guards[gkey]])
+        f = kind.flow(name, x, u)
+        g = kind.guard(name, gname, x, f)
         phases.append(ModePhase(
-            name, gname, direction, ca.Function(f"flow_{name}", [x, u], [f]),
-            ca.Function(f"guard_{gname}", [x], [g]),
-            ca.Function(f"rate_{gname}", [x, u], [ca.jacobian(g, x) @ f]),
-            ca.Function(f"reset_{gname}", [x], [_reset(eq, rkind, cas, x, n, vals)])))
-    foot = cas(eq.points["swing_foot"])
-    hip_angle = cas([hip])
+            name, gname, direction, ca.Function(f"flow_{len(phases)}", [x, u], [f]),
+            ca.Function(f"guard_{len(phases)}", [x, u], [g]),
+            ca.Function(f"rate_{len(phases)}", [x, u], [ca.jacobian(g, x) @ f]),
+            ca.Function(f"reset_{len(phases)}", [x], [kind.reset(name, gname, x)]),
+            keep=kind.keep(name, x, f, u),
+            clearance=ca.Function("clearance", [x], [kind.clearance(name, x)]),
+            step=ca.Function("step", [x], [kind.step(name, x)])))
     return {"phases": phases, "n": n,
-            "step": ca.Function("step", [x], [ca.sqrt(foot[0] ** 2 + foot[1] ** 2)]),
-            "ahead": ca.Function("ahead", [x], [cas([eq.guards["swing_foot_ahead"]])]),
-            "clearance": ca.Function("clearance", [x], [cas([eq.guards["swing_clearance"]])]),
-            "hip_angle": ca.Function("hip_angle", [x], [hip_angle]),
-            "power": ca.Function("power", [x, u], [u * ca.jacobian(hip_angle, x[:n])
-                                                   @ x[n:]])}
+            "ahead": ca.Function("ahead", [x], [kind.cas([kind.guards["swing_foot_ahead"]],
+                                                         x)]),
+            "hip_angle": ca.Function("hip_angle", [x], [kind.cas([kind.hip], x)])}
 
 
-def _reset(eq, kind, cas, x, n, vals):
-    """The reset of a guard (CasADi): ``knee`` ``Mk dq+ = Bk dq-`` with the shank's angle
-    set to the thigh's (:mod:`walkerlab.codegen.source`'s ``knee_reset``), ``heel``
-    ``Mi dq+ = B dq-`` and the role swap, None the identity."""
-    import casadi as ca
-    import sympy as sp
+class _Modes:
+    """The symbolic pieces of a walker's phases, in CasADi (subclasses name them)."""
 
-    if kind is None:
+    def __init__(self, data, eq, q, dq, params, leg_angles):
+        self.vals = dict(zip(params, data.params))
+        self.xs = list(q) + list(dq)
+        self.q, self.n = list(q), len(q)
+        sw, st = ("swing_thigh", "stance_thigh") if "swing_thigh" in leg_angles \
+            else ("swing", "stance")
+        key = "" if sw in leg_angles else "_angle"
+        self.hip = leg_angles[sw + key] - leg_angles[st + key]
+
+    def cas(self, exprs, x, extra=(), values=()):
+        """The sympy ``exprs`` at the CasADi state ``x`` (and ``extra`` symbols at
+        ``values``)."""
+        import casadi as ca
+
+        from walkerlab.optimal.collocation import _to_casadi
+
+        args = x if not extra else ca.vertcat(x, *values)
+        return _to_casadi(exprs, self.xs + list(extra), self.vals)(args)
+
+    def accel(self, M, C, G, Mfree, lock, x, u):
+        """``qdd`` of ``M qdd = -C dq - G`` plus the hip torque's ``Mfree^-1 B u`` (through
+        the lock ``a . qdd = 0`` when ``lock``, a sympy expression, is given)."""
+        import casadi as ca
+        import sympy as sp
+
+        n = self.n
+        qdd = ca.solve(self.cas(M, x), -self.cas(C, x) @ x[n:] - self.cas(G, x))
+        Mf = self.cas(Mfree, x)
+        acc = ca.solve(Mf, self.cas(sp.Matrix([self.hip]).jacobian(self.q).T, x) * u)
+        if lock is not None:  # the torque's share along the lock is taken by it
+            a = self.cas(sp.Matrix([lock]).jacobian(self.q).T, x)
+            Ma = ca.solve(Mf, a)
+            acc = acc - Ma * (a.T @ acc) / (a.T @ Ma)
+        return ca.vertcat(x[n:], qdd + acc)
+
+    def impact(self, sys_, x):
+        """``Mi dq+ = B dq-`` then ``q_new = relabel_q``, ``dq_new = relabel_rate dq+``."""
+        import casadi as ca
+
+        n = self.n
+        dq_plus = ca.solve(self.cas(sys_.Mi, x), self.cas(sys_.B, x) @ x[n:])
+        R = np.array(sys_.relabel_rate.subs(self.vals), float)
+        return ca.vertcat(self.cas(sys_.relabel_q, x), ca.DM(R) @ dq_plus)
+
+    def keep(self, name, x, f, u):
+        return None
+
+
+class _KneedModes(_Modes):
+    """A kneed walker (or straight legs): ``unlocked_swing`` / ``early_swing`` /
+    ``late_swing`` on the free flow, ``locked_swing`` on the locked one; ``knee_strike``
+    (the plastic knee strike), ``midstance`` (no jump), ``heel_strike``."""
+
+    def __init__(self, data):
+        from walkerlab.codegen import symbolic
+
+        eq = symbolic.derive(data.structure)
+        super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)
+        self.eq, self.guards = eq, eq.guards
+
+    def flow(self, name, x, u):
+        eq = self.eq
+        if name == "locked_swing":
+            return self.accel(*eq.locked, eq.M, eq.guards["knee_extension"], x, u)
+        if name in ("unlocked_swing", "early_swing", "late_swing"):
+            return self.accel(eq.M, eq.C, eq.G, eq.M, None, x, u)
+        raise ValueError(f"optimize: no symbolic form of the phase {name}")
+
+    def guard(self, name, gname, x, f):
+        key = {"knee_strike": "knee_extension", "heel_strike": "heel_strike",
+               "midstance": "swing_foot_ahead"}.get(gname)
+        if key is None:
+            raise ValueError(f"optimize: no symbolic form of the guard {gname}")
+        return self.cas([self.eq.guards[key]], x)
+
+    def reset(self, name, gname, x):
+        import sympy as sp
+
+        eq, n = self.eq, self.n
+        if gname == "knee_strike":  # the shank's angle set to the thigh's, dq+ from Mk, Bk
+            Mk, Bk = eq.knee_impact
+            lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, n))])
+            return self.impact(_Impact(Mk, Bk, lock, sp.eye(n)), x)
+        if gname == "heel_strike":
+            return self.impact(_Impact(eq.Mi, eq.B, eq.relabel_q, eq.relabel_rate), x)
         return x
-    if kind == "knee":
-        Mk, Bk = eq.knee_impact
-        q_lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, n))])
-        return ca.vertcat(cas(q_lock), ca.solve(cas(Mk), cas(Bk) @ x[n:]))
-    dq_plus = ca.solve(cas(eq.Mi), cas(eq.B) @ x[n:])
-    R = np.array(eq.relabel_rate.subs(vals), float)
-    return ca.vertcat(cas(eq.relabel_q), ca.DM(R) @ dq_plus)
+
+    def clearance(self, name, x):
+        return self.cas([self.eq.guards["swing_clearance"]], x)
+
+    def step(self, name, x):
+        import casadi as ca
+
+        foot = self.cas(self.eq.points["swing_foot"], x)
+        return ca.sqrt(foot[0] ** 2 + foot[1] ** 2)
+
+
+class _FlatModes(_Modes):
+    """Flat feet (:mod:`walkerlab.codegen.flatfoot`): phases ``<mode>:<swing part>`` on the
+    mode's flow (foot flat: the locked one, the lock ``phi = stance + ankle + gamma``);
+    ``foot_slap`` (plastic), ``midstance`` (no jump), ``heel_off`` (the heel's normal force
+    ``N - N_toe`` from the mode's accelerations; no jump), ``heel_strike`` (the mode's own
+    map); the stance contacts' normal forces kept ``>= 0``."""
+
+    PIN = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
+
+    def __init__(self, data):
+        from walkerlab.codegen.flatfoot import derive_flat
+
+        eq = derive_flat(data.structure)
+        super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)
+        self.eq, self.guards = eq, eq.guards
+
+    def _mode(self, name):
+        mode = name.split(":", 1)[0]
+        if mode not in self.PIN:
+            raise ValueError(f"optimize: no symbolic form of the phase {name}")
+        return mode, self.PIN[mode]
+
+    def flow(self, name, x, u):
+        mode, pin = self._mode(name)
+        fl = self.eq.flows[mode]
+        free = self.eq.flows["heel_off" if pin == "toe" else "heel_contact"].M
+        lock = self.eq.guards["foot_angle"] if mode == "foot_flat" else None
+        return self.accel(fl.M, fl.C, fl.G, free, lock, x, u)
+
+    def forces(self, name, x, f):
+        """The stance contacts' normal forces [N] in the phase (heel pinned: ``N, N_toe``;
+        toe: ``N``) from the phase's accelerations ``f[n:]``."""
+        _mode, pin = self._mode(name)
+        return self.cas(self.eq.ground[pin], x, self.eq.qdd, [f[self.n:]])
+
+    def guard(self, name, gname, x, f):
+        _mode, pin = self._mode(name)
+        if gname == "heel_off":
+            N = self.forces(name, x, f)
+            return N[0] - N[1]
+        key = {"foot_slap": "foot_angle", "midstance": "swing_foot_ahead",
+               "heel_strike": f"swing_heel_height_{pin}"}.get(gname)
+        if key is None:
+            raise ValueError(f"optimize: no symbolic form of the guard {gname}")
+        return self.cas([self.eq.guards[key]], x)
+
+    def reset(self, name, gname, x):
+        _mode, pin = self._mode(name)
+        if gname == "foot_slap":
+            return self.impact(self.eq.resets["foot_slap"], x)
+        if gname == "heel_strike":
+            return self.impact(self.eq.resets[f"heel_strike_{pin}"], x)
+        return x
+
+    def keep(self, name, x, f, u):
+        import casadi as ca
+
+        mode, _pin = self._mode(name)
+        N = self.forces(name, x, f)
+        # heel contact / heel off: the pinned point's; foot flat: the toe's (the heel's is
+        # the heel-off guard, kept by its sign inside the phase)
+        return ca.Function("keep", [x, u], [N[1] if mode == "foot_flat" else N[0]])
+
+    def clearance(self, name, x):
+        return self.cas([self.eq.guards[f"swing_heel_height_{self._mode(name)[1]}"]], x)
+
+    def step(self, name, x):
+        import casadi as ca
+
+        foot = self.cas(self.eq.kinematics[self._mode(name)[1]]["points"]["swing_foot"], x)
+        return ca.sqrt(foot[0] ** 2 + foot[1] ** 2)
+
+
+@dataclass(frozen=True)
+class _Impact:
+    """A plastic impact ``Mi dq+ = B dq-`` and the coordinates after it (sympy)."""
+
+    Mi: object
+    B: object
+    relabel_q: object
+    relabel_rate: object
