@@ -1,9 +1,11 @@
-"""A walker whose step is a fixed sequence of phases (the kneed walker of configs/kneed.yaml:
-unlocked swing, knee strike, locked swing, heel strike) optimised by multi-phase direct
-collocation (``walkerlab.optimal.phases`` / ``phased_collocation``): its CasADi phases are
-the rigid model's, a hip torque acts through the locked knee without unlocking it and its
-power is the energy's rate, and its least-effort gait on its slope is its passive gait
-(found independently by shooting, ``fixedpoint``)."""
+"""Walkers whose step is a sequence of phases optimised by multi-phase direct collocation
+(``walkerlab.optimal.phases`` / ``phased_collocation``): the kneed walker of
+configs/kneed.yaml (unlocked swing, knee strike, locked swing, heel strike) and the flat
+feet of configs/flat_feet.yaml (heel contact, foot slap, foot flat, mid-stance, heel off,
+heel strike).  Their CasADi phases are the rigid model's, a hip torque acts through a lock
+(the knee, the flat foot) without breaking it and its power is the energy's rate, and each
+walker's least-effort gait on its slope is its passive gait (found independently by
+shooting, ``fixedpoint``)."""
 
 from __future__ import annotations
 
@@ -12,7 +14,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
 from walkerlab.models.hybrid.actuated import actuate
@@ -71,7 +72,7 @@ def test_the_casadi_phases_are_the_rigid_models(kneed):
     _, data, walker = kneed
     assert phase_order(walker) == [("unlocked_swing", "knee_strike", 1),
                                    ("locked_swing", "heel_strike", -1)]
-    fns = mode_functions(data, symbolic.derive(data.structure), walker)
+    fns = mode_functions(data, walker)
     torqued = _torqued(data, 0.4)
     rng = np.random.default_rng(5)
     for _ in range(5):
@@ -80,7 +81,7 @@ def test_the_casadi_phases_are_the_rigid_models(kneed):
             g = next(g for g in ph.guards if g.outcome != "fall")
             np.testing.assert_allclose(mp.flow(x, 0.4).full().ravel(), tph.flow(0.0, x),
                                        rtol=0, atol=1e-12)
-            assert float(mp.guard(x)) == pytest.approx(g.function(0.0, x), abs=1e-14)
+            assert float(mp.guard(x, 0.0)) == pytest.approx(g.function(0.0, x), abs=1e-14)
             reset = g.reset or walker.reset
             np.testing.assert_allclose(mp.reset(x).full().ravel(), reset(x), rtol=0, atol=1e-12)
 
@@ -93,12 +94,85 @@ def test_a_mode_graph_without_a_fixed_sequence_is_refused_in_one_line():
         phase_order(build_walker(load_scene(CONFIGS / "flat_feet.yaml")))
 
 
-def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed):
-    """int u^2 dt = 0 at the passive gait, so the optimum is it (from a guess 5 % off it):
-    objective <= 1e-10, the step period within 1e-7 (relative) of the shooting fixed
-    point's (60 intervals shared 40 / 20 by the phases: 1.5e-8 seen; O(h^4): 1.0e-6 with
-    20, 7.7e-8 with 40), the knee strike at the passive gait's time, and the replay on the
-    rigid model (its own guards and resets) closing to 1e-6."""
+#: the flat-footed passive gait's phases (configs/flat_feet.yaml's note): the sequence
+#: through its mode graph, each ended by its guard (direction as solve_ivp's events)
+FLAT_ORDER = [("heel_contact:early_swing", "foot_slap", -1),
+              ("foot_flat:early_swing", "midstance", 1),
+              ("foot_flat:late_swing", "heel_off", -1),
+              ("heel_off:late_swing", "heel_strike", -1)]
+
+
+@pytest.fixture(scope="module")
+def flat():
+    scene = load_scene(CONFIGS / "flat_feet_optimal.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    return scene, data, make_rigid_walker(data)
+
+
+@pytest.mark.slow
+def test_the_flat_feet_phases_are_the_rigid_models(flat):
+    """The phase order read from a step's log; each phase's CasADi flow (with a hip torque)
+    against the actuated rigid model's, its guard against the rigid guard (heel off: the
+    heel's normal force through the actuated flow), its reset against the generated one, at
+    states near the gait (1e-12 relative: round-off).  ~12 s under load (the flat feet's
+    symbolic modes and ground forces built into CasADi)."""
+    from walkerlab.optimal.phases import mode_functions, phase_order
+
+    _, data, walker = flat
+    log = [(n, 0.0, 0.0, g) for n, g, _d in FLAT_ORDER]
+    assert phase_order(walker, log) == FLAT_ORDER
+    fns = mode_functions(data, walker, FLAT_ORDER)
+    u = 0.4
+    torqued = {ph.name: ph for ph in _torqued(data, u).phases}
+    rng = np.random.default_rng(7)
+    x0 = np.array([-0.3, 0.2, -0.05, -1.3, -1.2, 1.2])
+    for _ in range(4):
+        x = x0 + rng.normal(0.0, 0.03, 6)
+        for mp in fns["phases"]:
+            ph = torqued[mp.name]
+            g = next(g for g in ph.guards if g.name == mp.guard_name)
+            want = ph.flow(0.0, x)
+            np.testing.assert_allclose(mp.flow(x, u).full().ravel(), want, rtol=1e-12,
+                                       atol=1e-12 * np.abs(want).max())
+            assert float(mp.guard(x, u)) == pytest.approx(g.function(0.0, x), rel=1e-11,
+                                                          abs=1e-12)
+            if g.reset is not None:
+                np.testing.assert_allclose(mp.reset(x).full().ravel(), g.reset(x), rtol=0,
+                                           atol=1e-11)
+
+
+def test_a_hip_torque_on_a_flat_foot_keeps_it_flat_and_its_power_is_the_energy_rate(flat):
+    """In every mode the torque adds u d(hip angle)/dt to dE/dt (the lock and the pinned
+    contact do no work; the mode's generated energy, central differences h = 1e-6), and in
+    foot flat the foot's angle does not accelerate (stance + ankle)'' = 0."""
+    from walkerlab.codegen.cache import functions
+
+    _, data, walker = flat
+    u = 0.3
+    f = functions(data)
+    torqued = _torqued(data, u)
+    x = np.array([-0.3, 0.2, -0.2 - data.slope_rad, -1.3, -1.2, 1.2])  # on the foot's lock
+    for ph, passive in zip(torqued.phases[:3], walker.phases[:3]):
+        pin = "toe" if ph.name.startswith("heel_off") else "heel"
+
+        def rate(flow, energies=f[f"energies_{pin}"]):
+            def energy(z):
+                return sum(energies(z).values())
+            return sum((energy(x + 1e-6 * e) - energy(x - 1e-6 * e)) / 2e-6 * fi
+                       for e, fi in zip(np.eye(6), flow))
+        extra = rate(ph.flow(0.0, x)) - rate(passive.flow(0.0, x))
+        assert extra == pytest.approx(u * (x[3] - x[4]), abs=1e-7), ph.name
+    lk = torqued.phases[1].flow(0.0, x)
+    assert lk[4] + lk[5] == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.slow
+def test_the_flat_feet_least_effort_gait_is_their_passive_gait(flat):
+    """As the kneed walker's below, on flat feet through four phases (~15-45 s: 200
+    intervals, half placed by the flow's fifth derivative - heel contact's fast ankle):
+    objective <= 1e-10, the step period within 1e-7 (relative; 5e-9 seen) of the shooting
+    gait's, every contact pushing, the replay closing to 1e-6 (3e-7 seen; 8e-7 with
+    160 intervals, O(h^4))."""
     pytest.importorskip("casadi")
     import walkerlab as wl
     from walkerlab.integrate.solver import Solver
@@ -108,16 +182,46 @@ def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed):
         phased_guess,
         replay_phases,
     )
-    from walkerlab.optimal.phases import mode_functions
+    from walkerlab.optimal.phases import mode_functions, phase_order
+
+    scene, data, walker = flat
+    g = wl.Walker.from_scene(scene).fixed_point()
+    guess, log = phased_guess(walker, g.x, g.step_period, Solver.from_settings(scene.solver),
+                              200)
+    assert phase_order(walker, log) == FLAT_ORDER
+    fns = mode_functions(data, walker, FLAT_ORDER)
+    res = collocate_phases(fns, CollocationSpec(intervals=200), guess)
+    assert res.status == "Solve_Succeeded"
+    assert res.objective <= 1e-10
+    assert res.step_period_s == pytest.approx(g.step_period, rel=1e-7)
+    assert replay_phases(data, res)[0] <= 1e-6
+
+
+def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed):
+    """int u^2 dt = 0 at the passive gait, so the optimum is it (from a guess 5 % off it):
+    objective <= 1e-10, the step period within 1e-7 (relative) of the shooting fixed
+    point's (60 intervals: 4e-8 seen; O(h^4)), the knee strike at the passive gait's
+    time, and the replay on the rigid model (its own guards and resets) closing to
+    1e-6."""
+    pytest.importorskip("casadi")
+    import walkerlab as wl
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.phased_collocation import (
+        collocate_phases,
+        phased_guess,
+        replay_phases,
+    )
+    from walkerlab.optimal.phases import mode_functions, phase_order
 
     scene, data, walker = kneed
     g = wl.Walker.from_scene(scene).fixed_point()
     solver = Solver.from_settings(scene.solver)
-    guess = phased_guess(walker, g.x, g.step_period, solver, 60)
-    assert [x.shape[0] for _, _, x in guess] == [81, 41]
+    guess, log = phased_guess(walker, g.x, g.step_period, solver, 60)
+    assert sum(x.shape[0] - 1 for _, _, x in guess) == 2 * 60
     passive_knee_time = guess[0][1][-1]
     guess = [(name, t, x * 1.05) for name, t, x in guess]
-    fns = mode_functions(data, symbolic.derive(data.structure), walker)
+    fns = mode_functions(data, walker, phase_order(walker, log))
     res = collocate_phases(fns, CollocationSpec(intervals=60), guess)
     assert res.status == "Solve_Succeeded"
     assert res.objective <= 1e-10 and np.max(np.abs(res.u)) < 1e-5
