@@ -1,4 +1,5 @@
-"""A scene's optimal gait when its walker's step is a sequence of phases (a kneed walker):
+"""A scene's optimal gait when its walker's step is a sequence of phases (a kneed walker,
+flat feet):
 the transcription of :mod:`walkerlab.optimal.phased_collocation` set up from the scene,
 started from one step of the scene's gait, replayed on the rigid model, its Floquet
 multipliers from the replay."""
@@ -20,7 +21,8 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     data : WalkerData
         The scene's walker.
     spec : walkerlab.optimal.collocation.CollocationSpec
-        From the ``optimize`` section (``intervals`` shared among the phases by duration).
+        From the ``optimize`` section (``intervals`` shared among the phases:
+        :func:`walkerlab.optimal.phased_collocation.phased_guess`).
     x_gait : ndarray (2n,)
         The scene's gait just after heel strike (``fixedpoint.h5``).
     period_s : float

@@ -1,40 +1,50 @@
 """A periodic gait of a walker with a mode sequence by multi-phase direct collocation
-(CasADi ``Opti`` + IPOPT): one step as the walker's own fixed sequence of phases, each with
-its own free duration and Hermite-Simpson mesh, the guard ending each phase as a
-constraint at its end, the intermediate resets (a knee strike) linking the phases and the
-heel-strike reset as the periodic boundary condition.
+(CasADi ``Opti`` + IPOPT): one step as a fixed sequence of the walker's own phases, each
+with its own free duration and Hermite-Simpson mesh, the guard ending each phase as a
+constraint at its end, the intermediate resets (a knee strike, a foot slap) linking the
+phases and the heel-strike reset as the periodic boundary condition.
 
-Phase order.  Read from the rigid model (:func:`walkerlab.models.hybrid.rigid.
-make_rigid_walker`): from its first phase, the guard that does not end in a fall leads to
-the next phase (through its reset, if any) until the heel strike (:func:`phase_order`).  A
-kneed walker (McGeer 1990, "Passive walking with knees"; Hsu Chen 2007): ``unlocked_swing``
-(three links) until ``knee_strike`` (the knee extension crosses zero upward; plastic knee
-strike), ``locked_swing`` (the knee locked) until ``heel_strike`` (plastic, knee locked;
-roles swap, the new swing knee starts straight).
+Phase order (:func:`phase_order`).  Read from the rigid model
+(:func:`walkerlab.models.hybrid.rigid.make_rigid_walker`): from its first phase, the one
+guard that does not end in a fall leads to the next phase until the heel strike; where the
+phases form a graph (a flat foot's modes crossed with early / late swing), the sequence a
+step of the gait went through (its ``phase_log``).  A kneed walker (McGeer 1990, "Passive
+walking with knees"; Hsu Chen 2007): ``unlocked_swing`` until ``knee_strike`` (the knee's
+extension crosses zero upward; plastic knee strike), ``locked_swing`` until ``heel_strike``
+(plastic, knee locked; roles swap).  Flat feet on ankle springs (Wisse et al. 2006; the
+passive gait of configs/flat_feet.yaml): ``heel_contact:early_swing`` until ``foot_slap``
+(plastic, the foot locks flat), ``foot_flat:early_swing`` until ``midstance`` (no jump),
+``foot_flat:late_swing`` until ``heel_off`` (the heel's normal force reaches 0; no jump),
+``heel_off:late_swing`` until ``heel_strike`` (the toe-pinned map).
 
 Each phase's flow, guard and reset in CasADi come from the walker's symbolic equations
-(:func:`walkerlab.codegen.symbolic.derive`, the same ones its generated code is printed
-from): the free flow ``M qdd = B u - C dq - G``, the locked flow as the square system
-``[S^T M; J_k] qdd = [S^T (-C dq - G); 0]`` with the hip torque's acceleration projected on
-the lock (``M^-1 (B u + a lam)``, ``a . qdd = 0``, ``a`` the lock's gradient; the model
-layer's :meth:`walkerlab.models.hybrid.actuated.Actuators.added_acceleration`), the knee
-strike ``Mk dq+ = Bk dq-`` (the shank's angle set to the thigh's), the heel strike
-``Mi dq+ = B dq-`` then the role swap.  ``B`` is the gradient of the hip angle (swing thigh
-minus stance thigh): ``+u`` on the swing thigh, ``-u`` on the stance leg.
+(:func:`walkerlab.codegen.symbolic.derive`, :func:`walkerlab.codegen.flatfoot.derive_flat`:
+the ones its generated code is printed from): a free flow ``M qdd = B u - C dq - G``; a
+locked one (knee, flat foot) as the square system ``[S^T M; J] qdd = [S^T (-C dq - G); 0]``
+with the hip torque's acceleration projected on the lock (``M^-1 (B u + a lam)``,
+``a . qdd = 0``: the model layer's :meth:`walkerlab.models.hybrid.actuated.Actuators.
+added_acceleration`); a plastic impact ``Mi dq+ = B dq-`` then the new coordinates (the
+heel strike's role swap).  ``B`` is the gradient of the hip angle (swing minus stance
+thigh or leg): ``+u`` on the swing leg, ``-u`` on the stance leg.  A guard on a contact
+force (heel off) reads the ground reaction from the phase's accelerations, torque included;
+flat feet's stance contacts are kept pushing (normal forces ``>= 0``) at every point.
 
-Per phase ``p`` (Kelly 2017, SIAM Review 59(4):849-904, Sec. 4, separated Hermite-Simpson;
-the multi-phase form of Sec. 8 / Betts 2010, Ch. 4.7): ``2 N_p + 1`` points on ``[0, T_p]``,
-the defects of :mod:`walkerlab.optimal.collocation`, and at the phase's end ``guard_p = 0``
-with ``d * guard_p' >= touchdown_rate`` (``d`` the guard's crossing direction: the
-crossing is transversal, as the rigid model's event needs), and the guard's sign kept
-inside the phase (``d * guard_p <= 0`` at its interior points: the event has not happened
-earlier).  Links: ``x_{p+1}(0) = reset_p(x_p(T_p))``; periodic: ``x_0(0) =
-heel_strike(x_last(T_last))``.  Objective: ``int u^2 dt`` (Simpson on every phase) or the
-peak torque (epigraph).  The step period is ``sum T_p``.
+Per phase ``p`` (:mod:`walkerlab.optimal.phased_collocation`; Kelly 2017, SIAM Review
+59(4):849-904, Sec. 4, separated Hermite-Simpson; the multi-phase form of Betts 2010,
+Ch. 4.7): ``2 N_p + 1`` points on ``[0, T_p]``, the defects of
+:mod:`walkerlab.optimal.collocation`, and at the phase's end ``guard_p = 0`` with
+``d * dguard_p/dt >= touchdown_rate`` (``d`` the guard's crossing direction: a transversal
+crossing, as the rigid model's event needs; a force guard's rate leaves out the torque's
+own rate), and the guard's sign kept inside the phase (``d * guard_p <= 0`` at its
+interior points: the event has not happened earlier).  Links: ``x_{p+1}(0) =
+reset_p(x_p(T_p))``; periodic: ``x_0(0) = heel_strike(x_last(T_last))``.  Objective:
+``int u^2 dt`` (Simpson on every phase) or the peak torque (epigraph).  The step period is
+``sum T_p``.
 
 A result is a gait after its replay on the rigid model (its generated code, its own
 guards and resets) with the optimised torque as a function of the time since the heel
-strike (each phase's piecewise quadratic): :func:`replay_phases`.
+strike (each phase's piecewise quadratic): :func:`walkerlab.optimal.phased_collocation.
+replay_phases`.
 """
 
 from __future__ import annotations
