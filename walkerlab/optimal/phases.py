@@ -258,7 +258,8 @@ class _KneedModes(_Modes):
         eq, n = self.eq, self.n
         if gname == "knee_strike":  # the shank's angle set to the thigh's, dq+ from Mk, Bk
             Mk, Bk = eq.knee_impact
-            lock = sp.Matrix([eq.q[j] for j in (0, 0, *range(2, n))])
+            tied = eq.section_tied or {}  # the shank's angle: the thigh's (straight knee)
+            lock = sp.Matrix([eq.q[tied.get(j, j)] for j in range(n)])
             return self.impact(_Impact(Mk, Bk, lock, sp.eye(n)), x)
         if gname == "heel_strike":
             return self.impact(_Impact(eq.Mi, eq.B, eq.relabel_q, eq.relabel_rate), x)
