@@ -30,6 +30,29 @@ def kneed():
     return scene, data, make_rigid_walker(data)
 
 
+@pytest.fixture(scope="module")
+def kneed_start(kneed):
+    """The kneed walker's passive gait (shooting), one step of it on a 60-interval mesh and
+    its CasADi phases (built once for the tests that optimise it)."""
+    pytest.importorskip("casadi")
+    return _start(kneed, 60)
+
+
+def _start(walker_fixture, intervals: int):
+    """(gait, guess, CasADi phases) of a walker with phases: its passive fixed point, one
+    step of it on ``intervals`` and :func:`mode_functions` in that step's phase order."""
+    import walkerlab as wl
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.phased_collocation import phased_guess
+    from walkerlab.optimal.phases import mode_functions, phase_order
+
+    scene, data, walker = walker_fixture
+    g = wl.Walker.from_scene(scene).fixed_point()
+    guess, log = phased_guess(walker, g.x, g.step_period, Solver.from_settings(scene.solver),
+                              intervals)
+    return g, guess, mode_functions(data, walker, phase_order(walker, log))
+
+
 def _torqued(data, u: float):
     """The rigid kneed walker with a constant hip torque ``u`` [N m]."""
     spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(constant_n_m=u),
@@ -197,31 +220,20 @@ def test_the_flat_feet_least_effort_gait_is_their_passive_gait(flat):
     assert replay_phases(data, res)[0] <= 1e-6
 
 
-def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed):
+def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed, kneed_start):
     """int u^2 dt = 0 at the passive gait, so the optimum is it (from a guess 5 % off it):
     objective <= 1e-10, the step period within 1e-7 (relative) of the shooting fixed
     point's (60 intervals: 4e-8 seen; O(h^4)), the knee strike at the passive gait's
     time, and the replay on the rigid model (its own guards and resets) closing to
     1e-6."""
-    pytest.importorskip("casadi")
-    import walkerlab as wl
-    from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import (
-        collocate_phases,
-        phased_guess,
-        replay_phases,
-    )
-    from walkerlab.optimal.phases import mode_functions, phase_order
+    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
 
-    scene, data, walker = kneed
-    g = wl.Walker.from_scene(scene).fixed_point()
-    solver = Solver.from_settings(scene.solver)
-    guess, log = phased_guess(walker, g.x, g.step_period, solver, 60)
+    _, data, _ = kneed
+    g, guess, fns = kneed_start
     assert sum(x.shape[0] - 1 for _, _, x in guess) == 2 * 60
     passive_knee_time = guess[0][1][-1]
     guess = [(name, t, x * 1.05) for name, t, x in guess]
-    fns = mode_functions(data, walker, phase_order(walker, log))
     res = collocate_phases(fns, CollocationSpec(intervals=60), guess)
     assert res.status == "Solve_Succeeded"
     assert res.objective <= 1e-10 and np.max(np.abs(res.u)) < 1e-5
@@ -293,3 +305,42 @@ def test_optimize_command_on_the_kneed_walker(tmp_path):
     assert d.phase_names == ("unlocked_swing", "locked_swing")
     assert d.phase_duration_s.sum() == pytest.approx(d.step_period_s, rel=1e-12)
     assert (tmp_path / "kneed_optimal" / "report" / "figures" / "optimize.png").is_file()
+
+
+def _powered(data, start, intervals: int, speed: float):
+    """The least-effort step of a walker with phases at a target speed (``start`` from
+    :func:`_start`: its passive gait's step as the guess) and its replay error."""
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+
+    _g, guess, fns = start
+    res = collocate_phases(fns, CollocationSpec(intervals=intervals,
+                                                target_speed_m_per_s=speed), guess)
+    return res, replay_phases(data, res)[0]
+
+
+def test_a_powered_kneed_gait_replays_on_the_rigid_model(kneed, kneed_start):
+    """The kneed walker made to walk at 0.9 m/s (its passive gait: 0.870 m/s) by the least
+    hip torque: the speed met, the torque not zero (~0.01 N m), and the torque fed as a
+    function of time to the rigid model (its knee strike, its locked knee carrying the
+    torque through the lock, its heel strike) returns to the start within 1e-6 (2.5e-8
+    seen): the torque's path through both phases is the rigid model's."""
+    pytest.importorskip("casadi")
+    res, err = _powered(kneed[1], kneed_start, 60, 0.9)
+    assert res.status == "Solve_Succeeded"
+    assert res.step_length_m / res.step_period_s == pytest.approx(0.9, rel=1e-9)
+    assert 1e-3 < np.max(np.abs(res.u)) < 1.0
+    assert err <= 1e-6
+
+
+@pytest.mark.slow
+def test_a_powered_flat_footed_gait_replays_on_the_rigid_model(flat):
+    """Flat feet made to walk at 0.8 m/s (passive: 0.789 m/s) by the least hip torque
+    (~0.8 N m peak; ~30 s): the replay on the rigid model - its heel-off guard reading the
+    ground force through the torqued flow - closes within 1e-6 (3e-7 seen)."""
+    pytest.importorskip("casadi")
+    res, err = _powered(flat[1], _start(flat, 200), 200, 0.8)
+    assert res.status == "Solve_Succeeded"
+    assert res.step_length_m / res.step_period_s == pytest.approx(0.8, rel=1e-9)
+    assert 0.1 < np.max(np.abs(res.u)) < 10.0
+    assert err <= 1e-6

@@ -71,8 +71,8 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                         bool(err <= o.replay_tolerance and res.status == "Solve_Succeeded"),
                         res.status, res.iterations, res.wall_time_s, units,
                         objective_name=o.objective, objective_unit=_unit(o.objective),
-                        terms=res.terms, contact_outcome="not replayed: a walker with "
-                        "phases (the contact replay drives straight legs)",
+                        terms=res.terms, contact_outcome="not replayed: the contact view "
+                        "carries no hip torque on knees or flat feet yet",
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
                         phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
                         build_time_s=build + res.build_time_s)
