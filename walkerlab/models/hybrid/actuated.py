@@ -382,24 +382,30 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     base_jac = walker.variational
     has_torque = bool(spec.torques)
 
+    def locked(constraint):  # the torque's acceleration, through a phase's lock if any
+        if constraint is None:
+            return acts.added_acceleration
+        return lambda t, x: acts.added_acceleration(t, x, constraint)
+
     def flow_of(flow, constraint=None):
         if not has_torque:
             return flow
+        acc = locked(constraint)
 
         def f(t, x):
             out = np.array(flow(t, x), dtype=complex if np.iscomplexobj(x) else float)
-            out[acts.n:] += acts.added_acceleration(t, x, constraint)
+            out[acts.n:] += acc(t, x)
             return out
         return f
 
     def jac_of(jac, constraint=None):
         if not has_torque:
             return jac
+        acc = locked(constraint)
 
         def J(t, x):
             base = np.array(jac(t, x), float)
-            base[acts.n:] += complex_step_jacobian(
-                lambda z: acts.added_acceleration(t, z, constraint), np.asarray(x, float))
+            base[acts.n:] += complex_step_jacobian(lambda z: acc(t, z), np.asarray(x, float))
             return base
         return J
 
