@@ -280,11 +280,11 @@ def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResul
         us.append(np.asarray(get(U)).ravel())
         durs.append(Tv)
         offset += Tv
-    x = np.concatenate(xs)
+    X_all = np.concatenate(xs)  # (m, 2n): every phase's points in turn
     return PhasedResult(
-        t=np.concatenate(ts), x=x, u=np.concatenate(us), phase_names=tuple(names),
+        t=np.concatenate(ts), x=X_all, u=np.concatenate(us), phase_names=tuple(names),
         phase_start=np.array(starts), phase_duration_s=np.array(durs), step_period_s=offset,
-        step_length_m=float(fns["phases"][-1].step(x[-1])), objective=float(get(obj)),
+        step_length_m=float(fns["phases"][-1].step(X_all[-1])), objective=float(get(obj)),
         status=status,
         iterations=int(opti.stats().get("iter_count", -1)), build_time_s=build,
         wall_time_s=wall, cpu_time_s=cpu, terms={k: float(get(v)) for k, v in terms.items()})
