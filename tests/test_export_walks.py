@@ -41,11 +41,12 @@ def _scene(name):
 #: and toe contacts).  configs/rabbit.yaml (free knees, knee torques) is checked elsewhere.
 REFUSED = {"flat_feet": "walker.leg.foot.kind", "flat_feet_push_off": "walker.leg.foot.kind",
            "kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
-           "simplest": "walker.leg.bodies"}
+           "simplest": "walker.leg.bodies", "flat_feet_optimal": "walker.leg.foot.kind"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py); its walker is rabbit's (tests/test_export_five_link.py)
+#: kneed_optimal: kneed's walker (its MuJoCo walk needs kneed's knee latch: configs/kneed.yaml)
 SHIPPED = sorted(p.stem for p in (ROOT / "configs").glob("*.yaml")
-                 if p.stem not in ("rabbit", "rabbit_optimal"))
+                 if p.stem not in ("rabbit", "rabbit_optimal", "kneed_optimal"))
 #: Step-period tolerance against the rigid gait: 1 % (MuJoCo's contact is soft and linear,
 #: walkerlab's own contact model differs from the rigid one by 0.1-1 % on these walkers).
 #: powered_compass too: the export applies the push-off over one MuJoCo timestep (the rigid

@@ -51,7 +51,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     ----------
     scene : Scene
         With ``optimize``; straight legs, point feet, massive legs or massless ones with a
-        hip mass.
+        hip mass; or a kneed or flat-footed walker (a step of phases:
+        :func:`walkerlab.optimal.phased_scene.optimize_phased_scene`).
     x_gait : ndarray (2n,)
         The scene's gait just after heel strike (``fixedpoint.h5``): the initial guess is
         one step of it (unless ``optimize.initial_guess`` names an artifact).
@@ -86,6 +87,10 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     data = walker_data(scene.walker, scene.slope.phi_rad)
     spec = collocation_spec(scene)
     walker = build_walker(scene)
+    if data.structure.knee or data.structure.foot == "flat":  # a step of phases: its own
+        from walkerlab.optimal.phased_scene import optimize_phased_scene
+
+        return optimize_phased_scene(scene, data, spec, x_gait, period_s)  # transcription
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
     if guess_p is not None and spec.push_off_free:
         spec = replace(spec, push_off_n_s=guess_p)

@@ -106,8 +106,18 @@ def optimize_lines(d) -> list[str]:
             + (f" In the contact model: step period {num(d.contact_step_period_s)} s "
                f"({num(100 * (d.contact_step_period_s / d.step_period_s - 1), 2)} %)."
                if d.contact_step_period_s == d.contact_step_period_s
-               else f" Contact model: {d.contact_outcome}."),
+               else f" Contact model: {d.contact_outcome}.")
+            + _phases_line(d),
             ""]
+
+
+def _phases_line(d) -> str:
+    """The step's phases and their durations (a step of phases, e.g. a kneed walker's)."""
+    if not getattr(d, "phase_names", ()):
+        return ""
+    parts = ", ".join(f"{n} {num(float(t), 6)} s" for n, t in zip(d.phase_names,
+                                                                   d.phase_duration_s))
+    return f" Phases (each with its own mesh and free duration): {parts}."
 
 
 def _drawn_from(stem: str, arts: dict) -> bool:

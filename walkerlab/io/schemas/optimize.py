@@ -27,7 +27,14 @@ points)::
     replay/step_period            s        (closed by shooting) the closed step's period
     replay/collocated_start_error rad, rad/s  (closed by shooting) the open-loop return
                                            error from the collocated start itself
-    ipopt                         attributes: status, iterations, wall_time_s, cpu_time_s
+    ipopt                         attributes: status, iterations, wall_time_s, cpu_time_s,
+                                           build_time_s (the programme's build, when known)
+    phases/start_index            -        (a step of phases, e.g. a kneed walker's unlocked
+                                           and locked swing; attribute phase_names) index in
+                                           ``time`` of each phase's first point (a phase's
+                                           first time repeats the previous one's last: the
+                                           state jumps there, e.g. at a knee strike)
+    phases/duration               s        each phase's duration
     ipopt/<series>                -        on the ``iteration`` dimension: objective,
                                            primal_infeasibility, dual_infeasibility, barrier
     energy/kinetic, energy/potential  J    the walker's energies at the collocation points
@@ -81,6 +88,10 @@ class OptimizeData:
     ipopt_history: dict = field(default_factory=dict)  # walkerlab.optimal.ipopt.HISTORY
     energy: dict = field(default_factory=dict)  # kinetic, potential (time,) [energy_unit]
     energy_unit: str = "J"
+    phase_names: tuple = ()
+    phase_start: np.ndarray | None = None
+    phase_duration_s: np.ndarray | None = None
+    build_time_s: float = float("nan")
 
 
 def write(f, d: OptimizeData) -> None:
@@ -125,6 +136,13 @@ def write(f, d: OptimizeData) -> None:
     f.attrs["ipopt_iterations"] = int(d.iterations)
     f.attrs["ipopt_wall_time_s"] = float(d.wall_time_s)
     f.attrs["ipopt_cpu_time_s"] = float(d.cpu_time_s)
+    f.attrs["ipopt_build_time_s"] = float(d.build_time_s)
+    if d.phase_names:
+        f.attrs["phase_names"] = list(d.phase_names)
+        put(f, "phases/start_index", np.asarray(d.phase_start, np.int64), "-", "index in "
+            "time of each phase's first point (attribute phase_names)")
+        put(f, "phases/duration", np.asarray(d.phase_duration_s, float), "s", "each "
+            "phase's duration")
     for key, v, unit, what in (
             ("start_shift", d.start_shift, "-", "max |closed start - collocated start| "
              "[rad, rad/s]: the transcription's error"),
@@ -189,7 +207,11 @@ def load(path: Path) -> OptimizeData:
             float(f.attrs.get("ipopt_cpu_time_s", float("nan"))),
             {k: v[()] for k, v in f["ipopt"].items()} if "ipopt" in f else {},
             {k: v[()] for k, v in f["energy"].items()} if "energy" in f else {},
-            str(next(iter(f["energy"].values())).attrs["unit"]) if "energy" in f else "J")
+            str(next(iter(f["energy"].values())).attrs["unit"]) if "energy" in f else "J",
+            tuple(str(s) for s in f.attrs.get("phase_names", [])),
+            f["phases/start_index"][()] if "phases" in f else None,
+            f["phases/duration"][()] if "phases" in f else None,
+            float(f.attrs.get("ipopt_build_time_s", float("nan"))))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)

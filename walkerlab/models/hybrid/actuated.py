@@ -76,8 +76,11 @@ class Actuators:
         # d(delta)/dq and the absolute leg angles' Jacobian A = d(psi_sw, psi_st)/dq, exact:
         # the generated leg angles' rates are linear in dq
         rows = [la(np.concatenate([z, eye[k]])) for k in range(self.n)]
-        self.A = np.array([[float(r["swing_rate"]) for r in rows],
-                           [float(r["stance_rate"]) for r in rows]])
+        # the hip joins the thighs: a kneed walker's legs name them
+        self.legs = ("swing_thigh", "stance_thigh") if "swing_thigh_rate" in rows[0] \
+            else ("swing", "stance")
+        self.A = np.array([[float(r[f"{self.legs[0]}_rate"]) for r in rows],
+                           [float(r[f"{self.legs[1]}_rate"]) for r in rows]])
         self.ddelta_dq = self.A[0] - self.A[1]
         swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # the legs' absolute angles trade places
         self.R = np.linalg.pinv(self.A) @ swap @ self.A
@@ -90,8 +93,9 @@ class Actuators:
         """``(delta, ddelta, s, ds)``: hip angle (swing minus stance) [rad], its rate
         [rad/s], the phase variable (stance angle) [rad] and its rate [rad/s]."""
         d = self.fns["leg_angles"](x)
-        return (d["swing_angle"] - d["stance_angle"], d["swing_rate"] - d["stance_rate"],
-                d["stance_angle"], d["stance_rate"])
+        sw, st = self.legs
+        return (d[f"{sw}_angle"] - d[f"{st}_angle"], d[f"{sw}_rate"] - d[f"{st}_rate"],
+                d[f"{st}_angle"], d[f"{st}_rate"])
 
     def torques(self, t, x) -> np.ndarray:
         """Torque of each actuator (k,) [N m; N m/kg when ``scaled_by: foot_mass``] at the
@@ -120,10 +124,20 @@ class Actuators:
             return 0.0
         return float(np.real(np.sum(self.torques(t, x)) * self.hip_angles(x)[1]))
 
-    def added_acceleration(self, t, x):
-        """``M^-1 B tau`` (n,) [rad/s^2]."""
-        M = self.fns["matrices"](x)[0]
-        return np.linalg.solve(M, self.generalised_force(t, x))
+    def added_acceleration(self, t, x, constraint=None, M=None):
+        """``M^-1 B tau`` (n,) [rad/s^2]; in a phase holding a constraint with gradient
+        ``a = constraint(x)`` (n,) (a locked knee), the constrained system's
+        ``M^-1 (B tau + a lam)`` with ``a . qdd = 0`` (the lock's share: ``lam = -a M^-1
+        B tau / (a M^-1 a)``; the same as ``[S^T M; a] qdd = [S^T B tau; 0]``, ``S`` a
+        basis of the constraint's null space, :mod:`walkerlab.codegen.symbolic`).  ``M``
+        (n, n): the mass matrix of the phase (default: the generated ``matrices``')."""
+        M = self.fns["matrices"](x)[0] if M is None else M
+        acc = np.linalg.solve(M, self.generalised_force(t, x))
+        if constraint is None:
+            return acc
+        a = np.asarray(constraint(x))
+        Ma = np.linalg.solve(M, a)
+        return acc - Ma * (a @ acc) / (a @ Ma)
 
     # ---------------------------------------------------------------- push-off
     def hip_velocity(self, x) -> np.ndarray:
@@ -247,9 +261,12 @@ def _structure_check(data, spec) -> bool:
             raise ValueError(f"walker.actuation.torques.{i}.joint: {t.joint} is a five-link "
                              "biped's joint (knee.lock: free); a straight-legged walker's is "
                              "hip")
-    if st.knee or st.foot != "point":
-        raise ValueError("walker.actuation: actuators need straight legs with point feet "
-                         "today (knees, arc and flat feet: not yet)")
+    if st.foot != "point":
+        raise ValueError("walker.actuation: actuators need point feet today (arc and flat "
+                         "feet: not yet)")
+    if st.knee and (spec.push_off is not None or st.torso):
+        raise ValueError("walker.actuation.push_off: a kneed walker takes hip torques only "
+                         "today (no push-off, no torso)")
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
     if any(massless) and not limit:
@@ -279,7 +296,7 @@ def spring_equivalent(data, spec):
 
     st = data.structure
     laws = [t for t in spec.torques]
-    if not laws or st.knee_spring or st.torso or any(
+    if not laws or st.knee or st.knee_spring or st.torso or any(
             t.scaled_by != "none" or t.max_torque_n_m is not None or t.law.reference is not None
             or t.law.time_reference is not None for t in laws):
         return None
@@ -305,7 +322,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     act on the swing row alone), or a phase whose guards have no compiled outputs."""
     from walkerlab.codegen.actuated import ActuatedFlow
 
-    if limit:
+    if limit or data.structure.knee:  # the compiled laws drive the unconstrained flow only
         return None
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None and data.structure.free_knees:
@@ -365,24 +382,30 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     base_jac = walker.variational
     has_torque = bool(spec.torques)
 
-    def flow_of(flow):
+    def locked(constraint):  # the torque's acceleration, through a phase's lock if any
+        if constraint is None:
+            return acts.added_acceleration
+        return lambda t, x: acts.added_acceleration(t, x, constraint)
+
+    def flow_of(flow, constraint=None):
         if not has_torque:
             return flow
+        acc = locked(constraint)
 
         def f(t, x):
             out = np.array(flow(t, x), dtype=complex if np.iscomplexobj(x) else float)
-            out[acts.n:] += acts.added_acceleration(t, x)
+            out[acts.n:] += acc(t, x)
             return out
         return f
 
-    def jac_of(jac):
+    def jac_of(jac, constraint=None):
         if not has_torque:
             return jac
+        acc = locked(constraint)
 
         def J(t, x):
             base = np.array(jac(t, x), float)
-            base[acts.n:] += complex_step_jacobian(
-                lambda z: acts.added_acceleration(t, z), np.asarray(x, float))
+            base[acts.n:] += complex_step_jacobian(lambda z: acc(t, z), np.asarray(x, float))
             return base
         return J
 
@@ -398,11 +421,11 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
                         variational=ph.variational, compiled=ph.compiled)
                   for ph in fast.phases]
     for ph in walker.phases if sprung is None else ():
-        phases.append(Phase(ph.name, flow_of(ph.flow), ph.guards,
-                            jacobian=jac_of(ph.jacobian or base_jac),
+        phases.append(Phase(ph.name, flow_of(ph.flow, ph.constraint), ph.guards,
+                            jacobian=jac_of(ph.jacobian or base_jac, ph.constraint),
                             variational=None if has_torque else ph.variational,
                             compiled=(_compiled_laws(ph, data, acts, limit) if has_torque
-                                      else ph.compiled)))
+                                      else ph.compiled), constraint=ph.constraint))
     reset = walker.reset
     reset_jac = walker.reset_jacobian
     if spec.push_off is not None:

@@ -77,19 +77,24 @@ def heel_off_data(data, spec):
 
 
 def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
-    """The flat-footed walker with its ankle push-off (module docstring).
+    """The flat-footed walker with its ankle push-off (module docstring), or with hip
+    torques alone (:func:`walkerlab.models.hybrid.flat_hip_torque.actuate_flat_hips`).
 
     Raises
     ------
     ValueError
-        An actuator flat feet do not carry (a push-off impulse, hip torques), legs that
-        differ (one line).
+        An actuator flat feet do not carry (a push-off impulse, hip torques with an ankle
+        push-off), legs that differ (one line).
     """
     from walkerlab.models.hybrid.rigid_flat import make_flat_walker
 
+    if spec.torques and spec.push_off is None and spec.ankle_push_off is None:
+        from walkerlab.models.hybrid.flat_hip_torque import actuate_flat_hips
+
+        return actuate_flat_hips(walker, data, spec)
     if spec.push_off is not None or spec.torques:
-        raise ValueError("walker.actuation: flat feet take ankle_push_off (push_off "
-                         "impulses and hip torques are for point feet today)")
+        raise ValueError("walker.actuation: flat feet take ankle_push_off or hip torques, "
+                         "not together (push_off impulses are for point feet today)")
     if spec.ankle_push_off is None:
         raise ValueError("walker.actuation: flat feet need ankle_push_off")
     w = make_flat_walker(data, walker.name, walker.variant, heel_off_data(data, spec))

@@ -128,6 +128,11 @@ class Phase:
     ``compiled`` (optional) is a handle on the same flow compiled for CyRK's C++ integrators
     (:class:`walkerlab.codegen.compiled.CompiledFlow`: ``address(variational)``, ``data()``),
     used by the ``cyrk_compiled`` solver backend.
+
+    ``constraint`` (optional) is ``x -> (n,)``, the gradient in ``q`` of a holonomic
+    constraint the flow holds (a locked knee: ``d(shank - thigh)/dq``); a joint torque added
+    to such a phase acts through the constrained system (its share along the constraint is
+    taken by the lock).  None: the flow is unconstrained.
     """
 
     name: str
@@ -136,6 +141,7 @@ class Phase:
     jacobian: Callable[[float, np.ndarray], np.ndarray] | None = None
     variational: Callable[[float, np.ndarray], np.ndarray] | None = None
     compiled: object | None = None
+    constraint: Callable[[np.ndarray], np.ndarray] | None = None
 
 
 @dataclass(frozen=True)

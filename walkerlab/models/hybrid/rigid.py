@@ -38,6 +38,8 @@ from __future__ import annotations
 from dataclasses import replace
 from functools import partial
 
+import numpy as np
+
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.compiled import CompiledFlow
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
@@ -78,8 +80,16 @@ def _kneed_phases(data: WalkerData, f: dict, flow, var, compiled, heel: Guard,
             jacobian=f["flow_locked_jacobian"],
             variational=f.get("flow_locked_variational"),
             compiled=compiled("flow_locked", ("heel_strike", 0.0), ("swing_foot_ahead", 0.0),
-                              ("swing_foot_ahead", 0.0), ("hip_height", 0.0))),
+                              ("swing_foot_ahead", 0.0), ("hip_height", 0.0)),
+            constraint=partial(_lock_gradient, f["grad_knee_extension"])),
     )
+
+
+def _lock_gradient(grad, x):
+    """The locked knee's constraint gradient in ``q`` (n,): the first half of the generated
+    ``knee_extension`` guard's state gradient (it depends on the angles only)."""
+    x = np.asarray(x)
+    return np.asarray(grad(x))[:x.size // 2]
 
 
 def _straight_leg_phases(f: dict, flow, flow_jacobian, var, compiled, heel: Guard,

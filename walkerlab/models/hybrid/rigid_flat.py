@@ -86,8 +86,13 @@ def _heel_force(ground, flow, t, x) -> float:
 
 def make_flat_walker(data: WalkerData, name: str = "biped",
                      variant: str = "derived",
-                     heel_off_data: WalkerData | None = None) -> HybridWalker:
+                     heel_off_data: WalkerData | None = None,
+                     flow_of=None) -> HybridWalker:
     """A :class:`HybridWalker` for a flat-footed ``data`` (``structure.foot == "flat"``).
+
+    ``flow_of(mode, flow, jacobian) -> (flow, jacobian)``, if given, replaces each mode's
+    generated flow and Jacobian (joint torques added: the ground forces of the guards are
+    read through the replaced flow; no compiled or variational flows then).
 
     Returns
     -------
@@ -103,6 +108,8 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
         # an ankle push-off's heel off (other numbers than the guards') stays in Python
         if heel_off_data is not None:
             return None
+        if flow_of is not None:
+            return None
         return CompiledFlow(data.structure, tuple(data.params), f"flow_{mode}",
                             tuple((GUARD_OUTPUT[g.name].format(pin=pin[mode]), 0.0)
                                   for g in guards), first_chunk_steps=FIRST_CHUNK_STEPS[mode])
@@ -112,7 +119,10 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
         # it) from the released spring's numbers; guards and resets are the walker's own
         # (the new stance ankle lands at the walker's rest angle)
         f, g = (off if mode == "heel_off" else base), base
-        fl, p = f[f"flow_{mode}"], pin[mode]
+        fl, jac, p = f[f"flow_{mode}"], f[f"flow_{mode}_jacobian"], pin[mode]
+        var = f[f"flow_{mode}_variational"]
+        if flow_of is not None:
+            (fl, jac), var = flow_of(mode, fl, jac), None
         late = part == "late_swing"
         guards = []
         if late:
@@ -147,8 +157,8 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
                                 f["grad_swing_foot_ahead"], next_phase=f"{mode}:late_swing"))
         guards.append(Guard("fall", f[f"guard_hip_height_{p}"], -1, "fall",
                             f[f"grad_hip_height_{p}"]))
-        return Phase(f"{mode}:{part}", fl, tuple(guards), jacobian=f[f"flow_{mode}_jacobian"],
-                     variational=f[f"flow_{mode}_variational"], compiled=compiled(mode, guards))
+        return Phase(f"{mode}:{part}", fl, tuple(guards), jacobian=jac, variational=var,
+                     compiled=compiled(mode, guards))
 
     phases = tuple(phase(m, part) for part in SWING_PARTS for m in MODES)
     f = base

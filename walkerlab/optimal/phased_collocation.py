@@ -1,0 +1,350 @@
+"""The multi-phase transcription of :mod:`walkerlab.optimal.phases`: one step of a walker
+with a fixed mode sequence (a kneed walker's unlocked and locked swing) optimised by
+Hermite-Simpson collocation per phase (CasADi ``Opti`` + IPOPT), its starting guess from
+the rigid model's own step and its replay on the rigid model.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from walkerlab.optimal.ipopt import iteration_history
+
+__all__ = ["PhasedResult", "collocate_phases", "phase_torque_of_time", "phased_guess",
+           "replay_phases"]
+
+#: objectives the phased transcription takes (:data:`walkerlab.optimal.collocation.OBJECTIVES`)
+PHASED_OBJECTIVES = ("effort", "peak_torque")
+
+@dataclass
+class PhasedResult:
+    """An optimised step of a walker with phases.
+
+    Attributes
+    ----------
+    t : ndarray (m,)
+        Collocation times since the heel strike [s], every phase's ``2 N_p + 1`` points in
+        turn (a phase's first time repeats the previous phase's last: the state jumps there).
+    x : ndarray (m, 2n)
+        States there (``state_names()`` order).
+    u : ndarray (m,)
+        Hip torque [N m].
+    phase_names : tuple of str
+    phase_start : ndarray (P,) of int
+        Index in ``t`` of each phase's first point.
+    phase_duration_s : ndarray (P,)
+    step_period_s, step_length_m, objective : float
+    status : str
+    iterations : int
+    build_time_s, wall_time_s, cpu_time_s : float
+        Building the programme; IPOPT's wall and CPU (user + sys) time.
+    terms : dict
+        ``effort`` [N^2 m^2 s] and ``peak_torque`` [N m] at the optimum.
+    history : dict of str -> ndarray
+        IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    u: np.ndarray
+    phase_names: tuple
+    phase_start: np.ndarray
+    phase_duration_s: np.ndarray
+    step_period_s: float
+    step_length_m: float
+    objective: float
+    status: str
+    iterations: int
+    build_time_s: float
+    wall_time_s: float
+    cpu_time_s: float
+    terms: dict = field(default_factory=dict)
+    history: dict = field(default_factory=dict)
+    push_off_n_s: float = 0.0
+
+
+def phased_guess(walker, x0, period_s: float, solver, intervals: int):
+    """One step of the rigid ``walker`` from the post-impact state ``x0`` (2n,), each
+    phase sampled on its own mesh of ``N_p`` intervals (their mid-points halfway), the
+    ``intervals`` shared among the phases and placed within each by
+    :func:`mesh_density` (at least 3 a phase): Hermite-Simpson's error per interval,
+    ``~ h^5 |x^(5)|``, is then about the same in every interval (de Boor's equidistribution;
+    Betts 2010, Ch. 4.7), so a fast transient (a flat foot's ankle after heel strike) gets
+    short intervals and a slow phase long ones.
+
+    Returns
+    -------
+    guess : list of (name, t (2 N_p + 1,) [s from the phase's start], x (2 N_p + 1, 2n))
+    phase_log : list
+        The step's :attr:`walkerlab.integrate.rigid.Segment.phase_log` (its phase
+        sequence: :func:`walkerlab.optimal.phases.phase_order`).
+
+    Raises
+    ------
+    ValueError
+        The step does not end in a heel strike (one line).
+    """
+    from walkerlab.integrate.rigid import simulate_steps
+
+    x0 = np.asarray(x0, float)
+    seg = simulate_steps(walker, x0, 1, solver, max_step_time=3.0 * period_s).segments[0]
+    if seg.termination != "heel_strike":
+        raise ValueError(f"optimize: the starting gait does not make a step ({seg.termination})")
+    dens = [mesh_density(ph, sol, a, b, x0.size) for ph, sol, (a, b) in seg.pieces]
+    total = sum(c[-1] for _t, c in dens)
+    out = []
+    for (ph, sol, (a, b)), (tf, cum) in zip(seg.pieces, dens):
+        # half by the density, half by the duration (the density alone starves a slow phase
+        # whose errors the resets carry on: the kneed walker's locked swing)
+        cum = 0.5 * cum / total + 0.5 * (tf - tf[0]) / (seg.t_end - seg.t_start)
+        N = max(3, int(round(intervals * cum[-1])))
+        ends = np.interp(np.linspace(0.0, cum[-1], N + 1), cum, tf)
+        t = np.empty(2 * N + 1)
+        t[0::2], t[1::2] = ends, 0.5 * (ends[:-1] + ends[1:])
+        t[0], t[-1] = a, b
+        out.append((ph.name, t - a, np.asarray(sol(t), float)[:x0.size].T))
+    return out, seg.phase_log
+
+
+def mesh_density(phase, sol, a: float, b: float, n2: int, samples: int = 401):
+    """The cumulative mesh density of a phase on ``[a, b]`` [s]: ``int rho dt`` with
+    ``rho = max_i |x_i^(5)|^(1/5)`` (the fifth derivative from the phase's flow ``f``
+    along the dense output ``sol``, differentiated four times by finite differences on
+    ``samples`` points; within 1/40 of the ends, where the differences are one-sided, the
+    nearest value inside), floored at a tenth of its mean (no interval starves).
+
+    Returns
+    -------
+    t : ndarray (samples,) [s]
+    cum : ndarray (samples,)
+        ``int_a^t rho``, increasing, ``cum[0] = 0``.
+    """
+    from scipy.integrate import cumulative_trapezoid
+
+    t = np.linspace(a, b, samples)
+    x = np.asarray(sol(t), float)[:n2]
+    d = np.stack([np.asarray(phase.flow(tk, x[:, k]), float) for k, tk in enumerate(t)], 1)
+    for _ in range(4):
+        d = np.gradient(d, t, axis=1) if b > a else d
+    rho = np.max(np.abs(d), axis=0) ** 0.2
+    edge = max(1, samples // 40)  # one-sided differences at the ends: their nearest inside
+    rho[:edge], rho[-edge:] = rho[edge], rho[-edge - 1]
+    rho = np.maximum(rho, 0.1 * max(rho.mean(), 1e-300)) + 1e-300
+    return t, cumulative_trapezoid(rho, t, initial=0.0)
+
+
+def _simpson(T, tau, values):
+    """Simpson's rule on the 2N + 1 points ``T tau`` of one phase (``values`` (1, 2N + 1),
+    ``tau`` (2N + 1,) from 0 to 1, mid-points halfway)."""
+    import casadi as ca
+
+    K = values.shape[1]
+    w = np.zeros(K)
+    for i in range(0, K - 1, 2):
+        dt = tau[i + 2] - tau[i]
+        w[i] += dt / 6
+        w[i + 1] += 4 * dt / 6
+        w[i + 2] += dt / 6
+    return T * ca.sum2(ca.DM(w).T * values)
+
+
+def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
+    """One phase's defects (on the mesh ``T tau``), its guard at the end (transversal) and
+    inside (its sign), its unilateral contacts and the path constraints."""
+    K = X.shape[1]
+    f = [mp.flow(X[:, k], U[k]) for k in range(K)]
+    for i in range(0, K - 1, 2):
+        m, j = i + 1, i + 2
+        h = T * (tau[j] - tau[i])
+        opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (f[i] - f[j]))
+        opti.subject_to(X[:, j] == X[:, i] + h / 6 * (f[i] + 4 * f[m] + f[j]))
+    d = mp.direction
+    opti.subject_to(mp.guard(X[:, -1], U[-1]) == 0)
+    opti.subject_to(d * mp.guard_rate(X[:, -1], U[-1]) >= spec.touchdown_rate_rad_per_s)
+    for k in range(1, K - 1):  # the event has not happened inside the phase
+        opti.subject_to(d * mp.guard(X[:, k], U[k]) <= 0)
+    if mp.keep is not None:  # unilateral contacts push
+        for k in range(K):
+            opti.subject_to(mp.keep(X[:, k], U[k]) >= 0)
+    if spec.min_clearance_m is not None:
+        for k in range(1 if first else 0, K - 1 if last else K):
+            opti.subject_to(mp.clearance(X[:, k]) >= spec.min_clearance_m)
+    if spec.hip_angle_range_rad is not None:
+        lo, hi = spec.hip_angle_range_rad
+        for k in range(K):
+            opti.subject_to(opti.bounded(lo, fns["hip_angle"](X[:, k]), hi))
+    if spec.max_torque_n_m is not None:
+        opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
+    return _simpson(T, tau, U ** 2)
+
+
+def _check(spec) -> None:
+    """Refuse what the phased transcription does not take (one line)."""
+    asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
+    bad = [k for k in asked if k not in PHASED_OBJECTIVES]
+    if bad:
+        raise ValueError(f"optimize.objective: a walker with phases takes "
+                         f"{' or '.join(PHASED_OBJECTIVES)} (or their weighted sum) today")
+    if spec.push_off_free or spec.push_off_n_s:
+        raise ValueError("optimize.push_off: a walker with phases has no push-off today")
+    if spec.friction_coefficient is not None:
+        raise ValueError("optimize.friction_coefficient: not yet for a walker with phases")
+
+
+def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
+    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`).
+
+    Parameters
+    ----------
+    fns : dict
+        :func:`walkerlab.optimal.phases.mode_functions` of the walker.
+    spec : walkerlab.optimal.collocation.CollocationSpec
+        Its ``intervals`` are shared among the phases by ``guess``'s meshes.
+    guess : list of (name, t, x)
+        :func:`phased_guess`: each phase's starting mesh (its length fixes ``N_p``).
+
+    Returns
+    -------
+    PhasedResult
+
+    Raises
+    ------
+    ValueError
+        An objective or constraint this transcription does not take, or a guess whose
+        phases are not the walker's (one line).
+    """
+    import casadi as ca
+
+    from walkerlab.optimal.collocation import target_constraints
+
+    _check(spec)
+    phases = fns["phases"]
+    if [g[0] for g in guess] != [p.name for p in phases]:
+        raise ValueError("optimize: the starting step's phases "
+                         f"{[g[0] for g in guess]} are not the walker's")
+    t_build = time.perf_counter()
+    n2, P = 2 * fns["n"], len(phases)
+    opti = ca.Opti()
+    Xs = [opti.variable(n2, g[1].size) for g in guess]
+    Us = [opti.variable(1, g[1].size) for g in guess]
+    Ts = [opti.variable() for _ in guess]
+    effort = 0
+    taus = [np.asarray(g[1], float) / float(g[1][-1]) for g in guess]
+    for p, mp in enumerate(phases):
+        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], p == 0,
+                                 p == P - 1, fns)
+        nxt = Xs[p + 1][:, 0] if p + 1 < P else Xs[0][:, 0]
+        opti.subject_to(nxt == mp.reset(Xs[p][:, -1]))
+        Tg = float(guess[p][1][-1])
+        opti.subject_to(opti.bounded(0.05 * Tg, Ts[p], 5.0 * Tg))
+        opti.set_initial(Ts[p], Tg)
+        opti.set_initial(Xs[p], guess[p][2].T)
+        opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)))
+    opti.subject_to(fns["ahead"](Xs[-1][:, -1]) >= 1e-3)
+    period = sum(Ts[1:], Ts[0])
+    target_constraints(opti, spec, period, phases[-1].step(Xs[-1][:, -1]))
+    U = ca.horzcat(*Us)
+    asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
+    if "peak_torque" in asked:
+        peak = opti.variable()
+        opti.subject_to(opti.bounded(-peak, U, peak))
+        opti.set_initial(peak, 1.0)
+    else:
+        peak = ca.mmax(ca.fabs(U))
+    terms = {"effort": effort, "peak_torque": peak}
+    obj = sum(w * terms[k] for k, w in asked.items())
+    opti.minimize(obj)
+    opti.solver("ipopt", {"print_time": False},
+                {"print_level": 0, "tol": 1e-12, "acceptable_tol": 1e-10, "max_iter": 500,
+                 "sb": "yes"})
+    build = time.perf_counter() - t_build
+    return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build)
+
+
+def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResult:
+    """Run IPOPT and read the phases back as one step."""
+    t0, c0 = time.perf_counter(), os.times()
+    try:
+        sol = opti.solve()
+        status, get = "Solve_Succeeded", sol.value
+    except RuntimeError:
+        status, get = str(opti.stats().get("return_status", "failed")), opti.debug.value
+    c1 = os.times()
+    wall, cpu = time.perf_counter() - t0, (c1.user - c0.user) + (c1.system - c0.system)
+    n2 = Xs[0].shape[0]
+    ts, xs, us, starts, durs, offset = [], [], [], [], [], 0.0
+    for X, U, T, tau in zip(Xs, Us, Ts, taus):
+        Tv, K = float(get(T)), X.shape[1]
+        starts.append(sum(len(a) for a in ts))
+        ts.append(offset + Tv * tau)
+        xs.append(np.asarray(get(X)).reshape(n2, K).T)
+        us.append(np.asarray(get(U)).ravel())
+        durs.append(Tv)
+        offset += Tv
+    X_all = np.concatenate(xs)  # (m, 2n): every phase's points in turn
+    return PhasedResult(
+        t=np.concatenate(ts), x=X_all, u=np.concatenate(us), phase_names=tuple(names),
+        phase_start=np.array(starts), phase_duration_s=np.array(durs), step_period_s=offset,
+        step_length_m=float(fns["phases"][-1].step(X_all[-1])), objective=float(get(obj)),
+        status=status,
+        iterations=int(opti.stats().get("iter_count", -1)), build_time_s=build,
+        wall_time_s=wall, cpu_time_s=cpu, terms={k: float(get(v)) for k, v in terms.items()},
+        history=iteration_history(opti.stats()))
+
+
+def phase_torque_of_time(res: PhasedResult):
+    """The optimised hip torque as a function of the time since the heel strike [s] ->
+    [N m]: in the phase holding it, the quadratic through its interval's three points
+    (Hermite-Simpson's control), held outside the step."""
+    ends = np.cumsum(res.phase_duration_s)
+    bounds = list(res.phase_start) + [res.t.size]
+
+    def tau(s: float) -> float:
+        s = min(max(float(s), 0.0), float(ends[-1]))
+        p = min(int(np.searchsorted(ends, s)), len(ends) - 1)
+        t, u = res.t[bounds[p]:bounds[p + 1]], res.u[bounds[p]:bounds[p + 1]]
+        i = min(int(np.searchsorted(t[0::2], s, side="right")) - 1, (len(t) - 3) // 2) * 2
+        i = max(i, 0)
+        ti, tm, tj = t[i], t[i + 1], t[i + 2]
+        return float(u[i] * (s - tm) * (s - tj) / ((ti - tm) * (ti - tj))
+                     + u[i + 1] * (s - ti) * (s - tj) / ((tm - ti) * (tm - tj))
+                     + u[i + 2] * (s - ti) * (s - tm) / ((tj - ti) * (tj - tm)))
+    return tau
+
+
+def replay_phases(data, res: PhasedResult, solver=None):
+    """The optimised step replayed on the rigid model (its generated code, its own phases,
+    guards and resets; not the CasADi expressions): the walker with a hip actuator whose
+    torque is :func:`phase_torque_of_time` from each step's heel strike, one step from
+    ``x_0`` (DOP853 at rtol = atol = 1e-12 unless ``solver`` is given).
+
+    Returns
+    -------
+    error : float
+        Max-norm return error ``|x_0' - x_0|`` (inf when the step does not end in a heel
+        strike or crosses other phases than the optimised ones).
+    walker : HybridWalker
+        The replayed walker.
+    """
+    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+
+    spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
+    walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
+    acts = walker.actuators
+    tau = phase_torque_of_time(res)
+    acts.torques = lambda t, x: np.array([tau(float(np.real(t)) - acts.t_origin)])
+    solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+    seg = integrate_step(walker, np.asarray(res.x[0], float), solver,
+                         max_step_time=3.0 * res.step_period_s)
+    crossed = tuple(ph.name for ph, _s, _ab in seg.pieces)
+    if seg.termination != "heel_strike" or crossed != tuple(res.phase_names):
+        return float("inf"), walker
+    return float(np.max(np.abs(seg.x_next - res.x[0]))), walker
