@@ -198,7 +198,10 @@ def _stamp(path: Path) -> tuple:
 def _hash_scheme() -> str:
     """What a remembered hash is valid for: this module's source (the hashing code) and the
     walkerlab and h5py versions (how values are read)."""
-    h = hashlib.sha256(Path(__file__).read_bytes())
+    try:
+        h = hashlib.sha256(Path(__file__).read_bytes())
+    except OSError:  # no source file (a frozen or zipped install): never trust a memo
+        h = hashlib.sha256(os.urandom(16))
     h.update(f"{walkerlab.__version__} {h5py.__version__}".encode())
     return h.hexdigest()[:32]
 
@@ -214,7 +217,7 @@ def _disk_memo(key: tuple, value: str | None = None) -> str | None:
     d = private_dir("hashes", writable=value is not None)
     if d is None:
         return value
-    entry = d / f"{hashlib.sha256(key[0].encode()).hexdigest()[:32]}.json"
+    entry = d / f"{hashlib.sha256(os.fsencode(key[0])).hexdigest()[:32]}.json"
     stamp = [list(key), _hash_scheme()]
     if value is not None:
         write_private(entry, json.dumps({"stamp": stamp, "content_hash": value}))
