@@ -9,8 +9,10 @@ machine code it compiled earlier.  Both live in one folder per user, never in a 
 - ``$WALKERLAB_CACHE_DIR`` if set, else the platform's user cache folder:
   ``$XDG_CACHE_HOME/walkerlab`` (``~/.cache/walkerlab`` when unset) on Linux,
   ``~/Library/Caches/walkerlab`` on macOS, ``%LOCALAPPDATA%\\walkerlab`` on Windows;
-- sub-folders ``models/`` (generated Python), ``numba/`` (``NUMBA_CACHE_DIR``) and ``drop/``
-  (drop tests of contact laws, JSON numbers: :mod:`walkerlab.analysis.contact.drop`), created
+- sub-folders ``models/`` (generated Python), ``numba/`` (``NUMBA_CACHE_DIR``), ``drop/``
+  (drop tests of contact laws, JSON numbers: :mod:`walkerlab.analysis.contact.drop`) and
+  ``hashes/`` (recomputed content hashes of artifacts by file stamp, JSON: never trusted
+  for a file changed since, :mod:`walkerlab.io.artifacts`), created
   with mode 0700; files are written 0600, atomically (temporary name, then rename);
 - a folder or file is used only if it belongs to the current user, is not writable by group
   or others and is not a symbolic link (:func:`private_dir`, :func:`read_private`).  A file

@@ -13,6 +13,10 @@ measurement            what is timed                                            
                        folder: no generated code, no numba machine code, no drop
                        test) after ``walkerlab fixedpoint`` in that cache
 ``contact_sim_warm``   the same command again in that cache                              1 s
+``contact_sim_warm_``  ... and once more: the steady state of repeated runs (an
+``again``              upstream artifact changed less than 2 s before a check is
+                       hashed again; from then on its hash is remembered in the user
+                       cache, :mod:`walkerlab.io.artifacts`)
 ``report_cold``        the first ``walkerlab report SCENE`` of a fresh runs folder and   10 s
                        a fresh user cache, whole process
 ``montecarlo``         CPU per heel strike of the MFPT Monte Carlo walks (one chunk    1.2 x
@@ -29,7 +33,10 @@ measurement            what is timed                                            
                        fixed point done before)
 =====================  ==============================================================  =======
 
-Medians over ``repeats`` (the mesh and the robustness study once per tree unless asked).
+Medians over ``repeats`` (the mesh and the robustness study once per tree unless asked);
+with a second tree also the median over the repeats of each repeat's ratio of the two trees
+(``pair_ratios_this_over_vs``: the two runs of a pair are minutes apart at most, so a
+change of the machine's load moves both).
 """
 
 from __future__ import annotations
@@ -119,6 +126,9 @@ def _env(code: Path, cache: str | None = None) -> dict:
     env = dict(os.environ)
     env["PYTHONPATH"] = str(code)
     env.pop("NUMBA_CACHE_DIR", None)  # walkerlab sets it from its user cache
+    # an installed package has its bytecode (pip compiles it); without it every process
+    # compiles each imported module from source (~0.3 s CPU per process on the main job)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     if cache is not None:
         env["WALKERLAB_CACHE_DIR"] = cache
     return env
@@ -141,8 +151,8 @@ def _cli(*args: str) -> list[str]:
 
 
 def contact_sim(code: Path, scene: str) -> dict:
-    """Cold then warm ``contact-sim --force`` in a fresh user cache: ``{cold: (wall, cpu),
-    warm: (wall, cpu)}`` [s]."""
+    """Cold, warm and warm again ``contact-sim --force`` in a fresh user cache:
+    ``{cold: (wall, cpu), warm: (wall, cpu), warm_again: (wall, cpu)}`` [s]."""
     with tempfile.TemporaryDirectory() as d:
         env = _env(code, str(Path(d) / "cache"))
         runs = str(Path(d) / "runs")
@@ -150,7 +160,8 @@ def contact_sim(code: Path, scene: str) -> dict:
         cmd = _cli("contact-sim", scene, "--force", "--runs-dir", runs)
         cold = _run(cmd, env, code)[:2]
         warm = _run(cmd, env, code)[:2]
-    return {"cold": cold, "warm": warm}
+        again = _run(cmd, env, code)[:2]
+    return {"cold": cold, "warm": warm, "warm_again": again}
 
 
 def report_cold(code: Path, scene: str) -> tuple[float, float]:
@@ -248,7 +259,18 @@ def run_main_job(scene: str = "configs/paper.yaml", code: Path | None = None,
         out["ratios_this_over_vs"] = {m: res["this"][m] / res["vs"][m]
                                       for m in res["this"] if isinstance(res["this"][m], float)
                                       and res["vs"].get(m)}
+        out["pair_ratios_this_over_vs"] = _pair_ratios(raw)
     return out
+
+
+def _pair_ratios(raw: dict) -> dict:
+    """Median over the repeats of (this tree / vs tree) of each process measurement."""
+    per = {k: [_summary([r], [], {"mesh": [], "robustness": []}) for r in raw[k]]
+           for k in raw}
+    if not per["this"]:
+        return {}
+    return {m: float(np.median([a[m] / b[m] for a, b in zip(per["this"], per["vs"])]))
+            for m in per["this"][0] if all(b.get(m) for b in per["vs"])}
 
 
 def _summary(raw: list, mc: list, slow: dict) -> dict:
@@ -259,6 +281,9 @@ def _summary(raw: list, mc: list, slow: dict) -> dict:
         out["contact_sim_cold_cpu_s"] = float(np.median([c["cold"][1] for c in cs]))
         out["contact_sim_warm_wall_s"] = float(np.median([c["warm"][0] for c in cs]))
         out["contact_sim_warm_cpu_s"] = float(np.median([c["warm"][1] for c in cs]))
+        if "warm_again" in cs[0]:
+            out["contact_sim_warm_again_wall_s"] = _median([c["warm_again"] for c in cs], 0)
+            out["contact_sim_warm_again_cpu_s"] = _median([c["warm_again"] for c in cs], 1)
     if raw and "report_cold" in raw[0]:
         out["report_cold_wall_s"] = _median([r["report_cold"] for r in raw], 0)
         out["report_cold_cpu_s"] = _median([r["report_cold"] for r in raw], 1)
@@ -284,12 +309,14 @@ def lines(res: dict) -> list[str]:
     trees = list(res["results"])
     head = f"{'measurement':34s}" + "".join(f"{t:>12s}" for t in trees)
     if "ratios_this_over_vs" in res:
-        head += f"{'this/vs':>10s}"
+        head += f"{'this/vs':>10s}{'pairs':>10s}"
     rows = [head]
     for k in keys:
         row = f"{k:34s}" + "".join(f"{res['results'][t].get(k, float('nan')):12.3f}"
                                    for t in trees)
         if "ratios_this_over_vs" in res and k in res["ratios_this_over_vs"]:
             row += f"{res['ratios_this_over_vs'][k]:10.2f}"
+        if k in res.get("pair_ratios_this_over_vs", {}):
+            row += f"{res['pair_ratios_this_over_vs'][k]:10.2f}"
         rows.append(row)
     return rows

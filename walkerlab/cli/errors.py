@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 import os
+import sys
 
 import typer
 
@@ -83,6 +84,18 @@ def _disk_full_line(exc: BaseException) -> str:
             "limit) and rerun")
 
 
+#: errors shown as one line that live in modules a command may never import: looked up in
+#: ``sys.modules`` when an exception is handled (a module never imported raised nothing), so
+#: the guard does not import the rigid walker's analysis into every command
+_ONE_LINE_ERRORS = (("walkerlab.analysis.gait.poincare", "FixedPointNotFound"),)
+
+
+def _loaded_errors(names) -> tuple[type, ...]:
+    """The exception classes ``(module, name)`` of ``names`` whose module is imported."""
+    mods = ((sys.modules.get(m), n) for m, n in names)
+    return tuple(getattr(m, n) for m, n in mods if m is not None and hasattr(m, n))
+
+
 def guard(fn):
     """Run a command so that every failure is one line on stderr and a non-zero exit code."""
     import functools
@@ -90,7 +103,6 @@ def guard(fn):
     @functools.wraps(fn)
     def wrapper(*a, **k):
         from walkerlab import progress
-        from walkerlab.analysis.gait.poincare import FixedPointNotFound
         from walkerlab.config import SceneError
         from walkerlab.io.artifacts import ArtifactError, is_disk_full
         from walkerlab.io.runpaths import ArtifactBusy
@@ -112,8 +124,8 @@ def guard(fn):
             for line in str(exc).splitlines() or [""]:
                 typer.echo(f"error: {line.strip()}", err=True)
             raise typer.Exit(code=1) from None
-        except (ArtifactError, ArtifactBusy, StageError, FixedPointNotFound,
-                ValueError) as exc:
+        except (ArtifactError, ArtifactBusy, StageError, ValueError,
+                *_loaded_errors(_ONE_LINE_ERRORS)) as exc:
             if debug:
                 raise
             typer.echo(f"error: {one_line(exc)}", err=True)

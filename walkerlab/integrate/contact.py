@@ -45,7 +45,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import ODEintWarning, odeint, solve_ivp
 
 from walkerlab.models.contact.energy import (
     energy_rise_bound,
@@ -309,6 +308,8 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline
     fall.terminal = True
     fall.direction = -1
     events = [fall] + ([touch] if until_touchdown else [])
+    from scipy.integrate import solve_ivp  # here: the compiled backends need no scipy.integrate
+
     try:
         sol = solve_ivp(_guarded(f, deadline), (t0, t_end), z0, method="LSODA",
                         rtol=solver.rtol, atol=solver.atol,
@@ -349,6 +350,8 @@ class _Backend:
         self.data = walker.pack() if self.compiled else None
 
     def odeint_chunk(self, xs, tg):
+        from scipy.integrate import ODEintWarning, odeint
+
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ODEintWarning)
             X, info = odeint(self.frhs, xs, tg, Dfun=self.fjac, tfirst=True,
@@ -390,6 +393,8 @@ class _Backend:
                 nf += nf2
                 tn, Xn = np.concatenate([tn, tr]), np.vstack([Xn, Xr])
             return tn, Xn, ok, m, nf, nj
+        from scipy.integrate import solve_ivp
+
         kw = {"jac": self.fjac} if self.fjac is not None else {}
         sol = solve_ivp(self.frhs, (tg[0], tg[-1]), xa, method=self.method, rtol=s.rtol,
                         atol=s.atol, max_step=self.max_step, t_eval=tg, **kw)

@@ -37,7 +37,6 @@ passed (the actuation's derivatives left out: Newton directions only).
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from walkerlab.models.contact.actuation import powered_rhs
 
@@ -69,6 +68,8 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
     ``t_origin`` [s] is when the present step began (time-based torque laws); ``ankle``:
     the ankle push-off is on."""
     import time
+
+    from scipy.integrate import solve_ivp  # here: a run without actuators needs none of it
 
     n, nw = 2 * walker.nq, len(walker.actuators.work_names)
     method = solver.method if solver.method in IVP_METHODS else "LSODA"

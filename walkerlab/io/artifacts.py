@@ -176,10 +176,17 @@ def content_hash_of(f: h5py.File) -> str:
     return h.hexdigest()
 
 
-# Recomputed content hashes, per process, keyed by the file's identity and modification
-# stamp: a report checks the same upstream files several times; any rewrite or edit of a
-# file changes its stamp, so it is hashed again.
+# Recomputed content hashes, keyed by the file's identity and modification stamp (path,
+# inode, size, modification and status-change times [ns]): a report checks the same
+# upstream files several times, and every command checks the artifacts it reads (a
+# contact run its fixedpoint.h5).  Any rewrite or edit of a file changes its stamp - the
+# status-change time is set by the kernel on every change and cannot be set back - so it
+# is hashed again.  Kept per process and across processes in the private user cache
+# (``hashes/``, one small JSON file per artifact path: :func:`_disk_memo`).
 _HASH_MEMO: dict[tuple, str] = {}
+#: a file changed less than this long ago [ns] is always hashed: a second edit within the
+#: file system's time-stamp resolution could keep the same stamp
+RECENT_NS = 2_000_000_000
 
 
 def _stamp(path: Path) -> tuple:
@@ -187,13 +194,51 @@ def _stamp(path: Path) -> tuple:
     return (os.path.realpath(path), st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
+@lru_cache(maxsize=1)
+def _hash_scheme() -> str:
+    """What a remembered hash is valid for: this module's source (the hashing code) and the
+    walkerlab and h5py versions (how values are read)."""
+    try:
+        h = hashlib.sha256(Path(__file__).read_bytes())
+    except OSError:  # no source file (a frozen or zipped install): never trust a memo
+        h = hashlib.sha256(os.urandom(16))
+    h.update(f"{walkerlab.__version__} {h5py.__version__}".encode())
+    return h.hexdigest()[:32]
+
+
+def _disk_memo(key: tuple, value: str | None = None) -> str | None:
+    """The content hash remembered for the stamp ``key`` in the private user cache (None: not
+    remembered, another stamp, no usable cache); with ``value``: remember it (if the cache
+    can be written) and return it."""
+    import json
+
+    from walkerlab.usercache import private_dir, read_private, write_private
+
+    d = private_dir("hashes", writable=value is not None)
+    if d is None:
+        return value
+    entry = d / f"{hashlib.sha256(os.fsencode(key[0])).hexdigest()[:32]}.json"
+    stamp = [list(key), _hash_scheme()]
+    if value is not None:
+        write_private(entry, json.dumps({"stamp": stamp, "content_hash": value}))
+        return value
+    try:
+        got = json.loads(read_private(entry) or "null")
+    except ValueError:  # damaged: a miss (rewritten after hashing)
+        return None
+    if isinstance(got, dict) and got.get("stamp") == stamp \
+            and isinstance(got.get("content_hash"), str):
+        return got["content_hash"]
+    return None
+
+
 def _content_hash_memo(path: Path, f: h5py.File) -> str:
     key = _stamp(path)
-    if time.time_ns() - key[3] < 2_000_000_000:
-        # modified in the last 2 s: a second edit could keep the same coarse time stamp
+    if time.time_ns() - max(key[3], key[4]) < RECENT_NS:
+        # changed in the last 2 s: a second edit could keep the same coarse time stamp
         return content_hash_of(f)
     if key not in _HASH_MEMO:
-        _HASH_MEMO[key] = content_hash_of(f)
+        _HASH_MEMO[key] = _disk_memo(key) or _disk_memo(key, content_hash_of(f))
     return _HASH_MEMO[key]
 
 

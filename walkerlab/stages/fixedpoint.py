@@ -9,8 +9,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from walkerlab.analysis.gait.scene import fixed_point_run
-from walkerlab.analysis.gait.search import GaitNotFound
 from walkerlab.config import Scene, SceneError
 from walkerlab.io.schemas.fixedpoint import write_fixedpoint
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
@@ -48,6 +46,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                                                           sort_keys=True)
 
     def compute():
+        # the rigid analysis only when the gait is computed: a run that reuses fixedpoint.h5
+        # (every downstream stage's upstream check) imports none of it
+        from walkerlab.analysis.gait.scene import fixed_point_run
+        from walkerlab.analysis.gait.search import GaitNotFound
+
         guess = note = None
         try:
             if src is not None:  # the known gait carried here
