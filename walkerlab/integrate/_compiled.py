@@ -163,8 +163,8 @@ def guard_values(compiled, t: float, x: np.ndarray) -> np.ndarray | None:
     if "entry" not in memo:
         proto = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_double, ctypes.c_void_p,
                                  ctypes.c_void_p)
-        memo["entry"] = (proto(compiled.address(False)), compiled.data())  # own counter
-    fn, data = memo["entry"]
+        memo["entry"] = proto(compiled.address(False))
+    fn, data = memo["entry"], compiled.data()  # a fresh copy: the cfunc counts its calls
     y = np.ascontiguousarray(x, dtype=np.float64)
     out = np.empty(y.size + cols[0])
     fn(out.ctypes.data, float(t), y.ctypes.data, data.ctypes.data)
@@ -204,15 +204,15 @@ def first_chunk(compiled, solver) -> int:
 
 class _Plan:
     """What every run of one compiled phase on one solver shares (built once, kept on the
-    flow: its cfunc's address, data vector, CyRK's method and tolerances, the guards'
-    columns): a mode switch then costs the runs, not their set-up."""
+    flow: its cfunc's address, CyRK's method and tolerances, the guards' columns; not the
+    data vector, which a time-based torque law changes each step): a mode switch then costs
+    the runs, not their set-up."""
 
     def __init__(self, compiled, variational: bool, solver, m: int):
         from CyRK.cy.pyhelpers import find_ode_method_int
 
         self.ns = ns = _numba_solver()
         self.addr = compiled.address(variational)
-        self.data = compiled.data()  # CyRK copies it: never written here
         self.method_int = find_ode_method_int(solver.method)
         self.rtol = np.array([float(solver.rtol)])
         self.atol = np.ascontiguousarray(np.atleast_1d(solver.atol), dtype=np.float64)
@@ -223,14 +223,14 @@ class _Plan:
         self.n_extra, self.gcol, self.goff = (cols[0], cols[1] + m, cols[2]) if cols \
             else (0, None, None)
 
-    def run(self, ta, tb, ya, max_steps, first_step, dense):
-        """:func:`_solve` from ``ya`` at ``ta`` towards ``tb``."""
-        return _solve(self.addr, self.data, ta, tb, ya, self.method_int, self.rtol, self.atol,
+    def run(self, data, ta, tb, ya, max_steps, first_step, dense):
+        """:func:`_solve` from ``ya`` at ``ta`` towards ``tb`` with the flow's ``data``."""
+        return _solve(self.addr, data, ta, tb, ya, self.method_int, self.rtol, self.atol,
                       self.hmax, max_steps, first_step, dense, self.n_extra)
 
-    def piece(self, ta, tb, ya, h0) -> list:
+    def piece(self, data, ta, tb, ya, h0) -> list:
         """:func:`_piece` of this phase."""
-        return _piece(self.addr, self.data, ta, tb, ya, self.method_int, self.rtol, self.atol,
+        return _piece(self.addr, data, ta, tb, ya, self.method_int, self.rtol, self.atol,
                       self.hmax, h0) + [self.n_extra]
 
 
@@ -246,7 +246,7 @@ def _plan(compiled, variational: bool, solver, m: int) -> _Plan:
     return memo[key]
 
 
-def _crossing(plan: _Plan, T, Y, k: int, active, fns, n: int, m: int, dense, h0):
+def _crossing(plan: _Plan, data, T, Y, k: int, active, fns, n: int, m: int, dense, h0):
     """The phase's end at the first crossing, between steps ``k-1`` and ``k`` of the chunk
     ``(T, Y)``: that step again with dense output, the earliest root of the ``active``
     guards on it (Brent).  Returns ``(t, y (m,), failed, message or '', event, nfev)``."""
@@ -257,12 +257,12 @@ def _crossing(plan: _Plan, T, Y, k: int, active, fns, n: int, m: int, dense, h0)
     # 2 hk, and CyRK then refuses the first step; the step after it, about hk, is unused:
     # a longer span costs more unused steps)
     hk = T[k] - T[k - 1]
-    step, _, _, ok1, msg1, nf1 = plan.run(T[k - 1], T[k - 1] + REDO_SPAN_STEPS * hk,
+    step, _, _, ok1, msg1, nf1 = plan.run(data, T[k - 1], T[k - 1] + REDO_SPAN_STEPS * hk,
                                           Y[k - 1, :m], 0, hk, True)
     if not ok1:  # pragma: no cover - the step was accepted once already
         return float(T[k - 1]), Y[k - 1, :m], True, msg1, None, nf1
     if k > 1:  # the steps before it, run again with dense output on demand
-        dense.pieces.append(plan.piece(T[0], T[k - 1], Y[0, :m], h0))
+        dense.pieces.append(plan.piece(data, T[0], T[k - 1], Y[0, :m], h0))
     dense.pieces.append([float(T[k - 1]), float(T[k]), step])
     out = np.empty(m + plan.n_extra)
     call, sp, op = plan.ns.c_call, step.ptr, out.ctypes.data
@@ -310,6 +310,7 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     """
     m = y0.size
     plan = _plan(compiled, variational, solver, m)
+    data = compiled.data()  # CyRK copies it: never written here
     dirs = np.array([g.direction for g in guards])
     fns = [g.function for g in guards]
     if plan.cols:
@@ -321,15 +322,15 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     dense = CompiledDense(m + plan.n_extra)
     ta, ya, h0, nfev, K = float(t0), np.asarray(y0, float), 0.0, 0, plan.K
     while True:
-        _res, T, Y, ok, msg, nf = plan.run(ta, t1, ya, K, h0, False)
+        _res, T, Y, ok, msg, nf = plan.run(data, ta, t1, ya, K, h0, False)
         nfev += nf
         k, active = _first_crossing(values(T, Y), dirs) if T.size > 1 else (None, None)
         if k is not None:
-            te, ye, failed, msg1, i, nf1 = _crossing(plan, T, Y, k, active, fns, n, m, dense,
-                                                     h0)
+            te, ye, failed, msg1, i, nf1 = _crossing(plan, data, T, Y, k, active, fns, n, m,
+                                                     dense, h0)
             return te, ye, failed, msg1 or msg, i, dense, nfev + nf1
         if T.size > 1:
-            dense.pieces.append(plan.piece(T[0], T[-1], Y[0, :m], h0))
+            dense.pieces.append(plan.piece(data, T[0], T[-1], Y[0, :m], h0))
         if ok or T.size < 2 or T[-1] >= t1:
             return (float(T[-1]) if T.size else ta, Y[-1, :m] if T.size else ya, not ok, msg,
                     None, dense, nfev)
