@@ -9,7 +9,14 @@ Strides: DOP853 at rtol = atol = 1e-10 from each walker's gait; the cases are in
 imported and compiled), so the ratios hold on any machine.  Fixed point: the scene's solver
 from its initial guess, median of 3.
 
-    python scripts/bench_flat_feet.py [--rounds 15]
+    python scripts/bench_flat_feet.py [--rounds 15] [--contact]
+
+``--contact``: also the contact model of both walkers at the issue's 1e-6 rad (``walkerlab
+bench contact``'s scan, :func:`walkerlab.bench.contact.run_scene_benchmark`, CyRK's BDF only,
+3 runs per rtol): the band found, its median wall time and RHS calls, and flat feet over
+kneed.  Measured on the same scan with CPU times (session 12, load ~10): flat feet 74 ms
+against kneed's 134 ms (0.55x), 47 k RHS calls against 160 k; with a flat foot's rates held
+to the angles' atol, 460 ms (2.8x).
 """
 
 from __future__ import annotations
@@ -52,6 +59,8 @@ def main() -> None:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=15)
+    ap.add_argument("--contact", action="store_true",
+                    help="also the contact model at 1e-6 rad (see the module docstring)")
     a = ap.parse_args()
     cases = _cases()
     gc.collect()
@@ -79,6 +88,31 @@ def main() -> None:
         print(f"{name:10s} {b:14s} {1e3 * m:12.2f} {nfev[(name, b)]:6d} "
               f"{m / med[('kneed', b)]:12.2f} {m / med[('kneed', 'cyrk_compiled')]:13.2f} "
               f"{fp[(name, b)]:13.3f}")
+    if a.contact:
+        contact()
+
+
+def contact() -> None:
+    """Flat feet against the kneed walker at 1e-6 rad, contact model, one run."""
+    from walkerlab.bench.contact import run_scene_benchmark
+    from walkerlab.config import load_scene
+
+    out = {}
+    for name in ("kneed", "flat_feet"):
+        r = run_scene_benchmark(load_scene(CONFIGS / f"{name}.yaml"), methods=("cyrk_bdf",),
+                                repeats=3)
+        out[name] = t = r["target"]["cyrk_bdf"]
+        if t["reached"]:
+            print(f"contact {name:10s} band from rtol {t['rtols'][0]:.3g}: median wall "
+                  f"{1e3 * t['median_wall_time_s']:.1f} ms, RHS calls {int(np.median(t['nfev']))}, "
+                  f"worst error {t['worst_error_rad']:.2g} rad")
+        else:
+            print(f"contact {name:10s}: 1e-6 rad not reached")
+    if all(t["reached"] for t in out.values()):
+        k, f = out["kneed"], out["flat_feet"]
+        wall = f["median_wall_time_s"] / k["median_wall_time_s"]
+        print(f"contact flat feet / kneed: wall {wall:.2f}, "
+              f"RHS calls {np.median(f['nfev']) / np.median(k['nfev']):.2f}")
 
 
 if __name__ == "__main__":

@@ -65,6 +65,10 @@ class CompiledFlow:
         at the guards (:mod:`walkerlab.integrate._compiled`; the chunks then double): the
         steps after a crossing in a chunk are wasted, so a phase that often ends within a
         few steps wants a short first chunk (a flat foot's modes: 8).
+    chunk_rtol : float, optional
+        The tolerance ``first_chunk_steps`` was measured at: the chunk then scales with the
+        solver's ``rtol`` as a phase's step count does
+        (:func:`walkerlab.integrate._compiled.first_chunk`); None: the same at every rtol.
     """
 
     structure: object
@@ -72,6 +76,7 @@ class CompiledFlow:
     name: str = "flow"
     guards: tuple | None = None
     first_chunk_steps: int = 24
+    chunk_rtol: float | None = None
     _memo: dict = field(default_factory=dict, repr=False, compare=False)
     #: the batched step map may run this flow (its module's ``flow`` cfuncs and reset)
     batchable = True

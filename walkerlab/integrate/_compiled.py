@@ -27,7 +27,28 @@ import ctypes
 import numpy as np
 
 EPS = np.finfo(float).eps
+_NS: list = []  # CyRK's numba bridge, once imported
+
+
+def _numba_solver():
+    """CyRK's numba bridge (``CyRK.nb.numba_solver``), imported on first use with numba's
+    cache pointed at the user cache first (:func:`walkerlab.usercache.use_for_numba`)."""
+    if not _NS:
+        from walkerlab.usercache import use_for_numba
+
+        use_for_numba()  # numba's cache in the user cache (before numba loads)
+        from CyRK.nb import numba_solver
+
+        _NS.append(numba_solver)
+    return _NS[0]
 FIRST_CHUNK_STEPS = 24
+#: How a phase's step count n scales with the tolerance, ``n ~ rtol ** (-1 / order)``: DOP853
+#: 9 (measured on the flat foot's modes from rtol 1e-8 to 1e-12: x1.29-1.35 per decade),
+#: RK45 5 and RK23 3 (their error orders + 1).
+STEP_COUNT_ORDER = {"DOP853": 9.0, "RK45": 5.0, "RK23": 3.0}
+#: Span of the run that repeats a crossing step with dense output [steps of that size]:
+#: just over the 2 CyRK needs to take the first step as given.
+REDO_SPAN_STEPS = 2.0 + 1e-9
 
 
 class _Result:
@@ -59,41 +80,53 @@ class CompiledDense:
             piece[2] = _solve(*piece[2], *piece[3:])[0]
         return piece[2]
 
-    def _one(self, t: float) -> np.ndarray:
-        from walkerlab.usercache import use_for_numba
+    def _fill(self, times: np.ndarray, out: np.ndarray) -> None:
+        """The dense state (and guards) at each of ``times`` (k,) into the columns of ``out``
+        (m, k): one CyRK call per time, no Python per call beyond it."""
+        ns = _numba_solver()
 
-        use_for_numba()  # numba's cache in the user cache (before numba loads)
-        from CyRK.nb import numba_solver as ns
-
-        for j, piece in enumerate(self.pieces):
-            ta, tb = piece[0], piece[1]
-            if t <= tb or j == len(self.pieces) - 1:
-                out = np.empty(self.m)
-                ns.c_call(self._result(piece).ptr, float(min(max(t, ta), tb)), out.ctypes.data)
-                return out  # state, then the guards (extra outputs) if any
-        raise ValueError("no dense output")  # pragma: no cover
+        call, last = ns.c_call, len(self.pieces) - 1
+        if last < 0:
+            raise ValueError("no dense output")  # pragma: no cover
+        row = np.empty(self.m)
+        addr = row.ctypes.data
+        for c, t in enumerate(times.tolist()):
+            for j, piece in enumerate(self.pieces):
+                ta, tb = piece[0], piece[1]
+                if t <= tb or j == last:
+                    call(self._result(piece).ptr, min(max(t, ta), tb), addr)
+                    out[:, c] = row  # state, then the guards (extra outputs) if any
+                    break
 
     def __call__(self, t):
         t = np.asarray(t, dtype=float)
-        if t.ndim == 0:
-            return self._one(float(t))
-        return np.stack([self._one(float(s)) for s in t.ravel()], axis=1)
+        out = np.empty((self.m, t.size))
+        self._fill(t.ravel(), out)
+        return out[:, 0] if t.ndim == 0 else out
+
+
+def _copy_out(ptr, shape: tuple) -> np.ndarray:
+    """A float64 array of ``shape`` copied from C memory at ``ptr`` (a ctypes pointer):
+    one memmove, no ctypes array type built per call as ``np.ctypeslib.as_array`` does."""
+    out = np.empty(shape)
+    if out.size:
+        ctypes.memmove(out.ctypes.data, ptr, out.nbytes)
+    return out
+
+
+_NO_TIMES = np.empty(0)
 
 
 def _solve(addr, data, t0, t1, y0, method_int, rtol, atol, hmax, max_steps, first_step, dense,
            n_extra=0):
     """One CyRK run; returns ``(result, T (k,), Y (k, m + n_extra), ok, message, nfev)``."""
-    from walkerlab.usercache import use_for_numba
-
-    use_for_numba()  # numba's cache in the user cache (before numba loads)
-    from CyRK.nb import numba_solver as ns
+    ns = _numba_solver()
 
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
-    te = np.empty(0)
     c0 = data[-1]
     ptr = ns.c_numba_cysolve_ivp(
         addr, float(t0), float(t1), y0.ctypes.data, y0.size, method_int, 0, n_extra,
-        data.ctypes.data, data.size * 8, max_steps, 2000, dense, te.ctypes.data, 0,
+        data.ctypes.data, data.size * 8, max_steps, 2000, dense, _NO_TIMES.ctypes.data, 0,
         None, None, 0, rtol.ctypes.data, rtol.size, atol.ctypes.data, atol.size, hmax,
         float(first_step), False)
     if not ptr:  # pragma: no cover - allocation failure inside CyRK
@@ -101,11 +134,11 @@ def _solve(addr, data, t0, t1, y0, method_int, rtol, atol, hmax, max_steps, firs
     res = _Result(ptr, ns)
     k = int(ns.c_get_size(ptr))
     ndy = int(ns.c_get_num_dy(ptr))
-    T = np.ctypeslib.as_array(ns.c_get_t_ptr(ptr), (k,)).copy() if k else np.empty(0)
-    Y = (np.ctypeslib.as_array(ns.c_get_y_ptr(ptr), (k, ndy)).copy() if k
-         else np.empty((0, ndy)))
-    args = ctypes.cast(ns.c_get_args_ptr(ptr), ctypes.POINTER(ctypes.c_double))
-    nfev = int(args[data.size - 1] - c0)
+    T = _copy_out(ns.c_get_t_ptr(ptr), (k,))
+    Y = _copy_out(ns.c_get_y_ptr(ptr), (k, ndy))
+    # the call counter: the last entry of CyRK's copy of the data vector
+    args = ctypes.addressof(ns.c_get_args_ptr(ptr).contents)
+    nfev = int(ctypes.c_double.from_address(args + 8 * (data.size - 1)).value - c0)
     buf = ctypes.create_string_buffer(256)
     ns.c_get_msg_buf(ptr, ctypes.addressof(buf), 256)
     return (res, T, Y, bool(ns.c_get_success(ptr)), buf.value.decode(errors="replace"), nfev)
@@ -118,18 +151,136 @@ def _piece(addr, data, ta, tb, ya, method_int, rtol, atol, hmax, h0) -> list:
                                    True)]
 
 
+def guard_values(compiled, t: float, x: np.ndarray) -> np.ndarray | None:
+    """The phase's guards at one state ``x`` (2n,) at time ``t`` [s], from its compiled
+    flow's extra outputs (one cfunc call, no Python flow: what a mode's entry check needs);
+    None when the flow has no guard outputs (:attr:`CompiledFlow.guards` None).  The same
+    functions as the Python guards, to round-off."""
+    cols = compiled.guard_columns()
+    if cols is None:
+        return None
+    memo = compiled._memo  # noqa: SLF001 - the flow's own cache, shared with its backend
+    if "entry" not in memo:
+        proto = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_double, ctypes.c_void_p,
+                                 ctypes.c_void_p)
+        memo["entry"] = proto(compiled.address(False))
+    fn, data = memo["entry"], compiled.data()  # a fresh copy: the cfunc counts its calls
+    y = np.ascontiguousarray(x, dtype=np.float64)
+    out = np.empty(y.size + cols[0])
+    fn(out.ctypes.data, float(t), y.ctypes.data, data.ctypes.data)
+    return out[y.size + cols[1]] + cols[2]
+
+
 def _first_crossing(G: np.ndarray, dirs: np.ndarray):
     """First row ``k >= 1`` of guard values ``G`` (k, g) where a guard changes sign in its
-    direction between rows ``k-1`` and ``k`` (``solve_ivp``'s rule), and the mask of those
-    guards; ``(None, None)`` if none."""
-    a, b = G[:-1], G[1:]
-    up = (a <= 0) & (b >= 0) & (dirs >= 0)
-    down = (a >= 0) & (b <= 0) & (dirs <= 0)
-    hit = up | down
-    rows = np.flatnonzero(hit.any(axis=1))
-    if rows.size == 0:
+    direction between rows ``k-1`` and ``k`` (``solve_ivp``'s rule: ``up = g0 <= 0 <= g1``,
+    ``down = g0 >= 0 >= g1``), and the mask of those guards; ``(None, None)`` if none."""
+    nonpos, nonneg = G <= 0, G >= 0
+    hit = nonpos[:-1] & nonneg[1:]
+    hit &= dirs >= 0
+    down = nonneg[:-1] & nonpos[1:]
+    down &= dirs <= 0
+    hit |= down
+    rows = hit.any(axis=1)
+    j = int(rows.argmax())
+    if not rows[j]:
         return None, None
-    return int(rows[0]) + 1, hit[rows[0]]
+    return j + 1, hit[j]
+
+
+def first_chunk(compiled, solver) -> int:
+    """Steps of the first chunk of a phase [-]: the flow's ``first_chunk_steps`` (default
+    :data:`FIRST_CHUNK_STEPS`), scaled, when the flow gives the tolerance it was measured at
+    (``chunk_rtol``), as a phase's step count scales with the tolerance:
+    ``(rtol / chunk_rtol) ** (-1 / STEP_COUNT_ORDER[method])``.  The chunk depends on the
+    flow and the solver only, never on earlier runs (results do not depend on history)."""
+    k = getattr(compiled, "first_chunk_steps", FIRST_CHUNK_STEPS)
+    ref = getattr(compiled, "chunk_rtol", None)
+    order = STEP_COUNT_ORDER.get(solver.method)
+    if ref is None or order is None:
+        return k
+    return max(2, int(np.ceil(k * (float(solver.rtol) / ref) ** (-1.0 / order))))
+
+
+class _Plan:
+    """What every run of one compiled phase on one solver shares (built once, kept on the
+    flow: its cfunc's address, CyRK's method and tolerances, the guards' columns; not the
+    data vector, which a time-based torque law changes each step): a mode switch then costs
+    the runs, not their set-up."""
+
+    def __init__(self, compiled, variational: bool, solver, m: int):
+        from CyRK.cy.pyhelpers import find_ode_method_int
+
+        self.ns = ns = _numba_solver()
+        self.addr = compiled.address(variational)
+        self.method_int = find_ode_method_int(solver.method)
+        self.rtol = np.array([float(solver.rtol)])
+        self.atol = np.ascontiguousarray(np.atleast_1d(solver.atol), dtype=np.float64)
+        self.hmax = float(solver.max_step_s) if solver.max_step_s else ns.MAX_SIZE
+        self.K = first_chunk(compiled, solver)
+        cols = compiled.guard_columns()
+        self.cols = cols is not None
+        self.n_extra, self.gcol, self.goff = (cols[0], cols[1] + m, cols[2]) if cols \
+            else (0, None, None)
+
+    def run(self, data, ta, tb, ya, max_steps, first_step, dense):
+        """:func:`_solve` from ``ya`` at ``ta`` towards ``tb`` with the flow's ``data``."""
+        return _solve(self.addr, data, ta, tb, ya, self.method_int, self.rtol, self.atol,
+                      self.hmax, max_steps, first_step, dense, self.n_extra)
+
+    def piece(self, data, ta, tb, ya, h0) -> list:
+        """:func:`_piece` of this phase."""
+        return _piece(self.addr, data, ta, tb, ya, self.method_int, self.rtol, self.atol,
+                      self.hmax, h0) + [self.n_extra]
+
+
+def _plan(compiled, variational: bool, solver, m: int) -> _Plan:
+    """The :class:`_Plan` of ``compiled`` on ``solver`` (memoised on the flow)."""
+    memo = getattr(compiled, "_memo", None)
+    key = ("plan", variational, solver.method, float(solver.rtol),
+           tuple(np.atleast_1d(solver.atol).tolist()), solver.max_step_s, m)
+    if memo is None:
+        return _Plan(compiled, variational, solver, m)
+    if key not in memo:
+        memo[key] = _Plan(compiled, variational, solver, m)
+    return memo[key]
+
+
+def _crossing(plan: _Plan, data, T, Y, k: int, active, fns, n: int, m: int, dense, h0):
+    """The phase's end at the first crossing, between steps ``k-1`` and ``k`` of the chunk
+    ``(T, Y)``: that step again with dense output, the earliest root of the ``active``
+    guards on it (Brent).  Returns ``(t, y (m,), failed, message or '', event, nfev)``."""
+    from scipy.optimize import brentq
+
+    # the step T[k-1] -> T[k] again, with dense output (CyRK wants a first step of at most
+    # half the span, so the span is a little over 2 steps: T[k-1] + 2 hk can round below
+    # 2 hk, and CyRK then refuses the first step; the step after it, about hk, is unused:
+    # a longer span costs more unused steps)
+    hk = T[k] - T[k - 1]
+    step, _, _, ok1, msg1, nf1 = plan.run(data, T[k - 1], T[k - 1] + REDO_SPAN_STEPS * hk,
+                                          Y[k - 1, :m], 0, hk, True)
+    if not ok1:  # pragma: no cover - the step was accepted once already
+        return float(T[k - 1]), Y[k - 1, :m], True, msg1, None, nf1
+    if k > 1:  # the steps before it, run again with dense output on demand
+        dense.pieces.append(plan.piece(data, T[0], T[k - 1], Y[0, :m], h0))
+    dense.pieces.append([float(T[k - 1]), float(T[k]), step])
+    out = np.empty(m + plan.n_extra)
+    call, sp, op = plan.ns.c_call, step.ptr, out.ctypes.data
+    roots = []
+    for i in np.flatnonzero(active):  # each g is used (by brentq) in its iteration only
+        if plan.cols:
+            def g(t, _c=int(plan.gcol[i]), _o=float(plan.goff[i]), _a=(call, sp, op), _y=out):
+                _a[0](_a[1], t, _a[2])
+                return _y[_c] + _o
+        else:
+            def g(t, _f=fns[i], _a=(call, sp, op), _y=out):
+                _a[0](_a[1], t, _a[2])
+                return _f(t, _y[:n])
+        gk = g(T[k])
+        roots.append((float(T[k]) if gk == 0.0 else
+                      brentq(g, T[k - 1], T[k], xtol=4 * EPS, rtol=4 * EPS), int(i)))
+    te, i = min(roots)
+    return float(te), dense(te)[:m], False, "", i, nf1
 
 
 def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarray, guards,
@@ -157,77 +308,29 @@ def solve_phase(compiled, variational: bool, t0: float, t1: float, y0: np.ndarra
     -------
     t_last, y_last (m,), failed, message, event index or None, dense, nfev
     """
-    from walkerlab.usercache import use_for_numba
-
-    use_for_numba()  # numba's cache in the user cache (before numba loads)
-    from CyRK.cy.pyhelpers import find_ode_method_int
-    from CyRK.nb import numba_solver as ns
-    from scipy.optimize import brentq
-
-    addr = compiled.address(variational)
-    data = compiled.data()
-    method_int = find_ode_method_int(solver.method)
-    rtol = np.array([float(solver.rtol)])
-    atol = np.ascontiguousarray(np.atleast_1d(solver.atol), dtype=np.float64)
-    hmax = float(solver.max_step_s) if solver.max_step_s else ns.MAX_SIZE
     m = y0.size
-    cols = compiled.guard_columns()
+    plan = _plan(compiled, variational, solver, m)
+    data = compiled.data()  # CyRK copies it: never written here
     dirs = np.array([g.direction for g in guards])
     fns = [g.function for g in guards]
-    if cols is not None:
-        n_extra, gcol, goff = cols
-        gcol = gcol + m
-
+    if plan.cols:
         def values(T, Y):
-            return Y[:, gcol] + goff
+            return Y[:, plan.gcol] + plan.goff
     else:
-        n_extra = 0
-
         def values(T, Y):
             return np.array([[f(t, y[:n]) for f in fns] for t, y in zip(T, Y)])
-    dense = CompiledDense(m + n_extra)
-    ta, ya, h0, nfev = float(t0), np.asarray(y0, float), 0.0, 0
-    K = getattr(compiled, "first_chunk_steps", FIRST_CHUNK_STEPS)
+    dense = CompiledDense(m + plan.n_extra)
+    ta, ya, h0, nfev, K = float(t0), np.asarray(y0, float), 0.0, 0, plan.K
     while True:
-        res, T, Y, ok, msg, nf = _solve(addr, data, ta, t1, ya, method_int, rtol, atol, hmax,
-                                        K, h0, False, n_extra)
+        _res, T, Y, ok, msg, nf = plan.run(data, ta, t1, ya, K, h0, False)
         nfev += nf
         k, active = _first_crossing(values(T, Y), dirs) if T.size > 1 else (None, None)
         if k is not None:
-            # the step T[k-1] -> T[k] again, with dense output (CyRK wants a first step of
-            # at most half the span, so the span is 3 steps: T[k-1] + 2 hk can round below
-            # 2 hk, and CyRK then refuses the first step; the steps after it are unused)
-            hk = T[k] - T[k - 1]
-            step, _, _, ok1, msg1, nf1 = _solve(addr, data, T[k - 1], T[k - 1] + 3 * hk,
-                                                 Y[k - 1, :m], method_int, rtol, atol, hmax, 0,
-                                                 hk, True, n_extra)
-            nfev += nf1
-            if not ok1:  # pragma: no cover - the step was accepted once already
-                return float(T[k - 1]), Y[k - 1, :m], True, msg1, None, dense, nfev
-            if k > 1:  # the steps before it, run again with dense output on demand
-                dense.pieces.append(_piece(addr, data, T[0], T[k - 1], Y[0, :m], method_int,
-                                           rtol, atol, hmax, h0) + [n_extra])
-            dense.pieces.append([float(T[k - 1]), float(T[k]), step])
-            out = np.empty(m + n_extra)
-            call, sp, op = ns.c_call, step.ptr, out.ctypes.data
-            roots = []
-            for i in np.flatnonzero(active):  # each g is used (by brentq) in its iteration only
-                if cols is not None:
-                    def g(t, _c=int(gcol[i]), _o=float(goff[i]), _a=(call, sp, op), _y=out):
-                        _a[0](_a[1], t, _a[2])
-                        return _y[_c] + _o
-                else:
-                    def g(t, _f=fns[i], _a=(call, sp, op), _y=out):
-                        _a[0](_a[1], t, _a[2])
-                        return _f(t, _y[:n])
-                gk = g(T[k])
-                roots.append((float(T[k]) if gk == 0.0 else
-                              brentq(g, T[k - 1], T[k], xtol=4 * EPS, rtol=4 * EPS), int(i)))
-            te, i = min(roots)
-            return float(te), dense(te)[:m], False, msg, i, dense, nfev
+            te, ye, failed, msg1, i, nf1 = _crossing(plan, data, T, Y, k, active, fns, n, m,
+                                                     dense, h0)
+            return te, ye, failed, msg1 or msg, i, dense, nfev + nf1
         if T.size > 1:
-            dense.pieces.append(_piece(addr, data, T[0], T[-1], Y[0, :m], method_int, rtol, atol,
-                                       hmax, h0) + [n_extra])
+            dense.pieces.append(plan.piece(data, T[0], T[-1], Y[0, :m], h0))
         if ok or T.size < 2 or T[-1] >= t1:
             return (float(T[-1]) if T.size else ta, Y[-1, :m] if T.size else ya, not ok, msg,
                     None, dense, nfev)

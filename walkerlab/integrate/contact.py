@@ -60,7 +60,7 @@ from .solver import Solver
 
 __all__ = ["CHUNK_WALL_S", "CYRK_STEPS_PER_CALL", "METHODS", "ContactIntegration",
            "ContactLimits", "first_event", "hermite_root", "hermite_state",
-           "integrate_contact", "sample_grid", "trip_or_failure"]
+           "integrate_contact", "run_atol", "sample_grid", "trip_or_failure"]
 
 #: Solver methods this module runs.
 METHODS = ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853",
@@ -333,6 +333,19 @@ def _run_pinned(walker, x0, t0, t_end, until_touchdown, limits, solver, deadline
     return t, X, sol.nfev, sol.njev, term, sol.message
 
 
+def run_atol(walker, atol: float, method: str):
+    """The absolute tolerance a contact run hands its integrator: ``atol`` times the
+    walker's per-state :meth:`~walkerlab.models.contact.model.ContactWalker.atol_scale`
+    (2 nq,) (a flat foot's rotation rates looser), or the scalar ``atol`` itself where every
+    factor is 1 (every walker without flat feet: the same call as ever) and for numbalsoda
+    (a scalar atol only).  Units: those of each state [m, rad, m/s, rad/s]."""
+    scale = getattr(walker, "atol_scale", None)
+    if scale is None or method == "numbalsoda":
+        return atol
+    f = np.asarray(scale(), dtype=float)
+    return atol if np.all(f == 1.0) else atol * f
+
+
 class _Backend:
     """One chunk of a backend: ``chunk(xa, tg) -> (t, X, ok, message, nfev, njev)`` with the
     samples reached after ``tg[0]``; raises :class:`_TimeLimit` from a Python RHS."""
@@ -348,6 +361,7 @@ class _Backend:
         if self.method == "numbalsoda" and np.isfinite(self.max_step):
             raise ValueError("contact_solver.max_step_s is not supported by method numbalsoda")
         self.data = walker.pack() if self.compiled else None
+        self.atol = run_atol(walker, solver.atol, self.method)
 
     def odeint_chunk(self, xs, tg):
         from scipy.integrate import ODEintWarning, odeint
@@ -355,7 +369,7 @@ class _Backend:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ODEintWarning)
             X, info = odeint(self.frhs, xs, tg, Dfun=self.fjac, tfirst=True,
-                             rtol=self.solver.rtol, atol=self.solver.atol,
+                             rtol=self.solver.rtol, atol=self.atol,
                              hmax=self.max_step if np.isfinite(self.max_step) else 0.0,
                              full_output=True, mxstep=200000)
         ok = info["message"] == "Integration successful."
@@ -381,7 +395,7 @@ class _Backend:
             m = "Integration successful." if ok else "numbalsoda LSODA failed in this chunk"
             return tg[1:nk], X[1:nk], ok, m, nf, 0
         if self.method in _cyrk.CYRK_METHODS:  # whole chunk in compiled code (CyRK BDF)
-            X, ok, nf, m = _cyrk.solve_chunk(self.method, xa, tg, self.data, s.rtol, s.atol,
+            X, ok, nf, m = _cyrk.solve_chunk(self.method, xa, tg, self.data, s.rtol, self.atol,
                                              self.max_step, CYRK_STEPS_PER_CALL,
                                              kernels=self.walker.kernels)
             tn, Xn, nj = tg[1:len(X)], X[1:], 0
@@ -397,7 +411,7 @@ class _Backend:
 
         kw = {"jac": self.fjac} if self.fjac is not None else {}
         sol = solve_ivp(self.frhs, (tg[0], tg[-1]), xa, method=self.method, rtol=s.rtol,
-                        atol=s.atol, max_step=self.max_step, t_eval=tg, **kw)
+                        atol=self.atol, max_step=self.max_step, t_eval=tg, **kw)
         return sol.t[1:], sol.y.T[1:], sol.status == 0, sol.message, sol.nfev, sol.njev
 
 

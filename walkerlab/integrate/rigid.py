@@ -123,12 +123,20 @@ class _Held:
         return np.repeat(self._x[:, None], np.size(t), axis=1)
 
 
-def _violated_at_entry(phase: Phase, t: float, x: np.ndarray):
+def _violated_at_entry(phase: Phase, t: float, x: np.ndarray, backend: str = "cyrk"):
     """The first fall guard of ``phase`` marked ``at_entry`` whose function starts on its
-    firing side at ``(t, x)``, or None."""
-    for g in phase.guards:
+    firing side at ``(t, x)``, or None.  On ``cyrk_compiled`` a phase whose compiled flow
+    outputs its guards is checked from them (one cfunc call instead of the Python flow and
+    ground reactions a flat foot's force guards evaluate)."""
+    vals = None
+    if backend == "cyrk_compiled" and phase.compiled is not None:
+        from ._compiled import guard_values
+
+        vals = guard_values(phase.compiled, t, x)
+    for i, g in enumerate(phase.guards):
         if getattr(g, "at_entry", False) and g.outcome == "fall":
-            if g.direction * float(g.function(t, x)) > 0:
+            v = float(g.function(t, x)) if vals is None else float(vals[i])
+            if g.direction * v > 0:
                 return g
     return None
 
@@ -221,7 +229,7 @@ def _advance(walker: HybridWalker, phase: Phase, st: _StepState, t_stop: float, 
     """Run ``phase`` from ``st`` and record it (its dense output and log line, the state, the
     variational state); returns the guard that ended it, or None when the step ends without
     one (a fall guard violated as the phase begins, a solver failure, ``t_stop``)."""
-    broken = _violated_at_entry(phase, st.t, st.x)
+    broken = _violated_at_entry(phase, st.t, st.x, backend)
     if broken is not None:  # e.g. a unilateral contact already pulling as its mode begins
         st.termination, st.event = RunEnd.FALL, broken.name
         st.message = f"{broken.name}: already violated as {phase.name} begins"

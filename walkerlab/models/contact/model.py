@@ -50,10 +50,19 @@ from walkerlab.config.contact import ContactSettings, KneeStopSettings, TerrainS
 
 from .laws import ContactParamsSI, KneeStopSI, contact_params_si, knee_stop_si
 
-__all__ = ["FOOT_NAMES", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
+__all__ = ["FOOT_NAMES", "FOOT_RATE_ATOL_FACTOR", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
            "compass_gait_data", "flat_foot_numbers", "footprint_offsets", "state_name"]
 
 FOOT_NAMES = ("leg1", "leg2")
+#: A flat foot's rotation rate is integrated to this many times the run's ``atol`` [-]
+#: (:meth:`ContactWalker.atol_scale`).  The regularising foot inertia (0.1 kg, 5e-4 kg m^2)
+#: makes that rate a fast variable on the contact's slow manifold (eigenvalue ~ -7e5 1/s in
+#: foot flat, ~ 1 / inertia): an error e in it decays within microseconds and moves the foot
+#: angle by only ~ e / 7e5, so its absolute tolerance need not be the angles'.  Held to the
+#: angles' atol (1e-10 rad/s), CyRK's BDF (finite-difference Jacobian) chatters in foot flat
+#: (4 us steps at mid-stance, 13x the RHS calls at rtol 1e-9) and ends farther from the
+#: reference (configs/flat_feet.yaml, 5 strides: 1.8e-6 -> 2.3e-7 rad at rtol 1e-9).
+FOOT_RATE_ATOL_FACTOR = 100.0
 
 
 def state_name(coordinate: str, rate: bool = False) -> str:
@@ -345,6 +354,17 @@ class ContactWalker:
     def coordinate_names(self) -> tuple[str, ...]:
         """Floating coordinates (:func:`walkerlab.codegen.floating.coordinate_names`)."""
         return self._coords
+
+    def atol_scale(self) -> np.ndarray:
+        """Per-state factor (2 nq,) on a contact run's absolute tolerance [-]:
+        :data:`FOOT_RATE_ATOL_FACTOR` on each flat foot's rotation rate, 1 elsewhere (every
+        state of a walker without flat feet)."""
+        out = np.ones(2 * len(self._coords))
+        names = self.state_names()
+        for c in self._coords:
+            if c.endswith("_foot_angle"):
+                out[names.index(state_name(c, rate=True))] = FOOT_RATE_ATOL_FACTOR
+        return out
 
     def state_names(self) -> tuple[str, ...]:
         """Names of the states, in order (module docstring)."""

@@ -40,10 +40,17 @@ from walkerlab.walker.description import WalkerData
 
 #: The swing leg's parts of a step: before and after the legs pass each other.
 SWING_PARTS = ("early_swing", "late_swing")
-#: First chunk of each mode's compiled flow [steps] (``CompiledFlow.first_chunk_steps``):
-#: heel contact lasts ~50 DOP853 steps at rtol 1e-10, a foot flat before mid-stance ~5
-#: (each CyRK call costs as much as ~20 wasted steps: one chunk for heel contact).
-FIRST_CHUNK_STEPS = {"heel_contact": 64, "foot_flat": 8, "heel_off": 24}
+#: First chunk of each phase's compiled flow [steps] at rtol :data:`CHUNK_RTOL`
+#: (``CompiledFlow.first_chunk_steps``; scaled with the solver's rtol, ``chunk_rtol``): the
+#: steps a phase of the scene's gait takes at that rtol (DOP853, configs/flat_feet.yaml, rtol
+#: 1e-8 ... 1e-12: heel contact 21-58, foot flat before mid-stance 2-3, after it 4-10, heel
+#: off 6-20), ~1.2x and one more: the steps after a crossing in the chunk are wasted, and a
+#: chunk that stops short of it costs a restart and a chunk twice as long.
+FIRST_CHUNK_STEPS = {"heel_contact:early_swing": 42, "heel_contact:late_swing": 42,
+                     "foot_flat:early_swing": 3, "foot_flat:late_swing": 8,
+                     "heel_off:early_swing": 14, "heel_off:late_swing": 14}
+#: The tolerance the chunks of :data:`FIRST_CHUNK_STEPS` were measured at [-].
+CHUNK_RTOL = 1e-10
 #: Each guard's extra output of the compiled flows (``GUARDS`` of
 #: :func:`walkerlab.codegen.flatfoot.generate_flat_compiled`; ``{pin}`` the mode's pinned
 #: point): the same function of the state as the Python guard of that name.
@@ -103,7 +110,7 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     off = base if heel_off_data is None else functions(heel_off_data)
     pin = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
 
-    def compiled(mode: str, guards: list[Guard]):
+    def compiled(mode: str, part: str, guards: list[Guard]):
         # the phase's flow compiled, its guards the cfunc's extra outputs (GUARD_OUTPUT);
         # an ankle push-off's heel off (other numbers than the guards') stays in Python
         if heel_off_data is not None:
@@ -112,7 +119,9 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
             return None
         return CompiledFlow(data.structure, tuple(data.params), f"flow_{mode}",
                             tuple((GUARD_OUTPUT[g.name].format(pin=pin[mode]), 0.0)
-                                  for g in guards), first_chunk_steps=FIRST_CHUNK_STEPS[mode])
+                                  for g in guards),
+                            first_chunk_steps=FIRST_CHUNK_STEPS[f"{mode}:{part}"],
+                            chunk_rtol=CHUNK_RTOL)
 
     def phase(mode: str, part: str) -> Phase:
         # an ankle push-off acts in heel off: its flow (and the ground forces, read through
@@ -158,7 +167,7 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
         guards.append(Guard("fall", f[f"guard_hip_height_{p}"], -1, "fall",
                             f[f"grad_hip_height_{p}"]))
         return Phase(f"{mode}:{part}", fl, tuple(guards), jacobian=jac, variational=var,
-                     compiled=compiled(mode, guards))
+                     compiled=compiled(mode, part, guards))
 
     phases = tuple(phase(m, part) for part in SWING_PARTS for m in MODES)
     f = base
