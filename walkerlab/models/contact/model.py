@@ -50,8 +50,9 @@ from walkerlab.config.contact import ContactSettings, KneeStopSettings, TerrainS
 
 from .laws import ContactParamsSI, KneeStopSI, contact_params_si, knee_stop_si
 
-__all__ = ["FOOT_NAMES", "FOOT_RATE_ATOL_FACTOR", "ContactWalker", "STATE_OF_COORDINATE", "checkerboard_lanes",
-           "compass_gait_data", "flat_foot_numbers", "footprint_offsets", "state_name"]
+__all__ = ["FOOT_NAMES", "FOOT_RATE_ATOL_FACTOR", "ContactWalker", "STATE_OF_COORDINATE",
+           "checkerboard_lanes", "compass_gait_data", "flat_foot_numbers", "footprint_offsets",
+           "state_name"]
 
 FOOT_NAMES = ("leg1", "leg2")
 #: A flat foot's rotation rate is integrated to this many times the run's ``atol`` [-]
