@@ -87,8 +87,9 @@ def _energy_and_convergence(d, axes) -> None:
         ax.axhline(0.0, color="0.5", lw=0.8)
         ax.set_xlabel("time since heel strike [s]")
         ax.set_ylabel(f"energy change since heel strike [{d.energy_unit}]")
-        ax.set_title(f"total rises by {(ke + pe)[-1] - (ke + pe)[0]:.3g} {d.energy_unit} "
-                     "over the step (the actuators' net work)", fontsize=9)
+        inner = " and the collisions inside it" if len(d.phase_names) > 1 else ""
+        ax.set_title(f"total changes by {(ke + pe)[-1] - (ke + pe)[0]:.3g} {d.energy_unit} "
+                     f"over the step (the actuators' net work{inner})", fontsize=9)
         ax.legend(fontsize=8, loc="best")
     ax = axes[1]
     h = d.ipopt_history
