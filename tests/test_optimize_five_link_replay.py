@@ -143,3 +143,22 @@ def test_the_report_says_what_the_phase_replays_did():
     assert "virtual constraints" in text and "feed-forward alone" in text
     assert "0.39" in text and "(the feed-forward + PD law)" in text and "0.86 %" in text
     assert "virtual constraints" not in " ".join(optimize_lines(_data(False)))
+
+
+def test_the_feed_forward_is_the_transcriptions_control_at_the_time_the_step_passes_s():
+    """With the collocation times the feed-forward is ``u*(T(s))``: the Hermite-Simpson
+    control (each interval's quadratic, control_of_time against torques_of_time to
+    round-off) at the time the step passes ``s``; exact at the points, and between them
+    within the Hermite spline ``T``'s O(h^4) of a step at constant ``ds`` (T exact)."""
+    from walkerlab.optimal.five_link_collocation import torques_of_time
+    from walkerlab.optimal.five_link_replay import control_of_time
+
+    s, ds, delta, slope, _, _ = _table()
+    t = (s[0] - s) / 0.9
+    u = np.stack([np.sin(7 * t) * 30, t ** 3 - t], axis=1)
+    U, tau = control_of_time(t, u), torques_of_time(t, u)
+    for ti in np.linspace(0.0, t[-1] + 0.01, 37):
+        np.testing.assert_allclose(U(ti), tau(ti), rtol=0, atol=1e-12)
+    law = PhaseLaw(s, delta, slope, u, [2000.0, 500.0], [120.0, 60.0], t=t, ds=ds)
+    for si in np.linspace(-0.31, 0.3, 23):
+        np.testing.assert_allclose(law.ff(si), tau((s[0] - si) / 0.9), atol=1e-9)

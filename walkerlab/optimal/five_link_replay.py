@@ -8,8 +8,12 @@ else refused).  On the collocated step ``(t_i, x_i, u_i)`` each actuator's joint
 ``delta_k`` (:data:`walkerlab.optimal.five_link.JOINTS`) becomes a reference of ``s``: the
 cubic Hermite spline ``h_k`` through ``(s_i, delta_k(x_i))`` with the slopes
 ``ddelta_k(x_i) / ds(x_i)`` (so ``delta = h(s)`` and ``ddelta = h'(s) ds`` hold at every
-collocation point), the torque the not-a-knot cubic spline ``u_k(s)`` through
-``(s_i, u_k,i)``; the law::
+collocation point), the torque the transcription's own control (the quadratic in time of
+each Hermite-Simpson interval, :func:`walkerlab.optimal.five_link_collocation.
+torques_of_time`) at the time ``T(s)`` the collocated step passes ``s`` (``T`` the cubic
+Hermite spline through ``(s_i, t_i)`` with slopes ``1 / ds(x_i)``; a cubic spline of ``u``
+over ``s`` smooths the control's kinks at the interval ends, and a replay from the
+collocated start returns 6.6 times farther); the law::
 
     tau_k = u_k(s) - K_k (delta_k - h_k(s)) - D_k (ddelta_k - h_k'(s) ds)
 
@@ -38,7 +42,7 @@ import numpy as np
 from walkerlab.numerics import sort_multipliers
 
 __all__ = ["RABBIT_GAINS", "PhaseLaw", "PhaseReplay", "phase_law", "phased_walker", "replay_phase_law",
-           "replay_solver", "rigid_actuators"]
+           "replay_solver", "rigid_actuators", "control_of_time"]
 
 #: PD gains ``(K [N m/rad], D [N m s/rad])`` per joint (:data:`walkerlab.optimal.five_link.
 #: JOINTS` order), RABBIT's virtual-constraint controller of configs/rabbit.yaml
@@ -68,20 +72,32 @@ class PhaseLaw:
         The optimised torques there [N m].
     stiffness, damping : sequence of float (k,)
         ``K`` [N m/rad] and ``D`` [N m s/rad] per actuator.
+    t, ds : ndarray (m,), optional
+        The collocation times [s] and the phase variable's rate there [rad/s]: the
+        feed-forward is then the transcription's control at ``T(s)`` (module docstring);
+        without them the not-a-knot cubic spline of ``u`` over ``s``.
     """
 
-    def __init__(self, s, delta, ddelta_ds, u, stiffness, damping):
+    def __init__(self, s, delta, ddelta_ds, u, stiffness, damping, t=None, ds=None):
         from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
         s = np.asarray(s, float)
         order = np.argsort(s)
-        s = s[order]
-        self.h = CubicHermiteSpline(s, np.asarray(delta, float)[order],
+        so = s[order]
+        self.h = CubicHermiteSpline(so, np.asarray(delta, float)[order],
                                     np.asarray(ddelta_ds, float)[order], extrapolate=True)
         self.dh, self.d2h = self.h.derivative(), self.h.derivative(2)
-        self.ff = CubicSpline(s, np.asarray(u, float)[order], bc_type="not-a-knot",
-                              extrapolate=True)
-        self.dff = self.ff.derivative()
+        if t is None:
+            spline = CubicSpline(so, np.asarray(u, float)[order], bc_type="not-a-knot",
+                                 extrapolate=True)
+            self.ff, self.dff = spline, spline.derivative()
+        else:
+            T = CubicHermiteSpline(so, np.asarray(t, float)[order],
+                                   1.0 / np.asarray(ds, float)[order], extrapolate=True)
+            U = control_of_time(t, u)
+            dT, dU = T.derivative(), U.derivative()
+            self.ff = lambda r: U(T(r))
+            self.dff = lambda r: dU(T(r)) * np.expand_dims(dT(r), -1)
         self.K = np.asarray(stiffness, float)
         self.D = np.asarray(damping, float)
         self.torques = [None] * len(self.K)  # as TorqueLaws (its length: the actuators)
@@ -101,7 +117,7 @@ class PhaseLaw:
         return ff - self.K * err - self.D * derr
 
 
-def phase_law(acts, x, u, stiffness, damping) -> PhaseLaw:
+def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
     """The law of the collocated step ``x``, ``u`` (module docstring).
 
     Parameters
@@ -115,6 +131,9 @@ def phase_law(acts, x, u, stiffness, damping) -> PhaseLaw:
         Collocated torques [N m].
     stiffness, damping : sequence of float (k,)
         PD gains [N m/rad], [N m s/rad] (zeros: the feed-forward alone).
+    t : ndarray (m,), optional
+        Collocation times [s] (the feed-forward: the control at ``T(s)``; without: a
+        spline of ``u`` over ``s``).
 
     Returns
     -------
@@ -134,7 +153,32 @@ def phase_law(acts, x, u, stiffness, damping) -> PhaseLaw:
                          f"[{ds.min():.3g}, {ds.max():.3g}] rad/s): no phase-variable replay")
     delta = np.array([[float(v) for v in r[0]] for r in rows])
     ddelta = np.array([[float(v) for v in r[1]] for r in rows])
-    return PhaseLaw(s, delta, ddelta / ds[:, None], u, stiffness, damping)
+    return PhaseLaw(s, delta, ddelta / ds[:, None], u, stiffness, damping, t=t, ds=ds)
+
+
+def control_of_time(t, u):
+    """The Hermite-Simpson control as a :class:`scipy.interpolate.PPoly` of the time since
+    the heel strike [s] -> (k,) [N m]: each interval's quadratic through its three points
+    (:func:`walkerlab.optimal.five_link_collocation.torques_of_time`'s, with derivatives),
+    the last one extrapolated.
+
+    Parameters
+    ----------
+    t : ndarray (2N + 1,)
+        Collocation times [s].
+    u : ndarray (2N + 1, k)
+        Torques there [N m].
+    """
+    from scipy.interpolate import PPoly
+
+    t, u = np.asarray(t, float), np.asarray(u, float).reshape(len(t), -1)
+    ti, tm, tj = t[0:-1:2], t[1::2], t[2::2]
+    ui, um, uj = u[0:-1:2], u[1::2], u[2::2]
+    # Newton's form about t_i: u_i + a (t - t_i) + b (t - t_i)(t - t_m)
+    a = ((um - ui) / (tm - ti)[:, None])
+    b = ((uj - um) / (tj - tm)[:, None] - a) / (tj - ti)[:, None]
+    c = np.stack([b, a - b * (tm - ti)[:, None], ui])  # (3, N, k): powers of (t - t_i)
+    return PPoly(c, np.append(ti, tj[-1]), extrapolate=True)
 
 
 def phased_walker(data, law: PhaseLaw):
@@ -322,8 +366,8 @@ def phase_replays(data, t, x, u) -> tuple[dict, dict]:
     """
     acts = rigid_actuators(data)
     zero = (0.0,) * len(RABBIT_GAINS[0])
-    laws = {"feedback": phase_law(acts, x, u, *RABBIT_GAINS),
-            "feedforward": phase_law(acts, x, u, zero, zero)}
+    laws = {"feedback": phase_law(acts, x, u, *RABBIT_GAINS, t=t),
+            "feedforward": phase_law(acts, x, u, zero, zero, t=t)}
     replays = {name: replay_phase_law(data, t, x, u, law, close=name == "feedback")
                for name, law in laws.items()}
     return replays, laws
