@@ -41,8 +41,9 @@ import numpy as np
 
 from walkerlab.numerics import sort_multipliers
 
-__all__ = ["RABBIT_GAINS", "PhaseLaw", "PhaseReplay", "phase_law", "phased_walker", "replay_phase_law",
-           "replay_solver", "rigid_actuators", "control_of_time"]
+__all__ = ["RABBIT_GAINS", "PhaseLaw", "PhaseReplay", "control_of_time", "phase_law",
+           "phase_replays", "phased_walker", "replay_phase_law", "replay_solver",
+           "rigid_actuators"]
 
 #: PD gains ``(K [N m/rad], D [N m s/rad])`` per joint (:data:`walkerlab.optimal.five_link.
 #: JOINTS` order), RABBIT's virtual-constraint controller of configs/rabbit.yaml
