@@ -161,6 +161,7 @@ def test_kellys_step_meets_its_targets_and_constraints(optimised, fns_and_params
     assert feet[-1, 2] < 0 and feet[0, 2] >= -1e-9
     assert feet[:, 3:].max() <= 1e-9
     assert "stance_hip" in out and "a gait (the replay closes)" in out
+    assert "phase-variable feedback law" in out and "phase-variable feedforward law" in out
 
 
 @pytest.mark.slow  # shares the fixture above

@@ -27,7 +27,12 @@ def optimize_five_link_scene(scene):
     walkerlab.io.schemas.optimize.OptimizeData
         The collocated states and torques by name; ``replay_error`` the rigid model's
         return error from the closed start; ``gait`` when IPOPT converged, the shooting
-        closed and the replay returns within ``optimize.replay_tolerance``.
+        closed and the replay returns within ``optimize.replay_tolerance``;
+        ``phase_replays`` the phase-variable laws' rigid replays (``feedback``: closed,
+        ``feedforward``: from the collocated start) and ``contact_step_period_s`` the
+        contact model's under the feedback law (~2 s of CPU per rigid step map: ~35 maps,
+        and 2 contact strides: the phase replays cost ~3 min CPU beside the ~20 s of the
+        rest).
 
     Raises
     ------
