@@ -184,8 +184,11 @@ def control_of_time(t, u):
 
 def phased_walker(data, law: PhaseLaw):
     """The rigid five-link walker (its generated code, phases, guards and reset) driven by
-    ``law`` on :data:`walkerlab.optimal.five_link.JOINTS` (the Python flow: integrate it
-    with ``Solver(backend="scipy")`` or ``"cyrk"``, not the compiled laws)."""
+    ``law`` on :data:`walkerlab.optimal.five_link.JOINTS`: its flow in Python (the law is
+    a Python callable; the compiled flows, which carry only tabled laws, are dropped so
+    that no backend runs them)."""
+    from dataclasses import replace
+
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.models.hybrid.rigid import make_rigid_walker
@@ -195,7 +198,7 @@ def phased_walker(data, law: PhaseLaw):
                               for j in JOINTS])
     walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
     walker.actuators.laws = law
-    return walker
+    return replace(walker, phases=tuple(replace(ph, compiled=None) for ph in walker.phases))
 
 
 def rigid_actuators(data):
