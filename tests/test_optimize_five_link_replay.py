@@ -162,3 +162,25 @@ def test_the_feed_forward_is_the_transcriptions_control_at_the_time_the_step_pas
     law = PhaseLaw(s, delta, slope, u, [2000.0, 500.0], [120.0, 60.0], t=t, ds=ds)
     for si in np.linspace(-0.31, 0.3, 23):
         np.testing.assert_allclose(law.ff(si), tau((s[0] - si) / 0.9), atol=1e-9)
+
+
+def test_the_phased_walker_runs_its_law_on_every_backend():
+    """The law is a Python callable: the walker keeps no compiled flow (whose law block
+    would hold the placeholder zero laws), and its torque is the law's."""
+    from pathlib import Path
+
+    from walkerlab.config import load_scene
+    from walkerlab.optimal.five_link_replay import phased_walker
+    from walkerlab.walker.description import walker_data
+
+    scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / "rabbit_optimal.yaml")
+    data = walker_data(scene.walker, 0.0)
+    s, ds, delta, slope, u, _ = _table(k=2)
+    law = PhaseLaw(s, np.hstack([delta, delta]), np.hstack([slope, slope]),
+                   np.hstack([u, u]), [1.0] * 4, [0.0] * 4)
+    w = phased_walker(data, law)
+    assert all(ph.compiled is None for ph in w.phases)
+    x = np.array([0.1, 0.3, -0.1, -0.3, -0.1, -1.0, 0.4, -1.2, -1.0, -0.5])
+    deltas, ddeltas, sx, dsx = w.actuators.joint_angles(x)
+    np.testing.assert_allclose(w.actuators.torques(0.0, x), law.each(deltas, ddeltas, sx, dsx),
+                               rtol=1e-14)
