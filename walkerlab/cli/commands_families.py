@@ -235,6 +235,14 @@ def optimize(scene: Path | None = SceneArg,
         typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}; "
                    f"replay return error {d.replay_error:.2g}; max |Floquet multiplier| "
                    f"{mu:.4g}")
+        for law, r in d.phase_replays.items():  # a five-link biped's phase-variable laws
+            typer.echo(f"  phase-variable {law} law: from the collocated start "
+                       f"{r.collocated_start_error:.2g}; "
+                       + (f"closed (start moved {r.start_shift:.2g}): return error "
+                          f"{r.return_error:.2g}, step period {r.step_period_s:.9g} s, "
+                          if r.closed else "not closed, ")
+                       + f"max |multiplier| {max(abs(r.multipliers)):.4g}, torque within "
+                       f"{r.torque_error:.2g} N m of the optimal")
         if d.contact_step_period_s == d.contact_step_period_s:  # not NaN: replayed
             typer.echo(f"  contact model driven by the optimised torque: step period "
                        f"{d.contact_step_period_s:.5g} s "

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["contact_replay"]
+__all__ = ["contact_replay", "contact_replay_five_link"]
 
 
 def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
@@ -56,6 +56,61 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
     setup.actuators.laws = lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
     solver = SolverSettings.for_contact(method="LSODA", rtol=1e-6, atol=1e-8)
     _, run, _, _ = simulate_from(setup, res.x[0], res.step_period_s, solver=solver,
+                                 strides=strides)
+    hs = np.asarray(run.heel_strike_times, float)
+    period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
+    return period, str(run.termination)
+
+
+def contact_replay_five_link(scene, law, x0, step_period_s: float,
+                             strides: int = 1) -> tuple[float, str]:
+    """Run the contact model of a five-link biped under a phase-variable law.
+
+    The scene's walker gets torques on :data:`walkerlab.optimal.five_link.JOINTS` whose laws
+    are replaced by ``law`` (the contact view evaluates each stance leg's joints and phase
+    variable as the rigid one, :class:`walkerlab.models.contact.joint_torques.
+    JointTorqueActuators`); the scene's ``contact`` law (the paper's default one if none),
+    its terrain (continuous level ground if none: the optimised swing foot clears it) and
+    ``contact_solver`` (LSODA at rtol 1e-8, atol 1e-10 if none).
+
+    Parameters
+    ----------
+    scene : Scene
+        The optimised scene.
+    law : walkerlab.optimal.five_link_replay.PhaseLaw
+    x0 : ndarray (2n,)
+        The rigid start (post-impact, ``state_names()`` order) [rad, rad/s].
+    step_period_s : float
+        The rigid step period [s] (sets the run's length).
+    strides : int
+        Strides to run (2 steps each).
+
+    Returns
+    -------
+    step_period_s : float
+        Mean period of the run's steps after the first touchdown [s] (NaN if it made
+        fewer than two).
+    outcome : str
+        How the run ended, or why there is no replay (one line).
+    """
+    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.config import SolverSettings
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+    from walkerlab.optimal.five_link import JOINTS
+
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["walker"]["actuation"] = {"torques": [{"joint": j, "law": {}} for j in JOINTS]}
+    d.setdefault("contact", {})
+    d.setdefault("terrain", {})
+    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500}
+    try:
+        setup = contact_setup(type(scene).model_validate(d))
+    except (ContactSceneError, ValueError) as exc:
+        return float("nan"), f"not replayed: {exc}"
+    setup.actuators.rigid.laws = law
+    solver = scene.contact_solver or SolverSettings.for_contact(method="LSODA", rtol=1e-8,
+                                                                 atol=1e-10)
+    _, run, _, _ = simulate_from(setup, np.asarray(x0, float), step_period_s, solver=solver,
                                  strides=strides)
     hs = np.asarray(run.heel_strike_times, float)
     period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")

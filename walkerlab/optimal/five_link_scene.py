@@ -1,8 +1,12 @@
 """A five-link biped scene's least-effort step (``walkerlab optimize`` on a walker with free
 knees): collocated (:mod:`walkerlab.optimal.five_link_collocation`), closed by shooting
 under its own torques (:mod:`walkerlab.optimal.five_link_shooting`), replayed on the rigid
-model's generated code, stored as ``optimize.h5``.  Needs no upstream gait: the guess is
-built from the targets (Kelly 2017's set-up)."""
+model's generated code, and replayed with the torques as a function of the phase variable
+(feed-forward + PD on the collocated joint trajectory, and the feed-forward alone:
+:mod:`walkerlab.optimal.five_link_replay`) on the rigid model and - the PD law - in the
+contact model (:func:`walkerlab.optimal.contact_replay.contact_replay_five_link`); stored
+as ``optimize.h5``.  Needs no upstream gait: the guess is built from the targets (Kelly
+2017's set-up)."""
 
 from __future__ import annotations
 
@@ -23,7 +27,12 @@ def optimize_five_link_scene(scene):
     walkerlab.io.schemas.optimize.OptimizeData
         The collocated states and torques by name; ``replay_error`` the rigid model's
         return error from the closed start; ``gait`` when IPOPT converged, the shooting
-        closed and the replay returns within ``optimize.replay_tolerance``.
+        closed and the replay returns within ``optimize.replay_tolerance``;
+        ``phase_replays`` the phase-variable laws' rigid replays (``feedback``: closed,
+        ``feedforward``: from the collocated start) and ``contact_step_period_s`` the
+        contact model's under the feedback law (~2 s of CPU per rigid step map: ~35 maps,
+        and 2 contact strides: the phase replays cost ~3 min CPU beside the ~20 s of the
+        rest).
 
     Raises
     ------
@@ -59,14 +68,43 @@ def optimize_five_link_scene(scene):
     units = dict(zip(names, rigid.state_units()))
     gait = bool(res.status == "Solve_Succeeded" and closed.converged
                 and err <= o.replay_tolerance)
+    phases, contact = _phase_replays(scene, data, res)
     return OptimizeData(
         res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u, res.step_period_s,
         res.step_length_m, 0.0, res.objective, err, closed.multipliers, gait, res.status,
         res.iterations, res.wall_time_s, units, torque_names=JOINTS,
         start_shift=closed.shift, replay_step_period_s=closed.period_s,
         collocated_start_error=closed.open_loop_error, cpu_time_s=res.cpu_time_s,
-        contact_outcome="not replayed: a five-link biped's optimised torques are replayed on "
-        "the rigid model only", **step_record(scene, rigid, res))
+        contact_step_period_s=contact[0], contact_outcome=contact[1], phase_replays=phases,
+        **step_record(scene, rigid, res))
+
+
+#: strides of the contact replay (2 steps each; the first step starts from the rigid state)
+CONTACT_STRIDES = 2
+
+
+def _phase_replays(scene, data, res) -> tuple[dict, tuple[float, str]]:
+    """The phase-variable replays (:func:`walkerlab.optimal.five_link_replay.phase_replays`)
+    as ``optimize.h5``'s records, and the contact model's ``(step period [s], outcome)``
+    under the feed-forward + PD law from its closed start."""
+    from walkerlab.io.schemas.optimize import PhaseReplayData
+    from walkerlab.optimal.contact_replay import contact_replay_five_link
+    from walkerlab.optimal.five_link_replay import phase_replays
+
+    try:
+        replays, laws = phase_replays(data, res.t, res.x, res.u)
+    except ValueError as exc:  # the phase variable is not monotonic: no such replay
+        return {}, (float("nan"), f"not replayed: {exc}")
+    out = {name: PhaseReplayData(r.collocated_start_error, r.start_shift, r.return_error,
+                                 r.step_period_s, r.torque_error, r.multipliers, r.closed)
+           for name, r in replays.items()}
+    fb = replays["feedback"]
+    if not fb.closed:
+        return out, (float("nan"), "not replayed: the feed-forward + PD law did not close "
+                     "on the rigid model")
+    contact = contact_replay_five_link(scene, laws["feedback"], fb.x0, fb.step_period_s,
+                                       strides=CONTACT_STRIDES)
+    return out, contact
 
 
 #: the stick figure's polyline through the walker's named points

@@ -103,7 +103,9 @@ def optimize_lines(d) -> list[str]:
             f"torques as a function of time): return error {num(d.replay_error, 2)}, largest "
             f"|Floquet multiplier| {num(mu)}: "
             + ("**a gait**." if d.gait else "**not a gait** (the replay does not close).")
-            + (f" In the contact model: step period {num(d.contact_step_period_s)} s "
+            + phase_replay_text(d)
+            + (f" In the contact model{' (the feed-forward + PD law)' if d.phase_replays else ''}"
+               f": step period {num(d.contact_step_period_s)} s "
                f"({num(100 * (d.contact_step_period_s / d.step_period_s - 1), 2)} %)."
                if d.contact_step_period_s == d.contact_step_period_s
                else f" Contact model: {d.contact_outcome}.")
@@ -118,6 +120,29 @@ def _phases_line(d) -> str:
     parts = ", ".join(f"{n} {num(float(t), 6)} s" for n, t in zip(d.phase_names,
                                                                    d.phase_duration_s))
     return f" Phases (each with its own mesh and free duration): {parts}."
+
+
+def phase_replay_text(d) -> str:
+    """The phase-variable replays of a loaded ``optimize.h5`` (a five-link biped's) in
+    words; "" when it has none."""
+    import numpy as np
+
+    fb, ff = d.phase_replays.get("feedback"), d.phase_replays.get("feedforward")
+    out = ""
+    if fb is not None:
+        out += (f" Replayed as virtual constraints (the torques as a function of the phase "
+                f"variable, the stance leg's angle, plus PD tracking of the collocated joint "
+                f"trajectory): from the collocated start the step returns "
+                f"{num(fb.collocated_start_error, 2)} away; closed (start moved "
+                f"{num(fb.start_shift, 2)}) it returns to {num(fb.return_error, 2)}, step "
+                f"period {num(fb.step_period_s, 9)} s, largest |multiplier| "
+                f"{num(float(np.max(np.abs(fb.multipliers))))} (stable under the law), the "
+                f"law's torque within {num(fb.torque_error, 2)} N m of the optimal one.")
+    if ff is not None:
+        out += (f" The phase-variable feed-forward alone (no PD): one step from the "
+                f"collocated start returns {num(ff.collocated_start_error, 2)} away, largest "
+                f"|multiplier| of its step map there {num(float(np.max(np.abs(ff.multipliers))))}.")
+    return out
 
 
 def _drawn_from(stem: str, arts: dict) -> bool:

@@ -39,6 +39,16 @@ points)::
                                            primal_infeasibility, dual_infeasibility, barrier
     energy/kinetic, energy/potential  J    the walker's energies at the collocation points
                                            (their sum rises by the actuators' work)
+    replay/phase_<law>/...        (a five-link biped) the torques as a function of the
+                                  phase variable (the stance leg's angle), ``<law>``
+                                  ``feedback`` (feed-forward + PD on the collocated joint
+                                  trajectory: virtual constraints) or ``feedforward`` (no
+                                  PD): ``collocated_start_error``, ``start_shift``,
+                                  ``max_state_error`` (rad, rad/s: one step from the start
+                                  the law closes to, or from the collocated one),
+                                  ``step_period`` (s), ``torque_error`` (N m: max |tau(t) -
+                                  u*(t)| along it), ``multipliers/{real,imag}``; attribute
+                                  ``closed``
 
 attributes: ``gait`` (the replay closed), ``state_names``.
 """
@@ -52,8 +62,25 @@ import numpy as np
 
 STAGE = "optimize"
 
-__all__ = ["DESIGN_STAGE", "DesignData", "OptimizeData", "STAGE", "load", "load_design",
-           "write", "write_design"]
+__all__ = ["DESIGN_STAGE", "DesignData", "OptimizeData", "PHASE_LAWS", "PhaseReplayData",
+           "STAGE", "load", "load_design", "write", "write_design"]
+
+#: the phase-variable replays a five-link biped's artifact may carry
+PHASE_LAWS = ("feedback", "feedforward")
+
+
+@dataclass
+class PhaseReplayData:
+    """One phase-variable law's rigid replay (``replay/phase_<law>/``; units in the module
+    docstring)."""
+
+    collocated_start_error: float
+    start_shift: float
+    return_error: float
+    step_period_s: float
+    torque_error: float
+    multipliers: np.ndarray
+    closed: bool
 
 
 @dataclass
@@ -92,6 +119,41 @@ class OptimizeData:
     phase_start: np.ndarray | None = None
     phase_duration_s: np.ndarray | None = None
     build_time_s: float = float("nan")
+    phase_replays: dict = field(default_factory=dict)  # law name -> PhaseReplayData
+
+
+def _write_phase(f, law: str, r: PhaseReplayData) -> None:
+    """``replay/phase_<law>/``."""
+    from walkerlab.io.artifacts import put
+
+    g = f"replay/phase_{law}"
+    what = {"feedback": "the optimal torques as feed-forward of the phase variable plus PD "
+            "tracking of the collocated joint trajectory", "feedforward": "the optimal "
+            "torques as a function of the phase variable alone"}[law]
+    for key, v, unit, desc in (
+            ("collocated_start_error", r.collocated_start_error, "-", "one step's return "
+             "error from the collocated start [rad, rad/s]"),
+            ("start_shift", r.start_shift, "-", "max |closed start - collocated start| "
+             "[rad, rad/s] (0: not closed)"),
+            ("max_state_error", r.return_error, "-", "return error of one step from the "
+             "closed start (not closed: the collocated one) [rad, rad/s]"),
+            ("step_period", r.step_period_s, "s", "the replayed step's period"),
+            ("torque_error", r.torque_error, "N m", "max over the step of |law torque - "
+             "optimised torque| at the same time since the heel strike")):
+        put(f, f"{g}/{key}", float(v), unit, f"{what}: {desc}")
+    mu = np.asarray(r.multipliers, complex)
+    put(f, f"{g}/multipliers/real", mu.real, "-", f"{what}: multipliers of the step map")
+    put(f, f"{g}/multipliers/imag", mu.imag, "-", f"{what}: multipliers of the step map")
+    f[g].attrs["closed"] = bool(r.closed)
+
+
+def _load_phase(f, law: str) -> PhaseReplayData:
+    g = f[f"replay/phase_{law}"]
+    return PhaseReplayData(
+        float(g["collocated_start_error"][()]), float(g["start_shift"][()]),
+        float(g["max_state_error"][()]), float(g["step_period"][()]),
+        float(g["torque_error"][()]),
+        g["multipliers/real"][()] + 1j * g["multipliers/imag"][()], bool(g.attrs["closed"]))
 
 
 def write(f, d: OptimizeData) -> None:
@@ -151,6 +213,8 @@ def write(f, d: OptimizeData) -> None:
              "error from the collocated start [rad, rad/s]")):
         if np.isfinite(v):
             put(f, f"replay/{key}", float(v), unit, what)
+    for law, r in d.phase_replays.items():
+        _write_phase(f, law, r)
     _write_history_and_energy(f, d)
 
 
@@ -211,7 +275,8 @@ def load(path: Path) -> OptimizeData:
             tuple(str(s) for s in f.attrs.get("phase_names", [])),
             f["phases/start_index"][()] if "phases" in f else None,
             f["phases/duration"][()] if "phases" in f else None,
-            float(f.attrs.get("ipopt_build_time_s", float("nan"))))
+            float(f.attrs.get("ipopt_build_time_s", float("nan"))),
+            {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f})
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)
