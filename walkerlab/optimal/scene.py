@@ -30,7 +30,9 @@ def collocation_spec(scene):
                            target_step_length_m=o.target_step_length_m,
                            target_step_period_s=o.target_step_period_s,
                            objective=o.objective, weights=tuple((o.weights or {}).items()),
-                           smoothing_w=o.smoothing_w, min_clearance_m=o.min_clearance_m,
+                           cost_of_transport_effort_weight=(
+                               o.cost_of_transport_effort_weight),
+                           min_clearance_m=o.min_clearance_m,
                            friction_coefficient=o.friction_coefficient,
                            hip_angle_range_rad=o.hip_angle_range_rad,
                            touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
