@@ -1,0 +1,132 @@
+"""Benchmark of ``walkerlab optimize`` on the shipped optimisation scenes: the whole command
+as a new process, cold and warm, wall and CPU, medians.
+
+The goals (the optimal-gaits issue): the compass walker <= 5 s, Kuo's walker <= 5 s, the
+five-link biped <= 60 s on 2 cores (IPOPT with MUMPS; the collocation's expressions built once
+per walker and cached like the generated flows).  Each scene is timed
+
+- **cold**: a fresh runs folder and a fresh code cache (``WALKERLAB_CACHE_DIR``): the
+  generated model code, the upstream ``fixedpoint`` stage (straight legs), the symbolic
+  collocation expressions (the five-link's cached CasADi functions), the optimisation, the
+  rigid and contact replays and the figure;
+- **warm**: the same folders again with ``--force`` (the optimisation and everything after
+  it recomputed; the generated code, the cached expressions and the upstream gait reused),
+
+each ``repeats`` times, the medians reported with their spread.  Also read: the stage's own
+compute time (the CLI's ``compute`` line: the optimisation and its replays, no start-up),
+IPOPT's solve wall time and iterations (``optimize.h5``), and the CPU time (user + sys of the
+finished process, the operating system's accounting: it suffers less than wall time from a
+shared machine).  Speed goals are checked here, never in tests.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["GOALS_S", "SCENES", "bench_optimize", "lines"]
+
+#: the shipped optimisation scenes and their goals [s] (the optimal-gaits issue)
+GOALS_S = {"compass_optimal": 5.0, "kuo2002": 5.0, "rabbit_optimal": 60.0}
+SCENES = tuple(GOALS_S)
+_CONFIGS = Path(__file__).resolve().parents[2] / "configs"
+
+
+def _run(scene_path: Path, folder: Path, force: bool) -> dict:
+    """One ``walkerlab optimize`` process with ``folder`` as its runs folder and code
+    cache: wall [s], CPU (user + sys of the finished child, the children's rusage) [s],
+    the stage's ``compute`` seconds from its output (None when not printed), the exit code,
+    and IPOPT's wall time, iterations and status and the gait flag from ``optimize.h5``."""
+    import resource
+
+    env = {**os.environ, "WALKERLAB_CACHE_DIR": str(folder / "cache")}
+    cmd = [sys.executable, "-m", "walkerlab.cli", "optimize", str(scene_path),
+           "--runs-dir", str(folder / "runs")] + (["--force"] if force else [])
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                          check=False)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    text = proc.stdout.decode(errors="replace")
+    m = re.search(r"optimize\.h5 \(compute ([0-9.]+) s", text)
+    res = {"wall_s": wall, "cpu_s": (after.ru_utime - before.ru_utime)
+           + (after.ru_stime - before.ru_stime),
+           "compute_s": float(m.group(1)) if m else None, "returncode": proc.returncode,
+           "tail": text.strip().splitlines()[-3:]}
+    art = folder / "runs" / scene_path.stem / "optimize.h5"
+    if art.exists():
+        import h5py
+
+        with h5py.File(art, "r") as f:
+            res.update(ipopt_wall_s=float(f.attrs["ipopt_wall_time_s"]),
+                       ipopt_iterations=int(f.attrs["ipopt_iterations"]),
+                       ipopt_status=str(f.attrs["ipopt_status"]),
+                       gait=bool(f.attrs["gait"]))
+    return res
+
+
+def _median(runs: list[dict], key: str):
+    vals = [r[key] for r in runs if r.get(key) is not None]
+    if not vals:
+        return None
+    return {"median": float(np.median(vals)), "min": float(min(vals)),
+            "max": float(max(vals))}
+
+
+def bench_scene(name: str, repeats: int = 3) -> dict:
+    """Cold and warm ``walkerlab optimize`` of ``configs/<name>.yaml``, ``repeats`` each
+    (module docstring); cold and warm runs alternate (cold in a fresh folder, then warm
+    in it) so the machine's drift hits both alike."""
+    path = _CONFIGS / f"{name}.yaml"
+    cold, warm = [], []
+    for _ in range(repeats):
+        with tempfile.TemporaryDirectory(prefix="wl_bench_opt_") as d:
+            cold.append(_run(path, Path(d), force=False))
+            warm.append(_run(path, Path(d), force=True))
+    keys = ("wall_s", "cpu_s", "compute_s", "ipopt_wall_s", "ipopt_iterations")
+    out = {"scene": name, "goal_s": GOALS_S.get(name), "repeats": repeats,
+           "cold": {k: _median(cold, k) for k in keys},
+           "warm": {k: _median(warm, k) for k in keys},
+           "status": sorted({r.get("ipopt_status", f"exit {r['returncode']}")
+                             for r in cold + warm}),
+           "gait": all(r.get("gait", False) for r in cold + warm)}
+    bad = [r for r in cold + warm if r["returncode"] != 0]
+    if bad:
+        out["failure"] = bad[0]["tail"]
+    return out
+
+
+def bench_optimize(scenes=SCENES, repeats: int = 3) -> dict:
+    """:func:`bench_scene` of every scene; the load average before and after."""
+    load0 = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+    res = [bench_scene(s, repeats) for s in scenes]
+    load1 = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+    return {"scenes": res, "loadavg_1min_before": load0, "loadavg_1min_after": load1,
+            "note": "whole process (python -m walkerlab.cli optimize); cold: fresh runs "
+                    "folder and code cache; warm: the same with --force; cpu: user + sys "
+                    "of the process; compute: the stage's own; medians [min, max]"}
+
+
+def lines(result: dict) -> list[str]:
+    """The benchmark as a table, one line a scene and mode."""
+    def cell(d):
+        return "-" if d is None else f"{d['median']:.2f} [{d['min']:.2f}, {d['max']:.2f}]"
+
+    out = ["optimize: scene | mode | wall s | cpu s | compute s | ipopt s | iterations | goal s"]
+    for s in result["scenes"]:
+        for mode in ("cold", "warm"):
+            m = s[mode]
+            out.append(f"  {s['scene']} | {mode} | {cell(m['wall_s'])} | {cell(m['cpu_s'])} | "
+                       f"{cell(m['compute_s'])} | {cell(m['ipopt_wall_s'])} | "
+                       f"{cell(m['ipopt_iterations'])} | {s['goal_s']}")
+        out.append(f"  {s['scene']}: IPOPT {', '.join(s['status'])}; a gait: {s['gait']}"
+                   + (f"; FAILED: {s['failure']}" if "failure" in s else ""))
+    return out
