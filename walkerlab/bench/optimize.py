@@ -63,13 +63,11 @@ def _run(scene_path: Path, folder: Path, force: bool) -> dict:
            "tail": text.strip().splitlines()[-3:]}
     art = folder / "runs" / scene_path.stem / "optimize.h5"
     if art.exists():
-        import h5py
+        from walkerlab.io.schemas.optimize import load
 
-        with h5py.File(art, "r") as f:
-            res.update(ipopt_wall_s=float(f.attrs["ipopt_wall_time_s"]),
-                       ipopt_iterations=int(f.attrs["ipopt_iterations"]),
-                       ipopt_status=str(f.attrs["ipopt_status"]),
-                       gait=bool(f.attrs["gait"]))
+        d = load(art)
+        res.update(ipopt_wall_s=float(d.wall_time_s), ipopt_iterations=int(d.iterations),
+                   ipopt_status=str(d.status), gait=bool(d.gait))
     return res
 
 

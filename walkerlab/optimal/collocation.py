@@ -22,7 +22,8 @@ on the same points; with a free push-off its weighted square ``w P^2`` added), t
 push-off's work, the cost of transport (the hip's positive work ``int max(p, 0) dt``,
 exact through slack variables ``s >= 0, s >= p`` at every point as Srinivasan & Ruina
 2006 and Kelly 2017 do, plus the push-off's work, per weight and step length; alone, a
-tiny effort weight added) and the peak torque (epigraph form: ``-s <= u_k <= s``, minimise ``s``).  Constraints:
+tiny effort weight added) and the peak torque (epigraph form: ``-s <= u_k <= s``,
+minimise ``s``).  Constraints:
 optional target speed, step length or step period, a torque limit, no scuffing (the swing
 foot above a bound at every point but the ends), the stance foot's ground reaction
 ``m (a_com + g)`` with a non-negative normal force inside the friction cone, the hip's
