@@ -320,3 +320,40 @@ def test_a_guess_from_a_continuation_branch(compass, tmp_path):
     res = collocate_step(case.data, case.eq, CollocationSpec(intervals=40), t, x, fns=case.fns)
     assert res.status == "Solve_Succeeded" and res.objective <= 1e-10
     assert res.step_period_s == pytest.approx(passive.step_period_s, abs=1e-9)
+
+
+def test_step_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch):
+    """The straight-leg collocation's CasADi functions are built once per walker and read
+    back from the code cache (no symbolic derivation on a warm start: the build is not
+    called), and the functions read back compute bit for bit what the built ones do; a
+    damaged file is rebuilt."""
+    import walkerlab.optimal.collocation as collocation
+    from walkerlab.optimal import step_cache
+
+    monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
+    scene = load_scene(CONFIGS / "compass_optimal.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    monkeypatch.setattr(step_cache, "_memo", {})
+    built = step_cache.cached_step_functions(data)
+    files = list((tmp_path / "models").glob("*-steps-*.casadi"))
+    assert len(files) == 1
+    monkeypatch.setattr(step_cache, "_memo", {})
+
+    def no_build(*_a, **_k):
+        raise AssertionError("derived again")
+
+    build = collocation.step_functions
+    monkeypatch.setattr(collocation, "step_functions", no_build)
+    read = step_cache.cached_step_functions(data)
+    x = np.array([0.31, -0.22, -1.1, 0.4])
+    for name, args in (("flow", (x, 0.7)), ("reset", (x, 0.3)), ("grf", (x, 0.7)),
+                       ("guard_rate", (x, 0.7)), ("push_off_work", (x, 0.3))):
+        np.testing.assert_array_equal(np.asarray(read[name](*args)),
+                                      np.asarray(built[name](*args)))
+    assert read["n"] == 2 and read["total_mass_kg"] == built["total_mass_kg"]
+    files[0].write_text("damaged")
+    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(collocation, "step_functions", build)
+    again = step_cache.cached_step_functions(data)
+    np.testing.assert_array_equal(np.asarray(again["flow"](x, 0.7)),
+                                  np.asarray(built["flow"](x, 0.7)))

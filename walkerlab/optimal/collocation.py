@@ -334,8 +334,9 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     Parameters
     ----------
     data : WalkerData
-    eq : Equations
-        ``walkerlab.codegen.symbolic.derive(data.structure)``.
+    eq : Equations or None
+        ``walkerlab.codegen.symbolic.derive(data.structure)`` (unused when ``fns`` is
+        given, e.g. by :func:`walkerlab.optimal.step_cache.cached_step_functions`).
     spec : CollocationSpec
     guess_t : ndarray (m,)
         Times [s] of a guess step (e.g. a simulated gait from heel strike to heel strike).
