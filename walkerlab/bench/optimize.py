@@ -39,14 +39,17 @@ SCENES = tuple(GOALS_S)
 _CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 
-def _run(scene_path: Path, folder: Path, force: bool) -> dict:
+def _run(scene_path: Path, folder: Path, force: bool, tree: Path | None = None) -> dict:
     """One ``walkerlab optimize`` process with ``folder`` as its runs folder and code
-    cache: wall [s], CPU (user + sys of the finished child, the children's rusage) [s],
-    the stage's ``compute`` seconds from its output (None when not printed), the exit code,
-    and IPOPT's wall time, iterations and status and the gait flag from ``optimize.h5``."""
+    cache (``tree``: another code tree's ``walkerlab`` first on the child's path): wall
+    [s], CPU (user + sys of the finished child, the children's rusage) [s], the stage's
+    ``compute`` seconds from its output (None when not printed), the exit code, and IPOPT's
+    wall time, iterations and status and the gait flag from ``optimize.h5``."""
     import resource
 
     env = {**os.environ, "WALKERLAB_CACHE_DIR": str(folder / "cache")}
+    if tree is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(tree), env.get("PYTHONPATH", "")])
     cmd = [sys.executable, "-m", "walkerlab.cli", "optimize", str(scene_path),
            "--runs-dir", str(folder / "runs")] + (["--force"] if force else [])
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -79,33 +82,50 @@ def _median(runs: list[dict], key: str):
             "max": float(max(vals))}
 
 
-def bench_scene(name: str, repeats: int = 3) -> dict:
+def bench_scene(name: str, repeats: int = 3, vs: Path | None = None) -> dict:
     """Cold and warm ``walkerlab optimize`` of ``configs/<name>.yaml``, ``repeats`` each
-    (module docstring); cold and warm runs alternate (cold in a fresh folder, then warm
-    in it) so the machine's drift hits both alike."""
+    (module docstring); cold then warm in one fresh folder, repeated.  With ``vs`` (another
+    code tree) each repeat runs this tree and that one in turn, and the ratios this / vs
+    are taken pair by pair (medians), so the machine's drift hits both alike."""
     path = _CONFIGS / f"{name}.yaml"
-    cold, warm = [], []
+    runs = {"this": {"cold": [], "warm": []}, "vs": {"cold": [], "warm": []}}
     for _ in range(repeats):
-        with tempfile.TemporaryDirectory(prefix="wl_bench_opt_") as d:
-            cold.append(_run(path, Path(d), force=False))
-            warm.append(_run(path, Path(d), force=True))
+        for which, tree in (("this", None), ("vs", vs)) if vs is not None else (("this",
+                                                                                 None),):
+            with tempfile.TemporaryDirectory(prefix="wl_bench_opt_") as d:
+                runs[which]["cold"].append(_run(path, Path(d), False, tree))
+                runs[which]["warm"].append(_run(path, Path(d), True, tree))
     keys = ("wall_s", "cpu_s", "compute_s", "ipopt_wall_s", "ipopt_iterations")
+    this = runs["this"]
     out = {"scene": name, "goal_s": GOALS_S.get(name), "repeats": repeats,
-           "cold": {k: _median(cold, k) for k in keys},
-           "warm": {k: _median(warm, k) for k in keys},
+           "cold": {k: _median(this["cold"], k) for k in keys},
+           "warm": {k: _median(this["warm"], k) for k in keys},
            "status": sorted({r.get("ipopt_status", f"exit {r['returncode']}")
-                             for r in cold + warm}),
-           "gait": all(r.get("gait", False) for r in cold + warm)}
-    bad = [r for r in cold + warm if r["returncode"] != 0]
+                             for r in this["cold"] + this["warm"]}),
+           "gait": all(r.get("gait", False) for r in this["cold"] + this["warm"])}
+    if vs is not None:
+        out["vs"] = {"tree": str(vs), **{m: {k: _median(runs["vs"][m], k) for k in keys}
+                                         for m in ("cold", "warm")}}
+        out["ratio_this_over_vs"] = {m: {k: _paired(this[m], runs["vs"][m], k)
+                                         for k in ("wall_s", "cpu_s")}
+                                     for m in ("cold", "warm")}
+    bad = [r for r in this["cold"] + this["warm"] if r["returncode"] != 0]
     if bad:
         out["failure"] = bad[0]["tail"]
     return out
 
 
-def bench_optimize(scenes=SCENES, repeats: int = 3) -> dict:
-    """:func:`bench_scene` of every scene; the load average before and after."""
+def _paired(a: list[dict], b: list[dict], key: str):
+    """The ratios ``a[i][key] / b[i][key]`` run by run: median, min, max."""
+    return _median([{key: x[key] / y[key]} for x, y in zip(a, b)
+                    if x.get(key) and y.get(key)], key)
+
+
+def bench_optimize(scenes=SCENES, repeats: int = 3, vs: Path | None = None) -> dict:
+    """:func:`bench_scene` of every scene (against the code tree ``vs`` if given); the
+    load average before and after."""
     load0 = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
-    res = [bench_scene(s, repeats) for s in scenes]
+    res = [bench_scene(s, repeats, vs) for s in scenes]
     load1 = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
     return {"scenes": res, "loadavg_1min_before": load0, "loadavg_1min_after": load1,
             "note": "whole process (python -m walkerlab.cli optimize); cold: fresh runs "
@@ -127,4 +147,9 @@ def lines(result: dict) -> list[str]:
                        f"{cell(m['ipopt_iterations'])} | {s['goal_s']}")
         out.append(f"  {s['scene']}: IPOPT {', '.join(s['status'])}; a gait: {s['gait']}"
                    + (f"; FAILED: {s['failure']}" if "failure" in s else ""))
+        for mode, r in s.get("ratio_this_over_vs", {}).items():
+            v = s["vs"][mode]
+            out.append(f"  {s['scene']} | {mode} | vs {s['vs']['tree']}: wall "
+                       f"{cell(v['wall_s'])}, cpu {cell(v['cpu_s'])}; this / vs paired: "
+                       f"wall {cell(r['wall_s'])}, cpu {cell(r['cpu_s'])}")
     return out
