@@ -47,15 +47,17 @@ def _run(scene_path: Path, folder: Path, force: bool, tree: Path | None = None) 
     wall time, iterations and status and the gait flag from ``optimize.h5``."""
     import resource
 
-    env = {**os.environ, "WALKERLAB_CACHE_DIR": str(folder / "cache")}
-    if tree is not None:
-        env["PYTHONPATH"] = os.pathsep.join([str(tree), env.get("PYTHONPATH", "")])
+    # the child starts in ``folder`` (``-m`` puts the current folder first on the path)
+    # with the tree's walkerlab first on PYTHONPATH (this tree's when ``tree`` is None)
+    env = {**os.environ, "WALKERLAB_CACHE_DIR": str(folder / "cache"),
+           "PYTHONPATH": os.pathsep.join([str(tree or _CONFIGS.parent),
+                                          os.environ.get("PYTHONPATH", "")])}
     cmd = [sys.executable, "-m", "walkerlab.cli", "optimize", str(scene_path),
            "--runs-dir", str(folder / "runs")] + (["--force"] if force else [])
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
-    proc = subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                          check=False)
+    proc = subprocess.run(cmd, env=env, cwd=folder, stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, check=False)
     wall = time.perf_counter() - t0
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     text = proc.stdout.decode(errors="replace")
@@ -65,7 +67,7 @@ def _run(scene_path: Path, folder: Path, force: bool, tree: Path | None = None) 
            "compute_s": float(m.group(1)) if m else None, "returncode": proc.returncode,
            "tail": text.strip().splitlines()[-3:]}
     art = folder / "runs" / scene_path.stem / "optimize.h5"
-    if art.exists():
+    if proc.returncode == 0 and art.exists():  # not an earlier run's artifact
         from walkerlab.io.schemas.optimize import load
 
         d = load(art)
@@ -111,7 +113,7 @@ def bench_scene(name: str, repeats: int = 3, vs: Path | None = None) -> dict:
                                      for m in ("cold", "warm")}
     bad = [r for r in this["cold"] + this["warm"] if r["returncode"] != 0]
     if bad:
-        out["failure"] = bad[0]["tail"]
+        out["failure"] = f"exit {bad[0]['returncode']}: {bad[0]['tail']}"
     return out
 
 
