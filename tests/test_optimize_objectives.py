@@ -102,14 +102,64 @@ def test_kuo_least_push_off_is_his_closed_form(kuo):
 def test_kuo_weighted_sum_and_cost_of_transport_as_defined(kuo):
     """The weighted objective is the sum of its weighted terms; the massless swing leg's
     torque does no work, so the cost of transport is the push-off's work per weight and
-    step length, v^2 tan^2(alpha) / (2 g s), plus the smoothing's eps / 2 over the step
-    period (the smoothed positive part of a zero power, (0 + sqrt(0 + eps^2)) / 2)."""
+    step length, v^2 tan^2(alpha) / (2 g s), exactly (its positive work max(p, 0) at the
+    points, no smoothing width: the smoothed form added eps / 2 over the step period,
+    8 % of it here)."""
     _, res = kuo
     assert res.objective == pytest.approx(res.terms["push_off_work"]
                                           + 1e-4 * res.terms["effort"], rel=1e-14)
     th, dth = res.x[-1][0], res.x[-1][2]
-    cot = (0.5 * dth ** 2 * math.tan(th) ** 2 + 1e-3 / 2 * res.step_period_s) / (1.0 * 0.55)
-    assert res.terms["cost_of_transport"] == pytest.approx(cot, rel=1e-9)
+    cot = 0.5 * dth ** 2 * math.tan(th) ** 2 / (1.0 * 0.55)
+    assert res.terms["cost_of_transport"] == pytest.approx(cot, rel=1e-12)
+
+
+def test_kuo_least_cost_of_transport_alone_is_the_closed_form(kuo):
+    """objective: cost_of_transport alone (the push-off free, the targets of
+    configs/kuo2002.yaml: 0.4 m/s, 0.55 m; the positive work by slack variables, the
+    swing torque made unique by the default 1e-6 effort weight): IPOPT succeeds in < 60
+    iterations (19 seen; the smoothed form stopped 8 % above the optimum, at the smoothing's
+    bias) and the least cost of transport is Kuo's push-off work per weight and step
+    length, v^2 tan^2(alpha) / (2 M g s), v from the pendulum's quadrature of the target
+    step (collocation error ~1e-10 relative, slack complementarity ~1e-11 absolute:
+    asserted 1e-8); the objective adds 1e-6 of the effort and nothing else."""
+    case, _ = kuo
+    spec = replace(collocation_spec(case.scene), objective="cost_of_transport", weights=())
+    res = case.solve(spec)
+    assert res.status == "Solve_Succeeded" and res.iterations < 60
+    alpha = math.asin(0.55 / 2)
+    v = _pendulum_speed(alpha, 0.55 / 0.4)
+    assert res.push_off_n_s == pytest.approx(v * math.tan(alpha), rel=1e-8)
+    closed = 0.5 * (v * math.tan(alpha)) ** 2 / (1.0 * 1.0 * 0.55)
+    assert res.terms["cost_of_transport"] == pytest.approx(closed, rel=1e-8)
+    assert res.objective == pytest.approx(res.terms["cost_of_transport"]
+                                          + 1e-6 * res.terms["effort"], rel=1e-12)
+    assert replay(case.data, res)[0] <= 1e-6
+
+
+def test_cost_of_transport_alone_on_a_slope_is_a_passive_gait(compass):
+    """The compass walker on its 0.0525 rad slope with a hip torque, objective
+    cost_of_transport alone, started from its passive step with a 2 N m torque bump:
+    IPOPT succeeds in < 100 iterations (46 seen; the smoothed form: 331 iterations to a
+    gait with a 116 N m torque, and 500 without converging from zero torque) at the
+    optimum 0 (the slack variables' complementarity leaves ~1e-11), at a passive gait: the
+    torque vanishes to the tiny effort weight's resolution (|u| ~ sqrt(tol / w): 5e-3 N m
+    at w = 1e-6, asserted 1e-2, against ~30 N m of the level-ground optimum) and the step
+    is the passive walker's own, found by shooting from it (`find_fixed_point`), to 1e-3 s
+    (2e-4 s seen, the residual torque's effect).  CoT = 0 has two passive gaits at this
+    slope (0.734 s and 0.582 s); either is an optimum."""
+    from walkerlab.analysis.gait.poincare import find_fixed_point
+
+    case, _ = compass
+    bump = 2.0 * np.sin(np.pi * case.t / case.t[-1])
+    res = collocate_step(case.data, case.eq, CollocationSpec(intervals=40,
+                                                             objective="cost_of_transport"),
+                         case.t, case.x, bump, case.fns)
+    assert res.status == "Solve_Succeeded" and res.iterations < 100
+    assert 0.0 <= res.terms["cost_of_transport"] <= 1e-10 and res.objective <= 1e-10
+    assert np.max(np.abs(res.u)) < 1e-2
+    passive = find_fixed_point(build_walker(case.scene), res.x[0],
+                               Solver("DOP853", 1e-12, 1e-12))
+    assert res.step_period_s == pytest.approx(passive.period_s, abs=1e-3)
 
 
 def test_no_scuffing_bound_is_active(compass):
@@ -270,3 +320,40 @@ def test_a_guess_from_a_continuation_branch(compass, tmp_path):
     res = collocate_step(case.data, case.eq, CollocationSpec(intervals=40), t, x, fns=case.fns)
     assert res.status == "Solve_Succeeded" and res.objective <= 1e-10
     assert res.step_period_s == pytest.approx(passive.step_period_s, abs=1e-9)
+
+
+def test_step_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch):
+    """The straight-leg collocation's CasADi functions are built once per walker and read
+    back from the code cache (no symbolic derivation on a warm start: the build is not
+    called), and the functions read back compute bit for bit what the built ones do; a
+    damaged file is rebuilt."""
+    import walkerlab.optimal.collocation as collocation
+    from walkerlab.optimal import step_cache
+
+    monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
+    scene = load_scene(CONFIGS / "compass_optimal.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    monkeypatch.setattr(step_cache, "_memo", {})
+    built = step_cache.cached_step_functions(data)
+    files = list((tmp_path / "models").glob("*-steps-*.casadi"))
+    assert len(files) == 1
+    monkeypatch.setattr(step_cache, "_memo", {})
+
+    def no_build(*_a, **_k):
+        raise AssertionError("derived again")
+
+    build = collocation.step_functions
+    monkeypatch.setattr(collocation, "step_functions", no_build)
+    read = step_cache.cached_step_functions(data)
+    x = np.array([0.31, -0.22, -1.1, 0.4])
+    for name, args in (("flow", (x, 0.7)), ("reset", (x, 0.3)), ("grf", (x, 0.7)),
+                       ("guard_rate", (x, 0.7)), ("push_off_work", (x, 0.3))):
+        np.testing.assert_array_equal(np.asarray(read[name](*args)),
+                                      np.asarray(built[name](*args)))
+    assert read["n"] == 2 and read["total_mass_kg"] == built["total_mass_kg"]
+    files[0].write_text("damaged")
+    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(collocation, "step_functions", build)
+    again = step_cache.cached_step_functions(data)
+    np.testing.assert_array_equal(np.asarray(again["flow"](x, 0.7)),
+                                  np.asarray(built["flow"](x, 0.7)))

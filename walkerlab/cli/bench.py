@@ -27,6 +27,10 @@ benchmark      what is timed                                                    
                heel strike against a minimal numba loop, mesh MFPT, robustness
                (:mod:`walkerlab.bench.main_job`; ``scripts/bench_main_job.py
                --vs DIR`` puts another code tree beside this one)
+``optimize``   ``walkerlab optimize`` of every shipped optimisation scene,      compass,
+               whole process, cold (fresh runs folder and code cache) and warm  Kuo <= 5 s,
+               (``--force``), wall and CPU, medians of 3                        five-link
+               (:mod:`walkerlab.bench.optimize`; ``scripts/bench_optimize.py``) <= 60 s
 =============  ===============================================================  ==========
 
 The first ``walkerlab report`` of a fresh checkout is timed by ``scripts/bench_report.py``.
@@ -45,7 +49,7 @@ import numpy as np
 from walkerlab.bench import benchmarks as B
 from walkerlab.io.artifacts import atomic_write
 
-BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact", "main-job")
+BENCHMARKS = ("ideal", "fixedpoint", "sweep", "basin", "contact", "main-job", "optimize")
 
 
 def bench_sweep(workers: int = 2, slopes: str = "0.5:4.5:0.02", cpu: bool = True) -> dict:
@@ -139,6 +143,11 @@ def run_bench(what: str, out: Path, scenes=None) -> list[str]:
 
             lines += main_job_lines(res["result"])
             continue
+        if name == "optimize":
+            from walkerlab.bench.optimize import lines as optimize_lines
+
+            lines += optimize_lines(res["result"])
+            continue
         lines.append(f"{name}: {json.dumps(res['result'], default=str)[:2000]}")
     return lines
 
@@ -152,6 +161,10 @@ def _run_one(name: str, scenes) -> dict:
         from walkerlab.bench.main_job import run_main_job
 
         return run_main_job()
+    if name == "optimize":
+        from walkerlab.bench.optimize import bench_optimize
+
+        return bench_optimize()
     return {"ideal": B.bench_ideal, "fixedpoint": B.bench_fixedpoint, "sweep": bench_sweep,
             "basin": B.bench_basin,
             "contact": lambda: B.bench_contact_scenes(scenes)}[name]()

@@ -47,14 +47,17 @@ class OptimizeSettings(Strict):
                        "weighted"] = Field(
         "effort", description="effort: int u^2 dt [N^2 m^2 s] (plus push_off_weight P^2 "
         "when the push-off is free); push_off_work [J]; cost_of_transport: positive hip "
-        "work (smoothed) + push-off work per weight and step length [-]; peak_torque: max "
+        "work (exact, slack variables) + push-off work per weight and step length [-], "
+        "plus cost_of_transport_effort_weight * effort; peak_torque: max "
         "|u| [N m] (epigraph form); weighted: sum of weights[name] * name")
     weights: dict[Literal["effort", "push_off_work", "cost_of_transport", "peak_torque"],
                   float] | None = Field(None, description="objective: weighted: the terms' "
                                         "weights [1 / the term's unit]")
-    smoothing_w: float = Field(1e-3, gt=0, le=1e3, description="eps of the positive part "
-                               "(p + sqrt(p^2 + eps^2)) / 2 of the hip power in the "
-                               "cost of transport [W]")
+    cost_of_transport_effort_weight: float = Field(
+        1e-6, ge=0, le=1e3, description="objective: cost_of_transport: the weight of "
+        "int u^2 dt added to it, a tiny regularisation (the cost of transport alone leaves "
+        "the torque free where it does negative or no work) [1 / (N^2 m^2 s); per kg^2 "
+        "on massless legs]")
     intervals: int = Field(40, ge=4, le=400, description="Hermite-Simpson intervals [-]")
     push_off: Literal["fixed", "free"] = Field(
         "fixed", description="the push-off impulse: the scene's (fixed) or a decision "

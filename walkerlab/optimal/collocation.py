@@ -19,9 +19,11 @@ swing foot ahead); the step's start is the end mapped by push-off + heel strike 
 rate below ``-touchdown_rate``, the rigid model's event direction).  Objectives
 (:data:`OBJECTIVES`, or a weighted sum of them): the effort ``int u^2 dt`` (Simpson's rule
 on the same points; with a free push-off its weighted square ``w P^2`` added), the
-push-off's work, the cost of transport (the hip's positive work, ``max(p, 0)`` smoothed
-as ``(p + sqrt(p^2 + eps^2)) / 2``, plus the push-off's work, per weight and step length)
-and the peak torque (epigraph form: ``-s <= u_k <= s``, minimise ``s``).  Constraints:
+push-off's work, the cost of transport (the hip's positive work ``int max(p, 0) dt``,
+exact through slack variables ``s >= 0, s >= p`` at every point as Srinivasan & Ruina
+2006 and Kelly 2017 do, plus the push-off's work, per weight and step length; alone, a
+tiny effort weight added) and the peak torque (epigraph form: ``-s <= u_k <= s``,
+minimise ``s``).  Constraints:
 optional target speed, step length or step period, a torque limit, no scuffing (the swing
 foot above a bound at every point but the ends), the stance foot's ground reaction
 ``m (a_com + g)`` with a non-negative normal force inside the friction cone, the hip's
@@ -71,9 +73,17 @@ class CollocationSpec:
         A key of :data:`OBJECTIVES`, or ``weighted``: ``sum w_i J_i`` over ``weights``.
     weights : tuple of (str, float)
         The weighted sum's terms (names of :data:`OBJECTIVES`) and weights.
-    smoothing_w : float
-        ``eps`` [W] of the positive part ``max(p, 0) ~ (p + sqrt(p^2 + eps^2)) / 2`` in
-        the cost of transport (above it by at most ``eps / 2``, smooth and convex).
+    cost_of_transport_effort_weight : float
+        With ``objective = "cost_of_transport"``: ``w`` [1 / (N^2 m^2 s)] of the effort
+        added to it (``J = CoT + w int u^2 dt``).  The cost of transport alone leaves the
+        torque free wherever it does negative or no work (a torque per foot mass on massless
+        legs does none), a degenerate optimum; the tiny effort picks the least torque
+        among the least-CoT gaits.  Where the least cost of transport needs positive
+        work and nothing bounds the torque, ``w`` is part of the problem: the compass
+        walker on level ground with a hip torque only (0.5 m/s, 40-80 intervals) has CoT
+        0.091, 0.053, 0.030 at ``w`` = 1e-2, 1e-3, 1e-4, its torques growing towards
+        impulses (at 1e-6 they chatter between the points, the replay no longer closes);
+        give a torque limit or a larger ``w`` there.
     min_clearance_m : float or None
         The swing foot at least this high above the slope [m] at every point but the first
         and the last (no scuffing).
@@ -98,7 +108,7 @@ class CollocationSpec:
     target_step_period_s: float | None = None
     objective: str = "effort"
     weights: tuple = ()
-    smoothing_w: float = 1e-3
+    cost_of_transport_effort_weight: float = 1e-6
     min_clearance_m: float | None = None
     friction_coefficient: float | None = None
     hip_angle_range_rad: tuple | None = None
@@ -125,10 +135,11 @@ class CollocationResult:
     step_period_s, step_length_m, push_off_n_s : float
     objective : float
         The spec's objective at the optimum (its unit: :data:`OBJECTIVES`; ``effort``
-        with a free push-off adds ``push_off_weight P^2``).
+        with a free push-off adds ``push_off_weight P^2``, ``cost_of_transport``
+        ``cost_of_transport_effort_weight`` times the effort).
     terms : dict
-        Every objective of :data:`OBJECTIVES` evaluated there (the cost of transport
-        smoothed; ``peak_torque`` ``max |u|``).
+        Every objective of :data:`OBJECTIVES` evaluated there (the cost of transport's
+        positive work exact, ``max(p, 0)`` at the points; ``peak_torque`` ``max |u|``).
     status : str
         IPOPT's return status.
     iterations : int
@@ -337,8 +348,9 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     Parameters
     ----------
     data : WalkerData
-    eq : Equations
-        ``walkerlab.codegen.symbolic.derive(data.structure)``.
+    eq : Equations or None
+        ``walkerlab.codegen.symbolic.derive(data.structure)`` (unused when ``fns`` is
+        given, e.g. by :func:`walkerlab.optimal.step_cache.cached_step_functions`).
     spec : CollocationSpec
     guess_t : ndarray (m,)
         Times [s] of a guess step (e.g. a simulated gait from heel strike to heel strike).
@@ -379,9 +391,7 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     opti.set_initial(U, ug[None])
     if spec.push_off_free:
         opti.set_initial(P, spec.push_off_n_s)
-    opti.solver("ipopt", {"print_time": False},
-                {"print_level": 0, "tol": 1e-12, "acceptable_tol": 1e-10, "max_iter": 500,
-                 "sb": "yes"})
+    opti.solver("ipopt", {"print_time": False}, _ipopt_options(spec))
     t0 = time.perf_counter()
     try:
         sol = opti.solve()
@@ -399,6 +409,19 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
         iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall,
         terms={k: float(get(v)) for k, v in terms.items()},
         history=iteration_history(opti.stats()))
+
+
+def _ipopt_options(spec) -> dict:
+    """IPOPT's options: tight tolerances; with the cost of transport's slack variables no
+    bound relaxation (IPOPT relaxes every inequality by ``bound_relax_factor`` = 1e-8
+    relative by default, which lets each ``s_k`` go ~1e-8 below 0 and biases the positive
+    work by as much; at 0 the slack is exact)."""
+    opts = {"print_level": 0, "tol": 1e-12, "acceptable_tol": 1e-10, "max_iter": 500,
+            "sb": "yes"}
+    asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
+    if "cost_of_transport" in asked:
+        opts["bound_relax_factor"] = 0.0
+    return opts
 
 
 def _transcribe(opti, fns, spec, X, U, T, P, period_guess):
@@ -467,16 +490,15 @@ def _simpson(h, values):
 
 def _terms(opti, fns, spec, X, U, T, P):
     """The objectives used (:data:`OBJECTIVES`): effort ``int u^2 dt``, the push-off's work,
-    the cost of transport (positive hip work, smoothed, plus the push-off's work, per
-    weight and step length) and the peak torque (epigraph: ``-s <= u <= s``, minimise
-    ``s``; only when it is asked for, else ``max |u|`` afterwards)."""
+    the cost of transport (positive hip work plus the push-off's work, per weight and step
+    length) and the peak torque (epigraph: ``-s <= u <= s``, minimise ``s``).  Where the
+    cost of transport or the peak torque is asked for, it is in its exact slack form
+    (:func:`_positive_work`, the epigraph); else evaluated afterwards from the points
+    (``max(p, 0)``, ``max |u|``)."""
     import casadi as ca
 
     K = X.shape[1]
     h = T / ((K - 1) // 2)
-    eps = spec.smoothing_w
-    power = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(K)])
-    positive = 0.5 * (power + ca.sqrt(power ** 2 + eps ** 2))
     work = fns["push_off_work"](X[:, -1], P)
     weight = fns["total_mass_kg"] * fns["gravity"]
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
@@ -486,13 +508,38 @@ def _terms(opti, fns, spec, X, U, T, P):
         opti.set_initial(peak, 1.0)
     else:
         peak = ca.mmax(ca.fabs(U))
+    power = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(K)])
+    positive = (_positive_work(opti, power) if "cost_of_transport" in asked
+                else ca.fmax(power, 0))
     return {"effort": _simpson(h, U ** 2), "push_off_work": work,
             "cost_of_transport": (_simpson(h, positive) + work)
             / (weight * fns["step"](X[:, -1])), "peak_torque": peak}
 
 
+def _positive_work(opti, power):
+    """The positive part of the actuator power at the points, exactly, by slack variables
+    (Srinivasan & Ruina 2006, Nature 439:72-75; Kelly 2017, SIAM Review 59(4), on
+    non-smooth objectives): ``s_k >= 0`` and ``s_k >= p_k`` at every point, ``s`` in the
+    objective with positive quadrature weights, so at the optimum ``s_k = max(p_k, 0)``.
+    The problem stays smooth (the kink moves into linear inequalities, which the interior
+    point method handles); no smoothing width.
+
+    Returns
+    -------
+    casadi.MX (1, K)
+        The slack variables [W].
+    """
+    s = opti.variable(1, power.shape[1])
+    opti.subject_to(s >= 0)
+    opti.subject_to(s >= power)
+    opti.set_initial(s, 1e-3)
+    return s
+
+
 def _objective(spec, terms, P):
-    """The spec's objective from the terms (``effort`` with a free push-off: + ``w P^2``).
+    """The spec's objective from the terms (``effort`` with a free push-off: + ``w P^2``;
+    ``cost_of_transport`` alone: + ``cost_of_transport_effort_weight * effort``, the tiny
+    regularisation that makes its torque unique where the torque does no positive work).
 
     Raises
     ------
@@ -509,6 +556,8 @@ def _objective(spec, terms, P):
     obj = terms[spec.objective]
     if spec.objective == "effort" and spec.push_off_free:
         obj = obj + spec.push_off_weight * P ** 2
+    if spec.objective == "cost_of_transport":
+        obj = obj + spec.cost_of_transport_effort_weight * terms["effort"]
     return obj
 
 

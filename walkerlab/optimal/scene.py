@@ -30,7 +30,9 @@ def collocation_spec(scene):
                            target_step_length_m=o.target_step_length_m,
                            target_step_period_s=o.target_step_period_s,
                            objective=o.objective, weights=tuple((o.weights or {}).items()),
-                           smoothing_w=o.smoothing_w, min_clearance_m=o.min_clearance_m,
+                           cost_of_transport_effort_weight=(
+                               o.cost_of_transport_effort_weight),
+                           min_clearance_m=o.min_clearance_m,
                            friction_coefficient=o.friction_coefficient,
                            hip_angle_range_rad=o.hip_angle_range_rad,
                            touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
@@ -70,13 +72,13 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
         or the initial guess's artifact is unusable (one line).
     """
     from walkerlab.analysis.gait.poincare import poincare_map
-    from walkerlab.codegen import symbolic
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.collocation import collocate_step, replay
     from walkerlab.optimal.contact_replay import contact_replay
     from walkerlab.optimal.guess import starting_step
+    from walkerlab.optimal.step_cache import cached_step_functions
     from walkerlab.walker.description import walker_data
 
     try:
@@ -94,7 +96,7 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
     if guess_p is not None and spec.push_off_free:
         spec = replace(spec, push_off_n_s=guess_p)
-    res = collocate_step(data, symbolic.derive(data.structure), spec, t, guess, guess_u)
+    res = collocate_step(data, None, spec, t, guess, guess_u, cached_step_functions(data))
     err, replayed = replay(data, res)
     mu = np.full(res.x.shape[1], np.nan, complex)
     if np.isfinite(err):
