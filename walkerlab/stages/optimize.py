@@ -24,7 +24,9 @@ from walkerlab.stages.common import (
     with_defaults,
 )
 
-SECTIONS = ("walker", "slope", "ideal", "solver", "optimize")
+#: the sections optimize.h5 depends on (the contact ones: its contact replay)
+SECTIONS = ("walker", "slope", "ideal", "solver", "optimize", "contact", "terrain",
+            "contact_solver")
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:

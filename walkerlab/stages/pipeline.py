@@ -88,6 +88,9 @@ def report_plan(scene: Scene, full: bool = False) -> list[str]:
     # a simulation that starts from the gait runs (and shows) the fixed point it starts from,
     # with the section's defaults when the scene has none
     gait = fp or (sim and "fixedpoint" in needs("simulate", scene))
+    # a contact section without a gait to start from (a five-link optimum's contact replay
+    # reads it) runs no contact-sim
+    contact = contact and (gait or "fixedpoint" not in needs("contact-sim", scene))
     plan = {"fixedpoint": gait, "simulate": sim, "contact-sim": contact,
             "compare": contact and sim, "workprecision": full and scene.workprecision is not None,
             "basin": scene.basin is not None and fp,
