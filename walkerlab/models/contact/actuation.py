@@ -11,6 +11,15 @@ Which leg is the stance leg is a discrete state of the run, as in the rigid mode
 the start, then the leg whose foot touched down last (the integrator switches it at each
 touchdown, :mod:`walkerlab.integrate.contact_powered`).
 
+On a kneed walker (floating coordinates ``hip_x, hip_y, leg1_thigh_angle,
+leg1_shank_angle, leg2_thigh_angle, leg2_shank_angle``) the hip torque acts between the two
+thighs: ``+tau`` on the swing thigh's absolute angle, ``-tau`` on the stance thigh's, the
+shanks and knees get nothing; its power is ``tau (dtheta_swing_thigh -
+dtheta_stance_thigh)`` and its phase variable the stance thigh's angle (the rigid view's
+stance angle while the stance knee is straight).  The knee stops' power is a term of the
+ledger of its own (:data:`KNEE_WORK_NAMES`); a kneed walker takes hip torques alone (no
+push-off yet).
+
 Push-off
 --------
 The rigid model's push-off is an impulse ``P`` at the trailing foot along the trailing leg
@@ -50,7 +59,7 @@ import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
-__all__ = ["ANKLE_WORK_NAMES", "WORK_NAMES", "ContactActuators", "ContactRows", "powered_rhs"]
+__all__ = ["ANKLE_WORK_NAMES", "KNEE_WORK_NAMES", "WORK_NAMES", "ContactActuators", "ContactRows", "powered_rhs"]
 
 
 class ContactRows:
@@ -86,14 +95,15 @@ class ContactRows:
 
 class ContactActuators(ContactRows):
     """The actuators of one contact walker (straight legs; point feet, or flat feet with an
-    ankle push-off).
+    ankle push-off; or a hip torque between the thighs of a kneed walker with point feet).
 
     Parameters
     ----------
     spec : walkerlab.config.actuation.Actuation
     coordinates : tuple of str
         The floating coordinates (``hip_x, hip_y, leg1_angle, leg2_angle``; flat feet then
-        ``leg1_foot_angle, leg2_foot_angle``).
+        ``leg1_foot_angle, leg2_foot_angle``; knees: ``leg{i}_thigh_angle,
+        leg{i}_shank_angle`` in place of ``leg{i}_angle``).
     pulse_s : float
         Push-off pulse duration [s] (0: an impulse).
 
@@ -101,7 +111,7 @@ class ContactActuators(ContactRows):
     ------
     ValueError
         The walker's legs are not two straight legs with point feet, or flat feet with an
-        ankle push-off alone (one line).
+        ankle push-off alone, or kneed legs with point feet and hip torques alone (one line).
     """
 
     #: A touchdown is a heel strike only this far [m] ahead of the stance foot (a scuff
@@ -110,7 +120,17 @@ class ContactActuators(ContactRows):
 
     def __init__(self, spec, coordinates, pulse_s: float):
         names = tuple(coordinates)
-        if "leg1_angle" not in names or "leg2_angle" not in names:
+        #: a kneed walker: the hip torque acts on the thighs (module docstring)
+        self.knee = "leg1_thigh_angle" in names
+        if self.knee and (spec.push_off is not None
+                          or getattr(spec, "ankle_push_off", None) is not None
+                          or "leg1_foot_angle" in names
+                          or any(t.joint != "hip" for t in spec.torques)):
+            raise ValueError("walker.actuation: a kneed walker takes hip torques alone on "
+                             "point feet in the contact view (push-off: not yet)")
+        leg = ("leg1_thigh_angle", "leg2_thigh_angle") if self.knee else ("leg1_angle",
+                                                                            "leg2_angle")
+        if leg[0] not in names or leg[1] not in names:
             raise ValueError("walker.actuation: the contact view carries actuators on "
                              "straight legs with point feet only (knees, arc and flat feet: "
                              "not yet)")
@@ -128,7 +148,8 @@ class ContactActuators(ContactRows):
         self.spec = spec
         self.nq = len(names)
         self.pulse_s = float(pulse_s)
-        self.leg = (names.index("leg1_angle"), names.index("leg2_angle"))
+        #: each leg's angle column (a kneed walker's: its thigh's)
+        self.leg = (names.index(leg[0]), names.index(leg[1]))
         #: the hip's position columns (the floating base: the hip point itself)
         self.hip = (names.index("hip_x"), names.index("hip_y"))
         self.laws = TorqueLaws(spec.torques)
@@ -155,8 +176,10 @@ class ContactActuators(ContactRows):
 
     @property
     def work_names(self) -> tuple[str, ...]:
-        """Names of the work integrals this walker's run carries (:data:`WORK_NAMES`, or
-        :data:`ANKLE_WORK_NAMES` for an ankle push-off)."""
+        """Names of the work integrals this walker's run carries (:data:`WORK_NAMES`;
+        :data:`ANKLE_WORK_NAMES` for an ankle push-off, :data:`KNEE_WORK_NAMES` for knees)."""
+        if self.knee:
+            return KNEE_WORK_NAMES
         return WORK_NAMES if self.ankle is None else ANKLE_WORK_NAMES
 
     def ankle_torque(self, x, stance: int) -> tuple[np.ndarray, float]:
@@ -216,6 +239,8 @@ class ContactActuators(ContactRows):
 WORK_NAMES = ("hip_torque_positive", "hip_torque_negative", "push_off", "contact")
 #: ... and those of a flat-footed walker's ankle push-off run [J].
 ANKLE_WORK_NAMES = ("ankle_torque_positive", "ankle_torque_negative", "damper", "contact")
+#: ... and those of a kneed walker's (the knee stops' work last) [J].
+KNEE_WORK_NAMES = WORK_NAMES + ("knee_stop",)
 
 
 def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
@@ -242,11 +267,12 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
     -------
     dx : ndarray, shape (2 nq,)
         ``[dq, ddq]`` [m/s, rad/s, m/s^2, rad/s^2].
-    powers : ndarray, shape (4,)
+    powers : ndarray, shape (4,) or (5,)
         [W], in the order of ``walker.actuators.work_names``: the hip torques' positive and
         negative power, the push-off's, and the contact forces' (normal + friction, all
         points; negative while they dissipate or store); flat feet: the ankle push-off's
-        positive and negative power, the dampers', the contact forces'.
+        positive and negative power, the dampers', the contact forces'; knees: then the knee
+        stops' power.
     """
     acts = walker.actuators
     n = walker.nq
@@ -267,4 +293,8 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
         Q = Q + Qp
     if np.any(Q):
         dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
+    if acts.knee:
+        p_knee = float(np.sum(walker.kernels.knee_table(
+            np.ascontiguousarray(x[None], dtype=float), *walker._args())[0, :, 3]))
+        return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact, p_knee])
     return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact])

@@ -74,6 +74,8 @@ class JointTorqueActuators(ContactRows):
     pulse_s = 0.0
     #: No ankle push-off (point feet).
     ankle = None
+    #: Free knees: no knee stop, no knee-stop term in the ledger.
+    knee = False
     #: The work integrals a run carries (:data:`~walkerlab.models.contact.actuation.WORK_NAMES`:
     #: the hip-torque names carry every joint torque's work).
     work_names = WORK_NAMES
