@@ -2,7 +2,8 @@
 flat feet):
 the transcription of :mod:`walkerlab.optimal.phased_collocation` set up from the scene,
 started from one step of the scene's gait, replayed on the rigid model, its Floquet
-multipliers from the replay."""
+multipliers from the replay, and replayed in the contact model (2 strides; a kneed walker's
+hip torque acts between its thighs; flat feet are not replayed yet)."""
 
 from __future__ import annotations
 
@@ -44,6 +45,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.contact_replay import contact_replay_phased
     from walkerlab.optimal.phased_collocation import (
         collocate_phases,
         phased_guess,
@@ -65,6 +67,9 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     res = collocate_phases(fns, spec, guess)
     err, replayed = replay_phases(data, res)
     mu = _multipliers(replayed, res, scene, err)
+    contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
+    if np.isfinite(err):
+        contact_period, contact_outcome = contact_replay_phased(scene, res, strides=2)
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
@@ -72,8 +77,8 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                         bool(err <= o.replay_tolerance and res.status == "Solve_Succeeded"),
                         res.status, res.iterations, res.wall_time_s, units,
                         objective_name=o.objective, objective_unit=_unit(o.objective),
-                        terms=res.terms, contact_outcome="not replayed: the contact view "
-                        "carries no hip torque on knees or flat feet yet",
+                        terms=res.terms, contact_step_period_s=contact_period,
+                        contact_outcome=contact_outcome,
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
                         phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
                         build_time_s=build + res.build_time_s,
