@@ -100,3 +100,25 @@ def test_the_kneed_optimums_contact_replay_keeps_its_period(gait):
     period, outcome = contact_replay_phased(load_scene(CONFIGS / "kneed_optimal.yaml"), res)
     assert outcome == "heel_strike"
     assert abs(period / T - 1.0) < 0.03, period
+
+
+def test_contact_sim_stores_the_knee_stop_work(tmp_path):
+    """``walkerlab contact-sim`` on a kneed walker with a hip actuator (a zero torque law, so
+    that the rigid gait it starts from is the passive one; 0.7 s): the artifact's ledger
+    carries ``knee_stop`` beside the other terms and closes (as the run's)."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
+
+    raw = yaml.safe_load((CONFIGS / "kneed.yaml").read_text())
+    raw["walker"]["actuation"] = {"torques": [{"joint": "hip", "law": {}}]}
+    raw["contact_sim"] = {"n_strides": 1, "sample_rate_hz": 500, "t_final_s": 0.7}
+    path = tmp_path / "kneed_hip.yaml"
+    path.write_text(yaml.safe_dump(raw))
+    r = CliRunner().invoke(app, ["contact-sim", str(path), "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    led = load_contact_sim(tmp_path / "kneed_hip" / "contact_sim.h5").ledger
+    assert set(KNEE_WORK_NAMES) <= set(led) and led["knee_stop"][-1] < 0.0
+    assert np.max(np.abs(led["residual"])) < 1e-5  # J (kinetic energy ~0.9 J; 1.7e-7 rel.)

@@ -87,7 +87,9 @@ def contact_section(scene, arts) -> list[str]:
         out += ["**Energy ledger of the powered contact run** (work integrals carried with the "
                 f"state; J over the whole run): {terms}, contact forces (normal + friction, "
                 f"their dissipation and the energy their springs hold) "
-                f"{num(w['contact'][-1], 4)}; closure (kinetic + potential energy change minus "
+                f"{num(w['contact'][-1], 4)}"
+                + (f", knee stops {num(w['knee_stop'][-1], 4)}" if "knee_stop" in w else "")
+                + "; closure (kinetic + potential energy change minus "
                 f"these) at most {num(float(abs(w['residual']).max()), 2)} J.", ""]
     if per_fail is not None:
         out += [f"**Periodic gait of the contact model**: not found ({per_fail[0]}: "

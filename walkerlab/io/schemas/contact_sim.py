@@ -275,7 +275,9 @@ def _write_work(f, run: ContactSimRun) -> None:
             "ankle_torque_negative": "negative work of the ankle push-off torque",
             "damper": "work of the ankle (and hip) dampers",
             "contact": "work of the contact forces (normal + friction, every point): their "
-                       "dissipation and the energy their springs hold"}
+                       "dissipation and the energy their springs hold",
+            "knee_stop": "work of the knee stops (a kneed walker): their dissipation and "
+                         "the energy their springs hold"}
     if run.walker.structure.free_knees:  # a five-link biped: every joint torque's work
         what.update(hip_torque_positive="positive work of the joint torques (hips and knees)",
                     hip_torque_negative="negative work of the joint torques (hips and knees)")
