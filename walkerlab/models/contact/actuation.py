@@ -132,7 +132,7 @@ class ContactActuators(ContactRows):
                                                                             "leg2_angle")
         if leg[0] not in names or leg[1] not in names:
             raise ValueError("walker.actuation: the contact view carries actuators on "
-                             "straight legs with point feet only (knees, arc and flat feet: "
+                             "straight or kneed legs with point feet only (arc and flat feet: "
                              "not yet)")
         flat = "leg1_foot_angle" in names
         ankle = getattr(spec, "ankle_push_off", None)
