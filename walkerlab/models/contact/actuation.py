@@ -59,7 +59,8 @@ import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
-__all__ = ["ANKLE_WORK_NAMES", "KNEE_WORK_NAMES", "WORK_NAMES", "ContactActuators", "ContactRows", "powered_rhs"]
+__all__ = ["ANKLE_WORK_NAMES", "KNEE_WORK_NAMES", "WORK_NAMES", "ContactActuators",
+           "ContactRows", "powered_rhs"]
 
 
 class ContactRows:
