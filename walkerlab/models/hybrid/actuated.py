@@ -322,7 +322,9 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     act on the swing row alone), or a phase whose guards have no compiled outputs."""
     from walkerlab.codegen.actuated import ActuatedFlow
 
-    if limit or data.structure.knee:  # the compiled laws drive the unconstrained flow only
+    # the compiled laws drive the unconstrained flow only: not a locking knee's phases (a
+    # five-link biped's free knees are unconstrained)
+    if limit or (data.structure.knee and not data.structure.free_knees):
         return None
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None and data.structure.free_knees:
