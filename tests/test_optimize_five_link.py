@@ -18,6 +18,8 @@ from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+#: one worker computes the module's optimum (~3 min CPU with its phase replays) once
+pytestmark = pytest.mark.xdist_group("five_link_optimum")
 #: torques [N m] on the joints in walkerlab.optimal.five_link.JOINTS order
 TAU = np.array([7.0, -3.0, 11.0, -5.0])
 
