@@ -64,8 +64,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
                   f"computed in {o.wall_time_s:.2f} s")  # why: said when it started
         echo(f"{o.stage:>13s}: {status} -> {o.path}")
     if not any(o.stage in ("simulate", "contact-sim") for o in done):
-        echo(f"{'plot':>13s}: no trajectory figures (the scene has no 'simulate' or "
-             "'contact' section)")
+        echo(f"{'plot':>13s}: no trajectory figures (the report ran no 'simulate' or "
+             "'contact-sim')")
     for line in drawn:
         echo(line)
     paths, left_out = report_artifacts(scene, runs_root, done, full)
