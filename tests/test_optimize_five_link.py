@@ -18,8 +18,6 @@ from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
-#: one worker computes the module's optimum (~3 min CPU with its phase replays) once
-pytestmark = pytest.mark.xdist_group("five_link_optimum")
 #: torques [N m] on the joints in walkerlab.optimal.five_link.JOINTS order
 TAU = np.array([7.0, -3.0, 11.0, -5.0])
 
@@ -140,8 +138,7 @@ def optimised(tmp_path_factory):
     return load(runs / "rabbit_optimal" / "optimize.h5"), r.output, runs
 
 
-@pytest.mark.slow  # ~20 s CPU: the collocation (~3 s), the shooting (~9 s), the replay (~3 s)
-def test_kellys_step_meets_its_targets_and_constraints(optimised, fns_and_params):
+def check_kellys_step_meets_its_targets_and_constraints(optimised, fns_and_params):
     """0.5 m in 0.7 s exactly; the swing foot above the ground at every interior point and
     on it at the end, moving down there; no knee hyper-extended; torques finite, within
     RABBIT's 150 N m; IPOPT converged; the torques stored by joint name."""
@@ -166,8 +163,7 @@ def test_kellys_step_meets_its_targets_and_constraints(optimised, fns_and_params
     assert "phase-variable feedback law" in out and "phase-variable feedforward law" in out
 
 
-@pytest.mark.slow  # shares the fixture above
-def test_the_closed_step_replays_on_the_rigid_model(optimised):
+def check_the_closed_step_replays_on_the_rigid_model(optimised):
     """The open-loop torques do not close the collocated step (the gait is unstable under
     them: an error of ~1e-5 at the start grows to >1e-3), the shooting closes it a few 1e-5
     away with the step period within 1e-5 s of 0.7, and the rigid model's generated code
@@ -181,8 +177,7 @@ def test_the_closed_step_replays_on_the_rigid_model(optimised):
     assert (runs / "rabbit_optimal" / "report" / "figures" / "optimize.png").is_file()
 
 
-@pytest.mark.slow  # shares the fixture above (the report reuses its optimize.h5: ~2 s)
-def test_the_report_shows_the_optimised_step(optimised):
+def check_the_report_shows_the_optimised_step(optimised):
     """tests/test_scenes_end_to_end.py leaves this scene out (no gait for fixedpoint): its
     report is built here, the optimised step its only section."""
     from walkerlab.stages import report
@@ -194,8 +189,7 @@ def test_the_report_shows_the_optimised_step(optimised):
     assert "virtual constraints" in md and "feed-forward alone" in md
 
 
-@pytest.mark.slow  # one more collocation (25 intervals, ~2 s CPU) beside the fixture's 50
-def test_the_transcription_error_falls_at_hermite_simpsons_order(optimised):
+def check_the_transcription_error_falls_at_hermite_simpsons_order(optimised):
     """The open-loop return error of the collocated start (the transcription's error grown
     over the step by the same linearised map at both meshes) falls by 2^p when the mesh is
     halved: observed p >= 3.5 for Hermite-Simpson's 4 (measured 3.7: at 25 intervals the
@@ -220,8 +214,7 @@ def test_the_transcription_error_falls_at_hermite_simpsons_order(optimised):
     assert np.log2(e25 / e50) >= 3.5, (e25, e50)
 
 
-@pytest.mark.slow  # shares the fixture above (the phase replays: ~35 step maps, ~90 s CPU)
-def test_the_phase_variable_replay_closes_stable_with_the_optimal_torques(optimised):
+def check_the_phase_variable_replay_closes_stable_with_the_optimal_torques(optimised):
     """The optimum as virtual constraints (the torques as a function of the stance leg's
     angle, plus PD tracking of the collocated joint trajectory at RABBIT's gains): one step
     from the collocated start returns within the transcription's error (measured 4.2e-5);
@@ -241,8 +234,7 @@ def test_the_phase_variable_replay_closes_stable_with_the_optimal_torques(optimi
     assert np.max(np.abs(ff.multipliers)) > 1.0
 
 
-@pytest.mark.slow  # reads the fixture's artifact
-def test_the_phase_variable_law_walks_the_contact_model_at_the_optimums_period(optimised):
+def check_the_phase_variable_law_walks_the_contact_model_at_the_optimums_period(optimised):
     """The scene's contact replay: the feed-forward + PD law in the contact model (the
     paper's contact law with the scene's friction regularisation of 10 mm/s: the paper's
     100 mm/s lets the stance foot creep under the optimum's tangential load, |Ft/Fn| up to
@@ -253,3 +245,16 @@ def test_the_phase_variable_law_walks_the_contact_model_at_the_optimums_period(o
     assert scene.contact.written("stiction_velocity")[0] == 10.0
     assert d.contact_outcome == "heel_strike", d.contact_outcome
     assert abs(d.contact_step_period_s / d.step_period_s - 1.0) <= 0.03, d.contact_step_period_s
+
+
+@pytest.mark.slow  # one optimisation of rabbit_optimal (~4 min CPU with its phase replays)
+def test_the_shipped_five_link_optimum(optimised, fns_and_params):
+    """The checks of the shipped five-link optimum, in one test: pytest-xdist 3.8 (with
+    pytest 9) ignores ``xdist_group`` marks, so separate tests ran the fixture on both
+    workers (2 x 240 s of the slow set)."""
+    check_kellys_step_meets_its_targets_and_constraints(optimised, fns_and_params)
+    check_the_closed_step_replays_on_the_rigid_model(optimised)
+    check_the_report_shows_the_optimised_step(optimised)
+    check_the_transcription_error_falls_at_hermite_simpsons_order(optimised)
+    check_the_phase_variable_replay_closes_stable_with_the_optimal_torques(optimised)
+    check_the_phase_variable_law_walks_the_contact_model_at_the_optimums_period(optimised)
