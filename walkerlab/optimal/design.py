@@ -185,7 +185,6 @@ def measure_gradient(gaits: _Gaits, p, name: str, h_x: float = 1e-6,
     walkerlab.analysis.gait.poincare.FixedPointNotFound
         No gait at ``p`` near the last one.
     """
-    from walkerlab.analysis.gait.poincare import poincare_map
 
     p = np.asarray(p, float)
     w, fp = gaits.gait(p)
@@ -198,16 +197,25 @@ def measure_gradient(gaits: _Gaits, p, name: str, h_x: float = 1e-6,
                       for e in np.eye(n2)])
     grad = np.empty(p.size)
     for j in range(p.size):
-        dp = np.zeros(p.size)
-        dp[j] = h_p * max(1.0, abs(p[j]))
-        wp, wm = gaits.walker(p + dp), gaits.walker(p - dp)
-        dP = (poincare_map(wp, x, gaits.solver)[0] - poincare_map(wm, x, gaits.solver)[0]) \
-            / (2 * dp[j])
+        wp, wm, step, dx = _gait_shift(gaits, p, j, h_p, x, J)
         dm = (_measures(wp, x, gaits.solver)[name]
-              - _measures(wm, x, gaits.solver)[name]) / (2 * dp[j])
-        dx = np.linalg.solve(np.eye(n2) - J, dP)
+              - _measures(wm, x, gaits.solver)[name]) / (2 * step)
         grad[j] = dm_dx @ dx + dm
     return value, grad
+
+
+def _gait_shift(gaits: _Gaits, p, j: int, h: float, x, J):
+    """The walkers at ``p ± step e_j`` (``step = h max(1, |p_j|)``), the step and the fixed
+    point's shift ``dx*/dp_j = (I - DP)⁻¹ ∂P/∂p_j`` (2n,) from a central difference of
+    single maps at the fixed point ``x`` (``J``: its ``DP``)."""
+    from walkerlab.analysis.gait.poincare import poincare_map
+
+    dp = np.zeros(p.size)
+    dp[j] = h * max(1.0, abs(p[j]))
+    wp, wm = gaits.walker(p + dp), gaits.walker(p - dp)
+    dP = (poincare_map(wp, x, gaits.solver)[0] - poincare_map(wm, x, gaits.solver)[0]) \
+        / (2 * dp[j])
+    return wp, wm, dp[j], np.linalg.solve(np.eye(x.size) - J, dP)
 
 
 def multiplier_gradient(gaits: _Gaits, p, h: float = 1e-5) -> tuple[float, np.ndarray]:
@@ -253,15 +261,11 @@ def multiplier_gradient(gaits: _Gaits, p, h: float = 1e-5) -> tuple[float, np.nd
     lam, v, wl = ev[i], V[:, i], W[:, i]
     grad = np.empty(p.size)
     for j in range(p.size):
-        dp = np.zeros(p.size)
-        dp[j] = h * max(1.0, abs(p[j]))
-        wp, wm = gaits.walker(p + dp), gaits.walker(p - dp)
-        dP = (poincare_map(wp, x, gaits.solver)[0] - poincare_map(wm, x, gaits.solver)[0]) \
-            / (2 * dp[j])
-        dx = np.linalg.solve(np.eye(x.size) - J, dP) * dp[j]
+        wp, wm, step, dx_dp = _gait_shift(gaits, p, j, h, x, J)
+        dx = dx_dp * step
         Jp = poincare_map(wp, x + dx, gaits.solver, jacobian=True)[2]
         Jm = poincare_map(wm, x - dx, gaits.solver, jacobian=True)[2]
-        dJ = (np.asarray(Jp, float) - np.asarray(Jm, float)) / (2 * dp[j])
+        dJ = (np.asarray(Jp, float) - np.asarray(Jm, float)) / (2 * step)
         dlam = (wl.conj() @ dJ @ v) / (wl.conj() @ v)
         grad[j] = float(np.real(np.conj(lam) * dlam)) / abs(lam)
     return float(abs(lam)), grad
