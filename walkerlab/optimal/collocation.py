@@ -41,12 +41,11 @@ foot mass on the swing leg's row, the point hip's transition); one hip torque.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.ipopt import iteration_history
+from walkerlab.optimal.ipopt import iteration_history, solve
 
 __all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step", "replay",
            "step_functions", "target_constraints", "torque_of_time"]
@@ -392,13 +391,7 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     if spec.push_off_free:
         opti.set_initial(P, spec.push_off_n_s)
     opti.solver("ipopt", {"print_time": False}, _ipopt_options(spec))
-    t0 = time.perf_counter()
-    try:
-        sol = opti.solve()
-        status, get = "Solve_Succeeded", sol.value
-    except RuntimeError:
-        status, get = str(opti.stats().get("return_status", "failed")), opti.debug.value
-    wall = time.perf_counter() - t0
+    status, get, wall, _ = solve(opti)
     Tv = float(get(T))
     Xv, Uv = np.asarray(get(X)).reshape(n2, K).T, np.asarray(get(U)).ravel()
     return CollocationResult(
@@ -446,6 +439,20 @@ def _transcribe(opti, fns, spec, X, U, T, P, period_guess):
     if spec.max_torque_n_m is not None:
         opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
     target_constraints(opti, spec, T, fns["step"](X[:, -1]))
+
+
+def peak_torque(opti, U, asked: dict):
+    """The largest |torque| over the collocation points ``U``: in epigraph form (a variable
+    ``s`` with ``-s <= U <= s``) when it is among the ``asked`` objectives, else the plain
+    (non-smooth) maximum, for the record."""
+    import casadi as ca
+
+    if "peak_torque" not in asked:
+        return ca.mmax(ca.fabs(U))
+    peak = opti.variable()
+    opti.subject_to(opti.bounded(-peak, U, peak))
+    opti.set_initial(peak, 1.0)
+    return peak
 
 
 def target_constraints(opti, spec, T, length) -> None:
@@ -502,12 +509,7 @@ def _terms(opti, fns, spec, X, U, T, P):
     work = fns["push_off_work"](X[:, -1], P)
     weight = fns["total_mass_kg"] * fns["gravity"]
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
-    if "peak_torque" in asked:
-        peak = opti.variable()
-        opti.subject_to(opti.bounded(-peak, U, peak))
-        opti.set_initial(peak, 1.0)
-    else:
-        peak = ca.mmax(ca.fabs(U))
+    peak = peak_torque(opti, U, asked)
     power = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(K)])
     positive = (_positive_work(opti, power) if "cost_of_transport" in asked
                 else ca.fmax(power, 0))

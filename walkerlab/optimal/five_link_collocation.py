@@ -27,13 +27,12 @@ heel strike (:func:`torques_of_time`), one step from ``x_0`` (scipy's DOP853 at 
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from walkerlab.optimal.collocation import target_constraints
-from walkerlab.optimal.ipopt import iteration_history
+from walkerlab.optimal.ipopt import iteration_history, solve
 
 __all__ = ["FiveLinkResult", "collocate_five_link", "kelly_guess", "replay_five_link",
            "torques_of_time"]
@@ -175,13 +174,7 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     opti.solver("ipopt", {"print_time": False, "expand": True},
                 {"print_level": 0, "tol": 1e-10, "constr_viol_tol": 1e-11, "max_iter": 1000,
                  "sb": "yes"})
-    t0, c0 = time.perf_counter(), time.process_time()
-    try:
-        sol = opti.solve()
-        status, get = "Solve_Succeeded", sol.value
-    except RuntimeError:
-        status, get = str(opti.stats().get("return_status", "failed")), opti.debug.value
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    status, get, wall, cpu = solve(opti)
     Tv = float(get(T))
     Xv = np.asarray(get(X)).reshape(n2, K).T
     Uv = np.asarray(get(U)).reshape(4, K).T

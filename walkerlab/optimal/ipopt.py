@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import os
+import time
+
 import numpy as np
 
-__all__ = ["HISTORY", "iteration_history"]
+__all__ = ["HISTORY", "iteration_history", "solve"]
 
 #: the stored series and CasADi's names for them (IPOPT's iteration output: ``objective``,
 #: ``inf_pr`` the largest constraint violation, ``inf_du`` the dual infeasibility, ``mu`` the
@@ -30,3 +33,25 @@ def iteration_history(stats: dict) -> dict[str, np.ndarray]:
     """
     it = stats.get("iterations") or {}
     return {name: np.asarray(it.get(key, []), float) for name, key in HISTORY.items()}
+
+
+def solve(opti):
+    """Run IPOPT on a set-up ``casadi.Opti``, a failure included.
+
+    Returns
+    -------
+    status : str
+        IPOPT's return status (``Solve_Succeeded`` when it converged).
+    get : callable
+        Reads a variable or expression's value: the solution's, or at the last iterate
+        (``opti.debug.value``) when IPOPT stopped without success.
+    wall_s, cpu_s : float
+        The solve's wall time and this process's CPU time (user + system) [s].
+    """
+    t0, c0 = time.perf_counter(), os.times()
+    try:
+        status, get = "Solve_Succeeded", opti.solve().value
+    except RuntimeError:
+        status, get = str(opti.stats().get("return_status", "failed")), opti.debug.value
+    c1 = os.times()
+    return status, get, time.perf_counter() - t0, (c1.user - c0.user) + (c1.system - c0.system)

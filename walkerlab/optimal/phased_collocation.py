@@ -6,13 +6,12 @@ the rigid model's own step and its replay on the rigid model.
 
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.ipopt import iteration_history
+from walkerlab.optimal.ipopt import iteration_history, solve
 
 __all__ = ["PhasedResult", "collocate_phases", "phase_torque_of_time", "phased_guess",
            "replay_phases"]
@@ -219,7 +218,7 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
     """
     import casadi as ca
 
-    from walkerlab.optimal.collocation import target_constraints
+    from walkerlab.optimal.collocation import peak_torque, target_constraints
 
     _check(spec)
     phases = fns["phases"]
@@ -249,13 +248,7 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
     target_constraints(opti, spec, period, phases[-1].step(Xs[-1][:, -1]))
     U = ca.horzcat(*Us)
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
-    if "peak_torque" in asked:
-        peak = opti.variable()
-        opti.subject_to(opti.bounded(-peak, U, peak))
-        opti.set_initial(peak, 1.0)
-    else:
-        peak = ca.mmax(ca.fabs(U))
-    terms = {"effort": effort, "peak_torque": peak}
+    terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
     obj = sum(w * terms[k] for k, w in asked.items())
     opti.minimize(obj)
     opti.solver("ipopt", {"print_time": False},
@@ -267,14 +260,7 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
 
 def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResult:
     """Run IPOPT and read the phases back as one step."""
-    t0, c0 = time.perf_counter(), os.times()
-    try:
-        sol = opti.solve()
-        status, get = "Solve_Succeeded", sol.value
-    except RuntimeError:
-        status, get = str(opti.stats().get("return_status", "failed")), opti.debug.value
-    c1 = os.times()
-    wall, cpu = time.perf_counter() - t0, (c1.user - c0.user) + (c1.system - c0.system)
+    status, get, wall, cpu = solve(opti)
     n2 = Xs[0].shape[0]
     ts, xs, us, starts, durs, offset = [], [], [], [], [], 0.0
     for X, U, T, tau in zip(Xs, Us, Ts, taus):
