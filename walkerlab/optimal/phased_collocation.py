@@ -17,7 +17,7 @@ __all__ = ["PhasedResult", "collocate_phases", "phase_torque_of_time", "phased_g
            "replay_phases"]
 
 #: objectives the phased transcription takes (:data:`walkerlab.optimal.collocation.OBJECTIVES`)
-PHASED_OBJECTIVES = ("effort", "peak_torque")
+PHASED_OBJECTIVES = ("effort", "cost_of_transport", "peak_torque")
 
 @dataclass
 class PhasedResult:
@@ -42,7 +42,9 @@ class PhasedResult:
     build_time_s, wall_time_s, cpu_time_s : float
         Building the programme; IPOPT's wall and CPU (user + sys) time.
     terms : dict
-        ``effort`` [N^2 m^2 s] and ``peak_torque`` [N m] at the optimum.
+        ``effort`` [N^2 m^2 s], ``cost_of_transport`` [-] (the hip's positive work per
+        weight and step length; exact, ``max(p, 0)`` at the points) and ``peak_torque``
+        [N m] at the optimum.
     history : dict of str -> ndarray
         IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
     """
@@ -178,7 +180,29 @@ def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
             opti.subject_to(opti.bounded(lo, fns["hip_angle"](X[:, k]), hi))
     if spec.max_torque_n_m is not None:
         opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
+    if spec.friction_coefficient is not None:  # the stance foot's resultant in its cone
+        mu = spec.friction_coefficient
+        for k in range(K):
+            F = mp.grf(X[:, k], U[k])
+            opti.subject_to(F[0] >= 0)
+            opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
     return _simpson(T, tau, U ** 2)
+
+
+def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
+    """The hip's positive work over the step [J]: Simpson's rule per phase on
+    ``max(p, 0)`` at the points (``p = u d(hip angle)/dt``), exactly by slack variables
+    when ``slack`` (:func:`walkerlab.optimal.collocation.positive_power`), else evaluated
+    (for the record)."""
+    import casadi as ca
+
+    from walkerlab.optimal.collocation import positive_power
+
+    work = 0
+    for X, U, T, tau in zip(Xs, Us, Ts, taus):
+        p = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(X.shape[1])])
+        work = work + _simpson(T, tau, positive_power(opti, p) if slack else ca.fmax(p, 0))
+    return work
 
 
 def _check(spec) -> None:
@@ -189,12 +213,13 @@ def _check(spec) -> None:
         raise ValueError(f"optimize.objective: a walker with phases takes "
                          f"{' or '.join(PHASED_OBJECTIVES)} (or their weighted sum) today")
     if spec.push_off_free or spec.push_off_n_s:
-        raise ValueError("optimize.push_off: a walker with phases has no push-off today")
-    if spec.friction_coefficient is not None:
-        raise ValueError("optimize.friction_coefficient: not yet for a walker with phases")
+        raise ValueError("optimize.push_off: a walker with phases has no push-off impulse "
+                         "(the rigid kneed and flat-footed models carry none: "
+                         "walker.actuation.push_off is for straight legs on point feet)")
 
 
-def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
+def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
+                     ) -> PhasedResult:
     """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`).
 
     Parameters
@@ -205,6 +230,8 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
         Its ``intervals`` are shared among the phases by ``guess``'s meshes.
     guess : list of (name, t, x)
         :func:`phased_guess`: each phase's starting mesh (its length fixes ``N_p``).
+    guess_u : list of ndarray (2 N_p + 1,), optional
+        Each phase's starting hip torque [N m] (default 0; another optimisation's).
 
     Returns
     -------
@@ -218,7 +245,7 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
     """
     import casadi as ca
 
-    from walkerlab.optimal.collocation import peak_torque, target_constraints
+    from walkerlab.optimal.collocation import ipopt_options, peak_torque, target_constraints
 
     _check(spec)
     phases = fns["phases"]
@@ -242,18 +269,22 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
         opti.subject_to(opti.bounded(0.05 * Tg, Ts[p], 5.0 * Tg))
         opti.set_initial(Ts[p], Tg)
         opti.set_initial(Xs[p], guess[p][2].T)
-        opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)))
+        opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)) if guess_u is None
+                         else np.asarray(guess_u[p], float)[None])
     opti.subject_to(fns["ahead"](Xs[-1][:, -1]) >= 1e-3)
     period = sum(Ts[1:], Ts[0])
-    target_constraints(opti, spec, period, phases[-1].step(Xs[-1][:, -1]))
+    length = phases[-1].step(Xs[-1][:, -1])
+    target_constraints(opti, spec, period, length)
     U = ca.horzcat(*Us)
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
+    work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
+    terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"] * length)
     obj = sum(w * terms[k] for k, w in asked.items())
+    if spec.objective == "cost_of_transport":
+        obj = obj + spec.cost_of_transport_effort_weight * effort
     opti.minimize(obj)
-    opti.solver("ipopt", {"print_time": False},
-                {"print_level": 0, "tol": 1e-12, "acceptable_tol": 1e-10, "max_iter": 500,
-                 "sb": "yes"})
+    opti.solver("ipopt", {"print_time": False}, ipopt_options(spec))
     build = time.perf_counter() - t_build
     return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build)
 
