@@ -100,3 +100,106 @@ def test_the_kneed_ground_reaction_is_newton_eulers(kneed):
             want = _newton_euler(walker, data, x, ph.flow(0.0, x)[3:])
             got = mp.grf(x, u).full().ravel()
             np.testing.assert_allclose(got, want, rtol=0, atol=1e-10 * weight)
+
+
+@pytest.fixture(scope="module")
+def kneed_fast(kneed):
+    """The kneed walker's least-effort step at 0.9 m/s (its passive gait: 0.870 m/s) on 60
+    intervals from its passive gait's step, and that step (the guess)."""
+    import walkerlab as wl
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.phased_collocation import collocate_phases, phased_guess
+
+    scene, data, walker, fns = kneed
+    g = wl.Walker.from_scene(scene).fixed_point()
+    guess = phased_guess(walker, g.x, g.step_period, Solver.from_settings(scene.solver), 60)[0]
+    spec = CollocationSpec(intervals=60, target_speed_m_per_s=0.9)
+    return g, guess, spec, collocate_phases(fns, spec, guess)
+
+
+def _cone_ratios(fns, res):
+    """``F_t / F_n`` and ``F_n`` [N] at every point of ``res`` (its phases' ``grf``)."""
+    bounds = list(res.phase_start) + [res.t.size]
+    out = []
+    for mp, a, b in zip(fns["phases"], bounds[:-1], bounds[1:]):
+        for k in range(a, b):
+            F = mp.grf(res.x[k], res.u[k]).full().ravel()
+            out.append((F[1] / F[0], F[0]))
+    return np.array(out)
+
+
+def test_a_friction_cone_that_binds_changes_the_kneed_gait_and_it_replays(kneed, kneed_fast):
+    """At 0.9 m/s the least-effort gait needs |F_t| / F_n up to 0.2569 (just after the heel
+    strike); with mu = 0.9 of that the cone binds (the largest ratio is mu to 1e-8, now
+    at the heel strike's end of the step), the effort rises (2.3e-5 -> 1.2e-3 N^2 m^2 s
+    measured), the normal force stays positive and the replay on the rigid model still
+    closes (<= 1e-6; 1.9e-7 seen)."""
+    from dataclasses import replace
+
+    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+
+    _, data, _, fns = kneed
+    _g, guess, spec, free = kneed_fast
+    mu_free = np.max(np.abs(_cone_ratios(fns, free)[:, 0]))
+    assert 0.2 < mu_free < 0.3
+    mu = 0.9 * mu_free
+    res = collocate_phases(fns, replace(spec, friction_coefficient=mu), guess)
+    assert res.status == "Solve_Succeeded"
+    r = _cone_ratios(fns, res)
+    assert np.max(np.abs(r[:, 0])) == pytest.approx(mu, rel=1e-8)
+    assert np.min(r[:, 1]) > 0.0
+    assert res.objective > 10 * free.objective
+    assert res.step_length_m / res.step_period_s == pytest.approx(0.9, rel=1e-9)
+    assert replay_phases(data, res)[0] <= 1e-6
+
+
+def _as_artifact(res, walker):
+    """A phased result as the optimize.h5 reader returns it."""
+    from walkerlab.io.schemas.optimize import OptimizeData
+
+    names = list(walker.state_names())
+    return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
+                        res.step_period_s, res.step_length_m, 0.0, res.objective, 1e-9,
+                        np.zeros(6, complex), True, res.status, res.iterations, 0.1,
+                        dict.fromkeys(names, "-"), phase_names=res.phase_names,
+                        phase_start=res.phase_start, phase_duration_s=res.phase_duration_s)
+
+
+def test_another_optimize_h5_of_the_walker_starts_the_phased_collocation(kneed, kneed_fast):
+    """The 0.9 m/s optimum as the guess (its states and torque on its own mesh): IPOPT
+    returns to it (the objective and step period to 1e-9; an interior point method does
+    not warm-start: ~30 iterations as from the passive gait), and resampled to 40 intervals
+    it finds the same gait (step period to 1e-6: the coarser mesh's O(h^4))."""
+    from dataclasses import replace
+
+    from walkerlab.optimal.phased_collocation import collocate_phases, optimized_guess
+
+    _, _, walker, fns = kneed
+    _g, _guess, spec, free = kneed_fast
+    d = _as_artifact(free, walker)
+    names = list(free.phase_names)
+    guess, torque = optimized_guess(d, names, 60)
+    assert [x.shape[0] for _n, _t, x in guess] == [x.shape[0] for _n, _t, x in _guess]
+    again = collocate_phases(fns, spec, guess, torque)
+    assert again.status == "Solve_Succeeded"
+    assert again.objective == pytest.approx(free.objective, rel=1e-9)
+    assert again.step_period_s == pytest.approx(free.step_period_s, rel=1e-9)
+    guess, torque = optimized_guess(d, names, 40)
+    assert sum((x.shape[0] - 1) // 2 for _n, _t, x in guess) == 40
+    coarse = collocate_phases(fns, replace(spec, intervals=40), guess, torque)
+    assert coarse.status == "Solve_Succeeded"
+    assert coarse.step_period_s == pytest.approx(free.step_period_s, rel=1e-6)
+
+
+def test_an_optimize_h5_without_the_walkers_phases_is_refused_in_one_line(kneed, kneed_fast):
+    from walkerlab.optimal.phased_collocation import optimized_guess
+
+    _, _, walker, _fns = kneed
+    d = _as_artifact(kneed_fast[3], walker)
+    for phases, why in ((("locked_swing", "unlocked_swing"), "are not the scene gait's"),
+                        ((), "has no phases")):
+        d.phase_names = phases
+        with pytest.raises(ValueError, match="optimize.initial_guess") as e:
+            optimized_guess(d, ["unlocked_swing", "locked_swing"], 60)
+        assert why in str(e.value) and "\n" not in str(e.value)

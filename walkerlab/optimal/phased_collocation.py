@@ -13,8 +13,8 @@ import numpy as np
 
 from walkerlab.optimal.ipopt import iteration_history, solve
 
-__all__ = ["PhasedResult", "collocate_phases", "phase_torque_of_time", "phased_guess",
-           "replay_phases"]
+__all__ = ["PhasedResult", "collocate_phases", "optimized_guess", "phase_torque_of_time",
+           "phased_guess", "replay_phases"]
 
 #: objectives the phased transcription takes (:data:`walkerlab.optimal.collocation.OBJECTIVES`)
 PHASED_OBJECTIVES = ("effort", "cost_of_transport", "peak_torque")
@@ -109,6 +109,56 @@ def phased_guess(walker, x0, period_s: float, solver, intervals: int):
         t[0], t[-1] = a, b
         out.append((ph.name, t - a, np.asarray(sol(t), float)[:x0.size].T))
     return out, seg.phase_log
+
+
+def optimized_guess(d, names: list, intervals: int):
+    """Another optimisation's step (an ``optimize.h5`` of a walker with phases, read by
+    :func:`walkerlab.io.schemas.optimize.load`) as the starting guess: each phase's states
+    and torque on its own mesh, its ``N_p`` rescaled so that they sum to about
+    ``intervals`` (at least 3 a phase; the artifact's mesh density kept, its interval ends
+    interpolated, the points linearly; unchanged when the counts agree).
+
+    Parameters
+    ----------
+    d : walkerlab.io.schemas.optimize.OptimizeData
+    names : list of str
+        The phases the scene's gait goes through (the guess's must be the same).
+    intervals : int
+
+    Returns
+    -------
+    guess : list of (name, t (2 N_p + 1,) [s from the phase's start], x (2 N_p + 1, 2n))
+    torque : list of ndarray (2 N_p + 1,) [N m]
+
+    Raises
+    ------
+    ValueError
+        The artifact has no phases (a one-step optimisation) or other ones (one line
+        naming ``optimize.initial_guess``).
+    """
+    if not d.phase_names or d.phase_start is None:
+        raise ValueError("optimize.initial_guess: the optimize.h5 has no phases (a one-step "
+                         "optimisation): give one of this walker (its phases "
+                         f"{', '.join(names)})")
+    if list(d.phase_names) != list(names):
+        raise ValueError(f"optimize.initial_guess: its phases {list(d.phase_names)} are not "
+                         f"the scene gait's {list(names)}")
+    X = np.stack(list(d.states.values()), axis=1)
+    bounds = list(np.asarray(d.phase_start, int)) + [d.time.size]
+    counts = [(b - a - 1) // 2 for a, b in zip(bounds[:-1], bounds[1:])]
+    guess, torque = [], []
+    for name, a, b, n_old in zip(names, bounds[:-1], bounds[1:], counts):
+        t, u = np.asarray(d.time[a:b], float), np.asarray(d.torque[a:b], float)
+        n_new = max(3, int(round(intervals * n_old / sum(counts))))
+        tn = t
+        if n_new != n_old:
+            ends = np.interp(np.linspace(0.0, n_old, n_new + 1), np.arange(n_old + 1), t[0::2])
+            tn = np.empty(2 * n_new + 1)
+            tn[0::2], tn[1::2] = ends, 0.5 * (ends[:-1] + ends[1:])
+        xn = np.stack([np.interp(tn, t, X[a:b, c]) for c in range(X.shape[1])], axis=1)
+        guess.append((name, tn - tn[0], xn))
+        torque.append(np.interp(tn, t, u))
+    return guess, torque
 
 
 def mesh_density(phase, sol, a: float, b: float, n2: int, samples: int = 401):
