@@ -203,3 +203,76 @@ def test_an_optimize_h5_without_the_walkers_phases_is_refused_in_one_line(kneed,
         with pytest.raises(ValueError, match="optimize.initial_guess") as e:
             optimized_guess(d, ["unlocked_swing", "locked_swing"], 60)
         assert why in str(e.value) and "\n" not in str(e.value)
+
+
+@pytest.mark.slow
+def test_the_flat_feet_ground_reaction_is_the_rigid_models_and_newton_eulers():
+    """Every phase of the flat-footed gait, with a hip torque, near the gait: the normal
+    component equals the rigid model's own generated ground force (heel pinned: ``N``,
+    the heel's and toe's together in foot flat; toe pinned: ``N``) and both components
+    ``M (a_com + g)`` from the rigid model's points (heel-pinned; toe-pinned: less the
+    stance toe's acceleration) and torqued flow, to 1e-10 of the weight (~15 s: the flat
+    feet's CasADi phases)."""
+    pytest.importorskip("casadi")
+    from walkerlab.codegen.cache import functions
+    from walkerlab.optimal.phases import mode_functions
+
+    _, data, walker = _walker("flat_feet_optimal.yaml")
+    fns = mode_functions(data, walker, FLAT_ORDER)
+    f = functions(data)
+    u = 0.4
+    torqued = {ph.name: ph for ph in _torqued(data, u).phases}
+    weight = float(walker.total_mass_kg) * float(data.gravity_m_per_s2)
+    rng = np.random.default_rng(13)
+    x0 = np.array([-0.3, 0.2, -0.05, -1.3, -1.2, 1.2])
+    for _ in range(3):
+        x = x0 + rng.normal(0.0, 0.03, 6)
+        for mp in fns["phases"]:
+            qdd = torqued[mp.name].flow(0.0, x)[3:]
+            toe = mp.name.startswith("heel_off")
+            got = mp.grf(x, u).full().ravel()
+            normal = (f["ground_toe"] if toe else f["ground_heel"])(x, qdd)[0]
+            assert got[0] == pytest.approx(normal, abs=1e-10 * weight), mp.name
+            want = _newton_euler(walker, data, x, qdd, "stance_toe" if toe else None)
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-10 * weight,
+                                       err_msg=mp.name)
+
+
+def test_the_kneed_walkers_least_cost_of_transport_on_its_slope_is_its_passive_gait(
+        kneed, kneed_fast):
+    """Cost of transport (slack variables) with an effort weight of 1e-2 from the passive
+    gait's step: CoT ~0 (1.1e-11 seen: the interior point's slack floor), the torque ~0
+    (6e-5 N m seen), the step period within 1e-3 of the shooting gait's (1e-4 seen: the
+    objective, ~1e-11 there, resolves no closer) and the replay closing (<= 1e-6)."""
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+
+    _, data, _, fns = kneed
+    g, guess, _spec, _free = kneed_fast
+    res = collocate_phases(fns, CollocationSpec(intervals=60, objective="cost_of_transport",
+                                                cost_of_transport_effort_weight=1e-2), guess)
+    assert res.status == "Solve_Succeeded"
+    assert res.terms["cost_of_transport"] <= 1e-10
+    assert np.max(np.abs(res.u)) < 1e-3
+    assert res.step_period_s == pytest.approx(g.step_period, rel=1e-3)
+    assert replay_phases(data, res)[0] <= 1e-6
+
+
+@pytest.mark.slow
+def test_the_cost_of_transport_does_not_drift_to_large_torques(kneed, kneed_fast):
+    """At 0.9 m/s with the default effort weight 1e-6 (~25 s): the least-CoT gait needs no
+    positive work (CoT ~1e-11) and its torque stays the least-effort gait's size (< 0.1 N m;
+    0.0096 seen); with IPOPT's default initial barrier it drifted to 100 N m torques
+    chattering between the points and a replay that did not step
+    (:func:`walkerlab.optimal.phased_collocation._options`)."""
+    from dataclasses import replace
+
+    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+
+    _, data, _, fns = kneed
+    _g, guess, spec, _free = kneed_fast
+    res = collocate_phases(fns, replace(spec, objective="cost_of_transport"), guess)
+    assert res.status == "Solve_Succeeded"
+    assert res.terms["cost_of_transport"] <= 1e-10
+    assert np.max(np.abs(res.u)) < 0.1
+    assert replay_phases(data, res)[0] <= 1e-6
