@@ -278,3 +278,78 @@ def test_the_cost_of_transport_does_not_drift_to_large_torques(kneed, kneed_fast
     assert res.terms["cost_of_transport"] <= 1e-10
     assert np.max(np.abs(res.u)) < 0.1
     assert replay_phases(data, res)[0] <= 1e-6
+
+
+def _continuation(path, scene, names, slopes, X, periods):
+    """A continuation artifact over the slope with the gaits ``X`` (rows) at ``slopes``."""
+    from walkerlab.io.artifacts import put, write_artifact
+    from walkerlab.io.schemas.continuation import STAGE
+
+    def writer(f):
+        f.attrs.update(parameter_path="slope.angle_rad", parameter_unit="rad",
+                       state_names=names, parameter_start=float(np.mean(slopes)))
+        g = f.create_group("branches/0")
+        g.attrs["branch_period"] = 1
+        put(g, "param", np.array(slopes), "rad")
+        for k, n in enumerate(names):
+            put(g, f"state/{n}", X[:, k], "rad")
+            put(g, f"orbit/{n}", X[:, k:k + 1], "rad")
+        put(g, "period", np.array(periods), "s")
+        for part in ("real", "imag"):
+            put(g, f"multipliers/{part}", np.zeros((2, len(names))), "-")
+        put(g, "stable", np.ones(2, int), "-")
+        s = f.create_group("special_points")
+        for k in ("kind", "cause"):
+            put(s, k, np.zeros(0, "S1"), "-")
+        for k in ("param", "period", "branch"):
+            put(s, k, np.zeros(0), "-")
+        for n in names:
+            put(s, f"state/{n}", np.zeros(0), "rad")
+        for part in ("real", "imag"):
+            put(s, f"multipliers/{part}", np.zeros((0, len(names))), "-")
+
+    write_artifact(path, STAGE, scene, "x", writer, 0.0)
+
+
+def test_the_phased_scene_reads_its_guess_from_artifacts(kneed, kneed_fast, tmp_path):
+    """``optimize.initial_guess`` of a kneed scene: another phased optimize.h5 gives its
+    states and torque phase by phase (the same mesh: exactly); a continuation artifact's
+    branch at the scene's slope gives one step of the rigid walker from its gait there (the
+    phases simulated from it); a one-step optimize.h5 is refused in one line."""
+    from walkerlab.io.artifacts import write_artifact
+    from walkerlab.io.schemas import optimize as schema
+    from walkerlab.optimal.phased_scene import starting_phases
+
+    scene, _data, walker, _fns = kneed
+    g, guess, _spec, free = kneed_fast
+    names = list(walker.state_names())
+
+    def with_guess(spec):
+        d = scene.model_dump(mode="json", exclude_none=True)
+        d["optimize"]["initial_guess"] = spec
+        return type(scene).model_validate(d)
+
+    d = _as_artifact(free, walker)
+    path = tmp_path / "optimize.h5"
+    write_artifact(path, schema.STAGE, scene, "x", lambda f: schema.write(f, d), 0.0)
+    got, torque, order = starting_phases(with_guess({"from": str(path)}), walker, g.x,
+                                        g.step_period, 60)
+    assert [n for n, _g, _d in order] == list(free.phase_names)
+    np.testing.assert_array_equal(np.concatenate([x for _n, _t, x in got]), free.x)
+    np.testing.assert_array_equal(np.concatenate(torque), free.u)
+    slope = scene.slope.phi_rad
+    cpath = tmp_path / "continuation_slope.h5"
+    _continuation(cpath, scene, names, [slope - 0.01, slope + 0.01], np.array([g.x, g.x]),
+                  [g.step_period] * 2)
+    got, torque, _order = starting_phases(with_guess({"from": str(cpath), "at": slope}),
+                                         walker, np.zeros(6), g.step_period, 60)
+    assert torque is None
+    for (n1, t1, x1), (n2, t2, x2) in zip(got, guess):
+        assert n1 == n2
+        np.testing.assert_allclose(x1, x2, rtol=0, atol=1e-12)
+    d.phase_names, d.phase_start = (), None
+    write_artifact(path, schema.STAGE, scene, "x", lambda f: schema.write(f, d), 0.0)
+    with pytest.raises(ValueError, match="optimize.initial_guess: the optimize.h5 has no "
+                                         "phases") as e:
+        starting_phases(with_guess({"from": str(path)}), walker, g.x, g.step_period, 60)
+    assert "\n" not in str(e.value)

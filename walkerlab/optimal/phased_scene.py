@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["optimize_phased_scene"]
+__all__ = ["optimize_phased_scene", "starting_phases"]
 
 
 def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float):
@@ -54,7 +54,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     o = scene.optimize
     _refuse(scene)
     walker = make_rigid_walker(data)
-    guess, guess_u, order = _starting_step(scene, walker, x_gait, period_s, spec.intervals)
+    guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
     fns = mode_functions(data, walker, order)
     build = time.perf_counter() - t0
@@ -88,10 +88,29 @@ def _refuse(scene) -> None:
                          "torques, not together)")
 
 
-def _starting_step(scene, walker, x_gait, period_s: float, intervals: int):
-    """The guess (:func:`walkerlab.optimal.phased_collocation.phased_guess` or
-    :func:`~walkerlab.optimal.phased_collocation.optimized_guess`), its torque (None: 0)
-    and the step's phase order (the scene's gait's, or the continuation's gait's)."""
+def starting_phases(scene, walker, x_gait, period_s: float, intervals: int):
+    """The phased collocation's starting step for ``scene`` (its ``optimize.
+    initial_guess``, else one step of its gait ``x_gait`` (2n,) of period ``period_s``
+    [s]), on about ``intervals`` intervals.
+
+    Returns
+    -------
+    guess : list of (name, t, x)
+        :func:`walkerlab.optimal.phased_collocation.phased_guess` (the scene's or a
+        continuation artifact's gait) or :func:`~walkerlab.optimal.phased_collocation.
+        optimized_guess` (another ``optimize.h5``).
+    torque : list of ndarray or None
+        Each phase's hip torque [N m] (another ``optimize.h5``'s; None: 0).
+    order : list of (phase, guard, direction)
+        The phases the starting gait's step goes through
+        (:func:`walkerlab.optimal.phases.phase_order`).
+
+    Raises
+    ------
+    ValueError
+        An unusable artifact, or one whose phases are not the gait's (one line naming
+        ``optimize.initial_guess``).
+    """
     from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.guess import read_guess
     from walkerlab.optimal.phased_collocation import optimized_guess, phased_guess
