@@ -38,8 +38,14 @@ crossing, as the rigid model's event needs; a force guard's rate leaves out the 
 own rate), and the guard's sign kept inside the phase (``d * guard_p <= 0`` at its
 interior points: the event has not happened earlier).  Links: ``x_{p+1}(0) =
 reset_p(x_p(T_p))``; periodic: ``x_0(0) = heel_strike(x_last(T_last))``.  Objective:
-``int u^2 dt`` (Simpson on every phase) or the peak torque (epigraph).  The step period is
-``sum T_p``.
+``int u^2 dt`` (Simpson on every phase), the peak torque (epigraph), the cost of transport
+(the hip's positive work by slack variables ``s >= 0, s >= u d(hip)/dt`` at every point of
+every phase, per weight and step length, with a small effort weight; as
+:mod:`walkerlab.optimal.collocation`) or a weighted sum.  Optional friction cone: the
+ground's resultant on the stance foot (``sum m_i (a_i + g)``, the phase's accelerations;
+a kneed walker's stance foot, flat feet's pinned point or whole flat foot) with ``F_n >= 0``
+and ``|F_t| <= mu F_n`` at every point.  No push-off: the rigid kneed and flat-footed
+models carry no push-off impulse.  The step period is ``sum T_p``.
 
 A result is a gait after its replay on the rigid model (its generated code, its own
 guards and resets) with the optimised torque as a function of the time since the heel
