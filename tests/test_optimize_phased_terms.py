@@ -353,3 +353,19 @@ def test_the_phased_scene_reads_its_guess_from_artifacts(kneed, kneed_fast, tmp_
                                          "phases") as e:
         starting_phases(with_guess({"from": str(path)}), walker, g.x, g.step_period, 60)
     assert "\n" not in str(e.value)
+
+
+def test_an_ankle_push_off_is_refused_in_one_line():
+    """Flat feet with an ankle push-off (configs/flat_feet_push_off.yaml): the phased
+    transcription has a hip torque only (and the rigid flat feet take the two not
+    together), so the scene is refused before any work, naming the field."""
+    pytest.importorskip("casadi")
+    from walkerlab.optimal.scene import optimize_scene
+
+    scene = load_scene(CONFIGS / "flat_feet_push_off.yaml")
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["optimize"] = {"objective": "effort"}
+    scene = type(scene).model_validate(d)
+    with pytest.raises(ValueError, match="walker.actuation.ankle_push_off") as e:
+        optimize_scene(scene, np.zeros(6), 0.75)
+    assert "\n" not in str(e.value)
