@@ -346,6 +346,7 @@ def test_the_phased_scene_reads_its_guess_from_artifacts(kneed, kneed_fast, tmp_
     assert torque is None
     for (n1, t1, x1), (n2, t2, x2) in zip(got, guess):
         assert n1 == n2
+        np.testing.assert_allclose(t1, t2, rtol=0, atol=1e-12)
         np.testing.assert_allclose(x1, x2, rtol=0, atol=1e-12)
     d.phase_names, d.phase_start = (), None
     write_artifact(path, schema.STAGE, scene, "x", lambda f: schema.write(f, d), 0.0)
