@@ -350,7 +350,13 @@ def _options(spec, asked: dict) -> dict:
     torques whose power changes sign between the points and a replay that does not close;
     from a guess 5 % off its passive gait at 68 N m and a replay error 1.7e-2.  With 1e-9:
     0.0096 N m (the least-effort gait's 0.0097; 113 iterations, replay 1.2e-7) and
-    0.0063 N m (82 iterations, replay 1.6e-7)."""
+    0.0063 N m (82 iterations, replay 1.6e-7); on its passive slope (effort weight 1e-2)
+    the default barrier ends on the walker's other, unstable passive gait (period 0.4921 s,
+    |multiplier| 2.28), 1e-9 on the stable one (period within 1e-4).  The cost of
+    transport's torques are sharper than the effort's: at 0.9 m/s with the friction cone
+    binding (mu 0.2312) 3.5 N m peaks, the replay closing to 6.2e-6 on 60 intervals (not
+    a gait) and 6.8e-7 on 120, the cost of transport rising 2.69e-4 -> 3.23e-4 with the
+    mesh (the positive work is counted at the points)."""
     from walkerlab.optimal.collocation import ipopt_options
 
     opts = ipopt_options(spec)
