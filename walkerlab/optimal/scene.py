@@ -89,6 +89,10 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     data = walker_data(scene.walker, scene.slope.phi_rad)
     spec = collocation_spec(scene)
     walker = build_walker(scene)
+    if data.mirror is not None:  # legs that differ: a stride of two different steps
+        from walkerlab.optimal.stride_scene import optimize_stride_scene
+
+        return optimize_stride_scene(scene, data, spec, x_gait, period_s)
     if data.structure.knee or data.structure.foot == "flat":  # a step of phases: its own
         from walkerlab.optimal.phased_scene import optimize_phased_scene
 
