@@ -98,7 +98,7 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                         contact_outcome=contact_outcome, cpu_time_s=res.cpu_time_s,
                         phase_names=res.phase_names, phase_start=res.phase_start,
                         phase_duration_s=res.phase_duration_s,
-                        build_time_s=build + res.build_time_s,
+                        build_time_s=build + res.build_time_s, steps=2,
                         **_record(scene, walker, res))
 
 
