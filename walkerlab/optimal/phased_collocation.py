@@ -195,7 +195,10 @@ def _check(spec) -> None:
 
 
 def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
-    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`).
+    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`), or a stride of
+    steps (legs that differ, :mod:`walkerlab.optimal.stride`: a ``heel_strike`` phase
+    inside the sequence ends a step; every heel strike has the swing foot ahead, each step
+    its own clearance ends, and the targets are the mean step's).
 
     Parameters
     ----------

@@ -75,7 +75,7 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
         for k in range(1, steps):
             for a in (*axes[:2], *(grid[1][:1] if rows == 2 else ())):
                 a.axvline(d.time[d.phase_start[k * per]], color="0.3", ls=":", lw=1)
-        ax2.set_title(f"stride of {steps} steps (dotted: heel strike), mean step "
+        ax2.set_title(f"stride of {steps} steps (dotted: heel strike)\nmean step "
                       f"{d.step_period_s:.4g} s, {d.step_length_m:.4g} m, {speed:.3g} m/s; "
                       f"replay error {d.replay_error:.1g}", fontsize=9)
     fig.suptitle(f"{title}: optimised {'stride' if steps > 1 else 'step'} (direct collocation)"
