@@ -195,7 +195,10 @@ def _check(spec) -> None:
 
 
 def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
-    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`).
+    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`), or a stride of
+    steps (legs that differ, :mod:`walkerlab.optimal.stride`: a ``heel_strike`` phase
+    inside the sequence ends a step; every heel strike has the swing foot ahead, each step
+    its own clearance ends, and the targets are the mean step's).
 
     Parameters
     ----------
@@ -233,9 +236,10 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
     Ts = [opti.variable() for _ in guess]
     effort = 0
     taus = [np.asarray(g[1], float) / float(g[1][-1]) for g in guess]
-    for p, mp in enumerate(phases):
-        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], p == 0,
-                                 p == P - 1, fns)
+    for p, mp in enumerate(phases):  # a step starts at 0 and after each heel strike
+        starts = p == 0 or phases[p - 1].guard_name == "heel_strike"
+        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], starts,
+                                 p == P - 1 or mp.guard_name == "heel_strike", fns)
         nxt = Xs[p + 1][:, 0] if p + 1 < P else Xs[0][:, 0]
         opti.subject_to(nxt == mp.reset(Xs[p][:, -1]))
         Tg = float(guess[p][1][-1])
@@ -243,9 +247,15 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
         opti.set_initial(Ts[p], Tg)
         opti.set_initial(Xs[p], guess[p][2].T)
         opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)))
-    opti.subject_to(fns["ahead"](Xs[-1][:, -1]) >= 1e-3)
+    strikes = [p for p, mp in enumerate(phases[:-1]) if mp.guard_name == "heel_strike"]
+    for p in [*strikes, P - 1]:  # every heel strike with the swing foot ahead
+        opti.subject_to(fns["ahead"](Xs[p][:, -1]) >= 1e-3)
     period = sum(Ts[1:], Ts[0])
-    target_constraints(opti, spec, period, phases[-1].step(Xs[-1][:, -1]))
+    if strikes:  # a stride of steps: its mean step's period and length
+        steps = [phases[p].step(Xs[p][:, -1]) for p in [*strikes, P - 1]]
+        target_constraints(opti, spec, period / len(steps), sum(steps) / len(steps))
+    else:
+        target_constraints(opti, spec, period, phases[-1].step(Xs[-1][:, -1]))
     U = ca.horzcat(*Us)
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
