@@ -215,8 +215,8 @@ def step_functions(data, eq):
                          "a torso, partly massless legs: not yet)")
     if getattr(data, "mirror", None) is not None:
         raise ValueError("optimize: legs that differ take a stride of two different steps "
-                         "(a two-phase transcription: not yet); one step would be periodic "
-                         "only for mirror-image legs")
+                         "(walkerlab.optimal.stride); one step would be periodic only for "
+                         "mirror-image legs")
     n = len(eq.q)
     vals = dict(zip(eq.params, data.params))
     xs = list(eq.q) + list(eq.dq)

@@ -270,7 +270,10 @@ def _check(spec) -> None:
 
 def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
                      ) -> PhasedResult:
-    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`).
+    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`), or a stride of
+    steps (legs that differ, :mod:`walkerlab.optimal.stride`: a ``heel_strike`` phase
+    inside the sequence ends a step; every heel strike has the swing foot ahead, each step
+    its own clearance ends, and the targets are the mean step's).
 
     Parameters
     ----------
@@ -295,7 +298,7 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     """
     import casadi as ca
 
-    from walkerlab.optimal.collocation import peak_torque, target_constraints
+    from walkerlab.optimal.collocation import peak_torque
 
     _check(spec)
     phases = fns["phases"]
@@ -310,9 +313,10 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     Ts = [opti.variable() for _ in guess]
     effort = 0
     taus = [np.asarray(g[1], float) / float(g[1][-1]) for g in guess]
-    for p, mp in enumerate(phases):
-        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], p == 0,
-                                 p == P - 1, fns)
+    for p, mp in enumerate(phases):  # a step starts at 0 and after each heel strike
+        starts = p == 0 or phases[p - 1].guard_name == "heel_strike"
+        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], starts,
+                                 p == P - 1 or mp.guard_name == "heel_strike", fns)
         nxt = Xs[p + 1][:, 0] if p + 1 < P else Xs[0][:, 0]
         opti.subject_to(nxt == mp.reset(Xs[p][:, -1]))
         Tg = float(guess[p][1][-1])
@@ -321,15 +325,13 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
         opti.set_initial(Xs[p], guess[p][2].T)
         opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)) if guess_u is None
                          else np.asarray(guess_u[p], float)[None])
-    opti.subject_to(fns["ahead"](Xs[-1][:, -1]) >= 1e-3)
     period = sum(Ts[1:], Ts[0])
-    length = phases[-1].step(Xs[-1][:, -1])
-    target_constraints(opti, spec, period, length)
+    distance = _targets(opti, spec, fns, Xs, period)
     U = ca.horzcat(*Us)
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
     work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
-    terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"] * length)
+    terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"] * distance)
     obj = sum(w * terms[k] for k, w in asked.items())
     if spec.objective == "cost_of_transport":
         obj = obj + spec.cost_of_transport_effort_weight * effort
@@ -337,6 +339,25 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     opti.solver("ipopt", {"print_time": False}, _options(spec, asked))
     build = time.perf_counter() - t_build
     return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build)
+
+
+def _targets(opti, spec, fns, Xs, period):
+    """Every heel strike with the swing foot ahead and the gait targets on the step (a
+    stride: its mean step's period and length); returns the distance walked [m] (a
+    stride's: its steps' sum)."""
+    from walkerlab.optimal.collocation import target_constraints
+
+    phases, P = fns["phases"], len(fns["phases"])
+    strikes = [p for p, mp in enumerate(phases[:-1]) if mp.guard_name == "heel_strike"]
+    for p in [*strikes, P - 1]:  # every heel strike with the swing foot ahead
+        opti.subject_to(fns["ahead"](Xs[p][:, -1]) >= 1e-3)
+    if strikes:  # a stride of steps: its mean step's period and length
+        steps = [phases[p].step(Xs[p][:, -1]) for p in [*strikes, P - 1]]
+        target_constraints(opti, spec, period / len(steps), sum(steps) / len(steps))
+        return sum(steps)
+    length = phases[-1].step(Xs[-1][:, -1])
+    target_constraints(opti, spec, period, length)
+    return length
 
 
 def _options(spec, asked: dict) -> dict:
