@@ -313,7 +313,7 @@ class StepMap:
                 xk = X[k - 1]
                 ends = {}  # brentq's evaluations, t -> state (the root is one of them)
 
-                def gap(t, k=k, xk=xk, tg=tg, g=g):
+                def gap(t, k=k, xk=xk, tg=tg, g=g, ends=ends):
                     if t <= tg[k - 1]:
                         return g[k - 1]
                     ends[t] = run(xk, np.array([tg[k - 1], t]))[-1:]
