@@ -61,6 +61,11 @@ class Actuators:
     limit : bool
         The legs are massless (the walker's equations are the limit ``m_foot -> 0``).
     hip_mass_kg : float
+    torque_jacobian : callable or None
+        ``(t, x) -> (k, 2n)``: the torques' derivative by the state when it is known in
+        closed form (a torque of time alone: zeros), set after construction; the flow's
+        Jacobian is then :func:`torque_chain_jacobian`'s.  None (default): the complex step
+        through :meth:`added_acceleration`.
     """
 
     spec: object
