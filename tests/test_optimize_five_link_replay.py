@@ -184,3 +184,18 @@ def test_the_phased_walker_runs_its_law_on_every_backend():
     deltas, ddeltas, sx, dsx = w.actuators.joint_angles(x)
     np.testing.assert_allclose(w.actuators.torques(0.0, x), law.each(deltas, ddeltas, sx, dsx),
                                rtol=1e-14)
+
+
+@pytest.mark.parametrize("timed", [False, True])
+def test_the_one_table_evaluation_gives_the_splines_own_numbers(timed):
+    """At a real ``s`` the law reads h, h' and T (or the spline of u) from one stacked
+    PPoly: bit for bit what the separate splines give (the padded zero coefficient adds an
+    exact 0), inside the table and extrapolated past both ends."""
+    s, ds, delta, slope, u, _ = _table()
+    kw = {"t": (s[0] - s) / 0.9, "ds": ds} if timed else {}
+    law = PhaseLaw(s, delta, slope, u, [2000.0, 500.0], [120.0, 60.0], **kw)
+    rng = np.random.default_rng(5)
+    for si in np.concatenate([rng.uniform(-0.35, 0.35, 200), s]):
+        de, dde, dsi = rng.normal(0, 0.3, 2), rng.normal(0, 1, 2), float(rng.normal(-1, 0.2))
+        want = law.ff(si) - law.K * (de - law.h(si)) - law.D * (dde - law.dh(si) * dsi)
+        assert np.array_equal(law.each(de, dde, float(si), dsi), want)

@@ -613,6 +613,8 @@ def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
     acts = walker.actuators
     tau = torque_of_time(res)
     acts.torques = lambda t, x: np.array([tau(float(np.real(t)) - acts.t_origin)])
+    zero = np.zeros((1, 2 * acts.n))
+    acts.torque_jacobian = lambda t, x: zero  # a torque of time alone: d tau/dx = 0
     solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)
     seg = integrate_step(walker, np.asarray(res.x[0], float), solver,
                          max_step_time=3.0 * res.step_period_s)

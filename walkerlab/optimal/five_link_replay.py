@@ -102,6 +102,10 @@ class PhaseLaw:
         self.K = np.asarray(stiffness, float)
         self.D = np.asarray(damping, float)
         self.torques = [None] * len(self.K)  # as TorqueLaws (its length: the actuators)
+        # h, h' and T (or the spline of u) share their knots: one PPoly evaluates them all
+        # at a real s (the padded zero coefficient adds an exact 0: the same numbers)
+        self._outer = None if t is None else U
+        self._stack = _stacked((self.h, self.dh, spline if t is None else T))
 
     def __bool__(self) -> bool:
         return True
@@ -110,12 +114,33 @@ class PhaseLaw:
         """Torque of each actuator (k,) [N m] at the joint angles ``deltas`` (k,) [rad],
         their rates ``ddeltas`` (k,) [rad/s], the phase variable ``s`` [rad] and its rate
         ``ds`` [rad/s] (``t_step`` unused: the law reads no time)."""
-        h = _at(self.h, self.dh, s)
-        dh = _at(self.dh, self.d2h, s)
-        ff = _at(self.ff, self.dff, s)
+        if np.iscomplexobj(s):  # first order in the imaginary part (the complex step)
+            h = _at(self.h, self.dh, s)
+            dh = _at(self.dh, self.d2h, s)
+            ff = _at(self.ff, self.dff, s)
+        else:
+            k = len(self.K)
+            v = self._stack(s)
+            h, dh = v[..., :k], v[..., k:2 * k]
+            ff = v[..., 2 * k:] if self._outer is None else self._outer(v[..., 2 * k])
         err = np.asarray(deltas) - h
         derr = np.asarray(ddeltas) - dh * ds
         return ff - self.K * err - self.D * derr
+
+
+def _stacked(polys):
+    """One :class:`scipy.interpolate.PPoly` of the columns of ``polys`` (PPolys on the same
+    breakpoints, degree <= 3, each of shape (k_i,) or scalar), lower degrees padded with
+    leading zero coefficients."""
+    from scipy.interpolate import PPoly
+
+    order = max(p.c.shape[0] for p in polys)
+    cs = []
+    for p in polys:
+        c = p.c.reshape(p.c.shape[0], p.c.shape[1], -1)
+        pad = np.zeros((order - c.shape[0],) + c.shape[1:])
+        cs.append(np.concatenate([pad, c]))
+    return PPoly(np.concatenate(cs, axis=2), polys[0].x, extrapolate=True)
 
 
 def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:

@@ -43,7 +43,7 @@ from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian, fd_jacobian
 
-__all__ = ["Actuators", "actuate"]
+__all__ = ["Actuators", "actuate", "torque_chain_jacobian"]
 
 
 @dataclass
@@ -61,6 +61,11 @@ class Actuators:
     limit : bool
         The legs are massless (the walker's equations are the limit ``m_foot -> 0``).
     hip_mass_kg : float
+    torque_jacobian : callable or None
+        ``(t, x) -> (k, 2n)``: the torques' derivative by the state when it is known in
+        closed form (a torque of time alone: zeros), set after construction; the flow's
+        Jacobian is then :func:`torque_chain_jacobian`'s.  None (default): the complex step
+        through :meth:`added_acceleration`.
     """
 
     spec: object
@@ -86,6 +91,9 @@ class Actuators:
         self.R = np.linalg.pinv(self.A) @ swap @ self.A
         self.laws = TorqueLaws(self.spec.torques)
         self.t_origin = 0.0  # the time [s] the present step began (time_reference laws)
+        # (t, x) -> (k, 2n) the torques' derivative by the state, when known in closed form
+        # (a torque of time alone: zeros); None: the complex step differentiates the torques
+        self.torque_jacobian = None
         self._memo: dict = {}  # recent transitions (pre-impact state bytes -> result)
 
     # ---------------------------------------------------------------- joint torques
@@ -138,6 +146,25 @@ class Actuators:
         a = np.asarray(constraint(x))
         Ma = np.linalg.solve(M, a)
         return acc - Ma * (a @ acc) / (a @ Ma)
+
+    def acceleration_jacobian(self, t, x, constraint=None) -> np.ndarray:
+        """``d(M^-1 B tau)/dx`` (n, 2n) at the state ``x`` (2n,) (rows: ``qdd`` [rad/s^2];
+        columns: the state's entries).
+
+        With :attr:`torque_jacobian` set and no constraint: :func:`torque_chain_jacobian`
+        (``B`` is constant: the leg angles are linear in ``q``).  Otherwise the complex step
+        of :meth:`added_acceleration` (``2n`` calls through the torque laws)."""
+        x = np.asarray(x, float)
+        if self.torque_jacobian is None or constraint is not None:
+            return complex_step_jacobian(
+                lambda z: self.added_acceleration(t, z, constraint), x)
+        B = self.ddelta_dq
+        if self.limit:  # rows of the absolute leg angles, swing row first, / m_foot
+            B = np.zeros(self.n)
+            B[0] = 1.0
+        dtau = np.sum(np.asarray(self.torque_jacobian(t, x), float), axis=0)
+        return torque_chain_jacobian(self.fns["matrices"], x, self.generalised_force(t, x),
+                                     np.outer(B, dtau))
 
     # ---------------------------------------------------------------- push-off
     def hip_velocity(self, x) -> np.ndarray:
@@ -248,6 +275,41 @@ class Actuators:
     def reset(self, x) -> np.ndarray:
         """Post-impact state (2n,) after push-off and heel strike (roles swapped)."""
         return self.transition(x)["x_plus"]
+
+
+def torque_chain_jacobian(matrices, x, force, force_jacobian) -> np.ndarray:
+    """``d(M(q)^-1 F)/dx`` (n, 2n) of a generalised force ``F`` (n,) [N m] whose derivative
+    ``dF/dx`` (n, 2n) is known: ``M^-1 (dF/dx - [dM/dq_k acc]_k)``, ``acc = M^-1 F``
+    (``d(M^-1) = -M^-1 dM M^-1``; ``M`` depends on ``q`` only).  ``dM/dq_k`` by the complex
+    step of the generated ``matrices`` alone (``n`` calls, exact to round-off; Squire &
+    Trapp 1998).
+
+    Parameters
+    ----------
+    matrices : callable
+        The generated model's ``x (2n,) -> (M (n, n), C, G)`` (complex-safe).
+    x : ndarray (2n,)
+        The state (``q`` [rad], ``dq`` [rad/s]).
+    force : ndarray (n,)
+        ``F = B tau`` [N m].
+    force_jacobian : ndarray (n, 2n)
+        ``dF/dx`` (``B dtau/dx`` with a constant ``B``).
+
+    Returns
+    -------
+    ndarray (n, 2n)
+        ``d qdd / dx`` of the added acceleration [rad/s^2 per unit of each state entry].
+    """
+    x = np.asarray(x, float)
+    n, h = len(force), 1e-30
+    M = matrices(x)[0]
+    acc = np.linalg.solve(M, force)
+    rhs = np.array(force_jacobian, float)
+    for k in range(n):
+        xc = x.astype(complex)
+        xc[k] += 1j * h
+        rhs[:, k] -= (np.imag(matrices(xc)[0]) / h) @ acc
+    return np.linalg.solve(M, rhs)
 
 
 def _structure_check(data, spec) -> bool:
@@ -407,7 +469,7 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
 
         def J(t, x):
             base = np.array(jac(t, x), float)
-            base[acts.n:] += complex_step_jacobian(lambda z: acc(t, z), np.asarray(x, float))
+            base[acts.n:] += acts.acceleration_jacobian(t, x, constraint)
             return base
         return J
 

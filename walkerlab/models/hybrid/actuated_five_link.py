@@ -23,6 +23,7 @@ import numpy as np
 
 from walkerlab.config.actuation import FIVE_LINK_JOINTS
 from walkerlab.models.actuation import TorqueLaws
+from walkerlab.numerics import complex_step_jacobian
 
 __all__ = ["FiveLinkActuators", "five_link_actuators"]
 
@@ -66,6 +67,9 @@ class FiveLinkActuators:
         if shared is not None:  # one spline for every law's reference: 2 calls, not 2k
             self.laws.refs = shared
         self.t_origin = 0.0
+        # (t, x) -> (k, 2n) the torques' derivative by the state when known in closed form
+        # (a torque of time alone: zeros); None: the complex step differentiates the torques
+        self.torque_jacobian = None
 
     def joint_angles(self, x):
         """``(deltas, ddeltas, s, ds)``: each actuator's joint angle [rad] and rate [rad/s]
@@ -91,6 +95,18 @@ class FiveLinkActuators:
         """``M^-1 B tau`` (n,) [rad/s^2]."""
         M = self.fns["matrices"](x)[0]
         return np.linalg.solve(M, self.generalised_force(t, x))
+
+    def acceleration_jacobian(self, t, x, constraint=None) -> np.ndarray:
+        """``d(M^-1 B tau)/dx`` (n, 2n): :func:`walkerlab.models.hybrid.actuated.
+        torque_chain_jacobian` with :attr:`torque_jacobian` set, else the complex step of
+        :meth:`added_acceleration` (``constraint``: none on free joints, must be None)."""
+        from walkerlab.models.hybrid.actuated import torque_chain_jacobian
+
+        x = np.asarray(x, float)
+        if self.torque_jacobian is None:
+            return complex_step_jacobian(lambda z: self.added_acceleration(t, z), x)
+        return torque_chain_jacobian(self.fns["matrices"], x, self.generalised_force(t, x),
+                                     self.B @ np.asarray(self.torque_jacobian(t, x), float))
 
     def power(self, t, x) -> float:
         """Mechanical power of the joint torques [W]: ``sum tau_k ddelta_k``."""
