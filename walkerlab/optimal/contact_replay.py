@@ -10,7 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["contact_replay", "contact_replay_five_link", "contact_replay_phased"]
+__all__ = ["REPLAY_WALL_TIME_LIMIT_S", "contact_replay", "contact_replay_five_link",
+           "contact_replay_phased"]
+
+#: Wall-time limit [s] of a phased walker's contact replay (its powered run).
+REPLAY_WALL_TIME_LIMIT_S = 1800.0
 
 
 def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
@@ -159,7 +163,10 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     d = scene.model_dump(mode="json", exclude_none=True)
     d["walker"]["actuation"] = {"torques": [{"joint": "hip", "law": {}}]}
     d.setdefault("contact", {})
-    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500}
+    # a powered run is on a Python RHS (a flat-footed walker's stride: ~7 s CPU), so the
+    # wall-time limit is set for a loaded machine, not the contact-sim default (120 s)
+    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500,
+                        "wall_time_limit_s": REPLAY_WALL_TIME_LIMIT_S}
     try:
         setup = contact_setup(type(scene).model_validate(d))
     except (ContactSceneError, ValueError) as exc:
