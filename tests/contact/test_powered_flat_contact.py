@@ -164,8 +164,8 @@ def test_the_flat_hip_ledger_closes(gait):
 
 @pytest.mark.slow
 def test_contact_sim_of_a_flat_footed_walker_with_a_hip_torque_closes_its_ledger(tmp_path):
-    """``walkerlab contact-sim`` on flat feet with a hip actuator (LAW, 0.9 s; the stage
-    with its drop test: ~4 min wall under load): the artifact's ledger carries the hip
+    """``walkerlab contact-sim`` on flat feet with a hip actuator (LAW, 0.9 s; the whole
+    stage: ~4 min wall at a load of 15 on 2 cores): the artifact's ledger carries the hip
     torque's work both ways, the ankle dampers' and the contacts', and closes (as the
     run's, :func:`test_the_flat_hip_ledger_closes`)."""
     import yaml
