@@ -208,3 +208,22 @@ def test_the_flat_feet_optimums_contact_replay(gait):
                                             res, strides=1)
     assert outcome == "heel_strike"
     assert abs(period / 0.818 - 1.0) < 0.005, period
+
+
+@pytest.mark.parametrize("outcome", ["heel_strike", "time_limit"])
+def test_the_report_names_a_contact_replay_that_ended_short(outcome):
+    """A contact replay that ran out of time after one step (its mean period then reads
+    that step alone) is named as such in the report's optimize lines; a replay that made
+    its strides is not."""
+    import dataclasses
+
+    from walkerlab.io.schemas.optimize import OptimizeData
+    from walkerlab.report.figures_section import optimize_lines
+
+    t = np.linspace(0.0, 0.75, 5)
+    d = OptimizeData(t, {"a": t.copy()}, np.zeros(5), 0.75, 0.6, 0.0, 0.0, 1e-7,
+                     np.array([0.4 + 0j]), True, "Solve_Succeeded", 15, 3.0, {"a": "rad"})
+    d = dataclasses.replace(d, contact_step_period_s=0.794, contact_outcome=outcome)
+    text = " ".join(optimize_lines(d))
+    assert "step period 0.794" in text
+    assert ("ended short of its strides: time_limit" in text) == (outcome == "time_limit")
