@@ -188,6 +188,10 @@ def test_contact_sim_of_a_flat_footed_walker_with_a_hip_torque_closes_its_ledger
     assert led["damper"][-1] < 0.0 and led["contact"][-1] < 0.0
     assert len(c.heel_strike_times) >= 1
     assert np.max(np.abs(led["residual"])) < 5e-4  # J
+    from walkerlab.report.contact_sections import contact_section
+
+    text = " ".join(contact_section(load_scene(path), {"contact-sim": c}))
+    assert "hip torques +" in text and "ankle dampers" in text and "push-off" not in text
 
 
 def passive_contact_period(strides: int = 1) -> float:
