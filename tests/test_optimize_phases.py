@@ -343,10 +343,36 @@ def test_a_powered_kneed_gait_replays_on_the_rigid_model(kneed, kneed_start):
 def test_a_powered_flat_footed_gait_replays_on_the_rigid_model(flat):
     """Flat feet made to walk at 0.8 m/s (passive: 0.789 m/s) by the least hip torque
     (~0.8 N m peak; ~30 s): the replay on the rigid model - its heel-off guard reading the
-    ground force through the torqued flow - closes within 1e-6 (3e-7 seen)."""
+    ground force through the torqued flow - closes within 1e-6 (3e-7 seen).
+
+    Replayed in the contact model (the torque between the legs, one stride: 3 steps; ~17 s
+    CPU more) it walks, and the torque shortens its mean step period as it shortens the
+    rigid one: contact 0.8012 s against the passive contact model's 0.8121 s (-1.34 %),
+    rigid 0.7475 s against 0.7576 s (-1.33 %), within 0.3 % of each other.  Against the
+    rigid optimum the contact period is +7.2 % (the passive one's offset: the flat-footed
+    contact model walks slower than the rigid one, configs/flat_feet_optimal.yaml's note),
+    outside the issue's 3 %."""
     pytest.importorskip("casadi")
-    res, err = _powered(flat[1], _start(flat, 200), 200, 0.8)
+    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.api.scenes import with_changes
+    from walkerlab.models.contact.scene import contact_setup
+    from walkerlab.optimal.contact_replay import contact_replay_phased
+
+    start = _start(flat, 200)
+    res, err = _powered(flat[1], start, 200, 0.8)
     assert res.status == "Solve_Succeeded"
     assert res.step_length_m / res.step_period_s == pytest.approx(0.8, rel=1e-9)
     assert 0.1 < np.max(np.abs(res.u)) < 10.0
     assert err <= 1e-6
+    period, outcome = contact_replay_phased(flat[0], res, strides=1)
+    assert outcome == "heel_strike"
+    g = start[0]
+    rigid_change = res.step_period_s / g.step_period - 1.0
+    assert rigid_change < -0.01
+    # the passive contact model over the same 3 steps (the compiled passive run, < 1 s)
+    sc = with_changes(flat[0], {"contact_sim": {"n_strides": 2, "sample_rate_hz": 500,
+                                                "t_final_s": 4.6 * g.step_period}})
+    hs = simulate_from(contact_setup(sc), g.x, g.step_period, strides=2)[1].heel_strike_times
+    passive = float(np.mean(np.diff(np.asarray(hs, float)[:4])))
+    assert abs(period / passive - 1.0 - rigid_change) < 0.003, (period, passive)
+    assert 0.06 < period / res.step_period_s - 1.0 < 0.08

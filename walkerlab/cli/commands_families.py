@@ -246,7 +246,9 @@ def optimize(scene: Path | None = SceneArg,
         if d.contact_step_period_s == d.contact_step_period_s:  # not NaN: replayed
             typer.echo(f"  contact model driven by the optimised torque: step period "
                        f"{d.contact_step_period_s:.5g} s "
-                       f"({100 * (d.contact_step_period_s / d.step_period_s - 1):+.2f} %)")
+                       f"({100 * (d.contact_step_period_s / d.step_period_s - 1):+.2f} %)"
+                       + ("" if d.contact_outcome == "heel_strike" else
+                          f"; the run ended short of its strides: {d.contact_outcome}"))
         else:
             typer.echo(f"  contact model: {d.contact_outcome}")
         typer.echo("  a gait (the replay closes)" if d.gait else

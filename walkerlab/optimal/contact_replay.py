@@ -2,16 +2,20 @@
 function of the time since each touchdown, :func:`walkerlab.optimal.collocation.
 torque_of_time`) and push-off drive the scene's contact walker (its ``contact`` law, or the
 paper's default one) from the optimised start; the mean period of its steps is compared with
-the optimum's (the issue's check: within 3 %).  A walker with phases (the kneed walker:
-:func:`contact_replay_phased`) gets its optimised hip torque between the thighs; a walker
-whose legs differ (:func:`contact_replay_stride`) each step's own torque."""
+the optimum's (the issue's check: within 3 %).  A walker with phases
+(:func:`contact_replay_phased`) gets its optimised hip torque between the thighs (kneed) or
+the legs (flat feet); a walker whose legs differ (:func:`contact_replay_stride`) each step's
+own torque."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["contact_replay", "contact_replay_five_link", "contact_replay_phased",
-           "contact_replay_stride"]
+__all__ = ["REPLAY_WALL_TIME_LIMIT_S", "contact_replay", "contact_replay_five_link",
+           "contact_replay_phased", "contact_replay_stride"]
+
+#: Wall-time limit [s] of a phased walker's contact replay (its powered run).
+REPLAY_WALL_TIME_LIMIT_S = 1800.0
 
 
 def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
@@ -121,15 +125,19 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
 
 
 def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
-    """Run the contact model of a walker with phases (a kneed walker) with its optimised hip
-    torque.
+    """Run the contact model of a walker with phases (a kneed or flat-footed walker) with its
+    optimised hip torque.
 
     The scene's walker gets a hip torque whose law is replaced by
     :func:`walkerlab.optimal.phased_collocation.phase_torque_of_time` of the time since each
-    touchdown (between the thighs: :class:`walkerlab.models.contact.actuation.
-    ContactActuators`), from the collocated start ``res.x[0]``; the scene's ``contact`` law
-    (a kneed walker needs its ``knee_stop.latch`` to hold the stance knee as the rigid
-    model's lock does), ``terrain`` and ``contact_solver`` (the contact default if none).
+    touchdown (between the thighs, or the legs of a flat-footed walker:
+    :class:`walkerlab.models.contact.actuation.ContactActuators`), from the collocated start
+    ``res.x[0]``; the scene's ``contact`` law (a kneed walker needs its ``knee_stop.latch``
+    to hold the stance knee as the rigid model's lock does; flat feet their regularising
+    ``flat_foot_mass_kg`` and ``flat_foot_inertia_kg_m2``), ``terrain`` and
+    ``contact_solver`` (the contact default if none; a powered run takes it as LSODA, with a
+    flat foot's rotation rates at 100 times its atol:
+    :func:`walkerlab.integrate.contact_powered.powered_atol`).
 
     Parameters
     ----------
@@ -145,8 +153,9 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
         Mean period of the run's steps after the first touchdown [s] (NaN if it made
         fewer than two).
     outcome : str
-        How the run ended, or why there is no replay (flat feet: the contact view carries
-        no hip torque on them yet; one line).
+        How the run ended, or why there is no replay (a scene without the contact
+        section's flat-foot regularisation, a walker the contact view carries no hip torque
+        on; one line).
     """
     from walkerlab.analysis.contact.sim import simulate_from
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup
@@ -155,7 +164,10 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     d = scene.model_dump(mode="json", exclude_none=True)
     d["walker"]["actuation"] = {"torques": [{"joint": "hip", "law": {}}]}
     d.setdefault("contact", {})
-    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500}
+    # a powered run is on a Python RHS (a flat-footed walker's stride: ~7 s CPU), so the
+    # wall-time limit is set for a loaded machine, not the contact-sim default (120 s)
+    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500,
+                        "wall_time_limit_s": REPLAY_WALL_TIME_LIMIT_S}
     try:
         setup = contact_setup(type(scene).model_validate(d))
     except (ContactSceneError, ValueError) as exc:

@@ -2,8 +2,8 @@
 flat feet):
 the transcription of :mod:`walkerlab.optimal.phased_collocation` set up from the scene,
 started from one step of the scene's gait, replayed on the rigid model, its Floquet
-multipliers from the replay, and replayed in the contact model (2 strides; a kneed walker's
-hip torque acts between its thighs; flat feet are not replayed yet)."""
+multipliers from the replay, and replayed in the contact model (2 strides; the hip torque
+acts between a kneed walker's thighs, between a flat-footed walker's legs)."""
 
 from __future__ import annotations
 

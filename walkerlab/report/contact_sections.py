@@ -81,6 +81,9 @@ def contact_section(scene, arts) -> list[str]:
         terms = (f"push-off {num(w['push_off'][-1], 4)}, joint torques "
                  f"+{num(w['hip_torque_positive'][-1], 4)} / "
                  f"{num(w['hip_torque_negative'][-1], 4)}" if "push_off" in w else
+                 f"hip torques +{num(w['hip_torque_positive'][-1], 4)} / "
+                 f"{num(w['hip_torque_negative'][-1], 4)}, ankle dampers "
+                 f"{num(w['damper'][-1], 4)}" if "hip_torque_positive" in w else
                  f"ankle push-off +{num(w['ankle_torque_positive'][-1], 4)} / "
                  f"{num(w['ankle_torque_negative'][-1], 4)}, ankle dampers "
                  f"{num(w['damper'][-1], 4)}")

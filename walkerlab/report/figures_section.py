@@ -107,7 +107,9 @@ def optimize_lines(d) -> list[str]:
             + phase_replay_text(d)
             + (f" In the contact model{' (the feed-forward + PD law)' if d.phase_replays else ''}"
                f": step period {num(d.contact_step_period_s)} s "
-               f"({num(100 * (d.contact_step_period_s / d.step_period_s - 1), 2)} %)."
+               f"({num(100 * (d.contact_step_period_s / d.step_period_s - 1), 2)} %)"
+               + ("." if d.contact_outcome == "heel_strike"
+                  else f" (the run ended short of its strides: {d.contact_outcome}).")
                if d.contact_step_period_s == d.contact_step_period_s
                else f" Contact model: {d.contact_outcome}.")
             + _phases_line(d),

@@ -20,6 +20,15 @@ stance angle while the stance knee is straight).  The knee stops' power is a ter
 ledger of its own (:data:`KNEE_WORK_NAMES`); a kneed walker takes hip torques alone (no
 push-off yet).
 
+On a flat-footed walker (floating coordinates ``hip_x, hip_y, leg1_angle, leg2_angle,
+leg1_foot_angle, leg2_foot_angle``) the hip torque acts between the two legs as on point
+feet: ``+tau`` on the swing leg's absolute angle, ``-tau`` on the stance leg's, the feet
+(hinged at the ankles, on their springs) get nothing; its power is ``tau (dtheta_swing -
+dtheta_stance)``.  The ledger (:data:`FLAT_HIP_WORK_NAMES`) carries the torque's positive
+and negative work, the ankle dampers' and the contact forces' (the ankle springs' energy is
+the walker's potential energy).  Flat feet take hip torques or an ankle push-off, one of the
+two.
+
 Push-off
 --------
 The rigid model's push-off is an impulse ``P`` at the trailing foot along the trailing leg
@@ -59,8 +68,8 @@ import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
-__all__ = ["ANKLE_WORK_NAMES", "KNEE_WORK_NAMES", "WORK_NAMES", "ContactActuators",
-           "ContactRows", "powered_rhs"]
+__all__ = ["ANKLE_WORK_NAMES", "FLAT_HIP_WORK_NAMES", "KNEE_WORK_NAMES", "WORK_NAMES",
+           "ContactActuators", "ContactRows", "powered_rhs"]
 
 
 class ContactRows:
@@ -96,7 +105,8 @@ class ContactRows:
 
 class ContactActuators(ContactRows):
     """The actuators of one contact walker (straight legs; point feet, or flat feet with an
-    ankle push-off; or a hip torque between the thighs of a kneed walker with point feet).
+    ankle push-off or hip torques; or a hip torque between the thighs of a kneed walker with
+    point feet).
 
     Parameters
     ----------
@@ -112,7 +122,8 @@ class ContactActuators(ContactRows):
     ------
     ValueError
         The walker's legs are not two straight legs with point feet, or flat feet with an
-        ankle push-off alone, or kneed legs with point feet and hip torques alone (one line).
+        ankle push-off or hip torques (not both, no push-off impulse), or kneed legs with
+        point feet and hip torques alone (one line).
     """
 
     #: A touchdown is a heel strike only this far [m] ahead of the stance foot (a scuff
@@ -133,13 +144,14 @@ class ContactActuators(ContactRows):
                                                                             "leg2_angle")
         if leg[0] not in names or leg[1] not in names:
             raise ValueError("walker.actuation: the contact view carries actuators on "
-                             "straight or kneed legs with point feet only (arc and flat feet: "
-                             "not yet)")
+                             "straight legs (point or flat feet) or kneed legs with point "
+                             "feet only")
         flat = "leg1_foot_angle" in names
         ankle = getattr(spec, "ankle_push_off", None)
-        if flat and (ankle is None or spec.push_off is not None or spec.torques):
-            raise ValueError("walker.actuation: flat feet take ankle_push_off alone in the "
-                             "contact view")
+        if flat and (spec.push_off is not None or (ankle is None) == (not spec.torques)
+                     or any(t.joint != "hip" for t in spec.torques)):
+            raise ValueError("walker.actuation: flat feet take ankle_push_off or hip torques "
+                             "(one of the two, no push_off) in the contact view")
         if ankle is not None and not flat:
             raise ValueError("walker.actuation.ankle_push_off: flat feet only")
         self.ankle = ankle
@@ -178,10 +190,13 @@ class ContactActuators(ContactRows):
     @property
     def work_names(self) -> tuple[str, ...]:
         """Names of the work integrals this walker's run carries (:data:`WORK_NAMES`;
-        :data:`ANKLE_WORK_NAMES` for an ankle push-off, :data:`KNEE_WORK_NAMES` for knees)."""
+        :data:`ANKLE_WORK_NAMES` for an ankle push-off, :data:`FLAT_HIP_WORK_NAMES` for hip
+        torques on flat feet, :data:`KNEE_WORK_NAMES` for knees)."""
         if self.knee:
             return KNEE_WORK_NAMES
-        return WORK_NAMES if self.ankle is None else ANKLE_WORK_NAMES
+        if self.ankle is not None:
+            return ANKLE_WORK_NAMES
+        return WORK_NAMES if self.foot is None else FLAT_HIP_WORK_NAMES
 
     def ankle_torque(self, x, stance: int) -> tuple[np.ndarray, float]:
         """Generalised force (nq,) of the ankle push-off at leg ``stance``'s ankle (0: leg1,
@@ -240,6 +255,8 @@ class ContactActuators(ContactRows):
 WORK_NAMES = ("hip_torque_positive", "hip_torque_negative", "push_off", "contact")
 #: ... and those of a flat-footed walker's ankle push-off run [J].
 ANKLE_WORK_NAMES = ("ankle_torque_positive", "ankle_torque_negative", "damper", "contact")
+#: ... and those of a flat-footed walker's hip torque run [J].
+FLAT_HIP_WORK_NAMES = ("hip_torque_positive", "hip_torque_negative", "damper", "contact")
 #: ... and those of a kneed walker's (the knee stops' work last) [J].
 KNEE_WORK_NAMES = WORK_NAMES + ("knee_stop",)
 
@@ -272,8 +289,8 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
         [W], in the order of ``walker.actuators.work_names``: the hip torques' positive and
         negative power, the push-off's, and the contact forces' (normal + friction, all
         points; negative while they dissipate or store); flat feet: the ankle push-off's
-        positive and negative power, the dampers', the contact forces'; knees: then the knee
-        stops' power.
+        (or the hip torques') positive and negative power, the dampers', the contact forces';
+        knees: then the knee stops' power.
     """
     acts = walker.actuators
     n = walker.nq
@@ -288,6 +305,11 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
         return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0),
                              acts.damper_power(walker, x), p_contact])
     Q, p_tau = acts.hip_torque(x, stance, t_step)
+    if acts.foot is not None:  # hip torques on flat feet: no push-off, the ankle dampers
+        if np.any(Q):
+            dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
+        return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0),
+                             acts.damper_power(walker, x), p_contact])
     p_po = 0.0
     if push is not None:
         Qp, p_po = acts.push_off_force(walker, x, push[0], push[1])

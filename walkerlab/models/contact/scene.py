@@ -185,15 +185,16 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
 
     st = data.structure
     five_link = st.free_knees and st.foot == "point"
-    flat_push_off = st.foot == "flat" and spec.ankle_push_off is not None
+    flat = st.foot == "flat" and not st.knee
     kneed = st.knee and not five_link and st.foot == "point"
     if not five_link and ((st.knee and not kneed) or st.torso
-                          or not (st.foot == "point" or flat_push_off)):
+                          or not (st.foot == "point" or flat)):
         raise ContactSceneError(f"scene '{scene.name}': walker.actuation: the contact view "
                                 "carries actuators on straight legs with point feet and no "
                                 "torso, a hip torque on kneed legs with point feet, an ankle "
-                                "push-off on flat feet, and joint torques on free-jointed "
-                                "(five-link) bipeds, only (the rigid view has them too)")
+                                "push-off or a hip torque on flat feet, and joint torques on "
+                                "free-jointed (five-link) bipeds, only (the rigid view has "
+                                "them too)")
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
                                 "pinned start phase carries no actuators: leave it 'none'")
@@ -207,8 +208,10 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
             raise ContactSceneError(f"scene '{scene.name}': walker.actuation: a torque law on "
                                     "time since the heel strike has no contact periodic gait "
                                     "(contact_sim.start / periodic_gait): use a phase law")
-    if (five_link or kneed) and (cs.start == "periodic_gait" or cs.periodic_gait):
-        kind = "five-link biped" if five_link else "powered kneed walker"
+    flat_hip = flat and bool(spec.torques)
+    if (five_link or kneed or flat_hip) and (cs.start == "periodic_gait" or cs.periodic_gait):
+        kind = ("five-link biped" if five_link else "powered kneed walker" if kneed
+                else "flat-footed walker with hip torques")
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: a {kind}'s "
                                 "contact periodic gait is not found yet: start it from the "
                                 "rigid gait (start: ideal, periodic_gait: false)")
@@ -220,7 +223,7 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     try:
         return ContactActuators(spec, coordinate_names(st), scene.contact.push_off_pulse_s())
     except ValueError as err:
-        if not kneed:
+        if not (kneed or flat):
             raise
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
 
