@@ -48,11 +48,12 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     from walkerlab.optimal.contact_replay import contact_replay_phased
     from walkerlab.optimal.phased_collocation import (
         collocate_phases,
+        phase_torque_of_time,
         phased_guess,
         replay_phases,
     )
     from walkerlab.optimal.phases import mode_functions, phase_order
-    from walkerlab.optimal.scene import step_record
+    from walkerlab.optimal.scene import phase_replays, step_record
 
     o = scene.optimize
     if o.initial_guess is not None:
@@ -70,6 +71,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
     if np.isfinite(err):
         contact_period, contact_outcome = contact_replay_phased(scene, res, strides=2)
+    phases, phase_note = phase_replays(scene, data, res, phase_torque_of_time(res))
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
@@ -82,6 +84,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
                         phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
                         build_time_s=build + res.build_time_s,
+                        phase_replays=phases, phase_replay_outcome=phase_note,
                         **step_record(scene, walker, res))
 
 

@@ -120,6 +120,7 @@ class OptimizeData:
     phase_duration_s: np.ndarray | None = None
     build_time_s: float = float("nan")
     phase_replays: dict = field(default_factory=dict)  # law name -> PhaseReplayData
+    phase_replay_outcome: str = ""  # why there are no phase replays ("": there are, or off)
 
 
 def _write_phase(f, law: str, r: PhaseReplayData) -> None:
@@ -215,6 +216,8 @@ def write(f, d: OptimizeData) -> None:
             put(f, f"replay/{key}", float(v), unit, what)
     for law, r in d.phase_replays.items():
         _write_phase(f, law, r)
+    if d.phase_replay_outcome:
+        f.attrs["phase_replay_outcome"] = d.phase_replay_outcome
     _write_history_and_energy(f, d)
 
 
@@ -276,7 +279,8 @@ def load(path: Path) -> OptimizeData:
             f["phases/start_index"][()] if "phases" in f else None,
             f["phases/duration"][()] if "phases" in f else None,
             float(f.attrs.get("ipopt_build_time_s", float("nan"))),
-            {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f})
+            {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f},
+            str(f.attrs.get("phase_replay_outcome", "")))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)
