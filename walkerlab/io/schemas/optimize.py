@@ -39,8 +39,10 @@ points)::
                                            primal_infeasibility, dual_infeasibility, barrier
     energy/kinetic, energy/potential  J    the walker's energies at the collocation points
                                            (their sum rises by the actuators' work)
-    replay/phase_<law>/...        (a five-link biped) the torques as a function of the
-                                  phase variable (the stance leg's angle), ``<law>``
+    replay/phase_<law>/...        (optimize.phase_replay: a five-link biped's by default)
+                                  the torques as a function of the phase variable (the
+                                  stance leg's angle; a step of phases: one law per
+                                  phase), ``<law>``
                                   ``feedback`` (feed-forward + PD on the collocated joint
                                   trajectory: virtual constraints) or ``feedforward`` (no
                                   PD): ``collocated_start_error``, ``start_shift``,
@@ -50,7 +52,8 @@ points)::
                                   u*(t)| along it), ``multipliers/{real,imag}``; attribute
                                   ``closed``
 
-attributes: ``gait`` (the replay closed), ``state_names``.
+attributes: ``gait`` (the replay closed), ``state_names``; ``phase_replay_outcome`` (when
+the phase-variable replay was asked for and refused: why, one line).
 """
 
 from __future__ import annotations
@@ -65,7 +68,7 @@ STAGE = "optimize"
 __all__ = ["DESIGN_STAGE", "DesignData", "OptimizeData", "PHASE_LAWS", "PhaseReplayData",
            "STAGE", "load", "load_design", "write", "write_design"]
 
-#: the phase-variable replays a five-link biped's artifact may carry
+#: the phase-variable replays an artifact may carry (optimize.phase_replay)
 PHASE_LAWS = ("feedback", "feedforward")
 
 
