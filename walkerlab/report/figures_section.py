@@ -141,7 +141,9 @@ def phase_replay_text(d) -> str:
                 f"{num(fb.collocated_start_error, 2)} away; closed (start moved "
                 f"{num(fb.start_shift, 2)}) it returns to {num(fb.return_error, 2)}, step "
                 f"period {num(fb.step_period_s, 9)} s, largest |multiplier| "
-                f"{num(float(np.max(np.abs(fb.multipliers))))} (stable under the law), the "
+                f"{num(float(np.max(np.abs(fb.multipliers))))} ("
+                f"{'stable' if np.max(np.abs(fb.multipliers)) < 1 else 'unstable'} under the "
+                f"law), the "
                 f"law's torque within {num(fb.torque_error, 2)} N m of the optimal one.")
     if ff is not None:
         out += (f" The phase-variable feed-forward alone (no PD): one step from the "
