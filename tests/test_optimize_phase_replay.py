@@ -113,8 +113,9 @@ def test_a_step_of_phases_gets_one_law_per_phase_chosen_by_the_phase_variable(co
 def test_the_passive_gait_walks_on_under_the_phase_law(compass):
     """compass_optimal's optimum is its passive gait (torque zero): fed its own step
     (sampled at 41 times), the feed-forward law (zero) steps from the passive fixed point
-    back to it (to the integration's 1e-10), and so does the feed-forward + PD law (the
-    Hermite reference's O(h^4) error drives a torque of ~1e-4 N m: within 1e-6)."""
+    back to it (within 1e-8: DOP853 at 1e-10 against the fixed point's 1e-12), and so does
+    the feed-forward + PD law (the Hermite reference's O(h^4) error drives a torque of
+    ~1e-4 N m: within 1e-6)."""
     import walkerlab as wl
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
@@ -127,8 +128,8 @@ def test_the_passive_gait_walks_on_under_the_phase_law(compass):
     first = walk.stance_leg == walk.stance_leg[0]
     x = np.stack([np.interp(t, walk.t[first], col) for col in walk.x[first].T], axis=1)
     x[0] = g.x
-    solver = Solver(method="DOP853", rtol=1e-12, atol=1e-12)
-    for gains, tol in (((0.0, 0.0), 1e-10), (hip_gains(data, acts, g.x), 1e-6)):
+    solver = Solver(method="DOP853", rtol=1e-10, atol=1e-10)
+    for gains, tol in (((0.0, 0.0), 1e-8), (hip_gains(data, acts, g.x), 1e-6)):
         law = hip_phase_law(acts, t, x, np.zeros(t.size), gains)
         seg = integrate_step(hip_walker(data, law), g.x, solver,
                              max_step_time=3 * g.step_period)
