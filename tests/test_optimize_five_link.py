@@ -249,9 +249,9 @@ def check_the_phase_variable_law_walks_the_contact_model_at_the_optimums_period(
 
 @pytest.mark.slow  # one optimisation of rabbit_optimal (~4 min CPU with its phase replays)
 def test_the_shipped_five_link_optimum(optimised, fns_and_params):
-    """The checks of the shipped five-link optimum, in one test: pytest-xdist 3.8 (with
-    pytest 9) ignores ``xdist_group`` marks, so separate tests ran the fixture on both
-    workers (2 x 240 s of the slow set)."""
+    """The checks of the shipped five-link optimum, in one test: pytest-xdist 3.8 with
+    pytest 9.2 ignored ``xdist_group`` marks (pyproject now pins pytest < 9.2), so separate
+    tests ran the fixture on both workers (2 x 240 s of the slow set)."""
     check_kellys_step_meets_its_targets_and_constraints(optimised, fns_and_params)
     check_the_closed_step_replays_on_the_rigid_model(optimised)
     check_the_report_shows_the_optimised_step(optimised)

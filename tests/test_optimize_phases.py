@@ -247,10 +247,12 @@ def test_what_the_phased_transcription_does_not_take_is_refused_in_one_line():
     from walkerlab.optimal.collocation import CollocationSpec
     from walkerlab.optimal.phased_collocation import collocate_phases
 
-    for spec, field in ((CollocationSpec(objective="cost_of_transport"), "optimize.objective"),
+    for spec, field in ((CollocationSpec(objective="push_off_work"), "optimize.objective"),
+                        (CollocationSpec(objective="weighted",
+                                         weights=(("push_off_work", 1.0),)),
+                         "optimize.objective"),
                         (CollocationSpec(push_off_n_s=1.0), "optimize.push_off"),
-                        (CollocationSpec(friction_coefficient=0.8),
-                         "optimize.friction_coefficient")):
+                        (CollocationSpec(push_off_free=True), "optimize.push_off")):
         with pytest.raises(ValueError, match=field) as e:
             collocate_phases({"phases": []}, spec, [])
         assert "\n" not in str(e.value)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import h5py
 import numpy as np
+import pytest
 
 from walkerlab.config import scene_from_dict
 from walkerlab.io import artifacts as A
@@ -117,3 +118,39 @@ def test_a_recently_changed_artifact_is_always_hashed(tmp_path, monkeypatch):
     monkeypatch.setattr(A, "_HASH_MEMO", {})
     assert A.verified_hash(path) == "k" and A.verified_hash(path) == "k"
     assert len(hashed) == 2 and not (tmp_path / "cache" / "hashes").exists()
+
+
+#: never in the process of a whole (warm) ``contact-sim`` run either: besides the packages
+#: above (scipy.optimize is the periodic gait's root finder and the step map's brentq), no
+#: other scipy subpackage with a heavy import, no terminal-rendering or process-pool
+#: machinery, and none of the rigid analysis or the ``--adjust`` search
+NOT_IN_THE_RUN = tuple(m for m in NOT_ON_THE_PATH if m != "scipy.optimize") + (
+    "rich", "multiprocessing", "concurrent.futures.process", "scipy.interpolate",
+    "scipy.stats", "scipy.signal", "walkerlab.analysis.gait",
+    "walkerlab.analysis.contact.adjust", "walkerlab.analysis.contact.variational")
+
+_RUN = """
+import json, sys
+from walkerlab.cli import app
+try:
+    app(["-q", "contact-sim", "configs/paper.yaml", "--force", "--runs-dir", sys.argv[1]])
+except SystemExit as exc:
+    assert not exc.code, exc.code
+print(json.dumps(sorted(m for m in sys.argv[2:] if m in sys.modules)))
+"""
+
+
+@pytest.mark.slow  # two contact-sim processes (~3 s CPU each warm; a cold cache compiles)
+def test_a_whole_contact_sim_run_loads_only_what_it_uses(tmp_path):
+    """The process of a second (warm) ``walkerlab contact-sim configs/paper.yaml --force``
+    (the main job's warm profile, ``scripts/profile_contact_sim.py``) loads none of
+    :data:`NOT_IN_THE_RUN`: only the command layer, the stage, the contact model's
+    kernels, CyRK, numba, h5py and scipy.optimize."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    cmd = [sys.executable, "-c", _RUN, str(tmp_path / "runs"), *NOT_IN_THE_RUN]
+    for _ in range(2):  # the first fills the runs folder (fixedpoint.h5) and the caches
+        r = subprocess.run(cmd, env=env, cwd=ROOT, capture_output=True, text=True,
+                           timeout=600)
+        assert r.returncode == 0, r.stderr[-2000:]
+    assert json.loads(r.stdout.strip().splitlines()[-1]) == []
+    assert (tmp_path / "runs" / "paper" / "contact_sim.h5").is_file()

@@ -119,3 +119,52 @@ def test_fd_jacobian_on_the_compiled_map_agrees_with_the_variational_one(setup, 
     slow_fd = g.multipliers[np.abs(g.multipliers) > 1e-3]
     assert len(slow_v) == len(slow_fd) == 3
     assert np.max(np.abs(np.sort(np.abs(slow_v)) - np.sort(np.abs(slow_fd)))) < 2e-5
+
+
+def _counting_grid(monkeypatch):
+    """Record every run of the step map's grid integrator: (start state, sample times)."""
+    from walkerlab.analysis.contact import step_map
+
+    runs, real = [], step_map.contact_grid
+    monkeypatch.setattr(step_map, "contact_grid", lambda w, x, tg, *a, **k: (
+        runs.append((np.array(x, float), np.array(tg, float))) or real(w, x, tg, *a, **k)))
+    return runs, real
+
+
+def test_the_map_at_the_same_state_again_is_not_integrated_again(setup, paper_gait,
+                                                                 monkeypatch):
+    """The root finder's forward-difference Jacobian, the fixed point's last step and its
+    patch margin evaluate the map where it was just evaluated: the second call integrates
+    nothing and returns (copies of) the same bits, which a fresh map computes too."""
+    from walkerlab.analysis.contact.periodic import MAP_SOLVER
+
+    z = paper_gait.z
+    P = StepMap(setup[2], solver=MAP_SOLVER)
+    z1, T, ell = P(z)
+    runs, _ = _counting_grid(monkeypatch)
+    z2, T2, ell2 = P(z.copy())
+    assert runs == [] and P.nfev == 1
+    assert np.array_equal(z1, z2) and (T, ell) == (T2, ell2) and z1 is not z2
+    P.patch_margin(z)  # its own grid over the step, after the step's crossing from memory
+    assert len(runs) == 1 and len(runs[0][1]) == 2001
+    monkeypatch.undo()
+    z3, T3, ell3 = StepMap(setup[2], solver=MAP_SOLVER)(z)
+    assert np.array_equal(z1, z3) and (T, ell) == (T3, ell3)
+
+
+def test_the_crossing_state_is_brentqs_last_short_run_bit_for_bit(setup, paper_gait,
+                                                                    monkeypatch):
+    """The section state is the end of the short run brentq evaluated at its root (no run
+    after the root finder), identical to a fresh run from the sample before the crossing."""
+    from walkerlab.analysis.contact.periodic import MAP_SOLVER
+
+    P = StepMap(setup[2], solver=MAP_SOLVER)
+    runs, real = _counting_grid(monkeypatch)
+    te, xe = P.next_section(P.to_state(paper_gait.z))
+    short = [(x, tg) for x, tg in runs if len(tg) == 2]
+    assert short and all(tg[-1] != tg[0] for _, tg in short)
+    assert len({tg[-1] for _, tg in short}) == len(short)  # each evaluation once
+    assert te in {tg[-1] for _, tg in short}
+    xk, tk = short[0][0], short[0][1][0]
+    fresh = real(P.walker, xk, np.array([tk, te]), P.solver, P._data)[0][-1]
+    assert np.array_equal(xe, fresh)

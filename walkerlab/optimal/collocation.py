@@ -47,8 +47,9 @@ import numpy as np
 
 from walkerlab.optimal.ipopt import iteration_history, solve
 
-__all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step", "replay",
-           "step_functions", "target_constraints", "torque_of_time"]
+__all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step",
+           "ipopt_options", "positive_power", "replay", "step_functions",
+           "target_constraints", "torque_of_time"]
 
 
 @dataclass(frozen=True)
@@ -214,8 +215,8 @@ def step_functions(data, eq):
                          "a torso, partly massless legs: not yet)")
     if getattr(data, "mirror", None) is not None:
         raise ValueError("optimize: legs that differ take a stride of two different steps "
-                         "(a two-phase transcription: not yet); one step would be periodic "
-                         "only for mirror-image legs")
+                         "(walkerlab.optimal.stride); one step would be periodic only for "
+                         "mirror-image legs")
     n = len(eq.q)
     vals = dict(zip(eq.params, data.params))
     xs = list(eq.q) + list(eq.dq)
@@ -390,7 +391,7 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     opti.set_initial(U, ug[None])
     if spec.push_off_free:
         opti.set_initial(P, spec.push_off_n_s)
-    opti.solver("ipopt", {"print_time": False}, _ipopt_options(spec))
+    opti.solver("ipopt", {"print_time": False}, ipopt_options(spec))
     status, get, wall, _ = solve(opti)
     Tv = float(get(T))
     Xv, Uv = np.asarray(get(X)).reshape(n2, K).T, np.asarray(get(U)).ravel()
@@ -404,7 +405,7 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
         history=iteration_history(opti.stats()))
 
 
-def _ipopt_options(spec) -> dict:
+def ipopt_options(spec) -> dict:
     """IPOPT's options: tight tolerances; with the cost of transport's slack variables no
     bound relaxation (IPOPT relaxes every inequality by ``bound_relax_factor`` = 1e-8
     relative by default, which lets each ``s_k`` go ~1e-8 below 0 and biases the positive
@@ -500,7 +501,7 @@ def _terms(opti, fns, spec, X, U, T, P):
     the cost of transport (positive hip work plus the push-off's work, per weight and step
     length) and the peak torque (epigraph: ``-s <= u <= s``, minimise ``s``).  Where the
     cost of transport or the peak torque is asked for, it is in its exact slack form
-    (:func:`_positive_work`, the epigraph); else evaluated afterwards from the points
+    (:func:`positive_power`, the epigraph); else evaluated afterwards from the points
     (``max(p, 0)``, ``max |u|``)."""
     import casadi as ca
 
@@ -511,14 +512,14 @@ def _terms(opti, fns, spec, X, U, T, P):
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     peak = peak_torque(opti, U, asked)
     power = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(K)])
-    positive = (_positive_work(opti, power) if "cost_of_transport" in asked
+    positive = (positive_power(opti, power) if "cost_of_transport" in asked
                 else ca.fmax(power, 0))
     return {"effort": _simpson(h, U ** 2), "push_off_work": work,
             "cost_of_transport": (_simpson(h, positive) + work)
             / (weight * fns["step"](X[:, -1])), "peak_torque": peak}
 
 
-def _positive_work(opti, power):
+def positive_power(opti, power):
     """The positive part of the actuator power at the points, exactly, by slack variables
     (Srinivasan & Ruina 2006, Nature 439:72-75; Kelly 2017, SIAM Review 59(4), on
     non-smooth objectives): ``s_k >= 0`` and ``s_k >= p_k`` at every point, ``s`` in the

@@ -3,13 +3,15 @@ function of the time since each touchdown, :func:`walkerlab.optimal.collocation.
 torque_of_time`) and push-off drive the scene's contact walker (its ``contact`` law, or the
 paper's default one) from the optimised start; the mean period of its steps is compared with
 the optimum's (the issue's check: within 3 %).  A walker with phases (the kneed walker:
-:func:`contact_replay_phased`) gets its optimised hip torque between the thighs."""
+:func:`contact_replay_phased`) gets its optimised hip torque between the thighs; a walker
+whose legs differ (:func:`contact_replay_stride`) each step's own torque."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["contact_replay", "contact_replay_five_link", "contact_replay_phased"]
+__all__ = ["contact_replay", "contact_replay_five_link", "contact_replay_phased",
+           "contact_replay_stride"]
 
 
 def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
@@ -162,6 +164,63 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     setup.actuators.laws = lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
     _, run, _, _ = simulate_from(setup, np.asarray(res.x[0], float), res.step_period_s,
                                  strides=strides)
+    hs = np.asarray(run.heel_strike_times, float)
+    period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
+    return period, str(run.termination)
+
+
+def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
+    """Run the contact model of a walker whose legs differ with its optimised stride's hip
+    torques: leg A's step's (:func:`walkerlab.optimal.stride.step_of` 0) while ``leg2`` is
+    in stance, leg B's while ``leg1`` is, each as a function of the time since that step's
+    touchdown (:func:`walkerlab.optimal.phased_collocation.phase_torque_of_time`), from the
+    collocated start ``res.x[0]`` (leg2 in stance, as the rigid model's); the scene's
+    ``contact`` law (the paper's default one if none), ``terrain``; LSODA at rtol 1e-6,
+    atol 1e-8 (a powered contact run uses scipy's event location).
+
+    Parameters
+    ----------
+    scene : Scene
+        The optimised scene.
+    res : walkerlab.optimal.phased_collocation.PhasedResult
+        The optimised stride (its ``step_period_s`` the stride's).
+    strides : int
+        Strides to run (2 steps each).
+
+    Returns
+    -------
+    step_period_s : float
+        Mean period of the run's steps after the first touchdown [s] (NaN if it made
+        fewer than two).
+    outcome : str
+        How the run ended, or why there is no replay (one line).
+    """
+    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.config import SolverSettings
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+    from walkerlab.optimal.phased_collocation import phase_torque_of_time
+    from walkerlab.optimal.stride import step_of
+
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["walker"]["actuation"] = {"torques": [{"joint": "hip", "law": {}}]}
+    d.setdefault("contact", {})
+    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500}
+    try:
+        setup = contact_setup(type(scene).model_validate(d))
+    except (ContactSceneError, ValueError) as exc:
+        return float("nan"), f"not replayed: {exc}"
+    acts = setup.actuators
+    laws = [(lambda tau: lambda delta, ddelta, s, ds, t: np.array([tau(float(t))]))(
+        phase_torque_of_time(step_of(res, k))) for k in (0, 1)]
+    own = acts.hip_torque
+
+    def hip_torque(x, stance: int, t_step: float = 0.0):  # stance 1: leg2, leg A's step
+        acts.laws = laws[0] if stance == 1 else laws[1]
+        return own(x, stance, t_step)
+    acts.hip_torque = hip_torque
+    solver = SolverSettings.for_contact(method="LSODA", rtol=1e-6, atol=1e-8)
+    _, run, _, _ = simulate_from(setup, np.asarray(res.x[0], float), res.step_period_s / 2,
+                                 solver=solver, strides=strides)
     hs = np.asarray(run.heel_strike_times, float)
     period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
     return period, str(run.termination)

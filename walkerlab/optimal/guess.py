@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["simulated_step", "starting_step"]
+__all__ = ["read_guess", "simulated_step", "starting_step"]
 
 
 def simulated_step(walker, x0, period_s: float, solver, samples: int = 400):
@@ -59,14 +59,43 @@ def starting_step(scene, walker, x_gait, period_s: float):
         branch (one line naming the field).
     """
     from walkerlab.integrate.solver import Solver
-    from walkerlab.io.artifacts import ArtifactError, open_artifact
 
     solver = Solver.from_settings(scene.solver)
-    g = scene.optimize.initial_guess
-    if g is None:
+    if scene.optimize.initial_guess is None:
         return (*simulated_step(walker, x_gait, period_s, solver), None, None)
+    kind, got = read_guess(scene, list(walker.state_names()))
+    if kind == "optimize":
+        x = np.stack([got.states[n] for n in walker.state_names()], axis=1)
+        return got.time - got.time[0], x, got.torque, got.push_off_n_s
+    return (*simulated_step(walker, got, period_s, solver), None, None)
+
+
+def read_guess(scene, names: list):
+    """The artifact named by ``scene.optimize.initial_guess``: another ``optimize.h5``, or
+    a continuation artifact's gait at ``at`` on ``branch``.
+
+    Parameters
+    ----------
+    names : list of str
+        The walker's state names (the artifact's must be the same).
+
+    Returns
+    -------
+    kind : str
+        ``"optimize"`` or ``"continuation"``.
+    value : walkerlab.io.schemas.optimize.OptimizeData or ndarray (2n,)
+        The optimisation, or the branch's post-impact state there.
+
+    Raises
+    ------
+    ValueError
+        The artifact is missing, damaged, of another stage or walker, or ``at`` is off its
+        branch (one line naming the field).
+    """
+    from walkerlab.io.artifacts import ArtifactError, open_artifact
+
+    g = scene.optimize.initial_guess
     path = Path(g.from_)
-    names = list(walker.state_names())
     try:
         with open_artifact(path) as f:
             kind = str(f.attrs.get("stage"))
@@ -76,15 +105,13 @@ def starting_step(scene, walker, x_gait, period_s: float):
             d = load(path)
             if list(d.states) != names:
                 raise ValueError(f"its states {list(d.states)} are not the walker's {names}")
-            x = np.stack([d.states[n] for n in names], axis=1)
-            return d.time - d.time[0], x, d.torque, d.push_off_n_s
+            return "optimize", d
         if kind != "continuation" or g.at is None:
             raise ValueError("give an optimize.h5, or a continuation artifact with 'at'")
         from walkerlab.config.studies import GuessFromArtifact
         from walkerlab.io.schemas.continuation import load_continuation
 
-        x0 = GuessFromArtifact(from_=g.from_, at=g.at, branch=g.branch).pick(
+        return "continuation", GuessFromArtifact(from_=g.from_, at=g.at, branch=g.branch).pick(
             load_continuation(path), names)
     except (ArtifactError, ValueError, KeyError) as exc:
         raise ValueError(f"optimize.initial_guess: {exc}") from None
-    return (*simulated_step(walker, x0, period_s, solver), None, None)

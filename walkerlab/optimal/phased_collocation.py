@@ -13,11 +13,11 @@ import numpy as np
 
 from walkerlab.optimal.ipopt import iteration_history, solve
 
-__all__ = ["PhasedResult", "collocate_phases", "phase_torque_of_time", "phased_guess",
-           "replay_phases"]
+__all__ = ["PhasedResult", "collocate_phases", "optimized_guess", "phase_torque_of_time",
+           "phased_guess", "replay_phases"]
 
 #: objectives the phased transcription takes (:data:`walkerlab.optimal.collocation.OBJECTIVES`)
-PHASED_OBJECTIVES = ("effort", "peak_torque")
+PHASED_OBJECTIVES = ("effort", "cost_of_transport", "peak_torque")
 
 @dataclass
 class PhasedResult:
@@ -42,7 +42,9 @@ class PhasedResult:
     build_time_s, wall_time_s, cpu_time_s : float
         Building the programme; IPOPT's wall and CPU (user + sys) time.
     terms : dict
-        ``effort`` [N^2 m^2 s] and ``peak_torque`` [N m] at the optimum.
+        ``effort`` [N^2 m^2 s], ``cost_of_transport`` [-] (the hip's positive work per
+        weight and step length; exact, ``max(p, 0)`` at the points) and ``peak_torque``
+        [N m] at the optimum.
     history : dict of str -> ndarray
         IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
     """
@@ -107,6 +109,56 @@ def phased_guess(walker, x0, period_s: float, solver, intervals: int):
         t[0], t[-1] = a, b
         out.append((ph.name, t - a, np.asarray(sol(t), float)[:x0.size].T))
     return out, seg.phase_log
+
+
+def optimized_guess(d, names: list, intervals: int):
+    """Another optimisation's step (an ``optimize.h5`` of a walker with phases, read by
+    :func:`walkerlab.io.schemas.optimize.load`) as the starting guess: each phase's states
+    and torque on its own mesh, its ``N_p`` rescaled so that they sum to about
+    ``intervals`` (at least 3 a phase; the artifact's mesh density kept, its interval ends
+    interpolated, the points linearly; unchanged when the counts agree).
+
+    Parameters
+    ----------
+    d : walkerlab.io.schemas.optimize.OptimizeData
+    names : list of str
+        The phases the scene's gait goes through (the guess's must be the same).
+    intervals : int
+
+    Returns
+    -------
+    guess : list of (name, t (2 N_p + 1,) [s from the phase's start], x (2 N_p + 1, 2n))
+    torque : list of ndarray (2 N_p + 1,) [N m]
+
+    Raises
+    ------
+    ValueError
+        The artifact has no phases (a one-step optimisation) or other ones (one line
+        naming ``optimize.initial_guess``).
+    """
+    if not d.phase_names or d.phase_start is None:
+        raise ValueError("optimize.initial_guess: the optimize.h5 has no phases (a one-step "
+                         "optimisation): give one of this walker (its phases "
+                         f"{', '.join(names)})")
+    if list(d.phase_names) != list(names):
+        raise ValueError(f"optimize.initial_guess: its phases {list(d.phase_names)} are not "
+                         f"the scene gait's {list(names)}")
+    X = np.stack(list(d.states.values()), axis=1)
+    bounds = list(np.asarray(d.phase_start, int)) + [d.time.size]
+    counts = [(b - a - 1) // 2 for a, b in zip(bounds[:-1], bounds[1:])]
+    guess, torque = [], []
+    for name, a, b, n_old in zip(names, bounds[:-1], bounds[1:], counts):
+        t, u = np.asarray(d.time[a:b], float), np.asarray(d.torque[a:b], float)
+        n_new = max(3, int(round(intervals * n_old / sum(counts))))
+        tn = t
+        if n_new != n_old:
+            ends = np.interp(np.linspace(0.0, n_old, n_new + 1), np.arange(n_old + 1), t[0::2])
+            tn = np.empty(2 * n_new + 1)
+            tn[0::2], tn[1::2] = ends, 0.5 * (ends[:-1] + ends[1:])
+        xn = np.stack([np.interp(tn, t, X[a:b, c]) for c in range(X.shape[1])], axis=1)
+        guess.append((name, tn - tn[0], xn))
+        torque.append(np.interp(tn, t, u))
+    return guess, torque
 
 
 def mesh_density(phase, sol, a: float, b: float, n2: int, samples: int = 401):
@@ -178,7 +230,29 @@ def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
             opti.subject_to(opti.bounded(lo, fns["hip_angle"](X[:, k]), hi))
     if spec.max_torque_n_m is not None:
         opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
+    if spec.friction_coefficient is not None:  # the stance foot's resultant in its cone
+        mu = spec.friction_coefficient
+        for k in range(K):
+            F = mp.grf(X[:, k], U[k])
+            opti.subject_to(F[0] >= 0)
+            opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
     return _simpson(T, tau, U ** 2)
+
+
+def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
+    """The hip's positive work over the step [J]: Simpson's rule per phase on
+    ``max(p, 0)`` at the points (``p = u d(hip angle)/dt``), exactly by slack variables
+    when ``slack`` (:func:`walkerlab.optimal.collocation.positive_power`), else evaluated
+    (for the record)."""
+    import casadi as ca
+
+    from walkerlab.optimal.collocation import positive_power
+
+    work = 0
+    for X, U, T, tau in zip(Xs, Us, Ts, taus):
+        p = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(X.shape[1])])
+        work = work + _simpson(T, tau, positive_power(opti, p) if slack else ca.fmax(p, 0))
+    return work
 
 
 def _check(spec) -> None:
@@ -189,13 +263,17 @@ def _check(spec) -> None:
         raise ValueError(f"optimize.objective: a walker with phases takes "
                          f"{' or '.join(PHASED_OBJECTIVES)} (or their weighted sum) today")
     if spec.push_off_free or spec.push_off_n_s:
-        raise ValueError("optimize.push_off: a walker with phases has no push-off today")
-    if spec.friction_coefficient is not None:
-        raise ValueError("optimize.friction_coefficient: not yet for a walker with phases")
+        raise ValueError("optimize.push_off: a walker with phases has no push-off impulse "
+                         "(the rigid kneed and flat-footed models carry none: "
+                         "walker.actuation.push_off is for straight legs on point feet)")
 
 
-def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
-    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`).
+def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
+                     ) -> PhasedResult:
+    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`), or a stride of
+    steps (legs that differ, :mod:`walkerlab.optimal.stride`: a ``heel_strike`` phase
+    inside the sequence ends a step; every heel strike has the swing foot ahead, each step
+    its own clearance ends, and the targets are the mean step's).
 
     Parameters
     ----------
@@ -205,6 +283,8 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
         Its ``intervals`` are shared among the phases by ``guess``'s meshes.
     guess : list of (name, t, x)
         :func:`phased_guess`: each phase's starting mesh (its length fixes ``N_p``).
+    guess_u : list of ndarray (2 N_p + 1,), optional
+        Each phase's starting hip torque [N m] (default 0; another optimisation's).
 
     Returns
     -------
@@ -218,7 +298,7 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
     """
     import casadi as ca
 
-    from walkerlab.optimal.collocation import peak_torque, target_constraints
+    from walkerlab.optimal.collocation import peak_torque
 
     _check(spec)
     phases = fns["phases"]
@@ -233,29 +313,77 @@ def collocate_phases(fns: dict, spec, guess: list) -> PhasedResult:
     Ts = [opti.variable() for _ in guess]
     effort = 0
     taus = [np.asarray(g[1], float) / float(g[1][-1]) for g in guess]
-    for p, mp in enumerate(phases):
-        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], p == 0,
-                                 p == P - 1, fns)
+    for p, mp in enumerate(phases):  # a step starts at 0 and after each heel strike
+        starts = p == 0 or phases[p - 1].guard_name == "heel_strike"
+        effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], starts,
+                                 p == P - 1 or mp.guard_name == "heel_strike", fns)
         nxt = Xs[p + 1][:, 0] if p + 1 < P else Xs[0][:, 0]
         opti.subject_to(nxt == mp.reset(Xs[p][:, -1]))
         Tg = float(guess[p][1][-1])
         opti.subject_to(opti.bounded(0.05 * Tg, Ts[p], 5.0 * Tg))
         opti.set_initial(Ts[p], Tg)
         opti.set_initial(Xs[p], guess[p][2].T)
-        opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)))
-    opti.subject_to(fns["ahead"](Xs[-1][:, -1]) >= 1e-3)
+        opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)) if guess_u is None
+                         else np.asarray(guess_u[p], float)[None])
     period = sum(Ts[1:], Ts[0])
-    target_constraints(opti, spec, period, phases[-1].step(Xs[-1][:, -1]))
+    distance = _targets(opti, spec, fns, Xs, period)
     U = ca.horzcat(*Us)
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
+    work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
+    terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"] * distance)
     obj = sum(w * terms[k] for k, w in asked.items())
+    if spec.objective == "cost_of_transport":
+        obj = obj + spec.cost_of_transport_effort_weight * effort
     opti.minimize(obj)
-    opti.solver("ipopt", {"print_time": False},
-                {"print_level": 0, "tol": 1e-12, "acceptable_tol": 1e-10, "max_iter": 500,
-                 "sb": "yes"})
+    opti.solver("ipopt", {"print_time": False}, _options(spec, asked))
     build = time.perf_counter() - t_build
     return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build)
+
+
+def _targets(opti, spec, fns, Xs, period):
+    """Every heel strike with the swing foot ahead and the gait targets on the step (a
+    stride: its mean step's period and length); returns the distance walked [m] (a
+    stride's: its steps' sum)."""
+    from walkerlab.optimal.collocation import target_constraints
+
+    phases, P = fns["phases"], len(fns["phases"])
+    strikes = [p for p, mp in enumerate(phases[:-1]) if mp.guard_name == "heel_strike"]
+    for p in [*strikes, P - 1]:  # every heel strike with the swing foot ahead
+        opti.subject_to(fns["ahead"](Xs[p][:, -1]) >= 1e-3)
+    if strikes:  # a stride of steps: its mean step's period and length
+        steps = [phases[p].step(Xs[p][:, -1]) for p in [*strikes, P - 1]]
+        target_constraints(opti, spec, period / len(steps), sum(steps) / len(steps))
+        return sum(steps)
+    length = phases[-1].step(Xs[-1][:, -1])
+    target_constraints(opti, spec, period, length)
+    return length
+
+
+def _options(spec, asked: dict) -> dict:
+    """IPOPT's options (:func:`walkerlab.optimal.collocation.ipopt_options`); with the cost
+    of transport a small initial barrier (``mu_init`` 1e-9 for IPOPT's 0.1).  Its barrier
+    on ``s_k - p_k >= 0`` rewards negative power at every point, so early iterations (the
+    barrier large) push the torque to brake wherever it can, and the objective - zero on
+    every gait whose torque only brakes, a continuum, bar the tiny effort weight - does not
+    pull it back.  Measured on the kneed walker (60 intervals, effort weight 1e-6): at
+    0.9 m/s the default barrier ends (Solve_Succeeded, 223 iterations) at 100 N m peak
+    torques whose power changes sign between the points and a replay that does not close;
+    from a guess 5 % off its passive gait at 68 N m and a replay error 1.7e-2.  With 1e-9:
+    0.0096 N m (the least-effort gait's 0.0097; 113 iterations, replay 1.2e-7) and
+    0.0063 N m (82 iterations, replay 1.6e-7); on its passive slope (effort weight 1e-2)
+    the default barrier ends on the walker's other, unstable passive gait (period 0.4921 s,
+    |multiplier| 2.28), 1e-9 on the stable one (period within 1e-4).  The cost of
+    transport's torques are sharper than the effort's: at 0.9 m/s with the friction cone
+    binding (mu 0.2312) 3.5 N m peaks, the replay closing to 6.2e-6 on 60 intervals (not
+    a gait) and 6.8e-7 on 120, the cost of transport rising 2.69e-4 -> 3.23e-4 with the
+    mesh (the positive work is counted at the points)."""
+    from walkerlab.optimal.collocation import ipopt_options
+
+    opts = ipopt_options(spec)
+    if "cost_of_transport" in asked:
+        opts["mu_init"] = 1e-9
+    return opts
 
 
 def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResult:

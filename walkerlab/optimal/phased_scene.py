@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["optimize_phased_scene"]
+__all__ = ["optimize_phased_scene", "starting_phases"]
 
 
 def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float):
@@ -18,7 +18,9 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     Parameters
     ----------
     scene : Scene
-        With ``optimize`` (its ``initial_guess`` unset: the scene's gait is the guess).
+        With ``optimize``: the guess is one step of the scene's gait, of a continuation
+        artifact's gait (``initial_guess`` with ``at``) or another ``optimize.h5`` of the
+        walker with the same phases (its states and torque).
     data : WalkerData
         The scene's walker.
     spec : walkerlab.optimal.collocation.CollocationSpec
@@ -42,30 +44,25 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     """
     import time
 
-    from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.contact_replay import contact_replay_phased
     from walkerlab.optimal.phased_collocation import (
         collocate_phases,
         phase_torque_of_time,
-        phased_guess,
         replay_phases,
     )
-    from walkerlab.optimal.phases import mode_functions, phase_order
+    from walkerlab.optimal.phases import mode_functions
     from walkerlab.optimal.scene import phase_replays, step_record
 
     o = scene.optimize
-    if o.initial_guess is not None:
-        raise ValueError("optimize.initial_guess: a walker with phases starts from its own "
-                         "gait today")
+    _refuse(scene)
     walker = make_rigid_walker(data)
-    guess, log = phased_guess(walker, x_gait, period_s, Solver.from_settings(scene.solver),
-                              spec.intervals)
+    guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
-    fns = mode_functions(data, walker, phase_order(walker, log))
+    fns = mode_functions(data, walker, order)
     build = time.perf_counter() - t0
-    res = collocate_phases(fns, spec, guess)
+    res = collocate_phases(fns, spec, guess, guess_u)
     err, replayed = replay_phases(data, res)
     mu = _multipliers(replayed, res, scene, err)
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
@@ -86,6 +83,55 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                         build_time_s=build + res.build_time_s,
                         phase_replays=phases, phase_replay_outcome=phase_note,
                         **step_record(scene, walker, res))
+
+
+def _refuse(scene) -> None:
+    """Refuse an actuator the phased transcription does not model (one line)."""
+    act = getattr(scene.walker, "actuation", None)
+    if act is not None and getattr(act, "ankle_push_off", None) is not None:
+        raise ValueError("walker.actuation.ankle_push_off: the phased transcription has a hip "
+                         "torque only (the rigid flat feet take an ankle push-off or hip "
+                         "torques, not together)")
+
+
+def starting_phases(scene, walker, x_gait, period_s: float, intervals: int):
+    """The phased collocation's starting step for ``scene`` (its ``optimize.
+    initial_guess``, else one step of its gait ``x_gait`` (2n,) of period ``period_s``
+    [s]), on about ``intervals`` intervals.
+
+    Returns
+    -------
+    guess : list of (name, t, x)
+        :func:`walkerlab.optimal.phased_collocation.phased_guess` (the scene's or a
+        continuation artifact's gait) or :func:`~walkerlab.optimal.phased_collocation.
+        optimized_guess` (another ``optimize.h5``).
+    torque : list of ndarray or None
+        Each phase's hip torque [N m] (another ``optimize.h5``'s; None: 0).
+    order : list of (phase, guard, direction)
+        The phases the starting gait's step goes through
+        (:func:`walkerlab.optimal.phases.phase_order`).
+
+    Raises
+    ------
+    ValueError
+        An unusable artifact, or one whose phases are not the gait's (one line naming
+        ``optimize.initial_guess``).
+    """
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.guess import read_guess
+    from walkerlab.optimal.phased_collocation import optimized_guess, phased_guess
+    from walkerlab.optimal.phases import phase_order
+
+    kind, got = None, None
+    if scene.optimize.initial_guess is not None:
+        kind, got = read_guess(scene, list(walker.state_names()))
+    x0 = got if kind == "continuation" else x_gait
+    guess, log = phased_guess(walker, x0, period_s, Solver.from_settings(scene.solver),
+                              intervals)
+    order = phase_order(walker, log)
+    if kind != "optimize":
+        return guess, None, order
+    return (*optimized_guess(got, [n for n, _g, _d in order], intervals), order)
 
 
 def _unit(objective: str) -> str:

@@ -38,8 +38,14 @@ crossing, as the rigid model's event needs; a force guard's rate leaves out the 
 own rate), and the guard's sign kept inside the phase (``d * guard_p <= 0`` at its
 interior points: the event has not happened earlier).  Links: ``x_{p+1}(0) =
 reset_p(x_p(T_p))``; periodic: ``x_0(0) = heel_strike(x_last(T_last))``.  Objective:
-``int u^2 dt`` (Simpson on every phase) or the peak torque (epigraph).  The step period is
-``sum T_p``.
+``int u^2 dt`` (Simpson on every phase), the peak torque (epigraph), the cost of transport
+(the hip's positive work by slack variables ``s >= 0, s >= u d(hip)/dt`` at every point of
+every phase, per weight and step length, with a small effort weight; as
+:mod:`walkerlab.optimal.collocation`) or a weighted sum.  Optional friction cone: the
+ground's resultant on the stance foot (``sum m_i (a_i + g)``, the phase's accelerations;
+a kneed walker's stance foot, flat feet's pinned point or whole flat foot) with ``F_n >= 0``
+and ``|F_t| <= mu F_n`` at every point.  No push-off: the rigid kneed and flat-footed
+models carry no push-off impulse.  The step period is ``sum T_p``.
 
 A result is a gait after its replay on the rigid model (its generated code, its own
 guards and resets) with the optimised torque as a function of the time since the heel
@@ -80,6 +86,12 @@ class ModePhase:
     clearance, step : casadi.Function
         ``x ->`` the swing foot's height above the slope [m] and its distance from the
         stance reference point [m] in the phase's kinematics.
+    grf : casadi.Function
+        ``(x, u) -> (F_n, F_t)`` [N]: the ground's resultant force on the stance foot along
+        the slope's normal and tangent (forward, downhill, positive), ``sum_i m_i (a_i + g
+        y)`` over the mass points with the phase's accelerations (torque included): a
+        kneed walker's stance foot; flat feet's pinned point (heel contact, heel off) or,
+        foot flat, the heel's and the toe's together.
     """
 
     name: str
@@ -92,6 +104,7 @@ class ModePhase:
     keep: object = None
     clearance: object = None
     step: object = None
+    grf: object = None
 
 
 def phase_order(walker, phase_log=None) -> list[tuple[str, str, int]]:
@@ -138,7 +151,9 @@ def mode_functions(data, walker, order=None) -> dict:
     """CasADi functions of the step of ``data``'s walker (module docstring) from its
     symbolic equations, in the phase order ``order`` (:func:`phase_order`; default: the
     rigid model ``walker``'s fixed one): ``phases`` (list of :class:`ModePhase`),
-    ``ahead(x)`` (> 0: the swing foot ahead), ``hip_angle(x)`` [rad], ``n``.
+    ``ahead(x)`` (> 0: the swing foot ahead), ``hip_angle(x)`` [rad], ``power(x, u)``
+    (the hip torque's power ``u d(hip angle)/dt`` [W]), ``n``, ``total_mass_kg``,
+    ``gravity`` [m/s^2].
 
     Raises
     ------
@@ -167,17 +182,23 @@ def mode_functions(data, walker, order=None) -> dict:
             ca.Function(f"reset_{len(phases)}", [x], [kind.reset(name, gname, x)]),
             keep=kind.keep(name, x, f, u),
             clearance=ca.Function("clearance", [x], [kind.clearance(name, x)]),
-            step=ca.Function("step", [x], [kind.step(name, x)])))
+            step=ca.Function("step", [x], [kind.step(name, x)]),
+            grf=ca.Function(f"grf_{len(phases)}", [x, u], [kind.grf(name, x, f)])))
+    hip = kind.cas([kind.hip], x)
     return {"phases": phases, "n": n,
             "ahead": ca.Function("ahead", [x], [kind.cas([kind.guards["swing_foot_ahead"]],
                                                          x)]),
-            "hip_angle": ca.Function("hip_angle", [x], [kind.cas([kind.hip], x)])}
+            "hip_angle": ca.Function("hip_angle", [x], [hip]),
+            "power": ca.Function("power", [x, u], [u * (ca.jacobian(hip, x[:n]) @ x[n:])]),
+            "total_mass_kg": float(data.total_mass_kg),
+            "gravity": float(data.gravity_m_per_s2)}
 
 
 class _Modes:
     """The symbolic pieces of a walker's phases, in CasADi (subclasses name them)."""
 
     def __init__(self, data, eq, q, dq, params, leg_angles):
+        self.data = data
         self.vals = dict(zip(params, data.params))
         self.xs = list(q) + list(dq)
         self.q, self.n = list(q), len(q)
@@ -224,6 +245,16 @@ class _Modes:
     def keep(self, name, x, f, u):
         return None
 
+    def resultant(self, points, x, f):
+        """The ground's resultant on the walker (normal, tangential) [N] from its mass
+        points (``points``: sympy positions by name) and the accelerations ``f[n:]``."""
+        from types import SimpleNamespace
+
+        from walkerlab.optimal.collocation import _ground_reaction
+
+        return _ground_reaction(self.data, SimpleNamespace(q=self.q, points=points),
+                                self.xs, self.vals, x, f[self.n:])
+
 
 class _KneedModes(_Modes):
     """A kneed walker (or straight legs): ``unlocked_swing`` / ``early_swing`` /
@@ -267,6 +298,9 @@ class _KneedModes(_Modes):
 
     def clearance(self, name, x):
         return self.cas([self.eq.guards["swing_clearance"]], x)
+
+    def grf(self, name, x, f):
+        return self.resultant(self.eq.points, x, f)
 
     def step(self, name, x):
         import casadi as ca
@@ -340,6 +374,9 @@ class _FlatModes(_Modes):
 
     def clearance(self, name, x):
         return self.cas([self.eq.guards[f"swing_heel_height_{self._mode(name)[1]}"]], x)
+
+    def grf(self, name, x, f):
+        return self.resultant(self.eq.kinematics[self._mode(name)[1]]["points"], x, f)
 
     def step(self, name, x):
         import casadi as ca

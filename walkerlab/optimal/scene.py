@@ -55,7 +55,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     scene : Scene
         With ``optimize``; straight legs, point feet, massive legs or massless ones with a
         hip mass; or a kneed or flat-footed walker (a step of phases:
-        :func:`walkerlab.optimal.phased_scene.optimize_phased_scene`).
+        :func:`walkerlab.optimal.phased_scene.optimize_phased_scene`); or legs that differ
+        (a stride: :func:`walkerlab.optimal.stride_scene.optimize_stride_scene`).
     x_gait : ndarray (2n,)
         The scene's gait just after heel strike (``fixedpoint.h5``): the initial guess is
         one step of it (unless ``optimize.initial_guess`` names an artifact).
@@ -90,6 +91,10 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     data = walker_data(scene.walker, scene.slope.phi_rad)
     spec = collocation_spec(scene)
     walker = build_walker(scene)
+    if data.mirror is not None:  # legs that differ: a stride of two different steps
+        from walkerlab.optimal.stride_scene import optimize_stride_scene
+
+        return optimize_stride_scene(scene, data, spec, x_gait, period_s)
     if data.structure.knee or data.structure.foot == "flat":  # a step of phases: its own
         from walkerlab.optimal.phased_scene import optimize_phased_scene
 

@@ -69,7 +69,16 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
         ax3.set_title("the step, stop action (early: dark, late: yellow)", fontsize=9)
     if rows == 2:
         _energy_and_convergence(d, grid[1])
-    fig.suptitle(f"{title}: optimised step (direct collocation)"
+    steps = int(getattr(d, "steps", 1))
+    if steps > 1:  # a stride of legs that differ: its inner heel strikes marked
+        per = len(d.phase_names) // steps
+        for k in range(1, steps):
+            for a in (*axes[:2], *(grid[1][:1] if rows == 2 else ())):
+                a.axvline(d.time[d.phase_start[k * per]], color="0.3", ls=":", lw=1)
+        ax2.set_title(f"stride of {steps} steps (dotted: heel strike)\nmean step "
+                      f"{d.step_period_s:.4g} s, {d.step_length_m:.4g} m, {speed:.3g} m/s; "
+                      f"replay error {d.replay_error:.1g}", fontsize=9)
+    fig.suptitle(f"{title}: optimised {'stride' if steps > 1 else 'step'} (direct collocation)"
                  + ("" if d.gait else " — NOT a gait: the replay does not close"), fontsize=10)
     fig.tight_layout()
     return save(fig, Path(folder), "optimize")
@@ -89,7 +98,8 @@ def _energy_and_convergence(d, axes) -> None:
         ax.set_ylabel(f"energy change since heel strike [{d.energy_unit}]")
         inner = " and the collisions inside it" if len(d.phase_names) > 1 else ""
         ax.set_title(f"total changes by {(ke + pe)[-1] - (ke + pe)[0]:.3g} {d.energy_unit} "
-                     f"over the step (the actuators' net work{inner})", fontsize=9)
+                     f"over the {'stride' if getattr(d, 'steps', 1) > 1 else 'step'} "
+                     f"(the actuators' net work{inner})", fontsize=9)
         ax.legend(fontsize=8, loc="best")
     ax = axes[1]
     h = d.ipopt_history

@@ -39,7 +39,8 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
              "open squares: mesh values whose refinement did not converge."),
     ("optimize", "Optimised step (direct collocation, `walkerlab optimize`): the torques "
                  "at the collocation points (left) and the link angles over the step "
-                 "(middle; a five-link biped: the step as stop action, right)."),
+                 "(middle; a five-link biped: the step as stop action, right; legs that "
+                 "differ: the stride, its inner heel strike dotted)."),
 ]
 
 
@@ -115,12 +116,22 @@ def optimize_lines(d) -> list[str]:
 
 
 def _phases_line(d) -> str:
-    """The step's phases and their durations (a step of phases, e.g. a kneed walker's)."""
+    """The step's phases and their durations (a step of phases, e.g. a kneed walker's; a
+    stride of legs that differ: each step's period too)."""
     if not getattr(d, "phase_names", ()):
         return ""
     parts = ", ".join(f"{n} {num(float(t), 6)} s" for n, t in zip(d.phase_names,
                                                                    d.phase_duration_s))
-    return f" Phases (each with its own mesh and free duration): {parts}."
+    steps = int(getattr(d, "steps", 1))
+    stride = ""
+    if steps > 1:  # legs that differ: the steps' own periods, the mean above
+        per = len(d.phase_names) // steps
+        each = ", ".join(num(float(sum(d.phase_duration_s[k * per:(k + 1) * per])), 9)
+                         for k in range(steps))
+        stride = (f" A stride of {steps} different steps (legs that differ; step period "
+                  f"and length above: the mean step's; return error and multipliers: the "
+                  f"stride map's): step periods {each} s.")
+    return f" Phases (each with its own mesh and free duration): {parts}.{stride}"
 
 
 def phase_replay_text(d) -> str:

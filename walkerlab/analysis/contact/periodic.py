@@ -393,9 +393,9 @@ def _periodic_gait_result(walker: ContactWalker, P: StepMap, PC: StepMap, coarse
     zs = sol.x * scale
     z1, T, ell = P(zs)
     res_si = z1 - zs
+    margin = P.patch_margin(zs)  # from the step just taken (the map keeps its last one)
     PJ, J, ev, spread = _floquet_multipliers(walker, P, zs, solver, jacobian_solver,
                                              patch_spacing, deadline, fd_step, check_fd)
-    margin = P.patch_margin(zs)
     info = {"warmup_history": hist, "root_message": sol.message, "root_nfev": root_nfev,
             "fd_step": fd_step, "scales": scale, "method": method, "rtol": solver.rtol,
             "atol": solver.atol, "coarse_rtol": coarse_solver.rtol if coarse else None,

@@ -150,6 +150,7 @@ class StepMap:
         self.solver = solver  # the step map's integrator
         self.deadline = np.inf if deadline is None else deadline
         self.nfev = 0
+        self._last_section = (None, None)  # next_section's last (arguments, answer)
         w = self.walker
         kern = w.kernels
         args = (w.contact_params, w.walker_params, *w.kernel_lanes)
@@ -254,7 +255,22 @@ class StepMap:
         bracketed on the samples and located by ``scipy.optimize.brentq`` on short
         integrations from the sample before it, so the section state carries the
         integrator's accuracy, not an interpolant's.
+
+        The last call's answer is kept: the same arguments again (the root finder's
+        forward-difference Jacobian evaluates the map where it has just evaluated it, the
+        fixed point's last step and its patch margin start from the same state) return it
+        without integrating, a copy of what the integration (deterministic) gives.
         """
+        x0 = np.asarray(x0, float)
+        key = (x0.tobytes(), stance_to_come, dt, chunk_s, passive)
+        if self._last_section[0] != key:
+            self._last_section = (key, self._section(x0, stance_to_come, dt, chunk_s,
+                                                     passive))
+        te, xe = self._last_section[1]
+        return te, xe.copy()
+
+    def _section(self, x0, stance_to_come: int, dt: float, chunk_s: float, passive: bool):
+        """:meth:`next_section` without its memory of the last call."""
         ist, isw = self._angle[stance_to_come], self._angle[1 - stance_to_come]
         hth = 0.5 * self.walker.L
         if self.powered and not passive:
@@ -295,14 +311,19 @@ class StepMap:
             if up.size:
                 k = int(up[0])
                 xk = X[k - 1]
+                ends = {}  # brentq's evaluations, t -> state (the root is one of them)
 
-                def gap(t, k=k, xk=xk, tg=tg, g=g):
+                def gap(t, k=k, xk=xk, tg=tg, g=g, ends=ends):
                     if t <= tg[k - 1]:
                         return g[k - 1]
-                    return gfun(run(xk, np.array([tg[k - 1], t]))[-1:])[0]
+                    ends[t] = run(xk, np.array([tg[k - 1], t]))[-1:]
+                    return gfun(ends[t])[0]
 
                 te = brentq(gap, tg[k - 1], tg[k], xtol=1e-13, rtol=1e-14)
-                xe = run(xk, np.array([tg[k - 1], te]))[-1] if te > tg[k - 1] else xk
+                if te <= tg[k - 1]:
+                    return float(te), xk
+                # brentq answers a point it evaluated: that short run's end, not a new run
+                xe = ends[te][-1] if te in ends else run(xk, np.array([tg[k - 1], te]))[-1]
                 return float(te), xe
             ta, xa = tg[-1], X[-1]
         raise PeriodicGaitError(kind, f"step map: no {what} within {self.t_max:g} s")

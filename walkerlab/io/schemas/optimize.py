@@ -52,8 +52,12 @@ points)::
                                   u*(t)| along it), ``multipliers/{real,imag}``; attribute
                                   ``closed``
 
-attributes: ``gait`` (the replay closed), ``state_names``; ``phase_replay_outcome`` (when
-the phase-variable replay was asked for and refused: why, one line).
+attributes: ``gait`` (the replay closed), ``state_names``; ``steps`` (a stride of
+legs that differ: 2; absent for one step): ``time`` then covers the stride, its phases
+are the steps' (as many per step), ``step_period`` and ``step_length`` are the mean
+step's, and the replay's return error and multipliers are the stride map's;
+``phase_replay_outcome`` (when the phase-variable replay was asked for and refused: why,
+one line).
 """
 
 from __future__ import annotations
@@ -123,6 +127,7 @@ class OptimizeData:
     phase_duration_s: np.ndarray | None = None
     build_time_s: float = float("nan")
     phase_replays: dict = field(default_factory=dict)  # law name -> PhaseReplayData
+    steps: int = 1  # steps in the optimised period: 2 for a stride of legs that differ
     phase_replay_outcome: str = ""  # why there are no phase replays ("": there are, or off)
 
 
@@ -203,6 +208,8 @@ def write(f, d: OptimizeData) -> None:
     f.attrs["ipopt_wall_time_s"] = float(d.wall_time_s)
     f.attrs["ipopt_cpu_time_s"] = float(d.cpu_time_s)
     f.attrs["ipopt_build_time_s"] = float(d.build_time_s)
+    if d.steps > 1:
+        f.attrs["steps"] = int(d.steps)
     if d.phase_names:
         f.attrs["phase_names"] = list(d.phase_names)
         put(f, "phases/start_index", np.asarray(d.phase_start, np.int64), "-", "index in "
@@ -283,7 +290,7 @@ def load(path: Path) -> OptimizeData:
             f["phases/duration"][()] if "phases" in f else None,
             float(f.attrs.get("ipopt_build_time_s", float("nan"))),
             {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f},
-            str(f.attrs.get("phase_replay_outcome", "")))
+            int(f.attrs.get("steps", 1)), str(f.attrs.get("phase_replay_outcome", "")))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)

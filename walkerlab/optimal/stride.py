@@ -1,0 +1,172 @@
+"""A periodic gait of a walker whose legs differ, by multi-phase direct collocation of one
+**stride**: leg A's step (``leg1`` swinging, ``leg2`` in stance), its heel strike, leg B's
+step (the rigid model's ``mirror`` walker: ``leg2`` swinging), its heel strike back to the
+start.
+
+One step would close on itself only for mirror-image legs: with legs that differ it closes
+with the wrong leg in stance every other step (a false gait); the Poincaré map of such a
+walker is a stride (:func:`walkerlab.analysis.gait.poincare.poincare_map`, Goswami, Thuilot
+& Espiau 1998; Moon & Spong 2010), and so is the periodic boundary condition here.
+
+The stride is a fixed sequence of four phases of :mod:`walkerlab.optimal.phases`: each
+step's ``early_swing`` (until ``midstance``, the legs passing: the point foot scuffs through
+the ground there, which the rigid model ignores, paper Sec. 3.2) and ``late_swing`` (until
+``heel_strike``: the swing foot above the slope inside it, the guard zero with a minimum
+crossing rate at its end), each phase with its own free duration and Hermite-Simpson mesh
+(:func:`walkerlab.optimal.phased_collocation.collocate_phases`); leg A's phases from the
+symbolic equations with ``data``'s numbers, leg B's with ``data.mirror``'s (the same
+equations, the other leg's numbers), leg A's heel strike (its reset: the impact with A's
+numbers, roles swapped) links them, leg B's closes the stride.  Targets (speed, step
+length, step period) are the stride's mean step's.
+
+A result is a gait after its replay on the rigid model (:func:`replay_stride`): the
+actuated walker and its mirror, each step's torque the optimised one as a function of the
+time since that step's heel strike, one stride from the optimised start; its return error
+and the stride map's Floquet multipliers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+__all__ = ["STEP_PHASES", "replay_stride", "step_of", "stride_functions", "stride_guess",
+           "stride_walker"]
+
+#: the rigid model's phases of a straight-legged step (:func:`walkerlab.optimal.phases.
+#: phase_order` of it), each step of the stride named by its swinging leg
+STEP_PHASES = (("early_swing", "midstance", 1), ("late_swing", "heel_strike", -1))
+#: the stride's steps: the leg that swings in each (the rigid model's ``legs`` order)
+SWINGING = ("leg1", "leg2")
+
+
+def _named(leg: str, name: str) -> str:
+    """A stride phase's name: ``<swinging leg>:<rigid phase>``."""
+    return f"{leg}_swing:{name}"
+
+
+def stride_functions(data) -> dict:
+    """CasADi functions of the stride of ``data``'s walker (legs that differ: ``data.mirror``
+    not None): as :func:`walkerlab.optimal.phases.mode_functions`, its ``phases`` the four
+    of the stride (module docstring), named ``leg1_swing:early_swing`` ...
+
+    Raises
+    ------
+    ValueError
+        Mirror-image legs (one step is the map), knees, flat or arc feet, a torso, massless
+        legs (one line).
+    """
+    from walkerlab.optimal.phases import mode_functions
+
+    st = data.structure
+    if data.mirror is None:
+        raise ValueError("optimize: a stride is for legs that differ (mirror-image legs take "
+                         "one step)")
+    if st.knee or st.foot != "point" or st.torso or any(b.massless for b in st.bodies):
+        raise ValueError("optimize: a stride of legs that differ takes straight massive legs "
+                         "with point feet today (knees, flat or arc feet, a torso: not yet)")
+    fns, phases = None, []
+    for leg, d in zip(SWINGING, (replace(data, mirror_params=None), data.mirror)):
+        f = mode_functions(d, None, list(STEP_PHASES))
+        phases += [replace(p, name=_named(leg, p.name)) for p in f["phases"]]
+        fns = fns or f
+    return {**fns, "phases": phases}
+
+
+def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
+    """One stride of the rigid ``walker`` (legs that differ: ``walker.mirror``) from the
+    post-impact state ``x0`` (2n,), each step sampled on ``intervals`` intervals shared
+    among its phases (:func:`walkerlab.optimal.phased_collocation.phased_guess`).
+
+    Parameters
+    ----------
+    period_s : float
+        The gait's (mean) step period [s]: a step longer than three is no step.
+
+    Returns
+    -------
+    list of (name, t (2 N_p + 1,) [s from the phase's start], x (2 N_p + 1, 2n))
+        The four phases of :func:`stride_functions` in order.
+
+    Raises
+    ------
+    ValueError
+        A step does not end in a heel strike or crosses other phases (one line).
+    """
+    from walkerlab.optimal.phased_collocation import phased_guess
+
+    out, x = [], np.asarray(x0, float)
+    for leg, w in zip(SWINGING, (walker, walker.mirror)):
+        guess, log = phased_guess(w, x, period_s, solver, intervals)
+        if tuple(g[0] for g in guess) != tuple(p for p, _g, _d in STEP_PHASES):
+            raise ValueError(f"optimize: the starting gait's {leg} step crosses "
+                             f"{[g[0] for g in guess]}, not early and late swing")
+        out += [(_named(leg, name), t, xs) for name, t, xs in guess]
+        x = np.asarray(w.reset(guess[-1][2][-1]), float)
+    return out
+
+
+def step_of(res, k: int):
+    """Step ``k`` (0: leg A's, 1: leg B's) of an optimised stride
+    (:class:`walkerlab.optimal.phased_collocation.PhasedResult`) as a result of its own:
+    its points, phases and durations, its times from its heel strike [s]."""
+    P = len(STEP_PHASES)
+    bounds = list(res.phase_start) + [res.t.size]
+    a, b = bounds[k * P], bounds[(k + 1) * P]
+    t0 = float(res.t[a])
+    return replace(res, t=res.t[a:b] - t0, x=res.x[a:b], u=res.u[a:b],
+                   phase_names=res.phase_names[k * P:(k + 1) * P],
+                   phase_start=np.asarray(res.phase_start[k * P:(k + 1) * P]) - a,
+                   phase_duration_s=res.phase_duration_s[k * P:(k + 1) * P],
+                   step_period_s=float(np.sum(res.phase_duration_s[k * P:(k + 1) * P])))
+
+
+def stride_walker(data, res):
+    """The rigid walker of ``data`` and its mirror with a hip actuator each, whose torque is
+    the optimised one of its own step (:func:`walkerlab.optimal.phased_collocation.
+    phase_torque_of_time` of :func:`step_of`) from that step's heel strike."""
+    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+    from walkerlab.models.hybrid.actuated import actuate
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.phased_collocation import phase_torque_of_time
+
+    spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
+    walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
+    for k, w in enumerate((walker, walker.mirror)):
+        tau, acts = phase_torque_of_time(step_of(res, k)), w.actuators
+        acts.torques = (lambda tau_k, a: lambda t, x: np.array(
+            [tau_k(float(np.real(t)) - a.t_origin)]))(tau, acts)
+    return walker
+
+
+def replay_stride(data, res, solver=None):
+    """The optimised stride replayed on the rigid model (its generated code, its own phases,
+    guards and resets; not the CasADi expressions): :func:`stride_walker`, one stride
+    (:func:`walkerlab.analysis.gait.poincare.poincare_map`) from ``x_0`` (DOP853 at rtol =
+    atol = 1e-12 unless ``solver`` is given).
+
+    Returns
+    -------
+    error : float
+        Max-norm return error ``|x_0' - x_0|`` [rad, rad/s] (inf when a step does not end
+        in a heel strike or crosses other phases than the optimised ones).
+    walker : HybridWalker
+        The replayed walker (with its mirror).
+    """
+    from walkerlab.analysis.gait.poincare import StepFailed, poincare_map
+    from walkerlab.integrate.solver import Solver
+
+    walker = stride_walker(data, res)
+    solver = solver or Solver(method="DOP853", rtol=1e-12, atol=1e-12)
+    x0, segs = np.asarray(res.x[0], float), []
+    try:
+        x1 = poincare_map(walker, x0, solver, max_step_time=3.0 * res.step_period_s,
+                          steps=segs)[0]
+    except StepFailed:
+        return float("inf"), walker
+    crossed = tuple(_named(leg, ph.name) for leg, s in zip(SWINGING, segs)
+                    for ph, _s, _ab in s.pieces)
+    if crossed != tuple(res.phase_names):
+        return float("inf"), walker
+    return float(np.max(np.abs(x1 - x0))), walker
