@@ -74,6 +74,19 @@ def test_the_gains_give_the_hip_its_bandwidth(compass):
     assert D * b == pytest.approx(2 * w, rel=1e-12)
 
 
+def test_flat_feet_get_their_gains_from_the_flow():
+    """Flat feet have a mass matrix per contact mode (no generated ``matrices``): the hip's
+    mobility comes from the first phase's flow under a unit torque and under none, and
+    gives gains of the compass walker's size (same legs and hip: ~187 N m/rad there)."""
+    scene = load_scene(CONFIGS / "flat_feet_optimal.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    w = hip_walker(data, None)
+    assert "matrices" not in w.actuators.fns
+    K, D = hip_gains(data, w.actuators, np.array([-0.347, 0.256, 0.0, -1.34, -1.19, -11.3]),
+                     w)
+    assert 100.0 < K < 300.0 and D == pytest.approx(2 * K / (4 * np.sqrt(9.81)), rel=1e-12)
+
+
 def test_a_phase_variable_that_turns_back_is_refused_in_one_line(compass):
     """The references need a monotonic phase variable: a step whose stance angle turns
     back gets one line; a step of phases names the phase that turns back."""

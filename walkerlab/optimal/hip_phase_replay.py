@@ -94,13 +94,24 @@ def hip_walker(data, law, push_off_n_s: float = 0.0):
     return replace(walker, phases=tuple(replace(ph, compiled=None) for ph in walker.phases))
 
 
-def hip_gains(data, acts, x0) -> tuple[float, float]:
+def hip_gains(data, acts, x0, walker=None) -> tuple[float, float]:
     """``(K, D)`` of the module docstring at the state ``x0`` (2n,) [N m/rad, N m s/rad;
-    per foot mass on massless legs]."""
-    n = acts.n
-    M = np.asarray(acts.fns["matrices"](np.asarray(x0, float))[0], float)
-    col = np.eye(n)[0] if acts.limit else acts.ddelta_dq
-    b = float(acts.ddelta_dq @ np.linalg.solve(M, col))
+    per foot mass on massless legs]: the mobility ``b`` from the generated mass matrix, or
+    (flat feet: a mass matrix per contact mode) from ``walker``'s first phase's flow under
+    a unit torque and under none (``walker``: :func:`hip_walker`'s)."""
+    x0 = np.asarray(x0, float)
+    if "matrices" in acts.fns:
+        M = np.asarray(acts.fns["matrices"](x0)[0], float)
+        col = np.eye(acts.n)[0] if acts.limit else acts.ddelta_dq
+        b = float(acts.ddelta_dq @ np.linalg.solve(M, col))
+    else:
+        flow, saved = walker.phases[0].flow, walker.actuators.laws
+        acc = []
+        for v in (1.0, 0.0):
+            walker.actuators.laws = lambda *_a, v=v: np.array([v])
+            acc.append(np.asarray(flow(0.0, x0), float)[acts.n:])
+        walker.actuators.laws = saved
+        b = float(acts.ddelta_dq @ (acc[0] - acc[1]))
     w = BANDWIDTH * np.sqrt(data.gravity_m_per_s2 / data.leg_length_m)
     return w * w / b, 2.0 * w / b
 
@@ -180,8 +191,9 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
     names = tuple(getattr(res, "phase_names", ()) or ())
     start = getattr(res, "phase_start", None)
     push = float(getattr(res, "push_off_n_s", 0.0))
-    probe = hip_walker(data, None, push).actuators
-    gains = {"feedback": hip_gains(data, probe, res.x[0]), "feedforward": (0.0, 0.0)}
+    walker = hip_walker(data, None, push)
+    probe = walker.actuators
+    gains = {"feedback": hip_gains(data, probe, res.x[0], walker), "feedforward": (0.0, 0.0)}
     out = {}
     for name, g in gains.items():
         law = hip_phase_law(probe, res.t, res.x, res.u, g, start, names)
