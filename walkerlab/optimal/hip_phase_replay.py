@@ -31,11 +31,14 @@ import numpy as np
 
 from walkerlab.optimal.phase_replay import PhaseLaw, law_of_rows, replay_law
 
-__all__ = ["BANDWIDTH", "PiecewisePhaseLaw", "hip_gains", "hip_phase_law",
+__all__ = ["BANDWIDTH", "CLOSED", "PiecewisePhaseLaw", "hip_gains", "hip_phase_law",
            "hip_phase_records", "hip_phase_replays", "hip_walker"]
 
 #: the PD law's closed-loop frequency in units of the leg's pendulum frequency sqrt(g / l)
 BANDWIDTH = 4.0
+#: largest return error of a closed start [rad, rad/s]: above the step map's round-off
+#: (flat feet's four phases, the ankle's fast start: the root finder's best 2.3e-10)
+CLOSED = 1e-9
 
 
 class PiecewisePhaseLaw:
@@ -198,7 +201,7 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
     for name, g in gains.items():
         law = hip_phase_law(probe, res.t, res.x, res.u, g, start, names)
         out[name] = replay_law(hip_walker(data, law, push), solver, res.t, res.x, tau,
-                               close=name == "feedback", phases=names or None)
+                               close=name == "feedback", tol=CLOSED, phases=names or None)
     return out
 
 
