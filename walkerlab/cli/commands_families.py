@@ -235,7 +235,9 @@ def optimize(scene: Path | None = SceneArg,
         typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}; "
                    f"replay return error {d.replay_error:.2g}; max |Floquet multiplier| "
                    f"{mu:.4g}")
-        for law, r in d.phase_replays.items():  # a five-link biped's phase-variable laws
+        if d.phase_replay_outcome:  # asked for, and refused (a non-monotonic phase variable)
+            typer.echo(f"  phase-variable replay: {d.phase_replay_outcome}")
+        for law, r in d.phase_replays.items():  # the phase-variable laws (when asked for)
             typer.echo(f"  phase-variable {law} law: from the collocated start "
                        f"{r.collocated_start_error:.2g}; "
                        + (f"closed (start moved {r.start_shift:.2g}): return error "

@@ -87,6 +87,12 @@ class OptimizeSettings(Strict):
                                                 "(default: the scene's gait)")
     replay_tolerance: float = Field(1e-6, gt=0, le=1.0, description="largest return error "
                                     "of the replay for a gait [rad, rad/s]")
+    phase_replay: bool | None = Field(
+        None, description="also replay the step with the torques as a function of the "
+        "phase variable (the stance leg's angle): feed-forward + PD closed to its fixed "
+        "point, and the feed-forward alone (optimize.h5's replay/phase_*); default: on for "
+        "a five-link biped, off for the others (their replays run the law in Python, "
+        "~2-3 s of CPU per step map and ~20 maps)")
 
     @model_validator(mode="after")
     def _targets(self) -> OptimizeSettings:

@@ -35,11 +35,15 @@ model's :class:`~walkerlab.models.contact.joint_torques.JointTorqueActuators` ca
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from walkerlab.numerics import sort_multipliers
+from walkerlab.optimal.phase_replay import (
+    PhaseLaw,
+    PhaseReplay,
+    control_of_time,
+    law_of_rows,
+    replay_law,
+)
 
 __all__ = ["RABBIT_GAINS", "PhaseLaw", "PhaseReplay", "control_of_time", "phase_law",
            "phase_replays", "phased_walker", "replay_phase_law", "replay_solver",
@@ -48,99 +52,6 @@ __all__ = ["RABBIT_GAINS", "PhaseLaw", "PhaseReplay", "control_of_time", "phase_
 #: PD gains ``(K [N m/rad], D [N m s/rad])`` per joint (:data:`walkerlab.optimal.five_link.
 #: JOINTS` order), RABBIT's virtual-constraint controller of configs/rabbit.yaml
 RABBIT_GAINS = ((2000.0, 2000.0, 2000.0, 2000.0), (120.0, 120.0, 60.0, 60.0))
-
-
-def _at(f, df, u):
-    """``f(u)`` of a real spline, complex-safe to first order."""
-    r = np.real(u)
-    out = f(r)
-    if np.iscomplexobj(u):
-        out = out + 1j * np.imag(u) * df(r)
-    return out
-
-
-class PhaseLaw:
-    """The law of the module docstring (the interface of
-    :meth:`walkerlab.models.actuation.TorqueLaws.each`).
-
-    Parameters
-    ----------
-    s : ndarray (m,)
-        Phase variable at the collocation points, strictly monotonic [rad].
-    delta, ddelta_ds : ndarray (m, k)
-        Each actuator's joint angle there [rad] and its slope in ``s`` [rad/rad].
-    u : ndarray (m, k)
-        The optimised torques there [N m].
-    stiffness, damping : sequence of float (k,)
-        ``K`` [N m/rad] and ``D`` [N m s/rad] per actuator.
-    t, ds : ndarray (m,), optional
-        The collocation times [s] and the phase variable's rate there [rad/s]: the
-        feed-forward is then the transcription's control at ``T(s)`` (module docstring);
-        without them the not-a-knot cubic spline of ``u`` over ``s``.
-    """
-
-    def __init__(self, s, delta, ddelta_ds, u, stiffness, damping, t=None, ds=None):
-        from scipy.interpolate import CubicHermiteSpline, CubicSpline
-
-        s = np.asarray(s, float)
-        order = np.argsort(s)
-        so = s[order]
-        self.h = CubicHermiteSpline(so, np.asarray(delta, float)[order],
-                                    np.asarray(ddelta_ds, float)[order], extrapolate=True)
-        self.dh, self.d2h = self.h.derivative(), self.h.derivative(2)
-        if t is None:
-            spline = CubicSpline(so, np.asarray(u, float)[order], bc_type="not-a-knot",
-                                 extrapolate=True)
-            self.ff, self.dff = spline, spline.derivative()
-        else:
-            T = CubicHermiteSpline(so, np.asarray(t, float)[order],
-                                   1.0 / np.asarray(ds, float)[order], extrapolate=True)
-            U = control_of_time(t, u)
-            dT, dU = T.derivative(), U.derivative()
-            self.ff = lambda r: U(T(r))
-            self.dff = lambda r: dU(T(r)) * np.expand_dims(dT(r), -1)
-        self.K = np.asarray(stiffness, float)
-        self.D = np.asarray(damping, float)
-        self.torques = [None] * len(self.K)  # as TorqueLaws (its length: the actuators)
-        # h, h' and T (or the spline of u) share their knots: one PPoly evaluates them all
-        # at a real s (the padded zero coefficient adds an exact 0: the same numbers)
-        self._outer = None if t is None else U
-        self._stack = _stacked((self.h, self.dh, spline if t is None else T))
-
-    def __bool__(self) -> bool:
-        return True
-
-    def each(self, deltas, ddeltas, s, ds, t_step=0.0) -> np.ndarray:
-        """Torque of each actuator (k,) [N m] at the joint angles ``deltas`` (k,) [rad],
-        their rates ``ddeltas`` (k,) [rad/s], the phase variable ``s`` [rad] and its rate
-        ``ds`` [rad/s] (``t_step`` unused: the law reads no time)."""
-        if np.iscomplexobj(s):  # first order in the imaginary part (the complex step)
-            h = _at(self.h, self.dh, s)
-            dh = _at(self.dh, self.d2h, s)
-            ff = _at(self.ff, self.dff, s)
-        else:
-            k = len(self.K)
-            v = self._stack(s)
-            h, dh = v[..., :k], v[..., k:2 * k]
-            ff = v[..., 2 * k:] if self._outer is None else self._outer(v[..., 2 * k])
-        err = np.asarray(deltas) - h
-        derr = np.asarray(ddeltas) - dh * ds
-        return ff - self.K * err - self.D * derr
-
-
-def _stacked(polys):
-    """One :class:`scipy.interpolate.PPoly` of the columns of ``polys`` (PPolys on the same
-    breakpoints, degree <= 3, each of shape (k_i,) or scalar), lower degrees padded with
-    leading zero coefficients."""
-    from scipy.interpolate import PPoly
-
-    order = max(p.c.shape[0] for p in polys)
-    cs = []
-    for p in polys:
-        c = p.c.reshape(p.c.shape[0], p.c.shape[1], -1)
-        pad = np.zeros((order - c.shape[0],) + c.shape[1:])
-        cs.append(np.concatenate([pad, c]))
-    return PPoly(np.concatenate(cs, axis=2), polys[0].x, extrapolate=True)
 
 
 def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
@@ -171,40 +82,7 @@ def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
         The phase variable is not strictly monotonic over the step (one line).
     """
     rows = [acts.joint_angles(xi) for xi in np.asarray(x, float)]
-    s = np.array([float(r[2]) for r in rows])
-    ds = np.array([float(r[3]) for r in rows])
-    if not (np.all(ds < 0.0) or np.all(ds > 0.0)) or np.any(np.diff(s) == 0.0):
-        raise ValueError("optimize: the stance leg's angle (the phase variable) is not "
-                         f"monotonic over the optimised step (its rate spans "
-                         f"[{ds.min():.3g}, {ds.max():.3g}] rad/s): no phase-variable replay")
-    delta = np.array([[float(v) for v in r[0]] for r in rows])
-    ddelta = np.array([[float(v) for v in r[1]] for r in rows])
-    return PhaseLaw(s, delta, ddelta / ds[:, None], u, stiffness, damping, t=t, ds=ds)
-
-
-def control_of_time(t, u):
-    """The Hermite-Simpson control as a :class:`scipy.interpolate.PPoly` of the time since
-    the heel strike [s] -> (k,) [N m]: each interval's quadratic through its three points
-    (:func:`walkerlab.optimal.five_link_collocation.torques_of_time`'s, with derivatives),
-    the last one extrapolated.
-
-    Parameters
-    ----------
-    t : ndarray (2N + 1,)
-        Collocation times [s].
-    u : ndarray (2N + 1, k)
-        Torques there [N m].
-    """
-    from scipy.interpolate import PPoly
-
-    t, u = np.asarray(t, float), np.asarray(u, float).reshape(len(t), -1)
-    ti, tm, tj = t[0:-1:2], t[1::2], t[2::2]
-    ui, um, uj = u[0:-1:2], u[1::2], u[2::2]
-    # Newton's form about t_i: u_i + a (t - t_i) + b (t - t_i)(t - t_m)
-    a = ((um - ui) / (tm - ti)[:, None])
-    b = ((uj - um) / (tj - tm)[:, None] - a) / (tj - ti)[:, None]
-    c = np.stack([b, a - b * (tm - ti)[:, None], ui])  # (3, N, k): powers of (t - t_i)
-    return PPoly(c, np.append(ti, tj[-1]), extrapolate=True)
+    return law_of_rows(rows, u, stiffness, damping, t=t)
 
 
 def phased_walker(data, law: PhaseLaw):
@@ -235,45 +113,6 @@ def rigid_actuators(data):
 
     spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw()) for j in JOINTS])
     return five_link_actuators(data, spec, tuple(data.structure.roles))
-
-
-@dataclass
-class PhaseReplay:
-    """A phase-variable law's replay of the optimised step on the rigid model.
-
-    Attributes
-    ----------
-    collocated_start_error : float
-        ``max |P(x_col) - x_col|``: one step from the collocated start [rad, rad/s].
-    x0 : ndarray (2n,)
-        The closed (periodic) start, or the collocated one when the law was not closed.
-    start_shift : float
-        ``max |x0 - x_col|`` [rad, rad/s] (0: not closed).
-    return_error : float
-        ``max |P(x0) - x0|`` of the rigid replay from ``x0`` [rad, rad/s] (inf: the step
-        did not end in a heel strike).
-    step_period_s : float
-        The replayed step's period [s].
-    multipliers : ndarray (2n,) complex
-        Eigenvalues of the step map's Jacobian at ``x0`` (forward differences, sorted by
-        modulus; the Floquet multipliers when ``x0`` is closed; one ~0: the heel-strike
-        surface).
-    torque_error : float
-        ``max_t |tau(t) - u*(t)|`` over the replayed step from ``x0`` [N m]: the law's
-        torques against the optimised ones (:func:`walkerlab.optimal.five_link_collocation.
-        torques_of_time`) at the same time since the heel strike.
-    closed : bool
-        ``x0`` is the law's fixed point (``return_error`` below the closure's tolerance).
-    """
-
-    collocated_start_error: float
-    x0: np.ndarray
-    start_shift: float
-    return_error: float
-    step_period_s: float
-    multipliers: np.ndarray
-    torque_error: float
-    closed: bool
 
 
 def replay_solver():
@@ -317,57 +156,10 @@ def replay_phase_law(data, t, x, u, law: PhaseLaw, close: bool = True,
     PhaseReplay
         ``return_error`` inf, NaN multipliers when a step does not end in a heel strike.
     """
-    from scipy.optimize import root
-
-    from walkerlab.integrate.rigid import integrate_step
-    from walkerlab.numerics import fd_jacobian
-
-    walker, solver = phased_walker(data, law), replay_solver()
-    x_col = np.asarray(x, float)[0]
-    horizon = 3.0 * float(t[-1])
-
-    def step(z):
-        seg = integrate_step(walker, np.asarray(z, float), solver, max_step_time=horizon)
-        if seg.termination != "heel_strike":
-            raise ValueError(f"the replayed step ended in {seg.termination}")
-        return seg
-
-    try:
-        p_col = step(x_col).x_next
-        J = fd_jacobian(lambda z: step(z).x_next, x_col, 1e-6, central=False, f0=p_col)
-    except ValueError:
-        return PhaseReplay(float("inf"), x_col, 0.0, float("inf"), float("nan"),
-                           np.full(x_col.size, np.nan + 0j), float("nan"), False)
-    e_col = float(np.max(np.abs(p_col - x_col)))
-    x0 = x_col
-    if close and e_col > tol:
-        eye = np.eye(x_col.size)
-        try:
-            sol = root(lambda z: step(z).x_next - z, x_col, jac=lambda z: J - eye,
-                       method="hybr", options={"xtol": 1e-13})
-            x0 = sol.x
-        except ValueError:  # a fall on the way
-            x0 = x_col
-    seg = step(x0)
-    err = float(np.max(np.abs(seg.x_next - x0)))
-    closed = bool(close and err <= tol)
-    if x0 is not x_col:
-        J = fd_jacobian(lambda z: step(z).x_next, x0, 1e-6, central=False, f0=seg.x_next)
-    return PhaseReplay(e_col, np.asarray(x0, float), float(np.max(np.abs(x0 - x_col))), err,
-                       float(seg.t_end), sort_multipliers(np.linalg.eigvals(J)),
-                       _torque_error(walker, seg, t, u), closed)
-
-
-def _torque_error(walker, seg, t, u) -> float:
-    """``max |tau(t) - u*(t)|`` [N m] over the replayed step ``seg`` (4 samples per
-    collocation point)."""
     from walkerlab.optimal.five_link_collocation import torques_of_time
 
-    tau = torques_of_time(t, u)
-    ts = np.linspace(seg.t_start, seg.t_end, 4 * len(t))
-    xs = seg.sample(ts).T
-    return max(float(np.max(np.abs(walker.actuators.torques(ti, xi) - tau(ti - seg.t_start))))
-               for ti, xi in zip(ts, xs))
+    return replay_law(phased_walker(data, law), replay_solver(), t, x, torques_of_time(t, u),
+                      close=close, tol=tol)
 
 
 def phase_replays(data, t, x, u) -> tuple[dict, dict]:

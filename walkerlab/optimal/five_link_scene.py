@@ -87,17 +87,18 @@ def _phase_replays(scene, data, res) -> tuple[dict, tuple[float, str]]:
     """The phase-variable replays (:func:`walkerlab.optimal.five_link_replay.phase_replays`)
     as ``optimize.h5``'s records, and the contact model's ``(step period [s], outcome)``
     under the feed-forward + PD law from its closed start."""
-    from walkerlab.io.schemas.optimize import PhaseReplayData
     from walkerlab.optimal.contact_replay import contact_replay_five_link
     from walkerlab.optimal.five_link_replay import phase_replays
+    from walkerlab.optimal.phase_replay import records
 
+    if scene.optimize.phase_replay is False:  # None (the default) or True: replayed
+        return {}, (float("nan"), "not replayed: optimize.phase_replay is off (the contact "
+                    "replay runs the feed-forward + PD law)")
     try:
         replays, laws = phase_replays(data, res.t, res.x, res.u)
     except ValueError as exc:  # the phase variable is not monotonic: no such replay
         return {}, (float("nan"), f"not replayed: {exc}")
-    out = {name: PhaseReplayData(r.collocated_start_error, r.start_shift, r.return_error,
-                                 r.step_period_s, r.torque_error, r.multipliers, r.closed)
-           for name, r in replays.items()}
+    out = records(replays)
     fb = replays["feedback"]
     if not fb.closed:
         return out, (float("nan"), "not replayed: the feed-forward + PD law did not close "

@@ -47,9 +47,13 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.contact_replay import contact_replay_phased
-    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+    from walkerlab.optimal.phased_collocation import (
+        collocate_phases,
+        phase_torque_of_time,
+        replay_phases,
+    )
     from walkerlab.optimal.phases import mode_functions
-    from walkerlab.optimal.scene import step_record
+    from walkerlab.optimal.scene import phase_replays, step_record
 
     o = scene.optimize
     _refuse(scene)
@@ -64,6 +68,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
     if np.isfinite(err):
         contact_period, contact_outcome = contact_replay_phased(scene, res, strides=2)
+    phases, phase_note = phase_replays(scene, data, res, phase_torque_of_time(res))
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
@@ -76,6 +81,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                         cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
                         phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
                         build_time_s=build + res.build_time_s,
+                        phase_replays=phases, phase_replay_outcome=phase_note,
                         **step_record(scene, walker, res))
 
 

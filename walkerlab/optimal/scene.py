@@ -9,7 +9,8 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["collocation_spec", "needs_gait", "optimize_scene", "step_record"]
+__all__ = ["collocation_spec", "needs_gait", "optimize_scene", "phase_replays",
+           "step_record"]
 
 
 def collocation_spec(scene):
@@ -76,7 +77,7 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.collocation import collocate_step, replay
+    from walkerlab.optimal.collocation import collocate_step, replay, torque_of_time
     from walkerlab.optimal.contact_replay import contact_replay
     from walkerlab.optimal.guess import starting_step
     from walkerlab.optimal.step_cache import cached_step_functions
@@ -114,6 +115,7 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
     if np.isfinite(err):
         contact_period, contact_outcome = contact_replay(scene, res)
+    phases, phase_note = phase_replays(scene, data, res, torque_of_time(res))
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
@@ -125,7 +127,21 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
                         terms=res.terms, contact_step_period_s=contact_period,
                         contact_outcome=contact_outcome,
                         torque_unit="N m/kg" if _massless(data) else "N m",
+                        phase_replays=phases, phase_replay_outcome=phase_note,
                         **step_record(scene, walker, res))
+
+
+def phase_replays(scene, data, res, tau) -> tuple[dict, str]:
+    """The phase-variable replays of the optimised step ``res`` (``tau``: its torque of
+    the time since the heel strike) as ``optimize.h5``'s records, and why there are none
+    (:func:`walkerlab.optimal.hip_phase_replay.hip_phase_records`, the scene's solver;
+    ``({}, "")`` unless ``optimize.phase_replay`` is on: off by default here)."""
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.hip_phase_replay import hip_phase_records
+
+    if not scene.optimize.phase_replay:  # None: off (a five-link biped's default is on)
+        return {}, ""
+    return hip_phase_records(data, res, tau, Solver.from_settings(scene.solver))
 
 
 def step_record(scene, walker, res) -> dict:

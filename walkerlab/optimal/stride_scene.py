@@ -99,6 +99,8 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                         phase_names=res.phase_names, phase_start=res.phase_start,
                         phase_duration_s=res.phase_duration_s,
                         build_time_s=build + res.build_time_s, steps=2,
+                        phase_replay_outcome="not replayed: a stride of legs that differ is "
+                        "replayed as a function of time only" if o.phase_replay else "",
                         **_record(scene, walker, res))
 
 

@@ -88,6 +88,7 @@ def optimize_lines(d) -> list[str]:
     import numpy as np
 
     mu = float(np.max(np.abs(d.multipliers))) if len(d.multipliers) else float("nan")
+    five_link = bool(d.phase_replays) and d.torque_names != ("hip",)  # contact: its PD law
     peaks = np.abs(np.asarray(d.torque).reshape(len(d.time), -1)).max(axis=0)
     peak = ", ".join(f"{n} {num(float(v))}" for n, v in zip(d.torque_names, peaks))
     closed = ("" if not np.isfinite(d.start_shift) else
@@ -105,7 +106,7 @@ def optimize_lines(d) -> list[str]:
             f"|Floquet multiplier| {num(mu)}: "
             + ("**a gait**." if d.gait else "**not a gait** (the replay does not close).")
             + phase_replay_text(d)
-            + (f" In the contact model{' (the feed-forward + PD law)' if d.phase_replays else ''}"
+            + (f" In the contact model{' (the feed-forward + PD law)' if five_link else ''}"
                f": step period {num(d.contact_step_period_s)} s "
                f"({num(100 * (d.contact_step_period_s / d.step_period_s - 1), 2)} %)"
                + ("." if d.contact_outcome == "heel_strike"
@@ -136,12 +137,16 @@ def _phases_line(d) -> str:
 
 
 def phase_replay_text(d) -> str:
-    """The phase-variable replays of a loaded ``optimize.h5`` (a five-link biped's) in
-    words; "" when it has none."""
+    """The phase-variable replays of a loaded ``optimize.h5`` in words (a step of phases:
+    one law per phase); why there are none, or "" when they were not asked for."""
     import numpy as np
 
     fb, ff = d.phase_replays.get("feedback"), d.phase_replays.get("feedforward")
-    out = ""
+    out = f" Phase-variable replay: {d.phase_replay_outcome}." if getattr(
+        d, "phase_replay_outcome", "") else ""
+    if fb is not None and getattr(d, "phase_names", ()):
+        out += " One phase-variable law per phase (the phase in force: the one whose stretch " \
+               "of the phase variable holds its present value)."
     if fb is not None:
         out += (f" Replayed as virtual constraints (the torques as a function of the phase "
                 f"variable, the stance leg's angle, plus PD tracking of the collocated joint "
@@ -149,7 +154,9 @@ def phase_replay_text(d) -> str:
                 f"{num(fb.collocated_start_error, 2)} away; closed (start moved "
                 f"{num(fb.start_shift, 2)}) it returns to {num(fb.return_error, 2)}, step "
                 f"period {num(fb.step_period_s, 9)} s, largest |multiplier| "
-                f"{num(float(np.max(np.abs(fb.multipliers))))} (stable under the law), the "
+                f"{num(float(np.max(np.abs(fb.multipliers))))} ("
+                f"{'stable' if np.max(np.abs(fb.multipliers)) < 1 else 'unstable'} under the "
+                f"law), the "
                 f"law's torque within {num(fb.torque_error, 2)} N m of the optimal one.")
     if ff is not None:
         out += (f" The phase-variable feed-forward alone (no PD): one step from the "

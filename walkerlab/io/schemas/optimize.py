@@ -39,8 +39,10 @@ points)::
                                            primal_infeasibility, dual_infeasibility, barrier
     energy/kinetic, energy/potential  J    the walker's energies at the collocation points
                                            (their sum rises by the actuators' work)
-    replay/phase_<law>/...        (a five-link biped) the torques as a function of the
-                                  phase variable (the stance leg's angle), ``<law>``
+    replay/phase_<law>/...        (optimize.phase_replay: a five-link biped's by default)
+                                  the torques as a function of the phase variable (the
+                                  stance leg's angle; a step of phases: one law per
+                                  phase), ``<law>``
                                   ``feedback`` (feed-forward + PD on the collocated joint
                                   trajectory: virtual constraints) or ``feedforward`` (no
                                   PD): ``collocated_start_error``, ``start_shift``,
@@ -53,7 +55,9 @@ points)::
 attributes: ``gait`` (the replay closed), ``state_names``; ``steps`` (a stride of
 legs that differ: 2; absent for one step): ``time`` then covers the stride, its phases
 are the steps' (as many per step), ``step_period`` and ``step_length`` are the mean
-step's, and the replay's return error and multipliers are the stride map's.
+step's, and the replay's return error and multipliers are the stride map's;
+``phase_replay_outcome`` (when the phase-variable replay was asked for and refused: why,
+one line).
 """
 
 from __future__ import annotations
@@ -68,7 +72,7 @@ STAGE = "optimize"
 __all__ = ["DESIGN_STAGE", "DesignData", "OptimizeData", "PHASE_LAWS", "PhaseReplayData",
            "STAGE", "load", "load_design", "write", "write_design"]
 
-#: the phase-variable replays a five-link biped's artifact may carry
+#: the phase-variable replays an artifact may carry (optimize.phase_replay)
 PHASE_LAWS = ("feedback", "feedforward")
 
 
@@ -124,6 +128,7 @@ class OptimizeData:
     build_time_s: float = float("nan")
     phase_replays: dict = field(default_factory=dict)  # law name -> PhaseReplayData
     steps: int = 1  # steps in the optimised period: 2 for a stride of legs that differ
+    phase_replay_outcome: str = ""  # why there are no phase replays ("": there are, or off)
 
 
 def _write_phase(f, law: str, r: PhaseReplayData) -> None:
@@ -221,6 +226,8 @@ def write(f, d: OptimizeData) -> None:
             put(f, f"replay/{key}", float(v), unit, what)
     for law, r in d.phase_replays.items():
         _write_phase(f, law, r)
+    if d.phase_replay_outcome:
+        f.attrs["phase_replay_outcome"] = d.phase_replay_outcome
     _write_history_and_energy(f, d)
 
 
@@ -283,7 +290,7 @@ def load(path: Path) -> OptimizeData:
             f["phases/duration"][()] if "phases" in f else None,
             float(f.attrs.get("ipopt_build_time_s", float("nan"))),
             {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f},
-            int(f.attrs.get("steps", 1)))
+            int(f.attrs.get("steps", 1)), str(f.attrs.get("phase_replay_outcome", "")))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)
