@@ -69,7 +69,6 @@ Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.floating
                                          velocity, s, Fn, Ff, power, on_ground
 ``knee_table(X, PC, p)``                 (n, 2, 4) per knee: extension, its rate, stop torque,
                                          power
-``hip_heights(X, PC)``                   (n,) hip height above the ground line [m]
 ``rhs_packed(y, d, dy)``                 rhs from the packed data vector, counts calls
 ``build_cyrk()``, ``build_lsoda(sig)``   addresses of cfuncs of ``rhs_packed``
 =======================================  =================================================
@@ -452,16 +451,6 @@ def knee_table(X, PC, p, c1, c2):
                 out[r, k, 1] = rate
                 out[r, k, 2] = T
                 out[r, k, 3] = -T * rate
-    return out
-
-
-@njit(cache=True)
-def hip_heights(X, PC):
-    """Hip height above the ground line, hip . n [m], of each row of X (n, NX)."""
-    sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
-    out = np.empty(X.shape[0])
-    for r in range(X.shape[0]):
-        out[r] = X[r, 0] * sp + X[r, 1] * cp
     return out
 
 
