@@ -13,7 +13,7 @@ C++, the separation located as an event) with a plain-Python right-hand side
 where scipy's Radau took ~0.1 s, the restitutions within ~1e-11 relative of scipy's
 (rtol 1e-10).  A drop is computed once per contact law, mass, speed, gravity and tolerance
 and kept in the private user cache (``drop/<key>.json``; the key also hashes the sources
-that decide the numbers and CyRK's version); a damaged or foreign entry is a miss.
+that decide the numbers and the installed CyRK); a damaged or foreign entry is a miss.
 """
 
 from __future__ import annotations
@@ -75,16 +75,22 @@ _SOURCES = ("analysis/contact/drop.py", "models/contact/laws.py", "integrate/eve
 
 @lru_cache(maxsize=1)
 def _code_version() -> bytes:
-    """CyRK's version and the deciding sources (read once per process)."""
-    from importlib.metadata import version  # not CyRK.__version__: that imports numba
+    """The installed CyRK integrator (its compiled solver module's name, size and time: a
+    stat, where CyRK's version string costs ~45 ms of package metadata and
+    ``CyRK.__version__`` imports numba) and the deciding sources (read once per process)."""
+    import importlib.util
 
+    spec = importlib.util.find_spec("CyRK")
+    where = Path(spec.origin).parent / "cy" if spec and spec.origin else None
+    libs = sorted(where.glob("pysolver.*")) if where and where.is_dir() else []
+    stamp = [(p.name, p.stat().st_size, p.stat().st_mtime_ns) for p in libs]
     root = Path(__file__).resolve().parents[2]
-    return repr(("CyRK", version("CyRK"))).encode() + b"".join(
+    return repr(("CyRK", stamp)).encode() + b"".join(
         (root / rel).read_bytes() for rel in _SOURCES)
 
 
 def _cache_key(c, mass_kg, v_in, g, rtol) -> str:
-    """sha256 of the drop's numbers (exact reprs), the deciding sources and CyRK's version."""
+    """sha256 of the drop's numbers (exact reprs), the deciding sources and CyRK's build."""
     import hashlib
 
     h = hashlib.sha256(repr((float(c.k), float(c.e), float(c.cmax), float(c.dmax),
