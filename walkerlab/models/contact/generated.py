@@ -69,7 +69,6 @@ Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.floating
                                          velocity, s, Fn, Ff, power, on_ground
 ``knee_table(X, PC, p)``                 (n, 2, 4) per knee: extension, its rate, stop torque,
                                          power
-``hip_heights(X, PC)``                   (n,) hip height above the ground line [m]
 ``rhs_packed(y, d, dy)``                 rhs from the packed data vector, counts calls
 ``build_cyrk()``, ``build_lsoda(sig)``   addresses of cfuncs of ``rhs_packed``
 =======================================  =================================================
@@ -90,8 +89,8 @@ ASSEMBLY = '''
 # ---------------------------------------------------------------- contact assembly
 # (walkerlab.models.contact.generated.ASSEMBLY: walker-independent; laws from contact._kernels)
 from math import sin as _sin, cos as _cos
-from walkerlab.models.contact._kernels import (normal_force, friction_mu, in_patch,
-                                               patch_height, step)
+from walkerlab.models.contact._kernels import (normal_force, friction_mu, patch_height,
+                                               step)
 
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
@@ -143,11 +142,11 @@ def _chol_solve(L, B):
 
 
 @njit(cache=True)
-def _foot(P, V, i, PC, cen):
-    """Contact of point i from its position P[i] and material velocity V[i]:
-    (delta, ddot, vt, s, Fn, Ff, dFn/ddelta, dFn/dddot, mu, dmu/dvt)."""
-    sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
-    px, py, vx, vy = P[i, 0], P[i, 1], V[i, 0], V[i, 1]
+def _point(px, py, vx, vy, sp, cp, PC, cen):
+    """Contact of a point at (px, py) [m] whose material velocity is (vx, vy) [m/s] on the
+    lane ``cen``, the slope's (sin, cos) = (sp, cp): (delta, ddot, vt, s, Fn, Ff, dFn/ddelta,
+    dFn/dddot, mu, dmu/dvt).  The one contact kernel of the right-hand side, the Jacobian,
+    the pinned dynamics and the tables (one compile)."""
     delta = -(px * sp + py * cp)
     ddot = -(vx * sp + vy * cp)
     vt = vx * cp - vy * sp
@@ -197,7 +196,7 @@ def _knee(x, k, PC, delta):
 @njit(cache=True)
 def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
     """Q - h (NQ,) with the contact forces of the legs' points used and the knee stops;
-    fills M, the points' P, V, J, per-point ``info`` (NF, 10) (see _foot) and ``knees``
+    fills M, the points' P, V, J, per-point ``info`` (NF, 10) (see _point) and ``knees``
     (2, 5) (knees only with one contact point per leg: point k is leg k's)."""
     h = np.empty(NQ)
     dyn(x, p, M, h)
@@ -208,7 +207,7 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
         leg = POINT_LEG[i]
         if not ((leg == 0 and use1) or (leg == 1 and use2)):
             continue
-        res = _foot(P, V, i, PC, c1 if leg == 0 else c2)
+        res = _point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, c1 if leg == 0 else c2)
         for k in range(10):
             info[i, k] = res[k]
         fn, ff = res[4], res[5]
@@ -227,26 +226,6 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
             Q[2 + 2 * k] += T
             Q[3 + 2 * k] -= T
     return Q
-
-
-@njit(cache=True)
-def _foot_force(px, py, vx, vy, sp, cp, PC, cen):
-    """World-frame contact force (Fx, Fy) [N] on a foot at (px, py) moving at (vx, vy)."""
-    delta = -(px * sp + py * cp)
-    if delta + cen[-1] <= 0.0:
-        return 0.0, 0.0
-    hp = patch_height(px * cp - py * sp, cen, PC[I_HW], PC[I_CONT] > 0.5)
-    if not hp == hp:
-        return 0.0, 0.0
-    delta += hp
-    if delta <= 0.0:
-        return 0.0, 0.0
-    fn = normal_force(delta, -(vx * sp + vy * cp), PC[I_K], PC[I_E], PC[I_CMAX],
-                      PC[I_DMAX])[0]
-    if fn <= 0.0:
-        return 0.0, 0.0
-    ff = fn * friction_mu(vx * cp - vy * sp, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])[0]
-    return fn * sp + ff * cp, fn * cp - ff * sp
 
 
 @njit(cache=True)
@@ -420,14 +399,15 @@ def contact_table(X, PC, p, c1, c2):
         feet(X[r], p, P, V, J)
         for i in range(NF):
             cen = c1 if POINT_LEG[i] == 0 else c2
-            res = _foot(P, V, i, PC, cen)
+            res = _point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
             fn, ff = res[4], res[5]
             Fx = fn * sp + ff * cp
             Fy = fn * cp - ff * sp
             for k in range(6):
                 out[r, i, k] = res[k]
             out[r, i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
-            out[r, i, 7] = 1.0 if in_patch(res[3], cen, PC[I_HW], PC[I_CONT] > 0.5) else 0.0
+            hq = patch_height(res[3], cen, PC[I_HW], PC[I_CONT] > 0.5)  # NaN in a gap
+            out[r, i, 7] = 1.0 if hq == hq else 0.0
     return out
 
 
@@ -442,26 +422,18 @@ def knee_table(X, PC, p, c1, c2):
     P = np.empty((NF, 2))
     V = np.empty((NF, 2))
     J = np.empty((NF, 2, NQ))
+    sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
     if KNEE:
         for r in range(n):
             feet(X[r], p, P, V, J)
             for k in range(2):
-                delta = _foot(P, V, k, PC, c1 if k == 0 else c2)[0]
+                delta = _point(P[k, 0], P[k, 1], V[k, 0], V[k, 1], sp, cp, PC,
+                               c1 if k == 0 else c2)[0]
                 ext, rate, T, _, _ = _knee(X[r], k, PC, delta)
                 out[r, k, 0] = ext
                 out[r, k, 1] = rate
                 out[r, k, 2] = T
                 out[r, k, 3] = -T * rate
-    return out
-
-
-@njit(cache=True)
-def hip_heights(X, PC):
-    """Hip height above the ground line, hip . n [m], of each row of X (n, NX)."""
-    sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
-    out = np.empty(X.shape[0])
-    for r in range(X.shape[0]):
-        out[r] = X[r, 0] * sp + X[r, 1] * cp
     return out
 
 
@@ -541,8 +513,9 @@ def rhs_source(eq) -> str:
     Fs = sp.symbols(" ".join(f"_Fx{i} _Fy{i}" for i in range(len(eq.feet))), real=True)
     for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
         args = ", ".join(pr.doprint(e) for e in red[4 * i:4 * i + 4])
-        lines.append(f"    {Fs[2 * i]}, {Fs[2 * i + 1]} = _foot_force({args}, _sp, _cp, PC, "
-                     f"{('c1', 'c2')[leg]})")
+        lines += [f"    _r{i} = _point({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})",
+                  f"    {Fs[2 * i]} = _r{i}[4] * _sp + _r{i}[5] * _cp",  # (Fn, Ff) in the world
+                  f"    {Fs[2 * i + 1]} = _r{i}[4] * _cp - _r{i}[5] * _sp"]
     Q = -eq.h
     for i, (_, J) in enumerate(eq.feet):
         Q += J.T * sp.Matrix([Fs[2 * i], Fs[2 * i + 1]])

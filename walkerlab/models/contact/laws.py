@@ -35,6 +35,7 @@ __all__ = [
     "adams_step_derivative",
     "coulomb_friction_coefficient",
     "impact_normal_force",
+    "impact_normal_force_scalar",
 ]
 
 
@@ -227,6 +228,32 @@ def impact_normal_force(delta, delta_dot, k, e, cmax, dmax):
     dpos = np.maximum(delta, 0.0)
     f = k * dpos**e + adams_step(dpos, 0.0, 0.0, dmax, cmax) * np.asarray(delta_dot, float)
     return np.where(delta > 0.0, np.maximum(f, 0.0), 0.0)
+
+
+def impact_normal_force_scalar(delta: float, delta_dot: float, k: float, e: float,
+                               cmax: float, dmax: float) -> float:
+    """:func:`impact_normal_force` of one point, in plain Python floats: the same operations
+    in the same order, so the same number bit for bit (``tests/contact/test_laws_config.py``),
+    at a fraction of the array law's cost per call (what a Python right-hand side called
+    from a compiled integrator pays per evaluation, the drop test's).
+
+    Parameters
+    ----------
+    delta, delta_dot : float
+        Penetration ``[len]`` and its rate ``[len/s]``.
+    k, e, cmax, dmax : float
+        As in :func:`impact_normal_force`.
+
+    Returns
+    -------
+    float
+        Normal force ``[N]`` (>= 0).
+    """
+    if not delta > 0.0:
+        return 0.0
+    s = min(max((delta - 0.0) / (dmax - 0.0), 0.0), 1.0)  # adams_step(delta, 0, 0, dmax, cmax)
+    f = k * delta**e + (0.0 + (cmax - 0.0) * s * s * (3.0 - 2.0 * s)) * delta_dot
+    return f if f > 0.0 else 0.0
 
 
 def coulomb_friction_coefficient(v, mu_s, mu_d, v_s, v_d):
