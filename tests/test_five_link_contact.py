@@ -143,6 +143,7 @@ def test_joint_torques_act_as_the_independent_joint_torques():
     tau_swing_hip, tau_stance_knee, tau_swing_knee)``); the joint angles are the independent
     relative coordinates and the phase variable its hip-to-stance-foot angle; with the legs'
     roles swapped (leg1 in stance) the same torques land on the other leg."""
+    from walkerlab.models.contact.actuation import powered_rhs
     from walkerlab.models.contact.joint_torques import JointTorqueActuators
 
     sc = _scene(True)
@@ -179,6 +180,13 @@ def test_joint_torques_act_as_the_independent_joint_torques():
         xs = np.concatenate([xf[:w.nq][swap], xf[w.nq:][swap]])
         np.testing.assert_allclose(acts.torques(xs, 0, 0.0), tau, rtol=1e-14)
         np.testing.assert_allclose(acts.hip_torque(xs, 0, 0.0)[0], Q[swap], rtol=1e-14)
+        # the powered right-hand side the contact runs integrate: the same acceleration,
+        # the ledger's hip powers split by sign (point feet: no flat feet's dampers)
+        dx, powers = powered_rhs(w, xf, 1)
+        passive = np.array(w.rhs(0.0, xf), float)[w.nq:]
+        np.testing.assert_allclose(dx[w.nq:], passive + np.linalg.solve(w.mass_matrix(xf), Q),
+                                   rtol=1e-12, atol=1e-12)
+        assert powers[:2] == pytest.approx([max(power, 0.0), min(power, 0.0)], rel=1e-12)
 
 
 def test_contact_view_refuses_what_it_cannot_carry_in_one_line():

@@ -76,6 +76,8 @@ class JointTorqueActuators(ContactRows):
     ankle = None
     #: Free knees: no knee stop, no knee-stop term in the ledger.
     knee = False
+    #: Point feet: no flat feet's ankle dampers in the ledger.
+    foot = None
     #: The work integrals a run carries (:data:`~walkerlab.models.contact.actuation.WORK_NAMES`:
     #: the hip-torque names carry every joint torque's work).
     work_names = WORK_NAMES
