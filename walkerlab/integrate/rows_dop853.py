@@ -156,41 +156,33 @@ def _locate(fns, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
 
 
 @njit(cache=True, error_model="numpy")
-def _combine(w, ns, K, out):  # pragma: no cover - compiled
-    """``out[k] = sum_j w[j] K[j, k]`` over ``j < ns``, each sum from 0.0 in the order of
-    ``j`` (the loop over ``j`` outside: the components' sums are independent chains)."""
-    m = out.size
-    for k in range(m):
-        out[k] = 0.0
-    for j in range(ns):
-        c = w[j]
-        for k in range(m):
-            out[k] += c * K[j, k]
-
-
-@njit(cache=True, error_model="numpy")
-def _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol, a5, a3):  # pragma: no cover - compiled
+def _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - compiled
     """One DOP853 step of size ``h`` from ``(t, y)`` (``K[0]`` = f(t, y)), its stages by the
     flow ``fs``: ``ynew`` and the FSAL evaluation by ``f`` (flow and extra outputs) into
-    ``K[NS]``; returns the error norm.  ``a5``, ``a3`` (m,): scratch.  Each component's sums
-    run over the stages in order (``_combine``), the components side by side."""
+    ``K[NS]``; returns the error norm."""
     m = y.size
     for s in range(1, NS):
-        _combine(A[s], s, K, ynew)
         for k in range(m):
-            ynew[k] = y[k] + h * ynew[k]
+            acc = 0.0
+            for j in range(s):
+                acc += A[s, j] * K[j, k]
+            ynew[k] = y[k] + h * acc
         fs(K[s].ctypes, t + C[s] * h, ynew.ctypes, d.ctypes)
-    _combine(B, NS, K, ynew)
     for k in range(m):
-        ynew[k] = y[k] + h * ynew[k]
+        acc = 0.0
+        for j in range(NS):
+            acc += B[j] * K[j, k]
+        ynew[k] = y[k] + h * acc
     f(K[NS].ctypes, t + h, ynew.ctypes, d.ctypes)
-    _combine(E5, NS + 1, K, a5)
-    _combine(E3, NS + 1, K, a3)
     e5, e3 = 0.0, 0.0
     for k in range(m):
         sc = atol + rtol * max(abs(y[k]), abs(ynew[k]))
-        e5 += (a5[k] / sc) ** 2
-        e3 += (a3[k] / sc) ** 2
+        a5, a3 = 0.0, 0.0
+        for j in range(NS + 1):
+            a5 += E5[j] * K[j, k]
+            a3 += E3[j] * K[j, k]
+        e5 += (a5 / sc) ** 2
+        e3 += (a3 / sc) ** 2
     if e5 == 0.0 and e3 == 0.0:
         return 0.0
     return abs(h) * e5 / np.sqrt(e5 + 0.01 * e3)
@@ -260,7 +252,7 @@ def _row(fns, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
                 return FAILED, t, h_abs
             t_new = min(t + h_abs, t_bound)
             h = t_new - t
-            err = _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol, tmp, buf[:m])
+            err = _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol)
             if err < 1.0:
                 fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
                 if rejected:
