@@ -131,6 +131,7 @@ class BatchStepMap:
         #: rows integrated by the compiled per-row integrator (phases), for the record
         self.integrated = 0
         self._walkers: dict[float, object] = {}
+        self._fns: dict[int, tuple] = {}  # the per-row integrator's cfuncs, by phase
 
     # -- slope handling -------------------------------------------------------------------
     def _probe_slope_dependence(self) -> bool:
@@ -218,7 +219,7 @@ class BatchStepMap:
         g = self._guard_table()
         steps = np.zeros(W, np.int64)
         fell = np.zeros(W, np.bool_)
-        walk_rows(self._cfuncs(0), self._reset_flow, X, D, S, float(self.max_step_time_s),
+        walk_rows(*self._cfuncs(0), self._reset_flow, X, D, S, float(self.max_step_time_s),
                   *g, float(self.rtol), float(self.atol), self.n + self.phases[0][2], steps,
                   fell)
         return steps, fell, X
@@ -229,8 +230,6 @@ class BatchStepMap:
         from walkerlab.codegen.compiled import compiled_module
         from walkerlab.integrate.rows_dop853 import cfuncs
 
-        if not hasattr(self, "_fns"):
-            self._fns = {}
         if k not in self._fns:
             ph = self.phases[k]
             cf = ph[0].compiled
@@ -400,7 +399,7 @@ class BatchStepMap:
         te = np.empty(N)
         Yev = np.empty((N, m))
         H = self._h_rows[rows]
-        phase_rows(self._cfuncs(k), np.ascontiguousarray(Y, dtype=float),
+        phase_rows(*self._cfuncs(k), np.ascontiguousarray(Y, dtype=float),
                    np.ascontiguousarray(Dk),
                    np.ascontiguousarray(cap, dtype=float), self._gcols[k], self._goffs[k],
                    self._dirs[k], float(self.rtol), float(self.atol), m + n_extra, which, te,

@@ -52,8 +52,8 @@ DD = np.ascontiguousarray(_SCIPY_DOP853.D)
 
 
 def cfuncs(module, name: str, flow) -> tuple:
-    """``fns`` of :func:`phase_rows` for the cfunc ``flow`` named ``name`` of the compiled
-    ``module`` (:mod:`walkerlab.codegen.compiled`): with its guard-free twin and the
+    """``(f, fs, fg, sel)`` of :func:`phase_rows` for the cfunc ``flow`` named ``name`` of
+    the compiled ``module`` (:mod:`walkerlab.codegen.compiled`): with its guard-free twin and the
     one-guard cfunc when the module has them (``plain_flow``, ``guard_one``: the same
     values bit for bit), else ``flow`` for every role."""
     if hasattr(module, "plain_flow") and hasattr(module, "guard_one"):
@@ -107,20 +107,20 @@ def _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compil
 
 
 @njit(cache=True, error_model="numpy")
-def _guard_at(fns, t, y, d, buf, gcols, goffs, j, gv):  # pragma: no cover - compiled
-    """Guard ``j``'s value at ``(t, y)``: by the guard cfunc ``fns[2]`` alone when
-    ``fns[3]``, else from the flow ``fns[0]``'s extra outputs (the same value)."""
-    if fns[3]:
+def _guard_at(f, fg, sel, t, y, d, buf, gcols, goffs, j, gv):  # pragma: no cover - compiled
+    """Guard ``j``'s value at ``(t, y)``: by the guard cfunc ``fg`` alone when ``sel``,
+    else from the flow ``f``'s extra outputs (the same value)."""
+    if sel:
         buf[0] = gcols[j]
-        fns[2](buf.ctypes, t, y.ctypes, d.ctypes)
+        fg(buf.ctypes, t, y.ctypes, d.ctypes)
         return buf[0] + goffs[j]
-    fns[0](buf.ctypes, t, y.ctypes, d.ctypes)
+    f(buf.ctypes, t, y.ctypes, d.ctypes)
     _guards(buf, y.size, gcols, goffs, gv)
     return gv[j]
 
 
 @njit(cache=True, error_model="numpy")
-def _locate(fns, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
+def _locate(f, fg, sel, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
             gv):  # pragma: no cover - compiled
     """Time of guard ``j``'s crossing in the step ``[t_old, t_old + h]`` (values ``g0``,
     ``g1`` at its ends), by the Illinois method on the dense output (guard values by
@@ -137,7 +137,7 @@ def _locate(fns, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
         if not a < x < b:
             x = 0.5 * (a + b)
         _dense_at(F, y_old, x, tmp)
-        fx = _guard_at(fns, t_old + x * h, tmp, d, buf, gcols, goffs, j, gv)
+        fx = _guard_at(f, fg, sel, t_old + x * h, tmp, d, buf, gcols, goffs, j, gv)
         if fx == 0.0:
             break
         if (fx > 0.0) == (fb > 0.0):
@@ -226,13 +226,12 @@ def _work(m, n_out, ng):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def _row(fns, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
+def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
          work):  # pragma: no cover - compiled
     """One row to its first guard crossing: ``(which, t_event, next step size)``, the state
-    into ``yev``; ``fns``: the cfuncs (:func:`phase_rows`); ``h_first`` > 0: the first step
-    size [s] (else scipy's choice); ``work``: :func:`_work`'s scratch arrays (allocated once
-    per call of the caller, not per row)."""
-    f, fs = fns[0], fns[1]
+    into ``yev``; ``f, fs, fg, sel``: the cfuncs (:func:`phase_rows`); ``h_first`` > 0: the
+    first step size [s] (else scipy's choice); ``work``: :func:`_work`'s scratch arrays
+    (allocated once per call of the caller, not per row)."""
     m = y.size
     ng = gcols.size
     K, F, buf, ynew, tmp, G = work
@@ -272,7 +271,8 @@ def _row(fns, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
             if not dense:
                 _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp)
                 dense = True
-            tj = _locate(fns, F, y, t, h, d, buf, gcols, goffs, j, g0[j], g1[j], tmp, gv)
+            tj = _locate(f, fg, sel, F, y, t, h, d, buf, gcols, goffs, j, g0[j], g1[j], tmp,
+                         gv)
             if tj < te:
                 best, te = j, tj
         if best >= 0:
@@ -289,14 +289,15 @@ def _row(fns, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
 
 
 @njit(cache=True, error_model="numpy")
-def phase_rows(fns, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te, Yev,
-               H):  # pragma: no cover - compiled
+def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
+               Yev, H):  # pragma: no cover - compiled
     """Integrate every row of ``Y`` (N, m) [state units] with its data vector ``D[i]`` from
-    phase time 0 to its first guard crossing (module docstring): ``fns`` = ``(f, fs, fg,
-    sel)``, the cfuncs ``(dy, t, y, d)`` of the flow with its guard outputs ``f`` (a step's
+    phase time 0 to its first guard crossing (module docstring): ``f, fs, fg, sel``
+    (:func:`cfuncs`; separate arguments: a tuple of functions is an experimental numba
+    type), the cfuncs ``(dy, t, y, d)`` of the flow with its guard outputs ``f`` (a step's
     first and last evaluation), the flow alone ``fs`` (its other stages) and, when ``sel``,
     ``fg`` writing the guard column ``int(dy[0])`` into ``dy[0]`` (a crossing's location;
-    else ``f``'s guard outputs), :func:`cfuncs`; guard index or
+    else ``f``'s guard outputs); guard index or
     :data:`TIMEOUT` / :data:`FAILED` into ``which`` (N,), the time [s] into ``te`` (N,) and
     the state there into ``Yev`` (N, m).  ``cap`` (N,) [s]: time limits; ``gcols``, ``goffs``,
     ``dirs`` (g,): guard columns among the cfunc's extra outputs, offsets, directions;
@@ -307,8 +308,8 @@ def phase_rows(fns, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
     y = np.empty(Y.shape[1])
     for i in range(Y.shape[0]):
         y[:] = Y[i]
-        w, t, h = _row(fns, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol, Yev[i], H[i],
-                       work)
+        w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol, Yev[i],
+                       H[i], work)
         which[i] = w
         te[i] = t
         H[i] = h
@@ -327,8 +328,8 @@ def reset_rows(reset, X, D, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def walk_rows(fns, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, gout, rtol,
-              atol, n_out, steps, fell):  # pragma: no cover - compiled
+def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs,
+              gout, rtol, atol, n_out, steps, fell):  # pragma: no cover - compiled
     """Walk every row of ``X`` (W, m) up to ``n_steps`` steps, step ``s`` of walk ``w`` on
     the data vector ``D[w, s]`` (its slope): the phases of a step in turn (phase ``p``'s
     guards ``gstart[p]:gstart[p + 1]`` of the flat arrays ``gcols``, ``goffs``, ``dirs``
@@ -336,8 +337,8 @@ def walk_rows(fns, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, g
     each integrated by :func:`_row` as :func:`phase_rows` does (the step size carried from
     phase to phase), a heel strike reset by ``reset`` and counted in ``steps`` (W,); a fall,
     a step longer than ``max_time`` [s] or a failed integration sets ``fell`` (W,) and ends
-    the walk.  ``fns``: the flow's cfuncs (:func:`phase_rows`).  ``X`` is overwritten with
-    each walk's last post-impact state."""
+    the walk.  ``f, fs, fg, sel``: the flow's cfuncs (:func:`phase_rows`).  ``X`` is
+    overwritten with each walk's last post-impact state."""
     W, m = X.shape
     n_ph = gstart.size - 1
     yev = np.empty(m)
@@ -355,7 +356,7 @@ def walk_rows(fns, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, g
                 if max_time - T <= 0.0:
                     ended = True
                     break
-                which, te, h = _row(fns, y, d, max_time - T, gcols[a:b], goffs[a:b],
+                which, te, h = _row(f, fs, fg, sel, y, d, max_time - T, gcols[a:b], goffs[a:b],
                                     dirs[a:b], rtol, atol, yev, h, work)
                 if which < 0 or gout[a + which] == 1:
                     ended = True
