@@ -90,3 +90,59 @@ def test_kneed_walker_keeps_the_step_by_step_walks():
     assert not sm.can_walk
     with pytest.raises(ValueError, match="compiled walks need"):
         sm.walk(np.zeros((1, sm.n)), np.zeros((1, 1)))
+
+
+@pytest.mark.parametrize("scene", ["paper.yaml", "kneed.yaml"])
+def test_stage_and_guard_cfuncs_are_the_flows_values(scene):
+    """The generated ``plain_flow(name)`` (a DOP853 step's inner stages) writes the flow's 2n
+    values and ``guard_one()`` each guard's value (a crossing's location), bit for bit those
+    the flow cfunc writes with its guard outputs, for every flow of the module."""
+    from ctypes import POINTER, c_double
+
+    from walkerlab.integrate.rows_dop853 import cfuncs
+
+    def ptr(v):
+        return v.ctypes.data_as(POINTER(c_double))
+
+    sc = load_scene(ROOT / "configs" / scene)
+    w = build_walker(sc)
+    cf = w.phases[0].compiled
+    mod = compiled_module(cf.structure)
+    n, ng = w.layout().size, len(mod.GUARDS)
+    d = cf.data()
+    X = 0.4 * np.random.default_rng(2).standard_normal((20, n))
+    names = {p.compiled.name for p in w.phases}
+    for name in names:
+        full, plain, guard, sel = cfuncs(mod, name, getattr(mod, name))
+        assert sel
+        for x in X:
+            a, b, g = np.empty(n + ng), np.empty(n), np.empty(1)
+            full.ctypes(ptr(a), 0.0, ptr(x), ptr(d))
+            plain.ctypes(ptr(b), 0.0, ptr(x), ptr(d))
+            np.testing.assert_array_equal(b, a[:n])
+            for j in range(ng):
+                g[0] = j
+                guard.ctypes(ptr(g), 0.0, ptr(x), ptr(d))
+                assert g[0] == a[n + j] or (np.isnan(g[0]) and np.isnan(a[n + j]))
+
+
+def test_phase_rows_with_stage_cfuncs_equal_the_flow_alone(paper_map, paper_fixed_point):
+    """One phase of rows by ``phase_rows`` with the stage and guard cfuncs gives the same
+    crossings, times, states and next step sizes, bit for bit, as with the flow (and its
+    guard outputs) in every role."""
+    from walkerlab.integrate.rows_dop853 import phase_rows
+
+    rng = np.random.default_rng(7)
+    X = paper_fixed_point.x + 0.01 * rng.standard_normal((8, 4))
+    D = paper_map.data(paper_map.slope_rad + 0.003 * rng.standard_normal(8))
+    fns = paper_map._cfuncs(0)
+    assert fns[3]
+    res = []
+    for f in (fns, (fns[0], fns[0], fns[0], False)):
+        which, te, Yev, H = np.empty(8, np.int64), np.empty(8), np.empty((8, 4)), np.zeros(8)
+        phase_rows(*f, X.copy(), D.copy(), np.full(8, 5.0), paper_map._gcols[0],
+                   paper_map._goffs[0], paper_map._dirs[0], 1e-9, 1e-9, 4 + paper_map.phases[0][2],
+                   which, te, Yev, H)
+        res.append((which, te, Yev, H))
+    for a, b in zip(*res):
+        np.testing.assert_array_equal(a, b)

@@ -30,6 +30,7 @@ Generated functions (``x`` is the role-ordered state ``[q, dq]``, shape (2n,)):
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 import sympy as sp
@@ -426,15 +427,16 @@ def _reset_cfunc(eq: Equations, consts: list[str], reset: list[str]) -> list[str
 
 
 def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational: bool,
-           guards: tuple[list[str], list]) -> list[str]:
+           guards: tuple[list[str], list] | None, lazy: bool = False) -> list[str]:
     """A numba ``cfunc`` ``(dy, t, y, d)`` (CyRK's ``cyjit_sig``) writing the flow (and with
     ``variational`` the product ``A Phi`` of the flow Jacobian with ``y[2n:]``, row-major
-    (2n, 2n)) into ``dy``, then the guard values (CyRK's extra outputs); ``d`` holds the
-    constants, then a call counter."""
+    (2n, 2n)) into ``dy``, then the guard values (CyRK's extra outputs; none when ``guards``
+    is None); ``d`` holds the constants, then a call counter.  ``lazy``: the plain Python
+    function (no decorator), made a cfunc on first use (:func:`_stage_cfuncs`)."""
     m = 2 * len(eq.q)
     names = [str(s) for s in (*eq.q, *eq.dq)]
-    out = ["@cfunc(SIG, cache=True, error_model='numpy')",
-           f"def {name}(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out = [] if lazy else ["@cfunc(SIG, cache=True, error_model='numpy')"]
+    out += [f"def {name}(dy, t, y, d):  # pragma: no cover - runs compiled"]
     out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
     out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
     (fl, fo) = parts[0]
@@ -454,10 +456,57 @@ def _cfunc(name: str, eq: Equations, consts: list[str], parts: list, variational
                     terms.append(phi if a == "1.0" else f"({a}) * {phi}")
                 out.append(f"    dy[{m + i * m + j}] = {' + '.join(terms) or '0.0'}")
     k0 = m + m * m if variational else m
-    out += [ln[4:] for ln in guards[0]]
-    out += [f"    dy[{k0 + j}] = {PRINTER.doprint(e)}" for j, e in enumerate(guards[1])]
+    if guards is not None:
+        out += [ln[4:] for ln in guards[0]]
+        out += [f"    dy[{k0 + j}] = {PRINTER.doprint(e)}" for j, e in enumerate(guards[1])]
     out.append(f"    d[{len(consts)}] += 1.0")
     return out
+
+
+def _needed(lines: list[str], expr: str) -> list[str]:
+    """The assignments of ``lines`` (``name = rhs``, in order) that ``expr`` needs."""
+    need = set(re.findall(r"[A-Za-z_]\w*", expr))
+    keep = []
+    for ln in reversed(lines):
+        name, rhs = ln.strip().split(" = ", 1)
+        if name in need:
+            keep.append(ln)
+            need |= set(re.findall(r"[A-Za-z_]\w*", rhs))
+    return keep[::-1]
+
+
+def _guard_cfunc(eq: Equations, consts: list[str], guards: tuple[list[str], list]) -> list[str]:
+    """``_guard_one(dy, t, y, d)``: the guard number ``int(dy[0])`` (its index in ``GUARDS``)
+    of the state ``y`` into ``dy[0]``, with the lines and expressions of the flows' guard
+    outputs (the same values bit for bit), only those that guard needs; no call counted."""
+    names = [str(s) for s in (*eq.q, *eq.dq)]
+    out = ["def _guard_one(dy, t, y, d):  # pragma: no cover - runs compiled"]
+    out += [f"    {c} = d[{i}]" for i, c in enumerate(consts)]
+    out += [f"    {a} = y[{i}]" for i, a in enumerate(names)]
+    out.append("    j = int(dy[0])")
+    for j, e in enumerate(guards[1]):
+        text = PRINTER.doprint(e)
+        out.append(f"    {'if' if j == 0 else 'elif'} j == {j}:")
+        out += _needed(guards[0], text) + [f"{IND}dy[0] = {text}"]
+    return out + [""]
+
+
+def _stage_cfuncs(flows) -> list[str]:
+    """``plain_flow(name)`` and ``guard_one()``: made cfuncs on first use (a walker that never
+    runs the per-row integrator does not compile them)."""
+    return ["_LAZY = {}", "", "",
+            "def _lazy(name):",
+            "    if name not in _LAZY:",
+            "        _LAZY[name] = cfunc(SIG, cache=True, error_model='numpy')(globals()[name])",
+            "    return _LAZY[name]", "", "",
+            "def plain_flow(name):",
+            '    """The cfunc ``name`` (one of ' + ", ".join(f"``{k}``" for k in flows)
+            + ') without its guard',
+            '    outputs: the same 2n values and call count (the DOP853 stages)."""',
+            "    return _lazy(f'_{name}_plain')", "", "",
+            "def guard_one():",
+            '    """The cfunc writing guard ``int(dy[0])`` of ``y`` into ``dy[0]``."""',
+            "    return _lazy('_guard_one')", ""]
 
 
 def generate_compiled(eq: Equations, param_names, key: str) -> str:
@@ -472,8 +521,11 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     ``GUARDS`` (the guard names) and the cfuncs ``flow`` (2n outputs) and
     ``flow_variational`` (``2n + (2n)^2`` outputs: the flow and ``A(x) Phi``), plus
     ``flow_locked``/``flow_locked_variational`` for a kneed walker; each writes the values
-    of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  The
-    equations are those of :func:`generate` (same expressions, same key).
+    of ``GUARDS`` after its outputs (CyRK's "extra outputs", recorded at every step).  For
+    the per-row integrator (:mod:`walkerlab.integrate.rows_dop853`), made on first use:
+    ``plain_flow(name)``, the flow ``name`` without the guard outputs (its stages), and
+    ``guard_one()``, one guard's value (its crossing's location), the same lines and values
+    bit for bit.  The equations are those of :func:`generate` (same expressions, same key).
     """
     start_module(eq.params)
     flows = {"flow": eq}
@@ -501,6 +553,9 @@ def generate_compiled(eq: Equations, param_names, key: str) -> str:
     for k, e in flows.items():
         body += _cfunc(k, e, consts, parts[k], False, guards) + [""]
         body += _cfunc(f"{k}_variational", e, consts, parts[k], True, guards) + [""]
+        body += _cfunc(f"_{k}_plain", e, consts, parts[k], False, None, lazy=True) + [""]
+    body += _guard_cfunc(eq, consts, guards)
+    body += _stage_cfuncs(flows)
     body += _reset_cfunc(eq, consts, reset)
     head = [
         f"# walkerlab compiled model code (walkerlab.codegen.source); key {key}",

@@ -131,6 +131,7 @@ class BatchStepMap:
         #: rows integrated by the compiled per-row integrator (phases), for the record
         self.integrated = 0
         self._walkers: dict[float, object] = {}
+        self._fns: dict[int, tuple] = {}  # the per-row integrator's cfuncs, by phase
 
     # -- slope handling -------------------------------------------------------------------
     def _probe_slope_dependence(self) -> bool:
@@ -218,10 +219,22 @@ class BatchStepMap:
         g = self._guard_table()
         steps = np.zeros(W, np.int64)
         fell = np.zeros(W, np.bool_)
-        walk_rows(self.phases[0][1], self._reset_flow, X, D, S, float(self.max_step_time_s),
+        walk_rows(*self._cfuncs(0), self._reset_flow, X, D, S, float(self.max_step_time_s),
                   *g, float(self.rtol), float(self.atol), self.n + self.phases[0][2], steps,
                   fell)
         return steps, fell, X
+
+    def _cfuncs(self, k: int) -> tuple:
+        """Phase ``k``'s cfuncs for the per-row integrator
+        (:func:`walkerlab.integrate.rows_dop853.cfuncs`; made on first use)."""
+        from walkerlab.codegen.compiled import compiled_module
+        from walkerlab.integrate.rows_dop853 import cfuncs
+
+        if k not in self._fns:
+            ph = self.phases[k]
+            cf = ph[0].compiled
+            self._fns[k] = cfuncs(compiled_module(cf.structure), cf.name, ph[1])
+        return self._fns[k]
 
     def _guard_table(self):
         """``(gstart, gcols, goffs, dirs, gout)``: every phase's guards in flat arrays."""
@@ -380,13 +393,14 @@ class BatchStepMap:
         rows that go on to phase k + 1 (their entry states and times)."""
         from walkerlab.integrate.rows_dop853 import FAILED, phase_rows
 
-        ph, cfunc, n_extra, gcols, goffs, dirs = phase
+        ph, _, n_extra, gcols, goffs, dirs = phase
         N, m = Y.shape
         which = np.empty(N, np.int64)
         te = np.empty(N)
         Yev = np.empty((N, m))
         H = self._h_rows[rows]
-        phase_rows(cfunc, np.ascontiguousarray(Y, dtype=float), np.ascontiguousarray(Dk),
+        phase_rows(*self._cfuncs(k), np.ascontiguousarray(Y, dtype=float),
+                   np.ascontiguousarray(Dk),
                    np.ascontiguousarray(cap, dtype=float), self._gcols[k], self._goffs[k],
                    self._dirs[k], float(self.rtol), float(self.atol), m + n_extra, which, te,
                    Yev, H)

@@ -12,7 +12,10 @@ equals scipy's RMS norm at tolerances divided by ``sqrt(2n)``).
 
 The flow is the walker's compiled ``cfunc`` ``(dy, t, y, d)``
 (:class:`walkerlab.codegen.compiled.CompiledFlow`), called as a first-class function; its
-extra outputs are the guards (``G[gcols] + goffs``).  A guard ends the phase when it changes
+extra outputs are the guards (``G[gcols] + goffs``).  Where the generated module has them
+(:func:`cfuncs`), a step's inner stages call the flow without its guard outputs and a
+crossing is located on one guard's cfunc: the same values bit for bit, fewer operations
+(the guards are needed only at the ends of a step).  A guard ends the phase when it changes
 sign in its direction over an accepted step (``up``: from <= 0 to >= 0, ``down``: from >= 0 to
 <= 0, ``solve_ivp``'s rule); the crossing is located on the step's 7th-order dense output by
 the Illinois method (bracketing regula falsi) to 1e-15 s, and the first crossing of all the
@@ -32,7 +35,7 @@ import numpy as np  # noqa: E402
 from numba import njit  # noqa: E402
 from scipy.integrate import DOP853 as _SCIPY_DOP853  # noqa: E402
 
-__all__ = ["TIMEOUT", "FAILED", "phase_rows", "reset_rows", "walk_rows"]
+__all__ = ["TIMEOUT", "FAILED", "cfuncs", "phase_rows", "reset_rows", "walk_rows"]
 
 #: ``which`` of a row that reached its time cap / whose step size collapsed
 TIMEOUT, FAILED = -1, -2
@@ -46,6 +49,16 @@ B = np.ascontiguousarray(_SCIPY_DOP853.B)
 E3 = np.ascontiguousarray(_SCIPY_DOP853.E3)
 E5 = np.ascontiguousarray(_SCIPY_DOP853.E5)
 DD = np.ascontiguousarray(_SCIPY_DOP853.D)
+
+
+def cfuncs(module, name: str, flow) -> tuple:
+    """``(f, fs, fg, sel)`` of :func:`phase_rows` for the cfunc ``flow`` named ``name`` of
+    the compiled ``module`` (:mod:`walkerlab.codegen.compiled`): with its guard-free twin and the
+    one-guard cfunc when the module has them (``plain_flow``, ``guard_one``: the same
+    values bit for bit), else ``flow`` for every role."""
+    if hasattr(module, "plain_flow") and hasattr(module, "guard_one"):
+        return (flow, module.plain_flow(name), module.guard_one(), True)
+    return (flow, flow, flow, False)
 
 
 @njit(cache=True, error_model="numpy")
@@ -70,8 +83,9 @@ def _dense_at(F, y_old, x, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def _dense_coeffs(f, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compiled
-    """The 3 extra stages and the interpolant's coefficients ``F`` (7, m) of the step."""
+def _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compiled
+    """The 3 extra stages (flow ``fs``) and the interpolant's coefficients ``F`` (7, m)
+    of the step."""
     m = y.size
     for s in range(NS + 1, 16):
         for k in range(m):
@@ -79,7 +93,7 @@ def _dense_coeffs(f, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compile
             for j in range(s):
                 acc += A[s, j] * K[j, k]
             tmp[k] = y[k] + h * acc
-        f(K[s].ctypes, t + C[s] * h, tmp.ctypes, d.ctypes)
+        fs(K[s].ctypes, t + C[s] * h, tmp.ctypes, d.ctypes)
     for k in range(m):
         dy = ynew[k] - y[k]
         F[0, k] = dy
@@ -93,15 +107,28 @@ def _dense_coeffs(f, t, h, y, ynew, K, d, F, tmp):  # pragma: no cover - compile
 
 
 @njit(cache=True, error_model="numpy")
-def _locate(f, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
+def _guard_at(f, fg, sel, t, y, d, buf, gcols, goffs, j, gv):  # pragma: no cover - compiled
+    """Guard ``j``'s value at ``(t, y)``: by the guard cfunc ``fg`` alone when ``sel``,
+    else from the flow ``f``'s extra outputs (the same value)."""
+    if sel:
+        buf[0] = gcols[j]
+        fg(buf.ctypes, t, y.ctypes, d.ctypes)
+        return buf[0] + goffs[j]
+    f(buf.ctypes, t, y.ctypes, d.ctypes)
+    _guards(buf, y.size, gcols, goffs, gv)
+    return gv[j]
+
+
+@njit(cache=True, error_model="numpy")
+def _locate(f, fg, sel, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
             gv):  # pragma: no cover - compiled
     """Time of guard ``j``'s crossing in the step ``[t_old, t_old + h]`` (values ``g0``,
-    ``g1`` at its ends), by the Illinois method on the dense output."""
+    ``g1`` at its ends), by the Illinois method on the dense output (guard values by
+    :func:`_guard_at`)."""
     if g1 == 0.0:
         return t_old + h
     if g0 == 0.0:
         return t_old
-    m = y_old.size
     a, b, fa, fb = 0.0, 1.0, g0, g1
     x = 1.0
     side = 0
@@ -110,9 +137,7 @@ def _locate(f, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
         if not a < x < b:
             x = 0.5 * (a + b)
         _dense_at(F, y_old, x, tmp)
-        f(buf.ctypes, t_old + x * h, tmp.ctypes, d.ctypes)
-        _guards(buf, m, gcols, goffs, gv)
-        fx = gv[j]
+        fx = _guard_at(f, fg, sel, t_old + x * h, tmp, d, buf, gcols, goffs, j, gv)
         if fx == 0.0:
             break
         if (fx > 0.0) == (fb > 0.0):
@@ -131,9 +156,10 @@ def _locate(f, F, y_old, t_old, h, d, buf, gcols, goffs, j, g0, g1, tmp,
 
 
 @njit(cache=True, error_model="numpy")
-def _attempt(f, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - compiled
-    """One DOP853 step of size ``h`` from ``(t, y)`` (``K[0]`` = f(t, y)): ``ynew`` and
-    the FSAL evaluation (flow and extra outputs) into ``K[NS]``; returns the error norm."""
+def _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - compiled
+    """One DOP853 step of size ``h`` from ``(t, y)`` (``K[0]`` = f(t, y)), its stages by the
+    flow ``fs``: ``ynew`` and the FSAL evaluation by ``f`` (flow and extra outputs) into
+    ``K[NS]``; returns the error norm."""
     m = y.size
     for s in range(1, NS):
         for k in range(m):
@@ -141,7 +167,7 @@ def _attempt(f, t, y, h, K, d, ynew, rtol, atol):  # pragma: no cover - compiled
             for j in range(s):
                 acc += A[s, j] * K[j, k]
             ynew[k] = y[k] + h * acc
-        f(K[s].ctypes, t + C[s] * h, ynew.ctypes, d.ctypes)
+        fs(K[s].ctypes, t + C[s] * h, ynew.ctypes, d.ctypes)
     for k in range(m):
         acc = 0.0
         for j in range(NS):
@@ -200,11 +226,12 @@ def _work(m, n_out, ng):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
+def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
          work):  # pragma: no cover - compiled
     """One row to its first guard crossing: ``(which, t_event, next step size)``, the state
-    into ``yev``; ``h_first`` > 0: the first step size [s] (else scipy's choice); ``work``:
-    :func:`_work`'s scratch arrays (allocated once per call of the caller, not per row)."""
+    into ``yev``; ``f, fs, fg, sel``: the cfuncs (:func:`phase_rows`); ``h_first`` > 0: the
+    first step size [s] (else scipy's choice); ``work``: :func:`_work`'s scratch arrays
+    (allocated once per call of the caller, not per row)."""
     m = y.size
     ng = gcols.size
     K, F, buf, ynew, tmp, G = work
@@ -215,7 +242,7 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
     if h_first > 0.0:
         h_abs = min(h_first, t_bound)
     else:
-        h_abs = _first_step(f, y, K[0], d, buf, tmp, rtol, atol, t_bound)
+        h_abs = _first_step(fs, y, K[0], d, buf, tmp, rtol, atol, t_bound)
     while True:
         rejected = False
         while True:
@@ -224,7 +251,7 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
                 return FAILED, t, h_abs
             t_new = min(t + h_abs, t_bound)
             h = t_new - t
-            err = _attempt(f, t, y, h, K, d, ynew, rtol, atol)
+            err = _attempt(f, fs, t, y, h, K, d, ynew, rtol, atol)
             if err < 1.0:
                 fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
                 if rejected:
@@ -242,9 +269,10 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
             if not hit:
                 continue
             if not dense:
-                _dense_coeffs(f, t, h, y, ynew, K, d, F, tmp)
+                _dense_coeffs(fs, t, h, y, ynew, K, d, F, tmp)
                 dense = True
-            tj = _locate(f, F, y, t, h, d, buf, gcols, goffs, j, g0[j], g1[j], tmp, gv)
+            tj = _locate(f, fg, sel, F, y, t, h, d, buf, gcols, goffs, j, g0[j], g1[j], tmp,
+                         gv)
             if tj < te:
                 best, te = j, tj
         if best >= 0:
@@ -261,10 +289,15 @@ def _row(f, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first,
 
 
 @njit(cache=True, error_model="numpy")
-def phase_rows(f, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te, Yev,
-               H):  # pragma: no cover - compiled
+def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
+               Yev, H):  # pragma: no cover - compiled
     """Integrate every row of ``Y`` (N, m) [state units] with its data vector ``D[i]`` from
-    phase time 0 to its first guard crossing (module docstring): guard index or
+    phase time 0 to its first guard crossing (module docstring): ``f, fs, fg, sel``
+    (:func:`cfuncs`; separate arguments: a tuple of functions is an experimental numba
+    type), the cfuncs ``(dy, t, y, d)`` of the flow with its guard outputs ``f`` (a step's
+    first and last evaluation), the flow alone ``fs`` (its other stages) and, when ``sel``,
+    ``fg`` writing the guard column ``int(dy[0])`` into ``dy[0]`` (a crossing's location;
+    else ``f``'s guard outputs); guard index or
     :data:`TIMEOUT` / :data:`FAILED` into ``which`` (N,), the time [s] into ``te`` (N,) and
     the state there into ``Yev`` (N, m).  ``cap`` (N,) [s]: time limits; ``gcols``, ``goffs``,
     ``dirs`` (g,): guard columns among the cfunc's extra outputs, offsets, directions;
@@ -275,8 +308,8 @@ def phase_rows(f, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te, Y
     y = np.empty(Y.shape[1])
     for i in range(Y.shape[0]):
         y[:] = Y[i]
-        w, t, h = _row(f, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol, Yev[i], H[i],
-                       work)
+        w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol, Yev[i],
+                       H[i], work)
         which[i] = w
         te[i] = t
         H[i] = h
@@ -295,8 +328,8 @@ def reset_rows(reset, X, D, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, error_model="numpy")
-def walk_rows(f, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, gout, rtol,
-              atol, n_out, steps, fell):  # pragma: no cover - compiled
+def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs,
+              gout, rtol, atol, n_out, steps, fell):  # pragma: no cover - compiled
     """Walk every row of ``X`` (W, m) up to ``n_steps`` steps, step ``s`` of walk ``w`` on
     the data vector ``D[w, s]`` (its slope): the phases of a step in turn (phase ``p``'s
     guards ``gstart[p]:gstart[p + 1]`` of the flat arrays ``gcols``, ``goffs``, ``dirs``
@@ -304,7 +337,8 @@ def walk_rows(f, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, gou
     each integrated by :func:`_row` as :func:`phase_rows` does (the step size carried from
     phase to phase), a heel strike reset by ``reset`` and counted in ``steps`` (W,); a fall,
     a step longer than ``max_time`` [s] or a failed integration sets ``fell`` (W,) and ends
-    the walk.  ``X`` is overwritten with each walk's last post-impact state."""
+    the walk.  ``f, fs, fg, sel``: the flow's cfuncs (:func:`phase_rows`).  ``X`` is
+    overwritten with each walk's last post-impact state."""
     W, m = X.shape
     n_ph = gstart.size - 1
     yev = np.empty(m)
@@ -322,7 +356,7 @@ def walk_rows(f, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs, gou
                 if max_time - T <= 0.0:
                     ended = True
                     break
-                which, te, h = _row(f, y, d, max_time - T, gcols[a:b], goffs[a:b],
+                which, te, h = _row(f, fs, fg, sel, y, d, max_time - T, gcols[a:b], goffs[a:b],
                                     dirs[a:b], rtol, atol, yev, h, work)
                 if which < 0 or gout[a + which] == 1:
                     ended = True
