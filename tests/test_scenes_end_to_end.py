@@ -33,7 +33,7 @@ NO_GAIT = {"rabbit_optimal": "tests/test_optimize_five_link.py"}
 
 def reduced(path: Path, tmp: Path):
     """A fast copy of a scene: one stride, no work-precision or robustness study, one contact
-    stride."""
+    stride, no phase-variable replays."""
     d = yaml.safe_load(path.read_text())
     d.setdefault("name", path.stem)
     d.pop("workprecision", None)
@@ -47,6 +47,8 @@ def reduced(path: Path, tmp: Path):
     if "contact_sim" in d:
         d["contact_sim"]["n_strides"] = 1
         d["contact_sim"]["periodic_gait"] = False
+    if "optimize" in d:  # ~75 s CPU for kneed: tests/test_optimize_phases.py checks them
+        d["optimize"]["phase_replay"] = False
     p = tmp / path.name
     p.write_text(yaml.safe_dump(d))
     return load_scene(p)
