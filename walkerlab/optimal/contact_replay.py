@@ -38,9 +38,7 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
         How the run ended, or why there is no replay (massless legs: the contact view
         needs leg masses).
     """
-    from walkerlab.analysis.contact.sim import simulate_from
     from walkerlab.config import SolverSettings
-    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
     from walkerlab.optimal.collocation import torque_of_time
 
     w = scene.walker.model_dump()
@@ -48,25 +46,16 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
               for b in leg.get("bodies", [])]
     if bodies and all(b.get("mass_kg", 1.0) == 0.0 for b in bodies):
         return float("nan"), "not replayed: massless legs (the contact view needs masses)"
-    d = scene.model_dump(mode="json", exclude_none=True)
     act = {"torques": [{"joint": "hip", "law": {}}]}
     if res.push_off_n_s > 0.0:
         act["push_off"] = {"impulse_n_s": float(res.push_off_n_s)}
-    d["walker"]["actuation"] = act
-    d.setdefault("contact", {})
-    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500}
-    try:
-        setup = contact_setup(type(scene).model_validate(d))
-    except (ContactSceneError, ValueError) as exc:
-        return float("nan"), f"not replayed: {exc}"
+    setup, why = _powered_setup(scene, act, {"n_strides": strides, "sample_rate_hz": 500})
+    if setup is None:
+        return float("nan"), why
     tau = torque_of_time(res)
     setup.actuators.laws = lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
     solver = SolverSettings.for_contact(method="LSODA", rtol=1e-6, atol=1e-8)
-    _, run, _, _ = simulate_from(setup, res.x[0], res.step_period_s, solver=solver,
-                                 strides=strides)
-    hs = np.asarray(run.heel_strike_times, float)
-    period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
-    return period, str(run.termination)
+    return _run(setup, res.x[0], res.step_period_s, strides, solver)
 
 
 def contact_replay_five_link(scene, law, x0, step_period_s: float,
@@ -100,28 +89,17 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
     outcome : str
         How the run ended, or why there is no replay (one line).
     """
-    from walkerlab.analysis.contact.sim import simulate_from
     from walkerlab.config import SolverSettings
-    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
     from walkerlab.optimal.five_link import JOINTS
 
-    d = scene.model_dump(mode="json", exclude_none=True)
-    d["walker"]["actuation"] = {"torques": [{"joint": j, "law": {}} for j in JOINTS]}
-    d.setdefault("contact", {})
-    d.setdefault("terrain", {})
-    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500}
-    try:
-        setup = contact_setup(type(scene).model_validate(d))
-    except (ContactSceneError, ValueError) as exc:
-        return float("nan"), f"not replayed: {exc}"
+    setup, why = _powered_setup(scene, {"torques": [{"joint": j, "law": {}} for j in JOINTS]},
+                                {"n_strides": strides, "sample_rate_hz": 500}, terrain=True)
+    if setup is None:
+        return float("nan"), why
     setup.actuators.rigid.laws = law
     solver = scene.contact_solver or SolverSettings.for_contact(method="LSODA", rtol=1e-8,
                                                                  atol=1e-10)
-    _, run, _, _ = simulate_from(setup, np.asarray(x0, float), step_period_s, solver=solver,
-                                 strides=strides)
-    hs = np.asarray(run.heel_strike_times, float)
-    period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
-    return period, str(run.termination)
+    return _run(setup, x0, step_period_s, strides, solver)
 
 
 def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
@@ -157,28 +135,18 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
         section's flat-foot regularisation, a walker the contact view carries no hip torque
         on; one line).
     """
-    from walkerlab.analysis.contact.sim import simulate_from
-    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
     from walkerlab.optimal.phased_collocation import phase_torque_of_time
 
-    d = scene.model_dump(mode="json", exclude_none=True)
-    d["walker"]["actuation"] = {"torques": [{"joint": "hip", "law": {}}]}
-    d.setdefault("contact", {})
     # a powered run is on a Python RHS (a flat-footed walker's stride: ~7 s CPU), so the
     # wall-time limit is set for a loaded machine, not the contact-sim default (120 s)
-    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500,
-                        "wall_time_limit_s": REPLAY_WALL_TIME_LIMIT_S}
-    try:
-        setup = contact_setup(type(scene).model_validate(d))
-    except (ContactSceneError, ValueError) as exc:
-        return float("nan"), f"not replayed: {exc}"
+    setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]},
+                                {"n_strides": strides, "sample_rate_hz": 500,
+                                 "wall_time_limit_s": REPLAY_WALL_TIME_LIMIT_S})
+    if setup is None:
+        return float("nan"), why
     tau = phase_torque_of_time(res)
     setup.actuators.laws = lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
-    _, run, _, _ = simulate_from(setup, np.asarray(res.x[0], float), res.step_period_s,
-                                 strides=strides)
-    hs = np.asarray(run.heel_strike_times, float)
-    period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
-    return period, str(run.termination)
+    return _run(setup, res.x[0], res.step_period_s, strides)
 
 
 def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
@@ -207,20 +175,14 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
     outcome : str
         How the run ended, or why there is no replay (one line).
     """
-    from walkerlab.analysis.contact.sim import simulate_from
     from walkerlab.config import SolverSettings
-    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
     from walkerlab.optimal.phased_collocation import phase_torque_of_time
     from walkerlab.optimal.stride import step_of
 
-    d = scene.model_dump(mode="json", exclude_none=True)
-    d["walker"]["actuation"] = {"torques": [{"joint": "hip", "law": {}}]}
-    d.setdefault("contact", {})
-    d["contact_sim"] = {"n_strides": strides, "sample_rate_hz": 500}
-    try:
-        setup = contact_setup(type(scene).model_validate(d))
-    except (ContactSceneError, ValueError) as exc:
-        return float("nan"), f"not replayed: {exc}"
+    setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]},
+                                {"n_strides": strides, "sample_rate_hz": 500})
+    if setup is None:
+        return float("nan"), why
     acts = setup.actuators
     laws = [(lambda tau: lambda delta, ddelta, s, ds, t: np.array([tau(float(t))]))(
         phase_torque_of_time(step_of(res, k))) for k in (0, 1)]
@@ -231,8 +193,35 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
         return own(x, stance, t_step)
     acts.hip_torque = hip_torque
     solver = SolverSettings.for_contact(method="LSODA", rtol=1e-6, atol=1e-8)
-    _, run, _, _ = simulate_from(setup, np.asarray(res.x[0], float), res.step_period_s / 2,
-                                 solver=solver, strides=strides)
+    return _run(setup, res.x[0], res.step_period_s / 2, strides, solver)
+
+
+def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = False):
+    """The contact set-up of ``scene`` with ``actuation`` in place of its walker's and
+    ``contact_sim`` as its run section (its ``contact`` law, the paper's default one if none;
+    ``terrain``: continuous level ground if none), or ``(None, why)`` in one line."""
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["walker"]["actuation"] = actuation
+    d.setdefault("contact", {})
+    if terrain:
+        d.setdefault("terrain", {})
+    d["contact_sim"] = contact_sim
+    try:
+        return contact_setup(type(scene).model_validate(d)), ""
+    except (ContactSceneError, ValueError) as exc:
+        return None, f"not replayed: {exc}"
+
+
+def _run(setup, x0, step_period_s: float, strides: int, solver=None) -> tuple[float, str]:
+    """The powered contact run from ``x0``: the mean period of its steps after the first
+    touchdown [s] (NaN if fewer than two) and how it ended."""
+    from walkerlab.analysis.contact.sim import simulate_from
+
+    kw = {} if solver is None else {"solver": solver}
+    _, run, _, _ = simulate_from(setup, np.asarray(x0, float), step_period_s,
+                                 strides=strides, **kw)
     hs = np.asarray(run.heel_strike_times, float)
     period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
     return period, str(run.termination)
