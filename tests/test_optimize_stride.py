@@ -86,8 +86,8 @@ def test_the_least_effort_stride_is_the_passive_period_two_gait(asym):
     multipliers those of the fixed point (1e-6: the start's distance)."""
     from walkerlab.optimal.collocation import CollocationSpec
     from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.phased_scene import replay_multipliers
     from walkerlab.optimal.stride import replay_stride, step_of
-    from walkerlab.optimal.stride_scene import _multipliers
 
     scene, data, _walker, g, fns = asym
     guess = [(name, t, 1.05 * x) for name, t, x in _guess(asym, 60)]
@@ -100,7 +100,7 @@ def test_the_least_effort_stride_is_the_passive_period_two_gait(asym):
     np.testing.assert_allclose(res.x[0], g.x, atol=1e-6)
     err, replayed = replay_stride(data, res)
     assert err <= 1e-6
-    mu = _multipliers(replayed, res, scene, err)
+    mu = replay_multipliers(replayed, res, scene, err)
     np.testing.assert_allclose(np.sort_complex(mu), np.sort_complex(g.multipliers),
                                atol=1e-6)
 

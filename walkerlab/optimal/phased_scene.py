@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["optimize_phased_scene", "starting_phases"]
+__all__ = ["optimize_phased_scene", "replay_multipliers", "starting_phases"]
 
 
 def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float):
@@ -64,7 +64,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     build = time.perf_counter() - t0
     res = collocate_phases(fns, spec, guess, guess_u)
     err, replayed = replay_phases(data, res)
-    mu = _multipliers(replayed, res, scene, err)
+    mu = replay_multipliers(replayed, res, scene, err)
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
     if np.isfinite(err):
         contact_period, contact_outcome = contact_replay_phased(scene, res, strides=2)
@@ -141,9 +141,26 @@ def _unit(objective: str) -> str:
     return OBJECTIVES.get(objective, "-")
 
 
-def _multipliers(replayed, res, scene, err: float) -> np.ndarray:
+def replay_multipliers(replayed, res, scene, err: float) -> np.ndarray:
     """The replay map's Floquet multipliers at the start (variational equations +
-    saltation; NaN when the replay failed)."""
+    saltation through every phase, or both steps of a stride).
+
+    Parameters
+    ----------
+    replayed : HybridWalker
+        The rigid walker under the optimised torques.
+    res : PhasedResult
+        The optimum (its start ``res.x[0]``, shape (n,), and ``step_period_s`` [s]).
+    scene : Scene
+        Its ``solver`` integrates the map.
+    err : float
+        The replay's return error (NaN: the replay failed).
+
+    Returns
+    -------
+    ndarray, shape (n,), complex
+        The multipliers, NaN when the replay or the map failed (a report, not a gate).
+    """
     from walkerlab.analysis.gait.poincare import poincare_map
     from walkerlab.integrate.solver import Solver
 

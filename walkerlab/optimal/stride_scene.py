@@ -64,6 +64,7 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.contact_replay import contact_replay_stride
     from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.phased_scene import replay_multipliers
     from walkerlab.optimal.stride import replay_stride, stride_functions, stride_guess
 
     o = scene.optimize
@@ -79,7 +80,7 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     build = time.perf_counter() - t0
     res = collocate_phases(fns, spec, guess)
     err, replayed = replay_stride(data, res)
-    mu = _multipliers(replayed, res, scene, err)
+    mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
     if np.isfinite(err):
         contact_period, contact_outcome = contact_replay_stride(scene, res, strides=2)
@@ -123,20 +124,3 @@ def _record(scene, walker, res) -> dict:
     out["energy"] = {kind: np.concatenate([p["energy"][kind] for p in parts])
                      for kind in out["energy"]}
     return out
-
-
-def _multipliers(replayed, res, scene, err: float) -> np.ndarray:
-    """The stride map's Floquet multipliers at the replay's start (variational equations +
-    saltation through both steps; NaN when the replay failed)."""
-    from walkerlab.analysis.gait.poincare import poincare_map
-    from walkerlab.integrate.solver import Solver
-
-    mu = np.full(res.x.shape[1], np.nan, complex)
-    if not np.isfinite(err):
-        return mu
-    try:
-        DP = poincare_map(replayed, res.x[0], Solver.from_settings(scene.solver),
-                          max_step_time=3.0 * res.step_period_s, jacobian=True)[2]
-        return np.linalg.eigvals(DP).astype(complex)
-    except Exception:  # noqa: BLE001 - the replay's multipliers are a report, not a gate
-        return mu
