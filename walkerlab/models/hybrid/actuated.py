@@ -465,7 +465,6 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     def jac_of(jac, constraint=None):
         if not has_torque:
             return jac
-        acc = locked(constraint)
 
         def J(t, x):
             base = np.array(jac(t, x), float)
