@@ -31,8 +31,8 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["STEP_PHASES", "replay_stride", "step_of", "stride_functions", "stride_guess",
-           "stride_walker"]
+__all__ = ["STEP_PHASES", "STRIDE_PHASES", "replay_stride", "step_of", "stride_functions",
+           "stride_guess", "stride_walker"]
 
 #: the rigid model's phases of a straight-legged step (:func:`walkerlab.optimal.phases.
 #: phase_order` of it), each step of the stride named by its swinging leg
@@ -44,6 +44,10 @@ SWINGING = ("leg1", "leg2")
 def _named(leg: str, name: str) -> str:
     """A stride phase's name: ``<swinging leg>:<rigid phase>``."""
     return f"{leg}_swing:{name}"
+
+
+#: the stride's four phases in order (:func:`stride_functions`' ``phases``)
+STRIDE_PHASES = tuple(_named(leg, name) for leg in SWINGING for name, _g, _d in STEP_PHASES)
 
 
 def stride_functions(data) -> dict:

@@ -1,6 +1,8 @@
 """A scene's optimal gait when its walker's legs differ: the stride transcription of
 :mod:`walkerlab.optimal.stride` set up from the scene, started from one stride of the
-scene's gait (``fixedpoint``: the stride map's fixed point), replayed on the rigid model,
+scene's gait (``fixedpoint``: the stride map's fixed point), of a continuation artifact's
+gait or from another stride's ``optimize.h5`` (``optimize.initial_guess``), replayed on the
+rigid model,
 the stride map's Floquet multipliers from the replay, and replayed in the contact model
 (:func:`walkerlab.optimal.contact_replay.contact_replay_stride`)."""
 
@@ -8,23 +10,58 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["optimize_stride_scene"]
+__all__ = ["optimize_stride_scene", "starting_stride"]
 
 
 def _check(o) -> None:
     """Refuse what the stride transcription does not take (one line naming the field)."""
+    from walkerlab.optimal.phased_collocation import PHASED_OBJECTIVES
+
     asked = dict(o.weights or {}) if o.objective == "weighted" else {o.objective: 1.0}
-    bad = [k for k in asked if k not in ("effort", "peak_torque")]
+    bad = [k for k in asked if k not in PHASED_OBJECTIVES]
     if bad:
-        raise ValueError(f"optimize.objective: legs that differ take effort or peak_torque "
-                         f"(or their weighted sum) today, not {', '.join(bad)}")
+        raise ValueError(f"optimize.objective: legs that differ take "
+                         f"{', '.join(PHASED_OBJECTIVES)} (or their weighted sum), not "
+                         f"{', '.join(bad)}")
     if o.push_off == "free":
         raise ValueError("optimize.push_off: legs that differ have no push-off today")
-    if o.friction_coefficient is not None:
-        raise ValueError("optimize.friction_coefficient: not yet for legs that differ")
-    if o.initial_guess is not None:
-        raise ValueError("optimize.initial_guess: legs that differ start from their own "
-                         "gait today")
+
+
+def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
+    """The stride collocation's start for ``scene``: its ``optimize.initial_guess`` (another
+    stride's ``optimize.h5``: its four phases' states and torque; a continuation artifact's
+    gait at ``at``: the stride map's start there), else one stride of its gait ``x_gait``
+    (2n,) of mean step period ``period_s`` [s]; ``intervals`` a step.
+
+    Returns
+    -------
+    guess : list of (name, t, x)
+        The four phases :data:`walkerlab.optimal.stride.STRIDE_PHASES`
+        (:func:`walkerlab.optimal.stride.stride_guess`, or
+        :func:`walkerlab.optimal.phased_collocation.optimized_guess` on ``2 intervals``).
+    torque : list of ndarray or None
+        Each phase's hip torque [N m] (another ``optimize.h5``'s; None: 0).
+
+    Raises
+    ------
+    ValueError
+        An unusable artifact, one of another walker, or one without the stride's phases (a
+        one-step optimisation; one line naming ``optimize.initial_guess``); the starting
+        gait does not make a stride (one line).
+    """
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.guess import read_guess
+    from walkerlab.optimal.phased_collocation import optimized_guess
+    from walkerlab.optimal.stride import STRIDE_PHASES, stride_guess
+
+    kind, got = None, None
+    if scene.optimize.initial_guess is not None:
+        kind, got = read_guess(scene, list(walker.state_names()))
+    if kind == "optimize":
+        return optimized_guess(got, list(STRIDE_PHASES), 2 * intervals)
+    x0 = got if kind == "continuation" else x_gait
+    return stride_guess(walker, x0, period_s, Solver.from_settings(scene.solver),
+                        intervals), None
 
 
 def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float):
@@ -33,8 +70,9 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     Parameters
     ----------
     scene : Scene
-        With ``optimize`` (objective effort or peak_torque; targets, torque limit,
-        clearance, hip angle range).
+        With ``optimize`` (objective effort, cost_of_transport or peak_torque or their
+        weighted sum; targets, torque limit, clearance, hip angle range, friction cone;
+        the guess: :func:`starting_stride`).
     data : WalkerData
         The scene's walker (``data.mirror`` the other leg's step).
     spec : walkerlab.optimal.collocation.CollocationSpec
@@ -54,18 +92,17 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     Raises
     ------
     ValueError
-        An objective, constraint or guess this transcription does not take, a push-off, or
+        An objective this transcription does not take, a push-off, an unusable guess, or
         the starting gait does not make a stride (one line).
     """
     import time
 
-    from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.contact_replay import contact_replay_stride
     from walkerlab.optimal.phased_collocation import collocate_phases
     from walkerlab.optimal.phased_scene import replay_multipliers
-    from walkerlab.optimal.stride import replay_stride, stride_functions, stride_guess
+    from walkerlab.optimal.stride import replay_stride, stride_functions
 
     o = scene.optimize
     _check(o)
@@ -73,12 +110,11 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
         raise ValueError("walker.actuation.push_off: legs that differ have no push-off in "
                          "the stride transcription today")
     walker = make_rigid_walker(data)
-    guess = stride_guess(walker, x_gait, period_s, Solver.from_settings(scene.solver),
-                         spec.intervals)
+    guess, guess_u = starting_stride(scene, walker, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
     fns = stride_functions(data)
     build = time.perf_counter() - t0
-    res = collocate_phases(fns, spec, guess)
+    res = collocate_phases(fns, spec, guess, guess_u)
     err, replayed = replay_stride(data, res)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
