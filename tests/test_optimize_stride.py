@@ -130,23 +130,30 @@ def test_a_powered_stride_at_a_target_speed_replays_on_the_rigid_model(asym):
 
 
 def test_what_the_stride_does_not_take_is_refused_in_one_line(asym):
-    """Objectives other than effort / peak torque, a push-off, friction, another guess:
-    refused in one line naming the field (before any work); one step of legs that differ
-    stays refused by the one-step transcription."""
+    """A free push-off and objectives the phased transcription has no term for (the
+    push-off's work) are refused in one line naming the field (before any work); the cost
+    of transport and the friction cone pass the stride's checks, and a guess is read from
+    its artifact (a missing one refused naming ``optimize.initial_guess``); one step of legs
+    that differ stays refused by the one-step transcription."""
     from walkerlab.optimal.collocation import step_functions
     from walkerlab.optimal.scene import optimize_scene
+    from walkerlab.optimal.stride_scene import _check
 
     scene, data, _walker, g, _fns = asym
-    for field, value, says in (("objective", "cost_of_transport", "optimize.objective"),
-                               ("push_off", "free", "optimize.push_off"),
-                               ("friction_coefficient", 0.8, "optimize.friction_coefficient"),
-                               ("initial_guess", {"from": "x.h5"}, "optimize.initial_guess")):
+
+    def with_(field, value):
         d = scene.model_dump(mode="json", exclude_none=True)
         d["optimize"][field] = value
-        bad = type(scene).model_validate(d)
+        return type(scene).model_validate(d)
+
+    for field, value, says in (("objective", "push_off_work", "optimize.objective"),
+                               ("push_off", "free", "optimize.push_off"),
+                               ("initial_guess", {"from": "x.h5"}, "optimize.initial_guess")):
         with pytest.raises(ValueError, match=says) as exc:
-            optimize_scene(bad, g.x, g.step_period)
+            optimize_scene(with_(field, value), g.x, g.step_period)
         assert "\n" not in str(exc.value)
+    for field, value in (("objective", "cost_of_transport"), ("friction_coefficient", 0.8)):
+        _check(with_(field, value).optimize)  # accepted
     with pytest.raises(ValueError, match="legs that differ take a stride"):
         step_functions(data, None)
     with pytest.raises(ValueError, match="a stride is for legs that differ"):
@@ -178,3 +185,293 @@ def test_optimize_command_on_legs_that_differ(tmp_path):
                                                                    rel=1e-7)
     assert max(abs(d.multipliers)) == pytest.approx(0.3531, abs=1e-3)
     assert d.contact_step_period_s == pytest.approx(d.step_period_s, rel=0.03)
+
+
+def _torqued_pair(data):
+    """The actuated rigid walker and its mirror whose hip torque is ``cur["u"]`` [N m]."""
+    spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
+    tw, cur = actuate(make_rigid_walker(data), data, spec), {"u": 0.0}
+    for w in (tw, tw.mirror):
+        w.actuators.torques = lambda t, x: np.array([cur["u"]])
+    return tw, cur
+
+
+def _newton_euler(w, data, x, qdd):
+    """The ground's resultant on the rigid walker ``w`` (or its mirror) along the slope's
+    normal and tangent [N]: ``sum m_i (a_i + g y)`` over its three mass points (the hip,
+    ``m_sw_mass`` on the swing leg, ``m_st_mass`` on the stance leg: each step's own), the
+    points' positions from its generated code, their accelerations by the Cauchy integral
+    (:func:`tests.test_optimize_phased_terms._com_acceleration`) along ``qdd``."""
+    from tests.test_optimize_phased_terms import _com_acceleration
+
+    p = w.params
+    masses = {"hip": p["M_hip"], "swing_mass": p["m_sw_mass"], "stance_mass": p["m_st_mass"]}
+    total = sum(masses.values())
+    assert total == pytest.approx(float(w.total_mass_kg), rel=1e-14)
+
+    def com(qc):
+        X = np.concatenate([qc, np.zeros(2)]).astype(complex)[:, None]
+        pts = w.points(w.layout().state_rows(X))
+        return sum(m * np.asarray(pts[k]).ravel() for k, m in masses.items()) / total
+
+    a = _com_acceleration(com, x[:2].astype(complex), x[2:].astype(complex),
+                          np.asarray(qdd, complex))
+    F = total * (a + np.array([0.0, float(data.gravity_m_per_s2)]))
+    s, c = np.sin(data.slope_rad), np.cos(data.slope_rad)
+    return np.array([s * F[0] + c * F[1], c * F[0] - s * F[1]])
+
+
+def test_each_steps_power_hip_angle_and_ground_reaction_are_its_own_walkers(asym):
+    """The stride's ``power``, ``hip_angle`` and ``ahead`` are leg A's CasADi functions,
+    used on leg B's step too: at random states they equal both the rigid walker's and its
+    mirror's own (the torque times the rate of its hip angle, swing minus stance; the
+    midstance guard) to round-off - the same expressions, no leg's number in them.  Each
+    phase's ground reaction (the friction cone's) is its own walker's: Newton-Euler on the
+    rigid walker for leg A's phases, on the mirror (the other masses) for leg B's, to 1e-10
+    of the weight, and the two steps' differ (the legs' masses: 1e-4 of the weight)."""
+    _scene, data, _walker, _g, fns = asym
+    tw, cur = _torqued_pair(data)
+    weight = float(data.total_mass_kg) * float(data.gravity_m_per_s2)
+    rng = np.random.default_rng(7)
+    for _ in range(4):
+        x, cur["u"] = rng.normal(0.0, [0.2, 0.2, 1.0, 1.0]), float(rng.normal(0.0, 2.0))
+        for w in (tw, tw.mirror):
+            delta, ddelta, _s, _ds = w.actuators.hip_angles(x)
+            assert float(fns["power"](x, cur["u"])) == pytest.approx(
+                w.actuators.power(0.0, x), rel=1e-13, abs=1e-14)
+            assert float(fns["power"](x, cur["u"])) == pytest.approx(cur["u"] * ddelta,
+                                                                    rel=1e-13, abs=1e-14)
+            assert float(fns["hip_angle"](x)) == pytest.approx(delta, abs=1e-15)
+            ahead = next(g for g in w.phases[0].guards if g.name == "midstance")
+            assert float(fns["ahead"](x)) == pytest.approx(ahead.function(0.0, x), abs=1e-15)
+        got = []
+        for k, mp in enumerate(fns["phases"]):
+            w = tw if k < 2 else tw.mirror
+            want = _newton_euler(w, data, x, w.phases[k % 2].flow(0.0, x)[2:])
+            got.append(mp.grf(x, cur["u"]).full().ravel())
+            np.testing.assert_allclose(got[-1], want, rtol=0, atol=1e-10 * weight)
+        assert np.max(np.abs(got[0] - got[2])) > 1e-5 * weight  # 1e-4 of it seen
+
+
+def test_the_least_cost_of_transport_stride_on_its_slope_is_the_passive_gait(asym):
+    """Cost of transport (slack variables, the effort weight 1e-2 of the phased scenes' test
+    on the passive slope) from the passive stride: CoT ~0 (1.5e-11 seen: the interior
+    point's slack floor), torques ~0 (4e-5 N m seen), each step's period within 1e-4 of the
+    shooting fixed point's (6e-6 seen: the objective, ~1e-11, resolves no closer; the least
+    effort's 7.5e-8 on this mesh) and the replay closing (<= 1e-6; 1.1e-8 seen)."""
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.stride import replay_stride, step_of
+
+    _scene, data, _walker, g, fns = asym
+    res = collocate_phases(fns, CollocationSpec(intervals=40, objective="cost_of_transport",
+                                                cost_of_transport_effort_weight=1e-2),
+                           _guess(asym))
+    assert res.status == "Solve_Succeeded"
+    assert res.terms["cost_of_transport"] <= 1e-10
+    assert np.max(np.abs(res.u)) < 1e-3
+    periods = [step_of(res, k).step_period_s for k in (0, 1)]
+    np.testing.assert_allclose(periods, g.step_periods, rtol=1e-4, atol=0)
+    assert replay_stride(data, res)[0] <= 1e-6
+
+
+@pytest.fixture(scope="module")
+def fast(asym):
+    """The least-effort stride at 0.6 m/s (the passive gait: 0.528 m/s) on 40 intervals a
+    step from the passive stride, and its spec."""
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.phased_collocation import collocate_phases
+
+    spec = CollocationSpec(intervals=40, target_speed_m_per_s=0.6)
+    return spec, collocate_phases(asym[4], spec, _guess(asym))
+
+
+def _replayed_cost_of_transport(data, res):
+    """The cost of transport of ``res`` from its rigid replay, independent of the
+    transcription's CasADi terms: the hip's positive work ``int max(tau d(delta)/dt, 0)
+    dt`` along the replayed stride (each step's torque of time, ``delta`` the hip angle of
+    its own walker's generated code; the trapezoidal rule on 20001 points a phase) over
+    ``M g`` and the stride's distance (each step's length between the feet of the rigid
+    model's points at its heel strike)."""
+    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.phased_collocation import phase_torque_of_time
+    from walkerlab.optimal.stride import step_of, stride_walker
+
+    w, segs = stride_walker(data, res), []
+    poincare_map(w, np.asarray(res.x[0], float), Solver(method="DOP853", rtol=1e-12,
+                                                        atol=1e-12),
+                 max_step_time=3.0 * res.step_period_s, steps=segs)
+    work, distance = 0.0, 0.0
+    for k, (seg, wk) in enumerate(zip(segs, (w, w.mirror))):
+        tau = phase_torque_of_time(step_of(res, k))
+        for _ph, sol, (a, b) in seg.pieces:
+            t = np.linspace(a, b, 20001)
+            X = np.asarray(sol(t), float)[:4]
+            rate = np.array([wk.actuators.hip_angles(X[:, j])[1] for j in range(t.size)])
+            u = np.array([tau(tj - seg.t_start) for tj in t])
+            work += np.trapezoid(np.maximum(u * rate, 0.0), t)
+        pts = wk.points(wk.layout().state_rows(np.asarray(seg.x_end, float)[:, None]))
+        distance += float(np.linalg.norm(np.ravel(pts["swing_foot"])
+                                         - np.ravel(pts["stance_foot"])))
+    return work / (float(data.total_mass_kg) * float(data.gravity_m_per_s2) * distance)
+
+
+@pytest.mark.slow
+def test_the_least_cost_of_transport_stride_at_a_target_speed(asym, fast):
+    """At 0.6 m/s with the effort weight 1e-2 (~15 s: 72 IPOPT iterations, the replay and
+    the independent work integral): the stride's mean speed is met, its cost of transport
+    is positive and below the least-effort stride's (0.00330 vs 0.00378 seen), the replay
+    closes (<= 1e-6; 5.5e-8 seen), and the cost of transport from the rigid replay's own
+    power and step lengths is the stored one within 1e-3 relative (1.6e-4 seen: Simpson on
+    ``max(p, 0)`` at the points, whose kinks where the power changes sign cost O(h^2))."""
+    from dataclasses import replace as with_
+
+    from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.stride import replay_stride, step_of
+
+    _scene, data, _walker, _g, fns = asym
+    spec, least_effort = fast
+    res = collocate_phases(fns, with_(spec, objective="cost_of_transport",
+                                      cost_of_transport_effort_weight=1e-2), _guess(asym))
+    assert res.status == "Solve_Succeeded"
+    cot = res.terms["cost_of_transport"]
+    assert 1e-4 < cot < 0.95 * least_effort.terms["cost_of_transport"]
+    lengths = [float(fns["phases"][2 * k + 1].step(step_of(res, k).x[-1])) for k in (0, 1)]
+    assert sum(lengths) / res.step_period_s == pytest.approx(0.6, rel=1e-9)
+    assert replay_stride(data, res)[0] <= 1e-6
+    assert _replayed_cost_of_transport(data, res) == pytest.approx(cot, rel=1e-3)
+
+
+def _cone_ratios(data, res):
+    """``F_t / F_n`` and ``F_n`` [N] at every point of the stride ``res`` from the rigid
+    model (Newton-Euler with each step's own walker and torqued flow), not the CasADi."""
+    tw, cur = _torqued_pair(data)
+    bounds = list(res.phase_start) + [res.t.size]
+    out = []
+    for p, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
+        w = tw if p < 2 else tw.mirror
+        for k in range(a, b):
+            cur["u"] = float(res.u[k])
+            F = _newton_euler(w, data, res.x[k], w.phases[p % 2].flow(0.0, res.x[k])[2:])
+            out.append((F[1] / F[0], F[0]))
+    return np.array(out)
+
+
+def test_a_friction_cone_that_binds_changes_the_stride_and_it_replays(asym, fast):
+    """The least-effort stride at 0.6 m/s needs |F_t| / F_n up to 0.1785 (leg B's step,
+    at its heel strike; from the rigid model); with mu = 0.9 of that the cone binds in
+    every phase of both steps (the largest ratio is mu to 1e-7 relative: 4e-10 seen), the
+    effort rises (1.514 -> 1.584 N^2 m^2 s seen), the normal force stays positive, the
+    speed is met and the replay closes (<= 1e-6; 1.0e-7 seen)."""
+    from dataclasses import replace as with_
+
+    from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.stride import replay_stride
+
+    _scene, data, _walker, _g, fns = asym
+    spec, free = fast
+    mu_free = np.max(np.abs(_cone_ratios(data, free)[:, 0]))
+    assert 0.15 < mu_free < 0.2
+    mu = 0.9 * mu_free
+    res = collocate_phases(fns, with_(spec, friction_coefficient=mu), _guess(asym))
+    assert res.status == "Solve_Succeeded"
+    r = _cone_ratios(data, res)
+    assert np.max(np.abs(r[:, 0])) == pytest.approx(mu, rel=1e-7)
+    assert np.min(r[:, 1]) > 0.0
+    assert res.objective > 1.02 * free.objective
+    assert res.terms["effort"] == pytest.approx(res.objective, rel=1e-12)
+    lengths = [float(fns["phases"][p].step(res.x[k - 1])) for p, k in
+               ((1, res.phase_start[2]), (3, res.t.size))]
+    assert sum(lengths) / res.step_period_s == pytest.approx(0.6, rel=1e-9)
+    assert replay_stride(data, res)[0] <= 1e-6
+
+
+def _as_artifact(res, walker, path, scene):
+    """The stride ``res`` written as an ``optimize.h5`` at ``path`` (its states, torque and
+    phases: what :func:`walkerlab.io.schemas.optimize.load` reads back)."""
+    from walkerlab.io.artifacts import write_artifact
+    from walkerlab.io.schemas import optimize as schema
+
+    names = list(walker.state_names())
+    d = schema.OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
+                            res.step_period_s / 2, 0.35, 0.0, res.objective, 1e-9,
+                            np.zeros(4, complex), True, res.status, res.iterations, 0.1,
+                            dict.fromkeys(names, "-"), phase_names=res.phase_names,
+                            phase_start=res.phase_start,
+                            phase_duration_s=res.phase_duration_s, steps=2)
+    write_artifact(path, schema.STAGE, scene, "x", lambda f: schema.write(f, d), 0.0)
+    return d
+
+
+def _with_guess(scene, guess: dict):
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["optimize"]["initial_guess"] = guess
+    return type(scene).model_validate(d)
+
+
+def test_a_stride_starts_from_another_strides_optimize_h5(asym, fast, tmp_path):
+    """``optimize.initial_guess`` naming a converged stride's optimize.h5 (the 0.6 m/s
+    least effort): its four phases' states and torque come back exactly (the same mesh,
+    2 x 40 intervals), IPOPT's first iterate is the optimum (its objective to 1e-9; 0 from
+    the passive stride, whose torque is 0) and it returns to the same objective (1e-9).
+    Not in fewer iterations to speak of (11 seen, 12 from the passive stride; the cost of
+    transport 40 against 72): an interior point method without the optimum's multipliers
+    leaves the start for the central path and lowers its barrier from IPOPT's 0.1 again."""
+    from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.stride_scene import starting_stride
+
+    scene, _data, walker, g, fns = asym
+    spec, free = fast
+    path = tmp_path / "optimize.h5"
+    _as_artifact(free, walker, path, scene)
+    guess, torque = starting_stride(_with_guess(scene, {"from": str(path)}), walker, g.x,
+                                    g.step_period, 40)
+    np.testing.assert_array_equal(np.concatenate([x for _n, _t, x in guess]), free.x)
+    np.testing.assert_array_equal(np.concatenate(torque), free.u)
+    again = collocate_phases(fns, spec, guess, torque)
+    assert again.status == "Solve_Succeeded"
+    assert again.objective == pytest.approx(free.objective, rel=1e-9)
+    assert again.history["objective"][0] == pytest.approx(free.objective, rel=1e-9)
+    assert again.iterations <= free.iterations
+
+
+def test_a_stride_starts_from_a_continuation_gait_and_refuses_other_artifacts(asym, fast,
+                                                                             tmp_path):
+    """A continuation artifact's branch at ``at`` gives the stride map's start there: one
+    stride of the rigid walker and its mirror simulated from it (the scene's own gait's at
+    its slope: the same guess to 1e-12); a one-step optimize.h5 (no phases) and another
+    walker's (other states) are refused in one line naming ``optimize.initial_guess``."""
+    from tests.test_optimize_phased_terms import _continuation
+    from walkerlab.optimal.stride_scene import starting_stride
+
+    scene, _data, walker, g, _fns = asym
+    names = list(walker.state_names())
+    slope = scene.slope.phi_rad
+    cpath = tmp_path / "continuation_slope.h5"
+    _continuation(cpath, scene, names, [slope - 0.001, slope + 0.001], np.array([g.x, g.x]),
+                  [g.step_period] * 2)
+    got, torque = starting_stride(_with_guess(scene, {"from": str(cpath), "at": slope}),
+                                  walker, np.zeros(4), g.step_period, 40)
+    assert torque is None
+    for (n1, t1, x1), (n2, t2, x2) in zip(got, _guess(asym), strict=True):
+        assert n1 == n2
+        np.testing.assert_allclose(t1, t2, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(x1, x2, rtol=0, atol=1e-12)
+    path = tmp_path / "optimize.h5"
+    d = _as_artifact(fast[1], walker, path, scene)
+    d.phase_names, d.phase_start = (), None  # a one-step optimisation
+    from walkerlab.io.artifacts import write_artifact
+    from walkerlab.io.schemas import optimize as schema
+
+    write_artifact(path, schema.STAGE, scene, "x", lambda f: schema.write(f, d), 0.0)
+    other = tmp_path / "other.h5"
+    d = _as_artifact(fast[1], walker, other, scene)
+    d.states = {f"{n}_2": v for n, v in d.states.items()}  # another walker's states
+    d.state_units = dict.fromkeys(d.states, "-")
+    write_artifact(other, schema.STAGE, scene, "x", lambda f: schema.write(f, d), 0.0)
+    for p, why in ((path, "has no phases"), (other, "are not the walker's")):
+        with pytest.raises(ValueError, match="optimize.initial_guess") as e:
+            starting_stride(_with_guess(scene, {"from": str(p)}), walker, g.x, g.step_period,
+                            40)
+        assert why in str(e.value) and "\n" not in str(e.value)
