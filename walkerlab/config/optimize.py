@@ -24,7 +24,8 @@ class OptimizeGuess(Strict):
     """The collocation's starting step read from an artifact instead of the scene's gait:
     another ``optimize.h5`` (its states, torque, period and push-off), or a continuation
     artifact's branch at a parameter value (its gait there, one step of the scene's
-    walker simulated from it)."""
+    walker simulated from it; legs that differ: one stride, from another stride's
+    ``optimize.h5`` or the stride map's start)."""
 
     model_config = ConfigDict(populate_by_name=True)
 

@@ -17,7 +17,13 @@ crossing rate at its end), each phase with its own free duration and Hermite-Sim
 symbolic equations with ``data``'s numbers, leg B's with ``data.mirror``'s (the same
 equations, the other leg's numbers), leg A's heel strike (its reset: the impact with A's
 numbers, roles swapped) links them, leg B's closes the stride.  Targets (speed, step
-length, step period) are the stride's mean step's.
+length, step period) are the stride's mean step's.  The cost of transport is both steps'
+positive hip work over ``M g`` and the stride's distance (both step lengths): the power
+``u d(hip angle)/dt``, the hip angle (swing minus stance) and the swing foot ahead are leg
+A's functions, used on leg B's step as well - the same expressions in the mirror's state
+(its swing leg first), no leg's number in them.  The friction cone bounds each phase's
+ground reaction, from its own walker's masses.  No push-off: the transcription's resets
+carry none.
 
 A result is a gait after its replay on the rigid model (:func:`replay_stride`): the
 actuated walker and its mirror, each step's torque the optimised one as a function of the
