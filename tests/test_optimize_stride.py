@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -26,8 +27,6 @@ CONFIGS = Path(__file__).resolve().parents[1] / "configs"
 def asym():
     """(scene, data, rigid walker, passive gait, CasADi stride) built once."""
     pytest.importorskip("casadi")
-    from types import SimpleNamespace
-
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.optimal.stride import stride_functions
 
@@ -475,3 +474,36 @@ def test_a_stride_starts_from_a_continuation_gait_and_refuses_other_artifacts(as
             starting_stride(_with_guess(scene, {"from": str(p)}), walker, g.x, g.step_period,
                             40)
         assert why in str(e.value) and "\n" not in str(e.value)
+
+
+@pytest.mark.slow
+def test_the_stride_scene_takes_the_cost_of_transport_a_cone_and_a_guess(asym, fast,
+                                                                          tmp_path):
+    """``optimize_scene`` on the shipped scene (60 intervals a step) asking the least cost of
+    transport at 0.6 m/s (effort weight 1e-2) inside a friction cone that does not bind
+    (mu 0.5), started from the 40-interval least-effort stride's optimize.h5 (resampled to
+    2 x 60): a gait (the replay <= 1e-6), the stored terms those of the optimum, the mean
+    speed met, the cone kept at every point (from the rigid model), its four phases stored
+    (~25 s: the CasADi build, IPOPT, the replays and two contact strides)."""
+    from walkerlab.optimal.scene import optimize_scene
+    from walkerlab.optimal.stride import STRIDE_PHASES
+
+    scene, data, walker, g, _fns = asym
+    path = tmp_path / "optimize.h5"
+    _as_artifact(fast[1], walker, path, scene)
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["optimize"].update(objective="cost_of_transport", cost_of_transport_effort_weight=1e-2,
+                         target_speed_m_per_s=0.6, friction_coefficient=0.5,
+                         initial_guess={"from": str(path)})
+    out = optimize_scene(type(scene).model_validate(d), g.x, g.step_period)
+    assert out.gait and out.replay_error <= 1e-6 and out.status == "Solve_Succeeded"
+    assert out.objective_name == "cost_of_transport"
+    assert out.objective == pytest.approx(out.terms["cost_of_transport"]
+                                          + 1e-2 * out.terms["effort"], rel=1e-9)
+    assert 1e-4 < out.terms["cost_of_transport"] < 1e-2
+    assert out.step_length_m / out.step_period_s == pytest.approx(0.6, rel=1e-9)
+    assert tuple(out.phase_names) == STRIDE_PHASES
+    assert np.sum(np.diff([*out.phase_start, out.time.size]) // 2) == 120
+    X = np.stack(list(out.states.values()), axis=1)
+    res = SimpleNamespace(x=X, u=out.torque, t=out.time, phase_start=out.phase_start)
+    assert np.max(np.abs(_cone_ratios(data, res)[:, 0])) <= 0.5 + 1e-9
