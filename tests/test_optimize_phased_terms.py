@@ -262,7 +262,7 @@ def test_the_kneed_walkers_least_cost_of_transport_on_its_slope_is_its_passive_g
 
 @pytest.mark.slow
 def test_the_cost_of_transport_does_not_drift_to_large_torques(kneed, kneed_fast):
-    """At 0.9 m/s with the default effort weight 1e-6 (~25 s): the least-CoT gait needs no
+    """At 0.9 m/s with the effort weight 1e-6 (~25 s): the least-CoT gait needs no
     positive work (CoT ~1e-11) and its torque stays the least-effort gait's size (< 0.1 N m;
     0.0096 seen); with IPOPT's default initial barrier it drifted to 100 N m torques
     chattering between the points and a replay that did not step
@@ -273,7 +273,8 @@ def test_the_cost_of_transport_does_not_drift_to_large_torques(kneed, kneed_fast
 
     _, data, _, fns = kneed
     _g, guess, spec, _free = kneed_fast
-    res = collocate_phases(fns, replace(spec, objective="cost_of_transport"), guess)
+    res = collocate_phases(fns, replace(spec, objective="cost_of_transport",
+                                        cost_of_transport_effort_weight=1e-6), guess)
     assert res.status == "Solve_Succeeded"
     assert res.terms["cost_of_transport"] <= 1e-10
     assert np.max(np.abs(res.u)) < 0.1

@@ -215,6 +215,8 @@ def optimize(scene: Path | None = SceneArg,
         _optimize_design(scene, design, objective, maximize, runs_dir, force)
         return
 
+    from walkerlab.report.figures_section import cot_terms_text
+
     out = pipeline.run("optimize", load(scene), runs_dir, force)
     d = out.summary.get("data")
     if d is not None:
@@ -232,9 +234,9 @@ def optimize(scene: Path | None = SceneArg,
                        f"{d.collocated_start_error:.2g}; closed by shooting under the same "
                        f"torques: start moved {d.start_shift:.2g}, step period "
                        f"{d.replay_step_period_s:.9g} s")
-        typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}; "
-                   f"replay return error {d.replay_error:.2g}; max |Floquet multiplier| "
-                   f"{mu:.4g}")
+        typer.echo(f"  objective {d.objective_name} = {d.objective:.6g} {d.objective_unit}"
+                   + cot_terms_text(d) + f"; replay return error {d.replay_error:.2g}; "
+                   f"max |Floquet multiplier| {mu:.4g}")
         if d.phase_replay_outcome:  # asked for, and refused (a non-monotonic phase variable)
             typer.echo(f"  phase-variable replay: {d.phase_replay_outcome}")
         for law, r in d.phase_replays.items():  # the phase-variable laws (when asked for)

@@ -108,7 +108,7 @@ class CollocationSpec:
     target_step_period_s: float | None = None
     objective: str = "effort"
     weights: tuple = ()
-    cost_of_transport_effort_weight: float = 1e-6
+    cost_of_transport_effort_weight: float = 1e-4
     min_clearance_m: float | None = None
     friction_coefficient: float | None = None
     hip_angle_range_rad: tuple | None = None
@@ -409,12 +409,34 @@ def ipopt_options(spec) -> dict:
     """IPOPT's options: tight tolerances; with the cost of transport's slack variables no
     bound relaxation (IPOPT relaxes every inequality by ``bound_relax_factor`` = 1e-8
     relative by default, which lets each ``s_k`` go ~1e-8 below 0 and biases the positive
-    work by as much; at 0 the slack is exact)."""
+    work by as much; at 0 the slack is exact) and a small initial barrier (``mu_init``
+    1e-9 for IPOPT's 0.1).
+
+    The barrier on ``s_k - p_k >= 0`` rewards negative power at every point, so early
+    iterations (the barrier large) push the torque to brake wherever it can, and the
+    objective - zero on every gait whose torque only brakes, a continuum, bar the effort
+    weight - does not pull it back.  Measured on the kneed walker (60 intervals, effort
+    weight 1e-6): at 0.9 m/s the default barrier ends (Solve_Succeeded, 223 iterations) at
+    100 N m peak torques whose power changes sign between the points and a replay that does
+    not close; from a guess 5 % off its passive gait at 68 N m and a replay error 1.7e-2.
+    With 1e-9: 0.0096 N m (the least-effort gait's 0.0097; 113 iterations, replay 1.2e-7)
+    and 0.0063 N m (82 iterations, replay 1.6e-7); on its passive slope (effort weight
+    1e-2) the default barrier ends on the walker's other, unstable passive gait (period
+    0.4921 s, |multiplier| 2.28), 1e-9 on the stable one (period within 1e-4).  The
+    compass walker of configs/compass_optimal.yaml at 0.6 m/s (40 intervals, effort weight
+    1e-6): 180 N m and a replay error 1.7e-3 with the default barrier, 149 N m and 1.6e-4
+    with 1e-9; with the effort weight 1e-4 (the default since) a braking torque of 17 N m,
+    a gait (replay 2.7e-7).  The cost of transport's torques are sharper than the
+    effort's: the kneed walker at 0.9 m/s with the friction cone binding (mu 0.2312) has
+    3.5 N m peaks, the replay closing to 6.2e-6 on 60 intervals (not a gait) and 6.8e-7 on
+    120, the cost of transport rising 2.69e-4 -> 3.23e-4 with the mesh (the positive work
+    is counted at the points)."""
     opts = {"print_level": 0, "tol": 1e-12, "acceptable_tol": 1e-10, "max_iter": 500,
             "sb": "yes"}
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     if "cost_of_transport" in asked:
         opts["bound_relax_factor"] = 0.0
+        opts["mu_init"] = 1e-9
     return opts
 
 

@@ -361,29 +361,11 @@ def _targets(opti, spec, fns, Xs, period):
 
 
 def _options(spec, asked: dict) -> dict:
-    """IPOPT's options (:func:`walkerlab.optimal.collocation.ipopt_options`); with the cost
-    of transport a small initial barrier (``mu_init`` 1e-9 for IPOPT's 0.1).  Its barrier
-    on ``s_k - p_k >= 0`` rewards negative power at every point, so early iterations (the
-    barrier large) push the torque to brake wherever it can, and the objective - zero on
-    every gait whose torque only brakes, a continuum, bar the tiny effort weight - does not
-    pull it back.  Measured on the kneed walker (60 intervals, effort weight 1e-6): at
-    0.9 m/s the default barrier ends (Solve_Succeeded, 223 iterations) at 100 N m peak
-    torques whose power changes sign between the points and a replay that does not close;
-    from a guess 5 % off its passive gait at 68 N m and a replay error 1.7e-2.  With 1e-9:
-    0.0096 N m (the least-effort gait's 0.0097; 113 iterations, replay 1.2e-7) and
-    0.0063 N m (82 iterations, replay 1.6e-7); on its passive slope (effort weight 1e-2)
-    the default barrier ends on the walker's other, unstable passive gait (period 0.4921 s,
-    |multiplier| 2.28), 1e-9 on the stable one (period within 1e-4).  The cost of
-    transport's torques are sharper than the effort's: at 0.9 m/s with the friction cone
-    binding (mu 0.2312) 3.5 N m peaks, the replay closing to 6.2e-6 on 60 intervals (not
-    a gait) and 6.8e-7 on 120, the cost of transport rising 2.69e-4 -> 3.23e-4 with the
-    mesh (the positive work is counted at the points)."""
+    """IPOPT's options: :func:`walkerlab.optimal.collocation.ipopt_options` (with the cost
+    of transport its small initial barrier, measured on the kneed walker there)."""
     from walkerlab.optimal.collocation import ipopt_options
 
-    opts = ipopt_options(spec)
-    if "cost_of_transport" in asked:
-        opts["mu_init"] = 1e-9
-    return opts
+    return ipopt_options(spec)
 
 
 def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResult:

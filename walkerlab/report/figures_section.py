@@ -101,7 +101,8 @@ def optimize_lines(d) -> list[str]:
             f"period {num(d.step_period_s)} s, step length {num(d.step_length_m)} m, speed "
             f"{num(d.step_length_m / d.step_period_s)} m/s, push-off {num(d.push_off_n_s)} N s, "
             f"peak torque [{d.torque_unit}]: {peak}; objective {d.objective_name} = "
-            f"{num(d.objective)} {d.objective_unit}.{closed} Replayed on the rigid model (the "
+            f"{num(d.objective)} {d.objective_unit}{cot_terms_text(d)}.{closed} Replayed on "
+            f"the rigid model (the "
             f"torques as a function of time): return error {num(d.replay_error, 2)}, largest "
             f"|Floquet multiplier| {num(mu)}: "
             + ("**a gait**." if d.gait else "**not a gait** (the replay does not close).")
@@ -208,3 +209,13 @@ def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
                            workprecision_table(arts["workprecision"],
                                                stem.removeprefix("work_precision_")))
     return ["## Figures", "", *out] if out else []
+
+
+def cot_terms_text(d) -> str:
+    """The cost of transport's objective of ``optimize.h5`` (``d``) split into its terms
+    (it carries a small effort regularisation, ``optimize.cost_of_transport_effort_weight``:
+    ``" (cost of transport C, effort E (N m)^2 s)"``), else ``""``."""
+    if d.objective_name != "cost_of_transport" or "cost_of_transport" not in d.terms:
+        return ""
+    return (f" (cost of transport {float(d.terms['cost_of_transport']):.6g}, effort "
+            f"{float(d.terms.get('effort', float('nan'))):.4g} ({d.torque_unit})^2 s)")
