@@ -413,10 +413,10 @@ def test_a_stride_starts_from_another_strides_optimize_h5(asym, fast, tmp_path):
     """``optimize.initial_guess`` naming a converged stride's optimize.h5 (the 0.6 m/s
     least effort): its four phases' states and torque come back exactly (the same mesh,
     2 x 40 intervals), IPOPT's first iterate is the optimum (its objective to 1e-9; 0 from
-    the passive stride, whose torque is 0) and it returns to the same objective (1e-9).
-    Not in fewer iterations to speak of (11 seen, 12 from the passive stride; the cost of
-    transport 40 against 72): an interior point method without the optimum's multipliers
-    leaves the start for the central path and lowers its barrier from IPOPT's 0.1 again."""
+    the passive stride, whose torque is 0) and it returns to the same objective (1e-9) in
+    a few iterations with the barrier started small (``warm_start``, as the scene does for
+    an optimize.h5 guess; with IPOPT's default 0.1: 11, against 12 from the passive
+    stride, the start left for the central path)."""
     from walkerlab.optimal.phased_collocation import collocate_phases
     from walkerlab.optimal.stride_scene import starting_stride
 
@@ -428,11 +428,11 @@ def test_a_stride_starts_from_another_strides_optimize_h5(asym, fast, tmp_path):
                                     g.step_period, 40)
     np.testing.assert_array_equal(np.concatenate([x for _n, _t, x in guess]), free.x)
     np.testing.assert_array_equal(np.concatenate(torque), free.u)
-    again = collocate_phases(fns, spec, guess, torque)
+    again = collocate_phases(fns, replace(spec, warm_start=True), guess, torque)
     assert again.status == "Solve_Succeeded"
     assert again.objective == pytest.approx(free.objective, rel=1e-9)
     assert again.history["objective"][0] == pytest.approx(free.objective, rel=1e-9)
-    assert again.iterations <= free.iterations
+    assert again.iterations <= min(8, free.iterations)
 
 
 def test_a_stride_starts_from_a_continuation_gait_and_refuses_other_artifacts(asym, fast,

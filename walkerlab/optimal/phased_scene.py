@@ -7,6 +7,8 @@ acts between a kneed walker's thighs, between a flat-footed walker's legs)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 __all__ = ["optimize_phased_scene", "replay_multipliers", "starting_phases"]
@@ -62,7 +64,8 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     t0 = time.perf_counter()
     fns = mode_functions(data, walker, order)
     build = time.perf_counter() - t0
-    res = collocate_phases(fns, spec, guess, guess_u)
+    res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
+                           guess_u)
     err, replayed = replay_phases(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"

@@ -102,6 +102,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
     if guess_p is not None and spec.push_off_free:
         spec = replace(spec, push_off_n_s=guess_p)
+    if guess_u is not None:  # another optimize.h5: an optimum
+        spec = replace(spec, warm_start=True)
     res = collocate_step(data, None, spec, t, guess, guess_u, cached_step_functions(data))
     err, replayed = replay(data, res)
     mu = np.full(res.x.shape[1], np.nan, complex)

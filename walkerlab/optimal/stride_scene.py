@@ -8,6 +8,8 @@ the stride map's Floquet multipliers from the replay, and replayed in the contac
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 __all__ = ["optimize_stride_scene", "starting_stride"]
@@ -114,7 +116,8 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     t0 = time.perf_counter()
     fns = stride_functions(data)
     build = time.perf_counter() - t0
-    res = collocate_phases(fns, spec, guess, guess_u)
+    res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
+                           guess_u)
     err, replayed = replay_stride(data, res)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
     contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
