@@ -215,7 +215,7 @@ def optimize(scene: Path | None = SceneArg,
         _optimize_design(scene, design, objective, maximize, runs_dir, force)
         return
 
-    from walkerlab.report.figures_section import cot_terms_text
+    from walkerlab.report.figures_section import cot_terms_text, not_a_gait_reason
 
     out = pipeline.run("optimize", load(scene), runs_dir, force)
     d = out.summary.get("data")
@@ -256,8 +256,7 @@ def optimize(scene: Path | None = SceneArg,
         else:
             typer.echo(f"  contact model: {d.contact_outcome}")
         typer.echo("  a gait (the replay closes)" if d.gait else
-                   "  NOT a gait: the replay does not return to its start within "
-                   "optimize.replay_tolerance (or IPOPT did not converge)")
+                   f"  NOT a gait: {not_a_gait_reason(d)}")
     typer.echo(status(out))
     from walkerlab.stages.optimize import draw
 

@@ -7,6 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from walkerlab.report.markdown import details, num, table
 from walkerlab.report.workprecision_section import workprecision_table
 
@@ -105,7 +107,7 @@ def optimize_lines(d) -> list[str]:
             f"the rigid model (the "
             f"torques as a function of time): return error {num(d.replay_error, 2)}, largest "
             f"|Floquet multiplier| {num(mu)}: "
-            + ("**a gait**." if d.gait else "**not a gait** (the replay does not close).")
+            + ("**a gait**." if d.gait else f"**not a gait**: {not_a_gait_reason(d)}.")
             + phase_replay_text(d)
             + (f" In the contact model{' (the feed-forward + PD law)' if five_link else ''}"
                f": step period {num(d.contact_step_period_s)} s "
@@ -219,3 +221,20 @@ def cot_terms_text(d) -> str:
         return ""
     return (f" (cost of transport {float(d.terms['cost_of_transport']):.6g}, effort "
             f"{float(d.terms.get('effort', float('nan'))):.4g} ({d.torque_unit})^2 s)")
+
+
+def not_a_gait_reason(d) -> str:
+    """Why an ``optimize.h5`` (``d``) is not called a gait, and what helps (one clause):
+    IPOPT did not converge, or the replay does not return to its start within
+    ``optimize.replay_tolerance`` - on an open-loop unstable gait (a multiplier outside the
+    unit circle) the replay amplifies the collocation's own error, which more intervals
+    shrink (Hermite-Simpson: O(h^4))."""
+    if d.status != "Solve_Succeeded":
+        return f"IPOPT did not converge ({d.status})"
+    mu = float(np.max(np.abs(d.multipliers))) if len(d.multipliers) else float("nan")
+    text = (f"the replay returns {d.replay_error:.2g} away from its start, more than "
+            "optimize.replay_tolerance")
+    if mu > 1.0:
+        text += (f"; the gait is unstable open loop (max |multiplier| {mu:.3g}), so the "
+                 "replay amplifies the collocation's error: more optimize.intervals shrink it")
+    return text
