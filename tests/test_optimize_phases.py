@@ -382,3 +382,55 @@ def test_a_powered_flat_footed_gait_replays_on_the_rigid_model(flat):
     passive = float(np.mean(np.diff(np.asarray(hs, float)[:4])))
     assert abs(period / passive - 1.0 - rigid_change) < 0.003, (period, passive)
     assert 0.06 < period / res.step_period_s - 1.0 < 0.08
+
+
+def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch):
+    """A flat-footed walker's phases (configs/flat_feet_optimal.yaml: the heel-contact,
+    foot-flat and heel-off flows, their normal forces kept >= 0) are built once per walker
+    and phase order and read back from the code cache (the build not called on a warm
+    start), computing bit for bit what the built ones do; a damaged file is rebuilt and
+    written again (~6 s: one build of the flat feet's CasADi functions)."""
+    pytest.importorskip("casadi")
+    from walkerlab.optimal import phases, step_cache
+
+    monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
+    scene = load_scene(CONFIGS / "flat_feet_optimal.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    walker = make_rigid_walker(data)
+    from walkerlab.optimal.phased_scene import starting_phases
+
+    x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
+    order = starting_phases(scene, walker, x0, 0.76, 40)[2]  # the gait's phase sequence
+    monkeypatch.setattr(step_cache, "_memo", {})
+    built = step_cache.cached_mode_functions(data, walker, order)
+    files = list((tmp_path / "models").glob("*-modes-*.casadi"))
+    assert len(files) == 1
+    monkeypatch.setattr(step_cache, "_memo", {})
+
+    def no_build(*_a, **_k):
+        raise AssertionError("built again")
+
+    monkeypatch.setattr(phases, "mode_functions", no_build)
+    read = step_cache.cached_mode_functions(data, walker, order)
+    x = np.array([-0.2, 0.19, 0.01, -0.9, -0.85, -0.5])
+    assert [p.name for p in read["phases"]] == [p.name for p in built["phases"]]
+    assert sum(p.keep is not None for p in read["phases"]) >= 3
+    for a, b in zip(read["phases"], built["phases"]):
+        assert (a.guard_name, a.direction) == (b.guard_name, b.direction)
+        for f in ("flow", "guard_rate", "keep", "grf"):
+            if getattr(b, f) is not None:
+                np.testing.assert_array_equal(np.asarray(getattr(a, f)(x, 0.3)),
+                                              np.asarray(getattr(b, f)(x, 0.3)))
+        for f in ("guard", "reset", "clearance", "step"):
+            fa, fb = getattr(a, f), getattr(b, f)
+            args = (x, 0.3) if fb.n_in() == 2 else (x,)
+            np.testing.assert_array_equal(np.asarray(fa(*args)), np.asarray(fb(*args)))
+    np.testing.assert_array_equal(np.asarray(read["power"](x, 0.3)),
+                                  np.asarray(built["power"](x, 0.3)))
+    files[0].write_text("damaged")
+    monkeypatch.setattr(step_cache, "_memo", {})
+    calls = []
+    monkeypatch.setattr(phases, "mode_functions",
+                        lambda *a: calls.append(a) or built)
+    assert step_cache.cached_mode_functions(data, walker, order) is built
+    assert len(calls) == 1 and files[0].read_text() != "damaged"  # rebuilt and rewritten

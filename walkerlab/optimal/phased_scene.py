@@ -54,15 +54,15 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
         phase_torque_of_time,
         replay_phases,
     )
-    from walkerlab.optimal.phases import mode_functions
     from walkerlab.optimal.scene import phase_replays, step_record
+    from walkerlab.optimal.step_cache import cached_mode_functions
 
     o = scene.optimize
     _refuse(scene)
     walker = make_rigid_walker(data)
     guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
-    fns = mode_functions(data, walker, order)
+    fns = cached_mode_functions(data, walker, order)
     build = time.perf_counter() - t0
     res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
                            guess_u)

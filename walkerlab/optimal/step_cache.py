@@ -1,14 +1,16 @@
-"""The straight-legged walkers' collocation functions
-(:func:`walkerlab.optimal.collocation.step_functions`) built once per walker and cached on
-disk like the generated flows (:mod:`walkerlab.codegen.cache`), so a warm
-``walkerlab optimize`` neither derives the walker symbolically (sympy, ~1-2 s) nor converts
-it to CasADi.
+"""The collocation functions - the straight-legged walkers' one step
+(:func:`walkerlab.optimal.collocation.step_functions`) and the phases of a step of a kneed
+or flat-footed walker or of a stride (:func:`walkerlab.optimal.phases.mode_functions`) -
+built once per walker and cached on disk like the generated flows
+(:mod:`walkerlab.codegen.cache`), so a warm ``walkerlab optimize`` neither derives the
+walker symbolically (sympy, ~1-2 s) nor converts it to CasADi (flat feet: ~4 s).
 
 The functions have the walker's parameter values substituted (as the collocation builds
 them), so the cache file is keyed on the walker's structure (its generator's key) *and* its
-numbers: ``<user cache>/models/<cache_key(structure)>-steps-<hash>.casadi``, ``hash`` over
-the parameter vector, slope, gravity and total mass (their ``repr``, exact), the collocation
-module's and this module's sources and CasADi's version.  A deserialised CasADi function is
+numbers: ``<user cache>/models/<cache_key(structure)>-steps-<hash>.casadi`` (the phases':
+``-modes-``), ``hash`` over the parameter vector, slope, gravity and total mass (their
+``repr``, exact), the phase order, the collocation and phases modules' and this module's
+sources and CasADi's version.  A deserialised CasADi function is
 the same expression graph, so a cached and a freshly built optimisation agree bit for bit.
 The file follows the generated code's rules (private folder, sha256 header; a damaged or
 untrusted file is rebuilt).
@@ -20,27 +22,96 @@ import hashlib
 import json
 from pathlib import Path
 
-__all__ = ["cached_step_functions"]
+__all__ = ["cached_mode_functions", "cached_step_functions"]
 
 _memo: dict[str, dict] = {}
 #: the entries of :func:`step_functions` that are numbers, not CasADi functions
 _NUMBERS = ("n", "limit", "total_mass_kg", "gravity")
 
 
-def _key(data) -> str:
-    """The cache key of ``data``'s step functions (module docstring)."""
+def _key(data, kind: str = "steps", extra=()) -> str:
+    """The cache key of ``data``'s step (``kind`` "steps") or phase ("modes", ``extra``
+    the phase order) functions (module docstring)."""
     import casadi as ca
 
     from walkerlab.codegen.cache import cache_key
-    from walkerlab.optimal import collocation
+    from walkerlab.optimal import collocation, phases
 
     h = hashlib.sha256(repr((tuple(float(v) for v in data.params), float(data.slope_rad),
                              float(data.gravity_m_per_s2),
-                             float(data.total_mass_kg))).encode())
-    for mod in (collocation.__file__, __file__):
+                             float(data.total_mass_kg)) + ((tuple(extra),) if extra
+                                                           else ())).encode())
+    for mod in (collocation.__file__, __file__) + ((phases.__file__,) if extra else ()):
         h.update(Path(mod).read_bytes())
     h.update(ca.__version__.encode())
-    return f"{cache_key(data.structure)}-steps-{h.hexdigest()[:16]}"
+    return f"{cache_key(data.structure)}-{kind}-{h.hexdigest()[:16]}"
+
+
+def _read(key: str):
+    """The stored JSON of ``key`` and the path to write it (None, None: no user cache)."""
+    from walkerlab.codegen.cache import cache_dir, read_source
+
+    folder = cache_dir()
+    path = folder / f"{key}.casadi" if folder is not None else None
+    return (read_source(path) if path is not None else None), path
+
+
+#: a phase's CasADi functions (:class:`walkerlab.optimal.phases.ModePhase`), in order
+_PHASE_FNS = ("flow", "guard", "guard_rate", "reset", "keep", "clearance", "step", "grf")
+
+
+def cached_mode_functions(data, walker, order=None) -> dict:
+    """:func:`walkerlab.optimal.phases.mode_functions` of ``data`` (a WalkerData) in the
+    phase order ``order`` (default: the rigid ``walker``'s), from this process's memo, the
+    disk cache, or built (and written there).
+
+    Returns
+    -------
+    dict
+        As :func:`~walkerlab.optimal.phases.mode_functions`.
+
+    Raises
+    ------
+    ValueError
+        A walker or phase the transcription has no symbolic form for (one line; nothing
+        cached).
+    """
+    import casadi as ca
+
+    from walkerlab.codegen.cache import write_source
+    from walkerlab.optimal.phases import ModePhase, mode_functions, phase_order
+
+    order = [tuple(o) for o in (order if order is not None else phase_order(walker))]
+    key = _key(data, "modes", order)
+    if key in _memo:
+        return _memo[key]
+    text, path = _read(key)
+    fns = None
+    if text is not None:
+        try:
+            stored = json.loads(text)
+            fns = {k: (v if k in _NUMBERS else ca.Function.deserialize(v))
+                   for k, v in stored.items() if k != "phases"}
+            fns["phases"] = [ModePhase(p["name"], p["guard_name"], int(p["direction"]),
+                                       **{f: (None if p[f] is None
+                                              else ca.Function.deserialize(p[f]))
+                                          for f in _PHASE_FNS})
+                             for p in stored["phases"]]
+        except (RuntimeError, ValueError, TypeError, AttributeError, KeyError):
+            fns = None  # damaged: rebuilt below
+    if fns is None:
+        fns = mode_functions(data, walker, order)
+        if path is not None:
+            out = {k: (v if k in _NUMBERS else v.serialize())
+                   for k, v in fns.items() if k != "phases"}
+            out["phases"] = [{"name": p.name, "guard_name": p.guard_name,
+                              "direction": p.direction,
+                              **{f: (None if getattr(p, f) is None
+                                     else getattr(p, f).serialize()) for f in _PHASE_FNS}}
+                             for p in fns["phases"]]
+            write_source(path, json.dumps(out))
+    _memo[key] = fns
+    return fns
 
 
 def cached_step_functions(data) -> dict:
@@ -59,15 +130,13 @@ def cached_step_functions(data) -> dict:
     """
     import casadi as ca
 
-    from walkerlab.codegen.cache import cache_dir, read_source, write_source
+    from walkerlab.codegen.cache import write_source
     from walkerlab.optimal.collocation import step_functions
 
     key = _key(data)
     if key in _memo:
         return _memo[key]
-    folder = cache_dir()
-    path = folder / f"{key}.casadi" if folder is not None else None
-    text = read_source(path) if path is not None else None
+    text, path = _read(key)
     fns = None
     if text is not None:
         try:

@@ -67,7 +67,7 @@ def stride_functions(data) -> dict:
         Mirror-image legs (one step is the map), knees, flat or arc feet, a torso, massless
         legs (one line).
     """
-    from walkerlab.optimal.phases import mode_functions
+    from walkerlab.optimal.step_cache import cached_mode_functions
 
     st = data.structure
     if data.mirror is None:
@@ -78,7 +78,7 @@ def stride_functions(data) -> dict:
                          "with point feet today (knees, flat or arc feet, a torso: not yet)")
     fns, phases = None, []
     for leg, d in zip(SWINGING, (replace(data, mirror_params=None), data.mirror)):
-        f = mode_functions(d, None, list(STEP_PHASES))
+        f = cached_mode_functions(d, None, list(STEP_PHASES))
         phases += [replace(p, name=_named(leg, p.name)) for p in f["phases"]]
         fns = fns or f
     return {**fns, "phases": phases}
