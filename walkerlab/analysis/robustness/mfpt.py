@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.analysis.robustness.slope_stream import slope_rows
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 
 
@@ -152,8 +153,8 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
             if alive.size == 0:
                 break
             nb = min(wb, max_steps - k)
-            slopes = np.stack([draw_slopes(seed, walks[i], k + nb, mean, sd, distribution)[k:]
-                               for i in alive])
+            slopes = slope_rows(seed, [walks[i] for i in alive], k, nb, mean, sd,
+                                distribution)
             s, f, X[alive] = step_map.walk(X[alive], slopes)
             steps[alive] += s
             fell[alive] = f
@@ -165,8 +166,7 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
             break
         j = k % block
         if j == 0:  # the next block of slopes of every walk (same numbers for any grouping)
-            slopes = np.stack([draw_slopes(seed, w, k + block, mean, sd, distribution)[k:]
-                               for w in walks])
+            slopes = slope_rows(seed, walks, k, block, mean, sd, distribution)
         res = step_map.step(X[alive], slopes[alive, j])
         ok = res.outcome == HEEL_STRIKE
         steps[alive[ok]] += 1
