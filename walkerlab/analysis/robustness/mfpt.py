@@ -128,7 +128,9 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
     sd : float
         Standard deviation of the per-step slope [rad].
     walks : sequence of int
-        Walk numbers (each has its own random stream, :func:`draw_slopes`).
+        Walk numbers (each has its own random stream, :func:`draw_slopes`; drawn for all
+        walks at once by :func:`walkerlab.analysis.robustness.slope_stream.slope_rows`, the
+        same numbers).
     max_steps : int
         Step cap (censoring).
     seed : int
@@ -148,7 +150,7 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
     fell = np.zeros(W, dtype=bool)
     alive = np.arange(W)
     if getattr(step_map, "can_walk", False):  # whole walks compiled, block after block
-        wb = max(block, 200_000 // max(W, 1))  # (slopes drawn once per walk and block)
+        wb = max(block, 200_000 // max(W, 1))  # (all walks' slopes of a block at once)
         for k in range(0, max_steps, wb):
             if alive.size == 0:
                 break
