@@ -24,7 +24,9 @@ measurement            what is timed                                            
                        in process, :func:`walkerlab.studies.mfpt.run_walks`) against
                        the minimal numba loop over the same compass-gait flow at the
                        same accuracy and on the same slopes
-                       (:mod:`walkerlab.bench.minimal_compass`), interleaved
+                       (:mod:`walkerlab.bench.minimal_compass`), interleaved; also
+                       the median, min and max over the repeats of the two timed back
+                       to back (``montecarlo_pair_ratio_*``)
 ``mesh``               wall time of the mesh MFPT at ``sigma_mesh`` (2 workers,         15 s
                        :func:`walkerlab.studies.mfpt.mesh`, the scene's mfpt settings)
                        and its CPU (``mesh_cpu_s``: the mesh alone, workers
@@ -96,6 +98,7 @@ print(json.dumps({"library_us_per_step": out["library"], "minimal_us_per_step": 
     "ratio": out["library"] / out["minimal"], "steps": hs, "falls": int(res[1].sum()),
     "mfpt_steps": float(res[0].sum() / max(res[1].sum(), 1)),
     "walks_differing_from_minimal": int(np.sum((res[0] != bs) | (res[1] != bf))),
+    "pair_ratios": [a / b for a, b in zip(t["library"], t["minimal"])],
     "rtol": st.rtol, "atol": st.atol, "sigma_rad": sd, "walks": W, "max_steps": S}))
 """
 
@@ -290,6 +293,11 @@ def _summary(raw: list, mc: list, slow: dict) -> dict:
     if mc:
         for key in ("library_us_per_step", "minimal_us_per_step", "ratio"):
             out[f"montecarlo_{key}"] = float(np.median([m[key] for m in mc]))
+        pairs = [r for m in mc for r in m.get("pair_ratios", [])]
+        if pairs:  # each repeat's library / minimal, the two timed back to back
+            out["montecarlo_pair_ratio_median"] = float(np.median(pairs))
+            out["montecarlo_pair_ratio_min"] = float(np.min(pairs))
+            out["montecarlo_pair_ratio_max"] = float(np.max(pairs))
         out["montecarlo_detail"] = mc[-1]
     if slow["mesh"]:
         out["mesh_wall_s"] = float(np.median([m["wall_s"] for m in slow["mesh"]]))

@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from walkerlab.analysis.robustness.slope_stream import slope_rows
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 
 
@@ -127,7 +128,9 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
     sd : float
         Standard deviation of the per-step slope [rad].
     walks : sequence of int
-        Walk numbers (each has its own random stream, :func:`draw_slopes`).
+        Walk numbers (each has its own random stream, :func:`draw_slopes`; drawn for all
+        walks at once by :func:`walkerlab.analysis.robustness.slope_stream.slope_rows`, the
+        same numbers).
     max_steps : int
         Step cap (censoring).
     seed : int
@@ -147,13 +150,13 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
     fell = np.zeros(W, dtype=bool)
     alive = np.arange(W)
     if getattr(step_map, "can_walk", False):  # whole walks compiled, block after block
-        wb = max(block, 200_000 // max(W, 1))  # (slopes drawn once per walk and block)
+        wb = max(block, 200_000 // max(W, 1))  # (all walks' slopes of a block at once)
         for k in range(0, max_steps, wb):
             if alive.size == 0:
                 break
             nb = min(wb, max_steps - k)
-            slopes = np.stack([draw_slopes(seed, walks[i], k + nb, mean, sd, distribution)[k:]
-                               for i in alive])
+            slopes = slope_rows(seed, [walks[i] for i in alive], k, nb, mean, sd,
+                                distribution)
             s, f, X[alive] = step_map.walk(X[alive], slopes)
             steps[alive] += s
             fell[alive] = f
@@ -165,8 +168,7 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
             break
         j = k % block
         if j == 0:  # the next block of slopes of every walk (same numbers for any grouping)
-            slopes = np.stack([draw_slopes(seed, w, k + block, mean, sd, distribution)[k:]
-                               for w in walks])
+            slopes = slope_rows(seed, walks, k, block, mean, sd, distribution)
         res = step_map.step(X[alive], slopes[alive, j])
         ok = res.outcome == HEEL_STRIKE
         steps[alive[ok]] += 1
