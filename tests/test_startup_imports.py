@@ -154,3 +154,31 @@ def test_a_whole_contact_sim_run_loads_only_what_it_uses(tmp_path):
         assert r.returncode == 0, r.stderr[-2000:]
     assert json.loads(r.stdout.strip().splitlines()[-1]) == []
     assert (tmp_path / "runs" / "paper" / "contact_sim.h5").is_file()
+
+
+def test_the_remembered_hashes_stay_bounded(tmp_path, monkeypatch):
+    """The user cache's ``hashes/`` (one entry per artifact path: a test suite or a sweep
+    writes thousands) keeps at most ``MAX_HASH_ENTRIES``: past it the oldest half (by
+    modification time) goes, the newest entries stay, and a pruned artifact is hashed
+    again when next asked (a miss, not an error)."""
+    monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setattr(A, "MAX_HASH_ENTRIES", 6)
+    now = time.time_ns()
+    monkeypatch.setattr(A.time, "time_ns", lambda: now + 10_000_000_000)  # files are "old"
+    paths = [_artifact(tmp_path / "memo" / f"x{k}.h5", float(k)) for k in range(7)]
+    folder = tmp_path / "cache" / "hashes"
+    for p in paths:
+        monkeypatch.setattr(A, "_HASH_MEMO", {})
+        assert A.verified_hash(p) == "k"
+        if folder.exists():  # distinct, increasing modification times
+            for j, e in enumerate(sorted(folder.iterdir(), key=lambda e: e.stat().st_mtime)):
+                os.utime(e, ns=(now + j, now + j))
+    left = sorted(folder.iterdir(), key=lambda e: e.stat().st_mtime_ns)
+    assert len(left) == 3  # 7 > 6: down to 6 // 2, the newest kept
+    newest = A._disk_memo(A._stamp(paths[-1]))
+    assert newest is not None
+    hashed = []
+    real = A.content_hash_of
+    monkeypatch.setattr(A, "content_hash_of", lambda f: hashed.append(1) or real(f))
+    monkeypatch.setattr(A, "_HASH_MEMO", {})
+    assert A.verified_hash(paths[0]) == "k" and len(hashed) == 1  # pruned: hashed again

@@ -12,7 +12,8 @@ machine code it compiled earlier.  Both live in one folder per user, never in a 
 - sub-folders ``models/`` (generated Python), ``numba/`` (``NUMBA_CACHE_DIR``), ``drop/``
   (drop tests of contact laws, JSON numbers: :mod:`walkerlab.analysis.contact.drop`) and
   ``hashes/`` (recomputed content hashes of artifacts by file stamp, JSON: never trusted
-  for a file changed since, :mod:`walkerlab.io.artifacts`), created
+  for a file changed since, :mod:`walkerlab.io.artifacts`; at most 4096 entries, the
+  oldest half removed past that), created
   with mode 0700; files are written 0600, atomically (temporary name, then rename);
 - a folder or file is used only if it belongs to the current user, is not writable by group
   or others and is not a symbolic link (:func:`private_dir`, :func:`read_private`).  A file

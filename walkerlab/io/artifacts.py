@@ -187,6 +187,9 @@ _HASH_MEMO: dict[tuple, str] = {}
 #: a file changed less than this long ago [ns] is always hashed: a second edit within the
 #: file system's time-stamp resolution could keep the same stamp
 RECENT_NS = 2_000_000_000
+#: most entries kept in the user cache's ``hashes/`` (one a distinct artifact path; a test
+#: suite or a sweep writes thousands of temporary ones): past it the oldest half goes
+MAX_HASH_ENTRIES = 4096
 
 
 def _stamp(path: Path) -> tuple:
@@ -220,7 +223,8 @@ def _disk_memo(key: tuple, value: str | None = None) -> str | None:
     entry = d / f"{hashlib.sha256(os.fsencode(key[0])).hexdigest()[:32]}.json"
     stamp = [list(key), _hash_scheme()]
     if value is not None:
-        write_private(entry, json.dumps({"stamp": stamp, "content_hash": value}))
+        if write_private(entry, json.dumps({"stamp": stamp, "content_hash": value})):
+            _prune(d, MAX_HASH_ENTRIES)
         return value
     try:
         got = json.loads(read_private(entry) or "null")
@@ -230,6 +234,34 @@ def _disk_memo(key: tuple, value: str | None = None) -> str | None:
             and isinstance(got.get("content_hash"), str):
         return got["content_hash"]
     return None
+
+
+def _prune(folder: Path, keep: int) -> int:
+    """Remove the oldest (by modification time) ``*.json`` entries of ``folder`` down to
+    ``keep // 2`` when it holds more than ``keep``; returns how many went.  A remembered
+    hash is only a shortcut: a removed one is recomputed when next asked."""
+    try:
+        with os.scandir(folder) as it:
+            entries = [e for e in it if e.name.endswith(".json")]
+        if len(entries) <= keep:
+            return 0
+        stamped = []
+        for e in entries:
+            try:
+                stamped.append((e.stat(follow_symlinks=False).st_mtime_ns, e.path))
+            except OSError:  # gone meanwhile (another process pruning)
+                continue
+        stamped.sort()
+        gone = 0
+        for _t, p in stamped[:len(stamped) - keep // 2]:
+            try:
+                os.unlink(p)
+                gone += 1
+            except OSError:
+                pass
+        return gone
+    except OSError:
+        return 0
 
 
 def _content_hash_memo(path: Path, f: h5py.File) -> str:

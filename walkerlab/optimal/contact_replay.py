@@ -217,11 +217,13 @@ def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = Fa
 def _run(setup, x0, step_period_s: float, strides: int, solver=None) -> tuple[float, str]:
     """The powered contact run from ``x0``: the mean period of its steps after the first
     touchdown [s] (NaN if fewer than two) and how it ended."""
+    from walkerlab import progress
     from walkerlab.analysis.contact.sim import simulate_from
 
     kw = {} if solver is None else {"solver": solver}
-    _, run, _, _ = simulate_from(setup, np.asarray(x0, float), step_period_s,
-                                 strides=strides, **kw)
+    with progress.task(f"optimize: the contact replay ({strides} strides)"):
+        _, run, _, _ = simulate_from(setup, np.asarray(x0, float), step_period_s,
+                                     strides=strides, **kw)
     hs = np.asarray(run.heel_strike_times, float)
     period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
     return period, str(run.termination)

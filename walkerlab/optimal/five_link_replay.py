@@ -189,6 +189,12 @@ def phase_replays(data, t, x, u) -> tuple[dict, dict]:
     zero = (0.0,) * len(RABBIT_GAINS[0])
     laws = {"feedback": phase_law(acts, x, u, *RABBIT_GAINS, t=t),
             "feedforward": phase_law(acts, x, u, zero, zero, t=t)}
-    replays = {name: replay_phase_law(data, t, x, u, law, close=name == "feedback")
-               for name, law in laws.items()}
+    from walkerlab import progress
+
+    replays = {}
+    with progress.task("optimize: phase-variable replays (feedback closed, feed-forward; "
+                       "~2 s CPU a rigid step map, ~35 maps)", len(laws)) as bar:
+        for name, law in laws.items():
+            replays[name] = replay_phase_law(data, t, x, u, law, close=name == "feedback")
+            bar.advance(info=name)
     return replays, laws

@@ -191,6 +191,8 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
     ValueError
         The phase variable is not monotonic over the step or a phase of it (one line).
     """
+    from walkerlab import progress
+
     names = tuple(getattr(res, "phase_names", ()) or ())
     start = getattr(res, "phase_start", None)
     push = float(getattr(res, "push_off_n_s", 0.0))
@@ -198,10 +200,13 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
     probe = walker.actuators
     gains = {"feedback": hip_gains(data, probe, res.x[0], walker), "feedforward": (0.0, 0.0)}
     out = {}
-    for name, g in gains.items():
-        law = hip_phase_law(probe, res.t, res.x, res.u, g, start, names)
-        out[name] = replay_law(hip_walker(data, law, push), solver, res.t, res.x, tau,
-                               close=name == "feedback", tol=CLOSED, phases=names or None)
+    with progress.task("optimize: phase-variable replays (feedback closed, feed-forward)",
+                       len(gains)) as bar:
+        for name, g in gains.items():
+            law = hip_phase_law(probe, res.t, res.x, res.u, g, start, names)
+            out[name] = replay_law(hip_walker(data, law, push), solver, res.t, res.x, tau,
+                                   close=name == "feedback", tol=CLOSED, phases=names or None)
+            bar.advance(info=name)
     return out
 
 
