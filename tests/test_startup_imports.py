@@ -11,6 +11,7 @@ cache, and an edit is still detected.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import subprocess
@@ -167,18 +168,23 @@ def test_the_remembered_hashes_stay_bounded(tmp_path, monkeypatch):
     monkeypatch.setattr(A.time, "time_ns", lambda: now + 10_000_000_000)  # files are "old"
     paths = [_artifact(tmp_path / "memo" / f"x{k}.h5", float(k)) for k in range(7)]
     folder = tmp_path / "cache" / "hashes"
-    for p in paths:
+
+    def entry(p):  # the user cache's file of an artifact path (artifacts._disk_memo)
+        name = hashlib.sha256(os.fsencode(os.path.realpath(p))).hexdigest()[:32]
+        return folder / f"{name}.json"
+
+    for k, p in enumerate(paths):
         monkeypatch.setattr(A, "_HASH_MEMO", {})
         assert A.verified_hash(p) == "k"
-        if folder.exists():  # distinct, increasing modification times
-            for j, e in enumerate(sorted(folder.iterdir(), key=lambda e: e.stat().st_mtime)):
-                os.utime(e, ns=(now + j, now + j))
-    left = sorted(folder.iterdir(), key=lambda e: e.stat().st_mtime_ns)
-    assert len(left) == 3  # 7 > 6: down to 6 // 2, the newest kept
-    newest = A._disk_memo(A._stamp(paths[-1]))
-    assert newest is not None
+        if entry(p).exists():  # modification times in the past, increasing with k: the
+            t = now - (100 - k) * 10**8  # one being written (the 7th) is the newest
+            os.utime(entry(p), ns=(t, t))
+    left = {e.name for e in folder.iterdir()}
+    assert left == {entry(p).name for p in paths[4:]}  # 7 > 6: down to 6 // 2, the newest
     hashed = []
     real = A.content_hash_of
     monkeypatch.setattr(A, "content_hash_of", lambda f: hashed.append(1) or real(f))
     monkeypatch.setattr(A, "_HASH_MEMO", {})
     assert A.verified_hash(paths[0]) == "k" and len(hashed) == 1  # pruned: hashed again
+    monkeypatch.setattr(A, "_HASH_MEMO", {})
+    assert A.verified_hash(paths[-1]) == "k" and len(hashed) == 1  # kept: not hashed
