@@ -60,6 +60,52 @@ def _read(key: str):
 _PHASE_FNS = ("flow", "guard", "guard_rate", "reset", "keep", "clearance", "step", "grf")
 
 
+def _encode(fns: dict) -> str:
+    """``fns`` (numbers, CasADi functions, a list of :class:`ModePhase`) as JSON."""
+    def phase(p):
+        return {"name": p.name, "guard_name": p.guard_name, "direction": p.direction,
+                **{f: (None if getattr(p, f) is None else getattr(p, f).serialize())
+                   for f in _PHASE_FNS}}
+    return json.dumps({k: (v if k in _NUMBERS else [phase(p) for p in v] if k == "phases"
+                           else v.serialize()) for k, v in fns.items()})
+
+
+def _decode(text: str) -> dict:
+    """:func:`_encode`'s inverse (raises on a damaged text)."""
+    import casadi as ca
+
+    from walkerlab.optimal.phases import ModePhase
+
+    def phase(p):
+        return ModePhase(p["name"], p["guard_name"], int(p["direction"]),
+                         **{f: (None if p[f] is None else ca.Function.deserialize(p[f]))
+                            for f in _PHASE_FNS})
+    return {k: (v if k in _NUMBERS else [phase(p) for p in v] if k == "phases"
+                else ca.Function.deserialize(v)) for k, v in json.loads(text).items()}
+
+
+def _cached(key: str, build) -> dict:
+    """The functions of ``key`` from this process's memo, the disk cache (a damaged file:
+    rebuilt), or ``build()`` (and written there)."""
+    from walkerlab.codegen.cache import write_source
+
+    if key in _memo:
+        return _memo[key]
+    text, path = _read(key)
+    fns = None
+    if text is not None:
+        try:
+            fns = _decode(text)
+        except (RuntimeError, ValueError, TypeError, AttributeError, KeyError):
+            fns = None  # damaged: rebuilt below
+    if fns is None:
+        fns = build()
+        if path is not None:
+            write_source(path, _encode(fns))
+    _memo[key] = fns
+    return fns
+
+
 def cached_mode_functions(data, walker, order=None) -> dict:
     """:func:`walkerlab.optimal.phases.mode_functions` of ``data`` (a WalkerData) in the
     phase order ``order`` (default: the rigid ``walker``'s), from this process's memo, the
@@ -76,42 +122,11 @@ def cached_mode_functions(data, walker, order=None) -> dict:
         A walker or phase the transcription has no symbolic form for (one line; nothing
         cached).
     """
-    import casadi as ca
+    from walkerlab.optimal import phases
 
-    from walkerlab.codegen.cache import write_source
-    from walkerlab.optimal.phases import ModePhase, mode_functions, phase_order
-
-    order = [tuple(o) for o in (order if order is not None else phase_order(walker))]
-    key = _key(data, "modes", order)
-    if key in _memo:
-        return _memo[key]
-    text, path = _read(key)
-    fns = None
-    if text is not None:
-        try:
-            stored = json.loads(text)
-            fns = {k: (v if k in _NUMBERS else ca.Function.deserialize(v))
-                   for k, v in stored.items() if k != "phases"}
-            fns["phases"] = [ModePhase(p["name"], p["guard_name"], int(p["direction"]),
-                                       **{f: (None if p[f] is None
-                                              else ca.Function.deserialize(p[f]))
-                                          for f in _PHASE_FNS})
-                             for p in stored["phases"]]
-        except (RuntimeError, ValueError, TypeError, AttributeError, KeyError):
-            fns = None  # damaged: rebuilt below
-    if fns is None:
-        fns = mode_functions(data, walker, order)
-        if path is not None:
-            out = {k: (v if k in _NUMBERS else v.serialize())
-                   for k, v in fns.items() if k != "phases"}
-            out["phases"] = [{"name": p.name, "guard_name": p.guard_name,
-                              "direction": p.direction,
-                              **{f: (None if getattr(p, f) is None
-                                     else getattr(p, f).serialize()) for f in _PHASE_FNS}}
-                             for p in fns["phases"]]
-            write_source(path, json.dumps(out))
-    _memo[key] = fns
-    return fns
+    order = [tuple(o) for o in (order if order is not None else phases.phase_order(walker))]
+    return _cached(_key(data, "modes", order),
+                   lambda: phases.mode_functions(data, walker, order))
 
 
 def cached_step_functions(data) -> dict:
@@ -128,29 +143,10 @@ def cached_step_functions(data) -> dict:
     ValueError
         A walker the transcription does not handle (one line; nothing cached).
     """
-    import casadi as ca
+    from walkerlab.optimal import collocation
 
-    from walkerlab.codegen.cache import write_source
-    from walkerlab.optimal.collocation import step_functions
-
-    key = _key(data)
-    if key in _memo:
-        return _memo[key]
-    text, path = _read(key)
-    fns = None
-    if text is not None:
-        try:
-            stored = json.loads(text)
-            fns = {k: (v if k in _NUMBERS else ca.Function.deserialize(v))
-                   for k, v in stored.items()}
-        except (RuntimeError, ValueError, TypeError, AttributeError):
-            fns = None  # damaged: rebuilt below
-    if fns is None:
+    def build():
         from walkerlab.codegen import symbolic  # sympy: only on a miss (~0.5 s to import)
 
-        fns = step_functions(data, symbolic.derive(data.structure))
-        if path is not None:
-            write_source(path, json.dumps({k: (v if k in _NUMBERS else v.serialize())
-                                           for k, v in fns.items()}))
-    _memo[key] = fns
-    return fns
+        return collocation.step_functions(data, symbolic.derive(data.structure))
+    return _cached(_key(data), build)

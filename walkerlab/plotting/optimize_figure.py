@@ -45,7 +45,10 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
         ax.set_ylabel(f"joint torque [{d.torque_unit}] (+ on the joint's second link)")
         ax.legend(fontsize=8, loc="best")
     work = d.terms.get("push_off_work", 0.0)
-    ax.set_title(f"{d.objective_name} = {d.objective:.3g} {d.objective_unit}"
+    cot = (f" (CoT {float(d.terms['cost_of_transport']):.3g} + effort term)"
+           if d.objective_name == "cost_of_transport" and "cost_of_transport" in d.terms
+           else "")
+    ax.set_title(f"{d.objective_name} = {d.objective:.3g} {d.objective_unit}{cot}"
                  + (f"; push-off work {work:.3g} J" if work > 0 else ""), fontsize=10)
     for name, v in d.states.items():
         if d.state_units.get(name) == "rad":
