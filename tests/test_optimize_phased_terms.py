@@ -267,7 +267,7 @@ def test_the_cost_of_transport_does_not_drift_to_large_torques(kneed, kneed_fast
     positive work (CoT ~1e-11) and its torque stays the least-effort gait's size (< 0.1 N m;
     0.0096 seen); with IPOPT's default initial barrier it drifted to 100 N m torques
     chattering between the points and a replay that did not step
-    (:func:`walkerlab.optimal.phased_collocation._options`)."""
+    (:func:`walkerlab.optimal.collocation.ipopt_options`)."""
     from dataclasses import replace
 
     from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases

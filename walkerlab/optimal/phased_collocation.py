@@ -298,7 +298,7 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     """
     import casadi as ca
 
-    from walkerlab.optimal.collocation import peak_torque
+    from walkerlab.optimal.collocation import ipopt_options, peak_torque
 
     _check(spec)
     phases = fns["phases"]
@@ -336,7 +336,7 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     if spec.objective == "cost_of_transport":
         obj = obj + spec.cost_of_transport_effort_weight * effort
     opti.minimize(obj)
-    opti.solver("ipopt", {"print_time": False}, _options(spec, asked))
+    opti.solver("ipopt", {"print_time": False}, ipopt_options(spec))
     build = time.perf_counter() - t_build
     return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build)
 
@@ -358,14 +358,6 @@ def _targets(opti, spec, fns, Xs, period):
     length = phases[-1].step(Xs[-1][:, -1])
     target_constraints(opti, spec, period, length)
     return length
-
-
-def _options(spec, asked: dict) -> dict:
-    """IPOPT's options: :func:`walkerlab.optimal.collocation.ipopt_options` (with the cost
-    of transport its small initial barrier, measured on the kneed walker there)."""
-    from walkerlab.optimal.collocation import ipopt_options
-
-    return ipopt_options(spec)
 
 
 def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResult:
