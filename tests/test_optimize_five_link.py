@@ -124,8 +124,9 @@ def test_torques_of_time_is_the_intervals_quadratic():
 
 @pytest.fixture(scope="module")
 def optimised(tmp_path_factory):
-    """``walkerlab optimize configs/rabbit_optimal.yaml`` once (~20 s CPU, and the
-    phase-variable replays ~90 s, the contact replay ~10 s)."""
+    """``walkerlab optimize configs/rabbit_optimal.yaml`` once (~10 s CPU, the
+    phase-variable replays ~3 s on compiled flows (~30 s more to compile them on a cold
+    cache), the contact replay ~10 s)."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
@@ -247,7 +248,45 @@ def check_the_phase_variable_law_walks_the_contact_model_at_the_optimums_period(
     assert abs(d.contact_step_period_s / d.step_period_s - 1.0) <= 0.03, d.contact_step_period_s
 
 
-@pytest.mark.slow  # one optimisation of rabbit_optimal (~4 min CPU with its phase replays)
+def check_the_phase_laws_compiled_flows_are_its_python_flows(optimised):
+    """The phase-variable replays run the law inside the compiled flows (its law block,
+    :meth:`walkerlab.optimal.phase_replay.PhaseLaw.packed`, on CyRK's DOP853): at the
+    collocated states, perturbed by 0.01, each phase's cfunc gives the walker's Python flow
+    (the generated passive flow + ``M^-1 B tau`` with the law called in Python) to 1e-11 of
+    its largest entry, and its guards' outputs the Python guards."""
+    import ctypes
+
+    from walkerlab.optimal.five_link_replay import (
+        RABBIT_GAINS,
+        phase_law,
+        phased_walker,
+        rigid_actuators,
+    )
+
+    d, _, _ = optimised
+    scene = load_scene(CONFIGS / "rabbit_optimal.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    x = np.stack(list(d.states.values()), axis=1)
+    law = phase_law(rigid_actuators(data), x, d.torque, *RABBIT_GAINS, t=d.time)
+    w = phased_walker(data, law)
+    rng = np.random.default_rng(11)
+    p = ctypes.POINTER(ctypes.c_double)
+    for ph in w.phases:
+        cf = ph.compiled
+        mod = cf.module()
+        n_extra, cols, offs = cf.guard_columns()
+        for xi in x[::10] + rng.normal(0, 0.01, x[::10].shape):
+            dy, y, data_vec = np.zeros(x.shape[1] + n_extra), np.ascontiguousarray(xi), cf.data()
+            mod.flow.ctypes(dy.ctypes.data_as(p), 0.0, y.ctypes.data_as(p),
+                            data_vec.ctypes.data_as(p))
+            want = np.asarray(ph.flow(0.0, xi))
+            np.testing.assert_allclose(dy[:x.shape[1]], want, rtol=0,
+                                       atol=1e-11 * np.abs(want).max())
+            for g, c, o in zip(ph.guards, cols, offs):
+                assert dy[x.shape[1] + c] + o == pytest.approx(g.function(0.0, xi), abs=1e-12)
+
+
+@pytest.mark.slow  # one optimisation of rabbit_optimal (~25 s CPU warm, ~1 min cold)
 def test_the_shipped_five_link_optimum(optimised, fns_and_params):
     """The checks of the shipped five-link optimum, in one test: pytest-xdist 3.8 with
     pytest 9.2 ignored ``xdist_group`` marks (pyproject now pins pytest < 9.2), so separate
@@ -258,3 +297,4 @@ def test_the_shipped_five_link_optimum(optimised, fns_and_params):
     check_the_transcription_error_falls_at_hermite_simpsons_order(optimised)
     check_the_phase_variable_replay_closes_stable_with_the_optimal_torques(optimised)
     check_the_phase_variable_law_walks_the_contact_model_at_the_optimums_period(optimised)
+    check_the_phase_laws_compiled_flows_are_its_python_flows(optimised)

@@ -164,13 +164,13 @@ def test_the_feed_forward_is_the_transcriptions_control_at_the_time_the_step_pas
         np.testing.assert_allclose(law.ff(si), tau((s[0] - si) / 0.9), atol=1e-9)
 
 
-def test_the_phased_walker_runs_its_law_on_every_backend():
-    """The law is a Python callable: the walker keeps no compiled flow (whose law block
-    would hold the placeholder zero laws), and its torque is the law's."""
+def test_the_phased_walker_runs_its_law_in_python_and_compiled():
+    """The walker's Python torque is the law's; its compiled flows carry the law's block
+    (:meth:`PhaseLaw.packed`), not the placeholder zero laws ``actuate`` packed."""
     from pathlib import Path
 
     from walkerlab.config import load_scene
-    from walkerlab.optimal.five_link_replay import phased_walker
+    from walkerlab.optimal.five_link_replay import LIMIT_N_M, phased_walker
     from walkerlab.walker.description import walker_data
 
     scene = load_scene(Path(__file__).resolve().parents[1] / "configs" / "rabbit_optimal.yaml")
@@ -179,11 +179,44 @@ def test_the_phased_walker_runs_its_law_on_every_backend():
     law = PhaseLaw(s, np.hstack([delta, delta]), np.hstack([slope, slope]),
                    np.hstack([u, u]), [1.0] * 4, [0.0] * 4)
     w = phased_walker(data, law)
-    assert all(ph.compiled is None for ph in w.phases)
+    assert all(np.array_equal(ph.compiled.laws, law.packed(LIMIT_N_M)) for ph in w.phases)
     x = np.array([0.1, 0.3, -0.1, -0.3, -0.1, -1.0, 0.4, -1.2, -1.0, -0.5])
     deltas, ddeltas, sx, dsx = w.actuators.joint_angles(x)
     np.testing.assert_allclose(w.actuators.torques(0.0, x), law.each(deltas, ddeltas, sx, dsx),
                                rtol=1e-14)
+
+
+@pytest.mark.parametrize("timed", [False, True])
+def test_the_law_block_is_the_phase_law(timed):
+    """Plain Python (no numba): the compiled flows' law (``law_torque`` on
+    :meth:`PhaseLaw.packed`, kind FEEDFORWARD) against :meth:`PhaseLaw.each` inside the
+    table and extrapolated past both ends (to 1e-13 of the torque: the same splines'
+    coefficients, its own Horner sums), its partial derivatives against the complex step
+    through ``each`` (1e-8: the complex step's first order), saturation at the limit."""
+    from walkerlab.codegen.torque_law import law_torque
+
+    s, ds, delta, slope, u, _ = _table()
+    kw = {"t": (s[0] - s) / 0.9, "ds": ds} if timed else {}
+    law = PhaseLaw(s, delta, slope, u, [2000.0, 500.0], [120.0, 60.0], **kw)
+    b = law.packed()
+    rng = np.random.default_rng(3)
+    for si in np.concatenate([rng.uniform(-0.4, 0.4, 100), s]):
+        de, dde, dsi = rng.normal(0, 0.3, 2), rng.normal(0, 1, 2), float(rng.normal(-1, 0.2))
+        want = law.each(de, dde, float(si), dsi)
+        for k in range(2):
+            got = law_torque(b, k, de[k], dde[k], float(si), dsi, 0.0)
+            assert got[0] == pytest.approx(want[k], rel=1e-13, abs=1e-11)
+            h = 1e-30
+            for j in range(4):
+                z = [de.astype(complex), dde.astype(complex), complex(si), complex(dsi)]
+                if j < 2:
+                    z[j][k] += 1j * h
+                else:
+                    z[j] += 1j * h
+                d = np.imag(law.each(*z)[k]) / h
+                assert got[1 + j] == pytest.approx(d, rel=1e-8, abs=1e-8), (j, k)
+    sat = law.packed(limit=1.0)
+    assert law_torque(sat, 0, 5.0, 0.0, 0.1, -1.0, 0.0) == (-1.0, 0.0, 0.0, 0.0, 0.0)
 
 
 @pytest.mark.parametrize("timed", [False, True])

@@ -23,20 +23,30 @@ table                  the knots ``s`` (``n``), then per interval ``j`` the coef
 
 Outside its knots a table is held at its end values (slope and curvature 0), as
 :func:`walkerlab.models.actuation.phase_reference`.
+
+Kind 3, a *phase-variable feed-forward* law (an optimised step replayed as virtual
+constraints, :class:`walkerlab.optimal.phase_replay.PhaseLaw`): ``tau = U(T(s)) - K (delta -
+h(s)) - D (ddelta - h'(s) ds)``, every spline extrapolated with its end interval's cubic
+(:class:`scipy.interpolate.PPoly`'s ``extrapolate=True``).  Its table: the knots ``s``
+(``n``), ``h``'s coefficients as above, then ``T``'s (the time the optimised step passes
+``s``) on the same knots, then ``m`` (the count of ``U``'s knots, the times), those knots and
+``U``'s coefficients per interval (``U`` the feed-forward of time; a quadratic padded with
+``c0 = 0``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FIELDS", "HEAD", "kernel_source", "law_torque", "pack_laws", "table_value"]
+__all__ = ["FIELDS", "HEAD", "cubic_at", "interval", "kernel_source", "law_torque", "pack_laws",
+           "table_value"]
 
 #: An actuator's header fields in the law block, in order.
 FIELDS = ("kind", "constant_n_m", "stiffness_n_m_per_rad", "damping_n_m_s_per_rad",
           "rest_angle_rad", "limit_n_m", "knots", "table_offset")
 HEAD = len(FIELDS)
 #: Law kinds.
-PLAIN, PHASE, TIME = 0, 1, 2
+PLAIN, PHASE, TIME, FEEDFORWARD = 0, 1, 2, 3
 
 
 def pack_laws(laws) -> np.ndarray:
@@ -45,10 +55,12 @@ def pack_laws(laws) -> np.ndarray:
     Parameters
     ----------
     laws : sequence of tuple
-        Per actuator ``(kind, constant, stiffness, damping, rest, limit, knots, coefs)``:
-        ``kind`` one of :data:`PLAIN`, :data:`PHASE`, :data:`TIME`; ``limit`` [N m] or None;
-        ``knots`` (n,) increasing and ``coefs`` (4, n - 1) (PPoly order, highest degree
-        first), both None for a plain law.
+        Per actuator ``(kind, constant, stiffness, damping, rest, limit, knots, coefs[,
+        tail])``: ``kind`` one of :data:`PLAIN`, :data:`PHASE`, :data:`TIME`,
+        :data:`FEEDFORWARD`; ``limit`` [N m] or None; ``knots`` (n,) increasing and ``coefs``
+        (4, n - 1) (PPoly order, highest degree first), both None for a plain law; ``tail``
+        (1-D) appended after the table (a :data:`FEEDFORWARD` law's ``T`` and ``U``, module
+        docstring).
 
     Returns
     -------
@@ -57,12 +69,13 @@ def pack_laws(laws) -> np.ndarray:
     head = np.zeros((len(laws), HEAD))
     tables = []
     offset = 3 + HEAD * len(laws)
-    for i, (kind, c, k, d, rest, limit, knots, coefs) in enumerate(laws):
+    for i, (kind, c, k, d, rest, limit, knots, coefs, *tail) in enumerate(laws):
         n = 0 if knots is None else len(knots)
         head[i] = (kind, c, k, d, rest, np.inf if limit is None else limit, n, offset)
         if n:
             block = np.concatenate([np.asarray(knots, float),
-                                    np.asarray(coefs, float).T.ravel()])
+                                    np.asarray(coefs, float).T.ravel(),
+                                    *(np.asarray(a, float).ravel() for a in tail)])
             tables.append(block)
             offset += block.size
     body = np.concatenate([head.ravel(), *tables]) if tables else head.ravel()
@@ -85,6 +98,30 @@ def table_value(b, off, n, u):
     return h, (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2], 6.0 * b[c] * x + 2.0 * b[c + 1]
 
 
+def interval(b, off, n, u):
+    """Index ``j`` of the interval of the knots ``b[off:off + n]`` that holds ``u``
+    (``knots[j] <= u < knots[j + 1]``; the end intervals outside, as
+    :class:`scipy.interpolate.PPoly`), by bisection."""
+    lo, hi = 0, n - 2
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if b[off + mid] <= u:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+def cubic_at(b, off, n, u):
+    """``(p, p', p'')`` at ``u`` of the piecewise cubic with knots ``b[off:off + n]`` and
+    coefficients after them, extrapolated with its end intervals."""
+    j = interval(b, off, n, u)
+    c = off + n + 4 * j
+    x = u - b[off + j]
+    return (((b[c] * x + b[c + 1]) * x + b[c + 2]) * x + b[c + 3],
+            (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2], 6.0 * b[c] * x + 2.0 * b[c + 1])
+
+
 def law_torque(b, i, delta, ddelta, s, ds, t):
     """Actuator ``i``'s torque [N m] of the law block ``b`` and its partial derivatives
     ``(tau, dtau/ddelta, dtau/dddelta, dtau/ds, dtau/dds)``: ``delta``, ``ddelta`` the joint
@@ -100,9 +137,24 @@ def law_torque(b, i, delta, ddelta, s, ds, t):
         r, r1, r2 = table_value(b, int(b[h + 7]), int(b[h + 6]), s)
         err, derr = delta - r, ddelta - r1 * ds
         g_s, g_ds = K * r1 + D * r2 * ds, D * r1
-    else:
+    elif kind == TIME:
         r, r1, _r2 = table_value(b, int(b[h + 7]), int(b[h + 6]), t - b[2])
         err, derr = delta - r, ddelta - r1
+    else:  # FEEDFORWARD: U(T(s)) and the reference h(s), extrapolated
+        off, n = int(b[h + 7]), int(b[h + 6])
+        j = interval(b, off, n, s)
+        x = s - b[off + j]
+        c = off + n + 4 * j
+        r = ((b[c] * x + b[c + 1]) * x + b[c + 2]) * x + b[c + 3]
+        r1 = (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2]
+        r2 = 6.0 * b[c] * x + 2.0 * b[c + 1]
+        c += 4 * (n - 1)
+        tt = ((b[c] * x + b[c + 1]) * x + b[c + 2]) * x + b[c + 3]
+        dtt = (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2]
+        uoff = off + n + 8 * (n - 1)
+        c0, du, _u2 = cubic_at(b, uoff + 1, int(b[uoff]), tt)
+        err, derr = delta - r, ddelta - r1 * ds
+        g_s, g_ds = du * dtt + K * r1 + D * r2 * ds, D * r1
     tau = c0 - K * err - D * derr
     lim = b[h + 5]
     if tau > lim:
@@ -113,12 +165,14 @@ def law_torque(b, i, delta, ddelta, s, ds, t):
 
 
 def kernel_source() -> list[str]:
-    """Source lines of :func:`table_value` and :func:`law_torque` as numba ``njit``
+    """Source lines of :func:`table_value`, :func:`interval`, :func:`cubic_at` and
+    :func:`law_torque` as numba ``njit``
     functions (``cache=True``) with the constants they read, for a generated module."""
     import inspect
 
-    out = [f"HEAD, PLAIN, PHASE, TIME = {HEAD}, {PLAIN}, {PHASE}, {TIME}", ""]
-    for fn in (table_value, law_torque):
+    out = [f"HEAD, PLAIN, PHASE, TIME, FEEDFORWARD = {HEAD}, {PLAIN}, {PHASE}, {TIME}, "
+           f"{FEEDFORWARD}", ""]
+    for fn in (table_value, interval, cubic_at, law_torque):
         src = inspect.getsource(fn).splitlines()
         body = [ln for ln in src if ln.strip()]
         doc_end = next(k for k, ln in enumerate(body[1:], 1) if ln.rstrip().endswith('"""'))

@@ -85,11 +85,15 @@ def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
     return law_of_rows(rows, u, stiffness, damping, t=t)
 
 
+#: the replay's torque limit [N m]: none in effect (RABBIT's motors: 150 N m)
+LIMIT_N_M = 1e6
+
+
 def phased_walker(data, law: PhaseLaw):
     """The rigid five-link walker (its generated code, phases, guards and reset) driven by
-    ``law`` on :data:`walkerlab.optimal.five_link.JOINTS`: its flow in Python (the law is
-    a Python callable; the compiled flows, which carry only tabled laws, are dropped so
-    that no backend runs them)."""
+    ``law`` on :data:`walkerlab.optimal.five_link.JOINTS`: in Python (``law`` called) and
+    compiled (its flows' law block :meth:`PhaseLaw.packed`, the same splines: the
+    ``cyrk_compiled`` backend of :func:`replay_solver` runs it without a Python callback)."""
     from dataclasses import replace
 
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
@@ -97,11 +101,14 @@ def phased_walker(data, law: PhaseLaw):
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.five_link import JOINTS
 
-    spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw(), max_torque_n_m=1e6)
+    spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw(), max_torque_n_m=LIMIT_N_M)
                               for j in JOINTS])
     walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
     walker.actuators.laws = law
-    return replace(walker, phases=tuple(replace(ph, compiled=None) for ph in walker.phases))
+    block = law.packed(LIMIT_N_M)
+    return replace(walker, phases=tuple(
+        replace(ph, compiled=None if ph.compiled is None else replace(ph.compiled, laws=block))
+        for ph in walker.phases))
 
 
 def rigid_actuators(data):
@@ -116,12 +123,12 @@ def rigid_actuators(data):
 
 
 def replay_solver():
-    """The replay's integrator: LSODA at rtol = atol = 1e-12, scipy's (the law is a Python
-    callback; at RABBIT's gains the flow is stiff and LSODA switches to BDF, ~2.5x fewer
-    evaluations than DOP853)."""
+    """The replay's integrator: DOP853 at rtol = atol = 1e-12 on CyRK with the compiled
+    flows of :func:`phased_walker` (the law in the cfunc; ~25 ms a step map where scipy's
+    LSODA with the law as a Python callback took ~2.5 s)."""
     from walkerlab.integrate.solver import Solver
 
-    return Solver(method="LSODA", rtol=1e-12, atol=1e-12, backend="scipy")
+    return Solver(method="DOP853", rtol=1e-12, atol=1e-12, backend="cyrk_compiled")
 
 
 def replay_phase_law(data, t, x, u, law: PhaseLaw, close: bool = True,
@@ -134,7 +141,7 @@ def replay_phase_law(data, t, x, u, law: PhaseLaw, close: bool = True,
     ~1e-12), its fixed point solved by MINPACK's hybrj (``scipy.optimize.root``) from the
     collocated start with that Jacobian; the multipliers are the eigenvalues of the forward
     differences at the closed start (at the collocated one when not closed).  ~25 step
-    maps closed (~2.5 s CPU each: the PD gains make the flow stiff), 11 not.
+    maps closed (~25 ms CPU each on the compiled flows), 11 not.
 
     Parameters
     ----------
@@ -193,7 +200,7 @@ def phase_replays(data, t, x, u) -> tuple[dict, dict]:
 
     replays = {}
     with progress.task("optimize: phase-variable replays (feedback closed, feed-forward; "
-                       "~2 s CPU a rigid step map, ~35 maps)", len(laws)) as bar:
+                       "~35 rigid step maps on compiled flows)", len(laws)) as bar:
         for name, law in laws.items():
             replays[name] = replay_phase_law(data, t, x, u, law, close=name == "feedback")
             bar.advance(info=name)

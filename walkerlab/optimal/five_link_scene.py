@@ -30,9 +30,8 @@ def optimize_five_link_scene(scene):
         closed and the replay returns within ``optimize.replay_tolerance``;
         ``phase_replays`` the phase-variable laws' rigid replays (``feedback``: closed,
         ``feedforward``: from the collocated start) and ``contact_step_period_s`` the
-        contact model's under the feedback law (~2 s of CPU per rigid step map: ~35 maps,
-        and 2 contact strides: the phase replays cost ~3 min CPU beside the ~20 s of the
-        rest).
+        contact model's under the feedback law (~35 rigid step maps on the compiled flows,
+        ~3 s CPU, and 2 contact strides, ~10 s).
 
     Raises
     ------

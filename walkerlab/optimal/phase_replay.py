@@ -91,10 +91,35 @@ class PhaseLaw:
         # h, h' and T (or the spline of u) share their knots: one PPoly evaluates them all
         # at a real s (the padded zero coefficient adds an exact 0: the same numbers)
         self._outer = None if t is None else U
+        self._time = None if t is None else T
         self._stack = _stacked((self.h, self.dh, spline if t is None else T))
 
     def __bool__(self) -> bool:
         return True
+
+    def packed(self, limit: float | None = None) -> np.ndarray:
+        """The law as the law block of compiled flows (:func:`walkerlab.codegen.torque_law.
+        pack_laws`, kind ``FEEDFORWARD``: the same splines' coefficients, the feed-forward of
+        ``s`` alone as ``T(s) = s``), each torque saturated at ``limit`` [N m] (None: not).
+
+        Returns
+        -------
+        ndarray (L,)
+        """
+        from walkerlab.codegen.torque_law import FEEDFORWARD, pack_laws
+
+        knots = self.h.x
+        if self._outer is None:  # the feed-forward a spline of s: T(s) = s on s's knots
+            T = np.zeros((4, len(knots) - 1))
+            T[2], T[3] = 1.0, knots[:-1]
+            U = self.ff
+        else:
+            T, U = self._time.c, self._outer
+        uc = U.c.reshape(U.c.shape[0], U.c.shape[1], -1)
+        uc = np.concatenate([np.zeros((4 - uc.shape[0],) + uc.shape[1:]), uc])
+        return pack_laws([(FEEDFORWARD, 0.0, float(self.K[k]), float(self.D[k]), 0.0, limit,
+                           knots, self.h.c[:, :, k], T.T, [len(U.x)], U.x, uc[:, :, k].T)
+                          for k in range(len(self.K))])
 
     def __call__(self, delta, ddelta, s, ds, t_step=0.0) -> np.ndarray:
         """Torque (k,) [N m] of every actuator on the one joint angle ``delta`` [rad] and
