@@ -123,6 +123,69 @@ def test_a_step_of_phases_gets_one_law_per_phase_chosen_by_the_phase_variable(co
     assert law.law_at(x[19, 1]) is law.laws[0] and law.law_at(x[22, 1]) is law.laws[1]
 
 
+def _kneed_step():
+    """A kneed step by hand in two phases (points 0..20 and 20..40; state order swing thigh,
+    swing shank, stance, rates): the stance angle falls from 0.2 to -0.2 rad at -1 rad/s,
+    the swing thigh ``-s + 0.1 sin(5 s)``, the shank 0.1 rad behind it, the torque
+    ``3 cos(4 t)`` and 1 N m more in the second phase."""
+    t = np.linspace(0.0, 0.4, 41)
+    s, ds = 0.2 - t, np.full(t.size, -1.0)
+    th = -s + 0.1 * np.sin(5 * s)
+    dth = (-1 + 0.5 * np.cos(5 * s)) * ds
+    x = np.stack([th, th - 0.1, s, dth, dth, ds], axis=1)
+    idx = np.r_[0:21, 20:41]
+    u = 3.0 * np.cos(4 * t[idx]) + (np.arange(idx.size) >= 21)
+    return t[idx], x[idx], u, np.array([0, 21])
+
+
+def test_the_kneed_walkers_compiled_flows_run_the_piecewise_law():
+    """The replays run the law inside the compiled flows (``cyrk_compiled``): the law block
+    (kind PIECEWISE, plain Python ``law_torque``) gives the law's torque on both sides of
+    the break (1e-12 N m), and both phases' cfuncs - the free knee and the locked knee
+    (``[S^T M; J_k]`` rows) - give the Python flow (the constrained ``M^-1 (B tau + a
+    lam)``) to 1e-12 of its largest entry and their variational equations ``J Phi`` with
+    ``J`` the complex step through the law, at states around the gait."""
+    import ctypes
+
+    from walkerlab.codegen.torque_law import law_torque
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.hip_phase_replay import LIMIT_N_M, replay_solver
+
+    pytest.importorskip("numba")
+    scene = load_scene(CONFIGS / "kneed_optimal.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    acts = hip_walker(data, None).actuators
+    t, x, u, start = _kneed_step()
+    law = hip_phase_law(acts, t, x, u, (80.0, 9.0), start, ("unlocked_swing", "locked_swing"))
+    w = hip_walker(data, law)
+    assert replay_solver(w, Solver("DOP853", 1e-12, 1e-12)).backend == "cyrk_compiled"
+    b = law.packed(LIMIT_N_M)
+    x0 = scene.fixedpoint.initial_guess.as_array(w.state_names())
+    rng = np.random.default_rng(4)
+    states = x0 + rng.normal(0, [0.05, 0.05, 0.15, 0.3, 0.3, 0.3], (12, 6))
+    assert min(z[2] for z in states) < 0.0 < max(z[2] for z in states)  # both pieces
+    p = ctypes.POINTER(ctypes.c_double)
+    for ph in w.phases:
+        cf = ph.compiled
+        mod = cf.module()
+        n_extra = cf.guard_columns()[0]
+        for z in states:
+            d, dd, s_, ds_ = acts.hip_angles(z)
+            assert law_torque(b, 0, d, dd, s_, ds_, 0.0)[0] == pytest.approx(
+                law(d, dd, s_, ds_)[0], abs=1e-12)
+            Phi = rng.normal(size=(6, 6))
+            dy = np.zeros(6 + 36 + n_extra)
+            y, dv = np.concatenate([z, Phi.ravel()]), cf.data()
+            getattr(mod, f"{cf.name}_variational").ctypes(
+                dy.ctypes.data_as(p), 0.0, y.ctypes.data_as(p), dv.ctypes.data_as(p))
+            want = np.asarray(ph.flow(0.0, z))
+            np.testing.assert_allclose(dy[:6], want, rtol=0, atol=1e-12 * np.abs(want).max())
+            JP = ph.jacobian(0.0, z) @ Phi
+            np.testing.assert_allclose(dy[6:42].reshape(6, 6), JP, rtol=0,
+                                       atol=1e-12 * np.abs(JP).max())
+    assert [ph.compiled.name for ph in w.phases] == ["flow", "flow_locked"]
+
+
 def test_the_passive_gait_walks_on_under_the_phase_law(compass):
     """compass_optimal's optimum is its passive gait (torque zero): fed its own step
     (sampled at 41 times), the feed-forward law (zero) steps from the passive fixed point

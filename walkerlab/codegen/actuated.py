@@ -37,8 +37,16 @@ def _defined(lines: list[str]) -> set[str]:
     return {ln.split("=", 1)[0].strip() for ln in lines if "=" in ln}
 
 
+#: A kneed walker's locked knee (:mod:`walkerlab.codegen.symbolic`): ``S`` spans the
+#: null space of the lock ``J_k = [-1, 1, 0]`` in ``(swing thigh, swing shank, stance)``
+#: (thigh and shank together); the locked flow's rows are ``[S^T M; J_k]``, its forces
+#: ``[S^T (B tau - C dq - G); 0]``.
+KNEE_LOCK_BASIS = ((1, 0), (1, 0), (0, 1))
+
+
 def _joint_exprs(eq, joints):
-    """Per actuator ``(delta, ddelta, B (n,))``, and ``(s, ds)``, as sympy expressions."""
+    """Per actuator ``(delta, ddelta, B (n,))``, and ``(s, ds)``, as sympy expressions (the
+    phase variable ``s``: the stance leg's angle, a kneed walker's stance thigh's)."""
     import sympy as sp
 
     la = eq.leg_angles
@@ -49,8 +57,16 @@ def _joint_exprs(eq, joints):
     for first, second in joints:
         d = la[second] - la[first]
         out.append((d, rate(d), [sp.diff(d, qi) for qi in eq.q]))
-    s = la["stance"]
+    s = la["stance"] if "stance" in la else la["stance_thigh"]
     return out, (s, rate(s))
+
+
+def _locked(acts):
+    """The actuators' generalised-force directions in the locked flow's rows: ``[S^T B;
+    0]`` (:data:`KNEE_LOCK_BASIS`)."""
+    S = KNEE_LOCK_BASIS
+    return [(d, dd, [sum(S[i][r] * B[i] for i in range(len(B))) for r in range(2)] + [0])
+            for d, dd, B in acts]
 
 
 def _law_lines(eq, joints, printer, cse_lines):
@@ -72,9 +88,11 @@ def _law_lines(eq, joints, printer, cse_lines):
     return lines, acts, grads
 
 
-def _body(eq, joints, variational, guards, printer) -> list[str]:
+def _body(eq, joints, variational, guards, printer, locked: bool = False) -> list[str]:
     """The lines of one cfunc after its constants' unpacking (see the module docstring);
-    ``NCONST`` is the module's constant count (a compile-time global for numba)."""
+    ``NCONST`` is the module's constant count (a compile-time global for numba).
+    ``locked``: a kneed walker's flow with its swing knee locked (``eq.locked``'s rows,
+    :data:`KNEE_LOCK_BASIS`)."""
     import sympy as sp
 
     from walkerlab.codegen.source import cse_lines, flow_lines
@@ -82,6 +100,9 @@ def _body(eq, joints, variational, guards, printer) -> list[str]:
     n = len(eq.q)
     m = 2 * n
     law_lines, acts, grads = _law_lines(eq, joints, printer, cse_lines)
+    if locked:
+        acts = _locked(acts)
+        eq = replace(eq, M=eq.locked[0], C=eq.locked[1], G=eq.locked[2])
     taus = [sp.Symbol(f"_tau{k}", real=True) for k in range(len(acts))]
     G = eq.G - sum((sp.Matrix(B) * tau for (_d, _dd, B), tau in zip(acts, taus)),
                    sp.zeros(n, 1))
@@ -143,7 +164,8 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
     """Source of the compiled module of an actuated walker (module docstring): ``constants``,
     ``NCONST``, ``GUARDS`` (``eq.guards``' names, written after the outputs as
     :func:`walkerlab.codegen.source.generate_compiled` does) and the cfuncs ``flow`` (2n
-    outputs) and ``flow_variational`` (``2n + (2n)^2``).
+    outputs) and ``flow_variational`` (``2n + (2n)^2``), and for a kneed walker
+    ``flow_locked`` and ``flow_locked_variational`` (its swing knee locked).
 
     Parameters
     ----------
@@ -161,6 +183,10 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
     guards = cse_lines(list(eq.guards.values()), PRINTER)
     bodies = {nm: _body(eq, joints, var, guards, PRINTER)
               for nm, var in (("flow", False), ("flow_variational", True))}
+    if eq.locked is not None:  # a kneed walker: its flow with the swing knee locked too
+        bodies.update({nm: _body(eq, joints, var, guards, PRINTER, locked=True)
+                       for nm, var in (("flow_locked", False),
+                                       ("flow_locked_variational", True))})
     consts = list(param_names) + [h.split("=")[0].strip() for h in hoisted]
     text = []
     for nm, lines in bodies.items():

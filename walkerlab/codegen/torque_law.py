@@ -32,21 +32,29 @@ h(s)) - D (ddelta - h'(s) ds)``, every spline extrapolated with its end interval
 ``s``) on the same knots, then ``m`` (the count of ``U``'s knots, the times), those knots and
 ``U``'s coefficients per interval (``U`` the feed-forward of time; a quadratic padded with
 ``c0 = 0``).
+
+Kind 4, a *piecewise* phase-variable law (one kind-3 law per phase of a step, the one in
+force chosen by ``s``: :class:`walkerlab.optimal.hip_phase_replay.PiecewisePhaseLaw`): the
+header's ``knots`` field holds the count of pieces ``P``; the table holds ``sign`` (the
+phase variable's direction over the step), the ``P - 1`` breaks (``s`` where each piece
+after the first begins), each piece's offset from the table's start, then each piece as
+``n`` and a kind-3 table.  The piece in force is the number of breaks with
+``sign (s - break) >= 0``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FIELDS", "HEAD", "cubic_at", "interval", "kernel_source", "law_torque", "pack_laws",
-           "table_value"]
+__all__ = ["FIELDS", "HEAD", "cubic_at", "feedforward_terms", "interval", "kernel_source",
+           "law_torque", "pack_laws", "table_value"]
 
 #: An actuator's header fields in the law block, in order.
 FIELDS = ("kind", "constant_n_m", "stiffness_n_m_per_rad", "damping_n_m_s_per_rad",
           "rest_angle_rad", "limit_n_m", "knots", "table_offset")
 HEAD = len(FIELDS)
 #: Law kinds.
-PLAIN, PHASE, TIME, FEEDFORWARD = 0, 1, 2, 3
+PLAIN, PHASE, TIME, FEEDFORWARD, PIECEWISE = 0, 1, 2, 3, 4
 
 
 def pack_laws(laws) -> np.ndarray:
@@ -57,10 +65,11 @@ def pack_laws(laws) -> np.ndarray:
     laws : sequence of tuple
         Per actuator ``(kind, constant, stiffness, damping, rest, limit, knots, coefs[,
         tail])``: ``kind`` one of :data:`PLAIN`, :data:`PHASE`, :data:`TIME`,
-        :data:`FEEDFORWARD`; ``limit`` [N m] or None; ``knots`` (n,) increasing and ``coefs``
-        (4, n - 1) (PPoly order, highest degree first), both None for a plain law; ``tail``
-        (1-D) appended after the table (a :data:`FEEDFORWARD` law's ``T`` and ``U``, module
-        docstring).
+        :data:`FEEDFORWARD`, :data:`PIECEWISE`; ``limit`` [N m] or None; ``knots`` (n,)
+        increasing and ``coefs`` (4, n - 1) (PPoly order, highest degree first), both None
+        for a plain law; ``tail`` (1-D) appended after the table (a :data:`FEEDFORWARD`
+        law's ``T`` and ``U``, module docstring).  A :data:`PIECEWISE` law gives its piece
+        count as ``knots`` (an int), ``coefs`` None and its whole table as ``tail``.
 
     Returns
     -------
@@ -70,12 +79,13 @@ def pack_laws(laws) -> np.ndarray:
     tables = []
     offset = 3 + HEAD * len(laws)
     for i, (kind, c, k, d, rest, limit, knots, coefs, *tail) in enumerate(laws):
-        n = 0 if knots is None else len(knots)
+        n = 0 if knots is None else (int(knots) if np.ndim(knots) == 0 else len(knots))
         head[i] = (kind, c, k, d, rest, np.inf if limit is None else limit, n, offset)
         if n:
-            block = np.concatenate([np.asarray(knots, float),
-                                    np.asarray(coefs, float).T.ravel(),
-                                    *(np.asarray(a, float).ravel() for a in tail)])
+            block = np.concatenate(
+                ([] if np.ndim(knots) == 0 else [np.asarray(knots, float),
+                                                 np.asarray(coefs, float).T.ravel()])
+                + [np.asarray(a, float).ravel() for a in tail])
             tables.append(block)
             offset += block.size
     body = np.concatenate([head.ravel(), *tables]) if tables else head.ravel()
@@ -122,6 +132,24 @@ def cubic_at(b, off, n, u):
             (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2], 6.0 * b[c] * x + 2.0 * b[c + 1])
 
 
+def feedforward_terms(b, off, n, delta, ddelta, s, ds, K, D):
+    """A kind-3 table at ``b[off:]`` (``n`` knots): ``(U(T(s)), delta - h(s), ddelta -
+    h'(s) ds, dtau/ds, dtau/dds)`` (the last two the law's partials with gains ``K``,
+    ``D``)."""
+    j = interval(b, off, n, s)
+    x = s - b[off + j]
+    c = off + n + 4 * j
+    r = ((b[c] * x + b[c + 1]) * x + b[c + 2]) * x + b[c + 3]
+    r1 = (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2]
+    r2 = 6.0 * b[c] * x + 2.0 * b[c + 1]
+    c += 4 * (n - 1)
+    tt = ((b[c] * x + b[c + 1]) * x + b[c + 2]) * x + b[c + 3]
+    dtt = (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2]
+    uoff = off + n + 8 * (n - 1)
+    u, du, _u2 = cubic_at(b, uoff + 1, int(b[uoff]), tt)
+    return u, delta - r, ddelta - r1 * ds, du * dtt + K * r1 + D * r2 * ds, D * r1
+
+
 def law_torque(b, i, delta, ddelta, s, ds, t):
     """Actuator ``i``'s torque [N m] of the law block ``b`` and its partial derivatives
     ``(tau, dtau/ddelta, dtau/dddelta, dtau/ds, dtau/dds)``: ``delta``, ``ddelta`` the joint
@@ -140,21 +168,18 @@ def law_torque(b, i, delta, ddelta, s, ds, t):
     elif kind == TIME:
         r, r1, _r2 = table_value(b, int(b[h + 7]), int(b[h + 6]), t - b[2])
         err, derr = delta - r, ddelta - r1
-    else:  # FEEDFORWARD: U(T(s)) and the reference h(s), extrapolated
-        off, n = int(b[h + 7]), int(b[h + 6])
-        j = interval(b, off, n, s)
-        x = s - b[off + j]
-        c = off + n + 4 * j
-        r = ((b[c] * x + b[c + 1]) * x + b[c + 2]) * x + b[c + 3]
-        r1 = (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2]
-        r2 = 6.0 * b[c] * x + 2.0 * b[c + 1]
-        c += 4 * (n - 1)
-        tt = ((b[c] * x + b[c + 1]) * x + b[c + 2]) * x + b[c + 3]
-        dtt = (3.0 * b[c] * x + 2.0 * b[c + 1]) * x + b[c + 2]
-        uoff = off + n + 8 * (n - 1)
-        c0, du, _u2 = cubic_at(b, uoff + 1, int(b[uoff]), tt)
-        err, derr = delta - r, ddelta - r1 * ds
-        g_s, g_ds = du * dtt + K * r1 + D * r2 * ds, D * r1
+    elif kind == FEEDFORWARD:  # U(T(s)) and the reference h(s), extrapolated
+        c0, err, derr, g_s, g_ds = feedforward_terms(b, int(b[h + 7]), int(b[h + 6]), delta,
+                                                     ddelta, s, ds, K, D)
+    else:  # PIECEWISE: the piece in force at s
+        off, pieces = int(b[h + 7]), int(b[h + 6])
+        k = 0
+        for j in range(pieces - 1):
+            if b[off] * (s - b[off + 1 + j]) >= 0.0:
+                k += 1
+        po = off + int(b[off + pieces + k])
+        c0, err, derr, g_s, g_ds = feedforward_terms(b, po + 1, int(b[po]), delta, ddelta,
+                                                     s, ds, K, D)
     tau = c0 - K * err - D * derr
     lim = b[h + 5]
     if tau > lim:
@@ -165,14 +190,14 @@ def law_torque(b, i, delta, ddelta, s, ds, t):
 
 
 def kernel_source() -> list[str]:
-    """Source lines of :func:`table_value`, :func:`interval`, :func:`cubic_at` and
-    :func:`law_torque` as numba ``njit``
+    """Source lines of :func:`table_value`, :func:`interval`, :func:`cubic_at`,
+    :func:`feedforward_terms` and :func:`law_torque` as numba ``njit``
     functions (``cache=True``) with the constants they read, for a generated module."""
     import inspect
 
-    out = [f"HEAD, PLAIN, PHASE, TIME, FEEDFORWARD = {HEAD}, {PLAIN}, {PHASE}, {TIME}, "
-           f"{FEEDFORWARD}", ""]
-    for fn in (table_value, interval, cubic_at, law_torque):
+    out = [f"HEAD, PLAIN, PHASE, TIME, FEEDFORWARD, PIECEWISE = {HEAD}, {PLAIN}, {PHASE}, "
+           f"{TIME}, {FEEDFORWARD}, {PIECEWISE}", ""]
+    for fn in (table_value, interval, cubic_at, feedforward_terms, law_torque):
         src = inspect.getsource(fn).splitlines()
         body = [ln for ln in src if ln.strip()]
         doc_end = next(k for k, ln in enumerate(body[1:], 1) if ln.rstrip().endswith('"""'))

@@ -31,8 +31,9 @@ import numpy as np
 
 from walkerlab.optimal.phase_replay import PhaseLaw, law_of_rows, replay_law
 
-__all__ = ["BANDWIDTH", "CLOSED", "PiecewisePhaseLaw", "hip_gains", "hip_phase_law",
-           "hip_phase_records", "hip_phase_replays", "hip_walker"]
+__all__ = ["BANDWIDTH", "CLOSED", "LIMIT_N_M", "PiecewisePhaseLaw", "hip_gains",
+           "hip_phase_law", "hip_phase_records", "hip_phase_replays", "hip_walker",
+           "replay_solver"]
 
 #: the PD law's closed-loop frequency in units of the leg's pendulum frequency sqrt(g / l)
 BANDWIDTH = 4.0
@@ -69,6 +70,27 @@ class PiecewisePhaseLaw:
         passed = int(np.sum(self.sign * (float(np.real(s)) - self.breaks) >= 0.0))
         return self.laws[passed]
 
+    def packed(self, limit: float | None = None) -> np.ndarray:
+        """The law block of compiled flows (:func:`walkerlab.codegen.torque_law.pack_laws`,
+        kind PIECEWISE: each piece :meth:`PhaseLaw.table`, chosen by ``s`` as
+        :meth:`law_at`), each torque saturated at ``limit`` [N m] (None: not).
+
+        Returns
+        -------
+        ndarray (L,)
+        """
+        from walkerlab.codegen.torque_law import PIECEWISE, pack_laws
+
+        rows = []
+        for k in range(len(self.K)):
+            pieces = [np.concatenate([[len(law.h.x)], law.table(k)]) for law in self.laws]
+            head = 1 + len(self.breaks) + len(pieces)
+            offsets = head + np.cumsum([0] + [p.size for p in pieces[:-1]])
+            table = np.concatenate([[self.sign], self.breaks, offsets, *pieces])
+            rows.append((PIECEWISE, 0.0, float(self.K[k]), float(self.D[k]), 0.0, limit,
+                         len(pieces), None, table))
+        return pack_laws(rows)
+
     def each(self, deltas, ddeltas, s, ds, t_step=0.0) -> np.ndarray:
         """:meth:`PhaseLaw.each` of the law in force at ``s``."""
         return self.law_at(s).each(deltas, ddeltas, s, ds, t_step)
@@ -78,10 +100,16 @@ class PiecewisePhaseLaw:
         return self.law_at(s)(delta, ddelta, s, ds, t_step)
 
 
+#: the replays' torque limit [N m]: none in effect
+LIMIT_N_M = 1e6
+
+
 def hip_walker(data, law, push_off_n_s: float = 0.0):
     """The rigid walker of ``data`` (its generated code, phases, guards and reset) with a hip
     actuator driven by ``law`` and the push-off ``push_off_n_s`` [N s] (0: none): its flow
-    in Python (the compiled flows, which carry only tabled laws, are dropped)."""
+    in Python (``law`` called) and, where the walker has compiled actuated flows (massive
+    legs: straight or kneed, point feet), compiled with the law's block (``law.packed``,
+    the same splines); without a law (None) no compiled flow."""
     from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.models.hybrid.rigid import make_rigid_walker
@@ -90,11 +118,30 @@ def hip_walker(data, law, push_off_n_s: float = 0.0):
     massless = bool(st.bodies) and all(b.massless for b in st.bodies)
     push = PushOff(impulse_n_s=max(push_off_n_s, 0.0)) if push_off_n_s > 0.0 else None
     spec = Actuation(push_off=push,
-                     torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
+                     torques=[JointTorque(joint="hip", law=TorqueLaw(),
+                                          max_torque_n_m=LIMIT_N_M,
                                           scaled_by="foot_mass" if massless else "none")])
     walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
+    from walkerlab.codegen.actuated import ActuatedFlow
+
     walker.actuators.laws = law
-    return replace(walker, phases=tuple(replace(ph, compiled=None) for ph in walker.phases))
+    block = None if law is None else law.packed(LIMIT_N_M)
+    return replace(walker, phases=tuple(
+        replace(ph, compiled=replace(ph.compiled, laws=block)
+                if isinstance(ph.compiled, ActuatedFlow) and block is not None else None)
+        for ph in walker.phases))
+
+
+def replay_solver(walker, solver):
+    """The solver of the replays: ``solver`` on CyRK's compiled flows (``cyrk_compiled``)
+    when every phase of ``walker`` has one and CyRK integrates ``solver``'s method, else
+    ``solver`` itself (the law then a Python callback)."""
+    from walkerlab.integrate.solver import CYRK_METHODS, available_backends
+
+    if (all(ph.compiled is not None for ph in walker.phases) and solver.method in CYRK_METHODS
+            and "cyrk" in available_backends()):
+        return replace(solver, backend="cyrk_compiled")
+    return solver
 
 
 def hip_gains(data, acts, x0, walker=None) -> tuple[float, float]:
@@ -204,7 +251,8 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
                        len(gains)) as bar:
         for name, g in gains.items():
             law = hip_phase_law(probe, res.t, res.x, res.u, g, start, names)
-            out[name] = replay_law(hip_walker(data, law, push), solver, res.t, res.x, tau,
+            driven = hip_walker(data, law, push)
+            out[name] = replay_law(driven, replay_solver(driven, solver), res.t, res.x, tau,
                                    close=name == "feedback", tol=CLOSED, phases=names or None)
             bar.advance(info=name)
     return out

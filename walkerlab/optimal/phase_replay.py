@@ -97,17 +97,10 @@ class PhaseLaw:
     def __bool__(self) -> bool:
         return True
 
-    def packed(self, limit: float | None = None) -> np.ndarray:
-        """The law as the law block of compiled flows (:func:`walkerlab.codegen.torque_law.
-        pack_laws`, kind ``FEEDFORWARD``: the same splines' coefficients, the feed-forward of
-        ``s`` alone as ``T(s) = s``), each torque saturated at ``limit`` [N m] (None: not).
-
-        Returns
-        -------
-        ndarray (L,)
-        """
-        from walkerlab.codegen.torque_law import FEEDFORWARD, pack_laws
-
+    def table(self, k: int) -> np.ndarray:
+        """Actuator ``k``'s law as a kind-3 table (FEEDFORWARD, :mod:`walkerlab.codegen.
+        torque_law`): the knots, ``h``'s and ``T``'s coefficients (the feed-forward of ``s``
+        alone as ``T(s) = s``), ``U``'s knot count, knots and coefficients (1-D)."""
         knots = self.h.x
         if self._outer is None:  # the feed-forward a spline of s: T(s) = s on s's knots
             T = np.zeros((4, len(knots) - 1))
@@ -117,9 +110,23 @@ class PhaseLaw:
             T, U = self._time.c, self._outer
         uc = U.c.reshape(U.c.shape[0], U.c.shape[1], -1)
         uc = np.concatenate([np.zeros((4 - uc.shape[0],) + uc.shape[1:]), uc])
+        return np.concatenate([knots, self.h.c[:, :, k].T.ravel(), T.T.ravel(), [len(U.x)],
+                               U.x, uc[:, :, k].T.ravel()])
+
+    def packed(self, limit: float | None = None) -> np.ndarray:
+        """The law as the law block of compiled flows (:func:`walkerlab.codegen.torque_law.
+        pack_laws`, kind FEEDFORWARD: the same splines' coefficients, :meth:`table`), each
+        torque saturated at ``limit`` [N m] (None: not).
+
+        Returns
+        -------
+        ndarray (L,)
+        """
+        from walkerlab.codegen.torque_law import FEEDFORWARD, pack_laws
+
+        n = len(self.h.x)
         return pack_laws([(FEEDFORWARD, 0.0, float(self.K[k]), float(self.D[k]), 0.0, limit,
-                           knots, self.h.c[:, :, k], T.T, [len(U.x)], U.x, uc[:, :, k].T)
-                          for k in range(len(self.K))])
+                           n, None, self.table(k)) for k in range(len(self.K))])
 
     def __call__(self, delta, ddelta, s, ds, t_step=0.0) -> np.ndarray:
         """Torque (k,) [N m] of every actuator on the one joint angle ``delta`` [rad] and

@@ -384,9 +384,8 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     act on the swing row alone), or a phase whose guards have no compiled outputs."""
     from walkerlab.codegen.actuated import ActuatedFlow
 
-    # the compiled laws drive the unconstrained flow only: not a locking knee's phases (a
-    # five-link biped's free knees are unconstrained)
-    if limit or (data.structure.knee and not data.structure.free_knees):
+    # a kneed walker's phases: the free flow and the knee-locked one (``flow_locked``)
+    if limit:
         return None
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None and data.structure.free_knees:
@@ -395,8 +394,10 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
         guards = guard_outputs(phase, data)
     if guards is None:
         return None
-    links = getattr(acts, "links", None) or [("stance", "swing")] * len(acts.spec.torques)
-    return ActuatedFlow(data.structure, tuple(data.params), "flow", guards,
+    links = getattr(acts, "links", None) or \
+        [(acts.legs[1], acts.legs[0])] * len(acts.spec.torques)  # (stance, swing) thighs
+    name = phase.compiled.name if phase.compiled is not None else "flow"
+    return ActuatedFlow(data.structure, tuple(data.params), name, guards,
                         joints=tuple(tuple(j) for j in links), laws=acts.laws.packed(),
                         actuators=acts)
 
