@@ -93,8 +93,9 @@ class OptimizeSettings(Strict):
         None, description="also replay the step with the torques as a function of the "
         "phase variable (the stance leg's angle): feed-forward + PD closed to its fixed "
         "point, and the feed-forward alone (optimize.h5's replay/phase_*); default: on for "
-        "a five-link biped, off for the others (their replays run the law in Python, "
-        "~2-3 s of CPU per step map and ~20 maps)")
+        "a five-link biped, off for the others (~20 step maps: on compiled flows for "
+        "massive straight or kneed legs with point feet, ~10 ms each; massless legs and "
+        "flat feet run the law in Python, ~2-3 s of CPU each)")
 
     @model_validator(mode="after")
     def _targets(self) -> OptimizeSettings:
