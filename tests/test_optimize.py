@@ -166,7 +166,10 @@ def test_design_command_prints_the_optimum_and_refuses_bad_input_in_one_line(tmp
     assert (tmp_path / "paper" / "optimize_design.h5").is_file()
     for bad, msg in ((["--design", "walker.hip_mass_kg=5:x"], "FIELD=LO:HI"),
                      (["--design", "walker.hip_mass_kg=5:20", "--objective", "nope"],
-                      "--objective")):
+                      "--objective"),
+                     (["--design", "walker.hip_mas_kg=5:20"], "unknown field walker.hip_mas_kg"),
+                     (["--design", "walker.actuation.push_off.impulse_n_s=1:2"],
+                      "leaves it unset")):
         r = CliRunner().invoke(app, ["optimize", scene, *bad, "--runs-dir", str(tmp_path)])
         assert r.exit_code != 0 and r.output.count("error:") == 1 and msg in r.output, r.output
         assert "internal error" not in r.output

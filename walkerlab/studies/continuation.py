@@ -64,6 +64,9 @@ def scene_value(scene: Scene, path: str) -> float:
     from walkerlab.studies.runner import base_value
 
     v = base_value(scene.model_dump(mode="json"), path)
+    if v is None:  # a field the scene does not have (one line naming it), or one left unset
+        check_axes(scene, [ParamAxis(path, (), path)], values=False)
+        raise SceneError(f"{path}: the scene leaves it unset (no value to start from)")
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise SceneError(f"{path}: the scene's value {v!r} is not a number")
     return float(v)
