@@ -128,12 +128,90 @@ def test_a_powered_stride_at_a_target_speed_replays_on_the_rigid_model(asym):
     assert err <= 1e-6
 
 
+def _pushed(scene, impulse_n_s: float):
+    """``scene`` with a push-off of ``impulse_n_s`` [N s] before every heel strike."""
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["walker"]["actuation"] = {"push_off": {"impulse_n_s": impulse_n_s}}
+    return type(scene).model_validate(d)
+
+
+def test_a_stride_with_a_push_off_is_the_rigid_walkers_pushed_gait(asym):
+    """A fixed push-off of 0.5 N s before both heel strikes (each with its own leg's
+    impact): the least-effort stride has no hip torque (objective <= 1e-10), so it is the
+    pushed walker's passive period-2 gait, found independently by shooting on the rigid
+    model with the push-off (``fixedpoint``'s search on the scene with
+    ``walker.actuation.push_off``): each step's period within 1e-6 relative (the passive
+    stride's 7.5e-8 on 40 intervals), the start within 1e-5; its replay with the push-off
+    closes to 1e-6; and it is not the unpushed gait (both steps longer by > 1e-3)."""
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.stride import replay_stride, step_of
+
+    scene, data, _walker, g, fns = asym
+    _, search = solve_scene(_pushed(scene, 0.5))
+    r = search.gaits[search.selected].result
+    res = collocate_phases(fns, CollocationSpec(intervals=40, push_off_n_s=0.5),
+                           _guess(asym))
+    assert res.status == "Solve_Succeeded" and res.objective <= 1e-10
+    assert res.push_off_n_s == 0.5 and res.terms["push_off_work"] > 0.0
+    periods = [step_of(res, k).step_period_s for k in (0, 1)]
+    np.testing.assert_allclose(periods, r.step_periods_s, rtol=1e-6, atol=0)
+    assert np.min(np.abs(np.array(periods) / g.step_periods - 1.0)) > 1e-3  # pushed: not
+    # the passive gait (measured: 0.68002 / 0.71581 s against 0.67839 / 0.71442 s)
+    np.testing.assert_allclose(res.x[0], r.x, atol=1e-5)
+    err, _ = replay_stride(data, res)
+    assert err <= 1e-6
+
+
+@pytest.mark.slow
+def test_a_free_push_off_stride_on_level_ground(asym):
+    """Level ground at 0.5 m/s, least cost of transport, the push-off free (~15 s): the
+    optimum pushes off (P > 0) and replays with it on the rigid model within 1e-6 (60
+    intervals a step); its push-off work is both heel strikes' kinetic-energy jumps by the
+    push-off in the rigid model's own transition (numpy, :class:`walkerlab.models.hybrid.
+    actuated.Actuators`; the collocation's is CasADi's) to 1e-9 relative, and it is a part
+    of the cost of transport, ``(hip positive work + push-off work) / (M g d)``."""
+    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.stride import replay_stride, step_of
+
+    scene, data, _walker, _g, _fns = asym
+    d = _pushed(scene, 2.0).model_dump(mode="json", exclude_none=True)
+    d["slope"] = {"angle_rad": 0.0}
+    level = type(scene).model_validate(d)
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.stride import stride_functions, stride_guess
+
+    ldata = walker_data(level.walker, level.slope.phi_rad)
+    _, search = solve_scene(level)
+    r = search.gaits[search.selected].result
+    lw = make_rigid_walker(ldata)
+    guess = stride_guess(actuate(lw, ldata, level.walker.actuation), np.asarray(r.x),
+                         r.period_s / 2, Solver.from_settings(level.solver), 60)
+    spec = CollocationSpec(intervals=60, push_off_n_s=2.0, push_off_free=True,
+                           objective="cost_of_transport", target_speed_m_per_s=0.5)
+    res = collocate_phases(stride_functions(ldata), spec, guess)
+    assert res.status == "Solve_Succeeded" and res.push_off_n_s > 0.5
+    err, replayed = replay_stride(ldata, res)
+    assert err <= 1e-6
+    jumps = []
+    for k, w in enumerate((replayed, replayed.mirror)):
+        tr = w.actuators.transition(step_of(res, k).x[-1])
+        jumps.append(tr["ke_push_off"] - tr["ke_minus"])
+    assert res.terms["push_off_work"] == pytest.approx(sum(jumps), rel=1e-9)
+    weight = ldata.total_mass_kg * ldata.gravity_m_per_s2
+    distance = 0.5 * res.step_period_s
+    assert res.terms["cost_of_transport"] > sum(jumps) / (weight * distance)
+
+
 def test_what_the_stride_does_not_take_is_refused_in_one_line(asym):
-    """A free push-off and objectives the phased transcription has no term for (the
-    push-off's work) are refused in one line naming the field (before any work); the cost
-    of transport and the friction cone pass the stride's checks, and a guess is read from
-    its artifact (a missing one refused naming ``optimize.initial_guess``); one step of legs
-    that differ stays refused by the one-step transcription."""
+    """The push-off's work as an objective without a push-off is refused in one line
+    naming the field (before any work); the cost of transport, the friction cone and a
+    free push-off pass the stride's checks, and a guess is read from its artifact (a
+    missing one refused naming ``optimize.initial_guess``); one step of legs that differ
+    stays refused by the one-step transcription."""
     from walkerlab.optimal.collocation import step_functions
     from walkerlab.optimal.scene import optimize_scene
     from walkerlab.optimal.stride_scene import _check
@@ -146,13 +224,14 @@ def test_what_the_stride_does_not_take_is_refused_in_one_line(asym):
         return type(scene).model_validate(d)
 
     for field, value, says in (("objective", "push_off_work", "optimize.objective"),
-                               ("push_off", "free", "optimize.push_off"),
                                ("initial_guess", {"from": "x.h5"}, "optimize.initial_guess")):
         with pytest.raises(ValueError, match=says) as exc:
             optimize_scene(with_(field, value), g.x, g.step_period)
         assert "\n" not in str(exc.value)
-    for field, value in (("objective", "cost_of_transport"), ("friction_coefficient", 0.8)):
-        _check(with_(field, value).optimize)  # accepted
+    for field, value in (("objective", "cost_of_transport"), ("friction_coefficient", 0.8),
+                         ("push_off", "free")):
+        _check(with_(field, value).optimize, False)  # accepted
+    _check(with_("objective", "push_off_work").optimize, True)  # with a push-off
     with pytest.raises(ValueError, match="legs that differ take a stride"):
         step_functions(data, None)
     with pytest.raises(ValueError, match="a stride is for legs that differ"):

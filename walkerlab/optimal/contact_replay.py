@@ -179,8 +179,10 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
     from walkerlab.optimal.phased_collocation import phase_torque_of_time
     from walkerlab.optimal.stride import step_of
 
-    setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]},
-                                {"n_strides": strides, "sample_rate_hz": 500})
+    act = {"torques": [{"joint": "hip", "law": {}}]}
+    if res.push_off_n_s > 0.0:  # before each touchdown, as in the rigid model
+        act["push_off"] = {"impulse_n_s": float(res.push_off_n_s)}
+    setup, why = _powered_setup(scene, act, {"n_strides": strides, "sample_rate_hz": 500})
     if setup is None:
         return float("nan"), why
     acts = setup.actuators

@@ -255,14 +255,22 @@ def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
     return work
 
 
-def _check(spec) -> None:
+def _pushes(spec) -> bool:
+    """The spec has a push-off (fixed and positive, or free)."""
+    return bool(spec.push_off_free or spec.push_off_n_s)
+
+
+def _check(spec, phases) -> None:
     """Refuse what the phased transcription does not take (one line)."""
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
-    bad = [k for k in asked if k not in PHASED_OBJECTIVES]
+    strikes = [p for p in phases if p.guard_name == "heel_strike"]
+    pushes = _pushes(spec) and bool(strikes) and all(p.push_off is not None for p in strikes)
+    known = PHASED_OBJECTIVES + (("push_off_work",) if pushes else ())
+    bad = [k for k in asked if k not in known]
     if bad:
         raise ValueError(f"optimize.objective: a walker with phases takes "
-                         f"{' or '.join(PHASED_OBJECTIVES)} (or their weighted sum) today")
-    if spec.push_off_free or spec.push_off_n_s:
+                         f"{' or '.join(known)} (or their weighted sum) today")
+    if _pushes(spec) and not pushes:
         raise ValueError("optimize.push_off: a walker with phases has no push-off impulse "
                          "(the rigid kneed and flat-footed models carry none: "
                          "walker.actuation.push_off is for straight legs on point feet)")
@@ -300,8 +308,8 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
 
     from walkerlab.optimal.collocation import ipopt_options, peak_torque
 
-    _check(spec)
     phases = fns["phases"]
+    _check(spec, phases)
     if [g[0] for g in guess] != [p.name for p in phases]:
         raise ValueError("optimize: the starting step's phases "
                          f"{[g[0] for g in guess]} are not the walker's")
@@ -311,14 +319,23 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     Xs = [opti.variable(n2, g[1].size) for g in guess]
     Us = [opti.variable(1, g[1].size) for g in guess]
     Ts = [opti.variable() for _ in guess]
-    effort = 0
+    effort, po_work, strikes = 0, 0, 0
+    push = opti.variable() if spec.push_off_free else spec.push_off_n_s
+    if spec.push_off_free:
+        opti.subject_to(opti.bounded(0.0, push, spec.push_off_max_n_s))
+        opti.set_initial(push, spec.push_off_n_s)
     taus = [np.asarray(g[1], float) / float(g[1][-1]) for g in guess]
     for p, mp in enumerate(phases):  # a step starts at 0 and after each heel strike
         starts = p == 0 or phases[p - 1].guard_name == "heel_strike"
         effort = effort + _phase(opti, mp, spec, Xs[p], Us[p], Ts[p], taus[p], starts,
                                  p == P - 1 or mp.guard_name == "heel_strike", fns)
         nxt = Xs[p + 1][:, 0] if p + 1 < P else Xs[0][:, 0]
-        opti.subject_to(nxt == mp.reset(Xs[p][:, -1]))
+        if _pushes(spec) and mp.guard_name == "heel_strike":  # push-off + heel strike
+            x_plus, w = mp.push_off(Xs[p][:, -1], push)
+            opti.subject_to(nxt == x_plus)
+            po_work, strikes = po_work + w, strikes + 1
+        else:
+            opti.subject_to(nxt == mp.reset(Xs[p][:, -1]))
         Tg = float(guess[p][1][-1])
         opti.subject_to(opti.bounded(0.05 * Tg, Ts[p], 5.0 * Tg))
         opti.set_initial(Ts[p], Tg)
@@ -331,14 +348,21 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
     work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
+    if _pushes(spec):  # the push-offs' work is positive work too
+        work = work + po_work
     terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"] * distance)
+    if _pushes(spec):
+        terms["push_off_work"] = po_work
     obj = sum(w * terms[k] for k, w in asked.items())
+    if spec.objective == "effort" and spec.push_off_free:  # as one step's, at each strike
+        obj = obj + strikes * spec.push_off_weight * push ** 2
     if spec.objective == "cost_of_transport":
         obj = obj + spec.cost_of_transport_effort_weight * effort
     opti.minimize(obj)
     opti.solver("ipopt", {"print_time": False}, ipopt_options(spec))
     build = time.perf_counter() - t_build
-    return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build)
+    return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build,
+                  push if _pushes(spec) else 0.0)
 
 
 def _targets(opti, spec, fns, Xs, period):
@@ -360,8 +384,9 @@ def _targets(opti, spec, fns, Xs, period):
     return length
 
 
-def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResult:
-    """Run IPOPT and read the phases back as one step."""
+def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> PhasedResult:
+    """Run IPOPT and read the phases back as one step (``push``: the push-off impulse, a
+    number or the decision variable)."""
     status, get, wall, cpu = solve(opti)
     n2 = Xs[0].shape[0]
     ts, xs, us, starts, durs, offset = [], [], [], [], [], 0.0
@@ -381,7 +406,8 @@ def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build) -> PhasedResul
         status=status,
         iterations=int(opti.stats().get("iter_count", -1)), build_time_s=build,
         wall_time_s=wall, cpu_time_s=cpu, terms={k: float(get(v)) for k, v in terms.items()},
-        history=iteration_history(opti.stats()))
+        history=iteration_history(opti.stats()),
+        push_off_n_s=float(push) if isinstance(push, (int, float)) else float(get(push)))
 
 
 def phase_torque_of_time(res: PhasedResult):

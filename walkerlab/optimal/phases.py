@@ -86,6 +86,12 @@ class ModePhase:
     clearance, step : casadi.Function
         ``x ->`` the swing foot's height above the slope [m] and its distance from the
         stance reference point [m] in the phase's kinematics.
+    push_off : casadi.Function or None
+        ``(x, P) -> (x+, W)``: a heel strike preceded by a push-off impulse ``P`` [N s]
+        along the trailing leg (the extended-coordinate impact of
+        :mod:`walkerlab.models.hybrid.actuated`) and the push-off's work ``W`` [J]; straight
+        legs on point feet only (None elsewhere: the rigid kneed and flat-footed models
+        carry no push-off).
     grf : casadi.Function
         ``(x, u) -> (F_n, F_t)`` [N]: the ground's resultant force on the stance foot along
         the slope's normal and tangent (forward, downhill, positive), ``sum_i m_i (a_i + g
@@ -105,6 +111,7 @@ class ModePhase:
     clearance: object = None
     step: object = None
     grf: object = None
+    push_off: object = None
 
 
 def phase_order(walker, phase_log=None) -> list[tuple[str, str, int]]:
@@ -170,7 +177,7 @@ def mode_functions(data, walker, order=None) -> dict:
     order = order if order is not None else phase_order(walker)
     kind = _FlatModes(data) if st.foot == "flat" else _KneedModes(data)
     n = kind.n
-    x, u = ca.SX.sym("x", 2 * n), ca.SX.sym("u")
+    x, u, P = ca.SX.sym("x", 2 * n), ca.SX.sym("u"), ca.SX.sym("P")
     phases = []
     for name, gname, direction in order:
         f = kind.flow(name, x, u)
@@ -183,7 +190,8 @@ def mode_functions(data, walker, order=None) -> dict:
             keep=kind.keep(name, x, f, u),
             clearance=ca.Function("clearance", [x], [kind.clearance(name, x)]),
             step=ca.Function("step", [x], [kind.step(name, x)]),
-            grf=ca.Function(f"grf_{len(phases)}", [x, u], [kind.grf(name, x, f)])))
+            grf=ca.Function(f"grf_{len(phases)}", [x, u], [kind.grf(name, x, f)]),
+            push_off=kind.push_off(gname, x, P, len(phases))))
     hip = kind.cas([kind.hip], x)
     return {"phases": phases, "n": n,
             "ahead": ca.Function("ahead", [x], [kind.cas([kind.guards["swing_foot_ahead"]],
@@ -245,6 +253,11 @@ class _Modes:
     def keep(self, name, x, f, u):
         return None
 
+    def push_off(self, gname, x, P, k):
+        """The phase's heel strike with a push-off (:class:`ModePhase` ``push_off``), or
+        None."""
+        return None
+
     def resultant(self, points, x, f):
         """The ground's resultant on the walker (normal, tangential) [N] from its mass
         points (``points``: sympy positions by name) and the accelerations ``f[n:]``."""
@@ -298,6 +311,19 @@ class _KneedModes(_Modes):
 
     def clearance(self, name, x):
         return self.cas([self.eq.guards["swing_clearance"]], x)
+
+    def push_off(self, gname, x, P, k):
+        """Straight legs' heel strike after a push-off ``P`` [N s]: the one-step
+        transcription's extended-coordinate map (:mod:`walkerlab.optimal.collocation`)."""
+        import casadi as ca
+
+        from walkerlab.optimal.collocation import _reset_extended
+
+        if gname != "heel_strike" or self.data.structure.knee:
+            return None
+        x_plus, work = _reset_extended(self.eq, self.xs, self.vals, x, P,
+                                       self.data.total_mass_kg)
+        return ca.Function(f"push_off_{k}", [x, P], [x_plus, work])
 
     def grf(self, name, x, f):
         return self.resultant(self.eq.points, x, f)

@@ -57,7 +57,8 @@ def _read(key: str):
 
 
 #: a phase's CasADi functions (:class:`walkerlab.optimal.phases.ModePhase`), in order
-_PHASE_FNS = ("flow", "guard", "guard_rate", "reset", "keep", "clearance", "step", "grf")
+_PHASE_FNS = ("flow", "guard", "guard_rate", "reset", "keep", "clearance", "step", "grf",
+              "push_off")
 
 
 def _encode(fns: dict) -> str:

@@ -22,8 +22,10 @@ positive hip work over ``M g`` and the stride's distance (both step lengths): th
 ``u d(hip angle)/dt``, the hip angle (swing minus stance) and the swing foot ahead are leg
 A's functions, used on leg B's step as well - the same expressions in the mirror's state
 (its swing leg first), no leg's number in them.  The friction cone bounds each phase's
-ground reaction, from its own walker's masses.  No push-off: the transcription's resets
-carry none.
+ground reaction, from its own walker's masses.  A push-off (fixed, or free: one decision
+variable) acts before both heel strikes, each with its own leg's numbers (the extended-
+coordinate impact of :mod:`walkerlab.models.hybrid.actuated`); its work joins the cost of
+transport and can be the objective (``push_off_work``, both strikes').
 
 A result is a gait after its replay on the rigid model (:func:`replay_stride`): the
 actuated walker and its mirror, each step's torque the optimised one as a function of the
@@ -135,13 +137,17 @@ def step_of(res, k: int):
 def stride_walker(data, res):
     """The rigid walker of ``data`` and its mirror with a hip actuator each, whose torque is
     the optimised one of its own step (:func:`walkerlab.optimal.phased_collocation.
-    phase_torque_of_time` of :func:`step_of`) from that step's heel strike."""
-    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+    phase_torque_of_time` of :func:`step_of`) from that step's heel strike, and the
+    stride's push-off impulse ``res.push_off_n_s`` [N s] before each heel strike (if
+    any)."""
+    from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.phased_collocation import phase_torque_of_time
 
-    spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
+    push = PushOff(impulse_n_s=res.push_off_n_s) if res.push_off_n_s > 0.0 else None
+    spec = Actuation(push_off=push, torques=[JointTorque(joint="hip", law=TorqueLaw(),
+                                                         max_torque_n_m=1e6)])
     walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
     for k, w in enumerate((walker, walker.mirror)):
         tau, acts = phase_torque_of_time(step_of(res, k)), w.actuators

@@ -15,18 +15,20 @@ import numpy as np
 __all__ = ["optimize_stride_scene", "starting_stride"]
 
 
-def _check(o) -> None:
-    """Refuse what the stride transcription does not take (one line naming the field)."""
+def _check(o, pushes: bool) -> None:
+    """Refuse what the stride transcription does not take (one line naming the field);
+    ``pushes``: the stride has a push-off (fixed or free)."""
     from walkerlab.optimal.phased_collocation import PHASED_OBJECTIVES
 
     asked = dict(o.weights or {}) if o.objective == "weighted" else {o.objective: 1.0}
-    bad = [k for k in asked if k not in PHASED_OBJECTIVES]
+    known = PHASED_OBJECTIVES + (("push_off_work",) if pushes else ())
+    bad = [k for k in asked if k not in known]
     if bad:
         raise ValueError(f"optimize.objective: legs that differ take "
-                         f"{', '.join(PHASED_OBJECTIVES)} (or their weighted sum), not "
-                         f"{', '.join(bad)}")
-    if o.push_off == "free":
-        raise ValueError("optimize.push_off: legs that differ have no push-off today")
+                         f"{', '.join(known)} (or their weighted sum), not "
+                         f"{', '.join(bad)}" + ("" if pushes else " (push_off_work: with a "
+                                                "push-off, walker.actuation.push_off or "
+                                                "optimize.push_off: free)"))
 
 
 def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
@@ -107,12 +109,10 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     from walkerlab.optimal.stride import replay_stride, stride_functions
 
     o = scene.optimize
-    _check(o)
-    if spec.push_off_n_s:
-        raise ValueError("walker.actuation.push_off: legs that differ have no push-off in "
-                         "the stride transcription today")
+    _check(o, bool(spec.push_off_free or spec.push_off_n_s))
     walker = make_rigid_walker(data)
-    guess, guess_u = starting_stride(scene, walker, x_gait, period_s, spec.intervals)
+    guess, guess_u = starting_stride(scene, _guide(walker, data, spec), x_gait, period_s,
+                                     spec.intervals)
     t0 = time.perf_counter()
     fns = stride_functions(data)
     build = time.perf_counter() - t0
@@ -128,7 +128,8 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
-                        res.step_period_s / 2, float(np.mean(lengths)), 0.0, res.objective,
+                        res.step_period_s / 2, float(np.mean(lengths)), res.push_off_n_s,
+                        res.objective,
                         err, mu, bool(err <= o.replay_tolerance
                                       and res.status == "Solve_Succeeded"),
                         res.status, res.iterations, res.wall_time_s, units,
@@ -142,6 +143,18 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                         phase_replay_outcome="not replayed: a stride of legs that differ is "
                         "replayed as a function of time only" if o.phase_replay else "",
                         **_record(scene, walker, res))
+
+
+def _guide(walker, data, spec):
+    """The walker that steps the starting stride: ``walker``, with the scene's push-off
+    (``spec.push_off_n_s`` > 0) before each heel strike when it has one (its gait, from
+    ``fixedpoint``, is the pushed walker's)."""
+    if not spec.push_off_n_s:
+        return walker
+    from walkerlab.config.actuation import Actuation, PushOff
+    from walkerlab.models.hybrid.actuated import actuate
+
+    return actuate(walker, data, Actuation(push_off=PushOff(impulse_n_s=spec.push_off_n_s)))
 
 
 def _unit(objective: str) -> str:
