@@ -41,6 +41,7 @@ from walkerlab.optimal.phase_replay import (
     PhaseLaw,
     PhaseReplay,
     control_of_time,
+    driven_by,
     law_of_rows,
     replay_law,
 )
@@ -94,8 +95,6 @@ def phased_walker(data, law: PhaseLaw):
     ``law`` on :data:`walkerlab.optimal.five_link.JOINTS`: in Python (``law`` called) and
     compiled (its flows' law block :meth:`PhaseLaw.packed`, the same splines: the
     ``cyrk_compiled`` backend of :func:`replay_solver` runs it without a Python callback)."""
-    from dataclasses import replace
-
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.models.hybrid.rigid import make_rigid_walker
@@ -103,12 +102,8 @@ def phased_walker(data, law: PhaseLaw):
 
     spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw(), max_torque_n_m=LIMIT_N_M)
                               for j in JOINTS])
-    walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
-    walker.actuators.laws = law
-    block = law.packed(LIMIT_N_M)
-    return replace(walker, phases=tuple(
-        replace(ph, compiled=None if ph.compiled is None else replace(ph.compiled, laws=block))
-        for ph in walker.phases))
+    return driven_by(actuate(make_rigid_walker(data, "biped", "derived"), data, spec), law,
+                     LIMIT_N_M)
 
 
 def rigid_actuators(data):

@@ -29,7 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.optimal.phase_replay import PhaseLaw, law_of_rows, replay_law
+from walkerlab.optimal.phase_replay import PhaseLaw, driven_by, law_of_rows, replay_law
 
 __all__ = ["BANDWIDTH", "CLOSED", "LIMIT_N_M", "PiecewisePhaseLaw", "hip_gains",
            "hip_phase_law", "hip_phase_records", "hip_phase_replays", "hip_walker",
@@ -121,15 +121,8 @@ def hip_walker(data, law, push_off_n_s: float = 0.0):
                      torques=[JointTorque(joint="hip", law=TorqueLaw(),
                                           max_torque_n_m=LIMIT_N_M,
                                           scaled_by="foot_mass" if massless else "none")])
-    walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
-    from walkerlab.codegen.actuated import ActuatedFlow
-
-    walker.actuators.laws = law
-    block = None if law is None else law.packed(LIMIT_N_M)
-    return replace(walker, phases=tuple(
-        replace(ph, compiled=replace(ph.compiled, laws=block)
-                if isinstance(ph.compiled, ActuatedFlow) and block is not None else None)
-        for ph in walker.phases))
+    return driven_by(actuate(make_rigid_walker(data, "biped", "derived"), data, spec), law,
+                     LIMIT_N_M)
 
 
 def replay_solver(walker, solver):

@@ -32,8 +32,8 @@ import numpy as np
 
 from walkerlab.numerics import sort_multipliers
 
-__all__ = ["PhaseLaw", "PhaseReplay", "control_of_time", "law_of_rows", "records", "replay_law",
-           "torque_error"]
+__all__ = ["PhaseLaw", "PhaseReplay", "control_of_time", "driven_by", "law_of_rows", "records",
+           "replay_law", "torque_error"]
 
 
 def _at(f, df, u):
@@ -166,6 +166,23 @@ def _stacked(polys):
         pad = np.zeros((order - c.shape[0],) + c.shape[1:])
         cs.append(np.concatenate([pad, c]))
     return PPoly(np.concatenate(cs, axis=2), polys[0].x, extrapolate=True)
+
+
+def driven_by(walker, law, limit: float):
+    """``walker`` (actuated, its actuators' laws set to ``law``) with each phase's compiled
+    actuated flow (:class:`walkerlab.codegen.actuated.ActuatedFlow`) carrying ``law``'s
+    block (``law.packed(limit)``, the same splines, saturated at ``limit`` [N m]) and every
+    other compiled flow dropped (it would run without the law); ``law`` None: none kept."""
+    from dataclasses import replace
+
+    from walkerlab.codegen.actuated import ActuatedFlow
+
+    walker.actuators.laws = law
+    block = None if law is None else law.packed(limit)
+    return replace(walker, phases=tuple(
+        replace(ph, compiled=replace(ph.compiled, laws=block)
+                if isinstance(ph.compiled, ActuatedFlow) and block is not None else None)
+        for ph in walker.phases))
 
 
 def law_of_rows(rows, u, stiffness, damping, t=None,
