@@ -49,6 +49,37 @@ def test_side_errors_reach_this_process():
     assert multiprocessing.active_children() == []
 
 
+def test_cancel_stops_the_task_under_way():
+    """After an error or Ctrl-C here, the side process's task is stopped, not waited for."""
+    import time
+
+    with SideWorker() as side:
+        fut = side.submit(time.sleep, 20.0)
+        if fut is None:
+            pytest.skip("one core: no side process")
+        time.sleep(0.5)  # let it start (either way it must not run to its end)
+        side.close(cancel=True)
+    assert fut.cancelled() or fut.exception() is not None
+    assert multiprocessing.active_children() == []
+
+
+def test_an_interrupted_numba_cache_write_leaves_no_temporary_file(tmp_path):
+    from walkerlab.usercache import guard_numba_cache
+
+    guard_numba_cache()
+    from numba.core import caching
+
+    target = tmp_path / "kernel.nbi"
+    with pytest.raises(KeyboardInterrupt):
+        with caching.IndexDataCacheFile._open_for_write(None, str(target)) as f:
+            f.write(b"half")
+            raise KeyboardInterrupt
+    assert list(tmp_path.iterdir()) == []
+    with caching.IndexDataCacheFile._open_for_write(None, str(target)) as f:
+        f.write(b"whole")
+    assert [p.name for p in tmp_path.iterdir()] == ["kernel.nbi"]
+
+
 class _Recorder:
     """A side worker that records what it is given and runs nothing."""
 

@@ -238,9 +238,12 @@ def _discard(path: str) -> None:
 
 
 def _patch_numba_caching(caching) -> None:
-    """Make numba's cache reads bounded, non-blocking and tolerant of damage (a miss)."""
+    """Make numba's cache reads bounded, non-blocking and tolerant of damage (a miss), and
+    its writes leave no temporary file when interrupted."""
+    import contextlib
     import io
     import pickle
+    import uuid
 
     from walkerlab.safefs import NotARegularFile, read_regular
 
@@ -282,8 +285,25 @@ def _patch_numba_caching(caching) -> None:
             _discard(path)
             raise OSError(f"{path}: damaged numba cache file") from exc
 
+    @contextlib.contextmanager
+    def _open_for_write(self, filepath):
+        # numba's own, but an interrupt (SIGTERM of a side process, Ctrl-C) removes the
+        # temporary file too: nothing half-written stays in the cache
+        tmp = f"{filepath}.tmp.{uuid.uuid4().hex[:16]}"
+        try:
+            with open(tmp, "wb") as f:
+                yield f
+            os.replace(tmp, filepath)
+        except BaseException:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+            raise
+
     cls._load_index = _load_index
     cls._load_data = _load_data
+    cls._open_for_write = _open_for_write
     original = caching.Cache.load_overload
 
     def load_overload(self, sig, target_context):

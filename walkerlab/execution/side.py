@@ -9,9 +9,11 @@ kernels into the user cache while the rigid stages run here, and draws half of t
   process), by :func:`walkerlab.execution.workers.process_pool` (it ends when this process
   dies), and never with fewer than two cores (there it would only take turns with this
   process).
-- It ignores SIGINT: Ctrl-C reaches this process, which stops starting work, waits for the
-  task under way (a compile writes numba's cache files, a figure its file, each by a rename;
-  nothing half-written stays behind) and ends the process (:meth:`~SideWorker.close`).
+- It ignores SIGINT: Ctrl-C reaches this process, which cancels what has not started and
+  stops the task under way with SIGTERM (:meth:`~SideWorker.close` with ``cancel``; in the
+  side process SIGTERM raises ``SystemExit``, so a file being written is removed, never
+  left half-written: :func:`walkerlab.safefs.atomic_replace`, numba's cache writes through
+  :func:`walkerlab.usercache.guard_numba_cache`); after the work is done, it waits for it.
 - A side process that cannot start or breaks costs its work, never the run: results are
   then computed here.
 """
@@ -23,14 +25,20 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from concurrent.futures.process import BrokenProcessPool
 
-__all__ = ["SideWorker", "ignore_sigint"]
+__all__ = ["SideWorker", "side_signals"]
 
 
-def ignore_sigint() -> None:
-    """Ignore SIGINT (Ctrl-C) in this process (the side process's initializer)."""
+def _exit(signum, frame):
+    raise SystemExit(128 + signum)
+
+
+def side_signals() -> None:
+    """The side process's initializer: ignore SIGINT (Ctrl-C is this process's to handle),
+    and end by ``SystemExit`` on SIGTERM (``finally`` clauses run: no half-written file)."""
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, _exit)
 
 
 def _cores() -> int:
@@ -67,7 +75,7 @@ class SideWorker:
             if self._pool is None:
                 from walkerlab.execution.workers import process_pool
 
-                self._pool = process_pool(1, initializer=ignore_sigint)
+                self._pool = process_pool(1, initializer=side_signals)
             return self._pool.submit(fn, *args)
         except (BrokenProcessPool, OSError, RuntimeError):
             self.enabled = False
@@ -111,9 +119,15 @@ class SideWorker:
                 out[k] = here(items[k])
         return out
 
-    def close(self) -> None:
-        """Cancel what has not started, wait for the task under way, end the process."""
+    def close(self, cancel: bool = False) -> None:
+        """Cancel what has not started, wait for the task under way (``cancel``: stop it,
+        by SIGTERM: after an error or an interrupt here) and end the process."""
         if self._pool is not None:
+            if cancel:
+                # the executor keeps its processes in a private mapping: no public way to
+                # stop the task under way
+                for proc in list(getattr(self._pool, "_processes", {}).values()):
+                    proc.terminate()
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
         self.enabled = False
@@ -121,5 +135,5 @@ class SideWorker:
     def __enter__(self) -> SideWorker:
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, exc_type, *exc) -> None:
+        self.close(cancel=exc_type is not None)

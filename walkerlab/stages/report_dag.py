@@ -95,11 +95,11 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
             drawn.append(draw_if_changed(scene, runs_root, force, "trajectories", side,
                                          ahead))
     except BaseException:
+        side.close(cancel=True)
         if study is not None:
             study.cancel()
         raise
-    finally:
-        side.close()
+    side.close()
     if study is not None:
         study.release()
         add(study.join())
