@@ -6,8 +6,9 @@ cores of its own (:class:`walkerlab.execution.background.BackgroundStudy`) overl
 untimed stages, and draws each figure group once its artifacts are ready.  The basin of
 attraction and the attribution run after the study: their worker processes and timed cases
 must not share the study's cores.  Without the study, a side process on the second core
-(:class:`walkerlab.execution.side.SideWorker`, :func:`_side_work`) compiles the contact
-model's kernels while the rigid stages run here and draws half of the trajectory figures.
+(:class:`walkerlab.execution.side.SideWorker`, :func:`_warm_up`) compiles the contact
+model's kernels while the rigid stages run here (which meanwhile draw the ideal figures)
+and then draws half of the other trajectory figures.
 What the report shows: :mod:`walkerlab.stages.report_inputs`.
 """
 
@@ -92,8 +93,10 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
             if name in plan:
                 add(stage_module(name).run(scene, runs_root, force))
         if any(o.stage in ("simulate", "contact-sim") for o in done):
-            drawn.append(draw_if_changed(scene, runs_root, force, "trajectories", side,
-                                         ahead))
+            # shared only with a side process already up (matplotlib loaded): one started
+            # for the figures alone costs about what it saves
+            drawn.append(draw_if_changed(scene, runs_root, force, "trajectories",
+                                         side if side.started else None, ahead))
     except BaseException:
         side.close(cancel=True)
         if study is not None:
