@@ -179,3 +179,17 @@ def test_a_contact_run_after_the_warm_up_compiles_nothing(tmp_path):
                     "--runs-dir", runs], env=env, check=True, cwd=ROOT,
                    stdout=subprocess.DEVNULL)
     assert files() == before
+
+
+def test_no_side_process_on_a_busy_machine(monkeypatch):
+    """``idle_only``: a load average of at least the number of cores starts nothing (the
+    side process would only take turns with this one)."""
+    from walkerlab.execution import side as S
+
+    monkeypatch.setattr(S.os, "getloadavg", lambda: (2.5, 2.0, 2.0))
+    monkeypatch.setattr(S, "_cores", lambda: 2)
+    busy = SideWorker(idle_only=True)
+    assert not busy.enabled and busy.submit(pow, 2, 3) is None
+    monkeypatch.setattr(S.os, "getloadavg", lambda: (1.2, 1.0, 1.0))
+    assert SideWorker(idle_only=True).enabled
+    assert SideWorker().enabled  # without idle_only, the load is not asked

@@ -7,8 +7,10 @@ kernels into the user cache while the rigid stages run here, and draws half of t
 
 - The process is started on the first :meth:`~SideWorker.submit` (nothing to do, no
   process), by :func:`walkerlab.execution.workers.process_pool` (it ends when this process
-  dies), and never with fewer than two cores (there it would only take turns with this
-  process).
+  dies), and never with fewer than two cores, nor (``idle_only``) when the load average
+  of the last minute is at least the number of cores: there it would only take turns with
+  this process, and a second process costs CPU of its own (its imports, ~2-3 s on the
+  report).
 - It ignores SIGINT: Ctrl-C reaches this process, which cancels what has not started and
   stops the task under way with SIGTERM (:meth:`~SideWorker.close` with ``cancel``; in the
   side process SIGTERM raises ``SystemExit``, so a file being written is removed, never
@@ -25,7 +27,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from concurrent.futures.process import BrokenProcessPool
 
-__all__ = ["SideWorker", "side_signals"]
+__all__ = ["SideWorker", "side_signals", "spare_core"]
 
 
 def _exit(signum, frame):
@@ -47,6 +49,15 @@ def _cores() -> int:
     return os.cpu_count() or 1  # pragma: no cover - not Linux
 
 
+def spare_core(cores: int) -> bool:
+    """Whether the machine seems to have a core to spare: the load average of the last
+    minute is below ``cores`` (True where the system gives no load average)."""
+    try:
+        return os.getloadavg()[0] < cores
+    except OSError:  # pragma: no cover - no load average
+        return True
+
+
 class SideWorker:
     """A worker process beside this one, started on first use.
 
@@ -55,10 +66,13 @@ class SideWorker:
     enabled : bool
         False: no process is ever started (:meth:`submit` returns None, :meth:`share`
         computes everything here).  Also False with fewer than two cores.
+    idle_only : bool
+        Also False when the cores are busy (:func:`spare_core`).
     """
 
-    def __init__(self, enabled: bool = True):
-        self.enabled = enabled and _cores() >= 2
+    def __init__(self, enabled: bool = True, idle_only: bool = False):
+        cores = _cores()
+        self.enabled = enabled and cores >= 2 and (not idle_only or spare_core(cores))
         self._pool = None
 
     @property

@@ -72,8 +72,9 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
         on_done(o)
     drawn: list[str] = []
     study = _study(scene, runs_root, force) if "workprecision" in plan else None
-    # the study times its cases on both cores: no side process beside it
-    side = SideWorker(enabled=study is None)
+    # the study times its cases on both cores: no side process beside it; nor on a busy
+    # machine (it would take turns with this process and add its own start-up)
+    side = SideWorker(enabled=study is None, idle_only=True)
     try:
         warm = _warm_up(scene, runs_root, force, plan, side)
         if "fixedpoint" in plan:
