@@ -141,9 +141,9 @@ def test_figures_drawn_ahead_and_shared_make_the_whole_group(ideal_scene, tmp_pa
         figs = plot.run(ideal_scene, tmp_path, side=side, ahead=ahead)
         sim = plot.load_simulate(tmp_path / "ideal_only" / "simulate.h5")
         (tmp_path / "there").mkdir()
-        there = side.submit(plot.draw_figures, ideal_scene, (sim, None, None, None),
+        there = side.submit(plot.draw_figure, ideal_scene, (sim, None, None, None),
                             tmp_path / "there", "fig2_stick_ideal")
-        there = there.result() if there is not None else plot.draw_figures(
+        there = there.result() if there is not None else plot.draw_figure(
             ideal_scene, (sim, None, None, None), tmp_path / "there", "fig2_stick_ideal")
     stems = [s for s, _ in scene_figure_plan(ideal_scene, sim, None, None, None)]
     assert [p.name for p in figs] == [f"{s}.{e}" for s in stems for e in ("png", "svg")]

@@ -8,6 +8,7 @@ when that changes (:func:`draw_if_changed`).
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
 from walkerlab.config import Scene
@@ -36,7 +37,7 @@ def figures_key(scene: Scene, runs_root, part: str) -> tuple[Path, str]:
     return (runpaths.figures_dir(scene, runs_root) / f".drawn_from_{part}", drawing_key(arts))
 
 
-def draw_figures(scene: Scene, loaded: tuple, folder: Path, stem: str) -> list[Path]:
+def draw_figure(scene: Scene, loaded: tuple, folder: Path, stem: str) -> list[Path]:
     """Draw and save the trajectory figure ``stem`` of ``scene`` from its loaded artifacts
     ``loaded`` (simulate, contact-sim, terrain, compare; None where absent) into
     ``folder``; returns the written files (the side process's share of :func:`_draw`)."""
@@ -89,9 +90,8 @@ def _draw(scene: Scene, runs_root, part: str, side: SideWorker | None = None,
     done = {p.stem: p for p in ahead}
     # each figure is drawn once, here or in the side process: the same files either way
     drawn = (side or SideWorker(enabled=False)).share(
-        [s for s in stems if s not in done], lambda stem: draw_figures(scene, loaded, folder,
-                                                                       stem),
-        draw_figures, scene, loaded, folder)
+        [s for s in stems if s not in done], partial(draw_figure, scene, loaded, folder),
+        draw_figure, scene, loaded, folder)
     return [p for p in ahead if p.stem in stems] + [p for files in drawn for p in files]
 
 
