@@ -193,3 +193,23 @@ def test_no_side_process_on_a_busy_machine(monkeypatch):
     monkeypatch.setattr(S.os, "getloadavg", lambda: (1.2, 1.0, 1.0))
     assert SideWorker(idle_only=True).enabled
     assert SideWorker().enabled  # without idle_only, the load is not asked
+
+
+SIDE_CPU_CHILD = r"""
+import resource, time
+from walkerlab.execution.side import SideWorker
+with SideWorker() as side:
+    fut = side.submit(exec, "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass")
+    there = side.submit(time.process_time).result() if fut is not None and fut.result() is None else 0.0
+r = resource.getrusage(resource.RUSAGE_SELF)
+print(r.ru_utime + r.ru_stime + there)
+"""
+
+
+def test_the_main_job_benchmark_counts_the_side_process_cpu():
+    """A command's side process ends after the command's own process has been waited for:
+    the benchmark still counts its CPU (an accounting identity, not a timing)."""
+    from walkerlab.bench.main_job import _env, _run
+
+    _, cpu, out = _run([sys.executable, "-c", SIDE_CPU_CHILD], _env(ROOT), ROOT)
+    assert cpu >= 0.95 * float(out.strip().splitlines()[-1])
