@@ -23,7 +23,8 @@ machine code it compiled earlier.  Both live in one folder per user, never in a 
 - every cache read is bounded and non-blocking (:func:`walkerlab.safefs.read_regular`): a
   FIFO, device or huge file in the cache is a miss, never a hang - numba's own reads of its
   index (``.nbi``) and data (``.nbc``) files included, and a damaged one (garbage, empty,
-  truncated) is removed and rebuilt, never an ``UnpicklingError`` (:func:`guard_numba_cache`);
+  truncated) is removed and rebuilt, never an ``UnpicklingError``, and numba's writes leave
+  no temporary file when interrupted (SIGTERM, Ctrl-C) (:func:`guard_numba_cache`);
 - without a usable folder (read-only, not private, a link) the run uses one private
   temporary folder (:func:`private_tmp`, ``walkerlab_gen_<pid>_*`` in the system temp
   folder, mode 0700), shared with its worker processes and removed when the process that
