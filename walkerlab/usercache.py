@@ -23,7 +23,8 @@ machine code it compiled earlier.  Both live in one folder per user, never in a 
 - every cache read is bounded and non-blocking (:func:`walkerlab.safefs.read_regular`): a
   FIFO, device or huge file in the cache is a miss, never a hang - numba's own reads of its
   index (``.nbi``) and data (``.nbc``) files included, and a damaged one (garbage, empty,
-  truncated) is removed and rebuilt, never an ``UnpicklingError`` (:func:`guard_numba_cache`);
+  truncated) is removed and rebuilt, never an ``UnpicklingError``, and numba's writes leave
+  no temporary file when interrupted (SIGTERM, Ctrl-C) (:func:`guard_numba_cache`);
 - without a usable folder (read-only, not private, a link) the run uses one private
   temporary folder (:func:`private_tmp`, ``walkerlab_gen_<pid>_*`` in the system temp
   folder, mode 0700), shared with its worker processes and removed when the process that
@@ -238,9 +239,12 @@ def _discard(path: str) -> None:
 
 
 def _patch_numba_caching(caching) -> None:
-    """Make numba's cache reads bounded, non-blocking and tolerant of damage (a miss)."""
+    """Make numba's cache reads bounded, non-blocking and tolerant of damage (a miss), and
+    its writes leave no temporary file when interrupted."""
+    import contextlib
     import io
     import pickle
+    import uuid
 
     from walkerlab.safefs import NotARegularFile, read_regular
 
@@ -282,8 +286,25 @@ def _patch_numba_caching(caching) -> None:
             _discard(path)
             raise OSError(f"{path}: damaged numba cache file") from exc
 
+    @contextlib.contextmanager
+    def _open_for_write(self, filepath):
+        # numba's own, but an interrupt (SIGTERM of a side process, Ctrl-C) removes the
+        # temporary file too: nothing half-written stays in the cache
+        tmp = f"{filepath}.tmp.{uuid.uuid4().hex[:16]}"
+        try:
+            with open(tmp, "wb") as f:
+                yield f
+            os.replace(tmp, filepath)
+        except BaseException:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+            raise
+
     cls._load_index = _load_index
     cls._load_data = _load_data
+    cls._open_for_write = _open_for_write
     original = caching.Cache.load_overload
 
     def load_overload(self, sig, target_context):

@@ -35,6 +35,9 @@ measurement            what is timed                                            
                        fixed point done before)
 =====================  ==============================================================  =======
 
+CPU times of a command are those of its whole process tree: the worker processes that end
+after it (multiprocessing's forkserver, the report's side process, pool workers) are reaped
+here and counted (:func:`_count_orphans`).
 Medians over ``repeats`` (the mesh and the robustness study once per tree unless asked);
 with a second tree also the median over the repeats of each repeat's ratio of the two trees
 (``pair_ratios_this_over_vs``: the two runs of a pair are minutes apart at most, so a
@@ -137,12 +140,42 @@ def _env(code: Path, cache: str | None = None) -> dict:
     return env
 
 
+def _count_orphans() -> None:
+    """Become the reaper of this process's orphaned descendants (Linux
+    ``PR_SET_CHILD_SUBREAPER``): the worker processes a command leaves to end after it
+    (multiprocessing's forkserver and the workers it forked, which the command never waits
+    for) are then reaped here (:func:`_reap`) and their CPU counted in ``RUSAGE_CHILDREN``
+    (without it, a command's side process or pool workers would not count)."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0)  # PR_SET_CHILD_SUBREAPER
+        except (OSError, AttributeError):  # pragma: no cover - no prctl
+            pass
+
+
+def _reap(limit_s: float = 10.0) -> None:
+    """Wait (at most ``limit_s`` [s]) for the remaining child processes and reap them."""
+    end = time.monotonic() + limit_s
+    while time.monotonic() < end:
+        try:
+            pid, _ = os.waitpid(-1, os.WNOHANG)
+        except ChildProcessError:
+            return
+        if pid == 0:
+            time.sleep(0.01)
+
+
 def _run(cmd: list[str], env: dict, cwd: Path) -> tuple[float, float, str]:
-    """Wall [s], CPU of the process tree reaped [s] and stdout of one command."""
+    """Wall [s], CPU of the process tree [s] (its orphans included: :func:`_count_orphans`)
+    and stdout of one command."""
+    _count_orphans()
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     p = subprocess.run(cmd, env=env, cwd=cwd, capture_output=True, text=True)
     wall = time.perf_counter() - t0
+    _reap()
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode:
         raise RuntimeError(f"{' '.join(cmd[:5])}: exit {p.returncode}: {p.stderr[-400:]}")

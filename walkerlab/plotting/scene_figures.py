@@ -7,6 +7,8 @@ limit cycles (Fig. 9), energy (Fig. 10) and the drop test's restitution;
 
 from __future__ import annotations
 
+from collections.abc import Callable, Collection
+from functools import partial
 from pathlib import Path
 
 from walkerlab.io.trajectory import NamedTrajectory
@@ -14,11 +16,16 @@ from walkerlab.plotting import IDEAL_LABEL
 from walkerlab.plotting import figures as F
 from walkerlab.units import Units
 
+#: stems of the trajectory figures drawn from the rigid run (``simulate.h5``) alone: the same
+#: figure whether or not the scene also has a contact run
+IDEAL_ONLY = ("energy_ledger", "fig2_stick_ideal")
 
-def trajectory_figures(trajs: dict[str, NamedTrajectory], out_dir: Path, title: str,
-                       slope_rad: float, units: Units, terrain: dict | None = None,
-                       compare=None, drop=None, k_paper: float | None = None) -> list[Path]:
-    """Draw and save the trajectory figures (paper order: Figs. 2, 6, then 7-10).
+
+def trajectory_plan(trajs: dict[str, NamedTrajectory], title: str, slope_rad: float,
+                    units: Units, terrain: dict | None = None, compare=None, drop=None,
+                    k_paper: float | None = None) -> list[tuple[str, Callable]]:
+    """The trajectory figures (paper order: Figs. 2, 6, then 7-10) as ``(stem, build)``
+    pairs: ``build()`` draws the figure ``stem`` and returns it (unsaved).
 
     Parameters
     ----------
@@ -31,39 +38,34 @@ def trajectory_figures(trajs: dict[str, NamedTrajectory], out_dir: Path, title: 
     drop : optional
         The drop test of ``contact_sim.h5`` (restitution against stiffness, with the scene's
         stiffness ``k_paper`` marked).
-
-    Returns
-    -------
-    list of Path
-        Written files.
     """
-    written: list[Path] = []
+    plan: list[tuple[str, Callable]] = []
     for label, tr in trajs.items():
         stem = "fig2_stick_ideal" if label == IDEAL_LABEL else "fig6_stick_contact"
         ground = None if label == IDEAL_LABEL else terrain  # the contact walker's checkerboard
-        written += F.save(F.stick_diagram(tr, label, slope_rad=slope_rad, units=units,
-                                          terrain=ground), out_dir, stem)
-    written += F.save(F.fig7_angles_rates(trajs, title, units=units), out_dir,
-                      "fig7_angles_rates")
-    written += F.save(F.fig9_limit_cycle(trajs, units=units), out_dir, "fig9_limit_cycles")
-    written += F.save(F.fig10_energy(trajs, units=units), out_dir, "fig10_energy")
+        plan.append((stem, partial(F.stick_diagram, tr, label, slope_rad=slope_rad,
+                                   units=units, terrain=ground)))
+    plan += [("fig7_angles_rates", partial(F.fig7_angles_rates, trajs, title, units=units)),
+             ("fig9_limit_cycles", partial(F.fig9_limit_cycle, trajs, units=units)),
+             ("fig10_energy", partial(F.fig10_energy, trajs, units=units))]
     if compare is not None:
         c = compare
         phase = (c.step_phase, c.phase_errors) if c.phase_errors is not None else None
-        written += F.save(F.fig8_errors(c.time, c.errors, c.error_units, "contact - ideal",
-                                        scene_units=units, phase=phase), out_dir, "fig8_errors")
+        plan.append(("fig8_errors", partial(F.fig8_errors, c.time, c.errors, c.error_units,
+                                            "contact - ideal", scene_units=units,
+                                            phase=phase)))
     if drop is not None:
         from walkerlab.plotting.sweep_figures import restitution_figure
 
-        fig = restitution_figure(drop.stiffness, drop.restitution, unit=drop.unit,
-                                 k_paper=k_paper, mass_kg=drop.mass_kg, units=units)
-        written += F.save(fig, out_dir, "drop_restitution")
-    return written
+        plan.append(("drop_restitution", partial(
+            restitution_figure, drop.stiffness, drop.restitution, unit=drop.unit,
+            k_paper=k_paper, mass_kg=drop.mass_kg, units=units)))
+    return plan
 
 
-def scene_trajectory_figures(scene, sim, contact, terrain, compare, out_dir: Path
-                             ) -> list[Path]:
-    """:func:`trajectory_figures` of a scene's loaded artifacts, titled by its walker model.
+def scene_figure_plan(scene, sim, contact, terrain, compare) -> list[tuple[str, Callable]]:
+    """A scene's trajectory figures as ``(stem, build)`` pairs (:func:`trajectory_plan`,
+    titled by its walker model, after the energy ledger of ``simulate.h5`` if it has one).
 
     Parameters
     ----------
@@ -74,8 +76,6 @@ def scene_trajectory_figures(scene, sim, contact, terrain, compare, out_dir: Pat
         The contact walker's ground (:func:`walkerlab.io.terrain.load_terrain`).
     compare : CompareArtifact, optional
         Loaded ``compare.h5``.
-    out_dir : Path
-        The report's figures folder.
     """
     from walkerlab.plotting import CONTACT_LABEL
     from walkerlab.units import for_scene
@@ -84,12 +84,24 @@ def scene_trajectory_figures(scene, sim, contact, terrain, compare, out_dir: Pat
              if a is not None}
     title = f"{str(getattr(scene.walker, 'model', 'walker')).replace('_', ' ')} walking"
     has_drop = contact is not None and scene.contact is not None and contact.drop is not None
-    ledger = [] if sim is None or not sim.ledger else energy_ledger_figure(sim, out_dir,
-                                                                           for_scene(scene))
-    return ledger + trajectory_figures(
-        trajs, out_dir, title, scene.slope.phi_rad, for_scene(scene), terrain, compare,
+    ledger = [] if sim is None or not sim.ledger else [
+        ("energy_ledger", partial(energy_ledger, sim, for_scene(scene)))]
+    return ledger + trajectory_plan(
+        trajs, title, scene.slope.phi_rad, for_scene(scene), terrain, compare,
         contact.drop if has_drop else None,
         float(scene.contact.written("stiffness")[0]) if has_drop else None)
+
+
+def scene_trajectory_figures(scene, sim, contact, terrain, compare, out_dir: Path,
+                             only: Collection[str] | None = None) -> list[Path]:
+    """Draw and save the figures of :func:`scene_figure_plan` (same parameters) into
+    ``out_dir`` (the report's figures folder); ``only``: just the figures of these stems.
+    Returns the written files."""
+    written: list[Path] = []
+    for stem, build in scene_figure_plan(scene, sim, contact, terrain, compare):
+        if only is None or stem in only:
+            written += F.save(build(), out_dir, stem)
+    return written
 
 
 def workprecision_figures(wp, out_dir: Path, units: Units) -> list[Path]:
@@ -115,9 +127,9 @@ _SINKS = (("heel_strike_loss", "heel-strike collision"), ("actuator_work_negativ
           ("internal_collision_loss", "knee strikes, foot slaps"), ("damper_work", "dampers"))
 
 
-def energy_ledger_figure(sim, out_dir: Path, units: Units) -> list[Path]:
+def energy_ledger(sim, units: Units):
     """Sources and sinks of mechanical energy per step (stacked bars, from ``simulate.h5``'s
-    ``ledger/``) and the cost of transport per step; returns the written files."""
+    ``ledger/``) and the cost of transport per step: the figure (unsaved)."""
     import matplotlib.pyplot as plt
     import numpy as np
 
@@ -161,4 +173,4 @@ def energy_ledger_figure(sim, out_dir: Path, units: Units) -> list[Path]:
     ax2.set_ylabel("cost of transport [-]")
     ax2.set_title("cost of transport")
     fig.tight_layout()
-    return F.save(fig, out_dir, "energy_ledger")
+    return fig

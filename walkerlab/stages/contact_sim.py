@@ -67,3 +67,21 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         out.failure = (f"the contact walker did not complete the run: {kind}"
                        + (f" ({why})" if why else ""))
     return out
+
+
+def warm_up(scene: Scene) -> bool:
+    """Compile the numba kernels of the scene's contact run into the user cache, untimed
+    (:func:`walkerlab.analysis.contact.warm.compile_run_kernels`): ``walkerlab report`` runs
+    it in a side process while its rigid stages run, so :func:`run` only loads them.
+    Returns False when nothing was compiled (numba is not installed).
+
+    Raises
+    ------
+    walkerlab.models.contact.scene.ContactSceneError
+        As :func:`run` (no ``contact`` section, a walker that cannot stand on contacts).
+    """
+    from walkerlab.analysis.contact.warm import compile_run_kernels
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()  # the same cache folder as the run's (set before numba is imported)
+    return compile_run_kernels(contact_setup(scene))

@@ -5,12 +5,19 @@
 cores of its own (:class:`walkerlab.execution.background.BackgroundStudy`) overlapping the
 untimed stages, and draws each figure group once its artifacts are ready.  The basin of
 attraction and the attribution run after the study: their worker processes and timed cases
-must not share the study's cores.  What the report shows: :mod:`walkerlab.stages.report_inputs`.
+must not share the study's cores.  Without the study, a side process on the second core
+(:class:`walkerlab.execution.side.SideWorker`, :func:`_warm_up`) compiles the contact
+model's kernels while the rigid stages run here (which meanwhile draw the ideal figures)
+and then draws half of the other trajectory figures.
+What the report shows: :mod:`walkerlab.stages.report_inputs`.
 """
 
 from __future__ import annotations
 
+import importlib
+
 from walkerlab.config import Scene
+from walkerlab.execution.side import SideWorker
 from walkerlab.stages.pipeline import report_plan, stage_module
 
 
@@ -29,6 +36,22 @@ def _study(scene: Scene, runs_root, force: bool):
                            ("contact",) if scene.contact is not None else ())
 
 
+def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
+    """Start compiling the contact model's kernels in the side process (None when not
+    started): when the report will compute ``contact-sim`` (no artifact yet, or ``force``;
+    a reused artifact needs no kernels), then have the side process load matplotlib for
+    its share of the figures while this process runs the contact walker."""
+    from walkerlab.io.runpaths import stage_artifact
+
+    if "contact-sim" not in plan or not (
+            force or not stage_artifact(scene, runs_root, "contact-sim").is_file()):
+        return None
+    fut = side.submit(stage_module("contact-sim").warm_up, scene)
+    if fut is not None:
+        side.submit(importlib.import_module, "walkerlab.plotting.scene_figures")
+    return fut
+
+
 def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
                on_done=lambda outcome: None) -> tuple[list, list[str]]:
     """Run the stages of :func:`report_plan` and draw their figures
@@ -39,7 +62,7 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
     (list of StageOutcome, list of str)
         What each stage did, in order, and one line per figure group drawn or reused.
     """
-    from walkerlab.stages.plot import draw_if_changed
+    from walkerlab.stages.plot import draw_ideal_ahead, draw_if_changed
 
     plan = report_plan(scene, full)
     done: list = []
@@ -49,7 +72,11 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
         on_done(o)
     drawn: list[str] = []
     study = _study(scene, runs_root, force) if "workprecision" in plan else None
+    # the study times its cases on both cores: no side process beside it; nor on a busy
+    # machine (it would take turns with this process and add its own start-up)
+    side = SideWorker(enabled=study is None, idle_only=True)
     try:
+        warm = _warm_up(scene, runs_root, force, plan, side)
         if "fixedpoint" in plan:
             add(stage_module("fixedpoint").run(scene, runs_root, force, compare_variants=True))
         if study is not None:
@@ -58,15 +85,25 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
             # numba compiles here, once
             stage_module("workprecision").warm_up(scene, runs_root, "contact")
             study.ready("contact")
+        ahead = []
         for name in ("simulate", "contact-sim", "compare"):
+            if name == "contact-sim" and warm is not None:
+                if "simulate" in plan and not warm.done():  # this core's turn meanwhile
+                    ahead = draw_ideal_ahead(scene, runs_root, force)
+                side.wait(warm)  # compiled there (or failed: compiled here), never twice
             if name in plan:
                 add(stage_module(name).run(scene, runs_root, force))
         if any(o.stage in ("simulate", "contact-sim") for o in done):
-            drawn.append(draw_if_changed(scene, runs_root, force, "trajectories"))
+            # shared only with a side process already up (matplotlib loaded): one started
+            # for the figures alone costs about what it saves
+            drawn.append(draw_if_changed(scene, runs_root, force, "trajectories",
+                                         side if side.started else None, ahead))
     except BaseException:
+        side.close(cancel=True)
         if study is not None:
             study.cancel()
         raise
+    side.close()
     if study is not None:
         study.release()
         add(study.join())

@@ -183,7 +183,8 @@ def _with_heights(walker, limits: ContactLimits) -> ContactLimits:
     return replace(limits, **upd)
 
 
-def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_scale=None):
+def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_scale=None,
+                step_length_m: float | None = None):
     """The contact walker of a scene, its initial state and run limits (the start of
     :func:`simulate_from`, shared with the benchmark).
 
@@ -197,6 +198,9 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
         Strides the run may take (patches are laid out for them).
     rate_scale : (float, float), optional
         Multipliers on the initial rates (default ``contact_sim.initial_rate_scale``).
+    step_length_m : float, optional
+        Patch spacing [m] instead of the ideal step length of ``x_ideal``
+        (:meth:`ContactSetup.build`).
 
     Returns
     -------
@@ -205,7 +209,7 @@ def scene_start(setup: ContactSetup, x_ideal: np.ndarray, n_strides: int, rate_s
         scene's ``contact_sim`` section, the ideal step length [m].
     """
     cs = setup.sim
-    walker, step_length = setup.build(x_ideal, 2 * n_strides)
+    walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m)
     scale = cs.initial_rate_scale if rate_scale is None else rate_scale
     x0 = initial_state_from_ideal(walker, *np.asarray(x_ideal, float), rate_scale=tuple(scale))
     limits = ContactLimits(
