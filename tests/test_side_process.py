@@ -198,9 +198,11 @@ def test_no_side_process_on_a_busy_machine(monkeypatch):
 SIDE_CPU_CHILD = r"""
 import resource, time
 from walkerlab.execution.side import SideWorker
+BURN = "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass"
 with SideWorker() as side:
-    fut = side.submit(exec, "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass")
-    there = side.submit(time.process_time).result() if fut is not None and fut.result() is None else 0.0
+    fut = side.submit(exec, BURN)
+    done = fut is not None and fut.result() is None
+    there = side.submit(time.process_time).result() if done else 0.0
 r = resource.getrusage(resource.RUSAGE_SELF)
 print(r.ru_utime + r.ru_stime + there)
 """
