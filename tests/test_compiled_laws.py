@@ -100,12 +100,13 @@ def test_the_actuated_cfuncs_are_the_python_flow_and_jacobian(name):
         rng = np.random.default_rng(6)
         for _ in range(4):
             x = X0 + rng.normal(0, [0.05, 0.05, 0.3, 0.3])
-            out = _call(mod.flow, x, cf.data(), 4 + ng)
+            out = _call(mod.cfunc_of("flow"), x, cf.data(), 4 + ng)
             np.testing.assert_allclose(out[:4], ph.flow(0.3, x), rtol=0, atol=1e-13)
             for g, c, o in zip(ph.guards, cols, offs):
                 assert out[4 + c] + o == pytest.approx(g.function(0.3, x), abs=1e-14)
             P = rng.normal(size=(4, 4))
-            out = _call(mod.flow_variational, np.concatenate([x, P.ravel()]), cf.data(), 20 + ng)
+            out = _call(mod.cfunc_of("flow_variational"), np.concatenate([x, P.ravel()]),
+                        cf.data(), 20 + ng)
             np.testing.assert_allclose(out[4:20].reshape(4, 4), ph.jacobian(0.3, x) @ P,
                                        rtol=0, atol=1e-11)
 
@@ -143,7 +144,7 @@ def test_rabbit_runs_its_virtual_constraints_on_compiled_flows():
     rng = np.random.default_rng(8)
     for _ in range(3):
         x = x0 + rng.normal(0, 0.02, x0.size)
-        out = _call(mod.flow, x, cf.data(), x0.size + len(mod.GUARDS))
+        out = _call(mod.cfunc_of("flow"), x, cf.data(), x0.size + len(mod.GUARDS))
         want = np.asarray(w.phases[0].flow(0.3, x))
         np.testing.assert_allclose(out[:x0.size], want, rtol=0, atol=1e-11 * np.abs(want).max())
     lsoda = simulate_steps(w, x0, 1, Solver.from_settings(sc.solver)).segments[0]

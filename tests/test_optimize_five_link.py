@@ -277,7 +277,7 @@ def check_the_phase_laws_compiled_flows_are_its_python_flows(optimised):
         n_extra, cols, offs = cf.guard_columns()
         for xi in x[::10] + rng.normal(0, 0.01, x[::10].shape):
             dy, y, data_vec = np.zeros(x.shape[1] + n_extra), np.ascontiguousarray(xi), cf.data()
-            mod.flow.ctypes(dy.ctypes.data_as(p), 0.0, y.ctypes.data_as(p),
+            mod.cfunc_of("flow").ctypes(dy.ctypes.data_as(p), 0.0, y.ctypes.data_as(p),
                             data_vec.ctypes.data_as(p))
             want = np.asarray(ph.flow(0.0, xi))
             np.testing.assert_allclose(dy[:x.shape[1]], want, rtol=0,

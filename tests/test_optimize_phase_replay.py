@@ -176,7 +176,7 @@ def test_the_kneed_walkers_compiled_flows_run_the_piecewise_law():
             Phi = rng.normal(size=(6, 6))
             dy = np.zeros(6 + 36 + n_extra)
             y, dv = np.concatenate([z, Phi.ravel()]), cf.data()
-            getattr(mod, f"{cf.name}_variational").ctypes(
+            mod.cfunc_of(f"{cf.name}_variational").ctypes(
                 dy.ctypes.data_as(p), 0.0, y.ctypes.data_as(p), dv.ctypes.data_as(p))
             want = np.asarray(ph.flow(0.0, z))
             np.testing.assert_allclose(dy[:6], want, rtol=0, atol=1e-12 * np.abs(want).max())

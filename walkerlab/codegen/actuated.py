@@ -163,9 +163,11 @@ def _variational_lines(eq, acts, grads, fl, rows, printer, cse_lines) -> list[st
 def generate_actuated(eq, param_names, joints, key: str) -> str:
     """Source of the compiled module of an actuated walker (module docstring): ``constants``,
     ``NCONST``, ``GUARDS`` (``eq.guards``' names, written after the outputs as
-    :func:`walkerlab.codegen.source.generate_compiled` does) and the cfuncs ``flow`` (2n
-    outputs) and ``flow_variational`` (``2n + (2n)^2``), and for a kneed walker
-    ``flow_locked`` and ``flow_locked_variational`` (its swing knee locked).
+    :func:`walkerlab.codegen.source.generate_compiled` does) and the right-hand sides
+    ``flow`` (2n outputs) and ``flow_variational`` (``2n + (2n)^2``), and for a kneed walker
+    ``flow_locked`` and ``flow_locked_variational`` (its swing knee locked), each made a
+    cfunc by ``cfunc_of(name)`` on first use (the five-link biped's variational cfunc takes
+    ~15 s to compile, its flow ~9 s).
 
     Parameters
     ----------
@@ -189,10 +191,16 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
                                        ("flow_locked_variational", True))})
     consts = list(param_names) + [h.split("=")[0].strip() for h in hoisted]
     text = []
-    for nm, lines in bodies.items():
-        text += ["@cfunc(SIG, cache=True, error_model='numpy')",
-                 f"def {nm}(dy, t, y, d):  # pragma: no cover - runs compiled",
+    for nm, lines in bodies.items():  # plain functions: made cfuncs on first use
+        text += [f"def {nm}(dy, t, y, d):  # pragma: no cover - runs compiled",
                  *[f"    {c} = d[{i}]" for i, c in enumerate(consts)], *lines, ""]
+    text += ["_LAZY = {}", "", "",
+             "def cfunc_of(name):",
+             '    """The cfunc ``name`` (compiled, or loaded from numba\'s cache, on first use: a',
+             '    walker that never runs its variational equations does not compile them)."""',
+             "    if name not in _LAZY:",
+             "        _LAZY[name] = cfunc(SIG, cache=True, error_model='numpy')(globals()[name])",
+             "    return _LAZY[name]", ""]
     body = ["def constants(p):", f"    {', '.join(param_names)}, = p", *hoisted,
             f"    return np.array(({', '.join(consts)},), dtype=np.float64)", "",
             f"NCONST = {len(consts)}",
@@ -271,6 +279,15 @@ class ActuatedFlow(CompiledFlow):
 
     def module(self):
         return actuated_module(self.structure, self.joints)
+
+    def address(self, variational: bool = False) -> int:
+        """C address of the cfunc ``(dy, t, y, d)`` (:meth:`CompiledFlow.address`), compiled
+        or loaded on first use (the module's ``cfunc_of``)."""
+        k = (self.name, variational)
+        if k not in self._memo:
+            name = f"{self.name}_variational" if variational else self.name
+            self._memo[k] = self.module().cfunc_of(name).address
+        return self._memo[k]
 
     def data(self) -> np.ndarray:
         """Constants, the law block (with the present step's start time) and a zeroed
