@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from walkerlab.optimal.phase_replay import (
+    LIMIT_N_M,
     PhaseLaw,
     PhaseReplay,
     control_of_time,
@@ -84,10 +85,6 @@ def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
     """
     rows = [acts.joint_angles(xi) for xi in np.asarray(x, float)]
     return law_of_rows(rows, u, stiffness, damping, t=t)
-
-
-#: the replay's torque limit [N m]: none in effect (RABBIT's motors: 150 N m)
-LIMIT_N_M = 1e6
 
 
 def phased_walker(data, law: PhaseLaw):

@@ -29,7 +29,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.optimal.phase_replay import PhaseLaw, driven_by, law_of_rows, replay_law
+from walkerlab.optimal.phase_replay import (
+    LIMIT_N_M,
+    PhaseLaw,
+    driven_by,
+    law_of_rows,
+    replay_law,
+)
 
 __all__ = ["BANDWIDTH", "CLOSED", "LIMIT_N_M", "PiecewisePhaseLaw", "hip_gains",
            "hip_phase_law", "hip_phase_records", "hip_phase_replays", "hip_walker",
@@ -98,10 +104,6 @@ class PiecewisePhaseLaw:
     def __call__(self, delta, ddelta, s, ds, t_step=0.0) -> np.ndarray:
         """:meth:`PhaseLaw.__call__` of the law in force at ``s``."""
         return self.law_at(s)(delta, ddelta, s, ds, t_step)
-
-
-#: the replays' torque limit [N m]: none in effect
-LIMIT_N_M = 1e6
 
 
 def hip_walker(data, law, push_off_n_s: float = 0.0):

@@ -32,8 +32,12 @@ import numpy as np
 
 from walkerlab.numerics import sort_multipliers
 
-__all__ = ["PhaseLaw", "PhaseReplay", "control_of_time", "driven_by", "law_of_rows", "records",
-           "replay_law", "torque_error"]
+__all__ = ["LIMIT_N_M", "PhaseLaw", "PhaseReplay", "control_of_time", "driven_by",
+           "law_of_rows", "records", "replay_law", "torque_error"]
+
+#: the replays' torque limit [N m]: none in effect (the optimised torques are bounded by the
+#: transcription's own ``max_torque_n_m``)
+LIMIT_N_M = 1e6
 
 
 def _at(f, df, u):
