@@ -25,6 +25,8 @@ import ctypes
 
 import numpy as np
 
+from walkerlab.codegen import pending
+
 __all__ = ["CYRK_METHODS", "solve_chunk"]
 
 #: walkerlab method name -> CyRK method name.  Only BDF pays on the contact walker (bench,
@@ -41,6 +43,8 @@ def address(kernels) -> int:
     """C address of the cfunc of ``kernels.rhs_packed`` (compiled once per walker structure,
     numba disk cache)."""
     if kernels.__name__ not in _FPTR:
+        # a side process may be compiling it (a cold contact run): wait, then load it
+        pending.before_first_use(kernels.__name__, "build_cyrk")
         _FPTR[kernels.__name__] = kernels.build_cyrk()
     return _FPTR[kernels.__name__]
 

@@ -11,6 +11,7 @@ state without start-up transients; the gait is stored as with ``periodic_gait: t
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 from walkerlab.analysis.contact.record import contact_sim_run
@@ -39,6 +40,42 @@ def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool
     return (lambda f: write_contact_sim(f, run)), run.summary
 
 
+@contextlib.contextmanager
+def _rhs_beside(setup: ContactSetup):
+    """On the first contact run of a walker structure (its generated contact module not in
+    the user cache yet: numba compiles every kernel of the run), a side process on the
+    second core compiles the solver's compiled right-hand side (:func:`warm_rhs`) while
+    this one generates the model and compiles the others (the contact table, the pinned
+    start); this process's walk waits for it there and loads it
+    (:mod:`walkerlab.codegen.pending`).
+    Nothing beside a warm run, on one core, or on a busy machine
+    (:class:`~walkerlab.execution.side.SideWorker` ``idle_only``); a side process that
+    fails only means the right-hand side is compiled here.  The numbers are the same either
+    way."""
+    from walkerlab.codegen import pending
+    from walkerlab.models.contact.generated import contact_module_state
+
+    name, cached = contact_module_state(setup.walker.structure)
+    if cached or not _compiled_walk(setup):  # a warm run: no process machinery imported
+        yield
+        return
+    from walkerlab.execution.side import SideWorker
+
+    side = SideWorker(idle_only=True)
+    fut = side.submit(warm_rhs, setup)
+    if fut is not None:
+        pending.compiled_elsewhere(name, "build_cyrk", lambda: side.wait(fut))
+    try:
+        yield
+    except BaseException:
+        side.close(cancel=True)
+        raise
+    finally:
+        pending.forget(name)
+    # never needed here (an up-to-date artifact, or a run that ended before its walk)
+    side.close(cancel=fut is not None and not fut.done())
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         adjust: bool = False, periodic: bool = False) -> StageOutcome:
     """Simulate the contact walker (optionally after ``--adjust``) from ``fixedpoint.h5``
@@ -58,8 +95,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     periodic = periodic or setup.sim.periodic_gait
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())
-    out = run_cached("contact-sim", scene, runs_root, sections, up,
-                     lambda: _compute(setup, up[0], adjust, periodic), force)
+    with _rhs_beside(setup):  # started now: the freshness check runs meanwhile
+        out = run_cached("contact-sim", scene, runs_root, sections, up,
+                         lambda: _compute(setup, up[0], adjust, periodic), force)
     kind, why = run_end(out.path)
     # like simulate: a walker that does not walk fails the run (the shared run ends,
     # walkerlab.integrate.ends: trip, fall, airborne, no_heel_strike, ...)
@@ -85,3 +123,23 @@ def warm_up(scene: Scene) -> bool:
 
     use_for_numba()  # the same cache folder as the run's (set before numba is imported)
     return compile_run_kernels(contact_setup(scene))
+
+
+
+def _compiled_walk(setup: ContactSetup) -> bool:
+    """Whether the run integrates on the compiled right-hand side (CyRK's methods)."""
+    from walkerlab.integrate._cyrk import CYRK_METHODS
+
+    return setup.solver.method in CYRK_METHODS
+
+
+def warm_rhs(setup: ContactSetup) -> bool:
+    """Compile the compiled solvers' right-hand side of ``setup``'s walker into the user
+    cache (:func:`walkerlab.analysis.contact.warm.compile_rhs_kernels`; the side process of
+    a cold :func:`run`).  Returns False when nothing was compiled (numba is not installed).
+    """
+    from walkerlab.analysis.contact.warm import compile_rhs_kernels
+    from walkerlab.usercache import use_for_numba
+
+    use_for_numba()  # the same cache folder as the run's (set before numba is imported)
+    return compile_rhs_kernels(setup)

@@ -19,7 +19,7 @@ import numpy as np
 
 from walkerlab.models.contact.scene import ContactSetup
 
-__all__ = ["WARM_UP_TIME_S", "WARM_UP_STEP_M", "compile_run_kernels"]
+__all__ = ["WARM_UP_TIME_S", "WARM_UP_STEP_M", "compile_rhs_kernels", "compile_run_kernels"]
 
 #: simulated time of the warm-up run [s] (a few solver steps and samples)
 WARM_UP_TIME_S = 0.005
@@ -56,3 +56,32 @@ def compile_run_kernels(setup: ContactSetup) -> bool:
                                         step_length_m=WARM_UP_STEP_M)
     simulate_contact(walker, x0, WARM_UP_TIME_S, setup.solver, limits)
     return True
+
+
+
+def compile_rhs_kernels(setup: ContactSetup) -> bool:
+    """Compile the compiled solvers' right-hand side of ``setup``'s walker (the generated
+    module's CyRK cfunc: ``rhs_packed``, ``rhs`` and the contact law's kernels they call)
+    into numba's on-disk cache, without a run: no fixed point, none of the run's other
+    kernels (``pinned_to_full``, the contact table).  A cold contact run
+    (:func:`walkerlab.stages.contact_sim.run`) has this done in a side process while it
+    compiles those others itself; its walk then only loads it.
+
+    Returns
+    -------
+    bool
+        False when numba is not installed (nothing is compiled), else True.
+
+    Raises
+    ------
+    ValueError
+        Massless bodies (no contact model).
+    """
+    if importlib.util.find_spec("numba") is None:
+        return False
+    from walkerlab.integrate import _cyrk
+    from walkerlab.models.contact.generated import contact_module
+
+    _cyrk.address(contact_module(setup.walker.structure))
+    return True
+

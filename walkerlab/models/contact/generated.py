@@ -601,3 +601,16 @@ def contact_module(structure: Structure):
     return floating.load_generated(structure, "contact",
                                    lambda key: contact_source(structure, key),
                                    sources=(Path(__file__),))
+
+
+def contact_module_state(structure: Structure) -> tuple[str, bool]:
+    """The module name :func:`contact_module` gives ``structure``'s generated contact module
+    (``ContactWalker.kernels.__name__``) and whether its source is in the user cache already
+    (False: the first contact run of this walker structure with this cache and generator,
+    whose numba kernels that run compiles), without generating or importing it."""
+    from walkerlab.codegen import cache, floating
+
+    key = floating.module_key(structure, "contact", sources=(Path(__file__),))
+    folder = cache.cache_dir()
+    return (f"walkerlab_contact_{key}",
+            folder is not None and (folder / f"{key}_contact.py").is_file())
