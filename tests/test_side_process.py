@@ -187,12 +187,28 @@ def test_no_side_process_on_a_busy_machine(monkeypatch):
     from walkerlab.execution import side as S
 
     monkeypatch.setattr(S.os, "getloadavg", lambda: (2.5, 2.0, 2.0))
+    monkeypatch.setattr(S, "_running_now", lambda: 3)  # this process and two others
     monkeypatch.setattr(S, "_cores", lambda: 2)
     busy = SideWorker(idle_only=True)
     assert not busy.enabled and busy.submit(pow, 2, 3) is None
-    monkeypatch.setattr(S.os, "getloadavg", lambda: (1.2, 1.0, 1.0))
+    monkeypatch.setattr(S, "_running_now", lambda: 2)  # one other task: no core to spare
+    assert not SideWorker(idle_only=True).enabled
+    monkeypatch.setattr(S, "_running_now", lambda: None)  # no instant count: the average
+    assert not SideWorker(idle_only=True).enabled
+    # a burst that has ended: the minute's average still lags it, only this process runs
+    monkeypatch.setattr(S, "_running_now", lambda: 1)
     assert SideWorker(idle_only=True).enabled
+    monkeypatch.setattr(S.os, "getloadavg", lambda: (1.2, 1.0, 1.0))
+    monkeypatch.setattr(S, "_running_now", lambda: 3)
+    assert SideWorker(idle_only=True).enabled  # below the cores on average
     assert SideWorker().enabled  # without idle_only, the load is not asked
+
+
+def test_the_tasks_running_now_include_this_one():
+    from walkerlab.execution import side as S
+
+    now = S._running_now()
+    assert now is None or now >= 1
 
 
 SIDE_CPU_CHILD = r"""

@@ -7,10 +7,10 @@ kernels into the user cache while the rigid stages run here, and draws half of t
 
 - The process is started on the first :meth:`~SideWorker.submit` (nothing to do, no
   process), by :func:`walkerlab.execution.workers.process_pool` (it ends when this process
-  dies), and never with fewer than two cores, nor (``idle_only``) when the load average
-  of the last minute is at least the number of cores: there it would only take turns with
-  this process, and a second process costs CPU of its own (its imports, ~2-3 s on the
-  report).
+  dies), and never with fewer than two cores, nor (``idle_only``) when the cores are busy
+  (:func:`spare_core`: the load average of the last minute and the tasks running now both
+  at least the number of cores): there it would only take turns with this process, and a
+  second process costs CPU of its own (its imports, ~2-3 s on the report).
 - It ignores SIGINT: Ctrl-C reaches this process, which cancels what has not started and
   stops the task under way with SIGTERM (:meth:`~SideWorker.close` with ``cancel``; in the
   side process SIGTERM raises ``SystemExit``, so a file being written is removed, never
@@ -49,13 +49,40 @@ def _cores() -> int:
     return os.cpu_count() or 1  # pragma: no cover - not Linux
 
 
+#: looks at the tasks running now when the minute's load average says busy, and their spacing
+SAMPLES, SAMPLE_PERIOD_S = 5, 0.005
+
+
+def _running_now() -> int | None:
+    """Processes and threads running or ready to run at this instant, this one included
+    (Linux's ``/proc/loadavg``, its fourth field ``running/total``); None elsewhere."""
+    try:
+        with open("/proc/loadavg", encoding="ascii") as fh:
+            return int(fh.read().split()[3].split("/")[0])
+    except (OSError, ValueError, IndexError):
+        return None
+
+
 def spare_core(cores: int) -> bool:
     """Whether the machine seems to have a core to spare: the load average of the last
-    minute is below ``cores`` (True where the system gives no load average)."""
+    minute is below ``cores``, or (it lags a burst that has ended by about a minute: a
+    benchmark's or a user's previous command) fewer than ``cores`` tasks are running, this
+    process included, at each of :data:`SAMPLES` looks over ~20 ms.  True where the system
+    gives no load average."""
     try:
-        return os.getloadavg()[0] < cores
+        if os.getloadavg()[0] < cores:
+            return True
     except OSError:  # pragma: no cover - no load average
         return True
+    import time
+
+    for k in range(SAMPLES):  # a few looks, none of them busy: a snapshot may miss a task
+        now = _running_now()
+        if now is None or now >= cores:
+            return False
+        if k + 1 < SAMPLES:
+            time.sleep(SAMPLE_PERIOD_S)
+    return True
 
 
 class SideWorker:
