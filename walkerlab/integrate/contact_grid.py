@@ -25,10 +25,13 @@ from .ends import RunEnd
 from .events import odeint_grid
 from .solver import Solver
 
-__all__ = ["GRID_METHODS", "contact_grid"]
+__all__ = ["COMPILED_METHODS", "GRID_METHODS", "contact_grid"]
 
+#: methods that integrate the walker's compiled right-hand side (CyRK's, over the generated
+#: module's cfunc: ``kernels.build_cyrk``)
+COMPILED_METHODS = tuple(_cyrk.CYRK_METHODS)
 #: methods :func:`contact_grid` runs (compiled first).
-GRID_METHODS = (*_cyrk.CYRK_METHODS, "odeint")
+GRID_METHODS = (*COMPILED_METHODS, "odeint")
 
 
 def contact_grid(walker, x0, t_grid, solver: Solver, data: np.ndarray | None = None

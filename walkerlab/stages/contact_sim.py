@@ -128,9 +128,9 @@ def warm_up(scene: Scene) -> bool:
 
 def _compiled_walk(setup: ContactSetup) -> bool:
     """Whether the run integrates on the compiled right-hand side (CyRK's methods)."""
-    from walkerlab.integrate._cyrk import CYRK_METHODS
+    from walkerlab.integrate.contact_grid import COMPILED_METHODS
 
-    return setup.solver.method in CYRK_METHODS
+    return setup.solver.method in COMPILED_METHODS
 
 
 def warm_rhs(setup: ContactSetup) -> bool:
