@@ -56,7 +56,8 @@ def _rhs_beside(setup: ContactSetup):
     from walkerlab.models.contact.generated import contact_module_state
 
     name, cached = contact_module_state(setup.walker.structure)
-    if cached or not _compiled_walk(setup):  # a warm run: no process machinery imported
+    # a warm run (or no user cache to share the kernel through): no process machinery
+    if cached is not False or not _compiled_walk(setup):
         yield
         return
     from walkerlab.execution.side import SideWorker

@@ -58,7 +58,6 @@ def compile_run_kernels(setup: ContactSetup) -> bool:
     return True
 
 
-
 def compile_rhs_kernels(setup: ContactSetup) -> bool:
     """Compile the compiled solvers' right-hand side of ``setup``'s walker (the generated
     module's CyRK cfunc: ``rhs_packed``, ``rhs`` and the contact law's kernels they call)
