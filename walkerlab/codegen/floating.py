@@ -80,7 +80,7 @@ from walkerlab.walker.description import Structure, WalkerData, check_floating_v
 __all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "MASSLESS_MESSAGE", "FloatingEquations",
            "FloatingView", "check_masses", "contact_names", "coordinate_names",
            "derive_floating", "floating_module", "floating_params", "floating_view",
-           "param_names"]
+           "generated_state", "param_names"]
 
 MASSLESS_MESSAGE = "a floating (contact) model needs positive leg masses"
 LEGS = ("leg1", "leg2")
@@ -505,9 +505,28 @@ def load_generated(structure: Structure, tag: str, build, sources=()):
     rigid compiled flows, :func:`walkerlab.codegen.cache.import_generated`."""
     from walkerlab.codegen import cache
 
+    key, filename, module_name = _generated_names(structure, tag, sources)
+    return cache.import_generated(filename, module_name, lambda: build(key))
+
+
+def _generated_names(structure: Structure, tag: str, sources=()) -> tuple[str, str, str]:
+    """The cache key, file name and module name of the generated module ``tag`` of
+    ``structure`` (:func:`load_generated`)."""
     key = module_key(structure, tag, sources)
-    return cache.import_generated(f"{key}_{tag}.py", f"walkerlab_{tag}_{key}",
-                                  lambda: build(key))
+    return key, f"{key}_{tag}.py", f"walkerlab_{tag}_{key}"
+
+
+def generated_state(structure: Structure, tag: str, sources=()) -> tuple[str, bool | None]:
+    """The module name :func:`load_generated` gives the generated module ``tag`` of
+    ``structure``, and whether its source is in the user cache already (False: not yet,
+    so the first process to load it generates it and numba compiles its kernels; None: no
+    user cache folder, nothing shared between processes), without generating or importing
+    it."""
+    from walkerlab.codegen import cache
+
+    _key, filename, module_name = _generated_names(structure, tag, sources)
+    folder = cache.cache_dir()
+    return module_name, None if folder is None else (folder / filename).is_file()
 
 
 def floating_source(structure: Structure, key: str) -> str:

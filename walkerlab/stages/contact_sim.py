@@ -126,7 +126,6 @@ def warm_up(scene: Scene) -> bool:
     return compile_run_kernels(contact_setup(scene))
 
 
-
 def _compiled_walk(setup: ContactSetup) -> bool:
     """Whether the run integrates on the compiled right-hand side (CyRK's methods)."""
     from walkerlab.integrate.contact_grid import COMPILED_METHODS

@@ -606,12 +606,9 @@ def contact_module(structure: Structure):
 def contact_module_state(structure: Structure) -> tuple[str, bool | None]:
     """The module name :func:`contact_module` gives ``structure``'s generated contact module
     (``ContactWalker.kernels.__name__``) and whether its source is in the user cache already
-    (False: the first contact run of this walker structure with this cache and generator,
-    whose numba kernels that run compiles; None: no user cache folder, so no compiled
-    kernel is shared between processes), without generating or importing it."""
-    from walkerlab.codegen import cache, floating
+    (:func:`walkerlab.codegen.floating.generated_state`: False on the first contact run of
+    this walker structure with this cache and generator; None without a user cache
+    folder), without generating or importing it."""
+    from walkerlab.codegen import floating
 
-    key = floating.module_key(structure, "contact", sources=(Path(__file__),))
-    folder = cache.cache_dir()
-    return (f"walkerlab_contact_{key}",
-            None if folder is None else (folder / f"{key}_contact.py").is_file())
+    return floating.generated_state(structure, "contact", sources=(Path(__file__),))
