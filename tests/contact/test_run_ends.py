@@ -189,3 +189,41 @@ def test_the_upper_body_walker_makes_five_strides_from_its_contact_periodic_gait
     _, res, *_ = simulate_from_periodic_gait(contact_setup(scene), ideal_gait(scene).x)
     assert res.outcome.kind == "heel_strike", res.outcome
     assert len(res.heel_strike_times) >= 10
+
+
+@pytest.mark.parametrize("end", ["solver_failure", "time_limit"])
+def test_a_run_that_fails_after_its_strides_asked_for_still_walked(monkeypatch, end):
+    """configs/flat_feet_push_off.yaml's contact run made its 11 heel strikes, then LSODA
+    stalled on a patch edge in the step after them (a powered run asks its strides cap at
+    touchdowns, which it counts once samples follow them).  Before: outcome
+    'solver_failure' and exit code 1, as if it had not walked; a trip there was already
+    cut off as 'after the strides asked for'.  Now a solver failure or the wall-time limit
+    after the strides asked for ends the run by the cap and names the failure; before them
+    it is still a failure.  Here the paper walker's own run (2 strides, 5 heel strikes
+    asked for) is given that end: after all its samples, and after its 2nd heel strike."""
+    import dataclasses
+
+    from walkerlab.analysis.contact import sim
+
+    w = _paper()
+    x0 = initial_state_from_ideal(w, *FP)
+    cut = {"at": None}
+    real = sim.integrate_contact
+
+    def failing(*a, **k):
+        run = real(*a, **k)
+        assert run.termination == "heel_strike"  # the cap: 5 heel strikes were made
+        k_end = len(run.t) if cut["at"] is None else int(np.searchsorted(run.t, cut["at"]))
+        return dataclasses.replace(run, t=run.t[:k_end], X=run.X[:k_end],
+                                   termination=end, message="the solver stalled")
+
+    monkeypatch.setattr(sim, "integrate_contact", failing)
+    limits = ContactLimits(wall_time_limit_s=600.0)  # (named by a time_limit's message)
+    r = simulate_contact(w, x0, 5.0, limits=limits, max_heel_strikes=5)
+    assert r.termination == "heel_strike" and r.outcome.walked, r.outcome
+    assert len(r.heel_strike_times) == 5
+    assert end.replace("_", " ") in r.message and "the solver stalled" in r.message
+    cut["at"] = float(r.heel_strike_times[1]) + 0.05  # 2 heel strikes, short of the 4 asked
+    r = simulate_contact(w, x0, 5.0, limits=limits, max_heel_strikes=5)
+    assert r.termination == end and not r.outcome.walked, r.outcome
+    assert len(r.heel_strike_times) == 2

@@ -19,6 +19,7 @@ import numpy as np
 from walkerlab.analysis.contact.gait import ContactResult, classify, gait_events, heel_strike_count
 from walkerlab.config.solver import SolverSettings
 from walkerlab.integrate.contact import ContactLimits, integrate_contact
+from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import ContactSetup
 from walkerlab.walker.layout import StateIndex
@@ -82,7 +83,9 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         / :data:`AIRBORNE_HEIGHT_FACTOR` leg lengths.
     max_heel_strikes : int, optional
         Strides cap: stop (termination and outcome ``heel_strike``) at the end of the chunk
-        in which this many heel strikes have happened.
+        in which this many heel strikes have happened.  A run that ends in a trip, fall,
+        flight, solver failure or the wall-time limit after ``max_heel_strikes - 1`` heel
+        strikes (the strides asked for) ends by the cap too, its end named in the message.
     slip_limit_mm : float, optional
         A stance phase sliding farther than this [mm] makes the outcome ``slip``.
     min_step_m : float
@@ -123,11 +126,15 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
             and heel_strike_count(walker, run.t, run.X, min_step_m, initial_stance)
             < max_heel_strikes - 1):  # short of the strides asked for (2 N heel strikes)
         run = _go_on(walker, run, t_more, solver, limits, stop)
-    if stop is not None and run.event is not None:
+    if stop is not None and (run.event is not None or run.termination in _EVENTLESS_ENDS):
         # the strides asked for (2 N heel strikes; the cap stops at the one after) were made
-        # before the event: the run made its promise, the event comes after it
-        run = _made_before_event(run, lambda t, X: heel_strike_count(
-            walker, t, X, min_step_m, initial_stance) >= max_heel_strikes - 1)
+        # before the event, the solver's failure or the wall-time limit: the run made its
+        # promise, its end comes after it
+        def made(t, X):
+            return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
+                >= max_heel_strikes - 1
+        run = _made_before_event(run, made) if run.event is not None \
+            else _made_before_end(run, made)
     ev = gait_events(walker, run.t, run.X, min_step_m, initial_stance)
     hh = float(walker.hip_height(run.X[-1:])[0])
     out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
@@ -141,6 +148,10 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
                          work=run.work)
 
 
+#: the ends without an event that a run met after its strides asked for still ends by the cap
+_EVENTLESS_ENDS = (RunEnd.SOLVER_FAILURE.value, RunEnd.TIME_LIMIT.value)
+
+
 def _made_before_event(run, stop):
     """A run whose strides cap was met before the event (trip, fall, flight) that ended the
     chunk it was met in: cut before the event, ended by the cap (the event is named in the
@@ -152,6 +163,19 @@ def _made_before_event(run, stop):
            f"t = {float(run.event[2]):.4g} s (after the last of them: not part of the run)")
     return replace(run, t=run.t[:k], X=run.X[:k], event=None, termination="heel_strike",
                    message=msg, work=None if run.work is None else run.work[:k])
+
+
+def _made_before_end(run, stop):
+    """A run whose strides cap was met before the solver failed or the wall-time limit ran
+    out (in the chunk after the cap's heel strikes, or, powered, in the step after them:
+    its stop is asked at touchdowns, which it counts once samples follow them): ended by
+    the cap, the failure named in the message.  Every sample is kept: the run's samples
+    end where the solver last succeeded."""
+    if not stop(run.t, run.X):
+        return run
+    msg = (f"the heel strikes asked for were made; a {run.termination.replace('_', ' ')} "
+           f"followed ({run.message}; after the last of them: not part of the run)")
+    return replace(run, termination="heel_strike", message=msg)
 
 
 def _go_on(walker, run, t_more: float, solver, limits, stop):
