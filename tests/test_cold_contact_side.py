@@ -93,6 +93,24 @@ def test_the_right_hand_side_is_compiled_beside_only_on_a_cold_run(cached, fake_
     assert used == [True] and side.closed == [False]
 
 
+def test_a_run_whose_kernel_a_caller_compiles_beside_starts_nothing(fake_side, monkeypatch):
+    """In ``walkerlab report`` the report's own side process compiles the right-hand side
+    (:func:`walkerlab.stages.report_dag._warm_up`): the run starts no second one and its
+    walk waits for the report's."""
+    from walkerlab.models.contact import generated
+
+    setup = contact_setup(load_scene(ROOT / "configs" / "paper.yaml"))
+    monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_r", False))
+    seen: list[str] = []
+    pending.compiled_elsewhere("mod_r", "build_cyrk", lambda: seen.append("report's"))
+    try:
+        with contact_sim._rhs_beside(setup):
+            pending.before_first_use("mod_r", "build_cyrk")
+    finally:
+        pending.forget("mod_r")
+    assert fake_side.made == [] and seen == ["report's"]
+
+
 def test_a_side_process_that_was_never_needed_is_stopped(fake_side, monkeypatch):
     """A run that ends before its walk (or an up-to-date artifact) does not wait for the
     side process's compile: it is cancelled."""

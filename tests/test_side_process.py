@@ -83,6 +83,8 @@ def test_an_interrupted_numba_cache_write_leaves_no_temporary_file(tmp_path):
 class _Recorder:
     """A side worker that records what it is given and runs nothing."""
 
+    enabled = True
+
     def __init__(self):
         self.submitted = []
 
@@ -91,8 +93,11 @@ class _Recorder:
         return object()
 
 
-def test_warm_up_only_for_a_contact_run_the_report_computes(ideal_scene, tmp_path):  # noqa: F811
+def test_warm_up_only_for_a_contact_run_the_report_computes(ideal_scene,  # noqa: F811
+                                                            tmp_path, monkeypatch):
+    from walkerlab.codegen import pending
     from walkerlab.io.runpaths import stage_artifact
+    from walkerlab.models.contact import generated
     from walkerlab.stages import contact_sim
     from walkerlab.stages.pipeline import report_plan
     from walkerlab.stages.report_dag import _warm_up
@@ -101,8 +106,21 @@ def test_warm_up_only_for_a_contact_run_the_report_computes(ideal_scene, tmp_pat
     assert _warm_up(ideal_scene, tmp_path, True, report_plan(ideal_scene), side) is None
     assert side.submitted == []
     paper = load_scene(ROOT / "configs" / "paper.yaml")
-    assert _warm_up(paper, tmp_path, False, report_plan(paper), side) is not None
-    assert side.submitted[0] is contact_sim.warm_up
+    # the walker's generated module in the user cache: the side process loads every kernel
+    # (cheap) and the run waits for it
+    monkeypatch.setattr(generated, "contact_module_state", lambda st: ("m_warm", True))
+    fut, module = _warm_up(paper, tmp_path, False, report_plan(paper), side)
+    assert side.submitted[0] is contact_sim.warm_up and module is None
+    # its first contact run: the side process compiles the right-hand side only, and the
+    # run (not waiting for it first) waits for it just before its walk
+    monkeypatch.setattr(generated, "contact_module_state", lambda st: ("m_cold", False))
+    side = _Recorder()
+    fut, module = _warm_up(paper, tmp_path, False, report_plan(paper), side)
+    assert side.submitted[0] is contact_sim.warm_rhs and module == "m_cold"
+    assert pending.expected("m_cold", "build_cyrk")
+    pending.forget("m_cold")
+    assert not pending.expected("m_cold", "build_cyrk")
+    side = _Recorder()
     art = stage_artifact(paper, tmp_path, "contact-sim")  # reused unless forced
     art.parent.mkdir(parents=True, exist_ok=True)
     art.write_bytes(b"")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from walkerlab.analysis.contact.record import contact_sim_run
 from walkerlab.config import Scene
@@ -27,6 +28,9 @@ from walkerlab.stages.common import (
     run_cached,
 )
 
+if TYPE_CHECKING:
+    from concurrent.futures import Future
+
 SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_solver")
 
 
@@ -40,32 +44,55 @@ def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool
     return (lambda f: write_contact_sim(f, run)), run.summary
 
 
-@contextlib.contextmanager
-def _rhs_beside(setup: ContactSetup):
+def rhs_beside(setup: ContactSetup, side) -> tuple[str, Future] | None:
     """On the first contact run of a walker structure (its generated contact module not in
-    the user cache yet: numba compiles every kernel of the run), a side process on the
-    second core compiles the solver's compiled right-hand side (:func:`warm_rhs`) while
-    this one generates the model and compiles the others (the contact table, the pinned
-    start); this process's walk waits for it there and loads it
-    (:mod:`walkerlab.codegen.pending`).
-    Nothing beside a warm run, on one core, or on a busy machine
-    (:class:`~walkerlab.execution.side.SideWorker` ``idle_only``); a side process that
-    fails only means the right-hand side is compiled here.  The numbers are the same either
-    way."""
+    the user cache yet: numba compiles every kernel of the run) with a compiled walk, have
+    the side process ``side`` (:class:`~walkerlab.execution.side.SideWorker`) compile the
+    solver's compiled right-hand side (:func:`warm_rhs`), and this process's walk wait for
+    it there and load it (:mod:`walkerlab.codegen.pending`) while this process generates
+    the model and compiles the other kernels (the contact table, the pinned start).
+
+    Returns the generated module's name and the side process's future when a wait was
+    registered (the caller hands the name to :func:`walkerlab.codegen.pending.forget`
+    when the run is over), else None: a warm run, no user cache to share the kernel through, a walk
+    on scipy's solvers, another process compiling it already, or no side process (``side``
+    disabled, or it broke).  The numbers are the same either way."""
     from walkerlab.codegen import pending
     from walkerlab.models.contact.generated import contact_module_state
 
     name, cached = contact_module_state(setup.walker.structure)
-    # a warm run (or no user cache to share the kernel through): no process machinery
-    if cached is not False or not _compiled_walk(setup):
+    if (cached is not False or not _compiled_walk(setup)
+            or pending.expected(name, "build_cyrk")):
+        return None
+    fut = side.submit(warm_rhs, setup)
+    if fut is None:
+        return None
+    pending.compiled_elsewhere(name, "build_cyrk", lambda: side.wait(fut))
+    return name, fut
+
+
+@contextlib.contextmanager
+def _rhs_beside(setup: ContactSetup):
+    """:func:`rhs_beside` on a side process of this run's own, started only when it has
+    work (never beside a warm run, on one core or on a busy machine:
+    :class:`~walkerlab.execution.side.SideWorker` ``idle_only``; nor when another process
+    compiles the kernel already: the report's side process), and stopped if the run never
+    needed it.  A side process that fails only means the right-hand side is compiled
+    here."""
+    from walkerlab.codegen import pending
+    from walkerlab.models.contact.generated import contact_module_state
+
+    name, cached = contact_module_state(setup.walker.structure)
+    # a warm run (or no user cache to share the kernel through, or a process on it
+    # already): no process machinery
+    if (cached is not False or not _compiled_walk(setup)
+            or pending.expected(name, "build_cyrk")):
         yield
         return
     from walkerlab.execution.side import SideWorker
 
     side = SideWorker(idle_only=True)
-    fut = side.submit(warm_rhs, setup)
-    if fut is not None:
-        pending.compiled_elsewhere(name, "build_cyrk", lambda: side.wait(fut))
+    beside = rhs_beside(setup, side)
     try:
         yield
     except BaseException:
@@ -74,7 +101,7 @@ def _rhs_beside(setup: ContactSetup):
     finally:
         pending.forget(name)
     # never needed here (an up-to-date artifact, or a run that ended before its walk)
-    side.close(cancel=fut is not None and not fut.done())
+    side.close(cancel=beside is not None and not beside[1].done())
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,

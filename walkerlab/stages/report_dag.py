@@ -37,19 +37,36 @@ def _study(scene: Scene, runs_root, force: bool):
 
 
 def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
-    """Start compiling the contact model's kernels in the side process (None when not
-    started): when the report will compute ``contact-sim`` (no artifact yet, or ``force``;
-    a reused artifact needs no kernels), then have the side process load matplotlib for
-    its share of the figures while this process runs the contact walker."""
+    """Start compiling the contact model's kernels in the side process when the report
+    will compute ``contact-sim`` (no artifact yet, or ``force``; a reused artifact needs no
+    kernels), then have the side process load matplotlib for its share of the figures
+    while this process runs the contact walker.
+
+    Returns ``(future, module)``, or None when nothing was started.  On a walker
+    structure's first contact run with a compiled walk (``module``, the generated contact
+    module's name: :func:`walkerlab.stages.contact_sim.rhs_beside`), the side process
+    compiles the solver's right-hand side only, and the run here, free to start, compiles
+    the other kernels meanwhile and waits for that one just before its walk; else
+    (``module`` None) the side process compiles, or loads, all of them
+    (:func:`walkerlab.stages.contact_sim.warm_up`) and the run here waits for it first.
+    """
     from walkerlab.io.runpaths import stage_artifact
 
     if "contact-sim" not in plan or not (
             force or not stage_artifact(scene, runs_root, "contact-sim").is_file()):
         return None
-    fut = side.submit(stage_module("contact-sim").warm_up, scene)
-    if fut is not None:
-        side.submit(importlib.import_module, "walkerlab.plotting.scene_figures")
-    return fut
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+
+    cs = stage_module("contact-sim")
+    try:
+        beside = cs.rhs_beside(contact_setup(scene), side) if side.enabled else None
+    except (ContactSceneError, ValueError):  # the stage says so, in its turn
+        return None
+    fut, module = beside[::-1] if beside else (side.submit(cs.warm_up, scene), None)
+    if fut is None:
+        return None
+    side.submit(importlib.import_module, "walkerlab.plotting.scene_figures")
+    return fut, module
 
 
 def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
@@ -75,8 +92,9 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
     # the study times its cases on both cores: no side process beside it; nor on a busy
     # machine (it would take turns with this process and add its own start-up)
     side = SideWorker(enabled=study is None, idle_only=True)
+    module = None
     try:
-        warm = _warm_up(scene, runs_root, force, plan, side)
+        warm, module = _warm_up(scene, runs_root, force, plan, side) or (None, None)
         if "fixedpoint" in plan:
             add(stage_module("fixedpoint").run(scene, runs_root, force, compare_variants=True))
         if study is not None:
@@ -90,7 +108,8 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
             if name == "contact-sim" and warm is not None:
                 if "simulate" in plan and not warm.done():  # this core's turn meanwhile
                     ahead = draw_ideal_ahead(scene, runs_root, force)
-                side.wait(warm)  # compiled there (or failed: compiled here), never twice
+                if module is None:  # (else the walk waits for its right-hand side)
+                    side.wait(warm)  # compiled there (or failed: compiled here), never twice
             if name in plan:
                 add(stage_module(name).run(scene, runs_root, force))
         if any(o.stage in ("simulate", "contact-sim") for o in done):
@@ -103,6 +122,11 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
         if study is not None:
             study.cancel()
         raise
+    finally:
+        if module is not None:  # (waited for by the walk, or never needed)
+            from walkerlab.codegen import pending
+
+            pending.forget(module)
     side.close()
     if study is not None:
         study.release()
