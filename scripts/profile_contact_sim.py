@@ -14,6 +14,10 @@ the summary printed after it.  The phases add up to the whole process (``getrusa
 a few per cent).  Phases are found by wrapping functions as their modules load (names
 below), so nothing is imported early and the order of the imports is the CLI's own.
 
+What it cannot count: the interpreter's shutdown after the last exit function (until
+session 17 a garbage collection there took ~0.4-0.6 s of a warm run that no phase showed);
+compare "whole process" with the process's total from outside (``/usr/bin/time``).
+
 Use it warm (fixedpoint done and a first ``contact-sim`` run in the same user cache,
 ``WALKERLAB_CACHE_DIR``), on both trees of a comparison, several times: the machine is
 shared, CPU time varies less than wall time but still by ~10 %.
