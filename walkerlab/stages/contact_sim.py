@@ -29,7 +29,10 @@ from walkerlab.stages.common import (
 )
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from concurrent.futures import Future
+
+    from walkerlab.execution.side import SideWorker
 
 SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_solver")
 
@@ -44,19 +47,21 @@ def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool
     return (lambda f: write_contact_sim(f, run)), run.summary
 
 
-def rhs_beside(setup: ContactSetup, side) -> tuple[str, Future] | None:
+def rhs_beside(setup: ContactSetup, side: Callable[[], SideWorker]
+               ) -> tuple[str, SideWorker, Future] | None:
     """On the first contact run of a walker structure (its generated contact module not in
     the user cache yet: numba compiles every kernel of the run) with a compiled walk, have
-    the side process ``side`` (:class:`~walkerlab.execution.side.SideWorker`) compile the
-    solver's compiled right-hand side (:func:`warm_rhs`), and this process's walk wait for
-    it there and load it (:mod:`walkerlab.codegen.pending`) while this process generates
-    the model and compiles the other kernels (the contact table, the pinned start).
+    a side process (``side()``, a :class:`~walkerlab.execution.side.SideWorker`, asked for
+    only then) compile the solver's compiled right-hand side (:func:`warm_rhs`), and this
+    process's walk wait for it there and load it (:mod:`walkerlab.codegen.pending`) while
+    this process generates the model and compiles the other kernels (the contact table, the
+    pinned start).
 
-    Returns the generated module's name and the side process's future when a wait was
+    Returns the generated module's name, the side worker and its future when a wait was
     registered (the caller hands the name to :func:`walkerlab.codegen.pending.forget`
-    when the run is over), else None: a warm run, no user cache to share the kernel through, a walk
-    on scipy's solvers, another process compiling it already, or no side process (``side``
-    disabled, or it broke).  The numbers are the same either way."""
+    when the run is over), else None: a warm run, no user cache to share the kernel
+    through, a walk on scipy's solvers, another process compiling it already, or no side
+    process (disabled, or it broke).  The numbers are the same either way."""
     from walkerlab.codegen import pending
     from walkerlab.models.contact.generated import contact_module_state
 
@@ -64,35 +69,34 @@ def rhs_beside(setup: ContactSetup, side) -> tuple[str, Future] | None:
     if (cached is not False or not _compiled_walk(setup)
             or pending.expected(name, "build_cyrk")):
         return None
-    fut = side.submit(warm_rhs, setup)
+    worker = side()
+    fut = worker.submit(warm_rhs, setup)
     if fut is None:
         return None
-    pending.compiled_elsewhere(name, "build_cyrk", lambda: side.wait(fut))
-    return name, fut
+    pending.compiled_elsewhere(name, "build_cyrk", lambda: worker.wait(fut))
+    return name, worker, fut
+
+
+def _own_side() -> SideWorker:
+    from walkerlab.execution.side import SideWorker
+
+    return SideWorker(idle_only=True)
 
 
 @contextlib.contextmanager
 def _rhs_beside(setup: ContactSetup):
     """:func:`rhs_beside` on a side process of this run's own, started only when it has
-    work (never beside a warm run, on one core or on a busy machine:
-    :class:`~walkerlab.execution.side.SideWorker` ``idle_only``; nor when another process
-    compiles the kernel already: the report's side process), and stopped if the run never
-    needed it.  A side process that fails only means the right-hand side is compiled
-    here."""
+    work (a warm run imports no process machinery; never on one core or on a busy
+    machine: ``idle_only``; nor when another process compiles the kernel already: the
+    report's side process), and stopped if the run never needed it.  A side process that
+    fails only means the right-hand side is compiled here."""
     from walkerlab.codegen import pending
-    from walkerlab.models.contact.generated import contact_module_state
 
-    name, cached = contact_module_state(setup.walker.structure)
-    # a warm run (or no user cache to share the kernel through, or a process on it
-    # already): no process machinery
-    if (cached is not False or not _compiled_walk(setup)
-            or pending.expected(name, "build_cyrk")):
+    beside = rhs_beside(setup, _own_side)
+    if beside is None:
         yield
         return
-    from walkerlab.execution.side import SideWorker
-
-    side = SideWorker(idle_only=True)
-    beside = rhs_beside(setup, side)
+    name, side, fut = beside
     try:
         yield
     except BaseException:
@@ -101,7 +105,7 @@ def _rhs_beside(setup: ContactSetup):
     finally:
         pending.forget(name)
     # never needed here (an up-to-date artifact, or a run that ended before its walk)
-    side.close(cancel=beside is not None and not beside[1].done())
+    side.close(cancel=not fut.done())
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,

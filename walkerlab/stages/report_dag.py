@@ -59,10 +59,10 @@ def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
 
     cs = stage_module("contact-sim")
     try:
-        beside = cs.rhs_beside(contact_setup(scene), side) if side.enabled else None
+        beside = cs.rhs_beside(contact_setup(scene), lambda: side) if side.enabled else None
     except (ContactSceneError, ValueError):  # the stage says so, in its turn
         return None
-    fut, module = beside[::-1] if beside else (side.submit(cs.warm_up, scene), None)
+    module, _, fut = beside or (None, side, side.submit(cs.warm_up, scene))
     if fut is None:
         return None
     side.submit(importlib.import_module, "walkerlab.plotting.scene_figures")
