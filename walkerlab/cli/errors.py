@@ -87,7 +87,8 @@ def _disk_full_line(exc: BaseException) -> str:
 #: errors shown as one line that live in modules a command may never import: looked up in
 #: ``sys.modules`` when an exception is handled (a module never imported raised nothing), so
 #: the guard does not import the rigid walker's analysis into every command
-_ONE_LINE_ERRORS = (("walkerlab.analysis.gait.poincare", "FixedPointNotFound"),)
+_ONE_LINE_ERRORS = (("walkerlab.analysis.gait.poincare", "FixedPointNotFound"),
+                    ("walkerlab.analysis.gait.poincare", "MultipliersDisagree"))
 
 
 def _loaded_errors(names) -> tuple[type, ...]:
