@@ -391,7 +391,8 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         mult_fd = np.full(DP.shape[0], np.nan + 0j)
     return FixedPointResult(
         x=x, period_s=period, residual=res,
-        multipliers_variational=mult_var, multipliers_fd=mult_fd, jacobian_variational=DP, jacobian_fd=Jfd,
+        multipliers_variational=mult_var, multipliers_fd=mult_fd, jacobian_variational=DP,
+        jacobian_fd=Jfd,
         nfev=F.counter["nfev"] + nf2, iterations=F.counter["calls"],
         wall_time_s=time.perf_counter() - t0, variational_maps=F.counter["jacobians"] + 1,
         step_periods_s=tuple(float(sg.period) for sg in segs),
