@@ -134,8 +134,8 @@ SHIPPED = sorted(p.stem for p in CONFIGS.glob("*.yaml") if not p.stem.startswith
 LAW = {"stiffness_n_m_per_rad": 0.5, "damping_n_m_s_per_rad": 0.05, "rest_angle_rad": 0.3}
 VARIANTS = {
     "paper+push_off": _variant("paper", {"push_off": {"impulse_n_s": 0.3}}),
-    "paper+speed_gain": _variant("paper", {"push_off": {"impulse_n_s": 0.2,
-                                                        "speed_gain_n_s2_per_m": 0.3}}),
+    "paper+speed_gain": _variant("paper", {"push_off": {
+        "impulse_n_s": 0.2, "speed_gain_n_s2_per_m": 0.3, "reference_speed_m_per_s": 1.5}}),
     "paper+hip_pd": _variant("paper", {"torques": [{"joint": "hip", "law": LAW,
                                                     "max_torque_n_m": 5.0}]}),
     "powered_compass+hip_pd": _variant("powered_compass", {
