@@ -18,7 +18,8 @@ in a ``units: nondimensional`` scene every quantity is in the walker's own units
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -27,7 +28,12 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["Gait", "Step", "Walk", "Walker"]
+__all__ = ["STEP_TIME_LIMIT_S", "Gait", "Step", "Walk", "Walker"]
+
+#: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
+#: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
+#: search's budget (:data:`walkerlab.analysis.gait.poincare.ROOT_BUDGET_S`)
+STEP_TIME_LIMIT_S = 60.0
 
 
 @dataclass(frozen=True)
@@ -53,6 +59,22 @@ class Gait:
         max |P(x) - x| [state units].
     label : str
         Which gait of the search (``long_period``, ``short_period``, ...).
+    step_length : float
+        Mean step length [m]: stance foot to swing foot at heel strike
+        (:func:`walkerlab.analysis.gait.metrics.step_length`).
+    speed : float
+        Distance along the ground over the map's period [m/s].
+    cost_of_transport : float
+        Mean over the map's steps of (positive actuator work + push-off work + slope
+        energy if > 0) / (M g d) [-] (Kuo 2002; Collins et al. 2005); a passive gait's is
+        sin(slope).  NaN without a ledger (flat feet on legs that differ).
+    ledger : dict[str, ndarray (steps,)]
+        The energy ledger of each step of the map, as ``simulate.h5``'s ``ledger/``
+        (:func:`walkerlab.analysis.gait.energy.gait_ledger`): ``actuator_work_positive``,
+        ``actuator_work_negative``, ``push_off_work``, ``heel_strike_loss``,
+        ``internal_collision_loss``, ``damper_work``, ``potential_work``, ``energy_change``,
+        ``closure``, ``slope_energy`` [J], ``push_off_impulse`` [N s],
+        ``cost_of_transport`` [-].
     """
 
     x: np.ndarray
@@ -63,6 +85,10 @@ class Gait:
     jacobian: np.ndarray
     residual: float
     label: str
+    step_length: float = float("nan")
+    speed: float = float("nan")
+    cost_of_transport: float = float("nan")
+    ledger: dict = field(default_factory=dict)
 
     @property
     def state(self) -> dict[str, float]:
@@ -114,6 +140,14 @@ class Walk:
         ``(step, stance leg, phase, t_start, t_end, guard)`` of every phase.
     termination : str
         How the walk ended (``heel_strike`` after the last step, ``fall``, ...).
+    steps : dict[str, ndarray (k,)]
+        The step table of the ``simulate`` stage
+        (:func:`walkerlab.analysis.gait.metrics.step_table`): ``period`` [s],
+        ``step_length`` [m], ``hip_speed`` [m/s], ``impact_energy_loss`` [J],
+        ``termination``, ``stance_leg`` ... of each step (the last one may have fallen).
+    ledger : dict[str, ndarray (k,)]
+        The energy ledger of each step, as :attr:`Gait.ledger` (NaN for a step that did
+        not end by a heel strike; empty for flat feet on legs that differ).
     """
 
     t: np.ndarray
@@ -122,6 +156,23 @@ class Walk:
     heel_strikes: np.ndarray
     events: list
     termination: str
+    steps: dict = field(default_factory=dict)
+    ledger: dict = field(default_factory=dict)
+
+    @property
+    def step_length(self) -> np.ndarray:
+        """Length of each step [m] (``steps["step_length"]``)."""
+        return self.steps["step_length"]
+
+    @property
+    def speed(self) -> np.ndarray:
+        """Hip speed of each step [m/s] (``steps["hip_speed"]``)."""
+        return self.steps["hip_speed"]
+
+    @property
+    def cost_of_transport(self) -> np.ndarray:
+        """Cost of transport of each step [-] (``ledger["cost_of_transport"]``)."""
+        return self.ledger["cost_of_transport"]
 
 
 class Walker:
@@ -135,12 +186,24 @@ class Walker:
     scene : walkerlab.config.Scene
         A validated scene (its ``walker``, ``slope``, ``ideal``, ``solver`` and
         ``fixedpoint`` sections are used).
+    step_time_limit_s : float
+        CPU time each walking step of :meth:`step`, :meth:`jacobian`, :meth:`floquet` and
+        :meth:`simulate` may take [s] (this thread's CPU time, so a busy machine does not
+        trip it); past it the map stops with one line
+        (:class:`~walkerlab.analysis.gait.poincare.StepFailed`, ``time_limit``).  The
+        simulated time of a step is bounded apart, by ``fixedpoint.max_step_time_s``.
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        ``step_time_limit_s`` not a positive number.
     """
 
-    def __init__(self, scene: Scene):
+    def __init__(self, scene: Scene, step_time_limit_s: float = STEP_TIME_LIMIT_S):
         from walkerlab.integrate.solver import Solver
         from walkerlab.models.registry import build_walker
 
+        self.step_time_limit_s = _positive(step_time_limit_s, "step_time_limit_s")
         self.scene = scene
         self.model = build_walker(scene)
         self.solver = Solver.from_settings(scene.solver)
@@ -172,7 +235,7 @@ class Walker:
         """
         from walkerlab.api.scenes import with_changes
 
-        return Walker(with_changes(self.scene, changes))
+        return Walker(with_changes(self.scene, changes), self.step_time_limit_s)
 
     def state_names(self) -> list[str]:
         """Names of the role-ordered state (2n,), coordinates then rates."""
@@ -182,13 +245,91 @@ class Walker:
         """Units of the state's entries (``rad``, ``rad/s``)."""
         return list(self.model.state_units())
 
-    def _map(self, x, jacobian: bool = False, steps: list | None = None):
+    def check_state(self, x, what: str = "x") -> np.ndarray:
+        """``x`` as the walker's state: a float array (2n,) of finite numbers, rates within
+        :data:`~walkerlab.analysis.gait.scene.MAX_GUESS_RATE` sqrt(g/l) and angles within
+        [-pi, pi] (beyond them no walking gait is near: a leg that fast would leave the
+        ground, and the integrator crawls; the bounds of ``fixedpoint.initial_guess``).
+
+        Parameters
+        ----------
+        x : array_like, shape (2n,)
+            A role-ordered state (:meth:`state_names`) [rad, rad/s].
+        what : str
+            The argument's name in the message.
+
+        Returns
+        -------
+        ndarray, shape (2n,)
+
+        Raises
+        ------
+        walkerlab.config.SceneError
+            One line naming the shape, the entry or the value.
+        """
+        import math
+
         import numpy as np
 
+        from walkerlab.analysis.gait.scene import MAX_GUESS_RATE
+        from walkerlab.config import SceneError
+
+        names = self.state_names()
+        want = (f"give the state as {len(names)} numbers ({', '.join(names)}) "
+                "[rad, rad/s], e.g. gait.x")
+        if x is None or isinstance(x, (str, bytes, dict)):
+            raise SceneError(f"{what}={_short(x)}: {want}")
+        try:
+            arr = np.asarray(x)
+            if arr.dtype.kind not in "biuf" or arr.dtype.kind == "b":
+                raise TypeError
+            arr = arr.astype(float)
+        except (TypeError, ValueError):
+            raise SceneError(f"{what}={_short(x)}: not numbers; {want}") from None
+        if arr.shape != (len(names),):
+            raise SceneError(f"{what} has shape {arr.shape}; the walker's state is "
+                             f"({len(names)},): {want}")
+        p = self.model.params
+        max_rate = MAX_GUESS_RATE * math.sqrt(float(p["gravity_m_per_s2"])
+                                              / float(p["leg_length_m"]))
+        for i, (name, v) in enumerate(zip(names, arr)):
+            if not math.isfinite(v):
+                raise SceneError(f"{what}[{i}] ({name}) = {v}: give finite numbers")
+            if name.endswith("_rate") and abs(v) > max_rate:
+                raise SceneError(f"{what}[{i}] ({name}) = {v:g} rad/s is not a walking state: "
+                                 f"at most {max_rate:.3g} ({MAX_GUESS_RATE:g} sqrt(g/l); a "
+                                 "leg this fast would leave the ground)")
+            if name.endswith("_angle") and abs(v) > math.pi:
+                raise SceneError(f"{what}[{i}] ({name}) = {v:g} rad is more than half a "
+                                 "turn: give an angle within [-pi, pi]")
+        return arr
+
+    def _map(self, x, jacobian: bool = False, steps: list | None = None):
         from walkerlab.analysis.gait.poincare import poincare_map
 
-        return poincare_map(self.model, np.asarray(x, dtype=float), self.solver,
-                            self.max_step_time, jacobian=jacobian, steps=steps)
+        x = self.check_state(x)
+        with self._bounded():
+            return poincare_map(self.model, x, self.solver, self.max_step_time,
+                                jacobian=jacobian, steps=steps)
+
+    @contextmanager
+    def _bounded(self):
+        """Each walking step inside bounded to ``step_time_limit_s`` of CPU time; a failed
+        step said in one line (how and when it ended, what to do)."""
+        from walkerlab.analysis.gait.poincare import StepFailed
+        from walkerlab.integrate.time_limit import IntegrationTimeLimit, integration_time_limit
+
+        try:
+            with integration_time_limit(self.step_time_limit_s):
+                yield
+        except IntegrationTimeLimit:
+            out = StepFailed("time_limit", float("nan"), None)
+            out.args = (f"step: a walking step used up its {self.step_time_limit_s:g} s of "
+                        "CPU time (Walker(..., step_time_limit_s=...)): a state far from any "
+                        "gait, or a very stiff spring, makes the integrator crawl",)
+            raise out from None
+        except StepFailed as exc:
+            raise _clear(exc, self.max_step_time) from None
 
     def step(self, x) -> Step:
         """One Poincaré map step ``x -> P(x)`` (paper Eq. 10; a stride when legs differ).
@@ -196,12 +337,22 @@ class Walker:
         Parameters
         ----------
         x : array_like, shape (2n,)
-            State just after heel strike.
+            State just after heel strike (role order of :meth:`state_names`) [rad, rad/s].
+
+        Returns
+        -------
+        Step
+            ``x_next`` (2n,) the state just after the next heel strike, ``period`` [s] the
+            map's duration, ``events`` the phases ``(phase, t_start, t_end, guard)``.
 
         Raises
         ------
+        walkerlab.config.SceneError
+            ``x`` not a finite state of the walker's size, or no walking state
+            (:meth:`check_state`; one line).
         walkerlab.analysis.gait.poincare.StepFailed
-            The step fell, the solver failed or the step ran past ``max_step_time_s``.
+            The step fell, the solver failed, the step ran past ``max_step_time_s`` or the
+            step past ``step_time_limit_s`` of CPU time (one line: how and when).
         """
         segs: list = []
         x_next, period, _ = self._map(x, steps=segs)
@@ -214,14 +365,20 @@ class Walker:
 
         Raises
         ------
-        walkerlab.analysis.gait.poincare.StepFailed
+        walkerlab.config.SceneError, walkerlab.analysis.gait.poincare.StepFailed
             As :meth:`step`.
         """
         return self._map(x, jacobian=True)[2]
 
     def floquet(self, x) -> np.ndarray:
         """Floquet multipliers (2n,) at ``x`` (eigenvalues of :meth:`jacobian`), by
-        decreasing modulus; meaningful at a fixed point."""
+        decreasing modulus; meaningful at a fixed point.
+
+        Raises
+        ------
+        walkerlab.config.SceneError, walkerlab.analysis.gait.poincare.StepFailed
+            As :meth:`step`.
+        """
         import numpy as np
 
         from walkerlab.numerics import sort_multipliers
@@ -241,15 +398,19 @@ class Walker:
         """
         import numpy as np
 
+        from walkerlab.analysis.gait.energy import gait_ledger
         from walkerlab.analysis.gait.scene import solve_scene
 
         _, search = solve_scene(self.scene)
         chosen = search.gaits[search.selected]
         r = chosen.result
+        m, ledger = gait_ledger(self.model, r.x, self.model.steps_per_map, self.solver,
+                                self.max_step_time)
         return Gait(np.asarray(r.x, float), tuple(self.state_names()),
                     float(r.period_s) / self.model.steps_per_map, float(r.period_s),
                     np.asarray(r.multipliers_variational),
-                    np.asarray(r.jacobian_variational), float(r.residual), chosen.label)
+                    np.asarray(r.jacobian_variational), float(r.residual), chosen.label,
+                    m["step_length"], m["speed"], m["cost_of_transport"], ledger)
 
     def find_gait_for(self, vary: str, **target: float) -> tuple[Walker, Gait]:
         """The walker whose period-1 gait meets a target, one field freed (Kuo's
@@ -302,28 +463,51 @@ class Walker:
         Parameters
         ----------
         x0 : array_like, shape (2n,)
-            State just after heel strike; ``leg1`` swings first.
+            State just after heel strike; ``leg1`` swings first (:meth:`check_state`).
         strides : int
-            Strides (>= 1).
+            Strides, a whole number from 1 to
+            :data:`~walkerlab.config.MAX_SIMULATE_STRIDES` (as ``simulate.strides``).
         sample_rate_hz : float
-            Samples per second of the returned arrays [Hz].
+            Samples per second of the returned arrays [Hz] (as ``simulate.sample_rate_hz``);
+            the walk holds at most :data:`~walkerlab.config.MAX_SIMULATE_SAMPLES` samples,
+            as the ``simulate`` stage.
+
+        Returns
+        -------
+        Walk
+            Samples, heel strikes, phases, the step table and energy ledger per step.
 
         Raises
         ------
-        ValueError
-            ``strides`` < 1 or ``sample_rate_hz`` <= 0.
+        walkerlab.config.SceneError
+            ``strides`` not a whole number in range (``1.5``, ``True``, ``"2"``, ``10**9``),
+            ``sample_rate_hz`` not a positive number, more samples than the cap (said before
+            any is taken), or ``x0`` no state of the walker (one line each).
+        walkerlab.analysis.gait.poincare.StepFailed
+            A step used up ``step_time_limit_s`` of CPU time (a fall is recorded in
+            ``termination``, not raised).
         """
         import numpy as np
 
+        from walkerlab.analysis.gait.energy import trajectory_ledger
+        from walkerlab.analysis.gait.metrics import step_table
+        from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError
         from walkerlab.integrate.rigid import simulate_steps
 
-        if strides < 1 or not sample_rate_hz > 0:
-            raise ValueError("simulate: give strides >= 1 and sample_rate_hz > 0")
-        traj = simulate_steps(self.model, np.asarray(x0, float), 2 * int(strides),
-                              self.solver, max_step_time=self.max_step_time)
+        strides, rate = _simulate_options(strides, sample_rate_hz)
+        x0 = self.check_state(x0, "x0")
+        with self._bounded():
+            traj = simulate_steps(self.model, x0, 2 * strides, self.solver,
+                                  max_step_time=self.max_step_time)
+        counts = [max(2, int(np.ceil((seg.t_end - seg.t_start) * rate)) + 1)
+                  for seg in traj.segments]
+        if sum(counts) > MAX_SIMULATE_SAMPLES:
+            span = traj.segments[-1].t_end - traj.segments[0].t_start
+            raise SceneError(f"simulate: sample_rate_hz={rate:g} Hz over {span:.3g} s gives "
+                             f"{sum(counts):,} samples; at most {MAX_SIMULATE_SAMPLES:,} are "
+                             "kept (lower sample_rate_hz or strides)")
         ts, xs, legs, events = [], [], [], []
-        for seg in traj.segments:
-            n = max(2, int(np.ceil((seg.t_end - seg.t_start) * sample_rate_hz)) + 1)
+        for seg, n in zip(traj.segments, counts):
             t = np.linspace(seg.t_start, seg.t_end, n)
             ts.append(t)
             xs.append(seg.sample(t).T)
@@ -331,8 +515,77 @@ class Walker:
             events += [(seg.index, seg.stance_leg, *entry) for entry in seg.phase_log]
         hs = np.array([s.t_end for s in traj.segments if s.termination == "heel_strike"])
         return Walk(np.concatenate(ts), np.concatenate(xs), np.concatenate(legs), hs, events,
-                    traj.termination)
+                    traj.termination, step_table(traj), trajectory_ledger(traj))
 
     def __repr__(self) -> str:
         return (f"Walker({self.scene.name!r}, states={self.state_names()}, "
                 f"slope={self.model.params.get('slope_rad', 'n/a')})")
+
+
+def _short(value) -> str:
+    """``repr(value)``, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _positive(value, name: str) -> float:
+    """``value`` as a positive finite float, else one line naming ``name``."""
+    import math
+    import numbers
+
+    from walkerlab.config import SceneError
+
+    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+            or not math.isfinite(value) or value <= 0):
+        raise SceneError(f"{name}={_short(value)}: give a positive number of seconds")
+    return float(value)
+
+
+def _simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
+    """``(strides, sample_rate_hz)`` checked by the ``simulate`` section's own fields
+    (whole strides from 1 to the cap, a positive rate up to its cap); one line each."""
+    import numbers
+
+    from pydantic import ValidationError
+
+    from walkerlab.config import SceneError
+    from walkerlab.config.studies import SimulateSettings
+
+    if isinstance(strides, bool) or not isinstance(strides, numbers.Integral):
+        raise SceneError(f"simulate: strides={_short(strides)}: give a whole number of "
+                         "strides (an int, e.g. strides=10)")
+    if isinstance(sample_rate_hz, bool) or not isinstance(sample_rate_hz, numbers.Real):
+        raise SceneError(f"simulate: sample_rate_hz={_short(sample_rate_hz)}: give a "
+                         "number of samples per second, e.g. 500")
+    try:
+        sim = SimulateSettings.model_validate({"strides": int(strides),
+                                               "sample_rate_hz": float(sample_rate_hz)})
+    except ValidationError as err:
+        e = err.errors()[0]
+        field = e["loc"][0]
+        value = strides if field == "strides" else sample_rate_hz
+        raise SceneError(f"simulate: {field}={_short(value)}: {e['msg'].lower()} "
+                         f"(as simulate.{field})") from None
+    return sim.strides, sim.sample_rate_hz
+
+
+def _clear(exc, max_step_time: float):
+    """A :class:`StepFailed` of the map said in the walker's terms (one line: how the step
+    ended, when, and what to do), not in the integrator's."""
+    from walkerlab.analysis.gait.poincare import StepFailed
+
+    t = f"t = {exc.t:.4g} s"
+    why = {
+        "fall": f"the walker fell at {t}, before its heel strike (a fall guard fired): the "
+                "state is not on a walking gait; start from a gait (w.fixed_point().x) or "
+                "nearer to it",
+        "t_final": f"no heel strike within max_step_time_s = {max_step_time:g} s "
+                   "(fixedpoint.max_step_time_s): the walker stalled",
+        "solver_failure": f"the integrator stopped at {t}: "
+                          f"{' '.join(str(exc).split(' s ', 1)[-1].split())}",
+    }.get(exc.termination)
+    if why is None:
+        return exc
+    out = StepFailed(exc.termination, exc.t, exc.x)
+    out.args = (f"step: {why}",)
+    return out
