@@ -28,7 +28,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["STEP_TIME_LIMIT_S", "Gait", "Step", "Walk", "Walker"]
+__all__ = ["STEP_TIME_LIMIT_S", "Gait", "Step", "Target", "Walk", "Walker", "check_target",
+           "target"]
 
 #: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
 #: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
@@ -433,22 +434,23 @@ class Walker:
 
         Raises
         ------
-        ValueError
-            Not exactly one known target.
+        walkerlab.config.SceneError
+            Not exactly one known target, a target that is not a positive finite number
+            (``0``, ``nan``, ``inf``, ``-1``), or ``vary`` a field that takes whole numbers,
+            is no number, or is outside the ``walker`` and ``slope`` sections (the gait does
+            not depend on it): refused before any map (:func:`check_target`).
         walkerlab.studies.params.SweepError
-            ``vary`` names no numeric field.
+            ``vary`` names no field of the scene.
         walkerlab.analysis.continuation.target.TargetNotReached
             No gait meets the target near the start (one line).
         """
         from walkerlab.analysis.continuation.target import MEASURES, solve_target
         from walkerlab.studies.continuation import scene_family, scene_value
 
-        if len(target) != 1 or next(iter(target)) not in MEASURES:
-            raise ValueError(f"give exactly one target of {', '.join(MEASURES)}")
-        (name, value), = target.items()
+        name, value = check_target(self.scene, vary, target)
         fam = scene_family(self.scene, vary)
         res = solve_target(fam, scene_value(self.scene, vary), self.fixed_point().x,
-                           MEASURES[name][0], float(value))
+                           MEASURES[name][0], value)
         found = self.with_changes({vary: res.p})
         fp = self.scene.fixedpoint
         if fp is not None and fp.initial_guess is not None:  # start from the solution
@@ -589,3 +591,141 @@ def _clear(exc, max_step_time: float):
     out = StepFailed(exc.termination, exc.t, exc.x)
     out.args = (f"step: {why}",)
     return out
+
+
+def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
+    """The field and target of :meth:`Walker.find_gait_for` (and ``walkerlab target``)
+    checked before any map.
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+    vary : str
+        Dotted scene field to solve for.
+    target : dict
+        ``{measure: value}``, one of
+        :data:`walkerlab.analysis.continuation.target.MEASURES`.
+
+    Returns
+    -------
+    name : str
+        The measure (``speed_m_per_s``, ``step_length_m`` or ``step_period_s``).
+    value : float
+        The target [m/s, m or s].
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        Not exactly one known measure; a value that is not a positive finite number (a
+        speed, a step length and a step period are all > 0); ``vary`` not a string, a field
+        outside the ``walker`` and ``slope`` sections, a whole-number field or one whose
+        value is no number (one line each).
+    walkerlab.studies.params.SweepError
+        ``vary`` names no field of the scene (with the closest name).
+    """
+    import math
+    import numbers
+
+    from walkerlab.analysis.continuation.target import MEASURES
+    from walkerlab.config import SceneError
+    from walkerlab.studies.continuation import scene_family, scene_value
+    from walkerlab.studies.params import ParamAxis, takes_whole_numbers
+
+    if len(target) != 1 or next(iter(target)) not in MEASURES:
+        raise SceneError(f"target: give exactly one of {', '.join(MEASURES)} (got "
+                         f"{', '.join(target) or 'none'})")
+    (name, value), = target.items()
+    unit = MEASURES[name][1]
+    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+            or not math.isfinite(value) or value <= 0):
+        raise SceneError(f"target {name} (--{name.replace('_', '-')}) = {_short(value)}: "
+                         f"give a positive finite number [{unit}]")
+    if not isinstance(vary, str) or not vary.startswith(("walker.", "slope.")):
+        raise SceneError(f"target --vary {_short(vary)}: vary a numeric field of the walker "
+                         "or the slope (e.g. walker.actuation.push_off.impulse_n_s); the "
+                         "gait depends on no other section")
+    from walkerlab.studies.params import SweepError
+
+    try:
+        scene_family(scene, vary)  # an unknown field: SweepError with the closest name
+    except SweepError as exc:
+        raise SweepError(str(exc).replace("--param ", "target --vary ", 1)) from None
+    if takes_whole_numbers(scene, ParamAxis(vary, (), vary)):
+        raise SceneError(f"target --vary {vary}: the field takes whole numbers; a target is "
+                         "solved over a real-valued field")
+    scene_value(scene, vary)  # unset or not a number: one line
+    return name, float(value)
+
+
+@dataclass(frozen=True)
+class Target:
+    """The value of one field whose period-1 gait meets a target (:func:`target`).
+
+    Attributes
+    ----------
+    field : str
+        The dotted scene field solved for.
+    value : float
+        Its value [the field's unit, ``unit``].
+    unit : str
+        The field's unit (``-`` when it has none).
+    walker : Walker
+        The walker with ``field`` set to ``value``.
+    gait : Gait
+        Its period-1 gait (step length, speed, cost of transport, multipliers ...).
+    """
+
+    field: str
+    value: float
+    unit: str
+    walker: Walker
+    gait: Gait
+
+
+def target(scene: Scene | str | Path | dict[str, Any], vary: str, *,
+           speed_m_per_s: float | None = None, step_length_m: float | None = None,
+           step_period_s: float | None = None) -> Target:
+    """The value of ``vary`` whose period-1 gait has a target speed, step length or step
+    period, solved with the fixed point (``walkerlab target``; Kuo's DynLoco
+    ``findgait(target=speed, varying=P)``), in memory: nothing is written.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        A scene (:func:`walkerlab.api.load_scene`); its gait at its own value of ``vary``
+        starts the solve.
+    vary : str
+        A real-valued field of the ``walker`` or ``slope`` section
+        (``"walker.actuation.push_off.impulse_n_s"``).
+    speed_m_per_s, step_length_m, step_period_s : float
+        Exactly one target, a positive finite number [m/s, m, s].
+
+    Returns
+    -------
+    Target
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        The checks of ``walkerlab target`` (:func:`check_target`), before any map.
+    walkerlab.studies.params.SweepError
+        ``vary`` names no field of the scene.
+    walkerlab.analysis.continuation.target.TargetNotReached
+        No gait meets the target near the scene's own (one line).
+    walkerlab.analysis.gait.search.GaitNotFound
+        No gait at the scene's own value to start from.
+
+    Examples
+    --------
+    >>> t = wl.target("configs/powered_compass.yaml",
+    ...               "walker.actuation.push_off.impulse_n_s", speed_m_per_s=0.45)  # doctest: +SKIP
+    >>> t.value, t.gait.step_period, t.gait.cost_of_transport                      # doctest: +SKIP
+    """
+    from walkerlab.studies.continuation import scene_value
+    from walkerlab.units import field_unit
+
+    given = {k: v for k, v in (("speed_m_per_s", speed_m_per_s),
+                               ("step_length_m", step_length_m),
+                               ("step_period_s", step_period_s)) if v is not None}
+    walker, gait = Walker.from_scene(scene).find_gait_for(vary, **given)
+    return Target(vary, scene_value(walker.scene, vary), field_unit(vary) or "-", walker, gait)
