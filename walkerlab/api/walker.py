@@ -212,18 +212,20 @@ class Walker:
         self.max_step_time = 5.0 if fp is None else fp.max_step_time_s
 
     @classmethod
-    def from_scene(cls, scene: Scene | str | Path | dict[str, Any]) -> Walker:
+    def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
+                   step_time_limit_s: float = STEP_TIME_LIMIT_S) -> Walker:
         """The walker of a scene: a YAML path, a mapping with the scene's sections, or a
-        loaded scene.
+        loaded scene (``step_time_limit_s`` as in :class:`Walker`).
 
         Raises
         ------
         walkerlab.config.SceneError
-            The file is missing or the scene does not validate (one line per field).
+            The file is missing or the scene does not validate (one line per field), or a
+            bad ``step_time_limit_s``.
         """
         from walkerlab.api.scenes import as_scene
 
-        return cls(as_scene(scene))
+        return cls(as_scene(scene), step_time_limit_s)
 
     def with_changes(self, changes: dict[str, Any]) -> Walker:
         """A new walker with scene fields set by dotted path
