@@ -165,8 +165,8 @@ def target(scene: Path | None = SceneArg,
     given = {k: v for k, v in (("speed_m_per_s", speed), ("step_length_m", step_length),
                                ("step_period_s", step_period)) if v is not None}
     if len(given) != 1:
-        raise typer.BadParameter("give exactly one of --speed-m-per-s, --step-length-m, "
-                                 "--step-period-s")
+        fail(ValueError("target: give exactly one of --speed-m-per-s, --step-length-m, "
+                        f"--step-period-s (got {len(given) or 'none'})"))
     from walkerlab.analysis.continuation.target import TargetNotReached
     from walkerlab.analysis.gait.search import GaitNotFound
 

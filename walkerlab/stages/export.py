@@ -57,9 +57,10 @@ def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
     start = adams_start(scene, mb, data)
     adm = adm_text(scene, mb, data, name, walkerlab.__version__, start)
     acf = acf_text(scene, start)
-    path = runpaths.atomic_text(export_path(scene, runs_root, "adm", claim=True), adm)
-    runpaths.atomic_text(runpaths.scene_file(scene, runs_root, ADAMS_FILES["acf"], claim=True),
-                         acf)
+    path = export_path(scene, runs_root, "adm", claim=True)
+    runpaths.atomic_texts([  # both or neither
+        (path, adm),
+        (runpaths.scene_file(scene, runs_root, ADAMS_FILES["acf"], claim=True), acf)])
     return path
 
 
@@ -96,6 +97,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         masses), feet the formats cannot carry, or no rigid gait to start from; one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
+    walkerlab.io.artifacts.ArtifactError
+        A file cannot be written (a full disk, a folder in a file's place): the files of
+        the export (``walker.urdf`` and ``walker.gait.json``, ``walker.adm`` and
+        ``walker.acf``) are all written or all left as they were (one line).
     """
     path = export_path(scene, runs_root, fmt)  # check the format before building anything
     data = walker_data(scene.walker, scene.slope.phi_rad)
@@ -110,7 +115,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     else:
         text = mjcf_text(mb, name, walkerlab.__version__, extra)
     path = export_path(scene, runs_root, fmt, claim=True)
+    files = [(path, comments_in_scene_units(text, for_scene(scene)))]
     if fmt == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
-        runpaths.atomic_text(runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
-                             keyframe_json(mb, extra))
-    return runpaths.atomic_text(path, comments_in_scene_units(text, for_scene(scene)))
+        files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
+                      keyframe_json(mb, extra)))
+    runpaths.atomic_texts(files)  # the walker and its keyframe: both or neither
+    return path
