@@ -58,9 +58,9 @@ def stored_gait(scene: Scene, runs_root: Path | str):
     would)."""
     from walkerlab.io.artifacts import ArtifactError
     from walkerlab.io.schemas.fixedpoint import load_fixedpoint
-    from walkerlab.stages.fixedpoint import fresh_artifact
+    from walkerlab.stages.pipeline import fresh_fixedpoint
 
-    path = fresh_artifact(scene, runs_root)
+    path = fresh_fixedpoint(scene, runs_root)
     if path is None:
         return None
     try:
