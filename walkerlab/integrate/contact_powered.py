@@ -138,6 +138,35 @@ def _touchdown_event(walker, stance_of):
     return touch
 
 
+def _pulse_event(walker, stance_of, lead_s: float):
+    """Event: the push-off pulse starts, ``lead_s`` [s] before the swing foot's predicted
+    touchdown on ground ahead of the stance foot (as :func:`_touchdown_event`): its
+    penetration extrapolated ``lead_s`` ahead at its present rate, ``delta + lead_s
+    d delta/dt``, crosses 0 upwards (:func:`pulse_lead`)."""
+    acts = walker.actuators
+    n = 2 * walker.nq
+
+    def pulse(t, y):
+        stance = stance_of()
+        rows = acts.leg_contacts(walker, y[:n])
+        sw, st = rows[1 - stance], rows[stance]
+        if sw[7] < 0.5 or sw[3] - st[3] < acts.min_step_m:
+            return 1.0
+        return -float(pulse_lead(sw[0], sw[1], lead_s))
+
+    pulse.terminal = True
+    pulse.direction = -1
+    return pulse
+
+
+def pulse_lead(penetration, rate, pulse_s: float):
+    """The push-off pulse's start criterion: the swing foot's penetration [m] extrapolated
+    ``pulse_s`` [s] ahead at its rate [m/s], ``penetration + pulse_s * rate`` (a pulse
+    started where it crosses 0 upwards ends at the touchdown the extrapolation predicts;
+    arrays or floats alike)."""
+    return penetration + pulse_s * rate
+
+
 def _heel_off_event(walker, stance_of):
     """Event: the stance heel's penetration crosses 0 downwards (it leaves the ground) with
     the stance toe loaded (penetration > 0); the ankle push-off starts there."""
@@ -281,58 +310,119 @@ class _PoweredRun:
 
     def _keep(self, sol, t_end, y_end=None):
         """Store the samples before ``t_end`` (and ``(t_end, y_end)`` itself if given)."""
-        keep = sol.t < t_end - 1e-12
-        self.ts.append(sol.t[keep] if y_end is None else np.append(sol.t[keep], t_end))
-        self.Ys.append(sol.y.T[keep] if y_end is None else np.vstack([sol.y.T[keep],
-                                                                     y_end[None]]))
+        ts = np.asarray(sol.t, float)  # solve_ivp answers a list if no sample came
+        Y = sol.y.T if ts.size else np.empty((0, self.Ys[0].shape[1]))
+        keep = ts < t_end - 1e-12
+        self.ts.append(ts[keep] if y_end is None else np.append(ts[keep], t_end))
+        self.Ys.append(Y[keep] if y_end is None else np.vstack([Y[keep], y_end[None]]))
+
+    def _pulse(self, y, t, tp, trailing, force, touch: bool):
+        """The push-off pulse ``force`` [N] along leg ``trailing`` from ``t`` to ``tp`` [s];
+        ``touch``: the leading foot's touchdown may end it early (then the heel strike is
+        the caller's).  Returns ``(t, y, touched)``, or None when the run ends here (a fall
+        stored)."""
+        events = [self.fall, self.touch] if touch else [self.fall]
+        sol = self._run(y, t, tp, (trailing, force), events)
+        if sol is None:
+            return None
+        if sol.t_events[0].size:
+            self._fell(sol)
+            return None
+        if touch and sol.t_events[1].size:
+            t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+            self._keep(sol, t)
+            return t, y, True
+        self._keep(sol, tp)
+        return float(sol.t[-1]), sol.y[:, -1].copy(), False
+
+    def _fell(self, sol):
+        self._keep(sol, sol.t_events[0][0], sol.y_events[0][0])
+        self.term, self.msg = RunEnd.FALL, "fall: hip below the fall height"
+        k = sum(len(a) for a in self.ts) - 1
+        self.event = (RunEnd.FALL.value, k, float(sol.t_events[0][0]), "", np.nan)
 
     def go(self, x0, t, t1, stop):
+        """Integrate from ``(t, x0)`` to ``t1``: segments between the discrete events (the
+        push-off pulse's start, heel strike, heel off), the pulse its own segment."""
         acts = self.walker.actuators
         n, nw = 2 * self.walker.nq, len(acts.work_names)
         y = np.concatenate([x0, np.zeros(nw)])
         self.ts, self.Ys = [np.array([t])], [y[None]]
+        # the pulse ends at the predicted touchdown (module docstring); ``pushed``: this
+        # step's pulse has run (or is running)
+        pulsed = acts.ankle is None and acts.pulse_s > 0.0
+        lead = _pulse_event(self.walker, lambda: self.stance, acts.pulse_s) if pulsed else None
+        pushed = False
         while t < t1 - 1e-12:
             tb = min(t + self.limits.chunk_s, t1)
             watch = acts.ankle is not None and not self.ankle_on
+            arm = pulsed and not pushed
             sol = self._run(y, t, tb, None,
-                            [self.fall, self.touch] + ([self.heel_off] if watch else []))
+                            [self.fall, self.touch] + ([self.heel_off] if watch else [])
+                            + ([lead] if arm else []))
             if sol is None:
                 return
             if sol.t_events[0].size:  # a fall
-                self._keep(sol, sol.t_events[0][0], sol.y_events[0][0])
-                self.term, self.msg = RunEnd.FALL, "fall: hip below the fall height"
-                k = sum(len(a) for a in self.ts) - 1
-                self.event = (RunEnd.FALL.value, k, float(sol.t_events[0][0]), "", np.nan)
+                self._fell(sol)
                 return
             if watch and sol.t_events[2].size:  # heel off: the ankle push-off starts
                 t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
                 self._keep(sol, t)
                 self.ankle_on = True
                 continue
-            if not sol.t_events[1].size:  # the chunk's end
+            if arm and sol.t_events[2].size and not sol.t_events[1].size:
+                # the pulse starts pulse_s before the predicted touchdown, at the stance
+                # (trailing) foot, its impulse from the hip speed here (the pre-impact one)
+                t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
+                self._keep(sol, t)
+                pushed = True
+                P = acts.impulse(y[:n])
+                if not P > 0.0:
+                    continue
+                tp, trailing = min(t + acts.pulse_s, t1), self.stance
+                got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, True)
+                if got is None:
+                    return
+                t, y, touched = got
+                if not touched:  # the touchdown after the pulse: the next segments
+                    continue
+                self._strike(t)  # the pulse straddles the touchdown: its rest after it
+                if t < tp - 1e-12:
+                    got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, False)
+                    if got is None:
+                        return
+                    t, y = got[:2]
+                pushed = False
+            elif not sol.t_events[1].size:  # the chunk's end
                 self._keep(sol, np.inf)
                 t, y = float(sol.t[-1]), sol.y[:, -1].copy()
                 continue
-            t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
-            self._keep(sol, t)
-            trailing, self.stance = self.stance, 1 - self.stance  # heel strike: roles swap
-            self.t_origin, self.ankle_on = t, False
-            P = acts.impulse(y[:n]) if acts.ankle is None else 0.0
-            if P > 0.0 and acts.pulse_s == 0.0:
-                y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
-                y[n + 2] += w
-            elif P > 0.0:
-                tp = min(t + acts.pulse_s, t1)
-                sol = self._run(y, t, tp, (trailing, P / acts.pulse_s), [self.fall])
-                if sol is None:
-                    return
-                self._keep(sol, tp)
-                t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+            else:
+                t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+                self._keep(sol, t)
+                trailing = self.stance
+                self._strike(t)
+                P = acts.impulse(y[:n]) if acts.ankle is None and not pushed else 0.0
+                pushed = False
+                if P > 0.0 and acts.pulse_s == 0.0:
+                    y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
+                    y[n + 2] += w
+                elif P > 0.0:  # no pulse before the touchdown (it came too fast): from it
+                    tp = min(t + acts.pulse_s, t1)
+                    got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, False)
+                    if got is None:
+                        return
+                    t, y = got[:2]
             if stop is not None and stop(np.concatenate(self.ts),
                                          np.vstack(self.Ys)[:, :n]):
                 self._keep_last(t, y)
                 self.term, self.msg = RunEnd.HEEL_STRIKE, "the heel strikes asked for were made"
                 return
+
+    def _strike(self, t):
+        """Heel strike at ``t`` [s]: the roles swap, the step's clock and ankle reset."""
+        self.stance = 1 - self.stance
+        self.t_origin, self.ankle_on = t, False
 
     def _keep_last(self, t, y):
         if t > self.ts[-1][-1] + 1e-12 if len(self.ts[-1]) else True:
@@ -387,12 +477,46 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
 
     cross.terminal, cross.direction = True, 1.0
     y, t, struck = np.concatenate([np.asarray(x0, float), np.zeros(nw)]), 0.0, False
+    lead = _pulse_event(walker, lambda: run.stance, acts.pulse_s) if acts.pulse_s > 0 else None
+    pushed = False  # the pulse of the heel strike to come has run (or is running)
+
+    def pulse(y, t, tp, trailing, force, events):
+        sol = run._run(y, t, tp, (trailing, force), events)
+        if sol is None:
+            return None, (t, y[:n], run.term)
+        if sol.t_events[0].size:
+            return None, (float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL)
+        if len(events) > 1 and sol.t_events[1].size:
+            return (float(sol.t_events[1][0]), sol.y_events[1][0].copy(), True), None
+        return (float(sol.t[-1]), sol.y[:, -1].copy(), False), None
+
     while t < t_max - 1e-12:
-        sol = run._run(y, t, t_max, None, [run.fall, cross if struck else run.touch])
+        arm = lead is not None and not struck and not pushed
+        sol = run._run(y, t, t_max, None,
+                       [run.fall, cross if struck else run.touch] + ([lead] if arm else []))
         if sol is None:
             return t, y[:n], run.term
         if sol.t_events[0].size:
             return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
+        if arm and sol.t_events[2].size and not sol.t_events[1].size:
+            # the pulse, pulse_s before the predicted touchdown (as run_powered)
+            t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
+            pushed, P = True, acts.impulse(y[:n])
+            if not P > 0.0:
+                continue
+            tp, trailing = t + acts.pulse_s, run.stance
+            got, end = pulse(y, t, tp, trailing, P / acts.pulse_s, [run.fall, run.touch])
+            if got is None:
+                return end
+            t, y, touched = got
+            if touched:  # the heel strike inside the pulse: the roles swap, its rest
+                struck, run.stance, run.t_origin = True, 1 - trailing, t
+                if t < tp - 1e-12:
+                    got, end = pulse(y, t, tp, trailing, P / acts.pulse_s, [run.fall])
+                    if got is None:
+                        return end
+                    t, y = got[:2]
+            continue
         if not sol.t_events[1].size:
             return float(sol.t[-1]), sol.y[:n, -1], RunEnd.NO_HEEL_STRIKE
         t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
@@ -400,16 +524,14 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
             return t, y[:n], RunEnd.T_FINAL
         struck, trailing = True, run.stance
         run.stance, run.t_origin = 1 - trailing, t  # heel strike: the roles swap
-        P = acts.impulse(y[:n])
+        P = 0.0 if pushed else acts.impulse(y[:n])
         if P > 0.0 and acts.pulse_s == 0.0:
             y[:n] = impulse_jump(walker, y[:n], trailing, P)[0]
-        elif P > 0.0:
-            sol = run._run(y, t, t + acts.pulse_s, (trailing, P / acts.pulse_s), [run.fall])
-            if sol is None:
-                return t, y[:n], run.term
-            if sol.t_events[0].size:
-                return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
-            t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+        elif P > 0.0:  # no pulse before the touchdown (it came too fast): from it
+            got, end = pulse(y, t, t + acts.pulse_s, trailing, P / acts.pulse_s, [run.fall])
+            if got is None:
+                return end
+            t, y = got[:2]
     return t, y[:n], RunEnd.NO_HEEL_STRIKE
 
 

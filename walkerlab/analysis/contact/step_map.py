@@ -73,7 +73,8 @@ from scipy.optimize import brentq
 
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
-from walkerlab.integrate.contact_powered import powered_to_section, push_off, run_powered
+from walkerlab.integrate.contact_powered import (powered_to_section, pulse_lead, push_off,
+                                                 run_powered)
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
@@ -350,13 +351,18 @@ class StepMap:
         trailing = 1 - stance_to_come
         sw, st = f"leg{stance_to_come + 1}", f"leg{trailing + 1}"
 
-        def touch(X):  # the swing foot's penetration on its patch ahead, else -1
+        def touch(X):  # the swing foot's penetration on its patch ahead, else -1; with a
+            # pulse: extrapolated pulse_s ahead (the pulse ends at the predicted touchdown)
             fq = w.foot_quantities(X)
             ok = (fq[sw]["on_ground"] > 0.5) & (fq[sw]["s"] - fq[st]["s"] >= acts.min_step_m)
-            return np.where(ok, fq[sw]["penetration"], -1.0)
+            pen = fq[sw]["penetration"]
+            if acts.pulse_s > 0.0:
+                pen = pulse_lead(pen, fq[sw]["penetration_rate"], acts.pulse_s)
+            return np.where(ok, pen, -1.0)
 
         t1, x1 = self._grid_crossing(x0, touch, 0.0, 2e-3, 0.25, hth, "no_mid_stance",
-                                     "heel strike")
+                                     "heel strike" if acts.pulse_s == 0.0 else
+                                     "push-off before a heel strike")
         t2, x2, end = push_off(w, x1, t1, trailing, self.solver, self.deadline, hth)
         if end is not RunEnd.T_FINAL:
             return self._powered_end(t2, x2, end)
