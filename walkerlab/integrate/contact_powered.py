@@ -5,12 +5,28 @@ have: which leg is in stance (the hip torques act +tau on the swing leg) and whe
 push-off pulse is running (:mod:`walkerlab.models.contact.actuation`).  So the run goes in
 segments, on :func:`scipy.integrate.solve_ivp` with event location:
 
-1. from the step's start until the swing foot touches the ground on a patch at least
-   ``ContactActuators.min_step_m`` ahead of the stance foot (a heel strike), or a fall;
-2. at the touchdown the roles swap and the push-off starts at the (old) stance foot: for
-   ``pulse_s`` seconds a force ``P / pulse_s`` along that leg (or, with ``pulse_s = 0``, the
-   impulse at once: ``dq += M^-1 J^T P e``);
-3. repeat until the end time, the ``stop`` predicate (strides cap) or an event.
+1. from the step's start until the push-off pulse starts: ``pulse_s`` before the swing
+   foot's predicted touchdown on a patch at least ``ContactActuators.min_step_m`` ahead of
+   the stance foot (its penetration extrapolated at its rate, :func:`pulse_lead`, crosses 0),
+   or a fall;
+2. the pulse, a force ``P / pulse_s`` for ``pulse_s`` seconds along the stance (soon
+   trailing) leg at its foot, ``P`` from the hip speed at its start.  The rigid model's
+   push-off comes immediately before the heel strike, with the trailing foot free for it
+   (Kuo 2002); a pulse started at the touchdown instead works inside the compliant
+   collision, against the ground (3.5x the rigid work per step at 5 ms on
+   configs/powered_compass.yaml).  The touchdown, when it comes within the pulse, swaps the
+   roles and the pulse runs on to its end;
+3. to the touchdown (a heel strike: the roles swap) if the pulse ended before it; a touchdown
+   without a pulse before it (none predicted in time) gets the pulse from the touchdown, and
+   with ``pulse_s = 0`` the impulse at once at the touchdown (``dq += M^-1 J^T P e``, before
+   any collision force: the rigid model's order);
+4. repeat until the end time, the ``stop`` predicate (strides cap) or an event.
+
+As ``pulse_s -> 0`` the run converges to the impulse's, first order in ``pulse_s``: the pulse
+takes over the stance foot's weight support while it lasts, so its work falls short of the
+impulse's by ~13 mJ per ms on configs/powered_compass.yaml (0.2280 J for the impulse at the
+first touchdown, 0.2267 J at 0.1 ms, 0.2148 J at 1 ms, 0.1618 J at 5 ms; the rigid model's
+0.2346 J on its own gait, whose touchdown state the contact walker's differs from).
 
 A free-jointed (five-link) biped's joint torques (:mod:`walkerlab.models.contact.joint_torques`)
 run the same way: the stance leg switched at the heel strike sets which leg's hip and knee
@@ -43,7 +59,7 @@ from walkerlab.models.contact.actuation import powered_rhs
 from .ends import RunEnd
 
 __all__ = ["IVP_METHODS", "STALL_CALLS", "impulse_jump", "powered_atol", "powered_to_section",
-           "push_off", "run_powered"]
+           "pulse_lead", "pulse_lead_s", "push_off", "run_powered"]
 
 #: solve_ivp methods a powered run uses as given (others run as LSODA).
 IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
@@ -165,6 +181,15 @@ def pulse_lead(penetration, rate, pulse_s: float):
     started where it crosses 0 upwards ends at the touchdown the extrapolation predicts;
     arrays or floats alike)."""
     return penetration + pulse_s * rate
+
+
+def pulse_lead_s(acts) -> float:
+    """How long [s] before the predicted touchdown the push-off pulse starts: the pulse's
+    duration for a walker with a push-off impulse and a pulse, else 0 (no pulse event)."""
+    spec = getattr(acts, "spec", None)
+    if getattr(spec, "push_off", None) is None or getattr(acts, "ankle", None) is not None:
+        return 0.0
+    return float(acts.pulse_s)
 
 
 def _heel_off_event(walker, stance_of):
@@ -350,7 +375,7 @@ class _PoweredRun:
         self.ts, self.Ys = [np.array([t])], [y[None]]
         # the pulse ends at the predicted touchdown (module docstring); ``pushed``: this
         # step's pulse has run (or is running)
-        pulsed = acts.ankle is None and acts.pulse_s > 0.0
+        pulsed = pulse_lead_s(acts) > 0.0
         lead = _pulse_event(self.walker, lambda: self.stance, acts.pulse_s) if pulsed else None
         pushed = False
         while t < t1 - 1e-12:
@@ -433,9 +458,10 @@ class _PoweredRun:
 def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
                        deadline: float = np.inf, fall_hip_height_m: float = 0.5):
     """Integrate a powered walker from ``x0`` (leg ``stance`` in stance) through the next heel
-    strike (touchdown of the other leg ahead, the roles swap, the push-off pulse or impulse
-    at the old stance foot) to the next upward zero of ``section(x)``: the powered
-    contact step map's flow (:mod:`walkerlab.analysis.contact.step_map`).
+    strike (the push-off pulse at the stance foot ending at the predicted touchdown of the
+    other leg ahead, the touchdown, the roles swap; as :func:`run_powered`) to the next
+    upward zero of ``section(x)``: the powered contact step map's flow
+    (:mod:`walkerlab.analysis.contact.step_map`).
 
     Parameters
     ----------
@@ -477,7 +503,8 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
 
     cross.terminal, cross.direction = True, 1.0
     y, t, struck = np.concatenate([np.asarray(x0, float), np.zeros(nw)]), 0.0, False
-    lead = _pulse_event(walker, lambda: run.stance, acts.pulse_s) if acts.pulse_s > 0 else None
+    lead = (_pulse_event(walker, lambda: run.stance, acts.pulse_s) if pulse_lead_s(acts) > 0
+            else None)
     pushed = False  # the pulse of the heel strike to come has run (or is running)
 
     def pulse(y, t, tp, trailing, force, events):
@@ -537,18 +564,22 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
 
 def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.inf,
              fall_hip_height_m: float = 0.5):
-    """The push-off of a heel strike at ``(t, x)``: the pulse ``P / pulse_s`` along leg
-    ``trailing`` for ``pulse_s`` seconds on the powered contact integrator (the new stance
-    leg the other one), or with ``pulse_s = 0`` the impulse at once (:func:`impulse_jump`).
+    """The push-off of a heel strike from ``(t, x)``, the pulse's start (``pulse_s`` before
+    the predicted touchdown, :func:`pulse_lead`): the pulse ``P / pulse_s`` along leg
+    ``trailing`` for ``pulse_s`` seconds on the powered contact integrator (the touchdown
+    inside it not looked for: a walker powered by push-off alone, whose flow does not depend
+    on which leg is in stance), or, at the touchdown, with ``pulse_s = 0`` the impulse at
+    once (:func:`impulse_jump`).
 
     Parameters
     ----------
     walker : ContactWalker
         With ``actuators``.
     x : ndarray, shape (2 nq,)
-        The state at the touchdown [m, rad, m/s, rad/s].
+        The state at the pulse's start (the touchdown for ``pulse_s = 0``) [m, rad, m/s,
+        rad/s].
     t : float
-        The touchdown's time [s].
+        Its time [s].
     trailing : int
         The trailing leg (0: leg1, 1: leg2), the old stance leg.
     solver : Solver

@@ -9,8 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.analysis.contact.ledger import (STEP_LEDGER_DESCRIPTIONS, STEP_LEDGER_UNITS,
-                                               contact_step_ledger)
+from walkerlab.analysis.contact.ledger import (
+    STEP_LEDGER_DESCRIPTIONS,
+    STEP_LEDGER_UNITS,
+    contact_step_ledger,
+)
 from walkerlab.config import ContactSettings
 from walkerlab.models.contact.scene import ContactSetup
 
