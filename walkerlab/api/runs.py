@@ -109,7 +109,9 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
         (potential from the first stance foot), ``<point>_x``/``<point>_y`` [m] (``hip``,
         ``leg1_foot`` ...), ``stance_leg``, ``step_index``, ``phase``.  On ``step``: the
         step table ``steps_period`` [s], ``steps_step_length`` [m], ``steps_hip_speed``
-        [m/s], ``steps_impact_energy_loss`` [J], ``steps_termination`` ...
+        [m/s], ``steps_impact_energy_loss`` [J] (the heel-strike collision's loss),
+        ``steps_transition_energy_change`` [J] (net across push-off and heel strike),
+        ``steps_termination`` ...
         Attribute ``termination``: ``heel_strike`` when every step completed; a walker
         that falls is recorded (``fall``), not raised.
 

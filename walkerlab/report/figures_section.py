@@ -51,11 +51,16 @@ def steps_table(sim: SimulateArtifact) -> str:
     """Per-step table of ``simulate.h5`` (period, step length, hip speed, impact loss)."""
     u, s = sim.units, sim.steps
     cols = ("period", "step_length", "hip_speed", "impact_energy_loss")
+    head = [f"period [{u.time}]", f"step length [{u.length}]", f"hip speed [{u.speed}]",
+            f"impact loss [{u.energy}]"]
+    pushed = np.asarray((sim.ledger or {}).get("push_off_impulse", [0.0]), float)
+    if "transition_energy_change" in s and np.nanmax(np.abs(pushed), initial=0.0) > 0:
+        cols += ("transition_energy_change",)  # the push-off's gain, the collision's loss
+        head += [f"net, push-off + heel strike [{u.energy}]"]
     rows = [[int(i), str(leg), *[num(s[c][k]) for c in cols], str(term)]
             for k, (i, leg, term) in enumerate(zip(s["step"], s["stance_leg"],
                                                    s["termination"]))]
-    return table(["step", "stance leg", f"period [{u.time}]", f"step length [{u.length}]",
-                  f"hip speed [{u.speed}]", f"impact loss [{u.energy}]", "ended by"], rows)
+    return table(["step", "stance leg", *head, "ended by"], rows)
 
 
 def spring_law_note(scene) -> str:
