@@ -25,13 +25,31 @@ from .ends import RunEnd
 from .events import odeint_grid
 from .solver import Solver
 
-__all__ = ["COMPILED_METHODS", "GRID_METHODS", "contact_grid"]
+__all__ = ["COMPILED_METHODS", "GRID_METHODS", "compile_rhs", "contact_grid"]
 
 #: methods that integrate the walker's compiled right-hand side (CyRK's, over the generated
 #: module's cfunc: ``kernels.build_cyrk``)
 COMPILED_METHODS = tuple(_cyrk.CYRK_METHODS)
 #: methods :func:`contact_grid` runs (compiled first).
 GRID_METHODS = (*COMPILED_METHODS, "odeint")
+
+
+def compile_rhs(kernels) -> int:
+    """Compile (or load from numba's on-disk cache) the cfunc of the compiled methods'
+    right-hand side, ``kernels.rhs_packed``, once per walker structure.
+
+    Parameters
+    ----------
+    kernels : module
+        The walker's generated kernels
+        (:func:`walkerlab.models.contact.generated.contact_module`).
+
+    Returns
+    -------
+    int
+        The cfunc's C address.
+    """
+    return _cyrk.address(kernels)
 
 
 def contact_grid(walker, x0, t_grid, solver: Solver, data: np.ndarray | None = None
