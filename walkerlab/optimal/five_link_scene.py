@@ -44,7 +44,7 @@ def optimize_five_link_scene(scene):
     from walkerlab.optimal.five_link import JOINTS, five_link_functions
     from walkerlab.optimal.five_link_collocation import collocate_five_link, replay_five_link
     from walkerlab.optimal.five_link_shooting import close_step
-    from walkerlab.optimal.scene import step_record
+    from walkerlab.optimal.records import step_record
     from walkerlab.walker.description import walker_data
 
     o = scene.optimize
