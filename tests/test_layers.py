@@ -20,7 +20,9 @@ also those inside functions), never by running it: dependencies point down.
   closed lazily is still two modules that each need the other);
 - one formula, one place: one finite-difference and one complex-step Jacobian
   (:mod:`walkerlab.numerics`), no ``approx_fprime``;
-- package docstrings tell what the code does, not its issue history (no "issue N").
+- package docstrings tell what the code does, not its issue history (no "issue N"), and
+  cite papers, equations and the project's own files, never a path outside the project
+  (a notes file, ``../shared``, a machine's absolute path).
 """
 
 from __future__ import annotations
@@ -378,6 +380,41 @@ def test_no_issue_numbers_in_package_docstrings():
     bad = [f"{_rel(p)}:{n}" for p in _modules()
            for n, line in enumerate(p.read_text().splitlines(), 1)
            if re.search(r"\b[Ii]ssues? \d+", line)]
+    assert not bad, bad
+
+
+#: a reference to something outside the project: a notes file, a path that climbs out of
+#: the tree (``../``, not an ellipsis ``.../``), or an absolute path of a machine
+OUTSIDE = r"NOTES\.md|(?<!\.)\.\./|\bshared/|(?<![\w./-])/(?:work|home|root|tmp|Users)/"
+
+
+def _outside_references(paths) -> list[str]:
+    import re
+
+    return [f"{p}:{n}" for p in paths
+            for n, line in enumerate(p.read_text(errors="replace").splitlines(), 1)
+            if re.search(OUTSIDE, line)]
+
+
+def test_the_outside_reference_rule_catches_each_kind(tmp_path):
+    cases = ["(NOTES.md)", "see ../shared/NOTES.md", "bench, /work/notes/s3.md",
+             "a copy in shared/", "cached in /tmp/x", "/home/me/paper.pdf"]
+    fine = ["``ledger/work/<name>``", "<tendon tendon1=.../>", "scripts/bench_mfpt.py",
+            "MSC Adams/Solver function reference, IMPACT"]
+    for k, text in enumerate(cases + fine):
+        (tmp_path / f"{k}.py").write_text(f'"""{text}"""\n')
+    got = {int(Path(r.split(":")[0]).stem) for r in
+           _outside_references(sorted(tmp_path.glob("*.py")))}
+    assert got == set(range(len(cases)))
+
+
+def test_the_package_points_at_nothing_outside_the_project():
+    """Docstrings and comments cite the paper, an equation or a file of the project: a notes
+    file or a path outside the tree means nothing to a reader of the package."""
+    files = [p for p in sorted(PKG.rglob("*")) if p.is_file() and "__pycache__" not in p.parts
+             and p.suffix in (".py", ".md", ".txt", ".yaml", ".json", ".html", ".j2")]
+    assert len(files) > 100
+    bad = _outside_references(files)
     assert not bad, bad
 
 

@@ -11,9 +11,9 @@ this path).  ``"odeint"`` (scipy's LSODA through the Python right-hand side and 
 Jacobian) is the plain-library route, and the fallback when BDF stops on a force jump it
 cannot step over (a foot meeting the side of a patch below its top).
 
-Measured on the paper's walker (0.5 s from a mid-stance, rtol 1e-12, atol 1e-14, against
-Radau at rtol 1e-13): CyRK BDF's largest error 3.5e-10 m/s (5 000 RHS calls, ~5 ms), odeint
-1.8e-9 m/s (~15 000 Python calls, ~0.15-0.4 s).
+On the paper's walker (0.5 s from a mid-stance, rtol 1e-12, atol 1e-14, against Radau at
+rtol 1e-13): CyRK BDF's largest error 3.5e-10 m/s (5 000 RHS calls), odeint 1.8e-9 m/s
+(~15 000 Python calls); ``walkerlab bench contact`` times the methods.
 """
 
 from __future__ import annotations

@@ -31,7 +31,7 @@ def optimize_five_link_scene(scene):
         ``phase_replays`` the phase-variable laws' rigid replays (``feedback``: closed,
         ``feedforward``: from the collocated start) and ``contact_step_period_s`` the
         contact model's under the feedback law (~35 rigid step maps on the compiled flows,
-        ~3 s CPU, and 2 contact strides, ~10 s).
+        and 2 contact strides).
 
     Raises
     ------
