@@ -20,7 +20,7 @@ Modules: :mod:`~walkerlab.api.scenes` (:func:`load_scene`, :func:`with_changes`)
 walker in memory, its map, Jacobian, fixed point and walks, no artifact); this module only
 gathers their public names.
 
-Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
+Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``test`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what
 it uses.
 
