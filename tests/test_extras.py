@@ -97,3 +97,19 @@ def test_walking_an_exported_mjcf_without_mujoco_says_which_extra(monkeypatch, t
     monkeypatch.setitem(sys.modules, "mujoco", None)
     with pytest.raises(MissingExtra, match=r"pip install 'walkerlab\[engines\]'$"):
         walk(tmp_path / "walker.xml", 1.0)
+
+
+def test_the_python_api_without_its_datasets_says_which_extra(monkeypatch, tmp_path):
+    """The API's artifact view needs xarray and h5netcdf: one line naming the missing one
+    (h5netcdf was imported bare before the check, so a light install saw its traceback)."""
+    from walkerlab.io.datasets import load_dataset
+
+    monkeypatch.setitem(sys.modules, "h5netcdf", None)
+    path = tmp_path / "fixedpoint.h5"
+    import h5py
+
+    with h5py.File(path, "w") as f:
+        f.attrs["stage"] = "fixedpoint"
+    with pytest.raises(MissingExtra, match=r"^walkerlab's Python API needs h5netcdf \(not "
+                       r"installed\): pip install 'walkerlab\[api\]'$"):
+        load_dataset(path)
