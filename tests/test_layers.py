@@ -16,14 +16,19 @@ also those inside functions), never by running it: dependencies point down.
   ``config/`` never imports ``io/`` (a scene opens no artifact);
 - no name private to a module (``_name``) is imported by another package, and no private
   module is imported from outside its package;
+- no import circle among walkerlab's modules (imports inside functions count: a circle
+  closed lazily is still two modules that each need the other);
 - one formula, one place: one finite-difference and one complex-step Jacobian
   (:mod:`walkerlab.numerics`), no ``approx_fprime``;
-- package docstrings tell what the code does, not its issue history (no "issue N").
+- package docstrings tell what the code does, not its issue history (no "issue N"), and
+  cite papers, equations and the project's own files, never a path outside the project
+  (a notes file, ``../shared``, a machine's absolute path).
 """
 
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 PKG = Path(__file__).resolve().parents[1] / "walkerlab"
@@ -33,9 +38,15 @@ FRONT = ("cli", "api", "cli/bench.py")
 CHAINS = ("pipeline.py", "report_dag.py", "report.py")
 
 
+@functools.cache
+def _tree(path: Path) -> ast.Module:
+    """``path`` parsed once for every rule (the rules read the same files)."""
+    return ast.parse(path.read_text(), filename=str(path))
+
+
 def _imports(path: Path) -> list[str]:
     """Every module ``path`` imports, absolute (``from . import x`` resolved)."""
-    tree = ast.parse(path.read_text(), filename=str(path))
+    tree = _tree(path)
     try:
         pkg = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1])
     except ValueError:  # a file outside the package: the rules' self-tests
@@ -183,11 +194,22 @@ def test_the_middle_floor_points_down():
     assert not bad, bad
 
 
-def _private_crossings(path: Path) -> list[str]:
+def _private_owner(parts: list[str], i: int) -> str:
+    """The package that owns the private ``parts[i]``: ``parts[:i]`` when that is a package
+    (``_x`` is its private module, or a private name of its ``__init__``), else the package
+    of the module ``parts[:i]`` (``_x`` is a private name of that module)."""
+    if PKG.parent.joinpath(*parts[:i]).is_dir():
+        return ".".join(parts[:i])
+    return ".".join(parts[:i - 1])
+
+
+def _private_crossings(path: Path, here: str | None = None) -> list[str]:
     """Imports in ``path`` of a ``_name`` from a module of another package, or of a private
-    module (``pkg._mod``) from outside ``pkg``."""
-    here = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1]) \
-        if path.is_relative_to(PKG.parent) else ""
+    module (``pkg._mod``) from outside ``pkg``.  ``here`` is the importing package (read
+    from ``path`` when it lies in the package; the rules' self-tests pass it)."""
+    if here is None:
+        here = ".".join(path.relative_to(PKG.parent).with_suffix("").parts[:-1]) \
+            if path.is_relative_to(PKG.parent) else ""
     out = []
     for m in _imports(path):
         if not m.startswith("walkerlab."):
@@ -195,8 +217,8 @@ def _private_crossings(path: Path) -> list[str]:
         parts = m.split(".")
         for i, part in enumerate(parts):
             if part.startswith("_") and not part.startswith("__"):
-                owner = ".".join(parts[:i - 1]) if i == len(parts) - 1 else ".".join(parts[:i])
-                if not here.startswith(owner) or not owner:
+                owner = _private_owner(parts, i)
+                if not owner or not (here == owner or here.startswith(owner + ".")):
                     out.append(m)
                 break
     return out
@@ -209,9 +231,135 @@ def test_the_private_name_rule_catches_a_crossing(tmp_path):
     assert len(_private_crossings(bad)) == 2
 
 
+def test_the_private_name_rule_knows_a_package_from_a_module(tmp_path):
+    """A private module named in ``from pkg import _mod`` belongs to ``pkg``, not to
+    ``pkg``'s parent: imported from a sibling package it crosses (the owner read as the
+    parent let ``analysis/contact`` take ``integrate._cyrk``); a private name of a module is
+    owned by that module's package, and its subpackages may use it."""
+    f = tmp_path / "x.py"
+    f.write_text("from walkerlab.integrate import _compiled\n"
+                 "import walkerlab.integrate._compiled\n"
+                 "from walkerlab.integrate.rigid import _helper\n")
+    assert len(_private_crossings(f, here="walkerlab.analysis.contact")) == 3
+    assert _private_crossings(f, here="walkerlab.integrate") == []
+    assert _private_crossings(f, here="walkerlab.integrate.sub") == []
+    # a package whose name only begins like the owner's is another package
+    assert len(_private_crossings(f, here="walkerlab.integrate_x")) == 3
+
+
 def test_no_private_names_cross_packages():
     bad = {_rel(p): v for p in _modules() if (v := _private_crossings(p))}
     assert not bad, bad
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(PKG.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _import_graph(paths: dict[str, Path]) -> dict[str, set[str]]:
+    """``{module: the modules of paths it imports}``: ``from pkg import name`` is an arrow to
+    ``pkg.name`` when that is a module, else to ``pkg``; a package's ``__init__`` is a
+    module like any other (importing ``pkg.mod`` runs it, but that is no arrow of the
+    importer's making)."""
+    def resolve(name: str) -> str | None:
+        parts = name.split(".")
+        for i in range(len(parts), 0, -1):
+            if (c := ".".join(parts[:i])) in paths:
+                return c
+        return None
+
+    graph = {}
+    for mod, path in paths.items():
+        tree = _tree(path)
+        pkg = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
+        out = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                out |= {resolve(a.name) for a in node.names}
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    parts = pkg.split(".")[:len(pkg.split(".")) - node.level + 1]
+                    base = ".".join(parts + ([base] if base else []))
+                out |= {resolve(f"{base}.{a.name}") if f"{base}.{a.name}" in paths
+                        else resolve(base) for a in node.names}
+        graph[mod] = out - {None, mod}
+    return graph
+
+
+def _circles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan, iterative)."""
+    index, low, on, stack, out, n = {}, {}, set(), [], [], 0
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = n
+        n += 1
+        stack.append(root)
+        on.add(root)
+        while work:
+            v, it = work[-1]
+            w = next(it, None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = n
+                    n += 1
+                    stack.append(w)
+                    on.add(w)
+                    work.append((w, iter(sorted(graph.get(w, ())))))
+                elif w in on:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                comp = []
+                while True:
+                    w = stack.pop()
+                    on.discard(w)
+                    comp.append(w)
+                    if w == v:
+                        break
+                if len(comp) > 1:
+                    out.append(sorted(comp))
+    return out
+
+
+def test_the_circle_rule_sees_a_circle_closed_inside_a_function(tmp_path):
+    """A circle closed by an import inside a function, a relative import or ``from pkg
+    import mod`` is found; a package's ``__init__`` importing its own module is no circle
+    with that module's import of a sibling."""
+    pkg = tmp_path / "walkerlab" / "fam"
+    pkg.mkdir(parents=True)
+    files = {"walkerlab.fam": "from . import base\n",
+             "walkerlab.fam.base": "import numpy\n",
+             "walkerlab.fam.dispatch": "def f():\n    from walkerlab.fam.one import g\n",
+             "walkerlab.fam.one": "from .two import h\n",
+             "walkerlab.fam.two": "def h():\n    from walkerlab.fam import dispatch\n",
+             "walkerlab.fam.solo": "from walkerlab.fam import base\n"}
+    paths = {}
+    for mod, text in files.items():
+        parts = mod.split(".")[1:]
+        p = (tmp_path.joinpath("walkerlab", *parts, "__init__.py") if mod == "walkerlab.fam"
+             else tmp_path.joinpath("walkerlab", *parts).with_suffix(".py"))
+        p.write_text(text)
+        paths[mod] = p
+    graph = _import_graph(paths)
+    assert graph["walkerlab.fam.two"] == {"walkerlab.fam.dispatch"}
+    assert graph["walkerlab.fam.solo"] == {"walkerlab.fam.base"}
+    assert _circles(graph) == [["walkerlab.fam.dispatch", "walkerlab.fam.one",
+                                "walkerlab.fam.two"]]
+
+
+def test_no_import_circles():
+    """Dependencies point one way: no two walkerlab modules need each other, directly or
+    through others, at module level or inside functions (a dispatcher imports its
+    families; the helpers the families share live in a module of their own)."""
+    paths = {_module_name(p): p for p in _modules()}
+    assert _circles(_import_graph(paths)) == []
 
 
 def test_one_finite_difference_jacobian():
@@ -232,6 +380,41 @@ def test_no_issue_numbers_in_package_docstrings():
     bad = [f"{_rel(p)}:{n}" for p in _modules()
            for n, line in enumerate(p.read_text().splitlines(), 1)
            if re.search(r"\b[Ii]ssues? \d+", line)]
+    assert not bad, bad
+
+
+#: a reference to something outside the project: a notes file, a path that climbs out of
+#: the tree (``../``, not an ellipsis ``.../``), or an absolute path of a machine
+OUTSIDE = r"NOTES\.md|(?<!\.)\.\./|\bshared/|(?<![\w./-])/(?:work|home|root|tmp|Users)/"
+
+
+def _outside_references(paths) -> list[str]:
+    import re
+
+    return [f"{p}:{n}" for p in paths
+            for n, line in enumerate(p.read_text(errors="replace").splitlines(), 1)
+            if re.search(OUTSIDE, line)]
+
+
+def test_the_outside_reference_rule_catches_each_kind(tmp_path):
+    cases = ["(NOTES.md)", "see ../shared/NOTES.md", "bench, /work/notes/s3.md",
+             "a copy in shared/", "cached in /tmp/x", "/home/me/paper.pdf"]
+    fine = ["``ledger/work/<name>``", "<tendon tendon1=.../>", "scripts/bench_mfpt.py",
+            "MSC Adams/Solver function reference, IMPACT"]
+    for k, text in enumerate(cases + fine):
+        (tmp_path / f"{k}.py").write_text(f'"""{text}"""\n')
+    got = {int(Path(r.split(":")[0]).stem) for r in
+           _outside_references(sorted(tmp_path.glob("*.py")))}
+    assert got == set(range(len(cases)))
+
+
+def test_the_package_points_at_nothing_outside_the_project():
+    """Docstrings and comments cite the paper, an equation or a file of the project: a notes
+    file or a path outside the tree means nothing to a reader of the package."""
+    files = [p for p in sorted(PKG.rglob("*")) if p.is_file() and "__pycache__" not in p.parts
+             and p.suffix in (".py", ".md", ".txt", ".yaml", ".json", ".html", ".j2")]
+    assert len(files) > 100
+    bad = _outside_references(files)
     assert not bad, bad
 
 

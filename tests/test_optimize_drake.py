@@ -2,7 +2,7 @@
 RobotLocomotion/drake example, an independent implementation): at Drake's default
 parameters (hip 10 kg, legs 5 kg with the mass at 0.5 m, length 1 m, slope 0.0525 rad,
 g 9.81 - configs/compass_optimal.yaml is the same walker) the least-effort gait by
-collocation is Drake's limit cycle.  Skipped without pydrake (an optional dev extra)."""
+collocation is Drake's limit cycle.  Skipped without pydrake (the engines extra)."""
 
 from __future__ import annotations
 

@@ -7,12 +7,12 @@ function whose frame lands exactly on a chunk boundary therefore maps and unmaps
 every call.  ``scipy.optimize``'s first import runs ``scipy.special``'s module-level loops
 about 60 frames below the importer (nested imports), so whether it churns depends on how
 deep the first importer sits: from ``walkerlab fixedpoint``'s root finder it did,
-~8,000 ``mmap``/``munmap`` pairs and +50 ms of system time per process, and the count moved
+~8,000 ``mmap``/``munmap`` pairs per process, and the count moved
 with every frame added or removed anywhere between the CLI and the solver.
 
 :func:`import_on_fresh_stack` imports the module in a short-lived thread, whose data stack
-starts empty, so the cost of the import no longer depends on the caller's depth (a thread
-start, ~0.1 ms).  Python's import lock makes this an ordinary import: the module lands in
+starts empty, so the cost of the import no longer depends on the caller's depth (for the
+cost of a thread start).  Python's import lock makes this an ordinary import: the module lands in
 ``sys.modules`` for every thread, and an error raised by the import (ImportError or any
 error of the module's own code) is raised again in the caller.  The thread body calls
 ``__import__`` directly: the frames between the thread's start and the import are fixed

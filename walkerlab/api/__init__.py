@@ -22,7 +22,7 @@ walker in memory, its map, Jacobian, fixed point and walks, no artifact; and
 :func:`target`: the field value whose gait meets a target speed, step length or period, in
 memory as ``walkerlab target``); this module only gathers their public names.
 
-Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
+Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``test`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what
 it uses.
 

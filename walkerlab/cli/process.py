@@ -38,8 +38,8 @@ def single_threaded_blas() -> None:
     """Ask OpenBLAS for one thread unless the user chose a number (``OPENBLAS_NUM_THREADS``).
 
     walkerlab's matrices have at most a few dozen rows, which OpenBLAS never splits across
-    threads, but starting the thread pools of numpy's and scipy's OpenBLAS costs every
-    command ~50-100 ms of start-up on the 2-core machine (3 OS threads -> 1).  Must
+    threads, but starting the thread pools of numpy's and scipy's OpenBLAS adds to every
+    command's start-up (3 OS threads -> 1).  Must
     run before numpy is imported; worker processes (sweeps, basin) inherit it, as the
     work-precision workers already set it for themselves.
     """
@@ -108,10 +108,10 @@ def no_collection_at_exit() -> None:
     object into the garbage collector's permanent generation (``gc.freeze``) and the
     collector off.  The interpreter's shutdown then frees what reference counting frees
     and no longer walks the objects of numba, scipy, sympy and matplotlib in its
-    collections: measured ~0.4 s of a warm ``walkerlab contact-sim`` (2.2 -> 1.5 s wall)
-    and ~0.8 s of a cold first ``walkerlab report``.  Nothing is lost: the command's files
-    are written and closed before its exit functions run, and Python runs no finaliser
-    of a reference cycle at shutdown for certain anyway."""
+    collections (``walkerlab bench main-job`` times the commands it shortens: a warm
+    ``walkerlab contact-sim``, a cold first ``walkerlab report``).  Nothing is lost: the
+    command's files are written and closed before its exit functions run, and Python runs
+    no finaliser of a reference cycle at shutdown for certain anyway."""
     import gc
 
     gc.disable()

@@ -166,8 +166,8 @@ def generate_actuated(eq, param_names, joints, key: str) -> str:
     :func:`walkerlab.codegen.source.generate_compiled` does) and the right-hand sides
     ``flow`` (2n outputs) and ``flow_variational`` (``2n + (2n)^2``), and for a kneed walker
     ``flow_locked`` and ``flow_locked_variational`` (its swing knee locked), each made a
-    cfunc by ``cfunc_of(name)`` on first use (the five-link biped's variational cfunc takes
-    ~15 s to compile, its flow ~9 s).
+    cfunc by ``cfunc_of(name)`` on first use (the five-link biped's variational cfunc is
+    the longest to compile).
 
     Parameters
     ----------

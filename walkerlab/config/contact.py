@@ -8,8 +8,8 @@ this module imports no model (settings lie under the models, not beside them).
 Every dimensional number of :class:`ContactSettings` carries its unit in its name, in
 ADAMS's default mm-kg-s units (``stiffness_n_per_mm_pow_e``) or in SI
 (``stiffness_n_per_m_pow_e``); the contact model converts them to SI once per run
-(:func:`walkerlab.models.contact.laws.contact_params_si`; NOTES.md: "a wrong unit here changes the
-answer by 10^6").
+(:func:`walkerlab.models.contact.laws.contact_params_si`: ``k_SI = k_mm 1000^e``, so a
+stiffness read in the wrong system is off by ``1000^e``, ~4e6 for the paper's e = 2.2).
 """
 
 from __future__ import annotations
@@ -178,7 +178,8 @@ class ContactSettings(BaseModel):
     (:data:`CONTACT_QUANTITIES`; neither: the paper's value in mm-kg-s).  The contact model
     converts them to SI once per run (:func:`walkerlab.models.contact.laws.contact_params_si`).
     Defaults are the paper's values (k = 1e5, damping 90, mu_s = 0.9, mu_d = 0.7) read in
-    mm-kg-s, with the ADAMS View defaults for the rest (NOTES.md).
+    mm-kg-s, with the Adams/View contact defaults for the rest (exponent 2.2, penetration
+    depth 0.1 mm, stiction and friction transition velocities 100 and 1000 mm/s).
     """
 
     model_config = _STRICT

@@ -156,11 +156,16 @@ class DaskExecutor(_Context):
     ------
     walkerlab.execution.dask.DaskLost
         The address is not one, or the scheduler cannot be reached (one line).
+    walkerlab.extras.MissingExtra
+        Dask is not installed (one line naming the ``dask`` extra).
     """
 
     slots = None
 
     def __init__(self, scheduler):
+        from walkerlab.extras import require
+
+        require("distributed", "dask", "--scheduler")
         from walkerlab.execution.dask import connect, quiet_distributed
 
         self._own = isinstance(scheduler, str)

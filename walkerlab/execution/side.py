@@ -10,7 +10,7 @@ kernels into the user cache while the rigid stages run here, and draws half of t
   dies), and never with fewer than two cores, nor (``idle_only``) when the cores are busy
   (:func:`spare_core`: the load average of the last minute and the tasks running now both
   at least the number of cores): there it would only take turns with this process, and a
-  second process costs CPU of its own (its imports, ~2-3 s on the report).
+  second process costs CPU of its own (its imports).
 - It ignores SIGINT: Ctrl-C reaches this process, which cancels what has not started and
   stops the task under way with SIGTERM (:meth:`~SideWorker.close` with ``cancel``; in the
   side process SIGTERM raises ``SystemExit``, so a file being written is removed, never

@@ -92,7 +92,8 @@ class MjcfScene:
 
 
 #: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot
-#: touches only its own lane (the paper's checkerboard, NOTES.md); continuous: both bits.
+#: touches only its own lane (the paper's checkerboard terrain, its Section 4); continuous:
+#: both bits.
 LANE_BITS = {"leg1": 2, "leg2": 4}
 
 

@@ -274,9 +274,12 @@ def walk(xml_path, t_final_s: float, min_air_s: float = 0.1) -> MujocoWalk:
     ------
     ValueError
         The file has no ``gait`` keyframe (exported without a scene).
+    walkerlab.extras.MissingExtra
+        MuJoCo is not installed (one line naming the ``engines`` extra).
     """
-    import mujoco
+    from walkerlab.extras import require
 
+    mujoco = require("mujoco", "engines", "walking an exported MJCF in MuJoCo")
     model = mujoco.MjModel.from_xml_path(str(xml_path))
     data = mujoco.MjData(model)
     key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, "gait")

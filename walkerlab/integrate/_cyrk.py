@@ -29,8 +29,8 @@ from walkerlab.codegen import pending
 
 __all__ = ["CYRK_METHODS", "solve_chunk"]
 
-#: walkerlab method name -> CyRK method name.  Only BDF pays on the contact walker (bench,
-#: /work/notes/s3-ccontact.md): CyRK's LSODA needs ~1.3x the RHS calls of numbalsoda's, its
+#: walkerlab method name -> CyRK method name.  Only BDF pays on the contact walker (RHS calls
+#: of ``walkerlab bench contact``): CyRK's LSODA needs ~1.3x the RHS calls of numbalsoda's, its
 #: Radau 3x, and the explicit pairs (RK45, DOP853) are held by stability at >= 40k calls
 #: for 5 strides whatever the tolerance (stance-contact eigenvalues ~ -3e3 1/s, impacts
 #: ~ -1e5 1/s).

@@ -41,8 +41,8 @@ def kernel():
 
 def _entry(kern, f, Y, D, dY, G) -> None:
     """Call the kernel; after its first compilation through the compiled entry point of its
-    one signature (the dispatcher's typing of a first-class function argument costs about
-    twice the call itself on a few hundred rows)."""
+    one signature (the dispatcher's typing of a first-class function argument costs more
+    than the call itself on a few hundred rows)."""
     ep = _ENTRY.get(id(kern))
     if ep is None:
         kern(f, Y, D, dY, G)

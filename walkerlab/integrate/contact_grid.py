@@ -11,9 +11,9 @@ this path).  ``"odeint"`` (scipy's LSODA through the Python right-hand side and 
 Jacobian) is the plain-library route, and the fallback when BDF stops on a force jump it
 cannot step over (a foot meeting the side of a patch below its top).
 
-Measured on the paper's walker (0.5 s from a mid-stance, rtol 1e-12, atol 1e-14, against
-Radau at rtol 1e-13): CyRK BDF's largest error 3.5e-10 m/s (5 000 RHS calls, ~5 ms), odeint
-1.8e-9 m/s (~15 000 Python calls, ~0.15-0.4 s).
+On the paper's walker (0.5 s from a mid-stance, rtol 1e-12, atol 1e-14, against Radau at
+rtol 1e-13): CyRK BDF's largest error 3.5e-10 m/s (5 000 RHS calls), odeint 1.8e-9 m/s
+(~15 000 Python calls); ``walkerlab bench contact`` times the methods.
 """
 
 from __future__ import annotations
@@ -25,13 +25,31 @@ from .ends import RunEnd
 from .events import odeint_grid
 from .solver import Solver
 
-__all__ = ["COMPILED_METHODS", "GRID_METHODS", "contact_grid"]
+__all__ = ["COMPILED_METHODS", "GRID_METHODS", "compile_rhs", "contact_grid"]
 
 #: methods that integrate the walker's compiled right-hand side (CyRK's, over the generated
 #: module's cfunc: ``kernels.build_cyrk``)
 COMPILED_METHODS = tuple(_cyrk.CYRK_METHODS)
 #: methods :func:`contact_grid` runs (compiled first).
 GRID_METHODS = (*COMPILED_METHODS, "odeint")
+
+
+def compile_rhs(kernels) -> int:
+    """Compile (or load from numba's on-disk cache) the cfunc of the compiled methods'
+    right-hand side, ``kernels.rhs_packed``, once per walker structure.
+
+    Parameters
+    ----------
+    kernels : module
+        The walker's generated kernels
+        (:func:`walkerlab.models.contact.generated.contact_module`).
+
+    Returns
+    -------
+    int
+        The cfunc's C address.
+    """
+    return _cyrk.address(kernels)
 
 
 def contact_grid(walker, x0, t_grid, solver: Solver, data: np.ndarray | None = None

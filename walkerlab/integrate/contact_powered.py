@@ -130,7 +130,7 @@ def powered_atol(walker, atol: float):
     acts = walker.actuators
     if getattr(acts, "foot", None) is None or acts.ankle is not None:
         return atol
-    from .contact import run_atol
+    from .contact_events import run_atol
 
     return np.concatenate([run_atol(walker, atol, "LSODA"),
                            np.full(len(acts.work_names), float(atol))])
@@ -274,7 +274,7 @@ def run_powered(walker, x0, t0, t1, solver, limits, deadline, stop):
         :func:`walkerlab.integrate.contact.integrate_contact`'s free run, plus ``work``
         (n, 4) [J], the integrals of ``walker.actuators.work_names`` at the samples.
     """
-    from .contact import first_event, sample_grid
+    from .contact_events import first_event, sample_grid
 
     run = _PoweredRun(walker, solver, limits, deadline, sample_grid(t0, t1, limits.sample_rate_hz))
     run.go(x0, t0, t1, stop)
@@ -318,7 +318,7 @@ class _PoweredRun:
             self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
             return None
         except _Stall as stall:
-            from .contact import trip_or_failure
+            from .contact_events import trip_or_failure
 
             n2 = 2 * self.walker.nq  # the walker's state, without the work integrals
             state = np.asarray(stall.args[0])[:n2]
@@ -490,7 +490,7 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
         (``t_e``, ``x_e`` then where the run stopped), or ``NO_HEEL_STRIKE`` when neither a
         heel strike and the section came within ``t_max``.
     """
-    from .contact import ContactLimits
+    from .contact_events import ContactLimits
 
     limits = ContactLimits(fall_hip_height_m=fall_hip_height_m)
     run = _PoweredRun(walker, solver, limits, deadline, np.array([0.0, t_max]))
@@ -595,7 +595,7 @@ def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.in
         After the pulse (``T_FINAL``), or where a fall, the deadline or a solver failure
         stopped it.
     """
-    from .contact import ContactLimits
+    from .contact_events import ContactLimits
 
     acts = walker.actuators
     x = np.asarray(x, float)

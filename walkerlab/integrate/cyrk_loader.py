@@ -1,12 +1,11 @@
 """CyRK's ``pysolve_ivp`` without numba: a workaround of an eager import in ``CyRK/__init__.py``.
 
 ``import CyRK`` (0.20) imports its numba solvers (``CyRK.nb.nbrk``, ``CyRK.nb.numba_solver``)
-and so numba and llvmlite, about 180 modules and 0.25-0.5 s of start-up on the 2-core
-machine, although walkerlab's rigid-walker integration only calls ``pysolve_ivp``, which
-lives in the compiled extension ``CyRK.cy.pysolver`` and needs no numba.  Python runs a
-package's ``__init__`` before any of its submodules, so :func:`pysolve_ivp` does what
-``CyRK/__init__.py`` does for that one function, with the package module created but not yet
-executed:
+and so numba and llvmlite, about 180 modules of start-up, although walkerlab's
+rigid-walker integration only calls ``pysolve_ivp``, which lives in the compiled extension
+``CyRK.cy.pysolver`` and needs no numba.  Python runs a package's ``__init__`` before any of
+its submodules, so :func:`pysolve_ivp` does what ``CyRK/__init__.py`` does for that one
+function, with the package module created but not yet executed:
 
 1. ``sys.modules["CyRK"]`` = the package module from its import spec, not executed;
 2. CyRK's own CPU check (``CyRK._cpu_check.check_cpu``: the wheels are built for AVX2; a
@@ -21,9 +20,9 @@ sees the complete package, numba solvers included, with ``CyRK.cy`` the modules 
 loaded (a compiled module cannot be loaded twice, so the package must not be re-created).
 If ``CyRK`` is already imported, or any step of the shortcut fails (a CyRK release that moved
 these modules), the plain ``from CyRK import pysolve_ivp`` is used: the shortcut can only
-cost speed, never correctness.  Measured (whole ``walkerlab fixedpoint --force``
-process, paired with the plain import): 1068 -> 859 modules, peak memory 162 -> 104 MiB,
-14-20 % less CPU.  No upstream issue found; remove this module when CyRK imports its numba
+cost speed, never correctness.  A whole ``walkerlab fixedpoint --force`` process, paired
+with the plain import: 1068 -> 859 modules, peak memory 162 -> 104 MiB.  No upstream issue
+found; remove this module when CyRK imports its numba
 solvers lazily.
 """
 

@@ -12,7 +12,7 @@ instead of scipy's integrators, so every integration goes through this package w
   ``CyRK.pysolve_ivp`` instead (the same methods - Radau, BDF, LSODA, the Runge-Kutta
   pairs - ported to C++, events located like scipy's by Brent's method on the dense
   output), which calls the Python right-hand side from its C++ loop: on the drop test's
-  Radau ~30x less CPU than scipy's Python loop, the same steps to ~1e-11 relative;
+  Radau the same steps as scipy's Python loop to ~1e-11 relative;
 - :func:`odeint_grid`: ``scipy.integrate.odeint`` (LSODA with little per-step overhead) on a
   time grid.
 """

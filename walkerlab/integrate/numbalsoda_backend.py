@@ -21,8 +21,8 @@ def _load_driver():
     """numbalsoda's LSODA driver module, or None when the package is not installed.
 
     Loaded from its file, not through ``import numbalsoda``: the package's ``__init__`` also
-    imports its DOP853 ``solve_ivp`` driver, which compiles eagerly (~7 s per process on the
-    2-core machine), and only the LSODA driver (its ctypes entry point ``lsoda_wrapper`` and
+    imports its DOP853 ``solve_ivp`` driver, which compiles eagerly in every process, and
+    only the LSODA driver (its ctypes entry point ``lsoda_wrapper`` and
     the cfunc signature ``lsoda_sig``) is used here.
     """
     import importlib.util

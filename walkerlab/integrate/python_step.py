@@ -10,7 +10,8 @@ interface as the batched map (``step(X, gamma, drop_m) -> BatchStep``, ``walker`
 ``slope_rad``), so the gait sensitivity norm, the largest step-down/up and push
 (:mod:`walkerlab.analysis.robustness.measures`) and the Monte Carlo MFPT
 (:mod:`walkerlab.analysis.robustness.mfpt`)
-run on it unchanged, about 10-40 ms per step instead of a fraction of a millisecond.
+run on it unchanged, at the cost of a Python right-hand side per step
+(``scripts/bench_mfpt.py`` times the compiled map).
 
 A step-down of height ``drop`` [m] at the footfall: every heel-strike guard ``g`` (the swing
 heel's height above the slope line through the stance foot) becomes ``g + drop`` with the same

@@ -9,14 +9,13 @@ Integrators come from libraries, chosen by :class:`~walkerlab.integrate.solver.S
   scipy - RK23, RK45, DOP853 - with the adaptive stepping written in C++).  Guards are its
   events, located like scipy's by Brent's method on the dense output (xtol = 4 eps).
   On the compass gait it takes exactly scipy's steps (same time and state at heel strike to
-  round-off) 25-60 times faster: ``scripts/bench_integrators.py`` (its docstring gives the
-  measurements).
+  round-off) with the stepping in C++: ``scripts/bench_integrators.py`` times both.
 - ``"cyrk_compiled"``: the same CyRK pairs with the phase's flow (and variational equations)
   compiled by numba (:mod:`walkerlab.codegen.compiled`, cached on disk), so each phase runs in
   C++ without Python callbacks; guards are located on the step points and by Brent's method
-  on the dense output (:mod:`walkerlab.integrate._compiled`).  Imports numba (about 1 s per
-  process): meant for many-point studies.  A phase without a compiled flow (a replaced flow)
-  falls back to ``cyrk``.
+  on the dense output (:mod:`walkerlab.integrate._compiled`).  Imports numba (a start-up
+  cost in every process): meant for many-point studies.  A phase without a compiled flow
+  (a replaced flow) falls back to ``cyrk``.
 - ``"auto"`` (default): ``cyrk`` for the methods it shares with scipy when it is installed,
   else ``scipy``.
 """

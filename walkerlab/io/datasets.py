@@ -55,17 +55,14 @@ def xarray():
 
     Raises
     ------
-    ImportError
-        xarray or h5netcdf is not installed (the message names the missing one and how to
-        install it).
+    walkerlab.extras.MissingExtra
+        xarray or h5netcdf is not installed (an ImportError; one line naming the missing one
+        and the ``api`` extra).
     """
-    try:
-        import h5netcdf  # noqa: F401
-        import xarray as xr
-    except ImportError as exc:  # pragma: no cover - dev installs have both
-        raise ImportError(f"walkerlab's Python API needs xarray and h5netcdf ({exc.name} is "
-                          "missing): pip install 'walkerlab[api]'") from None
-    return xr
+    from walkerlab.extras import require
+
+    require("h5netcdf", "api", "walkerlab's Python API")
+    return require("xarray", "api", "walkerlab's Python API")
 
 
 def _prefix(group: str) -> str:
@@ -242,6 +239,7 @@ def load_dataset(path: str | Path):
     stage = _stage(path)
     with h5py.File(path, "r") as f:
         attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+    xarray()  # both installed, or one line naming the extra
     import h5netcdf
 
     with h5netcdf.File(path, "r") as nc:

@@ -137,7 +137,7 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     """
     from walkerlab.optimal.phased_collocation import phase_torque_of_time
 
-    # a powered run is on a Python RHS (a flat-footed walker's stride: ~7 s CPU), so the
+    # a powered run is on a Python RHS (slow on a flat-footed walker's stride), so the
     # wall-time limit is set for a loaded machine, not the contact-sim default (120 s)
     setup, why = _powered_setup(scene, {"torques": [{"joint": "hip", "law": {}}]},
                                 {"n_strides": strides, "sample_rate_hz": 500,

@@ -104,7 +104,7 @@ def _source_hash() -> str:
 
 def five_link_functions(structure) -> dict:
     """The step's CasADi functions of a free-jointed biped (module docstring), from the
-    memo, the disk cache, or derived (sympy, ~2 s) and written there.
+    memo, the disk cache, or derived (sympy) and written there.
 
     Parameters
     ----------

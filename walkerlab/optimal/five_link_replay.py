@@ -116,8 +116,8 @@ def rigid_actuators(data):
 
 def replay_solver():
     """The replay's integrator: DOP853 at rtol = atol = 1e-12 on CyRK with the compiled
-    flows of :func:`phased_walker` (the law in the cfunc; ~25 ms a step map where scipy's
-    LSODA with the law as a Python callback took ~2.5 s)."""
+    flows of :func:`phased_walker` (the law in the cfunc, not a Python callback of
+    scipy's LSODA)."""
     from walkerlab.integrate.solver import Solver
 
     return Solver(method="DOP853", rtol=1e-12, atol=1e-12, backend="cyrk_compiled")
@@ -133,7 +133,7 @@ def replay_phase_law(data, t, x, u, law: PhaseLaw, close: bool = True,
     ~1e-12), its fixed point solved by MINPACK's hybrj (``scipy.optimize.root``) from the
     collocated start with that Jacobian; the multipliers are the eigenvalues of the forward
     differences at the closed start (at the collocated one when not closed).  ~25 step
-    maps closed (~25 ms CPU each on the compiled flows), 11 not.
+    maps closed (on the compiled flows), 11 not.
 
     Parameters
     ----------

@@ -31,7 +31,7 @@ def optimize_five_link_scene(scene):
         ``phase_replays`` the phase-variable laws' rigid replays (``feedback``: closed,
         ``feedforward``: from the collocated start) and ``contact_step_period_s`` the
         contact model's under the feedback law (~35 rigid step maps on the compiled flows,
-        ~3 s CPU, and 2 contact strides, ~10 s).
+        and 2 contact strides).
 
     Raises
     ------
@@ -44,7 +44,7 @@ def optimize_five_link_scene(scene):
     from walkerlab.optimal.five_link import JOINTS, five_link_functions
     from walkerlab.optimal.five_link_collocation import collocate_five_link, replay_five_link
     from walkerlab.optimal.five_link_shooting import close_step
-    from walkerlab.optimal.scene import step_record
+    from walkerlab.optimal.records import step_record
     from walkerlab.walker.description import walker_data
 
     o = scene.optimize

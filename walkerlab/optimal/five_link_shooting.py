@@ -133,8 +133,8 @@ def close_step(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> Clos
 
     z0 = np.concatenate([np.asarray(x, float)[0, :], [float(t[-1])]])
     open_loop = float(np.max(np.abs(fun(z0)[:n2])))
-    # hybrd: its own finite-difference Jacobian, then Broyden updates (one G costs ~1/30
-    # of its Jacobian by CVODES' sensitivities)
+    # hybrd: its own finite-difference Jacobian, then Broyden updates (one G costs a small
+    # part of its Jacobian by CVODES' sensitivities)
     sol = root(fun, z0, method="hybr", options={"xtol": 1e-12})
     zs = sol.x
     resid = float(np.max(np.abs(fun(zs))))

@@ -54,7 +54,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
         phase_torque_of_time,
         replay_phases,
     )
-    from walkerlab.optimal.scene import phase_replays, step_record
+    from walkerlab.optimal.records import phase_replays, step_record
     from walkerlab.optimal.step_cache import cached_mode_functions
 
     o = scene.optimize

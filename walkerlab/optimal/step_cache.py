@@ -3,7 +3,8 @@
 or flat-footed walker or of a stride (:func:`walkerlab.optimal.phases.mode_functions`) -
 built once per walker and cached on disk like the generated flows
 (:mod:`walkerlab.codegen.cache`), so a warm ``walkerlab optimize`` neither derives the
-walker symbolically (sympy, ~1-2 s) nor converts it to CasADi (flat feet: ~4 s).
+walker symbolically (sympy) nor converts it to CasADi (``walkerlab bench optimize`` times
+both runs, cold and warm).
 
 The functions have the walker's parameter values substituted (as the collocation builds
 them), so the cache file is keyed on the walker's structure (its generator's key) *and* its
@@ -147,7 +148,7 @@ def cached_step_functions(data) -> dict:
     from walkerlab.optimal import collocation
 
     def build():
-        from walkerlab.codegen import symbolic  # sympy: only on a miss (~0.5 s to import)
+        from walkerlab.codegen import symbolic  # sympy: only on a miss (a slow import)
 
         return collocation.step_functions(data, symbolic.derive(data.structure))
     return _cached(_key(data), build)

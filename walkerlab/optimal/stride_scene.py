@@ -167,7 +167,7 @@ def _unit(objective: str) -> str:
 def _record(scene, walker, res) -> dict:
     """IPOPT's history and the energies at the points, each step's from its own walker
     (leg B's step: the mirror's masses), as :class:`OptimizeData` keywords."""
-    from walkerlab.optimal.scene import step_record
+    from walkerlab.optimal.records import step_record
     from walkerlab.optimal.stride import step_of
 
     parts = [step_record(scene, w, step_of(res, k))

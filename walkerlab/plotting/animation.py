@@ -112,8 +112,8 @@ def gif_writer(fps: float, colours: int = 64):
     """matplotlib's Pillow (GIF) writer, mapping every frame onto one palette taken from the
     first frame (``colours`` entries, no dithering).
 
-    ``PillowWriter`` itself quantizes each frame separately (median cut), which costs ~60 ms
-    a frame and was most of the time of an animation; the frames here share their colours
+    ``PillowWriter`` itself quantizes each frame separately (median cut), which was most
+    of the time of an animation; the frames here share their colours
     (legs, ground, text), so one palette serves them all.
     """
     from io import BytesIO

@@ -14,9 +14,9 @@ A scene compares itself with this module when it says ``published: paper``
 from __future__ import annotations
 
 TITLE = "A Modeling Framework for Rigid Legs Passive Dynamic Biped Walkers in MSC ADAMS"
-# The copy of the paper this project holds (its text, shared with the project's notes) prints
-# the title, abstract, body and references but no authors, venue or year; its newest
-# references are from 2024.  Fill these in from the published version when known.
+# The paper's text this module was written from prints the title, abstract, body and
+# references but no authors, venue or year; its newest references are from 2024.  Fill
+# these in from the published version when known.
 AUTHORS: str | None = None
 VENUE: str | None = None
 YEAR: int | None = None

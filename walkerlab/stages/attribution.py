@@ -4,8 +4,8 @@ The contact-vs-rigid gap of the contact model's periodic gait split by cause (fr
 creep, compliance, residual), the energy per step by sink and the initial-rate adjustment's
 effect with whether the adjusted start lies in the rigid walker's basin
 (:mod:`walkerlab.analysis.contact.attribution`).  Reads ``fixedpoint.h5``; any walker with a
-``contact`` section.  Cost: about 17 s CPU on the paper scene (seven periodic-gait searches
-and three short runs), so ``walkerlab report`` runs it only with ``--full``.
+``contact`` section.  Cost: seven periodic-gait searches and three short runs, so
+``walkerlab report`` runs it only with ``--full``.
 Layout: :mod:`walkerlab.io.schemas.attribution`.
 """
 

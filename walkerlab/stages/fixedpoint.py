@@ -67,7 +67,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """Find the fixed point of the scene's equation variant.
 
     With ``compare_variants`` (the default) the other equation variants (printed Appendix A,
-    ...) of a compass gait compared with published numbers are solved too (~0.1 s), for the
+    ...) of a compass gait compared with published numbers are solved too, for the
     report's comparison with Eq. (11): ``walkerlab fixedpoint`` then writes the very artifact
     the report needs.  ``compare_variants=False`` reuses such an artifact (a superset).
     ``known`` (or the scene's ``fixedpoint.from``): a scene whose gait is carried to this

@@ -29,6 +29,19 @@ SECTIONS = ("walker", "slope", "ideal", "solver", "optimize", "contact", "terrai
             "contact_solver")
 
 
+def check(scene: Scene, **options) -> None:
+    """Refuse, before any upstream stage runs, an optimisation CasADi is missing for.
+
+    Raises
+    ------
+    walkerlab.extras.MissingExtra
+        CasADi is not installed (one line naming the ``optimize`` extra).
+    """
+    from walkerlab.extras import require
+
+    require("casadi", "optimize", "walkerlab optimize")
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:
     """Compute (or reuse) ``optimize.h5``.
 

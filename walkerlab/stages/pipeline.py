@@ -89,7 +89,7 @@ def report_plan(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order: each only when the scene has its
     sections (``fixedpoint`` also when ``simulate`` starts from the gait); the
     work-precision study (it times every solver setting: most of a cold report) and the
-    Section-5 attribution (~15-17 s CPU on the paper scene) only with ``full``."""
+    Section-5 attribution (seven periodic-gait searches) only with ``full``."""
     sim, contact, fp = (getattr(scene, s) is not None for s in ("simulate", "contact",
                                                                 "fixedpoint"))
     # a simulation that starts from the gait runs (and shows) the fixed point it starts from,

@@ -1,8 +1,8 @@
 """Many contact-model walks on rough ground, on local processes or Dask: Monte Carlo
 MFPT on per-step slopes and the largest single step-down / step-up by bisection.
 
-Each walk is one task (:func:`run_contact_walk`, a full contact simulation, 0.05-1 s per
-step) dealt out by :func:`walkerlab.execution.executor.run_each` on
+Each walk is one task (:func:`run_contact_walk`, a full contact simulation) dealt out by
+:func:`walkerlab.execution.executor.run_each` on
 :func:`walkerlab.studies.runner.sweep_executor` (this process, a local pool or a Dask cluster,
 unchanged).  The terrain of walk ``w`` is drawn from the same random stream as the rigid
 model's walk ``w`` (:func:`walkerlab.analysis.robustness.mfpt.draw_slopes`), turned into patch

@@ -595,8 +595,8 @@ def run_chunk(task: Task) -> list[dict]:
 def warm_up() -> None:
     """Import the root-finding and integration libraries once (called in fresh worker
     processes and in the forkserver), so that processes forked from the forkserver start
-    warm (scipy.optimize + CyRK cost ~0.5 s per process otherwise).  CyRK comes through
-    :mod:`walkerlab.integrate.cyrk_loader` (its ``pysolve_ivp`` without numba, ~0.2 s less);
+    warm (each would import scipy.optimize and CyRK otherwise).  CyRK comes through
+    :mod:`walkerlab.integrate.cyrk_loader` (its ``pysolve_ivp`` without numba);
     the model code is built per scene by the points themselves (cached on disk)."""
     try:
         import scipy.optimize  # noqa: F401
@@ -611,6 +611,6 @@ def warm_up() -> None:
         pass
     # the imported libraries' objects live as long as the process: keep the cyclic garbage
     # collector from traversing them again and again (a full collection over them made the
-    # first dozen 5-stride runs of a process ~1.8x slower; see `walkerlab bench ideal`)
+    # first dozen 5-stride runs of a process slower; `walkerlab bench ideal` times them)
     gc.collect()
     gc.freeze()

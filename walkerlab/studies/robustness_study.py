@@ -38,7 +38,8 @@ def scene_robustness(scene, x_star: np.ndarray, workers: int = 1, scheduler=None
     ValueError
         A walker no step map can carry (slope-relative coordinates, legs that differ; one
         line).  A walker without compiled flows (flat feet) runs on the row-by-row
-        :class:`~walkerlab.integrate.python_step.PythonStepMap` (~5-10 ms a step).
+        :class:`~walkerlab.integrate.python_step.PythonStepMap` (a Python right-hand
+        side: slower).
     """
     from walkerlab.analysis.gait.poincare import poincare_map
     from walkerlab.config import RobustnessSettings

@@ -31,8 +31,8 @@ Progress and robustness
   chunk is submitted when the previous one returns, with its continuation state, so
   continuation is unchanged while rows come back every few points (D12).  They are written
   to the file after the first piece and then at least every :data:`FLUSH_EVERY_S` seconds
-  (one HDF5 append of every column costs the main process ~25 ms of CPU, taken from the
-  workers on a 2-core machine), and on an interruption.
+  (one HDF5 append of every column costs the main process CPU, taken from the workers
+  on a 2-core machine), and on an interruption.
 - Local pool workers watch the main process and exit within about a second when it dies,
   even by SIGKILL (D7); the forkserver and resource tracker then exit on their own (one
   mechanism for every pool of walkerlab: :mod:`walkerlab.execution.workers`).

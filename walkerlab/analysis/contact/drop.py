@@ -9,11 +9,11 @@ fixed) and in the rigid-limit family (:mod:`walkerlab.models.contact.rigid_limit
 
 Each drop integrates on CyRK's Radau (``CyRK.pysolve_ivp``: scipy's Radau IIA ported to
 C++, the separation located as an event) with a plain-Python right-hand side
-(:func:`walkerlab.models.contact.laws.impact_normal_force_scalar`): ~5 ms of CPU per drop
-where scipy's Radau took ~0.1 s, the restitutions within ~1e-11 relative of scipy's
-(rtol 1e-10).  A drop is computed once per contact law, mass, speed, gravity and tolerance
-and kept in the private user cache (``drop/<key>.json``; the key also hashes the sources
-that decide the numbers and the installed CyRK); a damaged or foreign entry is a miss.
+(:func:`walkerlab.models.contact.laws.impact_normal_force_scalar`), its restitutions within
+~1e-11 relative of scipy's Radau (rtol 1e-10).  A drop is computed once per contact law,
+mass, speed, gravity and tolerance and kept in the private user cache (``drop/<key>.json``;
+the key also hashes the sources that decide the numbers and the installed CyRK); a damaged
+or foreign entry is a miss.
 """
 
 from __future__ import annotations
@@ -76,7 +76,7 @@ _SOURCES = ("analysis/contact/drop.py", "models/contact/laws.py", "integrate/eve
 @lru_cache(maxsize=1)
 def _code_version() -> bytes:
     """The installed CyRK integrator (its compiled solver module's name, size and time: a
-    stat, where CyRK's version string costs ~45 ms of package metadata and
+    stat, where CyRK's version string reads the package metadata and
     ``CyRK.__version__`` imports numba) and the deciding sources (read once per process)."""
     import importlib.util
 

@@ -212,7 +212,7 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
     solver : walkerlab.integrate.solver.Solver
         The map's integrator while root finding (:data:`MAP_SOLVER`: ``"cyrk_bdf"``, CyRK's
         BDF over the compiled right-hand side with the section crossing found by brentq;
-        ``"odeint"`` the same through scipy's odeint and a Python RHS, 30-80x slower;
+        ``"odeint"`` the same through scipy's odeint and a Python RHS;
         the ``solve_ivp`` methods "LSODA", "Radau", "BDF" locate it as an event).  A
         walker with hip torques defaults to :data:`POWERED_MAP_SOLVER` (its map is Python
         throughout).
@@ -224,9 +224,7 @@ def find_contact_periodic_gait(walker: ContactWalker, guess, *, rate_scale=(1.0,
         forward-difference Jacobian) run on the map at its tolerances; the final hybr
         solve at ``solver.rtol`` starts from that fixed point with
         its Jacobian (a Newton direction accurate to the FD step, ~1e-3), so it needs only
-        a few map evaluations at the tight tolerance.  Measured on the paper's contact
-        (odeint, median CPU per map): 31 ms at rtol 1e-10, 130 ms at 1e-11, 114 ms at 1e-12;
-        cyrk_bdf: ~3 ms at 1e-10, ~5 ms at 1e-12 (the whole search 0.4 s CPU).
+        a few map evaluations at the tight tolerance.
     patch_spacing : float, optional
         Swing-patch distance ahead of the stance foot [m]; default the walker's lane spacing.
     time_limit_s : float, optional

@@ -88,7 +88,7 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
 
 #: wall-time limit of one walk [s]: WALK_TIME_LIMIT_S + WALK_TIME_PER_STEP_S per step (a
 #: foot caught below a patch's top at its edge makes the stiff solver grind until the
-#: limit: that walk has tripped; a step takes ~0.05 s on a quiet core)
+#: limit: that walk has tripped; a walking step takes a small fraction of the limit)
 WALK_TIME_LIMIT_S = 10.0
 WALK_TIME_PER_STEP_S = 2.0
 

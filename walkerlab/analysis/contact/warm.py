@@ -78,9 +78,9 @@ def compile_rhs_kernels(setup: ContactSetup) -> bool:
     """
     if importlib.util.find_spec("numba") is None:
         return False
-    from walkerlab.integrate import _cyrk
+    from walkerlab.integrate.contact_grid import compile_rhs
     from walkerlab.models.contact.generated import contact_module
 
-    _cyrk.address(contact_module(setup.walker.structure))
+    compile_rhs(contact_module(setup.walker.structure))
     return True
 

@@ -29,31 +29,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.analysis.gait.ledger import LEDGER_NAMES, quad_work
 from walkerlab.analysis.gait.metrics import step_length
-from walkerlab.io.schemas.simulate import LEDGER_UNITS
 
-__all__ = ["LEDGER_NAMES", "gait_ledger", "gait_measures", "quad_work", "step_ledger",
-           "trajectory_ledger"]
-
-#: the ledger's columns, each (step,) (units: the artifact's, ``LEDGER_UNITS``)
-LEDGER_NAMES = tuple(LEDGER_UNITS)
-
-
-def quad_work(f, a: float, b: float, scale: float) -> float:
-    """``int_a^b f dt`` [J] by adaptive quadrature.  A kinked integrand (``max(p, 0)`` where
-    the power changes sign, a saturated torque law) can keep quad from certifying its 1e-12
-    tolerance (its IntegrationWarning); the value is kept: the ledger's ``closure``, an
-    independent check, states the accuracy actually reached."""
-    import warnings
-
-    from scipy.integrate import IntegrationWarning, quad
-
-    if b <= a:
-        return 0.0
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", IntegrationWarning)
-        val, _ = quad(f, a, b, limit=400, epsabs=1e-13 * scale, epsrel=1e-12)
-    return float(val)
+__all__ = ["gait_ledger", "gait_measures", "step_ledger", "trajectory_ledger"]
 
 
 def _damped(walker) -> bool:
@@ -93,7 +72,8 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     Returns
     -------
     dict[str, float]
-        :data:`LEDGER_NAMES` [J; ``push_off_impulse`` N s; ``cost_of_transport`` -].
+        :data:`walkerlab.analysis.gait.ledger.LEDGER_NAMES` [J; ``push_off_impulse`` N s;
+        ``cost_of_transport`` -].
     """
     out = dict.fromkeys(LEDGER_NAMES, np.nan)
     if seg.termination != "heel_strike":

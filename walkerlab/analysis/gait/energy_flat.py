@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.analysis.gait.energy import LEDGER_NAMES, quad_work
+from walkerlab.analysis.gait.ledger import LEDGER_NAMES, quad_work
 from walkerlab.analysis.gait.metrics import step_length
 
 __all__ = ["flat_step_ledger", "flat_trajectory_ledger"]
@@ -66,7 +66,7 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
     Returns
     -------
     dict[str, float]
-        :data:`~walkerlab.analysis.gait.energy.LEDGER_NAMES` [J; ``push_off_impulse`` N s;
+        :data:`~walkerlab.analysis.gait.ledger.LEDGER_NAMES` [J; ``push_off_impulse`` N s;
         ``cost_of_transport`` -].
     """
     out = dict.fromkeys(LEDGER_NAMES, np.nan)

@@ -29,9 +29,9 @@ from walkerlab.models.hybrid.base import HybridWalker
 from walkerlab.numerics import sort_multipliers
 
 #: longest CPU time of one search for a gait [s] (:func:`search_budget`; a fixed point, or
-#: every start of :func:`walkerlab.analysis.gait.search.find_gaits`): the shipped scenes need
-#: 0.1-3 s; a spring or damper at its cap (1e6) makes the integrator crawl (about 40 s per
-#: step map), and the search's starts and MINPACK's own cap of 200 (n + 1) maps would keep it
+#: every start of :func:`walkerlab.analysis.gait.search.find_gaits`): the shipped scenes
+#: need a small part of it; a spring or damper at its cap (1e6) makes the integrator crawl
+#: (stiff), and the search's starts and MINPACK's own cap of 200 (n + 1) maps would keep it
 #: busy, silent, for many minutes before it says "no gait found"
 ROOT_BUDGET_S = 60.0
 #: the budget's clock: this thread's CPU time, so that a loaded machine (other processes on

@@ -67,7 +67,7 @@ def check_walking_state(x, walker, scene: Scene) -> None:
     above ``g`` the stance foot would leave the ground, so a walking gait has rates of the
     order of ``sqrt(g/l)`` (paper walker: 3.1 rad/s; its fixed point 0.86 rad/s).  Rates above
     :data:`MAX_GUESS_RATE` ``sqrt(g/l)`` (or angles beyond pi) send the map's integration
-    into spinning legs (1e6 rad/s ran 74 s, then ``OverflowError``).
+    into spinning legs (1e6 rad/s: a long run, then ``OverflowError``).
 
     Raises
     ------

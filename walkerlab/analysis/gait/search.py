@@ -166,7 +166,7 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         Which gait to choose (:func:`select_gait`).
     other_gait : bool
         Also look for the other gait of the long/short-period pair (deflation; a few
-        root-finder runs, about 0.05-0.4 s).  Needed by the ``long_period``/``short_period``
+        root-finder runs).  Needed by the ``long_period``/``short_period``
         policies and by ``stable`` when the first gait found is unstable.
     xtol, fd_step, max_step_time, fd_check
         As :func:`walkerlab.analysis.gait.poincare.find_fixed_point`.

@@ -1,7 +1,7 @@
 """The per-walk slope streams of the Monte Carlo walks for many walks at once: the numbers of
 :func:`walkerlab.analysis.robustness.mfpt.draw_slopes` bit for bit, without a NumPy
-``SeedSequence`` per walk (its construction, ~28 µs a walk, was most of the per-walk cost
-outside the compiled walks).
+``SeedSequence`` per walk (its construction was most of the per-walk cost outside the
+compiled walks: ``scripts/bench_mfpt.py``).
 
 Walk ``w`` of seed ``s`` draws from ``Generator(PCG64(SeedSequence(s, spawn_key=(w,))))``.
 Here the ``SeedSequence`` hashing is done for all walks together on NumPy arrays: the entropy
@@ -11,7 +11,7 @@ expanded by ``generate_state(4, uint64)`` (NumPy's ``numpy/random/bit_generator.
 PCG64's state follows from those words by ``pcg_setseq_128_srandom_r`` (two steps of the
 128-bit LCG, in Python integers; NumPy's ``numpy/random/src/pcg64/pcg64.h``) and is set on
 one reused ``PCG64``, whose ``Generator`` draws the walk's numbers: the draws themselves are
-NumPy's (ziggurat normal, uniform), about 5 µs a walk in all.
+NumPy's (ziggurat normal, uniform).
 
 The tests compare :func:`slope_rows` with ``draw_slopes`` bit for bit (several seeds, walks,
 both distributions).

@@ -41,7 +41,7 @@ def total_energy(walker, X) -> np.ndarray:
 
     Elastic: ``k d^(e+1) / (e+1)`` of each foot on a patch with penetration ``d > 0``, and
     ``k_k x^(e_k+1) / (e_k+1)`` of each knee stop at hyperextension ``x > 0`` (the integral
-    of the IMPACT spring force ``k d^e``; MSC Adams/Solver IMPACT, NOTES.md).
+    of the IMPACT spring force ``k d^e``; MSC Adams/Solver function reference, IMPACT).
 
     Parameters
     ----------

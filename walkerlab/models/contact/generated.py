@@ -485,7 +485,7 @@ def rhs_source(eq) -> str:
     and material velocities, the contact forces and knee-stop torques from the laws, then
     ``M`` and ``Q - h`` (common subexpressions shared) and an unrolled Cholesky solve that
     skips the structural zeros of ``M`` (fill-in tracked).  Same equations as the array
-    functions ``dyn``/``feet`` (tests check the two agree), ~2x faster per call, which is
+    functions ``dyn``/``feet`` (tests check the two agree), cheaper per call, which is
     what CyRK's BDF pays per step.
 
     The generated ``rhs`` takes the state ``x`` of shape (2 nq,) [m, rad, m/s, rad/s], the

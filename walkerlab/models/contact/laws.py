@@ -12,7 +12,8 @@ Sources
 * MSC Adams/Solver function reference, ``STEP`` (cubic step) and ``IMPACT`` (one-sided
   spring-damper contact force); Adams/View contact dialog, Coulomb friction with stiction
   and friction transition velocities.
-* /work/shared/NOTES.md, section "The MSC ADAMS model", which restates these laws.
+* The paper's Section 4 (its ADAMS model: IMPACT contact with Coulomb friction on a
+  checkerboard terrain; :mod:`walkerlab.published.paper`).
 
 Scalar, numba-compiled twins of these functions live in :mod:`walkerlab.models.contact._kernels`;
 ``tests/contact/test_laws.py`` checks that both agree.
@@ -154,7 +155,7 @@ def adams_step(x, x0, h0, x1, h1):
 
     ``h0`` for ``x <= x0``, ``h1`` for ``x >= x1`` and
     ``h0 + (h1 - h0) * s**2 * (3 - 2*s)``, ``s = (x - x0) / (x1 - x0)``, in between
-    (MSC Adams/Solver function reference, STEP; NOTES.md).
+    (MSC Adams/Solver function reference, STEP).
 
     Parameters
     ----------
@@ -200,8 +201,8 @@ def impact_normal_force(delta, delta_dot, k, e, cmax, dmax):
     """ADAMS ``IMPACT`` normal contact force (never pulls).
 
     ``Fn = max(0, k * delta**e + STEP(delta, 0, 0, dmax, cmax) * delta_dot)`` for
-    ``delta > 0`` and ``Fn = 0`` otherwise (MSC Adams/Solver function reference, IMPACT;
-    NOTES.md).  The damping ramps in over the first ``dmax`` of penetration, so the force is
+    ``delta > 0`` and ``Fn = 0`` otherwise (MSC Adams/Solver function reference,
+    IMPACT).  The damping ramps in over the first ``dmax`` of penetration, so the force is
     continuous at touchdown.
 
     Parameters
@@ -263,7 +264,7 @@ def coulomb_friction_coefficient(v, mu_s, mu_d, v_s, v_d):
     * ``v_s <= |v| <= v_d``: ``mu = -sign(v) * STEP(|v|, v_s, mu_s, v_d, mu_d)``;
     * ``|v| > v_d``: ``mu = -sign(v) * mu_d``.
 
-    (Adams/View contact, Coulomb friction; NOTES.md.)  The friction force is
+    (Adams/View contact, Coulomb friction.)  The friction force is
     ``mu * Fn`` along the direction in which ``v`` is measured.
 
     Parameters

@@ -332,7 +332,7 @@ class ContactWalker:
         """IMPACT static penetration (F / k)^(1/e) [m] under ``load`` [N] (default M g cos phi).
 
         The damping-free equilibrium of :func:`~walkerlab.models.contact.laws.impact_normal_force`
-        (MSC Adams/Solver IMPACT; NOTES.md): ``k delta^e = F``.
+        (MSC Adams/Solver function reference, IMPACT): ``k delta^e = F``.
         """
         if load is None:
             load = self.total_mass * self.g * np.cos(self.phi)
@@ -638,8 +638,8 @@ class ContactWalker:
 
     def hip_height(self, X) -> np.ndarray:
         """Hip height above the ground line, hip . n [m], for X (n, 2 nq) -> (n,) (numpy: a
-        dot product is not worth a compiled kernel per walker structure, ~0.3 s of numba
-        compiling in a fresh user cache; the same operations as that kernel had)."""
+        dot product is not worth a compiled kernel per walker structure, compiled anew in
+        a fresh user cache; the same operations as that kernel had)."""
         X = self._rows(X)
         phi = float(self.contact_params[self.kernels.I_PHI])
         return X[:, 0] * math.sin(phi) + X[:, 1] * math.cos(phi)

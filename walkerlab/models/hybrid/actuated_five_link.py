@@ -100,7 +100,7 @@ class FiveLinkActuators:
         """``d(M^-1 B tau)/dx`` (n, 2n): :func:`walkerlab.models.hybrid.actuated.
         torque_chain_jacobian` with :attr:`torque_jacobian` set, else the complex step of
         :meth:`added_acceleration` (``constraint``: none on free joints, must be None)."""
-        from walkerlab.models.hybrid.actuated import torque_chain_jacobian
+        from walkerlab.models.hybrid.actuators import torque_chain_jacobian
 
         x = np.asarray(x, float)
         if self.torque_jacobian is None:

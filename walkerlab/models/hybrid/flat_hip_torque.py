@@ -52,7 +52,7 @@ def actuate_flat_hips(walker: HybridWalker, data, spec) -> HybridWalker:
         A torque on another joint or per foot mass, legs that differ (one line).
     """
     from walkerlab.codegen.cache import functions
-    from walkerlab.models.hybrid.actuated import Actuators
+    from walkerlab.models.hybrid.actuators import Actuators
     from walkerlab.models.hybrid.rigid_flat import make_flat_walker
 
     for i, t in enumerate(spec.torques):

@@ -1,0 +1,115 @@
+"""What a light install (``pip install -e .``) has and what it says: the main job's
+dependencies only, every optional part behind an extra named by its purpose, and one line
+naming that extra when a command needs it and it is missing (``walkerlab optimize`` without
+CasADi, ``--scheduler`` without Dask, an exported MJCF walked without MuJoCo).  The README's
+two commands: one installs the main job and runs it, one installs what the tests need and
+runs them, as CI does."""
+
+from __future__ import annotations
+
+import re
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from walkerlab.extras import EXTRAS, MissingExtra, require
+
+ROOT = Path(__file__).resolve().parents[1]
+PROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+#: distributions a light install must not pull in (the optional parts' heavy ones)
+HEAVY = ("casadi", "dask", "distributed", "mujoco", "pin", "drake", "xarray", "h5netcdf",
+         "nbclient", "nbformat", "ipykernel", "jupyter", "pytest", "numbalsoda")
+
+
+def _name(req: str) -> str:
+    return re.split(r"[\s<>=!~;\[]", req, maxsplit=1)[0].lower()
+
+
+def _commands(text: str) -> list[str]:
+    return re.findall(r"```bash\n(.*?)\n```", text, re.S)
+
+
+def test_the_main_install_has_none_of_the_optional_parts():
+    deps = {_name(r) for r in PROJECT["dependencies"]}
+    assert deps and not deps & set(HEAVY), deps & set(HEAVY)
+
+
+def test_every_extra_is_named_by_its_purpose_and_the_tests_get_all_but_numbalsoda():
+    extras = PROJECT["optional-dependencies"]
+    assert set(extras) == set(EXTRAS) | {"test"}
+    test = set(extras["test"])
+    for name, reqs in extras.items():
+        if name not in ("test", "numbalsoda"):
+            assert set(reqs) <= test, (name, set(reqs) - test)
+    assert {_name(r) for r in extras["test"]} >= {"pytest", "pytest-xdist"}
+
+
+def test_the_readme_installs_the_main_job_then_the_tests_and_ci_runs_that_command():
+    readme = (ROOT / "README.md").read_text()
+    first, second = _commands(readme)[:2]
+    assert first.endswith("pip install -e . && walkerlab report"), first
+    assert second.endswith("pip install -e '.[test]' && pytest"), second
+    ci = (ROOT / ".ci" / "run").read_text()
+    assert second in ci.splitlines(), "CI runs the README's test command"
+    for name in EXTRAS:  # each extra is listed for what it does
+        assert f"| `{name}` |" in readme, name
+
+
+def test_require_names_the_extra_in_one_line(monkeypatch):
+    monkeypatch.setitem(sys.modules, "casadi", None)  # as if not installed
+    with pytest.raises(MissingExtra) as exc:
+        require("casadi", "optimize", "walkerlab optimize")
+    msg = str(exc.value)
+    assert msg == ("walkerlab optimize needs casadi (not installed): "
+                   "pip install 'walkerlab[optimize]'")
+    assert isinstance(exc.value, ValueError) and isinstance(exc.value, ImportError)
+    assert require("json", "optimize", "x") is sys.modules["json"]
+
+
+def test_walkerlab_optimize_without_casadi_says_so_before_any_stage_runs(monkeypatch,
+                                                                         tmp_path):
+    from walkerlab.cli import app
+
+    monkeypatch.setitem(sys.modules, "casadi", None)
+    r = CliRunner().invoke(app, ["optimize", str(ROOT / "configs" / "compass_optimal.yaml"),
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 1
+    assert r.stderr.strip() == ("error: walkerlab optimize needs casadi (not installed): "
+                                "pip install 'walkerlab[optimize]'")
+    assert not any(tmp_path.rglob("*.h5"))  # refused before the fixed point ran
+
+
+def test_a_scheduler_without_dask_says_which_extra(monkeypatch):
+    from walkerlab.execution.executor import make_executor
+
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    with pytest.raises(MissingExtra, match=r"^--scheduler needs distributed \(not "
+                       r"installed\): pip install 'walkerlab\[dask\]'$"):
+        make_executor(2, "tcp://127.0.0.1:8786")
+
+
+def test_walking_an_exported_mjcf_without_mujoco_says_which_extra(monkeypatch, tmp_path):
+    from walkerlab.export.mujoco_walk import walk
+
+    monkeypatch.setitem(sys.modules, "mujoco", None)
+    with pytest.raises(MissingExtra, match=r"pip install 'walkerlab\[engines\]'$"):
+        walk(tmp_path / "walker.xml", 1.0)
+
+
+def test_the_python_api_without_its_datasets_says_which_extra(monkeypatch, tmp_path):
+    """The API's artifact view needs xarray and h5netcdf: one line naming the missing one
+    (h5netcdf was imported bare before the check, so a light install saw its traceback)."""
+    from walkerlab.io.datasets import load_dataset
+
+    monkeypatch.setitem(sys.modules, "h5netcdf", None)
+    path = tmp_path / "fixedpoint.h5"
+    import h5py
+
+    with h5py.File(path, "w") as f:
+        f.attrs["stage"] = "fixedpoint"
+    with pytest.raises(MissingExtra, match=r"^walkerlab's Python API needs h5netcdf \(not "
+                       r"installed\): pip install 'walkerlab\[api\]'$"):
+        load_dataset(path)

@@ -1,0 +1,69 @@
+"""The optional parts of walkerlab, each an extra named by its purpose, and the one line a
+command says when the extra it needs is not installed.
+
+``pip install -e .`` installs the main job (fixed point, simulation, the contact model,
+the comparison, the report); ``pip install -e '.[test]'`` what the tests need (every extra
+below but ``numbalsoda``).  The extras are those of ``pyproject.toml``
+(``[project.optional-dependencies]``; a test checks the two agree).
+
+Imports nothing of walkerlab.
+"""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+
+__all__ = ["EXTRAS", "MissingExtra", "require"]
+
+#: extra -> what it is for (the commands and functions that need it)
+EXTRAS = {
+    "optimize": "walkerlab optimize: direct collocation with CasADi and IPOPT",
+    "dask": "--scheduler: studies on a Dask cluster",
+    "engines": "the exported models in other engines (MuJoCo, Pinocchio, Drake)",
+    "api": "the Python API's datasets (xarray, h5netcdf)",
+    "notebook": "examples/walkerlab_tour.ipynb (Jupyter)",
+    "numbalsoda": "contact_solver.method numbalsoda (builds with cmake, g++, gfortran)",
+}
+
+
+class MissingExtra(ValueError, ImportError):
+    """An optional dependency is not installed: one line naming the extra to install (a
+    ValueError, so a command prints it as its one-line error; an ImportError, as what it
+    is)."""
+
+
+def require(module: str, extra: str, what: str) -> ModuleType:
+    """Import ``module``, or say in one line which extra installs it.
+
+    Parameters
+    ----------
+    module : str
+        The importable name (``"casadi"``, ``"distributed"``, ``"mujoco"``).
+    extra : str
+        A key of :data:`EXTRAS`.
+    what : str
+        What needs it, as the user asked for it (``"walkerlab optimize"``,
+        ``"--scheduler"``).
+
+    Returns
+    -------
+    module
+        The imported module.
+
+    Raises
+    ------
+    MissingExtra
+        ``"<what> needs <module> (not installed): pip install 'walkerlab[<extra>]'"``; a
+        module that is installed but fails to import names that failure too.
+    KeyError
+        ``extra`` is not one of :data:`EXTRAS` (a programming error).
+    """
+    EXTRAS[extra]  # noqa: B018 - an unknown extra is a bug, not the user's
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        top = (exc.name or "").split(".")[0]
+        why = "not installed" if top == module.split(".")[0] else f"its import failed: {exc}"
+        raise MissingExtra(f"{what} needs {module} ({why}): pip install "
+                           f"'walkerlab[{extra}]'") from None

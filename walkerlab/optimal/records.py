@@ -1,0 +1,35 @@
+"""``optimize.h5``'s records of an optimised step that every transcription's scene driver
+writes the same way (:mod:`walkerlab.optimal.scene`, :mod:`walkerlab.optimal.phased_scene`,
+:mod:`walkerlab.optimal.stride_scene`, :mod:`walkerlab.optimal.five_link_scene`): the
+phase-variable replays and the solver's history with the walker's energies."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["phase_replays", "step_record"]
+
+
+def phase_replays(scene, data, res, tau) -> tuple[dict, str]:
+    """The phase-variable replays of the optimised step ``res`` (``tau``: its torque of
+    the time since the heel strike) as ``optimize.h5``'s records, and why there are none
+    (:func:`walkerlab.optimal.hip_phase_replay.hip_phase_records`, the scene's solver;
+    ``({}, "")`` unless ``optimize.phase_replay`` is on: off by default here)."""
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.hip_phase_replay import hip_phase_records
+
+    if not scene.optimize.phase_replay:  # None: off (a five-link biped's default is on)
+        return {}, ""
+    return hip_phase_records(data, res, tau, Solver.from_settings(scene.solver))
+
+
+def step_record(scene, walker, res) -> dict:
+    """IPOPT's iteration history and the walker's kinetic and potential energy at the
+    collocation points (``res``: a collocation result with ``x`` (2N + 1, 2n) in the
+    walker's state order and ``history``), as :class:`OptimizeData` keywords."""
+    from walkerlab.units import for_scene
+
+    ke, pe = walker.energies(np.asarray(res.x, float).T)
+    return {"ipopt_history": dict(res.history),
+            "energy": {"kinetic": np.asarray(ke, float), "potential": np.asarray(pe, float)},
+            "energy_unit": for_scene(scene).energy}
