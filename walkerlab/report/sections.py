@@ -91,13 +91,18 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     if c is not None:
         from walkerlab.integrate.ends import CONTACT_WALKED
 
-        walks = c.outcome in CONTACT_WALKED
+        # one verdict, from the steps (stored with the run); an older artifact: its outcome
+        walks = c.walks if c.walks is not None else c.outcome in CONTACT_WALKED
         extra = ""
         if c.periodic is not None and c.periodic.found:
             extra = ("; its own periodic gait is " + ("stable" if c.periodic.stable
                                                       else "unstable"))
+        elif c.periodic is not None:
+            extra = f"; its own periodic gait was not found ({c.periodic.outcome})"
+        why = f": {c.walks_reason}" if not walks and c.walks_reason else ""
         bullets.append(f"- **Contact walker walks**: {'yes' if walks else 'no'} "
-                       f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}){extra}.")
+                       f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}"
+                       f"{why}){extra}.")
     cols = inputs.gait_columns
     ideal = cols.get("ours, ideal")
     if ideal:
