@@ -16,7 +16,7 @@ from types import ModuleType
 import numpy as np
 
 from walkerlab.report.markdown import num, printed, sig_digits, table
-from walkerlab.report.text import zero_multipliers_text
+from walkerlab.report.text import ground_contact_text, zero_multipliers_text
 from walkerlab.units import Units, for_scene
 
 #: Table 3 rows (keys of :func:`walkerlab.comparison.tables.gait_metrics`): name, symbol, unit
@@ -65,6 +65,10 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
                        f"{num(fp.step_period_s)} {u.time}.")
         bullets.append(f"- **Stable**: {'yes' if fp.stable else 'no'} (largest "
                        f"|Floquet multiplier| {num(fp.max_abs_multiplier())}).")
+        g = getattr(fp, "ground_contact", None)
+        if g is not None:  # a gait that needs the ground to pull is no gait on real ground
+            bullets.append("- **Ground contact**: " + ground_contact_text(g, u).split(
+                ": ", 1)[1] + ".")
         eq = dict(zip(*published_fixed_point(pub)))
         for n, v, un in zip(fp.state_names, fp.x, fp.state_units):
             # as many digits as the published value has, so the two can be compared digit by digit
