@@ -611,15 +611,6 @@ class FloatingView:
         self._mod.feet(self._x(q, dq), self.params, P, V, J)
         return P, V, J
 
-    def contact_velocity_gradient(self, q, dq) -> np.ndarray:
-        """``d V_i / dq`` (nf, 2, nq): how each contact point's material velocity (at fixed
-        rates) changes with the coordinates [1/s]; ``(d V_i / dq) dq`` is the point's
-        acceleration at ``qdd = 0`` ([m/s^2], ``Jdot dq``)."""
-        nf = len(self.contact_names())
-        dV, dJtF = np.empty((nf, 2, self.nq)), np.empty((self.nq, self.nq))
-        self._mod.feet_jac(self._x(q, dq), np.zeros((nf, 2)), self.params, dV, dJtF)
-        return dV
-
     def energies(self, X) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic and potential energy [J] of states ``X`` (2 nq,) or (2 nq, k)."""
         return self._mod.energies(X, self.params)

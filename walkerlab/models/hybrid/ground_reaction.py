@@ -43,13 +43,58 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from walkerlab.codegen.floating import floating_view
+from walkerlab.codegen.floating import (
+    contact_names,
+    coordinate_names,
+    floating_module,
+    floating_params,
+)
 from walkerlab.walker.layout import StateLayout, floating_links_from_rigid
 
 __all__ = ["StanceReaction", "TransitionImpulses"]
 
 #: the floating view's contact point of each role's foot (leg1 swings, leg2 stands)
 _FOOT_OF_ROLE = {"swing": "leg1", "stance": "leg2"}
+
+
+class _View:
+    """The generated floating module's kernels (:mod:`walkerlab.codegen.floating`: ``dyn``,
+    ``feet``, ``feet_jac``) run as the plain Python they are generated from (their
+    ``py_func``): a check of a few hundred states costs no numba compilation or cache load
+    (about 0.07 ms a state)."""
+
+    def __init__(self, data):
+        mod = floating_module(data.structure)  # raises for a massless body
+        self.params = np.asarray(floating_params(data), float)
+        self.nq = int(mod.NQ)
+        self.names = contact_names(data.structure)
+        self.coordinates = coordinate_names(data.structure)
+        self._dyn, self._feet = mod.dyn.py_func, mod.feet.py_func
+        self._feet_jac = mod.feet_jac.py_func
+
+    def _x(self, q, dq=None) -> np.ndarray:
+        return np.concatenate([q, np.zeros(self.nq) if dq is None else dq])
+
+    def dynamics(self, q, dq) -> tuple[np.ndarray, np.ndarray]:
+        """``M(q)`` (nq, nq) and ``h(q, dq)`` (nq,)."""
+        M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
+        self._dyn(self._x(q, dq), self.params, M, h)
+        return M, h
+
+    def contact_points(self, q, dq=None):
+        """Contact points (nf, 2) [m], material velocities (nf, 2) [m/s], Jacobians
+        (nf, 2, nq)."""
+        nf = len(self.names)
+        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, self.nq))
+        self._feet(self._x(q, dq), self.params, P, V, J)
+        return P, V, J
+
+    def velocity_gradient(self, q, dq) -> np.ndarray:
+        """``d V_i / dq`` (nf, 2, nq) at fixed rates: ``(dV/dq) dq = Jdot dq``."""
+        nf = len(self.names)
+        dV, dJtF = np.empty((nf, 2, self.nq)), np.empty((self.nq, self.nq))
+        self._feet_jac(self._x(q, dq), np.zeros((nf, 2)), self.params, dV, dJtF)
+        return dV
 
 
 @dataclass(frozen=True)
@@ -123,18 +168,18 @@ class StanceReaction:
         self.view = None
         if any(b.massless for b in st.bodies):
             if not st.hip_mass or any(not b.massless for b in (*st.bodies, *st.torso)):
-                floating_view(data)  # raises: a massless body beside massive ones
+                floating_module(st)  # raises: a massless body beside massive ones
             # massless legs, all the mass at the hip (module docstring)
             self.hip_mass_kg = float(data.total_mass_kg)
             self.g = float(data.gravity_m_per_s2)
             return
-        self.view = floating_view(data)
-        coords = tuple(self.view.coordinate_names())
+        self.view = _View(data)
+        coords = tuple(self.view.coordinates)
         self._layout = StateLayout.floating(coords, coords + tuple(f"d_{c}" for c in coords),
                                             ("",) * (2 * len(coords)))
         self._hip = [coords.index("hip_x"), coords.index("hip_y")]
         self._links = [i for i in range(len(coords)) if i not in self._hip]
-        self._feet = {r: self.view.contact_names().index(f) for r, f in _FOOT_OF_ROLE.items()}
+        self._feet = {r: self.view.names.index(f) for r, f in _FOOT_OF_ROLE.items()}
 
     # ------------------------------------------------------------------ state maps
     def _values(self, x) -> dict:
@@ -213,10 +258,9 @@ class StanceReaction:
         qdd[self._links] = self._link_acceleration(x, xdot)
         i = self._feet["stance"]
         _, _, J = self.view.contact_points(q, dq)
-        dV = self.view.contact_velocity_gradient(q, dq)
+        dV = self.view.velocity_gradient(q, dq)
         qdd[self._hip] = -(J[i][:, self._links] @ qdd[self._links] + dV[i] @ dq)
-        M = self.view.mass_matrix(q)
-        h = self.view.bias(q, dq)
+        M, h = self.view.dynamics(q, dq)
         return (M @ qdd + h)[self._hip]
 
     def normal_and_tangential(self, F) -> tuple[float, float]:
@@ -252,7 +296,7 @@ class StanceReaction:
         if not np.allclose(q0[self._links], q1[self._links], atol=1e-8):
             raise ValueError("the post-impact state is not the pre-impact configuration "
                              "with the roles swapped")
-        total = (self.view.mass_matrix(q0) @ (v1 - v0))[self._hip]
+        total = (self.view.dynamics(q0, v0)[0] @ (v1 - v0))[self._hip]
         P, _, _ = self.view.contact_points(q0)
         push = self._push_off(x_minus, -P[self._feet["stance"]])  # the hip is at 0
         _, V, _ = self.view.contact_points(q1, v1)
