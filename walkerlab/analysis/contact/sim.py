@@ -91,7 +91,12 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         Strides cap: stop (termination and outcome ``heel_strike``) at the end of the chunk
         in which this many heel strikes have happened.  A run that ends in a trip, fall,
         flight, solver failure or the wall-time limit after ``max_heel_strikes - 1`` heel
-        strikes (the strides asked for) ends by the cap too, its end named in the message.
+        strikes (the strides asked for) ends by the cap too, its end named in the message
+        and in :attr:`~walkerlab.analysis.contact.gait.Outcome.after` (a trip, fall or
+        flight there makes :func:`~walkerlab.analysis.contact.gait.walk_verdict` say the run
+        does not walk).  A trip, fall or scuff on a checkerboard whose patches the footfalls
+        drifted off adds :meth:`~walkerlab.analysis.contact.gait.PatchFit.note` to the
+        message.
     slip_limit_mm : float, optional
         A stance phase sliding farther than this [mm] makes the outcome ``slip``.
     min_step_m : float
