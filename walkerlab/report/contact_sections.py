@@ -70,7 +70,9 @@ def contact_section(scene, arts) -> list[str]:
            + ", ".join(f"{k} = {num(v)}" + (f" {u}" if u not in ("", "-") else "")
                        for k, (v, u) in cp.items()) + ".", "",
            f"Outcome: **{outcome[0]}**" + (f" — {outcome[1]}" if outcome[1] and
-                                            outcome[1] != outcome[0] else ""), "",
+                                            outcome[1] != outcome[0] else "")
+           + ("" if c.walks is None else " Walks (the verdict from its steps): "
+              + ("yes." if c.walks else f"**no** — {c.walks_reason}.")), "",
            "Per-step stance slip [mm] (touchdown to lift-off of the stance foot; nan: the "
            "phase had not ended when the run did): " + ", ".join(num(v, 3) for v in slips)
            + (("; creep of both feet during double support [mm]: "

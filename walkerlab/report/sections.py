@@ -16,7 +16,7 @@ from types import ModuleType
 import numpy as np
 
 from walkerlab.report.markdown import num, printed, sig_digits, table
-from walkerlab.report.text import zero_multipliers_text
+from walkerlab.report.text import ground_contact_text, zero_multipliers_text
 from walkerlab.units import Units, for_scene
 
 #: Table 3 rows (keys of :func:`walkerlab.comparison.tables.gait_metrics`): name, symbol, unit
@@ -65,6 +65,10 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
                        f"{num(fp.step_period_s)} {u.time}.")
         bullets.append(f"- **Stable**: {'yes' if fp.stable else 'no'} (largest "
                        f"|Floquet multiplier| {num(fp.max_abs_multiplier())}).")
+        g = getattr(fp, "ground_contact", None)
+        if g is not None:  # a gait that needs the ground to pull is no gait on real ground
+            bullets.append("- **Ground contact**: " + ground_contact_text(g, u).split(
+                ": ", 1)[1] + ".")
         eq = dict(zip(*published_fixed_point(pub)))
         for n, v, un in zip(fp.state_names, fp.x, fp.state_units):
             # as many digits as the published value has, so the two can be compared digit by digit
@@ -91,13 +95,18 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
     if c is not None:
         from walkerlab.integrate.ends import CONTACT_WALKED
 
-        walks = c.outcome in CONTACT_WALKED
+        # one verdict, from the steps (stored with the run); an older artifact: its outcome
+        walks = c.walks if c.walks is not None else c.outcome in CONTACT_WALKED
         extra = ""
         if c.periodic is not None and c.periodic.found:
             extra = ("; its own periodic gait is " + ("stable" if c.periodic.stable
                                                       else "unstable"))
+        elif c.periodic is not None:
+            extra = f"; its own periodic gait was not found ({c.periodic.outcome})"
+        why = f": {c.walks_reason}" if not walks and c.walks_reason else ""
         bullets.append(f"- **Contact walker walks**: {'yes' if walks else 'no'} "
-                       f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}){extra}.")
+                       f"({len(c.heel_strike_times)} heel strikes, outcome {c.outcome}"
+                       f"{why}){extra}.")
     cols = inputs.gait_columns
     ideal = cols.get("ours, ideal")
     if ideal:

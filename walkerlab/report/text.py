@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from walkerlab.integrate.ends import CONTACT_WALKED
 from walkerlab.report.markdown import num
 
 if TYPE_CHECKING:  # the loaded artifacts these summaries print
@@ -61,6 +62,41 @@ def zero_multipliers_text(re, im, state_names: list[str] | None = None,
             "state" + (f" ({said})" if said else ""))
 
 
+def ground_contact_problems(g, u) -> list[str]:
+    """Why a gait's ground contact is not unilateral (``g``: the stored check,
+    :class:`~walkerlab.io.schemas.fixedpoint.GroundContactRecord`; ``u``: the units)."""
+    v, out = g.values, []
+    if v.get("min_normal_force_n", 0.0) < 0:
+        out.append(f"the stance foot would lift: its normal force falls to "
+                   f"{v['min_normal_force_n']:.4g} {u('N')} at t = "
+                   f"{v['min_normal_time_s']:.4g} {u.time} (the ground would have to pull)")
+    for key, what in (("heel_strike_normal_impulse_n_s", "heel strike"),
+                      ("push_off_normal_impulse_n_s", "push-off")):
+        if v.get(key, 0.0) < 0:
+            out.append(f"the {what}'s normal impulse is {v[key]:.4g} {u('N s')} (a pull)")
+    if v.get("trailing_foot_normal_velocity_m_per_s", 0.0) < 0:
+        out.append(f"the trailing foot moves into the ground after the transition "
+                   f"({v['trailing_foot_normal_velocity_m_per_s']:.4g} {u.speed})")
+    return out
+
+
+def ground_contact_text(g, u) -> str:
+    """One line on whether the gait needs only a ground that pushes (``g``: the stored
+    check; ``u``: the units)."""
+    if g.ok is None:
+        return f"ground contact: not checked ({g.not_checked})"
+    if not g.ok:
+        return "ground contact: NOT a gait on real ground: " + "; ".join(
+            ground_contact_problems(g, u))
+    v = g.values
+    po = v.get("push_off_normal_impulse_n_s", 0.0)
+    return (f"ground contact: unilateral (stance normal force >= "
+            f"{v['min_normal_force_n']:.4g} {u('N')}, heel-strike normal impulse "
+            f"{v['heel_strike_normal_impulse_n_s']:.4g} {u('N s')}"
+            + (f", push-off {po:.4g} {u('N s')}" if po > 0 else "")
+            + f"; friction coefficient needed {v['max_friction_ratio']:.3g})")
+
+
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     u, legs = fp.units, fp.legs_by_role
@@ -89,6 +125,8 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     verdict = "STABLE" if fp.stable else "UNSTABLE"
     lines.append(f"verdict: {verdict} (largest |multiplier| = {mod:.6f}; "
                  f"{zero_multipliers_text(re, im, fp.state_names, fp.scene_json)})")
+    if fp.ground_contact is not None:
+        lines.append(ground_contact_text(fp.ground_contact, u))
     lines += gaits_text(fp)
     return "\n".join(lines)
 
@@ -178,6 +216,8 @@ def contact_text(c: ContactSimArtifact) -> str:
     why = c.outcome_message
     # the message only when it says more than the outcome's name
     lines = [f"contact walker: outcome {kind}" + (f" ({why})" if why and why != kind else "")]
+    if c.walks is False and kind in CONTACT_WALKED:  # the verdict from the steps says more
+        lines.append(f"walks: no ({c.walks_reason})")
     if c.adjust is not None:  # --adjust: the scale it found
         s = np.atleast_1d(c.initial_rate_scale)
         # per named coordinate: the rates of leg1 (swing) and leg2 (stance) at the start

@@ -25,8 +25,9 @@ from walkerlab.integrate.contact import hermite_root
 from walkerlab.integrate.ends import CONTACT_WALKED, RUN_END_NAMES
 
 __all__ = ["CONTACT_OUTCOMES", "FOOT_MODES", "ContactResult", "FootTrace", "Outcome",
-           "StepSummary", "classify", "classify_complete", "foot_modes", "gait_events",
-           "heel_strike_count", "phase_slip"]
+           "PatchFit", "StepSummary", "classify", "classify_complete", "foot_modes",
+           "gait_events", "heel_strike_count", "patch_fit", "phase_slip", "step_trend",
+           "walk_verdict"]
 
 #: Outcome kinds of a contact run: the shared run ends (:mod:`walkerlab.integrate.ends`)
 #: that the contact model can produce.
@@ -51,6 +52,15 @@ class Outcome:
         Hip height above the ground line at ``time_s`` (or at the end) [m].
     message : str
         One line for people.
+    after : str
+        A run that made the heel strikes asked for and then met another end (``trip``,
+        ``fall``, ``airborne``, ``solver_failure``, ``time_limit``): that end's kind ("" when
+        none followed).  ``kind`` stays the strides cap's (the run made its promise); the
+        message names what followed, and :func:`walk_verdict` does not call it a walk.
+    after_time_s : float
+        Time [s] of that end (NaN when none).
+    after_message : str
+        What followed, in a few words (e.g. "fell into a gap (...) at t = 9.445 s").
     """
 
     kind: str
@@ -59,6 +69,9 @@ class Outcome:
     patch_edge_m: float = float("nan")
     hip_height_m: float = float("nan")
     message: str = ""
+    after: str = ""
+    after_time_s: float = float("nan")
+    after_message: str = ""
 
     @property
     def ok(self) -> bool:
@@ -227,6 +240,11 @@ class ContactResult:
     def walked_steps(self) -> int:
         """Number of heel strikes."""
         return len(self.heel_strike_times)
+
+    @property
+    def verdict(self) -> tuple[bool, str]:
+        """Whether the run walks and, if not, why (:func:`walk_verdict`)."""
+        return walk_verdict(self.outcome, self.steps)
 
     @property
     def fall_time(self) -> float | None:
@@ -457,6 +475,185 @@ def foot_modes(t, points: dict, leg: str, t0: float = -np.inf,
         else:
             out.append((m, float(ts[k]), float(ts[k])))
     return out
+
+
+# ---------------------------------------------------------------------------- terrain fit
+#: a footfall this far (as a fraction of the smaller margin of :class:`PatchFit`) from its
+#: patch's centre has used up most of the room the checkerboard gives it
+PATCH_MARGIN_USED = 0.5
+
+
+@dataclass
+class PatchFit:
+    """Where a contact run's footfalls landed on the checkerboard laid out for its gait.
+
+    Footfall ``k`` of the gait has a patch centred at ``s = k l`` in its leg's lane
+    (:func:`walkerlab.models.contact.model.checkerboard_lanes`, ``l`` the patch spacing,
+    the rigid gait's step); a patch is ``2 h`` wide.  A footfall lands on ground while it is
+    within ``h`` of its patch's centre; at mid-stance the swing foot passes the stance foot
+    (a straight leg's swing foot dips below the ground line there) over the gap of its own
+    lane, which reaches ``l - h`` either side of the stance footfall's patch centre.  The
+    footfalls of a contact gait whose steps differ from the spacing drift through both.
+
+    Attributes
+    ----------
+    spacing_m : float
+        Patch spacing ``l`` [m] (footfall to footfall).
+    half_width_m : float
+        ``h`` [m] (``terrain.patch_width_m / 2``).
+    offsets_m : ndarray (k,)
+        Each heel strike's footfall minus its patch's centre [m] (negative: short of it).
+    steps_m : ndarray (k,)
+        Each step's length, footfall to footfall [m] (the first from the initial stance
+        foot).
+    """
+
+    spacing_m: float
+    half_width_m: float
+    offsets_m: np.ndarray
+    steps_m: np.ndarray
+
+    @property
+    def margin_m(self) -> float:
+        """The smaller room [m] a footfall has: ``h`` (on its patch) or ``l - h`` (the swing
+        foot over its lane's gap beside it)."""
+        return min(self.half_width_m, self.spacing_m - self.half_width_m)
+
+    @property
+    def drift_m_per_step(self) -> float:
+        """Least-squares slope of the footfalls' offsets over the heel strikes [m/step]
+        (NaN with fewer than two)."""
+        k = self.offsets_m.size
+        return float(np.polyfit(np.arange(k), self.offsets_m, 1)[0]) if k >= 2 else np.nan
+
+    def note(self) -> str:
+        """Why the checkerboard does not suit the gait, when the last footfall used more
+        than :data:`PATCH_MARGIN_USED` of :attr:`margin_m` ("" otherwise): its offset, the
+        drift per step, the contact steps against the spacing, both margins, and the
+        patch width that balances them."""
+        if self.offsets_m.size < 2 or not np.isfinite(self.margin_m) or self.margin_m <= 0:
+            return ""
+        last = float(self.offsets_m[-1])
+        if abs(last) < PATCH_MARGIN_USED * self.margin_m:
+            return ""
+        sp, h = self.spacing_m, self.half_width_m
+        mean = float(np.mean(self.steps_m))
+        return (f"the patches ({2 * h:.3g} m wide at {sp:.4g} m spacing, the rigid gait's "
+                f"step) do not suit this gait's step: its contact steps average {mean:.4g} m, "
+                f"its footfalls drifted {1e3 * self.drift_m_per_step:+.3g} mm a step and "
+                f"heel strike {self.offsets_m.size} landed {last:+.3f} m from its patch's "
+                f"centre, where a footfall has ±{h:.3g} m on its patch and the swing foot "
+                f"±{sp - h:.3g} m over its lane's gap at mid-stance (terrain.patch_width_m "
+                f"near {sp:.3g} m balances the two; contact_sim.start: periodic_gait lays the "
+                "patches at the contact gait's own footfalls)")
+
+
+def patch_fit(walker, t, feet: dict, hs_t, hs_leg, initial_stance: str = "leg2"
+              ) -> PatchFit | None:
+    """The footfalls of a contact run against its checkerboard (:class:`PatchFit`); None on
+    continuous ground or without heel strikes.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        Its lanes (``walker.lane(leg)``, patch centres [m]) and ``patch_half_width`` [m].
+    t : ndarray (n,)
+        Sample times [s].
+    feet : dict[str, FootTrace]
+        Per leg (:func:`gait_events`' ``feet``).
+    hs_t, hs_leg : sequence
+        Heel-strike times [s] and legs.
+    initial_stance : str
+        The leg in stance at ``t[0]`` (its foot is footfall 0).
+    """
+    if getattr(walker, "continuous", True) or not len(hs_t):
+        return None
+    s_prev = float(feet[initial_stance].s[0])
+    off, steps = [], []
+    for th, leg in zip(hs_t, hs_leg):
+        s = float(np.interp(th, t, feet[leg].s))
+        lane = np.asarray(walker.lane(leg), float)
+        if not lane.size:
+            return None
+        off.append(s - float(lane[np.argmin(np.abs(lane - s))]))
+        steps.append(s - s_prev)
+        s_prev = s
+    c1, c2 = np.asarray(walker.lane("leg1"), float), np.asarray(walker.lane("leg2"), float)
+    spacing = float(abs(c1[0] - c2[0])) if c1.size and c2.size else np.nan
+    return PatchFit(spacing, float(walker.patch_half_width), np.array(off), np.array(steps))
+
+
+# ---------------------------------------------------------------------------- verdict
+#: ends after the strides asked for that are the walker's own (not the solver's or the
+#: wall clock's): a run that meets one does not walk
+WALKER_ENDS = ("trip", "fall", "airborne")
+#: a contact run's steps have settled when the last change of a leg's step period (against
+#: that leg's previous step: an asymmetric gait alternates) is below this fraction of it ...
+STEADY_PERIOD_CHANGE = 0.005
+#: ... or smaller than this fraction of the changes before it (they die out)
+SETTLING_RATIO = 0.5
+
+
+def step_trend(periods) -> str:
+    """"" when a contact run's step periods [s] settle, else what they do.
+
+    A leg's step is compared with that leg's previous one (``T_k - T_{k-2}``: a period-2
+    gait's steps alternate).  The steps have not settled when the last three such changes
+    share a sign, the last exceeds :data:`STEADY_PERIOD_CHANGE` of the period and is at
+    least :data:`SETTLING_RATIO` of the first of them (no decay towards a gait).
+
+    Parameters
+    ----------
+    periods : array_like (k,)
+        Step periods [s] (NaN: a step the run did not finish, left out).
+
+    Returns
+    -------
+    str
+        e.g. "its steps shorten monotonically (0.583 → 0.509 s)"; "" with fewer than five
+        finished steps.
+    """
+    T = np.asarray(periods, float)
+    T = T[np.isfinite(T)]
+    if T.size < 5:
+        return ""
+    d = T[2:] - T[:-2]
+    last3 = d[-3:]
+    if not (np.all(last3 > 0) or np.all(last3 < 0)):
+        return ""
+    if abs(last3[-1]) <= STEADY_PERIOD_CHANGE * T[-1] \
+            or abs(last3[-1]) < SETTLING_RATIO * abs(last3[0]):
+        return ""
+    way = "shorten" if last3[-1] < 0 else "lengthen"
+    mono = np.all(np.diff(T) < 0) if way == "shorten" else np.all(np.diff(T) > 0)
+    return (f"its steps {way}{' monotonically' if mono else ''} ({T[0]:.3f} → {T[-1]:.3f} s"
+            f", the last by {100 * abs(last3[-1]) / T[-1]:.2g} % against the same leg's "
+            "step before): no steady gait")
+
+
+def walk_verdict(outcome: Outcome, steps) -> tuple[bool, str]:
+    """Whether a contact run walks, one verdict from its steps: it made its heel strikes
+    (:attr:`Outcome.walked`), no trip, fall or flight (:data:`WALKER_ENDS`) ended it after
+    them (:attr:`Outcome.after`; a solver failure or the wall-time limit there is named in
+    the message only), and its step periods settle (:func:`step_trend`).
+
+    Returns
+    -------
+    walks : bool
+    why : str
+        "" when it walks, else the reason (one phrase).
+    """
+    if not outcome.walked:
+        return False, outcome.message
+    why = []
+    if outcome.after in WALKER_ENDS:  # a solver's failure or the wall time is no fall
+        what = outcome.after_message or (f"a {outcome.after.replace('_', ' ')} ended it at "
+                                         f"t = {outcome.after_time_s:.4g} s")
+        why.append(f"it made the heel strikes asked for, then {what}")
+    trend = step_trend([st.period for st in steps])
+    if trend:
+        why.append(trend)
+    return (not why), "; ".join(why)
 
 
 # ---------------------------------------------------------------------------- outcome

@@ -16,7 +16,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.analysis.contact.gait import ContactResult, classify, gait_events, heel_strike_count
+from walkerlab.analysis.contact.gait import (
+    ContactResult,
+    classify,
+    gait_events,
+    heel_strike_count,
+    patch_fit,
+)
 from walkerlab.config.solver import SolverSettings
 from walkerlab.integrate.contact import ContactLimits, integrate_contact
 from walkerlab.integrate.ends import RunEnd
@@ -85,7 +91,12 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         Strides cap: stop (termination and outcome ``heel_strike``) at the end of the chunk
         in which this many heel strikes have happened.  A run that ends in a trip, fall,
         flight, solver failure or the wall-time limit after ``max_heel_strikes - 1`` heel
-        strikes (the strides asked for) ends by the cap too, its end named in the message.
+        strikes (the strides asked for) ends by the cap too, its end named in the message
+        and in :attr:`~walkerlab.analysis.contact.gait.Outcome.after` (a trip, fall or
+        flight there makes :func:`~walkerlab.analysis.contact.gait.walk_verdict` say the run
+        does not walk).  A trip, fall or scuff on a checkerboard whose patches the footfalls
+        drifted off adds :meth:`~walkerlab.analysis.contact.gait.PatchFit.note` to the
+        message.
     slip_limit_mm : float, optional
         A stance phase sliding farther than this [mm] makes the outcome ``slip``.
     min_step_m : float
@@ -112,7 +123,7 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
     """
     solver = Solver.from_settings(solver or SolverSettings.for_contact())
     limits = _with_heights(walker, limits or ContactLimits())
-    stop = None
+    stop = after = None
     if max_heel_strikes is not None:
         def stop(t, X):
             return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
@@ -133,12 +144,23 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
         def made(t, X):
             return heel_strike_count(walker, t, X, min_step_m, initial_stance) \
                 >= max_heel_strikes - 1
+        before = run
         run = _made_before_event(run, made) if run.event is not None \
             else _made_before_end(run, made)
+        if run is not before:  # the end that followed the strides asked for, kept to name
+            after = (before.termination, float(before.event[2]) if before.event is not None
+                     else float(before.t[-1]), before.message)
     ev = gait_events(walker, run.t, run.X, min_step_m, initial_stance)
     hh = float(walker.hip_height(run.X[-1:])[0])
     out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
                    slip_limit_mm, limits.wall_time_limit_s, bool(walker.continuous))
+    if after is not None:
+        out = _named_after(out, after, ev, hh)
+    if out.after or out.kind in _OFF_THE_PATCHES:
+        fit = patch_fit(walker, run.t, ev["feet"], ev["hs_t"], ev["hs_leg"], initial_stance)
+        note = fit.note() if fit is not None else ""
+        if note:
+            out = replace(out, message=f"{out.message}; {note}")
     return ContactResult(t=run.t, x=run.X, state_names=tuple(walker.state_names()),
                          feet=ev["feet"], heel_strike_times=ev["hs_t"],
                          heel_strike_legs=ev["hs_leg"], steps=ev["steps"],
@@ -150,6 +172,31 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
 
 #: the ends without an event that a run met after its strides asked for still ends by the cap
 _EVENTLESS_ENDS = (RunEnd.SOLVER_FAILURE.value, RunEnd.TIME_LIMIT.value)
+#: outcomes a checkerboard laid out for another step can cause (its fit is then named)
+_OFF_THE_PATCHES = ("trip", "fall", "scuff")
+#: how the end that followed the strides asked for reads after "then"
+_AFTER_WORDS = {"trip": "tripped", "fall": "fell", "airborne": "left the ground",
+                "solver_failure": "the solver failed", "time_limit": "the wall time ran out"}
+#: a foot this far [m] below the ground line over a gap at the run's end fell into it
+_IN_A_GAP_M = 0.01
+
+
+def _named_after(out, after, ev, hip_height_m: float):
+    """The outcome ``out`` of a run ended by its strides cap with the end that followed the
+    strides asked for (``after``: termination, time [s], the integration's message) named:
+    :attr:`Outcome.after` and its time, and the message "walked: ..., then fell into a gap
+    ..." (a foot more than :data:`_IN_A_GAP_M` below the ground line over a gap at the end)."""
+    kind, t_after, msg = after
+    low = [(float(ft.penetration[-1]), name) for name, ft in ev["feet"].items()
+           if not ft.on_ground[-1] and ft.penetration[-1] > _IN_A_GAP_M]
+    what = _AFTER_WORDS.get(kind, kind.replace("_", " "))
+    if low and kind in ("trip", "fall"):
+        feet = " and ".join(f"{name} {depth:.3f} m" for depth, name in sorted(low)[::-1])
+        what = f"fell into a gap ({feet} below the ground line)"
+    what = f"{what} at t = {t_after:.4g} s"
+    return replace(out, after=kind, after_time_s=t_after, after_message=what,
+                   message=f"{out.message}, then {what}, hip {hip_height_m:.3f} m above the "
+                   f"ground (after the strides asked for: {msg})")
 
 
 def _made_before_event(run, stop):

@@ -1,7 +1,10 @@
-"""Checks of a rigid run's trajectory the report states: energy drift between impacts and
-the swing foot's clearance above the slope."""
+"""Checks of a rigid run's trajectory the report states: energy drift between impacts, the
+swing foot's clearance above the slope, and whether the gait's ground contact is unilateral
+(the ground pushes the stance foot, never pulls it)."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -44,3 +47,110 @@ def swing_foot_clearance(tr: NamedTrajectory, slope_rad: float, margin: float = 
         h = xy[1] * np.cos(slope_rad) + xy[0] * np.sin(slope_rad)
         lowest = min(lowest, float(np.min(h)))
     return lowest
+
+
+# ---------------------------------------------------------------------------- ground contact
+#: dense samples of each continuous phase at which the stance foot's normal force is read
+CONTACT_SAMPLES_PER_PHASE = 200
+
+
+@dataclass
+class GroundContact:
+    """Whether a rigid gait's ground contact is unilateral: the ground pushes, never pulls.
+
+    The rigid model pins the stance foot and takes the trailing foot off the ground at heel
+    strike; a real foot needs a non-negative normal force along every continuous phase and
+    non-negative normal impulses at the transition, and the trailing foot must move away
+    from the ground after it (:mod:`walkerlab.models.hybrid.ground_reaction`).
+
+    Attributes
+    ----------
+    min_normal_force_n : float
+        Smallest normal force on the stance foot over the map's steps [N] (NaN: not
+        checked).
+    min_normal_time_s : float
+        When it occurs, from the start of the map [s].
+    max_friction_ratio : float
+        Largest ``|tangential| / normal`` force while the normal force is positive [-]: the
+        friction coefficient the gait needs.
+    heel_strike_normal_impulse_n_s, push_off_normal_impulse_n_s : float
+        Smallest normal component of the heel strike's / push-off's impulse [N s] over the
+        map's transitions (push-off 0 without one).
+    trailing_foot_normal_velocity_m_per_s : float
+        Smallest normal velocity of the trailing foot just after a transition [m/s].
+    not_checked : str
+        Why the check could not be made ("" when it was): a walker without a floating view.
+    """
+
+    min_normal_force_n: float = np.nan
+    min_normal_time_s: float = np.nan
+    max_friction_ratio: float = np.nan
+    heel_strike_normal_impulse_n_s: float = np.nan
+    push_off_normal_impulse_n_s: float = np.nan
+    trailing_foot_normal_velocity_m_per_s: float = np.nan
+    not_checked: str = ""
+
+    @property
+    def ok(self) -> bool | None:
+        """True: the ground only pushes (every normal force and impulse >= 0, the trailing
+        foot leaves); False: it would have to pull; None: not checked."""
+        if self.not_checked:
+            return None
+        return bool(min(self.min_normal_force_n, self.heel_strike_normal_impulse_n_s,
+                        self.push_off_normal_impulse_n_s,
+                        self.trailing_foot_normal_velocity_m_per_s) >= 0)
+
+
+def ground_contact(walker, data, x, solver, samples: int = CONTACT_SAMPLES_PER_PHASE
+                   ) -> GroundContact:
+    """Check a rigid gait's ground contact over one Poincaré map from ``x`` (a step, or a
+    stride for legs that differ): the stance foot's normal force at ``samples`` points of
+    each continuous phase (its dense output), and the impulses of each transition
+    (:class:`walkerlab.models.hybrid.ground_reaction.StanceReaction`).
+
+    Parameters
+    ----------
+    walker : HybridWalker
+    data : walkerlab.walker.description.WalkerData
+        The walker's structure and numbers (``walker_data`` of its scene).
+    x : ndarray (2n,)
+        Post-impact state (the fixed point).
+    solver : Solver
+    samples : int
+        Samples per continuous phase.
+
+    Returns
+    -------
+    GroundContact
+        ``not_checked`` set for a walker without a floating view (massless legs, flat
+        feet) or a map that does not end in heel strikes.
+    """
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.models.hybrid.ground_reaction import StanceReaction
+
+    try:
+        reaction = {id(walker): StanceReaction(walker, data)}
+        if walker.mirror is not None:
+            reaction[id(walker.mirror)] = StanceReaction(walker.mirror, data.mirror)
+    except ValueError as exc:
+        return GroundContact(not_checked=str(exc))
+    traj = simulate_steps(walker, np.asarray(x, float), walker.steps_per_map, solver)
+    n = np.asarray(x).size
+    n_min, t_min, ratio = np.inf, np.nan, 0.0
+    hs, po, vt = np.inf, np.inf, np.inf
+    for seg in traj.segments:
+        if seg.termination != "heel_strike":
+            return GroundContact(not_checked=f"the map ends in {seg.termination}")
+        sr = reaction[id(walker.for_stance(seg.stance_leg))]
+        for phase, sol, (ta, tb) in seg.pieces:
+            for t in np.linspace(ta, tb, samples):
+                xs = np.ravel(sol(t))[:n]
+                fn, ft = sr.normal_and_tangential(sr.force(t, xs, phase.flow))
+                if fn < n_min:
+                    n_min, t_min = fn, float(t)
+                if fn > 0:
+                    ratio = max(ratio, abs(ft) / fn)
+        imp = sr.transition(seg.x_end, seg.x_next)
+        hs, po = min(hs, imp.heel_strike_normal), min(po, imp.push_off_normal)
+        vt = min(vt, imp.trailing_foot_normal_velocity)
+    return GroundContact(float(n_min), t_min, float(ratio), float(hs), float(po), float(vt))

@@ -165,7 +165,8 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
         The writer's input; a variant without a fixed point holds its
         :class:`~walkerlab.analysis.gait.poincare.FixedPointNotFound`.
     summary : dict
-        ``walker``, ``result`` (the selected gait), ``gaits`` (the search), ``variants``.
+        ``walker``, ``result`` (the selected gait), ``gaits`` (the search), ``variants``,
+        ``ground_contact`` (:func:`gait_ground_contact` of the selected gait).
 
     Raises
     ------
@@ -188,6 +189,23 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
             results[variant] = solve_variant(scene, variant, other_guess)
         except FixedPointNotFound as exc:
             results[variant] = exc
-    run = FixedPointRun(walker, search, results, scene.ideal.variant, other_guess)
-    summary = {"walker": walker, "result": main, "gaits": search, "variants": dict(results)}
+    ground = gait_ground_contact(scene, walker, main.x)
+    run = FixedPointRun(walker, search, results, scene.ideal.variant, other_guess, ground)
+    summary = {"walker": walker, "result": main, "gaits": search, "variants": dict(results),
+               "ground_contact": ground}
     return run, summary
+
+
+def gait_ground_contact(scene: Scene, walker, x):
+    """Whether the gait from ``x`` (the scene's walker's fixed point) needs only a ground that
+    pushes (:func:`walkerlab.analysis.gait.checks.ground_contact`, with the scene's solver).
+
+    Returns
+    -------
+    walkerlab.analysis.gait.checks.GroundContact
+    """
+    from walkerlab.analysis.gait.checks import ground_contact
+    from walkerlab.walker.description import walker_data
+
+    return ground_contact(walker, walker_data(scene.walker, scene.slope.phi_rad), x,
+                          Solver.from_settings(scene.solver))

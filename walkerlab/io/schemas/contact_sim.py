@@ -2,8 +2,11 @@
 
 Layout: the named ``samples/`` of :mod:`walkerlab.io.trajectory` (as ``simulate.h5``);
 root attributes ``model``, ``legs``, ``termination``, ``method``, ``outcome``,
-``outcome_message``, ``stiffness_family`` (``fall_time_s`` when it fell); ``outcome/``
-(event time [s], patch edge [m], hip height [m]); ``drop_test/`` (restitution, largest
+``outcome_message``, ``stiffness_family`` (``fall_time_s`` when it fell), ``walks`` (1/0:
+the one verdict from the steps, :func:`walkerlab.analysis.contact.gait.walk_verdict`) and
+``walks_reason`` (why not; "" when it walks); ``outcome/`` (event time [s], patch edge
+[m], hip height [m]; attributes ``after``, the end that followed the heel strikes asked
+for, "" when none, and ``after_time`` [s]); ``drop_test/`` (restitution, largest
 penetration [m] and contact time [s] of both stiffness families on dimension
 ``stiffness``); ``contact_params_si/`` (the contact law in SI); ``terrain/`` (patch
 centres [m] per lane); ``initial_state`` (named by ``contact_state``),
@@ -110,9 +113,14 @@ def _write_outcome_and_drop(f, run: ContactSimRun) -> None:
     f.attrs["stiffness_family"] = run.stiffness_family
     if res.fall_time is not None:
         f.attrs["fall_time_s"] = res.fall_time
+    walks, why = res.verdict
+    f.attrs["walks"] = int(walks)
+    f.attrs["walks_reason"] = why
     o = res.outcome
     g = f.create_group("outcome")
     g.attrs["kind"] = o.kind
+    g.attrs["after"] = o.after
+    g.attrs["after_time"] = o.after_time_s
     g.attrs["foot"] = o.foot
     g.attrs["message"] = o.message
     put(g, "time", o.time_s, "s", "time of the event that set the outcome (NaN: none)")
@@ -354,7 +362,10 @@ class ContactSimArtifact:
 
     ``summary`` maps each ``summary/`` name to ``(value, unit)``; ``initial_rate_scale``
     multiplies the rates named in ``rate_names`` (None in artifacts without them);
-    ``stage_wall_time_s``: the whole stage's compute time [s]; ``ledger`` (a powered run)
+    ``stage_wall_time_s``: the whole stage's compute time [s]; ``walks`` the run's verdict
+    from its steps and ``walks_reason`` why not (None and "" in artifacts without them: the
+    outcome decides); ``outcome_after`` the end that followed the heel strikes asked for
+    ("" when none); ``ledger`` (a powered run)
     maps each work integral's name (:data:`walkerlab.models.contact.actuation.WORK_NAMES`)
     and ``residual`` to its samples (n,) [J]; ``ledger_steps`` (a powered run) its ledger per
     step, name -> (steps,) (``ledger/steps/``: push-off work [J], ..., cost of transport).
@@ -365,6 +376,9 @@ class ContactSimArtifact:
     termination: str
     outcome: str
     outcome_message: str = ""
+    walks: bool | None = None
+    walks_reason: str = ""
+    outcome_after: str = ""
     stiffness_family: str = "paper"
     samples: NamedTrajectory | None = None
     summary: dict = field(default_factory=dict)
@@ -418,6 +432,10 @@ def load_contact_sim(path: Path) -> ContactSimArtifact:
             path=Path(path), units=for_artifact(f), termination=term,
             outcome=str(f.attrs.get("outcome", term)),
             outcome_message=str(f.attrs.get("outcome_message", "")),
+            walks=bool(f.attrs["walks"]) if "walks" in f.attrs else None,
+            walks_reason=str(f.attrs.get("walks_reason", "")),
+            outcome_after=(str(f["outcome"].attrs.get("after", "")) if "outcome" in f
+                           else ""),
             stiffness_family=str(f.attrs.get("stiffness_family", "paper")),
             samples=read_samples(f),
             summary={k: (f["summary"][k][()], str(f["summary"][k].attrs.get("unit", "")))

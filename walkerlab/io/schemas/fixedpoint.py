@@ -10,7 +10,8 @@ variant under ``variants/<variant>/`` (or its ``error`` attribute), each with:
 ``steps/{period,length,swing_leg}`` on dimension ``step``), ``residual``,
 ``floquet/{variational,finite_difference}/{real,imag,jacobian}``,
 ``floquet/max_difference``, ``floquet/stable``, ``stats/`` (RHS evaluations, map
-evaluations, wall time [s]).
+evaluations, wall time [s]); ``ground_contact/`` (the selected gait: whether the ground only
+pushes, :data:`GROUND_FIELDS`).
 """
 
 from __future__ import annotations
@@ -42,6 +43,8 @@ class FixedPointRun:
     own_variant : str
     other_guess : ndarray (2n,)
         Starting point of the other variants' root finder.
+    ground : walkerlab.analysis.gait.checks.GroundContact or None
+        Whether the selected gait's ground contact is unilateral (None: not computed).
     """
 
     walker: object
@@ -49,6 +52,7 @@ class FixedPointRun:
     variants: dict
     own_variant: str
     other_guess: np.ndarray
+    ground: object | None = None
 
 
 def _write_result(g, walker, res, guess) -> None:
@@ -115,12 +119,62 @@ def write_fixedpoint(f, run: FixedPointRun) -> None:
         grp = f.create_group(f"gaits/{g.label}")
         _write_result(grp, walker, g.result, g.start)
         grp.attrs["source"] = g.source
+    if run.ground is not None:
+        _write_ground(f.create_group("ground_contact"), run.ground)
     for v, r in run.variants.items():
         if isinstance(r, Exception):
             f.create_group(f"variants/{v}").attrs["error"] = str(r)
         else:
             _write_result(f.create_group(f"variants/{v}"), r[0], r[1],
                           guess if v == run.own_variant else run.other_guess)
+
+
+#: ``ground_contact/`` datasets: attribute of the check -> (name, unit, meaning)
+GROUND_FIELDS = {
+    "min_normal_force_n": ("min_normal_force", "N", "smallest normal force on the stance "
+                           "foot over the map's continuous phases (< 0: the foot would lift)"),
+    "min_normal_time_s": ("min_normal_time", "s", "when it occurs, from the map's start"),
+    "max_friction_ratio": ("max_friction_ratio", "-", "largest |tangential| / normal force "
+                           "(the friction coefficient the gait needs)"),
+    "heel_strike_normal_impulse_n_s": ("heel_strike_normal_impulse", "N s", "smallest normal "
+                                       "impulse of a heel strike (< 0: a pull)"),
+    "push_off_normal_impulse_n_s": ("push_off_normal_impulse", "N s", "smallest normal "
+                                    "impulse of a push-off (< 0: a pull; 0: none)"),
+    "trailing_foot_normal_velocity_m_per_s": ("trailing_foot_normal_velocity", "m/s",
+                                              "smallest normal velocity of the trailing foot "
+                                              "after a transition (< 0: into the ground)"),
+}
+
+
+def _write_ground(g, ground) -> None:
+    """``ground_contact/``: the unilateral-contact check of the selected gait (attributes
+    ``ok`` 1/0/-1 for yes/no/not checked and ``not_checked``, why not)."""
+    ok = ground.ok
+    g.attrs["ok"] = -1 if ok is None else int(ok)
+    g.attrs["not_checked"] = ground.not_checked
+    for attr, (name, unit, what) in GROUND_FIELDS.items():
+        put(g, name, float(getattr(ground, attr)), unit, what)
+
+
+@dataclass
+class GroundContactRecord:
+    """The stored unilateral-contact check (``ground_contact/``): ``ok`` True / False /
+    None (not checked, ``not_checked`` says why) and the numbers by their check's attribute
+    names (:data:`GROUND_FIELDS`, SI or the scene's units)."""
+
+    ok: bool | None
+    not_checked: str
+    values: dict
+
+
+def _ground(f) -> GroundContactRecord | None:
+    if "ground_contact" not in f:
+        return None
+    g = f["ground_contact"]
+    ok = int(g.attrs["ok"])
+    return GroundContactRecord(None if ok < 0 else bool(ok), str(g.attrs["not_checked"]),
+                               {a: float(g[name][()]) for a, (name, _, _) in
+                                GROUND_FIELDS.items() if name in g})
 
 
 @dataclass
@@ -219,6 +273,8 @@ class FixedPointArtifact(GaitResult):
         Every equation variant solved, by name (``error`` set where none was found).
     scene_json : str
         The resolved scene the gait was computed for (JSON).
+    ground_contact : GroundContactRecord or None
+        Whether the gait needs only a ground that pushes (None in artifacts without it).
     """
 
     path: Path = Path()
@@ -234,6 +290,7 @@ class FixedPointArtifact(GaitResult):
     gaits: dict = field(default_factory=dict)
     variants: dict = field(default_factory=dict)
     scene_json: str = "{}"
+    ground_contact: GroundContactRecord | None = None
 
 
 def load_fixedpoint(path: Path) -> FixedPointArtifact:
@@ -258,4 +315,5 @@ def load_fixedpoint(path: Path) -> FixedPointArtifact:
             gaits={str(lab): _gait(f[f"gaits/{lab}"], names)
                    for lab in f.attrs.get("gaits", [])} if "gaits" in f else {},
             variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
-            if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")))
+            if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")),
+            ground_contact=_ground(f))

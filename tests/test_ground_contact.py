@@ -1,0 +1,141 @@
+"""Unilateral ground contact of a rigid gait (issue 51, item 2b): the stance foot's normal
+force from the generated floating view against Newton's law on the compass gait's particles
+(``tests/independent/actuated_compass.py``: the hip and the two leg masses), the impulses of
+Kuo's push-off and heel strike, and the ``fixedpoint`` stage flagging a gait that needs the
+ground to pull (powered compass, push-off 50 N s)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.independent import actuated_compass as ref
+from walkerlab.config import scene_from_dict
+from walkerlab.models.hybrid.ground_reaction import StanceReaction
+from walkerlab.models.registry import build_walker
+from walkerlab.walker.description import walker_data
+
+G = ref.PAPER["g"]
+
+
+def _compass(push_off_n_s: float, slope: float = 0.0) -> dict:
+    return {"name": "t", "walker": {"model": "compass_gait", "leg_length_m": 1.0,
+                                    "leg_mass_kg": 5.0, "hip_mass_kg": 10.0,
+                                    "gravity_m_per_s2": G, "leg_mass_from_foot_m": 0.5,
+                                    "actuation": {"push_off": {"impulse_n_s": push_off_n_s}}},
+            "slope": {"angle_rad": slope},
+            "solver": {"method": "DOP853", "rtol": 1e-12, "atol": 1e-12},
+            "fixedpoint": {"tolerance": 1e-12}}
+
+
+def _reaction(push_off_n_s: float, slope: float = 0.0):
+    scene = scene_from_dict(_compass(push_off_n_s, slope))
+    w = build_walker(scene)
+    return w, StanceReaction(w, walker_data(scene.walker, scene.slope.phi_rad))
+
+
+def _newton(x, slope: float) -> np.ndarray:
+    """sum_i m_i (a_i + g) over the hip and leg particles, stance foot at rest at the origin
+    (the independent module's positions and flow; theta1 swing, theta2 stance)."""
+    p = ref.PAPER
+    m, MH, L, a, b = p["m"], p["M_H"], p["L"], p["a"], p["L"] - p["a"]
+    t1, t2, d1, d2 = x
+    dd1, dd2 = ref.flow(np.asarray(x), p, slope)[2:]
+
+    def acc(c, th, dth, ddth):  # of c (-sin th, cos th) (and of c (sin th, -cos th): minus)
+        return c * np.array([-np.cos(th) * ddth + np.sin(th) * dth ** 2,
+                             -np.sin(th) * ddth - np.cos(th) * dth ** 2])
+
+    a_hip = acc(L, t2, d2, dd2)
+    a_stance = acc(a, t2, d2, dd2)
+    a_swing = a_hip - acc(b, t1, d1, dd1)
+    up = np.array([0.0, G])
+    return MH * (a_hip + up) + m * (a_stance + up) + m * (a_swing + up)
+
+
+@pytest.mark.parametrize("slope", [0.0, 0.05])
+def test_the_stance_force_is_newtons_total_mass_times_com_acceleration_plus_g(slope):
+    w, sr = _reaction(3.0, slope)
+    rng = np.random.default_rng(5)
+    for _ in range(12):
+        x = rng.normal(0.0, [0.3, 0.3, 1.5, 1.5])
+        got = sr.force(0.0, x, w.phases[0].flow)
+        want = _newton(x, slope)
+        # both exact (generated floating rows vs. particles by hand): round-off only
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * 20 * G)
+        n, t = sr.normal_and_tangential(got)
+        assert n == pytest.approx(want @ [np.sin(slope), np.cos(slope)], abs=1e-8)
+
+
+@pytest.mark.parametrize("slope", [0.0, 0.05])
+def test_the_transition_impulses_equal_the_independent_push_off_and_heel_strike(slope):
+    """Kuo's push-off (3 N s along the trailing leg) then the plastic heel strike, against
+    the independent floating-coordinate transition: the heel strike's impulse at the leading
+    foot, the push-off's ``P e_leg`` (normal component ``P cos(theta_stance + phi)`` > 0) and
+    the trailing foot's normal velocity after them."""
+    w, sr = _reaction(3.0, slope)
+    th = 0.18
+    x_minus = np.array([-th - slope, th - slope, -0.85, -0.95])  # on the heel-strike guard
+    imp = sr.transition(x_minus)
+    x_plus, info = ref.push_off_heel_strike(x_minus, ref.PAPER, slope, 3.0)
+    np.testing.assert_allclose(w.reset(x_minus), x_plus, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(imp.heel_strike, info["impact_impulse"], rtol=0, atol=1e-9)
+    t2 = x_minus[1]
+    np.testing.assert_allclose(imp.push_off, 3.0 * np.array([-np.sin(t2), np.cos(t2)]),
+                               rtol=0, atol=1e-12)
+    assert imp.push_off_normal == pytest.approx(3.0 * np.cos(t2 + slope), rel=1e-12)
+    assert imp.trailing_foot_normal_velocity == pytest.approx(
+        info["trailing_foot_normal_velocity"], abs=1e-9)
+    # this state's swing foot rises at the guard: the "heel strike" would have to pull it
+    # down (-8.9 N s): the sign the check reads
+    assert imp.heel_strike_normal < 0
+    # the gait's own heel strike (one step from the shipped powered compass's gait) pushes
+    from walkerlab.config import SolverSettings
+    from walkerlab.integrate.rigid import integrate_step
+    from walkerlab.integrate.solver import Solver
+
+    seg = integrate_step(w, np.array([-0.1735, 0.1735, -0.7654, -0.8690]),
+                         Solver.from_settings(SolverSettings(method="DOP853", rtol=1e-10,
+                                                             atol=1e-10)))
+    imp = sr.transition(seg.x_end)
+    x_plus, info = ref.push_off_heel_strike(seg.x_end, ref.PAPER, slope, 3.0)
+    np.testing.assert_allclose(imp.heel_strike, info["impact_impulse"], rtol=0, atol=1e-9)
+    assert imp.heel_strike_normal > 0 and imp.trailing_foot_normal_velocity > 0
+
+
+def test_a_gait_that_needs_the_ground_to_pull_is_flagged(tmp_path):
+    """The powered compass at 50 N s has a period-1 'gait' whose post-impact stance rate
+    -3.555 rad/s asks the hip for v^2/l = 12.6 m/s^2 of centripetal acceleration against
+    g cos(0.738) = 7.26 m/s^2: the stance foot would lift.  The normal force there is
+    negative, and ``walkerlab fixedpoint`` says so and stores it."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+
+    w, sr = _reaction(50.0)
+    x = np.array([-0.7376664568, 0.7376664568, 2.8771358872, -3.5548150323])
+    assert 3.5548150323 ** 2 > G * np.cos(0.7376664568)  # the issue's numbers
+    n, _ = sr.normal_and_tangential(sr.force(0.0, x, w.phases[0].flow))
+    assert n < 0
+    np.testing.assert_allclose(sr.force(0.0, x, w.phases[0].flow), _newton(x, 0.0),
+                               rtol=0, atol=1e-8)
+
+    scene = tmp_path / "pc50.yaml"
+    scene.write_text(yaml.safe_dump(_compass(50.0)))
+    r = CliRunner().invoke(app, ["fixedpoint", str(scene), "--runs-dir", str(tmp_path / "r")])
+    assert r.exit_code == 0, r.output
+    assert "NOT a gait on real ground: the stance foot would lift" in r.output
+    fp = load_fixedpoint(tmp_path / "r" / "t" / "fixedpoint.h5")
+    assert fp.ground_contact is not None and fp.ground_contact.ok is False
+    assert fp.ground_contact.values["min_normal_force_n"] < -20.0  # -31.4 N
+    # the shipped powered compass (3 N s) is a gait on real ground
+    scene3 = tmp_path / "pc3.yaml"
+    scene3.write_text(yaml.safe_dump({**_compass(3.0), "name": "t3"}))
+    r = CliRunner().invoke(app, ["fixedpoint", str(scene3), "--runs-dir", str(tmp_path / "r")])
+    assert r.exit_code == 0, r.output
+    assert "ground contact: unilateral" in r.output
+    fp3 = load_fixedpoint(tmp_path / "r" / "t3" / "fixedpoint.h5")
+    assert fp3.ground_contact.ok is True
+    assert fp3.ground_contact.values["min_normal_force_n"] > 100.0  # 171.4 N

@@ -1,0 +1,313 @@
+"""The ground's force on a rigid hybrid walker's stance foot, and the impulses of its
+step-to-step transition, from the walker's generated floating view.
+
+The rigid model pins the stance foot; a real foot stays on the ground only while the
+ground pushes (a unilateral contact).  Its force follows from the floating view of the same
+walker (:mod:`walkerlab.codegen.floating`: coordinates ``[hip_x, hip_y, link angles]``, no
+foot pinned), whose equations ``M(q) qdd + h(q, dq) = sum_i J_i^T F_i + Q`` have, in the
+rows of the hip's position, the whole walker's linear momentum: every point of the walker
+moves with the hip, so ``J_i`` has the identity there, and a joint torque ``Q`` (an
+actuator, a spring, a damper between links) does no work on a translation of the whole
+walker.  With the stance foot the only contact,
+
+    F = (M qdd_f + h)[hip_x, hip_y]      (= total mass x (CoM acceleration + g), Newton)
+
+where ``qdd_f`` is the rigid flow's acceleration in the floating coordinates: the link
+angles' accelerations from the rigid ones, and the hip's from the stance foot's
+kinematics, ``v_hip = -J_s,links dq_links`` (the stance foot's material point at rest; an
+arc foot rolls), differentiated: ``a_hip = -(J_s,links qdd_links + (dV_s/dq) dq)``.
+
+At the end of a step the same rows give the total impulse of the ground,
+``Lambda = (M (dq_f+ - dq_f-))[hip rows]``: the push-off's (an impulse ``P`` along the
+trailing leg, :mod:`walkerlab.models.hybrid.actuated`) plus the heel strike's at the leading
+foot (the trailing foot leaves the ground with no impulse in the rigid model).  A
+unilateral contact needs the normal component of each >= 0, and the trailing foot must move
+away from the ground after the transition.
+
+A walker whose legs are massless (the simplest walker, Garcia et al. 1998; Kuo 2002) has no
+floating view; all its mass is the hip's, so the same rows read ``F = M_hip (a_hip + g)``,
+with the hip's acceleration ``d^2/dt^2 hip(q(t))`` from the rigid model's own ``points``
+(central differences along ``q + h dq + h^2 qdd / 2``), and the impulses
+``M_hip (v_hip+ - v_hip-)``.
+
+Nothing here knows the number of states: the rigid state is read by role name
+(``walker.leg_angles`` or the roles) and mapped to the floating view's link coordinates by
+:func:`walkerlab.walker.layout.floating_links_from_rigid`.  Leg angles are affine in the
+rigid coordinates (every generated walker's are), so the same map takes the rates'
+derivatives to the angles' accelerations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.codegen.floating import (
+    contact_names,
+    coordinate_names,
+    floating_module,
+    floating_params,
+)
+from walkerlab.walker.layout import StateLayout, floating_links_from_rigid
+
+__all__ = ["StanceReaction", "TransitionImpulses"]
+
+#: the floating view's contact point of each role's foot (leg1 swings, leg2 stands)
+_FOOT_OF_ROLE = {"swing": "leg1", "stance": "leg2"}
+
+
+class _View:
+    """The generated floating module's kernels (:mod:`walkerlab.codegen.floating`: ``dyn``,
+    ``feet``, ``feet_jac``) run as the plain Python they are generated from (their
+    ``py_func``): a check of a few hundred states costs no numba compilation or cache load
+    (about 0.07 ms a state)."""
+
+    def __init__(self, data):
+        mod = floating_module(data.structure)  # raises for a massless body
+        self.params = np.asarray(floating_params(data), float)
+        self.nq = int(mod.NQ)
+        self.names = contact_names(data.structure)
+        self.coordinates = coordinate_names(data.structure)
+        self._dyn, self._feet = mod.dyn.py_func, mod.feet.py_func
+        self._feet_jac = mod.feet_jac.py_func
+
+    def _x(self, q, dq=None) -> np.ndarray:
+        return np.concatenate([q, np.zeros(self.nq) if dq is None else dq])
+
+    def dynamics(self, q, dq) -> tuple[np.ndarray, np.ndarray]:
+        """``M(q)`` (nq, nq) and ``h(q, dq)`` (nq,)."""
+        M, h = np.empty((self.nq, self.nq)), np.empty(self.nq)
+        self._dyn(self._x(q, dq), self.params, M, h)
+        return M, h
+
+    def contact_points(self, q, dq=None):
+        """Contact points (nf, 2) [m], material velocities (nf, 2) [m/s], Jacobians
+        (nf, 2, nq)."""
+        nf = len(self.names)
+        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, self.nq))
+        self._feet(self._x(q, dq), self.params, P, V, J)
+        return P, V, J
+
+    def velocity_gradient(self, q, dq) -> np.ndarray:
+        """``d V_i / dq`` (nf, 2, nq) at fixed rates: ``(dV/dq) dq = Jdot dq``."""
+        nf = len(self.names)
+        dV, dJtF = np.empty((nf, 2, self.nq)), np.empty((self.nq, self.nq))
+        self._feet_jac(self._x(q, dq), np.zeros((nf, 2)), self.params, dV, dJtF)
+        return dV
+
+
+@dataclass(frozen=True)
+class TransitionImpulses:
+    """The ground's impulses across one step-to-step transition (push-off, heel strike).
+
+    Attributes
+    ----------
+    heel_strike : ndarray (2,)
+        Impulse on the leading foot [N s], world axes (x downhill, y up).
+    push_off : ndarray (2,)
+        Impulse on the trailing foot [N s] (zeros without a push-off).
+    trailing_foot_velocity : ndarray (2,)
+        The trailing foot's velocity just after the transition [m/s].
+    normal : ndarray (2,)
+        The ground's outward unit normal ``(sin phi, cos phi)``.
+    """
+
+    heel_strike: np.ndarray
+    push_off: np.ndarray
+    trailing_foot_velocity: np.ndarray
+    normal: np.ndarray
+
+    @property
+    def heel_strike_normal(self) -> float:
+        """Normal component of the heel strike's impulse [N s] (>= 0: the ground pushes)."""
+        return float(self.heel_strike @ self.normal)
+
+    @property
+    def push_off_normal(self) -> float:
+        """Normal component of the push-off's impulse [N s] (>= 0)."""
+        return float(self.push_off @ self.normal)
+
+    @property
+    def trailing_foot_normal_velocity(self) -> float:
+        """The trailing foot's velocity along the normal after the transition [m/s] (>= 0:
+        it leaves the ground, as the rigid model takes it to)."""
+        return float(self.trailing_foot_velocity @ self.normal)
+
+
+class StanceReaction:
+    """The ground reaction on the stance foot of one rigid walker's steps.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+        The rigid walker of the steps (for legs that differ, the walker of one stance leg:
+        ``walker.for_stance(leg)``).
+    data : WalkerData
+        Its structure and numbers (for legs that differ, the matching ``data`` or
+        ``data.mirror``: leg1 swinging).
+
+    Raises
+    ------
+    ValueError
+        A walker this cannot check: massless bodies beside massive ones other than the hip
+        (no floating view, :data:`walkerlab.codegen.floating.MASSLESS_MESSAGE`) or flat
+        feet (whose rigid model checks its own contact forces,
+        :mod:`walkerlab.models.hybrid.rigid_flat`).
+    """
+
+    def __init__(self, walker, data):
+        st = data.structure
+        if st.foot == "flat":
+            raise ValueError("flat feet: the rigid model's own guards check the heel's and "
+                             "toe's normal forces")
+        self.walker = walker
+        phi = float(walker.slope_rad)
+        self.normal = np.array([np.sin(phi), np.cos(phi)])
+        self.tangent = np.array([np.cos(phi), -np.sin(phi)])
+        self.view = None
+        if any(b.massless for b in st.bodies):
+            if not st.hip_mass or any(not b.massless for b in (*st.bodies, *st.torso)):
+                floating_module(st)  # raises: a massless body beside massive ones
+            # massless legs, all the mass at the hip (module docstring)
+            self.hip_mass_kg = float(data.total_mass_kg)
+            self.g = float(data.gravity_m_per_s2)
+            return
+        self.view = _View(data)
+        coords = tuple(self.view.coordinates)
+        self._layout = StateLayout.floating(coords, coords + tuple(f"d_{c}" for c in coords),
+                                            ("",) * (2 * len(coords)))
+        self._hip = [coords.index("hip_x"), coords.index("hip_y")]
+        self._links = [i for i in range(len(coords)) if i not in self._hip]
+        self._feet = {r: self.view.names.index(f) for r, f in _FOOT_OF_ROLE.items()}
+
+    # ------------------------------------------------------------------ state maps
+    def _values(self, x) -> dict:
+        """The rigid state's absolute link angles and rates by role name."""
+        w = self.walker
+        x = np.asarray(x, float)
+        if w.leg_angles is not None:
+            vals = {k: float(np.asarray(v)) for k, v in w.leg_angles(x).items()}
+        else:
+            vals = {}
+        n = w.n_coordinates
+        for i, r in enumerate(w.roles):  # a coordinate on no leg (a torso) by its own name
+            vals.setdefault(f"{r}_angle", float(x[i]))
+            vals.setdefault(f"{r}_rate", float(x[n + i]))
+        return vals
+
+    def floating_state(self, x, swapped: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """``(q, dq)`` of the floating view (nq,) for the rigid state ``x`` (2n,) with the
+        stance foot's material point at rest (``swapped``: ``x`` is a post-impact state,
+        roles swapped, and is expressed in the pre-impact labels: its stance leg in the
+        swing leg's place).  The hip's position is 0 (nothing here depends on it)."""
+        vals = self._values(x)
+        if swapped:
+            flip = {"swing": "stance", "stance": "swing"}
+            vals = {(flip[k.split("_", 1)[0]] + "_" + k.split("_", 1)[1]
+                     if k.split("_", 1)[0] in flip else k): v for k, v in vals.items()}
+        z = floating_links_from_rigid(vals, self._layout)
+        m = z.size // 2
+        q, dq = np.zeros(self.view.nq), np.zeros(self.view.nq)
+        q[self._links], dq[self._links] = z[:m], z[m:]
+        _, V, _ = self.view.contact_points(q, dq)
+        dq[self._hip] = -V[self._feet["swing" if swapped else "stance"]]
+        return q, dq
+
+    def _link_acceleration(self, x, xdot) -> np.ndarray:
+        """The link angles' accelerations (floating order) from the rigid rates' derivatives
+        (the leg-angle map is affine: its rate part is linear)."""
+        w = self.walker
+        n = w.n_coordinates
+        xa = np.concatenate([np.asarray(x, float)[:n], np.asarray(xdot, float)[n:]])
+        z = floating_links_from_rigid(self._values(xa), self._layout)
+        return z[z.size // 2:]
+
+    # ------------------------------------------------------------------ a point hip
+    def _point(self, name: str, q) -> np.ndarray:
+        """The rigid model's point ``name`` (2,) [m] (from the stance foot) at ``q`` (n,)."""
+        n = self.walker.n_coordinates
+        return np.asarray(self.walker.points(np.concatenate([q, np.zeros(n)]))[name], float)
+
+    def _point_velocity(self, name: str, x, h: float = 1e-6) -> np.ndarray:
+        """Velocity (2,) [m/s] of the rigid model's point ``name`` at state ``x`` (the
+        stance foot at rest), by central differences along ``dq``."""
+        n = self.walker.n_coordinates
+        q, dq = np.asarray(x, float)[:n], np.asarray(x, float)[n:]
+        return (self._point(name, q + h * dq) - self._point(name, q - h * dq)) / (2 * h)
+
+    def _hip_acceleration(self, x, xdot, h: float = 1e-4) -> np.ndarray:
+        """``d^2 hip / dt^2`` (2,) [m/s^2] along the flow: the second difference of the hip
+        along ``q + s dq + s^2 qdd / 2`` (error O(h^2))."""
+        n = self.walker.n_coordinates
+        q, dq, qdd = np.asarray(x, float)[:n], np.asarray(x, float)[n:], xdot[n:]
+        mid = q + 0.5 * h * h * qdd
+        return (self._point("hip", mid + h * dq) + self._point("hip", mid - h * dq)
+                - 2.0 * self._point("hip", q)) / (h * h)
+
+    # ------------------------------------------------------------------ forces
+    def force(self, t: float, x, flow) -> np.ndarray:
+        """The ground's force on the stance foot (2,) [N], world axes, at state ``x`` (2n,)
+        of a phase whose flow is ``flow(t, x) -> xdot (2n,)``."""
+        xdot = np.asarray(flow(t, np.asarray(x, float)), float)
+        if self.view is None:  # all the mass at the hip
+            return self.hip_mass_kg * (self._hip_acceleration(x, xdot)
+                                       + np.array([0.0, self.g]))
+        q, dq = self.floating_state(x)
+        qdd = np.zeros(self.view.nq)
+        qdd[self._links] = self._link_acceleration(x, xdot)
+        i = self._feet["stance"]
+        _, _, J = self.view.contact_points(q, dq)
+        dV = self.view.velocity_gradient(q, dq)
+        qdd[self._hip] = -(J[i][:, self._links] @ qdd[self._links] + dV[i] @ dq)
+        M, h = self.view.dynamics(q, dq)
+        return (M @ qdd + h)[self._hip]
+
+    def normal_and_tangential(self, F) -> tuple[float, float]:
+        """``(F . n, F . t)`` [N] of a force (2,) (n outward, t down the slope)."""
+        F = np.asarray(F, float)
+        return float(F @ self.normal), float(F @ self.tangent)
+
+    def transition(self, x_minus, x_plus=None) -> TransitionImpulses:
+        """The impulses of the transition from the pre-impact state ``x_minus`` (2n,) to
+        ``x_plus`` (default ``walker.reset(x_minus)``, roles swapped).
+
+        The total impulse of the ground is the hip rows of ``M (dq_f+ - dq_f-)``; the
+        push-off's is ``P e`` (``walker.actuators.impulse``, ``e`` from the trailing foot to
+        the hip), the heel strike's the rest.
+
+        Raises
+        ------
+        ValueError
+            ``x_plus`` is not the configuration of ``x_minus`` (it is not a transition).
+        """
+        w = self.walker
+        x_minus = np.asarray(x_minus, float)
+        x_plus = w.reset(x_minus) if x_plus is None else np.asarray(x_plus, float)
+        if self.view is None:  # all the mass at the hip
+            total = self.hip_mass_kg * (self._point_velocity("hip", x_plus)
+                                        - self._point_velocity("hip", x_minus))
+            e = self._point("hip", x_minus[:w.n_coordinates])  # from the trailing foot
+            trail = self._point_velocity("swing_foot", x_plus)  # the old stance foot
+            push = self._push_off(x_minus, e)
+            return TransitionImpulses(total - push, push, trail, self.normal.copy())
+        q0, v0 = self.floating_state(x_minus)
+        q1, v1 = self.floating_state(x_plus, swapped=True)
+        if not np.allclose(q0[self._links], q1[self._links], atol=1e-8):
+            raise ValueError("the post-impact state is not the pre-impact configuration "
+                             "with the roles swapped")
+        total = (self.view.dynamics(q0, v0)[0] @ (v1 - v0))[self._hip]
+        P, _, _ = self.view.contact_points(q0)
+        push = self._push_off(x_minus, -P[self._feet["stance"]])  # the hip is at 0
+        _, V, _ = self.view.contact_points(q1, v1)
+        return TransitionImpulses(total - push, push, V[self._feet["stance"]].copy(),
+                                  self.normal.copy())
+
+    def _push_off(self, x_minus, e) -> np.ndarray:
+        """The push-off's impulse (2,) [N s]: ``P`` (``walker.actuators.impulse``) along
+        ``e`` (from the trailing foot to the hip); zeros without a push-off."""
+        acts = getattr(self.walker, "actuators", None)
+        if acts is None or getattr(acts.spec, "push_off", None) is None:
+            return np.zeros(2)
+        e = np.asarray(e, float)
+        return float(acts.impulse(x_minus)) * e / np.sqrt(e @ e)
