@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from walkerlab.config import Scene
-from walkerlab.io.runpaths import stage_artifact
+from walkerlab.io.runpaths import design_stem, stage_artifact
 from walkerlab.io.schemas import optimize as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.stages.common import (
@@ -74,7 +74,10 @@ def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
 
 def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
                objective: str, maximize: bool = False) -> StageOutcome:
-    """Compute (or reuse) ``optimize_design.h5``: the fields within ``bounds``
+    """Compute (or reuse) the design optimisation's artifact
+    ``optimize_design_<fields>_<objective>[_maximize].h5``
+    (:func:`walkerlab.io.runpaths.design_stem`: one per set of fields and objective, so
+    another study does not replace it): the fields within ``bounds``
     (``{field: (lo, hi)}``) that minimise (``maximize``: maximise) the gait measure
     ``objective`` (:func:`walkerlab.optimal.design.design_optimize`).
 
@@ -93,13 +96,16 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
         try:
             r = design_optimize(scene, bounds, objective, load_fixedpoint(up).x, maximize)
         except (ValueError, FixedPointNotFound) as exc:
-            raise StageError(f"optimize --design: {exc}") from None
+            msg = str(exc)
+            raise StageError(msg if msg.startswith("optimize --design")
+                             else f"optimize --design: {msg}") from None
         return (lambda f: schema.write_design(f, r)), {"design": r}
 
     key = repr((sorted(bounds.items()), objective, maximize))
     return run_cached(schema.DESIGN_STAGE, scene, runs_root, ("walker", "slope", "ideal",
                                                               "solver"), (up,), compute,
-                      force, extra_key=key, artifact=schema.DESIGN_STAGE)
+                      force, extra_key=key,
+                      artifact=design_stem(list(bounds), objective, maximize))
 
 
 def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
@@ -116,10 +122,14 @@ def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks)
 
 
-def draw_design(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
-    """Draw ``optimize_design.png`` (PNG + SVG) from ``optimize_design.h5``."""
+def draw_design(scene: Scene, runs_root: Path | str, fields: list[str], objective: str,
+                maximize: bool = False) -> list[Path]:
+    """Draw the design optimisation's figure ``<stem>.png`` (PNG + SVG) from its artifact
+    ``<stem>.h5`` (``stem``: :func:`walkerlab.io.runpaths.design_stem` of ``fields``,
+    ``objective`` and ``maximize``)."""
     from walkerlab.io.runpaths import figures_dir
     from walkerlab.plotting.design_figure import save_design_figure
 
-    d = schema.load_design(stage_artifact(scene, runs_root, schema.DESIGN_STAGE))
-    return save_design_figure(d, scene.name, figures_dir(scene, runs_root))
+    stem = design_stem(list(fields), objective, maximize)
+    d = schema.load_design(stage_artifact(scene, runs_root, stem))
+    return save_design_figure(d, scene.name, figures_dir(scene, runs_root), stem)
