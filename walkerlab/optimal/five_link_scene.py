@@ -10,7 +10,26 @@ as ``optimize.h5``.  Needs no upstream gait: the guess is built from the targets
 
 from __future__ import annotations
 
-__all__ = ["optimize_five_link_scene", "stick_figures"]
+__all__ = ["check_targets", "optimize_five_link_scene", "stick_figures"]
+
+
+def check_targets(o) -> None:
+    """Refuse a five-link biped's ``optimize`` section ``o`` without a target (speed, step
+    length or step period): the least effort of a free step is a shuffle (RABBIT: a 1 mm
+    step at 0.0024 m/s, 1.2e-5 N² m² s), not a gait to optimise; Kelly (2017) fixes the
+    step length and period.
+
+    Raises
+    ------
+    ValueError
+        No target (one line saying which fields to give).
+    """
+    if all(t is None for t in (o.target_speed_m_per_s, o.target_step_length_m,
+                               o.target_step_period_s)):
+        raise ValueError("a five-link biped's optimal step needs a target (without one the "
+                         "least effort is a 1 mm shuffle): give optimize.target_step_length_m"
+                         " and target_step_period_s, or target_speed_m_per_s, as "
+                         "configs/rabbit_optimal.yaml (0.5 m in 0.7 s)")
 
 
 def optimize_five_link_scene(scene):
@@ -36,7 +55,8 @@ def optimize_five_link_scene(scene):
     Raises
     ------
     ValueError
-        A push-off asked for, a walker the five-link generator does not handle (one line).
+        No target (:func:`check_targets`), a push-off asked for, a walker the five-link
+        generator does not handle (one line).
     """
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
@@ -48,6 +68,7 @@ def optimize_five_link_scene(scene):
     from walkerlab.walker.description import walker_data
 
     o = scene.optimize
+    check_targets(o)
     if o.push_off == "free":
         raise ValueError("optimize.push_off: a five-link biped has no push-off (its hips and "
                          "knees are driven)")

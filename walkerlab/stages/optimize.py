@@ -35,12 +35,30 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     Raises
     ------
     StageError
-        A walker the collocation does not handle (one line); a missing ``optimize`` or
-        ``fixedpoint`` section runs with its defaults.
+        A walker the collocation does not handle, or the optimisation failed (one line,
+        chained to its origin for the debug trace); a five-link biped without a target
+        in its ``optimize`` section, or without the section (its step is built from the
+        targets).  A missing ``optimize`` section of another walker runs with its
+        defaults (said in one note), a missing ``fixedpoint`` section with its.
     """
     from walkerlab.optimal.scene import needs_gait, optimize_scene
 
+    missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
+    if not needs_gait(scene):  # a five-link biped: its guess is built from the targets
+        from walkerlab.optimal.five_link_scene import check_targets
+
+        try:
+            check_targets(scene.optimize)  # at once, before the collocation is built
+        except ValueError as exc:
+            raise StageError((f"scene '{scene.name}' has no 'optimize' section; "
+                              if missing else "optimize: ") + str(exc)) from exc
+    elif missing:
+        from walkerlab import progress
+
+        progress.note(f"optimize: scene '{scene.name}' has no 'optimize' section: its "
+                      "defaults (least effort int u^2 dt over 40 intervals, the scene's "
+                      "push-off fixed, no targets or limits)")
     if not needs_gait(scene):
         return _run_five_link(scene, runs_root, force)
     require(scene, "fixedpoint", "optimize")
@@ -51,7 +69,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         try:
             data = optimize_scene(scene, fp.x, fp.step_period_s)
         except ValueError as exc:
-            raise StageError(str(exc)) from None
+            raise StageError(str(exc)) from exc
         return (lambda f: schema.write(f, data)), {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, (up,), compute, force)
@@ -66,7 +84,7 @@ def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
         try:
             data = optimize_five_link_scene(scene)
         except ValueError as exc:
-            raise StageError(str(exc)) from None
+            raise StageError(str(exc)) from exc
         return (lambda f: schema.write(f, data)), {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, (), compute, force)
@@ -98,7 +116,7 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
         except (ValueError, FixedPointNotFound) as exc:
             msg = str(exc)
             raise StageError(msg if msg.startswith("optimize --design")
-                             else f"optimize --design: {msg}") from None
+                             else f"optimize --design: {msg}") from exc
         return (lambda f: schema.write_design(f, r)), {"design": r}
 
     key = repr((sorted(bounds.items()), objective, maximize))
