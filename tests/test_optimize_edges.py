@@ -65,3 +65,32 @@ def test_a_contact_replay_whose_solver_fails_is_an_outcome(monkeypatch):
     assert outcome.startswith("not replayed: the contact model's solver (LSODA, rtol 1e-08)")
     assert "f(a) and f(b) must have different signs" in outcome and "contact_solver" in outcome
     assert "\n" not in outcome
+
+
+def test_an_infeasible_target_is_not_replayed_on_contact_and_require_gait_fails(tmp_path):
+    """compass_optimal at 0.6 m/s with |u| <= 0.5 N m: IPOPT reports the problem infeasible
+    and the rigid replay returns 0.03 away - NOT a gait.  Before, the command exited 0 and
+    replayed the contact model on it anyway; now the contact replay is skipped ("not a
+    gait"), ``--require-gait`` exits 1 with one line (as ``fixedpoint --require-stable``,
+    optimize.h5 stays, and a reused one is judged alike)."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.optimize import load
+
+    d = yaml.safe_load((CONFIGS / "compass_optimal.yaml").read_text())
+    d["optimize"].update(target_speed_m_per_s=0.6, max_torque_n_m=0.5)
+    scene = tmp_path / "tight.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    args = ["optimize", str(scene), "--runs-dir", str(tmp_path / "runs")]
+    r = CliRunner().invoke(app, [*args, "--require-gait"])
+    assert r.exit_code == 1 and r.output.count("error:") == 1, r.output
+    assert "error: --require-gait: the optimum is NOT a gait: IPOPT did not converge" \
+        in r.output
+    out = load(tmp_path / "runs" / "tight" / "optimize.h5")
+    assert not out.gait and np.isfinite(out.replay_error)  # the old code replayed it
+    assert np.isnan(out.contact_step_period_s)
+    assert out.contact_outcome.startswith("not replayed: not a gait (IPOPT: ")
+    r = CliRunner().invoke(app, [*args, "--require-gait"])  # reused: read back
+    assert r.exit_code == 1 and "reused" in r.output and "--require-gait" in r.output

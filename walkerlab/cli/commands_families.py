@@ -201,6 +201,11 @@ def optimize(scene: Path | None = SceneArg,
                                            "basin_share | mfpt"),
              maximize: bool = typer.Option(False, "--maximize", help="with --design: "
                                            "maximise the objective"),
+             require_gait: bool = typer.Option(False, "--require-gait",
+                                               help="exit non-zero (one line) when the "
+                                               "optimum is not a gait (IPOPT did not "
+                                               "converge or the rigid replay does not "
+                                               "close); optimize.h5 stays"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """A periodic gait of a walker with a hip torque (a five-link biped: hip and knee
     torques) by direct collocation (CasADi + IPOPT; the scene's optimize section): least
@@ -212,6 +217,9 @@ def optimize(scene: Path | None = SceneArg,
     from walkerlab.stages import pipeline
 
     if design:
+        if require_gait:
+            raise ValueError("--require-gait: with the gait's optimisation, not --design "
+                             "(a design follows the scene's own gait)")
         _optimize_design(scene, design, objective, maximize, runs_dir, force)
         return
 
@@ -261,6 +269,13 @@ def optimize(scene: Path | None = SceneArg,
     from walkerlab.stages.optimize import draw
 
     typer.echo(f"figure: {draw(load(scene), runs_dir)[0]}")
+    if require_gait:  # the artifact stays: it holds what was found
+        from walkerlab.io.schemas.optimize import load as load_optimize
+
+        d = d if d is not None else load_optimize(out.path)
+        if not d.gait:
+            fail(RuntimeError(f"--require-gait: the optimum is NOT a gait: "
+                              f"{not_a_gait_reason(d)}"))
 
 
 def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> None:

@@ -64,7 +64,7 @@ def optimize_five_link_scene(scene):
     from walkerlab.optimal.five_link import JOINTS, five_link_functions
     from walkerlab.optimal.five_link_collocation import collocate_five_link, replay_five_link
     from walkerlab.optimal.five_link_shooting import close_step
-    from walkerlab.optimal.scene import step_record
+    from walkerlab.optimal.scene import not_a_gait_outcome, step_record
     from walkerlab.walker.description import walker_data
 
     o = scene.optimize
@@ -88,7 +88,9 @@ def optimize_five_link_scene(scene):
     units = dict(zip(names, rigid.state_units()))
     gait = bool(res.status == "Solve_Succeeded" and closed.converged
                 and err <= o.replay_tolerance)
-    phases, contact = _phase_replays(scene, data, res)
+    why = "" if gait else (not_a_gait_outcome(err, res.status) if closed.converged else
+                           "not replayed: not a gait (the shooting did not close the step)")
+    phases, contact = _phase_replays(scene, data, res, why)
     return OptimizeData(
         res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u, res.step_period_s,
         res.step_length_m, 0.0, res.objective, err, closed.multipliers, gait, res.status,
@@ -103,10 +105,11 @@ def optimize_five_link_scene(scene):
 CONTACT_STRIDES = 2
 
 
-def _phase_replays(scene, data, res) -> tuple[dict, tuple[float, str]]:
+def _phase_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple[float, str]]:
     """The phase-variable replays (:func:`walkerlab.optimal.five_link_replay.phase_replays`)
     as ``optimize.h5``'s records, and the contact model's ``(step period [s], outcome)``
-    under the feed-forward + PD law from its closed start."""
+    under the feed-forward + PD law from its closed start; an optimum that is not a gait
+    is not replayed there (``not_gait``: why, the contact outcome)."""
     from walkerlab.optimal.contact_replay import contact_replay_five_link
     from walkerlab.optimal.five_link_replay import phase_replays
     from walkerlab.optimal.phase_replay import records
@@ -119,6 +122,8 @@ def _phase_replays(scene, data, res) -> tuple[dict, tuple[float, str]]:
     except ValueError as exc:  # the phase variable is not monotonic: no such replay
         return {}, (float("nan"), f"not replayed: {exc}")
     out = records(replays)
+    if not_gait:
+        return out, (float("nan"), not_gait)
     fb = replays["feedback"]
     if not fb.closed:
         return out, (float("nan"), "not replayed: the feed-forward + PD law did not close "

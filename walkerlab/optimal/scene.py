@@ -9,8 +9,8 @@ from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["collocation_spec", "needs_gait", "optimize_scene", "phase_replays",
-           "step_record"]
+__all__ = ["collocation_spec", "needs_gait", "not_a_gait_outcome", "optimize_scene",
+           "phase_replays", "step_record"]
 
 
 def collocation_spec(scene):
@@ -114,16 +114,16 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
             mu = np.linalg.eigvals(DP).astype(complex)
         except Exception:  # noqa: BLE001 - the replay's multipliers are a report, not a gate
             pass
-    contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
-    if np.isfinite(err):
+    gait = bool(err <= o.replay_tolerance and res.status == "Solve_Succeeded")
+    contact_period, contact_outcome = float("nan"), not_a_gait_outcome(err, res.status)
+    if gait:  # the contact model replays a gait only
         contact_period, contact_outcome = contact_replay(scene, res)
     phases, phase_note = phase_replays(scene, data, res, torque_of_time(res))
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
                         res.step_period_s, res.step_length_m, res.push_off_n_s,
-                        res.objective, err, mu, bool(err <= o.replay_tolerance
-                                                     and res.status == "Solve_Succeeded"),
+                        res.objective, err, mu, gait,
                         res.status, res.iterations, res.wall_time_s, units,
                         objective_name=o.objective, objective_unit=_unit(o, data),
                         terms=res.terms, contact_step_period_s=contact_period,
@@ -131,6 +131,25 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
                         torque_unit="N m/kg" if _massless(data) else "N m",
                         phase_replays=phases, phase_replay_outcome=phase_note,
                         **step_record(scene, walker, res))
+
+
+def not_a_gait_outcome(err: float, status: str) -> str:
+    """The contact replay's outcome of an optimum that is not a gait (it is not replayed:
+    a step that does not close on the rigid model says nothing of the contact one).
+
+    Parameters
+    ----------
+    err : float
+        The rigid replay's return error [rad, rad/s] (inf or NaN: the replay failed).
+    status : str
+        IPOPT's status.
+    """
+    if not np.isfinite(err):
+        return "not replayed: the rigid replay failed"
+    if status != "Solve_Succeeded":
+        return f"not replayed: not a gait (IPOPT: {status})"
+    return (f"not replayed: not a gait (the rigid replay returns {err:.2g} away, more than "
+            "optimize.replay_tolerance)")
 
 
 def phase_replays(scene, data, res, tau) -> tuple[dict, str]:
