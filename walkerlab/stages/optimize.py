@@ -41,11 +41,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         targets).  A missing ``optimize`` section of another walker runs with its
         defaults (said in one note), a missing ``fixedpoint`` section with its.
     """
-    from walkerlab.optimal.scene import needs_gait, optimize_scene
+    from walkerlab.optimal.scene import five_link, no_gait_of_its_own, optimize_scene
 
     missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
-    if not needs_gait(scene):  # a five-link biped: its guess is built from the targets
+    if five_link(scene):  # a five-link biped: its guess is built from the targets
         from walkerlab.optimal.five_link_scene import check_targets
 
         try:
@@ -53,14 +53,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         except ValueError as exc:
             raise StageError((f"scene '{scene.name}' has no 'optimize' section; "
                               if missing else "optimize: ") + str(exc)) from exc
-    elif missing:
+        return _run_five_link(scene, runs_root, force)
+    if missing:
         from walkerlab import progress
 
         progress.note(f"optimize: scene '{scene.name}' has no 'optimize' section: its "
                       "defaults (least effort int u^2 dt over 40 intervals, the scene's "
                       "push-off fixed, no targets or limits)")
-    if not needs_gait(scene):
-        return _run_five_link(scene, runs_root, force)
+    if no_gait_of_its_own(scene):  # no gait to start from: a step from the targets
+        return _run_from_targets(scene, runs_root, force)
     require(scene, "fixedpoint", "optimize")
     up = stage_artifact(scene, runs_root, "fixedpoint")
 
@@ -73,6 +74,37 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         return (lambda f: schema.write(f, data)), {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, (up,), compute, force)
+
+
+def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
+    """``optimize.h5`` of a walker with no gait of its own (a passive walker on level
+    ground: :func:`walkerlab.optimal.scene.no_gait_of_its_own`): no upstream gait, the
+    starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
+    refused at once without them."""
+    from walkerlab.optimal.guess import target_numbers
+    from walkerlab.optimal.scene import optimize_scene
+
+    o = scene.optimize
+    try:
+        if all(v is None for v in (o.target_speed_m_per_s, o.target_step_length_m,
+                                   o.target_step_period_s)):
+            raise ValueError("the walker has no gait of its own (passive, on level or uphill "
+                             "ground): its optimal gait starts from the targets; give "
+                             "optimize.target_speed_m_per_s and target_step_length_m (or a "
+                             "downhill slope, or optimize.initial_guess)")
+        target_numbers(o, 1.0)  # enough targets for a step: refused at once
+    except ValueError as exc:
+        raise StageError(f"optimize: {exc}".replace("optimize: optimize: ", "optimize: ")) \
+            from exc
+
+    def compute():
+        try:
+            data = optimize_scene(scene, None, None)
+        except ValueError as exc:
+            raise StageError(str(exc)) from exc
+        return (lambda f: schema.write(f, data)), {"data": data}
+
+    return run_cached("optimize", scene, runs_root, SECTIONS, (), compute, force)
 
 
 def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
