@@ -23,7 +23,9 @@ the product):
   ``with_changes``, ``fixed_point``, ``fixed_points``, ``simulate``, ``contact_simulate``,
   ``compare``, ``basin`` and ``api.sweep`` (each returns an ``xarray.Dataset`` read from the
   stage's artifact; ``walkerlab.studies`` is the package of sweeps, basins and maps),
-  ``continuation`` (the loaded continuation artifact), ``mfpt`` (mean first-passage time)
+  ``continuation`` (the loaded continuation artifact), ``mfpt`` (mean first-passage time),
+  ``optimize`` (optimal gait or design), ``robustness``, ``export`` (the model file's path),
+  ``target`` (in memory: the field value whose gait meets a target), ``Walker``
 
 Importing the package has no side effects and loads no heavy optional package: the API's
 names are looked up on first use (PEP 562).
@@ -32,7 +34,8 @@ names are looked up on first use (PEP 562).
 __version__ = "0.1.0"
 
 _API = ("load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
-        "contact_simulate", "compare", "basin", "continuation", "mfpt", "Walker")
+        "contact_simulate", "compare", "basin", "continuation", "mfpt", "optimize",
+        "robustness", "export", "target", "Walker")
 __all__ = ["__version__", "api", *_API]
 
 
@@ -47,3 +50,43 @@ def __getattr__(name: str):
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
+
+
+import sys as _sys  # noqa: E402
+import types as _types  # noqa: E402
+
+
+class _CallablePackage(_types.ModuleType):
+    """The package :mod:`walkerlab.export` (exchange formats), which called is the front
+    door's :func:`walkerlab.api.export`: ``wl.export(scene, "mjcf")`` writes the model file,
+    ``walkerlab.export.adams`` stays the module."""
+
+    def __call__(self, *args, **kwargs):
+        """:func:`walkerlab.api.export` (same arguments, same return)."""
+        import importlib
+
+        return importlib.import_module("walkerlab.api").export(*args, **kwargs)
+
+
+class _Walkerlab(_types.ModuleType):
+    """This module's type: its attribute ``export`` is the package of exchange formats made
+    callable (:class:`_CallablePackage`), whichever was imported first (the import system
+    sets a subpackage as its parent's attribute, which would hide the front door's
+    function)."""
+
+    @property
+    def export(self):
+        import importlib
+
+        mod = self.__dict__.get("_export_package") or importlib.import_module("walkerlab.export")
+        if not isinstance(mod, _CallablePackage):
+            mod.__class__ = _CallablePackage
+        self.__dict__["_export_package"] = mod
+        return mod
+
+    @export.setter
+    def export(self, module) -> None:
+        self.__dict__["_export_package"] = module
+
+
+_sys.modules[__name__].__class__ = _Walkerlab

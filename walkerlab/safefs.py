@@ -20,13 +20,14 @@ and no larger than the caller's cap, which is checked before a byte is read.
 
 from __future__ import annotations
 
+import errno
 import os
 import stat
 import time
 from pathlib import Path
 
 __all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link", "temp_prefix",
-           "remove_stale_temps", "process_alive", "atomic_replace"]
+           "remove_stale_temps", "process_alive", "atomic_replace", "atomic_replace_all"]
 
 #: when this process started (wall clock) [s]; a temporary file older than this whose
 #: writer is gone is stale
@@ -140,6 +141,94 @@ def atomic_replace(path: Path | str, fill, *, mode: int = 0o644, suffix: str = "
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+def atomic_replace_all(items, *, mode: int = 0o644, suffix: str = ".tmp") -> list[Path]:
+    """Replace several files together, both or neither (an exported walker and its
+    sidecar): every temporary file is filled first (as :func:`atomic_replace`), then each
+    is renamed over its file; a rename that fails (a folder in the file's place, a full
+    disk) puts back the files already replaced (from hard links to the old ones, made
+    before the first rename) and removes the rest.
+
+    Parameters
+    ----------
+    items : sequence of (Path, callable ``(int, str) -> None``)
+        Each file and its ``fill``, as :func:`atomic_replace`'s.
+    mode, suffix
+        As :func:`atomic_replace`.
+
+    Returns
+    -------
+    list of Path
+
+    Raises
+    ------
+    OSError
+        A temporary file cannot be filled or a file cannot be replaced: every file is left
+        as it was, no temporary file or backup is left behind.
+    """
+    import tempfile
+
+    paths = [Path(p) for p, _ in items]
+    temps: list[str] = []
+    backups: list[tuple[Path, str | None]] = []  # (file, hard link to its old content)
+    done: list[int] = []
+    try:
+        for path, (_, fill) in zip(paths, items):
+            if path.is_dir():  # refused before anything is written
+                raise IsADirectoryError(21, "a folder stands in the file's place", str(path))
+            remove_stale_temps(path.parent, path.name, (suffix, ".bak"))
+            fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path.name), suffix=suffix,
+                                       dir=path.parent)
+            temps.append(tmp)
+            try:
+                fill(fd, tmp)
+            except BaseException:
+                try:
+                    os.close(fd)
+                except OSError:
+                    pass
+                raise
+            os.chmod(tmp, mode)
+        for path in paths:
+            old = None
+            if os.path.lexists(path):
+                _, old = tempfile.mkstemp(prefix=temp_prefix(path.name), suffix=".bak",
+                                          dir=path.parent)
+                os.unlink(old)
+                try:
+                    os.link(path, old, follow_symlinks=False)
+                except OSError as exc:  # a file system without hard links: a copy
+                    if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EXDEV,
+                                         errno.EMLINK):
+                        raise
+                    import shutil
+
+                    shutil.copy2(path, old)
+            backups.append((path, old))
+        for i, (path, tmp) in enumerate(zip(paths, temps)):
+            os.replace(tmp, path)
+            done.append(i)
+    except BaseException:
+        for i in reversed(done):  # put back what was replaced
+            path, old = backups[i]
+            try:
+                if old is None:
+                    path.unlink(missing_ok=True)
+                else:
+                    os.replace(old, path)
+            except OSError:
+                pass
+        for tmp in temps:
+            Path(tmp).unlink(missing_ok=True)
+        for _, old in backups:
+            if old is not None:
+                Path(old).unlink(missing_ok=True)
+        raise
+    for _, old in backups:
+        if old is not None:
+            Path(old).unlink(missing_ok=True)
+    return paths
 
 
 def process_alive(pid: int) -> bool:

@@ -182,9 +182,10 @@ def read_private(path: Path) -> str | None:
         return None
 
 
-def write_private(path: Path, text: str) -> bool:
+def write_private(path: Path, text: str, errors: list | None = None) -> bool:
     """Write ``path`` atomically with mode 0600; False (and nothing left behind) when the
-    folder cannot be written (read-only, disk full, ...)."""
+    folder cannot be written (read-only, disk full, ...), the OSError appended to
+    ``errors`` when given."""
     from walkerlab.safefs import atomic_replace
 
     def fill(fd, _tmp):
@@ -194,7 +195,9 @@ def write_private(path: Path, text: str) -> bool:
     try:
         atomic_replace(path, fill, mode=0o600, name=path.stem)
         return True
-    except OSError:
+    except OSError as exc:
+        if errors is not None:
+            errors.append(exc)
         return False
 
 

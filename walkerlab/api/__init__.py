@@ -14,11 +14,13 @@ of the front door is :func:`walkerlab.api.sweep` (``wl.api.sweep(scene, param, v
 
 Modules: :mod:`~walkerlab.api.scenes` (:func:`load_scene`, :func:`with_changes`),
 :mod:`~walkerlab.api.runs` (one scene: :func:`fixed_point`, :func:`fixed_points`,
-:func:`simulate`, :func:`contact_simulate`, :func:`compare`),
+:func:`simulate`, :func:`contact_simulate`, :func:`compare`, :func:`optimize` (optimal gait
+or design), :func:`robustness`, :func:`export` (the written model file's path)),
 :mod:`~walkerlab.api.studies` (many points: :func:`sweep`, :func:`basin`,
 :func:`continuation`, :func:`mfpt`) and :mod:`~walkerlab.api.walker` (:class:`Walker`: the
-walker in memory, its map, Jacobian, fixed point and walks, no artifact); this module only
-gathers their public names.
+walker in memory, its map, Jacobian, fixed point and walks, no artifact; and
+:func:`target`: the field value whose gait meets a target speed, step length or period, in
+memory as ``walkerlab target``); this module only gathers their public names.
 
 Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``dev`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what
@@ -34,11 +36,20 @@ Example
 >>> run.leg1_angle.plot()                                 # doctest: +SKIP
 """
 
-from walkerlab.api.runs import compare, contact_simulate, fixed_point, fixed_points, simulate
+from walkerlab.api.runs import (
+    compare,
+    contact_simulate,
+    export,
+    fixed_point,
+    fixed_points,
+    optimize,
+    robustness,
+    simulate,
+)
 from walkerlab.api.scenes import DEFAULT_RUNS, load_scene, with_changes
 from walkerlab.api.studies import basin, continuation, mfpt, sweep
-from walkerlab.api.walker import Walker
+from walkerlab.api.walker import Walker, target
 
 __all__ = ["DEFAULT_RUNS", "load_scene", "with_changes", "fixed_point", "fixed_points",
            "simulate", "contact_simulate", "compare", "sweep", "basin", "continuation", "mfpt",
-           "Walker"]
+           "optimize", "robustness", "export", "target", "Walker"]

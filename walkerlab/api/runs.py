@@ -1,6 +1,7 @@
 """One scene's runs from the front door (:mod:`walkerlab.api`): the gait, a rigid and a
-contact simulation, their comparison.  Each runs the stage the command runs and reads its
-artifact back as an ``xarray.Dataset``."""
+contact simulation, their comparison, the optimal gait or design, the robustness measures
+and the exported model.  Each runs the stage the command runs and reads its artifact back as
+an ``xarray.Dataset`` (the export: the written file's path)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 from walkerlab.api.scenes import DEFAULT_RUNS, as_scene, read_dataset, runs_folder
 
-__all__ = ["compare", "contact_simulate", "fixed_point", "fixed_points", "simulate"]
+__all__ = ["compare", "contact_simulate", "export", "fixed_point", "fixed_points", "optimize",
+           "robustness", "simulate"]
 
 
 def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -107,7 +109,9 @@ def simulate(scene: Scene | str | Path | dict, strides: int | None = None, *,
         (potential from the first stance foot), ``<point>_x``/``<point>_y`` [m] (``hip``,
         ``leg1_foot`` ...), ``stance_leg``, ``step_index``, ``phase``.  On ``step``: the
         step table ``steps_period`` [s], ``steps_step_length`` [m], ``steps_hip_speed``
-        [m/s], ``steps_impact_energy_loss`` [J], ``steps_termination`` ...
+        [m/s], ``steps_impact_energy_loss`` [J] (the heel-strike collision's loss),
+        ``steps_transition_energy_change`` [J] (net across push-off and heel strike),
+        ``steps_termination`` ...
         Attribute ``termination``: ``heel_strike`` when every step completed; a walker
         that falls is recorded (``fall``), not raised.
 
@@ -188,3 +192,189 @@ def compare(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_
     return read_dataset(pipeline.run("compare", as_scene(scene), runs_folder(runs_dir), force).path)
 
 
+
+
+def _design_bounds(design) -> dict:
+    """``{field: (lo, hi)}`` of :func:`optimize`'s ``design`` checked as ``--design``
+    (``FIELD=LO:HI``) is: a mapping of field names to two finite numbers, LO < HI."""
+    import math
+    import numbers
+
+    from walkerlab.config import SceneError
+
+    if not isinstance(design, dict) or not design:
+        raise SceneError(f"optimize: design={design!r}: give a mapping of fields to bounds, "
+                         "e.g. {'walker.hip_mass_kg': (5, 20)} (as --design FIELD=LO:HI)")
+    out = {}
+    for field, rng in design.items():
+        if not isinstance(field, str) or not field.strip():
+            raise SceneError(f"optimize: design field {field!r}: give a dotted scene field")
+        ok = (not isinstance(rng, (str, bytes)) and hasattr(rng, "__len__") and len(rng) == 2
+              and all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in rng))
+        if not ok or not all(math.isfinite(v) for v in rng) or not rng[0] < rng[1]:
+            raise SceneError(f"optimize: design {field}={rng!r}: give (LO, HI), two finite "
+                             "numbers with LO < HI, in the field's unit (as --design "
+                             "FIELD=LO:HI)")
+        out[field.strip()] = (float(rng[0]), float(rng[1]))
+    return out
+
+
+def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
+             objective: str = "max_abs_multiplier", maximize: bool = False,
+             runs_dir: str | Path = DEFAULT_RUNS, force: bool = False) -> xarray.Dataset:
+    """An optimal periodic gait by direct collocation, or an optimal design
+    (``walkerlab optimize``, ``walkerlab optimize --design``).
+
+    Without ``design``: the ``optimize`` stage (CasADi + IPOPT; the scene's ``optimize``
+    section, its defaults when absent): least int u^2 dt under the targets and limits given,
+    replayed on the rigid model; reads ``runs/<scene>/optimize.h5``.  With ``design``: the
+    fields within their bounds that minimise (``maximize``: maximise) a measure of the
+    scene's own gait, followed from the scene's values; reads ``optimize_design.h5``.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+    design : dict, optional
+        ``{field: (lo, hi)}``: dotted numeric scene fields and their bounds in the fields'
+        units (``{"walker.hip_mass_kg": (5, 20)}``), as ``--design FIELD=LO:HI``.
+    objective : str
+        With ``design``: a measure of :data:`walkerlab.optimal.design.MEASURES`
+        (``step_period``, ``step_length``, ``speed``, ``cost_of_transport``,
+        ``max_abs_multiplier``, ``gait_sensitivity_norm``, ``basin_share``, ``mfpt``).
+    maximize : bool
+        With ``design``: maximise the objective.
+    runs_dir, force
+        As :func:`fixed_point`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``optimize.h5``: the collocated step on ``time`` (states [rad, rad/s], ``torque``
+        [N m]), ``step_period`` [s], ``step_length`` [m], ``objective``, the replay's
+        ``multipliers``, the contact replay ...; ``optimize_design.h5``: the fields'
+        optimal values, the objective and its gradient.
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        ``design`` not a mapping of fields to (LO, HI) with finite LO < HI, an unknown
+        ``objective``, or ``objective``/``maximize`` given without ``design``; checked
+        before anything runs (one line).
+    walkerlab.studies.params.SweepError
+        A ``design`` field the scene does not have (with the closest name), before anything
+        runs.
+    walkerlab.stages.common.StageError
+        A walker the collocation does not handle, or no gait on the way (one line).
+    ImportError
+        CasADi missing (``pip install 'walkerlab[optimize]'``), or as :func:`fixed_point`.
+    """
+    from walkerlab.config import SceneError
+    from walkerlab.optimal.design import MEASURES
+    from walkerlab.stages import pipeline
+
+    sc, runs = as_scene(scene), runs_folder(runs_dir)
+    if design is None:
+        if objective != "max_abs_multiplier" or maximize:
+            raise SceneError("optimize: objective and maximize choose a design's measure; "
+                             "give design={field: (lo, hi)} too (the gait's own objective "
+                             "is the scene's optimize section)")
+        return read_dataset(pipeline.run("optimize", sc, runs, force).path)
+    bounds = _design_bounds(design)
+    if objective not in MEASURES:
+        raise SceneError(f"optimize: objective={objective!r}: one of {', '.join(MEASURES)}")
+    if not isinstance(maximize, bool):
+        raise SceneError(f"optimize: maximize={maximize!r}: give True or False")
+    from walkerlab.studies.params import ParamAxis, SweepError, check_axes
+
+    try:
+        check_axes(sc, [ParamAxis(f, (), f) for f in bounds], values=False)  # before any run
+    except SweepError as exc:
+        raise SweepError(str(exc).replace("--param ", "optimize: design field ", 1)) from None
+    from walkerlab.stages import optimize as stage
+
+    pipeline.run_upstream("optimize", sc, runs)
+    return read_dataset(stage.run_design(sc, runs, force, bounds, objective, maximize).path)
+
+
+def robustness(scene: Scene | str | Path | dict, *, workers: int = 1,
+               runs_dir: str | Path = DEFAULT_RUNS, force: bool = False) -> xarray.Dataset:
+    """Robustness of the gait beyond |multiplier| (``walkerlab robustness``): gait
+    sensitivity norms, the largest step-down/up and mid-stance push, and the Monte Carlo
+    mean first-passage time at the scene's sigma (the scene's ``robustness`` section, its
+    defaults when absent).  Runs the ``robustness`` stage and reads ``robustness.h5``.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        Needs a ``fixedpoint`` section.
+    workers : int
+        Local worker processes of the Monte Carlo (1: in this process), as ``--workers``.
+    runs_dir, force
+        As :func:`fixed_point`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The gait sensitivity norms per disturbance (``gsn_<disturbance>``) [per unit of the
+        disturbance], ``step_down_m``/``step_up_m`` brackets [m], ``push_forward_m_per_s``
+        / ``push_backward_m_per_s`` [m/s], ``mfpt_steps`` and its standard error
+        (:mod:`walkerlab.io.schemas.robustness`).
+
+    Raises
+    ------
+    walkerlab.stages.common.StageError
+        No ``fixedpoint`` section, a bad worker count (``0``, ``True``, ``"2"``), or a walker
+        the batched step map cannot carry (one line).
+    SceneError, ImportError
+        As :func:`fixed_point`.
+    """
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.robustness import check
+
+    sc = as_scene(scene)
+    check(sc, workers)  # before the upstream gait search
+    return read_dataset(pipeline.run("robustness", sc, runs_folder(runs_dir), force,
+                                     workers=workers).path)
+
+
+def export(scene: Scene | str | Path | dict, fmt: str = "urdf", *, walker_only: bool = False,
+           runs_dir: str | Path = DEFAULT_RUNS) -> Path:
+    """Write the scene's walker as a multibody model file (``walkerlab export``):
+    ``runs/<scene>/walker.urdf`` (Drake, Pinocchio; with the gait's keyframe beside it,
+    ``walker.gait.json``), ``walker.xml`` (MuJoCo MJCF, the gait as its ``gait`` keyframe)
+    or ``walker.adm`` + ``walker.acf`` (MSC Adams Solver).  The files of one export are
+    written together: all or none.
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+    fmt : {"urdf", "mjcf", "adm"}
+    walker_only : bool
+        URDF/MJCF: the walker alone, no gait search (no keyframe; the MJCF on a plane).
+    runs_dir : str or Path
+        Runs folder (``--runs-dir``).
+
+    Returns
+    -------
+    Path
+        The written file (``walker.adm`` for ``adm``).
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        ``fmt`` not one of the formats, ``walker_only`` not a bool (one line).
+    ValueError
+        A walker the format cannot carry (a massless link, feet), or no rigid gait for the
+        keyframe (one line).
+    walkerlab.io.artifacts.ArtifactError
+        A file cannot be written (disk full, a folder in a file's place): nothing replaced.
+    """
+    from walkerlab.config import SceneError
+    from walkerlab.export.multibody import FORMATS
+    from walkerlab.stages import export as stage
+
+    if not isinstance(fmt, str) or fmt not in (*FORMATS, "adm"):
+        raise SceneError(f"export: fmt={fmt!r}: one of {', '.join(FORMATS)}, adm")
+    if not isinstance(walker_only, bool):
+        raise SceneError(f"export: walker_only={walker_only!r}: give True or False")
+    return stage.run(as_scene(scene), runs_folder(runs_dir), fmt, walker_only=walker_only)

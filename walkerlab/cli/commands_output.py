@@ -62,7 +62,13 @@ def export(scene: Path | None = SceneArg,
     gait (found as `walkerlab fixedpoint` finds it) as a keyframe."""
     from walkerlab.stages import export as stage
 
-    typer.echo(f"wrote {stage.run(load(scene), runs_dir, fmt, walker_only=walker_only)}")
+    sc = load(scene)
+    typer.echo(f"wrote {stage.run(sc, runs_dir, fmt, walker_only=walker_only)}")
+    if fmt == "adm":  # the dataset is not the scene's walker: say so here, not in a comment
+        from walkerlab.export.adams import actuation_warning
+
+        if warning := actuation_warning(sc):
+            typer.echo(warning, err=True)
 
 
 @guard

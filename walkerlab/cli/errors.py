@@ -49,26 +49,32 @@ def _word_end(text: str) -> int:
 def one_line(text: str, limit: int = MAX_ERROR_CHARS) -> str:
     """A message as one line: its lines joined (a sentence wrapped over two lines stays
     whole); longer than ``limit``, it is cut after the last sentence or field boundary
-    (``.``, ``;``, ``:``, ``,`` followed by a space) and says how to see the rest."""
+    (``.``, ``;``, ``:``, ``,`` followed by a space) and says how to see the rest.  A
+    message ending in a ``[detail]`` (what a search tried) loses that detail first and keeps
+    the advice before it whole, however long."""
     line = " ".join(ln.strip() for ln in str(text).strip().splitlines() if ln.strip())
     if len(line) <= limit:
         return line
-    # a trailing "[detail]" (a solver's report) is cut first: the advice before it stays whole
+    # a trailing "[detail]" (a solver's report) is cut first: the advice before it stays
+    # whole, even when the advice alone is longer than the limit
     start = line.rfind(" [")
-    if line.endswith("]") and 0 < start <= limit:
+    if line.endswith("]") and start > 0:
+        budget = max(limit, start)
         more = f" ... rerun with {DEBUG_ENV}=1 for the rest]"
         detail = line[start:-1]
         # the detail's first clause (what was tried) whole, unless longer than a line of
-        # its own; further clauses ("; ") while they fit 80 characters past the limit:
+        # its own; further clauses ("; ") while they fit 80 characters past the budget:
         # never cut inside a clause, a parenthesis or a sentence
         clauses = detail.split("; ")
         keep = clauses[0] if len(clauses[0]) <= 160 else ""
         for c in clauses[1:] if keep else ():
-            if start + len(keep) + 2 + len(c) + len(more) > limit + 80:
+            if start + len(keep) + 2 + len(c) + len(more) > budget + 80:
                 break
             keep += "; " + c
+        if keep == detail:  # nothing cut: the advice, longer than the limit, and the detail
+            return line
         if not keep:  # one long clause: at a space outside parentheses
-            cut = _word_end(detail[:max(limit + 80 - start - len(more), 2)])
+            cut = _word_end(detail[:max(budget + 80 - start - len(more), 2)])
             keep = detail[:cut].rstrip(",;:( ") if cut > 2 else " ["
         return line[:start] + keep + more
     head = line[:limit]
@@ -87,7 +93,8 @@ def _disk_full_line(exc: BaseException) -> str:
 #: errors shown as one line that live in modules a command may never import: looked up in
 #: ``sys.modules`` when an exception is handled (a module never imported raised nothing), so
 #: the guard does not import the rigid walker's analysis into every command
-_ONE_LINE_ERRORS = (("walkerlab.analysis.gait.poincare", "FixedPointNotFound"),)
+_ONE_LINE_ERRORS = (("walkerlab.analysis.gait.poincare", "FixedPointNotFound"),
+                    ("walkerlab.analysis.gait.poincare", "MultipliersDisagree"))
 
 
 def _loaded_errors(names) -> tuple[type, ...]:

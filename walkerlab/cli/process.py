@@ -59,6 +59,7 @@ def process_settings() -> None:
       imported, and inherited by worker processes;
     - ``SIGXFSZ`` ignored (a file-size limit, ``ulimit -f``, then makes a write fail with
       EFBIG, reported as "disk full" in one line, instead of killing the process);
+    - ``SIGTERM`` handled as ``SIGINT`` (:func:`terminate_as_interrupt`);
     - the cyclic garbage collector's thresholds raised to :data:`GC_THRESHOLDS` (this
       process only; its workers keep Python's): a command imports scipy, h5py, pydantic and
       its own schema after this point, and with Python's (700, 10, 10) the collector walks
@@ -75,11 +76,31 @@ def process_settings() -> None:
     use_for_numba()
     if hasattr(signal, "SIGXFSZ"):
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    terminate_as_interrupt()
     gc.set_threshold(*GC_THRESHOLDS)
     # once per process (a test suite runs many commands in one); registered before the
     # libraries the command imports, so their exit functions run before it
     atexit.unregister(no_collection_at_exit)
     atexit.register(no_collection_at_exit)
+
+
+def _interrupt(signum, frame) -> None:
+    raise KeyboardInterrupt
+
+
+def terminate_as_interrupt() -> None:
+    """``SIGTERM`` (``kill PID``, a scheduler's stop) raises ``KeyboardInterrupt`` as Ctrl-C
+    does, so a write under way removes its temporary file and releases its lock as it does
+    on Ctrl-C (the default action ends the process at once, leaving both behind).  Only in
+    the main thread, and only over the default action (a handler someone else installed is
+    kept)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, _interrupt):
+        signal.signal(signal.SIGTERM, _interrupt)
 
 
 def no_collection_at_exit() -> None:

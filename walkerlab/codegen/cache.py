@@ -109,10 +109,10 @@ def _read(path: Path) -> dict | None:
         return None
 
 
-def write_source(path: Path, body: str) -> bool:
+def write_source(path: Path, body: str, errors: list | None = None) -> bool:
     """Write a cache file (sha256 header + body) atomically, mode 0600; False when the
-    folder cannot be written (nothing is left behind)."""
-    return usercache.write_private(path, f"# sha256 {_digest(body)}\n{body}")
+    folder cannot be written (nothing is left behind; the OSError appended to ``errors``)."""
+    return usercache.write_private(path, f"# sha256 {_digest(body)}\n{body}", errors)
 
 
 def generated_module(structure) -> dict:
@@ -182,10 +182,16 @@ def import_generated(filename: str, module_name: str, build):
     body = read_source(path) if path is not None else None  # None: missing, damaged, untrusted
     if body is None:
         body = build()
-        if path is None or not write_source(path, body):
+        errors: list = []
+        first = path
+        if path is None or not write_source(path, body, errors):
             path = usercache.private_tmp() / filename
-            if not write_source(path, body):
-                raise OSError(f"{path}: cannot write the generated module")
+            if not write_source(path, body, errors):
+                # the cause kept (its errno: a full disk or a file-size limit reads "disk
+                # full" as every other write), named by the cache file first tried
+                err = errors[-1] if errors else OSError()
+                raise OSError(err.errno, "cannot write the generated module "
+                              f"({err.strerror or err})", str(first or path)) from err
     spec = importlib.util.spec_from_loader(module_name, loader=None, origin=str(path))
     mod = importlib.util.module_from_spec(spec)
     mod.__file__ = str(path)

@@ -22,6 +22,7 @@ Generated functions (``x`` is the role-ordered state ``[q, dq]``, shape (2n,)):
 ``from_section(z)`` inverse of ``section`` on that surface (2n,)
 ``energies(X)``     ``(kinetic, potential)`` [J]
 ``points(X)``       dict of named positions (2,) or (2, k) [m]
+``point_velocities`` ``X -> dict`` of the same points' velocities (2,) or (2, k) [m/s]
 ``leg_angles(X)``   dict ``stance_angle, swing_angle, stance_rate, swing_rate`` (absolute)
 ``matrices(x)``     ``(M, C, G)`` numpy arrays
 ``impact_matrices`` ``q -> (De, E)`` extended impact system (paper Eq. 6-7)
@@ -344,6 +345,14 @@ def numpy_fn(name: str, eq: Equations, named: dict, args: str = "x") -> list[str
     return [f"    def {name}({args}):", unpack, *lines, f"{IND}return {{{', '.join(out)}}}"]
 
 
+def _point_velocities(eq: Equations) -> dict:
+    """Velocities (2, 1) [m/s] of the named points, ``d(point)/dq dq`` (exact, linear in
+    ``dq``): evaluated with complex numbers they are analytic in the whole state, so a complex
+    step differentiates through them (a point's Jacobian by a complex step cannot be)."""
+    q, dq = sp.Matrix(eq.q), sp.Matrix(eq.dq)
+    return {k: sp.Matrix(v).jacobian(q) * dq for k, v in eq.points.items()}
+
+
 def generate(eq: Equations, param_names, key: str) -> str:
     """Source text of the generated module (see module docstring).
 
@@ -379,6 +388,7 @@ def generate(eq: Equations, param_names, key: str) -> str:
         f"{IND}d = _energies(x)",
         f"{IND}return d['kinetic'], d['potential']",
         *numpy_fn("points", eq, eq.points),
+        *numpy_fn("point_velocities", eq, _point_velocities(eq)),
         *numpy_fn("leg_angles", eq, {**{f"{k}_angle": v for k, v in la.items()},
                                       **{f"{k}_rate": v for k, v in rates.items()}}),
         *numpy_fn("_matrices", eq, {"M": eq.M, "C": eq.C, "G": eq.G}),

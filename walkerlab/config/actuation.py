@@ -12,11 +12,17 @@ constraints: PD tracking of a reference of a monotonic phase variable).
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, model_serializer, model_validator
 
 from walkerlab.config.base import Strict
+
+#: a reference table's angle [rad]: within two turns of zero (a joint or stance-leg angle
+#: beyond that is no posture, and an unbounded one overflows the spline)
+TableAngle = Annotated[float, Field(ge=-6.3, le=6.3)]
+#: a time table's time since heel strike [s]: a step, not an era
+TableTime = Annotated[float, Field(ge=0, le=1e3)]
 
 
 class _JointTable(Strict):
@@ -24,12 +30,12 @@ class _JointTable(Strict):
     ``angle_rad`` (any joint's angle, e.g. a five-link biped's knee); the one not given is
     left out of the dump (a table as before serialises as before)."""
 
-    hip_angle_rad: list[float] | None = Field(None, min_length=2, max_length=200,
-                                              description="reference hip angle (swing minus "
-                                              "stance leg angle) at each abscissa [rad]")
-    angle_rad: list[float] | None = Field(None, min_length=2, max_length=200, description="the "
-                                          "reference of the joint's angle at each abscissa "
-                                          "(see JointTorque.joint) [rad]")
+    hip_angle_rad: list[TableAngle] | None = Field(
+        None, min_length=2, max_length=200, description="reference hip angle (swing minus "
+        "stance leg angle) at each abscissa [rad]")
+    angle_rad: list[TableAngle] | None = Field(
+        None, min_length=2, max_length=200, description="the reference of the joint's angle "
+        "at each abscissa (see JointTorque.joint) [rad]")
 
     @property
     def values_rad(self) -> list[float]:
@@ -77,7 +83,7 @@ class PhaseReference(_JointTable):
     al. 2003; a kneed stance leg's: the line from the hip to the stance foot): a
     piecewise-linear or cubic-spline table, held at its end values outside."""
 
-    phase_rad: list[float] = Field(min_length=2, max_length=200, description="stance-leg "
+    phase_rad: list[TableAngle] = Field(min_length=2, max_length=200, description="stance-leg "
                                    "angles of the table, increasing [rad]")
     interpolation: Literal["linear", "cubic"] = Field("cubic", description="piecewise-linear "
                                                       "or not-a-knot cubic spline")
@@ -94,7 +100,7 @@ class TimeReference(_JointTable):
     table, held at its end values outside (a time-based feed-forward pattern, the
     alternative to a phase variable, Westervelt et al. 2003 Sec. II)."""
 
-    time_s: list[float] = Field(min_length=2, max_length=200, description="times since the "
+    time_s: list[TableTime] = Field(min_length=2, max_length=200, description="times since the "
                                 "step's heel strike, increasing [s]")
     interpolation: Literal["linear", "cubic"] = Field("cubic", description="piecewise-linear "
                                                       "or not-a-knot cubic spline")

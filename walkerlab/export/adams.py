@@ -80,8 +80,9 @@ from walkerlab.config.contact import LENGTH_UNITS, ContactSettings, TerrainSetti
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.units import for_scene
 
-__all__ = ["ADAMS_FILES", "PIN_JOINT", "AdamsStart", "acf_text", "adams_start", "adm_text",
-           "check_adams_exportable", "contact_mm", "marker_id", "part_ids"]
+__all__ = ["ADAMS_FILES", "PIN_JOINT", "AdamsStart", "acf_text", "actuation_warning",
+           "adams_start", "adm_text", "check_adams_exportable", "contact_mm", "marker_id",
+           "part_ids"]
 
 #: Files of ``--format adm`` in ``runs/<scene>/``.
 ADAMS_FILES = {"adm": "walker.adm", "acf": "walker.acf"}
@@ -107,6 +108,29 @@ def part_ids(mb) -> dict[str, int]:
 def marker_id(part: int, role: str) -> int:
     """MARKER id of ``role`` (:data:`MARKER_OFFSET`) on PART ``part``."""
     return 100 * part + MARKER_OFFSET[role]
+
+
+def actuation_warning(scene: Scene) -> str:
+    """One line for the terminal when the dataset is not the scene's walker: its
+    ``walker.actuation`` (push-off, joint torques) is not exported, so ``walker.adm`` holds
+    the passive walker started from the powered gait - on level (or uphill) ground one that
+    cannot walk.  "" for a passive walker.
+    """
+    act = getattr(scene.walker, "actuation", None)
+    if act is None:
+        return ""
+    parts = [name for name, on in (("the push-off", act.push_off is not None),
+                                   ("the ankle push-off", act.ankle_push_off is not None),
+                                   ("the joint torques", bool(act.torques))) if on]
+    what = " and ".join(parts)
+    line = (f"warning: {ADAMS_FILES['adm']} holds the PASSIVE walker: walker.actuation "
+            f"({what}) is not exported to ADAMS")
+    if scene.slope.phi_rad <= 0:
+        return line + (f"; on {'level' if scene.slope.phi_rad == 0 else 'uphill'} ground "
+                       "the passive walker cannot walk: this dataset loses the gait it "
+                       "starts from and falls or stops")
+    return line + ("; it starts from the powered gait, which the passive walker does not "
+                   "repeat")
 
 
 def check_adams_exportable(mb) -> None:
@@ -194,7 +218,7 @@ class AdamsStart:
     rate_scale: tuple[float, float]
 
 
-def adams_start(scene: Scene, mb, data) -> AdamsStart:
+def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
     """The rigid gait's post-impact state (leg2 in stance, its foot at the origin), its rates
     times ``contact_sim.initial_rate_scale`` (the paper's Table 2 adjustment), and the
     checkerboard of :func:`walkerlab.export.scene.mjcf_scene` cut to the run's strides.
@@ -204,6 +228,9 @@ def adams_start(scene: Scene, mb, data) -> AdamsStart:
     scene : Scene
     mb : Multibody
     data : WalkerData
+    ideal : gait, optional
+        The rigid gait (as :func:`walkerlab.export.scene.mjcf_scene` takes it); default:
+        searched.
 
     Returns
     -------
@@ -222,11 +249,11 @@ def adams_start(scene: Scene, mb, data) -> AdamsStart:
     settings = scene.contact or ContactSettings()
     c, knee = contact_si(settings)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee)
-    ideal = ideal_gait(scene)
+    ideal = ideal_gait(scene) if ideal is None else ideal
     scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)
     z = walker.link_state_from_ideal(ideal.x, scale)
     q, v = walker.layout().coordinate_values(walker.pinned_to_full(z, np.zeros(2)))
-    extra = mjcf_scene(scene, mb, data)
+    extra = mjcf_scene(scene, mb, data, ideal)  # the same gait: one search, not two
     n = _strides(scene) + 2
     lanes = None if extra.lanes is None else tuple(tuple(lane[:n]) for lane in extra.lanes)
     return AdamsStart((float(q["hip_x"]), float(q["hip_y"])),

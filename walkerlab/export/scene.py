@@ -202,7 +202,7 @@ def actuation_json(scene: Scene) -> str | None:
     return json.dumps(act.model_dump(mode="json", exclude_none=True))
 
 
-def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
+def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
     """The gait keyframe, terrain, contact and latch of ``scene`` for the MJCF export.
 
     Parameters
@@ -212,6 +212,11 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
         to the paper's law and a checkerboard of 0.1 m patches.
     mb : Multibody
     data : WalkerData
+    ideal : gait, optional
+        The rigid (derived-variant) gait: ``x`` (role-order post-impact state), ``period_s``
+        [s] and, for legs that differ, ``step_lengths_m`` (a stored ``fixedpoint.h5`` gait,
+        :class:`walkerlab.io.schemas.fixedpoint.GaitResult`); default: searched
+        (:func:`walkerlab.analysis.contact.periodic.ideal_gait`).
 
     Returns
     -------
@@ -231,7 +236,7 @@ def mjcf_scene(scene: Scene, mb, data) -> MjcfScene:
     terrain = scene.terrain or TerrainSettings()
     c, knee = contact_si(settings)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee)
-    ideal = ideal_gait(scene)
+    ideal = ideal_gait(scene) if ideal is None else ideal
     z = walker.link_state_from_ideal(ideal.x)
     qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
     dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)

@@ -171,6 +171,43 @@ def guard_values(compiled, t: float, x: np.ndarray) -> np.ndarray | None:
     return out[y.size + cols[1]] + cols[2]
 
 
+def callable_flow(compiled, n: int, variational: bool):
+    """The compiled flow as Python callables for scipy's ``solve_ivp`` (a stiff method such
+    as LSODA, which CyRK does not have): ``(rhs, jac)``, ``rhs(t, y)`` one cfunc call (the
+    flow (n,), or with ``variational`` the flow and ``A(x) Phi`` (n + n^2,), ``Phi``
+    row-major), ``jac(t, y)`` the flow's Jacobian ``A`` (n, n) from the variational cfunc at
+    ``Phi = I`` (None with ``variational``: the solver takes none then).  The same
+    functions as the phase's Python flow and its Jacobian, to round-off; the data vector is
+    read once here (a time-based law's step start is fixed for the phase).
+    """
+    proto = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_double, ctypes.c_void_p,
+                             ctypes.c_void_p)
+    cols = compiled.guard_columns()
+    extra = 0 if cols is None else cols[0]
+    data = compiled.data()
+    fn = proto(compiled.address(variational))
+    m = n + n * n if variational else n
+
+    def rhs(t, y):
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        out = np.empty(m + extra)
+        fn(out.ctypes.data, float(t), y.ctypes.data, data.ctypes.data)
+        return out[:m]
+
+    if variational:
+        return rhs, None
+    fv = proto(compiled.address(True))
+    eye = np.eye(n).ravel()
+
+    def jac(t, x):
+        y = np.concatenate([np.asarray(x, dtype=np.float64), eye])
+        out = np.empty(n + n * n + extra)
+        fv(out.ctypes.data, float(t), y.ctypes.data, data.ctypes.data)
+        return out[n:n + n * n].reshape(n, n)
+
+    return rhs, jac
+
+
 def _first_crossing(G: np.ndarray, dirs: np.ndarray):
     """First row ``k >= 1`` of guard values ``G`` (k, g) where a guard changes sign in its
     direction between rows ``k-1`` and ``k`` (``solve_ivp``'s rule: ``up = g0 <= 0 <= g1``,

@@ -5,12 +5,28 @@ have: which leg is in stance (the hip torques act +tau on the swing leg) and whe
 push-off pulse is running (:mod:`walkerlab.models.contact.actuation`).  So the run goes in
 segments, on :func:`scipy.integrate.solve_ivp` with event location:
 
-1. from the step's start until the swing foot touches the ground on a patch at least
-   ``ContactActuators.min_step_m`` ahead of the stance foot (a heel strike), or a fall;
-2. at the touchdown the roles swap and the push-off starts at the (old) stance foot: for
-   ``pulse_s`` seconds a force ``P / pulse_s`` along that leg (or, with ``pulse_s = 0``, the
-   impulse at once: ``dq += M^-1 J^T P e``);
-3. repeat until the end time, the ``stop`` predicate (strides cap) or an event.
+1. from the step's start until the push-off pulse starts: ``pulse_s`` before the swing
+   foot's predicted touchdown on a patch at least ``ContactActuators.min_step_m`` ahead of
+   the stance foot (its penetration extrapolated at its rate, :func:`pulse_lead`, crosses 0),
+   or a fall;
+2. the pulse, a force ``P / pulse_s`` for ``pulse_s`` seconds along the stance (soon
+   trailing) leg at its foot, ``P`` from the hip speed at its start.  The rigid model's
+   push-off comes immediately before the heel strike, with the trailing foot free for it
+   (Kuo 2002); a pulse started at the touchdown instead works inside the compliant
+   collision, against the ground (3.5x the rigid work per step at 5 ms on
+   configs/powered_compass.yaml).  The touchdown, when it comes within the pulse, swaps the
+   roles and the pulse runs on to its end;
+3. to the touchdown (a heel strike: the roles swap) if the pulse ended before it; a touchdown
+   without a pulse before it (none predicted in time) gets the pulse from the touchdown, and
+   with ``pulse_s = 0`` the impulse at once at the touchdown (``dq += M^-1 J^T P e``, before
+   any collision force: the rigid model's order);
+4. repeat until the end time, the ``stop`` predicate (strides cap) or an event.
+
+As ``pulse_s -> 0`` the run converges to the impulse's, first order in ``pulse_s``: the pulse
+takes over the stance foot's weight support while it lasts, so its work falls short of the
+impulse's by ~13 mJ per ms on configs/powered_compass.yaml (0.2280 J for the impulse at the
+first touchdown, 0.2267 J at 0.1 ms, 0.2148 J at 1 ms, 0.1618 J at 5 ms; the rigid model's
+0.2346 J on its own gait, whose touchdown state the contact walker's differs from).
 
 A free-jointed (five-link) biped's joint torques (:mod:`walkerlab.models.contact.joint_torques`)
 run the same way: the stance leg switched at the heel strike sets which leg's hip and knee
@@ -43,7 +59,7 @@ from walkerlab.models.contact.actuation import powered_rhs
 from .ends import RunEnd
 
 __all__ = ["IVP_METHODS", "STALL_CALLS", "impulse_jump", "powered_atol", "powered_to_section",
-           "push_off", "run_powered"]
+           "pulse_lead", "pulse_lead_s", "push_off", "run_powered"]
 
 #: solve_ivp methods a powered run uses as given (others run as LSODA).
 IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
@@ -136,6 +152,44 @@ def _touchdown_event(walker, stance_of):
     touch.terminal = True
     touch.direction = -1
     return touch
+
+
+def _pulse_event(walker, stance_of, lead_s: float):
+    """Event: the push-off pulse starts, ``lead_s`` [s] before the swing foot's predicted
+    touchdown on ground ahead of the stance foot (as :func:`_touchdown_event`): its
+    penetration extrapolated ``lead_s`` ahead at its present rate, ``delta + lead_s
+    d delta/dt``, crosses 0 upwards (:func:`pulse_lead`)."""
+    acts = walker.actuators
+    n = 2 * walker.nq
+
+    def pulse(t, y):
+        stance = stance_of()
+        rows = acts.leg_contacts(walker, y[:n])
+        sw, st = rows[1 - stance], rows[stance]
+        if sw[7] < 0.5 or sw[3] - st[3] < acts.min_step_m:
+            return 1.0
+        return -float(pulse_lead(sw[0], sw[1], lead_s))
+
+    pulse.terminal = True
+    pulse.direction = -1
+    return pulse
+
+
+def pulse_lead(penetration, rate, pulse_s: float):
+    """The push-off pulse's start criterion: the swing foot's penetration [m] extrapolated
+    ``pulse_s`` [s] ahead at its rate [m/s], ``penetration + pulse_s * rate`` (a pulse
+    started where it crosses 0 upwards ends at the touchdown the extrapolation predicts;
+    arrays or floats alike)."""
+    return penetration + pulse_s * rate
+
+
+def pulse_lead_s(acts) -> float:
+    """How long [s] before the predicted touchdown the push-off pulse starts: the pulse's
+    duration for a walker with a push-off impulse and a pulse, else 0 (no pulse event)."""
+    spec = getattr(acts, "spec", None)
+    if getattr(spec, "push_off", None) is None or getattr(acts, "ankle", None) is not None:
+        return 0.0
+    return float(acts.pulse_s)
 
 
 def _heel_off_event(walker, stance_of):
@@ -281,58 +335,119 @@ class _PoweredRun:
 
     def _keep(self, sol, t_end, y_end=None):
         """Store the samples before ``t_end`` (and ``(t_end, y_end)`` itself if given)."""
-        keep = sol.t < t_end - 1e-12
-        self.ts.append(sol.t[keep] if y_end is None else np.append(sol.t[keep], t_end))
-        self.Ys.append(sol.y.T[keep] if y_end is None else np.vstack([sol.y.T[keep],
-                                                                     y_end[None]]))
+        ts = np.asarray(sol.t, float)  # solve_ivp answers a list if no sample came
+        Y = sol.y.T if ts.size else np.empty((0, self.Ys[0].shape[1]))
+        keep = ts < t_end - 1e-12
+        self.ts.append(ts[keep] if y_end is None else np.append(ts[keep], t_end))
+        self.Ys.append(Y[keep] if y_end is None else np.vstack([Y[keep], y_end[None]]))
+
+    def _pulse(self, y, t, tp, trailing, force, touch: bool):
+        """The push-off pulse ``force`` [N] along leg ``trailing`` from ``t`` to ``tp`` [s];
+        ``touch``: the leading foot's touchdown may end it early (then the heel strike is
+        the caller's).  Returns ``(t, y, touched)``, or None when the run ends here (a fall
+        stored)."""
+        events = [self.fall, self.touch] if touch else [self.fall]
+        sol = self._run(y, t, tp, (trailing, force), events)
+        if sol is None:
+            return None
+        if sol.t_events[0].size:
+            self._fell(sol)
+            return None
+        if touch and sol.t_events[1].size:
+            t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+            self._keep(sol, t)
+            return t, y, True
+        self._keep(sol, tp)
+        return float(sol.t[-1]), sol.y[:, -1].copy(), False
+
+    def _fell(self, sol):
+        self._keep(sol, sol.t_events[0][0], sol.y_events[0][0])
+        self.term, self.msg = RunEnd.FALL, "fall: hip below the fall height"
+        k = sum(len(a) for a in self.ts) - 1
+        self.event = (RunEnd.FALL.value, k, float(sol.t_events[0][0]), "", np.nan)
 
     def go(self, x0, t, t1, stop):
+        """Integrate from ``(t, x0)`` to ``t1``: segments between the discrete events (the
+        push-off pulse's start, heel strike, heel off), the pulse its own segment."""
         acts = self.walker.actuators
         n, nw = 2 * self.walker.nq, len(acts.work_names)
         y = np.concatenate([x0, np.zeros(nw)])
         self.ts, self.Ys = [np.array([t])], [y[None]]
+        # the pulse ends at the predicted touchdown (module docstring); ``pushed``: this
+        # step's pulse has run (or is running)
+        pulsed = pulse_lead_s(acts) > 0.0
+        lead = _pulse_event(self.walker, lambda: self.stance, acts.pulse_s) if pulsed else None
+        pushed = False
         while t < t1 - 1e-12:
             tb = min(t + self.limits.chunk_s, t1)
             watch = acts.ankle is not None and not self.ankle_on
+            arm = pulsed and not pushed
             sol = self._run(y, t, tb, None,
-                            [self.fall, self.touch] + ([self.heel_off] if watch else []))
+                            [self.fall, self.touch] + ([self.heel_off] if watch else [])
+                            + ([lead] if arm else []))
             if sol is None:
                 return
             if sol.t_events[0].size:  # a fall
-                self._keep(sol, sol.t_events[0][0], sol.y_events[0][0])
-                self.term, self.msg = RunEnd.FALL, "fall: hip below the fall height"
-                k = sum(len(a) for a in self.ts) - 1
-                self.event = (RunEnd.FALL.value, k, float(sol.t_events[0][0]), "", np.nan)
+                self._fell(sol)
                 return
             if watch and sol.t_events[2].size:  # heel off: the ankle push-off starts
                 t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
                 self._keep(sol, t)
                 self.ankle_on = True
                 continue
-            if not sol.t_events[1].size:  # the chunk's end
+            if arm and sol.t_events[2].size and not sol.t_events[1].size:
+                # the pulse starts pulse_s before the predicted touchdown, at the stance
+                # (trailing) foot, its impulse from the hip speed here (the pre-impact one)
+                t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
+                self._keep(sol, t)
+                pushed = True
+                P = acts.impulse(y[:n])
+                if not P > 0.0:
+                    continue
+                tp, trailing = min(t + acts.pulse_s, t1), self.stance
+                got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, True)
+                if got is None:
+                    return
+                t, y, touched = got
+                if not touched:  # the touchdown after the pulse: the next segments
+                    continue
+                self._strike(t)  # the pulse straddles the touchdown: its rest after it
+                if t < tp - 1e-12:
+                    got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, False)
+                    if got is None:
+                        return
+                    t, y = got[:2]
+                pushed = False
+            elif not sol.t_events[1].size:  # the chunk's end
                 self._keep(sol, np.inf)
                 t, y = float(sol.t[-1]), sol.y[:, -1].copy()
                 continue
-            t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
-            self._keep(sol, t)
-            trailing, self.stance = self.stance, 1 - self.stance  # heel strike: roles swap
-            self.t_origin, self.ankle_on = t, False
-            P = acts.impulse(y[:n]) if acts.ankle is None else 0.0
-            if P > 0.0 and acts.pulse_s == 0.0:
-                y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
-                y[n + 2] += w
-            elif P > 0.0:
-                tp = min(t + acts.pulse_s, t1)
-                sol = self._run(y, t, tp, (trailing, P / acts.pulse_s), [self.fall])
-                if sol is None:
-                    return
-                self._keep(sol, tp)
-                t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+            else:
+                t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+                self._keep(sol, t)
+                trailing = self.stance
+                self._strike(t)
+                P = acts.impulse(y[:n]) if acts.ankle is None and not pushed else 0.0
+                pushed = False
+                if P > 0.0 and acts.pulse_s == 0.0:
+                    y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
+                    y[n + 2] += w
+                elif P > 0.0:  # no pulse before the touchdown (it came too fast): from it
+                    tp = min(t + acts.pulse_s, t1)
+                    got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, False)
+                    if got is None:
+                        return
+                    t, y = got[:2]
             if stop is not None and stop(np.concatenate(self.ts),
                                          np.vstack(self.Ys)[:, :n]):
                 self._keep_last(t, y)
                 self.term, self.msg = RunEnd.HEEL_STRIKE, "the heel strikes asked for were made"
                 return
+
+    def _strike(self, t):
+        """Heel strike at ``t`` [s]: the roles swap, the step's clock and ankle reset."""
+        self.stance = 1 - self.stance
+        self.t_origin, self.ankle_on = t, False
 
     def _keep_last(self, t, y):
         if t > self.ts[-1][-1] + 1e-12 if len(self.ts[-1]) else True:
@@ -343,9 +458,10 @@ class _PoweredRun:
 def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
                        deadline: float = np.inf, fall_hip_height_m: float = 0.5):
     """Integrate a powered walker from ``x0`` (leg ``stance`` in stance) through the next heel
-    strike (touchdown of the other leg ahead, the roles swap, the push-off pulse or impulse
-    at the old stance foot) to the next upward zero of ``section(x)``: the powered
-    contact step map's flow (:mod:`walkerlab.analysis.contact.step_map`).
+    strike (the push-off pulse at the stance foot ending at the predicted touchdown of the
+    other leg ahead, the touchdown, the roles swap; as :func:`run_powered`) to the next
+    upward zero of ``section(x)``: the powered contact step map's flow
+    (:mod:`walkerlab.analysis.contact.step_map`).
 
     Parameters
     ----------
@@ -387,12 +503,47 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
 
     cross.terminal, cross.direction = True, 1.0
     y, t, struck = np.concatenate([np.asarray(x0, float), np.zeros(nw)]), 0.0, False
+    lead = (_pulse_event(walker, lambda: run.stance, acts.pulse_s) if pulse_lead_s(acts) > 0
+            else None)
+    pushed = False  # the pulse of the heel strike to come has run (or is running)
+
+    def pulse(y, t, tp, trailing, force, events):
+        sol = run._run(y, t, tp, (trailing, force), events)
+        if sol is None:
+            return None, (t, y[:n], run.term)
+        if sol.t_events[0].size:
+            return None, (float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL)
+        if len(events) > 1 and sol.t_events[1].size:
+            return (float(sol.t_events[1][0]), sol.y_events[1][0].copy(), True), None
+        return (float(sol.t[-1]), sol.y[:, -1].copy(), False), None
+
     while t < t_max - 1e-12:
-        sol = run._run(y, t, t_max, None, [run.fall, cross if struck else run.touch])
+        arm = lead is not None and not struck and not pushed
+        sol = run._run(y, t, t_max, None,
+                       [run.fall, cross if struck else run.touch] + ([lead] if arm else []))
         if sol is None:
             return t, y[:n], run.term
         if sol.t_events[0].size:
             return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
+        if arm and sol.t_events[2].size and not sol.t_events[1].size:
+            # the pulse, pulse_s before the predicted touchdown (as run_powered)
+            t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
+            pushed, P = True, acts.impulse(y[:n])
+            if not P > 0.0:
+                continue
+            tp, trailing = t + acts.pulse_s, run.stance
+            got, end = pulse(y, t, tp, trailing, P / acts.pulse_s, [run.fall, run.touch])
+            if got is None:
+                return end
+            t, y, touched = got
+            if touched:  # the heel strike inside the pulse: the roles swap, its rest
+                struck, run.stance, run.t_origin = True, 1 - trailing, t
+                if t < tp - 1e-12:
+                    got, end = pulse(y, t, tp, trailing, P / acts.pulse_s, [run.fall])
+                    if got is None:
+                        return end
+                    t, y = got[:2]
+            continue
         if not sol.t_events[1].size:
             return float(sol.t[-1]), sol.y[:n, -1], RunEnd.NO_HEEL_STRIKE
         t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
@@ -400,33 +551,35 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
             return t, y[:n], RunEnd.T_FINAL
         struck, trailing = True, run.stance
         run.stance, run.t_origin = 1 - trailing, t  # heel strike: the roles swap
-        P = acts.impulse(y[:n])
+        P = 0.0 if pushed else acts.impulse(y[:n])
         if P > 0.0 and acts.pulse_s == 0.0:
             y[:n] = impulse_jump(walker, y[:n], trailing, P)[0]
-        elif P > 0.0:
-            sol = run._run(y, t, t + acts.pulse_s, (trailing, P / acts.pulse_s), [run.fall])
-            if sol is None:
-                return t, y[:n], run.term
-            if sol.t_events[0].size:
-                return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
-            t, y = float(sol.t[-1]), sol.y[:, -1].copy()
+        elif P > 0.0:  # no pulse before the touchdown (it came too fast): from it
+            got, end = pulse(y, t, t + acts.pulse_s, trailing, P / acts.pulse_s, [run.fall])
+            if got is None:
+                return end
+            t, y = got[:2]
     return t, y[:n], RunEnd.NO_HEEL_STRIKE
 
 
 def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.inf,
              fall_hip_height_m: float = 0.5):
-    """The push-off of a heel strike at ``(t, x)``: the pulse ``P / pulse_s`` along leg
-    ``trailing`` for ``pulse_s`` seconds on the powered contact integrator (the new stance
-    leg the other one), or with ``pulse_s = 0`` the impulse at once (:func:`impulse_jump`).
+    """The push-off of a heel strike from ``(t, x)``, the pulse's start (``pulse_s`` before
+    the predicted touchdown, :func:`pulse_lead`): the pulse ``P / pulse_s`` along leg
+    ``trailing`` for ``pulse_s`` seconds on the powered contact integrator (the touchdown
+    inside it not looked for: a walker powered by push-off alone, whose flow does not depend
+    on which leg is in stance), or, at the touchdown, with ``pulse_s = 0`` the impulse at
+    once (:func:`impulse_jump`).
 
     Parameters
     ----------
     walker : ContactWalker
         With ``actuators``.
     x : ndarray, shape (2 nq,)
-        The state at the touchdown [m, rad, m/s, rad/s].
+        The state at the pulse's start (the touchdown for ``pulse_s = 0``) [m, rad, m/s,
+        rad/s].
     t : float
-        The touchdown's time [s].
+        Its time [s].
     trailing : int
         The trailing leg (0: leg1, 1: leg2), the old stance leg.
     solver : Solver

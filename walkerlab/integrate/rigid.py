@@ -25,6 +25,7 @@ from walkerlab.models.hybrid.base import HybridWalker, Phase
 from .ends import RunEnd
 from .rigid_phase import integrate_phase, numeric_jacobian, phase_rhs
 from .solver import Solver
+from .time_limit import start_step_clock
 
 #: A heel strike this soon after the step began [s] is no step: the state sat on the
 #: heel-strike surface and never moved (slope 0, all-zero state; a passive step lasts
@@ -224,6 +225,16 @@ def _end_step(walker: HybridWalker, phase: Phase, guard, st: _StepState, t0: flo
         st.Phi = RJ @ S @ st.Phi
 
 
+def _runs_compiled_on_scipy(phase: Phase) -> bool:
+    """Whether a phase run by scipy (a stiff method, e.g. LSODA) calls its compiled flow
+    instead of its Python one: a free-jointed walker's (five-link biped's) actuated flow,
+    whose Python flow evaluates the laws and differentiates them by the complex step on
+    every call (the compiled flow is the same function, to round-off)."""
+    c = phase.compiled
+    return (c is not None and getattr(c, "actuators", None) is not None
+            and bool(getattr(c.structure, "free_knees", False)))
+
+
 def _advance(walker: HybridWalker, phase: Phase, st: _StepState, t_stop: float, n: int,
              solver: Solver, backend: str, variational: bool):
     """Run ``phase`` from ``st`` and record it (its dense output and log line, the state, the
@@ -237,6 +248,10 @@ def _advance(walker: HybridWalker, phase: Phase, st: _StepState, t_stop: float, 
         st.phase_log.append((phase.name, st.t, st.t, broken.name))
         return None
     rhs, jac = phase_rhs(walker, phase, n, variational)
+    if backend == "scipy" and _runs_compiled_on_scipy(phase):
+        from walkerlab.integrate._compiled import callable_flow
+
+        rhs, jac = callable_flow(phase.compiled, n, variational)
     run = integrate_phase(phase, st.t, st.x, st.Phi, t_stop, n, solver, backend, rhs, jac,
                           variational)
     st.nfev += run.nfev
@@ -293,6 +308,7 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
     """
     backend = solver.resolved_backend()
     n = x0.size
+    start_step_clock()  # inside an integration_time_limit only: this step's CPU time
     if walker.actuators is not None:  # a time-based torque law counts from the step's start
         walker.actuators.begin_step(t0)
     t_stop = t0 + max_step_time

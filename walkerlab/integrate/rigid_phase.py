@@ -31,6 +31,7 @@ from walkerlab.models.hybrid.base import HybridWalker, Phase
 from walkerlab.numerics import complex_step_jacobian, fd_jacobian
 
 from .solver import Solver
+from .time_limit import check_time_limit, limited
 
 __all__ = ["IMPLICIT_METHODS", "PhaseRun", "integrate_phase", "numeric_jacobian", "phase_rhs"]
 
@@ -97,6 +98,7 @@ def solve_on(rhs, t0: float, t1: float, y0: np.ndarray, guards, n: int,
         ev.direction = gd.direction
         evs.append(ev)
     y0 = np.ascontiguousarray(y0, dtype=float)
+    rhs = limited(rhs)  # inside an integration_time_limit only: the clock checked
     if backend == "cyrk":
         from walkerlab.integrate.cyrk_loader import pysolve_ivp as cyrk_solver
 
@@ -177,6 +179,8 @@ def integrate_phase(phase: Phase, t0: float, x: np.ndarray, Phi: np.ndarray, t_s
     y0 = np.concatenate([x, Phi.ravel()]) if variational else x
     if backend == "cyrk_compiled" and phase.compiled is not None:
         from walkerlab.integrate._compiled import solve_phase
+
+        check_time_limit()  # no Python in the compiled flow: checked at each phase start
 
         return PhaseRun(*solve_phase(phase.compiled, variational, t0, t_stop, y0,
                                      phase.guards, n, solver))

@@ -133,6 +133,51 @@ def atomic_write(path: Path, write: Callable, mode: int = FILE_MODE) -> Path:
     return path
 
 
+def atomic_write_all(items) -> list[Path]:
+    """Write several files together, both or neither (:func:`walkerlab.safefs.
+    atomic_replace_all`): ``items`` is a sequence of ``(path, write)``, ``write(binary file
+    object)`` as :func:`atomic_write`'s.
+
+    Raises
+    ------
+    ArtifactError
+        A folder cannot be written, a folder stands in a file's place, the disk is full:
+        one line; every file is left as it was.
+    walkerlab.io.runpaths.RunPathError
+        A path is a symbolic link.
+    """
+    from walkerlab.safefs import atomic_replace_all, refuse_link
+
+    paths = [refuse_link(Path(p)) for p, _ in items]
+    for path in paths:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            os.close(os.open(path.parent, os.O_RDONLY))
+        except OSError as exc:
+            if is_disk_full(exc):
+                raise disk_full_error(path, exc) from None
+            raise ArtifactError(f"{path.parent}: cannot write there ({exc.strerror})") \
+                from None
+
+    def filler(write):
+        def fill(fd, _tmp):
+            with os.fdopen(fd, "wb") as fh:
+                write(fh)
+        return fill
+
+    try:
+        return atomic_replace_all([(p, filler(w)) for p, (_, w) in zip(paths, items)],
+                                  mode=FILE_MODE)
+    except OSError as exc:
+        where = Path(exc.filename) if exc.filename else paths[0]
+        names = " and ".join(p.name for p in paths)
+        if is_disk_full(exc):
+            raise disk_full_error(where, exc, f"nothing was replaced ({names} kept as "
+                                  "they were)") from None
+        raise ArtifactError(f"{where}: cannot write ({exc.strerror or exc}); nothing was "
+                            f"replaced ({names} kept as they were)") from None
+
+
 # HDF5 dimension-scale bookkeeping (netCDF-4 conventions): object references whose printed
 # form depends on the open file handle, not on the content; the scales themselves are hashed.
 _REFERENCE_ATTRS = frozenset({"DIMENSION_LIST", "REFERENCE_LIST"})

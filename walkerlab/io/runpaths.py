@@ -300,6 +300,14 @@ def atomic_text(path: Path, text: str) -> Path:
     return atomic_write(path, lambda fh: fh.write(text.encode()))
 
 
+def atomic_texts(items) -> list[Path]:
+    """Write text files together, all or none (:func:`walkerlab.io.artifacts.
+    atomic_write_all`): ``items`` is a sequence of ``(path, text)``."""
+    from walkerlab.io.artifacts import atomic_write_all
+
+    return atomic_write_all([(p, lambda fh, t=t: fh.write(t.encode())) for p, t in items])
+
+
 #: polling period while waiting for another writer's lock [s]
 LOCK_POLL_S = 0.2
 

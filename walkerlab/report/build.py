@@ -20,7 +20,7 @@ import walkerlab
 from walkerlab.io.runpaths import atomic_text
 from walkerlab.published import for_scene
 from walkerlab.report import contact_sections, sections, study_sections
-from walkerlab.report.figures_section import figures_section
+from walkerlab.report.figures_section import figures_section, ledger_section
 from walkerlab.report.markdown import details, num, table, text, to_html
 from walkerlab.report.robustness_section import mfpt_section, robustness_section
 from walkerlab.report.workprecision_section import workprecision_summary
@@ -134,6 +134,9 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
         md += sections.fixedpoint_section(arts["fixedpoint"], pub)
     md += contact_sections.initial_states_section(scene, arts)  # Table 2, then Table 3
     md += sections.gait_section(scene, inputs, pub)
+    rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
+        report_dir) else Path(figures_dir)
+    md += ledger_section(scene, Path(figures_dir), str(rel), arts)  # beside the gait
     md += contact_sections.sections(scene, inputs)
     md += attribution_section(scene, arts)
     md += workprecision_summary(scene, arts)
@@ -141,9 +144,7 @@ def write_report(scene, inputs: ReportInputs, report_dir: Path, figures_dir: Pat
     md += study_sections.basin_section(arts)
     md += robustness_section(arts, inputs.basin_area)
     md += mfpt_section(arts)
-    rel = Path(figures_dir).relative_to(report_dir) if Path(figures_dir).is_relative_to(
-        report_dir) else Path(figures_dir)
-    md += figures_section(Path(figures_dir), str(rel), arts)
+    md += figures_section(Path(figures_dir), str(rel), arts, units_for_scene(scene))
     md += ["## Scene", ""]
     md += details("Resolved scene (JSON)", "\n".join(
         ["```json", json.dumps(scene.model_dump(mode="json", exclude_none=True), indent=1),

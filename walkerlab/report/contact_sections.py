@@ -94,6 +94,7 @@ def contact_section(scene, arts) -> list[str]:
                 + (f", knee stops {num(w['knee_stop'][-1], 4)}" if "knee_stop" in w else "")
                 + "; closure (kinetic + potential energy change minus "
                 f"these) at most {num(float(abs(w['residual']).max()), 2)} J.", ""]
+        out += _cost_of_transport_lines(c, arts.get("simulate"))
     if per_fail is not None:
         out += [f"**Periodic gait of the contact model**: not found ({per_fail[0]}: "
                 f"{per_fail[1]}).", ""]
@@ -108,6 +109,45 @@ def contact_section(scene, arts) -> list[str]:
                 + ", ".join(f"{m:.4f}" for m in per[2][:3])
                 + " and three fast contact/creep modes ≈ 0.", ""]
     return out
+
+
+def _mean(v) -> float:
+    v = np.asarray(v, float)
+    v = v[np.isfinite(v)]
+    return float(v.mean()) if v.size else float("nan")
+
+
+def _cost_of_transport_lines(c, sim) -> list[str]:
+    """The rigid and the contact view's energetics side by side: step period, distance per
+    step, push-off and positive actuator work per step, cost of transport (means over the
+    steps; the contact view's from mid-step to mid-step, ``ledger/steps``)."""
+    led = c.ledger_steps
+    if not led or not len(led.get("cost_of_transport", ())):
+        return []
+    hs = np.asarray(c.heel_strike_times, float)
+    contact = [_mean(np.diff(hs)) if hs.size > 1 else float("nan"), _mean(led["distance"]),
+               _mean(led["push_off_work"]), _mean(led["actuator_work_positive"]),
+               _mean(led["cost_of_transport"])]
+    rigid = [float("nan")] * 5
+    if sim is not None and sim.ledger:
+        r = sim.ledger
+        rigid = [_mean(sim.steps.get("period", [])), _mean(sim.steps.get("step_length", [])),
+                 _mean(r.get("push_off_work", [])), _mean(r.get("actuator_work_positive", [])),
+                 _mean(r.get("cost_of_transport", []))]
+    names = [("step period", "s"), ("step length (contact: hip travel per step)", "m"),
+             ("push-off work per step", "J"), ("positive actuator work per step", "J"),
+             ("cost of transport", "-")]
+
+    def diff(a, b):
+        return f"{100 * (b / a - 1):+.1f} %" if np.isfinite(a) and np.isfinite(b) and a else "—"
+
+    rows = [[n, u, num(a), num(b), diff(a, b)] for (n, u), a, b in zip(names, rigid, contact)]
+    return ["**Energetics, rigid and contact view** (means per step: the rigid run's energy "
+            "ledger, the contact run's from mid-step to mid-step; cost of transport = (positive "
+            "actuator work + push-off work + the potential energy the slope releases) / (M g "
+            "distance); the contact push-off is a pulse ending at the touchdown, "
+            "contact.push_off_duration_s):", "",
+            _table(["quantity", "unit", "rigid", "contact", "contact vs rigid"], rows), ""]
 
 
 def _initial_state_lines(c, arts, pub, table2: dict) -> list[str]:

@@ -11,6 +11,7 @@ import numpy as np
 
 from walkerlab.report.markdown import details, num, table
 from walkerlab.report.workprecision_section import workprecision_table
+from walkerlab.units import Units
 
 if TYPE_CHECKING:  # loaded artifacts (walkerlab.io.schemas)
     from walkerlab.io.schemas.simulate import SimulateArtifact
@@ -50,15 +51,40 @@ def steps_table(sim: SimulateArtifact) -> str:
     """Per-step table of ``simulate.h5`` (period, step length, hip speed, impact loss)."""
     u, s = sim.units, sim.steps
     cols = ("period", "step_length", "hip_speed", "impact_energy_loss")
+    head = [f"period [{u.time}]", f"step length [{u.length}]", f"hip speed [{u.speed}]",
+            f"impact loss [{u.energy}]"]
+    pushed = np.asarray((sim.ledger or {}).get("push_off_impulse", [0.0]), float)
+    if "transition_energy_change" in s and np.nanmax(np.abs(pushed), initial=0.0) > 0:
+        cols += ("transition_energy_change",)  # the push-off's gain, the collision's loss
+        head += [f"net, push-off + heel strike [{u.energy}]"]
     rows = [[int(i), str(leg), *[num(s[c][k]) for c in cols], str(term)]
             for k, (i, leg, term) in enumerate(zip(s["step"], s["stance_leg"],
                                                    s["termination"]))]
-    return table(["step", "stance leg", f"period [{u.time}]", f"step length [{u.length}]",
-                  f"hip speed [{u.speed}]", f"impact loss [{u.energy}]", "ended by"], rows)
+    return table(["step", "stance leg", *head, "ended by"], rows)
 
 
-def energy_section(sim: SimulateArtifact) -> list[str]:
-    """The energy ledger of ``simulate.h5`` per step, and its closure."""
+def spring_law_note(scene) -> str:
+    """A sentence when a joint-torque law of ``scene`` is a spring (stiffness, no
+    reference to track, not scaled by a massless foot's mass - that one does no work): its
+    work enters the ledger and the cost of transport as motor work without regeneration
+    (what it stores counts as positive work when released), where a spring in
+    ``walker.springs`` is passive (its energy is potential energy); "" when none is."""
+    act = getattr(getattr(scene, "walker", None), "actuation", None)
+    springs = [f"walker.actuation.torques.{i} ({t.joint})"
+               for i, t in enumerate(getattr(act, "torques", None) or ())
+               if t.law.stiffness_n_m_per_rad > 0 and t.law.reference is None
+               and t.law.time_reference is None and t.scaled_by == "none"]
+    if not springs:
+        return ""
+    return (f" {', '.join(springs)}: a spring-like torque law, counted as motor work, no "
+            "regeneration - its positive work enters the cost of transport and its negative "
+            "work is lost; a passive spring (energy stored and returned, no cost) is written "
+            "in walker.springs (`springs:`).")
+
+
+def energy_section(sim: SimulateArtifact, scene=None) -> list[str]:
+    """The energy ledger of ``simulate.h5`` per step, and its closure (``scene``: its
+    spring-like torque laws are named, :func:`spring_law_note`)."""
     import math
 
     led, u = sim.ledger, sim.units
@@ -81,13 +107,33 @@ def energy_section(sim: SimulateArtifact) -> list[str]:
             f"the slope releases, per weight and distance along the ground), mean over the "
             f"steps: **{num(mean)}**. Energies in {u.energy}; the collisions, dampers and "
             "negative actuator work are the sinks; closure = the energy change minus the "
-            "sum of the terms." + note, "",
+            "sum of the terms." + spring_law_note(scene) + note, "",
             *details("Energy ledger per step (simulate.h5, ledger/)", table(head, rows))]
 
 
-def optimize_lines(d) -> list[str]:
-    """The optimised step of a loaded ``optimize.h5`` in words."""
+def ledger_section(scene, fig_dir: Path, rel: str, arts: dict) -> list[str]:
+    """The rigid walker's energy ledger and cost of transport (``simulate.h5``): a section
+    of its own, beside the gait (its figure and its per-step table); [] without a
+    ledger."""
+    if "simulate" not in arts:
+        return []
+    text = energy_section(arts["simulate"], scene)
+    if not text:
+        return []
+    out = ["## Energy ledger and cost of transport", ""]
+    png = Path(fig_dir) / "energy_ledger.png"
+    if png.is_file():
+        cap = dict(CAPTIONS)["energy_ledger"]
+        out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
+    return out + text
+
+
+def optimize_lines(d, units: Units = Units()) -> list[str]:
+    """The optimised step of a loaded ``optimize.h5`` in words (times, lengths, speeds and
+    impulses in ``units``: the scene's system)."""
     import numpy as np
+
+    t, m, v, imp = units.time, units.length, units.speed, units("N s")
 
     mu = float(np.max(np.abs(d.multipliers))) if len(d.multipliers) else float("nan")
     five_link = bool(d.phase_replays) and d.torque_names != ("hip",)  # contact: its PD law
@@ -97,36 +143,37 @@ def optimize_lines(d) -> list[str]:
               f" The torques are open loop and the gait unstable under them: from the "
               f"collocated start the step returns {num(d.collocated_start_error, 2)} away, so "
               f"the step is first closed by shooting under the same torques (start moved "
-              f"{num(d.start_shift, 2)}, step period {num(d.replay_step_period_s, 9)} s), "
+              f"{num(d.start_shift, 2)}, step period {num(d.replay_step_period_s, 9)} {t}), "
               f"then replayed.")
     return [f"IPOPT: {d.status} ({d.iterations} iterations, {num(d.wall_time_s, 3)} s). Step "
-            f"period {num(d.step_period_s)} s, step length {num(d.step_length_m)} m, speed "
-            f"{num(d.step_length_m / d.step_period_s)} m/s, push-off {num(d.push_off_n_s)} N s, "
+            f"period {num(d.step_period_s)} {t}, step length {num(d.step_length_m)} {m}, speed "
+            f"{num(d.step_length_m / d.step_period_s)} {v}, push-off {num(d.push_off_n_s)} "
+            f"{imp}, "
             f"peak torque [{d.torque_unit}]: {peak}; objective {d.objective_name} = "
-            f"{num(d.objective)} {d.objective_unit}{cot_terms_text(d)}.{closed} Replayed on "
+            f"{num(d.objective)} {d.objective_unit}{cot_terms_text(d, units)}.{closed} Replayed on "
             f"the rigid model (the "
             f"torques as a function of time): return error {num(d.replay_error, 2)}, largest "
             f"|Floquet multiplier| {num(mu)}: "
             + ("**a gait**." if d.gait else f"**not a gait**: {not_a_gait_reason(d)}.")
-            + phase_replay_text(d)
+            + phase_replay_text(d, units)
             + (f" In the contact model{' (the feed-forward + PD law)' if five_link else ''}"
-               f": step period {num(d.contact_step_period_s)} s "
+               f": step period {num(d.contact_step_period_s)} {t} "
                f"({num(100 * (d.contact_step_period_s / d.step_period_s - 1), 2)} %)"
                + ("." if d.contact_outcome == "heel_strike"
                   else f" (the run ended short of its strides: {d.contact_outcome}).")
                if d.contact_step_period_s == d.contact_step_period_s
                else f" Contact model: {d.contact_outcome}.")
-            + _phases_line(d),
+            + _phases_line(d, t),
             ""]
 
 
-def _phases_line(d) -> str:
+def _phases_line(d, t: str = "s") -> str:
     """The step's phases and their durations (a step of phases, e.g. a kneed walker's; a
     stride of legs that differ: each step's period too)."""
     if not getattr(d, "phase_names", ()):
         return ""
-    parts = ", ".join(f"{n} {num(float(t), 6)} s" for n, t in zip(d.phase_names,
-                                                                   d.phase_duration_s))
+    parts = ", ".join(f"{n} {num(float(dt), 6)} {t}" for n, dt in zip(d.phase_names,
+                                                                       d.phase_duration_s))
     steps = int(getattr(d, "steps", 1))
     stride = ""
     if steps > 1:  # legs that differ: the steps' own periods, the mean above
@@ -135,14 +182,16 @@ def _phases_line(d) -> str:
                          for k in range(steps))
         stride = (f" A stride of {steps} different steps (legs that differ; step period "
                   f"and length above: the mean step's; return error and multipliers: the "
-                  f"stride map's): step periods {each} s.")
+                  f"stride map's): step periods {each} {t}.")
     return f" Phases (each with its own mesh and free duration): {parts}.{stride}"
 
 
-def phase_replay_text(d) -> str:
+def phase_replay_text(d, units: Units = Units()) -> str:
     """The phase-variable replays of a loaded ``optimize.h5`` in words (a step of phases:
     one law per phase); why there are none, or "" when they were not asked for."""
     import numpy as np
+
+    t = units.time
 
     fb, ff = d.phase_replays.get("feedback"), d.phase_replays.get("feedforward")
     out = f" Phase-variable replay: {d.phase_replay_outcome}." if getattr(
@@ -156,11 +205,12 @@ def phase_replay_text(d) -> str:
                 f"trajectory): from the collocated start the step returns "
                 f"{num(fb.collocated_start_error, 2)} away; closed (start moved "
                 f"{num(fb.start_shift, 2)}) it returns to {num(fb.return_error, 2)}, step "
-                f"period {num(fb.step_period_s, 9)} s, largest |multiplier| "
+                f"period {num(fb.step_period_s, 9)} {t}, largest |multiplier| "
                 f"{num(float(np.max(np.abs(fb.multipliers))))} ("
                 f"{'stable' if np.max(np.abs(fb.multipliers)) < 1 else 'unstable'} under the "
                 f"law), the "
-                f"law's torque within {num(fb.torque_error, 2)} N m of the optimal one.")
+                f"law's torque within {num(fb.torque_error, 2)} {units('N m')} of the optimal "
+                "one.")
     if ff is not None:
         out += (f" The phase-variable feed-forward alone (no PD): one step from the "
                 f"collocated start returns {num(ff.collocated_start_error, 2)} away, largest "
@@ -182,9 +232,11 @@ def _drawn_from(stem: str, arts: dict) -> bool:
     return True
 
 
-def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
+def figures_section(fig_dir: Path, rel: str, arts: dict, units: Units = Units()
+                    ) -> list[str]:
     """Every figure that exists, with its raw data folded underneath where it is long
-    (``arts``: the loaded artifacts by stage name)."""
+    (``arts``: the loaded artifacts by stage name; ``units``: the scene's), but the energy
+    ledger's (its own section, :func:`ledger_section`, beside the gait)."""
     out = []
     gif = fig_dir / "animation.gif"  # written by `walkerlab animate`, embedded when present
     if gif.is_file():
@@ -198,11 +250,11 @@ def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
         png = fig_dir / f"{stem}.png"
         if not png.is_file() or not _drawn_from(stem, arts):
             continue
+        if stem == "energy_ledger" and ledger_section(None, fig_dir, rel, arts):
+            continue  # shown in its own section, with the ledger's table
         out += [f"![{cap}]({rel}/{png.name})", "", f"*{cap}*", ""]
         if stem == "optimize" and "optimize" in arts:
-            out += optimize_lines(arts["optimize"])
-        if stem == "energy_ledger" and "simulate" in arts:
-            out += energy_section(arts["simulate"])
+            out += optimize_lines(arts["optimize"], units)
         if stem == "fig7_angles_rates" and "simulate" in arts:
             out += details("Per-step data of the rigid walker (simulate.h5)",
                            steps_table(arts["simulate"]))
@@ -213,14 +265,15 @@ def figures_section(fig_dir: Path, rel: str, arts: dict) -> list[str]:
     return ["## Figures", "", *out] if out else []
 
 
-def cot_terms_text(d) -> str:
+def cot_terms_text(d, units: Units = Units()) -> str:
     """The cost of transport's objective of ``optimize.h5`` (``d``) split into its terms
     (it carries a small effort regularisation, ``optimize.cost_of_transport_effort_weight``:
     ``" (cost of transport C, effort E (N m)^2 s)"``), else ``""``."""
     if d.objective_name != "cost_of_transport" or "cost_of_transport" not in d.terms:
         return ""
     return (f" (cost of transport {float(d.terms['cost_of_transport']):.6g}, effort "
-            f"{float(d.terms.get('effort', float('nan'))):.4g} ({d.torque_unit})^2 s)")
+            f"{float(d.terms.get('effort', float('nan'))):.4g} ({units(d.torque_unit)})^2 "
+            f"{units.time})")
 
 
 def not_a_gait_reason(d) -> str:

@@ -51,24 +51,45 @@ def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = Fal
     return runpaths.scene_file(scene, runs_root, FORMATS[fmt], claim)
 
 
+def stored_gait(scene: Scene, runs_root: Path | str):
+    """The rigid gait of an up-to-date ``fixedpoint.h5`` (the derived equations' selected
+    gait, :class:`walkerlab.io.schemas.fixedpoint.GaitResult`), or None: missing, stale, or
+    of another equation variant (then the export searches, as ``walkerlab fixedpoint``
+    would)."""
+    from walkerlab.io.artifacts import ArtifactError
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.stages.pipeline import fresh_fixedpoint
+
+    path = fresh_fixedpoint(scene, runs_root)
+    if path is None:
+        return None
+    try:
+        fp = load_fixedpoint(path)
+    except ArtifactError:
+        return None
+    return fp if fp.variant == "derived" and not fp.error else None
+
+
 def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
     """``walker.adm`` and ``walker.acf`` (both built before either is written)."""
     check_adams_exportable(mb)  # before the gait search
-    start = adams_start(scene, mb, data)
+    start = adams_start(scene, mb, data, stored_gait(scene, runs_root))
     adm = adm_text(scene, mb, data, name, walkerlab.__version__, start)
     acf = acf_text(scene, start)
-    path = runpaths.atomic_text(export_path(scene, runs_root, "adm", claim=True), adm)
-    runpaths.atomic_text(runpaths.scene_file(scene, runs_root, ADAMS_FILES["acf"], claim=True),
-                         acf)
+    path = export_path(scene, runs_root, "adm", claim=True)
+    runpaths.atomic_texts([  # both or neither
+        (path, adm),
+        (runpaths.scene_file(scene, runs_root, ADAMS_FILES["acf"], claim=True), acf)])
     return path
 
 
-def _gait_scene(scene: Scene, mb, data):
-    """The MJCF's gait keyframe, terrain and contact; no rigid gait: one line."""
+def _gait_scene(scene: Scene, mb, data, runs_root):
+    """The MJCF's gait keyframe, terrain and contact (the gait of an up-to-date
+    ``fixedpoint.h5``, else searched); no rigid gait: one line."""
     from walkerlab.analysis.gait.poincare import FixedPointNotFound
 
     try:
-        return mjcf_scene(scene, mb, data)
+        return mjcf_scene(scene, mb, data, stored_gait(scene, runs_root))
     except FixedPointNotFound as exc:
         where = ("its fixedpoint section" if scene.fixedpoint is not None
                  else "an automatic search (the scene has no fixedpoint section)")
@@ -84,10 +105,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     ``<runs_root>/<scene name>/`` and return the file's path.
 
     The URDF and MJCF carry the rigid gait (the MJCF's ``gait`` keyframe, terrain and
-    contact; the URDF's keyframe sidecar), found as ``walkerlab fixedpoint`` finds it, from
-    the scene's ``fixedpoint`` section or, without one, from its defaults (an automatic
-    search).  ``walker_only``: the walker alone (no gait search; the MJCF on a plane with
-    MuJoCo's default contact, no sidecar).
+    contact; the URDF's keyframe sidecar): the gait of ``fixedpoint.h5`` when it is up to
+    date for the scene, else found as ``walkerlab fixedpoint`` finds it, from the scene's
+    ``fixedpoint`` section or, without one, from its defaults (an automatic search).
+    ``walker_only``: the walker alone (no gait search; the MJCF on a plane with MuJoCo's
+    default contact, no sidecar).
 
     Raises
     ------
@@ -96,6 +118,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         masses), feet the formats cannot carry, or no rigid gait to start from; one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
+    walkerlab.io.artifacts.ArtifactError
+        A file cannot be written (a full disk, a folder in a file's place): the files of
+        the export (``walker.urdf`` and ``walker.gait.json``, ``walker.adm`` and
+        ``walker.acf``) are all written or all left as they were (one line).
     """
     path = export_path(scene, runs_root, fmt)  # check the format before building anything
     data = walker_data(scene.walker, scene.slope.phi_rad)
@@ -104,13 +130,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     if fmt == "adm":
         return _run_adams(scene, runs_root, mb, data, name)
     check_exportable(scene)
-    extra = None if walker_only else _gait_scene(scene, mb, data)
+    extra = None if walker_only else _gait_scene(scene, mb, data, runs_root)
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__, actuation_json(scene))
     else:
         text = mjcf_text(mb, name, walkerlab.__version__, extra)
     path = export_path(scene, runs_root, fmt, claim=True)
+    files = [(path, comments_in_scene_units(text, for_scene(scene)))]
     if fmt == "urdf" and extra is not None:  # URDF has no state: the keyframe beside it
-        runpaths.atomic_text(runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
-                             keyframe_json(mb, extra))
-    return runpaths.atomic_text(path, comments_in_scene_units(text, for_scene(scene)))
+        files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
+                      keyframe_json(mb, extra)))
+    runpaths.atomic_texts(files)  # the walker and its keyframe: both or neither
+    return path

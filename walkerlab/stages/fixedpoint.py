@@ -16,6 +16,51 @@ from walkerlab.stages.common import StageError, StageOutcome, require, run_cache
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint", "published")
 
 
+def _known(scene: Scene, known) -> Scene | None:
+    """The scene whose gait starts this one's search by homotopy (``--from`` or
+    ``fixedpoint.from``), None without one; a bad one: StageError (one line)."""
+    if known is None and getattr(scene.fixedpoint, "from_", None) is None:
+        return None
+    from walkerlab.studies.continuation import known_scene  # only for a homotopy start
+
+    try:
+        return known_scene(scene, known)
+    except SceneError as exc:
+        raise StageError(f"fixedpoint.from: {exc}") from None
+
+
+def _from_key(src: Scene | None) -> str:
+    return "" if src is None else "from:" + json.dumps(src.model_dump(mode="json"),
+                                                       sort_keys=True)
+
+
+def fresh_artifact(scene: Scene, runs_root: Path | str = "runs") -> Path | None:
+    """``runs/<scene>/fixedpoint.h5`` when it is up to date for ``scene`` (what
+    :func:`run` would reuse, with or without the other equation variants), else None
+    (missing, stale, edited, or the scene's ``fixedpoint.from`` cannot be read).
+
+    Read-only: nothing is computed or written, no lock is taken.
+    """
+    from walkerlab.io.artifacts import verified_hash
+    from walkerlab.io.freshness import input_hash
+    from walkerlab.io.runpaths import RunPathError, stage_artifact
+
+    try:
+        path = stage_artifact(scene, runs_root, "fixedpoint")
+        from_key = _from_key(_known(scene, None))
+    except (StageError, RunPathError, ValueError):
+        return None
+    if not path.is_file():
+        return None
+    have = verified_hash(path)
+    if have is None:
+        return None
+    if any(have == input_hash("fixedpoint", scene, SECTIONS, (), extra + from_key)
+           for extra in ("variants", "")):
+        return path
+    return None
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         compare_variants: bool = True, known: Scene | Path | str | None = None
         ) -> StageOutcome:
@@ -34,16 +79,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         No ``fixedpoint`` section, or no fixed point for the scene's own variant.
     """
     require(scene, "fixedpoint", "fixedpoint")
-    src = None
-    if known is not None or getattr(scene.fixedpoint, "from_", None) is not None:
-        from walkerlab.studies.continuation import known_scene  # only for a homotopy start
-
-        try:
-            src = known_scene(scene, known)
-        except SceneError as exc:
-            raise StageError(f"fixedpoint.from: {exc}") from None
-    from_key = "" if src is None else "from:" + json.dumps(src.model_dump(mode="json"),
-                                                          sort_keys=True)
+    src = _known(scene, known)
+    from_key = _from_key(src)
 
     def compute():
         # the rigid analysis only when the gait is computed: a run that reuses fixedpoint.h5

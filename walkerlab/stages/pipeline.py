@@ -78,6 +78,13 @@ def run(stage: str, scene: Scene, runs_root: Path | str = "runs", *args, **optio
     return mod.run(scene, runs_root, *args, **options)
 
 
+def fresh_fixedpoint(scene: Scene, runs_root: Path | str = "runs") -> Path | None:
+    """``fixedpoint.h5`` when it is up to date for ``scene`` (what ``walkerlab fixedpoint``
+    would reuse), else None; nothing is computed (a stage that can use the gait without
+    running the stage, e.g. ``export``, reads it through here)."""
+    return stage_module("fixedpoint").fresh_artifact(scene, runs_root)
+
+
 def report_plan(scene: Scene, full: bool = False) -> list[str]:
     """The stages ``report`` runs for this scene, in order: each only when the scene has its
     sections (``fixedpoint`` also when ``simulate`` starts from the gait); the

@@ -9,6 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from walkerlab.analysis.contact.ledger import (
+    STEP_LEDGER_DESCRIPTIONS,
+    STEP_LEDGER_UNITS,
+    contact_step_ledger,
+)
 from walkerlab.config import ContactSettings
 from walkerlab.models.contact.scene import ContactSetup
 
@@ -144,4 +149,16 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
         initial_rate_scale=np.asarray(scale if scale is not None else cs.initial_rate_scale),
         stiffness_family=setup.law.stiffness_family,
         drop=drop_test(setup.law, walker.total_mass), drop_speed_m_per_s=DROP_SPEED,
-        summary=run_summary(res), gait=gait, gait_error=gait_error, adjust=adj)
+        summary=run_summary(res), gait=gait, gait_error=gait_error, adjust=adj,
+        **_step_ledger(walker, res))
+
+
+def _step_ledger(walker, res) -> dict:
+    """A powered run's ledger per step and its columns' units and descriptions (the
+    :class:`ContactSimRun` fields), or nothing."""
+    if getattr(res, "work", None) is None:
+        return {}
+    return {"step_ledger": contact_step_ledger(walker, res.t, res.x, res.work,
+                                               res.heel_strike_times),
+            "step_ledger_units": STEP_LEDGER_UNITS,
+            "step_ledger_descriptions": STEP_LEDGER_DESCRIPTIONS}

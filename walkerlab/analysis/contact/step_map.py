@@ -34,9 +34,10 @@ a 2 ms grid, :func:`walkerlab.integrate.contact_grid.contact_grid`; no Python pe
 the crossing bracketed on the samples and located by brentq on short compiled runs from the
 sample before it; ``"odeint"`` does the same through scipy's odeint, a ``solve_ivp`` method
 locates it as an event (:func:`walkerlab.integrate.events.run_to_event`).  A powered walker
-(``actuators``: straight legs, point feet) passes its heel strike inside the step: the swing
-foot's touchdown on its patch ahead, the push-off pulse along the trailing leg on the powered
-contact integrator (:mod:`walkerlab.integrate.contact_powered`) and the roles swap; with
+(``actuators``: straight legs, point feet) passes its heel strike inside the step: the
+push-off pulse along the trailing leg, ending at the swing foot's predicted touchdown on its
+patch ahead, on the powered contact integrator (:mod:`walkerlab.integrate.contact_powered`),
+the touchdown and the roles swap; with
 push-off alone the flow between is passive and compiled, with hip torques the whole step
 runs on the powered integrator.  Outputs besides ``P(z)``: the step period ``T`` [s] and the
 step length (along-slope displacement of the stance foot from one mid-stance to the next)
@@ -73,7 +74,13 @@ from scipy.optimize import brentq
 
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
-from walkerlab.integrate.contact_powered import powered_to_section, push_off, run_powered
+from walkerlab.integrate.contact_powered import (
+    powered_to_section,
+    pulse_lead,
+    pulse_lead_s,
+    push_off,
+    run_powered,
+)
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
@@ -331,7 +338,8 @@ class StepMap:
     def _powered_section(self, x0, stance_to_come, ist, isw, hth):
         """:meth:`next_section` of a powered walker: the heel strike, push-off and roles
         swap.  Push-off alone: the passive flow (compiled, :meth:`_grid_crossing`) to the
-        touchdown of the swing foot on its patch ahead, the pulse on the powered contact
+        pulse's start (``pulse_s`` before the predicted touchdown of the swing foot on its
+        patch ahead; the touchdown itself for an impulse), the pulse on the powered contact
         integrator (:func:`walkerlab.integrate.contact_powered.push_off`), the passive flow
         to mid-stance; with hip torques the whole step on the powered contact integrator
         (:func:`walkerlab.integrate.contact_powered.powered_to_section`)."""
@@ -349,14 +357,20 @@ class StepMap:
         w, acts = self.walker, self.walker.actuators
         trailing = 1 - stance_to_come
         sw, st = f"leg{stance_to_come + 1}", f"leg{trailing + 1}"
+        lead = pulse_lead_s(acts)  # the pulse ends at the predicted touchdown
 
-        def touch(X):  # the swing foot's penetration on its patch ahead, else -1
+        def touch(X):  # the swing foot's penetration on its patch ahead, else -1; with a
+            # pulse: extrapolated pulse_s ahead (the pulse ends at the predicted touchdown)
             fq = w.foot_quantities(X)
             ok = (fq[sw]["on_ground"] > 0.5) & (fq[sw]["s"] - fq[st]["s"] >= acts.min_step_m)
-            return np.where(ok, fq[sw]["penetration"], -1.0)
+            pen = fq[sw]["penetration"]
+            if lead > 0.0:
+                pen = pulse_lead(pen, fq[sw]["penetration_rate"], lead)
+            return np.where(ok, pen, -1.0)
 
         t1, x1 = self._grid_crossing(x0, touch, 0.0, 2e-3, 0.25, hth, "no_mid_stance",
-                                     "heel strike")
+                                     "heel strike" if lead == 0.0 else
+                                     "push-off before a heel strike")
         t2, x2, end = push_off(w, x1, t1, trailing, self.solver, self.deadline, hth)
         if end is not RunEnd.T_FINAL:
             return self._powered_end(t2, x2, end)

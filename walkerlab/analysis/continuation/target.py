@@ -99,7 +99,10 @@ def solve_target(family: WalkerFamily, p0: float, x0, measure: str, value: float
 
     if measure not in {m for m, _ in MEASURES.values()}:
         raise ValueError(f"target: {measure!r} is not one of speed, step_length, step_period")
-    w0 = family.walker(p0)
+    try:
+        w0 = family.walker(p0)
+    except MapFailed as exc:  # the start itself off the field's domain
+        raise TargetNotReached(f"no gait at the start ({exc})") from None
     z0 = np.asarray(w0.section(np.asarray(x0, float)), float)
     scale_p = max(abs(p0), 1e-3)
     maps = 0

@@ -32,7 +32,8 @@ import numpy as np
 from walkerlab.analysis.gait.metrics import step_length
 from walkerlab.io.schemas.simulate import LEDGER_UNITS
 
-__all__ = ["LEDGER_NAMES", "gait_measures", "quad_work", "step_ledger", "trajectory_ledger"]
+__all__ = ["LEDGER_NAMES", "gait_ledger", "gait_measures", "quad_work", "step_ledger",
+           "trajectory_ledger"]
 
 #: the ledger's columns, each (step,) (units: the artifact's, ``LEDGER_UNITS``)
 LEDGER_NAMES = tuple(LEDGER_UNITS)
@@ -175,7 +176,8 @@ def trajectory_ledger(traj) -> dict[str, np.ndarray]:
 
 def gait_measures(walker, x, steps: int, solver, max_step_time: float = 5.0
                   ) -> dict[str, float]:
-    """Step length, speed and cost of transport of a periodic gait through ``x``.
+    """Step length, speed and cost of transport of a periodic gait through ``x``
+    (:func:`gait_ledger` without the ledger).
 
     Parameters
     ----------
@@ -195,16 +197,38 @@ def gait_measures(walker, x, steps: int, solver, max_step_time: float = 5.0
         period's time), ``cost_of_transport`` [-] (mean over the steps; NaN without a
         ledger); all NaN when a step does not end by a heel strike.
     """
+    return gait_ledger(walker, x, steps, solver, max_step_time)[0]
+
+
+def gait_ledger(walker, x, steps: int, solver, max_step_time: float = 5.0
+                ) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+    """The measures of :func:`gait_measures` and the energy ledger of every step of a
+    periodic gait through ``x`` (one period simulated, :func:`trajectory_ledger`, as the
+    ``simulate`` stage computes them).
+
+    Parameters
+    ----------
+    As :func:`gait_measures`.
+
+    Returns
+    -------
+    measures : dict[str, float]
+        As :func:`gait_measures`.
+    ledger : dict[str, ndarray (steps,)]
+        :data:`LEDGER_NAMES` per step [J; ``push_off_impulse`` N s; ``cost_of_transport``
+        -]; empty when a step does not end by a heel strike, or for flat feet on legs that
+        differ (no ledger).
+    """
     from walkerlab.integrate.rigid import simulate_steps
 
     traj = simulate_steps(walker, np.asarray(x, float), int(steps), solver,
                           max_step_time=max_step_time)
     segs = traj.segments
     if len(segs) < steps or any(s.termination != "heel_strike" for s in segs):
-        return {"step_length": np.nan, "speed": np.nan, "cost_of_transport": np.nan}
+        return {"step_length": np.nan, "speed": np.nan, "cost_of_transport": np.nan}, {}
     lengths = [step_length(walker, s) for s in segs]
     led = trajectory_ledger(traj)
     cot = float(np.mean(led["cost_of_transport"])) if led else np.nan
-    return {"step_length": float(np.mean(lengths)),
-            "speed": float(np.sum(lengths) / (segs[-1].t_end - segs[0].t_start)),
-            "cost_of_transport": cot}
+    return ({"step_length": float(np.mean(lengths)),
+             "speed": float(np.sum(lengths) / (segs[-1].t_end - segs[0].t_start)),
+             "cost_of_transport": cot}, led)

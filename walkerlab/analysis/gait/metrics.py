@@ -129,13 +129,19 @@ def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
 
     Step length is the distance between the stance foot and the swing foot at heel strike;
     hip speed is the horizontal hip displacement over the step divided by its period;
+    ``impact_energy_loss`` [J] is the kinetic energy the heel-strike collision takes (a
+    walker with a push-off impulse: after the push-off minus after the heel strike, the
+    energy ledger's ``heel_strike_loss``), ``transition_energy_change`` [J] the net change of
+    the kinetic energy across the whole step-to-step transition (push-off and heel strike;
+    without a push-off minus the impact loss);
     ``phases`` lists the step's phases, each with the guard that ended it
     (``"early_swing (midstance) > late_swing (heel_strike)"``).
     """
     w = traj.walker
     rows = {k: [] for k in ("index", "stance_leg", "swing_leg", "t_start", "t_end", "period",
                             "termination", "event", "step_length", "hip_speed",
-                            "impact_energy_loss", "nfev", "midstance_time", "phases")}
+                            "impact_energy_loss", "transition_energy_change", "nfev",
+                            "midstance_time", "phases")}
     for seg in traj.segments:
         r2l = w.role_to_leg(seg.stance_leg)
         rows["index"].append(seg.index)
@@ -159,9 +165,16 @@ def step_table(traj: HybridTrajectory) -> dict[str, np.ndarray]:
             rows["hip_speed"].append(float((p1["hip"][0] - p0["hip"][0]) / seg.period))
             ke_m, _ = sw.energies(seg.x_end)
             ke_p, _ = w.for_stance(r2l.get("swing", seg.stance_leg)).energies(seg.x_next)
-            rows["impact_energy_loss"].append(float(ke_m - ke_p))
+            acts = sw.actuators
+            if acts is not None and acts.spec.push_off is not None:  # the collision alone
+                tr = acts.transition(seg.x_end)
+                rows["impact_energy_loss"].append(float(tr["ke_push_off"] - tr["ke_plus"]))
+            else:
+                rows["impact_energy_loss"].append(float(ke_m - ke_p))
+            rows["transition_energy_change"].append(float(ke_p - ke_m))
         else:
             rows["step_length"].append(np.nan)
             rows["hip_speed"].append(np.nan)
             rows["impact_energy_loss"].append(np.nan)
+            rows["transition_energy_change"].append(np.nan)
     return {k: np.asarray(v) for k, v in rows.items()}

@@ -39,6 +39,15 @@ ROOT_BUDGET_S = 60.0
 _clock = time.thread_time
 #: a step map slower than this [s] is said in one notice (the search is not silent)
 SLOW_MAP_S = 5.0
+#: a fixed point whose residual max |P(x) - x| is below this (or the root finder's ``xtol``,
+#: if larger) is converged, whatever MINPACK's status says (its "not making good progress"
+#: comes once the residual is at the integrator's round-off)
+RESIDUAL_TOL = 1e-10
+#: Floquet multipliers from the variational equations and from central differences of the
+#: map must agree to this (plus the differences' own error, see
+#: :func:`multiplier_check_tolerance`): a larger gap means one Jacobian is wrong, and the
+#: stability verdict with it
+MULTIPLIER_AGREEMENT = 1e-5
 
 
 class _Budget(threading.local):
@@ -95,8 +104,9 @@ def _map_ended(t: float) -> None:
         from walkerlab import progress
 
         progress.note(f"gait search: one step map took {dt:.0f} s (a very stiff or heavily "
-                      "damped spring makes every step slow); the search gives up after "
-                      f"{_BUDGET.deadline - _BUDGET.started:.0f} s")
+                      "damped spring makes every step slow); the search gives up once it "
+                      f"has spent {_BUDGET.deadline - _BUDGET.started:.0f} s of CPU time "
+                      "(checked between step maps: on a busy machine the wall time is longer)")
     _BUDGET.slowest = max(_BUDGET.slowest, dt)
 
 
@@ -118,6 +128,37 @@ class FixedPointNotFound(RuntimeError):
 
 class FixedPointGaveUp(FixedPointNotFound):
     """:func:`find_fixed_point` spent its (or its search's) time budget."""
+
+
+class MultipliersDisagree(RuntimeError):
+    """The Floquet multipliers of the variational equations and of central differences of
+    the map disagree beyond :func:`multiplier_check_tolerance`: one of the two Jacobians is
+    wrong, so no stability verdict can be given."""
+
+
+def multiplier_check_tolerance(solver: Solver, fd_step: float) -> float:
+    """Largest gap [-] allowed between the variational and the central-difference Floquet
+    multipliers: :data:`MULTIPLIER_AGREEMENT` plus the central differences' own error bound,
+    ``10 max(rtol, atol) / h`` (an integration error of relative size ``rtol`` divided by the
+    step ``h``; the truncation error ``O(h^2)`` is below it for ``h = 1e-7``)."""
+    return MULTIPLIER_AGREEMENT + 10.0 * max(solver.rtol, solver.atol) / fd_step
+
+
+def check_multipliers(mult_var: np.ndarray, mult_fd: np.ndarray, J_var: np.ndarray,
+                      J_fd: np.ndarray, tol: float) -> None:
+    """Raise :class:`MultipliersDisagree` when both the sorted multipliers (2n,) and the
+    Jacobians (2n, 2n) of the map differ by more than ``tol`` [-] (the Jacobians relative to
+    ``1 + max |DP|``): a multiplier gap with Jacobians that agree is an ill-conditioned
+    eigenvalue (a near-double one), not a wrong Jacobian."""
+    gap = float(np.max(np.abs(mult_var - mult_fd)))
+    jgap = float(np.max(np.abs(J_var - J_fd))) / (1.0 + float(np.max(np.abs(J_var))))
+    if gap > tol and jgap > tol:
+        raise MultipliersDisagree(
+            "the Floquet multipliers of the variational equations (largest |multiplier| "
+            f"{np.max(np.abs(mult_var)):.6f}) and of central differences of the map "
+            f"({np.max(np.abs(mult_fd)):.6f}) differ by {gap:.2g} (allowed {tol:.2g}; the "
+            f"Jacobians by {jgap:.2g}): one Jacobian of the map is wrong, so no stability "
+            "verdict is given - please report this walker")
 
 
 def poincare_map(walker: HybridWalker, x: np.ndarray, solver: Solver,
@@ -313,6 +354,9 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
     FixedPointNotFound
         The root finder did not converge, the map failed (fall) near the guess, or the
         budget was spent (the message says after how many maps and how long each took).
+    MultipliersDisagree
+        With ``fd_check``: the variational and the central-difference multipliers disagree
+        beyond :func:`multiplier_check_tolerance` (a wrong Jacobian: no verdict).
     """
     root = import_on_fresh_stack("scipy.optimize").root  # see walkerlab.freshstack
 
@@ -335,17 +379,20 @@ def find_fixed_point(walker: HybridWalker, guess: np.ndarray, solver: Solver, xt
         raise FixedPointGaveUp(str(exc), math.nan) from None
     x, xn, period, DP, segs = F.variational_at(sol.x, sol.message)
     res = float(np.max(np.abs(xn - x)))
-    _check_walking(walker, x, sol, res)
+    _check_walking(walker, x, sol, res, xtol)
+    mult_var = sort_multipliers(np.linalg.eigvals(DP))
     if fd_check:
         Jfd, nf2 = map_fd_jacobian(walker, x, solver, fd_step, max_step_time)
         mult_fd = sort_multipliers(np.linalg.eigvals(Jfd))
+        check_multipliers(mult_var, mult_fd, DP, Jfd,
+                          multiplier_check_tolerance(solver, fd_step))
     else:
         Jfd, nf2 = np.full_like(DP, np.nan), 0
         mult_fd = np.full(DP.shape[0], np.nan + 0j)
     return FixedPointResult(
         x=x, period_s=period, residual=res,
-        multipliers_variational=sort_multipliers(np.linalg.eigvals(DP)),
-        multipliers_fd=mult_fd, jacobian_variational=DP, jacobian_fd=Jfd,
+        multipliers_variational=mult_var, multipliers_fd=mult_fd, jacobian_variational=DP,
+        jacobian_fd=Jfd,
         nfev=F.counter["nfev"] + nf2, iterations=F.counter["calls"],
         wall_time_s=time.perf_counter() - t0, variational_maps=F.counter["jacobians"] + 1,
         step_periods_s=tuple(float(sg.period) for sg in segs),
@@ -443,10 +490,14 @@ class _ReducedMap:
         return x, xn, period, DP, segs
 
 
-def _check_walking(walker: HybridWalker, x: np.ndarray, sol, res: float) -> None:
-    """Raise :class:`FixedPointNotFound` unless the root finder converged (``sol``) to a
-    walking gait ``x`` with residual ``res`` below 1e-6 (not the trivial standing solution,
-    a step shorter than 1e-3 leg lengths)."""
+def _check_walking(walker: HybridWalker, x: np.ndarray, sol, res: float,
+                   xtol: float) -> None:
+    """Raise :class:`FixedPointNotFound` unless ``x`` is a walking gait (not the trivial
+    standing solution, a step shorter than 1e-3 leg lengths) whose residual ``res`` says it
+    is one: below 1e-6 when the root finder (``sol``) reports success, and below
+    ``max(xtol, RESIDUAL_TOL)`` when it does not (MINPACK's "not making good progress" at a
+    residual of 1e-12 is a converged gait: convergence is judged by the residual, not by the
+    root finder's status)."""
     message = " ".join(str(sol.message).split())
     step = walker.points(x).get("swing_foot")
     L = walker.params.get("leg_length_m", 1.0)
@@ -454,7 +505,7 @@ def _check_walking(walker: HybridWalker, x: np.ndarray, sol, res: float) -> None
         raise FixedPointNotFound("the root finder went to the trivial standing solution "
                                  f"(step length {1e3 * float(np.linalg.norm(step)):.2f} mm), "
                                  "not to a walking gait", res)
-    if not sol.success or res > 1e-6:
+    if res > 1e-6 or (not sol.success and res > max(xtol, RESIDUAL_TOL)):
         raise FixedPointNotFound(message, res)
 
 

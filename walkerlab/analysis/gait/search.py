@@ -399,15 +399,25 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
         last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
     if walker.slope_rad <= 0 and walker.actuators is None:
         why = "a passive walker needs a downhill slope (slope > 0) or walker.actuation"
+    elif walker.actuators is not None and had_guess:
+        why = ("the initial guess did not converge and the seeds are a passive walker's: "
+               "the walker may have no period-1 gait here")
     elif walker.actuators is not None:
-        why = ("the seeds are a passive walker's: give fixedpoint.initial_guess (a gait "
-               "at a nearby push-off or slope)")
+        why = "the seeds are a passive walker's, and a powered gait may lie far from them"
     else:
         why = "the walker may have no period-1 gait here"
+    if "standing" in last:  # walkerlab's own diagnosis, not a solver's detail: in the text
+        why, last = f"{why}; {last}", ""
     # the advice first, the solver's detail last: a one-line display that must shorten the
-    # message cuts the detail, never the advice
+    # message cuts the detail, never the advice; with a guess given, the advice is not to
+    # give one
+    nearer = ("start from a gait known nearby (walkerlab fixedpoint --from KNOWN_SCENE, or "
+              "its gait as fixedpoint.initial_guess)" if had_guess
+              else "give fixedpoint.initial_guess (a gait at a nearby push-off or slope)"
+              if walker.actuators is not None else "give fixedpoint.initial_guess")
     return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "
             "from a walker whose gait is known (walkerlab sweep SCENE --param "
-            "FIELD=KNOWN:THIS:STEP, e.g. slope.angle_deg), or "
-            + ("an initial_guess nearer a gait" if had_guess else "give fixedpoint.initial_guess")
-            + f" [tried {' and '.join(tried)}{res}; last: {last or 'every start fell'}]")
+            f"FIELD=KNOWN:THIS:STEP, e.g. slope.angle_deg), or {nearer}"
+            + f" [tried {' and '.join(tried)}{res}"
+            + (f"; last: {last}]" if last else "]" if "standing" in why
+               else "; last: every start fell]"))

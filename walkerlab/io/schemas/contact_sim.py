@@ -15,7 +15,11 @@ point, ``leg1_heel``, ``leg1_toe``, ...: which points are loaded when); ``events
 (heel-strike times [s] and legs); ``steps/`` (per step: times [s], stance slip and creep
 [mm], bounces, scuffs, peak penetration [m]; flat feet: the stance foot's mode sequence);
 ``summary/``; optional ``periodic_gait/`` (the contact model's own gait: period [s], step
-length [m], Floquet multipliers) and ``adjust/`` (``--adjust``'s search).
+length [m], Floquet multipliers) and ``adjust/`` (``--adjust``'s search); a powered walker's
+``ledger/`` (``time`` [s], the samples' times; ``work/<name>`` [J] the work integrals on it,
+``residual`` [J] the closure; ``steps/<name>`` the ledger per step on dimension
+``ledger_step``: push-off and torque work [J], contact work [J], distance [m], slope energy
+[J], cost of transport [-], :mod:`walkerlab.analysis.contact.ledger`).
 """
 
 from __future__ import annotations
@@ -90,6 +94,9 @@ class ContactSimRun:
     gait: object = None
     gait_error: Exception | None = None
     adjust: dict | None = None
+    step_ledger: dict | None = None
+    step_ledger_units: dict = field(default_factory=dict)
+    step_ledger_descriptions: dict = field(default_factory=dict)
 
 
 def _write_outcome_and_drop(f, run: ContactSimRun) -> None:
@@ -281,12 +288,24 @@ def _write_work(f, run: ContactSimRun) -> None:
     if run.walker.structure.free_knees:  # a five-link biped: every joint torque's work
         what.update(hip_torque_positive="positive work of the joint torques (hips and knees)",
                     hip_torque_negative="negative work of the joint torques (hips and knees)")
+    # the samples' times as the ledger's own coordinate (without it the dimension was a
+    # bare scale of zeros)
+    coordinate(f.require_group("ledger"), "time", np.asarray(run.result.t, float), "s",
+               "time of the samples")
     for k, name in enumerate(run.walker.actuators.work_names):
         put(f, f"ledger/work/{name}", work[:, k], "J", what[name] + " since the start",
             dims=("time",))
     E = run.walker.energies(run.result.x)["total"]
     put(f, "ledger/residual", (E - E[0]) - work.sum(axis=1), "J", "kinetic + potential "
         "energy change minus the works: the ledger's closure", dims=("time",))
+    if run.step_ledger:
+        g = f.require_group("ledger/steps")
+        n = len(next(iter(run.step_ledger.values())))
+        coordinate(g, "ledger_step", np.arange(n), "-", "step (mid-step to mid-step, "
+                   "around each heel strike with one before and after it)")
+        for name, v in run.step_ledger.items():
+            put(g, name, np.asarray(v, float), run.step_ledger_units.get(name, "-"),
+                run.step_ledger_descriptions.get(name, name), dims=("ledger_step",))
 
 
 @dataclass
@@ -337,7 +356,8 @@ class ContactSimArtifact:
     multiplies the rates named in ``rate_names`` (None in artifacts without them);
     ``stage_wall_time_s``: the whole stage's compute time [s]; ``ledger`` (a powered run)
     maps each work integral's name (:data:`walkerlab.models.contact.actuation.WORK_NAMES`)
-    and ``residual`` to its samples (n,) [J].
+    and ``residual`` to its samples (n,) [J]; ``ledger_steps`` (a powered run) its ledger per
+    step, name -> (steps,) (``ledger/steps/``: push-off work [J], ..., cost of transport).
     """
 
     path: Path
@@ -358,6 +378,7 @@ class ContactSimArtifact:
     periodic: PeriodicGait | None = None
     adjust: dict | None = None
     ledger: dict | None = None
+    ledger_steps: dict | None = None
 
 
 def _periodic(f) -> PeriodicGait | None:
@@ -416,7 +437,9 @@ def load_contact_sim(path: Path) -> ContactSimArtifact:
                     **{k: str(v) for k, v in f["adjust"].attrs.items()}}
             if "adjust" in f else None,
             ledger=({**{k: f["ledger/work"][k][()] for k in f["ledger/work"] if k != "time"},
-                     "residual": f["ledger/residual"][()]} if "ledger" in f else None))
+                     "residual": f["ledger/residual"][()]} if "ledger" in f else None),
+            ledger_steps=({k: f["ledger/steps"][k][()] for k in f["ledger/steps"]
+                           if k != "ledger_step"} if "ledger/steps" in f else None))
 
 
 def run_end(path: Path) -> tuple[str, str]:

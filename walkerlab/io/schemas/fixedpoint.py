@@ -162,6 +162,12 @@ class GaitResult:
         """Largest |Floquet multiplier| (variational)."""
         return float(np.max(np.abs(self.multipliers)))
 
+    @property
+    def period_s(self) -> float:
+        """Period of the Poincare map [s]: the stride's when legs differ (a map of two
+        steps), else the step's (as the search's result holds it)."""
+        return self.step_period_s if self.stride_period_s is None else self.stride_period_s
+
 
 def _gait(g, names: list[str]) -> GaitResult:
     if "error" in g.attrs:

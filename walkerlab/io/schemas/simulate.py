@@ -4,7 +4,9 @@ Layout: root attributes ``model``, ``variant``, ``legs``, ``termination``,
 ``strides_requested``, ``total_mass_kg``, ``gravity_m_per_s2``; ``state`` (dimension scale,
 role-ordered state names); ``samples/`` (:mod:`walkerlab.io.trajectory`); ``steps/`` (one
 row per step on dimension ``step``: ``t_start``, ``t_end``, ``period`` [s], ``step_length``
-[m], ``hip_speed`` [m/s], ``impact_energy_loss`` [J], ``stance_leg``, ``termination``,
+[m], ``hip_speed`` [m/s], ``impact_energy_loss`` [J] (the heel-strike collision's loss),
+``transition_energy_change`` [J] (the kinetic energy's net change across push-off and heel
+strike), ``stance_leg``, ``termination``,
 ``phases`` (each phase of the step and the guard that ended it) ...;
 ``steps/states/<i>`` start/end state of each segment as attributes); ``initial_state``
 [rad, rad/s]; ``summary/<name>`` (mean step period [s], step length [m], hip speed [m/s],
@@ -29,7 +31,15 @@ from walkerlab.units import Units, for_artifact
 STAGE = "simulate"
 #: unit of each ``steps/`` column
 STEP_UNITS = {"t_start": "s", "t_end": "s", "period": "s", "step_length": "m",
-              "hip_speed": "m/s", "impact_energy_loss": "J", "midstance_time": "s"}
+              "hip_speed": "m/s", "impact_energy_loss": "J", "transition_energy_change": "J",
+              "midstance_time": "s"}
+#: what each ``steps/`` column is, where its name does not say it all (others: the name)
+STEP_DESCRIPTIONS = {
+    "impact_energy_loss": "kinetic energy lost in the heel-strike collision (after the "
+                          "push-off, if any, minus after the heel strike)",
+    "transition_energy_change": "net change of the kinetic energy across the step-to-step "
+                                "transition (push-off and heel strike)",
+}
 #: unit of each ``ledger/`` column (the energy ledger, :mod:`walkerlab.analysis.gait.energy`)
 LEDGER_UNITS = {**{k: "J" for k in (
     "actuator_work_positive", "actuator_work_negative", "push_off_work", "heel_strike_loss",
@@ -114,7 +124,7 @@ def write_simulate(f, run: SimulateRun) -> None:
         if v.dtype.kind in "US":
             put(g, k, [str(s) for s in v], "-", k, dims=("step",))
         else:
-            put(g, k, v, STEP_UNITS.get(k, "-"), k, dims=("step",))
+            put(g, k, v, STEP_UNITS.get(k, "-"), STEP_DESCRIPTIONS.get(k, k), dims=("step",))
     for i, seg in enumerate(traj.segments):
         sg = g.create_group(f"states/{i:04d}")
         for nm, a, b in zip(names, seg.x_start, seg.x_end):

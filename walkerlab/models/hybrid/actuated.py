@@ -41,7 +41,7 @@ import numpy as np
 
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.models.hybrid.base import HybridWalker, Phase
-from walkerlab.numerics import complex_step_jacobian, fd_jacobian
+from walkerlab.numerics import complex_step_jacobian
 
 __all__ = ["Actuators", "actuate", "torque_chain_jacobian"]
 
@@ -168,20 +168,21 @@ class Actuators:
 
     # ---------------------------------------------------------------- push-off
     def hip_velocity(self, x) -> np.ndarray:
-        """Hip velocity (2,) [m/s] (world x forward, y up) of a pinned-stance state."""
-        n = self.n
-        q, dq = np.asarray(x[:n]), np.asarray(x[n:])
-        J = complex_step_jacobian(lambda qq: self.fns["points"](
-            np.concatenate([qq, np.zeros(n)]))["hip"], np.real(q)) if not np.iscomplexobj(x) \
-            else self._hip_jac_complex(q)
-        return J @ dq
+        """Hip velocity (2,) [m/s] (world x forward, y up) of a pinned-stance state ``x``
+        (2n,), from the generated ``point_velocities`` (analytic in the whole state: a
+        complex step differentiates through it)."""
+        return np.asarray(self.fns["point_velocities"](x)["hip"])
 
-    def _hip_jac_complex(self, q):
-        """The hip's position Jacobian (2, n) by central differences (for a state that is
-        already complex: a complex step cannot be nested)."""
-        n = self.n
-        return fd_jacobian(lambda qq: np.asarray(self.fns["points"](
-            np.concatenate([qq, np.zeros(n)]))["hip"]), np.real(q), 1e-7)
+    def _point_jacobians(self, q, names) -> np.ndarray:
+        """The named points' position Jacobians stacked (2 len(names), n) at ``q`` (n,),
+        column ``k`` the points' velocities for ``dq = e_k`` (exact, and analytic in ``q``:
+        complex-step safe)."""
+        eye = np.eye(self.n)
+        cols = []
+        for k in range(self.n):
+            v = self.fns["point_velocities"](np.concatenate([q, eye[k]]))
+            cols.append(np.concatenate([np.asarray(v[name]) for name in names]))
+        return np.array(cols).T
 
     def impulse(self, x) -> float:
         """Push-off impulse ``P`` [N s] for the pre-impact state ``x`` (>= 0)."""
@@ -244,13 +245,14 @@ class Actuators:
                 "impulse": P, "ke_minus": ke[0], "ke_push_off": ke[1], "ke_plus": ke[2]}
 
     def _transition_point_hip(self, x, P):
+        """Push-off and heel strike of a point hip mass on massless legs (Kuo 2002, Eq. 2
+        and its appendix); analytic in ``x`` (every point and Jacobian from the generated
+        ``points``/``point_velocities``, the least-squares solve by its normal equations with
+        a plain transpose), so the reset's Jacobian by the complex step is exact."""
         n, M = self.n, self.hip_mass_kg
-        q, dq = x[:n], x[n:]
+        q = x[:n]
         pts = self.fns["points"](x)
-        J = self._hip_jac_complex(np.real(q)) if np.iscomplexobj(x) else \
-            complex_step_jacobian(lambda qq: self.fns["points"](
-                np.concatenate([qq, np.zeros(n)]))["hip"], q)
-        v = J @ dq
+        v = self.hip_velocity(x)
         hip, lead = np.asarray(pts["hip"]), np.asarray(pts["swing_foot"])
         et = hip / np.sqrt(hip @ hip)          # trailing leg: stance foot at the origin
         el = (hip - lead) / np.sqrt((hip - lead) @ (hip - lead))
@@ -258,16 +260,9 @@ class Actuators:
         v_plus = v_po - (v_po @ el) * el
         v_foot = (v_plus @ et) * et            # the trailing foot: no velocity across its leg
         qn, R = self._relabel(np.real(q))
-        qn_real = qn
-        qn = qn + R @ (q - np.real(q))
-        zero = np.zeros(n)
-
-        def jac(name):
-            return complex_step_jacobian(lambda qq: self.fns["points"](
-                np.concatenate([qq, zero]))[name], qn_real)
-        Jn = np.vstack([jac("hip"), jac("swing_foot")])
-        dq_plus = np.linalg.lstsq(Jn, np.concatenate([v_plus, v_foot]), rcond=None)[0] \
-            if not np.iscomplexobj(x) else np.linalg.pinv(Jn) @ np.concatenate([v_plus, v_foot])
+        qn = qn + R @ (q - np.real(q))         # the swap is affine: exact for a complex step
+        Jn = self._point_jacobians(qn, ("hip", "swing_foot"))   # (4, n), full column rank
+        dq_plus = np.linalg.solve(Jn.T @ Jn, Jn.T @ np.concatenate([v_plus, v_foot]))
         ke = (0.5 * M * (v @ v), 0.5 * M * (v_po @ v_po), 0.5 * M * (v_plus @ v_plus))
         return {"x_plus": np.concatenate([qn, dq_plus]), "impulse": P, "ke_minus": ke[0],
                 "ke_push_off": ke[1], "ke_plus": ke[2]}
