@@ -159,7 +159,8 @@ def test_wl_optimize_design_is_the_command_s_optimum(tmp_path):
                     runs_dir=tmp_path)
     assert d.attrs["stage"] == "optimize_design" and float(d["values"][0]) == 20.0
     assert float(d["objective_value"]) == pytest.approx(0.5737, abs=1e-3)
-    assert (tmp_path / "paper" / "optimize_design.h5").is_file()
+    assert (tmp_path / "paper" / "optimize_design_walker.hip_mass_kg_max_abs_multiplier.h5"
+            ).is_file()  # one artifact per fields and objective
 
 
 @pytest.mark.parametrize("workers", [0, True, "2", 1.5])

@@ -76,6 +76,19 @@ def test_degrees_given_as_radians_are_named():
                          "(3 rad = 172°; did you mean angle_deg?)")
 
 
+def test_no_unit_hint_for_a_stiffness_damping_or_torque():
+    """``*_per_rad`` / ``*_per_m`` are rates per angle or length and ``*_n_m`` a torque:
+    a bound error there carries no "an angle in degrees?" or "a length in mm?" hint."""
+    hip = yaml.safe_load((ROOT / "configs" / "hip_spring.yaml").read_text())
+    for leaf, v in (("stiffness_n_m_per_rad", -1e-9), ("damping_n_m_s_per_rad", -0.5)):
+        spring = {**hip["walker"]["springs"][0], leaf: v}
+        (line,) = _errors({**hip, "walker": {**hip["walker"], "springs": [spring]}})
+        assert leaf in line and "degrees" not in line and "°" not in line, line
+    (line,) = _errors({"walker": WALKER, "slope": {"angle_deg": 1},
+                       "optimize": {"max_torque_n_m": 1e6}})
+    assert "max_torque_n_m" in line and " mm" not in line, line
+
+
 def test_millimetres_given_as_metres_are_named():
     (line,) = _errors({"walker": {**WALKER, "leg_length_m": 1000, "leg_mass_from_foot_m": 500},
                        "slope": {"angle_deg": 1}})

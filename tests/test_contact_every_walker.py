@@ -50,6 +50,45 @@ def test_fig7_colours_follow_the_coordinate_name_and_styles_the_model():
         plt.close(fig)
 
 
+def _trajectory(stems: list[str]):
+    from walkerlab.io.trajectory import NamedTrajectory
+
+    t = np.linspace(0.0, 1.0, 5)
+    coords = {f"{s}_{k}": t for k in ("angle", "rate") for s in stems}
+    units = {n: "rad" if n.endswith("_angle") else "rad/s" for n in coords}
+    z = np.zeros_like(t, dtype=int)
+    return NamedTrajectory(time=t, legs=["leg1", "leg2"], coordinates=coords, units=units,
+                           stance_leg=z, step_index=z, kinetic=t, potential=t)
+
+
+def test_fig7_of_a_five_link_biped_gives_each_link_one_colour_in_both_views():
+    """RABBIT: the rigid view lists each leg's hip-to-foot angle beside its thigh and shank
+    (``leg2, leg1, leg2_shank, leg2_thigh, leg1_thigh, leg1_shank, torso``), the contact
+    view the links only.  Before, leg1's whole-leg and shank curves were both blue and the
+    thigh green in the rigid view but blue in the contact one; now each of the 7 links has
+    a colour of its own, the same in both views, and each view one line style."""
+    import matplotlib.pyplot as plt
+
+    from walkerlab.plotting import figures as F
+
+    rigid = _trajectory(["leg2", "leg1", "leg2_shank", "leg2_thigh", "leg1_thigh",
+                         "leg1_shank", "torso"])
+    contact = _trajectory(["leg1_thigh", "leg1_shank", "leg2_thigh", "leg2_shank", "torso"])
+    fig = F.fig7_angles_rates({"ideal": rigid, "contact": contact})
+    try:
+        for ax in fig.axes[:2]:
+            colour, style = {}, {}
+            for line in ax.get_lines():
+                name, model = line.get_label().split(" - ")
+                colour.setdefault(name, set()).add(line.get_color())
+                style.setdefault(model, set()).add(line.get_linestyle())
+            assert len(colour) == 7 and all(len(c) == 1 for c in colour.values()), colour
+            assert len({c.pop() for c in colour.values()}) == 7  # no two links alike
+            assert style == {"ideal": {"-"}, "contact": {"--"}}
+    finally:
+        plt.close(fig)
+
+
 def test_patch_width_map_on_continuous_ground_says_it_does_not_apply(tmp_path):
     """kneed.yaml walks on continuous ground: before, ``stability-map --kind patch_width``
     computed 9 cells of 'no_ideal_gait'/'unsupported' and exited 0; now one line, rc 1,

@@ -163,16 +163,52 @@ def test_design_command_prints_the_optimum_and_refuses_bad_input_in_one_line(tmp
                                  "--runs-dir", str(tmp_path)])
     assert r.exit_code == 0, r.output
     assert "walker.hip_mass_kg = 20" in r.output
-    assert (tmp_path / "paper" / "optimize_design.h5").is_file()
+    first = tmp_path / "paper" / "optimize_design_walker.hip_mass_kg_max_abs_multiplier.h5"
+    assert first.is_file()
+    # another objective: an artifact of its own, the first one left as it was
+    before = first.stat().st_mtime_ns
+    r = CliRunner().invoke(app, ["optimize", scene, "--design", "walker.hip_mass_kg=5:20",
+                                 "--objective", "speed", "--maximize",
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "paper" / "optimize_design_walker.hip_mass_kg_speed_maximize.h5"
+            ).is_file() and first.stat().st_mtime_ns == before
+    fresh = tmp_path / "fresh"  # refused before the upstream stages run
     for bad, msg in ((["--design", "walker.hip_mass_kg=5:x"], "FIELD=LO:HI"),
                      (["--design", "walker.hip_mass_kg=5:20", "--objective", "nope"],
                       "--objective"),
-                     (["--design", "walker.hip_mas_kg=5:20"], "unknown field walker.hip_mas_kg"),
+                     (["--design", "walker.hip_mas_kg=5:20"],
+                      "--design walker.hip_mas_kg: unknown field walker.hip_mas_kg"),
+                     (["--design", "walker.hip_mass_kg=5:20", "--design",
+                       "walker.hip_mass_kg=6:8"], "walker.hip_mass_kg: given twice"),
+                     (["--design", "walker.hip_mass_kg=-1:20"], "greater than or equal to 0"),
                      (["--design", "walker.actuation.push_off.impulse_n_s=1:2"],
                       "leaves it unset")):
-        r = CliRunner().invoke(app, ["optimize", scene, *bad, "--runs-dir", str(tmp_path)])
+        r = CliRunner().invoke(app, ["optimize", scene, *bad, "--runs-dir", str(fresh)])
         assert r.exit_code != 0 and r.output.count("error:") == 1 and msg in r.output, r.output
-        assert "internal error" not in r.output
+        assert "internal error" not in r.output and "--param" not in r.output
+        assert not (fresh / "paper" / "fixedpoint.h5").exists(), bad
+
+
+def test_design_from_a_zero_stiffness_bound_stays_inside_the_bounds():
+    """A hip spring's stiffness within 0-30 N m/rad for the least speed of hip_spring.yaml
+    (speed rises with stiffness: 0.528 m/s at 0): the optimum is the bound 0, no walker is
+    built below it (every evaluation and the difference stencil stay >= 0; before, the
+    central difference at 0 built a spring of -1e-6 N m/rad and the run stopped), and the
+    gradient there is the one-sided difference of the re-solved speed (h = 1e-3 N m/rad:
+    truncation ~1e-7 relative)."""
+    from walkerlab.optimal.design import _Gaits, design_optimize, measure_gradient
+
+    scene = load_scene(CONFIGS / "hip_spring.yaml")
+    field = "walker.springs.0.stiffness_n_m_per_rad"
+    x = wl.Walker.from_scene(scene).fixed_point().x
+    res = design_optimize(scene, {field: (0.0, 30.0)}, "speed", x, max_evaluations=10)
+    assert all(p[0] >= 0.0 for p, _ in res.history)
+    assert res.values[0] == pytest.approx(0.0, abs=1e-9) and res.gradient[0] > 0
+    gaits = _Gaits(scene, [field], x, bounds=([0.0], [30.0]))
+    v0, g0 = measure_gradient(gaits, [0.0], "speed")
+    fd = (measure_gradient(gaits, [1e-3], "speed")[0] - v0) / 1e-3
+    assert g0[0] == pytest.approx(fd, rel=1e-3)
 
 
 @pytest.fixture(scope="module")

@@ -257,10 +257,18 @@ def test_bad_optimize_sections_say_which_field(tmp_path):
                                                                     exclude_none=True)
     for bad, field in (({"weights": {"effort": 1.0}}, "optimize.weights"),
                        ({"objective": "weighted"}, "optimize.weights"),
-                       ({"hip_angle_range_rad": [0.5, 0.1]}, "hip_angle_range_rad")):
+                       ({"hip_angle_range_rad": [0.5, 0.1]},
+                        r"hip_angle_range_rad: \[lo, hi\] with lo < hi")):
         d = {**base, "optimize": {**base["optimize"], **bad}}
         with pytest.raises((SceneError, ValueError), match=field):
             type(load_scene(CONFIGS / "compass_optimal.yaml")).model_validate(d)
+    # a YAML list is the hip range's form (as basin.x_range): the limits reach the spec
+    d = {**base, "optimize": {**base["optimize"], "hip_angle_range_rad": [-0.5, 0.5]}}
+    ok = type(load_scene(CONFIGS / "compass_optimal.yaml")).model_validate(d)
+    assert ok.optimize.hip_angle_range_rad == (-0.5, 0.5)
+    from walkerlab.optimal.scene import collocation_spec
+
+    assert collocation_spec(ok).hip_angle_range_rad == (-0.5, 0.5)
     scene = load_scene(CONFIGS / "compass_optimal.yaml")
     for path, msg in ((tmp_path / "none.h5", "not found"),):
         d = {**base, "optimize": {**base["optimize"], "initial_guess": {"from": str(path)}}}

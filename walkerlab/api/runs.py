@@ -229,7 +229,8 @@ def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
     section, its defaults when absent): least int u^2 dt under the targets and limits given,
     replayed on the rigid model; reads ``runs/<scene>/optimize.h5``.  With ``design``: the
     fields within their bounds that minimise (``maximize``: maximise) a measure of the
-    scene's own gait, followed from the scene's values; reads ``optimize_design.h5``.
+    scene's own gait, followed from the scene's values; reads its artifact
+    ``optimize_design_<fields>_<objective>[_maximize].h5``.
 
     Parameters
     ----------
@@ -251,7 +252,7 @@ def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
     xarray.Dataset
         ``optimize.h5``: the collocated step on ``time`` (states [rad, rad/s], ``torque``
         [N m]), ``step_period`` [s], ``step_length`` [m], ``objective``, the replay's
-        ``multipliers``, the contact replay ...; ``optimize_design.h5``: the fields'
+        ``multipliers``, the contact replay ...; the design's artifact: the fields'
         optimal values, the objective and its gradient.
 
     Raises

@@ -201,6 +201,11 @@ def optimize(scene: Path | None = SceneArg,
                                            "basin_share | mfpt"),
              maximize: bool = typer.Option(False, "--maximize", help="with --design: "
                                            "maximise the objective"),
+             require_gait: bool = typer.Option(False, "--require-gait",
+                                               help="exit non-zero (one line) when the "
+                                               "optimum is not a gait (IPOPT did not "
+                                               "converge or the rigid replay does not "
+                                               "close); optimize.h5 stays"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """A periodic gait of a walker with a hip torque (a five-link biped: hip and knee
     torques) by direct collocation (CasADi + IPOPT; the scene's optimize section): least
@@ -208,10 +213,13 @@ def optimize(scene: Path | None = SceneArg,
     optimize.h5.  With --design: the fields within
     their bounds that minimise (--maximize: maximise) a measure of the scene's own gait,
     followed from the scene's values, gradients through the fixed point; writes
-    optimize_design.h5."""
+    optimize_design_<fields>_<objective>[_maximize].h5 (one per fields and objective)."""
     from walkerlab.stages import pipeline
 
     if design:
+        if require_gait:
+            raise ValueError("--require-gait: with the gait's optimisation, not --design "
+                             "(a design follows the scene's own gait)")
         _optimize_design(scene, design, objective, maximize, runs_dir, force)
         return
 
@@ -267,29 +275,25 @@ def optimize(scene: Path | None = SceneArg,
     from walkerlab.stages.optimize import draw
 
     typer.echo(f"figure: {draw(load(scene), runs_dir)[0]}")
+    if require_gait:  # the artifact stays: it holds what was found
+        from walkerlab.io.schemas.optimize import load as load_optimize
+
+        d = d if d is not None else load_optimize(out.path)
+        if not d.gait:
+            fail(RuntimeError(f"--require-gait: the optimum is NOT a gait: "
+                              f"{not_a_gait_reason(d)}"))
 
 
 def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> None:
     """``walkerlab optimize --design``: parse FIELD=LO:HI, run, print the optimum."""
+    from walkerlab.optimal.design import MEASURES, design_bounds
     from walkerlab.stages import optimize as stage
     from walkerlab.stages import pipeline
-
-    bounds = {}
-    for item in design:
-        field, _, rng = item.partition("=")
-        lo, _, hi = rng.partition(":")
-        try:
-            lo_v, hi_v = float(lo), float(hi)
-        except ValueError:
-            raise ValueError(f"--design {item!r}: write FIELD=LO:HI with numbers") from None
-        if not (lo_v < hi_v) or not all(abs(v) < float("inf") for v in (lo_v, hi_v)):
-            raise ValueError(f"--design {item!r}: LO < HI, both finite")
-        bounds[field.strip()] = (lo_v, hi_v)
-    from walkerlab.optimal.design import MEASURES
 
     if objective not in MEASURES:
         raise ValueError(f"--objective: one of {', '.join(MEASURES)}, not {objective!r}")
     sc = load(scene)
+    bounds = design_bounds(sc, design)  # every field checked before the upstream stages
     pipeline.run_upstream("optimize", sc, runs_dir)
     out = stage.run_design(sc, runs_dir, force, bounds, objective, maximize)
     r = out.summary.get("design")
@@ -299,5 +303,5 @@ def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> Non
         for f, v, g in zip(r.fields, r.values, r.gradient):
             typer.echo(f"  {f} = {v:.8g}   d{r.objective}/d field = {g:.4g}")
     typer.echo(status(out))
-    for path in stage.draw_design(sc, runs_dir)[:1]:
+    for path in stage.draw_design(sc, runs_dir, list(bounds), objective, maximize)[:1]:
         typer.echo(f"figure: {path}")

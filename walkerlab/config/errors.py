@@ -178,14 +178,19 @@ _BOUND_ERRORS = ("less_than", "less_than_equal", "greater_than", "greater_than_e
 
 
 def _unit_hint(root: type[BaseModel], e: dict, parts: list) -> str:
-    """A likely unit mistake behind a bound error: an angle in degrees
-    given to a ``*_rad`` field (``3 rad = 172°; did you mean angle_deg?``), a length in
-    millimetres given to a ``*_m`` field (``1000 m: a length in mm? 1000 mm = 1 m``)."""
+    """A likely unit mistake behind a bound error: an angle in degrees given to a ``*_rad``
+    field (``3 rad = 172°; did you mean angle_deg?``), a length in millimetres given to a
+    ``*_m`` field (``1000 m: a length in mm? 1000 mm = 1 m``); none for a rate per radian or
+    per metre (``*_per_rad``, ``*_per_m``: a stiffness, a damping) or a torque (``*_n_m``)."""
     v = e.get("input")
     if e["type"] not in _BOUND_ERRORS or isinstance(v, bool) or not isinstance(v, int | float) \
             or not parts:
         return ""
     leaf = str(parts[-1])
+    # a rate per radian or per metre (a stiffness, a damping) and a torque [N m] are no
+    # angle or length: no unit hint there
+    if leaf.endswith(("_per_rad", "_per_m", "_n_m")):
+        return ""
     if leaf.endswith("_rad"):
         deg = leaf.removesuffix("_rad") + "_deg"
         sibling = deg in _fields_at(root, tuple(e["loc"][:-1]))

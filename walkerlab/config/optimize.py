@@ -8,11 +8,11 @@ direct collocation", SIAM Review 59(4):849-904 (Hermite-Simpson collocation); Ca
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import ConfigDict, Field, model_validator
 
-from walkerlab.config.base import Strict
+from walkerlab.config.base import AsTuple, Strict
 
 __all__ = ["OptimizeGuess", "OptimizeSettings"]
 
@@ -79,7 +79,7 @@ class OptimizeSettings(Strict):
     friction_coefficient: float | None = Field(None, gt=0, le=10, description="the stance "
                                                "foot's normal force >= 0 and |tangential| "
                                                "<= this times it [-]")
-    hip_angle_range_rad: tuple[float, float] | None = Field(
+    hip_angle_range_rad: Annotated[tuple[float, float] | None, AsTuple] = Field(
         None, description="the hip joint's limits on the swing - stance angle [rad]")
     touchdown_rate_rad_per_s: float = Field(0.05, gt=0, le=100, description="the heel-"
                                             "strike guard falls at least this fast at the "

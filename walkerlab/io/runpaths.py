@@ -49,7 +49,7 @@ except ImportError:  # pragma: no cover
 __all__ = ["RunPathError", "ArtifactBusy", "check_name", "scene_dir", "stage_artifact",
            "named_artifact", "scene_file", "report_dir", "figures_dir", "run_cache_dir",
            "artifact_lock", "refuse_link", "bifurcation_stem", "bifurcation_artifacts",
-           "STAGE_FILES"]
+           "design_stem", "STAGE_FILES"]
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
 MAX_NAME = 100
@@ -58,7 +58,8 @@ MAX_NAME = 100
 STAGE_FILES = frozenset({"fixedpoint", "simulate", "contact_sim", "compare", "workprecision",
                          "bifurcation", "basin", "report", "plot", "sweep", "rigid_limit"})
 STAGE_PREFIXES = ("stability_map", "stability-map",  # stability_map_<kind>.h5
-                  "bifurcation_")                      # bifurcation_<field>.h5
+                  "bifurcation_",                      # bifurcation_<field>.h5
+                  "optimize_design")                   # optimize_design_<fields>_<measure>
 
 ORIGIN_FILE = ".scene"
 MAX_MARKER_BYTES = 8192  # a resolved path of the scene file
@@ -195,6 +196,29 @@ def continuation_stem(path: str, path2: str | None = None) -> str:
     """
     return check_name(f"continuation_{path}" + (f"+{path2}" if path2 else ""),
                       "--param field" + (" and --param2 field" if path2 else ""))
+
+
+def design_stem(fields: list[str], objective: str, maximize: bool = False) -> str:
+    """File stem of a design optimisation's artifact (``walkerlab optimize --design``), one
+    per set of fields and objective, so that another design study does not replace it (as
+    :func:`continuation_stem`): ``optimize_design_<field>[+<field>...]_<objective>``, with
+    ``_maximize`` when maximised (``optimize_design_walker.hip_mass_kg_speed_maximize``);
+    when that passes 100 characters (long or many fields) the fields are named by a hash
+    (``optimize_design_<10 hex digits>_<objective>``).
+
+    Raises
+    ------
+    RunPathError
+        A field or the objective does not make a safe file name.
+    """
+    import hashlib
+
+    tail = f"_{objective}" + ("_maximize" if maximize else "")
+    stem = "optimize_design_" + "+".join(fields) + tail
+    if len(stem) > MAX_NAME:
+        digest = hashlib.sha256("+".join(fields).encode()).hexdigest()[:10]
+        stem = f"optimize_design_{digest}{tail}"
+    return check_name(stem, "--design field")
 
 
 def bifurcation_artifacts(scene, runs_root: Path | str) -> dict[str, Path]:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["REPLAY_WALL_TIME_LIMIT_S", "contact_replay", "contact_replay_five_link",
-           "contact_replay_phased", "contact_replay_stride"]
+           "contact_replay_phased", "contact_replay_stride", "replay_failure"]
 
 #: Wall-time limit [s] of a phased walker's contact replay (its powered run).
 REPLAY_WALL_TIME_LIMIT_S = 1800.0
@@ -224,8 +224,41 @@ def _run(setup, x0, step_period_s: float, strides: int, solver=None) -> tuple[fl
 
     kw = {} if solver is None else {"solver": solver}
     with progress.task(f"optimize: the contact replay ({strides} strides)"):
-        _, run, _, _ = simulate_from(setup, np.asarray(x0, float), step_period_s,
-                                     strides=strides, **kw)
+        try:
+            _, run, _, _ = simulate_from(setup, np.asarray(x0, float), step_period_s,
+                                         strides=strides, **kw)
+        except (ValueError, ArithmeticError, RuntimeError) as exc:
+            # the replay is a report on the optimum, not its gate: its solver's failure
+            # (scipy's event location on a PD law's stiff contact: "f(a) and f(b) must
+            # have different signs") is its outcome, the rigid optimum and replays stand
+            return float("nan"), replay_failure(exc, solver)
     hs = np.asarray(run.heel_strike_times, float)
     period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
     return period, str(run.termination)
+
+
+def replay_failure(exc: BaseException, solver=None) -> str:
+    """The contact replay's outcome when its integration raised ``exc`` (one line): what
+    failed, in the run's terms, and what to try.
+
+    Parameters
+    ----------
+    exc : BaseException
+        What the contact run raised (a solver's own message: scipy's event location
+        ``f(a) and f(b) must have different signs`` when a contact or heel-strike event
+        function changes sign between two evaluations of the dense output but not at
+        the step's ends).
+    solver : walkerlab.config.SolverSettings, optional
+        The run's contact solver (named in the advice).
+
+    Returns
+    -------
+    str
+        ``"not replayed: the contact model's solver failed ..."``.
+    """
+    which = "" if solver is None else f" ({solver.method}, rtol {solver.rtol:g})"
+    what = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    return (f"not replayed: the contact model's solver{which} failed while locating a "
+            f"contact event ({type(exc).__name__}: {what}); the rigid optimum and its "
+            "replays stand; try walkerlab contact-sim with another contact_solver "
+            "(method, rtol)")

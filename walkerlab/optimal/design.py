@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["MEASURES", "DesignResult", "design_optimize", "measure_gradient",
-           "multiplier_gradient"]
+__all__ = ["MEASURES", "DesignResult", "design_bounds", "design_optimize",
+           "measure_gradient", "multiplier_gradient"]
 
 #: Measures of a gait a design can optimise, with their units.
 MEASURES = {"step_period": "s", "step_length": "m", "speed": "m/s", "cost_of_transport": "-",
@@ -91,7 +91,7 @@ class DesignResult:
 class _Gaits:
     """Walkers and their gaits over the design, each solve started at the last gait."""
 
-    def __init__(self, scene, fields, x0, max_step=None):
+    def __init__(self, scene, fields, x0, max_step=None, bounds=None):
         from walkerlab.integrate.solver import Solver
         from walkerlab.studies.continuation import scene_value
 
@@ -103,7 +103,25 @@ class _Gaits:
         # longest design change solved in one go (field units); longer ones are walked in
         # equal sub-steps, each started at the gait before (natural-parameter continuation)
         self.max_step = None if max_step is None else np.asarray(max_step, float)
+        # the design's bounds ((k,), (k,)): no walker is built outside them (a difference
+        # stencil at a bound is one-sided there: a stiffness from 0 never goes below it)
+        k = len(self.fields)
+        lo, hi = (None, None) if bounds is None else bounds
+        self.lo = np.full(k, -np.inf) if lo is None else np.asarray(lo, float)
+        self.hi = np.full(k, np.inf) if hi is None else np.asarray(hi, float)
         self.count = 0
+
+    def stencil(self, p, j: int, h: float):
+        """The two design points of a difference in field ``j`` at ``p``: ``p ± step e_j``
+        (``step = h max(1, |p_j|)``) cut at the bounds, and their offsets ``(s+, s-)``
+        from ``p_j`` (both ``step`` inside the bounds; one of them 0 at a bound: a
+        one-sided difference).  The derivative is ``(f(p+) - f(p-)) / (s+ + s-)``."""
+        p = np.asarray(p, float)
+        step = h * max(1.0, abs(p[j]))
+        pp, pm = p.copy(), p.copy()
+        pp[j] = min(self.hi[j], p[j] + step)
+        pm[j] = max(self.lo[j], p[j] - step)
+        return pp, pm, pp[j] - p[j], p[j] - pm[j]
 
     def scene_at(self, p):
         from walkerlab.studies.params import apply_point
@@ -133,13 +151,12 @@ class _Gaits:
         start = self.last.copy(), self.p_last.copy()
         grad = np.empty(p.size)
         for j in range(p.size):
-            dp = np.zeros(p.size)
-            dp[j] = h_rel * max(1.0, abs(p[j]))
-            hi = self.value(p + dp, name)
+            pp, pm, sp, sm = self.stencil(p, j, h_rel)
+            hi = self.value(pp, name)
             self.last, self.p_last = start[0].copy(), start[1].copy()
-            lo = self.value(p - dp, name)
+            lo = self.value(pm, name)
             self.last, self.p_last = start[0].copy(), start[1].copy()
-            grad[j] = (hi - lo) / (2 * dp[j])
+            grad[j] = (hi - lo) / (sp + sm)
         return value, grad
 
     def gait(self, p):
@@ -197,25 +214,26 @@ def measure_gradient(gaits: _Gaits, p, name: str, h_x: float = 1e-6,
                       for e in np.eye(n2)])
     grad = np.empty(p.size)
     for j in range(p.size):
-        wp, wm, step, dx = _gait_shift(gaits, p, j, h_p, x, J)
+        wp, wm, (sp, sm), dx = _gait_shift(gaits, p, j, h_p, x, J)
         dm = (_measures(wp, x, gaits.solver)[name]
-              - _measures(wm, x, gaits.solver)[name]) / (2 * step)
+              - _measures(wm, x, gaits.solver)[name]) / (sp + sm)
         grad[j] = dm_dx @ dx + dm
     return value, grad
 
 
 def _gait_shift(gaits: _Gaits, p, j: int, h: float, x, J):
-    """The walkers at ``p ± step e_j`` (``step = h max(1, |p_j|)``), the step and the fixed
-    point's shift ``dx*/dp_j = (I - DP)⁻¹ ∂P/∂p_j`` (2n,) from a central difference of
-    single maps at the fixed point ``x`` (``J``: its ``DP``)."""
+    """The walkers at the difference stencil's two points ``p+``, ``p-``
+    (:meth:`_Gaits.stencil`: ``p ± step e_j`` within the bounds), their offsets
+    ``(s+, s-)`` and the fixed point's shift ``dx*/dp_j = (I - DP)⁻¹ ∂P/∂p_j`` (2n,) from
+    a difference of single maps at the fixed point ``x`` (``J``: its ``DP``; central
+    inside the bounds, one-sided at a bound)."""
     from walkerlab.analysis.gait.poincare import poincare_map
 
-    dp = np.zeros(p.size)
-    dp[j] = h * max(1.0, abs(p[j]))
-    wp, wm = gaits.walker(p + dp), gaits.walker(p - dp)
+    pp, pm, sp, sm = gaits.stencil(p, j, h)
+    wp, wm = gaits.walker(pp), gaits.walker(pm)
     dP = (poincare_map(wp, x, gaits.solver)[0] - poincare_map(wm, x, gaits.solver)[0]) \
-        / (2 * dp[j])
-    return wp, wm, dp[j], np.linalg.solve(np.eye(x.size) - J, dP)
+        / (sp + sm)
+    return wp, wm, (sp, sm), np.linalg.solve(np.eye(x.size) - J, dP)
 
 
 def multiplier_gradient(gaits: _Gaits, p, h: float = 1e-5) -> tuple[float, np.ndarray]:
@@ -261,14 +279,70 @@ def multiplier_gradient(gaits: _Gaits, p, h: float = 1e-5) -> tuple[float, np.nd
     lam, v, wl = ev[i], V[:, i], W[:, i]
     grad = np.empty(p.size)
     for j in range(p.size):
-        wp, wm, step, dx_dp = _gait_shift(gaits, p, j, h, x, J)
-        dx = dx_dp * step
-        Jp = poincare_map(wp, x + dx, gaits.solver, jacobian=True)[2]
-        Jm = poincare_map(wm, x - dx, gaits.solver, jacobian=True)[2]
-        dJ = (np.asarray(Jp, float) - np.asarray(Jm, float)) / (2 * step)
+        wp, wm, (sp, sm), dx_dp = _gait_shift(gaits, p, j, h, x, J)
+        Jp = poincare_map(wp, x + dx_dp * sp, gaits.solver, jacobian=True)[2]
+        Jm = poincare_map(wm, x - dx_dp * sm, gaits.solver, jacobian=True)[2]
+        dJ = (np.asarray(Jp, float) - np.asarray(Jm, float)) / (sp + sm)
         dlam = (wl.conj() @ dJ @ v) / (wl.conj() @ v)
         grad[j] = float(np.real(np.conj(lam) * dlam)) / abs(lam)
     return float(abs(lam)), grad
+
+
+def design_bounds(scene, items: list[str]) -> dict:
+    """The design's bounds from ``--design FIELD=LO:HI`` strings, checked against the scene
+    before anything runs: every field once, a numeric field the scene sets (not a whole
+    number), ``LO < HI`` both finite, and the scene valid with the field at each bound.
+
+    Parameters
+    ----------
+    scene : Scene
+    items : list of str
+        ``FIELD=LO:HI`` (the field's unit).
+
+    Returns
+    -------
+    dict
+        ``{field: (lo, hi)}`` in the order given.
+
+    Raises
+    ------
+    ValueError
+        One line naming ``--design`` and the item.
+    """
+    import math
+
+    from walkerlab.config.errors import SceneError
+    from walkerlab.studies.continuation import scene_value
+    from walkerlab.studies.params import ParamAxis, apply_point, takes_whole_numbers
+
+    bounds: dict = {}
+    base = scene.model_dump(mode="json")
+    for item in items:
+        field, _, rng = item.partition("=")
+        field = field.strip()
+        lo, _, hi = rng.partition(":")
+        try:
+            lo_v, hi_v = float(lo), float(hi)
+        except ValueError:
+            raise ValueError(f"--design {item!r}: write FIELD=LO:HI with numbers") from None
+        if not (lo_v < hi_v) or not all(math.isfinite(v) for v in (lo_v, hi_v)):
+            raise ValueError(f"--design {item!r}: LO < HI, both finite")
+        if field in bounds:
+            raise ValueError(f"--design {field}: given twice ({field}={bounds[field][0]:g}:"
+                             f"{bounds[field][1]:g} and {item}); give each field once")
+        try:  # an unknown field, one the scene leaves unset, or a bound out of its range
+            scene_value(scene, field)
+            if takes_whole_numbers(scene, ParamAxis(field, (), field)):
+                raise ValueError(f"{field}: the field takes whole numbers; a design "
+                                 "optimisation varies a real number")
+            for v in (lo_v, hi_v):
+                apply_point(base, [field], (v,), f"--design {item}")
+        except (SceneError, ValueError) as exc:
+            msg = str(exc).replace(f"--param {field!r}", f"--design {field}", 1)
+            raise ValueError(msg if msg.startswith("--design")
+                             else f"--design {item}: {msg}") from None
+        bounds[field] = (lo_v, hi_v)
+    return bounds
 
 
 def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool = False,
@@ -309,38 +383,45 @@ def design_optimize(scene, bounds: dict, objective: str, x_gait, maximize: bool 
     lo = np.array([bounds[f][0] for f in fields], float)
     hi = np.array([bounds[f][1] for f in fields], float)
     p0 = np.clip([float(scene_value(scene, f)) for f in fields], lo, hi)
-    gaits = _Gaits(scene, fields, x_gait, max_step=MAX_STEP_SHARE * (hi - lo))
+    gaits = _Gaits(scene, fields, x_gait, max_step=MAX_STEP_SHARE * (hi - lo),
+                   bounds=(lo, hi))
     sign = -1.0 if maximize else 1.0
     history: list = []
     if objective in SMOOTH:
         def fun(p):
+            p = np.clip(p, lo, hi)  # the optimiser's rounding never leaves the bounds
             v, g = measure_gradient(gaits, p, objective)
             history.append((np.array(p, float), v))
             return sign * v, sign * g
 
         res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
                        options={"maxiter": max_evaluations, "ftol": 1e-12})
+        res.x = np.clip(res.x, lo, hi)
         value, grad = measure_gradient(gaits, res.x, objective)
     elif objective in DIFFERENCED + SPECTRAL:
         slope = multiplier_gradient if objective in SPECTRAL else \
             (lambda g, p: g.differenced(p, objective))
 
         def fun(p):
+            p = np.clip(p, lo, hi)
             v, g = slope(gaits, p)
             history.append((np.array(p, float), v))
             return sign * v, sign * g
 
         res = minimize(fun, p0, jac=True, method="SLSQP", bounds=list(zip(lo, hi)),
                        options={"maxiter": max_evaluations, "ftol": 1e-10})
+        res.x = np.clip(res.x, lo, hi)
         value, grad = slope(gaits, res.x)
     else:
         def fun(p):
+            p = np.clip(p, lo, hi)
             v = gaits.value(p, objective)
             history.append((np.array(p, float), v))
             return sign * v
 
         res = minimize(fun, p0, method="Nelder-Mead", bounds=list(zip(lo, hi)),
                        options={"maxfev": max_evaluations, "xatol": 1e-6, "fatol": 1e-9})
+        res.x = np.clip(res.x, lo, hi)
         value, grad = gaits.value(res.x, objective), np.full(len(fields), np.nan)
     return DesignResult(fields, np.asarray(res.x, float), objective, float(value),
                         np.asarray(grad, float), bool(res.success), str(res.message),

@@ -10,7 +10,26 @@ as ``optimize.h5``.  Needs no upstream gait: the guess is built from the targets
 
 from __future__ import annotations
 
-__all__ = ["optimize_five_link_scene", "stick_figures"]
+__all__ = ["check_targets", "optimize_five_link_scene", "stick_figures"]
+
+
+def check_targets(o) -> None:
+    """Refuse a five-link biped's ``optimize`` section ``o`` without a target (speed, step
+    length or step period): the least effort of a free step is a shuffle (RABBIT: a 1 mm
+    step at 0.0024 m/s, 1.2e-5 N² m² s), not a gait to optimise; Kelly (2017) fixes the
+    step length and period.
+
+    Raises
+    ------
+    ValueError
+        No target (one line saying which fields to give).
+    """
+    if all(t is None for t in (o.target_speed_m_per_s, o.target_step_length_m,
+                               o.target_step_period_s)):
+        raise ValueError("a five-link biped's optimal step needs a target (without one the "
+                         "least effort is a 1 mm shuffle): give optimize.target_step_length_m"
+                         " and target_step_period_s, or target_speed_m_per_s, as "
+                         "configs/rabbit_optimal.yaml (0.5 m in 0.7 s)")
 
 
 def optimize_five_link_scene(scene):
@@ -36,7 +55,8 @@ def optimize_five_link_scene(scene):
     Raises
     ------
     ValueError
-        A push-off asked for, a walker the five-link generator does not handle (one line).
+        No target (:func:`check_targets`), a push-off asked for, a walker the five-link
+        generator does not handle (one line).
     """
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
@@ -44,10 +64,11 @@ def optimize_five_link_scene(scene):
     from walkerlab.optimal.five_link import JOINTS, five_link_functions
     from walkerlab.optimal.five_link_collocation import collocate_five_link, replay_five_link
     from walkerlab.optimal.five_link_shooting import close_step
-    from walkerlab.optimal.records import step_record
+    from walkerlab.optimal.records import not_a_gait_outcome, step_record
     from walkerlab.walker.description import walker_data
 
     o = scene.optimize
+    check_targets(o)
     if o.push_off == "free":
         raise ValueError("optimize.push_off: a five-link biped has no push-off (its hips and "
                          "knees are driven)")
@@ -67,7 +88,9 @@ def optimize_five_link_scene(scene):
     units = dict(zip(names, rigid.state_units()))
     gait = bool(res.status == "Solve_Succeeded" and closed.converged
                 and err <= o.replay_tolerance)
-    phases, contact = _phase_replays(scene, data, res)
+    why = "" if gait else (not_a_gait_outcome(err, res.status) if closed.converged else
+                           "not replayed: not a gait (the shooting did not close the step)")
+    phases, contact = _phase_replays(scene, data, res, why)
     return OptimizeData(
         res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u, res.step_period_s,
         res.step_length_m, 0.0, res.objective, err, closed.multipliers, gait, res.status,
@@ -82,10 +105,11 @@ def optimize_five_link_scene(scene):
 CONTACT_STRIDES = 2
 
 
-def _phase_replays(scene, data, res) -> tuple[dict, tuple[float, str]]:
+def _phase_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple[float, str]]:
     """The phase-variable replays (:func:`walkerlab.optimal.five_link_replay.phase_replays`)
     as ``optimize.h5``'s records, and the contact model's ``(step period [s], outcome)``
-    under the feed-forward + PD law from its closed start."""
+    under the feed-forward + PD law from its closed start; an optimum that is not a gait
+    is not replayed there (``not_gait``: why, the contact outcome)."""
     from walkerlab.optimal.contact_replay import contact_replay_five_link
     from walkerlab.optimal.five_link_replay import phase_replays
     from walkerlab.optimal.phase_replay import records
@@ -98,6 +122,8 @@ def _phase_replays(scene, data, res) -> tuple[dict, tuple[float, str]]:
     except ValueError as exc:  # the phase variable is not monotonic: no such replay
         return {}, (float("nan"), f"not replayed: {exc}")
     out = records(replays)
+    if not_gait:
+        return out, (float("nan"), not_gait)
     fb = replays["feedback"]
     if not fb.closed:
         return out, (float("nan"), "not replayed: the feed-forward + PD law did not close "

@@ -1,6 +1,8 @@
 """The collocation's starting step: one step of the scene's gait (the fixed point), of a
 continuation branch's gait at a parameter value, or another optimisation's result
-(``optimize.initial_guess``)."""
+(``optimize.initial_guess``); or, for a walker with no gait of its own (a passive walker on
+level ground), a step built from the targets (:func:`target_step`, as Kelly 2017 builds
+the five-link biped's)."""
 
 from __future__ import annotations
 
@@ -8,7 +10,105 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["read_guess", "simulated_step", "starting_step"]
+__all__ = ["read_guess", "simulated_step", "starting_step", "target_numbers", "target_step"]
+
+#: the swing leg's forward swing over the straight-line guess, as a share of the step's
+#: half-angle (a bump ``b sin(pi s)``: the swing foot clears level ground mid-step)
+SWING_BUMP = 0.5
+
+
+def target_numbers(o, leg_length_m: float) -> tuple[float, float]:
+    """The step length [m] and period [s] of a step built from the ``optimize`` section
+    ``o``'s targets: the two given, or one with the speed; a speed alone: a step of
+    ``0.625 leg_length`` (Kelly's 0.5 m on RABBIT's 0.8 m legs) at that speed.
+
+    Raises
+    ------
+    ValueError
+        Only a step length or only a step period given (one line: the other, or the speed).
+    """
+    v, d, t = o.target_speed_m_per_s, o.target_step_length_m, o.target_step_period_s
+    if d is None and t is not None and v is None or d is not None and t is None and v is None:
+        raise ValueError("optimize: a step built from the targets needs two of "
+                         "target_step_length_m, target_step_period_s, target_speed_m_per_s "
+                         "(or the speed alone)")
+    if d is None:
+        d = v * t if t is not None else 0.625 * leg_length_m
+    if t is None:
+        t = d / v
+    return float(d), float(t)
+
+
+def target_step(scene, walker, samples: int = 400):
+    """A starting step of a straight-legged walker with no gait of its own, from the targets
+    (:func:`target_numbers`): the legs swap at constant rates between the heel-strike
+    postures of the target step - stance leg from ``alpha - phi`` to ``-alpha - phi``,
+    swing leg the mirror, ``sin alpha = D / (2 l)``, ``phi`` the slope (angles from the
+    vertical, positive with the foot ahead; Garcia et al. 1998's post-impact posture) -
+    the swing leg swung ahead by ``SWING_BUMP alpha sin(pi s)`` (``s = t / T``) so its
+    foot clears level ground, zero hip torque; the free push-off starts at Kuo's (2002)
+    ``P = M v tan(alpha)`` (``v = 2 alpha l / T`` the hip's speed), capped at
+    ``optimize.push_off_max_n_s``.  Kelly (2017) starts the five-link biped alike.
+
+    Parameters
+    ----------
+    scene : Scene
+        With ``optimize`` targets.
+    walker : HybridWalker
+        The scene's rigid walker (straight legs, point feet).
+    samples : int
+
+    Returns
+    -------
+    t : ndarray (samples,) [s]; x : ndarray (samples, 2n) in ``walker.state_names()``
+    order; u : None; push_off : float [N s] (the free push-off's start) or None (fixed)
+
+    Raises
+    ------
+    ValueError
+        Too few targets (:func:`target_numbers`), a step longer than the legs allow.
+    """
+    o = scene.optimize
+    length = float(walker.params["leg_length_m"])
+    D, T = target_numbers(o, length)
+    if D >= 2.0 * length:
+        raise ValueError(f"optimize.target_step_length_m: {D:g} m is more than the legs "
+                         f"span ({2 * length:g} m)")
+    alpha, phi = float(np.arcsin(D / (2.0 * length))), float(walker.slope_rad)
+    t = np.linspace(0.0, T, samples)
+    s = t / T
+    bump, dbump = SWING_BUMP * alpha, SWING_BUMP * alpha * np.pi / T
+    stance, dstance = alpha * (1.0 - 2.0 * s) - phi, np.full_like(s, -2.0 * alpha / T)
+    swing = -alpha * (1.0 - 2.0 * s) - phi + bump * np.sin(np.pi * s)
+    dswing = 2.0 * alpha / T + dbump * np.cos(np.pi * s)
+    x = _states_from_legs(walker, stance, swing, dstance, dswing)
+    push = None
+    if o.push_off == "free":
+        m = float(walker.params["total_mass_kg"])
+        push = min(m * (2.0 * alpha * length / T) * np.tan(alpha), o.push_off_max_n_s)
+    return t, x, None, push
+
+
+def _states_from_legs(walker, stance, swing, dstance, dswing) -> np.ndarray:
+    """States (m, 2n) whose legs have these absolute angles and rates (m,) each: the
+    walker's ``leg_coordinates`` are affine in its state for straight legs (absolute,
+    slope-relative or relative coordinates), so the map is read off at the zero state and
+    the unit states and inverted by least squares (no projection on the heel-strike
+    surface: :func:`walkerlab.analysis.gait.starts.state_from_legs` does that for a
+    post-impact state)."""
+    leg = walker.legs[-1]  # in stance (the post-impact convention)
+    keys = [f"{leg}_angle", f"{walker.legs[0]}_angle", f"{leg}_rate", f"{walker.legs[0]}_rate"]
+    n2 = walker.layout().zeros().size
+
+    def coords(x):
+        d = walker.leg_coordinates(x, leg)
+        return np.array([float(d[k]) for k in keys])
+
+    c = coords(np.zeros(n2))
+    A = np.stack([coords(e) - c for e in np.eye(n2)], axis=1)
+    want = np.stack([stance, swing, dstance, dswing], axis=1) - c
+    return np.linalg.lstsq(A, want.T, rcond=None)[0].T
+
 
 
 def simulated_step(walker, x0, period_s: float, solver, samples: int = 400):
@@ -44,13 +144,15 @@ def simulated_step(walker, x0, period_s: float, solver, samples: int = 400):
 
 
 def starting_step(scene, walker, x_gait, period_s: float):
-    """The starting step of ``scene``'s collocation (module docstring).
+    """The starting step of ``scene``'s collocation (module docstring); ``x_gait`` None:
+    the walker has no gait, the step is built from the targets (:func:`target_step`).
 
     Returns
     -------
     t : ndarray (m,) [s]; x : ndarray (m, 2n); u : ndarray (m,) or None [N m];
     push_off : float or None [N s]
-        ``u`` and ``push_off`` from another ``optimize.h5`` only.
+        ``u`` and ``push_off`` from another ``optimize.h5`` only (``push_off`` also from
+        the targets when it is free).
 
     Raises
     ------
@@ -61,6 +163,8 @@ def starting_step(scene, walker, x_gait, period_s: float):
     from walkerlab.integrate.solver import Solver
 
     solver = Solver.from_settings(scene.solver)
+    if x_gait is None:  # no gait of its own: a step from the targets
+        return target_step(scene, walker)
     if scene.optimize.initial_guess is None:
         return (*simulated_step(walker, x_gait, period_s, solver), None, None)
     kind, got = read_guess(scene, list(walker.state_names()))

@@ -54,7 +54,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
         phase_torque_of_time,
         replay_phases,
     )
-    from walkerlab.optimal.records import phase_replays, step_record
+    from walkerlab.optimal.records import not_a_gait_outcome, phase_replays, step_record
     from walkerlab.optimal.step_cache import cached_mode_functions
 
     o = scene.optimize
@@ -68,15 +68,16 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                            guess_u)
     err, replayed = replay_phases(data, res)
     mu = replay_multipliers(replayed, res, scene, err)
-    contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
-    if np.isfinite(err):
+    gait = bool(err <= o.replay_tolerance and res.status == "Solve_Succeeded")
+    contact_period, contact_outcome = float("nan"), not_a_gait_outcome(err, res.status)
+    if gait:  # the contact model replays a gait only
         contact_period, contact_outcome = contact_replay_phased(scene, res, strides=2)
     phases, phase_note = phase_replays(scene, data, res, phase_torque_of_time(res))
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
                         res.step_period_s, res.step_length_m, 0.0, res.objective, err, mu,
-                        bool(err <= o.replay_tolerance and res.status == "Solve_Succeeded"),
+                        gait,
                         res.status, res.iterations, res.wall_time_s, units,
                         objective_name=o.objective, objective_unit=_unit(o.objective),
                         terms=res.terms, contact_step_period_s=contact_period,

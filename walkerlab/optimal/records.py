@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["phase_replays", "step_record"]
+__all__ = ["not_a_gait_outcome", "phase_replays", "step_record"]
 
 
 def phase_replays(scene, data, res, tau) -> tuple[dict, str]:
@@ -33,3 +33,22 @@ def step_record(scene, walker, res) -> dict:
     return {"ipopt_history": dict(res.history),
             "energy": {"kinetic": np.asarray(ke, float), "potential": np.asarray(pe, float)},
             "energy_unit": for_scene(scene).energy}
+
+
+def not_a_gait_outcome(err: float, status: str) -> str:
+    """The contact replay's outcome of an optimum that is not a gait (it is not replayed:
+    a step that does not close on the rigid model says nothing of the contact one).
+
+    Parameters
+    ----------
+    err : float
+        The rigid replay's return error [rad, rad/s] (inf or NaN: the replay failed).
+    status : str
+        IPOPT's status.
+    """
+    if not np.isfinite(err):
+        return "not replayed: the rigid replay failed"
+    if status != "Solve_Succeeded":
+        return f"not replayed: not a gait (IPOPT: {status})"
+    return (f"not replayed: not a gait (the rigid replay returns {err:.2g} away, more than "
+            "optimize.replay_tolerance)")

@@ -1,7 +1,8 @@
 """A scene's optimal gait (``walkerlab optimize``): the collocation of
 :mod:`walkerlab.optimal.collocation` set up from the scene (its walker, slope,
-push-off and ``optimize`` section), started from the scene's gait, replayed on the rigid
-model, its Floquet multipliers from the replay."""
+push-off and ``optimize`` section), started from the scene's gait (a walker with none, a
+passive walker on level ground: from the targets), replayed on the rigid model, its
+Floquet multipliers from the replay."""
 
 from __future__ import annotations
 
@@ -9,10 +10,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.optimal.records import phase_replays, step_record
+from walkerlab.optimal.records import not_a_gait_outcome, phase_replays, step_record
 
-__all__ = ["collocation_spec", "needs_gait", "optimize_scene", "phase_replays",
-           "step_record"]
+__all__ = ["collocation_spec", "five_link", "needs_gait", "no_gait_of_its_own",
+           "not_a_gait_outcome", "optimize_scene", "phase_replays", "step_record"]
 
 
 def collocation_spec(scene):
@@ -44,9 +45,29 @@ def collocation_spec(scene):
 def needs_gait(scene) -> bool:
     """Whether the scene's optimisation starts from its own gait (``fixedpoint.h5``): every
     walker but a five-link biped (``walker.leg.knee.lock: free``), whose guess is built from
-    the targets (:mod:`walkerlab.optimal.five_link_scene`)."""
+    the targets (:mod:`walkerlab.optimal.five_link_scene`), and a walker with no gait of its
+    own (:func:`no_gait_of_its_own`), whose step is built from them too
+    (:func:`walkerlab.optimal.guess.target_step`)."""
+    return not five_link(scene) and not no_gait_of_its_own(scene)
+
+
+def five_link(scene) -> bool:
+    """Whether the scene's walker is a five-link biped (``walker.leg.knee.lock: free``)."""
     knee = getattr(getattr(scene.walker, "leg", None), "knee", None)
-    return getattr(knee, "lock", None) != "free"
+    return getattr(knee, "lock", None) == "free"
+
+
+def no_gait_of_its_own(scene) -> bool:
+    """Whether the scene's walker has no period-1 gait to start an optimisation from: a
+    passive walker (no ``walker.actuation``) on level or uphill ground (slope <= 0) loses
+    energy at every heel strike and gains none from gravity over a step, so it has no gait
+    (the gait search says "a passive walker needs a downhill slope"); and no
+    ``optimize.initial_guess`` names another start.  Its optimal gait (a free push-off or
+    the hip torque powering it: Srinivasan & Ruina 2006, Kelly 2017's OptimTraj) starts
+    from the targets."""
+    o = getattr(scene, "optimize", None)
+    return (getattr(scene.walker, "actuation", None) is None and scene.slope.phi_rad <= 0.0
+            and (o is None or o.initial_guess is None))
 
 
 def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
@@ -59,10 +80,12 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
         hip mass; or a kneed or flat-footed walker (a step of phases:
         :func:`walkerlab.optimal.phased_scene.optimize_phased_scene`); or legs that differ
         (a stride: :func:`walkerlab.optimal.stride_scene.optimize_stride_scene`).
-    x_gait : ndarray (2n,)
+    x_gait : ndarray (2n,) or None
         The scene's gait just after heel strike (``fixedpoint.h5``): the initial guess is
-        one step of it (unless ``optimize.initial_guess`` names an artifact).
-    period_s : float
+        one step of it (unless ``optimize.initial_guess`` names an artifact); None: the
+        walker has none (:func:`no_gait_of_its_own`), the guess is built from the targets
+        (straight legs, point feet: :func:`walkerlab.optimal.guess.target_step`).
+    period_s : float or None
         Its step period [s].
 
     Returns
@@ -73,7 +96,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     ------
     ValueError
         A walker the transcription does not handle, the starting gait does not make a step,
-        or the initial guess's artifact is unusable (one line).
+        the initial guess's artifact is unusable, or no gait and a walker the targets' guess
+        does not build (legs with knees, flat feet, legs that differ) (one line).
     """
     from walkerlab.analysis.gait.poincare import poincare_map
     from walkerlab.integrate.solver import Solver
@@ -93,6 +117,12 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     data = walker_data(scene.walker, scene.slope.phi_rad)
     spec = collocation_spec(scene)
     walker = build_walker(scene)
+    if x_gait is None and (data.mirror is not None or data.structure.knee
+                           or data.structure.foot == "flat"):
+        raise ValueError("optimize: the walker has no gait of its own to start from (passive "
+                         "on level ground), and a step from the targets is built for "
+                         "straight legs with point feet only; give optimize.initial_guess "
+                         "(another optimize.h5) or a downhill slope")
     if data.mirror is not None:  # legs that differ: a stride of two different steps
         from walkerlab.optimal.stride_scene import optimize_stride_scene
 
@@ -116,16 +146,16 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
             mu = np.linalg.eigvals(DP).astype(complex)
         except Exception:  # noqa: BLE001 - the replay's multipliers are a report, not a gate
             pass
-    contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
-    if np.isfinite(err):
+    gait = bool(err <= o.replay_tolerance and res.status == "Solve_Succeeded")
+    contact_period, contact_outcome = float("nan"), not_a_gait_outcome(err, res.status)
+    if gait:  # the contact model replays a gait only
         contact_period, contact_outcome = contact_replay(scene, res)
     phases, phase_note = phase_replays(scene, data, res, torque_of_time(res))
     names = list(walker.state_names())
     units = dict(zip(names, walker.state_units()))
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
                         res.step_period_s, res.step_length_m, res.push_off_n_s,
-                        res.objective, err, mu, bool(err <= o.replay_tolerance
-                                                     and res.status == "Solve_Succeeded"),
+                        res.objective, err, mu, gait,
                         res.status, res.iterations, res.wall_time_s, units,
                         objective_name=o.objective, objective_unit=_unit(o, data),
                         terms=res.terms, contact_step_period_s=contact_period,

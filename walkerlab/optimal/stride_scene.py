@@ -106,6 +106,7 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     from walkerlab.optimal.contact_replay import contact_replay_stride
     from walkerlab.optimal.phased_collocation import collocate_phases
     from walkerlab.optimal.phased_scene import replay_multipliers
+    from walkerlab.optimal.records import not_a_gait_outcome
     from walkerlab.optimal.stride import replay_stride, stride_functions
 
     o = scene.optimize
@@ -120,8 +121,9 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
                            guess_u)
     err, replayed = replay_stride(data, res)
     mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
-    contact_period, contact_outcome = float("nan"), "not replayed: the rigid replay failed"
-    if np.isfinite(err):
+    gait = bool(err <= o.replay_tolerance and res.status == "Solve_Succeeded")
+    contact_period, contact_outcome = float("nan"), not_a_gait_outcome(err, res.status)
+    if gait:  # the contact model replays a gait only
         contact_period, contact_outcome = contact_replay_stride(scene, res, strides=2)
     lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
         [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
@@ -130,9 +132,7 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     return OptimizeData(res.t, {n: res.x[:, k] for k, n in enumerate(names)}, res.u,
                         res.step_period_s / 2, float(np.mean(lengths)), res.push_off_n_s,
                         res.objective,
-                        err, mu, bool(err <= o.replay_tolerance
-                                      and res.status == "Solve_Succeeded"),
-                        res.status, res.iterations, res.wall_time_s, units,
+                        err, mu, gait, res.status, res.iterations, res.wall_time_s, units,
                         objective_name=o.objective,
                         objective_unit=_unit(o.objective), terms=res.terms,
                         contact_step_period_s=contact_period,

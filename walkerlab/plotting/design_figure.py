@@ -9,8 +9,10 @@ from pathlib import Path
 __all__ = ["save_design_figure"]
 
 
-def save_design_figure(d, title: str, folder: Path) -> list[Path]:
-    """Draw ``optimize_design.png`` / ``.svg`` from a loaded ``optimize_design.h5``.
+def save_design_figure(d, title: str, folder: Path,
+                       stem: str = "optimize_design") -> list[Path]:
+    """Draw ``<stem>.png`` / ``.svg`` from a loaded design artifact (``<stem>.h5``,
+    :func:`walkerlab.io.runpaths.design_stem`).
 
     Parameters
     ----------
@@ -22,6 +24,8 @@ def save_design_figure(d, title: str, folder: Path) -> list[Path]:
         The scene's name.
     folder : Path
         The figures folder.
+    stem : str
+        The files' stem (the artifact's).
 
     Returns
     -------
@@ -59,4 +63,4 @@ def save_design_figure(d, title: str, folder: Path) -> list[Path]:
         ax.legend(fontsize=7, loc="best")
     fig.suptitle(f"{title}: design optimisation over its own gait", fontsize=10)
     fig.tight_layout()
-    return save(fig, Path(folder), "optimize_design")
+    return save(fig, Path(folder), stem)

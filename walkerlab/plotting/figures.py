@@ -25,9 +25,16 @@ SI_UNITS = Units()
 
 LEG_COLORS = ["tab:blue", "tab:red", "tab:green", "tab:purple"]
 MODEL_STYLES = ["-", "--", ":", "-."]
-#: colours of the parts of each leg (thigh, shank), leg by leg; the first is LEG_COLORS'
-PART_COLORS = [("tab:blue", "tab:green"), ("tab:red", "tab:purple"),
-               ("tab:olive", "tab:cyan"), ("tab:brown", "tab:pink")]
+#: colours of the links of each owner (leg1, leg2, a torso, ...), in :data:`PARTS` order;
+#: every colour once, the first of each leg LEG_COLORS'
+PART_COLORS = [("tab:blue", "tab:green", "tab:cyan", "navy"),
+               ("tab:red", "tab:purple", "tab:pink", "maroon"),
+               ("tab:olive", "tab:brown", "tab:gray", "darkgoldenrod"),
+               ("tab:orange", "black", "teal", "darkkhaki")]
+#: the links of a leg in colour order: thigh, shank, the whole leg (a straight leg's
+#: ``<leg>_angle``, or a kneed leg's hip-to-foot angle beside its links), a foot; others
+#: after them by name
+PARTS = ("thigh", "shank", "", "foot")
 
 
 def save(fig, folder: Path, stem: str) -> list[Path]:
@@ -76,12 +83,22 @@ def _owners(names) -> list[str]:
     return sorted({n.split("_", 1)[0] for n in names})
 
 
-def _coordinate_styles(names: list[str], model_index: int = 0) -> dict[str, dict]:
-    """Colour per leg and part of it (``leg1_thigh`` blue, ``leg1_shank`` cyan; first word
-    of the name: ``leg1``, ``torso``), line style per model (``model_index``: ideal solid,
-    contact dashed), so every curve is told apart by colour *and* the models by style,
-    also where the parts of one leg overlap (a locked knee)."""
-    stems = list(dict.fromkeys(n.rsplit("_", 1)[0] for n in names))
+def _part_rank(stem: str) -> tuple:
+    """Where a link (``leg1_thigh``, ``leg1``, ``torso``) comes among its owner's links:
+    :data:`PARTS` order, then by name."""
+    part = stem.split("_", 1)[1] if "_" in stem else ""
+    return (PARTS.index(part), "") if part in PARTS else (len(PARTS), part)
+
+
+def _coordinate_styles(names, model_index: int = 0) -> dict[str, dict]:
+    """One colour per link, whatever the view and its coordinates' order (``leg1_thigh``
+    blue, ``leg1_shank`` green, a straight ``leg1`` blue; ``leg2``'s in reds; first word of
+    the name: ``leg1``, ``torso``; :data:`PART_COLORS`), line style per model
+    (``model_index``: ideal solid, contact dashed), so every curve is told apart by colour
+    *and* the models by style, also where the parts of one leg overlap (a locked knee).
+    Give ``names`` of every view of a figure: the links are ranked over them all."""
+    stems = sorted({n.rsplit("_", 1)[0] for n in names},
+                   key=lambda s: (s.split("_", 1)[0], _part_rank(s)))
     owners = _owners(stems)
     out = {}
     for n in names:
@@ -99,8 +116,9 @@ def fig7_angles_rates(trajs: dict[str, NamedTrajectory], title: str = "walking",
     """Fig. 7: every named angle [rad] (a) and rate [rad/s] (b) over time, every model
     (``units``: the scene's unit labels)."""
     fig, axes = plt.subplots(2, 1, figsize=(8, 6.4), sharex=True, layout="constrained")
+    every = [n for tr in trajs.values() for n in tr.coordinates]  # one colour per link
     for mi, (label, tr) in enumerate(trajs.items()):
-        sty = _coordinate_styles(list(tr.coordinates), mi)
+        sty = {n: s for n, s in _coordinate_styles(every, mi).items() if n in tr.coordinates}
         for ax, names in zip(axes, (tr.angle_names(), tr.rate_names())):
             for n in sorted(names, key=lambda n: n.split("_", 1)[0]):  # legend: leg by leg
                 ax.plot(tr.time, tr.coordinates[n], lw=1.2,

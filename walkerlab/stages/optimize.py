@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from walkerlab.config import Scene
-from walkerlab.io.runpaths import stage_artifact
+from walkerlab.io.runpaths import design_stem, stage_artifact
 from walkerlab.io.schemas import optimize as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
 from walkerlab.stages.common import (
@@ -48,14 +48,33 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     Raises
     ------
     StageError
-        A walker the collocation does not handle (one line); a missing ``optimize`` or
-        ``fixedpoint`` section runs with its defaults.
+        A walker the collocation does not handle, or the optimisation failed (one line,
+        chained to its origin for the debug trace); a five-link biped without a target
+        in its ``optimize`` section, or without the section (its step is built from the
+        targets).  A missing ``optimize`` section of another walker runs with its
+        defaults (said in one note), a missing ``fixedpoint`` section with its.
     """
-    from walkerlab.optimal.scene import needs_gait, optimize_scene
+    from walkerlab.optimal.scene import five_link, no_gait_of_its_own, optimize_scene
 
+    missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
-    if not needs_gait(scene):
+    if five_link(scene):  # a five-link biped: its guess is built from the targets
+        from walkerlab.optimal.five_link_scene import check_targets
+
+        try:
+            check_targets(scene.optimize)  # at once, before the collocation is built
+        except ValueError as exc:
+            raise StageError((f"scene '{scene.name}' has no 'optimize' section; "
+                              if missing else "optimize: ") + str(exc)) from exc
         return _run_five_link(scene, runs_root, force)
+    if missing:
+        from walkerlab import progress
+
+        progress.note(f"optimize: scene '{scene.name}' has no 'optimize' section: its "
+                      "defaults (least effort int u^2 dt over 40 intervals, the scene's "
+                      "push-off fixed, no targets or limits)")
+    if no_gait_of_its_own(scene):  # no gait to start from: a step from the targets
+        return _run_from_targets(scene, runs_root, force)
     require(scene, "fixedpoint", "optimize")
     up = stage_artifact(scene, runs_root, "fixedpoint")
 
@@ -64,10 +83,41 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         try:
             data = optimize_scene(scene, fp.x, fp.step_period_s)
         except ValueError as exc:
-            raise StageError(str(exc)) from None
+            raise StageError(str(exc)) from exc
         return (lambda f: schema.write(f, data)), {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, (up,), compute, force)
+
+
+def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
+    """``optimize.h5`` of a walker with no gait of its own (a passive walker on level
+    ground: :func:`walkerlab.optimal.scene.no_gait_of_its_own`): no upstream gait, the
+    starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
+    refused at once without them."""
+    from walkerlab.optimal.guess import target_numbers
+    from walkerlab.optimal.scene import optimize_scene
+
+    o = scene.optimize
+    try:
+        if all(v is None for v in (o.target_speed_m_per_s, o.target_step_length_m,
+                                   o.target_step_period_s)):
+            raise ValueError("the walker has no gait of its own (passive, on level or uphill "
+                             "ground): its optimal gait starts from the targets; give "
+                             "optimize.target_speed_m_per_s and target_step_length_m (or a "
+                             "downhill slope, or optimize.initial_guess)")
+        target_numbers(o, 1.0)  # enough targets for a step: refused at once
+    except ValueError as exc:
+        raise StageError(f"optimize: {exc}".replace("optimize: optimize: ", "optimize: ")) \
+            from exc
+
+    def compute():
+        try:
+            data = optimize_scene(scene, None, None)
+        except ValueError as exc:
+            raise StageError(str(exc)) from exc
+        return (lambda f: schema.write(f, data)), {"data": data}
+
+    return run_cached("optimize", scene, runs_root, SECTIONS, (), compute, force)
 
 
 def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
@@ -79,7 +129,7 @@ def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
         try:
             data = optimize_five_link_scene(scene)
         except ValueError as exc:
-            raise StageError(str(exc)) from None
+            raise StageError(str(exc)) from exc
         return (lambda f: schema.write(f, data)), {"data": data}
 
     return run_cached("optimize", scene, runs_root, SECTIONS, (), compute, force)
@@ -87,7 +137,10 @@ def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
 
 def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
                objective: str, maximize: bool = False) -> StageOutcome:
-    """Compute (or reuse) ``optimize_design.h5``: the fields within ``bounds``
+    """Compute (or reuse) the design optimisation's artifact
+    ``optimize_design_<fields>_<objective>[_maximize].h5``
+    (:func:`walkerlab.io.runpaths.design_stem`: one per set of fields and objective, so
+    another study does not replace it): the fields within ``bounds``
     (``{field: (lo, hi)}``) that minimise (``maximize``: maximise) the gait measure
     ``objective`` (:func:`walkerlab.optimal.design.design_optimize`).
 
@@ -106,13 +159,16 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
         try:
             r = design_optimize(scene, bounds, objective, load_fixedpoint(up).x, maximize)
         except (ValueError, FixedPointNotFound) as exc:
-            raise StageError(f"optimize --design: {exc}") from None
+            msg = str(exc)
+            raise StageError(msg if msg.startswith("optimize --design")
+                             else f"optimize --design: {msg}") from exc
         return (lambda f: schema.write_design(f, r)), {"design": r}
 
     key = repr((sorted(bounds.items()), objective, maximize))
     return run_cached(schema.DESIGN_STAGE, scene, runs_root, ("walker", "slope", "ideal",
                                                               "solver"), (up,), compute,
-                      force, extra_key=key, artifact=schema.DESIGN_STAGE)
+                      force, extra_key=key,
+                      artifact=design_stem(list(bounds), objective, maximize))
 
 
 def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
@@ -129,10 +185,14 @@ def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks)
 
 
-def draw_design(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
-    """Draw ``optimize_design.png`` (PNG + SVG) from ``optimize_design.h5``."""
+def draw_design(scene: Scene, runs_root: Path | str, fields: list[str], objective: str,
+                maximize: bool = False) -> list[Path]:
+    """Draw the design optimisation's figure ``<stem>.png`` (PNG + SVG) from its artifact
+    ``<stem>.h5`` (``stem``: :func:`walkerlab.io.runpaths.design_stem` of ``fields``,
+    ``objective`` and ``maximize``)."""
     from walkerlab.io.runpaths import figures_dir
     from walkerlab.plotting.design_figure import save_design_figure
 
-    d = schema.load_design(stage_artifact(scene, runs_root, schema.DESIGN_STAGE))
-    return save_design_figure(d, scene.name, figures_dir(scene, runs_root))
+    stem = design_stem(list(fields), objective, maximize)
+    d = schema.load_design(stage_artifact(scene, runs_root, stem))
+    return save_design_figure(d, scene.name, figures_dir(scene, runs_root), stem)

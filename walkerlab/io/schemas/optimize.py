@@ -326,7 +326,8 @@ def write_design(f, r) -> None:
 
 @dataclass
 class DesignData:
-    """The contents of ``optimize_design.h5`` (:func:`write_design`)."""
+    """The contents of a design artifact ``optimize_design_<fields>_<objective>.h5``
+    (:func:`write_design`)."""
 
     fields: tuple
     values: np.ndarray  # (k,) the fields' units
@@ -342,7 +343,8 @@ class DesignData:
 
 
 def load_design(path: Path) -> DesignData:
-    """Read ``optimize_design.h5`` (:func:`write_design`).
+    """Read a design artifact ``optimize_design_<fields>_<objective>.h5``
+    (:func:`write_design`).
 
     Raises
     ------

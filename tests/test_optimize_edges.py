@@ -1,0 +1,178 @@
+"""``walkerlab optimize`` at its edges (issue 51, items 4, 7 and 15): a five-link biped
+without a target is refused at once, a failure keeps its origin for the debug trace, the
+contact replay's solver failure is the replay's outcome (not the optimisation's end), a
+level-ground optimum starts from its targets when the walker has no gait, and a result
+that is not a gait is not replayed on the contact model (``--require-gait``)."""
+
+from __future__ import annotations
+
+import traceback
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from walkerlab.config import load_scene
+
+pytest.importorskip("casadi")
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+
+
+def test_a_five_link_biped_without_a_target_is_refused_at_once(tmp_path):
+    """configs/rabbit.yaml has no ``optimize`` section: before, the default section (no
+    target) ran ~50 s into a 1 mm shuffle and then stopped on scipy's root finder ("f(a)
+    and f(b) must have different signs") in the contact replay; now one line at once, naming
+    the targets to give, and nothing written.  The StageError is chained to its origin (the
+    debug trace shows where it came from)."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.stages import optimize as stage
+    from walkerlab.stages.common import StageError
+
+    r = CliRunner().invoke(app, ["optimize", str(CONFIGS / "rabbit.yaml"), "--runs-dir",
+                                 str(tmp_path)])
+    assert r.exit_code == 1 and r.output.count("error:") == 1, r.output
+    assert "has no 'optimize' section" in r.output
+    assert "optimize.target_step_length_m" in r.output and "more characters" not in r.output
+    assert not list(tmp_path.rglob("optimize.h5"))
+    scene = load_scene(CONFIGS / "rabbit.yaml")
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["optimize"] = {"intervals": 20}  # a section without a target: refused alike
+    with pytest.raises(StageError, match="optimize: a five-link biped's optimal step "
+                       "needs a target") as exc:
+        stage.run(type(scene).model_validate(d), tmp_path)
+    origin = "".join(traceback.format_tb(exc.value.__cause__.__traceback__))
+    assert "five_link_scene.py" in origin
+
+
+def test_a_contact_replay_whose_solver_fails_is_an_outcome(monkeypatch):
+    """The contact replay is a report on the optimum: its solver's failure (scipy's event
+    location raising "f(a) and f(b) must have different signs", as RABBIT's feed-forward + PD
+    law did on the contact model without a target) becomes its outcome, one line saying
+    what failed and what to try, and the optimisation stands."""
+    from walkerlab.analysis.contact import sim
+    from walkerlab.config import SolverSettings
+    from walkerlab.optimal import contact_replay
+
+    def fail(*a, **k):
+        raise ValueError("f(a) and f(b) must have different signs")
+
+    monkeypatch.setattr(sim, "simulate_from", fail)
+    solver = SolverSettings.for_contact(method="LSODA", rtol=1e-8, atol=1e-10)
+    period, outcome = contact_replay._run(None, np.zeros(4), 0.7, 1, solver)
+    assert np.isnan(period)
+    assert outcome.startswith("not replayed: the contact model's solver (LSODA, rtol 1e-08)")
+    assert "f(a) and f(b) must have different signs" in outcome and "contact_solver" in outcome
+    assert "\n" not in outcome
+
+
+def test_an_infeasible_target_is_not_replayed_on_contact_and_require_gait_fails(tmp_path):
+    """compass_optimal at 0.6 m/s with |u| <= 0.5 N m: IPOPT reports the problem infeasible
+    and the rigid replay returns 0.03 away - NOT a gait.  Before, the command exited 0 and
+    replayed the contact model on it anyway; now the contact replay is skipped ("not a
+    gait"), ``--require-gait`` exits 1 with one line (as ``fixedpoint --require-stable``,
+    optimize.h5 stays, and a reused one is judged alike)."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.optimize import load
+
+    d = yaml.safe_load((CONFIGS / "compass_optimal.yaml").read_text())
+    d["optimize"].update(target_speed_m_per_s=0.6, max_torque_n_m=0.5)
+    scene = tmp_path / "tight.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    args = ["optimize", str(scene), "--runs-dir", str(tmp_path / "runs")]
+    r = CliRunner().invoke(app, [*args, "--require-gait"])
+    assert r.exit_code == 1 and r.output.count("error:") == 1, r.output
+    assert "error: --require-gait: the optimum is NOT a gait: IPOPT did not converge" \
+        in r.output
+    out = load(tmp_path / "runs" / "tight" / "optimize.h5")
+    assert not out.gait and np.isfinite(out.replay_error)  # the old code replayed it
+    assert np.isnan(out.contact_step_period_s)
+    assert out.contact_outcome.startswith("not replayed: not a gait (IPOPT: ")
+    r = CliRunner().invoke(app, [*args, "--require-gait"])  # reused: read back
+    assert r.exit_code == 1 and "reused" in r.output and "--require-gait" in r.output
+
+
+def _level_compass(**optimize):
+    """compass_optimal.yaml on level ground (a passive walker there has no gait)."""
+    scene = load_scene(CONFIGS / "compass_optimal.yaml")
+    d = scene.model_dump(mode="json", exclude_none=True)
+    d["slope"] = {"angle_rad": 0.0}
+    d["optimize"] = {**d["optimize"], **optimize}
+    return type(scene).model_validate(d)
+
+
+def test_a_level_ground_optimal_gait_starts_from_its_targets():
+    """The Srinivasan-Ruina / OptimTraj task: the compass walker on level ground, push-off
+    free, 0.6 m/s with 0.5 m steps.  It has no gait of its own (before: "no period-1 gait
+    found; a passive walker needs a downhill slope"), so no fixedpoint runs and the start
+    is built from the targets; IPOPT converges (8 iterations seen) to a gait whose rigid
+    replay returns to its start within the scene's 1e-6 (4.5e-8 seen), at the targets
+    (equality constraints: 1e-9), powered by a push-off > 0 (5.27 N s seen; Kuo's
+    ``M v tan(alpha)`` for this step is 3.1 N s, the hip torque doing the rest)."""
+    from walkerlab.models.registry import build_walker
+    from walkerlab.optimal.collocation import collocate_step, replay
+    from walkerlab.optimal.guess import starting_step
+    from walkerlab.optimal.scene import collocation_spec
+    from walkerlab.optimal.step_cache import cached_step_functions
+    from walkerlab.stages import pipeline
+    from walkerlab.walker.description import walker_data
+
+    scene = _level_compass(push_off="free", target_speed_m_per_s=0.6,
+                           target_step_length_m=0.5)
+    assert pipeline.order("optimize", scene) == ["optimize"]  # no gait to find first
+    walker = build_walker(scene)
+    t, x, u, p = starting_step(scene, walker, None, None)
+    assert u is None and p > 0 and t[-1] == pytest.approx(0.5 / 0.6, rel=1e-12)
+    data = walker_data(scene.walker, 0.0)
+    from dataclasses import replace
+
+    spec = replace(collocation_spec(scene), push_off_n_s=p)
+    res = collocate_step(data, None, spec, t, x, None, cached_step_functions(data))
+    assert res.status == "Solve_Succeeded"
+    err, _ = replay(data, res)
+    assert err <= scene.optimize.replay_tolerance
+    assert res.step_length_m == pytest.approx(0.5, abs=1e-9)
+    assert res.step_length_m / res.step_period_s == pytest.approx(0.6, abs=1e-9)
+    assert res.push_off_n_s > 1.0
+
+
+def test_a_level_ground_walker_without_targets_is_refused_at_once(tmp_path):
+    """No gait and no target to build a start from: one line naming the targets, before
+    anything runs (no fixedpoint.h5, no optimize.h5)."""
+    from walkerlab.stages import optimize as stage
+    from walkerlab.stages.common import StageError
+
+    with pytest.raises(StageError, match="optimize: the walker has no gait of its own .*"
+                       "optimize.target_speed_m_per_s"):
+        stage.run(_level_compass(push_off="free"), tmp_path)
+    with pytest.raises(StageError, match="needs two of target_step_length_m"):
+        stage.run(_level_compass(push_off="free", target_step_length_m=0.5), tmp_path)
+    assert not list(tmp_path.rglob("*.h5"))
+
+
+@pytest.mark.slow
+def test_the_level_ground_optimum_from_the_command(tmp_path):
+    """``walkerlab optimize`` of the level-ground compass with a free push-off: exit 0, a
+    gait, no fixedpoint.h5 (the start came from the targets); its rigid replay periodic."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.optimize import load
+
+    d = yaml.safe_load((CONFIGS / "compass_optimal.yaml").read_text())
+    d["slope"] = {"angle_rad": 0.0}
+    d["optimize"].update(push_off="free", target_speed_m_per_s=0.6, target_step_length_m=0.5)
+    scene = tmp_path / "level.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["optimize", str(scene), "--require-gait", "--runs-dir",
+                                 str(tmp_path / "runs")])
+    assert r.exit_code == 0 and "a gait (the replay closes)" in r.output, r.output
+    assert not (tmp_path / "runs" / "level" / "fixedpoint.h5").exists()
+    out = load(tmp_path / "runs" / "level" / "optimize.h5")
+    assert out.gait and out.replay_error <= 1e-6 and out.push_off_n_s > 1.0
+    assert out.step_length_m == pytest.approx(0.5, abs=1e-9)
