@@ -388,7 +388,6 @@ def generate(eq: Equations, param_names, key: str) -> str:
         f"{IND}d = _energies(x)",
         f"{IND}return d['kinetic'], d['potential']",
         *numpy_fn("points", eq, eq.points),
-        *numpy_fn("point_velocities", eq, _point_velocities(eq)),
         *numpy_fn("leg_angles", eq, {**{f"{k}_angle": v for k, v in la.items()},
                                       **{f"{k}_rate": v for k, v in rates.items()}}),
         *numpy_fn("_matrices", eq, {"M": eq.M, "C": eq.C, "G": eq.G}),
@@ -399,6 +398,9 @@ def generate(eq: Equations, param_names, key: str) -> str:
         "    def impact_matrices(q):",
         f"{IND}d = _impact_matrices(q)",
         f"{IND}return d['De'], d['E']",
+        # last: the cse symbols' numbering of the functions above stays as before (their
+        # printed expressions, and so their round-off, unchanged)
+        *numpy_fn("point_velocities", eq, _point_velocities(eq)),
         "    return {k: v for k, v in locals().items() if callable(v) and not k.startswith('_')}",
     ]
     head = [
