@@ -547,6 +547,50 @@ def floating_module(structure: Structure):
     return load_generated(structure, "floating", lambda key: floating_source(structure, key))
 
 
+_plain: dict[str, dict] = {}
+
+
+def floating_plain(structure: Structure) -> dict:
+    """The floating module's functions of ``structure`` as the plain Python they are
+    generated from (``njit`` the identity): the generated text (the user cache's, checked as
+    :func:`load_generated` checks it, or generated anew and written there), executed without
+    numba, for a check of a few hundred states that should load no compiler (the rigid
+    gait's ground reaction, :mod:`walkerlab.models.hybrid.ground_reaction`).  Memoised per
+    process.
+
+    Returns
+    -------
+    dict
+        The module's namespace (``NQ``, ``COORDINATES``, ``dyn``, ``feet``, ``feet_jac``, ...).
+
+    Raises
+    ------
+    ValueError
+        Massless bodies (:data:`MASSLESS_MESSAGE`).
+    """
+    check_masses(structure)
+    from walkerlab.codegen import cache
+
+    key, filename, _ = _generated_names(structure, "floating")
+    if key in _plain:
+        return _plain[key]
+    folder = cache.cache_dir()
+    body = cache.read_source(folder / filename) if folder is not None else None
+    if body is None:
+        body = floating_source(structure, key)
+        if folder is not None:  # as load_generated writes it (atomic; a failure: in memory)
+            cache.write_source(folder / filename, body)
+    body = body.replace("from numba import njit\n", "", 1)
+
+    def njit(*_args, **_kwargs):
+        return lambda f: f
+
+    ns = {"njit": njit, "__name__": f"walkerlab_floating_plain_{key}"}
+    exec(compile(body, f"<walkerlab floating model {key}>", "exec"), ns)  # codegen's text
+    _plain[key] = ns
+    return ns
+
+
 class FloatingView:
     """The floating view of one walker (structure + numbers).
 

@@ -46,8 +46,8 @@ import numpy as np
 from walkerlab.codegen.floating import (
     contact_names,
     coordinate_names,
-    floating_module,
     floating_params,
+    floating_plain,
 )
 from walkerlab.walker.layout import StateLayout, floating_links_from_rigid
 
@@ -59,18 +59,17 @@ _FOOT_OF_ROLE = {"swing": "leg1", "stance": "leg2"}
 
 class _View:
     """The generated floating module's kernels (:mod:`walkerlab.codegen.floating`: ``dyn``,
-    ``feet``, ``feet_jac``) run as the plain Python they are generated from (their
-    ``py_func``): a check of a few hundred states costs no numba compilation or cache load
-    (about 0.07 ms a state)."""
+    ``feet``, ``feet_jac``) run as the plain Python they are generated from
+    (:func:`~walkerlab.codegen.floating.floating_plain`): a check of a few hundred states
+    loads no numba and compiles nothing."""
 
     def __init__(self, data):
-        mod = floating_module(data.structure)  # raises for a massless body
+        mod = floating_plain(data.structure)  # raises for a massless body
         self.params = np.asarray(floating_params(data), float)
-        self.nq = int(mod.NQ)
+        self.nq = int(mod["NQ"])
         self.names = contact_names(data.structure)
         self.coordinates = coordinate_names(data.structure)
-        self._dyn, self._feet = mod.dyn.py_func, mod.feet.py_func
-        self._feet_jac = mod.feet_jac.py_func
+        self._dyn, self._feet, self._feet_jac = mod["dyn"], mod["feet"], mod["feet_jac"]
 
     def _x(self, q, dq=None) -> np.ndarray:
         return np.concatenate([q, np.zeros(self.nq) if dq is None else dq])
@@ -168,7 +167,7 @@ class StanceReaction:
         self.view = None
         if any(b.massless for b in st.bodies):
             if not st.hip_mass or any(not b.massless for b in (*st.bodies, *st.torso)):
-                floating_module(st)  # raises: a massless body beside massive ones
+                floating_plain(st)  # raises: a massless body beside massive ones
             # massless legs, all the mass at the hip (module docstring)
             self.hip_mass_kg = float(data.total_mass_kg)
             self.g = float(data.gravity_m_per_s2)
