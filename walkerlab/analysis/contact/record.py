@@ -111,6 +111,7 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
         from walkerlab.analysis.contact.adjust import adjust_rates, better_start
 
         adj = adjust_rates(setup, fp.x, fp.step_period_s)
+        tried = adj.pop("runs", None) or {}  # the search's own runs: not made again
         scale = adj["scale"]
     if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
         from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
@@ -126,10 +127,14 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
                                     ) from None
         scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
     else:
-        run = contact_run.simulate_from(setup, fp.x, fp.step_period_s, scale)
-        if adjust:  # the adjusted start must walk at least as well as the scene's own
-            plain = contact_run.simulate_from(setup, fp.x, fp.step_period_s, None)
-            adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
+        run = (tried.get("best") if adjust else None) or contact_run.simulate_from(
+            setup, fp.x, fp.step_period_s, scale)
+        if adjust:  # the adjusted start must walk better than the scene's own
+            plain = tried.get("scene") or contact_run.simulate_from(
+                setup, fp.x, fp.step_period_s, None)
+            adj["kept"], adj["kept_reason"] = better_start(
+                plain[1], run[1], adj.get("scene_objective", np.nan),
+                adj.get("objective", np.nan))
             if adj["kept"] == "scene":
                 run, scale = plain, None
         walker, res, x0, step_length = run
