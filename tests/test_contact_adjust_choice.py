@@ -170,3 +170,46 @@ def test_adjust_keeps_the_adjusted_start_when_it_walks_better(tmp_path, monkeypa
     with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:
         assert f["initial_rate_scale"][()].tolist() == [1.0, 1.1]
         assert f["adjust"].attrs["kept"] == "adjusted"
+
+
+@pytest.mark.slow
+def test_adjust_keeps_the_scenes_start_when_both_fall_at_once(tmp_path, monkeypatch):
+    """Issue 51, item 9: from rate scales (0.5, 0.5) and (0.6, 0.6) the paper's contact
+    walker falls before its first heel strike; the adjusted start walks no better, so the
+    scene's is kept and the command says why in one line."""
+    monkeypatch.setattr(contact_adjust, "adjust_rates", _adjust_to((0.6, 0.6)))
+    r = CliRunner().invoke(app, ["contact-sim", str(_scene(tmp_path, [0.5, 0.5])), "--adjust",
+                                 "--runs-dir", str(tmp_path / "runs")])
+    assert r.exit_code == 1  # the walker falls either way: the run fails
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("--adjust:"))
+    assert line.startswith("--adjust: kept the scene's initial rate scale (dtheta1 × 0.5; "
+                           "dtheta2 × 0.5), not the adjusted one (0.6, 0.6): no adjusted "
+                           "start walked better than the scene's (adjusted start: fall after "
+                           "0 heel strikes")
+    assert "; the scene's start: fall after 0 heel strikes" in line
+    with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:
+        assert f["initial_rate_scale"][()].tolist() == [0.5, 0.5]
+        assert f["adjust"].attrs["kept"] == "scene"
+
+
+@pytest.mark.slow
+def test_adjust_search_stops_at_its_cpu_budget(tmp_path):
+    """The real search with a 1 s CPU budget (the paper's contact runs take about 0.5 s of
+    CPU each): it stops after a few of its at most 1 + 64 + 60 runs, says so in one line
+    naming CPU time, and the start kept walks at least as well as the scene's."""
+    p = _scene(tmp_path, [0.5, 0.5])
+    d = yaml.safe_load(p.read_text())
+    d["contact_sim"]["adjust_cpu_budget_s"] = 1.0
+    p.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["contact-sim", str(p), "--adjust",
+                                 "--runs-dir", str(tmp_path / "runs")])
+    lines = [ln for ln in r.stdout.splitlines() if ln.startswith("--adjust:")]
+    gave = [ln for ln in lines if "gave up" in ln]
+    assert len(gave) == 1 and re.search(
+        r"--adjust: the search gave up after [\d.]+ s of CPU time \(contact_sim\."
+        r"adjust_cpu_budget_s: 1 s, checked between runs\) and (\d+) of at most 125 "
+        r"contact runs; kept the best start found so far$", gave[0])
+    with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:
+        n = int(f["adjust/evaluations"][()])
+        assert 2 <= n < 20
+        assert f["adjust"].attrs["gave_up"] == gave[0].removeprefix("--adjust: ")
