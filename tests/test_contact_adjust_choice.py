@@ -106,6 +106,27 @@ def test_adjust_search_on_a_walker_that_always_falls_keeps_the_scenes_start(monk
     assert kept == "scene" and why.startswith("no adjusted start walked better")
 
 
+def test_a_trial_run_that_ends_in_an_error_is_a_failed_start(monkeypatch):
+    """A grid start whose run ends in an error (scipy's "f(a) and f(b) must have different
+    signs" from a powered run's event location, seen on configs/powered_compass.yaml) counts
+    as a failed start and is named in the note; the search goes on."""
+    from walkerlab.analysis.contact import sim as contact_sim
+    fake = _Falls()
+
+    def sometimes_raises(setup, x_fp, period, rate_scale=None):
+        if len(fake.scales) == 3:
+            fake.scales.append(rate_scale)
+            raise ValueError("f(a) and f(b) must have different signs")
+        return fake(setup, x_fp, period, rate_scale)
+
+    monkeypatch.setattr(contact_sim, "simulate_from", sometimes_raises)
+    out = contact_adjust.adjust_rates(_paper_setup(), np.zeros(4), 0.7, grid=(0.8, 1.5, 3))
+    assert out["evaluations"] == len(fake.scales) == 10
+    assert ("1 trial run(s) ended in an error and count as failed starts (the first at rate "
+            "scale 0.8, 1.5: f(a) and f(b) must have different signs)") in out["note"]
+    assert out["scale"].tolist() == [1.0, 1.1]
+
+
 def test_adjust_search_gives_up_when_its_cpu_budget_is_spent(monkeypatch):
     """0.1 s of CPU a run against a 0.25 s budget (checked between runs): the search
     stops after the third run (the budget is seen spent before the fourth) and says so in

@@ -95,7 +95,9 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
         ``objective`` (its ``J``), ``scene_objective`` (``J`` of the scene's
         ``initial_rate_scale``), ``evaluations`` (contact runs), ``grid_best`` (2,),
         ``cpu_s`` (CPU time spent [s]), ``gave_up`` (one line when the budget ran out,
-        else ""), ``note`` (one line on a skipped refinement, else "") and ``runs``: the
+        else ""), ``note`` (one line on a skipped refinement or on trial runs that ended in
+        an error, ``ValueError``/``RuntimeError``/``ArithmeticError``, counted as failed
+        starts; else "") and ``runs``: the
         :func:`~walkerlab.analysis.contact.sim.simulate_from` results of the scene's start
         (``"scene"``) and of the best start (``"best"``), so that neither is run again.
     """
@@ -112,6 +114,7 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
     count = {"n": 0}
     best = {"J": np.inf, "scale": scene_scale, "run": None}
     runs = {}
+    errors = []  # (scale, exception) of trial runs that ended in an error
 
     def J(s, bar):
         spent = time.process_time() - cpu0
@@ -119,7 +122,17 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
             raise _BudgetSpent
         count["n"] += 1
         s = np.clip(np.asarray(s, float), 0.2, 5.0)
-        run = simulate_from(setup, x_fp, period, rate_scale=tuple(s))
+        try:
+            run = simulate_from(setup, x_fp, period, rate_scale=tuple(s))
+        except (ValueError, RuntimeError, ArithmeticError) as exc:
+            if "scene" not in runs:  # the scene's own start: as without --adjust
+                raise
+            # an off-nominal start the integrator could not finish (e.g. scipy's event
+            # location on a powered run): a start that does not walk, worse than any fall
+            errors.append((s, exc))
+            v = 2.0 + 2 * n_strides
+            bar.update(count["n"], info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: run failed")
+            return v
         walker, res, _, l_star = run
         v = start_mismatch(walker, res, period, l_star, n_strides)
         if "scene" not in runs:
@@ -151,6 +164,12 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
                        f"time (contact_sim.adjust_cpu_budget_s: {budget:g} s, checked between "
                        f"runs) and {count['n']} of at most {most} contact runs; kept the best "
                        "start found so far")
+    if errors:
+        (s0, e0) = errors[0]
+        first = str(e0).splitlines()[0] if str(e0) else type(e0).__name__
+        note = "; ".join(filter(None, [note, (
+            f"{len(errors)} trial run(s) ended in an error and count as failed starts "
+            f"(the first at rate scale {s0[0]:.3g}, {s0[1]:.3g}: {first})")]))
     return {"scale": np.asarray(best["scale"], float), "objective": float(best["J"]),
             "scene_objective": float(scene_J), "evaluations": count["n"],
             "grid_best": np.asarray(x0, float), "cpu_s": float(time.process_time() - cpu0),
