@@ -205,7 +205,7 @@ def test_adjust_keeps_the_scenes_start_when_both_fall_at_once(tmp_path, monkeypa
     line = next(ln for ln in r.stdout.splitlines() if ln.startswith("--adjust:"))
     assert line.startswith("--adjust: kept the scene's initial rate scale (dtheta1 × 0.5; "
                            "dtheta2 × 0.5), not the adjusted one (0.6, 0.6): no adjusted "
-                           "start walked better than the scene's (adjusted start: fall after "
+                           "start walked better than the scene's: adjusted start: fall after "
                            "0 heel strikes")
     assert "; the scene's start: fall after 0 heel strikes" in line
     with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:

@@ -228,10 +228,10 @@ def better_start(scene_run, adjusted_run, scene_objective: float = np.nan,
     a, s = _standing(adjusted_run), _standing(scene_run)
     both = f"adjusted start: {_said(adjusted_run)}; the scene's start: {_said(scene_run)}"
     if a < s:
-        return "adjusted", f"it walks better ({both})"
+        return "adjusted", f"it walks better: {both}"
     if s < a:
-        return "scene", f"the adjusted start walks worse ({both})"
+        return "scene", f"the adjusted start walks worse: {both}"
     if a[0] < 2 and adjusted_objective < scene_objective:  # NaN compares False
         return "adjusted", (f"both walk alike and it matches the ideal gait better (J "
-                            f"{adjusted_objective:.3g} against {scene_objective:.3g}; {both})")
-    return "scene", f"no adjusted start walked better than the scene's ({both})"
+                            f"{adjusted_objective:.3g} against {scene_objective:.3g}): {both}")
+    return "scene", f"no adjusted start walked better than the scene's: {both}"

@@ -86,7 +86,8 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     """The ``contact-sim`` stage's run: the contact walker of a scene (its ``setup``,
     :func:`walkerlab.models.contact.scene.contact_setup`) started from the ideal fixed point
     ``fp`` (a loaded ``fixedpoint.h5``) with the scene's rate scale, the rates ``adjust``
-    searches (kept only when they walk at least as well as the scene's own), or the contact
+    searches (kept only when they walk better than the scene's own, or as well and match the
+    ideal gait better: :func:`~walkerlab.analysis.contact.adjust.better_start`), or the contact
     model's own periodic gait (``contact_sim.start: periodic_gait``); with ``periodic`` (or
     that start) its periodic gait and Floquet multipliers; the drop test and the headline
     numbers.
