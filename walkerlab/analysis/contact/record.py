@@ -106,13 +106,14 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
 
     cs = setup.sim
     adj = scale = None
+    tried = {}  # the --adjust search's runs of the scene's start and the best start
     gait = gait_error = None
     adjust = adjust or cs.start == "adjusted"
     if adjust:
         from walkerlab.analysis.contact.adjust import adjust_rates, better_start
 
         adj = adjust_rates(setup, fp.x, fp.step_period_s)
-        tried = adj.pop("runs", None) or {}  # the search's own runs: not made again
+        tried = adj.pop("runs", None) or {}  # not made again
         scale = adj["scale"]
     if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
         from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
@@ -128,7 +129,7 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
                                     ) from None
         scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
     else:
-        run = (tried.get("best") if adjust else None) or contact_run.simulate_from(
+        run = tried.get("best") or contact_run.simulate_from(
             setup, fp.x, fp.step_period_s, scale)
         if adjust:  # the adjusted start must walk better than the scene's own
             plain = tried.get("scene") or contact_run.simulate_from(
