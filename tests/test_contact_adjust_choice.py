@@ -30,14 +30,118 @@ def _run(kind: str, steps: int, slip: float):
     (_run("trip", 5, 0.3), _run("heel_strike", 10, 2.0), "adjusted"),
     (_run("fall", 3, np.nan), _run("fall", 6, np.nan), "adjusted"),
     (_run("heel_strike", 10, 0.8), _run("heel_strike", 10, 1.2), "scene"),
-    (_run("heel_strike", 10, 1.0), _run("heel_strike", 10, 1.0), "adjusted"),  # a tie
+    # a tie keeps the scene's start: an adjustment that walks no better is not kept
+    (_run("heel_strike", 10, 1.0), _run("heel_strike", 10, 1.0), "scene"),
+    # issue 51, item 9: both fall at once; the adjusted start used to be kept
+    (_run("fall", 0, np.nan), _run("fall", 0, np.nan), "scene"),
+    (_run("fall", 2, np.nan), _run("trip", 2, np.nan), "scene"),
 ])
 def test_the_better_walk_is_kept(scene_run, adjusted_run, kept):
     got, why = contact_adjust.better_start(scene_run, adjusted_run)
     assert got == kept
-    assert why.startswith(f"adjusted start: {adjusted_run.outcome.kind} after "
-                          f"{adjusted_run.walked_steps} heel strikes")
+    assert (f"adjusted start: {adjusted_run.outcome.kind} after "
+            f"{adjusted_run.walked_steps} heel strikes") in why
     assert f"the scene's start: {scene_run.outcome.kind}" in why
+    if kept == "scene" and _standing_tie(scene_run, adjusted_run):
+        assert why.startswith("no adjusted start walked better than the scene's")
+
+
+def _standing_tie(a, b):
+    return (a.outcome.kind, a.walked_steps, a.max_stance_slip_mm) == (
+        b.outcome.kind, b.walked_steps, b.max_stance_slip_mm) or (
+        a.walked_steps == b.walked_steps and a.outcome.kind in ("fall", "trip"))
+
+
+def test_a_tie_of_two_walks_goes_to_the_better_match_of_the_ideal_gait():
+    """Both starts walk all their heel strikes alike: the adjusted one is kept only when
+    its period and step-length mismatch J is smaller (what the adjustment is for)."""
+    walk = _run("heel_strike", 10, 1.0)
+    assert contact_adjust.better_start(walk, walk, 2e-3, 1e-4)[0] == "adjusted"
+    assert contact_adjust.better_start(walk, walk, 1e-4, 1e-4)[0] == "scene"
+    fall = _run("fall", 3, np.nan)  # a smaller J of a fall says nothing: J = 1 + missing
+    assert contact_adjust.better_start(fall, fall, 8.0, 7.0)[0] == "scene"
+
+
+class _Falls:
+    """A stand-in for ``simulate_from`` whose every start falls at once, burning
+    ``cpu_s`` of CPU time a run (the 454 s search of issue 51, item 9, in small)."""
+
+    def __init__(self, cpu_s=0.0, walks=None):
+        self.cpu_s, self.walks, self.scales = cpu_s, walks, []
+
+    def __call__(self, setup, x_fp, period, rate_scale=None):
+        import time
+        self.scales.append(rate_scale)
+        t = time.process_time()
+        while time.process_time() - t < self.cpu_s:
+            pass
+        res = SimpleNamespace(heel_strike_times=[], termination="fall",
+                              outcome=SimpleNamespace(kind="fall"), walked_steps=0,
+                              max_stance_slip_mm=np.nan)
+        return None, res, None, 0.4
+
+
+def _paper_setup(**sim):
+    from walkerlab.config import scene_from_dict
+    from walkerlab.models.contact.scene import contact_setup
+    d = {**PAPER, "name": "paper", "contact_sim": {**PAPER["contact_sim"], **sim}}
+    return contact_setup(scene_from_dict(d))
+
+
+def test_adjust_search_on_a_walker_that_always_falls_keeps_the_scenes_start(monkeypatch):
+    """Every start falls at once: the search runs the scene's start and the grid, skips
+    Nelder-Mead (J = 1 + missing heel strikes is flat there) and keeps the scene's scale;
+    its two runs are handed back, not made again."""
+    from walkerlab.analysis.contact import sim as contact_sim
+    fake = _Falls()
+    monkeypatch.setattr(contact_sim, "simulate_from", fake)
+    out = contact_adjust.adjust_rates(_paper_setup(), np.zeros(4), 0.7, grid=(0.8, 1.5, 3))
+    assert out["evaluations"] == len(fake.scales) == 1 + 9  # no Nelder-Mead runs
+    assert out["scale"].tolist() == [1.0, 1.1]  # the scene's own (configs/paper.yaml)
+    assert out["objective"] == out["scene_objective"] == 11.0  # 1 + 10 missing
+    assert "Nelder-Mead refinement was skipped" in out["note"] and not out["gave_up"]
+    assert out["runs"]["scene"] is out["runs"]["best"]
+    kept, why = contact_adjust.better_start(out["runs"]["scene"][1], out["runs"]["best"][1],
+                                            out["scene_objective"], out["objective"])
+    assert kept == "scene" and why.startswith("no adjusted start walked better")
+
+
+def test_a_trial_run_that_ends_in_an_error_is_a_failed_start(monkeypatch):
+    """A grid start whose run ends in an error (scipy's "f(a) and f(b) must have different
+    signs" from a powered run's event location, seen on configs/powered_compass.yaml) counts
+    as a failed start and is named in the note; the search goes on."""
+    from walkerlab.analysis.contact import sim as contact_sim
+    fake = _Falls()
+
+    def sometimes_raises(setup, x_fp, period, rate_scale=None):
+        if len(fake.scales) == 3:
+            fake.scales.append(rate_scale)
+            raise ValueError("f(a) and f(b) must have different signs")
+        return fake(setup, x_fp, period, rate_scale)
+
+    monkeypatch.setattr(contact_sim, "simulate_from", sometimes_raises)
+    out = contact_adjust.adjust_rates(_paper_setup(), np.zeros(4), 0.7, grid=(0.8, 1.5, 3))
+    assert out["evaluations"] == len(fake.scales) == 10
+    assert ("1 trial run(s) ended in an error and count as failed starts (the first at rate "
+            "scale 0.8, 1.5: f(a) and f(b) must have different signs)") in out["note"]
+    assert out["scale"].tolist() == [1.0, 1.1]
+
+
+def test_adjust_search_gives_up_when_its_cpu_budget_is_spent(monkeypatch):
+    """0.1 s of CPU a run against a 0.25 s budget (checked between runs): the search
+    stops after the third run (the budget is seen spent before the fourth) and says so in
+    one line that names CPU time and the field."""
+    from walkerlab.analysis.contact import sim as contact_sim
+    fake = _Falls(cpu_s=0.1)
+    monkeypatch.setattr(contact_sim, "simulate_from", fake)
+    out = contact_adjust.adjust_rates(_paper_setup(adjust_cpu_budget_s=0.25), np.zeros(4), 0.7)
+    assert out["evaluations"] == len(fake.scales) == 3
+    assert out["cpu_s"] >= 0.25
+    g = out["gave_up"]
+    assert "\n" not in g and re.search(r"gave up after 0\.3\d* s of CPU time "
+                                       r"\(contact_sim\.adjust_cpu_budget_s: 0\.25 s", g)
+    assert "3 of at most 125 contact runs" in g
+    assert out["scale"].tolist() == [1.0, 1.1]
 
 
 def _scene(tmp_path, scale) -> Path:
@@ -87,3 +191,46 @@ def test_adjust_keeps_the_adjusted_start_when_it_walks_better(tmp_path, monkeypa
     with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:
         assert f["initial_rate_scale"][()].tolist() == [1.0, 1.1]
         assert f["adjust"].attrs["kept"] == "adjusted"
+
+
+@pytest.mark.slow
+def test_adjust_keeps_the_scenes_start_when_both_fall_at_once(tmp_path, monkeypatch):
+    """Issue 51, item 9: from rate scales (0.5, 0.5) and (0.6, 0.6) the paper's contact
+    walker falls before its first heel strike; the adjusted start walks no better, so the
+    scene's is kept and the command says why in one line."""
+    monkeypatch.setattr(contact_adjust, "adjust_rates", _adjust_to((0.6, 0.6)))
+    r = CliRunner().invoke(app, ["contact-sim", str(_scene(tmp_path, [0.5, 0.5])), "--adjust",
+                                 "--runs-dir", str(tmp_path / "runs")])
+    assert r.exit_code == 1  # the walker falls either way: the run fails
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("--adjust:"))
+    assert line.startswith("--adjust: kept the scene's initial rate scale (dtheta1 × 0.5; "
+                           "dtheta2 × 0.5), not the adjusted one (0.6, 0.6): no adjusted "
+                           "start walked better than the scene's: adjusted start: fall after "
+                           "0 heel strikes")
+    assert "; the scene's start: fall after 0 heel strikes" in line
+    with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:
+        assert f["initial_rate_scale"][()].tolist() == [0.5, 0.5]
+        assert f["adjust"].attrs["kept"] == "scene"
+
+
+@pytest.mark.slow
+def test_adjust_search_stops_at_its_cpu_budget(tmp_path):
+    """The real search with a 1 s CPU budget (the paper's contact runs take about 0.5 s of
+    CPU each): it stops after a few of its at most 1 + 64 + 60 runs, says so in one line
+    naming CPU time, and the start kept walks at least as well as the scene's."""
+    p = _scene(tmp_path, [0.5, 0.5])
+    d = yaml.safe_load(p.read_text())
+    d["contact_sim"]["adjust_cpu_budget_s"] = 1.0
+    p.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["contact-sim", str(p), "--adjust",
+                                 "--runs-dir", str(tmp_path / "runs")])
+    lines = [ln for ln in r.stdout.splitlines() if ln.startswith("--adjust:")]
+    gave = [ln for ln in lines if "gave up" in ln]
+    assert len(gave) == 1 and re.search(
+        r"--adjust: the search gave up after [\d.]+ s of CPU time \(contact_sim\."
+        r"adjust_cpu_budget_s: 1 s, checked between runs\) and (\d+) of at most 125 "
+        r"contact runs; kept the best start found so far$", gave[0])
+    with h5py.File(tmp_path / "runs" / "adj" / "contact_sim.h5") as f:
+        n = int(f["adjust/evaluations"][()])
+        assert 2 <= n < 20
+        assert f["adjust"].attrs["gave_up"] == gave[0].removeprefix("--adjust: ")

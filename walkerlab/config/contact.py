@@ -423,6 +423,11 @@ class ContactSimSettings(BaseModel):
         120.0, gt=0, description="Wall-time limit of the periodic-gait search [s]; when it "
         "runs out the gait is reported as 'time_limit' (null = none).",
         json_schema_extra={"unit": "s"})
+    adjust_cpu_budget_s: float | None = Field(
+        300.0, gt=0, description="CPU-time budget of the `contact-sim --adjust` search [s], "
+        "checked between its contact runs (a run under way is finished); when it is spent "
+        "the search keeps the best start found so far and says so (null = none).",
+        json_schema_extra={"unit": "s"})
     start: Literal["ideal", "adjusted", "periodic_gait"] = Field(
         "ideal", description="Initial state of the run: 'ideal' (the rigid fixed point, rates "
         "times initial_rate_scale; the default), 'adjusted' (rates searched as `contact-sim "
@@ -436,4 +441,6 @@ class ContactSimSettings(BaseModel):
         d = handler(self)
         if isinstance(d, dict) and d.get("start") == "ideal":
             d.pop("start", None)
+        if isinstance(d, dict) and d.get("adjust_cpu_budget_s") == 300.0:
+            d.pop("adjust_cpu_budget_s", None)  # likewise the default budget
         return d

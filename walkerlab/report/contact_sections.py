@@ -186,8 +186,9 @@ def _initial_state_lines(c, arts, pub, table2: dict) -> list[str]:
             + ")"
             + (f" (found by `--adjust`: objective {num(adj['objective'], 3)} after "
                f"{int(adj['evaluations'])} simulations)" if adj and adj["kept"] != "scene"
-               else f" (the scene's own: `--adjust` found a scale that walks worse; {adj['why']})"
+               else f" (the scene's own: `--adjust` found no scale that walks better; {adj['why']})"
                if adj else "")
+            + (f"; `--adjust`: {adj['gave_up']}" if adj and str(adj.get("gave_up", "")) else "")
             + "." + _table2_note(pub), ""]
 
 

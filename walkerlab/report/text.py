@@ -224,15 +224,18 @@ def contact_text(c: ContactSimArtifact) -> str:
         names = c.rate_names or ["leg1 rates", "leg2 rates"]
         kept, why = str(c.adjust.get("kept", "adjusted")), str(c.adjust.get("kept_reason", ""))
         found = np.atleast_1d(c.adjust.get("scale", s))
-        if kept == "scene":  # the adjusted start walked worse
+        if kept == "scene":  # the adjusted start walked no better
             lines.append("--adjust: kept the scene's initial rate scale ("
                          + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
-                         + "), which walks better than the adjusted one ("
+                         + "), not the adjusted one ("
                          + ", ".join(f"{v:.4g}" for v in found) + f"): {why}")
         else:
             lines.append("--adjust: kept the adjusted initial rate scale: "
                          + "; ".join(f"{n} × {v:.4g}" for n, v in zip(names, s))
                          + (f" ({why})" if why else ""))
+        for k in ("gave_up", "note"):  # a search that ran out of CPU time, or cut short
+            if str(c.adjust.get(k, "")):
+                lines.append(f"--adjust: {c.adjust[k]}")
     for k, (v, unit) in c.summary.items():
         lines.append(f"  {k:<32s} {num(v)}" + (f" {unit}" if unit not in ("", "-") else ""))
     if "wall_time_s" in c.summary and np.isfinite(c.stage_wall_time_s):

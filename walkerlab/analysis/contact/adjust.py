@@ -7,17 +7,69 @@ the last four steps,
     J(s) = mean(((T_k - T*) / T*)^2 + ((l_k - l*) / l*)^2)
 
 with ``T*``, ``l*`` the ideal step period and step length; a run that does not complete all
-heel strikes gets ``J = 1 + (missing steps)``.  A coarse grid (``scipy.optimize.brute``)
-is refined by Nelder-Mead (``scipy.optimize.minimize``).
+heel strikes gets ``J = 1 + (missing steps)``.  The scene's own start is run first, then a
+coarse grid (``scipy.optimize.brute``), refined by Nelder-Mead (``scipy.optimize.minimize``)
+only when some grid start walked all its heel strikes (``J`` < 1: below that ``J`` is a step
+function of the heel strikes made, on which Nelder-Mead only spends runs).  The search has a
+CPU-time budget (``contact_sim.adjust_cpu_budget_s``), checked between contact runs: when it
+is spent the search stops and keeps the best start found so far.
 """
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 from scipy.optimize import brute, minimize
 
+#: Nelder-Mead's most contact runs after the grid
+NELDER_MEAD_RUNS = 60
 
-def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> dict:
+
+class _BudgetSpent(Exception):
+    """The search's CPU-time budget ran out (raised between contact runs)."""
+
+
+def start_mismatch(walker, res, period: float, step_length: float, n_strides: int) -> float:
+    """The objective ``J`` of one contact run (module docstring).
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        The run's walker (its feet's positions).
+    res : ContactResult
+        The run (:func:`walkerlab.analysis.contact.sim.simulate_from`).
+    period : float
+        Ideal step period ``T*`` [s].
+    step_length : float
+        Ideal step length ``l*`` [m].
+    n_strides : int
+        Strides asked for (``2 n_strides`` heel strikes).
+
+    Returns
+    -------
+    float
+        ``J`` [-]: the mean squared relative period and step-length mismatch of the last
+        four steps, or ``1 + missing heel strikes`` for a run that does not make them all.
+    """
+    n_hs = len(res.heel_strike_times)
+    want = 2 * n_strides
+    if n_hs < want or res.termination in ("fall", "trip", "airborne"):
+        return 1.0 + (want - min(n_hs, want))
+    steps = [st for st in res.steps if np.isfinite(st.period)][-4:]
+    T = np.array([st.period for st in steps])
+    feet = np.asarray(walker.foot_positions(res.x)).reshape(len(res.t), -1, 2)
+    lens = []
+    for th in res.heel_strike_times[-4:]:
+        i = min(np.searchsorted(res.t, th), len(res.t) - 1)
+        lens.append(np.hypot(*(feet[i, 0] - feet[i, 1])))
+    lens = np.array(lens)
+    return float(np.mean(((T - period) / period) ** 2)
+                 + np.mean(((lens - step_length) / step_length) ** 2))
+
+
+def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8),
+                 cpu_budget_s: float | None = None) -> dict:
     """Find initial-rate scale factors that make the contact gait match the ideal one.
 
     Parameters
@@ -30,53 +82,99 @@ def adjust_rates(setup, x_fp: np.ndarray, period: float, grid=(0.8, 1.5, 8)) -> 
         Ideal step period [s].
     grid : (float, float, int)
         Lower and upper scale and points per axis of the coarse grid.
+    cpu_budget_s : float, optional
+        CPU time [s] of this process the search may spend, checked before each contact
+        run after the first (a run under way is finished: the search can overrun by one
+        run, at most ``contact_sim.wall_time_limit_s``); default
+        ``contact_sim.adjust_cpu_budget_s`` (None there: no budget).
 
     Returns
     -------
     dict
-        ``scale`` (2,), ``objective``, ``evaluations``, ``grid_best`` (2,).
+        ``scale`` (2,) (the best start found; the scene's own when nothing beat it),
+        ``objective`` (its ``J``), ``scene_objective`` (``J`` of the scene's
+        ``initial_rate_scale``), ``evaluations`` (contact runs), ``grid_best`` (2,),
+        ``cpu_s`` (CPU time spent [s]), ``gave_up`` (one line when the budget ran out,
+        else ""), ``note`` (one line on a skipped refinement or on trial runs that ended in
+        an error, ``ValueError``/``RuntimeError``/``ArithmeticError``, counted as failed
+        starts; else "") and ``runs``: the
+        :func:`~walkerlab.analysis.contact.sim.simulate_from` results of the scene's start
+        (``"scene"``) and of the best start (``"best"``), so that neither is run again.
     """
+    from walkerlab import progress
     from walkerlab.analysis.contact.sim import simulate_from
 
-    n_strides = setup.sim.n_strides
+    cs = setup.sim
+    n_strides = cs.n_strides
+    budget = getattr(cs, "adjust_cpu_budget_s", None) if cpu_budget_s is None else cpu_budget_s
+    scene_scale = np.asarray(cs.initial_rate_scale, float)
+    lo, hi, n = grid
+    most = 1 + n * n + NELDER_MEAD_RUNS
+    cpu0 = time.process_time()
     count = {"n": 0}
+    best = {"J": np.inf, "scale": scene_scale, "run": None}
+    runs = {}
+    errors = []  # (scale, exception) of trial runs that ended in an error
 
-    def J(s):
+    def J(s, bar):
+        spent = time.process_time() - cpu0
+        if count["n"] and budget is not None and spent > budget:
+            raise _BudgetSpent
         count["n"] += 1
         s = np.clip(np.asarray(s, float), 0.2, 5.0)
-        walker, res, _, l_star = simulate_from(setup, x_fp, period, rate_scale=tuple(s))
-        n_hs = len(res.heel_strike_times)
-        want = 2 * n_strides
-        if n_hs < want or res.termination in ("fall", "trip", "airborne"):
-            return 1.0 + (want - min(n_hs, want))
-        steps = [st for st in res.steps if np.isfinite(st.period)][-4:]
-        T = np.array([st.period for st in steps])
-        feet = np.asarray(walker.foot_positions(res.x)).reshape(len(res.t), -1, 2)
-        lens = []
-        for th in res.heel_strike_times[-4:]:
-            i = min(np.searchsorted(res.t, th), len(res.t) - 1)
-            lens.append(np.hypot(*(feet[i, 0] - feet[i, 1])))
-        lens = np.array(lens)
-        return float(np.mean(((T - period) / period) ** 2)
-                     + np.mean(((lens - l_star) / l_star) ** 2))
-
-    from walkerlab import progress
-
-    lo, hi, n = grid
-    with progress.task("adjust: contact runs (grid, then Nelder-Mead; at most)",
-                       n * n + 60) as bar:
-        def J_shown(s):  # progress: contact runs done of the most there can be
-            v = J(s)
-            bar.update(count["n"], info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: J {v:.3g}")
+        try:
+            run = simulate_from(setup, x_fp, period, rate_scale=tuple(s))
+        except (ValueError, RuntimeError, ArithmeticError) as exc:
+            if "scene" not in runs:  # the scene's own start: as without --adjust
+                raise
+            # an off-nominal start the integrator could not finish (e.g. scipy's event
+            # location on a powered run): a start that does not walk, worse than any fall
+            errors.append((s, exc))
+            v = 2.0 + 2 * n_strides
+            bar.update(count["n"], info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: run failed")
             return v
+        walker, res, _, l_star = run
+        v = start_mismatch(walker, res, period, l_star, n_strides)
+        if "scene" not in runs:
+            runs["scene"] = run
+        if v < best["J"]:
+            best.update(J=v, scale=s, run=run)
+        spent = time.process_time() - cpu0
+        bar.update(count["n"], info=f"rate scale {s[0]:.3f}, {s[1]:.3f}: J {v:.3g}; best "
+                   f"{best['J']:.3g}; CPU {spent:.0f} s"
+                   + (f" of {budget:.0f} s" if budget is not None else ""))
+        return v
 
-        x0, fval, _, _ = brute(J_shown, ((lo, hi), (lo, hi)), Ns=n, full_output=True,
-                               finish=None)
-        res = minimize(J_shown, x0, method="Nelder-Mead",
-                       options={"xatol": 1e-3, "fatol": 1e-8, "maxfev": 60})
-    best = res.x if res.fun <= fval else x0
-    return {"scale": np.asarray(best, float), "objective": float(min(res.fun, fval)),
-            "evaluations": count["n"], "grid_best": np.asarray(x0, float)}
+    gave_up = note = ""
+    x0 = scene_scale
+    with progress.task("adjust: contact runs (the scene's start, a grid, then Nelder-Mead; "
+                       "at most)", most) as bar:
+        try:
+            scene_J = J(scene_scale, bar)
+            x0 = np.asarray(brute(lambda s: J(s, bar), ((lo, hi), (lo, hi)), Ns=n,
+                                  finish=None), float)
+            if best["J"] >= 1.0:  # no start walked all its heel strikes: J is a step function
+                note = (f"no start walked all {2 * n_strides} heel strikes "
+                        f"(best J {best['J']:.3g}); the Nelder-Mead refinement was skipped")
+            else:
+                minimize(lambda s: J(s, bar), x0, method="Nelder-Mead",
+                         options={"xatol": 1e-3, "fatol": 1e-8, "maxfev": NELDER_MEAD_RUNS})
+        except _BudgetSpent:
+            gave_up = (f"the search gave up after {time.process_time() - cpu0:.3g} s of CPU "
+                       f"time (contact_sim.adjust_cpu_budget_s: {budget:g} s, checked between "
+                       f"runs) and {count['n']} of at most {most} contact runs; kept the best "
+                       "start found so far")
+    if errors:
+        (s0, e0) = errors[0]
+        first = str(e0).splitlines()[0] if str(e0) else type(e0).__name__
+        note = "; ".join(filter(None, [note, (
+            f"{len(errors)} trial run(s) ended in an error and count as failed starts "
+            f"(the first at rate scale {s0[0]:.3g}, {s0[1]:.3g}: {first})")]))
+    return {"scale": np.asarray(best["scale"], float), "objective": float(best["J"]),
+            "scene_objective": float(scene_J), "evaluations": count["n"],
+            "grid_best": np.asarray(x0, float), "cpu_s": float(time.process_time() - cpu0),
+            "gave_up": gave_up, "note": note,
+            "runs": {"scene": runs.get("scene"), "best": best["run"]}}
 
 
 #: run ends of a contact walker that walked cleanly; then those that walked with a defect
@@ -99,26 +197,41 @@ def _said(res) -> str:
             + (f", max slip {slip:.3g} mm" if np.isfinite(slip) else ""))
 
 
-def better_start(scene_run, adjusted_run) -> tuple[str, str]:
+def better_start(scene_run, adjusted_run, scene_objective: float = np.nan,
+                 adjusted_objective: float = np.nan) -> tuple[str, str]:
     """Which start of ``contact-sim --adjust`` to keep: the adjusted rates minimise the
     period and step-length mismatch (:func:`adjust_rates`), which does not guarantee a
     better walk, so the two runs are compared by outcome (walked cleanly > walked with a
-    scuff or slip > failed), then heel strikes, then the largest stance slip.
+    scuff or slip > failed), then heel strikes, then the largest stance slip.  An adjusted
+    start that walks no better is not kept: on a tie the scene's start stays, unless both
+    walked and the adjusted one matches the ideal gait better (a smaller objective ``J``:
+    what the adjustment is for).
 
     Parameters
     ----------
     scene_run, adjusted_run : ContactResult
         The run from the scene's ``contact_sim.initial_rate_scale`` and from the adjusted
         scale.
+    scene_objective, adjusted_objective : float, optional
+        Their objectives ``J`` [-] (:func:`start_mismatch`); NaN: unknown (a tie then keeps
+        the scene's start).
 
     Returns
     -------
     kept : {"adjusted", "scene"}
-        The adjusted start unless the scene's is strictly better.
+        The adjusted start only if it walks better than the scene's (or as well, both
+        having walked, with a smaller ``J``).
     reason : str
-        One line: both outcomes (``t_final after 10 heel strikes, max slip 1.4 mm``).
+        One line: why, and both outcomes (``adjusted start: fall after 2 heel strikes;
+        the scene's start: fall after 2 heel strikes``).
     """
     a, s = _standing(adjusted_run), _standing(scene_run)
-    kept = "scene" if s < a else "adjusted"
-    why = f"adjusted start: {_said(adjusted_run)}; the scene's start: {_said(scene_run)}"
-    return kept, why
+    both = f"adjusted start: {_said(adjusted_run)}; the scene's start: {_said(scene_run)}"
+    if a < s:
+        return "adjusted", f"it walks better: {both}"
+    if s < a:
+        return "scene", f"the adjusted start walks worse: {both}"
+    if a[0] < 2 and adjusted_objective < scene_objective:  # NaN compares False
+        return "adjusted", (f"both walk alike and it matches the ideal gait better (J "
+                            f"{adjusted_objective:.3g} against {scene_objective:.3g}): {both}")
+    return "scene", f"no adjusted start walked better than the scene's: {both}"

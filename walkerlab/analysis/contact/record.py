@@ -86,7 +86,8 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     """The ``contact-sim`` stage's run: the contact walker of a scene (its ``setup``,
     :func:`walkerlab.models.contact.scene.contact_setup`) started from the ideal fixed point
     ``fp`` (a loaded ``fixedpoint.h5``) with the scene's rate scale, the rates ``adjust``
-    searches (kept only when they walk at least as well as the scene's own), or the contact
+    searches (kept only when they walk better than the scene's own, or as well and match the
+    ideal gait better: :func:`~walkerlab.analysis.contact.adjust.better_start`), or the contact
     model's own periodic gait (``contact_sim.start: periodic_gait``); with ``periodic`` (or
     that start) its periodic gait and Floquet multipliers; the drop test and the headline
     numbers.
@@ -105,12 +106,14 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
 
     cs = setup.sim
     adj = scale = None
+    tried = {}  # the --adjust search's runs of the scene's start and the best start
     gait = gait_error = None
     adjust = adjust or cs.start == "adjusted"
     if adjust:
         from walkerlab.analysis.contact.adjust import adjust_rates, better_start
 
         adj = adjust_rates(setup, fp.x, fp.step_period_s)
+        tried = adj.pop("runs", None) or {}  # not made again
         scale = adj["scale"]
     if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
         from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
@@ -126,10 +129,14 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
                                     ) from None
         scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
     else:
-        run = contact_run.simulate_from(setup, fp.x, fp.step_period_s, scale)
-        if adjust:  # the adjusted start must walk at least as well as the scene's own
-            plain = contact_run.simulate_from(setup, fp.x, fp.step_period_s, None)
-            adj["kept"], adj["kept_reason"] = better_start(plain[1], run[1])
+        run = tried.get("best") or contact_run.simulate_from(
+            setup, fp.x, fp.step_period_s, scale)
+        if adjust:  # the adjusted start must walk better than the scene's own
+            plain = tried.get("scene") or contact_run.simulate_from(
+                setup, fp.x, fp.step_period_s, None)
+            adj["kept"], adj["kept_reason"] = better_start(
+                plain[1], run[1], adj.get("scene_objective", np.nan),
+                adj.get("objective", np.nan))
             if adj["kept"] == "scene":
                 run, scale = plain, None
         walker, res, x0, step_length = run

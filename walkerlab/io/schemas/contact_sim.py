@@ -258,7 +258,8 @@ def _write_periodic_and_adjust(f, run: ContactSimRun) -> None:
                 v = np.asarray(v, dtype=float)
                 put(f, f"adjust/{k}", v, "-", k,
                     dims=("rate",) if k == "scale" and v.shape == (2,) else None)
-        for k in ("kept", "kept_reason"):  # which start the run is from, and why
+        # which start the run is from, and why; a search that gave up, or skipped a part
+        for k in ("kept", "kept_reason", "gave_up", "note"):
             if k in adj:
                 f.require_group("adjust").attrs[k] = str(adj[k])
 
