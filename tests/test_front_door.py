@@ -131,9 +131,14 @@ def test_api_reuses_the_cli_artifact_and_fixed_points_stack_the_variants(tmp_pat
 
 
 def test_sweep_package_is_a_plain_package_and_the_api_sweep_lives_in_api(tmp_path):
+    import types
+
     import walkerlab.studies as package
 
-    assert not callable(package) and type(package) is type(wl)
+    # a plain package (walkerlab itself is a module whose ``export`` attribute is the
+    # exchange-format package made callable, ``wl.export``: its type is a ModuleType too)
+    assert not callable(package) and type(package) is types.ModuleType
+    assert isinstance(wl, types.ModuleType)
     sw = wl.api.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
     assert sw["outcome"].values.tolist() == ["ok"]
 
