@@ -55,6 +55,7 @@ def _drawn(frames, panel=0):
 
 
 @pytest.mark.parametrize("name", ["kneed", "round_feet"])
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_kneed_and_arc_feet_animate(name, tmp_path):
     """A kneed and an arc-foot scene animate without error into a multi-frame GIF."""
     _, out, gif = _animate(name, tmp_path)

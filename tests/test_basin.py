@@ -53,6 +53,7 @@ def test_fixed_point_converges_and_far_cell_falls(paper_walker, paper_fixed_poin
         slice_state(paper_walker, fp, ("swing_angle", "stance_rate"), (0.1, -1.0))
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_basin_stage_artifact_and_resume(tmp_path, paper_walker, paper_fixed_point):
     from walkerlab.io.artifacts import open_artifact
     from walkerlab.stages import pipeline
@@ -128,6 +129,7 @@ def test_heel_strike_cells_of_the_simplest_walker(tmp_path):
         heel_strike_slice(w, pre, ("stance_angle", "hip_angle"))
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_heel_strike_basin_of_the_simplest_walker_is_thin(tmp_path):
     """Schwab & Wisse (2001): the basin is "a small, thin area".  On a coarse 40 x 40 grid over
     their window (theta 0-0.4, theta-dot -0.6-0) the cell holding x* converges, under 2 % of

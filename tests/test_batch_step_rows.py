@@ -23,6 +23,7 @@ def paper_map(paper_scene):
     return BatchStepMap(build_walker(paper_scene), scene_walker_at(paper_scene), 1e-9, 1e-9)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_rows_step_does_not_depend_on_its_batch(paper_scene, paper_map, paper_fixed_point):
     """Each row alone gives the same numbers, bit for bit, as inside a batch of 6 (a stacked
     integrator shares step sizes among rows, so its rows differed at ~1e-10; Monte Carlo walks
@@ -82,6 +83,7 @@ def test_compiled_walks_equal_step_after_step(paper_scene, paper_map, paper_fixe
     assert 0 < fell.sum() < W
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_kneed_walker_keeps_the_step_by_step_walks():
     """A kneed walker (two flows, the knee strike's reset between phases) is not walked in
     one compiled call: ``can_walk`` is False and ``walk`` says why in one line."""

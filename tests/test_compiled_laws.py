@@ -84,6 +84,7 @@ def _call(cfunc, y: np.ndarray, data: np.ndarray, m: int) -> np.ndarray:
 
 
 @pytest.mark.parametrize("name", ["cubic", "saturated", "time_table"])
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_actuated_cfuncs_are_the_python_flow_and_jacobian(name):
     """At states around the gait: the flow to 1e-13 (the same equations, the torque added
     before or after the solve) and ``(J + chain) Phi`` to 1e-11 of the complex-step

@@ -118,6 +118,7 @@ def _pinned_acceleration(walker, x, Q):
     return np.linalg.solve(K, rhs)[:n]
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_pinned_dynamics_match_the_independent_lagrangian(walker):
     """Passive: the floating equations with the stance foot pinned (generated ``rhs_pinned``
     and the KKT system alike) give the independent accelerations."""

@@ -40,6 +40,7 @@ def _call(cfunc, x: np.ndarray, data: np.ndarray, m: int) -> np.ndarray:
     return dy
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_every_phase_is_compiled_with_its_guards_as_outputs(walker):
     """The cfunc of each phase at states around the gait: the flow to round-off of the
     Python flow (the same generated lines; 1e-12 relative allows a libm difference), each
@@ -103,6 +104,7 @@ def test_flat_feet_keep_the_row_by_row_step_map(walker):
     assert needs_python_path(walker)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_modes_entry_check_reads_the_compiled_guards(walker):
     """``guard_values``: the phase's guards at one state from its cfunc (the entry check of
     a mode on cyrk_compiled), each to round-off of the Python guard (forces ~100 N)."""

@@ -174,6 +174,7 @@ def _kernel_run(env):
 
 
 @pytest.mark.parametrize("damage", ["garbage", "empty", "fifo"])
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_m1_damaged_numba_cache_files_are_rebuilt(tmp_path, damage):
     cache = tmp_path / "cache"
     env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(cache), TMPDIR=str(tmp_path / "tmp"))

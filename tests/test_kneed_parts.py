@@ -231,6 +231,7 @@ def test_energy_with_spring_potential_is_conserved_unlocked_and_locked(name, gai
 
 
 @pytest.mark.parametrize("variant", list(VARIANTS))
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_floating_view_matches_the_floating_reference(variant):
     """The contact view's equations (floating base, both knees free): mass matrix and bias,
     springs included, against the independent floating reference."""

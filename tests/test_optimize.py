@@ -29,6 +29,7 @@ def _start(scene):
 
 
 @pytest.mark.parametrize("slope", [0.0174, 0.035, 0.0525])
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_least_effort_gait_on_a_slope_is_the_passive_gait(slope):
     """int u^2 dt = 0 at the passive gait, so the optimum is it: objective <= 1e-10, step
     period within 1e-7 s of the shooting fixed point (Hermite-Simpson with 40 intervals:
@@ -149,6 +150,7 @@ def test_design_optimisation_follows_the_gait_to_a_bounded_optimum():
     assert at_bound or abs(res.gradient[0]) < 1e-6 * max(1.0, abs(res.value))
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_design_command_prints_the_optimum_and_refuses_bad_input_in_one_line(tmp_path):
     """``walkerlab optimize --design``: the paper walker's hip mass within 5-20 kg that
     minimises its largest Floquet multiplier (SLSQP with the eigenvalue-perturbation

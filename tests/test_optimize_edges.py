@@ -67,6 +67,7 @@ def test_a_contact_replay_whose_solver_fails_is_an_outcome(monkeypatch):
     assert "\n" not in outcome
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_an_infeasible_target_is_not_replayed_on_contact_and_require_gait_fails(tmp_path):
     """compass_optimal at 0.6 m/s with |u| <= 0.5 N m: IPOPT reports the problem infeasible
     and the rigid replay returns 0.03 away - NOT a gait.  Before, the command exited 0 and

@@ -30,6 +30,7 @@ def fns_and_params():
     return five_link_functions(data.structure), np.asarray(data.params, float)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_casadi_step_matches_the_independent_derivation(fns_and_params):
     """The collocation's flow (with the four joint torques as the relative coordinates'
     generalised forces), heel-strike reset and swing-foot height against the independent

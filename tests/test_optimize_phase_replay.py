@@ -138,6 +138,7 @@ def _kneed_step():
     return t[idx], x[idx], u, np.array([0, 21])
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_kneed_walkers_compiled_flows_run_the_piecewise_law():
     """The replays run the law inside the compiled flows (``cyrk_compiled``): the law block
     (kind PIECEWISE, plain Python ``law_torque``) gives the law's torque on both sides of

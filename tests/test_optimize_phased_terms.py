@@ -131,6 +131,7 @@ def _cone_ratios(fns, res):
     return np.array(out)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_friction_cone_that_binds_changes_the_kneed_gait_and_it_replays(kneed, kneed_fast):
     """At 0.9 m/s the least-effort gait needs |F_t| / F_n up to 0.2569 (just after the heel
     strike); with mu = 0.9 of that the cone binds (the largest ratio is mu to 1e-8, now

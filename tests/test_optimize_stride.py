@@ -436,6 +436,7 @@ def _cone_ratios(data, res):
     return np.array(out)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_friction_cone_that_binds_changes_the_stride_and_it_replays(asym, fast):
     """The least-effort stride at 0.6 m/s needs |F_t| / F_n up to 0.1785 (leg B's step,
     at its heel strike; from the rigid model); with mu = 0.9 of that the cone binds in

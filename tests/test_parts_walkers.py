@@ -70,6 +70,7 @@ def test_flow_and_reset_match_the_independent_reference(name):
                                                          abs=1e-12)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_off_axis_rigid_upper_body_matches_the_reference():
     # a rigid body with inertia, its centre of mass off the torso's axis, on legs that differ
     # (leg B's point mass 3 cm ahead of its axis)

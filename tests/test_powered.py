@@ -157,6 +157,7 @@ def _ledger(name: str):
 # of its own (its step is optimised: tests/test_optimize_five_link.py)
 @pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED
                                   if n not in ("rabbit", "rabbit_optimal")])
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_energy_ledger_closes_and_cost_of_transport(name):
     w, led, ke = _ledger(name)
     assert np.all(np.isfinite(led["closure"]))
@@ -311,6 +312,7 @@ def test_the_export_refuses_an_ankle_push_off_in_one_line(tmp_path):
 
 
 @pytest.mark.parametrize("name", ["powered_compass", "kuo2002"])
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_automatic_gait_search_walks_on_level_ground(name):
     """No initial guess: the scale-free seeds sized by the slope the push-off stands for
     find the scene's gait (the one its guess names, or its partner)."""

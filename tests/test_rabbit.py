@@ -58,6 +58,7 @@ def test_references_are_the_scripts_hzd_design(scene):
     assert scene.slope.phi_rad == 0.0 and scene.walker.actuation.push_off is None
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_one_step_from_the_fixed_point_returns_to_it(step):
     w, x0, seg = step
     assert w.total_mass_kg == pytest.approx(32.0)  # 12 + 2 (6.8 + 3.2) kg (Table I)

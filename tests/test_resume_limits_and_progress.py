@@ -479,6 +479,7 @@ def test_progress_non_tty_sweep_prints_nothing_to_stderr(tmp_path, paper_scene):
 
 
 @pytest.mark.parametrize("quiet", [True, False])
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_progress_quiet_silences_notices(tmp_path, paper_scene, monkeypatch, quiet):
     """A resumed sweep with an edited row: without a terminal only the one-line notice
     reaches stderr; under --quiet nothing does."""

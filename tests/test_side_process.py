@@ -242,6 +242,7 @@ print(r.ru_utime + r.ru_stime + there)
 """
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_main_job_benchmark_counts_the_side_process_cpu():
     """A command's side process ends after the command's own process has been waited for:
     the benchmark still counts its CPU (an accounting identity, not a timing)."""

@@ -299,6 +299,7 @@ def dask_cluster():
             p.wait()
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_dask_cluster_matches_local_runner_and_survives_a_lost_worker(scene, tmp_path,
                                                                       dask_cluster,
                                                                       monkeypatch):

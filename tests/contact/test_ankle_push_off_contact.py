@@ -35,6 +35,7 @@ def contact_walker(rigid):
     return walker, initial_state_from_ideal(walker, gait.x)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_the_ankle_torque_is_a_force_pair_at_the_stance_ankle(contact_walker):
     """On a state in heel off (the stance foot turned 0.1 rad toe down from the leg's
     perpendicular, the legs moving): the push-off adds M^-1 tau (e_foot - e_leg) to the

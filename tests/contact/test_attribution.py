@@ -17,6 +17,7 @@ from walkerlab.config import load_scene
 from walkerlab.models.contact.scene import build
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_sinks_add_up_to_gravity_work_over_the_step():
     """Measured on the paper's contact: damping 1.128 J, friction in the impact (double
     support) 0.007 J, stance creep 0.093 J; sum 1.2283 J against M g l sin(phi) = 1.2284 J.

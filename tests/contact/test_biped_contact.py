@@ -25,6 +25,7 @@ def _scene(tmp_path, name="paper_rods", strides=1):
     return p
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_biped_scene_contact_sim_and_compare(tmp_path):
     scene, runs = _scene(tmp_path), tmp_path / "runs"
     r = CliRunner().invoke(app, ["contact-sim", str(scene), "--runs-dir", str(runs)])

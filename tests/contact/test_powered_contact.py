@@ -123,6 +123,7 @@ def walk(stage_run):
     return stage_run.walker, stage_run.result
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_contact_step_period_within_3_percent_of_the_rigid_gait(rigid, walk):
     _, gait = rigid
     _, res = walk
@@ -132,6 +133,7 @@ def test_contact_step_period_within_3_percent_of_the_rigid_gait(rigid, walk):
     assert abs(T / gait.step_period - 1.0) < 0.03, (T, gait.step_period)
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_contact_push_off_work_and_cost_of_transport_match_the_rigid_view(rigid, stage_run):
     """Per step (mid-step to mid-step) the contact push-off does the rigid push-off's work
     within 5 % (measured 0.2264 J against 0.2346 J, -3.5 %: the pulse ends at the touchdown;

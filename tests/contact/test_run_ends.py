@@ -113,6 +113,7 @@ def test_rigid_walker_that_never_moves_exits_1_in_one_line(tmp_path):
     assert "0 heel strikes" in err and "simulated" not in r.stdout
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_a_run_asked_for_n_strides_goes_on_until_it_makes_them_or_says_why_not():
     """configs/asymmetric_legs.yaml on its former 0.1 m patches: the contact model's steps
     are slower than the rigid ones the end time is sized by (5 rigid strides' time).

@@ -57,6 +57,7 @@ def test_unscaled_ideal_state_drifts_off_narrow_patches():
     assert 0.355 < np.diff(s_td)[-1] < 0.365
 
 
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_pinned_first_step_and_odeint_vs_radau():
     w = _paper(0.3)
     x0 = initial_state_from_ideal(w, *FP)

@@ -49,6 +49,7 @@ def _cfunc_outputs(phase, x):
 
 
 @pytest.mark.parametrize("scene", ["paper.yaml", "kneed.yaml"])
+@pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_compiled_flow_and_guards_match_python(scene):
     """Each phase's cfunc equals its Python flow, and its guard columns the phase's guards
     (which generated guard, which offset: the mapping written in the model layer)."""
