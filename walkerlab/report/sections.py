@@ -67,7 +67,7 @@ def summary_section(scene, inputs, pub: ModuleType | None) -> list[str]:
                        f"|Floquet multiplier| {num(fp.max_abs_multiplier())}).")
         g = getattr(fp, "ground_contact", None)
         if g is not None:  # a gait that needs the ground to pull is no gait on real ground
-            bullets.append("- **Ground contact**: " + ground_contact_text(g, u).split(
+            bullets.append("- **Ground reaction**: " + ground_contact_text(g, u).split(
                 ": ", 1)[1] + ".")
         eq = dict(zip(*published_fixed_point(pub)))
         for n, v, un in zip(fp.state_names, fp.x, fp.state_units):
