@@ -51,15 +51,17 @@ def test_cli_import_loads_no_numeric_library():
 def test_fixedpoint_command_loads_cyrk_without_numba(tmp_path):
     """The whole ``walkerlab fixedpoint --force``: CyRK integrates, numba is not loaded, no
     process-pool machinery (``multiprocessing``) is loaded, and OpenBLAS started no thread
-    pool (one OS thread in the process)."""
-    code = ("import os, sys\n"
+    pool (one OS thread in the process besides the threads Python started: the collector's
+    start-up timer, :func:`walkerlab.cli.process.pause_collection`)."""
+    code = ("import os, sys, threading\n"
             "from walkerlab.cli import app\n"
             "try:\n"
             "    app(['fixedpoint', 'configs/paper.yaml', '--force', '--runs-dir', sys.argv[1]])\n"
             "except SystemExit as exc:\n"
             "    assert not exc.code, exc.code\n"
             "tasks = '/proc/self/task'\n"
-            "threads = len(os.listdir(tasks)) if os.path.isdir(tasks) else 1\n"
+            "threads = (len(os.listdir(tasks)) - threading.active_count() + 1\n"
+            "           if os.path.isdir(tasks) else 1)\n"
             + _loaded(HEAVY + ("CyRK", "multiprocessing"),
                       f"{{'blas': os.environ.get({BLAS_THREADS_ENV!r}), 'threads': threads}}"))
     # a first run fills the shared cache (the rigid module AND the compiled flow: a cold
@@ -146,17 +148,23 @@ def test_a_command_process_ends_without_walking_its_objects_again():
     contact-sim``, ~0.8 s of a cold first report, measured.  A command's exit function
     (registered once, by the process settings every command applies, before the libraries
     it imports register theirs) freezes them all and turns the collector off, last: an
-    exit function registered before the command's runs after it and sees that; the
-    collector still runs during the command."""
-    code = ("import atexit, gc, json, sys\n"
+    exit function registered before the command's runs after it and sees that.  During
+    the command's start-up (``START_UP_S``, here shortened) the collector is off: the
+    libraries' long-lived objects are imported then, and every collection walked them
+    again; after it they are frozen and the collector runs again."""
+    code = ("import atexit, gc, json, sys, time\n"
             "atexit.register(lambda: print(json.dumps({'at_exit': [gc.isenabled(), "
             "gc.get_freeze_count() > 0]})))\n"
-            "from walkerlab.cli.process import process_settings\n"
-            "process_settings(); process_settings()\n"
-            "print(json.dumps({'during': [gc.isenabled(), gc.get_freeze_count()]}))\n")
+            "from walkerlab.cli import process\n"
+            "process.START_UP_S = 0.2\n"
+            "process.process_settings(); process.process_settings()\n"
+            "print(json.dumps({'start_up': [gc.isenabled(), gc.get_freeze_count()]}))\n"
+            "time.sleep(1.0)\n"
+            "print(json.dumps({'after': [gc.isenabled(), gc.get_freeze_count() > 0]}))\n")
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          env=env, cwd=ROOT, timeout=120)
     assert out.returncode == 0, out.stderr[-2000:]
     lines = [json.loads(line) for line in out.stdout.strip().splitlines()]
-    assert lines == [{"during": [True, 0]}, {"at_exit": [False, True]}]
+    assert lines == [{"start_up": [False, 0]}, {"after": [True, True]},
+                     {"at_exit": [False, True]}]

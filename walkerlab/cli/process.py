@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import gc
 import os
+import threading
 
 import typer
 
@@ -49,6 +51,9 @@ def single_threaded_blas() -> None:
 #: cyclic garbage collector thresholds of a command's process (generation 0 allocations,
 #: generation 1 and 2 collections; Python's are (700, 10, 10))
 GC_THRESHOLDS = (20_000, 20, 20)
+#: wall time [s] after a command's start during which the cyclic garbage collector does not
+#: run (:func:`pause_collection`)
+START_UP_S = 2.0
 
 
 def process_settings() -> None:
@@ -64,10 +69,10 @@ def process_settings() -> None:
       its own schema after this point, and with Python's (700, 10, 10) the collector walks
       those long-lived objects again and again (~5 % of ``walkerlab fixedpoint``'s
       CPU time).  Reference counting still frees everything without cycles at once;
+    - no cyclic collection during the command's start-up (:func:`pause_collection`);
     - no collection at the interpreter's shutdown (:func:`no_collection_at_exit`).
     """
     import atexit
-    import gc
     import signal
 
     from walkerlab.usercache import use_for_numba
@@ -76,10 +81,52 @@ def process_settings() -> None:
     if hasattr(signal, "SIGXFSZ"):
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     gc.set_threshold(*GC_THRESHOLDS)
+    pause_collection(START_UP_S)
     # once per process (a test suite runs many commands in one); registered before the
     # libraries the command imports, so their exit functions run before it
     atexit.unregister(no_collection_at_exit)
     atexit.register(no_collection_at_exit)
+
+
+#: the process's one start-up pause (a test suite runs many commands in one process): its
+#: timer, and whether the command's exit function has run (then the pause never ends)
+_PAUSE: dict = {"timer": None, "exiting": False}
+_PAUSE_LOCK = threading.Lock()
+
+
+def pause_collection(seconds: float) -> None:
+    """Turn the cyclic garbage collector off for the first ``seconds`` [s] (wall) of the
+    process, once per process; then every object allocated so far goes into the
+    collector's permanent generation (``gc.freeze``) and collection resumes
+    (:func:`_resume_collection`, on a daemon timer thread).
+
+    A command's start-up imports its libraries (typer, pydantic and the scene schema,
+    h5py, scipy.optimize, numba and its target set-up, the generated kernels): about a
+    million long-lived objects, which every generation-0 collection walked once more
+    without finding garbage (``gc.callbacks`` show it: nearly all of the collector's time
+    in a warm ``walkerlab contact-sim`` is spent during imports).  Frozen, they are never
+    walked again.  Reference
+    counting frees everything without cycles at once, as always; what is lost is only
+    cyclic garbage made during the pause, which is kept (frozen) instead of freed.
+    """
+    with _PAUSE_LOCK:
+        if _PAUSE["timer"] is not None or _PAUSE["exiting"]:
+            return
+        gc.disable()
+        timer = threading.Timer(seconds, _resume_collection)
+        timer.daemon = True
+        timer.name = "walkerlab-gc-resume"
+        _PAUSE["timer"] = timer
+    timer.start()
+
+
+def _resume_collection() -> None:
+    """End of :func:`pause_collection`: freeze and collect again (not once the command's
+    exit function has turned collection off for good)."""
+    with _PAUSE_LOCK:
+        if not _PAUSE["exiting"]:
+            gc.freeze()
+            gc.enable()
 
 
 def no_collection_at_exit() -> None:
@@ -91,7 +138,9 @@ def no_collection_at_exit() -> None:
     and ~0.8 s of a cold first ``walkerlab report``.  Nothing is lost: the command's files
     are written and closed before its exit functions run, and Python runs no finaliser
     of a reference cycle at shutdown for certain anyway."""
-    import gc
-
-    gc.disable()
-    gc.freeze()
+    with _PAUSE_LOCK:
+        _PAUSE["exiting"] = True
+        if _PAUSE["timer"] is not None:
+            _PAUSE["timer"].cancel()
+        gc.disable()
+        gc.freeze()
