@@ -157,18 +157,10 @@ def _cyrk_walks(mc):
     return walks
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scene", default=str(ROOT / "configs" / "paper.yaml"))
-    ap.add_argument("--walks", type=int, default=500)
-    ap.add_argument("--steps", type=int, default=100)
-    ap.add_argument("--sigma", type=float, default=0.002)
-    ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--chunk", type=float, default=-1.1,
-                    help="time span [s] of one CyRK call (a step needs ~0.7 s); negative: "
-                    "that many times the previous heel strike's time")
-    ap.add_argument("--out", type=Path, default=None)
-    a = ap.parse_args()
+def measure(scene_path: str, walks: int = 500, steps: int = 100, sigma: float = 0.002,
+            repeats: int = 5, chunk: float = -1.1) -> dict:
+    """CPU per heel strike [us] of the three loops (module docstring), their ratios to the
+    minimal loop (medians and each repeat's), and the walks that differ from it."""
     sys.path.insert(0, str(ROOT))
     spec = importlib.util.spec_from_file_location(
         "minimal_compass", ROOT / "walkerlab" / "bench" / "minimal_compass.py")
@@ -180,16 +172,16 @@ def main() -> None:
     from walkerlab.config import MfptSettings, load_scene
     from walkerlab.studies import mfpt as work
 
-    scene = load_scene(a.scene)
+    scene = load_scene(scene_path)
     _, search = solve_scene(scene, fd_check=False)
     x = np.asarray(search.gait.result.x, float)
     st = scene.mfpt or MfptSettings()
-    W, S = a.walks, a.steps
+    W, S = walks, steps
     base = scene.model_dump(mode="json")
-    task = work.WalkTask(base, tuple(map(float, x)), a.sigma, tuple(range(W)), S, st.seed,
+    task = work.WalkTask(base, tuple(map(float, x)), sigma, tuple(range(W)), S, st.seed,
                          "normal", 0)
     sm = work.step_map_for(base)
-    slopes = np.stack([draw_slopes(st.seed, w, S, sm.slope_rad, a.sigma) for w in range(W)])
+    slopes = np.stack([draw_slopes(st.seed, w, S, sm.slope_rad, sigma) for w in range(W)])
     p = mc.params(scene.walker)
     cy_walks = _cyrk_walks(mc)
     res = {k: (np.zeros(W, np.int64), np.zeros(W, bool)) for k in ("minimal", "cyrk")}
@@ -204,13 +196,13 @@ def main() -> None:
 
     def cyrk():
         s, f = res["cyrk"]
-        cy_walks(x, slopes, p, st.rtol / 2, st.atol / 2, st.max_step_time_s, a.chunk, s, f)
+        cy_walks(x, slopes, p, st.rtol / 2, st.atol / 2, st.max_step_time_s, chunk, s, f)
         return s, f
 
     runs = {"library": lib, "cyrk": cyrk, "minimal": minimal}
     out_runs = {k: fn() for k, fn in runs.items()}  # compile / load, warm
     t = {k: [] for k in runs}
-    for r in range(a.repeats):
+    for r in range(repeats):
         order = list(runs) if r % 2 == 0 else list(runs)[::-1]
         for k in order:
             c = time.process_time()
@@ -219,19 +211,34 @@ def main() -> None:
     ref = out_runs["minimal"]
     hs = {k: int(v[0].sum() + v[1].sum()) for k, v in out_runs.items()}
     us = {k: 1e6 * float(np.median(v)) / hs[k] for k, v in t.items()}
-    out = {"us_per_heel_strike": us,
-           "over_minimal": {k: us[k] / us["minimal"] for k in us},
-           "pair_ratios_over_minimal": {k: [a_ / b for a_, b in zip(t[k], t["minimal"])]
-                                        for k in t},
-           "heel_strikes": hs,
-           "falls": {k: int(v[1].sum()) for k, v in out_runs.items()},
-           "walks_differing_from_minimal": {
-               k: int(np.sum((v[0] != ref[0]) | (v[1] != ref[1])))
-               for k, v in out_runs.items()},
-           "walks": W, "max_steps": S, "sigma_rad": a.sigma, "rtol": st.rtol,
-           "atol": st.atol, "repeats": a.repeats, "chunk_s": a.chunk, **machine()}
-    for k in runs:
-        print(f"{k:8s} {us[k]:8.2f} us/heel strike  x{out['over_minimal'][k]:.3f} of the "
+    return {"us_per_heel_strike": us,
+            "over_minimal": {k: us[k] / us["minimal"] for k in us},
+            "pair_ratios_over_minimal": {k: [a_ / b for a_, b in zip(t[k], t["minimal"])]
+                                         for k in t},
+            "heel_strikes": hs,
+            "falls": {k: int(v[1].sum()) for k, v in out_runs.items()},
+            "walks_differing_from_minimal": {
+                k: int(np.sum((v[0] != ref[0]) | (v[1] != ref[1])))
+                for k, v in out_runs.items()},
+            "walks": W, "max_steps": S, "sigma_rad": sigma, "rtol": st.rtol,
+            "atol": st.atol, "repeats": repeats, "chunk_s": chunk, **machine()}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scene", default=str(ROOT / "configs" / "paper.yaml"))
+    ap.add_argument("--walks", type=int, default=500)
+    ap.add_argument("--steps", type=int, default=100)
+    ap.add_argument("--sigma", type=float, default=0.002)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--chunk", type=float, default=-1.1,
+                    help="time span [s] of one CyRK call (a step needs ~0.7 s); negative: "
+                    "that many times the previous heel strike's time")
+    ap.add_argument("--out", type=Path, default=None)
+    a = ap.parse_args()
+    out = measure(a.scene, a.walks, a.steps, a.sigma, a.repeats, a.chunk)
+    for k, us in out["us_per_heel_strike"].items():
+        print(f"{k:8s} {us:8.2f} us/heel strike  x{out['over_minimal'][k]:.3f} of the "
               f"minimal loop  walks differing {out['walks_differing_from_minimal'][k]}")
     if a.out is not None:
         a.out.write_text(json.dumps(out, indent=1, default=str))
