@@ -30,7 +30,9 @@ GUESS = np.array([-0.2022, 0.1674, -0.60, -0.84])  # the paper's Eq. (11)
 
 
 def flow(t, y):
-    """dy/dt of the pinned compass gait (Lagrange)."""
+    """dy/dt (4,) [rad/s, rad/s, rad/s^2, rad/s^2] of the pinned compass gait at the state
+    ``y`` (4,) [rad, rad, rad/s, rad/s] (Lagrange; Goswami, Thuilot & Espiau 1996, the
+    equations of :func:`walkerlab.bench.minimal_compass.flow`); ``t`` [s] unused."""
     mu = M * A + (M + MH) * L
     s, c = math.sin(y[0] - y[1]), math.cos(y[0] - y[1])
     d11, d12, d22 = M * B * B, -M * L * B * c, M * A * A + (M + MH) * L * L
@@ -41,7 +43,9 @@ def flow(t, y):
 
 
 def heel_strike(t, y):
-    """Zero at the heel strike; positive before midstance (the legs have not crossed)."""
+    """Heel-strike event of ``solve_ivp`` at the state ``y`` (4,) [rad, rad, rad/s, rad/s]:
+    ``theta1 + theta2 + 2 gamma`` [rad] once the legs have crossed (midstance), 1 before
+    (no heel strike while the swing foot is behind the stance foot)."""
     return y[0] + y[1] + 2.0 * GAMMA if y[0] - y[1] > 0 else 1.0
 
 
@@ -49,13 +53,16 @@ heel_strike.terminal, heel_strike.direction = True, -1
 
 
 def impact(x):
-    """Post-impact state (roles swapped) from the pre-impact state ``x``."""
+    """Post-impact state (4,) [rad, rad, rad/s, rad/s], the legs' roles swapped, from the
+    pre-impact state ``x`` (4,): plastic impact, angular momentum of the walker about the
+    new stance foot and of the trailing leg about the hip conserved (Goswami, Thuilot &
+    Espiau 1996)."""
     t1, t2, w1, w2 = x
     s1, c1, s2, c2 = math.sin(t1), math.cos(t1), math.sin(t2), math.cos(t2)
     h = np.array([-L * s2, L * c2])
     p1, p2, foot = h + B * np.array([s1, -c1]), A * np.array([-s2, c2]), h + L * np.array([s1, -c1])
 
-    def cross(r, v):
+    def cross(r, v):  # z component of r x v
         return r[0] * v[1] - r[1] * v[0]
 
     vh = -L * w2 * np.array([c2, s2])
@@ -73,13 +80,15 @@ def impact(x):
 
 
 def step(x):
-    """The Poincare map: (next post-impact state, step period [s])."""
+    """The Poincare map from the post-impact state ``x`` (4,) [rad, rad, rad/s, rad/s]:
+    (the next post-impact state (4,), the step period [s])."""
     sol = solve_ivp(flow, (0.0, 5.0), x, method="DOP853", rtol=1e-12, atol=1e-12,
                     events=heel_strike)
     return impact(sol.y_events[0][0]), sol.t_events[0][0]
 
 
 def main() -> None:
+    """Find and print the fixed point (4,) [rad, rad, rad/s, rad/s] and its period [s]."""
     sol = root(lambda x: step(x)[0] - x, GUESS, method="hybr", tol=1e-12)
     x = sol.x
     print("fixed point", " ".join(f"{v:.10f}" for v in x), f"period {step(x)[1]:.10f} s",
