@@ -1,7 +1,7 @@
 """The paper's main job, timed as a new user meets it (``walkerlab bench main-job``), with
 another code tree side by side.
 
-    python scripts/bench_main_job.py [--vs DIR] [--repeats 3] [--parts contact_sim,report,...]
+    python scripts/bench_main_job.py [--vs DIR] [--repeats 3] [--parts contact_sim,bare,report,...]
                                      [--out runs/bench/main_job.json]
 
 ``--vs DIR``: a second code tree (e.g. ``git worktree add /tmp/prev <commit>``) measured in
@@ -32,7 +32,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--mesh-repeats", type=int, default=1)
     ap.add_argument("--walks", type=int, default=500)
-    ap.add_argument("--parts", default="contact_sim,report,montecarlo,mesh,robustness")
+    ap.add_argument("--parts", default="contact_sim,bare,report,montecarlo,mesh,robustness")
     ap.add_argument("--out", type=Path, default=ROOT / "runs" / "bench" / "main_job.json")
     a = ap.parse_args()
     res = run_main_job(a.scene, ROOT, a.vs, a.repeats, walks=a.walks,

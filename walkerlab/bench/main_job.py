@@ -17,6 +17,11 @@ measurement            what is timed                                            
 ``again``              upstream artifact changed less than 2 s before a check is
                        hashed again; from then on its hash is remembered in the user
                        cache, :mod:`walkerlab.io.artifacts`)
+``warm_over_bare``     warm ``contact-sim --force`` against a bare numpy + scipy script   2.0 x
+                       that finds the paper walker's fixed point
+                       (:mod:`walkerlab.bench.bare_fixedpoint`), whole process against
+                       whole process, ``pairs`` pairs alternating which goes first
+                       (CPU of each; the median of the pairs' ratios)
 ``report_cold``        the first ``walkerlab report SCENE`` of a fresh runs folder and   10 s
                        a fresh user cache, whole process
 ``montecarlo``         CPU per heel strike of the MFPT Monte Carlo walks (one chunk    1.2 x
@@ -61,6 +66,8 @@ __all__ = ["run_main_job", "MC_CHILD", "MESH_CHILD"]
 
 HERE = Path(__file__).resolve()
 TREE = HERE.parents[2]
+#: the plain-library yardstick of a warm contact run (no walkerlab import)
+BARE = HERE.with_name("bare_fixedpoint.py")
 
 #: Monte Carlo walks: the library's chunk of walks and the minimal numba loop, interleaved
 MC_CHILD = r"""
@@ -200,6 +207,25 @@ def contact_sim(code: Path, scene: str) -> dict:
     return {"cold": cold, "warm": warm, "warm_again": again}
 
 
+def warm_vs_bare(code: Path, scene: str, pairs: int = 5) -> dict:
+    """Warm ``contact-sim --force`` and the bare scipy script (:data:`BARE`), ``pairs``
+    times alternating, in one fresh user cache (fixed point and a first contact run done
+    before): ``{"warm": [(wall, cpu), ...], "bare": [(wall, cpu), ...]}`` [s]."""
+    with tempfile.TemporaryDirectory() as d:
+        env = _env(code, str(Path(d) / "cache"))
+        runs = str(Path(d) / "runs")
+        _run(_cli("fixedpoint", scene, "--runs-dir", runs), env, code)
+        warm = _cli("contact-sim", scene, "--force", "--runs-dir", runs)
+        _run(warm, env, code)
+        _run(warm, env, code)  # the steady state (see contact_sim_warm_again)
+        out: dict = {"warm": [], "bare": []}
+        for i in range(pairs):
+            for k in (("warm", "bare") if i % 2 == 0 else ("bare", "warm")):
+                cmd = warm if k == "warm" else [sys.executable, str(BARE)]
+                out[k].append(_run(cmd, env, code)[:2])
+    return out
+
+
 def report_cold(code: Path, scene: str) -> tuple[float, float]:
     """The first ``walkerlab report`` of a fresh runs folder and user cache: (wall, cpu)."""
     with tempfile.TemporaryDirectory() as d:
@@ -230,6 +256,8 @@ def _one_tree(code: Path, scene: str, cfg: dict, runs: str) -> dict:
     out = {}
     if "contact_sim" in cfg["parts"]:
         out["contact_sim"] = contact_sim(code, scene)
+    if "bare" in cfg["parts"]:
+        out["bare"] = warm_vs_bare(code, scene)
     if "report" in cfg["parts"]:
         out["report_cold"] = report_cold(code, scene)
     return out
@@ -238,8 +266,9 @@ def _one_tree(code: Path, scene: str, cfg: dict, runs: str) -> dict:
 def run_main_job(scene: str = "configs/paper.yaml", code: Path | None = None,
                  vs: Path | None = None, repeats: int = 3, sigma_mc: float = 0.002,
                  walks: int = 500, steps: int = 100, sigma_mesh: float = 0.004,
-                 mesh_repeats: int = 1, parts: tuple = ("contact_sim", "report", "montecarlo",
-                                                        "mesh", "robustness")) -> dict:
+                 mesh_repeats: int = 1, parts: tuple = ("contact_sim", "bare", "report",
+                                                        "montecarlo", "mesh",
+                                                        "robustness")) -> dict:
     """Run the main-job benchmark (module docstring) on ``code`` (default this tree) and,
     with ``vs``, on a second tree side by side.
 
@@ -256,8 +285,8 @@ def run_main_job(scene: str = "configs/paper.yaml", code: Path | None = None,
     walks, steps : int
         Monte Carlo walks and their step cap.
     parts : tuple of str
-        Which measurements (``contact_sim``, ``report``, ``montecarlo``, ``mesh``,
-        ``robustness``).
+        Which measurements (``contact_sim``, ``bare`` (warm_over_bare), ``report``,
+        ``montecarlo``, ``mesh``, ``robustness``).
 
     Returns
     -------
@@ -320,6 +349,16 @@ def _summary(raw: list, mc: list, slow: dict) -> dict:
         if "warm_again" in cs[0]:
             out["contact_sim_warm_again_wall_s"] = _median([c["warm_again"] for c in cs], 0)
             out["contact_sim_warm_again_cpu_s"] = _median([c["warm_again"] for c in cs], 1)
+    if raw and "bare" in raw[0]:
+        warm = [c for r in raw for c in r["bare"]["warm"]]
+        bare = [c for r in raw for c in r["bare"]["bare"]]
+        out["bare_fixedpoint_wall_s"] = _median(bare, 0)
+        out["bare_fixedpoint_cpu_s"] = _median(bare, 1)
+        out["warm_paired_cpu_s"] = _median(warm, 1)
+        out["warm_over_bare_cpu"] = float(np.median([w[1] / b[1]
+                                                     for w, b in zip(warm, bare)]))
+        out["warm_over_bare_wall"] = float(np.median([w[0] / b[0]
+                                                      for w, b in zip(warm, bare)]))
     if raw and "report_cold" in raw[0]:
         out["report_cold_wall_s"] = _median([r["report_cold"] for r in raw], 0)
         out["report_cold_cpu_s"] = _median([r["report_cold"] for r in raw], 1)

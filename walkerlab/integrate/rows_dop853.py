@@ -23,6 +23,25 @@ row's guards wins (ties: the first guard).
 
 Row outcomes (``which``): the guard index, :data:`TIMEOUT` (``t`` reached the row's cap
 without a crossing) or :data:`FAILED` (the step size fell below 10 ulp of ``t``).
+
+Why not CyRK's DOP853 (a dependency, compiled, with dense output): the one CyRK entry point
+a compiled loop can call, its numba bridge (``CyRK.nb.numba_solver.c_numba_cysolve_ivp``,
+what ``nbsolve2_ivp`` calls), takes no events, and CyRK's events exist only for
+``pysolve_ivp`` (a Python right-hand side, called per stage) and ``cysolve_ivp`` (Cython
+callers only).  A Monte Carlo walk on CyRK therefore calls the solver once per time span
+of a step, has it build a solver and keep every step and its dense output on the heap,
+checks the guards on the kept steps and locates the heel strike through CyRK's
+dense-output calls; every call restarts the step-size selection.  How long a span should
+be depends on the gait: too short and a step takes a second call, too long and the walker
+(no impact applied) is integrated on past the heel strike into its fall.  Measured side by
+side in one process (``scripts/bench_mc_cyrk.py``: the same slopes, start, step cap and
+accuracy; the same walks and falls), CyRK with the span tuned to the paper walker's step
+was no faster than this module and at the Monte Carlo's allowance over the minimal numba
+loop (:mod:`walkerlab.bench.minimal_compass`), and several times slower with a span that
+does not suit the step; a span rule for every walker and every phase of this module's
+rows (several guards, the kneed and flat-foot phases) would have to be found first.  So
+this loop stays.  It is also what every stored Monte Carlo result was computed with
+(CyRK's step-size control and error norm differ: its numbers would not be bit-identical).
 """
 
 from __future__ import annotations

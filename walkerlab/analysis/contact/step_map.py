@@ -70,8 +70,8 @@ import dataclasses
 import time
 
 import numpy as np
-from scipy.optimize import brentq
 
+from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
 from walkerlab.integrate.contact_powered import (
@@ -86,6 +86,8 @@ from walkerlab.integrate.events import Event, EventRun, run_to_event
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.model import ContactWalker, footprint_offsets
 from walkerlab.walker.layout import StateIndex
+
+brentq = import_on_fresh_stack("scipy.optimize").brentq  # see walkerlab.freshstack
 
 __all__ = ["SCALES", "SECTION_NAMES", "SECTION_UNITS", "PeriodicGaitError", "StepMap",
            "section_coordinates", "section_guess_from_ideal"]

@@ -1,0 +1,50 @@
+"""The plain-library yardsticks of the main-job benchmark find what walkerlab finds: the
+bare scipy script the paper walker's fixed point, and the Monte Carlo walks on CyRK's
+DOP853 (``scripts/bench_mc_cyrk.py``) the same walks and falls as the minimal numba loop
+and the library (issue 51, items 16 and 17)."""
+
+from __future__ import annotations
+
+import importlib.util
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.slow
+def test_bare_script_finds_the_paper_walkers_fixed_point(paper_scene):
+    """The bare numpy + scipy script (no walkerlab import) prints the fixed point walkerlab
+    finds for configs/paper.yaml; both stop at 1e-12, so they agree to ~1e-10 rad."""
+    from walkerlab.analysis.gait.scene import solve_scene
+
+    out = subprocess.run([sys.executable, str(ROOT / "walkerlab" / "bench" /
+                                              "bare_fixedpoint.py")],
+                         capture_output=True, text=True, timeout=120, cwd="/")
+    assert out.returncode == 0, out.stderr[-2000:]
+    words = out.stdout.split()
+    bare = np.array([float(w) for w in words[2:6]])
+    _, search = solve_scene(paper_scene, fd_check=False)
+    np.testing.assert_allclose(bare, search.gait.result.x, rtol=0, atol=1e-9)
+    assert "walkerlab" not in out.stderr
+
+
+@pytest.mark.slow
+def test_cyrk_monte_carlo_walks_as_the_minimal_loop():
+    """CyRK's DOP853 driven from a numba loop makes the same heel strikes and falls as the
+    minimal loop and the library on the same slopes (what makes its timing comparable; at
+    the benchmark's sigma 0.002 rad none of 500 walks of 100 steps differed; at 0.004 rad a
+    walk at the edge of a fall may go either way on another integrator)."""
+    spec = importlib.util.spec_from_file_location("bench_mc_cyrk",
+                                                  ROOT / "scripts" / "bench_mc_cyrk.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = mod.measure(str(ROOT / "configs" / "paper.yaml"), walks=20, steps=10, sigma=0.002,
+                      repeats=1)
+    assert out["walks_differing_from_minimal"] == {"library": 0, "cyrk": 0, "minimal": 0}
+    assert len(set(out["heel_strikes"].values())) == 1
+    assert out["heel_strikes"]["minimal"] > 20  # the walks took steps
