@@ -623,8 +623,11 @@ def derive(structure: Structure) -> Equations:
         s, _lagrange(s, Mp, Mi, Bm, V, D), geo, points, bodies)
     swap = _swap_and_guards(s, points, swing_contact, sub)
     n = s.n
-    if s.knee or s.arc:  # the printed-equation variants exist for the point-foot compass gait
+    if s.arc:  # the swing arc's material contact point is not a named point's position
         De, E = sp.zeros(n + 2, n + 2), sp.zeros(2, n + 2)
+        extra = {"locked": dyn.locked, "knee_impact": dyn.knee_impact}
+    elif s.knee:  # the extended impact system: a push-off at the straight stance leg's foot
+        De, E = _extended(s, bodies, points["swing_foot"], dyn.lim)
         extra = {"locked": dyn.locked, "knee_impact": dyn.knee_impact}
     else:
         De, E = _extended(s, bodies, points["swing_foot"], dyn.lim)

@@ -37,9 +37,12 @@ def _structure_check(data, spec) -> bool:
     if st.foot != "point":
         raise ValueError("walker.actuation: actuators need point feet today (arc and flat "
                          "feet: not yet)")
-    if st.knee and (spec.push_off is not None or st.torso):
-        raise ValueError("walker.actuation.push_off: a kneed walker takes hip torques only "
-                         "today (no push-off, no torso)")
+    if st.knee and st.torso and (spec.push_off is not None or spec.torques):
+        raise ValueError("walker.actuation: a kneed walker with an upper body takes no "
+                         "actuators today")
+    if st.knee and spec.push_off is not None and st.foot != "point":
+        raise ValueError("walker.actuation.push_off: a kneed walker's push-off needs point "
+                         "feet today")
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
     if any(massless) and not limit:
@@ -155,6 +158,8 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         limit = _structure_check(data, spec)
         acts = Actuators(spec, functions(data), len(walker.roles), limit,
                          float(walker.total_mass_kg))
+        if data.structure.knee:  # heel strike with the swing knee locked (the last phase's)
+            acts.hold_lock(walker.phases[-1].constraint)
     base_jac = walker.variational
     has_torque = bool(spec.torques)
 

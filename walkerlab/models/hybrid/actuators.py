@@ -94,6 +94,20 @@ class Actuators:
         # (a torque of time alone: zeros); None: the complex step differentiates the torques
         self.torque_jacobian = None
         self._memo: dict = {}  # recent transitions (pre-impact state bytes -> result)
+        self.lock = None  # the gradient (n,) of a constraint held through the transition
+
+    def hold_lock(self, lock) -> None:
+        """Hold the constraint whose gradient is ``lock(x)`` (n,) (a locked swing knee)
+        through the push-off and the heel strike, as the passive heel strike does (McGeer
+        1990); the role swap's rate map is then the swap of the generated reset's positions
+        (affine in ``q``: central differences of unit step are exact), since a kneed leg's
+        thigh and shank both take the straight leg's rate."""
+        self.lock = lock
+        n, z = self.n, np.zeros(self.n)
+        pos = self.fns["reset"]
+        self.R = np.stack([(np.real(pos(np.concatenate([e, z])))[:n]
+                            - np.real(pos(np.concatenate([-e, z])))[:n]) / 2.0
+                           for e in np.eye(n)], axis=1)
 
     # ---------------------------------------------------------------- joint torques
     def hip_angles(self, x):
@@ -231,10 +245,21 @@ class Actuators:
         dqe = np.concatenate([dq, np.zeros(2)])
         Ef = np.zeros((2, n + 2))
         Ef[:, n:] = np.eye(2)
-        dqe_po = dqe + np.linalg.solve(De, Ef.T @ (P * e))
-        K = np.zeros((n + 4, n + 4), dtype=np.result_type(De, E))
-        K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -E.T, E
-        sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(2)]))
+        if self.lock is None:
+            dqe_po = dqe + np.linalg.solve(De, Ef.T @ (P * e))
+            K = np.zeros((n + 4, n + 4), dtype=np.result_type(De, E))
+            K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -E.T, E
+            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(2)]))
+        else:  # the swing knee locked through both impulses (as the passive heel strike)
+            a = np.concatenate([np.asarray(self.lock(x)), np.zeros(2)])[None, :]
+            A = np.zeros((n + 3, n + 3), dtype=np.result_type(De, a))
+            A[:n + 2, :n + 2], A[:n + 2, n + 2:], A[n + 2:, :n + 2] = De, -a.T, a
+            dqe_po = np.linalg.solve(A, np.concatenate([De @ dqe + Ef.T @ (P * e),
+                                                        np.zeros(1)]))[:n + 2]
+            C = np.vstack([E, a])
+            K = np.zeros((n + 5, n + 5), dtype=np.result_type(De, C))
+            K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -C.T, C
+            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(3)]))
         dq_plus = sol[:n]
         qn, R = self._relabel(np.real(q))
         qn = qn + R @ (q - np.real(q))  # the swap is affine: exact for a complex step too
