@@ -157,6 +157,37 @@ def generated_module(structure) -> dict:
 _imported: dict[str, object] = {}
 
 
+def generated_source(filename: str, build) -> tuple[str, Path]:
+    """The checked text of the generated module ``filename`` of the cache folder and the
+    file it is in: read (:func:`read_source`), or on a miss, a damaged or an untrusted file
+    made by ``build() -> str`` and written atomically (mode 0600); without a private cache
+    folder, or one that cannot be written, written to the run's private temporary folder
+    (:func:`walkerlab.usercache.private_tmp`, removed at exit).
+
+    Raises
+    ------
+    OSError
+        Neither folder can be written (its errno kept: a full disk reads "disk full"),
+        named by the cache file first tried.
+    """
+    folder = cache_dir()
+    path = folder / filename if folder is not None else None
+    body = read_source(path) if path is not None else None  # None: missing, damaged, untrusted
+    if body is None:
+        body = build()
+        errors: list = []
+        first = path
+        if path is None or not write_source(path, body, errors):
+            path = usercache.private_tmp() / filename
+            if not write_source(path, body, errors):
+                # the cause kept (its errno: a full disk or a file-size limit reads "disk
+                # full" as every other write), named by the cache file first tried
+                err = errors[-1] if errors else OSError()
+                raise OSError(err.errno, "cannot write the generated module "
+                              f"({err.strerror or err})", str(first or path)) from err
+    return body, path
+
+
 def import_generated(filename: str, module_name: str, build):
     """Import the generated module ``filename`` of the cache folder as a real module (so that
     numba's ``cache=True`` keeps its machine code, in the user cache:
@@ -177,21 +208,7 @@ def import_generated(filename: str, module_name: str, build):
     import sys
 
     usercache.use_for_numba()  # numba's cache in the user cache, not in a runs folder
-    folder = cache_dir()
-    path = folder / filename if folder is not None else None
-    body = read_source(path) if path is not None else None  # None: missing, damaged, untrusted
-    if body is None:
-        body = build()
-        errors: list = []
-        first = path
-        if path is None or not write_source(path, body, errors):
-            path = usercache.private_tmp() / filename
-            if not write_source(path, body, errors):
-                # the cause kept (its errno: a full disk or a file-size limit reads "disk
-                # full" as every other write), named by the cache file first tried
-                err = errors[-1] if errors else OSError()
-                raise OSError(err.errno, "cannot write the generated module "
-                              f"({err.strerror or err})", str(first or path)) from err
+    body, path = generated_source(filename, build)
     spec = importlib.util.spec_from_loader(module_name, loader=None, origin=str(path))
     mod = importlib.util.module_from_spec(spec)
     mod.__file__ = str(path)

@@ -552,8 +552,9 @@ _plain: dict[str, dict] = {}
 
 def floating_plain(structure: Structure) -> dict:
     """The floating module's functions of ``structure`` as the plain Python they are
-    generated from (``njit`` the identity): the generated text (the user cache's, checked as
-    :func:`load_generated` checks it, or generated anew and written there), executed without
+    generated from (``njit`` the identity): the generated text
+    (:func:`walkerlab.codegen.cache.generated_source`, as :func:`load_generated` reads and
+    writes it), executed without
     numba, for a check of a few hundred states that should load no compiler (the rigid
     gait's ground reaction, :mod:`walkerlab.models.hybrid.ground_reaction`).  Memoised per
     process.
@@ -574,12 +575,7 @@ def floating_plain(structure: Structure) -> dict:
     key, filename, _ = _generated_names(structure, "floating")
     if key in _plain:
         return _plain[key]
-    folder = cache.cache_dir()
-    body = cache.read_source(folder / filename) if folder is not None else None
-    if body is None:
-        body = floating_source(structure, key)
-        if folder is not None:  # as load_generated writes it (atomic; a failure: in memory)
-            cache.write_source(folder / filename, body)
+    body, _ = cache.generated_source(filename, lambda: floating_source(structure, key))
     body = body.replace("from numba import njit\n", "", 1)
 
     def njit(*_args, **_kwargs):

@@ -24,8 +24,9 @@ def check_targets(o) -> None:
     ValueError
         No target (one line saying which fields to give).
     """
-    if all(t is None for t in (o.target_speed_m_per_s, o.target_step_length_m,
-                               o.target_step_period_s)):
+    from walkerlab.optimal.guess import has_target
+
+    if not has_target(o):
         raise ValueError("a five-link biped's optimal step needs a target (without one the "
                          "least effort is a 1 mm shuffle): give optimize.target_step_length_m"
                          " and target_step_period_s, or target_speed_m_per_s, as "

@@ -10,11 +10,18 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["read_guess", "simulated_step", "starting_step", "target_numbers", "target_step"]
+__all__ = ["has_target", "read_guess", "simulated_step", "starting_step", "target_numbers",
+           "target_step"]
 
 #: the swing leg's forward swing over the straight-line guess, as a share of the step's
 #: half-angle (a bump ``b sin(pi s)``: the swing foot clears level ground mid-step)
 SWING_BUMP = 0.5
+
+
+def has_target(o) -> bool:
+    """The ``optimize`` section ``o`` gives a target speed, step length or step period."""
+    return any(t is not None for t in (o.target_speed_m_per_s, o.target_step_length_m,
+                                       o.target_step_period_s))
 
 
 def target_numbers(o, leg_length_m: float) -> tuple[float, float]:

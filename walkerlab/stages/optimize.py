@@ -94,13 +94,12 @@ def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
     ground: :func:`walkerlab.optimal.scene.no_gait_of_its_own`): no upstream gait, the
     starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
     refused at once without them."""
-    from walkerlab.optimal.guess import target_numbers
+    from walkerlab.optimal.guess import has_target, target_numbers
     from walkerlab.optimal.scene import optimize_scene
 
     o = scene.optimize
     try:
-        if all(v is None for v in (o.target_speed_m_per_s, o.target_step_length_m,
-                                   o.target_step_period_s)):
+        if not has_target(o):
             raise ValueError("the walker has no gait of its own (passive, on level or uphill "
                              "ground): its optimal gait starts from the targets; give "
                              "optimize.target_speed_m_per_s and target_step_length_m (or a "
