@@ -18,9 +18,9 @@ from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
-from walkerlab.optimal.collocation import CollocationSpec, collocate_step, replay, step_functions
+from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step, replay, step_functions
 from walkerlab.optimal.guess import simulated_step
-from walkerlab.optimal.scene import collocation_spec
+from walkerlab.optimal.drivers.step import collocation_spec
 from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")
@@ -266,7 +266,7 @@ def test_bad_optimize_sections_say_which_field(tmp_path):
     d = {**base, "optimize": {**base["optimize"], "hip_angle_range_rad": [-0.5, 0.5]}}
     ok = type(load_scene(CONFIGS / "compass_optimal.yaml")).model_validate(d)
     assert ok.optimize.hip_angle_range_rad == (-0.5, 0.5)
-    from walkerlab.optimal.scene import collocation_spec
+    from walkerlab.optimal.drivers.step import collocation_spec
 
     assert collocation_spec(ok).hip_angle_range_rad == (-0.5, 0.5)
     scene = load_scene(CONFIGS / "compass_optimal.yaml")
@@ -335,8 +335,8 @@ def test_step_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch)
     back from the code cache (no symbolic derivation on a warm start: the build is not
     called), and the functions read back compute bit for bit what the built ones do; a
     damaged file is rebuilt."""
-    import walkerlab.optimal.collocation as collocation
-    from walkerlab.optimal import step_cache
+    import walkerlab.optimal.transcription.step as collocation
+    from walkerlab.optimal.transcription import step_cache
 
     monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
     scene = load_scene(CONFIGS / "compass_optimal.yaml")

@@ -1,6 +1,6 @@
 """The collocation functions - the straight-legged walkers' one step
-(:func:`walkerlab.optimal.collocation.step_functions`) and the phases of a step of a kneed
-or flat-footed walker or of a stride (:func:`walkerlab.optimal.phases.mode_functions`) -
+(:func:`walkerlab.optimal.transcription.step.step_functions`) and the phases of a step of a kneed
+or flat-footed walker or of a stride (:func:`walkerlab.optimal.transcription.phases.mode_functions`) -
 built once per walker and cached on disk like the generated flows
 (:mod:`walkerlab.codegen.cache`), so a warm ``walkerlab optimize`` neither derives the
 walker symbolically (sympy) nor converts it to CasADi (``walkerlab bench optimize`` times
@@ -36,7 +36,7 @@ def _key(data, kind: str = "steps", extra=()) -> str:
     import casadi as ca
 
     from walkerlab.codegen.cache import cache_key
-    from walkerlab.optimal import collocation, phases
+    from walkerlab.optimal.transcription import phases, step as collocation
 
     h = hashlib.sha256(repr((tuple(float(v) for v in data.params), float(data.slope_rad),
                              float(data.gravity_m_per_s2),
@@ -57,7 +57,7 @@ def _read(key: str):
     return (read_source(path) if path is not None else None), path
 
 
-#: a phase's CasADi functions (:class:`walkerlab.optimal.phases.ModePhase`), in order
+#: a phase's CasADi functions (:class:`walkerlab.optimal.transcription.phases.ModePhase`), in order
 _PHASE_FNS = ("flow", "guard", "guard_rate", "reset", "keep", "clearance", "step", "grf",
               "push_off")
 
@@ -76,7 +76,7 @@ def _decode(text: str) -> dict:
     """:func:`_encode`'s inverse (raises on a damaged text)."""
     import casadi as ca
 
-    from walkerlab.optimal.phases import ModePhase
+    from walkerlab.optimal.transcription.phases import ModePhase
 
     def phase(p):
         return ModePhase(p["name"], p["guard_name"], int(p["direction"]),
@@ -109,14 +109,14 @@ def _cached(key: str, build) -> dict:
 
 
 def cached_mode_functions(data, walker, order=None) -> dict:
-    """:func:`walkerlab.optimal.phases.mode_functions` of ``data`` (a WalkerData) in the
+    """:func:`walkerlab.optimal.transcription.phases.mode_functions` of ``data`` (a WalkerData) in the
     phase order ``order`` (default: the rigid ``walker``'s), from this process's memo, the
     disk cache, or built (and written there).
 
     Returns
     -------
     dict
-        As :func:`~walkerlab.optimal.phases.mode_functions`.
+        As :func:`~walkerlab.optimal.transcription.phases.mode_functions`.
 
     Raises
     ------
@@ -124,7 +124,7 @@ def cached_mode_functions(data, walker, order=None) -> dict:
         A walker or phase the transcription has no symbolic form for (one line; nothing
         cached).
     """
-    from walkerlab.optimal import phases
+    from walkerlab.optimal.transcription import phases
 
     order = [tuple(o) for o in (order if order is not None else phases.phase_order(walker))]
     return _cached(_key(data, "modes", order),
@@ -132,20 +132,20 @@ def cached_mode_functions(data, walker, order=None) -> dict:
 
 
 def cached_step_functions(data) -> dict:
-    """:func:`walkerlab.optimal.collocation.step_functions` of ``data`` (a WalkerData),
+    """:func:`walkerlab.optimal.transcription.step.step_functions` of ``data`` (a WalkerData),
     from this process's memo, the disk cache, or derived and built (and written there).
 
     Returns
     -------
     dict
-        As :func:`~walkerlab.optimal.collocation.step_functions`.
+        As :func:`~walkerlab.optimal.transcription.step.step_functions`.
 
     Raises
     ------
     ValueError
         A walker the transcription does not handle (one line; nothing cached).
     """
-    from walkerlab.optimal import collocation
+    from walkerlab.optimal.transcription import step as collocation
 
     def build():
         from walkerlab.codegen import symbolic  # sympy: only on a miss (a slow import)

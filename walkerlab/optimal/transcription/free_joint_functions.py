@@ -1,5 +1,5 @@
 """CasADi functions of a free-jointed (five-link) biped's step, from its own symbolic model
-(:func:`walkerlab.codegen.five_link.derive_five_link`), built once per walker structure and
+(:func:`walkerlab.codegen.free_joints.derive_five_link`), built once per walker structure and
 cached on disk like the generated flows (:mod:`walkerlab.codegen.cache`).
 
 Every function takes the walker's parameter vector ``p`` (``structure.param_names`` order,
@@ -60,7 +60,7 @@ def _build(structure) -> dict:
     import casadi as ca
     import numpy as np
 
-    from walkerlab.codegen.five_link import derive_five_link
+    from walkerlab.codegen.free_joints import derive_five_link
     from walkerlab.config.actuation import FIVE_LINK_JOINTS
 
     eq = derive_five_link(structure)

@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.ipopt import iteration_history, solve
+from walkerlab.optimal.transcription.ipopt import iteration_history, solve
 
 __all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step",
            "ipopt_options", "positive_power", "replay", "step_functions",
@@ -151,7 +151,7 @@ class CollocationResult:
     replay_error : float
         Max-norm return error of the replay (module docstring).
     history : dict of str -> ndarray
-        IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
+        IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
     """
 
     t: np.ndarray
@@ -219,7 +219,7 @@ def step_functions(data, eq):
                          "a torso, partly massless legs: not yet)")
     if getattr(data, "mirror", None) is not None:
         raise ValueError("optimize: legs that differ take a stride of two different steps "
-                         "(walkerlab.optimal.stride); one step would be periodic only for "
+                         "(walkerlab.optimal.transcription.stride); one step would be periodic only for "
                          "mirror-image legs")
     n = len(eq.q)
     vals = dict(zip(eq.params, data.params))
@@ -354,7 +354,7 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     data : WalkerData
     eq : Equations or None
         ``walkerlab.codegen.symbolic.derive(data.structure)`` (unused when ``fns`` is
-        given, e.g. by :func:`walkerlab.optimal.step_cache.cached_step_functions`).
+        given, e.g. by :func:`walkerlab.optimal.transcription.step_cache.cached_step_functions`).
     spec : CollocationSpec
     guess_t : ndarray (m,)
         Times [s] of a guess step (e.g. a simulated gait from heel strike to heel strike).
