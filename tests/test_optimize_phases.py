@@ -391,6 +391,7 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
     start), computing bit for bit what the built ones do; a damaged file is rebuilt and
     written again (~6 s: one build of the flat feet's CasADi functions)."""
     pytest.importorskip("casadi")
+    from walkerlab.codegen import casadi_functions
     from walkerlab.optimal import phases, step_cache
 
     monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
@@ -401,11 +402,11 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
 
     x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     order = starting_phases(scene, walker, x0, 0.76, 40)[2]  # the gait's phase sequence
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     built = step_cache.cached_mode_functions(data, walker, order)
     files = list((tmp_path / "models").glob("*-modes-*.casadi"))
     assert len(files) == 1
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
 
     def no_build(*_a, **_k):
         raise AssertionError("built again")
@@ -428,7 +429,7 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
     np.testing.assert_array_equal(np.asarray(read["power"](x, 0.3)),
                                   np.asarray(built["power"](x, 0.3)))
     files[0].write_text("damaged")
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     calls = []
     monkeypatch.setattr(phases, "mode_functions",
                         lambda *a: calls.append(a) or built)
