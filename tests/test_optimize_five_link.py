@@ -196,10 +196,10 @@ def check_the_transcription_error_falls_at_hermite_simpsons_order(optimised):
     over the step by the same linearised map at both meshes) falls by 2^p when the mesh is
     halved: observed p >= 3.5 for Hermite-Simpson's 4 (measured 3.7: at 25 intervals the
     error, 0.67, is large enough to be past the linear growth, which lowers p)."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
+    from walkerlab.optimal.replay.shooting import open_loop_error
     from walkerlab.optimal.transcription.free_joint_functions import five_link_functions
     from walkerlab.optimal.transcription.free_joints import collocate_five_link
-    from walkerlab.optimal.replay.shooting import open_loop_error
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     d, _, _ = optimised
     assert len(d.time) == 101

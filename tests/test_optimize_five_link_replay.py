@@ -150,8 +150,8 @@ def test_the_feed_forward_is_the_transcriptions_control_at_the_time_the_step_pas
     control (each interval's quadratic, control_of_time against torques_of_time to
     round-off) at the time the step passes ``s``; exact at the points, and between them
     within the Hermite spline ``T``'s O(h^4) of a step at constant ``ds`` (T exact)."""
-    from walkerlab.optimal.transcription.free_joints import torques_of_time
     from walkerlab.optimal.replay.virtual_constraints import control_of_time
+    from walkerlab.optimal.transcription.free_joints import torques_of_time
 
     s, ds, delta, slope, _, _ = _table()
     t = (s[0] - s) / 0.9

@@ -110,8 +110,8 @@ def kneed_fast(kneed):
     intervals from its passive gait's step, and that step (the guess)."""
     import walkerlab as wl
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases, phased_guess
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     scene, data, walker, fns = kneed
     g = wl.Walker.from_scene(scene).fixed_point()
@@ -248,8 +248,8 @@ def test_the_kneed_walkers_least_cost_of_transport_on_its_slope_is_its_passive_g
     gait's step: CoT ~0 (1.1e-11 seen: the interior point's slack floor), the torque ~0
     (6e-5 N m seen), the step period within 1e-3 of the shooting gait's (1e-4 seen: the
     objective, ~1e-11 there, resolves no closer) and the replay closing (<= 1e-6)."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     _, data, _, fns = kneed
     g, guess, _spec, _free = kneed_fast

@@ -199,13 +199,13 @@ def test_the_flat_feet_least_effort_gait_is_their_passive_gait(flat):
     pytest.importorskip("casadi")
     import walkerlab as wl
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import (
         collocate_phases,
         phased_guess,
         replay_phases,
     )
     from walkerlab.optimal.transcription.phases import mode_functions, phase_order
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     scene, data, walker = flat
     g = wl.Walker.from_scene(scene).fixed_point()
@@ -226,8 +226,8 @@ def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed, kneed_st
     point's (60 intervals: 4e-8 seen; O(h^4)), the knee strike at the passive gait's
     time, and the replay on the rigid model (its own guards and resets) closing to
     1e-6."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     _, data, _ = kneed
     g, guess, fns = kneed_start
@@ -244,8 +244,8 @@ def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed, kneed_st
 
 
 def test_what_the_phased_transcription_does_not_take_is_refused_in_one_line():
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     for spec, field in ((CollocationSpec(objective="push_off_work"), "optimize.objective"),
                         (CollocationSpec(objective="weighted",
@@ -322,8 +322,8 @@ def test_optimize_command_on_the_kneed_walker(tmp_path):
 def _powered(data, start, intervals: int, speed: float):
     """The least-effort step of a walker with phases at a target speed (``start`` from
     :func:`_start`: its passive gait's step as the guess) and its replay error."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     _g, guess, fns = start
     res = collocate_phases(fns, CollocationSpec(intervals=intervals,
@@ -391,6 +391,7 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
     start), computing bit for bit what the built ones do; a damaged file is rebuilt and
     written again (~6 s: one build of the flat feet's CasADi functions)."""
     pytest.importorskip("casadi")
+    from walkerlab.codegen import casadi_functions
     from walkerlab.optimal.transcription import phases, step_cache
 
     monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
@@ -401,11 +402,11 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
 
     x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     order = starting_phases(scene, walker, x0, 0.76, 40)[2]  # the gait's phase sequence
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     built = step_cache.cached_mode_functions(data, walker, order)
     files = list((tmp_path / "models").glob("*-modes-*.casadi"))
     assert len(files) == 1
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
 
     def no_build(*_a, **_k):
         raise AssertionError("built again")
@@ -428,7 +429,7 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
     np.testing.assert_array_equal(np.asarray(read["power"](x, 0.3)),
                                   np.asarray(built["power"](x, 0.3)))
     files[0].write_text("damaged")
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     calls = []
     monkeypatch.setattr(phases, "mode_functions",
                         lambda *a: calls.append(a) or built)

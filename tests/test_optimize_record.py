@@ -13,8 +13,8 @@ import walkerlab as wl
 from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
-from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step
 from walkerlab.optimal.drivers.step import step_record
+from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step
 from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")

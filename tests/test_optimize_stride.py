@@ -1,4 +1,5 @@
-"""A walker whose legs differ optimised over one stride (``walkerlab.optimal.transcription.stride``):
+"""A walker whose legs differ optimised over one stride
+(``walkerlab.optimal.transcription.stride``):
 configs/asymmetric_optimal.yaml (the paper's walker with leg masses 5 / 5.5 kg, slope
 0.0174 rad, a hip torque).  Its CasADi phases are the rigid model's and its mirror's, its
 least-effort stride is the passive period-2 gait found independently by shooting
@@ -83,9 +84,9 @@ def test_the_least_effort_stride_is_the_passive_period_two_gait(asym):
     7.5e-8 on 40), the start
     within 1e-6, the replay over the stride closing to 1e-6 and the stride map's
     multipliers those of the fixed point (1e-6: the start's distance)."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
-    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.drivers.mode_sequence import replay_multipliers
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     scene, data, _walker, g, fns = asym
@@ -111,8 +112,8 @@ def test_a_powered_stride_at_a_target_speed_replays_on_the_rigid_model(asym):
     steps (the legs differ), and the torques fed as functions of time to the rigid model and
     its mirror return to the start within 1e-6 over the stride (~11 s under load: the
     optimisation and the replay of the torqued walker in Python)."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     _scene, data, _walker, _g, fns = asym
@@ -144,8 +145,8 @@ def test_a_stride_with_a_push_off_is_the_rigid_walkers_pushed_gait(asym):
     stride's 7.5e-8 on 40 intervals), the start within 1e-5; its replay with the push-off
     closes to 1e-6; and it is not the unpushed gait (both steps longer by > 1e-3)."""
     from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     scene, data, _walker, g, fns = asym
@@ -172,8 +173,8 @@ def test_a_free_push_off_stride_on_level_ground(asym):
     push-off in the rigid model's own transition (numpy, :class:`walkerlab.models.hybrid.
     actuated.Actuators`; the collocation's is CasADi's) to 1e-9 relative, and it is a part
     of the cost of transport, ``(hip positive work + push-off work) / (M g d)``."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     scene, data, _walker, _g, _fns = asym
@@ -212,9 +213,9 @@ def test_what_the_stride_does_not_take_is_refused_in_one_line(asym):
     free push-off pass the stride's checks, and a guess is read from its artifact (a
     missing one refused naming ``optimize.initial_guess``); one step of legs that differ
     stays refused by the one-step transcription."""
-    from walkerlab.optimal.transcription.step import step_functions
     from walkerlab.optimal.drivers.step import optimize_scene
     from walkerlab.optimal.drivers.stride import _check
+    from walkerlab.optimal.transcription.step import step_functions
 
     scene, data, _walker, g, _fns = asym
 
@@ -337,8 +338,8 @@ def test_the_least_cost_of_transport_stride_on_its_slope_is_the_passive_gait(asy
     point's slack floor), torques ~0 (4e-5 N m seen), each step's period within 1e-4 of the
     shooting fixed point's (6e-6 seen: the objective, ~1e-11, resolves no closer; the least
     effort's 7.5e-8 on this mesh) and the replay closing (<= 1e-6; 1.1e-8 seen)."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     _scene, data, _walker, g, fns = asym
@@ -357,8 +358,8 @@ def test_the_least_cost_of_transport_stride_on_its_slope_is_the_passive_gait(asy
 def fast(asym):
     """The least-effort stride at 0.6 m/s (the passive gait: 0.528 m/s) on 40 intervals a
     step from the passive stride, and its spec."""
-    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     spec = CollocationSpec(intervals=40, target_speed_m_per_s=0.6)
     return spec, collocate_phases(asym[4], spec, _guess(asym))
@@ -497,8 +498,8 @@ def test_a_stride_starts_from_another_strides_optimize_h5(asym, fast, tmp_path):
     a few iterations with the barrier started small (``warm_start``, as the scene does for
     an optimize.h5 guess; with IPOPT's default 0.1: 11, against 12 from the passive
     stride, the start left for the central path)."""
-    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.drivers.stride import starting_stride
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
 
     scene, _data, walker, g, fns = asym
     spec, free = fast

@@ -1,5 +1,6 @@
 """``optimize.h5``'s records of an optimised step that every transcription's scene driver
-writes the same way (:mod:`walkerlab.optimal.drivers.step`, :mod:`walkerlab.optimal.drivers.mode_sequence`,
+writes the same way (:mod:`walkerlab.optimal.drivers.step`,
+:mod:`walkerlab.optimal.drivers.mode_sequence`,
 :mod:`walkerlab.optimal.drivers.stride`, :mod:`walkerlab.optimal.drivers.free_joints`): the
 phase-variable replays and the solver's history with the walker's energies."""
 

@@ -94,8 +94,8 @@ def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
     ground: :func:`walkerlab.optimal.drivers.step.no_gait_of_its_own`): no upstream gait, the
     starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
     refused at once without them."""
-    from walkerlab.optimal.guess import has_target, target_numbers
     from walkerlab.optimal.drivers.step import optimize_scene
+    from walkerlab.optimal.guess import has_target, target_numbers
 
     o = scene.optimize
     try:

@@ -119,7 +119,8 @@ class OptimizeData:
     replay_step_period_s: float = float("nan")
     collocated_start_error: float = float("nan")
     cpu_time_s: float = float("nan")
-    ipopt_history: dict = field(default_factory=dict)  # walkerlab.optimal.transcription.ipopt.HISTORY
+    # walkerlab.optimal.transcription.ipopt.HISTORY
+    ipopt_history: dict = field(default_factory=dict)
     energy: dict = field(default_factory=dict)  # kinetic, potential (time,) [energy_unit]
     energy_unit: str = "J"
     phase_names: tuple = ()

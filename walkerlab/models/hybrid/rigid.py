@@ -14,7 +14,8 @@ Phases of a step (point feet, straight legs):
   zero: the swing foot reaches the slope), or a fall: the swing leg falls back behind the
   stance leg, or the hip reaches the slope.
 
-Flat feet on ankle springs have their own phase graph (:mod:`walkerlab.models.hybrid.rigid_foot_modes`).
+Flat feet on ankle springs have their own phase graph
+(:mod:`walkerlab.models.hybrid.rigid_foot_modes`).
 
 Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen 2007):
 

@@ -61,11 +61,11 @@ def optimize_five_link_scene(scene):
     """
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.transcription.step import CollocationSpec
+    from walkerlab.optimal.records import not_a_gait_outcome, step_record
+    from walkerlab.optimal.replay.shooting import close_step
     from walkerlab.optimal.transcription.free_joint_functions import JOINTS, five_link_functions
     from walkerlab.optimal.transcription.free_joints import collocate_five_link, replay_five_link
-    from walkerlab.optimal.replay.shooting import close_step
-    from walkerlab.optimal.records import not_a_gait_outcome, step_record
+    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.walker.description import walker_data
 
     o = scene.optimize
@@ -107,13 +107,14 @@ CONTACT_STRIDES = 2
 
 
 def _phase_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple[float, str]]:
-    """The phase-variable replays (:func:`walkerlab.optimal.replay.virtual_constraints.phase_replays`)
+    """The phase-variable replays
+    (:func:`walkerlab.optimal.replay.virtual_constraints.phase_replays`)
     as ``optimize.h5``'s records, and the contact model's ``(step period [s], outcome)``
     under the feed-forward + PD law from its closed start; an optimum that is not a gait
     is not replayed there (``not_gait``: why, the contact outcome)."""
     from walkerlab.optimal.replay.contact import contact_replay_five_link
-    from walkerlab.optimal.replay.virtual_constraints import phase_replays
     from walkerlab.optimal.replay.phase import records
+    from walkerlab.optimal.replay.virtual_constraints import phase_replays
 
     if scene.optimize.phase_replay is False:  # None (the default) or True: replayed
         return {}, (float("nan"), "not replayed: optimize.phase_replay is off (the contact "

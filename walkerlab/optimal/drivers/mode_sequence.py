@@ -48,13 +48,13 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
 
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.records import not_a_gait_outcome, phase_replays, step_record
     from walkerlab.optimal.replay.contact import contact_replay_phased
     from walkerlab.optimal.transcription.mode_sequence import (
         collocate_phases,
         phase_torque_of_time,
         replay_phases,
     )
-    from walkerlab.optimal.records import not_a_gait_outcome, phase_replays, step_record
     from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
     o = scene.optimize

@@ -103,9 +103,9 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.transcription.step import collocate_step, replay, torque_of_time
-    from walkerlab.optimal.replay.contact import contact_replay
     from walkerlab.optimal.guess import starting_step
+    from walkerlab.optimal.replay.contact import contact_replay
+    from walkerlab.optimal.transcription.step import collocate_step, replay, torque_of_time
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
     from walkerlab.walker.description import walker_data
 

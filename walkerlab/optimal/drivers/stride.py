@@ -103,10 +103,10 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
 
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.replay.contact import contact_replay_stride
-    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.drivers.mode_sequence import replay_multipliers
     from walkerlab.optimal.records import not_a_gait_outcome
+    from walkerlab.optimal.replay.contact import contact_replay_stride
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.transcription.stride import replay_stride, stride_functions
 
     o = scene.optimize

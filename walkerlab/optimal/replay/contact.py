@@ -62,7 +62,8 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
                              strides: int = 1) -> tuple[float, str]:
     """Run the contact model of a five-link biped under a phase-variable law.
 
-    The scene's walker gets torques on :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` whose laws
+    The scene's walker gets torques on
+    :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` whose laws
     are replaced by ``law`` (the contact view evaluates each stance leg's joints and phase
     variable as the rigid one, :class:`walkerlab.models.contact.joint_torques.
     JointTorqueActuators`); the scene's ``contact`` law (the paper's default one if none),
@@ -107,7 +108,8 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     optimised hip torque.
 
     The scene's walker gets a hip torque whose law is replaced by
-    :func:`walkerlab.optimal.transcription.mode_sequence.phase_torque_of_time` of the time since each
+    :func:`walkerlab.optimal.transcription.mode_sequence.phase_torque_of_time` of the time since
+    each
     touchdown (between the thighs, or the legs of a flat-footed walker:
     :class:`walkerlab.models.contact.actuation.ContactActuators`), from the collocated start
     ``res.x[0]``; the scene's ``contact`` law (a kneed walker needs its ``knee_stop.latch``
@@ -151,7 +153,8 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
 
 def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
     """Run the contact model of a walker whose legs differ with its optimised stride's hip
-    torques: leg A's step's (:func:`walkerlab.optimal.transcription.stride.step_of` 0) while ``leg2`` is
+    torques: leg A's step's (:func:`walkerlab.optimal.transcription.stride.step_of` 0) while
+    ``leg2`` is
     in stance, leg B's while ``leg1`` is, each as a function of the time since that step's
     touchdown (:func:`walkerlab.optimal.transcription.mode_sequence.phase_torque_of_time`), from the
     collocated start ``res.x[0]`` (leg2 in stance, as the rigid model's); the scene's

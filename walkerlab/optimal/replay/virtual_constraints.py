@@ -5,7 +5,8 @@ Phase variable ``s``: the virtual stance leg's absolute angle (hip to stance foo
 generated ``leg_angles``' ``stance``; Westervelt, Grizzle & Koditschek 2003, IEEE TAC
 48(1):42-56, Sec. IV), strictly monotonic over an optimised step (it decreases: checked,
 else refused).  On the collocated step ``(t_i, x_i, u_i)`` each actuator's joint angle
-``delta_k`` (:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`) becomes a reference of ``s``: the
+``delta_k`` (:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`) becomes a
+reference of ``s``: the
 cubic Hermite spline ``h_k`` through ``(s_i, delta_k(x_i))`` with the slopes
 ``ddelta_k(x_i) / ds(x_i)`` (so ``delta = h(s)`` and ``ddelta = h'(s) ds`` hold at every
 collocation point), the torque the transcription's own control (the quadratic in time of
@@ -51,7 +52,8 @@ __all__ = ["RABBIT_GAINS", "PhaseLaw", "PhaseReplay", "control_of_time", "phase_
            "phase_replays", "phased_walker", "replay_phase_law", "replay_solver",
            "rigid_actuators"]
 
-#: PD gains ``(K [N m/rad], D [N m s/rad])`` per joint (:data:`walkerlab.optimal.transcription.free_joint_functions.
+#: PD gains ``(K [N m/rad], D [N m s/rad])`` per joint
+#: (:data:`walkerlab.optimal.transcription.free_joint_functions.
 #: JOINTS` order), RABBIT's virtual-constraint controller of configs/rabbit.yaml
 RABBIT_GAINS = ((2000.0, 2000.0, 2000.0, 2000.0), (120.0, 120.0, 60.0, 60.0))
 
@@ -62,7 +64,8 @@ def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
     Parameters
     ----------
     acts : FiveLinkActuators
-        The rigid walker's actuators on :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` (their
+        The rigid walker's actuators on
+        :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` (their
         ``joint_angles``).
     x : ndarray (m, 2n)
         Collocated states (``state_names()`` order) [rad, rad/s].
@@ -89,7 +92,8 @@ def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
 
 def phased_walker(data, law: PhaseLaw):
     """The rigid five-link walker (its generated code, phases, guards and reset) driven by
-    ``law`` on :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`: in Python (``law`` called) and
+    ``law`` on :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`: in Python
+    (``law`` called) and
     compiled (its flows' law block :meth:`PhaseLaw.packed`, the same splines: the
     ``cyrk_compiled`` backend of :func:`replay_solver` runs it without a Python callback)."""
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
@@ -104,7 +108,8 @@ def phased_walker(data, law: PhaseLaw):
 
 
 def rigid_actuators(data):
-    """The rigid walker's actuators on :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` (for
+    """The rigid walker's actuators on
+    :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` (for
     :func:`phase_law`)."""
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
     from walkerlab.models.hybrid.actuated_five_link import five_link_actuators

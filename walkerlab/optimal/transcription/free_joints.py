@@ -5,9 +5,11 @@ do your own direct collocation", SIAM Review 59(4):849-904, Sec. 7 and his Optim
 torques at the hips and knees, no ankle torque).
 
 Transcription (separated Hermite-Simpson, as :mod:`walkerlab.optimal.transcription.step`): states
-``x_k`` (10,) and torques ``u_k`` (4,: :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`) at
+``x_k`` (10,) and torques ``u_k`` (4,:
+:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`) at
 ``2N + 1`` points on ``[0, T]``; the flow, the feet and the reset are the walker's own
-symbolic model (:func:`walkerlab.optimal.transcription.free_joint_functions.five_link_functions`).  Constraints:
+symbolic model (:func:`walkerlab.optimal.transcription.free_joint_functions.five_link_functions`).
+Constraints:
 
 - periodic through the heel strike: ``x_0 = reset(x_2N)`` (Kelly's ``cst_heelStrike``);
 - the step ends on the ground, ``step length`` ahead (``cst_stepLength``), the swing foot
@@ -31,8 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.transcription.step import target_constraints
 from walkerlab.optimal.transcription.ipopt import iteration_history, solve
+from walkerlab.optimal.transcription.step import target_constraints
 
 __all__ = ["FiveLinkResult", "collocate_five_link", "kelly_guess", "replay_five_link",
            "torques_of_time"]
@@ -49,7 +51,8 @@ class FiveLinkResult:
     x : ndarray (2N + 1, 10)
         States there (the walker's ``state_names()`` order).
     u : ndarray (2N + 1, 4)
-        Joint torques [N m] (:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` order).
+        Joint torques [N m] (:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`
+        order).
     step_period_s, step_length_m : float
     objective : float
         ``int |u|^2 dt`` [N^2 m^2 s] (Simpson's rule on the points).
@@ -136,7 +139,8 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     spec : walkerlab.optimal.transcription.step.CollocationSpec
         ``intervals``, ``max_torque_n_m`` and the targets (its push-off fields must be off).
     fns : dict, optional
-        :func:`walkerlab.optimal.transcription.free_joint_functions.five_link_functions` (looked up when not given).
+        :func:`walkerlab.optimal.transcription.free_joint_functions.five_link_functions` (looked up
+        when not given).
 
     Returns
     -------

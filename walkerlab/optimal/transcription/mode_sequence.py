@@ -1,4 +1,5 @@
-"""The multi-phase transcription of :mod:`walkerlab.optimal.transcription.phases`: one step of a walker
+"""The multi-phase transcription of :mod:`walkerlab.optimal.transcription.phases`: one step of a
+walker
 with a fixed mode sequence (a kneed walker's unlocked and locked swing) optimised by
 Hermite-Simpson collocation per phase (CasADi ``Opti`` + IPOPT), its starting guess from
 the rigid model's own step and its replay on the rigid model.
@@ -16,7 +17,8 @@ from walkerlab.optimal.transcription.ipopt import iteration_history, solve
 __all__ = ["PhasedResult", "collocate_phases", "optimized_guess", "phase_torque_of_time",
            "phased_guess", "replay_phases"]
 
-#: objectives the phased transcription takes (:data:`walkerlab.optimal.transcription.step.OBJECTIVES`)
+#: objectives the phased transcription takes
+#: (:data:`walkerlab.optimal.transcription.step.OBJECTIVES`)
 PHASED_OBJECTIVES = ("effort", "cost_of_transport", "peak_torque")
 
 @dataclass
@@ -278,7 +280,8 @@ def _check(spec, phases) -> None:
 
 def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
                      ) -> PhasedResult:
-    """Optimise one step phase by phase (:mod:`walkerlab.optimal.transcription.phases`), or a stride of
+    """Optimise one step phase by phase (:mod:`walkerlab.optimal.transcription.phases`), or a
+    stride of
     steps (legs that differ, :mod:`walkerlab.optimal.transcription.stride`: a ``heel_strike`` phase
     inside the sequence ends a step; every heel strike has the swing foot ahead, each step
     its own clearance ends, and the targets are the mean step's).

@@ -220,10 +220,10 @@ class _Modes:
         ``values``)."""
         import casadi as ca
 
-        from walkerlab.optimal.transcription.step import _to_casadi
+        from walkerlab.codegen.casadi_functions import casadi_function
 
         args = x if not extra else ca.vertcat(x, *values)
-        return _to_casadi(exprs, self.xs + list(extra), self.vals)(args)
+        return casadi_function(exprs, self.xs + list(extra), self.vals)(args)
 
     def accel(self, M, C, G, Mfree, lock, x, u):
         """``qdd`` of ``M qdd = -C dq - G`` plus the hip torque's ``Mfree^-1 B u`` (through

@@ -42,7 +42,8 @@ import numpy as np
 __all__ = ["STEP_PHASES", "STRIDE_PHASES", "replay_stride", "step_of", "stride_functions",
            "stride_guess", "stride_walker"]
 
-#: the rigid model's phases of a straight-legged step (:func:`walkerlab.optimal.transcription.phases.
+#: the rigid model's phases of a straight-legged step
+#: (:func:`walkerlab.optimal.transcription.phases.
 #: phase_order` of it), each step of the stride named by its swinging leg
 STEP_PHASES = (("early_swing", "midstance", 1), ("late_swing", "heel_strike", -1))
 #: the stride's steps: the leg that swings in each (the rigid model's ``legs`` order)
@@ -60,7 +61,8 @@ STRIDE_PHASES = tuple(_named(leg, name) for leg in SWINGING for name, _g, _d in 
 
 def stride_functions(data) -> dict:
     """CasADi functions of the stride of ``data``'s walker (legs that differ: ``data.mirror``
-    not None): as :func:`walkerlab.optimal.transcription.phases.mode_functions`, its ``phases`` the four
+    not None): as :func:`walkerlab.optimal.transcription.phases.mode_functions`, its ``phases`` the
+    four
     of the stride (module docstring), named ``leg1_swing:early_swing`` ...
 
     Raises
