@@ -24,25 +24,16 @@ __all__ = ["Actuators", "actuate", "torque_chain_jacobian"]
 
 
 def _structure_check(data, spec) -> bool:
-    """Refuse what this actuation does not handle (one line); True for massless legs."""
+    """Refuse what is physically impossible (one line); True for massless legs.  A joint
+    the walker does not have is refused by :func:`walkerlab.models.hybrid.actuators.
+    joint_links` (naming the joints it has)."""
     st = data.structure
     if spec.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
                          "flat); point feet take push_off, the impulse along the leg")
-    for i, t in enumerate(spec.torques):
-        if t.joint != "hip":
-            raise ValueError(f"walker.actuation.torques.{i}.joint: {t.joint} is a five-link "
-                             "biped's joint (knee.lock: free); a straight-legged walker's is "
-                             "hip")
-    if st.foot != "point":
-        raise ValueError("walker.actuation: actuators need point feet today (arc and flat "
-                         "feet: not yet)")
-    if st.knee and st.torso and (spec.push_off is not None or spec.torques):
-        raise ValueError("walker.actuation: a kneed walker with an upper body takes no "
-                         "actuators today")
-    if st.knee and spec.push_off is not None and st.foot != "point":
-        raise ValueError("walker.actuation.push_off: a kneed walker's push-off needs point "
-                         "feet today")
+    if st.foot == "arc" and spec.push_off is not None:
+        raise ValueError("walker.actuation.push_off: an arc foot's push-off at its rolling "
+                         "contact point is not derived yet (joint torques are)")
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
     if any(massless) and not limit:
@@ -54,6 +45,9 @@ def _structure_check(data, spec) -> bool:
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: the legs are massless "
                              "(a torque on them needs infinite acceleration): give the torque "
                              "per foot mass, scaled_by: foot_mass (Kuo 2002)")
+        if limit and t.joint != "hip":
+            raise ValueError(f"walker.actuation.torques.{i}.joint: the legs are massless: a "
+                             "torque per foot mass acts at the hip only (joint: hip)")
         if not limit and t.scaled_by != "none":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
                              "walkers whose legs are massless")
@@ -73,7 +67,7 @@ def spring_equivalent(data, spec):
     st = data.structure
     laws = [t for t in spec.torques]
     if not laws or st.knee or st.knee_spring or st.torso or any(
-            t.scaled_by != "none" or t.max_torque_n_m is not None or t.law.reference is not None
+            t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None or t.law.reference is not None
             or t.law.time_reference is not None for t in laws):
         return None
     K = sum(t.law.stiffness_n_m_per_rad for t in laws)
@@ -108,8 +102,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
         guards = guard_outputs(phase, data)
     if guards is None:
         return None
-    links = getattr(acts, "links", None) or \
-        [(acts.legs[1], acts.legs[0])] * len(acts.spec.torques)  # (stance, swing) thighs
+    links = acts.links  # each actuator's (first, second) link: keys of ``leg_angles``
     name = phase.compiled.name if phase.compiled is not None else "flow"
     return ActuatedFlow(data.structure, tuple(data.params), name, guards,
                         joints=tuple(tuple(j) for j in links), laws=acts.laws.packed(),
