@@ -67,8 +67,8 @@ def spring_equivalent(data, spec):
     st = data.structure
     laws = [t for t in spec.torques]
     if not laws or st.knee or st.knee_spring or st.torso or any(
-            t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None or t.law.reference is not None
-            or t.law.time_reference is not None for t in laws):
+            t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None
+            or t.law.reference is not None or t.law.time_reference is not None for t in laws):
         return None
     K = sum(t.law.stiffness_n_m_per_rad for t in laws)
     D = sum(t.law.damping_n_m_s_per_rad for t in laws)
