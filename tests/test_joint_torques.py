@@ -238,3 +238,14 @@ def test_ankle_torque_on_flat_feet():
     M = mode_mass_matrix(w.actuators.fns["energies_heel"], x)
     Q = _check_force(w, passive, x, FLAT, mass_matrix=M)
     np.testing.assert_allclose(Q, [0.0, 0.0, -2.0 - 5.0 * 0.05], atol=1e-8)
+
+
+@pytest.mark.slow  # the quick suite keeps to its CPU budget (a few seconds)
+def test_the_flat_foot_ledger_closes_with_an_ankle_torque():
+    """configs/flat_feet.yaml with a stance-ankle spring-like torque: one step from the
+    scene's start, the ledger (the torque's work ``int tau da`` over every mode) closes."""
+    torques = [{"joint": "stance_ankle", "law": {"constant_n_m": -1.0,
+                                                 "stiffness_n_m_per_rad": 2.0}}]
+    w = wl.Walker.from_scene(scene_from_dict(_scene("flat_feet", torques)))
+    passive = wl.Walker.from_scene(CONFIGS / "flat_feet.yaml")
+    _ledger_closes(w, passive.fixed_point().x)

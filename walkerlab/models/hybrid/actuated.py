@@ -1,12 +1,14 @@
 """A rigid hybrid walker with its actuators (:func:`actuate`): the flows gain the joint
 torques' acceleration ``M^-1 B tau``, the heel-strike reset a push-off impulse.
 
-Which actuators a walker gets follows its description: point feet the hip torques and the
-push-off of :class:`walkerlab.models.hybrid.actuators.Actuators` (the flow and reset
-equations, Kuo 2002); free knees those of
-:mod:`walkerlab.models.hybrid.actuated_five_link`; flat feet an ankle push-off
-(:mod:`walkerlab.models.hybrid.ankle_push_off`) or hip torques
-(:mod:`walkerlab.models.hybrid.flat_hip_torque`).  Those modules import the shared
+One actuator class for every walker (:class:`walkerlab.models.hybrid.actuators.Actuators`):
+a torque at any joint the walker has (:data:`walkerlab.config.actuation.JOINTS`: the hip
+between the legs, torso to leg, knees, flat feet's ankles), its ``B^T = d(delta)/dq`` from
+the generated link angles; the push-off of Kuo (2002) in its transition.  Free knees (the
+five-link biped) add one spline for laws sharing a table
+(:mod:`walkerlab.models.hybrid.actuated_five_link`); flat feet run their stance-foot modes'
+own mass matrices (:mod:`walkerlab.models.hybrid.flat_hip_torque`) or an ankle push-off
+(:mod:`walkerlab.models.hybrid.ankle_push_off`).  Those modules import the shared
 actuators from :mod:`walkerlab.models.hybrid.actuators`, never this one.
 """
 
@@ -124,17 +126,17 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     Returns
     -------
     HybridWalker
-        With ``actuators`` set (free knees: :class:`walkerlab.models.hybrid.
-        actuated_five_link.FiveLinkActuators`); every phase's flow in Python (the
+        With ``actuators`` set (:class:`walkerlab.models.hybrid.actuators.Actuators`);
+        every phase's flow in Python (the
         actuation added to the generated flow) and compiled with its laws
         (``cyrk_compiled``: :class:`walkerlab.codegen.actuated.ActuatedFlow`).
 
     Raises
     ------
     ValueError
-        A walker this actuation does not handle (locking knees, arc or flat feet, partly
-        massless legs), a joint the walker does not have, a push-off on free knees or a
-        torque scaling that does not fit the legs (one line).
+        A joint the walker does not have (naming the joints it has), partly massless legs,
+        a torque scaling that does not fit the legs, a push-off on free knees or arc feet
+        (one line).
     """
     from walkerlab.codegen.cache import functions
 
