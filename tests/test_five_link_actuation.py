@@ -102,7 +102,7 @@ def test_shared_spline_equals_each_laws_own():
 
 @pytest.mark.parametrize("edit, message", [
     (lambda c: c["actuation"].update(push_off={"impulse_n_s": 1.0}), "push_off"),
-    (lambda c: c["actuation"]["torques"][0].update(joint="hip"), "torques.0.joint"),
+    (lambda c: c["actuation"]["torques"][0].update(joint="stance_ankle"), "torques.0.joint"),
     (lambda c: (c.pop("torso"), c["actuation"]["torques"][0].update(joint="swing_hip")),
      "torques.0.joint"),
 ])

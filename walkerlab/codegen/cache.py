@@ -128,14 +128,14 @@ def generated_module(structure) -> dict:
     path = folder / f"{key}.py" if folder is not None else None
     ns = _read(path) if path is not None else None
     if ns is None and structure.foot == "flat":
-        from walkerlab.codegen import flatfoot
+        from walkerlab.codegen import foot_modes as flatfoot
 
         body = flatfoot.generate_flat(structure, key)
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))
         if path is not None:
             write_source(path, body)
     if ns is None and structure.free_knees:
-        from walkerlab.codegen import five_link
+        from walkerlab.codegen import free_joints as five_link
 
         body = five_link.generate_five_link(structure, key)
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))

@@ -32,7 +32,7 @@ def compiled_module(structure):
 
     def build() -> str:
         if structure.foot == "flat":  # a flat foot's modes: their own generator
-            from walkerlab.codegen import flatfoot
+            from walkerlab.codegen import foot_modes as flatfoot
 
             return flatfoot.generate_flat_compiled(structure, key)
         from walkerlab.codegen import source as codegen

@@ -158,20 +158,41 @@ FIVE_LINK_JOINTS = {"stance_hip": ("torso", "stance_thigh"),
                     "swing_knee": ("swing_thigh", "swing_shank")}
 
 
-class JointTorque(Strict):
-    """A torque actuator at a joint shared by two links.  ``joint: hip``: between the legs,
-    ``+tau`` on the swing leg (positive moves its foot forward) and ``-tau`` on the stance
-    leg.  On a five-link biped (``knee.lock: free``, ``torso.coupling: hinged``;
-    :data:`FIVE_LINK_JOINTS`): ``stance_hip`` / ``swing_hip`` between the torso and a thigh,
-    angle thigh minus torso (0 with the torso upright and the thigh hanging straight down,
-    positive flexed: the thigh ahead), ``+tau`` flexes (moves the thigh forward, the torso
-    back); ``stance_knee`` / ``swing_knee`` between a thigh and its shank, angle shank minus
-    thigh (0 straight, negative flexed), ``+tau`` extends the knee.  The joints follow the
-    roles (a leg's joint is ``swing_*`` while it swings)."""
+#: Every joint a walker can have: (first link, second link) by role; the joint's angle is
+#: ``angle(second) - angle(first)`` (absolute link angles, counter-clockwise) and ``+tau``
+#: acts on the second link, ``-tau`` on the first.  ``stance_leg`` / ``swing_leg`` name a
+#: leg's link at the joint: its thigh on a kneed walker, the leg itself on a straight one;
+#: ``torso`` the upper body (a bisecting torso's angle is the legs' mean); ``*_foot`` a flat
+#: foot (the ankle's angle: the sole's from the leg's perpendicular, positive toe up).
+JOINTS = {"hip": ("stance_leg", "swing_leg"),
+          "stance_hip": ("torso", "stance_leg"),
+          "swing_hip": ("torso", "swing_leg"),
+          "stance_knee": ("stance_thigh", "stance_shank"),
+          "swing_knee": ("swing_thigh", "swing_shank"),
+          "stance_ankle": ("stance_leg", "stance_foot"),
+          "swing_ankle": ("swing_leg", "swing_foot")}
 
-    joint: Literal["hip", "stance_hip", "swing_hip", "stance_knee", "swing_knee"] = Field(
-        description="the joint (hip: between the two legs; five-link bipeds: stance_hip, "
-        "swing_hip (torso to thigh), stance_knee, swing_knee (thigh to shank))")
+
+class JointTorque(Strict):
+    """A torque actuator at a joint shared by two links (:data:`JOINTS`).  ``joint: hip``:
+    between the legs (a kneed walker's thighs), ``+tau`` on the swing leg (positive moves its
+    foot forward) and ``-tau`` on the stance leg.  On any walker with a torso (hinged, or
+    bisecting the legs): ``stance_hip`` / ``swing_hip`` between the torso and a leg (thigh),
+    angle leg minus torso (0 with the leg along the torso's line, positive flexed: the leg
+    ahead), ``+tau`` flexes (moves the leg forward, the torso back).  On a kneed walker:
+    ``stance_knee`` / ``swing_knee`` between a thigh and its shank, angle shank minus thigh
+    (0 straight, negative flexed), ``+tau`` extends the knee (a locked knee takes it through
+    its lock).  On flat feet: ``stance_ankle`` / ``swing_ankle`` between a leg and its foot,
+    angle the sole's from the leg's perpendicular (positive toe up), ``+tau`` raises the toe
+    (a push-off is a negative torque; the swing foot is held at its rest angle: its lock
+    takes the torque).  The joints follow the roles (a leg's joint is ``swing_*`` while it
+    swings)."""
+
+    joint: Literal["hip", "stance_hip", "swing_hip", "stance_knee", "swing_knee",
+                   "stance_ankle", "swing_ankle"] = Field(
+        description="the joint (hip: between the two legs; with a torso: stance_hip, "
+        "swing_hip (torso to leg); kneed: stance_knee, swing_knee (thigh to shank); flat "
+        "feet: stance_ankle, swing_ankle (leg to foot))")
     law: TorqueLaw = Field(description="the torque law")
     max_torque_n_m: float | None = Field(None, gt=0, le=1e6, description="saturation |tau| <= "
                                          "max [N m] (null: none)")

@@ -158,10 +158,10 @@ WALKER_VOCABULARY = (
     "(with an optional spring-damper) or free knees (knee.lock: free), foot "
     "kind point, arc or flat (heel, toe, ankle spring); springs: torsional springs and "
     "dampers between links at the hip; torso: an upper body on a bisecting hip mechanism, or "
-    "hinged at the hip with free knees (a five-link biped); actuation: a push-off impulse and "
-    "hip torques on straight, point-footed legs and hip and knee torques on a five-link "
-    "biped (rigid and contact models), an ankle push-off on flat feet (rigid model)); no knee "
-    "or torso actuators outside the five-link biped yet")
+    "hinged at the hip with free knees (a five-link biped); actuation: torques at any joint "
+    "the walker has (hip, torso to leg, knees, flat feet's ankles) in the rigid model (the "
+    "contact model: hip torques on straight, point-footed legs and a five-link biped's "
+    "joints), a push-off impulse on point feet, an ankle push-off on flat feet)")
 
 
 def _walker_vocabulary_applies(root: type[BaseModel], e: dict, suggest=None) -> bool:

@@ -88,7 +88,12 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
             continue
         wdamp += quad_work(lambda t, sol=sol: _damper_power(walker, _state(sol, t, n2)),
                            ta, tb, scale)
-        if acts is not None and ph.name.startswith("heel_off"):
+        if acts is not None and getattr(acts, "links", None):  # joint torques: every mode
+            wpos += quad_work(lambda t, sol=sol: max(acts.power(t, _state(sol, t, n2)), 0.0),
+                              ta, tb, scale)
+            wneg += quad_work(lambda t, sol=sol: min(acts.power(t, _state(sol, t, n2)), 0.0),
+                              ta, tb, scale)
+        elif acts is not None and ph.name.startswith("heel_off"):
             def power(t, sol=sol):
                 x = _state(sol, t, n2)
                 return acts.torque(x[acts.ankle]) * x[acts.ankle + n2 // 2]

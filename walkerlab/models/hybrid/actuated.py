@@ -1,12 +1,14 @@
 """A rigid hybrid walker with its actuators (:func:`actuate`): the flows gain the joint
 torques' acceleration ``M^-1 B tau``, the heel-strike reset a push-off impulse.
 
-Which actuators a walker gets follows its description: point feet the hip torques and the
-push-off of :class:`walkerlab.models.hybrid.actuators.Actuators` (the flow and reset
-equations, Kuo 2002); free knees those of
-:mod:`walkerlab.models.hybrid.actuated_five_link`; flat feet an ankle push-off
-(:mod:`walkerlab.models.hybrid.ankle_push_off`) or hip torques
-(:mod:`walkerlab.models.hybrid.flat_hip_torque`).  Those modules import the shared
+One actuator class for every walker (:class:`walkerlab.models.hybrid.actuators.Actuators`):
+a torque at any joint the walker has (:data:`walkerlab.config.actuation.JOINTS`: the hip
+between the legs, torso to leg, knees, flat feet's ankles), its ``B^T = d(delta)/dq`` from
+the generated link angles; the push-off of Kuo (2002) in its transition.  Free knees (the
+five-link biped) add one spline for laws sharing a table
+(:mod:`walkerlab.models.hybrid.actuated_five_link`); flat feet run their stance-foot modes'
+own mass matrices (:mod:`walkerlab.models.hybrid.flat_hip_torque`) or an ankle push-off
+(:mod:`walkerlab.models.hybrid.ankle_push_off`).  Those modules import the shared
 actuators from :mod:`walkerlab.models.hybrid.actuators`, never this one.
 """
 
@@ -24,25 +26,16 @@ __all__ = ["Actuators", "actuate", "torque_chain_jacobian"]
 
 
 def _structure_check(data, spec) -> bool:
-    """Refuse what this actuation does not handle (one line); True for massless legs."""
+    """Refuse what is physically impossible (one line); True for massless legs.  A joint
+    the walker does not have is refused by :func:`walkerlab.models.hybrid.actuators.
+    joint_links` (naming the joints it has)."""
     st = data.structure
     if spec.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
                          "flat); point feet take push_off, the impulse along the leg")
-    for i, t in enumerate(spec.torques):
-        if t.joint != "hip":
-            raise ValueError(f"walker.actuation.torques.{i}.joint: {t.joint} is a five-link "
-                             "biped's joint (knee.lock: free); a straight-legged walker's is "
-                             "hip")
-    if st.foot != "point":
-        raise ValueError("walker.actuation: actuators need point feet today (arc and flat "
-                         "feet: not yet)")
-    if st.knee and st.torso and (spec.push_off is not None or spec.torques):
-        raise ValueError("walker.actuation: a kneed walker with an upper body takes no "
-                         "actuators today")
-    if st.knee and spec.push_off is not None and st.foot != "point":
-        raise ValueError("walker.actuation.push_off: a kneed walker's push-off needs point "
-                         "feet today")
+    if st.foot == "arc" and spec.push_off is not None:
+        raise ValueError("walker.actuation.push_off: an arc foot's push-off at its rolling "
+                         "contact point is not derived yet (joint torques are)")
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
     if any(massless) and not limit:
@@ -54,6 +47,9 @@ def _structure_check(data, spec) -> bool:
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: the legs are massless "
                              "(a torque on them needs infinite acceleration): give the torque "
                              "per foot mass, scaled_by: foot_mass (Kuo 2002)")
+        if limit and t.joint != "hip":
+            raise ValueError(f"walker.actuation.torques.{i}.joint: the legs are massless: a "
+                             "torque per foot mass acts at the hip only (joint: hip)")
         if not limit and t.scaled_by != "none":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
                              "walkers whose legs are massless")
@@ -73,8 +69,8 @@ def spring_equivalent(data, spec):
     st = data.structure
     laws = [t for t in spec.torques]
     if not laws or st.knee or st.knee_spring or st.torso or any(
-            t.scaled_by != "none" or t.max_torque_n_m is not None or t.law.reference is not None
-            or t.law.time_reference is not None for t in laws):
+            t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None
+            or t.law.reference is not None or t.law.time_reference is not None for t in laws):
         return None
     K = sum(t.law.stiffness_n_m_per_rad for t in laws)
     D = sum(t.law.damping_n_m_s_per_rad for t in laws)
@@ -108,8 +104,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
         guards = guard_outputs(phase, data)
     if guards is None:
         return None
-    links = getattr(acts, "links", None) or \
-        [(acts.legs[1], acts.legs[0])] * len(acts.spec.torques)  # (stance, swing) thighs
+    links = acts.links  # each actuator's (first, second) link: keys of ``leg_angles``
     name = phase.compiled.name if phase.compiled is not None else "flow"
     return ActuatedFlow(data.structure, tuple(data.params), name, guards,
                         joints=tuple(tuple(j) for j in links), laws=acts.laws.packed(),
@@ -131,17 +126,17 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     Returns
     -------
     HybridWalker
-        With ``actuators`` set (free knees: :class:`walkerlab.models.hybrid.
-        actuated_five_link.FiveLinkActuators`); every phase's flow in Python (the
+        With ``actuators`` set (:class:`walkerlab.models.hybrid.actuators.Actuators`);
+        every phase's flow in Python (the
         actuation added to the generated flow) and compiled with its laws
         (``cyrk_compiled``: :class:`walkerlab.codegen.actuated.ActuatedFlow`).
 
     Raises
     ------
     ValueError
-        A walker this actuation does not handle (locking knees, arc or flat feet, partly
-        massless legs), a joint the walker does not have, a push-off on free knees or a
-        torque scaling that does not fit the legs (one line).
+        A joint the walker does not have (naming the joints it has), partly massless legs,
+        a torque scaling that does not fit the legs, a push-off on free knees or arc feet
+        (one line).
     """
     from walkerlab.codegen.cache import functions
 

@@ -10,9 +10,11 @@ FIVE_LINK_JOINTS`) and its torque's generalised force is ``tau`` on the second l
 gains ``M^-1 B tau`` (:func:`walkerlab.models.hybrid.actuated.actuate` adds it, as on every
 actuated walker).  The phase variable ``s`` is the virtual stance leg's angle (hip to
 stance foot, from the generated ``leg_angles``), ``ds`` its rate; it decreases through a
-step.  The legacy ``joint: hip`` acts between the two thighs (a walker without torso).
+step.  ``joint: hip`` acts between the two thighs.
 The push-off impulse is not offered for these walkers (refused in one line).
 
+The actuators are the generic :class:`walkerlab.models.hybrid.actuators.Actuators`;
+here only what a free-jointed walker adds (one spline for laws sharing a table).
 Everything is complex-safe (the generated ``leg_angles`` and ``matrices`` are), so the flow's
 Jacobian is taken by the complex step as on the straight-legged walkers.
 """
@@ -21,99 +23,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.config.actuation import FIVE_LINK_JOINTS
-from walkerlab.models.actuation import TorqueLaws
-from walkerlab.numerics import complex_step_jacobian
+from walkerlab.models.hybrid.actuators import Actuators
 
 __all__ = ["FiveLinkActuators", "five_link_actuators"]
 
-#: the joint between the two thighs on a walker without torso (``joint: hip``)
-THIGHS = ("stance_thigh", "swing_thigh")
 
-
-class FiveLinkActuators:
-    """The joint torques of one free-jointed walker, bound to its generated model.
-
-    Parameters
-    ----------
-    spec : walkerlab.config.actuation.Actuation
-    fns : dict
-        The generated model's functions (``leg_angles``, ``matrices``).
-    roles : tuple of str
-        The walker's coordinates (:data:`walkerlab.walker.description.FREE_KNEE_ROLES`
-        [+ ``torso``]).
-
-    Attributes
-    ----------
-    B : ndarray, shape (n, k)
-        Each actuator's generalised-force direction (``+1`` on its second link's row,
-        ``-1`` on the first's).
-    links : list of (str, str)
-        Each actuator's (first, second) link.
-    """
-
-    limit = False  # the legs carry mass (the massless-leg scaling is the simplest walker's)
-
-    def __init__(self, spec, fns: dict, roles):
-        self.spec, self.fns, self.n = spec, fns, len(roles)
-        self.links = [THIGHS if t.joint == "hip" else FIVE_LINK_JOINTS[t.joint]
-                      for t in spec.torques]
-        self.B = np.zeros((self.n, len(self.links)))
-        for k, (a, b) in enumerate(self.links):
-            self.B[roles.index(a), k] -= 1.0
-            self.B[roles.index(b), k] += 1.0
-        self.laws = TorqueLaws(spec.torques)
-        shared = _shared_phase_table(spec.torques)
-        if shared is not None:  # one spline for every law's reference: 2 calls, not 2k
-            self.laws.refs = shared
-        self.t_origin = 0.0
-        # (t, x) -> (k, 2n) the torques' derivative by the state when known in closed form
-        # (a torque of time alone: zeros); None: the complex step differentiates the torques
-        self.torque_jacobian = None
-
-    def joint_angles(self, x):
-        """``(deltas, ddeltas, s, ds)``: each actuator's joint angle [rad] and rate [rad/s]
-        (lists, length k), the phase variable [rad] and its rate [rad/s]."""
-        d = self.fns["leg_angles"](x)
-        deltas = [d[f"{b}_angle"] - d[f"{a}_angle"] for a, b in self.links]
-        ddeltas = [d[f"{b}_rate"] - d[f"{a}_rate"] for a, b in self.links]
-        return deltas, ddeltas, d["stance_angle"], d["stance_rate"]
-
-    def torques(self, t, x) -> np.ndarray:
-        """Torque of each actuator (k,) [N m] at the state ``x`` (2n,) (complex-safe)."""
-        return self.laws.each(*self.joint_angles(x), t - self.t_origin)
-
-    def begin_step(self, t0: float) -> None:
-        """A step begins at ``t0`` [s] (the origin of ``time_reference`` laws)."""
-        self.t_origin = float(t0)
-
-    def generalised_force(self, t, x):
-        """``B tau`` (n,) [N m]."""
-        return self.B @ self.torques(t, x)
-
-    def added_acceleration(self, t, x):
-        """``M^-1 B tau`` (n,) [rad/s^2]."""
-        M = self.fns["matrices"](x)[0]
-        return np.linalg.solve(M, self.generalised_force(t, x))
-
-    def acceleration_jacobian(self, t, x, constraint=None) -> np.ndarray:
-        """``d(M^-1 B tau)/dx`` (n, 2n): :func:`walkerlab.models.hybrid.actuated.
-        torque_chain_jacobian` with :attr:`torque_jacobian` set, else the complex step of
-        :meth:`added_acceleration` (``constraint``: none on free joints, must be None)."""
-        from walkerlab.models.hybrid.actuators import torque_chain_jacobian
-
-        x = np.asarray(x, float)
-        if self.torque_jacobian is None:
-            return complex_step_jacobian(lambda z: self.added_acceleration(t, z), x)
-        return torque_chain_jacobian(self.fns["matrices"], x, self.generalised_force(t, x),
-                                     self.B @ np.asarray(self.torque_jacobian(t, x), float))
-
-    def power(self, t, x) -> float:
-        """Mechanical power of the joint torques [W]: ``sum tau_k ddelta_k``."""
-        if not self.spec.torques:
-            return 0.0
-        ddeltas = self.joint_angles(x)[1]
-        return float(np.real(np.sum(self.torques(t, x) * np.asarray(ddeltas))))
+#: a free-jointed walker's actuators are the generic ones (the name kept for its users)
+FiveLinkActuators = Actuators
 
 
 def _shared_phase_table(torques):
@@ -169,8 +85,8 @@ def five_link_actuators(data, spec, roles) -> FiveLinkActuators:
     Raises
     ------
     ValueError
-        A push-off, a torso joint without a hinged torso or ``joint: hip`` with one (one
-        line, naming the field).
+        A push-off, a joint the walker does not have (naming the joints it has), a torque
+        per foot mass (one line, naming the field).
     """
     from walkerlab.codegen.cache import functions
 
@@ -178,15 +94,11 @@ def five_link_actuators(data, spec, roles) -> FiveLinkActuators:
         raise ValueError("walker.actuation.push_off: not available on a walker with free "
                          "knees yet (drive its joints with torques)")
     for i, t in enumerate(spec.torques):
-        where = f"walker.actuation.torques.{i}"
         if t.scaled_by != "none":
-            raise ValueError(f"{where}.scaled_by: foot_mass is for walkers whose legs are "
-                             "massless")
-        torso = data.structure.hinged_torso
-        if t.joint in ("stance_hip", "swing_hip") and not torso:
-            raise ValueError(f"{where}.joint: {t.joint} joins the torso and a thigh: it needs "
-                             "a hinged torso (torso.coupling: hinged)")
-        if t.joint == "hip" and torso:
-            raise ValueError(f"{where}.joint: with a hinged torso the hips are stance_hip and "
-                             "swing_hip (torso to thigh), not hip")
-    return FiveLinkActuators(spec, functions(data), tuple(roles))
+            raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
+                             "walkers whose legs are massless")
+    acts = Actuators(spec, functions(data), len(roles), False, float(data.total_mass_kg))
+    shared = _shared_phase_table(spec.torques)
+    if shared is not None:  # one spline for every law's reference: 2 calls, not 2k
+        acts.laws.refs = shared
+    return acts

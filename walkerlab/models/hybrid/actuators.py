@@ -3,11 +3,18 @@ push-off impulse in the reset (Kuo 2002's two-impulse step-to-step transition).
 
 Flow
 ----
-``M(q) qdd + C(q, dq) dq + G(q) = B(q) tau``: each hip actuator's torque acts on the swing leg
-(``+tau``) and on the stance leg (``-tau``), so its generalised force is ``tau d(delta)/dq``
-with ``delta = psi_swing - psi_stance`` (the absolute leg angles; exact, from the generated
-leg angles' rates).  The generated passive flow is kept and the actuation added:
-``qdd = qdd_passive + M^-1 B tau``.  On a walker whose legs are massless (the limit
+``M(q) qdd + C(q, dq) dq + G(q) = B(q) tau``: each actuator's torque acts between the two
+links of its joint (:data:`walkerlab.config.actuation.JOINTS`: ``+tau`` on the second link,
+``-tau`` on the first), so its generalised force is ``tau d(delta)/dq`` with ``delta =
+psi_second - psi_first`` the joint's angle (virtual work).  The absolute link angles are the
+generated ``leg_angles`` of the walker (:func:`link_angles`: legs, thighs, shanks, torso; a
+bisecting torso's angle is the legs' mean, so a torso-to-leg torque reaches both legs; a flat
+foot's angle is its leg's plus the ankle's); their rates are linear in ``dq``, so the rows of
+``B^T = d(delta)/dq`` are read exactly from unit rates (and are constant: every link angle is
+affine in ``q``, checked).  A torque on a locked joint (a kneed walker's stance knee, a swing
+flat foot) has a zero row: the lock takes it.  The generated passive flow is kept and the
+actuation added: ``qdd = qdd_passive + M^-1 B tau`` (in a phase holding a constraint:
+through it).  On a walker whose legs are massless (the limit
 ``m_foot -> 0`` of the simplest walker, whose equations are the rows of the absolute leg
 angles divided by the foot mass), a torque ``scaled_by: foot_mass`` gives ``tau / m_foot``
 and acts on the swing row only (Kuo 2002: it stays finite there and does no work).
@@ -39,10 +46,51 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.config.actuation import JOINTS
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 from walkerlab.numerics import complex_step_jacobian
 
-__all__ = ["Actuators", "torque_chain_jacobian"]
+__all__ = ["Actuators", "joint_links", "link_angles", "torque_chain_jacobian"]
+
+
+def link_angles(la: dict) -> dict:
+    """The absolute angle and rate of every link, ``{link: (angle [rad], rate [rad/s])}``,
+    from a walker's generated ``leg_angles`` output ``la`` (keys ``<link>_angle``,
+    ``<link>_rate``): ``stance``, ``swing`` (straight legs; on a kneed walker the virtual legs
+    hip to foot where generated), ``stance_thigh``, ``stance_shank``, ``swing_thigh``,
+    ``swing_shank`` (kneed), ``torso``; on flat feet (whose output gives the ankles'
+    angles, the sole's from the leg's perpendicular) ``stance_foot`` / ``swing_foot`` = leg +
+    ankle.  Complex-safe (sums of the generated outputs)."""
+    out = {k[:-6]: (v, la[f"{k[:-6]}_rate"]) for k, v in la.items()
+           if k.endswith("_angle") and f"{k[:-6]}_rate" in la}
+    for leg in ("stance", "swing"):
+        ankle = out.pop(f"{leg}_ankle", None)
+        if ankle is not None:
+            out[f"{leg}_foot"] = (out[leg][0] + ankle[0], out[leg][1] + ankle[1])
+    return out
+
+
+def joint_links(links, joint: str, where: str = "joint") -> tuple[str, str]:
+    """``(first, second)``: the links (keys of :func:`link_angles`) a joint joins
+    (:data:`walkerlab.config.actuation.JOINTS`; a leg's link at the hip is its thigh on a
+    kneed walker).
+
+    Raises
+    ------
+    ValueError
+        The walker has no such joint: one line naming ``where`` and the joints it has.
+    """
+    links = set(links)
+    thigh = "_thigh" if "stance_thigh" in links else ""
+
+    def resolve(name):
+        a, b = JOINTS[name]
+        return tuple(f"{r[:-4]}{thigh}" if r.endswith("_leg") else r for r in (a, b))
+    have = [j for j in JOINTS if set(resolve(j)) <= links]
+    if joint not in have:
+        raise ValueError(f"{where}: {joint} is not a joint of this walker (its joints: "
+                         f"{', '.join(have)})")
+    return resolve(joint)
 
 
 @dataclass
@@ -73,6 +121,10 @@ class Actuators:
     limit: bool
     hip_mass_kg: float
 
+    #: with a bisecting torso on flat feet: the torso's angle, the legs' mean (the flat-foot
+    #: model's ``leg_angles`` output does not name it)
+    torso_mean: bool = False
+
     def __post_init__(self):
         eye = np.eye(self.n)
         la = self.fns["leg_angles"]
@@ -89,12 +141,39 @@ class Actuators:
         swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # the legs' absolute angles trade places
         self.R = np.linalg.pinv(self.A) @ swap @ self.A
         self.laws = TorqueLaws(self.spec.torques)
+        # each actuator's (first, second) link and its row of B^T = d(delta)/dq (exact)
+        names = self.link_angles(np.concatenate([z, z]))
+        self.links = [joint_links(names, t.joint, f"walker.actuation.torques.{i}.joint")
+                      for i, t in enumerate(self.spec.torques)]
+        ang = [self.link_angles(np.concatenate([z, e])) for e in eye]
+        self.B = np.array([[float(np.real(a[b][1] - a[f][1])) for (f, b) in self.links]
+                           for a in ang]).reshape(self.n, len(self.links))
+        q1 = np.linspace(0.1, 0.3, self.n)  # affine link angles: the same rows elsewhere
+        ang1 = [self.link_angles(np.concatenate([q1, e])) for e in eye]
+        B1 = np.array([[float(np.real(a[b][1] - a[f][1])) for (f, b) in self.links]
+                       for a in ang1]).reshape(self.n, len(self.links))
+        if not np.array_equal(B1, self.B):
+            raise ValueError("walker.actuation.torques: a joint's angle is not affine in the "
+                             "coordinates (B(q) would vary)")
+        #: every actuator at the one hip between the legs (the straight-legged walkers'
+        #: actuation: B tau = ddelta_dq sum(tau), as before)
+        self.hip_only = all(t.joint == "hip" for t in self.spec.torques) and not (
+            "stance_angle" in names and "stance_thigh" in names)
         self.t_origin = 0.0  # the time [s] the present step began (time_reference laws)
         # (t, x) -> (k, 2n) the torques' derivative by the state, when known in closed form
         # (a torque of time alone: zeros); None: the complex step differentiates the torques
         self.torque_jacobian = None
         self._memo: dict = {}  # recent transitions (pre-impact state bytes -> result)
         self.lock = None  # the gradient (n,) of a constraint held through the transition
+
+    def link_angles(self, x) -> dict:
+        """``{link: (angle [rad], rate [rad/s])}`` at the state ``x`` (2n,)
+        (:func:`link_angles`; a bisecting torso on flat feet: the legs' mean)."""
+        out = link_angles(self.fns["leg_angles"](x))
+        if self.torso_mean and "torso" not in out:
+            (a, da), (b, db) = out["stance"], out["swing"]
+            out["torso"] = ((a + b) / 2, (da + db) / 2)
+        return out
 
     def hold_lock(self, lock) -> None:
         """Hold the constraint whose gradient is ``lock(x)`` (n,) (a locked swing knee)
@@ -118,10 +197,22 @@ class Actuators:
         return (d[f"{sw}_angle"] - d[f"{st}_angle"], d[f"{sw}_rate"] - d[f"{st}_rate"],
                 d[f"{st}_angle"], d[f"{st}_rate"])
 
+    def joint_angles(self, x):
+        """``(deltas, ddeltas, s, ds)``: each actuator's joint angle [rad] and rate [rad/s]
+        (lists, length k), the phase variable (the stance leg's absolute angle; a kneed
+        walker's stance thigh's, a five-link biped's virtual stance leg's) [rad] and its
+        rate [rad/s]."""
+        d = self.link_angles(x)
+        s = d["stance"] if "stance" in d else d[self.legs[1]]
+        return ([d[b][0] - d[a][0] for a, b in self.links],
+                [d[b][1] - d[a][1] for a, b in self.links], s[0], s[1])
+
     def torques(self, t, x) -> np.ndarray:
         """Torque of each actuator (k,) [N m; N m/kg when ``scaled_by: foot_mass``] at the
         state ``x`` (2n,) (complex-safe: the complex step differentiates through it)."""
-        return self.laws(*self.hip_angles(x), t - self.t_origin)
+        if self.hip_only:
+            return self.laws(*self.hip_angles(x), t - self.t_origin)
+        return self.laws.each(*self.joint_angles(x), t - self.t_origin)
 
     def begin_step(self, t0: float) -> None:
         """A step begins at ``t0`` [s]: the origin of the time a ``time_reference`` law
@@ -134,16 +225,21 @@ class Actuators:
         if self.limit:  # rows of the absolute leg angles, swing row first, / m_foot
             col = np.zeros(self.n)
             col[0] = 1.0
-        else:
+        elif self.hip_only:
             col = self.ddelta_dq
+        else:
+            return self.B @ tau
         return col * np.sum(tau)
 
     def power(self, t, x) -> float:
-        """Mechanical power of the joint torques [W]: ``tau * ddelta`` (0 for torques scaled
-        by a massless foot's mass: they do no work in the limit)."""
+        """Mechanical power of the joint torques [W]: ``sum_k tau_k ddelta_k`` (0 for
+        torques scaled by a massless foot's mass: they do no work in the limit)."""
         if self.limit or not self.spec.torques:
             return 0.0
-        return float(np.real(np.sum(self.torques(t, x)) * self.hip_angles(x)[1]))
+        if self.hip_only:
+            return float(np.real(np.sum(self.torques(t, x)) * self.hip_angles(x)[1]))
+        ddeltas = self.joint_angles(x)[1]
+        return float(np.real(np.sum(self.torques(t, x) * np.asarray(ddeltas))))
 
     def added_acceleration(self, t, x, constraint=None, M=None):
         """``M^-1 B tau`` (n,) [rad/s^2]; in a phase holding a constraint with gradient
@@ -171,11 +267,15 @@ class Actuators:
         if self.torque_jacobian is None or constraint is not None:
             return complex_step_jacobian(
                 lambda z: self.added_acceleration(t, z, constraint), x)
+        dtau = np.asarray(self.torque_jacobian(t, x), float)
+        if not self.limit and not self.hip_only:
+            return torque_chain_jacobian(self.fns["matrices"], x,
+                                         self.generalised_force(t, x), self.B @ dtau)
         B = self.ddelta_dq
         if self.limit:  # rows of the absolute leg angles, swing row first, / m_foot
             B = np.zeros(self.n)
             B[0] = 1.0
-        dtau = np.sum(np.asarray(self.torque_jacobian(t, x), float), axis=0)
+        dtau = np.sum(dtau, axis=0)
         return torque_chain_jacobian(self.fns["matrices"], x, self.generalised_force(t, x),
                                      np.outer(B, dtau))
 
