@@ -187,11 +187,11 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     five_link = st.free_knees and st.foot == "point"
     flat = st.foot == "flat" and not st.knee
     kneed = st.knee and not five_link and st.foot == "point"
-    if not five_link and ((st.knee and not kneed) or st.torso
+    if not five_link and ((st.knee and not kneed) or (st.torso and (st.knee or flat))
                           or not (st.foot == "point" or flat)):
         raise ContactSceneError(f"scene '{scene.name}': walker.actuation: the contact view "
-                                "carries actuators on straight legs with point feet and no "
-                                "torso, a hip torque on kneed legs with point feet, an ankle "
+                                "carries actuators on straight legs with point feet (an upper "
+                                "body on a bisecting hip too), a hip torque on kneed legs with point feet, an ankle "
                                 "push-off or a hip torque on flat feet, and joint torques on "
                                 "free-jointed (five-link) bipeds, only (the rigid view has "
                                 "them too)")
