@@ -145,7 +145,7 @@ def contact_setup(scene: Scene) -> ContactSetup:
     ------
     ContactSceneError
         No ``contact`` section, a walker with actuators the contact view does not carry
-        (knees, arc or flat feet, a torso; a pinned or non-ideal start), a
+        (knees, arc feet, a torso on knees or flat feet; a pinned or non-ideal start), a
         walker with a massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).
@@ -187,12 +187,13 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     five_link = st.free_knees and st.foot == "point"
     flat = st.foot == "flat" and not st.knee
     kneed = st.knee and not five_link and st.foot == "point"
-    if not five_link and ((st.knee and not kneed) or st.torso
+    if not five_link and ((st.knee and not kneed) or (st.torso and (st.knee or flat))
                           or not (st.foot == "point" or flat)):
         raise ContactSceneError(f"scene '{scene.name}': walker.actuation: the contact view "
-                                "carries actuators on straight legs with point feet and no "
-                                "torso, a hip torque on kneed legs with point feet, an ankle "
-                                "push-off or a hip torque on flat feet, and joint torques on "
+                                "carries actuators on straight legs with point feet (an upper "
+                                "body on a bisecting hip too), a hip torque on kneed legs with "
+                                "point feet, an ankle push-off or a hip torque on flat feet, "
+                                "and joint torques on "
                                 "free-jointed (five-link) bipeds, only (the rigid view has "
                                 "them too)")
     if cs.pin_stance_until != "none":
@@ -253,7 +254,7 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     ------
     ContactSceneError
         No ``contact`` section, a walker with actuators the contact view does not carry
-        (knees, arc or flat feet, a torso; a pinned or non-ideal start), a
+        (knees, arc feet, a torso on knees or flat feet; a pinned or non-ideal start), a
         walker with a massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).
