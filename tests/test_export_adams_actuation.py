@@ -103,24 +103,40 @@ def powered(tmp_path_factory, compass_start):
 
 
 class AdamsState:
-    """A planar state of the compass walker as the dataset's markers see it (mm, rad):
-    the hip point, the legs' absolute angles and rates, each CONTACT's normal force."""
+    """A planar state of the walker as the dataset's markers see it (mm, rad): the hip
+    point and its velocity, each link's absolute angle and rate (``psi``, ``w`` by link
+    name), each CONTACT's normal force; the markers placed along the links as the writer
+    places them (joint, knee, foot)."""
 
     def __init__(self, mb, hip, vhip, psi, w, forces):
         ids = part_ids(mb)
-        self.L = mb.leg_length_m * MM
         self.part = {1: (0.0, 0.0)}
         self.pos, self.vel = {101: np.zeros(2)}, {101: np.zeros(2)}
-        for g in ("leg1", "leg2"):
-            p = ids[g]
-            self.part[p] = (psi[g], w[g])
-            e = np.array([math.sin(psi[g]), -math.cos(psi[g])])
-            de = w[g] * np.array([math.cos(psi[g]), math.sin(psi[g])])
-            self.pos[marker_id(p, "joint")] = np.asarray(hip, float)
-            self.vel[marker_id(p, "joint")] = np.asarray(vhip, float)
-            self.pos[marker_id(p, "foot")] = np.asarray(hip, float) + self.L * e
-            self.vel[marker_id(p, "foot")] = np.asarray(vhip, float) + self.L * de
+        frames = {}
+        for ln in mb.links:  # parents first (Multibody order)
+            if ln.parent == "hip":
+                p, v = np.asarray(hip, float), np.asarray(vhip, float)
+            else:
+                pp, pv = frames[ln.parent]
+                e, de = self._axis(psi[ln.parent], w[ln.parent])
+                p, v = pp + ln.joint_from_parent_m * MM * e, pv + ln.joint_from_parent_m * MM * de
+                self.pos[marker_id(ids[ln.parent], "knee")] = p
+                self.vel[marker_id(ids[ln.parent], "knee")] = v
+            frames[ln.name] = (p, v)
+            pid = ids[ln.name]
+            self.part[pid] = (psi[ln.name], w[ln.name])
+            self.pos[marker_id(pid, "joint")], self.vel[marker_id(pid, "joint")] = p, v
+            if ln.foot_m is not None:
+                e, de = self._axis(psi[ln.name], w[ln.name])
+                self.pos[marker_id(pid, "foot")] = p + ln.foot_m * MM * e
+                self.vel[marker_id(pid, "foot")] = v + ln.foot_m * MM * de
         self.forces = forces
+
+    @staticmethod
+    def _axis(psi, w):
+        """The link's axis (joint -> foot) and its rate of change."""
+        return (np.array([math.sin(psi), -math.cos(psi)]),
+                w * np.array([math.cos(psi), math.sin(psi)]))
 
     def namespace(self, variables):
         def az(i, j):
@@ -134,11 +150,15 @@ class AdamsState:
                 memo[v] = evaluate(variables[v], ns)
             return memo[v]
 
-        ns = {"AZ": az, "WZ": lambda i, j, k: self.part[i // 100][1] - self.part[j // 100][1],
+        def vrel(i, j=None):
+            return self.vel[i] - (0.0 if j is None else self.vel[j])
+
+        ns = {"AZ": az, "ATAN2": math.atan2,
+              "WZ": lambda i, j, k: self.part[i // 100][1] - self.part[j // 100][1],
               "DX": lambda i, j: self.pos[i][0] - self.pos[j][0],
               "DY": lambda i, j: self.pos[i][1] - self.pos[j][1],
               "DM": lambda i, j: float(np.hypot(*(self.pos[i] - self.pos[j]))),
-              "VX": lambda i: self.vel[i][0], "VY": lambda i: self.vel[i][1],
+              "VX": lambda i, j=None: vrel(i, j)[0], "VY": lambda i, j=None: vrel(i, j)[1],
               "VM": lambda i: float(np.hypot(*self.vel[i])),
               "CONTACT": lambda c, jflag, comp, rm: self.forces.get(c, 0.0),
               "VARVAL": varval, "MIN": min, "MAX": max,
@@ -327,3 +347,70 @@ def test_refused_actuation_in_one_line(tmp_path, change, word):
     with pytest.raises(ValueError, match=word):
         export_stage.run(scene, tmp_path / "runs", "adm")
     assert not list((tmp_path / "runs").rglob("walker.a*"))
+
+
+def test_five_link_joint_torques_equal_walkerlab_laws():
+    """configs/rabbit.yaml (five links: free knees, a torso; four PD laws on phase tables
+    of the virtual stance leg's angle, saturated at 150 N m): SFORCE/11-14 on the physical
+    joints (each leg's hip against the torso, each knee) evaluated at 30 states equal
+    walkerlab's laws (:meth:`TorqueLaws.each` on the joints of
+    :data:`walkerlab.config.actuation.FIVE_LINK_JOINTS` in the role the contact forces
+    give), the phase variable ``atan2(dx, -dy)`` of the hip -> stance foot line.  Was
+    refused ("free knees ... need a user subroutine")."""
+    from walkerlab.config.actuation import FIVE_LINK_JOINTS
+    from walkerlab.export.adams import JOINT_SFORCE, AdamsStart
+
+    scene = load_scene(ROOT / "configs" / "rabbit.yaml")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    mb = multibody(data)
+    names = [ln.name for ln in mb.links]
+    # a stand-in start (the laws do not read it): the gait search is not this test's
+    start = AdamsStart((0.1, 0.75), (0.7, 0.0), dict.fromkeys(names, 0.1),
+                       dict.fromkeys(names, 0.0), None, 0.1, 0.37, (1.0, 1.0))
+    adm = adm_text(scene, mb, data, "rabbit", "test", start)
+    assert all(len(ln) <= LINE_WIDTH for ln in adm.splitlines())
+    model = read_adm(adm)
+    v = model.functions()
+    ids = part_ids(mb)
+    laws = TorqueLaws(scene.walker.actuation.torques)
+    rng = np.random.default_rng(5)
+    roles_seen = set()
+    for n in range(30):
+        psi = {"leg1_thigh": rng.uniform(-0.6, 0.6), "leg2_thigh": rng.uniform(-0.6, 0.6),
+               "torso": rng.uniform(-0.3, 0.3)}
+        psi["leg1_shank"] = psi["leg1_thigh"] - rng.uniform(0, 0.8)
+        psi["leg2_shank"] = psi["leg2_thigh"] - rng.uniform(0, 0.8)
+        w = {k: rng.uniform(-3, 3) for k in psi}
+        stance = "leg1" if n % 2 else "leg2"
+        forces = {1: 300.0} if stance == "leg1" else {2: 300.0}
+        st = AdamsState(mb, (0.0, 800.0), (700.0, 10.0), psi, w, forces)
+        ns = st.namespace(v)
+        role = {"stance": stance, "swing": "leg2" if stance == "leg1" else "leg1"}
+        deltas, rates = [], []
+        for t in scene.walker.actuation.torques:
+            r, kind = t.joint.split("_")
+            first, second = (f"{role[r]}_{x.split('_')[1]}" if x != "torso" else x
+                             for x in FIVE_LINK_JOINTS[t.joint])
+            deltas.append(psi[second] - psi[first])
+            rates.append(w[second] - w[first])
+        foot = st.pos[marker_id(ids[f"{stance}_shank"], "foot")]
+        dfoot = st.vel[marker_id(ids[f"{stance}_shank"], "foot")] - np.array([700.0, 10.0])
+        dx, dy = foot - np.array([0.0, 800.0])
+        s = math.atan2(dx, -dy)
+        ds = (dx * dfoot[1] - dfoot[0] * dy) / (dx * dx + dy * dy)
+        assert ns["VARVAL"](ACT_VARIABLES["phase"]) == pytest.approx(s, abs=1e-14)
+        taus = laws.each(deltas, rates, s, ds) * MM
+        joints = [t.joint for t in scene.walker.actuation.torques]
+        for (kind, g), sid in JOINT_SFORCE.items():
+            sf = model.get("SFORCE", sid)
+            r = "stance" if g == stance else "swing"
+            want = float(sum(tau for tau, j in zip(taus, joints) if j == f"{r}_{kind}"))
+            got = evaluate(sf.args["FUNCTION"][0], ns)
+            assert math.isclose(got, want, rel_tol=1e-9, abs_tol=5e-3), (kind, g, got, want)
+            first = "torso" if kind == "hip" else f"{g}_thigh"
+            second = f"{g}_thigh" if kind == "hip" else f"{g}_shank"
+            assert sf.integer("I") == marker_id(ids[second], "joint")
+            assert sf.integer("J") == marker_id(ids[first], "joint" if kind == "hip"
+                                                else "knee")
+            roles_seen.add((r, abs(want) == 150.0 * MM))
+    assert {("stance", False), ("swing", False)} <= roles_seen

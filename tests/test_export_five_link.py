@@ -202,22 +202,6 @@ def test_motors_on_the_actuated_joints(exported):
             np.testing.assert_allclose(Q, expect, atol=1e-12)
 
 
-def test_adams_export_refuses_a_five_link_biped_in_one_line(tmp_path):
-    """``export --format adm`` of RABBIT: one line saying why (its phase-variable controller
-    switches the stance leg at every heel strike; a dataset would need a user subroutine),
-    no file left behind."""
-    from typer.testing import CliRunner
-
-    from walkerlab.cli import app
-
-    r = CliRunner().invoke(app, ["export", str(ROOT / "configs" / "rabbit.yaml"), "--format",
-                                 "adm", "--runs-dir", str(tmp_path)])
-    assert r.exit_code != 0
-    msg = r.output.strip()
-    assert "walker.leg.knee.lock" in msg and "subroutine" in msg and "\n" not in msg
-    assert not list(tmp_path.rglob("walker.adm")) and not list(tmp_path.rglob("walker.acf"))
-
-
 @pytest.mark.slow  # 40-90 s: 4.3 s of MuJoCo (20000 steps of 0.22 ms), the PD laws evaluated
 #                   in Python at every step
 def test_rabbit_walks_in_mujoco_with_its_controller(tmp_path, monkeypatch):

@@ -9,7 +9,8 @@ com_*.html): ``UNITS``, ``PART`` (``MASS``, ``CM``, ``IP``, ``QG``, ``REULER``, 
 (``JGRAVITY``), ``GRAPHICS`` (``ELLIPSOID``, ``BOX``), ``CONTACT`` (``IGEOM``, ``JGEOM``,
 ``IMPACT``, ``STIFFNESS``, ``DAMPING``, ``DMAX``, ``EXPONENT``, ``COULOMB_FRICTION``,
 ``MU_STATIC``, ``MU_DYNAMIC``, ``STICTION_TRANSITION_VELOCITY``,
-``FRICTION_TRANSITION_VELOCITY``), ``VARIABLE``, ``REQUEST`` (``F2``.. ``F8``),
+``FRICTION_TRANSITION_VELOCITY``), ``VARIABLE``, ``GFORCE`` (``I``, ``JFLOAT``, ``RM``,
+``FX``.. ``TZ``), ``MARKER/FLOATING``, ``REQUEST`` (``F2``.. ``F8``),
 ``OUTPUT`` and ``END``; commands ``SIMULATE/INITIAL_CONDITIONS``, ``DEACTIVATE/JOINT``,
 ``SIMULATE/DYNAMICS`` (``END``, ``STEPS``) and ``STOP``.  A line that starts with ``,``
 continues the statement above it; ``!`` starts a comment.
@@ -49,6 +50,16 @@ hip / knee joints                      JOINT/REVOLUTE I (child), J (parent)   -
 ``contact.friction_velocity_*``        CONTACT FRICTION_TRANSITION_VELOCITY   mm/s
 ``walker.springs`` (hip)               SPRINGDAMPER/ROTATIONAL KT, CT, ANGLE  N mm/rad, rad
 ``contact.knee_stop`` (kneed)          SFORCE/ROTATION FUNCTION=-IMPACT(..)   N mm, rad
+``walker.actuation.torques`` (hip)   SFORCE/10 ROTATION I leg1, J leg2,     N mm, rad
+                                       FUNCTION = role sign x the laws' sum
+                                       (VARIABLEs of AZ, WZ, MIN, MAX, IF)
+five-link ``stance_hip`` .. ``swing_   SFORCE/11-14 ROTATION on each leg's    N mm, rad
+knee``                                 hip (I thigh, J torso) and knee (I
+                                       shank, J thigh), the law of its role
+``walker.actuation.push_off``          GFORCE/1, 2 at the stance foot, along  N
+                                       foot -> hip: P / T while the swing
+                                       foot's touchdown is predicted < T
+``contact.push_off_duration_s``        the pulse's T (VARIABLE/332)           s
 rigid gait start (x ``contact_sim.     PART QG, REULER, VX, VY (CM), WZ       mm, deg, mm/s,
 initial_rate_scale``)                                                         rad/s
 ``contact_sim.n_strides``              acf SIMULATE/DYNAMICS END, STEPS       s
@@ -66,6 +77,24 @@ spheres of radius ``L/1000`` (the paper's 1 mm bevel) whose centre is the model'
 and the patches' top face lies that radius below the ground line, so the sphere touches where
 the model's point foot does; the temporary revolute joint pinning the stance foot (JOINT/99)
 holds during the initial-conditions analysis and is deactivated by the .acf before the run.
+
+Actuation (``walker.actuation``; every expression a ``VARIABLE`` of Adams runtime functions,
+each line within 80 columns, no expression continued over lines): the roles are not a
+latched state but a test of the feet's normal contact forces (``CONTACT(id, 0, 1, 0)``
+summed over each foot's CONTACTs): the foot carrying more is the stance foot (a tie, as at
+the start, is leg2's), so the roles swap as the leading foot's force passes the trailing
+foot's at heel strike; ``VARIABLE/303`` is +1 while leg2 stands, -1 while leg1 stands.  The
+laws are walkerlab's (:class:`walkerlab.models.actuation.TorqueLaws`): ``constant - K (delta
+- rest) - D ddelta``, or the PD tracking of a phase table, written exactly in truncated-power
+form (:func:`table_terms`; the phase variable the stance leg's angle, a five-link biped's the
+hip -> stance foot line's ``ATAN2``), each saturated by ``MIN``/``MAX``.  The push-off is a
+pulse ``P / T`` at the stance foot along the line to the hip, on while the swing foot is
+above ground, at least :data:`PUSH_MIN_STEP_M` ahead, and its penetration extrapolated ``T``
+ahead at its rate is positive (the contact view's start,
+:func:`walkerlab.integrate.contact_powered.pulse_lead`); it ends at the touchdown (the
+contact view runs a pulse that straddles the touchdown to its end).  Not written (refused in
+one line): time references (the time since heel strike is a latched state), a pulse of
+length 0 (an impulse), an ankle push-off (flat feet).
 """
 
 from __future__ import annotations
@@ -128,18 +157,13 @@ def check_adams_exportable(mb) -> None:
     Raises
     ------
     ValueError
-        Arc or flat feet, free knees (a five-link biped: its controller has no dataset
-        form), an upper body (its bisecting-hip coupling is not written).
+        Arc or flat feet, an upper body on a bisecting hip (its coupling is not
+        written).
     """
     if mb.foot != "point" and not (mb.foot == "arc" and mb.foot_radius_m == 0):  # R = 0
         raise ValueError(f"walker.leg.foot: {mb.foot} feet are not exported to ADAMS yet "
                          "(--format adm writes point feet only)")
-    if mb.knee and not mb.knee_stop:
-        raise ValueError("walker.leg.knee.lock: free knees (five-link biped) are not exported "
-                         "to ADAMS: its torques follow a phase variable whose stance leg "
-                         "switches at each heel strike, which needs a user subroutine (use "
-                         "--format mjcf)")
-    if mb.couplings or any(ln.name == "torso" for ln in mb.links):
+    if mb.couplings:
         raise ValueError("walker.torso: an upper body is not exported to ADAMS yet (its "
                          "bisecting hip would need a COUPLER); export a walker without it")
 
@@ -454,7 +478,7 @@ def _forces(mb, scene: Scene, ids: dict) -> list[str]:
                  if val > 0]  # KT, CT > 0 when given (default 0)
         out += _stmt(f"SPRINGDAMPER/{i + 1}, ROTATIONAL, I={marker_id(a, 'joint')}, J={jm}",
                      *coefs, f"ANGLE={_f(sp.rest_angle_rad)}")
-    if mb.knee:
+    if mb.knee and mb.knee_stop:
         from walkerlab.models.contact.rigid_limit import contact_si
 
         _, ks = contact_si(scene.contact or ContactSettings())
@@ -550,9 +574,6 @@ def check_adams_actuation(scene: Scene) -> None:
     if act is None:
         return
     for i, t in enumerate(act.torques):
-        if t.joint != "hip":
-            raise ValueError(f"walker.actuation.torques.{i}.joint: {t.joint} (a five-link "
-                             "joint) is not exported to ADAMS (use --format mjcf)")
         if t.law.time_reference is not None:
             raise ValueError(f"walker.actuation.torques.{i}.law.time_reference: the time "
                              "since heel strike is a state latched at touchdown that the "
@@ -655,6 +676,37 @@ def _reference(k: int, table, phase: str, dphase: str) -> list[str]:
     return out
 
 
+def _law(k: int, t, delta: int, ddelta: int) -> list[str]:
+    """Actuator ``k``'s law (:class:`walkerlab.config.actuation.JointTorque` ``t``) as
+    VARIABLEs on its joint's angle and rate (VARIABLEs ``delta``, ``ddelta``) and the phase
+    variable (:data:`ACT_VARIABLES` ``phase``, ``dphase``); its torque [N mm] in
+    ``hip_torque_ids(k)["tau"]``."""
+    V = ACT_VARIABLES
+    law, ids = t.law, hip_torque_ids(k)
+    base = ACT_BLOCK * (k + 1)
+    out = []
+    if law.reference is not None:
+        out.append(f"! actuator {k} ({t.joint}): -K (delta - h(s)) - D (ddelta - h'(s) ds)")
+        out += _reference(k, law.reference, f"VARVAL({V['phase']})", f"VARVAL({V['dphase']})")
+        err = f"VARVAL({delta})-VARVAL({ids['h']})"
+        derr = f"VARVAL({ddelta})-VARVAL({ids['dh']})"
+    else:
+        out.append(f"! actuator {k} ({t.joint}): constant - K (delta - rest) - D ddelta")
+        err = f"VARVAL({delta}){_plus(-law.rest_angle_rad)}"
+        derr = f"VARVAL({ddelta})"
+    out += [_var(ids["error"], err), _var(ids["rate_error"], derr),
+            _var(base + 102, _f(law.constant_n_m * MM)),
+            _var(base + 103, f"{_f(law.stiffness_n_m_per_rad * MM)}*VARVAL({ids['error']})"),
+            _var(base + 104, f"{_f(law.damping_n_m_s_per_rad * MM)}*VARVAL({ids['rate_error']})")]
+    raw = f"VARVAL({base + 102})-VARVAL({base + 103})-VARVAL({base + 104})"
+    if t.max_torque_n_m is None:
+        return out + [_var(ids["tau"], raw)]
+    # saturation |tau| <= max_torque_n_m
+    return out + [_var(base + 105, raw), _var(base + 106, _f(t.max_torque_n_m * MM)),
+                  _var(ids["tau"], f"MIN(MAX(VARVAL({base + 105}),-VARVAL({base + 106})),"
+                       f"VARVAL({base + 106}))")]
+
+
 def _hip_torques(act, m1: int, m2: int) -> list[str]:
     """The hip torques' laws as VARIABLEs and one SFORCE between leg1 (I) and leg2 (J)."""
     V = ACT_VARIABLES
@@ -666,39 +718,72 @@ def _hip_torques(act, m1: int, m2: int) -> list[str]:
            _var(V["ddelta"], f"VARVAL({V['sign']})*WZ({m1},{m2},{m2})"),
            _var(V["phase"], f"IF(VARVAL({V['sign']}):AZ({m1},101),0,AZ({m2},101))"),
            _var(V["dphase"], f"IF(VARVAL({V['sign']}):WZ({m1},101,101),0,WZ({m2},101,101))")]
-    taus = []
     for k, t in enumerate(act.torques):
-        law, ids = t.law, hip_torque_ids(k)
-        base = ACT_BLOCK * (k + 1)
-        if law.reference is not None:
-            out.append(f"! actuator {k}: -K (delta - h(s)) - D (ddelta - h'(s) ds), h the "
-                       "phase table")
-            out += _reference(k, law.reference, f"VARVAL({V['phase']})",
-                              f"VARVAL({V['dphase']})")
-            err = f"VARVAL({V['delta']})-VARVAL({ids['h']})"
-            derr = f"VARVAL({V['ddelta']})-VARVAL({ids['dh']})"
-        else:
-            out.append(f"! actuator {k}: constant - K (delta - rest) - D ddelta")
-            err = f"VARVAL({V['delta']}){_plus(-law.rest_angle_rad)}"
-            derr = f"VARVAL({V['ddelta']})"
-        out += [_var(ids["error"], err), _var(ids["rate_error"], derr),
-                _var(base + 102, _f(law.constant_n_m * MM)),
-                _var(base + 103, f"{_f(law.stiffness_n_m_per_rad * MM)}*VARVAL({ids['error']})"),
-                _var(base + 104, f"{_f(law.damping_n_m_s_per_rad * MM)}*"
-                     f"VARVAL({ids['rate_error']})")]
-        raw = f"VARVAL({base + 102})-VARVAL({base + 103})-VARVAL({base + 104})"
-        if t.max_torque_n_m is None:
-            out.append(_var(ids["tau"], raw))
-        else:  # saturation |tau| <= max_torque_n_m
-            out += [_var(base + 105, raw), _var(base + 106, _f(t.max_torque_n_m * MM)),
-                    _var(ids["tau"], f"MIN(MAX(VARVAL({base + 105}),-VARVAL({base + 106})),"
-                         f"VARVAL({base + 106}))")]
-        taus.append(f"VARVAL({ids['tau']})")
-    out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM, taus)
+        out += _law(k, t, V["delta"], V["ddelta"])
+    out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM,
+                      [f"VARVAL({hip_torque_ids(k)['tau']})" for k in range(len(act.torques))])
     out += ["! their sum on leg1 (I) about z, the reaction on leg2 (J): sign * tau (the",
             "! swing leg's torque on leg1 while it swings, minus it while leg1 stands)",
             f"SFORCE/{HIP_SFORCE}, ROTATION, I={m1}, J={m2}",
             f", FUNCTION=VARVAL({V['sign']})*VARVAL({HIP_TORQUE_SUM})"]
+    return out
+
+
+#: VARIABLE ids (angle [rad], rate [rad/s]) of a five-link biped's role joints
+#: (:data:`walkerlab.config.actuation.FIVE_LINK_JOINTS`: hip = thigh - torso, knee = shank -
+#: thigh) and of the sums of their laws [N mm].
+ROLE_JOINT_VARIABLES = {"stance_hip": (370, 371), "swing_hip": (372, 373),
+                        "stance_knee": (374, 375), "swing_knee": (376, 377)}
+ROLE_TORQUE_SUM = {"stance_hip": 9101, "swing_hip": 9102, "stance_knee": 9103,
+                   "swing_knee": 9104}
+#: SFORCE ids of a five-link biped's physical joints: (kind, leg) -> id.
+JOINT_SFORCE = {("hip", "leg1"): 11, ("hip", "leg2"): 12, ("knee", "leg1"): 13,
+                ("knee", "leg2"): 14}
+
+
+def _joint_torques(mb, act, ids: dict, feet: dict) -> list[str]:
+    """A five-link biped's joint torques: the role joints' angles picked by the role sign,
+    the phase variable the virtual stance leg's angle, one SFORCE per physical joint."""
+    V = ACT_VARIABLES
+    th = {g: marker_id(ids[f"{g}_thigh"], "joint") for g in ("leg1", "leg2")}
+    kn = {g: marker_id(ids[f"{g}_thigh"], "knee") for g in ("leg1", "leg2")}
+    sh = {g: marker_id(ids[f"{g}_shank"], "joint") for g in ("leg1", "leg2")}
+    to = marker_id(ids["torso"], "joint")
+    sgn = f"VARVAL({V['sign']})"
+    out = ["! joint torques (walker.actuation.torques) [N mm] of a five-link biped: +tau on",
+           "! the second link of the joint (thigh, shank), -tau on the first (torso,",
+           "! thigh); the joints follow the roles: stance_hip = stance thigh - torso,",
+           "! swing_knee = swing shank - swing thigh, ... (the role sign picks the leg);",
+           "! the phase variable the angle of the line from the hip to the stance foot",
+           "! from the downward vertical, ATAN2(dx, -dy), and its rate"]
+    for g, (a, r) in (("leg1", (380, 382)), ("leg2", (381, 383))):
+        f, h = feet[g], th[g]
+        out += [_var(a, f"ATAN2(DX({f},{h}),-DY({f},{h}))"),
+                _var(r + 4, f"DX({f},{h})*VY({f},{h})-VX({f},{h})*DY({f},{h})"),
+                _var(r, f"VARVAL({r + 4})/DM({f},{h})**2")]
+    out += [_var(V["phase"], f"IF({sgn}:VARVAL(380),0,VARVAL(381))"),
+            _var(V["dphase"], f"IF({sgn}:VARVAL(382),0,VARVAL(383))")]
+    angle = {"hip": lambda g: (f"AZ({th[g]},{to})", f"WZ({th[g]},{to},{to})"),
+             "knee": lambda g: (f"AZ({sh[g]},{kn[g]})", f"WZ({sh[g]},{kn[g]},{kn[g]})")}
+    for joint, (a, r) in ROLE_JOINT_VARIABLES.items():
+        role, kind = joint.split("_")
+        first, second = ("leg1", "leg2") if role == "stance" else ("leg2", "leg1")
+        (a1, r1), (a2, r2) = angle[kind](first), angle[kind](second)
+        out += [_var(a, f"IF({sgn}:{a1},0,{a2})"), _var(r, f"IF({sgn}:{r1},0,{r2})")]
+    for k, t in enumerate(act.torques):
+        out += _law(k, t, *ROLE_JOINT_VARIABLES[t.joint])
+    for joint, total in ROLE_TORQUE_SUM.items():
+        taus = [f"VARVAL({hip_torque_ids(k)['tau']})" for k, t in enumerate(act.torques)
+                if t.joint == joint]
+        out += _chain_sum(total - 100 + 10 * list(ROLE_TORQUE_SUM).index(joint), total, taus)
+    for (kind, g), sid in JOINT_SFORCE.items():
+        i_m, j_m = (th[g], to) if kind == "hip" else (sh[g], kn[g])
+        st, sw = ROLE_TORQUE_SUM[f"stance_{kind}"], ROLE_TORQUE_SUM[f"swing_{kind}"]
+        a, b = (st, sw) if g == "leg1" else (sw, st)  # sign < 0: leg1 stands
+        out += [f"! {g}'s {kind}: the {'stance' if g == 'leg1' else 'swing'} law while leg1 "
+                "stands, else the other",
+                f"SFORCE/{sid}, ROTATION, I={i_m}, J={j_m}",
+                f", FUNCTION=IF({sgn}:VARVAL({a}),0,VARVAL({b}))"]
     return out
 
 
@@ -779,7 +864,12 @@ def _actuation(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: bool) -> li
         cid += count
     out.append(_var(V["sign"], f"IF(VARVAL({V['force_leg1']})-VARVAL({V['force_leg2']}):"
                     "1,1,-1)"))
-    if act.torques:
+    if any(t.joint != "hip" for t in act.torques):
+        if "torso" not in ids or not mb.knee or any(t.joint == "hip" for t in act.torques):
+            raise ValueError("walker.actuation.torques: stance_hip, swing_hip, stance_knee "
+                             "and swing_knee need a five-link biped (free knees, a torso)")
+        out += _joint_torques(mb, act, ids, feet)
+    elif act.torques:
         out += _hip_torques(act, hips["leg1"], hips["leg2"])
     if act.push_off is not None:
         T = (scene.contact or ContactSettings()).push_off_pulse_s()
@@ -837,8 +927,8 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
                 "is not written)"]
     act = getattr(scene.walker, "actuation", None)
     if act is not None:
-        out += ["! walker.actuation: the hip torques (SFORCE/10) and the push-off pulse",
-                "! (GFORCE/1, 2) are written below, after the contacts"]
+        out += ["! walker.actuation: its joint torques (SFORCE) and push-off (GFORCE",
+                "! pulses) are written below, after the contacts"]
     out += _ground(mb, start, lanes)
     out += _parts(mb, start, ids, lanes)
     out += _joints(mb, start, ids)
