@@ -186,7 +186,7 @@ def test_hip_spring_round_trip(tmp_path_factory):
 
 def test_cli_writes_adm_and_acf(tmp_path):
     """``walkerlab export configs/powered_compass.yaml --format adm``: both files, the
-    actuators stated as not exported, no temporary file left."""
+    push-off written (GFORCE pulses, no warning), no temporary file left."""
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
@@ -197,7 +197,9 @@ def test_cli_writes_adm_and_acf(tmp_path):
     folder = tmp_path / "powered_compass"
     assert f"wrote {folder / 'walker.adm'}" in r.output
     adm = (folder / "walker.adm").read_text()
-    assert "NOT exported" in adm and parse_acf((folder / "walker.acf").read_text())
+    assert "NOT exported" not in adm and "warning" not in r.output
+    assert set(read_adm(adm).by_kind["GFORCE"]) == {1, 2}
+    assert parse_acf((folder / "walker.acf").read_text())
     assert not list(folder.glob(".*.tmp"))
 
 

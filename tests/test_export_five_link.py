@@ -165,17 +165,20 @@ def test_urdf_mass_matrix_is_the_independent_one(exported):
 
 
 def test_motors_on_the_actuated_joints(exported):
-    """Four motors on the physical joints (both legs' hips against the torso, both knees), no
-    knee limits (free knees), no coupling of the torso; a motor's control acts on the joint
-    as the law's torque (MuJoCo's actuator force mapped to walkerlab's coordinates is +u on
-    the thigh, -u on the torso; +u on the shank, -u on the thigh)."""
+    """Four motors on the physical joints (both legs' hips against the torso, both knees),
+    their control range the laws' saturation (150 N m), no knee limits (free knees), no
+    coupling of the torso; a motor's control acts on the joint as the law's torque (MuJoCo's
+    actuator force mapped to walkerlab's coordinates is +u on the thigh, -u on the torso; +u
+    on the shank, -u on the thigh), clamped at the saturation."""
     mujoco = pytest.importorskip("mujoco")
     scene, urdf, mjcf = exported
     text = Path(mjcf).read_text()
     for leg in ("leg1", "leg2"):
-        assert f'<motor name="{leg}_hip_motor" tendon="{leg}_hip_torso" gear="1"/>' in text
-        assert f'<motor name="{leg}_knee_motor" joint="{leg}_knee" gear="1"/>' in text
-    assert "range=" not in text and "<equality>" not in text
+        lim = 'ctrllimited="true" ctrlrange="-150.0 150.0"'
+        assert (f'<motor name="{leg}_hip_motor" tendon="{leg}_hip_torso" gear="1" {lim}/>'
+                in text)
+        assert f'<motor name="{leg}_knee_motor" joint="{leg}_knee" gear="1" {lim}/>' in text
+    assert " range=" not in text and "<equality>" not in text
     assert 'name="hip_actuation"' not in text
     assert "Motor leg1_hip_motor" in Path(urdf).read_text()
     assert 'type="revolute"' not in Path(urdf).read_text()  # free knees: continuous
@@ -189,29 +192,14 @@ def test_motors_on_the_actuated_joints(exported):
     want = {"leg1_hip_motor": ("leg1_thigh", "torso"), "leg2_knee_motor": ("leg2_shank",
                                                                            "leg2_thigh")}
     for motor, (plus, minus) in want.items():
-        data.ctrl[:] = 0.0
-        data.ctrl[model.actuator(motor).id] = 7.0
-        mujoco.mj_forward(model, data)
-        Q = T.T @ data.qfrc_actuator
-        expect = np.zeros(7)
-        expect[coords.index(plus)], expect[coords.index(minus)] = 7.0, -7.0
-        np.testing.assert_allclose(Q, expect, atol=1e-12)
-
-
-def test_adams_export_refuses_a_five_link_biped_in_one_line(tmp_path):
-    """``export --format adm`` of RABBIT: one line saying why (its phase-variable controller
-    switches the stance leg at every heel strike; a dataset would need a user subroutine),
-    no file left behind."""
-    from typer.testing import CliRunner
-
-    from walkerlab.cli import app
-
-    r = CliRunner().invoke(app, ["export", str(ROOT / "configs" / "rabbit.yaml"), "--format",
-                                 "adm", "--runs-dir", str(tmp_path)])
-    assert r.exit_code != 0
-    msg = r.output.strip()
-    assert "walker.leg.knee.lock" in msg and "subroutine" in msg and "\n" not in msg
-    assert not list(tmp_path.rglob("walker.adm")) and not list(tmp_path.rglob("walker.acf"))
+        for u, tau in ((7.0, 7.0), (-400.0, -150.0)):  # beyond the saturation: clamped
+            data.ctrl[:] = 0.0
+            data.ctrl[model.actuator(motor).id] = u
+            mujoco.mj_forward(model, data)
+            Q = T.T @ data.qfrc_actuator
+            expect = np.zeros(7)
+            expect[coords.index(plus)], expect[coords.index(minus)] = tau, -tau
+            np.testing.assert_allclose(Q, expect, atol=1e-12)
 
 
 @pytest.mark.slow  # 40-90 s: 4.3 s of MuJoCo (20000 steps of 0.22 ms), the PD laws evaluated

@@ -52,22 +52,29 @@ def test_export_reads_the_gait_of_an_up_to_date_fixedpoint_artifact(tmp_path, mo
     assert calls  # searched again
 
 
-# ------------------------------------------- 6: a powered walker's Adams dataset warns
-def test_adm_export_of_a_powered_walker_on_level_ground_says_it_cannot_walk(tmp_path):
+# --------------------------- 6: a powered walker's Adams dataset carries its actuation
+def test_adm_export_of_a_powered_walker_on_level_ground_carries_its_push_off(tmp_path):
+    """Issue 48: the push-off is written (GFORCE pulses), so no warning any more."""
     code, err, out = _cli("export", POWERED, "--format", "adm", "--runs-dir", tmp_path)
-    assert code == 0 and "walker.adm" in out
-    assert err.startswith("warning: walker.adm holds the PASSIVE walker") and "\n" not in err
-    assert "the push-off" in err and "on level ground the passive walker cannot walk" in err
+    assert code == 0 and "walker.adm" in out and err == ""
+    adm = (Path(tmp_path) / "powered_compass" / "walker.adm").read_text()
+    assert "GFORCE/1," in adm and "GFORCE/2," in adm and "PASSIVE" not in adm
 
 
-def test_adm_warning_names_what_is_left_out_and_is_empty_for_a_passive_walker():
-    from walkerlab.export.adams import actuation_warning
+def test_adm_warning_is_empty_and_what_is_not_written_is_refused():
+    """Push-off and hip torques are written (no warning line); a time reference is not
+    (refused in one line naming the field)."""
+    from walkerlab.export.adams import actuation_warning, check_adams_actuation
 
     d = yaml.safe_load(POWERED.read_text())
     d["slope"] = {"angle_deg": 1.0}
     d["walker"]["actuation"]["torques"] = [{"joint": "hip", "law": {"constant_n_m": 0.1}}]
-    line = actuation_warning(scene_from_dict(d))
-    assert "the push-off and the joint torques" in line and "level ground" not in line
+    assert actuation_warning(scene_from_dict(d)) == ""
+    check_adams_actuation(scene_from_dict(d))
+    d["walker"]["actuation"]["torques"][0]["law"]["time_reference"] = {
+        "time_s": [0.0, 0.4], "hip_angle_rad": [0.1, -0.1]}
+    with pytest.raises(ValueError, match="torques.0.law.time_reference"):
+        check_adams_actuation(scene_from_dict(d))
     assert actuation_warning(load_scene(ROOT / "configs" / "paper.yaml")) == ""
 
 

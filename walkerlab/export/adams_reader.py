@@ -41,7 +41,7 @@ ADM_SUBSET = {
     "UNITS": {"FORCE", "MASS", "LENGTH", "TIME"},
     "PART": {"GROUND", "MASS", "CM", "IP", "QG", "REULER", "VX", "VY", "VZ", "WX", "WY",
              "WZ"},
-    "MARKER": {"PART", "QP", "REULER"},
+    "MARKER": {"PART", "QP", "REULER", "FLOATING"},
     "JOINT": {"REVOLUTE", "FIXED", "PLANAR", "I", "J"},
     "ACCGRAV": {"IGRAVITY", "JGRAVITY", "KGRAVITY"},
     "GRAPHICS": {"ELLIPSOID", "CM", "XSCALE", "YSCALE", "ZSCALE", "BOX", "CORNER", "X", "Y",
@@ -51,6 +51,7 @@ ADM_SUBSET = {
                 "STICTION_TRANSITION_VELOCITY", "FRICTION_TRANSITION_VELOCITY"},
     "SPRINGDAMPER": {"ROTATIONAL", "I", "J", "KT", "CT", "ANGLE"},
     "SFORCE": {"ROTATION", "I", "J", "FUNCTION"},
+    "GFORCE": {"I", "JFLOAT", "RM", "FX", "FY", "FZ", "TX", "TY", "TZ"},
     "VARIABLE": {"FUNCTION"},
     "REQUEST": {"F2", "F3", "F4", "F6", "F7", "F8"},
     "OUTPUT": {"REQSAVE", "GRSAVE"},
@@ -297,6 +298,19 @@ class AdmModel:
         """``{id: (type, I marker, J marker)}``."""
         return {j.id: (j.flags[0], j.integer("I"), j.integer("J"))
                 for j in self.by_kind.get("JOINT", {}).values()}
+
+    def functions(self, kind: str = "VARIABLE") -> dict[int, str]:
+        """``{id: FUNCTION expression}`` of the ``kind`` statements that have one
+        (``VARIABLE``, ``SFORCE``), the expressions as written (Adams Solver function
+        syntax: ``VARVAL``, ``AZ``, ``WZ``, ``IF(e: a, b, c)``, ...)."""
+        return {sid: st.args["FUNCTION"][0] for sid, st in self.by_kind.get(kind, {}).items()
+                if "FUNCTION" in st.args}
+
+    def gforce(self, gid: int) -> dict[str, str]:
+        """A GFORCE's markers (``I``, ``JFLOAT``, ``RM``: ids as strings) and its six
+        component expressions (``FX`` .. ``TZ``)."""
+        g = self.get("GFORCE", gid)
+        return {k: v[0] for k, v in g.args.items()}
 
     def contact_si(self, cid: int) -> dict[str, float]:
         """A CONTACT's IMPACT law and Coulomb friction in SI: ``k`` [N/m^e], ``e``, ``cmax``

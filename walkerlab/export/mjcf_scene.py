@@ -14,7 +14,8 @@ if TYPE_CHECKING:  # the io layer reads the model's data classes, it does not bu
     from walkerlab.walker.multibody import Multibody
 
 __all__ = ["LANE_BITS", "MJCF_DEFAULT_TIMESTEP_S", "MJCF_MIN_INERTIA_KG_M2",
-           "MJCF_MIN_LENGTH_M", "MJCF_MIN_MASS_KG", "MjcfScene", "point_foot_radius"]
+           "MJCF_MIN_LENGTH_M", "MJCF_MIN_MASS_KG", "MjcfScene", "motor_limits",
+           "point_foot_radius"]
 
 #: Floor of a MuJoCo principal inertia [kg m^2] (MuJoCo's mjMINVAL is 1e-15).
 MJCF_MIN_INERTIA_KG_M2 = 1e-12
@@ -101,3 +102,46 @@ def point_foot_radius(mb: Multibody) -> float:
     """Radius [m] of the sphere that stands for a point foot: ``L / 1000`` (the paper's ADAMS
     feet carry a 1 mm bevel on a 1 m leg)."""
     return mb.leg_length_m / 1000
+
+
+def motor_limits(actuation_json: str | None) -> dict[str, float]:
+    """The control limits [N m] of a powered export's motors (``ctrlrange``, by motor name
+    as :func:`walkerlab.export.multibody.motors` names them) from the laws' saturations:
+    a motor's control is the sum of the laws of its joint's present role, each clipped at
+    its ``max_torque_n_m``, so its range is the larger of the roles' sums of limits.  A
+    motor with a law that has no limit (or no law: the push-off's idle hip motor) is left
+    out (unlimited).
+
+    Parameters
+    ----------
+    actuation_json : str or None
+        The scene's ``walker.actuation`` as JSON (:attr:`MjcfScene.actuation_json`).
+
+    Returns
+    -------
+    dict
+        ``{motor name: limit}``; ``hip`` (the torques between the legs), ``leg<i>_hip_motor``
+        (``stance_hip`` / ``swing_hip``), ``leg<i>_knee_motor`` (``stance_knee`` /
+        ``swing_knee``).
+    """
+    import json
+
+    if actuation_json is None:
+        return {}
+    roles: dict[str, list] = {}
+    for t in json.loads(actuation_json).get("torques", []):
+        roles.setdefault(t["joint"], []).append(t.get("max_torque_n_m"))
+
+    def total(joint):
+        lims = roles.get(joint)
+        return None if not lims or None in lims else float(sum(lims))
+
+    out = {}
+    if (hip := total("hip")) is not None:
+        out["hip"] = hip
+    for kind in ("hip", "knee"):
+        pair = [total(f"{r}_{kind}") for r in ("stance", "swing")
+                if f"{r}_{kind}" in roles]
+        if pair and None not in pair:
+            out.update({f"{leg}_{kind}_motor": max(pair) for leg in ("leg1", "leg2")})
+    return out

@@ -50,7 +50,9 @@ a five-link biped's joint torques on the physical joints: ``leg<i>_hip_motor`` o
 ``leg<i>_hip_torso = leg<i>_hip - torso_hip`` (the thigh relative to the torso: ``+u`` on the
 thigh, ``-u`` on the torso) and ``leg<i>_knee_motor`` on the joint ``leg<i>_knee`` (``+u``
 extends it); the loop gives each the torque of its leg's present role (``stance_hip`` of the
-stance leg, ...).  URDF has no actuator element for a torque between two non-adjacent joints:
+stance leg, ...).  A motor whose laws all saturate gets ``ctrllimited``/``ctrlrange`` at
+their limit (:func:`walkerlab.export.mjcf_scene.motor_limits`; MuJoCo clamps the control
+there).  URDF has no actuator element for a torque between two non-adjacent joints:
 the motors are stated in comments (and the laws in the keyframe sidecar).
 
 Bodies off a link's axis sit in place: a link's ``inertial`` origin is its centre of mass
@@ -95,6 +97,7 @@ from walkerlab.export.mjcf_scene import (
     MJCF_MIN_INERTIA_KG_M2,
     MJCF_MIN_MASS_KG,
     MjcfScene,
+    motor_limits,
     point_foot_radius,
 )
 from walkerlab.export.text import arc_feet, comment, header, num, nums
@@ -355,7 +358,10 @@ def mjcf_text(mb: Multibody, name: str, version: str = "", extra: MjcfScene | No
     motor_list = motors(extra.actuation_json if extra is not None else None)
     out += ["    </body>", "  </worldbody>", *_tendons(mb, motor_list)]
     if motor_list:  # the laws live in the custom text, a stepping loop sets the controls
-        out += ["  <actuator>", *(f'    <motor name="{name}" {kind}="{target}" gear="1"/>'
+        lim = motor_limits(extra.actuation_json)  # the saturations: MuJoCo clamps ctrl
+        rng = {n: f' ctrllimited="true" ctrlrange="{nums(-u, u)}"' for n, u in lim.items()}
+        out += ["  <actuator>", *(f'    <motor name="{name}" {kind}="{target}" gear="1"'
+                                  f'{rng.get(name, "")}/>'
                                   for name, kind, target in motor_list), "  </actuator>"]
     out += [*_mjcf_tail(mb, extra), ""]
     return "\n".join(out)

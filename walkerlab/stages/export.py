@@ -18,6 +18,7 @@ from walkerlab.export.adams import (
     acf_text,
     adams_start,
     adm_text,
+    check_adams_actuation,
     check_adams_exportable,
 )
 from walkerlab.export.multibody import (
@@ -73,6 +74,7 @@ def stored_gait(scene: Scene, runs_root: Path | str):
 def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
     """``walker.adm`` and ``walker.acf`` (both built before either is written)."""
     check_adams_exportable(mb)  # before the gait search
+    check_adams_actuation(scene)
     start = adams_start(scene, mb, data, stored_gait(scene, runs_root))
     adm = adm_text(scene, mb, data, name, walkerlab.__version__, start)
     acf = acf_text(scene, start)
