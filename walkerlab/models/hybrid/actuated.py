@@ -34,15 +34,9 @@ def _structure_check(data, spec) -> bool:
             raise ValueError(f"walker.actuation.torques.{i}.joint: {t.joint} is a five-link "
                              "biped's joint (knee.lock: free); a straight-legged walker's is "
                              "hip")
-    if st.foot != "point":
-        raise ValueError("walker.actuation: actuators need point feet today (arc and flat "
-                         "feet: not yet)")
-    if st.knee and st.torso and (spec.push_off is not None or spec.torques):
+    if st.knee and st.torso and spec.torques:
         raise ValueError("walker.actuation: a kneed walker with an upper body takes no "
-                         "actuators today")
-    if st.knee and spec.push_off is not None and st.foot != "point":
-        raise ValueError("walker.actuation.push_off: a kneed walker's push-off needs point "
-                         "feet today")
+                         "torques today")
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
     if any(massless) and not limit:

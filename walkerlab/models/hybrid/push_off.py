@@ -1,0 +1,219 @@
+"""Push-off and heel strike: the step-to-step transition of a powered rigid walker (Kuo
+2002's pre-emptive push-off impulse, then the plastic heel strike), through the generated
+impact maps, for every foot kind.
+
+The push-off is an impulse ``P`` [N s] at the trailing (stance) foot's material contact
+point, directed from that point to the hip, the foot being free for it; then the plastic
+heel strike pins the leading foot.  The contact point is
+
+- a point foot: the foot;
+- an arc foot: the arc's lowest point (the rolling contact, ``stance_contact``);
+- a flat foot: the trailing toe (:class:`FlatPushOff`).
+
+Point and arc feet share one form.  In the extended coordinates ``qe = (q, x_f, y_f)`` (the
+stance foot free, :func:`walkerlab.codegen.symbolic.derive`'s ``De, E``: ``De`` the mass
+matrix, ``E`` the leading foot's material contact point's Jacobian) the trailing contact's
+material point moves at ``(dx_f, dy_f)`` (for an arc the rolling offset's rate cancels its
+spin about its centre), so ``E_f = [0 | I]`` and::
+
+    De (dqe_po - dqe-) = E_f^T P e,        e = (hip - contact) / |hip - contact|
+    [De  -E^T] [dqe+]   [De dqe_po]
+    [E     0 ] [ F  ] = [    0    ]
+
+With ``P = 0`` this is the generated passive heel strike (tests show both to round-off).
+A kneed walker holds its swing knee through both impulses (the constraint's gradient,
+:meth:`PushOffTransition.hold_lock`).  A walker with massless legs (only the hip carries
+mass) has a singular ``De``: its transition is written for the hip mass directly (Kuo 2002,
+Eq. 2 and its appendix).  Flat feet: :class:`FlatPushOff`.
+
+States stay the walker's own (role-ordered ``(2n,)``): nothing here knows their number.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.models.actuation import push_off_impulse
+
+__all__ = ["PushOffTransition", "Transitions"]
+
+
+class Transitions:
+    """Memo of recent transitions (pre-impact state bytes -> result): the reset's result,
+    asked again by the energy ledger and the step table."""
+
+    def transition(self, x) -> dict:
+        """Push-off and heel strike from the pre-impact state ``x`` (2n,).
+
+        Returns
+        -------
+        dict
+            ``x_plus`` (2n,) the post-impact state, roles swapped; ``impulse`` P [N s];
+            ``ke_minus``, ``ke_push_off``, ``ke_plus`` kinetic energies [J] before the
+            push-off, after it and after the heel strike.
+        """
+        x = np.asarray(x)
+        key = None if np.iscomplexobj(x) else x.tobytes()
+        if key is not None and key in self._memo:
+            return self._memo[key]
+        out = self._transition(x)
+        if key is not None:
+            if len(self._memo) >= 256:
+                self._memo.pop(next(iter(self._memo)))
+            self._memo[key] = out
+        return out
+
+    def reset(self, x) -> np.ndarray:
+        """Post-impact state (2n,) after push-off and heel strike (roles swapped)."""
+        return self.transition(x)["x_plus"]
+
+
+@dataclass
+class PushOffTransition(Transitions):
+    """Push-off and heel strike of a point- or arc-footed walker (module docstring).
+
+    Attributes
+    ----------
+    spec : walkerlab.config.actuation.Actuation
+        Its ``push_off`` law (None: ``P = 0``).
+    fns : dict
+        The generated model's functions (``impact_matrices``, ``points``,
+        ``point_velocities``, ``leg_angles``, ``reset``).
+    n : int
+        Number of generalised coordinates.
+    limit : bool
+        The legs are massless (the walker's equations are the limit ``m_foot -> 0``).
+    hip_mass_kg : float
+    """
+
+    spec: object
+    fns: dict
+    n: int
+    limit: bool
+    hip_mass_kg: float
+
+    def __post_init__(self):
+        eye, z = np.eye(self.n), np.zeros(self.n)
+        # the absolute leg angles' Jacobian A = d(psi_sw, psi_st)/dq, exact: the generated
+        # leg angles' rates are linear in dq; the role swap's rate map R = A^-1 S A
+        rows = [self.fns["leg_angles"](np.concatenate([z, eye[k]])) for k in range(self.n)]
+        legs = ("swing_thigh", "stance_thigh") if "swing_thigh_rate" in rows[0] \
+            else ("swing", "stance")
+        A = np.array([[float(r[f"{legs[0]}_rate"]) for r in rows],
+                      [float(r[f"{legs[1]}_rate"]) for r in rows]])
+        swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # the legs' absolute angles trade places
+        self.R = np.linalg.pinv(A) @ swap @ A
+        self.lock = None  # the gradient (n,) of a constraint held through the transition
+        self._memo: dict = {}
+
+    def hold_lock(self, lock) -> None:
+        """Hold the constraint whose gradient is ``lock(x)`` (n,) (a locked swing knee)
+        through the push-off and the heel strike, as the passive heel strike does (McGeer
+        1990); the role swap's rate map is then the swap of the generated reset's positions
+        (affine in ``q``: central differences of unit step are exact), since a kneed leg's
+        thigh and shank both take the straight leg's rate."""
+        self.lock = lock
+        n, z = self.n, np.zeros(self.n)
+        pos = self.fns["reset"]
+        self.R = np.stack([(np.real(pos(np.concatenate([e, z])))[:n]
+                            - np.real(pos(np.concatenate([-e, z])))[:n]) / 2.0
+                           for e in np.eye(n)], axis=1)
+        self._memo.clear()
+
+    def hip_velocity(self, x) -> np.ndarray:
+        """Hip velocity (2,) [m/s] (world x forward, y up) of a state ``x`` (2n,), from the
+        generated ``point_velocities`` (analytic in the whole state: complex-step safe)."""
+        return np.asarray(self.fns["point_velocities"](x)["hip"])
+
+    def point_jacobians(self, q, names) -> np.ndarray:
+        """The named points' position Jacobians stacked (2 len(names), n) at ``q`` (n,),
+        column ``k`` the points' velocities for ``dq = e_k`` (exact, and analytic in ``q``:
+        complex-step safe)."""
+        eye = np.eye(self.n)
+        cols = []
+        for k in range(self.n):
+            v = self.fns["point_velocities"](np.concatenate([q, eye[k]]))
+            cols.append(np.concatenate([np.asarray(v[name]) for name in names]))
+        return np.array(cols).T
+
+    def impulse(self, x) -> float:
+        """Push-off impulse ``P`` [N s] for the pre-impact state ``x`` (>= 0)."""
+        po = self.spec.push_off
+        if po is None or po.speed_gain_n_s2_per_m == 0.0:
+            return push_off_impulse(po, 0.0)
+        v = self.hip_velocity(x)
+        return push_off_impulse(po, np.sqrt(v @ v))
+
+    def direction(self, x) -> np.ndarray:
+        """The push-off's unit direction (2,): from the trailing foot's contact point (an
+        arc's ``stance_contact``, else the stance foot at the origin) to the hip."""
+        pts = self.fns["points"](x)
+        r = np.asarray(pts["hip"])
+        if "stance_contact" in pts:
+            r = r - np.asarray(pts["stance_contact"])
+        return r / np.sqrt(r @ r)
+
+    def relabel(self, q):
+        """New coordinates (n,) after the role swap and the rate map ``R`` (n, n)."""
+        qn = np.real(self.fns["reset"](np.concatenate([np.real(q), np.zeros(self.n)]))[:self.n])
+        return qn, self.R
+
+    def _transition(self, x) -> dict:
+        n = self.n
+        q, dq = x[:n], x[n:]
+        P = self.impulse(x)
+        if self.limit:
+            return self._transition_point_hip(x, P)
+        De, E = self.fns["impact_matrices"](q)
+        De, E = np.asarray(De), np.asarray(E)
+        e = self.direction(x)
+        dqe = np.concatenate([dq, np.zeros(2)])
+        Ef = np.zeros((2, n + 2))
+        Ef[:, n:] = np.eye(2)
+        if self.lock is None:
+            dqe_po = dqe + np.linalg.solve(De, Ef.T @ (P * e))
+            K = np.zeros((n + 4, n + 4), dtype=np.result_type(De, E))
+            K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -E.T, E
+            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(2)]))
+        else:  # the swing knee locked through both impulses (as the passive heel strike)
+            a = np.concatenate([np.asarray(self.lock(x)), np.zeros(2)])[None, :]
+            A = np.zeros((n + 3, n + 3), dtype=np.result_type(De, a))
+            A[:n + 2, :n + 2], A[:n + 2, n + 2:], A[n + 2:, :n + 2] = De, -a.T, a
+            dqe_po = np.linalg.solve(A, np.concatenate([De @ dqe + Ef.T @ (P * e),
+                                                        np.zeros(1)]))[:n + 2]
+            C = np.vstack([E, a])
+            K = np.zeros((n + 5, n + 5), dtype=np.result_type(De, C))
+            K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -C.T, C
+            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(3)]))
+        dq_plus = sol[:n]
+        qn, R = self.relabel(np.real(q))
+        qn = qn + R @ (q - np.real(q))  # the swap is affine: exact for a complex step too
+        ke = (0.5 * dqe @ De @ dqe, 0.5 * dqe_po @ De @ dqe_po, 0.5 * sol[:n + 2] @ De
+              @ sol[:n + 2])
+        return {"x_plus": np.concatenate([qn, R @ dq_plus]),
+                "impulse": P, "ke_minus": ke[0], "ke_push_off": ke[1], "ke_plus": ke[2]}
+
+    def _transition_point_hip(self, x, P):
+        """Push-off and heel strike of a point hip mass on massless legs (Kuo 2002, Eq. 2
+        and its appendix); analytic in ``x`` (every point and Jacobian from the generated
+        ``points``/``point_velocities``, the least-squares solve by its normal equations with
+        a plain transpose), so the reset's Jacobian by the complex step is exact."""
+        n, M = self.n, self.hip_mass_kg
+        q = x[:n]
+        pts = self.fns["points"](x)
+        v = self.hip_velocity(x)
+        hip, lead = np.asarray(pts["hip"]), np.asarray(pts["swing_foot"])
+        et = hip / np.sqrt(hip @ hip)          # trailing leg: stance foot at the origin
+        el = (hip - lead) / np.sqrt((hip - lead) @ (hip - lead))
+        v_po = v + (P / M) * et
+        v_plus = v_po - (v_po @ el) * el
+        v_foot = (v_plus @ et) * et            # the trailing foot: no velocity across its leg
+        qn, R = self.relabel(np.real(q))
+        qn = qn + R @ (q - np.real(q))         # the swap is affine: exact for a complex step
+        Jn = self.point_jacobians(qn, ("hip", "swing_foot"))   # (4, n), full column rank
+        dq_plus = np.linalg.solve(Jn.T @ Jn, Jn.T @ np.concatenate([v_plus, v_foot]))
+        ke = (0.5 * M * (v @ v), 0.5 * M * (v_po @ v_po), 0.5 * M * (v_plus @ v_plus))
+        return {"x_plus": np.concatenate([qn, dq_plus]), "impulse": P, "ke_minus": ke[0],
+                "ke_push_off": ke[1], "ke_plus": ke[2]}
