@@ -97,3 +97,84 @@ def test_the_arc_foot_push_off_gait_is_the_independent_one():
     assert abs(gait.step_period - T) < 1e-9
     got = np.sort_complex(gait.multipliers[np.abs(gait.multipliers) > 1e-8])
     np.testing.assert_allclose(got, np.sort_complex(mult[np.abs(mult) > 1e-8]), atol=1e-7)
+
+
+# ------------------------------------------------------------------ flat feet: the toe
+def _cross(a, b) -> float:
+    """z component of the planar cross product ``a x b``."""
+    return float(a[0] * b[1] - a[1] * b[0])
+
+
+def _flat_states(rng, mode: str, k: int, gamma: float):
+    """``k`` states (6,) in ``mode`` (heel: foot turned toe up; toe: heel up)."""
+    X = np.column_stack([rng.uniform(-0.3, 0.3, (k, 2)), np.zeros(k),
+                         rng.uniform(-1.5, 1.5, (k, 3))])
+    phi = rng.uniform(0.02, 0.2, k) * (1.0 if mode == "heel" else -1.0)
+    X[:, 2] = phi - gamma - X[:, 1]
+    return X
+
+
+def test_a_toe_push_off_of_zero_is_the_generated_heel_strike():
+    """Every flat-foot phase's heel-strike guard: ``P = 0`` gives its generated passive
+    heel strike (heel- or toe-pinned kinematics) to round-off."""
+    d = _scene("flat_feet", None)
+    w0 = build_walker(scene_from_dict(d))
+    d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.0}}
+    w = build_walker(scene_from_dict(d))
+    rng = np.random.default_rng(6)
+    gamma = float(w.slope_rad)
+    for ph0, ph in zip(w0.phases, w.phases):
+        mode = "toe" if ph.name.startswith("heel_off") else "heel"
+        for g0, g in zip(ph0.guards, ph.guards):
+            if g.outcome != "heel_strike":
+                continue
+            for x in _flat_states(rng, mode, 3, gamma):
+                np.testing.assert_allclose(g.reset(x), g0.reset(x), rtol=0, atol=1e-13)
+
+
+@pytest.mark.slow  # builds the reference with sympy (~5 s)
+def test_the_toe_push_off_is_the_independent_one_and_balances_momentum():
+    """The pushed transition (impulse at the trailing toe towards the hip, the ankle held,
+    then the heel strike) equals the Newton-Euler prototype
+    (``tests/independent/flat_feet_push_off.py``), in heel-off and heel-contact states;
+    the angular momentum about the leading heel changes by ``(toe - heel) x P e`` (the
+    heel strike's impulse acts at the heel, the ankle's is internal); the kinetic energies
+    before, after the push-off and after the heel strike are the prototype's (the heel
+    strike removes energy).  Tolerances: linear solves of O(1) systems (1e-11 with
+    margin); the reset's complex-step Jacobian against central differences of step 1e-6."""
+    from tests.independent.flat_feet_push_off import pushed_heel_strike
+    from tests.independent.flat_feet_reference import FlatFeetReference
+
+    Pf = 3.0  # N s: the walker weighs ~ 8 kg
+    d = _scene("flat_feet", {"impulse_n_s": Pf})
+    scene = scene_from_dict(d)
+    w = build_walker(scene)
+    wk, leg = scene.walker, scene.walker.leg
+    ankle = leg.foot.ankle
+    ref = FlatFeetReference(dict(
+        M=wk.hip_mass_kg, m=leg.bodies[0].mass_kg, b=leg.bodies[0].from_hip_m,
+        L=leg.length_m, h=leg.foot.heel_m, t=leg.foot.toe_m,
+        k=ankle.stiffness_n_m_per_rad, r=ankle.rest_angle_rad,
+        c=ankle.damping_n_m_s_per_rad, gamma=scene.slope.angle_rad, g=wk.gravity_m_per_s2))
+    rng = np.random.default_rng(7)
+    for mode in ("toe", "heel"):
+        for x in _flat_states(rng, mode, 3, float(w.slope_rad)):
+            tr = w.actuators.transition(x)
+            want = pushed_heel_strike(ref, mode, x, Pf)
+            np.testing.assert_allclose(tr["x_plus"], want["x_plus"], rtol=0, atol=1e-11)
+            np.testing.assert_allclose([tr["ke_minus"], tr["ke_push_off"], tr["ke_plus"]],
+                                       want["ke"], rtol=1e-12)
+            assert tr["ke_plus"] < tr["ke_push_off"]  # the heel strike is plastic
+            pos, v0 = ref.positions(mode, x[:3]), ref.velocities(mode, x)
+            heel = pos["swing_heel"]
+            m = want["mass"]
+            h0 = sum(m[k] * _cross(pos[k] - heel, v0[k]) for k in m)
+            qn = tr["x_plus"][:3]
+            pn, vn = ref.positions("heel", qn), ref.velocities("heel", tr["x_plus"])
+            h1 = sum(m[k] * _cross(pn[k], vn[k]) for k in m)  # new heel at 0
+            lever = _cross(want["toe"] - heel, Pf * want["e"])
+            assert h1 - h0 == pytest.approx(lever, abs=1e-12 * max(1.0, abs(h0)))
+            J, h = w.reset_jacobian(x), 1e-6
+            Jfd = np.stack([(w.reset(x + h * e) - w.reset(x - h * e)) / (2 * h)
+                            for e in np.eye(6)], axis=1)
+            np.testing.assert_allclose(J[3:], Jfd[3:], rtol=0, atol=1e-6)
