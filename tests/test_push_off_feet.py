@@ -178,3 +178,36 @@ def test_the_toe_push_off_is_the_independent_one_and_balances_momentum():
             Jfd = np.stack([(w.reset(x + h * e) - w.reset(x - h * e)) / (2 * h)
                             for e in np.eye(6)], axis=1)
             np.testing.assert_allclose(J[3:], Jfd[3:], rtol=0, atol=1e-6)
+
+
+# ------------------------------------------------------------------ gaits and their ledgers
+#: scene, gentler slope [rad], push-off [N s], gait guess (a continuation from the passive)
+GAITS = {
+    "torso_bhm": (0.0087, 1.0, (-0.1988, 0.1814, -0.6137, -0.7444)),
+    "round_feet": (GAMMA, P, (-0.1888, 0.1788, -0.1987, -0.2371)),
+    "flat_feet": (0.032, 0.5, (-0.3019, 0.2400, 0.0, -1.1712, -1.0909, -7.9268)),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(GAITS))
+def test_pushed_gaits_are_stable_and_their_ledgers_close(name):
+    """A torso on the bisecting hip (half the passive slope), arc feet (half) and flat feet
+    (0.8 of it) walk with a push-off: a stable period-1 gait; over two steps the energy
+    ledger closes to 1e-9 of the kinetic energy (push-off work + slope = collision losses +
+    dampers; the integrator runs at 1e-12)."""
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+    from walkerlab.integrate.rigid import simulate_steps
+
+    gamma, impulse, guess = GAITS[name]
+    d = _scene(name, {"impulse_n_s": impulse}, gamma)
+    d["fixedpoint"]["initial_guess"] = dict(zip(d["fixedpoint"]["initial_guess"], guess))
+    w = wl.Walker.from_scene(d)
+    g = w.fixed_point()
+    assert np.max(np.abs(g.multipliers)) < 1.0
+    traj = simulate_steps(w.model, g.x, 2, w.solver, max_step_time=w.max_step_time)
+    led = trajectory_ledger(traj)
+    ke = np.array([w.model.energies(s.x_start)[0] for s in traj.segments])
+    assert np.all(np.abs(led["closure"]) / ke <= 1e-9)
+    assert np.all(led["push_off_work"] > 0.0)
+    np.testing.assert_allclose(led["push_off_impulse"], impulse, rtol=0, atol=0)
