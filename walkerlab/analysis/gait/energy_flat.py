@@ -88,7 +88,9 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
             continue
         wdamp += quad_work(lambda t, sol=sol: _damper_power(walker, _state(sol, t, n2)),
                            ta, tb, scale)
-        if getattr(acts, "ankle", None) is not None and ph.name.startswith("heel_off"):
+        # (a push-off at the toe alone has no ankle torque: ``ankle`` None)
+        if acts is not None and ph.name.startswith("heel_off") \
+                and getattr(acts, "ankle", 0) is not None:
             def power(t, sol=sol):
                 x = _state(sol, t, n2)
                 return acts.torque(x[acts.ankle]) * x[acts.ankle + n2 // 2]
