@@ -211,3 +211,14 @@ def test_pushed_gaits_are_stable_and_their_ledgers_close(name):
     assert np.all(np.abs(led["closure"]) / ke <= 1e-9)
     assert np.all(led["push_off_work"] > 0.0)
     np.testing.assert_allclose(led["push_off_impulse"], impulse, rtol=0, atol=0)
+
+
+def test_a_push_off_on_massless_arc_legs_is_refused_in_one_line():
+    """Massless legs on arc feet: the limit m -> 0 of the push-off depends on where the
+    vanishing mass sits on the arc (Kuo's closed form is the point foot's); one line."""
+    d = _scene("simplest", {"impulse_n_s": 0.01})
+    d["walker"]["coordinates"] = "absolute"
+    d["walker"]["leg"]["foot"] = {"kind": "arc", "radius_m": 0.1}
+    with pytest.raises(ValueError, match="give the legs mass") as e:
+        build_walker(scene_from_dict(d))
+    assert "\n" not in str(e.value) and "walker.actuation.push_off" in str(e.value)

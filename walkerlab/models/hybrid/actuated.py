@@ -43,6 +43,10 @@ def _structure_check(data, spec) -> bool:
         raise ValueError("walker.actuation: legs with some massless bodies are not supported")
     if limit and (st.torso or not st.hip_mass):
         raise ValueError("walker.actuation: massless legs need a hip mass and no torso")
+    if limit and st.foot != "point" and spec.push_off is not None:
+        raise ValueError("walker.actuation.push_off: on massless legs the push-off's limit "
+                         "m -> 0 is Kuo's point foot; an arc's depends on where its mass "
+                         "sits: give the legs mass")
     for i, t in enumerate(spec.torques):
         if limit and t.scaled_by != "foot_mass":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: the legs are massless "
