@@ -1,7 +1,7 @@
 """The MFPT Monte Carlo walks on three integrators, in one process, interleaved: CPU per heel
 strike of walkerlab's compiled walk (:mod:`walkerlab.integrate.rows_dop853` through
 :func:`walkerlab.studies.mfpt.run_walks`), of CyRK's compiled DOP853 driven from a numba
-loop, and of the minimal numba loop (:mod:`walkerlab.bench.minimal_compass`).
+loop, and of the minimal numba loop (:mod:`walkerlab.bench.minimal_collocation`).
 
     python scripts/bench_mc_cyrk.py [--scene configs/paper.yaml] [--walks 500] [--steps 100]
                                     [--sigma 0.002] [--repeats 5] [--out FILE.json]

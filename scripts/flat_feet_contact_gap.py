@@ -12,7 +12,7 @@ rules at each heel strike:
 - ``contact``: the run simply goes on (what ``walkerlab contact-sim`` does: the trailing
   foot, loaded on its toe by its deflected ankle spring, stays on the ground for ~17-20 ms
   and its spring pushes the trailing leg off);
-- ``rigid_rule``: the rigid view's heel strike (walkerlab.codegen.flatfoot): the trailing foot
+- ``rigid_rule``: the rigid view's heel strike (walkerlab.codegen.foot_modes): the trailing foot
   leaves the ground at once and snaps to its spring's rest angle (its spring energy lost) -
   its foot angle and rate are set to its leg's and the ground patch under it is removed.
 

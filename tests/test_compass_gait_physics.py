@@ -5,7 +5,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from walkerlab.codegen.symbolic import derive
-from walkerlab.models.hybrid.compass_gait import (
+from walkerlab.models.hybrid.printed_equations import (
     compass_gait_structure,
     energies,
     flow,

@@ -34,7 +34,7 @@ def test_largest_multiplier_gradient_equals_central_differences_of_the_resolved_
     the left/right eigenvectors equals the central difference (h = 1e-3 kg, truncation
     ~h² |λ'''| ≈ 1e-9 relative here) of |λ|max at re-solved fixed points to 1e-6 relative
     (measured 2.5e-8 at 10 kg and 3.3e-9 at 15 kg)."""
-    from walkerlab.optimal.design import _Gaits, multiplier_gradient
+    from walkerlab.optimal.design.search import _Gaits, multiplier_gradient
 
     scene, x = paper
     gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, max_step=[0.75])
@@ -51,7 +51,7 @@ def test_design_solves_follow_the_scenes_gait_not_a_neighbouring_one(paper):
     unstable gait of the same walker (|λ|max 2.48); walked in sub-steps of 0.75 kg it stays on
     the scene's own stable gait (|λ|max 0.5754, as the SLSQP path through 12.7 and 15.0 kg
     finds it)."""
-    from walkerlab.optimal.design import _Gaits
+    from walkerlab.optimal.design.search import _Gaits
 
     scene, x = paper
     gaits = _Gaits(scene, ["walker.hip_mass_kg"], x, max_step=[0.75])
@@ -63,7 +63,7 @@ def test_hip_mass_minimising_the_largest_multiplier_is_interior_with_zero_gradie
     """The paper walker's hip mass within 5-40 kg minimising |λ|max (SLSQP with the exact
     gradient): 20.64 kg, |λ|max 0.57365 (0.58585 at the scene's 10 kg), where the gradient
     vanishes (|d|λ|/dm| ≤ 1e-6 per kg, against -4.1e-3 per kg at 10 kg)."""
-    from walkerlab.optimal.design import design_optimize
+    from walkerlab.optimal.design.search import design_optimize
 
     scene, x = paper
     res = design_optimize(scene, {"walker.hip_mass_kg": (5.0, 40.0)}, "max_abs_multiplier", x)
@@ -79,7 +79,7 @@ def test_design_artifact_loads_back_and_draws_its_figure(paper, tmp_path):
     import h5py
 
     from walkerlab.io.schemas.optimize import load_design, write_design
-    from walkerlab.optimal.design import DesignResult
+    from walkerlab.optimal.design.search import DesignResult
     from walkerlab.plotting.design_figure import save_design_figure
 
     r = DesignResult(["walker.hip_mass_kg"], np.array([20.6]), "speed", 0.53,

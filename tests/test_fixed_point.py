@@ -5,7 +5,7 @@ import pytest
 
 from tests.conftest import TIGHT
 from walkerlab.analysis.gait.poincare import find_fixed_point, poincare_map
-from walkerlab.models.hybrid.compass_gait import make_compass_gait
+from walkerlab.models.hybrid.printed_equations import make_compass_gait
 from walkerlab.published import paper
 
 EQ11 = np.array(paper.EQ11_STATE)  # role-ordered, as printed

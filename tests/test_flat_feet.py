@@ -15,7 +15,7 @@ from walkerlab.codegen.cache import functions
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.hybrid.rigid_flat import mode_of, mode_sequence
+from walkerlab.models.hybrid.rigid_foot_modes import mode_of, mode_sequence
 from walkerlab.models.registry import build_walker
 from walkerlab.walker.description import walker_data
 

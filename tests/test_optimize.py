@@ -13,7 +13,7 @@ import pytest
 import walkerlab as wl
 from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
-from walkerlab.optimal.collocation import CollocationSpec, collocate_step, replay
+from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step, replay
 from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")
@@ -96,7 +96,7 @@ def test_design_gradient_through_the_fixed_point_equals_central_differences():
     """d(step period)/d(hip mass) and d(speed)/d(leg mass) of the paper walker's gait by the
     implicit function theorem on the Poincaré map, against central differences of the
     re-solved fixed point (h = 1e-3 kg: truncation ~1e-9 relative): <= 1e-6 relative."""
-    from walkerlab.optimal.design import _Gaits, measure_gradient
+    from walkerlab.optimal.design.search import _Gaits, measure_gradient
 
     scene = load_scene(CONFIGS / "paper.yaml")
     g = wl.Walker.from_scene(scene).fixed_point()
@@ -118,7 +118,7 @@ def test_design_gradient_of_step_length_and_cost_of_transport():
     differences of the re-solved fixed point (h = 1e-3): <= 1e-6 relative - the paper
     walker's step length in its hip mass (1e-7 seen), and powered_compass.yaml's cost of
     transport in its push-off impulse (a passive walker's is 0; 9e-9 seen)."""
-    from walkerlab.optimal.design import _Gaits, measure_gradient
+    from walkerlab.optimal.design.search import _Gaits, measure_gradient
 
     for name, scene_name, field, p in (
             ("step_length", "paper", "walker.hip_mass_kg", 10.0),
@@ -137,7 +137,7 @@ def test_design_optimisation_follows_the_gait_to_a_bounded_optimum():
     """The hip mass (5-20 kg) that maximises the paper walker's speed on its slope: SLSQP
     with the fixed-point gradient ends at a bound or where the gradient vanishes, and the
     speed there is at least the scene's."""
-    from walkerlab.optimal.design import design_optimize
+    from walkerlab.optimal.design.search import design_optimize
 
     scene = load_scene(CONFIGS / "paper.yaml")
     g = wl.Walker.from_scene(scene).fixed_point()
@@ -199,7 +199,7 @@ def test_design_from_a_zero_stiffness_bound_stays_inside_the_bounds():
     central difference at 0 built a spring of -1e-6 N m/rad and the run stopped), and the
     gradient there is the one-sided difference of the re-solved speed (h = 1e-3 N m/rad:
     truncation ~1e-7 relative)."""
-    from walkerlab.optimal.design import _Gaits, design_optimize, measure_gradient
+    from walkerlab.optimal.design.search import _Gaits, design_optimize, measure_gradient
 
     scene = load_scene(CONFIGS / "hip_spring.yaml")
     field = "walker.springs.0.stiffness_n_m_per_rad"
@@ -232,7 +232,7 @@ def test_design_on_robustness_measures(robust_paper, objective, maximize):
     differences of the re-solved gait), the basin share and the MFPT (Nelder-Mead: both are
     piecewise constant in the design, no gradient): the optimum is at least as good as the
     scene's 10 kg, the gradient is given only where the measure is smooth."""
-    from walkerlab.optimal.design import design_optimize
+    from walkerlab.optimal.design.search import design_optimize
 
     scene, x = robust_paper
     res = design_optimize(scene, {"walker.hip_mass_kg": (8.0, 12.0)}, objective, x,
@@ -247,7 +247,7 @@ def test_gait_sensitivity_norm_gradient_converges(robust_paper):
     """The GSN's differenced gradient (step 1e-4 of the field) and one with a ten times
     larger step agree to O(h^2) (<= 1e-4 relative): the measure is smooth and its
     differences are not noise (its own B, C, D are differences at 1e-6 of the state)."""
-    from walkerlab.optimal.design import _Gaits
+    from walkerlab.optimal.design.search import _Gaits
 
     scene, x = robust_paper
     gaits = _Gaits(scene, ["walker.hip_mass_kg"], x)

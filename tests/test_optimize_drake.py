@@ -16,8 +16,8 @@ from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
-from walkerlab.optimal.collocation import CollocationSpec, collocate_step
 from walkerlab.optimal.guess import simulated_step
+from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step
 from walkerlab.walker.description import walker_data
 
 drake = pytest.importorskip("pydrake.examples")

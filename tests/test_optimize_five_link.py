@@ -18,13 +18,13 @@ from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
-#: torques [N m] on the joints in walkerlab.optimal.five_link.JOINTS order
+#: torques [N m] on the joints in walkerlab.optimal.transcription.free_joint_functions.JOINTS order
 TAU = np.array([7.0, -3.0, 11.0, -5.0])
 
 
 @pytest.fixture(scope="module")
 def fns_and_params():
-    from walkerlab.optimal.five_link import five_link_functions
+    from walkerlab.optimal.transcription.free_joint_functions import five_link_functions
 
     data = walker_data(scene_from_dict(SCENE).walker, 0.0)
     return five_link_functions(data.structure), np.asarray(data.params, float)
@@ -57,7 +57,7 @@ def test_the_step_functions_are_built_once_and_cached(fns_and_params, tmp_path,
                                                      monkeypatch):
     """A miss derives (sympy) and writes the user cache; the next process reads it back
     (no derivation) and computes the same; a damaged file is derived again."""
-    from walkerlab.optimal import five_link as fl
+    from walkerlab.optimal.transcription import free_joint_functions as fl
 
     built = {k: v for k, v in fns_and_params[0].items() if k != "n"}
     calls = []
@@ -114,7 +114,7 @@ def test_a_five_link_walker_without_torso_is_refused_in_one_line(tmp_path):
 
 def test_torques_of_time_is_the_intervals_quadratic():
     """Exact on a quadratic (Hermite-Simpson's control), extrapolated past the end."""
-    from walkerlab.optimal.five_link_collocation import torques_of_time
+    from walkerlab.optimal.transcription.free_joints import torques_of_time
 
     t = np.linspace(0.0, 0.7, 11)
     u = np.stack([3 * t ** 2 - t + 2, -t ** 2], axis=1)
@@ -144,7 +144,7 @@ def check_kellys_step_meets_its_targets_and_constraints(optimised, fns_and_param
     """0.5 m in 0.7 s exactly; the swing foot above the ground at every interior point and
     on it at the end, moving down there; no knee hyper-extended; torques finite, within
     RABBIT's 150 N m; IPOPT converged; the torques stored by joint name."""
-    from walkerlab.optimal.five_link import JOINTS, five_link_functions
+    from walkerlab.optimal.transcription.free_joint_functions import JOINTS, five_link_functions
 
     d, out, _ = optimised
     assert d.status == "Solve_Succeeded"
@@ -196,10 +196,10 @@ def check_the_transcription_error_falls_at_hermite_simpsons_order(optimised):
     over the step by the same linearised map at both meshes) falls by 2^p when the mesh is
     halved: observed p >= 3.5 for Hermite-Simpson's 4 (measured 3.7: at 25 intervals the
     error, 0.67, is large enough to be past the linear growth, which lowers p)."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.five_link import five_link_functions
-    from walkerlab.optimal.five_link_collocation import collocate_five_link
-    from walkerlab.optimal.five_link_shooting import open_loop_error
+    from walkerlab.optimal.replay.shooting import open_loop_error
+    from walkerlab.optimal.transcription.free_joint_functions import five_link_functions
+    from walkerlab.optimal.transcription.free_joints import collocate_five_link
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     d, _, _ = optimised
     assert len(d.time) == 101
@@ -251,13 +251,13 @@ def check_the_phase_variable_law_walks_the_contact_model_at_the_optimums_period(
 
 def check_the_phase_laws_compiled_flows_are_its_python_flows(optimised):
     """The phase-variable replays run the law inside the compiled flows (its law block,
-    :meth:`walkerlab.optimal.phase_replay.PhaseLaw.packed`, on CyRK's DOP853): at the
+    :meth:`walkerlab.optimal.replay.phase.PhaseLaw.packed`, on CyRK's DOP853): at the
     collocated states, perturbed by 0.01, each phase's cfunc gives the walker's Python flow
     (the generated passive flow + ``M^-1 B tau`` with the law called in Python) to 1e-11 of
     its largest entry, and its guards' outputs the Python guards."""
     import ctypes
 
-    from walkerlab.optimal.five_link_replay import (
+    from walkerlab.optimal.replay.virtual_constraints import (
         RABBIT_GAINS,
         phase_law,
         phased_walker,

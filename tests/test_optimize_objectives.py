@@ -18,9 +18,14 @@ from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
-from walkerlab.optimal.collocation import CollocationSpec, collocate_step, replay, step_functions
+from walkerlab.optimal.drivers.step import collocation_spec
 from walkerlab.optimal.guess import simulated_step
-from walkerlab.optimal.scene import collocation_spec
+from walkerlab.optimal.transcription.step import (
+    CollocationSpec,
+    collocate_step,
+    replay,
+    step_functions,
+)
 from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")
@@ -266,7 +271,7 @@ def test_bad_optimize_sections_say_which_field(tmp_path):
     d = {**base, "optimize": {**base["optimize"], "hip_angle_range_rad": [-0.5, 0.5]}}
     ok = type(load_scene(CONFIGS / "compass_optimal.yaml")).model_validate(d)
     assert ok.optimize.hip_angle_range_rad == (-0.5, 0.5)
-    from walkerlab.optimal.scene import collocation_spec
+    from walkerlab.optimal.drivers.step import collocation_spec
 
     assert collocation_spec(ok).hip_angle_range_rad == (-0.5, 0.5)
     scene = load_scene(CONFIGS / "compass_optimal.yaml")
@@ -335,17 +340,18 @@ def test_step_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch)
     back from the code cache (no symbolic derivation on a warm start: the build is not
     called), and the functions read back compute bit for bit what the built ones do; a
     damaged file is rebuilt."""
-    import walkerlab.optimal.collocation as collocation
-    from walkerlab.optimal import step_cache
+    import walkerlab.optimal.transcription.step as collocation
+    from walkerlab.codegen import casadi_functions
+    from walkerlab.optimal.transcription import step_cache
 
     monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
     scene = load_scene(CONFIGS / "compass_optimal.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     built = step_cache.cached_step_functions(data)
     files = list((tmp_path / "models").glob("*-steps-*.casadi"))
     assert len(files) == 1
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
 
     def no_build(*_a, **_k):
         raise AssertionError("derived again")
@@ -360,7 +366,7 @@ def test_step_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch)
                                       np.asarray(built[name](*args)))
     assert read["n"] == 2 and read["total_mass_kg"] == built["total_mass_kg"]
     files[0].write_text("damaged")
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     monkeypatch.setattr(collocation, "step_functions", build)
     again = step_cache.cached_step_functions(data)
     np.testing.assert_array_equal(np.asarray(again["flow"](x, 0.7)),

@@ -1,6 +1,6 @@
 """The straight-legged and kneed walkers' optimised steps replayed with the hip torque as a
-function of the phase variable (walkerlab.optimal.hip_phase_replay, on the law and replay
-shared with the five-link biped, walkerlab.optimal.phase_replay): the law on steps built by
+function of the phase variable (walkerlab.optimal.replay.hip_phase, on the law and replay
+shared with the five-link biped, walkerlab.optimal.replay.phase): the law on steps built by
 hand, one law per phase, the one-line refusal, the passive gait under the law, the stored
 records and the report's words.  The closed replays of the shipped optima are measured by
 ``walkerlab optimize`` (``optimize.phase_replay: true``); the powered one is the slow test
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from walkerlab.config import load_scene
-from walkerlab.optimal.hip_phase_replay import (
+from walkerlab.optimal.replay.hip_phase import (
     PiecewisePhaseLaw,
     hip_gains,
     hip_phase_law,
@@ -150,7 +150,7 @@ def test_the_kneed_walkers_compiled_flows_run_the_piecewise_law():
 
     from walkerlab.codegen.torque_law import law_torque
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.hip_phase_replay import LIMIT_N_M, replay_solver
+    from walkerlab.optimal.replay.hip_phase import LIMIT_N_M, replay_solver
 
     pytest.importorskip("numba")
     scene = load_scene(CONFIGS / "kneed_optimal.yaml")
@@ -266,8 +266,8 @@ def test_a_powered_optimum_closes_under_the_phase_law():
     import walkerlab as wl
     from walkerlab.codegen import symbolic
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.collocation import CollocationSpec, collocate_step, torque_of_time
-    from walkerlab.optimal.hip_phase_replay import hip_phase_replays
+    from walkerlab.optimal.replay.hip_phase import hip_phase_replays
+    from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step, torque_of_time
 
     scene = load_scene(CONFIGS / "powered_compass.yaml")
     w = wl.Walker.from_scene(scene)

@@ -1,5 +1,5 @@
 """The one-step transcription's constraints and objectives on walkers whose step is a
-sequence of phases (``walkerlab.optimal.phased_collocation``): the stance foot's ground
+sequence of phases (``walkerlab.optimal.transcription.mode_sequence``): the stance foot's ground
 reaction (checked against an independent Newton-Euler computation and the rigid model's own
 normal forces) in its friction cone, the cost of transport by slack variables, and starting
 guesses read from artifacts."""
@@ -33,7 +33,7 @@ def _walker(name: str):
 @pytest.fixture(scope="module")
 def kneed():
     pytest.importorskip("casadi")
-    from walkerlab.optimal.phases import mode_functions
+    from walkerlab.optimal.transcription.phases import mode_functions
 
     scene, data, walker = _walker("kneed_optimal.yaml")
     return scene, data, walker, mode_functions(data, walker)
@@ -110,8 +110,8 @@ def kneed_fast(kneed):
     intervals from its passive gait's step, and that step (the guess)."""
     import walkerlab as wl
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases, phased_guess
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases, phased_guess
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     scene, data, walker, fns = kneed
     g = wl.Walker.from_scene(scene).fixed_point()
@@ -140,7 +140,7 @@ def test_a_friction_cone_that_binds_changes_the_kneed_gait_and_it_replays(kneed,
     closes (<= 1e-6; 1.9e-7 seen)."""
     from dataclasses import replace
 
-    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases, replay_phases
 
     _, data, _, fns = kneed
     _g, guess, spec, free = kneed_fast
@@ -177,7 +177,7 @@ def test_another_optimize_h5_of_the_walker_starts_the_phased_collocation(kneed, 
     1e-6: the coarser mesh's O(h^4))."""
     from dataclasses import replace
 
-    from walkerlab.optimal.phased_collocation import collocate_phases, optimized_guess
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases, optimized_guess
 
     _, _, walker, fns = kneed
     _g, _guess, spec, free = kneed_fast
@@ -197,7 +197,7 @@ def test_another_optimize_h5_of_the_walker_starts_the_phased_collocation(kneed, 
 
 
 def test_an_optimize_h5_without_the_walkers_phases_is_refused_in_one_line(kneed, kneed_fast):
-    from walkerlab.optimal.phased_collocation import optimized_guess
+    from walkerlab.optimal.transcription.mode_sequence import optimized_guess
 
     _, _, walker, _fns = kneed
     d = _as_artifact(kneed_fast[3], walker)
@@ -219,7 +219,7 @@ def test_the_flat_feet_ground_reaction_is_the_rigid_models_and_newton_eulers():
     feet's CasADi phases)."""
     pytest.importorskip("casadi")
     from walkerlab.codegen.cache import functions
-    from walkerlab.optimal.phases import mode_functions
+    from walkerlab.optimal.transcription.phases import mode_functions
 
     _, data, walker = _walker("flat_feet_optimal.yaml")
     fns = mode_functions(data, walker, FLAT_ORDER)
@@ -248,8 +248,8 @@ def test_the_kneed_walkers_least_cost_of_transport_on_its_slope_is_its_passive_g
     gait's step: CoT ~0 (1.1e-11 seen: the interior point's slack floor), the torque ~0
     (6e-5 N m seen), the step period within 1e-3 of the shooting gait's (1e-4 seen: the
     objective, ~1e-11 there, resolves no closer) and the replay closing (<= 1e-6)."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     _, data, _, fns = kneed
     g, guess, _spec, _free = kneed_fast
@@ -268,10 +268,10 @@ def test_the_cost_of_transport_does_not_drift_to_large_torques(kneed, kneed_fast
     positive work (CoT ~1e-11) and its torque stays the least-effort gait's size (< 0.1 N m;
     0.0096 seen); with IPOPT's default initial barrier it drifted to 100 N m torques
     chattering between the points and a replay that did not step
-    (:func:`walkerlab.optimal.collocation.ipopt_options`)."""
+    (:func:`walkerlab.optimal.transcription.step.ipopt_options`)."""
     from dataclasses import replace
 
-    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases, replay_phases
 
     _, data, _, fns = kneed
     _g, guess, spec, _free = kneed_fast
@@ -321,7 +321,7 @@ def test_the_phased_scene_reads_its_guess_from_artifacts(kneed, kneed_fast, tmp_
     phases simulated from it); a one-step optimize.h5 is refused in one line."""
     from walkerlab.io.artifacts import write_artifact
     from walkerlab.io.schemas import optimize as schema
-    from walkerlab.optimal.phased_scene import starting_phases
+    from walkerlab.optimal.drivers.mode_sequence import starting_phases
 
     scene, _data, walker, _fns = kneed
     g, guess, _spec, free = kneed_fast
@@ -364,7 +364,7 @@ def test_an_ankle_push_off_is_refused_in_one_line():
     transcription has a hip torque only (and the rigid flat feet take the two not
     together), so the scene is refused before any work, naming the field."""
     pytest.importorskip("casadi")
-    from walkerlab.optimal.scene import optimize_scene
+    from walkerlab.optimal.drivers.step import optimize_scene
 
     scene = load_scene(CONFIGS / "flat_feet_push_off.yaml")
     d = scene.model_dump(mode="json", exclude_none=True)

@@ -1,5 +1,5 @@
 """Walkers whose step is a sequence of phases optimised by multi-phase direct collocation
-(``walkerlab.optimal.phases`` / ``phased_collocation``): the kneed walker of
+(``walkerlab.optimal.transcription.phases`` / ``phased_collocation``): the kneed walker of
 configs/kneed.yaml (unlocked swing, knee strike, locked swing, heel strike) and the flat
 feet of configs/flat_feet.yaml (heel contact, foot slap, foot flat, mid-stance, heel off,
 heel strike).  Their CasADi phases are the rigid model's, a hip torque acts through a lock
@@ -43,8 +43,8 @@ def _start(walker_fixture, intervals: int):
     step of it on ``intervals`` and :func:`mode_functions` in that step's phase order."""
     import walkerlab as wl
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.phased_collocation import phased_guess
-    from walkerlab.optimal.phases import mode_functions, phase_order
+    from walkerlab.optimal.transcription.mode_sequence import phased_guess
+    from walkerlab.optimal.transcription.phases import mode_functions, phase_order
 
     scene, data, walker = walker_fixture
     g = wl.Walker.from_scene(scene).fixed_point()
@@ -90,7 +90,7 @@ def test_a_hip_torque_on_a_locked_knee_keeps_it_locked_and_its_power_is_the_ener
 def test_the_casadi_phases_are_the_rigid_models(kneed):
     """Flows (with a hip torque), guards and resets of every phase of the transcription
     against the rigid model's generated code at random states: round-off (1e-12)."""
-    from walkerlab.optimal.phases import mode_functions, phase_order
+    from walkerlab.optimal.transcription.phases import mode_functions, phase_order
 
     _, data, walker = kneed
     assert phase_order(walker) == [("unlocked_swing", "knee_strike", 1),
@@ -111,7 +111,7 @@ def test_the_casadi_phases_are_the_rigid_models(kneed):
 
 def test_a_mode_graph_without_a_fixed_sequence_is_refused_in_one_line():
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.phases import phase_order
+    from walkerlab.optimal.transcription.phases import phase_order
 
     with pytest.raises(ValueError, match="no fixed phase sequence"):
         phase_order(build_walker(load_scene(CONFIGS / "flat_feet.yaml")))
@@ -139,7 +139,7 @@ def test_the_flat_feet_phases_are_the_rigid_models(flat):
     heel's normal force through the actuated flow), its reset against the generated one, at
     states near the gait (1e-12 relative: round-off).  ~12 s under load (the flat feet's
     symbolic modes and ground forces built into CasADi)."""
-    from walkerlab.optimal.phases import mode_functions, phase_order
+    from walkerlab.optimal.transcription.phases import mode_functions, phase_order
 
     _, data, walker = flat
     log = [(n, 0.0, 0.0, g) for n, g, _d in FLAT_ORDER]
@@ -199,13 +199,13 @@ def test_the_flat_feet_least_effort_gait_is_their_passive_gait(flat):
     pytest.importorskip("casadi")
     import walkerlab as wl
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import (
+    from walkerlab.optimal.transcription.mode_sequence import (
         collocate_phases,
         phased_guess,
         replay_phases,
     )
-    from walkerlab.optimal.phases import mode_functions, phase_order
+    from walkerlab.optimal.transcription.phases import mode_functions, phase_order
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     scene, data, walker = flat
     g = wl.Walker.from_scene(scene).fixed_point()
@@ -226,8 +226,8 @@ def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed, kneed_st
     point's (60 intervals: 4e-8 seen; O(h^4)), the knee strike at the passive gait's
     time, and the replay on the rigid model (its own guards and resets) closing to
     1e-6."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     _, data, _ = kneed
     g, guess, fns = kneed_start
@@ -244,8 +244,8 @@ def test_the_kneed_walkers_least_effort_gait_is_its_passive_gait(kneed, kneed_st
 
 
 def test_what_the_phased_transcription_does_not_take_is_refused_in_one_line():
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     for spec, field in ((CollocationSpec(objective="push_off_work"), "optimize.objective"),
                         (CollocationSpec(objective="weighted",
@@ -322,8 +322,8 @@ def test_optimize_command_on_the_kneed_walker(tmp_path):
 def _powered(data, start, intervals: int, speed: float):
     """The least-effort step of a walker with phases at a target speed (``start`` from
     :func:`_start`: its passive gait's step as the guess) and its replay error."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases, replay_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     _g, guess, fns = start
     res = collocate_phases(fns, CollocationSpec(intervals=intervals,
@@ -362,7 +362,7 @@ def test_a_powered_flat_footed_gait_replays_on_the_rigid_model(flat):
     from walkerlab.analysis.contact.sim import simulate_from
     from walkerlab.api.scenes import with_changes
     from walkerlab.models.contact.scene import contact_setup
-    from walkerlab.optimal.contact_replay import contact_replay_phased
+    from walkerlab.optimal.replay.contact import contact_replay_phased
 
     start = _start(flat, 200)
     res, err = _powered(flat[1], start, 200, 0.8)
@@ -391,21 +391,22 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
     start), computing bit for bit what the built ones do; a damaged file is rebuilt and
     written again (~6 s: one build of the flat feet's CasADi functions)."""
     pytest.importorskip("casadi")
-    from walkerlab.optimal import phases, step_cache
+    from walkerlab.codegen import casadi_functions
+    from walkerlab.optimal.transcription import phases, step_cache
 
     monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
     scene = load_scene(CONFIGS / "flat_feet_optimal.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
     walker = make_rigid_walker(data)
-    from walkerlab.optimal.phased_scene import starting_phases
+    from walkerlab.optimal.drivers.mode_sequence import starting_phases
 
     x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     order = starting_phases(scene, walker, x0, 0.76, 40)[2]  # the gait's phase sequence
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     built = step_cache.cached_mode_functions(data, walker, order)
     files = list((tmp_path / "models").glob("*-modes-*.casadi"))
     assert len(files) == 1
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
 
     def no_build(*_a, **_k):
         raise AssertionError("built again")
@@ -428,7 +429,7 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
     np.testing.assert_array_equal(np.asarray(read["power"](x, 0.3)),
                                   np.asarray(built["power"](x, 0.3)))
     files[0].write_text("damaged")
-    monkeypatch.setattr(step_cache, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     calls = []
     monkeypatch.setattr(phases, "mode_functions",
                         lambda *a: calls.append(a) or built)

@@ -13,8 +13,8 @@ import walkerlab as wl
 from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
-from walkerlab.optimal.collocation import CollocationSpec, collocate_step
-from walkerlab.optimal.scene import step_record
+from walkerlab.optimal.drivers.step import step_record
+from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step
 from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")
@@ -93,7 +93,7 @@ def test_legs_that_differ_are_refused_in_one_line_not_optimised_as_one_step():
     scene = load_scene(CONFIGS / "asymmetric_legs.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
     assert data.mirror is not None
-    from walkerlab.optimal.collocation import step_functions
+    from walkerlab.optimal.transcription.step import step_functions
 
     with pytest.raises(ValueError, match="legs that differ") as info:
         step_functions(data, symbolic.derive(data.structure))

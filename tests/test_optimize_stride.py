@@ -1,4 +1,5 @@
-"""A walker whose legs differ optimised over one stride (``walkerlab.optimal.stride``):
+"""A walker whose legs differ optimised over one stride
+(``walkerlab.optimal.transcription.stride``):
 configs/asymmetric_optimal.yaml (the paper's walker with leg masses 5 / 5.5 kg, slope
 0.0174 rad, a hip torque).  Its CasADi phases are the rigid model's and its mirror's, its
 least-effort stride is the passive period-2 gait found independently by shooting
@@ -28,7 +29,7 @@ def asym():
     """(scene, data, rigid walker, passive gait, CasADi stride) built once."""
     pytest.importorskip("casadi")
     from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.optimal.stride import stride_functions
+    from walkerlab.optimal.transcription.stride import stride_functions
 
     scene = load_scene(CONFIGS / "asymmetric_optimal.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
@@ -42,7 +43,7 @@ def asym():
 
 def _guess(asym, intervals: int = 40):
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.stride import stride_guess
+    from walkerlab.optimal.transcription.stride import stride_guess
 
     scene, _data, walker, g, _fns = asym
     return stride_guess(walker, g.x, g.step_period, Solver.from_settings(scene.solver),
@@ -83,10 +84,10 @@ def test_the_least_effort_stride_is_the_passive_period_two_gait(asym):
     7.5e-8 on 40), the start
     within 1e-6, the replay over the stride closing to 1e-6 and the stride map's
     multipliers those of the fixed point (1e-6: the start's distance)."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.phased_scene import replay_multipliers
-    from walkerlab.optimal.stride import replay_stride, step_of
+    from walkerlab.optimal.drivers.mode_sequence import replay_multipliers
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
+    from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     scene, data, _walker, g, fns = asym
     guess = [(name, t, 1.05 * x) for name, t, x in _guess(asym, 60)]
@@ -111,9 +112,9 @@ def test_a_powered_stride_at_a_target_speed_replays_on_the_rigid_model(asym):
     steps (the legs differ), and the torques fed as functions of time to the rigid model and
     its mirror return to the start within 1e-6 over the stride (~11 s under load: the
     optimisation and the replay of the torqued walker in Python)."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.stride import replay_stride, step_of
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
+    from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     _scene, data, _walker, _g, fns = asym
     res = collocate_phases(fns, CollocationSpec(intervals=40, target_speed_m_per_s=0.6),
@@ -144,9 +145,9 @@ def test_a_stride_with_a_push_off_is_the_rigid_walkers_pushed_gait(asym):
     stride's 7.5e-8 on 40 intervals), the start within 1e-5; its replay with the push-off
     closes to 1e-6; and it is not the unpushed gait (both steps longer by > 1e-3)."""
     from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.stride import replay_stride, step_of
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
+    from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     scene, data, _walker, g, fns = asym
     _, search = solve_scene(_pushed(scene, 0.5))
@@ -172,9 +173,9 @@ def test_a_free_push_off_stride_on_level_ground(asym):
     push-off in the rigid model's own transition (numpy, :class:`walkerlab.models.hybrid.
     actuated.Actuators`; the collocation's is CasADi's) to 1e-9 relative, and it is a part
     of the cost of transport, ``(hip positive work + push-off work) / (M g d)``."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.stride import replay_stride, step_of
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
+    from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     scene, data, _walker, _g, _fns = asym
     d = _pushed(scene, 2.0).model_dump(mode="json", exclude_none=True)
@@ -182,7 +183,7 @@ def test_a_free_push_off_stride_on_level_ground(asym):
     level = type(scene).model_validate(d)
     from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.stride import stride_functions, stride_guess
+    from walkerlab.optimal.transcription.stride import stride_functions, stride_guess
 
     ldata = walker_data(level.walker, level.slope.phi_rad)
     _, search = solve_scene(level)
@@ -212,9 +213,9 @@ def test_what_the_stride_does_not_take_is_refused_in_one_line(asym):
     free push-off pass the stride's checks, and a guess is read from its artifact (a
     missing one refused naming ``optimize.initial_guess``); one step of legs that differ
     stays refused by the one-step transcription."""
-    from walkerlab.optimal.collocation import step_functions
-    from walkerlab.optimal.scene import optimize_scene
-    from walkerlab.optimal.stride_scene import _check
+    from walkerlab.optimal.drivers.step import optimize_scene
+    from walkerlab.optimal.drivers.stride import _check
+    from walkerlab.optimal.transcription.step import step_functions
 
     scene, data, _walker, g, _fns = asym
 
@@ -235,7 +236,7 @@ def test_what_the_stride_does_not_take_is_refused_in_one_line(asym):
     with pytest.raises(ValueError, match="legs that differ take a stride"):
         step_functions(data, None)
     with pytest.raises(ValueError, match="a stride is for legs that differ"):
-        from walkerlab.optimal.stride import stride_functions
+        from walkerlab.optimal.transcription.stride import stride_functions
 
         stride_functions(replace(data, mirror_params=None))
 
@@ -337,9 +338,9 @@ def test_the_least_cost_of_transport_stride_on_its_slope_is_the_passive_gait(asy
     point's slack floor), torques ~0 (4e-5 N m seen), each step's period within 1e-4 of the
     shooting fixed point's (6e-6 seen: the objective, ~1e-11, resolves no closer; the least
     effort's 7.5e-8 on this mesh) and the replay closing (<= 1e-6; 1.1e-8 seen)."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.stride import replay_stride, step_of
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
+    from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     _scene, data, _walker, g, fns = asym
     res = collocate_phases(fns, CollocationSpec(intervals=40, objective="cost_of_transport",
@@ -357,8 +358,8 @@ def test_the_least_cost_of_transport_stride_on_its_slope_is_the_passive_gait(asy
 def fast(asym):
     """The least-effort stride at 0.6 m/s (the passive gait: 0.528 m/s) on 40 intervals a
     step from the passive stride, and its spec."""
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.phased_collocation import collocate_phases
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     spec = CollocationSpec(intervals=40, target_speed_m_per_s=0.6)
     return spec, collocate_phases(asym[4], spec, _guess(asym))
@@ -373,8 +374,8 @@ def _replayed_cost_of_transport(data, res):
     model's points at its heel strike)."""
     from walkerlab.analysis.gait.poincare import poincare_map
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.phased_collocation import phase_torque_of_time
-    from walkerlab.optimal.stride import step_of, stride_walker
+    from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
+    from walkerlab.optimal.transcription.stride import step_of, stride_walker
 
     w, segs = stride_walker(data, res), []
     poincare_map(w, np.asarray(res.x[0], float), Solver(method="DOP853", rtol=1e-12,
@@ -405,8 +406,8 @@ def test_the_least_cost_of_transport_stride_at_a_target_speed(asym, fast):
     ``max(p, 0)`` at the points, whose kinks where the power changes sign cost O(h^2))."""
     from dataclasses import replace as with_
 
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.stride import replay_stride, step_of
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.stride import replay_stride, step_of
 
     _scene, data, _walker, _g, fns = asym
     spec, least_effort = fast
@@ -445,8 +446,8 @@ def test_a_friction_cone_that_binds_changes_the_stride_and_it_replays(asym, fast
     speed is met and the replay closes (<= 1e-6; 1.0e-7 seen)."""
     from dataclasses import replace as with_
 
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.stride import replay_stride
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.stride import replay_stride
 
     _scene, data, _walker, _g, fns = asym
     spec, free = fast
@@ -497,8 +498,8 @@ def test_a_stride_starts_from_another_strides_optimize_h5(asym, fast, tmp_path):
     a few iterations with the barrier started small (``warm_start``, as the scene does for
     an optimize.h5 guess; with IPOPT's default 0.1: 11, against 12 from the passive
     stride, the start left for the central path)."""
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.stride_scene import starting_stride
+    from walkerlab.optimal.drivers.stride import starting_stride
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
 
     scene, _data, walker, g, fns = asym
     spec, free = fast
@@ -522,7 +523,7 @@ def test_a_stride_starts_from_a_continuation_gait_and_refuses_other_artifacts(as
     its slope: the same guess to 1e-12); a one-step optimize.h5 (no phases) and another
     walker's (other states) are refused in one line naming ``optimize.initial_guess``."""
     from tests.test_optimize_phased_terms import _continuation
-    from walkerlab.optimal.stride_scene import starting_stride
+    from walkerlab.optimal.drivers.stride import starting_stride
 
     scene, _data, walker, g, _fns = asym
     names = list(walker.state_names())
@@ -565,8 +566,8 @@ def test_the_stride_scene_takes_the_cost_of_transport_a_cone_and_a_guess(asym, f
     2 x 60): a gait (the replay <= 1e-6), the stored terms those of the optimum, the mean
     speed met, the cone kept at every point (from the rigid model), its four phases stored
     (~25 s: the CasADi build, IPOPT, the replays and two contact strides)."""
-    from walkerlab.optimal.scene import optimize_scene
-    from walkerlab.optimal.stride import STRIDE_PHASES
+    from walkerlab.optimal.drivers.step import optimize_scene
+    from walkerlab.optimal.transcription.stride import STRIDE_PHASES
 
     scene, data, walker, g, _fns = asym
     path = tmp_path / "optimize.h5"

@@ -153,7 +153,7 @@ def _ledger(name: str):
 
 # rabbit: its fixed point takes ~2 min (ten coordinates, high-gain PD); tests/test_rabbit.py
 # closes its ledger on one step from the fixed point its scene stores; flat feet (passive
-# and with an ankle push-off): walkerlab.analysis.gait.energy_flat; rabbit_optimal: no gait
+# and with an ankle push-off): walkerlab.analysis.gait.energy_modes; rabbit_optimal: no gait
 # of its own (its step is optimised: tests/test_optimize_five_link.py)
 @pytest.mark.parametrize("name", [n for n in PASSIVE + POWERED
                                   if n not in ("rabbit", "rabbit_optimal")])

@@ -30,8 +30,8 @@ WALKER_COUNT = re.compile(r"^(nq|NQ|n_coordinates|n_states)$")
 #: (path relative to walkerlab/, source of the subscript): why it is not a state
 ALLOWED = {("config/errors.py", "x[:1]"): "the first character of an exponent string",
            # the benchmark's plain-numba baseline is a hand-written compass gait, a model of
-           # its own that shares nothing with the library (walkerlab.bench.minimal_compass)
-           **{("bench/minimal_compass.py", f"x[{i}]"): "the baseline's own compass state"
+           # its own that shares nothing with the library (walkerlab.bench.minimal_collocation)
+           **{("bench/minimal_collocation.py", f"x[{i}]"): "the baseline's own compass state"
               for i in range(4)}}
 
 

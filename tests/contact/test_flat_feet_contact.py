@@ -169,7 +169,7 @@ def test_step_modes_match_the_rigid_view():
     from walkerlab.integrate.contact import ContactLimits, integrate_contact
     from walkerlab.integrate.rigid import integrate_step
     from walkerlab.integrate.solver import Solver
-    from walkerlab.models.hybrid.rigid_flat import make_flat_walker, mode_of, mode_sequence
+    from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker, mode_of, mode_sequence
 
     d = copy.deepcopy(SCENE)
     d["walker"]["leg"]["foot"]["ankle"].update(

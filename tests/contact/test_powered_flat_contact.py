@@ -223,7 +223,7 @@ def test_the_flat_feet_optimums_contact_replay(gait):
     torque path adds nothing when the torque is zero.  Against the rigid optimum's
     0.7576 s it is +7.2 %: the flat-footed contact model itself walks slower than the rigid
     one (configs/flat_feet_optimal.yaml's note), so the issue's 3 % is not met here."""
-    from walkerlab.optimal.contact_replay import contact_replay_phased
+    from walkerlab.optimal.replay.contact import contact_replay_phased
 
     T = gait.step_period
     res = SimpleNamespace(t=np.array([0.0, T / 2, T]), u=np.zeros(3), x=gait.x[None],

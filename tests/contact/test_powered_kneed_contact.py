@@ -91,7 +91,7 @@ def test_the_kneed_optimums_contact_replay_keeps_its_period(gait):
     within 3 % of the rigid one (measured +1.99 %: the first two steps' start-up transient,
     configs/kneed.yaml's note; optimize's own replay of the collocated torque over 2
     strides: +1.26 %)."""
-    from walkerlab.optimal.contact_replay import contact_replay_phased
+    from walkerlab.optimal.replay.contact import contact_replay_phased
 
     T = gait.step_period
     res = SimpleNamespace(t=np.array([0.0, T / 2, T]), u=np.zeros(3), x=gait.x[None],

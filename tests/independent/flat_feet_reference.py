@@ -1,5 +1,5 @@
 """Independent reference of a walker on flat feet with ankle springs (rigid view), sharing no
-code with walkerlab's generator (:mod:`walkerlab.codegen.flatfoot`).
+code with walkerlab's generator (:mod:`walkerlab.codegen.foot_modes`).
 
 Written from scratch for the point-mass walker of ``configs/flat_feet.yaml`` (hip mass ``M``,
 one point mass ``m`` per leg at ``b`` from the hip, leg ``L`` hip to ankle; massless flat

@@ -45,7 +45,7 @@ def test_floating_layout_rates_and_legs():
 
 
 def test_built_rigid_walker_layout_is_its_state_names():
-    from walkerlab.models.hybrid.compass_gait import make_compass_gait
+    from walkerlab.models.hybrid.printed_equations import make_compass_gait
 
     w = make_compass_gait(1.0, 5.0, 10.0, 9.81, 0.5, 0.0174, "derived")
     assert list(w.layout().names) == w.state_names()

@@ -239,7 +239,7 @@ def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
         ``{field: (lo, hi)}``: dotted numeric scene fields and their bounds in the fields'
         units (``{"walker.hip_mass_kg": (5, 20)}``), as ``--design FIELD=LO:HI``.
     objective : str
-        With ``design``: a measure of :data:`walkerlab.optimal.design.MEASURES`
+        With ``design``: a measure of :data:`walkerlab.optimal.design.search.MEASURES`
         (``step_period``, ``step_length``, ``speed``, ``cost_of_transport``,
         ``max_abs_multiplier``, ``gait_sensitivity_norm``, ``basin_share``, ``mfpt``).
     maximize : bool
@@ -270,7 +270,7 @@ def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
         CasADi missing (``pip install 'walkerlab[optimize]'``), or as :func:`fixed_point`.
     """
     from walkerlab.config import SceneError
-    from walkerlab.optimal.design import MEASURES
+    from walkerlab.optimal.design.search import MEASURES
     from walkerlab.stages import pipeline
 
     sc, runs = as_scene(scene), runs_folder(runs_dir)

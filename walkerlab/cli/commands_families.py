@@ -286,7 +286,7 @@ def optimize(scene: Path | None = SceneArg,
 
 def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> None:
     """``walkerlab optimize --design``: parse FIELD=LO:HI, run, print the optimum."""
-    from walkerlab.optimal.design import MEASURES, design_bounds
+    from walkerlab.optimal.design.search import MEASURES, design_bounds
     from walkerlab.stages import optimize as stage
     from walkerlab.stages import pipeline
 

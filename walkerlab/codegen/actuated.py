@@ -243,7 +243,7 @@ def actuated_module(structure, joints):
 
     def build() -> str:
         if structure.free_knees:
-            from walkerlab.codegen.five_link import derive_five_link
+            from walkerlab.codegen.free_joints import derive_five_link
 
             eq = derive_five_link(structure)
         else:

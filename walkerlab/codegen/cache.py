@@ -54,19 +54,19 @@ def _generator_hash() -> str:
 @cache
 def _flat_generator_hash() -> str:
     """sha256 of the flat-foot generator's source (once per process)."""
-    return hashlib.sha256((Path(__file__).parent / "flatfoot.py").read_bytes()).hexdigest()
+    return hashlib.sha256((Path(__file__).parent / "foot_modes.py").read_bytes()).hexdigest()
 
 
 @cache
 def _five_link_generator_hash() -> str:
     """sha256 of the free-jointed (five-link) generator's source (once per process)."""
-    return hashlib.sha256((Path(__file__).parent / "five_link.py").read_bytes()).hexdigest()
+    return hashlib.sha256((Path(__file__).parent / "free_joints.py").read_bytes()).hexdigest()
 
 
 def cache_key(structure) -> str:
     """Cache key (hex, 24 characters) of a structure for the current generator (a
-    flat-footed walker's also covers :mod:`walkerlab.codegen.flatfoot`, a free-kneed one's
-    :mod:`walkerlab.codegen.five_link`, which no other structure's key reads)."""
+    flat-footed walker's also covers :mod:`walkerlab.codegen.foot_modes`, a free-kneed one's
+    :mod:`walkerlab.codegen.free_joints`, which no other structure's key reads)."""
     h = hashlib.sha256(structure.key().encode())
     h.update(_generator_hash().encode())
     if structure.foot == "flat":
@@ -128,14 +128,14 @@ def generated_module(structure) -> dict:
     path = folder / f"{key}.py" if folder is not None else None
     ns = _read(path) if path is not None else None
     if ns is None and structure.foot == "flat":
-        from walkerlab.codegen import flatfoot
+        from walkerlab.codegen import foot_modes as flatfoot
 
         body = flatfoot.generate_flat(structure, key)
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))
         if path is not None:
             write_source(path, body)
     if ns is None and structure.free_knees:
-        from walkerlab.codegen import five_link
+        from walkerlab.codegen import free_joints as five_link
 
         body = five_link.generate_five_link(structure, key)
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))

@@ -32,7 +32,7 @@ def compiled_module(structure):
 
     def build() -> str:
         if structure.foot == "flat":  # a flat foot's modes: their own generator
-            from walkerlab.codegen import flatfoot
+            from walkerlab.codegen import foot_modes as flatfoot
 
             return flatfoot.generate_flat_compiled(structure, key)
         from walkerlab.codegen import source as codegen
@@ -55,7 +55,7 @@ class CompiledFlow:
         Parameter vector (``structure.param_names`` order).
     name : str
         ``"flow"`` or ``"flow_locked"`` (kneed walker, knee locked); a flat foot's
-        ``"flow_<mode>"`` (:func:`walkerlab.codegen.flatfoot.generate_flat_compiled`).
+        ``"flow_<mode>"`` (:func:`walkerlab.codegen.foot_modes.generate_flat_compiled`).
     guards : tuple of (str, float), optional
         For each guard of the phase, in order: the generated guard it is and a constant added
         to it (``Guard.function = guard_<name> + offset``); the guards are then evaluated in

@@ -15,7 +15,7 @@ vertical, positive when the foot is ahead of the hip.  A torso hinged at the hip
 five-link biped of Westervelt, Grizzle & Koditschek 2003: free knees, ``torso.coupling:
 hinged``) adds its own coordinate ``torso_angle`` last (from the upward vertical, positive
 leaning back, as the rigid view's); its free knees have no stop (as in the rigid view,
-:mod:`walkerlab.codegen.five_link`); a bisecting torso is eliminated (its angle the mean of
+:mod:`walkerlab.codegen.free_joints`); a bisecting torso is eliminated (its angle the mean of
 the legs').  A point at distance ``d`` along a link
 at angle ``psi`` from the link's proximal joint is at ``joint + d (sin psi, -cos psi)``.
 
@@ -176,7 +176,7 @@ class FloatingEquations:
     knees : tuple of (int, int)
         Per leg with a knee stop, the indices in ``q`` of its thigh and shank angles (by
         their names); empty for straight legs and for free knees (``knee.lock: free``: no
-        stop, as in the rigid view, :mod:`walkerlab.codegen.five_link`).
+        stop, as in the rigid view, :mod:`walkerlab.codegen.free_joints`).
     contacts : tuple of str
         Names of the contact points, in the order of ``feet`` (:func:`contact_names`).
     point_legs : tuple of int

@@ -25,7 +25,7 @@ Outside its knots a table is held at its end values (slope and curvature 0), as
 :func:`walkerlab.models.actuation.phase_reference`.
 
 Kind 3, a *phase-variable feed-forward* law (an optimised step replayed as virtual
-constraints, :class:`walkerlab.optimal.phase_replay.PhaseLaw`): ``tau = U(T(s)) - K (delta -
+constraints, :class:`walkerlab.optimal.replay.phase.PhaseLaw`): ``tau = U(T(s)) - K (delta -
 h(s)) - D (ddelta - h'(s) ds)``, every spline extrapolated with its end interval's cubic
 (:class:`scipy.interpolate.PPoly`'s ``extrapolate=True``).  Its table: the knots ``s``
 (``n``), ``h``'s coefficients as above, then ``T``'s (the time the optimised step passes
@@ -34,7 +34,7 @@ h(s)) - D (ddelta - h'(s) ds)``, every spline extrapolated with its end interval
 ``c0 = 0``).
 
 Kind 4, a *piecewise* phase-variable law (one kind-3 law per phase of a step, the one in
-force chosen by ``s``: :class:`walkerlab.optimal.hip_phase_replay.PiecewisePhaseLaw`): the
+force chosen by ``s``: :class:`walkerlab.optimal.replay.hip_phase.PiecewisePhaseLaw`): the
 header's ``knots`` field holds the count of pieces ``P``; the table holds ``sign`` (the
 phase variable's direction over the step), the ``P - 1`` breaks (``s`` where each piece
 after the first begins), each piece's offset from the table's start, then each piece as

@@ -1,5 +1,5 @@
 """The ``optimize:`` section: a periodic gait of a powered walker by direct collocation
-(``walkerlab optimize``; :mod:`walkerlab.optimal.collocation`).
+(``walkerlab optimize``; :mod:`walkerlab.optimal.transcription.step`).
 
 Sources: Kelly (2017), "An introduction to trajectory optimization: how to do your own
 direct collocation", SIAM Review 59(4):849-904 (Hermite-Simpson collocation); CasADi's

@@ -53,7 +53,7 @@ def _passive(scene) -> HybridWalker:
     """The passive walker of the scene (its actuators left out)."""
     w = scene.walker
     if w.model == "compass_gait":
-        from walkerlab.models.hybrid.compass_gait import make_compass_gait
+        from walkerlab.models.hybrid.printed_equations import make_compass_gait
 
         return make_compass_gait(
             w.leg_length_m, w.leg_mass_kg, w.hip_mass_kg, w.gravity_m_per_s2,

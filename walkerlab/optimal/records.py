@@ -1,6 +1,7 @@
 """``optimize.h5``'s records of an optimised step that every transcription's scene driver
-writes the same way (:mod:`walkerlab.optimal.scene`, :mod:`walkerlab.optimal.phased_scene`,
-:mod:`walkerlab.optimal.stride_scene`, :mod:`walkerlab.optimal.five_link_scene`): the
+writes the same way (:mod:`walkerlab.optimal.drivers.step`,
+:mod:`walkerlab.optimal.drivers.mode_sequence`,
+:mod:`walkerlab.optimal.drivers.stride`, :mod:`walkerlab.optimal.drivers.free_joints`): the
 phase-variable replays and the solver's history with the walker's energies."""
 
 from __future__ import annotations
@@ -13,10 +14,10 @@ __all__ = ["not_a_gait_outcome", "phase_replays", "step_record"]
 def phase_replays(scene, data, res, tau) -> tuple[dict, str]:
     """The phase-variable replays of the optimised step ``res`` (``tau``: its torque of
     the time since the heel strike) as ``optimize.h5``'s records, and why there are none
-    (:func:`walkerlab.optimal.hip_phase_replay.hip_phase_records`, the scene's solver;
+    (:func:`walkerlab.optimal.replay.hip_phase.hip_phase_records`, the scene's solver;
     ``({}, "")`` unless ``optimize.phase_replay`` is on: off by default here)."""
     from walkerlab.integrate.solver import Solver
-    from walkerlab.optimal.hip_phase_replay import hip_phase_records
+    from walkerlab.optimal.replay.hip_phase import hip_phase_records
 
     if not scene.optimize.phase_replay:  # None: off (a five-link biped's default is on)
         return {}, ""

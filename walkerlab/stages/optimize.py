@@ -3,7 +3,7 @@
 Reads the scene's ``optimize`` section and its gait from ``fixedpoint.h5`` (the pipeline
 runs ``fixedpoint`` first, :mod:`walkerlab.stages.pipeline`; the collocation starts from
 one step of it; a five-link biped's from its targets, no upstream gait), optimises by
-:func:`walkerlab.optimal.scene.optimize_scene` (CasADi + IPOPT) and replays the result
+:func:`walkerlab.optimal.drivers.step.optimize_scene` (CasADi + IPOPT) and replays the result
 on the rigid model.  Skipped when the scene sections, the upstream gait and the code are
 unchanged.
 """
@@ -54,12 +54,12 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         targets).  A missing ``optimize`` section of another walker runs with its
         defaults (said in one note), a missing ``fixedpoint`` section with its.
     """
-    from walkerlab.optimal.scene import five_link, no_gait_of_its_own, optimize_scene
+    from walkerlab.optimal.drivers.step import five_link, no_gait_of_its_own, optimize_scene
 
     missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
     if five_link(scene):  # a five-link biped: its guess is built from the targets
-        from walkerlab.optimal.five_link_scene import check_targets
+        from walkerlab.optimal.drivers.free_joints import check_targets
 
         try:
             check_targets(scene.optimize)  # at once, before the collocation is built
@@ -91,11 +91,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
 
 def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
     """``optimize.h5`` of a walker with no gait of its own (a passive walker on level
-    ground: :func:`walkerlab.optimal.scene.no_gait_of_its_own`): no upstream gait, the
+    ground: :func:`walkerlab.optimal.drivers.step.no_gait_of_its_own`): no upstream gait, the
     starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
     refused at once without them."""
+    from walkerlab.optimal.drivers.step import optimize_scene
     from walkerlab.optimal.guess import has_target, target_numbers
-    from walkerlab.optimal.scene import optimize_scene
 
     o = scene.optimize
     try:
@@ -121,8 +121,8 @@ def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
 
 def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
     """``optimize.h5`` of a five-link biped (no upstream gait:
-    :func:`walkerlab.optimal.five_link_scene.optimize_five_link_scene`)."""
-    from walkerlab.optimal.five_link_scene import optimize_five_link_scene
+    :func:`walkerlab.optimal.drivers.free_joints.optimize_five_link_scene`)."""
+    from walkerlab.optimal.drivers.free_joints import optimize_five_link_scene
 
     def compute():
         try:
@@ -141,7 +141,7 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
     (:func:`walkerlab.io.runpaths.design_stem`: one per set of fields and objective, so
     another study does not replace it): the fields within ``bounds``
     (``{field: (lo, hi)}``) that minimise (``maximize``: maximise) the gait measure
-    ``objective`` (:func:`walkerlab.optimal.design.design_optimize`).
+    ``objective`` (:func:`walkerlab.optimal.design.search.design_optimize`).
 
     Raises
     ------
@@ -149,7 +149,7 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
         An unknown objective or field, or no gait along the way (one line).
     """
     from walkerlab.analysis.gait.poincare import FixedPointNotFound
-    from walkerlab.optimal.design import design_optimize
+    from walkerlab.optimal.design.search import design_optimize
 
     require(scene, "fixedpoint", "optimize")
     up = stage_artifact(scene, runs_root, "fixedpoint")
@@ -178,7 +178,7 @@ def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
     d = schema.load(stage_artifact(scene, runs_root, "optimize"))
     sticks = None
     if d.torque_names != ("hip",):  # a five-link biped: its step as stop action
-        from walkerlab.optimal.five_link_scene import stick_figures
+        from walkerlab.optimal.drivers.free_joints import stick_figures
 
         sticks = stick_figures(scene, d)
     return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks)

@@ -43,7 +43,7 @@ class BodySpec:
         return out + ["off_axis"] if self.off_axis else out
 
 
-#: Stance-foot modes of a flat foot, in the order a step meets them (codegen/flatfoot.py).
+#: Stance-foot modes of a flat foot, in the order a step meets them (codegen/foot_modes.py).
 FLAT_FOOT_MODES = ("heel_contact", "foot_flat", "heel_off")
 #: Short role tags of per-leg parameters (``m_sw_<body>``) when the legs differ.
 ROLE_TAG = {"swing": "sw", "stance": "st"}
@@ -93,7 +93,7 @@ class Structure:
     free_knees : bool
         Both knees free, never locking (``knee.lock: free``; needs ``knee``): every link
         angle is a coordinate (roles :data:`FREE_KNEE_ROLES`), derived by
-        :mod:`walkerlab.codegen.five_link`.
+        :mod:`walkerlab.codegen.free_joints`.
     hinged_torso : bool
         The torso (``torso`` bodies) is jointed at the hip with its own coordinate, role
         ``torso`` (its angle from the upward vertical, positive leaning back); needs
@@ -179,7 +179,7 @@ class Structure:
 def check_floating_view(structure: Structure) -> None:
     """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
     knees (the five-link biped) on legs that differ, on feet other than points, or with
-    springs (what the rigid view of free knees, :mod:`walkerlab.codegen.five_link`, refuses
+    springs (what the rigid view of free knees, :mod:`walkerlab.codegen.free_joints`, refuses
     too).
 
     Raises

@@ -438,7 +438,7 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
 
 # ---------------------------------------------------------------------------- foot modes
 #: Mode of a flat foot by which of its points carry load (heel, toe): the rigid view's
-#: names (:mod:`walkerlab.models.hybrid.rigid_flat`), ``off`` when neither does.
+#: names (:mod:`walkerlab.models.hybrid.rigid_foot_modes`), ``off`` when neither does.
 FOOT_MODES = {(True, False): "heel_contact", (True, True): "foot_flat",
               (False, True): "heel_off", (False, False): "off"}
 

@@ -136,13 +136,13 @@ def trajectory_ledger(traj) -> dict[str, np.ndarray]:
     """:func:`step_ledger` of every step of a :class:`~walkerlab.integrate.rigid.
     HybridTrajectory`, each column (steps,); flat feet (no generated flow matrices: their
     modes pin the heel or the toe) by
-    :func:`walkerlab.analysis.gait.energy_flat.flat_trajectory_ledger`, empty for flat
+    :func:`walkerlab.analysis.gait.energy_modes.flat_trajectory_ledger`, empty for flat
     feet on legs that differ."""
     from walkerlab.integrate.rigid import other_leg
 
     w = traj.walker
     if w.matrices is None:
-        from walkerlab.analysis.gait.energy_flat import flat_trajectory_ledger
+        from walkerlab.analysis.gait.energy_modes import flat_trajectory_ledger
 
         return {} if w.mirror is not None else flat_trajectory_ledger(traj)
     rows = {k: [] for k in LEDGER_NAMES}

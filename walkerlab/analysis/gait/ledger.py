@@ -1,6 +1,6 @@
 """What every energy ledger of a rigid walker shares: its columns and the quadrature of a
 power over a step (:mod:`walkerlab.analysis.gait.energy` for generated models,
-:mod:`walkerlab.analysis.gait.energy_flat` for flat feet)."""
+:mod:`walkerlab.analysis.gait.energy_modes` for flat feet)."""
 
 from __future__ import annotations
 

@@ -30,7 +30,7 @@ def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
     if getattr(scene.walker, "actuation", None) is not None:  # the printed ones are passive
         return own
     if compare and scene.walker.model == "compass_gait" and scene.published is not None:
-        from walkerlab.models.hybrid.compass_gait import VARIANTS
+        from walkerlab.models.hybrid.printed_equations import VARIANTS
 
         return own + tuple(v for v in VARIANTS if v != scene.ideal.variant)
     return own

@@ -119,7 +119,8 @@ class OptimizeData:
     replay_step_period_s: float = float("nan")
     collocated_start_error: float = float("nan")
     cpu_time_s: float = float("nan")
-    ipopt_history: dict = field(default_factory=dict)  # walkerlab.optimal.ipopt.HISTORY
+    # walkerlab.optimal.transcription.ipopt.HISTORY
+    ipopt_history: dict = field(default_factory=dict)
     energy: dict = field(default_factory=dict)  # kinetic, potential (time,) [energy_unit]
     energy_unit: str = "J"
     phase_names: tuple = ()
@@ -299,7 +300,7 @@ DESIGN_STAGE = "optimize_design"
 
 def write_design(f, r) -> None:
     """Fill an open artifact with a design optimisation ``r``
-    (:class:`walkerlab.optimal.design.DesignResult`): ``fields`` (attribute), ``values`` (k,)
+    (:class:`walkerlab.optimal.design.search.DesignResult`): ``fields`` (attribute), ``values`` (k,)
     in the fields' units, ``objective_value``, ``gradient`` (k,) [measure unit per field
     unit; NaN where the measure is not smooth], ``history/values`` (m, k) and
     ``history/objective`` (m,); attributes ``objective``, ``objective_unit``, ``success``,

@@ -141,7 +141,7 @@ def checkerboard_lanes(step_length: float, n_steps: int) -> tuple[np.ndarray, np
 def compass_gait_data(L=1.0, m=5.0, MH=10.0, a=0.5, g=9.81, phi=0.0174):
     """:class:`~walkerlab.walker.description.WalkerData` of the paper's compass gait (Table 1):
     leg length L [m], leg mass m [kg] at ``a`` [m] from the foot, hip mass MH [kg]."""
-    from walkerlab.models.hybrid.compass_gait import compass_gait_structure
+    from walkerlab.models.hybrid.printed_equations import compass_gait_structure
     from walkerlab.walker.description import WalkerData
 
     st = compass_gait_structure()

@@ -101,7 +101,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
         return None
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None and data.structure.free_knees:
-        from walkerlab.models.hybrid.rigid_five_link import guard_outputs
+        from walkerlab.models.hybrid.rigid_free_joints import guard_outputs
 
         guards = guard_outputs(phase, data)
     if guards is None:

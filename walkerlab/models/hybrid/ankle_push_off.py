@@ -4,7 +4,7 @@ and/or a constant plantarflexion torque acts, as Mizani et al. (2018; the paper'
 power the walker in ADAMS.
 
 On the stance ankle angle ``a`` (the sole's angle from the stance leg's perpendicular,
-positive toe up; :mod:`walkerlab.codegen.flatfoot`) the ankle spring gives ``-k (a - r)``;
+positive toe up; :mod:`walkerlab.codegen.foot_modes`) the ankle spring gives ``-k (a - r)``;
 the push-off adds ``-k_po (a - r_po) - tau_0``.  The sum is again a linear spring,
 ``-(k + k_po) (a - r_eff)`` with ``r_eff = (k r + k_po r_po - tau_0) / (k + k_po)``, so the
 heel-off mode runs on the walker's own generated equations with the ankle numbers
@@ -89,7 +89,7 @@ def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
     """
     from walkerlab.codegen.cache import functions
     from walkerlab.models.hybrid.push_off import push_off_flat
-    from walkerlab.models.hybrid.rigid_flat import make_flat_walker
+    from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 
     if spec.torques and spec.push_off is None and spec.ankle_push_off is None:
         from walkerlab.models.hybrid.flat_hip_torque import actuate_flat_hips

@@ -1,5 +1,5 @@
 """Hip torques on a walker with flat feet in the rigid view: each stance-foot mode's
-generated flow (:mod:`walkerlab.codegen.flatfoot`) gains the torque's acceleration
+generated flow (:mod:`walkerlab.codegen.foot_modes`) gains the torque's acceleration
 ``M_mode^-1 B tau`` (``B = d(swing - stance)/dq``: ``+tau`` on the swing leg, ``-tau`` on the
 stance leg, none on the ankle coordinate, which is the sole's angle from the stance leg), in
 foot flat through the locked foot (``a . qdd = 0``, ``a = d phi / dq``:
@@ -53,7 +53,7 @@ def actuate_flat_hips(walker: HybridWalker, data, spec) -> HybridWalker:
     """
     from walkerlab.codegen.cache import functions
     from walkerlab.models.hybrid.actuators import Actuators
-    from walkerlab.models.hybrid.rigid_flat import make_flat_walker
+    from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 
     for i, t in enumerate(spec.torques):
         if t.joint != "hip" or t.scaled_by != "none":

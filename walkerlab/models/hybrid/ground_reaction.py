@@ -152,7 +152,7 @@ class StanceReaction:
         A walker this cannot check: massless bodies beside massive ones other than the hip
         (no floating view, :data:`walkerlab.codegen.floating.MASSLESS_MESSAGE`) or flat
         feet (whose rigid model checks its own contact forces,
-        :mod:`walkerlab.models.hybrid.rigid_flat`).
+        :mod:`walkerlab.models.hybrid.rigid_foot_modes`).
     """
 
     def __init__(self, walker, data):

@@ -227,7 +227,7 @@ FLAT_PIN = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
 @dataclass
 class FlatPushOff(Transitions):
     """Push-off at the trailing toe of a flat foot, then the heel strike
-    (:func:`walkerlab.codegen.flatfoot.derive_flat`'s ``push_off_<pin>`` systems).
+    (:func:`walkerlab.codegen.foot_modes.derive_flat`'s ``push_off_<pin>`` systems).
 
     In the extended coordinates ``qe = (q, x_f, y_f)`` of the mode's pinned point (heel or
     toe), the impulse ``P`` at the stance toe along ``e`` (toe -> hip), the ankle's rate held
@@ -321,7 +321,7 @@ def push_off_flat(walker, fns: dict, spec, ankle_push=None):
     Parameters
     ----------
     walker : HybridWalker
-        A flat-footed walker (:func:`walkerlab.models.hybrid.rigid_flat.make_flat_walker`).
+        A flat-footed walker (:func:`walkerlab.models.hybrid.rigid_foot_modes.make_flat_walker`).
     fns : dict
         Its generated functions (the walker's own numbers: the heel strike's).
     spec : walkerlab.config.actuation.Actuation

@@ -14,7 +14,8 @@ Phases of a step (point feet, straight legs):
   zero: the swing foot reaches the slope), or a fall: the swing leg falls back behind the
   stance leg, or the hip reaches the slope.
 
-Flat feet on ankle springs have their own phase graph (:mod:`walkerlab.models.hybrid.rigid_flat`).
+Flat feet on ankle springs have their own phase graph
+(:mod:`walkerlab.models.hybrid.rigid_foot_modes`).
 
 Phases of a step with a knee (McGeer 1990 "Passive walking with knees"; Hsu Chen 2007):
 
@@ -43,7 +44,7 @@ import numpy as np
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.compiled import CompiledFlow
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
-from walkerlab.models.hybrid.rigid_flat import make_flat_walker
+from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 from walkerlab.walker.description import WalkerData
 
 #: Penetration of the swing foot (fraction of the leg length) reported as scuffing.
@@ -133,7 +134,7 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
     if data.structure.foot == "flat":  # modes of a flat foot: their own phase graph
         return make_flat_walker(data, name, variant)
     if data.structure.free_knees:  # every joint free (five-link bipeds): one flow
-        from walkerlab.models.hybrid.rigid_five_link import make_five_link_walker
+        from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
 
         return make_five_link_walker(data, name, variant)
     f = functions(data)

@@ -18,7 +18,7 @@ passive gait of configs/flat_feet.yaml): ``heel_contact:early_swing`` until ``fo
 ``heel_off:late_swing`` until ``heel_strike`` (the toe-pinned map).
 
 Each phase's flow, guard and reset in CasADi come from the walker's symbolic equations
-(:func:`walkerlab.codegen.symbolic.derive`, :func:`walkerlab.codegen.flatfoot.derive_flat`:
+(:func:`walkerlab.codegen.symbolic.derive`, :func:`walkerlab.codegen.foot_modes.derive_flat`:
 the ones its generated code is printed from): a free flow ``M qdd = B u - C dq - G``; a
 locked one (knee, flat foot) as the square system ``[S^T M; J] qdd = [S^T (-C dq - G); 0]``
 with the hip torque's acceleration projected on the lock (``M^-1 (B u + a lam)``,
@@ -29,10 +29,10 @@ thigh or leg): ``+u`` on the swing leg, ``-u`` on the stance leg.  A guard on a 
 force (heel off) reads the ground reaction from the phase's accelerations, torque included;
 flat feet's stance contacts are kept pushing (normal forces ``>= 0``) at every point.
 
-Per phase ``p`` (:mod:`walkerlab.optimal.phased_collocation`; Kelly 2017, SIAM Review
+Per phase ``p`` (:mod:`walkerlab.optimal.transcription.mode_sequence`; Kelly 2017, SIAM Review
 59(4):849-904, Sec. 4, separated Hermite-Simpson; the multi-phase form of Betts 2010,
 Ch. 4.7): ``2 N_p + 1`` points on ``[0, T_p]``, the defects of
-:mod:`walkerlab.optimal.collocation`, and at the phase's end ``guard_p = 0`` with
+:mod:`walkerlab.optimal.transcription.step`, and at the phase's end ``guard_p = 0`` with
 ``d * dguard_p/dt >= touchdown_rate`` (``d`` the guard's crossing direction: a transversal
 crossing, as the rigid model's event needs; a force guard's rate leaves out the torque's
 own rate), and the guard's sign kept inside the phase (``d * guard_p <= 0`` at its
@@ -41,7 +41,7 @@ reset_p(x_p(T_p))``; periodic: ``x_0(0) = heel_strike(x_last(T_last))``.  Object
 ``int u^2 dt`` (Simpson on every phase), the peak torque (epigraph), the cost of transport
 (the hip's positive work by slack variables ``s >= 0, s >= u d(hip)/dt`` at every point of
 every phase, per weight and step length, with a small effort weight; as
-:mod:`walkerlab.optimal.collocation`) or a weighted sum.  Optional friction cone: the
+:mod:`walkerlab.optimal.transcription.step`) or a weighted sum.  Optional friction cone: the
 ground's resultant on the stance foot (``sum m_i (a_i + g)``, the phase's accelerations;
 a kneed walker's stance foot, flat feet's pinned point or whole flat foot) with ``F_n >= 0``
 and ``|F_t| <= mu F_n`` at every point.  No push-off: the rigid kneed and flat-footed
@@ -49,7 +49,7 @@ models carry no push-off impulse.  The step period is ``sum T_p``.
 
 A result is a gait after its replay on the rigid model (its generated code, its own
 guards and resets) with the optimised torque as a function of the time since the heel
-strike (each phase's piecewise quadratic): :func:`walkerlab.optimal.phased_collocation.
+strike (each phase's piecewise quadratic): :func:`walkerlab.optimal.transcription.mode_sequence.
 replay_phases`.
 """
 
@@ -220,10 +220,10 @@ class _Modes:
         ``values``)."""
         import casadi as ca
 
-        from walkerlab.optimal.collocation import _to_casadi
+        from walkerlab.codegen.casadi_functions import casadi_function
 
         args = x if not extra else ca.vertcat(x, *values)
-        return _to_casadi(exprs, self.xs + list(extra), self.vals)(args)
+        return casadi_function(exprs, self.xs + list(extra), self.vals)(args)
 
     def accel(self, M, C, G, Mfree, lock, x, u):
         """``qdd`` of ``M qdd = -C dq - G`` plus the hip torque's ``Mfree^-1 B u`` (through
@@ -263,7 +263,7 @@ class _Modes:
         points (``points``: sympy positions by name) and the accelerations ``f[n:]``."""
         from types import SimpleNamespace
 
-        from walkerlab.optimal.collocation import _ground_reaction
+        from walkerlab.optimal.transcription.step import _ground_reaction
 
         return _ground_reaction(self.data, SimpleNamespace(q=self.q, points=points),
                                 self.xs, self.vals, x, f[self.n:])
@@ -314,10 +314,10 @@ class _KneedModes(_Modes):
 
     def push_off(self, gname, x, P, k):
         """Straight legs' heel strike after a push-off ``P`` [N s]: the one-step
-        transcription's extended-coordinate map (:mod:`walkerlab.optimal.collocation`)."""
+        transcription's extended-coordinate map (:mod:`walkerlab.optimal.transcription.step`)."""
         import casadi as ca
 
-        from walkerlab.optimal.collocation import _reset_extended
+        from walkerlab.optimal.transcription.step import _reset_extended
 
         if gname != "heel_strike" or self.data.structure.knee:
             return None
@@ -336,7 +336,7 @@ class _KneedModes(_Modes):
 
 
 class _FlatModes(_Modes):
-    """Flat feet (:mod:`walkerlab.codegen.flatfoot`): phases ``<mode>:<swing part>`` on the
+    """Flat feet (:mod:`walkerlab.codegen.foot_modes`): phases ``<mode>:<swing part>`` on the
     mode's flow (foot flat: the locked one, the lock ``phi = stance + ankle + gamma``);
     ``foot_slap`` (plastic), ``midstance`` (no jump), ``heel_off`` (the heel's normal force
     ``N - N_toe`` from the mode's accelerations; no jump), ``heel_strike`` (the mode's own
@@ -345,7 +345,7 @@ class _FlatModes(_Modes):
     PIN = {"heel_contact": "heel", "foot_flat": "heel", "heel_off": "toe"}
 
     def __init__(self, data):
-        from walkerlab.codegen.flatfoot import derive_flat
+        from walkerlab.codegen.foot_modes import derive_flat
 
         eq = derive_flat(data.structure)
         super().__init__(data, eq, eq.q, eq.dq, eq.params, eq.leg_angles)

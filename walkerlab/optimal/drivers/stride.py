@@ -1,10 +1,10 @@
 """A scene's optimal gait when its walker's legs differ: the stride transcription of
-:mod:`walkerlab.optimal.stride` set up from the scene, started from one stride of the
+:mod:`walkerlab.optimal.transcription.stride` set up from the scene, started from one stride of the
 scene's gait (``fixedpoint``: the stride map's fixed point), of a continuation artifact's
 gait or from another stride's ``optimize.h5`` (``optimize.initial_guess``), replayed on the
 rigid model,
 the stride map's Floquet multipliers from the replay, and replayed in the contact model
-(:func:`walkerlab.optimal.contact_replay.contact_replay_stride`)."""
+(:func:`walkerlab.optimal.replay.contact.contact_replay_stride`)."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ __all__ = ["optimize_stride_scene", "starting_stride"]
 def _check(o, pushes: bool) -> None:
     """Refuse what the stride transcription does not take (one line naming the field);
     ``pushes``: the stride has a push-off (fixed or free)."""
-    from walkerlab.optimal.phased_collocation import PHASED_OBJECTIVES
+    from walkerlab.optimal.transcription.mode_sequence import PHASED_OBJECTIVES
 
     asked = dict(o.weights or {}) if o.objective == "weighted" else {o.objective: 1.0}
     known = PHASED_OBJECTIVES + (("push_off_work",) if pushes else ())
@@ -40,9 +40,9 @@ def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
     Returns
     -------
     guess : list of (name, t, x)
-        The four phases :data:`walkerlab.optimal.stride.STRIDE_PHASES`
-        (:func:`walkerlab.optimal.stride.stride_guess`, or
-        :func:`walkerlab.optimal.phased_collocation.optimized_guess` on ``2 intervals``).
+        The four phases :data:`walkerlab.optimal.transcription.stride.STRIDE_PHASES`
+        (:func:`walkerlab.optimal.transcription.stride.stride_guess`, or
+        :func:`walkerlab.optimal.transcription.mode_sequence.optimized_guess` on ``2 intervals``).
     torque : list of ndarray or None
         Each phase's hip torque [N m] (another ``optimize.h5``'s; None: 0).
 
@@ -55,8 +55,8 @@ def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
     """
     from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.guess import read_guess
-    from walkerlab.optimal.phased_collocation import optimized_guess
-    from walkerlab.optimal.stride import STRIDE_PHASES, stride_guess
+    from walkerlab.optimal.transcription.mode_sequence import optimized_guess
+    from walkerlab.optimal.transcription.stride import STRIDE_PHASES, stride_guess
 
     kind, got = None, None
     if scene.optimize.initial_guess is not None:
@@ -79,7 +79,7 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
         the guess: :func:`starting_stride`).
     data : WalkerData
         The scene's walker (``data.mirror`` the other leg's step).
-    spec : walkerlab.optimal.collocation.CollocationSpec
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
         From the ``optimize`` section (``intervals`` per step, shared among its phases).
     x_gait : ndarray (2n,)
         The scene's gait just after heel strike, ``leg1`` about to swing (``fixedpoint.h5``).
@@ -103,11 +103,11 @@ def optimize_stride_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
 
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.contact_replay import contact_replay_stride
-    from walkerlab.optimal.phased_collocation import collocate_phases
-    from walkerlab.optimal.phased_scene import replay_multipliers
+    from walkerlab.optimal.drivers.mode_sequence import replay_multipliers
     from walkerlab.optimal.records import not_a_gait_outcome
-    from walkerlab.optimal.stride import replay_stride, stride_functions
+    from walkerlab.optimal.replay.contact import contact_replay_stride
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.stride import replay_stride, stride_functions
 
     o = scene.optimize
     _check(o, bool(spec.push_off_free or spec.push_off_n_s))
@@ -159,7 +159,7 @@ def _guide(walker, data, spec):
 
 def _unit(objective: str) -> str:
     """The objective's unit (a weighted sum's: ``-``)."""
-    from walkerlab.optimal.collocation import OBJECTIVES
+    from walkerlab.optimal.transcription.step import OBJECTIVES
 
     return OBJECTIVES.get(objective, "-")
 
@@ -168,7 +168,7 @@ def _record(scene, walker, res) -> dict:
     """IPOPT's history and the energies at the points, each step's from its own walker
     (leg B's step: the mirror's masses), as :class:`OptimizeData` keywords."""
     from walkerlab.optimal.records import step_record
-    from walkerlab.optimal.stride import step_of
+    from walkerlab.optimal.transcription.stride import step_of
 
     parts = [step_record(scene, w, step_of(res, k))
              for k, w in enumerate((walker, walker.mirror))]

@@ -1,6 +1,6 @@
 """A :class:`~walkerlab.models.hybrid.base.HybridWalker` of a biped whose joints are all free
 (``knee.lock: free``; with a hinged torso the five-link biped of Westervelt, Grizzle &
-Koditschek 2003, IEEE TAC 48(1):42-56), from the code :mod:`walkerlab.codegen.five_link`
+Koditschek 2003, IEEE TAC 48(1):42-56), from the code :mod:`walkerlab.codegen.free_joints`
 generates.
 
 One flow for the whole step (every link free, no knee lock), in two phases so that the
@@ -15,7 +15,7 @@ heel strike is looked for only once the swing foot is ahead:
   reaching the slope.
 
 The heel strike is plastic, the old stance foot leaves the ground without impulse, the legs
-swap roles (:mod:`walkerlab.codegen.five_link`).  The passive walker has no compiled flow
+swap roles (:mod:`walkerlab.codegen.free_joints`).  The passive walker has no compiled flow
 (``cyrk_compiled`` runs it on CyRK with the Python flow); one driven by joint torques does
 (:mod:`walkerlab.codegen.actuated`, its guards' outputs from :func:`guard_outputs`).
 """

@@ -45,7 +45,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.ipopt import iteration_history, solve
+from walkerlab.codegen.casadi_functions import casadi_function
+from walkerlab.optimal.transcription.ipopt import iteration_history, solve
 
 __all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step",
            "ipopt_options", "positive_power", "replay", "step_functions",
@@ -151,7 +152,7 @@ class CollocationResult:
     replay_error : float
         Max-norm return error of the replay (module docstring).
     history : dict of str -> ndarray
-        IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
+        IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
     """
 
     t: np.ndarray
@@ -167,23 +168,6 @@ class CollocationResult:
     replay_error: float = np.nan
     terms: dict = field(default_factory=dict)
     history: dict = field(default_factory=dict)
-
-
-def _to_casadi(exprs, syms, values: dict):
-    """A CasADi function of ``syms`` (sympy) computing the sympy matrix ``exprs`` with the
-    parameters ``values`` substituted (SX in, SX matrix out)."""
-    import casadi as ca
-    import sympy as sp
-
-    mat = sp.Matrix(exprs).subs(values)
-    f = sp.lambdify(syms, mat, modules=[{"sin": ca.sin, "cos": ca.cos, "sqrt": ca.sqrt,
-                                         "Abs": ca.fabs, "ImmutableDenseMatrix": list,
-                                         "MutableDenseMatrix": list}, "math"])
-    args = [ca.SX.sym(str(s)) for s in syms]
-    rows = f(*args)
-    out = ca.vertcat(*[ca.horzcat(*[ca.SX(v) if not isinstance(v, ca.SX) else v for v in r])
-                       for r in rows])
-    return ca.Function("f", [ca.vertcat(*args)], [out])
 
 
 def step_functions(data, eq):
@@ -212,39 +196,49 @@ def step_functions(data, eq):
     st = data.structure
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
-    if (st.knee or st.foot != "point" or st.torso or (any(massless) and not limit)
-            or (limit and not st.hip_mass)):
-        raise ValueError("optimize: straight legs with point feet only today, their bodies "
-                         "massive or all massless with a hip mass (knees, arc and flat feet, "
-                         "a torso, partly massless legs: not yet)")
+    if st.knee or st.foot == "flat":
+        raise ValueError("optimize: knees and flat feet take a step of phases "
+                         "(walkerlab.optimal.transcription.phases.mode_functions)")
+    if any(massless) and not limit:
+        raise ValueError("optimize: legs with some massless bodies have no finite equations "
+                         "of motion (a massless body carries no inertia its torque could "
+                         "act on): make every leg body massive, or all massless with a hip "
+                         "mass")
+    if limit and not st.hip_mass:
+        raise ValueError("optimize: massless legs without a hip mass have no mass at all "
+                         "(walker.hip_mass_kg must be > 0)")
     if getattr(data, "mirror", None) is not None:
         raise ValueError("optimize: legs that differ take a stride of two different steps "
-                         "(walkerlab.optimal.stride); one step would be periodic only for "
-                         "mirror-image legs")
+                         "(walkerlab.optimal.transcription.stride); one step would be periodic "
+                         "only for mirror-image legs")
     n = len(eq.q)
     vals = dict(zip(eq.params, data.params))
     xs = list(eq.q) + list(eq.dq)
 
     def fn(name, exprs, *extra):
-        return ca.Function(name, [x, *extra], [_to_casadi(exprs, xs, vals)(x)])
+        return ca.Function(name, [x, *extra], [casadi_function(exprs, xs, vals)(x)])
 
     x, u, P = ca.SX.sym("x", 2 * n), ca.SX.sym("u"), ca.SX.sym("P")
-    M, C, G = (_to_casadi(m, xs, vals)(x) for m in (eq.M, eq.C, eq.G))
+    M, C, G = (casadi_function(m, xs, vals)(x) for m in (eq.M, eq.C, eq.G))
     delta = eq.leg_angles["swing"] - eq.leg_angles["stance"]
     if limit:  # the rows of the absolute leg angles / m_foot, the swing row first
         B = ca.DM([1.0] + [0.0] * (n - 1))
     else:
-        B = _to_casadi(sp.Matrix([delta]).jacobian(eq.q).T, xs, vals)(x)
+        B = casadi_function(sp.Matrix([delta]).jacobian(eq.q).T, xs, vals)(x)
     qdd = ca.solve(M, B * u - C @ x[n:] - G)
-    foot = _to_casadi(eq.points["swing_foot"], xs, vals)(x)
-    hip_angle = _to_casadi([delta], xs, vals)(x)
+    foot = casadi_function(eq.points["swing_foot"], xs, vals)(x)
+    hip_angle = casadi_function([delta], xs, vals)(x)
     rate = ca.jacobian(hip_angle, x[:n]) @ x[n:]
-    reset, work = (_reset_point_hip if limit else _reset_extended)(eq, xs, vals, x, P,
-                                                                   data.total_mass_kg)
+    if limit:
+        reset, work = _reset_point_hip(eq, xs, vals, x, P, data.total_mass_kg)
+    elif st.foot == "point":  # the extended impact (an upper body rides on the hip)
+        reset, work = _reset_extended(eq, xs, vals, x, P, data.total_mass_kg)
+    else:  # arc feet: the generated plastic heel strike (no push-off)
+        reset, work = _reset_plastic(eq, xs, vals, x, P)
     return {"flow": ca.Function("flow", [x, u], [ca.vertcat(x[n:], qdd)]),
             "guard": fn("guard", [eq.guards["heel_strike"]]),
             "guard_rate": ca.Function("guard_rate", [x, u], [ca.jacobian(
-                _to_casadi([eq.guards["heel_strike"]], xs, vals)(x), x) @ ca.vertcat(
+                casadi_function([eq.guards["heel_strike"]], xs, vals)(x), x) @ ca.vertcat(
                     x[n:], qdd)]),
             "ahead": fn("ahead", [eq.guards["swing_foot_ahead"]]),
             "step": ca.Function("step", [x], [ca.sqrt(foot[0] ** 2 + foot[1] ** 2)]),
@@ -263,7 +257,7 @@ def _relabel(eq, xs, vals, x, dq_plus):
     """The post-impact state with the roles swapped (CasADi)."""
     import casadi as ca
 
-    qn = _to_casadi(eq.relabel_q, xs, vals)(x)
+    qn = casadi_function(eq.relabel_q, xs, vals)(x)
     R = np.array(eq.relabel_rate.subs(vals), float)
     return ca.vertcat(qn, ca.DM(R) @ dq_plus)
 
@@ -276,9 +270,9 @@ def _reset_extended(eq, xs, vals, x, P, _mass):
 
     n = len(eq.q)
     fs = {sp.Symbol("x_f"): 0, sp.Symbol("y_f"): 0}
-    De = _to_casadi(eq.De.subs(fs), xs, vals)(x)
-    E = _to_casadi(eq.E.subs(fs), xs, vals)(x)
-    hip = _to_casadi(eq.points["hip"], xs, vals)(x)
+    De = casadi_function(eq.De.subs(fs), xs, vals)(x)
+    E = casadi_function(eq.E.subs(fs), xs, vals)(x)
+    hip = casadi_function(eq.points["hip"], xs, vals)(x)
     e = hip / ca.sqrt(hip[0] ** 2 + hip[1] ** 2)
     dqe = ca.vertcat(x[n:], 0, 0)
     Ef = ca.horzcat(ca.SX.zeros(2, n), ca.SX.eye(2))
@@ -289,6 +283,19 @@ def _reset_extended(eq, xs, vals, x, P, _mass):
     return _relabel(eq, xs, vals, x, sol[:n]), work
 
 
+def _reset_plastic(eq, xs, vals, x, P):
+    """The heel strike of any straight-legged walker from its generated model, without a
+    push-off: the plastic impact ``Mi dq+ = B dq-`` (:mod:`walkerlab.codegen.symbolic`,
+    the map the rigid model's generated code prints) and the role swap; the push-off's
+    work 0 (arc feet: their push-off is refused by :func:`collocate_step`)."""
+    n = len(eq.q)
+    import casadi as ca
+
+    dq_plus = ca.solve(casadi_function(eq.Mi, xs, vals)(x),
+                       casadi_function(eq.B, xs, vals)(x) @ x[n:])
+    return _relabel(eq, xs, vals, x, dq_plus), 0 * P
+
+
 def _reset_point_hip(eq, xs, vals, x, P, mass):
     """Push-off + heel strike of a walker whose mass is all at the hip (Kuo 2002, Eq. 2):
     ``v_po = v + (P / M) e_trail``, the heel strike removes the velocity along the leading
@@ -297,15 +304,15 @@ def _reset_point_hip(eq, xs, vals, x, P, mass):
 
     n = len(eq.q)
     q, dq = x[:n], x[n:]
-    hip = _to_casadi(eq.points["hip"], xs, vals)(x)
-    lead = _to_casadi(eq.points["swing_foot"], xs, vals)(x)
+    hip = casadi_function(eq.points["hip"], xs, vals)(x)
+    lead = casadi_function(eq.points["swing_foot"], xs, vals)(x)
     v = ca.jacobian(hip, q) @ dq
     et = hip / ca.norm_2(hip)
     el = (hip - lead) / ca.norm_2(hip - lead)
     v_po = v + (P / mass) * et
     v_plus = v_po - ca.dot(v_po, el) * el
     v_foot = ca.dot(v_plus, et) * et
-    qn = _to_casadi(eq.relabel_q, xs, vals)(x)
+    qn = casadi_function(eq.relabel_q, xs, vals)(x)
     qs = ca.SX.sym("qs", n)  # the new coordinates: Jacobian of (hip, swing foot) there
     where = ca.Function("where", [x], [ca.vertcat(hip, lead)])
     Jn = ca.Function("Jn", [qs], [ca.jacobian(where(ca.vertcat(qs, ca.SX.zeros(n))),
@@ -335,7 +342,7 @@ def _ground_reaction(data, eq, xs, vals, x, qdd):
             pts.append((float(data.params[names.index(f"m_{tag}{b.name}")]),
                         f"{role}_{b.name}"))
     mtot = sum(m for m, _ in pts)
-    com = sum(m * _to_casadi(eq.points[p], xs, vals)(x) for m, p in pts) / mtot
+    com = sum(m * casadi_function(eq.points[p], xs, vals)(x) for m, p in pts) / mtot
     vel = ca.jacobian(com, x[:n]) @ x[n:]
     acc = ca.jacobian(vel, x) @ ca.vertcat(x[n:], qdd)
     F = mtot * (acc + ca.vertcat(0, data.gravity_m_per_s2))
@@ -354,7 +361,7 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     data : WalkerData
     eq : Equations or None
         ``walkerlab.codegen.symbolic.derive(data.structure)`` (unused when ``fns`` is
-        given, e.g. by :func:`walkerlab.optimal.step_cache.cached_step_functions`).
+        given, e.g. by :func:`walkerlab.optimal.transcription.step_cache.cached_step_functions`).
     spec : CollocationSpec
     guess_t : ndarray (m,)
         Times [s] of a guess step (e.g. a simulated gait from heel strike to heel strike).
@@ -376,6 +383,10 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     """
     import casadi as ca
 
+    if data.structure.foot == "arc" and (spec.push_off_free or spec.push_off_n_s):
+        raise ValueError("optimize: a push-off on arc feet (at the rolling contact point) "
+                         "is not in the rigid model yet; optimise the hip torque alone "
+                         "(no walker.actuation.push_off, optimize.push_off: fixed)")
     fns = fns or step_functions(data, eq)
     n2, N = 2 * fns["n"], int(spec.intervals)
     K = 2 * N + 1
@@ -405,8 +416,13 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
         push_off_n_s=float(get(P)) if spec.push_off_free else float(spec.push_off_n_s),
         objective=float(get(obj)), status=status,
         iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall,
-        terms={k: float(get(v)) for k, v in terms.items()},
+        terms={k: _number(get(v)) for k, v in terms.items()},
         history=iteration_history(opti.stats()))
+
+
+def _number(v) -> float:
+    """A scalar value of the optimum (a structurally zero term comes back sparse)."""
+    return float(np.asarray(v.toarray() if hasattr(v, "toarray") else v).ravel()[0])
 
 
 def ipopt_options(spec) -> dict:
@@ -642,7 +658,9 @@ def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
     spec = Actuation(push_off=PushOff(impulse_n_s=max(res.push_off_n_s, 0.0)),
                      torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
                                           scaled_by="foot_mass" if massless else "none")])
-    walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
+    passive = make_rigid_walker(data, "biped", "derived")
+    walker = (_hip_torque_walker(passive, data, spec.model_copy(update={"push_off": None}))
+              if st.foot == "arc" else actuate(passive, data, spec))
     acts = walker.actuators
     tau = torque_of_time(res)
     acts.torques = lambda t, x: np.array([tau(float(np.real(t)) - acts.t_origin)])
@@ -654,3 +672,39 @@ def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
     if seg.termination != "heel_strike":
         return float("inf"), walker
     return float(np.max(np.abs(seg.x_next - res.x[0]))), walker
+
+
+def _hip_torque_walker(walker, data, spec):
+    """The rigid ``walker`` (arc feet, whose actuation the model layer does not take yet)
+    with the hip torque of ``spec`` added to every phase's flow as ``M^-1 B tau``
+    (:class:`walkerlab.models.hybrid.actuators.Actuators` bound to the generated model; the
+    flow in Python, its Jacobian by the complex step), the passive heel strike kept."""
+    from dataclasses import replace
+
+    from walkerlab.codegen.cache import functions
+    from walkerlab.models.hybrid.actuators import Actuators
+    from walkerlab.models.hybrid.base import Phase
+
+    acts = Actuators(spec, functions(data), len(walker.roles), False,
+                     float(walker.total_mass_kg))
+    n = acts.n
+
+    def flow_of(flow):
+        def f(t, x):
+            out = np.array(flow(t, x), dtype=complex if np.iscomplexobj(x) else float)
+            out[n:] += acts.added_acceleration(t, x)
+            return out
+        return f
+
+    def jac_of(jac):
+        def J(t, x):
+            base = np.array(jac(t, x), float)
+            base[n:] += acts.acceleration_jacobian(t, x)
+            return base
+        return J
+
+    phases = tuple(Phase(ph.name, flow_of(ph.flow), ph.guards,
+                         jacobian=jac_of(ph.jacobian or walker.variational))
+                   for ph in walker.phases)
+    return replace(walker, phases=phases, variational=jac_of(walker.variational),
+                   actuators=acts)

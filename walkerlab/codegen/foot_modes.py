@@ -446,7 +446,7 @@ def generate_flat(structure: Structure, key: str) -> str:
         "    return {k: v for k, v in locals().items() if callable(v) and not k.startswith('_')}",
     ]
     head = [
-        f"# walkerlab generated model code (walkerlab.codegen.flatfoot); key {key}",
+        f"# walkerlab generated model code (walkerlab.codegen.foot_modes); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
         "from math import sin, cos, tan, sqrt, pi  # noqa: F401",
         "import numpy  # noqa: F401",
@@ -508,7 +508,7 @@ def generate_flat_compiled(structure: Structure, key: str) -> str:
             name = f"flow_{mode}_variational" if var else f"flow_{mode}"
             body += _cfunc(name, system, consts, parts[mode], var, extras[mode]) + [""]
     head = [
-        f"# walkerlab compiled model code (walkerlab.codegen.flatfoot); key {key}",
+        f"# walkerlab compiled model code (walkerlab.codegen.foot_modes); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
         "from math import sin, cos, tan, sqrt, pi  # noqa: F401",
         "import numpy as np",

@@ -1,5 +1,5 @@
 """A straight-legged or kneed walker's optimised step replayed with its hip torque as a
-function of the phase variable (:mod:`walkerlab.optimal.phase_replay`'s law and replay).
+function of the phase variable (:mod:`walkerlab.optimal.replay.phase`'s law and replay).
 
 Phase variable ``s``: the stance leg's absolute angle (the actuators' ``hip_angles``: the
 stance thigh's on a kneed walker, whose stance knee is locked), strictly monotonic over the
@@ -10,7 +10,7 @@ the law::
     tau = u(s) - K (delta - h(s)) - D (ddelta - h'(s) ds)
 
 with ``u(s)`` the optimised torque at the time the collocated step passes ``s`` and
-``h(s)`` the collocated hip angle (:class:`~walkerlab.optimal.phase_replay.PhaseLaw`).
+``h(s)`` the collocated hip angle (:class:`~walkerlab.optimal.replay.phase.PhaseLaw`).
 A step of phases (a kneed walker's unlocked and locked swing) gets one such law per phase,
 each from that phase's collocation points, monotonic in each (the phase variable's rate
 jumps at the knee strike); the law in force is the phase whose stretch of ``s`` holds the
@@ -29,7 +29,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from walkerlab.optimal.phase_replay import (
+from walkerlab.optimal.replay.phase import (
     LIMIT_N_M,
     PhaseLaw,
     driven_by,
@@ -49,7 +49,7 @@ CLOSED = 1e-9
 
 
 class PiecewisePhaseLaw:
-    """One :class:`~walkerlab.optimal.phase_replay.PhaseLaw` per phase of a step, chosen by
+    """One :class:`~walkerlab.optimal.replay.phase.PhaseLaw` per phase of a step, chosen by
     the phase variable ``s`` (the interface of :meth:`walkerlab.models.actuation.
     TorqueLaws.__call__`).
 
@@ -211,7 +211,7 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
     """Both phase-variable replays of an optimised step: ``feedback`` (the PD gains of
     :func:`hip_gains`, closed to its fixed point by scipy's root finder) and ``feedforward``
     (no PD, reported from the collocated start, its multipliers those of the step map
-    there) (:func:`walkerlab.optimal.phase_replay.replay_law`).
+    there) (:func:`walkerlab.optimal.replay.phase.replay_law`).
 
     Parameters
     ----------
@@ -255,9 +255,9 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
 
 def hip_phase_records(data, res, tau, solver) -> tuple[dict, str]:
     """:func:`hip_phase_replays` as ``optimize.h5``'s records
-    (:func:`walkerlab.optimal.phase_replay.records`) and ``""``; ``({}, the one-line
+    (:func:`walkerlab.optimal.replay.phase.records`) and ``""``; ``({}, the one-line
     reason)`` when the phase variable is not monotonic."""
-    from walkerlab.optimal.phase_replay import records
+    from walkerlab.optimal.replay.phase import records
 
     try:
         return records(hip_phase_replays(data, res, tau, solver)), ""

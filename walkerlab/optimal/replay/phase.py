@@ -20,8 +20,8 @@ step may end slightly after the collocated one; their cubic there is the end int
 Complex-safe to first order (``f(a + i e) = f(a) + i e f'(a)``): the rigid model's
 variational equations differentiate the law by the complex step.
 
-Used by the five-link biped (:mod:`walkerlab.optimal.five_link_replay`) and the
-straight-legged and kneed walkers (:mod:`walkerlab.optimal.hip_phase_replay`).
+Used by the five-link biped (:mod:`walkerlab.optimal.replay.virtual_constraints`) and the
+straight-legged and kneed walkers (:mod:`walkerlab.optimal.replay.hip_phase`).
 """
 
 from __future__ import annotations
@@ -232,7 +232,7 @@ def law_of_rows(rows, u, stiffness, damping, t=None,
 def control_of_time(t, u):
     """The Hermite-Simpson control as a :class:`scipy.interpolate.PPoly` of the time since
     the heel strike [s] -> (k,) [N m]: each interval's quadratic through its three points
-    (the transcriptions' own, e.g. :func:`walkerlab.optimal.five_link_collocation.
+    (the transcriptions' own, e.g. :func:`walkerlab.optimal.transcription.free_joints.
     torques_of_time`, with derivatives),
     the last one extrapolated.
 

@@ -8,12 +8,12 @@ with the wrong leg in stance every other step (a false gait); the Poincaré map 
 walker is a stride (:func:`walkerlab.analysis.gait.poincare.poincare_map`, Goswami, Thuilot
 & Espiau 1998; Moon & Spong 2010), and so is the periodic boundary condition here.
 
-The stride is a fixed sequence of four phases of :mod:`walkerlab.optimal.phases`: each
+The stride is a fixed sequence of four phases of :mod:`walkerlab.optimal.transcription.phases`: each
 step's ``early_swing`` (until ``midstance``, the legs passing: the point foot scuffs through
 the ground there, which the rigid model ignores, paper Sec. 3.2) and ``late_swing`` (until
 ``heel_strike``: the swing foot above the slope inside it, the guard zero with a minimum
 crossing rate at its end), each phase with its own free duration and Hermite-Simpson mesh
-(:func:`walkerlab.optimal.phased_collocation.collocate_phases`); leg A's phases from the
+(:func:`walkerlab.optimal.transcription.mode_sequence.collocate_phases`); leg A's phases from the
 symbolic equations with ``data``'s numbers, leg B's with ``data.mirror``'s (the same
 equations, the other leg's numbers), leg A's heel strike (its reset: the impact with A's
 numbers, roles swapped) links them, leg B's closes the stride.  Targets (speed, step
@@ -42,7 +42,8 @@ import numpy as np
 __all__ = ["STEP_PHASES", "STRIDE_PHASES", "replay_stride", "step_of", "stride_functions",
            "stride_guess", "stride_walker"]
 
-#: the rigid model's phases of a straight-legged step (:func:`walkerlab.optimal.phases.
+#: the rigid model's phases of a straight-legged step
+#: (:func:`walkerlab.optimal.transcription.phases.
 #: phase_order` of it), each step of the stride named by its swinging leg
 STEP_PHASES = (("early_swing", "midstance", 1), ("late_swing", "heel_strike", -1))
 #: the stride's steps: the leg that swings in each (the rigid model's ``legs`` order)
@@ -60,7 +61,8 @@ STRIDE_PHASES = tuple(_named(leg, name) for leg in SWINGING for name, _g, _d in 
 
 def stride_functions(data) -> dict:
     """CasADi functions of the stride of ``data``'s walker (legs that differ: ``data.mirror``
-    not None): as :func:`walkerlab.optimal.phases.mode_functions`, its ``phases`` the four
+    not None): as :func:`walkerlab.optimal.transcription.phases.mode_functions`, its ``phases`` the
+    four
     of the stride (module docstring), named ``leg1_swing:early_swing`` ...
 
     Raises
@@ -69,7 +71,7 @@ def stride_functions(data) -> dict:
         Mirror-image legs (one step is the map), knees, flat or arc feet, a torso, massless
         legs (one line).
     """
-    from walkerlab.optimal.step_cache import cached_mode_functions
+    from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
     st = data.structure
     if data.mirror is None:
@@ -89,7 +91,7 @@ def stride_functions(data) -> dict:
 def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
     """One stride of the rigid ``walker`` (legs that differ: ``walker.mirror``) from the
     post-impact state ``x0`` (2n,), each step sampled on ``intervals`` intervals shared
-    among its phases (:func:`walkerlab.optimal.phased_collocation.phased_guess`).
+    among its phases (:func:`walkerlab.optimal.transcription.mode_sequence.phased_guess`).
 
     Parameters
     ----------
@@ -106,7 +108,7 @@ def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
     ValueError
         A step does not end in a heel strike or crosses other phases (one line).
     """
-    from walkerlab.optimal.phased_collocation import phased_guess
+    from walkerlab.optimal.transcription.mode_sequence import phased_guess
 
     out, x = [], np.asarray(x0, float)
     for leg, w in zip(SWINGING, (walker, walker.mirror)):
@@ -121,7 +123,7 @@ def stride_guess(walker, x0, period_s: float, solver, intervals: int) -> list:
 
 def step_of(res, k: int):
     """Step ``k`` (0: leg A's, 1: leg B's) of an optimised stride
-    (:class:`walkerlab.optimal.phased_collocation.PhasedResult`) as a result of its own:
+    (:class:`walkerlab.optimal.transcription.mode_sequence.PhasedResult`) as a result of its own:
     its points, phases and durations, its times from its heel strike [s]."""
     P = len(STEP_PHASES)
     bounds = list(res.phase_start) + [res.t.size]
@@ -136,14 +138,14 @@ def step_of(res, k: int):
 
 def stride_walker(data, res):
     """The rigid walker of ``data`` and its mirror with a hip actuator each, whose torque is
-    the optimised one of its own step (:func:`walkerlab.optimal.phased_collocation.
+    the optimised one of its own step (:func:`walkerlab.optimal.transcription.mode_sequence.
     phase_torque_of_time` of :func:`step_of`) from that step's heel strike, and the
     stride's push-off impulse ``res.push_off_n_s`` [N s] before each heel strike (if
     any)."""
     from walkerlab.config.actuation import Actuation, JointTorque, PushOff, TorqueLaw
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.phased_collocation import phase_torque_of_time
+    from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
 
     push = PushOff(impulse_n_s=res.push_off_n_s) if res.push_off_n_s > 0.0 else None
     spec = Actuation(push_off=push, torques=[JointTorque(joint="hip", law=TorqueLaw(),

@@ -1,5 +1,5 @@
 """A scene's optimal gait (``walkerlab optimize``): the collocation of
-:mod:`walkerlab.optimal.collocation` set up from the scene (its walker, slope,
+:mod:`walkerlab.optimal.transcription.step` set up from the scene (its walker, slope,
 push-off and ``optimize`` section), started from the scene's gait (a walker with none, a
 passive walker on level ground: from the targets), replayed on the rigid model, its
 Floquet multipliers from the replay."""
@@ -17,10 +17,10 @@ __all__ = ["collocation_spec", "five_link", "needs_gait", "no_gait_of_its_own",
 
 
 def collocation_spec(scene):
-    """The :class:`walkerlab.optimal.collocation.CollocationSpec` of the scene's
+    """The :class:`walkerlab.optimal.transcription.step.CollocationSpec` of the scene's
     ``optimize`` section (the push-off's value, fixed or the free one's start, from the
     scene's actuation)."""
-    from walkerlab.optimal.collocation import CollocationSpec
+    from walkerlab.optimal.transcription.step import CollocationSpec
 
     o = scene.optimize
     act = getattr(scene.walker, "actuation", None)
@@ -45,7 +45,7 @@ def collocation_spec(scene):
 def needs_gait(scene) -> bool:
     """Whether the scene's optimisation starts from its own gait (``fixedpoint.h5``): every
     walker but a five-link biped (``walker.leg.knee.lock: free``), whose guess is built from
-    the targets (:mod:`walkerlab.optimal.five_link_scene`), and a walker with no gait of its
+    the targets (:mod:`walkerlab.optimal.drivers.free_joints`), and a walker with no gait of its
     own (:func:`no_gait_of_its_own`), whose step is built from them too
     (:func:`walkerlab.optimal.guess.target_step`)."""
     return not five_link(scene) and not no_gait_of_its_own(scene)
@@ -78,8 +78,8 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     scene : Scene
         With ``optimize``; straight legs, point feet, massive legs or massless ones with a
         hip mass; or a kneed or flat-footed walker (a step of phases:
-        :func:`walkerlab.optimal.phased_scene.optimize_phased_scene`); or legs that differ
-        (a stride: :func:`walkerlab.optimal.stride_scene.optimize_stride_scene`).
+        :func:`walkerlab.optimal.drivers.mode_sequence.optimize_phased_scene`); or legs that differ
+        (a stride: :func:`walkerlab.optimal.drivers.stride.optimize_stride_scene`).
     x_gait : ndarray (2n,) or None
         The scene's gait just after heel strike (``fixedpoint.h5``): the initial guess is
         one step of it (unless ``optimize.initial_guess`` names an artifact); None: the
@@ -103,10 +103,10 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
     from walkerlab.integrate.solver import Solver
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.collocation import collocate_step, replay, torque_of_time
-    from walkerlab.optimal.contact_replay import contact_replay
     from walkerlab.optimal.guess import starting_step
-    from walkerlab.optimal.step_cache import cached_step_functions
+    from walkerlab.optimal.replay.contact import contact_replay
+    from walkerlab.optimal.transcription.step import collocate_step, replay, torque_of_time
+    from walkerlab.optimal.transcription.step_cache import cached_step_functions
     from walkerlab.walker.description import walker_data
 
     try:
@@ -124,11 +124,11 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
                          "straight legs with point feet only; give optimize.initial_guess "
                          "(another optimize.h5) or a downhill slope")
     if data.mirror is not None:  # legs that differ: a stride of two different steps
-        from walkerlab.optimal.stride_scene import optimize_stride_scene
+        from walkerlab.optimal.drivers.stride import optimize_stride_scene
 
         return optimize_stride_scene(scene, data, spec, x_gait, period_s)
     if data.structure.knee or data.structure.foot == "flat":  # a step of phases: its own
-        from walkerlab.optimal.phased_scene import optimize_phased_scene
+        from walkerlab.optimal.drivers.mode_sequence import optimize_phased_scene
 
         return optimize_phased_scene(scene, data, spec, x_gait, period_s)  # transcription
     t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
@@ -168,7 +168,7 @@ def optimize_scene(scene, x_gait: np.ndarray, period_s: float):
 def _unit(o, data) -> str:
     """The objective's unit (a weighted sum's: ``-``; the torque per foot mass on massless
     legs: N m/kg in place of N m)."""
-    from walkerlab.optimal.collocation import OBJECTIVES
+    from walkerlab.optimal.transcription.step import OBJECTIVES
 
     unit = OBJECTIVES.get(o.objective, "-")
     if _massless(data):

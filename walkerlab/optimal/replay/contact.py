@@ -1,5 +1,5 @@
 """The optimised step replayed in the compliant-contact model: the optimised hip torque (as a
-function of the time since each touchdown, :func:`walkerlab.optimal.collocation.
+function of the time since each touchdown, :func:`walkerlab.optimal.transcription.step.
 torque_of_time`) and push-off drive the scene's contact walker (its ``contact`` law, or the
 paper's default one) from the optimised start; the mean period of its steps is compared with
 the optimum's (the issue's check: within 3 %).  A walker with phases
@@ -25,7 +25,7 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
     ----------
     scene : Scene
         The optimised scene (its ``contact``, ``terrain``, ``contact_solver`` if given).
-    res : walkerlab.optimal.collocation.CollocationResult
+    res : walkerlab.optimal.transcription.step.CollocationResult
     strides : int
         Strides to run (2 steps each).
 
@@ -39,7 +39,7 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
         needs leg masses).
     """
     from walkerlab.config import SolverSettings
-    from walkerlab.optimal.collocation import torque_of_time
+    from walkerlab.optimal.transcription.step import torque_of_time
 
     w = scene.walker.model_dump()
     bodies = [b for leg in [w.get("leg")] + list(w.get("legs") or []) if leg
@@ -62,7 +62,8 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
                              strides: int = 1) -> tuple[float, str]:
     """Run the contact model of a five-link biped under a phase-variable law.
 
-    The scene's walker gets torques on :data:`walkerlab.optimal.five_link.JOINTS` whose laws
+    The scene's walker gets torques on
+    :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` whose laws
     are replaced by ``law`` (the contact view evaluates each stance leg's joints and phase
     variable as the rigid one, :class:`walkerlab.models.contact.joint_torques.
     JointTorqueActuators`); the scene's ``contact`` law (the paper's default one if none),
@@ -73,7 +74,7 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
     ----------
     scene : Scene
         The optimised scene.
-    law : walkerlab.optimal.five_link_replay.PhaseLaw
+    law : walkerlab.optimal.replay.virtual_constraints.PhaseLaw
     x0 : ndarray (2n,)
         The rigid start (post-impact, ``state_names()`` order) [rad, rad/s].
     step_period_s : float
@@ -90,7 +91,7 @@ def contact_replay_five_link(scene, law, x0, step_period_s: float,
         How the run ended, or why there is no replay (one line).
     """
     from walkerlab.config import SolverSettings
-    from walkerlab.optimal.five_link import JOINTS
+    from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 
     setup, why = _powered_setup(scene, {"torques": [{"joint": j, "law": {}} for j in JOINTS]},
                                 {"n_strides": strides, "sample_rate_hz": 500}, terrain=True)
@@ -107,7 +108,8 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     optimised hip torque.
 
     The scene's walker gets a hip torque whose law is replaced by
-    :func:`walkerlab.optimal.phased_collocation.phase_torque_of_time` of the time since each
+    :func:`walkerlab.optimal.transcription.mode_sequence.phase_torque_of_time` of the time since
+    each
     touchdown (between the thighs, or the legs of a flat-footed walker:
     :class:`walkerlab.models.contact.actuation.ContactActuators`), from the collocated start
     ``res.x[0]``; the scene's ``contact`` law (a kneed walker needs its ``knee_stop.latch``
@@ -121,7 +123,7 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
     ----------
     scene : Scene
         The optimised scene.
-    res : walkerlab.optimal.phased_collocation.PhasedResult
+    res : walkerlab.optimal.transcription.mode_sequence.PhasedResult
     strides : int
         Strides to run (2 steps each).
 
@@ -135,7 +137,7 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
         section's flat-foot regularisation, a walker the contact view carries no hip torque
         on; one line).
     """
-    from walkerlab.optimal.phased_collocation import phase_torque_of_time
+    from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
 
     # a powered run is on a Python RHS (slow on a flat-footed walker's stride), so the
     # wall-time limit is set for a loaded machine, not the contact-sim default (120 s)
@@ -151,9 +153,10 @@ def contact_replay_phased(scene, res, strides: int = 1) -> tuple[float, str]:
 
 def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
     """Run the contact model of a walker whose legs differ with its optimised stride's hip
-    torques: leg A's step's (:func:`walkerlab.optimal.stride.step_of` 0) while ``leg2`` is
+    torques: leg A's step's (:func:`walkerlab.optimal.transcription.stride.step_of` 0) while
+    ``leg2`` is
     in stance, leg B's while ``leg1`` is, each as a function of the time since that step's
-    touchdown (:func:`walkerlab.optimal.phased_collocation.phase_torque_of_time`), from the
+    touchdown (:func:`walkerlab.optimal.transcription.mode_sequence.phase_torque_of_time`), from the
     collocated start ``res.x[0]`` (leg2 in stance, as the rigid model's); the scene's
     ``contact`` law (the paper's default one if none), ``terrain``; LSODA at rtol 1e-6,
     atol 1e-8 (a powered contact run uses scipy's event location).
@@ -162,7 +165,7 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
     ----------
     scene : Scene
         The optimised scene.
-    res : walkerlab.optimal.phased_collocation.PhasedResult
+    res : walkerlab.optimal.transcription.mode_sequence.PhasedResult
         The optimised stride (its ``step_period_s`` the stride's).
     strides : int
         Strides to run (2 steps each).
@@ -176,8 +179,8 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
         How the run ended, or why there is no replay (one line).
     """
     from walkerlab.config import SolverSettings
-    from walkerlab.optimal.phased_collocation import phase_torque_of_time
-    from walkerlab.optimal.stride import step_of
+    from walkerlab.optimal.transcription.mode_sequence import phase_torque_of_time
+    from walkerlab.optimal.transcription.stride import step_of
 
     act = {"torques": [{"joint": "hip", "law": {}}]}
     if res.push_off_n_s > 0.0:  # before each touchdown, as in the rigid model

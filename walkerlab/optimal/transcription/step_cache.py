@@ -1,10 +1,11 @@
 """The collocation functions - the straight-legged walkers' one step
-(:func:`walkerlab.optimal.collocation.step_functions`) and the phases of a step of a kneed
-or flat-footed walker or of a stride (:func:`walkerlab.optimal.phases.mode_functions`) -
-built once per walker and cached on disk like the generated flows
-(:mod:`walkerlab.codegen.cache`), so a warm ``walkerlab optimize`` neither derives the
-walker symbolically (sympy) nor converts it to CasADi (``walkerlab bench optimize`` times
-both runs, cold and warm).
+(:func:`walkerlab.optimal.transcription.step.step_functions`) and the phases of a step of a kneed
+or flat-footed walker or of a stride
+(:func:`walkerlab.optimal.transcription.phases.mode_functions`) -
+built once per walker and cached on disk like the generated flows (the one CasADi
+cache, :func:`walkerlab.codegen.casadi_functions.cached_functions`), so a warm
+``walkerlab optimize`` neither derives the walker symbolically (sympy) nor converts it to
+CasADi (``walkerlab bench optimize`` times both runs, cold and warm).
 
 The functions have the walker's parameter values substituted (as the collocation builds
 them), so the cache file is keyed on the walker's structure (its generator's key) *and* its
@@ -25,7 +26,6 @@ from pathlib import Path
 
 __all__ = ["cached_mode_functions", "cached_step_functions"]
 
-_memo: dict[str, dict] = {}
 #: the entries of :func:`step_functions` that are numbers, not CasADi functions
 _NUMBERS = ("n", "limit", "total_mass_kg", "gravity")
 
@@ -36,28 +36,23 @@ def _key(data, kind: str = "steps", extra=()) -> str:
     import casadi as ca
 
     from walkerlab.codegen.cache import cache_key
-    from walkerlab.optimal import collocation, phases
+    from walkerlab.optimal.transcription import phases
+    from walkerlab.optimal.transcription import step as collocation
 
     h = hashlib.sha256(repr((tuple(float(v) for v in data.params), float(data.slope_rad),
                              float(data.gravity_m_per_s2),
                              float(data.total_mass_kg)) + ((tuple(extra),) if extra
                                                            else ())).encode())
-    for mod in (collocation.__file__, __file__) + ((phases.__file__,) if extra else ()):
+    from walkerlab.codegen import casadi_functions
+
+    for mod in ((collocation.__file__, __file__, casadi_functions.__file__)
+                + ((phases.__file__,) if extra else ())):
         h.update(Path(mod).read_bytes())
     h.update(ca.__version__.encode())
     return f"{cache_key(data.structure)}-{kind}-{h.hexdigest()[:16]}"
 
 
-def _read(key: str):
-    """The stored JSON of ``key`` and the path to write it (None, None: no user cache)."""
-    from walkerlab.codegen.cache import cache_dir, read_source
-
-    folder = cache_dir()
-    path = folder / f"{key}.casadi" if folder is not None else None
-    return (read_source(path) if path is not None else None), path
-
-
-#: a phase's CasADi functions (:class:`walkerlab.optimal.phases.ModePhase`), in order
+#: a phase's CasADi functions (:class:`walkerlab.optimal.transcription.phases.ModePhase`), in order
 _PHASE_FNS = ("flow", "guard", "guard_rate", "reset", "keep", "clearance", "step", "grf",
               "push_off")
 
@@ -76,7 +71,7 @@ def _decode(text: str) -> dict:
     """:func:`_encode`'s inverse (raises on a damaged text)."""
     import casadi as ca
 
-    from walkerlab.optimal.phases import ModePhase
+    from walkerlab.optimal.transcription.phases import ModePhase
 
     def phase(p):
         return ModePhase(p["name"], p["guard_name"], int(p["direction"]),
@@ -87,36 +82,24 @@ def _decode(text: str) -> dict:
 
 
 def _cached(key: str, build) -> dict:
-    """The functions of ``key`` from this process's memo, the disk cache (a damaged file:
-    rebuilt), or ``build()`` (and written there)."""
-    from walkerlab.codegen.cache import write_source
+    """The functions of ``key`` through the one CasADi cache
+    (:func:`walkerlab.codegen.casadi_functions.cached_functions`: memo, disk, or
+    ``build()``)."""
+    from walkerlab.codegen.casadi_functions import cached_functions
 
-    if key in _memo:
-        return _memo[key]
-    text, path = _read(key)
-    fns = None
-    if text is not None:
-        try:
-            fns = _decode(text)
-        except (RuntimeError, ValueError, TypeError, AttributeError, KeyError):
-            fns = None  # damaged: rebuilt below
-    if fns is None:
-        fns = build()
-        if path is not None:
-            write_source(path, _encode(fns))
-    _memo[key] = fns
-    return fns
+    return cached_functions(key, build, _encode, _decode)
 
 
 def cached_mode_functions(data, walker, order=None) -> dict:
-    """:func:`walkerlab.optimal.phases.mode_functions` of ``data`` (a WalkerData) in the
+    """:func:`walkerlab.optimal.transcription.phases.mode_functions` of ``data`` (a WalkerData) in
+    the
     phase order ``order`` (default: the rigid ``walker``'s), from this process's memo, the
     disk cache, or built (and written there).
 
     Returns
     -------
     dict
-        As :func:`~walkerlab.optimal.phases.mode_functions`.
+        As :func:`~walkerlab.optimal.transcription.phases.mode_functions`.
 
     Raises
     ------
@@ -124,7 +107,7 @@ def cached_mode_functions(data, walker, order=None) -> dict:
         A walker or phase the transcription has no symbolic form for (one line; nothing
         cached).
     """
-    from walkerlab.optimal import phases
+    from walkerlab.optimal.transcription import phases
 
     order = [tuple(o) for o in (order if order is not None else phases.phase_order(walker))]
     return _cached(_key(data, "modes", order),
@@ -132,20 +115,20 @@ def cached_mode_functions(data, walker, order=None) -> dict:
 
 
 def cached_step_functions(data) -> dict:
-    """:func:`walkerlab.optimal.collocation.step_functions` of ``data`` (a WalkerData),
+    """:func:`walkerlab.optimal.transcription.step.step_functions` of ``data`` (a WalkerData),
     from this process's memo, the disk cache, or derived and built (and written there).
 
     Returns
     -------
     dict
-        As :func:`~walkerlab.optimal.collocation.step_functions`.
+        As :func:`~walkerlab.optimal.transcription.step.step_functions`.
 
     Raises
     ------
     ValueError
         A walker the transcription does not handle (one line; nothing cached).
     """
-    from walkerlab.optimal import collocation
+    from walkerlab.optimal.transcription import step as collocation
 
     def build():
         from walkerlab.codegen import symbolic  # sympy: only on a miss (a slow import)

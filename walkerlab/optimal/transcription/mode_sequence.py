@@ -1,4 +1,5 @@
-"""The multi-phase transcription of :mod:`walkerlab.optimal.phases`: one step of a walker
+"""The multi-phase transcription of :mod:`walkerlab.optimal.transcription.phases`: one step of a
+walker
 with a fixed mode sequence (a kneed walker's unlocked and locked swing) optimised by
 Hermite-Simpson collocation per phase (CasADi ``Opti`` + IPOPT), its starting guess from
 the rigid model's own step and its replay on the rigid model.
@@ -11,12 +12,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.ipopt import iteration_history, solve
+from walkerlab.optimal.transcription.ipopt import iteration_history, solve
 
 __all__ = ["PhasedResult", "collocate_phases", "optimized_guess", "phase_torque_of_time",
            "phased_guess", "replay_phases"]
 
-#: objectives the phased transcription takes (:data:`walkerlab.optimal.collocation.OBJECTIVES`)
+#: objectives the phased transcription takes
+#: (:data:`walkerlab.optimal.transcription.step.OBJECTIVES`)
 PHASED_OBJECTIVES = ("effort", "cost_of_transport", "peak_torque")
 
 @dataclass
@@ -46,7 +48,7 @@ class PhasedResult:
         weight and step length; exact, ``max(p, 0)`` at the points) and ``peak_torque``
         [N m] at the optimum.
     history : dict of str -> ndarray
-        IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
+        IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
     """
 
     t: np.ndarray
@@ -82,7 +84,7 @@ def phased_guess(walker, x0, period_s: float, solver, intervals: int):
     guess : list of (name, t (2 N_p + 1,) [s from the phase's start], x (2 N_p + 1, 2n))
     phase_log : list
         The step's :attr:`walkerlab.integrate.rigid.Segment.phase_log` (its phase
-        sequence: :func:`walkerlab.optimal.phases.phase_order`).
+        sequence: :func:`walkerlab.optimal.transcription.phases.phase_order`).
 
     Raises
     ------
@@ -242,11 +244,11 @@ def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
 def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
     """The hip's positive work over the step [J]: Simpson's rule per phase on
     ``max(p, 0)`` at the points (``p = u d(hip angle)/dt``), exactly by slack variables
-    when ``slack`` (:func:`walkerlab.optimal.collocation.positive_power`), else evaluated
+    when ``slack`` (:func:`walkerlab.optimal.transcription.step.positive_power`), else evaluated
     (for the record)."""
     import casadi as ca
 
-    from walkerlab.optimal.collocation import positive_power
+    from walkerlab.optimal.transcription.step import positive_power
 
     work = 0
     for X, U, T, tau in zip(Xs, Us, Ts, taus):
@@ -278,16 +280,17 @@ def _check(spec, phases) -> None:
 
 def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
                      ) -> PhasedResult:
-    """Optimise one step phase by phase (:mod:`walkerlab.optimal.phases`), or a stride of
-    steps (legs that differ, :mod:`walkerlab.optimal.stride`: a ``heel_strike`` phase
+    """Optimise one step phase by phase (:mod:`walkerlab.optimal.transcription.phases`), or a
+    stride of
+    steps (legs that differ, :mod:`walkerlab.optimal.transcription.stride`: a ``heel_strike`` phase
     inside the sequence ends a step; every heel strike has the swing foot ahead, each step
     its own clearance ends, and the targets are the mean step's).
 
     Parameters
     ----------
     fns : dict
-        :func:`walkerlab.optimal.phases.mode_functions` of the walker.
-    spec : walkerlab.optimal.collocation.CollocationSpec
+        :func:`walkerlab.optimal.transcription.phases.mode_functions` of the walker.
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
         Its ``intervals`` are shared among the phases by ``guess``'s meshes.
     guess : list of (name, t, x)
         :func:`phased_guess`: each phase's starting mesh (its length fixes ``N_p``).
@@ -306,7 +309,7 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     """
     import casadi as ca
 
-    from walkerlab.optimal.collocation import ipopt_options, peak_torque
+    from walkerlab.optimal.transcription.step import ipopt_options, peak_torque
 
     phases = fns["phases"]
     _check(spec, phases)
@@ -369,7 +372,7 @@ def _targets(opti, spec, fns, Xs, period):
     """Every heel strike with the swing foot ahead and the gait targets on the step (a
     stride: its mean step's period and length); returns the distance walked [m] (a
     stride's: its steps' sum)."""
-    from walkerlab.optimal.collocation import target_constraints
+    from walkerlab.optimal.transcription.step import target_constraints
 
     phases, P = fns["phases"], len(fns["phases"])
     strikes = [p for p, mp in enumerate(phases[:-1]) if mp.guard_name == "heel_strike"]

@@ -14,7 +14,7 @@ Its walker has no generated ``matrices`` (its modes pin the heel or the toe), so
   positions unchanged);
 - ``heel_strike_loss`` [J]: the kinetic energy the heel strike takes plus the trailing
   ankle spring's energy, lost when its massless foot leaves the ground and snaps to its
-  rest angle (``k (a - r)^2 / 2`` at the strike; :mod:`walkerlab.codegen.flatfoot`);
+  rest angle (``k (a - r)^2 / 2`` at the strike; :mod:`walkerlab.codegen.foot_modes`);
 - ``push_off_work``, ``push_off_impulse``: 0 (no impulse).
 
 The total energy ``E = T + V`` (gravity from the first stance heel and the springs, the

@@ -5,11 +5,12 @@ Phase variable ``s``: the virtual stance leg's absolute angle (hip to stance foo
 generated ``leg_angles``' ``stance``; Westervelt, Grizzle & Koditschek 2003, IEEE TAC
 48(1):42-56, Sec. IV), strictly monotonic over an optimised step (it decreases: checked,
 else refused).  On the collocated step ``(t_i, x_i, u_i)`` each actuator's joint angle
-``delta_k`` (:data:`walkerlab.optimal.five_link.JOINTS`) becomes a reference of ``s``: the
+``delta_k`` (:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`) becomes a
+reference of ``s``: the
 cubic Hermite spline ``h_k`` through ``(s_i, delta_k(x_i))`` with the slopes
 ``ddelta_k(x_i) / ds(x_i)`` (so ``delta = h(s)`` and ``ddelta = h'(s) ds`` hold at every
 collocation point), the torque the transcription's own control (the quadratic in time of
-each Hermite-Simpson interval, :func:`walkerlab.optimal.five_link_collocation.
+each Hermite-Simpson interval, :func:`walkerlab.optimal.transcription.free_joints.
 torques_of_time`) at the time ``T(s)`` the collocated step passes ``s`` (``T`` the cubic
 Hermite spline through ``(s_i, t_i)`` with slopes ``1 / ds(x_i)``; a cubic spline of ``u``
 over ``s`` smooths the control's kinks at the interval ends, and a replay from the
@@ -37,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.optimal.phase_replay import (
+from walkerlab.optimal.replay.phase import (
     LIMIT_N_M,
     PhaseLaw,
     PhaseReplay,
@@ -51,7 +52,8 @@ __all__ = ["RABBIT_GAINS", "PhaseLaw", "PhaseReplay", "control_of_time", "phase_
            "phase_replays", "phased_walker", "replay_phase_law", "replay_solver",
            "rigid_actuators"]
 
-#: PD gains ``(K [N m/rad], D [N m s/rad])`` per joint (:data:`walkerlab.optimal.five_link.
+#: PD gains ``(K [N m/rad], D [N m s/rad])`` per joint
+#: (:data:`walkerlab.optimal.transcription.free_joint_functions.
 #: JOINTS` order), RABBIT's virtual-constraint controller of configs/rabbit.yaml
 RABBIT_GAINS = ((2000.0, 2000.0, 2000.0, 2000.0), (120.0, 120.0, 60.0, 60.0))
 
@@ -62,7 +64,8 @@ def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
     Parameters
     ----------
     acts : FiveLinkActuators
-        The rigid walker's actuators on :data:`walkerlab.optimal.five_link.JOINTS` (their
+        The rigid walker's actuators on
+        :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` (their
         ``joint_angles``).
     x : ndarray (m, 2n)
         Collocated states (``state_names()`` order) [rad, rad/s].
@@ -89,13 +92,14 @@ def phase_law(acts, x, u, stiffness, damping, t=None) -> PhaseLaw:
 
 def phased_walker(data, law: PhaseLaw):
     """The rigid five-link walker (its generated code, phases, guards and reset) driven by
-    ``law`` on :data:`walkerlab.optimal.five_link.JOINTS`: in Python (``law`` called) and
+    ``law`` on :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`: in Python
+    (``law`` called) and
     compiled (its flows' law block :meth:`PhaseLaw.packed`, the same splines: the
     ``cyrk_compiled`` backend of :func:`replay_solver` runs it without a Python callback)."""
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.five_link import JOINTS
+    from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 
     spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw(), max_torque_n_m=LIMIT_N_M)
                               for j in JOINTS])
@@ -104,11 +108,12 @@ def phased_walker(data, law: PhaseLaw):
 
 
 def rigid_actuators(data):
-    """The rigid walker's actuators on :data:`walkerlab.optimal.five_link.JOINTS` (for
+    """The rigid walker's actuators on
+    :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` (for
     :func:`phase_law`)."""
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
     from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
-    from walkerlab.optimal.five_link import JOINTS
+    from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 
     spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw()) for j in JOINTS])
     return five_link_actuators(data, spec, tuple(data.structure.roles))
@@ -155,7 +160,7 @@ def replay_phase_law(data, t, x, u, law: PhaseLaw, close: bool = True,
     PhaseReplay
         ``return_error`` inf, NaN multipliers when a step does not end in a heel strike.
     """
-    from walkerlab.optimal.five_link_collocation import torques_of_time
+    from walkerlab.optimal.transcription.free_joints import torques_of_time
 
     return replay_law(phased_walker(data, law), replay_solver(), t, x, torques_of_time(t, u),
                       close=close, tol=tol)

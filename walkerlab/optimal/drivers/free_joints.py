@@ -1,10 +1,10 @@
 """A five-link biped scene's least-effort step (``walkerlab optimize`` on a walker with free
-knees): collocated (:mod:`walkerlab.optimal.five_link_collocation`), closed by shooting
-under its own torques (:mod:`walkerlab.optimal.five_link_shooting`), replayed on the rigid
+knees): collocated (:mod:`walkerlab.optimal.transcription.free_joints`), closed by shooting
+under its own torques (:mod:`walkerlab.optimal.replay.shooting`), replayed on the rigid
 model's generated code, and replayed with the torques as a function of the phase variable
 (feed-forward + PD on the collocated joint trajectory, and the feed-forward alone:
-:mod:`walkerlab.optimal.five_link_replay`) on the rigid model and - the PD law - in the
-contact model (:func:`walkerlab.optimal.contact_replay.contact_replay_five_link`); stored
+:mod:`walkerlab.optimal.replay.virtual_constraints`) on the rigid model and - the PD law - in the
+contact model (:func:`walkerlab.optimal.replay.contact.contact_replay_five_link`); stored
 as ``optimize.h5``.  Needs no upstream gait: the guess is built from the targets (Kelly
 2017's set-up)."""
 
@@ -61,11 +61,11 @@ def optimize_five_link_scene(scene):
     """
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.collocation import CollocationSpec
-    from walkerlab.optimal.five_link import JOINTS, five_link_functions
-    from walkerlab.optimal.five_link_collocation import collocate_five_link, replay_five_link
-    from walkerlab.optimal.five_link_shooting import close_step
     from walkerlab.optimal.records import not_a_gait_outcome, step_record
+    from walkerlab.optimal.replay.shooting import close_step
+    from walkerlab.optimal.transcription.free_joint_functions import JOINTS, five_link_functions
+    from walkerlab.optimal.transcription.free_joints import collocate_five_link, replay_five_link
+    from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.walker.description import walker_data
 
     o = scene.optimize
@@ -107,13 +107,14 @@ CONTACT_STRIDES = 2
 
 
 def _phase_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple[float, str]]:
-    """The phase-variable replays (:func:`walkerlab.optimal.five_link_replay.phase_replays`)
+    """The phase-variable replays
+    (:func:`walkerlab.optimal.replay.virtual_constraints.phase_replays`)
     as ``optimize.h5``'s records, and the contact model's ``(step period [s], outcome)``
     under the feed-forward + PD law from its closed start; an optimum that is not a gait
     is not replayed there (``not_gait``: why, the contact outcome)."""
-    from walkerlab.optimal.contact_replay import contact_replay_five_link
-    from walkerlab.optimal.five_link_replay import phase_replays
-    from walkerlab.optimal.phase_replay import records
+    from walkerlab.optimal.replay.contact import contact_replay_five_link
+    from walkerlab.optimal.replay.phase import records
+    from walkerlab.optimal.replay.virtual_constraints import phase_replays
 
     if scene.optimize.phase_replay is False:  # None (the default) or True: replayed
         return {}, (float("nan"), "not replayed: optimize.phase_replay is off (the contact "

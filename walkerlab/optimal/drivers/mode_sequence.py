@@ -1,6 +1,6 @@
 """A scene's optimal gait when its walker's step is a sequence of phases (a kneed walker,
 flat feet):
-the transcription of :mod:`walkerlab.optimal.phased_collocation` set up from the scene,
+the transcription of :mod:`walkerlab.optimal.transcription.mode_sequence` set up from the scene,
 started from one step of the scene's gait, replayed on the rigid model, its Floquet
 multipliers from the replay, and replayed in the contact model (2 strides; the hip torque
 acts between a kneed walker's thighs, between a flat-footed walker's legs)."""
@@ -25,9 +25,9 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
         walker with the same phases (its states and torque).
     data : WalkerData
         The scene's walker.
-    spec : walkerlab.optimal.collocation.CollocationSpec
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
         From the ``optimize`` section (``intervals`` shared among the phases:
-        :func:`walkerlab.optimal.phased_collocation.phased_guess`).
+        :func:`walkerlab.optimal.transcription.mode_sequence.phased_guess`).
     x_gait : ndarray (2n,)
         The scene's gait just after heel strike (``fixedpoint.h5``).
     period_s : float
@@ -48,14 +48,14 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
 
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.contact_replay import contact_replay_phased
-    from walkerlab.optimal.phased_collocation import (
+    from walkerlab.optimal.records import not_a_gait_outcome, phase_replays, step_record
+    from walkerlab.optimal.replay.contact import contact_replay_phased
+    from walkerlab.optimal.transcription.mode_sequence import (
         collocate_phases,
         phase_torque_of_time,
         replay_phases,
     )
-    from walkerlab.optimal.records import not_a_gait_outcome, phase_replays, step_record
-    from walkerlab.optimal.step_cache import cached_mode_functions
+    from walkerlab.optimal.transcription.step_cache import cached_mode_functions
 
     o = scene.optimize
     _refuse(scene)
@@ -106,14 +106,14 @@ def starting_phases(scene, walker, x_gait, period_s: float, intervals: int):
     Returns
     -------
     guess : list of (name, t, x)
-        :func:`walkerlab.optimal.phased_collocation.phased_guess` (the scene's or a
-        continuation artifact's gait) or :func:`~walkerlab.optimal.phased_collocation.
+        :func:`walkerlab.optimal.transcription.mode_sequence.phased_guess` (the scene's or a
+        continuation artifact's gait) or :func:`~walkerlab.optimal.transcription.mode_sequence.
         optimized_guess` (another ``optimize.h5``).
     torque : list of ndarray or None
         Each phase's hip torque [N m] (another ``optimize.h5``'s; None: 0).
     order : list of (phase, guard, direction)
         The phases the starting gait's step goes through
-        (:func:`walkerlab.optimal.phases.phase_order`).
+        (:func:`walkerlab.optimal.transcription.phases.phase_order`).
 
     Raises
     ------
@@ -123,8 +123,8 @@ def starting_phases(scene, walker, x_gait, period_s: float, intervals: int):
     """
     from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.guess import read_guess
-    from walkerlab.optimal.phased_collocation import optimized_guess, phased_guess
-    from walkerlab.optimal.phases import phase_order
+    from walkerlab.optimal.transcription.mode_sequence import optimized_guess, phased_guess
+    from walkerlab.optimal.transcription.phases import phase_order
 
     kind, got = None, None
     if scene.optimize.initial_guess is not None:
@@ -140,7 +140,7 @@ def starting_phases(scene, walker, x_gait, period_s: float, intervals: int):
 
 def _unit(objective: str) -> str:
     """The objective's unit (a weighted sum's: ``-``)."""
-    from walkerlab.optimal.collocation import OBJECTIVES
+    from walkerlab.optimal.transcription.step import OBJECTIVES
 
     return OBJECTIVES.get(objective, "-")
 

@@ -1,5 +1,5 @@
 """CasADi functions of a free-jointed (five-link) biped's step, from its own symbolic model
-(:func:`walkerlab.codegen.five_link.derive_five_link`), built once per walker structure and
+(:func:`walkerlab.codegen.free_joints.derive_five_link`), built once per walker structure and
 cached on disk like the generated flows (:mod:`walkerlab.codegen.cache`).
 
 Every function takes the walker's parameter vector ``p`` (``structure.param_names`` order,
@@ -29,7 +29,6 @@ rebuilt).
 from __future__ import annotations
 
 import hashlib
-import json
 from functools import cache
 from pathlib import Path
 
@@ -37,22 +36,6 @@ __all__ = ["JOINTS", "five_link_functions"]
 
 #: the actuated joints, the order of ``u`` (hips then knees)
 JOINTS = ("stance_hip", "swing_hip", "stance_knee", "swing_knee")
-_memo: dict[str, dict] = {}
-
-
-def _lambdify(exprs, syms: list, args: list):
-    """The sympy matrix ``exprs`` as a CasADi SX matrix, ``syms`` replaced by ``args``."""
-    import casadi as ca
-    import sympy as sp
-
-    mat = sp.Matrix(exprs)
-    f = sp.lambdify(syms, mat, modules=[{"sin": ca.sin, "cos": ca.cos, "sqrt": ca.sqrt,
-                                         "atan": ca.atan, "acos": ca.acos, "Abs": ca.fabs,
-                                         "ImmutableDenseMatrix": list,
-                                         "MutableDenseMatrix": list}, "math"])
-    rows = f(*args)
-    return ca.vertcat(*[ca.horzcat(*[v if isinstance(v, ca.SX) else ca.SX(float(v))
-                                     for v in r]) for r in rows])
 
 
 def _build(structure) -> dict:
@@ -60,7 +43,8 @@ def _build(structure) -> dict:
     import casadi as ca
     import numpy as np
 
-    from walkerlab.codegen.five_link import derive_five_link
+    from walkerlab.codegen.casadi_functions import casadi_matrix
+    from walkerlab.codegen.free_joints import derive_five_link
     from walkerlab.config.actuation import FIVE_LINK_JOINTS
 
     eq = derive_five_link(structure)
@@ -73,20 +57,20 @@ def _build(structure) -> dict:
         first, second = FIVE_LINK_JOINTS[j]
         B[roles.index(first), k] -= 1.0
         B[roles.index(second), k] += 1.0
-    M, C, G = (_lambdify(e, syms, args) for e in (eq.M, eq.C, eq.G))
+    M, C, G = (casadi_matrix(e, syms, args) for e in (eq.M, eq.C, eq.G))
     dq = x[n:]
     qdd = ca.solve(M, ca.DM(B) @ u - C @ dq - G)
     flow = ca.Function("flow", [x, u, p], [ca.vertcat(dq, qdd)], ["x", "u", "p"], ["dx"])
-    clear = _lambdify([eq.guards["heel_strike"]], syms, args)
-    ahead = _lambdify([eq.guards["swing_foot_ahead"]], syms, args)
+    clear = casadi_matrix([eq.guards["heel_strike"]], syms, args)
+    ahead = casadi_matrix([eq.guards["swing_foot_ahead"]], syms, args)
     rate = ca.jtimes(clear, x, ca.vertcat(dq, ca.SX.zeros(n)))
     knees = [x[roles.index(b)] - x[roles.index(a)]
              for a, b in (FIVE_LINK_JOINTS["stance_knee"], FIVE_LINK_JOINTS["swing_knee"])]
     feet = ca.Function("feet", [x, p], [ca.vertcat(clear, ahead, rate, *knees)], ["x", "p"],
                        ["feet"])
-    Mi, Bi = _lambdify(eq.Mi, syms, args), _lambdify(eq.B, syms, args)
+    Mi, Bi = casadi_matrix(eq.Mi, syms, args), casadi_matrix(eq.B, syms, args)
     dq_post = ca.solve(Mi, Bi @ dq)
-    qn = _lambdify(eq.relabel_q, syms, args)
+    qn = casadi_matrix(eq.relabel_q, syms, args)
     R = np.array(eq.relabel_rate, float)
     reset = ca.Function("reset", [x, p], [ca.vertcat(qn, ca.DM(R) @ dq_post)], ["x", "p"],
                         ["x_next"])
@@ -97,7 +81,10 @@ def _build(structure) -> dict:
 def _source_hash() -> str:
     import casadi as ca
 
+    from walkerlab.codegen import casadi_functions
+
     h = hashlib.sha256(Path(__file__).read_bytes())
+    h.update(Path(casadi_functions.__file__).read_bytes())  # the printer
     h.update(ca.__version__.encode())
     return h.hexdigest()[:12]
 
@@ -122,9 +109,8 @@ def five_link_functions(structure) -> dict:
         A walker without free knees or without a hinged torso (the hips act between the
         torso and the thighs), or one the five-link generator does not handle (one line).
     """
-    import casadi as ca
-
-    from walkerlab.codegen.cache import cache_dir, cache_key, read_source, write_source
+    from walkerlab.codegen.cache import cache_key
+    from walkerlab.codegen.casadi_functions import cached_functions
 
     if not (structure.free_knees and structure.hinged_torso):
         raise ValueError("optimize: the five-link collocation drives the hips between a hinged "
@@ -132,21 +118,6 @@ def five_link_functions(structure) -> dict:
                          "hinged, walker.leg.knee.lock: free)")
 
     key = f"{cache_key(structure)}-collocation-{_source_hash()}"
-    if key in _memo:
-        return _memo[key]
-    folder = cache_dir()
-    path = folder / f"{key}.casadi" if folder is not None else None
-    text = read_source(path) if path is not None else None
-    fns = None
-    if text is not None:
-        try:
-            fns = {k: ca.Function.deserialize(v) for k, v in json.loads(text).items()}
-        except (RuntimeError, ValueError, TypeError):
-            fns = None  # damaged: rebuilt below
-    if fns is None:
-        fns = _build(structure)
-        if path is not None:
-            write_source(path, json.dumps({k: f.serialize() for k, f in fns.items()}))
+    fns = dict(cached_functions(key, lambda: _build(structure)))
     fns["n"] = len(structure.roles)
-    _memo[key] = fns
     return fns

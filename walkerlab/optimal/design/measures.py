@@ -1,4 +1,4 @@
-"""Measures of a gait's robustness as design objectives (:mod:`walkerlab.optimal.design`),
+"""Measures of a gait's robustness as design objectives (:mod:`walkerlab.optimal.design.search`),
 each of the scene at the design point and its period-1 gait:
 
 - ``gait_sensitivity_norm`` [indicator units per disturbance unit]: Hobbelen & Wisse's

@@ -4,10 +4,12 @@ do your own direct collocation", SIAM Review 59(4):849-904, Sec. 7 and his Optim
 ``demo/fiveLinkBiped`` (step length 0.5 m, step period 0.7 s, minimise ``int |u|^2 dt``,
 torques at the hips and knees, no ankle torque).
 
-Transcription (separated Hermite-Simpson, as :mod:`walkerlab.optimal.collocation`): states
-``x_k`` (10,) and torques ``u_k`` (4,: :data:`walkerlab.optimal.five_link.JOINTS`) at
+Transcription (separated Hermite-Simpson, as :mod:`walkerlab.optimal.transcription.step`): states
+``x_k`` (10,) and torques ``u_k`` (4,:
+:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`) at
 ``2N + 1`` points on ``[0, T]``; the flow, the feet and the reset are the walker's own
-symbolic model (:func:`walkerlab.optimal.five_link.five_link_functions`).  Constraints:
+symbolic model (:func:`walkerlab.optimal.transcription.free_joint_functions.five_link_functions`).
+Constraints:
 
 - periodic through the heel strike: ``x_0 = reset(x_2N)`` (Kelly's ``cst_heelStrike``);
 - the step ends on the ground, ``step length`` ahead (``cst_stepLength``), the swing foot
@@ -31,8 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.collocation import target_constraints
-from walkerlab.optimal.ipopt import iteration_history, solve
+from walkerlab.optimal.transcription.ipopt import iteration_history, solve
+from walkerlab.optimal.transcription.step import target_constraints
 
 __all__ = ["FiveLinkResult", "collocate_five_link", "kelly_guess", "replay_five_link",
            "torques_of_time"]
@@ -49,7 +51,8 @@ class FiveLinkResult:
     x : ndarray (2N + 1, 10)
         States there (the walker's ``state_names()`` order).
     u : ndarray (2N + 1, 4)
-        Joint torques [N m] (:data:`walkerlab.optimal.five_link.JOINTS` order).
+        Joint torques [N m] (:data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`
+        order).
     step_period_s, step_length_m : float
     objective : float
         ``int |u|^2 dt`` [N^2 m^2 s] (Simpson's rule on the points).
@@ -59,7 +62,7 @@ class FiveLinkResult:
     wall_time_s, cpu_time_s : float
         The solve's (IPOPT and the function evaluations; not the set-up).
     history : dict of str -> ndarray
-        IPOPT's iteration history (:func:`walkerlab.optimal.ipopt.iteration_history`).
+        IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
     """
 
     t: np.ndarray
@@ -133,10 +136,11 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     ----------
     data : WalkerData
         ``structure.free_knees`` set (with or without a torso).
-    spec : walkerlab.optimal.collocation.CollocationSpec
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
         ``intervals``, ``max_torque_n_m`` and the targets (its push-off fields must be off).
     fns : dict, optional
-        :func:`walkerlab.optimal.five_link.five_link_functions` (looked up when not given).
+        :func:`walkerlab.optimal.transcription.free_joint_functions.five_link_functions` (looked up
+        when not given).
 
     Returns
     -------
@@ -149,7 +153,7 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     """
     import casadi as ca
 
-    from walkerlab.optimal.five_link import five_link_functions
+    from walkerlab.optimal.transcription.free_joint_functions import five_link_functions
 
     if spec.push_off_free or spec.push_off_n_s:
         raise ValueError("optimize.push_off: a five-link biped has no push-off (its hips and "
@@ -216,7 +220,7 @@ def replay_five_link(data, res: FiveLinkResult, x0: np.ndarray | None = None, so
     """One step of the rigid five-link model (its generated code, its own phases, guards and
     reset: not the CasADi expressions the optimisation used) from ``res.x[0]`` with the
     torques :func:`torques_of_time` of ``res`` (open loop), or from ``x0`` (the closed
-    start of :func:`walkerlab.optimal.five_link_shooting.close_step`).
+    start of :func:`walkerlab.optimal.replay.shooting.close_step`).
 
     Parameters
     ----------
@@ -242,7 +246,7 @@ def replay_five_link(data, res: FiveLinkResult, x0: np.ndarray | None = None, so
     from walkerlab.integrate.solver import Solver
     from walkerlab.models.hybrid.actuated import actuate
     from walkerlab.models.hybrid.rigid import make_rigid_walker
-    from walkerlab.optimal.five_link import JOINTS
+    from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 
     spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw(), max_torque_n_m=1e6)
                               for j in JOINTS])

@@ -1,11 +1,11 @@
 """The periodic orbit that a five-link biped's optimised torques actually drive, by shooting:
 how an open-loop replay of an unstable optimal gait is closed.
 
-The collocated step (:mod:`walkerlab.optimal.five_link_collocation`) satisfies the
+The collocated step (:mod:`walkerlab.optimal.transcription.free_joints`) satisfies the
 dynamics only to the transcription's error (Hermite-Simpson, ``O(h^4)``: ~1e-6 rad/s at 50
 intervals); the walker under open-loop torques is unstable (the error grows ~e^11-fold over
 a 0.7 s step of RABBIT), so a replay from the collocated start ends ~1e-2 away from it and
-never closes to 1e-6.  The torques ``u(t)`` (:func:`walkerlab.optimal.five_link_collocation.
+never closes to 1e-6.  The torques ``u(t)`` (:func:`walkerlab.optimal.transcription.free_joints.
 torques_of_time`, time since the heel strike) are kept and the start state ``x_0`` and the
 step's end time ``T`` are solved so that the step closes exactly::
 
@@ -109,7 +109,7 @@ def close_step(fns, params, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> Clos
     Parameters
     ----------
     fns : dict
-        :func:`walkerlab.optimal.five_link.five_link_functions`.
+        :func:`walkerlab.optimal.transcription.free_joint_functions.five_link_functions`.
     params : sequence of float
         The walker's parameters (``WalkerData.params``).
     t : ndarray (2N + 1,)
@@ -150,7 +150,7 @@ def _multipliers(fns, params, G, z, zs, t, u) -> np.ndarray:
     step (module docstring)."""
     import casadi as ca
 
-    from walkerlab.optimal.five_link_collocation import torques_of_time
+    from walkerlab.optimal.transcription.free_joints import torques_of_time
 
     n2 = 2 * fns["n"]
     xT_sym = G(z)[1]

@@ -1,0 +1,1 @@
+"""Design optimisation over a scene's numeric fields."""

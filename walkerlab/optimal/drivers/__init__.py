@@ -1,0 +1,1 @@
+"""Set-ups of ``walkerlab optimize`` from a scene: transcription, replay, records."""

@@ -1,0 +1,1 @@
+"""Optimised steps replayed on the rigid and contact views."""

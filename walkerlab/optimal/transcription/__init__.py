@@ -1,0 +1,1 @@
+"""Transcriptions of a periodic gait into a nonlinear program (CasADi + IPOPT)."""
