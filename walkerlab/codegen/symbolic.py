@@ -82,8 +82,9 @@ class Equations:
     section_drop : int
         Index in ``q`` solved from the heel-strike guard; ``drop_solution`` is its expression.
     De, E : Matrix
-        Extended impact matrices (coordinates ``[q, x_f, y_f]``, paper Eq. 6-7, A.7-A.24) for
-        the printed-equation variants (zeros for kneed or arc-footed walkers).
+        Extended impact matrices (coordinates ``[q, x_f, y_f]``, paper Eq. 6-7, A.7-A.24):
+        the stance foot free, ``E`` the swing foot's material contact point's Jacobian
+        (every foot kind: the push-off's transition reads them).
     section_tied : dict[int, int]
         State indices equal to another one on the section (kneed: the swing shank angle and
         rate equal the thigh's just after heel strike).
@@ -570,11 +571,16 @@ def _swap_and_guards(s: _Symbols, points: dict, swing_contact, sub: dict) -> dic
             "section_tied": tied}
 
 
-def _extended(s: _Symbols, bodies: list, foot, lim: bool):
-    """Extended impact matrices of the printed-equation variants (point-foot compass gait
-    only): with the stance foot free at ``(x_f, y_f)``, ``De`` is the Hessian of the kinetic
-    energy in the rates of ``[q, x_f, y_f]`` (massless bodies carry none) and ``E`` the
-    Jacobian of the swing foot's position (paper Eq. 6-7, A.7-A.24).
+def _extended(s: _Symbols, bodies: list, foot, lim: bool, spin=None):
+    """Extended impact matrices: with the stance foot free at ``(x_f, y_f)`` (the whole
+    walker translated by them), ``De`` is the Hessian of the kinetic energy in the rates of
+    ``[q, x_f, y_f]`` (massless bodies carry none) and ``E`` the Jacobian of the swing foot's
+    material contact point (paper Eq. 6-7, A.7-A.24).  A point foot's is its position's;
+    an arc foot's (``spin``, the swing arc's angle, given) moves at ``v_centre + w x (-R n)``
+    with ``foot`` its centre (McGeer 1990).  The stance arc's material contact point moves
+    at ``(dx_f, dy_f)`` here: the rolling offset's rate ``-R dpsi t`` cancels the arc's spin
+    about its centre ``R dpsi t``, so an impulse there (a push-off) has the generalised
+    force ``[0, ..., 0, F]`` for a point foot and an arc alike.
 
     Returns
     -------
@@ -592,6 +598,8 @@ def _extended(s: _Symbols, bodies: list, foot, lim: bool):
     Te = Te.subs(s.beta, 0) if lim else Te
     De = sp.hessian(Te, dqe)
     E = (foot + sp.Matrix([xf, yf])).jacobian(qe)
+    if spin is not None:  # the arc's material point: w x (-R n) = R w t
+        E += s.R * s.tangent * sp.Matrix([[sp.diff(spin, qi) for qi in qe]])
     return De, E
 
 
@@ -622,16 +630,13 @@ def derive(structure: Structure) -> Equations:
     dyn, points, swing_contact, bodies, sub = _to_scene(
         s, _lagrange(s, Mp, Mi, Bm, V, D), geo, points, bodies)
     swap = _swap_and_guards(s, points, swing_contact, sub)
-    n = s.n
-    if s.arc:  # the swing arc's material contact point is not a named point's position
-        De, E = sp.zeros(n + 2, n + 2), sp.zeros(2, n + 2)
-        extra = {"locked": dyn.locked, "knee_impact": dyn.knee_impact}
-    elif s.knee:  # the extended impact system: a push-off at the straight stance leg's foot
-        De, E = _extended(s, bodies, points["swing_foot"], dyn.lim)
-        extra = {"locked": dyn.locked, "knee_impact": dyn.knee_impact}
-    else:
-        De, E = _extended(s, bodies, points["swing_foot"], dyn.lim)
-        extra = {"section_tied": None}
+    # the extended impact system (a push-off at the stance foot's contact point): the swing
+    # foot's material contact point, an arc's from its centre and its spin
+    De, E = (_extended(s, bodies, points["swing_foot_centre"], dyn.lim,
+                       spin=s.ps_shank.subs(sub)) if s.arc
+             else _extended(s, bodies, points["swing_foot"], dyn.lim))
+    extra = ({"locked": dyn.locked, "knee_impact": dyn.knee_impact} if s.arc or s.knee
+             else {"section_tied": None})
     return Equations(
         q=tuple(s.q), dq=tuple(s.dq), params=tuple(s.par), M=dyn.M, C=dyn.C, G=dyn.G,
         Mi=dyn.Mi, B=dyn.Bm, kinetic=dyn.T, potential=dyn.V, points=points, De=De, E=E,

@@ -93,7 +93,8 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
                               ta, tb, scale)
             wneg += quad_work(lambda t, sol=sol: min(acts.power(t, _state(sol, t, n2)), 0.0),
                               ta, tb, scale)
-        elif acts is not None and ph.name.startswith("heel_off"):
+        elif acts is not None and ph.name.startswith("heel_off") \
+                and getattr(acts, "ankle", 0) is not None:  # a toe push-off alone: no ankle torque
             def power(t, sol=sol):
                 x = _state(sol, t, n2)
                 return acts.torque(x[acts.ankle]) * x[acts.ankle + n2 // 2]
@@ -104,15 +105,20 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
     ke_plus, pe_next = (float(v) for v in walker.energies(seg.x_next))
     pe_plus = pe_next + m * g * float(step[1])  # the next heel is step[1] higher
     loss = (ke_end + pe_end) - (ke_plus + pe_plus)  # collision + the trailing ankle spring
+    push = impulse = 0.0
+    if acts is not None and getattr(acts.spec, "push_off", None) is not None:
+        tr = acts.transition(seg.x_end)  # the toe's push-off before the heel strike
+        push, impulse = float(tr["ke_push_off"] - tr["ke_minus"]), float(tr["impulse"])
+        loss += push
     d_e = (ke_plus + pe_plus) - (ke0 + pe0)
-    closure = d_e - (wpos + wneg + wdamp - loss - internal)
+    closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
     d = step_length(walker, seg)
     slope_energy = m * g * d * np.sin(float(walker.slope_rad))
-    out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=0.0,
-               push_off_impulse=0.0, heel_strike_loss=loss, internal_collision_loss=internal,
+    out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
+               push_off_impulse=impulse, heel_strike_loss=loss, internal_collision_loss=internal,
                damper_work=wdamp, potential_work=-(pe_plus - pe0), energy_change=d_e,
                closure=closure, slope_energy=slope_energy,
-               cost_of_transport=(wpos + max(slope_energy, 0.0)) / (m * g * d))
+               cost_of_transport=(wpos + push + max(slope_energy, 0.0)) / (m * g * d))
     return out
 
 

@@ -33,15 +33,16 @@ def _structure_check(data, spec) -> bool:
     if spec.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
                          "flat); point feet take push_off, the impulse along the leg")
-    if st.foot == "arc" and spec.push_off is not None:
-        raise ValueError("walker.actuation.push_off: an arc foot's push-off at its rolling "
-                         "contact point is not derived yet (joint torques are)")
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
     if any(massless) and not limit:
         raise ValueError("walker.actuation: legs with some massless bodies are not supported")
     if limit and (st.torso or not st.hip_mass):
         raise ValueError("walker.actuation: massless legs need a hip mass and no torso")
+    if limit and st.foot != "point" and spec.push_off is not None:
+        raise ValueError("walker.actuation.push_off: on massless legs the push-off's limit "
+                         "m -> 0 is Kuo's point foot; an arc's depends on where its mass "
+                         "sits: give the legs mass")
     for i, t in enumerate(spec.torques):
         if limit and t.scaled_by != "foot_mass":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: the legs are massless "

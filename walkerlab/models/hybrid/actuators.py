@@ -47,7 +47,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from walkerlab.config.actuation import JOINTS
-from walkerlab.models.actuation import TorqueLaws, push_off_impulse
+from walkerlab.models.actuation import TorqueLaws
+from walkerlab.models.hybrid.push_off import PushOffTransition
 from walkerlab.numerics import complex_step_jacobian
 
 __all__ = ["Actuators", "joint_links", "link_angles", "torque_chain_jacobian"]
@@ -138,8 +139,6 @@ class Actuators:
         self.A = np.array([[float(r[f"{self.legs[0]}_rate"]) for r in rows],
                            [float(r[f"{self.legs[1]}_rate"]) for r in rows]])
         self.ddelta_dq = self.A[0] - self.A[1]
-        swap = np.array([[0.0, 1.0], [1.0, 0.0]])  # the legs' absolute angles trade places
-        self.R = np.linalg.pinv(self.A) @ swap @ self.A
         self.laws = TorqueLaws(self.spec.torques)
         # each actuator's (first, second) link and its row of B^T = d(delta)/dq (exact)
         names = self.link_angles(np.concatenate([z, z]))
@@ -163,8 +162,6 @@ class Actuators:
         # (t, x) -> (k, 2n) the torques' derivative by the state, when known in closed form
         # (a torque of time alone: zeros); None: the complex step differentiates the torques
         self.torque_jacobian = None
-        self._memo: dict = {}  # recent transitions (pre-impact state bytes -> result)
-        self.lock = None  # the gradient (n,) of a constraint held through the transition
 
     def link_angles(self, x) -> dict:
         """``{link: (angle [rad], rate [rad/s])}`` at the state ``x`` (2n,)
@@ -175,18 +172,19 @@ class Actuators:
             out["torso"] = ((a + b) / 2, (da + db) / 2)
         return out
 
+    @property
+    def push(self):
+        """The push-off and heel strike (:class:`walkerlab.models.hybrid.push_off.
+        PushOffTransition`), made on first use."""
+        if "_push" not in self.__dict__:
+            self._push = PushOffTransition(self.spec, self.fns, self.n, self.limit,
+                                           self.hip_mass_kg)
+        return self._push
+
     def hold_lock(self, lock) -> None:
-        """Hold the constraint whose gradient is ``lock(x)`` (n,) (a locked swing knee)
-        through the push-off and the heel strike, as the passive heel strike does (McGeer
-        1990); the role swap's rate map is then the swap of the generated reset's positions
-        (affine in ``q``: central differences of unit step are exact), since a kneed leg's
-        thigh and shank both take the straight leg's rate."""
-        self.lock = lock
-        n, z = self.n, np.zeros(self.n)
-        pos = self.fns["reset"]
-        self.R = np.stack([(np.real(pos(np.concatenate([e, z])))[:n]
-                            - np.real(pos(np.concatenate([-e, z])))[:n]) / 2.0
-                           for e in np.eye(n)], axis=1)
+        """Hold the constraint ``lock(x)`` (n,) (a locked swing knee) through the push-off
+        and the heel strike (:meth:`PushOffTransition.hold_lock`)."""
+        self.push.hold_lock(lock)
 
     # ---------------------------------------------------------------- joint torques
     def hip_angles(self, x):
@@ -281,119 +279,21 @@ class Actuators:
 
     # ---------------------------------------------------------------- push-off
     def hip_velocity(self, x) -> np.ndarray:
-        """Hip velocity (2,) [m/s] (world x forward, y up) of a pinned-stance state ``x``
-        (2n,), from the generated ``point_velocities`` (analytic in the whole state: a
-        complex step differentiates through it)."""
-        return np.asarray(self.fns["point_velocities"](x)["hip"])
-
-    def _point_jacobians(self, q, names) -> np.ndarray:
-        """The named points' position Jacobians stacked (2 len(names), n) at ``q`` (n,),
-        column ``k`` the points' velocities for ``dq = e_k`` (exact, and analytic in ``q``:
-        complex-step safe)."""
-        eye = np.eye(self.n)
-        cols = []
-        for k in range(self.n):
-            v = self.fns["point_velocities"](np.concatenate([q, eye[k]]))
-            cols.append(np.concatenate([np.asarray(v[name]) for name in names]))
-        return np.array(cols).T
+        """Hip velocity (2,) [m/s] of a state ``x`` (2n,) (:mod:`push_off`)."""
+        return self.push.hip_velocity(x)
 
     def impulse(self, x) -> float:
         """Push-off impulse ``P`` [N s] for the pre-impact state ``x`` (>= 0)."""
-        po = self.spec.push_off
-        if po is None or po.speed_gain_n_s2_per_m == 0.0:
-            return push_off_impulse(po, 0.0)
-        v = self.hip_velocity(x)
-        return push_off_impulse(po, np.sqrt(v @ v))
-
-    def _relabel(self, q):
-        """New coordinates (n,) after the role swap and the rate map ``R`` (n, n) (exact:
-        ``A^-1 S A`` with ``S`` the swap of the two legs' absolute angles)."""
-        qn = np.real(self.fns["reset"](np.concatenate([np.real(q), np.zeros(self.n)]))[:self.n])
-        return qn, self.R
+        return self.push.impulse(x)
 
     def transition(self, x) -> dict:
-        """Push-off and heel strike from the pre-impact state ``x`` (2n,).
-
-        Returns
-        -------
-        dict
-            ``x_plus`` (2n,) the post-impact state, roles swapped; ``impulse`` P [N s];
-            ``ke_minus``, ``ke_push_off``, ``ke_plus`` kinetic energies [J] before the
-            push-off, after it and after the heel strike.
-        """
-        x = np.asarray(x)
-        key = None if np.iscomplexobj(x) else x.tobytes()
-        if key is not None and key in self._memo:  # the reset's, asked again by the ledger
-            return self._memo[key]
-        out = self._transition(x)
-        if key is not None:
-            if len(self._memo) >= 256:
-                self._memo.pop(next(iter(self._memo)))
-            self._memo[key] = out
-        return out
-
-    def _transition(self, x) -> dict:
-        n = self.n
-        q, dq = x[:n], x[n:]
-        P = self.impulse(x)
-        if self.limit:
-            return self._transition_point_hip(x, P)
-        De, E = self.fns["impact_matrices"](q)
-        De, E = np.asarray(De), np.asarray(E)
-        r = np.asarray(self.fns["points"](x)["hip"])  # from the stance foot at the origin
-        e = r / np.sqrt(r @ r)
-        dqe = np.concatenate([dq, np.zeros(2)])
-        Ef = np.zeros((2, n + 2))
-        Ef[:, n:] = np.eye(2)
-        if self.lock is None:
-            dqe_po = dqe + np.linalg.solve(De, Ef.T @ (P * e))
-            K = np.zeros((n + 4, n + 4), dtype=np.result_type(De, E))
-            K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -E.T, E
-            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(2)]))
-        else:  # the swing knee locked through both impulses (as the passive heel strike)
-            a = np.concatenate([np.asarray(self.lock(x)), np.zeros(2)])[None, :]
-            A = np.zeros((n + 3, n + 3), dtype=np.result_type(De, a))
-            A[:n + 2, :n + 2], A[:n + 2, n + 2:], A[n + 2:, :n + 2] = De, -a.T, a
-            dqe_po = np.linalg.solve(A, np.concatenate([De @ dqe + Ef.T @ (P * e),
-                                                        np.zeros(1)]))[:n + 2]
-            C = np.vstack([E, a])
-            K = np.zeros((n + 5, n + 5), dtype=np.result_type(De, C))
-            K[:n + 2, :n + 2], K[:n + 2, n + 2:], K[n + 2:, :n + 2] = De, -C.T, C
-            sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, np.zeros(3)]))
-        dq_plus = sol[:n]
-        qn, R = self._relabel(np.real(q))
-        qn = qn + R @ (q - np.real(q))  # the swap is affine: exact for a complex step too
-        ke = (0.5 * dqe @ De @ dqe, 0.5 * dqe_po @ De @ dqe_po, 0.5 * sol[:n + 2] @ De
-              @ sol[:n + 2])
-        return {"x_plus": np.concatenate([qn, R @ dq_plus]),
-                "impulse": P, "ke_minus": ke[0], "ke_push_off": ke[1], "ke_plus": ke[2]}
-
-    def _transition_point_hip(self, x, P):
-        """Push-off and heel strike of a point hip mass on massless legs (Kuo 2002, Eq. 2
-        and its appendix); analytic in ``x`` (every point and Jacobian from the generated
-        ``points``/``point_velocities``, the least-squares solve by its normal equations with
-        a plain transpose), so the reset's Jacobian by the complex step is exact."""
-        n, M = self.n, self.hip_mass_kg
-        q = x[:n]
-        pts = self.fns["points"](x)
-        v = self.hip_velocity(x)
-        hip, lead = np.asarray(pts["hip"]), np.asarray(pts["swing_foot"])
-        et = hip / np.sqrt(hip @ hip)          # trailing leg: stance foot at the origin
-        el = (hip - lead) / np.sqrt((hip - lead) @ (hip - lead))
-        v_po = v + (P / M) * et
-        v_plus = v_po - (v_po @ el) * el
-        v_foot = (v_plus @ et) * et            # the trailing foot: no velocity across its leg
-        qn, R = self._relabel(np.real(q))
-        qn = qn + R @ (q - np.real(q))         # the swap is affine: exact for a complex step
-        Jn = self._point_jacobians(qn, ("hip", "swing_foot"))   # (4, n), full column rank
-        dq_plus = np.linalg.solve(Jn.T @ Jn, Jn.T @ np.concatenate([v_plus, v_foot]))
-        ke = (0.5 * M * (v @ v), 0.5 * M * (v_po @ v_po), 0.5 * M * (v_plus @ v_plus))
-        return {"x_plus": np.concatenate([qn, dq_plus]), "impulse": P, "ke_minus": ke[0],
-                "ke_push_off": ke[1], "ke_plus": ke[2]}
+        """Push-off and heel strike from the pre-impact state ``x`` (2n,)
+        (:meth:`walkerlab.models.hybrid.push_off.Transitions.transition`)."""
+        return self.push.transition(x)
 
     def reset(self, x) -> np.ndarray:
         """Post-impact state (2n,) after push-off and heel strike (roles swapped)."""
-        return self.transition(x)["x_plus"]
+        return self.push.reset(x)
 
 
 def torque_chain_jacobian(matrices, x, force, force_jacobian) -> np.ndarray:

@@ -77,28 +77,38 @@ def heel_off_data(data, spec):
 
 
 def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
-    """The flat-footed walker with its ankle push-off (module docstring), or with hip
-    torques alone (:func:`walkerlab.models.hybrid.flat_hip_torque.actuate_flat_hips`).
+    """The flat-footed walker with its ankle push-off (module docstring), a push-off impulse
+    at the trailing toe (:func:`walkerlab.models.hybrid.push_off.push_off_flat`), both, or
+    with hip torques alone (:func:`walkerlab.models.hybrid.flat_hip_torque.actuate_flat_hips`).
 
     Raises
     ------
     ValueError
-        An actuator flat feet do not carry (a push-off impulse, hip torques with an ankle
-        push-off), legs that differ (one line).
+        Hip torques with a push-off (not written yet), legs that differ with an ankle
+        push-off (one line).
     """
+    from walkerlab.codegen.cache import functions
+    from walkerlab.models.hybrid.push_off import push_off_flat
     from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 
     if spec.torques and spec.push_off is None and spec.ankle_push_off is None:
         from walkerlab.models.hybrid.flat_hip_torque import actuate_flat_hips
 
         return actuate_flat_hips(walker, data, spec)
-    if spec.push_off is not None or spec.torques:
-        raise ValueError("walker.actuation: flat feet take ankle_push_off or hip torques, "
-                         "not together (push_off impulses are for point feet today)")
-    if spec.ankle_push_off is None:
-        raise ValueError("walker.actuation: flat feet need ankle_push_off")
+    if spec.torques:
+        raise ValueError("walker.actuation: flat feet take hip torques alone today (not with "
+                         "push_off or ankle_push_off)")
+    if spec.ankle_push_off is None:  # the push-off impulse at the trailing toe alone
+        w = push_off_flat(walker, functions(data), spec)
+        if walker.mirror is not None:  # legs that differ: the next step's walker too
+            w = replace(w, mirror=push_off_flat(
+                walker.mirror, functions(replace(data.mirror, mirror_params=None)), spec))
+        return w
     w = make_flat_walker(data, walker.name, walker.variant, heel_off_data(data, spec))
-    return replace(w, actuators=AnklePushOffActuator(spec, list(w.roles).index("stance_ankle")))
+    ankle = AnklePushOffActuator(spec, list(w.roles).index("stance_ankle"))
+    if spec.push_off is not None:  # and the impulse at the toe before heel strike
+        return push_off_flat(w, functions(data), spec, ankle)
+    return replace(w, actuators=ankle)
 
 
 def ankle_push_off_work(walker: HybridWalker, seg) -> float:
