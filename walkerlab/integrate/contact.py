@@ -238,7 +238,8 @@ class _Backend:
         if self.method in _cyrk.CYRK_METHODS:  # whole chunk in compiled code (CyRK BDF)
             X, ok, nf, m = _cyrk.solve_chunk(self.method, xa, tg, self.data, s.rtol, self.atol,
                                              self.max_step, CYRK_STEPS_PER_CALL,
-                                             kernels=self.walker.kernels)
+                                             kernels=self.walker.kernels,
+                                             ready=getattr(self.walker, "rhs_ready", None))
             tn, Xn, nj = tg[1:len(X)], X[1:], 0
             if not ok:  # a force jump BDF cannot step over (a foot hitting the side of a
                 # patch below its top): odeint, which grinds through it as a plain odeint run
