@@ -83,6 +83,7 @@ class ContactRows:
     contact actuators (the powered run's touchdown and heel-off events read them)."""
 
     _points = None  # each leg's rows of the table, filled on first use
+    _last = None  # (walker, state bytes, rows) of the last call (the events share one state)
 
     def contact_rows(self, walker, x) -> np.ndarray:
         """The contact table (points, 8) at one state ``x`` (points as
@@ -96,16 +97,26 @@ class ContactRows:
         flat foot's, without building its dictionaries: the event functions' fast path):
         ``penetration`` [m], its rate [m/s], slip velocity [m/s], ``s`` [m], normal and
         friction force [N], power [W], ``on_ground``."""
+        x = np.asarray(x, float)
+        key = x.tobytes()
+        last = self._last
+        if last is not None and last[0] is walker and last[1] == key:  # the events of one
+            return last[2]  # step ask at the same state: the table once
         tab = self.contact_rows(walker, x)
         if self._points is None:  # each leg's rows of the table, once
             names = walker.contact_names()
             self._points = [[k for k, c in enumerate(names) if walker.contact_leg(c) == leg]
                             for leg in ("leg1", "leg2")]
+        if all(len(idx) == 1 for idx in self._points):  # point feet: each leg's one row
+            out = [tab[idx[0]].copy() for idx in self._points]
+            self._last = (walker, key, out)
+            return out
         out = []
         for idx in self._points:
             rows = tab[idx]
             on = rows[:, 7] > 0.5
             out.append(rows[int(np.argmax(np.where(on, rows[:, 0], rows[:, 0] - 1e3)))])
+        self._last = (walker, key, out)
         return out
 
 
