@@ -93,6 +93,7 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
     method = solver.method if solver.method in IVP_METHODS else "LSODA"
 
     mark = [t0, 0]
+    fast = getattr(walker.actuators, "compiled_rhs", lambda w: None)(walker)
 
     def f(t, y):
         if time.perf_counter() > deadline:
@@ -102,6 +103,8 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
         mark[1] += 1
         if mark[1] > STALL_CALLS:
             raise _Stall(y)
+        if fast is not None:  # the compiled right-hand side (point feet, straight legs)
+            return fast(y, stance, push, t - t_origin)
         dx, p = powered_rhs(walker, y[:n], stance, push, t - t_origin, ankle)
         return np.concatenate([dx, p])
 

@@ -250,6 +250,39 @@ class ContactActuators(ContactRows):
         n = self.nq
         return float(push_off_impulse(self.spec.push_off, np.hypot(x[n], x[n + 1])))
 
+    def compiled_rhs(self, walker):
+        """The compiled right-hand side of :func:`powered_rhs` for this walker, or None
+        where it has none (knees, flat feet: those run on :func:`powered_rhs`).
+
+        Returns
+        -------
+        callable or None
+            ``f(y, stance, push, t_step) -> ndarray (2 nq + 4,)``: ``[dx, powers]`` as
+            :func:`powered_rhs` returns them concatenated, the same numbers (its arithmetic
+            in the generated module's ``powered_rhs`` kernel, one call; the torque laws
+            evaluated here when there are any: they may be any callable).
+        """
+        kern = getattr(walker.kernels, "powered_rhs", None)
+        if kern is None or self.knee or self.foot is not None or self.ankle is not None:
+            return None
+        args = walker._args()
+        nx = 2 * self.nq
+        hx, hy = self.hip
+
+        def f(y, stance: int, push, t_step: float):
+            x = np.ascontiguousarray(y[:nx], dtype=float)
+            laws = self.laws
+            tau = 0.0
+            if laws:
+                delta, ddelta, s, ds = self.hip_angles(x, stance)
+                tau = float(np.sum(laws(delta, ddelta, s, ds, t_step)))
+            out = np.empty(nx + 4)
+            kern(x, *args, bool(laws), self.leg[1 - stance], self.leg[stance], tau,
+                 -1 if push is None else int(push[0]), 0.0 if push is None else float(push[1]),
+                 hx, hy, out)
+            return out
+        return f
+
     def push_direction(self, walker, x, trailing: int):
         """``(e, J, v)``: the unit vector (2,) from leg ``trailing``'s foot towards the hip
         (the push-off's direction), that foot's Jacobian (2, nq) and velocity (2,) [m/s]."""
