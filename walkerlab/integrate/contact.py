@@ -23,6 +23,13 @@ samples do not change) and the chunk goes on in odeint, whose RHS checks the dea
 numbalsoda's chunks are sized in wall time (each aims at :data:`CHUNK_WALL_S` seconds from
 the cost of the chunk before, the first is short).
 
+One loop (:func:`integrate_contact`'s free run) serves every walker: a powered one (with
+``actuators``) brings its actuation hook (:class:`walkerlab.integrate.contact_powered.
+ActuationHook`: the stance leg switched at touchdown, the push-off pulse, the ankle push-off,
+the work integrals, a compiled right-hand side where the walker has one), which integrates
+each chunk on solve_ivp with event location; the loop asks the strides cap after each of its
+heel strikes.
+
 Contact is decided by geometry only (the model): a foot gets the IMPACT force whenever it
 is below the top of a patch and inside its horizontal extent, in every state, so a step that
 would carry a foot from above a patch to deep inside it sees the force jump and is rejected
