@@ -24,17 +24,17 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_a_pending_kernel_is_waited_for_once_and_only_for_itself():
+    """The hand-off is an object the caller passes down, no module-level registry."""
     seen: list[str] = []
-    pending.compiled_elsewhere("mod_a", "build_cyrk", lambda: seen.append("a"))
-    pending.compiled_elsewhere("mod_b", "build_cyrk", lambda: seen.append("b"))
-    pending.before_first_use("mod_a", "other_kernel")
-    assert seen == []
-    pending.before_first_use("mod_a", "build_cyrk")
-    pending.before_first_use("mod_a", "build_cyrk")  # once
-    assert seen == ["a"]
-    pending.forget("mod_b")
-    pending.before_first_use("mod_b", "build_cyrk")
-    assert seen == ["a"]
+    a = pending.CompiledElsewhere("mod_a", "build_cyrk", lambda: seen.append("a"))
+    a.before_first_use("mod_a", "other_kernel")
+    a.before_first_use("mod_b", "build_cyrk")
+    assert seen == [] and a.expected
+    a.before_first_use("mod_a", "build_cyrk")
+    a.before_first_use("mod_a", "build_cyrk")  # once
+    assert seen == ["a"] and not a.expected
+    assert not [k for k, v in vars(pending).items()
+                if isinstance(v, (dict, list, set)) and not k.startswith("__")]
 
 
 class _FakeSide:
@@ -79,11 +79,15 @@ def test_the_right_hand_side_is_compiled_beside_only_on_a_cold_run(cached, fake_
     setup = contact_setup(load_scene(ROOT / "configs" / "paper.yaml"))
     monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_x", cached))
     used: list[bool] = []
-    with contact_sim._rhs_beside(setup):
-        # the walk's first use of the compiled right-hand side
-        used.append(("mod_x", "build_cyrk") in pending._WAITS)
-        pending.before_first_use("mod_x", "build_cyrk")
-    assert ("mod_x", "build_cyrk") not in pending._WAITS  # nothing left registered
+    with contact_sim._rhs_beside(setup, None) as run_setup:
+        # the walk's first use of the compiled right-hand side (the hand-off it was given)
+        ready = run_setup.rhs_ready
+        used.append(ready is not None)
+        if ready is not None:
+            ready.before_first_use("mod_x", "build_cyrk")
+            assert not ready.expected
+            assert run_setup.build(np.array([0.2, -0.2, -1.0, -1.0]), 2)[0].rhs_ready is ready
+    assert setup.rhs_ready is None  # the caller's setup untouched
     if cached is not False:  # warm, or nothing to share through: no side process
         assert fake_side.made == [] and used == [False]
         return
@@ -102,12 +106,10 @@ def test_a_run_whose_kernel_a_caller_compiles_beside_starts_nothing(fake_side, m
     setup = contact_setup(load_scene(ROOT / "configs" / "paper.yaml"))
     monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_r", False))
     seen: list[str] = []
-    pending.compiled_elsewhere("mod_r", "build_cyrk", lambda: seen.append("report's"))
-    try:
-        with contact_sim._rhs_beside(setup):
-            pending.before_first_use("mod_r", "build_cyrk")
-    finally:
-        pending.forget("mod_r")
+    ready = pending.CompiledElsewhere("mod_r", "build_cyrk", lambda: seen.append("report's"))
+    with contact_sim._rhs_beside(setup, ready) as run_setup:
+        assert run_setup.rhs_ready is ready
+        run_setup.rhs_ready.before_first_use("mod_r", "build_cyrk")
     assert fake_side.made == [] and seen == ["report's"]
 
 
@@ -121,10 +123,10 @@ def test_a_side_process_that_was_never_needed_is_stopped(fake_side, monkeypatch)
     setup = contact_setup(load_scene(ROOT / "configs" / "paper.yaml"))
     monkeypatch.setattr(generated, "contact_module_state", lambda s: ("mod_y", False))
     monkeypatch.setattr(_FakeSide, "submit", lambda self, fn, *a: Future())  # still running
-    with contact_sim._rhs_beside(setup):
+    with contact_sim._rhs_beside(setup, None):
         pass
     assert fake_side.made[0].closed == [True]
-    with pytest.raises(KeyError), contact_sim._rhs_beside(setup):
+    with pytest.raises(KeyError), contact_sim._rhs_beside(setup, None):
         raise KeyError("an error in the run")
     assert fake_side.made[1].closed == [True]
 
@@ -143,20 +145,20 @@ from pathlib import Path
 from walkerlab.codegen import pending
 
 waits = []
-register = pending.compiled_elsewhere
+register = pending.CompiledElsewhere.__init__
 numba_dir = Path(sys.argv[2]) / "numba"
 
 def rhs_files():
     return sorted((str(p), p.stat().st_mtime_ns) for p in numba_dir.rglob("*rhs*")
                   if p.is_file())
 
-def spy(name, kernel, wait):
+def spy(self, name, kernel, wait):
     def timed():
         ok = wait()
         waits.append([kernel, bool(ok), rhs_files()])
-    register(name, kernel, timed)
+    register(self, name, kernel, timed)
 
-pending.compiled_elsewhere = spy
+pending.CompiledElsewhere.__init__ = spy
 if __name__ == "__main__":
     from walkerlab.cli import app
     try:

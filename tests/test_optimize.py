@@ -85,6 +85,8 @@ def test_optimize_command_writes_its_artifact_and_refuses_what_it_cannot(tmp_pat
     # 0.77 % longer than the rigid one (the compliant feet), within the 3 % asked
     assert d.contact_step_period_s == pytest.approx(d.step_period_s, rel=0.03)
     assert d.contact_outcome == "heel_strike" and "contact model driven" in r.output
+    figs = tmp_path / "compass_optimal" / "report" / "figures"  # the SVG on request (--svg)
+    assert (figs / "optimize.png").is_file() and not (figs / "optimize.svg").exists()
     # arc feet: no transcription yet (a kneed walker has its phased one: test_optimize_phases)
     r = CliRunner().invoke(app, ["optimize", str(CONFIGS / "round_feet.yaml"),
                                  "--runs-dir", str(tmp_path)])

@@ -218,3 +218,46 @@ def test_the_powered_contact_periodic_gait_returns_to_itself_near_the_rigid_one(
     assert g.period_s == pytest.approx(gait.step_period, rel=0.03)
     assert g.stable and 0.5 < g.max_multiplier < 0.9
     assert g.patch_margin_m > 0.05
+
+
+def test_a_powered_run_is_the_passive_loop_with_an_actuation_hook(rigid, monkeypatch):
+    """One contact integrator loop: a powered walker's run goes through the passive run's
+    loop (:func:`walkerlab.integrate.contact._run_free`) with its actuation hook.  The
+    walker with a zero hip-torque law and no push-off walks as the passive walker: through
+    its first heel strike (~0.70 s, the stance leg switched) to 0.9 s the states agree
+    within 2e-5 (the powered hook integrates on solve_ivp's LSODA with event location and
+    the work integrals in its error norm, the passive run on the scene's backend: the two
+    agree to the integrator's tolerance, rtol 1e-6), and the actuators' work integrals are
+    exactly 0."""
+    from walkerlab.analysis.contact.sim import scene_start
+    from walkerlab.integrate import contact
+
+    _, gait = rigid
+    scene = with_changes(load_scene(SCENE), {
+        "walker.actuation.push_off": None,
+        "walker.actuation.torques": [{"joint": "hip", "law": {}}]})
+    setup = contact_setup(scene)
+    assert setup.actuators is not None and setup.actuators.spec.push_off is None
+    hooks = []
+    loop = contact._run_free
+
+    def spy(*a, **kw):
+        hooks.append(a[8] if len(a) > 8 else kw.get("hook"))
+        return loop(*a, **kw)
+
+    monkeypatch.setattr(contact, "_run_free", spy)
+    runs = []
+    for acts in (setup.actuators, None):
+        walker, x0, limits, _ = scene_start(replace(setup, actuators=acts), gait.x, 1)
+        limits = replace(limits, fall_hip_height_m=0.5 * walker.L)
+        runs.append(integrate_contact(walker, x0, 0.0, 0.9, Solver.from_settings(
+            setup.solver), limits))
+    powered, passive = runs
+    assert len(hooks) == 2 and hooks[0] is not None and hooks[1] is None
+    assert powered.termination == passive.termination == "t_final"
+    common, i, j = np.intersect1d(powered.t, passive.t, return_indices=True)
+    assert common.size > 400
+    assert np.max(np.abs(powered.X[i] - passive.X[j])) < 2e-5
+    names = setup.actuators.work_names
+    for k in ("hip_torque_positive", "hip_torque_negative", "push_off"):
+        assert np.all(powered.work[:, names.index(k)] == 0.0), k

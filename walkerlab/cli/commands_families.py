@@ -206,6 +206,8 @@ def optimize(scene: Path | None = SceneArg,
                                                "optimum is not a gait (IPOPT did not "
                                                "converge or the rigid replay does not "
                                                "close); optimize.h5 stays"),
+             svg: bool = typer.Option(False, "--svg", help="also write the figure as "
+                                      "SVG (walkerlab report always does)"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """A periodic gait of a walker with a hip torque (a five-link biped: hip and knee
     torques) by direct collocation (CasADi + IPOPT; the scene's optimize section): least
@@ -274,7 +276,7 @@ def optimize(scene: Path | None = SceneArg,
     typer.echo(status(out))
     from walkerlab.stages.optimize import draw
 
-    typer.echo(f"figure: {draw(load(scene), runs_dir)[0]}")
+    typer.echo(f"figure: {draw(load(scene), runs_dir, svg)[0]}")
     if require_gait:  # the artifact stays: it holds what was found
         from walkerlab.io.schemas.optimize import load as load_optimize
 

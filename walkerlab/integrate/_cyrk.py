@@ -25,8 +25,6 @@ import ctypes
 
 import numpy as np
 
-from walkerlab.codegen import pending
-
 __all__ = ["CYRK_METHODS", "solve_chunk"]
 
 #: walkerlab method name -> CyRK method name.  Only BDF pays on the contact walker (RHS calls
@@ -39,19 +37,20 @@ CYRK_METHODS = {"cyrk_bdf": "BDF"}
 _FPTR: dict = {}  # generated kernels module name -> cfunc address
 
 
-def address(kernels) -> int:
+def address(kernels, ready=None) -> int:
     """C address of the cfunc of ``kernels.rhs_packed`` (compiled once per walker structure,
-    numba disk cache)."""
+    numba disk cache); ``ready``: a :class:`walkerlab.codegen.pending.CompiledElsewhere`
+    (a side process compiling it: waited for first, then the kernel is loaded)."""
     if kernels.__name__ not in _FPTR:
-        # a side process may be compiling it (a cold contact run): wait, then load it
-        pending.before_first_use(kernels.__name__, "build_cyrk")
+        if ready is not None:  # a side process is compiling it (a cold contact run)
+            ready.before_first_use(kernels.__name__, "build_cyrk")
         _FPTR[kernels.__name__] = kernels.build_cyrk()
     return _FPTR[kernels.__name__]
 
 
 def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarray,
                 rtol: float, atol, max_step: float = np.inf, max_num_steps: int = 0, *,
-                kernels=None):
+                kernels=None, ready=None):
     """Integrate from ``x0`` at ``t_eval[0]`` over the sample times ``t_eval`` (n,) [s].
 
     Parameters
@@ -74,6 +73,9 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
         Most solver steps in this call (0: CyRK's default); past it the call stops
         unsuccessfully at the last sample reached (how a caller bounds the wall time of a
         compiled chunk, which checks no clock).
+    ready : walkerlab.codegen.pending.CompiledElsewhere, optional
+        The caller's hand-off when a side process compiles the right-hand side
+        (``ContactWalker.rhs_ready``).
 
     Returns
     -------
@@ -89,7 +91,7 @@ def solve_chunk(method: str, x0: np.ndarray, t_eval: np.ndarray, data: np.ndarra
     from CyRK.cy.pyhelpers import find_ode_method_int
     from CyRK.nb import numba_solver as ns
 
-    fptr = address(kernels)
+    fptr = address(kernels, ready)
     u0 = np.ascontiguousarray(x0, dtype=np.float64)
     te = np.ascontiguousarray(t_eval, dtype=np.float64)
     rt = np.array([float(rtol)])

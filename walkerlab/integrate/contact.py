@@ -23,6 +23,13 @@ samples do not change) and the chunk goes on in odeint, whose RHS checks the dea
 numbalsoda's chunks are sized in wall time (each aims at :data:`CHUNK_WALL_S` seconds from
 the cost of the chunk before, the first is short).
 
+One loop (:func:`integrate_contact`'s free run) serves every walker: a powered one (with
+``actuators``) brings its actuation hook (:class:`walkerlab.integrate.contact_powered.
+ActuationHook`: the stance leg switched at touchdown, the push-off pulse, the ankle push-off,
+the work integrals, a compiled right-hand side where the walker has one), which integrates
+each chunk on solve_ivp with event location; the loop asks the strides cap after each of its
+heel strikes.
+
 Contact is decided by geometry only (the model): a foot gets the IMPACT force whenever it
 is below the top of a patch and inside its horizontal extent, in every state, so a step that
 would carry a foot from above a patch to deep inside it sees the force jump and is rejected
@@ -68,7 +75,7 @@ from .solver import Solver
 
 __all__ = ["CHUNK_WALL_S", "CYRK_STEPS_PER_CALL", "METHODS", "ContactIntegration",
            "ContactLimits", "first_event", "hermite_root", "hermite_state",
-           "integrate_contact", "run_atol", "sample_grid", "trip_or_failure"]
+           "integrate_contact", "run_atol", "run_powered", "sample_grid", "trip_or_failure"]
 
 #: Solver methods this module runs.
 METHODS = ("odeint", "numbalsoda", "LSODA", "Radau", "BDF", "RK45", "DOP853",
@@ -238,7 +245,8 @@ class _Backend:
         if self.method in _cyrk.CYRK_METHODS:  # whole chunk in compiled code (CyRK BDF)
             X, ok, nf, m = _cyrk.solve_chunk(self.method, xa, tg, self.data, s.rtol, self.atol,
                                              self.max_step, CYRK_STEPS_PER_CALL,
-                                             kernels=self.walker.kernels)
+                                             kernels=self.walker.kernels,
+                                             ready=getattr(self.walker, "rhs_ready", None))
             tn, Xn, nj = tg[1:len(X)], X[1:], 0
             if not ok:  # a force jump BDF cannot step over (a foot hitting the side of a
                 # patch below its top): odeint, which grinds through it as a plain odeint run
@@ -256,24 +264,45 @@ class _Backend:
         return sol.t[1:], sol.y.T[1:], sol.status == 0, sol.message, sol.nfev, sol.njev
 
 
-def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
-    """Integrate the free walker until t1, an event, the deadline or ``stop``.
+def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop, hook=None):
+    """Integrate the free walker until t1, an event, the deadline or ``stop``: the one
+    contact integrator loop, passive or powered.
 
-    Returns (t, X, nfev, njev, termination, message, event)."""
-    be = _Backend(walker, solver, limits.use_jacobian, deadline)
+    ``hook``: a powered walker's actuation hook
+    (:class:`walkerlab.integrate.contact_powered.ActuationHook`): it integrates each chunk
+    (its discrete state, events and transitions), the loop asks ``stop`` after each of its
+    heel strikes; None: the passive walker on the solver's backend, ``stop`` asked after each
+    chunk, the energy guard and the events checked on each chunk's samples.
+
+    Returns (t, X, nfev, njev, termination, message, event, work), ``work`` None for a
+    passive run (:class:`ContactIntegration`)."""
+    if hook is not None:
+        hook.start(x0, t0)
+    be = _Backend(walker, solver, limits.use_jacobian, deadline) if hook is None else None
     rate = limits.sample_rate_hz
     ts, Xs, nfev, njev = [np.array([t0])], [x0[None]], 0, 0
     ta, xa = t0, x0
     term, msg, event = RunEnd.T_FINAL, "Integration successful.", None
     n_checked = 1
     # the energy guard (walkerlab.models.contact.energy): no sample above the start's energy + bound
-    e_start = float(total_energy(walker, x0)[0])
-    e_bound = energy_rise_bound(walker, x0, solver.rtol)
+    if hook is None:  # (a powered walker gains energy: no guard)
+        e_start = float(total_energy(walker, x0)[0])
+        e_bound = energy_rise_bound(walker, x0, solver.rtol)
     guarded = False  # the energy guard ended the run (no event state to interpolate)
     # numbalsoda: the first chunk is short, later ones sized to CHUNK_WALL_S
-    span = min(limits.chunk_s, 20.0 / rate) if be.sized_by_wall else limits.chunk_s
+    span = (min(limits.chunk_s, 20.0 / rate) if be is not None and be.sized_by_wall
+            else limits.chunk_s)
     while ta < t1 - 1e-12:
         tb = min(ta + span, t1)
+        if hook is not None:  # the powered walker's chunk: segments between its events
+            step = hook.advance(tb, t1)
+            if step == "end":
+                break
+            ta = hook.t
+            if step == "strike" and stop is not None and stop(*hook.samples()):
+                hook.stopped()
+                break
+            continue
         tg = sample_grid(ta, tb, rate)
         w0 = time.perf_counter()
         be.calls[0] = 0
@@ -323,10 +352,12 @@ def _run_free(walker, x0, t0, t1, solver, limits, deadline, stop):
             term, msg = RunEnd.HEEL_STRIKE, "the heel strikes asked for were made"
             break
         ta, xa = t_all[-1], X_all[-1]
+    if hook is not None:
+        return hook.finish()
     t_all, X_all = np.concatenate(ts), np.vstack(Xs)
     if event is not None and not guarded:  # cut at the event and append the event state
         t_all, X_all, msg = _cut_at_event(walker, t_all, X_all, event, term)
-    return t_all, X_all, nfev, njev, term, msg, event
+    return t_all, X_all, nfev, njev, term, msg, event, None
 
 
 def _energy_guard_end(walker, ta, xa, tn, Xn, bad: int, n_prev: int, e_bound: float,
@@ -370,6 +401,39 @@ def _cut_at_event(walker, t_all: np.ndarray, X_all: np.ndarray, event: tuple, te
            RunEnd.FALL: "fall: hip below the fall height",
            RunEnd.AIRBORNE: "airborne: hip above the airborne height"}[term]
     return t_all, X_all, msg
+
+
+def run_powered(walker, x0, t0, t1, solver, limits, deadline, stop):
+    """A powered walker's free run (no pinned phase) on the one loop with its actuation hook
+    (:class:`walkerlab.integrate.contact_powered.ActuationHook`).
+
+    Parameters
+    ----------
+    walker : ContactWalker
+        With ``actuators``; leg2 in stance at the start.
+    x0 : ndarray, shape (2 nq,)
+    t0, t1 : float
+        [s].
+    solver : Solver
+    limits : ContactLimits
+    deadline : float
+        ``time.perf_counter()`` value past which the run stops (``time_limit``).
+    stop : callable or None
+        ``stop(t, X) -> bool``, asked after each heel strike (strides cap).
+
+    Returns
+    -------
+    tuple
+        ``(t (n,), X (n, 2 nq), nfev, njev, termination, message, event, work)``, ``work``
+        (n, len(work_names)) [J] the integrals of ``walker.actuators.work_names`` at the
+        samples.
+    """
+    from .contact_powered import ActuationHook
+
+    hook = ActuationHook(walker, solver, limits, deadline,
+                         sample_grid(t0, t1, limits.sample_rate_hz))
+    return _run_free(walker, np.asarray(x0, float), t0, t1, solver, limits, deadline, stop,
+                     hook)
 
 
 def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
@@ -427,14 +491,14 @@ def integrate_contact(walker, x0: np.ndarray, t0: float, t_final: float,
             event = (RunEnd.FALL.value, len(tp) - 1, float(tp[-1]), "", np.nan)
     work = None
     if term is RunEnd.T_FINAL and t_pin < t_final - 1e-12:
+        hook = None
         if getattr(walker, "actuators", None) is not None:  # (never pinned: the scene refuses)
-            from .contact_powered import run_powered
+            from .contact_powered import ActuationHook
 
-            tf, Xf, nf, nj, term, msg, event, work = run_powered(
-                walker, x0, t_pin, t_final, solver, limits, deadline, stop)
-        else:
-            tf, Xf, nf, nj, term, msg, event = _run_free(walker, x0, t_pin, t_final, solver,
-                                                         limits, deadline, stop)
+            hook = ActuationHook(walker, solver, limits, deadline,
+                                 sample_grid(t_pin, t_final, limits.sample_rate_hz))
+        tf, Xf, nf, nj, term, msg, event, work = _run_free(walker, x0, t_pin, t_final, solver,
+                                                           limits, deadline, stop, hook)
         if ts:
             tf, Xf = tf[1:], Xf[1:]
         ts.append(tf)

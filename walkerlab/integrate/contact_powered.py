@@ -1,9 +1,11 @@
-"""Time integration of a powered compliant-contact walker (one with ``actuators``).
+"""The actuation hook of the contact integrator loop: a powered compliant-contact walker
+(one with ``actuators``) in :func:`walkerlab.integrate.contact.integrate_contact`'s one loop.
 
 A powered walker's right-hand side depends on two discrete states the passive one does not
 have: which leg is in stance (the hip torques act +tau on the swing leg) and whether a
-push-off pulse is running (:mod:`walkerlab.models.contact.actuation`).  So the run goes in
-segments, on :func:`scipy.integrate.solve_ivp` with event location:
+push-off pulse is running (:mod:`walkerlab.models.contact.actuation`).  So the loop's chunks
+go in segments (:class:`ActuationHook`, no loop of its own), on
+:func:`scipy.integrate.solve_ivp` with event location:
 
 1. from the step's start until the push-off pulse starts: ``pulse_s`` before the swing
    foot's predicted touchdown on a patch at least ``ContactActuators.min_step_m`` ahead of
@@ -58,8 +60,8 @@ from walkerlab.models.contact.actuation import powered_rhs
 
 from .ends import RunEnd
 
-__all__ = ["IVP_METHODS", "STALL_CALLS", "impulse_jump", "powered_atol", "powered_to_section",
-           "pulse_lead", "pulse_lead_s", "push_off", "run_powered"]
+__all__ = ["IVP_METHODS", "STALL_CALLS", "ActuationHook", "impulse_jump", "powered_atol",
+           "powered_to_section", "pulse_lead", "pulse_lead_s", "push_off"]
 
 #: solve_ivp methods a powered run uses as given (others run as LSODA).
 IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
@@ -91,6 +93,7 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
     method = solver.method if solver.method in IVP_METHODS else "LSODA"
 
     mark = [t0, 0]
+    fast = getattr(walker.actuators, "compiled_rhs", lambda w: None)(walker)
 
     def f(t, y):
         if time.perf_counter() > deadline:
@@ -100,6 +103,8 @@ def _segment(walker, y0, t0, t1, grid, stance, push, solver, limits, deadline, e
         mark[1] += 1
         if mark[1] > STALL_CALLS:
             raise _Stall(y)
+        if fast is not None:  # the compiled right-hand side (point feet, straight legs)
+            return fast(y, stance, push, t - t_origin)
         dx, p = powered_rhs(walker, y[:n], stance, push, t - t_origin, ankle)
         return np.concatenate([dx, p])
 
@@ -250,51 +255,26 @@ def impulse_jump(walker, x, trailing, P):
     return np.concatenate([x[:n], dq]), float(work)
 
 
-def run_powered(walker, x0, t0, t1, solver, limits, deadline, stop):
-    """Integrate the powered free walker until ``t1``, an event, the deadline or ``stop``.
+class ActuationHook:
+    """The actuation hook of the contact integrator loop
+    (:func:`walkerlab.integrate.contact.integrate_contact`) for a powered walker: its
+    discrete state (the stance leg, switched at touchdown; the push-off pulse; the ankle
+    push-off), the powered right-hand side with the work integrals, the events that switch
+    the discrete state and their transitions.  The loop asks :meth:`advance` for each chunk
+    (one or more segments on solve_ivp with event location), its stop predicate after each
+    heel strike, and :meth:`finish` for the samples.
 
     Parameters
     ----------
     walker : ContactWalker
-        With ``actuators``; leg2 in stance at the start.
-    x0 : ndarray, shape (2 nq,)
-    t0, t1 : float
-        [s].
+        With ``actuators``.
     solver : Solver
     limits : ContactLimits
     deadline : float
         ``time.perf_counter()`` value past which the run stops (``time_limit``).
-    stop : callable or None
-        ``stop(t, X) -> bool``, asked after each touchdown (strides cap).
-
-    Returns
-    -------
-    tuple
-        ``(t (n,), X (n, 2 nq), nfev, njev, termination, message, event, work)`` as
-        :func:`walkerlab.integrate.contact.integrate_contact`'s free run, plus ``work``
-        (n, 4) [J], the integrals of ``walker.actuators.work_names`` at the samples.
+    grid : ndarray
+        The run's sample times [s].
     """
-    from .contact_events import first_event, sample_grid
-
-    run = _PoweredRun(walker, solver, limits, deadline, sample_grid(t0, t1, limits.sample_rate_hz))
-    run.go(x0, t0, t1, stop)
-    n = 2 * walker.nq
-    Y = np.vstack(run.Ys)
-    t = np.concatenate(run.ts)
-    if run.term is not RunEnd.FALL and run.term is not RunEnd.TRIP:
-        ev = first_event(walker, t, Y[:, :n], limits, k0=1)
-        if ev is not None:  # a trip or flight seen on the samples: the run ends there
-            k = max(ev[1], 1)
-            t, Y = t[:k], Y[:k]
-            run.event, run.term = ev, RunEnd(ev[0])
-            run.msg = f"{ev[0]}: on the samples of the powered run at t = {ev[2]:.4g} s"
-    if run.event is not None and run.event[1] == -1:
-        run.event = (*run.event[:1], len(t) - 1, *run.event[2:])
-    return t, Y[:, :n], run.nfev, run.njev, run.term, run.msg, run.event, Y[:, n:]
-
-
-class _PoweredRun:
-    """The segments of one powered run (:func:`run_powered`)."""
 
     def __init__(self, walker, solver, limits, deadline, grid):
         self.walker, self.solver, self.limits = walker, solver, limits
@@ -366,83 +346,123 @@ class _PoweredRun:
         k = sum(len(a) for a in self.ts) - 1
         self.event = (RunEnd.FALL.value, k, float(sol.t_events[0][0]), "", np.nan)
 
-    def go(self, x0, t, t1, stop):
-        """Integrate from ``(t, x0)`` to ``t1``: segments between the discrete events (the
-        push-off pulse's start, heel strike, heel off), the pulse its own segment."""
+    def start(self, x0, t):
+        """Start a run at ``(t, x0)`` (leg2 in stance, the work integrals 0)."""
         acts = self.walker.actuators
-        n, nw = 2 * self.walker.nq, len(acts.work_names)
-        y = np.concatenate([x0, np.zeros(nw)])
-        self.ts, self.Ys = [np.array([t])], [y[None]]
+        nw = len(acts.work_names)
+        self.t, self.y = float(t), np.concatenate([np.asarray(x0, float), np.zeros(nw)])
+        self.ts, self.Ys = [np.array([self.t])], [self.y[None]]
         # the pulse ends at the predicted touchdown (module docstring); ``pushed``: this
         # step's pulse has run (or is running)
-        pulsed = pulse_lead_s(acts) > 0.0
-        lead = _pulse_event(self.walker, lambda: self.stance, acts.pulse_s) if pulsed else None
-        pushed = False
-        while t < t1 - 1e-12:
-            tb = min(t + self.limits.chunk_s, t1)
-            watch = acts.ankle is not None and not self.ankle_on
-            arm = pulsed and not pushed
-            sol = self._run(y, t, tb, None,
-                            [self.fall, self.touch] + ([self.heel_off] if watch else [])
-                            + ([lead] if arm else []))
-            if sol is None:
-                return
-            if sol.t_events[0].size:  # a fall
-                self._fell(sol)
-                return
-            if watch and sol.t_events[2].size:  # heel off: the ankle push-off starts
-                t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
-                self._keep(sol, t)
-                self.ankle_on = True
-                continue
-            if arm and sol.t_events[2].size and not sol.t_events[1].size:
-                # the pulse starts pulse_s before the predicted touchdown, at the stance
-                # (trailing) foot, its impulse from the hip speed here (the pre-impact one)
-                t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
-                self._keep(sol, t)
-                pushed = True
-                P = acts.impulse(y[:n])
-                if not P > 0.0:
-                    continue
-                tp, trailing = min(t + acts.pulse_s, t1), self.stance
-                got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, True)
+        self.pulsed = pulse_lead_s(acts) > 0.0
+        self.lead = (_pulse_event(self.walker, lambda: self.stance, acts.pulse_s)
+                     if self.pulsed else None)
+        self.pushed = False
+
+    def advance(self, tb: float, t1: float) -> str:
+        """Integrate from the present ``(self.t, self.y)`` to ``tb`` [s] or the next discrete
+        event (the push-off pulse's start, heel strike, heel off), the event's transition
+        applied (the pulse its own segments; ``t1`` the run's end).  Returns ``"end"`` (the
+        run ends here: a fall, the deadline, a stall or a solver failure, ``self.term``
+        says which), ``"strike"`` (a heel strike was handled: the caller may ask its stop
+        predicate) or ``"go"``."""
+        acts = self.walker.actuators
+        n = 2 * self.walker.nq
+        t, y = self.t, self.y
+        watch = acts.ankle is not None and not self.ankle_on
+        arm = self.pulsed and not self.pushed
+        sol = self._run(y, t, tb, None,
+                        [self.fall, self.touch] + ([self.heel_off] if watch else [])
+                        + ([self.lead] if arm else []))
+        if sol is None:
+            return "end"
+        if sol.t_events[0].size:  # a fall
+            self._fell(sol)
+            return "end"
+        if watch and sol.t_events[2].size:  # heel off: the ankle push-off starts
+            self.t, self.y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
+            self._keep(sol, self.t)
+            self.ankle_on = True
+            return "go"
+        if arm and sol.t_events[2].size and not sol.t_events[1].size:
+            # the pulse starts pulse_s before the predicted touchdown, at the stance
+            # (trailing) foot, its impulse from the hip speed here (the pre-impact one)
+            t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
+            self._keep(sol, t)
+            self.t, self.y = t, y
+            self.pushed = True
+            P = acts.impulse(y[:n])
+            if not P > 0.0:
+                return "go"
+            tp, trailing = min(t + acts.pulse_s, t1), self.stance
+            got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, True)
+            if got is None:
+                return "end"
+            t, y, touched = got
+            self.t, self.y = t, y
+            if not touched:  # the touchdown after the pulse: the next segments
+                return "go"
+            self._strike(t)  # the pulse straddles the touchdown: its rest after it
+            if t < tp - 1e-12:
+                got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, False)
                 if got is None:
-                    return
-                t, y, touched = got
-                if not touched:  # the touchdown after the pulse: the next segments
-                    continue
-                self._strike(t)  # the pulse straddles the touchdown: its rest after it
-                if t < tp - 1e-12:
-                    got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, False)
-                    if got is None:
-                        return
-                    t, y = got[:2]
-                pushed = False
-            elif not sol.t_events[1].size:  # the chunk's end
-                self._keep(sol, np.inf)
-                t, y = float(sol.t[-1]), sol.y[:, -1].copy()
-                continue
-            else:
-                t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
-                self._keep(sol, t)
-                trailing = self.stance
-                self._strike(t)
-                P = acts.impulse(y[:n]) if acts.ankle is None and not pushed else 0.0
-                pushed = False
-                if P > 0.0 and acts.pulse_s == 0.0:
-                    y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
-                    y[n + 2] += w
-                elif P > 0.0:  # no pulse before the touchdown (it came too fast): from it
-                    tp = min(t + acts.pulse_s, t1)
-                    got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, False)
-                    if got is None:
-                        return
-                    t, y = got[:2]
-            if stop is not None and stop(np.concatenate(self.ts),
-                                         np.vstack(self.Ys)[:, :n]):
-                self._keep_last(t, y)
-                self.term, self.msg = RunEnd.HEEL_STRIKE, "the heel strikes asked for were made"
-                return
+                    return "end"
+                self.t, self.y = got[:2]
+            self.pushed = False
+            return "strike"
+        if not sol.t_events[1].size:  # the chunk's end
+            self._keep(sol, np.inf)
+            self.t, self.y = float(sol.t[-1]), sol.y[:, -1].copy()
+            return "go"
+        t, y = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+        self._keep(sol, t)
+        self.t, self.y = t, y
+        trailing = self.stance
+        self._strike(t)
+        P = acts.impulse(y[:n]) if acts.ankle is None and not self.pushed else 0.0
+        self.pushed = False
+        if P > 0.0 and acts.pulse_s == 0.0:
+            y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)
+            y[n + 2] += w
+        elif P > 0.0:  # no pulse before the touchdown (it came too fast): from it
+            tp = min(t + acts.pulse_s, t1)
+            got = self._pulse(y, t, tp, trailing, P / acts.pulse_s, False)
+            if got is None:
+                return "end"
+            self.t, self.y = got[:2]
+        return "strike"
+
+    def samples(self) -> tuple[np.ndarray, np.ndarray]:
+        """The run's samples so far: times (n,) [s] and the walker's states (n, 2 nq)."""
+        return np.concatenate(self.ts), np.vstack(self.Ys)[:, :2 * self.walker.nq]
+
+    def stopped(self):
+        """The caller's stop predicate held after a heel strike: the present state is the
+        run's last sample, its end ``heel_strike``."""
+        self._keep_last(self.t, self.y)
+        self.term, self.msg = RunEnd.HEEL_STRIKE, "the heel strikes asked for were made"
+
+    def finish(self):
+        """The run's result: ``(t (n,), X (n, 2 nq), nfev, njev, termination, message,
+        event, work (n, len(work_names)))``, a trip or flight seen on the samples (as the
+        passive run's :func:`~walkerlab.integrate.contact_events.first_event`) ending it
+        there."""
+        from .contact_events import first_event
+
+        walker, limits = self.walker, self.limits
+        n = 2 * walker.nq
+        Y = np.vstack(self.Ys)
+        t = np.concatenate(self.ts)
+        if self.term is not RunEnd.FALL and self.term is not RunEnd.TRIP:
+            ev = first_event(walker, t, Y[:, :n], limits, k0=1)
+            if ev is not None:  # a trip or flight seen on the samples: the run ends there
+                k = max(ev[1], 1)
+                t, Y = t[:k], Y[:k]
+                self.event, self.term = ev, RunEnd(ev[0])
+                self.msg = f"{ev[0]}: on the samples of the powered run at t = {ev[2]:.4g} s"
+        if self.event is not None and self.event[1] == -1:
+            self.event = (*self.event[:1], len(t) - 1, *self.event[2:])
+        return t, Y[:, :n], self.nfev, self.njev, self.term, self.msg, self.event, Y[:, n:]
 
     def _strike(self, t):
         """Heel strike at ``t`` [s]: the roles swap, the step's clock and ankle reset."""
@@ -459,7 +479,8 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
                        deadline: float = np.inf, fall_hip_height_m: float = 0.5):
     """Integrate a powered walker from ``x0`` (leg ``stance`` in stance) through the next heel
     strike (the push-off pulse at the stance foot ending at the predicted touchdown of the
-    other leg ahead, the touchdown, the roles swap; as :func:`run_powered`) to the next
+    other leg ahead, the touchdown, the roles swap; as a powered run of
+    :func:`walkerlab.integrate.contact.integrate_contact`) to the next
     upward zero of ``section(x)``: the powered contact step map's flow
     (:mod:`walkerlab.analysis.contact.step_map`).
 
@@ -493,7 +514,7 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
     from .contact_events import ContactLimits
 
     limits = ContactLimits(fall_hip_height_m=fall_hip_height_m)
-    run = _PoweredRun(walker, solver, limits, deadline, np.array([0.0, t_max]))
+    run = ActuationHook(walker, solver, limits, deadline, np.array([0.0, t_max]))
     run.stance, run.t_origin = stance, 0.0
     n, nw = 2 * walker.nq, len(walker.actuators.work_names)
     acts = walker.actuators
@@ -526,7 +547,7 @@ def powered_to_section(walker, x0, stance: int, section, solver, t_max: float,
         if sol.t_events[0].size:
             return float(sol.t_events[0][0]), sol.y_events[0][0][:n], RunEnd.FALL
         if arm and sol.t_events[2].size and not sol.t_events[1].size:
-            # the pulse, pulse_s before the predicted touchdown (as run_powered)
+            # the pulse, pulse_s before the predicted touchdown (as ActuationHook.advance)
             t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
             pushed, P = True, acts.impulse(y[:n])
             if not P > 0.0:
@@ -605,7 +626,7 @@ def push_off(walker, x, t: float, trailing: int, solver, deadline: float = np.in
     if acts.pulse_s == 0.0:
         return t, impulse_jump(walker, x, trailing, P)[0], RunEnd.T_FINAL
     n, nw = 2 * walker.nq, len(walker.actuators.work_names)
-    run = _PoweredRun(walker, solver, ContactLimits(fall_hip_height_m=fall_hip_height_m),
+    run = ActuationHook(walker, solver, ContactLimits(fall_hip_height_m=fall_hip_height_m),
                       deadline, np.array([t, t + acts.pulse_s]))
     run.stance, run.t_origin = 1 - trailing, t
     sol = run._run(np.concatenate([x, np.zeros(nw)]), t, t + acts.pulse_s,

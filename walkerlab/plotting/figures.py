@@ -37,8 +37,10 @@ PART_COLORS = [("tab:blue", "tab:green", "tab:cyan", "navy"),
 PARTS = ("thigh", "shank", "", "foot")
 
 
-def save(fig, folder: Path, stem: str) -> list[Path]:
+def save(fig, folder: Path, stem: str, svg: bool = True) -> list[Path]:
     """Write ``stem.png`` (150 dpi) and ``stem.svg`` into ``folder``; close the figure.
+    ``svg`` False: the PNG alone (an earlier ``stem.svg`` is removed: it would show an
+    older result).
 
     Each file is written atomically (temporary name, then rename; mode 0644): an
     interrupted save leaves the previous figure or none, never a truncated file.
@@ -60,7 +62,9 @@ def save(fig, folder: Path, stem: str) -> list[Path]:
         fig.draw_without_rendering()
         bbox = fig.get_tightbbox(fig.canvas.get_renderer()).padded(
             matplotlib.rcParams["savefig.pad_inches"])
-        for ext in ("png", "svg"):
+        if not svg:
+            (folder / f"{stem}.svg").unlink(missing_ok=True)
+        for ext in ("png", "svg") if svg else ("png",):
             p = folder / f"{stem}.{ext}"
             atomic_write(p, lambda fh, ext=ext: fig.savefig(fh, format=ext, dpi=150,
                                                             bbox_inches=bbox))

@@ -9,17 +9,17 @@ from pathlib import Path
 __all__ = ["save_optimize_figure"]
 
 
-def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
-                         ) -> list[Path]:
-    """Draw ``optimize.png`` / ``.svg`` from a loaded ``optimize.h5`` (``d``:
-    :class:`walkerlab.io.schemas.optimize.OptimizeData`): left every torque [N m] at the
-    collocation points (by name), middle every angle state [rad] over the step, and with
-    ``sticks`` (a list of (m, 2) polylines [m], e.g. stance foot - knee - hip - torso / hip
-    - swing knee - swing foot at a few instants) a third panel with them drawn over each
-    other (stop action).  A second row, where the artifact has them: the kinetic, potential
-    and total mechanical energy's change since the heel strike [J] (the total changes by the
-    actuators' work),
-    and IPOPT's primal and dual infeasibility per iteration (log scale)."""
+def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None,
+                         svg: bool = True) -> list[Path]:
+    """Draw ``optimize.png`` / ``.svg`` (``svg`` False: the PNG alone) from a loaded
+    ``optimize.h5`` (``d``: :class:`walkerlab.io.schemas.optimize.OptimizeData`): left every
+    torque [N m] at the collocation points (by name), middle every angle state [rad] over
+    the step, and with ``sticks`` (a list of (m, 2) polylines [m], e.g. stance foot - knee -
+    hip - torso / hip - swing knee - swing foot at a few instants) a third panel with them
+    drawn over each other (stop action). A second row, where the artifact has them: the
+    kinetic, potential and total mechanical energy's change since the heel strike [J] (the
+    total changes by the actuators' work), and IPOPT's primal and dual infeasibility per
+    iteration (log scale)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -84,7 +84,7 @@ def save_optimize_figure(d, title: str, folder: Path, sticks: list | None = None
     fig.suptitle(f"{title}: optimised {'stride' if steps > 1 else 'step'} (direct collocation)"
                  + ("" if d.gait else " — NOT a gait: the replay does not close"), fontsize=10)
     fig.tight_layout()
-    return save(fig, Path(folder), "optimize")
+    return save(fig, Path(folder), "optimize", svg)
 
 
 def _energy_and_convergence(d, axes) -> None:

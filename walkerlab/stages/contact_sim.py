@@ -12,6 +12,7 @@ state without start-up transients; the gait is stored as with ``periodic_gait: t
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from concurrent.futures import Future
 
+    from walkerlab.codegen.pending import CompiledElsewhere
     from walkerlab.execution.side import SideWorker
 
 SECTIONS = ("walker", "slope", "contact", "terrain", "contact_sim", "contact_solver")
@@ -48,33 +50,30 @@ def _compute(setup: ContactSetup, fixedpoint: Path, adjust: bool, periodic: bool
 
 
 def rhs_beside(setup: ContactSetup, side: Callable[[], SideWorker]
-               ) -> tuple[str, SideWorker, Future] | None:
+               ) -> tuple[CompiledElsewhere, SideWorker, Future] | None:
     """On the first contact run of a walker structure (its generated contact module not in
     the user cache yet: numba compiles every kernel of the run) with a compiled walk, have
     a side process (``side()``, a :class:`~walkerlab.execution.side.SideWorker`, asked for
     only then) compile the solver's compiled right-hand side (:func:`warm_rhs`), and this
-    process's walk wait for it there and load it (:mod:`walkerlab.codegen.pending`) while
-    this process generates the model and compiles the other kernels (the contact table, the
-    pinned start).
+    process's walk wait for it there and load it while this process generates the model
+    and compiles the other kernels (the contact table, the pinned start).
 
-    Returns the generated module's name, the side worker and its future when a wait was
-    registered (the caller hands the name to :func:`walkerlab.codegen.pending.forget`
-    when the run is over), else None: a warm run, no user cache to share the kernel
-    through, a walk on scipy's solvers, another process compiling it already, or no side
-    process (disabled, or it broke).  The numbers are the same either way."""
-    from walkerlab.codegen import pending
+    Returns the hand-off (a :class:`walkerlab.codegen.pending.CompiledElsewhere`: the
+    caller passes it to the run as ``ContactSetup.rhs_ready``), the side worker and its
+    future, else None: a warm run, no user cache to share the kernel through, a walk on
+    scipy's solvers, or no side process (disabled, or it broke).  The numbers are the same
+    either way."""
+    from walkerlab.codegen.pending import CompiledElsewhere
     from walkerlab.models.contact.generated import contact_module_state
 
     name, cached = contact_module_state(setup.walker.structure)
-    if (cached is not False or not _compiled_walk(setup)
-            or pending.expected(name, "build_cyrk")):
+    if cached is not False or not _compiled_walk(setup):
         return None
     worker = side()
     fut = worker.submit(warm_rhs, setup)
     if fut is None:
         return None
-    pending.compiled_elsewhere(name, "build_cyrk", lambda: worker.wait(fut))
-    return name, worker, fut
+    return CompiledElsewhere(name, "build_cyrk", lambda: worker.wait(fut)), worker, fut
 
 
 def _own_side() -> SideWorker:
@@ -84,34 +83,37 @@ def _own_side() -> SideWorker:
 
 
 @contextlib.contextmanager
-def _rhs_beside(setup: ContactSetup):
+def _rhs_beside(setup: ContactSetup, rhs_ready: CompiledElsewhere | None):
     """:func:`rhs_beside` on a side process of this run's own, started only when it has
     work (a warm run imports no process machinery; never on one core or on a busy
-    machine: ``idle_only``; nor when another process compiles the kernel already: the
-    report's side process), and stopped if the run never needed it.  A side process that
-    fails only means the right-hand side is compiled here."""
-    from walkerlab.codegen import pending
-
+    machine: ``idle_only``; nor when the caller's process compiles the kernel already:
+    ``rhs_ready``, the report's side process), and stopped if the run never needed it.
+    Yields the setup the run uses (with the hand-off, if any).  A side process that fails
+    only means the right-hand side is compiled here."""
+    if rhs_ready is not None:
+        yield dataclasses.replace(setup, rhs_ready=rhs_ready)
+        return
     beside = rhs_beside(setup, _own_side)
     if beside is None:
-        yield
+        yield setup
         return
-    name, side, fut = beside
+    ready, side, fut = beside
     try:
-        yield
+        yield dataclasses.replace(setup, rhs_ready=ready)
     except BaseException:
         side.close(cancel=True)
         raise
-    finally:
-        pending.forget(name)
     # never needed here (an up-to-date artifact, or a run that ended before its walk)
     side.close(cancel=not fut.done())
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        adjust: bool = False, periodic: bool = False) -> StageOutcome:
+        adjust: bool = False, periodic: bool = False,
+        rhs_ready: CompiledElsewhere | None = None) -> StageOutcome:
     """Simulate the contact walker (optionally after ``--adjust``) from ``fixedpoint.h5``
     (which must exist: :mod:`walkerlab.stages.pipeline` runs it first) and write the artifact.
+    ``rhs_ready``: the caller's side process compiling the compiled right-hand side
+    (:func:`rhs_beside`; ``walkerlab report``), else this run starts its own when cold.
 
     ``StageOutcome.failure`` says so when the walker did not walk (trip, fall, ...).
 
@@ -127,9 +129,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     periodic = periodic or setup.sim.periodic_gait
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())
-    with _rhs_beside(setup):  # started now: the freshness check runs meanwhile
+    with _rhs_beside(setup, rhs_ready) as run_setup:  # started now: the freshness check
+        # runs meanwhile
         out = run_cached("contact-sim", scene, runs_root, sections, up,
-                         lambda: _compute(setup, up[0], adjust, periodic), force)
+                         lambda: _compute(run_setup, up[0], adjust, periodic), force)
     kind, why = run_end(out.path)
     # like simulate: a walker that does not walk fails the run (the shared run ends,
     # walkerlab.integrate.ends: trip, fall, airborne, no_heel_strike, ...)

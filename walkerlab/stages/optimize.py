@@ -170,8 +170,9 @@ def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
                       artifact=design_stem(list(bounds), objective, maximize))
 
 
-def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
-    """Draw ``optimize.png`` (PNG + SVG) from ``optimize.h5``."""
+def draw(scene: Scene, runs_root: Path | str = "runs", svg: bool = True) -> list[Path]:
+    """Draw ``optimize.png`` (PNG + SVG; ``svg`` False: the PNG alone) from
+    ``optimize.h5``."""
     from walkerlab.io.runpaths import figures_dir
     from walkerlab.plotting.optimize_figure import save_optimize_figure
 
@@ -181,7 +182,7 @@ def draw(scene: Scene, runs_root: Path | str = "runs") -> list[Path]:
         from walkerlab.optimal.drivers.free_joints import stick_figures
 
         sticks = stick_figures(scene, d)
-    return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks)
+    return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks, svg)
 
 
 def draw_design(scene: Scene, runs_root: Path | str, fields: list[str], objective: str,

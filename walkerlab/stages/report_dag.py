@@ -42,12 +42,13 @@ def _warm_up(scene: Scene, runs_root, force: bool, plan: list[str], side):
     kernels), then have the side process load matplotlib for its share of the figures
     while this process runs the contact walker.
 
-    Returns ``(future, module)``, or None when nothing was started.  On a walker
-    structure's first contact run with a compiled walk (``module``, the generated contact
-    module's name: :func:`walkerlab.stages.contact_sim.rhs_beside`), the side process
+    Returns ``(future, ready)``, or None when nothing was started.  On a walker
+    structure's first contact run with a compiled walk (``ready``, the hand-off
+    :func:`walkerlab.stages.contact_sim.rhs_beside` makes, passed to the contact-sim
+    stage's run as its ``rhs_ready``), the side process
     compiles the solver's right-hand side only, and the run here, free to start, compiles
     the other kernels meanwhile and waits for that one just before its walk; else
-    (``module`` None) the side process compiles, or loads, all of them
+    (``ready`` None) the side process compiles, or loads, all of them
     (:func:`walkerlab.stages.contact_sim.warm_up`) and the run here waits for it first.
     """
     from walkerlab.io.runpaths import stage_artifact
@@ -111,7 +112,9 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
                 if module is None:  # (else the walk waits for its right-hand side)
                     side.wait(warm)  # compiled there (or failed: compiled here), never twice
             if name in plan:
-                add(stage_module(name).run(scene, runs_root, force))
+                add(stage_module(name).run(scene, runs_root, force,
+                                           **({"rhs_ready": module} if module is not None
+                                              and name == "contact-sim" else {})))
         if any(o.stage in ("simulate", "contact-sim") for o in done):
             # shared only with a side process already up (matplotlib loaded): one started
             # for the figures alone costs about what it saves
@@ -122,11 +125,6 @@ def run_report(scene: Scene, runs_root, force: bool, full: bool = False,
         if study is not None:
             study.cancel()
         raise
-    finally:
-        if module is not None:  # (waited for by the walk, or never needed)
-            from walkerlab.codegen import pending
-
-            pending.forget(module)
     side.close()
     if study is not None:
         study.release()

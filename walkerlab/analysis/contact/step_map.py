@@ -72,14 +72,13 @@ import time
 import numpy as np
 
 from walkerlab.freshstack import import_on_fresh_stack
-from walkerlab.integrate.contact import ContactLimits
+from walkerlab.integrate.contact import ContactLimits, run_powered
 from walkerlab.integrate.contact_grid import GRID_METHODS, contact_grid
 from walkerlab.integrate.contact_powered import (
     powered_to_section,
     pulse_lead,
     pulse_lead_s,
     push_off,
-    run_powered,
 )
 from walkerlab.integrate.ends import RunEnd
 from walkerlab.integrate.events import Event, EventRun, run_to_event

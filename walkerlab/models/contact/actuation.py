@@ -83,6 +83,7 @@ class ContactRows:
     contact actuators (the powered run's touchdown and heel-off events read them)."""
 
     _points = None  # each leg's rows of the table, filled on first use
+    _last = None  # (walker, state bytes, rows) of the last call (the events share one state)
 
     def contact_rows(self, walker, x) -> np.ndarray:
         """The contact table (points, 8) at one state ``x`` (points as
@@ -96,16 +97,26 @@ class ContactRows:
         flat foot's, without building its dictionaries: the event functions' fast path):
         ``penetration`` [m], its rate [m/s], slip velocity [m/s], ``s`` [m], normal and
         friction force [N], power [W], ``on_ground``."""
+        x = np.asarray(x, float)
+        key = x.tobytes()
+        last = self._last
+        if last is not None and last[0] is walker and last[1] == key:  # the events of one
+            return last[2]  # step ask at the same state: the table once
         tab = self.contact_rows(walker, x)
         if self._points is None:  # each leg's rows of the table, once
             names = walker.contact_names()
             self._points = [[k for k, c in enumerate(names) if walker.contact_leg(c) == leg]
                             for leg in ("leg1", "leg2")]
+        if all(len(idx) == 1 for idx in self._points):  # point feet: each leg's one row
+            out = [tab[idx[0]].copy() for idx in self._points]
+            self._last = (walker, key, out)
+            return out
         out = []
         for idx in self._points:
             rows = tab[idx]
             on = rows[:, 7] > 0.5
             out.append(rows[int(np.argmax(np.where(on, rows[:, 0], rows[:, 0] - 1e3)))])
+        self._last = (walker, key, out)
         return out
 
 
@@ -238,6 +249,39 @@ class ContactActuators(ContactRows):
         speed)."""
         n = self.nq
         return float(push_off_impulse(self.spec.push_off, np.hypot(x[n], x[n + 1])))
+
+    def compiled_rhs(self, walker):
+        """The compiled right-hand side of :func:`powered_rhs` for this walker, or None
+        where it has none (knees, flat feet: those run on :func:`powered_rhs`).
+
+        Returns
+        -------
+        callable or None
+            ``f(y, stance, push, t_step) -> ndarray (2 nq + 4,)``: ``[dx, powers]`` as
+            :func:`powered_rhs` returns them concatenated, the same numbers (its arithmetic
+            in the generated module's ``powered_rhs`` kernel, one call; the torque laws
+            evaluated here when there are any: they may be any callable).
+        """
+        kern = getattr(walker.kernels, "powered_rhs", None)
+        if kern is None or self.knee or self.foot is not None or self.ankle is not None:
+            return None
+        args = walker._args()
+        nx = 2 * self.nq
+        hx, hy = self.hip
+
+        def f(y, stance: int, push, t_step: float):
+            x = np.ascontiguousarray(y[:nx], dtype=float)
+            laws = self.laws
+            tau = 0.0
+            if laws:
+                delta, ddelta, s, ds = self.hip_angles(x, stance)
+                tau = float(np.sum(laws(delta, ddelta, s, ds, t_step)))
+            out = np.empty(nx + 4)
+            kern(x, *args, bool(laws), self.leg[1 - stance], self.leg[stance], tau,
+                 -1 if push is None else int(push[0]), 0.0 if push is None else float(push[1]),
+                 hx, hy, out)
+            return out
+        return f
 
     def push_direction(self, walker, x, trailing: int):
         """``(e, J, v)``: the unit vector (2,) from leg ``trailing``'s foot towards the hip

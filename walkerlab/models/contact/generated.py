@@ -70,6 +70,8 @@ Generated functions (``x = [q, dq]`` (NX,), see :mod:`walkerlab.codegen.floating
 ``knee_table(X, PC, p)``                 (n, 2, 4) per knee: extension, its rate, stop torque,
                                          power
 ``rhs_packed(y, d, dy)``                 rhs from the packed data vector, counts calls
+``powered_rhs(x, PC, p, c1, c2, ...)``   a powered walker's rhs and ledger powers (hip
+                                         torque, push-off force; compiled actuation hook)
 ``build_cyrk()``, ``build_lsoda(sig)``   addresses of cfuncs of ``rhs_packed``
 =======================================  =================================================
 """
@@ -453,6 +455,64 @@ def rhs_packed(y, d, dy):
     for i in range(NX):
         dy[i] = r[i]
     d[d.size - 1] += 1.0
+
+
+@njit(cache=True, error_model='numpy')
+def powered_rhs(x, PC, p, c1, c2, has_tau, sw, st, tau, push_leg, force, hx, hy, out):
+    """A powered walker's right-hand side with its ledger's powers, into ``out``
+    (NX + 4,): ``[dx, hip torque's positive and negative power, push-off's, contact
+    forces']``, the arithmetic of :func:`walkerlab.models.contact.actuation.powered_rhs`
+    in the same order (the same numbers).  ``has_tau``: the walker has hip-torque laws,
+    whose torque ``tau`` [N m] acts +tau on coordinate ``sw``, -tau on ``st``; a push-off
+    force ``force`` [N] at point ``push_leg`` (-1: none) along the line from it to the hip
+    (coordinates ``hx``, ``hy``)."""
+    n = NQ
+    r = rhs(x, PC, p, c1, c2)
+    for i in range(NX):
+        out[i] = r[i]
+    tab = contact_table(x.reshape((1, NX)), PC, p, c1, c2)
+    rest = 0.0  # numpy's sum of the column: the first entry, then the others from 0.0
+    for i in range(1, NF):
+        rest += tab[0, i, 6]
+    p_contact = tab[0, 0, 6] + rest
+    Q = np.zeros(n)
+    p_tau = 0.0
+    if has_tau:
+        Q[sw] = Q[sw] + tau
+        Q[st] = Q[st] - tau
+        p_tau = tau * (x[n + sw] - x[n + st])
+    p_po = 0.0
+    if push_leg >= 0:
+        P = np.empty((NF, 2))
+        V = np.empty((NF, 2))
+        J = np.empty((NF, 2, n))
+        feet(x, p, P, V, J)
+        rr = np.empty(2)
+        rr[0] = x[hx] - P[push_leg, 0]
+        rr[1] = x[hy] - P[push_leg, 1]
+        e = rr / np.sqrt(np.dot(rr, rr))
+        F = force * e
+        Jt = np.ascontiguousarray(J[push_leg].T)
+        Qp = np.dot(Jt, F)
+        p_po = np.dot(F, V[push_leg].copy())
+        Q = Q + Qp
+    moved = False
+    for i in range(n):
+        if Q[i] != 0.0:
+            moved = True
+    if moved:
+        xz = np.zeros(NX)
+        xz[:n] = x[:n]
+        M = np.empty((n, n))
+        h = np.empty(n)
+        dyn(xz, p, M, h)
+        a = np.linalg.solve(M, Q)
+        for i in range(n):
+            out[n + i] = out[n + i] + a[i]
+    out[NX] = 0.0 if 0.0 > p_tau else p_tau  # Python's max(p_tau, 0.0), min(p_tau, 0.0)
+    out[NX + 1] = 0.0 if 0.0 < p_tau else p_tau
+    out[NX + 2] = p_po
+    out[NX + 3] = p_contact
 
 
 def build_cyrk():

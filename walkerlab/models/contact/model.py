@@ -186,6 +186,10 @@ class ContactWalker:
         the push-off pulse; a free-jointed (five-link) biped's joint torques
         (:mod:`walkerlab.models.contact.joint_torques`); a walker with them runs on
         :mod:`walkerlab.integrate.contact_powered` (its stance leg is a discrete state).
+    rhs_ready : walkerlab.codegen.pending.CompiledElsewhere, optional
+        A side process compiling the compiled solvers' right-hand side: the first compiled
+        chunk waits for it and loads the kernel from the cache (the caller's hand-off,
+        passed down with the walker; None: compile it here when needed).
 
     Raises
     ------
@@ -212,6 +216,7 @@ class ContactWalker:
     heights2: np.ndarray | None = None
     flat_foot: tuple[float, float] | None = None
     actuators: object = None
+    rhs_ready: object = None
 
     def __post_init__(self):
         from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params

@@ -29,6 +29,7 @@ from .model import ContactWalker, flat_foot_numbers
 from .rigid_limit import contact_si
 
 if TYPE_CHECKING:
+    from walkerlab.codegen.pending import CompiledElsewhere
     from walkerlab.walker.description import WalkerData
 
 __all__ = ["ContactSceneError", "ContactSetup", "build", "contact_setup", "ideal_step_length"]
@@ -98,6 +99,9 @@ class ContactSetup:
         The walker's actuators as forces (:mod:`walkerlab.models.contact.actuation`; a
         free-jointed biped's joint torques :mod:`walkerlab.models.contact.joint_torques`);
         None for a passive walker.
+    rhs_ready : walkerlab.codegen.pending.CompiledElsewhere or None
+        A side process compiling the walker's compiled right-hand side (the stage's hand-off:
+        the walkers :meth:`build` makes carry it to the compiled backend); None: none.
     """
 
     name: str
@@ -109,6 +113,7 @@ class ContactSetup:
     sim: ContactSimSettings
     solver: SolverSettings
     actuators: ContactActuators | JointTorqueActuators | None = None
+    rhs_ready: CompiledElsewhere | None = None
 
     def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
         """ContactWalker of the setup with checkerboard patches from the ideal step length.
@@ -130,7 +135,8 @@ class ContactSetup:
             Ideal step length [m] (the patch spacing unless ``step_length_m`` is given).
         """
         probe = ContactWalker(contact=self.law_si, data=self.walker, knee_stop=self.knee_stop,
-                              flat_foot=self.law.flat_foot(), actuators=self.actuators)
+                              flat_foot=self.law.flat_foot(), actuators=self.actuators,
+                              rhs_ready=self.rhs_ready)
         step_length = ideal_step_length(probe, x_ideal)
         return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
                                 n_steps=n_steps + 4), step_length
