@@ -197,6 +197,12 @@ class HybridWalker:
     matrices : callable or None
         ``x (2n,) -> (M (n, n), C (n, n), G (n,))`` of the generated flow (the energy
         ledger's damper power); None for hand-written models.
+    step_entry : callable or None
+        ``x (2n,) -> (x (2n,), phase name or None)``, applied as each step begins (after
+        the heel-strike map): the rest of the heel strike's impact where a second contact
+        stays closed (a flat foot's trailing toe, kept on the ground when its impulse is
+        compressive) and the phase the step begins in (None: ``phases[0]``).  None: the
+        step begins in ``phases[0]`` from the reset's state.
     """
 
     name: str
@@ -220,6 +226,7 @@ class HybridWalker:
     mirror: HybridWalker | None = None
     actuators: object | None = None
     matrices: Callable[[np.ndarray], tuple] | None = None
+    step_entry: Callable[[np.ndarray], tuple] | None = None
 
     def for_stance(self, stance_leg: str) -> HybridWalker:
         """The walker of a step with ``stance_leg`` in stance (this one or :attr:`mirror`)."""
