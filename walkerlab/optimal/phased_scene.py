@@ -59,7 +59,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
 
     o = scene.optimize
     _refuse(scene)
-    walker = make_rigid_walker(data)
+    walker = make_rigid_walker(data, double_support=False)  # no double support phases yet
     guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
     fns = cached_mode_functions(data, walker, order)
