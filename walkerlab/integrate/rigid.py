@@ -230,8 +230,8 @@ def _enter_step(walker: HybridWalker, st: _StepState, variational: bool) -> int:
     on the variational state); returns the index of the phase the step begins in."""
     entry = walker.step_entry
     x_new, name = entry(st.x)
-    if variational:
-        st.Phi = numeric_jacobian(lambda z: entry(z)[0], st.x) @ st.Phi
+    if variational and (name is not None or not np.array_equal(x_new, st.x)):
+        st.Phi = numeric_jacobian(lambda z: entry(z)[0], st.x) @ st.Phi  # else the identity
     st.x = np.asarray(x_new, dtype=float)
     return 0 if name is None else [p.name for p in walker.phases].index(name)
 

@@ -239,7 +239,9 @@ def _step_entry(f: dict, x):
     impact's second stage: the M-orthogonal projections onto the heel's and then the heel's
     and toe's constraints compose to the projection onto both) is compressive, and the toe's
     normal force right after is not pulling: ``(x+, "double_support:heel_contact")``; else
-    ``(x, None)``."""
+    ``(x, None)``, the single-contact heel strike as before (also where the impulse would
+    push but the spring then lifts the toe at once, e.g. a foot plantarflexed by a push-off:
+    a gait without double support keeps its numbers)."""
     if np.iscomplexobj(x):  # no complex step through the branch and the linear solve
         raise TypeError("the step entry takes real states")
     x = np.asarray(x, dtype=float)
@@ -253,7 +255,7 @@ def _step_entry(f: dict, x):
     if impulse_n < 0.0:
         return x, None
     if f["double_support_heel_contact_forces"](0.0, x_plus)[0] < 0.0:
-        return x_plus, None
+        return x, None  # no double support: the single-contact heel strike, as before
     return x_plus, DOUBLE_SUPPORT[0]
 
 
