@@ -53,7 +53,10 @@ SHIPPED = sorted(p.stem for p in (ROOT / "configs").glob("*.yaml")
 #: powered_compass too: the export applies the push-off over one MuJoCo timestep (the rigid
 #: model's impulse); with the contact model's 5 ms pulse MuJoCo's walker steps 2.06 % faster,
 #: 0.39 % with 1 ms (test_powered_export_reaches_the_rigid_gait_as_the_pulse_shortens).
-PERIOD_RTOL: dict[str, float] = {}
+#: flat_feet, flat_feet_optimal (one walker): the foot bodies carry the contact model's
+#: regularising 0.1 kg (the rigid view's feet are massless): +1.94 % (0.01 kg: +0.52 %;
+#: tests/test_export_flat_feet.py).
+PERIOD_RTOL: dict[str, float] = {"flat_feet": 0.025, "flat_feet_optimal": 0.025}
 
 
 @pytest.mark.slow
