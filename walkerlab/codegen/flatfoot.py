@@ -34,8 +34,15 @@ Resets (plastic impulses; the impulse acts only where a contact is made):
   velocities project the pre-impact momenta onto the coordinates with the swing heel pinned
   and the new stance ankle at the swing foot's rest angle, ``Mi dq+ = sum_i J_i+^T m_i v_i-``
   (``Mi = sum_i J_i+^T m_i J_i+`` plus rotational terms), then the leg roles swap; the
-  trailing foot leaves the ground and, massless, snaps to its rest angle (its spring energy
-  is lost).
+  trailing foot is released (massless, it snaps to its rest angle) unless the double
+  support keeps its toe down (below).
+
+Double support (after heel strike, roles swapped; :func:`_double_support`): the leading foot
+on its heel (or flat), the trailing foot on its toe, pinned (no slip); its ankle angle ``b``
+follows from the toe on the slope, the flow is Lagrange's equations on ``(q, b)`` with the
+toe's constraint and its force as multipliers (a numeric KKT solve in the generated code);
+the entry impact pins the toe (an impulse through the trailing ankle: the massless foot takes
+no impulsive moment), the second stage of the two-contact plastic impact.
 
 Ground reaction (for the heel-off and lift-off guards): the total force from Newton,
 ``F = sum m_i (a_i - g)`` over the bodies (the feet are massless), normal part ``N = F . n``;
@@ -486,6 +493,12 @@ def generate_flat(structure: Structure, key: str) -> str:
     modes; ``reset_<name>`` and ``reset_<name>_jacobian`` for ``foot_slap``,
     ``heel_strike_heel``, ``heel_strike_toe``; ``guard_<name>``/``grad_<name>``;
     ``ground_heel(x, qdd) -> (N, N_toe)`` and ``ground_toe(x, qdd) -> (N,)`` [N];
+    per leading-foot mode ``m`` of the double support (``heel_contact``, ``foot_flat``):
+    ``flow_double_support_<m>(t, x)``, ``double_support_<m>_forces(t, x)`` (trailing toe
+    normal and tangential, leading foot normal and its toe's share [N]),
+    ``double_support_<m>_entry(x) -> (x+, (Lam_n, Lam_t))`` [N s]; and
+    ``double_support_trailing(x) -> (b, db, spring energy [J], trailing sole angle from the
+    slope [rad])``;
     ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
     ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
     eq = derive_flat(structure)

@@ -10,6 +10,13 @@ Sec. 3.2).  Phase names are ``<mode>:<swing part>`` (:func:`mode_of`); the guard
 next phase, and the sequence met is found by events at run time and recorded per segment
 (:attr:`walkerlab.integrate.rigid.Segment.phase_log`).
 
+Double support (:func:`double_support_phases`): each step begins
+(:attr:`HybridWalker.step_entry`, after the single-contact heel-strike map) with the trailing
+toe kept on the ground when the impulse that pins it is compressive and its force then
+pushes: ``double_support:heel_contact`` (and ``double_support:foot_flat`` if the leading
+foot slaps down first) until ``toe_off``, then ``heel_contact:early_swing`` (or
+``foot_flat:early_swing``).  No slip is assumed at the trailing toe.
+
 Guards (``direction`` as ``solve_ivp``'s events):
 
 - ``foot_slap`` (heel contact): the toe reaches the slope, ``phi = stance + ankle + gamma``
