@@ -133,6 +133,10 @@ class Phase:
     constraint the flow holds (a locked knee: ``d(shank - thigh)/dq``); a joint torque added
     to such a phase acts through the constrained system (its share along the constraint is
     taken by the lock).  None: the flow is unconstrained.
+
+    ``held_energy`` (optional) is ``x -> (energy [J], power [W])`` of a spring-damper the
+    flow holds beyond the walker's ``energies`` (a flat foot's trailing ankle in double
+    support: its spring's energy and its damper's power, <= 0), for the energy ledger.
     """
 
     name: str
@@ -142,6 +146,7 @@ class Phase:
     variational: Callable[[float, np.ndarray], np.ndarray] | None = None
     compiled: object | None = None
     constraint: Callable[[np.ndarray], np.ndarray] | None = None
+    held_energy: Callable[[np.ndarray], tuple] | None = None
 
 
 @dataclass(frozen=True)

@@ -189,7 +189,9 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     phases = tuple(phase(m, part) for part in SWING_PARTS for m in MODES)
     entry = None
     if double_support and flow_of is None:
-        phases += double_support_phases(base)
+        trailing_c = dict(zip(data.structure.param_names, data.params)).get(
+            "c_sw_ankle" if data.structure.asymmetric else "c_ankle", 0.0)
+        phases += double_support_phases(base, float(trailing_c))
         entry = partial(_step_entry, base)
     f = base
     structure = data.structure
@@ -285,10 +287,17 @@ def _flow_jacobian(flow, t, x):
     return _jacobian(partial(flow, t), x)
 
 
-def double_support_phases(f: dict) -> tuple[Phase, ...]:
+def _held(f: dict, c: float, x) -> tuple[float, float]:
+    """The trailing ankle's spring energy [J] and damper power [W] in double support."""
+    _b, db, energy, _phi = f["double_support_trailing"](x)
+    return float(energy), -c * float(db) ** 2
+
+
+def double_support_phases(f: dict, c_trailing: float = 0.0) -> tuple[Phase, ...]:
     """The double-support phases of a flat-footed walker's generated functions ``f``
     (:func:`walkerlab.codegen.flatfoot.generate_flat`): the trailing foot on its toe (a
-    pin: no slip assumed), the leading foot on its heel (``double_support:heel_contact``)
+    pin: no slip assumed; ``c_trailing`` its ankle damper [N m s/rad], for the phases'
+    ``held_energy``), the leading foot on its heel (``double_support:heel_contact``)
     or flat (``double_support:foot_flat``).
 
     Guards: ``toe_off`` (the trailing toe's normal force decreasing through 0; the massless
@@ -298,6 +307,7 @@ def double_support_phases(f: dict) -> tuple[Phase, ...]:
     total normal force), ``stance_toe_lifts`` and ``stance_heel_lifts`` (foot flat),
     ``trailing_toe_pulls`` (its force pulling as the flat lead begins, :data:`PULL_N`), ``fall``.
     """
+    held = partial(_held, f, c_trailing)
     heel, flat = (f[f"double_support_{m}_forces"] for m in ("heel_contact", "foot_flat"))
     hip = Guard("fall", f["guard_hip_height_heel"], -1, "fall", f["grad_hip_height_heel"])
     slap = partial(_foot_slap_in_double_support, f)
@@ -308,12 +318,12 @@ def double_support_phases(f: dict) -> tuple[Phase, ...]:
         Guard("foot_slap", f["guard_foot_angle"], -1, "next_phase", f["grad_foot_angle"],
               slap, partial(_jacobian, slap), next_phase=DOUBLE_SUPPORT[1]),
         Guard("stance_foot_lifts", partial(_force, heel, 2), -1, "fall", at_entry=True),
-        hip), jacobian=partial(_flow_jacobian, fl_heel))
+        hip), jacobian=partial(_flow_jacobian, fl_heel), held_energy=held)
     on_flat = Phase(DOUBLE_SUPPORT[1], fl_flat, (
         Guard("toe_off", partial(_force, flat, 0), -1, "next_phase",
               next_phase="foot_flat:early_swing"),
         Guard("trailing_toe_pulls", partial(_pulls, flat), -1, "fall", at_entry=True),
         Guard("stance_toe_lifts", partial(_force, flat, 3), -1, "fall", at_entry=True),
         Guard("stance_heel_lifts", partial(_lead_heel, flat), -1, "fall", at_entry=True),
-        hip), jacobian=partial(_flow_jacobian, fl_flat))
+        hip), jacobian=partial(_flow_jacobian, fl_flat), held_energy=held)
     return on_heel, on_flat
