@@ -1,4 +1,4 @@
-"""Why the flat-footed walker's contact gait steps slower than its rigid gait
+"""How the flat-footed walker's contact gait compares with its rigid gait
 (configs/flat_feet.yaml): the measurement behind the note in that scene's contact section.
 
 Usage::
@@ -12,12 +12,14 @@ rules at each heel strike:
 - ``contact``: the run simply goes on (what ``walkerlab contact-sim`` does: the trailing
   foot, loaded on its toe by its deflected ankle spring, stays on the ground for ~17-20 ms
   and its spring pushes the trailing leg off);
-- ``rigid_rule``: the rigid view's heel strike (walkerlab.codegen.foot_modes): the trailing foot
-  leaves the ground at once and snaps to its spring's rest angle (its spring energy lost) -
-  its foot angle and rate are set to its leg's and the ground patch under it is removed.
+- ``rigid_rule``: the rigid view's heel strike without its double support (walkerlab before
+  issue 48; ``make_rigid_walker(..., double_support=False)``): the trailing foot leaves the
+  ground at once and snaps to its spring's rest angle (its spring energy lost) - its foot
+  angle and rate are set to its leg's and the ground patch under it is removed;
 
-each with the scene's regularising foot mass (0.1 kg) and with a tenth of it.  It prints the
-step periods and their ratio to the rigid gait's.  Nothing is asserted:
+each with the scene's regularising foot mass (0.1 kg) and with a tenth of it, from the rigid
+gait of the same rule (with and without the double support).  It prints the step periods
+and their ratio to that rigid gait's.  Nothing is asserted:
 tests/test_flat_feet_contact_gap.py checks the conclusions.
 """
 
@@ -35,17 +37,29 @@ from walkerlab.config import load_scene
 from walkerlab.integrate.contact import ContactLimits
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.contact.scene import contact_setup
+from walkerlab.models.hybrid.rigid import make_rigid_walker
 from walkerlab.models.registry import build_walker
+from walkerlab.walker.description import walker_data
 
 SCENE = Path(__file__).resolve().parents[1] / "configs" / "flat_feet.yaml"
 #: samples per second of each step's run: the heel strike is read at the first sample at or
 #: after it (50 us late at most)
 SAMPLE_RATE_HZ = 20000.0
+#: The contact gait's step length [m] (mean over its first 7-16 steps from the rigid gait
+#: with double support, patches at the rigid 0.6286 m) by foot mass scale: its steps are
+#: 3-5 % shorter than the rigid ones, so on patches laid at the rigid step its footfalls
+#: drift 15-25 mm a step towards the patches' back edges (their toes then leave the patch).
+CONTACT_STEP_M = {1.0: 0.6086, 0.1: 0.600}
 
 
-def rigid_gait(scene):
-    """The rigid view's fixed point (role order) and step period [s]."""
+def rigid_gait(scene, double_support: bool = True):
+    """The rigid view's fixed point (role order) and step period [s]; ``double_support``
+    False: the rigid view without its double support (the trailing foot released at heel
+    strike, walkerlab before issue 48)."""
     walker = build_walker(scene)
+    if not double_support:
+        walker = make_rigid_walker(walker_data(scene.walker, scene.slope.phi_rad),
+                                   double_support=False)
     guess = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     fp = find_fixed_point(walker, guess, Solver.from_settings(scene.solver), fd_check=False)
     return fp.x, float(fp.period_s)
@@ -65,17 +79,19 @@ def _release_trailing_foot(walker, X, leg: str):
 
 
 def step_periods(scene, x_ideal, steps: int, rigid_rule: bool,
-                 foot_mass_scale: float = 1.0) -> np.ndarray:
+                 foot_mass_scale: float = 1.0, spacing_m: float | None = None) -> np.ndarray:
     """Step periods [s] of the contact walker from the rigid fixed point ``x_ideal``, one
     run per step (``rigid_rule``: the rigid view's heel strike, see the module docstring);
-    ``foot_mass_scale`` scales the flat feet's mass and inertia."""
+    ``foot_mass_scale`` scales the flat feet's mass and inertia; ``spacing_m`` [m] lays the
+    patches at that step instead of the rigid gait's (:data:`CONTACT_STEP_M`: the contact
+    gait's own, so that its footfalls stay on their patches)."""
     setup = contact_setup(scene)
     if foot_mass_scale != 1.0:
         law = setup.law.model_copy(update={
             "flat_foot_mass_kg": setup.law.flat_foot_mass_kg * foot_mass_scale,
             "flat_foot_inertia_kg_m2": setup.law.flat_foot_inertia_kg_m2 * foot_mass_scale})
         setup = dataclasses.replace(setup, law=law)
-    walker, _ = setup.build(x_ideal, steps + 2)
+    walker, _ = setup.build(x_ideal, steps + 2, step_length_m=spacing_m)
     X = initial_state_from_ideal(walker, *x_ideal)
     trailing, out = "leg1", []
     for _ in range(steps):
@@ -96,11 +112,15 @@ def step_periods(scene, x_ideal, steps: int, rigid_rule: bool,
 
 def main(steps: int = 8) -> None:
     scene = load_scene(SCENE)
-    x_ideal, period = rigid_gait(scene)
-    print(f"rigid step period {period:.4f} s")
+    gaits = {rule: rigid_gait(scene, double_support=not rule) for rule in (False, True)}
+    for rule, (_x, period) in gaits.items():
+        print(f"rigid step period {period:.4f} s "
+              f"({'without' if rule else 'with'} its double support)")
     for rule in (False, True):
+        x_ideal, period = gaits[rule]
         for scale in (1.0, 0.1):
-            p = step_periods(scene, x_ideal, steps, rule, scale)
+            p = step_periods(scene, x_ideal, steps, rule, scale,
+                             None if rule else CONTACT_STEP_M[scale])
             name = "rigid_rule" if rule else "contact"
             print(f"{name:10s} foot mass x{scale:<4} periods {np.round(p, 4)}  last 4 / rigid "
                   f"{np.mean(p[-4:]) / period:.4f}")

@@ -142,6 +142,8 @@ def test_each_phase_ends_in_its_first_chunk_with_few_steps_wasted(walker, scene,
     finally:
         mp.undo()
     assert [s.termination for s in tr.segments] == ["heel_strike"] * 2
-    assert len(seen) == sum(len(s.phase_log) for s in tr.segments)  # one chunk per phase
+    # one chunk per compiled phase (the double support's flow is Python: CyRK's own loop)
+    assert len(seen) == sum(1 for s in tr.segments for name, *_ in s.phase_log
+                            if not name.startswith("double_support"))
     for steps, k in seen:
         assert k is not None and steps - k <= max(6, steps // 3), (rtol, steps, k)

@@ -129,7 +129,7 @@ FLAT_ORDER = [("heel_contact:early_swing", "foot_slap", -1),
 def flat():
     scene = load_scene(CONFIGS / "flat_feet_optimal.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    return scene, data, make_rigid_walker(data)
+    return scene, data, make_rigid_walker(data, double_support=False)  # as optimize builds it
 
 
 @pytest.mark.slow
@@ -397,7 +397,7 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
     monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
     scene = load_scene(CONFIGS / "flat_feet_optimal.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    walker = make_rigid_walker(data)
+    walker = make_rigid_walker(data, double_support=False)  # as optimize builds it
     from walkerlab.optimal.drivers.mode_sequence import starting_phases
 
     x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())

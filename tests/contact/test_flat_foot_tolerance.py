@@ -74,9 +74,9 @@ def test_the_flat_foot_scene_benchmark_reaches_1e6_rad():
     from walkerlab.bench.contact import run_scene_benchmark
 
     scene = load_scene(CONFIGS / "flat_feet.yaml")
-    out = run_scene_benchmark(scene, n_strides=5, methods=("cyrk_bdf",), repeats=1)
+    out = run_scene_benchmark(scene, n_strides=3, methods=("cyrk_bdf",), repeats=1)  # its 6 steps
     ref = out["reference"]
-    assert ref["method"] == "cyrk_bdf" and ref["complete"] and ref["heel_strikes"] >= 9
+    assert ref["method"] == "cyrk_bdf" and ref["complete"] and ref["heel_strikes"] >= 6
     t = out["target"]["cyrk_bdf"]
     assert t["reached"] and t["worst_error_rad"] <= 1e-6
     assert max(t["nfev"]) < 100_000

@@ -34,8 +34,15 @@ Resets (plastic impulses; the impulse acts only where a contact is made):
   velocities project the pre-impact momenta onto the coordinates with the swing heel pinned
   and the new stance ankle at the swing foot's rest angle, ``Mi dq+ = sum_i J_i+^T m_i v_i-``
   (``Mi = sum_i J_i+^T m_i J_i+`` plus rotational terms), then the leg roles swap; the
-  trailing foot leaves the ground and, massless, snaps to its rest angle (its spring energy
-  is lost).
+  trailing foot is released (massless, it snaps to its rest angle) unless the double
+  support keeps its toe down (below).
+
+Double support (after heel strike, roles swapped; :func:`_double_support`): the leading foot
+on its heel (or flat), the trailing foot on its toe, pinned (no slip); its ankle angle ``b``
+follows from the toe on the slope, the flow is Lagrange's equations on ``(q, b)`` with the
+toe's constraint and its force as multipliers (a numeric KKT solve in the generated code);
+the entry impact pins the toe (an impulse through the trailing ankle: the massless foot takes
+no impulsive moment), the second stage of the two-contact plastic impact.
 
 Ground reaction (for the heel-off and lift-off guards): the total force from Newton,
 ``F = sum m_i (a_i - g)`` over the bodies (the feet are massless), normal part ``N = F . n``;
@@ -124,6 +131,7 @@ class FlatEquations:
     kinematics: dict
     leg_angles: dict
     push_off: dict | None = None
+    double_support: dict | None = None
 
 
 def _add(lin: dict, angle, length) -> dict:
@@ -210,8 +218,11 @@ def derive_flat(structure: Structure) -> FlatEquations:
     qv, dqv, ddv = sp.Matrix(q), sp.Matrix(dq), sp.Matrix(qdd)
     link_angle = {"swing": ps_sw, "stance": ps_st, "torso": (ps_sw + ps_st) / 2}
     flows, kin, ground, guards = {}, {}, {}, {}
+    lead_force = {}
     for pin, (ankle_lin, off) in anchors.items():
         bodies, hip, sw_ankle = bodies_from(ankle_lin)
+        if pin == "heel":
+            trailing_ankle = position_of(sw_ankle)
 
         def at(lin, _off=off):
             return position_of(lin) + _off
@@ -252,6 +263,7 @@ def derive_flat(structure: Structure) -> FlatEquations:
         mode = "heel_contact" if pin == "heel" else "heel_off"
         flows[mode] = _System(q, dq, M=M, C=C, G=G)
         N = (F.T * normal)[0]
+        lead_force[pin] = (F, mom)
         # moment balance about the pinned heel: the toe's normal force (see module docstring)
         ground[pin] = [N, mom / (hs + ts)] if pin == "heel" else [N]
         heel_sw = at(_add(sw_ankle, ps_sw + rw + half, -hw))
@@ -313,9 +325,12 @@ def derive_flat(structure: Structure) -> FlatEquations:
                   "swing_ankle_angle": rw + 0 * ps_sw,
                   "swing_rate": dq[0], "stance_rate": dq[1], "stance_ankle_rate": dq[2],
                   "swing_ankle_rate": 0 * dq[0]}
+    double = _double_support(q, dq, qdd, flows, trailing_ankle, lead_force["heel"],
+                             (fp("toe", "swing"), fp("k", "swing"), fp("r", "swing"),
+                              fp("c", "swing")), hs + ts, gamma, normal, tangent, Jl)
     return FlatEquations(q=q, dq=dq, qdd=qdd, params=tuple(par), flows=flows, resets=resets,
                          guards=guards, ground=ground, kinematics=kin, leg_angles=leg_angles,
-                         push_off=push_off)
+                         push_off=push_off, double_support=double)
 
 
 def _translation_rows(lin: dict, qs) -> sp.Matrix:
@@ -364,6 +379,144 @@ def _push_off_systems(q, anchors, bodies_from, kin, flows, resets, post_q, post)
     return out
 
 
+
+#: The leading foot's modes in double support (the trailing foot on its toe): on its heel
+#: (turning about it) or flat (its angle locked).
+DOUBLE_SUPPORT_LEADS = ("heel_contact", "foot_flat")
+
+
+def _double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, gamma, normal,
+                    tangent, Jl) -> dict:
+    """Double support after heel strike (roles already swapped): the leading (stance) foot
+    on its heel at ``O`` (heel contact) or flat (foot flat), the trailing (swing) foot on its
+    toe at a point ``P`` of the slope.  The trailing foot's ankle angle ``b`` (its sole at
+    ``swing + b``) is no state: with the toe on the slope, ``sin(swing + b + gamma) = -h/t``
+    (``h`` the trailing ankle's height above the slope, ``t`` the toe length), the branch
+    with the heel up; its rate from the toe's zero normal velocity.  The flow: Lagrange's
+    equations on ``Q = (swing, stance, stance_ankle, b)`` (the foot massless: ``b``'s row
+    holds the spring ``k (b - r)`` and damper ``c db`` against the toe's force), the toe
+    pinned, ``[M, -J^T; J, 0] [Qdd; lam] = [-C dQ - G; -dJ dQ]`` (``J = dT/dQ`` (2 x 4) of
+    the toe ``T``; foot flat adds ``phi = 0``'s row ``[0, 1, 1, 0]``), ``lam`` the ground's
+    force on the toe (world axes) [N].  Entry (the plastic impact that pins the toe, Newton's
+    restitution 0): in ``q`` the toe's pin is one row ``g = u^T dA/dq`` (``A`` the trailing
+    ankle, ``u`` the unit vector from toe to ankle: a massless foot takes no impulsive
+    moment, so the toe's impulse ``Lam u`` passes through the ankle) and
+    ``[M, -g^T (, -Jl^T); g, 0 (; Jl, 0)] [dq+; Lam] = [M dq-; 0 (; 0)]``."""
+    b, db = sp.symbols("b_trail db_trail", real=True)
+    t_len, k_b, r_b, c_b = trailing
+    sw = q[0]
+    h = (ankle.T * normal)[0]
+    theta = sw + b
+    toe = ankle + t_len * sp.Matrix([sp.cos(theta), sp.sin(theta)])
+    Q, dQ = (*q, b), (*dq, db)
+    Qv, dQv = sp.Matrix(Q), sp.Matrix(dQ)
+    J = toe.jacobian(Qv)
+    dJ = (J * dQv).jacobian(Qv) * dQv
+    hc = flows["heel_contact"]
+    M4 = sp.zeros(4, 4)
+    M4[:3, :3] = hc.M
+    rhs = sp.zeros(4, 1)
+    rhs[:3, 0] = -hc.C * sp.Matrix(dq) - hc.G
+    rhs[3, 0] = -c_b * db - k_b * (b - r_b)
+    b_of = sp.asin(-h / t_len) - gamma - sw
+    hdot = (sp.Matrix([h]).jacobian(sp.Matrix(q)) * sp.Matrix(dq))[0]
+    db_of = -hdot / (t_len * sp.cos(theta + gamma)) - dq[0]
+    dA = ankle.jacobian(sp.Matrix(q))
+    u = -sp.Matrix([sp.cos(theta), sp.sin(theta)])  # toe -> ankle
+    g_row = u.T * dA
+    F, mom = lead_force
+    out = {"b": b, "db": db, "b_of": b_of, "db_of": db_of, "u": u, "toe": toe,
+           "trailing_spring": k_b * (b - r_b) ** 2 / 2, "foot_angle": theta + gamma}
+    for lead in DOUBLE_SUPPORT_LEADS:
+        rows = J if lead == "heel_contact" else J.col_join(sp.Matrix([[0, 1, 1, 0]]))
+        gam = -dJ if lead == "heel_contact" else (-dJ).col_join(sp.zeros(1, 1))
+        m = rows.rows
+        K = sp.zeros(4 + m, 4 + m)
+        K[:4, :4] = M4
+        K[:4, 4:] = -rows.T
+        K[4:, :4] = rows
+        imp_rows = g_row if lead == "heel_contact" else g_row.col_join(Jl)
+        mi = imp_rows.rows
+        Ki = sp.zeros(3 + mi, 3 + mi)
+        Ki[:3, :3] = hc.M
+        Ki[:3, 3:] = -imp_rows.T
+        Ki[3:, :3] = imp_rows
+        out[lead] = {"K": K, "rhs": rhs.col_join(gam), "Ki": Ki,
+                     "Ki_rhs": (hc.M * sp.Matrix(dq)).col_join(sp.zeros(mi, 1))}
+    # the leading foot's ground force: Newton's total (feet massless) less the toe's; in
+    # foot flat its toe's share from the moment balance about its heel, less the trailing
+    # toe's moment (the lock's multiplier is that moment: its toe force times the sole)
+    lam = sp.Matrix(sp.symbols("lam_x lam_y", real=True))
+    out["lead_normal"] = ((F - lam).T * normal)[0]
+    out["trail_normal"] = (lam.T * normal)[0]
+    out["trail_tangential"] = (lam.T * tangent)[0]
+    out["lam"] = lam
+    out["sole"] = sole
+    return out
+
+
+def _double_support_lines(eq: FlatEquations, lead: str) -> list[str]:
+    """Source of ``_double_support_<lead>(x) -> (xdot (6,), forces (4,))`` (forces: the
+    trailing toe's normal and tangential force, the leading foot's normal force and its
+    toe's share [N]), ``double_support_<lead>_entry(x) -> (x+, (Lam_n, Lam_t))`` (the toe's
+    impulse [N s]) and, once, ``double_support_trailing(x) -> (b, db)``."""
+    ds = eq.double_support
+    sysd = ds[lead]
+    n = len(eq.q)
+    head = [codegen.unpack(eq)]
+    lines, red = cse_lines([ds["b_of"]], PRINTER)
+    head += lines + [f"{IND}{ds['b']} = {PRINTER.doprint(red[0])}"]
+    lines, red = cse_lines([ds["db_of"]], PRINTER)
+    head += lines + [f"{IND}{ds['db']} = {PRINTER.doprint(red[0])}"]
+    K, rhs = sysd["K"], sysd["rhs"]
+    m = K.rows
+    lines, red = cse_lines(list(K) + list(rhs), PRINTER)
+    body = list(head) + lines
+    body.append(f"{IND}_K = np.array(({', '.join(PRINTER.doprint(e) for e in red[:m * m])},),"
+                f" dtype=float).reshape({m}, {m})")
+    body.append(f"{IND}_b = np.array(({', '.join(PRINTER.doprint(e) for e in red[m * m:])},),"
+                " dtype=float)")
+    body.append(f"{IND}_s = np.linalg.solve(_K, _b).tolist()")
+    body += [f"{IND}{s} = _s[{i}]" for i, s in enumerate(eq.qdd)]
+    body += [f"{IND}{ds['lam'][0]}, {ds['lam'][1]} = _s[4], _s[5]"]
+    toe_share = (f"_s[6] / ({PRINTER.doprint(ds['sole'])})" if lead == "foot_flat" else "0.0")
+    lines, red = cse_lines([ds["trail_normal"], ds["trail_tangential"], ds["lead_normal"]],
+                           PRINTER)
+    body += lines
+    rates = ", ".join(str(s) for s in eq.dq)
+    accs = ", ".join(str(s) for s in eq.qdd)
+    body.append(f"{IND}return (np.array(({rates}, {accs})), "
+                f"({', '.join(PRINTER.doprint(e) for e in red)}, {toe_share}))")
+    out = [f"    def _double_support_{lead}(x):", *body,
+           f"    def flow_double_support_{lead}(t, x):",
+           f"{IND}return _double_support_{lead}(x)[0]",
+           f"    def double_support_{lead}_forces(t, x):",
+           f"{IND}return _double_support_{lead}(x)[1]"]
+    Ki, kr = sysd["Ki"], sysd["Ki_rhs"]
+    mi = Ki.rows
+    lines, red = cse_lines(list(Ki) + list(kr) + list(ds["u"]), PRINTER)
+    nk = mi * mi + mi
+    u = [PRINTER.doprint(e) for e in red[nk:]]
+    names = ", ".join(str(s) for s in eq.q)
+    out += [f"    def double_support_{lead}_entry(x):", *head, *lines,
+            f"{IND}_K = np.array(({', '.join(PRINTER.doprint(e) for e in red[:mi * mi])},),"
+            f" dtype=float).reshape({mi}, {mi})",
+            f"{IND}_b = np.array(({', '.join(PRINTER.doprint(e) for e in red[mi * mi:nk])},),"
+            " dtype=float)",
+            f"{IND}_s = np.linalg.solve(_K, _b)",
+            f"{IND}_u = ({u[0]}, {u[1]})",
+            f"{IND}_L = float(_s[{n}])",
+            f"{IND}_n = (_u[0] * sin(gamma) + _u[1] * cos(gamma)) * _L",
+            f"{IND}_t = (_u[0] * cos(gamma) - _u[1] * sin(gamma)) * _L",
+            f"{IND}return np.array(({names}, *_s[:{n}])), (_n, _t)"]
+    if lead == DOUBLE_SUPPORT_LEADS[0]:
+        lines, red = cse_lines([ds["trailing_spring"], ds["foot_angle"]], PRINTER)
+        out += ["    def double_support_trailing(x):", *head, *lines,
+                f"{IND}return {ds['b']}, {ds['db']}, {PRINTER.doprint(red[0])}, "
+                f"{PRINTER.doprint(red[1])}"]
+    return out
+
+
 def _scalar_fn(name: str, eq: FlatEquations, exprs: list, with_acc: bool) -> list[str]:
     """A Python function ``(t, x)`` or ``(x, qdd)`` returning a float or a tuple."""
     lines, red = cse_lines(exprs, PRINTER)
@@ -389,6 +542,12 @@ def generate_flat(structure: Structure, key: str) -> str:
     modes; ``reset_<name>`` and ``reset_<name>_jacobian`` for ``foot_slap``,
     ``heel_strike_heel``, ``heel_strike_toe``; ``guard_<name>``/``grad_<name>``;
     ``ground_heel(x, qdd) -> (N, N_toe)`` and ``ground_toe(x, qdd) -> (N,)`` [N];
+    per leading-foot mode ``m`` of the double support (``heel_contact``, ``foot_flat``):
+    ``flow_double_support_<m>(t, x)``, ``double_support_<m>_forces(t, x)`` (trailing toe
+    normal and tangential, leading foot normal and its toe's share [N]),
+    ``double_support_<m>_entry(x) -> (x+, (Lam_n, Lam_t))`` [N s]; and
+    ``double_support_trailing(x) -> (b, db, spring energy [J], trailing sole angle from the
+    slope [rad])``;
     ``section``/``from_section``; ``energies`` and, per pinned point, ``energies_heel`` /
     ``energies_toe`` (dicts ``kinetic``, ``potential`` [J]); ``points``; ``leg_angles``)."""
     eq = derive_flat(structure)
@@ -406,6 +565,8 @@ def generate_flat(structure: Structure, key: str) -> str:
         fast += _grad_fn(f"grad_{name}", eq, expr)
     for pin, exprs in eq.ground.items():
         fast += _scalar_fn(f"ground_{pin}", eq, exprs, True)
+    for lead in DOUBLE_SUPPORT_LEADS:
+        fast += _double_support_lines(eq, lead)
     rest = "r_st_ankle" if structure.asymmetric else "r_ankle"
     section = [
         "    def section(x):",
@@ -448,7 +609,7 @@ def generate_flat(structure: Structure, key: str) -> str:
     head = [
         f"# walkerlab generated model code (walkerlab.codegen.foot_modes); key {key}",
         "# Do not edit: regenerated when the walker description or the generator changes.",
-        "from math import sin, cos, tan, sqrt, pi  # noqa: F401",
+        "from math import sin, cos, tan, sqrt, pi, asin  # noqa: F401",
         "import numpy  # noqa: F401",
         "import numpy as np",
         "",

@@ -72,6 +72,12 @@ class MjcfScene:
     push_off_duration_s : float
         The push-off pulse's duration [s]: one timestep (the rigid model's impulse as MuJoCo
         applies it; :func:`walkerlab.export.scene.mjcf_scene`).
+    flat_feet : tuple or None
+        Flat feet (:func:`walkerlab.export.scene.flat_feet`): per leg (leg1, leg2) ``(heel
+        [m], toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot
+        mass [kg], inertia about the ankle [kg m^2])``; the ``qpos``/``qvel`` then hold the
+        ankles in MuJoCo's tree order (``hip_x, hip_z, leg1_hip, leg1_ankle, leg2_hip,
+        leg2_ankle``).  None: no foot bodies.
     notes : tuple of str
         Comments written into the file (how the numbers were derived).
     """
@@ -90,6 +96,7 @@ class MjcfScene:
     actuation_json: str | None = None
     push_off_duration_s: float = 0.005
     patch_ahead_m: float = 0.0
+    flat_feet: tuple | None = None
 
 
 #: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot

@@ -399,19 +399,49 @@ def _mjcf_body(ln: Link, indent: str, mb: Multibody, extra: MjcfScene | None,
         # and in the x-z plane the sphere's section through its centre is the arc
         r = mb.foot_radius_m if arc_feet(mb) else point_foot_radius(mb)
         geom = f'type="sphere" pos="{nums(0, y, z)}" size="{num(r)}"'
-        lines += [f'{indent}  <site name="{foot}" pos="{nums(0, 0, z)}"/>',
-                  f'{indent}  <geom name="{foot}" {geom} contype="0" '
-                  f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
+        if extra is not None and extra.flat_feet is not None:
+            lines += _flat_foot_body(leg, indent + "  ", z, y, r, extra.flat_feet,
+                                     LANE_BITS.get(leg, 6), width)
+        else:
+            lines += [f'{indent}  <site name="{foot}" pos="{nums(0, 0, z)}"/>',
+                      f'{indent}  <geom name="{foot}" {geom} contype="0" '
+                      f'conaffinity="{LANE_BITS.get(leg, 6)}"/>']
     for child in children.get(ln.name, []):
         lines += _mjcf_body(child, indent + "  ", mb, extra, children, joint_springs)
     return lines + [f"{indent}</body>"]
+
+
+def _flat_foot_body(leg: str, indent: str, z: float, y: float, r: float, feet: tuple,
+                    bits: int, width: float) -> list[str]:
+    """A flat foot (:attr:`MjcfScene.flat_feet`): the site ``leg<i>_foot`` at the ankle and
+    the body ``leg<i>_sole`` on the hinge ``leg<i>_ankle`` (the legs' axis: positive toe up;
+    MuJoCo's joint spring ``stiffness``/``springref`` and ``damping`` are the ankle's), its
+    mass at the ankle, its sole perpendicular to the leg at the rest angle 0; contact
+    spheres of radius ``r`` at the heel (geom ``leg<i>_foot``: a stepping loop's heel
+    strike) and the toe (``leg<i>_toe``)."""
+    heel, toe, k, c, rest, mass, inertia = feet[0 if leg == "leg1" else 1]
+    lo = MJCF_MIN_INERTIA_KG_M2
+    i = max(inertia, lo)
+    sphere = f'type="sphere" size="{num(r)}" contype="0" conaffinity="{bits}"'
+    return [f'{indent}<site name="{leg}_foot" pos="{nums(0, 0, z)}"/>',
+            f'{indent}<body name="{leg}_sole" pos="{nums(0, 0, z)}">',
+            f'{indent}  <joint name="{leg}_ankle" type="hinge" axis="{AXIS}" '
+            f'stiffness="{num(k)}" springref="{num(rest)}" damping="{num(c)}"/>',
+            f'{indent}  <inertial pos="0 0 0" mass="{num(mass)}" '
+            f'diaginertia="{nums(i, i, lo)}"/>',
+            f'{indent}  <geom type="capsule" fromto="{nums(-heel, 0, 0, toe, 0, 0)}" '
+            f'size="{num(width / 4)}"/>',
+            f'{indent}  <geom name="{leg}_foot" pos="{nums(-heel, y, 0)}" {sphere}/>',
+            f'{indent}  <geom name="{leg}_toe" pos="{nums(toe, y, 0)}" {sphere}/>',
+            f"{indent}</body>"]
 
 
 def _mjcf_tail(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     """After the world: the equality constraints (couplings, knee latches), the numbers a
     stepping loop reads (``custom``) and the keyframes (``standing``; ``gait`` with
     ``extra``), through ``</mujoco>``."""
-    standing = [0.0, mb.leg_length_m] + [0.0] * len(mb.links)
+    ankles = 2 if extra is not None and extra.flat_feet is not None else 0
+    standing = [0.0, mb.leg_length_m] + [0.0] * (len(mb.links) + ankles)
     keys = [f'    <key name="standing" qpos="{nums(*standing)}"/>']
     equality = [f'    <tendon name="{cp.name}" tendon1="{cp.name}" '
                 f'solref="{nums(2 * (extra.timestep_s if extra else MJCF_DEFAULT_TIMESTEP_S), 1)}" '

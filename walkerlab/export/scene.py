@@ -43,15 +43,18 @@ from walkerlab.export.mjcf_scene import (
 )
 from walkerlab.models.contact.laws import ContactParamsSI
 
-__all__ = ["EXPORT_STEPS", "actuation_json", "arc_roll_m", "check_exportable", "joint_state",
-           "mjcf_scene", "mujoco_contact"]
+__all__ = ["EXPORT_STEPS", "actuation_json", "arc_roll_m", "check_exportable", "flat_feet",
+           "joint_state", "mjcf_scene", "mujoco_contact"]
 
 #: Footfalls laid out per lane in an exported checkerboard (the MuJoCo test walks >= 10 steps).
 EXPORT_STEPS = 40
 
 
-def check_exportable(scene: Scene) -> None:
+def check_exportable(scene: Scene, fmt: str | None = None, walker_only: bool = False) -> None:
     """Refuse walkers whose numbers MuJoCo cannot represent.
+
+    ``fmt`` (``"mjcf"``, ``"urdf"``; None: any) and ``walker_only`` (no gait, contact or
+    terrain) are the export's: flat feet are written to an MJCF with its scene only.
 
     Raises
     ------
@@ -59,14 +62,15 @@ def check_exportable(scene: Scene) -> None:
         One line naming the field: a mass below :data:`MJCF_MIN_MASS_KG` (but > 0; 0 is
         refused by the multibody model) or a length / foot radius below
         :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot); flat feet
-        (the multibody model has no foot link yet: the files would hold point feet); an
+        other than to an MJCF with its scene (the URDF has no foot link: it would hold point
+        feet; the MJCF's foot bodies take their mass from the scene's contact section); an
         ankle push-off (the file would walk passively).
     """
     foot = getattr(getattr(scene.walker, "leg", None), "foot", None)
-    if getattr(foot, "kind", None) == "flat":
-        raise ValueError("walker.leg.foot.kind: flat feet are not exported yet (a URDF/MJCF "
-                         "would hold point feet: no foot link, ankle spring or heel and toe "
-                         "contacts)")
+    if getattr(foot, "kind", None) == "flat" and (fmt != "mjcf" or walker_only):
+        raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF with the "
+                         "scene only (a URDF would hold point feet: no foot link, ankle "
+                         "spring or heel and toe contacts; --walker-only has no foot mass)")
     act = getattr(scene.walker, "actuation", None)
     if act is not None and act.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: not exported yet (the URDF/MJCF "
@@ -235,10 +239,16 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
     settings = scene.contact or ContactSettings()
     terrain = scene.terrain or TerrainSettings()
     c, knee = contact_si(settings)
-    walker = ContactWalker(contact=c, data=data, knee_stop=knee)
+    flat = data.structure.foot == "flat"
+    walker = ContactWalker(contact=c, data=data, knee_stop=knee,
+                           flat_foot=settings.flat_foot() if flat else None)
     ideal = ideal_gait(scene) if ideal is None else ideal
-    z = walker.link_state_from_ideal(ideal.x)
-    qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
+    if flat:
+        qpos, qvel, feet = _flat_keyframe(scene, mb, data, walker, ideal.x)
+    else:
+        z = walker.link_state_from_ideal(ideal.x)
+        qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
+        feet = None
     dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)
     lanes = None
     if terrain.kind == "checkerboard":
@@ -253,6 +263,11 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
             lanes = (tuple(ell1 + (k - 1) * (ell1 + ell2)), tuple((ell1 + ell2) * k))
         else:
             lanes = (tuple(ell2 * (2 * k - 1)), tuple(2 * ell2 * k))
+        if flat:  # a flat foot's patch centred on its sole, not on its heel's touchdown
+            from walkerlab.models.contact.model import footprint_offsets
+
+            lanes = tuple(tuple(s + off for s in lane)
+                          for lane, off in zip(lanes, footprint_offsets(data)))
     latch = (knee.latch_height, knee.latch_capture) if mb.knee and mb.knee_stop else None
     notes = (f"Keyframe 'gait': the rigid walker's fixed point (step period "
              f"{ideal.period_s:.6g} s), leg2 in stance, its foot's contact point at the "
@@ -281,8 +296,66 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
                   "one MuJoCo timestep, the rigid model's impulse as MuJoCo can apply it (the "
                   "contact model's contact.push_off_duration_s pulse agrees with it only to "
                   "first order in its length: -2.1 % step period with 5 ms).",)
+    if flat:
+        notes += ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
+                  "ankle springs as MuJoCo joint springs: stiffness, springref, damping), "
+                  "the contact model's regularising foot mass and inertia at the ankle "
+                  "(contact.flat_foot_mass_kg, contact.flat_foot_inertia_kg_m2: the rigid "
+                  "view's feet are massless), contact spheres at heel (geom leg<i>_foot) and "
+                  "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
+                  "gait's double support as it begins).",)
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
     return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
                      dt, solref, solimp, mu, latch, notes + terrain_notes, actuation,
-                     dt, ahead)  # the push-off over one timestep: the rigid model's impulse
+                     dt, ahead,  # the push-off over one timestep: the rigid model's impulse
+                     feet)
+
+
+def flat_feet(scene: Scene, data) -> tuple:
+    """Per leg (leg1, leg2: leg1 the swing role's numbers when the legs differ) ``(heel,
+    toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot mass
+    [kg], inertia about the ankle [kg m^2])`` of a flat-footed walker; mass and inertia the
+    contact model's (``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``).
+
+    Raises
+    ------
+    ValueError
+        The scene has no foot mass or inertia (one line naming the fields).
+    """
+    settings = scene.contact or ContactSettings()
+    mi = settings.flat_foot()
+    if mi is None:
+        raise ValueError("contact.flat_foot_mass_kg and contact.flat_foot_inertia_kg_m2: an "
+                         "MJCF's flat feet need their mass and inertia (the rigid view's "
+                         "feet are massless)")
+    st = data.structure
+    P = dict(zip(st.param_names, data.params))
+    tags = ("sw_", "st_") if st.asymmetric else ("", "")
+    return tuple((P[f"heel_{t}m"], P[f"toe_{t}m"], P[f"k_{t}ankle"], P[f"c_{t}ankle"],
+                  P[f"r_{t}ankle"], *mi) for t in tags)
+
+
+def _flat_keyframe(scene: Scene, mb, data, walker, x_ideal):
+    """The ``gait`` keyframe of flat feet (MuJoCo's tree order, :attr:`MjcfScene.flat_feet`)
+    from the rigid fixed point ``x_ideal`` with the rest of its heel strike applied (the
+    walker's :attr:`~walkerlab.models.hybrid.base.HybridWalker.step_entry`: the trailing
+    toe kept on the ground in double support, its foot at the angle that puts the toe on
+    the slope) or, where the gait has none, the trailing foot at its rest angle."""
+    from walkerlab.codegen.cache import functions
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+
+    feet = flat_feet(scene, data)
+    rigid = make_rigid_walker(data)
+    x, phase = rigid.step_entry(np.asarray(x_ideal, float))
+    X = walker.pinned_to_full(walker.link_state_from_ideal(x), np.zeros(2))
+    q, v = walker.layout().coordinate_values(X)
+    ankle1 = (feet[0][4], 0.0)
+    if phase is not None:  # double support: the trailing (leg1) foot on its toe
+        b, db, _e, _phi = functions(data)["double_support_trailing"](x)
+        ankle1 = (b, db)
+    qpos = [q["hip_x"], q["hip_y"], q["leg1_angle"], ankle1[0], q["leg2_angle"],
+            q["leg2_foot_angle"] - q["leg2_angle"]]
+    qvel = [v["hip_x"], v["hip_y"], v["leg1_angle"], ankle1[1], v["leg2_angle"],
+            v["leg2_foot_angle"] - v["leg2_angle"]]
+    return np.array(qpos, float), np.array(qvel, float), feet

@@ -225,6 +225,17 @@ def _end_step(walker: HybridWalker, phase: Phase, guard, st: _StepState, t0: flo
         st.Phi = RJ @ S @ st.Phi
 
 
+def _enter_step(walker: HybridWalker, st: _StepState, variational: bool) -> int:
+    """Apply :attr:`HybridWalker.step_entry` to the step's first state (with its Jacobian
+    on the variational state); returns the index of the phase the step begins in."""
+    entry = walker.step_entry
+    x_new, name = entry(st.x)
+    if variational and (name is not None or not np.array_equal(x_new, st.x)):
+        st.Phi = numeric_jacobian(lambda z: entry(z)[0], st.x) @ st.Phi  # else the identity
+    st.x = np.asarray(x_new, dtype=float)
+    return 0 if name is None else [p.name for p in walker.phases].index(name)
+
+
 def _runs_compiled_on_scipy(phase: Phase) -> bool:
     """Whether a phase run by scipy (a stiff method, e.g. LSODA) calls its compiled flow
     instead of its Python one: a free-jointed walker's (five-link biped's) actuated flow,
@@ -316,6 +327,8 @@ def integrate_step(walker: HybridWalker, x0: np.ndarray, solver: Solver, t0: flo
         t_stop = min(t_stop, t_final)
     st = _StepState(t0, np.asarray(x0, dtype=float), np.eye(n))
     k, switches = 0, 0
+    if walker.step_entry is not None:  # e.g. a flat foot's trailing toe kept down
+        k = _enter_step(walker, st, variational)
     while k < len(walker.phases) and switches <= MAX_PHASE_SWITCHES:
         phase = walker.phases[k]
         switches += 1

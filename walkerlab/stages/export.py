@@ -131,7 +131,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     name = scene.name or "walker"
     if fmt == "adm":
         return _run_adams(scene, runs_root, mb, data, name)
-    check_exportable(scene)
+    check_exportable(scene, fmt, walker_only)
     extra = None if walker_only else _gait_scene(scene, mb, data, runs_root)
     if fmt == "urdf":
         text = urdf_text(mb, name, walkerlab.__version__, actuation_json(scene))

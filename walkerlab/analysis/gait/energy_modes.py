@@ -9,12 +9,17 @@ Its walker has no generated ``matrices`` (its modes pin the heel or the toe), so
   (the torque is constant or linear in the ankle angle ``a``, so the ankle turning back
   towards the leg after an overshoot makes it negative);
 - ``damper_work`` [J] (<= 0): the ankle damper's ``-c_ankle (da/dt)^2`` (in every mode: in
-  foot flat ``da/dt = -d stance/dt``) and the hip spring-dampers' ``-c (d delta/dt)^2``;
+  foot flat ``da/dt = -d stance/dt``), the hip spring-dampers' ``-c (d delta/dt)^2`` and,
+  in double support, the trailing ankle's (its phases' ``held_energy``);
 - ``internal_collision_loss`` [J]: the kinetic energy the foot slaps take (plastic,
   positions unchanged);
 - ``heel_strike_loss`` [J]: the kinetic energy the heel strike takes plus the trailing
   ankle spring's energy, lost when its massless foot leaves the ground and snaps to its
-  rest angle (``k (a - r)^2 / 2`` at the strike; :mod:`walkerlab.codegen.foot_modes`);
+  rest angle (``k (a - r)^2 / 2`` at the strike; :mod:`walkerlab.codegen.foot_modes`); where
+  the step begins in double support (the trailing toe kept down,
+  :mod:`walkerlab.models.hybrid.rigid_foot_modes`) less what that spring gives back before its toe
+  lifts (its energy at the step's start less at toe off: the rest is lost there) and plus
+  the kinetic energy the toe-pinning impulse takes (the heel strike's second stage);
 - ``push_off_work``, ``push_off_impulse``: 0 (no impulse).
 
 The total energy ``E = T + V`` (gravity from the first stance heel and the springs, the
@@ -77,17 +82,24 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
     n2 = seg.x_start.size
     ke0, pe0 = (float(v) for v in walker.energies(seg.x_start))
     scale = max(ke0, 1e-12)
-    wpos = wneg = wdamp = internal = 0.0
+    wpos = wneg = wdamp = internal = returned = 0.0
     prev_ke = None
     for ph, sol, (ta, tb) in seg.pieces:
         ke_a = float(walker.energies(_state(sol, ta, n2))[0])
+        held = getattr(ph, "held_energy", None)
         if prev_ke is not None:  # a foot slap inside the step
             internal += prev_ke - ke_a
+        elif held is not None:  # double support: the toe-pinning impulse at the start
+            returned -= ke0 - ke_a
         prev_ke = float(walker.energies(_state(sol, tb, n2))[0])
         if tb <= ta:
             continue
         wdamp += quad_work(lambda t, sol=sol: _damper_power(walker, _state(sol, t, n2)),
                            ta, tb, scale)
+        if held is not None:  # the trailing ankle's damper, and what its spring gives back
+            wdamp += quad_work(lambda t, sol=sol, h=held: h(_state(sol, t, n2))[1], ta, tb,
+                               scale)
+            returned += held(_state(sol, ta, n2))[0] - held(_state(sol, tb, n2))[0]
         if acts is not None and getattr(acts, "links", None):  # joint torques: every mode
             wpos += quad_work(lambda t, sol=sol: max(acts.power(t, _state(sol, t, n2)), 0.0),
                               ta, tb, scale)
@@ -110,6 +122,8 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
         tr = acts.transition(seg.x_end)  # the toe's push-off before the heel strike
         push, impulse = float(tr["ke_push_off"] - tr["ke_minus"]), float(tr["impulse"])
         loss += push
+    if returned:  # double support: the spring's energy given back, the entry impulse's loss
+        loss -= returned
     d_e = (ke_plus + pe_plus) - (ke0 + pe0)
     closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
     d = step_length(walker, seg)

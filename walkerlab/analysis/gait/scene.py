@@ -97,10 +97,11 @@ def with_variant(scene: Scene, variant: str) -> Scene:
     return scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
 
 
-def solve_scene(scene: Scene, fd_check: bool = True, guess=None):
+def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None):
     """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
     ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
-    scene's initial guess.
+    scene's initial guess; ``walker`` (default: the scene's, ``build_walker``) another
+    rigid model of it (a flat foot's without its double support).
 
     Returns
     -------
@@ -115,7 +116,7 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None):
         A malformed initial guess or gait choice, or no ``fixedpoint`` section (one line).
     """
     fp = _settings(scene)
-    walker = build_walker(scene)
+    walker = build_walker(scene) if walker is None else walker
     start = initial_guess(scene, walker) if guess is None else guess
     search = find_gaits(walker, Solver.from_settings(scene.solver), start,
                         policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,

@@ -109,7 +109,8 @@ def starting_at(walker, phase_name: str):
 
     names = [p.name for p in walker.phases]
     k = names.index(phase_name)
-    return dataclasses.replace(walker, phases=walker.phases[k:] + walker.phases[:k])
+    return dataclasses.replace(walker, phases=walker.phases[k:] + walker.phases[:k],
+                               step_entry=None)  # a restart, not a heel strike
 
 
 def entry_lock(walker, phase_name: str):

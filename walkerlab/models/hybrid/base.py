@@ -133,6 +133,10 @@ class Phase:
     constraint the flow holds (a locked knee: ``d(shank - thigh)/dq``); a joint torque added
     to such a phase acts through the constrained system (its share along the constraint is
     taken by the lock).  None: the flow is unconstrained.
+
+    ``held_energy`` (optional) is ``x -> (energy [J], power [W])`` of a spring-damper the
+    flow holds beyond the walker's ``energies`` (a flat foot's trailing ankle in double
+    support: its spring's energy and its damper's power, <= 0), for the energy ledger.
     """
 
     name: str
@@ -142,6 +146,7 @@ class Phase:
     variational: Callable[[float, np.ndarray], np.ndarray] | None = None
     compiled: object | None = None
     constraint: Callable[[np.ndarray], np.ndarray] | None = None
+    held_energy: Callable[[np.ndarray], tuple] | None = None
 
 
 @dataclass(frozen=True)
@@ -197,6 +202,12 @@ class HybridWalker:
     matrices : callable or None
         ``x (2n,) -> (M (n, n), C (n, n), G (n,))`` of the generated flow (the energy
         ledger's damper power); None for hand-written models.
+    step_entry : callable or None
+        ``x (2n,) -> (x (2n,), phase name or None)``, applied as each step begins (after
+        the heel-strike map): the rest of the heel strike's impact where a second contact
+        stays closed (a flat foot's trailing toe, kept on the ground when its impulse is
+        compressive) and the phase the step begins in (None: ``phases[0]``).  None: the
+        step begins in ``phases[0]`` from the reset's state.
     """
 
     name: str
@@ -220,6 +231,7 @@ class HybridWalker:
     mirror: HybridWalker | None = None
     actuators: object | None = None
     matrices: Callable[[np.ndarray], tuple] | None = None
+    step_entry: Callable[[np.ndarray], tuple] | None = None
 
     def for_stance(self, stance_leg: str) -> HybridWalker:
         """The walker of a step with ``stance_leg`` in stance (this one or :attr:`mirror`)."""

@@ -341,7 +341,11 @@ def push_off_flat(walker, fns: dict, spec, ankle_push=None):
 
     phases = []
     for ph in walker.phases:
-        tr = by_pin[FLAT_PIN[ph.name.split(":", 1)[0]]]
+        mode = ph.name.split(":", 1)[0]
+        if not any(g.outcome == "heel_strike" for g in ph.guards) or mode not in FLAT_PIN:
+            phases.append(ph)  # no heel strike from here (double support ends at toe off)
+            continue
+        tr = by_pin[FLAT_PIN[mode]]
         guards = tuple(replace(g, reset=tr.reset, reset_jacobian=jac(tr))
                        if g.outcome == "heel_strike" else g for g in ph.guards)
         phases.append(replace(ph, guards=guards))

@@ -114,8 +114,8 @@ def _straight_leg_phases(f: dict, flow, flow_jacobian, var, compiled, heel: Guar
 
 
 def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "derived",
-                      flow=None, flow_jacobian=None, reset=None, reset_jacobian=None
-                      ) -> HybridWalker:
+                      flow=None, flow_jacobian=None, reset=None, reset_jacobian=None,
+                      double_support: bool = True) -> HybridWalker:
     """A hybrid walker from generated code; ``flow``/``reset`` may override the generated ones
     (the paper's printed Appendix A variants).
 
@@ -126,13 +126,17 @@ def make_rigid_walker(data: WalkerData, name: str = "biped", variant: str = "der
         Stored in artifacts.
     flow, flow_jacobian, reset, reset_jacobian : callable, optional
         Replacements for the generated functions (same signatures).
+    double_support : bool
+        Flat feet: the double support after heel strike
+        (:func:`walkerlab.models.hybrid.rigid_foot_modes.make_flat_walker`); False: the trailing
+        foot leaves the ground at heel strike.
 
     Returns
     -------
     HybridWalker
     """
     if data.structure.foot == "flat":  # modes of a flat foot: their own phase graph
-        return make_flat_walker(data, name, variant)
+        return make_flat_walker(data, name, variant, double_support=double_support)
     if data.structure.free_knees:  # every joint free (five-link bipeds): one flow
         from walkerlab.models.hybrid.rigid_free_joints import make_five_link_walker
 

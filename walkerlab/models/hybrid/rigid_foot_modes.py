@@ -10,6 +10,13 @@ Sec. 3.2).  Phase names are ``<mode>:<swing part>`` (:func:`mode_of`); the guard
 next phase, and the sequence met is found by events at run time and recorded per segment
 (:attr:`walkerlab.integrate.rigid.Segment.phase_log`).
 
+Double support (:func:`double_support_phases`): each step begins
+(:attr:`HybridWalker.step_entry`, after the single-contact heel-strike map) with the trailing
+toe kept on the ground when the impulse that pins it is compressive and its force then
+pushes: ``double_support:heel_contact`` (and ``double_support:foot_flat`` if the leading
+foot slaps down first) until ``toe_off``, then ``heel_contact:early_swing`` (or
+``foot_flat:early_swing``).  No slip is assumed at the trailing toe.
+
 Guards (``direction`` as ``solve_ivp``'s events):
 
 - ``foot_slap`` (heel contact): the toe reaches the slope, ``phi = stance + ankle + gamma``
@@ -32,9 +39,12 @@ from __future__ import annotations
 from dataclasses import replace
 from functools import partial
 
+import numpy as np
+
 from walkerlab.codegen.cache import functions
 from walkerlab.codegen.compiled import CompiledFlow
 from walkerlab.models.hybrid.base import LEGS, Guard, HybridWalker, Phase, role_to_leg
+from walkerlab.numerics import fd_jacobian
 from walkerlab.walker.description import FLAT_FOOT_MODES as MODES
 from walkerlab.walker.description import WalkerData
 
@@ -94,17 +104,24 @@ def _heel_force(ground, flow, t, x) -> float:
 def make_flat_walker(data: WalkerData, name: str = "biped",
                      variant: str = "derived",
                      heel_off_data: WalkerData | None = None,
-                     flow_of=None) -> HybridWalker:
+                     flow_of=None, double_support: bool = True) -> HybridWalker:
     """A :class:`HybridWalker` for a flat-footed ``data`` (``structure.foot == "flat"``).
 
     ``flow_of(mode, flow, jacobian) -> (flow, jacobian)``, if given, replaces each mode's
     generated flow and Jacobian (joint torques added: the ground forces of the guards are
     read through the replaced flow; no compiled or variational flows then).
 
+    ``double_support`` (default) adds the double support after heel strike
+    (:func:`double_support_phases`, :attr:`HybridWalker.step_entry`; passive: an ankle
+    push-off acts in heel off, until heel strike); not with ``flow_of`` (its torques are
+    not in the double support's closed chain: such a walker releases the trailing foot at
+    heel strike as before).
+
     Returns
     -------
     HybridWalker
-        Roles ``(swing, stance, stance_ankle)``; six phases ``<mode>:<swing part>``.
+        Roles ``(swing, stance, stance_ankle)``; six phases ``<mode>:<swing part>`` and,
+        with ``double_support``, ``double_support:heel_contact``, ``double_support:foot_flat``.
     """
     base = functions(data)
     off = base if heel_off_data is None else functions(heel_off_data)
@@ -170,6 +187,12 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
                      compiled=compiled(mode, part, guards))
 
     phases = tuple(phase(m, part) for part in SWING_PARTS for m in MODES)
+    entry = None
+    if double_support and flow_of is None:
+        trailing_c = dict(zip(data.structure.param_names, data.params)).get(
+            "c_sw_ankle" if data.structure.asymmetric else "c_ankle", 0.0)
+        phases += double_support_phases(base, float(trailing_c))
+        entry = partial(_step_entry, base)
     f = base
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
@@ -177,7 +200,8 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
               **dict(zip(structure.param_names, data.params))}
     mirror = data.mirror
     if mirror is not None:  # legs that differ: the next step's walker (leg2 swinging)
-        mirror = make_flat_walker(replace(mirror, mirror_params=None), name, variant)
+        mirror = make_flat_walker(replace(mirror, mirror_params=None), name, variant,
+                                  double_support=double_support)
     return HybridWalker(
         name=name, variant=variant, roles=structure.roles, legs=LEGS, phases=phases,
         reset=f["reset_heel_strike_heel"], energies=f["energies"], points=f["points"],
@@ -186,5 +210,120 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
         variational=f["flow_heel_contact_jacobian"],
         reset_jacobian=f["reset_heel_strike_heel_jacobian"],
         heel_strike_guard=f["guard_swing_heel_height_heel"], leg_angles=f["leg_angles"],
-        mirror=mirror,
+        mirror=mirror, step_entry=entry,
     )
+
+
+#: The double support's phases: the leading (stance) foot's mode after ``double_support:``.
+DOUBLE_SUPPORT = ("double_support:heel_contact", "double_support:foot_flat")
+#: The trailing foot's angle from the slope [rad] below which its heel is up (the toe alone
+#: on the ground) at heel strike, so that a double support on its toe can begin (a trailing
+#: foot flat at heel strike is released as before).
+TRAILING_HEEL_UP_RAD = -1e-9
+
+
+def _force(forces, which: int, t, x) -> float:
+    return float(forces(t, x)[which])
+
+
+#: ``trailing_toe_pulls`` fires as the flat lead begins with the trailing toe's force below
+#: minus this [N] (offset so that a crossing later in the phase is ``toe_off``'s).
+PULL_N = 1e-3
+
+
+def _pulls(forces, t, x) -> float:
+    return float(forces(t, x)[0]) + PULL_N
+
+
+def _lead_heel(forces, t, x) -> float:
+    """Double support, leading foot flat: its heel's normal force [N]."""
+    f = forces(t, x)
+    return float(f[2] - f[3])
+
+
+def _step_entry(f: dict, x):
+    """:attr:`HybridWalker.step_entry` of a flat-footed walker: the state after the
+    single-contact heel-strike map (the trailing foot released); the trailing toe is kept on
+    the ground when its foot is heel up and the impulse that pins it (the two-contact plastic
+    impact's second stage: the M-orthogonal projections onto the heel's and then the heel's
+    and toe's constraints compose to the projection onto both) is compressive, and the toe's
+    normal force right after is not pulling: ``(x+, "double_support:heel_contact")``; else
+    ``(x, None)``, the single-contact heel strike as before (also where the impulse would
+    push but the spring then lifts the toe at once, e.g. a foot plantarflexed by a push-off:
+    a gait without double support keeps its numbers)."""
+    if np.iscomplexobj(x):  # no complex step through the branch and the linear solve
+        raise TypeError("the step entry takes real states")
+    x = np.asarray(x, dtype=float)
+    try:
+        phi_t = f["double_support_trailing"](x)[3]
+    except ValueError:  # the trailing ankle higher than its toe is long: no toe contact
+        return x, None
+    if not phi_t < TRAILING_HEEL_UP_RAD:
+        return x, None
+    x_plus, (impulse_n, _t) = f["double_support_heel_contact_entry"](x)
+    if impulse_n < 0.0:
+        return x, None
+    if f["double_support_heel_contact_forces"](0.0, x_plus)[0] < 0.0:
+        return x, None  # no double support: the single-contact heel strike, as before
+    return x_plus, DOUBLE_SUPPORT[0]
+
+
+def _foot_slap_in_double_support(f: dict, x):
+    """The leading foot's slap in double support: the single-support foot-slap map, then
+    the impact that keeps the trailing toe pinned (the same composition as
+    :func:`_step_entry`)."""
+    return f["double_support_foot_flat_entry"](f["reset_foot_slap"](x))[0]
+
+
+def _jacobian(fun, x):
+    """Jacobian ``(m, 2n)`` of ``fun`` (2n,) -> (m,) by central differences, step
+    ``1e-6 (1 + |x_k|)``: the double support's flows and maps solve a linear system in
+    generated code (no complex step)."""
+    x = np.asarray(x, dtype=float)
+    return fd_jacobian(fun, x, 1e-6 * (1.0 + np.abs(x)))
+
+
+def _flow_jacobian(flow, t, x):
+    return _jacobian(partial(flow, t), x)
+
+
+def _held(f: dict, c: float, x) -> tuple[float, float]:
+    """The trailing ankle's spring energy [J] and damper power [W] in double support."""
+    _b, db, energy, _phi = f["double_support_trailing"](x)
+    return float(energy), -c * float(db) ** 2
+
+
+def double_support_phases(f: dict, c_trailing: float = 0.0) -> tuple[Phase, ...]:
+    """The double-support phases of a flat-footed walker's generated functions ``f``
+    (:func:`walkerlab.codegen.foot_modes.generate_flat`): the trailing foot on its toe (a
+    pin: no slip assumed; ``c_trailing`` its ankle damper [N m s/rad], for the phases'
+    ``held_energy``), the leading foot on its heel (``double_support:heel_contact``)
+    or flat (``double_support:foot_flat``).
+
+    Guards: ``toe_off`` (the trailing toe's normal force decreasing through 0; the massless
+    trailing foot then leaves the ground at its spring's rest angle, no impact) to
+    ``heel_contact:early_swing`` / ``foot_flat:early_swing``; ``foot_slap`` to the flat
+    lead (plastic, the toe kept pinned); falls: ``stance_foot_lifts`` (the leading foot's
+    total normal force), ``stance_toe_lifts`` and ``stance_heel_lifts`` (foot flat),
+    ``trailing_toe_pulls`` (its force pulling as the flat lead begins, :data:`PULL_N`), ``fall``.
+    """
+    held = partial(_held, f, c_trailing)
+    heel, flat = (f[f"double_support_{m}_forces"] for m in ("heel_contact", "foot_flat"))
+    hip = Guard("fall", f["guard_hip_height_heel"], -1, "fall", f["grad_hip_height_heel"])
+    slap = partial(_foot_slap_in_double_support, f)
+    fl_heel, fl_flat = (f[f"flow_double_support_{m}"] for m in ("heel_contact", "foot_flat"))
+    on_heel = Phase(DOUBLE_SUPPORT[0], fl_heel, (
+        Guard("toe_off", partial(_force, heel, 0), -1, "next_phase",
+              next_phase="heel_contact:early_swing"),
+        Guard("foot_slap", f["guard_foot_angle"], -1, "next_phase", f["grad_foot_angle"],
+              slap, partial(_jacobian, slap), next_phase=DOUBLE_SUPPORT[1]),
+        Guard("stance_foot_lifts", partial(_force, heel, 2), -1, "fall", at_entry=True),
+        hip), jacobian=partial(_flow_jacobian, fl_heel), held_energy=held)
+    on_flat = Phase(DOUBLE_SUPPORT[1], fl_flat, (
+        Guard("toe_off", partial(_force, flat, 0), -1, "next_phase",
+              next_phase="foot_flat:early_swing"),
+        Guard("trailing_toe_pulls", partial(_pulls, flat), -1, "fall", at_entry=True),
+        Guard("stance_toe_lifts", partial(_force, flat, 3), -1, "fall", at_entry=True),
+        Guard("stance_heel_lifts", partial(_lead_heel, flat), -1, "fall", at_entry=True),
+        hip), jacobian=partial(_flow_jacobian, fl_flat), held_energy=held)
+    return on_heel, on_flat

@@ -46,6 +46,7 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
     """
     import time
 
+    from walkerlab.analysis.gait.scene import solve_scene
     from walkerlab.io.schemas.optimize import OptimizeData
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.records import not_a_gait_outcome, phase_replays, step_record
@@ -59,7 +60,10 @@ def optimize_phased_scene(scene, data, spec, x_gait: np.ndarray, period_s: float
 
     o = scene.optimize
     _refuse(scene)
-    walker = make_rigid_walker(data)
+    walker = make_rigid_walker(data, double_support=False)  # no double support phases yet
+    if data.structure.foot == "flat":  # fixedpoint's gait has its double support
+        g = solve_scene(scene, False, walker=walker)[1].gait.result
+        x_gait, period_s = g.x, float(g.period_s)
     guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
     t0 = time.perf_counter()
     fns = cached_mode_functions(data, walker, order)
