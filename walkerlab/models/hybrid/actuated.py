@@ -135,9 +135,9 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     Raises
     ------
     ValueError
-        A joint the walker does not have (naming the joints it has), partly massless legs,
-        a torque scaling that does not fit the legs, a push-off on free knees or arc feet
-        (one line).
+        A joint the walker does not have (naming the joints it has), a torque across a
+        link that carries no mass, a torque scaling that does not fit the legs, a push-off
+        on massless arc-footed legs (one line).
     """
     from walkerlab.codegen.cache import functions
 

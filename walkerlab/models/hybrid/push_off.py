@@ -22,7 +22,9 @@ spin about its centre), so ``E_f = [0 | I]`` and::
 
 With ``P = 0`` this is the generated passive heel strike (tests show both to round-off).
 A kneed walker holds its swing knee through both impulses (the constraint's gradient,
-:meth:`PushOffTransition.hold_lock`).  A walker with massless legs (only the hip carries
+:meth:`PushOffTransition.hold_lock`); a free-jointed walker (the five-link biped) holds
+nothing: its generated ``De, E`` (:func:`walkerlab.codegen.free_joints.derive_five_link`)
+carry every link, the push-off along the virtual trailing leg (stance foot to hip).  A walker with massless legs (only the hip carries
 mass) has a singular ``De``: its transition is written for the hip mass directly (Kuo 2002,
 Eq. 2 and its appendix).  Flat feet: :class:`FlatPushOff`.
 
@@ -116,6 +118,14 @@ class PushOffTransition(Transitions):
         (affine in ``q``: central differences of unit step are exact), since a kneed leg's
         thigh and shank both take the straight leg's rate."""
         self.lock = lock
+        self.swap_from_reset()
+
+    def swap_from_reset(self) -> None:
+        """Take the role swap's rate map ``R`` (n, n) from the generated reset's positions
+        (affine in ``q``: central differences of unit step are exact): the swap of every
+        coordinate, where the legs' absolute angles alone do not fix it (a locked knee's
+        thigh and shank, a free-jointed walker's links, McGeer 1990; Westervelt et al.
+        2003, Sec. III-B)."""
         n, z = self.n, np.zeros(self.n)
         pos = self.fns["reset"]
         self.R = np.stack([(np.real(pos(np.concatenate([e, z])))[:n]
