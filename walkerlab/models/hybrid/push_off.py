@@ -262,12 +262,18 @@ class FlatPushOff(Transitions):
     pin : str or None
         ``heel`` or ``toe``: the pinned point of the mode the heel strike ends (None: read
         from the foot's angle, as the generated ``points``).
+    torques : Actuators or None
+        Joint torques acting with it (:class:`walkerlab.models.hybrid.actuators.Actuators`
+        on the flat-foot modes, :mod:`walkerlab.models.hybrid.flat_hip_torque`): their
+        ``links``, ``power`` and per-step hook are read through this object.  Finite
+        torques add no impulse: the transition is the same.
     """
 
     spec: object
     fns: dict
     ankle_push: object = None
     pin: str | None = None
+    torques: object = None
 
     limit = False
 
@@ -275,8 +281,20 @@ class FlatPushOff(Transitions):
         self._memo: dict = {}
         self.ankle = None if self.ankle_push is None else self.ankle_push.ankle
 
+    @property
+    def links(self) -> list:
+        """The joint torques' ``(first, second)`` links (empty without torques)."""
+        return [] if self.torques is None else self.torques.links
+
+    def power(self, t, x) -> float:
+        """Mechanical power of the joint torques [W] (0 without torques; the ankle
+        push-off's is ``torque(a) da/dt`` in heel off, apart)."""
+        return 0.0 if self.torques is None else self.torques.power(t, x)
+
     def begin_step(self, t0: float) -> None:
-        """No time-based law here (the integrator's per-step hook)."""
+        """The integrator's per-step hook (the joint torques' time origin, if any)."""
+        if self.torques is not None:
+            self.torques.begin_step(t0)
 
     def torque(self, a: float) -> float:
         """The ankle push-off's torque [N m] at ankle angle ``a`` [rad] (0 without one)."""
@@ -284,7 +302,7 @@ class FlatPushOff(Transitions):
 
     def at(self, pin: str) -> FlatPushOff:
         """The transition of the mode pinned at ``pin`` (``heel`` or ``toe``)."""
-        return FlatPushOff(self.spec, self.fns, self.ankle_push, pin)
+        return FlatPushOff(self.spec, self.fns, self.ankle_push, pin, self.torques)
 
     def _pin(self, x) -> str:
         """The pinned point: this transition's, else the toe once the foot's angle from the
@@ -323,7 +341,7 @@ class FlatPushOff(Transitions):
                 "impulse": P, "ke_minus": ke[0], "ke_push_off": ke[1], "ke_plus": ke[2]}
 
 
-def push_off_flat(walker, fns: dict, spec, ankle_push=None):
+def push_off_flat(walker, fns: dict, spec, ankle_push=None, torques=None):
     """The flat-footed ``walker`` with the push-off at its trailing toe before every heel
     strike (:class:`FlatPushOff`: each phase's heel-strike guard gets its mode's transition,
     its Jacobian by the complex step).
@@ -337,13 +355,15 @@ def push_off_flat(walker, fns: dict, spec, ankle_push=None):
     spec : walkerlab.config.actuation.Actuation
     ankle_push : AnklePushOffActuator, optional
         An ankle push-off acting in heel off as well.
+    torques : Actuators, optional
+        Joint torques acting as well (already in ``walker``'s flows).
 
     Returns
     -------
     HybridWalker
         With ``actuators`` the :class:`FlatPushOff` (its pin read from the state).
     """
-    acts = FlatPushOff(spec, fns, ankle_push)
+    acts = FlatPushOff(spec, fns, ankle_push, torques=torques)
     by_pin = {pin: acts.at(pin) for pin in ("heel", "toe")}
 
     def jac(tr):
