@@ -97,3 +97,43 @@ def test_ankle_push_off_on_legs_that_differ_is_each_legs_own():
         assert got.t_end - got.t_start == pytest.approx(ref.t_end - ref.t_start, abs=1e-9)
     # and the stiffer ankle makes a different step (the check above is not vacuous)
     assert abs((second.t_end - second.t_start) - (first.t_end - first.t_start)) > 1e-4
+
+
+def _partly_massless(act, m_b=0.0, from_hip_a=0.5):
+    """A biped whose legs carry a 5 kg point mass and a second body of ``m_b`` kg."""
+    return scene_from_dict({"walker": {
+        "model": "biped", "coordinates": "slope_relative", "gravity_m_per_s2": 9.81,
+        "hip_mass_kg": 10.0, "actuation": act,
+        "leg": {"length_m": 1.0, "bodies": [
+            {"kind": "point_mass", "name": "a", "mass_kg": 5.0, "from_hip_m": from_hip_a},
+            {"kind": "point_mass", "name": "b", "mass_kg": m_b, "from_hip_m": 0.9}]}},
+        "slope": {"angle_rad": 0.01}})
+
+
+def test_legs_with_some_massless_bodies_take_torques_and_a_push_off():
+    """Legs with a massless body beside a massive one (refused before: "legs with some
+    massless bodies are not supported"): the generated equations are the massless limit's
+    link-angle rows, the torque's force mapped into them; flow and push-off + heel strike
+    equal the walker whose second body weighs 1e-10 kg (regular equations) to O(1e-10)
+    (seen: 4e-10 on accelerations of ~10 rad/s^2).  A torque across a link that carries no
+    mass (the leg's only massive body at the hip: the swing leg's row is the limit's) is
+    refused in one line: infinite angular acceleration."""
+    act = {"torques": [{"joint": "hip", "law": {"stiffness_n_m_per_rad": 3.0,
+                                                "rest_angle_rad": 0.3,
+                                                "damping_n_m_s_per_rad": 0.5}}],
+           "push_off": {"impulse_n_s": 1.0}}
+    w0, w1 = build_walker(_partly_massless(act)), build_walker(_partly_massless(act, 1e-10))
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        x = np.array([0.2, 0.4, -0.9, 0.3]) + rng.normal(0.0, 0.05, 4)
+        f0, f1 = w0.phases[0].flow(0.0, x), w1.phases[0].flow(0.0, x)
+        np.testing.assert_allclose(f0, f1, rtol=0, atol=1e-8)
+        assert np.max(np.abs(f0[2:] - build_walker(_partly_massless(None)).phases[0].flow(
+            0.0, x)[2:])) > 0.1  # the torque acts
+        np.testing.assert_allclose(w0.reset(x), w1.reset(x), rtol=0, atol=1e-8)
+    with pytest.raises(ValueError, match=r"torques\.0\.joint") as e:
+        build_walker(_partly_massless({"torques": act["torques"]}, from_hip_a=0.0))
+    assert "\n" not in str(e.value)
+    with pytest.raises(ValueError, match=r"actuation\.push_off") as e:
+        build_walker(_partly_massless({"push_off": act["push_off"]}, from_hip_a=0.0))
+    assert "\n" not in str(e.value)

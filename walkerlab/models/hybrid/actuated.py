@@ -35,8 +35,8 @@ def _structure_check(data, spec) -> bool:
                          "flat); point feet take push_off, the impulse along the leg")
     massless = [b.massless for b in st.bodies]
     limit = bool(massless) and all(massless)
-    if any(massless) and not limit:
-        raise ValueError("walker.actuation: legs with some massless bodies are not supported")
+    # legs with some massless bodies: the force in the limit's rows (Actuators.link_rows,
+    # which refuses a torque across a link whose bodies are all massless)
     if limit and (st.torso or not st.hip_mass):
         raise ValueError("walker.actuation: massless legs need a hip mass and no torso")
     if limit and st.foot != "point" and spec.push_off is not None:
@@ -57,6 +57,19 @@ def _structure_check(data, spec) -> bool:
     return limit
 
 
+def _massive_impact_check(acts) -> None:
+    """Legs with some massless bodies and a push-off: the extended impact needs every
+    link to carry mass (``De`` regular); a leg whose massive bodies all sit at the hip is
+    the massless-legs limit in disguise, whose push-off is Kuo's point hip (one line)."""
+    q = np.linspace(0.1, 0.3, acts.n)
+    w = np.linalg.eigvalsh(np.real(np.asarray(acts.fns["impact_matrices"](q)[0], float)))
+    if w[0] <= 1e-10 * w[-1]:
+        raise ValueError("walker.actuation.push_off: a leg link carries no mass (its bodies "
+                         "are massless or at the hip), so the impulses have no finite "
+                         "velocities on it; describe those bodies as the hip mass with "
+                         "massless legs (Kuo's point-hip push-off) or give the link mass")
+
+
 def spring_equivalent(data, spec):
     """The walker's data with its hip torques as one more generated hip spring-damper, when
     every law is linear in the hip angle and rate (no reference, no saturation, not scaled
@@ -69,7 +82,8 @@ def spring_equivalent(data, spec):
 
     st = data.structure
     laws = [t for t in spec.torques]
-    if not laws or st.knee or st.knee_spring or st.torso or any(
+    if not laws or st.knee or st.knee_spring or st.torso or any(b.massless for b in st.bodies) \
+            or any(
             t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None
             or t.law.reference is not None or t.law.time_reference is not None for t in laws):
         return None
@@ -96,7 +110,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     from walkerlab.codegen.actuated import ActuatedFlow
 
     # a kneed walker's phases: the free flow and the knee-locked one (``flow_locked``)
-    if limit:
+    if limit or acts.rows is not None:  # the force in the massless limit's rows: Python
         return None
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None and data.structure.free_knees:
@@ -153,9 +167,12 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     else:
         limit = _structure_check(data, spec)
         acts = Actuators(spec, functions(data), len(walker.roles), limit,
-                         float(walker.total_mass_kg))
+                         float(walker.total_mass_kg),
+                         some_massless=any(b.massless for b in data.structure.bodies))
         if data.structure.knee:  # heel strike with the swing knee locked (the last phase's)
             acts.hold_lock(walker.phases[-1].constraint)
+        if spec.push_off is not None and acts.rows is not None:
+            _massive_impact_check(acts)
     base_jac = walker.variational
     has_torque = bool(spec.torques)
 
