@@ -34,11 +34,15 @@ def _structure_check(data, spec) -> bool:
         raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
                          "flat); point feet take push_off, the impulse along the leg")
     massless = [b.massless for b in st.bodies]
-    limit = bool(massless) and all(massless)
-    # legs with some massless bodies: the force in the limit's rows (Actuators.link_rows,
-    # which refuses a torque across a link whose bodies are all massless)
-    if limit and (st.torso or not st.hip_mass):
-        raise ValueError("walker.actuation: massless legs need a hip mass and no torso")
+    # Kuo's limit: massless legs on a point hip mass.  Legs with some massless bodies, or
+    # massless legs under a torso (which the legs' angles move): the force in the massless
+    # limit's rows (Actuators.link_rows, which refuses a torque across a link whose
+    # bodies are all massless)
+    limit = bool(massless) and all(massless) and not st.torso
+    if limit and not st.hip_mass:
+        raise ValueError("walker.actuation: massless legs without a hip mass or a torso "
+                         "have no mass at all (no equations of motion to drive): give "
+                         "walker.hip_mass_kg > 0")
     if limit and st.foot != "point" and spec.push_off is not None:
         raise ValueError("walker.actuation.push_off: on massless legs the push-off's limit "
                          "m -> 0 is Kuo's point foot; an arc's depends on where its mass "
@@ -53,21 +57,25 @@ def _structure_check(data, spec) -> bool:
                              "torque per foot mass acts at the hip only (joint: hip)")
         if not limit and t.scaled_by != "none":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
-                             "walkers whose legs are massless")
+                             "massless legs on a hip mass (Kuo 2002; no torso), where the "
+                             "legs' rows are divided by the vanishing mass")
     return limit
 
 
 def _massive_impact_check(acts) -> None:
     """Legs with some massless bodies and a push-off: the extended impact needs every
-    link to carry mass (``De`` regular); a leg whose massive bodies all sit at the hip is
-    the massless-legs limit in disguise, whose push-off is Kuo's point hip (one line)."""
+    link to carry mass (``De`` regular).  A leg link that moves no mass (its bodies
+    massless or at the hip; massless legs under a torso) takes any velocity at no cost:
+    the impulses leave it undetermined, and only a limiting rule fixes it (Kuo 2002's
+    point hip: the trailing foot keeps no velocity across its leg) (one line)."""
     q = np.linspace(0.1, 0.3, acts.n)
     w = np.linalg.eigvalsh(np.real(np.asarray(acts.fns["impact_matrices"](q)[0], float)))
     if w[0] <= 1e-10 * w[-1]:
-        raise ValueError("walker.actuation.push_off: a leg link carries no mass (its bodies "
-                         "are massless or at the hip), so the impulses have no finite "
-                         "velocities on it; describe those bodies as the hip mass with "
-                         "massless legs (Kuo's point-hip push-off) or give the link mass")
+        raise ValueError("walker.actuation.push_off: a leg link moves no mass (its bodies "
+                         "are massless or at the hip), so the impulses leave its velocity "
+                         "undetermined; give the leg mass, or describe the walker as "
+                         "massless legs on a hip mass without a torso (Kuo's point-hip "
+                         "push-off)")
 
 
 def spring_equivalent(data, spec):
