@@ -160,3 +160,17 @@ def test_legs_with_some_massless_bodies_take_torques_and_a_push_off():
     with pytest.raises(ValueError, match=r"actuation\.push_off") as e:
         build_walker(_partly_massless({"push_off": act["push_off"]}, from_hip_a=0.0))
     assert "\n" not in str(e.value)
+
+
+def test_the_contact_view_refuses_a_five_link_push_off_it_cannot_carry_in_one_line():
+    """The rigid view now carries a push-off on free knees; the contact view has no pulse
+    for it yet, so it refuses the scene in one line naming the field (never drops it)."""
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+
+    d = load_scene(CONFIGS / "rabbit.yaml").model_dump(exclude_none=True)
+    d["walker"]["actuation"]["push_off"] = {"impulse_n_s": 1.0}
+    scene = scene_from_dict(d)
+    build_walker(scene)  # the rigid view takes it
+    with pytest.raises(ContactSceneError, match=r"walker\.actuation\.push_off") as e:
+        contact_setup(scene)
+    assert "\n" not in str(e.value)

@@ -171,7 +171,7 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     if data.structure.free_knees:  # every joint free: hips and knees (five-link bipeds)
         from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
 
-        acts = five_link_actuators(data, spec, walker.roles)
+        acts = five_link_actuators(data, spec, walker.roles, push_off=True)
     else:
         limit = _structure_check(data, spec)
         acts = Actuators(spec, functions(data), len(walker.roles), limit,

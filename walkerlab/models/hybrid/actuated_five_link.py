@@ -69,7 +69,7 @@ def _shared_phase_table(torques):
             for i in range(len(tabs))]
 
 
-def five_link_actuators(data, spec, roles) -> FiveLinkActuators:
+def five_link_actuators(data, spec, roles, push_off: bool = False) -> FiveLinkActuators:
     """The actuators of a free-jointed walker, after checking what it can carry.
 
     Parameters
@@ -79,6 +79,11 @@ def five_link_actuators(data, spec, roles) -> FiveLinkActuators:
     spec : walkerlab.config.actuation.Actuation
     roles : tuple of str
         The walker's roles.
+    push_off : bool
+        The caller carries the push-off (the rigid view:
+        :func:`walkerlab.models.hybrid.actuated.actuate`); False (the contact view's
+        :class:`walkerlab.models.contact.joint_torques.JointTorqueActuators`, which has no
+        pulse for it yet): a push-off is refused in one line rather than dropped.
 
     Returns
     -------
@@ -87,11 +92,14 @@ def five_link_actuators(data, spec, roles) -> FiveLinkActuators:
     Raises
     ------
     ValueError
-        A joint the walker does not have (naming the joints it has), a torque per foot mass
-        (one line, naming the field).
+        A joint the walker does not have (naming the joints it has), a torque per foot mass,
+        a push-off the caller does not carry (one line, naming the field).
     """
     from walkerlab.codegen.cache import functions
 
+    if spec.push_off is not None and not push_off:
+        raise ValueError("walker.actuation.push_off: the contact view has no push-off pulse "
+                         "on a free-jointed biped yet (the rigid view carries it)")
     for i, t in enumerate(spec.torques):
         if t.scaled_by != "none":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
