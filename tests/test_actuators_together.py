@@ -97,6 +97,15 @@ def test_ankle_push_off_on_legs_that_differ_is_each_legs_own():
         assert got.t_end - got.t_start == pytest.approx(ref.t_end - ref.t_start, abs=1e-9)
     # and the stiffer ankle makes a different step (the check above is not vacuous)
     assert abs((second.t_end - second.t_start) - (first.t_end - first.t_start)) > 1e-4
+    # with a hip torque and the toe's push-off as well: each step's walker its own
+    pair["walker"]["actuation"]["push_off"] = {"impulse_n_s": 0.3}
+    pair["walker"]["actuation"]["torques"] = [{"joint": "hip", "law": {"constant_n_m": 0.0}}]
+    w3, t3 = _step(pair, 2)
+    assert w3.mirror is not None and w3.mirror.actuators.torques is not None
+    d["walker"]["actuation"]["push_off"] = {"impulse_n_s": 0.3}
+    _w4, ref4 = _step(d, 1)
+    np.testing.assert_allclose(t3.segments[0].x_next, ref4.segments[0].x_next, rtol=0,
+                               atol=1e-9)
 
 
 def _partly_massless(act, m_b=0.0, from_hip_a=0.5):

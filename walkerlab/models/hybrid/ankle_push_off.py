@@ -119,6 +119,7 @@ def _actuate_flat_step(walker: HybridWalker, data, spec) -> HybridWalker:
     from walkerlab.models.hybrid.push_off import FlatPushOff, push_off_flat
     from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 
+    walker = replace(walker, mirror=None)  # one step's (legs that differ: set by the caller)
     off = None if spec.ankle_push_off is None else heel_off_data(data, spec)
     torques = None
     if spec.torques:
