@@ -101,7 +101,6 @@ def test_shared_spline_equals_each_laws_own():
 
 
 @pytest.mark.parametrize("edit, message", [
-    (lambda c: c["actuation"].update(push_off={"impulse_n_s": 1.0}), "push_off"),
     (lambda c: c["actuation"]["torques"][0].update(joint="stance_ankle"), "torques.0.joint"),
     (lambda c: (c.pop("torso"), c["actuation"]["torques"][0].update(joint="swing_hip")),
      "torques.0.joint"),
@@ -135,3 +134,26 @@ def test_reference_tables_take_angle_rad_or_hip_angle_rad_once():
     for bad in ({}, {"angle_rad": [0, 1], "hip_angle_rad": [0, 1]}, {"angle_rad": [0, 1, 2]}):
         with pytest.raises(ValueError):
             PhaseReference(phase_rad=[0, 1], **bad)
+
+
+def test_push_off_matches_an_independent_impulse_and_is_the_heel_strike_at_zero():
+    """Kuo's push-off on the five-link biped (issue 48 item 5: refused before): the reset
+    equals the independent relative-coordinate model's push-off + heel strike
+    (tests/independent/five_link.py, its own De, E) to round-off; at P = 0 it is the passive
+    heel strike; the plastic heel strike after it loses kinetic energy."""
+    impulse = 4.0
+    w = build_walker(scene_with([], push_off={"impulse_n_s": impulse}))
+    w0 = build_walker(scene_with([], push_off={"impulse_n_s": 0.0}))
+    passive = build_walker(scene_from_dict(SCENE))
+    for x in states():
+        r, dr = to_ref(x)
+        r_new, dr_new = ref.push_off_heel_strike(r, dr, P, impulse)
+        got = w.reset(x)
+        np.testing.assert_allclose(got[:5], from_ref(r_new), atol=1e-12)
+        want = from_ref(dr_new)
+        np.testing.assert_allclose(got[5:], want, atol=1e-9 * max(1, abs(want).max()))
+        # P = 0: the generated passive heel strike, to round-off
+        np.testing.assert_allclose(w0.reset(x), passive.reset(x), rtol=0, atol=1e-12)
+        tr = w.actuators.transition(x)
+        assert tr["impulse"] == impulse and tr["ke_plus"] <= tr["ke_push_off"] + 1e-12
+

@@ -122,6 +122,26 @@ def heel_strike(r, dr, p: dict) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(r)[swap], dq[swap]
 
 
+def push_off_heel_strike(r, dr, p: dict, impulse: float) -> tuple[np.ndarray, np.ndarray]:
+    """Kuo's (2002) pre-emptive push-off, then the plastic heel strike and the legs' swap:
+    an impulse ``impulse`` [N s] at the stance foot, free for it, along the line from that
+    foot to the hip (``De (dqe' - dqe-) = [0 | I]^T impulse e``, the extended coordinates'
+    last two being the foot's position), then :func:`heel_strike`'s system from ``dqe'``
+    (the new rates; the trailing foot's own rate is dropped as it leaves the ground)."""
+    args = (list(r), list(dr), [p[k] for k in PARAMS])
+    De, E = (np.asarray(f(*args), float) for f in _model()[2:4])
+    hip = np.asarray(_model()[5](*args)[1], float).ravel()
+    e = hip / np.linalg.norm(hip)
+    n = De.shape[0]
+    dqe = np.concatenate([dr, [0.0, 0.0]])
+    dqe_po = dqe + np.linalg.solve(De, np.concatenate([np.zeros(n - 2), impulse * e]))
+    K = np.zeros((n + 2, n + 2))
+    K[:n, :n], K[:n, n:], K[n:, :n] = De, -E.T, E
+    sol = np.linalg.solve(K, np.concatenate([De @ dqe_po, [0.0, 0.0]]))
+    swap = [0, 2, 1, 4, 3]
+    return np.asarray(r)[swap], sol[:5][swap]
+
+
 def energy(r, dr, p: dict) -> float:
     """``T + V`` [J] (potential from the stance foot's height)."""
     f = _model()[4]

@@ -105,8 +105,8 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
                               ta, tb, scale)
             wneg += quad_work(lambda t, sol=sol: min(acts.power(t, _state(sol, t, n2)), 0.0),
                               ta, tb, scale)
-        elif acts is not None and ph.name.startswith("heel_off") \
-                and getattr(acts, "ankle", 0) is not None:  # a toe push-off alone: no ankle torque
+        if acts is not None and ph.name.startswith("heel_off") \
+                and getattr(acts, "ankle", None) is not None:  # an ankle push-off, in heel off
             def power(t, sol=sol):
                 x = _state(sol, t, n2)
                 return acts.torque(x[acts.ankle]) * x[acts.ankle + n2 // 2]

@@ -34,11 +34,15 @@ def _structure_check(data, spec) -> bool:
         raise ValueError("walker.actuation.ankle_push_off: needs flat feet (leg.foot.kind: "
                          "flat); point feet take push_off, the impulse along the leg")
     massless = [b.massless for b in st.bodies]
-    limit = bool(massless) and all(massless)
-    if any(massless) and not limit:
-        raise ValueError("walker.actuation: legs with some massless bodies are not supported")
-    if limit and (st.torso or not st.hip_mass):
-        raise ValueError("walker.actuation: massless legs need a hip mass and no torso")
+    # Kuo's limit: massless legs on a point hip mass.  Legs with some massless bodies, or
+    # massless legs under a torso (which the legs' angles move): the force in the massless
+    # limit's rows (Actuators.link_rows, which refuses a torque across a link whose
+    # bodies are all massless)
+    limit = bool(massless) and all(massless) and not st.torso
+    if limit and not st.hip_mass:
+        raise ValueError("walker.actuation: massless legs without a hip mass or a torso "
+                         "have no mass at all (no equations of motion to drive): give "
+                         "walker.hip_mass_kg > 0")
     if limit and st.foot != "point" and spec.push_off is not None:
         raise ValueError("walker.actuation.push_off: on massless legs the push-off's limit "
                          "m -> 0 is Kuo's point foot; an arc's depends on where its mass "
@@ -53,8 +57,25 @@ def _structure_check(data, spec) -> bool:
                              "torque per foot mass acts at the hip only (joint: hip)")
         if not limit and t.scaled_by != "none":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
-                             "walkers whose legs are massless")
+                             "massless legs on a hip mass (Kuo 2002; no torso), where the "
+                             "legs' rows are divided by the vanishing mass")
     return limit
+
+
+def _massive_impact_check(acts) -> None:
+    """Legs with some massless bodies and a push-off: the extended impact needs every
+    link to carry mass (``De`` regular).  A leg link that moves no mass (its bodies
+    massless or at the hip; massless legs under a torso) takes any velocity at no cost:
+    the impulses leave it undetermined, and only a limiting rule fixes it (Kuo 2002's
+    point hip: the trailing foot keeps no velocity across its leg) (one line)."""
+    q = np.linspace(0.1, 0.3, acts.n)
+    w = np.linalg.eigvalsh(np.real(np.asarray(acts.fns["impact_matrices"](q)[0], float)))
+    if w[0] <= 1e-10 * w[-1]:
+        raise ValueError("walker.actuation.push_off: a leg link moves no mass (its bodies "
+                         "are massless or at the hip), so the impulses leave its velocity "
+                         "undetermined; give the leg mass, or describe the walker as "
+                         "massless legs on a hip mass without a torso (Kuo's point-hip "
+                         "push-off)")
 
 
 def spring_equivalent(data, spec):
@@ -69,7 +90,8 @@ def spring_equivalent(data, spec):
 
     st = data.structure
     laws = [t for t in spec.torques]
-    if not laws or st.knee or st.knee_spring or st.torso or any(
+    if not laws or st.knee or st.knee_spring or st.torso or any(b.massless for b in st.bodies) \
+            or any(
             t.joint != "hip" or t.scaled_by != "none" or t.max_torque_n_m is not None
             or t.law.reference is not None or t.law.time_reference is not None for t in laws):
         return None
@@ -96,7 +118,7 @@ def _compiled_laws(phase: Phase, data, acts, limit: bool):
     from walkerlab.codegen.actuated import ActuatedFlow
 
     # a kneed walker's phases: the free flow and the knee-locked one (``flow_locked``)
-    if limit:
+    if limit or acts.rows is not None:  # the force in the massless limit's rows: Python
         return None
     guards = phase.compiled.guards if phase.compiled is not None else None
     if guards is None and data.structure.free_knees:
@@ -135,9 +157,9 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     Raises
     ------
     ValueError
-        A joint the walker does not have (naming the joints it has), partly massless legs,
-        a torque scaling that does not fit the legs, a push-off on free knees or arc feet
-        (one line).
+        A joint the walker does not have (naming the joints it has), a torque across a
+        link that carries no mass, a torque scaling that does not fit the legs, a push-off
+        on massless arc-footed legs (one line).
     """
     from walkerlab.codegen.cache import functions
 
@@ -149,13 +171,16 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
     if data.structure.free_knees:  # every joint free: hips and knees (five-link bipeds)
         from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
 
-        acts = five_link_actuators(data, spec, walker.roles)
+        acts = five_link_actuators(data, spec, walker.roles, push_off=True)
     else:
         limit = _structure_check(data, spec)
         acts = Actuators(spec, functions(data), len(walker.roles), limit,
-                         float(walker.total_mass_kg))
+                         float(walker.total_mass_kg),
+                         some_massless=any(b.massless for b in data.structure.bodies))
         if data.structure.knee:  # heel strike with the swing knee locked (the last phase's)
             acts.hold_lock(walker.phases[-1].constraint)
+        if spec.push_off is not None and acts.rows is not None:
+            _massive_impact_check(acts)
     base_jac = walker.variational
     has_torque = bool(spec.torques)
 

@@ -11,7 +11,9 @@ gains ``M^-1 B tau`` (:func:`walkerlab.models.hybrid.actuated.actuate` adds it, 
 actuated walker).  The phase variable ``s`` is the virtual stance leg's angle (hip to
 stance foot, from the generated ``leg_angles``), ``ds`` its rate; it decreases through a
 step.  ``joint: hip`` acts between the two thighs.
-The push-off impulse is not offered for these walkers (refused in one line).
+The push-off impulse (Kuo 2002) acts at the trailing foot along the virtual trailing leg
+(foot to hip), through the generated extended impact (``De, E``;
+:class:`walkerlab.models.hybrid.push_off.PushOffTransition`), as on every walker.
 
 The actuators are the generic :class:`walkerlab.models.hybrid.actuators.Actuators`;
 here only what a free-jointed walker adds (one spline for laws sharing a table).
@@ -67,7 +69,7 @@ def _shared_phase_table(torques):
             for i in range(len(tabs))]
 
 
-def five_link_actuators(data, spec, roles) -> FiveLinkActuators:
+def five_link_actuators(data, spec, roles, push_off: bool = False) -> FiveLinkActuators:
     """The actuators of a free-jointed walker, after checking what it can carry.
 
     Parameters
@@ -77,6 +79,11 @@ def five_link_actuators(data, spec, roles) -> FiveLinkActuators:
     spec : walkerlab.config.actuation.Actuation
     roles : tuple of str
         The walker's roles.
+    push_off : bool
+        The caller carries the push-off (the rigid view:
+        :func:`walkerlab.models.hybrid.actuated.actuate`); False (the contact view's
+        :class:`walkerlab.models.contact.joint_torques.JointTorqueActuators`, which has no
+        pulse for it yet): a push-off is refused in one line rather than dropped.
 
     Returns
     -------
@@ -85,19 +92,21 @@ def five_link_actuators(data, spec, roles) -> FiveLinkActuators:
     Raises
     ------
     ValueError
-        A push-off, a joint the walker does not have (naming the joints it has), a torque
-        per foot mass (one line, naming the field).
+        A joint the walker does not have (naming the joints it has), a torque per foot mass,
+        a push-off the caller does not carry (one line, naming the field).
     """
     from walkerlab.codegen.cache import functions
 
-    if spec.push_off is not None:
-        raise ValueError("walker.actuation.push_off: not available on a walker with free "
-                         "knees yet (drive its joints with torques)")
+    if spec.push_off is not None and not push_off:
+        raise ValueError("walker.actuation.push_off: the contact view has no push-off pulse "
+                         "on a free-jointed biped yet (the rigid view carries it)")
     for i, t in enumerate(spec.torques):
         if t.scaled_by != "none":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
                              "walkers whose legs are massless")
     acts = Actuators(spec, functions(data), len(roles), False, float(data.total_mass_kg))
+    if spec.push_off is not None:  # every link's swap from the generated reset
+        acts.push.swap_from_reset()
     shared = _shared_phase_table(spec.torques)
     if shared is not None:  # one spline for every law's reference: 2 calls, not 2k
         acts.laws.refs = shared

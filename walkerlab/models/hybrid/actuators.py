@@ -126,6 +126,11 @@ class Actuators:
     #: model's ``leg_angles`` output does not name it)
     torso_mean: bool = False
 
+    #: legs with some massless bodies: the generated equations' rows are link-angle rows
+    #: (:mod:`walkerlab.codegen.symbolic`'s massless limit), the force mapped into them
+    #: (:meth:`link_rows`)
+    some_massless: bool = False
+
     def __post_init__(self):
         eye = np.eye(self.n)
         la = self.fns["leg_angles"]
@@ -158,10 +163,57 @@ class Actuators:
         #: actuation: B tau = ddelta_dq sum(tau), as before)
         self.hip_only = all(t.joint == "hip" for t in self.spec.torques) and not (
             "stance_angle" in names and "stance_thigh" in names)
+        #: (n, n) the map of a generalised force in ``q``'s rows into the generated
+        #: equations' rows (legs with some massless bodies), or None: the same rows
+        self.rows = self.link_rows(q1) if self.some_massless and not self.limit else None
         self.t_origin = 0.0  # the time [s] the present step began (time_reference laws)
         # (t, x) -> (k, 2n) the torques' derivative by the state, when known in closed form
         # (a torque of time alone: zeros); None: the complex step differentiates the torques
         self.torque_jacobian = None
+
+    def link_rows(self, q) -> np.ndarray:
+        """The map ``L`` (n, n) of a generalised force ``F`` in ``q``'s rows into the
+        generated equations' rows on legs with some massless bodies, ``M_gen qdd + ... =
+        L F``.  The generated rows are link-angle rows, each at its massless limit
+        (:mod:`walkerlab.codegen.symbolic`, Garcia et al. 1998): a link that moves massive
+        bodies keeps its row's value at ``m = 0``, ``(A^-T F)_k`` (``A = dpsi/dq``); a link
+        that moves only massless bodies has its row divided by the vanishing mass, where a
+        finite torque would give an infinite angular acceleration.  With ``M_q`` the
+        Hessian of the generated kinetic energy in the rates (massless bodies carry none;
+        its null space: the motions of massless links alone), ``L = M_gen M_q^+`` on the
+        massive links' rows (exact: ``M_gen_r = (A^-T)_r M_q`` there and ``F`` lies in
+        ``M_q``'s range) and 0 on the others.  Constant (every link angle is affine in
+        ``q``), read at the angles ``q`` (n,).
+
+        Raises
+        ------
+        ValueError
+            A torque across a link that carries no mass (its virtual work on a motion of
+            massless links alone is not 0), naming ``walker.actuation.torques.<i>.joint``.
+        """
+        n = self.n
+        eye = np.eye(n)
+
+        def T(dq):
+            return float(np.real(self.fns["energies"](np.concatenate([q, dq]))[0]))
+        d = [T(eye[i]) for i in range(n)]
+        Mq = np.array([[2.0 * d[i] if i == j else T(eye[i] + eye[j]) - d[i] - d[j]
+                        for j in range(n)] for i in range(n)])
+        w, V = np.linalg.eigh(Mq)
+        null = V[:, w <= 1e-10 * max(float(np.max(np.abs(w))), 1e-300)]
+        for i, t in enumerate(self.spec.torques):
+            col = self.B[:, i]
+            if null.size and np.max(np.abs(null.T @ col)) > 1e-10 * max(np.max(np.abs(col)),
+                                                                        1e-300):
+                raise ValueError(f"walker.actuation.torques.{i}.joint: {t.joint} acts on a "
+                                 "link whose bodies are all massless (no inertia: a finite "
+                                 "torque there has an infinite angular acceleration); give "
+                                 "that link a body with mass")
+        Mg = np.real(np.asarray(self.fns["matrices"](np.concatenate([q, np.zeros(n)]))[0]))
+        L = Mg @ np.linalg.pinv(Mq)
+        if null.size:  # the massless links' rows (the limit's): no force reaches them
+            L[np.max(np.abs(Mg @ null), axis=1) > 1e-10 * np.max(np.abs(Mg))] = 0.0
+        return L
 
     def link_angles(self, x) -> dict:
         """``{link: (angle [rad], rate [rad/s])}`` at the state ``x`` (2n,)
@@ -226,8 +278,8 @@ class Actuators:
         elif self.hip_only:
             col = self.ddelta_dq
         else:
-            return self.B @ tau
-        return col * np.sum(tau)
+            return self.B @ tau if self.rows is None else self.rows @ (self.B @ tau)
+        return col * np.sum(tau) if self.rows is None else self.rows @ (col * np.sum(tau))
 
     def power(self, t, x) -> float:
         """Mechanical power of the joint torques [W]: ``sum_k tau_k ddelta_k`` (0 for
@@ -262,7 +314,7 @@ class Actuators:
         (``B`` is constant: the leg angles are linear in ``q``).  Otherwise the complex step
         of :meth:`added_acceleration` (``2n`` calls through the torque laws)."""
         x = np.asarray(x, float)
-        if self.torque_jacobian is None or constraint is not None:
+        if self.torque_jacobian is None or constraint is not None or self.rows is not None:
             return complex_step_jacobian(
                 lambda z: self.added_acceleration(t, z, constraint), x)
         dtau = np.asarray(self.torque_jacobian(t, x), float)

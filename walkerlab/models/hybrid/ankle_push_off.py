@@ -53,62 +53,89 @@ class AnklePushOffActuator:
 def heel_off_data(data, spec):
     """The walker's data with the heel-off mode's ankle numbers ``(k + k_po, r_eff)``.
 
+    Legs that differ: ``data`` is one step's (its stance leg's ankle numbers ``k_st_ankle``,
+    ``r_st_ankle``), the next step's walker takes its own.
+
     Raises
     ------
     ValueError
-        Legs that differ, or a total ankle stiffness of 0 with a constant torque (one line).
+        A total ankle stiffness of 0 with a constant torque (one line): the released
+        spring's rest angle ``r_eff`` would be infinite (a constant torque on a massless
+        foot with no spring to balance it has no heel-off flow).
     """
     st = data.structure
-    if st.asymmetric:
-        raise ValueError("walker.actuation.ankle_push_off: legs that differ are not "
-                         "supported yet")
+    tag = "st_" if st.asymmetric else ""  # the stance leg's own numbers when legs differ
     po = spec.ankle_push_off
     names = list(st.param_names)
     p = np.array(data.params, float)
-    k, r = p[names.index("k_ankle")], p[names.index("r_ankle")]
+    ik, ir = names.index(f"k_{tag}ankle"), names.index(f"r_{tag}ankle")
+    k, r = p[ik], p[ir]
     kt = k + po.stiffness_n_m_per_rad
     if kt <= 0.0:
         raise ValueError("walker.actuation.ankle_push_off: a constant torque needs an ankle "
                          "spring (leg.foot.ankle.stiffness_n_m_per_rad > 0)")
-    p[names.index("k_ankle")] = kt
-    p[names.index("r_ankle")] = (k * r + po.stiffness_n_m_per_rad * po.rest_angle_rad
-                                 - po.constant_n_m) / kt
-    return replace(data, params=tuple(float(v) for v in p))
+    p[ik] = kt
+    p[ir] = (k * r + po.stiffness_n_m_per_rad * po.rest_angle_rad - po.constant_n_m) / kt
+    return replace(data, params=tuple(float(v) for v in p), mirror_params=None)
 
 
 def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
-    """The flat-footed walker with its ankle push-off (module docstring), a push-off impulse
-    at the trailing toe (:func:`walkerlab.models.hybrid.push_off.push_off_flat`), both, or
-    with hip torques alone (:func:`walkerlab.models.hybrid.flat_hip_torque.actuate_flat_hips`).
+    """The flat-footed walker with its actuators, any of them together: joint torques
+    (:func:`walkerlab.models.hybrid.flat_hip_torque.actuate_flat_hips`), the ankle push-off
+    in heel off (module docstring) and the push-off impulse at the trailing toe before heel
+    strike (:func:`walkerlab.models.hybrid.push_off.push_off_flat`).  Legs that differ:
+    each step's walker on its own numbers (``mirror``).
+
+    Returns
+    -------
+    HybridWalker
+        Its ``actuators``: the torques' :class:`walkerlab.models.hybrid.actuators.Actuators`
+        (torques alone), an :class:`AnklePushOffActuator` (the ankle push-off alone) or a
+        :class:`walkerlab.models.hybrid.push_off.FlatPushOff` carrying every one given.
 
     Raises
     ------
     ValueError
-        Hip torques with a push-off (not written yet), legs that differ with an ankle
-        push-off (one line).
+        A joint the walker does not have, a torque per foot mass, an ankle push-off's
+        constant torque without an ankle spring (one line, naming the field).
     """
-    from walkerlab.codegen.cache import functions
-    from walkerlab.models.hybrid.push_off import push_off_flat
-    from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
+    from walkerlab.models.hybrid.flat_hip_torque import actuate_flat_hips
 
     if spec.torques and spec.push_off is None and spec.ankle_push_off is None:
-        from walkerlab.models.hybrid.flat_hip_torque import actuate_flat_hips
-
         return actuate_flat_hips(walker, data, spec)
+    if data.mirror is None:
+        return _actuate_flat_step(walker, data, spec)
+    w = _actuate_flat_step(walker, replace(data, mirror_params=None), spec)
+    # legs that differ: the next step's walker (leg2 swinging) on its own numbers
+    return replace(w, mirror=_actuate_flat_step(
+        walker.mirror, replace(data.mirror, mirror_params=None), spec))
+
+
+def _actuate_flat_step(walker: HybridWalker, data, spec) -> HybridWalker:
+    """One step's flat-footed walker (``data`` without ``mirror_params``, or legs alike)
+    with the push-off impulse and/or the ankle push-off, and joint torques if any."""
+    from walkerlab.codegen.cache import functions
+    from walkerlab.models.hybrid.flat_hip_torque import actuate_flat_hips
+    from walkerlab.models.hybrid.push_off import FlatPushOff, push_off_flat
+    from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
+
+    walker = replace(walker, mirror=None)  # one step's (legs that differ: set by the caller)
+    off = None if spec.ankle_push_off is None else heel_off_data(data, spec)
+    torques = None
     if spec.torques:
-        raise ValueError("walker.actuation: flat feet take hip torques alone today (not with "
-                         "push_off or ankle_push_off)")
-    if spec.ankle_push_off is None:  # the push-off impulse at the trailing toe alone
-        w = push_off_flat(walker, functions(data), spec)
-        if walker.mirror is not None:  # legs that differ: the next step's walker too
-            w = replace(w, mirror=push_off_flat(
-                walker.mirror, functions(replace(data.mirror, mirror_params=None)), spec))
-        return w
-    w = make_flat_walker(data, walker.name, walker.variant, heel_off_data(data, spec))
-    ankle = AnklePushOffActuator(spec, list(w.roles).index("stance_ankle"))
-    if spec.push_off is not None:  # and the impulse at the toe before heel strike
-        return push_off_flat(w, functions(data), spec, ankle)
-    return replace(w, actuators=ankle)
+        w = actuate_flat_hips(walker, replace(data, mirror_params=None), spec, off)
+        torques = w.actuators
+    elif off is not None:
+        w = make_flat_walker(data, walker.name, walker.variant, off)
+    else:
+        w = walker
+    ankle = None if off is None else AnklePushOffActuator(
+        spec, list(w.roles).index("stance_ankle"))
+    if spec.push_off is not None:  # the impulse at the toe before heel strike
+        return push_off_flat(w, functions(data), spec, ankle, torques)
+    if torques is None:
+        return replace(w, actuators=ankle)
+    return replace(w, actuators=FlatPushOff(spec, functions(data), ankle, torques=torques))
 
 
 def ankle_push_off_work(walker: HybridWalker, seg) -> float:

@@ -50,8 +50,12 @@ def mode_mass_matrix(kinetic, x) -> np.ndarray:
     return M
 
 
-def actuate_flat_hips(walker: HybridWalker, data, spec) -> HybridWalker:
+def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> HybridWalker:
     """The flat-footed walker with its joint torques (module docstring).
+
+    ``heel_off``: the walker's data with the heel-off mode's ankle numbers of an ankle
+    push-off acting as well (:func:`walkerlab.models.hybrid.ankle_push_off.heel_off_data`;
+    then ``data`` is one step's, without ``mirror_params``), or None.
 
     Raises
     ------
@@ -92,7 +96,7 @@ def actuate_flat_hips(walker: HybridWalker, data, spec) -> HybridWalker:
         return fl, J
 
     w = make_flat_walker(replace(data, mirror_params=None), walker.name, walker.variant,
-                         flow_of=flow_of)
+                         heel_off, flow_of=flow_of)
     mirror = walker.mirror
     if mirror is not None:  # legs that differ: the next step's walker, its own numbers
         mirror = actuate_flat_hips(mirror, data.mirror, spec)

@@ -22,9 +22,12 @@ spin about its centre), so ``E_f = [0 | I]`` and::
 
 With ``P = 0`` this is the generated passive heel strike (tests show both to round-off).
 A kneed walker holds its swing knee through both impulses (the constraint's gradient,
-:meth:`PushOffTransition.hold_lock`).  A walker with massless legs (only the hip carries
-mass) has a singular ``De``: its transition is written for the hip mass directly (Kuo 2002,
-Eq. 2 and its appendix).  Flat feet: :class:`FlatPushOff`.
+:meth:`PushOffTransition.hold_lock`); a free-jointed walker (the five-link biped) holds
+nothing: its generated ``De, E`` (:func:`walkerlab.codegen.free_joints.derive_five_link`)
+carry every link, the push-off along the virtual trailing leg (stance foot to hip).  A
+walker with massless legs (only the hip carries mass) has a singular ``De``: its
+transition is written for the hip mass directly (Kuo 2002, Eq. 2 and its appendix).
+Flat feet: :class:`FlatPushOff`.
 
 States stay the walker's own (role-ordered ``(2n,)``): nothing here knows their number.
 """
@@ -116,6 +119,14 @@ class PushOffTransition(Transitions):
         (affine in ``q``: central differences of unit step are exact), since a kneed leg's
         thigh and shank both take the straight leg's rate."""
         self.lock = lock
+        self.swap_from_reset()
+
+    def swap_from_reset(self) -> None:
+        """Take the role swap's rate map ``R`` (n, n) from the generated reset's positions
+        (affine in ``q``: central differences of unit step are exact): the swap of every
+        coordinate, where the legs' absolute angles alone do not fix it (a locked knee's
+        thigh and shank, a free-jointed walker's links, McGeer 1990; Westervelt et al.
+        2003, Sec. III-B)."""
         n, z = self.n, np.zeros(self.n)
         pos = self.fns["reset"]
         self.R = np.stack([(np.real(pos(np.concatenate([e, z])))[:n]
@@ -252,12 +263,18 @@ class FlatPushOff(Transitions):
     pin : str or None
         ``heel`` or ``toe``: the pinned point of the mode the heel strike ends (None: read
         from the foot's angle, as the generated ``points``).
+    torques : Actuators or None
+        Joint torques acting with it (:class:`walkerlab.models.hybrid.actuators.Actuators`
+        on the flat-foot modes, :mod:`walkerlab.models.hybrid.flat_hip_torque`): their
+        ``links``, ``power`` and per-step hook are read through this object.  Finite
+        torques add no impulse: the transition is the same.
     """
 
     spec: object
     fns: dict
     ankle_push: object = None
     pin: str | None = None
+    torques: object = None
 
     limit = False
 
@@ -265,8 +282,20 @@ class FlatPushOff(Transitions):
         self._memo: dict = {}
         self.ankle = None if self.ankle_push is None else self.ankle_push.ankle
 
+    @property
+    def links(self) -> list:
+        """The joint torques' ``(first, second)`` links (empty without torques)."""
+        return [] if self.torques is None else self.torques.links
+
+    def power(self, t, x) -> float:
+        """Mechanical power of the joint torques [W] (0 without torques; the ankle
+        push-off's is ``torque(a) da/dt`` in heel off, apart)."""
+        return 0.0 if self.torques is None else self.torques.power(t, x)
+
     def begin_step(self, t0: float) -> None:
-        """No time-based law here (the integrator's per-step hook)."""
+        """The integrator's per-step hook (the joint torques' time origin, if any)."""
+        if self.torques is not None:
+            self.torques.begin_step(t0)
 
     def torque(self, a: float) -> float:
         """The ankle push-off's torque [N m] at ankle angle ``a`` [rad] (0 without one)."""
@@ -274,7 +303,7 @@ class FlatPushOff(Transitions):
 
     def at(self, pin: str) -> FlatPushOff:
         """The transition of the mode pinned at ``pin`` (``heel`` or ``toe``)."""
-        return FlatPushOff(self.spec, self.fns, self.ankle_push, pin)
+        return FlatPushOff(self.spec, self.fns, self.ankle_push, pin, self.torques)
 
     def _pin(self, x) -> str:
         """The pinned point: this transition's, else the toe once the foot's angle from the
@@ -313,7 +342,7 @@ class FlatPushOff(Transitions):
                 "impulse": P, "ke_minus": ke[0], "ke_push_off": ke[1], "ke_plus": ke[2]}
 
 
-def push_off_flat(walker, fns: dict, spec, ankle_push=None):
+def push_off_flat(walker, fns: dict, spec, ankle_push=None, torques=None):
     """The flat-footed ``walker`` with the push-off at its trailing toe before every heel
     strike (:class:`FlatPushOff`: each phase's heel-strike guard gets its mode's transition,
     its Jacobian by the complex step).
@@ -327,13 +356,15 @@ def push_off_flat(walker, fns: dict, spec, ankle_push=None):
     spec : walkerlab.config.actuation.Actuation
     ankle_push : AnklePushOffActuator, optional
         An ankle push-off acting in heel off as well.
+    torques : Actuators, optional
+        Joint torques acting as well (already in ``walker``'s flows).
 
     Returns
     -------
     HybridWalker
         With ``actuators`` the :class:`FlatPushOff` (its pin read from the state).
     """
-    acts = FlatPushOff(spec, fns, ankle_push)
+    acts = FlatPushOff(spec, fns, ankle_push, torques=torques)
     by_pin = {pin: acts.at(pin) for pin in ("heel", "toe")}
 
     def jac(tr):

@@ -34,9 +34,11 @@ DOP853 at 1e-12) from ``x_0`` with the optimised torque as a function of time (p
 quadratic through the points, Hermite-Simpson's control), until its heel strike, then the
 same reset; the return error ``|x_0' - x_0|`` is stored.
 
-Straight legs with point feet (the walkers whose push-off the rigid view carries in
-extended coordinates), or massless legs with a hip mass (Kuo's 2002 walker: the torque per
-foot mass on the swing leg's row, the point hip's transition); one hip torque.
+Straight legs with point or arc feet, a torso on the bisecting hip (the push-off at the
+trailing foot's material contact point through the generated extended impact, as the rigid
+view's :mod:`walkerlab.models.hybrid.push_off`), or massless legs with a hip mass (Kuo's
+2002 walker: the torque per foot mass on the swing leg's row, the point hip's transition);
+one hip torque.
 """
 
 from __future__ import annotations
@@ -188,7 +190,8 @@ def step_functions(data, eq):
     Raises
     ------
     ValueError
-        Knees, arc or flat feet, a torso, partly massless legs (one line).
+        Knees or flat feet (a step of phases), partly massless legs, legs that differ
+        (one line).
     """
     import casadi as ca
     import sympy as sp
@@ -231,10 +234,8 @@ def step_functions(data, eq):
     rate = ca.jacobian(hip_angle, x[:n]) @ x[n:]
     if limit:
         reset, work = _reset_point_hip(eq, xs, vals, x, P, data.total_mass_kg)
-    elif st.foot == "point":  # the extended impact (an upper body rides on the hip)
+    else:  # the extended impact (an upper body rides on the hip; an arc's rolling contact)
         reset, work = _reset_extended(eq, xs, vals, x, P, data.total_mass_kg)
-    else:  # arc feet: the generated plastic heel strike (no push-off)
-        reset, work = _reset_plastic(eq, xs, vals, x, P)
     return {"flow": ca.Function("flow", [x, u], [ca.vertcat(x[n:], qdd)]),
             "guard": fn("guard", [eq.guards["heel_strike"]]),
             "guard_rate": ca.Function("guard_rate", [x, u], [ca.jacobian(
@@ -264,7 +265,10 @@ def _relabel(eq, xs, vals, x, dq_plus):
 
 def _reset_extended(eq, xs, vals, x, P, _mass):
     """Push-off + heel strike in extended coordinates ``[q, x_f, y_f]``
-    (:mod:`walkerlab.models.hybrid.actuated`), and the push-off's work [J]."""
+    (:mod:`walkerlab.models.hybrid.push_off`: the impulse at the trailing foot's material
+    contact point - a point foot, an arc's rolling contact ``stance_contact`` - from it to
+    the hip; the generated ``De, E``, an arc's ``E`` at the leading arc's material contact
+    point), and the push-off's work [J]."""
     import casadi as ca
     import sympy as sp
 
@@ -273,6 +277,8 @@ def _reset_extended(eq, xs, vals, x, P, _mass):
     De = casadi_function(eq.De.subs(fs), xs, vals)(x)
     E = casadi_function(eq.E.subs(fs), xs, vals)(x)
     hip = casadi_function(eq.points["hip"], xs, vals)(x)
+    if "stance_contact" in eq.points:  # an arc foot: from its rolling contact point
+        hip = hip - casadi_function(eq.points["stance_contact"], xs, vals)(x)
     e = hip / ca.sqrt(hip[0] ** 2 + hip[1] ** 2)
     dqe = ca.vertcat(x[n:], 0, 0)
     Ef = ca.horzcat(ca.SX.zeros(2, n), ca.SX.eye(2))
@@ -281,19 +287,6 @@ def _reset_extended(eq, xs, vals, x, P, _mass):
     sol = ca.solve(K, ca.vertcat(De @ dqe_po, 0, 0))
     work = 0.5 * (dqe_po.T @ De @ dqe_po - dqe.T @ De @ dqe)
     return _relabel(eq, xs, vals, x, sol[:n]), work
-
-
-def _reset_plastic(eq, xs, vals, x, P):
-    """The heel strike of any straight-legged walker from its generated model, without a
-    push-off: the plastic impact ``Mi dq+ = B dq-`` (:mod:`walkerlab.codegen.symbolic`,
-    the map the rigid model's generated code prints) and the role swap; the push-off's
-    work 0 (arc feet: their push-off is refused by :func:`collocate_step`)."""
-    n = len(eq.q)
-    import casadi as ca
-
-    dq_plus = ca.solve(casadi_function(eq.Mi, xs, vals)(x),
-                       casadi_function(eq.B, xs, vals)(x) @ x[n:])
-    return _relabel(eq, xs, vals, x, dq_plus), 0 * P
 
 
 def _reset_point_hip(eq, xs, vals, x, P, mass):
@@ -383,10 +376,6 @@ def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
     """
     import casadi as ca
 
-    if data.structure.foot == "arc" and (spec.push_off_free or spec.push_off_n_s):
-        raise ValueError("optimize: a push-off on arc feet (at the rolling contact point) "
-                         "is not in the rigid model yet; optimise the hip torque alone "
-                         "(no walker.actuation.push_off, optimize.push_off: fixed)")
     fns = fns or step_functions(data, eq)
     n2, N = 2 * fns["n"], int(spec.intervals)
     K = 2 * N + 1
@@ -659,8 +648,7 @@ def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
                      torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6,
                                           scaled_by="foot_mass" if massless else "none")])
     passive = make_rigid_walker(data, "biped", "derived")
-    walker = (_hip_torque_walker(passive, data, spec.model_copy(update={"push_off": None}))
-              if st.foot == "arc" else actuate(passive, data, spec))
+    walker = actuate(passive, data, spec)
     acts = walker.actuators
     tau = torque_of_time(res)
     acts.torques = lambda t, x: np.array([tau(float(np.real(t)) - acts.t_origin)])
@@ -672,39 +660,3 @@ def replay(data, res: CollocationResult, solver=None) -> tuple[float, object]:
     if seg.termination != "heel_strike":
         return float("inf"), walker
     return float(np.max(np.abs(seg.x_next - res.x[0]))), walker
-
-
-def _hip_torque_walker(walker, data, spec):
-    """The rigid ``walker`` (arc feet, whose actuation the model layer does not take yet)
-    with the hip torque of ``spec`` added to every phase's flow as ``M^-1 B tau``
-    (:class:`walkerlab.models.hybrid.actuators.Actuators` bound to the generated model; the
-    flow in Python, its Jacobian by the complex step), the passive heel strike kept."""
-    from dataclasses import replace
-
-    from walkerlab.codegen.cache import functions
-    from walkerlab.models.hybrid.actuators import Actuators
-    from walkerlab.models.hybrid.base import Phase
-
-    acts = Actuators(spec, functions(data), len(walker.roles), False,
-                     float(walker.total_mass_kg))
-    n = acts.n
-
-    def flow_of(flow):
-        def f(t, x):
-            out = np.array(flow(t, x), dtype=complex if np.iscomplexobj(x) else float)
-            out[n:] += acts.added_acceleration(t, x)
-            return out
-        return f
-
-    def jac_of(jac):
-        def J(t, x):
-            base = np.array(jac(t, x), float)
-            base[n:] += acts.acceleration_jacobian(t, x)
-            return base
-        return J
-
-    phases = tuple(Phase(ph.name, flow_of(ph.flow), ph.guards,
-                         jacobian=jac_of(ph.jacobian or walker.variational))
-                   for ph in walker.phases)
-    return replace(walker, phases=phases, variational=jac_of(walker.variational),
-                   actuators=acts)
