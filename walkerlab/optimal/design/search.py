@@ -5,7 +5,7 @@ the root finder at the last gait found, so the optimiser never jumps to another 
 Measures (of the period-1 gait ``x*(p)`` of the rigid model): ``step_period`` [s],
 ``step_length`` [m], ``speed`` [m/s], ``cost_of_transport`` [-] (the energy ledger's,
 :mod:`walkerlab.analysis.gait.energy`), ``max_abs_multiplier`` [-] and the robustness
-measures of :mod:`walkerlab.optimal.design.search.measures` (``gait_sensitivity_norm``,
+measures of :mod:`walkerlab.optimal.design.measures` (``gait_sensitivity_norm``,
 ``basin_share``, ``mfpt``).
 
 Gradients of the smooth measures are exact through the fixed point (the implicit function
@@ -136,8 +136,8 @@ class _Gaits:
 
     def value(self, p, name: str) -> float:
         """A measure that is not one map's (``max_abs_multiplier`` and
-        :data:`walkerlab.optimal.design.search.measures.ROBUSTNESS_MEASURES`) at ``p``."""
-        from walkerlab.optimal.design.search.measures import robustness_measure
+        :data:`walkerlab.optimal.design.measures.ROBUSTNESS_MEASURES`) at ``p``."""
+        from walkerlab.optimal.design.measures import robustness_measure
 
         w, fp = self.gait(p)
         if name == "max_abs_multiplier":
