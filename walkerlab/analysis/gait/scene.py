@@ -29,6 +29,8 @@ def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
     own = (scene.ideal.variant,)
     if getattr(scene.walker, "actuation", None) is not None:  # the printed ones are passive
         return own
+    if scene.terrain is not None and not scene.terrain.is_slope:  # ... and on the slope
+        return own
     if compare and scene.walker.model == "compass_gait" and scene.published is not None:
         from walkerlab.models.hybrid.printed_equations import VARIANTS
 
