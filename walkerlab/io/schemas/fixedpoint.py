@@ -285,6 +285,9 @@ class FixedPointArtifact(GaitResult):
         The resolved scene the gait was computed for (JSON).
     ground_contact : GroundContactRecord or None
         Whether the gait needs only a ground that pushes (None in artifacts without it).
+    footholds : dict or None
+        On stairs: ``footholds/``'s attributes (:class:`walkerlab.analysis.gait.treads.
+        TreadLanding` fields by name); None on a slope.
     """
 
     path: Path = Path()
@@ -301,6 +304,7 @@ class FixedPointArtifact(GaitResult):
     variants: dict = field(default_factory=dict)
     scene_json: str = "{}"
     ground_contact: GroundContactRecord | None = None
+    footholds: dict | None = None
 
 
 def load_fixedpoint(path: Path) -> FixedPointArtifact:
@@ -326,4 +330,6 @@ def load_fixedpoint(path: Path) -> FixedPointArtifact:
                    for lab in f.attrs.get("gaits", [])} if "gaits" in f else {},
             variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
             if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")),
-            ground_contact=_ground(f))
+            ground_contact=_ground(f),
+            footholds={k: (v.item() if hasattr(v, "item") else v)
+                       for k, v in f["footholds"].attrs.items()} if "footholds" in f else None)
