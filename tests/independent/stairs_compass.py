@@ -24,6 +24,8 @@ the legs swap roles.  Poincaré section: just after heel strike, where the new s
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import fsolve
@@ -42,8 +44,8 @@ class StairsCompass:
         p_sw, p_st, w_sw, w_st = x
         L, m, mh, a, b, g = self.L, self.m, self.mh, self.a, self.b, self.g
         c, s = np.cos(p_st - p_sw), np.sin(p_st - p_sw)
-        I = mh * L**2 + m * a**2 + m * L**2
-        M = np.array([[m * b**2, -m * L * b * c], [-m * L * b * c, I]])
+        inertia = mh * L**2 + m * a**2 + m * L**2
+        M = np.array([[m * b**2, -m * L * b * c], [-m * L * b * c, inertia]])
         rhs = -np.array([m * L * b * s * w_st**2 + m * g * b * np.sin(p_sw),
                          -m * L * b * s * w_sw**2 - g * (mh * L + m * a + m * L) * np.sin(p_st)])
         acc = np.linalg.solve(M, rhs)
@@ -112,10 +114,12 @@ class StairsCompass:
 
     def fixed_point(self, x0):
         z0 = np.array([x0[1], x0[2], x0[3]])
-        z = fsolve(lambda z: self.map(self.from_z(z))[1:] - z, z0, xtol=1e-14)
+        with warnings.catch_warnings():  # "no further improvement": at round-off
+            warnings.simplefilter("ignore", RuntimeWarning)
+            z = fsolve(lambda z: self.map(self.from_z(z))[1:] - z, z0, xtol=1e-14)
         return self.from_z(z)
 
-    def multipliers(self, x, h=2e-4):
+    def multipliers(self, x, h=1e-4):
         """Eigenvalues of the section map's Jacobian (3 x 3, five-point differences), with
         the zero multiplier of the full-state map appended; sorted by modulus."""
         z = x[1:]

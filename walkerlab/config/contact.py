@@ -43,6 +43,10 @@ def _list_to_tuple(v):
     return tuple(v) if isinstance(v, list) else v
 
 
+def _points_to_tuples(v):
+    return tuple(_list_to_tuple(p) for p in v) if isinstance(v, list) else v
+
+
 #: Metres per length unit of a contact field's name (``..._mm``: ADAMS's default mm-kg-s
 #: units, as the paper's numbers are read; ``..._m``: SI).
 LENGTH_UNITS = {"mm": 1e-3, "m": 1.0}
@@ -440,7 +444,8 @@ class TerrainSettings(BaseModel):
         "slope)", json_schema_extra={"unit": "rad"})
     periodic: bool | None = Field(
         None, description="footholds: repeat the list (default true); false: finite ground")
-    profile_m: tuple[tuple[float, float], ...] | None = Field(
+    profile_m: Annotated[tuple[tuple[float, float], ...] | None,
+                         BeforeValidator(_points_to_tuples)] = Field(
         None, description="profile: points [[x, y], ...] of a piecewise-linear ground height "
         "y(x) [m], x increasing", json_schema_extra={"unit": "m"})
     profile_csv: str | None = Field(
