@@ -123,7 +123,7 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     walkerlab.io.artifacts.ArtifactError
         ``fixedpoint.h5`` is missing or unreadable.
     """
-    if scene.terrain is not None and not scene.terrain.is_slope:  # (issue 49, item 3)
+    if scene.terrain is not None and not scene.terrain.is_slope:  # no contact geometry yet
         raise StageError(f"terrain.kind: {scene.terrain.kind}: the contact model walks on "
                          "the slope only (contact geometry of stairs, footholds and profiles "
                          "is not built yet)")
