@@ -358,18 +358,6 @@ class PerStepTerrain(BaseModel):
     slope_sd_rad: float = Field(0.0, ge=0, le=0.2,
                                 description="standard deviation of each step's slope [rad]")
     seed: int = Field(0, ge=0, description="seed of the per-step draws [-]")
-    height_sd_m: float | None = Field(
-        None, ge=0, le=1, description="standard deviation of each step's landing height "
-        "[m] (a step up or down at every footfall, drawn like the slopes from the same seed; "
-        "default none)", json_schema_extra={"unit": "m"})
-
-    @model_serializer(mode="wrap")
-    def _drop_unset_height(self, handler):
-        # per-step slopes alone serialise as before (same content hashes)
-        d = handler(self)
-        if isinstance(d, dict) and d.get("height_sd_m", 0) is None:
-            d.pop("height_sd_m")
-        return d
 
 
 #: Ground kinds of the ``terrain`` section (:class:`TerrainSettings`); ``slope`` is the
