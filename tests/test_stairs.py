@@ -190,3 +190,13 @@ def test_stairs_refused_where_not_modelled(paper_scene):
     d["ideal"] = {"variant": "appendix_a"}
     with pytest.raises(ValueError, match="ideal.variant: derived"):
         build_walker(scene_from_dict(d))
+
+
+def test_stairs_drawn_as_a_polyline_under_the_walker():
+    from walkerlab.plotting.animation import stairs_polyline
+
+    x, y = stairs_polyline(0.01, 0.4, "down", 0.1, np.array([-0.5, 0.9]))
+    # the first stance foot (origin) stands 0.1 m into its tread, at height 0
+    i = np.flatnonzero((x[::2] <= 0) & (x[1::2] >= 0))[0]
+    assert (x[2 * i], x[2 * i + 1], y[2 * i]) == pytest.approx((-0.1, 0.3, 0.0))
+    assert np.all(np.diff(y[::2]) == pytest.approx(-0.01)) and x.min() <= -0.5 <= 0.9 <= x.max()
