@@ -200,3 +200,33 @@ def test_stairs_drawn_as_a_polyline_under_the_walker():
     i = np.flatnonzero((x[::2] <= 0) & (x[1::2] >= 0))[0]
     assert (x[2 * i], x[2 * i + 1], y[2 * i]) == pytest.approx((-0.1, 0.3, 0.0))
     assert np.all(np.diff(y[::2]) == pytest.approx(-0.01)) and x.min() <= -0.5 <= 0.9 <= x.max()
+
+
+def test_footholds_of_one_height_are_a_landing_and_others_are_refused(paper_scene):
+    from walkerlab.models.registry import build_walker
+
+    sc = load_scene(ROOT / "configs" / "footholds.yaml")
+    w = build_walker(sc)
+    assert w.params["landing_drop_m"] == 0.005  # 5 mm below: the guard's offset
+    x = np.array([0.25, -0.2, -0.6, -0.9])
+    slope = build_walker(paper_scene)
+    # the heel strike: the swing foot 5 mm below the slope line (along its normal)
+    assert w.heel_strike_guard(0.0, x) == pytest.approx(
+        _clearance(slope, x) + 0.005 * np.cos(paper_scene.slope.phi_rad), abs=1e-15)
+    d = sc.model_dump(mode="json")
+    for terrain, words in (({"kind": "footholds", "foothold_heights_m": [0.0, -0.01]},
+                            "different heights"),
+                           ({"kind": "footholds", "foothold_slopes_rad": [0.01]},
+                            "own slopes"),
+                           ({"kind": "profile", "profile_m": [[0, 0], [1, -0.1]]},
+                            "profiles are not built")):
+        d["terrain"] = terrain
+        with pytest.raises(ValueError, match=words):
+            build_walker(scene_from_dict(d))
+
+
+def _clearance(walker, x):
+    """The swing foot's lowest point above the slope line through the stance foot [m]."""
+    p = walker.points(x)["swing_foot"]
+    phi = walker.slope_rad
+    return float(p[0] * np.sin(phi) + p[1] * np.cos(phi))

@@ -361,7 +361,8 @@ class PerStepTerrain(BaseModel):
 
 
 #: Ground kinds of the ``terrain`` section (:class:`TerrainSettings`); ``slope`` is the
-#: scene's straight ramp (``slope.angle_*``), the ground every scene had before stairs, footholds and profiles.
+#: scene's straight ramp (``slope.angle_*``), the ground of every scene before stairs,
+#: footholds and profiles.
 GROUND_KINDS = ("slope", "stairs", "footholds", "profile")
 #: The contact model's lanes (:attr:`TerrainSettings.lanes`), once written as ``kind``.
 LANE_KINDS = ("checkerboard", "continuous")

@@ -40,13 +40,14 @@ __all__ = ["landing_drop", "on_landing"]
 
 def landing_drop(terrain) -> float:
     """Depth [m] of each step's landing below the stance foot's level for a ground whose
-    every step is alike (``terrain.kind: stairs``: ``+riser_m`` down, ``-riser_m`` up);
-    0.0 for the slope.
+    every step is alike (``terrain.kind: stairs``: ``+riser_m`` down, ``-riser_m`` up;
+    ``footholds`` of one height ``h``: ``-h``, on the scene's slope); 0.0 for the slope.
 
     Raises
     ------
     ValueError
-        A ground whose steps differ (footholds, a profile): one line.
+        A ground whose steps differ (footholds of several heights or of their own slopes,
+        a profile): one line.
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
@@ -54,12 +55,17 @@ def landing_drop(terrain) -> float:
         return float(terrain.riser_m) * (-1.0 if terrain.direction == "up" else 1.0)
     if terrain.kind == "footholds":
         h = set(terrain.foothold_heights_m or (0.0,))
-        g = set(terrain.foothold_slopes_rad or ())
-        if len(h) == 1 and len(g) <= 1:
+        if terrain.foothold_slopes_rad is not None:
+            raise ValueError("terrain.foothold_slopes_rad: footholds of their own slopes are "
+                             "not built in the rigid model yet (the scene's slope is every "
+                             "foothold's)")
+        if len(h) == 1:
             return -float(h.pop())
-    raise ValueError(f"terrain.kind: {terrain.kind}: its steps differ; the rigid walker's "
-                     "period-1 gait needs one ground for every step (stairs, or footholds of "
-                     "one height)")
+        raise ValueError("terrain.foothold_heights_m: footholds of different heights are not "
+                         "built in the rigid model yet (its period-1 gait needs one landing "
+                         "height for every step)")
+    raise ValueError(f"terrain.kind: {terrain.kind}: the rigid model walks slopes, stairs "
+                     "and footholds of one height; height profiles are not built yet")
 
 
 def _clearance_names(f: dict) -> str:
