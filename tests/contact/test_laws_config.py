@@ -98,7 +98,7 @@ def test_bad_inputs_name_the_field(kw, field):
 
 
 def test_other_settings():
-    assert TerrainSettings().kind == "checkerboard"
+    assert TerrainSettings().lanes == "checkerboard"
     with pytest.raises(ValidationError, match="patch_width_m"):
         TerrainSettings(patch_width_m=0)
     with pytest.raises(ValidationError, match="pin_stance_until"):

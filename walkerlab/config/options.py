@@ -157,9 +157,9 @@ def map_not_applicable(scene: Scene, kind: str) -> str:
     does (a patch-width map needs the checkerboard terrain: on continuous ground there are
     no patches)."""
     terrain = scene.terrain
-    if kind == "patch_width" and terrain is not None and terrain.kind != "checkerboard":
+    if kind == "patch_width" and terrain is not None and terrain.lanes != "checkerboard":
         return (f"stability-map --kind patch_width does not apply to scene '{scene.name}': "
-                f"its terrain is {terrain.kind} ground, which has no patches (terrain.kind)")
+                f"its terrain is {terrain.lanes} ground, which has no patches (terrain.lanes)")
     return ""
 
 

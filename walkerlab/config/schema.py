@@ -174,6 +174,21 @@ class Scene(Strict):
         return self
 
     @model_validator(mode="after")
+    def _ground_fits_the_walker(self) -> Scene:
+        t = self.terrain
+        if t is None or t.kind != "stairs":
+            return self
+        if self.slope.phi_rad != 0:
+            raise ValueError(f"slope: terrain.kind: stairs has level treads; the slope must "
+                             f"be 0 (is {self.slope.phi_rad:g} rad)")
+        foot = getattr(getattr(self.walker, "leg", None), "foot", None)
+        length = (foot.heel_m + foot.toe_m) if getattr(foot, "kind", "") == "flat" else 0.0
+        if not t.tread_m > length:
+            raise ValueError(f"terrain.tread_m: {t.tread_m:g} m is shorter than the walker's "
+                             f"foot ({length:g} m heel to toe)")
+        return self
+
+    @model_validator(mode="after")
     def _published_exists(self) -> Scene:
         if self.published is not None:
             from walkerlab.published import available
@@ -240,6 +255,8 @@ class Scene(Strict):
         out = {n: d.get(n) for n in names}
         if self.units != "SI":  # labels of every artifact follow the unit system
             out["units"] = self.units
+        if "slope" in names and self.terrain is not None and not self.terrain.is_slope:
+            out["ground"] = self.terrain.ground()  # the rigid model walks on it
         return json.dumps(out, sort_keys=True)
 
     def section_hash(self, *names: str) -> str:

@@ -906,7 +906,7 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     check_adams_actuation(scene)
     start = start or adams_start(scene, mb, data)
     settings = scene.contact or ContactSettings()
-    lanes = (scene.terrain or TerrainSettings()).kind == "checkerboard" and \
+    lanes = (scene.terrain or TerrainSettings()).lanes == "checkerboard" and \
         start.lanes is not None
     law = contact_mm(settings)
     ids = part_ids(mb)

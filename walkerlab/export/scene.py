@@ -183,7 +183,7 @@ def _patch_ahead(scene: Scene, terrain: TerrainSettings, roll: float) -> tuple[f
     """Ground to add ahead of each patch for an arc foot's roll, and the note saying so; a
     warning on stderr where the scene's patch is narrower than the roll."""
     half = terrain.patch_width_m / 2
-    if terrain.kind != "checkerboard" or roll <= half:
+    if terrain.lanes != "checkerboard" or roll <= half:
         return 0.0, ()
     from walkerlab import progress
 
@@ -251,7 +251,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         feet = None
     dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)
     lanes = None
-    if terrain.kind == "checkerboard":
+    if terrain.lanes == "checkerboard":
         # the keyframe's feet are one step apart: leg2's step, the last of the gait's map
         ell2 = ideal_step_length(walker, ideal.x)
         ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())

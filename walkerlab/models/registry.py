@@ -36,7 +36,7 @@ def build_walker(scene) -> HybridWalker:
         The scene names a walker model or variant that has no rigid hybrid implementation,
         or actuators the walker cannot carry (one line).
     """
-    walker = _passive(scene)
+    walker = _on_ground(scene, _passive(scene))
     act = getattr(scene.walker, "actuation", None)
     if act is None:
         return walker
@@ -47,6 +47,22 @@ def build_walker(scene) -> HybridWalker:
         raise ValueError("walker.actuation: only with ideal.variant: derived (the printed "
                          "Appendix A equations are passive)")
     return actuate(walker, walker_data(scene.walker, scene.slope.phi_rad), act)
+
+
+def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
+    """The walker on the scene's ``terrain`` (stairs: the heel strike at the next tread,
+    :func:`walkerlab.models.hybrid.ground.on_landing`); a slope: ``walker`` itself."""
+    from walkerlab.models.hybrid.ground import landing_drop, on_landing
+
+    drop = landing_drop(scene.terrain)
+    if drop == 0.0:
+        return walker
+    from walkerlab.walker.description import walker_data
+
+    if walker.variant != "derived":
+        raise ValueError("terrain.kind: stairs and footholds need ideal.variant: derived "
+                         "(the printed Appendix A equations know only the slope)")
+    return on_landing(walker, walker_data(scene.walker, scene.slope.phi_rad), drop)
 
 
 def _passive(scene) -> HybridWalker:

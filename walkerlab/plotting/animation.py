@@ -172,7 +172,8 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
         Resolution of the saved frames; the figure is at least :data:`MIN_WIDTH_PX` wide.
     terrain : dict, optional
         Panel title -> the contact walker's ground (:func:`walkerlab.io.terrain.
-        load_terrain`): its checkerboard patches are drawn under that panel's slope line.
+        load_terrain`): its checkerboard patches are drawn under that panel's slope line;
+        or ``{"stairs": (riser_m, tread_m, direction, first_foothold_m)}``: the stairs.
 
     Returns
     -------
@@ -214,11 +215,37 @@ def walker_animation(trajs: dict[str, NamedTrajectory], slope_rad: float, fps: f
     return WalkerFrames(fig, times, draw, dpi)
 
 
+def stairs_polyline(riser_m: float, tread_m: float, direction: str, first_m: float,
+                    gx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Stairs as a polyline in world axes over ``[gx.min(), gx.max()]`` [m]: the first
+    stance foot at the origin, ``first_m`` from the back of its tread; each tread
+    ``tread_m`` deep, ``riser_m`` lower (``direction`` "down") or higher ("up") than the last.
+
+    Returns
+    -------
+    x, y : ndarray, shape (2k,)
+        Vertices (each tread's back and front end).
+    """
+    sign = 1.0 if direction == "up" else -1.0
+    k0 = int(np.floor((gx.min() + first_m) / tread_m))
+    k1 = int(np.ceil((gx.max() + first_m) / tread_m))
+    ks = np.arange(k0, k1 + 1)
+    xs = np.column_stack([ks * tread_m - first_m, (ks + 1) * tread_m - first_m]).ravel()
+    ys = np.repeat(sign * riser_m * ks, 2).astype(float)
+    return xs, ys
+
+
 def _draw_ground(ax, gx: np.ndarray, slope_rad: float, L: float, ground: dict | None) -> None:
-    """The slope line ``y = -x tan(phi)`` over ``gx`` (shaded below), or the contact walker's
-    patches over gaps (``ground``: :func:`walkerlab.io.terrain.load_terrain`)."""
+    """The slope line ``y = -x tan(phi)`` over ``gx`` (shaded below), the contact walker's
+    patches over gaps (``ground``: :func:`walkerlab.io.terrain.load_terrain`) or stairs
+    (``ground = {"stairs": (riser_m, tread_m, direction, first_foothold_m)}``,
+    :func:`stairs_polyline`)."""
     gy = -np.tan(slope_rad) * gx
-    if ground is not None and not ground["continuous"]:  # patches over gaps
+    if ground is not None and "stairs" in ground:  # the treads and risers, shaded below
+        sx, sy = stairs_polyline(*ground["stairs"], gx)
+        ax.fill_between(sx, sy, sy.min() - 3 * L, color="0.85", lw=0)
+        ax.plot(sx, sy, color="k", lw=1)
+    elif ground is not None and not ground["continuous"]:  # patches over gaps
         from walkerlab.plotting.figures import draw_patches
 
         draw_patches(ax, ground, slope_rad, 0.12 * L)

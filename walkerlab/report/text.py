@@ -97,6 +97,24 @@ def ground_contact_text(g, u) -> str:
             + f"; friction coefficient needed {v['max_friction_ratio']:.3g})")
 
 
+def footholds_text(fh: dict) -> str:
+    """Lines on a stair gait's footholds (``fixedpoint.h5``'s ``footholds/``, SI): step
+    advance, tread drift, the footfall that would miss a tread, the swing foot's clearances
+    over the tread behind, the stance tread and the riser edge ahead."""
+    miss = int(fh["steps_until_miss"])
+    edge = float(fh["riser_clearance_m"])
+    return "\n".join([
+        f"stairs ({fh['direction']}, riser {1e3 * fh['riser_m']:.4g} mm, tread "
+        f"{1e3 * fh['tread_m']:.4g} mm): step advance {1e3 * fh['step_advance_m']:.4f} mm, "
+        f"the foot drifts {1e3 * fh['drift_per_step_m']:+.4f} mm per tread",
+        f"  from {1e3 * fh['first_foothold_m']:.4g} mm on the first tread: "
+        + ("never misses a tread" if miss < 0 else f"footfall {miss} misses its tread"),
+        f"  swing-foot clearance: riser edge ahead {1e3 * edge:.4g} mm"
+        + (" (SCUFFS the riser: not modelled)" if fh["riser_scuff"] else "")
+        + f", stance tread {1e3 * fh['midstance_clearance_m']:.4g} mm (mid-stance "
+        f"foot-through as on a slope), tread behind {1e3 * fh['back_clearance_m']:.4g} mm"])
+
+
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     u, legs = fp.units, fp.legs_by_role
@@ -127,6 +145,8 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
                  f"{zero_multipliers_text(re, im, fp.state_names, fp.scene_json)})")
     if fp.ground_contact is not None:
         lines.append(ground_contact_text(fp.ground_contact, u))
+    if fp.footholds is not None:
+        lines.append(footholds_text(fp.footholds))
     lines += gaits_text(fp)
     return "\n".join(lines)
 

@@ -18,7 +18,7 @@ import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from walkerlab.config import Scene, SlopeSettings
+from walkerlab.config import Scene, SlopeSettings, TerrainSettings
 from walkerlab.io.runpaths import figures_dir, stage_artifact
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.io.schemas.simulate import load_simulate
@@ -62,7 +62,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", fps: float = FPS,
     elif contact.is_file():  # with the checkerboard it walks on
         trajs[CONTACT_LABEL] = load_contact_sim(contact).samples
         ground[CONTACT_LABEL] = load_terrain(contact)
-    slope = SlopeSettings.model_validate(json.loads(sim.scene_json)["slope"]).phi_rad
+    resolved = json.loads(sim.scene_json)
+    slope = SlopeSettings.model_validate(resolved["slope"]).phi_rad
+    if (resolved.get("terrain") or {}).get("kind") == "stairs":  # the rigid walker's stairs
+        t = TerrainSettings.model_validate(resolved["terrain"])
+        ground[IDEAL_LABEL] = {"stairs": (t.riser_m, t.tread_m, t.direction or "down",
+                                          t.tread_m / 2 if t.first_foothold_m is None
+                                          else t.first_foothold_m)}
     folder = figures_dir(scene, runs_root, claim=True)
     frames = walker_animation(trajs, slope, fps=fps, max_frames=max_frames,
                               time_unit=sim.units.time, terrain=ground)

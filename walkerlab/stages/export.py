@@ -117,7 +117,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     ------
     ValueError
         Unknown format, a walker with a massless link (a multibody model needs positive
-        masses), feet the formats cannot carry, or no rigid gait to start from; one line.
+        masses), feet the formats cannot carry, a ground other than the slope (stairs ...)
+        unless ``walker_only``, or no rigid gait to start from; one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
     walkerlab.io.artifacts.ArtifactError
@@ -126,6 +127,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         ``walker.acf``) are all written or all left as they were (one line).
     """
     path = export_path(scene, runs_root, fmt)  # check the format before building anything
+    if not walker_only and scene.terrain is not None and not scene.terrain.is_slope:
+        raise ValueError(f"terrain.kind: {scene.terrain.kind}: the exports carry a slope's "
+                         "ground only (boxes for stairs are not built yet); --walker-only "
+                         "writes the walker alone")
     data = walker_data(scene.walker, scene.slope.phi_rad)
     mb = multibody(data)
     name = scene.name or "walker"

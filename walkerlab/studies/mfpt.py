@@ -292,6 +292,9 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
     from walkerlab.models.registry import build_walker
 
+    if scene.terrain is not None and not scene.terrain.is_slope:
+        raise ValueError(f"terrain.kind: {scene.terrain.kind}: the MFPT study draws per-step "
+                         "slopes of a slope; on stairs, footholds or profiles it is not built")
     per = scene.terrain.per_step if scene.terrain is not None else None
     dist = per.slope_distribution if per is not None else "normal"
     seed = per.seed if per is not None else st.seed

@@ -29,6 +29,8 @@ def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
     own = (scene.ideal.variant,)
     if getattr(scene.walker, "actuation", None) is not None:  # the printed ones are passive
         return own
+    if scene.terrain is not None and not scene.terrain.is_slope:  # ... and on the slope
+        return own
     if compare and scene.walker.model == "compass_gait" and scene.published is not None:
         from walkerlab.models.hybrid.printed_equations import VARIANTS
 
@@ -191,9 +193,15 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
         except FixedPointNotFound as exc:
             results[variant] = exc
     ground = gait_ground_contact(scene, walker, main.x)
-    run = FixedPointRun(walker, search, results, scene.ideal.variant, other_guess, ground)
+    treads = None
+    if scene.terrain is not None and scene.terrain.kind == "stairs":
+        from walkerlab.analysis.gait.treads import tread_landing
+
+        treads = tread_landing(walker, main.x, scene.terrain, Solver.from_settings(scene.solver))
+    run = FixedPointRun(walker, search, results, scene.ideal.variant, other_guess, ground,
+                        treads)
     summary = {"walker": walker, "result": main, "gaits": search, "variants": dict(results),
-               "ground_contact": ground}
+               "ground_contact": ground, "footholds": treads}
     return run, summary
 
 

@@ -397,8 +397,10 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
     last = _short(last)
     if last and "standing" not in last:
         last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
-    if walker.slope_rad <= 0 and walker.actuators is None:
-        why = "a passive walker needs a downhill slope (slope > 0) or walker.actuation"
+    downhill = walker.slope_rad > 0 or walker.params.get("landing_drop_m", 0.0) > 0
+    if not downhill and walker.actuators is None:
+        why = ("a passive walker needs a downhill slope (slope > 0), stairs down or "
+               "walker.actuation")
     elif walker.actuators is not None and had_guess:
         why = ("the initial guess did not converge and the seeds are a passive walker's: "
                "the walker may have no period-1 gait here")

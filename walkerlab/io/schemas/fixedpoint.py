@@ -11,7 +11,9 @@ variant under ``variants/<variant>/`` (or its ``error`` attribute), each with:
 ``floquet/{variational,finite_difference}/{real,imag,jacobian}``,
 ``floquet/max_difference``, ``floquet/stable``, ``stats/`` (RHS evaluations, map
 evaluations, wall time [s]); ``ground_contact/`` (the selected gait: whether the ground only
-pushes, :data:`GROUND_FIELDS`).
+pushes, :data:`GROUND_FIELDS`); on stairs ``footholds/`` (attributes of
+:class:`walkerlab.analysis.gait.treads.TreadLanding`: step advance [m], tread drift per step
+[m], steps until a foot misses a tread, clearances [m]).
 """
 
 from __future__ import annotations
@@ -45,6 +47,9 @@ class FixedPointRun:
         Starting point of the other variants' root finder.
     ground : walkerlab.analysis.gait.checks.GroundContact or None
         Whether the selected gait's ground contact is unilateral (None: not computed).
+    footholds : walkerlab.analysis.gait.treads.TreadLanding or None
+        On stairs: the step advance, tread drift, steps until a foot misses a tread and the
+        swing foot's clearances (None: a slope).
     """
 
     walker: object
@@ -53,6 +58,7 @@ class FixedPointRun:
     own_variant: str
     other_guess: np.ndarray
     ground: object | None = None
+    footholds: object | None = None
 
 
 def _write_result(g, walker, res, guess) -> None:
@@ -121,6 +127,10 @@ def write_fixedpoint(f, run: FixedPointRun) -> None:
         grp.attrs["source"] = g.source
     if run.ground is not None:
         _write_ground(f.create_group("ground_contact"), run.ground)
+    if run.footholds is not None:  # stairs only: a slope's artifact is unchanged
+        fh = f.create_group("footholds")
+        for k, v in run.footholds.as_dict().items():
+            fh.attrs[k] = v
     for v, r in run.variants.items():
         if isinstance(r, Exception):
             f.create_group(f"variants/{v}").attrs["error"] = str(r)
@@ -275,6 +285,9 @@ class FixedPointArtifact(GaitResult):
         The resolved scene the gait was computed for (JSON).
     ground_contact : GroundContactRecord or None
         Whether the gait needs only a ground that pushes (None in artifacts without it).
+    footholds : dict or None
+        On stairs: ``footholds/``'s attributes (:class:`walkerlab.analysis.gait.treads.
+        TreadLanding` fields by name); None on a slope.
     """
 
     path: Path = Path()
@@ -291,6 +304,7 @@ class FixedPointArtifact(GaitResult):
     variants: dict = field(default_factory=dict)
     scene_json: str = "{}"
     ground_contact: GroundContactRecord | None = None
+    footholds: dict | None = None
 
 
 def load_fixedpoint(path: Path) -> FixedPointArtifact:
@@ -316,4 +330,6 @@ def load_fixedpoint(path: Path) -> FixedPointArtifact:
                    for lab in f.attrs.get("gaits", [])} if "gaits" in f else {},
             variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
             if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")),
-            ground_contact=_ground(f))
+            ground_contact=_ground(f),
+            footholds={k: (v.item() if hasattr(v, "item") else v)
+                       for k, v in f["footholds"].attrs.items()} if "footholds" in f else None)

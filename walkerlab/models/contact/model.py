@@ -306,7 +306,7 @@ class ContactWalker:
         o1, o2 = footprint_offsets(self.data)
         return dataclasses.replace(self, lane1=c1 + o1, lane2=c2 + o2,
                                    patch_half_width=0.5 * terrain.patch_width_m,
-                                   continuous=terrain.kind == "continuous")
+                                   continuous=terrain.lanes == "continuous")
 
     @property
     def structure(self):

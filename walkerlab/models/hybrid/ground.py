@@ -1,0 +1,185 @@
+"""The rigid walker on a ground other than its slope: the heel strike at a landing below (or
+above) the stance foot's level (stairs, footholds).
+
+The generated model of every point- or arc-footed biped has the swing foot's clearance above
+the slope line through the stance foot (``guard_swing_clearance``: its lowest point's
+distance along the slope's normal, :mod:`walkerlab.codegen.symbolic`; a free-jointed biped's
+heel-strike guard is that clearance itself).  A landing ``drop_m`` [m] below that line (a
+stair ``riser_m`` down; negative: up) is the same guard plus a constant,
+
+    ``heel_strike = swing_clearance + drop_m cos(gamma)``  (zero crossing downward),
+
+so the guard stays the generated, compiled one (:class:`walkerlab.codegen.compiled.
+CompiledFlow` carries the constant as the guard's offset) and nothing here knows a walker
+family.  The impact map is the walker's own (plastic, paper Eq. 5-8).  On level treads
+(``gamma = 0``) of stairs going down ``H``, the heel strike is the swing foot reaching
+``-H`` relative to the stance foot.
+
+Poincaré section: the state just after heel strike, where the new swing foot (the old stance
+foot) lies ``drop_m`` above the new stance foot's line: ``swing_clearance(x+) = drop_m
+cos(gamma)`` (both feet on their treads: for point feet exactly, for arc feet their lowest
+points).  The section keeps the coordinates the walker's own section keeps; the one it
+solves (and those tied to it, a locked knee's shank) comes from this surface by
+``scipy.optimize.newton`` with the generated gradient, started on the slope's surface.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from functools import partial
+
+import numpy as np
+from scipy.optimize import newton
+
+from walkerlab.codegen.cache import functions
+from walkerlab.models.hybrid.base import HybridWalker, Phase
+
+__all__ = ["landing_drop", "on_landing"]
+
+
+def landing_drop(terrain) -> float:
+    """Depth [m] of each step's landing below the stance foot's level for a ground whose
+    every step is alike (``terrain.kind: stairs``: ``+riser_m`` down, ``-riser_m`` up;
+    ``footholds`` of one height ``h``: ``-h``, on the scene's slope); 0.0 for the slope.
+
+    Raises
+    ------
+    ValueError
+        A ground whose steps differ (footholds of several heights or of their own slopes,
+        a profile): one line.
+    """
+    if terrain is None or terrain.kind == "slope":
+        return 0.0
+    if terrain.kind == "stairs":
+        return float(terrain.riser_m) * (-1.0 if terrain.direction == "up" else 1.0)
+    if terrain.kind == "footholds":
+        h = set(terrain.foothold_heights_m or (0.0,))
+        if terrain.foothold_slopes_rad is not None:
+            raise ValueError("terrain.foothold_slopes_rad: footholds of their own slopes are "
+                             "not built in the rigid model yet (the scene's slope is every "
+                             "foothold's)")
+        if len(h) == 1:
+            return -float(h.pop())
+        raise ValueError("terrain.foothold_heights_m: footholds of different heights are not "
+                         "built in the rigid model yet (its period-1 gait needs one landing "
+                         "height for every step)")
+    raise ValueError(f"terrain.kind: {terrain.kind}: the rigid model walks slopes, stairs "
+                     "and footholds of one height; height profiles are not built yet")
+
+
+def _clearance_names(f: dict) -> str:
+    if "guard_swing_clearance" in f:
+        return "swing_clearance"
+    return "heel_strike"  # a free-jointed biped: its heel strike is the clearance itself
+
+
+def _at(clearance, offset, t, x):
+    """``clearance(t, x) + offset``."""
+    return clearance(t, x) + offset
+
+
+class _LandingSection:
+    """``from_section`` of the post-impact surface ``swing_clearance(x) = level`` (see the
+    module docstring): the walker's own ``from_section`` (its slope's surface) as the start,
+    then the solved group of coordinates set to the root of the clearance."""
+
+    def __init__(self, walker: HybridWalker, clearance, gradient, level: float):
+        self.base, self.clearance, self.gradient, self.level = \
+            walker.from_section, clearance, gradient, level
+        m = 2 * walker.n_coordinates
+        keep = np.asarray(walker.section(np.arange(m, dtype=float)), dtype=float)
+        keep = [int(round(k)) for k in keep]
+        z = np.linspace(0.137, 0.419, len(keep)) * (-1.0) ** np.arange(len(keep))
+        x = np.asarray(walker.from_section(z), dtype=float)
+        dropped = [i for i in range(m) if i not in keep]
+        # a dropped coordinate equal to a kept one is tied to it (e.g. the shank's rate to
+        # the thigh's); the others are the solved group (one value)
+        self.group = [i for i in dropped if not any(x[i] == x[j] for j in keep)]
+
+    def __call__(self, z):
+        z = np.asarray(z)
+        if np.iscomplexobj(z):  # a complex step: the root's first-order change, exactly
+            x = self(z.real)
+            dx = np.imag(np.asarray(self.base(z)))
+            grad = np.asarray(self.gradient(x), dtype=float)
+            rest = [i for i in range(x.size) if i not in self.group]
+            dx[self.group] = -float(grad[rest] @ dx[rest]) / float(np.sum(grad[self.group]))
+            return x + 1j * dx
+        x = np.array(self.base(z), dtype=float)
+        g = self.group
+
+        def h(s):
+            x[g] = s
+            return self.clearance(0.0, x) - self.level
+
+        def dh(s):
+            x[g] = s
+            return float(np.sum(np.asarray(self.gradient(x))[g]))
+
+        s = newton(h, float(x[g[0]]), fprime=dh, tol=1e-15, maxiter=50)
+        x[g] = s
+        return x
+
+
+def on_landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
+    """``walker`` with its heel strike at a landing ``drop_m`` [m] below the slope line through
+    the stance foot (negative: above), the same for every step.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+        Built from the generated model of ``data`` (:func:`walkerlab.models.hybrid.rigid.
+        make_rigid_walker`), passive (actuators are added after).
+    data : walkerlab.walker.description.WalkerData
+        Its description (the generated functions' key).
+    drop_m : float
+        Landing depth [m] (stairs: the riser, negative going up).
+
+    Returns
+    -------
+    HybridWalker
+        The same walker (flows, impact maps, fall guards, points) with the heel-strike guard
+        ``swing_clearance + drop_m cos(gamma)`` and the section of the post-impact surface
+        ``swing_clearance = drop_m cos(gamma)``; ``params["landing_drop_m"]`` records the
+        drop.  ``drop_m == 0`` returns ``walker`` unchanged (today's guard, bit for bit).
+
+    Raises
+    ------
+    ValueError
+        A walker with flat feet (a heel-strike guard per foot mode) or printed equations
+        replacing the generated ones: one line.
+    """
+    if drop_m == 0.0:
+        return walker
+    if data.structure.foot == "flat":
+        raise ValueError("terrain.kind: flat feet on stairs or footholds are not supported yet "
+                         "(their heel strike is a guard per foot mode)")
+    f = functions(data)
+    name = _clearance_names(f)
+    clear, grad = f[f"guard_{name}"], f[f"grad_{name}"]
+    offset = float(drop_m) * math.cos(float(data.slope_rad))
+    phases = []
+    for ph in walker.phases:
+        guards, comp = list(ph.guards), ph.compiled
+        cg = list(comp.guards) if comp is not None and comp.guards is not None else None
+        for j, g in enumerate(guards):
+            if g.outcome != "heel_strike":
+                continue
+            guards[j] = replace(g, function=partial(_at, clear, offset), gradient=grad)
+            if cg is not None:
+                cg[j] = (name, offset)
+        if cg is not None:
+            comp = replace(comp, guards=tuple(cg), _memo={})
+        phases.append(Phase(ph.name, ph.flow, tuple(guards), jacobian=ph.jacobian,
+                            variational=ph.variational, compiled=comp,
+                            constraint=ph.constraint))
+    mirror = walker.mirror
+    if mirror is not None and data.mirror is not None:  # legs that differ: the next step's
+        mirror = on_landing(mirror, replace(data.mirror, mirror_params=None), drop_m)
+    return replace(walker, phases=tuple(phases),
+                   heel_strike_guard=partial(_at, clear, offset),
+                   from_section=_LandingSection(walker, clear, grad, offset),
+                   params={**walker.params, "landing_drop_m": float(drop_m)},
+                   mirror=mirror)
+
