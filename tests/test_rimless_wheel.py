@@ -140,3 +140,23 @@ def test_rimless_wheel_mfpt_matches_independent_monte_carlo():
         ref = _independent_mfpt(sd, 6000, 20000, seed=11)
         assert 10 < ref[0] < 1000
         assert abs(ours[0] - ref[0]) < 3 * math.hypot(ours[1], ref[1]), (sd, ours, ref)
+
+
+def test_rimless_wheel_basin_on_the_phase_plane():
+    """``basin.start: phase_plane``: a cell is the stance state itself (the wheel's section
+    has one coordinate).  A state with the energy to vault over its stance foot converges to
+    the gait; one without it (``w^2 < 2 g/L (1 - cos psi)``) falls backward (the energy
+    argument of Coleman, Chatterjee & Ruina 1997)."""
+    from walkerlab.studies.basin import CODE, BasinTask, run_basin_chunk
+
+    scene = load_scene(SCENE)
+    assert scene.basin.start == "phase_plane"
+    x_star = _walker().fixed_point().x
+    psi = 0.3
+    slow = math.sqrt(2 * G / L * (1 - math.cos(psi)))    # just enough to reach the top
+    # (2): rolling back (+0.25 rad/s) past the top, it turns before the top and rolls on
+    # (w-^2 = 0.25^2 + 2 g/L (cos 0.1 - cos 0.4727) gives w+^2 = 1.06 > the 0.95 needed)
+    cells = ((0, psi, -1.05 * slow), (1, psi, -0.95 * slow), (2, -0.1, 0.25))
+    out = {i: code for i, code, _, _ in run_basin_chunk(BasinTask(
+        scene.model_dump(mode="json"), tuple(x_star), cells))}
+    assert out == {0: CODE["converged"], 1: CODE["fell_backward"], 2: CODE["converged"]}
