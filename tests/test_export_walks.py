@@ -41,7 +41,8 @@ def _scene(name):
 #: and toe contacts).  configs/rabbit.yaml (free knees, knee torques) is checked elsewhere.
 REFUSED = {"flat_feet": "walker.leg.foot.kind", "flat_feet_push_off": "walker.leg.foot.kind",
            "kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
-           "simplest": "walker.leg.bodies", "flat_feet_optimal": "walker.leg.foot.kind"}
+           "simplest": "walker.leg.bodies", "flat_feet_optimal": "walker.leg.foot.kind",
+           "rimless_wheel": "walker.model"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py); its walker is rabbit's (tests/test_export_five_link.py)
 #: kneed_optimal: kneed's walker (its MuJoCo walk needs kneed's knee latch: configs/kneed.yaml)
