@@ -160,3 +160,15 @@ def test_rimless_wheel_basin_on_the_phase_plane():
     out = {i: code for i, code, _, _ in run_basin_chunk(BasinTask(
         scene.model_dump(mode="json"), tuple(x_star), cells))}
     assert out == {0: CODE["converged"], 1: CODE["fell_backward"], 2: CODE["converged"]}
+
+
+def test_rimless_wheel_floating_view_is_refused_in_one_line():
+    """No contact model or URDF/MJCF/Adams export yet: one line naming walker.model, from
+    the floating view's and the multibody export's common check."""
+    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.multibody import multibody
+
+    scene = load_scene(SCENE)
+    with pytest.raises(ValueError) as exc:
+        multibody(walker_data(scene.walker, scene.slope.phi_rad))
+    assert str(exc.value).startswith("walker.model: rimless_wheel") and "\n" not in str(exc.value)
