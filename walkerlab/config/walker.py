@@ -468,6 +468,12 @@ class RimlessWheelParams(Strict):
                                             "inertia of the wheel about its hub [kg m^2] "
                                             "(null: a point mass, 0)")
 
+    @property
+    def actuation(self) -> None:
+        """The wheel is passive: no ``actuation`` section (a key given is refused as any
+        unknown key)."""
+        return None
+
 
 # ``model`` is the discriminator; "compass_gait" is the paper's shorthand for a biped with a
 # hip mass and one point mass per leg (expanded by walkerlab.walker.description).
