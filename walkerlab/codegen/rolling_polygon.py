@@ -21,6 +21,8 @@ decreasing).  With the hub at ``L (-sin q, cos q)`` from the stance foot:
   dq-``); the new stance spoke is the old one turned by a spoke, ``q -> q + 2 alpha``;
 - fall: ``rolls_back``, the rate ``dq`` rising through zero (the wheel stops before
   vaulting over the stance foot and rolls back uphill);
+- ``swing_clearance``: the next spoke's foot above the slope line through the stance foot
+  (the step-down studies' guard: the heel strike on ground ``drop`` lower);
 - Poincaré section: the state just after heel strike, ``q = alpha - gamma`` (the previous
   stance foot still on the slope behind); the map is one-dimensional, in the rate.
 
@@ -85,7 +87,8 @@ def derive(structure: Structure) -> Equations:
         relabel_q=sp.Matrix([ahead]), relabel_rate=sp.eye(1),
         kinetic=kinetic, potential=potential,
         guards={"heel_strike": 2 * q + 2 * alpha + 2 * gamma, "rolls_back": dq,
-                "hip_height": (hub.T * normal)[0]},
+                "hip_height": (hub.T * normal)[0],
+                "swing_clearance": (swing_foot.T * normal)[0]},
         points={"hip": hub, "stance_foot": sp.zeros(2, 1), "swing_foot": swing_foot,
                 "trailing_foot": hub + L * _e(q - 2 * alpha)},
         leg_angles={"stance": q, "swing": ahead},
