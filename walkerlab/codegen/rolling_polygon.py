@@ -29,7 +29,8 @@ decreasing).  With the hub at ``L (-sin q, cos q)`` from the stance foot:
 The "legs" of the vocabulary are the two spokes of a step: ``stance`` and ``swing`` (the
 next spoke ahead, ``q + 2 alpha``), whose feet are the named points ``stance_foot`` and
 ``swing_foot``; the spoke behind (``q - 2 alpha``, the previous stance spoke just after a
-heel strike) has its foot at ``trailing_foot``; the hub is the point ``hip``.
+heel strike) has its foot at ``trailing_foot``, the others (``k`` spokes ahead of the
+stance spoke, ``2 <= k <= n - 2``) at ``spoke<k>_foot``; the hub is the point ``hip``.
 """
 
 from __future__ import annotations
@@ -90,7 +91,9 @@ def derive(structure: Structure) -> Equations:
                 "hip_height": (hub.T * normal)[0],
                 "swing_clearance": (swing_foot.T * normal)[0]},
         points={"hip": hub, "stance_foot": sp.zeros(2, 1), "swing_foot": swing_foot,
-                "trailing_foot": hub + L * _e(q - 2 * alpha)},
+                "trailing_foot": hub + L * _e(q - 2 * alpha),
+                **{f"spoke{k}_foot": hub + L * _e(q + 2 * k * alpha)
+                   for k in range(2, structure.spokes - 1)}},
         leg_angles={"stance": q, "swing": ahead},
         section_drop=0, drop_solution=alpha - gamma,
         De=sp.zeros(3, 3), E=sp.zeros(2, 3), limit=False, section_tied=None,
