@@ -42,7 +42,7 @@ def _scene(name):
 #: checked elsewhere.
 REFUSED = {"flat_feet_push_off": "walker.actuation.ankle_push_off",
            "kuo2002": "walker.leg.bodies", "schwab_wisse2001": "walker.leg.bodies",
-           "simplest": "walker.leg.bodies",
+           "simplest": "walker.leg.bodies", "rimless_wheel": "walker.model",
            "stairs": "terrain.kind: stairs", "footholds": "terrain.kind: footholds"}
 #: rabbit_optimal: no gait of its own (its step is optimised with open-loop torques:
 #: tests/test_optimize_five_link.py); its walker is rabbit's (tests/test_export_five_link.py)

@@ -58,6 +58,13 @@ def _flat_generator_hash() -> str:
 
 
 @cache
+def _spoked_generator_hash() -> str:
+    """sha256 of the spoked wheel's derivation (once per process)."""
+    return hashlib.sha256((Path(__file__).parent / "rolling_polygon.py").read_bytes()
+                          ).hexdigest()
+
+
+@cache
 def _five_link_generator_hash() -> str:
     """sha256 of the free-jointed (five-link) generator's source (once per process)."""
     return hashlib.sha256((Path(__file__).parent / "free_joints.py").read_bytes()).hexdigest()
@@ -66,13 +73,16 @@ def _five_link_generator_hash() -> str:
 def cache_key(structure) -> str:
     """Cache key (hex, 24 characters) of a structure for the current generator (a
     flat-footed walker's also covers :mod:`walkerlab.codegen.foot_modes`, a free-kneed one's
-    :mod:`walkerlab.codegen.free_joints`, which no other structure's key reads)."""
+    :mod:`walkerlab.codegen.free_joints`, a spoked wheel's
+    :mod:`walkerlab.codegen.rolling_polygon`, which no other structure's key reads)."""
     h = hashlib.sha256(structure.key().encode())
     h.update(_generator_hash().encode())
     if structure.foot == "flat":
         h.update(_flat_generator_hash().encode())
     if structure.free_knees:
         h.update(_five_link_generator_hash().encode())
+    if structure.spokes:
+        h.update(_spoked_generator_hash().encode())
     return h.hexdigest()[:24]
 
 
@@ -143,15 +153,28 @@ def generated_module(structure) -> dict:
             write_source(path, body)
     if ns is None:
         from walkerlab.codegen import source as codegen
-        from walkerlab.codegen import symbolic
 
-        eq = symbolic.derive(structure)
+        eq = derive_equations(structure)
         body = codegen.generate(eq, structure.param_names, key)
         ns = _exec(body, str(path or f"<walkerlab model {key}>"))
         if path is not None:
             write_source(path, body)
     _memo[key] = ns
     return ns
+
+
+def derive_equations(structure):
+    """The symbolic :class:`~walkerlab.codegen.symbolic.Equations` of ``structure`` that the
+    printers of :mod:`walkerlab.codegen.source` take: a spoked wheel's
+    (:mod:`walkerlab.codegen.rolling_polygon`) or a biped's
+    (:func:`walkerlab.codegen.symbolic.derive`)."""
+    if structure.spokes:
+        from walkerlab.codegen import rolling_polygon
+
+        return rolling_polygon.derive(structure)
+    from walkerlab.codegen import symbolic
+
+    return symbolic.derive(structure)
 
 
 _imported: dict[str, object] = {}

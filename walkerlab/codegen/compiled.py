@@ -36,9 +36,9 @@ def compiled_module(structure):
 
             return flatfoot.generate_flat_compiled(structure, key)
         from walkerlab.codegen import source as codegen
-        from walkerlab.codegen import symbolic
 
-        return codegen.generate_compiled(symbolic.derive(structure), structure.param_names, key)
+        return codegen.generate_compiled(cache.derive_equations(structure),
+                                         structure.param_names, key)
 
     return cache.import_generated(f"{key}_nb.py", f"walkerlab_compiled_{key}", build)
 

@@ -20,7 +20,7 @@ class SceneError(ValueError):
 
 
 # discriminator tags of walker models and bodies: not part of a field's path
-_TAGS = {"compass_gait", "biped", "point_mass", "rod", "point", "arc", "flat"}
+_TAGS = {"compass_gait", "biped", "rimless_wheel", "point_mass", "rod", "point", "arc", "flat"}
 
 
 def _loc_part(p) -> bool:
@@ -161,7 +161,8 @@ WALKER_VOCABULARY = (
     "hinged at the hip with free knees (a five-link biped); actuation: torques at any joint "
     "the walker has (hip, torso to leg, knees, flat feet's ankles) in the rigid model (the "
     "contact model: hip torques on straight, point-footed legs and a five-link biped's "
-    "joints), a push-off impulse on point feet, an ankle push-off on flat feet)")
+    "joints), a push-off impulse on point feet, an ankle push-off on flat feet), or "
+    "rimless_wheel (spokes, spoke_length_m, mass_kg, optional hub_inertia_kg_m2)")
 
 
 def _walker_vocabulary_applies(root: type[BaseModel], e: dict, suggest=None) -> bool:

@@ -240,9 +240,11 @@ class BasinSettings(Strict):
         None, gt=0, le=MAX_STEP_TIME_S,
         description="a step longer than this ends the cell as 'stalled' [s]; "
         "null = fixedpoint.max_step_time_s")
-    start: Literal["fixed_point", "heel_strike"] = Field(
+    start: Literal["fixed_point", "heel_strike", "phase_plane"] = Field(
         "fixed_point", description="how a cell's other coordinates are set: 'fixed_point' = "
-        "from x* (then projected on the heel-strike surface); 'heel_strike' = the cell is a "
+        "from x* (then projected on the heel-strike surface); 'phase_plane' = from x*, not "
+        "projected: the cell is any state of the stance phase (the rimless wheel, whose "
+        "section has one coordinate); 'heel_strike' = the cell is a "
         "state just after a heel strike, the heel-strike image of a pre-impact state on the "
         "guard that differs from x*'s pre-impact state in the two coordinates the axes depend "
         "on most (Schwab & Wisse 2001; for the simplest walker, whose post-impact states form "

@@ -1,5 +1,6 @@
-"""The walker sections of a scene (``walker:``): the compass gait of the paper's Table 1 and
-the generic biped described as data (legs, bodies, feet, knees, torso, springs).
+"""The walker sections of a scene (``walker:``): the compass gait of the paper's Table 1,
+the generic biped described as data (legs, bodies, feet, knees, torso, springs) and the
+rimless wheel (spokes on a hub).
 
 Every numeric field carries its unit in its name (``leg_length_m``) and a description;
 unknown keys are rejected (:class:`~walkerlab.config.base.Strict`).  The walker is expanded
@@ -446,6 +447,34 @@ class BipedParams(_Actuated):
         return (self.leg, self.leg) if self.leg is not None else tuple(self.legs)
 
 
+class RimlessWheelParams(Strict):
+    """A rimless wheel (McGeer 1990, "Passive dynamic walking", IJRR 9(2); Coleman,
+    Chatterjee & Ruina 1997, "Motions of a rimless spoked wheel", Dynamics and Stability
+    of Systems 12(3)): one rigid body, a hub of mass ``mass_kg`` (a point mass unless
+    ``hub_inertia_kg_m2`` is given) with ``spokes`` massless spokes of length
+    ``spoke_length_m``, ``2 pi / spokes`` apart.  It rolls about the stance spoke's foot;
+    the next spoke's foot striking the slope is the heel strike (plastic, angular momentum
+    about the new contact point conserved).  Drake's ``RimlessWheel`` example has the same
+    parameters (mass, length, gravity, number_of_spokes)."""
+
+    model: Literal["rimless_wheel"] = Field(description="walker model name")
+    spokes: int = Field(ge=3, le=360, description="number of spokes n [-] (the angle "
+                        "between neighbouring spokes is 2 pi / n)")
+    spoke_length_m: float = Field(gt=0, le=100, description="spoke length L, hub to "
+                                  "foot [m]")
+    mass_kg: float = Field(gt=0, le=1e4, description="hub mass M [kg]")
+    gravity_m_per_s2: float = Field(9.81, gt=0, le=100, description="gravity g [m/s^2]")
+    hub_inertia_kg_m2: float | None = Field(None, ge=0, le=1e6, description="moment of "
+                                            "inertia of the wheel about its hub [kg m^2] "
+                                            "(null: a point mass, 0)")
+
+    @property
+    def actuation(self) -> None:
+        """The wheel is passive: no ``actuation`` section (a key given is refused as any
+        unknown key)."""
+        return None
+
+
 # ``model`` is the discriminator; "compass_gait" is the paper's shorthand for a biped with a
 # hip mass and one point mass per leg (expanded by walkerlab.walker.description).
 def _walker_tag(v: Any) -> str:
@@ -454,5 +483,7 @@ def _walker_tag(v: Any) -> str:
 
 
 WalkerParams = Annotated[Annotated[CompassGaitParams, Tag("compass_gait")]
-                         | Annotated[BipedParams, Tag("biped")], Discriminator(_walker_tag)]
+                         | Annotated[BipedParams, Tag("biped")]
+                         | Annotated[RimlessWheelParams, Tag("rimless_wheel")],
+                         Discriminator(_walker_tag)]
 

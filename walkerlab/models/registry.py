@@ -25,7 +25,8 @@ def build_walker(scene) -> HybridWalker:
 
     ``model: compass_gait`` (paper Table 1) supports the printed-equation variants
     (``ideal.variant``); ``model: biped`` is any walker described as data, derived
-    symbolically (variant ``derived`` only).
+    symbolically (variant ``derived`` only); ``model: rimless_wheel`` is a spoked wheel
+    (:mod:`walkerlab.models.hybrid.rolling_polygon`, variant ``derived`` only).
 
     A ``walker.actuation`` section adds its actuators (:func:`walkerlab.models.hybrid.
     actuated.actuate`).
@@ -83,4 +84,12 @@ def _passive(scene) -> HybridWalker:
             raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "
                              "model: compass_gait (the paper's printed equations)")
         return make_rigid_walker(walker_data(w, scene.slope.phi_rad), "biped", "derived")
+    if w.model == "rimless_wheel":
+        from walkerlab.models.hybrid.rolling_polygon import make_spoked_walker
+        from walkerlab.walker.description import walker_data
+
+        if scene.ideal.variant != "derived":
+            raise ValueError(f"ideal.variant: {scene.ideal.variant!r} exists only for "
+                             "model: compass_gait (the paper's printed equations)")
+        return make_spoked_walker(walker_data(w, scene.slope.phi_rad))
     raise ValueError(f"walker.model: no rigid model for {w.model!r}")

@@ -8,6 +8,10 @@ map and record where each cell goes.  Here a cell's state takes its two axis coo
 ``fixed_point``  the coordinate fixed by the heel-strike surface from that constraint
                  (``walker.from_section(walker.section(x))``) and every other coordinate from
                  the fixed point ``x*`` (:func:`slice_state`), or
+``phase_plane``  the cell is the state itself, the axes from the grid and every other
+                 coordinate from ``x*``, not projected: any state of the stance phase (the
+                 rimless wheel's phase plane, Coleman, Chatterjee & Ruina 1997, whose
+                 Poincaré section has one coordinate), or
 ``heel_strike``  the cell is a state just after a heel strike, as Schwab & Wisse's: the image
                  ``walker.reset(x-)`` of a pre-impact state ``x-`` on the guard that equals
                  the fixed point's pre-impact state but in the two section coordinates the
@@ -69,9 +73,11 @@ def _index(names: list[str], name: str, field: str) -> int:
 
 
 def slice_state(walker, x_star: np.ndarray, axes: tuple[str, str],
-                values: tuple[float, float]) -> np.ndarray:
+                values: tuple[float, float], project: bool = True) -> np.ndarray:
     """Post-heel-strike state of one cell (``basin.start: fixed_point``; Schwab & Wisse
-    2001's grid of post-heel-strike states).
+    2001's grid of post-heel-strike states), or with ``project`` False the state as given
+    (``basin.start: phase_plane``: any state of the stance phase, Coleman, Chatterjee &
+    Ruina 1997's phase plane of the rimless wheel).
 
     Parameters
     ----------
@@ -100,6 +106,8 @@ def slice_state(walker, x_star: np.ndarray, axes: tuple[str, str],
         raise BasinError("basin: x_axis and y_axis name the same state")
     x = np.array(x_star, dtype=float)
     x[ix], x[iy] = values
+    if not project:
+        return x
     x = np.asarray(walker.from_section(walker.section(x)), dtype=float)
     for i, field, v in ((ix, "x_axis", values[0]), (iy, "y_axis", values[1])):
         if abs(x[i] - v) > 1e-12 * (1 + abs(v)):
@@ -349,8 +357,8 @@ def run_basin_chunk(task: BasinTask) -> list[tuple[int, int, int, int]]:
     hs = heel_strike_slice(walker, np.asarray(task.x_pre), axes) if task.x_pre else None
     out = []
     for idx, vx, vy in task.cells:
-        x0 = (slice_state(walker, x_star, axes, (vx, vy)) if hs is None
-              else hs.state(walker, (vx, vy)))
+        x0 = (slice_state(walker, x_star, axes, (vx, vy), st.start != "phase_plane")
+              if hs is None else hs.state(walker, (vx, vy)))
         if x0 is None:
             out.append((int(idx), CODE["unreachable"], 0, 0))
             continue
@@ -505,7 +513,8 @@ def _start_pre_impact(walker, x_star: np.ndarray, st, mst: float, xs: np.ndarray
         heel_strike_slice(walker, pre, (st.x_axis, st.y_axis))
         x_pre = tuple(float(v) for v in pre)
     else:
-        slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]))  # validate axes
+        slice_state(walker, x_star, (st.x_axis, st.y_axis), (xs[0], ys[0]),
+                    st.start != "phase_plane")  # validate axes
     return x_pre
 
 

@@ -25,6 +25,11 @@ FREE_KNEE_ROLES = ("stance_shank", "stance_thigh", "swing_thigh", "swing_shank")
 #: Roles with flat feet: the absolute leg angles and the stance ankle's angle (the swing
 #: foot is massless and sits at its spring's rest angle: no coordinate).
 FLAT_ROLES = ("swing", "stance", "stance_ankle")
+#: Roles of a spoked wheel (one rigid body): the stance spoke's absolute angle.
+SPOKED_ROLES = ("stance",)
+#: Parameters of a spoked wheel: gravity, spoke length, slope, hub mass, inertia about the
+#: hub, half the angle between neighbouring spokes (``pi / n``) [SI].
+SPOKED_PARAMS = ("g", "L", "gamma", "M_hub", "I_hub", "alpha")
 
 
 @dataclass(frozen=True)
@@ -98,6 +103,12 @@ class Structure:
         The torso (``torso`` bodies) is jointed at the hip with its own coordinate, role
         ``torso`` (its angle from the upward vertical, positive leaning back); needs
         ``free_knees``.
+    spokes : int
+        0, or the number of spokes of a spoked wheel (``model: rimless_wheel``): one rigid
+        body, a hub with ``spokes`` massless spokes ``2 alpha = 2 pi / spokes`` apart,
+        rolling about the stance spoke's foot (role ``stance``, parameters
+        :data:`SPOKED_PARAMS`; :mod:`walkerlab.codegen.rolling_polygon`; its floating view
+        has one contact point per spoke).  The other fields are then unused.
     """
 
     coordinates: str
@@ -112,9 +123,12 @@ class Structure:
     knee_spring: bool = False
     free_knees: bool = False
     hinged_torso: bool = False
+    spokes: int = 0
 
     @property
     def roles(self) -> tuple[str, ...]:
+        if self.spokes:
+            return SPOKED_ROLES
         if self.free_knees:
             return FREE_KNEE_ROLES + (("torso",) if self.hinged_torso else ())
         if self.foot == "flat":
@@ -124,6 +138,8 @@ class Structure:
     @property
     def param_names(self) -> tuple[str, ...]:
         """Names of the parameter vector, in order (SI units; ``gamma`` is the slope [rad])."""
+        if self.spokes:
+            return SPOKED_PARAMS
         names = ["g", "L", "gamma"] + (["M_hip"] if self.hip_mass else [])
         tags = [f"{ROLE_TAG[r]}_" for r in ("swing", "stance")] if self.asymmetric else [""]
         for b in self.bodies:
@@ -173,6 +189,8 @@ class Structure:
             d["free_knees"] = True
         if self.hinged_torso:
             d["hinged_torso"] = True
+        if self.spokes:
+            d = {"spokes": self.spokes}
         return json.dumps(d)
 
 
@@ -180,12 +198,21 @@ def check_floating_view(structure: Structure) -> None:
     """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
     knees (the five-link biped) on legs that differ, on feet other than points, or with
     springs (what the rigid view of free knees, :mod:`walkerlab.codegen.free_joints`, refuses
-    too).
+    too), and a spoked wheel.
+
+    A spoked wheel (``model: rimless_wheel``) has no floating view yet: it would be the
+    hub's position and the wheel's angle with one contact point per spoke, and needs a
+    positive inertia about the hub (a point-mass hub's angle has no dynamics once no spoke
+    is pinned).
 
     Raises
     ------
     ValueError
     """
+    if structure.spokes:
+        raise ValueError("walker.model: rimless_wheel has no floating view (contact model, "
+                         "URDF/MJCF/Adams export) yet; its rigid model runs fixedpoint, "
+                         "simulate, basin and mfpt")
     if structure.free_knees and (structure.foot != "point" or structure.asymmetric
                                  or structure.springs or structure.knee_spring):
         raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "
@@ -266,6 +293,20 @@ def _spring_roles(between, stance_leg: str) -> tuple[tuple[str, str], float]:
     return (b, a), -1.0
 
 
+def _spoked_data(w, slope_rad: float) -> WalkerData:
+    """Structure and parameters (:data:`SPOKED_PARAMS`) of a ``model: rimless_wheel``
+    section: a point-mass hub unless ``hub_inertia_kg_m2`` is given."""
+    import math
+
+    inertia = 0.0 if w.hub_inertia_kg_m2 is None else w.hub_inertia_kg_m2
+    params = (w.gravity_m_per_s2, w.spoke_length_m, slope_rad, w.mass_kg, inertia,
+              math.pi / w.spokes)
+    extra = {"spokes": w.spokes, "hub_inertia_kg_m2": inertia}
+    return WalkerData(Structure("absolute", (), hip_mass=True, spokes=w.spokes),
+                      tuple(float(v) for v in params), w.mass_kg, w.spoke_length_m,
+                      w.gravity_m_per_s2, slope_rad, extra)
+
+
 def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     """Structure and parameters of a scene's ``walker`` section.
 
@@ -276,7 +317,7 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
 
     Parameters
     ----------
-    walker_cfg : CompassGaitParams or BipedParams
+    walker_cfg : CompassGaitParams, BipedParams or RimlessWheelParams
         Validated ``walker`` section.
     slope_rad : float
         Slope angle [rad].
@@ -286,6 +327,8 @@ def walker_data(walker_cfg, slope_rad: float) -> WalkerData:
     WalkerData
     """
     extra = {}
+    if walker_cfg.model == "rimless_wheel":
+        return _spoked_data(walker_cfg, slope_rad)
     if walker_cfg.model == "compass_gait":
         extra = {"leg_mass_kg": walker_cfg.leg_mass_kg, "hip_mass_kg": walker_cfg.hip_mass_kg,
                  "leg_mass_from_foot_m": walker_cfg.leg_mass_from_foot_m}

@@ -165,7 +165,7 @@ class StanceReaction:
         self.normal = np.array([np.sin(phi), np.cos(phi)])
         self.tangent = np.array([np.cos(phi), -np.sin(phi)])
         self.view = None
-        if any(b.massless for b in st.bodies):
+        if st.spokes or any(b.massless for b in st.bodies):  # a wheel: its mass at the hub
             if not st.hip_mass or any(not b.massless for b in (*st.bodies, *st.torso)):
                 floating_plain(st)  # raises: a massless body beside massive ones
             # massless legs, all the mass at the hip (module docstring)
@@ -287,7 +287,9 @@ class StanceReaction:
             total = self.hip_mass_kg * (self._point_velocity("hip", x_plus)
                                         - self._point_velocity("hip", x_minus))
             e = self._point("hip", x_minus[:w.n_coordinates])  # from the trailing foot
-            trail = self._point_velocity("swing_foot", x_plus)  # the old stance foot
+            # the old stance foot: a biped's new swing foot, a wheel's spoke behind
+            trail = self._point_velocity("trailing_foot" if "trailing_foot" in w.points(
+                x_plus) else "swing_foot", x_plus)
             push = self._push_off(x_minus, e)
             return TransitionImpulses(total - push, push, trail, self.normal.copy())
         q0, v0 = self.floating_state(x_minus)

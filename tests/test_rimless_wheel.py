@@ -1,0 +1,174 @@
+"""The rimless wheel (``model: rimless_wheel``; McGeer 1990; Coleman, Chatterjee & Ruina 1997)
+at the defaults of Drake's ``RimlessWheel`` example (mass 1 kg, spoke length 1 m, gravity
+9.81 m/s^2, 8 spokes, slope 0.08 rad: ``configs/rimless_wheel.yaml``), against closed forms
+and a Monte Carlo written here from the wheel's closed-form step map (no walkerlab code).
+
+Closed forms (point mass at the hub, ``alpha = pi / n``, slope ``phi``):
+
+- over a step the hub drops ``L (cos(alpha - phi) - cos(alpha + phi)) = 2 L sin(alpha)
+  sin(phi)``, so the rate before heel strike is ``w-^2 = w+^2 + 4 g/L sin(alpha) sin(phi)``;
+- the plastic impact keeps the angular momentum about the new foot: ``w+ = cos(2 alpha) w-``;
+- the fixed point ``w+ = cos(2 alpha) sqrt(w+^2 + 4 g/L sin(alpha) sin(phi))`` is
+  ``w+ = cot(2 alpha) sqrt(4 g/L sin(alpha) sin(phi))``; with a hub inertia ``I`` the
+  impact ratio is ``(M L^2 cos(2 alpha) + I) / (M L^2 + I)`` and ``g/L`` becomes
+  ``M g L / (M L^2 + I)``;
+- the step period is the time of the inverted pendulum from ``alpha - phi`` to ``-alpha -
+  phi``, ``int dpsi / sqrt(w+^2 + 2 g/L (cos(alpha - phi) - cos psi))`` (quadrature);
+- the Poincaré map in the rate has the one multiplier ``cos(2 alpha)^2`` at the fixed point
+  (``dw+'/dw+ = cos(2 alpha) w+ / w- = cos(2 alpha)^2``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from walkerlab.config import SceneError, load_scene, scene_from_dict
+
+SCENE = "configs/rimless_wheel.yaml"
+G, L, M, N, PHI = 9.81, 1.0, 1.0, 8, 0.08   # Drake RimlessWheelParams defaults
+
+
+def _closed_form(inertia: float = 0.0):
+    """(post-impact rate magnitude [rad/s], step period [s], multiplier) of the passive gait."""
+    a = math.pi / N
+    J = M * L ** 2 + inertia
+    c = (M * L ** 2 * math.cos(2 * a) + inertia) / J
+    k = M * G * L / J                                  # g/L for a point mass
+    w = c / math.sqrt(1 - c * c) * math.sqrt(4 * k * math.sin(a) * math.sin(PHI))
+    top = math.cos(a - PHI)
+    period, err = quad(lambda p: 1.0 / math.sqrt(w * w + 2 * k * (top - math.cos(p))),
+                       -a - PHI, a - PHI, epsabs=1e-13, epsrel=1e-13, limit=200)
+    assert err < 1e-12
+    w_minus = math.sqrt(w * w + 4 * k * math.sin(a) * math.sin(PHI))
+    return w, period, c * w / w_minus
+
+
+def _walker(inertia: float | None = None):
+    from walkerlab.api import Walker
+
+    scene = load_scene(SCENE)
+    if inertia is not None:
+        d = scene.model_dump(mode="json")
+        d["walker"]["hub_inertia_kg_m2"] = inertia
+        scene = scene_from_dict(d)
+    return Walker.from_scene(scene)
+
+
+@pytest.mark.parametrize("inertia", [None, 0.25])
+def test_rimless_wheel_gait_matches_closed_form(inertia):
+    """Post-impact rate and step period to 1e-8 of the closed form (energy, impact,
+    quadrature), the post-impact angle ``alpha - phi``, and the one nontrivial Floquet
+    multiplier ``cos(2 alpha)^2`` (the other is 0: the map lands on the section)."""
+    gait = _walker(inertia).fixed_point()
+    w, period, mult = _closed_form(inertia or 0.0)
+    assert gait.names == ("stance_angle", "stance_rate")
+    assert gait.x[0] == pytest.approx(math.pi / N - PHI, abs=1e-12)
+    assert abs(-gait.x[1] - w) < 1e-8          # rolls downhill: the angle decreases
+    assert abs(gait.step_period - period) < 1e-8
+    mods = np.sort(np.abs(gait.multipliers))[::-1]
+    assert abs(mods[0] - mult) < 1e-6 and mods[1] < 1e-6
+    assert gait.step_length == pytest.approx(2 * L * math.sin(math.pi / N), rel=1e-9)
+    if inertia is None:
+        assert mult == pytest.approx(math.cos(2 * math.pi / N) ** 2, rel=1e-12)
+
+
+@pytest.mark.parametrize("change, field", [
+    ({"spokes": 2}, "walker.spokes"),
+    ({"spoke_length_m": -1.0}, "walker.spoke_length_m"),
+    ({"hub_inertia_kg_m2": -0.1}, "walker.hub_inertia_kg_m2"),
+    ({"leg_length_m": 1.0}, "walker.leg_length_m"),
+])
+def test_rimless_wheel_bad_input_is_one_line(change, field):
+    d = load_scene(SCENE).model_dump(mode="json")
+    d["walker"].update(change)
+    with pytest.raises(SceneError) as exc:
+        scene_from_dict(d)
+    msg = str(exc.value)
+    assert field in msg and "Traceback" not in msg and len(msg.splitlines()) == 1
+
+
+def _independent_mfpt(sd: float, walks: int, cap: int, seed: int):
+    """Monte Carlo of the closed-form step map on per-step slopes ``phi + sd N(0, 1)``: the
+    ground of step k is the line through its stance foot at slope gamma_k; a step starts at
+    ``alpha - gamma_{k-1}`` (the previous ground) and fails if the hub cannot vault over the
+    foot (``w^2 <= 2 g/L (1 - cos(alpha - gamma_{k-1}))``); else the heel strike at
+    ``-alpha - gamma_k`` and the impact give the next rate.  Censored geometric estimate
+    ``S / F``, standard error ``sqrt(m (m + 1) / F)`` (Byl & Tedrake 2009)."""
+    rng = np.random.default_rng(seed)
+    a, k = math.pi / N, G / L
+    c = math.cos(2 * a)
+    w = np.full(walks, _closed_form()[0])
+    prev = np.full(walks, PHI)
+    alive = np.ones(walks, bool)
+    S = F = 0
+    for _ in range(cap):
+        idx = np.flatnonzero(alive)
+        if idx.size == 0:
+            break
+        gam = PHI + sd * rng.standard_normal(idx.size)
+        p0, p1 = a - prev[idx], -a - gam
+        ok = ~((p0 > 0) & (w[idx] ** 2 <= 2 * k * (1 - np.cos(p0))))
+        S += int(ok.sum())
+        F += int((~ok).sum())
+        alive[idx[~ok]] = False
+        j = idx[ok]
+        w[j] = c * np.sqrt(w[j] ** 2 + 2 * k * (np.cos(p0[ok]) - np.cos(p1[ok])))
+        prev[j] = gam[ok]
+    m = S / F
+    return m, math.sqrt(m * (m + 1) / F)
+
+
+@pytest.mark.slow
+def test_rimless_wheel_mfpt_matches_independent_monte_carlo():
+    """walkerlab's Monte Carlo MFPT (batched compiled step map) within 3 combined standard
+    errors of the closed-form Monte Carlo, at two roughness levels (MFPT ~200 and ~30
+    steps)."""
+    from walkerlab.analysis.robustness.mfpt import monte_carlo
+    from walkerlab.integrate.python_step import make_step_map
+    from walkerlab.models.registry import build_walker
+    from walkerlab.studies.mfpt import scene_walker_at
+
+    scene = load_scene(SCENE)
+    x0 = _walker().fixed_point().x
+    sm = make_step_map(build_walker(scene), scene_walker_at(scene), 1e-9, 1e-9, 5.0)
+    for sd in (0.008, 0.012):
+        ours = monte_carlo(sm, x0, sd, range(1500), 4000, seed=3).mfpt
+        ref = _independent_mfpt(sd, 6000, 20000, seed=11)
+        assert 10 < ref[0] < 1000
+        assert abs(ours[0] - ref[0]) < 3 * math.hypot(ours[1], ref[1]), (sd, ours, ref)
+
+
+def test_rimless_wheel_basin_on_the_phase_plane():
+    """``basin.start: phase_plane``: a cell is the stance state itself (the wheel's section
+    has one coordinate).  A state with the energy to vault over its stance foot converges to
+    the gait; one without it (``w^2 < 2 g/L (1 - cos psi)``) falls backward (the energy
+    argument of Coleman, Chatterjee & Ruina 1997)."""
+    from walkerlab.studies.basin import CODE, BasinTask, run_basin_chunk
+
+    scene = load_scene(SCENE)
+    assert scene.basin.start == "phase_plane"
+    x_star = _walker().fixed_point().x
+    psi = 0.3
+    slow = math.sqrt(2 * G / L * (1 - math.cos(psi)))    # just enough to reach the top
+    # (2): rolling back (+0.25 rad/s) past the top, it turns before the top and rolls on
+    # (w-^2 = 0.25^2 + 2 g/L (cos 0.1 - cos 0.4727) gives w+^2 = 1.06 > the 0.95 needed)
+    cells = ((0, psi, -1.05 * slow), (1, psi, -0.95 * slow), (2, -0.1, 0.25))
+    out = {i: code for i, code, _, _ in run_basin_chunk(BasinTask(
+        scene.model_dump(mode="json"), tuple(x_star), cells))}
+    assert out == {0: CODE["converged"], 1: CODE["fell_backward"], 2: CODE["converged"]}
+
+
+def test_rimless_wheel_floating_view_is_refused_in_one_line():
+    """No contact model or URDF/MJCF/Adams export yet: one line naming walker.model, from
+    the floating view's and the multibody export's common check."""
+    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.multibody import multibody
+
+    scene = load_scene(SCENE)
+    with pytest.raises(ValueError) as exc:
+        multibody(walker_data(scene.walker, scene.slope.phi_rad))
+    assert str(exc.value).startswith("walker.model: rimless_wheel") and "\n" not in str(exc.value)
