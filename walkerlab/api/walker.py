@@ -572,8 +572,8 @@ class Walker:
 @dataclass(frozen=True)
 class ContactWalk:
     """A walk of the contact walker (:meth:`ContactWalker.simulate`), as the ``contact-sim``
-    stage records it (SI throughout; a ``units: nondimensional`` scene's contact run is in
-    SI too).
+    stage records it (units named in SI; in a ``units: nondimensional`` scene every quantity
+    is in the walker's own units, time in √(l/g), as :class:`Walk`'s).
 
     Attributes
     ----------
