@@ -109,6 +109,8 @@ def test_a_period_without_a_start_and_a_scene_without_contact_are_refused(paper_
                         "hip_mass_kg": 10.0, "gravity_m_per_s2": 9.81,
                         "leg_mass_from_foot_m": 0.5},
              "slope": {"angle_rad": 0.0174}, "fixedpoint": {}}
+    assert wl.ContactWalker is wl.api.ContactWalker is wl.api.walker.ContactWalker
+    assert paper_contact.rigid.contact().rigid is paper_contact.rigid
     with pytest.raises(ContactSceneError, match="no 'contact' section") as err:
         wl.Walker.from_scene(scene).contact()
     assert "\n" not in str(err.value)

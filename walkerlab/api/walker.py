@@ -695,6 +695,20 @@ class ContactWalker:
     step_time_limit_s : float
         As :class:`~walkerlab.api.walker.Walker` (the rigid view's steps).
 
+    Attributes
+    ----------
+    scene : walkerlab.config.Scene
+    setup : walkerlab.models.contact.scene.ContactSetup
+        The scene read once for the contact model (law in SI, walker data, actuators, run
+        options ``contact_sim``, solver settings).
+    model : walkerlab.models.contact.model.ContactWalker
+        The floating walker with compliant feet (state names, points, energies), on no
+        terrain.
+    solver : walkerlab.integrate.solver.Solver
+        The integrator of the scene's ``contact_solver`` section (default cyrk_bdf).
+    rigid : Walker
+        The rigid view (its gait starts the runs).
+
     Raises
     ------
     walkerlab.models.contact.scene.ContactSceneError
