@@ -123,5 +123,5 @@ def test_a_start_whose_periodic_gait_is_not_found_says_why_in_one_line(monkeypat
     monkeypatch.setattr(periodic, "simulate_from_periodic_gait", fails)
     setup = contact_setup(load_scene("configs/torso_bhm.yaml"))
     with pytest.raises(PeriodicGaitError, match="contact_sim.start: periodic_gait") as e:
-        contact_sim_run(setup, SimpleNamespace(x=np.zeros(4)))
+        contact_sim_run(setup, SimpleNamespace(x=np.zeros(4), step_period_s=np.nan))
     assert e.value.kind == "time_limit" and "wall-time limit" in str(e.value)

@@ -82,3 +82,26 @@ def test_no_write_outside_even_for_a_dict_scene(tmp_path, monkeypatch):
              "slope": {"angle_rad": 0.0174}, "fixedpoint": {}}
     gait = wl.Walker.from_scene(scene).fixed_point()
     assert gait.stable and os.listdir(tmp_path) == []
+
+
+def test_fixed_point_uses_the_walker_s_own_model_and_solver(paper, monkeypatch):
+    # built once by the constructor; fixed_point rebuilds neither (it did: solve_scene)
+    w = paper
+    before = w.fixed_point()
+    import walkerlab.analysis.gait.scene as gait_scene
+    import walkerlab.analysis.gait.search as search
+    import walkerlab.models.registry as registry
+
+    def no(*a, **k):
+        raise AssertionError("rebuilt from the scene")
+
+    monkeypatch.setattr(registry, "build_walker", no)
+    monkeypatch.setattr(gait_scene, "build_walker", no)
+    used = []
+    find = search.find_gaits
+    monkeypatch.setattr(gait_scene, "find_gaits",
+                        lambda walker, solver, *a, **k: used.append((walker, solver))
+                        or find(walker, solver, *a, **k))
+    gait = w.fixed_point()
+    assert used == [(w.model, w.solver)] and used[0][0] is w.model
+    assert np.array_equal(gait.x, before.x) and gait.step_period == before.step_period

@@ -25,7 +25,8 @@ the product):
   stage's artifact; ``walkerlab.studies`` is the package of sweeps, basins and maps),
   ``continuation`` (the loaded continuation artifact), ``mfpt`` (mean first-passage time),
   ``optimize`` (optimal gait or design), ``robustness``, ``export`` (the model file's path),
-  ``target`` (in memory: the field value whose gait meets a target), ``Walker``
+  ``target`` (in memory: the field value whose gait meets a target), ``Walker`` and
+  ``ContactWalker`` (the walker in memory: rigid and contact views)
 
 Importing the package has no side effects and loads no heavy optional package: the API's
 names are looked up on first use (PEP 562).
@@ -35,7 +36,7 @@ __version__ = "0.1.0"
 
 _API = ("load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
         "contact_simulate", "compare", "basin", "continuation", "mfpt", "optimize",
-        "robustness", "export", "target", "Walker")
+        "robustness", "export", "target", "Walker", "ContactWalker")
 __all__ = ["__version__", "api", *_API]
 
 

@@ -18,7 +18,9 @@ Modules: :mod:`~walkerlab.api.scenes` (:func:`load_scene`, :func:`with_changes`)
 or design), :func:`robustness`, :func:`export` (the written model file's path)),
 :mod:`~walkerlab.api.studies` (many points: :func:`sweep`, :func:`basin`,
 :func:`continuation`, :func:`mfpt`) and :mod:`~walkerlab.api.walker` (:class:`Walker`: the
-walker in memory, its map, Jacobian, fixed point and walks, no artifact; and
+walker in memory, its map, Jacobian, fixed point and walks, no artifact;
+:class:`ContactWalker` (``Walker.contact()``): its contact view in memory, the walks and
+periodic gait of ``walkerlab contact-sim``; and
 :func:`target`: the field value whose gait meets a target speed, step length or period, in
 memory as ``walkerlab target``); this module only gathers their public names.
 
@@ -48,8 +50,8 @@ from walkerlab.api.runs import (
 )
 from walkerlab.api.scenes import DEFAULT_RUNS, load_scene, with_changes
 from walkerlab.api.studies import basin, continuation, mfpt, sweep
-from walkerlab.api.walker import Walker, target
+from walkerlab.api.walker import ContactWalker, Walker, target
 
 __all__ = ["DEFAULT_RUNS", "load_scene", "with_changes", "fixed_point", "fixed_points",
            "simulate", "contact_simulate", "compare", "sweep", "basin", "continuation", "mfpt",
-           "optimize", "robustness", "export", "target", "Walker"]
+           "optimize", "robustness", "export", "target", "Walker", "ContactWalker"]

@@ -1,5 +1,7 @@
-"""A walker in memory: its Poincaré map, exact Jacobian, Floquet multipliers, fixed point
-and simulation, with no artifact written or read (only the generated-code cache is used).
+"""A walker in memory, both views: the rigid walker's Poincaré map, exact Jacobian, Floquet
+multipliers, fixed point and simulation (:class:`Walker`), and the compliant-contact
+walker's walks and own periodic gait (:class:`ContactWalker`), with no artifact written or
+read (only the generated-code cache is used).
 
 The artifact functions of :mod:`walkerlab.api` stay the front door for stored results; this
 is the object for loops and notebooks, as MuJoCo's ``MjModel``/``MjData`` or Pinocchio's
@@ -10,6 +12,13 @@ is the object for loops and notebooks, as MuJoCo's ``MjModel``/``MjData`` or Pin
     gait = w.fixed_point()              # the very numbers of `walkerlab fixedpoint`
     gait.state["stance_angle"], gait.step_period, gait.multipliers
     heavier = w.with_changes({"walker.hip_mass_kg": 12.0})
+    cw = w.contact()                    # the contact view (wl.ContactWalker)
+    walk = cw.simulate(strides=2)       # the very numbers of `walkerlab contact-sim`
+    walk.step_periods, walk.normal_force["leg2"], cw.periodic_gait().multipliers
+
+Each object builds its model and integrator once, from the scene (:attr:`Walker.model`,
+:attr:`Walker.solver`; :attr:`ContactWalker.setup`, :attr:`ContactWalker.solver`); every
+method uses them, and :meth:`Walker.with_changes` makes a new walker.
 
 States are role-ordered arrays of :meth:`Walker.state_names` (angles [rad], rates [rad/s];
 in a ``units: nondimensional`` scene every quantity is in the walker's own units, time in
@@ -18,6 +27,7 @@ in a ``units: nondimensional`` scene every quantity is in the walker's own units
 
 from __future__ import annotations
 
+import dataclasses
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,8 +38,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from walkerlab.config import Scene
 
-__all__ = ["STEP_TIME_LIMIT_S", "Gait", "Step", "Target", "Walk", "Walker", "check_target",
-           "target"]
+__all__ = ["STEP_TIME_LIMIT_S", "ContactWalk", "ContactWalker", "Gait", "Step", "Target",
+           "Walk", "Walker", "check_target", "target"]
 
 #: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
 #: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
@@ -180,7 +190,9 @@ class Walker:
     """The rigid hybrid walker of a scene, in memory.
 
     Build it with :meth:`from_scene`; it holds the validated scene, the generated model
-    (:func:`walkerlab.models.registry.build_walker`) and the scene's solver settings.
+    (:func:`walkerlab.models.registry.build_walker`) and the scene's integrator, built once:
+    every method uses them (a changed scene is a new walker, :meth:`with_changes`).
+    :meth:`contact` is the same walker's contact view.
 
     Parameters
     ----------
@@ -193,6 +205,16 @@ class Walker:
         trip it); past it the map stops with one line
         (:class:`~walkerlab.analysis.gait.poincare.StepFailed`, ``time_limit``).  The
         simulated time of a step is bounded apart, by ``fixedpoint.max_step_time_s``.
+
+    Attributes
+    ----------
+    scene : walkerlab.config.Scene
+    model : walkerlab.models.hybrid.HybridWalker
+        The generated rigid hybrid model.
+    solver : walkerlab.integrate.solver.Solver
+        The integrator of the scene's ``solver`` section.
+    max_step_time : float
+        Longest simulated time of one step [s] (``fixedpoint.max_step_time_s``).
 
     Raises
     ------
@@ -239,6 +261,17 @@ class Walker:
         from walkerlab.api.scenes import with_changes
 
         return Walker(with_changes(self.scene, changes), self.step_time_limit_s)
+
+    def contact(self) -> ContactWalker:
+        """The contact (compliant-foot) view of this walker: a :class:`ContactWalker` on the
+        same scene, whose runs start from this walker's gait.
+
+        Raises
+        ------
+        walkerlab.models.contact.scene.ContactSceneError
+            No ``contact`` section, or a walker the contact view does not carry (one line).
+        """
+        return ContactWalker(self.scene, self)
 
     def state_names(self) -> list[str]:
         """Names of the role-ordered state (2n,), coordinates then rates."""
@@ -390,7 +423,16 @@ class Walker:
 
     def fixed_point(self) -> Gait:
         """The period-1 gait the ``fixedpoint`` stage finds, bit for bit (the same search:
-        :func:`walkerlab.analysis.gait.scene.solve_scene`), without writing anything.
+        :func:`walkerlab.analysis.gait.scene.solve_scene`, on this walker's own model
+        :attr:`model` and integrator :attr:`solver`: nothing is rebuilt from the scene),
+        without writing anything.
+
+        Returns
+        -------
+        Gait
+            The selected gait: ``x`` (2n,) [rad, rad/s], step and map periods [s], Floquet
+            multipliers (2n,), the map's Jacobian (2n, 2n), step length [m], speed [m/s],
+            cost of transport [-] and the energy ledger of the map's steps.
 
         Raises
         ------
@@ -404,7 +446,7 @@ class Walker:
         from walkerlab.analysis.gait.energy import gait_ledger
         from walkerlab.analysis.gait.scene import solve_scene
 
-        _, search = solve_scene(self.scene)
+        _, search = solve_scene(self.scene, walker=self.model, solver=self.solver)
         chosen = search.gaits[search.selected]
         r = chosen.result
         m, ledger = gait_ledger(self.model, r.x, self.model.steps_per_map, self.solver,
@@ -525,6 +567,401 @@ class Walker:
         return (f"Walker({self.scene.name!r}, states={self.state_names()}, "
                 f"slope={self.model.params.get('slope_rad', 'n/a')})")
 
+
+
+@dataclass(frozen=True)
+class ContactWalk:
+    """A walk of the contact walker (:meth:`ContactWalker.simulate`), as the ``contact-sim``
+    stage records it (units named in SI; in a ``units: nondimensional`` scene every quantity
+    is in the walker's own units, time in √(l/g), as :class:`Walk`'s).
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Sample times [s] (at ``contact_sim.sample_rate_hz``; the last one is the event time
+        if an event ended the run).
+    x : ndarray, shape (m, N)
+        States of the floating walker, columns named by ``state_names`` [m, rad, m/s, rad/s].
+    state_names : tuple of str
+        The contact walker's state names (:meth:`ContactWalker.state_names`).
+    heel_strikes : ndarray, shape (k,)
+        Heel-strike times [s] (touchdowns of the swing foot ahead of the stance foot).
+    heel_strike_legs : tuple of str
+        Leg that struck at each heel strike.
+    steps : dict[str, ndarray (s,)]
+        The step table of ``contact_sim.h5``'s ``steps/``: ``t_start``, ``t_end``, ``period``
+        [s], ``stance_leg``, ``stance_slip_mm`` [mm], ``double_support_creep_mm`` [mm],
+        ``bounce_count``, ``scuff_count``, ``peak_penetration_m`` [m], ``liftoff_time`` [s].
+    normal_force, friction_force : dict[str, ndarray (m,)]
+        IMPACT normal force and Coulomb friction (down-slope) [N] at each contact point, by
+        its name (:meth:`ContactWalker.contact_names`: ``leg1``, ``leg2``; flat feet
+        ``leg1_heel``, ``leg1_toe``, ...).
+    penetration : dict[str, ndarray (m,)]
+        Signed penetration of each contact point [m] (< 0: above the ground).
+    termination : str
+        How the integration stopped (:mod:`walkerlab.integrate.ends`: ``heel_strike`` when
+        the strides asked for were made, ``t_final``, ``trip``, ``fall``, ...).
+    outcome : str
+        The run's verdict (``termination``, or ``slip``, ``scuff``, ``no_heel_strike``).
+    message : str
+        The outcome in one line.
+    walks : bool
+        The walker walked the run (:attr:`~walkerlab.analysis.contact.gait.ContactResult.verdict`).
+    x0 : ndarray, shape (N,)
+        The initial state [m, rad, m/s, rad/s].
+    x_ideal : ndarray, shape (2n,)
+        The rigid state the run started from (rigid role order) [rad, rad/s].
+    initial_rate_scale : ndarray, shape (2,)
+        Multipliers on the (swing, stance) rates of ``x_ideal`` [-].
+    step_length_m : float
+        Spacing of the terrain's patches [m] (the ideal step length, or the periodic gait's).
+    gait : walkerlab.analysis.contact.periodic.ContactPeriodicGait or None
+        The periodic gait the run started from (``contact_sim.start: periodic_gait``).
+    work : dict[str, ndarray (m,)]
+        A powered walker's work integrals since the start [J], by name
+        (``hip_torque_positive``, ``push_off``, ``contact``, ...); empty when passive.
+    step_ledger : dict[str, ndarray]
+        A powered walker's energy ledger per step
+        (:func:`walkerlab.analysis.contact.ledger.contact_step_ledger`); empty when passive.
+    result : walkerlab.analysis.contact.gait.ContactResult
+        The library's whole result (feet traces, touchdowns, counters).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    state_names: tuple
+    heel_strikes: np.ndarray
+    heel_strike_legs: tuple
+    steps: dict
+    normal_force: dict
+    friction_force: dict
+    penetration: dict
+    termination: str
+    outcome: str
+    message: str
+    walks: bool
+    x0: np.ndarray
+    x_ideal: np.ndarray
+    initial_rate_scale: np.ndarray
+    step_length_m: float
+    gait: Any = None
+    work: dict = field(default_factory=dict)
+    step_ledger: dict = field(default_factory=dict)
+    result: Any = None
+
+    @property
+    def step_periods(self) -> np.ndarray:
+        """Period of each step [s] (``steps["period"]``)."""
+        return self.steps["period"]
+
+    def column(self, name: str) -> np.ndarray:
+        """One state's samples (m,) by name (``walk.column("hip_x")``).
+
+        Raises
+        ------
+        KeyError
+            No state of that name (the message lists the names).
+        """
+        if name not in self.state_names:
+            raise KeyError(f"no state {name!r}; the contact walker's states are "
+                           f"{', '.join(self.state_names)}")
+        return self.x[:, self.state_names.index(name)]
+
+
+#: the step table's columns (the ``steps/`` group of ``contact_sim.h5``)
+_STEP_FIELDS = ("t_start", "t_end", "period", "stance_slip_mm", "double_support_creep_mm",
+                "bounce_count", "scuff_count", "peak_penetration_m", "liftoff_time")
+
+
+class ContactWalker:
+    """The contact (compliant-foot, floating-base) view of a scene's walker, in memory.
+
+    Build it with :meth:`from_scene` or :meth:`walkerlab.api.walker.Walker.contact`.  It
+    holds the scene's contact model once (:attr:`setup`: the walker's structure and
+    parameters, the contact law in SI, the knee stop, the actuators as forces, the run
+    options; :func:`walkerlab.models.contact.scene.contact_setup`), the model itself
+    (:attr:`model`, on no terrain), the integrator (:attr:`solver`, ``contact_solver``) and
+    the rigid view (:attr:`rigid`) whose gait starts a run.  Each run lays the terrain's
+    patches for its own start (they are spaced by its step length), as the stage does.
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+        A validated scene with a ``contact`` section (its ``walker``, ``slope``,
+        ``contact``, ``terrain``, ``contact_sim``, ``contact_solver`` and, for the rigid
+        gait, ``solver`` and ``fixedpoint`` sections are used).
+    rigid : Walker, optional
+        The scene's rigid walker (default: built here).
+    step_time_limit_s : float
+        As :class:`~walkerlab.api.walker.Walker` (the rigid view's steps).
+
+    Attributes
+    ----------
+    scene : walkerlab.config.Scene
+    setup : walkerlab.models.contact.scene.ContactSetup
+        The scene read once for the contact model (law in SI, walker data, actuators, run
+        options ``contact_sim``, solver settings).
+    model : walkerlab.models.contact.model.ContactWalker
+        The floating walker with compliant feet (state names, points, energies), on no
+        terrain.
+    solver : walkerlab.integrate.solver.Solver
+        The integrator of the scene's ``contact_solver`` section (default cyrk_bdf).
+    rigid : Walker
+        The rigid view (its gait starts the runs).
+
+    Raises
+    ------
+    walkerlab.models.contact.scene.ContactSceneError
+        No ``contact`` section, or a walker the contact view does not carry (one line:
+        :func:`~walkerlab.models.contact.scene.contact_setup`).
+    walkerlab.config.SceneError
+        A bad ``step_time_limit_s``.
+    """
+
+    def __init__(self, scene: Scene, rigid: Walker | None = None,
+                 step_time_limit_s: float = STEP_TIME_LIMIT_S):
+        from walkerlab.integrate.solver import Solver
+        from walkerlab.models.contact.model import ContactWalker as ContactModel
+        from walkerlab.models.contact.scene import contact_setup
+
+        self.scene = scene
+        self.setup = contact_setup(scene)
+        self.rigid = rigid if rigid is not None else Walker(scene, step_time_limit_s)
+        s = self.setup
+        self.model = ContactModel(contact=s.law_si, data=s.walker, knee_stop=s.knee_stop,
+                                  flat_foot=s.law.flat_foot(), actuators=s.actuators)
+        self.solver = Solver.from_settings(s.solver)
+        self._gait = None  # the rigid gait, found on first use
+        self._periodic_checked = False
+
+    @classmethod
+    def from_scene(cls, scene: Scene | str | Path | dict[str, Any],
+                   step_time_limit_s: float = STEP_TIME_LIMIT_S) -> ContactWalker:
+        """The contact walker of a scene: a YAML path, a mapping with the scene's sections,
+        or a loaded scene.
+
+        Raises
+        ------
+        walkerlab.config.SceneError
+            The file is missing or the scene does not validate (one line per field).
+        walkerlab.models.contact.scene.ContactSceneError
+            As :class:`ContactWalker`.
+        """
+        from walkerlab.api.scenes import as_scene
+
+        return cls(as_scene(scene), step_time_limit_s=step_time_limit_s)
+
+    def with_changes(self, changes: dict[str, Any]) -> ContactWalker:
+        """A new contact walker (and rigid walker) with scene fields set by dotted path
+        (``{"contact.mu_static": 0.6, "contact_sim.start": "periodic_gait"}``); this one is
+        unchanged.
+
+        Raises
+        ------
+        walkerlab.config.SceneError
+            An unknown field (with the closest name) or a value the field does not accept.
+        walkerlab.models.contact.scene.ContactSceneError
+            The changed scene's walker is one the contact view does not carry.
+        """
+        rigid = self.rigid.with_changes(changes)
+        return ContactWalker(rigid.scene, rigid)
+
+    def state_names(self) -> list[str]:
+        """Names of the floating walker's state (N,): the hip position, the link angles,
+        then their rates (``hip_x``, ``hip_y``, ``theta1``, ... , ``dhip_x``, ...)."""
+        return list(self.model.state_names())
+
+    def state_units(self) -> list[str]:
+        """Units of the state's entries (``m``, ``rad``, ``m/s``, ``rad/s``)."""
+        return list(self.model.state_units())
+
+    def contact_names(self) -> list[str]:
+        """Names of the contact points (``leg1``, ``leg2``; flat feet ``leg1_heel``, ...)."""
+        return list(self.model.contact_names())
+
+    def rigid_gait(self):
+        """The rigid view's period-1 gait (:meth:`Walker.fixed_point`, found once and kept):
+        the start of :meth:`simulate` and :meth:`periodic_gait`, as ``fixedpoint.h5`` is
+        the ``contact-sim`` stage's.
+
+        Raises
+        ------
+        walkerlab.analysis.gait.search.GaitNotFound
+            As :meth:`Walker.fixed_point`.
+        """
+        if self._gait is None:
+            self._gait = self.rigid.fixed_point()
+        return self._gait
+
+    def _start(self, x0, period_s) -> tuple[np.ndarray, float]:
+        """The rigid start ``x0`` (default the rigid gait) and its step period [s]."""
+        import numbers
+
+        from walkerlab.analysis.gait.poincare import StepFailed
+        from walkerlab.config import SceneError
+
+        if x0 is None:
+            if period_s is not None:
+                raise SceneError("simulate: period_s goes with x0 (without x0 the run starts "
+                                 "from the rigid gait with its own step period)")
+            gait = self.rigid_gait()
+            return gait.x, gait.step_period
+        x = self.rigid.check_state(x0, "x0")
+        if period_s is not None:
+            if (isinstance(period_s, bool) or not isinstance(period_s, numbers.Real)
+                    or not 0 < period_s < float("inf")):
+                raise SceneError(f"simulate: period_s={period_s!r}: give the rigid step "
+                                 "period from x0 as a positive number of seconds")
+            return x, float(period_s)
+        try:
+            step = self.rigid.step(x)
+        except StepFailed as exc:
+            raise SceneError(f"simulate: x0 sizes the run by its rigid step, which failed "
+                             f"({exc}); give period_s=...") from None
+        return x, step.period / self.rigid.model.steps_per_map
+
+    def _with_strides(self, strides):
+        """:attr:`setup` with ``contact_sim.n_strides`` set to ``strides`` (checked as the
+        field is)."""
+        import numbers
+
+        from walkerlab.config import MAX_CONTACT_STRIDES, SceneError
+
+        if strides is None:
+            return self.setup
+        if (isinstance(strides, bool) or not isinstance(strides, numbers.Integral)
+                or not 1 <= strides <= MAX_CONTACT_STRIDES):
+            raise SceneError(f"simulate: strides={strides!r}: give a whole number of strides "
+                             f"from 1 to {MAX_CONTACT_STRIDES} (as contact_sim.n_strides)")
+        sim = self.setup.sim.model_copy(update={"n_strides": int(strides)})
+        return dataclasses.replace(self.setup, sim=sim)
+
+    def simulate(self, x0=None, strides: int | None = None, *,
+                 period_s: float | None = None) -> ContactWalk:
+        """Walk the contact walker, started as the ``contact-sim`` stage starts it
+        (:func:`walkerlab.analysis.contact.record.contact_walk`): from the rigid state
+        ``x0`` with the stance foot at its static penetration and the rates times
+        ``contact_sim.initial_rate_scale`` (``start: ideal``), from the rates the
+        adjustment searches (``start: adjusted``), or from the contact model's own periodic
+        gait found from ``x0`` (``start: periodic_gait``); change the start with
+        :meth:`with_changes`.  With ``x0`` left out, the numbers are those of
+        ``walkerlab contact-sim`` for the same scene, bit for bit.
+
+        Parameters
+        ----------
+        x0 : array_like, shape (2n,), optional
+            A rigid post-impact state (:meth:`Walker.state_names` of :attr:`rigid`, leg1
+            swing, leg2 stance) [rad, rad/s]; default the rigid gait (:meth:`rigid_gait`).
+        strides : int, optional
+            Strides (two heel strikes each), 1 to
+            :data:`~walkerlab.config.MAX_CONTACT_STRIDES`; default ``contact_sim.n_strides``.
+        period_s : float, optional
+            The rigid step period from ``x0`` [s], which sizes the run's end time (default:
+            one rigid step from ``x0``; the rigid gait's own period without ``x0``).
+
+        Returns
+        -------
+        ContactWalk
+            Samples, heel strikes, the step table, contact forces by point, outcome.
+
+        Raises
+        ------
+        walkerlab.config.SceneError
+            ``x0`` not a finite rigid state of the walker's size (the message names the
+            states), ``strides`` not a whole number in range, a bad ``period_s``, or a rigid
+            step from ``x0`` that failed (one line each).
+        walkerlab.analysis.contact.step_map.PeriodicGaitError
+            ``start: periodic_gait`` and the periodic gait was not found (one line).
+        walkerlab.analysis.gait.search.GaitNotFound
+            No rigid gait to start from (``x0`` left out).
+        """
+        import numpy as np
+
+        from walkerlab.analysis.contact.ledger import contact_step_ledger
+        from walkerlab.analysis.contact.record import contact_walk
+
+        setup = self._with_strides(strides)
+        x_ideal, period = self._start(x0, period_s)
+        walker, res, x_start, step_length, scale, gait, _ = contact_walk(
+            setup, x_ideal, period, solver=self.solver)
+        steps = {k: np.array([getattr(s, k) for s in res.steps], dtype=float)
+                 for k in _STEP_FIELDS}
+        steps["stance_leg"] = np.array([s.stance_leg for s in res.steps], dtype=str)
+        points = res.points or res.feet
+        work, ledger = {}, {}
+        if res.work is not None:
+            names = tuple(walker.actuators.work_names)
+            work = {n: res.work[:, k] for k, n in enumerate(names)}
+            ledger = contact_step_ledger(walker, res.t, res.x, res.work,
+                                         res.heel_strike_times)
+        return ContactWalk(
+            t=res.t, x=res.x, state_names=tuple(res.state_names),
+            heel_strikes=np.asarray(res.heel_strike_times, float),
+            heel_strike_legs=tuple(res.heel_strike_legs), steps=steps,
+            normal_force={n: p.normal_force for n, p in points.items()},
+            friction_force={n: p.friction_force for n, p in points.items()},
+            penetration={n: p.penetration for n, p in points.items()},
+            termination=res.termination, outcome=res.outcome.kind,
+            message=res.outcome.message, walks=bool(res.verdict[0]),
+            x0=np.asarray(x_start, float), x_ideal=np.asarray(x_ideal, float),
+            initial_rate_scale=np.asarray(scale if scale is not None
+                                          else setup.sim.initial_rate_scale, float),
+            step_length_m=float(step_length), gait=gait, work=work, step_ledger=ledger,
+            result=res)
+
+    def periodic_gait(self, x0=None):
+        """The contact model's own periodic gait (fixed point of its mid-stance step map)
+        and its Floquet multipliers, as ``walkerlab contact-sim`` with
+        ``contact_sim.periodic_gait: true`` finds it
+        (:func:`walkerlab.analysis.contact.periodic.find_contact_periodic_gait`, from the
+        rigid state ``x0``, within ``contact_sim.periodic_time_limit_s``).
+
+        Parameters
+        ----------
+        x0 : array_like, shape (2n,), optional
+            The rigid state the search starts from [rad, rad/s]; default the rigid gait.
+
+        Returns
+        -------
+        walkerlab.analysis.contact.periodic.ContactPeriodicGait
+            ``fixed_point`` (the section state by name), ``period_s`` [s],
+            ``step_length_m`` [m], ``multipliers`` (n,) by decreasing modulus, ``jacobian``
+            (n, n), ``residual``, ``stable``, ``converged``, ``full_state`` (N,).
+
+        Raises
+        ------
+        walkerlab.config.SceneError
+            ``x0`` no rigid state of the walker (one line naming the states).
+        walkerlab.models.contact.scene.ContactSceneError
+            A walker whose contact periodic gait is not found yet (as ``contact_sim:
+            periodic_gait: true`` is refused for it; one line).
+        walkerlab.analysis.contact.step_map.PeriodicGaitError
+            The gait was not found (a step fell, found no mid-stance, the solver failed or
+            the time limit ran out; one line).
+        """
+        from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+
+        self._check_periodic()
+        x = self.rigid_gait().x if x0 is None else self.rigid.check_state(x0, "x0")
+        walker, _ = self.setup.build(x, 2 * self.setup.sim.n_strides)
+        return find_contact_periodic_gait(walker, x,
+                                          time_limit_s=self.setup.sim.periodic_time_limit_s)
+
+    def _check_periodic(self) -> None:
+        """Refuse a walker whose periodic gait the contact view does not find (the scene's
+        checks of ``contact_sim.periodic_gait: true``, run once on a copy of the scene)."""
+        cs = self.setup.sim
+        if cs.periodic_gait or cs.start == "periodic_gait" or self._periodic_checked:
+            return
+        from walkerlab.api.scenes import with_changes
+        from walkerlab.models.contact.scene import contact_setup
+
+        contact_setup(with_changes(self.scene, {"contact_sim.periodic_gait": True}))
+        self._periodic_checked = True
+
+    def __repr__(self) -> str:
+        return (f"ContactWalker({self.scene.name!r}, states={self.state_names()}, "
+                f"contacts={self.contact_names()})")
 
 def _short(value) -> str:
     """``repr(value)``, cut to 40 characters."""

@@ -82,15 +82,98 @@ def run_summary(res) -> dict:
     }
 
 
+def contact_walk(setup: ContactSetup, x_ideal: np.ndarray, period: float,
+                 adjust: bool = False, solver=None):
+    """The walking run of the ``contact-sim`` stage (its start and its integration, without
+    the periodic gait search, the drop test or the headline numbers): the contact walker of
+    a scene (its ``setup``, :func:`walkerlab.models.contact.scene.contact_setup`) started from
+    the ideal state ``x_ideal`` with the scene's rate scale, the rates ``adjust`` searches
+    (kept only when they walk better than the scene's own, or as well and match the ideal gait
+    better: :func:`~walkerlab.analysis.contact.adjust.better_start`), or the contact model's
+    own periodic gait (``contact_sim.start: periodic_gait``), for ``setup.sim.n_strides``
+    strides.  :func:`contact_sim_run` and the in-memory contact walker
+    (:class:`walkerlab.api.walker.ContactWalker`) both run it.
+
+    Parameters
+    ----------
+    setup : ContactSetup
+    x_ideal : ndarray, shape (2n,)
+        Rigid post-impact state (the rigid walker's ``state_names()``, leg1 swing, leg2
+        stance) [rad, rad/s]; the stage's is the fixed point of ``fixedpoint.h5``.
+    period : float
+        Rigid step period [s] from ``x_ideal`` (sizes the run's end time).
+    adjust : bool
+        Search the initial rates (``--adjust``; also with ``contact_sim.start: adjusted``).
+    solver : walkerlab.integrate.solver.Solver, optional
+        The run's integrator (default: the scene's ``contact_solver``, ``setup.solver``).
+
+    Returns
+    -------
+    walker : walkerlab.models.contact.model.ContactWalker
+        The contact model on the run's terrain.
+    result : walkerlab.analysis.contact.gait.ContactResult
+    x0 : ndarray, shape (N,)
+        The contact walker's initial state [m, rad, m/s, rad/s].
+    step_length : float
+        The patches' spacing [m] (ideal step length, or the periodic gait's).
+    scale : tuple of float or None
+        Multipliers on the (swing, stance) rates used (None: the scene's own).
+    gait : walkerlab.analysis.contact.periodic.ContactPeriodicGait or None
+        The periodic gait started from (``start: periodic_gait``), else None.
+    adjust : dict or None
+        The ``--adjust`` search's record (None without it).
+
+    Raises
+    ------
+    walkerlab.analysis.contact.step_map.PeriodicGaitError
+        ``start: periodic_gait`` and the gait was not found (one line naming the field).
+    """
+    from walkerlab.analysis.contact import sim as contact_run
+
+    cs = setup.sim
+    adj = scale = gait = None
+    tried = {}  # the --adjust search's runs of the scene's start and the best start
+    adjust = adjust or cs.start == "adjusted"
+    if adjust:
+        from walkerlab.analysis.contact.adjust import adjust_rates, better_start
+
+        adj = adjust_rates(setup, x_ideal, period)
+        tried = adj.pop("runs", None) or {}  # not made again
+        scale = adj["scale"]
+    if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
+        from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
+        from walkerlab.analysis.contact.step_map import PeriodicGaitError
+
+        try:
+            walker, res, x0, step_length, gait = simulate_from_periodic_gait(
+                setup, x_ideal, solver=solver)
+        except PeriodicGaitError as exc:
+            raise PeriodicGaitError(exc.kind, f"scene '{setup.name}': contact_sim.start: "
+                                    "periodic_gait: "
+                                    f"the contact walker's periodic gait was not found ({exc})"
+                                    ) from None
+        scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
+    else:
+        run = tried.get("best") or contact_run.simulate_from(
+            setup, x_ideal, period, scale, solver=solver)
+        if adjust:  # the adjusted start must walk better than the scene's own
+            plain = tried.get("scene") or contact_run.simulate_from(
+                setup, x_ideal, period, None, solver=solver)
+            adj["kept"], adj["kept_reason"] = better_start(
+                plain[1], run[1], adj.get("scene_objective", np.nan),
+                adj.get("objective", np.nan))
+            if adj["kept"] == "scene":
+                run, scale = plain, None
+        walker, res, x0, step_length = run
+    return walker, res, x0, step_length, scale, gait, adj
+
+
 def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: bool = False):
     """The ``contact-sim`` stage's run: the contact walker of a scene (its ``setup``,
     :func:`walkerlab.models.contact.scene.contact_setup`) started from the ideal fixed point
-    ``fp`` (a loaded ``fixedpoint.h5``) with the scene's rate scale, the rates ``adjust``
-    searches (kept only when they walk better than the scene's own, or as well and match the
-    ideal gait better: :func:`~walkerlab.analysis.contact.adjust.better_start`), or the contact
-    model's own periodic gait (``contact_sim.start: periodic_gait``); with ``periodic`` (or
-    that start) its periodic gait and Floquet multipliers; the drop test and the headline
-    numbers.
+    ``fp`` (a loaded ``fixedpoint.h5``) as :func:`contact_walk` runs it; with ``periodic``
+    (or ``contact_sim.start: periodic_gait``) its periodic gait and Floquet multipliers; the
+    drop test and the headline numbers.
 
     Returns
     -------
@@ -105,41 +188,9 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     from walkerlab.io.schemas.contact_sim import ContactSimRun
 
     cs = setup.sim
-    adj = scale = None
-    tried = {}  # the --adjust search's runs of the scene's start and the best start
-    gait = gait_error = None
-    adjust = adjust or cs.start == "adjusted"
-    if adjust:
-        from walkerlab.analysis.contact.adjust import adjust_rates, better_start
-
-        adj = adjust_rates(setup, fp.x, fp.step_period_s)
-        tried = adj.pop("runs", None) or {}  # not made again
-        scale = adj["scale"]
-    if cs.start == "periodic_gait":  # steady state: the contact model's own periodic gait
-        from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
-        from walkerlab.analysis.contact.step_map import PeriodicGaitError
-
-        try:
-            walker, res, x0, step_length, gait = simulate_from_periodic_gait(
-                setup, fp.x)
-        except PeriodicGaitError as exc:
-            raise PeriodicGaitError(exc.kind, f"scene '{setup.name}': contact_sim.start: "
-                                    "periodic_gait: "
-                                    f"the contact walker's periodic gait was not found ({exc})"
-                                    ) from None
-        scale = (1.0, 1.0)  # the start is the gait's state, not scaled rates
-    else:
-        run = tried.get("best") or contact_run.simulate_from(
-            setup, fp.x, fp.step_period_s, scale)
-        if adjust:  # the adjusted start must walk better than the scene's own
-            plain = tried.get("scene") or contact_run.simulate_from(
-                setup, fp.x, fp.step_period_s, None)
-            adj["kept"], adj["kept_reason"] = better_start(
-                plain[1], run[1], adj.get("scene_objective", np.nan),
-                adj.get("objective", np.nan))
-            if adj["kept"] == "scene":
-                run, scale = plain, None
-        walker, res, x0, step_length = run
+    gait_error = None
+    walker, res, x0, step_length, scale, gait, adj = contact_walk(
+        setup, fp.x, fp.step_period_s, adjust)
     if periodic and gait is None:
         from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
         from walkerlab.analysis.contact.step_map import PeriodicGaitError

@@ -99,11 +99,16 @@ def with_variant(scene: Scene, variant: str) -> Scene:
     return scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
 
 
-def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None):
+def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, solver=None):
     """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
     ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
     scene's initial guess; ``walker`` (default: the scene's, ``build_walker``) another
     rigid model of it (a flat foot's without its double support).
+
+    ``walker`` (a :class:`HybridWalker`) and ``solver`` (a
+    :class:`~walkerlab.integrate.solver.Solver`) are the scene's model and integrator when
+    the caller holds them already (the in-memory :class:`walkerlab.api.walker.Walker`);
+    default: built here from the scene (:func:`build_walker`, ``Solver.from_settings``).
 
     Returns
     -------
@@ -119,8 +124,9 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None):
     """
     fp = _settings(scene)
     walker = build_walker(scene) if walker is None else walker
+    solver = Solver.from_settings(scene.solver) if solver is None else solver
     start = initial_guess(scene, walker) if guess is None else guess
-    search = find_gaits(walker, Solver.from_settings(scene.solver), start,
+    search = find_gaits(walker, solver, start,
                         policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
                         fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
                         fd_check=fd_check)
