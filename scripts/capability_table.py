@@ -10,12 +10,15 @@ built and handed to the checkout that ``PYTHONPATH`` selects; nothing long is so
   law tracking a phase ``reference`` table) is built (``walkerlab.api.walker.Walker``) and
   one Poincaré-map step runs from the scene's ``fixedpoint.initial_guess``.  Accepted: it
   builds and the step runs (a step that ends in a fall guard is the walker's dynamics, not
-  a refusal: marked ``✓ (fell)``).  A five-link biped's virtual constraints are its shipped
-  four-joint law (``configs/rabbit.yaml``).
+  a refusal: marked ``✓ (fell)``).  The step starts from the shipped scene's gait
+  (``Walker.fixed_point``; its initial guess if none is found).  A walker shipped with
+  actuators (the five-link biped) keeps them, the cell's actuator added where it has none
+  at that joint; its virtual constraints are its shipped four-joint law.
 - **optimize**: ``walkerlab optimize SCENE`` with CasADi's ``Opti.solve`` replaced by an
   exit: accepted when the stage reaches IPOPT (every refusal check and the transcription's
-  set-up passed).
-- **design**: ``walkerlab optimize SCENE --design walker.gravity_m_per_s2=LO:HI`` with
+  set-up passed).  A five-link biped's scene gets configs/rabbit_optimal.yaml's targets
+  (its least effort needs one).
+- **design**: ``walkerlab optimize SCENE --design slope.angle_rad=LO:HI`` (±10 %) with
   ``scipy.optimize.minimize`` replaced by one evaluation of the objective and its gradient
   at the start, then an exit.
 - **MJCF / Adams export**: ``walkerlab export SCENE --format mjcf|adm`` into a temporary
@@ -119,22 +122,41 @@ HIP_REFERENCE = {"phase_rad": [-0.4, 0.4], "angle_rad": [0.8, -0.8],
                  "interpolation": "linear"}
 
 
+def with_actuator(shipped: dict | None, label: str, add: dict) -> tuple[str, dict]:
+    """The cell's actuation: the one actuator alone on a passive walker; on a walker shipped
+    with actuators (the five-link biped, which falls without them) its own section, with the
+    actuator added where it has none at that joint (its own law kept where it has)."""
+    if not shipped:
+        return label, add
+    act = json.loads(json.dumps(shipped))
+    if "push_off" in add:
+        if act.get("push_off"):
+            return "shipped", act
+        act["push_off"] = add["push_off"]
+        return f"shipped + {label}", act
+    joint = add["torques"][0]["joint"]
+    if any(t["joint"] == joint for t in act.get("torques", [])):
+        return "shipped", act
+    act["torques"] = [*act.get("torques", []), *add["torques"]]
+    return f"shipped + {label}", act
+
+
 def actuation_variants(scene: dict, cap: str) -> list[tuple[str, dict]]:
     """The ``walker.actuation`` sections to try for a torque / push-off cell (the first one
     accepted counts), each with a label."""
+    shipped = scene["walker"].get("actuation")
     if cap == "hip":
-        return [("hip", {"torques": [torque("hip")]})]
+        return [with_actuator(shipped, "hip", {"torques": [torque("hip")]})]
     if cap == "knee":
-        return [("swing_knee", {"torques": [torque("swing_knee")]}),
-                ("stance_knee", {"torques": [torque("stance_knee")]})]
+        return [with_actuator(shipped, j, {"torques": [torque(j)]})
+                for j in ("swing_knee", "stance_knee")]
     if cap == "ankle":
-        return [("stance_ankle", {"torques": [torque("stance_ankle")]})]
+        return [with_actuator(shipped, "stance_ankle", {"torques": [torque("stance_ankle")]})]
     if cap == "torso":
-        return [("stance_hip", {"torques": [torque("stance_hip")]})]
+        return [with_actuator(shipped, "stance_hip", {"torques": [torque("stance_hip")]})]
     if cap == "push_off":
-        return [("push_off", {"push_off": {"impulse_n_s": 0.05}})]
+        return [with_actuator(shipped, "push_off", {"push_off": {"impulse_n_s": 0.05}})]
     if cap == "virtual_constraints":
-        shipped = scene["walker"].get("actuation")
         if shipped and any(t.get("law", {}).get("reference") for t in
                            shipped.get("torques", [])):
             return [("shipped", shipped)]
@@ -172,8 +194,9 @@ def _on_alarm(signum, frame):
     raise CellTimeout
 
 
-def rigid_cell(scene: dict, cap: str, timeout_s: float) -> dict:
-    """Build the rigid walker with the cell's actuator and run one map step."""
+def rigid_cell(scene: dict, cap: str, timeout_s: float, start=None) -> dict:
+    """Build the rigid walker with the cell's actuator and run one map step from ``start``
+    (the shipped scene's gait; None: the scene's initial guess)."""
     if not applicable(scene, cap):
         return {"status": "n/a", "message": "", "detail": ""}
     out: dict = {}
@@ -184,28 +207,30 @@ def rigid_cell(scene: dict, cap: str, timeout_s: float) -> dict:
         signal.signal(signal.SIGPROF, _on_alarm)
         signal.setitimer(signal.ITIMER_PROF, timeout_s)
         try:
-            out = run_step(s)
+            out = run_step(s, start)
         except CellTimeout:
             out = {"status": "timeout", "message": f"no answer in {timeout_s:g} s CPU",
                    "detail": ""}
         finally:
             signal.setitimer(signal.ITIMER_PROF, 0)
         out["variant"] = label
+        out["start"] = "initial guess" if start is None else "shipped gait"
         out["cpu_s"] = round(time.process_time() - t0, 2)
         if out["status"] == "accepted":
             break
     return out
 
 
-def run_step(scene: dict) -> dict:
-    """Build ``Walker.from_scene(scene)`` and step once from the scene's initial guess."""
+def run_step(scene: dict, start=None) -> dict:
+    """Build ``Walker.from_scene(scene)`` and step once from ``start`` (None: the scene's
+    initial guess)."""
     from walkerlab.analysis.gait.poincare import StepFailed
     from walkerlab.analysis.gait.scene import initial_guess
     from walkerlab.api.walker import Walker
 
     try:
         w = Walker.from_scene(scene, step_time_limit_s=60.0)
-        x0 = initial_guess(w.scene, w.model)
+        x0 = initial_guess(w.scene, w.model) if start is None else start
     except CellTimeout:
         raise
     except Exception as exc:  # noqa: BLE001 - any refusal is the cell's answer
@@ -228,20 +253,48 @@ def run_step(scene: dict) -> dict:
 def rigid_family(family: str, caps: list[str], timeout_s: float) -> dict:
     """All rigid cells of a family (in this process)."""
     scene = load(family)
-    return {cap: rigid_cell(scene, cap, timeout_s) for cap in caps}
+    start = shipped_gait(scene, timeout_s)
+    return {cap: rigid_cell(scene, cap, timeout_s, start) for cap in caps}
+
+
+def shipped_gait(scene: dict, timeout_s: float):
+    """The shipped scene's period-1 gait (``Walker.fixed_point``) as the steps' start, or
+    None (then the initial guess) if it is not found within ``timeout_s`` of CPU."""
+    from walkerlab.api.walker import Walker
+
+    signal.signal(signal.SIGPROF, _on_alarm)
+    signal.setitimer(signal.ITIMER_PROF, timeout_s)
+    try:
+        return Walker.from_scene(scene).fixed_point().x
+    except (CellTimeout, Exception):  # noqa: BLE001 - the initial guess then
+        return None
+    finally:
+        signal.setitimer(signal.ITIMER_PROF, 0)
 
 
 # ---------------------------------------------------------------------------- command cells
 
+#: an ``optimize`` section a family's optimisation needs (a five-link biped's least effort
+#: needs a target: configs/rabbit_optimal.yaml's 0.5 m in 0.7 s)
+OPTIMIZE_SECTION = {"five-link": {"target_step_length_m": 0.5, "target_step_period_s": 0.7}}
+
+
 def command_args(family: str, cap: str, runs: Path) -> list[str]:
-    """The walkerlab command of a command cell."""
+    """The walkerlab command of a command cell (a changed scene written into ``runs``)."""
     scene = str(ROOT / FAMILIES[family])
+    if cap in ("optimize", "design") and family in OPTIMIZE_SECTION:
+        d = load(family)
+        d.setdefault("optimize", OPTIMIZE_SECTION[family])
+        runs.mkdir(parents=True, exist_ok=True)
+        scene = str(runs / Path(FAMILIES[family]).name)
+        Path(scene).write_text(yaml.safe_dump(d, sort_keys=False))
     if cap == "optimize":
         return ["optimize", scene, "--runs-dir", str(runs)]
-    if cap == "design":
-        g = float(load(family)["walker"]["gravity_m_per_s2"])
+    if cap == "design":  # the slope, +-10 % (level ground: +-0.005 rad)
+        phi = float(load(family)["slope"]["angle_rad"])
+        lo, hi = (0.9 * phi, 1.1 * phi) if phi > 0 else (phi - 0.005, phi + 0.005)
         return ["optimize", scene, "--runs-dir", str(runs), "--design",
-                f"walker.gravity_m_per_s2={0.95 * g:g}:{1.05 * g:g}"]
+                f"slope.angle_rad={lo:.6g}:{hi:.6g}"]
     if cap == "mjcf":
         return ["export", scene, "--format", "mjcf", "--runs-dir", str(runs)]
     if cap == "adams":
@@ -305,7 +358,8 @@ def command_cell(family: str, cap: str, runs: Path, timeout_s: float) -> dict:
         out.update(status="timeout", message=f"no answer in {timeout_s:g} s CPU",
                    detail=stderr[-500:])
     else:
-        out.update(status="refused", message=one_line(stderr or stdout),
+        out.update(status="refused",
+                   message=one_line(stderr or stdout).replace(f"{runs}/", ""),
                    detail=(stderr or stdout)[-2000:])
     return out
 
