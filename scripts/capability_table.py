@@ -200,6 +200,7 @@ def rigid_cell(scene: dict, cap: str, timeout_s: float, start=None) -> dict:
     if not applicable(scene, cap):
         return {"status": "n/a", "message": "", "detail": ""}
     out: dict = {}
+    first: dict | None = None
     for label, act in actuation_variants(scene, cap):
         s = json.loads(json.dumps(scene))
         s["walker"]["actuation"] = act
@@ -217,8 +218,9 @@ def rigid_cell(scene: dict, cap: str, timeout_s: float, start=None) -> dict:
         out["start"] = "initial guess" if start is None else "shipped gait"
         out["cpu_s"] = round(time.process_time() - t0, 2)
         if out["status"] == "accepted":
-            break
-    return out
+            return out
+        first = first or out
+    return first or out
 
 
 def run_step(scene: dict, start=None) -> dict:
