@@ -101,7 +101,7 @@ def test_patch_width_map_on_continuous_ground_says_it_does_not_apply(tmp_path):
     from walkerlab.stages.common import StageError
 
     scene = load_scene("configs/kneed.yaml")
-    with pytest.raises(StageError, match=r"does not apply.*continuous.*terrain\.kind") as e:
+    with pytest.raises(StageError, match=r"does not apply.*continuous.*terrain\.lanes") as e:
         stability_map.run(scene, tmp_path, kind="patch_width", n=2)
     assert "\n" not in str(e.value)
     assert not list(tmp_path.rglob("*.h5"))

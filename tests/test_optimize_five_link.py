@@ -57,17 +57,18 @@ def test_the_step_functions_are_built_once_and_cached(fns_and_params, tmp_path,
                                                      monkeypatch):
     """A miss derives (sympy) and writes the user cache; the next process reads it back
     (no derivation) and computes the same; a damaged file is derived again."""
+    from walkerlab.codegen import casadi_functions
     from walkerlab.optimal.transcription import free_joint_functions as fl
 
     built = {k: v for k, v in fns_and_params[0].items() if k != "n"}
     calls = []
     monkeypatch.setenv("WALKERLAB_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(fl, "_build", lambda s: calls.append(s) or dict(built))
-    monkeypatch.setattr(fl, "_memo", {})
+    monkeypatch.setattr(casadi_functions, "_memo", {})
     structure = walker_data(scene_from_dict(SCENE).walker, 0.0).structure
     fl.five_link_functions(structure)
     assert len(calls) == 1
-    fl._memo.clear()
+    casadi_functions.clear_memo()
     got = fl.five_link_functions(structure)
     assert len(calls) == 1 and got["n"] == 5
     x, p = states()[0], fns_and_params[1]
@@ -75,7 +76,7 @@ def test_the_step_functions_are_built_once_and_cached(fns_and_params, tmp_path,
                                   np.asarray(built["flow"](x, TAU, p)))
     (path,) = (tmp_path / "models").glob("*-collocation-*.casadi")
     path.write_text(path.read_text()[:-40])
-    fl._memo.clear()
+    casadi_functions.clear_memo()
     fl.five_link_functions(structure)
     assert len(calls) == 2
 
