@@ -117,7 +117,8 @@ def test_a_level_ground_optimal_gait_starts_from_its_targets():
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.driver import collocation_spec
     from walkerlab.optimal.guess import starting_step
-    from walkerlab.optimal.transcription.step import collocate_step, replay
+    from walkerlab.optimal.transcription.mode_sequence import collocate_step
+    from walkerlab.optimal.transcription.step import replay
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
     from walkerlab.stages import pipeline
     from walkerlab.walker.description import walker_data

@@ -72,7 +72,8 @@ def test_arc_feet_and_a_torso_are_optimised_and_an_arc_foot_push_off_refused_in_
     in one line naming the field."""
     pytest.importorskip("casadi")
     from walkerlab.codegen import symbolic
-    from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step, step_functions
+    from walkerlab.optimal.transcription.mode_sequence import collocate_step
+    from walkerlab.optimal.transcription.step import CollocationSpec, step_functions
     from walkerlab.walker.description import walker_data
 
     for name in ("round_feet", "torso_bhm"):

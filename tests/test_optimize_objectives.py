@@ -20,12 +20,8 @@ from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.optimal.driver import collocation_spec
 from walkerlab.optimal.guess import simulated_step
-from walkerlab.optimal.transcription.step import (
-    CollocationSpec,
-    collocate_step,
-    replay,
-    step_functions,
-)
+from walkerlab.optimal.transcription.mode_sequence import collocate_step
+from walkerlab.optimal.transcription.step import CollocationSpec, replay, step_functions
 from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")

@@ -346,11 +346,12 @@ def replay_multipliers(replayed, res, scene, err: float) -> np.ndarray:
 
 def _step(scene, data, spec, x_gait, period_s) -> Optimum:
     """One step of straight legs (point or arc feet, a torso, massless legs with a hip
-    mass): :func:`walkerlab.optimal.transcription.step.collocate_step`."""
+    mass): :func:`walkerlab.optimal.transcription.mode_sequence.collocate_step`."""
     from walkerlab.models.registry import build_walker
     from walkerlab.optimal.guess import starting_step
     from walkerlab.optimal.replay.contact import contact_replay
-    from walkerlab.optimal.transcription.step import collocate_step, replay, torque_of_time
+    from walkerlab.optimal.transcription.mode_sequence import collocate_step
+    from walkerlab.optimal.transcription.step import replay, torque_of_time
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
 
     o = scene.optimize

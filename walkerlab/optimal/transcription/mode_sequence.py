@@ -1,8 +1,12 @@
-"""The multi-phase transcription of :mod:`walkerlab.optimal.transcription.phases`: one step of a
-walker
-with a fixed mode sequence (a kneed walker's unlocked and locked swing) optimised by
-Hermite-Simpson collocation per phase (CasADi ``Opti`` + IPOPT), its starting guess from
-the rigid model's own step and its replay on the rigid model.
+"""The one multi-phase transcription of ``walkerlab optimize``: a step (or a stride) as a
+sequence of the walker's phases (:mod:`walkerlab.optimal.transcription.phases`; a kneed
+walker's unlocked and locked swing, flat feet's modes, a stride's steps of the walker and
+its mirror: :mod:`walkerlab.optimal.transcription.stride`) optimised by Hermite-Simpson
+collocation per phase (CasADi ``Opti`` + IPOPT), its starting guess from the rigid model's
+own step and its replay on the rigid model.  One step of straight legs is the sequence of
+one phase (:func:`collocate_step`: its flow, heel-strike guard and reset, push-off
+included, from :func:`walkerlab.optimal.transcription.step.step_functions`, on a uniform
+mesh; the transcription of :mod:`walkerlab.optimal.transcription.step`'s docstring).
 """
 
 from __future__ import annotations
@@ -14,8 +18,8 @@ import numpy as np
 
 from walkerlab.optimal.transcription.ipopt import iteration_history, solve
 
-__all__ = ["PhasedResult", "collocate_phases", "optimized_guess", "phase_torque_of_time",
-           "phased_guess", "replay_phases"]
+__all__ = ["PhasedResult", "collocate_phases", "collocate_step", "optimized_guess",
+           "phase_torque_of_time", "phased_guess", "replay_phases", "step_phase"]
 
 #: objectives the phased transcription takes
 #: (:data:`walkerlab.optimal.transcription.step.OBJECTIVES`)
@@ -218,7 +222,7 @@ def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
     d = mp.direction
     opti.subject_to(mp.guard(X[:, -1], U[-1]) == 0)
     opti.subject_to(d * mp.guard_rate(X[:, -1], U[-1]) >= spec.touchdown_rate_rad_per_s)
-    for k in range(1, K - 1):  # the event has not happened inside the phase
+    for k in range(1, K - 1) if mp.inside else ():  # the event has not happened inside
         opti.subject_to(d * mp.guard(X[:, k], U[k]) <= 0)
     if mp.keep is not None:  # unilateral contacts push
         for k in range(K):
@@ -390,6 +394,8 @@ def _targets(opti, spec, fns, Xs, period):
 def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> PhasedResult:
     """Run IPOPT and read the phases back as one step (``push``: the push-off impulse, a
     number or the decision variable)."""
+    from walkerlab.optimal.transcription.step import number
+
     status, get, wall, cpu = solve(opti)
     n2 = Xs[0].shape[0]
     ts, xs, us, starts, durs, offset = [], [], [], [], [], 0.0
@@ -408,7 +414,7 @@ def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> P
         step_length_m=float(fns["phases"][-1].step(X_all[-1])), objective=float(get(obj)),
         status=status,
         iterations=int(opti.stats().get("iter_count", -1)), build_time_s=build,
-        wall_time_s=wall, cpu_time_s=cpu, terms={k: float(get(v)) for k, v in terms.items()},
+        wall_time_s=wall, cpu_time_s=cpu, terms={k: number(get(v)) for k, v in terms.items()},
         history=iteration_history(opti.stats()),
         push_off_n_s=float(push) if isinstance(push, (int, float)) else float(get(push)))
 
@@ -465,3 +471,85 @@ def replay_phases(data, res: PhasedResult, solver=None):
     if seg.termination != "heel_strike" or crossed != tuple(res.phase_names):
         return float("inf"), walker
     return float(np.max(np.abs(seg.x_next - res.x[0]))), walker
+
+
+def step_phase(fns: dict):
+    """One step of straight legs as a phase
+    (:class:`walkerlab.optimal.transcription.phases.ModePhase`) from its one-step functions
+    ``fns`` (:func:`walkerlab.optimal.transcription.step.step_functions`): the flow, the
+    heel strike's guard (crossed downward) and rate, the reset without and with a push-off
+    (and its work), the clearance, the step length and the ground reaction; no guard sign
+    kept inside (``inside=False``: the swing foot of straight legs may dip through the
+    ground mid-swing, the clearance bound is ``optimize.min_clearance_m``)."""
+    import casadi as ca
+
+    from walkerlab.optimal.transcription.phases import ModePhase
+
+    x, u, P = ca.MX.sym("x", 2 * fns["n"]), ca.MX.sym("u"), ca.MX.sym("P")
+    return ModePhase("step", "heel_strike", -1, fns["flow"],
+                     ca.Function("guard", [x, u], [fns["guard"](x)]), fns["guard_rate"],
+                     ca.Function("reset", [x], [fns["reset"](x, 0.0)]),
+                     clearance=fns["clearance"], step=fns["step"], grf=fns["grf"],
+                     push_off=ca.Function("push_off", [x, P], [fns["reset"](x, P),
+                                                               fns["push_off_work"](x, P)]),
+                     inside=False)
+
+
+def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
+                   guess_u: np.ndarray | None = None, fns: dict | None = None):
+    """Optimise one step of straight legs (the transcription of
+    :mod:`walkerlab.optimal.transcription.step`'s docstring) as the sequence of one phase
+    (:func:`step_phase`) on a uniform mesh of ``spec.intervals`` intervals.
+
+    Parameters
+    ----------
+    data : WalkerData
+    eq : Equations or None
+        ``walkerlab.codegen.symbolic.derive(data.structure)`` (unused when ``fns`` is
+        given, e.g. by :func:`walkerlab.optimal.transcription.step_cache.
+        cached_step_functions`).
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
+    guess_t : ndarray (m,)
+        Times [s] of a guess step (e.g. a simulated gait from heel strike to heel strike).
+    guess_x : ndarray (m, 2n)
+        Its states.
+    guess_u : ndarray (m,), optional
+        Its hip torque [N m] (default 0).
+    fns : dict, optional
+        :func:`~walkerlab.optimal.transcription.step.step_functions` of the walker (built
+        when not given).
+
+    Returns
+    -------
+    walkerlab.optimal.transcription.step.CollocationResult
+
+    Raises
+    ------
+    ValueError
+        A walker this transcription does not handle, an unknown objective (one line).
+    """
+    from walkerlab.optimal.transcription.step import (
+        CollocationResult,
+        check_objective,
+        step_functions,
+    )
+
+    if data.structure.foot == "arc" and (spec.push_off_free or spec.push_off_n_s):
+        raise ValueError("optimize: a push-off on arc feet (at the rolling contact point) "
+                         "is not in the rigid model yet; optimise the hip torque alone "
+                         "(no walker.actuation.push_off, optimize.push_off: fixed)")
+    fns = fns or step_functions(data, eq)
+    check_objective(spec)
+    K = 2 * int(spec.intervals) + 1
+    tk = np.linspace(0.0, 1.0, K) * guess_t[-1]
+    x = np.stack([np.interp(tk, guess_t, guess_x[:, c]) for c in range(guess_x.shape[1])],
+                 axis=1)
+    u = np.interp(tk, guess_t, np.zeros_like(guess_t) if guess_u is None else guess_u)
+    res = collocate_phases({**fns, "phases": [step_phase(fns)]}, spec, [("step", tk, x)],
+                           [u])
+    return CollocationResult(
+        t=res.t, x=res.x, u=res.u, step_period_s=res.step_period_s,
+        step_length_m=res.step_length_m, push_off_n_s=res.push_off_n_s,
+        objective=res.objective, status=res.status, iterations=res.iterations,
+        wall_time_s=res.wall_time_s, terms={"push_off_work": 0.0, **res.terms},
+        history=res.history)
