@@ -290,7 +290,8 @@ def _reset_plastic(eq, xs, vals, x, P):
     """The heel strike of any straight-legged walker from its generated model, without a
     push-off: the plastic impact ``Mi dq+ = B dq-`` (:mod:`walkerlab.codegen.symbolic`,
     the map the rigid model's generated code prints) and the role swap; the push-off's
-    work 0 (arc feet: their push-off is refused by :func:`collocate_step`)."""
+    work 0 (arc feet: their push-off is refused by
+    :func:`walkerlab.optimal.transcription.mode_sequence.collocate_step`)."""
     n = len(eq.q)
     import casadi as ca
 
