@@ -63,16 +63,24 @@ def test_an_optimum_becomes_the_artifacts_record_field_for_field():
     assert d.phase_replays["feedback"].return_error == 3e-12 and d.step_period_s == 0.7
 
 
+def _calls(path: Path, name: str) -> set:
+    tree = ast.parse(path.read_text())
+    body = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == name)
+    return {c.func.id for c in ast.walk(body) if isinstance(c, ast.Call)
+            and isinstance(c.func, ast.Name)}
+
+
 def test_one_step_is_a_sequence_of_one_phase():
     """The one-step transcription has no defects, objective or constraints of its own: its
-    ``collocate_step`` is the multi-phase transcription's, over the step as one phase."""
+    ``collocate_step`` is the multi-phase transcription's, over the step as one phase; a
+    five-link biped's step is one phase of it too, with its four joint torques."""
     step = (PKG / "optimal" / "transcription" / "step.py").read_text()
     tree = ast.parse(step)
     defs = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
     assert not defs & {"collocate_step", "_transcribe", "_path_constraints", "_terms"}
-    seq = ast.parse((PKG / "optimal" / "transcription" / "mode_sequence.py").read_text())
-    body = next(n for n in seq.body if isinstance(n, ast.FunctionDef)
-                and n.name == "collocate_step")
-    calls = {c.func.id for c in ast.walk(body) if isinstance(c, ast.Call)
-             and isinstance(c.func, ast.Name)}
-    assert {"collocate_phases", "step_phase"} <= calls
+    tx = PKG / "optimal" / "transcription"
+    assert {"collocate_phases", "step_phase"} <= _calls(tx / "mode_sequence.py",
+                                                        "collocate_step")
+    assert {"collocate_phases", "step_sequence"} <= _calls(tx / "free_joints.py",
+                                                           "collocate_five_link")
+    assert "ca.Opti()" not in (tx / "free_joints.py").read_text()

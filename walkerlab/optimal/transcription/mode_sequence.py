@@ -6,7 +6,10 @@ collocation per phase (CasADi ``Opti`` + IPOPT), its starting guess from the rig
 own step and its replay on the rigid model.  One step of straight legs is the sequence of
 one phase (:func:`collocate_step`: its flow, heel-strike guard and reset, push-off
 included, from :func:`walkerlab.optimal.transcription.step.step_functions`, on a uniform
-mesh; the transcription of :mod:`walkerlab.optimal.transcription.step`'s docstring).
+mesh; the transcription of :mod:`walkerlab.optimal.transcription.step`'s docstring); a
+five-link biped's step is one phase with its four joint torques
+(:func:`walkerlab.optimal.transcription.free_joints.step_sequence`: its own constraints and
+IPOPT options beside).
 """
 
 from __future__ import annotations
@@ -212,21 +215,27 @@ def _simpson(T, tau, values):
 def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
     """One phase's defects (on the mesh ``T tau``), its guard at the end (transversal) and
     inside (its sign), its unilateral contacts and the path constraints."""
+    import casadi as ca
+
     K = X.shape[1]
-    f = [mp.flow(X[:, k], U[k]) for k in range(K)]
+    several = U.shape[0] > 1  # several torques (k, K): a column a point
+
+    def at(k):
+        return U[:, k] if several else U[k]
+    f = [mp.flow(X[:, k], at(k)) for k in range(K)]
     for i in range(0, K - 1, 2):
         m, j = i + 1, i + 2
         h = T * (tau[j] - tau[i])
         opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (f[i] - f[j]))
         opti.subject_to(X[:, j] == X[:, i] + h / 6 * (f[i] + 4 * f[m] + f[j]))
     d = mp.direction
-    opti.subject_to(mp.guard(X[:, -1], U[-1]) == 0)
-    opti.subject_to(d * mp.guard_rate(X[:, -1], U[-1]) >= spec.touchdown_rate_rad_per_s)
+    opti.subject_to(mp.guard(X[:, -1], at(-1)) == 0)
+    opti.subject_to(d * mp.guard_rate(X[:, -1], at(-1)) >= spec.touchdown_rate_rad_per_s)
     for k in range(1, K - 1) if mp.inside else ():  # the event has not happened inside
-        opti.subject_to(d * mp.guard(X[:, k], U[k]) <= 0)
+        opti.subject_to(d * mp.guard(X[:, k], at(k)) <= 0)
     if mp.keep is not None:  # unilateral contacts push
         for k in range(K):
-            opti.subject_to(mp.keep(X[:, k], U[k]) >= 0)
+            opti.subject_to(mp.keep(X[:, k], at(k)) >= 0)
     if spec.min_clearance_m is not None:
         for k in range(1 if first else 0, K - 1 if last else K):
             opti.subject_to(mp.clearance(X[:, k]) >= spec.min_clearance_m)
@@ -239,10 +248,10 @@ def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
     if spec.friction_coefficient is not None:  # the stance foot's resultant in its cone
         mu = spec.friction_coefficient
         for k in range(K):
-            F = mp.grf(X[:, k], U[k])
+            F = mp.grf(X[:, k], at(k))
             opti.subject_to(F[0] >= 0)
             opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
-    return _simpson(T, tau, U ** 2)
+    return _simpson(T, tau, ca.sum1(U ** 2) if several else U ** 2)
 
 
 def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
@@ -293,7 +302,13 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     Parameters
     ----------
     fns : dict
-        :func:`walkerlab.optimal.transcription.phases.mode_functions` of the walker.
+        :func:`walkerlab.optimal.transcription.phases.mode_functions` of the walker (or a
+        sequence of the same keys: :func:`step_phase`'s, :func:`walkerlab.optimal.
+        transcription.free_joints.step_sequence`); optional keys: ``torques`` (torques at
+        every point, default 1: ``u`` (k,) then, its effort ``int |u|^2 dt``), ``power``
+        (absent: no cost of transport), ``constrain(opti, Xs, Us, Ts)`` (a walker's own
+        constraints on the decision variables) and ``solver`` (``(plugin options, IPOPT
+        options)``, default :func:`walkerlab.optimal.transcription.step.ipopt_options`).
     spec : walkerlab.optimal.transcription.step.CollocationSpec
         Its ``intervals`` are shared among the phases by ``guess``'s meshes.
     guess : list of (name, t, x)
@@ -324,7 +339,8 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     n2, P = 2 * fns["n"], len(phases)
     opti = ca.Opti()
     Xs = [opti.variable(n2, g[1].size) for g in guess]
-    Us = [opti.variable(1, g[1].size) for g in guess]
+    nu = int(fns.get("torques", 1))  # torques at every point (a five-link biped: 4)
+    Us = [opti.variable(nu, g[1].size) for g in guess]
     Ts = [opti.variable() for _ in guess]
     effort, po_work, strikes = 0, 0, 0
     push = opti.variable() if spec.push_off_free else spec.push_off_n_s
@@ -347,17 +363,20 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
         opti.subject_to(opti.bounded(0.05 * Tg, Ts[p], 5.0 * Tg))
         opti.set_initial(Ts[p], Tg)
         opti.set_initial(Xs[p], guess[p][2].T)
-        opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)) if guess_u is None
-                         else np.asarray(guess_u[p], float)[None])
+        size = guess[p][1].size
+        opti.set_initial(Us[p], np.zeros((nu, size)) if guess_u is None
+                         else np.asarray(guess_u[p], float).reshape(size, nu).T)
     period = sum(Ts[1:], Ts[0])
     distance = _targets(opti, spec, fns, Xs, period)
     U = ca.horzcat(*Us)
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
-    work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
-    if _pushes(spec):  # the push-offs' work is positive work too
-        work = work + po_work
-    terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"] * distance)
+    if "power" in fns:  # the hip torque's power: the cost of transport
+        work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
+        if _pushes(spec):  # the push-offs' work is positive work too
+            work = work + po_work
+        terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"]
+                                             * distance)
     if _pushes(spec):
         terms["push_off_work"] = po_work
     obj = sum(w * terms[k] for k, w in asked.items())
@@ -366,7 +385,11 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     if spec.objective == "cost_of_transport":
         obj = obj + spec.cost_of_transport_effort_weight * effort
     opti.minimize(obj)
-    opti.solver("ipopt", {"print_time": False}, ipopt_options(spec))
+    if "constrain" in fns:  # a walker's own constraints on the whole sequence
+        fns["constrain"](opti, Xs, Us, Ts)
+    plugin, options = fns.get("solver", ({}, None))  # a walker's own IPOPT options
+    opti.solver("ipopt", {"print_time": False, **plugin},
+                ipopt_options(spec) if options is None else options)
     build = time.perf_counter() - t_build
     return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build,
                   push if _pushes(spec) else 0.0)
@@ -404,7 +427,8 @@ def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> P
         starts.append(sum(len(a) for a in ts))
         ts.append(offset + Tv * tau)
         xs.append(np.asarray(get(X)).reshape(n2, K).T)
-        us.append(np.asarray(get(U)).ravel())
+        u = np.asarray(get(U)).reshape(U.shape[0], K).T
+        us.append(u.ravel() if U.shape[0] == 1 else u)
         durs.append(Tv)
         offset += Tv
     X_all = np.concatenate(xs)  # (m, 2n): every phase's points in turn
