@@ -13,7 +13,8 @@ import pytest
 import walkerlab as wl
 from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
-from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step, replay
+from walkerlab.optimal.transcription.mode_sequence import collocate_step
+from walkerlab.optimal.transcription.step import CollocationSpec, replay
 from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")

@@ -27,7 +27,7 @@ GUESS = (-0.1888, 0.1788, -0.1987, -0.2371)
 def test_least_effort_with_an_arc_foot_push_off_is_the_rigid_pushed_gait():
     pytest.importorskip("casadi")
     from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.optimal.drivers.step import optimize_scene
+    from walkerlab.optimal.driver import optimize_scene
 
     scene = load_scene(CONFIGS / "round_feet.yaml")
     d = scene.model_dump(mode="json", exclude_none=True)

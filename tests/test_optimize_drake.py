@@ -17,7 +17,8 @@ from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
 from walkerlab.optimal.guess import simulated_step
-from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step
+from walkerlab.optimal.transcription.mode_sequence import collocate_step
+from walkerlab.optimal.transcription.step import CollocationSpec
 from walkerlab.walker.description import walker_data
 
 drake = pytest.importorskip("pydrake.examples")

@@ -43,7 +43,7 @@ def test_a_five_link_biped_without_a_target_is_refused_at_once(tmp_path):
                        "needs a target") as exc:
         stage.run(type(scene).model_validate(d), tmp_path)
     origin = "".join(traceback.format_tb(exc.value.__cause__.__traceback__))
-    assert "drivers/free_joints.py" in origin
+    assert "optimal/driver.py" in origin
 
 
 def test_a_contact_replay_whose_solver_fails_is_an_outcome(monkeypatch):
@@ -115,9 +115,10 @@ def test_a_level_ground_optimal_gait_starts_from_its_targets():
     (equality constraints: 1e-9), powered by a push-off > 0 (5.27 N s seen; Kuo's
     ``M v tan(alpha)`` for this step is 3.1 N s, the hip torque doing the rest)."""
     from walkerlab.models.registry import build_walker
-    from walkerlab.optimal.drivers.step import collocation_spec
+    from walkerlab.optimal.driver import collocation_spec
     from walkerlab.optimal.guess import starting_step
-    from walkerlab.optimal.transcription.step import collocate_step, replay
+    from walkerlab.optimal.transcription.mode_sequence import collocate_step
+    from walkerlab.optimal.transcription.step import replay
     from walkerlab.optimal.transcription.step_cache import cached_step_functions
     from walkerlab.stages import pipeline
     from walkerlab.walker.description import walker_data

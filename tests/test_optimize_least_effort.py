@@ -3,7 +3,7 @@ passively is its passive gait: int u^2 dt = 0 there, so the optimum is it.  Arc 
 (configs/round_feet.yaml), a torso on straight legs (configs/torso_bhm.yaml), knees
 (configs/kneed.yaml), flat feet (configs/flat_feet.yaml) and legs that differ
 (configs/asymmetric_legs.yaml), each through ``walkerlab optimize``'s scene path
-(:func:`walkerlab.optimal.drivers.step.optimize_scene`, the CasADi functions printed from the
+(:func:`walkerlab.optimal.driver.optimize_scene`, the CasADi functions printed from the
 walker's generated model), on its shipped slope and on one not shipped; against the
 passive gait of the fixedpoint stage's search (shooting on the rigid model, independent of
 the collocation)."""
@@ -50,7 +50,7 @@ def test_the_least_effort_gait_on_a_passive_slope_is_the_passive_gait(name, fact
     on the rigid model closing to the scene's replay tolerance) (~2-20 s each)."""
     pytest.importorskip("casadi")
     from walkerlab.analysis.gait.scene import solve_scene
-    from walkerlab.optimal.drivers.step import optimize_scene
+    from walkerlab.optimal.driver import optimize_scene
 
     scene = _scene(name, factor, intervals)
     _, search = solve_scene(scene)  # the fixedpoint stage's search (shooting)

@@ -18,14 +18,10 @@ from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
-from walkerlab.optimal.drivers.step import collocation_spec
+from walkerlab.optimal.driver import collocation_spec
 from walkerlab.optimal.guess import simulated_step
-from walkerlab.optimal.transcription.step import (
-    CollocationSpec,
-    collocate_step,
-    replay,
-    step_functions,
-)
+from walkerlab.optimal.transcription.mode_sequence import collocate_step
+from walkerlab.optimal.transcription.step import CollocationSpec, replay, step_functions
 from walkerlab.walker.description import walker_data
 
 pytest.importorskip("casadi")
@@ -271,7 +267,7 @@ def test_bad_optimize_sections_say_which_field(tmp_path):
     d = {**base, "optimize": {**base["optimize"], "hip_angle_range_rad": [-0.5, 0.5]}}
     ok = type(load_scene(CONFIGS / "compass_optimal.yaml")).model_validate(d)
     assert ok.optimize.hip_angle_range_rad == (-0.5, 0.5)
-    from walkerlab.optimal.drivers.step import collocation_spec
+    from walkerlab.optimal.driver import collocation_spec
 
     assert collocation_spec(ok).hip_angle_range_rad == (-0.5, 0.5)
     scene = load_scene(CONFIGS / "compass_optimal.yaml")

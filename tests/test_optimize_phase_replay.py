@@ -267,7 +267,8 @@ def test_a_powered_optimum_closes_under_the_phase_law():
     from walkerlab.codegen import symbolic
     from walkerlab.integrate.solver import Solver
     from walkerlab.optimal.replay.hip_phase import hip_phase_replays
-    from walkerlab.optimal.transcription.step import CollocationSpec, collocate_step, torque_of_time
+    from walkerlab.optimal.transcription.mode_sequence import collocate_step
+    from walkerlab.optimal.transcription.step import CollocationSpec, torque_of_time
 
     scene = load_scene(CONFIGS / "powered_compass.yaml")
     w = wl.Walker.from_scene(scene)

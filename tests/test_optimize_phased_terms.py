@@ -321,7 +321,7 @@ def test_the_phased_scene_reads_its_guess_from_artifacts(kneed, kneed_fast, tmp_
     phases simulated from it); a one-step optimize.h5 is refused in one line."""
     from walkerlab.io.artifacts import write_artifact
     from walkerlab.io.schemas import optimize as schema
-    from walkerlab.optimal.drivers.mode_sequence import starting_phases
+    from walkerlab.optimal.driver import starting_phases
 
     scene, _data, walker, _fns = kneed
     g, guess, _spec, free = kneed_fast
@@ -364,7 +364,7 @@ def test_an_ankle_push_off_is_refused_in_one_line():
     transcription has a hip torque only (and the rigid flat feet take the two not
     together), so the scene is refused before any work, naming the field."""
     pytest.importorskip("casadi")
-    from walkerlab.optimal.drivers.step import optimize_scene
+    from walkerlab.optimal.driver import optimize_scene
 
     scene = load_scene(CONFIGS / "flat_feet_push_off.yaml")
     d = scene.model_dump(mode="json", exclude_none=True)

@@ -398,7 +398,7 @@ def test_phase_functions_cached_on_disk_are_the_same_graph(tmp_path, monkeypatch
     scene = load_scene(CONFIGS / "flat_feet_optimal.yaml")
     data = walker_data(scene.walker, scene.slope.phi_rad)
     walker = make_rigid_walker(data, double_support=False)  # as optimize builds it
-    from walkerlab.optimal.drivers.mode_sequence import starting_phases
+    from walkerlab.optimal.driver import starting_phases
 
     x0 = scene.fixedpoint.initial_guess.as_array(walker.state_names())
     order = starting_phases(scene, walker, x0, 0.76, 40)[2]  # the gait's phase sequence

@@ -84,7 +84,7 @@ def test_the_least_effort_stride_is_the_passive_period_two_gait(asym):
     7.5e-8 on 40), the start
     within 1e-6, the replay over the stride closing to 1e-6 and the stride map's
     multipliers those of the fixed point (1e-6: the start's distance)."""
-    from walkerlab.optimal.drivers.mode_sequence import replay_multipliers
+    from walkerlab.optimal.driver import replay_multipliers
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
     from walkerlab.optimal.transcription.step import CollocationSpec
     from walkerlab.optimal.transcription.stride import replay_stride, step_of
@@ -213,8 +213,8 @@ def test_what_the_stride_does_not_take_is_refused_in_one_line(asym):
     free push-off pass the stride's checks, and a guess is read from its artifact (a
     missing one refused naming ``optimize.initial_guess``); one step of legs that differ
     stays refused by the one-step transcription."""
-    from walkerlab.optimal.drivers.step import optimize_scene
-    from walkerlab.optimal.drivers.stride import _check
+    from walkerlab.optimal.driver import _check_stride as _check
+    from walkerlab.optimal.driver import optimize_scene
     from walkerlab.optimal.transcription.step import step_functions
 
     scene, data, _walker, g, _fns = asym
@@ -498,7 +498,7 @@ def test_a_stride_starts_from_another_strides_optimize_h5(asym, fast, tmp_path):
     a few iterations with the barrier started small (``warm_start``, as the scene does for
     an optimize.h5 guess; with IPOPT's default 0.1: 11, against 12 from the passive
     stride, the start left for the central path)."""
-    from walkerlab.optimal.drivers.stride import starting_stride
+    from walkerlab.optimal.driver import starting_stride
     from walkerlab.optimal.transcription.mode_sequence import collocate_phases
 
     scene, _data, walker, g, fns = asym
@@ -523,7 +523,7 @@ def test_a_stride_starts_from_a_continuation_gait_and_refuses_other_artifacts(as
     its slope: the same guess to 1e-12); a one-step optimize.h5 (no phases) and another
     walker's (other states) are refused in one line naming ``optimize.initial_guess``."""
     from tests.test_optimize_phased_terms import _continuation
-    from walkerlab.optimal.drivers.stride import starting_stride
+    from walkerlab.optimal.driver import starting_stride
 
     scene, _data, walker, g, _fns = asym
     names = list(walker.state_names())
@@ -566,7 +566,7 @@ def test_the_stride_scene_takes_the_cost_of_transport_a_cone_and_a_guess(asym, f
     2 x 60): a gait (the replay <= 1e-6), the stored terms those of the optimum, the mean
     speed met, the cone kept at every point (from the rigid model), its four phases stored
     (~25 s: the CasADi build, IPOPT, the replays and two contact strides)."""
-    from walkerlab.optimal.drivers.step import optimize_scene
+    from walkerlab.optimal.driver import optimize_scene
     from walkerlab.optimal.transcription.stride import STRIDE_PHASES
 
     scene, data, walker, g, _fns = asym

@@ -3,8 +3,10 @@
 Reads the scene's ``optimize`` section and its gait from ``fixedpoint.h5`` (the pipeline
 runs ``fixedpoint`` first, :mod:`walkerlab.stages.pipeline`; the collocation starts from
 one step of it; a five-link biped's from its targets, no upstream gait), optimises by
-:func:`walkerlab.optimal.drivers.step.optimize_scene` (CasADi + IPOPT) and replays the result
-on the rigid model.  Skipped when the scene sections, the upstream gait and the code are
+:func:`walkerlab.optimal.driver.optimize_scene` (CasADi + IPOPT; the one driver: a step, a
+step of phases, a stride or a five-link biped's step, replayed on the rigid and contact
+models) and writes the optimum's records (:func:`walkerlab.io.schemas.optimize.
+optimize_record`).  Skipped when the scene sections, the upstream gait and the code are
 unchanged.
 """
 
@@ -54,19 +56,17 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
         targets).  A missing ``optimize`` section of another walker runs with its
         defaults (said in one note), a missing ``fixedpoint`` section with its.
     """
-    from walkerlab.optimal.drivers.step import five_link, no_gait_of_its_own, optimize_scene
+    from walkerlab.optimal.driver import check_targets, five_link, no_gait_of_its_own
 
     missing = getattr(scene, "optimize", None) is None
     scene = with_defaults(scene, "optimize", "optimize")  # a missing section: its defaults
     if five_link(scene):  # a five-link biped: its guess is built from the targets
-        from walkerlab.optimal.drivers.free_joints import check_targets
-
         try:
             check_targets(scene.optimize)  # at once, before the collocation is built
         except ValueError as exc:
             raise StageError((f"scene '{scene.name}' has no 'optimize' section; "
                               if missing else "optimize: ") + str(exc)) from exc
-        return _run_five_link(scene, runs_root, force)
+        return _run_optimum(scene, runs_root, force, None, ())
     if missing:
         from walkerlab import progress
 
@@ -78,23 +78,37 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> St
     require(scene, "fixedpoint", "optimize")
     up = stage_artifact(scene, runs_root, "fixedpoint")
 
+    return _run_optimum(scene, runs_root, force, up, (up,))
+
+
+def _run_optimum(scene: Scene, runs_root, force: bool, gait, upstream) -> StageOutcome:
+    """``optimize.h5`` of the scene's optimum (:func:`walkerlab.optimal.driver.
+    optimize_scene`, started from the gait of the artifact ``gait``, or from the targets
+    when None), its records built here (:func:`walkerlab.io.schemas.optimize.
+    optimize_record`, the energies in the scene's unit)."""
+    from walkerlab.optimal.driver import optimize_scene
+    from walkerlab.units import for_scene
+
     def compute():
-        fp = load_fixedpoint(up)
+        start = (None, None)
+        if gait is not None:
+            fp = load_fixedpoint(gait)
+            start = (fp.x, fp.step_period_s)
         try:
-            data = optimize_scene(scene, fp.x, fp.step_period_s)
+            optimum = optimize_scene(scene, *start)
         except ValueError as exc:
             raise StageError(str(exc)) from exc
+        data = schema.optimize_record(optimum, for_scene(scene).energy)
         return (lambda f: schema.write(f, data)), {"data": data}
 
-    return run_cached("optimize", scene, runs_root, SECTIONS, (up,), compute, force)
+    return run_cached("optimize", scene, runs_root, SECTIONS, upstream, compute, force)
 
 
 def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
     """``optimize.h5`` of a walker with no gait of its own (a passive walker on level
-    ground: :func:`walkerlab.optimal.drivers.step.no_gait_of_its_own`): no upstream gait, the
+    ground: :func:`walkerlab.optimal.driver.no_gait_of_its_own`): no upstream gait, the
     starting step built from the targets (:func:`walkerlab.optimal.guess.target_step`);
     refused at once without them."""
-    from walkerlab.optimal.drivers.step import optimize_scene
     from walkerlab.optimal.guess import has_target, target_numbers
 
     o = scene.optimize
@@ -108,30 +122,7 @@ def _run_from_targets(scene: Scene, runs_root, force: bool) -> StageOutcome:
     except ValueError as exc:
         raise StageError(f"optimize: {exc}".replace("optimize: optimize: ", "optimize: ")) \
             from exc
-
-    def compute():
-        try:
-            data = optimize_scene(scene, None, None)
-        except ValueError as exc:
-            raise StageError(str(exc)) from exc
-        return (lambda f: schema.write(f, data)), {"data": data}
-
-    return run_cached("optimize", scene, runs_root, SECTIONS, (), compute, force)
-
-
-def _run_five_link(scene: Scene, runs_root, force: bool) -> StageOutcome:
-    """``optimize.h5`` of a five-link biped (no upstream gait:
-    :func:`walkerlab.optimal.drivers.free_joints.optimize_five_link_scene`)."""
-    from walkerlab.optimal.drivers.free_joints import optimize_five_link_scene
-
-    def compute():
-        try:
-            data = optimize_five_link_scene(scene)
-        except ValueError as exc:
-            raise StageError(str(exc)) from exc
-        return (lambda f: schema.write(f, data)), {"data": data}
-
-    return run_cached("optimize", scene, runs_root, SECTIONS, (), compute, force)
+    return _run_optimum(scene, runs_root, force, None, ())
 
 
 def run_design(scene: Scene, runs_root: Path | str, force: bool, bounds: dict,
@@ -179,7 +170,7 @@ def draw(scene: Scene, runs_root: Path | str = "runs", svg: bool = True) -> list
     d = schema.load(stage_artifact(scene, runs_root, "optimize"))
     sticks = None
     if d.torque_names != ("hip",):  # a five-link biped: its step as stop action
-        from walkerlab.optimal.drivers.free_joints import stick_figures
+        from walkerlab.optimal.driver import stick_figures
 
         sticks = stick_figures(scene, d)
     return save_optimize_figure(d, scene.name, figures_dir(scene, runs_root), sticks, svg)

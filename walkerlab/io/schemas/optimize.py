@@ -70,7 +70,8 @@ import numpy as np
 STAGE = "optimize"
 
 __all__ = ["DESIGN_STAGE", "DesignData", "OptimizeData", "PHASE_LAWS", "PhaseReplayData",
-           "STAGE", "load", "load_design", "write", "write_design"]
+           "STAGE", "load", "load_design", "optimize_record", "phase_replay_records", "write",
+           "write_design"]
 
 #: the phase-variable replays an artifact may carry (optimize.phase_replay)
 PHASE_LAWS = ("feedback", "feedforward")
@@ -130,6 +131,28 @@ class OptimizeData:
     phase_replays: dict = field(default_factory=dict)  # law name -> PhaseReplayData
     steps: int = 1  # steps in the optimised period: 2 for a stride of legs that differ
     phase_replay_outcome: str = ""  # why there are no phase replays ("": there are, or off)
+
+
+def phase_replay_records(replays: dict) -> dict:
+    """The phase-variable replays ``{law: replay}`` (objects with the attributes of
+    :class:`PhaseReplayData`: :class:`walkerlab.optimal.replay.phase.PhaseReplay`) as
+    ``optimize.h5``'s records."""
+    return {name: PhaseReplayData(r.collocated_start_error, r.start_shift, r.return_error,
+                                  r.step_period_s, r.torque_error, r.multipliers, r.closed)
+            for name, r in replays.items()}
+
+
+def optimize_record(optimum, energy_unit: str = "J") -> OptimizeData:
+    """``optimize.h5``'s record of an optimised gait (the driver's
+    :class:`walkerlab.optimal.driver.Optimum`: an object with :class:`OptimizeData`'s
+    fields, its ``phase_replays`` the replays themselves), the energies in
+    ``energy_unit`` (the scene's)."""
+    from dataclasses import fields
+
+    kw = {f.name: getattr(optimum, f.name) for f in fields(OptimizeData)
+          if f.name != "energy_unit"}
+    kw["phase_replays"] = phase_replay_records(kw["phase_replays"])
+    return OptimizeData(**kw, energy_unit=energy_unit)
 
 
 def _write_phase(f, law: str, r: PhaseReplayData) -> None:

@@ -38,7 +38,7 @@ from walkerlab.optimal.replay.phase import (
 )
 
 __all__ = ["BANDWIDTH", "CLOSED", "LIMIT_N_M", "PiecewisePhaseLaw", "hip_gains",
-           "hip_phase_law", "hip_phase_records", "hip_phase_replays", "hip_walker",
+           "hip_phase_law", "hip_phase_replays", "hip_walker",
            "replay_solver"]
 
 #: the PD law's closed-loop frequency in units of the leg's pendulum frequency sqrt(g / l)
@@ -251,15 +251,3 @@ def hip_phase_replays(data, res, tau, solver) -> dict:
                                    close=name == "feedback", tol=CLOSED, phases=names or None)
             bar.advance(info=name)
     return out
-
-
-def hip_phase_records(data, res, tau, solver) -> tuple[dict, str]:
-    """:func:`hip_phase_replays` as ``optimize.h5``'s records
-    (:func:`walkerlab.optimal.replay.phase.records`) and ``""``; ``({}, the one-line
-    reason)`` when the phase variable is not monotonic."""
-    from walkerlab.optimal.replay.phase import records
-
-    try:
-        return records(hip_phase_replays(data, res, tau, solver)), ""
-    except ValueError as exc:
-        return {}, f"not replayed: {exc}"

@@ -33,7 +33,7 @@ import numpy as np
 from walkerlab.numerics import sort_multipliers
 
 __all__ = ["LIMIT_N_M", "PhaseLaw", "PhaseReplay", "control_of_time", "driven_by",
-           "law_of_rows", "records", "replay_law", "torque_error"]
+           "law_of_rows", "replay_law", "torque_error"]
 
 #: the replays' torque limit [N m]: none in effect (the optimised torques are bounded by the
 #: transcription's own ``max_torque_n_m``)
@@ -385,13 +385,3 @@ def torque_error(walker, seg, t, tau) -> float:
     xs = seg.sample(ts).T
     return max(float(np.max(np.abs(walker.actuators.torques(ti, xi) - tau(ti - seg.t_start))))
                for ti, xi in zip(ts, xs))
-
-
-def records(replays: dict) -> dict:
-    """The replays ``{law: PhaseReplay}`` as ``optimize.h5``'s records
-    (:class:`walkerlab.io.schemas.optimize.PhaseReplayData`)."""
-    from walkerlab.io.schemas.optimize import PhaseReplayData
-
-    return {name: PhaseReplayData(r.collocated_start_error, r.start_shift, r.return_error,
-                                  r.step_period_s, r.torque_error, r.multipliers, r.closed)
-            for name, r in replays.items()}

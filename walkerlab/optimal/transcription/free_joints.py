@@ -4,7 +4,8 @@ do your own direct collocation", SIAM Review 59(4):849-904, Sec. 7 and his Optim
 ``demo/fiveLinkBiped`` (step length 0.5 m, step period 0.7 s, minimise ``int |u|^2 dt``,
 torques at the hips and knees, no ankle torque).
 
-Transcription (separated Hermite-Simpson, as :mod:`walkerlab.optimal.transcription.step`): states
+Transcription (separated Hermite-Simpson: the multi-phase transcription of
+:mod:`walkerlab.optimal.transcription.mode_sequence` over the step as one phase): states
 ``x_k`` (10,) and torques ``u_k`` (4,:
 :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS`) at
 ``2N + 1`` points on ``[0, T]``; the flow, the feet and the reset are the walker's own
@@ -33,11 +34,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.transcription.ipopt import iteration_history, solve
-from walkerlab.optimal.transcription.step import target_constraints
-
 __all__ = ["FiveLinkResult", "collocate_five_link", "kelly_guess", "replay_five_link",
-           "torques_of_time"]
+           "step_sequence", "torques_of_time"]
 
 
 @dataclass
@@ -103,34 +101,56 @@ def _guess_numbers(data, spec):
     return D, T
 
 
-def _constrain(opti, fns: dict, spec, X, U, T, p) -> None:
-    """The step's constraints (module docstring) on the decision variables ``X`` (2n, K),
-    ``U`` (4, K) and ``T``."""
+def _constrain(opti, fns: dict, X, T, p) -> None:
+    """The five-link step's own constraints (module docstring) beside the multi-phase
+    transcription's (defects, heel strike at the end moving down, the swing foot above the
+    ground inside and ahead at the end, the reset, the torque limit, the targets): the
+    trailing foot lifts off at the start, no knee hyper-extension, the joint angles within
+    +-pi/2, the period within [0.1, 5] s."""
     import casadi as ca
 
     K = X.shape[1]
-    h = T / ((K - 1) // 2)
-    F = fns["flow"].map(K)(X, U, ca.repmat(p, 1, K))
     feet = fns["feet"].map(K)(X, ca.repmat(p, 1, K))  # clearance, ahead, rate, knees
-    i, m, j = np.arange(0, K - 1, 2), np.arange(1, K, 2), np.arange(2, K, 2)
-    opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (F[:, i] - F[:, j]))
-    opti.subject_to(X[:, j] == X[:, i] + h / 6 * (F[:, i] + 4 * F[:, m] + F[:, j]))
-    opti.subject_to(X[:, 0] == fns["reset"](X[:, -1], p))
-    opti.subject_to(feet[0, -1] == 0)                    # heel strike at the end
-    opti.subject_to(feet[2, -1] <= 0)                    # ... moving down
     opti.subject_to(feet[2, 0] >= 0)                     # the trailing foot lifts off
-    opti.subject_to(feet[0, 1:-1] >= 0)                  # above the ground in between
     opti.subject_to(ca.vec(feet[3:5, :]) <= 0)           # no knee hyper-extension
-    opti.subject_to(feet[1, -1] >= 1e-3)                 # the swing foot ahead
     opti.subject_to(opti.bounded(-np.pi / 2, X[:fns["n"], :], np.pi / 2))
     opti.subject_to(opti.bounded(0.1, T, 5.0))
-    if spec.max_torque_n_m is not None:
-        opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
-    target_constraints(opti, spec, T, feet[1, -1])
+
+
+def step_sequence(fns: dict, p) -> dict:
+    """The five-link step as a sequence of one phase for
+    :func:`walkerlab.optimal.transcription.mode_sequence.collocate_phases`: its flow with
+    the four joint torques (:data:`walkerlab.optimal.transcription.free_joint_functions.
+    JOINTS`), the swing foot's height as the heel-strike guard (crossed downward; kept
+    >= 0 inside), its rate, the reset, the step length, and the step's own constraints
+    (:func:`_constrain`) and IPOPT options; ``p`` the parameter vector."""
+    import casadi as ca
+
+    from walkerlab.optimal.transcription.free_joint_functions import JOINTS
+    from walkerlab.optimal.transcription.phases import ModePhase
+
+    x, u = ca.SX.sym("x", 2 * fns["n"]), ca.SX.sym("u", len(JOINTS))
+    feet = fns["feet"](x, p)
+    phase = ModePhase("step", "heel_strike", -1,
+                      ca.Function("flow", [x, u], [fns["flow"](x, u, p)]),
+                      ca.Function("guard", [x, u], [feet[0]]),
+                      ca.Function("guard_rate", [x, u], [feet[2]]),
+                      ca.Function("reset", [x], [fns["reset"](x, p)]),
+                      clearance=ca.Function("clearance", [x], [feet[0]]),
+                      step=ca.Function("step", [x], [feet[1]]))
+    return {"phases": [phase], "n": fns["n"], "torques": len(JOINTS),
+            "ahead": ca.Function("ahead", [x], [feet[1]]),
+            "constrain": lambda opti, Xs, Us, Ts: _constrain(opti, fns, Xs[0], Ts[0], p),
+            "solver": ({"expand": True},
+                       {"print_level": 0, "tol": 1e-10, "constr_viol_tol": 1e-11,
+                        "max_iter": 1000, "sb": "yes"})}
 
 
 def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
-    """Optimise one step of a five-link biped (module docstring).
+    """Optimise one step of a five-link biped (module docstring): the multi-phase
+    transcription (:func:`walkerlab.optimal.transcription.mode_sequence.collocate_phases`)
+    over the step as one phase with its four joint torques (:func:`step_sequence`), from
+    Kelly's guess (:func:`kelly_guess`) on a uniform mesh.
 
     Parameters
     ----------
@@ -151,43 +171,29 @@ def collocate_five_link(data, spec, fns: dict | None = None) -> FiveLinkResult:
     ValueError
         A push-off asked for (one line).
     """
+    from dataclasses import replace
+
     import casadi as ca
 
     from walkerlab.optimal.transcription.free_joint_functions import five_link_functions
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
 
     if spec.push_off_free or spec.push_off_n_s:
         raise ValueError("optimize.push_off: a five-link biped has no push-off (its hips and "
                          "knees are driven)")
     fns = fns or five_link_functions(data.structure)
-    n2, N = 2 * fns["n"], int(spec.intervals)
-    K = 2 * N + 1
+    K = 2 * int(spec.intervals) + 1
     p = ca.DM(np.asarray(data.params, float))
-    opti = ca.Opti()
-    X, U = opti.variable(n2, K), opti.variable(4, K)
-    T = opti.variable()
-    h = T / N
-    _constrain(opti, fns, spec, X, U, T, p)
-    weights = np.concatenate([[1.0], np.tile([4.0, 2.0], N)[:K - 2], [1.0]])
-    effort = h / 6 * ca.sum2(ca.DM(weights).T * ca.sum1(U ** 2))
-    opti.minimize(effort)
     D, Tg = _guess_numbers(data, spec)
-    _, xg = kelly_guess(data.leg_length_m, D, Tg, K)
-    opti.set_initial(T, Tg)
-    opti.set_initial(X, xg.T)
-    opti.set_initial(U, 0.0)
-    opti.solver("ipopt", {"print_time": False, "expand": True},
-                {"print_level": 0, "tol": 1e-10, "constr_viol_tol": 1e-11, "max_iter": 1000,
-                 "sb": "yes"})
-    status, get, wall, cpu = solve(opti)
-    Tv = float(get(T))
-    Xv = np.asarray(get(X)).reshape(n2, K).T
-    Uv = np.asarray(get(U)).reshape(4, K).T
+    tg, xg = kelly_guess(data.leg_length_m, D, Tg, K)
+    # the heel strike moving down (rate <= 0), not at a touchdown rate
+    res = collocate_phases(step_sequence(fns, p), replace(spec, touchdown_rate_rad_per_s=0.0),
+                           [("step", tg, xg)])
     return FiveLinkResult(
-        t=np.linspace(0.0, Tv, K), x=Xv, u=Uv, step_period_s=Tv,
-        step_length_m=float(np.asarray(fns["feet"](Xv[-1], p))[1, 0]),
-        objective=float(get(effort)), status=status,
-        iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall, cpu_time_s=cpu,
-        history=iteration_history(opti.stats()))
+        t=res.t, x=res.x, u=res.u, step_period_s=res.step_period_s,
+        step_length_m=res.step_length_m, objective=res.objective, status=res.status,
+        iterations=res.iterations, wall_time_s=res.wall_time_s, cpu_time_s=res.cpu_time_s,
+        history=res.history)
 
 
 def torques_of_time(t: np.ndarray, u: np.ndarray):

@@ -1,8 +1,15 @@
-"""The multi-phase transcription of :mod:`walkerlab.optimal.transcription.phases`: one step of a
-walker
-with a fixed mode sequence (a kneed walker's unlocked and locked swing) optimised by
-Hermite-Simpson collocation per phase (CasADi ``Opti`` + IPOPT), its starting guess from
-the rigid model's own step and its replay on the rigid model.
+"""The one multi-phase transcription of ``walkerlab optimize``: a step (or a stride) as a
+sequence of the walker's phases (:mod:`walkerlab.optimal.transcription.phases`; a kneed
+walker's unlocked and locked swing, flat feet's modes, a stride's steps of the walker and
+its mirror: :mod:`walkerlab.optimal.transcription.stride`) optimised by Hermite-Simpson
+collocation per phase (CasADi ``Opti`` + IPOPT), its starting guess from the rigid model's
+own step and its replay on the rigid model.  One step of straight legs is the sequence of
+one phase (:func:`collocate_step`: its flow, heel-strike guard and reset, push-off
+included, from :func:`walkerlab.optimal.transcription.step.step_functions`, on a uniform
+mesh; the transcription of :mod:`walkerlab.optimal.transcription.step`'s docstring); a
+five-link biped's step is one phase with its four joint torques
+(:func:`walkerlab.optimal.transcription.free_joints.step_sequence`: its own constraints and
+IPOPT options beside).
 """
 
 from __future__ import annotations
@@ -14,8 +21,8 @@ import numpy as np
 
 from walkerlab.optimal.transcription.ipopt import iteration_history, solve
 
-__all__ = ["PhasedResult", "collocate_phases", "optimized_guess", "phase_torque_of_time",
-           "phased_guess", "replay_phases"]
+__all__ = ["PhasedResult", "collocate_phases", "collocate_step", "optimized_guess",
+           "phase_torque_of_time", "phased_guess", "replay_phases", "step_phase"]
 
 #: objectives the phased transcription takes
 #: (:data:`walkerlab.optimal.transcription.step.OBJECTIVES`)
@@ -208,21 +215,27 @@ def _simpson(T, tau, values):
 def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
     """One phase's defects (on the mesh ``T tau``), its guard at the end (transversal) and
     inside (its sign), its unilateral contacts and the path constraints."""
+    import casadi as ca
+
     K = X.shape[1]
-    f = [mp.flow(X[:, k], U[k]) for k in range(K)]
+    several = U.shape[0] > 1  # several torques (k, K): a column a point
+
+    def at(k):
+        return U[:, k] if several else U[k]
+    f = [mp.flow(X[:, k], at(k)) for k in range(K)]
     for i in range(0, K - 1, 2):
         m, j = i + 1, i + 2
         h = T * (tau[j] - tau[i])
         opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (f[i] - f[j]))
         opti.subject_to(X[:, j] == X[:, i] + h / 6 * (f[i] + 4 * f[m] + f[j]))
     d = mp.direction
-    opti.subject_to(mp.guard(X[:, -1], U[-1]) == 0)
-    opti.subject_to(d * mp.guard_rate(X[:, -1], U[-1]) >= spec.touchdown_rate_rad_per_s)
-    for k in range(1, K - 1):  # the event has not happened inside the phase
-        opti.subject_to(d * mp.guard(X[:, k], U[k]) <= 0)
+    opti.subject_to(mp.guard(X[:, -1], at(-1)) == 0)
+    opti.subject_to(d * mp.guard_rate(X[:, -1], at(-1)) >= spec.touchdown_rate_rad_per_s)
+    for k in range(1, K - 1) if mp.inside else ():  # the event has not happened inside
+        opti.subject_to(d * mp.guard(X[:, k], at(k)) <= 0)
     if mp.keep is not None:  # unilateral contacts push
         for k in range(K):
-            opti.subject_to(mp.keep(X[:, k], U[k]) >= 0)
+            opti.subject_to(mp.keep(X[:, k], at(k)) >= 0)
     if spec.min_clearance_m is not None:
         for k in range(1 if first else 0, K - 1 if last else K):
             opti.subject_to(mp.clearance(X[:, k]) >= spec.min_clearance_m)
@@ -235,10 +248,10 @@ def _phase(opti, mp, spec, X, U, T, tau, first: bool, last: bool, fns):
     if spec.friction_coefficient is not None:  # the stance foot's resultant in its cone
         mu = spec.friction_coefficient
         for k in range(K):
-            F = mp.grf(X[:, k], U[k])
+            F = mp.grf(X[:, k], at(k))
             opti.subject_to(F[0] >= 0)
             opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
-    return _simpson(T, tau, U ** 2)
+    return _simpson(T, tau, ca.sum1(U ** 2) if several else U ** 2)
 
 
 def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
@@ -289,7 +302,13 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     Parameters
     ----------
     fns : dict
-        :func:`walkerlab.optimal.transcription.phases.mode_functions` of the walker.
+        :func:`walkerlab.optimal.transcription.phases.mode_functions` of the walker (or a
+        sequence of the same keys: :func:`step_phase`'s, :func:`walkerlab.optimal.
+        transcription.free_joints.step_sequence`); optional keys: ``torques`` (torques at
+        every point, default 1: ``u`` (k,) then, its effort ``int |u|^2 dt``), ``power``
+        (absent: no cost of transport), ``constrain(opti, Xs, Us, Ts)`` (a walker's own
+        constraints on the decision variables) and ``solver`` (``(plugin options, IPOPT
+        options)``, default :func:`walkerlab.optimal.transcription.step.ipopt_options`).
     spec : walkerlab.optimal.transcription.step.CollocationSpec
         Its ``intervals`` are shared among the phases by ``guess``'s meshes.
     guess : list of (name, t, x)
@@ -320,7 +339,8 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     n2, P = 2 * fns["n"], len(phases)
     opti = ca.Opti()
     Xs = [opti.variable(n2, g[1].size) for g in guess]
-    Us = [opti.variable(1, g[1].size) for g in guess]
+    nu = int(fns.get("torques", 1))  # torques at every point (a five-link biped: 4)
+    Us = [opti.variable(nu, g[1].size) for g in guess]
     Ts = [opti.variable() for _ in guess]
     effort, po_work, strikes = 0, 0, 0
     push = opti.variable() if spec.push_off_free else spec.push_off_n_s
@@ -343,17 +363,20 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
         opti.subject_to(opti.bounded(0.05 * Tg, Ts[p], 5.0 * Tg))
         opti.set_initial(Ts[p], Tg)
         opti.set_initial(Xs[p], guess[p][2].T)
-        opti.set_initial(Us[p], np.zeros((1, guess[p][1].size)) if guess_u is None
-                         else np.asarray(guess_u[p], float)[None])
+        size = guess[p][1].size
+        opti.set_initial(Us[p], np.zeros((nu, size)) if guess_u is None
+                         else np.asarray(guess_u[p], float).reshape(size, nu).T)
     period = sum(Ts[1:], Ts[0])
     distance = _targets(opti, spec, fns, Xs, period)
     U = ca.horzcat(*Us)
     asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
     terms = {"effort": effort, "peak_torque": peak_torque(opti, U, asked)}
-    work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
-    if _pushes(spec):  # the push-offs' work is positive work too
-        work = work + po_work
-    terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"] * distance)
+    if "power" in fns:  # the hip torque's power: the cost of transport
+        work = _positive_work(opti, fns, Xs, Us, Ts, taus, "cost_of_transport" in asked)
+        if _pushes(spec):  # the push-offs' work is positive work too
+            work = work + po_work
+        terms["cost_of_transport"] = work / (fns["total_mass_kg"] * fns["gravity"]
+                                             * distance)
     if _pushes(spec):
         terms["push_off_work"] = po_work
     obj = sum(w * terms[k] for k, w in asked.items())
@@ -362,7 +385,11 @@ def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
     if spec.objective == "cost_of_transport":
         obj = obj + spec.cost_of_transport_effort_weight * effort
     opti.minimize(obj)
-    opti.solver("ipopt", {"print_time": False}, ipopt_options(spec))
+    if "constrain" in fns:  # a walker's own constraints on the whole sequence
+        fns["constrain"](opti, Xs, Us, Ts)
+    plugin, options = fns.get("solver", ({}, None))  # a walker's own IPOPT options
+    opti.solver("ipopt", {"print_time": False, **plugin},
+                ipopt_options(spec) if options is None else options)
     build = time.perf_counter() - t_build
     return _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, [p.name for p in phases], build,
                   push if _pushes(spec) else 0.0)
@@ -390,6 +417,8 @@ def _targets(opti, spec, fns, Xs, period):
 def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> PhasedResult:
     """Run IPOPT and read the phases back as one step (``push``: the push-off impulse, a
     number or the decision variable)."""
+    from walkerlab.optimal.transcription.step import number
+
     status, get, wall, cpu = solve(opti)
     n2 = Xs[0].shape[0]
     ts, xs, us, starts, durs, offset = [], [], [], [], [], 0.0
@@ -398,7 +427,8 @@ def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> P
         starts.append(sum(len(a) for a in ts))
         ts.append(offset + Tv * tau)
         xs.append(np.asarray(get(X)).reshape(n2, K).T)
-        us.append(np.asarray(get(U)).ravel())
+        u = np.asarray(get(U)).reshape(U.shape[0], K).T
+        us.append(u.ravel() if U.shape[0] == 1 else u)
         durs.append(Tv)
         offset += Tv
     X_all = np.concatenate(xs)  # (m, 2n): every phase's points in turn
@@ -408,7 +438,7 @@ def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> P
         step_length_m=float(fns["phases"][-1].step(X_all[-1])), objective=float(get(obj)),
         status=status,
         iterations=int(opti.stats().get("iter_count", -1)), build_time_s=build,
-        wall_time_s=wall, cpu_time_s=cpu, terms={k: float(get(v)) for k, v in terms.items()},
+        wall_time_s=wall, cpu_time_s=cpu, terms={k: number(get(v)) for k, v in terms.items()},
         history=iteration_history(opti.stats()),
         push_off_n_s=float(push) if isinstance(push, (int, float)) else float(get(push)))
 
@@ -465,3 +495,81 @@ def replay_phases(data, res: PhasedResult, solver=None):
     if seg.termination != "heel_strike" or crossed != tuple(res.phase_names):
         return float("inf"), walker
     return float(np.max(np.abs(seg.x_next - res.x[0]))), walker
+
+
+def step_phase(fns: dict):
+    """One step of straight legs as a phase
+    (:class:`walkerlab.optimal.transcription.phases.ModePhase`) from its one-step functions
+    ``fns`` (:func:`walkerlab.optimal.transcription.step.step_functions`): the flow, the
+    heel strike's guard (crossed downward) and rate, the reset without and with a push-off
+    (and its work), the clearance, the step length and the ground reaction; no guard sign
+    kept inside (``inside=False``: the swing foot of straight legs may dip through the
+    ground mid-swing, the clearance bound is ``optimize.min_clearance_m``)."""
+    import casadi as ca
+
+    from walkerlab.optimal.transcription.phases import ModePhase
+
+    x, u, P = ca.MX.sym("x", 2 * fns["n"]), ca.MX.sym("u"), ca.MX.sym("P")
+    return ModePhase("step", "heel_strike", -1, fns["flow"],
+                     ca.Function("guard", [x, u], [fns["guard"](x)]), fns["guard_rate"],
+                     ca.Function("reset", [x], [fns["reset"](x, 0.0)]),
+                     clearance=fns["clearance"], step=fns["step"], grf=fns["grf"],
+                     push_off=ca.Function("push_off", [x, P], [fns["reset"](x, P),
+                                                               fns["push_off_work"](x, P)]),
+                     inside=False)
+
+
+def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
+                   guess_u: np.ndarray | None = None, fns: dict | None = None):
+    """Optimise one step of straight legs (the transcription of
+    :mod:`walkerlab.optimal.transcription.step`'s docstring) as the sequence of one phase
+    (:func:`step_phase`) on a uniform mesh of ``spec.intervals`` intervals.
+
+    Parameters
+    ----------
+    data : WalkerData
+    eq : Equations or None
+        ``walkerlab.codegen.symbolic.derive(data.structure)`` (unused when ``fns`` is
+        given, e.g. by :func:`walkerlab.optimal.transcription.step_cache.
+        cached_step_functions`).
+    spec : walkerlab.optimal.transcription.step.CollocationSpec
+    guess_t : ndarray (m,)
+        Times [s] of a guess step (e.g. a simulated gait from heel strike to heel strike).
+    guess_x : ndarray (m, 2n)
+        Its states.
+    guess_u : ndarray (m,), optional
+        Its hip torque [N m] (default 0).
+    fns : dict, optional
+        :func:`~walkerlab.optimal.transcription.step.step_functions` of the walker (built
+        when not given).
+
+    Returns
+    -------
+    walkerlab.optimal.transcription.step.CollocationResult
+
+    Raises
+    ------
+    ValueError
+        A walker this transcription does not handle, an unknown objective (one line).
+    """
+    from walkerlab.optimal.transcription.step import (
+        CollocationResult,
+        check_objective,
+        step_functions,
+    )
+
+    fns = fns or step_functions(data, eq)
+    check_objective(spec)
+    K = 2 * int(spec.intervals) + 1
+    tk = np.linspace(0.0, 1.0, K) * guess_t[-1]
+    x = np.stack([np.interp(tk, guess_t, guess_x[:, c]) for c in range(guess_x.shape[1])],
+                 axis=1)
+    u = np.interp(tk, guess_t, np.zeros_like(guess_t) if guess_u is None else guess_u)
+    res = collocate_phases({**fns, "phases": [step_phase(fns)]}, spec, [("step", tk, x)],
+                           [u])
+    return CollocationResult(
+        t=res.t, x=res.x, u=res.u, step_period_s=res.step_period_s,
+        step_length_m=res.step_length_m, push_off_n_s=res.push_off_n_s,
+        objective=res.objective, status=res.status, iterations=res.iterations,
+        wall_time_s=res.wall_time_s, terms={"push_off_work": 0.0, **res.terms},
+        history=res.history)

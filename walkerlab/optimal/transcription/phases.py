@@ -92,6 +92,11 @@ class ModePhase:
         :mod:`walkerlab.models.hybrid.actuated`) and the push-off's work ``W`` [J]; straight
         legs on point feet only (None elsewhere: the rigid kneed and flat-footed models
         carry no push-off).
+    inside : bool
+        The guard's sign is kept at the phase's interior points (the event has not
+        happened earlier); False for a step of one phase, whose heel-strike guard the
+        swing foot may cross mid-swing (straight legs scuff: the one-step transcription
+        bounds the clearance instead, ``optimize.min_clearance_m``).
     grf : casadi.Function
         ``(x, u) -> (F_n, F_t)`` [N]: the ground's resultant force on the stance foot along
         the slope's normal and tangent (forward, downhill, positive), ``sum_i m_i (a_i + g
@@ -112,6 +117,7 @@ class ModePhase:
     step: object = None
     grf: object = None
     push_off: object = None
+    inside: bool = True
 
 
 def phase_order(walker, phase_log=None) -> list[tuple[str, str, int]]:

@@ -29,6 +29,10 @@ foot above a bound at every point but the ends), the stance foot's ground reacti
 ``m (a_com + g)`` with a non-negative normal force inside the friction cone, the hip's
 joint limits.
 
+Collocated as the sequence of one phase by the multi-phase transcription
+(:func:`walkerlab.optimal.transcription.mode_sequence.collocate_step`); this module gives
+that phase its functions (:func:`step_functions`), the spec and the replay.
+
 A result is called a gait only after its **replay**: the rigid model integrated (scipy's
 DOP853 at 1e-12) from ``x_0`` with the optimised torque as a function of time (piecewise
 quadratic through the points, Hermite-Simpson's control), until its heel strike, then the
@@ -48,10 +52,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from walkerlab.codegen.casadi_functions import casadi_function
-from walkerlab.optimal.transcription.ipopt import iteration_history, solve
 
-__all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "collocate_step",
-           "ipopt_options", "positive_power", "replay", "step_functions",
+__all__ = ["OBJECTIVES", "CollocationResult", "CollocationSpec", "check_objective",
+           "ipopt_options", "number", "positive_power", "replay", "step_functions",
            "target_constraints", "torque_of_time"]
 
 
@@ -344,72 +347,7 @@ def _ground_reaction(data, eq, xs, vals, x, qdd):
                       ca.cos(gam) * F[0] - ca.sin(gam) * F[1])
 
 
-def collocate_step(data, eq, spec: CollocationSpec, guess_t: np.ndarray,
-                   guess_x: np.ndarray, guess_u: np.ndarray | None = None,
-                   fns: dict | None = None) -> CollocationResult:
-    """Optimise one step (module docstring).
-
-    Parameters
-    ----------
-    data : WalkerData
-    eq : Equations or None
-        ``walkerlab.codegen.symbolic.derive(data.structure)`` (unused when ``fns`` is
-        given, e.g. by :func:`walkerlab.optimal.transcription.step_cache.cached_step_functions`).
-    spec : CollocationSpec
-    guess_t : ndarray (m,)
-        Times [s] of a guess step (e.g. a simulated gait from heel strike to heel strike).
-    guess_x : ndarray (m, 2n)
-        Its states.
-    guess_u : ndarray (m,), optional
-        Its hip torque [N m] (default 0).
-    fns : dict, optional
-        :func:`step_functions` of the walker (built when not given).
-
-    Returns
-    -------
-    CollocationResult
-
-    Raises
-    ------
-    ValueError
-        A walker this transcription does not handle (one line).
-    """
-    import casadi as ca
-
-    fns = fns or step_functions(data, eq)
-    n2, N = 2 * fns["n"], int(spec.intervals)
-    K = 2 * N + 1
-    opti = ca.Opti()
-    X, U, T = opti.variable(n2, K), opti.variable(1, K), opti.variable()
-    P = opti.variable() if spec.push_off_free else spec.push_off_n_s
-    _transcribe(opti, fns, spec, X, U, T, P, guess_t[-1])
-    _path_constraints(opti, fns, spec, X, U)
-    terms = _terms(opti, fns, spec, X, U, T, P)
-    obj = _objective(spec, terms, P)
-    opti.minimize(obj)
-    tk = np.linspace(0.0, 1.0, K) * guess_t[-1]
-    opti.set_initial(T, float(guess_t[-1]))
-    opti.set_initial(X, np.stack([np.interp(tk, guess_t, guess_x[:, c])
-                                  for c in range(n2)]))
-    ug = np.interp(tk, guess_t, np.zeros_like(guess_t) if guess_u is None else guess_u)
-    opti.set_initial(U, ug[None])
-    if spec.push_off_free:
-        opti.set_initial(P, spec.push_off_n_s)
-    opti.solver("ipopt", {"print_time": False}, ipopt_options(spec))
-    status, get, wall, _ = solve(opti)
-    Tv = float(get(T))
-    Xv, Uv = np.asarray(get(X)).reshape(n2, K).T, np.asarray(get(U)).ravel()
-    return CollocationResult(
-        t=np.linspace(0.0, Tv, K), x=Xv, u=Uv, step_period_s=Tv,
-        step_length_m=float(fns["step"](Xv[-1])),
-        push_off_n_s=float(get(P)) if spec.push_off_free else float(spec.push_off_n_s),
-        objective=float(get(obj)), status=status,
-        iterations=int(opti.stats().get("iter_count", -1)), wall_time_s=wall,
-        terms={k: _number(get(v)) for k, v in terms.items()},
-        history=iteration_history(opti.stats()))
-
-
-def _number(v) -> float:
+def number(v) -> float:
     """A scalar value of the optimum (a structurally zero term comes back sparse)."""
     return float(np.asarray(v.toarray() if hasattr(v, "toarray") else v).ravel()[0])
 
@@ -456,30 +394,6 @@ def ipopt_options(spec) -> dict:
     return opts
 
 
-def _transcribe(opti, fns, spec, X, U, T, P, period_guess):
-    """Hermite-Simpson defects, the heel strike at the end, the periodic reset and the
-    targets (module docstring)."""
-    K = X.shape[1]
-    h = T / ((K - 1) // 2)
-    f = [fns["flow"](X[:, k], U[k]) for k in range(K)]
-    for i in range(0, K - 1, 2):
-        m, j = i + 1, i + 2
-        opti.subject_to(X[:, m] == 0.5 * (X[:, i] + X[:, j]) + h / 8 * (f[i] - f[j]))
-        opti.subject_to(X[:, j] == X[:, i] + h / 6 * (f[i] + 4 * f[m] + f[j]))
-    opti.subject_to(fns["guard"](X[:, -1]) == 0)
-    opti.subject_to(fns["ahead"](X[:, -1]) >= 1e-3)
-    # the swing foot comes down onto the ground (the rigid model's heel-strike direction)
-    opti.subject_to(fns["guard_rate"](X[:, -1], U[-1])
-                    <= -spec.touchdown_rate_rad_per_s)
-    opti.subject_to(X[:, 0] == fns["reset"](X[:, -1], P))
-    opti.subject_to(opti.bounded(0.05 * period_guess, T, 5.0 * period_guess))
-    if spec.push_off_free:
-        opti.subject_to(opti.bounded(0.0, P, spec.push_off_max_n_s))
-    if spec.max_torque_n_m is not None:
-        opti.subject_to(opti.bounded(-spec.max_torque_n_m, U, spec.max_torque_n_m))
-    target_constraints(opti, spec, T, fns["step"](X[:, -1]))
-
-
 def peak_torque(opti, U, asked: dict):
     """The largest |torque| over the collocation points ``U``: in epigraph form (a variable
     ``s`` with ``-s <= U <= s``) when it is among the ``asked`` objectives, else the plain
@@ -506,57 +420,6 @@ def target_constraints(opti, spec, T, length) -> None:
         opti.subject_to(length == spec.target_speed_m_per_s * T)
 
 
-def _path_constraints(opti, fns, spec, X, U):
-    """No scuffing (every point but the first and the last), the stance foot's ground
-    reaction in its friction cone, the hip's joint limits."""
-    K = X.shape[1]
-    if spec.min_clearance_m is not None:
-        for k in range(1, K - 1):
-            opti.subject_to(fns["clearance"](X[:, k]) >= spec.min_clearance_m)
-    if spec.friction_coefficient is not None:
-        mu = spec.friction_coefficient
-        for k in range(K):
-            F = fns["grf"](X[:, k], U[k])
-            opti.subject_to(F[0] >= 0)
-            opti.subject_to(opti.bounded(-mu * F[0], F[1], mu * F[0]))
-    if spec.hip_angle_range_rad is not None:
-        lo, hi = spec.hip_angle_range_rad
-        for k in range(K):
-            opti.subject_to(opti.bounded(lo, fns["hip_angle"](X[:, k]), hi))
-
-
-def _simpson(h, values):
-    """Simpson's rule on the 2N + 1 points (``values`` (1, 2N + 1))."""
-    import casadi as ca
-
-    K = values.shape[1]
-    w = np.concatenate([[1.0], np.tile([4.0, 2.0], (K - 1) // 2)[:K - 2], [1.0]])
-    return h / 6 * ca.sum2(ca.DM(w).T * values)
-
-
-def _terms(opti, fns, spec, X, U, T, P):
-    """The objectives used (:data:`OBJECTIVES`): effort ``int u^2 dt``, the push-off's work,
-    the cost of transport (positive hip work plus the push-off's work, per weight and step
-    length) and the peak torque (epigraph: ``-s <= u <= s``, minimise ``s``).  Where the
-    cost of transport or the peak torque is asked for, it is in its exact slack form
-    (:func:`positive_power`, the epigraph); else evaluated afterwards from the points
-    (``max(p, 0)``, ``max |u|``)."""
-    import casadi as ca
-
-    K = X.shape[1]
-    h = T / ((K - 1) // 2)
-    work = fns["push_off_work"](X[:, -1], P)
-    weight = fns["total_mass_kg"] * fns["gravity"]
-    asked = dict(spec.weights) if spec.objective == "weighted" else {spec.objective: 1.0}
-    peak = peak_torque(opti, U, asked)
-    power = ca.horzcat(*[fns["power"](X[:, k], U[k]) for k in range(K)])
-    positive = (positive_power(opti, power) if "cost_of_transport" in asked
-                else ca.fmax(power, 0))
-    return {"effort": _simpson(h, U ** 2), "push_off_work": work,
-            "cost_of_transport": (_simpson(h, positive) + work)
-            / (weight * fns["step"](X[:, -1])), "peak_torque": peak}
-
-
 def positive_power(opti, power):
     """The positive part of the actuator power at the points, exactly, by slack variables
     (Srinivasan & Ruina 2006, Nature 439:72-75; Kelly 2017, SIAM Review 59(4), on
@@ -577,29 +440,20 @@ def positive_power(opti, power):
     return s
 
 
-def _objective(spec, terms, P):
-    """The spec's objective from the terms (``effort`` with a free push-off: + ``w P^2``;
-    ``cost_of_transport`` alone: + ``cost_of_transport_effort_weight * effort``, the tiny
-    regularisation that makes its torque unique where the torque does no positive work).
+def check_objective(spec) -> None:
+    """Refuse an objective that is not one of :data:`OBJECTIVES` or their weighted sum.
 
     Raises
     ------
     ValueError
-        An unknown objective or weighted term (one line).
+        An unknown objective or weighted term, or a weighted sum of none (one line).
     """
     if spec.objective == "weighted":
         bad = [k for k, _ in spec.weights if k not in OBJECTIVES]
         if bad or not spec.weights:
             raise ValueError(f"optimize.weights: terms among {', '.join(OBJECTIVES)}")
-        return sum(w * terms[k] for k, w in spec.weights)
-    if spec.objective not in OBJECTIVES:
+    elif spec.objective not in OBJECTIVES:
         raise ValueError(f"optimize.objective: one of {', '.join(OBJECTIVES)} or weighted")
-    obj = terms[spec.objective]
-    if spec.objective == "effort" and spec.push_off_free:
-        obj = obj + spec.push_off_weight * P ** 2
-    if spec.objective == "cost_of_transport":
-        obj = obj + spec.cost_of_transport_effort_weight * terms["effort"]
-    return obj
 
 
 def torque_of_time(res: CollocationResult):

@@ -1,0 +1,701 @@
+"""A scene's optimal gait (``walkerlab optimize``): one driver that sets the collocation up
+from the scene - its walker, slope, push-off and ``optimize`` section - starts it from the
+scene's gait (or from the targets, or another optimisation), replays the optimum on the
+rigid model (its Floquet multipliers from the replay), in the contact model and as a
+phase-variable law, and returns it as an :class:`Optimum` (numbers; the stage writes the
+artifact's records: :func:`walkerlab.io.schemas.optimize.optimize_record`).
+
+The transcription follows the walker's step (Hermite-Simpson collocation, CasADi + IPOPT):
+
+- straight legs (point or arc feet, a torso, massless legs with a hip mass): one step,
+  one phase, the heel strike's reset (push-off included) the periodic boundary condition
+  (:mod:`walkerlab.optimal.transcription.step`);
+- knees or flat feet: the step as the walker's sequence of phases, each with its guard and
+  reset from the generated model (:mod:`walkerlab.optimal.transcription.mode_sequence`);
+- legs that differ: a stride, the step sequence of the walker and its mirror
+  (:mod:`walkerlab.optimal.transcription.stride`, on the same multi-phase transcription);
+- free knees (a five-link biped): one phase with its four joint torques, from the targets
+  (Kelly 2017's set-up; :mod:`walkerlab.optimal.transcription.free_joints`), closed by
+  shooting and replayed as virtual constraints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+__all__ = ["Optimum", "check_targets", "collocation_spec", "five_link", "needs_gait",
+           "no_gait_of_its_own", "not_a_gait_outcome", "optimize_scene", "replay_multipliers",
+           "starting_phases", "starting_stride", "history_and_energies", "stick_figures"]
+
+
+@dataclass
+class Optimum:
+    """An optimised gait and its replays, in numbers (the fields of
+    :class:`walkerlab.io.schemas.optimize.OptimizeData`, whose record the stage builds from
+    it: :func:`walkerlab.io.schemas.optimize.optimize_record`).
+
+    Attributes
+    ----------
+    time : ndarray (m,)
+        Collocation times since the heel strike [s].
+    states : dict of str -> ndarray (m,)
+        The states by the rigid walker's names [rad, rad/s].
+    torque : ndarray (m,) or (m, k)
+        The optimised torque(s) [N m; N m/kg on massless legs].
+    step_period_s, step_length_m, push_off_n_s, objective : float
+        A stride's: its mean step's period and length.
+    replay_error : float
+        The rigid replay's return error [rad, rad/s].
+    multipliers : ndarray (2n,) complex
+        The replay map's Floquet multipliers (NaN: none).
+    gait : bool
+        IPOPT converged and the replay closed within ``optimize.replay_tolerance``.
+    status : str
+    iterations : int
+    wall_time_s : float
+    state_units : dict
+    energy : dict
+        ``kinetic``, ``potential`` at the points [J] (each step's from its own walker).
+    phase_replays : dict of str -> walkerlab.optimal.replay.phase.PhaseReplay
+        The phase-variable replays (empty: none; ``phase_replay_outcome`` says why).
+    The other fields: as :class:`~walkerlab.io.schemas.optimize.OptimizeData`.
+    """
+
+    time: np.ndarray
+    states: dict
+    torque: np.ndarray
+    step_period_s: float
+    step_length_m: float
+    push_off_n_s: float
+    objective: float
+    replay_error: float
+    multipliers: np.ndarray
+    gait: bool
+    status: str
+    iterations: int
+    wall_time_s: float
+    state_units: dict
+    objective_name: str = "effort"
+    objective_unit: str = "N^2 m^2 s"
+    terms: dict = field(default_factory=dict)
+    contact_step_period_s: float = float("nan")
+    contact_outcome: str = ""
+    torque_unit: str = "N m"
+    torque_names: tuple = ("hip",)
+    start_shift: float = float("nan")
+    replay_step_period_s: float = float("nan")
+    collocated_start_error: float = float("nan")
+    cpu_time_s: float = float("nan")
+    ipopt_history: dict = field(default_factory=dict)
+    energy: dict = field(default_factory=dict)
+    phase_names: tuple = ()
+    phase_start: np.ndarray | None = None
+    phase_duration_s: np.ndarray | None = None
+    build_time_s: float = float("nan")
+    phase_replays: dict = field(default_factory=dict)
+    steps: int = 1
+    phase_replay_outcome: str = ""
+
+
+# -- the scene's set-up ------------------------------------------------------------------
+
+def collocation_spec(scene):
+    """The :class:`walkerlab.optimal.transcription.step.CollocationSpec` of the scene's
+    ``optimize`` section (the push-off's value, fixed or the free one's start, from the
+    scene's actuation)."""
+    from walkerlab.optimal.transcription.step import CollocationSpec
+
+    o = scene.optimize
+    act = getattr(scene.walker, "actuation", None)
+    push = float(act.push_off.impulse_n_s) if act is not None and act.push_off else 0.0
+    return CollocationSpec(intervals=o.intervals, push_off_n_s=push,
+                           push_off_free=o.push_off == "free",
+                           push_off_max_n_s=o.push_off_max_n_s,
+                           push_off_weight=o.push_off_weight_per_s,
+                           max_torque_n_m=o.max_torque_n_m,
+                           target_speed_m_per_s=o.target_speed_m_per_s,
+                           target_step_length_m=o.target_step_length_m,
+                           target_step_period_s=o.target_step_period_s,
+                           objective=o.objective, weights=tuple((o.weights or {}).items()),
+                           cost_of_transport_effort_weight=(
+                               o.cost_of_transport_effort_weight),
+                           min_clearance_m=o.min_clearance_m,
+                           friction_coefficient=o.friction_coefficient,
+                           hip_angle_range_rad=o.hip_angle_range_rad,
+                           touchdown_rate_rad_per_s=o.touchdown_rate_rad_per_s)
+
+
+def needs_gait(scene) -> bool:
+    """Whether the scene's optimisation starts from its own gait (``fixedpoint.h5``): every
+    walker but a five-link biped (``walker.leg.knee.lock: free``), whose guess is built from
+    the targets, and a walker with no gait of its own (:func:`no_gait_of_its_own`), whose
+    step is built from them too (:func:`walkerlab.optimal.guess.target_step`)."""
+    return not five_link(scene) and not no_gait_of_its_own(scene)
+
+
+def five_link(scene) -> bool:
+    """Whether the scene's walker is a five-link biped (``walker.leg.knee.lock: free``)."""
+    knee = getattr(getattr(scene.walker, "leg", None), "knee", None)
+    return getattr(knee, "lock", None) == "free"
+
+
+def no_gait_of_its_own(scene) -> bool:
+    """Whether the scene's walker has no period-1 gait to start an optimisation from: a
+    passive walker (no ``walker.actuation``) on level or uphill ground (slope <= 0) loses
+    energy at every heel strike and gains none from gravity over a step, so it has no gait
+    (the gait search says "a passive walker needs a downhill slope"); and no
+    ``optimize.initial_guess`` names another start.  Its optimal gait (a free push-off or
+    the hip torque powering it: Srinivasan & Ruina 2006, Kelly 2017's OptimTraj) starts
+    from the targets."""
+    o = getattr(scene, "optimize", None)
+    return (getattr(scene.walker, "actuation", None) is None and scene.slope.phi_rad <= 0.0
+            and (o is None or o.initial_guess is None))
+
+
+def check_targets(o) -> None:
+    """Refuse a five-link biped's ``optimize`` section ``o`` without a target (speed, step
+    length or step period): the least effort of a free step is a shuffle (RABBIT: a 1 mm
+    step at 0.0024 m/s, 1.2e-5 N² m² s), not a gait to optimise; Kelly (2017) fixes the
+    step length and period.
+
+    Raises
+    ------
+    ValueError
+        No target (one line saying which fields to give).
+    """
+    from walkerlab.optimal.guess import has_target
+
+    if not has_target(o):
+        raise ValueError("a five-link biped's optimal step needs a target (without one the "
+                         "least effort is a 1 mm shuffle): give optimize.target_step_length_m"
+                         " and target_step_period_s, or target_speed_m_per_s, as "
+                         "configs/rabbit_optimal.yaml (0.5 m in 0.7 s)")
+
+
+# -- the one entry point -----------------------------------------------------------------
+
+def optimize_scene(scene, x_gait: np.ndarray | None = None,
+                   period_s: float | None = None) -> Optimum:
+    """Optimise the scene's gait (the ``optimize`` section): a step, a step of phases, a
+    stride of two steps (legs that differ) or a five-link biped's step (module docstring).
+
+    Parameters
+    ----------
+    scene : Scene
+        With ``optimize``.
+    x_gait : ndarray (2n,) or None
+        The scene's gait just after heel strike (``fixedpoint.h5``): the initial guess is
+        one step of it (unless ``optimize.initial_guess`` names an artifact); None: the
+        walker has none (:func:`no_gait_of_its_own`; a five-link biped), the guess is built
+        from the targets.
+    period_s : float or None
+        Its step period [s].
+
+    Returns
+    -------
+    Optimum
+
+    Raises
+    ------
+    ValueError
+        A walker the transcription does not handle, the starting gait does not make a step,
+        the initial guess's artifact is unusable, no gait and a walker the targets' guess
+        does not build (legs with knees, flat feet, legs that differ), a five-link biped
+        without a target or with a push-off (one line).
+    """
+    try:
+        import casadi  # noqa: F401 - the collocation's modelling layer and IPOPT
+    except ImportError:
+        raise ValueError("optimize needs CasADi: pip install -e '.[optimize]'") from None
+    if five_link(scene):
+        return _five_link(scene)
+    from walkerlab.walker.description import walker_data
+
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    spec = collocation_spec(scene)
+    if x_gait is None and (data.mirror is not None or data.structure.knee
+                           or data.structure.foot == "flat"):
+        raise ValueError("optimize: the walker has no gait of its own to start from (passive "
+                         "on level ground), and a step from the targets is built for "
+                         "straight legs with point feet only; give optimize.initial_guess "
+                         "(another optimize.h5) or a downhill slope")
+    if data.mirror is not None:  # legs that differ: a stride of two different steps
+        return _stride(scene, data, spec, x_gait, period_s)
+    if data.structure.knee or data.structure.foot == "flat":  # a step of phases
+        return _phased(scene, data, spec, x_gait, period_s)
+    return _step(scene, data, spec, x_gait, period_s)
+
+
+# -- what every set-up shares ------------------------------------------------------------
+
+def _outcome(scene, res, err: float, contact) -> tuple[bool, float, str]:
+    """``(gait, contact step period [s], contact outcome)``: a gait when IPOPT converged
+    and the replay closed within ``optimize.replay_tolerance``; the contact model replays
+    a gait only (``contact()``: its ``(period, outcome)``)."""
+    gait = bool(err <= scene.optimize.replay_tolerance and res.status == "Solve_Succeeded")
+    if not gait:
+        return gait, float("nan"), not_a_gait_outcome(err, res.status)
+    return (gait, *contact())
+
+
+def _unit(o, data=None) -> str:
+    """The objective's unit (a weighted sum's: ``-``; the torque per foot mass on massless
+    legs: N m/kg in place of N m)."""
+    from walkerlab.optimal.transcription.step import OBJECTIVES
+
+    unit = OBJECTIVES.get(o.objective, "-")
+    if data is not None and _massless(data):
+        unit = {"N^2 m^2 s": "N^2 m^2 s / kg^2", "N m": "N m/kg"}.get(unit, unit)
+    return unit
+
+
+def _massless(data) -> bool:
+    """The legs are massless (the torque is per foot mass)."""
+    return bool(data.structure.bodies) and all(b.massless for b in data.structure.bodies)
+
+
+def _states(walker, res) -> tuple[dict, dict]:
+    """The collocated states by the walker's names, and their units."""
+    names = list(walker.state_names())
+    return ({n: res.x[:, k] for k, n in enumerate(names)},
+            dict(zip(names, walker.state_units())))
+
+
+def _phase_replays(scene, data, res, tau) -> tuple[dict, str]:
+    """The hip torque's phase-variable replays of the optimised step ``res`` (``tau``: its
+    torque of the time since the heel strike;
+    :func:`walkerlab.optimal.replay.hip_phase.hip_phase_replays`, the scene's solver), and
+    why there are none (``({}, "")`` unless ``optimize.phase_replay`` is on: off by default
+    here)."""
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.replay.hip_phase import hip_phase_replays
+
+    if not scene.optimize.phase_replay:  # None: off (a five-link biped's default is on)
+        return {}, ""
+    try:
+        return hip_phase_replays(data, res, tau, Solver.from_settings(scene.solver)), ""
+    except ValueError as exc:
+        return {}, f"not replayed: {exc}"
+
+
+def history_and_energies(scene, walker, res) -> dict:
+    """IPOPT's iteration history and the walker's kinetic and potential energy at the
+    collocation points (``res``: a collocation result with ``x`` (2N + 1, 2n) in the
+    walker's state order and ``history``), as :class:`Optimum` keywords (J)."""
+    ke, pe = walker.energies(np.asarray(res.x, float).T)
+    return {"ipopt_history": dict(res.history),
+            "energy": {"kinetic": np.asarray(ke, float), "potential": np.asarray(pe, float)}}
+
+
+def not_a_gait_outcome(err: float, status: str) -> str:
+    """The contact replay's outcome of an optimum that is not a gait (it is not replayed:
+    a step that does not close on the rigid model says nothing of the contact one).
+
+    Parameters
+    ----------
+    err : float
+        The rigid replay's return error [rad, rad/s] (inf or NaN: the replay failed).
+    status : str
+        IPOPT's status.
+    """
+    if not np.isfinite(err):
+        return "not replayed: the rigid replay failed"
+    if status != "Solve_Succeeded":
+        return f"not replayed: not a gait (IPOPT: {status})"
+    return (f"not replayed: not a gait (the rigid replay returns {err:.2g} away, more than "
+            "optimize.replay_tolerance)")
+
+
+def replay_multipliers(replayed, res, scene, err: float) -> np.ndarray:
+    """The replay map's Floquet multipliers at the start (variational equations +
+    saltation through every phase, or both steps of a stride).
+
+    Parameters
+    ----------
+    replayed : HybridWalker
+        The rigid walker under the optimised torques.
+    res : CollocationResult or PhasedResult
+        The optimum (its start ``res.x[0]``, shape (n,), and ``step_period_s`` [s]).
+    scene : Scene
+        Its ``solver`` integrates the map.
+    err : float
+        The replay's return error (NaN: the replay failed).
+
+    Returns
+    -------
+    ndarray, shape (n,), complex
+        The multipliers, NaN when the replay or the map failed (a report, not a gate).
+    """
+    from walkerlab.analysis.gait.poincare import poincare_map
+    from walkerlab.integrate.solver import Solver
+
+    mu = np.full(res.x.shape[1], np.nan, complex)
+    if not np.isfinite(err):
+        return mu
+    try:
+        DP = poincare_map(replayed, res.x[0], Solver.from_settings(scene.solver),
+                          max_step_time=3.0 * res.step_period_s, jacobian=True)[2]
+        return np.linalg.eigvals(DP).astype(complex)
+    except Exception:  # noqa: BLE001 - the replay's multipliers are a report, not a gate
+        return mu
+
+
+# -- one step of straight legs -----------------------------------------------------------
+
+def _step(scene, data, spec, x_gait, period_s) -> Optimum:
+    """One step of straight legs (point or arc feet, a torso, massless legs with a hip
+    mass): :func:`walkerlab.optimal.transcription.mode_sequence.collocate_step`."""
+    from walkerlab.models.registry import build_walker
+    from walkerlab.optimal.guess import starting_step
+    from walkerlab.optimal.replay.contact import contact_replay
+    from walkerlab.optimal.transcription.mode_sequence import collocate_step
+    from walkerlab.optimal.transcription.step import replay, torque_of_time
+    from walkerlab.optimal.transcription.step_cache import cached_step_functions
+
+    o = scene.optimize
+    walker = build_walker(scene)
+    t, guess, guess_u, guess_p = starting_step(scene, walker, x_gait, period_s)
+    if guess_p is not None and spec.push_off_free:
+        spec = replace(spec, push_off_n_s=guess_p)
+    if guess_u is not None:  # another optimize.h5: an optimum
+        spec = replace(spec, warm_start=True)
+    res = collocate_step(data, None, spec, t, guess, guess_u, cached_step_functions(data))
+    err, replayed = replay(data, res)
+    mu = replay_multipliers(replayed, res, scene, err)
+    gait, contact_period, contact_outcome = _outcome(
+        scene, res, err, lambda: contact_replay(scene, res))
+    phases, phase_note = _phase_replays(scene, data, res, torque_of_time(res))
+    states, units = _states(walker, res)
+    return Optimum(res.t, states, res.u, res.step_period_s, res.step_length_m,
+                   res.push_off_n_s, res.objective, err, mu, gait, res.status,
+                   res.iterations, res.wall_time_s, units, objective_name=o.objective,
+                   objective_unit=_unit(o, data), terms=res.terms,
+                   contact_step_period_s=contact_period, contact_outcome=contact_outcome,
+                   torque_unit="N m/kg" if _massless(data) else "N m",
+                   phase_replays=phases, phase_replay_outcome=phase_note,
+                   **history_and_energies(scene, walker, res))
+
+
+# -- a step of phases (knees, flat feet) -------------------------------------------------
+
+def starting_phases(scene, walker, x_gait, period_s: float, intervals: int):
+    """The phased collocation's starting step for ``scene`` (its ``optimize.
+    initial_guess``, else one step of its gait ``x_gait`` (2n,) of period ``period_s``
+    [s]), on about ``intervals`` intervals.
+
+    Returns
+    -------
+    guess : list of (name, t, x)
+        :func:`walkerlab.optimal.transcription.mode_sequence.phased_guess` (the scene's or a
+        continuation artifact's gait) or :func:`~walkerlab.optimal.transcription.
+        mode_sequence.optimized_guess` (another ``optimize.h5``).
+    torque : list of ndarray or None
+        Each phase's hip torque [N m] (another ``optimize.h5``'s; None: 0).
+    order : list of (phase, guard, direction)
+        The phases the starting gait's step goes through
+        (:func:`walkerlab.optimal.transcription.phases.phase_order`).
+
+    Raises
+    ------
+    ValueError
+        An unusable artifact, or one whose phases are not the gait's (one line naming
+        ``optimize.initial_guess``).
+    """
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.guess import read_guess
+    from walkerlab.optimal.transcription.mode_sequence import optimized_guess, phased_guess
+    from walkerlab.optimal.transcription.phases import phase_order
+
+    kind, got = None, None
+    if scene.optimize.initial_guess is not None:
+        kind, got = read_guess(scene, list(walker.state_names()))
+    x0 = got if kind == "continuation" else x_gait
+    guess, log = phased_guess(walker, x0, period_s, Solver.from_settings(scene.solver),
+                              intervals)
+    order = phase_order(walker, log)
+    if kind != "optimize":
+        return guess, None, order
+    return (*optimized_guess(got, [n for n, _g, _d in order], intervals), order)
+
+
+def _phased(scene, data, spec, x_gait, period_s) -> Optimum:
+    """One step of a kneed or flat-footed walker phase by phase
+    (:func:`walkerlab.optimal.transcription.mode_sequence.collocate_phases`), replayed on
+    the rigid model and in the contact model (2 strides; the hip torque acts between a
+    kneed walker's thighs, between a flat-footed walker's legs)."""
+    import time
+
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.replay.contact import contact_replay_phased
+    from walkerlab.optimal.transcription.mode_sequence import (
+        collocate_phases,
+        phase_torque_of_time,
+        replay_phases,
+    )
+    from walkerlab.optimal.transcription.step_cache import cached_mode_functions
+
+    o = scene.optimize
+    act = getattr(scene.walker, "actuation", None)
+    if act is not None and getattr(act, "ankle_push_off", None) is not None:
+        raise ValueError("walker.actuation.ankle_push_off: the phased transcription has a hip "
+                         "torque only (the rigid flat feet take an ankle push-off or hip "
+                         "torques, not together)")
+    walker = make_rigid_walker(data, double_support=False)  # no double-support phase yet
+    if data.structure.foot == "flat":  # fixedpoint's gait has its double support
+        g = solve_scene(scene, False, walker=walker)[1].gait.result
+        x_gait, period_s = g.x, float(g.period_s)
+    guess, guess_u, order = starting_phases(scene, walker, x_gait, period_s, spec.intervals)
+    t0 = time.perf_counter()
+    fns = cached_mode_functions(data, walker, order)
+    build = time.perf_counter() - t0
+    res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
+                           guess_u)
+    err, replayed = replay_phases(data, res)
+    mu = replay_multipliers(replayed, res, scene, err)
+    gait, contact_period, contact_outcome = _outcome(
+        scene, res, err, lambda: contact_replay_phased(scene, res, strides=2))
+    phases, phase_note = _phase_replays(scene, data, res, phase_torque_of_time(res))
+    states, units = _states(walker, res)
+    return Optimum(res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0,
+                   res.objective, err, mu, gait, res.status, res.iterations,
+                   res.wall_time_s, units, objective_name=o.objective,
+                   objective_unit=_unit(o), terms=res.terms,
+                   contact_step_period_s=contact_period, contact_outcome=contact_outcome,
+                   cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
+                   phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
+                   build_time_s=build + res.build_time_s, phase_replays=phases,
+                   phase_replay_outcome=phase_note, **history_and_energies(scene, walker, res))
+
+
+# -- a stride of two steps (legs that differ) --------------------------------------------
+
+def _check_stride(o, pushes: bool) -> None:
+    """Refuse what the stride transcription does not take (one line naming the field);
+    ``pushes``: the stride has a push-off (fixed or free)."""
+    from walkerlab.optimal.transcription.mode_sequence import PHASED_OBJECTIVES
+
+    asked = dict(o.weights or {}) if o.objective == "weighted" else {o.objective: 1.0}
+    known = PHASED_OBJECTIVES + (("push_off_work",) if pushes else ())
+    bad = [k for k in asked if k not in known]
+    if bad:
+        raise ValueError(f"optimize.objective: legs that differ take "
+                         f"{', '.join(known)} (or their weighted sum), not "
+                         f"{', '.join(bad)}" + ("" if pushes else " (push_off_work: with a "
+                                                "push-off, walker.actuation.push_off or "
+                                                "optimize.push_off: free)"))
+
+
+def starting_stride(scene, walker, x_gait, period_s: float, intervals: int):
+    """The stride collocation's start for ``scene``: its ``optimize.initial_guess`` (another
+    stride's ``optimize.h5``: its four phases' states and torque; a continuation artifact's
+    gait at ``at``: the stride map's start there), else one stride of its gait ``x_gait``
+    (2n,) of mean step period ``period_s`` [s]; ``intervals`` a step.
+
+    Returns
+    -------
+    guess : list of (name, t, x)
+        The four phases :data:`walkerlab.optimal.transcription.stride.STRIDE_PHASES`
+        (:func:`walkerlab.optimal.transcription.stride.stride_guess`, or
+        :func:`walkerlab.optimal.transcription.mode_sequence.optimized_guess` on
+        ``2 intervals``).
+    torque : list of ndarray or None
+        Each phase's hip torque [N m] (another ``optimize.h5``'s; None: 0).
+
+    Raises
+    ------
+    ValueError
+        An unusable artifact, one of another walker, or one without the stride's phases (a
+        one-step optimisation; one line naming ``optimize.initial_guess``); the starting
+        gait does not make a stride (one line).
+    """
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.optimal.guess import read_guess
+    from walkerlab.optimal.transcription.mode_sequence import optimized_guess
+    from walkerlab.optimal.transcription.stride import STRIDE_PHASES, stride_guess
+
+    kind, got = None, None
+    if scene.optimize.initial_guess is not None:
+        kind, got = read_guess(scene, list(walker.state_names()))
+    if kind == "optimize":
+        return optimized_guess(got, list(STRIDE_PHASES), 2 * intervals)
+    x0 = got if kind == "continuation" else x_gait
+    return stride_guess(walker, x0, period_s, Solver.from_settings(scene.solver),
+                        intervals), None
+
+
+def _stride(scene, data, spec, x_gait, period_s) -> Optimum:
+    """One stride of a walker whose legs differ (the step sequence of the walker and its
+    mirror: :func:`walkerlab.optimal.transcription.stride.stride_functions` on
+    :func:`~walkerlab.optimal.transcription.mode_sequence.collocate_phases`); its
+    ``step_period_s`` / ``step_length_m`` the mean step's, the multipliers the stride
+    map's, each step's energies from its own walker (leg B's step: the mirror's masses)."""
+    import time
+
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.replay.contact import contact_replay_stride
+    from walkerlab.optimal.transcription.mode_sequence import collocate_phases
+    from walkerlab.optimal.transcription.stride import replay_stride, step_of, stride_functions
+
+    o = scene.optimize
+    _check_stride(o, bool(spec.push_off_free or spec.push_off_n_s))
+    walker = make_rigid_walker(data)
+    guess, guess_u = starting_stride(scene, _guide(walker, data, spec), x_gait, period_s,
+                                     spec.intervals)
+    t0 = time.perf_counter()
+    fns = stride_functions(data)
+    build = time.perf_counter() - t0
+    res = collocate_phases(fns, replace(spec, warm_start=guess_u is not None), guess,
+                           guess_u)
+    err, replayed = replay_stride(data, res)
+    mu = replay_multipliers(replayed, res, scene, err)  # the stride map's
+    gait, contact_period, contact_outcome = _outcome(
+        scene, res, err, lambda: contact_replay_stride(scene, res, strides=2))
+    lengths = [float(p.step(res.x[k - 1])) for k, p in zip(
+        [*res.phase_start[2::2], res.t.size], fns["phases"][1::2])]
+    record = history_and_energies(scene, walker, res)
+    parts = [history_and_energies(scene, w, step_of(res, k))
+             for k, w in enumerate((walker, walker.mirror))]
+    record["energy"] = {kind: np.concatenate([p["energy"][kind] for p in parts])
+                        for kind in record["energy"]}
+    states, units = _states(walker, res)
+    return Optimum(res.t, states, res.u, res.step_period_s / 2, float(np.mean(lengths)),
+                   res.push_off_n_s, res.objective, err, mu, gait, res.status,
+                   res.iterations, res.wall_time_s, units, objective_name=o.objective,
+                   objective_unit=_unit(o), terms=res.terms,
+                   contact_step_period_s=contact_period, contact_outcome=contact_outcome,
+                   cpu_time_s=res.cpu_time_s, phase_names=res.phase_names,
+                   phase_start=res.phase_start, phase_duration_s=res.phase_duration_s,
+                   build_time_s=build + res.build_time_s, steps=2,
+                   phase_replay_outcome="not replayed: a stride of legs that differ is "
+                   "replayed as a function of time only" if o.phase_replay else "",
+                   **record)
+
+
+def _guide(walker, data, spec):
+    """The walker that steps the starting stride: ``walker``, with the scene's push-off
+    (``spec.push_off_n_s`` > 0) before each heel strike when it has one (its gait, from
+    ``fixedpoint``, is the pushed walker's)."""
+    if not spec.push_off_n_s:
+        return walker
+    from walkerlab.config.actuation import Actuation, PushOff
+    from walkerlab.models.hybrid.actuated import actuate
+
+    return actuate(walker, data, Actuation(push_off=PushOff(impulse_n_s=spec.push_off_n_s)))
+
+
+# -- a five-link biped (free knees) ------------------------------------------------------
+
+#: strides of the five-link contact replay (2 steps each; the first from the rigid state)
+CONTACT_STRIDES = 2
+
+
+def _five_link(scene) -> Optimum:
+    """Optimise, close and replay one step of the scene's five-link walker: collocated
+    (:mod:`walkerlab.optimal.transcription.free_joints`, its four joint torques), closed by
+    shooting under its own torques (:mod:`walkerlab.optimal.replay.shooting`), replayed on
+    the rigid model's generated code, and with the torques as a function of the phase
+    variable (feed-forward + PD, and the feed-forward alone:
+    :mod:`walkerlab.optimal.replay.virtual_constraints`) on the rigid model and - the PD
+    law - in the contact model (~35 rigid step maps and 2 contact strides).  Needs no
+    upstream gait: the guess is built from the targets (Kelly 2017's set-up).
+
+    Raises
+    ------
+    ValueError
+        No target (:func:`check_targets`), a push-off asked for, a walker the five-link
+        generator does not handle (one line).
+    """
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.optimal.replay.shooting import close_step
+    from walkerlab.optimal.transcription.free_joint_functions import (
+        JOINTS,
+        five_link_functions,
+    )
+    from walkerlab.optimal.transcription.free_joints import (
+        collocate_five_link,
+        replay_five_link,
+    )
+    from walkerlab.optimal.transcription.step import CollocationSpec
+    from walkerlab.walker.description import walker_data
+
+    o = scene.optimize
+    check_targets(o)
+    if o.push_off == "free":
+        raise ValueError("optimize.push_off: a five-link biped has no push-off (its hips and "
+                         "knees are driven)")
+    data = walker_data(scene.walker, scene.slope.phi_rad)
+    fns = five_link_functions(data.structure)
+    spec = CollocationSpec(intervals=o.intervals, max_torque_n_m=o.max_torque_n_m,
+                           target_speed_m_per_s=o.target_speed_m_per_s,
+                           target_step_length_m=o.target_step_length_m,
+                           target_step_period_s=o.target_step_period_s)
+    res = collocate_five_link(data, spec, fns)
+    closed = close_step(fns, data.params, res.t, res.x, res.u)
+    err = float("inf")
+    if closed.converged:
+        err = replay_five_link(data, res, closed.x0)[0]
+    rigid = make_rigid_walker(data, "biped", "derived")
+    gait = bool(res.status == "Solve_Succeeded" and closed.converged
+                and err <= o.replay_tolerance)
+    why = "" if gait else (not_a_gait_outcome(err, res.status) if closed.converged else
+                           "not replayed: not a gait (the shooting did not close the step)")
+    phases, contact = _five_link_replays(scene, data, res, why)
+    states, units = _states(rigid, res)
+    return Optimum(
+        res.t, states, res.u, res.step_period_s, res.step_length_m, 0.0, res.objective, err,
+        closed.multipliers, gait, res.status, res.iterations, res.wall_time_s, units,
+        torque_names=JOINTS, start_shift=closed.shift, replay_step_period_s=closed.period_s,
+        collocated_start_error=closed.open_loop_error, cpu_time_s=res.cpu_time_s,
+        contact_step_period_s=contact[0], contact_outcome=contact[1], phase_replays=phases,
+        **history_and_energies(scene, rigid, res))
+
+
+def _five_link_replays(scene, data, res, not_gait: str = "") -> tuple[dict, tuple]:
+    """The phase-variable replays
+    (:func:`walkerlab.optimal.replay.virtual_constraints.phase_replays`) and the contact
+    model's ``(step period [s], outcome)`` under the feed-forward + PD law from its closed
+    start; an optimum that is not a gait is not replayed there (``not_gait``: why, the
+    contact outcome)."""
+    from walkerlab.optimal.replay.contact import contact_replay_five_link
+    from walkerlab.optimal.replay.virtual_constraints import phase_replays
+
+    if scene.optimize.phase_replay is False:  # None (the default) or True: replayed
+        return {}, (float("nan"), "not replayed: optimize.phase_replay is off (the contact "
+                    "replay runs the feed-forward + PD law)")
+    try:
+        replays, laws = phase_replays(data, res.t, res.x, res.u)
+    except ValueError as exc:  # the phase variable is not monotonic: no such replay
+        return {}, (float("nan"), f"not replayed: {exc}")
+    if not_gait:
+        return replays, (float("nan"), not_gait)
+    fb = replays["feedback"]
+    if not fb.closed:
+        return replays, (float("nan"), "not replayed: the feed-forward + PD law did not "
+                         "close on the rigid model")
+    contact = contact_replay_five_link(scene, laws["feedback"], fb.x0, fb.step_period_s,
+                                       strides=CONTACT_STRIDES)
+    return replays, contact
+
+
+#: the stick figure's polyline through the walker's named points
+STICK = ("stance_foot", "stance_knee", "hip", "torso_top", "hip", "swing_knee", "swing_foot")
+
+
+def stick_figures(scene, d, frames: int = 8) -> list:
+    """The five-link walker of ``scene`` at ``frames`` instants of the stored step ``d``
+    (a loaded ``optimize.h5``): polylines (7, 2) [m] through :data:`STICK` (the torso's
+    top: its centre of mass, the generated ``torso_*`` point)."""
+    from walkerlab.models.hybrid.rigid import make_rigid_walker
+    from walkerlab.walker.description import walker_data
+
+    w = make_rigid_walker(walker_data(scene.walker, scene.slope.phi_rad), "biped", "derived")
+    names = w.state_names()
+    out = []
+    for k in np.linspace(0, len(d.time) - 1, frames).round().astype(int):
+        pts = w.points(np.array([d.states[n][k] for n in names]))
+        top = next(v for key, v in pts.items() if key.startswith("torso_"))
+        out.append(np.array([pts[n] if n != "torso_top" else top for n in STICK]))
+    return out

@@ -1,1 +1,0 @@
-"""Set-ups of ``walkerlab optimize`` from a scene: transcription, replay, records."""
