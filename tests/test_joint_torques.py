@@ -205,7 +205,7 @@ def test_hip_torque_on_flat_feet_with_legs_that_differ():
     actuators; a period-2 fixed point (a stride) and the generalised force of the joint
     angle read off the hip and ankles, in heel contact (pinned heel) and foot flat (the
     foot's lock takes its share)."""
-    from walkerlab.models.hybrid.flat_hip_torque import mode_mass_matrix
+    from walkerlab.models.hybrid.mode_torques import mode_mass_matrix
 
     law = {"constant_n_m": 0.3, "stiffness_n_m_per_rad": 1.0}
     w = wl.Walker.from_scene(scene_from_dict(_flat_unequal([{"joint": "hip", "law": law}])))
@@ -228,7 +228,7 @@ def test_hip_torque_on_flat_feet_with_legs_that_differ():
 def test_ankle_torque_on_flat_feet():
     """A stance-ankle torque on flat feet: the ankle coordinate's row alone (``+tau`` raises
     the toe), the joint angle read off the hip, ankle, heel and toe."""
-    from walkerlab.models.hybrid.flat_hip_torque import mode_mass_matrix
+    from walkerlab.models.hybrid.mode_torques import mode_mass_matrix
 
     torques = [{"joint": "stance_ankle", "law": {"constant_n_m": -2.0,
                                                  "stiffness_n_m_per_rad": 5.0}}]

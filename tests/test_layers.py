@@ -426,3 +426,18 @@ def test_no_top_level_package_holds_more_than_18_percent_of_the_lines():
     total = sum(sizes.values())
     big = {k: round(v / total, 3) for k, v in sizes.items() if v > 0.18 * total}
     assert not big, big
+
+
+#: words that name a walker family (a walker is data: its family is a scene, never a module)
+FAMILY_WORDS = ("compass", "kneed", "five_link", "fivelink", "flat", "rabbit", "rimless",
+                "torso", "round_feet", "arc_feet", "simplest", "kuo")
+
+
+def test_no_module_is_named_after_a_walker_family():
+    """Modules are named by role (description, generated model, actuated flow and reset,
+    views, optimisation), never by the walker family they were first written for."""
+    pkg = Path(__file__).resolve().parents[1] / "walkerlab"
+    named = [str(p.relative_to(pkg)) for p in pkg.rglob("*.py")
+             if any(w in part for part in p.relative_to(pkg).with_suffix("").parts
+                    for w in FAMILY_WORDS)]
+    assert not named, named

@@ -9,7 +9,7 @@ position), so a floating state with leg ``stance`` in stance is a rigid state in
 (:data:`walkerlab.walker.description.FREE_KNEE_ROLES` + ``torso``): ``stance_shank`` is
 ``leg{stance}_shank_angle``, ``swing_thigh`` the other leg's thigh, ``torso`` the torso's
 angle, and so on.  The torques are those of the rigid view's
-:class:`~walkerlab.models.hybrid.actuated_five_link.FiveLinkActuators` at that role state:
+:class:`~walkerlab.models.hybrid.free_joint_actuators.FiveLinkActuators` at that role state:
 
 - each joint's angle ``delta = q[second] - q[first]`` and its rate
   (:data:`walkerlab.config.actuation.FIVE_LINK_JOINTS`; ``stance_hip`` = stance thigh minus
@@ -64,7 +64,7 @@ class JointTorqueActuators(ContactRows):
     ------
     ValueError
         A push-off, or a joint the walker lacks (one line, naming the field; the rigid view's
-        :func:`~walkerlab.models.hybrid.actuated_five_link.five_link_actuators`).
+        :func:`~walkerlab.models.hybrid.free_joint_actuators.five_link_actuators`).
     """
 
     #: A touchdown is a heel strike only this far [m] ahead of the stance foot (as
@@ -83,7 +83,7 @@ class JointTorqueActuators(ContactRows):
     work_names = WORK_NAMES
 
     def __init__(self, data, spec, coordinates):
-        from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
+        from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators
 
         self.spec = spec
         roles = tuple(data.structure.roles)

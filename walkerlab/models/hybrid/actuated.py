@@ -6,8 +6,8 @@ a torque at any joint the walker has (:data:`walkerlab.config.actuation.JOINTS`:
 between the legs, torso to leg, knees, flat feet's ankles), its ``B^T = d(delta)/dq`` from
 the generated link angles; the push-off of Kuo (2002) in its transition.  Free knees (the
 five-link biped) add one spline for laws sharing a table
-(:mod:`walkerlab.models.hybrid.actuated_five_link`); flat feet run their stance-foot modes'
-own mass matrices (:mod:`walkerlab.models.hybrid.flat_hip_torque`) or an ankle push-off
+(:mod:`walkerlab.models.hybrid.free_joint_actuators`); flat feet run their stance-foot modes'
+own mass matrices (:mod:`walkerlab.models.hybrid.mode_torques`) or an ankle push-off
 (:mod:`walkerlab.models.hybrid.ankle_push_off`).  Those modules import the shared
 actuators from :mod:`walkerlab.models.hybrid.actuators`, never this one.
 """
@@ -169,7 +169,7 @@ def actuate(walker: HybridWalker, data, spec) -> HybridWalker:
         return actuate_flat(walker, data, spec)
     limit = False
     if data.structure.free_knees:  # every joint free: hips and knees (five-link bipeds)
-        from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
+        from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators
 
         acts = five_link_actuators(data, spec, walker.roles, push_off=True)
     else:

@@ -81,7 +81,7 @@ def heel_off_data(data, spec):
 
 def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
     """The flat-footed walker with its actuators, any of them together: joint torques
-    (:func:`walkerlab.models.hybrid.flat_hip_torque.actuate_flat_hips`), the ankle push-off
+    (:func:`walkerlab.models.hybrid.mode_torques.actuate_flat_hips`), the ankle push-off
     in heel off (module docstring) and the push-off impulse at the trailing toe before heel
     strike (:func:`walkerlab.models.hybrid.push_off.push_off_flat`).  Legs that differ:
     each step's walker on its own numbers (``mirror``).
@@ -99,7 +99,7 @@ def actuate_flat(walker: HybridWalker, data, spec) -> HybridWalker:
         A joint the walker does not have, a torque per foot mass, an ankle push-off's
         constant torque without an ankle spring (one line, naming the field).
     """
-    from walkerlab.models.hybrid.flat_hip_torque import actuate_flat_hips
+    from walkerlab.models.hybrid.mode_torques import actuate_flat_hips
 
     if spec.torques and spec.push_off is None and spec.ankle_push_off is None:
         return actuate_flat_hips(walker, data, spec)
@@ -115,7 +115,7 @@ def _actuate_flat_step(walker: HybridWalker, data, spec) -> HybridWalker:
     """One step's flat-footed walker (``data`` without ``mirror_params``, or legs alike)
     with the push-off impulse and/or the ankle push-off, and joint torques if any."""
     from walkerlab.codegen.cache import functions
-    from walkerlab.models.hybrid.flat_hip_torque import actuate_flat_hips
+    from walkerlab.models.hybrid.mode_torques import actuate_flat_hips
     from walkerlab.models.hybrid.push_off import FlatPushOff, push_off_flat
     from walkerlab.models.hybrid.rigid_foot_modes import make_flat_walker
 

@@ -265,7 +265,7 @@ class FlatPushOff(Transitions):
         from the foot's angle, as the generated ``points``).
     torques : Actuators or None
         Joint torques acting with it (:class:`walkerlab.models.hybrid.actuators.Actuators`
-        on the flat-foot modes, :mod:`walkerlab.models.hybrid.flat_hip_torque`): their
+        on the flat-foot modes, :mod:`walkerlab.models.hybrid.mode_torques`): their
         ``links``, ``power`` and per-step hook are read through this object.  Finite
         torques add no impulse: the transition is the same.
     """

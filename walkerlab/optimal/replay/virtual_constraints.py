@@ -28,7 +28,7 @@ Complex-safe to first order (``f(a + i e) = f(a) + i e f'(a)``): the rigid model
 variational equations differentiate the law by the complex step.
 
 The same object drives both views: the rigid model's
-:class:`~walkerlab.models.hybrid.actuated_five_link.FiveLinkActuators` and the contact
+:class:`~walkerlab.models.hybrid.free_joint_actuators.FiveLinkActuators` and the contact
 model's :class:`~walkerlab.models.contact.joint_torques.JointTorqueActuators` call its
 ``each(deltas, ddeltas, s, ds, t_step)`` as they call
 :meth:`walkerlab.models.actuation.TorqueLaws.each`.
@@ -112,7 +112,7 @@ def rigid_actuators(data):
     :data:`walkerlab.optimal.transcription.free_joint_functions.JOINTS` (for
     :func:`phase_law`)."""
     from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
-    from walkerlab.models.hybrid.actuated_five_link import five_link_actuators
+    from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators
     from walkerlab.optimal.transcription.free_joint_functions import JOINTS
 
     spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw()) for j in JOINTS])

@@ -11,7 +11,7 @@ lengths, as one generated module does:
                        with ``B u``); ``u`` (4,) the joint torques [N m] in :data:`JOINTS`
                        order, each ``+tau`` on its second link's row and ``-tau`` on its
                        first's (:data:`walkerlab.config.actuation.FIVE_LINK_JOINTS`, the
-                       signs of :mod:`walkerlab.models.hybrid.actuated_five_link`)
+                       signs of :mod:`walkerlab.models.hybrid.free_joint_actuators`)
 ``feet(x, p)``         ``[clearance, ahead, clearance rate, stance knee, swing knee]``: the
                        swing foot's height above the slope [m] (the heel-strike guard), its
                        distance ahead of the stance foot along the slope [m], the height's
