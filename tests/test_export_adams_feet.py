@@ -255,3 +255,69 @@ def test_bisecting_torso_coupler(tmp_path_factory):
                                                                             "leg2"))
     assert wt == pytest.approx(0.5 * (w1 + w2), abs=1e-14)
     assert "not exported" not in adm
+
+
+def test_ankle_and_hip_torques_on_flat_feet_equal_walkerlab_laws(flat, tmp_path_factory):
+    """Flat feet with a hip PD, a stance-ankle PD about -0.1 rad saturated at 20 N m and a
+    swing-ankle spring-damper (refused before: "stance_hip, ... need a five-link biped"):
+    SFORCE/17, 18 on each ankle (I foot, J leg) evaluated at 24 states equal walkerlab's
+    laws (:meth:`TorqueLaws.each` on the role ankles' angles, the roles from the feet's
+    contact forces); the hip SFORCE/10 the hip law's."""
+    from walkerlab.export.adams import (
+        ANKLE_TORQUE_SFORCE,
+        HIP_SFORCE,
+        adams_start,
+        adm_text,
+    )
+    from walkerlab.models.actuation import TorqueLaws
+
+    scene0, mb, data0, _model, _adm = flat
+    raw = yaml.safe_load((ROOT / "configs" / "flat_feet.yaml").read_text())
+    raw["walker"]["actuation"] = {"torques": [
+        {"joint": "hip", "law": {"stiffness_n_m_per_rad": 10.0, "damping_n_m_s_per_rad": 1.0,
+                                 "rest_angle_rad": 0.3}},
+        {"joint": "stance_ankle", "max_torque_n_m": 20.0,
+         "law": {"stiffness_n_m_per_rad": 60.0, "damping_n_m_s_per_rad": 2.0,
+                 "rest_angle_rad": -0.1, "constant_n_m": -3.0}},
+        {"joint": "swing_ankle", "law": {"stiffness_n_m_per_rad": 15.0,
+                                         "damping_n_m_s_per_rad": 0.5}}]}
+    path = tmp_path_factory.mktemp("ankle_t") / "flat_torques.yaml"
+    path.write_text(yaml.safe_dump(raw))
+    scene = load_scene(path)
+    start = adams_start(scene0, mb, data0)
+    model = read_adm(adm_text(scene, mb, walker_data(scene.walker, scene.slope.phi_rad),
+                              "t", "t", start))
+    v = model.functions()
+    ids = part_ids(mb)
+    laws = TorqueLaws(scene.walker.actuation.torques)
+    rng = np.random.default_rng(7)
+    cid = {g: next(c for c, s in model.by_kind["CONTACT"].items()
+                   if s.integer("IGEOM") == marker_id(ids[f"{g}_foot"], "toe"))
+           for g in ("leg1", "leg2")}
+    saturated = 0
+    for n in range(24):
+        psi = {g: rng.uniform(-0.4, 0.4) for g in ("leg1", "leg2")}
+        w = {g: rng.uniform(-2, 2) for g in ("leg1", "leg2")}
+        a = {g: rng.uniform(-0.6, 0.4) for g in ("leg1", "leg2")}
+        da = {g: rng.uniform(-3, 3) for g in ("leg1", "leg2")}
+        stance = ("leg1", "leg2")[n % 2]
+        swing = "leg2" if stance == "leg1" else "leg1"
+        st = AdamsState(mb, (10.0, 950.0), (600.0, -30.0), psi, w, {cid[stance]: 250.0})
+        for g in ("leg1", "leg2"):
+            st.part[ids[f"{g}_foot"]] = (psi[g] + a[g], w[g] + da[g])
+        ns = st.namespace(v)
+        deltas = [psi[swing] - psi[stance], a[stance], a[swing]]
+        rates = [w[swing] - w[stance], da[stance], da[swing]]
+        each = laws.each(deltas, rates, psi[stance], w[stance]) * MM
+        saturated += abs(each[1]) == 20.0 * MM
+        for g in ("leg1", "leg2"):
+            sf = model.get("SFORCE", ANKLE_TORQUE_SFORCE[g])
+            assert (sf.integer("I"), sf.integer("J")) == (
+                marker_id(ids[f"{g}_foot"], "joint"), marker_id(ids[g], "foot"))
+            want = each[1] if g == stance else each[2]
+            got = evaluate(sf.args["FUNCTION"][0], ns)
+            assert math.isclose(got, want, rel_tol=1e-12, abs_tol=1e-9), (g, got, want)
+        hip = evaluate(model.get("SFORCE", HIP_SFORCE).args["FUNCTION"][0], ns)
+        assert math.isclose(hip, each[0] * (1.0 if swing == "leg1" else -1.0), rel_tol=1e-12,
+                            abs_tol=1e-9)
+    assert 0 < saturated < 24

@@ -9,7 +9,8 @@ com_*.html): ``UNITS``, ``PART`` (``MASS``, ``CM``, ``IP``, ``QG``, ``REULER``, 
 (``JGRAVITY``), ``GRAPHICS`` (``ELLIPSOID``, ``BOX``), ``CONTACT`` (``IGEOM``, ``JGEOM``,
 ``IMPACT``, ``STIFFNESS``, ``DAMPING``, ``DMAX``, ``EXPONENT``, ``COULOMB_FRICTION``,
 ``MU_STATIC``, ``MU_DYNAMIC``, ``STICTION_TRANSITION_VELOCITY``,
-``FRICTION_TRANSITION_VELOCITY``), ``VARIABLE``, ``GFORCE`` (``I``, ``JFLOAT``, ``RM``,
+``FRICTION_TRANSITION_VELOCITY``), ``COUPLER`` (``JOINTS``, ``TYPE=R:R``, ``SCALES``),
+``VARIABLE``, ``GFORCE`` (``I``, ``JFLOAT``, ``RM``,
 ``FX``.. ``TZ``), ``MARKER/FLOATING``, ``REQUEST`` (``F2``.. ``F8``),
 ``OUTPUT`` and ``END``; commands ``SIMULATE/INITIAL_CONDITIONS``, ``DEACTIVATE/JOINT``,
 ``SIMULATE/DYNAMICS`` (``END``, ``STEPS``) and ``STOP``.  A line that starts with ``,``
@@ -60,15 +61,29 @@ knee``                                 hip (I thigh, J torso) and knee (I
                                        foot -> hip: P / T while the swing
                                        foot's touchdown is predicted < T
 ``contact.push_off_duration_s``        the pulse's T (VARIABLE/332)           s
+arc foot radius ``R``                  GRAPHICS/<foot marker> ELLIPSOID of    mm
+                                       diameter 2 R on the arc's centre
+flat foot ``heel_m``, ``toe_m``        foot PART markers ``+3`` (heel),       mm
+                                       ``+5`` (toe) along its x axis, spheres
+flat foot ``ankle`` spring             SPRINGDAMPER/21, 22 ROTATIONAL (I      N mm/rad, rad
+                                       foot, J leg) KT, CT, ANGLE
+``contact.flat_foot_mass_kg``,         foot PART MASS, IP (at the ankle)      kg, kg mm^2
+``flat_foot_inertia_kg_m2``
+``walker.actuation.ankle_push_off``    SFORCE/15, 16 ROTATION on each ankle   N mm
+                                       (I foot, J leg) from heel off
+bisecting torso (``walker.torso``)     COUPLER/1 of the torso's and leg1's    -
+                                       hip REVOLUTEs, SCALES = 1, -0.5
 rigid gait start (x ``contact_sim.     PART QG, REULER, VX, VY (CM), WZ       mm, deg, mm/s,
 initial_rate_scale``)                                                         rad/s
 ``contact_sim.n_strides``              acf SIMULATE/DYNAMICS END, STEPS       s
 =====================================  =====================================  ================
 
 Identifiers (what :mod:`walkerlab.export.adams_reader` relies on): PART/1 ground, PART/2 the
-hip, PART/3.. the links in :class:`walkerlab.walker.multibody.Multibody` order; markers of part
-``p``: ``100 p + 1`` CM, ``+ 2`` its proximal joint, ``+ 3`` the foot, ``+ 4`` the knee on
-the thigh; ground markers 101 (origin), 102 (stance-foot pin), 103 (planar joint).
+hip, PART/3.. the links in :class:`walkerlab.walker.multibody.Multibody` order, then flat
+feet's foot parts (:func:`part_ids`); markers of part ``p``: ``100 p + 1`` CM, ``+ 2`` its
+proximal joint (a foot part's: the ankle), ``+ 3`` the foot (a flat foot's heel; on its leg:
+the ankle), ``+ 4`` the knee on the thigh, ``+ 5`` a flat foot's toe; ground markers 101
+(origin), 102 (stance-foot pin), 103 (planar joint); JOINT/20, 21 the ankles.
 
 Modelling as the paper: the hip point mass is a part (the paper's "link-hip") fixed to leg2
 (a point mass at the hip acts the same on either leg), leg1 turns on it by a revolute joint;
@@ -77,6 +92,19 @@ spheres of radius ``L/1000`` (the paper's 1 mm bevel) whose centre is the model'
 and the patches' top face lies that radius below the ground line, so the sphere touches where
 the model's point foot does; the temporary revolute joint pinning the stance foot (JOINT/99)
 holds during the initial-conditions analysis and is deactivated by the .acf before the run.
+
+Feet and torso as the contact view has them: an **arc foot** is a sphere of radius ``R`` on
+the arc's centre (in the x-y plane its section is the arc; its lowest point is the contact
+view's rolling contact point, where IMPACT and Coulomb friction act), the patches not lowered
+and the pin at leg2's arc centre; a **flat foot** is a PART on a REVOLUTE at the leg's end
+(the ankle), ``REULER`` the leg's angle plus the ankle angle (positive toe up), with the
+contact model's regularising mass and inertia at the ankle (``contact.flat_foot_mass_kg``,
+``contact.flat_foot_inertia_kg_m2``: the rigid view's feet are massless), the ankle spring a
+rotational SPRINGDAMPER, contact spheres (the point foot's) at heel and toe, the start the
+MJCF keyframe (the rigid heel strike's double support: the trailing toe on the ground,
+leg2's heel at the origin and pinned); a **bisecting torso** is a PART on a REVOLUTE at the
+hip held at the legs' mean angle by a COUPLER (Adams couples the joints' rotations from the
+start, which satisfies the relation).
 
 Actuation (``walker.actuation``; every expression a ``VARIABLE`` of Adams runtime functions,
 each line within 80 columns, no expression continued over lines): the roles are not a
@@ -92,9 +120,12 @@ pulse ``P / T`` at the stance foot along the line to the hip, on while the swing
 above ground, at least :data:`PUSH_MIN_STEP_M` ahead, and its penetration extrapolated ``T``
 ahead at its rate is positive (the contact view's start,
 :func:`walkerlab.integrate.contact_powered.pulse_lead`); it ends at the touchdown (the
-contact view runs a pulse that straddles the touchdown to its end).  Not written (refused in
-one line): time references (the time since heel strike is a latched state), a pulse of
-length 0 (an impulse), an ankle push-off (flat feet).
+contact view runs a pulse that straddles the touchdown to its end); on flat feet it pushes at
+the toe and the touchdown is the heel's.  The ankle push-off acts on the stance ankle while
+its heel's normal force is 0 and its toe's positive (the contact view latches heel off and
+ends the push-off at the touchdown; here it ends when the roles swap, a few ms later).  Not
+written (refused in one line): time references (the time since heel strike is a latched
+state), a pulse of length 0 (an impulse).
 """
 
 from __future__ import annotations
@@ -836,8 +867,10 @@ def _law(k: int, t, delta: int, ddelta: int) -> list[str]:
                        f"VARVAL({base + 106}))")]
 
 
-def _hip_torques(act, m1: int, m2: int) -> list[str]:
-    """The hip torques' laws as VARIABLEs and one SFORCE between leg1 (I) and leg2 (J)."""
+def _hip_torques(act, m1: int, m2: int, ks: list | None = None) -> list[str]:
+    """The hip torques' laws (actuators ``ks``, default all) as VARIABLEs and one SFORCE
+    between leg1 (I) and leg2 (J)."""
+    ks = list(range(len(act.torques))) if ks is None else ks
     V = ACT_VARIABLES
     out = ["! hip torques (walker.actuation.torques) [N mm]: +tau on the swing leg, -tau",
            "! on the stance leg; delta = swing - stance leg angle (AZ of leg1's hip marker",
@@ -847,10 +880,10 @@ def _hip_torques(act, m1: int, m2: int) -> list[str]:
            _var(V["ddelta"], f"VARVAL({V['sign']})*WZ({m1},{m2},{m2})"),
            _var(V["phase"], f"IF(VARVAL({V['sign']}):AZ({m1},101),0,AZ({m2},101))"),
            _var(V["dphase"], f"IF(VARVAL({V['sign']}):WZ({m1},101,101),0,WZ({m2},101,101))")]
-    for k, t in enumerate(act.torques):
-        out += _law(k, t, V["delta"], V["ddelta"])
+    for k in ks:
+        out += _law(k, act.torques[k], V["delta"], V["ddelta"])
     out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM,
-                      [f"VARVAL({hip_torque_ids(k)['tau']})" for k in range(len(act.torques))])
+                      [f"VARVAL({hip_torque_ids(k)['tau']})" for k in ks])
     out += ["! their sum on leg1 (I) about z, the reaction on leg2 (J): sign * tau (the",
             "! swing leg's torque on leg1 while it swings, minus it while leg1 stands)",
             f"SFORCE/{HIP_SFORCE}, ROTATION, I={m1}, J={m2}",
@@ -1005,7 +1038,16 @@ def _actuation(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: bool) -> li
             out += _chain_sum(410 if g == "leg1" else 460, V[f"force_{g}"], terms("foot"))
     out.append(_var(V["sign"], f"IF(VARVAL({V['force_leg1']})-VARVAL({V['force_leg2']}):"
                     "1,1,-1)"))
-    if any(t.joint != "hip" for t in act.torques):
+    ankle = [k for k, t in enumerate(act.torques) if t.joint.endswith("_ankle")]
+    hip = [k for k, t in enumerate(act.torques) if t.joint == "hip"]
+    if ankle:
+        if mb.foot != "flat":
+            raise ValueError("walker.actuation.torques: stance_ankle and swing_ankle need "
+                             "flat feet (walker.leg.foot.kind: flat)")
+        if hip:
+            out += _hip_torques(act, hips["leg1"], hips["leg2"], hip)
+        out += _ankle_torques(mb, act, ids, hips, ankle, phase=not hip)
+    elif any(t.joint != "hip" for t in act.torques):
         if "torso" not in ids or not mb.knee or any(t.joint == "hip" for t in act.torques):
             raise ValueError("walker.actuation.torques: stance_hip, swing_hip, stance_knee "
                              "and swing_knee need a five-link biped (free knees, a torso)")
@@ -1022,6 +1064,51 @@ def _actuation(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: bool) -> li
             out += _push_off(mb, T, act.push_off, feet, hips)
     if act.ankle_push_off is not None:
         out += _ankle_push_off(mb, act.ankle_push_off, ids)
+    return out
+
+
+#: Flat feet's ankle torques: VARIABLE ids (angle [rad], rate [rad/s]) of the role ankles
+#: (the sole from the leg's perpendicular, toe up > 0), the sums of their laws [N mm] and
+#: the SFORCE ids of leg1's and leg2's ankles.
+ANKLE_ROLE_VARIABLES = {"stance_ankle": (384, 385), "swing_ankle": (388, 389)}
+ANKLE_TORQUE_SUM = {"stance_ankle": 9105, "swing_ankle": 9106}
+ANKLE_TORQUE_SFORCE = {"leg1": 17, "leg2": 18}
+
+
+def _ankle_torques(mb, act, ids: dict, hips: dict, ks: list, phase: bool) -> list[str]:
+    """Flat feet's ``stance_ankle`` / ``swing_ankle`` torques (actuators ``ks``): the role
+    ankles' angles ``AZ(foot, leg)`` picked by the role sign, each law on its role's angle
+    (the phase variable the stance leg's angle, written here when no hip torque wrote it:
+    ``phase``), one SFORCE per physical ankle (I the foot, J the leg) with its present
+    role's sum (+tau raises the toe)."""
+    V = ACT_VARIABLES
+    sgn = f"VARVAL({V['sign']})"
+    fj = {g: marker_id(ids[f"{g}_foot"], "joint") for g in ("leg1", "leg2")}
+    lf = {g: marker_id(ids[_leg_end(mb, g)], "foot") for g in ("leg1", "leg2")}
+    out = ["! ankle torques (walker.actuation.torques) [N mm] of flat feet: +tau on the",
+           "! foot (raises the toe), -tau on the leg; stance_ankle is the standing leg's",
+           "! ankle angle AZ(foot, leg), swing_ankle the other's (the role sign picks)"]
+    if phase:
+        m1, m2 = hips["leg1"], hips["leg2"]
+        out += [_var(V["phase"], f"IF({sgn}:AZ({m1},101),0,AZ({m2},101))"),
+                _var(V["dphase"], f"IF({sgn}:WZ({m1},101,101),0,WZ({m2},101,101))")]
+    for joint, (a, r) in ANKLE_ROLE_VARIABLES.items():
+        first, second = ("leg1", "leg2") if joint == "stance_ankle" else ("leg2", "leg1")
+        out += [_var(a, f"IF({sgn}:AZ({fj[first]},{lf[first]}),0,"
+                     f"AZ({fj[second]},{lf[second]}))"),
+                _var(r, f"IF({sgn}:WZ({fj[first]},{lf[first]},{lf[first]}),0,"
+                     f"WZ({fj[second]},{lf[second]},{lf[second]}))")]
+    for k in ks:
+        out += _law(k, act.torques[k], *ANKLE_ROLE_VARIABLES[act.torques[k].joint])
+    for i, (joint, total) in enumerate(ANKLE_TORQUE_SUM.items()):
+        taus = [f"VARVAL({hip_torque_ids(k)['tau']})" for k in ks
+                if act.torques[k].joint == joint]
+        out += _chain_sum(9041 + 10 * i, total, taus)
+    st, sw = ANKLE_TORQUE_SUM["stance_ankle"], ANKLE_TORQUE_SUM["swing_ankle"]
+    for g in ("leg1", "leg2"):
+        a, b = (st, sw) if g == "leg1" else (sw, st)  # sign < 0: leg1 stands
+        out += [f"SFORCE/{ANKLE_TORQUE_SFORCE[g]}, ROTATION, I={fj[g]}, J={lf[g]}",
+                f", FUNCTION=IF({sgn}:VARVAL({a}),0,VARVAL({b}))"]
     return out
 
 
