@@ -203,22 +203,6 @@ def test_cli_writes_adm_and_acf(tmp_path):
     assert not list(folder.glob(".*.tmp"))
 
 
-@pytest.mark.parametrize("name,word", [("round_feet", "arc feet"),
-                                       ("flat_feet", "flat feet"),
-                                       ("torso_bhm", "walker.torso")])
-def test_refused_in_one_line(name, word, tmp_path):
-    """Arc and flat feet, upper bodies: one line naming the field, exit 1, no file."""
-    from typer.testing import CliRunner
-
-    from walkerlab.cli import app
-
-    r = CliRunner().invoke(app, ["export", str(ROOT / "configs" / f"{name}.yaml"),
-                                 "--format", "adm", "--runs-dir", str(tmp_path)])
-    assert r.exit_code == 1
-    assert r.output.strip().count("\n") == 0 and word in r.output
-    assert not list(tmp_path.rglob("walker.a*"))
-
-
 def test_reader_refuses_outside_subset():
     with pytest.raises(AdmReadError, match="BEAM"):
         parse_adm("t\nBEAM/1, I=1, J=2\nEND\n")

@@ -289,26 +289,31 @@ def test_target_command_prints_the_value_or_one_line():
     assert "error: target: no gait with speed = 3" in r.output
 
 
-def test_the_export_refuses_an_ankle_push_off_in_one_line(tmp_path):
-    """Not silently passive: the URDF/MJCF export does not carry an ankle push-off and says
-    so (the contact periodic gait of a powered walker is computed:
-    tests/contact/test_powered_contact.py)."""
+def test_the_export_carries_an_ankle_push_off(tmp_path):
+    """Not silently passive: the MJCF of a flat-footed walker with an ankle push-off has a
+    motor on each ankle hinge and the law in its custom text (it walks:
+    tests/test_export_flat_feet.py); the URDF refuses flat feet in one line."""
     import yaml
     from typer.testing import CliRunner
 
     from walkerlab.cli import app
 
-    cases = []
     f = load_scene(CONFIGS / "flat_feet.yaml").model_dump(mode="json", exclude_none=True)
     f["walker"]["actuation"] = {"ankle_push_off": {"constant_n_m": 5.0}}
     f["name"] = "ankle_flat"
-    cases.append((f, ["export", "--format", "mjcf"], "not exported yet"))
-    for d, args, msg in cases:
-        scene = tmp_path / f"{d['name']}.yaml"
-        scene.write_text(yaml.safe_dump(d))
-        r = CliRunner().invoke(app, [*args, str(scene), "--runs-dir", str(tmp_path / "runs")])
-        assert r.exit_code == 1 and "Traceback" not in r.output, r.output
-        assert msg in r.output and r.output.count("error:") == 1, r.output
+    scene = tmp_path / "ankle_flat.yaml"
+    scene.write_text(yaml.safe_dump(f))
+    r = CliRunner().invoke(app, ["export", "--format", "mjcf", str(scene), "--runs-dir",
+                                 str(tmp_path / "runs")])
+    assert r.exit_code == 0, r.output
+    text = (tmp_path / "runs" / "ankle_flat" / "walker.xml").read_text()
+    for leg in ("leg1", "leg2"):
+        assert f'<motor name="{leg}_ankle_motor" joint="{leg}_ankle" gear="1"/>' in text
+    assert '"constant_n_m": 5.0' in text
+    r = CliRunner().invoke(app, ["export", "--format", "urdf", str(scene), "--runs-dir",
+                                 str(tmp_path / "urdf")])
+    assert r.exit_code == 1 and "Traceback" not in r.output and r.output.count("error:") == 1
+    assert "walker.leg.foot.kind" in r.output
 
 
 @pytest.mark.parametrize("name", ["powered_compass", "kuo2002"])

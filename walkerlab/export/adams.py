@@ -9,7 +9,8 @@ com_*.html): ``UNITS``, ``PART`` (``MASS``, ``CM``, ``IP``, ``QG``, ``REULER``, 
 (``JGRAVITY``), ``GRAPHICS`` (``ELLIPSOID``, ``BOX``), ``CONTACT`` (``IGEOM``, ``JGEOM``,
 ``IMPACT``, ``STIFFNESS``, ``DAMPING``, ``DMAX``, ``EXPONENT``, ``COULOMB_FRICTION``,
 ``MU_STATIC``, ``MU_DYNAMIC``, ``STICTION_TRANSITION_VELOCITY``,
-``FRICTION_TRANSITION_VELOCITY``), ``VARIABLE``, ``GFORCE`` (``I``, ``JFLOAT``, ``RM``,
+``FRICTION_TRANSITION_VELOCITY``), ``COUPLER`` (``JOINTS``, ``TYPE=R:R``, ``SCALES``),
+``VARIABLE``, ``GFORCE`` (``I``, ``JFLOAT``, ``RM``,
 ``FX``.. ``TZ``), ``MARKER/FLOATING``, ``REQUEST`` (``F2``.. ``F8``),
 ``OUTPUT`` and ``END``; commands ``SIMULATE/INITIAL_CONDITIONS``, ``DEACTIVATE/JOINT``,
 ``SIMULATE/DYNAMICS`` (``END``, ``STEPS``) and ``STOP``.  A line that starts with ``,``
@@ -60,15 +61,29 @@ knee``                                 hip (I thigh, J torso) and knee (I
                                        foot -> hip: P / T while the swing
                                        foot's touchdown is predicted < T
 ``contact.push_off_duration_s``        the pulse's T (VARIABLE/332)           s
+arc foot radius ``R``                  GRAPHICS/<foot marker> ELLIPSOID of    mm
+                                       diameter 2 R on the arc's centre
+flat foot ``heel_m``, ``toe_m``        foot PART markers ``+3`` (heel),       mm
+                                       ``+5`` (toe) along its x axis, spheres
+flat foot ``ankle`` spring             SPRINGDAMPER/21, 22 ROTATIONAL (I      N mm/rad, rad
+                                       foot, J leg) KT, CT, ANGLE
+``contact.flat_foot_mass_kg``,         foot PART MASS, IP (at the ankle)      kg, kg mm^2
+``flat_foot_inertia_kg_m2``
+``walker.actuation.ankle_push_off``    SFORCE/15, 16 ROTATION on each ankle   N mm
+                                       (I foot, J leg) from heel off
+bisecting torso (``walker.torso``)     COUPLER/1 of the torso's and leg1's    -
+                                       hip REVOLUTEs, SCALES = 1, -0.5
 rigid gait start (x ``contact_sim.     PART QG, REULER, VX, VY (CM), WZ       mm, deg, mm/s,
 initial_rate_scale``)                                                         rad/s
 ``contact_sim.n_strides``              acf SIMULATE/DYNAMICS END, STEPS       s
 =====================================  =====================================  ================
 
 Identifiers (what :mod:`walkerlab.export.adams_reader` relies on): PART/1 ground, PART/2 the
-hip, PART/3.. the links in :class:`walkerlab.walker.multibody.Multibody` order; markers of part
-``p``: ``100 p + 1`` CM, ``+ 2`` its proximal joint, ``+ 3`` the foot, ``+ 4`` the knee on
-the thigh; ground markers 101 (origin), 102 (stance-foot pin), 103 (planar joint).
+hip, PART/3.. the links in :class:`walkerlab.walker.multibody.Multibody` order, then flat
+feet's foot parts (:func:`part_ids`); markers of part ``p``: ``100 p + 1`` CM, ``+ 2`` its
+proximal joint (a foot part's: the ankle), ``+ 3`` the foot (a flat foot's heel; on its leg:
+the ankle), ``+ 4`` the knee on the thigh, ``+ 5`` a flat foot's toe; ground markers 101
+(origin), 102 (stance-foot pin), 103 (planar joint); JOINT/20, 21 the ankles.
 
 Modelling as the paper: the hip point mass is a part (the paper's "link-hip") fixed to leg2
 (a point mass at the hip acts the same on either leg), leg1 turns on it by a revolute joint;
@@ -77,6 +92,19 @@ spheres of radius ``L/1000`` (the paper's 1 mm bevel) whose centre is the model'
 and the patches' top face lies that radius below the ground line, so the sphere touches where
 the model's point foot does; the temporary revolute joint pinning the stance foot (JOINT/99)
 holds during the initial-conditions analysis and is deactivated by the .acf before the run.
+
+Feet and torso as the contact view has them: an **arc foot** is a sphere of radius ``R`` on
+the arc's centre (in the x-y plane its section is the arc; its lowest point is the contact
+view's rolling contact point, where IMPACT and Coulomb friction act), the patches not lowered
+and the pin at leg2's arc centre; a **flat foot** is a PART on a REVOLUTE at the leg's end
+(the ankle), ``REULER`` the leg's angle plus the ankle angle (positive toe up), with the
+contact model's regularising mass and inertia at the ankle (``contact.flat_foot_mass_kg``,
+``contact.flat_foot_inertia_kg_m2``: the rigid view's feet are massless), the ankle spring a
+rotational SPRINGDAMPER, contact spheres (the point foot's) at heel and toe, the start the
+MJCF keyframe (the rigid heel strike's double support: the trailing toe on the ground,
+leg2's heel at the origin and pinned); a **bisecting torso** is a PART on a REVOLUTE at the
+hip held at the legs' mean angle by a COUPLER (Adams couples the joints' rotations from the
+start, which satisfies the relation).
 
 Actuation (``walker.actuation``; every expression a ``VARIABLE`` of Adams runtime functions,
 each line within 80 columns, no expression continued over lines): the roles are not a
@@ -92,9 +120,12 @@ pulse ``P / T`` at the stance foot along the line to the hip, on while the swing
 above ground, at least :data:`PUSH_MIN_STEP_M` ahead, and its penetration extrapolated ``T``
 ahead at its rate is positive (the contact view's start,
 :func:`walkerlab.integrate.contact_powered.pulse_lead`); it ends at the touchdown (the
-contact view runs a pulse that straddles the touchdown to its end).  Not written (refused in
-one line): time references (the time since heel strike is a latched state), a pulse of
-length 0 (an impulse), an ankle push-off (flat feet).
+contact view runs a pulse that straddles the touchdown to its end); on flat feet it pushes at
+the toe and the touchdown is the heel's.  The ankle push-off acts on the stance ankle while
+its heel's normal force is 0 and its toe's positive (the contact view latches heel off and
+ends the push-off at the touchdown; here it ends when the roles swap, a few ms later).  Not
+written (refused in one line): time references (the time since heel strike is a latched
+state), a pulse of length 0 (an impulse).
 """
 
 from __future__ import annotations
@@ -121,10 +152,16 @@ ADAMS_FILES = {"adm": "walker.adm", "acf": "walker.acf"}
 PIN_JOINT = 99
 #: The planar joint that keeps leg2 (and so the walker) in the x-y plane.
 PLANAR_JOINT = 98
+#: Flat feet: the ankle revolutes of leg1 and leg2 (``ANKLE_JOINT``, ``+ 1``).
+ANKLE_JOINT = 20
+#: The bisecting hip's COUPLER (torso and leg1 hip revolutes).
+COUPLER_ID = 1
+#: Flat feet: the ankle SPRINGDAMPERs of leg1 and leg2 (``ANKLE_SPRING``, ``+ 1``).
+ANKLE_SPRING = 21
 #: Millimetres per metre (the file's length unit).
 MM = 1000.0
 #: Marker roles on a part: ``100 part + offset``.
-MARKER_OFFSET = {"cm": 1, "joint": 2, "foot": 3, "knee": 4}
+MARKER_OFFSET = {"cm": 1, "joint": 2, "foot": 3, "knee": 4, "toe": 5}
 #: Output steps per second of the .acf's dynamic run.
 STEPS_PER_S = 1000
 #: Lane offsets (z) of leg1's and leg2's feet and patches, in leg lengths.
@@ -132,8 +169,13 @@ LANE_Z = {"leg1": 0.05, "leg2": -0.05}
 
 
 def part_ids(mb) -> dict[str, int]:
-    """PART ids: ``ground`` 1, ``hip`` 2, the links from 3 in ``mb.links`` order."""
-    return {"ground": 1, "hip": 2, **{ln.name: 3 + i for i, ln in enumerate(mb.links)}}
+    """PART ids: ``ground`` 1, ``hip`` 2, the links from 3 in ``mb.links`` order, then flat
+    feet's foot parts ``leg1_foot``, ``leg2_foot``."""
+    ids = {"ground": 1, "hip": 2, **{ln.name: 3 + i for i, ln in enumerate(mb.links)}}
+    if mb.foot == "flat":
+        n = 3 + len(mb.links)
+        ids.update({"leg1_foot": n, "leg2_foot": n + 1})
+    return ids
 
 
 def marker_id(part: int, role: str) -> int:
@@ -154,18 +196,16 @@ def actuation_warning(scene: Scene) -> str:
 def check_adams_exportable(mb) -> None:
     """Refuse walkers the dataset cannot carry (one line).
 
-    Raises
-    ------
-    ValueError
-        Arc or flat feet, an upper body on a bisecting hip (its coupling is not
-        written).
+    Point, arc (a sphere of radius ``R``) and flat feet (foot parts on ankle revolutes)
+    are written, an upper body on a bisecting hip with a ``COUPLER``; nothing is refused
+    today (kept for the callers).
     """
-    if mb.foot != "point" and not (mb.foot == "arc" and mb.foot_radius_m == 0):  # R = 0
-        raise ValueError(f"walker.leg.foot: {mb.foot} feet are not exported to ADAMS yet "
-                         "(--format adm writes point feet only)")
-    if mb.couplings:
-        raise ValueError("walker.torso: an upper body is not exported to ADAMS yet (its "
-                         "bisecting hip would need a COUPLER); export a walker without it")
+    for cp in mb.couplings:
+        legs = {j for j, _c in cp.terms}
+        if cp.joint != "torso_hip" or not legs <= {"leg1_hip", "leg2_hip"} or \
+                abs(sum(c for _j, c in cp.terms) - 1.0) > 1e-12:
+            raise ValueError(f"walker.torso: the coupling {cp.name} is not a weighted mean of "
+                             "the hip joints, which a COUPLER of the hip revolutes cannot hold")
 
 
 def contact_mm(settings: ContactSettings) -> dict[str, float]:
@@ -219,6 +259,9 @@ class AdamsStart:
     period_s : float
         The rigid gait's step period [s].
     rate_scale : (float, float)
+    ankles : dict or None
+        Flat feet: each leg's ankle angle [rad] (the sole from the leg's perpendicular,
+        positive toe up) and its rate [rad/s], ``{leg: (a, da)}``; None otherwise.
     """
 
     hip: tuple[float, float]
@@ -229,6 +272,7 @@ class AdamsStart:
     patch_width_m: float
     period_s: float
     rate_scale: tuple[float, float]
+    ankles: dict | None = None
 
 
 def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
@@ -261,14 +305,25 @@ def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
 
     settings = scene.contact or ContactSettings()
     c, knee = contact_si(settings)
-    walker = ContactWalker(contact=c, data=data, knee_stop=knee)
     ideal = ideal_gait(scene) if ideal is None else ideal
     scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)
-    z = walker.link_state_from_ideal(ideal.x, scale)
-    q, v = walker.layout().coordinate_values(walker.pinned_to_full(z, np.zeros(2)))
     extra = mjcf_scene(scene, mb, data, ideal)  # the same gait: one search, not two
     n = _strides(scene) + 2
     lanes = None if extra.lanes is None else tuple(tuple(lane[:n]) for lane in extra.lanes)
+    if mb.foot == "flat":  # the MJCF keyframe: the rigid heel strike's double support
+        qp, qv = [float(x) for x in extra.qpos], [float(x) for x in extra.qvel]
+        return AdamsStart((qp[0], qp[1]), (qv[0], qv[1]), {"leg1": qp[2], "leg2": qp[4]},
+                          {"leg1": qv[2], "leg2": qv[4]}, lanes, float(extra.patch_width_m),
+                          float(ideal.period_s), (1.0, 1.0),
+                          {"leg1": (qp[3], qv[3]), "leg2": (qp[5], qv[5])})
+    walker = ContactWalker(contact=c, data=data, knee_stop=knee)
+    z = walker.link_state_from_ideal(ideal.x, scale)
+    q, v = walker.layout().coordinate_values(walker.pinned_to_full(z, np.zeros(2)))
+    link_of = {ln.joint: ln.name for ln in mb.links}
+    for cp in mb.couplings:  # a bisecting torso: its angle held at the legs' mean
+        name = link_of[cp.joint]
+        q[f"{name}_angle"] = sum(c * q[f"{link_of[j]}_angle"] for j, c in cp.terms)
+        v[f"{name}_angle"] = sum(c * v[f"{link_of[j]}_angle"] for j, c in cp.terms)
     return AdamsStart((float(q["hip_x"]), float(q["hip_y"])),
                       (float(v["hip_x"]), float(v["hip_y"])),
                       {ln.name: float(q[f"{ln.name}_angle"]) for ln in mb.links},
@@ -330,8 +385,10 @@ def _link_frames(mb, start: AdamsStart) -> dict[str, tuple]:
     return out
 
 
-def _parts(mb, start: AdamsStart, ids: dict, lanes: bool) -> list[str]:
-    """The PART and MARKER statements of the hip and the links, and the foot spheres."""
+def _parts(mb, start: AdamsStart, ids: dict, lanes: bool, feet: tuple | None = None
+           ) -> list[str]:
+    """The PART and MARKER statements of the hip and the links, and the foot spheres (flat
+    feet, ``feet`` of :func:`walkerlab.export.scene.flat_feet`: their parts)."""
     out = ["!", "! ---- parts: the hip (fixed to leg2) and the links ----"]
     hip_x, hip_y = start.hip
     hip_cm = marker_id(2, "cm")
@@ -366,14 +423,69 @@ def _parts(mb, start: AdamsStart, ids: dict, lanes: bool) -> list[str]:
             zl = LANE_Z[leg] * mb.leg_length_m * MM if lanes else 0.0
             out += _stmt(f"MARKER/{marker_id(p, 'foot')}, PART={p}",
                          f"QP={_fs(0.0, -ln.foot_m * MM, zl)}")
-            d = 2 * point_foot_radius(mb) * MM
-            out += _stmt(f"GRAPHICS/{marker_id(p, 'foot')}, ELLIPSOID, "
-                         f"CM={marker_id(p, 'foot')}", f"XSCALE={_f(d)}, YSCALE={_f(d)}, "
-                         f"ZSCALE={_f(d)}")
+            if mb.foot != "flat":  # a flat foot's marker is its ankle: no geometry
+                out += _sphere(marker_id(p, "foot"), 2 * _foot_sphere_m(mb) * MM)
         kids = [k for k in mb.links if k.parent == ln.name]
         if kids:
             out += _stmt(f"MARKER/{marker_id(p, 'knee')}, PART={p}",
                          f"QP={_fs(0.0, -kids[0].joint_from_parent_m * MM, 0.0)}")
+    if mb.foot == "flat":
+        out += _flat_foot_parts(mb, start, ids, lanes, frames, feet)
+    return out
+
+
+def _foot_sphere_m(mb) -> float:
+    """Radius [m] of a foot's contact sphere: an arc foot's ``R``, else the point foot's
+    :func:`walkerlab.export.mjcf_scene.point_foot_radius` (a flat foot's heel and toe)."""
+    return mb.foot_radius_m if mb.foot == "arc" and mb.foot_radius_m > 0 else \
+        point_foot_radius(mb)
+
+
+def _sphere(marker: int, d: float) -> list[str]:
+    """The contact sphere (an ELLIPSOID of diameter ``d`` [mm]) centred on ``marker``."""
+    return _stmt(f"GRAPHICS/{marker}, ELLIPSOID, CM={marker}",
+                 f"XSCALE={_f(d)}, YSCALE={_f(d)}, ZSCALE={_f(d)}")
+
+
+def _leg_end(mb, leg: str) -> str:
+    """The link that carries ``leg``'s foot (``leg1`` or ``leg1_shank``)."""
+    return f"{leg}_shank" if mb.knee else leg
+
+
+def _flat_foot_parts(mb, start: AdamsStart, ids: dict, lanes: bool, frames: dict,
+                     feet: tuple) -> list[str]:
+    """Flat feet: a foot PART per leg with its frame at the ankle (the leg's foot marker),
+    ``REULER`` the leg's angle plus the ankle angle (its x axis along the sole, heel ->
+    toe), the contact model's regularising mass at the ankle and inertia about it
+    (``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``: the rigid view's
+    feet are massless), its frame in its leg's lane (z as the leg's ankle marker: the
+    revolute's markers coincide), contact spheres at heel (``foot`` marker) and toe
+    (``toe`` marker),
+    radius :func:`walkerlab.export.mjcf_scene.point_foot_radius` as a point foot's.
+    ``feet``: :func:`walkerlab.export.scene.flat_feet`."""
+    out = ["!", "! ---- flat feet: parts on the ankles (the contact model's mass) ----"]
+    for k, leg in enumerate(("leg1", "leg2")):
+        heel, toe, _k, _c, _rest, mass, inertia = feet[k]
+        ln = next(x for x in mb.links if x.name == _leg_end(mb, leg))
+        joint, vjoint = frames[ln.name]
+        psi, w = start.angles[ln.name], start.rates[ln.name]
+        a, da = start.ankles[leg]
+        r = np.array(_rot(psi, (0.0, -ln.foot_m)))
+        pos, vel = joint + r, vjoint + w * np.array((-r[1], r[0]))
+        p = ids[f"{leg}_foot"]
+        zl = LANE_Z[leg] * mb.leg_length_m * MM if lanes else 0.0
+        out += [f"! {leg}_foot: {mass:g} kg at the ankle, heel {heel:g} m, toe {toe:g} m"]
+        out += _stmt(f"PART/{p}, MASS={_f(mass)}, CM={marker_id(p, 'cm')}",
+                     f"IP={_fs(inertia * MM * MM, 0.0, inertia * MM * MM)}",
+                     f"QG={_fs(pos[0] * MM, pos[1] * MM, zl)}",
+                     f"REULER={_deg(psi + a)}, 0.0D, 0.0D", f"VX={_f(vel[0] * MM)}",
+                     f"VY={_f(vel[1] * MM)}", f"WZ={_f(w + da)}")
+        out += [f"MARKER/{marker_id(p, 'cm')}, PART={p}, QP=0.0, 0.0, 0.0",
+                f"MARKER/{marker_id(p, 'joint')}, PART={p}, QP=0.0, 0.0, 0.0"]
+        d = 2 * _foot_sphere_m(mb) * MM
+        for role, x in (("foot", -heel), ("toe", toe)):
+            out += _stmt(f"MARKER/{marker_id(p, role)}, PART={p}", f"QP={_fs(x * MM, 0.0, 0.0)}")
+            out += _sphere(marker_id(p, role), d)
     return out
 
 
@@ -393,21 +505,46 @@ def _joints(mb, start: AdamsStart, ids: dict) -> list[str]:
                                                          else "knee"))
         out.append(f"! {ln.joint}")
         out.append(f"JOINT/{10 + i}, REVOLUTE, I={marker_id(p, 'joint')}, J={jm}")
+    if mb.foot == "flat":
+        for k, leg in enumerate(("leg1", "leg2")):
+            out.append(f"! {leg}_ankle: the ankle angle (toe up > 0) is AZ(foot, leg)")
+            out.append(f"JOINT/{ANKLE_JOINT + k}, REVOLUTE, "
+                       f"I={marker_id(ids[f'{leg}_foot'], 'joint')}, "
+                       f"J={marker_id(ids[_leg_end(mb, leg)], 'foot')}")
+    for cp in mb.couplings:  # the bisecting hip: COUPLER of the torso's and leg1's hip
+        link = {ln.joint: ln for ln in mb.links}
+        torso, leg1 = link[cp.joint], link["leg1_hip"]
+        c1 = dict(cp.terms).get(leg1.joint, 0.0)
+        jt, j1 = 10 + mb.links.index(torso), 10 + mb.links.index(leg1)
+        out += [f"! {cp.name}: {torso.name} = the legs' mean; the revolutes measure the",
+                f"! torso and leg1 from leg2 (the hip part is fixed to it), so {torso.name} -",
+                f"! leg2 = {c1:g} (leg1 - leg2): 1.0 q(JOINT/{jt}) - {c1:g} q(JOINT/{j1}) = 0 "
+                "(the start", "! satisfies it)",
+                f"COUPLER/{COUPLER_ID}, JOINTS={jt}, {j1}, TYPE=R:R, SCALES={_fs(1.0, -c1)}"]
     out.append("! plane constraint (the paper's): leg2 moves in the ground's x-y plane")
     out.append(f"JOINT/{PLANAR_JOINT}, PLANAR, I={marker_id(stance, 'joint')}, J=103")
     foot = ids["leg2_shank" if mb.knee else "leg2"]
+    pin = marker_id(ids["leg2_foot"], "foot") if mb.foot == "flat" else \
+        marker_id(foot, "foot")  # flat feet: leg2's heel
     out.append("! temporary stance-foot pin (Section 4): deactivated by walker.acf")
-    out.append(f"JOINT/{PIN_JOINT}, REVOLUTE, I={marker_id(foot, 'foot')}, J=102")
+    out.append(f"JOINT/{PIN_JOINT}, REVOLUTE, I={pin}, J=102")
     return out
 
 
 def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
     """PART/1 (ground), its markers, ACCGRAV and the checkerboard's patches (or one plane)."""
-    phi, r = mb.slope_rad, point_foot_radius(mb)
+    arc = mb.foot == "arc" and mb.foot_radius_m > 0  # the sphere is the arc: no offset
+    phi, r = mb.slope_rad, 0.0 if arc else point_foot_radius(mb)
     L = mb.leg_length_m
+    pin = (0.0, 0.0)  # the pin at leg2's foot point (flat feet: heel) at the origin
+    if arc:  # ... or at its arc's centre, R above the contact point at the origin
+        ln = next(x for x in mb.links if x.name == _leg_end(mb, "leg2"))
+        joint = _link_frames(mb, start)[ln.name][0]
+        pin = tuple(joint + np.array(_rot(start.angles[ln.name], (0.0, -ln.foot_m))))
     out = ["!", "! ---- ground, gravity (along -y) and the tilted ground's patches ----",
            "PART/1, GROUND", "MARKER/101, PART=1, QP=0.0, 0.0, 0.0",
-           f"MARKER/102, PART=1, QP=0.0, 0.0, {_f(LANE_Z['leg2'] * L * MM if lanes else 0.0)}",
+           f"MARKER/102, PART=1, QP={_fs(pin[0] * MM, pin[1] * MM)}, "
+           f"{_f(LANE_Z['leg2'] * L * MM if lanes else 0.0)}",
            "MARKER/103, PART=1, QP=0.0, 0.0, 0.0",
            f"ACCGRAV/IGRAVITY=0.0, JGRAVITY={_f(-mb.gravity_m_per_s2 * MM)}, KGRAVITY=0.0"]
     t, n = (math.cos(phi), -math.sin(phi)), (math.sin(phi), math.cos(phi))
@@ -433,33 +570,49 @@ def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
     return out
 
 
-def _contacts(mb, ids: dict, lanes: bool, n_patches: tuple, law: dict) -> list[str]:
-    """One CONTACT per foot sphere and patch of its lane."""
-    out = ["!", "! ---- contact: IMPACT normal force + Coulomb friction, mm-kg-s ----"]
-    feet = [ln for ln in mb.links if ln.foot_m is not None]
-    gid, cid = 1001, 1
-    groups = list(zip(feet, n_patches)) if lanes else [(f, n_patches[0]) for f in feet]
-    for ln, count in groups:
-        first = gid if lanes else 1001
-        for g in range(first, first + count):
-            out += _stmt(f"CONTACT/{cid}, IGEOM={marker_id(ids[ln.name], 'foot')}, JGEOM={g}",
-                         f"IMPACT, STIFFNESS={_f(law['STIFFNESS'])}, "
-                         f"EXPONENT={_f(law['EXPONENT'])}",
-                         f"DAMPING={_f(law['DAMPING'])}, DMAX={_f(law['DMAX'])}",
-                         f"COULOMB_FRICTION=ON, MU_STATIC={_f(law['MU_STATIC'])}, "
-                         f"MU_DYNAMIC={_f(law['MU_DYNAMIC'])}",
-                         "STICTION_TRANSITION_VELOCITY="
-                         f"{_f(law['STICTION_TRANSITION_VELOCITY'])}",
-                         "FRICTION_TRANSITION_VELOCITY="
-                         f"{_f(law['FRICTION_TRANSITION_VELOCITY'])}")
+def contact_pairs(mb, ids: dict, lanes: bool, n_patches: tuple) -> list[tuple]:
+    """The CONTACTs the dataset writes, in id order from 1: ``(cid, leg, role, IGEOM,
+    JGEOM)`` with ``role`` ``"foot"`` (a point or arc foot's sphere; a flat foot's heel)
+    or ``"toe"`` (a flat foot's toe); each foot sphere against every patch of its leg's
+    lane (or the one plane, GRAPHICS/1001)."""
+    if mb.foot == "flat":
+        geoms = [(leg, role, marker_id(ids[f"{leg}_foot"], role))
+                 for leg in ("leg1", "leg2") for role in ("foot", "toe")]
+    else:
+        geoms = [(ln.name.split("_")[0], "foot", marker_id(ids[ln.name], "foot"))
+                 for ln in mb.links if ln.foot_m is not None]
+    first = {"leg1": 1001, "leg2": 1001 + n_patches[0]} if lanes else \
+        {"leg1": 1001, "leg2": 1001}
+    out, cid = [], 1
+    for leg, role, m in geoms:
+        count = n_patches[0 if leg == "leg1" else 1] if lanes else n_patches[0]
+        for g in range(first[leg], first[leg] + count):
+            out.append((cid, leg, role, m, g))
             cid += 1
-        if lanes:
-            gid += count
     return out
 
 
-def _forces(mb, scene: Scene, ids: dict) -> list[str]:
-    """Hip springs (SPRINGDAMPER) and knee stops (SFORCE with IMPACT)."""
+def _contacts(mb, ids: dict, lanes: bool, n_patches: tuple, law: dict) -> list[str]:
+    """One CONTACT per foot sphere and patch of its lane (:func:`contact_pairs`)."""
+    out = ["!", "! ---- contact: IMPACT normal force + Coulomb friction, mm-kg-s ----"]
+    for cid, _leg, _role, m, g in contact_pairs(mb, ids, lanes, n_patches):
+        out += _stmt(f"CONTACT/{cid}, IGEOM={m}, JGEOM={g}",
+                     f"IMPACT, STIFFNESS={_f(law['STIFFNESS'])}, "
+                     f"EXPONENT={_f(law['EXPONENT'])}",
+                     f"DAMPING={_f(law['DAMPING'])}, DMAX={_f(law['DMAX'])}",
+                     f"COULOMB_FRICTION=ON, MU_STATIC={_f(law['MU_STATIC'])}, "
+                     f"MU_DYNAMIC={_f(law['MU_DYNAMIC'])}",
+                     "STICTION_TRANSITION_VELOCITY="
+                     f"{_f(law['STICTION_TRANSITION_VELOCITY'])}",
+                     "FRICTION_TRANSITION_VELOCITY="
+                     f"{_f(law['FRICTION_TRANSITION_VELOCITY'])}")
+    return out
+
+
+def _forces(mb, scene: Scene, ids: dict, feet: tuple | None = None) -> list[str]:
+    """Hip springs (SPRINGDAMPER), knee stops (SFORCE with IMPACT) and flat feet's ankle
+    springs (SPRINGDAMPER between the foot and its leg: ``feet`` of
+    :func:`walkerlab.export.scene.flat_feet`)."""
     out = []
     link_of = {"leg1": "leg1_thigh" if mb.knee else "leg1",
                "leg2": "leg2_thigh" if mb.knee else "leg2"}
@@ -478,6 +631,14 @@ def _forces(mb, scene: Scene, ids: dict) -> list[str]:
                  if val > 0]  # KT, CT > 0 when given (default 0)
         out += _stmt(f"SPRINGDAMPER/{i + 1}, ROTATIONAL, I={marker_id(a, 'joint')}, J={jm}",
                      *coefs, f"ANGLE={_f(sp.rest_angle_rad)}")
+    for k, leg in enumerate(("leg1", "leg2") if feet is not None else ()):
+        _h, _t, kt, ct, rest, _m, _i = feet[k]
+        coefs = [f"{key}={_f(val * MM)}" for key, val in (("KT", kt), ("CT", ct)) if val > 0]
+        out += [f"! {leg}'s ankle spring: -k (a - rest) - c da/dt on the ankle angle a (toe up)"]
+        out += _stmt(f"SPRINGDAMPER/{ANKLE_SPRING + k}, ROTATIONAL, "
+                     f"I={marker_id(ids[f'{leg}_foot'], 'joint')}, "
+                     f"J={marker_id(ids[_leg_end(mb, leg)], 'foot')}", *coefs,
+                     f"ANGLE={_f(rest)}")
     if mb.knee and mb.knee_stop:
         from walkerlab.models.contact.rigid_limit import contact_si
 
@@ -494,14 +655,17 @@ def _forces(mb, scene: Scene, ids: dict) -> list[str]:
     return out
 
 
-def _requests(mb, ids: dict) -> list[str]:
-    """Link angles and rates (REQUEST/<part>), energies (VARIABLEs, REQUEST/90), OUTPUT."""
+def _requests(mb, ids: dict, feet: tuple | None = None) -> list[str]:
+    """Link angles and rates (REQUEST/<part>), energies (VARIABLEs, REQUEST/90), OUTPUT
+    (flat feet's parts included)."""
     g = mb.gravity_m_per_s2 * MM
     out = ["!", "! ---- output: angles [rad], rates [rad/s] (F2, F3); energies [N mm] ----"]
     ke, pe = [], []
     parts = [(ids[ln.name], ln.mass_kg, ln.inertia_kg_m2 * MM * MM) for ln in mb.links]
     if mb.hip_mass_kg > 0:
         parts.insert(0, (2, mb.hip_mass_kg, 0.0))
+    for k, leg in enumerate(("leg1", "leg2") if feet is not None else ()):
+        parts.append((ids[f"{leg}_foot"], feet[k][5], feet[k][6] * MM * MM))
     for p, m, inertia in parts:
         cm = marker_id(p, "cm")
         if p != 2:
@@ -566,8 +730,7 @@ def check_adams_actuation(scene: Scene) -> None:
     ValueError
         A torque at a five-link joint (those walkers are refused anyway); a
         ``time_reference`` (the time since heel strike is a state latched at touchdown,
-        which needs a SENSOR's stored value or a user subroutine: not written); an ankle
-        push-off (flat feet are not exported); a push-off with
+        which needs a SENSOR's stored value or a user subroutine: not written); a push-off with
         ``contact.push_off_duration_s: 0`` (an impulse has no Adams force form).
     """
     act = getattr(scene.walker, "actuation", None)
@@ -579,9 +742,6 @@ def check_adams_actuation(scene: Scene) -> None:
                              "since heel strike is a state latched at touchdown that the "
                              "dataset does not write (use a phase reference, or --format "
                              "mjcf)")
-    if act.ankle_push_off is not None:
-        raise ValueError("walker.actuation.ankle_push_off: flat feet are not exported to "
-                         "ADAMS")
     pulse_s = (scene.contact or ContactSettings()).push_off_pulse_s()
     if act.push_off is not None and pulse_s <= 0:
         raise ValueError("contact.push_off_duration_s: 0 is an impulse, which has no force "
@@ -707,8 +867,10 @@ def _law(k: int, t, delta: int, ddelta: int) -> list[str]:
                        f"VARVAL({base + 106}))")]
 
 
-def _hip_torques(act, m1: int, m2: int) -> list[str]:
-    """The hip torques' laws as VARIABLEs and one SFORCE between leg1 (I) and leg2 (J)."""
+def _hip_torques(act, m1: int, m2: int, ks: list | None = None) -> list[str]:
+    """The hip torques' laws (actuators ``ks``, default all) as VARIABLEs and one SFORCE
+    between leg1 (I) and leg2 (J)."""
+    ks = list(range(len(act.torques))) if ks is None else ks
     V = ACT_VARIABLES
     out = ["! hip torques (walker.actuation.torques) [N mm]: +tau on the swing leg, -tau",
            "! on the stance leg; delta = swing - stance leg angle (AZ of leg1's hip marker",
@@ -718,10 +880,10 @@ def _hip_torques(act, m1: int, m2: int) -> list[str]:
            _var(V["ddelta"], f"VARVAL({V['sign']})*WZ({m1},{m2},{m2})"),
            _var(V["phase"], f"IF(VARVAL({V['sign']}):AZ({m1},101),0,AZ({m2},101))"),
            _var(V["dphase"], f"IF(VARVAL({V['sign']}):WZ({m1},101,101),0,WZ({m2},101,101))")]
-    for k, t in enumerate(act.torques):
-        out += _law(k, t, V["delta"], V["ddelta"])
+    for k in ks:
+        out += _law(k, act.torques[k], V["delta"], V["ddelta"])
     out += _chain_sum(HIP_TORQUE_SUM - 50, HIP_TORQUE_SUM,
-                      [f"VARVAL({hip_torque_ids(k)['tau']})" for k in range(len(act.torques))])
+                      [f"VARVAL({hip_torque_ids(k)['tau']})" for k in ks])
     out += ["! their sum on leg1 (I) about z, the reaction on leg2 (J): sign * tau (the",
             "! swing leg's torque on leg1 while it swings, minus it while leg1 stands)",
             f"SFORCE/{HIP_SFORCE}, ROTATION, I={m1}, J={m2}",
@@ -787,9 +949,16 @@ def _joint_torques(mb, act, ids: dict, feet: dict) -> list[str]:
     return out
 
 
-def _push_off(mb, T: float, po, feet: dict, hips: dict) -> list[str]:
-    """The push-off pulse: a GFORCE at each foot, on while that leg stands and the other
-    foot's touchdown is predicted less than ``T`` ahead (the contact view's start)."""
+def _push_off(mb, T: float, po, feet: dict, hips: dict, touch: dict | None = None
+              ) -> list[str]:
+    """The push-off pulse: a GFORCE at each foot (marker ``feet[leg]``), on while that leg
+    stands and the other foot's touchdown (marker ``touch[leg]``, default ``feet``: a flat
+    foot pushes at its toe and lands on its heel) is predicted less than ``T`` ahead (the
+    contact view's start).  An arc foot's marker is its centre: its penetration is ``R``
+    minus the centre's height."""
+    touch = feet if touch is None else touch
+    lift = mb.foot_radius_m * MM if mb.foot == "arc" and mb.foot_radius_m > 0 else 0.0
+    pen0 = f"{_f(lift)}" if lift else ""
     V = ACT_VARIABLES
     min_step = PUSH_MIN_STEP_M * MM
     out = [f"! push-off (walker.actuation.push_off): a force P / T for T = {T:g} s",
@@ -811,13 +980,14 @@ def _push_off(mb, T: float, po, feet: dict, hips: dict) -> list[str]:
     else:
         out.append(_var(V["impulse"], _f(po.impulse_n_s)))
     for g in ("leg1", "leg2"):
-        f = feet[g]
-        out += [_var(V[f"pen_{g}"], f"-(VARVAL(330)*DX({f},101)+VARVAL(331)*DY({f},101))"),
+        f = touch[g]
+        out += [_var(V[f"pen_{g}"],
+                     f"{pen0}-(VARVAL(330)*DX({f},101)+VARVAL(331)*DY({f},101))"),
                 _var(V[f"rate_{g}"], f"-(VARVAL(330)*VX({f})+VARVAL(331)*VY({f}))"),
                 _var(V[f"lead_{g}"], f"VARVAL({V[f'pen_{g}']})+VARVAL(332)*"
                      f"VARVAL({V[f'rate_{g}']})")]
-    out.append(_var(V["ahead"], f"VARVAL(331)*DX({feet['leg2']},{feet['leg1']})-VARVAL(330)*"
-                    f"DY({feet['leg2']},{feet['leg1']})"))
+    out.append(_var(V["ahead"], f"VARVAL(331)*DX({touch['leg2']},{touch['leg1']})-VARVAL(330)*"
+                    f"DY({touch['leg2']},{touch['leg1']})"))
     for i, (g, o) in enumerate((("leg1", "leg2"), ("leg2", "leg1"))):
         on = 350 + 2 * i
         stands = "1,0,0" if g == "leg1" else "0,0,1"  # sign < 0: leg1 stands
@@ -854,17 +1024,30 @@ def _actuation(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: bool) -> li
            "! leading foot's force passes the trailing foot's at heel strike: the contact",
            "! view's touchdown switch as a force test (no latched state).  VARIABLE/303:",
            "! +1 while leg2 stands (leg1 swings), -1 while leg1 stands."]
-    feet_links = [ln for ln in mb.links if ln.foot_m is not None]
-    cid = 1  # CONTACT ids as _contacts numbers them: per foot, its lane's patches
-    for ln, count in (zip(feet_links, n_patches) if lanes
-                      else ((f, n_patches[0]) for f in feet_links)):
-        g = ln.name.split("_")[0]
-        out += _chain_sum(410 if g == "leg1" else 460, V[f"force_{g}"],
-                          [f"CONTACT({c},0,1,0)" for c in range(cid, cid + count)])
-        cid += count
+    pairs = contact_pairs(mb, ids, lanes, n_patches)
+    for g in ("leg1", "leg2"):
+        def terms(role, g=g):
+            return [f"CONTACT({c},0,1,0)" for c, leg, r, _i, _j in pairs
+                    if leg == g and r == role]
+        if mb.foot == "flat":  # the heel's and the toe's force, then the foot's
+            heel, toe = FOOT_FORCES[g]
+            out += _chain_sum(410 if g == "leg1" else 460, heel, terms("foot"))
+            out += _chain_sum(430 if g == "leg1" else 480, toe, terms("toe"))
+            out.append(_var(V[f"force_{g}"], f"VARVAL({heel})+VARVAL({toe})"))
+        else:
+            out += _chain_sum(410 if g == "leg1" else 460, V[f"force_{g}"], terms("foot"))
     out.append(_var(V["sign"], f"IF(VARVAL({V['force_leg1']})-VARVAL({V['force_leg2']}):"
                     "1,1,-1)"))
-    if any(t.joint != "hip" for t in act.torques):
+    ankle = [k for k, t in enumerate(act.torques) if t.joint.endswith("_ankle")]
+    hip = [k for k, t in enumerate(act.torques) if t.joint == "hip"]
+    if ankle:
+        if mb.foot != "flat":
+            raise ValueError("walker.actuation.torques: stance_ankle and swing_ankle need "
+                             "flat feet (walker.leg.foot.kind: flat)")
+        if hip:
+            out += _hip_torques(act, hips["leg1"], hips["leg2"], hip)
+        out += _ankle_torques(mb, act, ids, hips, ankle, phase=not hip)
+    elif any(t.joint != "hip" for t in act.torques):
         if "torso" not in ids or not mb.knee or any(t.joint == "hip" for t in act.torques):
             raise ValueError("walker.actuation.torques: stance_hip, swing_hip, stance_knee "
                              "and swing_knee need a five-link biped (free knees, a torso)")
@@ -873,7 +1056,99 @@ def _actuation(mb, scene: Scene, ids: dict, n_patches: tuple, lanes: bool) -> li
         out += _hip_torques(act, hips["leg1"], hips["leg2"])
     if act.push_off is not None:
         T = (scene.contact or ContactSettings()).push_off_pulse_s()
-        out += _push_off(mb, T, act.push_off, feet, hips)
+        if mb.foot == "flat":  # at the toe, the touchdown the heel's
+            toes = {g: marker_id(ids[f"{g}_foot"], "toe") for g in ("leg1", "leg2")}
+            heels = {g: marker_id(ids[f"{g}_foot"], "foot") for g in ("leg1", "leg2")}
+            out += _push_off(mb, T, act.push_off, toes, hips, heels)
+        else:
+            out += _push_off(mb, T, act.push_off, feet, hips)
+    if act.ankle_push_off is not None:
+        out += _ankle_push_off(mb, act.ankle_push_off, ids)
+    return out
+
+
+#: Flat feet's ankle torques: VARIABLE ids (angle [rad], rate [rad/s]) of the role ankles
+#: (the sole from the leg's perpendicular, toe up > 0), the sums of their laws [N mm] and
+#: the SFORCE ids of leg1's and leg2's ankles.
+ANKLE_ROLE_VARIABLES = {"stance_ankle": (384, 385), "swing_ankle": (388, 389)}
+ANKLE_TORQUE_SUM = {"stance_ankle": 9105, "swing_ankle": 9106}
+ANKLE_TORQUE_SFORCE = {"leg1": 17, "leg2": 18}
+
+
+def _ankle_torques(mb, act, ids: dict, hips: dict, ks: list, phase: bool) -> list[str]:
+    """Flat feet's ``stance_ankle`` / ``swing_ankle`` torques (actuators ``ks``): the role
+    ankles' angles ``AZ(foot, leg)`` picked by the role sign, each law on its role's angle
+    (the phase variable the stance leg's angle, written here when no hip torque wrote it:
+    ``phase``), one SFORCE per physical ankle (I the foot, J the leg) with its present
+    role's sum (+tau raises the toe)."""
+    V = ACT_VARIABLES
+    sgn = f"VARVAL({V['sign']})"
+    fj = {g: marker_id(ids[f"{g}_foot"], "joint") for g in ("leg1", "leg2")}
+    lf = {g: marker_id(ids[_leg_end(mb, g)], "foot") for g in ("leg1", "leg2")}
+    out = ["! ankle torques (walker.actuation.torques) [N mm] of flat feet: +tau on the",
+           "! foot (raises the toe), -tau on the leg; stance_ankle is the standing leg's",
+           "! ankle angle AZ(foot, leg), swing_ankle the other's (the role sign picks)"]
+    if phase:
+        m1, m2 = hips["leg1"], hips["leg2"]
+        out += [_var(V["phase"], f"IF({sgn}:AZ({m1},101),0,AZ({m2},101))"),
+                _var(V["dphase"], f"IF({sgn}:WZ({m1},101,101),0,WZ({m2},101,101))")]
+    for joint, (a, r) in ANKLE_ROLE_VARIABLES.items():
+        first, second = ("leg1", "leg2") if joint == "stance_ankle" else ("leg2", "leg1")
+        out += [_var(a, f"IF({sgn}:AZ({fj[first]},{lf[first]}),0,"
+                     f"AZ({fj[second]},{lf[second]}))"),
+                _var(r, f"IF({sgn}:WZ({fj[first]},{lf[first]},{lf[first]}),0,"
+                     f"WZ({fj[second]},{lf[second]},{lf[second]}))")]
+    for k in ks:
+        out += _law(k, act.torques[k], *ANKLE_ROLE_VARIABLES[act.torques[k].joint])
+    for i, (joint, total) in enumerate(ANKLE_TORQUE_SUM.items()):
+        taus = [f"VARVAL({hip_torque_ids(k)['tau']})" for k in ks
+                if act.torques[k].joint == joint]
+        out += _chain_sum(9041 + 10 * i, total, taus)
+    st, sw = ANKLE_TORQUE_SUM["stance_ankle"], ANKLE_TORQUE_SUM["swing_ankle"]
+    for g in ("leg1", "leg2"):
+        a, b = (st, sw) if g == "leg1" else (sw, st)  # sign < 0: leg1 stands
+        out += [f"SFORCE/{ANKLE_TORQUE_SFORCE[g]}, ROTATION, I={fj[g]}, J={lf[g]}",
+                f", FUNCTION=IF({sgn}:VARVAL({a}),0,VARVAL({b}))"]
+    return out
+
+
+#: Flat feet: VARIABLE ids of each leg's heel and toe normal forces [N] (sums over the
+#: CONTACTs of its heel and toe spheres).
+FOOT_FORCES = {"leg1": (311, 313), "leg2": (312, 314)}
+#: The ankle push-off: VARIABLE ids by leg of the ankle angle [rad], the on switch (0 or
+#: 1) and the torque [N mm]; SFORCE ids by leg.
+ANKLE_VARIABLES = {"leg1": {"angle": 390, "heel_off": 396, "on": 392, "tau": 394},
+                   "leg2": {"angle": 391, "heel_off": 397, "on": 393, "tau": 395}}
+ANKLE_SFORCE = {"leg1": 15, "leg2": 16}
+
+
+def _ankle_push_off(mb, po, ids: dict) -> list[str]:
+    """The ankle push-off (:class:`walkerlab.config.actuation.AnklePushOff`): an SFORCE on
+    each ankle (I the foot, J the leg), ``-k (a - rest) - tau0`` [N mm] on the ankle angle
+    ``a = AZ(foot, leg)`` while that leg stands (the role sign), its heel carries no
+    normal force and its toe does (heel off; the contact view latches heel off at the
+    heel's lift-off and ends it at the swing foot's touchdown: here it ends when the roles
+    swap, as the landing foot's force passes the trailing foot's), else 0."""
+    V = ACT_VARIABLES
+    k, rest, tau0 = po.stiffness_n_m_per_rad * MM, po.rest_angle_rad, po.constant_n_m * MM
+    out = ["! ankle push-off (walker.actuation.ankle_push_off) [N mm]: -k (a - rest) - tau0",
+           f"! (k = {k:g} N mm/rad, rest = {rest:g} rad, tau0 = {tau0:g} N mm) on the stance",
+           "! ankle from heel off (its heel's normal force 0, its toe's > 0) to the roles'",
+           "! swap after heel strike; a = AZ(foot, leg), toe up > 0"]
+    for g in ("leg1", "leg2"):
+        W, (heel, toe) = ANKLE_VARIABLES[g], FOOT_FORCES[g]
+        fj = marker_id(ids[f"{g}_foot"], "joint")
+        lf = marker_id(ids[_leg_end(mb, g)], "foot")
+        stands = "1,0,0" if g == "leg1" else "0,0,1"  # sign < 0: leg1 stands
+        law = f"-{_f(tau0)}" if tau0 >= 0 else f"+{_f(-tau0)}"
+        if k:
+            law = f"-{_f(k)}*(VARVAL({W['angle']}){_plus(-rest)}){law}"
+        out += [_var(W["angle"], f"AZ({fj},{lf})"),
+                _var(W["heel_off"], f"IF(VARVAL({heel}):1,1,0)*IF(VARVAL({toe}):0,0,1)"),
+                _var(W["on"], f"IF(VARVAL({V['sign']}):{stands})*VARVAL({W['heel_off']})"),
+                _var(W["tau"], f"VARVAL({W['on']})*({law})"),
+                f"SFORCE/{ANKLE_SFORCE[g]}, ROTATION, I={fj}, J={lf}",
+                f", FUNCTION=VARVAL({W['tau']})"]
     return out
 
 
@@ -904,6 +1179,11 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
     """
     check_adams_exportable(mb)
     check_adams_actuation(scene)
+    feet = None
+    if mb.foot == "flat":
+        from walkerlab.export.scene import flat_feet
+
+        feet = flat_feet(scene, data)
     start = start or adams_start(scene, mb, data)
     settings = scene.contact or ContactSettings()
     lanes = (scene.terrain or TerrainSettings()).lanes == "checkerboard" and \
@@ -930,13 +1210,13 @@ def adm_text(scene: Scene, mb, data, name: str, version: str = "",
         out += ["! walker.actuation: its joint torques (SFORCE) and push-off (GFORCE",
                 "! pulses) are written below, after the contacts"]
     out += _ground(mb, start, lanes)
-    out += _parts(mb, start, ids, lanes)
+    out += _parts(mb, start, ids, lanes, feet)
     out += _joints(mb, start, ids)
-    out += _forces(mb, scene, ids)
+    out += _forces(mb, scene, ids, feet)
     n = tuple(len(lane) for lane in start.lanes) if lanes else (1,)
     out += _contacts(mb, ids, lanes, n, law)
     out += _actuation(mb, scene, ids, n, lanes)
-    out += _requests(mb, ids)
+    out += _requests(mb, ids, feet)
     return "\n".join([*out, "END", ""])
 
 

@@ -51,6 +51,7 @@ ADM_SUBSET = {
                 "STICTION_TRANSITION_VELOCITY", "FRICTION_TRANSITION_VELOCITY"},
     "SPRINGDAMPER": {"ROTATIONAL", "I", "J", "KT", "CT", "ANGLE"},
     "SFORCE": {"ROTATION", "I", "J", "FUNCTION"},
+    "COUPLER": {"JOINTS", "TYPE", "SCALES"},
     "GFORCE": {"I", "JFLOAT", "RM", "FX", "FY", "FZ", "TX", "TY", "TZ"},
     "VARIABLE": {"FUNCTION"},
     "REQUEST": {"F2", "F3", "F4", "F6", "F7", "F8"},

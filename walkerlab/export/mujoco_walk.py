@@ -17,7 +17,14 @@ leg2_hip``); at each heel strike the roles swap and the push-off
 ``P / T`` along the trailing leg at its foot for ``T = push_off_duration_s`` (the pulse's
 last MuJoCo step carries only its share of the force, so the impulse is ``P`` exactly)
 (``data.xfrc_applied`` on the leg's body, with the moment of the force about its centre of
-mass).  A five-link biped's joint torques are driven by :class:`JointTorqueLoop` (one motor
+mass).  An ankle push-off (flat feet: motors ``leg<i>_ankle_motor``) is the contact view's
+(:mod:`walkerlab.models.contact.actuation`): latched on when the stance foot's heel leaves
+the ground while its toe is loaded (the heel geom ``leg<i>_foot`` out of contact, the toe
+geom ``leg<i>_toe`` in contact) and off at the next heel strike; meanwhile the stance
+ankle's motor gives ``-stiffness (a - rest_angle_rad) - constant_n_m`` on its angle ``a``
+(positive toe up), the swing ankle's 0; heel off is taken once the heel has been out
+of contact :data:`HEEL_OFF_STEPS` MuJoCo steps running (the soft contact flickers).
+A five-link biped's joint torques are driven by :class:`JointTorqueLoop` (one motor
 per physical joint, the torque of its present role).
 """
 
@@ -91,6 +98,13 @@ def latch_rule(foot_height_m: float, knee_rad: float, release_height_m: float,
     return foot_height_m < release_height_m and knee_rad > -capture_rad
 
 
+#: MuJoCo steps the stance heel must stay out of contact, its toe in contact, for heel off:
+#: MuJoCo's soft contact flickers for 1-2 timesteps (0.18 ms) at a loaded heel during foot
+#: flat and as the heel lifts (flat_feet_push_off: gaps of 1-2 steps from 0.17 to 0.50 s of
+#: the first step), which must not start the push-off; 10 steps (1.8 ms) hold it back.
+HEEL_OFF_STEPS = 10
+
+
 class PoweredLoop:
     """The controller of a powered export (module docstring).
 
@@ -122,6 +136,31 @@ class PoweredLoop:
         self.hip = int(model.joint("hip_x").dofadr[0])
         self.dt = float(model.opt.timestep)
         self.stance, self.t_step, self.push = 1, 0.0, None  # leg2 stands at the keyframe
+        self.ankle = self.spec.ankle_push_off
+        self.heel_off = False  # the stance heel has left the ground (latched to heel strike)
+        self.off_steps = 0  # MuJoCo steps the stance heel has been off, its toe on
+        if self.ankle is not None:
+            self.ankle_motor = [int(model.actuator(f"{g}_ankle_motor").id) for g in LEGS]
+            ankles = [model.joint(f"{g}_ankle") for g in LEGS]
+            self.ankle_q = [int(j.qposadr[0]) for j in ankles]
+            self.heel_geom = [int(model.geom(f"{g}_foot").id) for g in LEGS]
+            self.toe_geom = [int(model.geom(f"{g}_toe").id) for g in LEGS]
+
+    def ankle_torque(self, data) -> float:
+        """The stance ankle's push-off torque [N m] for the coming step (module docstring);
+        latches heel off."""
+        st = self.stance
+        if not self.heel_off:
+            geoms = data.contact.geom[:data.ncon]
+            heel = bool((geoms == self.heel_geom[st]).any())
+            toe = bool((geoms == self.toe_geom[st]).any())
+            self.off_steps = self.off_steps + 1 if toe and not heel else 0
+            self.heel_off = self.off_steps >= HEEL_OFF_STEPS
+        if not self.heel_off:
+            return 0.0
+        a = float(data.qpos[self.ankle_q[st]])
+        return -self.ankle.stiffness_n_m_per_rad * (a - self.ankle.rest_angle_rad) \
+            - self.ankle.constant_n_m
 
     def control(self, data) -> None:
         """Set the hip motor and the push-off force for the coming step."""
@@ -133,7 +172,11 @@ class PoweredLoop:
                                          v[self.vadr[sw]] - v[self.vadr[st]],
                                          q[self.qadr[st]], v[self.vadr[st]],
                                          data.time - self.t_step)))
-        data.ctrl[self.motor] = tau if sw == 0 else -tau
+        if self.motor >= 0:
+            data.ctrl[self.motor] = tau if sw == 0 else -tau
+        if self.ankle is not None:
+            data.ctrl[self.ankle_motor[sw]] = 0.0
+            data.ctrl[self.ankle_motor[st]] = self.ankle_torque(data)
         data.xfrc_applied[:] = 0.0
         if self.push is not None and data.time < self.push[1]:
             # the pulse's share of this step: the last step of a pulse that is not a whole
@@ -150,7 +193,11 @@ class PoweredLoop:
         """Leg ``leg`` (0, 1) struck: roles swap, the push-off starts at the other foot."""
         from walkerlab.models.actuation import push_off_impulse
 
-        self.stance, self.t_step = leg, float(data.time)
+        self.stance, self.t_step, self.heel_off, self.off_steps = leg, float(data.time), \
+            False, 0
+        if self.spec.push_off is None:
+            self.push = None
+            return
         vx, vz = data.qvel[self.hip], data.qvel[self.hip + 1]
         P = float(push_off_impulse(self.spec.push_off, float(np.hypot(vx, vz))))
         self.push = ((1 - leg, data.time + self.pulse_s, P / self.pulse_s) if P > 0 else None)

@@ -254,7 +254,8 @@ def motors(actuation_json: str | None) -> list[tuple[str, str, str]]:
     """The motors of a powered export (module docstring): ``(name, kind, target)`` with
     ``kind`` ``"tendon"`` or ``"joint"``; none without actuation or torques.  A five-link
     biped's joints (``stance_hip``, ``swing_knee``, ...) become the physical joints' motors of
-    both legs (the roles swap at each heel strike)."""
+    both legs (the roles swap at each heel strike); an ankle push-off the motors
+    ``leg<i>_ankle_motor`` on the ankle hinges (flat feet)."""
     if actuation_json is None:
         return []
     joints = {t["joint"] for t in json.loads(actuation_json).get("torques", [])}
@@ -266,6 +267,8 @@ def motors(actuation_json: str | None) -> list[tuple[str, str, str]]:
             out += [(f"{leg}_{kind}_motor", "tendon" if kind == "hip" else "joint",
                      f"{leg}_hip_torso" if kind == "hip" else f"{leg}_knee")
                     for leg in ("leg1", "leg2")]
+    if "ankle_push_off" in json.loads(actuation_json):  # flat feet: the stance ankle's
+        out += [(f"{leg}_ankle_motor", "joint", f"{leg}_ankle") for leg in ("leg1", "leg2")]
     return out
 
 

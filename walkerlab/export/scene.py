@@ -63,18 +63,15 @@ def check_exportable(scene: Scene, fmt: str | None = None, walker_only: bool = F
         refused by the multibody model) or a length / foot radius below
         :data:`MJCF_MIN_LENGTH_M` (a foot radius of exactly 0 is a point foot); flat feet
         other than to an MJCF with its scene (the URDF has no foot link: it would hold point
-        feet; the MJCF's foot bodies take their mass from the scene's contact section); an
-        ankle push-off (the file would walk passively).
+        feet; the MJCF's foot bodies take their mass from the scene's contact section).  An
+        ankle push-off (flat feet) is exported: motors ``leg<i>_ankle_motor`` that
+        :mod:`walkerlab.export.mujoco_walk` drives.
     """
     foot = getattr(getattr(scene.walker, "leg", None), "foot", None)
     if getattr(foot, "kind", None) == "flat" and (fmt != "mjcf" or walker_only):
         raise ValueError("walker.leg.foot.kind: flat feet are exported to MJCF with the "
                          "scene only (a URDF would hold point feet: no foot link, ankle "
                          "spring or heel and toe contacts; --walker-only has no foot mass)")
-    act = getattr(scene.walker, "actuation", None)
-    if act is not None and act.ankle_push_off is not None:
-        raise ValueError("walker.actuation.ankle_push_off: not exported yet (the URDF/MJCF "
-                         "would hold a passive walker); export the scene without it")
     def walk(obj, path):
         if isinstance(obj, dict):
             for k, v in obj.items():
@@ -296,6 +293,13 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
                   "one MuJoCo timestep, the rigid model's impulse as MuJoCo can apply it (the "
                   "contact model's contact.push_off_duration_s pulse agrees with it only to "
                   "first order in its length: -2.1 % step period with 5 ms).",)
+    if actuation is not None and getattr(scene.walker.actuation, "ankle_push_off", None):
+        notes += ("Ankle push-off (walker.actuation.ankle_push_off): motors "
+                  "leg<i>_ankle_motor on the ankle hinges; a stepping loop latches the "
+                  "stance foot's heel off (its heel geom leg<i>_foot out of contact while its "
+                  "toe leg<i>_toe touches) and sets the stance ankle's motor to -stiffness "
+                  "(a - rest_angle_rad) - constant_n_m until the next heel strike "
+                  "(walkerlab.export.mujoco_walk), the contact model's AnklePushOff.",)
     if flat:
         notes += ("Flat feet: bodies leg<i>_sole on the ankle hinges leg<i>_ankle (the "
                   "ankle springs as MuJoCo joint springs: stiffness, springref, damping), "
