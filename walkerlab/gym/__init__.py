@@ -10,7 +10,7 @@ Example
 >>> import walkerlab.gym  # registers walkerlab/Walker-v0
 >>> env = gym.make("walkerlab/Walker-v0", scene="configs/paper.yaml")   # doctest: +SKIP
 >>> obs, info = env.reset(seed=0)                                       # doctest: +SKIP
->>> obs, reward, terminated, truncated, info = env.step(env.action_space.sample() * 0)  # doctest: +SKIP
+>>> out = env.step(env.action_space.sample() * 0)     # doctest: +SKIP
 """
 
 from walkerlab.extras import require

@@ -7,10 +7,11 @@ Action: one torque per joint of :attr:`WalkerEnv.joints` (:mod:`walkerlab.gym.ac
 added to the scene's own actuation and held over the control period: ``Box(-1, 1, (k,),
 float32)``, the torque as a fraction of its bound ``tau = a * tau_max``
 (:attr:`WalkerEnv.tau_max` [N m]; Walker2d's actions are normalised alike, by their motors'
-gears), or with ``normalize_action=False`` ``Box(-tau_max, tau_max)`` in N m.  An all-zero action is the scene as written (passive, or
-its own torque laws and push-off).
+gears), or with ``normalize_action=False`` ``Box(-tau_max, tau_max)`` in N m.  An all-zero
+action is the scene as written (passive, or its own torque laws and push-off).
 
-Observation: ``Box((2n + 3,), float64)`` (entries within +-:data:`OBS_BOUND`), by name :attr:`WalkerEnv.observation_names`:
+Observation: ``Box((2n + 3,), float64)`` (entries within +-:data:`OBS_BOUND`), by name
+:attr:`WalkerEnv.observation_names`:
 the walker's state (:attr:`WalkerEnv.state_names`: the rigid walker's role-ordered angles
 and rates [rad, rad/s]; in the contact view the floating state ``hip_x, hip_y``, link
 angles, then rates [m, rad, m/s, rad/s]), then the phase: ``stance_is_leg1`` (1.0 while
@@ -87,7 +88,8 @@ class WalkerEnv(gym.Env):
     control_period_s : float
         Time the action is held [s] (0.01: 100 Hz).
     max_episode_steps : int
-        Control periods before truncation.
+        Control periods before truncation (through ``gym.make(..., max_episode_steps=N)``
+        the TimeLimit wrapper truncates at N).
     max_torque_n_m : float or sequence of float, optional
         The action's bounds [N m] (default: the actuators' ``max_torque_n_m``, else
         :data:`walkerlab.gym.action.DEFAULT_TORQUE_FRACTION` ``M g l``).
@@ -199,7 +201,7 @@ class WalkerEnv(gym.Env):
         m = len(self.state_names)
         self.observation_space = spaces.Box(
             np.concatenate([np.full(m, -OBS_BOUND), [0.0, 0.0, 0.0]]),
-            np.concatenate([np.full(m, OBS_BOUND), [1.0, nphase - 1.0, OBS_BOUND]]),
+            np.concatenate([np.full(m, OBS_BOUND), [1.0, max(nphase - 1.0, 1.0), OBS_BOUND]]),
             dtype=np.float64)
         self.terrain_seed = 0
         self._elapsed = 0
