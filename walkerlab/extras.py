@@ -24,6 +24,7 @@ EXTRAS = {
     "api": "the Python API's datasets (xarray, h5netcdf)",
     "notebook": "examples/walkerlab_tour.ipynb (Jupyter)",
     "numbalsoda": "contact_solver.method numbalsoda (builds with cmake, g++, gfortran)",
+    "gym": "walkerlab.gym: the walker as a Gymnasium environment",
 }
 
 

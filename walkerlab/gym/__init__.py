@@ -1,0 +1,29 @@
+"""A scene's walker as a Gymnasium environment: :class:`~walkerlab.gym.env.WalkerEnv`,
+registered as ``walkerlab/Walker-v0`` (keyword ``scene``) when this package is imported.
+
+Needs gymnasium (``pip install 'walkerlab[gym]'``); nothing else in walkerlab imports this
+package, so the library runs without it.
+
+Example
+-------
+>>> import gymnasium as gym
+>>> import walkerlab.gym  # registers walkerlab/Walker-v0
+>>> env = gym.make("walkerlab/Walker-v0", scene="configs/paper.yaml")   # doctest: +SKIP
+>>> obs, info = env.reset(seed=0)                                       # doctest: +SKIP
+>>> out = env.step(env.action_space.sample() * 0)     # doctest: +SKIP
+"""
+
+from walkerlab.extras import require
+
+gymnasium = require("gymnasium", "gym", "walkerlab.gym")
+
+from walkerlab.gym.env import WalkerEnv  # noqa: E402
+
+__all__ = ["ENV_ID", "WalkerEnv"]
+
+#: the registered id
+ENV_ID = "walkerlab/Walker-v0"
+
+if ENV_ID not in gymnasium.registry:
+    gymnasium.register(id=ENV_ID, entry_point="walkerlab.gym.env:WalkerEnv",
+                       max_episode_steps=None)

@@ -1,0 +1,140 @@
+"""The action of the Gymnasium environment: one torque per actuated joint of the scene,
+added to the scene's own actuation, bounded by the actuators' limits.
+
+Which joints
+------------
+The joints of the scene's ``walker.actuation.torques`` (in their order, each joint once); a
+scene without torques (passive, or powered by a push-off alone) gets one torque at the
+``hip`` between the legs (:data:`walkerlab.config.actuation.JOINTS`: ``+tau`` on the swing
+leg, ``-tau`` on the stance leg).
+
+Bounds
+------
+``|tau_k| <= max_torque_n_m`` of the scene's actuator at that joint, when it has one;
+otherwise :data:`DEFAULT_TORQUE_FRACTION` times ``M g l`` (total mass, gravity, leg length:
+the torque that holds the whole walker's weight at a leg's length, 196 N m for the paper's
+20 kg, 1 m walker), unless the environment is given its own bounds.
+
+In the rigid view the torques act through the generic actuators of the hybrid model
+(:class:`walkerlab.models.hybrid.actuators.Actuators`, ``M^-1 B tau`` in the flow; in a phase
+holding a lock through it): :class:`ActionTorques` is that class with the torque read from
+the action instead of a law.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from walkerlab.models.hybrid.actuators import Actuators
+
+__all__ = ["DEFAULT_TORQUE_FRACTION", "ActionTorques", "action_joints", "action_limits",
+           "action_torques"]
+
+#: Default bound of an action torque whose joint has no ``max_torque_n_m`` [-], a fraction
+#: of ``M g l`` (a tenth of the weight's moment at a leg's length).
+DEFAULT_TORQUE_FRACTION = 0.1
+
+
+def action_joints(scene) -> list[str]:
+    """The joints the action drives: those of ``walker.actuation.torques`` (each once, in
+    order), else ``["hip"]``."""
+    act = getattr(scene.walker, "actuation", None)
+    joints: list[str] = []
+    for t in (act.torques if act is not None else ()):
+        if t.joint not in joints:
+            joints.append(t.joint)
+    return joints or ["hip"]
+
+
+def action_limits(scene, joints: list[str], total_mass_kg: float, gravity: float,
+                  leg_length_m: float, max_torque_n_m=None) -> np.ndarray:
+    """The bound of each action torque (k,) [N m].
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+    joints : list of str
+        :func:`action_joints`.
+    total_mass_kg, gravity, leg_length_m : float
+        ``M`` [kg], ``g`` [m/s^2], ``l`` [m] of the walker.
+    max_torque_n_m : float or sequence of float, optional
+        The environment's own bounds (one for all joints, or one per joint) [N m].
+
+    Returns
+    -------
+    ndarray, shape (k,)
+
+    Raises
+    ------
+    ValueError
+        ``max_torque_n_m`` not positive finite numbers, or of the wrong length (one line).
+    """
+    k = len(joints)
+    if max_torque_n_m is not None:
+        arr = np.atleast_1d(np.asarray(max_torque_n_m, dtype=float))
+        if arr.size == 1:
+            arr = np.full(k, float(arr[0]))
+        if arr.shape != (k,) or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+            raise ValueError(f"max_torque_n_m={max_torque_n_m!r}: give one positive number, "
+                             f"or {k} (one per joint: {', '.join(joints)}) [N m]")
+        return arr
+    default = DEFAULT_TORQUE_FRACTION * total_mass_kg * gravity * leg_length_m
+    act = getattr(scene.walker, "actuation", None)
+    out = np.full(k, default)
+    for i, j in enumerate(joints):
+        caps = [t.max_torque_n_m for t in (act.torques if act is not None else ())
+                if t.joint == j and t.max_torque_n_m is not None]
+        if caps:
+            out[i] = max(caps)
+    return out
+
+
+@dataclass
+class ActionTorques(Actuators):
+    """The generic joint actuators of a rigid walker whose torques are the action's
+    (:attr:`u`, (k,) [N m], set before each control period) instead of laws: the flow gains
+    :meth:`~walkerlab.models.hybrid.actuators.Actuators.added_acceleration` ``M^-1 B u``,
+    their power is :meth:`~walkerlab.models.hybrid.actuators.Actuators.power`."""
+
+    def __post_init__(self):
+        super().__post_init__()
+        self.u = np.zeros(len(self.spec.torques))
+
+    def torques(self, t, x) -> np.ndarray:
+        """The action's torques (k,) [N m] (whatever the state)."""
+        return self.u
+
+
+def action_torques(data, n: int, joints: list[str]) -> ActionTorques:
+    """:class:`ActionTorques` at ``joints`` of the walker ``data``.
+
+    Parameters
+    ----------
+    data : walkerlab.walker.description.WalkerData
+    n : int
+        Number of generalised coordinates of the rigid walker.
+    joints : list of str
+
+    Raises
+    ------
+    ValueError
+        A joint the walker does not have (naming those it has), or a walker whose legs are
+        massless (a torque there has no inertia to act on: the limit of Kuo's simplest
+        walker) or flat-footed (its stance-foot modes have mass matrices of their own), one
+        line each.
+    """
+    from walkerlab.codegen.cache import functions
+    from walkerlab.config.actuation import Actuation, JointTorque, TorqueLaw
+
+    st = data.structure
+    if st.foot == "flat":
+        raise ValueError("walkerlab.gym: flat feet are not carried yet (each stance-foot mode "
+                         "has its own mass matrix); use point or arc feet")
+    if st.bodies and all(b.massless for b in st.bodies):
+        raise ValueError("walkerlab.gym: the legs are massless (Kuo's simplest walker): a "
+                         "joint torque has no inertia to act on; give the legs mass")
+    spec = Actuation(torques=[JointTorque(joint=j, law=TorqueLaw()) for j in joints])
+    return ActionTorques(spec, functions(data), n, False, float(data.total_mass_kg),
+                         some_massless=any(b.massless for b in st.bodies))

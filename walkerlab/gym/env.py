@@ -1,0 +1,304 @@
+"""``walkerlab/Walker-v0``: a scene's walker as a Gymnasium environment
+(:class:`WalkerEnv`).
+
+Spaces
+------
+Action: one torque per joint of :attr:`WalkerEnv.joints` (:mod:`walkerlab.gym.action`),
+added to the scene's own actuation and held over the control period: ``Box(-1, 1, (k,),
+float32)``, the torque as a fraction of its bound ``tau = a * tau_max``
+(:attr:`WalkerEnv.tau_max` [N m]; Walker2d's actions are normalised alike, by their motors'
+gears), or with ``normalize_action=False`` ``Box(-tau_max, tau_max)`` in N m.  An all-zero
+action is the scene as written (passive, or its own torque laws and push-off).
+
+Observation: ``Box((2n + 3,), float64)`` (entries within +-:data:`OBS_BOUND`), by name
+:attr:`WalkerEnv.observation_names`:
+the walker's state (:attr:`WalkerEnv.state_names`: the rigid walker's role-ordered angles
+and rates [rad, rad/s]; in the contact view the floating state ``hip_x, hip_y``, link
+angles, then rates [m, rad, m/s, rad/s]), then the phase: ``stance_is_leg1`` (1.0 while
+``leg1`` is the stance leg, else 0.0), ``phase_index`` (the rigid step's continuous phase,
+:attr:`walkerlab.models.hybrid.HybridWalker.phases`; 0 in the contact view) and
+``time_since_heel_strike_s`` [s].
+
+Reward (Walker2d-v5's convention, every weight a keyword)::
+
+    reward = forward_reward_weight * (x_hip(t + dt) - x_hip(t)) / dt + healthy_reward
+             - ctrl_cost_weight * sum((u / tau_max)^2)
+             - work_cost_weight * (positive action work over the period [J]) / dt
+
+``x_hip`` the hip's world position along x (horizontal, downhill) [m]; defaults 1.0, 1.0,
+1e-3 (on the action normalised to [-1, 1], as Walker2d's actions are), 0.0; or a callable
+``reward_fn(env, info) -> float`` in its place.
+
+Episode: from the scene's gait (its fixed point, found once per scene and process and
+cached; :meth:`walkerlab.api.walker.Walker.fixed_point`), leg1 swinging, unless
+``reset(options={"state": x})`` gives the state (the rigid walker's post-impact state (2n,),
+or in the contact view its floating state (N,)); ``start_noise`` adds a uniform relative
+perturbation ``[-s, s]`` of the start's rates drawn by the reset's seed.  Terminated on a
+fall (a fall guard of the rigid model; in the contact view the hip below
+``contact_sim.fall_hip_height_m``), a stall (no heel strike within
+``fixedpoint.max_step_time_s``) or a solver failure; truncated after ``max_episode_steps``
+control periods.
+
+``info``: ``time_s``, ``heel_strike`` (bool), ``heel_strike_time_s`` (the exact event time
+of the last heel strike inside the control period, else None), ``heel_strike_times_s`` (all
+of them), ``steps`` (heel strikes so far), ``stance_leg``, ``hip_x_m``, ``termination``
+(``""``, ``fall``, ``stall``, ``solver_failure``), ``terrain_seed`` and the energy ledger's
+terms so far [J] (``ledger_<term>``: :data:`walkerlab.gym.rigid_view.LEDGER_TERMS`).
+``reset(seed=...)`` draws the terrain seed and the start's noise from the seed: the same
+seed, the same episode bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+__all__ = ["WalkerEnv"]
+
+#: bound of the observation's state entries [m, rad, m/s, rad/s] and time [s]: far beyond a
+#: walking state (an observation past it is clipped to it)
+OBS_BOUND = 1e6
+
+#: the fixed point of each scene, found once per process (key: the scene's JSON)
+_GAITS: dict[str, Any] = {}
+
+
+def _gait(walker):
+    key = walker.scene.model_dump_json()
+    if key not in _GAITS:
+        _GAITS[key] = walker.fixed_point()
+    return _GAITS[key]
+
+
+class WalkerEnv(gym.Env):
+    """A walkerlab scene's walker as a Gymnasium environment (module docstring: spaces,
+    reward, episode, info).
+
+    Parameters
+    ----------
+    scene : Scene, str, Path or dict
+        A scene (YAML path, mapping, or loaded :class:`walkerlab.config.Scene`).
+    view : {"rigid", "contact"}
+        The rigid hybrid model (default) or the compliant-contact model.
+    control_period_s : float
+        Time the action is held [s] (0.01: 100 Hz).
+    max_episode_steps : int
+        Control periods before truncation (through ``gym.make(..., max_episode_steps=N)``
+        the TimeLimit wrapper truncates at N).
+    max_torque_n_m : float or sequence of float, optional
+        The action's bounds [N m] (default: the actuators' ``max_torque_n_m``, else
+        :data:`walkerlab.gym.action.DEFAULT_TORQUE_FRACTION` ``M g l``).
+    forward_reward_weight, healthy_reward, ctrl_cost_weight, work_cost_weight : float
+        The reward's weights (module docstring).
+    reward_fn : callable, optional
+        ``(env, info) -> float`` in place of the default reward.
+    start_noise : float
+        Relative uniform noise on the start's rates [-] (0: the gait itself).
+    terrain_roughness_m : float
+        Contact view: patch heights uniform in ``[-r, r]`` [m], drawn by the terrain seed.
+    normalize_action : bool
+        Actions in [-1, 1] (fractions of :attr:`tau_max`; default) or in N m.
+    render_mode : {None, "rgb_array"}
+
+    Attributes
+    ----------
+    tau_max : ndarray (k,)
+        The bound of each action torque [N m].
+    joints : list of str
+        The action's joints.
+    state_names, observation_names : list of str
+        The walker's state's names; the observation's (the state's, then the phase's).
+    gait : walkerlab.api.walker.Gait
+        The scene's gait (the episodes' start).
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        A scene that does not load or validate (one line).
+    ValueError
+        A bad view, control period, episode length or bound, or a walker the action cannot
+        drive (flat feet, massless legs, a joint-less rimless wheel), one line each.
+    walkerlab.analysis.gait.search.GaitNotFound
+        The scene has no gait to start from.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
+
+    def __init__(self, scene, view: str = "rigid", control_period_s: float = 0.01,
+                 max_episode_steps: int = 1000, max_torque_n_m=None,
+                 forward_reward_weight: float = 1.0, healthy_reward: float = 1.0,
+                 ctrl_cost_weight: float = 1e-3, work_cost_weight: float = 0.0,
+                 reward_fn=None, start_noise: float = 0.0, terrain_roughness_m: float = 0.0,
+                 normalize_action: bool = True, render_mode: str | None = None):
+        from walkerlab.api.walker import Walker
+        from walkerlab.walker.description import walker_data
+
+        from .action import action_joints, action_limits, action_torques
+        from .rigid_view import RigidView
+
+        if view not in ("rigid", "contact"):
+            raise ValueError(f"view={view!r}: give 'rigid' or 'contact'")
+        if not (isinstance(control_period_s, (int, float)) and not isinstance(
+                control_period_s, bool) and 0 < control_period_s <= 1.0
+                and math.isfinite(control_period_s)):
+            raise ValueError(f"control_period_s={control_period_s!r}: give a positive number "
+                             "of seconds, at most 1")
+        if isinstance(max_episode_steps, bool) or not isinstance(max_episode_steps, int) \
+                or max_episode_steps < 1:
+            raise ValueError(f"max_episode_steps={max_episode_steps!r}: give a whole number "
+                             ">= 1")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode={render_mode!r}: give None or 'rgb_array'")
+        for name, v in (("start_noise", start_noise),
+                        ("terrain_roughness_m", terrain_roughness_m)):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise ValueError(f"{name}={v!r}: give a number >= 0")
+        self.rigid = Walker.from_scene(scene if not isinstance(scene, Path) else str(scene))
+        sc = self.rigid.scene
+        if sc.walker.model == "rimless_wheel":
+            raise ValueError("walkerlab.gym: the rimless wheel has no joint to drive")
+        self.scene, self.view = sc, view
+        self.dt = float(control_period_s)
+        self.max_episode_steps = max_episode_steps
+        self.render_mode = render_mode
+        self.metadata = dict(self.metadata, render_fps=max(1, round(1.0 / self.dt)))
+        self.weights = (float(forward_reward_weight), float(healthy_reward),
+                        float(ctrl_cost_weight), float(work_cost_weight))
+        self.reward_fn = reward_fn
+        self.start_noise = float(start_noise)
+        self.terrain_roughness_m = float(terrain_roughness_m)
+        model = self.rigid.model
+        data = walker_data(sc.walker, sc.slope.phi_rad)
+        self.joints = action_joints(sc)
+        self.gait = _gait(self.rigid)
+        self.sim = RigidView(model, self.rigid.solver, data, self.joints,
+                             self.rigid.max_step_time)
+        if view == "contact":
+            from walkerlab.models.contact.scene import contact_setup
+
+            from .contact_view import ContactView
+
+            links = action_torques(data, model.n_coordinates, self.joints).links
+            n_steps = int(math.ceil(max_episode_steps * self.dt / self.gait.step_period)) + 4
+            self.sim = ContactView(contact_setup(sc), links, self.gait.x, n_steps)
+        p = model.params
+        self.tau_max = action_limits(sc, self.joints, float(model.total_mass_kg),
+                                     float(p["gravity_m_per_s2"]), float(p["leg_length_m"]),
+                                     max_torque_n_m)
+        self.state_names = list(self.sim.state_names)
+        self.observation_names = self.state_names + ["stance_is_leg1", "phase_index",
+                                                     "time_since_heel_strike_s"]
+        self.normalize_action = bool(normalize_action)
+        bound = (np.ones_like(self.tau_max) if self.normalize_action else self.tau_max)
+        self.action_space = spaces.Box(-bound.astype(np.float32), bound.astype(np.float32),
+                                       dtype=np.float32)
+        nphase = len(model.phases) if view == "rigid" else 1
+        m = len(self.state_names)
+        self.observation_space = spaces.Box(
+            np.concatenate([np.full(m, -OBS_BOUND), [0.0, 0.0, 0.0]]),
+            np.concatenate([np.full(m, OBS_BOUND), [1.0, max(nphase - 1.0, 1.0), OBS_BOUND]]),
+            dtype=np.float64)
+        self.terrain_seed = 0
+        self._elapsed = 0
+
+    # ------------------------------------------------------------------ gymnasium API
+    def _obs(self) -> np.ndarray:
+        s = self.sim
+        if self.view == "rigid":
+            leg1, k = float(s.leg == "leg1"), float(s.k)
+        else:
+            leg1, k = float(s.stance == 0), 0.0
+        obs = np.concatenate([s.x, [leg1, k, s.t - s.t_step]]).astype(np.float64)
+        return np.clip(obs, self.observation_space.low, self.observation_space.high)
+
+    def _info(self, strikes: list[float]) -> dict:
+        s = self.sim
+        stance = (s.leg if self.view == "rigid" else f"leg{s.stance + 1}")
+        info = {"time_s": float(s.t), "heel_strike": bool(strikes),
+                "heel_strike_time_s": float(strikes[-1]) if strikes else None,
+                "heel_strike_times_s": [float(t) for t in strikes], "steps": int(s.steps),
+                "stance_leg": stance, "hip_x_m": s.hip_x(), "termination": s.ended,
+                "terrain_seed": int(self.terrain_seed)}
+        info.update({f"ledger_{k}": float(v) for k, v in s.ledger.items()})
+        return info
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Start an episode (module docstring); returns ``(observation, info)``.
+
+        Raises
+        ------
+        walkerlab.config.SceneError
+            ``options["state"]`` no state of the walker (one line naming the states).
+        ValueError
+            An unknown option.
+        """
+        super().reset(seed=seed)
+        options = dict(options or {})
+        state = options.pop("state", None)
+        if options:
+            raise ValueError(f"reset: unknown options {sorted(options)}; give 'state'")
+        self.terrain_seed = int(self.np_random.integers(2**31 - 1))
+        noise = (self.np_random.uniform(-self.start_noise, self.start_noise)
+                 if self.start_noise > 0 else None)
+        if self.view == "rigid":
+            x0 = (np.array(self.gait.x, float) if state is None
+                  else self.rigid.check_state(state, "options['state']"))
+        else:
+            self.sim.set_terrain(self.terrain_roughness_m, self.terrain_seed)
+            x0 = np.array(self.sim.x_start if state is None else state, float)
+            if x0.shape != self.sim.x_start.shape or not np.all(np.isfinite(x0)):
+                from walkerlab.config import SceneError
+
+                raise SceneError(f"options['state']: give {len(self.state_names)} finite "
+                                 f"numbers ({', '.join(self.state_names)})")
+        if noise is not None:
+            h = x0.size // 2
+            x0 = x0.copy()
+            x0[h:] *= 1.0 + self.np_random.uniform(-self.start_noise, self.start_noise, h)
+        self.sim.reset(x0)
+        self._elapsed = 0
+        return self._obs(), self._info([])
+
+    def step(self, action):
+        """Hold ``action`` (k,) (fractions of :attr:`tau_max`, or N m), clipped to the
+        bounds, for one control period; returns ``(observation, reward, terminated,
+        truncated, info)``."""
+        a = np.asarray(action, dtype=np.float64).reshape(-1)
+        if self.normalize_action and a.shape == self.tau_max.shape:
+            a = a * self.tau_max
+        u = np.clip(a, -self.tau_max, self.tau_max)
+        if u.shape != self.tau_max.shape:
+            raise ValueError(f"action has shape {np.shape(action)}; give "
+                             f"{self.tau_max.size} torques ({', '.join(self.joints)}) [N m]")
+        s = self.sim
+        x_before = s.hip_x()
+        w_before = s.ledger["action_work_positive"]
+        self._elapsed += 1
+        strikes = s.advance(u, self._elapsed * self.dt)
+        info = self._info(strikes)
+        terminated = bool(s.ended)
+        truncated = (not terminated) and self._elapsed >= self.max_episode_steps
+        if self.reward_fn is not None:
+            reward = float(self.reward_fn(self, info))
+        else:
+            fw, healthy, cw, ww = self.weights
+            reward = (fw * (info["hip_x_m"] - x_before) / self.dt
+                      + (0.0 if terminated else healthy)
+                      - cw * float(np.sum((u / self.tau_max) ** 2))
+                      - ww * (s.ledger["action_work_positive"] - w_before) / self.dt)
+        return self._obs(), float(reward), terminated, truncated, info
+
+    def render(self):
+        """The walker drawn (matplotlib, Agg) as an RGB array (H, W, 3) uint8, with
+        ``render_mode="rgb_array"``; None otherwise."""
+        if self.render_mode != "rgb_array":
+            return None
+        from .render import draw
+
+        return draw(self.sim.points(), float(self.scene.slope.phi_rad),
+                    float(self.rigid.model.params["leg_length_m"]), self.sim.t)

@@ -1,0 +1,219 @@
+"""The rigid view of the Gymnasium environment: the scene's hybrid walker advanced one
+control period at a time, resumable inside a step.
+
+Each control period integrates the walker's present phase with the library's integrator
+(:func:`walkerlab.integrate.rigid_phase.integrate_phase`: ``solve_ivp`` or CyRK, the scene's
+``solver`` section), its guards as terminal events; a guard inside the period is handled as
+:func:`walkerlab.integrate.rigid.integrate_step` handles it (a knee strike's reset and the
+next phase; a heel strike's reset map - with the scene's push-off - the roles swapped and
+the next step begun; a fall ends the episode) and the integration goes on to the period's
+end from the event's state.  So the heel strike's time is the event's own, located by the
+integrator inside the period (not rounded to the control grid), and with a zero action the
+walk is the scene's own walk (the period boundaries only restart the integrator).
+
+The action adds ``M^-1 B u`` to every phase's flow (:class:`walkerlab.gym.action.
+ActionTorques`); a zero action adds nothing (the scene's flows are called as they are).
+
+Energy ledger (the episode's sums, [J]): ``action_work_positive``, ``action_work_negative``
+(the action torques' power ``sum_k u_k ddelta_k`` integrated by 4-point Gauss-Legendre over
+each integrated piece), ``scene_torque_work`` (the scene's own torque laws), ``push_off_work``
+(kinetic energy the push-off adds, Kuo 2002), ``heel_strike_loss`` (kinetic energy change of
+the heel strike's collision, <= 0).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from walkerlab.integrate.rigid import MIN_STEP_TIME_S
+from walkerlab.integrate.rigid_phase import integrate_phase
+
+from .action import action_torques
+
+__all__ = ["LEDGER_TERMS", "RigidView"]
+
+#: the ledger's terms (:mod:`walkerlab.gym.rigid_view` docstring) [J]
+LEDGER_TERMS = ("action_work_positive", "action_work_negative", "scene_torque_work",
+                "push_off_work", "heel_strike_loss")
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
+
+
+class RigidView:
+    """The scene's rigid hybrid walker stepped by control periods.
+
+    Parameters
+    ----------
+    model : walkerlab.models.hybrid.HybridWalker
+        The scene's walker with its own actuators (:attr:`walkerlab.api.walker.Walker.model`).
+    solver : walkerlab.integrate.solver.Solver
+    data : walkerlab.walker.description.WalkerData
+        The walker's description (the action's actuators are built from it).
+    joints : list of str
+        The action's joints (:func:`walkerlab.gym.action.action_joints`).
+    max_step_time : float
+        A step longer than this [s] ends the episode (the walker stalled).
+
+    Raises
+    ------
+    ValueError
+        A walker the action cannot drive (:func:`walkerlab.gym.action.action_torques`).
+    """
+
+    def __init__(self, model, solver, data, joints, max_step_time: float):
+        self.model = model
+        self.solver = solver
+        backend = solver.resolved_backend()
+        # the compiled flows carry the scene's laws only: the action needs the Python flow
+        self.backend = "cyrk" if backend == "cyrk_compiled" else backend
+        n = model.n_coordinates
+        self.n = n
+        self.acts = {id(model): action_torques(data, n, joints)}
+        if model.mirror is not None:
+            self.acts[id(model.mirror)] = action_torques(data.mirror, n, joints)
+        self.max_step_time = float(max_step_time)
+        self.state_names = list(model.state_names())
+
+    # ------------------------------------------------------------------ state
+    def reset(self, x0: np.ndarray) -> None:
+        """Start at the post-impact state ``x0`` (2n,), ``leg1`` swinging, at t = 0."""
+        self.t = 0.0
+        self.t_step = 0.0
+        self.leg = self.model.legs[-1]
+        self.walker = self.model.for_stance(self.leg)
+        self.x = np.array(x0, dtype=float)
+        self.foot = np.zeros(2)
+        self.ended = ""
+        self.ledger = dict.fromkeys(LEDGER_TERMS, 0.0)
+        self.steps = 0
+        self._begin_step()
+
+    def _begin_step(self) -> None:
+        w = self.walker
+        if w.actuators is not None:
+            w.actuators.begin_step(self.t)
+        self.k = 0
+        if w.step_entry is not None:
+            x_new, name = w.step_entry(self.x)
+            self.x = np.asarray(x_new, float)
+            self.k = 0 if name is None else [p.name for p in w.phases].index(name)
+
+    def hip_x(self) -> float:
+        """World position of the hip along x (horizontal, downhill) [m]."""
+        return float(self.foot[0] + self.walker.points(self.x)["hip"][0])
+
+    def points(self) -> dict:
+        """World positions (2,) [m] of the walker's named points, by role."""
+        return {k: self.foot + np.asarray(v, float)
+                for k, v in self.walker.points(self.x).items()}
+
+    # ------------------------------------------------------------------ stepping
+    def _flow(self, phase, acts, act_on: bool):
+        if not act_on:
+            return phase.flow
+        n, flow, cons = self.n, phase.flow, phase.constraint
+
+        def f(t, x):
+            out = np.array(flow(t, x), dtype=float)
+            out[n:] += acts.added_acceleration(t, x, cons)
+            return out
+        return f
+
+    def _work(self, dense, ta: float, tb: float, acts, act_on: bool) -> None:
+        """Add the action's and the scene's torque work over ``[ta, tb]`` to the ledger."""
+        scene = self.walker.actuators
+        scene_on = scene is not None and bool(scene.spec.torques)
+        if tb <= ta or not (act_on or scene_on):
+            return
+        ts = 0.5 * (tb - ta) * _GL_X + 0.5 * (ta + tb)
+        X = np.atleast_2d(dense(ts))[:2 * self.n]
+        h = 0.5 * (tb - ta)
+        for j, tj in enumerate(ts):
+            xj = X[:, j]
+            if act_on:
+                p = acts.power(tj, xj)
+                key = "action_work_positive" if p > 0 else "action_work_negative"
+                self.ledger[key] += h * _GL_W[j] * p
+            if scene_on:
+                self.ledger["scene_torque_work"] += h * _GL_W[j] * scene.power(tj, xj)
+
+    def advance(self, u: np.ndarray, t_end: float) -> list[float]:
+        """Integrate to ``t_end`` [s] with the action torques ``u`` (k,) [N m] held.
+
+        Returns
+        -------
+        list of float
+            The heel-strike times inside the period [s] (the events' own times).
+            :attr:`ended` is set when the episode ended inside it (``fall``, ``stall``,
+            ``solver_failure``).
+        """
+        strikes: list[float] = []
+        n = self.n
+        while self.t < t_end and not self.ended:
+            w = self.walker
+            acts = self.acts[id(w)]
+            acts.u = np.asarray(u, dtype=float)
+            act_on = bool(np.any(acts.u))
+            phase = w.phases[self.k]
+            for g in phase.guards:  # a fall guard already violated as the phase begins
+                if (g.at_entry and g.outcome == "fall"
+                        and g.direction * float(g.function(self.t, self.x)) > 0):
+                    self.ended = "fall"
+            if self.ended:
+                break
+            t_stop = min(t_end, self.t_step + self.max_step_time)
+            rhs = self._flow(phase, acts, act_on)
+            jac = phase.jacobian if phase.jacobian is not None else w.variational
+            run = integrate_phase(phase, self.t, self.x, None, t_stop, 2 * n, self.solver,
+                                  self.backend, rhs, jac, False)
+            self._work(run.dense, self.t, run.t_last, acts, act_on)
+            self.t, self.x = run.t_last, np.array(run.y_last[:2 * n], float)
+            if run.failed or not np.all(np.isfinite(self.x)):
+                self.ended = "solver_failure"
+                break
+            if run.event is None:
+                if self.t >= self.t_step + self.max_step_time:
+                    self.ended = "stall"
+                continue
+            guard = phase.guards[run.event]
+            if guard.outcome == "fall":
+                self.ended = "fall"
+            elif guard.outcome == "next_phase":
+                target = guard.next_phase
+                self.k = (self.k + 1 if target is None
+                          else [p.name for p in w.phases].index(target))
+                if guard.reset is not None:
+                    self.x = np.asarray(guard.reset(self.x), float)
+                if self.k >= len(w.phases):
+                    self.ended = "fall"
+            elif self.t - self.t_step <= MIN_STEP_TIME_S:
+                self.ended = "stall"  # a heel strike at the step's start: no step
+            else:
+                self._heel_strike(guard)
+                strikes.append(self.t)
+        return strikes
+
+    def _heel_strike(self, guard) -> None:
+        """The reset map (push-off and collision, roles swapped), the next step begun."""
+        w = self.walker
+        x_minus = self.x
+        ke_minus = float(np.real(w.energies(x_minus)[0]))
+        push = 0.0
+        if guard.reset is not None:
+            x_plus = guard.reset(x_minus)
+        elif w.actuators is not None and w.actuators.spec.push_off is not None:
+            tr = w.actuators.transition(x_minus)
+            x_plus = tr["x_plus"]
+            push = float(tr["ke_push_off"] - tr["ke_minus"])
+        else:
+            x_plus = w.reset(x_minus)
+        self.foot = self.foot + np.asarray(w.points(x_minus)["swing_foot"], float)
+        self.leg = [g for g in self.model.legs if g != self.leg][0]
+        self.walker = self.model.for_stance(self.leg)
+        self.x = np.asarray(x_plus, float)
+        ke_plus = float(np.real(self.walker.energies(self.x)[0]))
+        self.ledger["push_off_work"] += push
+        self.ledger["heel_strike_loss"] += ke_plus - ke_minus - push
+        self.t_step = self.t
+        self.steps += 1
+        self._begin_step()
