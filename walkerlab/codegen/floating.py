@@ -77,7 +77,8 @@ import numpy as np
 
 from walkerlab.walker.description import Structure, WalkerData, check_floating_view
 
-__all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "MASSLESS_MESSAGE", "FloatingEquations",
+__all__ = ["FLAT_FOOT_MESSAGE", "FOOT_PARAMS", "HUB_INERTIA_MESSAGE", "MASSLESS_MESSAGE",
+           "WHEEL_COORDINATES", "FloatingEquations",
            "FloatingView", "check_masses", "contact_names", "coordinate_names",
            "derive_floating", "floating_module", "floating_params", "floating_view",
            "generated_state", "param_names"]
@@ -87,6 +88,14 @@ LEGS = ("leg1", "leg2")
 #: Floating-view parameters of a flat foot (not in the walker description, whose foot is
 #: massless): its mass at the ankle [kg] and its inertia about the ankle [kg m^2].
 FOOT_PARAMS = ("m_foot", "I_foot")
+#: The floating view's coordinates of a spoked wheel (``model: rimless_wheel``): the hub's
+#: position [m] and the absolute angle of spoke 0 [rad] (from the downward vertical,
+#: positive when its tip is ahead of the hub).
+WHEEL_COORDINATES = ("hip_x", "hip_y", "wheel_angle")
+HUB_INERTIA_MESSAGE = ("contact.hub_inertia_kg_m2: a rimless wheel with a point-mass hub "
+                       "(no walker.hub_inertia_kg_m2) needs a small regularising hub inertia "
+                       "in the contact model (its angle has no dynamics once no spoke is "
+                       "pinned)")
 FLAT_FOOT_MESSAGE = ("contact.flat_foot_mass_kg and contact.flat_foot_inertia_kg_m2: a "
                      "flat-footed walker's contact model needs its feet's mass and inertia "
                      "(the rigid view's feet are massless)")
@@ -94,6 +103,8 @@ FLAT_FOOT_MESSAGE = ("contact.flat_foot_mass_kg and contact.flat_foot_inertia_kg
 
 def coordinate_names(structure: Structure) -> tuple[str, ...]:
     """Names of the floating view's generalised coordinates (module docstring)."""
+    if structure.spokes:  # a spoked wheel: the hub's position and spoke0's angle
+        return WHEEL_COORDINATES
     if structure.knee:
         ang = tuple(f"{leg}_{ln}_angle" for leg in LEGS for ln in ("thigh", "shank"))
     else:
@@ -117,22 +128,38 @@ def param_names(structure: Structure) -> tuple[str, ...]:
 def contact_names(structure: Structure) -> tuple[str, ...]:
     """Names of the contact points, in the order of the generated ``feet`` (one per leg,
     ``leg1``, ``leg2``, for point and arc feet; ``leg1_heel``, ``leg1_toe``,
-    ``leg2_heel``, ``leg2_toe`` for flat feet)."""
+    ``leg2_heel``, ``leg2_toe`` for flat feet; a spoked wheel's spoke tips ``spoke0``,
+    ``spoke1``, ... in the order they touch down rolling downhill)."""
+    if structure.spokes:
+        return tuple(f"spoke{k}" for k in range(structure.spokes))
     if structure.foot == "flat":
         return tuple(f"{leg}_{end}" for leg in LEGS for end in ("heel", "toe"))
     return LEGS
 
 
 def floating_params(data: WalkerData, foot_mass_kg: float | None = None,
-                    foot_inertia_kg_m2: float | None = None) -> np.ndarray:
+                    foot_inertia_kg_m2: float | None = None,
+                    hub_inertia_kg_m2: float | None = None) -> np.ndarray:
     """The floating view's parameter vector (:func:`param_names` order) of ``data``.
+
+    ``hub_inertia_kg_m2`` [kg m^2]: a spoked wheel's regularising hub inertia
+    (``contact.hub_inertia_kg_m2``), used only when the wheel's own ``I_hub`` is 0 (a
+    point-mass hub, whose angle has no dynamics once no spoke is pinned); ignored otherwise.
 
     Raises
     ------
     ValueError
-        A flat-footed walker without a foot mass and inertia (:data:`FLAT_FOOT_MESSAGE`).
+        A flat-footed walker without a foot mass and inertia (:data:`FLAT_FOOT_MESSAGE`); a
+        point-mass hub without a regularising inertia (:data:`HUB_INERTIA_MESSAGE`).
     """
     p = [float(v) for v in data.params]
+    if data.structure.spokes:
+        i_hub = data.structure.param_names.index("I_hub")
+        if p[i_hub] <= 0.0:
+            if hub_inertia_kg_m2 is None:
+                raise ValueError(HUB_INERTIA_MESSAGE)
+            p[i_hub] = float(hub_inertia_kg_m2)
+        return np.asarray(p, dtype=float)
     if data.structure.foot == "flat":
         if foot_mass_kg is None or foot_inertia_kg_m2 is None:
             raise ValueError(FLAT_FOOT_MESSAGE)
@@ -212,6 +239,8 @@ def derive_floating(structure: Structure) -> FloatingEquations:
 
     check_floating_view(structure)
     check_masses(structure)
+    if structure.spokes:
+        return _derive_spoked(structure)
     if structure.foot not in ("point", "arc", "flat"):
         raise ValueError(f"walker.leg.foot.kind: {structure.foot!r} is not supported")
     names = coordinate_names(structure)
@@ -362,6 +391,44 @@ def derive_floating(structure: Structure) -> FloatingEquations:
                                          for leg in LEGS if knee and not structure.free_knees),
                              contacts=contact_names(structure),
                              point_legs=tuple(int(c[3]) - 1 for c in contact_names(structure)))
+
+
+def _derive_spoked(structure: Structure) -> FloatingEquations:
+    """The floating view of a spoked wheel (``model: rimless_wheel``; McGeer 1990, Coleman,
+    Chatterjee & Ruina 1997): one rigid body, the hub (mass ``M_hub`` at its centre, inertia
+    ``I_hub`` about it) with ``n`` massless spokes of length ``L``; ``q = [hip_x, hip_y,
+    wheel_angle]`` (:data:`WHEEL_COORDINATES`).  Spoke ``k``'s tip, the contact point
+    ``spoke<k>``, is at ``hub + L e(theta + 2 pi k / n)``: spoke 1 is the next ahead of
+    spoke 0 (the rigid view's swing spoke when spoke 0 is in stance), so rolling downhill
+    the spokes touch down in the order 0, 1, 2, ...  ``T = M |v|^2 / 2 + I w^2 / 2``,
+    ``V = M g y``; the mass matrix is ``diag(M, M, I)``.  The contact points alternate
+    between the legs' lanes (spoke ``k`` on leg2's for even ``k``, leg1's for odd: spoke 0
+    is the first stance, the pinned point of a pinned start)."""
+    import sympy as sp
+
+    names = coordinate_names(structure)
+    q = sp.symbols(names, real=True)
+    dq = sp.symbols([f"d_{n}" for n in names], real=True)
+    par = sp.symbols(param_names(structure), real=True)
+    P = dict(zip(param_names(structure), par))
+    g, L, m, inertia, alpha = P["g"], P["L"], P["M_hub"], P["I_hub"], P["alpha"]
+    hub = sp.Matrix([q[0], q[1]])
+    feet, points = [], {"hip": hub}
+    for k in range(structure.spokes):
+        psi = q[2] + 2 * k * alpha
+        tip = hub + L * sp.Matrix([sp.sin(psi), -sp.cos(psi)])
+        feet.append((tip, tip.jacobian(sp.Matrix(q))))
+        points[f"spoke{k}_foot"] = tip
+    M = sp.diag(m, m, inertia)
+    dqv = sp.Matrix(dq)
+    T = sp.Rational(1, 2) * (dqv.T * M * dqv)[0]
+    V = m * g * q[1]
+    h = sp.Matrix([0, m * g, 0])
+    contacts = contact_names(structure)
+    return FloatingEquations(q=tuple(q), dq=tuple(dq), params=tuple(par), M=M, h=h,
+                             feet=tuple(feet), kinetic=T, potential=V, points=points,
+                             knees=(), contacts=contacts,
+                             point_legs=tuple((k + 1) % 2 for k in range(len(contacts))))
 
 
 # ---------------------------------------------------------------------------- code generation

@@ -265,6 +265,16 @@ class ContactSettings(BaseModel):
         "about its ankle [kg m^2] (regularisation, see flat_foot_mass_kg).",
         json_schema_extra={"unit": "kg m^2"})
 
+    hub_inertia_kg_m2: float | None = Field(
+        None, gt=0, le=100, description="Rimless wheels with a point-mass hub only (SI): the "
+        "hub's moment of inertia about its centre [kg m^2] in the contact model.  The rigid "
+        "view's point-mass hub has none (it rolls about a pinned spoke); once no spoke is "
+        "pinned its angle would have no dynamics, so the floating contact model regularises "
+        "it with this small inertia (its share of the inertia about a spoke tip, I / "
+        "(M L^2 + I), is the relative change of the rolling dynamics).  Ignored when "
+        "walker.hub_inertia_kg_m2 is given.",
+        json_schema_extra={"unit": "kg m^2"})
+
     push_off_duration_s: float | None = Field(
         None, ge=0, le=0.5, description="Powered walkers only: the duration [s] of the "
         "push-off pulse, a constant force P / duration along the trailing leg (from its foot "

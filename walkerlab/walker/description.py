@@ -198,21 +198,15 @@ def check_floating_view(structure: Structure) -> None:
     """Refuse (one line) a walker that has no floating view (contact model, export) yet: free
     knees (the five-link biped) on legs that differ, on feet other than points, or with
     springs (what the rigid view of free knees, :mod:`walkerlab.codegen.free_joints`, refuses
-    too), and a spoked wheel.
+    too).
 
-    A spoked wheel (``model: rimless_wheel``) has no floating view yet: it would be the
-    hub's position and the wheel's angle with one contact point per spoke, and needs a
-    positive inertia about the hub (a point-mass hub's angle has no dynamics once no spoke
-    is pinned).
+    A spoked wheel (``model: rimless_wheel``) has one: the hub's position and the wheel's
+    angle with one contact point per spoke (:mod:`walkerlab.codegen.floating`).
 
     Raises
     ------
     ValueError
     """
-    if structure.spokes:
-        raise ValueError("walker.model: rimless_wheel has no floating view (contact model, "
-                         "URDF/MJCF/Adams export) yet; its rigid model runs fixedpoint, "
-                         "simulate, basin and mfpt")
     if structure.free_knees and (structure.foot != "point" or structure.asymmetric
                                  or structure.springs or structure.knee_spring):
         raise ValueError("walker.leg.knee.lock: free knees (the five-link biped) have a "

@@ -226,6 +226,10 @@ def multibody(data: WalkerData) -> Multibody:
     """
     s = data.structure
     check_floating_view(s)
+    if s.spokes:  # one rigid body, no links: walkerlab.export.multibody's wheel branch
+        raise ValueError("walker.model: rimless_wheel is one rigid body, not a tree of leg "
+                         "links: its URDF/MJCF come from walkerlab.export.multibody's "
+                         "wheel_urdf_text / wheel_mjcf_text")
     p = dict(zip(s.param_names, data.params))
     L = p["L"]
     lt, R = p["L_thigh"] if s.knee else 0.0, p["R_foot"] if s.foot == "arc" else 0.0

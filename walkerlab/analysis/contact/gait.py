@@ -325,10 +325,19 @@ def _foot_traces(walker, t, X, points: bool = False) -> dict[str, FootTrace]:
     return feet
 
 
+def _first_stance(feet, initial_stance: str) -> str:
+    """The foot in stance at the start: ``initial_stance``, or, for a walker whose feet are
+    not legs (a rimless wheel's spokes, ``spoke0``, ...), its first contact point (the
+    stance spoke of the rigid view's state it starts from)."""
+    return initial_stance if initial_stance in feet else next(iter(feet))
+
+
 def _heel_strikes(t, feet, min_step_m, initial_stance):
-    """Heel strikes (times, feet) and the bounces / scuffs counted per step."""
+    """Heel strikes (times, feet) and the bounces / scuffs counted per step; the feet are
+    the legs or, for a rimless wheel, its spokes (a heel strike is a spoke other than the
+    stance spoke touching down ahead of it)."""
     evs = sorted((tt, name) for name in feet for tt in feet[name].touchdown_times)
-    stance = initial_stance
+    stance = _first_stance(feet, initial_stance)
     s_stance = float(np.interp(t[0], t, feet[stance].s))
     hs_t, hs_leg, bounces, scuffs = [], [], [0], [0]
     for tt, name in evs:
@@ -383,6 +392,7 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
     """
     feet = _foot_traces(walker, t, X)
     hs_t, hs_leg, bounces, scuffs = _heel_strikes(t, feet, min_step_m, initial_stance)
+    initial_stance = _first_stance(feet, initial_stance)
     # an arc's contact point moves as it rolls, a flat foot's loaded point changes from heel
     # to toe: their slip is the integral of the material point's tangential velocity
     rolling = getattr(getattr(walker, "structure", None), "foot", "point") in ("arc", "flat")
@@ -393,7 +403,9 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
     # double-support intervals: overlaps of the feet's contact intervals (event times)
     iv = {f: _intervals(feet[f].touchdown_times, feet[f].liftoff_times, float(t[-1]))
           for f in names}
-    ds = [(max(a1, a2), min(b1, b2)) for a1, b1 in iv[names[0]] for a2, b2 in iv[names[1]]
+    # (a wheel: any two of its spokes, each overlap with the pair of spokes in contact)
+    ds = [(max(a1, a2), min(b1, b2), (f1, f2)) for j, f1 in enumerate(names)
+          for f2 in names[j + 1:] for a1, b1 in iv[f1] for a2, b2 in iv[f2]
           if min(b1, b2) > max(a1, a2)]
     steps = []
     for j, (ta, leg) in enumerate(zip(starts, legs)):
@@ -410,11 +422,11 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
         lo_mine = ft.liftoff_times[(ft.liftoff_times > ta) & (ft.liftoff_times < t_next)]
         sel = (t >= ta) & (t <= tb_or_end)
         creep = 0.0
-        for a, b in ds:
+        for a, b, pair in ds:
             a, b = max(a, ta), min(b, tb_or_end)
             if b > a:
                 creep += sum(abs(float(np.interp(b, t, feet[f].s) - np.interp(a, t, feet[f].s)))
-                             for f in names)
+                             for f in pair)
         peak = max(float(np.max(feet[f].penetration[sel] * feet[f].on_ground[sel]))
                    for f in names) if sel.any() else np.nan
         steps.append(StepSummary(j, leg, float(ta), float(tb), float(tb - ta),

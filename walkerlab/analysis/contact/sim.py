@@ -364,6 +364,8 @@ def named_trajectory(walker, res: ContactResult, legs=("leg1", "leg2")):
     step = np.zeros(t.size, dtype=int)
     for k, (ths, leg) in enumerate(zip(res.heel_strike_times, res.heel_strike_legs)):
         m = t >= ths
+        if leg not in legs:  # a rimless wheel's spoke: the leg of its lane (odd, even)
+            leg = walker.contact_leg(leg)
         stance[m] = legs.index(leg)
         step[m] = k + 1
     X = res.x

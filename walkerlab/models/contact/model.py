@@ -73,6 +73,8 @@ def state_name(coordinate: str, rate: bool = False) -> str:
         return ("v" if rate else "") + coordinate
     if coordinate == "torso_angle":  # a hinged torso (five-link biped)
         return ("d" if rate else "") + "theta_torso"
+    if coordinate == "wheel_angle":  # a spoked wheel: spoke 0's angle
+        return ("d" if rate else "") + "theta_wheel"
     leg, rest = coordinate.split("_", 1)
     i = leg[-1]
     link = rest[:-len("_angle")]
@@ -84,7 +86,7 @@ def state_name(coordinate: str, rate: bool = False) -> str:
 STATE_OF_COORDINATE = {c: state_name(c) for c in
                        ("hip_x", "hip_y", "leg1_angle", "leg2_angle", "leg1_thigh_angle",
                         "leg1_shank_angle", "leg2_thigh_angle", "leg2_shank_angle",
-                        "leg1_foot_angle", "leg2_foot_angle", "torso_angle")}
+                        "leg1_foot_angle", "leg2_foot_angle", "torso_angle", "wheel_angle")}
 
 
 def flat_foot_numbers(data) -> list[dict]:
@@ -181,6 +183,10 @@ class ContactWalker:
         A flat foot's regularising mass [kg] (at the ankle) and inertia about the ankle
         [kg m^2] (``contact.flat_foot_mass_kg``, ``contact.flat_foot_inertia_kg_m2``);
         required for flat feet, ignored otherwise.
+    hub_inertia : float, optional
+        A spoked wheel's regularising hub inertia [kg m^2] (``contact.hub_inertia_kg_m2``),
+        required when its hub is a point mass, ignored otherwise
+        (:func:`walkerlab.codegen.floating.floating_params`).
     actuators : ContactActuators or JointTorqueActuators, optional
         The walker's actuators (:mod:`walkerlab.models.contact.actuation`): hip torques and
         the push-off pulse; a free-jointed (five-link) biped's joint torques
@@ -217,6 +223,7 @@ class ContactWalker:
     flat_foot: tuple[float, float] | None = None
     actuators: object = None
     rhs_ready: object = None
+    hub_inertia: float | None = None
 
     def __post_init__(self):
         from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params
@@ -229,7 +236,8 @@ class ContactWalker:
                                                  self.phi))
         d = self.data
         check_masses(d.structure)
-        params = floating_params(d, *(self.flat_foot or (None, None)))
+        params = floating_params(d, *(self.flat_foot or (None, None)),
+                                 hub_inertia_kg_m2=self.hub_inertia)
         set_(self, "L", float(d.leg_length_m))
         set_(self, "g", float(d.gravity_m_per_s2))
         set_(self, "phi", float(d.slope_rad))
@@ -575,6 +583,8 @@ class ContactWalker:
 
         x = np.asarray(x_ideal, float)
         st = self.structure
+        if st.spokes:  # spoke 0 is the stance spoke: [wheel angle, its rate (stance scale)]
+            return np.array([x[0], x[1] * rate_scale[1]])
         if st.coordinates == "absolute" or st.knee:
             values = self.rigid_layout().named(x)  # the rigid state, by name
             if st.foot == "flat":
@@ -694,7 +704,7 @@ class ContactWalker:
             ``{"leg1": {...}, "leg2": {...}}``, arrays (n,) as :meth:`contact_quantities`.
         """
         cq = self.contact_quantities(X)
-        if self._contacts == FOOT_NAMES:
+        if self._contacts == FOOT_NAMES or self.structure.spokes:  # a wheel: per spoke
             return cq
         out = {}
         for leg in FOOT_NAMES:

@@ -53,6 +53,9 @@ def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
     touched down at ``s_toe - (heel + toe)`` (the post-impact state keeps the legs' angles;
     only the trailing foot's angle is lost, snapped to rest).  The checkerboard patches are
     spaced by it."""
+    if walker.structure.spokes:  # a wheel: the chord between neighbouring spoke tips
+        p = dict(zip(walker.structure.param_names, walker.walker_params))
+        return float(2.0 * p["L"] * np.sin(p["alpha"]))
     z = walker.link_state_from_ideal(x_ideal)
     x = walker.pinned_to_full(z, np.zeros(2))
     feet = walker.foot_positions(x)
@@ -136,7 +139,7 @@ class ContactSetup:
         """
         probe = ContactWalker(contact=self.law_si, data=self.walker, knee_stop=self.knee_stop,
                               flat_foot=self.law.flat_foot(), actuators=self.actuators,
-                              rhs_ready=self.rhs_ready)
+                              rhs_ready=self.rhs_ready, hub_inertia=self.law.hub_inertia_kg_m2)
         step_length = ideal_step_length(probe, x_ideal)
         return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
                                 n_steps=n_steps + 4), step_length
@@ -176,9 +179,27 @@ def contact_setup(scene: Scene) -> ContactSetup:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     if data.structure.foot == "flat" and contact.flat_foot() is None:
         raise ContactSceneError(f"scene '{scene.name}': {FLAT_FOOT_MESSAGE}")
+    if data.structure.spokes:
+        _check_wheel(scene, data)
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators)
+
+
+def _check_wheel(scene: Scene, data) -> None:
+    """A spoked wheel's contact scene: a regularising hub inertia for a point-mass hub
+    (:data:`walkerlab.codegen.floating.HUB_INERTIA_MESSAGE`) and continuous ground (its
+    spokes are not a pair of legs with a lane each); one-line refusals."""
+    from walkerlab.codegen.floating import HUB_INERTIA_MESSAGE
+
+    if data.extra.get("hub_inertia_kg_m2", 0.0) <= 0.0 \
+            and scene.contact.hub_inertia_kg_m2 is None:
+        raise ContactSceneError(f"scene '{scene.name}': {HUB_INERTIA_MESSAGE}")
+    terrain = scene.terrain or TerrainSettings()
+    if terrain.lanes != "continuous":
+        raise ContactSceneError(f"scene '{scene.name}': terrain.lanes: {terrain.lanes}: a "
+                                "rimless wheel's contact model runs on continuous ground "
+                                "(its spokes have no lanes of their own)")
 
 
 def _actuators(scene: Scene, data, cs: ContactSimSettings
