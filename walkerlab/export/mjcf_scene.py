@@ -72,6 +72,14 @@ class MjcfScene:
     push_off_duration_s : float
         The push-off pulse's duration [s]: one timestep (the rigid model's impulse as MuJoCo
         applies it; :func:`walkerlab.export.scene.mjcf_scene`).
+    lane_heights : (tuple of float, tuple of float) or None
+        Height [m] of each checkerboard patch along the slope normal (leg1's, leg2's lane,
+        one per centre of ``lanes``): the footholds of stairs and footholds, each a riser
+        below (or above) the last; None: every patch on the slope.
+    treads : tuple of (float, float, float) or None
+        Continuous stairs (``terrain.lanes: continuous``): each tread's ``(x_start, x_end,
+        height)`` [m] (level, in the world frame), written as a box whose top is the tread
+        and whose front or back face is the riser; None: the slope's plane.
     flat_feet : tuple or None
         Flat feet (:func:`walkerlab.export.scene.flat_feet`): per leg (leg1, leg2) ``(heel
         [m], toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot
@@ -97,6 +105,8 @@ class MjcfScene:
     push_off_duration_s: float = 0.005
     patch_ahead_m: float = 0.0
     flat_feet: tuple | None = None
+    lane_heights: tuple | None = None
+    treads: tuple | None = None
 
 
 #: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot

@@ -221,6 +221,8 @@ def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     n = (math.sin(phi), math.cos(phi))  # slope normal in (x, z)
     t = (math.cos(phi), -math.sin(phi))  # downhill along the slope
     off = extra.ground_offset_m
+    if extra.treads is not None:  # stairs: a box per tread, its top the tread
+        return _tread_boxes(mb, extra)
     if extra.lanes is None:
         return [f'    <geom name="ground" type="plane" size="0 0 1" euler="{nums(0, phi, 0)}" '
                 f'pos="{nums(-off * n[0], 0, -off * n[1])}" contype="6" conaffinity="0" '
@@ -228,14 +230,34 @@ def _ground(mb: Multibody, extra: MjcfScene | None) -> list[str]:
     half, depth = (extra.patch_width_m + extra.patch_ahead_m) / 2, extra.patch_width_m / 10
     out = []
     for leg, (y, centres) in zip(LANE_BITS, ((0.05, extra.lanes[0]), (-0.05, extra.lanes[1]))):
+        heights = None if extra.lane_heights is None else extra.lane_heights[
+            0 if leg == "leg1" else 1]
         for i, s in enumerate(centres):
             s = s + extra.patch_ahead_m / 2  # from footfall - w/2 to footfall + w/2 + ahead
             d = off + depth  # box centre below the surface
+            if heights is not None:  # a foothold a riser below (above) the last
+                d = d - heights[i]
             size = nums(half, 0.04 * mb.leg_length_m, depth)
             pos = nums(s * t[0] - d * n[0], y * mb.leg_length_m, s * t[1] - d * n[1])
             out.append(f'    <geom name="{leg}_patch{i}" type="box" size="{size}" pos="{pos}"'
                        f' euler="{nums(0, phi, 0)}" contype="{LANE_BITS[leg]}" conaffinity="0"'
                        ' rgba="0.8 0.8 0.8 1"/>')
+    return out
+
+
+def _tread_boxes(mb: Multibody, extra: MjcfScene) -> list[str]:
+    """Continuous stairs: one box per tread (``extra.treads``), its top the tread at the
+    ground offset below it, reaching a leg length below the lowest tread (so each riser is
+    a box face a toe can hit), both lanes' contact bits."""
+    off = extra.ground_offset_m
+    floor = min(h for _, _, h in extra.treads) - off - mb.leg_length_m
+    out = []
+    for i, (a, b, h) in enumerate(extra.treads):
+        top = h - off
+        size = nums((b - a) / 2, 0.1 * mb.leg_length_m, (top - floor) / 2)
+        pos = nums((a + b) / 2, 0, (top + floor) / 2)
+        out.append(f'    <geom name="tread{i}" type="box" size="{size}" pos="{pos}" '
+                   'contype="6" conaffinity="0" rgba="0.8 0.8 0.8 1"/>')
     return out
 
 

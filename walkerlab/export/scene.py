@@ -247,10 +247,13 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
         feet = None
     dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)
-    lanes = None
+    lanes = lane_heights = treads = None
+    if not terrain.is_slope:
+        lane_heights, treads = _ground_pieces(terrain, walker, ideal.x)
     if terrain.lanes == "checkerboard":
         # the keyframe's feet are one step apart: leg2's step, the last of the gait's map
-        ell2 = ideal_step_length(walker, ideal.x)
+        # (stairs, footholds: the footholds' spacing, along the slope)
+        ell2 = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
         ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
         # legs that differ: leg1's step differs from leg2's by the rigid steps' difference
         # (exact for point feet), else footfalls drift off the patches stride by stride
@@ -309,11 +312,45 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
                   "toe (leg<i>_toe); the keyframe has the trailing foot on its toe (the rigid "
                   "gait's double support as it begins).",)
     ahead, terrain_notes = _patch_ahead(scene, terrain, arc_roll_m(mb, qpos))
+    if treads is not None:
+        lanes = None  # continuous stairs: the treads are the ground
+        terrain_notes += (f"Stairs (terrain: riser {terrain.riser_m:g} m "
+                          f"{terrain.direction or 'down'}, tread {terrain.tread_m:g} m): a box "
+                          "per tread (geoms tread<i>), its top the tread, its faces the "
+                          "risers.",)
+    elif lane_heights is not None:
+        terrain_notes += ("Footholds (terrain.kind: " + terrain.kind + "): the checkerboard "
+                          "patches at the rigid gait's footholds, each at its tread's height "
+                          "(a riser below or above the last).",)
     return MjcfScene(tuple(qpos), tuple(qvel), lanes, terrain.patch_width_m,
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
                      dt, solref, solimp, mu, latch, notes + terrain_notes, actuation,
                      dt, ahead,  # the push-off over one timestep: the rigid model's impulse
-                     feet)
+                     feet, lane_heights, treads)
+
+
+def _ground_pieces(terrain: TerrainSettings, walker, x_ideal) -> tuple:
+    """The MJCF's ground on stairs or footholds (:class:`MjcfScene` ``lane_heights``,
+    ``treads``): the checkerboard patches' heights along the slope normal (footfall ``j``
+    at ``-j drop cos(phi)``, leg2's lane holding footfalls 0, 2, ..., leg1's -1, 1, 3, ...:
+    the keyframe's trailing foot stands on the tread behind), or continuous stairs' treads
+    (:func:`walkerlab.models.contact.terrain.stairs_line`, the stance foot at the origin).
+
+    Raises
+    ------
+    ValueError
+        A ground the contact model does not build (one line,
+        :func:`walkerlab.models.contact.terrain.check_ground`).
+    """
+    from walkerlab.models.contact.terrain import check_ground, stairs_line
+
+    drop = check_ground(terrain) * math.cos(float(walker.phi))
+    if terrain.lanes == "checkerboard":
+        k = np.arange(EXPORT_STEPS // 2 + 1)
+        return (tuple(-(2 * k - 1) * drop), tuple(-(2 * k) * drop)), None
+    line = stairs_line(terrain, 0.0, EXPORT_STEPS + 2)
+    return None, tuple((float(line[i, 0]), float(line[i + 1, 0]), float(line[i, 1]))
+                       for i in range(0, len(line), 2))
 
 
 def flat_feet(scene: Scene, data) -> tuple:

@@ -160,14 +160,18 @@ def first_event(walker, t, X, limits: ContactLimits, k0=1):
             if best is not None and k0 - 1 + k > best[1]:
                 break
             sa, sb = q["s"][k - 1], q["s"][k]
-            c = lane[int(np.argmin(np.abs(lane - sb)))]
+            j = int(np.argmin(np.abs(lane - sb)))
+            c = lane[j]
             edge = c - hw if sb < c else c + hw
             vs = q["slip_velocity"]
             te = hermite_root(tt[k - 1], tt[k], sa - edge, sb - edge, vs[k - 1], vs[k])
             if te is None:
                 te = float(tt[k])
             xe = hermite_state(walker, tt[k - 1], tt[k], X[k0 - 1 + k - 1], X[k0 - 1 + k], te)
-            pe = walker.contact_quantities(xe)[foot]["penetration"][0]
+            qe = walker.contact_quantities(xe)[foot]
+            pe = qe["penetration"][0]
+            if qe["on_ground"][0] <= 0.5:  # found on the gap's side of the edge: the depth
+                pe += walker.lane_heights(foot)[j]  # below that patch's top (stairs' lower)
             if pe > 0 and (best is None or te < best[2]):
                 best = (RunEnd.TRIP.value, k0 - 1 + k, float(te), foot, float(edge))
                 break

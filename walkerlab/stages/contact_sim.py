@@ -125,10 +125,6 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     walkerlab.io.artifacts.ArtifactError
         ``fixedpoint.h5`` is missing or unreadable.
     """
-    if scene.terrain is not None and not scene.terrain.is_slope:  # no contact geometry yet
-        raise StageError(f"terrain.kind: {scene.terrain.kind}: the contact model walks on "
-                         "the slope only (contact geometry of stairs, footholds and profiles "
-                         "is not built yet)")
     setup = contact_setup(scene)  # the scene read once: all the run needs, typed
     periodic = periodic or setup.sim.periodic_gait
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)

@@ -128,9 +128,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     """
     path = export_path(scene, runs_root, fmt)  # check the format before building anything
     if not walker_only and scene.terrain is not None and not scene.terrain.is_slope:
-        raise ValueError(f"terrain.kind: {scene.terrain.kind}: the exports carry a slope's "
-                         "ground only (boxes for stairs are not built yet); --walker-only "
-                         "writes the walker alone")
+        if fmt != "mjcf":
+            raise ValueError(f"terrain.kind: {scene.terrain.kind}: the {fmt} export carries a "
+                             "slope's ground only (stairs and footholds are in the MJCF); "
+                             "--walker-only writes the walker alone")
+        from walkerlab.models.contact.terrain import check_ground
+
+        check_ground(scene.terrain)  # a profile: one line
     data = walker_data(scene.walker, scene.slope.phi_rad)
     mb = multibody(data)
     name = scene.name or "walker"

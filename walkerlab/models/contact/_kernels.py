@@ -71,3 +71,45 @@ def patch_height(s, lane, hw, continuous):
         if abs(s - lane[j]) <= hw:
             return lane[n + j]
     return np.nan
+
+
+@njit(cache=True)
+def ground_line(px, py, line):
+    """Contact frame of a point at (px, py) [m] on a polyline ground (treads, risers,
+    profile segments): the signed penetration [m] (> 0 inside the ground) into the nearest
+    segment and that segment's outward unit normal (nx, ny).
+
+    ``line`` (2 m,): the polyline's vertices ``x0, y0, x1, y1, ...`` [m] in the world frame
+    (the ground lies to the right of each segment's direction: a segment running in +x has
+    the normal +y; a riser going down in +x faces +x).  The nearest segment is the one whose
+    closest point (clamped to the segment) is nearest; the sign is the side of that segment's
+    line.  Past a segment's end (a corner) the normal is the direction from that end to the
+    point, so penetration and normal are continuous around corners; the penetration is the
+    distance to the ground's surface (a signed distance function of the polyline)."""
+    m = line.shape[0] // 2
+    best = np.inf
+    delta, nx, ny = -np.inf, 0.0, 1.0
+    for j in range(m - 1):
+        ax, ay = line[2 * j], line[2 * j + 1]
+        ex, ey = line[2 * j + 2] - ax, line[2 * j + 3] - ay
+        l2 = ex * ex + ey * ey
+        if l2 <= 0.0:
+            continue
+        u = ((px - ax) * ex + (py - ay) * ey) / l2
+        clamped = u < 0.0 or u > 1.0
+        u = min(max(u, 0.0), 1.0)
+        dx, dy = px - (ax + u * ex), py - (ay + u * ey)
+        r2 = dx * dx + dy * dy
+        if r2 >= best:
+            continue
+        best = r2
+        ln = np.sqrt(l2)
+        sx, sy = -ey / ln, ex / ln  # the segment's outward normal
+        side = -((px - ax) * sx + (py - ay) * sy)  # > 0: inside the ground
+        r = np.sqrt(r2)
+        if clamped and r > 0.0:
+            sg = 1.0 if side > 0.0 else -1.0
+            delta, nx, ny = sg * r, -sg * dx / r, -sg * dy / r
+        else:
+            delta, nx, ny = side, sx, sy
+    return delta, nx, ny

@@ -129,13 +129,16 @@ def side_entry(walker, x, dt: float) -> tuple[str, float, float, float] | None:
     cq = walker.contact_quantities(np.atleast_2d(x))
     for foot, q in cq.items():  # every contact point on its leg's lane
         lane = walker.lane(foot)
-        if q["on_ground"][0] > 0.5 or q["penetration"][0] <= 0:
+        if q["on_ground"][0] > 0.5:
             continue
+        # depth below each side's patch top (the patches' own heights: stairs, rough ground)
+        h = walker.lane_heights(foot)
+        depth = q["penetration"][0] + np.concatenate([h, h])
         s, v = float(q["s"][0]), float(q["slip_velocity"][0])
         edges = np.concatenate([lane - walker.patch_half_width, lane + walker.patch_half_width])
         ahead = (edges - s) / v if v != 0 else np.full(edges.shape, np.inf)
-        ok = (ahead >= 0) & (ahead <= dt)
+        ok = (ahead >= 0) & (ahead <= dt) & (depth > 0)
         if ok.any():
             j = int(np.flatnonzero(ok)[np.argmin(ahead[ok])])
-            return foot, float(edges[j]), float(ahead[j]), float(q["penetration"][0])
+            return foot, float(edges[j]), float(ahead[j]), float(depth[j])
     return None

@@ -92,7 +92,7 @@ ASSEMBLY = '''
 # (walkerlab.models.contact.generated.ASSEMBLY: walker-independent; laws from contact._kernels)
 from math import sin as _sin, cos as _cos
 from walkerlab.models.contact._kernels import (normal_force, friction_mu, patch_height,
-                                               step)
+                                               step, ground_line)
 
 I_PHI, I_K, I_E, I_CMAX, I_DMAX = 0, 1, 2, 3, 4
 I_MUS, I_MUD, I_VS, I_VD, I_HW, I_CONT = 5, 6, 7, 8, 9, 10
@@ -147,8 +147,13 @@ def _chol_solve(L, B):
 def _point(px, py, vx, vy, sp, cp, PC, cen):
     """Contact of a point at (px, py) [m] whose material velocity is (vx, vy) [m/s] on the
     lane ``cen``, the slope's (sin, cos) = (sp, cp): (delta, ddot, vt, s, Fn, Ff, dFn/ddelta,
-    dFn/dddot, mu, dmu/dvt).  The one contact kernel of the right-hand side, the Jacobian,
-    the pinned dynamics and the tables (one compile)."""
+    dFn/dddot, mu, dmu/dvt, nx, ny), (nx, ny) the ground's outward normal there (the
+    friction acts along (ny, -nx)).  The one contact kernel of the right-hand side, the
+    Jacobian, the pinned dynamics and the tables (one compile).  On a polyline ground
+    (``PC[I_CONT] == 2``: ``cen`` its vertices, :func:`ground_line`) the penetration and
+    normal are the nearest segment's."""
+    if PC[I_CONT] > 1.5:
+        return _on_line(px, py, vx, vy, sp, cp, PC, cen)
     delta = -(px * sp + py * cp)
     ddot = -(vx * sp + vy * cp)
     vt = vx * cp - vy * sp
@@ -163,7 +168,23 @@ def _point(px, py, vx, vy, sp, cp, PC, cen):
         fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
         if fn > 0.0:
             mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
-    return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu
+    return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu, sp, cp
+
+
+@njit(cache=True)
+def _on_line(px, py, vx, vy, sp, cp, PC, line):
+    """:func:`_point` on the polyline ground ``line`` (stairs' treads and risers): the
+    IMPACT and Coulomb laws on the penetration into the nearest segment, along its normal."""
+    delta, nx, ny = ground_line(px, py, line)
+    ddot = -(vx * nx + vy * ny)
+    vt = vx * ny - vy * nx
+    s = px * cp - py * sp
+    fn, dfd, dfdd, mu, dmu = 0.0, 0.0, 0.0, 0.0, 0.0
+    if delta > 0.0:
+        fn, dfd, dfdd = normal_force(delta, ddot, PC[I_K], PC[I_E], PC[I_CMAX], PC[I_DMAX])
+        if fn > 0.0:
+            mu, dmu = friction_mu(vt, PC[I_MUS], PC[I_MUD], PC[I_VS], PC[I_VD])
+    return delta, ddot, vt, s, fn, mu * fn, dfd, dfdd, mu, dmu, nx, ny
 
 
 @njit(cache=True)
@@ -198,7 +219,7 @@ def _knee(x, k, PC, delta):
 @njit(cache=True)
 def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
     """Q - h (NQ,) with the contact forces of the legs' points used and the knee stops;
-    fills M, the points' P, V, J, per-point ``info`` (NF, 10) (see _point) and ``knees``
+    fills M, the points' P, V, J, per-point ``info`` (NF, 12) (see _point) and ``knees``
     (2, 5) (knees only with one contact point per leg: point k is leg k's)."""
     h = np.empty(NQ)
     dyn(x, p, M, h)
@@ -210,12 +231,13 @@ def _force(x, PC, p, c1, c2, use1, use2, M, P, V, J, info, knees):
         if not ((leg == 0 and use1) or (leg == 1 and use2)):
             continue
         res = _point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, c1 if leg == 0 else c2)
-        for k in range(10):
+        for k in range(12):
             info[i, k] = res[k]
         fn, ff = res[4], res[5]
         if fn > 0.0:
-            Fx = fn * sp + ff * cp
-            Fy = fn * cp - ff * sp
+            nx, ny = res[10], res[11]  # the ground's normal (the slope's: sp, cp)
+            Fx = fn * nx + ff * ny
+            Fy = fn * ny - ff * nx
             for k in range(NQ):
                 Q[k] += J[i, 0, k] * Fx + J[i, 1, k] * Fy
     if KNEE:
@@ -252,7 +274,7 @@ def jac(x, PC, p, c1, c2):
     P = np.empty((NF, 2))
     V = np.empty((NF, 2))
     J = np.empty((NF, 2, NQ))
-    info = np.zeros((NF, 10))
+    info = np.zeros((NF, 12))
     knees = np.zeros((2, 5))
     Q = _force(x, PC, p, c1, c2, True, True, M, P, V, J, info, knees)
     L = _chol(M)
@@ -260,11 +282,11 @@ def jac(x, PC, p, c1, c2):
     Dq = np.empty((NQ, NQ))
     Dv = np.empty((NQ, NQ))
     dyn_jac(x, a, p, Dq, Dv)
-    sp, cp = _sin(PC[I_PHI]), _cos(PC[I_PHI])
     F = np.zeros((NF, 2))
     for i in range(NF):
         fn, ff = info[i, 4], info[i, 5]
         if fn > 0.0:
+            sp, cp = info[i, 10], info[i, 11]  # the ground's normal at the point
             F[i, 0] = fn * sp + ff * cp
             F[i, 1] = fn * cp - ff * sp
     dV = np.empty((NF, 2, NQ))
@@ -280,6 +302,7 @@ def jac(x, PC, p, c1, c2):
         if fn <= 0.0:
             continue
         dfd, dfdd, mu, dmu = info[i, 6], info[i, 7], info[i, 8], info[i, 9]
+        sp, cp = info[i, 10], info[i, 11]  # the normal, locally constant
         dFx = np.empty(2 * NQ)
         dFy = np.empty(2 * NQ)
         for k in range(NQ):
@@ -345,7 +368,7 @@ def rhs_pinned(z, PC, p, c1, c2, foot2):
     P = np.empty((NF, 2))
     V = np.empty((NF, 2))
     J = np.empty((NF, 2, NQ))
-    info = np.zeros((NF, 10))
+    info = np.zeros((NF, 12))
     knees = np.zeros((2, 5))
     Q = _force(x, PC, p, c1, c2, True, False, M, P, V, J, info, knees)
     dV = np.empty((NF, 2, NQ))
@@ -403,8 +426,8 @@ def contact_table(X, PC, p, c1, c2):
             cen = c1 if POINT_LEG[i] == 0 else c2
             res = _point(P[i, 0], P[i, 1], V[i, 0], V[i, 1], sp, cp, PC, cen)
             fn, ff = res[4], res[5]
-            Fx = fn * sp + ff * cp
-            Fy = fn * cp - ff * sp
+            Fx = fn * res[10] + ff * res[11]
+            Fy = fn * res[11] - ff * res[10]
             for k in range(6):
                 out[r, i, k] = res[k]
             out[r, i, 6] = Fx * V[i, 0] + Fy * V[i, 1]
@@ -574,8 +597,9 @@ def rhs_source(eq) -> str:
     for i, leg in enumerate(eq.point_legs):  # each point on its leg's lane
         args = ", ".join(pr.doprint(e) for e in red[4 * i:4 * i + 4])
         lines += [f"    _r{i} = _point({args}, _sp, _cp, PC, {('c1', 'c2')[leg]})",
-                  f"    {Fs[2 * i]} = _r{i}[4] * _sp + _r{i}[5] * _cp",  # (Fn, Ff) in the world
-                  f"    {Fs[2 * i + 1]} = _r{i}[4] * _cp - _r{i}[5] * _sp"]
+                  # (Fn, Ff) in the world, along the ground's normal (the slope's: _sp, _cp)
+                  f"    {Fs[2 * i]} = _r{i}[4] * _r{i}[10] + _r{i}[5] * _r{i}[11]",
+                  f"    {Fs[2 * i + 1]} = _r{i}[4] * _r{i}[11] - _r{i}[5] * _r{i}[10]"]
     Q = -eq.h
     for i, (_, J) in enumerate(eq.feet):
         Q += J.T * sp.Matrix([Fs[2 * i], Fs[2 * i + 1]])
@@ -583,7 +607,9 @@ def rhs_source(eq) -> str:
         for k, (t, sh) in enumerate(eq.knees):
             T = sp.Symbol(f"_T{k}", real=True)
             # penetration of leg k's foot, -(p . n)
-            dl = f"-(({pr.doprint(red[4 * k])}) * _sp + ({pr.doprint(red[4 * k + 1])}) * _cp)"
+            # (a polyline ground: the penetration into it, _point's)
+            dl = (f"(_r{k}[0] if PC[I_CONT] > 1.5 else "
+                  f"-(({pr.doprint(red[4 * k])}) * _sp + ({pr.doprint(red[4 * k + 1])}) * _cp))")
             lines.append(f"    {T} = _knee_torque({eq.q[sh]} - {eq.q[t]}, "
                          f"{eq.dq[sh]} - {eq.dq[t]}, PC, {dl})")
             Q[t] += T

@@ -175,6 +175,14 @@ class ContactWalker:
         Half width of each patch [m].
     continuous : bool
         Ground everywhere (no lanes/gaps).
+    ground_line : ndarray, optional
+        A polyline ground (m, 2) [m], vertices (x, y) in the world frame, x increasing
+        along the walk (stairs: treads level, risers vertical; the ground lies below it):
+        both feet meet it everywhere (``continuous`` is then True and the lanes only name
+        the footfalls), each point with the contact law on its penetration into the nearest
+        segment, along that segment's normal (a toe caught by a riser is pushed back
+        horizontally; :func:`walkerlab.models.contact._kernels.ground_line`).  None: the
+        slope and its patches.
     data : WalkerData, optional
         Any walker description (:func:`walkerlab.walker.description.walker_data`).
     knee_stop : KneeStopSI, optional
@@ -224,6 +232,7 @@ class ContactWalker:
     actuators: object = None
     rhs_ready: object = None
     hub_inertia: float | None = None
+    ground_line: np.ndarray | None = None
 
     def __post_init__(self):
         from walkerlab.codegen.floating import check_masses, coordinate_names, floating_params
@@ -270,6 +279,17 @@ class ContactWalker:
             h = np.zeros(lane.size) if h is None else h
             set_(self, "_kernel_lane" + k, np.ascontiguousarray(
                 np.concatenate([lane, h, [h.max(initial=0.0)]])))
+        if self.ground_line is not None:  # both feet on the polyline (the kernels' mode 2)
+            g = np.ascontiguousarray(self.ground_line, dtype=float)
+            if g.ndim != 2 or g.shape[1] != 2 or g.shape[0] < 2 or not np.all(np.isfinite(g)):
+                raise ValueError("ground_line: finite polyline vertices (m >= 2, 2) [m], got "
+                                 f"shape {g.shape}")
+            set_(self, "ground_line", g)
+            set_(self, "continuous", True)
+            PC[mod.I_CONT] = 2.0
+            flat = np.ascontiguousarray(g.ravel())
+            set_(self, "_kernel_lane1", flat)
+            set_(self, "_kernel_lane2", flat.copy())
         set_(self, "kernels", mod)
         set_(self, "contact_params", PC)
         set_(self, "walker_params", params)
@@ -296,7 +316,9 @@ class ContactWalker:
                    n_steps: int) -> ContactWalker:
         """The same walker and contact law on ``terrain``: checkerboard patches spaced by
         ``step_length`` [m] for ``n_steps`` steps (each lane shifted by its leg's
-        :func:`footprint_offsets`), or continuous ground.
+        :func:`footprint_offsets`), or continuous ground; stairs and footholds as the
+        patches' heights or a polyline ground (:func:`walkerlab.models.contact.terrain.
+        terrain_ground`).
 
         Returns
         -------
@@ -308,13 +330,19 @@ class ContactWalker:
         ------
         ValueError
             From the copy's ``__post_init__``: ``heights1``/``heights2`` are set and no longer
-            have one value per patch of the new lanes.
+            have one value per patch of the new lanes; a ground the contact model does not
+            build (:func:`walkerlab.models.contact.terrain.terrain_ground`, one line).
         """
         c1, c2 = checkerboard_lanes(step_length, n_steps)
         o1, o2 = footprint_offsets(self.data)
-        return dataclasses.replace(self, lane1=c1 + o1, lane2=c2 + o2,
-                                   patch_half_width=0.5 * terrain.patch_width_m,
-                                   continuous=terrain.lanes == "continuous")
+        walker = dataclasses.replace(self, lane1=c1 + o1, lane2=c2 + o2,
+                                     patch_half_width=0.5 * terrain.patch_width_m,
+                                     continuous=terrain.lanes == "continuous")
+        if terrain.is_slope:
+            return walker
+        from .terrain import terrain_ground
+
+        return terrain_ground(walker, terrain, n_steps)
 
     @property
     def structure(self):
@@ -627,6 +655,14 @@ class ContactWalker:
         """
         leg = name if name in FOOT_NAMES else self.contact_leg(name)
         return self.lane1 if leg == "leg1" else self.lane2
+
+    def lane_heights(self, name: str) -> np.ndarray:
+        """Heights [m] (along the slope's outward normal) of the patches of the lane of
+        contact point (or leg) ``name``, one per :meth:`lane` centre (zeros: the flat
+        checkerboard)."""
+        leg = self.contact_leg(name) if name in self._contacts else name
+        return self._kernel_lane1[self.lane1.size:2 * self.lane1.size] if leg == "leg1" \
+            else self._kernel_lane2[self.lane2.size:2 * self.lane2.size]
 
     def foot_state(self, x, i: int) -> tuple[float, float, float, float]:
         """Reference contact point of leg ``i`` (0/1) (its only point; a flat foot's heel)

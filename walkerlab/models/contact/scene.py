@@ -27,6 +27,7 @@ from .joint_torques import JointTorqueActuators
 from .laws import ContactParamsSI, KneeStopSI
 from .model import ContactWalker, flat_foot_numbers
 from .rigid_limit import contact_si
+from .terrain import check_ground
 
 if TYPE_CHECKING:
     from walkerlab.codegen.pending import CompiledElsewhere
@@ -39,7 +40,7 @@ class ContactSceneError(ValueError):
     """The scene lacks a section the contact model needs (one-line message)."""
 
 
-def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
+def ideal_step_length(walker: ContactWalker, x_ideal, along_slope: bool = False) -> float:
     """Advance [m] of the ideal gait per step, from its post-impact state ``x_ideal`` (role
     order of the rigid model): the distance between the two feet's contact points with the
     stance leg placed by :meth:`ContactWalker.link_state_from_ideal` (the foot-to-foot chord
@@ -52,7 +53,9 @@ def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
     ``toe`` from its ankle, ``s_toe = s_ankle + sqrt(toe^2 - h_ankle^2)``, and its heel
     touched down at ``s_toe - (heel + toe)`` (the post-impact state keeps the legs' angles;
     only the trailing foot's angle is lost, snapped to rest).  The checkerboard patches are
-    spaced by it."""
+    spaced by it.  ``along_slope``: the chord's component along the slope instead (stairs
+    and footholds, where the feet at heel strike stand a riser apart: the footholds'
+    spacing)."""
     if walker.structure.spokes:  # a wheel: the chord between neighbouring spoke tips
         p = dict(zip(walker.structure.param_names, walker.walker_params))
         return float(2.0 * p["L"] * np.sin(p["alpha"]))
@@ -60,6 +63,8 @@ def ideal_step_length(walker: ContactWalker, x_ideal) -> float:
     x = walker.pinned_to_full(z, np.zeros(2))
     feet = walker.foot_positions(x)
     chord = float(np.hypot(*(feet[1] - feet[0])))
+    if along_slope:
+        chord = abs(float((feet[1] - feet[0]) @ walker.tangent))
     if walker.structure.foot == "flat":
         pts = walker.points(x)
         f1 = flat_foot_numbers(walker.data)[0]
@@ -140,7 +145,7 @@ class ContactSetup:
         probe = ContactWalker(contact=self.law_si, data=self.walker, knee_stop=self.knee_stop,
                               flat_foot=self.law.flat_foot(), actuators=self.actuators,
                               rhs_ready=self.rhs_ready, hub_inertia=self.law.hub_inertia_kg_m2)
-        step_length = ideal_step_length(probe, x_ideal)
+        step_length = ideal_step_length(probe, x_ideal, along_slope=not self.terrain.is_slope)
         return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
                                 n_steps=n_steps + 4), step_length
 
@@ -156,8 +161,9 @@ def contact_setup(scene: Scene) -> ContactSetup:
         No ``contact`` section, a walker with actuators the contact view does not carry
         (knees, arc feet, a torso on knees or flat feet; a pinned or non-ideal start), a
         walker with a massless body, flat feet without
-        ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
-        that is not a point (one line).
+        ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, a pinned stance foot
+        that is not a point, or a ground the contact model does not build (a height profile,
+        footholds of several heights, footholds on continuous ground) (one line).
     """
     from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, check_masses
     from walkerlab.walker.description import walker_data
@@ -166,6 +172,10 @@ def contact_setup(scene: Scene) -> ContactSetup:
         raise ContactSceneError(f"scene '{scene.name}' has no 'contact' section, which the "
                                 "contact model needs")
     contact = scene.contact
+    try:
+        check_ground(scene.terrain)
+    except ValueError as err:
+        raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     cs = scene.contact_sim or ContactSimSettings()
     data = walker_data(scene.walker, scene.slope.phi_rad)
     actuators = _actuators(scene, data, cs)

@@ -18,15 +18,28 @@ normal (:attr:`walkerlab.models.contact.model.ContactWalker.heights1`), so
   stay parallel to the scene's slope and gravity keeps its direction (the rigid model's
   per-step slope also turns gravity within the step); the two terrains agree to first
   order in ``gamma_k - gamma`` at the footfalls only.
+
+The scene's ground (``terrain.kind``, :func:`terrain_ground`) enters the same way: on the
+paper's checkerboard lanes (``lanes: checkerboard``) stairs and footholds are patches at the
+rigid gait's footholds, footfall ``k`` at the height of its tread, ``-k`` times the landing
+drop per step (:func:`walkerlab.models.hybrid.ground.landing_drop`; the heights the rigid
+model's heel strikes meet); on continuous ground (``lanes: continuous``) the stairs are a
+polyline of level treads and vertical risers (:func:`stairs_line`) that both feet meet
+everywhere, so a toe swinging into a riser is caught by it
+(:attr:`walkerlab.models.contact.model.ContactWalker.ground_line`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
 
-__all__ = ["footfall_lanes", "slope_heights", "step_heights"]
+from walkerlab.models.hybrid.ground import landing_drop
+
+__all__ = ["check_ground", "footfall_lanes", "slope_heights", "stairs_line", "step_heights",
+           "terrain_ground"]
 
 
 def slope_heights(slopes_rad: np.ndarray, mean_rad: float, step_length_m: float
@@ -78,3 +91,95 @@ def footfall_lanes(walker, heights_m: np.ndarray):
                   "patch_half_width": float(walker.lane1[0] - walker.lane2[0])}
     return replace(walker, heights2=h[0:2 * walker.lane2.size:2],
                    heights1=h[1:2 * walker.lane1.size:2], **ground)
+
+
+def stairs_line(terrain, first_x_m: float, n_treads: int, behind: int = 3) -> np.ndarray:
+    """Vertices (m, 2) [m] of stairs as a polyline in the world frame: level treads
+    ``tread_m`` deep, each ``riser_m`` below (``direction: down``) or above (``up``) the last,
+    joined by vertical risers; tread 0 at height 0 holds the first stance foot at
+    ``x = first_x_m``, ``first_foothold_m`` from its back end (default mid-tread).
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings
+        ``kind: stairs``.
+    first_x_m : float
+        The first stance foot's x [m].
+    n_treads : int
+        Treads ahead of tread 0 (the last one runs on for 100 treads' depth).
+    behind : int
+        Treads behind tread 0 (the first one runs back for 100 treads' depth).
+    """
+    D = float(terrain.tread_m)
+    dh = -landing_drop(terrain)  # each tread's height above the last [m]
+    u0 = D / 2 if terrain.first_foothold_m is None else float(terrain.first_foothold_m)
+    x0 = float(first_x_m) - u0
+    pts = []
+    for k in range(-int(behind), int(n_treads) + 1):
+        a, b = x0 + k * D, x0 + (k + 1) * D
+        if k == -int(behind):
+            a -= 100.0 * D
+        if k == int(n_treads):
+            b += 100.0 * D
+        pts += [(a, k * dh), (b, k * dh)]
+    return np.asarray(pts, dtype=float)
+
+
+def check_ground(terrain) -> float:
+    """The landing drop per step [m] of a ground the contact model builds (0.0 for the
+    slope; :func:`landing_drop`).
+
+    Raises
+    ------
+    ValueError
+        One line naming the field: a profile, footholds of several heights or of their own
+        slopes, footholds on continuous ground (no ground between the footholds).
+    """
+    if terrain is None or terrain.kind == "slope":
+        return 0.0
+    if terrain.kind == "profile":
+        raise ValueError("terrain.kind: profile: the contact model walks slopes, stairs and "
+                         "footholds (height profiles as contact geometry are not built yet)")
+    drop = landing_drop(terrain)
+    if terrain.kind == "footholds" and terrain.lanes == "continuous":
+        raise ValueError("terrain.lanes: continuous footholds have no ground between the "
+                         "footholds: use lanes: checkerboard (patches at the footholds)")
+    return drop
+
+
+def terrain_ground(walker, terrain, n_steps: int):
+    """``walker`` (its lanes laid out at the footfalls,
+    :meth:`walkerlab.models.contact.model.ContactWalker.on_terrain`) on the scene's ground.
+
+    Parameters
+    ----------
+    walker : ContactWalker
+    terrain : walkerlab.config.TerrainSettings
+    n_steps : int
+        Steps the run may take.
+
+    Returns
+    -------
+    ContactWalker
+        ``kind: slope``: ``walker`` itself (bit for bit today's ground).  Stairs and
+        footholds of one height on the checkerboard lanes: the patches at the footholds'
+        heights (footfall ``k`` at ``-k drop cos(phi)`` along the slope's normal,
+        :func:`footfall_lanes`).  Stairs on continuous ground: the treads and risers as a
+        polyline (:func:`stairs_line`).
+
+    Raises
+    ------
+    ValueError
+        A ground the contact model does not build (one line, naming the field): a profile,
+        footholds of several heights or slopes (:func:`landing_drop`'s refusals), footholds
+        on continuous ground (no ground between the footholds).
+    """
+    if terrain is None or terrain.kind == "slope":
+        return walker
+    drop = check_ground(terrain)
+    if terrain.lanes == "checkerboard":
+        n = 2 * max(walker.lane1.size, walker.lane2.size)
+        heights = -np.arange(n) * drop * math.cos(float(walker.phi))
+        return footfall_lanes(walker, heights)
+    first = float(walker.lane2[0]) if walker.lane2.size else 0.0
+    return replace(walker, ground_line=stairs_line(terrain, first, int(n_steps) + 2))
