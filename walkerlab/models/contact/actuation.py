@@ -17,8 +17,7 @@ thighs: ``+tau`` on the swing thigh's absolute angle, ``-tau`` on the stance thi
 shanks and knees get nothing; its power is ``tau (dtheta_swing_thigh -
 dtheta_stance_thigh)`` and its phase variable the stance thigh's angle (the rigid view's
 stance angle while the stance knee is straight).  The knee stops' power is a term of the
-ledger of its own (:data:`KNEE_WORK_NAMES`); a kneed walker takes hip torques alone (no
-push-off yet).
+ledger of its own (:data:`KNEE_WORK_NAMES`).
 
 On a flat-footed walker (floating coordinates ``hip_x, hip_y, leg1_angle, leg2_angle,
 leg1_foot_angle, leg2_foot_angle``) the hip torque acts between the two legs as on point
@@ -26,12 +25,25 @@ feet: ``+tau`` on the swing leg's absolute angle, ``-tau`` on the stance leg's, 
 (hinged at the ankles, on their springs) get nothing; its power is ``tau (dtheta_swing -
 dtheta_stance)``.  The ledger (:data:`FLAT_HIP_WORK_NAMES`) carries the torque's positive
 and negative work, the ankle dampers' and the contact forces' (the ankle springs' energy is
-the walker's potential energy).  Flat feet take hip torques or an ankle push-off, one of the
-two.
+the walker's potential energy).  An ankle push-off and a push-off may come with them.
+
+Any joint
+---------
+Every coordinate of the floating view but the hip's position is a link's absolute angle
+(a bisecting torso's angle is the legs' mean, of the thighs' on knees), so a torque at any
+joint of :data:`walkerlab.config.actuation.JOINTS` (the hip; ``stance_hip`` / ``swing_hip``
+torso to leg; ``stance_knee`` / ``swing_knee``; ``stance_ankle`` / ``swing_ankle``) has the
+constant generalised force ``B tau``: ``+1`` on its second link's coordinate, ``-1`` on its
+first's (``1/2`` on each leg for a bisecting torso), read per stance leg; its joint angle
+``B^T q`` and the phase variable (the stance leg's angle, a kneed walker's stance thigh's:
+the rigid view's) go into the same laws
+(:meth:`walkerlab.models.actuation.TorqueLaws.each`); its power is ``tau . B^T dq``.
 
 Push-off
 --------
-The rigid model's push-off is an impulse ``P`` at the trailing foot along the trailing leg
+The rigid model's push-off is an impulse ``P`` at the trailing foot's contact point (a point
+foot; an arc foot's material point at its rolling contact; a flat foot's toe, the ankle
+held: :meth:`PushOffPulse.push_off_force`) along the line from it to the hip
 (from the foot towards the hip) immediately before heel strike, the trailing foot free for it
 (Kuo 2002; its work is the kinetic energy it adds).  Here it is a pulse: a constant force
 ``(P / T) e`` at the trailing foot for ``T = contact.push_off_duration_s``, ending at the
@@ -75,7 +87,7 @@ import numpy as np
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
 __all__ = ["ANKLE_WORK_NAMES", "FLAT_HIP_WORK_NAMES", "KNEE_WORK_NAMES", "WORK_NAMES",
-           "ContactActuators", "ContactRows", "powered_rhs"]
+           "ContactActuators", "ContactRows", "PushOffPulse", "powered_rhs"]
 
 
 class ContactRows:
@@ -162,10 +174,30 @@ class PushOffPulse:
 
     def push_off_force(self, walker, x, trailing: int, force: float):
         """Generalised force (nq,) of a force ``force`` [N] at leg ``trailing``'s push-off
-        point along the line to the hip, and its power [W]."""
+        point along the line to the hip, and its power [W].
+
+        On a flat foot the ankle holds through the push-off, as in the rigid view
+        (:class:`walkerlab.models.hybrid.push_off.FlatPushOff`: a massless foot passes a
+        push off its ankle's line only with an ankle torque; the joint holds): the force at
+        the toe comes with the ankle torque ``lam`` (``+lam`` on the foot, ``-lam`` on the
+        leg) that leaves the ankle's angular acceleration from them at 0, ``a M^-1 (J^T F +
+        a lam) = 0`` with ``a = d(ankle)/dq``; the power is ``F . v_toe + lam d(ankle)/dt``
+        (``Q . dq``).  Without it the pulse would spin the light (regularising) foot about
+        its ankle and reach the legs only through the toe's lift-off."""
         e, J, v = self.push_direction(walker, x, trailing)
         F = force * e
-        return J.T @ F, float(F @ v)
+        Q = J.T @ F
+        foot = getattr(self, "foot", None)
+        if foot is None:
+            return Q, float(F @ v)
+        n = self.nq
+        a = np.zeros(n)
+        a[foot[trailing]], a[self.ankle_leg[trailing]] = 1.0, -1.0
+        M = walker.mass_matrix(x)
+        Ma = np.linalg.solve(M, a)
+        lam = -float(Ma @ Q) / float(a @ Ma)  # a M^-1 Q = Ma . Q (M symmetric)
+        Q = Q + lam * a
+        return Q, float(F @ v) + lam * float(a @ np.asarray(x, float)[n:])
 
 
 class ContactActuators(PushOffPulse, ContactRows):
