@@ -14,7 +14,7 @@ import pytest
 from walkerlab.api.scenes import with_changes
 from walkerlab.config import load_scene
 from walkerlab.models.contact.actuation import KNEE_WORK_NAMES, powered_rhs
-from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+from walkerlab.models.contact.scene import contact_setup
 
 CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 #: a small constant hip torque with a damper on the hip angle's rate [N m, N m s/rad]
@@ -78,11 +78,12 @@ def test_the_kneed_ledger_closes_with_the_knee_stop_term(gait):
     assert w["push_off"] == 0.0 and w["contact"] < 0.0 and w["knee_stop"] < 0.0
 
 
-def test_kneed_refusals_are_one_line():
-    with pytest.raises(ContactSceneError, match="kneed walker takes hip torques alone"):
-        contact_setup(_scene(**{"walker.actuation.push_off": {"impulse_n_s": 0.1}}))
-    with pytest.raises(ContactSceneError, match="powered kneed walker's contact periodic"):
-        contact_setup(_scene(**{"contact_sim.periodic_gait": True}))
+def test_a_kneed_walker_takes_a_push_off_and_the_periodic_gait():
+    """A push-off on knees and the contact periodic gait (refused before issue 48's
+    contact actuation) are carried."""
+    assert contact_setup(_scene(**{"walker.actuation.push_off": {"impulse_n_s": 0.1}})
+                         ).actuators.spec.push_off is not None
+    assert contact_setup(_scene(**{"contact_sim.periodic_gait": True})).actuators is not None
 
 
 def test_the_kneed_optimums_contact_replay_keeps_its_period(gait):

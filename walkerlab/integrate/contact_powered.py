@@ -192,7 +192,7 @@ def pulse_lead_s(acts) -> float:
     """How long [s] before the predicted touchdown the push-off pulse starts: the pulse's
     duration for a walker with a push-off impulse and a pulse, else 0 (no pulse event)."""
     spec = getattr(acts, "spec", None)
-    if getattr(spec, "push_off", None) is None or getattr(acts, "ankle", None) is not None:
+    if getattr(spec, "push_off", None) is None:
         return 0.0
     return float(acts.pulse_s)
 
@@ -379,15 +379,17 @@ class ActuationHook:
         if sol.t_events[0].size:  # a fall
             self._fell(sol)
             return "end"
-        if watch and sol.t_events[2].size:  # heel off: the ankle push-off starts
+        ilead = 3 if watch else 2  # the pulse event's index (after heel off's)
+        if watch and sol.t_events[2].size and not (arm and sol.t_events[3].size):
+            # heel off: the ankle push-off starts
             self.t, self.y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
             self._keep(sol, self.t)
             self.ankle_on = True
             return "go"
-        if arm and sol.t_events[2].size and not sol.t_events[1].size:
+        if arm and sol.t_events[ilead].size and not sol.t_events[1].size:
             # the pulse starts pulse_s before the predicted touchdown, at the stance
             # (trailing) foot, its impulse from the hip speed here (the pre-impact one)
-            t, y = float(sol.t_events[2][0]), sol.y_events[2][0].copy()
+            t, y = float(sol.t_events[ilead][0]), sol.y_events[ilead][0].copy()
             self._keep(sol, t)
             self.t, self.y = t, y
             self.pushed = True
@@ -419,7 +421,7 @@ class ActuationHook:
         self.t, self.y = t, y
         trailing = self.stance
         self._strike(t)
-        P = acts.impulse(y[:n]) if acts.ankle is None and not self.pushed else 0.0
+        P = acts.impulse(y[:n]) if not self.pushed else 0.0
         self.pushed = False
         if P > 0.0 and acts.pulse_s == 0.0:
             y[:n], w = impulse_jump(self.walker, y[:n], trailing, P)

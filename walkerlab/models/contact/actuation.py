@@ -17,8 +17,7 @@ thighs: ``+tau`` on the swing thigh's absolute angle, ``-tau`` on the stance thi
 shanks and knees get nothing; its power is ``tau (dtheta_swing_thigh -
 dtheta_stance_thigh)`` and its phase variable the stance thigh's angle (the rigid view's
 stance angle while the stance knee is straight).  The knee stops' power is a term of the
-ledger of its own (:data:`KNEE_WORK_NAMES`); a kneed walker takes hip torques alone (no
-push-off yet).
+ledger of its own (:data:`KNEE_WORK_NAMES`).
 
 On a flat-footed walker (floating coordinates ``hip_x, hip_y, leg1_angle, leg2_angle,
 leg1_foot_angle, leg2_foot_angle``) the hip torque acts between the two legs as on point
@@ -26,12 +25,25 @@ feet: ``+tau`` on the swing leg's absolute angle, ``-tau`` on the stance leg's, 
 (hinged at the ankles, on their springs) get nothing; its power is ``tau (dtheta_swing -
 dtheta_stance)``.  The ledger (:data:`FLAT_HIP_WORK_NAMES`) carries the torque's positive
 and negative work, the ankle dampers' and the contact forces' (the ankle springs' energy is
-the walker's potential energy).  Flat feet take hip torques or an ankle push-off, one of the
-two.
+the walker's potential energy).  An ankle push-off and a push-off may come with them.
+
+Any joint
+---------
+Every coordinate of the floating view but the hip's position is a link's absolute angle
+(a bisecting torso's angle is the legs' mean, of the thighs' on knees), so a torque at any
+joint of :data:`walkerlab.config.actuation.JOINTS` (the hip; ``stance_hip`` / ``swing_hip``
+torso to leg; ``stance_knee`` / ``swing_knee``; ``stance_ankle`` / ``swing_ankle``) has the
+constant generalised force ``B tau``: ``+1`` on its second link's coordinate, ``-1`` on its
+first's (``1/2`` on each leg for a bisecting torso), read per stance leg; its joint angle
+``B^T q`` and the phase variable (the stance leg's angle, a kneed walker's stance thigh's:
+the rigid view's) go into the same laws
+(:meth:`walkerlab.models.actuation.TorqueLaws.each`); its power is ``tau . B^T dq``.
 
 Push-off
 --------
-The rigid model's push-off is an impulse ``P`` at the trailing foot along the trailing leg
+The rigid model's push-off is an impulse ``P`` at the trailing foot's contact point (a point
+foot; an arc foot's material point at its rolling contact; a flat foot's toe, the ankle
+held: :meth:`PushOffPulse.push_off_force`) along the line from it to the hip
 (from the foot towards the hip) immediately before heel strike, the trailing foot free for it
 (Kuo 2002; its work is the kinetic energy it adds).  Here it is a pulse: a constant force
 ``(P / T) e`` at the trailing foot for ``T = contact.push_off_duration_s``, ending at the
@@ -75,7 +87,7 @@ import numpy as np
 from walkerlab.models.actuation import TorqueLaws, push_off_impulse
 
 __all__ = ["ANKLE_WORK_NAMES", "FLAT_HIP_WORK_NAMES", "KNEE_WORK_NAMES", "WORK_NAMES",
-           "ContactActuators", "ContactRows", "powered_rhs"]
+           "ContactActuators", "ContactRows", "PushOffPulse", "powered_rhs"]
 
 
 class ContactRows:
@@ -120,10 +132,80 @@ class ContactRows:
         return out
 
 
-class ContactActuators(ContactRows):
-    """The actuators of one contact walker (straight legs; point feet, or flat feet with an
-    ankle push-off or hip torques; or a hip torque between the thighs of a kneed walker with
-    point feet).
+class PushOffPulse:
+    """The push-off pulse of a contact walker's actuators, shared by every kind (a mixin:
+    the owner sets ``spec``, ``nq``, ``hip``, ``pulse_s``).
+
+    The pulse acts at the trailing foot's contact point (:meth:`push_row`): a point foot's
+    point, an arc foot's material point at its rolling contact (the generated ``feet``
+    gives that point's velocity and Jacobian), a flat foot's toe; along the line from that
+    point to the hip."""
+
+    _push_rows = None  # the contact-table row of each leg's push-off point, on first use
+
+    def push_row(self, walker, leg: int) -> int:
+        """Row of ``walker.contact_names()`` where leg ``leg`` (0: leg1, 1: leg2) pushes off:
+        ``leg{i}`` (point and arc feet) or ``leg{i}_toe`` (flat feet)."""
+        if self._push_rows is None:
+            names = tuple(walker.contact_names())
+            self._push_rows = tuple(
+                names.index(f"leg{i}_toe") if f"leg{i}_toe" in names else names.index(f"leg{i}")
+                for i in (1, 2))
+        return self._push_rows[leg]
+
+    def impulse(self, x) -> float:
+        """Push-off impulse ``P`` [N s] for the state ``x`` where the pulse starts (its hip
+        speed)."""
+        n = self.nq
+        return float(push_off_impulse(self.spec.push_off, np.hypot(x[n], x[n + 1])))
+
+    def push_direction(self, walker, x, trailing: int):
+        """``(e, J, v)``: the unit vector (2,) from leg ``trailing``'s push-off point
+        (:meth:`push_row`) towards the hip (the push-off's direction), that point's Jacobian
+        (2, nq) and velocity (2,) [m/s]."""
+        n = self.nq
+        nf = len(walker.contact_names())
+        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
+        x = np.asarray(x, float)
+        walker.kernels.feet(x, walker.walker_params, P, V, J)
+        k = self.push_row(walker, trailing)
+        r = x[list(self.hip)] - P[k]  # the hip is the floating base's point
+        return r / np.sqrt(r @ r), J[k], V[k]
+
+    def push_off_force(self, walker, x, trailing: int, force: float):
+        """Generalised force (nq,) of a force ``force`` [N] at leg ``trailing``'s push-off
+        point along the line to the hip, and its power [W].
+
+        On a flat foot the ankle holds through the push-off, as in the rigid view
+        (:class:`walkerlab.models.hybrid.push_off.FlatPushOff`: a massless foot passes a
+        push off its ankle's line only with an ankle torque; the joint holds): the force at
+        the toe comes with the ankle torque ``lam`` (``+lam`` on the foot, ``-lam`` on the
+        leg) that leaves the ankle's angular acceleration from them at 0, ``a M^-1 (J^T F +
+        a lam) = 0`` with ``a = d(ankle)/dq``; the power is ``F . v_toe + lam d(ankle)/dt``
+        (``Q . dq``).  Without it the pulse would spin the light (regularising) foot about
+        its ankle and reach the legs only through the toe's lift-off."""
+        e, J, v = self.push_direction(walker, x, trailing)
+        F = force * e
+        Q = J.T @ F
+        foot = getattr(self, "foot", None)
+        if foot is None:
+            return Q, float(F @ v)
+        n = self.nq
+        a = np.zeros(n)
+        a[foot[trailing]], a[self.ankle_leg[trailing]] = 1.0, -1.0
+        M = walker.mass_matrix(x)
+        Ma = np.linalg.solve(M, a)
+        lam = -float(Ma @ Q) / float(a @ Ma)  # a M^-1 Q = Ma . Q (M symmetric)
+        Q = Q + lam * a
+        return Q, float(F @ v) + lam * float(a @ np.asarray(x, float)[n:])
+
+
+class ContactActuators(PushOffPulse, ContactRows):
+    """The actuators of one contact walker whose floating coordinates are its links'
+    absolute angles (straight or kneed legs; point, arc or flat feet; a bisecting torso):
+    joint torques at any of its joints, a push-off pulse, a flat foot's ankle push-off
+    (module docstring).  A free-jointed biped has
+    :class:`walkerlab.models.contact.joint_torques.JointTorqueActuators`.
 
     Parameters
     ----------
@@ -134,43 +216,43 @@ class ContactActuators(ContactRows):
         leg{i}_shank_angle`` in place of ``leg{i}_angle``).
     pulse_s : float
         Push-off pulse duration [s] (0: an impulse).
+    torso : bool
+        The walker has a torso bisecting the legs (its angle the mean of the legs', of the
+        thighs' on knees: the rigid view's).
 
     Raises
     ------
     ValueError
-        The walker's legs are not two straight legs with point feet, or flat feet with an
-        ankle push-off or hip torques (not both, no push-off impulse), or kneed legs with
-        point feet and hip torques alone (one line).
+        An ankle push-off on feet that are not flat, a joint the walker does not have
+        (naming ``walker.actuation.torques.<i>.joint`` and the joints it has), a torque per
+        foot mass (one line).
     """
 
     #: A touchdown is a heel strike only this far [m] ahead of the stance foot (a scuff
     #: near mid-stance is not one; the contact gait analysis' ``min_step_m`` default).
     min_step_m = 0.05
 
-    def __init__(self, spec, coordinates, pulse_s: float):
+    def __init__(self, spec, coordinates, pulse_s: float, torso: bool = False):
+        from walkerlab.models.hybrid.actuators import joint_links
+
         names = tuple(coordinates)
         #: a kneed walker: the hip torque acts on the thighs (module docstring)
         self.knee = "leg1_thigh_angle" in names
-        if self.knee and (spec.push_off is not None
-                          or getattr(spec, "ankle_push_off", None) is not None
-                          or "leg1_foot_angle" in names
-                          or any(t.joint != "hip" for t in spec.torques)):
-            raise ValueError("walker.actuation: a kneed walker takes hip torques alone on "
-                             "point feet in the contact view (push-off: not yet)")
         leg = ("leg1_thigh_angle", "leg2_thigh_angle") if self.knee else ("leg1_angle",
                                                                             "leg2_angle")
         if leg[0] not in names or leg[1] not in names:
-            raise ValueError("walker.actuation: the contact view carries actuators on "
-                             "straight legs (point or flat feet) or kneed legs with point "
-                             "feet only")
+            raise ValueError("walker.actuation: the contact view carries these actuators on "
+                             "walkers whose coordinates are their links' angles (a "
+                             "free-jointed biped has its own)")
         flat = "leg1_foot_angle" in names
         ankle = getattr(spec, "ankle_push_off", None)
-        if flat and (spec.push_off is not None or (ankle is None) == (not spec.torques)
-                     or any(t.joint != "hip" for t in spec.torques)):
-            raise ValueError("walker.actuation: flat feet take ankle_push_off or hip torques "
-                             "(one of the two, no push_off) in the contact view")
         if ankle is not None and not flat:
             raise ValueError("walker.actuation.ankle_push_off: flat feet only")
+        for i, t in enumerate(spec.torques):
+            if t.scaled_by != "none":
+                raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
+                                 "walkers whose legs are massless (the contact view has "
+                                 "massive legs)")
         self.ankle = ankle
         self._dampers = None  # the walker's dampers, looked up on first use
         self.foot = ((names.index("leg1_foot_angle"), names.index("leg2_foot_angle"))
@@ -180,9 +262,45 @@ class ContactActuators(ContactRows):
         self.pulse_s = float(pulse_s)
         #: each leg's angle column (a kneed walker's: its thigh's)
         self.leg = (names.index(leg[0]), names.index(leg[1]))
+        #: the link an ankle joins to its foot (a kneed walker's shank)
+        self.ankle_leg = ((names.index("leg1_shank_angle"), names.index("leg2_shank_angle"))
+                          if self.knee else self.leg)
         #: the hip's position columns (the floating base: the hip point itself)
         self.hip = (names.index("hip_x"), names.index("hip_y"))
         self.laws = TorqueLaws(spec.torques)
+        #: every torque at the hip between the legs (the arithmetic of a single hip torque)
+        self.hip_only = all(t.joint == "hip" for t in spec.torques)
+        # per stance leg (0: leg1, 1: leg2): B (nq, k), +1 on each torque's second link's
+        # column, -1 on its first's (a bisecting torso: 1/2 on each leg)
+        self.B = []
+        for stance in (0, 1):
+            links = self._links(names, stance, torso)
+            pairs = [joint_links(links, t.joint, f"walker.actuation.torques.{i}.joint")
+                     for i, t in enumerate(spec.torques)]
+            B = np.zeros((self.nq, len(pairs)))
+            for k, (first, second) in enumerate(pairs):
+                for col, w in links[second]:
+                    B[col, k] += w
+                for col, w in links[first]:
+                    B[col, k] -= w
+            self.B.append(B)
+
+    def _links(self, names, stance: int, torso: bool) -> dict:
+        """``{link role: [(column, weight), ...]}`` with leg ``stance`` in stance: the
+        link's absolute angle as a weighted sum of coordinates."""
+        legs = {"stance": f"leg{stance + 1}", "swing": f"leg{2 - stance}"}
+        out = {}
+        for role, lg in legs.items():
+            if self.knee:
+                out[f"{role}_thigh"] = [(names.index(f"{lg}_thigh_angle"), 1.0)]
+                out[f"{role}_shank"] = [(names.index(f"{lg}_shank_angle"), 1.0)]
+            else:
+                out[role] = [(names.index(f"{lg}_angle"), 1.0)]
+            if self.foot is not None:
+                out[f"{role}_foot"] = [(names.index(f"{lg}_foot_angle"), 1.0)]
+        if torso:
+            out["torso"] = [(self.leg[0], 0.5), (self.leg[1], 0.5)]
+        return out
 
     def hip_angles(self, x, stance: int):
         """``(delta, ddelta, s, ds)`` with leg ``stance`` (0: leg1, 1: leg2) in stance:
@@ -192,12 +310,32 @@ class ContactActuators(ContactRows):
         i_sw, i_st = self.leg[1 - stance], self.leg[stance]
         return (x[i_sw] - x[i_st], x[n + i_sw] - x[n + i_st], x[i_st], x[n + i_st])
 
+    def joint_angles(self, x, stance: int):
+        """``(deltas (k,), ddeltas (k,), s, ds)``: each torque's joint angle [rad] and rate
+        [rad/s], ``angle(second) - angle(first)``, and the phase variable (the stance leg's
+        angle; a kneed walker's stance thigh's: the rigid view's) and its rate."""
+        n = self.nq
+        B, i_st = self.B[stance], self.leg[stance]
+        return B.T @ x[:n], B.T @ x[n:], x[i_st], x[n + i_st]
+
+    def torques(self, x, stance: int, t_step: float = 0.0) -> np.ndarray:
+        """Each actuator's torque (k,) [N m] (``walker.actuation.torques`` order)."""
+        x = np.asarray(x, float)
+        if self.hip_only:
+            return self.laws(*self.hip_angles(x, stance), t_step)
+        return self.laws.each(*self.joint_angles(x, stance), t_step)
+
     def hip_torque(self, x, stance: int, t_step: float = 0.0) -> tuple[np.ndarray, float]:
-        """Generalised force of the hip torques (nq,) [N, N m] and their power [W];
-        ``t_step`` the time since the step's heel strike [s] (``time_reference`` laws)."""
+        """Generalised force of the joint torques (nq,) [N, N m] and their power [W];
+        ``t_step`` the time since the step's heel strike [s] (``time_reference`` laws).
+        (The name is historical: every joint's torque is here.)"""
         Q = np.zeros(self.nq)
         if not self.laws:
             return Q, 0.0
+        if not self.hip_only:
+            deltas, ddeltas, s, ds = self.joint_angles(x, stance)
+            tau = self.laws.each(deltas, ddeltas, s, ds, t_step)
+            return self.B[stance] @ tau, float(tau @ ddeltas)
         delta, ddelta, s, ds = self.hip_angles(x, stance)
         tau = float(np.sum(self.laws(delta, ddelta, s, ds, t_step)))
         Q[self.leg[1 - stance]] += tau
@@ -206,20 +344,29 @@ class ContactActuators(ContactRows):
 
     @property
     def work_names(self) -> tuple[str, ...]:
-        """Names of the work integrals this walker's run carries (:data:`WORK_NAMES`;
-        :data:`ANKLE_WORK_NAMES` for an ankle push-off, :data:`FLAT_HIP_WORK_NAMES` for hip
-        torques on flat feet, :data:`KNEE_WORK_NAMES` for knees)."""
-        if self.knee:
-            return KNEE_WORK_NAMES
+        """Names of the work integrals this walker's run carries: point and arc feet
+        :data:`WORK_NAMES` (knees: :data:`KNEE_WORK_NAMES`); flat feet the ankle push-off's
+        positive and negative work (with one), the joint torques' (with some, or neither),
+        the push-off's (with one), the dampers', the contact forces' (an ankle push-off
+        alone: :data:`ANKLE_WORK_NAMES`; hip torques alone :data:`FLAT_HIP_WORK_NAMES`),
+        the knee stops' last on knees."""
+        knee = ("knee_stop",) if self.knee else ()
+        if self.foot is None:
+            return WORK_NAMES + knee
+        names = ()
         if self.ankle is not None:
-            return ANKLE_WORK_NAMES
-        return WORK_NAMES if self.foot is None else FLAT_HIP_WORK_NAMES
+            names += ANKLE_WORK_NAMES[:2]
+        if self.spec.torques or self.ankle is None:
+            names += WORK_NAMES[:2]
+        if self.spec.push_off is not None:
+            names += ("push_off",)
+        return names + ("damper", "contact") + knee
 
     def ankle_torque(self, x, stance: int) -> tuple[np.ndarray, float]:
         """Generalised force (nq,) of the ankle push-off at leg ``stance``'s ankle (0: leg1,
         1: leg2) and its power [W] (module docstring)."""
         n = self.nq
-        i_f, i_l = self.foot[stance], self.leg[stance]
+        i_f, i_l = self.foot[stance], self.ankle_leg[stance]
         po = self.ankle
         a = x[i_f] - x[i_l]
         tau = -po.stiffness_n_m_per_rad * (a - po.rest_angle_rad) - po.constant_n_m
@@ -239,20 +386,15 @@ class ContactActuators(ContactRows):
                              sum(float(p[f"c_s{i}"])
                                  for i in range(len(walker.data.structure.springs))))
         c_a, c_s = self._dampers
-        r1 = x[n + self.foot[0]] - x[n + self.leg[0]]
-        r2 = x[n + self.foot[1]] - x[n + self.leg[1]]
+        r1 = x[n + self.foot[0]] - x[n + self.ankle_leg[0]]
+        r2 = x[n + self.foot[1]] - x[n + self.ankle_leg[1]]
         hip = x[n + self.leg[1]] - x[n + self.leg[0]]
         return float(-c_a * (r1 * r1 + r2 * r2) - c_s * hip * hip)
 
-    def impulse(self, x) -> float:
-        """Push-off impulse ``P`` [N s] for the state ``x`` where the pulse starts (its hip
-        speed)."""
-        n = self.nq
-        return float(push_off_impulse(self.spec.push_off, np.hypot(x[n], x[n + 1])))
-
     def compiled_rhs(self, walker):
         """The compiled right-hand side of :func:`powered_rhs` for this walker, or None
-        where it has none (knees, flat feet: those run on :func:`powered_rhs`).
+        where it has none (knees, flat feet, torques at joints other than the hip: those
+        run on :func:`powered_rhs`).
 
         Returns
         -------
@@ -263,7 +405,8 @@ class ContactActuators(ContactRows):
             evaluated here when there are any: they may be any callable).
         """
         kern = getattr(walker.kernels, "powered_rhs", None)
-        if kern is None or self.knee or self.foot is not None or self.ankle is not None:
+        if (kern is None or self.knee or self.foot is not None or self.ankle is not None
+                or not self.hip_only):
             return None
         args = walker._args()
         nx = 2 * self.nq
@@ -278,28 +421,10 @@ class ContactActuators(ContactRows):
                 tau = float(np.sum(laws(delta, ddelta, s, ds, t_step)))
             out = np.empty(nx + 4)
             kern(x, *args, bool(laws), self.leg[1 - stance], self.leg[stance], tau,
-                 -1 if push is None else int(push[0]), 0.0 if push is None else float(push[1]),
-                 hx, hy, out)
+                 -1 if push is None else self.push_row(walker, int(push[0])),
+                 0.0 if push is None else float(push[1]), hx, hy, out)
             return out
         return f
-
-    def push_direction(self, walker, x, trailing: int):
-        """``(e, J, v)``: the unit vector (2,) from leg ``trailing``'s foot towards the hip
-        (the push-off's direction), that foot's Jacobian (2, nq) and velocity (2,) [m/s]."""
-        n = self.nq
-        nf = len(walker.contact_names())
-        P, V, J = np.empty((nf, 2)), np.empty((nf, 2)), np.empty((nf, 2, n))
-        x = np.asarray(x, float)
-        walker.kernels.feet(x, walker.walker_params, P, V, J)
-        r = x[list(self.hip)] - P[trailing]  # the hip is the floating base's point
-        return r / np.sqrt(r @ r), J[trailing], V[trailing]
-
-    def push_off_force(self, walker, x, trailing: int, force: float):
-        """Generalised force (nq,) of a force ``force`` [N] at leg ``trailing``'s foot
-        along that leg towards the hip, and its power [W]."""
-        e, J, v = self.push_direction(walker, x, trailing)
-        F = force * e
-        return J.T @ F, float(F @ v)
 
 
 #: Names of the work integrals a powered contact run carries beside the state [J].
@@ -348,19 +473,9 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
     dx = np.array(walker.rhs(0.0, x), float)
     p_contact = float(np.sum(walker.kernels.contact_table(
         np.ascontiguousarray(x[None], dtype=float), *walker._args())[0, :, 6]))
-    if acts.ankle is not None:
-        p_tau = 0.0
-        if ankle:
-            Q, p_tau = acts.ankle_torque(x, stance)
-            dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
-        return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0),
-                             acts.damper_power(walker, x), p_contact])
+    if getattr(acts, "foot", None) is not None:  # flat feet: the ankle dampers' term
+        return _flat_rhs(walker, acts, x, dx, p_contact, stance, push, t_step, ankle)
     Q, p_tau = acts.hip_torque(x, stance, t_step)
-    if acts.foot is not None:  # hip torques on flat feet: no push-off, the ankle dampers
-        if np.any(Q):
-            dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
-        return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0),
-                             acts.damper_power(walker, x), p_contact])
     p_po = 0.0
     if push is not None:
         Qp, p_po = acts.push_off_force(walker, x, push[0], push[1])
@@ -368,7 +483,43 @@ def powered_rhs(walker, x, stance: int, push: tuple[int, float] | None = None,
     if np.any(Q):
         dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
     if acts.knee:
-        p_knee = float(np.sum(walker.kernels.knee_table(
-            np.ascontiguousarray(x[None], dtype=float), *walker._args())[0, :, 3]))
-        return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact, p_knee])
+        return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact,
+                             _knee_power(walker, x)])
     return dx, np.array([max(p_tau, 0.0), min(p_tau, 0.0), p_po, p_contact])
+
+
+def _knee_power(walker, x) -> float:
+    """The knee stops' power [W] at the state ``x``."""
+    return float(np.sum(walker.kernels.knee_table(
+        np.ascontiguousarray(x[None], dtype=float), *walker._args())[0, :, 3]))
+
+
+def _flat_rhs(walker, acts, x, dx, p_contact, stance, push, t_step, ankle):
+    """:func:`powered_rhs` of a flat-footed walker: the ankle push-off (while ``ankle``),
+    the joint torques, the push-off pulse at the trailing toe; powers in the order of
+    ``acts.work_names``."""
+    n = walker.nq
+    powers = []
+    Q = None
+    if acts.ankle is not None:
+        p_a = 0.0
+        if ankle:
+            Q, p_a = acts.ankle_torque(x, stance)
+        powers += [max(p_a, 0.0), min(p_a, 0.0)]
+    if acts.spec.torques or acts.ankle is None:
+        Qt, p_tau = acts.hip_torque(x, stance, t_step)
+        if acts.spec.torques:
+            Q = Qt if Q is None else Q + Qt
+        powers += [max(p_tau, 0.0), min(p_tau, 0.0)]
+    if acts.spec.push_off is not None:
+        p_po = 0.0
+        if push is not None:
+            Qp, p_po = acts.push_off_force(walker, x, push[0], push[1])
+            Q = Qp if Q is None else Q + Qp
+        powers.append(p_po)
+    if Q is not None and np.any(Q):
+        dx[n:] += np.linalg.solve(walker.mass_matrix(x), Q)
+    powers += [acts.damper_power(walker, x), p_contact]
+    if acts.knee:
+        powers.append(_knee_power(walker, x))
+    return dx, np.array(powers)

@@ -33,19 +33,20 @@ switches it at that touchdown: the heel strike; the joints' roles swap with it, 
 ``swing_knee`` is the knee of the leg that swings now).  The time-based laws count from that
 touchdown.
 
-No push-off on these walkers (the rigid view refuses it too).
+A push-off is the pulse of :class:`~walkerlab.models.contact.actuation.PushOffPulse` at the
+trailing foot, along the line from it to the hip (the rigid view's impulse, Kuo 2002).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.models.contact.actuation import WORK_NAMES, ContactRows
+from walkerlab.models.contact.actuation import WORK_NAMES, ContactRows, PushOffPulse
 
 __all__ = ["JointTorqueActuators"]
 
 
-class JointTorqueActuators(ContactRows):
+class JointTorqueActuators(PushOffPulse, ContactRows):
     """The joint torques of one free-jointed contact walker (the interface of
     :class:`walkerlab.models.contact.actuation.ContactActuators` that
     :func:`~walkerlab.models.contact.actuation.powered_rhs` and
@@ -59,19 +60,20 @@ class JointTorqueActuators(ContactRows):
         Joint torques only.
     coordinates : tuple of str
         The floating coordinates (:func:`walkerlab.codegen.floating.coordinate_names`).
+    pulse_s : float
+        Push-off pulse duration [s] (0: an impulse; :class:`~walkerlab.models.contact.
+        actuation.PushOffPulse`, at the trailing foot along the line to the hip).
 
     Raises
     ------
     ValueError
-        A push-off, or a joint the walker lacks (one line, naming the field; the rigid view's
+        A joint the walker lacks (one line, naming the field; the rigid view's
         :func:`~walkerlab.models.hybrid.free_joint_actuators.five_link_actuators`).
     """
 
     #: A touchdown is a heel strike only this far [m] ahead of the stance foot (as
     #: :attr:`ContactActuators.min_step_m`).
     min_step_m = 0.05
-    #: No push-off pulse (refused on these walkers).
-    pulse_s = 0.0
     #: No ankle push-off (point feet).
     ankle = None
     #: Free knees: no knee stop, no knee-stop term in the ledger.
@@ -82,14 +84,17 @@ class JointTorqueActuators(ContactRows):
     #: the hip-torque names carry every joint torque's work).
     work_names = WORK_NAMES
 
-    def __init__(self, data, spec, coordinates):
+    def __init__(self, data, spec, coordinates, pulse_s: float = 0.0):
         from walkerlab.models.hybrid.free_joint_actuators import five_link_actuators
 
         self.spec = spec
         roles = tuple(data.structure.roles)
-        self.rigid = five_link_actuators(data, spec, roles)
+        self.rigid = five_link_actuators(data, spec, roles, push_off=True)
         names = tuple(coordinates)
         self.nq = len(names)
+        self.pulse_s = float(pulse_s)
+        #: the hip's position columns (the floating base: the hip point itself)
+        self.hip = (names.index("hip_x"), names.index("hip_y"))
         # floating index of each role, per stance leg (0: leg1, 1: leg2)
         self.index = []
         for stance in (0, 1):
@@ -122,6 +127,3 @@ class JointTorqueActuators(ContactRows):
         i = self.index[stance]
         return Q, float(Qr @ x[self.nq + i])
 
-    def impulse(self, x) -> float:
-        """Push-off impulse [N s]: none on these walkers."""
-        return 0.0

@@ -158,9 +158,9 @@ def contact_setup(scene: Scene) -> ContactSetup:
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, a walker with actuators the contact view does not carry
-        (knees, arc feet, a torso on knees or flat feet; a pinned or non-ideal start), a
-        walker with a massless body, flat feet without
+        No ``contact`` section, actuators with a pinned or non-ideal start (or a time law
+        with the contact periodic gait), a joint the walker does not have, a walker with a
+        massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, a pinned stance foot
         that is not a point, or a ground the contact model does not build (a height profile,
         footholds of several heights, footholds on continuous ground) (one line).
@@ -221,18 +221,7 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
     from walkerlab.codegen.floating import coordinate_names
 
     st = data.structure
-    five_link = st.free_knees and st.foot == "point"
-    flat = st.foot == "flat" and not st.knee
-    kneed = st.knee and not five_link and st.foot == "point"
-    if not five_link and ((st.knee and not kneed) or (st.torso and (st.knee or flat))
-                          or not (st.foot == "point" or flat)):
-        raise ContactSceneError(f"scene '{scene.name}': walker.actuation: the contact view "
-                                "carries actuators on straight legs with point feet (an upper "
-                                "body on a bisecting hip too), a hip torque on kneed legs with "
-                                "point feet, an ankle push-off or a hip torque on flat feet, "
-                                "and joint torques on "
-                                "free-jointed (five-link) bipeds, only (the rigid view has "
-                                "them too)")
+    five_link = st.free_knees
     if cs.pin_stance_until != "none":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: the "
                                 "pinned start phase carries no actuators: leave it 'none'")
@@ -246,23 +235,18 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
             raise ContactSceneError(f"scene '{scene.name}': walker.actuation: a torque law on "
                                     "time since the heel strike has no contact periodic gait "
                                     "(contact_sim.start / periodic_gait): use a phase law")
-    flat_hip = flat and bool(spec.torques)
-    if (five_link or kneed or flat_hip) and (cs.start == "periodic_gait" or cs.periodic_gait):
-        kind = ("five-link biped" if five_link else "powered kneed walker" if kneed
-                else "flat-footed walker with hip torques")
-        raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: a {kind}'s "
-                                "contact periodic gait is not found yet: start it from the "
-                                "rigid gait (start: ideal, periodic_gait: false)")
-    if five_link:  # joint torques at the hips and knees (the rigid view's laws)
-        try:
-            return JointTorqueActuators(data, spec, coordinate_names(st))
-        except ValueError as err:
-            raise ContactSceneError(f"scene '{scene.name}': {err}") from None
+        if getattr(spec, "ankle_push_off", None) is not None:
+            raise ContactSceneError(f"scene '{scene.name}': contact_sim.start: the contact "
+                                    "periodic gait's step map does not switch an ankle "
+                                    "push-off on at heel off: start from the rigid gait "
+                                    "(start: ideal, periodic_gait: false)")
+    pulse = scene.contact.push_off_pulse_s()
     try:
-        return ContactActuators(spec, coordinate_names(st), scene.contact.push_off_pulse_s())
+        if five_link:  # joint torques at the hips and knees (the rigid view's laws)
+            return JointTorqueActuators(data, spec, coordinate_names(st), pulse)
+        return ContactActuators(spec, coordinate_names(st), pulse,
+                                torso=bool(st.torso) and not st.hinged_torso)
     except ValueError as err:
-        if not (kneed or flat):
-            raise
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
 
 
@@ -290,9 +274,9 @@ def build(scene: Scene, x_ideal: np.ndarray, n_steps: int, step_length_m: float 
     Raises
     ------
     ContactSceneError
-        No ``contact`` section, a walker with actuators the contact view does not carry
-        (knees, arc feet, a torso on knees or flat feet; a pinned or non-ideal start), a
-        walker with a massless body, flat feet without
+        No ``contact`` section, actuators with a pinned or non-ideal start (or a time law
+        with the contact periodic gait), a joint the walker does not have, a walker with a
+        massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, or a pinned stance foot
         that is not a point (one line).
     """

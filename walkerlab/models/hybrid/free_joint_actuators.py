@@ -98,8 +98,9 @@ def five_link_actuators(data, spec, roles, push_off: bool = False) -> FiveLinkAc
     from walkerlab.codegen.cache import functions
 
     if spec.push_off is not None and not push_off:
-        raise ValueError("walker.actuation.push_off: the contact view has no push-off pulse "
-                         "on a free-jointed biped yet (the rigid view carries it)")
+        raise ValueError("walker.actuation.push_off: the free-jointed step's phase-law replay "
+                         "(walkerlab optimize) carries the joint torques alone; give the "
+                         "push-off to fixedpoint, simulate or contact-sim")
     for i, t in enumerate(spec.torques):
         if t.scaled_by != "none":
             raise ValueError(f"walker.actuation.torques.{i}.scaled_by: foot_mass is for "
