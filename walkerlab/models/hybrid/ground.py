@@ -35,7 +35,7 @@ from scipy.optimize import newton
 from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 
-__all__ = ["landing_drop", "on_landing"]
+__all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing"]
 
 
 def landing_drop(terrain) -> float:
@@ -61,11 +61,31 @@ def landing_drop(terrain) -> float:
                              "foothold's)")
         if len(h) == 1:
             return -float(h.pop())
-        raise ValueError("terrain.foothold_heights_m: footholds of different heights are not "
-                         "built in the rigid model yet (its period-1 gait needs one landing "
-                         "height for every step)")
-    raise ValueError(f"terrain.kind: {terrain.kind}: the rigid model walks slopes, stairs "
-                     "and footholds of one height; height profiles are not built yet")
+        raise ValueError("terrain.foothold_heights_m: footholds of different heights: a "
+                         "ground that differs from step to step (foothold_steps)")
+    raise ValueError(f"terrain.kind: {terrain.kind}: not one landing for every step")
+
+
+def foothold_steps(terrain, slope_rad: float) -> tuple[tuple[float, float], ...] | None:
+    """``((drop_m, slope_rad), ...)``: each step's landing depth [m] below the stance foot's
+    level and ground slope [rad] on footholds that differ from step to step (``terrain.kind:
+    footholds`` with several heights or with ``foothold_slopes_rad``), one per step in the
+    list's order; None for a ground whose every step is alike (:func:`landing_drop`).
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings or None
+    slope_rad : float
+        The scene's slope [rad] (every foothold's without ``foothold_slopes_rad``).
+    """
+    if terrain is None or terrain.kind != "footholds":
+        return None
+    h, g = terrain.foothold_heights_m, terrain.foothold_slopes_rad
+    if g is None and len(set(h or (0.0,))) == 1:
+        return None
+    n = len(h) if h else len(g)
+    return tuple((-float(h[k]) if h else 0.0, float(g[k]) if g else float(slope_rad))
+                 for k in range(n))
 
 
 def _clearance_names(f: dict) -> str:
@@ -183,3 +203,62 @@ def on_landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
                    params={**walker.params, "landing_drop_m": float(drop_m)},
                    mirror=mirror)
 
+
+
+def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalker:
+    """The walker on footholds that differ from step to step: step ``k`` lands
+    ``steps[k][0]`` [m] below the stance foot's level on ground of slope ``steps[k][1]``
+    [rad] (its heel strike the generated clearance above that slope's line plus
+    ``drop cos(slope)``, :func:`on_landing`); one Poincaré map walks the whole list (a
+    period-``p`` map, ``p = len(steps)``; legs that differ: ``lcm(p, 2)`` steps, each step the
+    leg in stance's own walker, as the stride of :attr:`HybridWalker.mirror`).
+
+    Parameters
+    ----------
+    walker_at : callable ``slope [rad] -> HybridWalker``
+        The scene's passive walker on a slope (absolute coordinates: the state is carried
+        from one step's slope to the next).
+    data_at : callable ``slope [rad] -> WalkerData``
+        Its description.
+    steps : sequence of (float, float)
+        ``(drop_m, slope_rad)`` per step (:func:`foothold_steps`).
+    periodic : bool
+        The list repeats (False: a walk ends after it).
+
+    Returns
+    -------
+    HybridWalker
+        Step 0's walker with :attr:`~HybridWalker.cycle` the walkers of every step of one
+        map; its section (``from_section``) is the post-impact surface of the map's last
+        step (the old stance foot ``drop cos(slope)`` above the last landing's line).
+
+    Raises
+    ------
+    ValueError
+        Coordinates measured from the slope with footholds of several slopes, or the
+        refusals of :func:`on_landing` (one line).
+    """
+    steps = tuple((float(d), float(g)) for d, g in steps)
+    base = {g: walker_at(g) for g in sorted({g for _, g in steps})}
+    data = {g: data_at(g) for g in base}
+    if len(base) > 1 and any(d.structure.coordinates != "absolute" for d in data.values()):
+        raise ValueError("terrain.foothold_slopes_rad: the walker's coordinates are measured "
+                         "from the slope (walker.coordinates); footholds of several slopes "
+                         "need absolute coordinates")
+    first = base[steps[0][1]]
+    legs_differ = first.mirror is not None
+    p = len(steps)
+    n = p * 2 if legs_differ and p % 2 else p
+    cycle = []
+    for k in range(n):
+        drop, g = steps[k % p]
+        w, d = base[g], data[g]
+        if legs_differ and k % 2 == 1:  # legs[0] in stance: the other leg's numbers
+            w, d = w.mirror, replace(d.mirror, mirror_params=None)
+        cycle.append(on_landing(replace(w, mirror=None), d, drop))
+    last = cycle[-1]
+    return replace(cycle[0], cycle=tuple(cycle), cycle_periodic=bool(periodic),
+                   mirror=cycle[1] if legs_differ else None,
+                   section=last.section, from_section=last.from_section,
+                   params={**cycle[0].params,  # the mean drop: downhill on average
+                           "landing_drop_m": sum(d for d, _ in steps) / p})
