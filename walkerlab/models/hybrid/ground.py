@@ -35,7 +35,8 @@ from scipy.optimize import newton
 from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 
-__all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing"]
+__all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing",
+           "with_clearance_guard"]
 
 
 def landing_drop(terrain) -> float:
@@ -172,6 +173,26 @@ def on_landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     """
     if drop_m == 0.0:
         return walker
+    return _landing(walker, data, float(drop_m))
+
+
+def with_clearance_guard(walker: HybridWalker, data) -> HybridWalker:
+    """``walker`` with its heel strike written as the swing foot's clearance above the slope
+    line (:func:`on_landing`'s guard at a landing of depth 0: the same surface as the
+    walker's own heel strike, located on another function): the guard whose offset a
+    per-step landing height shifts (:meth:`walkerlab.integrate.batch_step.BatchStepMap.step`
+    ``height_m``).
+
+    Raises
+    ------
+    ValueError
+        As :func:`on_landing`.
+    """
+    return _landing(walker, data, 0.0)
+
+
+def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
+    """:func:`on_landing`'s walker for any ``drop_m`` (0 included)."""
     if data.structure.foot == "flat":
         raise ValueError("terrain.kind: flat feet on stairs or footholds are not supported yet "
                          "(their heel strike is a guard per foot mode)")
@@ -196,7 +217,7 @@ def on_landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
                             constraint=ph.constraint))
     mirror = walker.mirror
     if mirror is not None and data.mirror is not None:  # legs that differ: the next step's
-        mirror = on_landing(mirror, replace(data.mirror, mirror_params=None), drop_m)
+        mirror = _landing(mirror, replace(data.mirror, mirror_params=None), drop_m)
     return replace(walker, phases=tuple(phases),
                    heel_strike_guard=partial(_at, clear, offset),
                    from_section=_LandingSection(walker, clear, grad, offset),
