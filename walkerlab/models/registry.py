@@ -74,7 +74,27 @@ def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
     return on_landing(walker, walker_data(scene.walker, scene.slope.phi_rad), drop)
 
 
-def _on_footholds(scene, walker: HybridWalker, steps, on_footholds) -> HybridWalker:
+def build_walker_on_steps(scene, steps) -> HybridWalker:
+    """The scene's rigid walker on a finite list of per-step grounds (a drawn rough ground,
+    ``simulate --terrain-seed``): step ``k`` lands ``steps[k][0]`` [m] below the stance
+    foot's level on ground of slope ``steps[k][1]`` [rad]; the walk ends after the list
+    (:func:`walkerlab.models.hybrid.ground.on_footholds`).
+
+    Raises
+    ------
+    ValueError
+        A ground other than the slope under it, or a walker that cannot walk it (one line).
+    """
+    from walkerlab.models.hybrid.ground import on_footholds
+
+    if scene.terrain is not None and not scene.terrain.is_slope:
+        raise ValueError(f"terrain.kind: {scene.terrain.kind}: per-step draws are of a slope "
+                         "(terrain.per_step on kind: slope)")
+    return _on_footholds(scene, _passive(scene), steps, on_footholds, periodic=False)
+
+
+def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
+                  periodic: bool | None = None) -> HybridWalker:
     """The walker on footholds of several heights or slopes (``on_footholds``:
     :func:`walkerlab.models.hybrid.ground.on_footholds`), each slope's walker built as the
     scene's on that slope."""
@@ -96,7 +116,8 @@ def _on_footholds(scene, walker: HybridWalker, steps, on_footholds) -> HybridWal
         return _passive(scene.model_copy(update={"slope": scene.slope.model_copy(
             update={"angle_rad": float(g), "angle_deg": None})}))
 
-    periodic = scene.terrain.periodic is not False
+    if periodic is None:
+        periodic = scene.terrain.periodic is not False
     return on_footholds(at, lambda g: walker_data(scene.walker, g), steps, periodic)
 
 

@@ -106,8 +106,51 @@ def simulate_run(scene: Scene, fixed_point=None):
             x0 = initial_state(sim.initial_state, walker.state_names())
         except ValueError as exc:
             raise ValueError(f"simulate.initial_state: {exc}") from None
+    if sim.terrain_seed is not None:
+        walker = rough_ground_walker(scene, 2 * sim.strides)
     r = simulate_scene(scene, walker, x0)
     from walkerlab.analysis.gait.energy import trajectory_ledger
 
     return SimulateRun(walker, r.trajectory, r.samples, r.steps, x0, sim.strides,
                        total_mass_kg(walker), r.summary, trajectory_ledger(r.trajectory))
+
+
+def rough_ground_steps(scene, n_steps: int) -> list[tuple[float, float]]:
+    """``[(drop_m, slope_rad), ...]`` of the first ``n_steps`` steps of the per-step ground
+    ``terrain.per_step`` drawn from ``simulate.terrain_seed``: walk 0 of that seed's Monte
+    Carlo streams (:func:`walkerlab.analysis.robustness.slope_stream.slope_rows`, the
+    landing heights :func:`walkerlab.analysis.robustness.mfpt.height_rows`), so a seed
+    names one ground, the same on every run and machine; ``drop_m`` is minus the height.
+
+    Raises
+    ------
+    ValueError
+        No ``terrain.per_step`` section (one line).
+    """
+    from walkerlab.analysis.robustness.mfpt import height_rows
+    from walkerlab.analysis.robustness.slope_stream import slope_rows
+
+    per = scene.terrain.per_step if scene.terrain is not None else None
+    if per is None:
+        raise ValueError("simulate.terrain_seed: the scene has no terrain.per_step (the "
+                         "distribution of each step's slope and landing height)")
+    seed = int(scene.simulate.terrain_seed)
+    g = slope_rows(seed, [0], 0, n_steps, scene.slope.phi_rad, per.slope_sd_rad,
+                   per.slope_distribution)[0]
+    dist, sd = per.heights
+    h = height_rows(seed, [0], 0, n_steps, sd, dist)[0] if sd > 0 else np.zeros(n_steps)
+    return [(-float(hk), float(gk)) for hk, gk in zip(h, g)]
+
+
+def rough_ground_walker(scene, n_steps: int):
+    """The scene's rigid walker on :func:`rough_ground_steps` (its walk ends after them).
+
+    Raises
+    ------
+    ValueError
+        As :func:`rough_ground_steps` and
+        :func:`walkerlab.models.registry.build_walker_on_steps` (one line).
+    """
+    from walkerlab.models.registry import build_walker_on_steps
+
+    return build_walker_on_steps(scene, rough_ground_steps(scene, n_steps))
