@@ -194,3 +194,43 @@ def test_terrain_seed_without_a_per_step_ground_is_one_line(paper_scene):
         with_terrain_seed(paper_scene, 3)
     with pytest.raises(SceneError, match="--terrain-seed -1: .*simulate.terrain_seed"):
         with_terrain_seed(_rough(paper_scene, None), -1)
+
+
+# -- height profiles ---------------------------------------------------------------------------
+
+def test_a_profile_of_constant_slope_walks_the_slope_gait(paper_scene, paper_fixed_point):
+    """A profile that is one straight line of the paper's slope (level scene slope: the
+    profile alone is the ground), in three collinear segments: the walk on it is the slope
+    walk (every post-impact state to 1e-9, step periods to 1e-9) and its footfalls lie on
+    the profile; a profile with a 2 cm drop half-way lands the walker lower there."""
+    from walkerlab.analysis.gait.rigid_run import profile_walk
+    from walkerlab.integrate.rigid import simulate_steps
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.models.registry import build_walker
+
+    phi = paper_scene.slope.phi_rad
+    d = paper_scene.model_dump(mode="json")
+    xs = np.array([-1.0, 0.9, 1.7, 40.0])
+    d["terrain"] = {"kind": "profile", "profile_m": [[x, -x * np.tan(phi)] for x in xs]}
+    d["slope"] = {"angle_rad": 0.0}
+    sc = scene_from_dict(d)
+    x0 = paper_fixed_point.x
+    tr = profile_walk(sc, x0, 8)
+    ref = simulate_steps(build_walker(paper_scene), x0, 8, Solver.from_settings(sc.solver))
+    assert len(tr.segments) == 8 and tr.termination == "heel_strike"
+    for a, b in zip(tr.segments, ref.segments):
+        assert np.max(np.abs(a.x_next - b.x_next)) < 1e-9
+        assert abs((a.t_end - a.t_start) - (b.t_end - b.t_start)) < 1e-9
+        xw, yw = a.stance_foot_world
+        assert abs(yw + xw * np.tan(phi)) < 1e-12  # every stance foot on the profile
+    # a bend: the ramp steepens to 0.03 rad at x = 1.5 m: every footfall on the profile,
+    # the later steps on the steeper ramp faster than the slope's
+    P = np.array([[-1.0, np.tan(phi)], [1.5, -1.5 * np.tan(phi)], [40.0, 0.0]])
+    P[2, 1] = P[1, 1] - (40.0 - 1.5) * np.tan(0.03)
+    d["terrain"] = {"kind": "profile", "profile_m": P.tolist()}
+    tr = profile_walk(scene_from_dict(d), x0, 8)
+    assert len(tr.segments) == 8
+    for a in tr.segments:
+        xw, yw = a.stance_foot_world
+        assert abs(yw - np.interp(xw, P[:, 0], P[:, 1])) < 1e-9
+    assert tr.segments[-1].x_next[3] < ref.segments[-1].x_next[3] - 0.01  # faster stance

@@ -74,6 +74,24 @@ def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
     return on_landing(walker, walker_data(scene.walker, scene.slope.phi_rad), drop)
 
 
+def passive_walker_at(scene):
+    """``(walker_at, data_at)``: ``slope [rad] -> HybridWalker`` (the scene's passive rigid
+    walker on that slope, the scene's own at its slope) and ``slope -> WalkerData``."""
+    from walkerlab.walker.description import walker_data
+
+    own = {}
+
+    def at(g: float) -> HybridWalker:
+        if g == scene.slope.phi_rad:
+            if "w" not in own:
+                own["w"] = _passive(scene)
+            return own["w"]
+        return _passive(scene.model_copy(update={"slope": scene.slope.model_copy(
+            update={"angle_rad": float(g), "angle_deg": None})}))
+
+    return at, (lambda g: walker_data(scene.walker, g))
+
+
 def build_walker_on_steps(scene, steps) -> HybridWalker:
     """The scene's rigid walker on a finite list of per-step grounds (a drawn rough ground,
     ``simulate --terrain-seed``): step ``k`` lands ``steps[k][0]`` [m] below the stance

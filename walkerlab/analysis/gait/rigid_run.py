@@ -49,8 +49,11 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
         (:func:`walkerlab.analysis.gait.metrics.sample_trajectory`).
     """
     sim = scene.simulate
-    traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
-                          max_step_time=sim.max_step_time_s)
+    if scene.terrain is not None and scene.terrain.kind == "profile":
+        traj = profile_walk(scene, x0, 2 * sim.strides)
+    else:
+        traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
+                              max_step_time=sim.max_step_time_s)
     samples = sample_trajectory(traj, sim.sample_rate_hz)
     steps = step_table(traj)
     ok = steps["termination"] == "heel_strike"
@@ -154,3 +157,25 @@ def rough_ground_walker(scene, n_steps: int):
     from walkerlab.models.registry import build_walker_on_steps
 
     return build_walker_on_steps(scene, rough_ground_steps(scene, n_steps))
+
+
+def profile_walk(scene, x0: np.ndarray, n_steps: int):
+    """``n_steps`` steps of the scene's rigid walker on its height profile from ``x0``
+    (:func:`walkerlab.analysis.gait.profile_walk.simulate_on_profile`).
+
+    Raises
+    ------
+    ValueError
+        A profile only in a CSV file, a walker with actuators or printed equations (one
+        line).
+    """
+    from walkerlab.analysis.gait.profile_walk import profile_points, simulate_on_profile
+    from walkerlab.models.registry import passive_walker_at
+
+    if getattr(scene.walker, "actuation", None) is not None or scene.ideal.variant != "derived":
+        raise ValueError("terrain.kind: profile: walked by the passive walker of the "
+                         "generated model only (no walker.actuation, ideal.variant: derived)")
+    at, data_at = passive_walker_at(scene)
+    return simulate_on_profile(at, data_at, profile_points(scene.terrain), x0, n_steps,
+                               Solver.from_settings(scene.solver),
+                               max_step_time=scene.simulate.max_step_time_s)

@@ -42,7 +42,9 @@ __all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing",
 def landing_drop(terrain) -> float:
     """Depth [m] of each step's landing below the stance foot's level for a ground whose
     every step is alike (``terrain.kind: stairs``: ``+riser_m`` down, ``-riser_m`` up;
-    ``footholds`` of one height ``h``: ``-h``, on the scene's slope); 0.0 for the slope.
+    ``footholds`` of one height ``h``: ``-h``, on the scene's slope); 0.0 for the slope and
+    for a profile (walked step by step, :mod:`walkerlab.analysis.gait.profile_walk`, from
+    the gait of the scene's slope).
 
     Raises
     ------
@@ -64,7 +66,9 @@ def landing_drop(terrain) -> float:
             return -float(h.pop())
         raise ValueError("terrain.foothold_heights_m: footholds of different heights: a "
                          "ground that differs from step to step (foothold_steps)")
-    raise ValueError(f"terrain.kind: {terrain.kind}: not one landing for every step")
+    # a profile: walked step by step (walkerlab.analysis.gait.profile_walk); its periodic
+    # gait, the start of the walk, is the scene's slope's
+    return 0.0
 
 
 def foothold_steps(terrain, slope_rad: float) -> tuple[tuple[float, float], ...] | None:
