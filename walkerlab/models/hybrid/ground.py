@@ -49,8 +49,8 @@ def landing_drop(terrain) -> float:
     Raises
     ------
     ValueError
-        A ground whose steps differ (footholds of several heights or of their own slopes,
-        a profile): one line.
+        A ground whose steps differ (footholds of several heights or of their own slopes:
+        :func:`foothold_steps` and :func:`on_footholds` walk them): one line.
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
@@ -59,13 +59,14 @@ def landing_drop(terrain) -> float:
     if terrain.kind == "footholds":
         h = set(terrain.foothold_heights_m or (0.0,))
         if terrain.foothold_slopes_rad is not None:
-            raise ValueError("terrain.foothold_slopes_rad: footholds of their own slopes are "
-                             "not built in the rigid model yet (the scene's slope is every "
-                             "foothold's)")
+            raise ValueError("terrain.foothold_slopes_rad: footholds of their own slopes "
+                             "differ from step to step: not one landing for every step (the "
+                             "rigid model walks them, one walker per step)")
         if len(h) == 1:
             return -float(h.pop())
-        raise ValueError("terrain.foothold_heights_m: footholds of different heights: a "
-                         "ground that differs from step to step (foothold_steps)")
+        raise ValueError("terrain.foothold_heights_m: footholds of different heights "
+                         "differ from step to step: not one landing for every step (the "
+                         "rigid model walks them, one walker per step)")
     # a profile: walked step by step (walkerlab.analysis.gait.profile_walk); its periodic
     # gait, the start of the walk, is the scene's slope's
     return 0.0
