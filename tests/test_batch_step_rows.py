@@ -144,7 +144,7 @@ def test_phase_rows_with_stage_cfuncs_equal_the_flow_alone(paper_map, paper_fixe
         which, te, Yev, H = np.empty(8, np.int64), np.empty(8), np.empty((8, 4)), np.zeros(8)
         phase_rows(*f, X.copy(), D.copy(), np.full(8, 5.0), paper_map._gcols[0],
                    paper_map._goffs[0], paper_map._dirs[0], 1e-9, 1e-9, 4 + paper_map.phases[0][2],
-                   which, te, Yev, H)
+                   which, te, Yev, H, -1, np.zeros(1))
         res.append((which, te, Yev, H))
     for a, b in zip(*res):
         np.testing.assert_array_equal(a, b)

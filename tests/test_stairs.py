@@ -214,15 +214,15 @@ def test_footholds_of_one_height_are_a_landing_and_others_are_refused(paper_scen
     assert w.heel_strike_guard(0.0, x) == pytest.approx(
         _clearance(slope, x) + 0.005 * np.cos(paper_scene.slope.phi_rad), abs=1e-15)
     d = sc.model_dump(mode="json")
-    for terrain, words in (({"kind": "footholds", "foothold_heights_m": [0.0, -0.01]},
-                            "different heights"),
-                           ({"kind": "footholds", "foothold_slopes_rad": [0.01]},
-                            "own slopes"),
-                           ({"kind": "profile", "profile_m": [[0, 0], [1, -0.1]]},
-                            "profiles are not built")):
+    # footholds that differ from step to step: one walker per step of a period-p map
+    # (tests/test_terrain_steps.py); on the printed equations: refused in one line
+    for terrain, period in (({"kind": "footholds", "foothold_heights_m": [0.0, -0.01]}, 2),
+                            ({"kind": "footholds", "foothold_slopes_rad": [0.01]}, 1)):
         d["terrain"] = terrain
-        with pytest.raises(ValueError, match=words):
-            build_walker(scene_from_dict(d))
+        assert build_walker(scene_from_dict(d)).steps_per_map == period
+    d["ideal"] = {"variant": "appendix_a"}
+    with pytest.raises(ValueError, match="footholds need ideal.variant: derived"):
+        build_walker(scene_from_dict(d))
 
 
 def _clearance(walker, x):

@@ -131,3 +131,36 @@ class StairsCompass:
             J[:, k] = (f[0] - 8 * f[1] + 8 * f[2] - f[3]) / (12 * h)
         mu = np.concatenate([np.linalg.eigvals(J), [0.0]])
         return mu[np.argsort(-np.abs(mu), kind="stable")]
+
+
+class FootholdsCompass(StairsCompass):
+    """The same walker on footholds of several heights: step ``k`` of a walk lands
+    ``drops[k % p]`` [m] below its stance foot (no walkerlab code).  Its Poincaré map walks
+    the ``p`` steps of the list; the section is the state just after the list's last heel
+    strike, where the new swing foot is ``drops[-1]`` above the new stance foot."""
+
+    def __init__(self, drops, **kw):
+        super().__init__(float(drops[-1]), **kw)
+        self.drops = [float(d) for d in drops]
+
+    def step_on(self, x, H):
+        """(pre-impact state, step time) of a step landing ``H`` [m] below."""
+        self.H, keep = H, self.H
+        try:
+            return self.step(x)
+        finally:
+            self.H = keep
+
+    def map(self, x):
+        for H in self.drops:
+            y, _ = self.step_on(x, H)
+            x = self.reset(y)
+        return x
+
+    def period(self, x):
+        """Duration of one map (all the list's steps) [s] from ``x``."""
+        t = 0.0
+        for H in self.drops:
+            y, dt = self.step_on(x, H)
+            x, t = self.reset(y), t + dt
+        return t

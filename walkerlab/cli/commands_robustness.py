@@ -71,7 +71,10 @@ def mfpt(scene: Path | None = SceneArg,
     sc = load(scene)
     out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
                        workers=workers, scheduler=scheduler)
-    if out.summary:
+    if out.summary and "sigma_m" in out.summary:  # a study of per-step landing heights
+        for s, m in zip(out.summary["sigma_m"], out.summary["mfpt_steps_montecarlo"]):
+            typer.echo(f"height sigma {1e3 * s:.4g} mm: MFPT Monte Carlo {m:.4g} steps")
+    elif out.summary:
         for s, m, me, why in zip(out.summary["sigma_rad"],
                                  out.summary["mfpt_steps_montecarlo"],
                                  out.summary["mfpt_steps_mesh"], out.summary["mesh_note"]):

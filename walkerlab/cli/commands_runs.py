@@ -40,6 +40,9 @@ def simulate(scene: Path | None = SceneArg,
              strides: int | None = typer.Option(
                  None, "--strides", help="strides to simulate (1 stride = 2 steps) "
                  "(default: simulate.strides of the scene)"),
+             terrain_seed: int | None = typer.Option(
+                 None, "--terrain-seed", help="walk the per-step ground of terrain.per_step "
+                 "drawn from this seed (the same seed walks the same ground, bit for bit)"),
              runs_dir: Path = RunsOpt, force: bool = ForceOpt) -> None:
     """Simulate N strides of the rigid walker from its fixed point (or from the state given
     as simulate.initial_state in the scene)."""
@@ -47,7 +50,8 @@ def simulate(scene: Path | None = SceneArg,
     from walkerlab.report.text import simulate_ending, simulate_text
     from walkerlab.stages import pipeline
 
-    out = pipeline.run("simulate", load(scene), runs_dir, force, strides=strides)
+    out = pipeline.run("simulate", load(scene), runs_dir, force, strides=strides,
+                       terrain_seed=terrain_seed)
     sim = load_simulate(out.path)
     ending = simulate_ending(sim)  # a fall: no success-style summary
     if ending is None:

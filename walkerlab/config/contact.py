@@ -359,6 +359,9 @@ class PerStepTerrain(BaseModel):
     (for a compass walker the heel-strike guard becomes ``theta_swing + theta_stance =
     -2 gamma_n``).  ``gamma_n`` is drawn i.i.d. about the scene's slope (``slope_sd_rad``;
     ``normal`` or ``uniform`` with the same standard deviation), reproducibly from ``seed``.
+    With ``height_sd_m``, step ``n``'s landing also lies ``h_n`` [m] above that line
+    (``h_n`` i.i.d. about 0, ``height_distribution``; its own stream of the same seed): the
+    heel strike is the swing foot's clearance above the line reaching ``h_n cos(gamma_n)``.
     """
 
     model_config = _STRICT
@@ -368,6 +371,29 @@ class PerStepTerrain(BaseModel):
     slope_sd_rad: float = Field(0.0, ge=0, le=0.2,
                                 description="standard deviation of each step's slope [rad]")
     seed: int = Field(0, ge=0, description="seed of the per-step draws [-]")
+    height_distribution: Literal["normal", "uniform"] | None = Field(
+        None, description="distribution of each step's landing height about the stance "
+        "foot's level (default normal)")
+    height_sd_m: float | None = Field(
+        None, ge=0, le=0.2, description="standard deviation of each step's landing height "
+        "above the slope line through the stance foot [m] (default 0: the slope)",
+        json_schema_extra={"unit": "m"})
+
+    @model_serializer(mode="wrap")
+    def _drop_unset(self, handler):
+        # a scene without per-step heights serialises as before (same content hashes)
+        d = handler(self)
+        if isinstance(d, dict):
+            for k in ("height_distribution", "height_sd_m"):
+                if d.get(k, 0) is None:
+                    d.pop(k)
+        return d
+
+    @property
+    def heights(self) -> tuple[str, float]:
+        """``(distribution, sd [m])`` of the per-step landing heights (normal, 0 unset)."""
+        return (self.height_distribution or "normal",
+                0.0 if self.height_sd_m is None else float(self.height_sd_m))
 
 
 #: Ground kinds of the ``terrain`` section (:class:`TerrainSettings`); ``slope`` is the

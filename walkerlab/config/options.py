@@ -131,6 +131,31 @@ def bifurcation_options(n_transient: int, n_keep: int, workers: int) -> tuple[in
     return n_transient, n_keep, checked_workers(workers)
 
 
+def with_terrain_seed(scene: Scene, seed: int | None) -> Scene:
+    """The scene with ``simulate.terrain_seed`` set to ``seed`` (``--terrain-seed``; None
+    keeps the scene's).
+
+    Raises
+    ------
+    SceneError
+        ``seed`` out of bounds, or no ``terrain.per_step`` to draw from (one line).
+    """
+    if seed is None:
+        return scene
+    from pydantic import ValidationError
+
+    sim = scene.simulate or SimulateSettings()
+    try:
+        sim = SimulateSettings.model_validate({**sim.model_dump(), "terrain_seed": seed})
+    except ValidationError as err:
+        raise SceneError(f"--terrain-seed {seed}: {err.errors()[0]['msg'].lower()} "
+                         "(simulate.terrain_seed)") from None
+    if scene.terrain is None or scene.terrain.per_step is None:
+        raise SceneError("--terrain-seed: the scene has no terrain.per_step (the "
+                         "distribution of each step's slope and landing height to draw)")
+    return scene.model_copy(update={"simulate": sim})
+
+
 def with_strides(scene: Scene, strides: int | None) -> Scene:
     """The scene with ``simulate.strides`` set to ``strides`` (``--strides``; the section is
     created with its defaults when absent; None keeps the scene's number).

@@ -12,7 +12,14 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_serializer,
+    model_validator,
+)
 
 from walkerlab.config.base import AsTuple, Strict
 from walkerlab.config.limits import (
@@ -176,6 +183,18 @@ class SimulateSettings(Strict):
     )
     max_step_time_s: float = Field(5.0, gt=0, le=MAX_STEP_TIME_S,
                                    description="a step longer than this ends the run [s]")
+    terrain_seed: int | None = Field(
+        None, ge=0, lt=2**63, description="walk the per-step ground of terrain.per_step drawn "
+        "from this seed (its Monte Carlo walk 0; walkerlab simulate --terrain-seed): the same "
+        "seed walks the same ground again, bit for bit [-]")
+
+    @model_serializer(mode="wrap")
+    def _drop_unset(self, handler):
+        # a scene without a terrain seed serialises as before (same content hashes)
+        d = handler(self)
+        if isinstance(d, dict) and d.get("terrain_seed", 0) is None:
+            d.pop("terrain_seed")
+        return d
 
 
 class WorkPrecisionSettings(Strict):
@@ -259,6 +278,11 @@ class MfptSettings(Strict):
     sigma_rad: list[Annotated[float, Field(gt=0, le=0.2)]] = Field(
         [0.002, 0.003, 0.004, 0.006], min_length=1, max_length=64,
         description="standard deviations of the per-step slope [rad]")
+    sigma_m: list[Annotated[float, Field(gt=0, le=0.2)]] | None = Field(
+        None, min_length=1, max_length=64, description="standard deviations of the per-step "
+        "landing height [m] (terrain.per_step.height_distribution): when given, the study's "
+        "roughness levels are these, each step's slope drawn with terrain.per_step."
+        "slope_sd_rad (default 0: the scene's slope); Monte Carlo only")
     method: Literal["mesh", "montecarlo", "both"] = Field(
         "both", description="mesh (rigid model), Monte Carlo, or both side by side")
     model: Literal["rigid", "contact"] = Field(
@@ -292,6 +316,24 @@ class MfptSettings(Strict):
                         "per walk [rad, rad/s]")
     max_step_time_s: float = Field(5.0, gt=0, le=MAX_STEP_TIME_S, description="no heel "
                                    "strike within this = a fall [s]")
+
+    @model_serializer(mode="wrap")
+    def _drop_unset(self, handler):
+        # a study of per-step slopes serialises as before (same content hashes)
+        d = handler(self)
+        if isinstance(d, dict) and d.get("sigma_m", 0) is None:
+            d.pop("sigma_m")
+        return d
+
+    @model_validator(mode="after")
+    def _heights_by_montecarlo(self) -> MfptSettings:
+        if self.sigma_m is not None and self.method != "montecarlo":
+            raise ValueError(f"mfpt.method: {self.method}: the study of per-step heights "
+                             "(mfpt.sigma_m) is Monte Carlo only (method: montecarlo)")
+        if self.sigma_m is not None and self.model != "rigid":
+            raise ValueError("mfpt.sigma_m: per-step heights are a rigid-model study "
+                             "(model: rigid)")
+        return self
 
 
 class RobustnessSettings(Strict):

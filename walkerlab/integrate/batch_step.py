@@ -128,6 +128,15 @@ class BatchStepMap:
         self.slope_rad = float(walker.slope_rad)
         self._resets_depend_on_slope = self._probe_slope_dependence()
         self._reset_flow = self._probe_compiled_reset(compiled_module(lastc.structure))
+        # per phase: the heel-strike guard's index (-1: none) and whether it is the swing
+        # foot's clearance above the slope line (a per-row landing height is then an offset)
+        self._hs_phase = [next((j for j, g in enumerate(p[0].guards)
+                                if g.outcome == "heel_strike"), -1) for p in self.phases]
+        self.clearance_guard = all(
+            h < 0 or p[0].compiled.guards[h][0] in ("swing_clearance",) or (
+                p[0].compiled.guards[h][0] == "heel_strike" and "swing_clearance" not in
+                compiled_module(p[0].compiled.structure).GUARDS)
+            for p, h in zip(self.phases, self._hs_phase))
         #: rows integrated by the compiled per-row integrator (phases), for the record
         self.integrated = 0
         self._walkers: dict[float, object] = {}
@@ -180,7 +189,7 @@ class BatchStepMap:
                            if g.outcome == "next_phase")
         return len(cf) == 1 and no_mid_reset and self._reset_flow is not None
 
-    def walk(self, X: np.ndarray, gamma: np.ndarray):
+    def walk(self, X: np.ndarray, gamma: np.ndarray, height_m: np.ndarray | None = None):
         """Walk every row up to ``gamma.shape[1]`` steps, step ``s`` of row ``w`` on the
         slope ``gamma[w, s]`` [rad], until it falls (any step that does not end in heel
         strike), all in compiled code (:func:`walkerlab.integrate.rows_dop853.walk_rows`;
@@ -192,6 +201,9 @@ class BatchStepMap:
             Post-impact states [rad, rad/s].
         gamma : ndarray, shape (W, S)
             Slopes [rad].
+        height_m : ndarray, shape (W, S), optional
+            Landing heights [m] above the slope line through the stance foot (as
+            :meth:`step`'s).
 
         Returns
         -------
@@ -219,10 +231,28 @@ class BatchStepMap:
         g = self._guard_table()
         steps = np.zeros(W, np.int64)
         fell = np.zeros(W, np.bool_)
+        hoff = (np.zeros((1, 1)) if height_m is None else
+                self._height_offsets(height_m, gamma).reshape(W, S))
         walk_rows(*self._cfuncs(0), self._reset_flow, X, D, S, float(self.max_step_time_s),
                   *g, float(self.rtol), float(self.atol), self.n + self.phases[0][2], steps,
-                  fell)
+                  fell, height_m is not None, hoff)
         return steps, fell, X
+
+    def _height_offsets(self, height_m, gamma) -> np.ndarray:
+        """The heel-strike guard's offsets ``-h cos(gamma)`` [m] of landings ``h`` [m] above
+        the slope line (the clearance's normal distance, :func:`walkerlab.models.hybrid.
+        ground.on_landing`), C-contiguous float.
+
+        Raises
+        ------
+        ValueError
+            A walker whose heel-strike guard is not the swing foot's clearance (one line).
+        """
+        if not self.clearance_guard:
+            raise ValueError(f"{self.walker.name}: per-step heights need the heel strike as "
+                             "the swing foot's clearance (ground.with_clearance_guard)")
+        h = np.asarray(height_m, dtype=float)
+        return np.ascontiguousarray(-h * np.cos(np.broadcast_to(gamma, h.shape)))
 
     def _cfuncs(self, k: int) -> tuple:
         """Phase ``k``'s cfuncs for the per-row integrator
@@ -265,7 +295,8 @@ class BatchStepMap:
 
     # -- the map --------------------------------------------------------------------------
     def step(self, X: np.ndarray, gamma: np.ndarray | float | None = None,
-             drop_m: np.ndarray | float | None = None) -> BatchStep:
+             drop_m: np.ndarray | float | None = None,
+             height_m: np.ndarray | float | None = None) -> BatchStep:
         """One step of every row.
 
         Parameters
@@ -280,11 +311,20 @@ class BatchStepMap:
             model's swing-foot clearance above that line: the heel strike is the clearance
             reaching ``-drop_m`` after the foot has risen above both ground levels (rows
             with ``drop_m = 0`` keep the ordinary heel-strike guard).
+        height_m : ndarray (N,) or float, optional
+            Landing height [m] of this step above the slope line through the stance foot
+            (rough ground, ``terrain.per_step.height_sd_m``): the heel strike is the swing
+            foot's clearance reaching ``height_m cos(gamma)``, armed as the walker's own
+            guard (its late swing), integrated by the compiled per-row integrator (the
+            guard's offset per row).  Needs a walker whose heel strike is the clearance
+            (:func:`walkerlab.models.hybrid.ground.with_clearance_guard`).
 
         Raises
         ------
         ValueError
-            ``drop_m`` for a walker whose generated model has no swing-foot clearance.
+            ``drop_m`` for a walker whose generated model has no swing-foot clearance;
+            ``height_m`` with ``drop_m`` or for a walker whose heel strike is not the
+            clearance.
 
         Returns
         -------
@@ -296,6 +336,12 @@ class BatchStepMap:
                                 np.asarray(gamma, dtype=float), (N,)).copy()
         D = self.data(gamma)
         nc = D.shape[1]
+        self._hoff = None
+        if height_m is not None:
+            if drop_m is not None:
+                raise ValueError("BatchStepMap.step: a drop_m or a height_m, not both")
+            self._hoff = self._height_offsets(
+                np.broadcast_to(np.asarray(height_m, dtype=float), (N,)), gamma)
         if drop_m is not None:
             if self._clear is None:
                 raise ValueError(f"{self.walker.name}: no swing-foot clearance in the model; "
@@ -399,11 +445,13 @@ class BatchStepMap:
         te = np.empty(N)
         Yev = np.empty((N, m))
         H = self._h_rows[rows]
+        hoff = getattr(self, "_hoff", None)
+        hs = self._hs_phase[k] if hoff is not None else -1
         phase_rows(*self._cfuncs(k), np.ascontiguousarray(Y, dtype=float),
                    np.ascontiguousarray(Dk),
                    np.ascontiguousarray(cap, dtype=float), self._gcols[k], self._goffs[k],
                    self._dirs[k], float(self.rtol), float(self.atol), m + n_extra, which, te,
-                   Yev, H)
+                   Yev, H, hs, hoff[rows] if hs >= 0 else np.zeros(1))
         self._h_rows[rows] = H
         out.outcome[rows[which == FAILED]] = SOLVER_FAILURE  # (TIMEOUT: already set)
         self.integrated += N

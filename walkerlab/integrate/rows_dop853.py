@@ -309,7 +309,7 @@ def _row(f, fs, fg, sel, y, d, cap, gcols, goffs, dirs, rtol, atol, yev, h_first
 
 @njit(cache=True, error_model="numpy")
 def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out, which, te,
-               Yev, H):  # pragma: no cover - compiled
+               Yev, H, hs, hoff):  # pragma: no cover - compiled
     """Integrate every row of ``Y`` (N, m) [state units] with its data vector ``D[i]`` from
     phase time 0 to its first guard crossing (module docstring): ``f, fs, fg, sel``
     (:func:`cfuncs`; separate arguments: a tuple of functions is an experimental numba
@@ -322,12 +322,17 @@ def phase_rows(f, fs, fg, sel, Y, D, cap, gcols, goffs, dirs, rtol, atol, n_out,
     ``dirs`` (g,): guard columns among the cfunc's extra outputs, offsets, directions;
     ``n_out``: outputs the cfunc writes (m + extra); ``H`` (N,) [s]: each row's first step
     size (<= 0: scipy's choice), overwritten with the step size it would take next (a row
-    going on to the next phase starts with it)."""
+    going on to the next phase starts with it).  ``hs`` >= 0: guard ``hs`` (the heel
+    strike) of row ``i`` has ``hoff[i]`` added to its offset (a per-row landing height, the
+    ground of that row's step: :meth:`walkerlab.integrate.batch_step.BatchStepMap.step`)."""
     work = _work(Y.shape[1], n_out, gcols.size)
     y = np.empty(Y.shape[1])
+    go = goffs.copy()
     for i in range(Y.shape[0]):
         y[:] = Y[i]
-        w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, goffs, dirs, rtol, atol, Yev[i],
+        if hs >= 0:
+            go[hs] = goffs[hs] + hoff[i]
+        w, t, h = _row(f, fs, fg, sel, y, D[i], cap[i], gcols, go, dirs, rtol, atol, Yev[i],
                        H[i], work)
         which[i] = w
         te[i] = t
@@ -348,7 +353,8 @@ def reset_rows(reset, X, D, out):  # pragma: no cover - compiled
 
 @njit(cache=True, error_model="numpy")
 def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, goffs, dirs,
-              gout, rtol, atol, n_out, steps, fell):  # pragma: no cover - compiled
+              gout, rtol, atol, n_out, steps, fell, per_step,
+              hoff):  # pragma: no cover - compiled
     """Walk every row of ``X`` (W, m) up to ``n_steps`` steps, step ``s`` of walk ``w`` on
     the data vector ``D[w, s]`` (its slope): the phases of a step in turn (phase ``p``'s
     guards ``gstart[p]:gstart[p + 1]`` of the flat arrays ``gcols``, ``goffs``, ``dirs``
@@ -357,25 +363,31 @@ def walk_rows(f, fs, fg, sel, reset, X, D, n_steps, max_time, gstart, gcols, gof
     phase to phase), a heel strike reset by ``reset`` and counted in ``steps`` (W,); a fall,
     a step longer than ``max_time`` [s] or a failed integration sets ``fell`` (W,) and ends
     the walk.  ``f, fs, fg, sel``: the flow's cfuncs (:func:`phase_rows`).  ``X`` is
-    overwritten with each walk's last post-impact state."""
+    overwritten with each walk's last post-impact state.  ``per_step``: ``hoff[w, s]``
+    ((W, n_steps) [m]) is added to the heel-strike guards' offsets of step ``s`` of walk
+    ``w`` (its landing height); else ``hoff`` is not read."""
     W, m = X.shape
     n_ph = gstart.size - 1
     yev = np.empty(m)
     x = np.empty(m)
     y = np.empty(m)
     work = _work(m, n_out, np.max(gstart[1:] - gstart[:-1]))
+    go = goffs.copy()
     for w in range(W):
         x[:] = X[w]
         for s in range(n_steps):
             T, h, ended = 0.0, 0.0, False
             d = np.ascontiguousarray(D[w, s])
             y[:] = x
+            if per_step:
+                for j in range(go.size):
+                    go[j] = goffs[j] + hoff[w, s] if gout[j] == 0 else goffs[j]
             for p in range(n_ph):
                 a, b = gstart[p], gstart[p + 1]
                 if max_time - T <= 0.0:
                     ended = True
                     break
-                which, te, h = _row(f, fs, fg, sel, y, d, max_time - T, gcols[a:b], goffs[a:b],
+                which, te, h = _row(f, fs, fg, sel, y, d, max_time - T, gcols[a:b], go[a:b],
                                     dirs[a:b], rtol, atol, yev, h, work)
                 if which < 0 or gout[a + which] == 1:
                     ended = True

@@ -53,8 +53,16 @@ def build_walker(scene) -> HybridWalker:
 def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
     """The walker on the scene's ``terrain`` (stairs: the heel strike at the next tread,
     :func:`walkerlab.models.hybrid.ground.on_landing`); a slope: ``walker`` itself."""
-    from walkerlab.models.hybrid.ground import landing_drop, on_landing
+    from walkerlab.models.hybrid.ground import (
+        foothold_steps,
+        landing_drop,
+        on_footholds,
+        on_landing,
+    )
 
+    steps = foothold_steps(scene.terrain, scene.slope.phi_rad)
+    if steps is not None:  # footholds that differ from step to step
+        return _on_footholds(scene, walker, steps, on_footholds)
     drop = landing_drop(scene.terrain)
     if drop == 0.0:
         return walker
@@ -64,6 +72,71 @@ def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
         raise ValueError("terrain.kind: stairs and footholds need ideal.variant: derived "
                          "(the printed Appendix A equations know only the slope)")
     return on_landing(walker, walker_data(scene.walker, scene.slope.phi_rad), drop)
+
+
+def passive_walker_at(scene):
+    """``(walker_at, data_at)``: ``slope [rad] -> HybridWalker`` (the scene's passive rigid
+    walker on that slope, the scene's own at its slope) and ``slope -> WalkerData``."""
+    from walkerlab.walker.description import walker_data
+
+    own = {}
+
+    def at(g: float) -> HybridWalker:
+        if g == scene.slope.phi_rad:
+            if "w" not in own:
+                own["w"] = _passive(scene)
+            return own["w"]
+        return _passive(scene.model_copy(update={"slope": scene.slope.model_copy(
+            update={"angle_rad": float(g), "angle_deg": None})}))
+
+    return at, (lambda g: walker_data(scene.walker, g))
+
+
+def build_walker_on_steps(scene, steps) -> HybridWalker:
+    """The scene's rigid walker on a finite list of per-step grounds (a drawn rough ground,
+    ``simulate --terrain-seed``): step ``k`` lands ``steps[k][0]`` [m] below the stance
+    foot's level on ground of slope ``steps[k][1]`` [rad]; the walk ends after the list
+    (:func:`walkerlab.models.hybrid.ground.on_footholds`).
+
+    Raises
+    ------
+    ValueError
+        A ground other than the slope under it, or a walker that cannot walk it (one line).
+    """
+    from walkerlab.models.hybrid.ground import on_footholds
+
+    if scene.terrain is not None and not scene.terrain.is_slope:
+        raise ValueError(f"terrain.kind: {scene.terrain.kind}: per-step draws are of a slope "
+                         "(terrain.per_step on kind: slope)")
+    return _on_footholds(scene, _passive(scene), steps, on_footholds, periodic=False)
+
+
+def _on_footholds(scene, walker: HybridWalker, steps, on_footholds,
+                  periodic: bool | None = None) -> HybridWalker:
+    """The walker on footholds of several heights or slopes (``on_footholds``:
+    :func:`walkerlab.models.hybrid.ground.on_footholds`), each slope's walker built as the
+    scene's on that slope."""
+    from walkerlab.walker.description import walker_data
+
+    if walker.variant != "derived":
+        raise ValueError("terrain.kind: footholds need ideal.variant: derived (the printed "
+                         "Appendix A equations know only the slope)")
+    if getattr(scene.walker, "actuation", None) is not None:
+        raise ValueError("walker.actuation: footholds of several heights or slopes are built "
+                         "for passive walkers only")
+    if walker.actuators is not None or walker.step_entry is not None:
+        raise ValueError("terrain.kind: footholds of several heights or slopes: not built "
+                         "for this walker (flat feet or actuators)")
+
+    def at(g: float) -> HybridWalker:
+        if g == scene.slope.phi_rad:
+            return walker
+        return _passive(scene.model_copy(update={"slope": scene.slope.model_copy(
+            update={"angle_rad": float(g), "angle_deg": None})}))
+
+    if periodic is None:
+        periodic = scene.terrain.periodic is not False
+    return on_footholds(at, lambda g: walker_data(scene.walker, g), steps, periodic)
 
 
 def _passive(scene) -> HybridWalker:

@@ -1,4 +1,5 @@
-"""Mean first-passage time against the per-step slope's standard deviation, drawn from
+"""Mean first-passage time against the terrain's roughness (the per-step slope's or landing
+height's standard deviation), drawn from
 ``mfpt.h5`` only (as Byl & Tedrake 2009, Fig. 9: log MFPT against the terrain roughness)."""
 
 from __future__ import annotations
@@ -21,7 +22,9 @@ def plain_log_ticks(axis) -> None:
 
 
 def mfpt_figure(d, title: str = ""):
-    """log10 MFPT [steps] against sigma [rad]: Monte Carlo with 2 standard errors, mesh.
+    """log10 MFPT [steps] against the roughness: the per-step slope's sigma [rad], or the
+    per-step landing height's [mm] for a study of heights (``d.sigma_m``); Monte Carlo with
+    2 standard errors, mesh.
 
     Parameters
     ----------
@@ -30,7 +33,8 @@ def mfpt_figure(d, title: str = ""):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.0, 4.2), layout="constrained")
-    s = np.asarray(d.sigma_rad)
+    heights = getattr(d, "sigma_m", None) is not None  # a study of per-step heights
+    s = 1e3 * np.asarray(d.sigma_m) if heights else np.asarray(d.sigma_rad)
     mc, se = d["mfpt_steps_montecarlo"], d["mfpt_steps_montecarlo_stderr"]
     ok = np.isfinite(mc)
     if ok.any():
@@ -53,7 +57,8 @@ def mfpt_figure(d, title: str = ""):
                     label="mesh, converged (< 5 % on refinement)")
     ax.set_yscale("log")
     plain_log_ticks(ax.yaxis)
-    ax.set_xlabel("per-step slope standard deviation sigma [rad]")
+    ax.set_xlabel("per-step landing height standard deviation sigma [mm]" if heights else
+                  "per-step slope standard deviation sigma [rad]")
     ax.set_ylabel("MFPT [steps before the fall]")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)

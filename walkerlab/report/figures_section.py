@@ -38,7 +38,8 @@ CAPTIONS = [  # paper order: Figs. 2 and 6, then 7-10, then the studies beyond t
     ("bifurcation", "Bifurcation diagram over the slope."),
     ("basin", "Basin of attraction: where each cell of the Poincaré-section slice goes "
               "(left) and how many steps the converged cells take (right)."),
-    ("mfpt", "Mean first-passage time against the per-step slope's σ (`walkerlab mfpt`); "
+    ("mfpt", "Mean first-passage time against the terrain's roughness, the per-step "
+             "slope's σ or landing height's σ (`walkerlab mfpt`); "
              "open squares: mesh values whose refinement did not converge."),
     ("optimize", "Optimised step (direct collocation, `walkerlab optimize`): the torques "
                  "at the collocation points (left) and the link angles over the step "

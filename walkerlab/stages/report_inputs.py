@@ -47,7 +47,7 @@ def computed_for(scene: Scene, runs_root, stage: str, variants: tuple[str, ...] 
     if not stored_content_hash_matches(path):
         return f"{path.name} was changed after it was written"
     up = tuple(stage_artifact(scene, runs_root, s) for s in needs(stage, scene))
-    have, sections = stored_hash(path), stage_module(stage).SECTIONS
+    have, sections = stored_hash(path), stage_sections(stage, scene)
     for extra in (c for k in range(len(variants) + 1) for c in combinations(variants, k)):
         if have == input_hash(stage, scene, sections + extra, up):
             return ""
@@ -69,7 +69,14 @@ def _why_left_out(scene: Scene, stage: str, p: Path, full: bool) -> str:
         return f"an earlier standalone run: the scene has {NOT_RUN.get(stage, 'no section for it')}"
     if kind == "bifurcation" and not stored_content_hash_matches(p):  # edited by hand (26)
         return "changed after it was written: rerun 'walkerlab bifurcation'"
-    return EARLIER[kind] if changed_fields(p, scene, stage_module(kind).SECTIONS) else ""
+    return EARLIER[kind] if changed_fields(p, scene, stage_sections(kind, scene)) else ""
+
+
+def stage_sections(stage: str, scene: Scene) -> tuple[str, ...]:
+    """The scene sections ``stage``'s input hash covers (a module's ``sections(scene)``
+    where it depends on the scene, e.g. simulate on a drawn ground; else ``SECTIONS``)."""
+    mod = stage_module(stage)
+    return mod.sections(scene) if hasattr(mod, "sections") else mod.SECTIONS
 
 
 def report_artifacts(scene: Scene, runs_root, done: list, full: bool = False

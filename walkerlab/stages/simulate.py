@@ -10,7 +10,7 @@ from pathlib import Path
 
 from walkerlab.analysis.gait.rigid_run import simulate_run
 from walkerlab.config import Scene, SceneError
-from walkerlab.config.options import with_strides
+from walkerlab.config.options import with_strides, with_terrain_seed
 from walkerlab.io.freshness import input_hash
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
@@ -20,8 +20,17 @@ from walkerlab.stages.common import StageError, StageOutcome, run_cached
 SECTIONS = ("walker", "slope", "ideal", "solver", "simulate")
 
 
+def sections(scene: Scene) -> tuple[str, ...]:
+    """The sections the run depends on: :data:`SECTIONS`, and ``terrain`` (its per-step
+    distributions) for a run on a drawn ground (``simulate.terrain_seed``)."""
+    sim = scene.simulate
+    if sim is not None and sim.terrain_seed is not None:
+        return (*SECTIONS, "terrain")
+    return SECTIONS
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
-        strides: int | None = None) -> StageOutcome:
+        strides: int | None = None, terrain_seed: int | None = None) -> StageOutcome:
     """Simulate ``simulate.strides`` strides (2 steps each) and write ``simulate.h5``.
 
     The initial state is the fixed point from ``fixedpoint.h5`` (which must exist:
@@ -29,6 +38,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     ``strides`` (the scene's number), an existing run of the same walker with *more* strides
     (``simulate --strides 20``) is reused, and said so in ``StageOutcome.note``
     (:func:`walkerlab.io.schemas.simulate.longer_run_note`), rather than replaced.
+    ``terrain_seed`` (``--terrain-seed``): walk the per-step ground of ``terrain.per_step``
+    drawn from that seed (:func:`walkerlab.analysis.gait.rigid_run.rough_ground_steps`).
 
     Raises
     ------
@@ -37,18 +48,19 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
         is recorded (``StageOutcome.failure`` says so).
     """
     try:
-        scene = with_strides(scene, strides)
+        scene = with_terrain_seed(with_strides(scene, strides), terrain_seed)
     except SceneError as exc:
         raise StageError(str(exc)) from None
+    secs = sections(scene)
     upstream: tuple[Path, ...] = ()
     if scene.simulate.initial_state == "fixed_point":
         upstream = (stage_artifact(scene, runs_root, "fixedpoint"),)
     path, note = stage_artifact(scene, runs_root, "simulate"), ""
     if strides is None and not force:
         note = longer_run_note(path, scene.simulate.strides, lambda n: input_hash(
-            "simulate", with_strides(scene, n), SECTIONS, upstream))
+            "simulate", with_strides(scene, n), secs, upstream))
     out = (StageOutcome("simulate", path, True, 0.0, {}, note) if note else
-           run_cached("simulate", scene, runs_root, SECTIONS, upstream,
+           run_cached("simulate", scene, runs_root, secs, upstream,
                       lambda: _compute(scene, upstream), force))
     term = run_end(out.path)
     if term != "heel_strike":

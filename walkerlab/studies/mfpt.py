@@ -36,20 +36,40 @@ def scene_walker_at(scene):
     return at
 
 
-def step_map_for(base: dict) -> BatchStepMap:
+def step_map_for(base: dict, heights: bool = False) -> BatchStepMap:
     """The batched step map of a scene mapping (built once per process; a walker without
     compiled flows, e.g. flat feet, gets the row-by-row
-    :class:`~walkerlab.integrate.python_step.PythonStepMap`)."""
+    :class:`~walkerlab.integrate.python_step.PythonStepMap`); ``heights``: its heel strike
+    written as the swing foot's clearance, for per-step landing heights
+    (:func:`walkerlab.models.hybrid.ground.with_clearance_guard`).
+
+    Raises
+    ------
+    ValueError
+        ``heights`` for a walker without compiled flows or on a ground other than a slope
+        (one line).
+    """
     from walkerlab.config import MfptSettings, scene_from_dict
     from walkerlab.integrate.python_step import make_step_map
     from walkerlab.models.registry import build_walker
 
-    key = json.dumps(base, sort_keys=True)
+    key = json.dumps(base, sort_keys=True) + ("/heights" if heights else "")
     if key not in _MAPS:
         scene = scene_from_dict(base)
         st = scene.mfpt or MfptSettings()
+        walker = build_walker(scene)
+        if heights:
+            from walkerlab.integrate.python_step import needs_python_path
+            from walkerlab.models.hybrid.ground import with_clearance_guard
+            from walkerlab.walker.description import walker_data
+
+            if needs_python_path(walker) or walker.variant != "derived":
+                raise ValueError("mfpt.sigma_m: per-step heights need the compiled, generated "
+                                 "model (ideal.variant: derived; not flat feet)")
+            walker = with_clearance_guard(walker, walker_data(scene.walker,
+                                                              scene.slope.phi_rad))
         _MAPS.clear()
-        _MAPS[key] = make_step_map(build_walker(scene), scene_walker_at(scene), st.rtol,
+        _MAPS[key] = make_step_map(walker, scene_walker_at(scene), st.rtol,
                                    st.atol, st.max_step_time_s)
     return _MAPS[key]
 
@@ -72,6 +92,8 @@ class WalkTask:
         Step cap, the run's seed, the chunk's index.
     distribution : str
         ``normal`` or ``uniform``.
+    heights : (str, float) or None
+        Per-step landing heights' distribution and standard deviation [m]; None: none.
     """
 
     base: dict
@@ -82,6 +104,7 @@ class WalkTask:
     seed: int
     distribution: str
     index: int
+    heights: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -108,9 +131,9 @@ class ImageTask:
 
 def run_walks(task: WalkTask):
     """``(index, steps, fell)`` of a chunk of walks."""
-    sm = step_map_for(task.base)
+    sm = step_map_for(task.base, task.heights is not None)
     res = M.monte_carlo(sm, np.asarray(task.x0), task.sd, task.walks, task.max_steps,
-                        task.seed, distribution=task.distribution)
+                        task.seed, distribution=task.distribution, heights=task.heights)
     return task.index, res.steps, res.fell
 
 
@@ -123,7 +146,7 @@ def run_images(task: ImageTask):
 
 def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, seed: int,
                 distribution: str = "normal", workers: int = 1, scheduler=None,
-                partial=None) -> M.MonteCarloResult:
+                partial=None, heights: tuple | None = None) -> M.MonteCarloResult:
     """Monte Carlo MFPT walks of a scene at one sigma [rad] (see
     :func:`walkerlab.analysis.robustness.mfpt.monte_carlo`), chunked over the executor.
 
@@ -131,7 +154,9 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
     there by an interrupted run are taken as they are (a chunk's walks do not depend on
     when or where they ran), and every chunk that finishes is stored.
 
-    ``x0`` (2n,): the gait's post-impact state (``state_names()``, [rad, rad/s]).  The
+    ``x0`` (2n,): the gait's post-impact state (``state_names()``, [rad, rad/s]).
+    ``heights`` ``(distribution, sd [m])``: per-step landing heights too
+    (:func:`walkerlab.analysis.robustness.mfpt.height_rows`).  The
     censored geometric estimate of Byl & Tedrake (2009) is
     :attr:`~walkerlab.analysis.robustness.mfpt.MonteCarloResult.mfpt` [steps].
     """
@@ -141,12 +166,16 @@ def monte_carlo(scene, x0: np.ndarray, sd: float, walks: int, max_steps: int, se
     base = scene.model_dump(mode="json")
     tasks = [WalkTask(base, tuple(float(v) for v in x0), float(sd),
                       tuple(range(a, min(a + WALKS_PER_TASK, walks))), max_steps, seed,
-                      distribution, i)
+                      distribution, i, None if heights is None else
+                      (str(heights[0]), float(heights[1])))
              for i, a in enumerate(range(0, walks, WALKS_PER_TASK))]
     steps = np.zeros(walks, dtype=np.int64)
     fell = np.zeros(walks, dtype=bool)
 
     def name(i: int) -> str:
+        if heights is not None:
+            return (f"montecarlo/sigma={float(sd)!r}/height={heights[0]}:"
+                    f"{float(heights[1])!r}/chunk={i}")
         return f"montecarlo/sigma={float(sd)!r}/chunk={i}"
 
     def put(i, s, f):
@@ -298,6 +327,8 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
     per = scene.terrain.per_step if scene.terrain is not None else None
     dist = per.slope_distribution if per is not None else "normal"
     seed = per.seed if per is not None else st.seed
+    if getattr(st, "sigma_m", None) is not None:
+        return _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial)
     walker = build_walker(scene)
     contact = getattr(st, "model", "rigid") == "contact"
     if contact:
@@ -347,6 +378,35 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
                       "change": r.change if math.isfinite(r.change) else math.nan}
                      for r in all_meshes]
     return MfptData(sig, vals, st.method, walker.state_names(), hist)
+
+
+def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial):
+    """:func:`mfpt_study` over per-step landing heights (``st.sigma_m`` [m], each step's
+    slope drawn with ``terrain.per_step.slope_sd_rad``): Monte Carlo at each level."""
+    import time
+
+    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
+    from walkerlab.models.registry import build_walker
+
+    walker = build_walker(scene)
+    step_map_for(scene.model_dump(mode="json"), True)  # validates the walker here
+    hdist = per.heights[0] if per is not None else "normal"
+    slope_sd = float(per.slope_sd_rad) if per is not None else 0.0
+    sig_m = np.asarray(st.sigma_m, float)
+    vals = {k: np.full(sig_m.size, np.nan) for k in VARIABLES}
+    for i, sd_m in enumerate(sig_m):
+        t = time.perf_counter()
+        mc = monte_carlo(scene, x_star, slope_sd, st.walks, st.max_steps, seed, dist,
+                         workers, scheduler, partial, heights=(hdist, float(sd_m)))
+        m, se = mc.mfpt
+        vals["mfpt_steps_montecarlo"][i] = m
+        vals["mfpt_steps_montecarlo_stderr"][i] = se
+        vals["montecarlo_walks"][i] = mc.steps.size
+        vals["montecarlo_falls"][i] = int(mc.fell.sum())
+        vals["montecarlo_heel_strikes"][i] = int(mc.steps.sum())
+        vals["montecarlo_wall_time_s"][i] = time.perf_counter() - t
+    return MfptData(np.full(sig_m.size, slope_sd), vals, st.method, walker.state_names(), [],
+                    sigma_m=sig_m)
 
 
 def _contact_start(scene, x_star: np.ndarray, st):
@@ -435,7 +495,8 @@ def mfpt_summary(data, rel_change: float | None = None) -> dict:
     or, when the mesh's refinement did not converge, why
     (:meth:`walkerlab.io.schemas.mfpt.MfptData.mesh_notes`; ``rel_change``:
     ``mfpt.mesh_rel_change``)."""
-    return {"sigma_rad": list(map(float, data.sigma_rad)),
+    heights = {} if data.sigma_m is None else {"sigma_m": list(map(float, data.sigma_m))}
+    return {"sigma_rad": list(map(float, data.sigma_rad)), **heights,
             "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
             "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"])),
             "mesh_note": data.mesh_notes(rel_change)}

@@ -203,8 +203,8 @@ def _step_map(walker, x, solver, max_step_time, jacobian, steps):
     legs = walker.legs
     period, nfev, DP = 0.0, 0, np.eye(np.size(x))
     for k in range(walker.steps_per_map):
-        stance = legs[1] if k == 0 else legs[0]
-        seg = integrate_step(walker.for_stance(stance), x, solver, t0=period,
+        stance = legs[1] if k % 2 == 0 else legs[0]
+        seg = integrate_step(walker.for_step(k), x, solver, t0=period,
                              max_step_time=max_step_time, variational=jacobian, index=k,
                              stance_leg=stance)
         if steps is not None:

@@ -49,8 +49,11 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
         (:func:`walkerlab.analysis.gait.metrics.sample_trajectory`).
     """
     sim = scene.simulate
-    traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
-                          max_step_time=sim.max_step_time_s)
+    if scene.terrain is not None and scene.terrain.kind == "profile":
+        traj = profile_walk(scene, x0, 2 * sim.strides)
+    else:
+        traj = simulate_steps(walker, x0, 2 * sim.strides, Solver.from_settings(scene.solver),
+                              max_step_time=sim.max_step_time_s)
     samples = sample_trajectory(traj, sim.sample_rate_hz)
     steps = step_table(traj)
     ok = steps["termination"] == "heel_strike"
@@ -106,8 +109,73 @@ def simulate_run(scene: Scene, fixed_point=None):
             x0 = initial_state(sim.initial_state, walker.state_names())
         except ValueError as exc:
             raise ValueError(f"simulate.initial_state: {exc}") from None
+    if sim.terrain_seed is not None:
+        walker = rough_ground_walker(scene, 2 * sim.strides)
     r = simulate_scene(scene, walker, x0)
     from walkerlab.analysis.gait.energy import trajectory_ledger
 
     return SimulateRun(walker, r.trajectory, r.samples, r.steps, x0, sim.strides,
                        total_mass_kg(walker), r.summary, trajectory_ledger(r.trajectory))
+
+
+def rough_ground_steps(scene, n_steps: int) -> list[tuple[float, float]]:
+    """``[(drop_m, slope_rad), ...]`` of the first ``n_steps`` steps of the per-step ground
+    ``terrain.per_step`` drawn from ``simulate.terrain_seed``: walk 0 of that seed's Monte
+    Carlo streams (:func:`walkerlab.analysis.robustness.slope_stream.slope_rows`, the
+    landing heights :func:`walkerlab.analysis.robustness.mfpt.height_rows`), so a seed
+    names one ground, the same on every run and machine; ``drop_m`` is minus the height.
+
+    Raises
+    ------
+    ValueError
+        No ``terrain.per_step`` section (one line).
+    """
+    from walkerlab.analysis.robustness.mfpt import height_rows
+    from walkerlab.analysis.robustness.slope_stream import slope_rows
+
+    per = scene.terrain.per_step if scene.terrain is not None else None
+    if per is None:
+        raise ValueError("simulate.terrain_seed: the scene has no terrain.per_step (the "
+                         "distribution of each step's slope and landing height)")
+    seed = int(scene.simulate.terrain_seed)
+    g = slope_rows(seed, [0], 0, n_steps, scene.slope.phi_rad, per.slope_sd_rad,
+                   per.slope_distribution)[0]
+    dist, sd = per.heights
+    h = height_rows(seed, [0], 0, n_steps, sd, dist)[0] if sd > 0 else np.zeros(n_steps)
+    return [(-float(hk), float(gk)) for hk, gk in zip(h, g)]
+
+
+def rough_ground_walker(scene, n_steps: int):
+    """The scene's rigid walker on :func:`rough_ground_steps` (its walk ends after them).
+
+    Raises
+    ------
+    ValueError
+        As :func:`rough_ground_steps` and
+        :func:`walkerlab.models.registry.build_walker_on_steps` (one line).
+    """
+    from walkerlab.models.registry import build_walker_on_steps
+
+    return build_walker_on_steps(scene, rough_ground_steps(scene, n_steps))
+
+
+def profile_walk(scene, x0: np.ndarray, n_steps: int):
+    """``n_steps`` steps of the scene's rigid walker on its height profile from ``x0``
+    (:func:`walkerlab.analysis.gait.profile_walk.simulate_on_profile`).
+
+    Raises
+    ------
+    ValueError
+        A profile only in a CSV file, a walker with actuators or printed equations (one
+        line).
+    """
+    from walkerlab.analysis.gait.profile_walk import profile_points, simulate_on_profile
+    from walkerlab.models.registry import passive_walker_at
+
+    if getattr(scene.walker, "actuation", None) is not None or scene.ideal.variant != "derived":
+        raise ValueError("terrain.kind: profile: walked by the passive walker of the "
+                         "generated model only (no walker.actuation, ideal.variant: derived)")
+    at, data_at = passive_walker_at(scene)
+    return simulate_on_profile(at, data_at, profile_points(scene.terrain), x0, n_steps,
+                               Solver.from_settings(scene.solver),
+                               max_step_time=scene.simulate.max_step_time_s)

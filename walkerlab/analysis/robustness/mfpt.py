@@ -92,6 +92,30 @@ def draw_slopes(seed: int, walk: int, n: int, mean: float, sd: float,
     return mean + sd * rng.standard_normal(n)
 
 
+#: walk ``w``'s landing heights come from the stream of walk ``w + HEIGHT_STREAM`` of the
+#: same seed (:func:`height_rows`): independent of its slopes, replayable from the seed
+HEIGHT_STREAM = 2**31
+
+
+def height_rows(seed: int, walks, start: int, n: int, sd: float,
+                distribution: str = "normal") -> np.ndarray:
+    """Landing heights [m] above the slope line of steps ``start .. start + n - 1`` of each
+    walk in ``walks`` (each in ``[0, 2**31)``), about 0 with standard deviation ``sd`` [m]:
+    :func:`walkerlab.analysis.robustness.slope_stream.slope_rows` of the walks
+    ``w + HEIGHT_STREAM``; shape (len(walks), n).
+
+    Raises
+    ------
+    ValueError
+        A negative seed, a walk number outside ``[0, 2**31)``.
+    """
+    walks = [int(w) for w in walks]
+    if any(not 0 <= w < HEIGHT_STREAM for w in walks):
+        raise ValueError("walk numbers of per-step heights must be in [0, 2**31)")
+    return slope_rows(seed, [w + HEIGHT_STREAM for w in walks], start, n, 0.0, sd,
+                      distribution)
+
+
 @dataclass
 class MonteCarloResult:
     """Monte Carlo walks on per-step slopes.
@@ -115,7 +139,8 @@ class MonteCarloResult:
 
 def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range | list,
                 max_steps: int, seed: int, mean: float | None = None,
-                distribution: str = "normal", block: int = 64) -> MonteCarloResult:
+                distribution: str = "normal", block: int = 64,
+                heights: tuple[str, float] | None = None) -> MonteCarloResult:
     """Walk ``len(walks)`` walkers from ``x0`` on random per-step slopes until each falls or
     reaches ``max_steps`` heel strikes (Byl & Tedrake 2009; module docstring, "Monte
     Carlo").
@@ -137,6 +162,10 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
     mean : float, optional
         Mean slope [rad]; default the walker's.
     distribution : {"normal", "uniform"}
+    heights : (distribution, sd [m]), optional
+        Each step's landing also lies a height drawn so (:func:`height_rows`) above the
+        slope line through the stance foot (``step_map`` built on
+        :func:`walkerlab.models.hybrid.ground.with_clearance_guard`).
 
     Returns
     -------
@@ -157,7 +186,12 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
             nb = min(wb, max_steps - k)
             slopes = slope_rows(seed, [walks[i] for i in alive], k, nb, mean, sd,
                                 distribution)
-            s, f, X[alive] = step_map.walk(X[alive], slopes)
+            if heights is None:
+                s, f, X[alive] = step_map.walk(X[alive], slopes)
+            else:
+                hts = height_rows(seed, [walks[i] for i in alive], k, nb, heights[1],
+                                  heights[0])
+                s, f, X[alive] = step_map.walk(X[alive], slopes, hts)
             steps[alive] += s
             fell[alive] = f
             alive = alive[~f]
@@ -169,7 +203,12 @@ def monte_carlo(step_map: BatchStepMap, x0: np.ndarray, sd: float, walks: range 
         j = k % block
         if j == 0:  # the next block of slopes of every walk (same numbers for any grouping)
             slopes = slope_rows(seed, walks, k, block, mean, sd, distribution)
-        res = step_map.step(X[alive], slopes[alive, j])
+            if heights is not None:
+                hts = height_rows(seed, walks, k, block, heights[1], heights[0])
+        if heights is None:
+            res = step_map.step(X[alive], slopes[alive, j])
+        else:
+            res = step_map.step(X[alive], slopes[alive, j], height_m=hts[alive, j])
         ok = res.outcome == HEEL_STRIKE
         steps[alive[ok]] += 1
         fell[alive[~ok]] = True

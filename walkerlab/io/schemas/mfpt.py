@@ -15,6 +15,9 @@ Layout (netCDF-4 conventions: ``sigma_rad`` is the coordinate / dimension scale)
     mesh_converged                  (sigma,)  -      change < the scene's mesh_rel_change
     mesh_escaped                    (sigma,)  -      off-mesh probability per step
     mesh_wall_time_s, montecarlo_wall_time_s (sigma,) s
+    sigma_m                         (sigma,)  m      per-step landing height standard
+                                                     deviation (a study of heights only:
+                                                     sigma_rad is then the slope's, fixed)
 """
 
 from __future__ import annotations
@@ -61,6 +64,9 @@ class MfptData:
     state_names : list of str
     mesh_history : list of dict
         Every mesh of every sigma: ``sigma_rad, h, cells, mfpt_steps, change``.
+    sigma_m : ndarray or None
+        The roughness levels of a study of per-step landing heights [m] (``mfpt.sigma_m``);
+        None: a study of per-step slopes.
     """
 
     sigma_rad: np.ndarray
@@ -68,6 +74,7 @@ class MfptData:
     method: str
     state_names: list
     mesh_history: list
+    sigma_m: np.ndarray | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.values[name]
@@ -102,6 +109,9 @@ def write(f, data: MfptData) -> None:
                "standard deviation of the per-step slope")
     for name, (unit, desc) in VARIABLES.items():
         put(f, name, np.asarray(data.values[name], float), unit, desc, dims=("sigma_rad",))
+    if data.sigma_m is not None:
+        put(f, "sigma_m", np.asarray(data.sigma_m, float), "m",
+            "standard deviation of the per-step landing height", dims=("sigma_rad",))
     f.attrs["method"] = data.method
     f.attrs["state_names"] = list(data.state_names)
     hist = data.mesh_history
@@ -130,4 +140,5 @@ def load(path: Path) -> MfptData:
         hist = [{c: float(arrays[c][i]) for c in hist_cols}
                 for i in range(len(arrays["sigma_rad"]))]
         return MfptData(sigma, values, str(f.attrs["method"]),
-                        [str(s) for s in f.attrs["state_names"]], hist)
+                        [str(s) for s in f.attrs["state_names"]], hist,
+                        f["sigma_m"][()] if "sigma_m" in f else None)

@@ -208,6 +208,14 @@ class HybridWalker:
         stays closed (a flat foot's trailing toe, kept on the ground when its impulse is
         compressive) and the phase the step begins in (None: ``phases[0]``).  None: the
         step begins in ``phases[0]`` from the reset's state.
+    cycle : tuple of HybridWalker or None
+        The walkers of the steps of one Poincaré map in order, when the ground differs from
+        step to step (footholds of several heights or slopes,
+        :func:`walkerlab.models.hybrid.ground.on_footholds`): step ``k`` of a walk is taken
+        by ``cycle[k % len(cycle)]`` (:meth:`for_step`); None: :attr:`mirror` decides.
+    cycle_periodic : bool
+        Whether :attr:`cycle` repeats (a periodic ground); False: the ground ends after its
+        steps (a finite foothold list: a walk stops there).
     """
 
     name: str
@@ -232,6 +240,15 @@ class HybridWalker:
     actuators: object | None = None
     matrices: Callable[[np.ndarray], tuple] | None = None
     step_entry: Callable[[np.ndarray], tuple] | None = None
+    cycle: tuple | None = None
+    cycle_periodic: bool = True
+
+    def for_step(self, k: int) -> HybridWalker:
+        """The walker of step ``k`` (0-based from the map's start, ``legs[1]`` in stance
+        first): ``cycle[k % len(cycle)]``, else this one or :attr:`mirror` by stance leg."""
+        if self.cycle is not None:
+            return self.cycle[k % len(self.cycle)]
+        return self.for_stance(self.legs[1] if k % 2 == 0 else self.legs[0])
 
     def for_stance(self, stance_leg: str) -> HybridWalker:
         """The walker of a step with ``stance_leg`` in stance (this one or :attr:`mirror`)."""
@@ -241,7 +258,10 @@ class HybridWalker:
 
     @property
     def steps_per_map(self) -> int:
-        """Steps in one Poincaré map: 1 (mirror-image legs) or 2 (a stride)."""
+        """Steps in one Poincaré map: 1 (mirror-image legs), 2 (a stride) or the period of
+        :attr:`cycle` (a ground that differs from step to step)."""
+        if self.cycle is not None:
+            return len(self.cycle)
         return 1 if self.mirror is None else 2
 
     @property

@@ -35,19 +35,22 @@ from scipy.optimize import newton
 from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import HybridWalker, Phase
 
-__all__ = ["landing_drop", "on_landing"]
+__all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing",
+           "with_clearance_guard"]
 
 
 def landing_drop(terrain) -> float:
     """Depth [m] of each step's landing below the stance foot's level for a ground whose
     every step is alike (``terrain.kind: stairs``: ``+riser_m`` down, ``-riser_m`` up;
-    ``footholds`` of one height ``h``: ``-h``, on the scene's slope); 0.0 for the slope.
+    ``footholds`` of one height ``h``: ``-h``, on the scene's slope); 0.0 for the slope and
+    for a profile (walked step by step, :mod:`walkerlab.analysis.gait.profile_walk`, from
+    the gait of the scene's slope).
 
     Raises
     ------
     ValueError
-        A ground whose steps differ (footholds of several heights or of their own slopes,
-        a profile): one line.
+        A ground whose steps differ (footholds of several heights or of their own slopes:
+        :func:`foothold_steps` and :func:`on_footholds` walk them): one line.
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
@@ -56,16 +59,39 @@ def landing_drop(terrain) -> float:
     if terrain.kind == "footholds":
         h = set(terrain.foothold_heights_m or (0.0,))
         if terrain.foothold_slopes_rad is not None:
-            raise ValueError("terrain.foothold_slopes_rad: footholds of their own slopes are "
-                             "not built in the rigid model yet (the scene's slope is every "
-                             "foothold's)")
+            raise ValueError("terrain.foothold_slopes_rad: footholds of their own slopes "
+                             "differ from step to step: not one landing for every step (the "
+                             "rigid model walks them, one walker per step)")
         if len(h) == 1:
             return -float(h.pop())
-        raise ValueError("terrain.foothold_heights_m: footholds of different heights are not "
-                         "built in the rigid model yet (its period-1 gait needs one landing "
-                         "height for every step)")
-    raise ValueError(f"terrain.kind: {terrain.kind}: the rigid model walks slopes, stairs "
-                     "and footholds of one height; height profiles are not built yet")
+        raise ValueError("terrain.foothold_heights_m: footholds of different heights "
+                         "differ from step to step: not one landing for every step (the "
+                         "rigid model walks them, one walker per step)")
+    # a profile: walked step by step (walkerlab.analysis.gait.profile_walk); its periodic
+    # gait, the start of the walk, is the scene's slope's
+    return 0.0
+
+
+def foothold_steps(terrain, slope_rad: float) -> tuple[tuple[float, float], ...] | None:
+    """``((drop_m, slope_rad), ...)``: each step's landing depth [m] below the stance foot's
+    level and ground slope [rad] on footholds that differ from step to step (``terrain.kind:
+    footholds`` with several heights or with ``foothold_slopes_rad``), one per step in the
+    list's order; None for a ground whose every step is alike (:func:`landing_drop`).
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings or None
+    slope_rad : float
+        The scene's slope [rad] (every foothold's without ``foothold_slopes_rad``).
+    """
+    if terrain is None or terrain.kind != "footholds":
+        return None
+    h, g = terrain.foothold_heights_m, terrain.foothold_slopes_rad
+    if g is None and len(set(h or (0.0,))) == 1:
+        return None
+    n = len(h) if h else len(g)
+    return tuple((-float(h[k]) if h else 0.0, float(g[k]) if g else float(slope_rad))
+                 for k in range(n))
 
 
 def _clearance_names(f: dict) -> str:
@@ -152,6 +178,26 @@ def on_landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
     """
     if drop_m == 0.0:
         return walker
+    return _landing(walker, data, float(drop_m))
+
+
+def with_clearance_guard(walker: HybridWalker, data) -> HybridWalker:
+    """``walker`` with its heel strike written as the swing foot's clearance above the slope
+    line (:func:`on_landing`'s guard at a landing of depth 0: the same surface as the
+    walker's own heel strike, located on another function): the guard whose offset a
+    per-step landing height shifts (:meth:`walkerlab.integrate.batch_step.BatchStepMap.step`
+    ``height_m``).
+
+    Raises
+    ------
+    ValueError
+        As :func:`on_landing`.
+    """
+    return _landing(walker, data, 0.0)
+
+
+def _landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
+    """:func:`on_landing`'s walker for any ``drop_m`` (0 included)."""
     if data.structure.foot == "flat":
         raise ValueError("terrain.kind: flat feet on stairs or footholds are not supported yet "
                          "(their heel strike is a guard per foot mode)")
@@ -176,10 +222,69 @@ def on_landing(walker: HybridWalker, data, drop_m: float) -> HybridWalker:
                             constraint=ph.constraint))
     mirror = walker.mirror
     if mirror is not None and data.mirror is not None:  # legs that differ: the next step's
-        mirror = on_landing(mirror, replace(data.mirror, mirror_params=None), drop_m)
+        mirror = _landing(mirror, replace(data.mirror, mirror_params=None), drop_m)
     return replace(walker, phases=tuple(phases),
                    heel_strike_guard=partial(_at, clear, offset),
                    from_section=_LandingSection(walker, clear, grad, offset),
                    params={**walker.params, "landing_drop_m": float(drop_m)},
                    mirror=mirror)
 
+
+
+def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalker:
+    """The walker on footholds that differ from step to step: step ``k`` lands
+    ``steps[k][0]`` [m] below the stance foot's level on ground of slope ``steps[k][1]``
+    [rad] (its heel strike the generated clearance above that slope's line plus
+    ``drop cos(slope)``, :func:`on_landing`); one Poincaré map walks the whole list (a
+    period-``p`` map, ``p = len(steps)``; legs that differ: ``lcm(p, 2)`` steps, each step the
+    leg in stance's own walker, as the stride of :attr:`HybridWalker.mirror`).
+
+    Parameters
+    ----------
+    walker_at : callable ``slope [rad] -> HybridWalker``
+        The scene's passive walker on a slope (absolute coordinates: the state is carried
+        from one step's slope to the next).
+    data_at : callable ``slope [rad] -> WalkerData``
+        Its description.
+    steps : sequence of (float, float)
+        ``(drop_m, slope_rad)`` per step (:func:`foothold_steps`).
+    periodic : bool
+        The list repeats (False: a walk ends after it).
+
+    Returns
+    -------
+    HybridWalker
+        Step 0's walker with :attr:`~HybridWalker.cycle` the walkers of every step of one
+        map; its section (``from_section``) is the post-impact surface of the map's last
+        step (the old stance foot ``drop cos(slope)`` above the last landing's line).
+
+    Raises
+    ------
+    ValueError
+        Coordinates measured from the slope with footholds of several slopes, or the
+        refusals of :func:`on_landing` (one line).
+    """
+    steps = tuple((float(d), float(g)) for d, g in steps)
+    base = {g: walker_at(g) for g in sorted({g for _, g in steps})}
+    data = {g: data_at(g) for g in base}
+    if len(base) > 1 and any(d.structure.coordinates != "absolute" for d in data.values()):
+        raise ValueError("terrain.foothold_slopes_rad: the walker's coordinates are measured "
+                         "from the slope (walker.coordinates); footholds of several slopes "
+                         "need absolute coordinates")
+    first = base[steps[0][1]]
+    legs_differ = first.mirror is not None
+    p = len(steps)
+    n = p * 2 if legs_differ and p % 2 else p
+    cycle = []
+    for k in range(n):
+        drop, g = steps[k % p]
+        w, d = base[g], data[g]
+        if legs_differ and k % 2 == 1:  # legs[0] in stance: the other leg's numbers
+            w, d = w.mirror, replace(d.mirror, mirror_params=None)
+        cycle.append(on_landing(replace(w, mirror=None), d, drop))
+    last = cycle[-1]
+    return replace(cycle[0], cycle=tuple(cycle), cycle_periodic=bool(periodic),
+                   mirror=cycle[1] if legs_differ else None,
+                   section=last.section, from_section=last.from_section,
+                   params={**cycle[0].params,  # the mean drop: downhill on average
+                           "landing_drop_m": sum(d for d, _ in steps) / p})
