@@ -24,6 +24,7 @@ EXTRAS = {
     "api": "the Python API's datasets (xarray, h5netcdf)",
     "notebook": "examples/walkerlab_tour.ipynb (Jupyter)",
     "numbalsoda": "contact_solver.method numbalsoda (builds with cmake, g++, gfortran)",
+    "osim": "the OpenSim export walked in OpenSim (walkerlab.export.opensim_walk; tests)",
 }
 
 
