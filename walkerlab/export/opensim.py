@@ -48,9 +48,10 @@ Forces:
   ``CoordinateActuator`` per joint (``leg<i>_hip_motor``, ``leg<i>_knee_motor``;
   ``optimal_force`` 1 N m, so the control is the torque), the laws in a comment; the
   push-off (``walker.actuation.push_off``) is a ``PrescribedForce`` ``leg<i>_push_off`` on
-  each leg at its foot along the leg (foot to hip), applying no force by default: a
-  stepping loop switches it on for one pulse of ``P / T`` after each heel strike
-  (:mod:`walkerlab.export.opensim_walk`, as the MJCF's loop does).
+  each leg at its foot along the leg (foot to hip), ``F = impulse_n_s / T`` (``T`` the
+  scene's ``contact.push_off_duration_s``), applying no force by default: a stepping loop
+  switches the trailing leg's on for ``T`` from each heel strike, as the MJCF's loop does
+  (:mod:`walkerlab.export.opensim_walk`).
 """
 
 from __future__ import annotations
@@ -379,7 +380,8 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
             "leg<i>_push_off, F = impulse_n_s / T along the leg from foot to hip at its foot, "
             "applies no force by default; a stepping loop (walkerlab.export.opensim_walk) "
             f"switches the trailing leg's on for T = {gait.push_off_duration_s:g} s from each "
-            "heel strike (P / F for a law whose impulse P depends on the hip's speed)."))
+            "heel strike (P / F for a law whose impulse P depends on the hip's speed; the rigid "
+            "model pushes off immediately before heel strike)."))
     if gait.actuation_json is not None:
         out.append(comment(f"walkerlab_actuation: {gait.actuation_json}"))
     if mb.knee and mb.knee_stop:
