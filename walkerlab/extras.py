@@ -25,6 +25,7 @@ EXTRAS = {
     "notebook": "examples/walkerlab_tour.ipynb (Jupyter)",
     "numbalsoda": "contact_solver.method numbalsoda (builds with cmake, g++, gfortran)",
     "gym": "walkerlab.gym: the walker as a Gymnasium environment",
+    "osim": "the OpenSim export walked in OpenSim (walkerlab.export.opensim_walk; tests)",
 }
 
 

@@ -52,14 +52,16 @@ def animate(scene: Path | None = SceneArg, runs_dir: Path = RunsOpt) -> None:
 @guard
 def export(scene: Path | None = SceneArg,
            fmt: str = typer.Option("urdf", "--format", help="urdf (Drake, Pinocchio), mjcf "
-                                   "(MuJoCo) or adm (MSC Adams Solver .adm + .acf)"),
+                                   "(MuJoCo), adm (MSC Adams Solver .adm + .acf) or osim "
+                                   "(OpenSim)"),
            runs_dir: Path = RunsOpt,
            walker_only: bool = typer.Option(
                False, "--walker-only", help="urdf/mjcf: the walker alone, without the rigid "
                "gait (no keyframe; the MJCF on a plane with MuJoCo's default contact)")) -> None:
     """Write the walker as a floating planar multibody model: runs/<scene>/walker.urdf,
-    walker.xml, or walker.adm + walker.acf (Adams Solver).  The URDF and MJCF carry the rigid
-    gait (found as `walkerlab fixedpoint` finds it) as a keyframe."""
+    walker.xml, walker.adm + walker.acf (Adams Solver) or walker.osim (OpenSim).  The URDF,
+    MJCF and OpenSim model carry the rigid gait (found as `walkerlab fixedpoint` finds it) as
+    a keyframe (OpenSim: the default state)."""
     from walkerlab.stages import export as stage
 
     sc = load(scene)

@@ -1,5 +1,6 @@
-"""Stage ``export``: the scene's walker as a URDF or MJCF file, or an Adams Solver dataset and
-command file (``--format adm``: :mod:`walkerlab.export.adams`), in ``runs/<scene>/``.
+"""Stage ``export``: the scene's walker as a URDF or MJCF file, an Adams Solver dataset and
+command file (``--format adm``: :mod:`walkerlab.export.adams`) or an OpenSim model
+(``--format osim``: :mod:`walkerlab.export.opensim`), in ``runs/<scene>/``.
 
 Not an HDF5 artifact: an exchange file for multibody libraries (Drake, Pinocchio read URDF;
 MuJoCo reads MJCF), written from the scene's ``walker`` and ``slope`` sections only (no
@@ -29,6 +30,7 @@ from walkerlab.export.multibody import (
     mjcf_text,
     urdf_text,
 )
+from walkerlab.export.opensim import OSIM_FILE, check_osim_exportable, osim_gait, osim_text
 from walkerlab.export.scene import actuation_json, check_exportable, mjcf_scene
 from walkerlab.io import runpaths
 from walkerlab.units import for_scene
@@ -46,9 +48,11 @@ def export_path(scene: Scene, runs_root: Path | str, fmt: str, claim: bool = Fal
     """
     if fmt == "adm":
         return runpaths.scene_file(scene, runs_root, ADAMS_FILES["adm"], claim)
+    if fmt == "osim":
+        return runpaths.scene_file(scene, runs_root, OSIM_FILE, claim)
     if fmt not in FORMATS:
         raise ValueError(f"--format: unknown format {fmt!r} (choose "
-                         f"{', '.join(FORMATS)} or adm)")
+                         f"{', '.join(FORMATS)}, adm or osim)")
     return runpaths.scene_file(scene, runs_root, FORMATS[fmt], claim)
 
 
@@ -85,13 +89,26 @@ def _run_adams(scene: Scene, runs_root, mb, data, name: str) -> Path:
     return path
 
 
-def _gait_scene(scene: Scene, mb, data, runs_root):
-    """The MJCF's gait keyframe, terrain and contact (the gait of an up-to-date
-    ``fixedpoint.h5``, else searched); no rigid gait: one line."""
+def _run_osim(scene: Scene, runs_root, mb, data, name: str, walker_only: bool) -> Path:
+    """``walker.osim``: the walker, its gait as the default state, its ground and contact."""
+    if walker_only:
+        raise ValueError("--walker-only: the OpenSim export carries the gait, ground and "
+                         "contact (its default state is the rigid gait); drop --walker-only")
+    check_osim_exportable(scene, mb)  # before the gait search
+    check_exportable(scene, "osim")
+    gait = _gait(scene, runs_root, lambda ideal: osim_gait(scene, mb, data, ideal))
+    text = osim_text(mb, gait, name, walkerlab.__version__)
+    path = export_path(scene, runs_root, "osim", claim=True)
+    runpaths.atomic_texts([(path, comments_in_scene_units(text, for_scene(scene)))])
+    return path
+
+
+def _gait(scene: Scene, runs_root, build):
+    """``build(ideal gait)``; no rigid gait: one line."""
     from walkerlab.analysis.gait.poincare import FixedPointNotFound
 
     try:
-        return mjcf_scene(scene, mb, data, stored_gait(scene, runs_root))
+        return build(stored_gait(scene, runs_root))
     except FixedPointNotFound as exc:
         where = ("its fixedpoint section" if scene.fixedpoint is not None
                  else "an automatic search (the scene has no fixedpoint section)")
@@ -100,10 +117,17 @@ def _gait_scene(scene: Scene, mb, data, runs_root):
                          f"{' '.join(str(exc).split())}") from None
 
 
+def _gait_scene(scene: Scene, mb, data, runs_root):
+    """The MJCF's gait keyframe, terrain and contact (the gait of an up-to-date
+    ``fixedpoint.h5``, else searched); no rigid gait: one line."""
+    return _gait(scene, runs_root, lambda ideal: mjcf_scene(scene, mb, data, ideal))
+
+
 def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
         walker_only: bool = False) -> Path:
-    """Write the scene's walker as ``fmt`` ("urdf", "mjcf" or "adm": ``walker.adm`` and
-    ``walker.acf``, returning the .adm's path) into
+    """Write the scene's walker as ``fmt`` ("urdf", "mjcf", "adm": ``walker.adm`` and
+    ``walker.acf``, returning the .adm's path, or "osim": ``walker.osim``,
+    :mod:`walkerlab.export.opensim`) into
     ``<runs_root>/<scene name>/`` and return the file's path.
 
     The URDF and MJCF carry the rigid gait (the MJCF's ``gait`` keyframe, terrain and
@@ -140,6 +164,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     name = scene.name or "walker"
     if fmt == "adm":
         return _run_adams(scene, runs_root, mb, data, name)
+    if fmt == "osim":
+        return _run_osim(scene, runs_root, mb, data, name, walker_only)
     check_exportable(scene, fmt, walker_only)
     extra = None if walker_only else _gait_scene(scene, mb, data, runs_root)
     if fmt == "urdf":

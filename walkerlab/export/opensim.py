@@ -1,0 +1,538 @@
+"""The walker as an OpenSim model (``walkerlab export SCENE --format osim``: ``walker.osim``).
+
+OpenSim 4 (Delp et al. 2007, Seth et al. 2018) reads the model's XML; this module writes it as
+text (OpenSim itself is optional: the ``osim`` extra, for loading and walking the file,
+:mod:`walkerlab.export.opensim_walk`).  The model is the floating planar walker of
+:func:`walkerlab.walker.multibody.multibody` in OpenSim's frame: x downhill (horizontal),
+**y up**, every joint about **z**, so that a positive angle moves the foot ahead (a link hangs
+along its body's -y axis: a point at ``s`` along it lies at ``joint + s (sin psi, -cos psi)``,
+walkerlab's convention, paper Eq. 1).
+
+Bodies and joints:
+
+- ``hip``: the hip point mass on a ``CustomJoint`` ``base`` with two translations only (the
+  coordinates ``hip_x``, ``hip_y`` [m]; the base never rotates, as in the URDF and MJCF);
+- one ``Body`` per link (``leg<i>`` or ``leg<i>_thigh``, ``leg<i>_shank``; ``torso``): its
+  mass, centre of mass ``(off-axis, -along, 0)`` and inertia about it (``Izz`` the planar
+  moment; ``Ixx = Iyy = Izz`` only make the tensor valid, nothing turns about x or y);
+- ``PinJoint`` ``leg<i>_hip`` (coordinate = the absolute link angle, the base does not
+  rotate) and ``leg<i>_knee`` (shank - thigh); a hinged torso's ``torso_hip``.
+  The coordinates' ``default_value`` and ``default_speed_value`` are the rigid gait's fixed
+  point (:func:`walkerlab.export.scene.mjcf_scene`'s ``gait`` keyframe: just after heel
+  strike, leg2 in stance, its foot's contact point at the origin): the model walks from its
+  default state.
+
+Forces:
+
+- **ground contact**: one ``HuntCrossleyForce`` per leg between its foot sphere and its own
+  ground (the paper's checkerboard lanes: a leg touches only its lane).  A point foot is a
+  sphere of radius :func:`walkerlab.export.mjcf_scene.point_foot_radius` with the ground
+  lowered by that radius; an arc foot is the sphere of its arc.  Continuous terrain is a
+  ``ContactHalfSpace`` along the slope; a checkerboard patch is a ``ContactSphere`` of radius
+  :func:`patch_radius` whose top touches the slope line at the footfall (its surface stays
+  within one foot-sphere radius of the line over the patch's width and falls away beyond, so
+  the swing foot passes over the other lane's footfalls; OpenSim's Hunt-Crossley force takes
+  spheres and half-spaces only).  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax)
+  d'`` is translated by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static
+  penetration; stated in the file).
+- **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
+  two links at the hip a ``BushingForce`` between the links' hip frames (rotational stiffness
+  and damping about z; the rest angle in the second frame's orientation).
+- **knee stop**: a ``CoordinateLimitForce`` ``leg<i>_knee_stop`` at 0 (straight), the
+  stop's IMPACT law linearised at full damping (:func:`knee_stop_limit`).  The knee latch
+  of ``contact.knee_stop.latch`` (the stop acting in flexion too while the leg's foot is on
+  the ground) is a second, mirrored ``CoordinateLimitForce`` ``leg<i>_knee_latch`` that
+  applies no force by default: OpenSim has no contact-switched force, a stepping loop
+  switches it (``Force.setAppliesForce``, :mod:`walkerlab.export.opensim_walk`).
+- **actuators**: each joint torque law of ``walker.actuation.torques`` is exported as a
+  ``CoordinateActuator`` per joint (``leg<i>_hip_motor``, ``leg<i>_knee_motor``;
+  ``optimal_force`` 1 N m, so the control is the torque), the laws in a comment; the
+  push-off (``walker.actuation.push_off``) is a ``PrescribedForce`` ``leg<i>_push_off`` on
+  each leg at its foot along the leg (foot to hip), ``F = impulse_n_s / T`` (``T`` the
+  scene's ``contact.push_off_duration_s``), applying no force by default: a stepping loop
+  switches the trailing leg's on for ``T`` from each heel strike, as the MJCF's loop does
+  (:mod:`walkerlab.export.opensim_walk`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from walkerlab.config import Scene
+from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.export.mjcf_scene import point_foot_radius
+from walkerlab.export.text import comment, num, nums
+from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
+
+__all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
+           "knee_stop_limit", "osim_gait", "osim_text", "patch_radius"]
+
+#: The export's file name in ``runs/<scene>/``.
+OSIM_FILE = "walker.osim"
+#: OpenSim's document version written (OpenSim 4.6 writes 40600; older 4.x read it).
+DOCUMENT_VERSION = 40600
+
+
+@dataclass(frozen=True)
+class OsimGait:
+    """What the OpenSim model carries beyond the walker (from the scene and its rigid gait).
+
+    Attributes
+    ----------
+    qpos, qvel : tuple of float
+        Default values and speeds of the coordinates (``hip_x``, ``hip_y``, then each link's
+        joint as in :attr:`Multibody.links`) [m, rad; m/s, rad/s].
+    period_s : float
+        The rigid gait's step period [s].
+    step_length_m : float
+        The rigid gait's step length along the slope [m].
+    lanes : tuple of (tuple of float, tuple of float) or None
+        Footfall centres along the slope [m] of leg1's and leg2's lane; None: continuous.
+    patch_width_m : float
+        The checkerboard patch width [m].
+    ground_offset_m : float
+        The ground lies this far below the feet's reference points [m].
+    contact : ContactParamsSI
+    knee : KneeStopSI
+    push_off : object or None
+        ``walker.actuation.push_off`` (:class:`walkerlab.config.actuation.PushOff`).
+    push_off_duration_s : float
+        The push-off pulse's duration [s] (the scene's ``contact.push_off_duration_s``).
+    actuation_json : str or None
+        The scene's ``walker.actuation`` as JSON.
+    """
+
+    qpos: tuple
+    qvel: tuple
+    period_s: float
+    step_length_m: float
+    lanes: tuple | None
+    patch_width_m: float
+    ground_offset_m: float
+    contact: ContactParamsSI
+    knee: KneeStopSI
+    push_off: object = None
+    push_off_duration_s: float = 0.005
+    actuation_json: str | None = None
+
+    @property
+    def speed_m_per_s(self) -> float:
+        """The rigid gait's speed along the slope: step length / step period [m/s]."""
+        return self.step_length_m / self.period_s
+
+
+def check_osim_exportable(scene: Scene, mb) -> None:
+    """Refuse what the OpenSim export cannot express.
+
+    Raises
+    ------
+    ValueError
+        One line naming the field: flat feet (``walker.leg.foot.kind``: no foot bodies in
+        this export), a bisecting hip mechanism (``walker.torso.coupling``: a coupling of one
+        coordinate to two is not written yet), an ankle push-off
+        (``walker.actuation.ankle_push_off``).
+    """
+    foot = getattr(getattr(scene.walker, "leg", None), "foot", None)
+    if getattr(foot, "kind", None) == "flat":
+        raise ValueError("walker.leg.foot.kind: flat feet are not in the OpenSim export (no "
+                         "foot bodies, ankle springs or heel and toe contacts); --format mjcf "
+                         "carries them")
+    if mb.couplings:
+        raise ValueError("walker.torso.coupling: the bisecting hip mechanism (torso angle = "
+                         "mean of the hip angles) is not in the OpenSim export (a coupler "
+                         "constraint on two independent coordinates is not written yet)")
+    act = getattr(scene.walker, "actuation", None)
+    if act is not None and act.ankle_push_off is not None:
+        raise ValueError("walker.actuation.ankle_push_off: not in the OpenSim export (the "
+                         "model would walk passively); export the scene without it")
+
+
+def hunt_crossley(c: ContactParamsSI, weight_n: float, radius_m: float
+                  ) -> tuple[float, float, float, str]:
+    """OpenSim Hunt-Crossley parameters for the scene's IMPACT law.
+
+    Simbody's Hunt-Crossley force between a sphere of effective radius ``R`` and a surface
+    (Hunt & Crossley 1975; Simbody ``HuntCrossleyForce``, both surfaces with the same
+    parameters ``s``, ``c``) is ``f = (4/3) k^(3/2) sqrt(R) d^(3/2) (1 + 3/2 c v)`` with
+    ``k = s^(2/3) / 2``, i.e. ``f = K d^(3/2) (1 + 3/2 c v)``, ``K = (4/3) s sqrt(R) /
+    2^(3/2)``.  The IMPACT law ``k_I d^e + STEP(d, 0, 0, dmax, cmax) d'`` of the walker's
+    weight ``W`` on one foot rests at ``d_s = (W / k_I)^(1/e)``; the translation keeps that
+    static point (``K d_s^(3/2) = W``) and the damping there (``3/2 c W = cmax STEP(d_s)``).
+    Friction: ``static_friction`` = ``mu_static``, ``dynamic_friction`` = ``mu_dynamic``,
+    ``transition_velocity`` = the stiction velocity (Simbody's friction peaks at the static
+    coefficient there, as IMPACT's STEP does), no viscous friction.
+
+    Limits: the exponent is Hertz's 3/2 (IMPACT's ``e`` is exact only at ``d_s``: the tangent
+    stiffness there is ``3/2 W / d_s`` against ``e W / d_s``), the damping grows with
+    ``d^(3/2)`` rather than IMPACT's cubic step, and the load on a foot is not always ``W``.
+
+    Parameters
+    ----------
+    c : ContactParamsSI
+        The scene's contact law in SI.
+    weight_n : float
+        The walker's weight normal to the slope ``M g cos(phi)`` [N].
+    radius_m : float
+        Effective contact radius ``R`` [m] (the foot sphere's; against a sphere of radius
+        ``Rg``: ``r Rg / (r + Rg)``).
+
+    Returns
+    -------
+    stiffness_pa, dissipation_s_per_m, transition_velocity_m_per_s, note
+    """
+    ds = (weight_n / c.k) ** (1.0 / c.e)
+    K = weight_n / ds ** 1.5
+    s_param = K * 2 ** 1.5 * 3 / (4 * math.sqrt(radius_m))
+    x = min(ds / c.dmax, 1.0)
+    cs = c.cmax * x * x * (3 - 2 * x)
+    diss = cs / (1.5 * weight_n)
+    note = (f"Contact from the scene's IMPACT law (walkerlab.export.opensim.hunt_crossley): "
+            f"k = {c.k:.6g} N/m^{c.e:g}, cmax = {c.cmax:.6g} N s/m, dmax = {c.dmax:.6g} m; the "
+            f"weight W = {weight_n:.6g} N on one foot rests at d_s = {ds:.4g} m; Hertz "
+            f"K d^1.5 with K = {K:.6g} N/m^1.5 through that point (Simbody: K = (4/3) s "
+            f"sqrt(R) / 2^1.5, R = {radius_m:.4g} m, s = {s_param:.6g} Pa), damping "
+            f"{cs:.4g} N s/m there (dissipation c = {diss:.4g} s/m); friction mu_static "
+            f"{c.mu_s:g}, mu_dynamic {c.mu_d:g}, transition velocity = stiction velocity "
+            f"{c.v_s:g} m/s. Limits: exponent 1.5 (tangent stiffness 1.5 W/d_s against "
+            f"{c.e:g} W/d_s), damping ~ d^1.5 instead of a cubic step.")
+    return s_param, diss, float(c.v_s), note
+
+
+def knee_stop_limit(knee: KneeStopSI) -> tuple[float, float, float]:
+    """A ``CoordinateLimitForce``'s stiffness [N m/deg], damping [N m s/deg] and transition
+    [deg] for the knee stop's IMPACT law ``k ext^e + STEP(ext, 0, 0, dmax, cmax) ext'``
+    (:class:`walkerlab.config.contact.KneeStopSettings`): the tangent stiffness at full
+    damping ``e k dmax^(e - 1)``, the full damping ``cmax``, the transition width ``dmax``
+    (OpenSim's limit force is linear past its transition; its units are degrees)."""
+    deg = math.pi / 180
+    k_lin = knee.e * knee.k * knee.dmax ** (knee.e - 1)
+    return k_lin * deg, knee.cmax * deg, knee.dmax / deg
+
+
+def patch_radius(patch_width_m: float, foot_sphere_m: float) -> float:
+    """Radius [m] of the sphere standing for a checkerboard patch: its surface falls
+    ``(w/2)^2 / (2 Rg)`` below the slope line at the patch's edge; that drop is one foot-sphere
+    radius (``L / 1000``), ``Rg = (w/2)^2 / (2 r)``."""
+    return (patch_width_m / 2) ** 2 / (2 * foot_sphere_m)
+
+
+def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
+    """The rigid gait, ground and contact of ``scene`` for the OpenSim export.
+
+    Parameters
+    ----------
+    scene : Scene
+    mb : Multibody
+    data : WalkerData
+    ideal : gait, optional
+        The rigid gait (a stored ``fixedpoint.h5`` gait); default: searched.
+
+    Returns
+    -------
+    OsimGait
+
+    Raises
+    ------
+    walkerlab.analysis.gait.poincare.FixedPointNotFound
+        No rigid gait.
+    """
+    from walkerlab.analysis.contact.periodic import ideal_gait
+    from walkerlab.export.scene import mjcf_scene
+    from walkerlab.models.contact.model import ContactWalker
+    from walkerlab.models.contact.rigid_limit import contact_si
+    from walkerlab.models.contact.scene import ideal_step_length
+
+    settings = scene.contact or ContactSettings()
+    terrain = scene.terrain or TerrainSettings()
+    c, knee = contact_si(settings)
+    ideal = ideal_gait(scene) if ideal is None else ideal
+    ms = mjcf_scene(scene, mb, data, ideal)
+    walker = ContactWalker(contact=c, data=data, knee_stop=knee)
+    ell = ideal_step_length(walker, ideal.x)
+    ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
+    if len(ells) == 2:
+        ell = 0.5 * (ells[0] + ells[1])
+    act = getattr(scene.walker, "actuation", None)
+    return OsimGait(ms.qpos, ms.qvel, float(ideal.period_s), float(ell), ms.lanes,
+                    terrain.patch_width_m, ms.ground_offset_m, c, knee,
+                    None if act is None else act.push_off,
+                    settings.push_off_pulse_s(), ms.actuation_json)
+
+
+# ----------------------------------------------------------------------------- the XML
+
+
+def _frame(name: str, parent: str, translation=(0.0, 0.0, 0.0), orientation=(0.0, 0.0, 0.0),
+           ind: str = "\t\t\t\t\t\t") -> list[str]:
+    return [f"{ind}<PhysicalOffsetFrame name={quoteattr(name)}>",
+            f"{ind}\t<socket_parent>{parent}</socket_parent>",
+            f"{ind}\t<translation>{nums(*translation)}</translation>",
+            f"{ind}\t<orientation>{nums(*orientation)}</orientation>",
+            f"{ind}</PhysicalOffsetFrame>"]
+
+
+def _coordinate(name: str, value: float, speed: float, ind: str = "\t\t\t\t\t\t") -> list[str]:
+    return [f"{ind}<Coordinate name={quoteattr(name)}>",
+            f"{ind}\t<default_value>{num(value)}</default_value>",
+            f"{ind}\t<default_speed_value>{num(speed)}</default_speed_value>",
+            f"{ind}\t<range>-1e6 1e6</range>",
+            f"{ind}\t<clamped>false</clamped>",
+            f"{ind}</Coordinate>"]
+
+
+def _body(name: str, mass: float, com=(0.0, 0.0), inertia: float = 0.0) -> list[str]:
+    i = "\t\t\t\t"
+    return [f"{i}<Body name={quoteattr(name)}>", f"{i}\t<mass>{num(mass)}</mass>",
+            f"{i}\t<mass_center>{nums(com[0], com[1], 0.0)}</mass_center>",
+            f"{i}\t<inertia>{nums(inertia, inertia, inertia, 0.0, 0.0, 0.0)}</inertia>",
+            f"{i}</Body>"]
+
+
+def _limit_force(name: str, coord: str, upper: tuple, lower: tuple, damping: float,
+                 transition: float, applies: bool = True) -> list[str]:
+    i = "\t\t\t\t"
+    return [f"{i}<CoordinateLimitForce name={quoteattr(name)}>",
+            f"{i}\t<appliesForce>{str(applies).lower()}</appliesForce>",
+            f"{i}\t<coordinate>{coord}</coordinate>",
+            f"{i}\t<upper_stiffness>{num(upper[1])}</upper_stiffness>",
+            f"{i}\t<upper_limit>{num(upper[0])}</upper_limit>",
+            f"{i}\t<lower_stiffness>{num(lower[1])}</lower_stiffness>",
+            f"{i}\t<lower_limit>{num(lower[0])}</lower_limit>",
+            f"{i}\t<damping>{num(damping)}</damping>",
+            f"{i}\t<transition>{num(transition)}</transition>",
+            f"{i}</CoordinateLimitForce>"]
+
+
+def _torque_joints(actuation_json: str | None, mb) -> list[str]:
+    """Joints that get a ``CoordinateActuator``: the hips (a hip torque between the legs, or
+    a stance/swing hip law) and, with knee laws, the knees."""
+    import json
+
+    if actuation_json is None:
+        return []
+    laws = json.loads(actuation_json).get("torques", [])
+    kinds = {("knee" if t["joint"].endswith("knee") else "hip") for t in laws}
+    joints = [ln.joint for ln in mb.links]
+    return [j for j in joints if j.rsplit("_", 1)[-1] in kinds and not j.startswith("torso")]
+
+
+def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
+    """The OpenSim model's XML (module docstring for its content).
+
+    Parameters
+    ----------
+    mb : Multibody
+        From :func:`walkerlab.walker.multibody.multibody`.
+    gait : OsimGait
+        From :func:`osim_gait`.
+    name : str
+        The model's name (the scene's).
+    version : str
+        walkerlab's version, for the header comment.
+
+    Returns
+    -------
+    str
+        An ``OpenSimDocument`` (version :data:`DOCUMENT_VERSION`).
+    """
+    phi, g = mb.slope_rad, mb.gravity_m_per_s2
+    t_hat = np.array([math.cos(phi), -math.sin(phi)])  # along the slope, downhill
+    n_hat = np.array([math.sin(phi), math.cos(phi)])  # the slope's normal, up
+    arc = mb.foot == "arc" and mb.foot_radius_m > 0
+    r_foot = mb.foot_radius_m if arc else point_foot_radius(mb)
+    offset = gait.ground_offset_m
+    total = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
+    weight = total * g * math.cos(phi)
+    rg = None if gait.lanes is None else patch_radius(gait.patch_width_m, r_foot)
+    r_eff = r_foot if rg is None else r_foot * rg / (r_foot + rg)
+    stiff, diss, vt, contact_note = hunt_crossley(gait.contact, weight, r_eff)
+    joints = ["hip_x", "hip_y", *(ln.joint for ln in mb.links)]
+    q0, v0 = dict(zip(joints, gait.qpos)), dict(zip(joints, gait.qvel))
+    link_of = {ln.name: ln for ln in mb.links}
+
+    out = ['<?xml version="1.0" encoding="UTF-8" ?>',
+           f'<OpenSimDocument Version="{DOCUMENT_VERSION}">',
+           comment(f"walker {name!s} exported by walkerlab {version} (OpenSim model)."),
+           comment("Planar walker in the x-y plane: x downhill (horizontal), y up; joints about "
+                   "z (positive angle = foot ahead). Coordinates: hip_x, hip_y (the hip's "
+                   "position [m]); leg<i>_hip = absolute link angle from the vertical [rad]; "
+                   "leg<i>_knee = shank - thigh [rad], 0 = straight."),
+           comment(f"Gravity g = {num(g)} m/s^2 along -y. Ground: slope {num(phi)} rad, "
+                   f"falling towards +x. Total mass {num(total)} kg."),
+           comment(f"Default state: the rigid gait's fixed point just after heel strike (leg2 "
+                   f"in stance, its foot's contact point at the origin): step period "
+                   f"{gait.period_s:.8g} s, step length {gait.step_length_m:.8g} m, speed "
+                   f"{gait.speed_m_per_s:.8g} m/s along the slope."),
+           comment(contact_note)]
+    if rg is not None:
+        out.append(comment(
+            f"Terrain: checkerboard lanes (each leg touches only its own); a patch of width "
+            f"{num(gait.patch_width_m)} m is a sphere of radius {rg:.6g} m whose top touches "
+            f"the slope line at the footfall (it falls {r_foot:.4g} m below the line at the "
+            "patch's edge: walkerlab.export.opensim.patch_radius)."))
+    if gait.push_off is not None:
+        out.append(comment(
+            "Push-off (walker.actuation.push_off, walkerlab_actuation below): PrescribedForce "
+            "leg<i>_push_off, F = impulse_n_s / T along the leg from foot to hip at its foot, "
+            "applies no force by default; a stepping loop (walkerlab.export.opensim_walk) "
+            f"switches the trailing leg's on for T = {gait.push_off_duration_s:g} s from each "
+            "heel strike (P / F for a law whose impulse P depends on the hip's speed; the rigid "
+            "model pushes off immediately before heel strike)."))
+    if gait.actuation_json is not None:
+        out.append(comment(f"walkerlab_actuation: {gait.actuation_json}"))
+    if mb.knee and mb.knee_stop:
+        out.append(comment(
+            "Knee stop: CoordinateLimitForce leg<i>_knee_stop at 0 (straight); knee latch "
+            "leg<i>_knee_latch (the same stop acting in flexion) applies no force by default: "
+            f"a stepping loop switches it on while the leg's foot is less than "
+            f"{gait.knee.latch_height:.4g} m above the ground and its knee within "
+            f"{gait.knee.latch_capture:.4g} rad of straight (walkerlab.export.opensim_walk)."))
+    out += [f"\t<Model name={quoteattr(name)}>", f"\t\t<gravity>{nums(0.0, -g, 0.0)}</gravity>",
+            '\t\t<BodySet name="bodyset">', "\t\t\t<objects>"]
+    out += _body("hip", mb.hip_mass_kg)
+    for ln in mb.links:
+        along = -ln.com_m  # com_m is along the link's downward axis (-y)
+        out += _body(ln.name, ln.mass_kg, (ln.com_off_axis_m, along), ln.inertia_kg_m2)
+    out += ["\t\t\t</objects>", "\t\t</BodySet>", '\t\t<JointSet name="jointset">',
+            "\t\t\t<objects>", '\t\t\t\t<CustomJoint name="base">',
+            "\t\t\t\t\t<socket_parent_frame>/ground</socket_parent_frame>",
+            "\t\t\t\t\t<socket_child_frame>/bodyset/hip</socket_child_frame>",
+            "\t\t\t\t\t<coordinates>",
+            *_coordinate("hip_x", q0["hip_x"], v0["hip_x"]),
+            *_coordinate("hip_y", q0["hip_y"], v0["hip_y"]),
+            "\t\t\t\t\t</coordinates>", "\t\t\t\t\t<SpatialTransform>"]
+    for axis_name, axis, coord in (("rotation1", "1 0 0", None), ("rotation2", "0 1 0", None),
+                                   ("rotation3", "0 0 1", None),
+                                   ("translation1", "1 0 0", "hip_x"),
+                                   ("translation2", "0 1 0", "hip_y"),
+                                   ("translation3", "0 0 1", None)):
+        fn = ('<LinearFunction name="function"><coefficients>1 0</coefficients>'
+              "</LinearFunction>" if coord else
+              '<Constant name="function"><value>0</value></Constant>')
+        out += [f'\t\t\t\t\t\t<TransformAxis name="{axis_name}">',
+                f"\t\t\t\t\t\t\t<coordinates>{coord or ''}</coordinates>",
+                f"\t\t\t\t\t\t\t<axis>{axis}</axis>", f"\t\t\t\t\t\t\t{fn}",
+                "\t\t\t\t\t\t</TransformAxis>"]
+    out += ["\t\t\t\t\t</SpatialTransform>", "\t\t\t\t</CustomJoint>"]
+    for ln in mb.links:
+        parent = "hip" if ln.parent == "hip" else ln.parent
+        out += [f"\t\t\t\t<PinJoint name={quoteattr(ln.joint)}>",
+                f"\t\t\t\t\t<socket_parent_frame>{parent}_at_{ln.joint}</socket_parent_frame>",
+                f"\t\t\t\t\t<socket_child_frame>{ln.name}_at_{ln.joint}</socket_child_frame>",
+                "\t\t\t\t\t<coordinates>", *_coordinate(ln.joint, q0[ln.joint], v0[ln.joint]),
+                "\t\t\t\t\t</coordinates>", "\t\t\t\t\t<frames>",
+                *_frame(f"{parent}_at_{ln.joint}", f"/bodyset/{parent}",
+                        (0.0, -ln.joint_from_parent_m, 0.0)),
+                *_frame(f"{ln.name}_at_{ln.joint}", f"/bodyset/{ln.name}"),
+                "\t\t\t\t\t</frames>", "\t\t\t\t</PinJoint>"]
+    out += ["\t\t\t</objects>", "\t\t</JointSet>", '\t\t<ForceSet name="forceset">',
+            "\t\t\t<objects>"]
+    feet = [ln for ln in mb.links if ln.foot_m is not None]
+    for i, ln in enumerate(feet):
+        leg = ln.name.split("_")[0]
+        grounds = ["ground"] if rg is None else [
+            f"{leg}_patch{j}" for j in range(len(gait.lanes[i]))]
+        out += [f"\t\t\t\t<HuntCrossleyForce name=\"{leg}_contact\">",
+                '\t\t\t\t\t<HuntCrossleyForce::ContactParametersSet name="contact_parameters">',
+                "\t\t\t\t\t\t<objects>", "\t\t\t\t\t\t\t<HuntCrossleyForce::ContactParameters>",
+                f"\t\t\t\t\t\t\t\t<geometry>{leg}_foot {' '.join(grounds)}</geometry>",
+                f"\t\t\t\t\t\t\t\t<stiffness>{num(stiff)}</stiffness>",
+                f"\t\t\t\t\t\t\t\t<dissipation>{num(diss)}</dissipation>",
+                f"\t\t\t\t\t\t\t\t<static_friction>{num(gait.contact.mu_s)}</static_friction>",
+                f"\t\t\t\t\t\t\t\t<dynamic_friction>{num(gait.contact.mu_d)}"
+                "</dynamic_friction>",
+                "\t\t\t\t\t\t\t\t<viscous_friction>0</viscous_friction>",
+                "\t\t\t\t\t\t\t</HuntCrossleyForce::ContactParameters>",
+                "\t\t\t\t\t\t</objects>", "\t\t\t\t\t</HuntCrossleyForce::ContactParametersSet>",
+                f"\t\t\t\t\t<transition_velocity>{num(vt)}</transition_velocity>",
+                "\t\t\t\t</HuntCrossleyForce>"]
+    for sp in mb.springs:
+        if len(sp.terms) == 1:  # a knee spring: the knee coordinate itself
+            out += [f"\t\t\t\t<SpringGeneralizedForce name={quoteattr(sp.name)}>",
+                    f"\t\t\t\t\t<coordinate>{sp.terms[0][0]}</coordinate>",
+                    f"\t\t\t\t\t<stiffness>{num(sp.stiffness_n_m_per_rad)}</stiffness>",
+                    f"\t\t\t\t\t<rest_length>{num(sp.rest_angle_rad)}</rest_length>",
+                    f"\t\t\t\t\t<viscosity>{num(sp.damping_n_m_s_per_rad)}</viscosity>",
+                    "\t\t\t\t</SpringGeneralizedForce>"]
+            continue
+        first, second = sp.between  # delta = angle(second) - angle(first), about z
+        j1, j2 = link_of[first].joint, link_of[second].joint
+        # the rest angle: the second link's frame turned by +rest, so delta - rest is the
+        # bushing's rotation of frame2 relative to frame1
+        out += [f"\t\t\t\t<BushingForce name={quoteattr(sp.name)}>",
+                f"\t\t\t\t\t<socket_frame1>{first}_spring_{j1}</socket_frame1>",
+                f"\t\t\t\t\t<socket_frame2>{second}_spring_{j2}</socket_frame2>",
+                f"\t\t\t\t\t<rotational_stiffness>{nums(0, 0, sp.stiffness_n_m_per_rad)}"
+                "</rotational_stiffness>",
+                "\t\t\t\t\t<translational_stiffness>0 0 0</translational_stiffness>",
+                f"\t\t\t\t\t<rotational_damping>{nums(0, 0, sp.damping_n_m_s_per_rad)}"
+                "</rotational_damping>",
+                "\t\t\t\t\t<translational_damping>0 0 0</translational_damping>",
+                "\t\t\t\t\t<frames>",
+                *_frame(f"{first}_spring_{j1}", f"/bodyset/{first}"),
+                *_frame(f"{second}_spring_{j2}", f"/bodyset/{second}",
+                        orientation=(0.0, 0.0, -sp.rest_angle_rad)),
+                "\t\t\t\t\t</frames>", "\t\t\t\t</BushingForce>"]
+    if mb.knee and mb.knee_stop:
+        kl, cl, tr = knee_stop_limit(gait.knee)
+        for ln in mb.links:
+            if ln.joint.endswith("_knee"):
+                # the side a force does not limit: at half a turn, never reached (OpenSim's
+                # limit force returns NaN with a zero stiffness)
+                out += _limit_force(f"{ln.joint}_stop", ln.joint, (0.0, kl), (-180.0, kl),
+                                    cl, tr)
+                out += _limit_force(f"{ln.joint}_latch", ln.joint, (180.0, kl), (0.0, kl),
+                                    cl, tr, applies=False)
+    for j in _torque_joints(gait.actuation_json, mb):
+        out += [f"\t\t\t\t<CoordinateActuator name=\"{j}_motor\">",
+                f"\t\t\t\t\t<coordinate>{j}</coordinate>",
+                "\t\t\t\t\t<optimal_force>1</optimal_force>", "\t\t\t\t</CoordinateActuator>"]
+    if gait.push_off is not None:
+        force = gait.push_off.impulse_n_s / gait.push_off_duration_s
+        for ln in feet:
+            leg = ln.name.split("_")[0]
+            out += [f"\t\t\t\t<PrescribedForce name=\"{leg}_push_off\">",
+                    "\t\t\t\t\t<appliesForce>false</appliesForce>",
+                    f"\t\t\t\t\t<socket_frame>/bodyset/{ln.name}</socket_frame>",
+                    "\t\t\t\t\t<pointIsGlobal>false</pointIsGlobal>",
+                    "\t\t\t\t\t<forceIsGlobal>false</forceIsGlobal>",
+                    '\t\t\t\t\t<FunctionSet name="forceFunctions"><objects>'
+                    '<Constant><value>0</value></Constant>'
+                    f'<Constant><value>{num(force)}</value></Constant>'
+                    '<Constant><value>0</value></Constant></objects></FunctionSet>',
+                    '\t\t\t\t\t<FunctionSet name="pointFunctions"><objects>'
+                    '<Constant><value>0</value></Constant>'
+                    f'<Constant><value>{num(-ln.foot_m)}</value></Constant>'
+                    '<Constant><value>0</value></Constant></objects></FunctionSet>',
+                    "\t\t\t\t</PrescribedForce>"]
+    out += ["\t\t\t</objects>", "\t\t</ForceSet>",
+            '\t\t<ContactGeometrySet name="contactgeometryset">', "\t\t\t<objects>"]
+    for ln in feet:
+        leg = ln.name.split("_")[0]
+        out += [f"\t\t\t\t<ContactSphere name=\"{leg}_foot\">",
+                f"\t\t\t\t\t<socket_frame>/bodyset/{ln.name}</socket_frame>",
+                f"\t\t\t\t\t<location>{nums(0.0, -ln.foot_m, 0.0)}</location>",
+                f"\t\t\t\t\t<radius>{num(r_foot)}</radius>", "\t\t\t\t</ContactSphere>"]
+    if rg is None:  # OpenSim's half-space fills local x > 0: turned so its normal is n_hat
+        p = -offset * n_hat
+        out += ['\t\t\t\t<ContactHalfSpace name="ground">',
+                "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
+                f"\t\t\t\t\t<location>{nums(p[0], p[1], 0.0)}</location>",
+                f"\t\t\t\t\t<orientation>{nums(0.0, 0.0, -math.pi / 2 - phi)}</orientation>",
+                "\t\t\t\t</ContactHalfSpace>"]
+    else:
+        for i, ln in enumerate(feet):
+            leg = ln.name.split("_")[0]
+            for j, s in enumerate(gait.lanes[i]):
+                p = s * t_hat - (offset + rg) * n_hat
+                out += [f"\t\t\t\t<ContactSphere name=\"{leg}_patch{j}\">",
+                        "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
+                        f"\t\t\t\t\t<location>{nums(p[0], p[1], 0.0)}</location>",
+                        f"\t\t\t\t\t<radius>{num(rg)}</radius>", "\t\t\t\t</ContactSphere>"]
+    out += ["\t\t\t</objects>", "\t\t</ContactGeometrySet>", "\t</Model>",
+            "</OpenSimDocument>", ""]
+    return "\n".join(out)

@@ -1,0 +1,238 @@
+"""Run an exported OpenSim walker (``walker.osim``) in OpenSim's forward simulation from its
+default state and read its heel strikes and centre of mass.
+
+OpenSim is an optional dependency (the ``osim`` extra): imported inside the functions.
+
+OpenSim's ``Manager`` integrates the model in windows of ``window_s``; after each window the
+loop reads each leg's ``HuntCrossleyForce`` (the force on the leg's body).  A heel strike of
+leg i is the first window with contact on its foot after the foot has been off the ground for
+at least ``min_air_s`` (shorter gaps are bounces of the compliant contact).  Two stepping
+rules act between windows (``Force.setAppliesForce`` on the state, then the manager restarts
+from it; OpenSim has no contact-switched force):
+
+- the **knee latch** of a kneed export (``leg<i>_knee_latch``, the knee stop mirrored) is on
+  while the leg's foot is less than the release height above the slope line and its knee is
+  within the capture flexion of straight
+  (:func:`walkerlab.export.mujoco_walk.latch_rule`, the MJCF's rule);
+- the **push-off** of a powered export (``leg<i>_push_off``, the force ``F = P0 / T`` along
+  the leg from foot to hip, ``P0`` the law's ``impulse_n_s``, ``T`` the scene's
+  ``contact.push_off_duration_s``): at each heel strike (the end of the window in which
+  it is seen) the trailing leg's is switched on for ``P / F`` (``T`` for a constant impulse;
+  ``P`` the law's impulse, :func:`walkerlab.models.actuation.push_off_impulse`, at the hip's
+  speed), as the MJCF's loop does.  The rigid model pushes off immediately before heel
+  strike; a pulse ending at the swing foot's predicted touchdown (the contact model's rule)
+  was tried on powered_compass and made the steps shrink (a fall after 9 strikes).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["OpensimWalk", "walk"]
+
+LEGS = ("leg1", "leg2")
+
+
+@dataclass
+class OpensimWalk:
+    """Heel strikes and the centre of mass of an OpenSim run.
+
+    Attributes
+    ----------
+    times_s : ndarray (n,)
+        Heel-strike times [s] (the end of the window in which the contact began).
+    legs : list of str
+        The striking leg of each.
+    com_along_m : ndarray (n,)
+        The centre of mass's position along the slope at each strike [m].
+    positions_m : ndarray (n,)
+        The striking foot's position along the slope at each strike [m].
+    fell : bool
+        The hip dropped below half its starting height above the slope.
+    t_end_s : float
+        Simulated time [s].
+    mass_kg : float
+        The model's total mass [kg].
+    """
+
+    times_s: np.ndarray
+    legs: list
+    com_along_m: np.ndarray
+    positions_m: np.ndarray
+    fell: bool
+    t_end_s: float
+    mass_kg: float
+
+    @property
+    def alternating(self) -> bool:
+        """Every strike is by the other leg than the one before."""
+        return all(a != b for a, b in zip(self.legs, self.legs[1:]))
+
+    @property
+    def step_periods_s(self) -> np.ndarray:
+        """Times between successive heel strikes [s], (n - 1,)."""
+        return np.diff(self.times_s)
+
+    def speed_m_per_s(self, skip: int = 2) -> float:
+        """The centre of mass's mean speed along the slope from strike ``skip`` to the last
+        one (whole steps: the speed within a step varies) [m/s]."""
+        return float((self.com_along_m[-1] - self.com_along_m[skip])
+                     / (self.times_s[-1] - self.times_s[skip]))
+
+
+def _header(text: str) -> dict:
+    """Slope, latch and push-off numbers from the file's comments."""
+    out: dict = {}
+    if m := re.search(r"Ground: slope (\S+) rad", text):
+        out["slope"] = float(m.group(1))
+    if m := re.search(r"less than (\S+) m above the ground and its knee within (\S+) rad",
+                      text):
+        out["latch"] = (float(m.group(1)), float(m.group(2)))
+    if m := re.search(r"on for T = (\S+) s", text):
+        out["pulse"] = float(m.group(1))
+    if m := re.search(r"walkerlab_actuation: (\{.*\}) -->", text):
+        out["actuation"] = json.loads(m.group(1))
+    return out
+
+
+def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
+         min_air_s: float = 0.05, accuracy: float = 1e-7) -> OpensimWalk:
+    """Simulate ``walker.osim`` for ``duration_s`` from its default state (module docstring).
+
+    Parameters
+    ----------
+    path : path
+        An OpenSim export (:mod:`walkerlab.export.opensim`).
+    duration_s : float
+        Simulated time [s].
+    window_s : float
+        Length of a window between the stepping rules [s].
+    min_air_s : float
+        Shortest time off the ground before a contact counts as a heel strike [s].
+    accuracy : float
+        The integrator's accuracy (OpenSim's default integrator, Runge-Kutta-Merson).
+
+    Returns
+    -------
+    OpensimWalk
+
+    Raises
+    ------
+    walkerlab.extras.MissingExtra
+        OpenSim is not installed (one line naming the ``osim`` extra).
+    """
+    from walkerlab.export.mujoco_walk import latch_rule
+    from walkerlab.extras import require
+
+    osim = require("opensim", "osim", "walking an OpenSim export")
+    osim.Logger.setLevelString("warn")  # not a report per window
+    text = Path(path).read_text()
+    info = _header(text)
+    phi = info.get("slope", 0.0)
+    t_hat = np.array([math.cos(phi), -math.sin(phi)])
+    n_hat = np.array([math.sin(phi), math.cos(phi)])
+    model = osim.Model(str(path))
+    state = model.initSystem()
+    fs = model.getForceSet()
+    contact = {g: fs.get(f"{g}_contact") for g in LEGS}
+    bodies = {g: model.getBodySet().get(g if model.getBodySet().contains(g) else f"{g}_shank")
+              for g in LEGS}
+    feet = {g: osim.ContactSphere.safeDownCast(model.getContactGeometrySet().get(f"{g}_foot"))
+            for g in LEGS}
+    foot_loc = {g: osim.Vec3(feet[g].get_location()) for g in LEGS}
+    kneed = fs.contains("leg1_knee_latch")
+    latch = {g: fs.get(f"{g}_knee_latch") for g in LEGS} if kneed else {}
+    knee = {g: model.getCoordinateSet().get(f"{g}_knee") for g in LEGS} if kneed else {}
+    push = ({g: osim.PrescribedForce.safeDownCast(fs.get(f"{g}_push_off")) for g in LEGS}
+            if fs.contains("leg1_push_off") else {})
+    push_law = None
+    if push:
+        from walkerlab.config.actuation import Actuation
+        from walkerlab.models.actuation import push_off_impulse
+
+        push_law = Actuation.model_validate(info["actuation"]).push_off
+    hip_x = model.getCoordinateSet().get("hip_x")
+    hip_y = model.getCoordinateSet().get("hip_y")
+    mass = model.getTotalMass(state)
+
+    def along(g, s):  # the foot point's position along the slope [m]
+        p = bodies[g].findStationLocationInGround(s, foot_loc[g]).to_numpy()[:2]
+        return float(p @ t_hat)
+
+    def height(g, s):  # the foot point's height above the slope line [m] (the ground lies
+        # one foot-sphere radius below it: 0 on the ground)
+        p = bodies[g].findStationLocationInGround(s, foot_loc[g]).to_numpy()[:2]
+        return float(p @ n_hat)
+
+    def loaded(g, s):
+        v = contact[g].getRecordValues(s)
+        return abs(v.get(0)) + abs(v.get(1)) > 0.0
+
+    def com_along(s):
+        return float(model.calcMassCenterPosition(s).to_numpy()[:2] @ t_hat)
+
+    h0 = hip_x.getValue(state) * n_hat[0] + hip_y.getValue(state) * n_hat[1]
+    manager = osim.Manager(model)
+    manager.setIntegratorAccuracy(accuracy)
+    state.setTime(0.0)
+    model.realizeDynamics(state)
+    air = {g: (0.0 if loaded(g, state) else min_air_s) for g in LEGS}
+    on = {g: loaded(g, state) for g in LEGS}
+    latched = {g: False for g in LEGS}
+    stance = "leg2"  # the default state: leg2 in stance
+    times, legs, com, feet_at = [], [], [], []
+    fell, t = False, 0.0
+    pulse_until, pushing = -1.0, None
+    restart = True
+    while t < duration_s - 1e-12:
+        changed = False
+        if kneed:
+            want = {g: latch_rule(height(g, state), knee[g].getValue(state), *info["latch"])
+                    for g in LEGS}  # both before either switch (a switch drops the stage)
+            for g in LEGS:
+                if want[g] != latched[g]:
+                    latch[g].setAppliesForce(state, want[g])
+                    latched[g], changed = want[g], True
+        if pushing is not None and t >= pulse_until - 1e-12:
+            push[pushing].setAppliesForce(state, False)
+            pushing, changed = None, True
+        if changed or restart:
+            manager = osim.Manager(model)
+            manager.setIntegratorAccuracy(accuracy)
+            manager.initialize(state)
+            restart = False
+        step = window_s if pushing is None else pulse_until - t
+        t = min(t + step, duration_s)
+        state = osim.State(manager.integrate(t))
+        model.realizeDynamics(state)
+        now_on = {g: loaded(g, state) for g in LEGS}  # before a switch drops the stage
+        for g in LEGS:
+            now = now_on[g]
+            if now and not on[g] and air[g] >= min_air_s and g != stance:
+                times.append(t)
+                legs.append(g)
+                com.append(com_along(state))
+                feet_at.append(along(g, state))
+                trailing, stance = stance, g
+                if push:  # the trailing leg pushes off from the heel strike (the MJCF's loop)
+                    v = np.array([hip_x.getSpeedValue(state), hip_y.getSpeedValue(state)])
+                    P = float(push_off_impulse(push_law, float(v @ t_hat)))
+                    if P > 0:  # the file's force F = impulse_n_s / T: the pulse lasts P / F
+                        T = info["pulse"] * P / push_law.impulse_n_s
+                        push[trailing].setAppliesForce(state, True)
+                        pushing, pulse_until, restart = trailing, t + T, True
+            air[g] = 0.0 if now else air[g] + step
+            on[g] = now
+        model.realizeDynamics(state)  # after a switch
+        hip_h = hip_x.getValue(state) * n_hat[0] + hip_y.getValue(state) * n_hat[1]
+        if hip_h < 0.5 * h0:
+            fell = True
+            break
+    return OpensimWalk(np.array(times), legs, np.array(com), np.array(feet_at), fell, t,
+                        mass)
