@@ -37,12 +37,12 @@ def test_the_main_install_has_none_of_the_optional_parts():
     assert deps and not deps & set(HEAVY), deps & set(HEAVY)
 
 
-def test_every_extra_is_named_by_its_purpose_and_the_tests_get_all_but_numbalsoda():
+def test_every_extra_is_named_by_its_purpose_and_the_tests_get_all_but_numbalsoda_and_docs():
     extras = PROJECT["optional-dependencies"]
     assert set(extras) == set(EXTRAS) | {"test"}
     test = set(extras["test"])
     for name, reqs in extras.items():
-        if name not in ("test", "numbalsoda"):
+        if name not in ("test", "numbalsoda", "docs"):
             assert set(reqs) <= test, (name, set(reqs) - test)
     assert {_name(r) for r in extras["test"]} >= {"pytest", "pytest-xdist"}
 
@@ -54,8 +54,15 @@ def test_the_readme_installs_the_main_job_then_the_tests_and_ci_runs_that_comman
     assert second.endswith("pip install -e '.[test]' && pytest"), second
     ci = (ROOT / ".ci" / "run").read_text()
     assert second in ci.splitlines(), "CI runs the README's test command"
-    for name in EXTRAS:  # each extra is listed for what it does
-        assert f"| `{name}` |" in readme, name
+    install = (ROOT / "docs" / "user_guide" / "installation.md").read_text()
+    assert _commands(install)[:2] == [first, second], "the user guide repeats them"
+    for name in EXTRAS:  # each extra is listed for what it does (in the user guide)
+        assert f"| `{name}` |" in install, name
+    assert len(_commands(readme)) == 2, "the README has exactly the two commands"
+    docs = (ROOT / "docs" / "README.md").read_text()
+    build = "python -m sphinx -W --keep-going -b html docs docs/_build/html"
+    assert _commands(docs)[0].endswith(f"pip install -e '.[docs]' && {build}")
+    assert f". .venv/bin/activate && pip install -e '.[docs]' && {build}" in ci.splitlines()
 
 
 def test_require_names_the_extra_in_one_line(monkeypatch):

@@ -1,6 +1,6 @@
 """walkerlab: a command-line lab for passive-dynamic biped walkers.
 
-The package is split by role (lower layers first; the README describes
+The package is split by role (lower layers first; the documentation, docs/, describes
 the product):
 
 - :mod:`walkerlab.walker`   the walker as data: description, state layout, link tree

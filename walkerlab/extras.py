@@ -3,7 +3,7 @@ command says when the extra it needs is not installed.
 
 ``pip install -e .`` installs the main job (fixed point, simulation, the contact model,
 the comparison, the report); ``pip install -e '.[test]'`` what the tests need (every extra
-below but ``numbalsoda``).  The extras are those of ``pyproject.toml``
+below but ``numbalsoda`` and ``docs``).  The extras are those of ``pyproject.toml``
 (``[project.optional-dependencies]``; a test checks the two agree).
 
 Imports nothing of walkerlab.
@@ -26,6 +26,7 @@ EXTRAS = {
     "numbalsoda": "contact_solver.method numbalsoda (builds with cmake, g++, gfortran)",
     "gym": "walkerlab.gym: the walker as a Gymnasium environment",
     "osim": "the OpenSim export walked in OpenSim (walkerlab.export.opensim_walk; tests)",
+    "docs": "the documentation site: Sphinx, numpydoc, sphinx-gallery (docs/README.md)",
 }
 
 

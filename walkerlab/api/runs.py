@@ -42,7 +42,7 @@ def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFA
         state just after heel strike; ``step_period`` () [s]; ``multipliers`` (multiplier,)
         complex Floquet multipliers (variational equations), ``multipliers_fd`` (finite
         differences); ``jacobian`` (state, state_in) of the Poincaré map; ``floquet_stable``
-        (all |multiplier| < 1); ``residual`` () max |P(x*) - x*|; ``initial_guess``.
+        (all ``|multiplier|`` < 1); ``residual`` () max ``|P(x*) - x*|``; ``initial_guess``.
         Attributes: the artifact's (``scene_json``, ``input_hash``, ``variant`` ...).
 
     Raises
@@ -299,7 +299,7 @@ def optimize(scene: Scene | str | Path | dict, *, design: dict | None = None,
 
 def robustness(scene: Scene | str | Path | dict, *, workers: int = 1,
                runs_dir: str | Path = DEFAULT_RUNS, force: bool = False) -> xarray.Dataset:
-    """Robustness of the gait beyond |multiplier| (``walkerlab robustness``): gait
+    """Robustness of the gait beyond ``|multiplier|`` (``walkerlab robustness``): gait
     sensitivity norms, the largest step-down/up and mid-stance push, and the Monte Carlo
     mean first-passage time at the scene's sigma (the scene's ``robustness`` section, its
     defaults when absent).  Runs the ``robustness`` stage and reads ``robustness.h5``.

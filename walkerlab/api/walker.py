@@ -67,7 +67,7 @@ class Gait:
     jacobian : ndarray, shape (2n, 2n)
         Jacobian of the Poincaré map at ``x``.
     residual : float
-        max |P(x) - x| [state units].
+        max ``|P(x) - x|`` [state units].
     label : str
         Which gait of the search (``long_period``, ``short_period``, ...).
     step_length : float
@@ -108,7 +108,7 @@ class Gait:
 
     @property
     def stable(self) -> bool:
-        """All |Floquet multipliers| < 1."""
+        """All ``|Floquet multipliers|`` < 1."""
         import numpy as np
 
         return bool(np.max(np.abs(self.multipliers)) < 1.0)

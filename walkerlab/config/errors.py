@@ -150,7 +150,7 @@ class _Suggester:
 
 
 #: What a walker can be today, said by an error on an unknown walker field or kind and by
-#: the README (one place: update it as the walker vocabulary grows)
+#: the user guide, docs/user_guide/walkers.md (one place: update it as the walker vocabulary grows)
 WALKER_VOCABULARY = (
     "a walker today is planar: model compass_gait (hip mass, one point mass per "
     "leg) or biped (hip_mass_kg; one leg: or a legs: pair that may differ, each with "

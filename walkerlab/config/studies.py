@@ -337,7 +337,7 @@ class MfptSettings(Strict):
 
 
 class RobustnessSettings(Strict):
-    """Robustness of the gait beyond |lambda| (``walkerlab robustness``): gait
+    """Robustness of the gait beyond ``|lambda|`` (``walkerlab robustness``): gait
     sensitivity norms (Hobbelen & Wisse 2007), the largest single step-down and step-up
     (bisection), and the MFPT at one per-step slope sigma by Monte Carlo (Byl & Tedrake 2009)."""
 

@@ -46,16 +46,16 @@ hip / knee joints                      JOINT/REVOLUTE I (child), J (parent)   -
 ``contact.exponent``                   CONTACT EXPONENT                       -
 ``contact.max_damping_*``              CONTACT DAMPING                        N s/mm
 ``contact.penetration_at_max_*``       CONTACT DMAX                           mm
-``contact.mu_static`` / ``mu_dynamic`` CONTACT MU_STATIC / MU_DYNAMIC         -
+``contact.mu_static``, ``mu_dynamic``  CONTACT MU_STATIC / MU_DYNAMIC         -
 ``contact.stiction_velocity_*``        CONTACT STICTION_TRANSITION_VELOCITY   mm/s
 ``contact.friction_velocity_*``        CONTACT FRICTION_TRANSITION_VELOCITY   mm/s
 ``walker.springs`` (hip)               SPRINGDAMPER/ROTATIONAL KT, CT, ANGLE  N mm/rad, rad
 ``contact.knee_stop`` (kneed)          SFORCE/ROTATION FUNCTION=-IMPACT(..)   N mm, rad
-``walker.actuation.torques`` (hip)   SFORCE/10 ROTATION I leg1, J leg2,     N mm, rad
+``walker.actuation.torques`` (hip)     SFORCE/10 ROTATION I leg1, J leg2,     N mm, rad
                                        FUNCTION = role sign x the laws' sum
                                        (VARIABLEs of AZ, WZ, MIN, MAX, IF)
-five-link ``stance_hip`` .. ``swing_   SFORCE/11-14 ROTATION on each leg's    N mm, rad
-knee``                                 hip (I thigh, J torso) and knee (I
+five-link hip and knee torques         SFORCE/11-14 ROTATION on each leg's    N mm, rad
+                                       hip (I thigh, J torso) and knee (I
                                        shank, J thigh), the law of its role
 ``walker.actuation.push_off``          GFORCE/1, 2 at the stance foot, along  N
                                        foot -> hip: P / T while the swing
@@ -64,7 +64,7 @@ knee``                                 hip (I thigh, J torso) and knee (I
 arc foot radius ``R``                  GRAPHICS/<foot marker> ELLIPSOID of    mm
                                        diameter 2 R on the arc's centre
 flat foot ``heel_m``, ``toe_m``        foot PART markers ``+3`` (heel),       mm
-                                       ``+5`` (toe) along its x axis, spheres
+                                       ``+5`` (toe) on its x axis, spheres
 flat foot ``ankle`` spring             SPRINGDAMPER/21, 22 ROTATIONAL (I      N mm/rad, rad
                                        foot, J leg) KT, CT, ANGLE
 ``contact.flat_foot_mass_kg``,         foot PART MASS, IP (at the ankle)      kg, kg mm^2
@@ -73,8 +73,8 @@ flat foot ``ankle`` spring             SPRINGDAMPER/21, 22 ROTATIONAL (I      N 
                                        (I foot, J leg) from heel off
 bisecting torso (``walker.torso``)     COUPLER/1 of the torso's and leg1's    -
                                        hip REVOLUTEs, SCALES = 1, -0.5
-rigid gait start (x ``contact_sim.     PART QG, REULER, VX, VY (CM), WZ       mm, deg, mm/s,
-initial_rate_scale``)                                                         rad/s
+rigid gait x ``initial_rate_scale``    PART QG, REULER, VX, VY (CM), WZ       mm, deg, mm/s,
+                                                                              rad/s
 ``contact_sim.n_strides``              acf SIMULATE/DYNAMICS END, STEPS       s
 =====================================  =====================================  ================
 

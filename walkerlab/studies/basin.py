@@ -5,31 +5,41 @@ start the walker from every cell of a grid of post-heel-strike states, iterate t
 map and record where each cell goes.  Here a cell's state takes its two axis coordinates
 (named by ``walker.state_names()``) from the grid, and either (``basin.start``)
 
-``fixed_point``  the coordinate fixed by the heel-strike surface from that constraint
-                 (``walker.from_section(walker.section(x))``) and every other coordinate from
-                 the fixed point ``x*`` (:func:`slice_state`), or
-``phase_plane``  the cell is the state itself, the axes from the grid and every other
-                 coordinate from ``x*``, not projected: any state of the stance phase (the
-                 rimless wheel's phase plane, Coleman, Chatterjee & Ruina 1997, whose
-                 Poincaré section has one coordinate), or
-``heel_strike``  the cell is a state just after a heel strike, as Schwab & Wisse's: the image
-                 ``walker.reset(x-)`` of a pre-impact state ``x-`` on the guard that equals
-                 the fixed point's pre-impact state but in the two section coordinates the
-                 axis values depend on most (:func:`heel_strike_slice`).  For the simplest
-                 walker the post-impact states form a 2-D set (the massless swing leg's rate
-                 follows from the stance leg's), so this cell is the only one there is.
+``fixed_point``
+    the coordinate fixed by the heel-strike surface from that constraint
+    (``walker.from_section(walker.section(x))``) and every other coordinate from
+    the fixed point ``x*`` (:func:`slice_state`), or
+``phase_plane``
+    the cell is the state itself, the axes from the grid and every other
+    coordinate from ``x*``, not projected: any state of the stance phase (the
+    rimless wheel's phase plane, Coleman, Chatterjee & Ruina 1997, whose
+    Poincaré section has one coordinate), or
+``heel_strike``
+    the cell is a state just after a heel strike, as Schwab & Wisse's: the image
+    ``walker.reset(x-)`` of a pre-impact state ``x-`` on the guard that equals
+    the fixed point's pre-impact state but in the two section coordinates the
+    axis values depend on most (:func:`heel_strike_slice`).  For the simplest
+    walker the post-impact states form a 2-D set (the massless swing leg's rate
+    follows from the stance leg's), so this cell is the only one there is.
 
 Outcome of a cell (:data:`OUTCOMES`, stored as int8 codes):
 
-``converged``        ``max|x_k - x*| < converge_tol`` after ``k`` steps (the period-1 gait)
-``other_attractor``  ``max|x_k - x_{k-p}| < period_tol`` for some ``1 <= p <= max_period``
-                     away from ``x*`` (a period-``p`` gait; ``p`` is stored)
-``fell_forward``     a fall guard fired with the hip ahead of the stance foot (x > 0)
-``fell_backward``    ... with the hip behind it
-``max_steps``        none of the above within ``max_steps`` steps
-``stalled``          a step longer than ``max_step_time_s``, or a solver failure
-``unreachable``      (``start: heel_strike``) no pre-impact state on the guard has a heel
-                     strike that lands on the cell
+``converged``
+    ``max|x_k - x*| < converge_tol`` after ``k`` steps (the period-1 gait)
+``other_attractor``
+    ``max|x_k - x_{k-p}| < period_tol`` for some ``1 <= p <= max_period``
+    away from ``x*`` (a period-``p`` gait; ``p`` is stored)
+``fell_forward``
+    a fall guard fired with the hip ahead of the stance foot (x > 0)
+``fell_backward``
+    ... with the hip behind it
+``max_steps``
+    none of the above within ``max_steps`` steps
+``stalled``
+    a step longer than ``max_step_time_s``, or a solver failure
+``unreachable``
+    (``start: heel_strike``) no pre-impact state on the guard has a heel
+    strike that lands on the cell
 
 Cells are evaluated in chunks (one grid row each) by
 :func:`walkerlab.studies.runner.sweep_executor` - in this process, on a local process pool

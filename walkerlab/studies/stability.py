@@ -1,7 +1,7 @@
 """Stability maps of the compliant-contact gait itself.
 
 Each cell of a map (a parameter y against the slope) asks: *does the contact model have a
-periodic gait here, is it stable, what is its largest |Floquet multiplier|, or why not?*
+periodic gait here, is it stable, what is its largest ``|Floquet multiplier|``, or why not?*
 The gait is the fixed point of the contact walker's own mid-stance step map
 (:func:`walkerlab.analysis.contact.periodic.find_contact_periodic_gait`).  Along each row
 (one y value, slopes ascending) every cell starts from the contact gait of its neighbour
@@ -9,7 +9,7 @@ The gait is the fixed point of the contact walker's own mid-stance step map
 fixed point at that slope (placed on the contact model and iterated a few steps).
 
 Cell results (:data:`CELL_FIELDS`): ``exists`` (converged and every loaded foot stays on its
-patch), ``stable`` (all |multipliers| < 1), ``max_abs_multiplier``, ``step_period_s``,
+patch), ``stable`` (all ``|multipliers|`` < 1), ``max_abs_multiplier``, ``step_period_s``,
 ``patch_margin_m``, ``source`` ("neighbour" / "ideal"), ``reason`` ("" when the gait
 exists, else ``fall``, ``no_mid_stance``, ``solver_failure``, ``time_limit``,
 ``not_converged``, ``off_patch``, ``no_ideal_gait``, ``invalid_config``, ``unsupported``:

@@ -132,7 +132,7 @@ class StepSummary:
         step, each from touchdown to lift-off (flight between bounces excluded) [mm];
         positive = downhill.  NaN when the stance phase does not end before the run does.
     double_support_creep_mm : float
-        Along-slope travel of both feet (sum of |displacement|) while both are loaded, within
+        Along-slope travel of both feet (sum of ``|displacement|``) while both are loaded, within
         the step [mm] (the smoothed-stiction creep; reported apart from the slip).
     bounce_count : int
         Touchdowns of the stance foot within the step after the one that starts it.
@@ -253,7 +253,7 @@ class ContactResult:
 
     @property
     def max_stance_slip_mm(self) -> float:
-        """Largest |stance slip| over the stance phases that ended [mm] (0 if none)."""
+        """Largest ``|stance slip|`` over the stance phases that ended [mm] (0 if none)."""
         v = [abs(s.stance_slip_mm) for s in self.steps if np.isfinite(s.stance_slip_mm)]
         return float(max(v, default=0.0))
 

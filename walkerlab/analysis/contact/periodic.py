@@ -81,7 +81,7 @@ class ContactPeriodicGait:
     step_length_m : float
         Along-slope advance of the stance foot per step [m].
     residual : float
-        max |(P(z) - z) / scale| (scaled, see :data:`SCALES`) [-].
+        max ``|(P(z) - z) / scale|`` (scaled, see :data:`SCALES`) [-].
     residual_si : ndarray (n,)
         P(z) - z in SI units.
     jacobian : ndarray (n, n)
@@ -89,10 +89,10 @@ class ContactPeriodicGait:
     multipliers : ndarray (n,) complex
         Floquet multipliers, sorted by decreasing modulus.
     multiplier_fd_spread : float
-        max change of the slow (|lambda| > 1e-3) sorted multipliers when the FD step is
+        max change of the slow (``|lambda|`` > 1e-3) sorted multipliers when the FD step is
         multiplied or divided by 3.
     stable : bool
-        All |multipliers| < 1.
+        All ``|multipliers|`` < 1.
     converged : bool
     message : str
     nfev : int
@@ -127,7 +127,7 @@ class ContactPeriodicGait:
 
     @property
     def max_multiplier(self) -> float:
-        """Largest |multiplier| [-]."""
+        """Largest ``|multiplier|`` [-]."""
         return float(np.max(np.abs(self.multipliers)))
 
 
@@ -356,7 +356,7 @@ def _floquet_multipliers(walker: ContactWalker, P: StepMap, zs: np.ndarray, solv
     """The final Jacobian of :func:`find_contact_periodic_gait` at the fixed point ``zs``:
     central differences of step ``fd_step * scale`` on the map at ``jacobian_solver``'s
     tolerances (``P`` itself when they equal ``solver``'s), its sorted eigenvalues (the
-    Floquet multipliers) and, with ``check_fd``, the largest change of the slow (|lambda| >
+    Floquet multipliers) and, with ``check_fd``, the largest change of the slow (``|lambda|`` >
     1e-3) multipliers for the step times 3 and over 3 (NaN without).  Returns
     ``(PJ, J, multipliers, spread)``, ``PJ`` the map the Jacobian used."""
     scale = P.scale

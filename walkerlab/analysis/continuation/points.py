@@ -121,7 +121,7 @@ def _null_tangent(Fz: np.ndarray, Fp_scaled: np.ndarray) -> np.ndarray:
 
 def correct(sys: BranchSystem, u0: np.ndarray, row: np.ndarray, target: float,
              J0: np.ndarray | None = None, xtol: float = 1e-13):
-    """Solve ``[F(z, p); row . u - target] = 0`` from ``u0`` (scaled ``u = (z, p/p_scale)``)
+    """Solve ``[F(z, p); row @ u - target] = 0`` from ``u0`` (scaled ``u = (z, p/p_scale)``)
     with ``scipy.optimize.root`` (``hybr``, analytic bordered Jacobian).
 
     The bordered corrector of pseudo-arclength continuation (Allgower & Georg 2003, ch. 2;
@@ -354,7 +354,7 @@ def locate_on_bound(sys, a, b, kind, k):
 def switch_period_doubling(family: WalkerFamily, sp: SpecialPoint, p_scale: float,
                            eps: float = 1e-3) -> BranchPoint:
     """First point of the period-``2k`` branch born at the period doubling ``sp`` (on the
-    period-``k`` branch): the fixed point of the ``2k``-step map with ``v . (z - z*) = eps``
+    period-``k`` branch): the fixed point of the ``2k``-step map with ``v @ (z - z*) = eps``
     (``v`` the eigenvector of the multiplier -1), the parameter free (branch switching at a
     flip bifurcation; Kuznetsov, "Elements of Applied Bifurcation Theory", 3rd ed. 2004,
     ch. 10).

@@ -41,7 +41,7 @@ class TargetResult:
     measures : dict[str, float]
         ``speed`` [m/s], ``step_length`` [m], ``step_period`` [s] of the gait.
     residual : float
-        max |F| at the solution (state part [rad, rad/s] and target part [its unit]).
+        max ``|F|`` at the solution (state part [rad, rad/s] and target part [its unit]).
     maps : int
         Step maps integrated.
     """

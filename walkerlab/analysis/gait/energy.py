@@ -133,9 +133,9 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
 
 
 def trajectory_ledger(traj) -> dict[str, np.ndarray]:
-    """:func:`step_ledger` of every step of a :class:`~walkerlab.integrate.rigid.
-    HybridTrajectory`, each column (steps,); flat feet (no generated flow matrices: their
-    modes pin the heel or the toe) by
+    """:func:`step_ledger` of every step of a
+    :class:`~walkerlab.integrate.rigid.HybridTrajectory`, each column (steps,); flat feet
+    (no generated flow matrices: their modes pin the heel or the toe) by
     :func:`walkerlab.analysis.gait.energy_modes.flat_trajectory_ledger`, empty for flat
     feet on legs that differ."""
     from walkerlab.integrate.rigid import other_leg

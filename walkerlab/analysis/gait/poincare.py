@@ -39,7 +39,7 @@ ROOT_BUDGET_S = 60.0
 _clock = time.thread_time
 #: a step map slower than this [s] is said in one notice (the search is not silent)
 SLOW_MAP_S = 5.0
-#: a fixed point whose residual max |P(x) - x| is below this (or the root finder's ``xtol``,
+#: a fixed point whose residual max ``|P(x) - x|`` is below this (or the root finder's ``xtol``,
 #: if larger) is converged, whatever MINPACK's status says (its "not making good progress"
 #: comes once the residual is at the integrator's round-off)
 RESIDUAL_TOL = 1e-10

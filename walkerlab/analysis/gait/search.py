@@ -101,7 +101,7 @@ class Gait:
 
     @property
     def max_multiplier(self) -> float:
-        """Largest |Floquet multiplier| (variational) [-]."""
+        """Largest ``|Floquet multiplier|`` (variational) [-]."""
         return float(np.max(np.abs(self.result.multipliers_variational)))
 
     def describe(self, time_unit: str = "s") -> str:

@@ -1,2 +1,2 @@
-"""Robustness beyond |λ|: local sensitivity measures, pushes, mean first-passage time and
+"""Robustness beyond ``|λ|``: local sensitivity measures, pushes, mean first-passage time and
 the basin's area."""

@@ -109,7 +109,7 @@ def pcg64_states(seed: int, walks) -> list[tuple[int, int]]:
 
 def slope_rows(seed: int, walks, start: int, n: int, mean: float, sd: float,
                distribution: str = "normal") -> np.ndarray:
-    """Slopes [rad] of steps ``start .. start + n - 1`` of each walk in ``walks``: row ``i``
+    """Slopes [rad] of steps ``start`` to ``start + n - 1`` of each walk in ``walks``: row ``i``
     is ``draw_slopes(seed, walks[i], start + n, mean, sd, distribution)[start:]`` bit for bit
     (:func:`walkerlab.analysis.robustness.mfpt.draw_slopes`).
 

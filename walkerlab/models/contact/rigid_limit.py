@@ -116,8 +116,8 @@ def scale(contact: ContactParamsSI, knee: KneeStopSI, kappa: float
 
 def contact_si(settings: ContactSettings) -> tuple[ContactParamsSI, KneeStopSI]:
     """The scene's contact and knee stop in SI, with its ``stiffness_family`` applied: the
-    contact model's parameters of a run (built once per run, :func:`walkerlab.models.contact.scene.
-    build`).
+    contact model's parameters of a run (built once per run,
+    :func:`walkerlab.models.contact.scene.build`).
 
     ``stiffness_family: paper`` returns the numbers as written, converted to SI
     (:func:`walkerlab.models.contact.laws.contact_params_si`).  ``rigid_limit`` reads the maximum

@@ -1,7 +1,7 @@
-"""Ankle push-off of a walker on flat feet in the rigid view (``walker.actuation.
-ankle_push_off``): from heel off until heel strike a pre-loaded ankle spring is released
-and/or a constant plantarflexion torque acts, as Mizani et al. (2018; the paper's ref. [32])
-power the walker in ADAMS.
+"""Ankle push-off of a walker on flat feet in the rigid view
+(``walker.actuation.ankle_push_off``): from heel off until heel strike a pre-loaded ankle
+spring is released and/or a constant plantarflexion torque acts, as Mizani et al. (2018;
+the paper's ref. [32]) power the walker in ADAMS.
 
 On the stance ankle angle ``a`` (the sole's angle from the stance leg's perpendicular,
 positive toe up; :mod:`walkerlab.codegen.foot_modes`) the ankle spring gives ``-k (a - r)``;

@@ -38,8 +38,7 @@ Contract of :class:`HybridWalker` (nothing outside the model layer may assume mo
     ``(kinetic, potential)`` [J]; potential relative to the reference point's height.
 ``params``
     Includes ``gravity_m_per_s2``, ``leg_length_m``, ``total_mass_kg``, ``slope_rad``.
-``section(x)`` / ``from_section(z)``, ``reset``, ``reset_jacobian``, ``variational``,
-``heel_strike_guard``
+``section``, ``from_section``, ``reset``, ``reset_jacobian``, ``variational``, ``heel_strike_guard``
     Poincaré-section coordinates (state minus the coordinate fixed by the heel-strike
     surface) and its inverse; heel-strike map incl. the role swap and its Jacobian (2n, 2n);
     flow Jacobian ``(t, x) -> (2n, 2n)``; the heel-strike guard function.

@@ -3,15 +3,16 @@ generated flow (:mod:`walkerlab.codegen.foot_modes`) gains the torques' accelera
 ``M_mode^-1 B tau`` (:class:`walkerlab.models.hybrid.actuators.Actuators`: ``B^T =
 d(delta)/dq`` of each joint's angle, the hip between the legs, a torso's hips, the ankles
 (``stance_ankle``: the ankle coordinate itself; the swing foot is held at its rest angle,
-so its ankle's torque has a zero row)), in foot flat through the locked foot (``a . qdd =
-0``, ``a = d phi / dq``: :meth:`walkerlab.models.hybrid.actuators.Actuators.
-added_acceleration`).  ``M_mode`` is the Hessian in the rates of the mode's generated
-kinetic energy (heel- or toe-pinned kinematics), read exactly by polarisation (the energy is
-quadratic in the rates; complex-safe in the angles, so the added acceleration's Jacobian is
-the complex step's).  The guards read the ground forces through the actuated flow (a joint
-torque is internal: the ground reaction's formula from the accelerations holds); resets
-stay the walker's.  Legs that differ: the next step's walker (``mirror``) gets its own
-actuators on its own numbers.
+so its ankle's torque has a zero row)), in foot flat through the locked foot (``a @ qdd =
+0``, ``a = d phi / dq``:
+:meth:`walkerlab.models.hybrid.actuators.Actuators.added_acceleration`).  ``M_mode`` is the
+Hessian in the rates of the mode's generated kinetic energy (heel- or toe-pinned
+kinematics), read exactly by polarisation (the energy is quadratic in the rates;
+complex-safe in the angles, so the added acceleration's Jacobian is the complex step's).
+The guards read the ground forces through the actuated flow (a joint torque is internal:
+the ground reaction's formula from the accelerations holds); resets stay the walker's.
+Legs that differ: the next step's walker (``mirror``) gets its own actuators on its own
+numbers.
 """
 
 from __future__ import annotations

@@ -21,12 +21,15 @@ This module keeps the paper's *printed* equations (Appendix A) for comparison.
 
 Equation variants
 -----------------
-``derived``      generic symbolic derivation - the default.
-``appendix_a``   the printed Appendix A flow (A.4-A.6, including the wrong sign of
-                 ``C[1, 0]`` in A.5) with the impact of A.57; reproduces the paper's Eq. 11.
-``appendix_a_literal``  as ``appendix_a`` but also with the printed y-component of the
-                 swing-foot position (A.55, ``cos(theta1) - cos(-theta2)``); its fixed point
-                 does *not* match Eq. 11, which shows the MATLAB code did not use that sign.
+``derived``
+    generic symbolic derivation - the default.
+``appendix_a``
+    the printed Appendix A flow (A.4-A.6, including the wrong sign of ``C[1, 0]`` in A.5)
+    with the impact of A.57; reproduces the paper's Eq. 11.
+``appendix_a_literal``
+    as ``appendix_a`` but also with the printed y-component of the swing-foot position
+    (A.55, ``cos(theta1) - cos(-theta2)``); its fixed point does *not* match Eq. 11, which
+    shows the MATLAB code did not use that sign.
 """
 
 from __future__ import annotations
