@@ -23,7 +23,8 @@ scene's fixed point written to 8 digits, sampled at the points.
 
     python -m walkerlab.bench.minimal_casadi     (or: python walkerlab/bench/minimal_casadi.py)
 
-prints IPOPT's status, iterations, the step period [s] and the objective [N^2 m^2 s].
+prints IPOPT's status, iterations, the step period [s], the objective [N^2 m^2 s] and the
+step's start (the post-impact state) [rad, rad/s].
 """
 
 from __future__ import annotations
@@ -124,9 +125,10 @@ def main() -> None:
                 {"print_level": 0, "tol": 1e-12, "acceptable_tol": 1e-10, "max_iter": 500,
                  "sb": "yes"})
     s = opti.solve()
+    x0 = " ".join(f"{v:.10f}" for v in s.value(X[:, 0]))
     print(f"{s.stats()['return_status']} after {s.stats()['iter_count']} iterations; step "
-          f"period {s.value(T):.6f} s, objective {s.value(opti.f):.3e} N^2 m^2 s, "
-          f"start {np.round(s.value(X[:, 0]), 8)}")
+          f"period {s.value(T):.10f} s, objective {s.value(opti.f):.3e} N^2 m^2 s, "
+          f"start {x0}")
 
 
 if __name__ == "__main__":
