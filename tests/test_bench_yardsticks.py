@@ -48,3 +48,26 @@ def test_cyrk_monte_carlo_walks_as_the_minimal_loop():
     assert out["walks_differing_from_minimal"] == {"library": 0, "cyrk": 0, "minimal": 0}
     assert len(set(out["heel_strikes"].values())) == 1
     assert out["heel_strikes"]["minimal"] > 20  # the walks took steps
+
+
+@pytest.mark.slow
+def test_minimal_casadi_script_finds_compass_optimal_gait():
+    """The minimal CasADi + IPOPT script (no walkerlab import) collocates the least-effort
+    step of configs/compass_optimal.yaml: the passive gait (u = 0), as walkerlab optimize
+    finds; its start and step period equal the rigid fixed point to Hermite-Simpson's error
+    on 40 intervals (measured 5e-8; bound 1e-6)."""
+    import walkerlab as wl
+
+    out = subprocess.run([sys.executable, str(ROOT / "walkerlab" / "bench" /
+                                              "minimal_casadi.py")],
+                         capture_output=True, text=True, timeout=120, cwd="/")
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.startswith("Solve_Succeeded"), out.stdout
+    words = out.stdout.split()
+    period = float(words[words.index("period") + 1])
+    objective = float(words[words.index("objective") + 1])
+    start = np.array([float(w) for w in words[words.index("start") + 1:][:4]])
+    gait = wl.Walker.from_scene(ROOT / "configs" / "compass_optimal.yaml").fixed_point()
+    assert objective < 1e-12  # int u^2 dt [N^2 m^2 s]: zero torque
+    assert abs(period - gait.step_period) < 1e-6
+    np.testing.assert_allclose(start, gait.x, rtol=0, atol=1e-6)
