@@ -416,7 +416,7 @@ def test_straight_line_rhs_is_the_array_assembly_with_contact_and_latch():
         x[1] -= 1e-4  # both feet a little deeper
         M, P, V, J = (np.empty((nq, nq)), np.empty((2, 2)), np.empty((2, 2)),
                       np.empty((2, 2, nq)))
-        info, knees = np.zeros((2, 10)), np.zeros((2, 5))
+        info, knees = np.zeros((2, 12)), np.zeros((2, 5))
         Q = w.kernels._force(x, *w._args(), True, True, M, P, V, J, info, knees)
         assert np.all(knees[:, 2] < 0) and np.all(info[:, 4] > 0)  # latches hold, feet loaded
         want = np.linalg.solve(M, Q)
