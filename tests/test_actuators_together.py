@@ -171,15 +171,15 @@ def test_legs_with_some_massless_bodies_take_torques_and_a_push_off():
     assert "\n" not in str(e.value)
 
 
-def test_the_contact_view_refuses_a_five_link_push_off_it_cannot_carry_in_one_line():
-    """The rigid view now carries a push-off on free knees; the contact view has no pulse
-    for it yet, so it refuses the scene in one line naming the field (never drops it)."""
-    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+def test_the_contact_view_carries_a_five_link_push_off():
+    """The rigid view carries a push-off on free knees, and so does the contact view (its
+    pulse at the trailing foot along the leg, as on every walker): the scene is set up with
+    the push-off in its actuators, never dropped."""
+    from walkerlab.models.contact.scene import contact_setup
 
     d = load_scene(CONFIGS / "rabbit.yaml").model_dump(exclude_none=True)
     d["walker"]["actuation"]["push_off"] = {"impulse_n_s": 1.0}
     scene = scene_from_dict(d)
     build_walker(scene)  # the rigid view takes it
-    with pytest.raises(ContactSceneError, match=r"walker\.actuation\.push_off") as e:
-        contact_setup(scene)
-    assert "\n" not in str(e.value)
+    acts = contact_setup(scene).actuators
+    assert acts is not None and acts.spec.push_off.impulse_n_s == 1.0

@@ -31,8 +31,8 @@ WALKER_COUNT = re.compile(r"^(nq|NQ|n_coordinates|n_states)$")
 ALLOWED = {("config/errors.py", "x[:1]"): "the first character of an exponent string",
            # the benchmark's plain-numba baseline is a hand-written compass gait, a model of
            # its own that shares nothing with the library (walkerlab.bench.minimal_collocation)
-           **{("bench/minimal_collocation.py", f"x[{i}]"): "the baseline's own compass state"
-              for i in range(4)}}
+           **{(f"bench/{f}.py", f"x[{i}]"): "the baseline's own compass state"
+              for f in ("minimal_collocation", "minimal_casadi") for i in range(4)}}
 
 
 def _int_literal(e) -> bool:

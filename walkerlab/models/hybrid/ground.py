@@ -30,7 +30,6 @@ from dataclasses import replace
 from functools import partial
 
 import numpy as np
-from scipy.optimize import newton
 
 from walkerlab.codegen.cache import functions
 from walkerlab.models.hybrid.base import HybridWalker, Phase
@@ -142,6 +141,8 @@ class _LandingSection:
         def dh(s):
             x[g] = s
             return float(np.sum(np.asarray(self.gradient(x))[g]))
+
+        from scipy.optimize import newton  # the stairs' section only: no import at start-up
 
         s = newton(h, float(x[g[0]]), fprime=dh, tol=1e-15, maxiter=50)
         x[g] = s
