@@ -99,7 +99,7 @@ HEIGHT_STREAM = 2**31
 
 def height_rows(seed: int, walks, start: int, n: int, sd: float,
                 distribution: str = "normal") -> np.ndarray:
-    """Landing heights [m] above the slope line of steps ``start .. start + n - 1`` of each
+    """Landing heights [m] above the slope line of steps ``start`` to ``start + n - 1`` of each
     walk in ``walks`` (each in ``[0, 2**31)``), about 0 with standard deviation ``sd`` [m]:
     :func:`walkerlab.analysis.robustness.slope_stream.slope_rows` of the walks
     ``w + HEIGHT_STREAM``; shape (len(walks), n).
