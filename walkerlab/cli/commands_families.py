@@ -296,7 +296,8 @@ def _optimize_design(scene, design, objective, maximize, runs_dir, force) -> Non
         raise ValueError(f"--objective: one of {', '.join(MEASURES)}, not {objective!r}")
     sc = load(scene)
     bounds = design_bounds(sc, design)  # every field checked before the upstream stages
-    pipeline.run_upstream("optimize", sc, runs_dir)
+    for up in pipeline.order("fixedpoint", sc):  # the design follows the scene's own gait
+        pipeline.stage_module(up).run(sc, runs_dir)  # (a five-link biped's optimize needs none)
     out = stage.run_design(sc, runs_dir, force, bounds, objective, maximize)
     r = out.summary.get("design")
     if r is not None:
