@@ -47,9 +47,15 @@ the contact term).  Samples are on the run's grid (``sample_rate_hz`` from ``t0`
 flights are found on them as in the passive run (:func:`walkerlab.integrate.contact.first_event`).
 
 Methods: a :func:`~scipy.integrate.solve_ivp` method of the settings (``LSODA``, ``Radau``,
-``BDF``, ...); the compiled backends (``cyrk_bdf``, ``numbalsoda``) and ``odeint`` have no
-event location and run as ``LSODA`` here.  The analytic Jacobian of the passive walker is
-passed (the actuation's derivatives left out: Newton directions only).
+``BDF``, ...); ``numbalsoda`` and ``odeint`` have no event location and run as ``LSODA``
+here.  With ``cyrk_bdf`` a walker whose actuation the compiled kernel carries (point or arc
+feet, straight legs, plain hip laws: :func:`walkerlab.integrate.contact_powered_chunks.
+chunk_rhs`) runs between its events in compiled chunks on the run's samples, as the passive
+run does; the sample interval where an event's function changes sign is handed to the
+``LSODA`` segments here, which locate the event and apply its transition (the push-off pulse
+runs there too); other walkers run as ``LSODA``.  The analytic Jacobian of the passive
+walker is passed to ``solve_ivp`` (the actuation's derivatives left out: Newton directions
+only).
 """
 
 from __future__ import annotations
