@@ -47,9 +47,15 @@ the contact term).  Samples are on the run's grid (``sample_rate_hz`` from ``t0`
 flights are found on them as in the passive run (:func:`walkerlab.integrate.contact.first_event`).
 
 Methods: a :func:`~scipy.integrate.solve_ivp` method of the settings (``LSODA``, ``Radau``,
-``BDF``, ...); the compiled backends (``cyrk_bdf``, ``numbalsoda``) and ``odeint`` have no
-event location and run as ``LSODA`` here.  The analytic Jacobian of the passive walker is
-passed (the actuation's derivatives left out: Newton directions only).
+``BDF``, ...); ``numbalsoda`` and ``odeint`` have no event location and run as ``LSODA``
+here.  With ``cyrk_bdf`` a walker whose actuation the compiled kernel carries (point or arc
+feet, straight legs, plain hip laws: :func:`walkerlab.integrate.contact_powered_chunks.
+chunk_rhs`) runs between its events in compiled chunks on the run's samples, as the passive
+run does; the sample interval where an event's function changes sign is handed to the
+``LSODA`` segments here, which locate the event and apply its transition (the push-off pulse
+runs there too); other walkers run as ``LSODA``.  The analytic Jacobian of the passive
+walker is passed to ``solve_ivp`` (the actuation's derivatives left out: Newton directions
+only).
 """
 
 from __future__ import annotations
@@ -70,6 +76,10 @@ IVP_METHODS = ("LSODA", "Radau", "BDF", "RK45", "DOP853", "RK23")
 #: RHS calls without the time advancing by more than 1e-9 s after which a segment ends (a
 #: force jump the solver cannot step over, e.g. a foot entering a patch from its side).
 STALL_CALLS = 20_000
+
+#: Most CyRK steps in one compiled chunk of a powered run (as the passive loop's
+#: ``CYRK_STEPS_PER_CALL``): past it the chunk goes on in ``solve_ivp``.
+CHUNK_STEPS = 100_000
 
 
 class _Deadline(Exception):
@@ -358,6 +368,55 @@ class ActuationHook:
         self.lead = (_pulse_event(self.walker, lambda: self.stance, acts.pulse_s)
                      if self.pulsed else None)
         self.pushed = False
+        # the compiled chunks between events (contact_powered_chunks), where they apply
+        from .contact_powered_chunks import chunk_rhs
+
+        self.fast = chunk_rhs(self.walker, self.solver.method)
+
+    def _compiled(self, tb: float):
+        """A compiled chunk from the present state to ``tb`` [s] on the run's samples
+        (:mod:`walkerlab.integrate.contact_powered_chunks`): ``"go"`` when it reached ``tb``
+        with no event on its samples, ``"end"`` at the deadline, else the time [s] of the
+        sample closing the first sample interval where an event's function changes sign
+        (or where the compiled solver stopped), the present state moved to the interval's
+        start: ``solve_ivp`` takes it from there."""
+        import time
+
+        from . import _cyrk
+
+        walker, acts, n = self.walker, self.walker.actuators, 2 * self.walker.nq
+        t, grid = self.t, self.grid
+        tg = np.concatenate([[t], grid[(grid > t + 1e-12) & (grid < tb - 1e-12)], [tb]])
+        s = self.solver
+        X, ok, nf, _m = _cyrk.solve_chunk(
+            s.method, self.y, tg, self.fast.data(self.stance), s.rtol,
+            powered_atol(walker, s.atol), s.max_step_s or np.inf, CHUNK_STEPS,
+            kernels=self.fast.kernels)
+        self.nfev += nf
+        if len(X) < 2:
+            return tb
+        # per point: penetration, its rate, slip, s, Fn, Ff, power, on_ground
+        rows = walker.kernels.contact_table(np.ascontiguousarray(X[:, :n]), *walker._args())
+        sw, st = rows[:, acts.push_row(walker, 1 - self.stance)], \
+            rows[:, acts.push_row(walker, self.stance)]
+        ahead = (sw[:, 7] >= 0.5) & (sw[:, 3] - st[:, 3] >= acts.min_step_m)
+        gs = [walker.hip_height(X[:, :n]) - self.limits.fall_hip_height_m,
+              np.where(ahead, -sw[:, 0], 1.0)]
+        if self.pulsed and not self.pushed:
+            gs.append(np.where(ahead, -pulse_lead(sw[:, 0], sw[:, 1], acts.pulse_s), 1.0))
+        hit = np.zeros(len(X) - 1, bool)
+        for g in gs:  # solve_ivp's rule for direction -1: g >= 0, then g <= 0
+            hit |= (g[:-1] >= 0.0) & (g[1:] <= 0.0)
+        k = int(np.argmax(hit)) + 1 if hit.any() else len(X)
+        self.ts.append(tg[1:k])
+        self.Ys.append(X[1:k])
+        self.t, self.y = float(tg[k - 1]), X[k - 1].copy()
+        if k == len(X) == len(tg) and ok:
+            return "go"
+        if time.perf_counter() > self.deadline:
+            self.term, self.msg = RunEnd.TIME_LIMIT, "wall-time limit reached"
+            return "end"
+        return float(tg[k]) if k < len(tg) else tb
 
     def advance(self, tb: float, t1: float) -> str:
         """Integrate from the present ``(self.t, self.y)`` to ``tb`` [s] or the next discrete
@@ -368,6 +427,12 @@ class ActuationHook:
         predicate) or ``"go"``."""
         acts = self.walker.actuators
         n = 2 * self.walker.nq
+        if self.fast is not None and acts.laws is self.fast.source:  # compiled up to
+            # the sample interval of the next event
+            got = self._compiled(tb)
+            if isinstance(got, str):
+                return got
+            tb = got
         t, y = self.t, self.y
         watch = acts.ankle is not None and not self.ankle_on
         arm = self.pulsed and not self.pushed
