@@ -11,6 +11,12 @@ kinematics), read exactly by polarisation (the energy is quadratic in the rates;
 complex-safe in the angles, so the added acceleration's Jacobian is the complex step's).
 The guards read the ground forces through the actuated flow (a joint torque is internal:
 the ground reaction's formula from the accelerations holds); resets stay the walker's.
+The double support after heel strike (the trailing toe pinned,
+:func:`walkerlab.models.hybrid.rigid_foot_modes.double_support_phases`) is kept: its closed
+chain gains the torques' generalised force, ``[M -J^T; J 0] [qdd; lam] = [-h + B tau; -dJ
+dq]``, so its flow, the toe-off guard's and the falls' contact forces and the step entry's
+check of the trailing toe's force all carry the torque (the swing foot's ankle has no row
+there either: the trailing foot's ankle angle is no coordinate of ``q``).
 Legs that differ: the next step's walker (``mirror``) gets its own actuators on its own
 numbers.
 """
@@ -97,7 +103,8 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> Hybrid
         return fl, J
 
     w = make_flat_walker(replace(data, mirror_params=None), walker.name, walker.variant,
-                         heel_off, flow_of=flow_of)
+                         heel_off, flow_of=flow_of, force=acts.generalised_force,
+                         step_clock=lambda: acts.t_origin)
     mirror = walker.mirror
     if mirror is not None:  # legs that differ: the next step's walker, its own numbers
         mirror = actuate_flat_hips(mirror, data.mirror, spec)
