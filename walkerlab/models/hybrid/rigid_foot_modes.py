@@ -231,7 +231,11 @@ def _force(forces, which: int, t, x) -> float:
 
 def _with_force(fun, force, t, x):
     """``fun(t, x, gen)`` with the joint torques' generalised force ``gen = force(t, x)``
-    (3,) [N m] in the closed chain's right-hand side."""
+    (3,) [N m] in the closed chain's right-hand side.  Real states only, as the generated
+    closed chain (a numeric linear solve): a complex state raises ``TypeError``, so that
+    :func:`walkerlab.integrate.rigid_phase.numeric_jacobian` takes central differences."""
+    if np.iscomplexobj(x):
+        raise TypeError("the double support's closed chain takes real states")
     return fun(t, x, np.asarray(force(t, x), dtype=float))
 
 
