@@ -60,6 +60,9 @@ def mode_mass_matrix(kinetic, x) -> np.ndarray:
 def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> HybridWalker:
     """The flat-footed walker with its joint torques (module docstring).
 
+    The double support is kept when ``walker`` has it (its ``step_entry``; a walker made
+    with ``double_support=False`` stays without).
+
     ``heel_off``: the walker's data with the heel-off mode's ankle numbers of an ankle
     push-off acting as well (:func:`walkerlab.models.hybrid.ankle_push_off.heel_off_data`;
     then ``data`` is one step's, without ``mirror_params``), or None.
@@ -104,7 +107,8 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> Hybrid
 
     w = make_flat_walker(replace(data, mirror_params=None), walker.name, walker.variant,
                          heel_off, flow_of=flow_of, force=acts.generalised_force,
-                         step_clock=lambda: acts.t_origin)
+                         step_clock=lambda: acts.t_origin,
+                         double_support=walker.step_entry is not None)
     mirror = walker.mirror
     if mirror is not None:  # legs that differ: the next step's walker, its own numbers
         mirror = actuate_flat_hips(mirror, data.mirror, spec)
