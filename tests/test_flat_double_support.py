@@ -175,3 +175,68 @@ def test_the_energy_ledger_closes_through_the_double_support(flat):
              - f["double_support_trailing"](np.ravel(dense(tb))[:6])[2])
     assert 0.3 < given < 0.6
     assert led["heel_strike_loss"][0] == pytest.approx(0.542, abs=2e-3)
+
+
+def _actuated(torques, ankle_push_off=None):
+    d = yaml.safe_load((ROOT / "configs/flat_feet.yaml").read_text())
+    d["walker"]["actuation"] = {k: v for k, v in (("torques", torques),
+                                                  ("ankle_push_off", ankle_push_off)) if v}
+    sc = scene_from_dict(d, "flat_feet.yaml")
+    return build_walker(sc), Solver.from_settings(sc.solver)
+
+
+@pytest.mark.parametrize("joint", ["hip", "stance_ankle"])
+def test_a_zero_torque_keeps_the_double_support(flat, joint):
+    """A joint torque law of zero gains on flat feet (its flow the passive one's plus an
+    exact 0) keeps the double support after heel strike: the passive gait's step from its
+    fixed point, the same phases, period and next state to 1e-9 (the single-support modes
+    run the Python flows instead of the compiled ones: round-off, measured 1e-13).  Before,
+    an actuated walker released the trailing toe at heel strike: period 0.7576 s, not
+    0.8102 s."""
+    _sc, _w, _f, seg, _traj = flat
+    w, solver = _actuated([{"joint": joint, "law": {}}])
+    s = simulate_steps(w, X_STAR, 1, solver).segments[0]
+    assert [p[0] for p in s.phase_log] == [p[0] for p in seg.phase_log]
+    assert s.phase_log[0][0] == "double_support:heel_contact"
+    assert abs((s.t_end - s.t_start) - (seg.t_end - seg.t_start)) < 1e-9
+    assert np.max(np.abs(s.x_next - seg.x_next)) < 1e-9
+    assert np.max(np.abs(s.x_next - X_STAR)) < 1e-9  # the passive fixed point is the map's
+
+
+def test_a_zero_torque_with_an_ankle_push_off_keeps_the_double_support():
+    """An ankle push-off (0.5 N m in heel off) with a zero-gain hip torque: the step of the
+    ankle push-off alone (which keeps the double support), the same phases and next state
+    to 1e-9."""
+    po = {"constant_n_m": 0.5}
+    ref, solver = _actuated([], po)
+    w, _ = _actuated([{"joint": "hip", "law": {}}], po)
+    a, b = (simulate_steps(m, X_STAR, 1, solver).segments[0] for m in (ref, w))
+    assert a.phase_log[0][0] == "double_support:heel_contact"
+    assert [p[0] for p in b.phase_log] == [p[0] for p in a.phase_log]
+    assert abs((b.t_end - b.t_start) - (a.t_end - a.t_start)) < 1e-9
+    assert np.max(np.abs(b.x_next - a.x_next)) < 1e-9
+
+
+def test_the_ledger_closes_with_a_hip_torque_in_double_support(flat):
+    """A hip torque (0.3 N m + 1 N m/rad) through a step that begins in double support: the
+    closed chain carries the torque's generalised force (``[M -J^T; J 0] [qdd; lam] =
+    [-h + B tau; -dJ dq]``), so the ledger (the torque's work ``int tau d(delta)`` in every
+    phase, double support's included) closes to 1e-9 of the kinetic energy (rtol 1e-12:
+    measured 3e-12 J); the torque's work in double support alone (6e-4 J) is far above
+    that, so a closed chain without the torque would not close."""
+    from scipy.integrate import quad
+
+    from walkerlab.analysis.gait.energy import trajectory_ledger
+
+    w, solver = _actuated([{"joint": "hip", "law": {"constant_n_m": 0.3,
+                                                    "stiffness_n_m_per_rad": 1.0}}])
+    traj = simulate_steps(w, X_STAR, 1, solver)
+    seg = traj.segments[0]
+    assert seg.termination == "heel_strike"
+    assert seg.phase_log[0][0] == "double_support:heel_contact"
+    assert seg.phase_log[0][3] == "toe_off"
+    led = trajectory_ledger(traj)
+    assert abs(led["closure"][0]) < 1e-9 * w.energies(seg.x_start)[0]
+    _ph, dense, (ta, tb) = seg.pieces[0]
+    work = quad(lambda t: w.actuators.power(t, np.ravel(dense(t))[:6]), ta, tb)[0]
+    assert abs(work) > 1e-4

@@ -456,10 +456,13 @@ def _double_support(q, dq, qdd, flows, ankle, lead_force, trailing, sole, gamma,
 
 
 def _double_support_lines(eq: FlatEquations, lead: str) -> list[str]:
-    """Source of ``_double_support_<lead>(x) -> (xdot (6,), forces (4,))`` (forces: the
-    trailing toe's normal and tangential force, the leading foot's normal force and its
-    toe's share [N]), ``double_support_<lead>_entry(x) -> (x+, (Lam_n, Lam_t))`` (the toe's
-    impulse [N s]) and, once, ``double_support_trailing(x) -> (b, db)``."""
+    """Source of ``_double_support_<lead>(x, gen=None) -> (xdot (6,), forces (4,))``
+    (forces: the trailing toe's normal and tangential force, the leading foot's normal force
+    and its toe's share [N]; ``gen`` (3,) [N m], if given, a generalised force in ``q``'s
+    rows added to the right-hand side: joint torques' ``B tau``, the closed chain's
+    ``[M -J^T; J 0] [Qdd; lam] = [-C dQ - G + (B tau, 0); -dJ dQ]``),
+    ``double_support_<lead>_entry(x) -> (x+, (Lam_n, Lam_t))`` (the toe's impulse [N s])
+    and, once, ``double_support_trailing(x) -> (b, db)``."""
     ds = eq.double_support
     sysd = ds[lead]
     n = len(eq.q)
@@ -476,6 +479,8 @@ def _double_support_lines(eq: FlatEquations, lead: str) -> list[str]:
                 f" dtype=float).reshape({m}, {m})")
     body.append(f"{IND}_b = np.array(({', '.join(PRINTER.doprint(e) for e in red[m * m:])},),"
                 " dtype=float)")
+    body.append(f"{IND}if gen is not None:  # joint torques' generalised force in q's rows")
+    body.append(f"{IND}    _b[:{n}] += gen")
     body.append(f"{IND}_s = np.linalg.solve(_K, _b).tolist()")
     body += [f"{IND}{s} = _s[{i}]" for i, s in enumerate(eq.qdd)]
     body += [f"{IND}{ds['lam'][0]}, {ds['lam'][1]} = _s[4], _s[5]"]
@@ -487,11 +492,11 @@ def _double_support_lines(eq: FlatEquations, lead: str) -> list[str]:
     accs = ", ".join(str(s) for s in eq.qdd)
     body.append(f"{IND}return (np.array(({rates}, {accs})), "
                 f"({', '.join(PRINTER.doprint(e) for e in red)}, {toe_share}))")
-    out = [f"    def _double_support_{lead}(x):", *body,
-           f"    def flow_double_support_{lead}(t, x):",
-           f"{IND}return _double_support_{lead}(x)[0]",
-           f"    def double_support_{lead}_forces(t, x):",
-           f"{IND}return _double_support_{lead}(x)[1]"]
+    out = [f"    def _double_support_{lead}(x, gen=None):", *body,
+           f"    def flow_double_support_{lead}(t, x, gen=None):",
+           f"{IND}return _double_support_{lead}(x, gen)[0]",
+           f"    def double_support_{lead}_forces(t, x, gen=None):",
+           f"{IND}return _double_support_{lead}(x, gen)[1]"]
     Ki, kr = sysd["Ki"], sysd["Ki_rhs"]
     mi = Ki.rows
     lines, red = cse_lines(list(Ki) + list(kr) + list(ds["u"]), PRINTER)
@@ -543,8 +548,9 @@ def generate_flat(structure: Structure, key: str) -> str:
     ``heel_strike_heel``, ``heel_strike_toe``; ``guard_<name>``/``grad_<name>``;
     ``ground_heel(x, qdd) -> (N, N_toe)`` and ``ground_toe(x, qdd) -> (N,)`` [N];
     per leading-foot mode ``m`` of the double support (``heel_contact``, ``foot_flat``):
-    ``flow_double_support_<m>(t, x)``, ``double_support_<m>_forces(t, x)`` (trailing toe
-    normal and tangential, leading foot normal and its toe's share [N]),
+    ``flow_double_support_<m>(t, x, gen=None)``, ``double_support_<m>_forces(t, x,
+    gen=None)`` (trailing toe normal and tangential, leading foot normal and its toe's share
+    [N]; ``gen`` (3,) [N m] a generalised force in ``q``'s rows, joint torques' ``B tau``),
     ``double_support_<m>_entry(x) -> (x+, (Lam_n, Lam_t))`` [N s]; and
     ``double_support_trailing(x) -> (b, db, spring energy [J], trailing sole angle from the
     slope [rad])``;

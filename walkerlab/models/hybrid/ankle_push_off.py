@@ -126,7 +126,8 @@ def _actuate_flat_step(walker: HybridWalker, data, spec) -> HybridWalker:
         w = actuate_flat_hips(walker, replace(data, mirror_params=None), spec, off)
         torques = w.actuators
     elif off is not None:
-        w = make_flat_walker(data, walker.name, walker.variant, off)
+        w = make_flat_walker(data, walker.name, walker.variant, off,
+                             double_support=walker.step_entry is not None)
     else:
         w = walker
     ankle = None if off is None else AnklePushOffActuator(

@@ -11,6 +11,12 @@ kinematics), read exactly by polarisation (the energy is quadratic in the rates;
 complex-safe in the angles, so the added acceleration's Jacobian is the complex step's).
 The guards read the ground forces through the actuated flow (a joint torque is internal:
 the ground reaction's formula from the accelerations holds); resets stay the walker's.
+The double support after heel strike (the trailing toe pinned,
+:func:`walkerlab.models.hybrid.rigid_foot_modes.double_support_phases`) is kept: its closed
+chain gains the torques' generalised force, ``[M -J^T; J 0] [qdd; lam] = [-h + B tau; -dJ
+dq]``, so its flow, the toe-off guard's and the falls' contact forces and the step entry's
+check of the trailing toe's force all carry the torque (the swing foot's ankle has no row
+there either: the trailing foot's ankle angle is no coordinate of ``q``).
 Legs that differ: the next step's walker (``mirror``) gets its own actuators on its own
 numbers.
 """
@@ -53,6 +59,9 @@ def mode_mass_matrix(kinetic, x) -> np.ndarray:
 
 def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> HybridWalker:
     """The flat-footed walker with its joint torques (module docstring).
+
+    The double support is kept when ``walker`` has it (its ``step_entry``; a walker made
+    with ``double_support=False`` stays without).
 
     ``heel_off``: the walker's data with the heel-off mode's ankle numbers of an ankle
     push-off acting as well (:func:`walkerlab.models.hybrid.ankle_push_off.heel_off_data`;
@@ -97,7 +106,9 @@ def actuate_flat_hips(walker: HybridWalker, data, spec, heel_off=None) -> Hybrid
         return fl, J
 
     w = make_flat_walker(replace(data, mirror_params=None), walker.name, walker.variant,
-                         heel_off, flow_of=flow_of)
+                         heel_off, flow_of=flow_of, force=acts.generalised_force,
+                         step_clock=lambda: acts.t_origin,
+                         double_support=walker.step_entry is not None)
     mirror = walker.mirror
     if mirror is not None:  # legs that differ: the next step's walker, its own numbers
         mirror = actuate_flat_hips(mirror, data.mirror, spec)

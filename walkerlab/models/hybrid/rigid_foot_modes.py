@@ -104,7 +104,8 @@ def _heel_force(ground, flow, t, x) -> float:
 def make_flat_walker(data: WalkerData, name: str = "biped",
                      variant: str = "derived",
                      heel_off_data: WalkerData | None = None,
-                     flow_of=None, double_support: bool = True) -> HybridWalker:
+                     flow_of=None, double_support: bool = True,
+                     force=None, step_clock=None) -> HybridWalker:
     """A :class:`HybridWalker` for a flat-footed ``data`` (``structure.foot == "flat"``).
 
     ``flow_of(mode, flow, jacobian) -> (flow, jacobian)``, if given, replaces each mode's
@@ -112,10 +113,12 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
     read through the replaced flow; no compiled or variational flows then).
 
     ``double_support`` (default) adds the double support after heel strike
-    (:func:`double_support_phases`, :attr:`HybridWalker.step_entry`; passive: an ankle
-    push-off acts in heel off, until heel strike); not with ``flow_of`` (its torques are
-    not in the double support's closed chain: such a walker releases the trailing foot at
-    heel strike as before).
+    (:func:`double_support_phases`, :attr:`HybridWalker.step_entry`; an ankle push-off
+    acts in heel off, until heel strike).  ``force(t, x) -> (3,)`` [N m], if given: the
+    generalised force ``B tau`` of the joint torques that ``flow_of`` adds, which the
+    double support's closed chain then carries too (its flow, the toe-off guard's and the
+    falls' contact forces, the step entry's check of the trailing toe's force, read at
+    ``step_clock()`` [s], the time the present step began; default 0).
 
     Returns
     -------
@@ -188,11 +191,11 @@ def make_flat_walker(data: WalkerData, name: str = "biped",
 
     phases = tuple(phase(m, part) for part in SWING_PARTS for m in MODES)
     entry = None
-    if double_support and flow_of is None:
+    if double_support:
         trailing_c = dict(zip(data.structure.param_names, data.params)).get(
             "c_sw_ankle" if data.structure.asymmetric else "c_ankle", 0.0)
-        phases += double_support_phases(base, float(trailing_c))
-        entry = partial(_step_entry, base)
+        phases += double_support_phases(base, float(trailing_c), force)
+        entry = partial(_step_entry, base, force, step_clock)
     f = base
     structure = data.structure
     params = {"leg_length_m": data.leg_length_m, "gravity_m_per_s2": data.gravity_m_per_s2,
@@ -226,6 +229,16 @@ def _force(forces, which: int, t, x) -> float:
     return float(forces(t, x)[which])
 
 
+def _with_force(fun, force, t, x):
+    """``fun(t, x, gen)`` with the joint torques' generalised force ``gen = force(t, x)``
+    (3,) [N m] in the closed chain's right-hand side.  Real states only, as the generated
+    closed chain (a numeric linear solve): a complex state raises ``TypeError``, so that
+    :func:`walkerlab.integrate.rigid_phase.numeric_jacobian` takes central differences."""
+    if np.iscomplexobj(x):
+        raise TypeError("the double support's closed chain takes real states")
+    return fun(t, x, np.asarray(force(t, x), dtype=float))
+
+
 #: ``trailing_toe_pulls`` fires as the flat lead begins with the trailing toe's force below
 #: minus this [N] (offset so that a crossing later in the phase is ``toe_off``'s).
 PULL_N = 1e-3
@@ -241,7 +254,7 @@ def _lead_heel(forces, t, x) -> float:
     return float(f[2] - f[3])
 
 
-def _step_entry(f: dict, x):
+def _step_entry(f: dict, force, step_clock, x):
     """:attr:`HybridWalker.step_entry` of a flat-footed walker: the state after the
     single-contact heel-strike map (the trailing foot released); the trailing toe is kept on
     the ground when its foot is heel up and the impulse that pins it (the two-contact plastic
@@ -250,7 +263,9 @@ def _step_entry(f: dict, x):
     normal force right after is not pulling: ``(x+, "double_support:heel_contact")``; else
     ``(x, None)``, the single-contact heel strike as before (also where the impulse would
     push but the spring then lifts the toe at once, e.g. a foot plantarflexed by a push-off:
-    a gait without double support keeps its numbers)."""
+    a gait without double support keeps its numbers).  ``force(t, x) -> (3,)`` [N m] or
+    None: joint torques' generalised force, in the toe's force after the impact, at the
+    step's start ``step_clock()`` [s] (None: 0)."""
     if np.iscomplexobj(x):  # no complex step through the branch and the linear solve
         raise TypeError("the step entry takes real states")
     x = np.asarray(x, dtype=float)
@@ -263,7 +278,11 @@ def _step_entry(f: dict, x):
     x_plus, (impulse_n, _t) = f["double_support_heel_contact_entry"](x)
     if impulse_n < 0.0:
         return x, None
-    if f["double_support_heel_contact_forces"](0.0, x_plus)[0] < 0.0:
+    forces = f["double_support_heel_contact_forces"]
+    if force is not None:
+        forces = partial(_with_force, forces, force)
+    t0 = 0.0 if step_clock is None else float(step_clock())
+    if forces(t0, x_plus)[0] < 0.0:
         return x, None  # no double support: the single-contact heel strike, as before
     return x_plus, DOUBLE_SUPPORT[0]
 
@@ -293,12 +312,17 @@ def _held(f: dict, c: float, x) -> tuple[float, float]:
     return float(energy), -c * float(db) ** 2
 
 
-def double_support_phases(f: dict, c_trailing: float = 0.0) -> tuple[Phase, ...]:
+def double_support_phases(f: dict, c_trailing: float = 0.0,
+                          force=None) -> tuple[Phase, ...]:
     """The double-support phases of a flat-footed walker's generated functions ``f``
     (:func:`walkerlab.codegen.foot_modes.generate_flat`): the trailing foot on its toe (a
     pin: no slip assumed; ``c_trailing`` its ankle damper [N m s/rad], for the phases'
     ``held_energy``), the leading foot on its heel (``double_support:heel_contact``)
-    or flat (``double_support:foot_flat``).
+    or flat (``double_support:foot_flat``).  ``force(t, x) -> (3,)`` [N m], if given: joint
+    torques' generalised force ``B tau`` in ``q``'s rows, added to the closed chain's
+    right-hand side (``[M -J^T; J 0] [qdd; lam] = [-h + B tau; -dJ dq]``): the flows and
+    the contact forces of the guards carry it (a joint torque is internal: it moves the
+    contact forces only through the accelerations and the constraint forces).
 
     Guards: ``toe_off`` (the trailing toe's normal force decreasing through 0; the massless
     trailing foot then leaves the ground at its spring's rest angle, no impact) to
@@ -309,9 +333,12 @@ def double_support_phases(f: dict, c_trailing: float = 0.0) -> tuple[Phase, ...]
     """
     held = partial(_held, f, c_trailing)
     heel, flat = (f[f"double_support_{m}_forces"] for m in ("heel_contact", "foot_flat"))
+    fl_heel, fl_flat = (f[f"flow_double_support_{m}"] for m in ("heel_contact", "foot_flat"))
+    if force is not None:
+        heel, flat, fl_heel, fl_flat = (partial(_with_force, fun, force)
+                                        for fun in (heel, flat, fl_heel, fl_flat))
     hip = Guard("fall", f["guard_hip_height_heel"], -1, "fall", f["grad_hip_height_heel"])
     slap = partial(_foot_slap_in_double_support, f)
-    fl_heel, fl_flat = (f[f"flow_double_support_{m}"] for m in ("heel_contact", "foot_flat"))
     on_heel = Phase(DOUBLE_SUPPORT[0], fl_heel, (
         Guard("toe_off", partial(_force, heel, 0), -1, "next_phase",
               next_phase="heel_contact:early_swing"),

@@ -484,7 +484,8 @@ def replay_phases(data, res: PhasedResult, solver=None):
     from walkerlab.models.hybrid.rigid import make_rigid_walker
 
     spec = Actuation(torques=[JointTorque(joint="hip", law=TorqueLaw(), max_torque_n_m=1e6)])
-    walker = actuate(make_rigid_walker(data, "biped", "derived"), data, spec)
+    walker = actuate(make_rigid_walker(data, "biped", "derived", double_support=False), data,
+                     spec)  # the transcription has no double support yet
     acts = walker.actuators
     tau = phase_torque_of_time(res)
     acts.torques = lambda t, x: np.array([tau(float(np.real(t)) - acts.t_origin)])
