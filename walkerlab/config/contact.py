@@ -318,7 +318,8 @@ class ContactSettings(BaseModel):
                     if d.get(name, 0) is None:
                         d.pop(name)
             # a scene without flat feet serialises as before (same content hashes)
-            for k in ("flat_foot_mass_kg", "flat_foot_inertia_kg_m2", "push_off_duration_s"):
+            for k in ("flat_foot_mass_kg", "flat_foot_inertia_kg_m2", "push_off_duration_s",
+                      "hub_inertia_kg_m2"):
                 if d.get(k, 0) is None:
                     d.pop(k)
         return d
