@@ -24,7 +24,8 @@ KNEED = ("kneed.yaml", {"slope.angle_rad": 0.045,
 #: flat feet with a hip spring and a toe push-off
 FLAT = ("flat_feet.yaml", {"walker.actuation": {
     "push_off": {"impulse_n_s": 0.05},
-    "torques": [{"joint": "hip", "law": {"stiffness_n_m_per_rad": 2.0}}]}})
+    "torques": [{"joint": "hip", "law": {"stiffness_n_m_per_rad": 2.0}}]},
+    "terrain.patch_width_m": 0.5})
 
 
 def _scene(case, strides=2, **more):
@@ -120,21 +121,12 @@ def test_a_pushed_kneed_walker_steps_at_its_rigid_period():
 @pytest.mark.slow  # ~2 min: two rigid gaits, two contact runs of flat feet
 def test_flat_feet_with_a_hip_torque_and_a_toe_push_off():
     """configs/flat_feet.yaml's walker with a hip spring and a 0.05 N s push-off at the
-    trailing toe: the ledger (hip torque both ways, push-off, dampers, contacts) closes to
-    1e-4 of the kinetic energy.  The period's gap to the rigid gait (measured +8.4 %,
-    alternating 0.794/0.842 s a step) is the rigid view's: with joint torques its flat feet
-    have no double support (a zero torque law steps at 0.7576 s, the passive walker with
-    its double support at 0.8102 s); the contact run with a zero torque steps within 3 % of
-    the rigid gait with the push-off alone, which keeps the double support (measured
-    +1.4 % over steps 2-5, the passive walker's +1.5 %: the regularising foot mass)."""
+    trailing toe (0.5 m patches: on the scene's 0.6 m ones a heel enters a patch from its
+    side): the ledger (hip torque both ways, push-off, dampers, contacts) closes to 1e-4 of
+    the kinetic energy, and after the first step (the start-up transient: -5 %) the steps
+    come within 3 % of the rigid gait, which keeps its double support with torques
+    (measured +2.7, +1.0, +2.2 %)."""
     T, periods, resid, work = _run(FLAT, 2)
     assert resid < 1e-4 and work["push_off"] > 0.0 and work["damper"] < 0.0
     assert work["hip_torque_positive"] > 0.0 > work["hip_torque_negative"]
-    zero = (FLAT[0], {"walker.actuation": {"push_off": {"impulse_n_s": 0.05},
-                                           "torques": [{"joint": "hip", "law": {}}]}})
-    _, periods0, resid0, _ = _run(zero, 2)
-    import walkerlab as wl
-
-    push = _scene((FLAT[0], {"walker.actuation": {"push_off": {"impulse_n_s": 0.05}}}))
-    T_ds = wl.Walker.from_scene(push).fixed_point().step_period
-    assert abs(np.mean(periods0[1:]) / T_ds - 1) < 0.03, periods0 / T_ds
+    assert np.all(np.abs(periods[1:] / T - 1) < 0.03), periods / T
