@@ -163,7 +163,7 @@ def measure(scene_path: str, walks: int = 500, steps: int = 100, sigma: float = 
     minimal loop (medians and each repeat's), and the walks that differ from it."""
     sys.path.insert(0, str(ROOT))
     spec = importlib.util.spec_from_file_location(
-        "minimal_compass", ROOT / "walkerlab" / "bench" / "minimal_compass.py")
+        "minimal_collocation", ROOT / "walkerlab" / "bench" / "minimal_collocation.py")
     mc = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mc)
     from walkerlab.analysis.gait.scene import solve_scene

@@ -42,7 +42,7 @@ def test_every_extra_is_named_by_its_purpose_and_the_tests_get_all_but_numbalsod
     assert set(extras) == set(EXTRAS) | {"test"}
     test = set(extras["test"])
     for name, reqs in extras.items():
-        if name not in ("test", "numbalsoda", "docs"):
+        if name not in ("test", "numbalsoda", "docs", "osim"):
             assert set(reqs) <= test, (name, set(reqs) - test)
     assert {_name(r) for r in extras["test"]} >= {"pytest", "pytest-xdist"}
 

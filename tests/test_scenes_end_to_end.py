@@ -94,7 +94,7 @@ def png_only(monkeypatch):
 
     from walkerlab.plotting import figures
 
-    def save(fig, folder, stem):
+    def save(fig, folder, stem, svg=True):
         p = Path(folder) / f"{stem}.png"
         p.parent.mkdir(parents=True, exist_ok=True)
         try:
