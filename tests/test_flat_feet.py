@@ -245,19 +245,32 @@ def test_heel_strike_from_each_pin_matches_the_reference_and_balances_momentum(f
 
 
 @pytest.mark.slow
-def test_one_step_goes_heel_contact_foot_flat_heel_off_then_heel_strike(step, ref, gait):
+def test_one_step_goes_heel_contact_foot_flat_heel_off_then_heel_strike(step, ref, gait,
+                                                                         walker):
     """One step from the fixed point: the modes are found by events at run time, in the
-    order [heel_contact, foot_flat, heel_off], then heel strike; the switch times and the
-    post-impact state equal the reference's own step (its own event functions, rtol 1e-12:
-    agreement to 1e-9)."""
+    order [double_support, heel_contact, foot_flat, heel_off], then heel strike.  The step
+    begins in double support (the walker's step entry keeps the trailing toe down: the
+    gait's trailing foot is heel up at heel strike and the pinning impulse compressive)
+    until toe off, where the trailing toe's force is 0; from the toe-off state on the
+    walker is in single support, and the switch times and the post-impact state equal the
+    reference's own single-support step from that state (its own event functions, rtol
+    1e-12: agreement to 1e-9; the reference has no double support)."""
     assert step.termination == "heel_strike" and step.event == "heel_strike"
-    assert mode_sequence(step.phase_log) == ["heel_contact", "foot_flat", "heel_off"]
-    assert [e for *_, e in step.phase_log] == ["foot_slap", "midstance", "heel_off",
-                                               "heel_strike"]
-    r = ref.step(gait.x)
+    assert mode_sequence(step.phase_log) == ["double_support", "heel_contact", "foot_flat",
+                                             "heel_off"]
+    assert [e for *_, e in step.phase_log] == ["toe_off", "foot_slap", "midstance",
+                                               "heel_off", "heel_strike"]
+    x_entry, first = walker.step_entry(gait.x)
+    assert first == "double_support:heel_contact" == step.phase_log[0][0]
+    ds, dense, (t0, t_off) = step.pieces[0]
+    np.testing.assert_array_equal(np.ravel(dense(t0))[:6], x_entry)
+    x_off = np.ravel(dense(t_off))[:6]
+    toe_off = next(g for g in ds.guards if g.name == "toe_off")
+    assert abs(toe_off.function(t_off, x_off)) < 1e-6  # N, of ~150 N at the step's start
+    r = ref.step(x_off)
     assert r["modes"] == ["heel_contact", "foot_flat", "heel_off"]
-    ends = [tb for name, _ta, tb, ev in step.phase_log if ev != "midstance"]
-    np.testing.assert_allclose(ends, r["times"], atol=1e-9)
+    ends = [tb for name, _ta, tb, ev in step.phase_log if ev not in ("midstance", "toe_off")]
+    np.testing.assert_allclose(np.subtract(ends, t_off), r["times"], atol=1e-9)
     np.testing.assert_allclose(step.x_next, r["x_plus"], atol=1e-9)
 
 
@@ -385,11 +398,21 @@ def test_every_contact_pushes_along_the_gait_s_step(step, fns, ref):
     """The unilateral contacts hold along the whole step (sampled every ~2 ms): the heel in
     heel contact, heel and toe in foot flat (the heel's share reaches 0 only at heel off),
     the toe in heel off; the foot-flat forces equal the reference's own (Newton plus the
-    moment about the heel in its two-coordinate model) to 1e-8 N."""
+    moment about the heel in its two-coordinate model) to 1e-8 N.  In double support (no
+    reference: the closed chain's forces, ``double_support_<lead mode>_forces``) the
+    trailing toe pushes until toe off, where its force reaches 0, and the leading foot
+    carries more than 100 N (its heel and toe each push when it lies flat)."""
     for phase, dense, (ta, tb) in step.pieces:
         mode = mode_of(phase.name)
         for t in np.linspace(ta, tb, max(int((tb - ta) / 2e-3), 5)):
             x = np.ravel(dense(t))[:6]
+            if mode == "double_support":
+                lead = phase.name.split(":", 1)[1]
+                trail_n, _trail_t, n, n_toe = fns[f"double_support_{lead}_forces"](t, x)
+                assert trail_n > -1e-6 and n > 100.0  # trail_n: 0 at toe off (t = tb)
+                if lead == "foot_flat":
+                    assert n_toe > 0.0 and n - n_toe > 0.0
+                continue
             qdd = fns[f"flow_{mode}"](0.0, x)[3:]
             if mode == "heel_off":
                 assert fns["ground_toe"](x, qdd)[0] > 100.0
