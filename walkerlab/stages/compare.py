@@ -37,13 +37,17 @@ def compare_files(ideal_path: Path, contact_path: Path) -> Comparison:
                "contact": gait_metrics(contact, mass_kg=mass_kg, g=g)}
     lc = {a.removesuffix("_angle"): limit_cycle_distance(ideal, contact, a, r)
           for a, r in ideal.phase_pairs() if a in contact.coordinates and r in contact.coordinates}
+    # the largest errors over the coordinates both views name (none in common, e.g. the
+    # rimless wheel's spokes in the rigid view and its wheel angle in the contact view: NaN)
     ang = [n for n in err if ideal.units[n] == "rad"]
     rat = [n for n in err if ideal.units[n].startswith("rad/")]  # rad/s, or per time unit
     return Comparison(
         legs=ideal.legs, time=t, errors=err, error_units={n: ideal.units[n] for n in err},
         limit_cycle_distance=lc,
-        max_abs_angle_rad=float(max(np.max(np.abs(err[n])) for n in ang)),
-        max_abs_rate_rad_per_s=float(max(np.max(np.abs(err[n])) for n in rat)),
+        max_abs_angle_rad=float(max((np.max(np.abs(err[n])) for n in ang if err[n].size),
+                                    default=np.nan)),
+        max_abs_rate_rad_per_s=float(max((np.max(np.abs(err[n])) for n in rat if err[n].size),
+                                         default=np.nan)),
         metrics=metrics, metric_units=METRIC_UNITS, step_phase=step_phase, phase_errors=perr)
 
 

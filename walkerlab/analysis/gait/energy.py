@@ -20,16 +20,20 @@ step's kinetic energy).  ``potential_work = -dV`` [J] is gravity's (and the spri
 
 Cost of transport (Kuo 2002; Collins et al. 2005): ``(positive actuator work + push-off
 work + M g d sin(phi)^+) / (M g d)`` with ``M`` the walker's mass, ``d`` the step's length
-along the ground and ``M g d sin(phi)`` the potential energy the slope releases over it
-(nothing uphill).  A passive gait's is ``sin(phi)``; a powered gait on level ground's is the
-actuators' share alone.
+along the ground and ``M g d sin(phi)`` (``slope_energy``) the potential energy the slope
+releases over it (nothing uphill).  A passive gait's is ``sin(phi)``; a powered gait on level
+ground's is the actuators' share alone.  On stairs and footholds
+(:func:`walkerlab.models.hybrid.ground.on_landing`) ``slope_energy`` is ``M g h`` with ``h``
+[m] the step's descent, the stance foot's height minus the landing swing foot's (a stair's
+riser down level treads; the slope's drop plus the foothold's depth): a passive gait's cost
+of transport is then ``h / d``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.analysis.gait.ledger import LEDGER_NAMES, quad_work
+from walkerlab.analysis.gait.ledger import LEDGER_NAMES, quad_work, released_energy
 from walkerlab.analysis.gait.metrics import step_length
 
 __all__ = ["gait_ledger", "gait_measures", "step_ledger", "trajectory_ledger"]
@@ -122,7 +126,7 @@ def step_ledger(walker, seg, next_walker=None) -> dict[str, float]:
     d_e = (ke_plus + pe_plus) - (ke0 + pe0)
     closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
     d = step_length(walker, seg)
-    slope_energy = m * g * d * np.sin(float(walker.slope_rad))
+    slope_energy = released_energy(walker, d, float(step[1]))
     cot = (wpos + push + max(slope_energy, 0.0)) / (m * g * d)
     out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
                push_off_impulse=impulse, heel_strike_loss=loss,

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from walkerlab.analysis.gait.ledger import LEDGER_NAMES, quad_work
+from walkerlab.analysis.gait.ledger import LEDGER_NAMES, quad_work, released_energy
 from walkerlab.analysis.gait.metrics import step_length
 
 __all__ = ["flat_step_ledger", "flat_trajectory_ledger"]
@@ -127,7 +127,7 @@ def flat_step_ledger(walker, seg) -> dict[str, float]:
     d_e = (ke_plus + pe_plus) - (ke0 + pe0)
     closure = d_e - (wpos + wneg + wdamp + push - loss - internal)
     d = step_length(walker, seg)
-    slope_energy = m * g * d * np.sin(float(walker.slope_rad))
+    slope_energy = released_energy(walker, d, float(step[1]))
     out.update(actuator_work_positive=wpos, actuator_work_negative=wneg, push_off_work=push,
                push_off_impulse=impulse, heel_strike_loss=loss, internal_collision_loss=internal,
                damper_work=wdamp, potential_work=-(pe_plus - pe0), energy_change=d_e,

@@ -4,9 +4,11 @@ power over a step (:mod:`walkerlab.analysis.gait.energy` for generated models,
 
 from __future__ import annotations
 
+import numpy as np
+
 from walkerlab.io.schemas.simulate import LEDGER_UNITS
 
-__all__ = ["LEDGER_NAMES", "quad_work"]
+__all__ = ["LEDGER_NAMES", "quad_work", "released_energy"]
 
 #: the ledger's columns, each (step,) (units: the artifact's, ``LEDGER_UNITS``)
 LEDGER_NAMES = tuple(LEDGER_UNITS)
@@ -27,3 +29,32 @@ def quad_work(f, a: float, b: float, scale: float) -> float:
         warnings.simplefilter("ignore", IntegrationWarning)
         val, _ = quad(f, a, b, limit=400, epsabs=1e-13 * scale, epsrel=1e-12)
     return float(val)
+
+
+def released_energy(walker, d: float, rise: float) -> float:
+    """The potential energy [J] the ground releases over a step: the ledger's
+    ``slope_energy``, what a passive gait's collisions (and dampers) take.
+
+    Parameters
+    ----------
+    walker : HybridWalker
+        The step's walker (its mass ``total_mass_kg`` [kg], ``params["gravity_m_per_s2"]``,
+        ``slope_rad``).
+    d : float
+        The step's length [m] (:func:`walkerlab.analysis.gait.metrics.step_length`).
+    rise : float
+        The landing swing foot's height above the stance foot [m], world vertical
+        (``points(x_end)["swing_foot"][1]``).
+
+    Returns
+    -------
+    float
+        On the slope ``M g d sin(phi)`` (Kuo 2002; Collins et al. 2005); on stairs and
+        footholds (a walker of :func:`walkerlab.models.hybrid.ground.on_landing`, whose
+        ``params`` record ``landing_drop_m``) gravity's work over the step's descent,
+        ``-M g rise`` (down level treads of riser ``H``: ``M g H``).
+    """
+    m, g = float(walker.total_mass_kg), float(walker.params["gravity_m_per_s2"])
+    if "landing_drop_m" in walker.params:
+        return -m * g * rise
+    return m * g * d * np.sin(float(walker.slope_rad))
