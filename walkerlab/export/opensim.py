@@ -38,11 +38,13 @@ Forces:
 - **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
   two links at the hip a ``BushingForce`` between the links' hip frames (rotational stiffness
   and damping about z; the rest angle in the second frame's orientation).
-- **knee stop**: a ``CoordinateLimitForce`` ``leg<i>_knee_stop`` at 0 (straight), the
-  stop's IMPACT law linearised at full damping (:func:`knee_stop_limit`).  The knee latch
-  of ``contact.knee_stop.latch`` (the stop acting in flexion too while the leg's foot is on
-  the ground) is a second, mirrored ``CoordinateLimitForce`` ``leg<i>_knee_latch`` that
-  applies no force by default: OpenSim has no contact-switched force, a stepping loop
+- **knee stop**: an ``ExpressionBasedCoordinateForce`` ``leg<i>_knee_stop``, the stop's
+  IMPACT law on the knee's hyperextension, clamped to push only (:func:`knee_stop_expression`,
+  walkerlab's own law: a ``CoordinateLimitForce``'s damping is not clamped and holds a knee
+  that the stance load left hyperextended, so the new swing knee stays straight and the foot
+  scuffs).  The knee latch of ``contact.knee_stop.latch`` (the stop acting in flexion too
+  while the leg's foot is on the ground) is a second, mirrored force ``leg<i>_knee_latch``
+  that applies no force by default: OpenSim has no contact-switched force, a stepping loop
   switches it (``Force.setAppliesForce``, :mod:`walkerlab.export.opensim_walk`).
 - **actuators**: each joint torque law of ``walker.actuation.torques`` is exported as a
   ``CoordinateActuator`` per joint (``leg<i>_hip_motor``, ``leg<i>_knee_motor``;
@@ -69,7 +71,7 @@ from walkerlab.export.text import comment, num, nums
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
 
 __all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
-           "knee_stop_limit", "osim_gait", "osim_text", "patch_radius"]
+           "knee_stop_expression", "osim_gait", "osim_text", "patch_radius"]
 
 #: The export's file name in ``runs/<scene>/``.
 OSIM_FILE = "walker.osim"
@@ -202,15 +204,39 @@ def hunt_crossley(c: ContactParamsSI, weight_n: float, radius_m: float
     return s_param, diss, float(c.v_s), note
 
 
-def knee_stop_limit(knee: KneeStopSI) -> tuple[float, float, float]:
-    """A ``CoordinateLimitForce``'s stiffness [N m/deg], damping [N m s/deg] and transition
-    [deg] for the knee stop's IMPACT law ``k ext^e + STEP(ext, 0, 0, dmax, cmax) ext'``
-    (:class:`walkerlab.config.contact.KneeStopSettings`): the tangent stiffness at full
-    damping ``e k dmax^(e - 1)``, the full damping ``cmax``, the transition width ``dmax``
-    (OpenSim's limit force is linear past its transition; its units are degrees)."""
-    deg = math.pi / 180
-    k_lin = knee.e * knee.k * knee.dmax ** (knee.e - 1)
-    return k_lin * deg, knee.cmax * deg, knee.dmax / deg
+def knee_stop_expression(knee: KneeStopSI, side: str) -> str:
+    """The knee stop's IMPACT law as an ``ExpressionBasedCoordinateForce`` expression in the
+    knee coordinate ``q`` [rad] (0 straight, < 0 flexed) and its rate ``qdot`` [rad/s].
+
+    With ``d`` the penetration (``q`` for the stop, ``-q`` for the latch) the torque's size is
+    ``max(0, k max(d, 0)^e + STEP(d, 0, 0, dmax, cmax) d')`` (ADAMS IMPACT; the cubic STEP
+    written out), the contact model's knee stop (``contact.knee_stop``) without the
+    latch's engagement weight (the stepping loop switches the latch on and off): it pushes
+    only, so its damping never holds a knee leaving the stop.
+
+    Parameters
+    ----------
+    knee : KneeStopSI
+    side : {"stop", "latch"}
+        ``"stop"``: against hyperextension (torque <= 0); ``"latch"``: against flexion
+        (torque >= 0).
+
+    Returns
+    -------
+    str
+        A Lepton expression (OpenSim's expression parser).
+
+    Raises
+    ------
+    ValueError
+        ``side`` is neither.
+    """
+    if side not in ("stop", "latch"):
+        raise ValueError(f"side: 'stop' or 'latch', not {side!r}")
+    d, dd, sign = ("q", "qdot", "-") if side == "stop" else ("(-q)", "(-qdot)", "")
+    x = f"min(max({d}/{knee.dmax!r},0),1)"
+    return (f"{sign}max(0,{knee.k!r}*max({d},0)^{knee.e!r}"
+            f"+{knee.cmax!r}*{x}^2*(3-2*{x})*{dd})")
 
 
 def patch_radius(patch_width_m: float, foot_sphere_m: float) -> float:
@@ -292,19 +318,14 @@ def _body(name: str, mass: float, com=(0.0, 0.0), inertia: float = 0.0) -> list[
             f"{i}</Body>"]
 
 
-def _limit_force(name: str, coord: str, upper: tuple, lower: tuple, damping: float,
-                 transition: float, applies: bool = True) -> list[str]:
+def _expression_force(name: str, coord: str, expression: str, applies: bool = True
+                      ) -> list[str]:
     i = "\t\t\t\t"
-    return [f"{i}<CoordinateLimitForce name={quoteattr(name)}>",
+    return [f"{i}<ExpressionBasedCoordinateForce name={quoteattr(name)}>",
             f"{i}\t<appliesForce>{str(applies).lower()}</appliesForce>",
             f"{i}\t<coordinate>{coord}</coordinate>",
-            f"{i}\t<upper_stiffness>{num(upper[1])}</upper_stiffness>",
-            f"{i}\t<upper_limit>{num(upper[0])}</upper_limit>",
-            f"{i}\t<lower_stiffness>{num(lower[1])}</lower_stiffness>",
-            f"{i}\t<lower_limit>{num(lower[0])}</lower_limit>",
-            f"{i}\t<damping>{num(damping)}</damping>",
-            f"{i}\t<transition>{num(transition)}</transition>",
-            f"{i}</CoordinateLimitForce>"]
+            f"{i}\t<expression>{expression}</expression>",
+            f"{i}</ExpressionBasedCoordinateForce>"]
 
 
 def _torque_joints(actuation_json: str | None, mb) -> list[str]:
@@ -386,8 +407,11 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
         out.append(comment(f"walkerlab_actuation: {gait.actuation_json}"))
     if mb.knee and mb.knee_stop:
         out.append(comment(
-            "Knee stop: CoordinateLimitForce leg<i>_knee_stop at 0 (straight); knee latch "
-            "leg<i>_knee_latch (the same stop acting in flexion) applies no force by default: "
+            "Knee stop: ExpressionBasedCoordinateForce leg<i>_knee_stop, the scene's IMPACT "
+            f"law on the hyperextension (k = {gait.knee.k:.6g} N m/rad^{gait.knee.e:g}, cmax = "
+            f"{gait.knee.cmax:.6g} N m s/rad, dmax = {gait.knee.dmax:.4g} rad; pushing only); "
+            "knee latch leg<i>_knee_latch (the same law acting in flexion) applies no force by "
+            "default: "
             f"a stepping loop switches it on while the leg's foot is less than "
             f"{gait.knee.latch_height:.4g} m above the ground and its knee within "
             f"{gait.knee.latch_capture:.4g} rad of straight (walkerlab.export.opensim_walk)."))
@@ -478,15 +502,13 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
                         orientation=(0.0, 0.0, -sp.rest_angle_rad)),
                 "\t\t\t\t\t</frames>", "\t\t\t\t</BushingForce>"]
     if mb.knee and mb.knee_stop:
-        kl, cl, tr = knee_stop_limit(gait.knee)
         for ln in mb.links:
             if ln.joint.endswith("_knee"):
-                # the side a force does not limit: at half a turn, never reached (OpenSim's
-                # limit force returns NaN with a zero stiffness)
-                out += _limit_force(f"{ln.joint}_stop", ln.joint, (0.0, kl), (-180.0, kl),
-                                    cl, tr)
-                out += _limit_force(f"{ln.joint}_latch", ln.joint, (180.0, kl), (0.0, kl),
-                                    cl, tr, applies=False)
+                out += _expression_force(f"{ln.joint}_stop", ln.joint,
+                                         knee_stop_expression(gait.knee, "stop"))
+                out += _expression_force(f"{ln.joint}_latch", ln.joint,
+                                         knee_stop_expression(gait.knee, "latch"),
+                                         applies=False)
     for j in _torque_joints(gait.actuation_json, mb):
         out += [f"\t\t\t\t<CoordinateActuator name=\"{j}_motor\">",
                 f"\t\t\t\t\t<coordinate>{j}</coordinate>",
