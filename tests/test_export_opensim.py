@@ -80,7 +80,8 @@ def test_osim_export_refuses_walker_only(tmp_path):
 
 
 #: (scene, rigid-gait tolerance on the step period, on the speed): the issue's 3 % and 5 %;
-#: kneed with the knee latch switched by the stepping loop; powered_compass's speed 8 %: its compliant gait's steps are 4.5 % shorter (module docstring)
+#: powered_compass's speed 8 %: its compliant gait's steps are 4.5 % shorter (module
+#: docstring); kneed with its knee latch switched by the stepping loop
 WALKS = [("paper", 0.03, 0.05), ("powered_compass", 0.03, 0.08), ("kneed", 0.03, 0.05)]
 
 
