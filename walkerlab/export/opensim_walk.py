@@ -131,6 +131,7 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
     from walkerlab.extras import require
 
     osim = require("opensim", "osim", "walking an OpenSim export")
+    osim.Logger.removeFileSink()  # OpenSim logs to ./opensim.log: nothing outside runs/
     osim.Logger.setLevelString("warn")  # not a report per window
     text = Path(path).read_text()
     info = _header(text)
