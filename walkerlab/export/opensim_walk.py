@@ -34,50 +34,30 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.export.mujoco_walk import MujocoWalk
+
 __all__ = ["OpensimWalk", "walk"]
 
 LEGS = ("leg1", "leg2")
 
 
 @dataclass
-class OpensimWalk:
-    """Heel strikes and the centre of mass of an OpenSim run.
+class OpensimWalk(MujocoWalk):
+    """Heel strikes and the centre of mass of an OpenSim run: a
+    :class:`walkerlab.export.mujoco_walk.MujocoWalk` (``times_s`` the end of the window in
+    which the contact began; ``fell``: the hip below half its starting height above the
+    slope) with
 
     Attributes
     ----------
-    times_s : ndarray (n,)
-        Heel-strike times [s] (the end of the window in which the contact began).
-    legs : list of str
-        The striking leg of each.
     com_along_m : ndarray (n,)
         The centre of mass's position along the slope at each strike [m].
-    positions_m : ndarray (n,)
-        The striking foot's position along the slope at each strike [m].
-    fell : bool
-        The hip dropped below half its starting height above the slope.
-    t_end_s : float
-        Simulated time [s].
     mass_kg : float
         The model's total mass [kg].
     """
 
-    times_s: np.ndarray
-    legs: list
     com_along_m: np.ndarray
-    positions_m: np.ndarray
-    fell: bool
-    t_end_s: float
     mass_kg: float
-
-    @property
-    def alternating(self) -> bool:
-        """Every strike is by the other leg than the one before."""
-        return all(a != b for a, b in zip(self.legs, self.legs[1:]))
-
-    @property
-    def step_periods_s(self) -> np.ndarray:
-        """Times between successive heel strikes [s], (n - 1,)."""
-        return np.diff(self.times_s)
 
     def speed_m_per_s(self, skip: int = 2) -> float:
         """The centre of mass's mean speed along the slope from strike ``skip`` to the last
@@ -235,5 +215,5 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
         if hip_h < 0.5 * h0:
             fell = True
             break
-    return OpensimWalk(np.array(times), legs, np.array(com), np.array(feet_at), fell, t,
-                        mass)
+    return OpensimWalk(times_s=np.array(times), legs=legs, positions_m=np.array(feet_at),
+                       fell=fell, t_end_s=t, com_along_m=np.array(com), mass_kg=mass)
