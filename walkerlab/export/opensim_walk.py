@@ -21,7 +21,8 @@ from it; OpenSim has no contact-switched force):
   ``P`` the law's impulse, :func:`walkerlab.models.actuation.push_off_impulse`, at the hip's
   speed), as the MJCF's loop does.  The rigid model pushes off immediately before heel
   strike; a pulse ending at the swing foot's predicted touchdown (the contact model's rule)
-  was tried on powered_compass and made the steps shrink (a fall after 9 strikes).
+  was tried on powered_compass with the paper's friction velocities and made the steps
+  shrink (a fall after 9 strikes).
 """
 
 from __future__ import annotations
