@@ -62,6 +62,7 @@ def test_the_readme_installs_the_main_job_then_the_tests_and_ci_runs_that_comman
     docs = (ROOT / "docs" / "README.md").read_text()
     build = "python -m sphinx -W --keep-going -b html docs docs/_build/html"
     assert _commands(docs)[0].endswith(f"pip install -e '.[docs]' && {build}")
+    assert f"`pip install -e '.[docs]' && {build}`" in readme, "the README names the docs build"
     assert f". .venv/bin/activate && pip install -e '.[docs]' && {build}" in ci.splitlines()
 
 
