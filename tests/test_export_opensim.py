@@ -76,14 +76,55 @@ def test_osim_export_refuses_in_one_line(name, field, tmp_path):
     assert not any(tmp_path.rglob("*.osim"))
 
 
+RABBIT = ["leg1_hip", "leg1_knee", "leg2_hip", "leg2_knee", "torso_hip"]
+
+
+@pytest.mark.parametrize("joint, stance, expected", [
+    # joint angle = angle(second link) - angle(first link) (config.actuation.JOINTS); the
+    # coordinates: leg<i>_hip and torso_hip absolute angles, leg<i>_knee = shank - thigh
+    ("hip", 1, {"leg1_hip": 1.0, "leg2_hip": -1.0}),  # swing leg1 - stance leg2
+    ("hip", 0, {"leg2_hip": 1.0, "leg1_hip": -1.0}),
+    ("stance_hip", 1, {"leg2_hip": 1.0, "torso_hip": -1.0}),
+    ("swing_hip", 1, {"leg1_hip": 1.0, "torso_hip": -1.0}),
+    ("stance_knee", 1, {"leg2_knee": 1.0}),  # (hip + knee) - hip
+    ("swing_knee", 0, {"leg2_knee": 1.0}),
+])
+def test_a_joint_torque_is_its_generalised_forces_by_virtual_work(joint, stance, expected):
+    from walkerlab.export.opensim import torque_generalized_forces
+
+    assert torque_generalized_forces(joint, stance, RABBIT) == expected
+
+
+def test_the_five_link_export_has_a_motor_on_every_coordinate_its_laws_move(tmp_path):
+    """RABBIT's hip and knee laws move all five coordinates: the torso takes the hip torques'
+    reaction (before: motors on the legs only, and none was driven)."""
+    root = ET.fromstring(export_stage.run(_scene("rabbit"), tmp_path, "osim").read_text()
+                         .replace("::", "__"))
+    motors = {m.get("name"): m.find("coordinate").text
+              for m in root.iter("CoordinateActuator")}
+    assert motors == {f"{c}_motor": c for c in RABBIT}
+
+
+def test_osim_export_refuses_a_torque_per_foot_mass(tmp_path):
+    from walkerlab.api.scenes import with_changes
+
+    sc = with_changes(_scene("paper"), {"walker.actuation": {"torques": [
+        {"joint": "hip", "law": {"stiffness_n_m_per_rad": 1.0}, "scaled_by": "foot_mass"}]}})
+    with pytest.raises(ValueError, match=r"^walker\.actuation\.torques\.0\.scaled_by: "):
+        export_stage.run(sc, tmp_path, "osim")
+    assert not any(tmp_path.rglob("*.osim"))
+
+
 def test_osim_export_refuses_walker_only(tmp_path):
     with pytest.raises(ValueError, match=r"^--walker-only"):
         export_stage.run(_scene("paper"), tmp_path, "osim", walker_only=True)
 
 
 #: (scene, rigid-gait tolerance on the step period, on the speed): the issue's 3 % and 5 %
-#: (kneed with its knee latch switched by the stepping loop)
-WALKS = [("paper", 0.03, 0.05), ("powered_compass", 0.03, 0.05), ("kneed", 0.03, 0.05)]
+#: (kneed with its knee latch switched by the stepping loop; RABBIT with its joint torque
+#: laws set by it: before, no law drove the motors and it fell at 0.35 s)
+WALKS = [("paper", 0.03, 0.05), ("powered_compass", 0.03, 0.05), ("kneed", 0.03, 0.05),
+         ("rabbit", 0.03, 0.05)]
 
 
 @pytest.mark.slow

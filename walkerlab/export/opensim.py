@@ -46,9 +46,13 @@ Forces:
   while the leg's foot is on the ground) is a second, mirrored force ``leg<i>_knee_latch``
   that applies no force by default: OpenSim has no contact-switched force, a stepping loop
   switches it (``Force.setAppliesForce``, :mod:`walkerlab.export.opensim_walk`).
-- **actuators**: each joint torque law of ``walker.actuation.torques`` is exported as a
-  ``CoordinateActuator`` per joint (``leg<i>_hip_motor``, ``leg<i>_knee_motor``;
-  ``optimal_force`` 1 N m, so the control is the torque), the laws in a comment; the
+- **actuators**: the joint torque laws of ``walker.actuation.torques`` are exported as a
+  ``CoordinateActuator`` ``<coordinate>_motor`` on every coordinate a law's joint moves
+  (:func:`torque_generalized_forces`: a torque between the torso and a thigh is ``+tau`` on
+  ``leg<i>_hip`` and ``-tau`` on ``torso_hip``; a knee torque ``tau`` on ``leg<i>_knee``;
+  ``optimal_force`` 1 N m, so the control is the generalised force), the laws in a comment
+  (``walkerlab_actuation``): a stepping loop sets the controls from the laws between windows
+  (:mod:`walkerlab.export.opensim_walk`); the
   push-off (``walker.actuation.push_off``) is a ``PrescribedForce`` ``leg<i>_push_off`` on
   each leg at its foot along the leg (foot to hip), ``F = impulse_n_s / T`` (``T`` the
   scene's ``contact.push_off_duration_s``), applying no force by default: a stepping loop
@@ -151,6 +155,18 @@ def check_osim_exportable(scene: Scene, mb) -> None:
     if act is not None and act.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: not in the OpenSim export (the "
                          "model would walk passively); export the scene without it")
+    coords = [ln.joint for ln in mb.links]
+    for i, t in enumerate(getattr(act, "torques", None) or []):
+        field = f"walker.actuation.torques.{i}"
+        if t.scaled_by != "none":
+            raise ValueError(f"{field}.scaled_by: a torque per foot mass ({t.scaled_by}) is "
+                             "not in the OpenSim export (N m only)")
+        try:
+            for st in (0, 1):
+                torque_generalized_forces(t.joint, st, coords)
+        except ValueError:
+            raise ValueError(f"{field}.joint: {t.joint} is not a joint of the OpenSim "
+                             "export") from None
 
 
 def hunt_crossley(c: ContactParamsSI, weight_n: float, radius_m: float
@@ -328,17 +344,86 @@ def _expression_force(name: str, coord: str, expression: str, applies: bool = Tr
             f"{i}</ExpressionBasedCoordinateForce>"]
 
 
+def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
+    """A role's link's absolute angle as a combination of the export's coordinates.
+
+    ``leg<i>_hip`` is a link's absolute angle (the base never rotates), ``leg<i>_knee`` the
+    shank's angle minus the thigh's and ``torso_hip`` the torso's, so the thigh (or a straight
+    leg) is ``leg<i>_hip``, the shank ``leg<i>_hip + leg<i>_knee``, the torso ``torso_hip``.
+
+    Parameters
+    ----------
+    link : str
+        A link by role, as :data:`walkerlab.config.actuation.JOINTS` names them
+        (``stance_leg``, ``swing_thigh``, ``stance_shank``, ``torso``, ...).
+    stance : {0, 1}
+        The stance leg (0: ``leg1``).
+    coordinates : collection of str
+        The model's coordinate names.
+
+    Returns
+    -------
+    dict
+        Coordinate name -> coefficient (the angle is the sum of coefficient x coordinate).
+
+    Raises
+    ------
+    ValueError
+        The link is not in this model (a foot: flat feet are not exported).
+    """
+    if link == "torso" and "torso_hip" in coordinates:
+        return {"torso_hip": 1.0}
+    role, _, part = link.partition("_")
+    leg = f"leg{(stance if role == 'stance' else 1 - stance) + 1}"
+    if role in ("stance", "swing") and part in ("leg", "thigh", "shank") \
+            and f"{leg}_hip" in coordinates:
+        out = {f"{leg}_hip": 1.0}
+        if part == "shank" and f"{leg}_knee" in coordinates:
+            out[f"{leg}_knee"] = 1.0
+        return out
+    raise ValueError(f"{link}: not a link of this OpenSim model")
+
+
+def torque_generalized_forces(joint: str, stance: int, coordinates) -> dict[str, float]:
+    """The generalised force on each coordinate of a unit torque at a joint by role: the
+    joint's angle is ``angle(second) - angle(first)`` (:data:`walkerlab.config.actuation.JOINTS`)
+    and by virtual work a torque ``tau`` on it is ``tau`` times that combination's coefficients.
+
+    Parameters
+    ----------
+    joint : str
+        ``hip``, ``stance_hip``, ``swing_knee``, ...
+    stance : {0, 1}
+        The stance leg.
+    coordinates : collection of str
+        The model's coordinate names.
+
+    Returns
+    -------
+    dict
+        Coordinate name -> coefficient (zeros dropped).
+    """
+    from walkerlab.config.actuation import JOINTS
+
+    first, second = JOINTS[joint]
+    out = dict(link_angle(second, stance, coordinates))
+    for c, k in link_angle(first, stance, coordinates).items():
+        out[c] = out.get(c, 0.0) - k
+    return {c: k for c, k in out.items() if k != 0.0}
+
+
 def _torque_joints(actuation_json: str | None, mb) -> list[str]:
-    """Joints that get a ``CoordinateActuator``: the hips (a hip torque between the legs, or
-    a stance/swing hip law) and, with knee laws, the knees."""
+    """Coordinates that get a ``CoordinateActuator``: every coordinate a torque law's joint
+    moves in either stance (:func:`torque_generalized_forces`)."""
     import json
 
     if actuation_json is None:
         return []
     laws = json.loads(actuation_json).get("torques", [])
-    kinds = {("knee" if t["joint"].endswith("knee") else "hip") for t in laws}
-    joints = [ln.joint for ln in mb.links]
-    return [j for j in joints if j.rsplit("_", 1)[-1] in kinds and not j.startswith("torso")]
+    coords = [ln.joint for ln in mb.links]
+    used = {c for t in laws for st in (0, 1)
+            for c in torque_generalized_forces(t["joint"], st, coords)}
+    return [c for c in coords if c in used]
 
 
 def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
@@ -403,6 +488,16 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
             f"switches the trailing leg's on for T = {gait.push_off_duration_s:g} s from each "
             "heel strike (P / F for a law whose impulse P depends on the hip's speed; the rigid "
             "model pushes off immediately before heel strike)."))
+    motors = _torque_joints(gait.actuation_json, mb)
+    if motors:
+        out.append(comment(
+            "Joint torques (walker.actuation.torques, walkerlab_actuation below): "
+            f"CoordinateActuators {', '.join(m + '_motor' for m in motors)} (optimal force "
+            "1 N m: the control is the generalised force); a torque tau at a joint of angle "
+            "angle(second link) - angle(first link) is +tau and -tau on the coordinates of "
+            "those links' absolute angles (leg<i>_hip and torso_hip are absolute, leg<i>_knee "
+            "is shank - thigh); a stepping loop (walkerlab.export.opensim_walk) sets them from "
+            "the laws between windows, the roles swapping at each heel strike."))
     if gait.actuation_json is not None:
         out.append(comment(f"walkerlab_actuation: {gait.actuation_json}"))
     if mb.knee and mb.knee_stop:
@@ -509,7 +604,7 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
                 out += _expression_force(f"{ln.joint}_latch", ln.joint,
                                          knee_stop_expression(gait.knee, "latch"),
                                          applies=False)
-    for j in _torque_joints(gait.actuation_json, mb):
+    for j in motors:
         out += [f"\t\t\t\t<CoordinateActuator name=\"{j}_motor\">",
                 f"\t\t\t\t\t<coordinate>{j}</coordinate>",
                 "\t\t\t\t\t<optimal_force>1</optimal_force>", "\t\t\t\t</CoordinateActuator>"]

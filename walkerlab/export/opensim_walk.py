@@ -6,9 +6,16 @@ OpenSim is an optional dependency (the ``osim`` extra): imported inside the func
 OpenSim's ``Manager`` integrates the model in windows of ``window_s``; after each window the
 loop reads each leg's ``HuntCrossleyForce`` (the force on the leg's body).  A heel strike of
 leg i is the first window with contact on its foot after the foot has been off the ground for
-at least ``min_air_s`` (shorter gaps are bounces of the compliant contact).  Two stepping
+at least ``min_air_s`` (shorter gaps are bounces of the compliant contact).  The stepping
 rules act between windows (``Force.setAppliesForce`` on the state, then the manager restarts
 from it; OpenSim has no contact-switched force):
+
+- the **joint torques** of a powered export (``<coordinate>_motor``): before each window every
+  law of ``walker.actuation.torques`` is evaluated at its joint's angle and rate in the
+  present roles (leg2 stands in the default state; the roles swap at each heel strike), the
+  rigid view's phase variable and the time since the heel strike
+  (:class:`walkerlab.models.actuation.TorqueLaws`, the rigid and contact views' own), and
+  its generalised forces are held over the window as the motors' override actuation;
 
 - the **knee latch** of a kneed export (``leg<i>_knee_latch``, the knee stop mirrored) is on
   while the leg's foot is less than the release height above the slope line and its knee is
@@ -82,6 +89,61 @@ def _header(text: str) -> dict:
     return out
 
 
+class _Drive:
+    """The torque laws of ``walker.actuation.torques`` on the export's ``<coordinate>_motor``
+    actuators (module docstring): each law's joint angle and rate, the phase variable (the
+    angle of the line from the hip to the stance foot from the downward vertical, the rigid
+    view's), the laws (:class:`walkerlab.models.actuation.TorqueLaws`), and the generalised
+    forces they make (:func:`walkerlab.export.opensim.torque_generalized_forces`) as the
+    actuators' override actuation."""
+
+    def __init__(self, model, spec, coords, bodies, foot_loc):
+        import opensim as osim
+
+        from walkerlab.export.opensim import torque_generalized_forces
+        from walkerlab.models.actuation import TorqueLaws
+
+        self.laws = TorqueLaws(spec.torques)
+        self.gf = [[torque_generalized_forces(t.joint, st, coords) for t in spec.torques]
+                   for st in (0, 1)]
+        cs = model.getCoordinateSet()
+        self.coord = {c: cs.get(c) for c in coords}
+        fs = model.getForceSet()
+        self.motor = {c: osim.CoordinateActuator.safeDownCast(fs.get(f"{c}_motor"))
+                      for c in coords if fs.contains(f"{c}_motor")}
+        self.bodies, self.foot_loc = bodies, foot_loc
+        self.hip = (cs.get("hip_x"), cs.get("hip_y"))
+
+    def phase(self, state, stance: int) -> tuple[float, float]:
+        """The phase variable [rad] and its rate [rad/s] (class docstring)."""
+        g = LEGS[stance]
+        b, loc = self.bodies[g], self.foot_loc[g]
+        foot = b.findStationLocationInGround(state, loc).to_numpy()[:2]
+        vfoot = b.findStationVelocityInGround(state, loc).to_numpy()[:2]
+        hip = np.array([c.getValue(state) for c in self.hip])
+        vhip = np.array([c.getSpeedValue(state) for c in self.hip])
+        u, w = foot[0] - hip[0], hip[1] - foot[1]
+        du, dw = vfoot[0] - vhip[0], vhip[1] - vfoot[1]
+        return math.atan2(u, w), (du * w - u * dw) / (u * u + w * w)
+
+    def control(self, state, stance: int, t_step: float) -> None:
+        """Set every motor's override actuation for the coming window [N m]."""
+        gf = self.gf[stance]
+        q = {c: k.getValue(state) for c, k in self.coord.items()}
+        v = {c: k.getSpeedValue(state) for c, k in self.coord.items()}
+        deltas = [sum(k * q[c] for c, k in g.items()) for g in gf]
+        rates = [sum(k * v[c] for c, k in g.items()) for g in gf]
+        s, ds = self.phase(state, stance)
+        tau = self.laws.each(np.array(deltas), np.array(rates), s, ds, t_step)
+        out = dict.fromkeys(self.motor, 0.0)
+        for g, tq in zip(gf, tau):
+            for c, k in g.items():
+                out[c] += k * float(tq)
+        for c, m in self.motor.items():
+            m.setOverrideActuation(state, out[c])
+            m.overrideActuation(state, True)
+
+
 def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
          min_air_s: float = 0.05, accuracy: float = 1e-7) -> OpensimWalk:
     """Simulate ``walker.osim`` for ``duration_s`` from its default state (module docstring).
@@ -134,11 +196,16 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
     push = ({g: osim.PrescribedForce.safeDownCast(fs.get(f"{g}_push_off")) for g in LEGS}
             if fs.contains("leg1_push_off") else {})
     push_law = None
-    if push:
+    spec = None
+    if "actuation" in info:
         from walkerlab.config.actuation import Actuation
         from walkerlab.models.actuation import push_off_impulse
 
-        push_law = Actuation.model_validate(info["actuation"]).push_off
+        spec = Actuation.model_validate(info["actuation"])
+        push_law = spec.push_off
+    coords = [model.getCoordinateSet().get(i).getName()
+              for i in range(model.getCoordinateSet().getSize())]
+    drive = _Drive(model, spec, coords, bodies, foot_loc) if spec and spec.torques else None
     hip_x = model.getCoordinateSet().get("hip_x")
     hip_y = model.getCoordinateSet().get("hip_y")
     mass = model.getTotalMass(state)
@@ -170,7 +237,7 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
     stance = "leg2"  # the default state: leg2 in stance
     times, legs, com, feet_at = [], [], [], []
     fell, t = False, 0.0
-    pulse_until, pushing = -1.0, None
+    pulse_until, pushing, t_step = -1.0, None, 0.0
     restart = True
     while t < duration_s - 1e-12:
         changed = False
@@ -184,7 +251,10 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
         if pushing is not None and t >= pulse_until - 1e-12:
             push[pushing].setAppliesForce(state, False)
             pushing, changed = None, True
-        if changed or restart:
+        if drive is not None:  # the laws' torques, held over the window
+            model.realizeVelocity(state)
+            drive.control(state, LEGS.index(stance), t - t_step)
+        if changed or restart or drive is not None:
             manager = osim.Manager(model)
             manager.setIntegratorAccuracy(accuracy)
             manager.initialize(state)
@@ -201,7 +271,7 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
                 legs.append(g)
                 com.append(com_along(state))
                 feet_at.append(along(g, state))
-                trailing, stance = stance, g
+                trailing, stance, t_step = stance, g, t
                 if push:  # the trailing leg pushes off from the heel strike (the MJCF's loop)
                     v = np.array([hip_x.getSpeedValue(state), hip_y.getSpeedValue(state)])
                     P = float(push_off_impulse(push_law, float(v @ t_hat)))
