@@ -286,3 +286,84 @@ def test_rimless_wheel_mjcf_rolls_in_mujoco():
     assert len(strikes) >= 10
     periods = np.diff(strikes)
     assert np.all(np.abs(periods / gait.step_period - 1) < 0.03), periods
+
+
+@pytest.fixture(scope="module")
+def wheel_runs(tmp_path_factory):
+    """The shipped scene's ``fixedpoint``, ``simulate``, ``contact-sim`` and ``compare``
+    artifacts (about 2 s): (runs folder, scene)."""
+    from walkerlab.stages import pipeline
+
+    runs = tmp_path_factory.mktemp("rimless_runs")
+    scene = load_scene(SCENE)
+    pipeline.run("compare", scene, runs)
+    return runs, scene
+
+
+def test_rimless_wheel_compare_names_the_same_coordinates(wheel_runs):
+    """``walkerlab compare``: the contact view names the rigid view's leg coordinates (the
+    stance spoke's and the next spoke's angle and rate, ``leg<i>_angle``/``_rate``, from its
+    stance and next spoke tips about the hub), so the errors are computed, not NaN: at the
+    same fraction of each step the angles agree within 1e-3 rad (measured 1.5e-4: the
+    contact steps are 0.05 % shorter) and the limit cycles lie within 5e-3 rad of each other
+    (measured 9.2e-4; the impact is spread over the contact's compression).  On the clock,
+    99 % of the samples agree within 0.02 rad (measured 7e-3 rad); the largest error
+    (4 alpha) is a leg's spoke changing at the heel strike, whose times drift apart by the
+    step periods' 0.05 %, as the paper's biped's legs swap at theirs."""
+    from walkerlab.io.schemas.compare import load_compare
+
+    runs, scene = wheel_runs
+    c = load_compare(runs / scene.name / "compare.h5")
+    assert set(c.errors) == {"leg1_angle", "leg2_angle", "leg1_rate", "leg2_rate"}
+    assert np.isfinite(c.max_abs_angle_rad) and np.isfinite(c.max_abs_rate_rad_per_s)
+    assert c.max_abs_angle_rad <= 4 * math.pi / N + 1e-9
+    for name in ("leg1_angle", "leg2_angle"):
+        assert np.max(np.abs(c.phase_errors[name])) < 1e-3
+        assert np.percentile(np.abs(c.errors[name]), 99) < 0.02
+    assert set(c.limit_cycle_distance) == {"leg1", "leg2"}
+    assert all(0 < d < 5e-3 for d in c.limit_cycle_distance.values())
+
+
+def test_rimless_wheel_contact_gait_metrics(wheel_runs):
+    """The contact view's Table 3 metrics of the wheel: its step length is the chord between
+    neighbouring spoke tips, ``2 L sin(pi / n)`` (0.7654 m), within 1 mm (the spoke about to
+    strike is a sample above the ground; the stance tip slips 0.03 mm a step), and its
+    stance-frame energy (PE from the stance spoke's foot) agrees with the rigid view's within
+    0.1 % (the contact's compression and its 1e-3 kg m^2 hub inertia; measured 9.935 against
+    9.934 J; on today's code it was taken from an unset stance foot: garbage, e.g.
+    8.725 or -76.89 J).  The rigid stance-frame energy is constant over a step: ``(M L^2)
+    w+^2 / 2 + M g L cos(alpha - phi)``."""
+    from walkerlab.io.schemas.compare import load_compare
+
+    runs, scene = wheel_runs
+    m = load_compare(runs / scene.name / "compare.h5").metrics
+    chord = 2 * L * math.sin(math.pi / N)
+    assert m["ideal"]["step_length_m"] == pytest.approx(chord, abs=1e-9)
+    assert m["contact"]["step_length_m"] == pytest.approx(chord, abs=1e-3)
+    w, _, _ = _closed_form()
+    e_stance = 0.5 * M * L ** 2 * w ** 2 + M * G * L * math.cos(math.pi / N - PHI)
+    assert m["ideal"]["E_avg_stance_frame_J"] == pytest.approx(e_stance, rel=1e-9)
+    assert m["contact"]["E_avg_stance_frame_J"] == pytest.approx(e_stance, rel=1e-3)
+    # both count the steps their runs began: the rigid run's 2 x simulate.strides ending
+    # at a heel strike; the contact run's 2 x contact_sim.n_strides and the one it ended in
+    assert m["ideal"]["n_steps"] == 2 * scene.simulate.strides
+    assert m["contact"]["n_steps"] == 2 * scene.contact_sim.n_strides + 1
+
+
+def test_rimless_wheel_contact_trajectory_alternates_its_legs(wheel_runs):
+    """The contact view's named trajectory: the stance leg alternates at every heel strike
+    (a spoke's lane would repeat a leg on a wheel with an odd number of spokes), each leg's
+    foot is a spoke tip (the stance leg's on the ground: height above the slope < 0.1 mm)."""
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
+
+    runs, scene = wheel_runs
+    tr = load_contact_sim(runs / scene.name / "contact_sim.h5").samples
+    change = np.flatnonzero(np.diff(tr.stance_leg)) + 1
+    assert change.size == 2 * scene.contact_sim.n_strides
+    assert np.all(np.diff(tr.stance_leg[change]) != 0)
+    n = np.array([math.sin(PHI), math.cos(PHI)])
+    for i, leg in enumerate(tr.legs):
+        foot = tr.points[f"{leg}_foot"]
+        assert np.allclose(np.hypot(*(foot - tr.points["hip"])), L, atol=1e-12)
+        on = tr.stance_leg == i
+        assert np.max(np.abs(n @ foot[:, on])) < 1e-4
