@@ -286,3 +286,160 @@ def test_rimless_wheel_mjcf_rolls_in_mujoco():
     assert len(strikes) >= 10
     periods = np.diff(strikes)
     assert np.all(np.abs(periods / gait.step_period - 1) < 0.03), periods
+
+
+@pytest.fixture(scope="module")
+def wheel_runs(tmp_path_factory):
+    """The shipped scene's ``fixedpoint``, ``simulate``, ``contact-sim`` and ``compare``
+    artifacts (about 2 s): (runs folder, scene)."""
+    from walkerlab.stages import pipeline
+
+    runs = tmp_path_factory.mktemp("rimless_runs")
+    scene = load_scene(SCENE)
+    pipeline.run("compare", scene, runs)
+    return runs, scene
+
+
+def test_rimless_wheel_compare_names_the_same_coordinates(wheel_runs):
+    """``walkerlab compare``: the contact view names the rigid view's leg coordinates (the
+    stance spoke's and the next spoke's angle and rate, ``leg<i>_angle``/``_rate``, from its
+    stance and next spoke tips about the hub), so the errors are computed, not NaN: at the
+    same fraction of each step the angles agree within 1e-3 rad (measured 1.5e-4: the
+    contact steps are 0.05 % shorter) and the limit cycles lie within 5e-3 rad of each other
+    (measured 9.2e-4; the impact is spread over the contact's compression).  On the clock,
+    99 % of the samples agree within 0.02 rad (measured 7e-3 rad); the largest error
+    (4 alpha) is a leg's spoke changing at the heel strike, whose times drift apart by the
+    step periods' 0.05 %, as the paper's biped's legs swap at theirs."""
+    from walkerlab.io.schemas.compare import load_compare
+
+    runs, scene = wheel_runs
+    c = load_compare(runs / scene.name / "compare.h5")
+    assert set(c.errors) == {"leg1_angle", "leg2_angle", "leg1_rate", "leg2_rate"}
+    assert np.isfinite(c.max_abs_angle_rad) and np.isfinite(c.max_abs_rate_rad_per_s)
+    assert c.max_abs_angle_rad <= 4 * math.pi / N + 1e-9
+    for name in ("leg1_angle", "leg2_angle"):
+        assert np.max(np.abs(c.phase_errors[name])) < 1e-3
+        assert np.percentile(np.abs(c.errors[name]), 99) < 0.02
+    assert set(c.limit_cycle_distance) == {"leg1", "leg2"}
+    assert all(0 < d < 5e-3 for d in c.limit_cycle_distance.values())
+
+
+def test_rimless_wheel_contact_gait_metrics(wheel_runs):
+    """The contact view's Table 3 metrics of the wheel: its step length is the chord between
+    neighbouring spoke tips, ``2 L sin(pi / n)`` (0.7654 m; the feet at heel strike are two
+    tips of one rigid body, so exactly; today it was NaN: no leg's foot named), and its
+    stance-frame energy (PE from the stance spoke's foot) agrees with the rigid view's within
+    0.1 % (the contact's compression and its 1e-3 kg m^2 hub inertia; measured 9.935 against
+    9.934 J; on today's code it was taken from an unset stance foot: garbage, e.g.
+    8.725 or -76.89 J).  The rigid stance-frame energy is constant over a step: ``(M L^2)
+    w+^2 / 2 + M g L cos(alpha - phi)``."""
+    from walkerlab.io.schemas.compare import load_compare
+
+    runs, scene = wheel_runs
+    m = load_compare(runs / scene.name / "compare.h5").metrics
+    chord = 2 * L * math.sin(math.pi / N)
+    assert m["ideal"]["step_length_m"] == pytest.approx(chord, abs=1e-9)
+    assert m["contact"]["step_length_m"] == pytest.approx(chord, abs=1e-9)
+    w, _, _ = _closed_form()
+    e_stance = 0.5 * M * L ** 2 * w ** 2 + M * G * L * math.cos(math.pi / N - PHI)
+    assert m["ideal"]["E_avg_stance_frame_J"] == pytest.approx(e_stance, rel=1e-9)
+    assert m["contact"]["E_avg_stance_frame_J"] == pytest.approx(e_stance, rel=1e-3)
+    # both count the steps their runs began: the rigid run's 2 x simulate.strides ending
+    # at a heel strike; the contact run's 2 x contact_sim.n_strides and the one it ended in
+    assert m["ideal"]["n_steps"] == 2 * scene.simulate.strides
+    assert m["contact"]["n_steps"] == 2 * scene.contact_sim.n_strides + 1
+
+
+def test_rimless_wheel_contact_trajectory_alternates_its_legs(wheel_runs):
+    """The contact view's named trajectory: the stance leg alternates at every heel strike
+    (a spoke's lane would repeat a leg on a wheel with an odd number of spokes), each leg's
+    foot is a spoke tip (the stance leg's on the ground: height above the slope < 0.1 mm)."""
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
+
+    runs, scene = wheel_runs
+    tr = load_contact_sim(runs / scene.name / "contact_sim.h5").samples
+    change = np.flatnonzero(np.diff(tr.stance_leg)) + 1
+    assert change.size == 2 * scene.contact_sim.n_strides
+    assert np.all(np.diff(tr.stance_leg[change]) != 0)
+    n = np.array([math.sin(PHI), math.cos(PHI)])
+    for i, leg in enumerate(tr.legs):
+        foot = tr.points[f"{leg}_foot"]
+        assert np.allclose(np.hypot(*(foot - tr.points["hip"])), L, atol=1e-12)
+        on = tr.stance_leg == i
+        assert np.max(np.abs(n @ foot[:, on])) < 1e-4
+
+
+@pytest.mark.parametrize("fmt", ["adm", "osim"])
+def test_rimless_wheel_export_refuses_leg_formats_in_one_line(fmt, tmp_path):
+    """``walkerlab export --format adm|osim``: the Adams and OpenSim writers build a tree of
+    leg links; the wheel is refused in one line naming walker.model, nothing written."""
+    from walkerlab.stages import export as export_stage
+
+    with pytest.raises(ValueError) as exc:
+        export_stage.run(load_scene(SCENE), tmp_path, fmt)
+    msg = str(exc.value)
+    assert msg.startswith("walker.model: rimless_wheel") and "\n" not in msg
+    assert "urdf or mjcf" in msg
+    assert not list(tmp_path.rglob("walker.*"))
+
+
+def _keyframe_closed_form():
+    """The gait keyframe from the closed form: spoke 0's tip at the origin, the hub at
+    ``L (-sin q, cos q)``, ``q = alpha - phi``, turning at ``-w+`` (hub velocity
+    ``w L (-cos q, -sin q)``)."""
+    w, _, _ = _closed_form()
+    q, dq = math.pi / N - PHI, -w
+    return ([-L * math.sin(q), L * math.cos(q), q],
+            [-L * math.cos(q) * dq, -L * math.sin(q) * dq, dq])
+
+
+def test_rimless_wheel_export_stage_writes_the_wheel_with_its_gait(wheel_runs):
+    """``walkerlab export --format urdf|mjcf`` writes the wheel's own files (hub on hip_x,
+    hip_z and the hinge wheel, a tip sphere per spoke) with the rigid gait (from the stored
+    fixedpoint.h5) as the MJCF's ``gait`` keyframe and the URDF's sidecar: the closed form's
+    state to 1e-9."""
+    import json
+    import xml.etree.ElementTree as ET
+
+    from walkerlab.stages import export as export_stage
+
+    runs, scene = wheel_runs
+    qpos, qvel = _keyframe_closed_form()
+    mjcf = ET.parse(export_stage.run(scene, runs, "mjcf")).getroot()
+    assert [j.get("name") for j in mjcf.iter("joint")] == ["hip_x", "hip_z", "wheel"]
+    assert {g.get("name") for g in mjcf.iter("geom")} >= {f"spoke{k}_tip" for k in range(N)}
+    key = mjcf.find("keyframe/key")
+    assert key.get("name") == "gait"
+    assert np.allclose([float(v) for v in key.get("qpos").split()], qpos, atol=1e-9)
+    assert np.allclose([float(v) for v in key.get("qvel").split()], qvel, atol=1e-9)
+    urdf = ET.parse(export_stage.run(scene, runs, "urdf")).getroot()
+    assert [j.get("name") for j in urdf.iter("joint")] == ["hip_x", "hip_z", "wheel"]
+    side = json.loads((runs / scene.name / export_stage.SIDECAR).read_text())
+    assert side["joints"] == ["hip_x", "hip_z", "wheel"]
+    assert np.allclose(side["qpos"], qpos, atol=1e-9) and np.allclose(side["qvel"], qvel,
+                                                                       atol=1e-9)
+
+
+def test_rimless_wheel_export_stage_mjcf_rolls_in_mujoco(wheel_runs):
+    """The stage's MJCF, reset to its ``gait`` keyframe, rolls down the slope in MuJoCo:
+    over 5.6 rigid steps each strike is the next spoke ahead touching down, 5 strikes, with
+    step periods within 2 % of the rigid 1.03455 s (measured -0.3 % to -0.6 %: MuJoCo's soft
+    contact of time constant 2 ms, the scene's friction 0.9)."""
+    mujoco = pytest.importorskip("mujoco")
+    from walkerlab.stages import export as export_stage
+
+    runs, scene = wheel_runs
+    w, period, _ = _closed_form()
+    model = mujoco.MjModel.from_xml_path(str(export_stage.run(scene, runs, "mjcf")))
+    d = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, d, model.key("gait").id)
+    tips = {model.geom(f"spoke{k}_tip").id: k for k in range(N)}
+    stance, strikes = 0, []
+    while d.time < 5.6 * period:
+        mujoco.mj_step(model, d, nstep=10)  # strikes to 10 timesteps (1 ms)
+        touching = {tips.get(g) for c in d.contact[:d.ncon] for g in (c.geom1, c.geom2)}
+        if (stance + 1) % N in touching:  # the next spoke ahead touches down
+            stance = (stance + 1) % N
+            strikes.append(d.time)
+    assert len(strikes) == 5, strikes
+    assert np.all(np.abs(np.diff(strikes) / period - 1) < 0.02), np.diff(strikes)

@@ -23,7 +23,10 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     centre of mass and the hip advance alike).
     ``E_avg`` is the time average of KE + PE over the first ``n_energy_steps`` steps with PE
     from the first stance foot; ``E_avg_stance_frame`` measures PE from the current stance
-    foot instead (needs ``mass_kg``).
+    foot instead (needs ``mass_kg``; NaN where the trajectory names no ``<leg>_foot`` of its
+    stance leg).  ``n_steps`` counts the steps the run began: a rigid run ends at a heel
+    strike, a contact run at its end time within a step, which counts too (the complete steps
+    alone give the step periods and lengths).
 
     Returns
     -------
@@ -84,7 +87,7 @@ def gait_metrics(tr: NamedTrajectory, left_leg: str | None = None, n_energy_step
     tt = tr.time[sl]
     out["E_avg_J"] = float(np.trapezoid(tr.total[sl], tt) / (tt[-1] - tt[0]))
     if mass_kg is not None:
-        y_st = np.empty(tt.size)
+        y_st = np.full(tt.size, np.nan)  # NaN where no stance foot is named
         for k, leg in enumerate(tr.legs):
             foot = tr.points.get(f"{leg}_foot")
             if foot is not None:

@@ -37,8 +37,7 @@ def compare_files(ideal_path: Path, contact_path: Path) -> Comparison:
                "contact": gait_metrics(contact, mass_kg=mass_kg, g=g)}
     lc = {a.removesuffix("_angle"): limit_cycle_distance(ideal, contact, a, r)
           for a, r in ideal.phase_pairs() if a in contact.coordinates and r in contact.coordinates}
-    # the largest errors over the coordinates both views name (none in common, e.g. the
-    # rimless wheel's spokes in the rigid view and its wheel angle in the contact view: NaN)
+    # the largest errors over the coordinates both views name (none in common: NaN)
     ang = [n for n in err if ideal.units[n] == "rad"]
     rat = [n for n in err if ideal.units[n].startswith("rad/")]  # rad/s, or per time unit
     return Comparison(

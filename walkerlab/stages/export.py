@@ -5,7 +5,8 @@ command file (``--format adm``: :mod:`walkerlab.export.adams`) or an OpenSim mod
 Not an HDF5 artifact: an exchange file for multibody libraries (Drake, Pinocchio read URDF;
 MuJoCo reads MJCF), written from the scene's ``walker`` and ``slope`` sections only (no
 upstream artifact), atomically (temporary name, then rename).  Formats and conventions:
-:mod:`walkerlab.export.multibody`.
+:mod:`walkerlab.export.multibody`.  A spoked wheel (one rigid body on its spokes, no tree of
+leg links) is written by that module's wheel writers, as URDF or MJCF only.
 """
 
 from __future__ import annotations
@@ -29,9 +30,18 @@ from walkerlab.export.multibody import (
     keyframe_json,
     mjcf_text,
     urdf_text,
+    wheel_mjcf_text,
+    wheel_urdf_text,
 )
 from walkerlab.export.opensim import OSIM_FILE, check_osim_exportable, osim_gait, osim_text
-from walkerlab.export.scene import actuation_json, check_exportable, mjcf_scene
+from walkerlab.export.scene import (
+    actuation_json,
+    check_exportable,
+    check_wheel_exportable,
+    mjcf_scene,
+    wheel_keyframe,
+    wheel_keyframe_json,
+)
 from walkerlab.io import runpaths
 from walkerlab.units import for_scene
 from walkerlab.walker.description import walker_data
@@ -117,6 +127,34 @@ def _gait(scene: Scene, runs_root, build):
                          f"{' '.join(str(exc).split())}") from None
 
 
+def _run_wheel(scene: Scene, runs_root, data, name: str, fmt: str, walker_only: bool) -> Path:
+    """A spoked wheel (one rigid body on its spokes, no tree of leg links) by its own
+    writers (:func:`walkerlab.export.multibody.wheel_urdf_text`, ``wheel_mjcf_text``): the
+    rigid gait as the MJCF's ``gait`` keyframe (the URDF's sidecar), the scene's static
+    friction coefficient on the spoke tips; other formats and grounds refused in one line
+    (:func:`walkerlab.export.scene.check_wheel_exportable`)."""
+    check_wheel_exportable(scene, fmt, walker_only)
+    check_exportable(scene, fmt, walker_only)
+    hub = scene.contact.hub_inertia_kg_m2 if scene.contact is not None else None
+    key = None if walker_only else _gait(scene, runs_root,
+                                         lambda ideal: wheel_keyframe(scene, data, ideal))
+    version = walkerlab.__version__
+    if fmt == "urdf":
+        text = wheel_urdf_text(data, name, version, hub)
+    elif key is None:
+        text = wheel_mjcf_text(data, name, version, hub)
+    else:
+        text = wheel_mjcf_text(data, name, version, hub, qpos=key.qpos, qvel=key.qvel,
+                               friction=key.friction)
+    path = export_path(scene, runs_root, fmt, claim=True)
+    files = [(path, comments_in_scene_units(text, for_scene(scene)))]
+    if fmt == "urdf" and key is not None:  # URDF has no state: the keyframe beside it
+        files.append((runpaths.scene_file(scene, runs_root, SIDECAR, claim=True),
+                      wheel_keyframe_json(key)))
+    runpaths.atomic_texts(files)  # the wheel and its keyframe: both or neither
+    return path
+
+
 def _gait_scene(scene: Scene, mb, data, runs_root):
     """The MJCF's gait keyframe, terrain and contact (the gait of an up-to-date
     ``fixedpoint.h5``, else searched); no rigid gait: one line."""
@@ -135,14 +173,15 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     date for the scene, else found as ``walkerlab fixedpoint`` finds it, from the scene's
     ``fixedpoint`` section or, without one, from its defaults (an automatic search).
     ``walker_only``: the walker alone (no gait search; the MJCF on a plane with MuJoCo's
-    default contact, no sidecar).
+    default contact, no sidecar).  A spoked wheel: its own URDF / MJCF (:func:`_run_wheel`).
 
     Raises
     ------
     ValueError
         Unknown format, a walker with a massless link (a multibody model needs positive
         masses), feet the formats cannot carry, a ground other than the slope (stairs ...)
-        unless ``walker_only``, or no rigid gait to start from; one line.
+        unless ``walker_only``, or no rigid gait to start from; a spoked wheel to a format
+        other than urdf or mjcf (naming walker.model); one line.
     walkerlab.io.runpaths.RunPathError
         The run folder is not allowed.
     walkerlab.io.artifacts.ArtifactError
@@ -160,8 +199,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
 
         check_ground(scene.terrain)  # a profile: one line
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    mb = multibody(data)
     name = scene.name or "walker"
+    if data.structure.spokes:  # one rigid body on its spokes: no tree of leg links
+        return _run_wheel(scene, runs_root, data, name, fmt, walker_only)
+    mb = multibody(data)
     if fmt == "adm":
         return _run_adams(scene, runs_root, mb, data, name)
     if fmt == "osim":
