@@ -15,6 +15,7 @@ velocities (100 and 1000 mm/s, OpenSim's transition velocity 0.1 m/s) powered_co
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -27,6 +28,10 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def _scene(name):
+    if name == "stairs_continuous":  # the treads as continuous ground, not patches
+        from walkerlab.api.scenes import with_changes
+
+        return with_changes(_scene("stairs"), {"terrain.lanes": "continuous"})
     return load_scene(ROOT / "configs" / f"{name}.yaml")
 
 
@@ -65,7 +70,7 @@ def test_osim_export_carries_the_walker_and_its_gait(paper_osim):
 
 @pytest.mark.parametrize("name, field", [("flat_feet", "walker.leg.foot.kind"),
                                          ("torso_bhm", "walker.torso.coupling"),
-                                         ("stairs", "terrain.kind: stairs"),
+                                         ("stairs_continuous", "terrain.lanes: continuous"),
                                          ("simplest", "walker.leg.bodies")])
 def test_osim_export_refuses_in_one_line(name, field, tmp_path):
     """What the OpenSim export cannot express: one line naming the field, nothing written."""
@@ -115,6 +120,33 @@ def test_osim_export_refuses_a_torque_per_foot_mass(tmp_path):
     assert not any(tmp_path.rglob("*.osim"))
 
 
+@pytest.mark.parametrize("name, radius", [("stairs", 0.15 ** 2 / (2 * 0.012)),
+                                          ("footholds", 0.05 ** 2 / (2 * 0.001))])
+def test_osim_export_puts_the_patches_on_the_treads(name, radius, tmp_path):
+    """Stairs (1 cm risers, 0.41 m treads) and footholds (5 mm below the last): each patch
+    sphere's top at its footfall's height; the stairs' spheres small enough that the tread
+    behind is 1 cm + 2 foot radii below its top at the patch's edge (0.9375 m; the flat
+    patches' 11.25 m reached into the swing foot's path), the footholds' the flat patches'
+    (their edge 1 mm down: 1.25 m)."""
+    root = ET.fromstring(export_stage.run(_scene(name), tmp_path, "osim").read_text()
+                         .replace("::", "__"))
+    sc = _scene(name)
+    patches = {g.get("name"): g for g in root.iter("ContactSphere") if "patch" in g.get("name")}
+    assert all(float(g.find("radius").text) == pytest.approx(radius, rel=1e-6)
+               for g in patches.values())
+    phi, foot = sc.slope.phi_rad, 0.001  # the point foot's sphere, the ground lowered by it
+    n_hat = (math.sin(phi), math.cos(phi))
+    height = {n: sum(float(x) * k for x, k in zip(g.find("location").text.split(), n_hat))
+              + radius + foot for n, g in patches.items()}  # the top along the slope normal
+    drop = (sc.terrain.riser_m if name == "stairs" else -sc.terrain.foothold_heights_m[0]) \
+        * math.cos(phi)
+    # leg2 stands on footfall 0 at the origin; leg1's lane holds footfalls -1, 1, 3, ...
+    assert height["leg2_patch0"] == pytest.approx(0.0, abs=1e-12)
+    assert height["leg1_patch0"] == pytest.approx(drop, rel=1e-9)
+    assert height["leg1_patch1"] == pytest.approx(-drop, rel=1e-9)
+    assert height["leg2_patch1"] == pytest.approx(-2 * drop, rel=1e-9)
+
+
 def test_osim_export_refuses_walker_only(tmp_path):
     with pytest.raises(ValueError, match=r"^--walker-only"):
         export_stage.run(_scene("paper"), tmp_path, "osim", walker_only=True)
@@ -124,7 +156,7 @@ def test_osim_export_refuses_walker_only(tmp_path):
 #: (kneed with its knee latch switched by the stepping loop; RABBIT with its joint torque
 #: laws set by it: before, no law drove the motors and it fell at 0.35 s)
 WALKS = [("paper", 0.03, 0.05), ("powered_compass", 0.03, 0.05), ("kneed", 0.03, 0.05),
-         ("rabbit", 0.03, 0.05)]
+         ("rabbit", 0.03, 0.05), ("stairs", 0.03, 0.05), ("footholds", 0.03, 0.05)]
 
 
 @pytest.mark.slow

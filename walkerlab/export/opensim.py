@@ -32,7 +32,9 @@ Forces:
   :func:`patch_radius` whose top touches the slope line at the footfall (its surface stays
   within one foot-sphere radius of the line over the patch's width and falls away beyond, so
   the swing foot passes over the other lane's footfalls; OpenSim's Hunt-Crossley force takes
-  spheres and half-spaces only).  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax)
+  spheres and half-spaces only).  On stairs and footholds (``terrain.lanes: checkerboard``)
+  each patch's top is at its footfall's height (the MJCF's ``lane_heights``) and the radius
+  is :func:`terrain_patch_radius`; continuous stairs are refused.  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax)
   d'`` is translated by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static
   penetration; stated in the file).
 - **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
@@ -75,7 +77,8 @@ from walkerlab.export.text import comment, num, nums
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
 
 __all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
-           "knee_stop_expression", "osim_gait", "osim_text", "patch_radius"]
+           "knee_stop_expression", "osim_gait", "osim_text", "patch_radius",
+           "link_angle", "terrain_patch_radius", "torque_generalized_forces"]
 
 #: The export's file name in ``runs/<scene>/``.
 OSIM_FILE = "walker.osim"
@@ -110,6 +113,9 @@ class OsimGait:
         The push-off pulse's duration [s] (the scene's ``contact.push_off_duration_s``).
     actuation_json : str or None
         The scene's ``walker.actuation`` as JSON.
+    lane_heights : tuple of (tuple of float, tuple of float) or None
+        Stairs and footholds: each patch's height along the slope normal [m] (its tread's,
+        as :class:`walkerlab.export.mjcf_scene.MjcfScene` has them); None: on the slope line.
     """
 
     qpos: tuple
@@ -124,6 +130,7 @@ class OsimGait:
     push_off: object = None
     push_off_duration_s: float = 0.005
     actuation_json: str | None = None
+    lane_heights: tuple | None = None
 
     @property
     def speed_m_per_s(self) -> float:
@@ -262,6 +269,24 @@ def patch_radius(patch_width_m: float, foot_sphere_m: float) -> float:
     return (patch_width_m / 2) ** 2 / (2 * foot_sphere_m)
 
 
+def terrain_patch_radius(gait: OsimGait, foot_sphere_m: float) -> float:
+    """Radius [m] of the patch spheres: :func:`patch_radius` on a slope's patches; on stairs
+    and footholds no larger than the radius whose surface falls ``h`` plus two foot-sphere
+    radii below its top at ``d = max(w/2, l/3)`` from its centre, ``Rg <= d^2 / (2 (h + 2 r))``
+    (``h`` the largest rise between consecutive footfalls, ``w`` the patch width, ``l`` the
+    step length).  A sphere does not end at the patch's edge: on stairs.yaml, at the flat
+    patches' radius (11.25 m), the tread behind reached into the swing foot's path, which
+    falls below the tread it left about half a step (0.22 of 0.41 m) from it."""
+    rg = patch_radius(gait.patch_width_m, foot_sphere_m)
+    if gait.lane_heights is None:
+        return rg
+    falls = sorted((s, h) for lane, hs in zip(gait.lanes, gait.lane_heights)
+                   for s, h in zip(lane, hs))
+    rise = max((abs(a[1] - b[1]) for a, b in zip(falls, falls[1:])), default=0.0)
+    d = max(gait.patch_width_m / 2, gait.step_length_m / 3)
+    return min(rg, d ** 2 / (2 * (rise + 2 * foot_sphere_m)))
+
+
 def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     """The rigid gait, ground and contact of ``scene`` for the OpenSim export.
 
@@ -292,9 +317,14 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     terrain = scene.terrain or TerrainSettings()
     c, knee = contact_si(settings)
     ideal = ideal_gait(scene) if ideal is None else ideal
+    if not terrain.is_slope and terrain.lanes != "checkerboard":
+        raise ValueError(f"terrain.lanes: {terrain.lanes}: continuous {terrain.kind} are not "
+                         "in the OpenSim export (its Hunt-Crossley contact takes spheres and "
+                         "half-spaces, not a tread's box); lanes: checkerboard puts the "
+                         "patches on the treads")
     ms = mjcf_scene(scene, mb, data, ideal)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee)
-    ell = ideal_step_length(walker, ideal.x)
+    ell = ideal_step_length(walker, ideal.x, along_slope=not terrain.is_slope)
     ells = tuple(getattr(ideal, "step_lengths_m", ()) or ())
     if len(ells) == 2:
         ell = 0.5 * (ells[0] + ells[1])
@@ -302,7 +332,7 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     return OsimGait(ms.qpos, ms.qvel, float(ideal.period_s), float(ell), ms.lanes,
                     terrain.patch_width_m, ms.ground_offset_m, c, knee,
                     None if act is None else act.push_off,
-                    settings.push_off_pulse_s(), ms.actuation_json)
+                    settings.push_off_pulse_s(), ms.actuation_json, ms.lane_heights)
 
 
 # ----------------------------------------------------------------------------- the XML
@@ -453,7 +483,7 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
     offset = gait.ground_offset_m
     total = mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links)
     weight = total * g * math.cos(phi)
-    rg = None if gait.lanes is None else patch_radius(gait.patch_width_m, r_foot)
+    rg = None if gait.lanes is None else terrain_patch_radius(gait, r_foot)
     r_eff = r_foot if rg is None else r_foot * rg / (r_foot + rg)
     stiff, diss, vt, contact_note = hunt_crossley(gait.contact, weight, r_eff)
     joints = ["hip_x", "hip_y", *(ln.joint for ln in mb.links)]
@@ -479,7 +509,11 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
             f"Terrain: checkerboard lanes (each leg touches only its own); a patch of width "
             f"{num(gait.patch_width_m)} m is a sphere of radius {rg:.6g} m whose top touches "
             f"the slope line at the footfall (it falls {r_foot:.4g} m below the line at the "
-            "patch's edge: walkerlab.export.opensim.patch_radius)."))
+            "patch's edge: walkerlab.export.opensim.patch_radius)"
+            + ("" if gait.lane_heights is None else
+               "; stairs or footholds: each patch's top at its tread's height, the radius "
+               "small enough that the tread behind falls clear of the swing foot's path "
+               "(walkerlab.export.opensim.terrain_patch_radius)") + "."))
     if gait.push_off is not None:
         out.append(comment(
             "Push-off (walker.actuation.push_off, walkerlab_actuation below): PrescribedForce "
@@ -645,7 +679,8 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
         for i, ln in enumerate(feet):
             leg = ln.name.split("_")[0]
             for j, s in enumerate(gait.lanes[i]):
-                p = s * t_hat - (offset + rg) * n_hat
+                h = 0.0 if gait.lane_heights is None else gait.lane_heights[i][j]
+                p = s * t_hat + (h - offset - rg) * n_hat
                 out += [f"\t\t\t\t<ContactSphere name=\"{leg}_patch{j}\">",
                         "\t\t\t\t\t<socket_frame>/ground</socket_frame>",
                         f"\t\t\t\t\t<location>{nums(p[0], p[1], 0.0)}</location>",
