@@ -6,8 +6,8 @@ from pathlib import Path
 
 import typer
 
-SceneArg = typer.Argument(None, help="scene YAML file (default: configs/paper.yaml, "
-                          "the paper's walker)",
+SceneArg = typer.Argument(None, help="scene YAML file, or a shipped scene's name (paper, "
+                          "kneed, rabbit, ...) (default: configs/paper.yaml, the paper's walker)",
                           show_default=False)
 
 

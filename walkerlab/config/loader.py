@@ -32,6 +32,22 @@ def default_scene_path() -> Path:
     return Path(walkerlab.__file__).resolve().parent.parent / "configs" / "paper.yaml"
 
 
+def shipped_scene_path(name: str | Path) -> Path | None:
+    """A shipped scene by name (``paper``, ``kneed``, ``rabbit.yaml``) or by its path in the
+    repository (``configs/paper.yaml``): the file in the ``configs`` folder next to the
+    package (an editable install), or None when there is none."""
+    import walkerlab
+
+    configs = Path(walkerlab.__file__).resolve().parent.parent / "configs"
+    p = Path(name)
+    if len(p.parts) == 2 and p.parts[0] == "configs":
+        p = Path(p.name)
+    if len(p.parts) != 1 or p.name in ("", ".", ".."):
+        return None
+    f = configs / (p.name if p.suffix in (".yaml", ".yml") else f"{p.name}.yaml")
+    return f if f.is_file() else None
+
+
 class _SceneLoader(yaml.SafeLoader):
     """``yaml.SafeLoader`` that refuses duplicate keys and nesting deeper than
     :data:`MAX_YAML_DEPTH` (the composer recurses once per level: 20000 levels would exhaust
@@ -91,7 +107,8 @@ def load_scene(path: str | Path) -> Scene:
     Parameters
     ----------
     path : str or Path
-        YAML scene file.
+        YAML scene file; one not found in the working folder may name a shipped scene
+        (``"paper"``, ``"kneed"``, ``"configs/rabbit.yaml"``: :func:`shipped_scene_path`).
 
     Returns
     -------
@@ -107,6 +124,8 @@ def load_scene(path: str | Path) -> Scene:
     from walkerlab.safefs import NotARegularFile, read_regular
 
     path = Path(path)
+    if not path.exists() and (shipped := shipped_scene_path(path)) is not None:
+        path = shipped
     if path.is_dir():
         raise SceneError(f"{path}: is a directory, not a scene file")
     if not path.is_file():
