@@ -34,8 +34,8 @@ Forces:
   the swing foot passes over the other lane's footfalls; OpenSim's Hunt-Crossley force takes
   spheres and half-spaces only).  On stairs and footholds (``terrain.lanes: checkerboard``)
   each patch's top is at its footfall's height (the MJCF's ``lane_heights``) and the radius
-  is :func:`terrain_patch_radius`; continuous stairs are refused.  The scene's IMPACT law ``k d^e + STEP(d, 0, 0, dmax, cmax)
-  d'`` is translated by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static
+  is :func:`terrain_patch_radius`; continuous stairs are refused.  The scene's IMPACT law
+  ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static
   penetration; stated in the file).
 - **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
   two links at the hip a ``BushingForce`` between the links' hip frames (rotational stiffness
