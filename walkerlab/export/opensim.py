@@ -35,8 +35,8 @@ Forces:
   spheres and half-spaces only).  On stairs and footholds (``terrain.lanes: checkerboard``)
   each patch's top is at its footfall's height (the MJCF's ``lane_heights``) and the radius
   is :func:`terrain_patch_radius`; continuous stairs are refused.  The scene's IMPACT law
-  ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated by :func:`hunt_crossley` (Hertz ``d^1.5``, matched at the static
-  penetration; stated in the file).
+  ``k d^e + STEP(d, 0, 0, dmax, cmax) d'`` is translated by :func:`hunt_crossley` (Hertz
+  ``d^1.5``, matched at the static penetration; stated in the file).
 - **springs**: a knee spring (one coordinate) is a ``SpringGeneralizedForce``; a spring between
   two links at the hip a ``BushingForce`` between the links' hip frames (rotational stiffness
   and damping about z; the rest angle in the second frame's orientation).
