@@ -69,7 +69,6 @@ def test_osim_export_carries_the_walker_and_its_gait(paper_osim):
 
 
 @pytest.mark.parametrize("name, field", [("flat_feet", "walker.leg.foot.kind"),
-                                         ("torso_bhm", "walker.torso.coupling"),
                                          ("stairs_continuous", "terrain.lanes: continuous"),
                                          ("simplest", "walker.leg.bodies")])
 def test_osim_export_refuses_in_one_line(name, field, tmp_path):
@@ -145,6 +144,52 @@ def test_osim_export_puts_the_patches_on_the_treads(name, radius, tmp_path):
     assert height["leg1_patch0"] == pytest.approx(drop, rel=1e-9)
     assert height["leg1_patch1"] == pytest.approx(-drop, rel=1e-9)
     assert height["leg2_patch1"] == pytest.approx(-2 * drop, rel=1e-9)
+
+
+def test_the_bisecting_torso_is_a_coordinate_coupler(tmp_path):
+    """torso_bhm's bisecting hip mechanism: a CoordinateCouplerConstraint torso_hip =
+    0.5 leg1_hip + 0.5 leg2_hip (before: refused), the default torso angle the legs' mean."""
+    root = ET.fromstring(export_stage.run(_scene("torso_bhm"), tmp_path, "osim").read_text()
+                         .replace("::", "__"))
+    (c,) = list(root.iter("CoordinateCouplerConstraint"))
+    assert c.find("dependent_coordinate_name").text == "torso_hip"
+    assert c.find("independent_coordinate_names").text.split() == ["leg1_hip", "leg2_hip"]
+    f = c.find("coupled_coordinates_function/MultivariatePolynomialFunction")
+    assert [float(x) for x in f.find("coefficients").text.split()] == [0.0, 0.5, 0.5]
+    assert (f.find("dimension").text, f.find("order").text) == ("2", "1")
+    q = {k.get("name"): float(k.find("default_value").text) for k in root.iter("Coordinate")}
+    assert q["torso_hip"] == pytest.approx(0.5 * (q["leg1_hip"] + q["leg2_hip"]), abs=1e-15)
+
+
+@pytest.mark.slow
+def test_the_bisecting_torso_holds_in_opensim(tmp_path):
+    """OpenSim enforces the coupler: over 0.5 s of torso_bhm's walk (its first heel strike
+    at 0.86 s) the torso angle stays the legs' mean to OpenSim's constraint tolerance, and
+    the model has the scene's mass (20.x kg with the torso)."""
+    osim = pytest.importorskip("opensim")
+    import numpy as np
+
+    path = export_stage.run(_scene("torso_bhm"), tmp_path, "osim")
+    osim.Logger.removeFileSink()
+    model = osim.Model(str(path))
+    state = model.initSystem()
+    cs = model.getCoordinateSet()
+    manager = osim.Manager(model)
+    manager.setIntegratorAccuracy(1e-7)
+    manager.initialize(state)
+    gaps = []
+    for t in np.linspace(0.05, 0.5, 10):
+        st = manager.integrate(float(t))
+        q = [cs.get(n).getValue(st) for n in ("leg1_hip", "leg2_hip", "torso_hip")]
+        gaps.append(abs(q[2] - 0.5 * (q[0] + q[1])))
+    assert max(gaps) < 1e-6
+    sc = _scene("torso_bhm")
+    from walkerlab.walker.description import walker_data
+    from walkerlab.walker.multibody import multibody
+
+    mb = multibody(walker_data(sc.walker, sc.slope.phi_rad))
+    assert model.getTotalMass(state) == pytest.approx(
+        mb.hip_mass_kg + sum(ln.mass_kg for ln in mb.links), rel=1e-12)
 
 
 def test_osim_export_refuses_walker_only(tmp_path):

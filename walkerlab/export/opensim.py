@@ -145,19 +145,14 @@ def check_osim_exportable(scene: Scene, mb) -> None:
     ------
     ValueError
         One line naming the field: flat feet (``walker.leg.foot.kind``: no foot bodies in
-        this export), a bisecting hip mechanism (``walker.torso.coupling``: a coupling of one
-        coordinate to two is not written yet), an ankle push-off
-        (``walker.actuation.ankle_push_off``).
+        this export), an ankle push-off (``walker.actuation.ankle_push_off``), a torque law
+        per foot mass or on a joint the model lacks (``walker.actuation.torques.<i>``).
     """
     foot = getattr(getattr(scene.walker, "leg", None), "foot", None)
     if getattr(foot, "kind", None) == "flat":
         raise ValueError("walker.leg.foot.kind: flat feet are not in the OpenSim export (no "
                          "foot bodies, ankle springs or heel and toe contacts); --format mjcf "
                          "carries them")
-    if mb.couplings:
-        raise ValueError("walker.torso.coupling: the bisecting hip mechanism (torso angle = "
-                         "mean of the hip angles) is not in the OpenSim export (a coupler "
-                         "constraint on two independent coordinates is not written yet)")
     act = getattr(scene.walker, "actuation", None)
     if act is not None and act.ankle_push_off is not None:
         raise ValueError("walker.actuation.ankle_push_off: not in the OpenSim export (the "
@@ -442,6 +437,34 @@ def torque_generalized_forces(joint: str, stance: int, coordinates) -> dict[str,
     return {c: k for c, k in out.items() if k != 0.0}
 
 
+def _couplers(mb) -> list[str]:
+    """A ``ConstraintSet`` of one ``CoordinateCouplerConstraint`` per coupling of ``mb`` (the
+    bisecting hip: ``torso_hip = 0.5 leg1_hip + 0.5 leg2_hip``, the links' absolute angles):
+    a first-order ``MultivariatePolynomialFunction`` of the independent coordinates, whose
+    coefficients OpenSim orders as the constant, then the last coordinate's, ..., the first's."""
+    if not mb.couplings:
+        return []
+    i = "\t\t\t\t"
+    out = ['\t\t<ConstraintSet name="constraintset">', "\t\t\t<objects>"]
+    for cp in mb.couplings:
+        coefs = [0.0, *(c for _, c in reversed(cp.terms))]
+        out += [f"{i}<CoordinateCouplerConstraint name={quoteattr(cp.name)}>",
+                f"{i}\t<isEnforced>true</isEnforced>",
+                f"{i}\t<coupled_coordinates_function>",
+                f"{i}\t\t<MultivariatePolynomialFunction>",
+                f"{i}\t\t\t<coefficients>{nums(*coefs)}</coefficients>",
+                f"{i}\t\t\t<dimension>{len(cp.terms)}</dimension>",
+                f"{i}\t\t\t<order>1</order>",
+                f"{i}\t\t</MultivariatePolynomialFunction>",
+                f"{i}\t</coupled_coordinates_function>",
+                f"{i}\t<independent_coordinate_names>{' '.join(j for j, _ in cp.terms)}"
+                "</independent_coordinate_names>",
+                f"{i}\t<dependent_coordinate_name>{cp.joint}</dependent_coordinate_name>",
+                f"{i}\t<scale_factor>1</scale_factor>",
+                f"{i}</CoordinateCouplerConstraint>"]
+    return out + ["\t\t\t</objects>", "\t\t</ConstraintSet>"]
+
+
 def _torque_joints(actuation_json: str | None, mb) -> list[str]:
     """Coordinates that get a ``CoordinateActuator``: every coordinate a torque law's joint
     moves in either stance (:func:`torque_generalized_forces`)."""
@@ -582,7 +605,8 @@ def osim_text(mb, gait: OsimGait, name: str, version: str = "") -> str:
                         (0.0, -ln.joint_from_parent_m, 0.0)),
                 *_frame(f"{ln.name}_at_{ln.joint}", f"/bodyset/{ln.name}"),
                 "\t\t\t\t\t</frames>", "\t\t\t\t</PinJoint>"]
-    out += ["\t\t\t</objects>", "\t\t</JointSet>", '\t\t<ForceSet name="forceset">',
+    out += ["\t\t\t</objects>", "\t\t</JointSet>", *_couplers(mb),
+            '\t\t<ForceSet name="forceset">',
             "\t\t\t<objects>"]
     feet = [ln for ln in mb.links if ln.foot_m is not None]
     for i, ln in enumerate(feet):
