@@ -21,8 +21,8 @@ built and handed to the checkout that ``PYTHONPATH`` selects; nothing long is so
 - **design**: ``walkerlab optimize SCENE --design slope.angle_rad=LO:HI`` (±10 %) with
   ``scipy.optimize.minimize`` replaced by one evaluation of the objective and its gradient
   at the start, then an exit.
-- **MJCF / Adams export**: ``walkerlab export SCENE --format mjcf|adm`` into a temporary
-  runs folder (the shipped scene; a warning the command prints is kept in the JSON).
+- **MJCF / Adams / OpenSim export**: ``walkerlab export SCENE --format mjcf|adm|osim`` into
+  a temporary runs folder (the shipped scene; a warning the command prints is kept in the JSON).
 
 Every cell has a CPU-time limit (``--timeout``); the torque cells of a family share one
 child process, every command cell runs in its own.
@@ -75,6 +75,7 @@ CAPABILITIES = {
     "design": "design",
     "mjcf": "MJCF export",
     "adams": "Adams export",
+    "osim": "OpenSim export",
 }
 RIGID = ("hip", "knee", "ankle", "torso", "push_off", "virtual_constraints")
 EXIT_REACHED = 77  # a command cell's child: the solver was reached (set-up accepted)
@@ -301,6 +302,8 @@ def command_args(family: str, cap: str, runs: Path) -> list[str]:
         return ["export", scene, "--format", "mjcf", "--runs-dir", str(runs)]
     if cap == "adams":
         return ["export", scene, "--format", "adm", "--runs-dir", str(runs)]
+    if cap == "osim":
+        return ["export", scene, "--format", "osim", "--runs-dir", str(runs)]
     raise ValueError(cap)
 
 
