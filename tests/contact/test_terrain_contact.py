@@ -85,7 +85,7 @@ def test_stairs_as_patches_at_the_footholds_and_as_treads_and_risers():
 
 @pytest.mark.parametrize("terrain, field", [
     ({"kind": "profile", "profile_m": [[0, 0], [1, -0.01]], "riser_m": None,
-      "tread_m": None, "direction": None}, "terrain.kind: profile"),
+      "tread_m": None, "direction": None}, "terrain.lanes: a profile"),
     ({"kind": "footholds", "foothold_heights_m": [-0.01], "lanes": "continuous",
       "riser_m": None, "tread_m": None, "direction": None}, "terrain.lanes"),
 ])
@@ -119,3 +119,52 @@ def test_contact_run_down_stairs_keeps_the_rigid_stair_gait():
     period = float(np.mean(np.diff(res.heel_strike_times)[2:]))
     assert period == pytest.approx(rigid.period_s, rel=0.03)
     assert period == pytest.approx(rigid.period_s, rel=0.015)  # what it is (+0.9 %)
+
+
+def _kneed_on(profile):
+    """configs/kneed.yaml (whose knees clear continuous ground) on a profile, continuous."""
+    d = load_scene(ROOT / "configs" / "kneed.yaml").model_dump(mode="json")
+    d["terrain"] = {"kind": "profile", "profile_m": profile, "lanes": "continuous"}
+    d["contact_sim"]["n_strides"] = 3
+    return scene_from_dict(d)
+
+
+def _heel_strikes(scene):
+    from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.models.contact.scene import contact_setup
+
+    _, search = solve_scene(scene)
+    _, res, _, _ = simulate_from(contact_setup(scene), search.result.x,
+                                 search.result.period_s)
+    return np.asarray(res.heel_strike_times), res
+
+
+def test_a_profile_is_the_contact_models_polyline_ground():
+    """The profile's first point at the first stance foot (as the rigid walk places it), its
+    end segments run on along their lines; a profile along the slope line through the stance
+    foot is the slope: the kneed walker's contact run on it strikes the ground when it does
+    on continuous slope ground (to 1e-5 s, the integrator's tolerance: two kernels, the
+    half-plane and the polyline), and on a 1 mm undulation it keeps walking."""
+    import math
+
+    from walkerlab.models.contact.terrain import profile_line
+
+    phi = load_scene(ROOT / "configs" / "kneed.yaml").slope.angle_rad
+    t = math.tan(phi)
+    flat = _kneed_on([[-1.0, t], [6.0, -6.0 * t]])
+    line = profile_line(flat.terrain, 0.0, 0.0)
+    assert np.allclose(line[1], [0.0, 0.0]) and np.allclose(line[2], [7.0, -7.0 * t])
+    assert np.allclose(np.diff(line[:, 1]) / np.diff(line[:, 0]), -t)  # one straight line
+    d = flat.model_dump(mode="json")
+    d["terrain"] = {"kind": "slope", "lanes": "continuous"}
+    slope = scene_from_dict(d)
+    a, _ = _heel_strikes(slope)
+    b, _ = _heel_strikes(flat)
+    assert len(a) >= 5 and len(a) == len(b)
+    assert np.max(np.abs(a - b)) < 1e-5
+    bumpy = _kneed_on([[round(-1.0 + 0.1 * i, 6), -(-1.0 + 0.1 * i) * t
+                        + (0.001 * math.sin(2 * math.pi * (-1.0 + 0.1 * i) / 0.9)
+                           if -1.0 + 0.1 * i > 0.3 else 0.0)] for i in range(61)])
+    c, res = _heel_strikes(bumpy)
+    assert len(c) == len(a) and not np.allclose(c, a, atol=1e-4), res.message

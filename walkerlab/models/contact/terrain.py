@@ -38,8 +38,8 @@ import numpy as np
 
 from walkerlab.models.hybrid.ground import landing_drop
 
-__all__ = ["check_ground", "footfall_lanes", "slope_heights", "stairs_line", "step_heights",
-           "terrain_ground"]
+__all__ = ["check_ground", "footfall_lanes", "profile_line", "slope_heights", "stairs_line",
+           "step_heights", "terrain_ground"]
 
 
 def slope_heights(slopes_rad: np.ndarray, mean_rad: float, step_length_m: float
@@ -132,19 +132,46 @@ def check_ground(terrain) -> float:
     Raises
     ------
     ValueError
-        One line naming the field: a profile, footholds of several heights or of their own
-        slopes, footholds on continuous ground (no ground between the footholds).
+        One line naming the field: a profile on checkerboard lanes or from a CSV,
+        footholds of several heights or of their own slopes, footholds on continuous ground
+        (no ground between the footholds).
     """
     if terrain is None or terrain.kind == "slope":
         return 0.0
     if terrain.kind == "profile":
-        raise ValueError("terrain.kind: profile: the contact model walks slopes, stairs and "
-                         "footholds (height profiles as contact geometry are not built yet)")
+        if terrain.lanes != "continuous":
+            raise ValueError("terrain.lanes: a profile is continuous ground for the contact "
+                             "model (lanes: continuous; checkerboard patches need the rigid "
+                             "footholds of a periodic ground)")
+        if terrain.profile_m is None:
+            raise ValueError("terrain.profile_csv: the contact model reads inline profiles "
+                             "(terrain.profile_m) only so far, as the rigid walk does")
+        return 0.0
     drop = landing_drop(terrain)
     if terrain.kind == "footholds" and terrain.lanes == "continuous":
         raise ValueError("terrain.lanes: continuous footholds have no ground between the "
                          "footholds: use lanes: checkerboard (patches at the footholds)")
     return drop
+
+
+def profile_line(terrain, first_x_m: float, first_y_m: float) -> np.ndarray:
+    """Vertices (m, 2) [m] of a height profile (``terrain.profile_m``) as the contact model's
+    polyline ground in the world frame: the profile's first point at the first stance foot
+    (as the rigid walk places it, :mod:`walkerlab.analysis.gait.profile_walk`), its first and
+    last segments run on along their own lines for 100 m.
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings
+        ``kind: profile`` with ``profile_m``.
+    first_x_m, first_y_m : float
+        The first stance foot's contact point in the world frame [m].
+    """
+    pts = np.asarray(terrain.profile_m, dtype=float)
+    pts = pts - pts[0] + np.array([first_x_m, first_y_m])
+    head = pts[0] - 100.0 * (pts[1] - pts[0]) / np.hypot(*(pts[1] - pts[0]))
+    tail = pts[-1] + 100.0 * (pts[-1] - pts[-2]) / np.hypot(*(pts[-1] - pts[-2]))
+    return np.vstack([head, pts, tail])
 
 
 def terrain_ground(walker, terrain, n_steps: int):
@@ -165,7 +192,7 @@ def terrain_ground(walker, terrain, n_steps: int):
         footholds of one height on the checkerboard lanes: the patches at the footholds'
         heights (footfall ``k`` at ``-k drop cos(phi)`` along the slope's normal,
         :func:`footfall_lanes`).  Stairs on continuous ground: the treads and risers as a
-        polyline (:func:`stairs_line`).
+        polyline (:func:`stairs_line`); a profile: its polyline (:func:`profile_line`).
 
     Raises
     ------
@@ -182,4 +209,8 @@ def terrain_ground(walker, terrain, n_steps: int):
         heights = -np.arange(n) * drop * math.cos(float(walker.phi))
         return footfall_lanes(walker, heights)
     first = float(walker.lane2[0]) if walker.lane2.size else 0.0
+    if terrain.kind == "profile":  # the first footfall along the slope, in the world frame
+        phi = float(walker.phi)
+        return replace(walker, ground_line=profile_line(
+            terrain, first * math.cos(phi), -first * math.sin(phi)))
     return replace(walker, ground_line=stairs_line(terrain, first, int(n_steps) + 2))
