@@ -80,6 +80,11 @@ class MjcfScene:
         Continuous stairs (``terrain.lanes: continuous``): each tread's ``(x_start, x_end,
         height)`` [m] (level, in the world frame), written as a box whose top is the tread
         and whose front or back face is the riser; None: the slope's plane.
+    profile : ndarray (m, 2) or None
+        A height profile (``terrain.kind: profile``, ``lanes: continuous``): its polyline in
+        the world frame (x downhill, z up) [m], the first stance foot's contact point at its
+        first vertex (:func:`walkerlab.models.contact.terrain.profile_line`), written as a
+        MuJoCo height field sampled every :data:`PROFILE_DX_M`; None: no profile.
     flat_feet : tuple or None
         Flat feet (:func:`walkerlab.export.scene.flat_feet`): per leg (leg1, leg2) ``(heel
         [m], toe [m], ankle stiffness [N m/rad], damping [N m s/rad], rest angle [rad], foot
@@ -107,7 +112,13 @@ class MjcfScene:
     flat_feet: tuple | None = None
     lane_heights: tuple | None = None
     treads: tuple | None = None
+    profile: object = None
 
+
+#: Height-field sampling of a profile along x [m] (MuJoCo interpolates linearly between
+#: samples: a profile's vertices between samples are cut by at most its slope change times
+#: this spacing).
+PROFILE_DX_M = 0.005
 
 #: Contact bits (contype of the ground pieces, conaffinity of the feet): each leg's foot
 #: touches only its own lane (the paper's checkerboard terrain, its Section 4); continuous:

@@ -312,6 +312,10 @@ def osim_gait(scene: Scene, mb, data, ideal=None) -> OsimGait:
     terrain = scene.terrain or TerrainSettings()
     c, knee = contact_si(settings)
     ideal = ideal_gait(scene) if ideal is None else ideal
+    if terrain.kind == "profile":
+        raise ValueError("terrain.kind: profile: not in the OpenSim export (its Hunt-Crossley "
+                         "contact takes spheres and half-spaces, not a polyline; --format "
+                         "mjcf writes it as a height field)")
     if not terrain.is_slope and terrain.lanes != "checkerboard":
         raise ValueError(f"terrain.lanes: {terrain.lanes}: continuous {terrain.kind} are not "
                          "in the OpenSim export (its Hunt-Crossley contact takes spheres and "

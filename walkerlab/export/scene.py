@@ -253,8 +253,13 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
         qpos, qvel = joint_state(mb, walker, walker.pinned_to_full(z, np.zeros(2)))
         feet = None
     dt, solref, solimp, mu, notes = mujoco_contact(c, walker.total_mass, walker.g, walker.phi)
-    lanes = lane_heights = treads = None
-    if not terrain.is_slope:
+    lanes = lane_heights = treads = profile = None
+    if terrain.kind == "profile":
+        from walkerlab.models.contact.terrain import check_ground, profile_line
+
+        check_ground(terrain)  # continuous lanes, an inline profile: one line otherwise
+        profile = profile_line(terrain, 0.0, 0.0)  # leg2's contact point at the origin
+    elif not terrain.is_slope:
         lane_heights, treads = _ground_pieces(terrain, walker, ideal.x)
     if terrain.lanes == "checkerboard":
         # the keyframe's feet are one step apart: leg2's step, the last of the gait's map
@@ -324,6 +329,11 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
                           f"{terrain.direction or 'down'}, tread {terrain.tread_m:g} m): a box "
                           "per tread (geoms tread<i>), its top the tread, its faces the "
                           "risers.",)
+    elif profile is not None:
+        lanes = None
+        terrain_notes += ("Profile (terrain.kind: profile, lanes: continuous): a height field "
+                          "hfield 'profile' sampled every 5 mm from its polyline, the first "
+                          "stance foot on its first point (both feet touch it).",)
     elif lane_heights is not None:
         terrain_notes += ("Footholds (terrain.kind: " + terrain.kind + "): the checkerboard "
                           "patches at the rigid gait's footholds, each at its tread's height "
@@ -332,7 +342,7 @@ def mjcf_scene(scene: Scene, mb, data, ideal=None) -> MjcfScene:
                      0.0 if mb.foot == "arc" and mb.foot_radius_m > 0 else point_foot_radius(mb),
                      dt, solref, solimp, mu, latch, notes + terrain_notes, actuation,
                      dt, ahead,  # the push-off over one timestep: the rigid model's impulse
-                     feet, lane_heights, treads)
+                     feet, lane_heights, treads, profile)
 
 
 def _ground_pieces(terrain: TerrainSettings, walker, x_ideal) -> tuple:
