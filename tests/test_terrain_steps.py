@@ -234,3 +234,40 @@ def test_a_profile_of_constant_slope_walks_the_slope_gait(paper_scene, paper_fix
         xw, yw = a.stance_foot_world
         assert abs(yw - np.interp(xw, P[:, 0], P[:, 1])) < 1e-9
     assert tr.segments[-1].x_next[3] < ref.segments[-1].x_next[3] - 0.01  # faster stance
+
+
+def test_a_profile_from_a_csv_is_its_points(tmp_path):
+    """``terrain.profile_csv`` (issue 49: "inline or from a CSV"; before: refused at the walk):
+    read relative to the scene's folder (a header row and ``#`` lines skipped) into
+    ``profile_m``, so the scene equals the inline one (its content hash follows the numbers)
+    and walks; a missing file or a row that is not two numbers gets one line naming the
+    field and the line."""
+    import yaml
+
+    from walkerlab.analysis.gait.rigid_run import profile_walk
+    from walkerlab.config import SceneError, load_scene
+
+    base = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    pts = [[-1.0, 0.0174], [0.9, -0.0157], [40.0, -0.70]]
+    inline = dict(base, name="p", terrain={"kind": "profile", "profile_m": pts})
+    (tmp_path / "inline.yaml").write_text(yaml.safe_dump(inline))
+    (tmp_path / "ground").mkdir()
+    (tmp_path / "ground" / "p.csv").write_text(
+        "x_m, y_m\n# from a survey\n" + "".join(f"{x}, {y}\n" for x, y in pts))
+    csv = dict(base, name="p", terrain={"kind": "profile", "profile_csv": "ground/p.csv"})
+    (tmp_path / "csv.yaml").write_text(yaml.safe_dump(csv))
+    a, b = load_scene(tmp_path / "inline.yaml"), load_scene(tmp_path / "csv.yaml")
+    assert b.terrain.profile_m == tuple(tuple(p) for p in pts)
+    assert b.model_dump(mode="json") == a.model_dump(mode="json")
+    g = base["fixedpoint"]["initial_guess"]  # paper Eq. (11), near the gait
+    x0 = np.array([g["swing_angle_rad"], g["stance_angle_rad"], g["swing_rate_rad_per_s"],
+                   g["stance_rate_rad_per_s"]])
+    assert len(profile_walk(b, x0, 2).segments) == 2
+    (tmp_path / "ground" / "p.csv").write_text("0, 0\n1, x\n")
+    with pytest.raises(SceneError, match=r"terrain\.profile_csv: ground/p\.csv: line 2: give "
+                       r"two numbers x, y \[m\] \(got '1,x'\)$"):
+        load_scene(tmp_path / "csv.yaml")
+    (tmp_path / "ground" / "p.csv").unlink()
+    with pytest.raises(SceneError, match=r"terrain\.profile_csv: ground/p\.csv: file not "
+                       r"found \(relative to the scene's folder\)$"):
+        load_scene(tmp_path / "csv.yaml")

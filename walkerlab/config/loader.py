@@ -170,6 +170,10 @@ def load_scene(path: str | Path) -> Scene:
             raise SceneError(f"{path}: the file name gives the run-folder name {path.stem!r}, "
                              "which is not allowed (letters, digits and . _ + - only, not "
                              "starting with a dot); rename the file or set 'name:' in it")
+    terrain = data.get("terrain")
+    if isinstance(terrain, dict) and isinstance(terrain.get("profile_csv"), str) \
+            and terrain.get("profile_m") is None:
+        data = {**data, "terrain": _profile_from_csv(terrain, path)}
     scene = scene_from_dict(data, path)
     scene._origin = path.resolve()
     if unit_warnings(scene):
@@ -178,6 +182,51 @@ def load_scene(path: str | Path) -> Scene:
         for line in unit_warnings(scene):
             progress.note(f"warning: {path}: {line}")
     return scene
+
+
+def _profile_from_csv(terrain: dict, scene_path: Path) -> dict:
+    """``terrain`` with ``profile_csv`` read into ``profile_m``: a CSV of ``x, y`` rows [m]
+    (a first row that is not two numbers is a header; blank lines and ``#`` comments are
+    skipped), relative to the scene's folder.  The points then stand in the scene (its
+    content hash follows the profile's numbers, not the file's name).
+
+    Raises
+    ------
+    SceneError
+        The file is missing or unreadable, or a row is not two numbers (one line naming
+        the scene, the field and the file's line).
+    """
+    import csv
+    import io
+
+    from walkerlab.safefs import NotARegularFile, read_regular
+
+    name = terrain["profile_csv"]
+    where = f"{scene_path}: terrain.profile_csv: {name}"
+    f = scene_path.parent / name
+    if not f.is_file():
+        raise SceneError(f"{where}: file not found (relative to the scene's folder)")
+    try:
+        text = read_regular(f, MAX_SCENE_BYTES, "profile file").decode("utf-8")
+    except (NotARegularFile, OSError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{where}: unreadable ({_first_line(exc)})") from None
+    rows = []
+    for line_no, row in enumerate(csv.reader(io.StringIO(text)), start=1):
+        cells = [c.strip() for c in row]
+        if not any(cells) or cells[0].startswith("#"):
+            continue
+        try:
+            if len(cells) != 2:
+                raise ValueError
+            rows.append([float(cells[0]), float(cells[1])])
+        except ValueError:
+            if not rows and line_no == 1:  # a header row
+                continue
+            raise SceneError(f"{where}: line {line_no}: give two numbers x, y [m] "
+                             f"(got {','.join(cells)[:60]!r})") from None
+    out = {k: v for k, v in terrain.items() if k != "profile_csv"}
+    out["profile_m"] = rows
+    return out
 
 
 def scene_from_dict(data: dict[str, Any], origin: str | Path = "<scene>") -> Scene:
