@@ -151,3 +151,43 @@ def test_reset_from_a_given_state_and_bad_inputs_say_one_line():
         WalkerEnv(str(ROOT / "configs" / "flat_feet.yaml"))
     with pytest.raises(ValueError, match="rimless wheel"):
         WalkerEnv(str(ROOT / "configs" / "rimless_wheel.yaml"))
+
+
+def _zero_walk(env, seed=0):
+    env.reset(seed=seed)
+    strikes, info = [], {}
+    for _ in range(env.max_episode_steps):
+        _, _, term, trunc, info = env.step(np.zeros(env.action_space.shape, np.float32))
+        strikes += info["heel_strike_times_s"]
+        if term or trunc:
+            break
+    return np.asarray(strikes), info
+
+
+def test_the_contact_view_keeps_the_scenes_stairs():
+    """configs/stairs.yaml in the contact view (patches a riser lower each step): a zero
+    action walks down them at the rigid stair gait's step period (0.70998 s) within 3 %, as
+    `contact-sim` does (before: the episode's reset laid every patch flat, and the walker
+    fell at 2.07 s after one heel strike); a roughness adds to the stairs' heights."""
+    env = _env("stairs", view="contact", max_episode_steps=600)
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "" and len(strikes) >= 8
+    assert np.mean(np.diff(strikes)[2:]) == pytest.approx(0.70998, rel=0.03)
+    base = env.sim._heights
+    rough = _env("stairs", view="contact", max_episode_steps=5, terrain_roughness_m=0.002)
+    rough.reset(seed=3)
+    for got, b in zip((rough.sim.walker.heights1, rough.sim.walker.heights2), base):
+        d = np.asarray(got) - np.asarray(b)
+        assert np.all(np.abs(d) <= 0.002) and np.any(d != 0)
+
+
+def test_the_rigid_view_refuses_a_ground_whose_steps_differ():
+    """A profile (or per-step ground): the rigid view steps one walker, so it says so in one
+    line (before: it walked the scene's slope under a profile); the contact view, which has
+    the profile as geometry, takes it."""
+    with pytest.raises(ValueError, match=r"^walkerlab\.gym: terrain\.kind: profile: .*"
+                       r"use view='contact'$"):
+        _env("profile")
+    env = _env("profile", view="contact", max_episode_steps=70)
+    strikes, info = _zero_walk(env)
+    assert info["termination"] == "" and len(strikes) >= 1

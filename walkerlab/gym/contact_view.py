@@ -103,17 +103,22 @@ class ContactView:
         self.acts = acts
         self.state_names = list(self.walker.state_names())
         self._lanes = (self.walker.lane1.copy(), self.walker.lane2.copy())
+        # the scene's own patch heights (stairs, footholds; None on the slope): roughness adds
+        self._heights = (self.walker.heights1, self.walker.heights2)
 
     def set_terrain(self, roughness_m: float, seed: int) -> None:
-        """Patch heights drawn from ``[-roughness_m, roughness_m]`` [m] by ``seed`` (0: flat)."""
+        """The scene's patch heights (its stairs' or footholds'; none on the slope) plus
+        heights drawn from ``[-roughness_m, roughness_m]`` [m] by ``seed`` (0: the scene's
+        ground as it is)."""
         w = self.walker
+        base = self._heights
         if roughness_m > 0.0:
             rng = np.random.default_rng(seed)
-            h1 = rng.uniform(-roughness_m, roughness_m, self._lanes[0].size)
-            h2 = rng.uniform(-roughness_m, roughness_m, self._lanes[1].size)
-            self.walker = dataclasses.replace(w, heights1=h1, heights2=h2)
-        elif w.heights1 is not None or w.heights2 is not None:
-            self.walker = dataclasses.replace(w, heights1=None, heights2=None)
+            h = [rng.uniform(-roughness_m, roughness_m, lane.size) for lane in self._lanes]
+            h = [d if b is None else np.asarray(b, float) + d for b, d in zip(base, h)]
+            self.walker = dataclasses.replace(w, heights1=h[0], heights2=h[1])
+        elif w.heights1 is not base[0] or w.heights2 is not base[1]:
+            self.walker = dataclasses.replace(w, heights1=base[0], heights2=base[1])
 
     def reset(self, x0: np.ndarray | None = None) -> None:
         """Start at the contact state ``x0`` (N,) (default: the scene's start), leg2 in

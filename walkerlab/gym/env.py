@@ -75,6 +75,29 @@ def _gait(walker):
     return _GAITS[key]
 
 
+
+def _check_rigid_ground(scene) -> None:
+    """The rigid view steps one hybrid walker: a ground whose steps differ (a profile,
+    footholds of several heights or slopes, per-step random ground) is refused in one line
+    (``walkerlab simulate`` walks them step by step; the contact view has the ground as
+    geometry)."""
+    from walkerlab.models.hybrid.ground import foothold_steps
+
+    t = scene.terrain
+    if t is None:
+        return
+    if t.kind == "profile":
+        what = "terrain.kind: profile"
+    elif getattr(t, "per_step", None) is not None:
+        what = "terrain.per_step"
+    elif t.kind == "footholds" and foothold_steps(t, scene.slope.phi_rad) is not None:
+        what = "terrain.foothold_heights_m"
+    else:
+        return
+    raise ValueError(f"walkerlab.gym: {what}: the rigid view steps one walker on a ground "
+                     "whose every step is alike (slope, stairs, footholds of one height); "
+                     "use view='contact'")
+
 class WalkerEnv(gym.Env):
     """A walkerlab scene's walker as a Gymnasium environment (module docstring: spaces,
     reward, episode, info).
@@ -162,6 +185,8 @@ class WalkerEnv(gym.Env):
         sc = self.rigid.scene
         if sc.walker.model == "rimless_wheel":
             raise ValueError("walkerlab.gym: the rimless wheel has no joint to drive")
+        if view == "rigid":
+            _check_rigid_ground(sc)
         self.scene, self.view = sc, view
         self.dt = float(control_period_s)
         self.max_episode_steps = max_episode_steps
