@@ -321,3 +321,39 @@ def test_ankle_and_hip_torques_on_flat_feet_equal_walkerlab_laws(flat, tmp_path_
         assert math.isclose(hip, each[0] * (1.0 if swing == "leg1" else -1.0), rel_tol=1e-12,
                             abs_tol=1e-9)
     assert 0 < saturated < 24
+
+
+@pytest.mark.parametrize("name", ["stairs", "footholds"])
+def test_the_adams_patches_stand_at_the_footholds_heights(name, tmp_path):
+    """Issue 49's "the ADAMS dataset's patches at the footholds" (before: refused): the
+    checkerboard's boxes of configs/stairs.yaml (1 cm risers) and configs/footholds.yaml
+    (each footfall 5 mm lower) read back with their top faces at the footholds' heights,
+    footfall k at -k drop cos(phi) along the slope normal (leg2's lane: k = 0, 2, ...;
+    leg1's: -1, 1, 3, ...), the point foot's sphere radius below; continuous stairs are
+    refused in one line."""
+    from walkerlab.api.scenes import with_changes
+    from walkerlab.export.mjcf_scene import point_foot_radius
+
+    sc = load_scene(ROOT / "configs" / f"{name}.yaml")
+    path = export_stage.run(sc, tmp_path, "adm")
+    model = read_adm(path.read_text())
+    mb = multibody(walker_data(sc.walker, sc.slope.phi_rad))
+    phi = sc.slope.phi_rad
+    n_hat = np.array([math.sin(phi), math.cos(phi)])
+    drop = (sc.terrain.riser_m if name == "stairs" else -sc.terrain.foothold_heights_m[0]) \
+        * math.cos(phi)
+    boxes = {g.integer("CORNER"): g for g in model.by_kind["GRAPHICS"].values()
+             if "BOX" in g.flags}
+    tops = []
+    for mid, g in sorted(boxes.items()):
+        corner, _ = model.marker_pose(mid)  # [m]
+        tops.append(float(corner[:2] @ n_hat) + g.number("Y") / 1000.0)
+    half = len(tops) // 2  # leg1's lane, then leg2's
+    k1 = np.arange(half) * 2 - 1
+    k2 = np.arange(len(tops) - half) * 2
+    want = np.concatenate([-k1 * drop, -k2 * drop]) - point_foot_radius(mb)
+    assert np.allclose(tops, want, atol=1e-9)
+    flat = with_changes(sc, {"terrain.lanes": "continuous"}) if name == "stairs" else None
+    if flat is not None:
+        with pytest.raises(ValueError, match=r"^terrain\.lanes: continuous: the Adams"):
+            export_stage.run(flat, tmp_path / "c", "adm")

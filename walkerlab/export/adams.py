@@ -42,6 +42,8 @@ hip / knee joints                      JOINT/REVOLUTE I (child), J (parent)   -
                                        ground; gravity along -y)
 ``terrain`` (checkerboard)             GRAPHICS/BOX patches at the rigid      mm
                                        gait's footfalls, one lane per leg
+                                       (stairs, footholds: each at its
+                                       tread's height)
 ``contact.stiffness_*``                CONTACT STIFFNESS                      N/mm^e
 ``contact.exponent``                   CONTACT EXPONENT                       -
 ``contact.max_damping_*``              CONTACT DAMPING                        N s/mm
@@ -262,6 +264,9 @@ class AdamsStart:
     ankles : dict or None
         Flat feet: each leg's ankle angle [rad] (the sole from the leg's perpendicular,
         positive toe up) and its rate [rad/s], ``{leg: (a, da)}``; None otherwise.
+    lane_heights : (tuple, tuple) or None
+        Stairs and footholds: each patch's height along the slope normal [m] (its tread's,
+        one per centre of ``lanes``); None: every patch on the slope line.
     """
 
     hip: tuple[float, float]
@@ -273,6 +278,7 @@ class AdamsStart:
     period_s: float
     rate_scale: tuple[float, float]
     ankles: dict | None = None
+    lane_heights: tuple | None = None
 
 
 def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
@@ -309,13 +315,19 @@ def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
     scale = tuple(scene.contact_sim.initial_rate_scale) if scene.contact_sim else (1.0, 1.0)
     extra = mjcf_scene(scene, mb, data, ideal)  # the same gait: one search, not two
     n = _strides(scene) + 2
+    if extra.lanes is None and (extra.treads is not None or extra.profile is not None):
+        raise ValueError(f"terrain.lanes: continuous: the Adams dataset carries the ground as "
+                         f"patches (lanes: checkerboard, at the footholds' heights), not "
+                         f"continuous {scene.terrain.kind}")
     lanes = None if extra.lanes is None else tuple(tuple(lane[:n]) for lane in extra.lanes)
+    heights = (None if extra.lane_heights is None or lanes is None else
+               tuple(tuple(float(h) for h in hs[:n]) for hs in extra.lane_heights))
     if mb.foot == "flat":  # the MJCF keyframe: the rigid heel strike's double support
         qp, qv = [float(x) for x in extra.qpos], [float(x) for x in extra.qvel]
         return AdamsStart((qp[0], qp[1]), (qv[0], qv[1]), {"leg1": qp[2], "leg2": qp[4]},
                           {"leg1": qv[2], "leg2": qv[4]}, lanes, float(extra.patch_width_m),
                           float(ideal.period_s), (1.0, 1.0),
-                          {"leg1": (qp[3], qv[3]), "leg2": (qp[5], qv[5])})
+                          {"leg1": (qp[3], qv[3]), "leg2": (qp[5], qv[5])}, heights)
     walker = ContactWalker(contact=c, data=data, knee_stop=knee)
     z = walker.link_state_from_ideal(ideal.x, scale)
     q, v = walker.layout().coordinate_values(walker.pinned_to_full(z, np.zeros(2)))
@@ -329,7 +341,7 @@ def adams_start(scene: Scene, mb, data, ideal=None) -> AdamsStart:
                       {ln.name: float(q[f"{ln.name}_angle"]) for ln in mb.links},
                       {ln.name: float(v[f"{ln.name}_angle"]) for ln in mb.links},
                       lanes, float(extra.patch_width_m), float(ideal.period_s),
-                      (float(scale[0]), float(scale[1])))
+                      (float(scale[0]), float(scale[1])), None, heights)
 
 
 def _strides(scene: Scene) -> int:
@@ -553,15 +565,18 @@ def _ground(mb, start: AdamsStart, lanes: bool) -> list[str]:
     centres = start.lanes if start.lanes is not None else ((0.0,),)
     length = w if start.lanes is not None else 40 * L
     legs = ("leg1", "leg2") if start.lanes is not None else ("both",)
+    heights = start.lane_heights or ((), ())
     gid = 1001
-    for leg, lane in zip(legs, centres):
+    for i, (leg, lane) in enumerate(zip(legs, centres)):
         zw = 0.04 * L if lanes else L / 5
         zc = LANE_Z.get(leg, 0.0) * L if lanes else 0.0
-        for s in lane:
+        for j, s in enumerate(lane):
             s0 = s - length / 2 if lanes else -length / 4
-            d = r + depth  # the box's bottom below the ground line
+            h = heights[i][j] if i < len(heights) and j < len(heights[i]) else 0.0
+            d = r + depth - h  # the box's bottom below the ground line (a tread: h lower)
             corner = (s0 * t[0] - d * n[0], s0 * t[1] - d * n[1], zc - zw / 2)
-            out.append(f"! patch of {leg} at s = {s:.6g} m")
+            out.append(f"! patch of {leg} at s = {s:.6g} m"
+                       + (f", {h:.6g} m along the normal" if h else ""))
             out += _stmt(f"MARKER/{gid}, PART=1", f"QP={_fs(*(x * MM for x in corner))}",
                          f"REULER={_deg(-phi)}, 0.0D, 0.0D")
             out += _stmt(f"GRAPHICS/{gid}, BOX, CORNER={gid}",

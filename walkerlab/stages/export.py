@@ -191,10 +191,11 @@ def run(scene: Scene, runs_root: Path | str = "runs", fmt: str = "urdf",
     """
     path = export_path(scene, runs_root, fmt)  # check the format before building anything
     if not walker_only and scene.terrain is not None and not scene.terrain.is_slope:
-        if fmt not in ("mjcf", "osim"):
+        if fmt not in ("mjcf", "osim", "adm"):
             raise ValueError(f"terrain.kind: {scene.terrain.kind}: the {fmt} export carries a "
-                             "slope's ground only (stairs and footholds are in the MJCF and "
-                             "the OpenSim model); --walker-only writes the walker alone")
+                             "slope's ground only (stairs, footholds and profiles are in the "
+                             "MJCF, the OpenSim model and the Adams dataset); --walker-only "
+                             "writes the walker alone")
         from walkerlab.models.contact.terrain import check_ground
 
         check_ground(scene.terrain)  # a profile: one line
