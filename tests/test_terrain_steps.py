@@ -271,3 +271,35 @@ def test_a_profile_from_a_csv_is_its_points(tmp_path):
     with pytest.raises(SceneError, match=r"terrain\.profile_csv: ground/p\.csv: file not "
                        r"found \(relative to the scene's folder\)$"):
         load_scene(tmp_path / "csv.yaml")
+
+
+@pytest.mark.parametrize("command", [["basin"], ["robustness"], ["bifurcation"],
+                                     ["continuation", "--param",
+                                      "slope.angle_rad=0.04:0.06"]])
+def test_studies_of_the_periodic_gait_refuse_a_profile(command, tmp_path):
+    """configs/profile.yaml: a profile has no periodic gait (its steps all differ), so the
+    studies of one refuse it in one line naming the field (before: basin, robustness and
+    continuation ran on the scene's slope as if it were the profile's gait); fixedpoint
+    says whose gait it reports."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, [*command[:1], str(ROOT / "configs" / "profile.yaml"),
+                                 *command[1:], "--runs-dir", str(tmp_path)])
+    assert r.exit_code != 0
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: terrain.kind: profile: ")
+    assert "is a study of a periodic gait" in lines[0]
+    assert {p.name for p in tmp_path.rglob("*.h5")} <= {"fixedpoint.h5"}  # its upstream
+
+
+def test_fixedpoint_on_a_profile_names_the_slopes_gait(tmp_path):
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, ["fixedpoint", str(ROOT / "configs" / "profile.yaml"),
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert "ground: terrain.kind: profile: this is the gait of the scene's slope" in r.output

@@ -115,6 +115,16 @@ def footholds_text(fh: dict) -> str:
         f"foot-through as on a slope), tread behind {1e3 * fh['back_clearance_m']:.4g} mm"])
 
 
+def _terrain_kind(scene_json) -> str | None:
+    """``terrain.kind`` of a stored scene (None: no terrain section, or unreadable)."""
+    import json
+
+    try:
+        return (json.loads(scene_json or "{}").get("terrain") or {}).get("kind")
+    except (TypeError, ValueError, AttributeError):
+        return None
+
+
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     u, legs = fp.units, fp.legs_by_role
@@ -145,6 +155,10 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
                  f"{zero_multipliers_text(re, im, fp.state_names, fp.scene_json)})")
     if fp.ground_contact is not None:
         lines.append(ground_contact_text(fp.ground_contact, u))
+    if _terrain_kind(fp.scene_json) == "profile":
+        lines.append("ground: terrain.kind: profile: this is the gait of the scene's slope, "
+                     "where the walk on the profile starts (walkerlab simulate walks the "
+                     "profile; its steps all differ, so it has no fixed point of its own)")
     if fp.footholds is not None:
         lines.append(footholds_text(fp.footholds))
     lines += gaits_text(fp)

@@ -14,6 +14,7 @@ from walkerlab.io.freshness import input_hash
 from walkerlab.io.runpaths import figures_dir, stage_artifact
 from walkerlab.io.schemas.basin import load_basin, write_basin
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.plotting.artifact_figures import save_basin_figure
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
@@ -54,6 +55,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     """Compute (or reuse) the basin map on ``grid`` (nx, ny) cells (default ``basin.grid``)
     with ``workers`` local processes or a Dask ``scheduler``; ``resume`` continues an
     interrupted run.  Raises StageError: no ``fixedpoint`` section, bad basin settings."""
+    check_periodic_ground(scene.terrain, "the basin of attraction")
+
     from walkerlab.studies.basin import BasinError, basin_run
 
     grid, workers = check(scene, grid, workers)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 from walkerlab.config import Scene
 from walkerlab.io.runpaths import figures_dir
+from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "solver", "fixedpoint")
@@ -33,6 +34,8 @@ def run(scene: Scene, path: str, start: float, stop: float, switch: int = 0,
     walkerlab.studies.params.SweepError
         A field that does not exist (one line).
     """
+    check_periodic_ground(scene.terrain, "continuation")
+
     from walkerlab.analysis.continuation.gait_map import MapFailed
     from walkerlab.io.runpaths import bifurcation_artifacts, continuation_stem
     from walkerlab.io.schemas.bifurcation import load_bifurcation

@@ -15,6 +15,7 @@ from walkerlab.config import CommandOptions, Scene, validate_option
 from walkerlab.io.runpaths import stage_artifact
 from walkerlab.io.schemas import robustness as schema
 from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+from walkerlab.models.hybrid.ground import check_periodic_ground
 from walkerlab.stages.common import StageError, StageOutcome, require, run_cached
 
 SECTIONS = ("walker", "slope", "ideal", "terrain", "mfpt", "robustness")
@@ -43,6 +44,8 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False, worke
     StageError
         Missing sections, or a walker the batched step map cannot carry (one line).
     """
+    check_periodic_ground(scene.terrain, "the robustness study")
+
     from walkerlab.studies.robustness_study import scene_robustness
 
     workers = check(scene, workers)

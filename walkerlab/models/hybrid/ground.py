@@ -71,6 +71,27 @@ def landing_drop(terrain) -> float:
     return 0.0
 
 
+def check_periodic_ground(terrain, study: str) -> None:
+    """Refuse a study of the periodic gait on a ground without one: a height profile, whose
+    steps all differ (the scene's slope gait is only where its walk starts).
+
+    Parameters
+    ----------
+    terrain : walkerlab.config.TerrainSettings or None
+    study : str
+        What is refused, for the message (``"the basin of attraction"``).
+
+    Raises
+    ------
+    ValueError
+        ``terrain.kind: profile`` (one line naming the field).
+    """
+    if terrain is not None and terrain.kind == "profile":
+        raise ValueError(f"terrain.kind: profile: {study} is a study of a periodic gait, and a "
+                         "profile's steps all differ (walkerlab simulate walks it; the scene "
+                         "with terrain.kind: slope has the ramp's periodic gait)")
+
+
 def foothold_steps(terrain, slope_rad: float) -> tuple[tuple[float, float], ...] | None:
     """``((drop_m, slope_rad), ...)``: each step's landing depth [m] below the stance foot's
     level and ground slope [rad] on footholds that differ from step to step (``terrain.kind:
