@@ -126,15 +126,16 @@ class _Drive:
         du, dw = vfoot[0] - vhip[0], vhip[1] - vfoot[1]
         return math.atan2(u, w), (du * w - u * dw) / (u * u + w * w)
 
-    def control(self, state, stance: int, t_step: float) -> None:
-        """Set every motor's override actuation for the coming window [N m]."""
+    def control(self, state, stance: int, since_s: float) -> None:
+        """Set every motor's override actuation for the coming window [N m] (``since_s``:
+        the time since the last heel strike [s], for time-referenced laws)."""
         gf = self.gf[stance]
         q = {c: k.getValue(state) for c, k in self.coord.items()}
         v = {c: k.getSpeedValue(state) for c, k in self.coord.items()}
         deltas = [sum(k * q[c] for c, k in g.items()) for g in gf]
         rates = [sum(k * v[c] for c, k in g.items()) for g in gf]
         s, ds = self.phase(state, stance)
-        tau = self.laws.each(np.array(deltas), np.array(rates), s, ds, t_step)
+        tau = self.laws.each(np.array(deltas), np.array(rates), s, ds, since_s)
         out = dict.fromkeys(self.motor, 0.0)
         for g, tq in zip(gf, tau):
             for c, k in g.items():
