@@ -208,7 +208,7 @@ def test_rabbit_walks_in_mujoco_with_its_controller(tmp_path, monkeypatch):
     """configs/rabbit.yaml exported to MJCF (its keyframe the rigid fixed point: the scene's
     initial guess, the fixed point to 1e-8, tests/test_rabbit.py; the gait search itself is
     the export's, left out here for time) walks in MuJoCo from the ``gait`` keyframe under
-    JointTorqueLoop: 11 alternating heel strikes in 4.3 s, mean step period within 1 % of
+    PoweredLoop: 11 alternating heel strikes in 4.3 s, mean step period within 1 % of
     the rigid 0.37093 s (measured 0.3716 s, +0.2 %), steps 0.3385-0.3388 m against the rigid
     0.33847 m."""
     from walkerlab.export.mujoco_walk import walk

@@ -94,7 +94,7 @@ RABBIT = ["leg1_hip", "leg1_knee", "leg2_hip", "leg2_knee", "torso_hip"]
     ("swing_knee", 0, {"leg2_knee": 1.0}),
 ])
 def test_a_joint_torque_is_its_generalised_forces_by_virtual_work(joint, stance, expected):
-    from walkerlab.export.opensim import torque_generalized_forces
+    from walkerlab.export.joint_torques import torque_generalized_forces
 
     assert torque_generalized_forces(joint, stance, RABBIT) == expected
 

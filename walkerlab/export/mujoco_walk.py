@@ -9,10 +9,15 @@ where no stepping rule acts.  The knee latch of a kneed export (equality
 constraints ``leg<i>_latch``) is switched before every step by :func:`latch_rule`.
 
 A powered export (custom text ``walkerlab_actuation``: the scene's ``walker.actuation``) is
-driven by :class:`PoweredLoop`: before every MuJoCo step the hip motor's control is the swing
-leg's hip torque of the laws (:class:`walkerlab.models.actuation.TorqueLaws`, the rigid and
-contact views' own), its sign flipped while leg2 swings (the motor drives ``leg1_hip -
-leg2_hip``); at each heel strike the roles swap and the push-off
+driven by :class:`PoweredLoop`, one loop for every walker: before every MuJoCo step each law
+of ``walker.actuation.torques`` (:class:`walkerlab.models.actuation.TorqueLaws`, the rigid and
+contact views' own) is evaluated at its joint's angle and rate in the present roles (leg2
+stands at the keyframe; the roles swap at each heel strike), the phase variable of the rigid
+view (the angle of the line from the hip to the stance foot's site from the downward
+vertical) and the time since the heel strike, and its generalised forces
+(:func:`walkerlab.export.joint_torques.torque_generalized_forces`: a hip, torso-leg, knee or
+ankle torque on the joints' coordinates) are applied as ``data.qfrc_applied`` (the file's
+motors, for a user's own controller, are left at 0).  At each heel strike the push-off
 (:func:`walkerlab.models.actuation.push_off_impulse` at the hip's speed) acts as a force
 ``P / T`` along the trailing leg at its foot for ``T = push_off_duration_s`` (the pulse's
 last MuJoCo step carries only its share of the force, so the impulse is ``P`` exactly)
@@ -24,8 +29,6 @@ geom ``leg<i>_toe`` in contact) and off at the next heel strike; meanwhile the s
 ankle's motor gives ``-stiffness (a - rest_angle_rad) - constant_n_m`` on its angle ``a``
 (positive toe up), the swing ankle's 0; heel off is taken once the heel has been out
 of contact :data:`HEEL_OFF_STEPS` MuJoCo steps running (the soft contact flickers).
-A five-link biped's joint torques are driven by :class:`JointTorqueLoop` (one motor
-per physical joint, the torque of its present role).
 """
 
 from __future__ import annotations
@@ -35,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["JointTorqueLoop", "MujocoWalk", "PoweredLoop", "latch_rule", "powered_loop", "walk"]
+__all__ = ["MujocoWalk", "PoweredLoop", "latch_rule", "powered_loop", "walk"]
 
 LEGS = ("leg1", "leg2")
 
@@ -120,6 +123,7 @@ class PoweredLoop:
         import mujoco
 
         from walkerlab.config.actuation import Actuation
+        from walkerlab.export.joint_torques import torque_generalized_forces
         from walkerlab.models.actuation import TorqueLaws
 
         i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation")
@@ -128,12 +132,17 @@ class PoweredLoop:
             bytes(model.text_data[adr:adr + size - 1]).decode()))
         self.laws = TorqueLaws(self.spec.torques)
         self.pulse_s = _numeric(model, "push_off_duration_s", 0.005)
-        self.motor = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, "hip")
-        joints = [model.joint(f"{g}_hip") for g in LEGS]
-        self.qadr = [int(j.qposadr[0]) for j in joints]
-        self.vadr = [int(j.dofadr[0]) for j in joints]
-        self.body = [int(model.body(g).id) for g in LEGS]
+        hinges = [model.joint(i) for i in range(model.njnt)
+                  if model.jnt_type[i] == mujoco.mjtJoint.mjJNT_HINGE]
+        coords = [j.name for j in hinges]
+        self.gf = [[torque_generalized_forces(t.joint, st, coords) for t in self.spec.torques]
+                   for st in (0, 1)]  # per stance leg (0: leg1), per law
+        self.q_of = {j.name: int(j.qposadr[0]) for j in hinges}
+        self.v_of = {j.name: int(j.dofadr[0]) for j in hinges}
+        self.body = [int(model.body(g if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, g)
+                                    >= 0 else f"{g}_shank").id) for g in LEGS]
         self.hip = int(model.joint("hip_x").dofadr[0])
+        self.hip_q = int(model.joint("hip_x").qposadr[0])
         self.dt = float(model.opt.timestep)
         self.stance, self.t_step, self.push = 1, 0.0, None  # leg2 stands at the keyframe
         self.ankle = self.spec.ankle_push_off
@@ -162,18 +171,36 @@ class PoweredLoop:
         return -self.ankle.stiffness_n_m_per_rad * (a - self.ankle.rest_angle_rad) \
             - self.ankle.constant_n_m
 
+    def phase(self, data) -> tuple[float, float]:
+        """The phase variable [rad] and its rate [rad/s]: the angle from the downward
+        vertical of the line from the hip to the stance foot's site (the rigid view's)."""
+        import mujoco
+
+        foot = data.site_xpos[self._site[self.stance]]
+        vel = np.zeros(6)
+        mujoco.mj_objectVelocity(self._model, data, mujoco.mjtObj.mjOBJ_SITE,
+                                 self._site[self.stance], vel, 0)
+        u, w = foot[0] - data.qpos[self.hip_q], data.qpos[self.hip_q + 1] - foot[2]
+        du, dw = vel[3] - data.qvel[self.hip], data.qvel[self.hip + 1] - vel[5]
+        return math.atan2(u, w), (du * w - u * dw) / (u * u + w * w)
+
     def control(self, data) -> None:
-        """Set the hip motor and the push-off force for the coming step."""
+        """Set the joint torques, the ankle motors and the push-off force for the coming
+        step."""
         st, sw = self.stance, 1 - self.stance
-        q, v = data.qpos, data.qvel
-        tau = 0.0
         if self.laws:
-            tau = float(np.sum(self.laws(q[self.qadr[sw]] - q[self.qadr[st]],
-                                         v[self.vadr[sw]] - v[self.vadr[st]],
-                                         q[self.qadr[st]], v[self.vadr[st]],
-                                         data.time - self.t_step)))
-        if self.motor >= 0:
-            data.ctrl[self.motor] = tau if sw == 0 else -tau
+            gf = self.gf[st]
+            q, v = data.qpos, data.qvel
+            deltas = [sum(k * q[self.q_of[c]] for c, k in g.items()) for g in gf]
+            rates = [sum(k * v[self.v_of[c]] for c, k in g.items()) for g in gf]
+            s, ds = self.phase(data)
+            taus = self.laws.each(np.array(deltas), np.array(rates), s, ds,
+                                  data.time - self.t_step)
+            for c in self.v_of.values():
+                data.qfrc_applied[c] = 0.0
+            for g, tau in zip(gf, taus):
+                for c, k in g.items():
+                    data.qfrc_applied[self.v_of[c]] += k * float(tau)
         if self.ankle is not None:
             data.ctrl[self.ankle_motor[sw]] = 0.0
             data.ctrl[self.ankle_motor[st]] = self.ankle_torque(data)
@@ -205,6 +232,7 @@ class PoweredLoop:
     def bind(self, model, site: list) -> None:
         """The foot sites and the hip body (ids)."""
         self._site = site
+        self._model = model
         self._hip_body = int(model.body("hip").id)
 
 
@@ -216,97 +244,8 @@ class PoweredLoop:
 LOOK_EVERY = 5
 
 
-class JointTorqueLoop:
-    """The controller of a powered five-link export (motors ``leg<i>_hip_motor`` on the
-    tendons ``leg<i>_hip - torso_hip``, ``leg<i>_knee_motor`` on the knees): before every
-    MuJoCo step each motor's control is the torque of its joint's present role (leg2 stands
-    at the keyframe; the roles swap at each heel strike), from the laws of the custom text
-    ``walkerlab_actuation`` (:class:`walkerlab.models.actuation.TorqueLaws`, the rigid and
-    contact views' own) at the joints' angles (``stance_hip`` = stance thigh - torso,
-    ``swing_knee`` = the swing knee's angle, ...) and the phase variable of the rigid view:
-    the angle of the line from the hip to the stance foot from the downward vertical,
-    ``atan(u / w)`` with ``(u, w) = l_t (sin, cos)(thigh) + l_s (sin, cos)(shank)`` (absolute
-    angles; ``l_t``, ``l_s`` read from the model: the knee's and the foot site's offsets).
-
-    Parameters
-    ----------
-    model : mujoco.MjModel
-        With the custom text ``walkerlab_actuation`` and the five-link motors.
-    spec : walkerlab.config.actuation.Actuation
-        The laws (read from that text).
-    """
-
-    def __init__(self, model, spec):
-        from walkerlab.models.actuation import TorqueLaws
-
-        self.spec, self.laws = spec, TorqueLaws(spec.torques)
-        self.joints = [t.joint for t in spec.torques]
-        self.hip = [(int(model.joint(f"{g}_hip").qposadr[0]),
-                     int(model.joint(f"{g}_hip").dofadr[0])) for g in LEGS]
-        self.knee = [(int(model.joint(f"{g}_knee").qposadr[0]),
-                      int(model.joint(f"{g}_knee").dofadr[0])) for g in LEGS]
-        self.torso = (int(model.joint("torso_hip").qposadr[0]),
-                      int(model.joint("torso_hip").dofadr[0]))
-        self.motor = {(kind, i): int(model.actuator(f"{g}_{kind}_motor").id)
-                      for kind in ("hip", "knee") for i, g in enumerate(LEGS)}
-        self.lt = -float(model.body("leg1_shank").pos[2])
-        self.ls = -float(model.site("leg1_foot").pos[2])
-        self.stance, self.t_step = 1, 0.0
-
-    def phase(self, q, v) -> tuple[float, float]:
-        """The phase variable [rad] and its rate [rad/s] (class docstring)."""
-        (qh, vh), (qk, vk) = self.hip[self.stance], self.knee[self.stance]
-        t, dt = q[qh], v[vh]
-        sh, dsh = t + q[qk], dt + v[vk]
-        u = self.lt * math.sin(t) + self.ls * math.sin(sh)
-        w = self.lt * math.cos(t) + self.ls * math.cos(sh)
-        du = self.lt * math.cos(t) * dt + self.ls * math.cos(sh) * dsh
-        dw = -self.lt * math.sin(t) * dt - self.ls * math.sin(sh) * dsh
-        return math.atan(u / w), (du * w - u * dw) / (u * u + w * w)
-
-    def control(self, data) -> None:
-        """Set every motor for the coming step."""
-        q, v = data.qpos, data.qvel
-        role = {"stance": self.stance, "swing": 1 - self.stance}
-        deltas, rates, targets = [], [], []
-        for j in self.joints:
-            r, kind = j.split("_")
-            i = role[r]
-            if kind == "hip":
-                deltas.append(q[self.hip[i][0]] - q[self.torso[0]])
-                rates.append(v[self.hip[i][1]] - v[self.torso[1]])
-            else:
-                deltas.append(q[self.knee[i][0]])
-                rates.append(v[self.knee[i][1]])
-            targets.append(self.motor[(kind, i)])
-        s, ds = self.phase(q, v)
-        data.ctrl[:] = 0.0
-        for m, tau in zip(targets, self.laws.each(deltas, rates, s, ds, data.time - self.t_step)):
-            data.ctrl[m] += float(tau)
-
-    def heel_strike(self, data, leg: int) -> None:
-        """Leg ``leg`` (0, 1) struck: it is the stance leg now."""
-        self.stance, self.t_step = leg, float(data.time)
-
-    def bind(self, model, site: list) -> None:
-        """Nothing to bind (the interface of :class:`PoweredLoop`)."""
-
-
-def powered_loop(model):
-    """The controller of a powered export: :class:`JointTorqueLoop` for a five-link biped's
-    joint torques, else :class:`PoweredLoop`."""
-    import json
-
-    import mujoco
-
-    from walkerlab.config.actuation import Actuation
-
-    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, "walkerlab_actuation")
-    adr, size = int(model.text_adr[i]), int(model.text_size[i])
-    spec = Actuation.model_validate(json.loads(
-        bytes(model.text_data[adr:adr + size - 1]).decode()))
-    if any(t.joint != "hip" for t in spec.torques):
-        return JointTorqueLoop(model, spec)
+def powered_loop(model) -> PoweredLoop:
+    """The controller of a powered export (module docstring): :class:`PoweredLoop`."""
     return PoweredLoop(model)
 
 

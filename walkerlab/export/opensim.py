@@ -50,8 +50,9 @@ Forces:
   switches it (``Force.setAppliesForce``, :mod:`walkerlab.export.opensim_walk`).
 - **actuators**: the joint torque laws of ``walker.actuation.torques`` are exported as a
   ``CoordinateActuator`` ``<coordinate>_motor`` on every coordinate a law's joint moves
-  (:func:`torque_generalized_forces`: a torque between the torso and a thigh is ``+tau`` on
-  ``leg<i>_hip`` and ``-tau`` on ``torso_hip``; a knee torque ``tau`` on ``leg<i>_knee``;
+  (:func:`walkerlab.export.joint_torques.torque_generalized_forces`: a torque between the
+  torso and a thigh is ``+tau`` on ``leg<i>_hip`` and ``-tau`` on ``torso_hip``; a knee
+  torque ``tau`` on ``leg<i>_knee``;
   ``optimal_force`` 1 N m, so the control is the generalised force), the laws in a comment
   (``walkerlab_actuation``): a stepping loop sets the controls from the laws between windows
   (:mod:`walkerlab.export.opensim_walk`); the
@@ -72,13 +73,14 @@ import numpy as np
 
 from walkerlab.config import Scene
 from walkerlab.config.contact import ContactSettings, TerrainSettings
+from walkerlab.export.joint_torques import torque_generalized_forces
 from walkerlab.export.mjcf_scene import point_foot_radius
 from walkerlab.export.text import comment, num, nums
 from walkerlab.models.contact.laws import ContactParamsSI, KneeStopSI
 
 __all__ = ["OSIM_FILE", "OsimGait", "check_osim_exportable", "hunt_crossley",
            "knee_stop_expression", "osim_gait", "osim_text", "patch_radius",
-           "link_angle", "terrain_patch_radius", "torque_generalized_forces"]
+           "terrain_patch_radius"]
 
 #: The export's file name in ``runs/<scene>/``.
 OSIM_FILE = "walker.osim"
@@ -373,74 +375,6 @@ def _expression_force(name: str, coord: str, expression: str, applies: bool = Tr
             f"{i}</ExpressionBasedCoordinateForce>"]
 
 
-def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
-    """A role's link's absolute angle as a combination of the export's coordinates.
-
-    ``leg<i>_hip`` is a link's absolute angle (the base never rotates), ``leg<i>_knee`` the
-    shank's angle minus the thigh's and ``torso_hip`` the torso's, so the thigh (or a straight
-    leg) is ``leg<i>_hip``, the shank ``leg<i>_hip + leg<i>_knee``, the torso ``torso_hip``.
-
-    Parameters
-    ----------
-    link : str
-        A link by role, as :data:`walkerlab.config.actuation.JOINTS` names them
-        (``stance_leg``, ``swing_thigh``, ``stance_shank``, ``torso``, ...).
-    stance : {0, 1}
-        The stance leg (0: ``leg1``).
-    coordinates : collection of str
-        The model's coordinate names.
-
-    Returns
-    -------
-    dict
-        Coordinate name -> coefficient (the angle is the sum of coefficient x coordinate).
-
-    Raises
-    ------
-    ValueError
-        The link is not in this model (a foot: flat feet are not exported).
-    """
-    if link == "torso" and "torso_hip" in coordinates:
-        return {"torso_hip": 1.0}
-    role, _, part = link.partition("_")
-    leg = f"leg{(stance if role == 'stance' else 1 - stance) + 1}"
-    if role in ("stance", "swing") and part in ("leg", "thigh", "shank") \
-            and f"{leg}_hip" in coordinates:
-        out = {f"{leg}_hip": 1.0}
-        if part == "shank" and f"{leg}_knee" in coordinates:
-            out[f"{leg}_knee"] = 1.0
-        return out
-    raise ValueError(f"{link}: not a link of this OpenSim model")
-
-
-def torque_generalized_forces(joint: str, stance: int, coordinates) -> dict[str, float]:
-    """The generalised force on each coordinate of a unit torque at a joint by role: the
-    joint's angle is ``angle(second) - angle(first)`` (:data:`walkerlab.config.actuation.JOINTS`)
-    and by virtual work a torque ``tau`` on it is ``tau`` times that combination's coefficients.
-
-    Parameters
-    ----------
-    joint : str
-        ``hip``, ``stance_hip``, ``swing_knee``, ...
-    stance : {0, 1}
-        The stance leg.
-    coordinates : collection of str
-        The model's coordinate names.
-
-    Returns
-    -------
-    dict
-        Coordinate name -> coefficient (zeros dropped).
-    """
-    from walkerlab.config.actuation import JOINTS
-
-    first, second = JOINTS[joint]
-    out = dict(link_angle(second, stance, coordinates))
-    for c, k in link_angle(first, stance, coordinates).items():
-        out[c] = out.get(c, 0.0) - k
-    return {c: k for c, k in out.items() if k != 0.0}
-
-
 def _couplers(mb) -> list[str]:
     """A ``ConstraintSet`` of one ``CoordinateCouplerConstraint`` per coupling of ``mb`` (the
     bisecting hip: ``torso_hip = 0.5 leg1_hip + 0.5 leg2_hip``, the links' absolute angles):
@@ -471,7 +405,7 @@ def _couplers(mb) -> list[str]:
 
 def _torque_joints(actuation_json: str | None, mb) -> list[str]:
     """Coordinates that get a ``CoordinateActuator``: every coordinate a torque law's joint
-    moves in either stance (:func:`torque_generalized_forces`)."""
+    moves in either stance (:func:`walkerlab.export.joint_torques.torque_generalized_forces`)."""
     import json
 
     if actuation_json is None:

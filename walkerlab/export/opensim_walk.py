@@ -94,13 +94,13 @@ class _Drive:
     actuators (module docstring): each law's joint angle and rate, the phase variable (the
     angle of the line from the hip to the stance foot from the downward vertical, the rigid
     view's), the laws (:class:`walkerlab.models.actuation.TorqueLaws`), and the generalised
-    forces they make (:func:`walkerlab.export.opensim.torque_generalized_forces`) as the
+    forces they make (:func:`walkerlab.export.joint_torques.torque_generalized_forces`) as the
     actuators' override actuation."""
 
     def __init__(self, model, spec, coords, bodies, foot_loc):
         import opensim as osim
 
-        from walkerlab.export.opensim import torque_generalized_forces
+        from walkerlab.export.joint_torques import torque_generalized_forces
         from walkerlab.models.actuation import TorqueLaws
 
         self.laws = TorqueLaws(spec.torques)

@@ -1,0 +1,88 @@
+"""The joint torques of an exported walker on its coordinates (the MJCF's and the OpenSim
+model's, which name and define them alike: ``hip_x``, ``hip_y``/``hip_z`` the hip's position,
+``leg<i>_hip`` and ``torso_hip`` absolute link angles from the vertical (the base never
+rotates), ``leg<i>_knee`` shank minus thigh, ``leg<i>_ankle`` a flat foot's angle from its
+leg's perpendicular; positive moves a foot ahead, a toe up).
+
+A torque ``tau`` at a joint by role (:data:`walkerlab.config.actuation.JOINTS`: angle =
+angle(second link) - angle(first link)) does virtual work ``tau`` times that angle's
+variation, so its generalised forces are ``tau`` times the angle's coefficients on the
+coordinates (:func:`torque_generalized_forces`): the same loop drives a hip, a knee, a
+torso-leg or an ankle torque on any walker the exports write.
+"""
+
+from __future__ import annotations
+
+__all__ = ["link_angle", "torque_generalized_forces"]
+
+
+def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
+    """A role's link's absolute angle as a combination of the export's coordinates.
+
+    ``leg<i>_hip`` is a link's absolute angle (the base never rotates), ``leg<i>_knee`` the
+    shank's angle minus the thigh's, ``leg<i>_ankle`` a flat foot's angle from its leg's
+    perpendicular and ``torso_hip`` the torso's, so the thigh (or a straight leg) is
+    ``leg<i>_hip``, the shank ``leg<i>_hip + leg<i>_knee``, the foot that plus
+    ``leg<i>_ankle`` (up to a constant), the torso ``torso_hip``.
+
+    Parameters
+    ----------
+    link : str
+        A link by role, as :data:`walkerlab.config.actuation.JOINTS` names them
+        (``stance_leg``, ``swing_thigh``, ``stance_shank``, ``torso``, ...).
+    stance : {0, 1}
+        The stance leg (0: ``leg1``).
+    coordinates : collection of str
+        The model's coordinate names.
+
+    Returns
+    -------
+    dict
+        Coordinate name -> coefficient (the angle is the sum of coefficient x coordinate).
+
+    Raises
+    ------
+    ValueError
+        The link is not in this model.
+    """
+    if link == "torso" and "torso_hip" in coordinates:
+        return {"torso_hip": 1.0}
+    role, _, part = link.partition("_")
+    leg = f"leg{(stance if role == 'stance' else 1 - stance) + 1}"
+    if role in ("stance", "swing") and part in ("leg", "thigh", "shank", "foot") \
+            and f"{leg}_hip" in coordinates and (part != "foot" or f"{leg}_ankle" in coordinates):
+        out = {f"{leg}_hip": 1.0}
+        if part in ("shank", "foot") and f"{leg}_knee" in coordinates:
+            out[f"{leg}_knee"] = 1.0
+        if part == "foot":
+            out[f"{leg}_ankle"] = 1.0
+        return out
+    raise ValueError(f"{link}: not a link of this OpenSim model")
+
+
+def torque_generalized_forces(joint: str, stance: int, coordinates) -> dict[str, float]:
+    """The generalised force on each coordinate of a unit torque at a joint by role: the
+    joint's angle is ``angle(second) - angle(first)`` (:data:`walkerlab.config.actuation.JOINTS`)
+    and by virtual work a torque ``tau`` on it is ``tau`` times that combination's coefficients.
+
+    Parameters
+    ----------
+    joint : str
+        ``hip``, ``stance_hip``, ``swing_knee``, ...
+    stance : {0, 1}
+        The stance leg.
+    coordinates : collection of str
+        The model's coordinate names.
+
+    Returns
+    -------
+    dict
+        Coordinate name -> coefficient (zeros dropped).
+    """
+    from walkerlab.config.actuation import JOINTS
+
+    first, second = JOINTS[joint]
+    out = dict(link_angle(second, stance, coordinates))
+    for c, k in link_angle(first, stance, coordinates).items():
+        out[c] = out.get(c, 0.0) - k
+    return {c: k for c, k in out.items() if k != 0.0}
