@@ -13,7 +13,12 @@ torso-leg or an ankle torque on any walker the exports write.
 
 from __future__ import annotations
 
-__all__ = ["link_angle", "torque_generalized_forces"]
+import math
+
+import numpy as np
+
+__all__ = ["law_generalized_forces", "link_angle", "stance_phase",
+           "torque_generalized_forces"]
 
 
 def link_angle(link: str, stance: int, coordinates) -> dict[str, float]:
@@ -86,3 +91,49 @@ def torque_generalized_forces(joint: str, stance: int, coordinates) -> dict[str,
     for c, k in link_angle(first, stance, coordinates).items():
         out[c] = out.get(c, 0.0) - k
     return {c: k for c, k in out.items() if k != 0.0}
+
+
+def stance_phase(hip, hip_velocity, foot, foot_velocity) -> tuple[float, float]:
+    """The rigid view's phase variable: the angle [rad] from the downward vertical of the
+    line from the hip to the stance foot (positive with the foot ahead), and its rate
+    [rad/s].
+
+    Parameters
+    ----------
+    hip, hip_velocity, foot, foot_velocity : sequence of 2 floats
+        Horizontal and vertical position [m] and velocity [m/s] of the hip and of the stance
+        foot's contact point (any frame with x forward and the second axis up).
+    """
+    u, w = foot[0] - hip[0], hip[1] - foot[1]
+    du, dw = foot_velocity[0] - hip_velocity[0], hip_velocity[1] - foot_velocity[1]
+    return math.atan2(u, w), (du * w - u * dw) / (u * u + w * w)
+
+
+def law_generalized_forces(laws, gf, q, v, phase, since_s: float) -> dict[str, float]:
+    """The generalised forces [N m] of the torque laws in the present roles.
+
+    Parameters
+    ----------
+    laws : walkerlab.models.actuation.TorqueLaws
+    gf : list of dict
+        Per law, :func:`torque_generalized_forces` of its joint in the present stance (also
+        its joint angle's coefficients on the coordinates).
+    q, v : mapping
+        Coordinate name -> value [rad] and rate [rad/s].
+    phase : (float, float)
+        :func:`stance_phase`.
+    since_s : float
+        Time since the last heel strike [s] (time-referenced laws).
+
+    Returns
+    -------
+    dict
+        Coordinate name -> generalised force, every coordinate a law moves.
+    """
+    deltas = np.array([sum(k * q[c] for c, k in g.items()) for g in gf])
+    rates = np.array([sum(k * v[c] for c, k in g.items()) for g in gf])
+    out: dict[str, float] = {}
+    for g, tau in zip(gf, laws.each(deltas, rates, phase[0], phase[1], since_s)):
+        for c, k in g.items():
+            out[c] = out.get(c, 0.0) + k * float(tau)
+    return out

@@ -38,6 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
+
 __all__ = ["MujocoWalk", "PoweredLoop", "latch_rule", "powered_loop", "walk"]
 
 LEGS = ("leg1", "leg2")
@@ -173,34 +175,29 @@ class PoweredLoop:
 
     def phase(self, data) -> tuple[float, float]:
         """The phase variable [rad] and its rate [rad/s]: the angle from the downward
-        vertical of the line from the hip to the stance foot's site (the rigid view's)."""
+        vertical of the line from the hip to the stance foot's site (the rigid view's,
+        :func:`walkerlab.export.joint_torques.stance_phase`; MuJoCo's x-z plane)."""
         import mujoco
 
-        foot = data.site_xpos[self._site[self.stance]]
         vel = np.zeros(6)
         mujoco.mj_objectVelocity(self._model, data, mujoco.mjtObj.mjOBJ_SITE,
                                  self._site[self.stance], vel, 0)
-        u, w = foot[0] - data.qpos[self.hip_q], data.qpos[self.hip_q + 1] - foot[2]
-        du, dw = vel[3] - data.qvel[self.hip], data.qvel[self.hip + 1] - vel[5]
-        return math.atan2(u, w), (du * w - u * dw) / (u * u + w * w)
+        foot = data.site_xpos[self._site[self.stance]]
+        h, dh = self.hip_q, self.hip
+        return stance_phase(data.qpos[h:h + 2], data.qvel[dh:dh + 2], foot[[0, 2]],
+                            vel[[3, 5]])
 
     def control(self, data) -> None:
         """Set the joint torques, the ankle motors and the push-off force for the coming
         step."""
         st, sw = self.stance, 1 - self.stance
         if self.laws:
-            gf = self.gf[st]
-            q, v = data.qpos, data.qvel
-            deltas = [sum(k * q[self.q_of[c]] for c, k in g.items()) for g in gf]
-            rates = [sum(k * v[self.v_of[c]] for c, k in g.items()) for g in gf]
-            s, ds = self.phase(data)
-            taus = self.laws.each(np.array(deltas), np.array(rates), s, ds,
-                                  data.time - self.t_step)
-            for c in self.v_of.values():
-                data.qfrc_applied[c] = 0.0
-            for g, tau in zip(gf, taus):
-                for c, k in g.items():
-                    data.qfrc_applied[self.v_of[c]] += k * float(tau)
+            q = {c: data.qpos[a] for c, a in self.q_of.items()}
+            v = {c: data.qvel[a] for c, a in self.v_of.items()}
+            out = law_generalized_forces(self.laws, self.gf[st], q, v, self.phase(data),
+                                         data.time - self.t_step)
+            for c, a in self.v_of.items():
+                data.qfrc_applied[a] = out.get(c, 0.0)
         if self.ankle is not None:
             data.ctrl[self.ankle_motor[sw]] = 0.0
             data.ctrl[self.ankle_motor[st]] = self.ankle_torque(data)

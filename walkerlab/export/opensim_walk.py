@@ -42,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
 from walkerlab.export.mujoco_walk import MujocoWalk
 
 __all__ = ["OpensimWalk", "walk"]
@@ -118,32 +119,21 @@ class _Drive:
         """The phase variable [rad] and its rate [rad/s] (class docstring)."""
         g = LEGS[stance]
         b, loc = self.bodies[g], self.foot_loc[g]
-        foot = b.findStationLocationInGround(state, loc).to_numpy()[:2]
-        vfoot = b.findStationVelocityInGround(state, loc).to_numpy()[:2]
-        hip = np.array([c.getValue(state) for c in self.hip])
-        vhip = np.array([c.getSpeedValue(state) for c in self.hip])
-        u, w = foot[0] - hip[0], hip[1] - foot[1]
-        du, dw = vfoot[0] - vhip[0], vhip[1] - vfoot[1]
-        return math.atan2(u, w), (du * w - u * dw) / (u * u + w * w)
+        return stance_phase([c.getValue(state) for c in self.hip],
+                            [c.getSpeedValue(state) for c in self.hip],
+                            b.findStationLocationInGround(state, loc).to_numpy()[:2],
+                            b.findStationVelocityInGround(state, loc).to_numpy()[:2])
 
     def control(self, state, stance: int, since_s: float) -> None:
         """Set every motor's override actuation for the coming window [N m] (``since_s``:
         the time since the last heel strike [s], for time-referenced laws)."""
-        gf = self.gf[stance]
         q = {c: k.getValue(state) for c, k in self.coord.items()}
         v = {c: k.getSpeedValue(state) for c, k in self.coord.items()}
-        deltas = [sum(k * q[c] for c, k in g.items()) for g in gf]
-        rates = [sum(k * v[c] for c, k in g.items()) for g in gf]
-        s, ds = self.phase(state, stance)
-        tau = self.laws.each(np.array(deltas), np.array(rates), s, ds, since_s)
-        out = dict.fromkeys(self.motor, 0.0)
-        for g, tq in zip(gf, tau):
-            for c, k in g.items():
-                out[c] += k * float(tq)
+        out = law_generalized_forces(self.laws, self.gf[stance], q, v,
+                                     self.phase(state, stance), since_s)
         for c, m in self.motor.items():
-            m.setOverrideActuation(state, out[c])
+            m.setOverrideActuation(state, out.get(c, 0.0))
             m.overrideActuation(state, True)
-
 
 def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
          min_air_s: float = 0.05, accuracy: float = 1e-7) -> OpensimWalk:

@@ -356,13 +356,7 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
             mc = monte_carlo(scene, x_star, sd, st.walks, st.max_steps, seed, dist, workers,
                              scheduler, partial)
         if contact or st.method in ("montecarlo", "both"):
-            m, se = mc.mfpt
-            vals["mfpt_steps_montecarlo"][i] = m
-            vals["mfpt_steps_montecarlo_stderr"][i] = se
-            vals["montecarlo_walks"][i] = mc.steps.size
-            vals["montecarlo_falls"][i] = int(mc.fell.sum())
-            vals["montecarlo_heel_strikes"][i] = int(mc.steps.sum())
-            vals["montecarlo_wall_time_s"][i] = time.perf_counter() - t
+            _record_monte_carlo(vals, i, mc, time.perf_counter() - t)
         if st.method in ("mesh", "both"):
             t = time.perf_counter()
             last, all_meshes = mesh(scene, x_star, sd, st, workers, scheduler, dist, partial)
@@ -378,6 +372,15 @@ def mfpt_study(scene, x_star: np.ndarray, st, workers: int = 1, scheduler=None,
                       "change": r.change if math.isfinite(r.change) else math.nan}
                      for r in all_meshes]
     return MfptData(sig, vals, st.method, walker.state_names(), hist)
+
+
+def _record_monte_carlo(vals: dict, i: int, mc, wall_s: float) -> None:
+    """Row ``i`` of the study's Monte Carlo columns from the walks ``mc``."""
+    vals["mfpt_steps_montecarlo"][i], vals["mfpt_steps_montecarlo_stderr"][i] = mc.mfpt
+    vals["montecarlo_walks"][i] = mc.steps.size
+    vals["montecarlo_falls"][i] = int(mc.fell.sum())
+    vals["montecarlo_heel_strikes"][i] = int(mc.steps.sum())
+    vals["montecarlo_wall_time_s"][i] = wall_s
 
 
 def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partial):
@@ -398,13 +401,7 @@ def _height_study(scene, x_star, st, per, dist, seed, workers, scheduler, partia
         t = time.perf_counter()
         mc = monte_carlo(scene, x_star, slope_sd, st.walks, st.max_steps, seed, dist,
                          workers, scheduler, partial, heights=(hdist, float(sd_m)))
-        m, se = mc.mfpt
-        vals["mfpt_steps_montecarlo"][i] = m
-        vals["mfpt_steps_montecarlo_stderr"][i] = se
-        vals["montecarlo_walks"][i] = mc.steps.size
-        vals["montecarlo_falls"][i] = int(mc.fell.sum())
-        vals["montecarlo_heel_strikes"][i] = int(mc.steps.sum())
-        vals["montecarlo_wall_time_s"][i] = time.perf_counter() - t
+        _record_monte_carlo(vals, i, mc, time.perf_counter() - t)
     return MfptData(np.full(sig_m.size, slope_sd), vals, st.method, walker.state_names(), [],
                     sigma_m=sig_m)
 
