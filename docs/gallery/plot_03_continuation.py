@@ -6,7 +6,8 @@ Continuation: the gait over the slope, to the first period doubling
 walker's gait over the slope by pseudo-arclength continuation, with exact Jacobians of the
 Poincaré map, and locates the special points on the way: the first period doubling, where a
 Floquet multiplier crosses -1, lies near 4.39°; with ``switch=True`` the period-2 branch
-born there is followed too, to its own period doubling near 4.91°. The artifact goes to a temporary runs folder.
+born there is followed too, to its own period doubling near 4.91°. The artifact goes to a
+temporary runs folder.
 """
 
 import tempfile
