@@ -148,6 +148,50 @@ def test_fixedpoint_artifact_records_every_gait(tmp_path):
     assert fp.gaits["long_period"].step_period_s == fp.step_period_s
 
 
+def _fake_gait(period, x, mult, stable, ground_ok):
+    """A found gait with just what the ordering and the choice read (no root finding)."""
+    from types import SimpleNamespace
+
+    from walkerlab.analysis.gait.search import Gait
+
+    res = SimpleNamespace(period_s=period, x=np.array(x, float), stable=stable,
+                          multipliers_variational=np.array([mult, 0.1]))
+    return Gait("period_1", res, "seed", np.array(x, float),
+                SimpleNamespace(ok=ground_ok))
+
+
+@pytest.mark.parametrize("order", [(0, 1), (1, 0)])
+def test_the_chosen_gait_does_not_depend_on_the_order_the_gaits_were_found_in(order):
+    """The 50 N s powered compass: an unstable short-period gait that needs the ground to
+    pull (|lambda| 89.3) and an unstable long-period one on real ground (|lambda| 17.8);
+    either found first, the long one is listed first and chosen, the short one is listed
+    with its verdict and left out with a note."""
+    from walkerlab.analysis.gait.search import GaitSearch, order_gaits, select_gait
+
+    gaits = [_fake_gait(0.926018, [-0.78, 0.78, 2.87, -2.92], 17.8, False, True),
+             _fake_gait(0.524552, [-0.74, 0.74, 2.88, -3.55], 89.3, False, False)]
+    found = order_gaits([gaits[k] for k in order])
+    assert [g.label for g in found] == ["long_period", "short_period"]
+    search = GaitSearch(found, 0, "stable")
+    assert select_gait(search) == 0
+    assert any("short-period gait (needs the ground to pull" in n for n in search.notes)
+
+
+def test_a_stable_gait_that_needs_the_ground_to_pull_is_not_chosen_over_one_on_real_ground():
+    from walkerlab.analysis.gait.search import GaitSearch, order_gaits, select_gait
+
+    found = order_gaits([_fake_gait(0.9, [0.1, 0.2], 0.5, True, False),
+                         _fake_gait(0.5, [0.3, 0.4], 3.0, False, True)])
+    search = GaitSearch(found, 0, "stable")
+    assert found[select_gait(search)].result.period_s == 0.5
+    # ... but asked for by label or by the guess it is chosen all the same
+    assert select_gait(GaitSearch(found, 0, "long_period")) == 0
+    # equal periods: ordered by the state, whichever came first
+    a, b = _fake_gait(0.7, [0.2, 0.0], 2.0, False, True), _fake_gait(0.7, [0.1, 0.0], 2.0,
+                                                                         False, True)
+    assert order_gaits([a, b])[0] is b and order_gaits([b, a])[0] is b
+
+
 def test_failed_search_says_what_was_tried_in_one_line():
     """Level ground has no passive gait: the message names the attempts and the next step."""
     d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())

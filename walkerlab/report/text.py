@@ -185,6 +185,19 @@ _GAIT_SOURCES = {"initial_guess": "root finder from the initial guess",
                  "deflation": "deflated root finder near the other gait"}
 
 
+def _ground_word(g, u) -> str:
+    """``, on real ground`` / ``, NEEDS THE GROUND TO PULL (min normal force -31.4 N)`` for
+    a gait that carries its ground check, else ``""``."""
+    gc = g.ground_contact
+    if gc is None or gc.ok is None:
+        return ""
+    if gc.ok:
+        return ", on real ground"
+    n = gc.values.get("min_normal_force_n", 0.0)
+    return (", NEEDS THE GROUND TO PULL" + (f" (stance normal force down to {n:.4g} {u('N')})"
+                                              if n < 0 else " (a pulling impulse)"))
+
+
 def gaits_text(fp: FixedPointArtifact) -> list[str]:
     """Lines on the period-1 gaits recorded in ``fixedpoint.h5`` (every gait found, the one
     selected by ``fixedpoint.gait`` marked ``*``, and why)."""
@@ -198,7 +211,7 @@ def gaits_text(fp: FixedPointArtifact) -> list[str]:
         mod = float(np.max(np.hypot(g.multipliers.real, g.multipliers.imag)))
         lines.append(f"  {'*' if lab == sel else ' '} {lab.replace('_', '-'):<12s} step period "
                      f"{g.step_period_s:.6f} {fp.units.time}, max |multiplier| {mod:.4g}, "
-                     f"{'stable' if g.stable else 'UNSTABLE'} "
+                     f"{'stable' if g.stable else 'UNSTABLE'}{_ground_word(g, fp.units)} "
                      f"({_GAIT_SOURCES.get(g.source, g.source)})")
     notes = fp.gait_notes
     lines.append(f"selected (fixedpoint.gait: {fp.gait_policy}): "

@@ -99,7 +99,8 @@ def with_variant(scene: Scene, variant: str) -> Scene:
     return scene.model_copy(update={"ideal": scene.ideal.model_copy(update={"variant": variant})})
 
 
-def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, solver=None):
+def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, solver=None,
+                ground: bool = False):
     """The period-1 gait(s) of the scene's walker, chosen by ``fixedpoint.gait``, from
     ``guess`` (a state (2n,), e.g. a known gait carried here by homotopy) or else the
     scene's initial guess; ``walker`` (default: the scene's, ``build_walker``) another
@@ -109,6 +110,9 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     :class:`~walkerlab.integrate.solver.Solver`) are the scene's model and integrator when
     the caller holds them already (the in-memory :class:`walkerlab.api.walker.Walker`);
     default: built here from the scene (:func:`build_walker`, ``Solver.from_settings``).
+    ``ground``: check every gait found for a ground that only pushes
+    (:func:`gait_ground_contact`; each :class:`~walkerlab.analysis.gait.search.Gait` carries
+    its verdict and the selection prefers the gaits that need no pull).
 
     Returns
     -------
@@ -129,7 +133,9 @@ def solve_scene(scene: Scene, fd_check: bool = True, guess=None, walker=None, so
     search = find_gaits(walker, solver, start,
                         policy=fp.gait, other_gait=fp.other_gait, xtol=fp.tolerance,
                         fd_step=fp.fd_step, max_step_time=fp.max_step_time_s,
-                        fd_check=fd_check)
+                        fd_check=fd_check,
+                        ground_check=(lambda x: gait_ground_contact(scene, walker, x))
+                        if ground else None)
     return walker, search
 
 
@@ -186,7 +192,7 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
     """
     from walkerlab.io.schemas.fixedpoint import FixedPointRun
 
-    walker, search = solve_scene(scene, guess=guess)
+    walker, search = solve_scene(scene, guess=guess, ground=True)
     if note:
         search.notes.append(note)
     main = search.result
@@ -198,7 +204,7 @@ def fixed_point_run(scene: Scene, compare_variants: bool = True, guess=None,
             results[variant] = solve_variant(scene, variant, other_guess)
         except FixedPointNotFound as exc:
             results[variant] = exc
-    ground = gait_ground_contact(scene, walker, main.x)
+    ground = search.gait.ground  # every gait found carries its check (solve_scene)
     treads = None
     if scene.terrain is not None and scene.terrain.kind == "stairs":
         from walkerlab.analysis.gait.treads import tread_landing

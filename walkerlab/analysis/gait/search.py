@@ -57,7 +57,8 @@ from walkerlab.analysis.gait.starts import (
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.hybrid.base import HybridWalker
 
-__all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "find_gaits", "select_gait"]
+__all__ = ["Gait", "GaitSearch", "GaitNotFound", "POLICIES", "find_gaits", "order_gaits",
+           "select_gait"]
 
 #: gait choices of ``fixedpoint.gait``
 POLICIES = ("stable", "long_period", "short_period", "nearest_guess")
@@ -92,12 +93,21 @@ class Gait:
         ``"deflation"`` (near the other gait, deflated).
     start : ndarray (2n,)
         The root finder's starting state.
+    ground : walkerlab.analysis.gait.checks.GroundContact or None
+        Whether the gait needs only a ground that pushes (None: not checked).
     """
 
     label: str
     result: FixedPointResult
     source: str
     start: np.ndarray
+    ground: object | None = None
+
+    @property
+    def on_real_ground(self) -> bool:
+        """False only when the ground check found that the gait needs the ground to pull
+        (a negative normal force or impulse); True when it holds or was not made."""
+        return getattr(self.ground, "ok", None) is not False
 
     @property
     def max_multiplier(self) -> float:
@@ -151,7 +161,8 @@ def _is_new(res: FixedPointResult, found: list[Gait]) -> bool:
 def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = None,
                policy: str = "stable", other_gait: bool = True, xtol: float = 1e-12,
                fd_step: float = 1e-7, max_step_time: float = 5.0, fd_check: bool = True,
-               time_unit: str = "s", seeds: bool = True) -> GaitSearch:
+               time_unit: str = "s", seeds: bool = True,
+               ground_check=None) -> GaitSearch:
     """Find the walker's period-1 gait(s) and choose one.
 
     Parameters
@@ -175,6 +186,10 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
         scene).
     seeds : bool
         Try the scale-free seeds when the guess does not converge (always without a guess).
+    ground_check : callable, optional
+        ``ground_check(x) -> GroundContact`` for a fixed point ``x`` (2n,): every gait found
+        carries its verdict (:attr:`Gait.ground`), and :func:`select_gait` prefers gaits on
+        a ground that only pushes.
 
     Returns
     -------
@@ -197,14 +212,14 @@ def find_gaits(walker: HybridWalker, solver: Solver, guess: np.ndarray | None = 
     try:
         with search_budget():  # every start, seed and root finder: one time budget
             return _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step,
-                               max_step_time, fd_check, time_unit, seeds)
+                               max_step_time, fd_check, time_unit, seeds, ground_check)
     except (SearchGaveUp, FixedPointGaveUp) as exc:
         why = str(exc).removeprefix("no fixed point found: ").removesuffix(" (residual nan)")
         raise GaitNotFound(f"no period-1 gait found: {why}", math.nan) from None
 
 
 def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_step_time,
-                fd_check, time_unit, seeds) -> GaitSearch:
+                fd_check, time_unit, seeds, ground_check=None) -> GaitSearch:
     s = _RootStarts(walker, solver, {"xtol": xtol, "fd_step": fd_step,
                                      "max_step_time": max_step_time, "fd_check": fd_check})
     if guess is not None:
@@ -222,13 +237,25 @@ def _find_gaits(walker, solver, guess, policy, other_gait, xtol, fd_step, max_st
     if other_gait or policy in ("long_period", "short_period") or (
             policy == "stable" and not s.found[0].result.stable):
         s.other_gait()
-    found = s.found
-    found.sort(key=lambda g: -g.result.period_s)
-    if len(found) == 2:
-        found[0].label, found[1].label = "long_period", "short_period"
+    found = order_gaits(s.found)
+    if ground_check is not None:
+        for g in found:
+            g.ground = ground_check(g.result.x)
     search = GaitSearch(found, 0, policy, s.notes, s.tried)
     search.selected = select_gait(search, guess, time_unit)
     return search
+
+
+def order_gaits(found: list[Gait]) -> list[Gait]:
+    """The gaits longest step period first, labelled ``long_period``/``short_period`` when
+    there are two.  Equal periods (to 1e-12 s) are ordered by the state (rounded to 1e-9), so
+    the order, and with it every tie in :func:`select_gait`, depends only on which gaits were
+    found, never on the order the root finder reached them in."""
+    found = sorted(found, key=lambda g: (-round(float(g.result.period_s), 12),
+                                         tuple(np.round(g.result.x, 9))))
+    if len(found) == 2:
+        found[0].label, found[1].label = "long_period", "short_period"
+    return found
 
 
 class _RootStarts:
@@ -339,6 +366,12 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
     - ``nearest_guess``: the gait the root finder reached from the initial guess (else the
       one nearest it, max-norm over the state).
 
+    Under ``stable`` the gaits that need the ground to pull (:attr:`Gait.on_real_ground`
+    False) are chosen only when no other gait was found, with a note.  Ties (equal
+    multipliers or distances) go to the first gait in ``search.gaits`` (longest period
+    first), so the choice depends only on the gaits found, not on the order they were
+    found in.
+
     Raises
     ------
     GaitNotFound
@@ -365,11 +398,22 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
         return k
     if policy == "nearest_guess":
         return nearest(range(len(gaits)))
-    stable = [k for k, g in enumerate(gaits) if g.result.stable]
+    real = [k for k, g in enumerate(gaits) if g.on_real_ground]
+    if real and len(real) < len(gaits):
+        search.notes.append(
+            "left out: the " + ", ".join(gaits[k].label.replace("_", "-") for k in
+                                          range(len(gaits)) if k not in real)
+            + " gait (needs the ground to pull: the stance foot would lift)")
+        pool = real
+    else:
+        pool = list(range(len(gaits)))
+    if not real:
+        search.notes.append("every gait found needs the ground to pull")
+    stable = [k for k in pool if gaits[k].result.stable]
     if stable:
         k = nearest(stable)
         if guess is not None:
-            near = nearest(range(len(gaits)))
+            near = nearest(pool)
             if near != k:
                 other = gaits[near].label.replace("_", "-")
                 search.notes.append(
@@ -380,7 +424,7 @@ def select_gait(search: GaitSearch, guess: np.ndarray | None = None,
     search.notes.append("no stable period-1 gait found: "
                         + ("the one nearest the initial guess" if guess is not None
                            else "the least unstable one"))
-    return nearest(range(len(gaits)))
+    return nearest(pool)
 
 
 def _short(msg: str) -> str:

@@ -125,6 +125,8 @@ def write_fixedpoint(f, run: FixedPointRun) -> None:
         grp = f.create_group(f"gaits/{g.label}")
         _write_result(grp, walker, g.result, g.start)
         grp.attrs["source"] = g.source
+        if getattr(g, "ground", None) is not None:  # every gait found: its ground verdict
+            _write_ground(grp.create_group("ground_contact"), g.ground)
     if run.ground is not None:
         _write_ground(f.create_group("ground_contact"), run.ground)
     if run.footholds is not None:  # stairs only: a slope's artifact is unchanged
@@ -206,6 +208,9 @@ class GaitResult:
         How the gait was found ("initial_guess", "seed", "deflation"; "" at the root).
     error : str
         Why no fixed point was found ("" when found; then the other fields are NaN).
+    ground_contact : GroundContactRecord or None
+        Whether this gait needs only a ground that pushes (``gaits/<label>/ground_contact/``;
+        None where not checked: equation variants, older artifacts).
     """
 
     x: np.ndarray
@@ -221,6 +226,7 @@ class GaitResult:
     step_periods_s: tuple = ()
     step_lengths_m: tuple = ()
     step_swing_legs: tuple = ()
+    ground_contact: GroundContactRecord | None = None
 
     def max_abs_multiplier(self) -> float:
         """Largest |Floquet multiplier| (variational)."""
@@ -245,7 +251,7 @@ def _gait(g, names: list[str]) -> GaitResult:
                         + 1j * g["floquet/finite_difference/imag"][()]),
         max_difference=float(g["floquet/max_difference"][()]),
         stable=bool(g["floquet/stable"][()]), source=str(g.attrs.get("source", "")),
-        **_stride(g))
+        ground_contact=_ground(g), **_stride(g))
 
 
 def _stride(g) -> dict:
@@ -330,6 +336,5 @@ def load_fixedpoint(path: Path) -> FixedPointArtifact:
                    for lab in f.attrs.get("gaits", [])} if "gaits" in f else {},
             variants={v: _gait(f["variants"][v], names) for v in f["variants"]}
             if "variants" in f else {}, scene_json=str(f.attrs.get("scene_json", "{}")),
-            ground_contact=_ground(f),
             footholds={k: (v.item() if hasattr(v, "item") else v)
                        for k, v in f["footholds"].attrs.items()} if "footholds" in f else None)
