@@ -34,6 +34,7 @@ extensions = [
     "myst_parser",
     "sphinx_gallery.gen_gallery",
     "scene_schema",
+    "artifact_reference",
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
