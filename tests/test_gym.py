@@ -191,3 +191,141 @@ def test_the_rigid_view_refuses_a_ground_whose_steps_differ():
     env = _env("profile", view="contact", max_episode_steps=70)
     strikes, info = _zero_walk(env)
     assert info["termination"] == "" and len(strikes) >= 1
+
+
+def _one_line_error(exc_info, *words):
+    text = str(exc_info.value)
+    assert "\n" not in text and all(w in text for w in words), text
+
+
+@pytest.mark.parametrize("view", ["rigid", "contact"])
+def test_a_nan_none_complex_or_ill_shaped_action_is_refused_in_one_line(view):
+    """Before: the rigid view took ``[nan]`` and ``None`` (NaN observation and reward,
+    'solver_failure'); the contact view returned a NaN observation, did not terminate, and
+    its next step raised scipy's "y0 must be finite"; a complex action was cast with a
+    warning and ``[[0.1]]`` reshaped.  Now each is gymnasium's ``InvalidAction`` (a
+    ValueError) naming the action space, and the episode goes on untouched."""
+    from walkerlab.gym.env import InvalidAction
+
+    env = _env("paper", view=view, max_episode_steps=5)
+    env.reset(seed=0)
+    for bad in ([np.nan], None, [np.inf], [1 + 1j], np.array([0.1], complex), [[0.1]],
+                [0.1, 0.2], "x", [[0.1], [0.2, 0.3]]):
+        with pytest.raises(InvalidAction) as exc:
+            env.step(bad)
+        assert isinstance(exc.value, ValueError)
+        assert isinstance(exc.value, gym.error.InvalidAction)
+        _one_line_error(exc, "action", "Box(")
+    obs, r, term, _, info = env.step(np.zeros(1, np.float32))
+    assert np.all(np.isfinite(obs)) and np.isfinite(r) and not term, info
+    assert info["time_s"] == pytest.approx(0.01)  # the refused actions did not advance it
+
+
+def test_step_or_render_before_reset_asks_for_a_reset():
+    """Outside ``gym.make`` (no order-enforcing wrapper) ``step``/``render`` before
+    ``reset`` raised AttributeError; now gymnasium's ResetNeeded."""
+    from walkerlab.gym import WalkerEnv
+
+    env = WalkerEnv(str(ROOT / "configs" / "paper.yaml"), render_mode="rgb_array")
+    with pytest.raises(gym.error.ResetNeeded, match="step"):
+        env.step(np.zeros(1))
+    with pytest.raises(gym.error.ResetNeeded, match="render"):
+        env.render()
+    env.reset(seed=0)
+    env.step(np.zeros(1))
+    assert env.render().ndim == 3
+
+
+def test_start_noise_is_bounded_and_options_must_be_a_dict():
+    """``start_noise=1e300`` was taken and overflowed (OverflowError) after the start's
+    check; ``reset(options=[1, 2])`` raised a bare TypeError.  Now start_noise is refused
+    above 1 (rates times 1 + U(-s, s)) and a noisy given state is checked after the noise."""
+    from walkerlab.config import SceneError
+    from walkerlab.gym import WalkerEnv
+
+    scene = str(ROOT / "configs" / "paper.yaml")
+    for noise in (1e300, 1.5, True, float("nan"), -0.1):
+        with pytest.raises(ValueError, match="^start_noise=") as exc:
+            WalkerEnv(scene, start_noise=noise)
+        _one_line_error(exc)
+    env = WalkerEnv(scene, start_noise=1.0)
+    obs, _ = env.reset(seed=0)
+    assert np.all(np.isfinite(obs)) and not np.array_equal(obs[:4], env.gait.x)
+    with pytest.raises(ValueError, match="options must be a dict") as exc:
+        env.reset(options=[1, 2])
+    _one_line_error(exc, "list")
+    # the bound on rates (20 sqrt(g/l) = 62.6 rad/s) holds 40 rad/s; the noise (up to x2)
+    # may take it past: the check comes after the noise, and names the state
+    x = np.array(env.gait.x, float)
+    x[2:] = 40.0
+    seeds = [s for s in range(20) if _raises(env, x, s)]
+    assert seeds and len(seeds) < 20, seeds
+    with pytest.raises(SceneError, match=r"options\['state'\]"):
+        env.reset(seed=seeds[0], options={"state": x})
+
+
+def _raises(env, x, seed):
+    from walkerlab.config import SceneError
+
+    try:
+        env.reset(seed=seed, options={"state": x})
+    except SceneError:
+        return True
+    return False
+
+
+def test_a_huge_max_episode_steps_lays_out_the_contact_ground_as_the_walk_goes():
+    """``max_episode_steps=10**12`` in the contact view asked for 52.9 GiB of patches
+    (MemoryError); the patches are now laid out for 32 steps at a time and again as the
+    walk nears their end, and a walk whose ground is laid out afresh after its first heel
+    strike is the walk on ground laid out once, bit for bit."""
+    from walkerlab.gym import WalkerEnv
+    from walkerlab.gym.contact_view import LAYOUT_STEPS
+
+    scene = str(ROOT / "configs" / "paper.yaml")
+    huge = WalkerEnv(scene, view="contact", max_episode_steps=10**12)
+    assert huge.sim.walker.lane1.size <= LAYOUT_STEPS
+    short = WalkerEnv(scene, view="contact", max_episode_steps=10)  # 5 steps laid out
+    runs = []
+    for env in (huge, short):
+        env.reset(seed=0)
+        out, laid = [], []
+        for _ in range(80):
+            obs, _, term, _, info = env.step(np.zeros(1))
+            out.append(obs)
+            laid.append(env.sim.walker.lane1.size)
+            assert not term, info
+        assert info["steps"] >= 1
+        runs.append((np.array(out), laid))
+    assert runs[1][1][-1] > runs[1][1][0]  # the short layout grew at the heel strike
+    np.testing.assert_array_equal(runs[0][0], runs[1][0])
+
+
+def test_rough_contact_ground_ends_episodes_cleanly_for_seeds_0_to_5():
+    """``terrain_roughness_m=0.05``: before, seed 0 raised scipy's "f(a) and f(b) must have
+    different signs" at step 51 and seeds 1 and 5 threw the hip to 6.4 and 373 m (the
+    starting stance foot's patch raised under it; a swing foot meeting a raised patch's side
+    is pushed out as from below its top).  Now the starting patch is the scene's, and each
+    episode runs its 60 periods or ends as ``launch`` (hip above 1.5 leg lengths plus the
+    highest patch) or ``solver_failure`` (with the solver's words) - no exception, finite
+    observations."""
+    from walkerlab.gym.contact_view import LAUNCH_HIP_FACTOR
+
+    env = _env("paper", view="contact", terrain_roughness_m=0.05)
+    ends = {}
+    for seed in range(6):
+        env.reset(seed=seed)
+        assert env.sim.walker.heights2[0] == 0.0  # the starting stance foot's patch
+        assert np.ptp(env.sim.walker.heights1) > 0.02  # the rest is rough
+        top = LAUNCH_HIP_FACTOR * 1.0 + 0.05  # leg length 1 m, patches within 5 cm
+        for _ in range(60):
+            obs, r, term, _, info = env.step(np.zeros(1, np.float32))
+            assert np.all(np.isfinite(obs)) and np.isfinite(r)
+            hip = env.sim.walker.hip_height(env.sim.x)[0]
+            assert hip <= top + 0.01, (seed, hip)  # event located to the solver's tolerance
+            if term:
+                break
+        ends[seed] = info["termination"]
+        assert ends[seed] in ("", "launch", "solver_failure"), info
+        assert (ends[seed] == "solver_failure") == bool(info["solver_message"])
+    assert "" in ends.values(), ends

@@ -17,9 +17,9 @@ from walkerlab.extras import require
 
 gymnasium = require("gymnasium", "gym", "walkerlab.gym")
 
-from walkerlab.gym.env import WalkerEnv  # noqa: E402
+from walkerlab.gym.env import InvalidAction, WalkerEnv  # noqa: E402
 
-__all__ = ["ENV_ID", "WalkerEnv"]
+__all__ = ["ENV_ID", "InvalidAction", "WalkerEnv"]
 
 #: the registered id
 ENV_ID = "walkerlab/Walker-v0"

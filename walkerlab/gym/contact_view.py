@@ -22,7 +22,22 @@ on the second link of their joint and ``-tau`` on the first, on the floating coo
 
 Seeded terrain: with ``terrain_roughness_m > 0`` each patch is raised or lowered by a height
 drawn uniformly from ``[-r, r]`` by the episode's terrain seed (rough ground as geometry,
-:attr:`~walkerlab.models.contact.model.ContactWalker.heights1`).
+:attr:`~walkerlab.models.contact.model.ContactWalker.heights1`), all but the starting stance
+foot's patch (the walker starts on the scene's own ground, not inside a raised patch).  The
+patches are laid out for :data:`LAYOUT_STEPS` steps at a time and laid out again for twice
+as many as the walk nears their end (memory and each contact evaluation's patch search stay
+proportional to the walk so far, not to ``max_episode_steps``); a patch's height depends on
+the seed and its place only, so the ground a walker meets does not depend on when it was laid.
+
+A third terminal event ends the episode as ``launch``: the hip more than
+:data:`LAUNCH_HIP_FACTOR` leg lengths above the ground line (plus the highest ground laid out).
+No walker with a foot on the ground gets there; a foot that meets a raised patch's side below
+its top does (the contact law measures the penetration below the patch's top, so the foot is
+pushed out at once as from that depth: the walker is thrown into the air).
+
+A control period whose heel-strike event cannot be located (``solve_ivp``'s root bracketing
+fails: the swing foot's touchdown test jumps where a foot meets a patch's side below its top)
+ends the episode as ``solver_failure``, with the solver's message in :attr:`ContactView.failure`.
 """
 
 from __future__ import annotations
@@ -41,6 +56,11 @@ CONTACT_LEDGER_TERMS = ("action_work_positive", "action_work_negative", "scene_t
 #: a touchdown is a heel strike only this far [m] ahead of the stance foot (as the contact
 #: view's powered run, ``ContactActuators.min_step_m``)
 MIN_STEP_M = 0.05
+#: the hip this many leg lengths above the ground line (plus the highest ground laid out)
+#: ends the episode as ``launch`` (a walking hip is at most one leg length above its foot)
+LAUNCH_HIP_FACTOR = 1.5
+#: steps the patches are laid out for at a time (the layout doubles as the walk nears its end)
+LAYOUT_STEPS = 32
 _IVP_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(4)
 
@@ -71,7 +91,8 @@ class ContactView:
     x_gait : ndarray (2n,)
         The rigid gait's post-impact state (the start).
     n_steps : int
-        Steps the episode may take (the patches laid out).
+        Steps the episode may take (the patches are first laid out for at most
+        :data:`LAYOUT_STEPS` of them, then for more as the walk goes).
 
     Raises
     ------
@@ -81,14 +102,14 @@ class ContactView:
     """
 
     def __init__(self, setup, links, x_gait, n_steps: int):
-        from walkerlab.analysis.contact.sim import scene_start
-
         acts = setup.actuators
         if acts is not None and getattr(acts, "ankle", None) is not None:
             raise ValueError("walkerlab.gym: the contact view does not carry the scene's "
                              "ankle push-off yet; use view='rigid'")
-        self.walker, self.x_start, self.limits, self.step_length = scene_start(
-            setup, np.asarray(x_gait, float), max(1, n_steps // 2 + 1))
+        self._setup, self._x_gait = setup, np.asarray(x_gait, float)
+        self._first_layout = max(1, min(int(n_steps), LAYOUT_STEPS))
+        self._roughness, self._seed = 0.0, 0
+        self.x_start, self.limits, self.step_length = self._lay_out(self._first_layout)
         names = tuple(self.walker.coordinate_names())
         self.nq = len(names)
         self.index = []  # per stance leg (0: leg1, 1: leg2): (first, second) coordinates
@@ -102,23 +123,49 @@ class ContactView:
         self.rows = acts if acts is not None else ContactRows()
         self.acts = acts
         self.state_names = list(self.walker.state_names())
-        self._lanes = (self.walker.lane1.copy(), self.walker.lane2.copy())
+
+    def _lay_out(self, n_steps: int):
+        """Patches for ``n_steps`` steps (:func:`walkerlab.analysis.contact.sim.scene_start`),
+        the episode's roughness on them; returns the scene's start, limits, step length."""
+        from walkerlab.analysis.contact.sim import scene_start
+
+        walker, x0, limits, step_length = scene_start(self._setup, self._x_gait,
+                                                      n_steps // 2 + 1)
+        self._laid = n_steps
+        self._lanes = (walker.lane1.copy(), walker.lane2.copy())
         # the scene's own patch heights (stairs, footholds; None on the slope): roughness adds
-        self._heights = (self.walker.heights1, self.walker.heights2)
+        self._heights = (walker.heights1, walker.heights2)
+        self._scene_walker = walker
+        self._roughen()
+        w = self.walker
+        ground = [0.0] + [float(np.max(h)) for h in (w.heights1, w.heights2)
+                          if h is not None and np.size(h)]
+        if w.ground_line is not None:
+            ground.append(float(np.max(w.ground_line[:, 0] * np.sin(w.phi)
+                                       + w.ground_line[:, 1] * np.cos(w.phi))))
+        self._launch_height = LAUNCH_HIP_FACTOR * float(w.L) + max(ground)
+        return x0, limits, step_length
+
+    def _roughen(self) -> None:
+        w, base, r = self._scene_walker, self._heights, self._roughness
+        if r <= 0.0:
+            self.walker = w
+            return
+        h = []
+        for k, (lane, b) in enumerate(zip(self._lanes, base)):
+            d = np.random.default_rng([self._seed, k]).uniform(-r, r, lane.size)
+            if k == 1:
+                d[0] = 0.0  # leg2's first patch: the starting stance foot's ground
+            h.append(d if b is None else np.asarray(b, float) + d)
+        self.walker = dataclasses.replace(w, heights1=h[0], heights2=h[1])
 
     def set_terrain(self, roughness_m: float, seed: int) -> None:
         """The scene's patch heights (its stairs' or footholds'; none on the slope) plus
         heights drawn from ``[-roughness_m, roughness_m]`` [m] by ``seed`` (0: the scene's
-        ground as it is)."""
-        w = self.walker
-        base = self._heights
-        if roughness_m > 0.0:
-            rng = np.random.default_rng(seed)
-            h = [rng.uniform(-roughness_m, roughness_m, lane.size) for lane in self._lanes]
-            h = [d if b is None else np.asarray(b, float) + d for b, d in zip(base, h)]
-            self.walker = dataclasses.replace(w, heights1=h[0], heights2=h[1])
-        elif w.heights1 is not base[0] or w.heights2 is not base[1]:
-            self.walker = dataclasses.replace(w, heights1=base[0], heights2=base[1])
+        ground as it is), the starting stance foot's patch (leg2's first) left as the scene
+        has it; the patches laid out afresh for :data:`LAYOUT_STEPS` steps."""
+        self._roughness, self._seed = float(roughness_m), int(seed)
+        self._lay_out(self._first_layout)
 
     def reset(self, x0: np.ndarray | None = None) -> None:
         """Start at the contact state ``x0`` (N,) (default: the scene's start), leg2 in
@@ -128,6 +175,7 @@ class ContactView:
         self.stance = 1
         self.x = np.array(self.x_start if x0 is None else x0, dtype=float)
         self.ended = ""
+        self.failure = ""
         self.ledger = dict.fromkeys(CONTACT_LEDGER_TERMS, 0.0)
         self.steps = 0
 
@@ -179,7 +227,11 @@ class ContactView:
         def fall(t, y):
             return w.fall_margin(y[:n], self.limits.fall_hip_height_m)
         fall.terminal, fall.direction = True, -1
-        return [touch, fall]
+
+        def launch(t, y):
+            return self._launch_height - float(w.hip_height(y[:n])[0])
+        launch.terminal, launch.direction = True, -1
+        return [touch, fall, launch]
 
     def _work(self, sol, ta, tb, Q) -> None:
         acts = self.acts
@@ -205,7 +257,7 @@ class ContactView:
         -------
         list of float
             The heel-strike (touchdown) times inside the period [s]; :attr:`ended` is set
-            when the episode ended inside it (``fall``, ``solver_failure``).
+            when the episode ended inside it (``fall``, ``launch``, ``solver_failure``).
         """
         from scipy.integrate import solve_ivp
 
@@ -214,18 +266,23 @@ class ContactView:
             f, Q = self._rhs(u)
             jac = self.walker.jac if self.method in ("Radau", "BDF", "LSODA") else None
             kw = {"jac": jac} if jac is not None else {}
-            sol = solve_ivp(f, (self.t, t_end), self.x, method=self.method, rtol=self.rtol,
-                            atol=self.atol, events=self._events(), dense_output=True, **kw)
-            if sol.status == -1:
-                self.ended = "solver_failure"
+            try:
+                sol = solve_ivp(f, (self.t, t_end), self.x, method=self.method,
+                                rtol=self.rtol, atol=self.atol, events=self._events(),
+                                dense_output=True, **kw)
+            except ValueError as err:  # an event's root not bracketed (module docstring)
+                self.ended, self.failure = "solver_failure", str(err)
+                break
+            if sol.status == -1 or not np.all(np.isfinite(sol.y[:, -1])):
+                self.ended, self.failure = "solver_failure", str(sol.message)
                 break
             fired = [(te[0], i) for i, te in enumerate(sol.t_events) if len(te)]
             if fired:
                 te, i = min(fired)
                 self._work(sol.sol, self.t, te, Q)
                 self.t, self.x = float(te), np.array(sol.y_events[i][0], float)
-                if i == 1:
-                    self.ended = "fall"
+                if i > 0:
+                    self.ended = "fall" if i == 1 else "launch"
                     break
                 self._touchdown()
                 strikes.append(self.t)
@@ -249,3 +306,5 @@ class ContactView:
         self.stance = 1 - trailing
         self.t_step = self.t
         self.steps += 1
+        if self.steps + 4 >= self._laid:  # the walk nears the patches' end: lay out more
+            self._lay_out(2 * self._laid)

@@ -32,17 +32,24 @@ Reward (Walker2d-v5's convention, every weight a keyword)::
 Episode: from the scene's gait (its fixed point, found once per scene and process and
 cached; :meth:`walkerlab.api.walker.Walker.fixed_point`), leg1 swinging, unless
 ``reset(options={"state": x})`` gives the state (the rigid walker's post-impact state (2n,),
-or in the contact view its floating state (N,)); ``start_noise`` adds a uniform relative
-perturbation ``[-s, s]`` of the start's rates drawn by the reset's seed.  Terminated on a
-fall (a fall guard of the rigid model; in the contact view the hip below
+or in the contact view its floating state (N,)); ``start_noise`` (at most 1) multiplies the
+start's rates by ``1 + U(-s, s)`` drawn by the reset's seed, before the start is checked.
+Terminated on a fall (a fall guard of the rigid model; in the contact view the hip below
 ``contact_sim.fall_hip_height_m``), a stall (no heel strike within
-``fixedpoint.max_step_time_s``) or a solver failure; truncated after ``max_episode_steps``
-control periods.
+``fixedpoint.max_step_time_s``), a launch (contact view: the hip thrown above
+:data:`walkerlab.gym.contact_view.LAUNCH_HIP_FACTOR` leg lengths, a foot having met a raised
+patch's side) or a solver failure; truncated after ``max_episode_steps`` control periods.
+``step`` and ``render`` before the first ``reset`` raise gymnasium's ``ResetNeeded`` (as
+``gym.make``'s order enforcing does); an action that is not ``k`` finite real numbers of shape
+``(k,)`` (None, NaN, inf, complex, another shape) raises :class:`InvalidAction` (a
+``ValueError``), one line naming the action space.
 
 ``info``: ``time_s``, ``heel_strike`` (bool), ``heel_strike_time_s`` (the exact event time
 of the last heel strike inside the control period, else None), ``heel_strike_times_s`` (all
 of them), ``steps`` (heel strikes so far), ``stance_leg``, ``hip_x_m``, ``termination``
-(``""``, ``fall``, ``stall``, ``solver_failure``), ``terrain_seed`` and the energy ledger's
+(``""``, ``fall``, ``stall``, ``launch``, ``solver_failure``), ``solver_message`` (the
+solver's words on a ``solver_failure`` in the contact view, else ``""``), ``terrain_seed`` and
+the energy ledger's
 terms so far [J] (``ledger_<term>``: :data:`walkerlab.gym.rigid_view.LEDGER_TERMS`).
 ``reset(seed=...)`` draws the terrain seed and the start's noise from the seed: the same
 seed, the same episode bit for bit.
@@ -51,6 +58,7 @@ seed, the same episode bit for bit.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -58,7 +66,11 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-__all__ = ["WalkerEnv"]
+__all__ = ["InvalidAction", "WalkerEnv"]
+
+#: the largest ``start_noise``: the start's rates times ``1 + U(-1, 1)`` (from rest to twice
+#: the gait's rates; beyond, rates change sign)
+MAX_START_NOISE = 1.0
 
 #: bound of the observation's state entries [m, rad, m/s, rad/s] and time [s]: far beyond a
 #: walking state (an observation past it is clipped to it)
@@ -98,6 +110,11 @@ def _check_rigid_ground(scene) -> None:
                      "whose every step is alike (slope, stairs, footholds of one height); "
                      "use view='contact'")
 
+class InvalidAction(ValueError, gym.error.InvalidAction):
+    """An action that is not the environment's ``k`` finite real torques of shape ``(k,)``
+    (a ``ValueError`` and gymnasium's ``InvalidAction``)."""
+
+
 class WalkerEnv(gym.Env):
     """A walkerlab scene's walker as a Gymnasium environment (module docstring: spaces,
     reward, episode, info).
@@ -121,7 +138,7 @@ class WalkerEnv(gym.Env):
     reward_fn : callable, optional
         ``(env, info) -> float`` in place of the default reward.
     start_noise : float
-        Relative uniform noise on the start's rates [-] (0: the gait itself).
+        Relative uniform noise on the start's rates [-], in ``[0, 1]`` (0: the gait itself).
     terrain_roughness_m : float
         Contact view: patch heights uniform in ``[-r, r]`` [m], drawn by the terrain seed.
     normalize_action : bool
@@ -179,8 +196,12 @@ class WalkerEnv(gym.Env):
             raise ValueError(f"render_mode={render_mode!r}: give None or 'rgb_array'")
         for name, v in (("start_noise", start_noise),
                         ("terrain_roughness_m", terrain_roughness_m)):
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+            if not (isinstance(v, (int, float)) and not isinstance(v, bool)
+                    and math.isfinite(v) and v >= 0):
                 raise ValueError(f"{name}={v!r}: give a number >= 0")
+        if start_noise > MAX_START_NOISE:
+            raise ValueError(f"start_noise={start_noise!r}: give a relative noise in [0, "
+                             f"{MAX_START_NOISE:g}] (the start's rates times 1 + U(-s, s))")
         self.rigid = Walker.from_scene(scene if not isinstance(scene, Path) else str(scene))
         sc = self.rigid.scene
         if sc.walker.model == "rimless_wheel":
@@ -230,6 +251,7 @@ class WalkerEnv(gym.Env):
             dtype=np.float64)
         self.terrain_seed = 0
         self._elapsed = 0
+        self._has_reset = False
 
     # ------------------------------------------------------------------ gymnasium API
     def _obs(self) -> np.ndarray:
@@ -248,6 +270,7 @@ class WalkerEnv(gym.Env):
                 "heel_strike_time_s": float(strikes[-1]) if strikes else None,
                 "heel_strike_times_s": [float(t) for t in strikes], "steps": int(s.steps),
                 "stance_leg": stance, "hip_x_m": s.hip_x(), "termination": s.ended,
+                "solver_message": str(getattr(s, "failure", "")),
                 "terrain_seed": int(self.terrain_seed)}
         info.update({f"ledger_{k}": float(v) for k, v in s.ledger.items()})
         return info
@@ -260,8 +283,11 @@ class WalkerEnv(gym.Env):
         walkerlab.config.SceneError
             ``options["state"]`` no state of the walker (one line naming the states).
         ValueError
-            An unknown option.
+            ``options`` not a dict, or an unknown option (one line).
         """
+        if options is not None and not isinstance(options, Mapping):
+            raise ValueError(f"reset: options must be a dict such as {{'state': x}} or None, "
+                             f"got a {type(options).__name__}")
         super().reset(seed=seed)
         options = dict(options or {})
         state = options.pop("state", None)
@@ -270,36 +296,78 @@ class WalkerEnv(gym.Env):
         self.terrain_seed = int(self.np_random.integers(2**31 - 1))
         noise = (self.np_random.uniform(-self.start_noise, self.start_noise)
                  if self.start_noise > 0 else None)
-        if self.view == "rigid":
-            x0 = (np.array(self.gait.x, float) if state is None
-                  else self.rigid.check_state(state, "options['state']"))
-        else:
+        if self.view == "contact":
             self.sim.set_terrain(self.terrain_roughness_m, self.terrain_seed)
-            x0 = np.array(self.sim.x_start if state is None else state, float)
-            if x0.shape != self.sim.x_start.shape or not np.all(np.isfinite(x0)):
-                from walkerlab.config import SceneError
-
-                raise SceneError(f"options['state']: give {len(self.state_names)} finite "
-                                 f"numbers ({', '.join(self.state_names)})")
-        if noise is not None:
-            h = x0.size // 2
-            x0 = x0.copy()
+        start = self.gait.x if self.view == "rigid" else self.sim.x_start
+        try:
+            x0 = np.array(start if state is None else state, float)
+        except (TypeError, ValueError):  # not numbers: the checks below say so
+            x0 = state
+        if noise is not None and isinstance(x0, np.ndarray) and x0.ndim == 1:
+            h = x0.size // 2  # before the check: the noisy start is checked
             x0[h:] *= 1.0 + self.np_random.uniform(-self.start_noise, self.start_noise, h)
+        if self.view == "rigid":
+            x0 = self.rigid.check_state(x0, "options['state']" if state is not None
+                                        else "the start with start_noise")
+        elif not (isinstance(x0, np.ndarray) and x0.shape == self.sim.x_start.shape
+                  and np.all(np.isfinite(x0))):
+            from walkerlab.config import SceneError
+
+            raise SceneError(f"options['state']: give {len(self.state_names)} finite "
+                             f"numbers ({', '.join(self.state_names)})")
         self.sim.reset(x0)
         self._elapsed = 0
+        self._has_reset = True
         return self._obs(), self._info([])
+
+    def _action(self, action) -> np.ndarray:
+        """``action`` as finite float64 torques (k,) (not yet scaled or clipped).
+
+        Raises
+        ------
+        InvalidAction
+            None, not real numbers (complex, text, objects), not of shape (k,), or NaN/inf
+            entries (one line naming the action space).
+        """
+        k = self.tau_max.size
+        want = (f"give {k} finite real number{'s' if k > 1 else ''} "
+                f"({', '.join(self.joints)}), shape ({k},), in {self.action_space}")
+        if action is None:
+            raise InvalidAction(f"action is None: {want}")
+        try:
+            a = np.asarray(action)
+        except (ValueError, TypeError):  # ragged nesting
+            raise InvalidAction(f"action of type {type(action).__name__} is not an array of "
+                                f"numbers: {want}") from None
+        if a.dtype.kind not in "iuf":
+            what = "complex" if a.dtype.kind == "c" else f"of dtype {a.dtype}"
+            raise InvalidAction(f"action is {what}: {want}")
+        if a.shape != (k,):
+            raise InvalidAction(f"action has shape {a.shape}: {want}")
+        a = a.astype(np.float64)
+        bad = np.flatnonzero(~np.isfinite(a))
+        if bad.size:
+            raise InvalidAction(f"action[{int(bad[0])}] is {a[bad[0]]}: {want}")
+        return a
 
     def step(self, action):
         """Hold ``action`` (k,) (fractions of :attr:`tau_max`, or N m), clipped to the
         bounds, for one control period; returns ``(observation, reward, terminated,
-        truncated, info)``."""
-        a = np.asarray(action, dtype=np.float64).reshape(-1)
-        if self.normalize_action and a.shape == self.tau_max.shape:
+        truncated, info)``.
+
+        Raises
+        ------
+        gymnasium.error.ResetNeeded
+            Before the first :meth:`reset`.
+        InvalidAction
+            Not ``k`` finite real numbers of shape ``(k,)`` (one line).
+        """
+        if not self._has_reset:
+            raise gym.error.ResetNeeded("Cannot call env.step() before calling env.reset()")
+        a = self._action(action)
+        if self.normalize_action:
             a = a * self.tau_max
         u = np.clip(a, -self.tau_max, self.tau_max)
-        if u.shape != self.tau_max.shape:
-            raise ValueError(f"action has shape {np.shape(action)}; give "
-                             f"{self.tau_max.size} torques ({', '.join(self.joints)}) [N m]")
         s = self.sim
         x_before = s.hip_x()
         w_before = s.ledger["action_work_positive"]
@@ -320,7 +388,15 @@ class WalkerEnv(gym.Env):
 
     def render(self):
         """The walker drawn (matplotlib, Agg) as an RGB array (H, W, 3) uint8, with
-        ``render_mode="rgb_array"``; None otherwise."""
+        ``render_mode="rgb_array"``; None otherwise.
+
+        Raises
+        ------
+        gymnasium.error.ResetNeeded
+            Before the first :meth:`reset`.
+        """
+        if not self._has_reset:
+            raise gym.error.ResetNeeded("Cannot call env.render() before calling env.reset()")
         if self.render_mode != "rgb_array":
             return None
         from .render import draw
