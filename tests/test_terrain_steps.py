@@ -118,6 +118,33 @@ def test_a_three_height_foothold_gait_is_written_and_read_back(tmp_path):
     assert out.startswith("simulated 5 strides: 10 heel strikes")
 
 
+def test_a_finite_foothold_list_of_one_height_ends_the_walk(tmp_path):
+    """Issue 56 item 3: ``periodic: false`` with every foothold at one height was walked as
+    endless ground (10 heel strikes of a 3-foothold list); now the walk ends after the list,
+    as with heights that differ, and says so in one line.  The gait is the one-height
+    ground's (one step a map), bit for bit."""
+    from walkerlab.config import load_scene
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.io.schemas.simulate import load_simulate
+    from walkerlab.models.registry import build_walker
+
+    f = _footholds_file(tmp_path, [-0.005] * 3, periodic=False)
+    code, out, err = _cli("simulate", f, "--runs-dir", tmp_path / "runs")
+    assert code == 0, err
+    sim = load_simulate(tmp_path / "runs" / "fh" / "simulate.h5")
+    assert sim.heel_strike_count() == 3 and sim.termination == "heel_strike"
+    assert out.splitlines()[0] == ("the ground ends after its 3 footholds (terrain.periodic: "
+                                   "false): 3 heel strikes of the 10 asked (5 strides)")
+    w = build_walker(load_scene(f))
+    assert w.steps_per_map == 1 and w.ground_steps == 3
+    (tmp_path / "endless").mkdir()
+    endless = _footholds_file(tmp_path / "endless", [-0.005])  # periodic: true
+    code, out, err = _cli("fixedpoint", endless, "--runs-dir", tmp_path / "r2")
+    assert code == 0, err
+    np.testing.assert_array_equal(
+        load_fixedpoint(tmp_path / "runs" / "fh" / "fixedpoint.h5").x,
+        load_fixedpoint(tmp_path / "r2" / "fh" / "fixedpoint.h5").x)
+
 # -- per-step heights in the MFPT study --------------------------------------------------------
 
 def _independent_walk(ref, x0, gamma, heights, max_steps=2000, t_cap=5.0):

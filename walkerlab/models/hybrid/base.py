@@ -212,9 +212,10 @@ class HybridWalker:
         step to step (footholds of several heights or slopes,
         :func:`walkerlab.models.hybrid.ground.on_footholds`): step ``k`` of a walk is taken
         by ``cycle[k % len(cycle)]`` (:meth:`for_step`); None: :attr:`mirror` decides.
-    cycle_periodic : bool
-        Whether :attr:`cycle` repeats (a periodic ground); False: the ground ends after its
-        steps (a finite foothold list: a walk stops there).
+    ground_steps : int or None
+        Steps of a finite ground (``terrain.periodic: false``: a foothold list that does not
+        repeat, of one height or several; a drawn rough ground): a walk stops after them.
+        None: the ground goes on (:attr:`cycle`, if any, repeats).
     """
 
     name: str
@@ -240,7 +241,7 @@ class HybridWalker:
     matrices: Callable[[np.ndarray], tuple] | None = None
     step_entry: Callable[[np.ndarray], tuple] | None = None
     cycle: tuple | None = None
-    cycle_periodic: bool = True
+    ground_steps: int | None = None
 
     def for_step(self, k: int) -> HybridWalker:
         """The walker of step ``k`` (0-based from the map's start, ``legs[1]`` in stance

@@ -305,7 +305,7 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalk
             w, d = w.mirror, replace(d.mirror, mirror_params=None)
         cycle.append(on_landing(replace(w, mirror=None), d, drop))
     last = cycle[-1]
-    return replace(cycle[0], cycle=tuple(cycle), cycle_periodic=bool(periodic),
+    return replace(cycle[0], cycle=tuple(cycle), ground_steps=None if periodic else p,
                    mirror=cycle[1] if legs_differ else None,
                    section=last.section, from_section=last.from_section,
                    params={**cycle[0].params,  # the mean drop: downhill on average
