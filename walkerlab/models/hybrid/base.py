@@ -60,6 +60,13 @@ GuardOutcome = Literal["next_phase", "heel_strike", "fall"]
 LEGS = ("leg1", "leg2")
 
 
+class OffSection(RuntimeError):
+    """``from_section(z)`` found no state on the post-impact surface with the section
+    coordinates ``z`` (a landing the legs cannot reach from there: e.g. a stair riser higher
+    than the stance leg's posture allows).  A root finder's iterate there is a failed map,
+    as a fall is."""
+
+
 def role_to_leg(stance_leg: str) -> dict[str, str]:
     """``{"stance": stance_leg, "swing": other leg}``.
 
@@ -174,7 +181,8 @@ class HybridWalker:
     section : callable ``x -> ndarray``
         Coordinates that parametrise the Poincaré section (state minus the guard constraint).
     from_section : callable ``z -> x``
-        Inverse of ``section`` on the guard surface.
+        Inverse of ``section`` on the guard surface; raises :class:`OffSection` where the
+        surface has no state with those section coordinates.
     role_to_leg : callable ``(stance_leg: str) -> dict[role, leg]``
         Which physical leg plays each role when ``stance_leg`` is in stance.
     total_mass_kg : float
