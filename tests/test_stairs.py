@@ -230,3 +230,82 @@ def _clearance(walker, x):
     p = walker.points(x)["swing_foot"]
     phi = walker.slope_rad
     return float(p[0] * np.sin(phi) + p[1] * np.cos(phi))
+
+
+# -- no gait, and the seeds, on stairs (issue 56 item 8) ---------------------------------------
+
+def _stairs_file(tmp_path, guess: bool = True, **terrain):
+    """configs/stairs.yaml with other ``terrain`` fields (and without its initial guess)."""
+    import yaml
+
+    d = yaml.safe_load((ROOT / "configs" / "stairs.yaml").read_text())
+    d["terrain"] = {**d["terrain"], **terrain}
+    if not guess:
+        del d["fixedpoint"]["initial_guess"]
+    f = tmp_path / "st.yaml"
+    f.write_text(yaml.safe_dump(d))
+    return f
+
+
+def _cli(*args):
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, [str(a) for a in args])
+    return r.exit_code, r.stdout, r.stderr
+
+
+@pytest.mark.parametrize("riser_m, guess", [(0.01, True), (0.05, True), (0.01, False)])
+def test_stairs_going_up_end_in_the_no_gait_message(tmp_path, riser_m, guess):
+    """Stairs up: the root finder's iterates left the post-impact surface (no posture of the
+    legs reaches a landing that high) and Newton's failure ended as "internal error
+    (RuntimeError): Failed to converge after 50 iterations"; now such an iterate is a failed
+    map, and the search ends in the no-gait line with the physical reason and the advice."""
+    f = _stairs_file(tmp_path, guess, direction="up", riser_m=riser_m)
+    code, out, err = _cli("fixedpoint", f, "--runs-dir", tmp_path / "runs")
+    assert code == 1 and len(err.splitlines()) == 1, err
+    assert err.startswith("error: fixedpoint: no period-1 gait found; a passive walker "
+                          "cannot climb stairs")
+    assert "walkerlab fixedpoint --from KNOWN_SCENE" in err
+    assert "internal error" not in err and "WALKERLAB_DEBUG=1 for the traceback" not in err
+
+
+def test_a_landing_out_of_the_legs_reach_is_off_the_section(paper_scene):
+    """A 1 cm riser up with the stance leg 0.05 rad from the vertical: no swing-leg angle
+    puts the old stance foot 1 cm below (L (cos 0.05 - 1) = -1.25 mm): OffSection, the
+    failed map the root finder steps back from, not scipy's RuntimeError."""
+    from walkerlab.models.hybrid.base import OffSection
+    from walkerlab.models.registry import build_walker
+
+    w = build_walker(_on_stairs(paper_scene, 0.01, direction="up"))
+    with pytest.raises(OffSection, match="no post-impact state"):
+        w.from_section(np.array([0.05, -0.6, -0.84]))
+    x = w.from_section(np.array([0.1674, -0.6, -0.84]))  # reachable: on the surface
+    assert _clearance(w, x) == pytest.approx(-0.01, abs=1e-12)
+
+
+def test_a_high_riser_down_is_searched_without_an_internal_error(tmp_path):
+    """A 0.2 m riser down ended in the same internal error; the search now finds this
+    riser's period-1 gaits (both unstable: the selection says so) and the treads'
+    verdict says the foot misses its tread."""
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+
+    f = _stairs_file(tmp_path, riser_m=0.2)
+    code, out, err = _cli("fixedpoint", f, "--runs-dir", tmp_path / "runs")
+    assert code == 0, err
+    fp = load_fixedpoint(tmp_path / "runs" / "st" / "fixedpoint.h5")
+    assert fp.residual < 1e-10 and not fp.stable
+    assert "footfall 1 misses its tread" in out
+
+
+def test_level_stairs_without_a_guess_find_their_gait_from_the_seeds(paper_scene):
+    """The seeds were sized by the slope (0 on level treads: a 0.046 rad step angle) and
+    all 45 fell; sized by the slope of the same drop per step (landing_slope) they find the
+    shipped stairs' gait, the one the paper's guess gives (to the root finder's 1e-9)."""
+    sc = load_scene(ROOT / "configs" / "stairs.yaml")
+    d = sc.model_dump(mode="json")
+    d["fixedpoint"].pop("initial_guess")
+    _, seeded = _gait(scene_from_dict(d))
+    _, guessed = _gait(sc)
+    assert np.max(np.abs(seeded.x - guessed.x)) < TIGHT_STATE

@@ -76,6 +76,75 @@ def test_a_finite_foothold_list_ends_the_walk(paper_scene, paper_fixed_point):
         np.testing.assert_array_equal(a.x_next, b.x_next)
 
 
+
+def _footholds_file(tmp_path, heights, **extra):
+    """configs/footholds.yaml with other foothold heights (and ``extra`` terrain fields)."""
+    import yaml
+
+    d = yaml.safe_load((ROOT / "configs" / "footholds.yaml").read_text())
+    d["terrain"] = {**d["terrain"], "foothold_heights_m": list(heights), **extra}
+    f = tmp_path / "fh.yaml"
+    f.write_text(yaml.safe_dump(d))
+    return f
+
+
+def _cli(*args):
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    r = CliRunner().invoke(app, [str(a) for a in args])
+    return r.exit_code, r.stdout, r.stderr
+
+
+def test_a_three_height_foothold_gait_is_written_and_read_back(tmp_path):
+    """Issue 56 item 2: footholds of three heights (a period-3 map, the legs taking turns
+    leg1, leg2, leg1) were refused by the writer ("/steps/swing_leg: dimension 'step'
+    exists with another length": two leg names for three steps); now fixedpoint writes the
+    gait, the artifact reads back each step and simulate walks from it."""
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+
+    f = _footholds_file(tmp_path, [-0.005, 0.0, -0.01])
+    code, out, err = _cli("fixedpoint", f, "--runs-dir", tmp_path / "runs")
+    assert code == 0, err
+    fp = load_fixedpoint(tmp_path / "runs" / "fh" / "fixedpoint.h5")
+    assert fp.step_swing_legs == ("leg1", "leg2", "leg1")
+    assert len(fp.step_periods_s) == len(fp.step_lengths_m) == 3
+    # the map's period is its three steps' (to rounding of three additions)
+    assert abs(sum(fp.step_periods_s) - fp.stride_period_s) < 1e-12
+    assert fp.residual < 1e-10
+    code, out, err = _cli("simulate", f, "--runs-dir", tmp_path / "runs")
+    assert code == 0, err
+    assert out.startswith("simulated 5 strides: 10 heel strikes")
+
+
+def test_a_finite_foothold_list_of_one_height_ends_the_walk(tmp_path):
+    """Issue 56 item 3: ``periodic: false`` with every foothold at one height was walked as
+    endless ground (10 heel strikes of a 3-foothold list); now the walk ends after the list,
+    as with heights that differ, and says so in one line.  The gait is the one-height
+    ground's (one step a map), bit for bit."""
+    from walkerlab.config import load_scene
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.io.schemas.simulate import load_simulate
+    from walkerlab.models.registry import build_walker
+
+    f = _footholds_file(tmp_path, [-0.005] * 3, periodic=False)
+    code, out, err = _cli("simulate", f, "--runs-dir", tmp_path / "runs")
+    assert code == 0, err
+    sim = load_simulate(tmp_path / "runs" / "fh" / "simulate.h5")
+    assert sim.heel_strike_count() == 3 and sim.termination == "heel_strike"
+    assert out.splitlines()[0] == ("the ground ends after its 3 footholds (terrain.periodic: "
+                                   "false): 3 heel strikes of the 10 asked (5 strides)")
+    w = build_walker(load_scene(f))
+    assert w.steps_per_map == 1 and w.ground_steps == 3
+    (tmp_path / "endless").mkdir()
+    endless = _footholds_file(tmp_path / "endless", [-0.005])  # periodic: true
+    code, out, err = _cli("fixedpoint", endless, "--runs-dir", tmp_path / "r2")
+    assert code == 0, err
+    np.testing.assert_array_equal(
+        load_fixedpoint(tmp_path / "runs" / "fh" / "fixedpoint.h5").x,
+        load_fixedpoint(tmp_path / "r2" / "fh" / "fixedpoint.h5").x)
+
 # -- per-step heights in the MFPT study --------------------------------------------------------
 
 def _independent_walk(ref, x0, gamma, heights, max_steps=2000, t_cap=5.0):

@@ -100,6 +100,52 @@ def test_ground_the_contact_model_does_not_build_is_refused_in_one_line(terrain,
     assert field in str(err.value) and "\n" not in str(err.value)
 
 
+
+def test_the_contact_periodic_gait_on_stairs_is_laid_per_step():
+    """Issue 56 item 10b: ``contact_sim.start: periodic_gait`` on stairs ended in "heights1:
+    one finite height [m] per patch of lane1 (1), got shape (9,)" (the step map's one patch
+    per lane kept the stairs' nine heights).  The step map now lays its stance patch at 0
+    and the swing patch a riser lower, and measures the new stance foot's penetration from
+    its own patch: the gait it finds is one of the stairs, so the run started from it on the
+    stairs' patches repeats its step period at every step."""
+    from walkerlab.analysis.contact.periodic import simulate_from_periodic_gait
+    from walkerlab.analysis.gait.scene import solve_scene
+    from walkerlab.models.contact.scene import contact_setup
+
+    sc = _stairs()
+    d = sc.model_dump(mode="json")
+    d["contact_sim"] = {**d["contact_sim"], "start": "periodic_gait", "n_strides": 2}
+    sc = scene_from_dict(d)
+    _, search = solve_scene(sc)
+    _, res, _, _, gait = simulate_from_periodic_gait(contact_setup(sc), search.result.x)
+    assert gait.converged and gait.stable
+    periods = np.diff(res.heel_strike_times)
+    assert periods.size >= 3
+    # measured: every step within 3.5e-5 s of the gait's 0.717155 s (the run's solver is
+    # the scene's contact_solver, the gait's map CyRK's BDF at its own tolerance)
+    assert np.max(np.abs(periods - gait.period_s)) < 1e-4
+    # the stairs' gait, not the level one: 9 mm shorter than the rigid 0.414 m step
+    assert gait.step_length_m == pytest.approx(0.4055, abs=1e-3)
+
+
+def test_the_contact_periodic_gait_on_a_polyline_ground_is_refused_in_one_line(tmp_path):
+    """Stairs on continuous lanes are a polyline the step map cannot re-centre (before:
+    scipy's "f(a) and f(b) must have different signs"): one line naming the field."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = yaml.safe_load((ROOT / "configs" / "stairs.yaml").read_text())
+    d["terrain"]["lanes"] = "continuous"
+    d["contact_sim"]["start"] = "periodic_gait"
+    f = tmp_path / "st.yaml"
+    f.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["contact-sim", str(f), "--runs-dir", str(tmp_path / "r")])
+    assert r.exit_code != 0
+    assert r.stderr.startswith("error: contact_sim.start / periodic_gait: ")
+    assert len(r.stderr.splitlines()) == 1 and "lanes: checkerboard" in r.stderr
+
 @pytest.mark.slow
 def test_contact_run_down_stairs_keeps_the_rigid_stair_gait():
     """configs/stairs.yaml (the paper walker down 1 cm stairs, 0.3 m patches at the rigid

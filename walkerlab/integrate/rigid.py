@@ -402,9 +402,9 @@ def simulate_steps(walker: HybridWalker, x0: np.ndarray, n_steps: int, solver: S
     x, t, leg = np.asarray(x0, float), 0.0, first_stance_leg
     foot = np.zeros(2)
     for k in range(n_steps):
+        if walker.ground_steps is not None and k >= walker.ground_steps:
+            break  # a finite ground (a foothold list that does not repeat): it ends here
         if walker.cycle is not None:  # a ground that differs from step to step
-            if not walker.cycle_periodic and k >= len(walker.cycle):
-                break  # a finite foothold list: the ground ends here
             step_walker = walker.cycle[k % len(walker.cycle)]
         else:
             step_walker = walker.for_stance(leg)  # legs that differ: each leg's own numbers

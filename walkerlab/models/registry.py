@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from walkerlab.models.hybrid.base import HybridWalker
 
 
@@ -64,14 +66,19 @@ def _on_ground(scene, walker: HybridWalker) -> HybridWalker:
     if steps is not None:  # footholds that differ from step to step
         return _on_footholds(scene, walker, steps, on_footholds)
     drop = landing_drop(scene.terrain)
-    if drop == 0.0:
-        return walker
-    from walkerlab.walker.description import walker_data
+    if drop != 0.0:
+        from walkerlab.walker.description import walker_data
 
-    if walker.variant != "derived":
-        raise ValueError("terrain.kind: stairs and footholds need ideal.variant: derived "
-                         "(the printed Appendix A equations know only the slope)")
-    return on_landing(walker, walker_data(scene.walker, scene.slope.phi_rad), drop)
+        if walker.variant != "derived":
+            raise ValueError("terrain.kind: stairs and footholds need ideal.variant: derived "
+                             "(the printed Appendix A equations know only the slope)")
+        walker = on_landing(walker, walker_data(scene.walker, scene.slope.phi_rad), drop)
+    t = scene.terrain
+    if t is not None and t.kind == "footholds" and t.periodic is False:
+        # footholds of one height that do not repeat: the gait is the one-step map's, the
+        # walk ends after the list (as for footholds that differ, on_footholds)
+        walker = replace(walker, ground_steps=len(t.foothold_heights_m))
+    return walker
 
 
 def passive_walker_at(scene):

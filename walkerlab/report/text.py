@@ -243,8 +243,14 @@ def simulate_text(sim: SimulateArtifact) -> str:
     if ending is not None:
         return ending
     u, s = sim.units, sim.summary
-    lines = [f"simulated {sim.strides_requested} strides: "
-             f"{sim.heel_strike_count()} heel strikes"]
+    if "ground_steps" in s:  # a finite foothold list, shorter than the strides asked
+        n = int(s["ground_steps"])
+        lines = [f"the ground ends after its {n} footholds (terrain.periodic: false): "
+                 f"{sim.heel_strike_count()} heel strikes of the "
+                 f"{2 * sim.strides_requested} asked ({sim.strides_requested} strides)"]
+    else:
+        lines = [f"simulated {sim.strides_requested} strides: "
+                 f"{sim.heel_strike_count()} heel strikes"]
     if u.nondimensional:
         lines.append(f"  ({u.sentence()})")
     lines.append(f"  mean step period  {num(s['mean_period_s'], 7)} {u.time}")

@@ -60,7 +60,10 @@ The re-centring is physically invisible as long as each foot stays inside its pa
 its stance (the IMPACT force only depends on the patch membership, not on the distance to
 the centre): :func:`find_contact_periodic_gait` reports the worst margin to a patch edge
 (``patch_margin_m``), and the fixed point is then a true periodic gait of a checkerboard
-whose patches are spaced by the gait's own step length.
+whose patches are spaced by the gait's own step length.  On stairs and footholds of one
+height (patches a riser apart, :func:`walkerlab.models.contact.terrain.terrain_ground`) the
+swing patch lies the step's rise (:func:`step_rise`) above the stance patch, and the new
+stance foot's penetration is measured from its own patch: each step on the same ground.
 
 """
 
@@ -109,6 +112,39 @@ class PeriodicGaitError(RuntimeError):
 DEFAULT_SOLVER = Solver("LSODA", 1e-11, 1e-13)
 
 
+def step_rise(walker: ContactWalker) -> float:
+    """Height [m] (along the slope's normal) of each footfall's patch above the last one's on
+    a ground whose every step is alike (stairs, footholds of one height, on checkerboard
+    lanes: :func:`walkerlab.models.contact.terrain.terrain_ground`); 0.0 without patch
+    heights.
+
+    Raises
+    ------
+    ValueError
+        A polyline ground (continuous stairs, a profile), or footfall heights whose steps
+        differ (rough ground): the step map's ground is the same at every step (one line,
+        naming ``contact_sim.start``).
+    """
+    if walker.ground_line is not None:
+        raise ValueError("contact_sim.start / periodic_gait: the contact periodic gait's "
+                         "step map lays a patch at each foot (checkerboard lanes); a polyline "
+                         "ground (stairs on continuous lanes, a profile) has none: use "
+                         "terrain.lanes: checkerboard, or start: ideal")
+    if walker.heights1 is None and walker.heights2 is None:
+        return 0.0
+    h2 = np.zeros(walker.lane2.size) if walker.heights2 is None else walker.heights2
+    h1 = np.zeros(walker.lane1.size) if walker.heights1 is None else walker.heights1
+    n = min(h1.size, h2.size)  # footfall order: leg2's 0, leg1's 1, leg2's 2, ...
+    h = np.ravel(np.column_stack([h2[:n], h1[:n]]))
+    rises = np.diff(h) if h.size > 1 else np.zeros(1)
+    # equal to rounding (the heights are -k * drop * cos(phi), k up to a few hundred)
+    if np.ptp(rises) > 1e-9 * max(1.0, float(np.max(np.abs(h)))):
+        raise ValueError("contact_sim.start / periodic_gait: the contact periodic gait needs "
+                         "a ground whose every step is alike (slope, stairs, footholds of one "
+                         "height); these footfall heights differ from step to step")
+    return float(rises[0])
+
+
 class StepMap:
     """Mid-stance-to-mid-stance step map of a :class:`ContactWalker`.
 
@@ -152,8 +188,13 @@ class StepMap:
         keep_ground = walker.continuous and walker.structure.knee
         # each patch centred on its foot's footprint (a flat foot's lies ahead of its heel)
         o2 = footprint_offsets(walker.data)[1]
+        #: height [m] of the swing lane's patch above the stance patch (stairs, footholds)
+        self.rise = step_rise(walker)
+        heights = {} if walker.heights1 is None and walker.heights2 is None else {
+            "heights1": np.array([self.rise]), "heights2": np.array([0.0])}
         self.walker = dataclasses.replace(walker, lane1=np.array([self.spacing + o2]),
-                                          lane2=np.array([o2]), continuous=keep_ground)
+                                          lane2=np.array([o2]), continuous=keep_ground,
+                                          **heights)
         self.method, self.t_max = solver.method, t_max
         self.solver = solver  # the step map's integrator
         self.deadline = np.inf if deadline is None else deadline
@@ -214,7 +255,11 @@ class StepMap:
         x = np.asarray(x, float)
         px, py, vx, vy = self.walker.foot_state(x, stance)
         p, v = np.array([px, py]), np.array([vx, vy])
-        z = np.concatenate([x[self._columns(stance)], [-p @ self.n, v @ self.t, -v @ self.n]])
+        # the penetration below the foot's own patch: leg1's (stance 0) lies ``rise`` above
+        # leg2's on stairs and footholds, the next step's ground as the last one
+        h = self.rise if stance == 0 else 0.0
+        z = np.concatenate([x[self._columns(stance)], [h - p @ self.n, v @ self.t,
+                                                        -v @ self.n]])
         return z, float(p @ self.t)
 
     # ------------------------------------------------------------------ the map

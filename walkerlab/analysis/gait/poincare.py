@@ -25,7 +25,7 @@ from walkerlab.freshstack import import_on_fresh_stack
 from walkerlab.integrate.rigid import integrate_step
 from walkerlab.integrate.rigid_phase import numeric_jacobian
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.models.hybrid.base import HybridWalker, OffSection
 from walkerlab.numerics import sort_multipliers
 
 #: longest CPU time of one search for a gait [s] (:func:`search_budget`; a fixed point, or
@@ -433,11 +433,11 @@ class _ReducedMap:
         if key in self._last:
             return self._last[key].copy()
         walker = self.walker
-        x = walker.from_section(z)
         self.counter["calls"] += 1
         try:
+            x = walker.from_section(z)
             xn, _, nf = poincare_map(walker, x, self.solver, self.max_step_time)
-        except StepFailed:
+        except (StepFailed, OffSection):
             r = np.full(z.size, 1e3 * (1 + np.linalg.norm(z)))  # push the solver away
         else:
             self.counter["nfev"] += nf
@@ -457,7 +457,7 @@ class _ReducedMap:
         try:  # asked again: the updated guess stopped helping; the true one here
             out = poincare_map(walker, walker.from_section(z), self.solver,
                                self.max_step_time, jacobian=True, steps=segs)
-        except StepFailed:
+        except (StepFailed, OffSection):
             return next(iter(self.start.values()))
         self.counter["nfev"] += out[3]
         self.counter["jacobians"] += 1
@@ -472,9 +472,14 @@ class _ReducedMap:
         Raises
         ------
         FixedPointNotFound
-            The map fails at ``z`` (``message``: the root finder's).
+            The map fails at ``z`` (``message``: the root finder's), or ``z`` is off the
+            post-impact surface (:class:`~walkerlab.models.hybrid.base.OffSection`).
         """
-        x = self.walker.from_section(z)
+        try:
+            x = self.walker.from_section(z)
+        except OffSection as exc:
+            raise FixedPointNotFound(f"{message}; the last iterate is off the post-impact "
+                                     f"surface ({exc})", float("nan")) from None
         if z.tobytes() in self._variational:  # the Jacobian was last computed at the solution
             xn, period, DP, _, segs = self._variational[z.tobytes()]
             self.counter["jacobians"] -= 1

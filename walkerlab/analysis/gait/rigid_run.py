@@ -29,7 +29,9 @@ class RigidRun:
     summary : dict
         ``termination``, ``steps_completed``, ``wall_time_s`` [s], ``nfev``, and over the
         steps that ended by a heel strike ``mean_period_s`` [s], ``mean_step_length_m`` [m],
-        ``mean_hip_speed_m_per_s`` [m/s] (NaN: none), ``mean_total_energy_J`` [J].
+        ``mean_hip_speed_m_per_s`` [m/s] (NaN: none), ``mean_total_energy_J`` [J]; on a
+        finite ground shorter than the run (``terrain.periodic: false``) ``ground_steps``,
+        its steps (the walk ends there).
     """
 
     trajectory: object
@@ -68,6 +70,9 @@ def simulate_scene(scene: Scene, walker, x0: np.ndarray) -> RigidRun:
                                    else np.nan),
         "mean_total_energy_J": float(np.mean(samples.total)),
     }
+    ends = getattr(walker, "ground_steps", None)
+    if ends is not None and traj.termination == "heel_strike" and ends < 2 * sim.strides:
+        summary["ground_steps"] = int(ends)  # a finite ground ended the walk
     return RigidRun(traj, samples, steps, summary)
 
 

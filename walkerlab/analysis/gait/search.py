@@ -293,7 +293,7 @@ class _RootStarts:
         walk to in :data:`~walkerlab.analysis.gait.starts.WALK_STEPS` steps."""
         walker, solver, max_step_time = self.walker, self.solver, self.kw["max_step_time"]
         n_started = 0
-        ranked, n_seeds = screen_seeds(walker, solver, max_step_time)
+        ranked, n_seeds, n_off = screen_seeds(walker, solver, max_step_time)
         for _err, _desc, x in ranked[:ROOT_STARTS]:
             n_started += 1
             g = self.attempt(x, "seed")
@@ -301,7 +301,9 @@ class _RootStarts:
                 self.found.append(g)
                 break
         self.tried.append(f"{n_started} of {n_seeds} scale-free seeds "
-                          f"({n_seeds - len(ranked)} fell within the first step)")
+                          f"({n_seeds - len(ranked) - n_off} fell within the first step"
+                          + (f", {n_off} could not reach the landing" if n_off else "")
+                          + ")")
         if self.found or not ranked:
             return
         n_walked = n_started = 0  # second round: from where the seeds walk to
@@ -441,8 +443,13 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
     last = _short(last)
     if last and "standing" not in last:
         last = "scipy: " + last[:1].lower() + last[1:].rstrip(".")
-    downhill = walker.slope_rad > 0 or walker.params.get("landing_drop_m", 0.0) > 0
-    if not downhill and walker.actuators is None:
+    drop = walker.params.get("landing_drop_m", 0.0)
+    downhill = walker.slope_rad > 0 or drop > 0
+    if drop < 0 and walker.slope_rad <= 0 and walker.actuators is None:
+        # every step lands higher: gravity cannot pay the climb (nor the heel strikes' loss)
+        why = ("a passive walker cannot climb stairs or step up (each step up takes energy "
+               "only actuators give: walker.actuation; passive, walk stairs down)")
+    elif not downhill and walker.actuators is None:
         why = ("a passive walker needs a downhill slope (slope > 0), stairs down or "
                "walker.actuation")
     elif walker.actuators is not None and had_guess:
@@ -459,8 +466,10 @@ def _failure(walker: HybridWalker, tried: list[str], best: float, last: str,
     # give one
     nearer = ("start from a gait known nearby (walkerlab fixedpoint --from KNOWN_SCENE, or "
               "its gait as fixedpoint.initial_guess)" if had_guess
-              else "give fixedpoint.initial_guess (a gait at a nearby push-off or slope)"
-              if walker.actuators is not None else "give fixedpoint.initial_guess")
+              else "give fixedpoint.initial_guess (a gait at a nearby push-off or slope, or "
+              "walkerlab fixedpoint --from KNOWN_SCENE)"
+              if walker.actuators is not None else "give fixedpoint.initial_guess (or start "
+              "from a gait known nearby: walkerlab fixedpoint --from KNOWN_SCENE)")
     return (f"no period-1 gait found; {why}; to see where the gait ends, try a continuation "
             "from a walker whose gait is known (walkerlab sweep SCENE --param "
             f"FIELD=KNOWN:THIS:STEP, e.g. slope.angle_deg), or {nearer}"

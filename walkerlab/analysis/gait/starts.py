@@ -25,7 +25,7 @@ import numpy as np
 
 from walkerlab.analysis.gait.poincare import FixedPointResult, StepFailed, poincare_map
 from walkerlab.integrate.solver import Solver
-from walkerlab.models.hybrid.base import HybridWalker
+from walkerlab.models.hybrid.base import HybridWalker, OffSection
 
 __all__ = ["coarse_solver", "deflation_starts", "screen_seeds", "seed_states",
            "state_from_legs", "step_length", "walked_start"]
@@ -58,6 +58,11 @@ def state_from_legs(walker: HybridWalker, stance_angle: float, swing_angle: floa
     -------
     ndarray, shape (2n,)
         Role-ordered state, leg ``walker.legs[-1]`` in stance.
+
+    Raises
+    ------
+    walkerlab.models.hybrid.base.OffSection
+        No state on the heel-strike surface near these legs (a landing they cannot reach).
     """
     from scipy.optimize import least_squares
 
@@ -96,12 +101,25 @@ def powered_slope(walker: HybridWalker) -> float:
     return (p * p / (4.0 * m * m * g * length)) ** 0.75
 
 
+def landing_slope(walker: HybridWalker) -> float:
+    """The slope [rad] whose passive gait drops, per step, what a landing ``d`` below the
+    stance foot (stairs down, footholds: ``params["landing_drop_m"]``) does: a slope
+    ``gamma`` drops ``d ~ 2 l alpha gamma`` a step with ``alpha ~ gamma^(1/3)`` (Garcia et
+    al. 1998), so ``gamma = (d / (2 l))^(3/4)``; 0 on the slope itself and for landings
+    above the stance foot.  Only the seeds' size (level treads have ``phi = 0``)."""
+    d = float(walker.params.get("landing_drop_m", 0.0))
+    if not d > 0.0:
+        return 0.0
+    return (d / (2.0 * float(walker.params["leg_length_m"]))) ** 0.75
+
+
 def seed_states(walker: HybridWalker) -> list[tuple[str, np.ndarray]]:
     """Scale-free seeds just after heel strike, from the slope and the walker's size.
 
     Step half-angle ``alpha = c gamma^(1/3)`` (``c`` in :data:`SEED_STEP`; Garcia et al.
     1998: the step angle of both gaits scales as gamma^(1/3) on small slopes; a powered
-    walker's ``gamma`` adds :func:`powered_slope`), stance leg at ``alpha - phi`` and swing
+    walker's ``gamma`` adds :func:`powered_slope`, a landing below the stance foot
+    :func:`landing_slope`), stance leg at ``alpha - phi`` and swing
     leg at ``-alpha - phi`` from the vertical (``phi`` the slope: the feet lie on it),
     stance rate ``-k alpha sqrt(g/l)`` (``k`` in :data:`SEED_STANCE_RATE`; their
     ``theta_dot ~ -theta``), swing rate ``r`` times the stance rate (``r`` in
@@ -114,14 +132,17 @@ def seed_states(walker: HybridWalker) -> list[tuple[str, np.ndarray]]:
         [rad/s]), for each seed.
     """
     phi = float(walker.slope_rad)
-    gamma = max(phi, 1e-4) + powered_slope(walker)
+    gamma = max(phi, 1e-4) + powered_slope(walker) + landing_slope(walker)
     omega = math.sqrt(float(walker.params["gravity_m_per_s2"])
                       / float(walker.params["leg_length_m"]))
     out = []
     for c, k, r in itertools.product(SEED_STEP, SEED_STANCE_RATE, SEED_SWING_RATIO):
         alpha = min(c * gamma ** (1.0 / 3.0), 0.6)
         rate = -k * alpha * omega
-        x = state_from_legs(walker, alpha - phi, -alpha - phi, rate, r * rate)
+        try:
+            x = state_from_legs(walker, alpha - phi, -alpha - phi, rate, r * rate)
+        except OffSection:  # legs this far apart cannot reach the landing: no seed
+            continue
         out.append((f"step angle {c:g} gamma^(1/3), stance rate {k:g} alpha sqrt(g/l), "
                     f"swing/stance rate {r:g}", x))
     return out
@@ -133,7 +154,7 @@ def coarse_solver(solver: Solver) -> Solver:
 
 
 def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
-                 ) -> tuple[list[tuple[float, str, np.ndarray]], int]:
+                 ) -> tuple[list[tuple[float, str, np.ndarray]], int, int]:
     """Seeds ranked by one coarse Poincaré-map step: ``|section(P(x)) - section(x)| /
     |section(x)|`` (seeds that fall within the step are dropped).  The seeds are
     :func:`seed_states` (Garcia et al. 1998's gamma^(1/3) scaling); ``max_step_time`` [s]
@@ -144,7 +165,10 @@ def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
     ranked : list of (float, str, ndarray (2n,))
         Relative residual [-], description, state ([rad, rad/s]); smallest residual first.
     n_seeds : int
-        Seeds tried.
+        Seeds of the grid (:data:`SEED_STEP` x :data:`SEED_STANCE_RATE` x
+        :data:`SEED_SWING_RATIO`).
+    n_off : int
+        Seeds whose legs cannot reach the landing (:func:`seed_states` leaves them out).
     """
     coarse = coarse_solver(solver)
     seeds = seed_states(walker)
@@ -158,7 +182,8 @@ def screen_seeds(walker: HybridWalker, solver: Solver, max_step_time: float
         ranked.append((float(np.linalg.norm(walker.section(xn) - z) / np.linalg.norm(z)),
                        desc, x))
     ranked.sort(key=lambda t: t[0])
-    return ranked, len(seeds)
+    n_seeds = len(SEED_STEP) * len(SEED_STANCE_RATE) * len(SEED_SWING_RATIO)
+    return ranked, n_seeds, n_seeds - len(seeds)
 
 
 def walked_start(walker: HybridWalker, x: np.ndarray, solver: Solver,
@@ -227,8 +252,14 @@ def deflation_starts(walker: HybridWalker, first: FixedPointResult) -> list[np.n
         for sign in (1.0, -1.0):
             dz = np.zeros(z1.size)
             dz[j] = sign * DEFLATION_OFFSET * max(abs(float(z1[j])), 0.1)
-            x = walker.from_section(z1 + dz)
+            try:
+                x = walker.from_section(z1 + dz)
+            except OffSection:  # off the post-impact surface (a landing out of reach)
+                continue
             pair.append((step_length(walker, x), x))
+        if len(pair) < 2:
+            out += [x for _, x in pair]
+            continue
         (l_plus, x_plus), (l_minus, x_minus) = pair
         flip = math.isfinite(l_plus) and math.isfinite(l_minus) and \
             abs(l_plus - l_minus) > 1e-12 and ((l_minus < l_plus) == shorter_first)

@@ -72,17 +72,20 @@ def _write_result(g, walker, res, guess) -> None:
     for name, val, u in zip(names, guess, units):
         put(g, f"initial_guess/{name}", float(val), u, "root-finder starting point")
     steps = len(getattr(res, "step_periods_s", ()))
-    if steps > 1:  # legs that differ: the map is a stride; each step on its own
+    if steps > 1:  # legs or footholds that differ: the map is several steps, each on its own
         put(g, "step_period", res.period_s / steps, "s", "mean step period of the period-1 "
-            "gait (the Poincare map is a stride of two steps)")
+            f"gait (the Poincare map is a stride of {steps} steps)")
         put(g, "stride_period", res.period_s, "s", "stride period (period of the map)")
-        coordinate(g, "step", np.arange(steps), "-", "step of the stride (leg1 swings first)")
+        coordinate(g, "step", np.arange(steps), "-",
+                   f"step of the stride ({walker.legs[0]} swings first)")
         put(g, "steps/period", np.array(res.step_periods_s), "s", "period of each step",
             dims=("step",))
         put(g, "steps/length", np.array(res.step_lengths_m), "m", "length of each step "
             "(stance foot to swing foot at heel strike)", dims=("step",))
-        put(g, "steps/swing_leg", np.array([b"leg1", b"leg2"][:steps]), "-",
-            "swing leg of each step", dims=("step",))
+        # the legs take turns (walkerlab.analysis.gait.poincare: step k has legs[k % 2]
+        # swinging), also over an odd number of steps (footholds of period 3, ...)
+        swing = np.array([walker.legs[k % 2].encode() for k in range(steps)])
+        put(g, "steps/swing_leg", swing, "-", "swing leg of each step", dims=("step",))
     else:
         put(g, "step_period", res.period_s, "s", "step period of the period-1 gait")
     put(g, "residual", res.residual, "rad or rad/s", "max |P(x*) - x*| over the state")

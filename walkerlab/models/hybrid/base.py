@@ -60,6 +60,13 @@ GuardOutcome = Literal["next_phase", "heel_strike", "fall"]
 LEGS = ("leg1", "leg2")
 
 
+class OffSection(RuntimeError):
+    """``from_section(z)`` found no state on the post-impact surface with the section
+    coordinates ``z`` (a landing the legs cannot reach from there: e.g. a stair riser higher
+    than the stance leg's posture allows).  A root finder's iterate there is a failed map,
+    as a fall is."""
+
+
 def role_to_leg(stance_leg: str) -> dict[str, str]:
     """``{"stance": stance_leg, "swing": other leg}``.
 
@@ -174,7 +181,8 @@ class HybridWalker:
     section : callable ``x -> ndarray``
         Coordinates that parametrise the Poincaré section (state minus the guard constraint).
     from_section : callable ``z -> x``
-        Inverse of ``section`` on the guard surface.
+        Inverse of ``section`` on the guard surface; raises :class:`OffSection` where the
+        surface has no state with those section coordinates.
     role_to_leg : callable ``(stance_leg: str) -> dict[role, leg]``
         Which physical leg plays each role when ``stance_leg`` is in stance.
     total_mass_kg : float
@@ -212,9 +220,10 @@ class HybridWalker:
         step to step (footholds of several heights or slopes,
         :func:`walkerlab.models.hybrid.ground.on_footholds`): step ``k`` of a walk is taken
         by ``cycle[k % len(cycle)]`` (:meth:`for_step`); None: :attr:`mirror` decides.
-    cycle_periodic : bool
-        Whether :attr:`cycle` repeats (a periodic ground); False: the ground ends after its
-        steps (a finite foothold list: a walk stops there).
+    ground_steps : int or None
+        Steps of a finite ground (``terrain.periodic: false``: a foothold list that does not
+        repeat, of one height or several; a drawn rough ground): a walk stops after them.
+        None: the ground goes on (:attr:`cycle`, if any, repeats).
     """
 
     name: str
@@ -240,7 +249,7 @@ class HybridWalker:
     matrices: Callable[[np.ndarray], tuple] | None = None
     step_entry: Callable[[np.ndarray], tuple] | None = None
     cycle: tuple | None = None
-    cycle_periodic: bool = True
+    ground_steps: int | None = None
 
     def for_step(self, k: int) -> HybridWalker:
         """The walker of step ``k`` (0-based from the map's start, ``legs[1]`` in stance

@@ -32,7 +32,7 @@ from functools import partial
 import numpy as np
 
 from walkerlab.codegen.cache import functions
-from walkerlab.models.hybrid.base import HybridWalker, Phase
+from walkerlab.models.hybrid.base import HybridWalker, OffSection, Phase
 
 __all__ = ["foothold_steps", "landing_drop", "on_footholds", "on_landing",
            "with_clearance_guard"]
@@ -165,7 +165,14 @@ class _LandingSection:
 
         from scipy.optimize import newton  # the stairs' section only: no import at start-up
 
-        s = newton(h, float(x[g[0]]), fprime=dh, tol=1e-15, maxiter=50)
+        try:
+            s = newton(h, float(x[g[0]]), fprime=dh, tol=1e-15, maxiter=50)
+        except (RuntimeError, ZeroDivisionError) as exc:  # no root, or Newton lost it
+            raise OffSection(f"no post-impact state with the old stance foot {self.level:g} m "
+                             f"above the new stance foot's line here ({exc})") from None
+        if not math.isfinite(s):
+            raise OffSection(f"no post-impact state with the old stance foot {self.level:g} m "
+                             "above the new stance foot's line here")
         x[g] = s
         return x
 
@@ -305,7 +312,7 @@ def on_footholds(walker_at, data_at, steps, periodic: bool = True) -> HybridWalk
             w, d = w.mirror, replace(d.mirror, mirror_params=None)
         cycle.append(on_landing(replace(w, mirror=None), d, drop))
     last = cycle[-1]
-    return replace(cycle[0], cycle=tuple(cycle), cycle_periodic=bool(periodic),
+    return replace(cycle[0], cycle=tuple(cycle), ground_steps=None if periodic else p,
                    mirror=cycle[1] if legs_differ else None,
                    section=last.section, from_section=last.from_section,
                    params={**cycle[0].params,  # the mean drop: downhill on average
