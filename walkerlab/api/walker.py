@@ -721,16 +721,13 @@ class ContactWalker:
     def __init__(self, scene: Scene, rigid: Walker | None = None,
                  step_time_limit_s: float = STEP_TIME_LIMIT_S):
         from walkerlab.integrate.solver import Solver
-        from walkerlab.models.contact.model import ContactWalker as ContactModel
         from walkerlab.models.contact.scene import contact_setup
 
         self.scene = scene
         self.setup = contact_setup(scene)
         self.rigid = rigid if rigid is not None else Walker(scene, step_time_limit_s)
-        s = self.setup
-        self.model = ContactModel(contact=s.law_si, data=s.walker, knee_stop=s.knee_stop,
-                                  flat_foot=s.law.flat_foot(), actuators=s.actuators)
-        self.solver = Solver.from_settings(s.solver)
+        self.model = self.setup.model()  # as the stage's (a wheel's hub inertia too)
+        self.solver = Solver.from_settings(self.setup.solver)
         self._gait = None  # the rigid gait, found on first use
         self._periodic_checked = False
 
@@ -953,10 +950,9 @@ class ContactWalker:
         cs = self.setup.sim
         if cs.periodic_gait or cs.start == "periodic_gait" or self._periodic_checked:
             return
-        from walkerlab.api.scenes import with_changes
         from walkerlab.models.contact.scene import contact_setup
 
-        contact_setup(with_changes(self.scene, {"contact_sim.periodic_gait": True}))
+        contact_setup(self.scene, periodic=True)
         self._periodic_checked = True
 
     def __repr__(self) -> str:
