@@ -261,6 +261,12 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
                                 "powered walker's contact run starts from the rigid gait "
                                 "(start: ideal) or its own periodic gait (periodic_gait)")
     if cs.start == "periodic_gait" or cs.periodic_gait:
+        if five_link:
+            raise ContactSceneError(f"scene '{scene.name}': contact_sim.start / "
+                                    "periodic_gait: the contact periodic gait's step map "
+                                    "carries straight legs' hip torques and push-off, not "
+                                    "joint torques at the knees: start from the rigid gait "
+                                    "(start: ideal, periodic_gait: false)")
         tr = [t.law.time_reference for t in getattr(spec, "torques", None) or ()]
         if any(r is not None for r in tr):
             raise ContactSceneError(f"scene '{scene.name}': walker.actuation: a torque law on "
