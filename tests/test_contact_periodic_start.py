@@ -125,3 +125,40 @@ def test_a_start_whose_periodic_gait_is_not_found_says_why_in_one_line(monkeypat
     with pytest.raises(PeriodicGaitError, match="contact_sim.start: periodic_gait") as e:
         contact_sim_run(setup, SimpleNamespace(x=np.zeros(4), step_period_s=np.nan))
     assert e.value.kind == "time_limit" and "wall-time limit" in str(e.value)
+
+
+def test_a_periodic_gait_search_that_did_not_converge_is_a_gait_not_found(tmp_path,
+                                                                          monkeypatch):
+    """issue 56 item 7, the stage's side: ``start: periodic_gait`` from a search that did
+    not converge is one line naming the field and exit 1 (it started the run from the
+    unconverged state); ``periodic_gait: true`` stores it as not found (outcome
+    ``not_converged``, its message), not as a gait with its multipliers."""
+    import yaml
+    from scipy.optimize import OptimizeResult
+    from typer.testing import CliRunner
+
+    from walkerlab.analysis.contact import periodic
+    from walkerlab.cli import app
+    from walkerlab.io.artifacts import open_artifact
+
+    def warm_up_only(P, PC, coarse, z, *args, **kwargs):  # hybr stopping short, anywhere
+        return OptimizeResult(x=z / P.scale, nfev=0, message="stopped short"), 0
+
+    monkeypatch.setattr(periodic, "_solve_fixed_point", warm_up_only)
+    d = yaml.safe_load(Path("configs/paper.yaml").read_text())
+    runs = str(tmp_path / "runs")
+    for name, start, found in (("steady", "periodic_gait", False), ("also", "ideal", True)):
+        d["contact_sim"].update({"start": start, "n_strides": 1, "periodic_gait": True})
+        p = tmp_path / f"paper_{name}.yaml"
+        p.write_text(yaml.safe_dump(d))
+        r = CliRunner().invoke(app, ["contact-sim", str(p), "--runs-dir", runs])
+        if not found:
+            assert r.exit_code == 1 and "Traceback" not in r.output
+            line, = [ln for ln in r.output.splitlines() if ln.startswith("error:")]
+            assert "contact_sim.start: periodic_gait" in line and "did not converge" in line
+            continue
+        assert r.exit_code == 0, r.output
+        with open_artifact(Path(runs) / f"paper_{name}" / "contact_sim.h5") as f:
+            g = f["periodic_gait"]
+            assert g.attrs["outcome"] == "not_converged" and "multipliers" not in g
+            assert "did not converge" in g.attrs["message"]

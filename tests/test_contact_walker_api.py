@@ -125,3 +125,30 @@ def test_a_powered_contact_walk_equals_the_stage_s(tmp_path):
     assert walk.gait is not None and walk.work and walk.walks
     assert walk.work["push_off"][-1] > 0  # the pulse does positive work on the walker
     _same_as_the_stage(cw, walk, walk.gait, tmp_path)
+
+
+def _stops_short(monkeypatch):
+    """The contact periodic-gait search's root solve stops at its warm-up state (as hybr
+    stops "not making good progress" above the residual asked for): a search that did
+    not converge, whatever the machine."""
+    from scipy.optimize import OptimizeResult
+
+    from walkerlab.analysis.contact import periodic
+
+    def warm_up_only(P, PC, coarse, z, *args, **kwargs):
+        return OptimizeResult(x=z / P.scale, nfev=0, message="stopped short"), 0
+
+    monkeypatch.setattr(periodic, "_solve_fixed_point", warm_up_only)
+
+
+def test_a_contact_periodic_gait_that_did_not_converge_is_raised(paper_contact, monkeypatch):
+    # issue 56 item 7: the search's result came back with converged False (a residual
+    # 0.014 and a multiplier 79.7 from the map's Jacobian away from its fixed point)
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+
+    _stops_short(monkeypatch)
+    cw = paper_contact.with_changes({"contact_sim.n_strides": 1})
+    with pytest.raises(PeriodicGaitError, match=r"did not converge \(scaled residual "
+                       r"\S+ > 1e-08: stopped short\)") as err:
+        cw.periodic_gait()
+    assert err.value.kind == "not_converged" and "\n" not in str(err.value)

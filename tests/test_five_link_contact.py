@@ -201,6 +201,22 @@ def test_contact_view_carries_a_push_off_on_a_five_link_biped():
     assert acts.spec.push_off is not None and acts.pulse_s > 0.0
 
 
+@pytest.mark.parametrize("start", [{"start": "periodic_gait"}, {"periodic_gait": True}])
+def test_a_five_link_contact_periodic_gait_is_refused_in_one_line(start):
+    """The contact periodic gait's step map carries straight legs' hip torques and
+    push-off, not a five-link biped's joint torques: its start (or ``periodic_gait``,
+    ``wl.ContactWalker.periodic_gait``) is refused in one line naming the field; it was an
+    internal error ('JointTorqueActuators' object has no attribute 'laws')."""
+    from walkerlab.models.contact.scene import ContactSceneError, contact_setup
+
+    cfg = yaml.safe_load((ROOT / "configs" / "rabbit.yaml").read_text())
+    cfg["contact_sim"].update(start)
+    with pytest.raises(ContactSceneError, match="contact_sim.start / periodic_gait") as e:
+        contact_setup(scene_from_dict(cfg))
+    assert "\n" not in str(e.value)
+    contact_setup(scene_from_dict(cfg | {"contact_sim": {}}))  # the rigid start: carried
+
+
 @pytest.mark.slow  # 80-130 s: 11 heel strikes of RABBIT on compliant contact (solve_ivp,
 #                   ~27000 right-hand sides with the PD laws evaluated in Python)
 def test_rabbit_walks_on_contact_at_its_rigid_step_period():

@@ -210,10 +210,13 @@ def test_rimless_wheel_floating_view():
 @pytest.mark.parametrize("changes, field", [
     ({"contact.hub_inertia_kg_m2": None}, "contact.hub_inertia_kg_m2"),
     ({"terrain.lanes": "checkerboard"}, "terrain.lanes"),
+    ({"contact_sim.start": "periodic_gait"}, "contact_sim.start"),
+    ({"contact_sim.periodic_gait": True}, "periodic_gait"),
 ])
 def test_rimless_wheel_contact_refusals_are_one_line(changes, field):
-    """A point-mass hub without the contact model's regularising inertia, and checkerboard
-    lanes (the spokes have none of their own): one line naming the field."""
+    """A point-mass hub without the contact model's regularising inertia, checkerboard
+    lanes (the spokes have none of their own) and the contact periodic gait (its step map's
+    mid-stance section is a biped's: an IndexError before): one line naming the field."""
     from walkerlab.models.contact.scene import ContactSceneError, contact_setup
 
     with pytest.raises(ContactSceneError) as exc:
@@ -348,6 +351,31 @@ def test_rimless_wheel_contact_gait_metrics(wheel_runs):
     # at a heel strike; the contact run's 2 x contact_sim.n_strides and the one it ended in
     assert m["ideal"]["n_steps"] == 2 * scene.simulate.strides
     assert m["contact"]["n_steps"] == 2 * scene.contact_sim.n_strides + 1
+
+
+def test_the_in_memory_contact_wheel_walks_the_stage_s_run(wheel_runs):
+    """``wl.ContactWalker`` builds the shipped wheel as ``walkerlab contact-sim`` does (the
+    regularising ``contact.hub_inertia_kg_m2`` the scene sets; it was refused for want of a
+    hub inertia) and walks the stage's run bit for bit; its periodic gait, which the
+    contact view does not find for a wheel, is refused in one line (an IndexError before),
+    as the stage refuses ``--periodic``."""
+    from walkerlab.api import ContactWalker
+    from walkerlab.io.schemas.contact_sim import load_contact_sim
+    from walkerlab.models.contact.scene import ContactSceneError
+
+    runs, scene = wheel_runs
+    cw = ContactWalker.from_scene(SCENE)
+    assert cw.model.mass_matrix(np.zeros(3))[2, 2] == scene.contact.hub_inertia_kg_m2
+    walk = cw.simulate()
+    art = load_contact_sim(runs / scene.name / "contact_sim.h5")
+    assert walk.walks and walk.heel_strikes.size >= 2 * scene.contact_sim.n_strides
+    assert np.array_equal(walk.heel_strikes, art.heel_strike_times)  # bit for bit
+    assert np.array_equal(walk.step_periods, art.steps["period"], equal_nan=True)
+    assert np.array_equal(walk.t, art.samples.time)
+    assert walk.termination == art.termination and walk.outcome == art.outcome
+    with pytest.raises(ContactSceneError, match="periodic_gait") as exc:
+        cw.periodic_gait()
+    assert "\n" not in str(exc.value)
 
 
 def test_rimless_wheel_contact_trajectory_alternates_its_legs(wheel_runs):

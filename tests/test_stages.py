@@ -144,6 +144,55 @@ def test_truncated_artifact_is_a_clear_error(tmp_path):
             pass
 
 
+def _overwritten(good: bytes, off: int, path: Path) -> Path:
+    """``path`` holding ``good`` with 64 bytes overwritten at ``off`` (0, 1, ..., 63)."""
+    b = bytearray(good)
+    b[off:off + 64] = bytes(range(64))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(bytes(b))
+    return path
+
+
+def test_a_fixedpoint_damaged_in_the_middle_is_recomputed_with_a_notice(
+        ideal_scene, tmp_path, capfd):
+    # issue 56 item 9: a fixedpoint.h5 with bytes overwritten in its middle still opens,
+    # but HDF5 cannot walk its objects ("Object visitation failed", a RuntimeError); every
+    # later command was an internal error; now the cache sees a damaged artifact
+    import walkerlab.io.artifacts as A
+    from walkerlab.io.schemas.fixedpoint import load_fixedpoint
+    from walkerlab.stages import fixedpoint
+
+    runs = tmp_path / "runs"
+    first = fixedpoint.run(ideal_scene, runs)
+    good, x, key = first.path.read_bytes(), load_fixedpoint(first.path).x, \
+        A.verified_hash(first.path)
+    # every 4 KiB of the middle half (data, object headers, symbol tables, heaps): the
+    # cache's check gives the hash (bytes nothing reads) or None, the loader one line
+    n = len(good)
+    for off in range(n // 4, 3 * n // 4, 4096):
+        p = _overwritten(good, off, tmp_path / f"sweep{off}" / "fixedpoint.h5")
+        assert A.verified_hash(p) in (None, key)
+        try:
+            load_fixedpoint(p)
+        except ArtifactError as err:
+            assert "\n" not in str(err) and "fixedpoint.h5" in str(err)
+    # the object header of the group nearest the file's middle: the file opens, its walk fails
+    with h5py.File(first.path, "r") as f:
+        heads = []
+        f.visititems(lambda name, o: heads.append(h5py.h5o.get_info(o.id).addr)
+                     if isinstance(o, h5py.Group) else None)
+    mid = min(heads, key=lambda a: abs(a - n // 2))
+    _overwritten(good, mid, first.path)
+    with h5py.File(first.path, "r") as f, pytest.raises(RuntimeError):
+        A.content_hash_of(f)  # what the cache's check met
+    capfd.readouterr()
+    again = fixedpoint.run(ideal_scene, runs)
+    assert not again.reused and "damaged" in again.note
+    assert f"recomputing {first.path} (it is damaged" in capfd.readouterr().err
+    assert np.array_equal(load_fixedpoint(again.path).x, x)  # the same gait, rewritten
+    assert fixedpoint.run(ideal_scene, runs).reused
+
+
 def test_artifact_of_another_version_is_refused(tmp_path):
     p = tmp_path / "fixedpoint.h5"
     with h5py.File(p, "w") as f:

@@ -721,16 +721,13 @@ class ContactWalker:
     def __init__(self, scene: Scene, rigid: Walker | None = None,
                  step_time_limit_s: float = STEP_TIME_LIMIT_S):
         from walkerlab.integrate.solver import Solver
-        from walkerlab.models.contact.model import ContactWalker as ContactModel
         from walkerlab.models.contact.scene import contact_setup
 
         self.scene = scene
         self.setup = contact_setup(scene)
         self.rigid = rigid if rigid is not None else Walker(scene, step_time_limit_s)
-        s = self.setup
-        self.model = ContactModel(contact=s.law_si, data=s.walker, knee_stop=s.knee_stop,
-                                  flat_foot=s.law.flat_foot(), actuators=s.actuators)
-        self.solver = Solver.from_settings(s.solver)
+        self.model = self.setup.model()  # as the stage's (a wheel's hub inertia too)
+        self.solver = Solver.from_settings(self.setup.solver)
         self._gait = None  # the rigid gait, found on first use
         self._periodic_checked = False
 
@@ -926,7 +923,8 @@ class ContactWalker:
         walkerlab.analysis.contact.periodic.ContactPeriodicGait
             ``fixed_point`` (the section state by name), ``period_s`` [s],
             ``step_length_m`` [m], ``multipliers`` (n,) by decreasing modulus, ``jacobian``
-            (n, n), ``residual``, ``stable``, ``converged``, ``full_state`` (N,).
+            (n, n), ``residual`` (below the search's tolerance: ``converged`` is True),
+            ``stable``, ``full_state`` (N,).
 
         Raises
         ------
@@ -936,16 +934,21 @@ class ContactWalker:
             A walker whose contact periodic gait is not found yet (as ``contact_sim:
             periodic_gait: true`` is refused for it; one line).
         walkerlab.analysis.contact.step_map.PeriodicGaitError
-            The gait was not found (a step fell, found no mid-stance, the solver failed or
-            the time limit ran out; one line).
+            The gait was not found (a step fell, found no mid-stance, the solver failed,
+            the time limit ran out, or the search did not converge: ``kind``
+            ``not_converged``, :func:`~walkerlab.analysis.contact.periodic.converged_gait`;
+            one line), as the stage reports it.
         """
-        from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+        from walkerlab.analysis.contact.periodic import (
+            converged_gait,
+            find_contact_periodic_gait,
+        )
 
         self._check_periodic()
         x = self.rigid_gait().x if x0 is None else self.rigid.check_state(x0, "x0")
         walker, _ = self.setup.build(x, 2 * self.setup.sim.n_strides)
-        return find_contact_periodic_gait(walker, x,
-                                          time_limit_s=self.setup.sim.periodic_time_limit_s)
+        return converged_gait(find_contact_periodic_gait(
+            walker, x, time_limit_s=self.setup.sim.periodic_time_limit_s))
 
     def _check_periodic(self) -> None:
         """Refuse a walker whose periodic gait the contact view does not find (the scene's
@@ -953,10 +956,9 @@ class ContactWalker:
         cs = self.setup.sim
         if cs.periodic_gait or cs.start == "periodic_gait" or self._periodic_checked:
             return
-        from walkerlab.api.scenes import with_changes
         from walkerlab.models.contact.scene import contact_setup
 
-        contact_setup(with_changes(self.scene, {"contact_sim.periodic_gait": True}))
+        contact_setup(self.scene, periodic=True)
         self._periodic_checked = True
 
     def __repr__(self) -> str:

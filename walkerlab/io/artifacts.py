@@ -51,6 +51,30 @@ class ArtifactError(RuntimeError):
     """An artifact is missing, unreadable, of another stage or of another walkerlab version."""
 
 
+#: what h5py raises reading a file that opens but is damaged inside (HDF5's error stack
+#: surfaces as OSError, RuntimeError such as "Iteration operator failed", KeyError or
+#: ValueError): such an artifact counts as damaged, never as a result
+READ_ERRORS = (OSError, RuntimeError, KeyError, ValueError)
+
+
+def raised_by_hdf5(exc: BaseException) -> bool:
+    """Whether ``exc`` was raised inside h5py (its innermost frame is h5py's: HDF5 failed to
+    read the file), not by the code reading the values."""
+    tb = exc.__traceback__
+    if tb is None:
+        return False
+    while tb.tb_next is not None:
+        tb = tb.tb_next
+    return "h5py" in Path(tb.tb_frame.f_code.co_filename).parts
+
+
+def damaged_error(path: Path, exc: BaseException) -> ArtifactError:
+    """The one-line error of an artifact that opens but whose content HDF5 cannot read."""
+    why = " ".join(str(exc).split()) or type(exc).__name__
+    return ArtifactError(f"{path}: damaged (HDF5 cannot read it: {why}); rerun its stage "
+                         "with --force (or delete it and rerun)")
+
+
 FILE_MODE = 0o644
 #: root attributes that record the run, not its result (not hashed)
 VOLATILE_ATTRS = frozenset({"content_hash", "created_utc", "wall_time_s", "workers",
@@ -324,7 +348,7 @@ def content_hash(path: Path) -> str | None:
     try:
         with h5py.File(path, "r") as f:
             return _content_hash_memo(Path(path), f)
-    except (OSError, KeyError, ValueError):
+    except READ_ERRORS:  # absent, truncated, or damaged inside
         return None
 
 
@@ -353,7 +377,7 @@ def stored_content_hash_matches(path: Path) -> bool:
         with h5py.File(path, "r") as f:
             stored = f.attrs.get("content_hash")
             return stored is not None and str(stored) == _content_hash_memo(Path(path), f)
-    except (OSError, KeyError, ValueError):
+    except READ_ERRORS:  # absent, truncated, or damaged inside
         return False
 
 
@@ -361,7 +385,8 @@ def verified_hash(path: Path) -> str | None:
     """``input_hash`` of an artifact whose content still matches its stored content hash.
 
     None when the file is absent, unreadable, of another walkerlab version, or was modified
-    after it was written (edited with h5py, truncated, ...).
+    after it was written (edited with h5py, truncated, damaged inside: any dataset or
+    attribute HDF5 cannot read, :data:`READ_ERRORS`).
     """
     try:
         with h5py.File(path, "r") as f:
@@ -371,7 +396,7 @@ def verified_hash(path: Path) -> str | None:
             if stored is None or str(stored) != _content_hash_memo(Path(path), f):
                 return None
             return str(f.attrs.get("input_hash"))
-    except (OSError, KeyError, ValueError):
+    except READ_ERRORS:  # absent, truncated, or damaged inside (a recompute replaces it)
         return None
 
 
@@ -487,8 +512,10 @@ def open_artifact(path: Path, stage: str | None = None,
     Raises
     ------
     ArtifactError
-        Missing file, not a readable HDF5 file (e.g. truncated), another stage's file, or a
-        file written by another walkerlab version (one line naming the file).
+        Missing file, not a readable HDF5 file (e.g. truncated), another stage's file, a
+        file written by another walkerlab version, or a dataset or attribute HDF5 cannot
+        read while the body of the ``with`` reads it (a file damaged inside; h5py's
+        OSError, RuntimeError or ValueError) (one line naming the file).
     """
     path = Path(path)
     if not path.is_file():
@@ -499,14 +526,17 @@ def open_artifact(path: Path, stage: str | None = None,
         raise ArtifactError(f"{path}: artifact not found (run its stage first)")
     try:
         f = h5py.File(path, "r")
-    except OSError:
+    except (OSError, RuntimeError):
         raise ArtifactError(f"{path}: not a readable HDF5 artifact (truncated or damaged); "
                             "delete it and rerun its stage") from None
     try:
-        got = f.attrs.get("stage")
+        try:
+            got = f.attrs.get("stage")
+            ver = f.attrs.get("walkerlab_version")
+        except READ_ERRORS as exc:
+            raise damaged_error(path, exc) from None
         if stage is not None and got != stage:
             raise ArtifactError(f"{path}: expected a '{stage}' artifact, found '{got}'")
-        ver = f.attrs.get("walkerlab_version")
         if check_version and ver != walkerlab.__version__:
             raise ArtifactError(f"{path}: written by walkerlab {ver}, this is "
                                 f"{walkerlab.__version__}; rerun the stage to refresh it")
@@ -518,6 +548,10 @@ def open_artifact(path: Path, stage: str | None = None,
                 what = what[what.rindex("(") + 1:-1]
             raise ArtifactError(f"{path}: {what} (the artifact is damaged or lacks what "
                                 "this reader needs); rerun its stage with --force") from None
+        except (OSError, RuntimeError, ValueError) as exc:
+            if isinstance(exc, ArtifactError) or not raised_by_hdf5(exc):
+                raise  # the reader's own error, not the file's
+            raise damaged_error(path, exc) from None
     finally:
         f.close()
 
@@ -529,7 +563,7 @@ def stored_hash(path: Path) -> str | None:
             if f.attrs.get("walkerlab_version") != walkerlab.__version__:
                 return None
             return str(f.attrs.get("input_hash"))
-    except (OSError, KeyError):
+    except READ_ERRORS:
         return None
 
 
@@ -540,6 +574,6 @@ def root_attrs(path: Path, *names: str) -> dict:
     try:
         with h5py.File(path, "r") as f:
             out = {n: f.attrs[n] for n in names if n in f.attrs}
-    except OSError:
+    except READ_ERRORS:
         return {}
     return {k: v.decode() if isinstance(v, bytes) else v for k, v in out.items()}

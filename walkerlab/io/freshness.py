@@ -79,6 +79,8 @@ def recompute_reason(path: Path, scene, sections: tuple[str, ...],
     """One line saying why an existing artifact ``path`` is out of date (``have``: its
     verified input hash, None when its content does not match its stored hash)."""
     if have is None:
+        if content_hash(path) is None:  # opens (or not) but HDF5 cannot read all of it
+            return "it is damaged: HDF5 cannot read all of it"
         return "it was written by another walkerlab version or changed after it was written"
     diff = changed_fields(path, scene, sections)
     if diff:

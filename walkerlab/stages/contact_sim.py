@@ -120,12 +120,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     Raises
     ------
     walkerlab.models.contact.scene.ContactSceneError
-        The scene has no ``contact`` section, or its walker cannot stand on contacts
+        The scene has no ``contact`` section, its walker cannot stand on contacts, or its
+        periodic gait (``periodic``) is one the contact view does not find
         (:func:`walkerlab.models.contact.scene.contact_setup`; one line).
     walkerlab.io.artifacts.ArtifactError
         ``fixedpoint.h5`` is missing or unreadable.
     """
-    setup = contact_setup(scene)  # the scene read once: all the run needs, typed
+    setup = contact_setup(scene, periodic)  # the scene read once: all the run needs, typed
     periodic = periodic or setup.sim.periodic_gait
     up = (stage_artifact(scene, runs_root, "fixedpoint"),)
     sections = SECTIONS + (("adjust",) if adjust else ()) + (("periodic",) if periodic else ())

@@ -60,7 +60,7 @@ POWERED_MAP_SOLVER = Solver("LSODA", 1e-10, 1e-12)
 POWERED_COARSE_SOLVER = Solver("LSODA", 1e-8, 1e-10)
 
 __all__ = ["COARSE_SOLVER", "MAP_SOLVER", "POWERED_COARSE_SOLVER", "POWERED_MAP_SOLVER",
-           "ContactPeriodicGait", "find_contact_periodic_gait",
+           "ContactPeriodicGait", "converged_gait", "find_contact_periodic_gait",
            "ideal_gait", "simulate_from_periodic_gait"]
 
 
@@ -129,6 +129,32 @@ class ContactPeriodicGait:
     def max_multiplier(self) -> float:
         """Largest ``|multiplier|`` [-]."""
         return float(np.max(np.abs(self.multipliers)))
+
+
+def converged_gait(gait: ContactPeriodicGait) -> ContactPeriodicGait:
+    """``gait`` if its search converged (scaled residual below the search's
+    ``residual_tol``), for the callers that start from the gait or hand it on as found
+    (``contact_sim.start: periodic_gait``, ``periodic_gait: true``,
+    :meth:`walkerlab.api.walker.ContactWalker.periodic_gait`, the rough-ground start): an
+    unconverged state's period and Floquet multipliers (the finite-difference Jacobian of
+    the map away from its fixed point) are no gait's.
+
+    Raises
+    ------
+    walkerlab.analysis.contact.step_map.PeriodicGaitError
+        ``kind`` "not_converged": one line with the residual, the tolerance and the root
+        finder's message.
+    """
+    if gait.converged:
+        return gait
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+
+    tol = gait.info.get("residual_tol", float("nan"))
+    # the root finder's message, to its first clause ("The iteration is not making good
+    # progress, as measured by ..."): the line stays whole on the terminal
+    why = " ".join(str(gait.info.get("root_message", gait.message)).split()).split(",")[0]
+    raise PeriodicGaitError("not_converged", f"the fixed-point search did not converge "
+                            f"(scaled residual {gait.residual:.3g} > {tol:g}: {why})")
 
 
 def ideal_gait(scene):
@@ -397,7 +423,8 @@ def _periodic_gait_result(walker: ContactWalker, P: StepMap, PC: StepMap, coarse
     info = {"warmup_history": hist, "root_message": sol.message, "root_nfev": root_nfev,
             "fd_step": fd_step, "scales": scale, "method": method, "rtol": solver.rtol,
             "atol": solver.atol, "coarse_rtol": coarse_solver.rtol if coarse else None,
-            "coarse_map_evaluations": PC.nfev if coarse else 0, "patch_spacing_m": P.spacing}
+            "coarse_map_evaluations": PC.nfev if coarse else 0, "patch_spacing_m": P.spacing,
+            "residual_tol": residual_tol}
     resid = float(np.max(np.abs(res_si / scale)))
     return ContactPeriodicGait(
         z=zs, fixed_point=dict(zip(P.names, map(float, zs))), period_s=T,
@@ -433,14 +460,16 @@ def simulate_from_periodic_gait(setup, x_ideal: np.ndarray, strides: int | None 
     Raises
     ------
     walkerlab.analysis.contact.periodic.PeriodicGaitError
-        The periodic gait was not found (fell, no mid-stance, solver failure, time limit).
+        The periodic gait was not found (fell, no mid-stance, solver failure, time limit,
+        not converged: :func:`converged_gait`).
     """
     from walkerlab.analysis.contact.sim import scene_start, simulate_contact
 
     cs, sv = setup.sim, solver or setup.solver
     n_strides = strides or cs.n_strides
     probe, _, limits, _ = scene_start(setup, x_ideal, n_strides)
-    gait = find_contact_periodic_gait(probe, x_ideal, time_limit_s=cs.periodic_time_limit_s)
+    gait = converged_gait(find_contact_periodic_gait(probe, x_ideal,
+                                                     time_limit_s=cs.periodic_time_limit_s))
     walker, step_length = setup.build(x_ideal, 2 * n_strides, step_length_m=gait.step_length_m)
     x0 = np.asarray(gait.full_state, float)
     t_final = cs.t_final_s or (2 * n_strides + 1) * gait.period_s

@@ -192,11 +192,15 @@ def contact_sim_run(setup: ContactSetup, fp, adjust: bool = False, periodic: boo
     walker, res, x0, step_length, scale, gait, adj = contact_walk(
         setup, fp.x, fp.step_period_s, adjust)
     if periodic and gait is None:
-        from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+        from walkerlab.analysis.contact.periodic import (
+            converged_gait,
+            find_contact_periodic_gait,
+        )
         from walkerlab.analysis.contact.step_map import PeriodicGaitError
 
-        try:
-            gait = find_contact_periodic_gait(walker, fp.x, time_limit_s=cs.periodic_time_limit_s)
+        try:  # an unconverged search is a gait not found (its outcome and message)
+            gait = converged_gait(find_contact_periodic_gait(
+                walker, fp.x, time_limit_s=cs.periodic_time_limit_s))
         except PeriodicGaitError as exc:
             gait_error = exc
     return ContactSimRun(

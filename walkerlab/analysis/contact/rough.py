@@ -64,7 +64,7 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
     walkerlab.models.contact.scene.ContactSceneError
         No ``contact`` section.
     """
-    from walkerlab.analysis.contact.periodic import find_contact_periodic_gait
+    from walkerlab.analysis.contact.periodic import converged_gait, find_contact_periodic_gait
     from walkerlab.analysis.contact.sim import scene_start
     from walkerlab.models.contact.scene import contact_setup
 
@@ -80,7 +80,8 @@ def contact_start(scene, x_ideal: np.ndarray, periodic: bool = True) -> ContactS
         return ContactStart(scene.model_dump(mode="json"), tuple(map(float, x_ideal)),
                             tuple(map(float, x0)), float(step_length), float(period),
                             float(scene.slope.phi_rad))
-    gait = find_contact_periodic_gait(probe, x_ideal, time_limit_s=cs.periodic_time_limit_s)
+    gait = converged_gait(find_contact_periodic_gait(probe, x_ideal,
+                                                     time_limit_s=cs.periodic_time_limit_s))
     return ContactStart(scene.model_dump(mode="json"), tuple(map(float, x_ideal)),
                         tuple(map(float, gait.full_state)), float(gait.step_length_m),
                         float(gait.period_s), float(scene.slope.phi_rad))

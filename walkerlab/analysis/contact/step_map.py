@@ -101,7 +101,8 @@ SECTION_UNITS = ("rad", "rad/s", "rad/s", "m", "m/s", "m/s")
 
 class PeriodicGaitError(RuntimeError):
     """The step map or the search failed; ``kind`` is one of "fall", "no_mid_stance",
-    "time_limit", "solver_failure"."""
+    "time_limit", "solver_failure", "not_converged" (the search ended away from a fixed
+    point: :func:`walkerlab.analysis.contact.periodic.converged_gait`)."""
 
     def __init__(self, kind: str, message: str):
         super().__init__(message)

@@ -123,6 +123,20 @@ class ContactSetup:
     actuators: ContactActuators | JointTorqueActuators | None = None
     rhs_ready: CompiledElsewhere | None = None
 
+    def model(self) -> ContactWalker:
+        """The setup's contact walker on no terrain: its law, knee stop, flat feet,
+        actuators, a wheel's regularising hub inertia (``contact.hub_inertia_kg_m2``) and
+        the compiled right-hand side's hand-off, the one construction :meth:`build` and the
+        in-memory :class:`walkerlab.api.walker.ContactWalker` share.
+
+        Returns
+        -------
+        ContactWalker
+        """
+        return ContactWalker(contact=self.law_si, data=self.walker, knee_stop=self.knee_stop,
+                             flat_foot=self.law.flat_foot(), actuators=self.actuators,
+                             rhs_ready=self.rhs_ready, hub_inertia=self.law.hub_inertia_kg_m2)
+
     def build(self, x_ideal: np.ndarray, n_steps: int, step_length_m: float | None = None):
         """ContactWalker of the setup with checkerboard patches from the ideal step length.
 
@@ -142,18 +156,24 @@ class ContactSetup:
         step_length : float
             Ideal step length [m] (the patch spacing unless ``step_length_m`` is given).
         """
-        probe = ContactWalker(contact=self.law_si, data=self.walker, knee_stop=self.knee_stop,
-                              flat_foot=self.law.flat_foot(), actuators=self.actuators,
-                              rhs_ready=self.rhs_ready, hub_inertia=self.law.hub_inertia_kg_m2)
+        probe = self.model()
         step_length = ideal_step_length(probe, x_ideal, along_slope=not self.terrain.is_slope)
         return probe.on_terrain(self.terrain, step_length=step_length_m or step_length,
                                 n_steps=n_steps + 4), step_length
 
 
-def contact_setup(scene: Scene) -> ContactSetup:
+def contact_setup(scene: Scene, periodic: bool = False) -> ContactSetup:
     """The scene turned once into what a contact run needs (any walker with positive leg
     masses): its walker data, the contact law and knee stop in SI, terrain, run options and
     solver settings.
+
+    Parameters
+    ----------
+    scene : Scene
+    periodic : bool
+        The run also finds the contact periodic gait (``contact-sim --periodic``,
+        :meth:`walkerlab.api.walker.ContactWalker.periodic_gait`): the scene is checked as
+        with ``contact_sim.periodic_gait: true``.
 
     Raises
     ------
@@ -162,8 +182,10 @@ def contact_setup(scene: Scene) -> ContactSetup:
         with the contact periodic gait), a joint the walker does not have, a walker with a
         massless body, flat feet without
         ``contact.flat_foot_mass_kg`` / ``flat_foot_inertia_kg_m2``, a pinned stance foot
-        that is not a point, or a ground the contact model does not build (a height profile,
-        footholds of several heights, footholds on continuous ground) (one line).
+        that is not a point, a ground the contact model does not build (a height profile,
+        footholds of several heights, footholds on continuous ground), or the periodic gait
+        (``contact_sim.start: periodic_gait``, ``periodic_gait: true`` or ``periodic``) of a
+        walker whose step map it does not carry (a rimless wheel) (one line).
     """
     from walkerlab.codegen.floating import FLAT_FOOT_MESSAGE, check_masses
     from walkerlab.walker.description import walker_data
@@ -177,8 +199,10 @@ def contact_setup(scene: Scene) -> ContactSetup:
     except ValueError as err:
         raise ContactSceneError(f"scene '{scene.name}': {err}") from None
     cs = scene.contact_sim or ContactSimSettings()
+    # checked as the run uses it: with its periodic gait when the caller asks for one
+    checked = cs.model_copy(update={"periodic_gait": True}) if periodic else cs
     data = walker_data(scene.walker, scene.slope.phi_rad)
-    actuators = _actuators(scene, data, cs)
+    actuators = _actuators(scene, data, checked)
     if cs.pin_stance_until != "none" and data.structure.foot != "point":
         raise ContactSceneError(f"scene '{scene.name}': contact_sim.pin_stance_until: pinning "
                                 f"the stance foot needs point feet (this walker's are "
@@ -190,16 +214,17 @@ def contact_setup(scene: Scene) -> ContactSetup:
     if data.structure.foot == "flat" and contact.flat_foot() is None:
         raise ContactSceneError(f"scene '{scene.name}': {FLAT_FOOT_MESSAGE}")
     if data.structure.spokes:
-        _check_wheel(scene, data)
+        _check_wheel(scene, data, checked)
     si, knee = contact_si(contact)  # the contact law in SI: once per run
     return ContactSetup(scene.name, contact, si, knee, data, scene.terrain or TerrainSettings(),
                         cs, scene.contact_solver or SolverSettings.for_contact(), actuators)
 
 
-def _check_wheel(scene: Scene, data) -> None:
+def _check_wheel(scene: Scene, data, cs: ContactSimSettings) -> None:
     """A spoked wheel's contact scene: a regularising hub inertia for a point-mass hub
-    (:data:`walkerlab.codegen.floating.HUB_INERTIA_MESSAGE`) and continuous ground (its
-    spokes are not a pair of legs with a lane each); one-line refusals."""
+    (:data:`walkerlab.codegen.floating.HUB_INERTIA_MESSAGE`), continuous ground (its
+    spokes are not a pair of legs with a lane each) and no contact periodic gait (the step
+    map's mid-stance section is a biped's); one-line refusals."""
     from walkerlab.codegen.floating import HUB_INERTIA_MESSAGE
 
     if data.extra.get("hub_inertia_kg_m2", 0.0) <= 0.0 \
@@ -210,6 +235,12 @@ def _check_wheel(scene: Scene, data) -> None:
         raise ContactSceneError(f"scene '{scene.name}': terrain.lanes: {terrain.lanes}: a "
                                 "rimless wheel's contact model runs on continuous ground "
                                 "(its spokes have no lanes of their own)")
+    if cs.start == "periodic_gait" or cs.periodic_gait:
+        raise ContactSceneError(f"scene '{scene.name}': contact_sim.start / periodic_gait: "
+                                "the contact periodic gait (also --periodic) is found on a "
+                                "biped's mid-stance step map, which a rimless wheel has not: "
+                                "start from the rigid gait (start: ideal, periodic_gait: "
+                                "false)")
 
 
 def _actuators(scene: Scene, data, cs: ContactSimSettings
@@ -230,6 +261,12 @@ def _actuators(scene: Scene, data, cs: ContactSimSettings
                                 "powered walker's contact run starts from the rigid gait "
                                 "(start: ideal) or its own periodic gait (periodic_gait)")
     if cs.start == "periodic_gait" or cs.periodic_gait:
+        if five_link:
+            raise ContactSceneError(f"scene '{scene.name}': contact_sim.start / "
+                                    "periodic_gait: the contact periodic gait's step map "
+                                    "carries straight legs' hip torques and push-off, not "
+                                    "joint torques at the knees: start from the rigid gait "
+                                    "(start: ideal, periodic_gait: false)")
         tr = [t.law.time_reference for t in getattr(spec, "torques", None) or ()]
         if any(r is not None for r in tr):
             raise ContactSceneError(f"scene '{scene.name}': walker.actuation: a torque law on "
