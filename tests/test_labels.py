@@ -170,6 +170,23 @@ def test_contact_report_summary_rows():
     assert "integration" in rows[2][0] and "took 11.0 s" in rows[2][0]
 
 
+def test_the_contact_report_shows_the_slip_path_and_the_friction_work_beside_the_push_off():
+    """Issue 56 item 15: the report's contact section gives the stance foot's slip path and
+    friction work per step, and the friction work against the push-off's."""
+    from types import SimpleNamespace
+
+    from walkerlab.report.contact_sections import _slip_path_lines
+
+    c = SimpleNamespace(steps={"stance_slip_mm": np.array([0.13, np.nan]),
+                               "stance_slip_path_mm": np.array([3.97, np.nan]),
+                               "friction_work_j": np.array([0.087, np.nan])},
+                        ledger_steps={"push_off_work": np.array([0.1758])})
+    text = " ".join(_slip_path_lines(c))
+    assert "Slip path of the stance foot per step [mm]" in text and "3.97" in text
+    assert "friction work per stance [J]" in text and "0.087" in text
+    assert "49 % of the push-off" in text  # 0.087 / 0.1758
+
+
 def test_clearance_says_below_for_penetration():
     from walkerlab.report.sections import clearance_text
 
