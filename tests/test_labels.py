@@ -98,6 +98,25 @@ def test_nondimensional_artifact_units_and_cli_text(simplest_run):
     assert not re.search(r"\d (s|rad/s)$", fp, re.M), fp
 
 
+def test_a_walk_that_runs_off_its_profile_says_so_not_the_strides_asked():
+    """Issue 56 item 16: a walk that left its profile after one heel strike said "simulated
+    5 strides: 1 heel strikes"."""
+    from types import SimpleNamespace
+
+    from walkerlab.report.text import simulate_text
+
+    s = {"mean_period_s": 0.7, "mean_step_length_m": 0.3, "mean_hip_speed_m_per_s": 0.4,
+         "mean_total_energy_J": 10.0, "nfev": 100, "wall_time_s": 0.1}
+    sim = SimpleNamespace(termination="heel_strike", strides_requested=5, summary=s,
+                          units=SI_U, heel_strike_count=lambda: 1)
+    first = simulate_text(sim).splitlines()[0]
+    assert "simulated 5 strides" not in first
+    assert "ended at the end of its terrain" in first and "after 1 heel strike " in first
+    assert "0.5 strides of the 5 asked" in first
+    sim.heel_strike_count = lambda: 10
+    assert simulate_text(sim).startswith("simulated 5 strides: 10 heel strikes")
+
+
 def test_nondimensional_report_and_figures_follow_the_scene(simplest_run):
     """Report summary, gait table and the figures' axis labels of a nondimensional scene."""
     from walkerlab.io.runpaths import stage_artifact

@@ -230,8 +230,14 @@ def simulate_text(sim: SimulateArtifact) -> str:
     if ending is not None:
         return ending
     u, s = sim.units, sim.summary
-    lines = [f"simulated {sim.strides_requested} strides: "
-             f"{sim.heel_strike_count()} heel strikes"]
+    n = sim.heel_strike_count()
+    if n < 2 * sim.strides_requested:  # every step a heel strike, but fewer than asked
+        lines = [f"the walk ended at the end of its terrain (the profile's last point or the "
+                 f"last foothold: the next step would land past it) after {n} heel "
+                 f"strike{'' if n == 1 else 's'} ({n / 2:g} stride{'' if n == 2 else 's'} of "
+                 f"the {sim.strides_requested} asked)"]
+    else:
+        lines = [f"simulated {sim.strides_requested} strides: {n} heel strikes"]
     if u.nondimensional:
         lines.append(f"  ({u.sentence()})")
     lines.append(f"  mean step period  {num(s['mean_period_s'], 7)} {u.time}")
