@@ -320,6 +320,37 @@ def compare_text(c: Comparison) -> str:
     return "\n".join(lines)
 
 
+def mfpt_text(summary: dict) -> str:
+    """One line per sigma of an MFPT study (:func:`walkerlab.studies.mfpt.mfpt_summary`):
+    the Monte Carlo MFPT with its standard error and its falls, the mesh MFPT and why it may
+    be off; a method that was not run is left out (no "mesh nan")."""
+    n = len(summary["sigma_rad"])
+    nan = [float("nan")] * n
+    heights = summary.get("sigma_m")
+    lines = []
+    for i in range(n):
+        label = (f"height sigma {1e3 * heights[i]:.4g} mm" if heights is not None
+                 else f"sigma {summary['sigma_rad'][i]:.4g} rad")
+        m, se = summary["mfpt_steps_montecarlo"][i], \
+            summary.get("mfpt_steps_montecarlo_stderr", nan)[i]
+        walks, falls = (summary.get(k, nan)[i] for k in ("montecarlo_walks",
+                                                         "montecarlo_falls"))
+        parts = []
+        if np.isinf(m):
+            parts.append(f"MFPT Monte Carlo: none of {walks:.0f} walks fell (beyond their "
+                         "step cap)" if np.isfinite(walks) else "MFPT Monte Carlo: no walk fell")
+        elif np.isfinite(m):
+            parts.append(f"MFPT Monte Carlo {m:.4g}" + (f" ± {se:.2g}" if np.isfinite(se) else "")
+                         + " steps" + (f" ({falls:.0f} of {walks:.0f} walks fell)"
+                                       if np.isfinite(falls) and np.isfinite(walks) else ""))
+        me = summary.get("mfpt_steps_mesh", nan)[i]
+        if np.isfinite(me):
+            why = summary.get("mesh_note", [""] * n)[i]
+            parts.append(f"mesh {me:.4g} steps" + (f" - mesh {why}" if why else ""))
+        lines.append(f"{label}: " + (", ".join(parts) or "no MFPT computed"))
+    return "\n".join(lines)
+
+
 def _ms(t: float) -> str:
     return f"{num(1e3 * t, 3)} ms"
 
