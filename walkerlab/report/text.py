@@ -125,6 +125,27 @@ def _terrain_kind(scene_json) -> str | None:
         return None
 
 
+def _stride_reason(scene_json) -> str:
+    """Why a gait's Poincaré map is a stride (from the stored scene): "the legs differ",
+    "the footholds differ" or both; "its steps differ" when the scene does not say."""
+    import json
+
+    try:
+        d = json.loads(scene_json or "{}")
+        legs = (d.get("walker") or {}).get("legs") or []
+        terrain = d.get("terrain") or {}
+    except (TypeError, ValueError, AttributeError):
+        return "its steps differ"
+    why = []
+    if len(legs) > 1 and any(leg != legs[0] for leg in legs[1:]):
+        why.append("legs")
+    if terrain.get("kind") == "footholds" and any(
+            len(set(terrain.get(k) or ())) > 1
+            for k in ("foothold_heights_m", "foothold_slopes_rad")):
+        why.append("footholds")
+    return f"the {' and the '.join(why)} differ" if why else "its steps differ"
+
+
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     u, legs = fp.units, fp.legs_by_role
@@ -139,7 +160,7 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     lines.append(f"  step period     {fp.step_period_s:.10f} {u.time}")
     if fp.stride_period_s is not None:  # legs that differ: the Poincare map is a stride
         lines.append(f"  stride period   {fp.stride_period_s:.10f} {u.time} (the map is a "
-                     "stride: the legs differ)")
+                     f"stride: {_stride_reason(fp.scene_json)})")
         for leg, T, d in zip(fp.step_swing_legs, fp.step_periods_s, fp.step_lengths_m):
             lines.append(f"    step with {leg} swinging: period {T:.10f} {u.time}, "
                          f"length {d:.10f} {u.length}")
