@@ -4,7 +4,7 @@ another code tree side by side.
     python scripts/bench_main_job.py [--vs DIR] [--repeats 3] [--parts contact_sim,bare,report,...]
                                      [--out runs/bench/main_job.json]
 
-``--vs DIR``: a second code tree (e.g. ``git worktree add /tmp/prev <commit>``) measured in
+``--vs DIR``: a second code tree (e.g. ``git worktree add prev_tree <commit>``) measured in
 the same run, alternating which goes first; the table gives this/vs ratios.  What is
 measured and the goals: :mod:`walkerlab.bench.main_job`.
 """

@@ -1,7 +1,7 @@
 """CPU by phase of one ``walkerlab contact-sim`` process (the warm profile of the main job).
 
     python scripts/profile_contact_sim.py [--imports] -q contact-sim configs/paper.yaml \
-        --force --runs-dir /tmp/runs
+        --force --runs-dir runs_profile
 
 Runs the CLI in this process with the given arguments and prints, on stderr, the process
 CPU time (``time.process_time``, user + system) spent in each phase: interpreter start-up,

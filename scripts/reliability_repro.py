@@ -2,7 +2,9 @@
 
 Usage::
 
-    PYTHONPATH=/work/wt/base python scripts/reliability_repro.py /tmp/repro_base [CASE ...]
+    PYTHONPATH=. python scripts/reliability_repro.py repro_base [CASE ...]
+
+(from the checkout's root, which the ``PYTHONPATH`` names; ``repro_base`` is created).
 
 Cases ``d*`` are issue 12's, ``i19_<item>_*`` issue 19's (items 1-14; every case gets its
 own user cache, ``WALKERLAB_CACHE_DIR=<case>/uc``).

@@ -117,6 +117,24 @@ def test_a_number_yaml_reads_as_text_says_how_to_write_it(tmp_path):
     assert yaml.safe_load("x: 1.0e+4")["x"] == 1e4  # the advice is what YAML reads
 
 
+@pytest.mark.parametrize("form,plain", [("0x10", "16"), ("1_0.0", "10.0"), ("010", "8"),
+                                        ("0b11", "3"), ("1:20", "80")])
+def test_a_yaml_1_1_number_form_is_refused_naming_the_field(tmp_path, form, plain):
+    """Issue 56 item 16: PyYAML reads YAML 1.1's hex, underscore, octal, binary and base-60
+    forms as numbers (``hip_mass_kg: 0x10`` was a 16 kg hip); the field refuses them, in
+    one line, with the number YAML 1.1 would have read."""
+    p = tmp_path / "y11.yaml"
+    p.write_text("walker: {model: compass_gait, leg_length_m: 1, leg_mass_kg: 5, "
+                 f"hip_mass_kg: {form}, leg_mass_from_foot_m: 0.5}}\nslope: {{angle_deg: 1}}\n")
+    with pytest.raises(SceneError) as exc:
+        load_scene(p)
+    msg = str(exc.value)
+    assert "\n" not in msg and "walker.hip_mass_kg" in msg and f"(got '{form}')" in msg
+    assert msg.endswith(f"YAML 1.1 reads {plain})")
+    p.write_text(p.read_text().replace(f"hip_mass_kg: {form}", "hip_mass_kg: 10"))
+    assert load_scene(p).walker.hip_mass_kg == 10  # a plain decimal is read
+
+
 # --------------------------------------------------------------- 10: said once
 def test_messages_are_not_doubled():
     d = {"walker": {k: v for k, v in WALKER.items() if k != "leg_mass_from_foot_m"}

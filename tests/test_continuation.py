@@ -335,3 +335,21 @@ def test_no_cost_of_transport_figure_without_finite_measures():
     b = {"gait": {"speed": nan, "cost_of_transport": nan}, "stable": np.ones(3, bool),
          "param": np.arange(3.0), "period": 1}
     assert cost_of_transport_figure(SimpleNamespace(branches=[b], path="x", unit="-")) is None
+
+
+def test_a_homotopy_from_a_scene_with_the_same_numbers_says_so_without_an_empty_list(
+        monkeypatch):
+    """Issue 56 item 16: ``fixedpoint.from`` a scene whose walker and slope are this one's
+    said "by homotopy over  (8 continuation points" (an empty field list)."""
+    from types import SimpleNamespace
+
+    from walkerlab.studies import continuation as C
+
+    sc = load_scene(Path(__file__).resolve().parents[1] / "configs" / "paper.yaml")
+    same = SimpleNamespace(reached=True, fields={}, specials=[], x=np.zeros(4),
+                           branch=SimpleNamespace(points=[None] * 8))
+    monkeypatch.setattr(C, "homotopy_gait", lambda known, new: same)
+    _, note = C.homotopy_start(sc, sc)
+    assert "over  (" not in note and "by homotopy over" not in note
+    assert note == ("initial guess: the gait of scene paper, whose walker and slope have this "
+                    "scene's numbers (nothing to carry by homotopy)")

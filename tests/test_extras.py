@@ -121,3 +121,36 @@ def test_the_python_api_without_its_datasets_says_which_extra(monkeypatch, tmp_p
     with pytest.raises(MissingExtra, match=r"^walkerlab's Python API needs h5netcdf \(not "
                        r"installed\): pip install 'walkerlab\[api\]'$"):
         load_dataset(path)
+
+
+def test_the_docs_name_only_extras_that_exist():
+    """Issue 56 item 16: the user guide said CasADi came with "the `dev` and `optimize`
+    extras"; there is no `dev` extra.  Every extra the docs name ("the `x` extra",
+    "`x` and `y` extras", ``.[x]``) is one of pyproject's."""
+    extras = set(PROJECT["optional-dependencies"])
+    named = {}
+    for f in [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]:
+        text = f.read_text()
+        for group in re.findall(r"((?:`[\w-]+`(?:,| and| or)? ?)+) extras?\b", text):
+            for name in re.findall(r"`([\w-]+)`", group):
+                named.setdefault(name, f.name)
+        for group in re.findall(r"\.\[([\w,-]+)\]", text):
+            for name in group.split(","):
+                if name != "NAME":  # the placeholder of "pip install -e '.[NAME]'"
+                    named.setdefault(name, f.name)
+    assert "optimize" in named  # the patterns find the docs' mentions
+    unknown = {n: where for n, where in named.items() if n not in extras}
+    assert not unknown, unknown
+
+
+def test_the_banner_and_the_description_say_passive_and_powered():
+    """Issue 56 item 16: the CLI banner and pyproject's description said "passive-dynamic"
+    though the lab powers walkers (push-off, joint torques, optimal gaits)."""
+    import walkerlab
+    from walkerlab.cli import app
+
+    # rich wraps the help to the terminal's width: the words, joined again
+    banner = " ".join(re.sub(r"[│╭╮╰╯─]", " ", CliRunner().invoke(app, ["--help"]).output)
+                      .split())
+    for text in (banner, PROJECT["description"], walkerlab.__doc__.splitlines()[0]):
+        assert "passive-dynamic" not in text and "passive and powered" in text, text

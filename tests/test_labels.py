@@ -98,6 +98,25 @@ def test_nondimensional_artifact_units_and_cli_text(simplest_run):
     assert not re.search(r"\d (s|rad/s)$", fp, re.M), fp
 
 
+def test_a_walk_that_runs_off_its_profile_says_so_not_the_strides_asked():
+    """Issue 56 item 16: a walk that left its profile after one heel strike said "simulated
+    5 strides: 1 heel strikes"."""
+    from types import SimpleNamespace
+
+    from walkerlab.report.text import simulate_text
+
+    s = {"mean_period_s": 0.7, "mean_step_length_m": 0.3, "mean_hip_speed_m_per_s": 0.4,
+         "mean_total_energy_J": 10.0, "nfev": 100, "wall_time_s": 0.1}
+    sim = SimpleNamespace(termination="heel_strike", strides_requested=5, summary=s,
+                          units=SI_U, heel_strike_count=lambda: 1)
+    first = simulate_text(sim).splitlines()[0]
+    assert "simulated 5 strides" not in first
+    assert "ended at the end of its terrain" in first and "after 1 heel strike " in first
+    assert "0.5 strides of the 5 asked" in first
+    sim.heel_strike_count = lambda: 10
+    assert simulate_text(sim).startswith("simulated 5 strides: 10 heel strikes")
+
+
 def test_nondimensional_report_and_figures_follow_the_scene(simplest_run):
     """Report summary, gait table and the figures' axis labels of a nondimensional scene."""
     from walkerlab.io.runpaths import stage_artifact
@@ -168,6 +187,23 @@ def test_contact_report_summary_rows():
                           "wall_time_s": (np.float64(0.124), "s")}, 11.02)
     assert rows[0][1] == "0" and rows[1][1] == "10"
     assert "integration" in rows[2][0] and "took 11.0 s" in rows[2][0]
+
+
+def test_the_contact_report_shows_the_slip_path_and_the_friction_work_beside_the_push_off():
+    """Issue 56 item 15: the report's contact section gives the stance foot's slip path and
+    friction work per step, and the friction work against the push-off's."""
+    from types import SimpleNamespace
+
+    from walkerlab.report.contact_sections import _slip_path_lines
+
+    c = SimpleNamespace(steps={"stance_slip_mm": np.array([0.13, np.nan]),
+                               "stance_slip_path_mm": np.array([3.97, np.nan]),
+                               "friction_work_j": np.array([0.087, np.nan])},
+                        ledger_steps={"push_off_work": np.array([0.1758])})
+    text = " ".join(_slip_path_lines(c))
+    assert "Slip path of the stance foot per step [mm]" in text and "3.97" in text
+    assert "friction work per stance [J]" in text and "0.087" in text
+    assert "49 % of the push-off" in text  # 0.087 / 0.1758
 
 
 def test_clearance_says_below_for_penetration():

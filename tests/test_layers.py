@@ -408,6 +408,30 @@ def test_the_outside_reference_rule_catches_each_kind(tmp_path):
     assert got == set(range(len(cases)))
 
 
+def test_the_scenes_and_scripts_point_at_nothing_outside_the_project():
+    """Issue 56 item 16: shipped scenes cited the paper as a file outside the project
+    (``shared/seeds/...``) and ``scripts/reliability_repro.py`` carried an absolute path of
+    one machine (``PYTHONPATH=/work/wt/base``)."""
+    import io
+    import re
+    import tokenize
+
+    root = PKG.parent
+    scenes = sorted((root / "configs").glob("*.yaml"))
+    scripts = sorted((root / "scripts").glob("*.py"))
+    assert len(scenes) > 20 and len(scripts) > 5
+    bad = _outside_references(scenes)
+    for p in scripts:  # their prose: docstring and comments (a script's hostile inputs,
+        # "../evil", are its data)
+        src = p.read_text()
+        prose = [ast.get_docstring(ast.parse(src)) or ""] + [
+            t.string for t in tokenize.generate_tokens(io.StringIO(src).readline)
+            if t.type == tokenize.COMMENT]
+        bad += [f"{p}: {line}" for text in prose for line in text.splitlines()
+                if re.search(OUTSIDE, line)]
+    assert not bad, bad
+
+
 def test_the_package_points_at_nothing_outside_the_project():
     """Docstrings and comments cite the paper, an equation or a file of the project: a notes
     file or a path outside the tree means nothing to a reader of the package."""

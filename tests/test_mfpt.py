@@ -356,3 +356,53 @@ def test_largest_step_down_and_up_of_the_paper_walker(paper_map, paper_fixed_poi
         h = R.largest_tolerable(paper_map, paper_fixed_point.x, "floor_height", 0.02, 0.001,
                                 sign=sign)
         assert 0.001 <= h < 0.02
+
+
+def test_the_mfpt_lines_give_the_standard_error_and_the_falls_and_no_mesh_nan(tmp_path,
+                                                                             monkeypatch):
+    """Issue 56 item 16: the terminal printed "MFPT Monte Carlo 1234, mesh nan steps" for a
+    Monte-Carlo-only study, without the standard error or the number of walks that fell."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
+    from walkerlab.stages import common, pipeline
+    from walkerlab.studies.mfpt import mfpt_summary
+
+    vals = {k: np.array([np.nan, np.nan]) for k in VARIABLES}
+    vals.update(mfpt_steps_montecarlo=np.array([1234.0, np.inf]),
+                mfpt_steps_montecarlo_stderr=np.array([56.0, np.nan]),
+                montecarlo_walks=np.array([100.0, 100.0]),
+                montecarlo_falls=np.array([37.0, 0.0]))
+    summary = mfpt_summary(MfptData(np.array([0.004, 0.001]), vals, "montecarlo",
+                                    ["a", "b", "c", "d"], []))
+    out = common.StageOutcome("mfpt", tmp_path / "mfpt.h5", False, 1.0, summary)
+    monkeypatch.setattr(pipeline, "run", lambda *a, **k: out)
+    r = CliRunner().invoke(app, ["mfpt", str(ROOT / "configs" / "paper.yaml"), "--runs-dir",
+                                 str(tmp_path / "runs")])
+    lines = [ln for ln in r.stdout.splitlines() if ln.startswith("sigma")]
+    assert lines[0] == "sigma 0.004 rad: MFPT Monte Carlo 1234 ± 56 steps (37 of 100 walks fell)"
+    assert lines[1].startswith("sigma 0.001 rad: MFPT Monte Carlo: none of 100 walks fell")
+    assert not any("nan" in ln or "mesh" in ln for ln in lines), lines
+
+
+def test_mfpt_says_it_does_not_use_the_scenes_per_step_slope_spread(tmp_path, monkeypatch):
+    """Issue 56 item 16: ``mfpt`` swept mfpt.sigma_rad and silently ignored the scene's
+    terrain.per_step.slope_sd_rad; it now says so in one line (and nothing without it)."""
+    from walkerlab import progress
+    from walkerlab.config import scene_from_dict
+    from walkerlab.stages import common
+    from walkerlab.stages import mfpt as stage
+
+    notes = []
+    monkeypatch.setattr(progress, "note", notes.append)
+    monkeypatch.setattr(stage, "run_cached", lambda *a, **k: common.StageOutcome(
+        "mfpt", tmp_path / "mfpt.h5", True, 0.0, {}))
+    monkeypatch.setattr(stage, "draw", lambda *a, **k: [])
+    data = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    stage.run(scene_from_dict(data, "p.yaml"), tmp_path, sigma_rad=[0.002, 0.004])
+    assert notes == []
+    data["terrain"] = {**data.get("terrain", {}), "per_step": {"slope_sd_rad": 0.003}}
+    stage.run(scene_from_dict(data, "p.yaml"), tmp_path, sigma_rad=[0.002, 0.004])
+    assert len(notes) == 1 and "terrain.per_step.slope_sd_rad (0.003 rad) is not used" in \
+        notes[0] and "mfpt.sigma_rad (--sigma-rad) 0.002, 0.004 rad" in notes[0], notes

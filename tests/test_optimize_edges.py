@@ -67,6 +67,39 @@ def test_a_contact_replay_whose_solver_fails_is_an_outcome(monkeypatch):
     assert "\n" not in outcome
 
 
+def test_the_contact_replay_runs_the_scenes_contact_solver_it_advises_changing(monkeypatch):
+    """Issue 56 item 16: the contact replay of a straight-legged optimum ran LSODA at rtol
+    1e-6 whatever the scene's contact_solver, yet its failure advised changing
+    contact_solver.  It now runs the scene's; a stride's replay, whose solver stays fixed
+    (the shipped asymmetric_optimal's replay unchanged), says so instead."""
+    from types import SimpleNamespace
+
+    from walkerlab.analysis.contact import sim
+    from walkerlab.optimal.replay import contact as contact_replay
+    from walkerlab.optimal.transcription import step
+
+    used = []
+
+    def fail(*a, **k):
+        used.append(k.get("solver"))
+        raise ValueError("f(a) and f(b) must have different signs")
+
+    monkeypatch.setattr(sim, "simulate_from", fail)
+    monkeypatch.setattr(step, "torque_of_time", lambda res: (lambda t: 0.0))
+    d = load_scene(CONFIGS / "compass_optimal.yaml").model_dump(mode="json", exclude_none=True)
+    d["contact_solver"] = {"method": "Radau", "rtol": 1e-7, "atol": 1e-9}
+    scene = type(load_scene(CONFIGS / "compass_optimal.yaml")).model_validate(d)
+    res = SimpleNamespace(push_off_n_s=0.0, x=np.zeros((1, 4)), step_period_s=0.7)
+    period, outcome = contact_replay.contact_replay(scene, res)
+    assert np.isnan(period) and used[-1].method == "Radau" and used[-1].rtol == 1e-7
+    assert "solver (Radau, rtol 1e-07) failed" in outcome
+    assert outcome.endswith("set another contact_solver (method, rtol) in the scene: the "
+                            "replay runs it")
+    fixed = contact_replay.replay_failure(ValueError("x"), used[-1], fixed=True)
+    assert "this replay's solver is fixed (the scene's contact_solver is not used here)" in \
+        fixed and "set another contact_solver" not in fixed
+
+
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_an_infeasible_target_is_not_replayed_on_contact_and_require_gait_fails(tmp_path):
     """compass_optimal at 0.6 m/s with |u| <= 0.5 N m: IPOPT reports the problem infeasible

@@ -220,6 +220,49 @@ def test_d3_read_only_runs_folder_is_one_line(tmp_path, monkeypatch):
     assert code == 1 and "Permission denied" in err and "\n" not in err, err
 
 
+def _read_only(monkeypatch):
+    """What a read-only runs folder does to walkerlab's writes (root ignores file modes, so
+    the failures are raised where the kernel would raise them): no lock file, no temporary
+    file."""
+    import errno
+    import tempfile
+
+    from walkerlab.io import runpaths
+
+    def no_lock(lock):
+        raise RunPathError(f"{lock.parent}: cannot write the run folder (Read-only file "
+                           "system)")
+
+    def no_temp(suffix=None, prefix=None, dir=None, text=False):
+        raise OSError(errno.EROFS, "Read-only file system", f"{dir}/{prefix}x1y2{suffix}")
+
+    monkeypatch.setattr(runpaths, "_open_lock", no_lock)
+    monkeypatch.setattr(tempfile, "mkstemp", no_temp)
+
+
+def test_a_read_only_runs_folder_reuses_an_up_to_date_artifact_and_names_its_folder(
+        tmp_path, monkeypatch):
+    """Issue 56 item 16: a read-only runs folder could not even reuse an up-to-date
+    artifact (the lock file was created first), and a write there named the temporary
+    file (".walker.xml.<pid>.<random>.tmp") and said "walker.xml kept as they were"."""
+    from walkerlab.io.artifacts import atomic_write_all
+
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(-0.8))
+    _read_only(monkeypatch)
+    again = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(-0.8))
+    assert again.reused
+    with pytest.raises(RunPathError, match="cannot write the run folder"):  # a write: one line
+        common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(-0.8),
+                          force=True)
+    folder = tmp_path / "paper"
+    with pytest.raises(ArtifactError) as exc:
+        atomic_write_all([(folder / "walker.xml", lambda fh: fh.write(b"<mujoco/>"))])
+    msg = str(exc.value)
+    assert msg.startswith(f"{folder}: cannot write there (Read-only file system)"), msg
+    assert ".tmp" not in msg and "(walker.xml kept as it was)" in msg
+
+
 def test_d3_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     path = stage_artifact(sc, tmp_path, "simulate")

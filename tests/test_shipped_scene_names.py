@@ -50,3 +50,18 @@ def test_the_gymnasium_environment_takes_a_shipped_name(tmp_path, monkeypatch):
     obs, info = env.reset(seed=0)
     assert obs.shape == env.observation_space.shape
     env.close()
+
+
+def test_shipped_scenes_cite_the_paper_by_its_title_not_a_path_outside_the_project():
+    """Issue 56 item 16: four shipped scenes cited the paper as
+    ``shared/seeds/000_cba74126b2033523.txt``, a file outside the project; they cite its
+    title (comments only: the scenes' numbers are unchanged)."""
+    import re
+
+    from walkerlab.published.paper import TITLE
+
+    for f in sorted((ROOT / "configs").glob("*.yaml")):
+        text = f.read_text()
+        assert "shared/" not in text and not re.search(r"(^|[\s(\"'])/(work|home|tmp)/", text), f
+        if "The compass-gait walker of the paper" in text or "The paper's compass-gait" in text:
+            assert " ".join(TITLE.split()) in " ".join(text.replace("#", " ").split()), f

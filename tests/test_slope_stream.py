@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from walkerlab.analysis.robustness import mfpt as M
-from walkerlab.analysis.robustness.slope_stream import pcg64_states, slope_rows
+from walkerlab.analysis.robustness.slope_stream import slope_rows
 from walkerlab.integrate.batch_step import BatchStepMap
 from walkerlab.models.registry import build_walker
 from walkerlab.studies.mfpt import scene_walker_at
@@ -30,11 +30,23 @@ def test_slope_rows_equal_draw_slopes_bit_for_bit(seed, distribution):
     np.testing.assert_array_equal(got, ref)
 
 
-def test_pcg64_states_are_numpys():
-    for seed in (0, 3, 2**40 + 1, 2**130 + 7):
-        for w in (0, 9, 2**32 - 1):
-            st = np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(w,))).state["state"]
-            assert pcg64_states(seed, [w]) == [(st["state"], st["inc"])]
+def test_the_streams_are_seeded_by_numpys_public_seed_sequence(monkeypatch):
+    """Issue 56 item 16: the streams were seeded by a copy of NumPy's SeedSequence hashing
+    and PCG64 seeding (its internals, with no upper bound on NumPy); they are seeded by
+    ``np.random.SeedSequence`` itself, one per walk, and stay ``draw_slopes``' bit for bit
+    (the pinned stream above)."""
+    made = []
+    real = np.random.SeedSequence
+
+    def seed_sequence(*a, **k):
+        made.append(k.get("spawn_key"))
+        return real(*a, **k)
+
+    monkeypatch.setattr(np.random, "SeedSequence", seed_sequence)
+    got = slope_rows(5, [17, 3], 0, 3, 0.01, 0.002)
+    assert made == [(17,), (3,)]
+    assert got[0].tolist() == [0.009488771964797518, 0.004431233023424911,
+                               0.011411737196432414]
 
 
 def test_long_normal_stream_reaches_the_tails_and_stays_equal():

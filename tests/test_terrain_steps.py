@@ -372,3 +372,21 @@ def test_fixedpoint_on_a_profile_names_the_slopes_gait(tmp_path):
                                  "--runs-dir", str(tmp_path)])
     assert r.exit_code == 0, r.output
     assert "ground: terrain.kind: profile: this is the gait of the scene's slope" in r.output
+
+
+def test_a_stride_map_of_footholds_that_differ_does_not_blame_the_legs(tmp_path):
+    """Issue 56 item 16: a period-2 gait of two foothold heights printed "(the map is a
+    stride: the legs differ)" for a walker whose legs are the same."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = yaml.safe_load((ROOT / "configs" / "footholds.yaml").read_text())
+    d["terrain"]["foothold_heights_m"] = [-0.005, -0.003]
+    scene = tmp_path / "two_heights.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["fixedpoint", str(scene), "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    line = next(ln for ln in r.output.splitlines() if "stride period" in ln)
+    assert line.endswith("(the map is a stride: the footholds differ)"), line

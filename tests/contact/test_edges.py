@@ -11,6 +11,7 @@ import pytest
 from tests.contact.conftest import FP, STEP_LENGTH
 from walkerlab.analysis.contact.drop import restitution_curve
 from walkerlab.analysis.contact.gait import CONTACT_OUTCOMES as OUTCOME_KINDS
+from walkerlab.analysis.contact.gait import gait_events
 from walkerlab.analysis.contact.gait import phase_slip as _phase_slip
 from walkerlab.analysis.contact.sim import initial_state_from_ideal, simulate_contact
 from walkerlab.config import ContactSettings, SolverSettings, TerrainSettings
@@ -103,6 +104,57 @@ def test_slip_window_is_one_stance_phase():
     assert ended and all(abs(st.stance_slip_mm) < 2.0 for st in ended)
     assert np.isnan(r.steps[-1].stance_slip_mm)
     assert all(np.isfinite(st.double_support_creep_mm) for st in r.steps)
+
+
+class _TwoFeet:
+    """A stand-in walker whose two point feet follow given traces (``gait_events`` reads
+    the contact table through ``foot_quantities`` and ``contact_names`` only)."""
+
+    def __init__(self, traces):
+        self.traces = traces
+
+    def contact_names(self):
+        return tuple(self.traces)
+
+    def foot_quantities(self, X):
+        return self.traces
+
+
+def _scuffing_walk():
+    """Stance leg2 creeps to and fro (0.01 m/s, 10 Hz; net 0) from 0 to its lift-off at
+    0.6 s; leg1 strikes at 0.5 s; leg2 swings from 0.7 s at 1 m/s, scuffs the ground
+    (0.8-0.85 s) and strikes at 1.3 s; friction F = -200 v on a loaded foot."""
+    t = np.linspace(0.0, 1.6, 1601)
+    on2 = (t < 0.6) | ((t >= 0.8) & (t < 0.85)) | (t >= 1.3)
+    v2 = np.where(t < 0.6, 0.01 * np.sin(2 * np.pi * t / 0.1),
+                  np.where((t >= 0.7) & (t < 1.3), 1.0, 0.0))
+    s2 = np.concatenate([[0.0], np.cumsum(0.5 * (v2[1:] + v2[:-1]) * np.diff(t))])
+    on1 = t >= 0.5
+
+    def trace(on, v, s):
+        pen = np.where(on, 1e-4, -1e-3)
+        return {"normal_force": 100.0 * on, "friction_force": -200.0 * v * on,
+                "penetration": pen, "penetration_rate": np.gradient(pen, t),
+                "slip_velocity": v, "s": s, "on_ground": np.ones_like(t)}
+
+    feet = {"leg1": trace(on1, np.zeros_like(t), np.full_like(t, 0.3)),
+            "leg2": trace(on2, v2, s2)}
+    return gait_events(_TwoFeet(feet), t, np.zeros((t.size, 1)))
+
+
+def test_the_stance_slip_is_the_stance_foots_and_its_path_and_friction_work_are_reported():
+    """Issue 56 item 15: the net stance slip counted the swing foot's scuff (here 50 mm,
+    0.05 s at 1 m/s) and hid the to-and-fro creep; the stance foot's slip path (the
+    integral of |v| over its stance, 0.6 s x 0.01 m/s x 2/pi = 3.82 mm) and its friction
+    work (200 N s/m x 0.6 s x (0.01 m/s)^2 / 2 = 6 mJ) are reported per step."""
+    ev = _scuffing_walk()
+    assert ev["hs_leg"] == ["leg1", "leg2"] and ev["steps"][1].scuff_count == 1
+    first = ev["steps"][0]
+    # six whole creep periods: the net slip is ~0 (the trapezoid on 1 ms samples: < 1e-3 mm)
+    assert abs(first.stance_slip_mm) < 1e-3
+    # 1 ms trapezoids of a 10 Hz sine: relative error ~1e-3
+    assert first.stance_slip_path_mm == pytest.approx(1e3 * 0.6 * 0.01 * 2 / np.pi, rel=5e-3)
+    assert first.friction_work_j == pytest.approx(200 * 0.6 * 0.01 ** 2 / 2, rel=5e-3)
 
 
 def test_drop_restitution_monotone_per_family_rigid_limit_near_plastic():

@@ -168,3 +168,18 @@ def test_the_crossing_state_is_brentqs_last_short_run_bit_for_bit(setup, paper_g
     xk, tk = short[0][0], short[0][1][0]
     fresh = real(P.walker, xk, np.array([tk, te]), P.solver, P._data)[0][-1]
     assert np.array_equal(xe, fresh)
+
+
+def test_a_periodic_gait_search_that_falls_says_what_to_try(setup):
+    """Issue 56 item 16: a search whose step map fell said only "step map: the walker fell
+    (hip below L/2)"; it now says what to try.  The paper walker started from the rigid
+    gait with its rates at 20 % falls in the first steps of the map."""
+    from walkerlab.analysis.contact.step_map import PeriodicGaitError
+
+    _, ideal, walker = setup
+    with pytest.raises(PeriodicGaitError) as exc:
+        find_contact_periodic_gait(walker, ideal.x, rate_scale=(0.2, 0.2), warmup_steps=2)
+    msg = str(exc.value)
+    assert exc.value.kind == "fall" and msg.startswith("step map: the walker fell (hip below "
+                                                       "L/2): ")
+    assert "walkerlab contact-sim" in msg and "stiffer" in msg and "periodic_gait(x0)" in msg

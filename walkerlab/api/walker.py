@@ -591,7 +591,8 @@ class ContactWalk:
     steps : dict[str, ndarray (s,)]
         The step table of ``contact_sim.h5``'s ``steps/``: ``t_start``, ``t_end``, ``period``
         [s], ``stance_leg``, ``stance_slip_mm`` [mm], ``double_support_creep_mm`` [mm],
-        ``bounce_count``, ``scuff_count``, ``peak_penetration_m`` [m], ``liftoff_time`` [s].
+        ``bounce_count``, ``scuff_count``, ``peak_penetration_m`` [m], ``liftoff_time`` [s],
+        ``stance_slip_path_mm`` [mm], ``friction_work_j`` [J].
     normal_force, friction_force : dict[str, ndarray (m,)]
         IMPACT normal force and Coulomb friction (down-slope) [N] at each contact point, by
         its name (:meth:`ContactWalker.contact_names`: ``leg1``, ``leg2``; flat feet
@@ -670,7 +671,8 @@ class ContactWalk:
 
 #: the step table's columns (the ``steps/`` group of ``contact_sim.h5``)
 _STEP_FIELDS = ("t_start", "t_end", "period", "stance_slip_mm", "double_support_creep_mm",
-                "bounce_count", "scuff_count", "peak_penetration_m", "liftoff_time")
+                "bounce_count", "scuff_count", "peak_penetration_m", "liftoff_time",
+                "stance_slip_path_mm", "friction_work_j")
 
 
 class ContactWalker:

@@ -40,7 +40,8 @@ from walkerlab.cli.typer_flags import flags_take_no_value
 flags_take_no_value()
 
 app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
-                  help="walkerlab: passive-dynamic biped walkers, from fixed point to report.")
+                  help="walkerlab: planar biped walkers, passive and powered, from fixed point to "
+                  "report.")
 
 
 @app.callback()
@@ -52,7 +53,7 @@ def _main(version: bool = typer.Option(False, "--version", callback=version_call
                                      help="no progress display and no notices on stderr "
                                      "(errors are still shown); progress is also off when "
                                      "stderr is not a terminal")) -> None:
-    """walkerlab: passive-dynamic biped walkers, from fixed point to report."""
+    """walkerlab: planar biped walkers, passive and powered, from fixed point to report."""
     single_threaded_blas()
     process_settings()
     from walkerlab import progress

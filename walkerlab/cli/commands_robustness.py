@@ -71,15 +71,16 @@ def mfpt(scene: Path | None = SceneArg,
     sc = load(scene)
     out = pipeline.run("mfpt", sc, runs_dir, force, sigma_rad=sig, method=method,
                        workers=workers, scheduler=scheduler)
-    if out.summary and "sigma_m" in out.summary:  # a study of per-step landing heights
-        for s, m in zip(out.summary["sigma_m"], out.summary["mfpt_steps_montecarlo"]):
-            typer.echo(f"height sigma {1e3 * s:.4g} mm: MFPT Monte Carlo {m:.4g} steps")
-    elif out.summary:
-        for s, m, me, why in zip(out.summary["sigma_rad"],
-                                 out.summary["mfpt_steps_montecarlo"],
-                                 out.summary["mfpt_steps_mesh"], out.summary["mesh_note"]):
-            typer.echo(f"sigma {s:.4g} rad: MFPT Monte Carlo {m:.4g}, mesh {me:.4g} steps"
-                       + (f" - mesh {why}" if why else ""))
+    from walkerlab.report.text import mfpt_text
+
+    summary = out.summary
+    if not summary and out.path.is_file():  # reused: the same lines from the artifact
+        from walkerlab.io.schemas.mfpt import load as load_mfpt
+        from walkerlab.studies.mfpt import mfpt_summary
+
+        summary = mfpt_summary(load_mfpt(out.path), stage.check(sc)[0].mesh_rel_change)
+    if summary:
+        typer.echo(mfpt_text(summary))
     typer.echo(status(out))
     typer.echo(f"figure: {stage.figure_path(sc, runs_dir)}")
 

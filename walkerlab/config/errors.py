@@ -201,6 +201,18 @@ def _unit_hint(root: type[BaseModel], e: dict, parts: list) -> str:
         return f" ({v:g} m: a length in mm? {v:g} mm = {v / 1000:g} m)"
     return ""
 
+def _yaml11_number(text: str) -> str:
+    """The plain decimal of a YAML-1.1-only number form (``0x10`` -> ``16``, ``1_0.0`` ->
+    ``10.0``; :mod:`walkerlab.config.loader` keeps those as text), "" for other text."""
+    import yaml
+
+    try:
+        v = yaml.safe_load(text)  # PyYAML: YAML 1.1, which reads these forms as numbers
+    except yaml.YAMLError:
+        return ""
+    return repr(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else ""
+
+
 def _error_line(root: type[BaseModel], e: dict, suggest=None) -> str:
     """One error as ``<field path>: <message>`` (an unknown key names the likely field)."""
     parts = [p for p in e["loc"] if _loc_part(p)]
@@ -222,6 +234,9 @@ def _error_line(root: type[BaseModel], e: dict, suggest=None) -> str:
             x = x if x[:1] in "+-" else "+" + x
             msg += (f"; YAML reads {e['input']} as text: write "
                     f"{m if '.' in m else m + '.0'}e{x}")
+        elif isinstance(e["input"], str) and (plain := _yaml11_number(e["input"])):
+            msg += (f"; {e['input']} is a YAML 1.1 number form (hex, binary, octal, base 60, "
+                    f"underscores), refused: write a plain decimal (YAML 1.1 reads {plain})")
     if not loc and re.match(r"^[a-z_]+(\.[a-z_]+)*: ", msg) \
             and msg.split(".", 1)[0].split(":", 1)[0] in root.model_fields:
         return msg  # a cross-field check names its field ("published: ...")

@@ -195,11 +195,15 @@ def atomic_write_all(items) -> list[Path]:
     except OSError as exc:
         where = Path(exc.filename) if exc.filename else paths[0]
         names = " and ".join(p.name for p in paths)
+        kept = (f"nothing was replaced ({names} kept as "
+                f"{'it was' if len(paths) == 1 else 'they were'})")
+        temporary = where.name.startswith(".") and where.name.endswith(".tmp")
         if is_disk_full(exc):
-            raise disk_full_error(where, exc, f"nothing was replaced ({names} kept as "
-                                  "they were)") from None
-        raise ArtifactError(f"{where}: cannot write ({exc.strerror or exc}); nothing was "
-                            f"replaced ({names} kept as they were)") from None
+            raise disk_full_error(where.parent if temporary else where, exc, kept) from None
+        if temporary:  # our own temporary name: the folder is at fault, name it
+            raise ArtifactError(f"{where.parent}: cannot write there ({exc.strerror or exc}); "
+                                f"{kept}") from None
+        raise ArtifactError(f"{where}: cannot write ({exc.strerror or exc}); {kept}") from None
 
 
 # HDF5 dimension-scale bookkeeping (netCDF-4 conventions): object references whose printed

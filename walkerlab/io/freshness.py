@@ -27,7 +27,7 @@ from walkerlab.io.artifacts import (
     verified_hash,
     write_artifact,
 )
-from walkerlab.io.runpaths import artifact_lock, stage_artifact
+from walkerlab.io.runpaths import artifact_lock, claimed, stage_artifact
 from walkerlab.safefs import NotARegularFile, read_regular, refuse_link
 
 
@@ -174,6 +174,17 @@ def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str
         is computed), an artifact that cannot be written (one line); and whatever
         ``compute`` raises (nothing is written then).
     """
+    def up_to_date(have) -> bool:
+        return have == key or any(have == input_hash(stage, scene, sections, upstream, a)
+                                  for a in also_accept)
+
+    key = input_hash(stage, scene, sections, upstream, extra_key)
+    if not force and claimed(scene, runs_root):  # an up-to-date artifact is reused without
+        # writing anything (the lock, the folder's claim): a read-only runs folder serves it;
+        # artifacts are replaced atomically, so reading one without the lock sees a whole file
+        path = refuse_link(stage_artifact(scene, runs_root, artifact or stage))
+        if path.is_file() and up_to_date(verified_hash(path)):
+            return CachedArtifact(path, True, 0.0, {})
     # a link in place of the artifact is refused now, not after the computation
     path = refuse_link(stage_artifact(scene, runs_root, artifact or stage, claim=True))
     # one writer per artifact: a second identical run waits, then finds the result up to date
@@ -184,8 +195,7 @@ def write_if_stale(stage: str, scene, runs_root: Path | str, sections: tuple[str
             note = "--force"  # recomputed whatever it holds: its content is not hashed
         elif path.is_file():
             have = verified_hash(path)
-            if have == key or any(have == input_hash(stage, scene, sections, upstream, a)
-                                  for a in also_accept):
+            if up_to_date(have):
                 return CachedArtifact(path, True, 0.0, {})
             # never replace a result silently: say what is recomputed and why (one line)
             note = recompute_reason(path, scene, sections, have)

@@ -48,7 +48,7 @@ except ImportError:  # pragma: no cover
 
 __all__ = ["RunPathError", "ArtifactBusy", "check_name", "scene_dir", "stage_artifact",
            "named_artifact", "scene_file", "report_dir", "figures_dir", "run_cache_dir",
-           "artifact_lock", "refuse_link", "bifurcation_stem", "bifurcation_artifacts",
+           "artifact_lock", "claimed", "refuse_link", "bifurcation_stem", "bifurcation_artifacts",
            "design_stem", "STAGE_FILES"]
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_+\-][A-Za-z0-9._+\-]*$")
@@ -129,15 +129,7 @@ def scene_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
             _mkdir(d)
         return d
     marker = d / ORIGIN_FILE
-    from walkerlab.safefs import NotARegularFile, read_regular
-
-    try:  # a bounded regular file: a FIFO or /dev/zero in its place must not hang or fill RAM
-        owner = Path(read_regular(marker, MAX_MARKER_BYTES, "run-folder marker")
-                     .decode().strip())
-    except NotARegularFile as exc:
-        raise RunPathError(f"{exc}; remove it") from None
-    except (OSError, UnicodeDecodeError, ValueError):
-        owner = None
+    owner = _owner(marker)
     if owner is not None and owner != Path(origin) and owner.is_file():
         raise RunPathError(f"{d}: run folder of {owner}; {origin} has the same name "
                            f"{name!r}: set another 'name:' in one of them or use --runs-dir")
@@ -150,6 +142,34 @@ def scene_dir(scene, runs_root: Path | str, claim: bool = False) -> Path:
 
 #: suffixes of walkerlab's temporary files in run folders (artifacts, figures, animation)
 TEMP_SUFFIXES = (".tmp", ".gif", ".mp4")
+
+
+def _owner(marker: Path) -> Path | None:
+    """The scene file a run folder's marker names (None: no readable marker)."""
+    from walkerlab.safefs import NotARegularFile, read_regular
+
+    try:  # a bounded regular file: a FIFO or /dev/zero in its place must not hang or fill RAM
+        return Path(read_regular(marker, MAX_MARKER_BYTES, "run-folder marker")
+                    .decode().strip())
+    except NotARegularFile as exc:
+        raise RunPathError(f"{exc}; remove it") from None
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+
+
+def claimed(scene, runs_root: Path | str) -> bool:
+    """Whether the scene's run folder is already its own (its marker names the scene file,
+    or the scene has none): a reader may then use it without claiming it (a read-only runs
+    folder).
+
+    Raises
+    ------
+    RunPathError
+        As :func:`scene_dir`.
+    """
+    d = scene_dir(scene, runs_root)
+    origin = getattr(scene, "origin", None)
+    return origin is None or _owner(d / ORIGIN_FILE) == Path(origin)
 
 
 def _mkdir(d: Path) -> None:

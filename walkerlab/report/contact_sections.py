@@ -78,6 +78,7 @@ def contact_section(scene, arts) -> list[str]:
            + (("; creep of both feet during double support [mm]: "
                + ", ".join(num(v, 3) for v in creep)) if creep is not None else "")
            + "; step periods [s]: " + ", ".join(num(v, 4) for v in periods) + ".", ""]
+    out += _slip_path_lines(c)
     if c.ledger is not None:
         w = c.ledger
         terms = (f"push-off {num(w['push_off'][-1], 4)}, joint torques "
@@ -111,6 +112,24 @@ def contact_section(scene, arts) -> list[str]:
                 + ", ".join(f"{m:.4f}" for m in per[2][:3])
                 + " and three fast contact/creep modes ≈ 0.", ""]
     return out
+
+
+def _slip_path_lines(c) -> list[str]:
+    """The stance foot's slip path and friction work per step (``steps/``; none in an
+    artifact written before they were), and the friction work against the push-off's."""
+    path, work = c.steps.get("stance_slip_path_mm"), c.steps.get("friction_work_j")
+    if path is None or work is None:
+        return []
+    line = ("Slip path of the stance foot per step [mm] (integral of |slip velocity| over its "
+            "stance: the to-and-fro creep of the regularised friction law that the net slip "
+            "hides): " + ", ".join(num(v, 3) for v in path) + "; friction work per stance "
+            "[J] (dissipated): " + ", ".join(num(v, 3) for v in work) + ".")
+    push = (c.ledger_steps or {}).get("push_off_work")
+    if push is not None and _mean(push) > 0 and np.isfinite(_mean(work)):
+        line += (f" Friction takes {num(_mean(work), 3)} J a stance, "
+                 f"{100 * _mean(work) / _mean(push):.0f} % of the push-off's "
+                 f"{num(_mean(push), 3)} J.")
+    return [line, ""]
 
 
 def _mean(v) -> float:

@@ -125,6 +125,27 @@ def _terrain_kind(scene_json) -> str | None:
         return None
 
 
+def _stride_reason(scene_json) -> str:
+    """Why a gait's Poincaré map is a stride (from the stored scene): "the legs differ",
+    "the footholds differ" or both; "its steps differ" when the scene does not say."""
+    import json
+
+    try:
+        d = json.loads(scene_json or "{}")
+        legs = (d.get("walker") or {}).get("legs") or []
+        terrain = d.get("terrain") or {}
+    except (TypeError, ValueError, AttributeError):
+        return "its steps differ"
+    why = []
+    if len(legs) > 1 and any(leg != legs[0] for leg in legs[1:]):
+        why.append("legs")
+    if terrain.get("kind") == "footholds" and any(
+            len(set(terrain.get(k) or ())) > 1
+            for k in ("foothold_heights_m", "foothold_slopes_rad")):
+        why.append("footholds")
+    return f"the {' and the '.join(why)} differ" if why else "its steps differ"
+
+
 def fixedpoint_text(fp: FixedPointArtifact) -> str:
     """Fixed point by leg name with units, step period, Floquet multipliers, verdict."""
     u, legs = fp.units, fp.legs_by_role
@@ -139,7 +160,7 @@ def fixedpoint_text(fp: FixedPointArtifact) -> str:
     lines.append(f"  step period     {fp.step_period_s:.10f} {u.time}")
     if fp.stride_period_s is not None:  # legs that differ: the Poincare map is a stride
         lines.append(f"  stride period   {fp.stride_period_s:.10f} {u.time} (the map is a "
-                     "stride: the legs differ)")
+                     f"stride: {_stride_reason(fp.scene_json)})")
         for leg, T, d in zip(fp.step_swing_legs, fp.step_periods_s, fp.step_lengths_m):
             lines.append(f"    step with {leg} swinging: period {T:.10f} {u.time}, "
                          f"length {d:.10f} {u.length}")
@@ -243,14 +264,18 @@ def simulate_text(sim: SimulateArtifact) -> str:
     if ending is not None:
         return ending
     u, s = sim.units, sim.summary
+    n = sim.heel_strike_count()
     if "ground_steps" in s:  # a finite foothold list, shorter than the strides asked
-        n = int(s["ground_steps"])
-        lines = [f"the ground ends after its {n} footholds (terrain.periodic: false): "
-                 f"{sim.heel_strike_count()} heel strikes of the "
-                 f"{2 * sim.strides_requested} asked ({sim.strides_requested} strides)"]
+        lines = [f"the ground ends after its {int(s['ground_steps'])} footholds (terrain."
+                 f"periodic: false): {n} heel strikes of the {2 * sim.strides_requested} "
+                 f"asked ({sim.strides_requested} strides)"]
+    elif n < 2 * sim.strides_requested:  # every step a heel strike, but fewer than asked
+        lines = [f"the walk ended at the end of its terrain (the profile's last point or the "
+                 f"last foothold: the next step would land past it) after {n} heel "
+                 f"strike{'' if n == 1 else 's'} ({n / 2:g} stride{'' if n == 2 else 's'} of "
+                 f"the {sim.strides_requested} asked)"]
     else:
-        lines = [f"simulated {sim.strides_requested} strides: "
-                 f"{sim.heel_strike_count()} heel strikes"]
+        lines = [f"simulated {sim.strides_requested} strides: {n} heel strikes"]
     if u.nondimensional:
         lines.append(f"  ({u.sentence()})")
     lines.append(f"  mean step period  {num(s['mean_period_s'], 7)} {u.time}")
@@ -330,6 +355,37 @@ def compare_text(c: Comparison) -> str:
                 lines.append(f"  {k:<22s} {num(m['ideal'][k]):>11s} "
                              f"{num(m['contact'][k]):>11s}"
                              + (f" {unit}" if unit not in ("", "-") else ""))
+    return "\n".join(lines)
+
+
+def mfpt_text(summary: dict) -> str:
+    """One line per sigma of an MFPT study (:func:`walkerlab.studies.mfpt.mfpt_summary`):
+    the Monte Carlo MFPT with its standard error and its falls, the mesh MFPT and why it may
+    be off; a method that was not run is left out (no "mesh nan")."""
+    n = len(summary["sigma_rad"])
+    nan = [float("nan")] * n
+    heights = summary.get("sigma_m")
+    lines = []
+    for i in range(n):
+        label = (f"height sigma {1e3 * heights[i]:.4g} mm" if heights is not None
+                 else f"sigma {summary['sigma_rad'][i]:.4g} rad")
+        m, se = summary["mfpt_steps_montecarlo"][i], \
+            summary.get("mfpt_steps_montecarlo_stderr", nan)[i]
+        walks, falls = (summary.get(k, nan)[i] for k in ("montecarlo_walks",
+                                                         "montecarlo_falls"))
+        parts = []
+        if np.isinf(m):
+            parts.append(f"MFPT Monte Carlo: none of {walks:.0f} walks fell (beyond their "
+                         "step cap)" if np.isfinite(walks) else "MFPT Monte Carlo: no walk fell")
+        elif np.isfinite(m):
+            parts.append(f"MFPT Monte Carlo {m:.4g}" + (f" ± {se:.2g}" if np.isfinite(se) else "")
+                         + " steps" + (f" ({falls:.0f} of {walks:.0f} walks fell)"
+                                       if np.isfinite(falls) and np.isfinite(walks) else ""))
+        me = summary.get("mfpt_steps_mesh", nan)[i]
+        if np.isfinite(me):
+            why = summary.get("mesh_note", [""] * n)[i]
+            parts.append(f"mesh {me:.4g} steps" + (f" - mesh {why}" if why else ""))
+        lines.append(f"{label}: " + (", ".join(parts) or "no MFPT computed"))
     return "\n".join(lines)
 
 

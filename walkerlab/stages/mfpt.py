@@ -51,6 +51,13 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     from walkerlab.studies.mfpt import MfptStudyError, mfpt_summary, resumable_mfpt_study
 
     st, workers = check(scene, sigma_rad, method, workers)
+    per = scene.terrain.per_step if scene.terrain is not None else None
+    if per is not None and per.slope_sd_rad > 0 and getattr(st, "sigma_m", None) is None:
+        from walkerlab import progress
+
+        progress.note(f"mfpt: terrain.per_step.slope_sd_rad ({per.slope_sd_rad:g} rad) is not "
+                      "used: the study sweeps mfpt.sigma_rad (--sigma-rad) "
+                      f"{', '.join(f'{v:g}' for v in st.sigma_rad)} rad")
     up, path = (stage_artifact(scene, runs_root, s) for s in ("fixedpoint", "mfpt"))
     done = []  # the resume file, removed once the artifact is written
 

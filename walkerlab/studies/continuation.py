@@ -375,7 +375,11 @@ def homotopy_start(scene: Scene, known: Scene):
                          f"{why})")
     on_way = ", ".join(f"{s.kind.replace('_', ' ')} at lambda {s.p:.4g}"
                        for s in res.specials) or "no special point"
-    note = (f"initial guess carried from scene {known.name} by homotopy over "
-            f"{', '.join(res.fields)} ({len(res.branch.points)} continuation points; "
-            f"{on_way} on the way)")
+    if not res.fields:  # nothing differs: the known gait is this walker's own
+        note = (f"initial guess: the gait of scene {known.name}, whose walker and slope have "
+                "this scene's numbers (nothing to carry by homotopy)")
+    else:
+        note = (f"initial guess carried from scene {known.name} by homotopy over "
+                f"{', '.join(res.fields)} ({len(res.branch.points)} continuation points; "
+                f"{on_way} on the way)")
     return res.x, note

@@ -487,13 +487,23 @@ def resumable_mfpt_study(scene, x_star: np.ndarray, st, partial_path, key: str,
 
 
 def mfpt_summary(data, rel_change: float | None = None) -> dict:
-    """The printable summary of an ``MfptData``: ``sigma_rad`` [rad], the Monte Carlo and
-    mesh MFPT [steps] at each sigma (lists of float), and ``mesh_note``: for each sigma ''
-    or, when the mesh's refinement did not converge, why
+    """The printable summary of an ``MfptData``: ``sigma_rad`` [rad] (``sigma_m`` [m] for a
+    study of landing heights), the Monte Carlo MFPT, its standard error [steps], its walks
+    and falls, and the mesh MFPT [steps] at each sigma (lists of float; NaN: that method was
+    not run), and ``mesh_note``: for each sigma '' or, when the mesh's refinement did not
+    converge, why
     (:meth:`walkerlab.io.schemas.mfpt.MfptData.mesh_notes`; ``rel_change``:
     ``mfpt.mesh_rel_change``)."""
     heights = {} if data.sigma_m is None else {"sigma_m": list(map(float, data.sigma_m))}
+    n = len(data.sigma_rad)
+
+    def col(name):  # a column an older artifact may lack: NaN
+        return list(map(float, data.values.get(name, np.full(n, np.nan))))
+
     return {"sigma_rad": list(map(float, data.sigma_rad)), **heights,
-            "mfpt_steps_montecarlo": list(map(float, data["mfpt_steps_montecarlo"])),
-            "mfpt_steps_mesh": list(map(float, data["mfpt_steps_mesh"])),
+            "mfpt_steps_montecarlo": col("mfpt_steps_montecarlo"),
+            "mfpt_steps_montecarlo_stderr": col("mfpt_steps_montecarlo_stderr"),
+            "montecarlo_walks": col("montecarlo_walks"),
+            "montecarlo_falls": col("montecarlo_falls"),
+            "mfpt_steps_mesh": col("mfpt_steps_mesh"),
             "mesh_note": data.mesh_notes(rel_change)}

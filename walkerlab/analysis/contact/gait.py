@@ -129,8 +129,9 @@ class StepSummary:
         ``t_end - t_start`` [s] (nan if incomplete).
     stance_slip_mm : float
         Along-slope slide of the stance foot over its stance phase(s) that start in this
-        step, each from touchdown to lift-off (flight between bounces excluded) [mm];
-        positive = downhill.  NaN when the stance phase does not end before the run does.
+        step (before the other foot's heel strike: the swing foot's scuffs are not stance),
+        each from touchdown to lift-off (flight between bounces excluded) [mm]; positive =
+        downhill.  NaN when the stance phase does not end before the run does.
     double_support_creep_mm : float
         Along-slope travel of both feet (sum of ``|displacement|``) while both are loaded, within
         the step [mm] (the smoothed-stiction creep; reported apart from the slip).
@@ -147,6 +148,17 @@ class StepSummary:
         (``"heel_contact (0.7736 s) > foot_flat (1.0382 s) > heel_off (1.3785 s)"``, from the
         contact table, :func:`foot_modes`; modes shorter than two samples left out); "" for
         other feet.
+    stance_slip_path_mm : float
+        Path of the stance foot's slip over the same stance phase(s) as ``stance_slip_mm``,
+        the integral of ``|slip velocity|`` [mm]: the to-and-fro creep of the regularised
+        friction law that the net slide hides.  Each phase counts from the first sample one
+        sample interval after its touchdown (the heel-strike collision, shorter than a
+        sample interval, is the heel strike's, and the samples do not resolve it).  NaN as
+        ``stance_slip_mm``.
+    friction_work_j : float
+        Work the friction forces of the stance foot's contact points take over the same
+        phase(s) as ``stance_slip_path_mm``, ``-sum of the integrals of F_t v_t`` [J]
+        (>= 0: dissipated).  NaN as ``stance_slip_mm``.
     """
 
     index: int
@@ -161,6 +173,8 @@ class StepSummary:
     peak_penetration_m: float
     liftoff_time: float = float("nan")
     foot_modes: str = ""
+    stance_slip_path_mm: float = float("nan")
+    friction_work_j: float = float("nan")
 
 
 @dataclass
@@ -304,6 +318,33 @@ def phase_slip(t, s, td, lo, ta, tb, v=None):
     return total if any_phase else np.nan
 
 
+def stance_phases(td, lo, ta, tb) -> list[tuple[float, float]] | None:
+    """Contact phases [(touchdown, lift-off)] [s] of a foot that start in [ta, tb); None if
+    the last such phase has no lift-off (as :func:`phase_slip`'s NaN)."""
+    out = []
+    for tdj in td:
+        if ta - 1e-12 <= tdj < tb:
+            nxt = lo[lo > tdj]
+            if not nxt.size:
+                return None
+            out.append((float(tdj), float(nxt[0])))
+    return out
+
+
+def phase_integral(t, y, phases) -> float:
+    """Trapezoidal integral of the samples ``y`` (n,) on ``t`` (n,) [s] over ``phases``
+    [(a, b)] [s], the ends interpolated; NaN if ``phases`` is None (an unfinished phase)."""
+    if phases is None:
+        return np.nan
+    total = 0.0
+    for a, b in phases:
+        m = (t > a) & (t < b)
+        tt = np.concatenate([[a], t[m], [b]])
+        yy = np.concatenate([[np.interp(a, t, y)], y[m], [np.interp(b, t, y)]])
+        total += float(np.trapezoid(yy, tt))
+    return total
+
+
 def _intervals(td, lo, t_end):
     """Contact intervals [(touchdown, lift-off)] of a foot (lift-off = ``t_end`` if none)."""
     out = []
@@ -407,18 +448,40 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
     ds = [(max(a1, a2), min(b1, b2), (f1, f2)) for j, f1 in enumerate(names)
           for f2 in names[j + 1:] for a1, b1 in iv[f1] for a2, b2 in iv[f2]
           if min(b1, b2) > max(a1, a2)]
+    points = feet if tuple(walker.contact_names()) == tuple(feet) else \
+        _foot_traces(walker, t, X, points=True)
+    leg_of = getattr(walker, "contact_leg", None)
+    dt_sample = float(np.median(np.diff(t))) if t.size > 1 else 0.0
     steps = []
     for j, (ta, leg) in enumerate(zip(starts, legs)):
         tb = starts[j + 1] if j + 1 < len(starts) else np.nan
         tb_or_end = tb if np.isfinite(tb) else t[-1]
-        # stance phases of this leg that begin between its heel strike and its next one
+        # stance phases of this leg that begin between its heel strike and the other foot's
+        # (its touchdowns after that are the swing foot's scuffs, not stance)
+        t_other = starts[j + 1] if j + 1 < len(starts) else np.inf
         t_next = starts[j + 2] if j + 2 < len(starts) else np.inf
         ft = feet[leg]
         td = ft.touchdown_times
         if j == 0 and (not td.size or td[0] > t[0]) and loaded[leg][0]:
             td = np.concatenate([[t[0]], td])
-        slip = phase_slip(t, ft.s, td, ft.liftoff_times, ta, t_next,
+        slip = phase_slip(t, ft.s, td, ft.liftoff_times, ta, t_other,
                           ft.slip_velocity if rolling else None)
+        phases = stance_phases(td, ft.liftoff_times, ta, t_other)
+        # the slip path and friction work of the stance, from the first sample one sample
+        # interval after each touchdown: the heel-strike collision (a fraction of a
+        # millisecond) falls between the samples, and a sample that happens to land in it
+        # would alias its sliding (0.6 m/s against ~0.01 m/s of creep) into the sum (its
+        # loss is the heel strike's)
+        held = None if phases is None else [
+            (a if a <= t[0] else float(t[min(np.searchsorted(t, a + dt_sample), t.size - 1)]),
+             b) for a, b in phases]
+        held = held if held is None else [(a, b) for a, b in held if b > a]
+        path = phase_integral(t, np.abs(ft.slip_velocity), held)
+        mine = [p for name, p in points.items()
+                if name == leg or (name not in feet and leg_of is not None
+                                   and leg_of(name) == leg)]
+        friction = -sum(phase_integral(t, p.friction_force * p.slip_velocity, held)
+                        for p in mine) if phases else np.nan
         lo_mine = ft.liftoff_times[(ft.liftoff_times > ta) & (ft.liftoff_times < t_next)]
         sel = (t >= ta) & (t <= tb_or_end)
         creep = 0.0
@@ -432,9 +495,9 @@ def gait_events(walker, t, X, min_step_m: float = 0.05, initial_stance: str = "l
         steps.append(StepSummary(j, leg, float(ta), float(tb), float(tb - ta),
                                  float(1e3 * slip), float(1e3 * creep), int(bounces[j]),
                                  int(scuffs[j]), max(peak, 0.0),
-                                 float(lo_mine[-1]) if lo_mine.size else np.nan))
-    points = feet if tuple(walker.contact_names()) == tuple(feet) else \
-        _foot_traces(walker, t, X, points=True)
+                                 float(lo_mine[-1]) if lo_mine.size else np.nan,
+                                 stance_slip_path_mm=float(1e3 * path) if phases else np.nan,
+                                 friction_work_j=float(friction) if phases else np.nan))
     if all(f"{st.stance_leg}_heel" in points and f"{st.stance_leg}_toe" in points
            for st in steps):  # flat feet: each step's mode sequence from the contact table
         dt = 2.0 * float(np.median(np.diff(t))) if t.size > 1 else 0.0

@@ -58,9 +58,17 @@ def rate_states(walker, leg: str) -> list[str]:
     return [lay.rate_of(s) for s in walker.leg_angle_states(leg)]
 
 
+def _finite_mean(v) -> float:
+    """Mean of the finite entries of ``v`` (NaN if none)."""
+    v = np.asarray(v, float)
+    v = v[np.isfinite(v)]
+    return float(v.mean()) if v.size else float("nan")
+
+
 def run_summary(res) -> dict:
     """Headline numbers of a contact run ``res`` (ContactResult): how it ended, heel strikes,
-    strides, stance slip and double-support creep [mm], peak penetration [mm], bounces,
+    strides, stance slip, its path and double-support creep [mm], the friction work per
+    stance [J], peak penetration [mm], bounces,
     scuffs, RHS/Jacobian evaluations and the integration's wall time [s]."""
     steps = res.steps
     slips = np.array([s.stance_slip_mm for s in steps])
@@ -74,6 +82,8 @@ def run_summary(res) -> dict:
         if np.isfinite(slips).any() else np.nan,
         "max_abs_stance_slip_mm": float(res.max_stance_slip_mm),
         "total_double_support_creep_mm": float(np.sum(creep)) if creep.size else 0.0,
+        "mean_stance_slip_path_mm": _finite_mean([s.stance_slip_path_mm for s in steps]),
+        "mean_friction_work_j": _finite_mean([s.friction_work_j for s in steps]),
         "peak_penetration_mm": float(max((s.peak_penetration_m for s in steps),
                                          default=np.nan) * 1e3),
         "total_bounces": int(sum(s.bounce_count for s in steps)),

@@ -109,6 +109,15 @@ class PeriodicGaitError(RuntimeError):
         self.kind = kind
 
 
+#: what to try when a step of the map falls: the search starts from the rigid gait's state
+#: (placed on the contact model) and iterates the map from it
+FELL_ADVICE = ("the contact gait, if there is one, is far from the rigid gait the search "
+               "starts from; check that walkerlab contact-sim walks from the rigid gait (its "
+               "outcome says why not), make the contact law stiffer (closer to the rigid "
+               "model), or start the search elsewhere (ContactWalker.periodic_gait(x0))")
+#: a step of the map that fell
+FELL = f"step map: the walker fell (hip below L/2): {FELL_ADVICE}"
+
 #: the step map's default integrator (LSODA with the analytic Jacobian)
 DEFAULT_SOLVER = Solver("LSODA", 1e-11, 1e-13)
 
@@ -361,7 +370,7 @@ class StepMap:
             up = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0)) + 1
             down = np.flatnonzero(hh < hth)
             if down.size and (not up.size or down[0] <= up[0]):
-                raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+                raise PeriodicGaitError("fall", FELL)
             if up.size:
                 k = int(up[0])
                 xk = X[k - 1]
@@ -431,7 +440,7 @@ class StepMap:
         if end is RunEnd.T_FINAL:
             return float(te), xe
         if end is RunEnd.FALL:
-            raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+            raise PeriodicGaitError("fall", FELL)
         if end is RunEnd.TIME_LIMIT:
             raise PeriodicGaitError("time_limit", "periodic-gait search: wall-time limit "
                                     "reached")
@@ -457,7 +466,7 @@ class StepMap:
         run = self.integrate(self.to_state(z))
         if run.event != "mid_stance":
             if run.end is RunEnd.FALL:
-                raise PeriodicGaitError("fall", "step map: the walker fell (hip below L/2)")
+                raise PeriodicGaitError("fall", FELL)
             if run.end is RunEnd.SOLVER_FAILURE:
                 raise PeriodicGaitError("solver_failure", f"step map: {run.message}")
             raise PeriodicGaitError("no_mid_stance", f"step map: no mid-stance within "
@@ -579,10 +588,13 @@ def section_guess_from_ideal(step_map: StepMap, x_ideal, rate_scale=(1.0, 1.0)) 
                 raise
             raise PeriodicGaitError("fall" if e.kind == "fall" else "no_mid_stance",
                                     "the ideal state does not reach mid-stance on the "
-                                    "contact model") from None
+                                    "contact model" + (f" (it falls): {FELL_ADVICE}"
+                                                       if e.kind == "fall" else "")) from None
         return step_map.to_section(xe, 1)[0]
     run = step_map.integrate(x0, stance_to_come=1)
     if run.event != "mid_stance":
-        raise PeriodicGaitError("fall" if run.end is RunEnd.FALL else "no_mid_stance",
-                                "the ideal state does not reach mid-stance on the contact model")
+        fell = run.end is RunEnd.FALL
+        raise PeriodicGaitError("fall" if fell else "no_mid_stance",
+                                "the ideal state does not reach mid-stance on the contact model"
+                                + (f" (it falls): {FELL_ADVICE}" if fell else ""))
     return step_map.to_section(run.y_event, 1)[0]

@@ -16,7 +16,8 @@ centres [m] per lane); ``initial_state`` (named by ``contact_state``),
 heel and toe combined); ``contact_points/<point>/`` (flat feet only: the same per contact
 point, ``leg1_heel``, ``leg1_toe``, ...: which points are loaded when); ``events/``
 (heel-strike times [s] and legs); ``steps/`` (per step: times [s], stance slip and creep
-[mm], bounces, scuffs, peak penetration [m]; flat feet: the stance foot's mode sequence);
+[mm], friction work [J], bounces, scuffs, peak penetration [m]; flat feet: the stance
+foot's mode sequence);
 ``summary/``; optional ``periodic_gait/`` (the contact model's own gait: period [s], step
 length [m], Floquet multipliers) and ``adjust/`` (``--adjust``'s search); a powered walker's
 ``ledger/`` (``time`` [s], the samples' times; ``work/<name>`` [J] the work integrals on it,
@@ -41,7 +42,14 @@ STAGE = "contact-sim"
 #: unit of each ``summary/`` entry (others: "-")
 SUMMARY_UNITS = {"mean_abs_stance_slip_mm": "mm", "peak_penetration_mm": "mm",
                  "max_abs_stance_slip_mm": "mm", "total_double_support_creep_mm": "mm",
+                 "mean_stance_slip_path_mm": "mm", "mean_friction_work_j": "J",
                  "wall_time_s": "s"}
+#: the stance foot's slip path and friction work per step (``steps/``): name, unit, meaning
+STEP_SLIP_FIELDS = (
+    ("stance_slip_path_mm", "mm", "path of the stance foot's slip over its stance phase(s), "
+     "integral of |slip velocity| (the to-and-fro creep the net stance_slip_mm hides)"),
+    ("friction_work_j", "J", "work the friction forces of the stance foot's contact points "
+     "take over its stance phase(s), -integral of F_t v_t (>= 0: dissipated)"))
 
 
 @dataclass
@@ -217,6 +225,9 @@ def _write_feet_events_steps(f, run: ContactSimRun) -> None:
                       ("bounce_count", "-"), ("scuff_count", "-"),
                       ("peak_penetration_m", "m"), ("liftoff_time", "s")):
         put(g, fld, np.array([getattr(s, fld) for s in steps], dtype=float), unit, fld,
+            dims=s_dim if steps else None)
+    for fld, unit, what in STEP_SLIP_FIELDS:
+        put(g, fld, np.array([getattr(s, fld) for s in steps], dtype=float), unit, what,
             dims=s_dim if steps else None)
     put(g, "stance_leg", [s.stance_leg for s in steps] or [""], "-", "stance leg",
         dims=s_dim)
@@ -428,7 +439,8 @@ def load_contact_sim(path: Path) -> ContactSimArtifact:
                              for fam in ("paper", "rigid_limit")},
                             float(g.attrs.get("mass_kg", 20.0)))
         steps = {k: f[f"steps/{k}"][()] for k in ("stance_slip_mm", "double_support_creep_mm",
-                                                   "period") if f"steps/{k}" in f}
+                                                   "period", "stance_slip_path_mm",
+                                                   "friction_work_j") if f"steps/{k}" in f}
         return ContactSimArtifact(
             path=Path(path), units=for_artifact(f), termination=term,
             outcome=str(f.attrs.get("outcome", term)),

@@ -24,7 +24,8 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
     Parameters
     ----------
     scene : Scene
-        The optimised scene (its ``contact``, ``terrain``, ``contact_solver`` if given).
+        The optimised scene (its ``contact``, ``terrain``, ``contact_solver``: LSODA at
+        rtol 1e-6, atol 1e-8 if none).
     res : walkerlab.optimal.transcription.step.CollocationResult
     strides : int
         Strides to run (2 steps each).
@@ -54,7 +55,8 @@ def contact_replay(scene, res, strides: int = 1) -> tuple[float, str]:
         return float("nan"), why
     tau = torque_of_time(res)
     setup.actuators.laws = lambda delta, ddelta, s, ds, t: np.array([tau(float(t))])
-    solver = SolverSettings.for_contact(method="LSODA", rtol=1e-6, atol=1e-8)
+    solver = scene.contact_solver or SolverSettings.for_contact(method="LSODA", rtol=1e-6,
+                                                                atol=1e-8)
     return _run(setup, res.x[0], res.step_period_s, strides, solver)
 
 
@@ -197,8 +199,10 @@ def contact_replay_stride(scene, res, strides: int = 2) -> tuple[float, str]:
         acts.laws = laws[0] if stance == 1 else laws[1]
         return own(x, stance, t_step)
     acts.hip_torque = hip_torque
+    # a fixed solver, whatever the scene's contact_solver (configs/asymmetric_optimal.yaml's
+    # replay is kept as it was): the outcome of a failure says so
     solver = SolverSettings.for_contact(method="LSODA", rtol=1e-6, atol=1e-8)
-    return _run(setup, res.x[0], res.step_period_s / 2, strides, solver)
+    return _run(setup, res.x[0], res.step_period_s / 2, strides, solver, fixed=True)
 
 
 def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = False):
@@ -219,9 +223,11 @@ def _powered_setup(scene, actuation: dict, contact_sim: dict, terrain: bool = Fa
         return None, f"not replayed: {exc}"
 
 
-def _run(setup, x0, step_period_s: float, strides: int, solver=None) -> tuple[float, str]:
+def _run(setup, x0, step_period_s: float, strides: int, solver=None,
+         fixed: bool = False) -> tuple[float, str]:
     """The powered contact run from ``x0``: the mean period of its steps after the first
-    touchdown [s] (NaN if fewer than two) and how it ended."""
+    touchdown [s] (NaN if fewer than two) and how it ended (``fixed``: ``solver`` is the
+    replay's own, not the scene's ``contact_solver``; :func:`replay_failure`)."""
     from walkerlab import progress
     from walkerlab.analysis.contact.sim import simulate_from
 
@@ -234,13 +240,13 @@ def _run(setup, x0, step_period_s: float, strides: int, solver=None) -> tuple[fl
             # the replay is a report on the optimum, not its gate: its solver's failure
             # (scipy's event location on a PD law's stiff contact: "f(a) and f(b) must
             # have different signs") is its outcome, the rigid optimum and replays stand
-            return float("nan"), replay_failure(exc, solver)
+            return float("nan"), replay_failure(exc, solver, fixed)
     hs = np.asarray(run.heel_strike_times, float)
     period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
     return period, str(run.termination)
 
 
-def replay_failure(exc: BaseException, solver=None) -> str:
+def replay_failure(exc: BaseException, solver=None, fixed: bool = False) -> str:
     """The contact replay's outcome when its integration raised ``exc`` (one line): what
     failed, in the run's terms, and what to try.
 
@@ -253,6 +259,10 @@ def replay_failure(exc: BaseException, solver=None) -> str:
         the step's ends).
     solver : walkerlab.config.SolverSettings, optional
         The run's contact solver (named in the advice).
+    fixed : bool
+        The replay runs ``solver`` whatever the scene's ``contact_solver`` (a stride's
+        replay): the advice is then ``walkerlab contact-sim``, which runs the scene's, not
+        a change of ``contact_solver``.
 
     Returns
     -------
@@ -261,7 +271,9 @@ def replay_failure(exc: BaseException, solver=None) -> str:
     """
     which = "" if solver is None else f" ({solver.method}, rtol {solver.rtol:g})"
     what = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    advice = ("this replay's solver is fixed (the scene's contact_solver is not used "
+              "here): walkerlab contact-sim runs the walker with the scene's" if fixed else
+              "set another contact_solver (method, rtol) in the scene: the replay runs it")
     return (f"not replayed: the contact model's solver{which} failed while locating a "
             f"contact event ({type(exc).__name__}: {what}); the rigid optimum and its "
-            "replays stand; try walkerlab contact-sim with another contact_solver "
-            "(method, rtol)")
+            f"replays stand; {advice}")
