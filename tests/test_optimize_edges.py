@@ -67,6 +67,55 @@ def test_a_contact_replay_whose_solver_fails_is_an_outcome(monkeypatch):
     assert "\n" not in outcome
 
 
+def _interrupted_in_a_ctypes_callback(signum):
+    """What a Ctrl-C (or SIGTERM) during a cold contact replay does: numba compiles the
+    contact model through llvmlite, whose object cache calls back into Python through
+    ctypes; the signal's handler runs there and its ``KeyboardInterrupt`` is printed and
+    dropped by ctypes ("Exception ignored on calling ctypes callback function").  Here the
+    process's own handler is called inside a ctypes callback (deterministic: no real
+    signal, whose handler runs at the interpreter's next check), then the run fails as the
+    compile's aftermath did (scipy's event location, which the replay reports as its
+    solver's failure)."""
+    import ctypes
+    import signal
+
+    def body():
+        signal.getsignal(signum)(signum, None)
+
+    ctypes.CFUNCTYPE(None)(body)()  # the exception cannot cross the C frame: dropped
+    raise ValueError("f(a) and f(b) must have different signs")
+
+
+@pytest.mark.parametrize("signum", ["SIGINT", "SIGTERM"])
+def test_an_interrupt_swallowed_in_the_contact_replay_exits_130_and_writes_nothing(
+        tmp_path, monkeypatch, signum):
+    """Before, an interrupt swallowed by a ctypes callback in a cold ``optimize``'s
+    contact replay went unnoticed: exit 0 and an ``optimize.h5`` with a NaN contact replay
+    blaming the solver, which the rerun reused.  Now the command's signal handler records
+    the interrupt, the command ends ``interrupted`` with code 130, no traceback, and no
+    ``optimize.h5`` is written (nothing for a rerun to reuse)."""
+    import signal
+
+    from typer.testing import CliRunner
+
+    from walkerlab.analysis.contact import sim
+    from walkerlab.cli import app
+
+    monkeypatch.setattr(sim, "simulate_from",
+                        lambda *a, **k: _interrupted_in_a_ctypes_callback(
+                            getattr(signal, signum)))
+    r = CliRunner().invoke(app, ["optimize", str(CONFIGS / "compass_optimal.yaml"),
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 130, r.output
+    assert r.output.strip().splitlines()[-1] == "interrupted", r.output
+    assert "Traceback" not in r.output and "error:" not in r.output
+    assert not list(tmp_path.rglob("optimize.h5"))
+    assert not list(tmp_path.rglob(".optimize*"))  # no temporary file or lock left
+    from walkerlab.safefs import interrupted
+
+    assert not interrupted()  # reported, then forgotten: the next command starts clean
+
+
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_an_infeasible_target_is_not_replayed_on_contact_and_require_gait_fails(tmp_path):
     """compass_optimal at 0.6 m/s with |u| <= 0.5 N m: IPOPT reports the problem infeasible

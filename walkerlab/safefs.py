@@ -27,11 +27,47 @@ import time
 from pathlib import Path
 
 __all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link", "temp_prefix",
-           "remove_stale_temps", "process_alive", "atomic_replace", "atomic_replace_all"]
+           "remove_stale_temps", "process_alive", "atomic_replace", "atomic_replace_all",
+           "note_interrupt", "clear_interrupt", "interrupted", "raise_if_interrupted"]
 
 #: when this process started (wall clock) [s]; a temporary file older than this whose
 #: writer is gone is stale
 PROCESS_START = time.time()
+
+
+#: whether this process was interrupted (Ctrl-C, SIGTERM) since the command began: set by
+#: the command's signal handler (:func:`walkerlab.cli.process.terminate_as_interrupt`), so
+#: an interrupt a library swallowed (a ``KeyboardInterrupt`` raised inside a ctypes callback,
+#: as numba's compiler runs them, is printed and dropped) still stops every write
+_INTERRUPTED = [False]
+
+
+def note_interrupt() -> None:
+    """Record that this process was interrupted (the signal handler's first act)."""
+    _INTERRUPTED[0] = True
+
+
+def clear_interrupt() -> None:
+    """Forget an interrupt (a command begins, or has reported it)."""
+    _INTERRUPTED[0] = False
+
+
+def interrupted() -> bool:
+    """Whether this process was interrupted since :func:`clear_interrupt`, even if the
+    ``KeyboardInterrupt`` was swallowed on its way."""
+    return _INTERRUPTED[0]
+
+
+def raise_if_interrupted() -> None:
+    """Raise ``KeyboardInterrupt`` if this process was interrupted (:func:`interrupted`).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        An interrupt was received, whether or not its exception reached the caller.
+    """
+    if _INTERRUPTED[0]:
+        raise KeyboardInterrupt
 
 
 class RunPathError(ValueError):
@@ -97,8 +133,10 @@ def atomic_replace(path: Path | str, fill, *, mode: int = 0o644, suffix: str = "
     ``O_CREAT | O_EXCL``, never through a symbolic link; named ``.<name>.<pid>.*<suffix>``,
     those of a killed earlier writer removed first) is filled by ``fill(fd, tmp_path)``,
     given ``mode`` and renamed over ``path`` (a crash leaves the old file or none, never a
-    truncated one).  ``fill`` writes the open descriptor ``fd`` (and closes it, e.g. with
-    ``os.fdopen``) or closes it and writes the file by name.  On any error the temporary file
+    truncated one; an interrupt received while it was filled, even one a library swallowed,
+    renames nothing: :func:`raise_if_interrupted`).  ``fill`` writes the open descriptor
+    ``fd`` (and closes it, e.g. with ``os.fdopen``) or closes it and writes the file by
+    name.  On any error the temporary file
     is removed and the error raised.
 
     Parameters
@@ -122,6 +160,8 @@ def atomic_replace(path: Path | str, fill, *, mode: int = 0o644, suffix: str = "
     ------
     OSError
         The folder cannot be written, the disk is full, ... (nothing is left behind).
+    KeyboardInterrupt
+        The process was interrupted (:func:`interrupted`): nothing is replaced or left.
     """
     import tempfile
 
@@ -132,6 +172,7 @@ def atomic_replace(path: Path | str, fill, *, mode: int = 0o644, suffix: str = "
     try:
         fill(fd, tmp)
         os.chmod(tmp, mode)
+        raise_if_interrupted()  # a result computed across an interrupt is not kept
         os.replace(tmp, path)
     except BaseException:
         try:
@@ -190,6 +231,7 @@ def atomic_replace_all(items, *, mode: int = 0o644, suffix: str = ".tmp") -> lis
                     pass
                 raise
             os.chmod(tmp, mode)
+        raise_if_interrupted()  # a result computed across an interrupt is not kept
         for path in paths:
             old = None
             if os.path.lexists(path):

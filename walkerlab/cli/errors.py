@@ -7,7 +7,9 @@
   one line ``error: ...`` on stderr, exit code 1;
 - an unexpected exception: one line ``error: internal error (<type>): <message>`` and a hint
   to rerun with ``WALKERLAB_DEBUG=1``, which shows the traceback instead; exit code 1;
-- Ctrl-C: ``interrupted``, exit code 130.
+- Ctrl-C or SIGTERM: ``interrupted``, exit code 130, also when a library swallowed the
+  interrupt's exception (:func:`walkerlab.safefs.interrupted`; whatever failed after it is
+  not reported, and no artifact is written: :func:`walkerlab.safefs.atomic_replace`).
 """
 
 from __future__ import annotations
@@ -113,16 +115,27 @@ def guard(fn):
         from walkerlab.config import SceneError
         from walkerlab.io.artifacts import ArtifactError, is_disk_full
         from walkerlab.io.runpaths import ArtifactBusy
+        from walkerlab.safefs import clear_interrupt, interrupted
         from walkerlab.stages.common import StageError
 
         debug = _debug()
+        clear_interrupt()
         try:
-            # a spinner with the elapsed time on a terminal: never silent while it works
-            with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
-                return fn(*a, **k)
+            try:
+                # a spinner with the elapsed time on a terminal: never silent while it works
+                with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
+                    out = fn(*a, **k)
+            except Exception:
+                if interrupted():  # what followed an interrupt a library swallowed
+                    raise KeyboardInterrupt from None
+                raise
+            if interrupted():  # an interrupt swallowed on its way (a ctypes callback's)
+                raise KeyboardInterrupt
+            return out
         except (typer.Exit, typer.Abort, SystemExit):
             raise
         except KeyboardInterrupt:
+            clear_interrupt()
             typer.echo("interrupted", err=True)
             raise typer.Exit(code=130) from None
         except SceneError as exc:  # every config error, one line each
