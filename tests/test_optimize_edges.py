@@ -114,6 +114,13 @@ def test_an_interrupt_swallowed_in_the_contact_replay_exits_130_and_writes_nothi
     from walkerlab.safefs import interrupted
 
     assert not interrupted()  # reported, then forgotten: the next command starts clean
+    # outside a command (a Python session that ran one) an interrupt is the plain
+    # KeyboardInterrupt and nothing is recorded to stop a later write
+    handler = signal.getsignal(getattr(signal, signum))
+    if callable(handler):
+        with pytest.raises(KeyboardInterrupt):
+            handler(getattr(signal, signum), None)
+    assert not interrupted()
 
 
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget

@@ -20,6 +20,7 @@ and no larger than the caller's cap, which is checked before a byte is read.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import stat
@@ -28,34 +29,51 @@ from pathlib import Path
 
 __all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link", "temp_prefix",
            "remove_stale_temps", "process_alive", "atomic_replace", "atomic_replace_all",
-           "note_interrupt", "clear_interrupt", "interrupted", "raise_if_interrupted"]
+           "watching_interrupts", "note_interrupt", "interrupted", "raise_if_interrupted"]
 
 #: when this process started (wall clock) [s]; a temporary file older than this whose
 #: writer is gone is stale
 PROCESS_START = time.time()
 
 
-#: whether this process was interrupted (Ctrl-C, SIGTERM) since the command began: set by
-#: the command's signal handler (:func:`walkerlab.cli.process.terminate_as_interrupt`), so
-#: an interrupt a library swallowed (a ``KeyboardInterrupt`` raised inside a ctypes callback,
-#: as numba's compiler runs them, is printed and dropped) still stops every write
-_INTERRUPTED = [False]
+#: the interrupt watch of the command under way (:func:`watching_interrupts`): how many
+#: watches are open, and whether this process was interrupted (Ctrl-C, SIGTERM) during
+#: them.  Set by the command's signal handler (:func:`walkerlab.cli.process.
+#: terminate_as_interrupt`), so an interrupt a library swallowed (a ``KeyboardInterrupt``
+#: raised inside a ctypes callback, as numba's compiler runs them, is printed and dropped)
+#: still stops every write; outside a command nothing is recorded
+_WATCH = {"depth": 0, "interrupted": False}
+
+
+@contextlib.contextmanager
+def watching_interrupts():
+    """Record interrupts (:func:`note_interrupt`) while the block runs (a command), and
+    forget them after it.
+
+    Yields
+    ------
+    None
+    """
+    _WATCH["depth"] += 1
+    try:
+        yield
+    finally:
+        _WATCH["depth"] -= 1
+        if _WATCH["depth"] == 0:
+            _WATCH["interrupted"] = False
 
 
 def note_interrupt() -> None:
-    """Record that this process was interrupted (the signal handler's first act)."""
-    _INTERRUPTED[0] = True
-
-
-def clear_interrupt() -> None:
-    """Forget an interrupt (a command begins, or has reported it)."""
-    _INTERRUPTED[0] = False
+    """Record that this process was interrupted (the signal handler's first act; nothing
+    outside :func:`watching_interrupts`)."""
+    if _WATCH["depth"] > 0:
+        _WATCH["interrupted"] = True
 
 
 def interrupted() -> bool:
-    """Whether this process was interrupted since :func:`clear_interrupt`, even if the
-    ``KeyboardInterrupt`` was swallowed on its way."""
-    return _INTERRUPTED[0]
+    """Whether this process was interrupted during the present :func:`watching_interrupts`
+    block, even if the ``KeyboardInterrupt`` was swallowed on its way."""
+    return _WATCH["interrupted"]
 
 
 def raise_if_interrupted() -> None:
@@ -66,7 +84,7 @@ def raise_if_interrupted() -> None:
     KeyboardInterrupt
         An interrupt was received, whether or not its exception reached the caller.
     """
-    if _INTERRUPTED[0]:
+    if _WATCH["interrupted"]:
         raise KeyboardInterrupt
 
 

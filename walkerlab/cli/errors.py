@@ -115,27 +115,30 @@ def guard(fn):
         from walkerlab.config import SceneError
         from walkerlab.io.artifacts import ArtifactError, is_disk_full
         from walkerlab.io.runpaths import ArtifactBusy
-        from walkerlab.safefs import clear_interrupt, interrupted
+        from walkerlab.safefs import interrupted, raise_if_interrupted, watching_interrupts
         from walkerlab.stages.common import StageError
 
         debug = _debug()
-        clear_interrupt()
+
+        def watched():
+            with watching_interrupts():
+                try:
+                    # a spinner with the elapsed time on a terminal: never silent while it
+                    # works
+                    with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
+                        out = fn(*a, **k)
+                except Exception:
+                    if interrupted():  # what followed an interrupt a library swallowed
+                        raise KeyboardInterrupt from None
+                    raise
+                raise_if_interrupted()  # swallowed on its way (a ctypes callback's)
+                return out
+
         try:
-            try:
-                # a spinner with the elapsed time on a terminal: never silent while it works
-                with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
-                    out = fn(*a, **k)
-            except Exception:
-                if interrupted():  # what followed an interrupt a library swallowed
-                    raise KeyboardInterrupt from None
-                raise
-            if interrupted():  # an interrupt swallowed on its way (a ctypes callback's)
-                raise KeyboardInterrupt
-            return out
+            return watched()
         except (typer.Exit, typer.Abort, SystemExit):
             raise
         except KeyboardInterrupt:
-            clear_interrupt()
             typer.echo("interrupted", err=True)
             raise typer.Exit(code=130) from None
         except SceneError as exc:  # every config error, one line each
