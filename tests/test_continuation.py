@@ -230,6 +230,38 @@ def test_two_parameter_period_doubling_curve_matches_independent_onsets():
     assert abs(c.p[-1] - ref) < 1e-4, (c.p[-1], ref)
 
 
+def test_a_gait_found_with_from_is_reused_by_a_run_without_it(tmp_path, monkeypatch):
+    """``fixedpoint --from`` writes the scene's gait; before, every later command without
+    ``--from`` (``report``, ``simulate``) recomputed it by the plain search ("an upstream
+    artifact or a stage option changed") - and failed where only the homotopy finds it.
+    Now the artifact says which start found it and is reused while the scene and the code
+    are unchanged; a changed scene still recomputes."""
+    import yaml
+
+    from walkerlab.analysis.gait import scene as gait_scene
+    from walkerlab.stages import fixedpoint as stage
+
+    d = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+    d["walker"]["hip_mass_kg"] = 10.5
+    path = tmp_path / "heavier.yaml"
+    path.write_text(yaml.safe_dump(d))
+    scene = load_scene(path)
+    made = stage.run(scene, tmp_path, known=ROOT / "configs" / "paper.yaml")
+    assert not made.reused
+
+    def search(*a, **k):  # the plain search must not run again
+        raise AssertionError("fixedpoint recomputed without --from")
+    monkeypatch.setattr(gait_scene, "fixed_point_run", search)
+    for variants in (True, False):  # the report's run (variants) and simulate's
+        again = stage.run(scene, tmp_path, compare_variants=variants)
+        assert again.reused and again.path == made.path
+    assert stage.fresh_artifact(scene, tmp_path) == made.path
+    d["walker"]["hip_mass_kg"] = 11.0  # another scene: not this gait
+    path.write_text(yaml.safe_dump(d))
+    with pytest.raises(AssertionError, match="recomputed without --from"):
+        stage.run(load_scene(path), tmp_path)
+
+
 @pytest.mark.slow
 def test_homotopy_and_initial_guess_from_an_artifact(tmp_path):
     """``fixedpoint --from`` carries the kneed gait to a steeper, heavier-hipped design (both

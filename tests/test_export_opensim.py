@@ -229,3 +229,63 @@ def test_osim_export_walks_in_opensim(name, period_rtol, speed_rtol, tmp_path):
     assert not w.fell and w.alternating and len(w.times_s) >= 11
     assert w.step_periods_s[1:].mean() == pytest.approx(period, rel=period_rtol)
     assert w.speed_m_per_s() == pytest.approx(speed, rel=speed_rtol)
+
+
+def test_an_opensim_walk_never_imports_opensim_beside_casadi(tmp_path, monkeypatch):
+    """OpenSim's Moco links a CasADi of its own: with the ``optimize`` extra's CasADi
+    loaded, ``import opensim`` fails ("libosimMoco.so: undefined symbol
+    _ZN6casadi2MX6binaryEx..."; the reverse order breaks ``import casadi``), and walkerlab
+    advised ``pip install 'walkerlab[osim]'``, which does not help.  Now the walk runs in a
+    process of its own, which never imports CasADi.  A stand-in ``opensim`` fails as Moco
+    does beside CasADi and says where it was imported otherwise: the walk reaches the
+    child process (its error comes back in one line) and this process never imports it."""
+    pytest.importorskip("casadi")
+    import os
+    import sys
+
+    from walkerlab.export.opensim_walk import walk
+    from walkerlab.extras import MissingExtra
+
+    fake = tmp_path / "fake"
+    (fake / "opensim").mkdir(parents=True)
+    (fake / "opensim" / "__init__.py").write_text(
+        "import sys\n"
+        "if 'casadi' in sys.modules:  # as OpenSim's Moco beside another CasADi\n"
+        "    raise ImportError('libosimMoco.so: undefined symbol: _ZN6casadi2MX6binaryEx')\n"
+        "raise RuntimeError('stand-in opensim imported in a process without CasADi')\n")
+    monkeypatch.syspath_prepend(str(fake))
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(
+        p for p in (str(fake), os.environ.get("PYTHONPATH")) if p))
+    import casadi  # noqa: F401 - loaded here, as after walkerlab optimize
+
+    osim_file = tmp_path / "walker.osim"
+    osim_file.write_text("<OpenSimDocument/>")
+    with pytest.raises(RuntimeError, match="stand-in opensim imported in a process "
+                       "without CasADi") as exc:
+        walk(osim_file, 0.1)
+    assert not isinstance(exc.value, MissingExtra)
+    assert "opensim" not in sys.modules
+    assert "\n" not in str(exc.value)
+
+
+@pytest.mark.slow
+def test_a_session_that_optimises_then_walks_an_opensim_export(tmp_path):
+    """With both extras installed, one Python session optimises a gait (CasADi loaded) and
+    then walks an OpenSim export (OpenSim in its own process), and optimises again after
+    it; before, the walk failed with Moco's undefined CasADi symbol.  ~10 s."""
+    pytest.importorskip("casadi")
+    import importlib.util
+    import sys
+
+    if importlib.util.find_spec("opensim") is None:
+        pytest.skip("opensim not installed")
+    from walkerlab.export.opensim_walk import walk
+    from walkerlab.stages import pipeline
+
+    opt = _scene("compass_optimal")
+    pipeline.run("optimize", opt, tmp_path, False)
+    assert "casadi" in sys.modules
+    w = walk(export_stage.run(_scene("paper"), tmp_path, "osim"), 2.0)
+    assert not w.fell and len(w.times_s) >= 2 and w.alternating
+    assert "opensim" not in sys.modules
+    pipeline.run("optimize", opt, tmp_path, True)  # CasADi still works after the walk

@@ -154,3 +154,20 @@ def test_the_banner_and_the_description_say_passive_and_powered():
                       .split())
     for text in (banner, PROJECT["description"], walkerlab.__doc__.splitlines()[0]):
         assert "passive-dynamic" not in text and "passive and powered" in text, text
+
+
+def test_an_installed_module_that_fails_to_import_is_not_sent_to_pip(tmp_path, monkeypatch):
+    """A module that is installed but whose import fails on something else (OpenSim's
+    Moco beside another CasADi: an undefined symbol; a missing system library) was told
+    ``pip install 'walkerlab[osim]'``, which installs nothing new.  Now the line names the
+    failure and no extra."""
+    (tmp_path / "broken_extra_module.py").write_text(
+        "raise ImportError('libosimMoco.so: undefined symbol: _ZN6casadi', name='libosimMoco')\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with pytest.raises(MissingExtra) as exc:
+        require("broken_extra_module", "osim", "walking an OpenSim export")
+    msg = str(exc.value)
+    assert msg == ("walking an OpenSim export needs broken_extra_module, which is installed "
+                   "but failed to import (libosimMoco.so: undefined symbol: _ZN6casadi); "
+                   "repair that installation")
+    assert "pip install" not in msg

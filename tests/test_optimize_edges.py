@@ -100,6 +100,62 @@ def test_the_contact_replay_runs_the_scenes_contact_solver_it_advises_changing(m
         fixed and "set another contact_solver" not in fixed
 
 
+def _interrupted_in_a_ctypes_callback(signum):
+    """What a Ctrl-C (or SIGTERM) during a cold contact replay does: numba compiles the
+    contact model through llvmlite, whose object cache calls back into Python through
+    ctypes; the signal's handler runs there and its ``KeyboardInterrupt`` is printed and
+    dropped by ctypes ("Exception ignored on calling ctypes callback function").  Here the
+    process's own handler is called inside a ctypes callback (deterministic: no real
+    signal, whose handler runs at the interpreter's next check), then the run fails as the
+    compile's aftermath did (scipy's event location, which the replay reports as its
+    solver's failure)."""
+    import ctypes
+    import signal
+
+    def body():
+        signal.getsignal(signum)(signum, None)
+
+    ctypes.CFUNCTYPE(None)(body)()  # the exception cannot cross the C frame: dropped
+    raise ValueError("f(a) and f(b) must have different signs")
+
+
+@pytest.mark.parametrize("signum", ["SIGINT", "SIGTERM"])
+def test_an_interrupt_swallowed_in_the_contact_replay_exits_130_and_writes_nothing(
+        tmp_path, monkeypatch, signum):
+    """Before, an interrupt swallowed by a ctypes callback in a cold ``optimize``'s
+    contact replay went unnoticed: exit 0 and an ``optimize.h5`` with a NaN contact replay
+    blaming the solver, which the rerun reused.  Now the command's signal handler records
+    the interrupt, the command ends ``interrupted`` with code 130, no traceback, and no
+    ``optimize.h5`` is written (nothing for a rerun to reuse)."""
+    import signal
+
+    from typer.testing import CliRunner
+
+    from walkerlab.analysis.contact import sim
+    from walkerlab.cli import app
+
+    monkeypatch.setattr(sim, "simulate_from",
+                        lambda *a, **k: _interrupted_in_a_ctypes_callback(
+                            getattr(signal, signum)))
+    r = CliRunner().invoke(app, ["optimize", str(CONFIGS / "compass_optimal.yaml"),
+                                 "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 130, r.output
+    assert r.output.strip().splitlines()[-1] == "interrupted", r.output
+    assert "Traceback" not in r.output and "error:" not in r.output
+    assert not list(tmp_path.rglob("optimize.h5"))
+    assert not list(tmp_path.rglob(".optimize*"))  # no temporary file or lock left
+    from walkerlab.safefs import interrupted
+
+    assert not interrupted()  # reported, then forgotten: the next command starts clean
+    # outside a command (a Python session that ran one) an interrupt is the plain
+    # KeyboardInterrupt and nothing is recorded to stop a later write
+    handler = signal.getsignal(getattr(signal, signum))
+    if callable(handler):
+        with pytest.raises(KeyboardInterrupt):
+            handler(getattr(signal, signum), None)
+    assert not interrupted()
+
+
 @pytest.mark.slow  # in `pytest -m slow`: the quick suite keeps to its CPU budget
 def test_an_infeasible_target_is_not_replayed_on_contact_and_require_gait_fails(tmp_path):
     """compass_optimal at 0.6 m/s with |u| <= 0.5 N m: IPOPT reports the problem infeasible
@@ -211,3 +267,81 @@ def test_the_level_ground_optimum_from_the_command(tmp_path):
     out = load(tmp_path / "runs" / "level" / "optimize.h5")
     assert out.gait and out.replay_error <= 1e-6 and out.push_off_n_s > 1.0
     assert out.step_length_m == pytest.approx(0.5, abs=1e-9)
+
+
+def _scene_file(tmp_path, base: str, name: str, **optimize) -> Path:
+    """``configs/<base>.yaml`` with ``optimize`` fields added, written as ``<name>.yaml``."""
+    import yaml
+
+    d = yaml.safe_load((CONFIGS / f"{base}.yaml").read_text())
+    d.setdefault("optimize", {}).update(optimize)
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(d))
+    return path
+
+
+def test_a_positive_clearance_on_straight_legs_is_refused_before_any_stage_runs(tmp_path):
+    """Straight legs' swing foot is level with the stance foot when the legs cross
+    (clearance l (cos theta - cos phi) = 0 at phi = theta), so ``min_clearance_m > 0``
+    cannot hold at every point: before, IPOPT "converged" on the mesh (the crossing fell
+    between two points) to a 3.7 s step with 48 N m of hip torque that does not replay
+    (return error inf); now one line naming the field and the reason, before fixedpoint
+    runs, nothing written."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    scene = _scene_file(tmp_path, "compass_optimal", "clear", min_clearance_m=0.01)
+    r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
+    assert r.exit_code == 1 and r.output.count("error:") == 1, r.output
+    assert "error: optimize.min_clearance_m: straight legs" in r.output
+    assert "when the legs cross" in r.output and "Traceback" not in r.output
+    assert not list((tmp_path / "r").rglob("*.h5"))  # refused before fixedpoint ran
+
+
+@pytest.mark.parametrize("foot", [{"kind": "point"}, {"kind": "arc", "radius_m": 0.2}])
+def test_a_kneed_walker_with_a_push_off_is_refused_in_one_true_line(tmp_path, foot):
+    """Before: round feet ended in "does not make a step (fall)" (the passive guess) and
+    point feet in "the rigid kneed ... models carry none", though the rigid kneed model
+    carries the push-off; now one line, before any stage runs: the phased transcription
+    has none yet."""
+    import yaml
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+
+    d = yaml.safe_load((CONFIGS / "kneed_optimal.yaml").read_text())
+    d["walker"]["actuation"] = {"push_off": {"impulse_n_s": 0.05}}
+    d["walker"]["leg"]["foot"] = foot
+    scene = tmp_path / "kneed_push.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path / "r")])
+    assert r.exit_code == 1 and r.output.count("error:") == 1, r.output
+    assert "optimize.push_off: the phased transcription (knees or flat feet) has no " \
+        "push-off yet" in r.output
+    assert "carry none" not in r.output and "fall" not in r.output
+    assert not list((tmp_path / "r").rglob("*.h5"))
+
+
+def test_an_infeasible_optimum_names_the_constraint_that_cannot_hold(tmp_path):
+    """A step length of 0.8 m with the hip angle within +-0.3 rad cannot be: a straight
+    leg's step is 2 l sin(|hip| / 2) <= 0.299 m.  Before, IPOPT's "Infeasible_Problem_
+    Detected" was all that was said; now the constraint groups with the largest violation
+    at its last iterate are named (the target step length first: 0.8 - 0.299 = 0.5 m),
+    in the output and in optimize.h5."""
+    from typer.testing import CliRunner
+
+    from walkerlab.cli import app
+    from walkerlab.io.schemas.optimize import load
+
+    scene = _scene_file(tmp_path, "compass_optimal", "far", intervals=10,
+                        target_step_length_m=0.8, hip_angle_range_rad=[-0.3, 0.3])
+    r = CliRunner().invoke(app, ["optimize", str(scene), "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    d = load(tmp_path / "far" / "optimize.h5")
+    assert d.status != "Solve_Succeeded" and not d.gait
+    assert d.violations.startswith("the target step length "), d.violations
+    # the bound's gap, 0.8 - 2 sin(0.15) = 0.501 m, to IPOPT's tolerance at its last
+    # iterate (it stops at the hip bound; 0.01 m covers where it stops on the mesh)
+    assert float(d.violations.split(",")[0].split()[-1]) == pytest.approx(0.501, abs=0.01)
+    assert f"largest constraint violations: {d.violations}" in r.output

@@ -14,7 +14,7 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
-__all__ = ["EXTRAS", "MissingExtra", "require"]
+__all__ = ["EXTRAS", "MissingExtra", "require", "require_installed"]
 
 #: extra -> what it is for (the commands and functions that need it)
 EXTRAS = {
@@ -58,7 +58,9 @@ def require(module: str, extra: str, what: str) -> ModuleType:
     ------
     MissingExtra
         ``"<what> needs <module> (not installed): pip install 'walkerlab[<extra>]'"``; a
-        module that is installed but fails to import names that failure too.
+        module that is installed but fails to import names that failure and no extra
+        (installing it again would not help: OpenSim's Moco beside another CasADi, a
+        missing system library).
     KeyError
         ``extra`` is not one of :data:`EXTRAS` (a programming error).
     """
@@ -67,6 +69,33 @@ def require(module: str, extra: str, what: str) -> ModuleType:
         return importlib.import_module(module)
     except ImportError as exc:
         top = (exc.name or "").split(".")[0]
-        why = "not installed" if top == module.split(".")[0] else f"its import failed: {exc}"
-        raise MissingExtra(f"{what} needs {module} ({why}): pip install "
-                           f"'walkerlab[{extra}]'") from None
+        if top == module.split(".")[0]:
+            raise MissingExtra(_missing(module, extra, what)) from None
+        # installed, but its import failed (a library it links is missing or conflicts):
+        # installing the extra again would not help, the reason is what to act on
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise MissingExtra(f"{what} needs {module}, which is installed but failed to "
+                           f"import ({first}); repair that installation") from None
+
+
+def _missing(module: str, extra: str, what: str) -> str:
+    return f"{what} needs {module} (not installed): pip install 'walkerlab[{extra}]'"
+
+
+def require_installed(module: str, extra: str, what: str) -> None:
+    """Check that ``module`` is installed without importing it (``importlib.util.
+    find_spec``: for a module imported in a child process only), or say in one line which
+    extra installs it.
+
+    Raises
+    ------
+    MissingExtra
+        ``"<what> needs <module> (not installed): pip install 'walkerlab[<extra>]'"``.
+    KeyError
+        ``extra`` is not one of :data:`EXTRAS` (a programming error).
+    """
+    import importlib.util
+
+    EXTRAS[extra]  # noqa: B018 - an unknown extra is a bug, not the user's
+    if importlib.util.find_spec(module) is None:
+        raise MissingExtra(_missing(module, extra, what))

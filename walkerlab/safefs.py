@@ -20,6 +20,7 @@ and no larger than the caller's cap, which is checked before a byte is read.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import stat
@@ -27,11 +28,64 @@ import time
 from pathlib import Path
 
 __all__ = ["NotARegularFile", "RunPathError", "read_regular", "refuse_link", "temp_prefix",
-           "remove_stale_temps", "process_alive", "atomic_replace", "atomic_replace_all"]
+           "remove_stale_temps", "process_alive", "atomic_replace", "atomic_replace_all",
+           "watching_interrupts", "note_interrupt", "interrupted", "raise_if_interrupted"]
 
 #: when this process started (wall clock) [s]; a temporary file older than this whose
 #: writer is gone is stale
 PROCESS_START = time.time()
+
+
+#: the interrupt watch of the command under way (:func:`watching_interrupts`): how many
+#: watches are open, and whether this process was interrupted (Ctrl-C, SIGTERM) during
+#: them.  Set by the command's signal handler (:func:`walkerlab.cli.process.
+#: terminate_as_interrupt`), so an interrupt a library swallowed (a ``KeyboardInterrupt``
+#: raised inside a ctypes callback, as numba's compiler runs them, is printed and dropped)
+#: still stops every write; outside a command nothing is recorded
+_WATCH = {"depth": 0, "interrupted": False}
+
+
+@contextlib.contextmanager
+def watching_interrupts():
+    """Record interrupts (:func:`note_interrupt`) while the block runs (a command), and
+    forget them after it.
+
+    Yields
+    ------
+    None
+    """
+    _WATCH["depth"] += 1
+    try:
+        yield
+    finally:
+        _WATCH["depth"] -= 1
+        if _WATCH["depth"] == 0:
+            _WATCH["interrupted"] = False
+
+
+def note_interrupt() -> None:
+    """Record that this process was interrupted (the signal handler's first act; nothing
+    outside :func:`watching_interrupts`)."""
+    if _WATCH["depth"] > 0:
+        _WATCH["interrupted"] = True
+
+
+def interrupted() -> bool:
+    """Whether this process was interrupted during the present :func:`watching_interrupts`
+    block, even if the ``KeyboardInterrupt`` was swallowed on its way."""
+    return _WATCH["interrupted"]
+
+
+def raise_if_interrupted() -> None:
+    """Raise ``KeyboardInterrupt`` if this process was interrupted (:func:`interrupted`).
+
+    Raises
+    ------
+    KeyboardInterrupt
+        An interrupt was received, whether or not its exception reached the caller.
+    """
+    if _WATCH["interrupted"]:
+        raise KeyboardInterrupt
 
 
 class RunPathError(ValueError):
@@ -97,8 +151,10 @@ def atomic_replace(path: Path | str, fill, *, mode: int = 0o644, suffix: str = "
     ``O_CREAT | O_EXCL``, never through a symbolic link; named ``.<name>.<pid>.*<suffix>``,
     those of a killed earlier writer removed first) is filled by ``fill(fd, tmp_path)``,
     given ``mode`` and renamed over ``path`` (a crash leaves the old file or none, never a
-    truncated one).  ``fill`` writes the open descriptor ``fd`` (and closes it, e.g. with
-    ``os.fdopen``) or closes it and writes the file by name.  On any error the temporary file
+    truncated one; an interrupt received while it was filled, even one a library swallowed,
+    renames nothing: :func:`raise_if_interrupted`).  ``fill`` writes the open descriptor
+    ``fd`` (and closes it, e.g. with ``os.fdopen``) or closes it and writes the file by
+    name.  On any error the temporary file
     is removed and the error raised.
 
     Parameters
@@ -122,6 +178,8 @@ def atomic_replace(path: Path | str, fill, *, mode: int = 0o644, suffix: str = "
     ------
     OSError
         The folder cannot be written, the disk is full, ... (nothing is left behind).
+    KeyboardInterrupt
+        The process was interrupted (:func:`interrupted`): nothing is replaced or left.
     """
     import tempfile
 
@@ -132,6 +190,7 @@ def atomic_replace(path: Path | str, fill, *, mode: int = 0o644, suffix: str = "
     try:
         fill(fd, tmp)
         os.chmod(tmp, mode)
+        raise_if_interrupted()  # a result computed across an interrupt is not kept
         os.replace(tmp, path)
     except BaseException:
         try:
@@ -190,6 +249,7 @@ def atomic_replace_all(items, *, mode: int = 0o644, suffix: str = ".tmp") -> lis
                     pass
                 raise
             os.chmod(tmp, mode)
+        raise_if_interrupted()  # a result computed across an interrupt is not kept
         for path in paths:
             old = None
             if os.path.lexists(path):

@@ -155,7 +155,57 @@ def test_a_fall_on_continuous_ground_names_the_scuffs_and_the_checkerboard():
     _, res, _, _ = simulate_from(contact_setup(scene), ideal.x, ideal.period_s)
     assert res.outcome.kind == "fall"
     assert "scuffed the ground" in res.outcome.message
-    assert "terrain.kind: checkerboard" in res.outcome.message
+    assert "terrain.lanes: checkerboard" in res.outcome.message  # the field's own name
+
+
+def _contact_walker(scene):
+    """The scene's contact walker on its ground (patches 0.4 m apart: their spacing does
+    not enter the advice)."""
+    from walkerlab.models.contact.scene import contact_setup
+
+    setup = contact_setup(scene)
+    n = 2 * len(setup.walker.structure.bodies) + 2  # a state of the walker's size
+    return setup.build(np.zeros(max(n, 4)), 4, step_length_m=0.4)[0]
+
+
+def test_a_fall_after_scuffs_is_advised_for_the_walker_and_its_ground():
+    """Before, every fall after scuffs blamed a straight leg's mid-stance dip and suggested
+    the checkerboard: also for a kneed walker whose latch is off (its stance knee buckles)
+    and on a profile (where the checkerboard is refused).  Now the advice fits: the latch
+    for a kneed walker without it, knees on a profile, the checkerboard
+    (``terrain.lanes``) for straight legs on continuous slope."""
+    from walkerlab.analysis.contact.gait import scuff_cause
+    from walkerlab.api.scenes import with_changes
+    from walkerlab.config import load_scene
+
+    kneed = load_scene(ROOT / "configs" / "kneed.yaml")
+    unlatched = with_changes(kneed, {"contact.knee_stop.latch": False})
+    why = scuff_cause(_contact_walker(unlatched))
+    assert "contact.knee_stop.latch: true" in why
+    assert "straight leg" not in why and "checkerboard" not in why
+    assert scuff_cause(_contact_walker(kneed)) == ""  # latched: nothing general to name
+    paper = load_scene(ROOT / "configs" / "paper.yaml")
+    profile = yaml.safe_load((ROOT / "configs" / "profile.yaml").read_text())["terrain"]
+    on_profile = paper.model_copy(update={"terrain": TerrainSettings(**profile)})
+    why = scuff_cause(_contact_walker(on_profile))
+    assert "straight leg" in why and "knees" in why and "checkerboard" not in why
+    flat = with_changes(paper, {"terrain.kind": "continuous"})  # paper.yaml: kind: checkerboard
+    assert "terrain.lanes: checkerboard" in scuff_cause(_contact_walker(flat))
+
+
+def test_an_unlatched_kneed_walker_on_a_profile_falls_with_the_latch_advice(tmp_path):
+    """configs/profile.yaml (a kneed walker) with its latch off: the stance knee buckles
+    and the walker falls after one scuff.  Before: "a straight leg's swing foot passes below
+    the ground line ...; terrain.kind: checkerboard gives it a gap there" (refused on a
+    profile); now the latch."""
+    text = (ROOT / "configs" / "profile.yaml").read_text()
+    assert text.count("latch: true") == 1
+    scene = tmp_path / "profile_unlatched.yaml"
+    scene.write_text(text.replace("latch: true", "latch: false"))
+    r = CliRunner().invoke(app, ["contact-sim", str(scene), "--runs-dir", str(tmp_path)])
+    assert r.exit_code == 1 and "fall" in r.output, r.output
+    assert "scuffed the ground" in r.output and "contact.knee_stop.latch: true" in r.output
+    assert "checkerboard" not in r.output and "straight leg" not in r.output
 
 
 def test_a_benchmark_never_reports_a_target_on_a_run_that_stopped_early():

@@ -7,7 +7,9 @@
   one line ``error: ...`` on stderr, exit code 1;
 - an unexpected exception: one line ``error: internal error (<type>): <message>`` and a hint
   to rerun with ``WALKERLAB_DEBUG=1``, which shows the traceback instead; exit code 1;
-- Ctrl-C: ``interrupted``, exit code 130.
+- Ctrl-C or SIGTERM: ``interrupted``, exit code 130, also when a library swallowed the
+  interrupt's exception (:func:`walkerlab.safefs.interrupted`; whatever failed after it is
+  not reported, and no artifact is written: :func:`walkerlab.safefs.atomic_replace`).
 """
 
 from __future__ import annotations
@@ -113,13 +115,27 @@ def guard(fn):
         from walkerlab.config import SceneError
         from walkerlab.io.artifacts import ArtifactError, is_disk_full
         from walkerlab.io.runpaths import ArtifactBusy
+        from walkerlab.safefs import interrupted, raise_if_interrupted, watching_interrupts
         from walkerlab.stages.common import StageError
 
         debug = _debug()
+
+        def watched():
+            with watching_interrupts():
+                try:
+                    # a spinner with the elapsed time on a terminal: never silent while it
+                    # works
+                    with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
+                        out = fn(*a, **k)
+                except Exception:
+                    if interrupted():  # what followed an interrupt a library swallowed
+                        raise KeyboardInterrupt from None
+                    raise
+                raise_if_interrupted()  # swallowed on its way (a ctypes callback's)
+                return out
+
         try:
-            # a spinner with the elapsed time on a terminal: never silent while it works
-            with progress.task(f"walkerlab {fn.__name__.replace('_', '-')}"):
-                return fn(*a, **k)
+            return watched()
         except (typer.Exit, typer.Abort, SystemExit):
             raise
         except KeyboardInterrupt:

@@ -59,7 +59,8 @@ def process_settings() -> None:
       imported, and inherited by worker processes;
     - ``SIGXFSZ`` ignored (a file-size limit, ``ulimit -f``, then makes a write fail with
       EFBIG, reported as "disk full" in one line, instead of killing the process);
-    - ``SIGTERM`` handled as ``SIGINT`` (:func:`terminate_as_interrupt`);
+    - ``SIGTERM`` handled as ``SIGINT``, and both recorded even when a library swallows
+      their exception (:func:`terminate_as_interrupt`);
     - the cyclic garbage collector's thresholds raised to :data:`GC_THRESHOLDS` (this
       process only; its workers keep Python's): a command imports scipy, h5py, pydantic and
       its own schema after this point, and with Python's (700, 10, 10) the collector walks
@@ -85,22 +86,50 @@ def process_settings() -> None:
 
 
 def _interrupt(signum, frame) -> None:
+    from walkerlab.safefs import note_interrupt
+
+    note_interrupt()  # kept even if the exception below is swallowed on its way
     raise KeyboardInterrupt
+
+
+def _unraisable(hook):
+    """``sys.unraisablehook`` over ``hook``: a ``KeyboardInterrupt`` that could not be
+    raised (the signal handler ran inside a ctypes callback, e.g. numba's compiler's, which
+    prints and drops its exceptions) is recorded (:func:`walkerlab.safefs.note_interrupt`)
+    instead of printed as a traceback; anything else goes to ``hook``."""
+    def unraisable(args) -> None:
+        if isinstance(args.exc_value, KeyboardInterrupt):
+            from walkerlab.safefs import note_interrupt
+
+            note_interrupt()
+            return
+        hook(args)
+    unraisable.walkerlab = True
+    return unraisable
 
 
 def terminate_as_interrupt() -> None:
     """``SIGTERM`` (``kill PID``, a scheduler's stop) raises ``KeyboardInterrupt`` as Ctrl-C
     does, so a write under way removes its temporary file and releases its lock as it does
-    on Ctrl-C (the default action ends the process at once, leaving both behind).  Only in
-    the main thread, and only over the default action (a handler someone else installed is
-    kept)."""
+    on Ctrl-C (the default action ends the process at once, leaving both behind).  Both
+    signals also record the interrupt (:func:`walkerlab.safefs.note_interrupt`): one whose
+    exception a library swallows (raised inside a ctypes callback while numba compiles)
+    still ends the command with code 130 and writes no artifact
+    (:func:`walkerlab.safefs.atomic_replace`).  Only in the main thread, and only over the
+    default actions (a handler someone else installed is kept; an ignored SIGINT, as in a
+    shell's background job, stays ignored)."""
     import signal
+    import sys
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         return
     if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, _interrupt):
         signal.signal(signal.SIGTERM, _interrupt)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _interrupt)
+    if not getattr(sys.unraisablehook, "walkerlab", False):
+        sys.unraisablehook = _unraisable(sys.unraisablehook)
 
 
 def no_collection_at_exit() -> None:

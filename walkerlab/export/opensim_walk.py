@@ -1,7 +1,13 @@
 """Run an exported OpenSim walker (``walker.osim``) in OpenSim's forward simulation from its
 default state and read its heel strikes and centre of mass.
 
-OpenSim is an optional dependency (the ``osim`` extra): imported inside the functions.
+OpenSim is an optional dependency (the ``osim`` extra), imported only in a child process:
+:func:`walk` runs the simulation in ``python -m walkerlab.export.opensim_walk`` and reads its
+numbers back.  OpenSim's Moco library links a CasADi of its own, and the ``optimize``
+extra's CasADi in the same process leaves it an undefined symbol (or the reverse, in a
+session that walks first and optimises after); in its own process OpenSim never meets
+another CasADi, so a session (or an environment with both extras) can optimise a gait and
+walk its OpenSim export.
 
 OpenSim's ``Manager`` integrates the model in windows of ``window_s``; after each window the
 loop reads each leg's ``HuntCrossleyForce`` (the force on the leg's body).  A heel strike of
@@ -37,7 +43,8 @@ from __future__ import annotations
 import json
 import math
 import re
-from dataclasses import dataclass
+import sys
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -45,7 +52,7 @@ import numpy as np
 from walkerlab.export.joint_torques import law_generalized_forces, stance_phase
 from walkerlab.export.mujoco_walk import MujocoWalk
 
-__all__ = ["OpensimWalk", "walk"]
+__all__ = ["OpensimWalk", "walk", "walk_here"]
 
 LEGS = ("leg1", "leg2")
 
@@ -137,7 +144,94 @@ class _Drive:
 
 def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
          min_air_s: float = 0.05, accuracy: float = 1e-7) -> OpensimWalk:
-    """Simulate ``walker.osim`` for ``duration_s`` from its default state (module docstring).
+    """Simulate ``walker.osim`` for ``duration_s`` from its default state (module docstring),
+    in a child process that alone imports OpenSim (``python -m
+    walkerlab.export.opensim_walk``: the module docstring says why).
+
+    Parameters
+    ----------
+    path : path
+        An OpenSim export (:mod:`walkerlab.export.opensim`).
+    duration_s : float
+        Simulated time [s].
+    window_s : float
+        Length of a window between the stepping rules [s].
+    min_air_s : float
+        Shortest time off the ground before a contact counts as a heel strike [s].
+    accuracy : float
+        The integrator's accuracy (OpenSim's default integrator, Runge-Kutta-Merson).
+
+    Returns
+    -------
+    OpensimWalk
+
+    Raises
+    ------
+    walkerlab.extras.MissingExtra
+        OpenSim is not installed (one line naming the ``osim`` extra), or its import failed
+        in the child process (one line with the reason).
+    RuntimeError
+        The child process failed otherwise (its last line of error output).
+    """
+    import os
+    import subprocess
+    import tempfile
+
+    import walkerlab
+    from walkerlab.extras import MissingExtra, require_installed
+
+    require_installed("opensim", "osim", "walking an OpenSim export")
+    env = dict(os.environ)  # this walkerlab, whatever put it on sys.path here
+    here = str(Path(walkerlab.__file__).resolve().parents[1])
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (here, env.get("PYTHONPATH")) if p)
+    with tempfile.TemporaryDirectory(prefix="walkerlab_osim_") as tmp:
+        out = Path(tmp) / "walk.json"
+        args = {"path": str(Path(path).resolve()), "duration_s": float(duration_s),
+                "window_s": float(window_s), "min_air_s": float(min_air_s),
+                "accuracy": float(accuracy), "out": str(out)}
+        proc = subprocess.run([sys.executable, "-m", "walkerlab.export.opensim_walk",
+                               json.dumps(args)], env=env, cwd=tmp, capture_output=True,
+                              text=True, check=False)
+        if proc.returncode != 0 or not out.is_file():
+            lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+            last = lines[-1].strip() if lines else f"exit code {proc.returncode}"
+            if proc.returncode == _MISSING_EXIT:
+                raise MissingExtra(last)
+            raise RuntimeError(f"walking the OpenSim export {path} failed in its process: "
+                               f"{last}")
+        d = json.loads(out.read_text())
+    return OpensimWalk(times_s=np.array(d["times_s"], float), legs=list(d["legs"]),
+                       positions_m=np.array(d["positions_m"], float), fell=bool(d["fell"]),
+                       t_end_s=float(d["t_end_s"]),
+                       com_along_m=np.array(d["com_along_m"], float),
+                       mass_kg=float(d["mass_kg"]))
+
+
+#: exit code of the child process when OpenSim cannot be imported (its one line on stderr)
+_MISSING_EXIT = 3
+
+
+def _main(argv: list[str]) -> int:
+    """The child process of :func:`walk`: ``argv[0]`` the JSON of its arguments and the
+    output file; writes the walk's numbers there as JSON (floats exactly: ``repr``)."""
+    from walkerlab.extras import MissingExtra
+
+    a = json.loads(argv[0])
+    try:
+        w = walk_here(a["path"], a["duration_s"], a["window_s"], a["min_air_s"],
+                      a["accuracy"])
+    except MissingExtra as exc:
+        print(str(exc), file=sys.stderr)
+        return _MISSING_EXIT
+    d = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(w).items()}
+    Path(a["out"]).write_text(json.dumps(d))
+    return 0
+
+
+def walk_here(path: Path | str, duration_s: float, window_s: float = 5e-4,
+              min_air_s: float = 0.05, accuracy: float = 1e-7) -> OpensimWalk:
+    """Simulate ``walker.osim`` for ``duration_s`` from its default state in this process
+    (imports OpenSim here: :func:`walk` runs it in a process of its own).
 
     Parameters
     ----------
@@ -279,3 +373,7 @@ def walk(path: Path | str, duration_s: float, window_s: float = 5e-4,
             break
     return OpensimWalk(times_s=np.array(times), legs=legs, positions_m=np.array(feet_at),
                        fell=fell, t_end_s=t, com_along_m=np.array(com), mass_kg=mass)
+
+
+if __name__ == "__main__":
+    sys.exit(_main(sys.argv[1:]))

@@ -25,8 +25,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-__all__ = ["Optimum", "check_targets", "collocation_spec", "five_link", "needs_gait",
-           "no_gait_of_its_own", "not_a_gait_outcome", "optimize_scene", "replay_multipliers",
+__all__ = ["Optimum", "check_clearance", "check_targets", "collocation_spec", "five_link",
+           "needs_gait", "no_gait_of_its_own", "not_a_gait_outcome", "optimize_scene",
+           "replay_multipliers",
            "starting_phases", "starting_stride", "history_and_energies", "stick_figures"]
 
 
@@ -97,6 +98,7 @@ class Optimum:
     phase_replays: dict = field(default_factory=dict)
     steps: int = 1
     phase_replay_outcome: str = ""
+    violations: str = ""
 
 
 # -- the scene's set-up ------------------------------------------------------------------
@@ -215,6 +217,7 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
 
     data = walker_data(scene.walker, scene.slope.phi_rad)
     spec = collocation_spec(scene)
+    check_clearance(scene, data)
     if x_gait is None and (data.mirror is not None or data.structure.knee
                            or data.structure.foot == "flat"):
         raise ValueError("optimize: the walker has no gait of its own to start from (passive "
@@ -226,6 +229,62 @@ def optimize_scene(scene, x_gait: np.ndarray | None = None,
     if data.structure.knee or data.structure.foot == "flat":  # a step of phases
         return _phased(scene, data, spec, x_gait, period_s)
     return _step(scene, data, spec, x_gait, period_s)
+
+
+def check_clearance(scene, data=None) -> None:
+    """Refuse, before any stage runs, what the collocation cannot do: a clearance that
+    cannot hold (``optimize.min_clearance_m > 0`` for straight legs of one length and foot:
+    :func:`_feet_level_when_legs_cross`) and a push-off on a kneed walker (the phased
+    transcription has none: :data:`walkerlab.optimal.transcription.mode_sequence.
+    PHASED_PUSH_OFF`).
+
+    Parameters
+    ----------
+    scene : Scene
+    data : WalkerData, optional
+        The scene's walker (built from ``scene`` if not given).
+
+    Raises
+    ------
+    ValueError
+        ``optimize.min_clearance_m: ...`` or ``optimize.push_off: ...`` with the reason and
+        what to give instead (one line).
+    """
+    o = getattr(scene, "optimize", None)
+    if o is None or five_link(scene):
+        return
+    if data is None:
+        from walkerlab.walker.description import walker_data
+
+        data = walker_data(scene.walker, scene.slope.phi_rad)
+    act = getattr(scene.walker, "actuation", None)
+    if data.structure.knee and (o.push_off == "free" or (
+            act is not None and act.push_off and act.push_off.impulse_n_s)):
+        from walkerlab.optimal.transcription.mode_sequence import PHASED_PUSH_OFF
+
+        raise ValueError(PHASED_PUSH_OFF)
+    if (o.min_clearance_m or 0.0) > 0.0 and _feet_level_when_legs_cross(scene, data):
+        raise ValueError(
+            "optimize.min_clearance_m: straight legs cannot clear the ground mid-swing: the "
+            "swing foot is level with the stance foot when the legs cross (as at both ends "
+            "of the step), so a clearance > 0 cannot hold; give 0 (no scuffing below the "
+            "slope) or a walker with knees (walker.leg.knee)")
+
+
+def _feet_level_when_legs_cross(scene, data) -> bool:
+    """Whether the swing foot is level with the stance foot when the legs cross: straight
+    legs (no knee, not flat feet) of one length and foot.  With the legs at angles
+    ``theta`` (stance) and ``phi`` (swing) from the slope's normal, the swing foot's
+    clearance is ``l (cos theta - cos phi)`` (point feet; arc feet alike, the arcs' centres
+    at the same distance), zero when ``phi = theta``: the swing leg passes the stance leg
+    mid-step, so no clearance > 0 holds over the swing - the straight-legged models ignore
+    that scuffing (McGeer 1990, Int. J. Robotics Research 9(2):62-82; Garcia et al. 1998,
+    J. Biomech. Eng. 120:281-288)."""
+    if data.structure.knee or data.structure.foot == "flat":
+        return False
+    w = scene.walker.model_dump()
+    legs = [leg for leg in [w.get("leg")] + list(w.get("legs") or []) if leg]
+    return len({(repr(leg.get("length_m")), repr(leg.get("foot"))) for leg in legs}) <= 1
 
 
 # -- what every set-up shares ------------------------------------------------------------
@@ -283,10 +342,12 @@ def _phase_replays(scene, data, res, tau) -> tuple[dict, str]:
 def history_and_energies(scene, walker, res) -> dict:
     """IPOPT's iteration history and the walker's kinetic and potential energy at the
     collocation points (``res``: a collocation result with ``x`` (2N + 1, 2n) in the
-    walker's state order and ``history``), as :class:`Optimum` keywords (J)."""
+    walker's state order and ``history``), as :class:`Optimum` keywords (J); with the
+    constraint groups IPOPT left violated (``res.violations``, when it did not converge)."""
     ke, pe = walker.energies(np.asarray(res.x, float).T)
     return {"ipopt_history": dict(res.history),
-            "energy": {"kinetic": np.asarray(ke, float), "potential": np.asarray(pe, float)}}
+            "energy": {"kinetic": np.asarray(ke, float), "potential": np.asarray(pe, float)},
+            "violations": str(getattr(res, "violations", ""))}
 
 
 def not_a_gait_outcome(err: float, status: str) -> str:
@@ -431,6 +492,7 @@ def _phased(scene, data, spec, x_gait, period_s) -> Optimum:
     from walkerlab.models.hybrid.rigid import make_rigid_walker
     from walkerlab.optimal.replay.contact import contact_replay_phased
     from walkerlab.optimal.transcription.mode_sequence import (
+        PHASED_PUSH_OFF,
         collocate_phases,
         phase_torque_of_time,
         replay_phases,
@@ -443,6 +505,9 @@ def _phased(scene, data, spec, x_gait, period_s) -> Optimum:
         raise ValueError("walker.actuation.ankle_push_off: the phased transcription has a hip "
                          "torque only (the rigid flat feet take an ankle push-off or hip "
                          "torques, not together)")
+    if data.structure.knee and (spec.push_off_free or spec.push_off_n_s):
+        # before the guess: the passive guess of a pushed walker may not make a step
+        raise ValueError(PHASED_PUSH_OFF)
     walker = make_rigid_walker(data, double_support=False)  # no double-support phase yet
     if data.structure.foot == "flat":  # fixedpoint's gait has its double support
         g = solve_scene(scene, False, walker=walker)[1].gait.result

@@ -284,7 +284,9 @@ def not_a_gait_reason(d) -> str:
     unit circle) the replay amplifies the collocation's own error, which more intervals
     shrink (Hermite-Simpson: O(h^4))."""
     if d.status != "Solve_Succeeded":
-        return f"IPOPT did not converge ({d.status})"
+        worst = getattr(d, "violations", "")
+        return f"IPOPT did not converge ({d.status})" + (
+            f"; largest constraint violations: {worst}" if worst else "")
     mu = float(np.max(np.abs(d.multipliers))) if len(d.multipliers) else float("nan")
     text = (f"the replay returns {d.replay_error:.2g} away from its start, more than "
             "optimize.replay_tolerance")

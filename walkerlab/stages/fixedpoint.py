@@ -30,8 +30,39 @@ def _known(scene: Scene, known) -> Scene | None:
 
 
 def _from_key(src: Scene | None) -> str:
-    return "" if src is None else "from:" + json.dumps(src.model_dump(mode="json"),
-                                                       sort_keys=True)
+    """The input-hash key of a homotopy start from ``src`` (its scene's digest; "": none)."""
+    if src is None:
+        return ""
+    import hashlib
+
+    text = json.dumps(src.model_dump(mode="json"), sort_keys=True)
+    return "from:" + hashlib.sha256(text.encode()).hexdigest()
+
+
+#: root attribute of a fixedpoint.h5 found from a known gait (``--from``): its
+#: :func:`_from_key`, so a later run without ``--from`` reuses the gait while the scene and
+#: the code are unchanged
+FROM_ATTR = "homotopy_from"
+
+
+def _stored_from(scene: Scene, runs_root) -> str:
+    """The :func:`_from_key` the scene's ``fixedpoint.h5`` was found with ("": none, or no
+    artifact)."""
+    from walkerlab.io.artifacts import root_attrs
+    from walkerlab.io.runpaths import stage_artifact
+
+    key = root_attrs(stage_artifact(scene, runs_root, "fixedpoint"), FROM_ATTR)
+    return str(key.get(FROM_ATTR, ""))
+
+
+def _accepted(from_key: str, stored: str, compare_variants: bool) -> tuple[str, ...]:
+    """The extra keys besides the one asked for whose artifact is up to date: the superset
+    with the other equation variants, and a gait found from a known one (``stored``, when
+    this run has no ``--from``: the same scene's gait whichever start found it)."""
+    keys = [] if compare_variants else ["variants" + from_key]
+    if stored and not from_key:
+        keys += ["variants" + stored] + ([] if compare_variants else [stored])
+    return tuple(keys)
 
 
 def fresh_artifact(scene: Scene, runs_root: Path | str = "runs") -> Path | None:
@@ -55,8 +86,9 @@ def fresh_artifact(scene: Scene, runs_root: Path | str = "runs") -> Path | None:
     have = verified_hash(path)
     if have is None:
         return None
-    if any(have == input_hash("fixedpoint", scene, SECTIONS, (), extra + from_key)
-           for extra in ("variants", "")):
+    keys = ("variants" + from_key, from_key, *_accepted(from_key, _stored_from(
+        scene, runs_root), False))
+    if any(have == input_hash("fixedpoint", scene, SECTIONS, (), k) for k in keys):
         return path
     return None
 
@@ -71,7 +103,9 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
     report's comparison with Eq. (11): ``walkerlab fixedpoint`` then writes the very artifact
     the report needs.  ``compare_variants=False`` reuses such an artifact (a superset).
     ``known`` (or the scene's ``fixedpoint.from``): a scene whose gait is carried to this
-    walker by homotopy and used as the initial guess (``walkerlab fixedpoint --from``).
+    walker by homotopy and used as the initial guess (``walkerlab fixedpoint --from``);
+    the artifact it writes says so (:data:`FROM_ATTR`), and a later run without one
+    reuses it while the scene's sections and the code are unchanged.
 
     Raises
     ------
@@ -101,6 +135,10 @@ def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False,
             raise StageError(str(exc)) from None
         return (lambda f: write_fixedpoint(f, run)), summary
 
+    # a gait found with --from is reused by a run without it (report, simulate, ...) while
+    # the scene and the code are unchanged: the start that found it is no input of the gait
+    stored = "" if force or src is not None else _stored_from(scene, runs_root)
     return run_cached("fixedpoint", scene, runs_root, SECTIONS, (), compute, force,
+                      extra_attrs={FROM_ATTR: from_key} if from_key else None,
                       extra_key=("variants" if compare_variants else "") + from_key,
-                      also_accept=() if compare_variants else ("variants" + from_key,))
+                      also_accept=_accepted(from_key, stored, compare_variants))

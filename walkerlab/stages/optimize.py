@@ -38,10 +38,15 @@ def check(scene: Scene, **options) -> None:
     ------
     walkerlab.extras.MissingExtra
         CasADi is not installed (one line naming the ``optimize`` extra).
+    ValueError
+        A swing-foot clearance that cannot hold (``optimize.min_clearance_m > 0`` on
+        straight legs: :func:`walkerlab.optimal.driver.check_clearance`; one line).
     """
     from walkerlab.extras import require
+    from walkerlab.optimal.driver import check_clearance
 
     require("casadi", "optimize", "walkerlab optimize")
+    check_clearance(scene)
 
 
 def run(scene: Scene, runs_root: Path | str = "runs", force: bool = False) -> StageOutcome:

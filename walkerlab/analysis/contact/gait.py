@@ -766,9 +766,51 @@ def _other(steps, leg: str) -> str:
     return next((s.stance_leg for s in steps if s.stance_leg != leg), "")
 
 
+def scuff_cause(walker) -> str:
+    """The likely cause of swing-foot scuffs before a fall, for the walker and its ground,
+    and what helps (a parenthesis; ``""``: none to name).
+
+    - a kneed walker whose stance knee is not latched
+      (``contact.knee_stop.latch: false``): the stance knee flexes under load, the hip
+      sinks and the swing foot meets the ground; the latch holds it as the rigid model's
+      knee lock does;
+    - straight legs: the swing foot passes below the ground line near mid-stance (the
+      rigid model ignores that scuffing); on continuous slope or stairs the checkerboard
+      (``terrain.lanes: checkerboard``) gives it a gap there; a profile is continuous
+      ground only (the checkerboard is refused there): knees clear it;
+    - a latched kneed walker, flat feet, free knees: nothing general to name.
+
+    Parameters
+    ----------
+    walker : walkerlab.models.contact.model.ContactWalker
+        The run's walker (its ``data.structure``, ``knee_stop``, ``continuous`` and
+        ``ground_line``).
+
+    Returns
+    -------
+    str
+    """
+    st = walker.data.structure
+    if st.knee and not st.free_knees:
+        if walker.knee_stop is not None and not walker.knee_stop.latch:
+            return ("(the stance knee is not latched: it flexes under the load and the hip "
+                    "sinks; contact.knee_stop.latch: true holds it as the rigid model's "
+                    "knee lock does)")
+        return ""
+    if st.knee or st.foot == "flat" or st.spokes:
+        return ""
+    straight = "a straight leg's swing foot passes below the ground line near mid-stance"
+    if getattr(walker, "ground_line", None) is not None:  # a profile: continuous only
+        return (f"({straight}; a profile is continuous ground, where straight legs scuff: "
+                "a walker with knees clears it)")
+    if walker.continuous:
+        return f"({straight}; terrain.lanes: checkerboard gives it a gap there)"
+    return f"({straight})"
+
+
 def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps: list,
              message: str, limits, slip_limit_mm: float | None,
-             wall_time_limit_s: float | None, continuous: bool = False) -> Outcome:
+             wall_time_limit_s: float | None, scuff_why: str = "") -> Outcome:
     """The typed outcome of a contact run from how its integration stopped.
 
     Parameters
@@ -786,8 +828,9 @@ def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps:
         The solver's message.
     limits : ContactLimits
     slip_limit_mm, wall_time_limit_s : float or None
-    continuous : bool
-        The ground is continuous (a fall after swing-foot scuffs suggests the checkerboard).
+    scuff_why : str
+        The likely cause of swing-foot scuffs before a fall, and what helps
+        (:func:`scuff_cause` of the run's walker; ``""``: none named).
     """
     n_hs = max(len(steps) - 1, 0)
     te = float(t[-1])
@@ -800,10 +843,8 @@ def classify(termination: str, event, t: np.ndarray, hip_height_m: float, steps:
         scuffs = sum(st.scuff_count for st in steps)
         why = ""
         if scuffs:  # the run's own table counts them: name the likely cause
-            why = (f"; the swing foot scuffed the ground {scuffs} time(s) before (a straight "
-                   "leg's swing foot passes below the ground line near mid-stance"
-                   + ("; terrain.kind: checkerboard gives it a gap there)"
-                      if continuous else ")"))
+            why = (f"; the swing foot scuffed the ground {scuffs} time(s) before"
+                   + (f" {scuff_why}" if scuff_why else ""))
         return Outcome("fall", te, "", np.nan, hip_height_m,
                        f"fall: hip {hip_height_m:.3f} m above ground "
                        f"(< {limits.fall_hip_height_m:g} m) at t = {te:.4g} s after {n_hs} "

@@ -22,6 +22,7 @@ from walkerlab.analysis.contact.gait import (
     gait_events,
     heel_strike_count,
     patch_fit,
+    scuff_cause,
 )
 from walkerlab.config.solver import SolverSettings
 from walkerlab.integrate.contact import ContactLimits, integrate_contact
@@ -154,7 +155,7 @@ def simulate_contact(walker, x0: np.ndarray, t_final: float,
     ev = gait_events(walker, run.t, run.X, min_step_m, initial_stance)
     hh = float(walker.hip_height(run.X[-1:])[0])
     out = classify(run.termination, run.event, run.t, hh, ev["steps"], run.message, limits,
-                   slip_limit_mm, limits.wall_time_limit_s, bool(walker.continuous))
+                   slip_limit_mm, limits.wall_time_limit_s, scuff_cause(walker))
     if after is not None:
         out = _named_after(out, after, ev, hh)
     if out.after or out.kind in _OFF_THE_PATCHES:

@@ -57,7 +57,8 @@ legs that differ: 2; absent for one step): ``time`` then covers the stride, its 
 are the steps' (as many per step), ``step_period`` and ``step_length`` are the mean
 step's, and the replay's return error and multipliers are the stride map's;
 ``phase_replay_outcome`` (when the phase-variable replay was asked for and refused: why,
-one line).
+one line); ``ipopt_violations`` (when IPOPT did not converge: the constraint groups with
+the largest violation at its last iterate, one line).
 """
 
 from __future__ import annotations
@@ -131,6 +132,8 @@ class OptimizeData:
     phase_replays: dict = field(default_factory=dict)  # law name -> PhaseReplayData
     steps: int = 1  # steps in the optimised period: 2 for a stride of legs that differ
     phase_replay_outcome: str = ""  # why there are no phase replays ("": there are, or off)
+    # IPOPT did not converge: the constraint groups with the largest violation ("": none)
+    violations: str = ""
 
 
 def phase_replay_records(replays: dict) -> dict:
@@ -252,6 +255,8 @@ def write(f, d: OptimizeData) -> None:
         _write_phase(f, law, r)
     if d.phase_replay_outcome:
         f.attrs["phase_replay_outcome"] = d.phase_replay_outcome
+    if d.violations:
+        f.attrs["ipopt_violations"] = d.violations
     _write_history_and_energy(f, d)
 
 
@@ -314,7 +319,8 @@ def load(path: Path) -> OptimizeData:
             f["phases/duration"][()] if "phases" in f else None,
             float(f.attrs.get("ipopt_build_time_s", float("nan"))),
             {law: _load_phase(f, law) for law in PHASE_LAWS if f"replay/phase_{law}" in f},
-            int(f.attrs.get("steps", 1)), str(f.attrs.get("phase_replay_outcome", "")))
+            int(f.attrs.get("steps", 1)), str(f.attrs.get("phase_replay_outcome", "")),
+            str(f.attrs.get("ipopt_violations", "")))
 
 
 #: the design optimisation's artifact (``walkerlab optimize --design``)

@@ -230,6 +230,7 @@ def _run(setup, x0, step_period_s: float, strides: int, solver=None,
     replay's own, not the scene's ``contact_solver``; :func:`replay_failure`)."""
     from walkerlab import progress
     from walkerlab.analysis.contact.sim import simulate_from
+    from walkerlab.safefs import raise_if_interrupted
 
     kw = {} if solver is None else {"solver": solver}
     with progress.task(f"optimize: the contact replay ({strides} strides)"):
@@ -237,10 +238,14 @@ def _run(setup, x0, step_period_s: float, strides: int, solver=None,
             _, run, _, _ = simulate_from(setup, np.asarray(x0, float), step_period_s,
                                          strides=strides, **kw)
         except (ValueError, ArithmeticError, RuntimeError) as exc:
+            # a failure that followed an interrupt a library swallowed (raised inside a
+            # ctypes callback while numba compiled the contact model) is the interrupt
+            raise_if_interrupted()
             # the replay is a report on the optimum, not its gate: its solver's failure
             # (scipy's event location on a PD law's stiff contact: "f(a) and f(b) must
             # have different signs") is its outcome, the rigid optimum and replays stand
             return float("nan"), replay_failure(exc, solver, fixed)
+    raise_if_interrupted()
     hs = np.asarray(run.heel_strike_times, float)
     period = float(np.mean(np.diff(hs))) if hs.size >= 2 else float("nan")
     return period, str(run.termination)

@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-__all__ = ["HISTORY", "iteration_history", "solve"]
+__all__ = ["CONSTRAINT_GROUPS", "HISTORY", "iteration_history", "largest_violations", "solve"]
 
 #: the stored series and CasADi's names for them (IPOPT's iteration output: ``objective``,
 #: ``inf_pr`` the largest constraint violation, ``inf_du`` the dual infeasibility, ``mu`` the
@@ -55,3 +55,85 @@ def solve(opti):
         status, get = str(opti.stats().get("return_status", "failed")), opti.debug.value
     c1 = os.times()
     return status, get, time.perf_counter() - t0, (c1.user - c0.user) + (c1.system - c0.system)
+
+
+#: the transcription's constraint groups, named by what their line of code constrains (the
+#: first key found in the line of ``opti.subject_to`` that set the constraint names it)
+CONSTRAINT_GROUPS = (
+    ("clearance", "the swing foot's clearance (optimize.min_clearance_m)"),
+    ("guard_rate", "the touchdown rate (optimize.touchdown_rate_rad_per_s)"),
+    ("guard(X[:, -1]", "the event (heel or knee strike) at the phase's end"),
+    ("guard(X[:, k]", "no event (heel or knee strike) before the phase's end"),
+    ("keep(", "the unilateral contacts (the ground and a locked knee push)"),
+    ("h / 8", "the dynamics (Hermite-Simpson defects)"),
+    ("h / 6", "the dynamics (Hermite-Simpson defects)"),
+    ("x_plus", "the push-off and heel strike into the next step (periodicity)"),
+    ("reset(", "the impact (heel or knee strike) into the next phase (periodicity)"),
+    ("F[0]", "the friction cone (optimize.friction_coefficient)"),
+    ("hip_angle", "the hip angle range (optimize.hip_angle_range_rad)"),
+    ("max_torque", "the torque limit (optimize.max_torque_n_m)"),
+    ("push_off_max", "the push-off's bounds (optimize.push_off_max_n_s)"),
+    ("Ts[p]", "the phases' durations (0.05 to 5 times the guess's)"),
+    ("ahead", "the swing foot ahead at heel strike"),
+    ("target_step_period", "the target step period"),
+    ("target_step_length", "the target step length"),
+    ("target_speed", "the target speed"),
+    ("feet[2", "the trailing foot lifts off"),
+    ("feet[3:5", "no knee hyper-extension"),
+    ("np.pi / 2", "the joint angles within +-90 deg"),
+    ("0.1, T", "the step period within 0.1-5 s"),
+)
+
+
+def _group(describe: str) -> str:
+    """The constraint group of a constraint described by CasADi (``Opti.debug.g_describe``:
+    "... called from <file>:<line>"): :data:`CONSTRAINT_GROUPS`' name for that line of
+    code, else the line itself."""
+    import linecache
+    import re
+
+    m = re.search(r"called from (.*):(\d+)", describe)
+    if m is None:
+        return describe.strip()
+    code = linecache.getline(m.group(1), int(m.group(2))).strip()
+    for key, name in CONSTRAINT_GROUPS:
+        if key in code:
+            return name
+    return code or f"{m.group(1)}:{m.group(2)}"
+
+
+def largest_violations(opti, count: int = 3, tol: float = 1e-6) -> str:
+    """The constraint groups with the largest violation at IPOPT's last iterate (what
+    cannot hold when IPOPT ends infeasible), as one clause.
+
+    Parameters
+    ----------
+    opti : casadi.Opti
+        After a solve that failed (its last iterate: ``opti.debug``).
+    count : int
+        Groups named at most.
+    tol : float
+        Violations at or below this are not named (each constraint's own unit).
+
+    Returns
+    -------
+    str
+        ``"<group> <violation>, ..."``, largest first (each group's largest violation in
+        its constraint's own unit: m, rad, rad/s, N, s); ``""`` when none exceeds ``tol``
+        or the iterate cannot be read.
+    """
+    try:
+        d = opti.debug
+        g = np.atleast_1d(np.asarray(d.value(opti.g), float)).ravel()
+        lb = np.atleast_1d(np.asarray(d.value(opti.lbg), float)).ravel()
+        ub = np.atleast_1d(np.asarray(d.value(opti.ubg), float)).ravel()
+    except RuntimeError:  # no iterate to read
+        return ""
+    viol = np.maximum(np.maximum(lb - g, g - ub), 0.0)
+    viol[~np.isfinite(g)] = np.inf
+    worst: dict[str, float] = {}
+    for i in np.flatnonzero(viol > tol):
+        name = _group(d.g_describe(int(i)))
+        worst[name] = max(worst.get(name, 0.0), float(viol[i]))
+    top = sorted(worst.items(), key=lambda kv: -kv[1])[:count]
+    return ", ".join(f"{name} {v:.2g}" for name, v in top)

@@ -19,7 +19,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from walkerlab.optimal.transcription.ipopt import iteration_history, solve
+from walkerlab.optimal.transcription.ipopt import (
+    iteration_history,
+    largest_violations,
+    solve,
+)
 
 __all__ = ["PhasedResult", "collocate_phases", "collocate_step", "optimized_guess",
            "phase_torque_of_time", "phased_guess", "replay_phases", "step_phase"]
@@ -56,6 +60,10 @@ class PhasedResult:
         [N m] at the optimum.
     history : dict of str -> ndarray
         IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
+    violations : str
+        When IPOPT did not converge: the constraint groups with the largest violation at
+        its last iterate (:func:`walkerlab.optimal.transcription.ipopt.largest_violations`;
+        ``""``: none, or it converged).
     """
 
     t: np.ndarray
@@ -75,6 +83,7 @@ class PhasedResult:
     terms: dict = field(default_factory=dict)
     history: dict = field(default_factory=dict)
     push_off_n_s: float = 0.0
+    violations: str = ""
 
 
 def phased_guess(walker, x0, period_s: float, solver, intervals: int):
@@ -270,6 +279,14 @@ def _positive_work(opti, fns, Xs, Us, Ts, taus, slack: bool):
     return work
 
 
+#: why a walker with phases is not optimised with a push-off (one line)
+PHASED_PUSH_OFF = (
+    "optimize.push_off: the phased transcription (knees or flat feet) has no push-off yet: "
+    "its heel strike is the plain impact (the rigid kneed model's push-off runs in "
+    "fixedpoint and simulate, not here); optimise the hip torque alone (no "
+    "walker.actuation.push_off, optimize.push_off: fixed)")
+
+
 def _pushes(spec) -> bool:
     """The spec has a push-off (fixed and positive, or free)."""
     return bool(spec.push_off_free or spec.push_off_n_s)
@@ -286,9 +303,7 @@ def _check(spec, phases) -> None:
         raise ValueError(f"optimize.objective: a walker with phases takes "
                          f"{' or '.join(known)} (or their weighted sum) today")
     if _pushes(spec) and not pushes:
-        raise ValueError("optimize.push_off: a walker with phases has no push-off impulse "
-                         "(the rigid kneed and flat-footed models carry none: "
-                         "walker.actuation.push_off is for straight legs on point feet)")
+        raise ValueError(PHASED_PUSH_OFF)
 
 
 def collocate_phases(fns: dict, spec, guess: list, guess_u: list | None = None
@@ -440,7 +455,8 @@ def _solve(opti, Xs, Us, Ts, taus, obj, terms, fns, names, build, push=0.0) -> P
         iterations=int(opti.stats().get("iter_count", -1)), build_time_s=build,
         wall_time_s=wall, cpu_time_s=cpu, terms={k: number(get(v)) for k, v in terms.items()},
         history=iteration_history(opti.stats()),
-        push_off_n_s=float(push) if isinstance(push, (int, float)) else float(get(push)))
+        push_off_n_s=float(push) if isinstance(push, (int, float)) else float(get(push)),
+        violations="" if status == "Solve_Succeeded" else largest_violations(opti))
 
 
 def phase_torque_of_time(res: PhasedResult):
@@ -573,4 +589,4 @@ def collocate_step(data, eq, spec, guess_t: np.ndarray, guess_x: np.ndarray,
         step_length_m=res.step_length_m, push_off_n_s=res.push_off_n_s,
         objective=res.objective, status=res.status, iterations=res.iterations,
         wall_time_s=res.wall_time_s, terms={"push_off_work": 0.0, **res.terms},
-        history=res.history)
+        history=res.history, violations=res.violations)

@@ -158,6 +158,9 @@ class CollocationResult:
         Max-norm return error of the replay (module docstring).
     history : dict of str -> ndarray
         IPOPT's iteration history (:func:`walkerlab.optimal.transcription.ipopt.iteration_history`).
+    violations : str
+        When IPOPT did not converge: the constraint groups with the largest violation
+        (:func:`walkerlab.optimal.transcription.ipopt.largest_violations`).
     """
 
     t: np.ndarray
@@ -173,6 +176,7 @@ class CollocationResult:
     replay_error: float = np.nan
     terms: dict = field(default_factory=dict)
     history: dict = field(default_factory=dict)
+    violations: str = ""
 
 
 def step_functions(data, eq):
