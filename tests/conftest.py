@@ -36,3 +36,14 @@ def paper_walker(paper_scene):
 @pytest.fixture(scope="session")
 def paper_fixed_point(paper_walker):
     return find_fixed_point(paper_walker, np.array(paper.EQ11_STATE), TIGHT)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Each test file runs on one pytest-xdist worker (``--dist loadgroup``, pyproject): a
+    file's module-scoped fixtures (fixed points, compiled models) are computed once, not once
+    per worker, and the two workers do not compile the same model side by side.  Tests with
+    an ``xdist_group`` mark of their own keep it (the group then spans files)."""
+    for item in items:
+        if not any(item.iter_markers("xdist_group")):
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))

@@ -59,6 +59,8 @@ def test_compiled_reset_is_the_walkers_reset(scene):
         np.testing.assert_array_equal(out, np.array([wg.reset(x) for x in X]))
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 def test_compiled_walks_equal_step_after_step(paper_scene, paper_map, paper_fixed_point):
     """A whole walk in compiled code (``BatchStepMap.walk``) gives the same heel strikes,
     falls and last states, bit for bit, as ``step`` called step after step on the same
@@ -128,6 +130,8 @@ def test_stage_and_guard_cfuncs_are_the_flows_values(scene):
                 assert g[0] == a[n + j] or (np.isnan(g[0]) and np.isnan(a[n + j]))
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 def test_phase_rows_with_stage_cfuncs_equal_the_flow_alone(paper_map, paper_fixed_point):
     """One phase of rows by ``phase_rows`` with the stage and guard cfuncs gives the same
     crossings, times, states and next step sizes, bit for bit, as with the flow (and its

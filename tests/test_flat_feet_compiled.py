@@ -71,6 +71,8 @@ def test_every_phase_is_compiled_with_its_guards_as_outputs(walker):
                 assert abs(out[6 + c] + o - py) <= 1e-12 * max(1.0, abs(py)), (ph.name, g.name)
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 def test_the_variational_cfunc_is_the_flow_jacobian_times_phi(walker):
     rng = np.random.default_rng(4)
     x = np.array([-0.3, 0.25, -0.05, -1.3, -1.2, -5.0])

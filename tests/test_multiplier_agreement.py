@@ -82,6 +82,8 @@ def test_kuo_walker_multipliers_at_other_gaits(k, P, slope):
     np.testing.assert_allclose(gait.multipliers, mult, rtol=0, atol=1e-6)
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 def test_target_and_fixedpoint_give_one_verdict():
     """``walkerlab target`` prints the multipliers of the gait it finds from the same
     computation as ``fixedpoint``: at the shipped scene's own speed the two agree."""

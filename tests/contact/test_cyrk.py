@@ -1,6 +1,7 @@
 """The cyrk_bdf route (CyRK's BDF with the compiled RHS) against scipy's odeint."""
 
 import numpy as np
+import pytest
 
 from tests.contact.test_numbalsoda import _bench_case
 from walkerlab.analysis.contact.sim import simulate_contact
@@ -29,6 +30,8 @@ def test_cyrk_bdf_five_strides_match_odeint():
     assert np.abs(b.x[:, leg_angle_columns(w)] - a.x[:, leg_angle_columns(w)]).max() < 1e-7
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 def test_cyrk_bdf_failure_is_finished_by_odeint(monkeypatch):
     """When BDF stops inside a chunk (as at a force jump it cannot step over), odeint
     finishes that chunk from the last sample reached: same uniform samples, odeint's RHS

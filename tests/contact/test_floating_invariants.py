@@ -245,6 +245,8 @@ def _kneed_on_one_leg(knee_stop=None):
     return w, sol.sol(np.linspace(0, 0.3, 301)).T
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 def test_kneed_walker_standing_holds_its_knee_straight_with_the_stop():
     """Standing on its stance leg (0.3 s, the inverted pendulum barely starts to fall), the
     load pushes the stance knee into hyperextension; the stop holds it within 1e-5 rad of
@@ -268,7 +270,7 @@ def test_kneed_walker_standing_holds_its_knee_straight_with_the_stop():
     assert wf.knee_stop_quantities(Xf)["leg2"]["extension"].max() > 10 * kq["extension"].max()
 
 
-@pytest.mark.parametrize("rate", [0.5, 2.0, 5.0])
+@pytest.mark.parametrize("rate", [0.5, pytest.param(2.0, marks=pytest.mark.slow), 5.0])
 def test_compliant_knee_strike_loses_the_rigid_knee_strike_energy(rate):
     """A knee closing at ``rate`` [rad/s] on its stop in free flight loses the energy of the
     plastic impulse that locks it (the rigid knee strike, projected with the floating M at

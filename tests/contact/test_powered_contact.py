@@ -49,6 +49,8 @@ def _rigid_push_off_work(w, gait) -> float:
     return float(tr["ke_push_off"] - tr["ke_minus"])
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 def test_pulse_converges_to_the_impulse(rigid):
     """The push-off pulse ends at the predicted touchdown (the rigid push-off comes
     immediately before the heel strike).  From the rigid gait, through the first heel strike

@@ -64,6 +64,8 @@ def test_a_one_sample_run_maps_onto_the_named_layout():
     assert set(tr.coordinates) == {"leg1_angle", "leg1_rate", "leg2_angle", "leg2_rate"}
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["cyrk_bdf", "odeint"])
 def test_wall_time_limit_holds_inside_a_chunk(method):
     """Rates x1e6 (issue 19 item 9: a 120 s limit computed for 182 s, one 1 s chunk of
@@ -226,6 +228,8 @@ def test_a_benchmark_never_reports_a_target_on_a_run_that_stopped_early():
     assert case.error(full) == np.inf
 
 
+# the quick suite's CPU budget (README): a longer run, in `pytest -m slow`
+@pytest.mark.slow
 def test_the_upper_body_walker_makes_five_strides_from_its_contact_periodic_gait():
     """configs/torso_bhm.yaml: from the adjusted rigid start the footfalls drift off the
     0.1 m patches and a foot in a gap enters a patch's side at 8.69 s, where the solver
