@@ -15,6 +15,8 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 
+from walkerlab.walker.kinds import Kind, kind_of
+
 #: Roles of the generalised coordinates for each coordinate scheme (see HybridWalker.roles).
 ROLES = {"absolute": ("swing", "stance"), "slope_relative": ("stance", "hip")}
 #: Roles with a knee: swing thigh and shank free, the stance leg straight (absolute angles).
@@ -124,6 +126,12 @@ class Structure:
     free_knees: bool = False
     hinged_torso: bool = False
     spokes: int = 0
+
+    @property
+    def kind(self) -> Kind:
+        """The walker's structural kind (:func:`walkerlab.walker.kinds.kind_of`): what the
+        layers consult instead of this structure's switches."""
+        return kind_of(self)
 
     @property
     def roles(self) -> tuple[str, ...]:

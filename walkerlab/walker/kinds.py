@@ -1,0 +1,245 @@
+"""The structural kind of a walker, chosen once from its description, and what each kind
+can do in each view: the capability table, as data.
+
+A walker description (:class:`~walkerlab.walker.description.Structure`) has many switches
+(feet, knees, a torso, springs, legs that differ); only a few of them change the *form* of
+the hybrid system - its coordinates, its phases and resets, which bodies touch the ground -
+and so which code derives, integrates, optimises and exports it.  Those few decide the
+walker's :class:`Kind`:
+
+``straight_legs``
+    Two straight legs on point or arc (rolling) feet, with or without an upper body held on
+    the legs' bisector and springs: the compass gait family (Goswami, Thuilot & Espiau 1996;
+    Garcia et al. 1998; Kuo 2002).  One phase, one heel-strike reset.
+``locking_knees``
+    Legs with knees that are free in early swing and lock at the knee strike (McGeer 1990,
+    "Passive walking with knees"; Hsu Chen 2007): two phases, two resets.
+``flat_feet``
+    Straight legs on massless flat feet on ankle springs, the stance foot going through heel
+    contact, foot flat and heel off (foot modes: a phase graph of its own).
+``free_joints``
+    Every joint free - hips and knees, optionally a hinged torso: the five-link biped
+    (Westervelt, Grizzle & Koditschek 2003, RABBIT), driven by joint torques.
+``rolling_polygon``
+    A rimless (spoked) wheel: one rigid body rolling on its spokes (McGeer 1990; Coleman,
+    Chatterjee & Ruina 1997).  It has no joint, so no actuator.
+
+The layers ask the kind (:func:`kind_of`, once), never the switches: a layer's code for a
+kind is reached through the kind's name in that layer's own table of parts (the rigid
+model's builders, the contact model's geometry, the export's writers, the transcriptions).
+Whether a kind supports a feature in a view is read from :data:`CAPABILITIES`; a refusal is
+:meth:`Kind.require`'s one line, naming the scene field and the physical or modelling
+reason, so ``walkerlab capabilities``, the documentation and the refusals say the same.
+
+Adding a kind is one :class:`Kind` here and its row of :data:`CAPABILITIES`; each layer
+then gets its part for it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["CAPABILITIES", "FEATURES", "KINDS", "VIEWS", "Kind", "KindRefused", "kind_of",
+           "table_rows"]
+
+#: the views of one walker description: name -> what it is
+VIEWS = {
+    "rigid": "rigid hybrid model (fixedpoint, simulate, studies)",
+    "contact": "compliant-contact model (contact-sim)",
+    "mjcf": "MuJoCo export (MJCF)",
+    "adams": "MSC Adams dataset (.adm)",
+    "osim": "OpenSim model (.osim)",
+    "gym": "Gymnasium environment (walkerlab.gym)",
+    "optimize": "direct collocation (walkerlab optimize)",
+}
+
+#: what a scene can ask of a walker: name -> what it is (and its scene field)
+FEATURES = {
+    "walk": "the walker itself, passive (walker)",
+    "hip_torque": "a torque law at the hips (walker.actuation.torques: hip)",
+    "knee_torque": "a torque law at the knees (walker.actuation.torques: knee)",
+    "ankle_torque": "a torque law at the ankles (walker.actuation.torques: ankle)",
+    "torso_torque": "a torque law between torso and legs (walker.actuation.torques: torso)",
+    "push_off": "a push-off impulse before heel strike (walker.actuation.push_off)",
+    "ankle_push_off": "an ankle push-off of a flat foot (walker.actuation.ankle_push_off)",
+    "stairs": "stairs (terrain.kind: stairs)",
+    "footholds": "footholds of several heights or slopes (terrain.kind: footholds)",
+    "profile": "a height profile (terrain.kind: profile)",
+}
+
+
+class KindRefused(ValueError):
+    """A feature the walker's kind does not have in a view: one line naming the field."""
+
+
+@dataclass(frozen=True)
+class Kind:
+    """One structural kind of walker (see the module docstring).
+
+    Attributes
+    ----------
+    name : str
+        Its key in :data:`KINDS` and in every layer's table of parts.
+    title : str
+        A few words for tables and messages.
+    reference : str
+        Where the kind's model comes from (papers).
+    """
+
+    name: str
+    title: str
+    reference: str
+
+    def cell(self, feature: str, view: str) -> str | None:
+        """None when the kind supports ``feature`` in ``view``, else the one-line reason
+        (:data:`CAPABILITIES`).
+
+        Raises
+        ------
+        KeyError
+            An unknown feature or view.
+        """
+        if feature not in FEATURES or view not in VIEWS:
+            raise KeyError(f"{feature!r} in {view!r}: features are {', '.join(FEATURES)}; "
+                           f"views {', '.join(VIEWS)}")
+        row = CAPABILITIES[self.name]
+        return row.get((feature, view), row.get((feature, "*")))
+
+    def supports(self, feature: str, view: str) -> bool:
+        """Whether the kind has ``feature`` in ``view``."""
+        return self.cell(feature, view) is None
+
+    def require(self, feature: str, view: str, field: str) -> None:
+        """Refuse ``feature`` in ``view`` if the table does.
+
+        Parameters
+        ----------
+        feature, view : str
+            Keys of :data:`FEATURES` and :data:`VIEWS`.
+        field : str
+            The scene field (or command option) the refusal names, first in its line.
+
+        Raises
+        ------
+        KindRefused
+            ``"<field>: <reason>"``, one line.
+        """
+        why = self.cell(feature, view)
+        if why is not None:
+            raise KindRefused(f"{field}: {why}")
+
+
+#: every kind, in the order tables list them
+KINDS = {k.name: k for k in (
+    Kind("straight_legs", "straight legs (point or arc feet)",
+         "Goswami, Thuilot & Espiau 1996; Garcia et al. 1998; Kuo 2002"),
+    Kind("locking_knees", "knees that lock at the knee strike",
+         "McGeer 1990 (passive walking with knees); Hsu Chen 2007"),
+    Kind("flat_feet", "flat feet on ankle springs (foot modes)",
+         "McGeer 1990; Collins, Wisse & Ruina 2001"),
+    Kind("free_joints", "free hips and knees, hinged torso (five-link biped)",
+         "Westervelt, Grizzle & Koditschek 2003 (RABBIT)"),
+    Kind("rolling_polygon", "rimless (spoked) wheel",
+         "McGeer 1990; Coleman, Chatterjee & Ruina 1997"),
+)}
+
+_NO_KNEE = "the legs are straight: there is no knee"
+_NO_ANKLE = ("an ankle is a flat foot's joint (walker.leg.foot.kind: flat); point and arc "
+             "feet have none")
+_NO_JOINT = "a spoked wheel is one rigid body: it has no joint to drive"
+_FLAT_MODES = "each stance-foot mode of a flat foot has its own mass matrix"
+
+#: kind -> {(feature, view or "*"): reason}; a cell not listed is supported.  ``"*"``
+#: stands for every view of that feature.  Each reason is physical (the walker lacks the
+#: part) or says what the view's model does not carry.
+CAPABILITIES: dict[str, dict[tuple[str, str], str]] = {
+    "straight_legs": {
+        ("knee_torque", "*"): _NO_KNEE,
+        ("ankle_torque", "*"): _NO_ANKLE,
+        ("ankle_push_off", "*"): _NO_ANKLE,
+        ("profile", "osim"): ("OpenSim's Hunt-Crossley contact takes spheres and half-spaces, "
+                              "not a height profile; --format mjcf carries it as a height "
+                              "field"),
+    },
+    "locking_knees": {
+        ("ankle_torque", "*"): _NO_ANKLE,
+        ("ankle_push_off", "*"): _NO_ANKLE,
+        ("profile", "osim"): ("OpenSim's Hunt-Crossley contact takes spheres and half-spaces, "
+                              "not a height profile; --format mjcf carries it as a height "
+                              "field"),
+    },
+    "flat_feet": {
+        ("knee_torque", "*"): ("flat feet are not available with a knee yet "
+                               "(walker.leg.knee)"),
+        ("walk", "osim"): ("the OpenSim export has no foot bodies, ankle springs or heel and "
+                           "toe contacts; --format mjcf carries flat feet"),
+        ("ankle_push_off", "osim"): ("the OpenSim export has no flat feet; --format mjcf "
+                                     "carries them"),
+        ("walk", "gym"): f"not carried yet ({_FLAT_MODES}); use point or arc feet",
+        ("footholds", "rigid"): ("footholds of several heights or slopes are built for "
+                                 "point and arc feet (a flat foot's modes have no per-step "
+                                 "landing yet)"),
+    },
+    "free_joints": {
+        ("ankle_torque", "*"): _NO_ANKLE,
+        ("ankle_push_off", "*"): _NO_ANKLE,
+        ("push_off", "optimize"): ("the five-link collocation drives the hips and knees; it "
+                                   "has no push-off"),
+        ("footholds", "rigid"): ("footholds of several heights or slopes are built for "
+                                 "passive walkers; a five-link biped walks by its torques"),
+        ("profile", "osim"): ("OpenSim's Hunt-Crossley contact takes spheres and half-spaces, "
+                              "not a height profile; --format mjcf carries it as a height "
+                              "field"),
+    },
+    "rolling_polygon": {
+        **{(f, "*"): _NO_JOINT for f in ("hip_torque", "knee_torque", "ankle_torque",
+                                         "torso_torque", "push_off", "ankle_push_off")},
+        ("walk", "adams"): ("the Adams dataset writes a tree of leg links; a spoked wheel "
+                            "(one rigid body) is exported as mjcf or urdf"),
+        ("walk", "osim"): ("the OpenSim export writes a tree of leg links; a spoked wheel "
+                           "(one rigid body) is exported as mjcf or urdf"),
+        ("walk", "gym"): _NO_JOINT,
+        ("walk", "optimize"): (f"{_NO_JOINT}: there is no input to optimise (its gait is "
+                               "the passive one, walkerlab fixedpoint)"),
+        **{(f, "mjcf"): ("a spoked wheel's MJCF carries the slope's plane only; "
+                         "--walker-only writes the wheel alone")
+           for f in ("stairs", "footholds", "profile")},
+    },
+}
+
+
+def kind_of(structure) -> Kind:
+    """The kind of a walker structure (:class:`~walkerlab.walker.description.Structure`):
+    the one place the structure's switches choose among :data:`KINDS`.
+
+    Parameters
+    ----------
+    structure : walkerlab.walker.description.Structure
+
+    Returns
+    -------
+    Kind
+    """
+    if structure.spokes:
+        return KINDS["rolling_polygon"]
+    if structure.free_knees:
+        return KINDS["free_joints"]
+    if structure.foot == "flat":
+        return KINDS["flat_feet"]
+    if structure.knee:
+        return KINDS["locking_knees"]
+    return KINDS["straight_legs"]
+
+
+def table_rows() -> list[dict]:
+    """The capability table, one row per kind × feature × view: ``{"kind", "feature",
+    "view", "supported", "reason"}`` (``reason`` "" when supported) - what ``walkerlab
+    capabilities --json`` prints."""
+    rows = []
+    for kind in KINDS.values():
+        for feature in FEATURES:
+            for view in VIEWS:
+                why = kind.cell(feature, view)
+                rows.append({"kind": kind.name, "feature": feature, "view": view,
+                             "supported": why is None, "reason": why or ""})
+    return rows
