@@ -15,6 +15,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from walkerlab.io.artifacts import READ_ERRORS
+
 __all__ = ["read_basin_partial", "basin_partial_writer"]
 
 #: the cell arrays of a basin map, in the order they are stored
@@ -51,7 +53,7 @@ def read_basin_partial(part: Path, key: str, shape: tuple[int, int]
             arrays = {k: f[k][()] for k in CELL_ARRAYS}
             stored = [x.decode() if isinstance(x, bytes) else str(x)
                       for x in f["row_hash"][()]] if "row_hash" in f else [""] * shape[0]
-    except (OSError, KeyError, ValueError):
+    except READ_ERRORS:  # absent, truncated or damaged inside: computed again
         return None, None
     return arrays, stored
 

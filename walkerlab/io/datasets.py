@@ -37,7 +37,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from walkerlab.io.artifacts import ArtifactError
+from walkerlab.io.artifacts import READ_ERRORS, ArtifactError
 
 __all__ = ["load_dataset", "load_fixed_points", "xarray"]
 
@@ -132,7 +132,7 @@ def _stage(path: Path) -> str:
     try:
         with h5py.File(path, "r") as f:
             stage = f.attrs.get("stage")
-    except (OSError, FileNotFoundError):
+    except READ_ERRORS:  # absent, not HDF5, or damaged inside
         raise ArtifactError(f"{path}: missing or not an HDF5 artifact") from None
     if stage is None:
         raise ArtifactError(f"{path}: not a walkerlab artifact (no 'stage' attribute)")

@@ -43,6 +43,7 @@ import numpy as np
 
 import walkerlab
 from walkerlab.io import netcdf
+from walkerlab.io.artifacts import READ_ERRORS
 from walkerlab.io.sweep_resume import (
     STR,
     chain_check,
@@ -369,7 +370,7 @@ def complete_sweep(path: Path, input_hash: str) -> bool:
                     and bool(f.attrs.get("complete", False))
                     and np.unique(f["points/index"][()]).size == int(f.attrs["n_points"])
                     and str(f.attrs.get("content_hash")) == content_hash_of(f))
-    except (OSError, KeyError):
+    except READ_ERRORS:  # absent, truncated or damaged inside: not complete
         return False
 
 

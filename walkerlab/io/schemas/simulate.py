@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from walkerlab.io.artifacts import open_artifact, put
+from walkerlab.io.artifacts import READ_ERRORS, open_artifact, put
 from walkerlab.io.netcdf import coordinate
 from walkerlab.io.trajectory import NamedTrajectory, read_samples, write_samples
 from walkerlab.units import Units, for_artifact
@@ -226,7 +226,7 @@ def strides_of(path: Path) -> int | None:
     try:
         with h5py.File(path, "r") as f:
             return int(f.attrs["strides_requested"])
-    except (OSError, KeyError, ValueError, TypeError):
+    except (*READ_ERRORS, TypeError):  # absent, truncated or damaged inside
         return None
 
 
