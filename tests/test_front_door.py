@@ -135,10 +135,10 @@ def test_sweep_package_is_a_plain_package_and_the_api_sweep_lives_in_api(tmp_pat
 
     import walkerlab.studies as package
 
-    # a plain package (walkerlab itself is a module whose ``export`` attribute is the
-    # exchange-format package made callable, ``wl.export``: its type is a ModuleType too)
+    # plain packages: walkerlab itself swaps no module class (the front door's export is
+    # ``wl.export_scene``, the package ``walkerlab.export`` is not callable)
     assert not callable(package) and type(package) is types.ModuleType
-    assert isinstance(wl, types.ModuleType)
+    assert type(wl) is types.ModuleType
     sw = wl.api.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
     assert sw["outcome"].values.tolist() == ["ok"]
 
