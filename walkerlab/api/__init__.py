@@ -22,9 +22,10 @@ formats, so the top level names the function ``wl.export_scene``)),
 :func:`continuation`, :func:`mfpt`) and :mod:`~walkerlab.api.walker` (:class:`Walker`: the
 walker in memory, its map, Jacobian, fixed point and walks, no artifact;
 :class:`ContactWalker` (``Walker.contact()``): its contact view in memory, the walks and
-periodic gait of ``walkerlab contact-sim``; and
-:func:`target`: the field value whose gait meets a target speed, step length or period, in
-memory as ``walkerlab target``); this module only gathers their public names.
+periodic gait of ``walkerlab contact-sim``), :mod:`~walkerlab.api.walks` (the records of
+their runs) and :mod:`~walkerlab.api.targets` (:func:`target`: the field value whose gait
+meets a target speed, step length or period, in memory as ``walkerlab target``); this
+module only gathers their public names.
 
 Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``test`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what
@@ -52,7 +53,8 @@ from walkerlab.api.runs import (
 )
 from walkerlab.api.scenes import DEFAULT_RUNS, load_scene, with_changes
 from walkerlab.api.studies import basin, continuation, mfpt, sweep
-from walkerlab.api.walker import ContactWalker, Walker, target
+from walkerlab.api.targets import target
+from walkerlab.api.walker import ContactWalker, Walker
 
 export = export_scene  # ``wl.api.export``: this package has no subpackage of that name
 
