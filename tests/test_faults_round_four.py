@@ -51,7 +51,7 @@ STUDIES = {
 
 @pytest.mark.slow
 @pytest.mark.parametrize("study", sorted(STUDIES))
-def test_i1_full_disk_while_a_study_writes_its_partial_file_is_one_line(tmp_path, study):
+def test_full_disk_while_a_study_writes_its_partial_file_is_one_line(tmp_path, study):
     args, sections = STUDIES[study]
     scene = _scene(tmp_path, **sections)
     runs = tmp_path / "runs"
@@ -112,7 +112,7 @@ def _mc(scene, x, part, key="key"):
     return work.resumable_mfpt_study(scene, x, st, part, key, workers=1)
 
 
-def test_i2_lost_dask_worker_keeps_finished_mfpt_chunks_and_advises_a_rerun(
+def test_lost_dask_worker_keeps_finished_mfpt_chunks_and_advises_a_rerun(
         tmp_path, paper_scene, paper_fixed_point, chunked_walks):
     from walkerlab.execution.dask import DaskLost
 
@@ -139,7 +139,7 @@ def _damage_a_group(part: Path, which: int) -> None:
 
 
 @pytest.mark.parametrize("which", [0, -1])  # the sigma group (every chunk), one chunk's group
-def test_i3_damaged_mfpt_partial_pieces_are_dropped_and_computed_again(
+def test_damaged_mfpt_partial_pieces_are_dropped_and_computed_again(
         tmp_path, paper_scene, paper_fixed_point, chunked_walks, which):
     part = tmp_path / "mfpt.h5.partial"
     ref = _mc(paper_scene, paper_fixed_point.x, part)[0]
@@ -154,7 +154,7 @@ def test_i3_damaged_mfpt_partial_pieces_are_dropped_and_computed_again(
 
 # ------------------------------------------------------------------ 5: a link, before computing
 @pytest.mark.parametrize("stage", ["continuation", "robustness"])
-def test_i5_link_in_place_of_an_artifact_is_refused_before_computing(tmp_path, monkeypatch,
+def test_link_in_place_of_an_artifact_is_refused_before_computing(tmp_path, monkeypatch,
                                                                      stage):
     from walkerlab.io.artifacts import write_artifact
     from walkerlab.io.freshness import write_if_stale
@@ -183,7 +183,7 @@ FLAT = yaml.safe_load((ROOT / "configs" / "flat_feet.yaml").read_text())
 
 
 @pytest.mark.parametrize("field, value", [("heel_m", 0), ("toe_m", 1e-9)])
-def test_i7_flat_foot_without_a_heel_or_toe_is_one_line_naming_the_field(tmp_path, field,
+def test_flat_foot_without_a_heel_or_toe_is_one_line_naming_the_field(tmp_path, field,
                                                                          value):
     data = yaml.safe_load(yaml.safe_dump(FLAT))
     data["walker"]["leg"]["foot"][field] = value
@@ -198,7 +198,7 @@ def test_i7_flat_foot_without_a_heel_or_toe_is_one_line_naming_the_field(tmp_pat
 
 # ------------------------------------------------------------------ 8: a bounded gait search
 @pytest.mark.parametrize("search", ["find_fixed_point", "find_gaits"])
-def test_i8_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
+def test_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
         paper_walker, monkeypatch, search):
     """A spring and damper at their caps (1e6) make one step map take ~40 s, and the search
     went on for 12+ maps (459 s, silent) before "no gait found".  Here every step is made
@@ -247,7 +247,7 @@ def _mfpt_data(converged: float):
     return MfptData(np.array([0.008]), vals, "both", ["a", "b", "c", "d"], [])
 
 
-def test_i9_mesh_mfpt_that_did_not_converge_is_said_on_the_cli_and_in_the_report(
+def test_mesh_mfpt_that_did_not_converge_is_said_on_the_cli_and_in_the_report(
         tmp_path, monkeypatch):
     from walkerlab.report.robustness_section import mfpt_section
     from walkerlab.stages import common, pipeline
@@ -268,7 +268,7 @@ def test_i9_mesh_mfpt_that_did_not_converge_is_said_on_the_cli_and_in_the_report
 
 # ------------------------------------------------------------------ 10: the gait simulate uses
 @pytest.mark.slow
-def test_i10_report_of_a_scene_without_fixedpoint_section_shows_the_gait_simulate_starts_from(
+def test_report_of_a_scene_without_fixedpoint_section_shows_the_gait_simulate_starts_from(
         tmp_path):
     scene = tmp_path / "nofp.yaml"
     scene.write_text(yaml.safe_dump({k: v for k, v in IDEAL.items() if k != "fixedpoint"}))
@@ -284,7 +284,7 @@ def test_i10_report_of_a_scene_without_fixedpoint_section_shows_the_gait_simulat
 
 
 # ------------------------------------------------------------------ 11: a damper is not drift
-def test_i11_a_dampers_loss_is_named_and_the_balance_checked_with_it():
+def test_a_dampers_loss_is_named_and_the_balance_checked_with_it():
     """Hip spring 20 N m/rad with a 0.05 N m s/rad damper: the report called the damper's
     0.026 J "energy drift between impacts" (3.7e-9 J without the damper).  The energy ledger
     of the run (``simulate.h5``, ledger/) has the damper's work and the balance's closure."""
@@ -309,7 +309,7 @@ def test_i11_a_dampers_loss_is_named_and_the_balance_checked_with_it():
 
 
 # ------------------------------------------------------------------ 12: the upper body drawn
-def test_i12_animation_draws_the_upper_body(tmp_path):
+def test_animation_draws_the_upper_body(tmp_path):
     """torso_bhm: a 5 kg upper body 0.2 m above the hip on a bisecting hip.  Every frame
     draws a line from the hip to it (before: only the legs and the hip were drawn)."""
     from walkerlab.config import load_scene
@@ -339,7 +339,7 @@ def test_i12_animation_draws_the_upper_body(tmp_path):
 
 # ------------------------------------------------------------------ 6: a stride map on a branch
 @pytest.mark.slow
-def test_i6_continuation_where_the_legs_start_to_differ_writes_its_artifact(tmp_path):
+def test_continuation_where_the_legs_start_to_differ_writes_its_artifact(tmp_path):
     """A hip spring's rest angle from 0 (legs alike: a one-step map) to 0.01 rad (legs that
     differ: a stride) - before: 9-15 s of work, then "setting an array element with a
     sequence" while writing (orbits of 1 and 2 heel strikes on one branch).  The branch has
@@ -384,7 +384,7 @@ class _LostDataFuture:
         raise TimeoutError
 
 
-def test_i4_waiting_for_a_dask_result_is_bounded_and_says_why(monkeypatch):
+def test_waiting_for_a_dask_result_is_bounded_and_says_why(monkeypatch):
     """A sweep's chains wait on each finished piece's result (its continuation guess):
     with the worker that held it killed, that wait never ended (170 s+, while mfpt's wait
     for finished futures ended at 60 s).  Both waits are now one: no worker for
@@ -399,7 +399,7 @@ def test_i4_waiting_for_a_dask_result_is_bounded_and_says_why(monkeypatch):
     assert "--resume" in str(info.value) and "{rerun}" not in str(info.value)
 
 
-def test_i8_search_budgets_nest_and_end_with_their_search():
+def test_search_budgets_nest_and_end_with_their_search():
     """A fixed point inside a gait search keeps the search's earlier deadline and adds its
     maps to the search's count; after the search no map is bounded (per thread)."""
     import threading

@@ -85,7 +85,7 @@ def _sweep_files(folder: Path) -> set[str]:
 
 @pytest.mark.xdist_group("timing")  # wall-clock bound: not beside another of them
 @pytest.mark.slow
-def test_h1_dask_only_worker_killed_bounded_wait_one_line_resume(tmp_path, one_worker_cluster):
+def test_dask_only_worker_killed_bounded_wait_one_line_resume(tmp_path, one_worker_cluster):
     addr, wpid, _ = one_worker_cluster
     os.kill(wpid, signal.SIGKILL)  # the only worker dies; its nanny does not restart it
     env = _env(tmp_path, WALKERLAB_DASK_WORKER_WAIT_S="3")
@@ -106,7 +106,7 @@ def test_h1_dask_only_worker_killed_bounded_wait_one_line_resume(tmp_path, one_w
 
 
 @pytest.mark.slow
-def test_h1_dask_scheduler_killed_one_line_suggests_resume(tmp_path, one_worker_cluster):
+def test_dask_scheduler_killed_one_line_suggests_resume(tmp_path, one_worker_cluster):
     addr, wpid, proc = one_worker_cluster
     env = _env(tmp_path)
     folder = tmp_path / "runs" / "paper"
@@ -151,7 +151,7 @@ def _fifo_all(folder: Path, suffixes=None) -> int:
 
 
 @pytest.mark.slow  # compiles the kernels into a fresh cache (~9 s CPU)
-def test_h2_fifos_in_the_user_cache_do_not_hang_fixedpoint(tmp_path):
+def test_fifos_in_the_user_cache_do_not_hang_fixedpoint(tmp_path):
     cache = tmp_path / "cache"
     env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(cache), TMPDIR=str(tmp_path / "tmp"))
     (tmp_path / "tmp").mkdir()
@@ -340,7 +340,7 @@ def _dead_pid() -> int:
 
 
 @pytest.mark.slow
-def test_low_killed_animate_temp_files_are_removed_and_a_linked_gif_refused(tmp_path):
+def test_killed_animate_temp_files_are_removed_and_a_linked_gif_refused(tmp_path):
     env = _env(tmp_path)
     args = ["animate", PAPER, "--runs-dir", tmp_path / "runs"]
     assert _run(args, env).returncode == 0
@@ -370,7 +370,7 @@ def test_low_killed_animate_temp_files_are_removed_and_a_linked_gif_refused(tmp_
     assert target.read_bytes() == b"mine" and (figs / "animation.gif").is_symlink()
 
 
-def test_low_knee_latch_on_a_straight_leg_walker_is_an_error(tmp_path):
+def test_knee_latch_on_a_straight_leg_walker_is_an_error(tmp_path):
     import yaml
 
     for cfg in ("paper.yaml", "round_feet.yaml"):
@@ -385,7 +385,7 @@ def test_low_knee_latch_on_a_straight_leg_walker_is_an_error(tmp_path):
     assert not (tmp_path / "runs").exists()
 
 
-def test_low_cache_dir_symlink_is_refused_before_anything_is_created(tmp_path):
+def test_cache_dir_symlink_is_refused_before_anything_is_created(tmp_path):
     target = tmp_path / "target"
     target.mkdir(mode=0o700)
     link = tmp_path / "cache_link"
@@ -501,7 +501,7 @@ def test_m4_animate_leaves_out_a_stale_or_edited_contact_sim(tmp_path):
 
 
 @pytest.mark.xdist_group("timing")  # wall-clock bound: not beside another of them
-def test_h1_dask_garbage_scheduler_address_is_one_line_at_once(tmp_path):
+def test_dask_garbage_scheduler_address_is_one_line_at_once(tmp_path):
     pytest.importorskip("distributed")
     for addr in ("not an address", "tcp://host", "inproc://x"):
         t0 = time.monotonic()
