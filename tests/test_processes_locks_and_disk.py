@@ -492,3 +492,64 @@ def test_bench_out_naming_a_file_says_what_to_do(tmp_path):
     code, err, _ = _cli("bench", "ideal", "--out", f)
     assert code == 1 and "is a file; --out names a folder" in err and "\n" not in err
     assert f.read_text() == "keep"
+
+
+# -------------------- one-line advice kept whole; SIGTERM as Ctrl-C; a full disk
+def test_advice_longer_than_the_limit_is_kept_whole_only_the_detail_is_cut():
+    from walkerlab.cli.errors import MAX_ERROR_CHARS, one_line
+
+    advice = "no gait; " + "advice " * 60  # longer than the limit on its own
+    assert len(advice) > MAX_ERROR_CHARS
+    line = one_line(advice + "[tried a; last: " + "word " * 60 + "]")
+    assert line.startswith(advice + "[tried a ... rerun with WALKERLAB_DEBUG=1")
+    short = advice + "[tried a and b]"
+    assert one_line(short) == short  # nothing cut: nothing to rerun for
+
+
+# ------------------------------------------------------------- 15: SIGTERM as Ctrl-C
+def test_sigterm_during_a_write_leaves_no_lock_nor_temporary_file(tmp_path):
+    script = textwrap.dedent(f"""
+        import sys, time
+        from walkerlab.cli.process import terminate_as_interrupt
+        terminate_as_interrupt()
+        from walkerlab.config import load_scene
+        from walkerlab.io.freshness import write_if_stale
+        sc = load_scene({str(ROOT / 'configs' / 'paper.yaml')!r})
+        def writer(f):
+            f.create_dataset('x', data=[1.0])
+            print('ready', flush=True)
+            time.sleep(60)
+        try:
+            write_if_stale('fixedpoint', sc, {str(tmp_path)!r}, ('walker',), (),
+                           lambda: (writer, dict()))
+        except KeyboardInterrupt:
+            sys.exit(130)
+        """)
+    with subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                          text=True) as p:
+        try:
+            assert p.stdout.readline().strip() == "ready"
+            p.send_signal(signal.SIGTERM)
+            assert p.wait(timeout=30) == 130
+        finally:
+            p.kill()
+    left = sorted(q.name for q in (tmp_path / "paper").iterdir())
+    assert left == [".scene"], left  # no .fixedpoint.h5.lock, no temporary file
+
+
+# ------------------------------------------ 15: a full disk while the model is written
+def test_a_file_size_limit_while_the_generated_module_is_written_says_disk_full(monkeypatch):
+    import walkerlab.safefs as safefs
+    from walkerlab.cli.errors import _disk_full_line
+    from walkerlab.codegen import cache
+    from walkerlab.io.artifacts import is_disk_full
+
+    def full(path, fill, **kw):
+        raise OSError(errno.EFBIG, "File too large", str(path))
+
+    monkeypatch.setattr(safefs, "atomic_replace", full)
+    with pytest.raises(OSError) as exc:
+        cache.import_generated("zz_never_written_nb.py", "walkerlab_zz_never", lambda: "X = 1")
+    assert is_disk_full(exc.value) and "cannot write the generated module" in str(exc.value)
+    line = _disk_full_line(exc.value)
+    assert line.startswith("error: disk full: cannot write ") and "zz_never_written" in line

@@ -3,12 +3,14 @@ its numbers from compare.h5 / contact_sim.h5, and the paper's printed error appe
 ``published: paper`` (the kneed, round-feet and rods reports showed the paper's 0.5 mm)."""
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import yaml
 
 from walkerlab.comparison.report_numbers import report_numbers
-from walkerlab.config import load_scene
+from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.io.schemas.compare import load_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.report.build import ReportInputs
@@ -49,3 +51,52 @@ def test_table3_shows_the_contact_periodic_gait_beside_the_run():
     assert col["t_cycle_s"] == 2 * 0.711
     assert col["v_com_m_per_s"] == pytest.approx(0.3605 / 0.711)
     assert np.isnan(col["E_avg_J"])
+
+
+# -------------------- the energy ledger, a section of its own
+POWERED = ROOT / "configs" / "powered_compass.yaml"
+
+
+def _ledger_sim():
+    keys = ("push_off_work", "actuator_work_positive", "actuator_work_negative",
+            "heel_strike_loss", "internal_collision_loss", "damper_work", "potential_work",
+            "closure", "cost_of_transport")
+    from walkerlab.units import Units
+
+    return SimpleNamespace(ledger={k: [0.1, 0.1] for k in keys}, units=Units(), samples=None)
+
+
+def test_the_energy_ledger_is_a_section_beside_the_gait_not_under_figures(tmp_path,
+                                                                          monkeypatch):
+    from walkerlab.report import build, contact_sections, sections
+
+    for mod, name in ((sections, "summary_section"), (contact_sections, "sections"),
+                      (contact_sections, "initial_states_section")):
+        monkeypatch.setattr(mod, name, lambda *a, **k: [])
+    monkeypatch.setattr(sections, "gait_section",
+                        lambda scene, inputs, pub: ["## Gait characteristics", ""])
+    for stem in ("energy_ledger", "fig10_energy"):
+        (tmp_path / f"{stem}.png").write_bytes(b"")
+    scene = load_scene(POWERED)
+    build.write_report(scene, build.ReportInputs({"simulate": _ledger_sim()}), tmp_path,
+                       tmp_path)
+    md = (tmp_path / "report.md").read_text()
+    gait, ledger = md.index("## Gait characteristics"), md.index("## Energy ledger and cost")
+    figures = md.index("## Figures")
+    assert gait < ledger < figures
+    assert md.index("energy_ledger.png") < figures  # the figure moved with its table
+    assert md.index("Cost of transport") < figures and md.count("energy_ledger.png") == 1
+
+
+def test_a_spring_written_as_an_actuator_law_is_named_as_motor_work():
+    from walkerlab.report.figures_section import spring_law_note
+
+    d = yaml.safe_load(POWERED.read_text())
+    d["walker"]["actuation"]["torques"] = [
+        {"joint": "hip", "law": {"stiffness_n_m_per_rad": 20.0}}]
+    note = spring_law_note(scene_from_dict(d))
+    assert "walker.actuation.torques.0 (hip)" in note and "motor work, no regeneration" in note
+    assert "walker.springs" in note
+    assert spring_law_note(load_scene(POWERED)) == ""  # push-off alone
+    # Kuo's spring scaled by the massless foot's mass does no work: not named
+    assert spring_law_note(load_scene(ROOT / "configs" / "kuo2002.yaml")) == ""

@@ -589,3 +589,29 @@ def test_force_replaces_an_artifact_without_hashing_it(tmp_path, monkeypatch):
         assert float(f["fixed_point/stance_rate"][()]) == 2.0
     again = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(3.0))
     assert verified == [out.path] and again.reused
+
+
+# -------------------- an initial guess from a FIFO
+def _cli_four(*args):
+    r = CliRunner().invoke(app, [str(a) for a in args])
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+def _one_line(*args) -> str:
+    code, err, _ = _cli_four(*args)
+    assert code == 1, (code, err)
+    assert len(err.splitlines()) == 1, err
+    return err
+
+
+def test_an_initial_guess_from_a_fifo_is_not_a_regular_file(tmp_path):
+    import os
+
+    fifo = tmp_path / "branch.h5"
+    os.mkfifo(fifo)
+    data = yaml.safe_load((ROOT / "configs" / "simplest.yaml").read_text())
+    data["fixedpoint"]["initial_guess"] = {"from": str(fifo), "at": 0.5}
+    scene = tmp_path / "s.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    err = _one_line("fixedpoint", scene, "--runs-dir", tmp_path / "runs")
+    assert err.endswith(f"{fifo}: not a regular file; give an HDF5 artifact")
