@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 from scipy.optimize import brentq, root
@@ -390,8 +391,8 @@ def test_a_homotopy_from_a_scene_with_the_same_numbers_says_so_without_an_empty_
 
 
 # -------------------- --param of a continuation, a fall named once, a two-parameter artifact
-def _cli(*args):
-    r = CliRunner().invoke(app, [str(a) for a in args])
+def _cli(*args, env=None):
+    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
     return r.exit_code, r.stderr.strip(), r.stdout
 
 
@@ -472,3 +473,26 @@ def test_switch_and_param2_runs_are_both_kept(tmp_path):
     assert (figs / "continuation_slope.angle_rad.png").is_file()
     assert (figs / "continuation_slope.angle_rad+walker.leg.length_m.png").is_file()
     assert "continuation_slope.angle_rad+walker.leg.length_m.h5" in out2
+
+
+# -------------------- a stride map on a branch where the legs start to differ
+
+
+# ------------------------------------------------------------------ 6: a stride map on a branch
+@pytest.mark.slow
+def test_continuation_where_the_legs_start_to_differ_writes_its_artifact(tmp_path):
+    """A hip spring's rest angle from 0 (legs alike: a one-step map) to 0.01 rad (legs that
+    differ: a stride) - before: 9-15 s of work, then "setting an array element with a
+    sequence" while writing (orbits of 1 and 2 heel strikes on one branch).  The branch has
+    one map, a stride, throughout; the fixed points at 0 are the gait's, as before."""
+    from walkerlab.io.schemas.continuation import load_continuation
+
+    code, err, _ = _cli("continuation", ROOT / "configs" / "hip_spring.yaml", "--param",
+                        "walker.springs.0.rest_angle_rad=0:0.01", "--runs-dir", tmp_path)
+    assert code == 0, err
+    path = tmp_path / "hip_spring" / "continuation_walker.springs.0.rest_angle_rad.h5"
+    with h5py.File(path, "r") as f:
+        orbit = f["branches/0/orbit/swing_angle"][()]
+    assert orbit.ndim == 2 and orbit.shape[1] == 2  # two heel strikes a map at every point
+    d = load_continuation(path)
+    assert np.all(np.isfinite(d.branches[0]["param"]))

@@ -183,3 +183,68 @@ def test_require_stable_names_a_stable_gait_the_policy_passed_over():
                                 "short_period": SimpleNamespace(stable=False)})
     line = unstable_gait_line(fp)
     assert "the long-period gait is stable: set fixedpoint.gait: stable" in line
+
+
+# -------------------- a bounded gait search
+# ------------------------------------------------------------------ 8: a bounded gait search
+@pytest.mark.parametrize("search", ["find_fixed_point", "find_gaits"])
+def test_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
+        paper_walker, monkeypatch, search):
+    """A spring and damper at their caps (1e6) make one step map take ~40 s, and the search
+    went on for 12+ maps (459 s, silent) before "no gait found".  Here every step is made
+    0.25 s slower and the budget is 0.6 s: the search stops after a few maps (MINPACK alone
+    needs ~20), says why, and a slow map is said in one notice."""
+    import time as _time
+
+    from walkerlab import progress
+    from walkerlab.analysis.gait import poincare
+    from walkerlab.analysis.gait import search as gait_search
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.published import paper
+
+    monkeypatch.setattr(poincare, "ROOT_BUDGET_S", 0.6, raising=False)
+    monkeypatch.setattr(poincare, "SLOW_MAP_S", 0.2, raising=False)
+    steps, notes = [], []
+    real = poincare.integrate_step
+
+    def slow_step(*a, **k):
+        steps.append(1)
+        t = _time.thread_time()  # the budget counts this thread's CPU time, so burn it
+        while _time.thread_time() - t < 0.25:
+            pass
+        return real(*a, **k)
+
+    monkeypatch.setattr(poincare, "integrate_step", slow_step)
+    monkeypatch.setattr(progress, "note", notes.append)
+    solver, guess = Solver("DOP853", 1e-12, 1e-12), np.array(paper.EQ11_STATE)
+    with pytest.raises(poincare.FixedPointNotFound, match="gave up after [1-4] step map"):
+        if search == "find_fixed_point":
+            poincare.find_fixed_point(paper_walker, guess, solver)
+        else:
+            gait_search.find_gaits(paper_walker, solver, guess)
+    assert 1 <= len(steps) <= 4, len(steps)
+    assert len(notes) == 1 and "step map took" in notes[0], notes
+
+
+def test_search_budgets_nest_and_end_with_their_search():
+    """A fixed point inside a gait search keeps the search's earlier deadline and adds its
+    maps to the search's count; after the search no map is bounded (per thread)."""
+    import threading
+
+    from walkerlab.analysis.gait import poincare as P
+
+    with P.search_budget(1000.0):
+        outer = P._BUDGET.deadline
+        with P.search_budget(2000.0):
+            assert P._BUDGET.deadline == outer
+            P._map_started()
+        with P.search_budget(0.0):
+            with pytest.raises(P.SearchGaveUp, match="gave up after 1 step map"):
+                P._map_started()
+        assert P._BUDGET.deadline == outer
+        seen = []
+        t = threading.Thread(target=lambda: seen.append(P._BUDGET.deadline))
+        t.start()
+        t.join()
+        assert seen == [float("inf")]  # another thread's search has its own budget
+    assert P._BUDGET.deadline == float("inf")

@@ -511,3 +511,45 @@ def test_dask_garbage_scheduler_address_is_one_line_at_once(tmp_path):
         assert r.returncode == 1
         lines = r.stderr.strip().splitlines()
         assert len(lines) == 1 and "not a Dask scheduler address" in lines[0], lines
+
+
+# -------------------- every Dask wait bounded
+class _NoWorkerClient:
+    """A client whose scheduler answers but has no worker (the only one was killed)."""
+
+    status = "running"
+    scheduler = type("S", (), {"address": "tcp://127.0.0.1:1", "identity": None})()
+
+    def sync(self, fn, callback_timeout=None):
+        return {"workers": {}}
+
+
+class _LostDataFuture:
+    """A finished future whose data died with its worker: Dask computes it again, and its
+    ``result()`` waits - for ever, with no worker, unless given a timeout."""
+
+    key = "piece-1"
+    status = "finished"
+
+    def result(self, timeout=None):
+        if timeout is None:
+            raise AssertionError("an unbounded wait on a Dask future")
+        import time as _time
+
+        _time.sleep(min(timeout, 0.05))
+        raise TimeoutError
+
+
+def test_waiting_for_a_dask_result_is_bounded_and_says_why(monkeypatch):
+    """A sweep's chains wait on each finished piece's result (its continuation guess):
+    with the worker that held it killed, that wait never ended (170 s+, while mfpt's wait
+    for finished futures ended at 60 s).  Both waits are now one: no worker for
+    $WALKERLAB_DASK_WORKER_WAIT_S seconds ends it in one line."""
+    pytest.importorskip("distributed")
+    from walkerlab.execution import dask as D
+
+    monkeypatch.setattr(D, "CHECK_S", 0.05)
+    monkeypatch.setenv(D.WAIT_ENV, "0.3")
+    with pytest.raises(D.DaskLost, match="has had no worker for 0.3 s") as info:
+        D.result(_NoWorkerClient(), _LostDataFuture())
+    assert "--resume" in str(info.value) and "{rerun}" not in str(info.value)

@@ -18,6 +18,7 @@ import textwrap
 import time
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 import yaml
@@ -553,3 +554,49 @@ def test_a_file_size_limit_while_the_generated_module_is_written_says_disk_full(
     assert is_disk_full(exc.value) and "cannot write the generated module" in str(exc.value)
     line = _disk_full_line(exc.value)
     assert line.startswith("error: disk full: cannot write ") and "zz_never_written" in line
+
+
+# -------------------- a full disk while a study writes its partial file
+def _scene(tmp_path: Path, name: str = "paper", **sections) -> Path:
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump({**IDEAL, **sections}))
+    return path
+
+
+STUDIES = {
+    "mfpt": (["mfpt", "--method", "montecarlo"],
+             {"mfpt": {"sigma_rad": [0.008], "walks": 12, "max_steps": 8}}),
+    "sweep": (["sweep", "--param", "slope.angle_rad=0.012:0.02:0.001"], {}),
+    "basin": (["basin", "--grid", "8x8"], {"basin": {"max_steps": 5}}),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("study", sorted(STUDIES))
+def test_full_disk_while_a_study_writes_its_partial_file_is_one_line(tmp_path, study):
+    args, sections = STUDIES[study]
+    scene = _scene(tmp_path, **sections)
+    runs = tmp_path / "runs"
+    code, err, _ = _cli("fixedpoint", scene, "--runs-dir", runs)
+    assert code == 0, err
+    limit = 4096  # an HDF5 file of a few pieces is larger: the partial file's writes fail
+    script = f"""
+        import resource, sys
+        resource.setrlimit(resource.RLIMIT_FSIZE, ({limit}, {limit}))
+        from walkerlab.cli import app
+        sys.argv = ["walkerlab", *{args!r}, {str(scene)!r}, "--workers", "1",
+                    "--runs-dir", {str(runs)!r}]
+        app()
+        """
+    r = subprocess.run([sys.executable, "-c", textwrap.dedent(script)], cwd=tmp_path,
+                       env=ENV, capture_output=True, text=True, timeout=300)
+    err = r.stderr.strip().splitlines()
+    assert r.returncode == 1 and len(err) == 1 and err[0].startswith("error: disk full"), \
+        (r.returncode, err[:5])
+    left = [p for p in runs.rglob("*") if p.is_file() and p.name != ".scene"
+            and p.name != "fixedpoint.h5"]
+    assert not [p for p in left if p.name.endswith(".tmp")]
+    for p in left:  # what is left is a whole file (the work saved before the disk filled)
+        assert p.name.endswith(".partial"), p
+        with h5py.File(p, "r") as f:
+            assert "input_hash" in f.attrs

@@ -592,13 +592,10 @@ def test_force_replaces_an_artifact_without_hashing_it(tmp_path, monkeypatch):
 
 
 # -------------------- an initial guess from a FIFO
-def _cli_four(*args):
-    r = CliRunner().invoke(app, [str(a) for a in args])
-    return r.exit_code, r.stderr.strip(), r.stdout
 
 
 def _one_line(*args) -> str:
-    code, err, _ = _cli_four(*args)
+    code, err, _ = _cli(*args)
     assert code == 1, (code, err)
     assert len(err.splitlines()) == 1, err
     return err
@@ -615,3 +612,30 @@ def test_an_initial_guess_from_a_fifo_is_not_a_regular_file(tmp_path):
     scene.write_text(yaml.safe_dump(data))
     err = _one_line("fixedpoint", scene, "--runs-dir", tmp_path / "runs")
     assert err.endswith(f"{fifo}: not a regular file; give an HDF5 artifact")
+
+
+# -------------------- a link in an artifact's place, before computing
+# ------------------------------------------------------------------ 5: a link, before computing
+@pytest.mark.parametrize("stage", ["continuation", "robustness"])
+def test_link_in_place_of_an_artifact_is_refused_before_computing(tmp_path, monkeypatch,
+                                                                     stage):
+    from walkerlab.io.artifacts import write_artifact
+    from walkerlab.io.freshness import write_if_stale
+    from walkerlab.io.runpaths import RunPathError
+
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    runs = tmp_path / "runs"
+    elsewhere = tmp_path / "elsewhere.h5"  # a valid artifact of another run
+    write_artifact(elsewhere, stage, sc, "other inputs", lambda f: None, 0.0)
+    link = runs / "paper" / f"{stage}.h5"
+    link.parent.mkdir(parents=True)
+    link.symlink_to(elsewhere)
+    computed, told = [], []
+
+    def compute():
+        computed.append(1)
+        return (lambda f: None), {}
+
+    with pytest.raises(RunPathError, match="symbolic link"):
+        write_if_stale(stage, sc, runs, ("walker",), (), compute, tell=told.append)
+    assert not computed and not told  # before: "recomputing ... changed" and the computation
