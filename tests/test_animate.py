@@ -152,3 +152,33 @@ def test_report_embeds_the_gif(tmp_path):
     md = figures_section(figs, "figures", {})
     assert any(line.startswith("![") and "figures/animation.gif" in line for line in md)
     assert "data:image/gif;base64," in to_html("\n".join(md), tmp_path)
+
+
+# -------------------- the upper body drawn
+# ------------------------------------------------------------------ 12: the upper body drawn
+def test_animation_draws_the_upper_body(tmp_path):
+    """torso_bhm: a 5 kg upper body 0.2 m above the hip on a bisecting hip.  Every frame
+    draws a line from the hip to it (before: only the legs and the hip were drawn)."""
+    from walkerlab.config import load_scene
+    from walkerlab.io.artifacts import open_artifact
+    from walkerlab.io.trajectory import read_samples
+    from walkerlab.plotting.animation import walker_animation
+    from walkerlab.stages import pipeline
+
+    scene = load_scene(ROOT / "configs" / "torso_bhm.yaml")
+    with open_artifact(pipeline.run("simulate", scene, tmp_path).path, "simulate") as f:
+        tr = read_samples(f)
+    frames = walker_animation({"rigid": tr}, scene.slope.phi_rad, max_frames=8)
+    try:
+        for j in range(len(frames.times)):
+            frames.draw(j)
+            i = np.clip(np.searchsorted(tr.time, frames.times[j]), 0, tr.time.size - 1)
+            hip, body = tr.points["hip"][:, i], tr.points["torso_mass"][:, i]
+            assert body[1] > hip[1] and abs(np.hypot(*(body - hip)) - 0.2) < 1e-9
+            lines = [np.column_stack(ln.get_data()) for ln in frames.fig.axes[0].lines]
+            assert any(len(xy) == 2 and np.allclose(xy, [hip, body], atol=1e-12)
+                       for xy in lines), "no line from the hip to the upper body"
+    finally:
+        import matplotlib.pyplot as plt
+
+        plt.close(frames.fig)

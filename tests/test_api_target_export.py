@@ -1,5 +1,5 @@
 """The front door goes where the command line goes (``wl.optimize``, ``wl.target``,
-``wl.export``, ``wl.robustness``, with the commands' checks), ``walkerlab target`` refuses a
+``wl.export_scene``, ``wl.robustness``, with the commands' checks), ``walkerlab target`` refuses a
 bad target or field at once in one line, and an export writes its files together: all or
 none."""
 
@@ -70,7 +70,7 @@ def test_an_export_writes_its_files_together_or_not_at_all(tmp_path, monkeypatch
     from walkerlab import safefs
 
     runs = tmp_path / "runs"
-    adm = wl.export(CONFIGS / "paper.yaml", "adm", runs_dir=runs)
+    adm = wl.export_scene(CONFIGS / "paper.yaml", "adm", runs_dir=runs)
     acf = adm.with_suffix(".acf")
     old_adm, old_acf = adm.read_bytes(), acf.read_bytes()
     adm.write_bytes(old_adm + b"! old\n")
@@ -94,40 +94,44 @@ def test_an_export_writes_its_files_together_or_not_at_all(tmp_path, monkeypatch
 
     monkeypatch.setattr(safefs.os, "replace", full_at_second)
     with pytest.raises(ArtifactError, match="disk full.*nothing was replaced"):
-        wl.export(CONFIGS / "paper.yaml", "adm", runs_dir=runs)
+        wl.export_scene(CONFIGS / "paper.yaml", "adm", runs_dir=runs)
     monkeypatch.setattr(safefs.os, "replace", real)
     assert adm.read_bytes() == old_adm + b"! old\n"
     assert acf.read_bytes() == old_acf + b"! old\n"
     assert sorted(p.name for p in adm.parent.iterdir()) == [".scene", "walker.acf",
                                                            "walker.adm"]  # no temp, no backup
     # and a good export replaces both
-    wl.export(CONFIGS / "paper.yaml", "adm", runs_dir=runs)
+    wl.export_scene(CONFIGS / "paper.yaml", "adm", runs_dir=runs)
     assert adm.read_bytes() == old_adm and acf.read_bytes() == old_acf
 
 
 def test_the_urdf_and_its_keyframe_are_written_together(tmp_path):
     runs = tmp_path / "runs"
-    urdf = wl.export(CONFIGS / "paper.yaml", runs_dir=runs)
+    urdf = wl.export_scene(CONFIGS / "paper.yaml", runs_dir=runs)
     side = urdf.with_name("walker.gait.json")
     assert urdf.name == "walker.urdf" and side.is_file()
     urdf.write_text("old")
     side.unlink()
     side.mkdir()
     with pytest.raises(ArtifactError, match="walker.gait.json: cannot write.*nothing was repl"):
-        wl.export(CONFIGS / "paper.yaml", runs_dir=runs)
+        wl.export_scene(CONFIGS / "paper.yaml", runs_dir=runs)
     assert urdf.read_text() == "old"
 
 
-def test_wl_export_checks_its_arguments_and_stays_callable(tmp_path):
+def test_export_scene_checks_its_arguments_and_the_export_package_stays_a_package(tmp_path):
+    import types
+
     import walkerlab.export.adams  # noqa: F401 - the package imported first ...
 
-    assert callable(wl.export) and wl.export.adams.__name__ == "walkerlab.export.adams"
+    assert wl.api.export is wl.export_scene and callable(wl.export_scene)
+    assert type(wl.export) is types.ModuleType and not callable(wl.export)
+    assert wl.export.adams.__name__ == "walkerlab.export.adams"
     for kw, says in ((dict(fmt="stl"), "fmt='stl': one of urdf, mjcf, adm"),
                      (dict(fmt=None), "fmt=None"),
                      (dict(walker_only="yes"), "walker_only='yes': give True or False")):
         with pytest.raises(SceneError, match=says):
-            wl.export(CONFIGS / "paper.yaml", runs_dir=tmp_path, **kw)
-    p = wl.export(CONFIGS / "paper.yaml", "mjcf", walker_only=True, runs_dir=tmp_path)
+            wl.export_scene(CONFIGS / "paper.yaml", runs_dir=tmp_path, **kw)
+    p = wl.export_scene(CONFIGS / "paper.yaml", "mjcf", walker_only=True, runs_dir=tmp_path)
     assert p.name == "walker.xml" and "<mujoco" in p.read_text()
     assert not any(tmp_path.rglob(".*.tmp"))
 

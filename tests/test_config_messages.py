@@ -202,3 +202,77 @@ def test_an_unknown_walker_part_says_what_a_walker_can_be(walker):
     assert "elastic" not in vocabulary and "yet" not in vocabulary
     guide = (ROOT / "docs" / "user_guide" / "walkers.md").read_text()  # the README's section
     assert "a torque at any joint the walker has" in " ".join(guide.split())
+
+
+# -------------------- reference tables bounded
+# ------------------------------------------------------ 15: reference tables bounded
+@pytest.mark.parametrize("where", ["angle_rad", "phase_rad"])
+def test_a_reference_angle_beyond_two_turns_is_refused_naming_the_entry(where):
+    d = yaml.safe_load((ROOT / "configs" / "rabbit.yaml").read_text())
+    d["walker"]["actuation"]["torques"][0]["law"]["reference"][where][1] = 1e308
+    with pytest.raises(SceneError) as exc:
+        scene_from_dict(d, "s.yaml")
+    assert str(exc.value) == (f"s.yaml: walker.actuation.torques.0.law.reference.{where}.1: "
+                              "Input should be less than or equal to 6.3")
+
+
+# -------------------- unknown keys, a NUL byte, a knee or a field one level too high
+SIMPLEST = yaml.safe_load((ROOT / "configs" / "simplest.yaml").read_text())
+
+
+# ------------------------------------------------------- 1: thousands of unknown keys
+def test_thousands_of_unknown_keys_give_a_capped_list_and_few_suggestions(monkeypatch):
+    import difflib
+
+    from walkerlab.config import errors
+
+    calls = []
+    real = difflib.get_close_matches
+    monkeypatch.setattr(difflib, "get_close_matches",
+                        lambda *a, **k: calls.append(a[0]) or real(*a, **k))
+    data = dict(SIMPLEST, **{f"zzunknown{i}": 1 for i in range(3000)})
+    with pytest.raises(SceneError) as exc:
+        scene_from_dict(data, "s.yaml")
+    lines = str(exc.value).splitlines()
+    assert len(lines) == errors.MAX_ERROR_LINES
+    assert lines[0] == "s.yaml: zzunknown0: unknown field"
+    assert lines[-1] == f"s.yaml: … and {3000 - errors.MAX_ERROR_LINES + 1} more errors"
+    # a suggestion only for the lines printed: the work does not grow with the keys
+    assert len(calls) <= errors.MAX_ERROR_LINES
+
+
+def test_a_few_unknown_keys_are_all_listed_with_their_suggestion():
+    data = dict(SIMPLEST, slop=SIMPLEST["slope"], zzz=1)
+    del data["slope"]
+    lines = str(pytest.raises(SceneError, scene_from_dict, data, "s.yaml").value).splitlines()
+    assert lines == ["s.yaml: slop: unknown field (did you mean slope?)",
+                     "s.yaml: zzz: unknown field"]
+
+
+# ------------------------------------------------------------- 2: a NUL byte in a scene
+def test_a_nul_byte_in_a_scene_is_one_line_naming_the_file_and_line(tmp_path):
+    f = tmp_path / "nul.yaml"
+    f.write_bytes((ROOT / "configs" / "simplest.yaml").read_bytes() + b"\nextra: 1\x00\n")
+    code, err, _ = _cli("fixedpoint", f, "--runs-dir", tmp_path / "runs")
+    assert code == 1
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"error: {f}: line ") and "0x00" in lines[0]
+    with pytest.raises(SceneError, match=r"nul.yaml: line \d+: character 0x00 "):
+        load_scene(f)
+
+
+# --------------------------------------- 6: a knee at the walker's level, not the leg's
+@pytest.mark.parametrize("scene, meant", [("asymmetric_legs.yaml", "legs.N.knee"),
+                                          ("paper_rods.yaml", "leg.knee")])
+def test_a_knee_given_to_the_walker_points_to_the_leg(scene, meant):
+    d = yaml.safe_load((ROOT / "configs" / scene).read_text())
+    d["walker"]["knee"] = {"thigh_length_m": 0.5}
+    lines = str(pytest.raises(SceneError, scene_from_dict, d, "s.yaml").value).splitlines()
+    assert lines == [f"s.yaml: walker.knee: unknown field (did you mean {meant}?)"]
+
+
+def test_a_field_given_one_section_too_high_points_to_its_section():
+    d = dict(SIMPLEST, angle_deg=2.0)
+    lines = str(pytest.raises(SceneError, scene_from_dict, d, "s.yaml").value).splitlines()
+    assert lines == ["s.yaml: angle_deg: unknown field (did you mean slope.angle_deg?)"]

@@ -14,12 +14,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 from scipy.optimize import brentq, root
+from typer.testing import CliRunner
 
 from walkerlab.analysis.continuation.branch import SPECIAL_KINDS
 from walkerlab.analysis.gait.poincare import poincare_map
+from walkerlab.cli import app
 from walkerlab.config import load_scene
 from walkerlab.integrate.solver import Solver
 from walkerlab.models.registry import build_walker
@@ -385,3 +388,111 @@ def test_a_homotopy_from_a_scene_with_the_same_numbers_says_so_without_an_empty_
     assert "over  (" not in note and "by homotopy over" not in note
     assert note == ("initial guess: the gait of scene paper, whose walker and slope have this "
                     "scene's numbers (nothing to carry by homotopy)")
+
+
+# -------------------- --param of a continuation, a fall named once, a two-parameter artifact
+def _cli(*args, env=None):
+    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+def _one_line(*args) -> str:
+    code, err, _ = _cli(*args)
+    assert code == 1, (code, err)
+    assert len(err.splitlines()) == 1, err
+    return err
+
+
+@pytest.mark.filterwarnings("error")
+def test_a_continuation_to_infinity_is_one_line_and_no_numpy_warning(tmp_path):
+    err = _one_line("continuation", ROOT / "configs" / "paper.yaml", "--param",
+                    "slope.angle_deg=1:inf", "--runs-dir", tmp_path)
+    assert err == "error: --param slope.angle_deg: stop inf is not a finite number"
+
+
+@pytest.mark.parametrize("param2", ["slope.angle_deg=1:2", "slope.angle_rad=0.01:0.02"])
+def test_param2_the_same_field_as_param_is_refused(tmp_path, param2):
+    err = _one_line("continuation", ROOT / "configs" / "paper.yaml", "--param",
+                    "slope.angle_deg=1:2", "--param2", param2, "--runs-dir", tmp_path)
+    assert "the same field as --param slope.angle_deg" in err
+
+
+def test_an_index_past_an_unnamed_list_says_its_indices(tmp_path):
+    err = _one_line("continuation", ROOT / "configs" / "asymmetric_legs.yaml", "--param",
+                    "walker.legs.5.length_m=0.9:1", "--runs-dir", tmp_path)
+    assert err.endswith("index 5 is out of range (the list has 2 items, indices 0-1)")
+    assert "None" not in err
+
+
+def test_a_continuation_over_a_whole_number_field_is_refused_as_typed(tmp_path):
+    err = _one_line("continuation", ROOT / "configs" / "paper.yaml", "--param",
+                    "simulate.strides=1:2", "--runs-dir", tmp_path)
+    assert err.startswith("error: --param simulate.strides: the field takes whole numbers")
+    assert "<sweep>" not in err and "2.0" not in err
+
+
+def test_a_fall_is_named_once():
+    from types import SimpleNamespace
+
+    from walkerlab.analysis.continuation.gait_map import _cause
+
+    walker = SimpleNamespace(phases=[])
+    seg = SimpleNamespace(termination="event", event="fall", phase_times={})
+    assert _cause(walker, seg) == "fall"
+    seg.event = "stance_heel_touches_down"
+    assert _cause(walker, seg) == "fall (stance_heel_touches_down)"
+
+
+# ------------------------------ 11: a two-parameter run keeps the one-parameter artifact
+def test_a_two_parameter_continuation_has_its_own_artifact_name():
+    from walkerlab.io.runpaths import continuation_stem
+
+    one = continuation_stem("walker.leg.bodies.rod.mass_kg")
+    two = continuation_stem("walker.leg.bodies.rod.mass_kg", "walker.hip_mass_kg")
+    assert one == "continuation_walker.leg.bodies.rod.mass_kg"
+    assert two == "continuation_walker.leg.bodies.rod.mass_kg+walker.hip_mass_kg"
+
+
+@pytest.mark.slow
+def test_switch_and_param2_runs_are_both_kept(tmp_path):
+    from walkerlab.io.schemas.continuation import load_continuation
+
+    scene, runs = ROOT / "configs" / "simplest.yaml", tmp_path / "runs"
+    base = ["continuation", scene, "--param", "slope.angle_rad=0.0085:0.0095", "--runs-dir",
+            runs]
+    code, err, out = _cli(*base, "--switch")
+    assert code == 0, err
+    code, err, out2 = _cli(*base, "--param2", "walker.leg.length_m=0.95:1.05")
+    assert code == 0, err
+    d = runs / "simplest"
+    one = load_continuation(d / "continuation_slope.angle_rad.h5")
+    two = load_continuation(d / "continuation_slope.angle_rad+walker.leg.length_m.h5")
+    assert not one.curves and {b["period"] for b in one.branches} >= {1}
+    assert len(one.branches) >= len(two.branches)
+    figs = d / "report" / "figures"
+    assert (figs / "continuation_slope.angle_rad.png").is_file()
+    assert (figs / "continuation_slope.angle_rad+walker.leg.length_m.png").is_file()
+    assert "continuation_slope.angle_rad+walker.leg.length_m.h5" in out2
+
+
+# -------------------- a stride map on a branch where the legs start to differ
+
+
+# ------------------------------------------------------------------ 6: a stride map on a branch
+@pytest.mark.slow
+def test_continuation_where_the_legs_start_to_differ_writes_its_artifact(tmp_path):
+    """A hip spring's rest angle from 0 (legs alike: a one-step map) to 0.01 rad (legs that
+    differ: a stride) - before: 9-15 s of work, then "setting an array element with a
+    sequence" while writing (orbits of 1 and 2 heel strikes on one branch).  The branch has
+    one map, a stride, throughout; the fixed points at 0 are the gait's, as before."""
+    from walkerlab.io.schemas.continuation import load_continuation
+
+    code, err, _ = _cli("continuation", ROOT / "configs" / "hip_spring.yaml", "--param",
+                        "walker.springs.0.rest_angle_rad=0:0.01", "--runs-dir", tmp_path)
+    assert code == 0, err
+    path = tmp_path / "hip_spring" / "continuation_walker.springs.0.rest_angle_rad.h5"
+    with h5py.File(path, "r") as f:
+        orbit = f["branches/0/orbit/swing_angle"][()]
+    assert orbit.ndim == 2 and orbit.shape[1] == 2  # two heel strikes a map at every point
+    d = load_continuation(path)
+    assert np.all(np.isfinite(d.branches[0]["param"]))

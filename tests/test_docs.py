@@ -123,3 +123,22 @@ def test_the_equations_chapter_and_the_artifact_page_are_in_the_tables_of_conten
     eq = (DOCS / "user_guide" / "equations.md").read_text()
     for topic in ("Rigid", "heel strike", "contact law", "energy ledger", "Sources"):
         assert topic.lower() in eq.lower(), topic
+
+
+# -------------------- the README names every API function
+# ------------------------------------------------------------------- 8: README drift
+def test_the_readme_names_every_api_function_and_the_basin_file_a_grid_writes():
+    import walkerlab as wl
+    from walkerlab.stages.basin import stem
+
+    guide = ROOT / "docs" / "user_guide"  # the README's tables and API section live there
+    text = " ".join((guide / "python_api.md").read_text().split())
+    api = text[text.index("# Python API"):text.index("examples/walkerlab_tour.ipynb")]
+    for name in wl.api.__all__:
+        if name != "DEFAULT_RUNS":
+            assert f"`{name}`" in api, name
+    sc = load_scene(ROOT / "configs" / "paper.yaml")
+    assert stem(sc, (40, 40)) == "basin_40x40" and stem(sc, None) == "basin"
+    row = next(ln for ln in (guide / "commands.md").read_text().splitlines()
+               if ln.startswith("| `walkerlab basin"))
+    assert "`basin_<NX>x<NY>.h5`" in row and "`basin_40x40.h5`" in row

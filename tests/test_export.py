@@ -463,3 +463,30 @@ def test_bisecting_hip_holds_in_a_mujoco_run(tmp_path):
         contacts += d.ncon > 0
     assert contacts > 0 and abs(d.qpos[leg1] - d.qpos[leg2]) > 0.1  # it moved, on the ground
     assert worst < 1e-6, worst
+
+
+# -------------------- the export reads an up-to-date fixedpoint.h5
+POWERED = ROOT / "configs" / "powered_compass.yaml"
+
+
+# ------------------------------------------------ 8: export reads a fresh fixedpoint.h5
+def test_export_reads_the_gait_of_an_up_to_date_fixedpoint_artifact(tmp_path, monkeypatch):
+    """With fixedpoint.h5 up to date the export searches no gait (RABBIT: 94 s of search ->
+    2 s), and writes the very file the search gives (bit for bit); a stale artifact is not
+    read (the search runs)."""
+    from walkerlab.analysis.gait import search
+    from walkerlab.stages import export, fixedpoint
+
+    scene = load_scene(POWERED)
+    searched = export.run(scene, tmp_path / "a", "mjcf").read_text()  # no artifact: search
+    fixedpoint.run(scene, tmp_path / "b")
+    calls = []
+    real = search.find_gaits
+    monkeypatch.setattr(search, "find_gaits", lambda *a, **k: calls.append(1) or real(*a, **k))
+    assert export.run(scene, tmp_path / "b", "mjcf").read_text() == searched
+    assert export.run(scene, tmp_path / "b", "adm").is_file()
+    assert calls == []  # read, not searched (the adm export searched twice before)
+    other = scene.model_copy(update={"solver": scene.solver.model_copy(update={"rtol": 1e-11})})
+    assert fixedpoint.fresh_artifact(other, tmp_path / "b") is None  # stale for this scene
+    export.run(other, tmp_path / "b", "mjcf")
+    assert calls  # searched again

@@ -21,8 +21,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from typer.testing import CliRunner
 
-from walkerlab.config import load_scene
+from walkerlab.cli import app
+from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.export.adams import (
     ACT_VARIABLES,
     HIP_SFORCE,
@@ -414,3 +416,38 @@ def test_five_link_joint_torques_equal_walkerlab_laws():
                                                 else "knee")
             roles_seen.add((r, abs(want) == 150.0 * MM))
     assert {("stance", False), ("swing", False)} <= roles_seen
+
+
+# -------------------- a powered walker's Adams dataset carries its actuation
+POWERED = ROOT / "configs" / "powered_compass.yaml"
+
+
+def _cli(*args):
+    r = CliRunner().invoke(app, [str(a) for a in args])
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+# --------------------------- 6: a powered walker's Adams dataset carries its actuation
+def test_adm_export_of_a_powered_walker_on_level_ground_carries_its_push_off(tmp_path):
+    """Issue 48: the push-off is written (GFORCE pulses), so no warning any more."""
+    code, err, out = _cli("export", POWERED, "--format", "adm", "--runs-dir", tmp_path)
+    assert code == 0 and "walker.adm" in out and err == ""
+    adm = (Path(tmp_path) / "powered_compass" / "walker.adm").read_text()
+    assert "GFORCE/1," in adm and "GFORCE/2," in adm and "PASSIVE" not in adm
+
+
+def test_adm_warning_is_empty_and_what_is_not_written_is_refused():
+    """Push-off and hip torques are written (no warning line); a time reference is not
+    (refused in one line naming the field)."""
+    from walkerlab.export.adams import actuation_warning, check_adams_actuation
+
+    d = yaml.safe_load(POWERED.read_text())
+    d["slope"] = {"angle_deg": 1.0}
+    d["walker"]["actuation"]["torques"] = [{"joint": "hip", "law": {"constant_n_m": 0.1}}]
+    assert actuation_warning(scene_from_dict(d)) == ""
+    check_adams_actuation(scene_from_dict(d))
+    d["walker"]["actuation"]["torques"][0]["law"]["time_reference"] = {
+        "time_s": [0.0, 0.4], "hip_angle_rad": [0.1, -0.1]}
+    with pytest.raises(ValueError, match="torques.0.law.time_reference"):
+        check_adams_actuation(scene_from_dict(d))
+    assert actuation_warning(load_scene(ROOT / "configs" / "paper.yaml")) == ""

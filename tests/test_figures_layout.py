@@ -12,7 +12,7 @@ import pytest
 import yaml
 from matplotlib.colors import to_rgb
 
-from walkerlab.config import scene_from_dict
+from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.io.artifacts import open_artifact
 from walkerlab.io.trajectory import read_samples
 from walkerlab.plotting import figures as F
@@ -145,3 +145,141 @@ def test_stability_map_marks_the_scenes_point_with_three_cells_a_side():
     x, y = star.get_xdata()[0], star.get_ydata()[0]
     assert x == pytest.approx((0.997 - 0.5) / 1.75, rel=1e-12)
     assert y == pytest.approx(2 / 3, rel=1e-12)
+
+
+# -------------------- figure captions, axes, tables; a continuation figure's stability
+PAPER = ROOT / "configs" / "paper.yaml"
+
+
+def _branch_data(mmax, special=None):
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    p = np.arange(len(mmax), dtype=float)
+    mult = np.c_[np.asarray(mmax, float), 0.1 * np.ones(len(mmax))].astype(complex)
+    b = {"period": 1, "param": p, "states": {"stance_angle": 0.2 + 0.01 * p},
+         "multipliers": mult, "stable": np.asarray(mmax) < 1}
+    return SimpleNamespace(branches=[b], special=special or {}, state_names=["stance_angle"],
+                           unit="deg", path="slope.angle_deg", start=0.0)
+
+
+# ------------------------------------------------------------------- 9: figure nits
+def test_fig9_caption_does_not_promise_a_panel_per_link_of_a_straight_leg():
+    from walkerlab.report.figures_section import CAPTIONS
+
+    cap = dict(CAPTIONS)["fig9_limit_cycles"]
+    assert "one panel per link" not in cap and "both legs in each panel" in cap
+
+
+def test_mfpt_log_axis_ticks_are_plain_numbers():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import numpy as np
+
+    from walkerlab.plotting.mfpt_figures import mfpt_figure
+
+    class D(dict):
+        sigma_rad = np.array([0.002, 0.003, 0.004])
+
+    d = D(mfpt_steps_montecarlo=np.array([5.5, 4.2, 3.1]),
+          mfpt_steps_montecarlo_stderr=np.array([0.2, 0.2, 0.1]),
+          mfpt_steps_mesh=np.array([5.4, 4.1, 3.2]), mesh_converged=np.ones(3))
+    fig = mfpt_figure(d)
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_yticklabels(minor=True) + ax.get_yticklabels()]
+    shown = [s for s in labels if s]
+    assert shown and not any("10^" in s or "times" in s or "×" in s for s in shown), shown
+    assert {"3", "4", "5"} <= set(shown)
+
+
+def test_table_2_comes_before_table_3_and_headings_are_capitalised(tmp_path, monkeypatch):
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from walkerlab.report import build, contact_sections, sections
+
+    monkeypatch.setattr(contact_sections, "initial_states_section",
+                        lambda scene, arts: ["## Table 2 — initial states", ""])
+    monkeypatch.setattr(sections, "gait_section",
+                        lambda scene, inputs, pub: ["## Table 3 — gait characteristics", ""])
+    scene = load_scene(PAPER)
+    build.write_report(scene, build.ReportInputs({}), tmp_path, tmp_path)
+    md = (tmp_path / "report.md").read_text()
+    assert md.index("## Table 2") < md.index("## Table 3")
+    c = SimpleNamespace(initial_rate_scale=np.array([1.0, 1.0]), rate_names=["leg1", "leg2"],
+                        adjust=None, samples=SimpleNamespace(coordinates={"leg1_angle": [0.2]}))
+    lines = contact_sections._initial_state_lines(c, {}, None, {})
+    assert lines[0] == "## Initial states (ideal vs contact model)"
+
+
+def test_limit_cycle_distance_column_has_a_unit():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from walkerlab.report.build import ReportInputs
+    from walkerlab.report.contact_sections import compare_section
+
+    c = SimpleNamespace(errors={"leg1_angle": np.array([0.01]), "leg1_rate": np.array([0.1])},
+                        limit_cycle_distance={"leg1": 0.02}, time=np.array([0.0, 1.0]),
+                        metrics={})
+    scene = load_scene(PAPER).model_copy(update={"published": None})
+    text = "\n".join(compare_section(scene, ReportInputs({"compare": c})))
+    assert "mean limit-cycle distance [rad, rad/s: in the (angle, rate) plane]" in text
+
+
+def test_the_notebook_basin_panel_names_its_axes_and_colours():
+    import json
+
+    nb = json.loads((ROOT / "examples" / "walkerlab_tour.ipynb").read_text())
+    cell = next("".join(c["source"]) for c in nb["cells"]
+                if "basin.outcome.plot" in "".join(c["source"]))
+    assert "ax[2].set_xlabel(" in cell and "ax[2].set_ylabel(" in cell  # not "cell centres"
+    assert "OUTCOME_COLORS" in cell and "ax[2].legend(" in cell  # each colour named
+
+
+def test_a_branch_is_drawn_stable_only_where_its_largest_multiplier_is_below_one():
+    import numpy as np
+
+    from walkerlab.plotting.continuation_figures import continuation_figure, stability_pieces
+
+    mmax = np.array([0.8, 0.9, 1.2, 1.1, 0.95])
+    pieces = stability_pieces(np.arange(5.0), np.zeros((5, 1)), mmax)
+    assert [st for *_x, st in pieces] == [True, False, True]
+    assert pieces[0][0][-1] == pytest.approx(1 + 0.1 / 0.3)  # |λ| = 1, linearly between
+    assert pieces[1][0][0] == pieces[0][0][-1] and pieces[1][2][0] == 1.0
+    fig = continuation_figure(_branch_data(mmax))
+    ax2 = fig.axes[1]
+    for line in ax2.get_lines():
+        y = np.asarray(line.get_ydata(), float)
+        if line.get_linestyle() == "-" and y.size > 1:
+            assert np.all(y <= 1.0 + 1e-12), y  # solid: stable
+        if line.get_linestyle() == "--":
+            assert np.all(y >= 1.0 - 1e-12), y
+
+
+def test_special_point_labels_stay_inside_the_axes_clear_of_their_markers():
+    import numpy as np
+
+    from walkerlab.plotting.continuation_figures import continuation_figure
+
+    # the third label of a point at the top: stacked highest, where it left the axes
+    sp = {"kind": np.array(["period_doubling", "fold", "branch_end"]),
+          "param": np.array([1.0, 2.0, 4.0]), "period": np.array([1, 1, 1]),
+          "states": {"stance_angle": np.array([0.21, 0.22, 0.24])}}
+    fig = continuation_figure(_branch_data([0.8, 0.9, 1.2, 1.1, 1.3], sp))
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    box = ax.get_window_extent()
+    from matplotlib.text import Text
+
+    for t in ax.texts:
+        bb = Text.get_window_extent(t)  # the label itself, without its leader line
+        assert box.y0 - 1 <= bb.y0 and bb.y1 <= box.y1 + 1, t.get_text()  # not clipped
+        assert box.x0 - 1 <= bb.x0 and bb.x1 <= box.x1 + 1, t.get_text()
+        x, y = ax.transData.transform((float(t.xy[0]), float(t.xy[1])))
+        assert not (bb.x0 - 4 <= x <= bb.x1 + 4 and bb.y0 - 4 <= y <= bb.y1 + 4), t.get_text()

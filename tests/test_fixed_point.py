@@ -1,10 +1,16 @@
 """Fixed point of the Poincaré map for the paper's scene, and Eq. (11)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
+import yaml
+from typer.testing import CliRunner
 
 from tests.conftest import TIGHT
 from walkerlab.analysis.gait.poincare import find_fixed_point, poincare_map
+from walkerlab.cli import app
+from walkerlab.config import load_scene
 from walkerlab.models.hybrid.printed_equations import make_compass_gait
 from walkerlab.published import paper
 
@@ -52,3 +58,193 @@ def test_flat_ground_has_no_passive_gait():
     w = make_compass_gait(1.0, 5.0, 10.0, 9.81, 0.5, 0.0, "derived")
     with pytest.raises(FixedPointNotFound):
         find_fixed_point(w, EQ11, TIGHT)
+
+
+# -------------------- the no-gait advice, whole
+ROOT = Path(__file__).resolve().parents[1]
+
+
+POWERED = ROOT / "configs" / "powered_compass.yaml"
+
+
+def _cli(*args):
+    r = CliRunner().invoke(app, [str(a) for a in args])
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+# ------------------------------------------------ 9/15: the no-gait advice, whole
+def test_no_gait_with_an_initial_guess_advises_something_else_and_keeps_the_diagnosis(
+        tmp_path):
+    """Push-off 0 on level ground from the shipped guess: no gait.  The guess is given, so
+    the advice is not to give one; the diagnosis (the standing solution) is in the line,
+    and nothing of the advice is cut."""
+    d = yaml.safe_load(POWERED.read_text())
+    d["walker"]["actuation"]["push_off"]["impulse_n_s"] = 0.0
+    f = tmp_path / "p0.yaml"
+    f.write_text(yaml.safe_dump(d))
+    code, err, _ = _cli("fixedpoint", f, "--runs-dir", tmp_path / "runs")
+    assert code == 1 and len(err.splitlines()) == 1
+    assert "give fixedpoint.initial_guess" not in err
+    assert "the initial guess did not converge" in err
+    assert "start from a gait known nearby (walkerlab fixedpoint --from" in err
+    assert "trivial standing solution" in err
+    assert "more characters" not in err and "WALKERLAB_DEBUG" not in err
+
+
+# -------------------- no-gait messages whole, the verdict's zero multipliers, --require-stable
+def _one_line(*args) -> str:
+    code, err, _ = _cli(*args)
+    assert code == 1, (code, err)
+    assert len(err.splitlines()) == 1, err
+    return err
+
+
+PAPER = ROOT / "configs" / "paper.yaml"
+
+
+# ------------------------------------------------ 5: an uphill no-gait message, whole
+def test_an_uphill_no_gait_message_ends_its_clauses(tmp_path):
+    d = yaml.safe_load(PAPER.read_text())
+    d["slope"] = {"angle_rad": -0.0174}
+    scene = tmp_path / "uphill.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    err = _one_line("fixedpoint", scene, "--runs-dir", tmp_path / "runs")
+    assert "downhill slope" in err and "try a continuation" in err
+    # what was tried is printed whole: no sentence or parenthesis left open
+    assert "scale-free seeds (45 fell within the first step)" in err
+    assert "[tried the initial guess and 0 of 45" in err
+
+
+def test_a_long_detail_is_cut_between_clauses():
+    from walkerlab.cli.errors import one_line
+
+    advice = "no gait; " + "advice " * 38
+    detail = "[tried a and b (3 fell within the first step); last: " + "word " * 40 + "]"
+    line = one_line(advice + detail)
+    assert line.startswith(advice + "[tried a and b (3 fell within the first step) ... rerun")
+
+
+# ------------------------------------ 7: the zero multipliers of this walker, not all
+@pytest.mark.parametrize("scene, names, says, not_said", [
+    ("kneed.yaml", ["swing_thigh_angle", "swing_shank_angle", "stance_angle"],
+     "swing knee is straight and locked", ("flat foot", "no mass")),
+    ("flat_feet.yaml", ["swing_angle", "stance_angle", "stance_ankle_angle"],
+     "flat foot lands", ("knee", "no mass")),
+    ("simplest.yaml", ["stance_angle", "hip_angle"], "swing leg has no mass",
+     ("knee", "flat foot")),
+])
+def test_the_verdict_names_only_the_zero_multipliers_that_apply(scene, names, says, not_said):
+    import json
+
+    import numpy as np
+
+    from walkerlab.report.text import zero_multipliers_text
+
+    sc = load_scene(ROOT / "configs" / scene)
+    n0 = 1 + (1 if scene == "simplest.yaml" else 2)
+    re = np.r_[np.zeros(n0), 0.5, 0.4]
+    text = zero_multipliers_text(re, np.zeros_like(re), names,
+                                 json.dumps(sc.model_dump(mode="json")))
+    assert text.startswith(f"{n0} multipliers are 0 by construction")
+    assert says in text and not any(w in text for w in not_said)
+    assert "e.g." not in text
+
+
+# ------------------------------------------- 12: demanding a stable gait (--require-stable)
+def test_require_stable_refuses_an_unstable_gait_in_one_line_and_keeps_the_artifact(tmp_path):
+    d = yaml.safe_load(PAPER.read_text())
+    d["slope"] = {"angle_deg": 12.0}
+    scene = tmp_path / "steep.yaml"
+    scene.write_text(yaml.safe_dump(d))
+    runs = tmp_path / "runs"
+    code, err, out = _cli("fixedpoint", scene, "--runs-dir", runs)
+    assert code == 0 and "verdict: UNSTABLE" in out  # as before: the gait found, exit 0
+    code, err, out = _cli("fixedpoint", scene, "--runs-dir", runs, "--require-stable")
+    assert code == 1 and "verdict: UNSTABLE" in out
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("error: --require-stable: the gait found is unstable (largest "
+                          "|Floquet multiplier| ")
+    assert "no stable period-1 gait was found" in err
+    assert (runs / "steep" / "fixedpoint.h5").is_file()
+    code, err, _ = _cli("fixedpoint", PAPER, "--runs-dir", runs, "--require-stable")
+    assert code == 0, err
+
+
+def test_require_stable_names_a_stable_gait_the_policy_passed_over():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from walkerlab.report.text import unstable_gait_line
+
+    fp = SimpleNamespace(multipliers=np.array([2.4, 0.1]), step_period_s=0.61,
+                         units=SimpleNamespace(time="s"), gait_policy="short_period",
+                         gaits={"long_period": SimpleNamespace(stable=True),
+                                "short_period": SimpleNamespace(stable=False)})
+    line = unstable_gait_line(fp)
+    assert "the long-period gait is stable: set fixedpoint.gait: stable" in line
+
+
+# -------------------- a bounded gait search
+# ------------------------------------------------------------------ 8: a bounded gait search
+@pytest.mark.parametrize("search", ["find_fixed_point", "find_gaits"])
+def test_gait_search_gives_up_when_its_budget_is_spent_and_says_why(
+        paper_walker, monkeypatch, search):
+    """A spring and damper at their caps (1e6) make one step map take ~40 s, and the search
+    went on for 12+ maps (459 s, silent) before "no gait found".  Here every step is made
+    0.25 s slower and the budget is 0.6 s: the search stops after a few maps (MINPACK alone
+    needs ~20), says why, and a slow map is said in one notice."""
+    import time as _time
+
+    from walkerlab import progress
+    from walkerlab.analysis.gait import poincare
+    from walkerlab.analysis.gait import search as gait_search
+    from walkerlab.integrate.solver import Solver
+    from walkerlab.published import paper
+
+    monkeypatch.setattr(poincare, "ROOT_BUDGET_S", 0.6, raising=False)
+    monkeypatch.setattr(poincare, "SLOW_MAP_S", 0.2, raising=False)
+    steps, notes = [], []
+    real = poincare.integrate_step
+
+    def slow_step(*a, **k):
+        steps.append(1)
+        t = _time.thread_time()  # the budget counts this thread's CPU time, so burn it
+        while _time.thread_time() - t < 0.25:
+            pass
+        return real(*a, **k)
+
+    monkeypatch.setattr(poincare, "integrate_step", slow_step)
+    monkeypatch.setattr(progress, "note", notes.append)
+    solver, guess = Solver("DOP853", 1e-12, 1e-12), np.array(paper.EQ11_STATE)
+    with pytest.raises(poincare.FixedPointNotFound, match="gave up after [1-4] step map"):
+        if search == "find_fixed_point":
+            poincare.find_fixed_point(paper_walker, guess, solver)
+        else:
+            gait_search.find_gaits(paper_walker, solver, guess)
+    assert 1 <= len(steps) <= 4, len(steps)
+    assert len(notes) == 1 and "step map took" in notes[0], notes
+
+
+def test_search_budgets_nest_and_end_with_their_search():
+    """A fixed point inside a gait search keeps the search's earlier deadline and adds its
+    maps to the search's count; after the search no map is bounded (per thread)."""
+    import threading
+
+    from walkerlab.analysis.gait import poincare as P
+
+    with P.search_budget(1000.0):
+        outer = P._BUDGET.deadline
+        with P.search_budget(2000.0):
+            assert P._BUDGET.deadline == outer
+            P._map_started()
+        with P.search_budget(0.0):
+            with pytest.raises(P.SearchGaveUp, match="gave up after 1 step map"):
+                P._map_started()
+        assert P._BUDGET.deadline == outer
+        seen = []
+        t = threading.Thread(target=lambda: seen.append(P._BUDGET.deadline))
+        t.start()
+        t.join()
+        assert seen == [float("inf")]  # another thread's search has its own budget
+    assert P._BUDGET.deadline == float("inf")

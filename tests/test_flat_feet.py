@@ -9,8 +9,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
+from typer.testing import CliRunner
 
 from walkerlab.analysis.gait.poincare import find_fixed_point
+from walkerlab.cli import app
 from walkerlab.codegen.cache import functions
 from walkerlab.config import SceneError, load_scene, scene_from_dict
 from walkerlab.integrate.rigid import integrate_step, simulate_steps
@@ -500,3 +503,26 @@ def test_the_guards_the_walker_calls_have_the_right_sign_along_a_step(walker, st
     assert abs(hs.function(0, step.x_end)) < 1e-12
     flow = walker.phases[[p.name for p in walker.phases].index("heel_off:late_swing")].flow
     assert hs.gradient(step.x_end) @ flow(0, step.x_end) < 0  # the heel comes down
+
+
+# -------------------- flat-foot edges
+def _cli(*args, env=None):
+    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+FLAT = yaml.safe_load((ROOT / "configs" / "flat_feet.yaml").read_text())
+
+
+@pytest.mark.parametrize("field, value", [("heel_m", 0), ("toe_m", 1e-9)])
+def test_flat_foot_without_a_heel_or_toe_is_one_line_naming_the_field(tmp_path, field,
+                                                                         value):
+    data = yaml.safe_load(yaml.safe_dump(FLAT))
+    data["walker"]["leg"]["foot"][field] = value
+    scene = tmp_path / "flat.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    # before: internal error (ZeroDivisionError) / (OverflowError, after 103 s)
+    code, err, _ = _cli("fixedpoint", scene, "--runs-dir", tmp_path / "runs")
+    lines = err.splitlines()
+    assert code == 1 and len(lines) == 1, lines
+    assert f"foot.{field}" in lines[0] and "internal error" not in lines[0], lines

@@ -135,10 +135,10 @@ def test_sweep_package_is_a_plain_package_and_the_api_sweep_lives_in_api(tmp_pat
 
     import walkerlab.studies as package
 
-    # a plain package (walkerlab itself is a module whose ``export`` attribute is the
-    # exchange-format package made callable, ``wl.export``: its type is a ModuleType too)
+    # plain packages: walkerlab itself swaps no module class (the front door's export is
+    # ``wl.export_scene``, the package ``walkerlab.export`` is not callable)
     assert not callable(package) and type(package) is types.ModuleType
-    assert isinstance(wl, types.ModuleType)
+    assert type(wl) is types.ModuleType
     sw = wl.api.sweep(_paper(name="tl"), "slope.angle_deg", [1.0], runs_dir=tmp_path)
     assert sw["outcome"].values.tolist() == ["ok"]
 
@@ -299,3 +299,47 @@ def test_example_notebook_runs(tmp_path, monkeypatch):
     assert (tmp_path / "runs" / "paper_rods" / "basin_10x10.h5").is_file()
     after = set((ROOT / "runs").rglob("*")) if (ROOT / "runs").exists() else set()
     assert after == before  # nothing written into the repository
+
+
+# -------------------- the API makes the command line's checks
+PAPER = ROOT / "configs" / "paper.yaml"
+
+
+# ------------------------------------------- 4: the API makes the command line's checks
+def test_mfpt_is_on_the_package_face():
+    import walkerlab as wl
+
+    assert "mfpt" in wl.__all__ and wl.mfpt is wl.api.mfpt
+
+
+@pytest.mark.parametrize("call, says", [
+    (lambda wl, r: wl.api.mfpt(ROOT / "configs" / "simplest.yaml", sigma_rad="0.004",
+                               runs_dir=r), "--sigma-rad '0.004': give a sequence"),
+    (lambda wl, r: wl.api.mfpt(ROOT / "configs" / "simplest.yaml", sigma_rad=0.004,
+                               runs_dir=r), "--sigma-rad 0.004: give a sequence"),
+    (lambda wl, r: wl.basin(ROOT / "configs" / "simplest.yaml", grid="10x10", runs_dir=r),
+     "--grid '10x10': give a sequence"),
+    (lambda wl, r: wl.continuation(PAPER, "slope.angle_deg", 1, 2,
+                                   param2="walker.hip_mass_kg", runs_dir=r),
+     "--param2 walker.hip_mass_kg: no range"),
+    (lambda wl, r: wl.continuation(PAPER, "slope.angle_deg", 1, 2, param2="walker.hip_mass_kg",
+                                   range2=(1.0,), runs_dir=r), "range2 must be two numbers"),
+    (lambda wl, r: wl.continuation(PAPER, "slope.angle_deg", 1, 2, param2="walker.hip_mass_kg",
+                                   range2="ab", runs_dir=r), "range2 must be two numbers"),
+    (lambda wl, r: wl.continuation(PAPER, "slope.angle_deg", 1, 2, range2=(1, 2),
+                                   runs_dir=r), "range2 given without param2"),
+    (lambda wl, r: wl.continuation(PAPER, "slope.angle_deg", 1, 1, runs_dir=r),
+     "start and stop are both 1"),
+    (lambda wl, r: wl.continuation(PAPER, None, 1, 2, runs_dir=r),
+     "--param: give a dotted numeric scene field"),
+    (lambda wl, r: wl.continuation(PAPER, "slope.angle_deg", 1, float("inf"), runs_dir=r),
+     "stop inf is not a finite number"),
+], ids=["mfpt-str", "mfpt-float", "basin-str", "no-range2", "range2-short", "range2-str",
+        "range2-alone", "start-eq-stop", "param-none", "inf"])
+def test_the_api_refuses_what_the_command_refuses_in_one_line(tmp_path, call, says):
+    import walkerlab as wl
+
+    with pytest.raises(SceneError) as exc:
+        call(wl, tmp_path)
+    assert says in str(exc.value) and "\n" not in str(exc.value)
+    assert not list(tmp_path.rglob("*.h5"))  # refused before anything ran

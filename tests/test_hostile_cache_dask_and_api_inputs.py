@@ -85,7 +85,7 @@ def _sweep_files(folder: Path) -> set[str]:
 
 @pytest.mark.xdist_group("timing")  # wall-clock bound: not beside another of them
 @pytest.mark.slow
-def test_h1_dask_only_worker_killed_bounded_wait_one_line_resume(tmp_path, one_worker_cluster):
+def test_dask_only_worker_killed_bounded_wait_one_line_resume(tmp_path, one_worker_cluster):
     addr, wpid, _ = one_worker_cluster
     os.kill(wpid, signal.SIGKILL)  # the only worker dies; its nanny does not restart it
     env = _env(tmp_path, WALKERLAB_DASK_WORKER_WAIT_S="3")
@@ -106,7 +106,7 @@ def test_h1_dask_only_worker_killed_bounded_wait_one_line_resume(tmp_path, one_w
 
 
 @pytest.mark.slow
-def test_h1_dask_scheduler_killed_one_line_suggests_resume(tmp_path, one_worker_cluster):
+def test_dask_scheduler_killed_one_line_suggests_resume(tmp_path, one_worker_cluster):
     addr, wpid, proc = one_worker_cluster
     env = _env(tmp_path)
     folder = tmp_path / "runs" / "paper"
@@ -151,7 +151,7 @@ def _fifo_all(folder: Path, suffixes=None) -> int:
 
 
 @pytest.mark.slow  # compiles the kernels into a fresh cache (~9 s CPU)
-def test_h2_fifos_in_the_user_cache_do_not_hang_fixedpoint(tmp_path):
+def test_fifos_in_the_user_cache_do_not_hang_fixedpoint(tmp_path):
     cache = tmp_path / "cache"
     env = _env(tmp_path, WALKERLAB_CACHE_DIR=str(cache), TMPDIR=str(tmp_path / "tmp"))
     (tmp_path / "tmp").mkdir()
@@ -340,7 +340,7 @@ def _dead_pid() -> int:
 
 
 @pytest.mark.slow
-def test_low_killed_animate_temp_files_are_removed_and_a_linked_gif_refused(tmp_path):
+def test_killed_animate_temp_files_are_removed_and_a_linked_gif_refused(tmp_path):
     env = _env(tmp_path)
     args = ["animate", PAPER, "--runs-dir", tmp_path / "runs"]
     assert _run(args, env).returncode == 0
@@ -370,7 +370,7 @@ def test_low_killed_animate_temp_files_are_removed_and_a_linked_gif_refused(tmp_
     assert target.read_bytes() == b"mine" and (figs / "animation.gif").is_symlink()
 
 
-def test_low_knee_latch_on_a_straight_leg_walker_is_an_error(tmp_path):
+def test_knee_latch_on_a_straight_leg_walker_is_an_error(tmp_path):
     import yaml
 
     for cfg in ("paper.yaml", "round_feet.yaml"):
@@ -385,7 +385,7 @@ def test_low_knee_latch_on_a_straight_leg_walker_is_an_error(tmp_path):
     assert not (tmp_path / "runs").exists()
 
 
-def test_low_cache_dir_symlink_is_refused_before_anything_is_created(tmp_path):
+def test_cache_dir_symlink_is_refused_before_anything_is_created(tmp_path):
     target = tmp_path / "target"
     target.mkdir(mode=0o700)
     link = tmp_path / "cache_link"
@@ -501,7 +501,7 @@ def test_m4_animate_leaves_out_a_stale_or_edited_contact_sim(tmp_path):
 
 
 @pytest.mark.xdist_group("timing")  # wall-clock bound: not beside another of them
-def test_h1_dask_garbage_scheduler_address_is_one_line_at_once(tmp_path):
+def test_dask_garbage_scheduler_address_is_one_line_at_once(tmp_path):
     pytest.importorskip("distributed")
     for addr in ("not an address", "tcp://host", "inproc://x"):
         t0 = time.monotonic()
@@ -511,3 +511,45 @@ def test_h1_dask_garbage_scheduler_address_is_one_line_at_once(tmp_path):
         assert r.returncode == 1
         lines = r.stderr.strip().splitlines()
         assert len(lines) == 1 and "not a Dask scheduler address" in lines[0], lines
+
+
+# -------------------- every Dask wait bounded
+class _NoWorkerClient:
+    """A client whose scheduler answers but has no worker (the only one was killed)."""
+
+    status = "running"
+    scheduler = type("S", (), {"address": "tcp://127.0.0.1:1", "identity": None})()
+
+    def sync(self, fn, callback_timeout=None):
+        return {"workers": {}}
+
+
+class _LostDataFuture:
+    """A finished future whose data died with its worker: Dask computes it again, and its
+    ``result()`` waits - for ever, with no worker, unless given a timeout."""
+
+    key = "piece-1"
+    status = "finished"
+
+    def result(self, timeout=None):
+        if timeout is None:
+            raise AssertionError("an unbounded wait on a Dask future")
+        import time as _time
+
+        _time.sleep(min(timeout, 0.05))
+        raise TimeoutError
+
+
+def test_waiting_for_a_dask_result_is_bounded_and_says_why(monkeypatch):
+    """A sweep's chains wait on each finished piece's result (its continuation guess):
+    with the worker that held it killed, that wait never ended (170 s+, while mfpt's wait
+    for finished futures ended at 60 s).  Both waits are now one: no worker for
+    $WALKERLAB_DASK_WORKER_WAIT_S seconds ends it in one line."""
+    pytest.importorskip("distributed")
+    from walkerlab.execution import dask as D
+
+    monkeypatch.setattr(D, "CHECK_S", 0.05)
+    monkeypatch.setenv(D.WAIT_ENV, "0.3")
+    with pytest.raises(D.DaskLost, match="has had no worker for 0.3 s") as info:
+        D.result(_NoWorkerClient(), _LostDataFuture())
+    assert "--resume" in str(info.value) and "{rerun}" not in str(info.value)

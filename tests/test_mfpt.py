@@ -7,8 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from typer.testing import CliRunner
 
 from walkerlab.analysis.robustness import mfpt as M
+from walkerlab.cli import app
 from walkerlab.config import load_scene
 from walkerlab.integrate.batch_step import HEEL_STRIKE, BatchStepMap
 from walkerlab.integrate.rigid import Solver, integrate_step
@@ -406,3 +408,51 @@ def test_mfpt_says_it_does_not_use_the_scenes_per_step_slope_spread(tmp_path, mo
     stage.run(scene_from_dict(data, "p.yaml"), tmp_path, sigma_rad=[0.002, 0.004])
     assert len(notes) == 1 and "terrain.per_step.slope_sd_rad (0.003 rad) is not used" in \
         notes[0] and "mfpt.sigma_rad (--sigma-rad) 0.002, 0.004 rad" in notes[0], notes
+
+
+# -------------------- an unconverged mesh
+PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+
+
+IDEAL = {k: v for k, v in PAPER.items() if k in ("walker", "slope", "solver", "fixedpoint",
+                                                  "simulate")}
+
+
+def _cli(*args, env=None):
+    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+def _scene(tmp_path: Path, name: str = "paper", **sections) -> Path:
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump({**IDEAL, **sections}))
+    return path
+
+
+def _mfpt_data(converged: float):
+    from walkerlab.io.schemas.mfpt import VARIABLES, MfptData
+
+    vals = {k: np.array([np.nan]) for k in VARIABLES}
+    vals.update(mfpt_steps_montecarlo=np.array([6.0]), mfpt_steps_mesh=np.array([5.606]),
+                mesh_cells=np.array([80.0]), mesh_change=np.array([0.106]),
+                mesh_converged=np.array([converged]))
+    return MfptData(np.array([0.008]), vals, "both", ["a", "b", "c", "d"], [])
+
+
+def test_mesh_mfpt_that_did_not_converge_is_said_on_the_cli_and_in_the_report(
+        tmp_path, monkeypatch):
+    from walkerlab.report.robustness_section import mfpt_section
+    from walkerlab.stages import common, pipeline
+    from walkerlab.studies.mfpt import mfpt_summary
+
+    data = _mfpt_data(0.0)
+    summary = mfpt_summary(data)
+    out = common.StageOutcome("mfpt", tmp_path / "mfpt.h5", False, 1.0, summary)
+    monkeypatch.setattr(pipeline, "run", lambda *a, **k: out)
+    code, err, stdout = _cli("mfpt", _scene(tmp_path), "--runs-dir", tmp_path / "runs")
+    line = [ln for ln in stdout.splitlines() if ln.startswith("sigma 0.008")]
+    assert line and "mesh 5.606 steps" in line[0], stdout
+    assert "NOT converged" in line[0] and "10.6 %" in line[0], line  # before: not said
+    report = "\n".join(mfpt_section({"mfpt": data}))
+    assert "NOT converged" in report and "10.6 %" in report
+    assert "NOT converged" not in "\n".join(mfpt_section({"mfpt": _mfpt_data(1.0)}))

@@ -164,3 +164,75 @@ def test_killed_mfpt_stage_resumes_and_keeps_pieces_across_sigma_lists(tmp_path,
     got = load(out.path)
     for k in ("mfpt_steps_montecarlo", "montecarlo_heel_strikes", "montecarlo_falls"):
         assert got[k][0] == ref[k][0], k
+
+
+# -------------------- mfpt's partial file under a lost worker or damage
+@pytest.fixture
+def chunked_walks(monkeypatch):
+    """Walks in chunks of 3; ``calls["lose_after"]`` chunks, then the Dask cluster is lost
+    (as :class:`walkerlab.execution.dask.DaskExecutor` reports it)."""
+    from walkerlab.execution.dask import DaskLost
+    from walkerlab.studies import mfpt as work
+
+    monkeypatch.setattr(work, "WALKS_PER_TASK", 3)
+    calls = {"walks": 0, "lose_after": None}
+    walks = work.run_walks
+
+    def counted(task):
+        if calls["lose_after"] is not None and calls["walks"] >= calls["lose_after"]:
+            raise DaskLost("Dask scheduler tcp://x:1 has had no worker for 60 s (2 task(s) "
+                           "waiting); the work finished so far is kept: start workers and "
+                           "{rerun}")
+        calls["walks"] += 1
+        return walks(task)
+
+    monkeypatch.setattr(work, "run_walks", counted)
+    return calls
+
+
+def _mc(scene, x, part, key="key"):
+    from walkerlab.config import MfptSettings
+    from walkerlab.studies import mfpt as work
+
+    st = MfptSettings(sigma_rad=[0.008], method="montecarlo", walks=12, max_steps=10)
+    return work.resumable_mfpt_study(scene, x, st, part, key, workers=1)
+
+
+def _damage_a_group(part: Path, which: int) -> None:
+    """Overwrite the signature of the ``which``-th HDF5 symbol-table node (a group's list
+    of links): opening the group fails ("bad symbol table node signature")."""
+    data = bytearray(part.read_bytes())
+    at = [i for i in range(len(data) - 3) if data[i:i + 4] == b"SNOD"][which]
+    data[at:at + 4] = b"XXXX"
+    part.write_bytes(bytes(data))
+
+
+def test_lost_dask_worker_keeps_finished_mfpt_chunks_and_advises_a_rerun(
+        tmp_path, paper_scene, paper_fixed_point, chunked_walks):
+    from walkerlab.execution.dask import DaskLost
+
+    part = tmp_path / "mfpt.h5.partial"
+    chunked_walks["lose_after"] = 2
+    with pytest.raises(DaskLost) as info:  # before: MfptStudyError, the partial file removed
+        _mc(paper_scene, paper_fixed_point.x, part)
+    msg = str(info.value)
+    assert "no worker for 60 s" in msg and "--resume" not in msg  # mfpt has no --resume
+    assert "rerun the same command" in msg
+    assert part.is_file()
+    chunked_walks.update(walks=0, lose_after=None)
+    _mc(paper_scene, paper_fixed_point.x, part)
+    assert chunked_walks["walks"] == 2  # 4 chunks of 3 walks; the 2 finished ones kept
+
+
+@pytest.mark.parametrize("which", [0, -1])  # the sigma group (every chunk), one chunk's group
+def test_damaged_mfpt_partial_pieces_are_dropped_and_computed_again(
+        tmp_path, paper_scene, paper_fixed_point, chunked_walks, which):
+    part = tmp_path / "mfpt.h5.partial"
+    ref = _mc(paper_scene, paper_fixed_point.x, part)[0]
+    assert chunked_walks["walks"] == 4 and part.is_file()  # the stage removes it, not the study
+    _damage_a_group(part, which)
+    chunked_walks["walks"] = 0
+    # before: "Unable to synchronously check link existence" on every rerun
+    data, p = _mc(paper_scene, paper_fixed_point.x, part)
+    assert p.dropped >= 1 and 1 <= chunked_walks["walks"] <= 4
+    assert np.array_equal(data["mfpt_steps_montecarlo"], ref["mfpt_steps_montecarlo"])

@@ -8,8 +8,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from typer.testing import CliRunner
 
 import walkerlab as wl
+from walkerlab.cli import app
 from walkerlab.codegen import symbolic
 from walkerlab.config import load_scene
 from walkerlab.models.registry import build_walker
@@ -119,3 +121,41 @@ def test_why_a_result_is_not_a_gait_is_said_with_what_helps():
     assert "1.1e-06" in says and "6.92" in says and "optimize.intervals" in says
     d.multipliers = np.array([0.9 + 0j])
     assert "intervals" not in not_a_gait_reason(d)
+
+
+# -------------------- a nondimensional optimum in its units
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _cli(*args):
+    r = CliRunner().invoke(app, [str(a) for a in args])
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+def _optimum():
+    from walkerlab.io.schemas.optimize import OptimizeData
+
+    return OptimizeData(
+        time=np.linspace(0, 1.375, 3), states={}, torque=np.array([0.1, 1.679, 0.2]),
+        step_period_s=1.375, step_length_m=0.55, push_off_n_s=0.1335, objective=0.009,
+        replay_error=9e-8, multipliers=np.array([2.3, 0.1]), gait=True,
+        status="Solve_Succeeded", iterations=17, wall_time_s=0.3, state_units={},
+        torque_unit="N m/kg", contact_outcome="not replayed")
+
+
+def test_a_nondimensional_optimum_is_printed_in_its_units(tmp_path, monkeypatch):
+    from walkerlab.report.figures_section import optimize_lines
+    from walkerlab.stages import pipeline
+    from walkerlab.stages.common import StageOutcome
+    from walkerlab.units import Units
+
+    text = optimize_lines(_optimum(), Units("nondimensional"))[0]
+    assert ("Step period 1.375 √(l/g), step length 0.5500 l, speed 0.4000 √(g l), push-off "
+            "0.1335 M √(g l)") in text
+    assert " m/s" not in text and " N s" not in text
+    monkeypatch.setattr(pipeline, "run", lambda *a, **k: StageOutcome(
+        "optimize", tmp_path / "optimize.h5", False, 1.0, {"data": _optimum()}))
+    code, err, out = _cli("optimize", ROOT / "configs" / "kuo2002.yaml",
+                          "--runs-dir", tmp_path)
+    assert ("step period 1.375 √(l/g), step length 0.55 l, speed 0.4 √(g l), push-off 0.1335 "
+            "M √(g l), peak |torque| [g l]") in out, out + err

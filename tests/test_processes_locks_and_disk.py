@@ -18,6 +18,7 @@ import textwrap
 import time
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 import yaml
@@ -100,7 +101,7 @@ def _kill_and_check_orphans(main: subprocess.Popen, want: int, sig: int,
 
 
 # ------------------------------------------------------------------ 1: worker lifecycle
-def test_i1_stability_map_workers_end_with_their_parent_and_free_the_lock(tmp_path):
+def test_stability_map_workers_end_with_their_parent_and_free_the_lock(tmp_path):
     """SIGKILL here, SIGTERM for the work-precision lane below: the same watch ends both."""
     sig = signal.SIGKILL
     script = textwrap.dedent(f"""
@@ -119,7 +120,7 @@ def test_i1_stability_map_workers_end_with_their_parent_and_free_the_lock(tmp_pa
         pass
 
 
-def test_i1_work_precision_lane_worker_ends_with_its_parent():
+def test_work_precision_lane_worker_ends_with_its_parent():
     script = textwrap.dedent("""
         import time
         from walkerlab.bench.workprecision import start_worker
@@ -132,7 +133,7 @@ def test_i1_work_precision_lane_worker_ends_with_its_parent():
     assert not alive, "spawned lane worker (or its resource tracker) outlived its parent"
 
 
-def test_i1_lock_kept_by_a_dead_holders_child_is_taken_over(tmp_path):
+def test_lock_kept_by_a_dead_holders_child_is_taken_over(tmp_path):
     """The holder records its pid, forks a child that keeps the lock file open and is
     killed: the lock is taken over at once, not waited on."""
     target = tmp_path / "a.h5"
@@ -160,7 +161,7 @@ def test_i1_lock_kept_by_a_dead_holders_child_is_taken_over(tmp_path):
     assert not (tmp_path / ".a.h5.lock").exists()  # removed on release
 
 
-def test_i1_lock_of_a_live_holder_is_not_taken_over(tmp_path):
+def test_lock_of_a_live_holder_is_not_taken_over(tmp_path):
     target = tmp_path / "a.h5"
     holder = subprocess.Popen([sys.executable, "-c", textwrap.dedent(f"""
         import time
@@ -181,7 +182,7 @@ def test_i1_lock_of_a_live_holder_is_not_taken_over(tmp_path):
 
 
 @pytest.mark.parametrize("host,taken_over", [("this", True), ("elsewhere.example", False)])
-def test_i1_only_a_dead_holder_of_this_host_is_taken_over(tmp_path, host, taken_over):
+def test_only_a_dead_holder_of_this_host_is_taken_over(tmp_path, host, taken_over):
     """A pid recorded by another machine sharing the folder cannot be checked here: its
     lock is waited on, never taken over."""
     import socket
@@ -230,7 +231,7 @@ def user_cache(tmp_path, monkeypatch):
     cache.clear_memo()
 
 
-def test_i2_generated_code_lives_in_a_private_user_cache(user_cache, tmp_path):
+def test_generated_code_lives_in_a_private_user_cache(user_cache, tmp_path):
     from walkerlab.codegen import cache
 
     cache.generated_module(_simple_structure())
@@ -242,7 +243,7 @@ def test_i2_generated_code_lives_in_a_private_user_cache(user_cache, tmp_path):
 
 
 @pytest.mark.parametrize("how", ["group_writable", "other_owner", "symlink"])
-def test_i2_untrusted_cache_file_is_regenerated_never_executed(user_cache, tmp_path, how):
+def test_untrusted_cache_file_is_regenerated_never_executed(user_cache, tmp_path, how):
     import hashlib
 
     from walkerlab.codegen import cache
@@ -274,7 +275,7 @@ def test_i2_untrusted_cache_file_is_regenerated_never_executed(user_cache, tmp_p
     assert stat.S_IMODE(path.stat().st_mode) == 0o600 and path.stat().st_uid == os.geteuid()
 
 
-def test_i2_nothing_from_a_runs_folder_is_executed(user_cache, tmp_path):
+def test_nothing_from_a_runs_folder_is_executed(user_cache, tmp_path):
     """A runs folder unpacked from someone else carries ``.cache/models``: never read."""
     from walkerlab.codegen import cache
 
@@ -293,7 +294,7 @@ def test_i2_nothing_from_a_runs_folder_is_executed(user_cache, tmp_path):
     assert not flag.exists()
 
 
-def test_i14_numba_cache_is_written_to_the_user_cache(tmp_path):
+def test_numba_cache_is_written_to_the_user_cache(tmp_path):
     env = {k: v for k, v in ENV.items() if k != "NUMBA_CACHE_DIR"}
     env["WALKERLAB_CACHE_DIR"] = str(tmp_path / "uc")
     out = subprocess.run([sys.executable, "-c", textwrap.dedent("""
@@ -308,7 +309,7 @@ def test_i14_numba_cache_is_written_to_the_user_cache(tmp_path):
 
 
 # ------------------------------------------------------------------ 3: symbolic links
-def test_i3_lock_file_symlink_is_refused_and_its_target_untouched(tmp_path):
+def test_lock_file_symlink_is_refused_and_its_target_untouched(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     runs = tmp_path / "runs"
     (runs / "paper").mkdir(parents=True)
@@ -321,7 +322,7 @@ def test_i3_lock_file_symlink_is_refused_and_its_target_untouched(tmp_path):
 
 
 @pytest.mark.parametrize("name", ["fixedpoint.h5", "report.md", "basin.h5.partial"])
-def test_i3_writers_refuse_a_symlink_in_place(tmp_path, name):
+def test_writers_refuse_a_symlink_in_place(tmp_path, name):
     victim = tmp_path / "victim.txt"
     victim.write_text("precious\n")
     link = tmp_path / "paper" / name
@@ -342,7 +343,7 @@ def test_i3_writers_refuse_a_symlink_in_place(tmp_path, name):
     assert victim.read_text() == "precious\n" and link.is_symlink()
 
 
-def test_i3_basin_partial_symlink_is_one_line_error(tmp_path):
+def test_basin_partial_symlink_is_one_line_error(tmp_path):
     runs = tmp_path / "runs"
     (runs / "paper").mkdir(parents=True)
     victim = tmp_path / "victim.txt"
@@ -355,7 +356,7 @@ def test_i3_basin_partial_symlink_is_one_line_error(tmp_path):
     assert victim.read_text() == "precious\n"
 
 
-def test_i3_report_folder_symlink_leaving_runs_is_refused(tmp_path):
+def test_report_folder_symlink_leaving_runs_is_refused(tmp_path):
     runs = tmp_path / "runs"
     (runs / "paper").mkdir(parents=True)
     outside = tmp_path / "outside"
@@ -377,7 +378,7 @@ def _limited(script: str, limit_bytes: int, cwd: Path, env=None) -> subprocess.C
                           timeout=300)
 
 
-def test_i7_full_disk_is_one_line_and_keeps_the_old_artifact(tmp_path):
+def test_full_disk_is_one_line_and_keeps_the_old_artifact(tmp_path):
     scene = tmp_path / "paper.yaml"
     scene.write_text(yaml.safe_dump(IDEAL))
     code, err, _ = _cli("simulate", scene, "--strides", "1", "--runs-dir", tmp_path / "runs")
@@ -398,7 +399,7 @@ def test_i7_full_disk_is_one_line_and_keeps_the_old_artifact(tmp_path):
     assert not [p for p in (tmp_path / "runs").rglob("*") if p.name.endswith(".tmp")]
 
 
-def test_i7_cache_write_on_a_full_disk_leaves_nothing(tmp_path):
+def test_cache_write_on_a_full_disk_leaves_nothing(tmp_path):
     r = _limited("""
         from walkerlab.codegen import cache
         from walkerlab.walker.description import BodySpec, Structure
@@ -409,7 +410,7 @@ def test_i7_cache_write_on_a_full_disk_leaves_nothing(tmp_path):
     assert not [p for p in (tmp_path / "uc").rglob("*") if p.is_file()]
 
 
-def test_i7_disk_full_errors_map_to_one_line(tmp_path):
+def test_disk_full_errors_map_to_one_line(tmp_path):
     def boom(fh):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
     (tmp_path / "x.json").write_text("old")
@@ -427,7 +428,7 @@ def test_i7_disk_full_errors_map_to_one_line(tmp_path):
                                     # measured before the integration's CPU time was timed
                                     '{"vec": [1.0], "nfev": 3, "times": [0.1], '
                                     '"cpu_times": [0.1]}'])
-def test_i10_damaged_work_precision_case_is_measured_again(tmp_path, monkeypatch, damage):
+def test_damaged_work_precision_case_is_measured_again(tmp_path, monkeypatch, damage):
     from walkerlab.bench import workprecision as W
 
     good = {"vec": [1.0, 2.0], "nfev": 10, "times": [0.01], "cpu_times": [0.01],
@@ -442,7 +443,7 @@ def test_i10_damaged_work_precision_case_is_measured_again(tmp_path, monkeypatch
 
 
 # ------------------------------------------------------------------ 14: messages
-def test_i14_one_line_keeps_a_wrapped_sentence_and_cuts_at_a_boundary():
+def test_one_line_keeps_a_wrapped_sentence_and_cuts_at_a_boundary():
     short = _one_line("the error is larger than allowed, as measured by the\nreference run.")
     assert short == "the error is larger than allowed, as measured by the reference run."
     long = _one_line("first field: bad value. " + "second sentence goes on " * 30 + "end.")
@@ -454,7 +455,7 @@ def test_i14_one_line_keeps_a_wrapped_sentence_and_cuts_at_a_boundary():
 @pytest.mark.parametrize("value,traceback", [("false", False), ("0", False), ("no", False),
                                              ("", False), ("1", True), ("true", True),
                                              ("YES", True)])
-def test_i14_debug_switch_accepts_1_true_yes_only(tmp_path, value, traceback):
+def test_debug_switch_accepts_1_true_yes_only(tmp_path, value, traceback):
     r = CliRunner().invoke(app, ["fixedpoint", str(tmp_path / "missing.yaml")],
                            env={"WALKERLAB_DEBUG": value})
     assert r.exit_code == 1
@@ -463,14 +464,14 @@ def test_i14_debug_switch_accepts_1_true_yes_only(tmp_path, value, traceback):
         assert r.stderr.strip().startswith("error: ") and "scene file not found" in r.stderr
 
 
-def test_i14_empty_runs_dir_is_refused(tmp_path, monkeypatch):
+def test_empty_runs_dir_is_refused(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code, err, _ = _cli("fixedpoint", ROOT / "configs" / "paper.yaml", "--runs-dir", "")
     assert code == 2 and "empty folder name" in err
     assert list(tmp_path.iterdir()) == []
 
 
-def test_i14_report_markdown_escapes_the_scene_source():
+def test_report_markdown_escapes_the_scene_source():
     from walkerlab.report.build import _header
     from walkerlab.report.markdown import to_html
 
@@ -481,14 +482,121 @@ def test_i14_report_markdown_escapes_the_scene_source():
     assert "<script>" not in html and "&lt;script&gt;" in html and "&amp;lt;" not in html
 
 
-def test_i14_device_as_scene_is_not_a_regular_file():
+def test_device_as_scene_is_not_a_regular_file():
     code, err, _ = _cli("fixedpoint", "/dev/zero")
     assert code == 1 and err == "error: /dev/zero: not a regular file; give a YAML scene file"
 
 
-def test_i14_bench_out_naming_a_file_says_what_to_do(tmp_path):
+def test_bench_out_naming_a_file_says_what_to_do(tmp_path):
     f = tmp_path / "FILE"
     f.write_text("keep")
     code, err, _ = _cli("bench", "ideal", "--out", f)
     assert code == 1 and "is a file; --out names a folder" in err and "\n" not in err
     assert f.read_text() == "keep"
+
+
+# -------------------- one-line advice kept whole; SIGTERM as Ctrl-C; a full disk
+def test_advice_longer_than_the_limit_is_kept_whole_only_the_detail_is_cut():
+    from walkerlab.cli.errors import MAX_ERROR_CHARS, one_line
+
+    advice = "no gait; " + "advice " * 60  # longer than the limit on its own
+    assert len(advice) > MAX_ERROR_CHARS
+    line = one_line(advice + "[tried a; last: " + "word " * 60 + "]")
+    assert line.startswith(advice + "[tried a ... rerun with WALKERLAB_DEBUG=1")
+    short = advice + "[tried a and b]"
+    assert one_line(short) == short  # nothing cut: nothing to rerun for
+
+
+# ------------------------------------------------------------- 15: SIGTERM as Ctrl-C
+def test_sigterm_during_a_write_leaves_no_lock_nor_temporary_file(tmp_path):
+    script = textwrap.dedent(f"""
+        import sys, time
+        from walkerlab.cli.process import terminate_as_interrupt
+        terminate_as_interrupt()
+        from walkerlab.config import load_scene
+        from walkerlab.io.freshness import write_if_stale
+        sc = load_scene({str(ROOT / 'configs' / 'paper.yaml')!r})
+        def writer(f):
+            f.create_dataset('x', data=[1.0])
+            print('ready', flush=True)
+            time.sleep(60)
+        try:
+            write_if_stale('fixedpoint', sc, {str(tmp_path)!r}, ('walker',), (),
+                           lambda: (writer, dict()))
+        except KeyboardInterrupt:
+            sys.exit(130)
+        """)
+    with subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                          text=True) as p:
+        try:
+            assert p.stdout.readline().strip() == "ready"
+            p.send_signal(signal.SIGTERM)
+            assert p.wait(timeout=30) == 130
+        finally:
+            p.kill()
+    left = sorted(q.name for q in (tmp_path / "paper").iterdir())
+    assert left == [".scene"], left  # no .fixedpoint.h5.lock, no temporary file
+
+
+# ------------------------------------------ 15: a full disk while the model is written
+def test_a_file_size_limit_while_the_generated_module_is_written_says_disk_full(monkeypatch):
+    import walkerlab.safefs as safefs
+    from walkerlab.cli.errors import _disk_full_line
+    from walkerlab.codegen import cache
+    from walkerlab.io.artifacts import is_disk_full
+
+    def full(path, fill, **kw):
+        raise OSError(errno.EFBIG, "File too large", str(path))
+
+    monkeypatch.setattr(safefs, "atomic_replace", full)
+    with pytest.raises(OSError) as exc:
+        cache.import_generated("zz_never_written_nb.py", "walkerlab_zz_never", lambda: "X = 1")
+    assert is_disk_full(exc.value) and "cannot write the generated module" in str(exc.value)
+    line = _disk_full_line(exc.value)
+    assert line.startswith("error: disk full: cannot write ") and "zz_never_written" in line
+
+
+# -------------------- a full disk while a study writes its partial file
+def _scene(tmp_path: Path, name: str = "paper", **sections) -> Path:
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(yaml.safe_dump({**IDEAL, **sections}))
+    return path
+
+
+STUDIES = {
+    "mfpt": (["mfpt", "--method", "montecarlo"],
+             {"mfpt": {"sigma_rad": [0.008], "walks": 12, "max_steps": 8}}),
+    "sweep": (["sweep", "--param", "slope.angle_rad=0.012:0.02:0.001"], {}),
+    "basin": (["basin", "--grid", "8x8"], {"basin": {"max_steps": 5}}),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("study", sorted(STUDIES))
+def test_full_disk_while_a_study_writes_its_partial_file_is_one_line(tmp_path, study):
+    args, sections = STUDIES[study]
+    scene = _scene(tmp_path, **sections)
+    runs = tmp_path / "runs"
+    code, err, _ = _cli("fixedpoint", scene, "--runs-dir", runs)
+    assert code == 0, err
+    limit = 4096  # an HDF5 file of a few pieces is larger: the partial file's writes fail
+    script = f"""
+        import resource, sys
+        resource.setrlimit(resource.RLIMIT_FSIZE, ({limit}, {limit}))
+        from walkerlab.cli import app
+        sys.argv = ["walkerlab", *{args!r}, {str(scene)!r}, "--workers", "1",
+                    "--runs-dir", {str(runs)!r}]
+        app()
+        """
+    r = subprocess.run([sys.executable, "-c", textwrap.dedent(script)], cwd=tmp_path,
+                       env=ENV, capture_output=True, text=True, timeout=300)
+    err = r.stderr.strip().splitlines()
+    assert r.returncode == 1 and len(err) == 1 and err[0].startswith("error: disk full"), \
+        (r.returncode, err[:5])
+    left = [p for p in runs.rglob("*") if p.is_file() and p.name != ".scene"
+            and p.name != "fixedpoint.h5"]
+    assert not [p for p in left if p.name.endswith(".tmp")]
+    for p in left:  # what is left is a whole file (the work saved before the disk filled)
+        assert p.name.endswith(".partial"), p
+        with h5py.File(p, "r") as f:
+            assert "input_hash" in f.attrs

@@ -3,12 +3,16 @@ its numbers from compare.h5 / contact_sim.h5, and the paper's printed error appe
 ``published: paper`` (the kneed, round-feet and rods reports showed the paper's 0.5 mm)."""
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import yaml
+from typer.testing import CliRunner
 
+from walkerlab.cli import app
 from walkerlab.comparison.report_numbers import report_numbers
-from walkerlab.config import load_scene
+from walkerlab.config import load_scene, scene_from_dict
 from walkerlab.io.schemas.compare import load_compare
 from walkerlab.io.schemas.contact_sim import load_contact_sim
 from walkerlab.report.build import ReportInputs
@@ -49,3 +53,107 @@ def test_table3_shows_the_contact_periodic_gait_beside_the_run():
     assert col["t_cycle_s"] == 2 * 0.711
     assert col["v_com_m_per_s"] == pytest.approx(0.3605 / 0.711)
     assert np.isnan(col["E_avg_J"])
+
+
+# -------------------- the energy ledger, a section of its own
+POWERED = ROOT / "configs" / "powered_compass.yaml"
+
+
+def _ledger_sim():
+    keys = ("push_off_work", "actuator_work_positive", "actuator_work_negative",
+            "heel_strike_loss", "internal_collision_loss", "damper_work", "potential_work",
+            "closure", "cost_of_transport")
+    from walkerlab.units import Units
+
+    return SimpleNamespace(ledger={k: [0.1, 0.1] for k in keys}, units=Units(), samples=None)
+
+
+def test_the_energy_ledger_is_a_section_beside_the_gait_not_under_figures(tmp_path,
+                                                                          monkeypatch):
+    from walkerlab.report import build, contact_sections, sections
+
+    for mod, name in ((sections, "summary_section"), (contact_sections, "sections"),
+                      (contact_sections, "initial_states_section")):
+        monkeypatch.setattr(mod, name, lambda *a, **k: [])
+    monkeypatch.setattr(sections, "gait_section",
+                        lambda scene, inputs, pub: ["## Gait characteristics", ""])
+    for stem in ("energy_ledger", "fig10_energy"):
+        (tmp_path / f"{stem}.png").write_bytes(b"")
+    scene = load_scene(POWERED)
+    build.write_report(scene, build.ReportInputs({"simulate": _ledger_sim()}), tmp_path,
+                       tmp_path)
+    md = (tmp_path / "report.md").read_text()
+    gait, ledger = md.index("## Gait characteristics"), md.index("## Energy ledger and cost")
+    figures = md.index("## Figures")
+    assert gait < ledger < figures
+    assert md.index("energy_ledger.png") < figures  # the figure moved with its table
+    assert md.index("Cost of transport") < figures and md.count("energy_ledger.png") == 1
+
+
+def test_a_spring_written_as_an_actuator_law_is_named_as_motor_work():
+    from walkerlab.report.figures_section import spring_law_note
+
+    d = yaml.safe_load(POWERED.read_text())
+    d["walker"]["actuation"]["torques"] = [
+        {"joint": "hip", "law": {"stiffness_n_m_per_rad": 20.0}}]
+    note = spring_law_note(scene_from_dict(d))
+    assert "walker.actuation.torques.0 (hip)" in note and "motor work, no regeneration" in note
+    assert "walker.springs" in note
+    assert spring_law_note(load_scene(POWERED)) == ""  # push-off alone
+    # Kuo's spring scaled by the massless foot's mass does no work: not named
+    assert spring_law_note(load_scene(ROOT / "configs" / "kuo2002.yaml")) == ""
+
+
+# -------------------- the gait simulate starts from; a damper is not drift
+PAPER = yaml.safe_load((ROOT / "configs" / "paper.yaml").read_text())
+
+
+IDEAL = {k: v for k, v in PAPER.items() if k in ("walker", "slope", "solver", "fixedpoint",
+                                                  "simulate")}
+
+
+def _cli(*args, env=None):
+    r = CliRunner().invoke(app, [str(a) for a in args], env=env)
+    return r.exit_code, r.stderr.strip(), r.stdout
+
+
+# ------------------------------------------------------------------ 10: the gait simulate uses
+@pytest.mark.slow
+def test_report_of_a_scene_without_fixedpoint_section_shows_the_gait_simulate_starts_from(
+        tmp_path):
+    scene = tmp_path / "nofp.yaml"
+    scene.write_text(yaml.safe_dump({k: v for k, v in IDEAL.items() if k != "fixedpoint"}))
+    runs = tmp_path / "runs"
+    code, err, _ = _cli("simulate", scene, "--runs-dir", runs)  # runs the fixed point first
+    assert code == 0, err
+    code, err, _ = _cli("report", scene, "--runs-dir", runs)
+    assert code == 0, err
+    md = (runs / "nofp" / "report" / "report.md").read_text()
+    # before: left out ("an earlier standalone run: the scene has no 'fixedpoint' section")
+    assert "## Fixed point of the Poincaré map" in md and "Floquet multipliers" in md
+    assert "fixedpoint.h5 (an earlier standalone run" not in md
+
+
+# ------------------------------------------------------------------ 11: a damper is not drift
+def test_a_dampers_loss_is_named_and_the_balance_checked_with_it():
+    """Hip spring 20 N m/rad with a 0.05 N m s/rad damper: the report called the damper's
+    0.026 J "energy drift between impacts" (3.7e-9 J without the damper).  The energy ledger
+    of the run (``simulate.h5``, ledger/) has the damper's work and the balance's closure."""
+    from types import SimpleNamespace
+
+    from walkerlab.report.sections import energy_check
+    from walkerlab.units import Units
+
+    def sim(damper):
+        n = 3
+        return SimpleNamespace(ledger={
+            "damper_work": np.full(n, damper), "actuator_work_positive": np.zeros(n),
+            "actuator_work_negative": np.zeros(n), "closure": np.array([-2e-13, 2.5e-13, 0])})
+
+    text, rows = energy_check(sim(-0.0527), (0.026, 1.7e-4), Units())
+    assert "drift" not in text and "dampers dissipate 0.0527 J per step" in text, text
+    assert "closes to 2.5e-13 J" in text, text
+    assert [r[0] for r in rows] == ["damper work per step (energy ledger)",
+                                    "energy balance closure, largest per step (ledger)"]
+    text, rows = energy_check(sim(0.0), (3.7e-9, 1e-11), Units())  # no damper: drift is the check
+    assert text.startswith("energy drift between impacts 3.7e-09 J"), text

@@ -110,7 +110,7 @@ def _interrupt_after(n):
     return stop
 
 
-def test_item4_edited_basin_partial_rows_are_computed_again(tmp_path, monkeypatch):
+def test_edited_basin_partial_rows_are_computed_again(tmp_path, monkeypatch):
     calls: list[int] = []
     monkeypatch.setattr(basin_mod, "run_basin_chunk", _fake_basin_chunk(calls))
     with pytest.raises(KeyboardInterrupt):
@@ -127,7 +127,7 @@ def test_item4_edited_basin_partial_rows_are_computed_again(tmp_path, monkeypatc
     assert sum(calls) == 20 and res["cells_computed"] == 20
 
 
-def test_item4_intact_basin_partial_rows_are_kept(tmp_path, monkeypatch):
+def test_intact_basin_partial_rows_are_kept(tmp_path, monkeypatch):
     calls: list[int] = []
     monkeypatch.setattr(basin_mod, "run_basin_chunk", _fake_basin_chunk(calls))
     with pytest.raises(KeyboardInterrupt):
@@ -194,13 +194,13 @@ def _assert_same_rows(a: dict, b: dict) -> None:
             assert list(a[k]) == list(b[k]), k
 
 
-def test_item13_resumed_sweep_is_bit_identical_to_an_uninterrupted_one(tmp_path, fake_points):
+def test_resumed_sweep_is_bit_identical_to_an_uninterrupted_one(tmp_path, fake_points):
     ref = _rows(_sweep(tmp_path, "ref"))
     got = _rows(_interrupted(tmp_path, "cut", at=20))
     _assert_same_rows(got, ref)
 
 
-def test_item4_edited_sweep_partial_rows_are_computed_again(tmp_path, fake_points):
+def test_edited_sweep_partial_rows_are_computed_again(tmp_path, fake_points):
     ref = _rows(_sweep(tmp_path, "ref"))
     rec = Recorder()
 
@@ -215,7 +215,7 @@ def test_item4_edited_sweep_partial_rows_are_computed_again(tmp_path, fake_point
     assert len(rec.notes) == 1 and "failed their integrity check" in rec.notes[0]
 
 
-def test_item4_edited_checkpoint_restarts_its_chain(tmp_path, fake_points):
+def test_edited_checkpoint_restarts_its_chain(tmp_path, fake_points):
     ref = _rows(_sweep(tmp_path, "ref"))
 
     def edit(f):  # a forged continuation state
@@ -224,7 +224,7 @@ def test_item4_edited_checkpoint_restarts_its_chain(tmp_path, fake_points):
     _assert_same_rows(_rows(_interrupted(tmp_path, "forged", at=20, edit=edit)), ref)
 
 
-def test_item4_unreadable_checkpoints_restart_every_chain(tmp_path, fake_points):
+def test_unreadable_checkpoints_restart_every_chain(tmp_path, fake_points):
     ref = _rows(_sweep(tmp_path, "ref"))
 
     def edit(f):  # as after a kill in the middle of a checkpoint write
@@ -233,7 +233,7 @@ def test_item4_unreadable_checkpoints_restart_every_chain(tmp_path, fake_points)
     _assert_same_rows(_rows(_interrupted(tmp_path, "lost", at=20, edit=edit)), ref)
 
 
-def test_item4_finished_sweep_carries_a_content_hash(tmp_path, fake_points):
+def test_finished_sweep_carries_a_content_hash(tmp_path, fake_points):
     out = _sweep(tmp_path, "fin")
     from walkerlab.studies.runner import sweep_input_hash
 
@@ -258,7 +258,7 @@ def _fake_fixedpoint(wall: float, value: float = -0.8):
     return compute
 
 
-def test_item11_content_hash_covers_results_not_timings(tmp_path):
+def test_content_hash_covers_results_not_timings(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     first = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_fixedpoint(1.2))
     key = input_hash("simulate", sc, ("walker",), (first.path,))
@@ -271,7 +271,7 @@ def test_item11_content_hash_covers_results_not_timings(tmp_path):
     assert input_hash("simulate", sc, ("walker",), (changed.path,)) != key
 
 
-def test_item11_run_records_are_not_hashed(tmp_path):
+def test_run_records_are_not_hashed(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
 
     def writer(wall, cells):
@@ -295,7 +295,7 @@ def test_item11_run_records_are_not_hashed(tmp_path):
     (yaml.safe_dump(IDEAL) + "slope:\n  angle_deg: 3.0\n", "duplicate key 'slope'"),
     ("walker:\n  a: 1\n  a: 2\n", "duplicate key 'a'"),
 ])
-def test_item12_yaml_limits_are_one_line_naming_the_file(tmp_path, text, match):
+def test_yaml_limits_are_one_line_naming_the_file(tmp_path, text, match):
     p = _write(tmp_path / "bad.yaml", text)
     with pytest.raises(SceneError, match=match) as exc:
         load_scene(p)
@@ -304,7 +304,7 @@ def test_item12_yaml_limits_are_one_line_naming_the_file(tmp_path, text, match):
     assert rc == 1 and err.startswith(f"error: {p}") and len(err.splitlines()) == 1
 
 
-def test_item12_moderate_nesting_and_merge_keys_still_load(tmp_path):
+def test_moderate_nesting_and_merge_keys_still_load(tmp_path):
     d = copy.deepcopy(IDEAL)
     text = "base: &b\n  angle_deg: 2.0\nslope:\n  <<: *b\n" + yaml.safe_dump(
         {k: v for k, v in d.items() if k != "slope"})
@@ -330,7 +330,7 @@ def paper_scene(tmp_path):
     (["bifurcation", "--transient", "1000000000"], "--transient"),
     (["bifurcation", "--keep", "1000000000"], "--keep"),
 ])
-def test_item5_cli_sizes_have_the_yaml_caps(tmp_path, paper_scene, args, match):
+def test_cli_sizes_have_the_yaml_caps(tmp_path, paper_scene, args, match):
     sc = _write(tmp_path / "full.yaml", {**PAPER, "name": "paper"}) if args[0] == \
         "stability-map" else paper_scene
     rc, err, _ = _cli(args[0], sc, *args[1:], "--runs-dir", tmp_path / "runs")
@@ -338,12 +338,12 @@ def test_item5_cli_sizes_have_the_yaml_caps(tmp_path, paper_scene, args, match):
     assert not (tmp_path / "runs" / "paper" / "fixedpoint.h5").exists()  # refused up front
 
 
-def test_item5_basin_grid_cap_is_the_scene_field(tmp_path):
+def test_basin_grid_cap_is_the_scene_field(tmp_path):
     with pytest.raises(SceneError, match="basin.grid"):
         scene_from_dict({**IDEAL, "basin": {"grid": [MAX_BASIN_CELLS_PER_AXIS + 1, 10]}})
 
 
-def test_item5_tiny_max_step_is_refused(tmp_path):
+def test_tiny_max_step_is_refused(tmp_path):
     p = _write(tmp_path / "s.yaml", {**IDEAL, "solver": {**IDEAL["solver"],
                                                          "max_step_s": 1e-12}})
     with pytest.raises(SceneError, match=r"s\.yaml: solver\.max_step_s: 1e-12 s would allow"):
@@ -353,12 +353,12 @@ def test_item5_tiny_max_step_is_refused(tmp_path):
     assert load_scene(ok).solver.max_step_s == 1e-3
 
 
-def test_item5_long_source_is_refused():
+def test_long_source_is_refused():
     with pytest.raises(SceneError, match="source"):
         scene_from_dict({**IDEAL, "source": "x" * (MAX_SOURCE_CHARS + 1)})
 
 
-def test_item5_sample_count_is_capped_before_memory_runs_out(tmp_path):
+def test_sample_count_is_capped_before_memory_runs_out(tmp_path):
     p = _write(tmp_path / "paper.yaml", {**IDEAL, "simulate": {"strides": 1000,
                                                               "sample_rate_hz": 1e6}})
     rc, err, _ = _cli("simulate", p, "--runs-dir", tmp_path / "runs")
@@ -366,7 +366,7 @@ def test_item5_sample_count_is_capped_before_memory_runs_out(tmp_path):
     assert not (tmp_path / "runs" / "paper" / "simulate.h5").exists()
 
 
-def test_item5_sample_trajectory_checks_the_count_first():
+def test_sample_trajectory_checks_the_count_first():
     from walkerlab.analysis.gait.metrics import sample_trajectory
 
     class Seg:
@@ -380,7 +380,7 @@ def test_item5_sample_trajectory_checks_the_count_first():
 
 
 @pytest.mark.parametrize("kind", ["fifo", "dev_zero", "huge"])
-def test_item5_files_read_are_bounded_regular_files(tmp_path, paper_scene, kind):
+def test_files_read_are_bounded_regular_files(tmp_path, paper_scene, kind):
     marker = tmp_path / "runs" / "paper" / ".scene"
     marker.parent.mkdir(parents=True)
     if kind == "fifo":
@@ -394,7 +394,7 @@ def test_item5_files_read_are_bounded_regular_files(tmp_path, paper_scene, kind)
 
 
 @pytest.mark.parametrize("kind", ["fifo", "dev_zero", "big"])
-def test_item5_scene_file_is_a_bounded_regular_file(tmp_path, kind):
+def test_scene_file_is_a_bounded_regular_file(tmp_path, kind):
     p = tmp_path / "s.yaml"
     if kind == "fifo":
         os.mkfifo(p)

@@ -66,26 +66,26 @@ def _cli(*args, env=None):
 
 # ------------------------------------------------------------------ D1, D2: names and paths
 @pytest.mark.parametrize("name", ["../evil", "/tmp/x", "a/b", "..", ".hidden", "a\\b", ""])
-def test_d1_scene_name_with_path_parts_rejected(name):
+def test_scene_name_with_path_parts_rejected(name):
     with pytest.raises(SceneError, match="name"):
         scene_from_dict({**IDEAL, "name": name})
 
 
-def test_d1_scene_file_stem_that_is_not_a_name(tmp_path):
+def test_scene_file_stem_that_is_not_a_name(tmp_path):
     p = _write(tmp_path / "...yaml", IDEAL)
     with pytest.raises(SceneError, match="file name gives the run-folder name '..'"):
         load_scene(p)
 
 
 @pytest.mark.parametrize("name", ["../../x", "/tmp/x", "a/b", ".."])
-def test_d1_sweep_name_outside_runs_rejected(tmp_path, name):
+def test_sweep_name_outside_runs_rejected(tmp_path, name):
     code, err, _ = _cli("sweep", ROOT / "configs" / "goswami1996.yaml", "--param",
                         "slope.angle_deg=3", "--name", name, "--runs-dir", tmp_path / "runs")
     assert code == 1 and err.startswith("error: --name") and "\n" not in err
     assert not any(tmp_path.rglob("*.h5*"))
 
 
-def test_d1_symlinked_run_folder_leaving_runs_rejected(tmp_path):
+def test_symlinked_run_folder_leaving_runs_rejected(tmp_path):
     (tmp_path / "runs").mkdir()
     (tmp_path / "elsewhere").mkdir()
     (tmp_path / "runs" / "paper").symlink_to(tmp_path / "elsewhere")
@@ -97,7 +97,7 @@ def test_d1_symlinked_run_folder_leaving_runs_rejected(tmp_path):
 @pytest.mark.parametrize("name", ["fixedpoint", "simulate.h5", "contact_sim", "compare",
                                   "bifurcation", "workprecision", "basin",
                                   "stability_map_stiffness"])
-def test_d2_sweep_cannot_take_a_stage_artifact_name(tmp_path, name):
+def test_sweep_cannot_take_a_stage_artifact_name(tmp_path, name):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     from walkerlab.stages.sweep import sweep_path
 
@@ -105,7 +105,7 @@ def test_d2_sweep_cannot_take_a_stage_artifact_name(tmp_path, name):
         sweep_path(sc, [parse_param("slope.angle_deg=1")], "fixedpoint", tmp_path, name)
 
 
-def test_d2_two_scene_files_with_one_name_do_not_share_a_run_folder(tmp_path):
+def test_two_scene_files_with_one_name_do_not_share_a_run_folder(tmp_path):
     a = load_scene(_write(tmp_path / "a" / "paper.yaml", IDEAL))
     b = load_scene(_write(tmp_path / "b" / "paper.yaml", IDEAL))
     runs = tmp_path / "runs"
@@ -139,7 +139,7 @@ def test_d2_two_scene_files_with_one_name_do_not_share_a_run_folder(tmp_path):
     ("contact_sim.n_strides", 10_000_000, "contact_sim.n_strides"),
     ("contact_solver.rtol", 1e-14, "contact_solver.rtol"),
 ])
-def test_d10_strict_finite_numbers_name_the_field(tmp_path, path, value, field):
+def test_strict_finite_numbers_name_the_field(tmp_path, path, value, field):
     p = _write(tmp_path / "s.yaml", _with(PAPER, path, value))
     with pytest.raises(SceneError) as exc:
         load_scene(p)
@@ -160,7 +160,7 @@ def test_strict_still_accepts_yaml_ints_and_nested_mappings(tmp_path):
 
 @pytest.mark.parametrize("kind,match", [("binary", "not a text"), ("dir", "is a directory"),
                                         ("missing", "not found")])
-def test_d9_scene_file_errors_are_one_line(tmp_path, kind, match):
+def test_scene_file_errors_are_one_line(tmp_path, kind, match):
     p = tmp_path / "s.yaml"
     if kind == "binary":
         p.write_bytes(bytes(range(256)) * 4)
@@ -181,13 +181,13 @@ def test_d9_scene_file_errors_are_one_line(tmp_path, kind, match):
     (["sweep", "{scene}", "--param", "slope.angle_deg=1", "--name", "fixedpoint"],
      "stage's artifact"),
 ])
-def test_d3_bad_arguments_give_one_line(tmp_path, args, match):
+def test_bad_arguments_give_one_line(tmp_path, args, match):
     args = [a.replace("{scene}", str(ROOT / "configs" / "goswami1996.yaml")) for a in args]
     code, err, _ = _cli(*args, "--runs-dir" if args[0] != "bench" else "--out", tmp_path / "r")
     assert code == 1 and match in err and "\n" not in err and "Traceback" not in err, err
 
 
-def test_d3_unexpected_exception_is_one_line_with_debug_hint(tmp_path, monkeypatch):
+def test_unexpected_exception_is_one_line_with_debug_hint(tmp_path, monkeypatch):
     from walkerlab.stages import fixedpoint
 
     def boom(*a, **k):
@@ -202,7 +202,7 @@ def test_d3_unexpected_exception_is_one_line_with_debug_hint(tmp_path, monkeypat
     assert isinstance(r.exception, ZeroDivisionError)  # the traceback is there on request
 
 
-def test_d3_read_only_runs_folder_is_one_line(tmp_path, monkeypatch):
+def test_read_only_runs_folder_is_one_line(tmp_path, monkeypatch):
     import tempfile
 
     def denied(*a, **k):  # root ignores file modes: simulate EACCES where it would occur
@@ -263,7 +263,7 @@ def test_a_read_only_runs_folder_reuses_an_up_to_date_artifact_and_names_its_fol
     assert ".tmp" not in msg and "(walker.xml kept as it was)" in msg
 
 
-def test_d3_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
+def test_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     path = stage_artifact(sc, tmp_path, "simulate")
     write_artifact(path, "simulate", sc, "k", lambda f: None, 0.0)  # no samples/ inside
@@ -275,7 +275,7 @@ def test_d3_plot_after_a_dataset_was_removed_is_one_line(tmp_path):
 
 @pytest.mark.parametrize("termination,code", [("fall", 1), ("solver_failure", 1),
                                               ("t_final", 0)])
-def test_d11_contact_sim_fall_exits_non_zero(tmp_path, monkeypatch, termination, code):
+def test_contact_sim_fall_exits_non_zero(tmp_path, monkeypatch, termination, code):
     sc = scene_from_dict({**PAPER, "name": "paper"})
     path = stage_artifact(sc, tmp_path, "contact-sim")
 
@@ -310,7 +310,7 @@ def _fake_compute(value: float):
     return compute
 
 
-def test_d6_edited_artifact_and_edited_upstream_are_detected(tmp_path):
+def test_edited_artifact_and_edited_upstream_are_detected(tmp_path):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     first = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(-0.8))
     assert not first.reused
@@ -328,7 +328,7 @@ def test_d6_edited_artifact_and_edited_upstream_are_detected(tmp_path):
 
 
 # ------------------------------------------------------------------ D5, permissions
-def test_d5_interrupted_figure_save_leaves_the_old_file(tmp_path):
+def test_interrupted_figure_save_leaves_the_old_file(tmp_path):
     import matplotlib.pyplot as plt
 
     from walkerlab.plotting.figures import save
@@ -349,7 +349,7 @@ def test_d5_interrupted_figure_save_leaves_the_old_file(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png", "f.svg"]  # no temp left
 
 
-def test_d5_report_is_written_atomically(tmp_path, monkeypatch):
+def test_report_is_written_atomically(tmp_path, monkeypatch):
     """The report writer goes through atomic_write (a kill cannot leave a 0-byte file)."""
     from walkerlab.stages import report
 
@@ -403,7 +403,7 @@ def _fake_sweep(tmp_path, name, n=9, **kw):
                            runs_root=tmp_path, name=name, progress=False, **kw)
 
 
-def test_d12_rows_saved_every_few_points_and_kept_on_resume(tmp_path, monkeypatch, fake_points):
+def test_rows_saved_every_few_points_and_kept_on_resume(tmp_path, monkeypatch, fake_points):
     seen = []
 
     def stop(done, total):
@@ -421,7 +421,7 @@ def test_d12_rows_saved_every_few_points_and_kept_on_resume(tmp_path, monkeypatc
     assert list(done["index"]) == list(range(40))
 
 
-def test_d4_second_identical_sweep_fails_in_one_line_while_the_first_runs(tmp_path,
+def test_second_identical_sweep_fails_in_one_line_while_the_first_runs(tmp_path,
                                                                            fake_points):
     target = tmp_path / "paper" / "same.h5"
     target.parent.mkdir(parents=True)
@@ -447,7 +447,7 @@ def test_d4_second_identical_sweep_fails_in_one_line_while_the_first_runs(tmp_pa
     assert load_sweep(_fake_sweep(tmp_path, "same", n=3))["points"]["index"].size == 3
 
 
-def test_d4_half_done_sweep_is_never_finalized(tmp_path, monkeypatch, fake_points):
+def test_half_done_sweep_is_never_finalized(tmp_path, monkeypatch, fake_points):
     def lossy(chains, *a, **k):  # an executor that loses a piece
         for ci, chain in enumerate(chains[1:], 1):
             guess = None
@@ -461,7 +461,7 @@ def test_d4_half_done_sweep_is_never_finalized(tmp_path, monkeypatch, fake_point
     assert not (tmp_path / "paper" / "half.h5").exists()
 
 
-def test_d3_grid_cap_is_on_the_product_of_the_axes():
+def test_grid_cap_is_on_the_product_of_the_axes():
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     axes = [parse_param("slope.angle_deg=0:99999:1"), parse_param("walker.hip_mass_kg=0:99:1")]
     assert math.prod(len(a) for a in axes) > runner.MAX_GRID_POINTS
@@ -485,7 +485,7 @@ def _descendants(pid: int) -> list[int]:
     return res
 
 
-def test_d7_sigkill_of_the_main_process_leaves_no_workers(tmp_path):
+def test_sigkill_of_the_main_process_leaves_no_workers(tmp_path):
     # the forkserver's preload (model derivation) is skipped to keep the test short: the
     # workers then derive in their initializer, which the parent watch covers the same way
     script = textwrap.dedent(f"""
@@ -527,7 +527,7 @@ def test_d7_sigkill_of_the_main_process_leaves_no_workers(tmp_path):
     assert not alive, f"still running after SIGKILL of the main process: {names}"
 
 
-def test_d4_a_second_stage_run_waits_for_the_first_writer(tmp_path, capfd):
+def test_a_second_stage_run_waits_for_the_first_writer(tmp_path, capfd):
     sc = scene_from_dict({**IDEAL, "name": "paper"})
     target = stage_artifact(sc, tmp_path, "fixedpoint")
     target.parent.mkdir(parents=True)
@@ -550,7 +550,7 @@ def test_d4_a_second_stage_run_waits_for_the_first_writer(tmp_path, capfd):
     assert not out.reused and f"pid {holder.pid}" in capfd.readouterr().err
 
 
-def test_d6_memoised_content_hash_sees_an_edit(tmp_path, monkeypatch):
+def test_memoised_content_hash_sees_an_edit(tmp_path, monkeypatch):
     """The per-process memo of content hashes (a report checks each upstream file several
     times) is keyed by the file's stamp: an edit after memoisation is still detected."""
     from walkerlab.io import artifacts as A
@@ -589,3 +589,53 @@ def test_force_replaces_an_artifact_without_hashing_it(tmp_path, monkeypatch):
         assert float(f["fixed_point/stance_rate"][()]) == 2.0
     again = common.run_cached("fixedpoint", sc, tmp_path, ("walker",), (), _fake_compute(3.0))
     assert verified == [out.path] and again.reused
+
+
+# -------------------- an initial guess from a FIFO
+
+
+def _one_line(*args) -> str:
+    code, err, _ = _cli(*args)
+    assert code == 1, (code, err)
+    assert len(err.splitlines()) == 1, err
+    return err
+
+
+def test_an_initial_guess_from_a_fifo_is_not_a_regular_file(tmp_path):
+    import os
+
+    fifo = tmp_path / "branch.h5"
+    os.mkfifo(fifo)
+    data = yaml.safe_load((ROOT / "configs" / "simplest.yaml").read_text())
+    data["fixedpoint"]["initial_guess"] = {"from": str(fifo), "at": 0.5}
+    scene = tmp_path / "s.yaml"
+    scene.write_text(yaml.safe_dump(data))
+    err = _one_line("fixedpoint", scene, "--runs-dir", tmp_path / "runs")
+    assert err.endswith(f"{fifo}: not a regular file; give an HDF5 artifact")
+
+
+# -------------------- a link in an artifact's place, before computing
+# ------------------------------------------------------------------ 5: a link, before computing
+@pytest.mark.parametrize("stage", ["continuation", "robustness"])
+def test_link_in_place_of_an_artifact_is_refused_before_computing(tmp_path, monkeypatch,
+                                                                     stage):
+    from walkerlab.io.artifacts import write_artifact
+    from walkerlab.io.freshness import write_if_stale
+    from walkerlab.io.runpaths import RunPathError
+
+    sc = scene_from_dict({**IDEAL, "name": "paper"})
+    runs = tmp_path / "runs"
+    elsewhere = tmp_path / "elsewhere.h5"  # a valid artifact of another run
+    write_artifact(elsewhere, stage, sc, "other inputs", lambda f: None, 0.0)
+    link = runs / "paper" / f"{stage}.h5"
+    link.parent.mkdir(parents=True)
+    link.symlink_to(elsewhere)
+    computed, told = [], []
+
+    def compute():
+        computed.append(1)
+        return (lambda f: None), {}
+
+    with pytest.raises(RunPathError, match="symbolic link"):
+        write_if_stale(stage, sc, runs, ("walker",), (), compute, tell=told.append)
+    assert not computed and not told  # before: "recomputing ... changed" and the computation

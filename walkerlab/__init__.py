@@ -24,8 +24,9 @@ the product):
   ``compare``, ``basin`` and ``api.sweep`` (each returns an ``xarray.Dataset`` read from the
   stage's artifact; ``walkerlab.studies`` is the package of sweeps, basins and maps),
   ``continuation`` (the loaded continuation artifact), ``mfpt`` (mean first-passage time),
-  ``optimize`` (optimal gait or design), ``robustness``, ``export`` (the model file's path),
-  ``target`` (in memory: the field value whose gait meets a target), ``Walker`` and
+  ``optimize`` (optimal gait or design), ``robustness``, ``export_scene`` (the model file's
+  path; also ``walkerlab.api.export``; ``walkerlab.export`` is the package of exchange
+  formats), ``target`` (in memory: the field value whose gait meets a target), ``Walker`` and
   ``ContactWalker`` (the walker in memory: rigid and contact views)
 
 Importing the package has no side effects and loads no heavy optional package: the API's
@@ -36,7 +37,7 @@ __version__ = "0.1.0"
 
 _API = ("load_scene", "with_changes", "fixed_point", "fixed_points", "simulate",
         "contact_simulate", "compare", "basin", "continuation", "mfpt", "optimize",
-        "robustness", "export", "target", "Walker", "ContactWalker")
+        "robustness", "export_scene", "target", "Walker", "ContactWalker")
 __all__ = ["__version__", "api", *_API]
 
 
@@ -46,48 +47,13 @@ def __getattr__(name: str):
 
         api = importlib.import_module("walkerlab.api")
         return api if name == "api" else getattr(api, name)
+    if name == "export":  # the subpackage, once imported, is a plain attribute
+        raise AttributeError("module 'walkerlab' has no attribute 'export': the model file "
+                             "is written by walkerlab.export_scene (walkerlab.api.export); "
+                             "the exchange formats are the package walkerlab.export "
+                             "(import walkerlab.export)")
     raise AttributeError(f"module 'walkerlab' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
-
-
-import sys as _sys  # noqa: E402
-import types as _types  # noqa: E402
-
-
-class _CallablePackage(_types.ModuleType):
-    """The package :mod:`walkerlab.export` (exchange formats), which called is the front
-    door's :func:`walkerlab.api.export`: ``wl.export(scene, "mjcf")`` writes the model file,
-    ``walkerlab.export.adams`` stays the module."""
-
-    def __call__(self, *args, **kwargs):
-        """:func:`walkerlab.api.export` (same arguments, same return)."""
-        import importlib
-
-        return importlib.import_module("walkerlab.api").export(*args, **kwargs)
-
-
-class _Walkerlab(_types.ModuleType):
-    """This module's type: its attribute ``export`` is the package of exchange formats made
-    callable (:class:`_CallablePackage`), whichever was imported first (the import system
-    sets a subpackage as its parent's attribute, which would hide the front door's
-    function)."""
-
-    @property
-    def export(self):
-        import importlib
-
-        mod = self.__dict__.get("_export_package") or importlib.import_module("walkerlab.export")
-        if not isinstance(mod, _CallablePackage):
-            mod.__class__ = _CallablePackage
-        self.__dict__["_export_package"] = mod
-        return mod
-
-    @export.setter
-    def export(self, module) -> None:
-        self.__dict__["_export_package"] = module
-
-
-_sys.modules[__name__].__class__ = _Walkerlab

@@ -2,13 +2,14 @@
 Exports: the walker as MJCF, walking in MuJoCo
 ==============================================
 
-``walkerlab export SCENE --format mjcf`` (here :func:`walkerlab.api.export`) writes the
-walker as a floating planar multibody model for MuJoCo: links with their masses and
-inertias, hinges, the slope, the contact from the scene's IMPACT law and a ``gait`` keyframe
-at the rigid fixed point. :func:`walkerlab.export.mujoco_walk.walk` runs it in MuJoCo from
-that keyframe; its heel strikes come at the rigid step period. (``--format urdf`` and
-``--format adm`` write the URDF for Drake and Pinocchio and the MSC Adams dataset.) Walking
-it needs the ``engines`` extra (MuJoCo).
+``walkerlab export SCENE --format mjcf`` (here :func:`walkerlab.export_scene`, also
+``walkerlab.api.export``) writes the walker as a floating planar multibody model for MuJoCo:
+links with their masses and inertias, hinges, the slope, the contact from the scene's IMPACT
+law and a ``gait`` keyframe at the rigid fixed point.
+:func:`walkerlab.export.mujoco_walk.walk` runs it in MuJoCo from that keyframe; its heel
+strikes come at the rigid step period. (``--format urdf`` and ``--format adm`` write the
+URDF for Drake and Pinocchio and the MSC Adams dataset.) Walking it needs the ``engines``
+extra (MuJoCo).
 """
 
 import tempfile
@@ -23,7 +24,7 @@ from walkerlab.export.mujoco_walk import walk
 ROOT = Path(wl.__file__).resolve().parents[1]  # configs/ beside the package
 runs = Path(tempfile.mkdtemp(prefix="walkerlab-gallery-"))
 scene = wl.load_scene(ROOT / "configs" / "paper.yaml")
-xml = wl.export(scene, "mjcf", runs_dir=runs)
+xml = wl.export_scene(scene, "mjcf", runs_dir=runs)
 text = Path(xml).read_text()
 print(f"{Path(xml).name}: {len(text.splitlines())} lines")
 print("\n".join(line for line in text.splitlines()

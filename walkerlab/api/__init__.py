@@ -15,14 +15,17 @@ of the front door is :func:`walkerlab.api.sweep` (``wl.api.sweep(scene, param, v
 Modules: :mod:`~walkerlab.api.scenes` (:func:`load_scene`, :func:`with_changes`),
 :mod:`~walkerlab.api.runs` (one scene: :func:`fixed_point`, :func:`fixed_points`,
 :func:`simulate`, :func:`contact_simulate`, :func:`compare`, :func:`optimize` (optimal gait
-or design), :func:`robustness`, :func:`export` (the written model file's path)),
+or design), :func:`robustness`, :func:`export_scene` (the written model file's path; here
+also named ``export``, ``wl.api.export``: the package ``walkerlab.export`` holds the exchange
+formats, so the top level names the function ``wl.export_scene``)),
 :mod:`~walkerlab.api.studies` (many points: :func:`sweep`, :func:`basin`,
 :func:`continuation`, :func:`mfpt`) and :mod:`~walkerlab.api.walker` (:class:`Walker`: the
 walker in memory, its map, Jacobian, fixed point and walks, no artifact;
 :class:`ContactWalker` (``Walker.contact()``): its contact view in memory, the walks and
-periodic gait of ``walkerlab contact-sim``; and
-:func:`target`: the field value whose gait meets a target speed, step length or period, in
-memory as ``walkerlab target``); this module only gathers their public names.
+periodic gait of ``walkerlab contact-sim``), :mod:`~walkerlab.api.walks` (the records of
+their runs) and :mod:`~walkerlab.api.targets` (:func:`target`: the field value whose gait
+meets a target speed, step length or period, in memory as ``walkerlab target``); this
+module only gathers their public names.
 
 Needs xarray and h5netcdf (``pip install 'walkerlab[api]'``; the ``test`` extra has them).
 Importing this module loads neither them nor the numeric stack: each function imports what
@@ -41,7 +44,7 @@ Example
 from walkerlab.api.runs import (
     compare,
     contact_simulate,
-    export,
+    export_scene,
     fixed_point,
     fixed_points,
     optimize,
@@ -50,8 +53,11 @@ from walkerlab.api.runs import (
 )
 from walkerlab.api.scenes import DEFAULT_RUNS, load_scene, with_changes
 from walkerlab.api.studies import basin, continuation, mfpt, sweep
-from walkerlab.api.walker import ContactWalker, Walker, target
+from walkerlab.api.targets import target
+from walkerlab.api.walker import ContactWalker, Walker
+
+export = export_scene  # ``wl.api.export``: this package has no subpackage of that name
 
 __all__ = ["DEFAULT_RUNS", "load_scene", "with_changes", "fixed_point", "fixed_points",
            "simulate", "contact_simulate", "compare", "sweep", "basin", "continuation", "mfpt",
-           "optimize", "robustness", "export", "target", "Walker", "ContactWalker"]
+           "optimize", "robustness", "export", "export_scene", "target", "Walker", "ContactWalker"]

@@ -15,8 +15,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 from walkerlab.api.scenes import DEFAULT_RUNS, as_scene, read_dataset, runs_folder
 
-__all__ = ["compare", "contact_simulate", "export", "fixed_point", "fixed_points", "optimize",
-           "robustness", "simulate"]
+__all__ = ["compare", "contact_simulate", "export_scene", "fixed_point", "fixed_points",
+           "optimize", "robustness", "simulate"]
 
 
 def fixed_point(scene: Scene | str | Path | dict, *, runs_dir: str | Path = DEFAULT_RUNS,
@@ -338,8 +338,8 @@ def robustness(scene: Scene | str | Path | dict, *, workers: int = 1,
                                      workers=workers).path)
 
 
-def export(scene: Scene | str | Path | dict, fmt: str = "urdf", *, walker_only: bool = False,
-           runs_dir: str | Path = DEFAULT_RUNS) -> Path:
+def export_scene(scene: Scene | str | Path | dict, fmt: str = "urdf", *,
+                 walker_only: bool = False, runs_dir: str | Path = DEFAULT_RUNS) -> Path:
     """Write the scene's walker as a multibody model file (``walkerlab export``):
     ``runs/<scene>/walker.urdf`` (Drake, Pinocchio; with the gait's keyframe beside it,
     ``walker.gait.json``), ``walker.xml`` (MuJoCo MJCF, the gait as its ``gait`` keyframe)

@@ -25,165 +25,31 @@ in a ``units: nondimensional`` scene every quantity is in the walker's own units
 √(l/g)).  Nothing here knows how many states a walker has.
 """
 
+
 from __future__ import annotations
 
 import dataclasses
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from walkerlab.api.checks import (
+    STEP_TIME_LIMIT_S,
+    check_target,
+    clear_step_failure,
+    positive,
+    short,
+    simulate_options,
+)
+from walkerlab.api.walks import STEP_FIELDS, ContactWalk, Gait, Step, Walk
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
 
     from walkerlab.config import Scene
 
-__all__ = ["STEP_TIME_LIMIT_S", "ContactWalk", "ContactWalker", "Gait", "Step", "Target",
-           "Walk", "Walker", "check_target", "target"]
-
-#: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
-#: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
-#: search's budget (:data:`walkerlab.analysis.gait.poincare.ROOT_BUDGET_S`)
-STEP_TIME_LIMIT_S = 60.0
-
-
-@dataclass(frozen=True)
-class Gait:
-    """A period-1 gait (fixed point of the Poincaré map), as ``walkerlab fixedpoint`` finds it.
-
-    Attributes
-    ----------
-    x : ndarray, shape (2n,)
-        State just after heel strike (role order of ``names``) [rad, rad/s].
-    names : tuple of str
-        State names (:meth:`Walker.state_names`).
-    step_period : float
-        Step period [s, or √(l/g) in a nondimensional scene]; for a walker whose legs
-        differ (a stride map), the mean of its two steps.
-    map_period : float
-        Period of the Poincaré map [s]: the step period, or the stride period.
-    multipliers : ndarray, shape (2n,), complex
-        Floquet multipliers (variational equations with saltation), by decreasing modulus.
-    jacobian : ndarray, shape (2n, 2n)
-        Jacobian of the Poincaré map at ``x``.
-    residual : float
-        max ``|P(x) - x|`` [state units].
-    label : str
-        Which gait of the search (``long_period``, ``short_period``, ...).
-    step_length : float
-        Mean step length [m]: stance foot to swing foot at heel strike
-        (:func:`walkerlab.analysis.gait.metrics.step_length`).
-    speed : float
-        Distance along the ground over the map's period [m/s].
-    cost_of_transport : float
-        Mean over the map's steps of (positive actuator work + push-off work + slope
-        energy if > 0) / (M g d) [-] (Kuo 2002; Collins et al. 2005); a passive gait's is
-        sin(slope).  NaN without a ledger (flat feet on legs that differ).
-    ledger : dict[str, ndarray (steps,)]
-        The energy ledger of each step of the map, as ``simulate.h5``'s ``ledger/``
-        (:func:`walkerlab.analysis.gait.energy.gait_ledger`): ``actuator_work_positive``,
-        ``actuator_work_negative``, ``push_off_work``, ``heel_strike_loss``,
-        ``internal_collision_loss``, ``damper_work``, ``potential_work``, ``energy_change``,
-        ``closure``, ``slope_energy`` [J], ``push_off_impulse`` [N s],
-        ``cost_of_transport`` [-].
-    """
-
-    x: np.ndarray
-    names: tuple
-    step_period: float
-    map_period: float
-    multipliers: np.ndarray
-    jacobian: np.ndarray
-    residual: float
-    label: str
-    step_length: float = float("nan")
-    speed: float = float("nan")
-    cost_of_transport: float = float("nan")
-    ledger: dict = field(default_factory=dict)
-
-    @property
-    def state(self) -> dict[str, float]:
-        """The fixed point by state name."""
-        return {n: float(v) for n, v in zip(self.names, self.x)}
-
-    @property
-    def stable(self) -> bool:
-        """All ``|Floquet multipliers|`` < 1."""
-        import numpy as np
-
-        return bool(np.max(np.abs(self.multipliers)) < 1.0)
-
-
-@dataclass(frozen=True)
-class Step:
-    """One application of the Poincaré map (a step, or a stride when the legs differ).
-
-    Attributes
-    ----------
-    x_next : ndarray, shape (2n,)
-        State just after the last heel strike.
-    period : float
-        Duration [s].
-    events : list of (str, float, float, str)
-        Each phase of each step: ``(phase, t_start [s], t_end [s], guard that ended it)``.
-    """
-
-    x_next: np.ndarray
-    period: float
-    events: list
-
-
-@dataclass(frozen=True)
-class Walk:
-    """A simulated walk.
-
-    Attributes
-    ----------
-    t : ndarray, shape (m,)
-        Sample times [s].
-    x : ndarray, shape (m, 2n)
-        Role-ordered states at ``t`` (roles swap at every heel strike).
-    stance_leg : ndarray, shape (m,), str
-        Physical leg in stance at each sample.
-    heel_strikes : ndarray, shape (k,)
-        Times of the heel strikes [s].
-    events : list of (int, str, str, float, float, str)
-        ``(step, stance leg, phase, t_start, t_end, guard)`` of every phase.
-    termination : str
-        How the walk ended (``heel_strike`` after the last step, ``fall``, ...).
-    steps : dict[str, ndarray (k,)]
-        The step table of the ``simulate`` stage
-        (:func:`walkerlab.analysis.gait.metrics.step_table`): ``period`` [s],
-        ``step_length`` [m], ``hip_speed`` [m/s], ``impact_energy_loss`` [J],
-        ``termination``, ``stance_leg`` ... of each step (the last one may have fallen).
-    ledger : dict[str, ndarray (k,)]
-        The energy ledger of each step, as :attr:`Gait.ledger` (NaN for a step that did
-        not end by a heel strike; empty for flat feet on legs that differ).
-    """
-
-    t: np.ndarray
-    x: np.ndarray
-    stance_leg: np.ndarray
-    heel_strikes: np.ndarray
-    events: list
-    termination: str
-    steps: dict = field(default_factory=dict)
-    ledger: dict = field(default_factory=dict)
-
-    @property
-    def step_length(self) -> np.ndarray:
-        """Length of each step [m] (``steps["step_length"]``)."""
-        return self.steps["step_length"]
-
-    @property
-    def speed(self) -> np.ndarray:
-        """Hip speed of each step [m/s] (``steps["hip_speed"]``)."""
-        return self.steps["hip_speed"]
-
-    @property
-    def cost_of_transport(self) -> np.ndarray:
-        """Cost of transport of each step [-] (``ledger["cost_of_transport"]``)."""
-        return self.ledger["cost_of_transport"]
+__all__ = ["STEP_TIME_LIMIT_S", "ContactWalk", "ContactWalker", "Gait", "Step", "Walk",
+           "Walker", "check_target"]
 
 
 class Walker:
@@ -226,7 +92,7 @@ class Walker:
         from walkerlab.integrate.solver import Solver
         from walkerlab.models.registry import build_walker
 
-        self.step_time_limit_s = _positive(step_time_limit_s, "step_time_limit_s")
+        self.step_time_limit_s = positive(step_time_limit_s, "step_time_limit_s")
         self.scene = scene
         self.model = build_walker(scene)
         self.solver = Solver.from_settings(scene.solver)
@@ -314,14 +180,14 @@ class Walker:
         want = (f"give the state as {len(names)} numbers ({', '.join(names)}) "
                 "[rad, rad/s], e.g. gait.x")
         if x is None or isinstance(x, (str, bytes, dict)):
-            raise SceneError(f"{what}={_short(x)}: {want}")
+            raise SceneError(f"{what}={short(x)}: {want}")
         try:
             arr = np.asarray(x)
             if arr.dtype.kind not in "biuf" or arr.dtype.kind == "b":
                 raise TypeError
             arr = arr.astype(float)
         except (TypeError, ValueError):
-            raise SceneError(f"{what}={_short(x)}: not numbers; {want}") from None
+            raise SceneError(f"{what}={short(x)}: not numbers; {want}") from None
         if arr.shape != (len(names),):
             raise SceneError(f"{what} has shape {arr.shape}; the walker's state is "
                              f"({len(names)},): {want}")
@@ -365,7 +231,7 @@ class Walker:
                         "gait, or a very stiff spring, makes the integrator crawl",)
             raise out from None
         except StepFailed as exc:
-            raise _clear(exc, self.max_step_time) from None
+            raise clear_step_failure(exc, self.max_step_time) from None
 
     def step(self, x) -> Step:
         """One Poincaré map step ``x -> P(x)`` (paper Eq. 10; a stride when legs differ).
@@ -540,7 +406,7 @@ class Walker:
         from walkerlab.config import MAX_SIMULATE_SAMPLES, SceneError
         from walkerlab.integrate.rigid import simulate_steps
 
-        strides, rate = _simulate_options(strides, sample_rate_hz)
+        strides, rate = simulate_options(strides, sample_rate_hz)
         x0 = self.check_state(x0, "x0")
         with self._bounded():
             traj = simulate_steps(self.model, x0, 2 * strides, self.solver,
@@ -568,111 +434,6 @@ class Walker:
                 f"slope={self.model.params.get('slope_rad', 'n/a')})")
 
 
-
-@dataclass(frozen=True)
-class ContactWalk:
-    """A walk of the contact walker (:meth:`ContactWalker.simulate`), as the ``contact-sim``
-    stage records it (units named in SI; in a ``units: nondimensional`` scene every quantity
-    is in the walker's own units, time in √(l/g), as :class:`Walk`'s).
-
-    Attributes
-    ----------
-    t : ndarray, shape (m,)
-        Sample times [s] (at ``contact_sim.sample_rate_hz``; the last one is the event time
-        if an event ended the run).
-    x : ndarray, shape (m, N)
-        States of the floating walker, columns named by ``state_names`` [m, rad, m/s, rad/s].
-    state_names : tuple of str
-        The contact walker's state names (:meth:`ContactWalker.state_names`).
-    heel_strikes : ndarray, shape (k,)
-        Heel-strike times [s] (touchdowns of the swing foot ahead of the stance foot).
-    heel_strike_legs : tuple of str
-        Leg that struck at each heel strike.
-    steps : dict[str, ndarray (s,)]
-        The step table of ``contact_sim.h5``'s ``steps/``: ``t_start``, ``t_end``, ``period``
-        [s], ``stance_leg``, ``stance_slip_mm`` [mm], ``double_support_creep_mm`` [mm],
-        ``bounce_count``, ``scuff_count``, ``peak_penetration_m`` [m], ``liftoff_time`` [s],
-        ``stance_slip_path_mm`` [mm], ``friction_work_j`` [J].
-    normal_force, friction_force : dict[str, ndarray (m,)]
-        IMPACT normal force and Coulomb friction (down-slope) [N] at each contact point, by
-        its name (:meth:`ContactWalker.contact_names`: ``leg1``, ``leg2``; flat feet
-        ``leg1_heel``, ``leg1_toe``, ...).
-    penetration : dict[str, ndarray (m,)]
-        Signed penetration of each contact point [m] (< 0: above the ground).
-    termination : str
-        How the integration stopped (:mod:`walkerlab.integrate.ends`: ``heel_strike`` when
-        the strides asked for were made, ``t_final``, ``trip``, ``fall``, ...).
-    outcome : str
-        The run's verdict (``termination``, or ``slip``, ``scuff``, ``no_heel_strike``).
-    message : str
-        The outcome in one line.
-    walks : bool
-        The walker walked the run (:attr:`~walkerlab.analysis.contact.gait.ContactResult.verdict`).
-    x0 : ndarray, shape (N,)
-        The initial state [m, rad, m/s, rad/s].
-    x_ideal : ndarray, shape (2n,)
-        The rigid state the run started from (rigid role order) [rad, rad/s].
-    initial_rate_scale : ndarray, shape (2,)
-        Multipliers on the (swing, stance) rates of ``x_ideal`` [-].
-    step_length_m : float
-        Spacing of the terrain's patches [m] (the ideal step length, or the periodic gait's).
-    gait : walkerlab.analysis.contact.periodic.ContactPeriodicGait or None
-        The periodic gait the run started from (``contact_sim.start: periodic_gait``).
-    work : dict[str, ndarray (m,)]
-        A powered walker's work integrals since the start [J], by name
-        (``hip_torque_positive``, ``push_off``, ``contact``, ...); empty when passive.
-    step_ledger : dict[str, ndarray]
-        A powered walker's energy ledger per step
-        (:func:`walkerlab.analysis.contact.ledger.contact_step_ledger`); empty when passive.
-    result : walkerlab.analysis.contact.gait.ContactResult
-        The library's whole result (feet traces, touchdowns, counters).
-    """
-
-    t: np.ndarray
-    x: np.ndarray
-    state_names: tuple
-    heel_strikes: np.ndarray
-    heel_strike_legs: tuple
-    steps: dict
-    normal_force: dict
-    friction_force: dict
-    penetration: dict
-    termination: str
-    outcome: str
-    message: str
-    walks: bool
-    x0: np.ndarray
-    x_ideal: np.ndarray
-    initial_rate_scale: np.ndarray
-    step_length_m: float
-    gait: Any = None
-    work: dict = field(default_factory=dict)
-    step_ledger: dict = field(default_factory=dict)
-    result: Any = None
-
-    @property
-    def step_periods(self) -> np.ndarray:
-        """Period of each step [s] (``steps["period"]``)."""
-        return self.steps["period"]
-
-    def column(self, name: str) -> np.ndarray:
-        """One state's samples (m,) by name (``walk.column("hip_x")``).
-
-        Raises
-        ------
-        KeyError
-            No state of that name (the message lists the names).
-        """
-        if name not in self.state_names:
-            raise KeyError(f"no state {name!r}; the contact walker's states are "
-                           f"{', '.join(self.state_names)}")
-        return self.x[:, self.state_names.index(name)]
-
-
-#: the step table's columns (the ``steps/`` group of ``contact_sim.h5``)
-_STEP_FIELDS = ("t_start", "t_end", "period", "stance_slip_mm", "double_support_creep_mm",
-                "bounce_count", "scuff_count", "peak_penetration_m", "liftoff_time",
-                "stance_slip_path_mm", "friction_work_j")
 
 
 class ContactWalker:
@@ -884,7 +645,7 @@ class ContactWalker:
         walker, res, x_start, step_length, scale, gait, _ = contact_walk(
             setup, x_ideal, period, solver=self.solver)
         steps = {k: np.array([getattr(s, k) for s in res.steps], dtype=float)
-                 for k in _STEP_FIELDS}
+                 for k in STEP_FIELDS}
         steps["stance_leg"] = np.array([s.stance_leg for s in res.steps], dtype=str)
         points = res.points or res.feet
         work, ledger = {}, {}
@@ -967,208 +728,3 @@ class ContactWalker:
         return (f"ContactWalker({self.scene.name!r}, states={self.state_names()}, "
                 f"contacts={self.contact_names()})")
 
-def _short(value) -> str:
-    """``repr(value)``, cut to 40 characters."""
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
-def _positive(value, name: str) -> float:
-    """``value`` as a positive finite float, else one line naming ``name``."""
-    import math
-    import numbers
-
-    from walkerlab.config import SceneError
-
-    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
-            or not math.isfinite(value) or value <= 0):
-        raise SceneError(f"{name}={_short(value)}: give a positive number of seconds")
-    return float(value)
-
-
-def _simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
-    """``(strides, sample_rate_hz)`` checked by the ``simulate`` section's own fields
-    (whole strides from 1 to the cap, a positive rate up to its cap); one line each."""
-    import numbers
-
-    from pydantic import ValidationError
-
-    from walkerlab.config import SceneError
-    from walkerlab.config.studies import SimulateSettings
-
-    if isinstance(strides, bool) or not isinstance(strides, numbers.Integral):
-        raise SceneError(f"simulate: strides={_short(strides)}: give a whole number of "
-                         "strides (an int, e.g. strides=10)")
-    if isinstance(sample_rate_hz, bool) or not isinstance(sample_rate_hz, numbers.Real):
-        raise SceneError(f"simulate: sample_rate_hz={_short(sample_rate_hz)}: give a "
-                         "number of samples per second, e.g. 500")
-    try:
-        sim = SimulateSettings.model_validate({"strides": int(strides),
-                                               "sample_rate_hz": float(sample_rate_hz)})
-    except ValidationError as err:
-        e = err.errors()[0]
-        field = e["loc"][0]
-        value = strides if field == "strides" else sample_rate_hz
-        raise SceneError(f"simulate: {field}={_short(value)}: {e['msg'].lower()} "
-                         f"(as simulate.{field})") from None
-    return sim.strides, sim.sample_rate_hz
-
-
-def _clear(exc, max_step_time: float):
-    """A :class:`StepFailed` of the map said in the walker's terms (one line: how the step
-    ended, when, and what to do), not in the integrator's."""
-    from walkerlab.analysis.gait.poincare import StepFailed
-
-    t = f"t = {exc.t:.4g} s"
-    why = {
-        "fall": f"the walker fell at {t}, before its heel strike (a fall guard fired): the "
-                "state is not on a walking gait; start from a gait (w.fixed_point().x) or "
-                "nearer to it",
-        "t_final": f"no heel strike within max_step_time_s = {max_step_time:g} s "
-                   "(fixedpoint.max_step_time_s): the walker stalled",
-        "solver_failure": f"the integrator stopped at {t}: "
-                          f"{' '.join(str(exc).split(' s ', 1)[-1].split())}",
-    }.get(exc.termination)
-    if why is None:
-        return exc
-    out = StepFailed(exc.termination, exc.t, exc.x)
-    out.args = (f"step: {why}",)
-    return out
-
-
-def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
-    """The field and target of :meth:`Walker.find_gait_for` (and ``walkerlab target``)
-    checked before any map.
-
-    Parameters
-    ----------
-    scene : walkerlab.config.Scene
-    vary : str
-        Dotted scene field to solve for.
-    target : dict
-        ``{measure: value}``, one of
-        :data:`walkerlab.analysis.continuation.target.MEASURES`.
-
-    Returns
-    -------
-    name : str
-        The measure (``speed_m_per_s``, ``step_length_m`` or ``step_period_s``).
-    value : float
-        The target [m/s, m or s].
-
-    Raises
-    ------
-    walkerlab.config.SceneError
-        Not exactly one known measure; a value that is not a positive finite number (a
-        speed, a step length and a step period are all > 0); ``vary`` not a string, a field
-        outside the ``walker`` and ``slope`` sections, a whole-number field or one whose
-        value is no number (one line each).
-    walkerlab.studies.params.SweepError
-        ``vary`` names no field of the scene (with the closest name).
-    """
-    import math
-    import numbers
-
-    from walkerlab.analysis.continuation.target import MEASURES
-    from walkerlab.config import SceneError
-    from walkerlab.studies.continuation import scene_family, scene_value
-    from walkerlab.studies.params import ParamAxis, takes_whole_numbers
-
-    if len(target) != 1 or next(iter(target)) not in MEASURES:
-        raise SceneError(f"target: give exactly one of {', '.join(MEASURES)} (got "
-                         f"{', '.join(target) or 'none'})")
-    (name, value), = target.items()
-    unit = MEASURES[name][1]
-    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
-            or not math.isfinite(value) or value <= 0):
-        raise SceneError(f"target {name} (--{name.replace('_', '-')}) = {_short(value)}: "
-                         f"give a positive finite number [{unit}]")
-    if not isinstance(vary, str) or not vary.startswith(("walker.", "slope.")):
-        raise SceneError(f"target --vary {_short(vary)}: vary a numeric field of the walker "
-                         "or the slope (e.g. walker.actuation.push_off.impulse_n_s); the "
-                         "gait depends on no other section")
-    from walkerlab.studies.params import SweepError
-
-    try:
-        scene_family(scene, vary)  # an unknown field: SweepError with the closest name
-    except SweepError as exc:
-        raise SweepError(str(exc).replace("--param ", "target --vary ", 1)) from None
-    if takes_whole_numbers(scene, ParamAxis(vary, (), vary)):
-        raise SceneError(f"target --vary {vary}: the field takes whole numbers; a target is "
-                         "solved over a real-valued field")
-    scene_value(scene, vary)  # unset or not a number: one line
-    return name, float(value)
-
-
-@dataclass(frozen=True)
-class Target:
-    """The value of one field whose period-1 gait meets a target (:func:`target`).
-
-    Attributes
-    ----------
-    field : str
-        The dotted scene field solved for.
-    value : float
-        Its value [the field's unit, ``unit``].
-    unit : str
-        The field's unit (``-`` when it has none).
-    walker : Walker
-        The walker with ``field`` set to ``value``.
-    gait : Gait
-        Its period-1 gait (step length, speed, cost of transport, multipliers ...).
-    """
-
-    field: str
-    value: float
-    unit: str
-    walker: Walker
-    gait: Gait
-
-
-def target(scene: Scene | str | Path | dict[str, Any], vary: str, *,
-           speed_m_per_s: float | None = None, step_length_m: float | None = None,
-           step_period_s: float | None = None) -> Target:
-    """The value of ``vary`` whose period-1 gait has a target speed, step length or step
-    period, solved with the fixed point (``walkerlab target``; Kuo's DynLoco
-    ``findgait(target=speed, varying=P)``), in memory: nothing is written.
-
-    Parameters
-    ----------
-    scene : Scene, str, Path or dict
-        A scene (:func:`walkerlab.api.load_scene`); its gait at its own value of ``vary``
-        starts the solve.
-    vary : str
-        A real-valued field of the ``walker`` or ``slope`` section
-        (``"walker.actuation.push_off.impulse_n_s"``).
-    speed_m_per_s, step_length_m, step_period_s : float
-        Exactly one target, a positive finite number [m/s, m, s].
-
-    Returns
-    -------
-    Target
-
-    Raises
-    ------
-    walkerlab.config.SceneError
-        The checks of ``walkerlab target`` (:func:`check_target`), before any map.
-    walkerlab.studies.params.SweepError
-        ``vary`` names no field of the scene.
-    walkerlab.analysis.continuation.target.TargetNotReached
-        No gait meets the target near the scene's own (one line).
-    walkerlab.analysis.gait.search.GaitNotFound
-        No gait at the scene's own value to start from.
-
-    Examples
-    --------
-    >>> t = wl.target("configs/powered_compass.yaml",
-    ...               "walker.actuation.push_off.impulse_n_s", speed_m_per_s=0.45)  # doctest: +SKIP
-    >>> t.value, t.gait.step_period, t.gait.cost_of_transport                      # doctest: +SKIP
-    """
-    from walkerlab.studies.continuation import scene_value
-    from walkerlab.units import field_unit
-
-    given = {k: v for k, v in (("speed_m_per_s", speed_m_per_s),
-                               ("step_length_m", step_length_m),
-                               ("step_period_s", step_period_s)) if v is not None}
-    walker, gait = Walker.from_scene(scene).find_gait_for(vary, **given)
-    return Target(vary, scene_value(walker.scene, vary), field_unit(vary) or "-", walker, gait)

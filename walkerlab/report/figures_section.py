@@ -70,9 +70,9 @@ def spring_law_note(scene) -> str:
     work enters the ledger and the cost of transport as motor work without regeneration
     (what it stores counts as positive work when released), where a spring in
     ``walker.springs`` is passive (its energy is potential energy); "" when none is."""
-    act = getattr(getattr(scene, "walker", None), "actuation", None)
+    act = scene.walker.actuation if scene is not None else None
     springs = [f"walker.actuation.torques.{i} ({t.joint})"
-               for i, t in enumerate(getattr(act, "torques", None) or ())
+               for i, t in enumerate(act.torques if act is not None else ())
                if t.law.stiffness_n_m_per_rad > 0 and t.law.reference is None
                and t.law.time_reference is None and t.scaled_by == "none"]
     if not springs:

@@ -177,7 +177,7 @@ def profile_walk(scene, x0: np.ndarray, n_steps: int):
     from walkerlab.analysis.gait.profile_walk import profile_points, simulate_on_profile
     from walkerlab.models.registry import passive_walker_at
 
-    if getattr(scene.walker, "actuation", None) is not None or scene.ideal.variant != "derived":
+    if scene.walker.actuation is not None or scene.ideal.variant != "derived":
         raise ValueError("terrain.kind: profile: walked by the passive walker of the "
                          "generated model only (no walker.actuation, ideal.variant: derived)")
     at, data_at = passive_walker_at(scene)

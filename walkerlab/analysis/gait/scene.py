@@ -27,7 +27,7 @@ def variants_for(scene: Scene, compare: bool) -> tuple[str, ...]:
     """The scene's own equation variant first, then (``compare``, for a compass gait compared
     with published numbers) the other variants: they explain the difference from Eq. 11."""
     own = (scene.ideal.variant,)
-    if getattr(scene.walker, "actuation", None) is not None:  # the printed ones are passive
+    if scene.walker.actuation is not None:  # the printed ones are passive
         return own
     if scene.terrain is not None and not scene.terrain.is_slope:  # ... and on the slope
         return own

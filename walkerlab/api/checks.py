@@ -1,0 +1,152 @@
+"""The checks of the in-memory walker's arguments (:mod:`walkerlab.api.walker`,
+:mod:`walkerlab.api.targets`), each refusing a bad value in one line that names it, and the
+map's failures said in the walker's terms."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # pragma: no cover
+    from walkerlab.config import Scene
+
+__all__ = ["STEP_TIME_LIMIT_S", "check_target", "clear_step_failure", "positive", "short",
+           "simulate_options"]
+
+#: CPU time one walking step of the in-memory walker may take [s] (a map is one step, or a
+#: stride of two; :func:`walkerlab.integrate.time_limit.integration_time_limit`), as the gait
+#: search's budget (:data:`walkerlab.analysis.gait.poincare.ROOT_BUDGET_S`)
+STEP_TIME_LIMIT_S = 60.0
+
+
+def short(value) -> str:
+    """``repr(value)``, cut to 40 characters."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def positive(value, name: str) -> float:
+    """``value`` as a positive finite float, else one line naming ``name``."""
+    import math
+    import numbers
+
+    from walkerlab.config import SceneError
+
+    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+            or not math.isfinite(value) or value <= 0):
+        raise SceneError(f"{name}={short(value)}: give a positive number of seconds")
+    return float(value)
+
+
+def simulate_options(strides, sample_rate_hz) -> tuple[int, float]:
+    """``(strides, sample_rate_hz)`` checked by the ``simulate`` section's own fields
+    (whole strides from 1 to the cap, a positive rate up to its cap); one line each."""
+    import numbers
+
+    from pydantic import ValidationError
+
+    from walkerlab.config import SceneError
+    from walkerlab.config.studies import SimulateSettings
+
+    if isinstance(strides, bool) or not isinstance(strides, numbers.Integral):
+        raise SceneError(f"simulate: strides={short(strides)}: give a whole number of "
+                         "strides (an int, e.g. strides=10)")
+    if isinstance(sample_rate_hz, bool) or not isinstance(sample_rate_hz, numbers.Real):
+        raise SceneError(f"simulate: sample_rate_hz={short(sample_rate_hz)}: give a "
+                         "number of samples per second, e.g. 500")
+    try:
+        sim = SimulateSettings.model_validate({"strides": int(strides),
+                                               "sample_rate_hz": float(sample_rate_hz)})
+    except ValidationError as err:
+        e = err.errors()[0]
+        field = e["loc"][0]
+        value = strides if field == "strides" else sample_rate_hz
+        raise SceneError(f"simulate: {field}={short(value)}: {e['msg'].lower()} "
+                         f"(as simulate.{field})") from None
+    return sim.strides, sim.sample_rate_hz
+
+
+def clear_step_failure(exc, max_step_time: float):
+    """A :class:`StepFailed` of the map said in the walker's terms (one line: how the step
+    ended, when, and what to do), not in the integrator's."""
+    from walkerlab.analysis.gait.poincare import StepFailed
+
+    t = f"t = {exc.t:.4g} s"
+    why = {
+        "fall": f"the walker fell at {t}, before its heel strike (a fall guard fired): the "
+                "state is not on a walking gait; start from a gait (w.fixed_point().x) or "
+                "nearer to it",
+        "t_final": f"no heel strike within max_step_time_s = {max_step_time:g} s "
+                   "(fixedpoint.max_step_time_s): the walker stalled",
+        "solver_failure": f"the integrator stopped at {t}: "
+                          f"{' '.join(str(exc).split(' s ', 1)[-1].split())}",
+    }.get(exc.termination)
+    if why is None:
+        return exc
+    out = StepFailed(exc.termination, exc.t, exc.x)
+    out.args = (f"step: {why}",)
+    return out
+
+
+
+def check_target(scene: Scene, vary, target: dict) -> tuple[str, float]:
+    """The field and target of :meth:`walkerlab.api.walker.Walker.find_gait_for` (and
+    ``walkerlab target``) checked before any map.
+
+    Parameters
+    ----------
+    scene : walkerlab.config.Scene
+    vary : str
+        Dotted scene field to solve for.
+    target : dict
+        ``{measure: value}``, one of
+        :data:`walkerlab.analysis.continuation.target.MEASURES`.
+
+    Returns
+    -------
+    name : str
+        The measure (``speed_m_per_s``, ``step_length_m`` or ``step_period_s``).
+    value : float
+        The target [m/s, m or s].
+
+    Raises
+    ------
+    walkerlab.config.SceneError
+        Not exactly one known measure; a value that is not a positive finite number (a
+        speed, a step length and a step period are all > 0); ``vary`` not a string, a field
+        outside the ``walker`` and ``slope`` sections, a whole-number field or one whose
+        value is no number (one line each).
+    walkerlab.studies.params.SweepError
+        ``vary`` names no field of the scene (with the closest name).
+    """
+    import math
+    import numbers
+
+    from walkerlab.analysis.continuation.target import MEASURES
+    from walkerlab.config import SceneError
+    from walkerlab.studies.continuation import scene_family, scene_value
+    from walkerlab.studies.params import ParamAxis, takes_whole_numbers
+
+    if len(target) != 1 or next(iter(target)) not in MEASURES:
+        raise SceneError(f"target: give exactly one of {', '.join(MEASURES)} (got "
+                         f"{', '.join(target) or 'none'})")
+    (name, value), = target.items()
+    unit = MEASURES[name][1]
+    if (isinstance(value, bool) or not isinstance(value, numbers.Real)
+            or not math.isfinite(value) or value <= 0):
+        raise SceneError(f"target {name} (--{name.replace('_', '-')}) = {short(value)}: "
+                         f"give a positive finite number [{unit}]")
+    if not isinstance(vary, str) or not vary.startswith(("walker.", "slope.")):
+        raise SceneError(f"target --vary {short(vary)}: vary a numeric field of the walker "
+                         "or the slope (e.g. walker.actuation.push_off.impulse_n_s); the "
+                         "gait depends on no other section")
+    from walkerlab.studies.params import SweepError
+
+    try:
+        scene_family(scene, vary)  # an unknown field: SweepError with the closest name
+    except SweepError as exc:
+        raise SweepError(str(exc).replace("--param ", "target --vary ", 1)) from None
+    if takes_whole_numbers(scene, ParamAxis(vary, (), vary)):
+        raise SceneError(f"target --vary {vary}: the field takes whole numbers; a target is "
+                         "solved over a real-valued field")
+    scene_value(scene, vary)  # unset or not a number: one line
+    return name, float(value)

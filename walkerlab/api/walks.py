@@ -1,0 +1,263 @@
+"""The records of the in-memory walker's runs (:mod:`walkerlab.api.walker`): a rigid
+gait (:class:`Gait`), one step of the Poincaré map (:class:`Step`), a rigid walk
+(:class:`Walk`) and a walk of the contact view (:class:`ContactWalk`, with the step table's
+columns :data:`STEP_FIELDS`).  Plain frozen dataclasses: they hold arrays and numbers and run
+nothing."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # pragma: no cover
+    import numpy as np
+
+__all__ = ["STEP_FIELDS", "ContactWalk", "Gait", "Step", "Walk"]
+
+
+@dataclass(frozen=True)
+class Gait:
+    """A period-1 gait (fixed point of the Poincaré map), as ``walkerlab fixedpoint`` finds it.
+
+    Attributes
+    ----------
+    x : ndarray, shape (2n,)
+        State just after heel strike (role order of ``names``) [rad, rad/s].
+    names : tuple of str
+        State names (:meth:`~walkerlab.api.walker.Walker.state_names`).
+    step_period : float
+        Step period [s, or √(l/g) in a nondimensional scene]; for a walker whose legs
+        differ (a stride map), the mean of its two steps.
+    map_period : float
+        Period of the Poincaré map [s]: the step period, or the stride period.
+    multipliers : ndarray, shape (2n,), complex
+        Floquet multipliers (variational equations with saltation), by decreasing modulus.
+    jacobian : ndarray, shape (2n, 2n)
+        Jacobian of the Poincaré map at ``x``.
+    residual : float
+        max ``|P(x) - x|`` [state units].
+    label : str
+        Which gait of the search (``long_period``, ``short_period``, ...).
+    step_length : float
+        Mean step length [m]: stance foot to swing foot at heel strike
+        (:func:`walkerlab.analysis.gait.metrics.step_length`).
+    speed : float
+        Distance along the ground over the map's period [m/s].
+    cost_of_transport : float
+        Mean over the map's steps of (positive actuator work + push-off work + slope
+        energy if > 0) / (M g d) [-] (Kuo 2002; Collins et al. 2005); a passive gait's is
+        sin(slope).  NaN without a ledger (flat feet on legs that differ).
+    ledger : dict[str, ndarray (steps,)]
+        The energy ledger of each step of the map, as ``simulate.h5``'s ``ledger/``
+        (:func:`walkerlab.analysis.gait.energy.gait_ledger`): ``actuator_work_positive``,
+        ``actuator_work_negative``, ``push_off_work``, ``heel_strike_loss``,
+        ``internal_collision_loss``, ``damper_work``, ``potential_work``, ``energy_change``,
+        ``closure``, ``slope_energy`` [J], ``push_off_impulse`` [N s],
+        ``cost_of_transport`` [-].
+    """
+
+    x: np.ndarray
+    names: tuple
+    step_period: float
+    map_period: float
+    multipliers: np.ndarray
+    jacobian: np.ndarray
+    residual: float
+    label: str
+    step_length: float = float("nan")
+    speed: float = float("nan")
+    cost_of_transport: float = float("nan")
+    ledger: dict = field(default_factory=dict)
+
+    @property
+    def state(self) -> dict[str, float]:
+        """The fixed point by state name."""
+        return {n: float(v) for n, v in zip(self.names, self.x)}
+
+    @property
+    def stable(self) -> bool:
+        """All ``|Floquet multipliers|`` < 1."""
+        import numpy as np
+
+        return bool(np.max(np.abs(self.multipliers)) < 1.0)
+
+
+@dataclass(frozen=True)
+class Step:
+    """One application of the Poincaré map (a step, or a stride when the legs differ).
+
+    Attributes
+    ----------
+    x_next : ndarray, shape (2n,)
+        State just after the last heel strike.
+    period : float
+        Duration [s].
+    events : list of (str, float, float, str)
+        Each phase of each step: ``(phase, t_start [s], t_end [s], guard that ended it)``.
+    """
+
+    x_next: np.ndarray
+    period: float
+    events: list
+
+
+@dataclass(frozen=True)
+class Walk:
+    """A simulated walk.
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Sample times [s].
+    x : ndarray, shape (m, 2n)
+        Role-ordered states at ``t`` (roles swap at every heel strike).
+    stance_leg : ndarray, shape (m,), str
+        Physical leg in stance at each sample.
+    heel_strikes : ndarray, shape (k,)
+        Times of the heel strikes [s].
+    events : list of (int, str, str, float, float, str)
+        ``(step, stance leg, phase, t_start, t_end, guard)`` of every phase.
+    termination : str
+        How the walk ended (``heel_strike`` after the last step, ``fall``, ...).
+    steps : dict[str, ndarray (k,)]
+        The step table of the ``simulate`` stage
+        (:func:`walkerlab.analysis.gait.metrics.step_table`): ``period`` [s],
+        ``step_length`` [m], ``hip_speed`` [m/s], ``impact_energy_loss`` [J],
+        ``termination``, ``stance_leg`` ... of each step (the last one may have fallen).
+    ledger : dict[str, ndarray (k,)]
+        The energy ledger of each step, as :attr:`Gait.ledger` (NaN for a step that did
+        not end by a heel strike; empty for flat feet on legs that differ).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    stance_leg: np.ndarray
+    heel_strikes: np.ndarray
+    events: list
+    termination: str
+    steps: dict = field(default_factory=dict)
+    ledger: dict = field(default_factory=dict)
+
+    @property
+    def step_length(self) -> np.ndarray:
+        """Length of each step [m] (``steps["step_length"]``)."""
+        return self.steps["step_length"]
+
+    @property
+    def speed(self) -> np.ndarray:
+        """Hip speed of each step [m/s] (``steps["hip_speed"]``)."""
+        return self.steps["hip_speed"]
+
+    @property
+    def cost_of_transport(self) -> np.ndarray:
+        """Cost of transport of each step [-] (``ledger["cost_of_transport"]``)."""
+        return self.ledger["cost_of_transport"]
+
+
+
+@dataclass(frozen=True)
+class ContactWalk:
+    """A walk of the contact walker (:meth:`~walkerlab.api.walker.ContactWalker.simulate`),
+    as the ``contact-sim`` stage records it (units named in SI; in a ``units:
+    nondimensional`` scene every quantity is in the walker's own units, time in √(l/g), as
+    :class:`Walk`'s).
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Sample times [s] (at ``contact_sim.sample_rate_hz``; the last one is the event time
+        if an event ended the run).
+    x : ndarray, shape (m, N)
+        States of the floating walker, columns named by ``state_names`` [m, rad, m/s, rad/s].
+    state_names : tuple of str
+        The contact walker's state names (:meth:`~walkerlab.api.walker.ContactWalker.state_names`).
+    heel_strikes : ndarray, shape (k,)
+        Heel-strike times [s] (touchdowns of the swing foot ahead of the stance foot).
+    heel_strike_legs : tuple of str
+        Leg that struck at each heel strike.
+    steps : dict[str, ndarray (s,)]
+        The step table of ``contact_sim.h5``'s ``steps/``: ``t_start``, ``t_end``, ``period``
+        [s], ``stance_leg``, ``stance_slip_mm`` [mm], ``double_support_creep_mm`` [mm],
+        ``bounce_count``, ``scuff_count``, ``peak_penetration_m`` [m], ``liftoff_time`` [s],
+        ``stance_slip_path_mm`` [mm], ``friction_work_j`` [J].
+    normal_force, friction_force : dict[str, ndarray (m,)]
+        IMPACT normal force and Coulomb friction (down-slope) [N] at each contact point, by
+        its name (:meth:`~walkerlab.api.walker.ContactWalker.contact_names`: ``leg1``,
+        ``leg2``; flat feet ``leg1_heel``, ``leg1_toe``, ...).
+    penetration : dict[str, ndarray (m,)]
+        Signed penetration of each contact point [m] (< 0: above the ground).
+    termination : str
+        How the integration stopped (:mod:`walkerlab.integrate.ends`: ``heel_strike`` when
+        the strides asked for were made, ``t_final``, ``trip``, ``fall``, ...).
+    outcome : str
+        The run's verdict (``termination``, or ``slip``, ``scuff``, ``no_heel_strike``).
+    message : str
+        The outcome in one line.
+    walks : bool
+        The walker walked the run (:attr:`~walkerlab.analysis.contact.gait.ContactResult.verdict`).
+    x0 : ndarray, shape (N,)
+        The initial state [m, rad, m/s, rad/s].
+    x_ideal : ndarray, shape (2n,)
+        The rigid state the run started from (rigid role order) [rad, rad/s].
+    initial_rate_scale : ndarray, shape (2,)
+        Multipliers on the (swing, stance) rates of ``x_ideal`` [-].
+    step_length_m : float
+        Spacing of the terrain's patches [m] (the ideal step length, or the periodic gait's).
+    gait : walkerlab.analysis.contact.periodic.ContactPeriodicGait or None
+        The periodic gait the run started from (``contact_sim.start: periodic_gait``).
+    work : dict[str, ndarray (m,)]
+        A powered walker's work integrals since the start [J], by name
+        (``hip_torque_positive``, ``push_off``, ``contact``, ...); empty when passive.
+    step_ledger : dict[str, ndarray]
+        A powered walker's energy ledger per step
+        (:func:`walkerlab.analysis.contact.ledger.contact_step_ledger`); empty when passive.
+    result : walkerlab.analysis.contact.gait.ContactResult
+        The library's whole result (feet traces, touchdowns, counters).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    state_names: tuple
+    heel_strikes: np.ndarray
+    heel_strike_legs: tuple
+    steps: dict
+    normal_force: dict
+    friction_force: dict
+    penetration: dict
+    termination: str
+    outcome: str
+    message: str
+    walks: bool
+    x0: np.ndarray
+    x_ideal: np.ndarray
+    initial_rate_scale: np.ndarray
+    step_length_m: float
+    gait: Any = None
+    work: dict = field(default_factory=dict)
+    step_ledger: dict = field(default_factory=dict)
+    result: Any = None
+
+    @property
+    def step_periods(self) -> np.ndarray:
+        """Period of each step [s] (``steps["period"]``)."""
+        return self.steps["period"]
+
+    def column(self, name: str) -> np.ndarray:
+        """One state's samples (m,) by name (``walk.column("hip_x")``).
+
+        Raises
+        ------
+        KeyError
+            No state of that name (the message lists the names).
+        """
+        if name not in self.state_names:
+            raise KeyError(f"no state {name!r}; the contact walker's states are "
+                           f"{', '.join(self.state_names)}")
+        return self.x[:, self.state_names.index(name)]
+
+
+#: the step table's columns (the ``steps/`` group of ``contact_sim.h5``)
+STEP_FIELDS = ("t_start", "t_end", "period", "stance_slip_mm", "double_support_creep_mm",
+                "bounce_count", "scuff_count", "peak_penetration_m", "liftoff_time",
+                "stance_slip_path_mm", "friction_work_j")
+
